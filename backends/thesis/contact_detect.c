@@ -1,0 +1,72 @@
+/* Contact detection between the body (a disk of radius R about C) and a
+ * beam (the segment P .. P + L u). MODEL.md section 3.
+ *
+ *   s = clamp((C - P) . u, 0, L),  Q = P + s u,  gap = |C - Q| - R
+ *   tangent (0 < s < L):  n = +-perp(u) toward the body, lever a = s u
+ *   tip (s = L):          n = (C - Q) / |C - Q|,          lever a = L u
+ *   pivot end (s = 0):    n = (C - P) / |C - P|,          lever a = 0
+ *   c = sgn (a x n),  v_rel = v . n - omega c
+ *
+ * Every expression is written so that mirroring the scene in x (x -> -x,
+ * sgn -> -sgn) mirrors each intermediate value bit for bit (MODEL.md
+ * oracle 4): products and sums keep the same operands in the same order. */
+#include <math.h>
+
+#include "thesis/thesis.h"
+
+void thesis_beam_direction(const thesis_beam *b, double u[2])
+{
+	double cs = cos(b->theta), sn = b->sgn * sin(b->theta);
+	u[0] = b->u0[0] * cs - b->u0[1] * sn;
+	u[1] = b->u0[1] * cs + b->u0[0] * sn;
+}
+
+int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out)
+{
+	const thesis_beam *b = &w->beams[i];
+	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+	double reach = b->length + w->radius + margin;
+	if (dx * dx + dy * dy > reach * reach)
+		return 0; /* outside the beam's disc: no trigonometry needed */
+
+	double u[2];
+	thesis_beam_direction(b, u);
+	double s = dx * u[0] + dy * u[1];
+	double n[2], a[2], dist;
+	if (s > 0.0 && s < b->length) {
+		double cross = u[0] * dy - u[1] * dx; /* u x (C - P) */
+		double side = cross >= 0.0 ? 1.0 : -1.0;
+		dist = fabs(cross);
+		n[0] = -side * u[1];
+		n[1] = side * u[0];
+		a[0] = s * u[0];
+		a[1] = s * u[1];
+		out->type = BSIM_CONTACT_TANGENT;
+	} else {
+		double l = s > 0.0 ? b->length : 0.0;
+		a[0] = l * u[0];
+		a[1] = l * u[1];
+		double qx = dx - a[0], qy = dy - a[1];
+		dist = sqrt(qx * qx + qy * qy);
+		if (dist == 0.0)
+			return 0; /* centre on the segment's end: no normal */
+		n[0] = qx / dist;
+		n[1] = qy / dist;
+		out->type = BSIM_CONTACT_TIP;
+	}
+	out->gap = dist - w->radius;
+	if (out->gap > margin)
+		return 0;
+	out->beam = i;
+	out->n[0] = n[0];
+	out->n[1] = n[1];
+	out->c = b->sgn * (a[0] * n[1] - a[1] * n[0]);
+	out->e = out->type == BSIM_CONTACT_TIP ? w->e_tip : w->e_tangent;
+	out->impulse = 0.0;
+	return 1;
+}
+
+void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c)
+{
+	c->vrel = (w->v[0] * c->n[0] + w->v[1] * c->n[1]) - w->beams[c->beam].omega * c->c;
+}

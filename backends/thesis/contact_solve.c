@@ -1,0 +1,85 @@
+/* One step of smooth motion with persistent contacts: the essay's constraint
+ * method (MODEL.md section 5) in velocity form.
+ *
+ * Free velocities over the step: v* = v + h F / M, omega*_i from the beam
+ * integrator. Contact impulses P_i >= 0 then give
+ *   v' = v* + sum_i P_i n_i / M,   omega'_i = omega*_i - P_i c_i / (I_i D_i).
+ * Positions move with the mean velocity (midpoint), so the gap changes by
+ * h (v_rel + v_rel') / 2 to first order. Requiring the gap to stay >= 0,
+ *   v_rel' >= -v_rel - 2 max(gap, 0) / h   (euler: v_rel' >= -max(gap, 0)/h),
+ * with P_i (v_rel' - bound) = 0, is a complementarity problem; for a
+ * touching contact at rest (gap 0, v_rel 0) it is v_rel' >= 0: the two bodies
+ * share the normal velocity while lambda = P / h >= 0 (essay Eqs. 2.10-2.13,
+ * whose curvature terms enter here through the geometry of the next step),
+ * and a contact whose free motion separates gets P = 0 and detaches. A
+ * contact still some way off is included too (speculative), so no step can
+ * carry the body through a beam.
+ *
+ * Ledger: with midpoint positions the body's kinetic energy changes by
+ * exactly F . dx + sum P_i n_i . v_m, a beam's energy by -h d omega_m^2 -
+ * P_i c_i omega_m; the contact forces' work sum P_i (n_i . v_m - c_i
+ * omega_m,i) is reported, negated, as energy.contact. */
+#include <math.h>
+
+#include "thesis/thesis.h"
+
+void thesis_contact_solve(struct bsim_world *w, const double force[2], double h)
+{
+	double v0[2] = {w->v[0], w->v[1]};
+	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
+	thesis_contact *cs = w->contacts;
+	int n = w->n_contacts;
+
+	for (int k = 0; k < n; k++) {
+		thesis_contact *c = &cs[k];
+		const thesis_beam *b = &w->beams[c->beam];
+		double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
+		double omega_free = thesis_beam_free_omega(b, h, w->integrator);
+		double gap = fmax(c->gap, 0.0);
+		c->inv_i = thesis_beam_response(b, h, w->integrator);
+		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - omega_free * c->c;
+		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
+	}
+	thesis_lcp_solve(w, cs, n);
+
+	double jx = 0.0, jy = 0.0;
+	if (n == 2) { /* one expression for a pair: a mirrored pair sums alike */
+		jx = cs[0].impulse * cs[0].n[0] + cs[1].impulse * cs[1].n[0];
+		jy = cs[0].impulse * cs[0].n[1] + cs[1].impulse * cs[1].n[1];
+	} else {
+		for (int k = 0; k < n; k++) {
+			jx += cs[k].impulse * cs[k].n[0];
+			jy += cs[k].impulse * cs[k].n[1];
+		}
+	}
+	w->v[0] = vf[0] + jx * w->inv_mass;
+	w->v[1] = vf[1] + jy * w->inv_mass;
+	double vm[2] = {0.5 * (v0[0] + w->v[0]), 0.5 * (v0[1] + w->v[1])};
+	if (w->integrator == THESIS_EULER) {
+		vm[0] = w->v[0];
+		vm[1] = w->v[1];
+	}
+	w->x[0] += h * vm[0];
+	w->x[1] += h * vm[1];
+
+	/* Beams in contact take their impulse; all others move freely. A beam
+	 * at rest and untouched stays at rest and costs nothing. */
+	for (int k = 0; k < n; k++)
+		w->contact_of[cs[k].beam] = k;
+	for (int i = 0; i < w->n_beams; i++) {
+		thesis_beam *b = &w->beams[i];
+		int k = w->contact_of[i];
+		w->contact_of[i] = -1;
+		if (k < 0 && b->theta == 0.0 && b->omega == 0.0)
+			continue;
+		double omega_new = thesis_beam_free_omega(b, h, w->integrator);
+		if (k >= 0) {
+			omega_new -= cs[k].impulse * cs[k].c * cs[k].inv_i;
+			double omega_m = w->integrator == THESIS_EULER ? omega_new
+								       : 0.5 * (b->omega + omega_new);
+			w->energy.contact -= cs[k].impulse *
+					     ((cs[k].n[0] * vm[0] + cs[k].n[1] * vm[1]) - cs[k].c * omega_m);
+		}
+		w->energy.damper += thesis_beam_advance(b, omega_new, h, w->integrator);
+	}
+}

@@ -1,0 +1,99 @@
+/* Impacts: the essay's collision method (MODEL.md section 4).
+ *
+ * A contact that touches, or will touch within this step (gap + h v_rel <=
+ * slop), and approaches (v_rel < 0) takes an instantaneous frictionless
+ * impulse along n. With the effective mass 1/m_eff = 1/M + c^2/I,
+ *   J = -(1 + e) m_eff v_rel,  v += J n / M,  omega -= J c / I,
+ * which reverses v_rel scaled by e and conserves the angular momentum of
+ * body and beam about the pivot (essay Eqs. 2.4-2.9). Restitution is e for
+ * tangent contacts and tip_restitution for tip contacts. An approach slower
+ * than rest_threshold gets e = 0: the contact turns persistent (essay
+ * Sec. 2.4); its velocity jump is the plastic impulse rather than the
+ * essay's bare reset of omega, so momentum stays conserved.
+ *
+ * Several contacts at once: simultaneous (default) solves all impulses as
+ * one complementarity problem with the bound v_rel+ >= -e v_rel- (exactly
+ * mirror symmetric); nearest_first is the essay's order: the contact with
+ * the smaller gap first, then the others, repeated while any approaches. */
+#include <math.h>
+#include <stddef.h>
+
+#include "thesis/thesis.h"
+
+static void impact_bounds(const struct bsim_world *w, thesis_contact *c)
+{
+	c->bound = c->vrel < -w->rest_threshold ? -c->e * c->vrel : 0.0;
+}
+
+static void impact_apply(struct bsim_world *w, const thesis_contact *cs, int n)
+{
+	double jx = 0.0, jy = 0.0;
+	if (n == 2) { /* one expression for a pair: a mirrored pair sums alike */
+		jx = cs[0].impulse * cs[0].n[0] + cs[1].impulse * cs[1].n[0];
+		jy = cs[0].impulse * cs[0].n[1] + cs[1].impulse * cs[1].n[1];
+	} else {
+		for (int i = 0; i < n; i++) {
+			jx += cs[i].impulse * cs[i].n[0];
+			jy += cs[i].impulse * cs[i].n[1];
+		}
+	}
+	w->v[0] += jx * w->inv_mass;
+	w->v[1] += jy * w->inv_mass;
+	for (int i = 0; i < n; i++) {
+		thesis_beam *b = &w->beams[cs[i].beam];
+		b->omega -= cs[i].impulse * cs[i].c / b->inertia;
+	}
+}
+
+/* The essay's order: one contact at a time, nearest first. */
+static void impact_nearest_first(struct bsim_world *w, thesis_contact *cs, int n)
+{
+	for (int pass = 0; pass < 100; pass++) {
+		thesis_contact *next = NULL;
+		for (int i = 0; i < n; i++) {
+			thesis_contact_velocity(w, &cs[i]);
+			if (cs[i].vrel < 0.0 && (!next || cs[i].gap < next->gap))
+				next = &cs[i];
+		}
+		if (!next)
+			return;
+		impact_bounds(w, next);
+		thesis_lcp_solve(w, next, 1);
+		impact_apply(w, next, 1);
+		if (next->impulse > 0.0 && next->bound > 0.0)
+			w->impacts++;
+	}
+}
+
+int thesis_impact_resolve(struct bsim_world *w, double h)
+{
+	/* The touching contacts go to the front of the list. */
+	thesis_contact *cs = w->contacts;
+	int n = 0, approaching = 0;
+	for (int i = 0; i < w->n_contacts; i++) {
+		thesis_contact c = cs[i];
+		thesis_contact_velocity(w, &c);
+		if (c.gap + h * fmin(c.vrel, 0.0) > w->slop)
+			continue;
+		c.inv_i = 1.0 / w->beams[c.beam].inertia;
+		approaching |= c.vrel < 0.0;
+		cs[i] = cs[n];
+		cs[n++] = c;
+	}
+	if (!approaching)
+		return 0;
+
+	double ke = thesis_kinetic_energy(w);
+	if (w->impact_order == THESIS_NEAREST_FIRST) {
+		impact_nearest_first(w, cs, n);
+	} else {
+		for (int i = 0; i < n; i++)
+			impact_bounds(w, &cs[i]);
+		thesis_lcp_solve(w, cs, n);
+		impact_apply(w, cs, n);
+		for (int i = 0; i < n; i++)
+			w->impacts += cs[i].impulse > 0.0 && cs[i].bound > 0.0;
+	}
+	w->energy.impact += ke - thesis_kinetic_energy(w);
+	return 1;
+}

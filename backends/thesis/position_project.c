@@ -1,0 +1,64 @@
+/* Position projection: keeps the drift of persistent contacts bounded
+ * (MODEL.md section 5).
+ *
+ * The velocity-level contact holds v_rel = 0, but the contact geometry
+ * turns within a step, so a gap drifts at second order (about h^2 v^2 / R
+ * per step). After the step, contacts that penetrate by more than slop are
+ * pushed apart with position impulses mu_i >= 0 that solve the same
+ * complementarity problem as impacts, on positions:
+ *   gap_i + sum_j K_ij mu_j >= 0,   dx = sum mu_i n_i / M,   dtheta_i = -mu_i c_i / I_i.
+ * Velocities are untouched, so no energy is injected into the motion; the
+ * springs' energy change, and the work the runner credits to the external
+ * force over the shift dx, are reported as energy.correction. */
+#include "thesis/thesis.h"
+
+static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const double force[2])
+{
+	for (int k = 0; k < n; k++) {
+		cs[k].vrel = cs[k].gap;
+		cs[k].bound = 0.0;
+		cs[k].inv_i = 1.0 / w->beams[cs[k].beam].inertia;
+	}
+	thesis_lcp_solve(w, cs, n);
+	double dx = 0.0, dy = 0.0, de = 0.0;
+	for (int k = 0; k < n; k++) {
+		thesis_beam *b = &w->beams[cs[k].beam];
+		double theta = b->theta - cs[k].impulse * cs[k].c * cs[k].inv_i;
+		de += 0.5 * b->stiffness * (theta * theta - b->theta * b->theta);
+		b->theta = theta;
+		dx += cs[k].impulse * cs[k].n[0];
+		dy += cs[k].impulse * cs[k].n[1];
+	}
+	dx *= w->inv_mass;
+	dy *= w->inv_mass;
+	w->x[0] += dx;
+	w->x[1] += dy;
+	w->energy.correction += (force[0] * dx + force[1] * dy) - de;
+}
+
+/* Re-detects the step's contacts at the new positions (they are the only
+ * beams the step could have reached) and projects out penetration. */
+void thesis_position_project(struct bsim_world *w, const double force[2])
+{
+	double margin = w->contact_tol;
+	thesis_contact *cs = w->contacts;
+	int n = 0;
+	for (int k = 0; k < w->n_contacts; k++)
+		n += thesis_contact_detect(w, cs[k].beam, margin, &cs[n]);
+	for (int pass = 0; w->projection && pass < 3; pass++) {
+		int deep = 0;
+		for (int k = 0; k < n; k++)
+			deep |= cs[k].gap < -w->slop;
+		if (!deep)
+			break;
+		project_once(w, cs, n, force);
+		int m = 0;
+		for (int k = 0; k < n; k++)
+			m += thesis_contact_detect(w, cs[k].beam, margin, &cs[m]);
+		n = m;
+	}
+	w->n_contacts = n;
+	for (int k = 0; k < n; k++)
+		if (cs[k].gap <= w->contact_tol)
+			w->contact_type[cs[k].beam] = cs[k].type;
+}

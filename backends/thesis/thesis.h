@@ -1,0 +1,90 @@
+/* The essay's collision + constraint solver ("thesis" backend): internal
+ * types shared by its files. MODEL.md sections 2-5.
+ *
+ * Sign conventions. Beam i turns about its pivot P_i; theta_i > 0 swings the
+ * tip forward (+y). Its direction is u = R(sgn * theta) u0, with u0 the rest
+ * direction and sgn = +1 if the forward swing is counter-clockwise (a beam
+ * pointing right, like the left beam) and -1 otherwise. For a contact with
+ * unit normal n (beam -> body) at lever a = Q - P, the generalised lever is
+ * c = sgn (a x n): the body's normal velocity gains P/M per impulse P and
+ * the beam's omega loses P c / I, and v_rel = v . n - omega c. */
+#ifndef BSIM_THESIS_H
+#define BSIM_THESIS_H
+
+#include "beamsim/backend.h"
+
+typedef struct thesis_beam {
+	double p[2];      /* pivot, m */
+	double u0[2];     /* rest direction, exact for multiples of 90 degrees */
+	double sgn;       /* +1: forward swing is counter-clockwise */
+	double length;    /* m */
+	double inertia;   /* kg m^2 about the pivot */
+	double stiffness; /* N m/rad */
+	double damping;   /* N m s/rad */
+	double theta;     /* rad */
+	double omega;     /* rad/s */
+} thesis_beam;
+
+typedef struct thesis_contact {
+	int beam;
+	int type;      /* BSIM_CONTACT_TANGENT or BSIM_CONTACT_TIP */
+	double gap;    /* distance to the segment minus R, m (< 0: penetration) */
+	double n[2];   /* unit normal from the beam toward the body */
+	double c;      /* generalised lever sgn (a x n), m */
+	double inv_i;  /* 1/I for impacts and projection, 1/(I D) in a step */
+	double e;      /* restitution of this contact */
+	double vrel;   /* relative normal velocity, m/s (< 0: approaching) */
+	double bound;  /* lower bound on the solved velocity, m/s */
+	double impulse; /* N s */
+} thesis_contact;
+
+enum { THESIS_MIDPOINT = 0, THESIS_EULER = 1 };
+enum { THESIS_SIMULTANEOUS = 0, THESIS_NEAREST_FIRST = 1 };
+
+struct bsim_world {
+	double x[2], v[2]; /* body centre and velocity */
+	double mass, inv_mass, radius;
+	int n_beams;
+	thesis_beam *beams;
+	double e_tangent, e_tip; /* restitution */
+	double rest_threshold;   /* m/s */
+	/* knobs */
+	int integrator, impact_order, projection;
+	double slop;        /* penetration tolerated before projection, m */
+	double contact_tol; /* gap counted as touching in the state, m */
+	/* per step */
+	thesis_contact *contacts; /* n_beams capacity */
+	int n_contacts;
+	int *contact_of;   /* per beam: its index in contacts, or -1 */
+	int *contact_type; /* per beam, at the end of the step */
+	bsim_step_energy energy;
+	int impacts;
+};
+
+/* contact_detect.c */
+void thesis_beam_direction(const thesis_beam *b, double u[2]);
+int thesis_contact_detect(const struct bsim_world *w, int i, double margin,
+			  thesis_contact *out);
+void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c);
+
+/* lcp_solve.c */
+void thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n);
+
+/* impact_resolve.c */
+int thesis_impact_resolve(struct bsim_world *w, double h);
+
+/* beam_integrate.c */
+double thesis_beam_response(const thesis_beam *b, double h, int integrator);
+double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator);
+double thesis_beam_advance(thesis_beam *b, double omega_new, double h, int integrator);
+
+/* contact_solve.c */
+void thesis_contact_solve(struct bsim_world *w, const double force[2], double h);
+
+/* position_project.c */
+void thesis_position_project(struct bsim_world *w, const double force[2]);
+
+/* the kinetic energy of body and beams, J */
+double thesis_kinetic_energy(const struct bsim_world *w);
+
+#endif

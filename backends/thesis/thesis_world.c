@@ -1,0 +1,186 @@
+/* The thesis backend: world creation, state access, knobs, and the order of
+ * one step (MODEL.md sections 3-5):
+ *   1. detect the contacts the step can reach (speculative margin);
+ *   2. impacts of approaching contacts (restitution, or plastic below
+ *      rest_threshold);
+ *   3. smooth motion under the external force, springs, dampers and
+ *      persistent contact forces;
+ *   4. projection of any penetration left by the contacts' curvature. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "thesis/thesis.h"
+
+static const bsim_knob thesis_knobs[] = {
+	{"integrator", BSIM_KNOB_CHOICE, "midpoint", "midpoint|euler",
+	 "beam and body update: implicit midpoint (A-stable, exact energy ledger) or "
+	 "semi-implicit Euler"},
+	{"impact_order", BSIM_KNOB_CHOICE, "simultaneous", "simultaneous|nearest_first",
+	 "impacts with both beams: one complementarity solve, or the essay's nearest-first order"},
+	{"projection", BSIM_KNOB_INT, "1", NULL,
+	 "1: project out penetration deeper than slop after each step; 0: leave it"},
+	{"slop", BSIM_KNOB_DOUBLE, "1e-6", NULL, "penetration tolerated before projection, m"},
+	{"contact_tol", BSIM_KNOB_DOUBLE, "1e-3", NULL,
+	 "gap below which a beam is reported as touching the body, m"},
+};
+enum { KNOB_INTEGRATOR, KNOB_IMPACT_ORDER, KNOB_PROJECTION, KNOB_SLOP, KNOB_CONTACT_TOL };
+#define N_KNOBS ((int)(sizeof thesis_knobs / sizeof thesis_knobs[0]))
+
+/* The rest direction, exact at multiples of 90 degrees so that a mirrored
+ * beam (0 vs 180 degrees) is mirrored bit for bit. */
+static void rest_direction(double deg, double u[2])
+{
+	double q = deg / 90.0;
+	if (q == floor(q)) {
+		static const double c[4] = {1, 0, -1, 0}, s[4] = {0, 1, 0, -1};
+		long k = ((long)q % 4 + 4) % 4;
+		u[0] = c[k];
+		u[1] = s[k];
+		return;
+	}
+	const double rad = deg * 0.017453292519943295; /* pi / 180 */
+	u[0] = cos(rad);
+	u[1] = sin(rad);
+}
+
+static void thesis_destroy(bsim_world *w)
+{
+	if (!w)
+		return;
+	free(w->beams);
+	free(w->contacts);
+	free(w->contact_of);
+	free(w->contact_type);
+	free(w);
+}
+
+static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
+			 bsim_error *err)
+{
+	*out = NULL;
+	int rc = bsim_options_check(opts, thesis_knobs, N_KNOBS, "thesis", err);
+	if (rc)
+		return rc;
+	bsim_world *w = calloc(1, sizeof *w);
+	size_t nb = scene->n_beams > 0 ? (size_t)scene->n_beams : 1;
+	if (w) {
+		w->beams = calloc(nb, sizeof *w->beams);
+		w->contacts = calloc(nb, sizeof *w->contacts);
+		w->contact_of = malloc(nb * sizeof *w->contact_of);
+		w->contact_type = calloc(nb, sizeof *w->contact_type);
+	}
+	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type) {
+		thesis_destroy(w);
+		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
+	}
+	memcpy(w->x, scene->body.start, sizeof w->x);
+	memcpy(w->v, scene->body.velocity, sizeof w->v);
+	w->mass = scene->body.mass;
+	w->inv_mass = 1.0 / scene->body.mass;
+	w->radius = scene->body.radius;
+	w->n_beams = scene->n_beams;
+	for (int i = 0; i < scene->n_beams; i++) {
+		const bsim_beam_def *d = &scene->beams[i];
+		thesis_beam *b = &w->beams[i];
+		memcpy(b->p, d->pivot, sizeof b->p);
+		rest_direction(d->rest_angle_deg, b->u0);
+		b->sgn = b->u0[0] >= 0.0 ? 1.0 : -1.0; /* forward = toward +y */
+		b->length = d->length;
+		b->inertia = d->inertia;
+		b->stiffness = d->stiffness;
+		b->damping = d->damping;
+		b->theta = d->initial_theta;
+		b->omega = d->initial_omega;
+		w->contact_of[i] = -1;
+	}
+	w->e_tangent = scene->contact.restitution;
+	w->e_tip = scene->contact.tip_restitution;
+	w->rest_threshold = scene->contact.rest_threshold;
+	w->integrator = bsim_options_choice(opts, &thesis_knobs[KNOB_INTEGRATOR]);
+	w->impact_order = bsim_options_choice(opts, &thesis_knobs[KNOB_IMPACT_ORDER]);
+	w->projection = bsim_options_int(opts, &thesis_knobs[KNOB_PROJECTION]) != 0;
+	w->slop = bsim_options_double(opts, &thesis_knobs[KNOB_SLOP]);
+	w->contact_tol = fmax(bsim_options_double(opts, &thesis_knobs[KNOB_CONTACT_TOL]), w->slop);
+	*out = w;
+	return BSIM_OK;
+}
+
+double thesis_kinetic_energy(const bsim_world *w)
+{
+	double e = 0.5 * w->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);
+	for (int i = 0; i < w->n_beams; i++)
+		e += 0.5 * w->beams[i].inertia * w->beams[i].omega * w->beams[i].omega;
+	return e;
+}
+
+/* How far beam i and the body can close on each other within the step, with
+ * a factor 2 of safety: body and tip speeds, and what the force and the
+ * spring add over the step. Contacts within it enter the step's solve. */
+static double step_margin(const bsim_world *w, const thesis_beam *b, double speed, double h)
+{
+	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
+		       b->inertia;
+	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
+}
+
+static void thesis_step(bsim_world *w, const double force[2], double h)
+{
+	memset(&w->energy, 0, sizeof w->energy);
+	w->impacts = 0;
+	double speed = hypot(w->v[0], w->v[1]) + h * hypot(force[0], force[1]) * w->inv_mass;
+	int n = 0;
+	for (int i = 0; i < w->n_beams; i++) {
+		w->contact_type[i] = BSIM_CONTACT_NONE;
+		n += thesis_contact_detect(w, i, step_margin(w, &w->beams[i], speed, h),
+					   &w->contacts[n]);
+	}
+	w->n_contacts = n;
+	if (n)
+		thesis_impact_resolve(w, h);
+	thesis_contact_solve(w, force, h);
+	if (n)
+		thesis_position_project(w, force);
+}
+
+static void thesis_get_state(const bsim_world *w, bsim_state *s)
+{
+	memcpy(s->x, w->x, sizeof s->x);
+	memcpy(s->v, w->v, sizeof s->v);
+	int n = s->n_beams < w->n_beams ? s->n_beams : w->n_beams;
+	for (int i = 0; i < n; i++) {
+		s->theta[i] = w->beams[i].theta;
+		s->omega[i] = w->beams[i].omega;
+		s->contact[i] = w->contact_type[i];
+	}
+	s->energy = w->energy;
+	s->impacts = w->impacts;
+}
+
+static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
+{
+	if (s->n_beams != w->n_beams)
+		return bsim_error_set(err, BSIM_EINPUT, "thesis: state has %d beams, world has %d",
+				      s->n_beams, w->n_beams);
+	memcpy(w->x, s->x, sizeof w->x);
+	memcpy(w->v, s->v, sizeof w->v);
+	for (int i = 0; i < w->n_beams; i++) {
+		w->beams[i].theta = s->theta[i];
+		w->beams[i].omega = s->omega[i];
+		w->contact_type[i] = s->contact[i];
+	}
+	return BSIM_OK;
+}
+
+const bsim_backend bsim_backend_thesis = {
+	.name = "thesis",
+	.description = "the essay's collision + constraint solver: impulses with restitution, "
+		       "persistent contact by complementarity, implicit beam springs",
+	.knobs = thesis_knobs,
+	.n_knobs = N_KNOBS,
+	.create = thesis_create,
+	.destroy = thesis_destroy,
+	.step = thesis_step,
+	.get_state = thesis_get_state,
+	.set_state = thesis_set_state,
+};

@@ -1,0 +1,50 @@
+/* The effect pipeline (DESIGN.md "Effects"): built once from the scene's
+ * list; an effect that is not listed is not in the pipeline at all, so it
+ * costs nothing per step and a scene without random force never draws. */
+#ifndef BEAMSIM_EFFECTS_H
+#define BEAMSIM_EFFECTS_H
+
+#include <stdint.h>
+
+#include "beamsim/scene.h"
+#include "beamsim/schedule.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define BSIM_EFFECTS_MAX 8
+
+typedef struct bsim_effect {
+	const char *name;
+	/* Adds this effect's force on the body (N) at step n into f. */
+	void (*apply)(struct bsim_effect *e, long n, double h, double f[2]);
+	double param;            /* force or magnitude, N */
+	bsim_schedule *schedule; /* random_force only */
+	double last;             /* last force value applied along its axis, N */
+} bsim_effect;
+
+typedef struct bsim_effects {
+	int n;
+	bsim_effect e[BSIM_EFFECTS_MAX];
+	bsim_effect *random; /* the random-force effect, or NULL */
+} bsim_effects;
+
+/* Builds the pipeline from scene->effects; seed is the trial's mixed seed. */
+int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed);
+void bsim_effects_free(bsim_effects *fx);
+
+/* Sum of all effects' forces on the body at step n. */
+static inline void bsim_effects_force(bsim_effects *fx, long n, double h,
+				      double f[2])
+{
+	f[0] = 0.0;
+	f[1] = 0.0;
+	for (int i = 0; i < fx->n; i++)
+		fx->e[i].apply(&fx->e[i], n, h, f);
+}
+
+#ifdef __cplusplus
+}
+#endif
+#endif

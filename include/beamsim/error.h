@@ -1,0 +1,35 @@
+/* Error codes and messages: every fallible call returns a code and fills a
+ * bsim_error with one readable line (file, line, field, what was expected). */
+#ifndef BEAMSIM_ERROR_H
+#define BEAMSIM_ERROR_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The codes double as the program's exit status (DESIGN.md "Command line"). */
+enum {
+	BSIM_OK = 0,
+	BSIM_EFAIL = 1,     /* a run failed (I/O, a non-finite state, ...) */
+	BSIM_EINPUT = 2,    /* bad usage, a bad scene or experiment file */
+	BSIM_EDISAGREE = 3, /* compare/regress found a disagreement */
+};
+
+#define BSIM_ERROR_MSG_MAX 1024
+
+typedef struct bsim_error {
+	int code;
+	char msg[BSIM_ERROR_MSG_MAX];
+} bsim_error;
+
+/* Sets err (if not NULL) and returns code. printf-style message. */
+int bsim_error_set(bsim_error *err, int code, const char *fmt, ...)
+	__attribute__((format(printf, 3, 4)));
+
+/* Clears err to BSIM_OK with an empty message. */
+void bsim_error_clear(bsim_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

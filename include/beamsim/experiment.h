@@ -1,0 +1,56 @@
+/* An experiment: a scene, fixed overrides, a grid of parameter values whose
+ * cartesian product is the groups, trials per group and a seed
+ * (DESIGN.md "Experiment file"). */
+#ifndef BEAMSIM_EXPERIMENT_H
+#define BEAMSIM_EXPERIMENT_H
+
+#include <stdint.h>
+
+#include "beamsim/error.h"
+#include "beamsim/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bsim_grid_axis {
+	char *key;        /* dotted scene path */
+	int n_values;
+	char **values;    /* YAML scalar text of each value */
+	char **origins;   /* "file:line" of each value, for error messages */
+} bsim_grid_axis;
+
+typedef struct bsim_experiment {
+	char path[1024];
+	char scene_path[1024]; /* resolved relative to the experiment file */
+	int trials;
+	uint64_t seed;
+	int n_set;             /* fixed overrides from the `set:` block */
+	bsim_override *set;    /* strings owned by the experiment */
+	int n_axes;
+	bsim_grid_axis *axes;  /* the first axis varies slowest */
+	int n_groups;          /* product of the axes' sizes, >= 1 */
+} bsim_experiment;
+
+/* Loads an experiment file. Errors (unknown keys, an empty grid, ...) are
+ * BSIM_EINPUT with file, line, field and what was expected. The scene of
+ * every group is loaded and validated here, so a bad grid value fails before
+ * any trial runs. extra: command-line --set overrides applied to every group
+ * (after `set:`, before the grid values). */
+int bsim_experiment_load(const char *path, const bsim_override *extra,
+			 int n_extra, bsim_experiment *out, bsim_error *err);
+
+void bsim_experiment_free(bsim_experiment *e);
+
+/* The value index along each axis for group g (idx has n_axes entries). */
+void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx);
+
+/* Builds the scene of group g: scene file + set + extra + grid values. */
+int bsim_experiment_group_scene(const bsim_experiment *e, int g,
+				const bsim_override *extra, int n_extra,
+				bsim_scene *out, bsim_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

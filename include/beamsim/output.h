@@ -1,0 +1,34 @@
+/* The output files of a sweep (DESIGN.md "Outputs", a contract):
+ * summary.json, trials.csv and the text table of p_traverse. Files are
+ * written to a temporary name and renamed, so a reader never sees half a
+ * file and an interrupted run leaves none. */
+#ifndef BEAMSIM_OUTPUT_H
+#define BEAMSIM_OUTPUT_H
+
+#include <stdio.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/experiment.h"
+#include "beamsim/sweep.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+int bsim_output_summary_json(const char *path, const bsim_experiment *e,
+			     const char *backend, const bsim_options *opts,
+			     const bsim_sweep_result *r, bsim_error *err);
+int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r,
+			   bsim_error *err);
+/* p_traverse over the first two grid axes (columns: axis 0, rows: axis 1),
+ * one table per combination of the other axes. */
+void bsim_output_table(FILE *f, const bsim_experiment *e,
+		       const bsim_sweep_result *r);
+
+/* Creates dir (and parents) if missing. */
+int bsim_output_mkdir(const char *dir, bsim_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,95 @@
+/* A scene: one body, any number of beams, the contact law, the effects to
+ * simulate, and the integration and termination settings (DESIGN.md "Scene
+ * file", MODEL.md sections 1-6). All quantities SI. */
+#ifndef BEAMSIM_SCENE_H
+#define BEAMSIM_SCENE_H
+
+#include "beamsim/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bsim_beam_def {
+	double pivot[2];       /* m */
+	double rest_angle_deg; /* direction of the beam at rest, 0 = +x, degrees */
+	double length;         /* m, > 0 */
+	double mass;           /* kg, > 0 */
+	double inertia;        /* kg m^2 about the pivot; default mass*length^2/3 */
+	double stiffness;      /* N m/rad, >= 0 */
+	double damping;        /* N m s/rad, >= 0 */
+	double initial_theta;  /* rad, forward positive; default 0 */
+	double initial_omega;  /* rad/s; default 0 */
+} bsim_beam_def;
+
+typedef struct bsim_body_def {
+	double mass;        /* kg, > 0 */
+	double radius;      /* m, > 0 */
+	double start[2];    /* m; default (0, 0) */
+	double velocity[2]; /* m/s; default (0, 0) */
+} bsim_body_def;
+
+typedef struct bsim_contact_def {
+	double restitution;     /* tangent impacts, in [0, 1]; default 0.8 */
+	double tip_restitution; /* tip (point) impacts, in [0, 1]; default 1 */
+	double rest_threshold;  /* m/s: slower approaches become persistent; default 0.05 */
+} bsim_contact_def;
+
+/* Effects: only those present are simulated (has_* = 1). */
+typedef struct bsim_effects_def {
+	int has_propulsion;
+	double propulsion_force; /* N, along +y */
+	int has_random_force;
+	double random_magnitude; /* N, Rm: F_rand = Rm * N(0,1), >= 0 */
+	double random_frequency; /* Hz, refresh rate of the draw, > 0; default 50 */
+} bsim_effects_def;
+
+typedef struct bsim_scene {
+	char name[128];
+	char path[1024]; /* the file it came from, "" if built in code */
+	bsim_body_def body;
+	int n_beams;
+	bsim_beam_def *beams; /* n_beams entries, owned by the scene */
+	bsim_contact_def contact;
+	bsim_effects_def effects;
+	double dt;       /* s, > 0; default 0.004 */
+	int max_steps;   /* > 0; default 3000 */
+	double success_y;  /* m; default 65 */
+	double side_x;     /* m, > 0; default 25 */
+	double classify_y; /* m, >= success_y; default 80 */
+	double landscape_y0; /* m, zero of the propulsive potential; default 60 */
+} bsim_scene;
+
+/* One override of a scene field by dotted path, e.g. key "beams.0.stiffness",
+ * value "250" (any YAML flow text: "7", "[0, 5]", "{force: 7}"). origin names
+ * where it came from for error messages: "--set" or "h2.yaml:14". */
+typedef struct bsim_override {
+	const char *key;
+	const char *value;
+	const char *origin;
+} bsim_override;
+
+/* Loads and validates a scene file, applying the overrides in order (later
+ * ones win). On failure returns BSIM_EINPUT with one message naming the file
+ * (or the override's origin), line, field and what was expected. */
+int bsim_scene_load(const char *path, const bsim_override *overrides,
+		    int n_overrides, bsim_scene *out, bsim_error *err);
+
+/* Fills the essay's single-gate scene (MODEL.md section 1, Table 2.1) with
+ * the given propulsion and random force magnitude (0 = effect absent). */
+void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm);
+
+/* Range and geometry checks (positive masses, no initial overlap, ...) on a
+ * scene built in code; bsim_scene_load runs the same checks. */
+int bsim_scene_validate(const bsim_scene *s, bsim_error *err);
+
+int bsim_scene_copy(bsim_scene *dst, const bsim_scene *src);
+void bsim_scene_free(bsim_scene *s);
+
+/* Sets the number of beams, (re)allocating the array; new beams are zeroed. */
+int bsim_scene_set_beams(bsim_scene *s, int n_beams);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

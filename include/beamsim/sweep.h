@@ -1,0 +1,56 @@
+/* A sweep: every (group, trial) of an experiment on one backend, in parallel
+ * (OpenMP), with results independent of the number of threads. */
+#ifndef BEAMSIM_SWEEP_H
+#define BEAMSIM_SWEEP_H
+
+#include "beamsim/backend.h"
+#include "beamsim/experiment.h"
+#include "beamsim/trial.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bsim_group_result {
+	int trials, traversed, side_exit, stuck, left, right;
+	int stuck_in_contact;
+	int landscape_left, landscape_right; /* traversed, by larger peak theta */
+	double p_traverse, ci95[2];          /* Wilson 95% */
+	long steps;                          /* steps integrated in the group */
+} bsim_group_result;
+
+typedef struct bsim_sweep_result {
+	int n_groups, trials;
+	bsim_trial_result *trials_out; /* n_groups * trials, index g*trials + t */
+	bsim_group_result *groups;     /* n_groups */
+	double wall_seconds;
+	long total_steps;
+} bsim_sweep_result;
+
+/* Called from one thread now and then with done/total trials. */
+typedef void (*bsim_progress_fn)(void *user, long done, long total);
+
+typedef struct bsim_sweep_config {
+	const bsim_backend *backend;
+	const bsim_options *opts;
+	int threads;           /* <= 0: all available */
+	const bsim_override *extra; /* command-line --set, applied to every group */
+	int n_extra;
+	bsim_progress_fn progress; /* may be NULL */
+	void *progress_user;
+} bsim_sweep_config;
+
+/* Runs the sweep. e->trials and e->seed are used as they are (the caller
+ * applies --trials/--seed). */
+int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg,
+		   bsim_sweep_result *out, bsim_error *err);
+void bsim_sweep_result_free(bsim_sweep_result *r);
+
+/* Aggregates one group's trials into counts and the Wilson interval. */
+void bsim_group_aggregate(const bsim_trial_result *trials, int n,
+			  bsim_group_result *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

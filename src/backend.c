@@ -1,0 +1,65 @@
+/* The backend registry and the state buffers every backend fills. */
+#include "beamsim/backend.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const bsim_backend *const registry[] = {
+	&bsim_backend_thesis,
+	NULL,
+};
+
+const bsim_backend *const *bsim_backends(void)
+{
+	return registry;
+}
+
+const bsim_backend *bsim_backend_find(const char *name, bsim_error *err)
+{
+	char known[256] = "";
+	for (int i = 0; registry[i]; i++) {
+		if (strcmp(registry[i]->name, name) == 0)
+			return registry[i];
+		if (i)
+			strncat(known, ", ", sizeof known - strlen(known) - 1);
+		strncat(known, registry[i]->name, sizeof known - strlen(known) - 1);
+	}
+	bsim_error_set(err, BSIM_EINPUT, "--backend %s: unknown backend (expected one of %s)", name,
+		       known);
+	return NULL;
+}
+
+int bsim_state_alloc(bsim_state *s, int n_beams)
+{
+	memset(s, 0, sizeof *s);
+	s->n_beams = n_beams;
+	size_t n = n_beams > 0 ? (size_t)n_beams : 1;
+	s->theta = calloc(n, sizeof *s->theta);
+	s->omega = calloc(n, sizeof *s->omega);
+	s->contact = calloc(n, sizeof *s->contact);
+	if (!s->theta || !s->omega || !s->contact) {
+		bsim_state_free(s);
+		return BSIM_EFAIL;
+	}
+	return BSIM_OK;
+}
+
+void bsim_state_free(bsim_state *s)
+{
+	free(s->theta);
+	free(s->omega);
+	free(s->contact);
+	memset(s, 0, sizeof *s);
+}
+
+void bsim_state_copy(bsim_state *dst, const bsim_state *src)
+{
+	int n = src->n_beams < dst->n_beams ? src->n_beams : dst->n_beams;
+	memcpy(dst->x, src->x, sizeof dst->x);
+	memcpy(dst->v, src->v, sizeof dst->v);
+	memcpy(dst->theta, src->theta, (size_t)n * sizeof *dst->theta);
+	memcpy(dst->omega, src->omega, (size_t)n * sizeof *dst->omega);
+	memcpy(dst->contact, src->contact, (size_t)n * sizeof *dst->contact);
+	dst->energy = src->energy;
+	dst->impacts = src->impacts;
+}

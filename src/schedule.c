@@ -1,0 +1,116 @@
+/* Random-force schedules: Rm * z_j, z_j ~ N(0,1), drawn lazily in order from
+ * a GSL Mersenne Twister seeded per (experiment seed, group, trial). */
+#include "beamsim/schedule.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+
+struct bsim_schedule {
+	gsl_rng *rng;
+	double magnitude; /* N */
+	double frequency; /* Hz */
+	double *z;        /* standard-normal values drawn so far */
+	long n_drawn, cap;
+	unsigned long draws;
+};
+
+static unsigned long total_draws;
+
+/* SplitMix64's finaliser (Steele, Lea & Flood 2014): a bijection with full
+ * avalanche, applied to each input in turn so that nearby (g, t) pairs get
+ * unrelated streams. */
+static uint64_t splitmix64(uint64_t z)
+{
+	z += 0x9e3779b97f4a7c15ULL;
+	z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+	z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+	return z ^ (z >> 31);
+}
+
+uint64_t bsim_seed_mix(uint64_t seed, uint64_t group, uint64_t trial)
+{
+	uint64_t h = splitmix64(seed);
+	h = splitmix64(h ^ group);
+	return splitmix64(h ^ trial);
+}
+
+bsim_schedule *bsim_schedule_alloc(double magnitude, double frequency, uint64_t seed)
+{
+	bsim_schedule *s = calloc(1, sizeof *s);
+	if (!s)
+		return NULL;
+	s->rng = gsl_rng_alloc(gsl_rng_mt19937);
+	if (!s->rng) {
+		free(s);
+		return NULL;
+	}
+	s->frequency = frequency;
+	bsim_schedule_reset(s, magnitude, seed);
+	return s;
+}
+
+void bsim_schedule_free(bsim_schedule *s)
+{
+	if (!s)
+		return;
+	gsl_rng_free(s->rng);
+	free(s->z);
+	free(s);
+}
+
+void bsim_schedule_reset(bsim_schedule *s, double magnitude, uint64_t seed)
+{
+	/* gsl_rng_set takes an unsigned long (64 bits here); MT19937 uses its
+	 * low 32 bits, so fold the high half in. */
+	gsl_rng_set(s->rng, (unsigned long)(seed ^ (seed >> 32)));
+	s->magnitude = magnitude;
+	s->n_drawn = 0;
+	s->draws = 0;
+}
+
+long bsim_schedule_index(const bsim_schedule *s, long n, double h)
+{
+	/* Value j applies on [j/f, (j+1)/f). When 1/(f h) is a whole number of
+	 * steps (5 for 50 Hz at 4 ms) use integer division, so that rounding
+	 * of n*h*f never moves a refresh by a step. */
+	double per = 1.0 / (s->frequency * h);
+	double whole = nearbyint(per);
+	if (whole >= 1.0 && fabs(per - whole) <= 1e-9 * per)
+		return n / (long)whole;
+	return (long)floor((double)n * h * s->frequency);
+}
+
+double bsim_schedule_value(bsim_schedule *s, long j)
+{
+	if (j >= s->n_drawn) {
+		if (j >= s->cap) {
+			long cap = s->cap ? s->cap : 256;
+			while (cap <= j)
+				cap *= 2;
+			double *z = realloc(s->z, (size_t)cap * sizeof *z);
+			if (!z)
+				return NAN; /* the runner stops on a non-finite force */
+			s->z = z;
+			s->cap = cap;
+		}
+		while (s->n_drawn <= j) {
+			s->z[s->n_drawn++] = gsl_ran_gaussian_ziggurat(s->rng, 1.0);
+			s->draws++;
+			__atomic_fetch_add(&total_draws, 1UL, __ATOMIC_RELAXED);
+		}
+	}
+	return s->magnitude * s->z[j];
+}
+
+unsigned long bsim_schedule_draws(const bsim_schedule *s)
+{
+	return s->draws;
+}
+
+unsigned long bsim_schedule_total_draws(void)
+{
+	return __atomic_load_n(&total_draws, __ATOMIC_RELAXED);
+}

@@ -1,0 +1,244 @@
+/* The trial runner (MODEL.md section 6, DESIGN.md "The flow of one
+ * experiment"): time, forces from the effect pipeline, termination,
+ * outcomes, the energy ledger and recording. Everything here is the same
+ * code for every backend. */
+#include "beamsim/trial.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/effects.h"
+
+struct bsim_runner {
+	bsim_state s0, s1; /* before and after a step */
+	int cap;           /* beams the states hold */
+};
+
+bsim_runner *bsim_runner_alloc(void)
+{
+	return calloc(1, sizeof(bsim_runner));
+}
+
+void bsim_runner_free(bsim_runner *r)
+{
+	if (!r)
+		return;
+	bsim_state_free(&r->s0);
+	bsim_state_free(&r->s1);
+	free(r);
+}
+
+static int runner_reserve(bsim_runner *r, int n_beams)
+{
+	if (r->cap == n_beams && r->s0.theta)
+		return BSIM_OK;
+	bsim_state_free(&r->s0);
+	bsim_state_free(&r->s1);
+	r->cap = 0;
+	if (bsim_state_alloc(&r->s0, n_beams) || bsim_state_alloc(&r->s1, n_beams))
+		return BSIM_EFAIL;
+	r->cap = n_beams;
+	return BSIM_OK;
+}
+
+const char *bsim_outcome_name(bsim_outcome o)
+{
+	static const char *names[] = {"traversed", "side_exit", "stuck"};
+	return (unsigned)o < 3 ? names[o] : "?";
+}
+
+const char *bsim_type_name(bsim_type t)
+{
+	static const char *names[] = {"none", "left", "right"};
+	return (unsigned)t < 3 ? names[t] : "?";
+}
+
+/* Kinetic energy of body and beams, J. */
+static double energy_kinetic(const bsim_scene *sc, const bsim_state *s)
+{
+	double e = 0.5 * sc->body.mass * (s->v[0] * s->v[0] + s->v[1] * s->v[1]);
+	for (int i = 0; i < s->n_beams; i++)
+		e += 0.5 * sc->beams[i].inertia * s->omega[i] * s->omega[i];
+	return e;
+}
+
+/* Elastic energy of the beam springs, J. */
+static double energy_springs(const bsim_scene *sc, const bsim_state *s)
+{
+	double e = 0.0;
+	for (int i = 0; i < s->n_beams; i++)
+		e += 0.5 * sc->beams[i].stiffness * s->theta[i] * s->theta[i];
+	return e;
+}
+
+void bsim_recorder_header(FILE *f, int n_beams)
+{
+	fputs("t,x,y,vx,vy", f);
+	for (int i = 1; i <= n_beams; i++)
+		fprintf(f, ",theta%d,omega%d", i, i);
+	fputs(",f_rand", f);
+	for (int i = 1; i <= n_beams; i++)
+		fprintf(f, ",contact%d", i);
+	fputs(",e_kin,e_beam,e_prop\n", f);
+}
+
+static void record_row(FILE *f, const bsim_scene *sc, const bsim_state *s, double t,
+		       double f_rand)
+{
+	double f_prop = sc->effects.has_propulsion ? sc->effects.propulsion_force : 0.0;
+	fprintf(f, "%.6f,%.10g,%.10g,%.10g,%.10g", t, s->x[0], s->x[1], s->v[0], s->v[1]);
+	for (int i = 0; i < s->n_beams; i++)
+		fprintf(f, ",%.10g,%.10g", s->theta[i], s->omega[i]);
+	fprintf(f, ",%.10g", f_rand);
+	for (int i = 0; i < s->n_beams; i++)
+		fprintf(f, ",%d", s->contact[i]);
+	fprintf(f, ",%.10g,%.10g,%.10g\n", energy_kinetic(sc, s), energy_springs(sc, s),
+		f_prop * (sc->landscape_y0 - s->x[1]));
+}
+
+/* One step's entry in the ledger: the work of each force over the body's
+ * displacement, the backend's losses, and what is left over. */
+static void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state *s0,
+			const bsim_state *s1, double e0, double e1)
+{
+	double dx = s1->x[0] - s0->x[0], dy = s1->x[1] - s0->x[1];
+	double w_prop = 0.0, w_rand = 0.0;
+	for (int i = 0; i < fx->n; i++) {
+		if (&fx->e[i] == fx->random)
+			w_rand += fx->e[i].last * dx;
+		else
+			w_prop += fx->e[i].last * dy;
+	}
+	const bsim_step_energy *se = &s1->energy;
+	double r = (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -
+				se->correction);
+	l->w_prop += w_prop;
+	l->w_rand += w_rand;
+	l->damper += se->damper;
+	l->impact += se->impact;
+	l->contact += se->contact;
+	l->correction += se->correction;
+	l->residual += r;
+	l->residual_abs += fabs(r);
+	l->residual_max = fmax(l->residual_max, fabs(r));
+}
+
+static int state_finite(const bsim_state *s)
+{
+	double sum = s->x[0] + s->x[1] + s->v[0] + s->v[1];
+	for (int i = 0; i < s->n_beams; i++)
+		sum += s->theta[i] + s->omega[i];
+	return isfinite(sum);
+}
+
+static int any_contact(const bsim_state *s)
+{
+	for (int i = 0; i < s->n_beams; i++)
+		if (s->contact[i])
+			return 1;
+	return 0;
+}
+
+static double random_value(const bsim_effects *fx)
+{
+	return fx->random ? fx->random->last : 0.0;
+}
+
+int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *backend,
+		   const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
+		   bsim_trial_result *out, bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	if (runner_reserve(r, scene->n_beams))
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	bsim_world *w = NULL;
+	int rc = backend->create(scene, opts, &w, err);
+	if (rc)
+		return rc;
+	bsim_effects fx;
+	if (bsim_effects_init(&fx, scene, seed)) {
+		backend->destroy(w);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+
+	bsim_state *s0 = &r->s0, *s1 = &r->s1;
+	backend->get_state(w, s0);
+	const double h = scene->dt;
+	const int n_max = scene->max_steps;
+	double e0 = energy_kinetic(scene, s0) + energy_springs(scene, s0);
+	out->ledger.e_start = e0;
+	for (int i = 0; i < 2 && i < scene->n_beams; i++)
+		out->max_theta[i] = s0->theta[i];
+	int stride = rec && rec->stride > 0 ? rec->stride : 1;
+	FILE *csv = rec ? rec->csv : NULL;
+	double f[2];
+
+	int done = 0; /* the outcome is known; running on to classify_y */
+	long recorded = -1;
+	long n = 0, run_on = 0;
+	out->outcome = BSIM_STUCK;
+	while (1) {
+		int stop = done ? s0->x[1] >= scene->classify_y || run_on >= n_max : n >= n_max;
+		if (stop)
+			break;
+		bsim_effects_force(&fx, n, h, f);
+		if (csv && n % stride == 0) {
+			record_row(csv, scene, s0, (double)n * h, random_value(&fx));
+			recorded = n;
+		}
+		backend->step(w, f, h);
+		backend->get_state(w, s1);
+		n++;
+		run_on += done;
+		double e1 = energy_kinetic(scene, s1) + energy_springs(scene, s1);
+		ledger_step(&out->ledger, &fx, s0, s1, e0, e1);
+		e0 = e1;
+		bsim_state *t = s0;
+		s0 = s1;
+		s1 = t;
+		if (!state_finite(s0)) {
+			rc = bsim_error_set(err, BSIM_EFAIL,
+					    "%s backend: non-finite state at step %ld (t = %g s)",
+					    backend->name, n, (double)n * h);
+			break;
+		}
+		if (done)
+			continue;
+		for (int i = 0; i < 2 && i < scene->n_beams; i++)
+			out->max_theta[i] = fmax(out->max_theta[i], s0->theta[i]);
+		if (fabs(s0->x[0]) >= scene->side_x) {
+			out->outcome = BSIM_SIDE_EXIT;
+			break;
+		}
+		if (s0->x[1] >= scene->success_y) {
+			out->outcome = BSIM_TRAVERSED;
+			out->steps = (int)n;
+			out->t_end = (double)n * h;
+			done = 1;
+		}
+	}
+	if (csv && recorded != n) /* the final state, whatever the stride */
+		record_row(csv, scene, s0, (double)n * h, random_value(&fx));
+	if (out->outcome != BSIM_TRAVERSED) {
+		out->steps = (int)n;
+		out->t_end = (double)n * h;
+	}
+	if (out->outcome == BSIM_STUCK)
+		out->in_contact_end = any_contact(s0);
+	if (out->outcome == BSIM_TRAVERSED) {
+		out->type = s0->v[0] > 0.0   ? BSIM_TYPE_LEFT
+			    : s0->v[0] < 0.0 ? BSIM_TYPE_RIGHT
+					     : BSIM_TYPE_NONE;
+		out->landscape_left = out->max_theta[0] > out->max_theta[1];
+	}
+	out->x_end = s0->x[0];
+	out->y_end = s0->x[1];
+	out->vx_end = s0->v[0];
+	out->steps_run = (int)n;
+	out->ledger.e_end = e0;
+	out->draws = fx.random ? bsim_schedule_draws(fx.random->schedule) : 0;
+	bsim_effects_free(&fx);
+	backend->destroy(w);
+	return rc;
+}

@@ -1,0 +1,124 @@
+#include "support.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static char *slurp_fd(int fd)
+{
+	size_t cap = 4096, len = 0;
+	char *buf = malloc(cap);
+	if (!buf)
+		return NULL;
+	lseek(fd, 0, SEEK_SET);
+	for (;;) {
+		if (len + 1 >= cap) {
+			cap *= 2;
+			char *nb = realloc(buf, cap);
+			if (!nb) {
+				free(buf);
+				return NULL;
+			}
+			buf = nb;
+		}
+		ssize_t k = read(fd, buf + len, cap - len - 1);
+		if (k <= 0)
+			break;
+		len += (size_t)k;
+	}
+	buf[len] = '\0';
+	return buf;
+}
+
+int bsim_test_cli(const char *const argv[], char **out, char **err)
+{
+	int n = 0;
+	while (argv[n])
+		n++;
+	char **args = calloc((size_t)n + 2, sizeof *args);
+	args[0] = (char *)BSIM_EXE;
+	for (int i = 0; i < n; i++)
+		args[i + 1] = (char *)argv[i];
+
+	FILE *fo = tmpfile(), *fe = tmpfile();
+	fflush(NULL);
+	pid_t pid = fork();
+	if (pid == 0) {
+		dup2(fileno(fo), 1);
+		dup2(fileno(fe), 2);
+		int devnull = open("/dev/null", O_RDONLY);
+		dup2(devnull, 0);
+		execv(BSIM_EXE, args);
+		_exit(127);
+	}
+	int status = 0;
+	waitpid(pid, &status, 0);
+	free(args);
+	if (out)
+		*out = slurp_fd(fileno(fo));
+	if (err)
+		*err = slurp_fd(fileno(fe));
+	fclose(fo);
+	fclose(fe);
+	return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static void mkdirs(const char *path)
+{
+	char tmp[1024];
+	snprintf(tmp, sizeof tmp, "%s", path);
+	for (char *p = tmp + 1; *p; p++) {
+		if (*p == '/') {
+			*p = '\0';
+			mkdir(tmp, 0755);
+			*p = '/';
+		}
+	}
+	mkdir(tmp, 0755);
+}
+
+const char *bsim_test_dir(const char *name)
+{
+	static char path[1024];
+	char cmd[1200];
+	snprintf(path, sizeof path, "%s/%s", BSIM_TEST_TMP, name);
+	snprintf(cmd, sizeof cmd, "rm -rf '%s'", path);
+	if (system(cmd) != 0)
+		return path;
+	mkdirs(path);
+	return path;
+}
+
+const char *bsim_test_write(const char *dir, const char *name, const char *text)
+{
+	static char path[1024];
+	snprintf(path, sizeof path, "%s/%s", dir, name);
+	FILE *f = fopen(path, "w");
+	if (f) {
+		fputs(text, f);
+		fclose(f);
+	}
+	return path;
+}
+
+char *bsim_test_read(const char *path)
+{
+	int fd = open(path, O_RDONLY);
+	if (fd < 0)
+		return NULL;
+	char *s = slurp_fd(fd);
+	close(fd);
+	return s;
+}
+
+const char *bsim_test_src(const char *rel)
+{
+	static char path[1024];
+	snprintf(path, sizeof path, "%s/%s", BSIM_SOURCE_DIR, rel);
+	return path;
+}
