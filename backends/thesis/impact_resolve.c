@@ -60,7 +60,7 @@ static void impact_nearest_first(struct bsim_world *w, thesis_contact *cs, int n
 		impact_bounds(w, next);
 		thesis_lcp_solve(w, next, 1);
 		impact_apply(w, next, 1);
-		if (next->impulse > 0.0 && next->bound > 0.0)
+		if (next->impulse > 0.0 && next->vrel < -w->rest_threshold)
 			w->impacts++;
 	}
 }
@@ -92,7 +92,7 @@ int thesis_impact_resolve(struct bsim_world *w, double h)
 		thesis_lcp_solve(w, cs, n);
 		impact_apply(w, cs, n);
 		for (int i = 0; i < n; i++)
-			w->impacts += cs[i].impulse > 0.0 && cs[i].bound > 0.0;
+			w->impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->rest_threshold;
 	}
 	w->energy.impact += ke - thesis_kinetic_energy(w);
 	return 1;

@@ -1,0 +1,114 @@
+/* MODEL.md oracle 2: a beam released from theta0 with no body follows the
+ * damped oscillator I th'' + d th' + k th = 0; the implicit midpoint update
+ * converges at second order and stays stable and non-expansive for stiff
+ * springs (omega_n h up to 4). */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+
+#include <cmocka.h>
+
+#include "beamsim/backend.h"
+#include "scenes.h"
+
+/* Closed-form underdamped response with theta(0) = th0, omega(0) = 0. */
+static double oscillator(double k, double d, double inertia, double th0, double t)
+{
+	double wn = sqrt(k / inertia), zeta = d / (2.0 * sqrt(k * inertia));
+	double wd = wn * sqrt(1.0 - zeta * zeta);
+	return th0 * exp(-zeta * wn * t) * (cos(wd * t) + zeta * wn / wd * sin(wd * t));
+}
+
+/* Max |theta - exact| over t in [0, t_end] for a Table 2.1 beam. */
+static double vibration_error(double h, double t_end)
+{
+	bsim_scene s;
+	scene_one_beam(&s);
+	s.beams[0].stiffness = 400.0;
+	s.beams[0].damping = 50.0;
+	s.beams[0].initial_theta = 0.1;
+	bsim_world *w = NULL;
+	bsim_error err;
+	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	bsim_state st;
+	bsim_state_alloc(&st, 1);
+	const double zero[2] = {0.0, 0.0};
+	double worst = 0.0;
+	long n_steps = lround(t_end / h);
+	for (long n = 1; n <= n_steps; n++) {
+		bsim_backend_thesis.step(w, zero, h);
+		bsim_backend_thesis.get_state(w, &st);
+		double exact = oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
+		worst = fmax(worst, fabs(st.theta[0] - exact));
+	}
+	bsim_state_free(&st);
+	bsim_backend_thesis.destroy(w);
+	bsim_scene_free(&s);
+	return worst;
+}
+
+static void test_free_vibration_oracle(void **state)
+{
+	(void)state;
+	double inertia = 0.1 * 625.0 / 3.0;
+	/* Table 2.1: omega_n = 4.38 rad/s, zeta = 0.274 */
+	assert_true(fabs(sqrt(400.0 / inertia) - 4.38) < 5e-3);
+	assert_true(fabs(50.0 / (2.0 * sqrt(400.0 * inertia)) - 0.274) < 5e-4);
+
+	double e1 = vibration_error(0.004, 3.0);
+	double e2 = vibration_error(0.002, 3.0);
+	print_message("free vibration: max error %.3g rad at h = 4 ms, %.3g at 2 ms (ratio %.2f)\n",
+		      e1, e2, e1 / e2);
+	assert_true(e1 < 2e-5); /* 0.02% of theta0 over 3 s at the essay's step */
+	assert_true(e1 / e2 > 3.6 && e1 / e2 < 4.4); /* second order */
+}
+
+/* omega_n h from 0.05 to 4: no growth of the beam's energy, with and without
+ * the damper; the undamped energy is kept to round-off. */
+static void test_stiff_spring_stable(void **state)
+{
+	(void)state;
+	const double h = 0.004, wh[] = {0.05, 0.5, 2.0, 4.0};
+	for (int damped = 0; damped < 2; damped++) {
+		for (size_t c = 0; c < sizeof wh / sizeof wh[0]; c++) {
+			bsim_scene s;
+			scene_one_beam(&s);
+			double inertia = s.beams[0].inertia;
+			double k = inertia * (wh[c] / h) * (wh[c] / h);
+			s.beams[0].stiffness = k;
+			s.beams[0].damping = damped ? 2.0 * 0.05 * sqrt(k * inertia) : 0.0;
+			s.beams[0].initial_theta = 0.2;
+			bsim_world *w = NULL;
+			bsim_error err;
+			assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+			bsim_state st;
+			bsim_state_alloc(&st, 1);
+			const double zero[2] = {0.0, 0.0};
+			double e0 = 0.5 * k * 0.04, e_prev = e0;
+			for (int n = 0; n < 5000; n++) {
+				bsim_backend_thesis.step(w, zero, h);
+				bsim_backend_thesis.get_state(w, &st);
+				double e = 0.5 * k * st.theta[0] * st.theta[0] +
+					   0.5 * inertia * st.omega[0] * st.omega[0];
+				assert_true(isfinite(e));
+				assert_true(e <= e_prev * (1.0 + 1e-12) + 1e-300);
+				e_prev = e;
+			}
+			if (!damped)
+				assert_true(fabs(e_prev - e0) <= 1e-10 * e0);
+			bsim_state_free(&st);
+			bsim_backend_thesis.destroy(w);
+			bsim_scene_free(&s);
+		}
+	}
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_free_vibration_oracle),
+		cmocka_unit_test(test_stiff_spring_stable),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
