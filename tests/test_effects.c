@@ -36,6 +36,7 @@ static void test_no_random_force_no_draws(void **state)
 	assert_int_equal(bsim_schedule_total_draws(), before);
 
 	/* the same scene with noise draws once per 1/f = 5 steps actually run */
+	bsim_scene_free(&s);
 	bsim_scene_init_gate(&s, 9.0, 20.0);
 	before = bsim_schedule_total_draws();
 	assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL, 1, NULL, &out, &err),

@@ -1,0 +1,284 @@
+/* beamsim bench: the speed of a backend on the essay's experiments, on one
+ * thread and on all of them, and the wall time of H1 + H2 together. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <getopt.h>
+#include <omp.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "beamsim/progress.h"
+#include "beamsim/sweep.h"
+#include "cli_common.h"
+
+#define BENCH_H1 "configs/thesis/h1_symmetric.yaml"
+#define BENCH_H2 "configs/thesis/h2_asymmetric.yaml"
+
+static const char bench_help[] =
+        "Usage: beamsim bench [OPTIONS]\n"
+        "\n"
+        "Runs an experiment (default " BENCH_H1 ") on one thread and\n"
+        "on all threads and reports wall time, steps/s, trials/s and steps/s per core;\n"
+        "then runs " BENCH_H2 " on all threads and reports the\n"
+        "wall time of H1 + H2. The default experiment paths are relative to the\n"
+        "current directory (run it from the source tree).\n"
+        "\n"
+        "Options:\n"
+        "  --backend B            physics backend (default thesis; see beamsim backends)\n"
+        "  --backend-opt K=V      a backend option, repeatable\n"
+        "  --experiment FILE      benchmark this experiment instead of H1 (no H2 step)\n"
+        "  --trials N             trials per group (default: the experiment's)\n"
+        "  --no-h2                skip the H1 + H2 step\n"
+        "  --json FILE            also write the results as JSON to FILE\n"
+        "  -h, --help             show this help\n";
+
+enum { OPT_BACKEND = 256, OPT_BACKEND_OPT, OPT_EXPERIMENT, OPT_TRIALS, OPT_NO_H2, OPT_JSON };
+
+static const struct option bench_options[] = {
+        {"backend", required_argument, NULL, OPT_BACKEND},
+        {"backend-opt", required_argument, NULL, OPT_BACKEND_OPT},
+        {"experiment", required_argument, NULL, OPT_EXPERIMENT},
+        {"trials", required_argument, NULL, OPT_TRIALS},
+        {"no-h2", no_argument, NULL, OPT_NO_H2},
+        {"json", required_argument, NULL, OPT_JSON},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+};
+
+typedef struct bench_args {
+	const char *backend;
+	bsim_options opts;
+	const char *experiment;
+	int custom; /* --experiment given */
+	long trials;
+	int h2;
+	const char *json;
+} bench_args;
+
+typedef struct bench_run {
+	const char *experiment;
+	int threads;
+	long trials, steps;
+	double wall;
+} bench_run;
+
+#define BENCH_RUNS_MAX 3
+
+/* Fills a; returns -1 to go on, else the exit status. */
+static int bench_parse(int argc, char **argv, bench_args *a)
+{
+	int c;
+	opterr = 0;
+	while ((c = getopt_long(argc, argv, ":h", bench_options, NULL)) != -1) {
+		int rc = CLI_OK;
+		switch (c) {
+		case 'h':
+			fputs(bench_help, stdout);
+			return CLI_OK;
+		case OPT_BACKEND:
+			a->backend = optarg;
+			break;
+		case OPT_BACKEND_OPT:
+			rc = cli_options_add(&a->opts, "bench", optarg);
+			break;
+		case OPT_EXPERIMENT:
+			a->experiment = optarg;
+			a->custom = 1;
+			break;
+		case OPT_TRIALS:
+			if (cli_parse_long(optarg, 1, INT32_MAX, &a->trials) != 0)
+				rc = cli_usage("bench", "--trials %s: expected an integer >= 1",
+				               optarg);
+			break;
+		case OPT_NO_H2:
+			a->h2 = 0;
+			break;
+		case OPT_JSON:
+			a->json = optarg;
+			break;
+		default:
+			return cli_bad_option("bench", argv, c);
+		}
+		if (rc != CLI_OK)
+			return rc;
+	}
+	if (optind != argc)
+		return cli_usage("bench", "unexpected argument %s", argv[optind]);
+	/* H1 + H2 is the essay's pair; it means nothing for another file. */
+	if (a->custom)
+		a->h2 = 0;
+	return -1;
+}
+
+/* The default experiments are found relative to the current directory. */
+static int bench_find(const char *path)
+{
+	if (access(path, R_OK) == 0)
+		return CLI_OK;
+	cli_error("%s not found: run beamsim bench from the source tree, or pass "
+	          "--experiment FILE",
+	          path);
+	return CLI_USAGE;
+}
+
+static void bench_print_header(void)
+{
+	printf("%-36s %7s %7s %12s %9s %10s %9s %13s\n", "experiment", "threads", "trials", "steps",
+	       "wall s", "steps/s", "trials/s", "steps/s/core");
+}
+
+static void bench_print_run(const bench_run *r)
+{
+	double wall = r->wall > 0 ? r->wall : 1e-9;
+	printf("%-36s %7d %7ld %12ld %9.3f %10.4g %9.1f %13.4g\n", r->experiment, r->threads,
+	       r->trials, r->steps, r->wall, r->steps / wall, r->trials / wall,
+	       r->steps / wall / r->threads);
+	fflush(stdout);
+}
+
+/* One sweep of e on the given threads, timed. label (the path as given)
+ * outlives e. */
+static int bench_sweep(const bench_args *a, const bsim_backend *backend, const bsim_experiment *e,
+                       const char *label, int threads, bench_run *out)
+{
+	bsim_progress progress;
+	bsim_progress_init(&progress, 1);
+	bsim_sweep_config cfg = {
+	        .backend = backend,
+	        .opts = &a->opts,
+	        .threads = threads,
+	        .progress = bsim_progress_update,
+	        .progress_user = &progress,
+	};
+	bsim_sweep_result r;
+	bsim_error err;
+	int rc = bsim_sweep_run(e, &cfg, &r, &err);
+	bsim_progress_finish(&progress);
+	if (rc != BSIM_OK) {
+		cli_error("%s", err.msg);
+		return rc;
+	}
+	*out = (bench_run){
+	        .experiment = label,
+	        .threads = threads,
+	        .trials = (long)r.n_groups * r.trials,
+	        .steps = r.total_steps,
+	        .wall = r.wall_seconds,
+	};
+	bsim_sweep_result_free(&r);
+	bench_print_run(out);
+	return CLI_OK;
+}
+
+static int bench_load(const bench_args *a, const char *path, bsim_experiment *e)
+{
+	bsim_error err;
+	if (bsim_experiment_load(path, NULL, 0, e, &err) != BSIM_OK) {
+		cli_error("%s", err.msg);
+		return err.code ? err.code : CLI_USAGE;
+	}
+	if (a->trials > 0)
+		e->trials = (int)a->trials;
+	return CLI_OK;
+}
+
+/* Runs e on each of the thread counts, appending to runs. */
+static int bench_experiment(const bench_args *a, const bsim_backend *backend,
+                            const bsim_experiment *e, const char *path, const int *threads,
+                            int n_threads, bench_run *runs, int *n_runs)
+{
+	int rc = CLI_OK;
+	for (int i = 0; i < n_threads && rc == CLI_OK; i++) {
+		rc = bench_sweep(a, backend, e, path, threads[i], &runs[*n_runs]);
+		*n_runs += rc == CLI_OK;
+	}
+	return rc;
+}
+
+static int bench_json(const bench_args *a, const bsim_backend *backend, int threads,
+                      const bench_run *runs, int n_runs, double h1_h2)
+{
+	cli_file o;
+	if (cli_file_open(&o, a->json) != CLI_OK)
+		return CLI_FAIL;
+	FILE *f = o.f;
+	fputs("{\"backend\": ", f);
+	cli_json_string(f, a->backend);
+	fputs(", \"options\": ", f);
+	cli_json_options(f, backend, &a->opts);
+	fprintf(f, ", \"threads\": %d, \"runs\": [", threads);
+	for (int i = 0; i < n_runs; i++) {
+		const bench_run *r = &runs[i];
+		double wall = r->wall > 0 ? r->wall : 1e-9;
+		fputs(i ? ",\n  {\"experiment\": " : "\n  {\"experiment\": ", f);
+		cli_json_string(f, r->experiment);
+		fprintf(f, ", \"threads\": %d, \"trials\": %ld, \"steps\": %ld, \"wall_seconds\": ",
+		        r->threads, r->trials, r->steps);
+		cli_json_double(f, r->wall);
+		fputs(", \"steps_per_second\": ", f);
+		cli_json_double(f, r->steps / wall);
+		fputs(", \"trials_per_second\": ", f);
+		cli_json_double(f, r->trials / wall);
+		fputc('}', f);
+	}
+	fputs("],\n \"h1_h2_seconds\": ", f);
+	if (h1_h2 >= 0)
+		cli_json_double(f, h1_h2);
+	else
+		fputs("null", f);
+	fputs("}\n", f);
+	return cli_file_commit(&o);
+}
+
+/* Both experiments are loaded before anything runs, so a bad file fails
+ * at once rather than after the first timing. */
+static int bench_main(const bench_args *a, const bsim_backend *backend)
+{
+	int all = omp_get_max_threads();
+	bsim_experiment h1, h2;
+	/* A file given with --experiment is reported by the loader. */
+	int rc = a->custom ? CLI_OK : bench_find(a->experiment);
+	if (rc == CLI_OK && a->h2)
+		rc = bench_find(BENCH_H2);
+	if (rc == CLI_OK)
+		rc = bench_load(a, a->experiment, &h1);
+	if (rc != CLI_OK)
+		return rc;
+	if (a->h2 && (rc = bench_load(a, BENCH_H2, &h2)) != CLI_OK) {
+		bsim_experiment_free(&h1);
+		return rc;
+	}
+
+	bench_run runs[BENCH_RUNS_MAX];
+	int n_runs = 0;
+	const int h1_threads[] = {1, all};
+	printf("backend %s, %d threads\n\n", a->backend, all);
+	bench_print_header();
+	rc = bench_experiment(a, backend, &h1, a->experiment, h1_threads, 2, runs, &n_runs);
+	if (rc == CLI_OK && a->h2)
+		rc = bench_experiment(a, backend, &h2, BENCH_H2, &all, 1, runs, &n_runs);
+	bsim_experiment_free(&h1);
+	if (a->h2)
+		bsim_experiment_free(&h2);
+	if (rc != CLI_OK)
+		return rc;
+
+	/* The all-threads H1 run above is the H1 half of H1 + H2. */
+	double h1_h2 = -1.0;
+	if (a->h2) {
+		h1_h2 = runs[1].wall + runs[2].wall;
+		printf("\nH1 + H2 on %d threads: %.3f s\n", all, h1_h2);
+	}
+	return a->json ? bench_json(a, backend, all, runs, n_runs, h1_h2) : CLI_OK;
+}
+
+int cmd_bench(int argc, char **argv)
+{
+	bench_args a = {.backend = "thesis", .experiment = BENCH_H1, .h2 = 1};
+	int rc = bench_parse(argc, argv, &a);
+	if (rc >= 0)
+		return rc;
+	const bsim_backend *backend = cli_backend(a.backend, &a.opts);
+	return backend ? bench_main(&a, backend) : CLI_USAGE;
+}

@@ -1,0 +1,286 @@
+/* beamsim run: one trial of a scene, with its outcome, end state, peak
+ * angles and energy ledger; optionally the trajectory as CSV. The seed is
+ * mixed from (seed, group, trial) exactly as in a sweep, so any trial of a
+ * sweep can be replayed and recorded. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/schedule.h"
+#include "beamsim/trial.h"
+#include "cli_common.h"
+
+static const char run_help[] =
+        "Usage: beamsim run SCENE [OPTIONS]\n"
+        "\n"
+        "Runs one trial of the scene file SCENE and prints its outcome, end state,\n"
+        "peak beam angles and energy ledger. The random-force schedule is that of\n"
+        "trial I of group G of a sweep with seed N, so a sweep's trial can be replayed.\n"
+        "\n"
+        "Options:\n"
+        "  --backend B            physics backend (default thesis; see beamsim backends)\n"
+        "  --backend-opt K=V      a backend option, repeatable\n"
+        "  --seed N               experiment seed (default 1)\n"
+        "  --group G              group index for the seed (default 0)\n"
+        "  --trial I              trial index for the seed (default 0)\n"
+        "  --set KEY=VALUE        override a scene field by dotted path, repeatable\n"
+        "                         (e.g. --set effects.random_force.magnitude=30)\n"
+        "  --trajectory FILE.csv  write the trajectory, one row per recorded step\n"
+        "  --stride N             record every N-th step (default 1)\n"
+        "  --json                 print one JSON object instead of text\n"
+        "  -h, --help             show this help\n";
+
+enum {
+	OPT_BACKEND = 256,
+	OPT_BACKEND_OPT,
+	OPT_SEED,
+	OPT_GROUP,
+	OPT_TRIAL,
+	OPT_SET,
+	OPT_TRAJECTORY,
+	OPT_STRIDE,
+	OPT_JSON
+};
+
+static const struct option run_options[] = {
+        {"backend", required_argument, NULL, OPT_BACKEND},
+        {"backend-opt", required_argument, NULL, OPT_BACKEND_OPT},
+        {"seed", required_argument, NULL, OPT_SEED},
+        {"group", required_argument, NULL, OPT_GROUP},
+        {"trial", required_argument, NULL, OPT_TRIAL},
+        {"set", required_argument, NULL, OPT_SET},
+        {"trajectory", required_argument, NULL, OPT_TRAJECTORY},
+        {"stride", required_argument, NULL, OPT_STRIDE},
+        {"json", no_argument, NULL, OPT_JSON},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+};
+
+typedef struct run_args {
+	const char *scene;
+	const char *backend;
+	bsim_options opts;
+	uint64_t seed;
+	long group, trial, stride;
+	cli_sets sets;
+	const char *trajectory;
+	int json;
+} run_args;
+
+/* Fills a; returns -1 to go on, else the exit status. */
+static int run_parse(int argc, char **argv, run_args *a)
+{
+	int c;
+	opterr = 0;
+	while ((c = getopt_long(argc, argv, ":h", run_options, NULL)) != -1) {
+		int rc = CLI_OK;
+		switch (c) {
+		case 'h':
+			fputs(run_help, stdout);
+			return CLI_OK;
+		case OPT_BACKEND:
+			a->backend = optarg;
+			break;
+		case OPT_BACKEND_OPT:
+			rc = cli_options_add(&a->opts, "run", optarg);
+			break;
+		case OPT_SEED:
+			if (cli_parse_u64(optarg, &a->seed) != 0)
+				rc = cli_usage("run", "--seed %s: expected an integer >= 0",
+				               optarg);
+			break;
+		case OPT_GROUP:
+			if (cli_parse_long(optarg, 0, INT32_MAX, &a->group) != 0)
+				rc = cli_usage("run", "--group %s: expected an integer >= 0",
+				               optarg);
+			break;
+		case OPT_TRIAL:
+			if (cli_parse_long(optarg, 0, INT32_MAX, &a->trial) != 0)
+				rc = cli_usage("run", "--trial %s: expected an integer >= 0",
+				               optarg);
+			break;
+		case OPT_SET:
+			rc = cli_sets_add(&a->sets, "run", optarg);
+			break;
+		case OPT_TRAJECTORY:
+			a->trajectory = optarg;
+			break;
+		case OPT_STRIDE:
+			if (cli_parse_long(optarg, 1, INT32_MAX, &a->stride) != 0)
+				rc = cli_usage("run", "--stride %s: expected an integer >= 1",
+				               optarg);
+			break;
+		case OPT_JSON:
+			a->json = 1;
+			break;
+		default:
+			return cli_bad_option("run", argv, c);
+		}
+		if (rc != CLI_OK)
+			return rc;
+	}
+	if (optind + 1 != argc)
+		return cli_usage("run",
+		                 optind == argc ? "missing SCENE" : "expected one SCENE, got %d",
+		                 argc - optind);
+	a->scene = argv[optind];
+	return -1;
+}
+
+static void print_ledger_json(const bsim_ledger *l)
+{
+	const struct {
+		const char *name;
+		double value;
+	} terms[] = {
+	        {"e_start", l->e_start},
+	        {"e_end", l->e_end},
+	        {"w_prop", l->w_prop},
+	        {"w_rand", l->w_rand},
+	        {"damper", l->damper},
+	        {"impact", l->impact},
+	        {"contact", l->contact},
+	        {"correction", l->correction},
+	        {"residual", l->residual},
+	        {"residual_max", l->residual_max},
+	        {"residual_abs", l->residual_abs},
+	};
+	fputc('{', stdout);
+	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
+		printf("%s\"%s\": ", i ? ", " : "", terms[i].name);
+		cli_json_double(stdout, terms[i].value);
+	}
+	fputc('}', stdout);
+}
+
+static void print_json(const run_args *a, const bsim_backend *b, const bsim_scene *s,
+                       uint64_t mixed, const bsim_trial_result *r)
+{
+	fputs("{\"scene\": ", stdout);
+	cli_json_string(stdout, a->scene);
+	fputs(", \"name\": ", stdout);
+	cli_json_string(stdout, s->name);
+	fputs(", \"backend\": ", stdout);
+	cli_json_string(stdout, a->backend);
+	fputs(", \"backend_options\": ", stdout);
+	cli_json_options(stdout, b, &a->opts);
+	printf(", \"seed\": %" PRIu64 ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": %" PRIu64,
+	       a->seed, a->group, a->trial, mixed);
+	fputs(", \"outcome\": ", stdout);
+	cli_json_string(stdout, bsim_outcome_name(r->outcome));
+	fputs(", \"type\": ", stdout);
+	cli_json_string(stdout, bsim_type_name(r->type));
+	printf(", \"landscape_left\": %d, \"in_contact_end\": %d", r->landscape_left,
+	       r->in_contact_end);
+	printf(", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
+	       r->draws);
+	const char *names[] = {"t_end", "x_end", "y_end", "vx_end"};
+	const double values[] = {r->t_end, r->x_end, r->y_end, r->vx_end};
+	for (int i = 0; i < 4; i++) {
+		printf(", \"%s\": ", names[i]);
+		cli_json_double(stdout, values[i]);
+	}
+	fputs(", \"max_theta\": [", stdout);
+	cli_json_double(stdout, r->max_theta[0]);
+	fputs(", ", stdout);
+	cli_json_double(stdout, r->max_theta[1]);
+	fputs("], \"ledger\": ", stdout);
+	print_ledger_json(&r->ledger);
+	fputs("}\n", stdout);
+}
+
+static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
+                       const bsim_trial_result *r)
+{
+	const bsim_ledger *l = &r->ledger;
+	printf("scene       %s (%s), backend %s\n", a->scene, s->name, a->backend);
+	printf("seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
+	       ", %lu draws)\n",
+	       a->seed, a->group, a->trial, mixed, r->draws);
+	printf("outcome     %s", bsim_outcome_name(r->outcome));
+	if (r->outcome == BSIM_TRAVERSED)
+		printf(", type %s, landscape %s", bsim_type_name(r->type),
+		       r->landscape_left                   ? "left"
+		       : r->max_theta[1] > r->max_theta[0] ? "right"
+		                                           : "none");
+	else if (r->outcome == BSIM_STUCK)
+		printf(", %s", r->in_contact_end ? "in contact" : "not in contact");
+	printf("\nsteps       %d to the outcome at t = %.6g s, %d run\n", r->steps, r->t_end,
+	       r->steps_run);
+	printf("end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,
+	       r->vx_end);
+	printf("peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0], r->max_theta[1]);
+	printf("energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
+	printf("  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
+	printf("  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
+	       l->damper, l->impact, l->contact, l->correction);
+	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step)\n", l->residual,
+	       l->residual_abs, l->residual_max);
+}
+
+/* Runs the trial, recording into the trajectory file if one was asked
+ * for; the file appears only if the run finished. */
+static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_backend *backend,
+                     uint64_t mixed, bsim_trial_result *res)
+{
+	cli_file traj = {0};
+	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride};
+	if (a->trajectory) {
+		if (cli_file_open(&traj, a->trajectory) != CLI_OK)
+			return CLI_FAIL;
+		bsim_recorder_header(traj.f, scene->n_beams);
+		rec.csv = traj.f;
+	}
+	bsim_runner *runner = bsim_runner_alloc();
+	if (!runner) {
+		cli_file_abort(&traj);
+		cli_error("out of memory for a trial runner");
+		return CLI_FAIL;
+	}
+	bsim_error err;
+	bsim_error_clear(&err);
+	int rc = bsim_trial_run(runner, scene, backend, &a->opts, mixed,
+	                        a->trajectory ? &rec : NULL, res, &err);
+	bsim_runner_free(runner);
+	if (rc != BSIM_OK) {
+		cli_file_abort(&traj);
+		cli_error("%s", err.msg);
+		return rc;
+	}
+	return a->trajectory ? cli_file_commit(&traj) : CLI_OK;
+}
+
+int cmd_run(int argc, char **argv)
+{
+	run_args a = {.backend = "thesis", .seed = 1, .stride = 1};
+	int rc = run_parse(argc, argv, &a);
+	if (rc >= 0) {
+		cli_sets_free(&a.sets);
+		return rc;
+	}
+	const bsim_backend *backend = cli_backend(a.backend, &a.opts);
+	bsim_scene scene;
+	bsim_error err;
+	if (!backend) {
+		rc = CLI_USAGE;
+	} else if (bsim_scene_load(a.scene, a.sets.ov, a.sets.n, &scene, &err) != BSIM_OK) {
+		cli_error("%s", err.msg);
+		rc = err.code ? err.code : CLI_USAGE;
+	} else {
+		uint64_t mixed = bsim_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
+		bsim_trial_result res;
+		memset(&res, 0, sizeof res);
+		rc = run_trial(&a, &scene, backend, mixed, &res);
+		if (rc == CLI_OK && a.json)
+			print_json(&a, backend, &scene, mixed, &res);
+		else if (rc == CLI_OK)
+			print_text(&a, &scene, mixed, &res);
+		bsim_scene_free(&scene);
+	}
+	cli_sets_free(&a.sets);
+	return rc;
+}

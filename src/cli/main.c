@@ -1,0 +1,62 @@
+/* The beamsim program: dispatch to one subcommand per file. */
+#include <stdio.h>
+#include <string.h>
+
+#include "beamsim/version.h"
+#include "cli_common.h"
+
+typedef struct cli_command {
+	const char *name;
+	cli_command_fn run;
+	const char *summary;
+} cli_command;
+
+static const cli_command commands[] = {
+        {"run", cmd_run, "run one trial of a scene, print its outcome, record a trajectory"},
+        {"sweep", cmd_sweep, "run every group and trial of an experiment in parallel"},
+        {"backends", cmd_backends, "list the physics backends and their options"},
+        {"bench", cmd_bench, "measure the speed of a backend on the essay's experiments"},
+};
+
+#define N_COMMANDS ((int)(sizeof commands / sizeof commands[0]))
+
+static void usage(FILE *f)
+{
+	fputs("Usage: beamsim COMMAND [OPTIONS]\n"
+	      "       beamsim COMMAND --help\n"
+	      "       beamsim --version\n"
+	      "\n"
+	      "Simulates a self-propelled disk traversing elastic beam gates.\n"
+	      "\n"
+	      "Commands:\n",
+	      f);
+	for (int i = 0; i < N_COMMANDS; i++)
+		fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
+	fputs("\n"
+	      "Exit status: 0 success, 1 a run failed, 2 bad usage or a bad scene or\n"
+	      "experiment file.\n",
+	      f);
+}
+
+int main(int argc, char **argv)
+{
+	if (argc < 2) {
+		usage(stderr);
+		return CLI_USAGE;
+	}
+	const char *name = argv[1];
+	if (strcmp(name, "--help") == 0 || strcmp(name, "-h") == 0 || strcmp(name, "help") == 0) {
+		usage(stdout);
+		return CLI_OK;
+	}
+	if (strcmp(name, "--version") == 0 || strcmp(name, "-V") == 0) {
+		printf("beamsim %s\n", BSIM_VERSION);
+		return CLI_OK;
+	}
+	for (int i = 0; i < N_COMMANDS; i++)
+		if (strcmp(name, commands[i].name) == 0)
+			return commands[i].run(argc - 1, argv + 1);
+	fprintf(stderr, "beamsim: unknown command '%s'\n\n", name);
+	usage(stderr);
+	return CLI_USAGE;
+}

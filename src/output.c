@@ -1,0 +1,406 @@
+/* The output files of a sweep (DESIGN.md "Outputs"): summary.json,
+ * trials.csv and the p_traverse table.
+ *
+ * Every file is written to PATH.tmp.PID, flushed to disk and renamed over
+ * PATH: rename is atomic, so a reader (or a resumed run) sees either the old
+ * file or the whole new one, never a torn one. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/output.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <inttypes.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "beamsim/version.h"
+
+/* ---- atomic files ---------------------------------------------------- */
+
+typedef struct out_file {
+	FILE *f;
+	const char *path;
+	char tmp[1100];
+} out_file;
+
+static int out_open(out_file *o, const char *path, bsim_error *err)
+{
+	o->path = path;
+	int n = snprintf(o->tmp, sizeof o->tmp, "%s.tmp.%ld", path, (long)getpid());
+	if (n < 0 || (size_t)n >= sizeof o->tmp)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", path);
+	o->f = fopen(o->tmp, "w");
+	if (!o->f)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write: %s", o->tmp,
+		                      strerror(errno));
+	return BSIM_OK;
+}
+
+/* Flushes to disk and renames into place; on any error the temporary file
+ * is removed and PATH is left as it was. */
+static int out_commit(out_file *o, bsim_error *err)
+{
+	int bad = ferror(o->f) || fflush(o->f) != 0 || fsync(fileno(o->f)) != 0;
+	int saved = errno;
+	bad |= fclose(o->f) != 0;
+	if (!bad && rename(o->tmp, o->path) == 0)
+		return BSIM_OK;
+	if (!bad)
+		saved = errno;
+	unlink(o->tmp);
+	return bsim_error_set(err, BSIM_EFAIL, "%s: write failed: %s", o->path, strerror(saved));
+}
+
+/* ---- JSON ------------------------------------------------------------ */
+
+static void json_string(FILE *f, const char *s)
+{
+	fputc('"', f);
+	for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+		switch (*p) {
+		case '"':
+			fputs("\\\"", f);
+			break;
+		case '\\':
+			fputs("\\\\", f);
+			break;
+		case '\n':
+			fputs("\\n", f);
+			break;
+		case '\r':
+			fputs("\\r", f);
+			break;
+		case '\t':
+			fputs("\\t", f);
+			break;
+		default:
+			if (*p < 0x20)
+				fprintf(f, "\\u%04x", *p);
+			else
+				fputc(*p, f);
+		}
+	}
+	fputc('"', f);
+}
+
+/* The shortest of %.15g..%.17g that reads back as the same double: exact
+ * round trip, and 0.42 stays "0.42" instead of "0.41999999999999998".
+ * JSON has no NaN or infinity; they become null. */
+static void json_double(FILE *f, double x)
+{
+	char buf[32];
+	if (!isfinite(x)) {
+		fputs("null", f);
+		return;
+	}
+	for (int prec = 15; prec <= 17; prec++) {
+		snprintf(buf, sizeof buf, "%.*g", prec, x);
+		if (strtod(buf, NULL) == x)
+			break;
+	}
+	fputs(buf, f);
+}
+
+/* A grid value is a JSON number when its YAML text is a finite number. */
+static int text_number(const char *s, double *out)
+{
+	char *end;
+	while (*s == ' ' || *s == '\t')
+		s++;
+	if (*s == '\0')
+		return 0;
+	errno = 0;
+	*out = strtod(s, &end);
+	while (*end == ' ' || *end == '\t')
+		end++;
+	return errno == 0 && *end == '\0' && isfinite(*out);
+}
+
+/* Every knob of the backend with its effective value (given or default),
+ * so the summary alone says how the backend was configured. */
+static void json_backend_options(FILE *f, const char *backend, const bsim_options *opts)
+{
+	const bsim_backend *b = bsim_backend_find(backend, NULL);
+	int first = 1;
+	fputc('{', f);
+	for (int i = 0; b && i < b->n_knobs; i++) {
+		const char *v = bsim_options_get(opts, b->knobs[i].name);
+		if (!v)
+			v = b->knobs[i].default_value ? b->knobs[i].default_value : "";
+		fputs(first ? "" : ", ", f);
+		json_string(f, b->knobs[i].name);
+		fputs(": ", f);
+		json_string(f, v);
+		first = 0;
+	}
+	/* Options the backend does not list (none once checked) still show. */
+	for (int i = 0; opts && i < opts->n; i++) {
+		int known = 0;
+		for (int j = 0; b && j < b->n_knobs; j++)
+			known |= strcmp(b->knobs[j].name, opts->key[i]) == 0;
+		if (known)
+			continue;
+		fputs(first ? "" : ", ", f);
+		json_string(f, opts->key[i]);
+		fputs(": ", f);
+		json_string(f, opts->value[i]);
+		first = 0;
+	}
+	fputc('}', f);
+}
+
+static void json_params(FILE *f, const bsim_experiment *e, const int *idx)
+{
+	fputc('{', f);
+	for (int a = 0; a < e->n_axes; a++) {
+		const char *text = e->axes[a].values[idx[a]];
+		double x;
+		fputs(a ? ", " : "", f);
+		json_string(f, e->axes[a].key);
+		fputs(": ", f);
+		if (text_number(text, &x))
+			json_double(f, x);
+		else
+			json_string(f, text);
+	}
+	fputc('}', f);
+}
+
+static void json_group(FILE *f, const bsim_experiment *e, const bsim_group_result *g, int *idx)
+{
+	fputs("{\"params\": ", f);
+	json_params(f, e, idx);
+	fprintf(f,
+	        ", \"trials\": %d, \"traversed\": %d, \"side_exit\": %d, \"stuck\": %d, "
+	        "\"left\": %d, \"right\": %d, \"p_traverse\": ",
+	        g->trials, g->traversed, g->side_exit, g->stuck, g->left, g->right);
+	json_double(f, g->p_traverse);
+	fputs(", \"ci95\": [", f);
+	json_double(f, g->ci95[0]);
+	fputs(", ", f);
+	json_double(f, g->ci95[1]);
+	fprintf(f,
+	        "], \"stuck_in_contact\": %d, \"landscape_left\": %d, \"landscape_right\": %d, "
+	        "\"steps\": %ld}",
+	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps);
+}
+
+/* One group per line: the file stays small, diffs line up with groups, and
+ * the wall_seconds line is the only one that differs between equal runs. */
+int bsim_output_summary_json(const char *path, const bsim_experiment *e, const char *backend,
+                             const bsim_options *opts, const bsim_sweep_result *r, bsim_error *err)
+{
+	out_file o;
+	if (out_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	int *idx = calloc(e->n_axes > 0 ? (size_t)e->n_axes : 1, sizeof *idx);
+	if (!idx) {
+		fclose(o.f);
+		unlink(o.tmp);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	FILE *f = o.f;
+	fputs("{\n  \"backend\": ", f);
+	json_string(f, backend);
+	fputs(",\n  \"backend_options\": ", f);
+	json_backend_options(f, backend, opts);
+	fputs(",\n  \"experiment\": ", f);
+	json_string(f, e->path);
+	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d", e->seed, r->trials);
+	fprintf(f, ",\n  \"wall_seconds\": %.3f", r->wall_seconds);
+	fputs(",\n  \"groups\": [", f);
+	for (int g = 0; g < r->n_groups; g++) {
+		bsim_experiment_group_index(e, g, idx);
+		fputs(g ? ",\n    " : "\n    ", f);
+		json_group(f, e, &r->groups[g], idx);
+	}
+	fputs("\n  ],\n  \"version\": ", f);
+	json_string(f, BSIM_VERSION);
+	fputs(",\n  \"scene\": ", f);
+	json_string(f, e->scene_path);
+	fputs("\n}\n", f);
+	free(idx);
+	return out_commit(&o, err);
+}
+
+/* ---- trials.csv -------------------------------------------------------- */
+
+int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_error *err)
+{
+	out_file o;
+	if (out_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fputs("group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2\n",
+	      o.f);
+	for (int g = 0; g < r->n_groups; g++) {
+		for (int t = 0; t < r->trials; t++) {
+			const bsim_trial_result *x = &r->trials_out[(size_t)g * r->trials + t];
+			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", g, t,
+			        bsim_outcome_name(x->outcome), bsim_type_name(x->type), x->steps,
+			        x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
+			        x->max_theta[1]);
+		}
+	}
+	return out_commit(&o, err);
+}
+
+/* ---- the p_traverse table ------------------------------------------------ */
+
+/* Where each group sits in the tables: cell[(rest * n1 + i1) * n0 + i0] is
+ * the group at axis-0 value i0, axis-1 value i1 and index rest over the
+ * remaining axes (axis 2 slowest). Built from bsim_experiment_group_index,
+ * so it does not assume an order of groups. */
+typedef struct table_layout {
+	int n0, n1, n_rest;
+	int *cell;
+} table_layout;
+
+static int layout_build(table_layout *l, const bsim_experiment *e)
+{
+	l->n0 = e->n_axes > 0 ? e->axes[0].n_values : 1;
+	l->n1 = e->n_axes > 1 ? e->axes[1].n_values : 1;
+	l->n_rest = 1;
+	for (int a = 2; a < e->n_axes; a++)
+		l->n_rest *= e->axes[a].n_values;
+	size_t n = (size_t)l->n0 * l->n1 * l->n_rest;
+	int *idx = calloc(e->n_axes > 0 ? (size_t)e->n_axes : 1, sizeof *idx);
+	l->cell = malloc(n * sizeof *l->cell);
+	if (!idx || !l->cell) {
+		free(idx);
+		free(l->cell);
+		return -1;
+	}
+	for (size_t i = 0; i < n; i++)
+		l->cell[i] = -1;
+	for (int g = 0; g < e->n_groups; g++) {
+		bsim_experiment_group_index(e, g, idx);
+		int rest = 0;
+		for (int a = 2; a < e->n_axes; a++)
+			rest = rest * e->axes[a].n_values + idx[a];
+		int i0 = e->n_axes > 0 ? idx[0] : 0, i1 = e->n_axes > 1 ? idx[1] : 0;
+		l->cell[((size_t)rest * l->n1 + i1) * l->n0 + i0] = g;
+	}
+	free(idx);
+	return 0;
+}
+
+static int max_len(const bsim_grid_axis *axis, int floor)
+{
+	int w = floor;
+	for (int i = 0; i < axis->n_values; i++) {
+		int len = (int)strlen(axis->values[i]);
+		w = len > w ? len : w;
+	}
+	return w;
+}
+
+/* "beams.0.stiffness = 100, contact.restitution = 0.8" for table rest. */
+static void table_heading(FILE *f, const bsim_experiment *e, int rest)
+{
+	int div = 1;
+	for (int a = 2; a < e->n_axes; a++)
+		div *= e->axes[a].n_values;
+	for (int a = 2; a < e->n_axes; a++) {
+		div /= e->axes[a].n_values;
+		int i = (rest / div) % e->axes[a].n_values;
+		fprintf(f, "%s%s = %s", a > 2 ? ", " : "", e->axes[a].key, e->axes[a].values[i]);
+	}
+	fputc('\n', f);
+}
+
+static void table_rule(FILE *f, int w, char c)
+{
+	for (int i = 0; i < w; i++)
+		fputc(c, f);
+}
+
+/* One table: a header naming both axes, column values, a rule, and one row
+ * of p_traverse per axis-1 value.
+ *
+ *                                 | effects.propulsion.force
+ *  effects.random_force.magnitude |    4     5     6
+ *  -------------------------------+------------------
+ *                               0 | 0.00  0.12  0.40 */
+static void table_one(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r,
+                      const table_layout *l, int rest)
+{
+	const bsim_grid_axis *a0 = &e->axes[0];
+	const bsim_grid_axis *a1 = e->n_axes > 1 ? &e->axes[1] : NULL;
+	const char *row_key = a1 ? a1->key : "p_traverse";
+	int cw = max_len(a0, 4);
+	int rw = a1 ? max_len(a1, (int)strlen(row_key)) : (int)strlen(row_key);
+
+	fprintf(f, "%*s | %s\n%-*s |", rw, "", a0->key, rw, a1 ? row_key : "");
+	for (int i0 = 0; i0 < l->n0; i0++)
+		fprintf(f, "%s%*s", i0 ? "  " : " ", cw, a0->values[i0]);
+	fputc('\n', f);
+	table_rule(f, rw + 1, '-');
+	fputc('+', f);
+	table_rule(f, l->n0 * (cw + 2), '-');
+	fputc('\n', f);
+	for (int i1 = 0; i1 < l->n1; i1++) {
+		fprintf(f, "%*s |", rw, a1 ? a1->values[i1] : row_key);
+		for (int i0 = 0; i0 < l->n0; i0++) {
+			int g = l->cell[((size_t)rest * l->n1 + i1) * l->n0 + i0];
+			if (g >= 0 && g < r->n_groups)
+				fprintf(f, "%s%*.2f", i0 ? "  " : " ", cw, r->groups[g].p_traverse);
+			else
+				fprintf(f, "%s%*s", i0 ? "  " : " ", cw, "-");
+		}
+		fputc('\n', f);
+	}
+}
+
+void bsim_output_table(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r)
+{
+	fprintf(f, "p_traverse, %d trials per group\n", r->trials);
+	if (e->n_axes == 0) {
+		if (r->n_groups > 0)
+			fprintf(f, "%.2f [%.2f, %.2f]\n", r->groups[0].p_traverse,
+			        r->groups[0].ci95[0], r->groups[0].ci95[1]);
+		return;
+	}
+	table_layout l;
+	if (layout_build(&l, e) != 0) {
+		fputs("(out of memory for the table)\n", f);
+		return;
+	}
+	for (int rest = 0; rest < l.n_rest; rest++) {
+		fputc('\n', f);
+		if (e->n_axes > 2)
+			table_heading(f, e, rest);
+		table_one(f, e, r, &l, rest);
+	}
+	free(l.cell);
+}
+
+/* ---- directories ---------------------------------------------------------- */
+
+int bsim_output_mkdir(const char *dir, bsim_error *err)
+{
+	char path[1024];
+	struct stat st;
+	int n = snprintf(path, sizeof path, "%s", dir);
+	if (n <= 0 || (size_t)n >= sizeof path)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: bad directory name", dir);
+	/* Each parent in turn, like mkdir -p; existing ones are fine. */
+	for (char *p = path + 1; *p; p++) {
+		if (*p != '/')
+			continue;
+		*p = '\0';
+		if (mkdir(path, 0777) != 0 && errno != EEXIST)
+			return bsim_error_set(err, BSIM_EFAIL, "%s: cannot create: %s", path,
+			                      strerror(errno));
+		*p = '/';
+	}
+	if (mkdir(path, 0777) != 0 && errno != EEXIST)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot create: %s", dir,
+		                      strerror(errno));
+	if (stat(path, &st) != 0 || !S_ISDIR(st.st_mode))
+		return bsim_error_set(err, BSIM_EFAIL, "%s: not a directory", dir);
+	return BSIM_OK;
+}

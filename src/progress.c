@@ -1,0 +1,66 @@
+/* The progress line of long runs; see beamsim/progress.h. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/progress.h"
+
+#include <stdio.h>
+#include <time.h>
+#include <unistd.h>
+
+/* Redraw interval, s: fast enough to look live, slow enough to cost nothing. */
+#define PROGRESS_INTERVAL 0.1
+
+static double monotonic_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void bsim_progress_init(bsim_progress *p, int enabled)
+{
+	p->active = enabled && isatty(STDERR_FILENO);
+	p->shown = 0;
+	p->t_start = monotonic_seconds();
+	p->t_last = -1.0;
+}
+
+/* "0:03", "12:40", "1:02:03". */
+static void format_duration(char *buf, size_t n, double s)
+{
+	long t = (long)(s + 0.5);
+	if (t >= 3600)
+		snprintf(buf, n, "%ld:%02ld:%02ld", t / 3600, t / 60 % 60, t % 60);
+	else
+		snprintf(buf, n, "%ld:%02ld", t / 60, t % 60);
+}
+
+void bsim_progress_update(void *user, long done, long total)
+{
+	bsim_progress *p = user;
+	if (!p || !p->active || total <= 0)
+		return;
+	double now = monotonic_seconds();
+	if (done < total && p->t_last >= 0.0 && now - p->t_last < PROGRESS_INTERVAL)
+		return;
+	p->t_last = now;
+
+	char eta[32] = "-:--";
+	double elapsed = now - p->t_start;
+	if (done >= total)
+		format_duration(eta, sizeof eta, elapsed);
+	else if (done > 0)
+		format_duration(eta, sizeof eta, elapsed * (double)(total - done) / (double)done);
+	/* Trailing spaces wipe what a longer previous line left behind. */
+	fprintf(stderr, "\r  %ld/%ld trials  %d%%  %s %s   ", done, total,
+	        (int)(100.0 * (double)done / (double)total), done >= total ? "took" : "ETA", eta);
+	fflush(stderr);
+	p->shown = 1;
+}
+
+void bsim_progress_finish(bsim_progress *p)
+{
+	if (p->active && p->shown)
+		fputc('\n', stderr);
+	p->shown = 0;
+}

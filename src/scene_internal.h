@@ -1,0 +1,73 @@
+/* Internal: what scene.c, scene_schema.c and scene_load.c share. The scene
+ * schema is a table per YAML mapping (key, type, range, offset), so the file
+ * loader and bsim_scene_validate check the same things from one list. */
+#ifndef BSIM_SCENE_INTERNAL_H
+#define BSIM_SCENE_INTERNAL_H
+
+#include <stddef.h>
+
+#include "beamsim/scene.h"
+#include "yaml_doc.h"
+
+typedef enum scene_kind {
+	SK_NUMBER, /* double, finite, in range */
+	SK_INT,    /* int > 0 */
+	SK_VEC2,   /* double[2], finite: [x, y] */
+	SK_NAME,   /* char[128], non-empty */
+	SK_BLOCK,  /* a nested mapping (sub) */
+	SK_BEAMS,  /* the list of beams (sub describes one beam) */
+} scene_kind;
+
+typedef enum scene_range {
+	SR_ANY,      /* any finite number */
+	SR_POSITIVE, /* > 0 */
+	SR_NONNEG,   /* >= 0 */
+	SR_UNIT,     /* in [0, 1] */
+} scene_range;
+
+/* For an SK_BLOCK without a presence flag. */
+#define SCENE_NO_FLAG ((size_t)-1)
+
+typedef struct scene_table scene_table;
+
+typedef struct scene_field {
+	const char *key;
+	scene_kind kind;
+	scene_range range;
+	int required;
+	/* Byte offset of the value in the struct the table describes; for an
+	 * SK_BLOCK, of the int set to 1 when the block is present (effects
+	 * simulate only what is listed), or SCENE_NO_FLAG. */
+	size_t offset;
+	const scene_table *sub;
+} scene_field;
+
+struct scene_table {
+	const scene_field *fields;
+	int n_fields;
+};
+
+extern const scene_table scene_top_table;  /* offsets into bsim_scene */
+extern const scene_table scene_beam_table; /* offsets into bsim_beam_def */
+
+/* What a field expects, for messages: "a positive number", "a mapping". */
+const char *scene_phrase(const scene_field *f);
+
+int scene_in_range(scene_range r, double v);
+
+/* "pivot, rest_angle_deg, ..." for unknown-key messages. */
+void scene_keys(const scene_table *t, char *buf, size_t size);
+
+/* Everything that has a default gets it; the rest is zero. */
+void scene_defaults(bsim_scene *s);
+
+/* Index of the first beam the body overlaps at the start (distance from the
+ * body centre to the beam segment < radius), or -1; *dist in m. */
+int scene_overlap(const bsim_scene *s, double *dist);
+
+/* bsim_scene_load on a document already read (the experiment loader reads
+ * the scene file once and builds every group from a clone of it). */
+int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,
+                      bsim_error *err);
+
+#endif

@@ -1,0 +1,222 @@
+/* A sweep: every (group, trial) of an experiment on one backend.
+ *
+ * The (group, trial) pairs form one flat list, index g*trials + t, handed
+ * out dynamically to OpenMP threads (trials end at very different times, so
+ * a static split would leave threads idle). A trial's seed depends only on
+ * (experiment seed, g, t) and its result goes to its own slot, so the
+ * result is the same whatever the thread count (DESIGN.md "Determinism"). */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/sweep.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "beamsim/schedule.h"
+#include "beamsim/stats.h"
+
+static double monotonic_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out)
+{
+	memset(out, 0, sizeof *out);
+	out->trials = n;
+	for (int i = 0; i < n; i++) {
+		const bsim_trial_result *t = &trials[i];
+		out->steps += t->steps_run;
+		switch (t->outcome) {
+		case BSIM_TRAVERSED:
+			out->traversed++;
+			out->left += t->type == BSIM_TYPE_LEFT;
+			out->right += t->type == BSIM_TYPE_RIGHT;
+			/* Equal peaks (e.g. a beam never touched twice) count as
+			 * neither side rather than defaulting to one. */
+			out->landscape_left += t->landscape_left != 0;
+			out->landscape_right +=
+			        !t->landscape_left && t->max_theta[1] > t->max_theta[0];
+			break;
+		case BSIM_SIDE_EXIT:
+			out->side_exit++;
+			break;
+		case BSIM_STUCK:
+			out->stuck++;
+			out->stuck_in_contact += t->in_contact_end != 0;
+			break;
+		}
+	}
+	out->p_traverse = n > 0 ? (double)out->traversed / n : 0.0;
+	bsim_wilson(out->traversed, n, BSIM_Z95, &out->ci95[0], &out->ci95[1]);
+}
+
+void bsim_sweep_result_free(bsim_sweep_result *r)
+{
+	if (!r)
+		return;
+	free(r->trials_out);
+	free(r->groups);
+	memset(r, 0, sizeof *r);
+}
+
+static void scenes_free(bsim_scene *scenes, int n)
+{
+	for (int g = 0; g < n; g++)
+		bsim_scene_free(&scenes[g]);
+	free(scenes);
+}
+
+/* Every group's scene, built once: a trial only reads its scene. */
+static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_scene **out,
+                        bsim_error *err)
+{
+	bsim_scene *scenes = calloc((size_t)e->n_groups, sizeof *scenes);
+	*out = NULL;
+	if (!scenes)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %d scenes", e->n_groups);
+	for (int g = 0; g < e->n_groups; g++) {
+		int rc = bsim_experiment_group_scene(e, g, cfg->extra, cfg->n_extra, &scenes[g],
+		                                     err);
+		if (rc != BSIM_OK) {
+			scenes_free(scenes, g);
+			return rc;
+		}
+	}
+	*out = scenes;
+	return BSIM_OK;
+}
+
+/* What the threads share. first_fail is the index of the lowest failed
+ * trial so far (total if none, -1 if a thread could not start). */
+typedef struct sweep_shared {
+	const bsim_experiment *e;
+	const bsim_sweep_config *cfg;
+	const bsim_scene *scenes;
+	bsim_trial_result *results;
+	long total;
+	long done;
+	long first_fail;
+	bsim_error fail;
+} sweep_shared;
+
+static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
+{
+#pragma omp critical(bsim_sweep_fail)
+	{
+		if (i < sh->first_fail) {
+			if (i < 0)
+				bsim_error_set(&sh->fail, code, "%s", msg);
+			else
+				bsim_error_set(&sh->fail, code, "group %ld, trial %ld: %s",
+				               i / sh->e->trials, i % sh->e->trials, msg);
+#pragma omp atomic write
+			sh->first_fail = i;
+		}
+	}
+}
+
+/* Trials are handed out in index order, so when trial i fails every trial
+ * before it has started; skipping only those after it lets the others
+ * finish and makes the reported error the first by (g, t) whatever the
+ * thread count. */
+static void sweep_thread(sweep_shared *sh)
+{
+	const bsim_experiment *e = sh->e;
+	const bsim_sweep_config *cfg = sh->cfg;
+	int leader = omp_get_thread_num() == 0;
+	bsim_runner *runner = bsim_runner_alloc();
+	bsim_error err;
+
+	if (!runner)
+		shared_fail(sh, -1, BSIM_EFAIL, "out of memory for a trial runner");
+#pragma omp for schedule(dynamic)
+	for (long i = 0; i < sh->total; i++) {
+		long stop;
+#pragma omp atomic read
+		stop = sh->first_fail;
+		if (!runner || i > stop)
+			continue;
+		long g = i / e->trials, t = i % e->trials;
+		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
+		bsim_error_clear(&err);
+		int rc = bsim_trial_run(runner, &sh->scenes[g], cfg->backend, cfg->opts, seed, NULL,
+		                        &sh->results[i], &err);
+		if (rc != BSIM_OK)
+			shared_fail(sh, i, rc, err.msg);
+		long done;
+#pragma omp atomic capture
+		done = ++sh->done;
+		if (leader && cfg->progress)
+			cfg->progress(cfg->progress_user, done, sh->total);
+	}
+	bsim_runner_free(runner);
+}
+
+static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_error *err)
+{
+	size_t n = (size_t)n_groups * (size_t)trials;
+	memset(r, 0, sizeof *r);
+	r->n_groups = n_groups;
+	r->trials = trials;
+	r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
+	r->groups = calloc(n_groups ? (size_t)n_groups : 1, sizeof *r->groups);
+	if (!r->trials_out || !r->groups) {
+		bsim_sweep_result_free(r);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %zu trial results", n);
+	}
+	return BSIM_OK;
+}
+
+int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
+                   bsim_error *err)
+{
+	double t0 = monotonic_seconds();
+	if (e->trials < 0 || e->n_groups < 1)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: expected at least one group and trials >= 0", e->path);
+	if (result_alloc(out, e->n_groups, e->trials, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	bsim_scene *scenes;
+	int rc = scenes_build(e, cfg, &scenes, err);
+	if (rc != BSIM_OK) {
+		bsim_sweep_result_free(out);
+		return rc;
+	}
+
+	sweep_shared sh = {
+	        .e = e,
+	        .cfg = cfg,
+	        .scenes = scenes,
+	        .results = out->trials_out,
+	        .total = (long)e->n_groups * e->trials,
+	};
+	sh.first_fail = sh.total;
+	bsim_error_clear(&sh.fail);
+	int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
+	if (threads > sh.total)
+		threads = sh.total > 0 ? (int)sh.total : 1;
+
+#pragma omp parallel num_threads(threads)
+	sweep_thread(&sh);
+
+	scenes_free(scenes, e->n_groups);
+	if (sh.first_fail < sh.total) {
+		bsim_sweep_result_free(out);
+		return bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
+	}
+	for (int g = 0; g < e->n_groups; g++)
+		bsim_group_aggregate(&out->trials_out[(size_t)g * e->trials], e->trials,
+		                     &out->groups[g]);
+	for (size_t i = 0; i < (size_t)sh.total; i++)
+		out->total_steps += out->trials_out[i].steps_run;
+	/* The final count may have been reached on another thread. */
+	if (cfg->progress)
+		cfg->progress(cfg->progress_user, sh.total, sh.total);
+	out->wall_seconds = monotonic_seconds() - t0;
+	return BSIM_OK;
+}

@@ -1,0 +1,96 @@
+/* Internal: a YAML document read quietly with libfyaml, and the pieces every
+ * loader needs to report one-line errors "WHERE: FIELD: expected WHAT, got
+ * GOT". WHERE is the file position of the offending node, or the origin of
+ * the override that put the node there (overrides tag the nodes they create
+ * with fy_node_set_meta, see yaml_override.c). */
+#ifndef BSIM_YAML_DOC_H
+#define BSIM_YAML_DOC_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <libfyaml.h>
+
+#include "beamsim/error.h"
+#include "beamsim/scene.h"
+
+typedef struct ydoc {
+	struct fy_document *fyd;
+	const char *path; /* the file name used in messages, borrowed */
+} ydoc;
+
+/* Reads and parses path. A syntax error becomes BSIM_EINPUT with
+ * "FILE:LINE:COL: syntax: expected valid YAML, got MSG"; libfyaml prints
+ * nothing itself. */
+int ydoc_load(ydoc *d, const char *path, bsim_error *err);
+
+/* Parses YAML flow text (an override value) into a new document. On failure
+ * returns NULL and, if msg is given, libfyaml's first message. */
+struct fy_document *ydoc_parse_text(const char *text, char *msg, size_t size);
+
+void ydoc_free(ydoc *d);
+
+/* The override that created n or one of its ancestors, NULL if it came from
+ * the file. */
+const bsim_override *ydoc_origin(struct fy_node *n);
+
+/* Writes where n is: the override origin, else "FILE:LINE:COL". Nodes without
+ * a position of their own (an empty value, an empty mapping) use alt, usually
+ * the key they belong to. */
+void ydoc_where(const ydoc *d, struct fy_node *n, struct fy_node *alt, char *buf, size_t size);
+
+/* buf = a followed by b, cut to size: field paths ("beams.0.mass") only
+ * ever appear in messages. */
+void ydoc_join(char *buf, size_t size, const char *a, const char *b);
+
+/* The 1-based line of n (or of alt when n has no position), 0 if unknown;
+ * for "FILE:LINE" origins of experiment values. */
+int ydoc_line(struct fy_node *n, struct fy_node *alt);
+
+/* Sets err to "WHERE: FIELD: MESSAGE" and returns BSIM_EINPUT. */
+int ydoc_fail(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
+              bsim_error *err, const char *fmt, ...) __attribute__((format(printf, 6, 7)));
+
+/* Sets err to "WHERE: FIELD: expected WHAT, got <n described>". */
+int ydoc_expected(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
+                  const char *what, bsim_error *err);
+
+/* An absent or empty value ("key:" with nothing after it). */
+int ydoc_is_null(struct fy_node *n);
+
+/* What a node is, for the "got ..." half of a message: the scalar text
+ * ("-1", ".nan", "\"7\"" for a quoted string), "a mapping", "a list of 3
+ * items", "nothing". */
+void ydoc_describe(struct fy_node *n, char *buf, size_t size);
+
+/* The text of a plain scalar; NULL for anything else (a quoted string, a
+ * collection, an empty value). */
+const char *ydoc_plain(struct fy_node *n);
+
+/* Number parsing: YDOC_NUM_OK, YDOC_NUM_NONE (not a plain number),
+ * YDOC_NUM_NONFINITE (.nan, .inf, 1e999, "nan", ...). */
+enum { YDOC_NUM_OK = 0, YDOC_NUM_NONE = 1, YDOC_NUM_NONFINITE = 2 };
+int ydoc_number(struct fy_node *n, double *out);
+
+/* Plain decimal integers only ("3000", "+7", "-1"); 1 on success. */
+int ydoc_int64(struct fy_node *n, long long *out);
+int ydoc_uint64(struct fy_node *n, uint64_t *out);
+
+/* The pair of a mapping whose scalar key is exactly comp[0..len). */
+struct fy_node_pair *ydoc_pair(struct fy_node *map, const char *comp, size_t len);
+
+/* A list index in a dotted path: decimal digits only; 1 on success. */
+int ydoc_index(const char *comp, size_t len, int *out);
+
+/* The child of a mapping by key or of a sequence by decimal index; NULL if
+ * absent or n is a scalar. len is the length of comp. */
+struct fy_node *ydoc_child(struct fy_node *n, const char *comp, size_t len);
+
+/* The node at a dotted path ("beams.0.pivot") below root, NULL if absent. */
+struct fy_node *ydoc_lookup(struct fy_node *root, const char *path);
+
+/* Flow text of a node that re-parses to the same value: plain scalars as
+ * written, anything else emitted on one line. malloc'd, NULL on failure. */
+char *ydoc_flow_text(struct fy_node *n);
+
+#endif

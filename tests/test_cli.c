@@ -1,0 +1,399 @@
+/* The beamsim program as a user meets it (DESIGN.md "Command line",
+ * "Outputs"): help, version, exit statuses, run, sweep, backends. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <dirent.h>
+
+#include <cmocka.h>
+
+#include "support.h"
+
+#define TRIALS_HEADER                                                                              \
+	"group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2\n"
+#define TRAJ_HEADER                                                                                \
+	"t,x,y,vx,vy,theta1,omega1,theta2,omega2,f_rand,contact1,contact2,e_kin,e_beam,e_prop\n"
+
+/* Runs the program; keeps stdout and stderr for the checks. */
+typedef struct cli_run {
+	int status;
+	char *out, *err;
+} cli_run;
+
+static cli_run run_cli(const char *const argv[])
+{
+	cli_run r;
+	r.status = bsim_test_cli(argv, &r.out, &r.err);
+	assert_non_null(r.out);
+	assert_non_null(r.err);
+	return r;
+}
+
+static void cli_run_free(cli_run *r)
+{
+	free(r->out);
+	free(r->err);
+}
+
+static void assert_contains(const char *text, const char *part)
+{
+	if (!strstr(text, part))
+		fail_msg("expected \"%s\" in:\n%s", part, text);
+}
+
+static char gate[1024];
+
+static int setup(void **state)
+{
+	(void)state;
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	return 0;
+}
+
+/* A small experiment on the essay's gate: 2 x 1 groups of 3 short trials. */
+static const char *small_experiment(const char *dir)
+{
+	char text[2048];
+	snprintf(text, sizeof text,
+	         "scene: %s\n"
+	         "trials: 3\n"
+	         "seed: 5\n"
+	         "set:\n"
+	         "  integration.max_steps: 800\n"
+	         "grid:\n"
+	         "  effects.propulsion.force: [6, 8]\n"
+	         "  effects.random_force.magnitude: [20]\n",
+	         gate);
+	return bsim_test_write(dir, "small.yaml", text);
+}
+
+static void check_help(const char *cmd, const char *const *mentions)
+{
+	const char *argv[] = {cmd, "--help", NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 0);
+	for (int i = 0; mentions[i]; i++)
+		assert_contains(r.out, mentions[i]);
+	cli_run_free(&r);
+}
+
+static void test_help(void **state)
+{
+	(void)state;
+	static const char *const top[] = {"run", "sweep", "backends", "bench", "--version", NULL};
+	static const char *const run[] = {
+	        "SCENE", "--backend",    "--backend-opt", "--seed", "--group", "--trial",
+	        "--set", "--trajectory", "--stride",      "--json", NULL};
+	static const char *const sweep[] = {"EXPERIMENT", "--out",    "--backend", "--backend-opt",
+	                                    "--threads",  "--trials", "--seed",    "--set",
+	                                    "--quiet",    NULL};
+	static const char *const backends[] = {"backends", "--help", NULL};
+	static const char *const bench[] = {"--backend", "--backend-opt", "--experiment",
+	                                    "--trials",  "--no-h2",       "--json",
+	                                    NULL};
+	const char *argv[] = {"--help", NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 0);
+	for (int i = 0; top[i]; i++)
+		assert_contains(r.out, top[i]);
+	cli_run_free(&r);
+	check_help("run", run);
+	check_help("sweep", sweep);
+	check_help("backends", backends);
+	check_help("bench", bench);
+}
+
+static void test_version(void **state)
+{
+	(void)state;
+	const char *argv[] = {"--version", NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 0);
+	assert_string_equal(r.out, "beamsim 0.1.0\n");
+	cli_run_free(&r);
+}
+
+static void test_bad_usage(void **state)
+{
+	(void)state;
+	const char *none[] = {NULL};
+	const char *unknown[] = {"fly", NULL};
+	const char *bad_opt[] = {"run", gate, "--warp", NULL};
+	const char *no_value[] = {"run", gate, "--seed", NULL};
+	const char *bad_seed[] = {"run", gate, "--seed", "-3", NULL};
+	const char *bad_set[] = {"run", gate, "--set", "nokey", NULL};
+	const char *no_scene[] = {"run", NULL};
+	const char *const *cases[] = {none,     unknown, bad_opt, no_value,
+	                              bad_seed, bad_set, no_scene};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		cli_run r = run_cli(cases[i]);
+		assert_int_equal(r.status, 2);
+		assert_contains(r.err, "beamsim");
+		assert_string_equal(r.out, "");
+		cli_run_free(&r);
+	}
+}
+
+static void test_sweep_needs_out(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("needs_out");
+	char exp[1024];
+	snprintf(exp, sizeof exp, "%s", small_experiment(dir));
+	const char *argv[] = {"sweep", exp, NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err, "--out");
+	cli_run_free(&r);
+}
+
+static void test_unknown_backend(void **state)
+{
+	(void)state;
+	const char *argv[] = {"run", gate, "--backend", "nosuch", NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err, "nosuch");
+	assert_contains(r.err, "thesis");
+	cli_run_free(&r);
+	const char *opt[] = {"run", gate, "--backend-opt", "nosuch=1", NULL};
+	r = run_cli(opt);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err, "nosuch");
+	cli_run_free(&r);
+}
+
+static void test_bad_scene(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("bad_scene");
+	char path[1024];
+	snprintf(path, sizeof path, "%s",
+	         bsim_test_write(dir, "bad.yaml", "name: bad\nbody: {mass: -1, radius: 10}\n"));
+	const char *argv[] = {"run", path, NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err, "bad.yaml");
+	assert_contains(r.err, "body.mass");
+	cli_run_free(&r);
+	const char *missing[] = {"run", "/nonexistent/scene.yaml", NULL};
+	r = run_cli(missing);
+	assert_int_equal(r.status, 2);
+	cli_run_free(&r);
+	const char *bad_set[] = {"run", gate, "--set", "body.mass=-1", NULL};
+	r = run_cli(bad_set);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err, "--set");
+	cli_run_free(&r);
+}
+
+static long json_long(const char *json, const char *key)
+{
+	char pat[64];
+	snprintf(pat, sizeof pat, "\"%s\": ", key);
+	const char *p = strstr(json, pat);
+	assert_non_null(p);
+	return strtol(p + strlen(pat), NULL, 10);
+}
+
+static void test_run(void **state)
+{
+	(void)state;
+	const char *text[] = {"run", gate, NULL};
+	cli_run r = run_cli(text);
+	assert_int_equal(r.status, 0);
+	assert_contains(r.out, "outcome");
+	assert_contains(r.out, "residual");
+	cli_run_free(&r);
+
+	const char *json[] = {"run", gate, "--json", "--seed", "3", "--trial", "2", NULL};
+	r = run_cli(json);
+	assert_int_equal(r.status, 0);
+	assert_true(r.out[0] == '{');
+	assert_contains(r.out, "\"outcome\": \"");
+	assert_contains(r.out, "\"ledger\": {");
+	assert_true(json_long(r.out, "draws") > 0);
+	cli_run_free(&r);
+
+	/* --set reaches the scene: without random force there are no draws. */
+	const char *no_rand[] = {"run", gate, "--json", "--set", "effects.random_force.magnitude=0",
+	                         NULL};
+	r = run_cli(no_rand);
+	assert_int_equal(r.status, 0);
+	assert_int_equal(json_long(r.out, "draws"), 0);
+	cli_run_free(&r);
+}
+
+static int count_lines(const char *s)
+{
+	int n = 0;
+	for (; *s; s++)
+		n += *s == '\n';
+	return n;
+}
+
+/* No PATH.tmp.PID is left behind in dir. */
+static void assert_no_tmp(const char *dir)
+{
+	DIR *d = opendir(dir);
+	assert_non_null(d);
+	for (struct dirent *e; (e = readdir(d));)
+		if (strstr(e->d_name, ".tmp."))
+			fail_msg("left over: %s/%s", dir, e->d_name);
+	closedir(d);
+}
+
+static void test_trajectory(void **state)
+{
+	(void)state;
+	char dir[1024], path[1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("trajectory"));
+	snprintf(path, sizeof path, "%s/traj.csv", dir);
+	const char *argv[] = {"run", gate, "--json", "--trajectory", path, NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 0);
+	long steps_run = json_long(r.out, "steps_run");
+	cli_run_free(&r);
+	char *csv = bsim_test_read(path);
+	assert_non_null(csv);
+	assert_memory_equal(csv, TRAJ_HEADER, strlen(TRAJ_HEADER));
+	/* One row per state: t = 0 and after every step. */
+	assert_int_equal(count_lines(csv) - 1, steps_run + 1);
+	free(csv);
+	assert_no_tmp(dir);
+
+	/* With a stride, every N-th step and the last one. */
+	const char *strided[] = {"run", gate, "--trajectory", path, "--stride", "10", NULL};
+	r = run_cli(strided);
+	assert_int_equal(r.status, 0);
+	cli_run_free(&r);
+	csv = bsim_test_read(path);
+	assert_non_null(csv);
+	int rows = count_lines(csv) - 1;
+	assert_true(rows >= steps_run / 10 && rows <= steps_run / 10 + 2);
+	free(csv);
+}
+
+/* Keys appear in this order in text. */
+static void assert_in_order(const char *text, const char *const *keys)
+{
+	const char *at = text;
+	for (int i = 0; keys[i]; i++) {
+		const char *p = strstr(at, keys[i]);
+		if (!p)
+			fail_msg("expected %s after offset %ld in:\n%s", keys[i], (long)(at - text),
+			         text);
+		at = p + strlen(keys[i]);
+	}
+}
+
+static void test_sweep(void **state)
+{
+	(void)state;
+	char dir[1024], exp[1100], out[1100], file[1200];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("sweep"));
+	snprintf(exp, sizeof exp, "%s", small_experiment(dir));
+	snprintf(out, sizeof out, "%s/out/nested", dir);
+	const char *argv[] = {"sweep", exp, "--out", out, "--threads", "2", NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 0);
+	assert_contains(r.out, "effects.propulsion.force");
+	assert_contains(r.out, "trials/s");
+	cli_run_free(&r);
+
+	snprintf(file, sizeof file, "%s/trials.csv", out);
+	char *csv = bsim_test_read(file);
+	assert_non_null(csv);
+	assert_memory_equal(csv, TRIALS_HEADER, strlen(TRIALS_HEADER));
+	assert_int_equal(count_lines(csv), 1 + 2 * 3);
+	assert_contains(csv, "\n1,2,");
+	free(csv);
+
+	snprintf(file, sizeof file, "%s/summary.json", out);
+	char *json = bsim_test_read(file);
+	assert_non_null(json);
+	static const char *const top[] = {"\"backend\": \"thesis\"",
+	                                  "\"backend_options\": {",
+	                                  "\"experiment\": ",
+	                                  "\"seed\": 5",
+	                                  "\"trials_per_group\": 3",
+	                                  "\"wall_seconds\": ",
+	                                  "\"groups\": [",
+	                                  "\"version\": \"0.1.0\"",
+	                                  "\"scene\": ",
+	                                  NULL};
+	static const char *const group[] = {"{\"params\": {\"effects.propulsion.force\": 6, "
+	                                    "\"effects.random_force.magnitude\": 20}",
+	                                    "\"trials\": 3",
+	                                    "\"traversed\": ",
+	                                    "\"side_exit\": ",
+	                                    "\"stuck\": ",
+	                                    "\"left\": ",
+	                                    "\"right\": ",
+	                                    "\"p_traverse\": ",
+	                                    "\"ci95\": [",
+	                                    "\"effects.propulsion.force\": 8",
+	                                    NULL};
+	assert_in_order(json, top);
+	assert_in_order(json, group);
+	free(json);
+	assert_no_tmp(out);
+
+	/* --quiet prints nothing on success. */
+	const char *quiet[] = {"sweep", exp, "--out", out, "--quiet", NULL};
+	r = run_cli(quiet);
+	assert_int_equal(r.status, 0);
+	assert_string_equal(r.out, "");
+	cli_run_free(&r);
+}
+
+/* A bad experiment writes nothing, not even the directory. */
+static void test_sweep_bad_experiment(void **state)
+{
+	(void)state;
+	char dir[1024], exp[1100], out[1100];
+	struct stat st;
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("sweep_bad"));
+	snprintf(exp, sizeof exp, "%s",
+	         bsim_test_write(dir, "bad.yaml", "scene: nosuch.yaml\ntrials: 3\n"));
+	snprintf(out, sizeof out, "%s/out", dir);
+	const char *argv[] = {"sweep", exp, "--out", out, NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err, "beamsim: ");
+	cli_run_free(&r);
+	assert_true(stat(out, &st) != 0);
+}
+
+static void test_backends(void **state)
+{
+	(void)state;
+	const char *argv[] = {"backends", NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 0);
+	assert_contains(r.out, "thesis");
+	cli_run_free(&r);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_help),
+	        cmocka_unit_test(test_version),
+	        cmocka_unit_test(test_bad_usage),
+	        cmocka_unit_test(test_sweep_needs_out),
+	        cmocka_unit_test(test_unknown_backend),
+	        cmocka_unit_test(test_bad_scene),
+	        cmocka_unit_test(test_run),
+	        cmocka_unit_test(test_trajectory),
+	        cmocka_unit_test(test_sweep),
+	        cmocka_unit_test(test_sweep_bad_experiment),
+	        cmocka_unit_test(test_backends),
+	};
+	return cmocka_run_group_tests(tests, setup, NULL);
+}

@@ -1,0 +1,454 @@
+/* Scene and experiment loading through the public API: the essay's files
+ * load to the essay's numbers, overrides land where their dotted path says,
+ * defaults fill what a file leaves out, and grids expand in the documented
+ * order. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "beamsim/experiment.h"
+#include "beamsim/scene.h"
+#include "support.h"
+
+/* cmocka 1.1.5 has no assert_double_equal. */
+#define assert_near(a, b, tol) assert_true(fabs((a) - (b)) <= (tol))
+
+/* A gate with nothing optional: every default applies. */
+static const char minimal_scene[] =
+        "body: { mass: 2, radius: 5 }\n"
+        "beams:\n"
+        "  - { pivot: [-20, 40], length: 10, mass: 0.3, stiffness: 100 }\n";
+
+static const char *write_minimal(const char *dir_name)
+{
+	const char *dir = bsim_test_dir(dir_name);
+	return bsim_test_write(dir, "minimal.yaml", minimal_scene);
+}
+
+static void load_ok(const char *path, const bsim_override *ov, int n, bsim_scene *s)
+{
+	bsim_error err = {0};
+	int rc = bsim_scene_load(path, ov, n, s, &err);
+	if (rc != BSIM_OK)
+		fail_msg("%s: %s", path, err.msg);
+}
+
+static void assert_beam_equal(const bsim_beam_def *a, const bsim_beam_def *b)
+{
+	assert_true(a->pivot[0] == b->pivot[0] && a->pivot[1] == b->pivot[1]);
+	assert_true(a->rest_angle_deg == b->rest_angle_deg);
+	assert_true(a->length == b->length);
+	assert_true(a->mass == b->mass);
+	assert_near(a->inertia, b->inertia, 1e-12);
+	assert_true(a->stiffness == b->stiffness);
+	assert_true(a->damping == b->damping);
+	assert_true(a->initial_theta == b->initial_theta);
+	assert_true(a->initial_omega == b->initial_omega);
+}
+
+static void assert_scene_equal(const bsim_scene *a, const bsim_scene *b)
+{
+	assert_string_equal(a->name, b->name);
+	assert_memory_equal(&a->body, &b->body, sizeof a->body);
+	assert_int_equal(a->n_beams, b->n_beams);
+	for (int i = 0; i < a->n_beams; i++)
+		assert_beam_equal(&a->beams[i], &b->beams[i]);
+	assert_memory_equal(&a->contact, &b->contact, sizeof a->contact);
+	assert_int_equal(a->effects.has_propulsion, b->effects.has_propulsion);
+	assert_true(a->effects.propulsion_force == b->effects.propulsion_force);
+	assert_int_equal(a->effects.has_random_force, b->effects.has_random_force);
+	assert_true(a->effects.random_magnitude == b->effects.random_magnitude);
+	assert_true(a->effects.random_frequency == b->effects.random_frequency);
+	assert_true(a->dt == b->dt);
+	assert_int_equal(a->max_steps, b->max_steps);
+	assert_true(a->success_y == b->success_y);
+	assert_true(a->side_x == b->side_x);
+	assert_true(a->classify_y == b->classify_y);
+	assert_true(a->landscape_y0 == b->landscape_y0);
+}
+
+static void gate_file_is_table_2_1(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	load_ok(bsim_test_src("configs/thesis/gate.yaml"), NULL, 0, &s);
+	assert_string_equal(s.name, "thesis-gate");
+	assert_non_null(strstr(s.path, "configs/thesis/gate.yaml"));
+	assert_true(s.body.mass == 1.0 && s.body.radius == 10.0);
+	assert_true(s.body.start[0] == 0 && s.body.start[1] == 0);
+	assert_int_equal(s.n_beams, 2);
+	assert_true(s.beams[0].pivot[0] == -25 && s.beams[0].pivot[1] == 30);
+	assert_true(s.beams[1].pivot[0] == 25 && s.beams[1].rest_angle_deg == 180);
+	for (int i = 0; i < 2; i++) {
+		assert_true(s.beams[i].length == 25 && s.beams[i].mass == 0.1);
+		assert_near(s.beams[i].inertia, 20.833333333333, 1e-9); /* m L^2 / 3 */
+		assert_true(s.beams[i].stiffness == 400 && s.beams[i].damping == 50);
+	}
+	assert_true(s.contact.restitution == 0.8 && s.contact.tip_restitution == 1.0);
+	assert_true(s.contact.rest_threshold == 0.05);
+	assert_true(s.effects.has_propulsion && s.effects.propulsion_force == 7.0);
+	assert_true(s.effects.has_random_force && s.effects.random_magnitude == 20.0);
+	assert_true(s.effects.random_frequency == 50.0);
+	assert_true(s.dt == 0.004 && s.max_steps == 3000);
+	assert_true(s.success_y == 65 && s.side_x == 25 && s.classify_y == 80);
+	assert_true(s.landscape_y0 == 60);
+
+	bsim_scene g;
+	bsim_scene_init_gate(&g, 7, 20);
+	assert_string_equal(g.path, "");
+	assert_scene_equal(&s, &g);
+	bsim_scene_free(&g);
+	bsim_scene_free(&s);
+}
+
+static void init_gate_is_valid_and_rm_zero_has_no_random_force(void **state)
+{
+	(void)state;
+	bsim_scene g;
+	bsim_error err = {0};
+	bsim_scene_init_gate(&g, 4, 0);
+	assert_int_equal(bsim_scene_validate(&g, &err), BSIM_OK);
+	assert_int_equal(g.effects.has_random_force, 0);
+	assert_int_equal(g.effects.has_propulsion, 1);
+	assert_true(g.effects.propulsion_force == 4);
+	bsim_scene_free(&g);
+}
+
+static void override_sets_beam_stiffness(void **state)
+{
+	(void)state;
+	bsim_override ov[] = {{"beams.0.stiffness", "250", "--set beams.0.stiffness=250"}};
+	bsim_scene s;
+	load_ok(bsim_test_src("configs/thesis/gate.yaml"), ov, 1, &s);
+	assert_true(s.beams[0].stiffness == 250);
+	assert_true(s.beams[1].stiffness == 400);
+	bsim_scene_free(&s);
+}
+
+static void override_sets_body_start_list(void **state)
+{
+	(void)state;
+	bsim_override ov[] = {{"body.start", "[1, 2]", NULL}};
+	bsim_scene s;
+	load_ok(bsim_test_src("configs/thesis/gate.yaml"), ov, 1, &s);
+	assert_true(s.body.start[0] == 1 && s.body.start[1] == 2);
+	bsim_scene_free(&s);
+}
+
+static void later_override_wins(void **state)
+{
+	(void)state;
+	bsim_override ov[] = {{"effects.propulsion", "{force: 3}", "a"},
+	                      {"effects.propulsion.force", "5", "b"}};
+	bsim_scene s;
+	load_ok(bsim_test_src("configs/thesis/gate.yaml"), ov, 2, &s);
+	assert_true(s.effects.propulsion_force == 5);
+	bsim_scene_free(&s);
+}
+
+static void override_inserts_missing_block(void **state)
+{
+	(void)state;
+	const char *path = write_minimal("insert_block");
+	bsim_scene s;
+	load_ok(path, NULL, 0, &s);
+	assert_int_equal(s.effects.has_random_force, 0);
+	assert_int_equal(s.effects.has_propulsion, 0);
+	bsim_scene_free(&s);
+
+	bsim_override ov[] = {{"effects.random_force.magnitude", "30", "--set x"}};
+	load_ok(path, ov, 1, &s);
+	assert_int_equal(s.effects.has_random_force, 1);
+	assert_true(s.effects.random_magnitude == 30);
+	assert_true(s.effects.random_frequency == 50); /* the block's default */
+	assert_int_equal(s.effects.has_propulsion, 0);
+	bsim_scene_free(&s);
+}
+
+static void defaults_fill_what_a_file_leaves_out(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	load_ok(write_minimal("defaults"), NULL, 0, &s);
+	assert_string_equal(s.name, "minimal"); /* base name without extension */
+	assert_true(s.body.mass == 2 && s.body.radius == 5);
+	assert_true(s.body.start[0] == 0 && s.body.velocity[1] == 0);
+	assert_int_equal(s.n_beams, 1);
+	const bsim_beam_def *b = &s.beams[0];
+	assert_true(b->rest_angle_deg == 0 && b->damping == 0);
+	assert_true(b->initial_theta == 0 && b->initial_omega == 0);
+	assert_near(b->inertia, 0.3 * 10 * 10 / 3.0, 1e-12);
+	assert_true(s.contact.restitution == 0.8 && s.contact.tip_restitution == 1.0);
+	assert_true(s.contact.rest_threshold == 0.05);
+	assert_true(s.effects.random_frequency == 50);
+	assert_true(s.dt == 0.004 && s.max_steps == 3000);
+	assert_true(s.success_y == 65 && s.side_x == 25 && s.classify_y == 80);
+	assert_true(s.landscape_y0 == 60);
+	bsim_scene_free(&s);
+}
+
+static void zero_magnitude_means_no_random_force(void **state)
+{
+	(void)state;
+	bsim_override ov[] = {{"effects.random_force.magnitude", "0", NULL}};
+	bsim_scene s;
+	load_ok(bsim_test_src("configs/thesis/gate.yaml"), ov, 1, &s);
+	assert_int_equal(s.effects.has_random_force, 0);
+	assert_int_equal(s.effects.has_propulsion, 1);
+	bsim_scene_free(&s);
+}
+
+/* The message names where, which field, what was expected, what was there. */
+static void expect_error(const char *path, const bsim_override *ov, int n, const char *msg)
+{
+	bsim_scene s;
+	bsim_error err = {0};
+	assert_int_equal(bsim_scene_load(path, ov, n, &s, &err), BSIM_EINPUT);
+	assert_int_equal(err.code, BSIM_EINPUT);
+	if (!strstr(err.msg, msg))
+		fail_msg("got \"%s\", wanted \"%s\"", err.msg, msg);
+	assert_null(s.beams);
+}
+
+static void errors_name_file_line_field(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("errors");
+	const char *p = bsim_test_write(dir, "bad.yaml",
+	                                "body: { mass: 1, radius: 10 }\n"
+	                                "beams:\n"
+	                                "  - pivot: [-25, 30]\n"
+	                                "    length: 25\n"
+	                                "    mass: 0.1\n"
+	                                "    stifness: 400\n");
+	expect_error(p, NULL, 0,
+	             "bad.yaml:6:5: beams.0.stifness: unknown key (expected one of pivot, "
+	             "rest_angle_deg, length, mass, inertia, stiffness, damping, initial_theta, "
+	             "initial_omega)");
+	p = bsim_test_write(dir, "missing.yaml",
+	                    "body: { mass: 1, radius: 10 }\n"
+	                    "beams:\n"
+	                    "  - { pivot: [-25, 30], length: 25, mass: 0.1, stiffness: 1 }\n"
+	                    "  - { pivot: [25, 30], mass: 0.1, stiffness: 1 }\n");
+	expect_error(p, NULL, 0,
+	             "missing.yaml:4:7: beams.1.length: missing (expected a positive number)");
+	p = bsim_test_write(dir, "mass.yaml", "body: { mass: -1, radius: 10 }\n");
+	expect_error(p, NULL, 0, "mass.yaml:1:15: body.mass: expected a positive number, got -1");
+}
+
+static void override_errors_name_the_override(void **state)
+{
+	(void)state;
+	const char *gate = bsim_test_src("configs/thesis/gate.yaml");
+	bsim_override mass[] = {{"body.mass", "-1", "--set body.mass=-1"}};
+	expect_error(gate, mass, 1,
+	             "--set body.mass=-1: body.mass: expected a positive number, got -1");
+	bsim_override idx[] = {{"beams.2.stiffness", "1", "h2.yaml:7"}};
+	expect_error(gate, idx, 1, "h2.yaml:7: beams.2: expected an index from 0 to 1, got 2");
+	bsim_override through[] = {{"body.mass.x", "1", "o"}};
+	expect_error(gate, through, 1, "o: body.mass.x: expected a mapping or list at body.mass");
+	bsim_override start[] = {{"body.start", "[0, 25]", "s"}};
+	expect_error(
+	        gate, start, 1,
+	        "s: body.start: the body (radius 10) overlaps beam 0 at the start (distance 5 m)");
+	/* An unknown key inside an override's own mapping still names it. */
+	bsim_override inner[] = {{"effects.propulsion", "{forc: 3}", "p"}};
+	expect_error(gate, inner, 1,
+	             "p: effects.propulsion.forc: unknown key (expected one of force)");
+}
+
+static void validate_checks_code_built_scenes(void **state)
+{
+	(void)state;
+	bsim_scene g, c;
+	bsim_error err = {0};
+	bsim_scene_init_gate(&g, 7, 20);
+	assert_int_equal(bsim_scene_copy(&c, &g), BSIM_OK);
+	assert_ptr_not_equal(c.beams, g.beams);
+	c.beams[1].length = 0;
+	assert_int_equal(bsim_scene_validate(&c, &err), BSIM_EINPUT);
+	assert_non_null(strstr(err.msg, "beams.1.length: expected a positive number, got 0"));
+	assert_true(g.beams[1].length == 25); /* the copy is deep */
+	c.beams[1].length = 25;
+	c.body.start[1] = 25; /* 5 m below the left beam */
+	assert_int_equal(bsim_scene_validate(&c, &err), BSIM_EINPUT);
+	assert_non_null(strstr(err.msg, "overlaps beam 0"));
+	c.body.start[1] = 0;
+	assert_int_equal(bsim_scene_set_beams(&c, 3), BSIM_OK);
+	assert_true(c.beams[2].length == 0 && c.beams[1].length == 25);
+	assert_int_equal(bsim_scene_validate(&c, &err), BSIM_EINPUT);
+	assert_int_equal(bsim_scene_set_beams(&c, 2), BSIM_OK);
+	assert_int_equal(bsim_scene_validate(&c, &err), BSIM_OK);
+	bsim_scene_free(&c);
+	bsim_scene_free(&g);
+}
+
+static void load_experiment(const char *rel, bsim_experiment *e)
+{
+	bsim_error err = {0};
+	if (bsim_experiment_load(bsim_test_src(rel), NULL, 0, e, &err) != BSIM_OK)
+		fail_msg("%s: %s", rel, err.msg);
+}
+
+static void group_scene(const bsim_experiment *e, int g, bsim_scene *s)
+{
+	bsim_error err = {0};
+	if (bsim_experiment_group_scene(e, g, NULL, 0, s, &err) != BSIM_OK)
+		fail_msg("group %d: %s", g, err.msg);
+}
+
+static void h1_has_30_groups_first_axis_slowest(void **state)
+{
+	(void)state;
+	bsim_experiment e;
+	load_experiment("configs/thesis/h1_symmetric.yaml", &e);
+	assert_int_equal(e.n_groups, 30);
+	assert_int_equal(e.trials, 100);
+	assert_true(e.seed == 1);
+	assert_int_equal(e.n_set, 0);
+	assert_int_equal(e.n_axes, 2);
+	assert_string_equal(e.axes[0].key, "effects.propulsion.force");
+	assert_string_equal(e.axes[1].key, "effects.random_force.magnitude");
+	assert_non_null(strstr(e.scene_path, "configs/thesis/gate.yaml"));
+	assert_non_null(strstr(e.axes[1].origins[2], "h1_symmetric.yaml:7"));
+
+	int idx[2];
+	static const int want[][3] = {{0, 0, 0}, {1, 0, 1}, {5, 1, 0}, {29, 5, 4}};
+	for (int i = 0; i < 4; i++) {
+		bsim_experiment_group_index(&e, want[i][0], idx);
+		assert_int_equal(idx[0], want[i][1]);
+		assert_int_equal(idx[1], want[i][2]);
+	}
+	static const double f_rm[][3] = {{0, 4, 0}, {1, 4, 10}, {5, 5, 0}, {29, 9, 40}};
+	for (int i = 0; i < 4; i++) {
+		bsim_scene s;
+		group_scene(&e, (int)f_rm[i][0], &s);
+		assert_true(s.effects.propulsion_force == f_rm[i][1]);
+		assert_true(s.effects.random_magnitude == f_rm[i][2]);
+		assert_int_equal(s.effects.has_random_force, f_rm[i][2] > 0);
+		assert_true(s.beams[0].stiffness == 400);
+		bsim_scene_free(&s);
+	}
+	bsim_experiment_free(&e);
+}
+
+static void h2_has_162_groups_and_set_block(void **state)
+{
+	(void)state;
+	bsim_experiment e;
+	load_experiment("configs/thesis/h2_asymmetric.yaml", &e);
+	assert_int_equal(e.n_groups, 162);
+	assert_true(e.seed == 2);
+	assert_int_equal(e.n_set, 1);
+	assert_string_equal(e.set[0].key, "beams.1.stiffness");
+	assert_string_equal(e.set[0].value, "500");
+	bsim_scene s;
+	group_scene(&e, 0, &s);
+	assert_true(s.beams[1].stiffness == 500);
+	assert_true(s.beams[0].stiffness == 100);
+	assert_true(s.effects.propulsion_force == 7 && s.effects.random_magnitude == 10);
+	bsim_scene_free(&s);
+	group_scene(&e, 161, &s);
+	assert_true(s.beams[1].stiffness == 500 && s.beams[0].stiffness == 500);
+	assert_true(s.effects.propulsion_force == 9 && s.effects.random_magnitude == 60);
+	bsim_scene_free(&s);
+	group_scene(&e, 10, &s); /* F7, Rm20 (10 / 9 = 1), k1 150 (10 % 9 = 1) */
+	assert_true(s.effects.random_magnitude == 20 && s.beams[0].stiffness == 150);
+	bsim_scene_free(&s);
+	bsim_experiment_free(&e);
+}
+
+static void experiment_grid_value_is_validated_at_load(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("exp_bad");
+	bsim_test_write(dir, "gate.yaml", minimal_scene);
+	const char *p = bsim_test_write(dir, "exp.yaml",
+	                                "scene: gate.yaml\n"
+	                                "trials: 3\n"
+	                                "seed: 0\n"
+	                                "grid:\n"
+	                                "  body.mass: [1, 2,\n"
+	                                "    -4]\n");
+	bsim_experiment e;
+	bsim_error err = {0};
+	assert_int_equal(bsim_experiment_load(p, NULL, 0, &e, &err), BSIM_EINPUT);
+	assert_non_null(
+	        strstr(err.msg, "exp.yaml:6: body.mass: expected a positive number, got -4"));
+	assert_int_equal(e.n_groups, 0);
+
+	bsim_override extra[] = {{"body.radius", "0", "--set body.radius=0"}};
+	p = bsim_test_write(dir, "good.yaml",
+	                    "name: h0\nscene: gate.yaml\ntrials: 3\nseed: 0\n"
+	                    "grid: {body.mass: [1, 2]}\n");
+	assert_int_equal(bsim_experiment_load(p, extra, 1, &e, &err), BSIM_EINPUT);
+	assert_non_null(
+	        strstr(err.msg, "--set body.radius=0: body.radius: expected a positive number"));
+	assert_int_equal(bsim_experiment_load(p, NULL, 0, &e, &err), BSIM_OK);
+	assert_int_equal(e.n_groups, 2);
+	bsim_experiment_free(&e);
+}
+
+static void experiment_set_takes_any_yaml_value(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("exp_set");
+	bsim_test_write(dir, "gate.yaml", minimal_scene);
+	const char *p = bsim_test_write(dir, "exp.yaml",
+	                                "scene: gate.yaml\n"
+	                                "trials: 1\n"
+	                                "seed: 18446744073709551615\n"
+	                                "set:\n"
+	                                "  body.start: [3, -4]\n"
+	                                "  effects.propulsion: { force: 6 }\n"
+	                                "  name: 'h 1'\n"
+	                                "grid:\n"
+	                                "  body.start.1: [-5]\n");
+	bsim_experiment e;
+	bsim_error err = {0};
+	if (bsim_experiment_load(p, NULL, 0, &e, &err) != BSIM_OK)
+		fail_msg("%s", err.msg);
+	assert_true(e.seed == UINT64_MAX);
+	assert_int_equal(e.n_set, 3);
+	assert_string_equal(e.set[0].value, "[3, -4]");
+	assert_non_null(strstr(e.set[1].origin, "exp.yaml:6"));
+	bsim_scene s;
+	bsim_override extra[] = {{"body.mass", "4", "--set body.mass=4"}};
+	if (bsim_experiment_group_scene(&e, 0, extra, 1, &s, &err) != BSIM_OK)
+		fail_msg("%s", err.msg);
+	assert_true(s.body.start[0] == 3 && s.body.start[1] == -5); /* grid after set */
+	assert_true(s.effects.has_propulsion && s.effects.propulsion_force == 6);
+	assert_string_equal(s.name, "h 1");
+	assert_true(s.body.mass == 4);
+	bsim_scene_free(&s);
+	bsim_experiment_free(&e);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(gate_file_is_table_2_1),
+	        cmocka_unit_test(init_gate_is_valid_and_rm_zero_has_no_random_force),
+	        cmocka_unit_test(override_sets_beam_stiffness),
+	        cmocka_unit_test(override_sets_body_start_list),
+	        cmocka_unit_test(later_override_wins),
+	        cmocka_unit_test(override_inserts_missing_block),
+	        cmocka_unit_test(defaults_fill_what_a_file_leaves_out),
+	        cmocka_unit_test(zero_magnitude_means_no_random_force),
+	        cmocka_unit_test(errors_name_file_line_field),
+	        cmocka_unit_test(override_errors_name_the_override),
+	        cmocka_unit_test(validate_checks_code_built_scenes),
+	        cmocka_unit_test(h1_has_30_groups_first_axis_slowest),
+	        cmocka_unit_test(h2_has_162_groups_and_set_block),
+	        cmocka_unit_test(experiment_grid_value_is_validated_at_load),
+	        cmocka_unit_test(experiment_set_takes_any_yaml_value),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,313 @@
+/* Bad scenes and experiments through the real program: each error kind exits
+ * with status 2 and one line on stderr naming the file (or the --set), the
+ * line, the field and what was expected; a failed sweep writes nothing. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "support.h"
+
+/* A valid gate body and beam list that the bad files below build on. */
+#define BODY "body: { mass: 1, radius: 10 }\n"
+#define BEAMS                                                                                      \
+	"beams:\n"                                                                                 \
+	"  - { pivot: [-25, 30], length: 25, mass: 0.1, stiffness: 400 }\n"                        \
+	"  - { pivot: [25, 30], rest_angle_deg: 180, length: 25, mass: 0.1,\n"                     \
+	"      stiffness: 400 }\n"
+
+/* Runs argv and checks status 2 and that the single stderr line holds every
+ * needle (NULL-terminated). */
+static void expect_input_error(const char *const argv[], const char *const needles[])
+{
+	char *out = NULL, *err = NULL;
+	int rc = bsim_test_cli(argv, &out, &err);
+	assert_non_null(err);
+	if (rc != 2)
+		fail_msg("exit status %d, stderr: %s", rc, err);
+	for (int i = 0; needles[i]; i++)
+		if (!strstr(err, needles[i]))
+			fail_msg("stderr \"%s\" lacks \"%s\"", err, needles[i]);
+	/* One message: libfyaml must not print diagnostics of its own. */
+	const char *nl = strchr(err, '\n');
+	if (!nl || nl[1] != '\0')
+		fail_msg("expected one line on stderr, got \"%s\"", err);
+	free(out);
+	free(err);
+}
+
+/* beamsim run on a scene file with the given text. */
+static void run_bad_scene(const char *name, const char *text, const char *const needles[])
+{
+	const char *dir = bsim_test_dir(name);
+	char file[64];
+	snprintf(file, sizeof file, "%s.yaml", name);
+	char path[1200];
+	snprintf(path, sizeof path, "%s", bsim_test_write(dir, file, text));
+	const char *argv[] = {"run", path, NULL};
+	expect_input_error(argv, needles);
+}
+
+static void unknown_key(void **state)
+{
+	(void)state;
+	const char *text = BODY "beams:\n"
+	                        "  - pivot: [-25, 30]\n"
+	                        "    length: 25\n"
+	                        "    mass: 0.1\n"
+	                        "    stifness: 400\n";
+	const char *needles[] = {"unknown_key.yaml:6:5: ", "beams.0.stifness",
+	                         "unknown key (expected one of pivot,", NULL};
+	run_bad_scene("unknown_key", text, needles);
+}
+
+static void unknown_top_level_key(void **state)
+{
+	(void)state;
+	const char *needles[] = {"top_key.yaml:7:1: ", "bodyy",
+	                         "unknown key (expected one of name, body", NULL};
+	run_bad_scene("top_key", BODY BEAMS "\nbodyy: 3\n", needles);
+}
+
+static void string_for_number(void **state)
+{
+	(void)state;
+	const char *needles[] = {"wrong_type.yaml:1:15: ", "body.mass",
+	                         "expected a positive number, got heavy", NULL};
+	run_bad_scene("wrong_type", "body: { mass: heavy, radius: 10 }\n" BEAMS, needles);
+}
+
+static void mapping_for_list(void **state)
+{
+	(void)state;
+	const char *needles[] = {"map_list.yaml:2:", "beams", "expected a non-empty list of beams",
+	                         "got a mapping", NULL};
+	run_bad_scene("map_list", BODY "beams: { pivot: [0, 30] }\n", needles);
+}
+
+static void three_element_pivot(void **state)
+{
+	(void)state;
+	const char *text =
+	        BODY "beams:\n"
+	             "  - { pivot: [-25, 30, 0], length: 25, mass: 0.1, stiffness: 1 }\n";
+	const char *needles[] = {"pivot3.yaml:3:", "beams.0.pivot", "expected a list of 2 numbers",
+	                         "got a list of 3 items", NULL};
+	run_bad_scene("pivot3", text, needles);
+}
+
+static void non_integer_max_steps(void **state)
+{
+	(void)state;
+	const char *needles[] = {"steps.yaml:6:", "integration.max_steps",
+	                         "expected a positive integer, got 2.5", NULL};
+	run_bad_scene("steps", BODY BEAMS "integration: { max_steps: 2.5 }\n", needles);
+}
+
+static void nan_value(void **state)
+{
+	(void)state;
+	const char *needles[] = {"nan.yaml:6:", "contact.restitution",
+	                         "expected a finite number, got .nan", NULL};
+	run_bad_scene("nan", BODY BEAMS "contact: { restitution: .nan }\n", needles);
+}
+
+static void inf_value(void **state)
+{
+	(void)state;
+	const char *text = BODY "beams:\n"
+	                        "  - { pivot: [-25, 30], length: 25, mass: 0.1, stiffness: 1,\n"
+	                        "      damping: -.inf }\n";
+	const char *needles[] = {"inf.yaml:4:16: ", "beams.0.damping",
+	                         "expected a finite number, got -.inf", NULL};
+	run_bad_scene("inf", text, needles);
+	const char *needles2[] = {"inftext.yaml:1:", "body.radius", "expected a finite number",
+	                          "got inf", NULL};
+	run_bad_scene("inftext", "body: { mass: 1, radius: inf }\n" BEAMS, needles2);
+}
+
+static void non_positive_mass(void **state)
+{
+	(void)state;
+	const char *needles[] = {"mass.yaml:1:15: ", "body.mass",
+	                         "expected a positive number, got 0", NULL};
+	run_bad_scene("mass", "body: { mass: 0, radius: 10 }\n" BEAMS, needles);
+}
+
+static void non_positive_length(void **state)
+{
+	(void)state;
+	const char *text = BODY "beams:\n"
+	                        "  - { pivot: [-25, 30], length: -25, mass: 0.1, stiffness: 1 }\n";
+	const char *needles[] = {"length.yaml:3:", "beams.0.length",
+	                         "expected a positive number, got -25", NULL};
+	run_bad_scene("length", text, needles);
+}
+
+static void non_positive_dt(void **state)
+{
+	(void)state;
+	const char *needles[] = {"dt.yaml:7:", "integration.dt",
+	                         "expected a positive number, got 0", NULL};
+	run_bad_scene("dt", BODY BEAMS "integration:\n  dt: 0\n", needles);
+}
+
+static void missing_required_key(void **state)
+{
+	(void)state;
+	const char *text = BODY "beams:\n"
+	                        "  - { pivot: [-25, 30], mass: 0.1, stiffness: 1 }\n";
+	const char *needles[] = {"missing.yaml:3:", "beams.0.length",
+	                         "missing (expected a positive number)", NULL};
+	run_bad_scene("missing", text, needles);
+}
+
+static void overlapping_start(void **state)
+{
+	(void)state;
+	/* 5 m below the left beam with a 10 m radius. */
+	const char *needles[] = {"overlap.yaml:1:", "body.start",
+	                         "the body (radius 10) overlaps beam 0 at the start (distance 5 m)",
+	                         NULL};
+	run_bad_scene("overlap", "body: { mass: 1, radius: 10, start: [-10, 25] }\n" BEAMS,
+	              needles);
+}
+
+static void yaml_syntax_error(void **state)
+{
+	(void)state;
+	const char *needles[] = {"syntax.yaml:2:26: ", "syntax: expected valid YAML",
+	                         "mismatched flow sequence end", NULL};
+	run_bad_scene("syntax",
+	              "body: { mass: 1, radius: 10 }\n"
+	              "beams: [ {pivot: [0, 30] ]\n"
+	              "integration: { dt: 1 }\n",
+	              needles);
+	const char *needles2[] = {"dup.yaml:2:1: ", "duplicate key", NULL};
+	run_bad_scene("dup", BODY "body: { mass: 2 }\n", needles2);
+}
+
+static void bad_set_value(void **state)
+{
+	(void)state;
+	const char *gate = bsim_test_src("configs/thesis/gate.yaml");
+	char path[1100];
+	snprintf(path, sizeof path, "%s", gate);
+	const char *argv[] = {"run", path, "--set", "body.mass=-1", NULL};
+	const char *needles[] = {"--set body.mass=-1", "body.mass",
+	                         "expected a positive number, got -1", NULL};
+	expect_input_error(argv, needles);
+	const char *argv2[] = {"run", path, "--set", "body.start=[1, 2", NULL};
+	const char *needles2[] = {"body.start=[1, 2", "body.start", "expected a YAML value", NULL};
+	expect_input_error(argv2, needles2);
+	const char *argv3[] = {"run", path, "--set", "beams.7.mass=1", NULL};
+	const char *needles3[] = {"beams.7.mass=1", "beams.7", "expected an index from 0 to 1",
+	                          NULL};
+	expect_input_error(argv3, needles3);
+}
+
+static void set_into_unknown_key(void **state)
+{
+	(void)state;
+	char path[1100];
+	snprintf(path, sizeof path, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	const char *argv[] = {"run", path, "--set", "effects.random_force.magnitud=3", NULL};
+	const char *needles[] = {"--set effects.random_force.magnitud=3",
+	                         "effects.random_force.magnitud",
+	                         "unknown key (expected one of magnitude, frequency)", NULL};
+	expect_input_error(argv, needles);
+}
+
+/* beamsim sweep on an experiment with the given text (next to a good
+ * gate.yaml); the output directory must stay without results. */
+static void sweep_bad_experiment(const char *name, const char *text, const char *const needles[])
+{
+	char dir[1024], exp[1200], out[1200];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir(name));
+	bsim_test_write(dir, "gate.yaml", BODY BEAMS);
+	char file[64];
+	snprintf(file, sizeof file, "%s.yaml", name);
+	snprintf(exp, sizeof exp, "%s", bsim_test_write(dir, file, text));
+	snprintf(out, sizeof out, "%s/out", dir);
+	const char *argv[] = {"sweep", exp, "--trials", "1", "--out", out, NULL};
+	expect_input_error(argv, needles);
+	char path[1300];
+	snprintf(path, sizeof path, "%s/summary.json", out);
+	char *summary = bsim_test_read(path);
+	snprintf(path, sizeof path, "%s/trials.csv", out);
+	char *trials = bsim_test_read(path);
+	assert_null(summary);
+	assert_null(trials);
+}
+
+static void empty_grid(void **state)
+{
+	(void)state;
+	const char *needles[] = {"empty_grid.yaml:4:", "grid", "expected at least one axis",
+	                         "got an empty mapping", NULL};
+	sweep_bad_experiment("empty_grid", "scene: gate.yaml\ntrials: 2\nseed: 1\ngrid: {}\n",
+	                     needles);
+	const char *needles2[] = {"empty_axis.yaml:5:", "grid.effects.propulsion.force",
+	                          "expected a non-empty list of values, got an empty list", NULL};
+	sweep_bad_experiment("empty_axis",
+	                     "scene: gate.yaml\ntrials: 2\nseed: 1\ngrid:\n"
+	                     "  effects.propulsion.force: []\n",
+	                     needles2);
+}
+
+static void bad_grid_value(void **state)
+{
+	(void)state;
+	const char *needles[] = {"grid_value.yaml:6: ", "body.mass",
+	                         "expected a positive number, got -1", NULL};
+	sweep_bad_experiment("grid_value",
+	                     "scene: gate.yaml\ntrials: 2\nseed: 1\ngrid:\n"
+	                     "  effects.propulsion.force: [4, 5]\n"
+	                     "  body.mass: [1, -1]\n",
+	                     needles);
+}
+
+static void bad_experiment_keys(void **state)
+{
+	(void)state;
+	const char *needles[] = {"trials.yaml:2:", "trials", "expected a positive integer, got 0",
+	                         NULL};
+	sweep_bad_experiment("trials",
+	                     "scene: gate.yaml\ntrials: 0\nseed: 1\ngrid: {body.mass: [1]}\n",
+	                     needles);
+	const char *needles2[] = {
+	        "exp_key.yaml:4:", "seeds",
+	        "unknown key (expected one of name, scene, trials, seed, set, grid)", NULL};
+	sweep_bad_experiment("exp_key",
+	                     "scene: gate.yaml\ntrials: 2\nseed: 1\nseeds: 2\n"
+	                     "grid: {body.mass: [1]}\n",
+	                     needles2);
+	const char *needles3[] = {"no_scene.yaml:1:", "scene", "expected a readable scene file",
+	                          NULL};
+	sweep_bad_experiment("no_scene",
+	                     "scene: nowhere.yaml\ntrials: 2\nseed: 1\ngrid: {body.mass: [1]}\n",
+	                     needles3);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(unknown_key),         cmocka_unit_test(unknown_top_level_key),
+	        cmocka_unit_test(string_for_number),   cmocka_unit_test(mapping_for_list),
+	        cmocka_unit_test(three_element_pivot), cmocka_unit_test(non_integer_max_steps),
+	        cmocka_unit_test(nan_value),           cmocka_unit_test(inf_value),
+	        cmocka_unit_test(non_positive_mass),   cmocka_unit_test(non_positive_length),
+	        cmocka_unit_test(non_positive_dt),     cmocka_unit_test(missing_required_key),
+	        cmocka_unit_test(overlapping_start),   cmocka_unit_test(yaml_syntax_error),
+	        cmocka_unit_test(bad_set_value),       cmocka_unit_test(set_into_unknown_key),
+	        cmocka_unit_test(empty_grid),          cmocka_unit_test(bad_grid_value),
+	        cmocka_unit_test(bad_experiment_keys),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
