@@ -23,12 +23,14 @@ static void random_force_apply(bsim_effect *e, long n, double h, double f[2])
 }
 
 static bsim_effect *effects_add(bsim_effects *fx, const char *name,
-				void (*apply)(bsim_effect *, long, double, double[2]), double param)
+				void (*apply)(bsim_effect *, long, double, double[2]), int axis,
+				double param)
 {
 	bsim_effect *e = &fx->e[fx->n++];
 	memset(e, 0, sizeof *e);
 	e->name = name;
 	e->apply = apply;
+	e->axis = axis;
 	e->param = param;
 	return e;
 }
@@ -38,9 +40,9 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	memset(fx, 0, sizeof *fx);
 	const bsim_effects_def *d = &scene->effects;
 	if (d->has_propulsion)
-		effects_add(fx, "propulsion", propulsion_apply, d->propulsion_force);
+		effects_add(fx, "propulsion", propulsion_apply, 1, d->propulsion_force);
 	if (d->has_random_force) {
-		bsim_effect *e = effects_add(fx, "random_force", random_force_apply,
+		bsim_effect *e = effects_add(fx, "random_force", random_force_apply, 0,
 					     d->random_magnitude);
 		e->schedule = bsim_schedule_alloc(d->random_magnitude, d->random_frequency, seed);
 		if (!e->schedule) {

@@ -102,13 +102,14 @@ static void record_row(FILE *f, const bsim_scene *sc, const bsim_state *s, doubl
 static void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state *s0,
 			const bsim_state *s1, double e0, double e1)
 {
-	double dx = s1->x[0] - s0->x[0], dy = s1->x[1] - s0->x[1];
+	const double d[2] = {s1->x[0] - s0->x[0], s1->x[1] - s0->x[1]};
 	double w_prop = 0.0, w_rand = 0.0;
 	for (int i = 0; i < fx->n; i++) {
+		double work = fx->e[i].last * d[fx->e[i].axis];
 		if (&fx->e[i] == fx->random)
-			w_rand += fx->e[i].last * dx;
+			w_rand += work;
 		else
-			w_prop += fx->e[i].last * dy;
+			w_prop += work;
 	}
 	const bsim_step_energy *se = &s1->energy;
 	double r = (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -

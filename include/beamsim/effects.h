@@ -19,6 +19,7 @@ typedef struct bsim_effect {
 	const char *name;
 	/* Adds this effect's force on the body (N) at step n into f. */
 	void (*apply)(struct bsim_effect *e, long n, double h, double f[2]);
+	int axis;                /* the body axis the force acts along: 0 = x, 1 = y */
 	double param;            /* force or magnitude, N */
 	bsim_schedule *schedule; /* random_force only */
 	double last;             /* last force value applied along its axis, N */
