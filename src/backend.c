@@ -5,8 +5,8 @@
 #include <string.h>
 
 static const bsim_backend *const registry[] = {
-	&bsim_backend_thesis,
-	NULL,
+        &bsim_backend_thesis,
+        NULL,
 };
 
 const bsim_backend *const *bsim_backends(void)
@@ -25,7 +25,7 @@ const bsim_backend *bsim_backend_find(const char *name, bsim_error *err)
 		strncat(known, registry[i]->name, sizeof known - strlen(known) - 1);
 	}
 	bsim_error_set(err, BSIM_EINPUT, "--backend %s: unknown backend (expected one of %s)", name,
-		       known);
+	               known);
 	return NULL;
 }
 

@@ -23,8 +23,8 @@ static void random_force_apply(bsim_effect *e, long n, double h, double f[2])
 }
 
 static bsim_effect *effects_add(bsim_effects *fx, const char *name,
-				void (*apply)(bsim_effect *, long, double, double[2]), int axis,
-				double param)
+                                void (*apply)(bsim_effect *, long, double, double[2]), int axis,
+                                double param)
 {
 	bsim_effect *e = &fx->e[fx->n++];
 	memset(e, 0, sizeof *e);
@@ -42,8 +42,8 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	if (d->has_propulsion)
 		effects_add(fx, "propulsion", propulsion_apply, 1, d->propulsion_force);
 	if (d->has_random_force) {
-		bsim_effect *e = effects_add(fx, "random_force", random_force_apply, 0,
-					     d->random_magnitude);
+		bsim_effect *e =
+		        effects_add(fx, "random_force", random_force_apply, 0, d->random_magnitude);
 		e->schedule = bsim_schedule_alloc(d->random_magnitude, d->random_frequency, seed);
 		if (!e->schedule) {
 			fx->n--;

@@ -14,16 +14,16 @@ int bsim_options_add(bsim_options *opts, const char *kv, bsim_error *err)
 	if (!eq || klen == 0 || klen >= sizeof opts->key[0] ||
 	    strlen(eq + 1) >= sizeof opts->value[0] || eq[1] == '\0')
 		return bsim_error_set(err, BSIM_EINPUT,
-				      "--backend-opt %s: expected KEY=VALUE (key < 32, value < 64 "
-				      "characters)",
-				      kv);
+		                      "--backend-opt %s: expected KEY=VALUE (key < 32, value < 64 "
+		                      "characters)",
+		                      kv);
 	int slot = opts->n;
 	for (int i = 0; i < opts->n; i++)
 		if (strlen(opts->key[i]) == klen && strncmp(opts->key[i], kv, klen) == 0)
 			slot = i;
 	if (slot == BSIM_OPTIONS_MAX)
 		return bsim_error_set(err, BSIM_EINPUT, "--backend-opt %s: more than %d options",
-				      kv, BSIM_OPTIONS_MAX);
+		                      kv, BSIM_OPTIONS_MAX);
 	memcpy(opts->key[slot], kv, klen);
 	opts->key[slot][klen] = '\0';
 	strcpy(opts->value[slot], eq + 1);
@@ -80,7 +80,7 @@ static const bsim_knob *knob_find(const bsim_knob *knobs, int n, const char *nam
 }
 
 int bsim_options_check(const bsim_options *opts, const bsim_knob *knobs, int n_knobs,
-		       const char *backend, bsim_error *err)
+                       const char *backend, bsim_error *err)
 {
 	for (int i = 0; opts && i < opts->n; i++) {
 		const bsim_knob *k = knob_find(knobs, n_knobs, opts->key[i]);
@@ -94,21 +94,21 @@ int bsim_options_check(const bsim_options *opts, const bsim_knob *knobs, int n_k
 				strncat(names, knobs[j].name, sizeof names - strlen(names) - 1);
 			}
 			return bsim_error_set(err, BSIM_EINPUT,
-					      "--backend-opt %s: unknown option of backend %s "
-					      "(expected one of %s)",
-					      opts->key[i], backend, names);
+			                      "--backend-opt %s: unknown option of backend %s "
+			                      "(expected one of %s)",
+			                      opts->key[i], backend, names);
 		}
 		const char *v = opts->value[i];
 		int ok = k->type == BSIM_KNOB_DOUBLE ? parse_double(v, &d)
-			 : k->type == BSIM_KNOB_INT  ? parse_long(v, &l)
-						     : choice_index(k->choices, v) >= 0;
+		         : k->type == BSIM_KNOB_INT  ? parse_long(v, &l)
+		                                     : choice_index(k->choices, v) >= 0;
 		if (!ok)
 			return bsim_error_set(err, BSIM_EINPUT,
-					      "--backend-opt %s=%s: expected %s%s", k->name, v,
-					      k->type == BSIM_KNOB_DOUBLE ? "a finite number"
-					      : k->type == BSIM_KNOB_INT  ? "an integer"
-									  : "one of ",
-					      k->type == BSIM_KNOB_CHOICE ? k->choices : "");
+			                      "--backend-opt %s=%s: expected %s%s", k->name, v,
+			                      k->type == BSIM_KNOB_DOUBLE ? "a finite number"
+			                      : k->type == BSIM_KNOB_INT  ? "an integer"
+			                                                  : "one of ",
+			                      k->type == BSIM_KNOB_CHOICE ? k->choices : "");
 	}
 	return BSIM_OK;
 }

@@ -1,109 +1,21 @@
 /* The output files of a sweep (DESIGN.md "Outputs"): summary.json,
- * trials.csv and the p_traverse table.
- *
- * Every file is written to PATH.tmp.PID, flushed to disk and renamed over
- * PATH: rename is atomic, so a reader (or a resumed run) sees either the old
- * file or the whole new one, never a torn one. */
+ * trials.csv and the p_traverse table. Both files go through
+ * bsim_atomic_file, so a reader never sees a torn one. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "beamsim/output.h"
 
 #include <errno.h>
 #include <math.h>
-#include <stdint.h>
 #include <inttypes.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
+#include "beamsim/atomic_file.h"
+#include "beamsim/json.h"
 #include "beamsim/version.h"
-
-/* ---- atomic files ---------------------------------------------------- */
-
-typedef struct out_file {
-	FILE *f;
-	const char *path;
-	char tmp[1100];
-} out_file;
-
-static int out_open(out_file *o, const char *path, bsim_error *err)
-{
-	o->path = path;
-	int n = snprintf(o->tmp, sizeof o->tmp, "%s.tmp.%ld", path, (long)getpid());
-	if (n < 0 || (size_t)n >= sizeof o->tmp)
-		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", path);
-	o->f = fopen(o->tmp, "w");
-	if (!o->f)
-		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write: %s", o->tmp,
-		                      strerror(errno));
-	return BSIM_OK;
-}
-
-/* Flushes to disk and renames into place; on any error the temporary file
- * is removed and PATH is left as it was. */
-static int out_commit(out_file *o, bsim_error *err)
-{
-	int bad = ferror(o->f) || fflush(o->f) != 0 || fsync(fileno(o->f)) != 0;
-	int saved = errno;
-	bad |= fclose(o->f) != 0;
-	if (!bad && rename(o->tmp, o->path) == 0)
-		return BSIM_OK;
-	if (!bad)
-		saved = errno;
-	unlink(o->tmp);
-	return bsim_error_set(err, BSIM_EFAIL, "%s: write failed: %s", o->path, strerror(saved));
-}
-
-/* ---- JSON ------------------------------------------------------------ */
-
-static void json_string(FILE *f, const char *s)
-{
-	fputc('"', f);
-	for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-		switch (*p) {
-		case '"':
-			fputs("\\\"", f);
-			break;
-		case '\\':
-			fputs("\\\\", f);
-			break;
-		case '\n':
-			fputs("\\n", f);
-			break;
-		case '\r':
-			fputs("\\r", f);
-			break;
-		case '\t':
-			fputs("\\t", f);
-			break;
-		default:
-			if (*p < 0x20)
-				fprintf(f, "\\u%04x", *p);
-			else
-				fputc(*p, f);
-		}
-	}
-	fputc('"', f);
-}
-
-/* The shortest of %.15g..%.17g that reads back as the same double: exact
- * round trip, and 0.42 stays "0.42" instead of "0.41999999999999998".
- * JSON has no NaN or infinity; they become null. */
-static void json_double(FILE *f, double x)
-{
-	char buf[32];
-	if (!isfinite(x)) {
-		fputs("null", f);
-		return;
-	}
-	for (int prec = 15; prec <= 17; prec++) {
-		snprintf(buf, sizeof buf, "%.*g", prec, x);
-		if (strtod(buf, NULL) == x)
-			break;
-	}
-	fputs(buf, f);
-}
 
 /* A grid value is a JSON number when its YAML text is a finite number. */
 static int text_number(const char *s, double *out)
@@ -120,35 +32,35 @@ static int text_number(const char *s, double *out)
 	return errno == 0 && *end == '\0' && isfinite(*out);
 }
 
-/* Every knob of the backend with its effective value (given or default),
- * so the summary alone says how the backend was configured. */
-static void json_backend_options(FILE *f, const char *backend, const bsim_options *opts)
+/* "key": "value", after a comma unless it is the first member. */
+static void json_member(FILE *f, int *first, const char *key, const char *value)
 {
-	const bsim_backend *b = bsim_backend_find(backend, NULL);
+	fputs(*first ? "" : ", ", f);
+	bsim_json_string(f, key);
+	fputs(": ", f);
+	bsim_json_string(f, value);
+	*first = 0;
+}
+
+/* Knobs first, in the backend's order, so records of one backend line up;
+ * then any option the backend does not list (none once checked), so
+ * nothing given is hidden. */
+void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_options *opts)
+{
 	int first = 1;
 	fputc('{', f);
 	for (int i = 0; b && i < b->n_knobs; i++) {
 		const char *v = bsim_options_get(opts, b->knobs[i].name);
 		if (!v)
 			v = b->knobs[i].default_value ? b->knobs[i].default_value : "";
-		fputs(first ? "" : ", ", f);
-		json_string(f, b->knobs[i].name);
-		fputs(": ", f);
-		json_string(f, v);
-		first = 0;
+		json_member(f, &first, b->knobs[i].name, v);
 	}
-	/* Options the backend does not list (none once checked) still show. */
 	for (int i = 0; opts && i < opts->n; i++) {
 		int known = 0;
 		for (int j = 0; b && j < b->n_knobs; j++)
 			known |= strcmp(b->knobs[j].name, opts->key[i]) == 0;
-		if (known)
-			continue;
-		fputs(first ? "" : ", ", f);
-		json_string(f, opts->key[i]);
-		fputs(": ", f);
-		json_string(f, opts->value[i]);
-		first = 0;
+		if (!known)
+			json_member(f, &first, opts->key[i], opts->value[i]);
 	}
 	fputc('}', f);
 }
@@ -160,12 +72,12 @@ static void json_params(FILE *f, const bsim_experiment *e, const int *idx)
 		const char *text = e->axes[a].values[idx[a]];
 		double x;
 		fputs(a ? ", " : "", f);
-		json_string(f, e->axes[a].key);
+		bsim_json_string(f, e->axes[a].key);
 		fputs(": ", f);
 		if (text_number(text, &x))
-			json_double(f, x);
+			bsim_json_number(f, x);
 		else
-			json_string(f, text);
+			bsim_json_string(f, text);
 	}
 	fputc('}', f);
 }
@@ -178,61 +90,78 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_group_resul
 	        ", \"trials\": %d, \"traversed\": %d, \"side_exit\": %d, \"stuck\": %d, "
 	        "\"left\": %d, \"right\": %d, \"p_traverse\": ",
 	        g->trials, g->traversed, g->side_exit, g->stuck, g->left, g->right);
-	json_double(f, g->p_traverse);
+	bsim_json_number(f, g->p_traverse);
 	fputs(", \"ci95\": [", f);
-	json_double(f, g->ci95[0]);
+	bsim_json_number(f, g->ci95[0]);
 	fputs(", ", f);
-	json_double(f, g->ci95[1]);
+	bsim_json_number(f, g->ci95[1]);
 	fprintf(f,
 	        "], \"stuck_in_contact\": %d, \"landscape_left\": %d, \"landscape_right\": %d, "
 	        "\"steps\": %ld}",
 	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps);
 }
 
+/* An index per grid axis for bsim_experiment_group_index; never a
+ * zero-size calloc, so NULL always means out of memory. */
+static int *group_index_alloc(const bsim_experiment *e)
+{
+	return calloc(e->n_axes > 0 ? (size_t)e->n_axes : 1, sizeof(int));
+}
+
 /* One group per line: the file stays small, diffs line up with groups, and
  * the wall_seconds line is the only one that differs between equal runs. */
-int bsim_output_summary_json(const char *path, const bsim_experiment *e, const char *backend,
-                             const bsim_options *opts, const bsim_sweep_result *r, bsim_error *err)
+static void json_groups(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int *idx)
 {
-	out_file o;
-	if (out_open(&o, path, err) != BSIM_OK)
-		return BSIM_EFAIL;
-	int *idx = calloc(e->n_axes > 0 ? (size_t)e->n_axes : 1, sizeof *idx);
-	if (!idx) {
-		fclose(o.f);
-		unlink(o.tmp);
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	}
-	FILE *f = o.f;
-	fputs("{\n  \"backend\": ", f);
-	json_string(f, backend);
-	fputs(",\n  \"backend_options\": ", f);
-	json_backend_options(f, backend, opts);
-	fputs(",\n  \"experiment\": ", f);
-	json_string(f, e->path);
-	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d", e->seed, r->trials);
-	fprintf(f, ",\n  \"wall_seconds\": %.3f", r->wall_seconds);
 	fputs(",\n  \"groups\": [", f);
 	for (int g = 0; g < r->n_groups; g++) {
 		bsim_experiment_group_index(e, g, idx);
 		fputs(g ? ",\n    " : "\n    ", f);
 		json_group(f, e, &r->groups[g], idx);
 	}
-	fputs("\n  ],\n  \"version\": ", f);
-	json_string(f, BSIM_VERSION);
+	fputs("\n  ]", f);
+}
+
+static void json_summary(FILE *f, const bsim_experiment *e, const char *backend,
+                         const bsim_options *opts, const bsim_sweep_result *r, int *idx)
+{
+	fputs("{\n  \"backend\": ", f);
+	bsim_json_string(f, backend);
+	fputs(",\n  \"backend_options\": ", f);
+	bsim_output_backend_options(f, bsim_backend_find(backend, NULL), opts);
+	fputs(",\n  \"experiment\": ", f);
+	bsim_json_string(f, e->path);
+	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d", e->seed, r->trials);
+	fprintf(f, ",\n  \"wall_seconds\": %.3f", r->wall_seconds);
+	json_groups(f, e, r, idx);
+	fputs(",\n  \"version\": ", f);
+	bsim_json_string(f, BSIM_VERSION);
 	fputs(",\n  \"scene\": ", f);
-	json_string(f, e->scene_path);
+	bsim_json_string(f, e->scene_path);
 	fputs("\n}\n", f);
+}
+
+int bsim_output_summary_json(const char *path, const bsim_experiment *e, const char *backend,
+                             const bsim_options *opts, const bsim_sweep_result *r, bsim_error *err)
+{
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	int *idx = group_index_alloc(e);
+	if (!idx) {
+		bsim_atomic_file_abort(&o);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	json_summary(o.f, e, backend, opts, r, idx);
 	free(idx);
-	return out_commit(&o, err);
+	return bsim_atomic_file_commit(&o, err);
 }
 
 /* ---- trials.csv -------------------------------------------------------- */
 
 int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_error *err)
 {
-	out_file o;
-	if (out_open(&o, path, err) != BSIM_OK)
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	fputs("group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2\n",
 	      o.f);
@@ -245,7 +174,7 @@ int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_er
 			        x->max_theta[1]);
 		}
 	}
-	return out_commit(&o, err);
+	return bsim_atomic_file_commit(&o, err);
 }
 
 /* ---- the p_traverse table ------------------------------------------------ */
@@ -267,7 +196,7 @@ static int layout_build(table_layout *l, const bsim_experiment *e)
 	for (int a = 2; a < e->n_axes; a++)
 		l->n_rest *= e->axes[a].n_values;
 	size_t n = (size_t)l->n0 * l->n1 * l->n_rest;
-	int *idx = calloc(e->n_axes > 0 ? (size_t)e->n_axes : 1, sizeof *idx);
+	int *idx = group_index_alloc(e);
 	l->cell = malloc(n * sizeof *l->cell);
 	if (!idx || !l->cell) {
 		free(idx);

@@ -3,25 +3,19 @@
 
 #include "beamsim/progress.h"
 
+#include "beamsim/clock.h"
+
 #include <stdio.h>
-#include <time.h>
 #include <unistd.h>
 
 /* Redraw interval, s: fast enough to look live, slow enough to cost nothing. */
 #define PROGRESS_INTERVAL 0.1
 
-static double monotonic_seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 void bsim_progress_init(bsim_progress *p, int enabled)
 {
 	p->active = enabled && isatty(STDERR_FILENO);
 	p->shown = 0;
-	p->t_start = monotonic_seconds();
+	p->t_start = bsim_clock_seconds();
 	p->t_last = -1.0;
 }
 
@@ -40,7 +34,7 @@ void bsim_progress_update(void *user, long done, long total)
 	bsim_progress *p = user;
 	if (!p || !p->active || total <= 0)
 		return;
-	double now = monotonic_seconds();
+	double now = bsim_clock_seconds();
 	if (done < total && p->t_last >= 0.0 && now - p->t_last < PROGRESS_INTERVAL)
 		return;
 	p->t_last = now;

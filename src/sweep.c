@@ -5,24 +5,16 @@
  * a static split would leave threads idle). A trial's seed depends only on
  * (experiment seed, g, t) and its result goes to its own slot, so the
  * result is the same whatever the thread count (DESIGN.md "Determinism"). */
-#define _POSIX_C_SOURCE 200809L
 
 #include "beamsim/sweep.h"
 
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "beamsim/clock.h"
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"
-
-static double monotonic_seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out)
 {
@@ -175,7 +167,7 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_err
 int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
                    bsim_error *err)
 {
-	double t0 = monotonic_seconds();
+	double t0 = bsim_clock_seconds();
 	if (e->trials < 0 || e->n_groups < 1)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: expected at least one group and trials >= 0", e->path);
@@ -217,6 +209,6 @@ int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_
 	/* The final count may have been reached on another thread. */
 	if (cfg->progress)
 		cfg->progress(cfg->progress_user, sh.total, sh.total);
-	out->wall_seconds = monotonic_seconds() - t0;
+	out->wall_seconds = bsim_clock_seconds() - t0;
 	return BSIM_OK;
 }

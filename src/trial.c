@@ -83,8 +83,7 @@ void bsim_recorder_header(FILE *f, int n_beams)
 	fputs(",e_kin,e_beam,e_prop\n", f);
 }
 
-static void record_row(FILE *f, const bsim_scene *sc, const bsim_state *s, double t,
-		       double f_rand)
+static void record_row(FILE *f, const bsim_scene *sc, const bsim_state *s, double t, double f_rand)
 {
 	double f_prop = sc->effects.has_propulsion ? sc->effects.propulsion_force : 0.0;
 	fprintf(f, "%.6f,%.10g,%.10g,%.10g,%.10g", t, s->x[0], s->x[1], s->v[0], s->v[1]);
@@ -94,13 +93,13 @@ static void record_row(FILE *f, const bsim_scene *sc, const bsim_state *s, doubl
 	for (int i = 0; i < s->n_beams; i++)
 		fprintf(f, ",%d", s->contact[i]);
 	fprintf(f, ",%.10g,%.10g,%.10g\n", energy_kinetic(sc, s), energy_springs(sc, s),
-		f_prop * (sc->landscape_y0 - s->x[1]));
+	        f_prop * (sc->landscape_y0 - s->x[1]));
 }
 
 /* One step's entry in the ledger: the work of each force over the body's
  * displacement, the backend's losses, and what is left over. */
 static void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state *s0,
-			const bsim_state *s1, double e0, double e1)
+                        const bsim_state *s1, double e0, double e1)
 {
 	const double d[2] = {s1->x[0] - s0->x[0], s1->x[1] - s0->x[1]};
 	double w_prop = 0.0, w_rand = 0.0;
@@ -112,8 +111,8 @@ static void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state
 			w_prop += work;
 	}
 	const bsim_step_energy *se = &s1->energy;
-	double r = (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -
-				se->correction);
+	double r = (e1 - e0) -
+	           (w_prop + w_rand - se->damper - se->impact - se->contact - se->correction);
 	l->w_prop += w_prop;
 	l->w_rand += w_rand;
 	l->damper += se->damper;
@@ -147,8 +146,8 @@ static double random_value(const bsim_effects *fx)
 }
 
 int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *backend,
-		   const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
-		   bsim_trial_result *out, bsim_error *err)
+                   const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
+                   bsim_trial_result *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
 	if (runner_reserve(r, scene->n_beams))
@@ -200,8 +199,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		s1 = t;
 		if (!state_finite(s0)) {
 			rc = bsim_error_set(err, BSIM_EFAIL,
-					    "%s backend: non-finite state at step %ld (t = %g s)",
-					    backend->name, n, (double)n * h);
+			                    "%s backend: non-finite state at step %ld (t = %g s)",
+			                    backend->name, n, (double)n * h);
 			break;
 		}
 		if (done)
@@ -229,8 +228,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		out->in_contact_end = any_contact(s0);
 	if (out->outcome == BSIM_TRAVERSED) {
 		out->type = s0->v[0] > 0.0   ? BSIM_TYPE_LEFT
-			    : s0->v[0] < 0.0 ? BSIM_TYPE_RIGHT
-					     : BSIM_TYPE_NONE;
+		            : s0->v[0] < 0.0 ? BSIM_TYPE_RIGHT
+		                             : BSIM_TYPE_NONE;
 		out->landscape_left = out->max_theta[0] > out->max_theta[1];
 	}
 	out->x_end = s0->x[0];

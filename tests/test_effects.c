@@ -30,7 +30,7 @@ static void test_no_random_force_no_draws(void **state)
 	bsim_error err;
 	unsigned long before = bsim_schedule_total_draws();
 	assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL, 1, NULL, &out, &err),
-			 BSIM_OK);
+	                 BSIM_OK);
 	assert_true(out.steps_run > 100);
 	assert_int_equal(out.draws, 0);
 	assert_int_equal(bsim_schedule_total_draws(), before);
@@ -40,7 +40,7 @@ static void test_no_random_force_no_draws(void **state)
 	bsim_scene_init_gate(&s, 9.0, 20.0);
 	before = bsim_schedule_total_draws();
 	assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL, 1, NULL, &out, &err),
-			 BSIM_OK);
+	                 BSIM_OK);
 	assert_int_equal(out.draws, (unsigned long)((out.steps_run - 1) / 5 + 1));
 	assert_int_equal(bsim_schedule_total_draws() - before, out.draws);
 	bsim_runner_free(r);
@@ -115,10 +115,10 @@ static void test_seed_mixing(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_no_random_force_no_draws),
-		cmocka_unit_test(test_empty_pipeline),
-		cmocka_unit_test(test_schedule_hold_and_scale),
-		cmocka_unit_test(test_seed_mixing),
+	        cmocka_unit_test(test_no_random_force_no_draws),
+	        cmocka_unit_test(test_empty_pipeline),
+	        cmocka_unit_test(test_schedule_hold_and_scale),
+	        cmocka_unit_test(test_seed_mixing),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -21,7 +21,7 @@ static bsim_trial_result run(const bsim_scene *s, uint64_t seed)
 	bsim_trial_result out;
 	bsim_error err;
 	assert_int_equal(bsim_trial_run(r, s, &bsim_backend_thesis, NULL, seed, NULL, &out, &err),
-			 BSIM_OK);
+	                 BSIM_OK);
 	bsim_runner_free(r);
 	return out;
 }
@@ -43,9 +43,9 @@ static void test_conservative_scene(void **state)
 	bsim_trial_result out = run(&s, 1);
 	const bsim_ledger *l = &out.ledger;
 	print_message("conservative: E %.6f -> %.6f J (drift %.2e), impact %.2e, contact %.2e, "
-		      "correction %.2e, residual max %.2e J, peak theta %.3f\n",
-		      l->e_start, l->e_end, l->e_end - l->e_start, l->impact, l->contact,
-		      l->correction, l->residual_max, fmax(out.max_theta[0], out.max_theta[1]));
+	              "correction %.2e, residual max %.2e J, peak theta %.3f\n",
+	              l->e_start, l->e_end, l->e_end - l->e_start, l->impact, l->contact,
+	              l->correction, l->residual_max, fmax(out.max_theta[0], out.max_theta[1]));
 	assert_true(fmax(out.max_theta[0], out.max_theta[1]) > 0.3); /* the beams were hit */
 	assert_true(l->w_prop == 0.0 && l->w_rand == 0.0 && l->damper == 0.0);
 	assert_true(fabs(l->e_end - l->e_start) <= 1e-9 * l->e_start);
@@ -64,14 +64,13 @@ static void test_driven_damped_noisy(void **state)
 		bsim_trial_result out = run(&s, bsim_seed_mix(3, 0, (uint64_t)trial));
 		const bsim_ledger *l = &out.ledger;
 		double scale = fabs(l->w_prop) + fabs(l->w_rand) + l->damper + l->impact;
-		double balance = (l->e_end - l->e_start) -
-				 (l->w_prop + l->w_rand - l->damper - l->impact - l->contact -
-				  l->correction);
+		double balance = (l->e_end - l->e_start) - (l->w_prop + l->w_rand - l->damper -
+		                                            l->impact - l->contact - l->correction);
 		if (trial == 0)
 			print_message("driven: W_prop %.2f W_rand %.2f damper %.2f impact %.2f "
-				      "contact %.2e correction %.2e, imbalance %.2e J\n",
-				      l->w_prop, l->w_rand, l->damper, l->impact, l->contact,
-				      l->correction, balance);
+			              "contact %.2e correction %.2e, imbalance %.2e J\n",
+			              l->w_prop, l->w_rand, l->damper, l->impact, l->contact,
+			              l->correction, balance);
 		assert_true(l->damper > 0.0 && l->impact > 0.0 && l->w_prop > 0.0);
 		assert_true(fabs(balance) <= 1e-9 * scale);
 		assert_true(l->residual_abs <= 1e-9 * scale);
@@ -84,8 +83,8 @@ static void test_driven_damped_noisy(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_conservative_scene),
-		cmocka_unit_test(test_driven_damped_noisy),
+	        cmocka_unit_test(test_conservative_scene),
+	        cmocka_unit_test(test_driven_damped_noisy),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

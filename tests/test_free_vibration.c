@@ -59,7 +59,7 @@ static void test_free_vibration_oracle(void **state)
 	double e1 = vibration_error(0.004, 3.0);
 	double e2 = vibration_error(0.002, 3.0);
 	print_message("free vibration: max error %.3g rad at h = 4 ms, %.3g at 2 ms (ratio %.2f)\n",
-		      e1, e2, e1 / e2);
+	              e1, e2, e1 / e2);
 	assert_true(e1 < 2e-5); /* 0.02% of theta0 over 3 s at the essay's step */
 	assert_true(e1 / e2 > 3.6 && e1 / e2 < 4.4); /* second order */
 }
@@ -90,7 +90,7 @@ static void test_stiff_spring_stable(void **state)
 				bsim_backend_thesis.step(w, zero, h);
 				bsim_backend_thesis.get_state(w, &st);
 				double e = 0.5 * k * st.theta[0] * st.theta[0] +
-					   0.5 * inertia * st.omega[0] * st.omega[0];
+				           0.5 * inertia * st.omega[0] * st.omega[0];
 				assert_true(isfinite(e));
 				assert_true(e <= e_prev * (1.0 + 1e-12) + 1e-300);
 				e_prev = e;
@@ -107,8 +107,8 @@ static void test_stiff_spring_stable(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_free_vibration_oracle),
-		cmocka_unit_test(test_stiff_spring_stable),
+	        cmocka_unit_test(test_free_vibration_oracle),
+	        cmocka_unit_test(test_stiff_spring_stable),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

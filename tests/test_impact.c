@@ -55,7 +55,7 @@ static void check_tangent(double r, double e, double u)
 	assert_true(fabs(vrel_after - e * u) <= 4 * tol);
 	/* angular momentum about the pivot: M r v + I omega = M r u */
 	assert_true(fabs(mass * r * st.v[1] + inertia * st.omega[0] - mass * r * u) <=
-		    1e-12 * mass * r * u);
+	            1e-12 * mass * r * u);
 	assert_true(st.energy.impact >= 0.0);
 	assert_int_equal(st.impacts, 1);
 	bsim_state_free(&st);
@@ -99,7 +99,7 @@ static void test_tip_impact_conserves(void **state)
 	double mass = s.body.mass, inertia = s.beams[0].inertia;
 	double ke0 = 0.5 * mass * (0.36 + 4.0);
 	double ke1 = 0.5 * mass * (st.v[0] * st.v[0] + st.v[1] * st.v[1]) +
-		     0.5 * inertia * st.omega[0] * st.omega[0];
+	             0.5 * inertia * st.omega[0] * st.omega[0];
 	assert_true(fabs(ke1 - ke0) <= 1e-12 * ke0);
 	assert_int_equal(st.impacts, 1);
 	assert_true(st.omega[0] > 0.0); /* the tip was pushed forward */
@@ -173,9 +173,9 @@ static void test_simultaneous_double_impact(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_tangent_impact_oracle),
-		cmocka_unit_test(test_tip_impact_conserves),
-		cmocka_unit_test(test_simultaneous_double_impact),
+	        cmocka_unit_test(test_tangent_impact_oracle),
+	        cmocka_unit_test(test_tip_impact_conserves),
+	        cmocka_unit_test(test_simultaneous_double_impact),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -89,12 +89,12 @@ static void test_mirror_trials(void **state)
 		bsim_trial_result ra, rb;
 		bsim_error err;
 		uint64_t seed = bsim_seed_mix(9, 1, (uint64_t)t);
-		assert_int_equal(bsim_trial_run(r, &a, &bsim_backend_thesis, NULL, seed, NULL, &ra,
-						&err),
-				 BSIM_OK);
-		assert_int_equal(bsim_trial_run(r, &b, &bsim_backend_thesis, NULL, seed, NULL, &rb,
-						&err),
-				 BSIM_OK);
+		assert_int_equal(
+		        bsim_trial_run(r, &a, &bsim_backend_thesis, NULL, seed, NULL, &ra, &err),
+		        BSIM_OK);
+		assert_int_equal(
+		        bsim_trial_run(r, &b, &bsim_backend_thesis, NULL, seed, NULL, &rb, &err),
+		        BSIM_OK);
 		assert_int_equal(ra.outcome, rb.outcome);
 		assert_int_equal(ra.steps, rb.steps);
 		assert_true(ra.x_end == -rb.x_end && ra.vx_end == -rb.vx_end);
@@ -113,8 +113,8 @@ static void test_mirror_trials(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_mirror_bitwise_steps),
-		cmocka_unit_test(test_mirror_trials),
+	        cmocka_unit_test(test_mirror_bitwise_steps),
+	        cmocka_unit_test(test_mirror_trials),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -65,7 +65,8 @@ static void test_impact_chain_settles(void **state)
 			last_impact = n;
 		}
 		double left = segment_distance(st.x, s.beams[0].pivot, st.theta[0]);
-		double right = segment_distance(st.x, s.beams[1].pivot, 3.141592653589793 - st.theta[1]);
+		double right =
+		        segment_distance(st.x, s.beams[1].pivot, 3.141592653589793 - st.theta[1]);
 		worst = fmax(worst, fmax(R - left, R - right));
 	}
 	/* the balance point on the landscape, by bisection on (20, 38) */
@@ -78,11 +79,11 @@ static void test_impact_chain_settles(void **state)
 			hi = mid;
 	}
 	print_message("settling: %d impacts, the last at step %d; rest at y = %.6f (landscape "
-		      "%.6f), theta %.6f (landscape %.6f); max penetration %.2e m\n",
-		      impacts, last_impact, st.x[1], lo, st.theta[0], landscape_theta(st.x[1]),
-		      worst);
-	assert_true(impacts >= 3);            /* a chain of impacts ... */
-	assert_true(last_impact < 2000);      /* ... that ends */
+	              "%.6f), theta %.6f (landscape %.6f); max penetration %.2e m\n",
+	              impacts, last_impact, st.x[1], lo, st.theta[0], landscape_theta(st.x[1]),
+	              worst);
+	assert_true(impacts >= 3);                             /* a chain of impacts ... */
+	assert_true(last_impact < 2000);                       /* ... that ends */
 	assert_int_equal(st.contact[0], BSIM_CONTACT_TANGENT); /* held in contact */
 	assert_int_equal(st.contact[1], BSIM_CONTACT_TANGENT);
 	assert_true(st.x[0] == 0.0);
@@ -98,7 +99,7 @@ static void test_impact_chain_settles(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_impact_chain_settles),
+	        cmocka_unit_test(test_impact_chain_settles),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

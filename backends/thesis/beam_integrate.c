@@ -32,7 +32,8 @@ double thesis_beam_response(const thesis_beam *b, double h, int integrator)
 double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator)
 {
 	if (integrator == THESIS_EULER)
-		return b->omega - h * (b->stiffness * b->theta + b->damping * b->omega) / b->inertia;
+		return b->omega -
+		       h * (b->stiffness * b->theta + b->damping * b->omega) / b->inertia;
 	double d = midpoint_d(b, h);
 	return (b->omega * (2.0 - d) - h * b->stiffness * b->theta / b->inertia) / d;
 }

@@ -75,10 +75,12 @@ void thesis_contact_solve(struct bsim_world *w, const double force[2], double h)
 		double omega_new = thesis_beam_free_omega(b, h, w->integrator);
 		if (k >= 0) {
 			omega_new -= cs[k].impulse * cs[k].c * cs[k].inv_i;
-			double omega_m = w->integrator == THESIS_EULER ? omega_new
-								       : 0.5 * (b->omega + omega_new);
-			w->energy.contact -= cs[k].impulse *
-					     ((cs[k].n[0] * vm[0] + cs[k].n[1] * vm[1]) - cs[k].c * omega_m);
+			double omega_m = w->integrator == THESIS_EULER
+			                         ? omega_new
+			                         : 0.5 * (b->omega + omega_new);
+			w->energy.contact -=
+			        cs[k].impulse *
+			        ((cs[k].n[0] * vm[0] + cs[k].n[1] * vm[1]) - cs[k].c * omega_m);
 		}
 		w->energy.damper += thesis_beam_advance(b, omega_new, h, w->integrator);
 	}

@@ -27,14 +27,14 @@ typedef struct thesis_beam {
 
 typedef struct thesis_contact {
 	int beam;
-	int type;      /* BSIM_CONTACT_TANGENT or BSIM_CONTACT_TIP */
-	double gap;    /* distance to the segment minus R, m (< 0: penetration) */
-	double n[2];   /* unit normal from the beam toward the body */
-	double c;      /* generalised lever sgn (a x n), m */
-	double inv_i;  /* 1/I for impacts and projection, 1/(I D) in a step */
-	double e;      /* restitution of this contact */
-	double vrel;   /* relative normal velocity, m/s (< 0: approaching) */
-	double bound;  /* lower bound on the solved velocity, m/s */
+	int type;       /* BSIM_CONTACT_TANGENT or BSIM_CONTACT_TIP */
+	double gap;     /* distance to the segment minus R, m (< 0: penetration) */
+	double n[2];    /* unit normal from the beam toward the body */
+	double c;       /* generalised lever sgn (a x n), m */
+	double inv_i;   /* 1/I for impacts and projection, 1/(I D) in a step */
+	double e;       /* restitution of this contact */
+	double vrel;    /* relative normal velocity, m/s (< 0: approaching) */
+	double bound;   /* lower bound on the solved velocity, m/s */
 	double impulse; /* N s */
 } thesis_contact;
 
@@ -63,8 +63,7 @@ struct bsim_world {
 
 /* contact_detect.c */
 void thesis_beam_direction(const thesis_beam *b, double u[2]);
-int thesis_contact_detect(const struct bsim_world *w, int i, double margin,
-			  thesis_contact *out);
+int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out);
 void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c);
 
 /* lcp_solve.c */

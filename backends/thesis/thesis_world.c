@@ -13,16 +13,16 @@
 #include "thesis/thesis.h"
 
 static const bsim_knob thesis_knobs[] = {
-	{"integrator", BSIM_KNOB_CHOICE, "midpoint", "midpoint|euler",
-	 "beam and body update: implicit midpoint (A-stable, exact energy ledger) or "
-	 "semi-implicit Euler"},
-	{"impact_order", BSIM_KNOB_CHOICE, "simultaneous", "simultaneous|nearest_first",
-	 "impacts with both beams: one complementarity solve, or the essay's nearest-first order"},
-	{"projection", BSIM_KNOB_INT, "1", NULL,
-	 "1: project out penetration deeper than slop after each step; 0: leave it"},
-	{"slop", BSIM_KNOB_DOUBLE, "1e-6", NULL, "penetration tolerated before projection, m"},
-	{"contact_tol", BSIM_KNOB_DOUBLE, "1e-3", NULL,
-	 "gap below which a beam is reported as touching the body, m"},
+        {"integrator", BSIM_KNOB_CHOICE, "midpoint", "midpoint|euler",
+         "beam and body update: implicit midpoint (A-stable, exact energy ledger) or "
+         "semi-implicit Euler"},
+        {"impact_order", BSIM_KNOB_CHOICE, "simultaneous", "simultaneous|nearest_first",
+         "impacts with both beams: one complementarity solve, or the essay's nearest-first order"},
+        {"projection", BSIM_KNOB_INT, "1", NULL,
+         "1: project out penetration deeper than slop after each step; 0: leave it"},
+        {"slop", BSIM_KNOB_DOUBLE, "1e-6", NULL, "penetration tolerated before projection, m"},
+        {"contact_tol", BSIM_KNOB_DOUBLE, "1e-3", NULL,
+         "gap below which a beam is reported as touching the body, m"},
 };
 enum { KNOB_INTEGRATOR, KNOB_IMPACT_ORDER, KNOB_PROJECTION, KNOB_SLOP, KNOB_CONTACT_TOL };
 #define N_KNOBS ((int)(sizeof thesis_knobs / sizeof thesis_knobs[0]))
@@ -56,7 +56,7 @@ static void thesis_destroy(bsim_world *w)
 }
 
 static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
-			 bsim_error *err)
+                         bsim_error *err)
 {
 	*out = NULL;
 	int rc = bsim_options_check(opts, thesis_knobs, N_KNOBS, "thesis", err);
@@ -120,7 +120,7 @@ double thesis_kinetic_energy(const bsim_world *w)
 static double step_margin(const bsim_world *w, const thesis_beam *b, double speed, double h)
 {
 	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
-		       b->inertia;
+	               b->inertia;
 	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
 }
 
@@ -133,7 +133,7 @@ static void thesis_step(bsim_world *w, const double force[2], double h)
 	for (int i = 0; i < w->n_beams; i++) {
 		w->contact_type[i] = BSIM_CONTACT_NONE;
 		n += thesis_contact_detect(w, i, step_margin(w, &w->beams[i], speed, h),
-					   &w->contacts[n]);
+		                           &w->contacts[n]);
 	}
 	w->n_contacts = n;
 	if (n)
@@ -161,7 +161,7 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 {
 	if (s->n_beams != w->n_beams)
 		return bsim_error_set(err, BSIM_EINPUT, "thesis: state has %d beams, world has %d",
-				      s->n_beams, w->n_beams);
+		                      s->n_beams, w->n_beams);
 	memcpy(w->x, s->x, sizeof w->x);
 	memcpy(w->v, s->v, sizeof w->v);
 	for (int i = 0; i < w->n_beams; i++) {
@@ -173,14 +173,14 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 }
 
 const bsim_backend bsim_backend_thesis = {
-	.name = "thesis",
-	.description = "the essay's collision + constraint solver: impulses with restitution, "
-		       "persistent contact by complementarity, implicit beam springs",
-	.knobs = thesis_knobs,
-	.n_knobs = N_KNOBS,
-	.create = thesis_create,
-	.destroy = thesis_destroy,
-	.step = thesis_step,
-	.get_state = thesis_get_state,
-	.set_state = thesis_set_state,
+        .name = "thesis",
+        .description = "the essay's collision + constraint solver: impulses with restitution, "
+                       "persistent contact by complementarity, implicit beam springs",
+        .knobs = thesis_knobs,
+        .n_knobs = N_KNOBS,
+        .create = thesis_create,
+        .destroy = thesis_destroy,
+        .step = thesis_step,
+        .get_state = thesis_get_state,
+        .set_state = thesis_set_state,
 };

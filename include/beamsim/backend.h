@@ -27,14 +27,14 @@ typedef struct bsim_step_energy {
 } bsim_step_energy;
 
 typedef struct bsim_state {
-	double x[2];     /* body centre, m */
-	double v[2];     /* body velocity, m/s */
+	double x[2]; /* body centre, m */
+	double v[2]; /* body velocity, m/s */
 	int n_beams;
-	double *theta;   /* n_beams, rad, forward positive */
-	double *omega;   /* n_beams, rad/s */
-	int *contact;    /* n_beams, BSIM_CONTACT_* at the end of the step */
+	double *theta;           /* n_beams, rad, forward positive */
+	double *omega;           /* n_beams, rad/s */
+	int *contact;            /* n_beams, BSIM_CONTACT_* at the end of the step */
 	bsim_step_energy energy; /* of the last step */
-	int impacts;     /* impacts resolved in the last step */
+	int impacts;             /* impacts resolved in the last step */
 } bsim_state;
 
 int bsim_state_alloc(bsim_state *s, int n_beams);
@@ -66,8 +66,8 @@ typedef struct bsim_knob {
 
 /* Checks every option names a knob and parses as its type (BSIM_EINPUT
  * naming the option and what was expected otherwise). */
-int bsim_options_check(const bsim_options *opts, const bsim_knob *knobs,
-		       int n_knobs, const char *backend, bsim_error *err);
+int bsim_options_check(const bsim_options *opts, const bsim_knob *knobs, int n_knobs,
+                       const char *backend, bsim_error *err);
 /* Typed look-ups with the knob's default. */
 double bsim_options_double(const bsim_options *opts, const bsim_knob *knob);
 long bsim_options_int(const bsim_options *opts, const bsim_knob *knob);
@@ -81,8 +81,8 @@ typedef struct bsim_backend {
 	const char *description;
 	const bsim_knob *knobs;
 	int n_knobs;
-	int (*create)(const bsim_scene *scene, const bsim_options *opts,
-		      bsim_world **out, bsim_error *err);
+	int (*create)(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
+	              bsim_error *err);
 	void (*destroy)(bsim_world *w);
 	/* Advance one step of h seconds with force (N) on the body centre. */
 	void (*step)(bsim_world *w, const double force[2], double h);

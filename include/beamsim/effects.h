@@ -36,8 +36,7 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed);
 void bsim_effects_free(bsim_effects *fx);
 
 /* Sum of all effects' forces on the body at step n. */
-static inline void bsim_effects_force(bsim_effects *fx, long n, double h,
-				      double f[2])
+static inline void bsim_effects_force(bsim_effects *fx, long n, double h, double f[2])
 {
 	f[0] = 0.0;
 	f[1] = 0.0;

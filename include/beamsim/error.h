@@ -24,7 +24,7 @@ typedef struct bsim_error {
 
 /* Sets err (if not NULL) and returns code. printf-style message. */
 int bsim_error_set(bsim_error *err, int code, const char *fmt, ...)
-	__attribute__((format(printf, 3, 4)));
+        __attribute__((format(printf, 3, 4)));
 
 /* Clears err to BSIM_OK with an empty message. */
 void bsim_error_clear(bsim_error *err);

@@ -14,10 +14,10 @@ extern "C" {
 #endif
 
 typedef struct bsim_grid_axis {
-	char *key;        /* dotted scene path */
+	char *key; /* dotted scene path */
 	int n_values;
-	char **values;    /* YAML scalar text of each value */
-	char **origins;   /* "file:line" of each value, for error messages */
+	char **values;  /* YAML scalar text of each value */
+	char **origins; /* "file:line" of each value, for error messages */
 } bsim_grid_axis;
 
 typedef struct bsim_experiment {
@@ -25,11 +25,11 @@ typedef struct bsim_experiment {
 	char scene_path[1024]; /* resolved relative to the experiment file */
 	int trials;
 	uint64_t seed;
-	int n_set;             /* fixed overrides from the `set:` block */
-	bsim_override *set;    /* strings owned by the experiment */
+	int n_set;          /* fixed overrides from the `set:` block */
+	bsim_override *set; /* strings owned by the experiment */
 	int n_axes;
-	bsim_grid_axis *axes;  /* the first axis varies slowest */
-	int n_groups;          /* product of the axes' sizes, >= 1 */
+	bsim_grid_axis *axes; /* the first axis varies slowest */
+	int n_groups;         /* product of the axes' sizes, >= 1 */
 } bsim_experiment;
 
 /* Loads an experiment file. Errors (unknown keys, an empty grid, ...) are
@@ -37,8 +37,8 @@ typedef struct bsim_experiment {
  * every group is loaded and validated here, so a bad grid value fails before
  * any trial runs. extra: command-line --set overrides applied to every group
  * (after `set:`, before the grid values). */
-int bsim_experiment_load(const char *path, const bsim_override *extra,
-			 int n_extra, bsim_experiment *out, bsim_error *err);
+int bsim_experiment_load(const char *path, const bsim_override *extra, int n_extra,
+                         bsim_experiment *out, bsim_error *err);
 
 void bsim_experiment_free(bsim_experiment *e);
 
@@ -46,9 +46,8 @@ void bsim_experiment_free(bsim_experiment *e);
 void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx);
 
 /* Builds the scene of group g: scene file + set + extra + grid values. */
-int bsim_experiment_group_scene(const bsim_experiment *e, int g,
-				const bsim_override *extra, int n_extra,
-				bsim_scene *out, bsim_error *err);
+int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_override *extra,
+                                int n_extra, bsim_scene *out, bsim_error *err);
 
 #ifdef __cplusplus
 }

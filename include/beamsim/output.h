@@ -1,6 +1,6 @@
 /* The output files of a sweep (DESIGN.md "Outputs", a contract):
  * summary.json, trials.csv and the text table of p_traverse. Files are
- * written to a temporary name and renamed, so a reader never sees half a
+ * written through beamsim/atomic_file.h, so a reader never sees half a
  * file and an interrupted run leaves none. */
 #ifndef BEAMSIM_OUTPUT_H
 #define BEAMSIM_OUTPUT_H
@@ -15,15 +15,18 @@
 extern "C" {
 #endif
 
-int bsim_output_summary_json(const char *path, const bsim_experiment *e,
-			     const char *backend, const bsim_options *opts,
-			     const bsim_sweep_result *r, bsim_error *err);
-int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r,
-			   bsim_error *err);
+int bsim_output_summary_json(const char *path, const bsim_experiment *e, const char *backend,
+                             const bsim_options *opts, const bsim_sweep_result *r, bsim_error *err);
+int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_error *err);
 /* p_traverse over the first two grid axes (columns: axis 0, rows: axis 1),
  * one table per combination of the other axes. */
-void bsim_output_table(FILE *f, const bsim_experiment *e,
-		       const bsim_sweep_result *r);
+void bsim_output_table(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r);
+
+/* A JSON object of every knob of backend b (may be NULL) with its
+ * effective value, given in opts or the default, then any option of opts
+ * that b does not list: a record alone says how the backend was run.
+ * Shared by summary.json, run --json and bench --json. */
+void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_options *opts);
 
 /* Creates dir (and parents) if missing. */
 int bsim_output_mkdir(const char *dir, bsim_error *err);

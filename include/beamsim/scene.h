@@ -52,11 +52,11 @@ typedef struct bsim_scene {
 	bsim_beam_def *beams; /* n_beams entries, owned by the scene */
 	bsim_contact_def contact;
 	bsim_effects_def effects;
-	double dt;       /* s, > 0; default 0.004 */
-	int max_steps;   /* > 0; default 3000 */
-	double success_y;  /* m; default 65 */
-	double side_x;     /* m, > 0; default 25 */
-	double classify_y; /* m, >= success_y; default 80 */
+	double dt;           /* s, > 0; default 0.004 */
+	int max_steps;       /* > 0; default 3000 */
+	double success_y;    /* m; default 65 */
+	double side_x;       /* m, > 0; default 25 */
+	double classify_y;   /* m, >= success_y; default 80 */
 	double landscape_y0; /* m, zero of the propulsive potential; default 60 */
 } bsim_scene;
 
@@ -72,8 +72,8 @@ typedef struct bsim_override {
 /* Loads and validates a scene file, applying the overrides in order (later
  * ones win). On failure returns BSIM_EINPUT with one message naming the file
  * (or the override's origin), line, field and what was expected. */
-int bsim_scene_load(const char *path, const bsim_override *overrides,
-		    int n_overrides, bsim_scene *out, bsim_error *err);
+int bsim_scene_load(const char *path, const bsim_override *overrides, int n_overrides,
+                    bsim_scene *out, bsim_error *err);
 
 /* Fills the essay's single-gate scene (MODEL.md section 1, Table 2.1) with
  * the given propulsion and random force magnitude (0 = effect absent). */

@@ -20,8 +20,7 @@ uint64_t bsim_seed_mix(uint64_t seed, uint64_t group, uint64_t trial);
 typedef struct bsim_schedule bsim_schedule;
 
 /* magnitude Rm in N, frequency f in Hz (> 0), seed from bsim_seed_mix. */
-bsim_schedule *bsim_schedule_alloc(double magnitude, double frequency,
-				   uint64_t seed);
+bsim_schedule *bsim_schedule_alloc(double magnitude, double frequency, uint64_t seed);
 void bsim_schedule_free(bsim_schedule *s);
 
 /* Restarts the schedule with a new seed (no allocation: reuse across trials). */

@@ -33,7 +33,7 @@ typedef void (*bsim_progress_fn)(void *user, long done, long total);
 typedef struct bsim_sweep_config {
 	const bsim_backend *backend;
 	const bsim_options *opts;
-	int threads;           /* <= 0: all available */
+	int threads;                /* <= 0: all available */
 	const bsim_override *extra; /* command-line --set, applied to every group */
 	int n_extra;
 	bsim_progress_fn progress; /* may be NULL */
@@ -42,13 +42,12 @@ typedef struct bsim_sweep_config {
 
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller
  * applies --trials/--seed). */
-int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg,
-		   bsim_sweep_result *out, bsim_error *err);
+int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
+                   bsim_error *err);
 void bsim_sweep_result_free(bsim_sweep_result *r);
 
 /* Aggregates one group's trials into counts and the Wilson interval. */
-void bsim_group_aggregate(const bsim_trial_result *trials, int n,
-			  bsim_group_result *out);
+void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out);
 
 #ifdef __cplusplus
 }

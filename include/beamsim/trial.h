@@ -31,30 +31,30 @@ typedef enum {
  * with r the step's residual; |r| summed and at its largest are kept. */
 typedef struct bsim_ledger {
 	double e_start, e_end;
-	double w_prop, w_rand;  /* work of the propulsive and random forces */
+	double w_prop, w_rand; /* work of the propulsive and random forces */
 	double damper, impact, contact, correction;
-	double residual;        /* sum of r */
-	double residual_max;    /* max |r| over steps */
-	double residual_abs;    /* sum of |r| */
+	double residual;     /* sum of r */
+	double residual_max; /* max |r| over steps */
+	double residual_abs; /* sum of |r| */
 } bsim_ledger;
 
 typedef struct bsim_trial_result {
 	bsim_outcome outcome;
 	bsim_type type;
-	int landscape_left;   /* 1 if beam 0's peak theta > beam 1's (traversed) */
-	int steps;            /* steps to the outcome event */
-	double t_end;         /* s, time of the outcome event */
+	int landscape_left;          /* 1 if beam 0's peak theta > beam 1's (traversed) */
+	int steps;                   /* steps to the outcome event */
+	double t_end;                /* s, time of the outcome event */
 	double x_end, y_end, vx_end; /* at the end of the run (classify_y for traversed) */
-	double max_theta[2];  /* peak theta of beams 0 and 1, rad */
-	int in_contact_end;   /* stuck: 1 if any beam touched the body at the end */
-	int steps_run;        /* all steps integrated, incl. those to classify_y */
-	unsigned long draws;  /* standard-normal draws made */
+	double max_theta[2];         /* peak theta of beams 0 and 1, rad */
+	int in_contact_end;          /* stuck: 1 if any beam touched the body at the end */
+	int steps_run;               /* all steps integrated, incl. those to classify_y */
+	unsigned long draws;         /* standard-normal draws made */
 	bsim_ledger ledger;
 } bsim_trial_result;
 
 /* Trajectory recording: one CSV row per step (DESIGN.md "Outputs"). */
 typedef struct bsim_recorder {
-	FILE *csv; /* NULL: no recording */
+	FILE *csv;  /* NULL: no recording */
 	int stride; /* record every stride-th step (>= 1) */
 } bsim_recorder;
 
@@ -70,10 +70,9 @@ void bsim_runner_free(bsim_runner *r);
 /* Runs one trial. seed: the mixed seed (bsim_seed_mix). rec may be NULL.
  * Returns BSIM_OK, BSIM_EINPUT (backend options), BSIM_EFAIL (non-finite
  * state: the message says at which step). */
-int bsim_trial_run(bsim_runner *r, const bsim_scene *scene,
-		   const bsim_backend *backend, const bsim_options *opts,
-		   uint64_t seed, const bsim_recorder *rec,
-		   bsim_trial_result *out, bsim_error *err);
+int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *backend,
+                   const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
+                   bsim_trial_result *out, bsim_error *err);
 
 const char *bsim_outcome_name(bsim_outcome o);
 const char *bsim_type_name(bsim_type t);

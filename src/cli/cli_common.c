@@ -5,12 +5,11 @@
 
 #include <errno.h>
 #include <getopt.h>
-#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-#include <unistd.h>
+
+#include "beamsim/progress.h"
 
 void cli_error(const char *fmt, ...)
 {
@@ -146,99 +145,43 @@ const bsim_backend *cli_backend(const char *name, const bsim_options *opts)
 	return NULL;
 }
 
-void cli_json_string(FILE *f, const char *s)
+int cli_report(int rc, const bsim_error *err)
 {
-	fputc('"', f);
-	for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-		if (*p == '"' || *p == '\\')
-			fprintf(f, "\\%c", *p);
-		else if (*p == '\n')
-			fputs("\\n", f);
-		else if (*p == '\t')
-			fputs("\\t", f);
-		else if (*p < 0x20)
-			fprintf(f, "\\u%04x", *p);
-		else
-			fputc(*p, f);
-	}
-	fputc('"', f);
+	if (rc != BSIM_OK)
+		cli_error("%s", err->msg);
+	return rc;
 }
 
-void cli_json_double(FILE *f, double x)
+int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsim_experiment *e)
 {
-	char buf[32];
-	if (!isfinite(x)) {
-		fputs("null", f);
-		return;
+	bsim_error err;
+	const bsim_override *ov = sets ? sets->ov : NULL;
+	if (bsim_experiment_load(path, ov, sets ? sets->n : 0, e, &err) != BSIM_OK) {
+		cli_error("%s", err.msg);
+		return err.code ? err.code : CLI_USAGE;
 	}
-	/* The shortest %.Ng that reads back as x. */
-	for (int prec = 15; prec <= 17; prec++) {
-		snprintf(buf, sizeof buf, "%.*g", prec, x);
-		if (strtod(buf, NULL) == x)
-			break;
-	}
-	fputs(buf, f);
-}
-
-void cli_json_options(FILE *f, const bsim_backend *b, const bsim_options *opts)
-{
-	fputc('{', f);
-	for (int i = 0; i < b->n_knobs; i++) {
-		const char *v = bsim_options_get(opts, b->knobs[i].name);
-		if (!v)
-			v = b->knobs[i].default_value ? b->knobs[i].default_value : "";
-		fputs(i ? ", " : "", f);
-		cli_json_string(f, b->knobs[i].name);
-		fputs(": ", f);
-		cli_json_string(f, v);
-	}
-	fputc('}', f);
-}
-
-int cli_file_open(cli_file *o, const char *path)
-{
-	o->path = path;
-	o->f = NULL;
-	int n = snprintf(o->tmp, sizeof o->tmp, "%s.tmp.%ld", path, (long)getpid());
-	if (n < 0 || (size_t)n >= sizeof o->tmp) {
-		cli_error("%s: path too long", path);
-		return CLI_FAIL;
-	}
-	o->f = fopen(o->tmp, "w");
-	if (!o->f) {
-		cli_error("%s: cannot write: %s", o->tmp, strerror(errno));
-		return CLI_FAIL;
-	}
+	if (trials > 0)
+		e->trials = (int)trials;
 	return CLI_OK;
 }
 
-int cli_file_commit(cli_file *o)
+/* The progress state lives here, for exactly the length of the run, so
+ * callers cannot leave cfg pointing at it. */
+int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int show_progress,
+                  bsim_sweep_result *r)
 {
-	int bad = ferror(o->f) || fflush(o->f) != 0 || fsync(fileno(o->f)) != 0;
-	int saved = errno;
-	bad |= fclose(o->f) != 0;
-	o->f = NULL;
-	if (!bad && rename(o->tmp, o->path) == 0)
-		return CLI_OK;
-	if (!bad)
-		saved = errno;
-	unlink(o->tmp);
-	cli_error("%s: write failed: %s", o->path, strerror(saved));
-	return CLI_FAIL;
+	bsim_progress progress;
+	bsim_sweep_config c = *cfg;
+	bsim_error err;
+	bsim_progress_init(&progress, show_progress);
+	c.progress = bsim_progress_update;
+	c.progress_user = &progress;
+	int rc = bsim_sweep_run(e, &c, r, &err);
+	bsim_progress_finish(&progress);
+	return cli_report(rc, &err);
 }
 
-void cli_file_abort(cli_file *o)
+double cli_per_second(double count, double wall)
 {
-	if (o->f) {
-		fclose(o->f);
-		o->f = NULL;
-		unlink(o->tmp);
-	}
-}
-
-double cli_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+	return count / (wall > 0 ? wall : 1e-9);
 }

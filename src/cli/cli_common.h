@@ -1,6 +1,8 @@
 /* What the subcommands of the beamsim program share: argument parsing,
- * --set and --backend-opt collection, backend look-up, error printing,
- * JSON printing and atomic file writes. */
+ * --set and --backend-opt collection, backend and experiment loading,
+ * running a sweep with a progress line, and error printing. JSON values
+ * and atomic file writes come from the library (beamsim/json.h,
+ * beamsim/atomic_file.h), shared with the sweep's output files. */
 #ifndef BEAMSIM_CLI_COMMON_H
 #define BEAMSIM_CLI_COMMON_H
 
@@ -9,6 +11,7 @@
 
 #include "beamsim/backend.h"
 #include "beamsim/scene.h"
+#include "beamsim/sweep.h"
 
 /* Exit statuses (DESIGN.md "Command line"); they equal the bsim_error codes. */
 enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2 };
@@ -52,30 +55,23 @@ int cli_options_add(bsim_options *opts, const char *cmd, const char *kv);
  * returns NULL (exit status 2) if unknown or an option is bad. */
 const bsim_backend *cli_backend(const char *name, const bsim_options *opts);
 
-/* JSON values: an escaped string, a double that reads back exactly (null
- * if not finite), and an object of every knob of backend b with its
- * effective value (given or default), so a record says how it was run. */
-void cli_json_string(FILE *f, const char *s);
-void cli_json_double(FILE *f, double x);
-void cli_json_options(FILE *f, const bsim_backend *b, const bsim_options *opts);
+/* Prints err's message if rc is not BSIM_OK; returns rc, which is also
+ * the exit status (the codes are equal). */
+int cli_report(int rc, const bsim_error *err);
 
-/* An output file written to PATH.tmp.PID and renamed into place when
- * complete, so no reader ever sees a partial file. */
-typedef struct cli_file {
-	FILE *f;
-	const char *path;
-	char tmp[1100];
-} cli_file;
+/* Loads an experiment with the --set overrides (sets may be NULL) and,
+ * if trials > 0, that many trials per group. Prints any error; returns
+ * the exit status (2 for a bad file). */
+int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsim_experiment *e);
 
-/* 0, or prints the error and returns 1. */
-int cli_file_open(cli_file *o, const char *path);
-/* Flushes to disk and renames; 0, or prints the error, removes the
- * temporary file and returns 1. */
-int cli_file_commit(cli_file *o);
-/* Drops the temporary file (the run failed). */
-void cli_file_abort(cli_file *o);
+/* bsim_sweep_run with a progress line on stderr if show_progress (cfg's
+ * own progress fields are ignored). Prints any error; returns the exit
+ * status. */
+int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int show_progress,
+                  bsim_sweep_result *r);
 
-/* Seconds on the monotonic clock. */
-double cli_now(void);
+/* count per second of wall time. A run too short for the clock (wall 0)
+ * counts as 1 ns, so a rate is always finite. */
+double cli_per_second(double count, double wall);
 
 #endif

@@ -8,7 +8,9 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "beamsim/progress.h"
+#include "beamsim/atomic_file.h"
+#include "beamsim/json.h"
+#include "beamsim/output.h"
 #include "beamsim/sweep.h"
 #include "cli_common.h"
 
@@ -130,10 +132,10 @@ static void bench_print_header(void)
 
 static void bench_print_run(const bench_run *r)
 {
-	double wall = r->wall > 0 ? r->wall : 1e-9;
+	double steps_per_second = cli_per_second(r->steps, r->wall);
 	printf("%-36s %7d %7ld %12ld %9.3f %10.4g %9.1f %13.4g\n", r->experiment, r->threads,
-	       r->trials, r->steps, r->wall, r->steps / wall, r->trials / wall,
-	       r->steps / wall / r->threads);
+	       r->trials, r->steps, r->wall, steps_per_second, cli_per_second(r->trials, r->wall),
+	       steps_per_second / r->threads);
 	fflush(stdout);
 }
 
@@ -142,23 +144,11 @@ static void bench_print_run(const bench_run *r)
 static int bench_sweep(const bench_args *a, const bsim_backend *backend, const bsim_experiment *e,
                        const char *label, int threads, bench_run *out)
 {
-	bsim_progress progress;
-	bsim_progress_init(&progress, 1);
-	bsim_sweep_config cfg = {
-	        .backend = backend,
-	        .opts = &a->opts,
-	        .threads = threads,
-	        .progress = bsim_progress_update,
-	        .progress_user = &progress,
-	};
+	bsim_sweep_config cfg = {.backend = backend, .opts = &a->opts, .threads = threads};
 	bsim_sweep_result r;
-	bsim_error err;
-	int rc = bsim_sweep_run(e, &cfg, &r, &err);
-	bsim_progress_finish(&progress);
-	if (rc != BSIM_OK) {
-		cli_error("%s", err.msg);
+	int rc = cli_sweep_run(e, &cfg, 1, &r);
+	if (rc != CLI_OK)
 		return rc;
-	}
 	*out = (bench_run){
 	        .experiment = label,
 	        .threads = threads,
@@ -168,18 +158,6 @@ static int bench_sweep(const bench_args *a, const bsim_backend *backend, const b
 	};
 	bsim_sweep_result_free(&r);
 	bench_print_run(out);
-	return CLI_OK;
-}
-
-static int bench_load(const bench_args *a, const char *path, bsim_experiment *e)
-{
-	bsim_error err;
-	if (bsim_experiment_load(path, NULL, 0, e, &err) != BSIM_OK) {
-		cli_error("%s", err.msg);
-		return err.code ? err.code : CLI_USAGE;
-	}
-	if (a->trials > 0)
-		e->trials = (int)a->trials;
 	return CLI_OK;
 }
 
@@ -196,39 +174,50 @@ static int bench_experiment(const bench_args *a, const bsim_backend *backend,
 	return rc;
 }
 
-static int bench_json(const bench_args *a, const bsim_backend *backend, int threads,
-                      const bench_run *runs, int n_runs, double h1_h2)
+static void bench_json_run(FILE *f, const bench_run *r)
 {
-	cli_file o;
-	if (cli_file_open(&o, a->json) != CLI_OK)
-		return CLI_FAIL;
-	FILE *f = o.f;
+	fputs("{\"experiment\": ", f);
+	bsim_json_string(f, r->experiment);
+	fprintf(f, ", \"threads\": %d, \"trials\": %ld, \"steps\": %ld, \"wall_seconds\": ",
+	        r->threads, r->trials, r->steps);
+	bsim_json_number(f, r->wall);
+	fputs(", \"steps_per_second\": ", f);
+	bsim_json_number(f, cli_per_second(r->steps, r->wall));
+	fputs(", \"trials_per_second\": ", f);
+	bsim_json_number(f, cli_per_second(r->trials, r->wall));
+	fputc('}', f);
+}
+
+/* h1_h2 < 0: no H1 + H2 step, written as null. */
+static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *backend, int threads,
+                             const bench_run *runs, int n_runs, double h1_h2)
+{
 	fputs("{\"backend\": ", f);
-	cli_json_string(f, a->backend);
+	bsim_json_string(f, a->backend);
 	fputs(", \"options\": ", f);
-	cli_json_options(f, backend, &a->opts);
+	bsim_output_backend_options(f, backend, &a->opts);
 	fprintf(f, ", \"threads\": %d, \"runs\": [", threads);
 	for (int i = 0; i < n_runs; i++) {
-		const bench_run *r = &runs[i];
-		double wall = r->wall > 0 ? r->wall : 1e-9;
-		fputs(i ? ",\n  {\"experiment\": " : "\n  {\"experiment\": ", f);
-		cli_json_string(f, r->experiment);
-		fprintf(f, ", \"threads\": %d, \"trials\": %ld, \"steps\": %ld, \"wall_seconds\": ",
-		        r->threads, r->trials, r->steps);
-		cli_json_double(f, r->wall);
-		fputs(", \"steps_per_second\": ", f);
-		cli_json_double(f, r->steps / wall);
-		fputs(", \"trials_per_second\": ", f);
-		cli_json_double(f, r->trials / wall);
-		fputc('}', f);
+		fputs(i ? ",\n  " : "\n  ", f);
+		bench_json_run(f, &runs[i]);
 	}
 	fputs("],\n \"h1_h2_seconds\": ", f);
 	if (h1_h2 >= 0)
-		cli_json_double(f, h1_h2);
+		bsim_json_number(f, h1_h2);
 	else
 		fputs("null", f);
 	fputs("}\n", f);
-	return cli_file_commit(&o);
+}
+
+static int bench_json(const bench_args *a, const bsim_backend *backend, int threads,
+                      const bench_run *runs, int n_runs, double h1_h2)
+{
+	bsim_atomic_file o;
+	bsim_error err;
+	if (bsim_atomic_file_open(&o, a->json, &err) != BSIM_OK)
+		return cli_report(BSIM_EFAIL, &err);
+	bench_json_write(o.f, a, backend, threads, runs, n_runs, h1_h2);
+	return cli_report(bsim_atomic_file_commit(&o, &err), &err);
 }
 
 /* Both experiments are loaded before anything runs, so a bad file fails
@@ -242,10 +231,10 @@ static int bench_main(const bench_args *a, const bsim_backend *backend)
 	if (rc == CLI_OK && a->h2)
 		rc = bench_find(BENCH_H2);
 	if (rc == CLI_OK)
-		rc = bench_load(a, a->experiment, &h1);
+		rc = cli_experiment_load(a->experiment, NULL, a->trials, &h1);
 	if (rc != CLI_OK)
 		return rc;
-	if (a->h2 && (rc = bench_load(a, BENCH_H2, &h2)) != CLI_OK) {
+	if (a->h2 && (rc = cli_experiment_load(BENCH_H2, NULL, a->trials, &h2)) != CLI_OK) {
 		bsim_experiment_free(&h1);
 		return rc;
 	}

@@ -10,6 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/atomic_file.h"
+#include "beamsim/json.h"
+#include "beamsim/output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "cli_common.h"
@@ -152,7 +155,7 @@ static void print_ledger_json(const bsim_ledger *l)
 	fputc('{', stdout);
 	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
 		printf("%s\"%s\": ", i ? ", " : "", terms[i].name);
-		cli_json_double(stdout, terms[i].value);
+		bsim_json_number(stdout, terms[i].value);
 	}
 	fputc('}', stdout);
 }
@@ -161,19 +164,19 @@ static void print_json(const run_args *a, const bsim_backend *b, const bsim_scen
                        uint64_t mixed, const bsim_trial_result *r)
 {
 	fputs("{\"scene\": ", stdout);
-	cli_json_string(stdout, a->scene);
+	bsim_json_string(stdout, a->scene);
 	fputs(", \"name\": ", stdout);
-	cli_json_string(stdout, s->name);
+	bsim_json_string(stdout, s->name);
 	fputs(", \"backend\": ", stdout);
-	cli_json_string(stdout, a->backend);
+	bsim_json_string(stdout, a->backend);
 	fputs(", \"backend_options\": ", stdout);
-	cli_json_options(stdout, b, &a->opts);
+	bsim_output_backend_options(stdout, b, &a->opts);
 	printf(", \"seed\": %" PRIu64 ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": %" PRIu64,
 	       a->seed, a->group, a->trial, mixed);
 	fputs(", \"outcome\": ", stdout);
-	cli_json_string(stdout, bsim_outcome_name(r->outcome));
+	bsim_json_string(stdout, bsim_outcome_name(r->outcome));
 	fputs(", \"type\": ", stdout);
-	cli_json_string(stdout, bsim_type_name(r->type));
+	bsim_json_string(stdout, bsim_type_name(r->type));
 	printf(", \"landscape_left\": %d, \"in_contact_end\": %d", r->landscape_left,
 	       r->in_contact_end);
 	printf(", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
@@ -182,12 +185,12 @@ static void print_json(const run_args *a, const bsim_backend *b, const bsim_scen
 	const double values[] = {r->t_end, r->x_end, r->y_end, r->vx_end};
 	for (int i = 0; i < 4; i++) {
 		printf(", \"%s\": ", names[i]);
-		cli_json_double(stdout, values[i]);
+		bsim_json_number(stdout, values[i]);
 	}
 	fputs(", \"max_theta\": [", stdout);
-	cli_json_double(stdout, r->max_theta[0]);
+	bsim_json_number(stdout, r->max_theta[0]);
 	fputs(", ", stdout);
-	cli_json_double(stdout, r->max_theta[1]);
+	bsim_json_number(stdout, r->max_theta[1]);
 	fputs("], \"ledger\": ", stdout);
 	print_ledger_json(&r->ledger);
 	fputs("}\n", stdout);
@@ -227,31 +230,33 @@ static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
 static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_backend *backend,
                      uint64_t mixed, bsim_trial_result *res)
 {
-	cli_file traj = {0};
+	bsim_atomic_file traj = {0};
 	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride};
+	bsim_error err;
 	if (a->trajectory) {
-		if (cli_file_open(&traj, a->trajectory) != CLI_OK)
-			return CLI_FAIL;
+		if (bsim_atomic_file_open(&traj, a->trajectory, &err) != BSIM_OK)
+			return cli_report(BSIM_EFAIL, &err);
 		bsim_recorder_header(traj.f, scene->n_beams);
 		rec.csv = traj.f;
 	}
 	bsim_runner *runner = bsim_runner_alloc();
 	if (!runner) {
-		cli_file_abort(&traj);
+		bsim_atomic_file_abort(&traj);
 		cli_error("out of memory for a trial runner");
 		return CLI_FAIL;
 	}
-	bsim_error err;
 	bsim_error_clear(&err);
 	int rc = bsim_trial_run(runner, scene, backend, &a->opts, mixed,
 	                        a->trajectory ? &rec : NULL, res, &err);
 	bsim_runner_free(runner);
 	if (rc != BSIM_OK) {
-		cli_file_abort(&traj);
-		cli_error("%s", err.msg);
-		return rc;
+		bsim_atomic_file_abort(&traj);
+		return cli_report(rc, &err);
 	}
-	return a->trajectory ? cli_file_commit(&traj) : CLI_OK;
+	if (!a->trajectory)
+		return CLI_OK;
+	rc = bsim_atomic_file_commit(&traj, &err);
+	return cli_report(rc, &err);
 }
 
 int cmd_run(int argc, char **argv)

@@ -11,7 +11,6 @@
 #include <unistd.h>
 
 #include "beamsim/output.h"
-#include "beamsim/progress.h"
 #include "beamsim/sweep.h"
 #include "cli_common.h"
 
@@ -126,6 +125,8 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 	a->experiment = argv[optind];
 	if (!a->out)
 		return cli_usage("sweep", "--out DIR is required");
+	if (strlen(a->out) > 1000) /* DIR/summary.json must fit the path buffers */
+		return cli_usage("sweep", "--out DIR is longer than 1000 characters");
 	return -1;
 }
 
@@ -147,11 +148,10 @@ static void sweep_report(const sweep_args *a, const bsim_experiment *e, const bs
                          int threads)
 {
 	long n = (long)r->n_groups * r->trials;
-	double wall = r->wall_seconds > 0 ? r->wall_seconds : 1e-9;
 	bsim_output_table(stdout, e, r);
 	printf("\n%ld trials, %ld steps in %.3f s on %d thread%s: %.0f trials/s, %.3g steps/s\n", n,
-	       r->total_steps, r->wall_seconds, threads, threads == 1 ? "" : "s", n / wall,
-	       r->total_steps / wall);
+	       r->total_steps, r->wall_seconds, threads, threads == 1 ? "" : "s",
+	       cli_per_second(n, r->wall_seconds), cli_per_second(r->total_steps, r->wall_seconds));
 	printf("wrote %s/summary.json and %s/trials.csv\n", a->out, a->out);
 }
 
@@ -163,12 +163,9 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 	bsim_experiment e;
 	bsim_error err;
 	struct stat st;
-	if (bsim_experiment_load(a->experiment, a->sets.ov, a->sets.n, &e, &err) != BSIM_OK) {
-		cli_error("%s", err.msg);
-		return err.code ? err.code : CLI_USAGE;
-	}
-	if (a->trials > 0)
-		e.trials = (int)a->trials;
+	int rc = cli_experiment_load(a->experiment, &a->sets, a->trials, &e);
+	if (rc != CLI_OK)
+		return rc;
 	if (a->has_seed)
 		e.seed = a->seed;
 	int created = stat(a->out, &st) != 0;
@@ -178,8 +175,6 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 		return CLI_FAIL;
 	}
 
-	bsim_progress progress;
-	bsim_progress_init(&progress, !a->quiet);
 	int threads = a->threads > 0 ? (int)a->threads : omp_get_max_threads();
 	bsim_sweep_config cfg = {
 	        .backend = backend,
@@ -187,14 +182,10 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 	        .threads = threads,
 	        .extra = a->sets.ov,
 	        .n_extra = a->sets.n,
-	        .progress = bsim_progress_update,
-	        .progress_user = &progress,
 	};
 	bsim_sweep_result r;
-	int rc = bsim_sweep_run(&e, &cfg, &r, &err);
-	bsim_progress_finish(&progress);
-	if (rc != BSIM_OK) {
-		cli_error("%s", err.msg);
+	rc = cli_sweep_run(&e, &cfg, !a->quiet, &r);
+	if (rc != CLI_OK) {
 		if (created)
 			rmdir(a->out);
 	} else {

@@ -1,0 +1,15 @@
+/* Wall-clock time for timings and ETAs. */
+#ifndef BEAMSIM_CLOCK_H
+#define BEAMSIM_CLOCK_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Seconds on a monotonic clock from an arbitrary origin. */
+double bsim_clock_seconds(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

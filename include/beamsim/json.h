@@ -1,0 +1,26 @@
+/* JSON values for the files and records beamsim writes (summary.json,
+ * run --json, bench --json). Only the two leaf values that need care live
+ * here; callers write the braces, commas and keys themselves, so each
+ * output keeps the exact layout its contract (DESIGN.md "Outputs") gives. */
+#ifndef BEAMSIM_JSON_H
+#define BEAMSIM_JSON_H
+
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* s as a JSON string: quotes, backslashes and control characters escaped
+ * (\n, \r, \t by name, the rest as \u00XX); other bytes, UTF-8 included,
+ * are written as they are. */
+void bsim_json_string(FILE *f, const char *s);
+
+/* x as the shortest of %.15g, %.16g, %.17g that reads back as the same
+ * double; null if x is not finite (JSON has no NaN or infinity). */
+void bsim_json_number(FILE *f, double x);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,62 @@
+/* Whole-or-nothing files; see beamsim/atomic_file.h. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/atomic_file.h"
+
+#include <errno.h>
+#include <string.h>
+#include <unistd.h>
+
+int bsim_atomic_file_open(bsim_atomic_file *o, const char *path, bsim_error *err)
+{
+	o->f = NULL;
+	o->path = path;
+	/* The process id keeps two runs writing the same PATH apart. */
+	int n = snprintf(o->tmp, sizeof o->tmp, "%s.tmp.%ld", path, (long)getpid());
+	if (n < 0 || (size_t)n >= sizeof o->tmp)
+		/* Abbreviated, so the message keeps its end within the error. */
+		return bsim_error_set(err, BSIM_EFAIL, "%.200s%s: path too long", path,
+		                      strlen(path) > 200 ? "..." : "");
+	o->f = fopen(o->tmp, "w");
+	if (!o->f)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write: %s", o->tmp,
+		                      strerror(errno));
+	return BSIM_OK;
+}
+
+/* Flushes f to disk and closes it: 0, or the errno of the first
+ * failure. fsync comes before the rename, else a crash soon after could
+ * leave PATH renamed but empty on some file systems. A write that failed
+ * earlier shows only as ferror; errno most likely still holds its cause. */
+static int flush_close(FILE *f)
+{
+	int saved = 0;
+	if (ferror(f))
+		saved = errno ? errno : EIO;
+	else if (fflush(f) != 0 || fsync(fileno(f)) != 0)
+		saved = errno;
+	if (fclose(f) != 0 && saved == 0)
+		saved = errno;
+	return saved;
+}
+
+int bsim_atomic_file_commit(bsim_atomic_file *o, bsim_error *err)
+{
+	int saved = flush_close(o->f);
+	o->f = NULL;
+	if (saved == 0 && rename(o->tmp, o->path) == 0)
+		return BSIM_OK;
+	if (saved == 0)
+		saved = errno;
+	unlink(o->tmp);
+	return bsim_error_set(err, BSIM_EFAIL, "%s: write failed: %s", o->path, strerror(saved));
+}
+
+void bsim_atomic_file_abort(bsim_atomic_file *o)
+{
+	if (!o->f)
+		return;
+	fclose(o->f);
+	o->f = NULL;
+	unlink(o->tmp);
+}
