@@ -20,17 +20,24 @@ static double oscillator(double k, double d, double inertia, double th0, double 
 	return th0 * exp(-zeta * wn * t) * (cos(wd * t) + zeta * wn / wd * sin(wd * t));
 }
 
+/* A Table 2.1 beam alone (no body in reach), released from theta0 at rest. */
+static bsim_world *beam_released(bsim_scene *s, double k, double d, double theta0)
+{
+	scene_one_beam(s);
+	s->beams[0].stiffness = k;
+	s->beams[0].damping = d;
+	s->beams[0].initial_theta = theta0;
+	bsim_world *w = NULL;
+	bsim_error err;
+	assert_int_equal(bsim_backend_thesis.create(s, NULL, &w, &err), BSIM_OK);
+	return w;
+}
+
 /* Max |theta - exact| over t in [0, t_end] for a Table 2.1 beam. */
 static double vibration_error(double h, double t_end)
 {
 	bsim_scene s;
-	scene_one_beam(&s);
-	s.beams[0].stiffness = 400.0;
-	s.beams[0].damping = 50.0;
-	s.beams[0].initial_theta = 0.1;
-	bsim_world *w = NULL;
-	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	bsim_world *w = beam_released(&s, 400.0, 50.0, 0.1);
 	bsim_state st;
 	bsim_state_alloc(&st, 1);
 	const double zero[2] = {0.0, 0.0};
@@ -72,16 +79,12 @@ static void test_stiff_spring_stable(void **state)
 	const double h = 0.004, wh[] = {0.05, 0.5, 2.0, 4.0};
 	for (int damped = 0; damped < 2; damped++) {
 		for (size_t c = 0; c < sizeof wh / sizeof wh[0]; c++) {
-			bsim_scene s;
-			scene_one_beam(&s);
-			double inertia = s.beams[0].inertia;
+			const double inertia = 0.1 * 625.0 / 3.0; /* scene_one_beam's beam */
 			double k = inertia * (wh[c] / h) * (wh[c] / h);
-			s.beams[0].stiffness = k;
-			s.beams[0].damping = damped ? 2.0 * 0.05 * sqrt(k * inertia) : 0.0;
-			s.beams[0].initial_theta = 0.2;
-			bsim_world *w = NULL;
-			bsim_error err;
-			assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+			bsim_scene s;
+			bsim_world *w = beam_released(
+			        &s, k, damped ? 2.0 * 0.05 * sqrt(k * inertia) : 0.0, 0.2);
+			assert_true(s.beams[0].inertia == inertia);
 			bsim_state st;
 			bsim_state_alloc(&st, 1);
 			const double zero[2] = {0.0, 0.0};
