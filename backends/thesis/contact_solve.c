@@ -42,18 +42,10 @@ void thesis_contact_solve(struct bsim_world *w, const double force[2], double h)
 	}
 	thesis_lcp_solve(w, cs, n);
 
-	double jx = 0.0, jy = 0.0;
-	if (n == 2) { /* one expression for a pair: a mirrored pair sums alike */
-		jx = cs[0].impulse * cs[0].n[0] + cs[1].impulse * cs[1].n[0];
-		jy = cs[0].impulse * cs[0].n[1] + cs[1].impulse * cs[1].n[1];
-	} else {
-		for (int k = 0; k < n; k++) {
-			jx += cs[k].impulse * cs[k].n[0];
-			jy += cs[k].impulse * cs[k].n[1];
-		}
-	}
-	w->v[0] = vf[0] + jx * w->inv_mass;
-	w->v[1] = vf[1] + jy * w->inv_mass;
+	double j[2];
+	thesis_impulse_sum(cs, n, j);
+	w->v[0] = vf[0] + j[0] * w->inv_mass;
+	w->v[1] = vf[1] + j[1] * w->inv_mass;
 	double vm[2] = {0.5 * (v0[0] + w->v[0]), 0.5 * (v0[1] + w->v[1])};
 	if (w->integrator == THESIS_EULER) {
 		vm[0] = w->v[0];

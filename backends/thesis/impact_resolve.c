@@ -27,18 +27,10 @@ static void impact_bounds(const struct bsim_world *w, thesis_contact *c)
 
 static void impact_apply(struct bsim_world *w, const thesis_contact *cs, int n)
 {
-	double jx = 0.0, jy = 0.0;
-	if (n == 2) { /* one expression for a pair: a mirrored pair sums alike */
-		jx = cs[0].impulse * cs[0].n[0] + cs[1].impulse * cs[1].n[0];
-		jy = cs[0].impulse * cs[0].n[1] + cs[1].impulse * cs[1].n[1];
-	} else {
-		for (int i = 0; i < n; i++) {
-			jx += cs[i].impulse * cs[i].n[0];
-			jy += cs[i].impulse * cs[i].n[1];
-		}
-	}
-	w->v[0] += jx * w->inv_mass;
-	w->v[1] += jy * w->inv_mass;
+	double j[2];
+	thesis_impulse_sum(cs, n, j);
+	w->v[0] += j[0] * w->inv_mass;
+	w->v[1] += j[1] * w->inv_mass;
 	for (int i = 0; i < n; i++) {
 		thesis_beam *b = &w->beams[cs[i].beam];
 		b->omega -= cs[i].impulse * cs[i].c / b->inertia;

@@ -81,3 +81,17 @@ void thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n)
 		lcp_gauss_seidel(w, cs, n);
 	}
 }
+
+void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2])
+{
+	j[0] = j[1] = 0.0;
+	if (n == 2) { /* one expression for a pair: a mirrored pair sums alike */
+		j[0] = cs[0].impulse * cs[0].n[0] + cs[1].impulse * cs[1].n[0];
+		j[1] = cs[0].impulse * cs[0].n[1] + cs[1].impulse * cs[1].n[1];
+		return;
+	}
+	for (int k = 0; k < n; k++) {
+		j[0] += cs[k].impulse * cs[k].n[0];
+		j[1] += cs[k].impulse * cs[k].n[1];
+	}
+}

@@ -68,6 +68,8 @@ void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c);
 
 /* lcp_solve.c */
 void thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n);
+/* The total impulse sum P_i n_i on the body, N s. */
+void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2]);
 
 /* impact_resolve.c */
 int thesis_impact_resolve(struct bsim_world *w, double h);
