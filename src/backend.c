@@ -6,6 +6,7 @@
 
 static const bsim_backend *const registry[] = {
         &bsim_backend_thesis,
+        &bsim_backend_box2d,
         NULL,
 };
 

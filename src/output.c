@@ -82,6 +82,17 @@ static void json_params(FILE *f, const bsim_experiment *e, const int *idx)
 	fputc('}', f);
 }
 
+void bsim_output_group_params(FILE *f, const bsim_experiment *e, int g)
+{
+	int idx[BSIM_OUTPUT_AXES_MAX];
+	if (e->n_axes > BSIM_OUTPUT_AXES_MAX) {
+		fputs("{}", f);
+		return;
+	}
+	bsim_experiment_group_index(e, g, idx);
+	json_params(f, e, idx);
+}
+
 static void json_group(FILE *f, const bsim_experiment *e, const bsim_group_result *g, int *idx)
 {
 	fputs("{\"params\": ", f);

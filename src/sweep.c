@@ -4,7 +4,9 @@
  * out dynamically to OpenMP threads (trials end at very different times, so
  * a static split would leave threads idle). A trial's seed depends only on
  * (experiment seed, g, t) and its result goes to its own slot, so the
- * result is the same whatever the thread count (DESIGN.md "Determinism"). */
+ * result is the same whatever the thread count (DESIGN.md "Determinism").
+ * A paired sweep runs each trial on a second backend too, in the same slot
+ * of a second result (trial_pair.c). */
 
 #include "beamsim/sweep.h"
 
@@ -15,6 +17,7 @@
 #include "beamsim/clock.h"
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"
+#include "trial_pair.h"
 
 void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out)
 {
@@ -90,6 +93,10 @@ typedef struct sweep_shared {
 	const bsim_sweep_config *cfg;
 	const bsim_scene *scenes;
 	bsim_trial_result *results;
+	const bsim_backend *backend_b; /* NULL: not paired */
+	const bsim_options *opts_b;
+	bsim_trial_result *results_b;
+	double *t_separate;
 	long total;
 	long done;
 	long first_fail;
@@ -122,10 +129,14 @@ static void sweep_thread(sweep_shared *sh)
 	const bsim_sweep_config *cfg = sh->cfg;
 	int leader = omp_get_thread_num() == 0;
 	bsim_runner *runner = bsim_runner_alloc();
+	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
 	bsim_error err;
 
-	if (!runner)
+	if (!runner || (sh->backend_b && !pair)) {
+		bsim_runner_free(runner);
+		runner = NULL;
 		shared_fail(sh, -1, BSIM_EFAIL, "out of memory for a trial runner");
+	}
 #pragma omp for schedule(dynamic)
 	for (long i = 0; i < sh->total; i++) {
 		long stop;
@@ -136,8 +147,13 @@ static void sweep_thread(sweep_shared *sh)
 		long g = i / e->trials, t = i % e->trials;
 		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
-		int rc = bsim_trial_run(runner, &sh->scenes[g], cfg->backend, cfg->opts, seed, NULL,
-		                        &sh->results[i], &err);
+		const bsim_scene *scene = &sh->scenes[g];
+		int rc = pair ? trial_pair_run(pair, scene, cfg->backend, cfg->opts, sh->backend_b,
+		                               sh->opts_b, seed, 0.01 * scene->body.radius,
+		                               &sh->results[i], &sh->results_b[i],
+		                               &sh->t_separate[i], &err)
+		              : bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, NULL,
+		                               &sh->results[i], &err);
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
 		long done;
@@ -147,6 +163,7 @@ static void sweep_thread(sweep_shared *sh)
 			cfg->progress(cfg->progress_user, done, sh->total);
 	}
 	bsim_runner_free(runner);
+	trial_pair_free(pair);
 }
 
 static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_error *err)
@@ -164,51 +181,91 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_err
 	return BSIM_OK;
 }
 
-int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
-                   bsim_error *err)
+static void result_finish(bsim_sweep_result *r, int n_groups, int trials, double wall)
+{
+	for (int g = 0; g < n_groups; g++)
+		bsim_group_aggregate(&r->trials_out[(size_t)g * trials], trials, &r->groups[g]);
+	for (size_t i = 0; i < (size_t)n_groups * trials; i++)
+		r->total_steps += r->trials_out[i].steps_run;
+	r->wall_seconds = wall;
+}
+
+/* A plain sweep (backend_b NULL) or a paired one. */
+static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                        const bsim_backend *backend_b, const bsim_options *opts_b,
+                        bsim_sweep_result *out, bsim_sweep_result *out_b, double **t_separate,
+                        bsim_error *err)
 {
 	double t0 = bsim_clock_seconds();
 	if (e->trials < 0 || e->n_groups < 1)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: expected at least one group and trials >= 0", e->path);
+	long total = (long)e->n_groups * e->trials;
 	if (result_alloc(out, e->n_groups, e->trials, err) != BSIM_OK)
 		return BSIM_EFAIL;
+	if (backend_b) {
+		*t_separate = calloc(total ? (size_t)total : 1, sizeof **t_separate);
+		if (!*t_separate || result_alloc(out_b, e->n_groups, e->trials, err) != BSIM_OK) {
+			free(*t_separate);
+			*t_separate = NULL;
+			bsim_sweep_result_free(out);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory for %ld pairs", total);
+		}
+	}
 	bsim_scene *scenes;
 	int rc = scenes_build(e, cfg, &scenes, err);
-	if (rc != BSIM_OK) {
-		bsim_sweep_result_free(out);
-		return rc;
-	}
-
 	sweep_shared sh = {
 	        .e = e,
 	        .cfg = cfg,
 	        .scenes = scenes,
 	        .results = out->trials_out,
-	        .total = (long)e->n_groups * e->trials,
+	        .backend_b = backend_b,
+	        .opts_b = opts_b,
+	        .results_b = backend_b ? out_b->trials_out : NULL,
+	        .t_separate = backend_b ? *t_separate : NULL,
+	        .total = total,
 	};
-	sh.first_fail = sh.total;
-	bsim_error_clear(&sh.fail);
-	int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
-	if (threads > sh.total)
-		threads = sh.total > 0 ? (int)sh.total : 1;
-
+	if (rc == BSIM_OK) {
+		sh.first_fail = sh.total;
+		bsim_error_clear(&sh.fail);
+		int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
+		if (threads > sh.total)
+			threads = sh.total > 0 ? (int)sh.total : 1;
 #pragma omp parallel num_threads(threads)
-	sweep_thread(&sh);
-
-	scenes_free(scenes, e->n_groups);
-	if (sh.first_fail < sh.total) {
-		bsim_sweep_result_free(out);
-		return bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
+		sweep_thread(&sh);
+		scenes_free(scenes, e->n_groups);
+		if (sh.first_fail < sh.total)
+			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
 	}
-	for (int g = 0; g < e->n_groups; g++)
-		bsim_group_aggregate(&out->trials_out[(size_t)g * e->trials], e->trials,
-		                     &out->groups[g]);
-	for (size_t i = 0; i < (size_t)sh.total; i++)
-		out->total_steps += out->trials_out[i].steps_run;
+	if (rc != BSIM_OK) {
+		bsim_sweep_result_free(out);
+		if (backend_b) {
+			bsim_sweep_result_free(out_b);
+			free(*t_separate);
+			*t_separate = NULL;
+		}
+		return rc;
+	}
 	/* The final count may have been reached on another thread. */
 	if (cfg->progress)
 		cfg->progress(cfg->progress_user, sh.total, sh.total);
-	out->wall_seconds = bsim_clock_seconds() - t0;
+	double wall = bsim_clock_seconds() - t0;
+	result_finish(out, e->n_groups, e->trials, wall);
+	if (backend_b)
+		result_finish(out_b, e->n_groups, e->trials, wall);
 	return BSIM_OK;
+}
+
+int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
+                   bsim_error *err)
+{
+	return sweep_common(e, cfg, NULL, NULL, out, NULL, NULL, err);
+}
+
+int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                          const bsim_backend *backend_b, const bsim_options *opts_b,
+                          bsim_sweep_result *out_a, bsim_sweep_result *out_b, double **t_separate,
+                          bsim_error *err)
+{
+	return sweep_common(e, cfg, backend_b, opts_b, out_a, out_b, t_separate, err);
 }

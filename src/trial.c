@@ -172,7 +172,10 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		out->max_theta[i] = s0->theta[i];
 	int stride = rec && rec->stride > 0 ? rec->stride : 1;
 	FILE *csv = rec ? rec->csv : NULL;
+	bsim_trace_fn trace = rec ? rec->trace : NULL;
 	double f[2];
+	if (trace)
+		trace(rec->trace_user, 0, s0);
 
 	int done = 0; /* the outcome is known; running on to classify_y */
 	long recorded = -1;
@@ -191,6 +194,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		backend->get_state(w, s1);
 		n++;
 		run_on += done;
+		if (trace)
+			trace(rec->trace_user, n, s1);
 		double e1 = energy_kinetic(scene, s1) + energy_springs(scene, s1);
 		ledger_step(&out->ledger, &fx, s0, s1, e0, e1);
 		e0 = e1;

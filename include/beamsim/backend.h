@@ -96,6 +96,7 @@ const bsim_backend *const *bsim_backends(void);
 const bsim_backend *bsim_backend_find(const char *name, bsim_error *err);
 
 extern const bsim_backend bsim_backend_thesis;
+extern const bsim_backend bsim_backend_box2d;
 
 #ifdef __cplusplus
 }

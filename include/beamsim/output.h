@@ -18,6 +18,13 @@ extern "C" {
 int bsim_output_summary_json(const char *path, const bsim_experiment *e, const char *backend,
                              const bsim_options *opts, const bsim_sweep_result *r, bsim_error *err);
 int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_error *err);
+/* Reads a trials.csv written by bsim_output_trials_csv back into r (which
+ * it allocates: n_groups x trials rows, each exactly once) and aggregates
+ * the groups. The fields not in the file are zero. BSIM_EINPUT with
+ * file and line on a malformed, missing or extra row. */
+int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_sweep_result *r,
+                            bsim_error *err);
+
 /* p_traverse over the first two grid axes (columns: axis 0, rows: axis 1),
  * one table per combination of the other axes. */
 void bsim_output_table(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r);
@@ -27,6 +34,12 @@ void bsim_output_table(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
  * that b does not list: a record alone says how the backend was run.
  * Shared by summary.json, run --json and bench --json. */
 void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_options *opts);
+
+/* The JSON object {axis key: value} of group g, values as numbers where
+ * they are numbers (as in summary.json); {} beyond BSIM_OUTPUT_AXES_MAX
+ * axes. */
+#define BSIM_OUTPUT_AXES_MAX 32
+void bsim_output_group_params(FILE *f, const bsim_experiment *e, int g);
 
 /* Creates dir (and parents) if missing. */
 int bsim_output_mkdir(const char *dir, bsim_error *err);

@@ -44,6 +44,17 @@ typedef struct bsim_sweep_config {
  * applies --trials/--seed). */
 int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
                    bsim_error *err);
+
+/* The same sweep run as pairs (beamsim compare): every trial runs on
+ * cfg->backend into out_a and, with the same schedule, on backend_b into
+ * out_b. t_separate (malloc'd, n_groups * trials, index g*trials + t) gets
+ * the time, s, at which the pair's body centres first lie more than 1% of
+ * the body radius apart, -1 if never while both ran. out_a and out_b each
+ * equal what bsim_sweep_run gives for its backend. */
+int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                          const bsim_backend *backend_b, const bsim_options *opts_b,
+                          bsim_sweep_result *out_a, bsim_sweep_result *out_b, double **t_separate,
+                          bsim_error *err);
 void bsim_sweep_result_free(bsim_sweep_result *r);
 
 /* Aggregates one group's trials into counts and the Wilson interval. */

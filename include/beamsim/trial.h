@@ -52,10 +52,16 @@ typedef struct bsim_trial_result {
 	bsim_ledger ledger;
 } bsim_trial_result;
 
+/* Called with the state at t = 0 and after every step (step = 1, 2, ...),
+ * whatever the stride; for in-memory use of a trajectory (compare). */
+typedef void (*bsim_trace_fn)(void *user, long step, const bsim_state *s);
+
 /* Trajectory recording: one CSV row per step (DESIGN.md "Outputs"). */
 typedef struct bsim_recorder {
-	FILE *csv;  /* NULL: no recording */
-	int stride; /* record every stride-th step (>= 1) */
+	FILE *csv;           /* NULL: no recording */
+	int stride;          /* record every stride-th step (>= 1) */
+	bsim_trace_fn trace; /* NULL: none */
+	void *trace_user;
 } bsim_recorder;
 
 /* Writes the trajectory CSV header for a scene of n_beams beams. */

@@ -14,7 +14,7 @@
 #include "beamsim/sweep.h"
 
 /* Exit statuses (DESIGN.md "Command line"); they equal the bsim_error codes. */
-enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2 };
+enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2, CLI_DISAGREE = 3 };
 
 /* One subcommand: argv[0] is its name. Returns the exit status. */
 typedef int (*cli_command_fn)(int argc, char **argv);
@@ -23,6 +23,8 @@ int cmd_run(int argc, char **argv);
 int cmd_sweep(int argc, char **argv);
 int cmd_backends(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
+int cmd_regress(int argc, char **argv);
 
 /* "beamsim: MSG" on stderr. */
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

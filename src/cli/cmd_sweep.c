@@ -13,6 +13,7 @@
 #include "beamsim/output.h"
 #include "beamsim/sweep.h"
 #include "cli_common.h"
+#include "cli_store.h"
 
 static const char sweep_help[] =
         "Usage: beamsim sweep EXPERIMENT --out DIR [OPTIONS]\n"
@@ -20,6 +21,8 @@ static const char sweep_help[] =
         "Runs every trial of every group of the experiment file EXPERIMENT and writes\n"
         "DIR/summary.json (per-group counts, p_traverse and its 95% Wilson interval)\n"
         "and DIR/trials.csv (one row per trial). The results do not depend on --threads.\n"
+        "DIR/run.json and DIR/inputs/ record the run, so `beamsim regress DIR` can\n"
+        "repeat it.\n"
         "\n"
         "Options:\n"
         "  --out DIR              output directory, created if missing (required)\n"
@@ -130,20 +133,6 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 	return -1;
 }
 
-static int sweep_write(const sweep_args *a, const bsim_experiment *e, const bsim_sweep_result *r)
-{
-	char summary[1100], trials[1100];
-	bsim_error err;
-	snprintf(summary, sizeof summary, "%s/summary.json", a->out);
-	snprintf(trials, sizeof trials, "%s/trials.csv", a->out);
-	if (bsim_output_summary_json(summary, e, a->backend, &a->opts, r, &err) != BSIM_OK ||
-	    bsim_output_trials_csv(trials, r, &err) != BSIM_OK) {
-		cli_error("%s", err.msg);
-		return CLI_FAIL;
-	}
-	return CLI_OK;
-}
-
 static void sweep_report(const sweep_args *a, const bsim_experiment *e, const bsim_sweep_result *r,
                          int threads)
 {
@@ -189,7 +178,7 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 		if (created)
 			rmdir(a->out);
 	} else {
-		rc = sweep_write(a, &e, &r);
+		rc = cli_store_sweep(a->out, &e, backend, &a->opts, a->sets.ov, a->sets.n, &r);
 		if (rc == CLI_OK && !a->quiet)
 			sweep_report(a, &e, &r, threads);
 		bsim_sweep_result_free(&r);

@@ -1,0 +1,622 @@
+/* The Box2D 2.4.1 backend ("box2d"): the model of MODEL.md sections 2-5 built
+ * from Box2D's rigid bodies, joints and contacts, behind the C interface of
+ * include/beamsim/backend.h. The only C++ in the project.
+ *
+ * Units. Box2D works in float32 and prefers lengths of 0.1-10 units; our
+ * body is 10 m and the beams 25 m, so every quantity is scaled by s
+ * (knob unit_scale, default 0.1) with mass and time unchanged:
+ *   length, velocity, force, impulse  x s
+ *   torque, inertia, stiffness k, damping d, energy  x s^2
+ *   angle, angular velocity, time  x 1
+ * The per-step limits b2_maxTranslation = 2 units and b2_maxRotation = pi/2
+ * are not reached: at s = 0.1, h = 4 ms they clamp only above 5000 m/s and
+ * 390 rad/s (the gate sees < 20 m/s and < 10 rad/s).
+ *
+ * Bodies.
+ *   body:  dynamic bullet disk, fixed rotation, mass M at its centre.
+ *   beam i: dynamic body whose origin is the pivot P, angle a_i = sgn theta_i
+ *          (sgn = +1 if the rest direction u0 has x >= 0, else -1: theta > 0
+ *          swings the tip forward, +y), one two-sided edge from (0, 0) to
+ *          L u0 in its own frame. Mass data: m at the pivot and
+ *          b2MassData.I = I (the scene's inertia about the pivot). Box2D's I
+ *          is about the body origin and SetMassData stores
+ *          I_c = I - m |c|^2 about the centre c; with c = 0 (the pivot)
+ *          I_c = I, and a beam turning about its pinned centre has exactly
+ *          inertia I about the pivot. The pin carries the mass, so it has no
+ *          centripetal load and its rows do not couple to the rotation.
+ *   ground: static, no fixtures; the pivots hang on it.
+ * Collision filtering: the body collides with beams only; beams collide
+ * with nothing else (MODEL.md section 1: beams pass through each other).
+ *
+ * Spring and damper, I beta = tau_c - k theta - d omega (essay Eq. 2.2), two
+ * realisations (knob spring):
+ *   torque: revolute pin at P; before every (sub)step of h the torque
+ *           tau = -k theta - d omega is applied, so Box2D's symplectic Euler
+ *           gives  omega' = omega + h (tau + tau_c) / I,  theta' = theta + h omega'.
+ *           The damper's work over the step is -d omega h omega'.
+ *   weld:   b2WeldJoint at P (its rigid point rows are the pin) with angular
+ *           stiffness k and damping d. Its soft row, solved to convergence,
+ *           is backward Euler:  I (omega' - omega) = -h (k (theta + h omega') +
+ *           d omega') + h tau_c;  the damper's share of its impulse,
+ *           -h d omega', dissipates h d omega'^2. A beam with k = 0 keeps the
+ *           revolute pin and torque damper (a weld with stiffness 0 is rigid).
+ *
+ * Contacts: one circle-edge manifold per beam. Box2D's edge carries a skin
+ * b2_polygonRadius = 2 b2_linearSlop (units) and its position solver rests a
+ * contact at a penetration of b2_linearSlop, so the disk's Box2D radius is
+ *   R_b = R s - b2_polygonRadius + b2_linearSlop:
+ * a resting contact then sits at the model's distance R, and a contact
+ * starts (and takes its restitution) at a gap of b2_linearSlop / s (0.05 m).
+ * Restitution: e = contact.restitution on the fixtures, and in PreSolve the
+ * vertex manifolds (b2CollideEdgeAndCircle's e_circles: the tip, feature 1,
+ * or the pivot end, feature 0) get tip_restitution; the pivot end is a point
+ * contact on a fixed point, like the thesis backend, reported as TIP.
+ * restitutionThreshold = rest_threshold s: Box2D makes approaches slower than
+ * it fully inelastic, the same rule as the thesis backend's switch.
+ *
+ * Energy of a step, for the runner's ledger (dE = W - damper - impact -
+ * contact - correction):
+ *   damper: torque mode d omega h omega' (omega as applied, omega' as solved);
+ *           weld mode h d omega'^2.
+ *   impact, contact: the velocity solve changes the kinetic energy by exactly
+ *           sum_j P_j (v_j- + v_j+)/2 over its rows j (impulse P_j, relative
+ *           normal velocity v_j = J_j v before and after; the pin rows do no
+ *           work). For each contact row, with the normal n and point Q that
+ *           the solver used (captured in PreSolve), v- from the velocities
+ *           the solve starts from (this step's force and torque integrated)
+ *           and v+ from the solved velocities (PostSolve), the loss
+ *           -P (v- + v+)/2 is an impact if v- < -rest_threshold, else contact
+ *           work. Continuous-collision (TOI) sub-solves are measured the same
+ *           way from the velocities they start from.
+ *   correction: 0. The position solver moves bodies without changing
+ *           velocities; its energy, the float32 rounding, and the integrators'
+ *           own errors (symplectic Euler's spring and force splitting, the weld's
+ *           backward Euler) are what the runner's residual shows.
+ */
+#include <box2d/box2d.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <cstdio>
+#include <vector>
+
+#include "beamsim/backend.h"
+
+namespace {
+
+/* The knobs. The spring default comes from measurements (tests/
+ * test_box2d_oracles.c prints them), Table 2.1 beam, theta0 = 0.1 rad, 3 s:
+ *   free vibration, max |theta - exact| at h = 4 ms (2 ms):
+ *     torque 1.9e-4 rad (9.8e-5), first order; weld 8.1e-4 rad (4.1e-4)
+ *   stiff springs, omega_n h = 0.5 / 2 / 4, undamped, 5000 steps:
+ *     torque: energy bounded (symplectic) to omega_n h < 2, blows up at 4;
+ *     weld: stable at any omega_n h, loses energy (backward Euler).
+ *   energy ledger, gate F = 7 N, Rm = 20 N: residual / throughput
+ *     torque 3e-3, weld 6e-3.
+ * torque is four times more accurate at the essay's step and its ledger
+ * closes better, so it is the default; weld is there for stiff springs
+ * (omega_n h >= 2), where torque is unstable. */
+const bsim_knob box2d_knobs[] = {
+        {"velocity_iterations", BSIM_KNOB_INT, "8", NULL,
+         "Box2D velocity iterations per step (sequential impulses), >= 1"},
+        {"position_iterations", BSIM_KNOB_INT, "3", NULL,
+         "Box2D position iterations per step (penetration and pin drift), >= 0"},
+        {"substeps", BSIM_KNOB_INT, "1", NULL,
+         "Box2D steps of h/n per step, force and spring torque re-applied each, 1..1000"},
+        {"spring", BSIM_KNOB_CHOICE, "torque", "torque|weld",
+         "beam spring + damper: explicit torque on a revolute pin (symplectic, stable for "
+         "omega_n h < 2), or a soft b2WeldJoint (implicit, always stable, dissipative)"},
+        {"unit_scale", BSIM_KNOB_DOUBLE, "0.1", NULL,
+         "Box2D units per metre (Box2D prefers 0.1-10 units; the body is 10 m), > 0"},
+};
+enum { KNOB_VEL_IT, KNOB_POS_IT, KNOB_SUBSTEPS, KNOB_SPRING, KNOB_UNIT_SCALE };
+constexpr int N_KNOBS = (int)(sizeof box2d_knobs / sizeof box2d_knobs[0]);
+
+enum { SPRING_TORQUE = 0, SPRING_WELD = 1 };
+
+/* The beam's translational mass in Box2D, as a multiple of the body's. The
+ * pin holds the beam's centre (its pivot) still, so the exact dynamics never
+ * see this mass, only I about the pivot; but the sequential-impulse solver
+ * does: with the scene's 0.1 kg the contact row sees 1/m = 10 /kg beside
+ * 1/M + c^2/I = 31 /kg, and 8 iterations left a 1.2% error in the body's
+ * velocity after a square-on impact at r = 10 m (1.3953 vs 1.3793 m/s,
+ * 20% in the measured impact loss). At 1000 M it is exact to float32. */
+constexpr double PIN_MASS_RATIO = 1000.0;
+
+/* Collision categories: the body meets beams, nothing else meets anything. */
+constexpr uint16 CATEGORY_BODY = 0x0001, CATEGORY_BEAM = 0x0002;
+
+/* The rest direction, exact at multiples of 90 degrees so that a mirrored
+ * beam (0 vs 180 degrees) has a mirrored tip bit for bit. */
+void rest_direction(double deg, double u[2])
+{
+	double q = deg / 90.0;
+	if (q == std::floor(q)) {
+		static const double c[4] = {1, 0, -1, 0}, sn[4] = {0, 1, 0, -1};
+		long k = ((long)q % 4 + 4) % 4;
+		u[0] = c[k];
+		u[1] = sn[k];
+		return;
+	}
+	const double rad = deg * 0.017453292519943295; /* pi / 180 */
+	u[0] = std::cos(rad);
+	u[1] = std::sin(rad);
+}
+
+/* One beam: its Box2D body and what a step measures about it. */
+struct beam_rec {
+	b2Body *body = nullptr;
+	double pivot[2] = {0, 0}; /* m */
+	double u0[2] = {1, 0};    /* rest direction */
+	double sgn = 1.0;         /* Box2D angle = sgn theta */
+	double inertia = 0.0;     /* kg m^2 about the pivot */
+	double stiffness = 0.0;   /* N m/rad */
+	double damping = 0.0;     /* N m s/rad */
+	bool weld = false;        /* spring and damper in a b2WeldJoint */
+	/* the (sub)step in progress */
+	b2Vec2 start_position; /* Box2D transform before the step, to tell */
+	float start_angle = 0; /* the regular solve's PreSolve from a TOI's */
+	double omega_applied = 0.0; /* omega the damper torque used, rad/s */
+	double w_pre = 0.0;         /* Box2D angular velocity the solve starts from */
+	/* the captured contact row: normal n (beam -> body), point Q, the
+	 * velocities its solve starts from */
+	bool row = false;
+	double n[2] = {0, 0}, q[2] = {0, 0}; /* m */
+	double row_v[2] = {0, 0};            /* body velocity, m/s */
+	double row_w = 0.0;                  /* beam angular velocity, rad/s (Box2D sense) */
+	double row_u[2] = {0, 0};            /* beam pivot velocity, m/s (0 if pinned) */
+};
+
+class contact_ledger;
+
+} /* namespace */
+
+struct bsim_world {
+	bsim_scene scene; /* a copy, to rebuild the world in set_state */
+	/* knobs */
+	int velocity_iterations = 8, position_iterations = 3, substeps = 1;
+	int spring = SPRING_TORQUE;
+	double s = 0.1; /* Box2D units per metre */
+	/* Box2D */
+	b2World *world = nullptr;
+	b2Body *body = nullptr;
+	contact_ledger *listener = nullptr;
+	std::vector<beam_rec> beams;
+	/* the step in progress */
+	b2Vec2 body_start;        /* Box2D position before the step */
+	double v_pre[2] = {0, 0}; /* body velocity the solve starts from, m/s */
+	/* results of the last step */
+	std::vector<int> contact_type;
+	bsim_step_energy energy = {0, 0, 0, 0};
+	int impacts = 0;
+	long toi_events = 0; /* continuous-collision sub-solves, all steps */
+};
+
+namespace {
+
+/* Sets tip restitution on vertex contacts and captures the contact row the
+ * solver will use; PostSolve turns the row's impulse into energy. */
+class contact_ledger : public b2ContactListener {
+public:
+	explicit contact_ledger(bsim_world *w) : w_(w) {}
+
+	void PreSolve(b2Contact *contact, const b2Manifold *old_manifold) override
+	{
+		(void)old_manifold;
+		beam_rec *b = beam_of(contact);
+		if (!b)
+			return;
+		const b2Manifold *m = contact->GetManifold();
+		const bsim_contact_def &law = w_->scene.contact;
+		/* vertex region of the edge: the tip (or the pivot end) */
+		contact->SetRestitution(
+		        (float)(m->type == b2Manifold::e_circles ? law.tip_restitution
+		                                                 : law.restitution));
+		b2WorldManifold wm;
+		contact->GetWorldManifold(&wm);
+		const double s = w_->s;
+		b->row = true;
+		b->n[0] = wm.normal.x;
+		b->n[1] = wm.normal.y;
+		b->q[0] = wm.points[0].x / s;
+		b->q[1] = wm.points[0].y / s;
+		/* The regular solve's PreSolve runs before anything moved; a TOI
+		 * sub-solve's runs after the step's solve moved the bodies. */
+		bool regular = w_->body->GetPosition() == w_->body_start &&
+		               b->body->GetPosition() == b->start_position &&
+		               b->body->GetAngle() == b->start_angle;
+		if (regular) {
+			b->row_v[0] = w_->v_pre[0];
+			b->row_v[1] = w_->v_pre[1];
+			b->row_w = b->w_pre;
+			b2Vec2 u = b->body->GetLinearVelocity();
+			b->row_u[0] = u.x / s;
+			b->row_u[1] = u.y / s;
+		} else {
+			b2Vec2 u = b->body->GetLinearVelocity();
+			b->row_u[0] = u.x / s;
+			b->row_u[1] = u.y / s;
+			b2Vec2 v = w_->body->GetLinearVelocity();
+			b->row_v[0] = v.x / s;
+			b->row_v[1] = v.y / s;
+			b->row_w = b->body->GetAngularVelocity();
+			w_->toi_events++;
+		}
+	}
+
+	void PostSolve(b2Contact *contact, const b2ContactImpulse *impulse) override
+	{
+		beam_rec *b = beam_of(contact);
+		if (!b || !b->row || impulse->count < 1)
+			return;
+		b->row = false;
+		const double s = w_->s;
+		double p = impulse->normalImpulses[0] / s; /* N s */
+		b2Vec2 v = w_->body->GetLinearVelocity();
+		const double v_post[2] = {v.x / s, v.y / s};
+		b2Vec2 u = b->body->GetLinearVelocity();
+		const double u_post[2] = {u.x / s, u.y / s};
+		double v_minus = normal_velocity(b, b->row_v, b->row_u, b->row_w);
+		double v_plus = normal_velocity(b, v_post, u_post, b->body->GetAngularVelocity());
+		double loss = -0.5 * p * (v_minus + v_plus);
+		if (getenv("B2DBG")) { b2Vec2 lv = b->body->GetLinearVelocity(); fprintf(stderr, "post P %.5g vm %.5g vp %.5g n %.4f %.4f q %.4f %.4f w %.5g -> %.5g beamlin %.3g %.3g toi %ld loss %.4g\n", p, v_minus, v_plus, b->n[0], b->n[1], b->q[0], b->q[1], b->row_w, (double)b->body->GetAngularVelocity(), lv.x/s, lv.y/s, w_->toi_events, loss); }
+		if (v_minus < -w_->scene.contact.rest_threshold) {
+			w_->energy.impact += loss;
+			w_->impacts += p > 0.0;
+		} else {
+			w_->energy.contact += loss;
+		}
+	}
+
+private:
+	beam_rec *beam_of(b2Contact *c)
+	{
+		uintptr_t a = c->GetFixtureA()->GetBody()->GetUserData().pointer;
+		uintptr_t bb = c->GetFixtureB()->GetBody()->GetUserData().pointer;
+		uintptr_t i = a ? a : bb; /* beam index + 1; the body is 0 */
+		return i ? &w_->beams[i - 1] : nullptr;
+	}
+
+	/* (v_body - u_pivot - omega x a) . n at the captured point, lever
+	 * a = Q - P, m/s: the row J v of the solver */
+	static double normal_velocity(const beam_rec *b, const double v[2], const double u[2],
+	                              double w)
+	{
+		double ax = b->q[0] - b->pivot[0], ay = b->q[1] - b->pivot[1];
+		return (v[0] - u[0] + w * ay) * b->n[0] + (v[1] - u[1] - w * ax) * b->n[1];
+	}
+
+	bsim_world *w_;
+};
+
+void world_free_box2d(bsim_world *w)
+{
+	delete w->world; /* owns bodies, fixtures, joints */
+	delete w->listener;
+	w->world = nullptr;
+	w->listener = nullptr;
+	w->body = nullptr;
+	for (beam_rec &b : w->beams)
+		b.body = nullptr;
+}
+
+/* Builds the Box2D world with the body and beams at the given state. */
+void world_build(bsim_world *w, const double x[2], const double v[2], const double *theta,
+                 const double *omega)
+{
+	const double s = w->s;
+	const bsim_scene &sc = w->scene;
+	w->world = new b2World(b2Vec2(0.0f, 0.0f)); /* horizontal plane: no gravity */
+	w->world->SetAllowSleeping(false);
+	w->world->SetContinuousPhysics(true);
+	w->world->SetWarmStarting(true);
+	w->listener = new contact_ledger(w);
+	w->world->SetContactListener(w->listener);
+
+	b2BodyDef gd;
+	b2Body *ground = w->world->CreateBody(&gd);
+
+	b2BodyDef bd;
+	bd.type = b2_dynamicBody;
+	bd.position.Set((float)(x[0] * s), (float)(x[1] * s));
+	bd.linearVelocity.Set((float)(v[0] * s), (float)(v[1] * s));
+	bd.fixedRotation = true; /* forces act at the centre; frictionless */
+	bd.bullet = true;
+	bd.userData.pointer = 0;
+	w->body = w->world->CreateBody(&bd);
+	b2CircleShape disk;
+	disk.m_radius = (float)(sc.body.radius * s) - b2_polygonRadius + b2_linearSlop;
+	b2FixtureDef fd;
+	fd.shape = &disk;
+	fd.density = 0.0f; /* mass set below */
+	fd.friction = 0.0f;
+	fd.restitution = (float)sc.contact.restitution;
+	fd.restitutionThreshold = (float)(sc.contact.rest_threshold * s);
+	fd.filter.categoryBits = CATEGORY_BODY;
+	fd.filter.maskBits = CATEGORY_BEAM;
+	w->body->CreateFixture(&fd);
+	b2MassData md;
+	md.mass = (float)sc.body.mass;
+	md.center.SetZero();
+	md.I = (float)(0.5 * sc.body.mass * sc.body.radius * sc.body.radius * s * s);
+	w->body->SetMassData(&md);
+
+	for (size_t i = 0; i < w->beams.size(); i++) {
+		beam_rec &b = w->beams[i];
+		const bsim_beam_def &d = sc.beams[i];
+		b2BodyDef beam_def;
+		beam_def.type = b2_dynamicBody;
+		beam_def.position.Set((float)(b.pivot[0] * s), (float)(b.pivot[1] * s));
+		beam_def.angle = (float)(b.sgn * theta[i]);
+		beam_def.angularVelocity = (float)(b.sgn * omega[i]);
+		beam_def.userData.pointer = (uintptr_t)(i + 1);
+		b.body = w->world->CreateBody(&beam_def);
+		b2EdgeShape edge;
+		edge.SetTwoSided(b2Vec2(0.0f, 0.0f), b2Vec2((float)(d.length * s * b.u0[0]),
+		                                            (float)(d.length * s * b.u0[1])));
+		b2FixtureDef ef;
+		ef.shape = &edge;
+		ef.density = 0.0f;
+		ef.friction = 0.0f;
+		ef.restitution = (float)sc.contact.restitution;
+		ef.restitutionThreshold = (float)(sc.contact.rest_threshold * s);
+		ef.filter.categoryBits = CATEGORY_BEAM;
+		ef.filter.maskBits = CATEGORY_BODY;
+		b.body->CreateFixture(&ef);
+		b2MassData bm;
+		bm.mass = (float)(PIN_MASS_RATIO * sc.body.mass);
+		bm.center.SetZero(); /* the pivot: I about it is I about the centre */
+		bm.I = (float)(b.inertia * s * s);
+		b.body->SetMassData(&bm);
+
+		const b2Vec2 anchor = b.body->GetPosition();
+		if (b.weld) {
+			b2WeldJointDef jd;
+			jd.Initialize(ground, b.body, anchor);
+			jd.referenceAngle = 0.0f; /* the rest angle, whatever theta is now */
+			jd.stiffness = (float)(b.stiffness * s * s);
+			jd.damping = (float)(b.damping * s * s);
+			w->world->CreateJoint(&jd);
+		} else {
+			b2RevoluteJointDef jd;
+			jd.Initialize(ground, b.body, anchor);
+			w->world->CreateJoint(&jd);
+		}
+	}
+}
+
+/* The model's contact state of beam i at the current positions: Box2D's own
+ * edge-circle test (touching within b2_linearSlop / s of the distance R). */
+int contact_type_of(const bsim_world *w, const beam_rec &b)
+{
+	const b2Fixture *fe = b.body->GetFixtureList();
+	const b2Fixture *fc = w->body->GetFixtureList();
+	b2Manifold m;
+	b2CollideEdgeAndCircle(&m, static_cast<const b2EdgeShape *>(fe->GetShape()),
+	                       b.body->GetTransform(),
+	                       static_cast<const b2CircleShape *>(fc->GetShape()),
+	                       w->body->GetTransform());
+	if (m.pointCount == 0)
+		return BSIM_CONTACT_NONE;
+	return m.type == b2Manifold::e_circles ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
+}
+
+void update_contact_types(bsim_world *w)
+{
+	const double s = w->s;
+	const b2Vec2 c = w->body->GetPosition();
+	const double reach_extra = w->scene.body.radius + 1.0; /* m, generous */
+	for (size_t i = 0; i < w->beams.size(); i++) {
+		const beam_rec &b = w->beams[i];
+		double dx = c.x / s - b.pivot[0], dy = c.y / s - b.pivot[1];
+		double reach = w->scene.beams[i].length + reach_extra;
+		w->contact_type[i] = dx * dx + dy * dy > reach * reach ? BSIM_CONTACT_NONE
+		                                                       : contact_type_of(w, b);
+	}
+}
+
+void box2d_destroy(bsim_world *w)
+{
+	if (!w)
+		return;
+	world_free_box2d(w);
+	bsim_scene_free(&w->scene);
+	delete w;
+}
+
+int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
+                      bsim_error *err)
+{
+	int rc = bsim_options_check(opts, box2d_knobs, N_KNOBS, "box2d", err);
+	if (rc)
+		return rc;
+	long vel_it = bsim_options_int(opts, &box2d_knobs[KNOB_VEL_IT]);
+	long pos_it = bsim_options_int(opts, &box2d_knobs[KNOB_POS_IT]);
+	long substeps = bsim_options_int(opts, &box2d_knobs[KNOB_SUBSTEPS]);
+	double s = bsim_options_double(opts, &box2d_knobs[KNOB_UNIT_SCALE]);
+	if (vel_it < 1 || vel_it > 1000)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "box2d: velocity_iterations=%ld: expected 1..1000", vel_it);
+	if (pos_it < 0 || pos_it > 1000)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "box2d: position_iterations=%ld: expected 0..1000", pos_it);
+	if (substeps < 1 || substeps > 1000)
+		return bsim_error_set(err, BSIM_EINPUT, "box2d: substeps=%ld: expected 1..1000",
+		                      substeps);
+	if (!(s > 0.0) || !std::isfinite(s))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "box2d: unit_scale=%g: expected a positive number", s);
+	/* The disk must be larger than Box2D's skin, and its coordinates within
+	 * float32's reach. */
+	if (scene->body.radius * s <= 2.0 * b2_polygonRadius)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "box2d: unit_scale=%g makes the body radius %g units, "
+		                      "below Box2D's skin (%g units); use a larger unit_scale",
+		                      s, scene->body.radius * s, (double)b2_polygonRadius);
+	double extent = std::fabs(scene->body.start[0]) + std::fabs(scene->body.start[1]);
+	for (int i = 0; i < scene->n_beams; i++)
+		extent = std::fmax(extent, std::fabs(scene->beams[i].pivot[0]) +
+		                                   std::fabs(scene->beams[i].pivot[1]) +
+		                                   scene->beams[i].length);
+	if (extent * s > 1e5)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "box2d: unit_scale=%g puts the scene %g units from the origin, "
+		                      "too far for float32; use a smaller unit_scale",
+		                      s, extent * s);
+
+	bsim_world *w = new (std::nothrow) bsim_world;
+	if (!w)
+		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory");
+	std::memset(&w->scene, 0, sizeof w->scene);
+	if (bsim_scene_copy(&w->scene, scene)) {
+		delete w;
+		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory");
+	}
+	w->velocity_iterations = (int)vel_it;
+	w->position_iterations = (int)pos_it;
+	w->substeps = (int)substeps;
+	w->spring = bsim_options_choice(opts, &box2d_knobs[KNOB_SPRING]);
+	w->s = s;
+	int n = scene->n_beams;
+	w->beams.resize((size_t)n);
+	w->contact_type.assign((size_t)n, BSIM_CONTACT_NONE);
+	std::vector<double> theta((size_t)n + 1), omega((size_t)n + 1);
+	for (int i = 0; i < n; i++) {
+		const bsim_beam_def &d = scene->beams[i];
+		beam_rec &b = w->beams[(size_t)i];
+		b.pivot[0] = d.pivot[0];
+		b.pivot[1] = d.pivot[1];
+		rest_direction(d.rest_angle_deg, b.u0);
+		b.sgn = b.u0[0] >= 0.0 ? 1.0 : -1.0; /* forward = toward +y */
+		b.inertia = d.inertia;
+		b.stiffness = d.stiffness;
+		b.damping = d.damping;
+		b.weld = w->spring == SPRING_WELD && d.stiffness > 0.0;
+		theta[(size_t)i] = d.initial_theta;
+		omega[(size_t)i] = d.initial_omega;
+	}
+	world_build(w, scene->body.start, scene->body.velocity, theta.data(), omega.data());
+	update_contact_types(w);
+	*out = w;
+	return BSIM_OK;
+}
+
+int box2d_create(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
+                 bsim_error *err)
+{
+	*out = nullptr;
+	try {
+		return box2d_create_impl(scene, opts, out, err);
+	} catch (const std::bad_alloc &) {
+		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory");
+	}
+}
+
+/* One Box2D step of h seconds with force f (N) on the body. */
+void box2d_substep(bsim_world *w, const double f[2], double h)
+{
+	const double s = w->s;
+	const double mass = w->scene.body.mass;
+	b2Vec2 v0 = w->body->GetLinearVelocity();
+	w->body_start = w->body->GetPosition();
+	/* the body's velocity once Box2D has integrated the force */
+	w->v_pre[0] = v0.x / s + h * f[0] / mass;
+	w->v_pre[1] = v0.y / s + h * f[1] / mass;
+	w->body->ApplyForceToCenter(b2Vec2((float)(f[0] * s), (float)(f[1] * s)), false);
+
+	for (beam_rec &b : w->beams) {
+		b.start_position = b.body->GetPosition();
+		b.start_angle = b.body->GetAngle();
+		b.row = false;
+		double w0 = b.body->GetAngularVelocity();
+		b.omega_applied = b.sgn * w0;
+		if (b.weld) {
+			b.w_pre = w0;
+			continue;
+		}
+		/* tau = -k theta - d omega, N m, forward positive */
+		double theta = b.sgn * (double)b.start_angle;
+		double tau = -b.stiffness * theta - b.damping * b.omega_applied;
+		if (tau == 0.0) {
+			b.w_pre = w0;
+			continue;
+		}
+		b.w_pre = w0 + h * b.sgn * tau / b.inertia;
+		b.body->ApplyTorque((float)(b.sgn * tau * s * s), false);
+	}
+
+	w->world->Step((float)h, w->velocity_iterations, w->position_iterations);
+
+	for (beam_rec &b : w->beams) {
+		if (b.damping == 0.0)
+			continue;
+		double omega_new = b.sgn * (double)b.body->GetAngularVelocity();
+		w->energy.damper += b.weld ? h * b.damping * omega_new * omega_new
+		                           : h * b.damping * b.omega_applied * omega_new;
+	}
+}
+
+void box2d_step(bsim_world *w, const double force[2], double h)
+{
+	w->energy = bsim_step_energy{0.0, 0.0, 0.0, 0.0};
+	w->impacts = 0;
+	const double hs = h / w->substeps;
+	for (int k = 0; k < w->substeps; k++)
+		box2d_substep(w, force, hs);
+	update_contact_types(w);
+}
+
+void box2d_get_state(const bsim_world *w, bsim_state *st)
+{
+	const double s = w->s;
+	b2Vec2 p = w->body->GetPosition(), v = w->body->GetLinearVelocity();
+	st->x[0] = p.x / s;
+	st->x[1] = p.y / s;
+	st->v[0] = v.x / s;
+	st->v[1] = v.y / s;
+	int n = st->n_beams < (int)w->beams.size() ? st->n_beams : (int)w->beams.size();
+	for (int i = 0; i < n; i++) {
+		const beam_rec &b = w->beams[(size_t)i];
+		st->theta[i] = b.sgn * (double)b.body->GetAngle();
+		st->omega[i] = b.sgn * (double)b.body->GetAngularVelocity();
+		st->contact[i] = w->contact_type[(size_t)i];
+	}
+	st->energy = w->energy;
+	st->impacts = w->impacts;
+}
+
+/* Rebuilds the world at the state: no contact or joint impulses carried
+ * over, so a run restarted here is the same as a fresh world started here. */
+int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
+{
+	if (st->n_beams != (int)w->beams.size())
+		return bsim_error_set(err, BSIM_EINPUT, "box2d: state has %d beams, world has %d",
+		                      st->n_beams, (int)w->beams.size());
+	try {
+		world_free_box2d(w);
+		world_build(w, st->x, st->v, st->theta, st->omega);
+	} catch (const std::bad_alloc &) {
+		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory");
+	}
+	update_contact_types(w);
+	w->energy = bsim_step_energy{0.0, 0.0, 0.0, 0.0};
+	w->impacts = 0;
+	return BSIM_OK;
+}
+
+} /* namespace */
+
+extern "C" const bsim_backend bsim_backend_box2d = {
+        "box2d",
+        "Box2D 2.4.1: sequential-impulse contacts with restitution, revolute pins with "
+        "spring torques or soft weld joints, float32, scaled units",
+        box2d_knobs,
+        N_KNOBS,
+        box2d_create,
+        box2d_destroy,
+        box2d_step,
+        box2d_get_state,
+        box2d_set_state,
+};

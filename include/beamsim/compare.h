@@ -1,0 +1,99 @@
+/* Comparing two sweeps trial by trial: two backends run with the same
+ * schedules (beamsim compare) or a stored sweep and its rerun (beamsim
+ * regress). Trial t of group g in one is the pair of trial t of group g in
+ * the other, so every test here is a paired one. */
+#ifndef BEAMSIM_COMPARE_H
+#define BEAMSIM_COMPARE_H
+
+#include "beamsim/error.h"
+#include "beamsim/stats.h"
+#include "beamsim/sweep.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The per-trial events compared: each is a yes/no of one trial. */
+typedef enum {
+	BSIM_EVENT_TRAVERSED = 0,
+	BSIM_EVENT_LEFT,  /* traversed over the left beam */
+	BSIM_EVENT_RIGHT, /* traversed over the right beam */
+	BSIM_EVENT_SIDE_EXIT,
+	BSIM_EVENT_STUCK,
+	BSIM_N_EVENTS
+} bsim_event;
+
+const char *bsim_event_name(bsim_event ev);
+/* 1 if trial r shows event ev. */
+int bsim_event_of(const bsim_trial_result *r, bsim_event ev);
+
+/* When a group disagrees: some event's McNemar p-value, Holm-adjusted over
+ * every (group, event) test of the comparison, is below alpha AND that
+ * event's probabilities differ by at least margin. The margin keeps a
+ * statistically clear but practically negligible difference (likely with
+ * many trials) from failing a guard; set it to 0 for significance alone.
+ * exact: any trial not identical in every trials.csv field makes its
+ * group disagree (regress --exact: identical code and inputs must give
+ * identical trials). */
+typedef struct bsim_compare_rule {
+	double alpha;  /* family-wise error rate, (0, 1) */
+	double margin; /* |p_A - p_B|, [0, 1] */
+	int exact;
+} bsim_compare_rule;
+
+#define BSIM_COMPARE_ALPHA 0.05
+#define BSIM_COMPARE_MARGIN 0.05
+
+typedef struct bsim_event_test {
+	bsim_pairs pairs;        /* a: both, b: only A, c: only B, d: neither */
+	double p_a, p_b;         /* event probabilities */
+	double ci_a[2], ci_b[2]; /* Wilson 95% */
+	double diff, diff_ci[2]; /* p_a - p_b, Newcombe paired 95% */
+	double p_value, p_holm;  /* exact McNemar, and Holm-adjusted */
+	int beyond;              /* p_holm < alpha and |diff| >= margin */
+} bsim_event_test;
+
+typedef enum {
+	BSIM_VERDICT_SAME = 0,     /* every pair had the same outcome */
+	BSIM_VERDICT_AGREE = 1,    /* outcomes differ, no event significantly */
+	BSIM_VERDICT_SMALL = 2,    /* significant, but within the margin */
+	BSIM_VERDICT_DISAGREE = 3, /* beyond the rule */
+} bsim_verdict;
+
+const char *bsim_verdict_name(bsim_verdict v);
+
+typedef struct bsim_compare_group {
+	bsim_event_test ev[BSIM_N_EVENTS];
+	int discordant;   /* pairs with a different outcome or type */
+	int changed;      /* pairs not identical in any trials.csv field */
+	int separated;    /* pairs whose trajectories separated */
+	double t_sep[3];  /* 10%, 50%, 90% quantiles of the separation time
+	                   * over separated pairs, s; -1 if none */
+	bsim_verdict verdict;
+} bsim_compare_group;
+
+typedef struct bsim_comparison {
+	int n_groups, trials;
+	bsim_compare_rule rule;
+	bsim_compare_group *groups;
+	int n_disagree; /* groups with BSIM_VERDICT_DISAGREE */
+	int separated;  /* pairs that separated, over all groups */
+	double t_sep[3];
+} bsim_comparison;
+
+/* Compares a and b (same groups and trials). t_separate may be NULL (no
+ * trajectories, e.g. regress). BSIM_EINPUT if the shapes differ. */
+int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
+                         const double *t_separate, const bsim_compare_rule *rule,
+                         bsim_comparison *out, bsim_error *err);
+void bsim_comparison_free(bsim_comparison *c);
+
+/* 1 if trials differ in outcome or traversal type. */
+int bsim_trial_discordant(const bsim_trial_result *a, const bsim_trial_result *b);
+/* 1 if trials are identical in every field trials.csv records. */
+int bsim_trial_identical(const bsim_trial_result *a, const bsim_trial_result *b);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

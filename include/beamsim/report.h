@@ -1,0 +1,50 @@
+/* The report of a paired comparison (DESIGN.md "Outputs": compare's
+ * report.md for people, report.json for tools) and the per-pair table
+ * pairs.csv. beamsim regress reuses the sections for a stored run against
+ * its rerun. */
+#ifndef BEAMSIM_REPORT_H
+#define BEAMSIM_REPORT_H
+
+#include <stdio.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/compare.h"
+#include "beamsim/experiment.h"
+#include "beamsim/sweep.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* One side of a comparison. */
+typedef struct bsim_report_side {
+	const char *label;           /* "thesis", "baseline", ... */
+	const bsim_backend *backend; /* the backend that ran it */
+	const bsim_options *opts;    /* as given, for the replay lines */
+	const bsim_sweep_result *run;
+} bsim_report_side;
+
+typedef struct bsim_report {
+	const bsim_experiment *e;
+	const bsim_override *extra; /* command-line --set, for the replay lines */
+	int n_extra;
+	bsim_report_side side[2];
+	const double *t_separate; /* NULL: no trajectories compared */
+	const bsim_comparison *cmp;
+	int examples; /* discordant trials shown per disagreeing group */
+} bsim_report;
+
+/* The body of report.md: the verdict, the rule, the separation times, one
+ * table row per group, then each disagreeing group in detail with example
+ * trials and the `beamsim run` lines that replay them. */
+void bsim_report_md(FILE *f, const bsim_report *r);
+/* report.json: the same content as one JSON object. */
+void bsim_report_json(FILE *f, const bsim_report *r);
+/* pairs.csv: group,trial,outcome_a,type_a,outcome_b,type_b,t_separate
+ * (t_separate empty when the pair never separated). */
+void bsim_report_pairs_csv(FILE *f, const bsim_report *r);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,45 @@
+/* The record a sweep or comparison leaves in its output directory, so that
+ * `beamsim regress DIR` can run it again: DIR/run.json (command, version,
+ * backends with every knob's effective value, seed, trials, the comparison
+ * rule) and DIR/inputs/ (the scene file as it was, and the experiment with
+ * its command-line --set overrides folded into `set:`). */
+#ifndef BEAMSIM_RUN_RECORD_H
+#define BEAMSIM_RUN_RECORD_H
+
+#include <stdint.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/compare.h"
+#include "beamsim/experiment.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bsim_run_record {
+	char command[16]; /* "sweep" or "compare" */
+	char version[32]; /* of the beamsim that wrote it */
+	int n_backends;   /* 1 (sweep) or 2 (compare) */
+	char backend[2][32];
+	bsim_options opts[2]; /* every knob, effective value */
+	uint64_t seed;
+	int trials;
+	bsim_compare_rule rule; /* compare only */
+} bsim_run_record;
+
+/* opts with every knob of b not given set to its default. */
+void bsim_options_effective(const bsim_backend *b, const bsim_options *given, bsim_options *out);
+
+/* Writes DIR/inputs/scene.yaml, DIR/inputs/experiment.yaml and, last,
+ * DIR/run.json, each atomically: a directory with run.json is complete. */
+int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsim_experiment *e,
+                          const bsim_override *extra, int n_extra, bsim_error *err);
+
+/* Reads DIR/run.json. BSIM_EINPUT naming the file and field on a missing
+ * or malformed record. The experiment to load is DIR/inputs/experiment.yaml. */
+int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

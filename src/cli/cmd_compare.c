@@ -1,0 +1,290 @@
+/* beamsim compare: an experiment on two backends with the same schedules,
+ * trial by trial, and a report of where their traversal statistics agree
+ * and where they do not. Exit status 3 when a group disagrees beyond the
+ * rule (see beamsim/compare.h), so the command can guard CI. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <getopt.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "beamsim/output.h"
+#include "cli_common.h"
+#include "cli_store.h"
+
+static const char compare_help[] =
+        "Usage: beamsim compare EXPERIMENT --out DIR [OPTIONS]\n"
+        "\n"
+        "Runs every trial of the experiment on two backends with the same random-force\n"
+        "schedule, so trial t of group g is a pair, and reports per group: both\n"
+        "backends' probabilities of traversed, left, right, side_exit and stuck with\n"
+        "Wilson 95% intervals, their paired difference (Newcombe 95% interval), the\n"
+        "exact McNemar test on the discordant pairs, Holm-corrected over all groups\n"
+        "and events, a verdict, and the times at which paired trajectories first\n"
+        "separate by more than 1% of the body radius. Disagreeing groups list example\n"
+        "trials with the `beamsim run` lines that replay them on either backend.\n"
+        "\n"
+        "A group disagrees when an event's Holm-adjusted p-value is below --alpha and\n"
+        "its probabilities differ by at least --margin. Exit status 3 if any does.\n"
+        "\n"
+        "Writes DIR/report.md, DIR/report.json, DIR/pairs.csv, DIR/<backend>/summary.json\n"
+        "and trials.csv for each backend, and DIR/run.json with DIR/inputs/ for\n"
+        "`beamsim regress DIR`.\n"
+        "\n"
+        "Options:\n"
+        "  --out DIR              output directory, created if missing (required)\n"
+        "  --backends A,B         the two backends (default thesis,box2d)\n"
+        "  --backend-opt B:K=V    option K=V for backend B, repeatable\n"
+        "  --threads N            worker threads (default: all cores)\n"
+        "  --trials N             trials per group (default: the experiment's)\n"
+        "  --seed N               experiment seed (default: the experiment's)\n"
+        "  --set KEY=VALUE        override a scene field in every group, repeatable\n"
+        "  --alpha A              family-wise error rate (default 0.05)\n"
+        "  --margin M             smallest difference that counts (default 0.05)\n"
+        "  --examples N           discordant trials shown per disagreeing group (default 3)\n"
+        "  --quiet                no progress line, nothing on stdout\n"
+        "  -h, --help             show this help\n";
+
+enum {
+	OPT_BACKENDS = 256,
+	OPT_BACKEND_OPT,
+	OPT_THREADS,
+	OPT_TRIALS,
+	OPT_SEED,
+	OPT_SET,
+	OPT_OUT,
+	OPT_ALPHA,
+	OPT_MARGIN,
+	OPT_EXAMPLES,
+	OPT_QUIET
+};
+
+static const struct option compare_options[] = {
+        {"backends", required_argument, NULL, OPT_BACKENDS},
+        {"backend-opt", required_argument, NULL, OPT_BACKEND_OPT},
+        {"threads", required_argument, NULL, OPT_THREADS},
+        {"trials", required_argument, NULL, OPT_TRIALS},
+        {"seed", required_argument, NULL, OPT_SEED},
+        {"set", required_argument, NULL, OPT_SET},
+        {"out", required_argument, NULL, OPT_OUT},
+        {"alpha", required_argument, NULL, OPT_ALPHA},
+        {"margin", required_argument, NULL, OPT_MARGIN},
+        {"examples", required_argument, NULL, OPT_EXAMPLES},
+        {"quiet", no_argument, NULL, OPT_QUIET},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+};
+
+typedef struct compare_args {
+	const char *experiment;
+	char names[2][32];
+	bsim_options opts[2];
+	long threads, trials, examples;
+	int has_seed;
+	uint64_t seed;
+	cli_sets sets;
+	const char *out;
+	bsim_compare_rule rule;
+	int quiet;
+	/* --backend-opt before --backends is resolved after parsing */
+	int n_pending;
+	char pending[2 * BSIM_OPTIONS_MAX][128];
+} compare_args;
+
+static int parse_backends(compare_args *a, const char *text)
+{
+	const char *comma = strchr(text, ',');
+	size_t n0 = comma ? (size_t)(comma - text) : 0;
+	if (!comma || n0 == 0 || n0 >= sizeof a->names[0] || strchr(comma + 1, ',') ||
+	    comma[1] == '\0' || strlen(comma + 1) >= sizeof a->names[1])
+		return cli_usage("compare", "--backends %s: expected two names A,B", text);
+	snprintf(a->names[0], sizeof a->names[0], "%.*s", (int)n0, text);
+	snprintf(a->names[1], sizeof a->names[1], "%s", comma + 1);
+	return CLI_OK;
+}
+
+static int parse_unit(const char *opt, const char *text, double lo, double hi, int open_lo,
+                      double *out)
+{
+	char *end;
+	double x = strtod(text, &end);
+	if (end == text || *end || !(open_lo ? x > lo : x >= lo) || !(x < hi || (!open_lo && x <= hi)))
+		return cli_usage("compare", "%s %s: expected a number in %s%g, %g%s", opt, text,
+		                 open_lo ? "(" : "[", lo, hi, open_lo ? ")" : "]");
+	*out = x;
+	return CLI_OK;
+}
+
+/* "B:K=V" into the options of backend B (one of the two). */
+static int backend_opt(compare_args *a, const char *text)
+{
+	const char *colon = strchr(text, ':');
+	for (int i = 0; colon && i < 2; i++)
+		if (strlen(a->names[i]) == (size_t)(colon - text) &&
+		    strncmp(text, a->names[i], (size_t)(colon - text)) == 0)
+			return cli_options_add(&a->opts[i], "compare", colon + 1);
+	return cli_usage("compare", "--backend-opt %s: expected B:KEY=VALUE with B one of %s, %s",
+	                 text, a->names[0], a->names[1]);
+}
+
+static int compare_option(compare_args *a, int c)
+{
+	switch (c) {
+	case OPT_BACKENDS:
+		return parse_backends(a, optarg);
+	case OPT_BACKEND_OPT:
+		if (a->n_pending == (int)(sizeof a->pending / sizeof a->pending[0]) ||
+		    strlen(optarg) >= sizeof a->pending[0])
+			return cli_usage("compare", "--backend-opt %s: too many or too long", optarg);
+		snprintf(a->pending[a->n_pending++], sizeof a->pending[0], "%s", optarg);
+		return CLI_OK;
+	case OPT_THREADS:
+		if (cli_parse_long(optarg, 1, 4096, &a->threads) != 0)
+			return cli_usage("compare", "--threads %s: expected an integer >= 1", optarg);
+		return CLI_OK;
+	case OPT_TRIALS:
+		if (cli_parse_long(optarg, 1, INT32_MAX, &a->trials) != 0)
+			return cli_usage("compare", "--trials %s: expected an integer >= 1", optarg);
+		return CLI_OK;
+	case OPT_SEED:
+		a->has_seed = 1;
+		if (cli_parse_u64(optarg, &a->seed) != 0)
+			return cli_usage("compare", "--seed %s: expected an integer >= 0", optarg);
+		return CLI_OK;
+	case OPT_SET:
+		return cli_sets_add(&a->sets, "compare", optarg);
+	case OPT_OUT:
+		a->out = optarg;
+		return CLI_OK;
+	case OPT_ALPHA:
+		return parse_unit("--alpha", optarg, 0.0, 1.0, 1, &a->rule.alpha);
+	case OPT_MARGIN:
+		return parse_unit("--margin", optarg, 0.0, 1.0, 0, &a->rule.margin);
+	case OPT_EXAMPLES:
+		if (cli_parse_long(optarg, 0, 1000, &a->examples) != 0)
+			return cli_usage("compare", "--examples %s: expected an integer 0..1000",
+			                 optarg);
+		return CLI_OK;
+	case OPT_QUIET:
+		a->quiet = 1;
+		return CLI_OK;
+	}
+	return CLI_USAGE;
+}
+
+/* Fills a; returns -1 to go on, else the exit status. */
+static int compare_parse(int argc, char **argv, compare_args *a)
+{
+	int c;
+	opterr = 0;
+	while ((c = getopt_long(argc, argv, ":h", compare_options, NULL)) != -1) {
+		if (c == 'h') {
+			fputs(compare_help, stdout);
+			return CLI_OK;
+		}
+		if (c == '?' || c == ':')
+			return cli_bad_option("compare", argv, c);
+		int rc = compare_option(a, c);
+		if (rc != CLI_OK)
+			return rc;
+	}
+	if (optind + 1 != argc)
+		return cli_usage("compare",
+		                 optind == argc ? "missing EXPERIMENT"
+		                                : "expected one EXPERIMENT, got %d",
+		                 argc - optind);
+	a->experiment = argv[optind];
+	if (!a->out)
+		return cli_usage("compare", "--out DIR is required");
+	if (strlen(a->out) > 900)
+		return cli_usage("compare", "--out DIR is longer than 900 characters");
+	if (strcmp(a->names[0], a->names[1]) == 0)
+		return cli_usage("compare", "--backends %s,%s: expected two different backends",
+		                 a->names[0], a->names[1]);
+	for (int i = 0; i < a->n_pending; i++) {
+		int rc = backend_opt(a, a->pending[i]);
+		if (rc != CLI_OK)
+			return rc;
+	}
+	return -1;
+}
+
+static void compare_summary(const compare_args *a, const bsim_experiment *e,
+                            const bsim_comparison *cmp)
+{
+	printf("%s vs %s on %s: %d of %d groups disagree (alpha %g, margin %g), %d x %d trials\n",
+	       a->names[0], a->names[1], e->path, cmp->n_disagree, cmp->n_groups, cmp->rule.alpha,
+	       cmp->rule.margin, e->n_groups, e->trials);
+	for (int g = 0; g < cmp->n_groups; g++)
+		if (cmp->groups[g].verdict == BSIM_VERDICT_DISAGREE) {
+			const bsim_event_test *t = &cmp->groups[g].ev[BSIM_EVENT_TRAVERSED];
+			printf("  group %d: p_traverse %.2f vs %.2f, %d discordant pairs\n", g, t->p_a,
+			       t->p_b, cmp->groups[g].discordant);
+		}
+	printf("wrote %s/report.md, %s/report.json, %s/pairs.csv and each backend's sweep in "
+	       "%s/%s and %s/%s\n",
+	       a->out, a->out, a->out, a->out, a->names[0], a->out, a->names[1]);
+}
+
+static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_backend *b1)
+{
+	bsim_experiment e;
+	bsim_error err;
+	struct stat st;
+	int rc = cli_experiment_load(a->experiment, &a->sets, a->trials, &e);
+	if (rc != CLI_OK)
+		return rc;
+	if (a->has_seed)
+		e.seed = a->seed;
+	int created = stat(a->out, &st) != 0;
+	if (bsim_output_mkdir(a->out, &err) != BSIM_OK) {
+		cli_error("%s", err.msg);
+		bsim_experiment_free(&e);
+		return CLI_FAIL;
+	}
+	cli_compare_job job = {
+	        .e = &e,
+	        .backend = {b0, b1},
+	        .opts = {&a->opts[0], &a->opts[1]},
+	        .extra = a->sets.ov,
+	        .n_extra = a->sets.n,
+	        .threads = a->threads > 0 ? (int)a->threads : omp_get_max_threads(),
+	        .rule = a->rule,
+	        .examples = (int)a->examples,
+	        .progress = !a->quiet,
+	        .out = a->out,
+	};
+	bsim_comparison cmp;
+	rc = cli_compare_execute(&job, &cmp);
+	if (rc != CLI_OK && created)
+		rmdir(a->out); /* removes it only if the run left it empty */
+	if (rc == CLI_OK) {
+		if (!a->quiet)
+			compare_summary(a, &e, &cmp);
+		rc = cmp.n_disagree > 0 ? CLI_DISAGREE : CLI_OK;
+	}
+	bsim_comparison_free(&cmp);
+	bsim_experiment_free(&e);
+	return rc;
+}
+
+int cmd_compare(int argc, char **argv)
+{
+	compare_args a = {
+	        .names = {"thesis", "box2d"},
+	        .rule = {BSIM_COMPARE_ALPHA, BSIM_COMPARE_MARGIN, 0},
+	        .examples = 3,
+	};
+	int rc = compare_parse(argc, argv, &a);
+	if (rc < 0) {
+		const bsim_backend *b0 = cli_backend(a.names[0], &a.opts[0]);
+		const bsim_backend *b1 = b0 ? cli_backend(a.names[1], &a.opts[1]) : NULL;
+		rc = b0 && b1 ? compare_main(&a, b0, b1) : CLI_USAGE;
+	}
+	cli_sets_free(&a.sets);
+	return rc;
+}

@@ -1,0 +1,421 @@
+/* The comparison report (beamsim/report.h).
+ *
+ * Every number in report.md is also in report.json; the Markdown rounds
+ * for reading, the JSON keeps full precision. Replay lines name the scene,
+ * the backend with the options given, the seed, group and trial, and every
+ * override in the order the experiment applied it (set:, --set, grid), so
+ * `beamsim run` rebuilds exactly the scene and schedule of that trial. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/report.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/json.h"
+#include "beamsim/output.h"
+
+/* A word for a POSIX shell: as it is if it is made of safe characters,
+ * else in single quotes with each ' written as '\''. */
+static void shell_word(FILE *f, const char *s)
+{
+	if (*s && strspn(s, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789"
+	                    "_-+=.,/:@%") == strlen(s)) {
+		fputs(s, f);
+		return;
+	}
+	fputc('\'', f);
+	for (; *s; s++)
+		if (*s == '\'')
+			fputs("'\\''", f);
+		else
+			fputc(*s, f);
+	fputc('\'', f);
+}
+
+static void set_word(FILE *f, const char *key, const char *value)
+{
+	char buf[1200];
+	snprintf(buf, sizeof buf, "%s=%s", key, value);
+	fputs(" --set ", f);
+	shell_word(f, buf);
+}
+
+static void replay_line(FILE *f, const bsim_report *r, int side, int g, int t)
+{
+	const bsim_experiment *e = r->e;
+	const bsim_report_side *s = &r->side[side];
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	fputs("beamsim run ", f);
+	shell_word(f, e->scene_path);
+	fprintf(f, " --backend %s", s->backend->name);
+	for (int i = 0; s->opts && i < s->opts->n; i++) {
+		char buf[128];
+		snprintf(buf, sizeof buf, "%s=%s", s->opts->key[i], s->opts->value[i]);
+		fputs(" --backend-opt ", f);
+		shell_word(f, buf);
+	}
+	fprintf(f, " --seed %" PRIu64 " --group %d --trial %d", e->seed, g, t);
+	for (int i = 0; i < e->n_set; i++)
+		set_word(f, e->set[i].key, e->set[i].value);
+	for (int i = 0; i < r->n_extra; i++)
+		set_word(f, r->extra[i].key, r->extra[i].value);
+	if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
+		bsim_experiment_group_index(e, g, idx);
+	for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
+		set_word(f, e->axes[a].key, e->axes[a].values[idx[a]]);
+}
+
+static const bsim_trial_result *trial_of(const bsim_report *r, int side, int g, int t)
+{
+	const bsim_sweep_result *run = r->side[side].run;
+	return &run->trials_out[(size_t)g * run->trials + t];
+}
+
+/* "traversed (left) at 3.24 s" */
+static void outcome_text(FILE *f, const bsim_trial_result *x)
+{
+	fputs(bsim_outcome_name(x->outcome), f);
+	if (x->outcome == BSIM_TRAVERSED)
+		fprintf(f, " (%s)", bsim_type_name(x->type));
+	fprintf(f, " at %.3f s", x->t_end);
+}
+
+static void params_text(FILE *f, const bsim_experiment *e, int g)
+{
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
+		bsim_experiment_group_index(e, g, idx);
+	for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
+		fprintf(f, "%s%s = %s", a ? ", " : "", e->axes[a].key, e->axes[a].values[idx[a]]);
+}
+
+/* The event with the smallest adjusted p-value: what a row shows. */
+static int key_event(const bsim_compare_group *cg)
+{
+	int k = BSIM_EVENT_TRAVERSED;
+	for (int ev = 1; ev < BSIM_N_EVENTS; ev++)
+		if (cg->ev[ev].p_holm < cg->ev[k].p_holm)
+			k = ev;
+	return k;
+}
+
+static void md_separation(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	long pairs = (long)c->n_groups * c->trials;
+	if (!r->t_separate)
+		return;
+	fprintf(f,
+	        "Paired trajectories (same scene, same random-force schedule) separated by more "
+	        "than 1%% of the body radius in %d of %ld pairs",
+	        c->separated, pairs);
+	if (c->separated > 0)
+		fprintf(f, "; separation time quantiles 10%% / 50%% / 90%%: %.3f / %.3f / %.3f s",
+		        c->t_sep[0], c->t_sep[1], c->t_sep[2]);
+	fputs(". Per pair: pairs.csv.\n\n", f);
+}
+
+static void md_table(FILE *f, const bsim_report *r)
+{
+	const bsim_experiment *e = r->e;
+	const char *la = r->side[0].label, *lb = r->side[1].label;
+	fputs("| group |", f);
+	for (int a = 0; a < e->n_axes; a++)
+		fprintf(f, " %s |", e->axes[a].key);
+	fprintf(f,
+	        " p_traverse %s [95%%] | p_traverse %s [95%%] | difference [95%%] | discordant "
+	        "| min p (Holm), event | t_sep median (s) | verdict |\n|---|",
+	        la, lb);
+	for (int a = 0; a < e->n_axes; a++)
+		fputs("---|", f);
+	fputs("---|---|---|---|---|---|---|\n", f);
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	for (int g = 0; g < r->cmp->n_groups; g++) {
+		const bsim_compare_group *cg = &r->cmp->groups[g];
+		const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];
+		int k = key_event(cg);
+		if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
+			bsim_experiment_group_index(e, g, idx);
+		fprintf(f, "| %d |", g);
+		for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
+			fprintf(f, " %s |", e->axes[a].values[idx[a]]);
+		fprintf(f,
+		        " %.2f [%.2f, %.2f] | %.2f [%.2f, %.2f] | %+.2f [%+.2f, %+.2f] | %d | %.2g, %s "
+		        "|",
+		        t->p_a, t->ci_a[0], t->ci_a[1], t->p_b, t->ci_b[0], t->ci_b[1], t->diff,
+		        t->diff_ci[0], t->diff_ci[1], cg->discordant, cg->ev[k].p_holm,
+		        bsim_event_name((bsim_event)k));
+		if (cg->t_sep[1] >= 0.0)
+			fprintf(f, " %.3f |", cg->t_sep[1]);
+		else
+			fputs(" - |", f);
+		fprintf(f, " %s |\n", bsim_verdict_name(cg->verdict));
+	}
+	fputc('\n', f);
+}
+
+static void md_events(FILE *f, const bsim_report *r, const bsim_compare_group *cg)
+{
+	fprintf(f,
+	        "| event | %s | %s | difference [95%%] | only %s | only %s | McNemar p | Holm p "
+	        "| beyond |\n|---|---|---|---|---|---|---|---|---|\n",
+	        r->side[0].label, r->side[1].label, r->side[0].label, r->side[1].label);
+	for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
+		const bsim_event_test *t = &cg->ev[ev];
+		fprintf(f, "| %s | %.2f | %.2f | %+.2f [%+.2f, %+.2f] | %d | %d | %.3g | %.3g | %s |\n",
+		        bsim_event_name((bsim_event)ev), t->p_a, t->p_b, t->diff, t->diff_ci[0],
+		        t->diff_ci[1], t->pairs.b, t->pairs.c, t->p_value, t->p_holm,
+		        t->beyond ? "yes" : "no");
+	}
+	fputc('\n', f);
+}
+
+static void md_examples(FILE *f, const bsim_report *r, int g)
+{
+	int shown = 0;
+	for (int t = 0; t < r->cmp->trials && shown < r->examples; t++) {
+		const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
+		if (!bsim_trial_discordant(a, b))
+			continue;
+		shown++;
+		fprintf(f, "- trial %d: %s ", t, r->side[0].label);
+		outcome_text(f, a);
+		fprintf(f, ", %s ", r->side[1].label);
+		outcome_text(f, b);
+		if (r->t_separate) {
+			double ts = r->t_separate[(size_t)g * r->cmp->trials + t];
+			if (ts >= 0.0)
+				fprintf(f, "; separated at %.3f s", ts);
+		}
+		fputs("\n\n  ```\n", f);
+		for (int s = 0; s < 2; s++) {
+			fputs("  ", f);
+			replay_line(f, r, s, g, t);
+			fputc('\n', f);
+		}
+		fputs("  ```\n", f);
+	}
+	fputc('\n', f);
+}
+
+void bsim_report_md(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	int counts[4] = {0};
+	for (int g = 0; g < c->n_groups; g++)
+		counts[c->groups[g].verdict]++;
+	fprintf(f,
+	        "**%d of %d groups disagree** (%d same, %d agree, %d differ within the margin), "
+	        "%d trials per group.\n\n",
+	        c->n_disagree, c->n_groups, counts[BSIM_VERDICT_SAME], counts[BSIM_VERDICT_AGREE],
+	        counts[BSIM_VERDICT_SMALL], c->trials);
+	fprintf(f,
+	        "Rule: a group disagrees when, for one of the events traversed, left, right, "
+	        "side_exit, stuck, the exact McNemar test on the paired trials gives a p-value "
+	        "below %g after Holm's correction over all %d groups x %d events, and the two "
+	        "probabilities differ by at least %g",
+	        c->rule.alpha, c->n_groups, BSIM_N_EVENTS, c->rule.margin);
+	fputs(c->rule.exact ? "; or when any trial differs in any trials.csv field.\n\n" : ".\n\n",
+	      f);
+	md_separation(f, r);
+	md_table(f, r);
+	for (int g = 0; g < c->n_groups; g++) {
+		const bsim_compare_group *cg = &c->groups[g];
+		if (cg->verdict != BSIM_VERDICT_DISAGREE)
+			continue;
+		fprintf(f, "### Group %d: ", g);
+		params_text(f, r->e, g);
+		fprintf(f, "\n\n%d discordant pairs, %d trials changed in any field.\n\n",
+		        cg->discordant, cg->changed);
+		md_events(f, r, cg);
+		md_examples(f, r, g);
+	}
+}
+
+/* ---- report.json ---------------------------------------------------------- */
+
+static void json_pair_of_numbers(FILE *f, const double v[2])
+{
+	fputc('[', f);
+	bsim_json_number(f, v[0]);
+	fputs(", ", f);
+	bsim_json_number(f, v[1]);
+	fputc(']', f);
+}
+
+static void json_quantiles(FILE *f, const double q[3])
+{
+	if (q[0] < 0.0) {
+		fputs("null", f);
+		return;
+	}
+	fputc('[', f);
+	for (int k = 0; k < 3; k++) {
+		fputs(k ? ", " : "", f);
+		bsim_json_number(f, q[k]);
+	}
+	fputc(']', f);
+}
+
+static void json_event(FILE *f, const bsim_event_test *t)
+{
+	fputs("{\"p_a\": ", f);
+	bsim_json_number(f, t->p_a);
+	fputs(", \"ci95_a\": ", f);
+	json_pair_of_numbers(f, t->ci_a);
+	fputs(", \"p_b\": ", f);
+	bsim_json_number(f, t->p_b);
+	fputs(", \"ci95_b\": ", f);
+	json_pair_of_numbers(f, t->ci_b);
+	fputs(", \"difference\": ", f);
+	bsim_json_number(f, t->diff);
+	fputs(", \"difference_ci95\": ", f);
+	json_pair_of_numbers(f, t->diff_ci);
+	fprintf(f, ", \"both\": %d, \"only_a\": %d, \"only_b\": %d, \"neither\": %d", t->pairs.a,
+	        t->pairs.b, t->pairs.c, t->pairs.d);
+	fputs(", \"p_mcnemar\": ", f);
+	bsim_json_number(f, t->p_value);
+	fputs(", \"p_holm\": ", f);
+	bsim_json_number(f, t->p_holm);
+	fprintf(f, ", \"beyond\": %s}", t->beyond ? "true" : "false");
+}
+
+static void json_outcome(FILE *f, const bsim_trial_result *x)
+{
+	fputs("{\"outcome\": ", f);
+	bsim_json_string(f, bsim_outcome_name(x->outcome));
+	fputs(", \"type\": ", f);
+	bsim_json_string(f, bsim_type_name(x->type));
+	fputs(", \"t_end\": ", f);
+	bsim_json_number(f, x->t_end);
+	fputc('}', f);
+}
+
+/* The replay line as a JSON string: written to memory first. */
+static void json_replay(FILE *f, const bsim_report *r, int side, int g, int t)
+{
+	char *buf = NULL;
+	size_t len = 0;
+	FILE *m = open_memstream(&buf, &len);
+	if (!m) {
+		fputs("null", f);
+		return;
+	}
+	replay_line(m, r, side, g, t);
+	fclose(m);
+	bsim_json_string(f, buf);
+	free(buf);
+}
+
+static void json_examples(FILE *f, const bsim_report *r, int g)
+{
+	int shown = 0;
+	fputs(", \"examples\": [", f);
+	for (int t = 0; t < r->cmp->trials && shown < r->examples; t++) {
+		const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
+		if (!bsim_trial_discordant(a, b))
+			continue;
+		fprintf(f, "%s\n      {\"trial\": %d, \"a\": ", shown ? "," : "", t);
+		json_outcome(f, a);
+		fputs(", \"b\": ", f);
+		json_outcome(f, b);
+		fputs(", \"t_separate\": ", f);
+		double ts = r->t_separate ? r->t_separate[(size_t)g * r->cmp->trials + t] : -1.0;
+		if (ts >= 0.0)
+			bsim_json_number(f, ts);
+		else
+			fputs("null", f);
+		fputs(", \"replay_a\": ", f);
+		json_replay(f, r, 0, g, t);
+		fputs(", \"replay_b\": ", f);
+		json_replay(f, r, 1, g, t);
+		fputc('}', f);
+		shown++;
+	}
+	fputc(']', f);
+}
+
+static void json_side(FILE *f, const bsim_report_side *s)
+{
+	fputs("{\"label\": ", f);
+	bsim_json_string(f, s->label);
+	fputs(", \"backend\": ", f);
+	bsim_json_string(f, s->backend->name);
+	fputs(", \"backend_options\": ", f);
+	bsim_output_backend_options(f, s->backend, s->opts);
+	fputs(", \"wall_seconds\": ", f);
+	bsim_json_number(f, s->run->wall_seconds);
+	fputc('}', f);
+}
+
+void bsim_report_json(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	fputs("{\n  \"experiment\": ", f);
+	bsim_json_string(f, r->e->path);
+	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d,\n  \"a\": ", r->e->seed,
+	        c->trials);
+	json_side(f, &r->side[0]);
+	fputs(",\n  \"b\": ", f);
+	json_side(f, &r->side[1]);
+	fputs(",\n  \"rule\": {\"alpha\": ", f);
+	bsim_json_number(f, c->rule.alpha);
+	fputs(", \"margin\": ", f);
+	bsim_json_number(f, c->rule.margin);
+	fprintf(f, ", \"exact\": %s, \"correction\": \"holm\", \"test\": \"mcnemar_exact\"}",
+	        c->rule.exact ? "true" : "false");
+	fprintf(f, ",\n  \"groups_disagreeing\": %d,\n  \"separation\": ", c->n_disagree);
+	if (r->t_separate) {
+		fprintf(f, "{\"distance\": \"0.01 body radius\", \"separated\": %d, \"pairs\": %ld, "
+		           "\"quantiles_10_50_90_s\": ",
+		        c->separated, (long)c->n_groups * c->trials);
+		json_quantiles(f, c->t_sep);
+		fputc('}', f);
+	} else {
+		fputs("null", f);
+	}
+	fputs(",\n  \"groups\": [", f);
+	for (int g = 0; g < c->n_groups; g++) {
+		const bsim_compare_group *cg = &c->groups[g];
+		fprintf(f, "%s\n    {\"group\": %d, \"params\": ", g ? "," : "", g);
+		bsim_output_group_params(f, r->e, g);
+		fputs(", \"verdict\": ", f);
+		bsim_json_string(f, bsim_verdict_name(cg->verdict));
+		fprintf(f, ", \"discordant\": %d, \"changed\": %d, \"separated\": %d, ",
+		        cg->discordant, cg->changed, cg->separated);
+		fputs("\"t_separate_quantiles_s\": ", f);
+		json_quantiles(f, cg->t_sep);
+		fputs(",\n     \"events\": {", f);
+		for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
+			fputs(ev ? ",\n       " : "\n       ", f);
+			bsim_json_string(f, bsim_event_name((bsim_event)ev));
+			fputs(": ", f);
+			json_event(f, &cg->ev[ev]);
+		}
+		fputc('}', f);
+		if (cg->verdict == BSIM_VERDICT_DISAGREE)
+			json_examples(f, r, g);
+		fputc('}', f);
+	}
+	fputs("\n  ]\n}\n", f);
+}
+
+void bsim_report_pairs_csv(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	fputs("group,trial,outcome_a,type_a,outcome_b,type_b,t_separate\n", f);
+	for (int g = 0; g < c->n_groups; g++)
+		for (int t = 0; t < c->trials; t++) {
+			const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
+			fprintf(f, "%d,%d,%s,%s,%s,%s,", g, t, bsim_outcome_name(a->outcome),
+			        bsim_type_name(a->type), bsim_outcome_name(b->outcome),
+			        bsim_type_name(b->type));
+			double ts = r->t_separate ? r->t_separate[(size_t)g * c->trials + t] : -1.0;
+			if (ts >= 0.0)
+				fprintf(f, "%.10g", ts);
+			fputc('\n', f);
+		}
+}

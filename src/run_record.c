@@ -1,0 +1,256 @@
+/* The record of a run for beamsim regress (beamsim/run_record.h).
+ *
+ * The stored experiment is regenerated from the loaded one rather than
+ * copied: its `scene:` must name the copied scene, and the command line's
+ * --set overrides, applied after `set:` and before the grid, become the
+ * last entries of `set:`, which is where they act. run.json is JSON, which
+ * is YAML, so it reads back through libfyaml like every other input. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/run_record.h"
+
+#include <inttypes.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/atomic_file.h"
+#include "beamsim/json.h"
+#include "beamsim/output.h"
+#include "beamsim/version.h"
+#include "yaml_doc.h"
+
+void bsim_options_effective(const bsim_backend *b, const bsim_options *given, bsim_options *out)
+{
+	*out = given ? *given : (bsim_options){0};
+	for (int i = 0; i < b->n_knobs && out->n < BSIM_OPTIONS_MAX; i++) {
+		if (bsim_options_get(out, b->knobs[i].name) || !b->knobs[i].default_value)
+			continue;
+		snprintf(out->key[out->n], sizeof out->key[0], "%s", b->knobs[i].name);
+		snprintf(out->value[out->n], sizeof out->value[0], "%s", b->knobs[i].default_value);
+		out->n++;
+	}
+}
+
+static int path_join(char *buf, size_t size, const char *dir, const char *name, bsim_error *err)
+{
+	int n = snprintf(buf, size, "%s/%s", dir, name);
+	if (n < 0 || (size_t)n >= size)
+		return bsim_error_set(err, BSIM_EFAIL, "%s/%s: path too long", dir, name);
+	return BSIM_OK;
+}
+
+static int copy_file(const char *from, const char *to, bsim_error *err)
+{
+	FILE *in = fopen(from, "rb");
+	if (!in)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot read the file", from);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, to, err) != BSIM_OK) {
+		fclose(in);
+		return BSIM_EFAIL;
+	}
+	char buf[8192];
+	size_t n;
+	while ((n = fread(buf, 1, sizeof buf, in)) > 0)
+		fwrite(buf, 1, n, o.f);
+	int bad = ferror(in);
+	fclose(in);
+	if (bad) {
+		bsim_atomic_file_abort(&o);
+		return bsim_error_set(err, BSIM_EFAIL, "%s: read error", from);
+	}
+	return bsim_atomic_file_commit(&o, err);
+}
+
+static int write_experiment(const char *path, const bsim_experiment *e, const bsim_override *extra,
+                            int n_extra, bsim_error *err)
+{
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	FILE *f = o.f;
+	fprintf(f, "# The experiment of a stored run, written by beamsim %s from\n# %s\n",
+	        BSIM_VERSION, e->path);
+	fprintf(f, "scene: scene.yaml\ntrials: %d\nseed: %" PRIu64 "\n", e->trials, e->seed);
+	if (e->n_set + n_extra > 0)
+		fputs("set:\n", f);
+	for (int i = 0; i < e->n_set; i++)
+		fprintf(f, "  %s: %s\n", e->set[i].key, e->set[i].value);
+	for (int i = 0; i < n_extra; i++)
+		fprintf(f, "  %s: %s  # %s\n", extra[i].key, extra[i].value, extra[i].origin);
+	fputs("grid:\n", f);
+	for (int a = 0; a < e->n_axes; a++) {
+		fprintf(f, "  %s: [", e->axes[a].key);
+		for (int i = 0; i < e->axes[a].n_values; i++)
+			fprintf(f, "%s%s", i ? ", " : "", e->axes[a].values[i]);
+		fputs("]\n", f);
+	}
+	return bsim_atomic_file_commit(&o, err);
+}
+
+static void json_options(FILE *f, const bsim_options *o)
+{
+	fputc('{', f);
+	for (int i = 0; i < o->n; i++) {
+		fputs(i ? ", " : "", f);
+		bsim_json_string(f, o->key[i]);
+		fputs(": ", f);
+		bsim_json_string(f, o->value[i]);
+	}
+	fputc('}', f);
+}
+
+static int write_json(const char *path, const bsim_run_record *rec, const bsim_experiment *e,
+                      bsim_error *err)
+{
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	FILE *f = o.f;
+	fputs("{\n  \"command\": ", f);
+	bsim_json_string(f, rec->command);
+	fputs(",\n  \"beamsim_version\": ", f);
+	bsim_json_string(f, BSIM_VERSION);
+	fputs(",\n  \"source_experiment\": ", f);
+	bsim_json_string(f, e->path);
+	fputs(",\n  \"experiment\": \"inputs/experiment.yaml\",\n  \"backends\": [", f);
+	for (int i = 0; i < rec->n_backends; i++) {
+		fputs(i ? ", " : "", f);
+		fputs("{\"name\": ", f);
+		bsim_json_string(f, rec->backend[i]);
+		fputs(", \"options\": ", f);
+		json_options(f, &rec->opts[i]);
+		fputc('}', f);
+	}
+	fprintf(f, "],\n  \"seed\": %" PRIu64 ",\n  \"trials\": %d", rec->seed, rec->trials);
+	fputs(",\n  \"rule\": {\"alpha\": ", f);
+	bsim_json_number(f, rec->rule.alpha);
+	fputs(", \"margin\": ", f);
+	bsim_json_number(f, rec->rule.margin);
+	fprintf(f, ", \"exact\": %s}\n}\n", rec->rule.exact ? "true" : "false");
+	return bsim_atomic_file_commit(&o, err);
+}
+
+int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsim_experiment *e,
+                          const bsim_override *extra, int n_extra, bsim_error *err)
+{
+	char inputs[1100], path[1200];
+	if (path_join(inputs, sizeof inputs, dir, "inputs", err) ||
+	    bsim_output_mkdir(inputs, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (path_join(path, sizeof path, inputs, "scene.yaml", err) ||
+	    copy_file(e->scene_path, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (path_join(path, sizeof path, inputs, "experiment.yaml", err) ||
+	    write_experiment(path, e, extra, n_extra, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (path_join(path, sizeof path, dir, "run.json", err) ||
+	    write_json(path, rec, e, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	return BSIM_OK;
+}
+
+/* Reading: every field named in the message as it appears in run.json. */
+static int need_text(const ydoc *d, struct fy_node *root, const char *field, char *buf,
+                     size_t size, bsim_error *err)
+{
+	struct fy_node *n = ydoc_lookup(root, field);
+	size_t len;
+	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
+	if (!t || len == 0 || len >= size)
+		return ydoc_expected(d, n, NULL, field, "a string", err);
+	memcpy(buf, t, len);
+	buf[len] = '\0';
+	return BSIM_OK;
+}
+
+static int need_number(const ydoc *d, struct fy_node *root, const char *field, double *out,
+                       bsim_error *err)
+{
+	struct fy_node *n = ydoc_lookup(root, field);
+	if (!n || ydoc_number(n, out) != YDOC_NUM_OK)
+		return ydoc_expected(d, n, NULL, field, "a number", err);
+	return BSIM_OK;
+}
+
+static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_record *rec,
+                        bsim_error *err)
+{
+	char field[64];
+	snprintf(field, sizeof field, "backends.%d.name", i);
+	if (need_text(d, root, field, rec->backend[i], sizeof rec->backend[i], err))
+		return BSIM_EINPUT;
+	snprintf(field, sizeof field, "backends.%d.options", i);
+	struct fy_node *opts = ydoc_lookup(root, field);
+	if (!opts || !fy_node_is_mapping(opts) || fy_node_mapping_item_count(opts) > BSIM_OPTIONS_MAX)
+		return ydoc_expected(d, opts, NULL, field, "a mapping of knobs", err);
+	void *it = NULL;
+	struct fy_node_pair *p;
+	while ((p = fy_node_mapping_iterate(opts, &it)) != NULL) {
+		size_t kl, vl;
+		const char *k = fy_node_get_scalar(fy_node_pair_key(p), &kl);
+		const char *v = fy_node_get_scalar(fy_node_pair_value(p), &vl);
+		bsim_options *o = &rec->opts[i];
+		if (!k || !v || kl >= sizeof o->key[0] || vl >= sizeof o->value[0])
+			return ydoc_expected(d, fy_node_pair_value(p), NULL, field,
+			                     "knob: value strings", err);
+		snprintf(o->key[o->n], sizeof o->key[0], "%.*s", (int)kl, k);
+		snprintf(o->value[o->n], sizeof o->value[0], "%.*s", (int)vl, v);
+		o->n++;
+	}
+	return BSIM_OK;
+}
+
+int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
+{
+	char path[1100];
+	ydoc d;
+	memset(rec, 0, sizeof *rec);
+	if (path_join(path, sizeof path, dir, "run.json", err))
+		return BSIM_EINPUT;
+	if (ydoc_load(&d, path, err) != BSIM_OK) {
+		char msg[sizeof err->msg];
+		snprintf(msg, sizeof msg, "%s", err->msg);
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s (is %s the --out directory of beamsim sweep or compare?)",
+		                      msg, dir);
+	}
+	struct fy_node *root = fy_document_root(d.fyd);
+	double alpha = 0, margin = 0;
+	int rc = need_text(&d, root, "command", rec->command, sizeof rec->command, err);
+	if (!rc)
+		rc = need_text(&d, root, "beamsim_version", rec->version, sizeof rec->version, err);
+	struct fy_node *b = ydoc_lookup(root, "backends");
+	if (!rc && (!b || !fy_node_is_sequence(b) || fy_node_sequence_item_count(b) < 1 ||
+	            fy_node_sequence_item_count(b) > 2))
+		rc = ydoc_expected(&d, b, NULL, "backends", "a list of 1 or 2 backends", err);
+	if (!rc)
+		rec->n_backends = fy_node_sequence_item_count(b);
+	for (int i = 0; !rc && i < rec->n_backends; i++)
+		rc = read_backend(&d, root, i, rec, err);
+	struct fy_node *sn = ydoc_lookup(root, "seed"), *tn = ydoc_lookup(root, "trials");
+	long long trials = 0;
+	if (!rc && (!sn || !ydoc_uint64(sn, &rec->seed)))
+		rc = ydoc_expected(&d, sn, NULL, "seed", "an integer >= 0", err);
+	if (!rc && (!tn || !ydoc_int64(tn, &trials) || trials < 1 || trials > INT32_MAX))
+		rc = ydoc_expected(&d, tn, NULL, "trials", "an integer >= 1", err);
+	if (!rc)
+		rc = need_number(&d, root, "rule.alpha", &alpha, err);
+	if (!rc)
+		rc = need_number(&d, root, "rule.margin", &margin, err);
+	if (!rc) {
+		struct fy_node *ex = ydoc_lookup(root, "rule.exact");
+		const char *t = ex ? ydoc_plain(ex) : NULL;
+		rec->rule.exact = t && strcmp(t, "true") == 0;
+		rec->trials = (int)trials;
+		rec->rule.alpha = alpha;
+		rec->rule.margin = margin;
+		if (strcmp(rec->command, "sweep") != 0 && strcmp(rec->command, "compare") != 0)
+			rc = ydoc_expected(&d, ydoc_lookup(root, "command"), NULL, "command",
+			                   "\"sweep\" or \"compare\"", err);
+	}
+	ydoc_free(&d);
+	return rc;
+}

@@ -1,0 +1,35 @@
+/* Internal: one trial run on two backends with the same schedule, and the
+ * time at which their body trajectories first separate (beamsim compare). */
+#ifndef BSIM_TRIAL_PAIR_H
+#define BSIM_TRIAL_PAIR_H
+
+#include <stdint.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/trial.h"
+
+/* The body centre after every step of one run. */
+typedef struct trial_trace {
+	double *xy; /* 2 * n, m */
+	long n, cap;
+	int oom; /* a push failed: the trace is incomplete */
+} trial_trace;
+
+/* Per-thread memory: a runner and two traces, reused trial after trial. */
+typedef struct trial_pair {
+	bsim_runner *runner;
+	trial_trace trace[2];
+} trial_pair;
+
+trial_pair *trial_pair_alloc(void);
+void trial_pair_free(trial_pair *p);
+
+/* Trial `seed` of scene on backend a then b. t_separate: the first time,
+ * s, at which the body centres are more than sep_distance apart (m),
+ * compared while both runs go on; -1 if they never are. */
+int trial_pair_run(trial_pair *p, const bsim_scene *scene, const bsim_backend *a,
+                   const bsim_options *opts_a, const bsim_backend *b, const bsim_options *opts_b,
+                   uint64_t seed, double sep_distance, bsim_trial_result *ra,
+                   bsim_trial_result *rb, double *t_separate, bsim_error *err);
+
+#endif

@@ -1,0 +1,295 @@
+/* beamsim compare and regress through the real program: each backend's
+ * half of a comparison is exactly its own sweep (the pairs share
+ * schedules), results do not depend on threads, the replay lines in a
+ * report reproduce the trials they name, a rerun of a stored run with the
+ * same code reproduces it exactly, and a baseline whose outcomes were
+ * changed is caught (exit status 3) in the groups that were changed. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "support.h"
+
+static char experiment[1200];
+static char cmp_dir[1200];
+
+static const char *out_dir(const char *name)
+{
+	static char buf[4][1200];
+	static int k;
+	k = (k + 1) % 4;
+	snprintf(buf[k], sizeof buf[k], "%s", bsim_test_dir(name));
+	return buf[k];
+}
+
+static char *read_in(const char *dir, const char *name)
+{
+	char path[1400];
+	snprintf(path, sizeof path, "%s/%s", dir, name);
+	char *s = bsim_test_read(path);
+	assert_non_null(s);
+	return s;
+}
+
+static int setup(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("exp");
+	char text[2000];
+	snprintf(text, sizeof text,
+	         "scene: %s\ntrials: 12\nseed: 5\ngrid:\n"
+	         "  effects.propulsion.force: [8, 9]\n"
+	         "  effects.random_force.magnitude: [0, 30]\n",
+	         bsim_test_src("configs/thesis/gate.yaml"));
+	snprintf(experiment, sizeof experiment, "%s", bsim_test_write(dir, "small.yaml", text));
+	snprintf(cmp_dir, sizeof cmp_dir, "%s", out_dir("cmp"));
+	const char *argv[] = {"compare", experiment, "--threads", "2", "--quiet",
+	                      "--out",   cmp_dir,    NULL};
+	int status = bsim_test_cli(argv, NULL, NULL);
+	return status == 0 || status == 3 ? 0 : -1;
+}
+
+/* Each backend's trials in the comparison are those of its own sweep. */
+static void test_halves_are_sweeps(void **state)
+{
+	(void)state;
+	const char *backends[] = {"thesis", "box2d"};
+	for (int i = 0; i < 2; i++) {
+		const char *dir = out_dir(backends[i]);
+		const char *argv[] = {"sweep",       experiment, "--backend", backends[i],
+		                      "--quiet",     "--out",    dir,         NULL};
+		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+		char sub[1300];
+		snprintf(sub, sizeof sub, "%s/%s", cmp_dir, backends[i]);
+		char *a = read_in(dir, "trials.csv"), *b = read_in(sub, "trials.csv");
+		assert_string_equal(a, b);
+		free(a);
+		free(b);
+	}
+}
+
+/* The exit status says what report.json says; threads change nothing. */
+static void test_status_and_threads(void **state)
+{
+	(void)state;
+	const char *dir = out_dir("cmp1");
+	const char *argv[] = {"compare", experiment, "--threads", "1", "--quiet", "--out", dir, NULL};
+	int status = bsim_test_cli(argv, NULL, NULL);
+	char *json = read_in(dir, "report.json");
+	int disagreeing = -1;
+	const char *p = strstr(json, "\"groups_disagreeing\": ");
+	assert_non_null(p);
+	sscanf(p, "\"groups_disagreeing\": %d", &disagreeing);
+	assert_int_equal(status, disagreeing > 0 ? 3 : 0);
+	char *pairs1 = read_in(dir, "pairs.csv"), *pairs2 = read_in(cmp_dir, "pairs.csv");
+	assert_string_equal(pairs1, pairs2);
+	free(json);
+	free(pairs1);
+	free(pairs2);
+}
+
+/* Splits a replay line (plain words, no quoting needed for these scenes)
+ * after "beamsim " into argv; returns argc. */
+static int split(char *line, const char *argv[], int max)
+{
+	int n = 0;
+	assert_true(strncmp(line, "beamsim ", 8) == 0);
+	assert_null(strchr(line, '\''));
+	for (char *tok = strtok(line + 8, " "); tok && n < max - 2; tok = strtok(NULL, " "))
+		argv[n++] = tok;
+	argv[n++] = "--json";
+	argv[n] = NULL;
+	return n;
+}
+
+/* The JSON string value after key at or after *from (no escapes). */
+static char *json_text(const char **from, const char *key)
+{
+	const char *p = strstr(*from, key);
+	if (!p)
+		return NULL;
+	p += strlen(key);
+	const char *end = strchr(p, '"');
+	*from = end;
+	char *s = malloc((size_t)(end - p) + 1);
+	memcpy(s, p, (size_t)(end - p));
+	s[end - p] = '\0';
+	return s;
+}
+
+/* Every replay line of a report, of sides first_side..1 (0: a, 1: b),
+ * gives the outcome the report states. */
+static int check_replays(const char *json, int first_side)
+{
+	int checked = 0;
+	const char *at = json;
+	for (;;) {
+		const char *ex = strstr(at, "{\"trial\": ");
+		if (!ex)
+			break;
+		at = ex + 1;
+		for (int side = first_side; side < 2; side++) {
+			const char *from = ex;
+			char *outcome = json_text(&from, side ? "\"b\": {\"outcome\": \""
+			                                      : "\"a\": {\"outcome\": \"");
+			char *type = json_text(&from, "\"type\": \"");
+			char *line = json_text(&from, side ? "\"replay_b\": \"" : "\"replay_a\": \"");
+			assert_non_null(line);
+			const char *argv[64];
+			split(line, argv, 64);
+			char *out = NULL;
+			assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
+			char want[128];
+			snprintf(want, sizeof want, "\"outcome\": \"%s\"", outcome);
+			assert_non_null(strstr(out, want));
+			snprintf(want, sizeof want, "\"type\": \"%s\"", type);
+			assert_non_null(strstr(out, want));
+			checked++;
+			free(out);
+			free(outcome);
+			free(type);
+			free(line);
+		}
+	}
+	return checked;
+}
+
+static void test_compare_replays(void **state)
+{
+	(void)state;
+	char *json = read_in(cmp_dir, "report.json");
+	check_replays(json, 0);
+	free(json);
+}
+
+/* Same code, same inputs: every trial identical, exit 0 even with --exact. */
+static void test_regress_identical(void **state)
+{
+	(void)state;
+	const char *dir = out_dir("rerun");
+	const char *argv[] = {"regress", cmp_dir, "--exact", "--out", dir, NULL};
+	char *out = NULL;
+	assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
+	assert_non_null(strstr(out, "thesis: 0 of 48 trials changed"));
+	assert_non_null(strstr(out, "box2d: 0 of 48 trials changed"));
+	free(out);
+	/* The rerun is itself a baseline. */
+	char *a = read_in(dir, "run.json");
+	assert_non_null(strstr(a, "\"command\": \"compare\""));
+	free(a);
+}
+
+/* A stored sweep whose group 2 (force 9, no noise) traversals were all
+ * rewritten as side exits: regress flags group 3 only, exit 3, and its
+ * replay lines reproduce the rerun's (true) outcomes. */
+static void test_regress_catches_changes(void **state)
+{
+	(void)state;
+	const char *base = out_dir("base");
+	const char *sweep[] = {"sweep", experiment, "--quiet", "--out", base, NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	char *csv = read_in(base, "trials.csv");
+	char *edited = malloc(strlen(csv) * 2 + 1);
+	char *w = edited;
+	int changed = 0;
+	for (char *line = strtok(csv, "\n"); line; line = strtok(NULL, "\n")) {
+		if (strncmp(line, "2,", 2) == 0 && strstr(line, ",traversed,")) {
+			char *o = strstr(line, ",traversed,");
+			char *rest = strchr(o + 11, ',');
+			w += sprintf(w, "%.*s,side_exit,none%s\n", (int)(o - line), line, rest);
+			changed++;
+		} else {
+			w += sprintf(w, "%s\n", line);
+		}
+	}
+	assert_true(changed >= 10); /* force 9 without noise traverses */
+	bsim_test_write(base, "trials.csv", edited);
+
+	const char *dir = out_dir("caught");
+	const char *argv[] = {"regress", base, "--quiet", "--out", dir, NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 3);
+	char *json = read_in(dir, "regress.json");
+	int disagree = 0;
+	for (const char *p = json; (p = strstr(p, "\"verdict\": \"DISAGREE\"")); p++)
+		disagree++;
+	assert_int_equal(disagree, 1);
+	assert_non_null(strstr(json, "{\"group\": 2, \"params\": {\"effects.propulsion.force\": 9, "
+	                             "\"effects.random_force.magnitude\": 0}, \"verdict\": "
+	                             "\"DISAGREE\""));
+	/* The rerun's side replays; the baseline's was edited, so it cannot. */
+	assert_int_equal(check_replays(json, 1), 3);
+	free(csv);
+	free(edited);
+	free(json);
+}
+
+/* --exact: one end position changed in the 10th digit is a change. */
+static void test_regress_exact(void **state)
+{
+	(void)state;
+	const char *base = out_dir("exact");
+	const char *sweep[] = {"sweep", experiment, "--quiet", "--out", base, NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	char *csv = read_in(base, "trials.csv");
+	char *row = strstr(csv, "\n0,0,");
+	assert_non_null(row);
+	char *field = row + 1;
+	for (int i = 0; i < 6; i++) /* to x_end */
+		field = strchr(field, ',') + 1;
+	*field = *field == '1' ? '2' : '1';
+	bsim_test_write(base, "trials.csv", csv);
+	const char *loose[] = {"regress", base, "--quiet", "--out", out_dir("loose"), NULL};
+	assert_int_equal(bsim_test_cli(loose, NULL, NULL), 0);
+	const char *exact[] = {"regress", base, "--quiet", "--exact", "--out", out_dir("tight"),
+	                       NULL};
+	assert_int_equal(bsim_test_cli(exact, NULL, NULL), 3);
+	free(csv);
+}
+
+static void test_bad_usage(void **state)
+{
+	(void)state;
+	char *err = NULL;
+	const char *same[] = {"compare", experiment, "--backends", "thesis,thesis",
+	                      "--out",   out_dir("bad1"), NULL};
+	assert_int_equal(bsim_test_cli(same, NULL, &err), 2);
+	assert_non_null(strstr(err, "two different backends"));
+	free(err);
+	const char *knob[] = {"compare",     experiment, "--backend-opt", "box2d:nope=1",
+	                      "--out",       out_dir("bad2"), NULL};
+	assert_int_equal(bsim_test_cli(knob, NULL, &err), 2);
+	assert_non_null(strstr(err, "nope"));
+	free(err);
+	const char *who[] = {"compare", experiment, "--backend-opt", "ode:x=1", "--out",
+	                     out_dir("bad3"), NULL};
+	assert_int_equal(bsim_test_cli(who, NULL, &err), 2);
+	assert_non_null(strstr(err, "B:KEY=VALUE"));
+	free(err);
+	const char *empty = out_dir("empty");
+	const char *none[] = {"regress", empty, "--out", out_dir("bad4"), NULL};
+	assert_int_equal(bsim_test_cli(none, NULL, &err), 2);
+	assert_non_null(strstr(err, "run.json"));
+	free(err);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_halves_are_sweeps),
+	        cmocka_unit_test(test_status_and_threads),
+	        cmocka_unit_test(test_compare_replays),
+	        cmocka_unit_test(test_regress_identical),
+	        cmocka_unit_test(test_regress_catches_changes),
+	        cmocka_unit_test(test_regress_exact),
+	        cmocka_unit_test(test_bad_usage),
+	};
+	return cmocka_run_group_tests(tests, setup, NULL);
+}
