@@ -17,13 +17,14 @@
  *   beam i: dynamic body whose origin is the pivot P, angle a_i = sgn theta_i
  *          (sgn = +1 if the rest direction u0 has x >= 0, else -1: theta > 0
  *          swings the tip forward, +y), one two-sided edge from (0, 0) to
- *          L u0 in its own frame. Mass data: m at the pivot and
+ *          L u0 in its own frame. Mass data: centre c at the pivot and
  *          b2MassData.I = I (the scene's inertia about the pivot). Box2D's I
  *          is about the body origin and SetMassData stores
  *          I_c = I - m |c|^2 about the centre c; with c = 0 (the pivot)
  *          I_c = I, and a beam turning about its pinned centre has exactly
- *          inertia I about the pivot. The pin carries the mass, so it has no
- *          centripetal load and its rows do not couple to the rotation.
+ *          inertia I about the pivot. The pin then has no centripetal load
+ *          and its rows do not couple to the rotation. The translational
+ *          mass is PIN_MASS_RATIO M, not the scene's m (see there).
  *   ground: static, no fixtures; the pivots hang on it.
  * Collision filtering: the body collides with beams only; beams collide
  * with nothing else (MODEL.md section 1: beams pass through each other).
@@ -70,8 +71,14 @@
  *           way from the velocities they start from.
  *   correction: 0. The position solver moves bodies without changing
  *           velocities; its energy, the float32 rounding, and the integrators'
- *           own errors (symplectic Euler's spring and force splitting, the weld's
- *           backward Euler) are what the runner's residual shows.
+ *           own errors are what the runner's residual shows. The largest are
+ *           Box2D's semi-implicit Euler: the runner credits a force F with
+ *           F . (x' - x) = h F . v', one h^2 |F|^2 / 2M per step more than
+ *           the kinetic energy it adds; at an impact the force and the spring
+ *           torque act before the velocity jump and are credited over the
+ *           motion after it (h F . dv, k theta h d omega); the weld's backward
+ *           Euler removes k (h omega')^2 / 2 a step. All are O(h): the knob
+ *           substeps shrinks them.
  */
 #include <box2d/box2d.h>
 
@@ -79,25 +86,34 @@
 #include <cstdlib>
 #include <cstring>
 #include <new>
-#include <cstdio>
 #include <vector>
 
 #include "beamsim/backend.h"
 
-namespace {
+namespace
+{
 
-/* The knobs. The spring default comes from measurements (tests/
- * test_box2d_oracles.c prints them), Table 2.1 beam, theta0 = 0.1 rad, 3 s:
- *   free vibration, max |theta - exact| at h = 4 ms (2 ms):
- *     torque 1.9e-4 rad (9.8e-5), first order; weld 8.1e-4 rad (4.1e-4)
- *   stiff springs, omega_n h = 0.5 / 2 / 4, undamped, 5000 steps:
- *     torque: energy bounded (symplectic) to omega_n h < 2, blows up at 4;
- *     weld: stable at any omega_n h, loses energy (backward Euler).
- *   energy ledger, gate F = 7 N, Rm = 20 N: residual / throughput
- *     torque 3e-3, weld 6e-3.
- * torque is four times more accurate at the essay's step and its ledger
- * closes better, so it is the default; weld is there for stiff springs
- * (omega_n h >= 2), where torque is unstable. */
+/* The knobs. The spring default is chosen from these measurements
+ * (tests/test_box2d_oracles.c prints them; h = 4 ms, substeps = 1):
+ *   free vibration, Table 2.1 beam from 0.1 rad, max |theta - exact| over
+ *   3 s: torque 8.1e-4 rad, weld 1.19e-3 rad; both first order (halved at
+ *   h = 2 ms).
+ *   stiff springs, undamped, omega_n h = 0.5 / 1.5 / 4: torque keeps
+ *   E/E0 within 1.33 / 4.0 (symplectic) and is unstable at 4 (E/E0 = 51,
+ *   bounded only by Box2D's b2_maxRotation clamp); weld never gains
+ *   energy and is stable at any step, but damps numerically (backward
+ *   Euler, extra damping ratio ~ omega_n h / 2: 0.009 at the essay's beam,
+ *   beside its physical 0.274).
+ *   conservative gate (e = 1, d = 0, no force): E drifts +7.5% (torque:
+ *   the explicit spring torque acts before each impact's velocity jump
+ *   and the beam turns after it) and -6.2% (weld) over 12 s.
+ *   driven damped noisy gate (F = 7 N, Rm = 20 N), worst of 10 trials,
+ *   |ledger residual| / energy throughput: torque 8.9e-2, weld 3.7e-2
+ *   (torque with substeps = 4: 2.7e-2).
+ * weld is the default: always stable (configs/hard/ has stiff beams), its
+ * errors only ever remove energy, and its ledger closes 2.4 times better;
+ * it costs a 1.5 times larger free-vibration error at the essay's step.
+ * torque is the more accurate choice for soft beams and smooth motion. */
 const bsim_knob box2d_knobs[] = {
         {"velocity_iterations", BSIM_KNOB_INT, "8", NULL,
          "Box2D velocity iterations per step (sequential impulses), >= 1"},
@@ -105,7 +121,7 @@ const bsim_knob box2d_knobs[] = {
          "Box2D position iterations per step (penetration and pin drift), >= 0"},
         {"substeps", BSIM_KNOB_INT, "1", NULL,
          "Box2D steps of h/n per step, force and spring torque re-applied each, 1..1000"},
-        {"spring", BSIM_KNOB_CHOICE, "torque", "torque|weld",
+        {"spring", BSIM_KNOB_CHOICE, "weld", "torque|weld",
          "beam spring + damper: explicit torque on a revolute pin (symplectic, stable for "
          "omega_n h < 2), or a soft b2WeldJoint (implicit, always stable, dissipative)"},
         {"unit_scale", BSIM_KNOB_DOUBLE, "0.1", NULL,
@@ -156,8 +172,8 @@ struct beam_rec {
 	double damping = 0.0;     /* N m s/rad */
 	bool weld = false;        /* spring and damper in a b2WeldJoint */
 	/* the (sub)step in progress */
-	b2Vec2 start_position; /* Box2D transform before the step, to tell */
-	float start_angle = 0; /* the regular solve's PreSolve from a TOI's */
+	b2Vec2 start_position;      /* Box2D transform before the step, to tell */
+	float start_angle = 0;      /* the regular solve's PreSolve from a TOI's */
 	double omega_applied = 0.0; /* omega the damper torque used, rad/s */
 	double w_pre = 0.0;         /* Box2D angular velocity the solve starts from */
 	/* the captured contact row: normal n (beam -> body), point Q, the
@@ -177,7 +193,7 @@ struct bsim_world {
 	bsim_scene scene; /* a copy, to rebuild the world in set_state */
 	/* knobs */
 	int velocity_iterations = 8, position_iterations = 3, substeps = 1;
-	int spring = SPRING_TORQUE;
+	int spring = SPRING_WELD;
 	double s = 0.1; /* Box2D units per metre */
 	/* Box2D */
 	b2World *world = nullptr;
@@ -194,13 +210,17 @@ struct bsim_world {
 	long toi_events = 0; /* continuous-collision sub-solves, all steps */
 };
 
-namespace {
+namespace
+{
 
 /* Sets tip restitution on vertex contacts and captures the contact row the
  * solver will use; PostSolve turns the row's impulse into energy. */
-class contact_ledger : public b2ContactListener {
-public:
-	explicit contact_ledger(bsim_world *w) : w_(w) {}
+class contact_ledger : public b2ContactListener
+{
+      public:
+	explicit contact_ledger(bsim_world *w) : w_(w)
+	{
+	}
 
 	void PreSolve(b2Contact *contact, const b2Manifold *old_manifold) override
 	{
@@ -211,9 +231,9 @@ public:
 		const b2Manifold *m = contact->GetManifold();
 		const bsim_contact_def &law = w_->scene.contact;
 		/* vertex region of the edge: the tip (or the pivot end) */
-		contact->SetRestitution(
-		        (float)(m->type == b2Manifold::e_circles ? law.tip_restitution
-		                                                 : law.restitution));
+		contact->SetRestitution((float)(m->type == b2Manifold::e_circles
+		                                        ? law.tip_restitution
+		                                        : law.restitution));
 		b2WorldManifold wm;
 		contact->GetWorldManifold(&wm);
 		const double s = w_->s;
@@ -261,7 +281,6 @@ public:
 		double v_minus = normal_velocity(b, b->row_v, b->row_u, b->row_w);
 		double v_plus = normal_velocity(b, v_post, u_post, b->body->GetAngularVelocity());
 		double loss = -0.5 * p * (v_minus + v_plus);
-		if (getenv("B2DBG")) { b2Vec2 lv = b->body->GetLinearVelocity(); fprintf(stderr, "post P %.5g vm %.5g vp %.5g n %.4f %.4f q %.4f %.4f w %.5g -> %.5g beamlin %.3g %.3g toi %ld loss %.4g\n", p, v_minus, v_plus, b->n[0], b->n[1], b->q[0], b->q[1], b->row_w, (double)b->body->GetAngularVelocity(), lv.x/s, lv.y/s, w_->toi_events, loss); }
 		if (v_minus < -w_->scene.contact.rest_threshold) {
 			w_->energy.impact += loss;
 			w_->impacts += p > 0.0;
@@ -270,7 +289,7 @@ public:
 		}
 	}
 
-private:
+      private:
 	beam_rec *beam_of(b2Contact *c)
 	{
 		uintptr_t a = c->GetFixtureA()->GetBody()->GetUserData().pointer;
@@ -394,10 +413,9 @@ int contact_type_of(const bsim_world *w, const beam_rec &b)
 	const b2Fixture *fe = b.body->GetFixtureList();
 	const b2Fixture *fc = w->body->GetFixtureList();
 	b2Manifold m;
-	b2CollideEdgeAndCircle(&m, static_cast<const b2EdgeShape *>(fe->GetShape()),
-	                       b.body->GetTransform(),
-	                       static_cast<const b2CircleShape *>(fc->GetShape()),
-	                       w->body->GetTransform());
+	b2CollideEdgeAndCircle(
+	        &m, static_cast<const b2EdgeShape *>(fe->GetShape()), b.body->GetTransform(),
+	        static_cast<const b2CircleShape *>(fc->GetShape()), w->body->GetTransform());
 	if (m.pointCount == 0)
 		return BSIM_CONTACT_NONE;
 	return m.type == b2Manifold::e_circles ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
@@ -461,10 +479,11 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 		                                   std::fabs(scene->beams[i].pivot[1]) +
 		                                   scene->beams[i].length);
 	if (extent * s > 1e5)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "box2d: unit_scale=%g puts the scene %g units from the origin, "
-		                      "too far for float32; use a smaller unit_scale",
-		                      s, extent * s);
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "box2d: unit_scale=%g puts the scene %g units from the origin, "
+		        "too far for float32; use a smaller unit_scale",
+		        s, extent * s);
 
 	bsim_world *w = new (std::nothrow) bsim_world;
 	if (!w)

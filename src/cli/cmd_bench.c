@@ -1,5 +1,7 @@
 /* beamsim bench: the speed of a backend on the essay's experiments, on one
- * thread and on all of them, and the wall time of H1 + H2 together. */
+ * thread and on all of them, the wall time of H1 + H2 together, and the
+ * speed of a second backend on the same H1 trials (same scenes, same time
+ * step, same schedules) with the ratio of the two. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <getopt.h>
@@ -23,8 +25,10 @@ static const char bench_help[] =
         "Runs an experiment (default " BENCH_H1 ") on one thread and\n"
         "on all threads and reports wall time, steps/s, trials/s and steps/s per core;\n"
         "then runs " BENCH_H2 " on all threads and reports the\n"
-        "wall time of H1 + H2. The default experiment paths are relative to the\n"
-        "current directory (run it from the source tree).\n"
+        "wall time of H1 + H2. Then runs the experiment on one thread with a second\n"
+        "backend (--vs, default box2d) at the same time step and prints how many\n"
+        "times faster the first is, per step and per trial. The default experiment\n"
+        "paths are relative to the current directory (run it from the source tree).\n"
         "\n"
         "Options:\n"
         "  --backend B            physics backend (default thesis; see beamsim backends)\n"
@@ -32,10 +36,22 @@ static const char bench_help[] =
         "  --experiment FILE      benchmark this experiment instead of H1 (no H2 step)\n"
         "  --trials N             trials per group (default: the experiment's)\n"
         "  --no-h2                skip the H1 + H2 step\n"
+        "  --vs B                 the backend to compare speed with (default box2d;\n"
+        "                         none: skip)\n"
+        "  --vs-opt K=V           an option of the --vs backend, repeatable\n"
         "  --json FILE            also write the results as JSON to FILE\n"
         "  -h, --help             show this help\n";
 
-enum { OPT_BACKEND = 256, OPT_BACKEND_OPT, OPT_EXPERIMENT, OPT_TRIALS, OPT_NO_H2, OPT_JSON };
+enum {
+	OPT_BACKEND = 256,
+	OPT_BACKEND_OPT,
+	OPT_EXPERIMENT,
+	OPT_TRIALS,
+	OPT_NO_H2,
+	OPT_VS,
+	OPT_VS_OPT,
+	OPT_JSON
+};
 
 static const struct option bench_options[] = {
         {"backend", required_argument, NULL, OPT_BACKEND},
@@ -43,6 +59,8 @@ static const struct option bench_options[] = {
         {"experiment", required_argument, NULL, OPT_EXPERIMENT},
         {"trials", required_argument, NULL, OPT_TRIALS},
         {"no-h2", no_argument, NULL, OPT_NO_H2},
+        {"vs", required_argument, NULL, OPT_VS},
+        {"vs-opt", required_argument, NULL, OPT_VS_OPT},
         {"json", required_argument, NULL, OPT_JSON},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -55,6 +73,8 @@ typedef struct bench_args {
 	int custom; /* --experiment given */
 	long trials;
 	int h2;
+	const char *vs; /* NULL: none */
+	bsim_options vs_opts;
 	const char *json;
 } bench_args;
 
@@ -65,7 +85,7 @@ typedef struct bench_run {
 	double wall;
 } bench_run;
 
-#define BENCH_RUNS_MAX 3
+#define BENCH_RUNS_MAX 4
 
 /* Fills a; returns -1 to go on, else the exit status. */
 static int bench_parse(int argc, char **argv, bench_args *a)
@@ -95,6 +115,12 @@ static int bench_parse(int argc, char **argv, bench_args *a)
 			break;
 		case OPT_NO_H2:
 			a->h2 = 0;
+			break;
+		case OPT_VS:
+			a->vs = strcmp(optarg, "none") == 0 ? NULL : optarg;
+			break;
+		case OPT_VS_OPT:
+			rc = cli_options_add(&a->vs_opts, "bench", optarg);
 			break;
 		case OPT_JSON:
 			a->json = optarg;
@@ -141,10 +167,10 @@ static void bench_print_run(const bench_run *r)
 
 /* One sweep of e on the given threads, timed. label (the path as given)
  * outlives e. */
-static int bench_sweep(const bench_args *a, const bsim_backend *backend, const bsim_experiment *e,
-                       const char *label, int threads, bench_run *out)
+static int bench_sweep(const bsim_backend *backend, const bsim_options *opts,
+                       const bsim_experiment *e, const char *label, int threads, bench_run *out)
 {
-	bsim_sweep_config cfg = {.backend = backend, .opts = &a->opts, .threads = threads};
+	bsim_sweep_config cfg = {.backend = backend, .opts = opts, .threads = threads};
 	bsim_sweep_result r;
 	int rc = cli_sweep_run(e, &cfg, 1, &r);
 	if (rc != CLI_OK)
@@ -168,7 +194,7 @@ static int bench_experiment(const bench_args *a, const bsim_backend *backend,
 {
 	int rc = CLI_OK;
 	for (int i = 0; i < n_threads && rc == CLI_OK; i++) {
-		rc = bench_sweep(a, backend, e, path, threads[i], &runs[*n_runs]);
+		rc = bench_sweep(backend, &a->opts, e, path, threads[i], &runs[*n_runs]);
 		*n_runs += rc == CLI_OK;
 	}
 	return rc;
@@ -188,9 +214,17 @@ static void bench_json_run(FILE *f, const bench_run *r)
 	fputc('}', f);
 }
 
-/* h1_h2 < 0: no H1 + H2 step, written as null. */
-static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *backend, int threads,
-                             const bench_run *runs, int n_runs, double h1_h2)
+/* How many times faster per step the first run is than the second. */
+static double bench_speedup_per_step(const bench_run *mine, const bench_run *theirs)
+{
+	return cli_per_second(mine->steps, mine->wall) / cli_per_second(theirs->steps, theirs->wall);
+}
+
+/* h1_h2 < 0: no H1 + H2 step, written as null. vs: the second backend,
+ * whose run is the last of runs (NULL: none). */
+static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *backend,
+                             const bsim_backend *vs, int threads, const bench_run *runs,
+                             int n_runs, double h1_h2)
 {
 	fputs("{\"backend\": ", f);
 	bsim_json_string(f, a->backend);
@@ -206,23 +240,59 @@ static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *b
 		bsim_json_number(f, h1_h2);
 	else
 		fputs("null", f);
+	fputs(",\n \"vs\": ", f);
+	if (vs) {
+		const bench_run *mine = &runs[0], *theirs = &runs[n_runs - 1];
+		fputs("{\"backend\": ", f);
+		bsim_json_string(f, vs->name);
+		fputs(", \"options\": ", f);
+		bsim_output_backend_options(f, vs, &a->vs_opts);
+		fputs(", \"run\": ", f);
+		bench_json_run(f, theirs);
+		fputs(", \"speedup_per_step\": ", f);
+		bsim_json_number(f, bench_speedup_per_step(mine, theirs));
+		fputs(", \"speedup_per_trial\": ", f);
+		bsim_json_number(f, theirs->wall / mine->wall);
+		fputc('}', f);
+	} else {
+		fputs("null", f);
+	}
 	fputs("}\n", f);
 }
 
-static int bench_json(const bench_args *a, const bsim_backend *backend, int threads,
-                      const bench_run *runs, int n_runs, double h1_h2)
+static int bench_json(const bench_args *a, const bsim_backend *backend, const bsim_backend *vs,
+                      int threads, const bench_run *runs, int n_runs, double h1_h2)
 {
 	bsim_atomic_file o;
 	bsim_error err;
 	if (bsim_atomic_file_open(&o, a->json, &err) != BSIM_OK)
 		return cli_report(BSIM_EFAIL, &err);
-	bench_json_write(o.f, a, backend, threads, runs, n_runs, h1_h2);
+	bench_json_write(o.f, a, backend, vs, threads, runs, n_runs, h1_h2);
 	return cli_report(bsim_atomic_file_commit(&o, &err), &err);
 }
 
 /* Both experiments are loaded before anything runs, so a bad file fails
  * at once rather than after the first timing. */
-static int bench_main(const bench_args *a, const bsim_backend *backend)
+/* The second backend on the first run's trials: one thread each, so the
+ * ratio compares the solvers, not the scheduling. */
+static int bench_vs(const bench_args *a, const bsim_backend *vs, const bsim_experiment *h1,
+                    bench_run *runs, int *n_runs)
+{
+	printf("\nbackend %s, 1 thread\n\n", vs->name);
+	bench_print_header();
+	int rc = bench_sweep(vs, &a->vs_opts, h1, a->experiment, 1, &runs[*n_runs]);
+	if (rc != CLI_OK)
+		return rc;
+	const bench_run *mine = &runs[0], *theirs = &runs[*n_runs];
+	(*n_runs)++;
+	printf("\n%s is %.1f times faster than %s per step and %.1f times per trial "
+	       "(%s, same time step, 1 thread)\n",
+	       a->backend, bench_speedup_per_step(mine, theirs), vs->name, theirs->wall / mine->wall,
+	       a->experiment);
+	return CLI_OK;
+}
+
+static int bench_main(const bench_args *a, const bsim_backend *backend, const bsim_backend *vs)
 {
 	int all = omp_get_max_threads();
 	bsim_experiment h1, h2;
@@ -247,27 +317,31 @@ static int bench_main(const bench_args *a, const bsim_backend *backend)
 	rc = bench_experiment(a, backend, &h1, a->experiment, h1_threads, 2, runs, &n_runs);
 	if (rc == CLI_OK && a->h2)
 		rc = bench_experiment(a, backend, &h2, BENCH_H2, &all, 1, runs, &n_runs);
+	/* The all-threads H1 run above is the H1 half of H1 + H2. */
+	double h1_h2 = -1.0;
+	if (rc == CLI_OK && a->h2) {
+		h1_h2 = runs[1].wall + runs[2].wall;
+		printf("\nH1 + H2 on %d threads: %.3f s\n", all, h1_h2);
+	}
+	if (rc == CLI_OK && vs)
+		rc = bench_vs(a, vs, &h1, runs, &n_runs);
 	bsim_experiment_free(&h1);
 	if (a->h2)
 		bsim_experiment_free(&h2);
 	if (rc != CLI_OK)
 		return rc;
-
-	/* The all-threads H1 run above is the H1 half of H1 + H2. */
-	double h1_h2 = -1.0;
-	if (a->h2) {
-		h1_h2 = runs[1].wall + runs[2].wall;
-		printf("\nH1 + H2 on %d threads: %.3f s\n", all, h1_h2);
-	}
-	return a->json ? bench_json(a, backend, all, runs, n_runs, h1_h2) : CLI_OK;
+	return a->json ? bench_json(a, backend, vs, all, runs, n_runs, h1_h2) : CLI_OK;
 }
 
 int cmd_bench(int argc, char **argv)
 {
-	bench_args a = {.backend = "thesis", .experiment = BENCH_H1, .h2 = 1};
+	bench_args a = {.backend = "thesis", .experiment = BENCH_H1, .h2 = 1, .vs = "box2d"};
 	int rc = bench_parse(argc, argv, &a);
 	if (rc >= 0)
 		return rc;
 	const bsim_backend *backend = cli_backend(a.backend, &a.opts);
-	return backend ? bench_main(&a, backend) : CLI_USAGE;
+	const bsim_backend *vs = backend && a.vs ? cli_backend(a.vs, &a.vs_opts) : NULL;
+	if (!backend || (a.vs && !vs))
+		return CLI_USAGE;
+	return bench_main(&a, backend, vs);
 }
