@@ -2,14 +2,20 @@
  * from Box2D's rigid bodies, joints and contacts, behind the C interface of
  * include/beamsim/backend.h. The only C++ in the project.
  *
- * Units. Box2D works in float32 and prefers lengths of 0.1-10 units; our
- * body is 10 m and the beams 25 m, so every quantity is scaled by s
- * (knob unit_scale, default 0.1) with mass and time unchanged:
+ * Units. Box2D works in float32 and prefers moving bodies of 0.1-10 units;
+ * our body is 10 m and the beams 25 m. Every quantity is scaled by s (knob
+ * unit_scale) with mass and time unchanged:
  *   length, velocity, force, impulse  x s
  *   torque, inertia, stiffness k, damping d, energy  x s^2
  *   angle, angular velocity, time  x 1
+ * The default s = 1 keeps the body at 10 units, the top of Box2D's range,
+ * because Box2D's contacts start at a gap of b2_linearSlop = 0.005 units:
+ * 0.005 m at s = 1, but 0.05 m at s = 0.1, where the body meets the beams
+ * early enough to bias traversal (H2 compared with the thesis backend,
+ * 16,200 pairs: traversed on thesis only / box2d only 197 / 101 at
+ * s = 0.1, 54 / 48 at s = 1; README "Comparing the backends").
  * The per-step limits b2_maxTranslation = 2 units and b2_maxRotation = pi/2
- * are not reached: at s = 0.1, h = 4 ms they clamp only above 5000 m/s and
+ * are not reached: at s = 1, h = 4 ms they clamp only above 500 m/s and
  * 390 rad/s (the gate sees < 20 m/s and < 10 rad/s).
  *
  * Bodies.
@@ -104,14 +110,14 @@ namespace
  *   energy and is stable at any step, but damps numerically (backward
  *   Euler, extra damping ratio ~ omega_n h / 2: 0.009 at the essay's beam,
  *   beside its physical 0.274).
- *   conservative gate (e = 1, d = 0, no force): E drifts +7.5% (torque:
+ *   conservative gate (e = 1, d = 0, no force): E drifts +1.5% (torque:
  *   the explicit spring torque acts before each impact's velocity jump
- *   and the beam turns after it) and -6.2% (weld) over 12 s.
+ *   and the beam turns after it) and -7.0% (weld) over 12 s.
  *   driven damped noisy gate (F = 7 N, Rm = 20 N), worst of 10 trials,
- *   |ledger residual| / energy throughput: torque 8.9e-2, weld 3.7e-2
+ *   |ledger residual| / energy throughput: torque 6.9e-2, weld 3.5e-2
  *   (torque with substeps = 4: 2.7e-2).
  * weld is the default: always stable (configs/hard/ has stiff beams), its
- * errors only ever remove energy, and its ledger closes 2.4 times better;
+ * errors only ever remove energy, and its ledger closes 2 times better;
  * it costs a 1.5 times larger free-vibration error at the essay's step.
  * torque is the more accurate choice for soft beams and smooth motion. */
 const bsim_knob box2d_knobs[] = {
@@ -124,8 +130,8 @@ const bsim_knob box2d_knobs[] = {
         {"spring", BSIM_KNOB_CHOICE, "weld", "torque|weld",
          "beam spring + damper: explicit torque on a revolute pin (symplectic, stable for "
          "omega_n h < 2), or a soft b2WeldJoint (implicit, always stable, dissipative)"},
-        {"unit_scale", BSIM_KNOB_DOUBLE, "0.1", NULL,
-         "Box2D units per metre (Box2D prefers 0.1-10 units; the body is 10 m), > 0"},
+        {"unit_scale", BSIM_KNOB_DOUBLE, "1", NULL,
+         "Box2D units per metre, > 0 (contacts start at a gap of 0.005 m / unit_scale)"},
 };
 enum { KNOB_VEL_IT, KNOB_POS_IT, KNOB_SUBSTEPS, KNOB_SPRING, KNOB_UNIT_SCALE };
 constexpr int N_KNOBS = (int)(sizeof box2d_knobs / sizeof box2d_knobs[0]);
@@ -194,7 +200,7 @@ struct bsim_world {
 	/* knobs */
 	int velocity_iterations = 8, position_iterations = 3, substeps = 1;
 	int spring = SPRING_WELD;
-	double s = 0.1; /* Box2D units per metre */
+	double s = 1.0; /* Box2D units per metre */
 	/* Box2D */
 	b2World *world = nullptr;
 	b2Body *body = nullptr;
