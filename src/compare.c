@@ -14,8 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const event_names[BSIM_N_EVENTS] = {"traversed", "left", "right",
-                                                       "side_exit", "stuck"};
+static const char *const event_names[BSIM_N_EVENTS] = {"traversed", "left", "right", "side_exit",
+                                                       "stuck"};
 
 const char *bsim_event_name(bsim_event ev)
 {
@@ -67,8 +67,8 @@ int bsim_trial_identical(const bsim_trial_result *a, const bsim_trial_result *b)
 	       a->max_theta[0] == b->max_theta[0] && a->max_theta[1] == b->max_theta[1];
 }
 
-static void event_test(const bsim_trial_result *a, const bsim_trial_result *b, int n,
-                       bsim_event ev, bsim_event_test *t)
+static void event_test(const bsim_trial_result *a, const bsim_trial_result *b, int n, bsim_event ev,
+                       bsim_event_test *t)
 {
 	memset(t, 0, sizeof *t);
 	for (int i = 0; i < n; i++) {
@@ -140,9 +140,10 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 {
 	memset(out, 0, sizeof *out);
 	if (a->n_groups != b->n_groups || a->trials != b->trials)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "cannot pair %d groups x %d trials with %d groups x %d trials",
-		                      a->n_groups, a->trials, b->n_groups, b->trials);
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "cannot pair %d groups x %d trials with %d groups x %d trials", a->n_groups,
+		        a->trials, b->n_groups, b->trials);
 	int G = a->n_groups, n = a->trials;
 	long total = (long)G * n;
 	out->n_groups = G;

@@ -143,7 +143,8 @@ static void md_table(FILE *f, const bsim_report *r)
 		for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
 			fprintf(f, " %s |", e->axes[a].values[idx[a]]);
 		fprintf(f,
-		        " %.2f [%.2f, %.2f] | %.2f [%.2f, %.2f] | %+.2f [%+.2f, %+.2f] | %d | %.2g, %s "
+		        " %.2f [%.2f, %.2f] | %.2f [%.2f, %.2f] | %+.2f [%+.2f, %+.2f] | %d | "
+		        "%.2g, %s "
 		        "|",
 		        t->p_a, t->ci_a[0], t->ci_a[1], t->p_b, t->ci_b[0], t->ci_b[1], t->diff,
 		        t->diff_ci[0], t->diff_ci[1], cg->discordant, cg->ev[k].p_holm,
@@ -165,7 +166,9 @@ static void md_events(FILE *f, const bsim_report *r, const bsim_compare_group *c
 	        r->side[0].label, r->side[1].label, r->side[0].label, r->side[1].label);
 	for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
 		const bsim_event_test *t = &cg->ev[ev];
-		fprintf(f, "| %s | %.2f | %.2f | %+.2f [%+.2f, %+.2f] | %d | %d | %.3g | %.3g | %s |\n",
+		fprintf(f,
+		        "| %s | %.2f | %.2f | %+.2f [%+.2f, %+.2f] | %d | %d | %.3g | %.3g | %s "
+		        "|\n",
 		        bsim_event_name((bsim_event)ev), t->p_a, t->p_b, t->diff, t->diff_ci[0],
 		        t->diff_ci[1], t->pairs.b, t->pairs.c, t->p_value, t->p_holm,
 		        t->beyond ? "yes" : "no");
@@ -356,7 +359,8 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	const bsim_comparison *c = r->cmp;
 	fputs("{\n  \"experiment\": ", f);
 	bsim_json_string(f, r->e->path);
-	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d,\n  \"a\": ", r->e->seed,
+	fprintf(f,
+	        ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d,\n  \"a\": ", r->e->seed,
 	        c->trials);
 	json_side(f, &r->side[0]);
 	fputs(",\n  \"b\": ", f);
@@ -369,8 +373,9 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	        c->rule.exact ? "true" : "false");
 	fprintf(f, ",\n  \"groups_disagreeing\": %d,\n  \"separation\": ", c->n_disagree);
 	if (r->t_separate) {
-		fprintf(f, "{\"distance\": \"0.01 body radius\", \"separated\": %d, \"pairs\": %ld, "
-		           "\"quantiles_10_50_90_s\": ",
+		fprintf(f,
+		        "{\"distance\": \"0.01 body radius\", \"separated\": %d, \"pairs\": %ld, "
+		        "\"quantiles_10_50_90_s\": ",
 		        c->separated, (long)c->n_groups * c->trials);
 		json_quantiles(f, c->t_sep);
 		fputc('}', f);
@@ -409,7 +414,8 @@ void bsim_report_pairs_csv(FILE *f, const bsim_report *r)
 	fputs("group,trial,outcome_a,type_a,outcome_b,type_b,t_separate\n", f);
 	for (int g = 0; g < c->n_groups; g++)
 		for (int t = 0; t < c->trials; t++) {
-			const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
+			const bsim_trial_result *a = trial_of(r, 0, g, t),
+			                        *b = trial_of(r, 1, g, t);
 			fprintf(f, "%d,%d,%s,%s,%s,%s,", g, t, bsim_outcome_name(a->outcome),
 			        bsim_type_name(a->type), bsim_outcome_name(b->outcome),
 			        bsim_type_name(b->type));

@@ -153,8 +153,8 @@ int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsi
 }
 
 /* Reading: every field named in the message as it appears in run.json. */
-static int need_text(const ydoc *d, struct fy_node *root, const char *field, char *buf,
-                     size_t size, bsim_error *err)
+static int need_text(const ydoc *d, struct fy_node *root, const char *field, char *buf, size_t size,
+                     bsim_error *err)
 {
 	struct fy_node *n = ydoc_lookup(root, field);
 	size_t len;
@@ -184,7 +184,8 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 		return BSIM_EINPUT;
 	snprintf(field, sizeof field, "backends.%d.options", i);
 	struct fy_node *opts = ydoc_lookup(root, field);
-	if (!opts || !fy_node_is_mapping(opts) || fy_node_mapping_item_count(opts) > BSIM_OPTIONS_MAX)
+	if (!opts || !fy_node_is_mapping(opts) ||
+	    fy_node_mapping_item_count(opts) > BSIM_OPTIONS_MAX)
 		return ydoc_expected(d, opts, NULL, field, "a mapping of knobs", err);
 	void *it = NULL;
 	struct fy_node_pair *p;

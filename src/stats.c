@@ -96,8 +96,10 @@ void bsim_paired_diff_ci(const bsim_pairs *t, double z, double *lo, double *hi)
 	double d = p1 - p2;
 	double den = (double)(t->a + t->b) * (t->c + t->d) * (t->a + t->c) * (t->b + t->d);
 	double phi = den > 0.0 ? ((double)t->a * t->d - (double)t->b * t->c) / sqrt(den) : 0.0;
-	double dl = (p1 - l1) * (p1 - l1) - 2.0 * phi * (p1 - l1) * (u2 - p2) + (u2 - p2) * (u2 - p2);
-	double du = (u1 - p1) * (u1 - p1) - 2.0 * phi * (u1 - p1) * (p2 - l2) + (p2 - l2) * (p2 - l2);
+	double dl =
+	        (p1 - l1) * (p1 - l1) - 2.0 * phi * (p1 - l1) * (u2 - p2) + (u2 - p2) * (u2 - p2);
+	double du =
+	        (u1 - p1) * (u1 - p1) - 2.0 * phi * (u1 - p1) * (p2 - l2) + (p2 - l2) * (p2 - l2);
 	*lo = fmax(-1.0, d - sqrt(fmax(dl, 0.0)));
 	*hi = fmin(1.0, d + sqrt(fmax(du, 0.0)));
 }

@@ -209,7 +209,8 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 			free(*t_separate);
 			*t_separate = NULL;
 			bsim_sweep_result_free(out);
-			return bsim_error_set(err, BSIM_EFAIL, "out of memory for %ld pairs", total);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory for %ld pairs",
+			                      total);
 		}
 	}
 	bsim_scene *scenes;

@@ -67,8 +67,8 @@ static int run_traced(trial_pair *p, int k, const bsim_scene *scene, const bsim_
 
 int trial_pair_run(trial_pair *p, const bsim_scene *scene, const bsim_backend *a,
                    const bsim_options *opts_a, const bsim_backend *b, const bsim_options *opts_b,
-                   uint64_t seed, double sep_distance, bsim_trial_result *ra,
-                   bsim_trial_result *rb, double *t_separate, bsim_error *err)
+                   uint64_t seed, double sep_distance, bsim_trial_result *ra, bsim_trial_result *rb,
+                   double *t_separate, bsim_error *err)
 {
 	int rc = run_traced(p, 0, scene, a, opts_a, seed, ra, err);
 	if (rc == BSIM_OK)

@@ -29,7 +29,7 @@ void trial_pair_free(trial_pair *p);
  * compared while both runs go on; -1 if they never are. */
 int trial_pair_run(trial_pair *p, const bsim_scene *scene, const bsim_backend *a,
                    const bsim_options *opts_a, const bsim_backend *b, const bsim_options *opts_b,
-                   uint64_t seed, double sep_distance, bsim_trial_result *ra,
-                   bsim_trial_result *rb, double *t_separate, bsim_error *err);
+                   uint64_t seed, double sep_distance, bsim_trial_result *ra, bsim_trial_result *rb,
+                   double *t_separate, bsim_error *err);
 
 #endif

@@ -26,7 +26,8 @@ static int parse_row(char *line, const bsim_sweep_result *r, bsim_trial_result *
 	static const char *const types[] = {"none", "left", "right"};
 	char *f[11], *save = NULL;
 	int n = 0;
-	for (char *tok = strtok_r(line, ",", &save); tok && n < 11; tok = strtok_r(NULL, ",", &save))
+	for (char *tok = strtok_r(line, ",", &save); tok && n < 11;
+	     tok = strtok_r(NULL, ",", &save))
 		f[n++] = tok;
 	if (n != 11 || strtok_r(NULL, ",", &save))
 		return -1;
@@ -48,8 +49,8 @@ static int parse_row(char *line, const bsim_sweep_result *r, bsim_trial_result *
 	x->steps = (int)strtol(f[4], &end, 10);
 	if (*end)
 		return -1;
-	double *v[6] = {&x->t_end, &x->x_end, &x->y_end, &x->vx_end, &x->max_theta[0],
-	                &x->max_theta[1]};
+	double *v[6] = {&x->t_end,  &x->x_end,        &x->y_end,
+	                &x->vx_end, &x->max_theta[0], &x->max_theta[1]};
 	for (int i = 0; i < 6; i++) {
 		*v[i] = strtod(f[5 + i], &end);
 		if (*end)
@@ -84,8 +85,8 @@ int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_swe
 		line[strcspn(line, "\r\n")] = '\0';
 		if (lineno == 1) {
 			if (strcmp(line, header) != 0)
-				rc = bsim_error_set(err, BSIM_EINPUT, "%s:1: expected the header %s",
-				                    path, header);
+				rc = bsim_error_set(err, BSIM_EINPUT,
+				                    "%s:1: expected the header %s", path, header);
 			continue;
 		}
 		if (parse_row(line, r, r->trials_out) != 0)

@@ -31,4 +31,32 @@ static inline void scene_one_beam(bsim_scene *s)
 	s->body.start[1] = -100.0;
 }
 
+/* The gate with elastic impacts (tangent and tip), springs but no dampers,
+ * no effects, and the body launched at (3, 0) with (0.4, 12) m/s: energy
+ * is conserved exactly by the model (MODEL.md oracle 3). */
+static inline void scene_gate_conservative(bsim_scene *s)
+{
+	scene_gate_quiet(s);
+	s->contact.restitution = 1.0;
+	s->contact.tip_restitution = 1.0;
+	s->beams[0].damping = s->beams[1].damping = 0.0;
+	s->body.start[0] = 3.0;
+	s->body.velocity[0] = 0.4;
+	s->body.velocity[1] = 12.0;
+}
+
+/* The mirror image of a two-beam scene: x -> -x, so the beams change
+ * places and sides (MODEL.md oracle 4). m is a new scene. */
+static inline void scene_mirror(const bsim_scene *s, bsim_scene *m)
+{
+	bsim_scene_copy(m, s);
+	m->body.start[0] = -s->body.start[0];
+	m->body.velocity[0] = -s->body.velocity[0];
+	for (int i = 0; i < 2; i++) {
+		m->beams[i] = s->beams[1 - i];
+		m->beams[i].pivot[0] = -s->beams[1 - i].pivot[0];
+		m->beams[i].rest_angle_deg = 180.0 - s->beams[1 - i].rest_angle_deg;
+	}
+}
+
 #endif

@@ -51,8 +51,8 @@ static int setup(void **state)
 	         bsim_test_src("configs/thesis/gate.yaml"));
 	snprintf(experiment, sizeof experiment, "%s", bsim_test_write(dir, "small.yaml", text));
 	snprintf(cmp_dir, sizeof cmp_dir, "%s", out_dir("cmp"));
-	const char *argv[] = {"compare", experiment, "--threads", "2", "--quiet",
-	                      "--out",   cmp_dir,    NULL};
+	const char *argv[] = {"compare", experiment, "--threads", "2",
+	                      "--quiet", "--out",    cmp_dir,     NULL};
 	int status = bsim_test_cli(argv, NULL, NULL);
 	return status == 0 || status == 3 ? 0 : -1;
 }
@@ -64,8 +64,8 @@ static void test_halves_are_sweeps(void **state)
 	const char *backends[] = {"thesis", "box2d"};
 	for (int i = 0; i < 2; i++) {
 		const char *dir = out_dir(backends[i]);
-		const char *argv[] = {"sweep",       experiment, "--backend", backends[i],
-		                      "--quiet",     "--out",    dir,         NULL};
+		const char *argv[] = {"sweep",   experiment, "--backend", backends[i],
+		                      "--quiet", "--out",    dir,         NULL};
 		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 		char sub[1300];
 		snprintf(sub, sizeof sub, "%s/%s", cmp_dir, backends[i]);
@@ -81,7 +81,8 @@ static void test_status_and_threads(void **state)
 {
 	(void)state;
 	const char *dir = out_dir("cmp1");
-	const char *argv[] = {"compare", experiment, "--threads", "1", "--quiet", "--out", dir, NULL};
+	const char *argv[] = {"compare", experiment, "--threads", "1",
+	                      "--quiet", "--out",    dir,         NULL};
 	int status = bsim_test_cli(argv, NULL, NULL);
 	char *json = read_in(dir, "report.json");
 	int disagreeing = -1;
@@ -141,7 +142,8 @@ static int check_replays(const char *json, int first_side)
 			char *outcome = json_text(&from, side ? "\"b\": {\"outcome\": \""
 			                                      : "\"a\": {\"outcome\": \"");
 			char *type = json_text(&from, "\"type\": \"");
-			char *line = json_text(&from, side ? "\"replay_b\": \"" : "\"replay_a\": \"");
+			char *line =
+			        json_text(&from, side ? "\"replay_b\": \"" : "\"replay_a\": \"");
 			assert_non_null(line);
 			const char *argv[64];
 			split(line, argv, 64);
@@ -248,8 +250,8 @@ static void test_regress_exact(void **state)
 	bsim_test_write(base, "trials.csv", csv);
 	const char *loose[] = {"regress", base, "--quiet", "--out", out_dir("loose"), NULL};
 	assert_int_equal(bsim_test_cli(loose, NULL, NULL), 0);
-	const char *exact[] = {"regress", base, "--quiet", "--exact", "--out", out_dir("tight"),
-	                       NULL};
+	const char *exact[] = {"regress",        base, "--quiet", "--exact", "--out",
+	                       out_dir("tight"), NULL};
 	assert_int_equal(bsim_test_cli(exact, NULL, NULL), 3);
 	free(csv);
 }
@@ -258,17 +260,17 @@ static void test_bad_usage(void **state)
 {
 	(void)state;
 	char *err = NULL;
-	const char *same[] = {"compare", experiment, "--backends", "thesis,thesis",
+	const char *same[] = {"compare", experiment,      "--backends", "thesis,thesis",
 	                      "--out",   out_dir("bad1"), NULL};
 	assert_int_equal(bsim_test_cli(same, NULL, &err), 2);
 	assert_non_null(strstr(err, "two different backends"));
 	free(err);
-	const char *knob[] = {"compare",     experiment, "--backend-opt", "box2d:nope=1",
-	                      "--out",       out_dir("bad2"), NULL};
+	const char *knob[] = {"compare",       experiment, "--backend-opt", "box2d:nope=1", "--out",
+	                      out_dir("bad2"), NULL};
 	assert_int_equal(bsim_test_cli(knob, NULL, &err), 2);
 	assert_non_null(strstr(err, "nope"));
 	free(err);
-	const char *who[] = {"compare", experiment, "--backend-opt", "ode:x=1", "--out",
+	const char *who[] = {"compare",       experiment, "--backend-opt", "ode:x=1", "--out",
 	                     out_dir("bad3"), NULL};
 	assert_int_equal(bsim_test_cli(who, NULL, &err), 2);
 	assert_non_null(strstr(err, "B:KEY=VALUE"));

@@ -32,13 +32,7 @@ static void test_conservative_scene(void **state)
 {
 	(void)state;
 	bsim_scene s;
-	scene_gate_quiet(&s);
-	s.contact.restitution = 1.0;
-	s.contact.tip_restitution = 1.0;
-	s.beams[0].damping = s.beams[1].damping = 0.0;
-	s.body.start[0] = 3.0;
-	s.body.velocity[0] = 0.4;
-	s.body.velocity[1] = 12.0;
+	scene_gate_conservative(&s);
 	s.max_steps = 3000;
 	bsim_trial_result out = run(&s, 1);
 	const bsim_ledger *l = &out.ledger;

@@ -13,19 +13,6 @@
 #include "beamsim/trial.h"
 #include "scenes.h"
 
-/* The mirror image: x -> -x, so the beams change places and sides. */
-static void scene_mirror(const bsim_scene *s, bsim_scene *m)
-{
-	bsim_scene_copy(m, s);
-	m->body.start[0] = -s->body.start[0];
-	m->body.velocity[0] = -s->body.velocity[0];
-	for (int i = 0; i < 2; i++) {
-		m->beams[i] = s->beams[1 - i];
-		m->beams[i].pivot[0] = -s->beams[1 - i].pivot[0];
-		m->beams[i].rest_angle_deg = 180.0 - s->beams[1 - i].rest_angle_deg;
-	}
-}
-
 static void asymmetric_gate(bsim_scene *s, double f_prop, double rm)
 {
 	bsim_scene_init_gate(s, f_prop, rm);

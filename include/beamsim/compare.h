@@ -41,7 +41,7 @@ typedef struct bsim_compare_rule {
 	int exact;
 } bsim_compare_rule;
 
-#define BSIM_COMPARE_ALPHA 0.05
+#define BSIM_COMPARE_ALPHA  0.05
 #define BSIM_COMPARE_MARGIN 0.05
 
 typedef struct bsim_event_test {
@@ -64,11 +64,11 @@ const char *bsim_verdict_name(bsim_verdict v);
 
 typedef struct bsim_compare_group {
 	bsim_event_test ev[BSIM_N_EVENTS];
-	int discordant;   /* pairs with a different outcome or type */
-	int changed;      /* pairs not identical in any trials.csv field */
-	int separated;    /* pairs whose trajectories separated */
-	double t_sep[3];  /* 10%, 50%, 90% quantiles of the separation time
-	                   * over separated pairs, s; -1 if none */
+	int discordant;  /* pairs with a different outcome or type */
+	int changed;     /* pairs not identical in any trials.csv field */
+	int separated;   /* pairs whose trajectories separated */
+	double t_sep[3]; /* 10%, 50%, 90% quantiles of the separation time
+	                  * over separated pairs, s; -1 if none */
 	bsim_verdict verdict;
 } bsim_compare_group;
 

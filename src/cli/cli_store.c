@@ -23,8 +23,8 @@ int cli_path(char *buf, size_t size, const char *dir, const char *name)
 	return CLI_OK;
 }
 
-static void record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e,
-                        int n, const bsim_backend *const *b, const bsim_options *const *opts,
+static void record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e, int n,
+                        const bsim_backend *const *b, const bsim_options *const *opts,
                         const bsim_compare_rule *rule)
 {
 	memset(rec, 0, sizeof *rec);
@@ -108,11 +108,12 @@ static char *compare_title(const cli_compare_job *job)
 	if (!f)
 		return NULL;
 	fprintf(f, "# beamsim compare: %s vs %s\n\n", job->backend[0]->name, job->backend[1]->name);
-	fprintf(f, "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; both backends "
-	           "ran every trial with the same random-force schedule, so trial t of group g is "
-	           "a pair.\n\n",
-	        job->e->path, job->e->scene_path, (unsigned long long)job->e->seed, job->e->n_groups,
-	        job->e->trials);
+	fprintf(f,
+	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; both backends "
+	        "ran every trial with the same random-force schedule, so trial t of group g is "
+	        "a pair.\n\n",
+	        job->e->path, job->e->scene_path, (unsigned long long)job->e->seed,
+	        job->e->n_groups, job->e->trials);
 	for (int i = 0; i < 2; i++) {
 		fprintf(f, "- %s options: ", job->backend[i]->name);
 		bsim_output_backend_options(f, job->backend[i], job->opts[i]);
@@ -136,8 +137,8 @@ static int compare_write(const cli_compare_job *job, const bsim_sweep_result r[2
 	};
 	for (int i = 0; i < 2; i++) {
 		char dir[1100];
-		rep.side[i] = (bsim_report_side){job->backend[i]->name, job->backend[i], job->opts[i],
-		                                 &r[i]};
+		rep.side[i] = (bsim_report_side){job->backend[i]->name, job->backend[i],
+		                                 job->opts[i], &r[i]};
 		if (cli_path(dir, sizeof dir, job->out, job->backend[i]->name) ||
 		    sweep_files(dir, job->e, job->backend[i], job->opts[i], &r[i]))
 			return CLI_FAIL;

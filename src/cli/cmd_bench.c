@@ -217,14 +217,15 @@ static void bench_json_run(FILE *f, const bench_run *r)
 /* How many times faster per step the first run is than the second. */
 static double bench_speedup_per_step(const bench_run *mine, const bench_run *theirs)
 {
-	return cli_per_second(mine->steps, mine->wall) / cli_per_second(theirs->steps, theirs->wall);
+	return cli_per_second(mine->steps, mine->wall) /
+	       cli_per_second(theirs->steps, theirs->wall);
 }
 
 /* h1_h2 < 0: no H1 + H2 step, written as null. vs: the second backend,
  * whose run is the last of runs (NULL: none). */
 static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *backend,
-                             const bsim_backend *vs, int threads, const bench_run *runs,
-                             int n_runs, double h1_h2)
+                             const bsim_backend *vs, int threads, const bench_run *runs, int n_runs,
+                             double h1_h2)
 {
 	fputs("{\"backend\": ", f);
 	bsim_json_string(f, a->backend);
@@ -287,8 +288,8 @@ static int bench_vs(const bench_args *a, const bsim_backend *vs, const bsim_expe
 	(*n_runs)++;
 	printf("\n%s is %.1f times faster than %s per step and %.1f times per trial "
 	       "(%s, same time step, 1 thread)\n",
-	       a->backend, bench_speedup_per_step(mine, theirs), vs->name, theirs->wall / mine->wall,
-	       a->experiment);
+	       a->backend, bench_speedup_per_step(mine, theirs), vs->name,
+	       theirs->wall / mine->wall, a->experiment);
 	return CLI_OK;
 }
 

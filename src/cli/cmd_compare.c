@@ -112,7 +112,8 @@ static int parse_unit(const char *opt, const char *text, double lo, double hi, i
 {
 	char *end;
 	double x = strtod(text, &end);
-	if (end == text || *end || !(open_lo ? x > lo : x >= lo) || !(x < hi || (!open_lo && x <= hi)))
+	if (end == text || *end || !(open_lo ? x > lo : x >= lo) ||
+	    !(x < hi || (!open_lo && x <= hi)))
 		return cli_usage("compare", "%s %s: expected a number in %s%g, %g%s", opt, text,
 		                 open_lo ? "(" : "[", lo, hi, open_lo ? ")" : "]");
 	*out = x;
@@ -139,16 +140,19 @@ static int compare_option(compare_args *a, int c)
 	case OPT_BACKEND_OPT:
 		if (a->n_pending == (int)(sizeof a->pending / sizeof a->pending[0]) ||
 		    strlen(optarg) >= sizeof a->pending[0])
-			return cli_usage("compare", "--backend-opt %s: too many or too long", optarg);
+			return cli_usage("compare", "--backend-opt %s: too many or too long",
+			                 optarg);
 		snprintf(a->pending[a->n_pending++], sizeof a->pending[0], "%s", optarg);
 		return CLI_OK;
 	case OPT_THREADS:
 		if (cli_parse_long(optarg, 1, 4096, &a->threads) != 0)
-			return cli_usage("compare", "--threads %s: expected an integer >= 1", optarg);
+			return cli_usage("compare", "--threads %s: expected an integer >= 1",
+			                 optarg);
 		return CLI_OK;
 	case OPT_TRIALS:
 		if (cli_parse_long(optarg, 1, INT32_MAX, &a->trials) != 0)
-			return cli_usage("compare", "--trials %s: expected an integer >= 1", optarg);
+			return cli_usage("compare", "--trials %s: expected an integer >= 1",
+			                 optarg);
 		return CLI_OK;
 	case OPT_SEED:
 		a->has_seed = 1;
@@ -222,8 +226,8 @@ static void compare_summary(const compare_args *a, const bsim_experiment *e,
 	for (int g = 0; g < cmp->n_groups; g++)
 		if (cmp->groups[g].verdict == BSIM_VERDICT_DISAGREE) {
 			const bsim_event_test *t = &cmp->groups[g].ev[BSIM_EVENT_TRAVERSED];
-			printf("  group %d: p_traverse %.2f vs %.2f, %d discordant pairs\n", g, t->p_a,
-			       t->p_b, cmp->groups[g].discordant);
+			printf("  group %d: p_traverse %.2f vs %.2f, %d discordant pairs\n", g,
+			       t->p_a, t->p_b, cmp->groups[g].discordant);
 		}
 	printf("wrote %s/report.md, %s/report.json, %s/pairs.csv and each backend's sweep in "
 	       "%s/%s and %s/%s\n",

@@ -126,8 +126,8 @@ static int regress_parse(int argc, char **argv, regress_args *a)
 	struct stat sb, so;
 	if (stat(a->baseline, &sb) == 0 && stat(a->out, &so) == 0 && sb.st_ino == so.st_ino &&
 	    sb.st_dev == so.st_dev)
-		return cli_usage("regress", "--out %s: expected a directory other than the baseline",
-		                 a->out);
+		return cli_usage("regress",
+		                 "--out %s: expected a directory other than the baseline", a->out);
 	return -1;
 }
 
@@ -233,13 +233,13 @@ typedef struct regress_part {
 	bsim_report rep;
 } regress_part;
 
-static void regress_md(FILE *f, const regress_args *a, const regress_run *run,
-                       regress_part *parts)
+static void regress_md(FILE *f, const regress_args *a, const regress_run *run, regress_part *parts)
 {
-	fprintf(f, "# beamsim regress\n\nBaseline `%s` (%s by beamsim %s), rerun `%s` by beamsim "
-	           "%s: experiment `%s`, seed %llu, %d groups x %d trials.\n\n",
-	        a->baseline, run->rec.command, run->rec.version, a->out, BSIM_VERSION,
-	        run->e.path, (unsigned long long)run->e.seed, run->e.n_groups, run->e.trials);
+	fprintf(f,
+	        "# beamsim regress\n\nBaseline `%s` (%s by beamsim %s), rerun `%s` by beamsim "
+	        "%s: experiment `%s`, seed %llu, %d groups x %d trials.\n\n",
+	        a->baseline, run->rec.command, run->rec.version, a->out, BSIM_VERSION, run->e.path,
+	        (unsigned long long)run->e.seed, run->e.n_groups, run->e.trials);
 	for (int i = 0; i < run->rec.n_backends; i++) {
 		int changed = 0;
 		for (int g = 0; g < parts[i].cmp.n_groups; g++)
