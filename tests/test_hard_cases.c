@@ -22,6 +22,8 @@
 #include "support.h"
 
 static const char *const BACKENDS[2] = {"thesis", "box2d"};
+/* Box2D pivot drift in case 3: measured 9.7e-5 m (1:1000), bound 1e-3 m. */
+#define PIVOT_BOUND_BOX2D 1e-3
 
 static const bsim_backend *backend(const char *name)
 {
@@ -228,11 +230,12 @@ static void test_double_impact(void **state)
 
 typedef struct {
 	const bsim_scene *s;
-	double pen_max; /* max (R - distance), m */
-	int tunnels;    /* side flips while inside the beam's span */
-	int nonfinite;  /* steps with a non-finite value */
-	double side[8]; /* last side per beam (0: unknown) */
-	double e_max;   /* max energy seen, J */
+	double pen_max;   /* max (R - distance), m */
+	int tunnels;      /* side flips while inside the beam's span */
+	int nonfinite;    /* steps with a non-finite value */
+	double side[8];   /* last side per beam (0: unknown) */
+	double e_max;     /* max energy seen, J */
+	double pivot_max; /* max distance of a pinned point from its pivot, m */
 } watch;
 
 static void watch_fn(void *user, long step, const bsim_state *st)
@@ -248,6 +251,7 @@ static void watch_fn(void *user, long step, const bsim_state *st)
 		return;
 	}
 	wt->e_max = fmax(wt->e_max, energy_of(wt->s, st));
+	wt->pivot_max = fmax(wt->pivot_max, st->pivot_drift);
 	for (int i = 0; i < st->n_beams && i < 8; i++) {
 		const bsim_beam_def *d = &wt->s->beams[i];
 		double s, side;
@@ -305,15 +309,15 @@ static void test_mass_ratio(void **state)
 				double input = l->w_prop + l->w_rand;
 				double excess = l->e_end - (l->e_start + input);
 				double scale = fabs(l->w_prop) + fabs(l->w_rand) + l->e_start;
-				print_message("mass ratio %s 1:%g wn*h %.2f: rc %d, %s after %d "
-				              "steps, max "
-				              "|theta| %.3g, penetration %.3e m, E_end - (E_0 + W) "
-				              "= %.3e J "
-				              "(W throughput %.3g J)\n",
-				              BACKENDS[k], beam_mass[m], wnh[j], rc,
-				              bsim_outcome_name(res.outcome), res.steps,
-				              fmax(fabs(res.max_theta[0]), fabs(res.max_theta[1])),
-				              wt.pen_max, excess, scale);
+				print_message(
+				        "mass ratio %s 1:%g wn*h %.2f: rc %d, %s after %d "
+				        "steps, max "
+				        "|theta| %.3g, penetration %.3e m, pivot drift %.3e m, "
+				        "E_end - (E_0 + W) = %.3e J (W throughput %.3g J)\n",
+				        BACKENDS[k], beam_mass[m], wnh[j], rc,
+				        bsim_outcome_name(res.outcome), res.steps,
+				        fmax(fabs(res.max_theta[0]), fabs(res.max_theta[1])),
+				        wt.pen_max, wt.pivot_max, excess, scale);
 				assert_int_equal(rc, BSIM_OK);
 				assert_int_equal(wt.nonfinite, 0);
 				assert_int_equal(wt.tunnels, 0);
@@ -321,6 +325,9 @@ static void test_mass_ratio(void **state)
 				 * rests contacts at b2_linearSlop = 5 mm and lets a hard
 				 * impact sink in further within a step */
 				assert_true(wt.pen_max <= (k == 0 ? 1e-5 : 0.1));
+				/* the pin: exact in thesis; Box2D's joint rows converge
+				 * iteratively, so a pivot can be pushed off it */
+				assert_true(wt.pivot_max <= (k == 0 ? 0.0 : PIVOT_BOUND_BOX2D));
 				/* energy never rises above what the forces put in */
 				assert_true(excess <= 1e-6 * scale + 1e-9);
 				bsim_scene_free(&s);

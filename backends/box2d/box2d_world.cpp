@@ -602,8 +602,15 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 	st->v[0] = v.x / s;
 	st->v[1] = v.y / s;
 	int n = st->n_beams < (int)w->beams.size() ? st->n_beams : (int)w->beams.size();
+	st->pivot_drift = 0.0;
 	for (int i = 0; i < n; i++) {
 		const beam_rec &b = w->beams[(size_t)i];
+		/* The beam body's origin is its pivot; the pin joint holds it there
+		 * only as well as Box2D's iterative solver converges. */
+		const double *pivot = w->scene.beams[i].pivot;
+		b2Vec2 o = b.body->GetPosition();
+		st->pivot_drift = std::fmax(st->pivot_drift,
+		                            std::hypot(o.x / s - pivot[0], o.y / s - pivot[1]));
 		st->theta[i] = b.sgn * (double)b.body->GetAngle();
 		st->omega[i] = b.sgn * (double)b.body->GetAngularVelocity();
 		st->contact[i] = w->contact_type[(size_t)i];

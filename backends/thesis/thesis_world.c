@@ -147,6 +147,7 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 {
 	memcpy(s->x, w->x, sizeof s->x);
 	memcpy(s->v, w->v, sizeof s->v);
+	s->pivot_drift = 0.0; /* a beam here is an angle about a fixed pivot */
 	int n = s->n_beams < w->n_beams ? s->n_beams : w->n_beams;
 	for (int i = 0; i < n; i++) {
 		s->theta[i] = w->beams[i].theta;

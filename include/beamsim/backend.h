@@ -35,6 +35,8 @@ typedef struct bsim_state {
 	int *contact;            /* n_beams, BSIM_CONTACT_* at the end of the step */
 	bsim_step_energy energy; /* of the last step */
 	int impacts;             /* impacts resolved in the last step */
+	double pivot_drift;      /* m, largest distance of a beam's pinned point from
+	                          * its pivot (0 where the pin is exact by construction) */
 } bsim_state;
 
 int bsim_state_alloc(bsim_state *s, int n_beams);

@@ -1,0 +1,107 @@
+/* What accuracy costs in time (beamsim accuracy), by the method of Erez,
+ * Tassa & Todorov, "Simulation tools for model-based robotics", ICRA 2015.
+ *
+ * For each backend a reference trajectory x_ref(t) is run at the finest
+ * step h_ref with the most accurate knobs. For a setting (knobs, h) pieces
+ * of duration T are restarted from reference states (set_state) at N
+ * times t_k on a grid of h_max (a whole number of steps of every h), with
+ * the same random-force schedule, and the consistency error is
+ *   e = mean_k | p(t_k + T) - p_ref(t_k + T) |,
+ * p the stacked positions of the body centre and the beam tips (m); a tip
+ * of a beam of length L whose angles differ by dtheta is 2 L |sin(dtheta/2)|
+ * apart. Restarting from the reference keeps chaos (divergence of nearby
+ * trajectories) out of the error. A batch of trials per setting then gives
+ * p_traverse (against the reference setting's, same seeds), the energy
+ * ledger residual per simulated second (sum |r| / sum t, J/s) and the cost
+ * (wall seconds per simulated second). All times in s, lengths in m. */
+#ifndef BEAMSIM_ACCURACY_H
+#define BEAMSIM_ACCURACY_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* States of a reference trajectory at t = k * grid, k = 0 .. n-1. */
+typedef struct bsim_accuracy_reference {
+	double h;    /* s, its step */
+	double grid; /* s, between stored states: a whole number of steps */
+	int n;
+	bsim_state *states;
+} bsim_accuracy_reference;
+
+/* Runs one trial of scene (its dt is the step; grid a multiple of it) with
+ * the schedule of seed and keeps the states on the grid. */
+int bsim_accuracy_reference_run(bsim_accuracy_reference *ref, const bsim_scene *scene,
+                                const bsim_backend *b, const bsim_options *opts, uint64_t seed,
+                                double grid, bsim_error *err);
+void bsim_accuracy_reference_free(bsim_accuracy_reference *ref);
+
+/* The consistency error of (b, opts, scene->dt): n_pieces pieces of
+ * duration piece (a multiple of ref->grid) restarted at evenly spaced grid
+ * points, and its mean and largest value over the pieces (m). */
+int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_scene *scene,
+                              const bsim_backend *b, const bsim_options *opts, uint64_t seed,
+                              double piece, int n_pieces, double *mean, double *max,
+                              bsim_error *err);
+
+typedef struct bsim_accuracy_config {
+	double h_ref;  /* s, finest step and the reference's (0.000125) */
+	double h_max;  /* s, coarsest step (0.016); steps are h_max / 2^i */
+	double piece;  /* s, duration of restarted pieces (0.064) */
+	int n_pieces;  /* restart points (16) */
+	int n_trials;  /* trials of the p_traverse batch (40) */
+	uint64_t seed; /* schedules: bsim_seed_mix(seed, 0, trial) */
+	int threads;   /* <= 0: all */
+	int progress;  /* 1: a progress line on stderr */
+} bsim_accuracy_config;
+
+/* One row: a backend, a knob setting and a time step. */
+typedef struct bsim_accuracy_row {
+	const char *backend;
+	char setting[96]; /* knob values, e.g. "midpoint simultaneous" */
+	bsim_options opts;
+	int reference;            /* 1: the reference knobs (p_ref comes from h_ref here) */
+	double h;                 /* s */
+	double err_mean, err_max; /* consistency error, m */
+	double residual_rate;     /* energy-ledger residual, J per simulated s */
+	double p, p_ref, p_err;   /* p_traverse, the reference's, |p - p_ref| */
+	double sim_seconds;       /* simulated by the batch, s */
+	double wall_seconds;      /* wall time of the batch and pieces, s */
+	double cost;              /* wall s per simulated s */
+	double speed;             /* simulated s per wall s (x real time) */
+	int failed;               /* trials that ended in a non-finite state */
+} bsim_accuracy_row;
+
+typedef struct bsim_accuracy_result {
+	int n;
+	bsim_accuracy_row *rows; /* by backend, setting, then h from coarse to fine */
+	double wall_seconds;
+} bsim_accuracy_result;
+
+/* The knob settings studied for a backend ("thesis", "box2d"): n settings
+ * into a malloc'd array (caller frees); the reference knobs are one of them. */
+int bsim_accuracy_settings(const bsim_backend *b, bsim_accuracy_row **out, int *n, bsim_error *err);
+
+/* The whole study over the backends. Results other than the timings do not
+ * depend on the number of threads. */
+int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backends, int n_backends,
+                      const bsim_accuracy_config *cfg, bsim_accuracy_result *out, bsim_error *err);
+void bsim_accuracy_result_free(bsim_accuracy_result *r);
+
+/* accuracy.csv, accuracy.md and accuracy.png of a result. */
+int bsim_accuracy_write_csv(const char *path, const bsim_accuracy_result *r, bsim_error *err);
+int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result *r,
+                           const bsim_accuracy_config *cfg, const char *scene_label,
+                           bsim_error *err);
+int bsim_accuracy_write_png(const char *path, const bsim_accuracy_result *r, bsim_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
