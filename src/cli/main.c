@@ -19,7 +19,8 @@ static const cli_command commands[] = {
         {"regress", cmd_regress, "rerun a stored sweep or comparison and report what changed"},
         {"backends", cmd_backends, "list the physics backends and their options"},
         {"bench", cmd_bench, "measure the speed of a backend on the essay's experiments"},
-        {"accuracy", cmd_accuracy, "what accuracy costs in time: error against speed per backend and step"},
+        {"accuracy", cmd_accuracy,
+         "what accuracy costs in time: error against speed per backend and step"},
 };
 
 #define N_COMMANDS ((int)(sizeof commands / sizeof commands[0]))
