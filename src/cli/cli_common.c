@@ -72,6 +72,18 @@ int cli_parse_u64(const char *text, uint64_t *out)
 	return 0;
 }
 
+int cli_parse_fraction(const char *cmd, const char *opt, const char *text, int open, double *out)
+{
+	char *end;
+	double x = strtod(text, &end);
+	int inside = open ? x > 0.0 && x < 1.0 : x >= 0.0 && x <= 1.0;
+	if (end == text || *end || !inside)
+		return cli_usage(cmd, "%s %s: expected a number in %s", opt, text,
+		                 open ? "(0, 1)" : "[0, 1]");
+	*out = x;
+	return CLI_OK;
+}
+
 static char *dup_range(const char *s, size_t n)
 {
 	char *d = malloc(n + 1);

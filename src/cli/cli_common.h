@@ -41,6 +41,10 @@ int cli_bad_option(const char *cmd, char **argv, int c);
 int cli_parse_long(const char *text, long min, long max, long *out);
 int cli_parse_u64(const char *text, uint64_t *out);
 
+/* The --alpha and --margin of compare and regress: the whole text a number
+ * in (0, 1) if open, else in [0, 1]. 0, or a usage error of cmd naming opt. */
+int cli_parse_fraction(const char *cmd, const char *opt, const char *text, int open, double *out);
+
 /* The --set KEY=VALUE overrides of one command, in order. */
 typedef struct cli_sets {
 	int n, cap;

@@ -107,19 +107,6 @@ static int parse_backends(compare_args *a, const char *text)
 	return CLI_OK;
 }
 
-static int parse_unit(const char *opt, const char *text, double lo, double hi, int open_lo,
-                      double *out)
-{
-	char *end;
-	double x = strtod(text, &end);
-	if (end == text || *end || !(open_lo ? x > lo : x >= lo) ||
-	    !(x < hi || (!open_lo && x <= hi)))
-		return cli_usage("compare", "%s %s: expected a number in %s%g, %g%s", opt, text,
-		                 open_lo ? "(" : "[", lo, hi, open_lo ? ")" : "]");
-	*out = x;
-	return CLI_OK;
-}
-
 /* "B:K=V" into the options of backend B (one of the two). */
 static int backend_opt(compare_args *a, const char *text)
 {
@@ -165,9 +152,9 @@ static int compare_option(compare_args *a, int c)
 		a->out = optarg;
 		return CLI_OK;
 	case OPT_ALPHA:
-		return parse_unit("--alpha", optarg, 0.0, 1.0, 1, &a->rule.alpha);
+		return cli_parse_fraction("compare", "--alpha", optarg, 1, &a->rule.alpha);
 	case OPT_MARGIN:
-		return parse_unit("--margin", optarg, 0.0, 1.0, 0, &a->rule.margin);
+		return cli_parse_fraction("compare", "--margin", optarg, 0, &a->rule.margin);
 	case OPT_EXAMPLES:
 		if (cli_parse_long(optarg, 0, 1000, &a->examples) != 0)
 			return cli_usage("compare", "--examples %s: expected an integer 0..1000",

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "beamsim/atomic_file.h"
+#include "beamsim/json.h"
 #include "beamsim/output.h"
 #include "beamsim/report.h"
 #include "beamsim/version.h"
@@ -64,16 +65,6 @@ typedef struct regress_args {
 	int exact, quiet;
 } regress_args;
 
-static int parse_fraction(const char *opt, const char *text, double *out)
-{
-	char *end;
-	double x = strtod(text, &end);
-	if (end == text || *end || !(x >= 0.0 && x <= 1.0))
-		return cli_usage("regress", "%s %s: expected a number in [0, 1]", opt, text);
-	*out = x;
-	return CLI_OK;
-}
-
 static int regress_parse(int argc, char **argv, regress_args *a)
 {
 	int c;
@@ -93,13 +84,10 @@ static int regress_parse(int argc, char **argv, regress_args *a)
 				               optarg);
 			break;
 		case OPT_ALPHA:
-			rc = parse_fraction("--alpha", optarg, &a->alpha);
-			if (rc == CLI_OK && (a->alpha <= 0.0 || a->alpha >= 1.0))
-				rc = cli_usage("regress", "--alpha %s: expected a number in (0, 1)",
-				               optarg);
+			rc = cli_parse_fraction("regress", "--alpha", optarg, 1, &a->alpha);
 			break;
 		case OPT_MARGIN:
-			rc = parse_fraction("--margin", optarg, &a->margin);
+			rc = cli_parse_fraction("regress", "--margin", optarg, 0, &a->margin);
 			break;
 		case OPT_EXACT:
 			a->exact = 1;
@@ -253,8 +241,10 @@ static void regress_md(FILE *f, const regress_args *a, const regress_run *run, r
 static void regress_json(FILE *f, const regress_run *run, regress_part *parts)
 {
 	fputs("{\"baseline_version\": ", f);
-	fprintf(f, "\"%s\", \"version\": \"%s\", \"backends\": [\n", run->rec.version,
-	        BSIM_VERSION);
+	bsim_json_string(f, run->rec.version);
+	fputs(", \"version\": ", f);
+	bsim_json_string(f, BSIM_VERSION);
+	fputs(", \"backends\": [\n", f);
 	for (int i = 0; i < run->rec.n_backends; i++) {
 		fputs(i ? ",\n" : "", f);
 		bsim_report_json(f, &parts[i].rep);
