@@ -1,0 +1,44 @@
+/* Figures drawn by gnuplot (Debian gnuplot-nox) from scripts beamsim writes.
+ *
+ * A figure NAME in directory DIR is four kinds of file side by side:
+ *   NAME.gp            the gnuplot script, rerunnable by hand (`gnuplot NAME.gp` in DIR)
+ *   NAME*.dat / .csv   the data it reads, written by the caller beforehand
+ *   NAME.png, NAME.svg what gnuplot draws (pngcairo and svg terminals)
+ * The script is the caller's gnuplot commands (the body) wrapped in a loop
+ * over the two terminals, so a user restyles the body once and gets both.
+ * Data files are named in the body relative to DIR.
+ *
+ * gnuplot writes the images under temporary names, renamed into place when
+ * it succeeds, so a figure appears whole or not at all. Without gnuplot on
+ * the PATH the script and data are still written and the caller is told
+ * (drawn = 0), with a message naming the package to install. */
+#ifndef BSIM_FIGURE_H
+#define BSIM_FIGURE_H
+
+#include "beamsim/error.h"
+
+typedef struct bsim_figure_def {
+	const char *dir;  /* output directory, existing */
+	const char *name; /* base name of NAME.gp, NAME.png, NAME.svg */
+	int width;        /* pixels of the PNG (and the SVG's size), default 900 */
+	int height;       /* default 600 */
+	const char *font; /* gnuplot font spec, default "sans,11" */
+} bsim_figure_def;
+
+/* dir and name NULL, 900 x 600, "sans,11". */
+bsim_figure_def bsim_figure_default(void);
+
+/* Writes DIR/NAME.gp around body (gnuplot commands, newline-separated) and,
+ * if gnuplot is on the PATH, runs it to draw NAME.png and NAME.svg. drawn
+ * (may be NULL) is 1 if both images were drawn, 0 if gnuplot is missing.
+ * BSIM_EFAIL naming the script if it cannot be written or gnuplot fails. */
+int bsim_figure_render(const bsim_figure_def *def, const char *body, int *drawn, bsim_error *err);
+
+/* 1 if gnuplot can be run (looked up once per process). */
+int bsim_figure_available(void);
+
+/* The message for a missing gnuplot, naming the package and DIR: for the
+ * CLI to print once after writing a directory's figures. */
+const char *bsim_figure_missing_hint(void);
+
+#endif
