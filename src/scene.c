@@ -58,6 +58,28 @@ void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm)
 	s->effects.random_magnitude = rm;
 }
 
+void bsim_beam_rest_direction(const bsim_beam_def *b, double u0[2])
+{
+	double q = b->rest_angle_deg / 90.0;
+	if (q == floor(q) && fabs(q) < 1e15) {
+		static const double c[4] = {1, 0, -1, 0}, s[4] = {0, 1, 0, -1};
+		long k = ((long)fmod(q, 4.0) + 4) % 4;
+		u0[0] = c[k];
+		u0[1] = s[k];
+		return;
+	}
+	const double rad = b->rest_angle_deg * (BSIM_PI / 180);
+	u0[0] = cos(rad);
+	u0[1] = sin(rad);
+}
+
+double bsim_beam_forward_sign(const bsim_beam_def *b)
+{
+	double u0[2];
+	bsim_beam_rest_direction(b, u0);
+	return u0[0] >= 0.0 ? 1.0 : -1.0;
+}
+
 int scene_overlap(const bsim_scene *s, double *dist)
 {
 	const double *c = s->body.start;
@@ -65,10 +87,11 @@ int scene_overlap(const bsim_scene *s, double *dist)
 		const bsim_beam_def *b = &s->beams[i];
 		/* Forward-positive theta moves the tip toward +y: a beam pointing
 		 * left (cos(rest) < 0) turns clockwise for positive theta. */
-		double rest = b->rest_angle_deg * BSIM_PI / 180;
-		double sign = cos(rest) >= 0 ? 1 : -1;
-		double ang = rest + sign * b->initial_theta;
-		double ux = cos(ang), uy = sin(ang);
+		double u0[2];
+		bsim_beam_rest_direction(b, u0);
+		double sn = bsim_beam_forward_sign(b) * sin(b->initial_theta);
+		double cs = cos(b->initial_theta);
+		double ux = u0[0] * cs - u0[1] * sn, uy = u0[1] * cs + u0[0] * sn;
 		double dx = c[0] - b->pivot[0], dy = c[1] - b->pivot[1];
 		double along = fmin(fmax(dx * ux + dy * uy, 0), b->length);
 		double d = hypot(dx - along * ux, dy - along * uy);

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "beamsim/effects.h"
+#include "beamsim/landscape.h"
 
 struct bsim_runner {
 	bsim_state s0, s1; /* before and after a step */
@@ -85,7 +86,6 @@ void bsim_recorder_header(FILE *f, int n_beams)
 
 static void record_row(FILE *f, const bsim_scene *sc, const bsim_state *s, double t, double f_rand)
 {
-	double f_prop = sc->effects.has_propulsion ? sc->effects.propulsion_force : 0.0;
 	fprintf(f, "%.6f,%.10g,%.10g,%.10g,%.10g", t, s->x[0], s->x[1], s->v[0], s->v[1]);
 	for (int i = 0; i < s->n_beams; i++)
 		fprintf(f, ",%.10g,%.10g", s->theta[i], s->omega[i]);
@@ -93,7 +93,7 @@ static void record_row(FILE *f, const bsim_scene *sc, const bsim_state *s, doubl
 	for (int i = 0; i < s->n_beams; i++)
 		fprintf(f, ",%d", s->contact[i]);
 	fprintf(f, ",%.10g,%.10g,%.10g\n", energy_kinetic(sc, s), energy_springs(sc, s),
-	        f_prop * (sc->landscape_y0 - s->x[1]));
+	        bsim_landscape_e_prop(sc, s->x[1]));
 }
 
 /* One step's entry in the ledger: the work of each force over the body's
