@@ -38,7 +38,8 @@ int bsim_state_alloc(bsim_state *s, int n_beams)
 	s->theta = calloc(n, sizeof *s->theta);
 	s->omega = calloc(n, sizeof *s->omega);
 	s->contact = calloc(n, sizeof *s->contact);
-	if (!s->theta || !s->omega || !s->contact) {
+	s->active = calloc(n, sizeof *s->active);
+	if (!s->theta || !s->omega || !s->contact || !s->active) {
 		bsim_state_free(s);
 		return BSIM_EFAIL;
 	}
@@ -50,6 +51,7 @@ void bsim_state_free(bsim_state *s)
 	free(s->theta);
 	free(s->omega);
 	free(s->contact);
+	free(s->active);
 	memset(s, 0, sizeof *s);
 }
 
@@ -61,6 +63,24 @@ void bsim_state_copy(bsim_state *dst, const bsim_state *src)
 	memcpy(dst->theta, src->theta, (size_t)n * sizeof *dst->theta);
 	memcpy(dst->omega, src->omega, (size_t)n * sizeof *dst->omega);
 	memcpy(dst->contact, src->contact, (size_t)n * sizeof *dst->contact);
+	dst->n_active = 0;
+	for (int k = 0; k < src->n_active; k++)
+		if (src->active[k] < dst->n_beams)
+			dst->active[dst->n_active++] = src->active[k];
 	dst->energy = src->energy;
 	dst->impacts = src->impacts;
+}
+
+void bsim_state_set_active(bsim_state *s, const int *active, int n)
+{
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k];
+		s->theta[i] = 0.0;
+		s->omega[i] = 0.0;
+		s->contact[i] = BSIM_CONTACT_NONE;
+	}
+	s->n_active = 0;
+	for (int k = 0; k < n; k++)
+		if (active[k] >= 0 && active[k] < s->n_beams)
+			s->active[s->n_active++] = active[k];
 }

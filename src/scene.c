@@ -119,7 +119,7 @@ static int check_value(const bsim_scene *s, const scene_field *f, const char *ba
 	int n = 1;
 	if (f->kind == SK_INT) {
 		int k = *(const int *)p;
-		if (k <= 0)
+		if (k < (f->range == SR_NONNEG ? 0 : 1))
 			return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s, got %d", who,
 			                      field, scene_phrase(f), k);
 		return BSIM_OK;
@@ -159,12 +159,42 @@ static int check_table(const bsim_scene *s, const scene_table *t, const char *ba
 			char sub[260];
 			ydoc_join(sub, sizeof sub, field, ".");
 			rc = check_table(s, f->sub, base, sub, err);
-		} else if (f->kind != SK_BEAMS) {
+		} else if (f->kind == SK_NUMBER || f->kind == SK_INT || f->kind == SK_VEC2 ||
+		           f->kind == SK_NAME) {
 			rc = check_value(s, f, base, field, err);
 		}
 		if (rc)
 			return rc;
 	}
+	return BSIM_OK;
+}
+
+/* A lattice's shape must match its beams, and the body must start inside
+ * the field (between the sides; below the end). */
+static int lattice_validate(const bsim_scene *s, const char *who, bsim_error *err)
+{
+	const bsim_lattice_def *l = &s->lattice;
+	if (l->rows < 1 || l->columns < 1 || l->ix_max - l->ix_min + 1 != l->columns)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: lattice: expected at least one gate (columns = ix_max - "
+		                      "ix_min + 1 >= 1, rows >= 1), got %d x %d",
+		                      who, l->columns, l->rows);
+	if (!(l->width > 0) || !(l->depth > 0) || !isfinite(l->width) || !isfinite(l->depth) ||
+	    !isfinite(l->pivot_y))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: lattice.gate: expected positive width and depth, got %g "
+		                      "and %g",
+		                      who, l->width, l->depth);
+	if ((long)s->n_beams != 2L * l->columns * l->rows)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: lattice: expected %ld beams (2 per gate), got %d", who,
+		                      2L * l->columns * l->rows, s->n_beams);
+	double centre = 0.5 * l->width * (l->ix_min + l->ix_max);
+	if (!(fabs(s->body.start[0] - centre) < s->side_x))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.start: expected a point between the lattice's "
+		                      "sides (|x - %g| < side_x = %g), got x = %g",
+		                      who, centre, s->side_x, s->body.start[0]);
 	return BSIM_OK;
 }
 
@@ -181,6 +211,11 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		char prefix[64];
 		snprintf(prefix, sizeof prefix, "beams.%d.", i);
 		rc = check_table(s, &scene_beam_table, (const char *)&s->beams[i], prefix, err);
+		if (rc)
+			return rc;
+	}
+	if (s->has_lattice) {
+		rc = lattice_validate(s, who, err);
 		if (rc)
 			return rc;
 	}

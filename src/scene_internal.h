@@ -10,12 +10,15 @@
 #include "yaml_doc.h"
 
 typedef enum scene_kind {
-	SK_NUMBER, /* double, finite, in range */
-	SK_INT,    /* int > 0 */
-	SK_VEC2,   /* double[2], finite: [x, y] */
-	SK_NAME,   /* char[128], non-empty */
-	SK_BLOCK,  /* a nested mapping (sub) */
-	SK_BEAMS,  /* the list of beams (sub describes one beam) */
+	SK_NUMBER,  /* double, finite, in range */
+	SK_INT,     /* int > 0 */
+	SK_VEC2,    /* double[2], finite: [x, y] */
+	SK_NAME,    /* char[128], non-empty */
+	SK_BLOCK,   /* a nested mapping (sub) */
+	SK_BEAMS,   /* the list of beams (sub describes one beam) */
+	SK_INDEX,   /* int, any sign */
+	SK_LATTICE, /* the lattice block (scene_lattice.c) */
+	SK_LATER,   /* read by the block's own code after the table's walk */
 } scene_kind;
 
 typedef enum scene_range {
@@ -64,6 +67,28 @@ void scene_defaults(bsim_scene *s);
 /* Index of the first beam the body overlaps at the start (distance from the
  * body centre to the beam segment < radius), or -1; *dist in m. */
 int scene_overlap(const bsim_scene *s, double *dist);
+
+/* A walk of a scene document into a scene (scene_load.c). */
+typedef struct scene_walk {
+	const ydoc *d;
+	bsim_scene *s;
+	bsim_error *err;
+} scene_walk;
+
+/* Walks one mapping (NULL: an empty one) against table t into base: unknown
+ * keys are errors, known ones are stored, missing required ones reported. */
+int scene_walk_table(scene_walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
+                     char *base, const char *prefix);
+
+/* The lattice: block (scene_lattice.c): its keys, maps and CSV file, then
+ * the beams built from it. */
+int scene_walk_lattice(scene_walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key);
+extern const scene_table scene_lattice_table;
+
+/* The termination defaults of a lattice (lattice.c): success_y = depth
+ * rows, side_x = width columns / 2, classify_y = success_y, landscape y0 =
+ * success_y, gate_steps = 3000, max_steps = gate_steps (rows + columns). */
+void scene_lattice_defaults(bsim_scene *s);
 
 /* bsim_scene_load on a document already read (the experiment loader reads
  * the scene file once and builds every group from a clone of it). */

@@ -12,14 +12,9 @@
 #include "scene_internal.h"
 #include "yaml_override.h"
 
-typedef struct walk {
-	const ydoc *d;
-	bsim_scene *s;
-	bsim_error *err;
-} walk;
+typedef scene_walk walk;
 
-static int walk_table(walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
-                      char *base, const char *prefix);
+#define walk_table scene_walk_table
 
 /* "expected WHAT, got <the node>" at node n (or its key). */
 static int expected(walk *w, struct fy_node *n, struct fy_node *key, const char *field,
@@ -43,7 +38,9 @@ static int walk_int(walk *w, const scene_field *f, struct fy_node *n, struct fy_
                     const char *field, int *out)
 {
 	long long v = 0;
-	if (!ydoc_int64(n, &v) || v <= 0 || v > INT_MAX)
+	long long lo = f->kind == SK_INDEX ? -1000000 : f->range == SR_NONNEG ? 0 : 1;
+	long long hi = f->kind == SK_INDEX ? 1000000 : INT_MAX;
+	if (!ydoc_int64(n, &v) || v < lo || v > hi)
 		return expected(w, n, key, field, scene_phrase(f));
 	*out = (int)v;
 	return BSIM_OK;
@@ -139,6 +136,12 @@ static int walk_field(walk *w, const scene_field *f, struct fy_node *n, struct f
 		return walk_block(w, f, n, key, base, field);
 	case SK_BEAMS:
 		return walk_beams(w, f, n, key);
+	case SK_INDEX:
+		return walk_int(w, f, n, key, field, (int *)(base + f->offset));
+	case SK_LATTICE:
+		return scene_walk_lattice(w, f, n, key);
+	case SK_LATER:
+		return BSIM_OK;
 	}
 	return BSIM_OK;
 }
@@ -154,8 +157,8 @@ static int find_field(const scene_table *t, const char *key)
 /* Walks one mapping (NULL: an empty one) against table t: unknown keys are
  * errors, known ones are stored, missing required ones are reported at the
  * mapping (or at alt, the key naming it, when it is empty). */
-static int walk_table(walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
-                      char *base, const char *prefix)
+int scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
+                     char *base, const char *prefix)
 {
 	unsigned seen = 0;
 	void *it = NULL;
@@ -281,6 +284,48 @@ static void effects_present(bsim_scene *s)
 		s->effects.has_random_force = 0;
 }
 
+/* A scene has beams: or lattice:, not both, not neither. */
+static int check_beams_or_lattice(walk *w, struct fy_node *root)
+{
+	struct fy_node_pair *beams = ydoc_pair(root, "beams", 5);
+	struct fy_node_pair *lattice = ydoc_pair(root, "lattice", 7);
+	if (beams && lattice)
+		return ydoc_fail(w->d, fy_node_pair_key(lattice), root, "lattice", w->err,
+		                 "expected either beams: or lattice:, not both");
+	if (!beams && !lattice)
+		return ydoc_fail(w->d, root, NULL, "beams", w->err,
+		                 "missing (expected a non-empty list of beams, or a lattice: "
+		                 "block)");
+	return BSIM_OK;
+}
+
+/* The lattice's termination defaults where the file and overrides leave a
+ * key out (scene_lattice_defaults). */
+static void lattice_defaults(walk *w, struct fy_node *root)
+{
+	bsim_scene *s = w->s, given = *s;
+	scene_lattice_defaults(s);
+	static const char *const keys[] = {"termination.success_y",  "termination.side_x",
+	                                   "termination.classify_y", "landscape.y0",
+	                                   "termination.gate_steps", "integration.max_steps"};
+	if (ydoc_lookup(root, keys[0]))
+		s->success_y = given.success_y;
+	if (ydoc_lookup(root, keys[1]))
+		s->side_x = given.side_x;
+	if (ydoc_lookup(root, keys[2]))
+		s->classify_y = given.classify_y;
+	else
+		s->classify_y = s->success_y;
+	if (ydoc_lookup(root, keys[3]))
+		s->landscape_y0 = given.landscape_y0;
+	if (ydoc_lookup(root, keys[4]))
+		s->gate_steps = given.gate_steps;
+	if (ydoc_lookup(root, keys[5]))
+		s->max_steps = given.max_steps;
+	else
+		s->max_steps = s->gate_steps * (s->lattice.rows + s->lattice.columns);
+}
+
 static int walk_scene(walk *w)
 {
 	struct fy_node *root = fy_document_root(w->d->fyd);
@@ -288,6 +333,10 @@ static int walk_scene(walk *w)
 		return expected(w, root, NULL, "scene",
 		                "a mapping of scene keys (body, beams, ...)");
 	int rc = walk_table(w, &scene_top_table, root, NULL, (char *)w->s, "");
+	if (!rc)
+		rc = check_beams_or_lattice(w, root);
+	if (!rc && w->s->has_lattice)
+		lattice_defaults(w, root);
 	if (!rc)
 		rc = check_termination(w);
 	if (!rc)

@@ -69,6 +69,7 @@ static const scene_field termination_fields[] = {
         {"success_y", SK_NUMBER, SR_ANY, 0, S(success_y), NULL},   /* m */
         {"side_x", SK_NUMBER, SR_POSITIVE, 0, S(side_x), NULL},    /* m */
         {"classify_y", SK_NUMBER, SR_ANY, 0, S(classify_y), NULL}, /* m, >= success_y */
+        {"gate_steps", SK_INT, SR_NONNEG, 0, S(gate_steps), NULL}, /* 0: max_steps */
 };
 static const scene_table termination_table = TABLE(termination_fields);
 
@@ -80,7 +81,8 @@ static const scene_table landscape_table = TABLE(landscape_fields);
 static const scene_field top_fields[] = {
         {"name", SK_NAME, SR_ANY, 0, S(name), NULL},
         {"body", SK_BLOCK, SR_ANY, 1, SCENE_NO_FLAG, &body_table},
-        {"beams", SK_BEAMS, SR_ANY, 1, S(beams), &scene_beam_table},
+        {"beams", SK_BEAMS, SR_ANY, 0, S(beams), &scene_beam_table},
+        {"lattice", SK_LATTICE, SR_ANY, 0, S(has_lattice), &scene_lattice_table},
         {"contact", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &contact_table},
         {"effects", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &effects_table},
         {"integration", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &integration_table},
@@ -88,6 +90,38 @@ static const scene_field top_fields[] = {
         {"landscape", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &landscape_table},
 };
 const scene_table scene_top_table = TABLE(top_fields);
+
+/* The lattice block (scene_lattice.c reads the SK_LATER keys itself). */
+static const scene_field lattice_gate_fields[] = {
+        {"width", SK_NUMBER, SR_POSITIVE, 0, S(lattice.width), NULL}, /* m */
+        {"depth", SK_NUMBER, SR_POSITIVE, 0, S(lattice.depth), NULL}, /* m */
+        {"pivot_y", SK_NUMBER, SR_ANY, 0, S(lattice.pivot_y), NULL},  /* m */
+};
+static const scene_table lattice_gate_table = TABLE(lattice_gate_fields);
+
+static const scene_field lattice_beam_fields[] = {
+        {"length", SK_NUMBER, SR_POSITIVE, 1, S(lattice.beam.length), NULL},     /* m */
+        {"mass", SK_NUMBER, SR_POSITIVE, 1, S(lattice.beam.mass), NULL},         /* kg */
+        {"inertia", SK_NUMBER, SR_POSITIVE, 0, S(lattice.beam.inertia), NULL},   /* kg m^2 */
+        {"stiffness", SK_NUMBER, SR_NONNEG, 1, S(lattice.beam.stiffness), NULL}, /* N m/rad */
+        {"damping", SK_NUMBER, SR_NONNEG, 0, S(lattice.beam.damping), NULL},     /* N m s/rad */
+};
+static const scene_table lattice_beam_table = TABLE(lattice_beam_fields);
+
+static const scene_field lattice_fields[] = {
+        {"columns", SK_INT, SR_POSITIVE, 0, S(lattice.columns), NULL},
+        {"rows", SK_INT, SR_POSITIVE, 1, S(lattice.rows), NULL},
+        {"ix_min", SK_INDEX, SR_ANY, 0, S(lattice.ix_min), NULL},
+        {"ix_max", SK_INDEX, SR_ANY, 0, S(lattice.ix_max), NULL},
+        {"gate", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &lattice_gate_table},
+        {"beam", SK_BLOCK, SR_ANY, 1, SCENE_NO_FLAG, &lattice_beam_table},
+        {"stiffness", SK_LATER, SR_NONNEG, 0, 0, NULL},
+        {"stiffness_left", SK_LATER, SR_NONNEG, 0, 0, NULL},
+        {"stiffness_right", SK_LATER, SR_NONNEG, 0, 0, NULL},
+        {"stiffness_file", SK_LATER, SR_ANY, 0, 0, NULL},
+        {"protocol", SK_LATER, SR_ANY, 0, 0, NULL},
+};
+const scene_table scene_lattice_table = TABLE(lattice_fields);
 
 const char *scene_phrase(const scene_field *f)
 {
@@ -104,7 +138,7 @@ const char *scene_phrase(const scene_field *f)
 			return "a number";
 		}
 	case SK_INT:
-		return "a positive integer";
+		return f->range == SR_NONNEG ? "an integer >= 0" : "a positive integer";
 	case SK_VEC2:
 		return "a list of 2 numbers [x, y]";
 	case SK_NAME:
@@ -113,6 +147,12 @@ const char *scene_phrase(const scene_field *f)
 		return "a mapping";
 	case SK_BEAMS:
 		return "a non-empty list of beams";
+	case SK_INDEX:
+		return "an integer";
+	case SK_LATTICE:
+		return "a mapping (a gate lattice)";
+	case SK_LATER:
+		return "a value";
 	}
 	return "a value";
 }

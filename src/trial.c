@@ -1,7 +1,20 @@
 /* The trial runner (MODEL.md section 6, DESIGN.md "The flow of one
  * experiment"): time, forces from the effect pipeline, termination,
  * outcomes, the energy ledger and recording. Everything here is the same
- * code for every backend. */
+ * code for every backend.
+ *
+ * Cost. A step's bookkeeping visits only the beams the backend lists as
+ * active (bsim_state.active: the others are exactly at rest), so in a
+ * lattice it costs what the beams near the body cost, like the backend's
+ * step. Energies summed over the active beams in ascending order are the
+ * sums over all beams to the bit (a beam at rest adds +0).
+ *
+ * Lattices (MODEL.md section 8). The runner follows the gate the body is
+ * in (lattice.h), records each entry (bsim_gate_entry), ends the trial as
+ * stuck when the body has spent gate_steps steps in one gate, and measures
+ * side exits from the field's centre line. Under the essay's protocol
+ * (lattice.protocol: essay, trial_essay.c) each entry replaces the world by
+ * one holding only the entered gate's two beams, at rest. */
 #include "beamsim/trial.h"
 
 #include <math.h>
@@ -10,10 +23,17 @@
 
 #include "beamsim/effects.h"
 #include "beamsim/landscape.h"
+#include "beamsim/lattice.h"
+#include "trial_essay.h"
 
 struct bsim_runner {
 	bsim_state s0, s1; /* before and after a step */
 	int cap;           /* beams the states hold */
+	bsim_state whole;  /* the whole lattice's state, for recording (essay protocol) */
+	double *peak;      /* per beam of the scene */
+	int *negative;     /* beams whose peak starts below 0 */
+	int peak_cap;
+	trial_essay essay;
 };
 
 bsim_runner *bsim_runner_alloc(void)
@@ -27,6 +47,9 @@ void bsim_runner_free(bsim_runner *r)
 		return;
 	bsim_state_free(&r->s0);
 	bsim_state_free(&r->s1);
+	bsim_state_free(&r->whole);
+	free(r->peak);
+	free(r->negative);
 	free(r);
 }
 
@@ -43,6 +66,19 @@ static int runner_reserve(bsim_runner *r, int n_beams)
 	return BSIM_OK;
 }
 
+static int peaks_reserve(bsim_runner *r, int n_beams)
+{
+	if (r->peak_cap >= n_beams && r->peak)
+		return BSIM_OK;
+	free(r->peak);
+	free(r->negative);
+	size_t n = n_beams > 0 ? (size_t)n_beams : 1;
+	r->peak = malloc(n * sizeof *r->peak);
+	r->negative = malloc(n * sizeof *r->negative);
+	r->peak_cap = r->peak && r->negative ? n_beams : 0;
+	return r->peak_cap ? BSIM_OK : BSIM_EFAIL;
+}
+
 const char *bsim_outcome_name(bsim_outcome o)
 {
 	static const char *names[] = {"traversed", "side_exit", "stuck"};
@@ -55,12 +91,66 @@ const char *bsim_type_name(bsim_type t)
 	return (unsigned)t < 3 ? names[t] : "?";
 }
 
-/* Kinetic energy of body and beams, J. */
+const char *bsim_edge_name(bsim_edge e)
+{
+	static const char *names[] = {"start", "bottom", "left", "right", "top"};
+	return (unsigned)e < 5 ? names[e] : "?";
+}
+
+/* ---- the trial log ----------------------------------------------------- */
+
+bsim_trial_log *bsim_trial_log_alloc(void)
+{
+	return calloc(1, sizeof(bsim_trial_log));
+}
+
+void bsim_trial_log_free(bsim_trial_log *l)
+{
+	if (!l)
+		return;
+	free(l->entries);
+	free(l->peak);
+	free(l);
+}
+
+static int log_push(bsim_trial_log *l, const bsim_gate_entry *e)
+{
+	if (l->n_entries == l->cap_entries) {
+		int cap = l->cap_entries ? 2 * l->cap_entries : 16;
+		bsim_gate_entry *p = realloc(l->entries, (size_t)cap * sizeof *p);
+		if (!p)
+			return BSIM_EFAIL;
+		l->entries = p;
+		l->cap_entries = cap;
+	}
+	l->entries[l->n_entries++] = *e;
+	return BSIM_OK;
+}
+
+static int log_peaks(bsim_trial_log *l, const double *peak, int n)
+{
+	if (l->cap_beams < n) {
+		double *p = realloc(l->peak, (size_t)n * sizeof *p);
+		if (!p)
+			return BSIM_EFAIL;
+		l->peak = p;
+		l->cap_beams = n;
+	}
+	memcpy(l->peak, peak, (size_t)n * sizeof *peak);
+	l->n_beams = n;
+	return BSIM_OK;
+}
+
+/* ---- energies and recording ------------------------------------------- */
+
+/* Kinetic energy of body and beams, J. Beams at rest add nothing. */
 static double energy_kinetic(const bsim_scene *sc, const bsim_state *s)
 {
 	double e = 0.5 * sc->body.mass * (s->v[0] * s->v[0] + s->v[1] * s->v[1]);
-	for (int i = 0; i < s->n_beams; i++)
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k];
 		e += 0.5 * sc->beams[i].inertia * s->omega[i] * s->omega[i];
+	}
 	return e;
 }
 
@@ -68,8 +158,10 @@ static double energy_kinetic(const bsim_scene *sc, const bsim_state *s)
 static double energy_springs(const bsim_scene *sc, const bsim_state *s)
 {
 	double e = 0.0;
-	for (int i = 0; i < s->n_beams; i++)
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k];
 		e += 0.5 * sc->beams[i].stiffness * s->theta[i] * s->theta[i];
+	}
 	return e;
 }
 
@@ -111,14 +203,15 @@ static void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state
 			w_prop += work;
 	}
 	const bsim_step_energy *se = &s1->energy;
-	double r = (e1 - e0) -
-	           (w_prop + w_rand - se->damper - se->impact - se->contact - se->correction);
+	double r = (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -
+	                        se->correction - se->sleep);
 	l->w_prop += w_prop;
 	l->w_rand += w_rand;
 	l->damper += se->damper;
 	l->impact += se->impact;
 	l->contact += se->contact;
 	l->correction += se->correction;
+	l->sleep += se->sleep;
 	l->residual += r;
 	l->residual_abs += fabs(r);
 	l->residual_max = fmax(l->residual_max, fabs(r));
@@ -127,15 +220,15 @@ static void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state
 static int state_finite(const bsim_state *s)
 {
 	double sum = s->x[0] + s->x[1] + s->v[0] + s->v[1];
-	for (int i = 0; i < s->n_beams; i++)
-		sum += s->theta[i] + s->omega[i];
+	for (int k = 0; k < s->n_active; k++)
+		sum += s->theta[s->active[k]] + s->omega[s->active[k]];
 	return isfinite(sum);
 }
 
 static int any_contact(const bsim_state *s)
 {
-	for (int i = 0; i < s->n_beams; i++)
-		if (s->contact[i])
+	for (int k = 0; k < s->n_active; k++)
+		if (s->contact[s->active[k]])
 			return 1;
 	return 0;
 }
@@ -145,31 +238,271 @@ static double random_value(const bsim_effects *fx)
 	return fx->random ? fx->random->last : 0.0;
 }
 
+/* ---- peaks --------------------------------------------------------------- */
+
+/* The world's beam i is the scene's beam map[i] (map NULL: the same). */
+static int scene_beam(const int *map, int i)
+{
+	return map ? map[i] : i;
+}
+
+/* Every beam's peak theta over the steps so far: the active beams, beams 0
+ * and 1 (trials.csv's two columns), and any beam whose peak is still below
+ * 0 (a beam at rest has theta 0). */
+static void peaks_update(bsim_runner *r, const bsim_scene *scene, const int *map,
+                         const bsim_state *s, int *n_negative)
+{
+	double *peak = r->peak;
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k], g = scene_beam(map, i);
+		peak[g] = fmax(peak[g], s->theta[i]);
+	}
+	if (!map)
+		for (int i = 0; i < 2 && i < scene->n_beams; i++)
+			peak[i] = fmax(peak[i], s->theta[i]);
+	int m = 0; /* only without a map: the essay's beams all start at rest */
+	for (int k = 0; k < *n_negative; k++) {
+		int i = r->negative[k];
+		peak[i] = fmax(peak[i], s->theta[i]);
+		if (peak[i] < 0.0)
+			r->negative[m++] = i;
+	}
+	*n_negative = m;
+}
+
+/* ---- gates ------------------------------------------------------------- */
+
+typedef struct gate_track {
+	int ix, iy;  /* the gate the body is in */
+	long dwell;  /* steps since it entered */
+	int entries; /* gates entered, the start gate included */
+} gate_track;
+
+/* The entry record of gate (ix, iy) through edge, the body at s. */
+static void entry_fill(bsim_gate_entry *e, const bsim_scene *scene, const int *map,
+                       const bsim_state *s, int ix, int iy, bsim_edge edge, double pos, long n,
+                       double h)
+{
+	const bsim_lattice_def *l = &scene->lattice;
+	double ox = scene->has_lattice ? l->width * ix : 0.0;
+	double oy = scene->has_lattice ? l->depth * iy : 0.0;
+	memset(e, 0, sizeof *e);
+	e->ix = ix;
+	e->iy = iy;
+	e->edge = edge;
+	e->step = (int)n;
+	e->t = (double)n * h;
+	e->pos = pos;
+	e->x[0] = s->x[0] - ox;
+	e->x[1] = s->x[1] - oy;
+	e->v[0] = s->v[0];
+	e->v[1] = s->v[1];
+	if (!scene->has_lattice) {
+		for (int side = 0; side < 2 && side < s->n_beams; side++) {
+			e->theta[side] = s->theta[side];
+			e->omega[side] = s->omega[side];
+		}
+		return;
+	}
+	/* Whole world: the entered gate's beams as they are. The essay's
+	 * world holds only the gate being left, whose beams are not these. */
+	for (int side = 0; side < 2 && !map; side++) {
+		int b = bsim_lattice_beam(l, ix, iy, side);
+		e->theta[side] = s->theta[b];
+		e->omega[side] = s->omega[b];
+	}
+}
+
+/* Where the straight path p0 -> p1 crosses x = bx (axis 0) or y = by (axis
+ * 1), as a fraction of the step. */
+static double crossing(const double p0[2], const double p1[2], int axis, double at)
+{
+	double d = p1[axis] - p0[axis];
+	return d != 0.0 ? (at - p0[axis]) / d : 0.0;
+}
+
+/* The gates the body entered in a step that took it from gate (g->ix,
+ * g->iy) at p0 to gate (ix, iy) at p1: one, or two when it cut a corner
+ * (the first boundary crossed first). Each goes to e[]; returns how many. */
+static int entries_of_step(const bsim_scene *scene, const int *map, const gate_track *g,
+                           const double p0[2], const bsim_state *s, int ix, int iy, long n,
+                           double h, bsim_gate_entry e[2])
+{
+	const bsim_lattice_def *l = &scene->lattice;
+	const double *p1 = s->x;
+	double bx = l->width * (ix > g->ix ? ix : g->ix) - 0.5 * l->width;
+	double by = l->depth * (iy > g->iy ? iy : g->iy);
+	double fx = ix != g->ix ? crossing(p0, p1, 0, bx) : 2.0;
+	double fy = iy != g->iy ? crossing(p0, p1, 1, by) : 2.0;
+	bsim_edge ex = ix > g->ix ? BSIM_EDGE_LEFT : BSIM_EDGE_RIGHT;
+	bsim_edge ey = iy > g->iy ? BSIM_EDGE_BOTTOM : BSIM_EDGE_TOP;
+	/* the crossing point, along the edge, in the entered gate's frame */
+	double pos_x = p0[0] + fy * (p1[0] - p0[0]) - l->width * ix;
+	double pos_y = p0[1] + fx * (p1[1] - p0[1]) - l->depth * iy;
+	if (ix == g->ix) {
+		entry_fill(&e[0], scene, map, s, ix, iy, ey, pos_x, n, h);
+		return 1;
+	}
+	if (iy == g->iy) {
+		entry_fill(&e[0], scene, map, s, ix, iy, ex, pos_y, n, h);
+		return 1;
+	}
+	if (fx <= fy) { /* across the side first, then the row boundary */
+		entry_fill(&e[0], scene, map, s, ix, g->iy, ex, pos_y + l->depth * (iy - g->iy), n,
+		           h);
+		entry_fill(&e[1], scene, map, s, ix, iy, ey, pos_x, n, h);
+	} else {
+		entry_fill(&e[0], scene, map, s, g->ix, iy, ey, pos_x + l->width * (ix - g->ix), n,
+		           h);
+		entry_fill(&e[1], scene, map, s, ix, iy, ex, pos_y, n, h);
+	}
+	/* The intermediate gate's frame: the body is in (ix, iy) at the end. */
+	e[0].x[0] = s->x[0] - l->width * e[0].ix;
+	e[0].x[1] = s->x[1] - l->depth * e[0].iy;
+	return 2;
+}
+
+/* ---- the run ------------------------------------------------------------- */
+
+typedef struct trial_ctx {
+	bsim_runner *r;
+	const bsim_scene *scene;
+	const bsim_backend *backend;
+	const bsim_options *opts;
+	const bsim_recorder *rec;
+	bsim_trial_log *log;
+	bsim_world *w;
+	const bsim_scene *ws; /* the scene the world holds: the scene, or one gate's */
+	const int *map;       /* world beam -> scene beam, NULL: the same */
+	gate_track gate;
+	bsim_trial_result *out;
+} trial_ctx;
+
+/* A full-lattice state for the recorder from the world's state. */
+static const bsim_state *whole_state(trial_ctx *c, const bsim_state *s)
+{
+	if (!c->map)
+		return s;
+	bsim_state *g = &c->r->whole;
+	int local[2];
+	for (int k = 0; k < s->n_active && k < 2; k++)
+		local[k] = c->map[s->active[k]];
+	bsim_state_set_active(g, local, s->n_active < 2 ? s->n_active : 2);
+	memcpy(g->x, s->x, sizeof g->x);
+	memcpy(g->v, s->v, sizeof g->v);
+	for (int k = 0; k < s->n_active && k < 2; k++) {
+		int i = s->active[k];
+		g->theta[c->map[i]] = s->theta[i];
+		g->omega[c->map[i]] = s->omega[i];
+		g->contact[c->map[i]] = s->contact[i];
+	}
+	g->energy = s->energy;
+	g->impacts = s->impacts;
+	return g;
+}
+
+/* The body entered gate (ix, iy) at the end of step n (s: the state). */
+static int gate_enter(trial_ctx *c, bsim_state **s0, const double p0[2], int ix, int iy, long n,
+                      double *e0, bsim_error *err)
+{
+	bsim_gate_entry e[2];
+	int k = entries_of_step(c->scene, c->map, &c->gate, p0, *s0, ix, iy, n, c->scene->dt, e);
+	for (int i = 0; i < k; i++)
+		if (c->log && log_push(c->log, &e[i]))
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate path");
+	c->gate.ix = ix;
+	c->gate.iy = iy;
+	c->gate.dwell = 0;
+	c->gate.entries += k;
+	if (c->scene->lattice.protocol != BSIM_PROTOCOL_ESSAY)
+		return BSIM_OK;
+	double e_before = *e0;
+	int rc = trial_essay_enter(&c->r->essay, c->scene, c->backend, c->opts, ix, iy, *s0, &c->w,
+	                           &c->out->reset_overlaps, err);
+	if (rc)
+		return rc;
+	c->backend->get_state(c->w, *s0);
+	*e0 = energy_kinetic(c->ws, *s0) + energy_springs(c->ws, *s0);
+	c->out->ledger.reset += e_before - *e0;
+	return BSIM_OK;
+}
+
+static int trial_setup(trial_ctx *c, bsim_error *err)
+{
+	const bsim_scene *scene = c->scene;
+	bsim_runner *r = c->r;
+	int essay = scene->has_lattice && scene->lattice.protocol == BSIM_PROTOCOL_ESSAY;
+	int world_beams = essay ? 2 : scene->n_beams;
+	if (runner_reserve(r, world_beams) || peaks_reserve(r, scene->n_beams))
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	if (essay && c->rec && c->rec->csv && r->whole.n_beams != scene->n_beams) {
+		bsim_state_free(&r->whole);
+		if (bsim_state_alloc(&r->whole, scene->n_beams))
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	c->ws = scene;
+	c->map = NULL;
+	double p[2] = {scene->body.start[0], scene->body.start[1]};
+	bsim_scene_gate_at(scene, p, &c->gate.ix, &c->gate.iy);
+	if (!essay)
+		return c->backend->create(scene, c->opts, &c->w, err);
+	int rc = trial_essay_start(&r->essay, scene, c->backend, c->opts, c->gate.ix, c->gate.iy,
+	                           &c->w, &c->out->reset_overlaps, err);
+	c->ws = &r->essay.scene;
+	c->map = r->essay.map;
+	return rc;
+}
+
 int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *backend,
                    const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
                    bsim_trial_result *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
-	if (runner_reserve(r, scene->n_beams))
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	bsim_world *w = NULL;
-	int rc = backend->create(scene, opts, &w, err);
-	if (rc)
+	trial_ctx c = {.r = r,
+	               .scene = scene,
+	               .backend = backend,
+	               .opts = opts,
+	               .rec = rec,
+	               .log = rec ? rec->log : NULL,
+	               .out = out};
+	if (c.log)
+		c.log->n_entries = 0;
+	int rc = trial_setup(&c, err);
+	if (rc) {
+		trial_essay_release(&r->essay, backend, &c.w);
 		return rc;
+	}
 	bsim_effects fx;
 	if (bsim_effects_init(&fx, scene, seed)) {
-		backend->destroy(w);
+		backend->destroy(c.w);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 
 	bsim_state *s0 = &r->s0, *s1 = &r->s1;
-	backend->get_state(w, s0);
+	backend->get_state(c.w, s0);
 	const double h = scene->dt;
 	const int n_max = scene->max_steps;
-	double e0 = energy_kinetic(scene, s0) + energy_springs(scene, s0);
+	const long gate_max = scene->gate_steps > 0 ? scene->gate_steps : n_max;
+	const double centre = bsim_scene_centre_x(scene);
+	double e0 = energy_kinetic(c.ws, s0) + energy_springs(c.ws, s0);
 	out->ledger.e_start = e0;
-	for (int i = 0; i < 2 && i < scene->n_beams; i++)
-		out->max_theta[i] = s0->theta[i];
+	/* Peaks start at the initial angles: every beam of the scene (the
+	 * essay's world holds one gate; the others start at rest). */
+	int n_negative = 0;
+	for (int i = 0; i < scene->n_beams; i++)
+		r->peak[i] = c.map ? 0.0 : s0->theta[i];
+	for (int i = 0; !c.map && i < scene->n_beams; i++)
+		if (r->peak[i] < 0.0)
+			r->negative[n_negative++] = i;
+	if (c.log) {
+		bsim_gate_entry e;
+		entry_fill(&e, scene, c.map, s0, c.gate.ix, c.gate.iy, BSIM_EDGE_START,
+		           s0->x[0] - (scene->has_lattice ? scene->lattice.width * c.gate.ix : 0.0),
+		           0, h);
+		if (log_push(c.log, &e))
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate path");
+	}
+	c.gate.entries = 1;
 	int stride = rec && rec->stride > 0 ? rec->stride : 1;
 	FILE *csv = rec ? rec->csv : NULL;
 	bsim_trace_fn trace = rec ? rec->trace : NULL;
@@ -181,24 +514,28 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	long recorded = -1;
 	long n = 0, run_on = 0;
 	out->outcome = BSIM_STUCK;
-	while (1) {
-		int stop = done ? s0->x[1] >= scene->classify_y || run_on >= n_max : n >= n_max;
+	while (rc == BSIM_OK) {
+		int stop = done ? s0->x[1] >= scene->classify_y || run_on >= n_max
+		                : n >= n_max || c.gate.dwell >= gate_max;
 		if (stop)
 			break;
 		bsim_effects_force(&fx, n, h, f);
 		if (csv && n % stride == 0) {
-			record_row(csv, scene, s0, (double)n * h, random_value(&fx));
+			record_row(csv, scene, whole_state(&c, s0), (double)n * h,
+			           random_value(&fx));
 			recorded = n;
 		}
-		backend->step(w, f, h);
-		backend->get_state(w, s1);
+		backend->step(c.w, f, h);
+		backend->get_state(c.w, s1);
 		n++;
+		c.gate.dwell++;
 		run_on += done;
 		if (trace)
 			trace(rec->trace_user, n, s1);
-		double e1 = energy_kinetic(scene, s1) + energy_springs(scene, s1);
+		double e1 = energy_kinetic(c.ws, s1) + energy_springs(c.ws, s1);
 		ledger_step(&out->ledger, &fx, s0, s1, e0, e1);
 		e0 = e1;
+		double p0[2] = {s0->x[0], s0->x[1]};
 		bsim_state *t = s0;
 		s0 = s1;
 		s1 = t;
@@ -210,9 +547,17 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		}
 		if (done)
 			continue;
-		for (int i = 0; i < 2 && i < scene->n_beams; i++)
-			out->max_theta[i] = fmax(out->max_theta[i], s0->theta[i]);
-		if (fabs(s0->x[0]) >= scene->side_x) {
+		peaks_update(r, scene, c.map, s0, &n_negative);
+		/* The gate first: a body that leaves the field ends in the gate it
+		 * left from (gates are clamped into the field). */
+		if (scene->has_lattice) {
+			int ix, iy;
+			bsim_scene_gate_at(scene, s0->x, &ix, &iy);
+			if ((ix != c.gate.ix || iy != c.gate.iy) &&
+			    (rc = gate_enter(&c, &s0, p0, ix, iy, n, &e0, err)) != BSIM_OK)
+				break;
+		}
+		if (fabs(s0->x[0] - centre) >= scene->side_x) {
 			out->outcome = BSIM_SIDE_EXIT;
 			break;
 		}
@@ -223,14 +568,16 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 			done = 1;
 		}
 	}
-	if (csv && recorded != n) /* the final state, whatever the stride */
-		record_row(csv, scene, s0, (double)n * h, random_value(&fx));
+	if (csv && recorded != n && rc == BSIM_OK) /* the final state, whatever the stride */
+		record_row(csv, scene, whole_state(&c, s0), (double)n * h, random_value(&fx));
 	if (out->outcome != BSIM_TRAVERSED) {
 		out->steps = (int)n;
 		out->t_end = (double)n * h;
 	}
 	if (out->outcome == BSIM_STUCK)
 		out->in_contact_end = any_contact(s0);
+	for (int i = 0; i < 2 && i < scene->n_beams; i++)
+		out->max_theta[i] = r->peak[i];
 	if (out->outcome == BSIM_TRAVERSED) {
 		out->type = s0->v[0] > 0.0   ? BSIM_TYPE_LEFT
 		            : s0->v[0] < 0.0 ? BSIM_TYPE_RIGHT
@@ -243,7 +590,12 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	out->steps_run = (int)n;
 	out->ledger.e_end = e0;
 	out->draws = fx.random ? bsim_schedule_draws(fx.random->schedule) : 0;
+	out->final_ix = c.gate.ix;
+	out->final_iy = c.gate.iy;
+	out->gates_entered = c.gate.entries;
+	if (rc == BSIM_OK && c.log && log_peaks(c.log, r->peak, scene->n_beams))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the peaks");
 	bsim_effects_free(&fx);
-	backend->destroy(w);
+	trial_essay_release(&r->essay, backend, &c.w);
 	return rc;
 }

@@ -88,6 +88,7 @@
  */
 #include <box2d/box2d.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -132,8 +133,12 @@ const bsim_knob box2d_knobs[] = {
          "omega_n h < 2), or a soft b2WeldJoint (implicit, always stable, dissipative)"},
         {"unit_scale", BSIM_KNOB_DOUBLE, "1", NULL,
          "Box2D units per metre, > 0 (contacts start at a gap of 0.005 m / unit_scale)"},
+        {"sleep", BSIM_KNOB_CHOICE, "auto", "auto|on|off",
+         "Box2D's own sleeping for the beams, never for the body; auto: on for lattice "
+         "scenes"},
 };
-enum { KNOB_VEL_IT, KNOB_POS_IT, KNOB_SUBSTEPS, KNOB_SPRING, KNOB_UNIT_SCALE };
+enum { KNOB_VEL_IT, KNOB_POS_IT, KNOB_SUBSTEPS, KNOB_SPRING, KNOB_UNIT_SCALE, KNOB_SLEEP };
+enum { SLEEP_AUTO = 0, SLEEP_ON = 1, SLEEP_OFF = 2 };
 constexpr int N_KNOBS = (int)(sizeof box2d_knobs / sizeof box2d_knobs[0]);
 
 enum { SPRING_TORQUE = 0, SPRING_WELD = 1 };
@@ -170,6 +175,7 @@ void rest_direction(double deg, double u[2])
 /* One beam: its Box2D body and what a step measures about it. */
 struct beam_rec {
 	b2Body *body = nullptr;
+	int index = 0;            /* in the scene's beams */
 	double pivot[2] = {0, 0}; /* m */
 	double u0[2] = {1, 0};    /* rest direction */
 	double sgn = 1.0;         /* Box2D angle = sgn theta */
@@ -195,12 +201,23 @@ class contact_ledger;
 
 } /* namespace */
 
+struct bsim_world;
+static void mark_live(bsim_world *w, int i);
+
 struct bsim_world {
 	bsim_scene scene; /* a copy, to rebuild the world in set_state */
 	/* knobs */
 	int velocity_iterations = 8, position_iterations = 3, substeps = 1;
 	int spring = SPRING_WELD;
-	double s = 1.0; /* Box2D units per metre */
+	double s = 1.0;     /* Box2D units per metre */
+	bool sleep = false; /* Box2D's sleeping for the beams */
+	/* Live beams: those that may have moved, ascending. In a lattice only
+	 * the beams the body has touched are visited each step; elsewhere every
+	 * beam is, as it always was. */
+	bool track_live = false;
+	std::vector<int> live;
+	std::vector<char> is_live;
+	std::vector<int> typed; /* beams whose contact_type is not NONE */
 	/* Box2D */
 	b2World *world = nullptr;
 	b2Body *body = nullptr;
@@ -211,10 +228,20 @@ struct bsim_world {
 	double v_pre[2] = {0, 0}; /* body velocity the solve starts from, m/s */
 	/* results of the last step */
 	std::vector<int> contact_type;
-	bsim_step_energy energy = {0, 0, 0, 0};
+	bsim_step_energy energy = {};
 	int impacts = 0;
 	long toi_events = 0; /* continuous-collision sub-solves, all steps */
 };
+
+/* Adds beam i to the ascending live list. */
+static void mark_live(bsim_world *w, int i)
+{
+	if (!w->track_live || w->is_live[(size_t)i])
+		return;
+	w->is_live[(size_t)i] = 1;
+	auto at = std::lower_bound(w->live.begin(), w->live.end(), i);
+	w->live.insert(at, i);
+}
 
 namespace
 {
@@ -234,6 +261,7 @@ class contact_ledger : public b2ContactListener
 		beam_rec *b = beam_of(contact);
 		if (!b)
 			return;
+		mark_live(w_, b->index);
 		const b2Manifold *m = contact->GetManifold();
 		const bsim_contact_def &law = w_->scene.contact;
 		/* vertex region of the edge: the tip (or the pivot end) */
@@ -334,7 +362,7 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 	const double s = w->s;
 	const bsim_scene &sc = w->scene;
 	w->world = new b2World(b2Vec2(0.0f, 0.0f)); /* horizontal plane: no gravity */
-	w->world->SetAllowSleeping(false);
+	w->world->SetAllowSleeping(w->sleep);
 	w->world->SetContinuousPhysics(true);
 	w->world->SetWarmStarting(true);
 	w->listener = new contact_ledger(w);
@@ -349,6 +377,7 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 	bd.linearVelocity.Set((float)(v[0] * s), (float)(v[1] * s));
 	bd.fixedRotation = true; /* forces act at the centre; frictionless */
 	bd.bullet = true;
+	bd.allowSleep = false; /* the body never sleeps; only beams do */
 	bd.userData.pointer = 0;
 	w->body = w->world->CreateBody(&bd);
 	b2CircleShape disk;
@@ -377,7 +406,11 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 		beam_def.angle = (float)(b.sgn * theta[i]);
 		beam_def.angularVelocity = (float)(b.sgn * omega[i]);
 		beam_def.userData.pointer = (uintptr_t)(i + 1);
+		/* With sleeping, a beam at rest starts asleep and Box2D wakes it
+		 * when the body touches it. */
+		beam_def.awake = !w->sleep || theta[i] != 0.0 || omega[i] != 0.0;
 		b.body = w->world->CreateBody(&beam_def);
+		b.index = (int)i;
 		b2EdgeShape edge;
 		edge.SetTwoSided(b2Vec2(0.0f, 0.0f), b2Vec2((float)(d.length * s * b.u0[0]),
 		                                            (float)(d.length * s * b.u0[1])));
@@ -409,7 +442,21 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 			jd.Initialize(ground, b.body, anchor);
 			w->world->CreateJoint(&jd);
 		}
+		/* What a step records of a beam before it starts, valid for a beam
+		 * that is not live: it has not moved since it was built. */
+		b.start_position = b.body->GetPosition();
+		b.start_angle = b.body->GetAngle();
+		b.omega_applied = b.sgn * (double)b.body->GetAngularVelocity();
+		b.w_pre = b.body->GetAngularVelocity();
+		b.row = false;
 	}
+	w->live.clear();
+	w->is_live.assign(w->beams.size(), 0);
+	for (size_t i = 0; i < w->beams.size(); i++)
+		if (!w->track_live || theta[i] != 0.0 || omega[i] != 0.0) {
+			w->live.push_back((int)i);
+			w->is_live[i] = 1;
+		}
 }
 
 /* The model's contact state of beam i at the current positions: Box2D's own
@@ -427,8 +474,34 @@ int contact_type_of(const bsim_world *w, const beam_rec &b)
 	return m.type == b2Manifold::e_circles ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
 }
 
+/* In a lattice: only the beams whose fattened bounding box overlaps the
+ * body's (Box2D's contact list of the body; a touching beam is always among
+ * them) can touch it. */
+void update_contact_types_live(bsim_world *w)
+{
+	for (int i : w->typed)
+		w->contact_type[(size_t)i] = BSIM_CONTACT_NONE;
+	w->typed.clear();
+	for (b2ContactEdge *e = w->body->GetContactList(); e; e = e->next) {
+		uintptr_t id = e->other->GetUserData().pointer;
+		if (!id)
+			continue;
+		int i = (int)(id - 1);
+		int type = contact_type_of(w, w->beams[(size_t)i]);
+		if (type == BSIM_CONTACT_NONE)
+			continue;
+		w->contact_type[(size_t)i] = type;
+		w->typed.push_back(i);
+		mark_live(w, i);
+	}
+}
+
 void update_contact_types(bsim_world *w)
 {
+	if (w->track_live) {
+		update_contact_types_live(w);
+		return;
+	}
 	const double s = w->s;
 	const b2Vec2 c = w->body->GetPosition();
 	const double reach_extra = w->scene.body.radius + 1.0; /* m, generous */
@@ -504,6 +577,9 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	w->substeps = (int)substeps;
 	w->spring = bsim_options_choice(opts, &box2d_knobs[KNOB_SPRING]);
 	w->s = s;
+	int sleep = bsim_options_choice(opts, &box2d_knobs[KNOB_SLEEP]);
+	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
+	w->track_live = scene->has_lattice != 0;
 	int n = scene->n_beams;
 	w->beams.resize((size_t)n);
 	w->contact_type.assign((size_t)n, BSIM_CONTACT_NONE);
@@ -551,7 +627,9 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 	w->v_pre[1] = v0.y / s + h * f[1] / mass;
 	w->body->ApplyForceToCenter(b2Vec2((float)(f[0] * s), (float)(f[1] * s)), false);
 
-	for (beam_rec &b : w->beams) {
+	const size_t n_live = w->track_live ? w->live.size() : w->beams.size();
+	for (size_t k = 0; k < n_live; k++) {
+		beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
 		b.start_position = b.body->GetPosition();
 		b.start_angle = b.body->GetAngle();
 		b.row = false;
@@ -574,7 +652,10 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 
 	w->world->Step((float)h, w->velocity_iterations, w->position_iterations);
 
-	for (beam_rec &b : w->beams) {
+	/* The live list may have grown in the step (PreSolve). */
+	const size_t n_after = w->track_live ? w->live.size() : w->beams.size();
+	for (size_t k = 0; k < n_after; k++) {
+		const beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
 		if (b.damping == 0.0)
 			continue;
 		double omega_new = b.sgn * (double)b.body->GetAngularVelocity();
@@ -585,7 +666,7 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 
 void box2d_step(bsim_world *w, const double force[2], double h)
 {
-	w->energy = bsim_step_energy{0.0, 0.0, 0.0, 0.0};
+	w->energy = bsim_step_energy{};
 	w->impacts = 0;
 	const double hs = h / w->substeps;
 	for (int k = 0; k < w->substeps; k++)
@@ -603,7 +684,15 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 	st->v[1] = v.y / s;
 	int n = st->n_beams < (int)w->beams.size() ? st->n_beams : (int)w->beams.size();
 	st->pivot_drift = 0.0;
-	for (int i = 0; i < n; i++) {
+	if (w->track_live) {
+		bsim_state_set_active(st, w->live.data(), (int)w->live.size());
+	} else {
+		st->n_active = 0;
+		for (int i = 0; i < n; i++)
+			st->active[st->n_active++] = i;
+	}
+	for (int k = 0; k < st->n_active; k++) {
+		int i = st->active[k];
 		const beam_rec &b = w->beams[(size_t)i];
 		/* The beam body's origin is its pivot; the pin joint holds it there
 		 * only as well as Box2D's iterative solver converges. */
@@ -629,11 +718,18 @@ int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
 	try {
 		world_free_box2d(w);
 		world_build(w, st->x, st->v, st->theta, st->omega);
+		for (int i = 0; i < st->n_beams; i++)
+			if (st->contact[i] != BSIM_CONTACT_NONE)
+				mark_live(w, i);
+		w->typed.clear();
+		for (size_t i = 0; i < w->beams.size(); i++)
+			if (w->contact_type[i] != BSIM_CONTACT_NONE)
+				w->typed.push_back((int)i);
 	} catch (const std::bad_alloc &) {
 		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory");
 	}
 	update_contact_types(w);
-	w->energy = bsim_step_energy{0.0, 0.0, 0.0, 0.0};
+	w->energy = bsim_step_energy{};
 	w->impacts = 0;
 	return BSIM_OK;
 }

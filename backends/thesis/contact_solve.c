@@ -55,10 +55,13 @@ void thesis_contact_solve(struct bsim_world *w, const double force[2], double h)
 	w->x[1] += h * vm[1];
 
 	/* Beams in contact take their impulse; all others move freely. A beam
-	 * at rest and untouched stays at rest and costs nothing. */
+	 * at rest and untouched stays at rest and costs nothing: only the awake
+	 * ones (every contact's beam among them) are visited, in ascending
+	 * order, so the ledger's sums are those over all beams. */
 	for (int k = 0; k < n; k++)
 		w->contact_of[cs[k].beam] = k;
-	for (int i = 0; i < w->n_beams; i++) {
+	for (int a = 0; a < w->n_awake; a++) {
+		int i = w->awake[a];
 		thesis_beam *b = &w->beams[i];
 		int k = w->contact_of[i];
 		w->contact_of[i] = -1;

@@ -9,11 +9,28 @@
  *
  * n = 1: P = max(0, -q / K). n = 2: the four index sets are tried in turn and
  * the first that satisfies all signs is the solution; Cramer's rule keeps a
- * mirrored pair of contacts exactly mirrored. n > 2 (a body among many
- * beams): projected Gauss-Seidel. */
+ * mirrored pair of contacts exactly mirrored.
+ *
+ * n > 2 happens in a lattice, where neighbouring gates share pivot points
+ * and a body can touch three or four beams at once. Up to LCP_EXACT_MAX
+ * contacts the active sets S are enumerated the same way, smallest first:
+ *   P_S = -K_SS^-1 q_S (LU, GSL),  P_S >= 0,  w_j >= 0 for j not in S;
+ * the first that holds is the solution (unique, K being positive definite;
+ * where K is only semi-definite, as for two pivot-end contacts at one shared
+ * pivot, an S with K_SS singular is skipped and the solution with linearly
+ * independent rows is found). Beyond that, or if round-off leaves no set
+ * within tolerance, projected Gauss-Seidel iterates to convergence; each
+ * such solve is counted (thesis_lcp_fallbacks). test_lattice checks both
+ * paths against the complementarity conditions. */
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_permutation.h>
 #include <math.h>
 
 #include "thesis/thesis.h"
+
+/* Contacts solved exactly by enumeration: 2^n active sets. */
+#define LCP_EXACT_MAX 10
 
 static double k_entry(const struct bsim_world *w, const thesis_contact *a, const thesis_contact *b)
 {
@@ -55,7 +72,7 @@ static void lcp_gauss_seidel(const struct bsim_world *w, thesis_contact *cs, int
 {
 	for (int i = 0; i < n; i++)
 		cs[i].impulse = 0.0;
-	for (int iter = 0; iter < 100; iter++) {
+	for (int iter = 0; iter < 100000; iter++) {
 		double change = 0.0;
 		for (int i = 0; i < n; i++) {
 			double wi = cs[i].vrel - cs[i].bound;
@@ -70,6 +87,94 @@ static void lcp_gauss_seidel(const struct bsim_world *w, thesis_contact *cs, int
 	}
 }
 
+static int popcount(unsigned v)
+{
+	int c = 0;
+	for (; v; v &= v - 1)
+		c++;
+	return c;
+}
+
+/* Tries active set `mask`: 1 and the impulses in cs if it solves the LCP. */
+static int lcp_try_set(const struct bsim_world *w, thesis_contact *cs, int n, unsigned mask,
+                       const double *q, double tol)
+{
+	double kss[LCP_EXACT_MAX * LCP_EXACT_MAX], p[LCP_EXACT_MAX], rhs[LCP_EXACT_MAX];
+	int idx[LCP_EXACT_MAX], m = 0;
+	for (int i = 0; i < n; i++)
+		if (mask & (1u << i))
+			idx[m++] = i;
+	for (int a = 0; a < m; a++) {
+		rhs[a] = -q[idx[a]];
+		for (int b = 0; b < m; b++)
+			kss[a * m + b] = k_entry(w, &cs[idx[a]], &cs[idx[b]]);
+	}
+	if (m > 0) {
+		/* LU with partial pivoting; a pivot below round-off of the
+		 * diagonal marks K_SS singular (checked here, so GSL's error
+		 * handler never sees a singular solve). */
+		double scale = 0.0;
+		for (int a = 0; a < m; a++)
+			scale = fmax(scale, kss[a * m + a]);
+		size_t perm_data[LCP_EXACT_MAX];
+		gsl_permutation perm = {(size_t)m, perm_data};
+		int sign;
+		gsl_matrix_view kv = gsl_matrix_view_array(kss, (size_t)m, (size_t)m);
+		gsl_vector_view rv = gsl_vector_view_array(rhs, (size_t)m);
+		gsl_vector_view pv = gsl_vector_view_array(p, (size_t)m);
+		if (gsl_linalg_LU_decomp(&kv.matrix, &perm, &sign) != GSL_SUCCESS)
+			return 0;
+		for (int a = 0; a < m; a++)
+			if (!(fabs(kss[a * m + a]) > 1e-12 * scale))
+				return 0;
+		if (gsl_linalg_LU_solve(&kv.matrix, &perm, &rv.vector, &pv.vector) != GSL_SUCCESS)
+			return 0;
+	}
+	for (int a = 0; a < m; a++)
+		if (!(p[a] >= 0.0))
+			return 0;
+	for (int j = 0; j < n; j++) {
+		if (mask & (1u << j))
+			continue;
+		double wj = q[j];
+		for (int a = 0; a < m; a++)
+			wj += k_entry(w, &cs[j], &cs[idx[a]]) * p[a];
+		if (wj < -tol)
+			return 0;
+	}
+	for (int i = 0; i < n; i++)
+		cs[i].impulse = 0.0;
+	for (int a = 0; a < m; a++)
+		cs[idx[a]].impulse = p[a];
+	return 1;
+}
+
+static int lcp_enumerate(const struct bsim_world *w, thesis_contact *cs, int n)
+{
+	double q[LCP_EXACT_MAX], qmax = 0.0;
+	for (int i = 0; i < n; i++) {
+		q[i] = cs[i].vrel - cs[i].bound;
+		qmax = fmax(qmax, fabs(q[i]));
+	}
+	double tol = 1e-12 * (1.0 + qmax); /* m/s */
+	unsigned sets = 1u << n;
+	for (int size = 0; size <= n; size++)
+		for (unsigned mask = 0; mask < sets; mask++)
+			if (popcount(mask) == size && lcp_try_set(w, cs, n, mask, q, tol))
+				return 1;
+	return 0;
+}
+
+static long lcp_fallbacks;
+
+long thesis_lcp_fallbacks(void)
+{
+	long n;
+#pragma omp atomic read
+	n = lcp_fallbacks;
+	return n;
+}
+
 void thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n)
 {
 	if (n == 1) {
@@ -78,6 +183,10 @@ void thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n)
 	} else if (n == 2) {
 		lcp_two(w, &cs[0], &cs[1]);
 	} else if (n > 2) {
+		if (n <= LCP_EXACT_MAX && lcp_enumerate(w, cs, n))
+			return;
+#pragma omp atomic update
+		lcp_fallbacks++;
 		lcp_gauss_seidel(w, cs, n);
 	}
 }

@@ -38,6 +38,15 @@ typedef struct thesis_contact {
 	double impulse; /* N s */
 } thesis_contact;
 
+/* The broad phase's uniform grid over the pivots (broad_phase.c). */
+typedef struct thesis_grid {
+	double origin[2]; /* m, corner of cell (0, 0) */
+	double cell;      /* m, cell side, >= the largest beam reach L + R */
+	int nx, ny;       /* cells */
+	int *start;       /* nx ny + 1 offsets into items */
+	int *items;       /* beam indices, ascending within a cell */
+} thesis_grid;
+
 enum { THESIS_MIDPOINT = 0, THESIS_EULER = 1 };
 enum { THESIS_SIMULTANEOUS = 0, THESIS_NEAREST_FIRST = 1 };
 
@@ -50,8 +59,22 @@ struct bsim_world {
 	double rest_threshold;   /* m/s */
 	/* knobs */
 	int integrator, impact_order, projection;
-	double slop;        /* penetration tolerated before projection, m */
-	double contact_tol; /* gap counted as touching in the state, m */
+	double slop;         /* penetration tolerated before projection, m */
+	double contact_tol;  /* gap counted as touching in the state, m */
+	int broad_phase;     /* 1: grid query for beams at rest; 0: test every beam */
+	int sleep;           /* 1: beams below sleep_energy, body far, are put to rest */
+	double sleep_energy; /* J */
+	thesis_grid grid;
+	/* Awake beams: every beam with theta or omega not exactly 0 or a
+	 * contact this step is listed (ascending); the others are at rest and
+	 * cost nothing (beam_sleep.c). */
+	int *awake;
+	int n_awake;
+	unsigned char *is_awake; /* per beam */
+	int *candidates;         /* per step: beams to test, ascending */
+	int *typed;              /* beams whose contact_type is not NONE */
+	int n_typed;
+	long sleeps; /* beams put to rest by sleeping, all steps */
 	/* per step */
 	thesis_contact *contacts; /* n_beams capacity */
 	int n_contacts;
@@ -61,6 +84,17 @@ struct bsim_world {
 	int impacts;
 };
 
+/* broad_phase.c */
+double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b, double speed, double h);
+int thesis_grid_build(thesis_grid *g, const struct bsim_world *w);
+void thesis_grid_free(thesis_grid *g);
+int thesis_broad_phase(struct bsim_world *w, double speed, double h);
+
+/* beam_sleep.c */
+void thesis_beam_wake(struct bsim_world *w, int i);
+void thesis_beams_sleep(struct bsim_world *w, double speed, double h);
+void thesis_awake_prune(struct bsim_world *w);
+
 /* contact_detect.c */
 void thesis_beam_direction(const thesis_beam *b, double u[2]);
 int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out);
@@ -68,6 +102,9 @@ void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c);
 
 /* lcp_solve.c */
 void thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n);
+/* Solves with more than 2 contacts that fell back to Gauss-Seidel, all
+ * worlds, since the program started. */
+long thesis_lcp_fallbacks(void);
 /* The total impulse sum P_i n_i on the body, N s. */
 void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2]);
 

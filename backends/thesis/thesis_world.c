@@ -5,7 +5,11 @@
  *      rest_threshold);
  *   3. smooth motion under the external force, springs, dampers and
  *      persistent contact forces;
- *   4. projection of any penetration left by the contacts' curvature. */
+ *   4. projection of any penetration left by the contacts' curvature;
+ *   5. sleeping: beams the body has left and whose energy has decayed are
+ *      put exactly to rest (beam_sleep.c).
+ * Only the beams near the body (broad_phase.c) and the awake ones are
+ * touched, so a step costs the same in a field of one gate or a thousand. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,8 +27,26 @@ static const bsim_knob thesis_knobs[] = {
         {"slop", BSIM_KNOB_DOUBLE, "1e-6", NULL, "penetration tolerated before projection, m"},
         {"contact_tol", BSIM_KNOB_DOUBLE, "1e-3", NULL,
          "gap below which a beam is reported as touching the body, m"},
+        {"broad_phase", BSIM_KNOB_INT, "1", NULL,
+         "1: test only the beams near the body (a grid over the pivots) and the awake "
+         "ones; 0: test every beam every step (same results, for checking)"},
+        {"sleep", BSIM_KNOB_CHOICE, "auto", "auto|on|off",
+         "put beams the body has left back exactly to rest once their energy is below "
+         "sleep_energy; auto: on for lattice scenes"},
+        {"sleep_energy", BSIM_KNOB_DOUBLE, "1e-6", NULL,
+         "energy below which a beam the body has left sleeps, J"},
 };
-enum { KNOB_INTEGRATOR, KNOB_IMPACT_ORDER, KNOB_PROJECTION, KNOB_SLOP, KNOB_CONTACT_TOL };
+enum {
+	KNOB_INTEGRATOR,
+	KNOB_IMPACT_ORDER,
+	KNOB_PROJECTION,
+	KNOB_SLOP,
+	KNOB_CONTACT_TOL,
+	KNOB_BROAD_PHASE,
+	KNOB_SLEEP,
+	KNOB_SLEEP_ENERGY
+};
+enum { SLEEP_AUTO = 0, SLEEP_ON = 1, SLEEP_OFF = 2 };
 #define N_KNOBS ((int)(sizeof thesis_knobs / sizeof thesis_knobs[0]))
 
 /* The rest direction, exact at multiples of 90 degrees so that a mirrored
@@ -52,6 +74,11 @@ static void thesis_destroy(bsim_world *w)
 	free(w->contacts);
 	free(w->contact_of);
 	free(w->contact_type);
+	free(w->awake);
+	free(w->is_awake);
+	free(w->candidates);
+	free(w->typed);
+	thesis_grid_free(&w->grid);
 	free(w);
 }
 
@@ -69,8 +96,13 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->contacts = calloc(nb, sizeof *w->contacts);
 		w->contact_of = malloc(nb * sizeof *w->contact_of);
 		w->contact_type = calloc(nb, sizeof *w->contact_type);
+		w->awake = malloc(nb * sizeof *w->awake);
+		w->is_awake = calloc(nb, sizeof *w->is_awake);
+		w->candidates = malloc(nb * sizeof *w->candidates);
+		w->typed = malloc(nb * sizeof *w->typed);
 	}
-	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type) {
+	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type || !w->awake ||
+	    !w->is_awake || !w->candidates || !w->typed) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
@@ -102,38 +134,53 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	w->projection = bsim_options_int(opts, &thesis_knobs[KNOB_PROJECTION]) != 0;
 	w->slop = bsim_options_double(opts, &thesis_knobs[KNOB_SLOP]);
 	w->contact_tol = fmax(bsim_options_double(opts, &thesis_knobs[KNOB_CONTACT_TOL]), w->slop);
+	w->broad_phase = bsim_options_int(opts, &thesis_knobs[KNOB_BROAD_PHASE]) != 0;
+	int sleep = bsim_options_choice(opts, &thesis_knobs[KNOB_SLEEP]);
+	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
+	w->sleep_energy = bsim_options_double(opts, &thesis_knobs[KNOB_SLEEP_ENERGY]);
+	if (!(w->sleep_energy >= 0.0) || !isfinite(w->sleep_energy)) {
+		thesis_destroy(w);
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "thesis: sleep_energy: expected a number >= 0 (J)");
+	}
+	for (int i = 0; i < w->n_beams; i++)
+		if (w->beams[i].theta != 0.0 || w->beams[i].omega != 0.0)
+			thesis_beam_wake(w, i);
+	if (w->broad_phase && thesis_grid_build(&w->grid, w)) {
+		thesis_destroy(w);
+		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
+	}
 	*out = w;
 	return BSIM_OK;
 }
 
+/* Beams at rest have omega = 0 and add nothing: the awake ones, in
+ * ascending order, give the sum over all beams to the bit. */
 double thesis_kinetic_energy(const bsim_world *w)
 {
 	double e = 0.5 * w->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);
-	for (int i = 0; i < w->n_beams; i++)
-		e += 0.5 * w->beams[i].inertia * w->beams[i].omega * w->beams[i].omega;
+	for (int k = 0; k < w->n_awake; k++) {
+		const thesis_beam *b = &w->beams[w->awake[k]];
+		e += 0.5 * b->inertia * b->omega * b->omega;
+	}
 	return e;
-}
-
-/* How far beam i and the body can close on each other within the step, with
- * a factor 2 of safety: body and tip speeds, and what the force and the
- * spring add over the step. Contacts within it enter the step's solve. */
-static double step_margin(const bsim_world *w, const thesis_beam *b, double speed, double h)
-{
-	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
-	               b->inertia;
-	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
 }
 
 static void thesis_step(bsim_world *w, const double force[2], double h)
 {
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
+	for (int k = 0; k < w->n_typed; k++)
+		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
+	w->n_typed = 0;
 	double speed = hypot(w->v[0], w->v[1]) + h * hypot(force[0], force[1]) * w->inv_mass;
+	int m = thesis_broad_phase(w, speed, h);
 	int n = 0;
-	for (int i = 0; i < w->n_beams; i++) {
-		w->contact_type[i] = BSIM_CONTACT_NONE;
-		n += thesis_contact_detect(w, i, step_margin(w, &w->beams[i], speed, h),
-		                           &w->contacts[n]);
+	for (int k = 0; k < m; k++) {
+		int i = w->candidates[k];
+		if (thesis_contact_detect(w, i, thesis_step_margin(w, &w->beams[i], speed, h),
+		                          &w->contacts[n]))
+			thesis_beam_wake(w, w->contacts[n++].beam);
 	}
 	w->n_contacts = n;
 	if (n)
@@ -141,6 +188,12 @@ static void thesis_step(bsim_world *w, const double force[2], double h)
 	thesis_contact_solve(w, force, h);
 	if (n)
 		thesis_position_project(w, force);
+	for (int k = 0; k < w->n_contacts; k++)
+		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE)
+			w->typed[w->n_typed++] = w->contacts[k].beam;
+	if (w->sleep)
+		thesis_beams_sleep(w, speed, h);
+	thesis_awake_prune(w);
 }
 
 static void thesis_get_state(const bsim_world *w, bsim_state *s)
@@ -148,8 +201,9 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 	memcpy(s->x, w->x, sizeof s->x);
 	memcpy(s->v, w->v, sizeof s->v);
 	s->pivot_drift = 0.0; /* a beam here is an angle about a fixed pivot */
-	int n = s->n_beams < w->n_beams ? s->n_beams : w->n_beams;
-	for (int i = 0; i < n; i++) {
+	bsim_state_set_active(s, w->awake, w->n_awake);
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k];
 		s->theta[i] = w->beams[i].theta;
 		s->omega[i] = w->beams[i].omega;
 		s->contact[i] = w->contact_type[i];
@@ -165,10 +219,17 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 		                      s->n_beams, w->n_beams);
 	memcpy(w->x, s->x, sizeof w->x);
 	memcpy(w->v, s->v, sizeof w->v);
+	w->n_awake = 0;
+	w->n_typed = 0;
+	memset(w->is_awake, 0, (size_t)w->n_beams * sizeof *w->is_awake);
 	for (int i = 0; i < w->n_beams; i++) {
 		w->beams[i].theta = s->theta[i];
 		w->beams[i].omega = s->omega[i];
 		w->contact_type[i] = s->contact[i];
+		if (s->contact[i] != BSIM_CONTACT_NONE)
+			w->typed[w->n_typed++] = i;
+		if (s->theta[i] != 0.0 || s->omega[i] != 0.0 || s->contact[i] != BSIM_CONTACT_NONE)
+			thesis_beam_wake(w, i);
 	}
 	return BSIM_OK;
 }

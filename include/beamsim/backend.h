@@ -18,12 +18,13 @@ enum { BSIM_CONTACT_NONE = 0, BSIM_CONTACT_TANGENT = 1, BSIM_CONTACT_TIP = 2 };
 
 /* Energy flows of the last step, J, as measured by the backend. With the
  * runner's work of the external force they close the energy ledger:
- * dE = W_ext - damper - impact - contact - correction. */
+ * dE = W_ext - damper - impact - contact - correction - sleep. */
 typedef struct bsim_step_energy {
 	double damper;     /* dissipated by the beam dampers (>= 0) */
 	double impact;     /* lost in impacts, incl. plastic entry to rest (>= 0) */
 	double contact;    /* -(work of persistent contact forces), ~0 */
 	double correction; /* energy change from position correction */
+	double sleep;      /* of beams put exactly to rest by sleeping (>= 0) */
 } bsim_step_energy;
 
 typedef struct bsim_state {
@@ -37,11 +38,22 @@ typedef struct bsim_state {
 	int impacts;             /* impacts resolved in the last step */
 	double pivot_drift;      /* m, largest distance of a beam's pinned point from
 	                          * its pivot (0 where the pin is exact by construction) */
+	/* The beams that may be away from rest, ascending: every beam not
+	 * listed has theta = omega = 0 and no contact, and so have its entries
+	 * in theta, omega and contact. A backend may list more than it must
+	 * (all n_beams, say); readers that loop over active[] instead of all
+	 * beams cost what the beams near the body cost. */
+	int n_active;
+	int *active; /* n_beams capacity */
 } bsim_state;
 
 int bsim_state_alloc(bsim_state *s, int n_beams);
 void bsim_state_free(bsim_state *s);
 void bsim_state_copy(bsim_state *dst, const bsim_state *src);
+/* For a backend's get_state: zeroes the entries of the beams s lists now,
+ * then lists the n given ones (ascending), whose entries the backend then
+ * writes. Costs the two lists, not n_beams. */
+void bsim_state_set_active(bsim_state *s, const int *active, int n);
 
 /* Backend options: typed key/value knobs, `--backend-opt key=value`. */
 #define BSIM_OPTIONS_MAX 16

@@ -44,6 +44,30 @@ typedef struct bsim_effects_def {
 	double random_frequency; /* Hz, refresh rate of the draw, > 0; default 50 */
 } bsim_effects_def;
 
+/* A gate lattice (MODEL.md section 8, DESIGN.md "Scene file"): gates
+ * (ix, iy), ix_min <= ix <= ix_max, 0 <= iy < rows. Gate (ix, iy) spans
+ * X in [width ix - width/2, width ix + width/2), Y in [depth iy, depth (iy + 1))
+ * (essay Eq. 2.17); its left beam hangs at (width ix - width/2, depth iy +
+ * pivot_y) pointing +x, its right beam at (width ix + width/2, ...) pointing
+ * -x, so neighbouring gates share pivot points. The scene's beams are the
+ * lattice's, gate by gate: beam 2 ((iy) columns + ix - ix_min) + side, side 0
+ * the left beam and 1 the right (bsim_lattice_beam). */
+typedef enum bsim_protocol {
+	BSIM_PROTOCOL_WORLD = 0, /* one world: every beam keeps its state */
+	BSIM_PROTOCOL_ESSAY = 1, /* the essay's: only the active gate, reset on entry */
+} bsim_protocol;
+
+typedef struct bsim_lattice_def {
+	int columns, rows;        /* gates across (ix) and along (iy), >= 1 */
+	int ix_min, ix_max;       /* ix_max - ix_min + 1 = columns */
+	double width;             /* m, gate width along x; default 50 */
+	double depth;             /* m, gate depth along y; default 60 */
+	double pivot_y;           /* m, pivot row above the gate's bottom edge; default 30 */
+	bsim_beam_def beam;       /* every beam's length, mass, inertia, stiffness, damping */
+	bsim_protocol protocol;   /* default BSIM_PROTOCOL_WORLD */
+	char stiffness_file[256]; /* the map's CSV as the scene names it, "" if none */
+} bsim_lattice_def;
+
 typedef struct bsim_scene {
 	char name[128];
 	char path[1024]; /* the file it came from, "" if built in code */
@@ -58,6 +82,12 @@ typedef struct bsim_scene {
 	double side_x;       /* m, > 0; default 25 */
 	double classify_y;   /* m, >= success_y; default 80 */
 	double landscape_y0; /* m, zero of the propulsive potential; default 60 */
+	/* Stuck: the body stayed gate_steps steps in one gate (a lattice;
+	 * default 3000, the essay's single-gate limit), or max_steps in all.
+	 * 0: the same as max_steps. */
+	int gate_steps;
+	int has_lattice; /* 1: beams were built from lattice */
+	bsim_lattice_def lattice;
 } bsim_scene;
 
 /* One override of a scene field by dotted path, e.g. key "beams.0.stiffness",

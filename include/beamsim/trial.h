@@ -14,9 +14,9 @@ extern "C" {
 #endif
 
 typedef enum {
-	BSIM_TRAVERSED = 0, /* y >= success_y with |x| < side_x */
-	BSIM_SIDE_EXIT = 1, /* |x| >= side_x before traversing */
-	BSIM_STUCK = 2,     /* max_steps reached */
+	BSIM_TRAVERSED = 0, /* y >= success_y with |x - x_c| < side_x */
+	BSIM_SIDE_EXIT = 1, /* |x - x_c| >= side_x before traversing */
+	BSIM_STUCK = 2,     /* max_steps reached, or gate_steps in one gate */
 } bsim_outcome;
 
 typedef enum {
@@ -27,12 +27,16 @@ typedef enum {
 
 /* The energy ledger of a trial, J (MODEL.md section 10, oracle 3).
  * E = body KE + sum(1/2 I omega^2 + 1/2 k theta^2). Each step:
- *   E' - E = w_prop + w_rand - damper - impact - contact - correction + r
- * with r the step's residual; |r| summed and at its largest are kept. */
+ *   E' - E = w_prop + w_rand - damper - impact - contact - correction - sleep + r
+ * with r the step's residual; |r| summed and at its largest are kept. The
+ * essay's lattice protocol resets the beams of each gate entered; the energy
+ * they held leaves the world there and is booked as reset. */
 typedef struct bsim_ledger {
 	double e_start, e_end;
 	double w_prop, w_rand; /* work of the propulsive and random forces */
 	double damper, impact, contact, correction;
+	double sleep;        /* energy of beams put to rest by the backend's sleeping */
+	double reset;        /* energy of beams reset by the essay protocol */
 	double residual;     /* sum of r */
 	double residual_max; /* max |r| over steps */
 	double residual_abs; /* sum of |r| */
@@ -50,7 +54,54 @@ typedef struct bsim_trial_result {
 	int steps_run;               /* all steps integrated, incl. those to classify_y */
 	unsigned long draws;         /* standard-normal draws made */
 	bsim_ledger ledger;
+	/* The gate where the trial ended (a lattice, lattice.h; (0, 0) for any
+	 * other scene): the last gate entered before the outcome. */
+	int final_ix, final_iy;
+	int gates_entered;  /* gates in the path, the start gate included */
+	int reset_overlaps; /* essay protocol: entries whose reset beams overlapped the body */
 } bsim_trial_result;
+
+/* Which edge of a gate the body crossed to enter it. */
+typedef enum {
+	BSIM_EDGE_START = 0,  /* the gate the trial starts in */
+	BSIM_EDGE_BOTTOM = 1, /* from the gate below (iy - 1) */
+	BSIM_EDGE_LEFT = 2,   /* from the gate on the left (ix - 1) */
+	BSIM_EDGE_RIGHT = 3,  /* from the gate on the right (ix + 1) */
+	BSIM_EDGE_TOP = 4,    /* from the gate above (iy + 1) */
+} bsim_edge;
+
+const char *bsim_edge_name(bsim_edge e);
+
+/* One entry into a gate: the state with which a single-gate map (entry ->
+ * exit) would start, in the gate's own frame (Eq. 2.17: x = X - width ix,
+ * y = Y - depth iy). The beams are the entered gate's as the body arrived:
+ * the state it left them in (whole world), before the essay protocol
+ * resets them. */
+typedef struct bsim_gate_entry {
+	int ix, iy;
+	bsim_edge edge;
+	int step;        /* the step at whose end the body was inside */
+	double t;        /* s */
+	double pos;      /* m, where the path crossed the edge: x on a bottom or top
+	                  * edge, y on a left or right one, gate frame; START: x */
+	double x[2];     /* m, body centre at the end of that step, gate frame */
+	double v[2];     /* m/s */
+	double theta[2]; /* rad, the gate's left and right beam */
+	double omega[2]; /* rad/s */
+} bsim_gate_entry;
+
+/* What a trial can leave beyond its result (bsim_recorder.log): the gate
+ * path with each entry's state, and every beam's peak angle. Reused from
+ * trial to trial; alloc/free pair. */
+typedef struct bsim_trial_log {
+	int n_entries, cap_entries;
+	bsim_gate_entry *entries;
+	int n_beams, cap_beams;
+	double *peak; /* n_beams: peak theta of every beam, rad */
+} bsim_trial_log;
+
+bsim_trial_log *bsim_trial_log_alloc(void);
+void bsim_trial_log_free(bsim_trial_log *l);
 
 /* Called with the state at t = 0 and after every step (step = 1, 2, ...),
  * whatever the stride; for in-memory use of a trajectory (compare). */
@@ -62,6 +113,7 @@ typedef struct bsim_recorder {
 	int stride;          /* record every stride-th step (>= 1) */
 	bsim_trace_fn trace; /* NULL: none */
 	void *trace_user;
+	bsim_trial_log *log; /* NULL: none */
 } bsim_recorder;
 
 /* Writes the trajectory CSV header for a scene of n_beams beams. */
@@ -74,6 +126,9 @@ bsim_runner *bsim_runner_alloc(void);
 void bsim_runner_free(bsim_runner *r);
 
 /* Runs one trial. seed: the mixed seed (bsim_seed_mix). rec may be NULL.
+ * A lattice scene runs under its lattice.protocol: the whole world, or the
+ * essay's (each gate entered gets a fresh world of its two beams at rest,
+ * the body's state carried over; the trace then sees that world's state).
  * Returns BSIM_OK, BSIM_EINPUT (backend options), BSIM_EFAIL (non-finite
  * state: the message says at which step). */
 int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *backend,

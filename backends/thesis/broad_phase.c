@@ -1,0 +1,166 @@
+/* Broad phase: which beams a step must test for contact, at a cost that
+ * follows the body rather than the size of the field.
+ *
+ * Within one step of h a beam i and the body can close by at most
+ *   m_i = 2 (h (|v| + L_i |omega_i|) + h^2 L_i (k_i |theta_i| + d_i |omega_i|) / I_i) + slop
+ * (body and tip speeds, and what the force and the spring add, with a
+ * factor 2 of safety; |v| already includes h |F| / M). A beam can touch the
+ * body only if the body's centre C lies within L_i + R + m_i of its pivot
+ * P_i; contact_detect.c makes that test exactly, beam by beam.
+ *
+ * A beam at rest (theta = omega = 0) has m_i = 2 h |v| + slop, the same for
+ * every such beam. The pivots sit in a uniform grid of cells of side
+ *   c >= max_i L_i + R,
+ * so every beam at rest that can touch the body has its pivot in a cell
+ * overlapping the square [C - r, C + r]^2 with r = c + 2 h |v| + slop >=
+ * L_i + R + m_i: 3 x 3 or 4 x 4 cells, whatever the number of beams. Awake
+ * beams (beam_sleep.c) are few and are all tested, each with its own
+ * margin. The candidates are tested in ascending beam order, so the
+ * contacts come out in the order of testing every beam: the broad phase
+ * changes the cost, never a bit of the result (test_lattice checks it
+ * against broad_phase=0). */
+#include <math.h>
+#include <stdlib.h>
+
+#include "thesis/thesis.h"
+
+double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b, double speed, double h)
+{
+	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
+	               b->inertia;
+	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
+}
+
+void thesis_grid_free(thesis_grid *g)
+{
+	free(g->start);
+	free(g->items);
+	g->start = g->items = NULL;
+	g->nx = g->ny = 0;
+}
+
+static void grid_cell_of(const thesis_grid *g, const double p[2], int *cx, int *cy)
+{
+	*cx = (int)floor((p[0] - g->origin[0]) / g->cell);
+	*cy = (int)floor((p[1] - g->origin[1]) / g->cell);
+}
+
+int thesis_grid_build(thesis_grid *g, const struct bsim_world *w)
+{
+	thesis_grid_free(g);
+	double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, reach = 0.0;
+	for (int i = 0; i < w->n_beams; i++) {
+		const thesis_beam *b = &w->beams[i];
+		for (int a = 0; a < 2; a++) {
+			lo[a] = fmin(lo[a], b->p[a]);
+			hi[a] = fmax(hi[a], b->p[a]);
+		}
+		reach = fmax(reach, b->length + w->radius);
+	}
+	if (w->n_beams == 0)
+		lo[0] = lo[1] = hi[0] = hi[1] = 0.0;
+	/* A cell at least the reach wide; wider where the pivots are spread so
+	 * far apart that the grid would hold many more cells than beams. */
+	g->cell = reach > 0.0 ? reach : 1.0;
+	double cells_max = 4.0 * w->n_beams + 16.0;
+	while (((hi[0] - lo[0]) / g->cell + 1.0) * ((hi[1] - lo[1]) / g->cell + 1.0) > cells_max)
+		g->cell *= 2.0;
+	g->origin[0] = lo[0];
+	g->origin[1] = lo[1];
+	g->nx = (int)floor((hi[0] - lo[0]) / g->cell) + 1;
+	g->ny = (int)floor((hi[1] - lo[1]) / g->cell) + 1;
+	size_t cells = (size_t)g->nx * (size_t)g->ny;
+	g->start = calloc(cells + 1, sizeof *g->start);
+	g->items = malloc((w->n_beams > 0 ? (size_t)w->n_beams : 1) * sizeof *g->items);
+	if (!g->start || !g->items) {
+		thesis_grid_free(g);
+		return -1;
+	}
+	/* Counting sort by cell keeps the beams of a cell in ascending order. */
+	for (int i = 0; i < w->n_beams; i++) {
+		int cx, cy;
+		grid_cell_of(g, w->beams[i].p, &cx, &cy);
+		g->start[(size_t)cy * g->nx + cx + 1]++;
+	}
+	for (size_t c = 0; c < cells; c++)
+		g->start[c + 1] += g->start[c];
+	int *fill = malloc((cells ? cells : 1) * sizeof *fill);
+	if (!fill) {
+		thesis_grid_free(g);
+		return -1;
+	}
+	for (size_t c = 0; c < cells; c++)
+		fill[c] = g->start[c];
+	for (int i = 0; i < w->n_beams; i++) {
+		int cx, cy;
+		grid_cell_of(g, w->beams[i].p, &cx, &cy);
+		g->items[fill[(size_t)cy * g->nx + cx]++] = i;
+	}
+	free(fill);
+	return 0;
+}
+
+static int cmp_int(const void *a, const void *b)
+{
+	int x = *(const int *)a, y = *(const int *)b;
+	return (x > y) - (x < y);
+}
+
+/* Sorts the first n candidates ascending: by insertion while they are few
+ * (the usual case, and the awake ones come sorted). */
+static void sort_small(int *v, int n)
+{
+	if (n > 32) {
+		qsort(v, (size_t)n, sizeof *v, cmp_int);
+		return;
+	}
+	for (int i = 1; i < n; i++) {
+		int x = v[i], j = i - 1;
+		for (; j >= 0 && v[j] > x; j--)
+			v[j + 1] = v[j];
+		v[j + 1] = x;
+	}
+}
+
+/* Fills w->candidates with the beams the step must test; returns how many. */
+int thesis_broad_phase(struct bsim_world *w, double speed, double h)
+{
+	int *out = w->candidates;
+	int n = 0;
+	if (!w->broad_phase) {
+		for (int i = 0; i < w->n_beams; i++)
+			out[n++] = i;
+		return n;
+	}
+	for (int k = 0; k < w->n_awake; k++)
+		out[n++] = w->awake[k];
+	const thesis_grid *g = &w->grid;
+	double r = g->cell + 2.0 * h * speed + w->slop;
+	double lo[2] = {w->x[0] - r, w->x[1] - r}, hi[2] = {w->x[0] + r, w->x[1] + r};
+	int c0x, c0y, c1x, c1y;
+	/* Far outside the grid: no cell is near (and no int overflow). */
+	if (hi[0] < g->origin[0] || hi[1] < g->origin[1] ||
+	    lo[0] > g->origin[0] + g->cell * g->nx || lo[1] > g->origin[1] + g->cell * g->ny)
+		return n;
+	grid_cell_of(g, lo, &c0x, &c0y);
+	grid_cell_of(g, hi, &c1x, &c1y);
+	c0x = c0x < 0 ? 0 : c0x;
+	c0y = c0y < 0 ? 0 : c0y;
+	c1x = c1x >= g->nx ? g->nx - 1 : c1x;
+	c1y = c1y >= g->ny ? g->ny - 1 : c1y;
+	int sleeping_found = 0;
+	for (int cy = c0y; cy <= c1y; cy++)
+		for (int cx = c0x; cx <= c1x; cx++) {
+			size_t c = (size_t)cy * g->nx + cx;
+			for (int k = g->start[c]; k < g->start[c + 1]; k++) {
+				int i = g->items[k];
+				if (w->is_awake[i])
+					continue;
+				out[n++] = i;
+				sleeping_found = 1;
+			}
+		}
+	if (sleeping_found)
+		sort_small(out, n);
+	return n;
+}
