@@ -64,7 +64,8 @@ int bsim_trial_identical(const bsim_trial_result *a, const bsim_trial_result *b)
 {
 	return !bsim_trial_discordant(a, b) && a->steps == b->steps && a->t_end == b->t_end &&
 	       a->x_end == b->x_end && a->y_end == b->y_end && a->vx_end == b->vx_end &&
-	       a->max_theta[0] == b->max_theta[0] && a->max_theta[1] == b->max_theta[1];
+	       a->max_theta[0] == b->max_theta[0] && a->max_theta[1] == b->max_theta[1] &&
+	       a->final_ix == b->final_ix && a->final_iy == b->final_iy;
 }
 
 static void event_test(const bsim_trial_result *a, const bsim_trial_result *b, int n, bsim_event ev,

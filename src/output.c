@@ -15,6 +15,7 @@
 
 #include "beamsim/atomic_file.h"
 #include "beamsim/json.h"
+#include "beamsim/lattice.h"
 #include "beamsim/version.h"
 
 /* A grid value is a JSON number when its YAML text is a finite number. */
@@ -93,8 +94,66 @@ void bsim_output_group_params(FILE *f, const bsim_experiment *e, int g)
 	json_params(f, e, idx);
 }
 
-static void json_group(FILE *f, const bsim_experiment *e, const bsim_group_result *g, int *idx)
+/* A lattice group's final-location distribution, transitions and time per
+ * row (beamsim/lattice.h). */
+static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 {
+	bsim_lattice_summary ls;
+	const bsim_trial_result *t = &r->trials_out[(size_t)group * r->trials];
+	const bsim_trial_log *l = r->logs ? &r->logs[(size_t)group * r->trials] : NULL;
+	if (bsim_lattice_summarise(t, l, r->trials, r->lattice_def.rows, &ls) != BSIM_OK) {
+		fputs(", \"lattice\": null", f);
+		return;
+	}
+	fputs(", \"lattice\": {\"final_locations\": [", f);
+	for (int k = 0; k < ls.n_locations; k++) {
+		const bsim_location_count *c = &ls.locations[k];
+		char label[48];
+		bsim_location_label(c->loc, label, sizeof label);
+		static const char *const kinds[] = {"end", "side", "stuck"};
+		fprintf(f, "%s{\"location\": \"%s\", \"kind\": \"%s\", \"ix\": ", k ? ", " : "",
+		        label, kinds[c->loc.kind]);
+		if (c->loc.kind == BSIM_LOCATION_SIDE)
+			fputs("null", f);
+		else
+			fprintf(f, "%d", c->loc.ix);
+		fputs(", \"iy\": ", f);
+		if (c->loc.kind == BSIM_LOCATION_END)
+			fputs("null", f);
+		else
+			fprintf(f, "%d", c->loc.iy);
+		fprintf(f, ", \"count\": %d, \"p\": ", c->count);
+		bsim_json_number(f, c->p);
+		fputs(", \"ci95\": [", f);
+		bsim_json_number(f, c->ci95[0]);
+		fputs(", ", f);
+		bsim_json_number(f, c->ci95[1]);
+		fputs("]}", f);
+	}
+	fputs("], \"transitions\": [", f);
+	for (int k = 0; k < ls.n_transitions; k++) {
+		const bsim_transition *x = &ls.transitions[k];
+		fprintf(f, "%s{\"from\": [%d, %d], \"to\": [%d, %d], \"count\": %d}", k ? ", " : "",
+		        x->from[0], x->from[1], x->to[0], x->to[1], x->count);
+	}
+	fputs("], \"rows\": [", f);
+	for (int iy = 0; iy < ls.rows; iy++) {
+		fprintf(f, "%s{\"iy\": %d, \"trials\": %d, \"mean_time_s\": ", iy ? ", " : "", iy,
+		        ls.row_trials[iy]);
+		if (ls.row_trials[iy] > 0)
+			bsim_json_number(f, ls.row_time[iy]);
+		else
+			fputs("null", f);
+		fputc('}', f);
+	}
+	fputs("]}", f);
+	bsim_lattice_summary_free(&ls);
+}
+
+static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int group,
+                       int *idx)
+{
+	const bsim_group_result *g = &r->groups[group];
 	fputs("{\"params\": ", f);
 	json_params(f, e, idx);
 	fprintf(f,
@@ -108,8 +167,11 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_group_resul
 	bsim_json_number(f, g->ci95[1]);
 	fprintf(f,
 	        "], \"stuck_in_contact\": %d, \"landscape_left\": %d, \"landscape_right\": %d, "
-	        "\"steps\": %ld}",
+	        "\"steps\": %ld",
 	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps);
+	if (r->lattice)
+		json_lattice(f, r, group);
+	fputc('}', f);
 }
 
 /* An index per grid axis for bsim_experiment_group_index; never a
@@ -127,7 +189,7 @@ static void json_groups(FILE *f, const bsim_experiment *e, const bsim_sweep_resu
 	for (int g = 0; g < r->n_groups; g++) {
 		bsim_experiment_group_index(e, g, idx);
 		fputs(g ? ",\n    " : "\n    ", f);
-		json_group(f, e, &r->groups[g], idx);
+		json_group(f, e, r, g, idx);
 	}
 	fputs("\n  ]", f);
 }
@@ -174,15 +236,25 @@ int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_er
 	bsim_atomic_file o;
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
-	fputs("group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2\n",
+	fputs("group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"
+	      "final_ix,final_iy,location,path\n",
 	      o.f);
 	for (int g = 0; g < r->n_groups; g++) {
 		for (int t = 0; t < r->trials; t++) {
-			const bsim_trial_result *x = &r->trials_out[(size_t)g * r->trials + t];
-			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", g, t,
-			        bsim_outcome_name(x->outcome), bsim_type_name(x->type), x->steps,
-			        x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
-			        x->max_theta[1]);
+			size_t i = (size_t)g * r->trials + t;
+			const bsim_trial_result *x = &r->trials_out[i];
+			char label[48];
+			bsim_location_label(bsim_location_of(x), label, sizeof label);
+			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%d,%s,",
+			        g, t, bsim_outcome_name(x->outcome), bsim_type_name(x->type),
+			        x->steps, x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
+			        x->max_theta[1], x->final_ix, x->final_iy, label);
+			/* the gates entered, in order: "ix:iy ix:iy ..." */
+			const bsim_trial_log *l = r->logs ? &r->logs[i] : NULL;
+			for (int k = 0; l && k < l->n_entries; k++)
+				fprintf(o.f, "%s%d:%d", k ? " " : "", l->entries[k].ix,
+				        l->entries[k].iy);
+			fputc('\n', o.f);
 		}
 	}
 	return bsim_atomic_file_commit(&o, err);

@@ -54,6 +54,10 @@ void bsim_sweep_result_free(bsim_sweep_result *r)
 {
 	if (!r)
 		return;
+	if (r->logs)
+		for (size_t i = 0; i < (size_t)r->n_groups * r->trials; i++)
+			bsim_trial_log_clear(&r->logs[i]);
+	free(r->logs);
 	free(r->trials_out);
 	free(r->groups);
 	memset(r, 0, sizeof *r);
@@ -66,22 +70,34 @@ static void scenes_free(bsim_scene *scenes, int n)
 	free(scenes);
 }
 
-/* Every group's scene, built once: a trial only reads its scene. */
-static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_scene **out,
-                        bsim_error *err)
+/* Every group's scene, built once: a trial only reads its scene. The
+ * second side of a paired sweep adds its own overrides after extra. */
+static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, int side_b,
+                        bsim_scene **out, bsim_error *err)
 {
 	bsim_scene *scenes = calloc((size_t)e->n_groups, sizeof *scenes);
 	*out = NULL;
 	if (!scenes)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %d scenes", e->n_groups);
+	int n_ov = cfg->n_extra + (side_b ? cfg->n_extra_b : 0);
+	bsim_override *ov = calloc(n_ov > 0 ? (size_t)n_ov : 1, sizeof *ov);
+	if (!ov) {
+		free(scenes);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %d scenes", e->n_groups);
+	}
+	for (int i = 0; i < cfg->n_extra; i++)
+		ov[i] = cfg->extra[i];
+	for (int i = 0; side_b && i < cfg->n_extra_b; i++)
+		ov[cfg->n_extra + i] = cfg->extra_b[i];
 	for (int g = 0; g < e->n_groups; g++) {
-		int rc = bsim_experiment_group_scene(e, g, cfg->extra, cfg->n_extra, &scenes[g],
-		                                     err);
+		int rc = bsim_experiment_group_scene(e, g, ov, n_ov, &scenes[g], err);
 		if (rc != BSIM_OK) {
 			scenes_free(scenes, g);
+			free(ov);
 			return rc;
 		}
 	}
+	free(ov);
 	*out = scenes;
 	return BSIM_OK;
 }
@@ -92,10 +108,13 @@ typedef struct sweep_shared {
 	const bsim_experiment *e;
 	const bsim_sweep_config *cfg;
 	const bsim_scene *scenes;
+	const bsim_scene *scenes_b; /* the second side's (may be scenes) */
 	bsim_trial_result *results;
+	bsim_trial_log *logs;
 	const bsim_backend *backend_b; /* NULL: not paired */
 	const bsim_options *opts_b;
 	bsim_trial_result *results_b;
+	bsim_trial_log *logs_b;
 	double *t_separate;
 	long total;
 	long done;
@@ -130,9 +149,10 @@ static void sweep_thread(sweep_shared *sh)
 	int leader = omp_get_thread_num() == 0;
 	bsim_runner *runner = bsim_runner_alloc();
 	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
+	bsim_trial_log *log[2] = {bsim_trial_log_alloc(), bsim_trial_log_alloc()};
 	bsim_error err;
 
-	if (!runner || (sh->backend_b && !pair)) {
+	if (!runner || (sh->backend_b && !pair) || !log[0] || !log[1]) {
 		bsim_runner_free(runner);
 		runner = NULL;
 		shared_fail(sh, -1, BSIM_EFAIL, "out of memory for a trial runner");
@@ -148,12 +168,19 @@ static void sweep_thread(sweep_shared *sh)
 		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
 		const bsim_scene *scene = &sh->scenes[g];
-		int rc = pair ? trial_pair_run(pair, scene, cfg->backend, cfg->opts, sh->backend_b,
-		                               sh->opts_b, seed, 0.01 * scene->body.radius,
-		                               &sh->results[i], &sh->results_b[i],
-		                               &sh->t_separate[i], &err)
-		              : bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, NULL,
+		int stride = cfg->track_stride > 0 ? cfg->track_stride : 10;
+		log[0]->track_stride = log[1]->track_stride = t < cfg->track_trials ? stride : 0;
+		bsim_recorder rec = {.stride = 1, .log = log[0]};
+		int rc = pair ? trial_pair_run(pair, scene, &sh->scenes_b[g], cfg->backend,
+		                               cfg->opts, sh->backend_b, sh->opts_b, seed,
+		                               0.01 * scene->body.radius, &sh->results[i],
+		                               &sh->results_b[i], log, &sh->t_separate[i], &err)
+		              : bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, &rec,
 		                               &sh->results[i], &err);
+		if (rc == BSIM_OK && bsim_trial_log_copy(&sh->logs[i], log[0]) != BSIM_OK)
+			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
+		if (rc == BSIM_OK && pair && bsim_trial_log_copy(&sh->logs_b[i], log[1]) != BSIM_OK)
+			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
 		long done;
@@ -164,6 +191,8 @@ static void sweep_thread(sweep_shared *sh)
 	}
 	bsim_runner_free(runner);
 	trial_pair_free(pair);
+	bsim_trial_log_free(log[0]);
+	bsim_trial_log_free(log[1]);
 }
 
 static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_error *err)
@@ -173,8 +202,9 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_err
 	r->n_groups = n_groups;
 	r->trials = trials;
 	r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
+	r->logs = calloc(n ? n : 1, sizeof *r->logs);
 	r->groups = calloc(n_groups ? (size_t)n_groups : 1, sizeof *r->groups);
-	if (!r->trials_out || !r->groups) {
+	if (!r->trials_out || !r->groups || !r->logs) {
 		bsim_sweep_result_free(r);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %zu trial results", n);
 	}
@@ -213,16 +243,22 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 			                      total);
 		}
 	}
-	bsim_scene *scenes;
-	int rc = scenes_build(e, cfg, &scenes, err);
+	bsim_scene *scenes, *scenes_b = NULL;
+	int rc = scenes_build(e, cfg, 0, &scenes, err);
+	if (rc == BSIM_OK && backend_b && cfg->n_extra_b > 0 &&
+	    (rc = scenes_build(e, cfg, 1, &scenes_b, err)) != BSIM_OK)
+		scenes_free(scenes, e->n_groups);
 	sweep_shared sh = {
 	        .e = e,
 	        .cfg = cfg,
 	        .scenes = scenes,
+	        .scenes_b = scenes_b ? scenes_b : scenes,
 	        .results = out->trials_out,
+	        .logs = out->logs,
 	        .backend_b = backend_b,
 	        .opts_b = opts_b,
 	        .results_b = backend_b ? out_b->trials_out : NULL,
+	        .logs_b = backend_b ? out_b->logs : NULL,
 	        .t_separate = backend_b ? *t_separate : NULL,
 	        .total = total,
 	};
@@ -234,7 +270,15 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 			threads = sh.total > 0 ? (int)sh.total : 1;
 #pragma omp parallel num_threads(threads)
 		sweep_thread(&sh);
+		out->lattice = scenes[0].has_lattice;
+		out->lattice_def = scenes[0].lattice;
+		if (backend_b) {
+			out_b->lattice = sh.scenes_b[0].has_lattice;
+			out_b->lattice_def = sh.scenes_b[0].lattice;
+		}
 		scenes_free(scenes, e->n_groups);
+		if (scenes_b)
+			scenes_free(scenes_b, e->n_groups);
 		if (sh.first_fail < sh.total)
 			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
 	}

@@ -104,13 +104,69 @@ bsim_trial_log *bsim_trial_log_alloc(void)
 	return calloc(1, sizeof(bsim_trial_log));
 }
 
-void bsim_trial_log_free(bsim_trial_log *l)
+void bsim_trial_log_clear(bsim_trial_log *l)
 {
 	if (!l)
 		return;
 	free(l->entries);
 	free(l->peak);
+	free(l->track);
+	memset(l, 0, sizeof *l);
+}
+
+void bsim_trial_log_free(bsim_trial_log *l)
+{
+	bsim_trial_log_clear(l);
 	free(l);
+}
+
+/* A malloc'd copy of n items of size bytes (NULL for none). */
+static void *dup_items(const void *src, size_t n, size_t size, int *oom)
+{
+	if (n == 0)
+		return NULL;
+	void *p = malloc(n * size);
+	if (!p) {
+		*oom = 1;
+		return NULL;
+	}
+	memcpy(p, src, n * size);
+	return p;
+}
+
+int bsim_trial_log_copy(bsim_trial_log *dst, const bsim_trial_log *src)
+{
+	int oom = 0;
+	memset(dst, 0, sizeof *dst);
+	dst->entries = dup_items(src->entries, (size_t)src->n_entries, sizeof *src->entries, &oom);
+	dst->peak = dup_items(src->peak, (size_t)src->n_beams, sizeof *src->peak, &oom);
+	dst->track = dup_items(src->track, 3 * (size_t)src->n_track, sizeof *src->track, &oom);
+	if (oom) {
+		bsim_trial_log_clear(dst);
+		return BSIM_EFAIL;
+	}
+	dst->n_entries = dst->cap_entries = src->n_entries;
+	dst->n_beams = dst->cap_beams = src->n_beams;
+	dst->n_track = dst->cap_track = src->n_track;
+	dst->track_stride = src->track_stride;
+	return BSIM_OK;
+}
+
+static int log_track(bsim_trial_log *l, double t, const double x[2])
+{
+	if (l->n_track == l->cap_track) {
+		int cap = l->cap_track ? 2 * l->cap_track : 256;
+		double *p = realloc(l->track, 3 * (size_t)cap * sizeof *p);
+		if (!p)
+			return BSIM_EFAIL;
+		l->track = p;
+		l->cap_track = cap;
+	}
+	double *row = &l->track[3 * (size_t)l->n_track++];
+	row[0] = t;
+	row[1] = x[0];
+	row[2] = x[1];
+	return BSIM_OK;
 }
 
 static int log_push(bsim_trial_log *l, const bsim_gate_entry *e)
@@ -466,7 +522,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	               .log = rec ? rec->log : NULL,
 	               .out = out};
 	if (c.log)
-		c.log->n_entries = 0;
+		c.log->n_entries = c.log->n_track = 0;
+	const int track = c.log ? c.log->track_stride : 0;
 	int rc = trial_setup(&c, err);
 	if (rc) {
 		trial_essay_release(&r->essay, backend, &c.w);
@@ -503,6 +560,9 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate path");
 	}
 	c.gate.entries = 1;
+	if (track > 0 && log_track(c.log, 0.0, s0->x))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the track");
+	long tracked = 0;
 	int stride = rec && rec->stride > 0 ? rec->stride : 1;
 	FILE *csv = rec ? rec->csv : NULL;
 	bsim_trace_fn trace = rec ? rec->trace : NULL;
@@ -532,6 +592,11 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		run_on += done;
 		if (trace)
 			trace(rec->trace_user, n, s1);
+		if (track > 0 && n % track == 0) {
+			tracked = n;
+			if (log_track(c.log, (double)n * h, s1->x))
+				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the track");
+		}
 		double e1 = energy_kinetic(c.ws, s1) + energy_springs(c.ws, s1);
 		ledger_step(&out->ledger, &fx, s0, s1, e0, e1);
 		e0 = e1;
@@ -570,6 +635,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	}
 	if (csv && recorded != n && rc == BSIM_OK) /* the final state, whatever the stride */
 		record_row(csv, scene, whole_state(&c, s0), (double)n * h, random_value(&fx));
+	if (track > 0 && tracked != n && rc == BSIM_OK && log_track(c.log, (double)n * h, s0->x))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the track");
 	if (out->outcome != BSIM_TRAVERSED) {
 		out->steps = (int)n;
 		out->t_end = (double)n * h;

@@ -53,26 +53,28 @@ static void trace_push(void *user, long step, const bsim_state *s)
 
 static int run_traced(trial_pair *p, int k, const bsim_scene *scene, const bsim_backend *b,
                       const bsim_options *opts, uint64_t seed, bsim_trial_result *r,
-                      bsim_error *err)
+                      bsim_trial_log *log, bsim_error *err)
 {
 	trial_trace *tr = &p->trace[k];
 	tr->n = 0;
 	tr->oom = 0;
-	bsim_recorder rec = {.csv = NULL, .stride = 1, .trace = trace_push, .trace_user = tr};
+	bsim_recorder rec = {
+	        .csv = NULL, .stride = 1, .trace = trace_push, .trace_user = tr, .log = log};
 	int rc = bsim_trial_run(p->runner, scene, b, opts, seed, &rec, r, err);
 	if (rc == BSIM_OK && tr->oom)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for a %ld-step trace", tr->n);
 	return rc;
 }
 
-int trial_pair_run(trial_pair *p, const bsim_scene *scene, const bsim_backend *a,
-                   const bsim_options *opts_a, const bsim_backend *b, const bsim_options *opts_b,
-                   uint64_t seed, double sep_distance, bsim_trial_result *ra, bsim_trial_result *rb,
+int trial_pair_run(trial_pair *p, const bsim_scene *scene, const bsim_scene *scene_b,
+                   const bsim_backend *a, const bsim_options *opts_a, const bsim_backend *b,
+                   const bsim_options *opts_b, uint64_t seed, double sep_distance,
+                   bsim_trial_result *ra, bsim_trial_result *rb, bsim_trial_log *logs[2],
                    double *t_separate, bsim_error *err)
 {
-	int rc = run_traced(p, 0, scene, a, opts_a, seed, ra, err);
+	int rc = run_traced(p, 0, scene, a, opts_a, seed, ra, logs ? logs[0] : NULL, err);
 	if (rc == BSIM_OK)
-		rc = run_traced(p, 1, scene, b, opts_b, seed, rb, err);
+		rc = run_traced(p, 1, scene_b, b, opts_b, seed, rb, logs ? logs[1] : NULL, err);
 	if (rc != BSIM_OK)
 		return rc;
 	const double *xa = p->trace[0].xy, *xb = p->trace[1].xy;

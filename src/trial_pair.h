@@ -24,12 +24,15 @@ typedef struct trial_pair {
 trial_pair *trial_pair_alloc(void);
 void trial_pair_free(trial_pair *p);
 
-/* Trial `seed` of scene on backend a then b. t_separate: the first time,
+/* Trial `seed` of scene on backend a then of scene_b (scene, or one that
+ * differs only in what the comparison is about) on b; logs[0] and [1] (may
+ * be NULL) receive the two runs' logs. t_separate: the first time,
  * s, at which the body centres are more than sep_distance apart (m),
  * compared while both runs go on; -1 if they never are. */
-int trial_pair_run(trial_pair *p, const bsim_scene *scene, const bsim_backend *a,
-                   const bsim_options *opts_a, const bsim_backend *b, const bsim_options *opts_b,
-                   uint64_t seed, double sep_distance, bsim_trial_result *ra, bsim_trial_result *rb,
+int trial_pair_run(trial_pair *p, const bsim_scene *scene, const bsim_scene *scene_b,
+                   const bsim_backend *a, const bsim_options *opts_a, const bsim_backend *b,
+                   const bsim_options *opts_b, uint64_t seed, double sep_distance,
+                   bsim_trial_result *ra, bsim_trial_result *rb, bsim_trial_log *logs[2],
                    double *t_separate, bsim_error *err);
 
 #endif

@@ -14,8 +14,9 @@
 
 #include "support.h"
 
+/* The contract's columns come first; later columns are appended after them. */
 #define TRIALS_HEADER                                                                              \
-	"group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2\n"
+	"group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"
 #define TRAJ_HEADER                                                                                \
 	"t,x,y,vx,vy,theta1,omega1,theta2,omega2,f_rand,contact1,contact2,e_kin,e_beam,e_prop\n"
 

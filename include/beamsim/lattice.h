@@ -67,6 +67,41 @@ int bsim_location_equal(bsim_location a, bsim_location b);
  * and the final-location CSV. */
 void bsim_location_label(bsim_location loc, char *buf, size_t size);
 
+/* ---- a group of lattice trials ------------------------------------------ */
+
+typedef struct bsim_location_count {
+	bsim_location loc;
+	int count;
+	double p, ci95[2]; /* count / trials, Wilson 95% */
+} bsim_location_count;
+
+typedef struct bsim_transition {
+	int from[2], to[2]; /* gates (ix, iy): one entry of the path to the next */
+	int count;
+} bsim_transition;
+
+typedef struct bsim_lattice_summary {
+	int trials;
+	int n_locations;                /* distinct final locations, ends by ix, sides by iy, */
+	bsim_location_count *locations; /* then stuck gates by (iy, ix) */
+	int n_transitions;              /* distinct gate-to-gate steps, by from */
+	bsim_transition *transitions;   /* then to, (iy, ix) order */
+	int rows;
+	int *row_trials;  /* per row iy: trials whose path entered it */
+	double *row_time; /* per row: their mean time spent in it, s */
+} bsim_lattice_summary;
+
+/* Summarises n trials of one group (logs: their gate paths, may be NULL:
+ * no transitions or row times) of a lattice of `rows` rows. */
+int bsim_lattice_summarise(const bsim_trial_result *trials, const bsim_trial_log *logs, int n,
+                           int rows, bsim_lattice_summary *out);
+void bsim_lattice_summary_free(bsim_lattice_summary *s);
+
+/* Time the trial spent in each row, s: row_time[iy] for iy < rows, from
+ * the log's entries (a row not entered gets 0). */
+void bsim_lattice_row_times(const bsim_trial_result *r, const bsim_trial_log *log, int rows,
+                            double *row_time);
+
 #ifdef __cplusplus
 }
 #endif

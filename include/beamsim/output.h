@@ -25,6 +25,14 @@ int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_er
 int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_sweep_result *r,
                             bsim_error *err);
 
+/* A lattice sweep's own files in dir (docs/lattice.md "Files"):
+ * lattice_map.csv, final_locations.csv, transitions.csv, gate_entries.csv,
+ * beam_peaks.csv and, if any trial was tracked, trajectories.csv. Nothing
+ * for a sweep of gate scenes. extra: the command line's --set, to rebuild
+ * the groups' stiffness maps. */
+int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_override *extra,
+                        int n_extra, const bsim_sweep_result *r, bsim_error *err);
+
 /* p_traverse over the first two grid axes (columns: axis 0, rows: axis 1),
  * one table per combination of the other axes. */
 void bsim_output_table(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r);

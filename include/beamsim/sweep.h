@@ -25,6 +25,12 @@ typedef struct bsim_sweep_result {
 	bsim_group_result *groups;     /* n_groups */
 	double wall_seconds;
 	long total_steps;
+	/* Each trial's gate path with entry states, peaks of every beam and,
+	 * for the first track_trials of each group, the body's track; same
+	 * index as trials_out. NULL when read back from trials.csv. */
+	bsim_trial_log *logs;
+	int lattice;                  /* 1: the groups' scenes are gate lattices */
+	bsim_lattice_def lattice_def; /* group 0's, when lattice */
 } bsim_sweep_result;
 
 /* Called from one thread now and then with done/total trials. */
@@ -38,6 +44,16 @@ typedef struct bsim_sweep_config {
 	int n_extra;
 	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
+	/* The body's track (bsim_trial_log) for trials t < track_trials of
+	 * every group, every track_stride steps (<= 0: 10, 0.04 s at the
+	 * essay's step). */
+	int track_trials;
+	int track_stride;
+	/* A paired sweep only: overrides applied after extra to the second
+	 * side's scenes (e.g. lattice.protocol=essay), so the two sides can
+	 * differ in the scene while sharing every schedule. */
+	const bsim_override *extra_b;
+	int n_extra_b;
 } bsim_sweep_config;
 
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller

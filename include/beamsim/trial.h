@@ -98,10 +98,20 @@ typedef struct bsim_trial_log {
 	bsim_gate_entry *entries;
 	int n_beams, cap_beams;
 	double *peak; /* n_beams: peak theta of every beam, rad */
+	/* The body's track, if track_stride > 0 (set by the caller): (t, x, y)
+	 * at t = 0, every track_stride steps and at the end of the run. */
+	int track_stride;
+	int n_track, cap_track;
+	double *track; /* 3 n_track: s, m, m */
 } bsim_trial_log;
 
 bsim_trial_log *bsim_trial_log_alloc(void);
 void bsim_trial_log_free(bsim_trial_log *l);
+/* dst = a copy of src's entries, peaks and track (dst's own memory;
+ * dst zeroed or a log from here). */
+int bsim_trial_log_copy(bsim_trial_log *dst, const bsim_trial_log *src);
+/* Frees what a log holds, not the log itself (for logs in arrays). */
+void bsim_trial_log_clear(bsim_trial_log *l);
 
 /* Called with the state at t = 0 and after every step (step = 1, 2, ...),
  * whatever the stride; for in-memory use of a trajectory (compare). */

@@ -43,7 +43,8 @@ static void record_fill(bsim_run_record *rec, const char *command, const bsim_ex
 }
 
 static int sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
-                       const bsim_options *opts, const bsim_sweep_result *r)
+                       const bsim_options *opts, const bsim_override *extra, int n_extra,
+                       const bsim_sweep_result *r)
 {
 	char summary[1100], trials[1100];
 	bsim_error err;
@@ -52,7 +53,8 @@ static int sweep_files(const char *dir, const bsim_experiment *e, const bsim_bac
 		return CLI_FAIL;
 	if (bsim_output_mkdir(dir, &err) != BSIM_OK ||
 	    bsim_output_summary_json(summary, e, b->name, opts, r, &err) != BSIM_OK ||
-	    bsim_output_trials_csv(trials, r, &err) != BSIM_OK) {
+	    bsim_output_trials_csv(trials, r, &err) != BSIM_OK ||
+	    bsim_output_lattice(dir, e, extra, n_extra, r, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return CLI_FAIL;
 	}
@@ -65,7 +67,7 @@ int cli_store_sweep(const char *dir, const bsim_experiment *e, const bsim_backen
 {
 	bsim_run_record rec;
 	bsim_error err;
-	if (sweep_files(dir, e, b, opts, r) != CLI_OK)
+	if (sweep_files(dir, e, b, opts, extra, n_extra, r) != CLI_OK)
 		return CLI_FAIL;
 	record_fill(&rec, "sweep", e, 1, &b, &opts, NULL);
 	if (bsim_run_record_write(dir, &rec, e, extra, n_extra, &err) != BSIM_OK) {
@@ -140,7 +142,8 @@ static int compare_write(const cli_compare_job *job, const bsim_sweep_result r[2
 		rep.side[i] = (bsim_report_side){job->backend[i]->name, job->backend[i],
 		                                 job->opts[i], &r[i]};
 		if (cli_path(dir, sizeof dir, job->out, job->backend[i]->name) ||
-		    sweep_files(dir, job->e, job->backend[i], job->opts[i], &r[i]))
+		    sweep_files(dir, job->e, job->backend[i], job->opts[i], job->extra,
+		                job->n_extra, &r[i]))
 			return CLI_FAIL;
 	}
 	char *title = compare_title(job);

@@ -32,7 +32,12 @@ static const char sweep_help[] =
         "  --trials N             trials per group (default: the experiment's)\n"
         "  --seed N               experiment seed (default: the experiment's)\n"
         "  --set KEY=VALUE        override a scene field in every group, repeatable\n"
+        "  --trajectories N       a lattice: the body's track (every 10 steps) of the\n"
+        "                         first N trials of each group in DIR/trajectories.csv\n"
         "  --quiet                no progress line, nothing on stdout\n"
+        "\n"
+        "A lattice experiment also writes DIR/lattice_map.csv, final_locations.csv,\n"
+        "transitions.csv, gate_entries.csv and beam_peaks.csv (docs/lattice.md).\n"
         "  -h, --help             show this help\n";
 
 enum {
@@ -43,6 +48,7 @@ enum {
 	OPT_SEED,
 	OPT_SET,
 	OPT_OUT,
+	OPT_TRAJECTORIES,
 	OPT_QUIET
 };
 
@@ -54,6 +60,7 @@ static const struct option sweep_options[] = {
         {"seed", required_argument, NULL, OPT_SEED},
         {"set", required_argument, NULL, OPT_SET},
         {"out", required_argument, NULL, OPT_OUT},
+        {"trajectories", required_argument, NULL, OPT_TRAJECTORIES},
         {"quiet", no_argument, NULL, OPT_QUIET},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -69,6 +76,7 @@ typedef struct sweep_args {
 	uint64_t seed;
 	cli_sets sets;
 	const char *out;
+	long trajectories;
 	int quiet;
 } sweep_args;
 
@@ -110,6 +118,12 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 			break;
 		case OPT_OUT:
 			a->out = optarg;
+			break;
+		case OPT_TRAJECTORIES:
+			if (cli_parse_long(optarg, 0, INT32_MAX, &a->trajectories) != 0)
+				rc = cli_usage("sweep",
+				               "--trajectories %s: expected an integer >= 0",
+				               optarg);
 			break;
 		case OPT_QUIET:
 			a->quiet = 1;
@@ -171,6 +185,7 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 	        .threads = threads,
 	        .extra = a->sets.ov,
 	        .n_extra = a->sets.n,
+	        .track_trials = (int)a->trajectories,
 	};
 	bsim_sweep_result r;
 	rc = cli_sweep_run(&e, &cfg, !a->quiet, &r);
