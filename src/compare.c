@@ -5,14 +5,18 @@
  *   p_A = (a + b)/n, p_B = (a + c)/n        Wilson 95% each
  *   p_A - p_B = (b - c)/n                   Newcombe paired 95%
  *   McNemar exact: b ~ Binomial(b + c, 1/2) under "no difference"
- * The p-values of all G x 5 tests are Holm-adjusted together, so the
+ * For a lattice, the final-location test (bsim_location_test) joins them.
+ * The p-values of all G x 5 (or 6) tests are Holm-adjusted together, so the
  * chance that any agreeing group is called disagreeing stays below alpha
  * however many groups an experiment has. */
 #include "beamsim/compare.h"
 
+#include <gsl/gsl_rng.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "beamsim/lattice.h"
 
 static const char *const event_names[BSIM_N_EVENTS] = {"traversed", "left", "right", "side_exit",
                                                        "stuck"};
@@ -57,7 +61,8 @@ const char *bsim_verdict_name(bsim_verdict v)
 
 int bsim_trial_discordant(const bsim_trial_result *a, const bsim_trial_result *b)
 {
-	return a->outcome != b->outcome || a->type != b->type;
+	return a->outcome != b->outcome || a->type != b->type ||
+	       !bsim_location_equal(bsim_location_of(a), bsim_location_of(b));
 }
 
 int bsim_trial_identical(const bsim_trial_result *a, const bsim_trial_result *b)
@@ -89,6 +94,130 @@ static void event_test(const bsim_trial_result *a, const bsim_trial_result *b, i
 	t->p_value = bsim_mcnemar_exact(t->pairs.b, t->pairs.c);
 }
 
+/* ---- the final-location permutation test ------------------------------- */
+
+static int location_sort_cmp(const void *x, const void *y)
+{
+	const bsim_location *a = x, *b = y;
+	if (a->kind != b->kind)
+		return a->kind < b->kind ? -1 : 1;
+	if (a->iy != b->iy)
+		return a->iy < b->iy ? -1 : 1;
+	return (a->ix > b->ix) - (a->ix < b->ix);
+}
+
+/* The category of loc among the sorted distinct locs[0..m). */
+static int location_index(const bsim_location *locs, int m, bsim_location loc)
+{
+	int lo = 0, hi = m - 1;
+	while (lo <= hi) {
+		int mid = (lo + hi) / 2, c = location_sort_cmp(&locs[mid], &loc);
+		if (c == 0)
+			return mid;
+		if (c < 0)
+			lo = mid + 1;
+		else
+			hi = mid - 1;
+	}
+	return -1;
+}
+
+/* The swap of discordant pair k (categories ca -> A, cb -> B) changes
+ * diff = count_A - count_B by -2 at ca and +2 at cb, and T by the change of
+ * those two terms. */
+static long swap_pair(long *diff, int ca, int cb, long t)
+{
+	t -= labs(diff[ca]) + labs(diff[cb]);
+	diff[ca] -= 2;
+	diff[cb] += 2;
+	return t + labs(diff[ca]) + labs(diff[cb]);
+}
+
+void bsim_location_test_run(const bsim_trial_result *a, const bsim_trial_result *b, int n,
+                            uint64_t seed, bsim_location_test *out)
+{
+	memset(out, 0, sizeof *out);
+	out->p_value = out->p_holm = 1.0;
+	out->exact = 1;
+	bsim_location *locs = malloc((2 * (size_t)n + 1) * sizeof *locs);
+	int *ca = malloc(((size_t)n + 1) * sizeof *ca), *cb = malloc(((size_t)n + 1) * sizeof *cb);
+	long *diff = calloc(2 * (size_t)n + 1, sizeof *diff);
+	long *work = calloc(2 * (size_t)n + 1, sizeof *work);
+	if (!locs || !ca || !cb || !diff || !work)
+		goto done;
+	for (int i = 0; i < n; i++) {
+		locs[2 * i] = bsim_location_of(&a[i]);
+		locs[2 * i + 1] = bsim_location_of(&b[i]);
+	}
+	qsort(locs, 2 * (size_t)n, sizeof *locs, location_sort_cmp);
+	int m = 0;
+	for (int i = 0; i < 2 * n; i++)
+		if (m == 0 || location_sort_cmp(&locs[m - 1], &locs[i]) != 0)
+			locs[m++] = locs[i];
+	int d = 0;
+	for (int i = 0; i < n; i++) {
+		int x = location_index(locs, m, bsim_location_of(&a[i]));
+		int y = location_index(locs, m, bsim_location_of(&b[i]));
+		diff[x]++;
+		diff[y]--;
+		if (x != y) {
+			ca[d] = x;
+			cb[d] = y;
+			d++;
+		}
+	}
+	long t_obs = 0;
+	for (int c = 0; c < m; c++)
+		t_obs += labs(diff[c]);
+	out->discordant = d;
+	out->tv = n > 0 ? 0.5 * (double)t_obs / n : 0.0;
+	if (d == 0)
+		goto done;
+	long ge = 0;
+	if (d <= BSIM_LOCATION_EXACT_MAX) {
+		/* every subset of swaps, in Gray-code order: one swap per step */
+		memcpy(work, diff, (size_t)m * sizeof *work);
+		long t = t_obs, total = 1L << d;
+		ge = 1; /* the identity */
+		for (long k = 1; k < total; k++) {
+			/* Gray code g(k) = k ^ (k >> 1) differs from g(k - 1) in
+			 * bit j = ctz(k); the pair is swapped in g(k) when bit
+			 * j + 1 of k is 0, and swapped back otherwise. */
+			int j = __builtin_ctzl((unsigned long)k);
+			int swapped = ((k >> (j + 1)) & 1) == 0;
+			t = swapped ? swap_pair(work, ca[j], cb[j], t)
+			            : swap_pair(work, cb[j], ca[j], t);
+			ge += t >= t_obs;
+		}
+		out->p_value = (double)ge / (double)total;
+		out->resamples = total;
+	} else {
+		gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+		if (!rng)
+			goto done;
+		gsl_rng_set(rng, (unsigned long)(seed ? seed : 1));
+		for (long r = 0; r < BSIM_LOCATION_RESAMPLES; r++) {
+			memcpy(work, diff, (size_t)m * sizeof *work);
+			long t = t_obs;
+			for (int k = 0; k < d; k++)
+				if (gsl_rng_get(rng) & 1)
+					t = swap_pair(work, ca[k], cb[k], t);
+			ge += t >= t_obs;
+		}
+		gsl_rng_free(rng);
+		out->exact = 0;
+		out->resamples = BSIM_LOCATION_RESAMPLES;
+		out->p_value = (1.0 + (double)ge) / (1.0 + BSIM_LOCATION_RESAMPLES);
+	}
+	out->p_holm = out->p_value;
+done:
+	free(locs);
+	free(ca);
+	free(cb);
+	free(diff);
+	free(work);
+}
+
 static int cmp_double(const void *x, const void *y)
 {
 	double a = *(const double *)x, b = *(const double *)y;
@@ -117,7 +246,7 @@ static int separated_times(const double *t, long n, double *buf)
 	return k;
 }
 
-static void group_verdict(bsim_compare_group *g, const bsim_compare_rule *rule)
+static void group_verdict(bsim_compare_group *g, const bsim_compare_rule *rule, int lattice)
 {
 	int significant = 0, beyond = 0;
 	for (int e = 0; e < BSIM_N_EVENTS; e++) {
@@ -126,6 +255,12 @@ static void group_verdict(bsim_compare_group *g, const bsim_compare_rule *rule)
 		t->beyond = sig && fabs(t->diff) >= rule->margin;
 		significant |= sig;
 		beyond |= t->beyond;
+	}
+	if (lattice) {
+		int sig = g->loc.p_holm < rule->alpha;
+		g->loc.beyond = sig && g->loc.tv >= rule->margin;
+		significant |= sig;
+		beyond |= g->loc.beyond;
 	}
 	if (beyond || (rule->exact && g->changed > 0))
 		g->verdict = BSIM_VERDICT_DISAGREE;
@@ -150,8 +285,11 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 	out->n_groups = G;
 	out->trials = n;
 	out->rule = *rule;
+	out->lattice = a->lattice && b->lattice;
+	/* tests per group: the events, and the final location on a lattice */
+	const int T = BSIM_N_EVENTS + out->lattice;
 	out->groups = calloc(G > 0 ? (size_t)G : 1, sizeof *out->groups);
-	double *p = calloc((size_t)(G > 0 ? G : 1) * BSIM_N_EVENTS, sizeof *p);
+	double *p = calloc((size_t)(G > 0 ? G : 1) * T, sizeof *p);
 	double *buf = malloc((size_t)(total > 0 ? total : 1) * sizeof *buf);
 	if (!out->groups || !p || !buf) {
 		free(p);
@@ -165,7 +303,11 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 		bsim_compare_group *cg = &out->groups[g];
 		for (int e = 0; e < BSIM_N_EVENTS; e++) {
 			event_test(ra, rb, n, (bsim_event)e, &cg->ev[e]);
-			p[g * BSIM_N_EVENTS + e] = cg->ev[e].p_value;
+			p[g * T + e] = cg->ev[e].p_value;
+		}
+		if (out->lattice) {
+			bsim_location_test_run(ra, rb, n, 0x5eed0000u + (uint64_t)g, &cg->loc);
+			p[g * T + BSIM_N_EVENTS] = cg->loc.p_value;
 		}
 		for (int i = 0; i < n; i++) {
 			cg->discordant += bsim_trial_discordant(&ra[i], &rb[i]);
@@ -177,12 +319,14 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 			quantiles(buf, cg->separated, cg->t_sep);
 		}
 	}
-	bsim_holm(p, G * BSIM_N_EVENTS, p);
+	bsim_holm(p, G * T, p);
 	for (int g = 0; g < G; g++) {
 		bsim_compare_group *cg = &out->groups[g];
 		for (int e = 0; e < BSIM_N_EVENTS; e++)
-			cg->ev[e].p_holm = p[g * BSIM_N_EVENTS + e];
-		group_verdict(cg, rule);
+			cg->ev[e].p_holm = p[g * T + e];
+		if (out->lattice)
+			cg->loc.p_holm = p[g * T + BSIM_N_EVENTS];
+		group_verdict(cg, rule, out->lattice);
 		out->n_disagree += cg->verdict == BSIM_VERDICT_DISAGREE;
 	}
 	out->t_sep[0] = out->t_sep[1] = out->t_sep[2] = -1.0;

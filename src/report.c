@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "beamsim/json.h"
+#include "beamsim/lattice.h"
 #include "beamsim/output.h"
 
 /* A word for a POSIX shell: as it is if it is made of safe characters,
@@ -62,6 +63,8 @@ static void replay_line(FILE *f, const bsim_report *r, int side, int g, int t)
 		set_word(f, e->set[i].key, e->set[i].value);
 	for (int i = 0; i < r->n_extra; i++)
 		set_word(f, r->extra[i].key, r->extra[i].value);
+	for (int i = 0; side == 1 && i < r->n_extra_b; i++)
+		set_word(f, r->extra_b[i].key, r->extra_b[i].value);
 	if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
 		bsim_experiment_group_index(e, g, idx);
 	for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
@@ -74,13 +77,18 @@ static const bsim_trial_result *trial_of(const bsim_report *r, int side, int g, 
 	return &run->trials_out[(size_t)g * run->trials + t];
 }
 
-/* "traversed (left) at 3.24 s" */
-static void outcome_text(FILE *f, const bsim_trial_result *x)
+/* "traversed (left) at 3.24 s"; on a lattice "... at 3.24 s, end:-2" */
+static void outcome_text(FILE *f, const bsim_report *r, const bsim_trial_result *x)
 {
 	fputs(bsim_outcome_name(x->outcome), f);
 	if (x->outcome == BSIM_TRAVERSED)
 		fprintf(f, " (%s)", bsim_type_name(x->type));
 	fprintf(f, " at %.3f s", x->t_end);
+	if (r->cmp->lattice) {
+		char label[48];
+		bsim_location_label(bsim_location_of(x), label, sizeof label);
+		fprintf(f, ", %s", label);
+	}
 }
 
 static void params_text(FILE *f, const bsim_experiment *e, int g)
@@ -185,9 +193,9 @@ static void md_examples(FILE *f, const bsim_report *r, int g)
 			continue;
 		shown++;
 		fprintf(f, "- trial %d: %s ", t, r->side[0].label);
-		outcome_text(f, a);
+		outcome_text(f, r, a);
 		fprintf(f, ", %s ", r->side[1].label);
-		outcome_text(f, b);
+		outcome_text(f, r, b);
 		if (r->t_separate) {
 			double ts = r->t_separate[(size_t)g * r->cmp->trials + t];
 			if (ts >= 0.0)
@@ -202,6 +210,90 @@ static void md_examples(FILE *f, const bsim_report *r, int g)
 		fputs("  ```\n", f);
 	}
 	fputc('\n', f);
+}
+
+/* One side's distribution of final locations of group g. */
+static int side_locations(const bsim_report *r, int side, int g, bsim_lattice_summary *ls)
+{
+	const bsim_sweep_result *run = r->side[side].run;
+	return bsim_lattice_summarise(&run->trials_out[(size_t)g * run->trials], NULL, run->trials,
+	                              run->lattice_def.rows, ls);
+}
+
+static const char *location_test_name(const bsim_location_test *t)
+{
+	return t->exact ? "exact (all swaps)" : "Monte Carlo (20,000 swaps)";
+}
+
+/* Both sides' final-location distributions (lattices), group by group, and
+ * the paired permutation test of their difference. */
+static void md_locations(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	fprintf(f,
+	        "## Final locations\n\nWhere each trial ended: `end:ix` reached the end through "
+	        "column ix, `side:iy` left the field through a side at row iy, `stuck:ix:iy` "
+	        "stuck in gate (ix, iy). Test of the difference: a paired permutation test on "
+	        "the final locations (the two locations of a discordant pair swapped with "
+	        "probability 1/2; statistic: the total variation distance), exact when at "
+	        "most %d pairs are discordant, else Monte Carlo; in the Holm family above.\n\n",
+	        BSIM_LOCATION_EXACT_MAX);
+	for (int g = 0; g < c->n_groups; g++) {
+		const bsim_location_test *t = &c->groups[g].loc;
+		bsim_lattice_summary ls[2];
+		if (side_locations(r, 0, g, &ls[0]) != BSIM_OK)
+			return;
+		if (side_locations(r, 1, g, &ls[1]) != BSIM_OK) {
+			bsim_lattice_summary_free(&ls[0]);
+			return;
+		}
+		fprintf(f, "### Group %d: ", g);
+		params_text(f, r->e, g);
+		fprintf(f,
+		        "\n\n%d discordant pairs; total variation %.3f; permutation p = %.3g "
+		        "(%s), Holm %.3g%s.\n\n| location | %s [95%%] | %s [95%%] "
+		        "|\n|---|---|---|\n",
+		        t->discordant, t->tv, t->p_value, location_test_name(t), t->p_holm,
+		        t->beyond ? ", **beyond the rule**" : "", r->side[0].label,
+		        r->side[1].label);
+		/* the union of both sides' locations, in the summaries' order */
+		int i = 0, j = 0;
+		while (i < ls[0].n_locations || j < ls[1].n_locations) {
+			const bsim_location_count *x =
+			        i < ls[0].n_locations ? &ls[0].locations[i] : NULL;
+			const bsim_location_count *y =
+			        j < ls[1].n_locations ? &ls[1].locations[j] : NULL;
+			char la[48], lb[48];
+			if (x)
+				bsim_location_label(x->loc, la, sizeof la);
+			if (y)
+				bsim_location_label(y->loc, lb, sizeof lb);
+			int order = !x ? 1 : !y ? -1 : 0;
+			if (x && y) {
+				bsim_location p = x->loc, q = y->loc;
+				order = p.kind != q.kind ? (p.kind < q.kind ? -1 : 1)
+				        : p.iy != q.iy   ? (p.iy < q.iy ? -1 : 1)
+				        : p.ix != q.ix   ? (p.ix < q.ix ? -1 : 1)
+				                         : 0;
+			}
+			const bsim_location_count *show = order <= 0 ? x : y;
+			fprintf(f, "| %s |", order <= 0 ? la : lb);
+			if (order <= 0)
+				fprintf(f, " %.3f [%.3f, %.3f] |", x->p, x->ci95[0], x->ci95[1]);
+			else
+				fputs(" 0 |", f);
+			if (order >= 0)
+				fprintf(f, " %.3f [%.3f, %.3f] |\n", y->p, y->ci95[0], y->ci95[1]);
+			else
+				fputs(" 0 |\n", f);
+			(void)show;
+			i += order <= 0;
+			j += order >= 0;
+		}
+		fputc('\n', f);
+		bsim_lattice_summary_free(&ls[0]);
+		bsim_lattice_summary_free(&ls[1]);
+	}
 }
 
 void bsim_report_md(FILE *f, const bsim_report *r)
@@ -223,8 +315,15 @@ void bsim_report_md(FILE *f, const bsim_report *r)
 	        c->rule.alpha, c->n_groups, BSIM_N_EVENTS, c->rule.margin);
 	fputs(c->rule.exact ? "; or when any trial differs in any trials.csv field.\n\n" : ".\n\n",
 	      f);
+	if (c->lattice)
+		fputs("On a lattice a group also disagrees when the final-location test's Holm "
+		      "p-value is below alpha and the total variation distance between the two "
+		      "distributions is at least the margin (section Final locations).\n\n",
+		      f);
 	md_separation(f, r);
 	md_table(f, r);
+	if (c->lattice)
+		md_locations(f, r);
 	for (int g = 0; g < c->n_groups; g++) {
 		const bsim_compare_group *cg = &c->groups[g];
 		if (cg->verdict != BSIM_VERDICT_DISAGREE)
@@ -341,6 +440,50 @@ static void json_examples(FILE *f, const bsim_report *r, int g)
 	fputc(']', f);
 }
 
+static void json_location_list(FILE *f, const bsim_lattice_summary *ls)
+{
+	fputc('[', f);
+	for (int k = 0; k < ls->n_locations; k++) {
+		const bsim_location_count *c = &ls->locations[k];
+		char label[48];
+		bsim_location_label(c->loc, label, sizeof label);
+		fprintf(f, "%s{\"location\": \"%s\", \"count\": %d, \"p\": ", k ? ", " : "", label,
+		        c->count);
+		bsim_json_number(f, c->p);
+		fputs(", \"ci95\": ", f);
+		json_pair_of_numbers(f, c->ci95);
+		fputc('}', f);
+	}
+	fputc(']', f);
+}
+
+static void json_locations(FILE *f, const bsim_report *r, int g)
+{
+	const bsim_location_test *t = &r->cmp->groups[g].loc;
+	bsim_lattice_summary ls[2];
+	fputs(",\n     \"final_locations\": {\"test\": ", f);
+	bsim_json_string(f, t->exact ? "paired permutation, exact"
+	                             : "paired permutation, monte carlo");
+	fprintf(f, ", \"resamples\": %ld, \"discordant\": %d, \"total_variation\": ", t->resamples,
+	        t->discordant);
+	bsim_json_number(f, t->tv);
+	fputs(", \"p\": ", f);
+	bsim_json_number(f, t->p_value);
+	fputs(", \"p_holm\": ", f);
+	bsim_json_number(f, t->p_holm);
+	fprintf(f, ", \"beyond\": %s", t->beyond ? "true" : "false");
+	for (int side = 0; side < 2; side++) {
+		fputs(side ? ", \"b\": " : ", \"a\": ", f);
+		if (side_locations(r, side, g, &ls[side]) != BSIM_OK) {
+			fputs("null", f);
+			continue;
+		}
+		json_location_list(f, &ls[side]);
+		bsim_lattice_summary_free(&ls[side]);
+	}
+	fputc('}', f);
+}
+
 static void json_side(FILE *f, const bsim_report_side *s)
 {
 	fputs("{\"label\": ", f);
@@ -369,8 +512,11 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	bsim_json_number(f, c->rule.alpha);
 	fputs(", \"margin\": ", f);
 	bsim_json_number(f, c->rule.margin);
-	fprintf(f, ", \"exact\": %s, \"correction\": \"holm\", \"test\": \"mcnemar_exact\"}",
+	fprintf(f, ", \"exact\": %s, \"correction\": \"holm\", \"test\": \"mcnemar_exact\"",
 	        c->rule.exact ? "true" : "false");
+	if (c->lattice)
+		fputs(", \"final_location_test\": \"paired_permutation\"", f);
+	fputc('}', f);
 	fprintf(f, ",\n  \"groups_disagreeing\": %d,\n  \"separation\": ", c->n_disagree);
 	if (r->t_separate) {
 		fprintf(f,
@@ -401,6 +547,8 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 			json_event(f, &cg->ev[ev]);
 		}
 		fputc('}', f);
+		if (c->lattice)
+			json_locations(f, r, g);
 		if (cg->verdict == BSIM_VERDICT_DISAGREE)
 			json_examples(f, r, g);
 		fputc('}', f);
@@ -411,7 +559,8 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 void bsim_report_pairs_csv(FILE *f, const bsim_report *r)
 {
 	const bsim_comparison *c = r->cmp;
-	fputs("group,trial,outcome_a,type_a,outcome_b,type_b,t_separate\n", f);
+	fputs("group,trial,outcome_a,type_a,outcome_b,type_b,t_separate,location_a,location_b\n",
+	      f);
 	for (int g = 0; g < c->n_groups; g++)
 		for (int t = 0; t < c->trials; t++) {
 			const bsim_trial_result *a = trial_of(r, 0, g, t),
@@ -422,6 +571,9 @@ void bsim_report_pairs_csv(FILE *f, const bsim_report *r)
 			double ts = r->t_separate ? r->t_separate[(size_t)g * c->trials + t] : -1.0;
 			if (ts >= 0.0)
 				fprintf(f, "%.10g", ts);
-			fputc('\n', f);
+			char la[48], lb[48];
+			bsim_location_label(bsim_location_of(a), la, sizeof la);
+			bsim_location_label(bsim_location_of(b), lb, sizeof lb);
+			fprintf(f, ",%s,%s\n", la, lb);
 		}
 }

@@ -124,13 +124,54 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 		json_options(f, &rec->opts[i]);
 		fputc('}', f);
 	}
-	fprintf(f, "],\n  \"seed\": %" PRIu64 ",\n  \"trials\": %d", rec->seed, rec->trials);
+	fputc(']', f);
+	if (rec->protocol[0][0]) {
+		fputs(",\n  \"protocols\": [", f);
+		bsim_json_string(f, rec->protocol[0]);
+		fputs(", ", f);
+		bsim_json_string(f, rec->protocol[1]);
+		fputc(']', f);
+	}
+	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials\": %d", rec->seed, rec->trials);
 	fputs(",\n  \"rule\": {\"alpha\": ", f);
 	bsim_json_number(f, rec->rule.alpha);
 	fputs(", \"margin\": ", f);
 	bsim_json_number(f, rec->rule.margin);
 	fprintf(f, ", \"exact\": %s}\n}\n", rec->rule.exact ? "true" : "false");
 	return bsim_atomic_file_commit(&o, err);
+}
+
+/* A lattice's stiffness_file goes beside the copied scene, under the name
+ * the scene (or an override) gives it, for every group that names one. */
+static int copy_stiffness_files(const char *inputs, const bsim_experiment *e,
+                                const bsim_override *extra, int n_extra, bsim_error *err)
+{
+	for (int g = 0; g < e->n_groups; g++) {
+		bsim_scene s;
+		if (bsim_experiment_group_scene(e, g, extra, n_extra, &s, err) != BSIM_OK)
+			return BSIM_EFAIL;
+		char name[sizeof s.lattice.stiffness_file];
+		int lattice = s.has_lattice;
+		snprintf(name, sizeof name, "%s", s.lattice.stiffness_file);
+		bsim_scene_free(&s);
+		if (!lattice)
+			return BSIM_OK; /* a gate experiment: no group is a lattice */
+		if (!name[0])
+			continue;
+		char from[1400], to[1400];
+		const char *slash = strrchr(e->scene_path, '/');
+		int dir = slash ? (int)(slash - e->scene_path + 1) : 0;
+		snprintf(from, sizeof from, "%.*s%s", dir, e->scene_path, name);
+		if (path_join(to, sizeof to, inputs, name, err))
+			return BSIM_EFAIL;
+		char *last = strrchr(to, '/');
+		*last = '\0';
+		int rc = bsim_output_mkdir(to, err);
+		*last = '/';
+		if (rc != BSIM_OK || copy_file(from, to, err) != BSIM_OK)
+			return BSIM_EFAIL;
+	}
+	return BSIM_OK;
 }
 
 int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsim_experiment *e,
@@ -142,6 +183,8 @@ int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsi
 		return BSIM_EFAIL;
 	if (path_join(path, sizeof path, inputs, "scene.yaml", err) ||
 	    copy_file(e->scene_path, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (copy_stiffness_files(inputs, e, extra, n_extra, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (path_join(path, sizeof path, inputs, "experiment.yaml", err) ||
 	    write_experiment(path, e, extra, n_extra, err) != BSIM_OK)
@@ -231,6 +274,16 @@ int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 		rec->n_backends = fy_node_sequence_item_count(b);
 	for (int i = 0; !rc && i < rec->n_backends; i++)
 		rc = read_backend(&d, root, i, rec, err);
+	struct fy_node *pn = ydoc_lookup(root, "protocols");
+	if (!rc && pn &&
+	    (!fy_node_is_sequence(pn) || fy_node_sequence_item_count(pn) != 2 ||
+	     rec->n_backends != 2))
+		rc = ydoc_expected(&d, pn, NULL, "protocols", "a list of 2 lattice protocols", err);
+	for (int i = 0; !rc && pn && i < 2; i++) {
+		char field[32];
+		snprintf(field, sizeof field, "protocols.%d", i);
+		rc = need_text(&d, root, field, rec->protocol[i], sizeof rec->protocol[i], err);
+	}
 	struct fy_node *sn = ydoc_lookup(root, "seed"), *tn = ydoc_lookup(root, "trials");
 	long long trials = 0;
 	if (!rc && (!sn || !ydoc_uint64(sn, &rec->seed)))

@@ -148,6 +148,9 @@ int thesis_broad_phase(struct bsim_world *w, double speed, double h)
 	c0y = c0y < 0 ? 0 : c0y;
 	c1x = c1x >= g->nx ? g->nx - 1 : c1x;
 	c1y = c1y >= g->ny ? g->ny - 1 : c1y;
+	/* A beam at rest is a candidate only if the body is within its reach
+	 * (the test contact_detect.c makes first, here without the call). */
+	double margin = 2.0 * h * speed + w->slop;
 	int sleeping_found = 0;
 	for (int cy = c0y; cy <= c1y; cy++)
 		for (int cx = c0x; cx <= c1x; cx++) {
@@ -155,6 +158,11 @@ int thesis_broad_phase(struct bsim_world *w, double speed, double h)
 			for (int k = g->start[c]; k < g->start[c + 1]; k++) {
 				int i = g->items[k];
 				if (w->is_awake[i])
+					continue;
+				const thesis_beam *b = &w->beams[i];
+				double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+				double reach = b->length + w->radius + margin;
+				if (dx * dx + dy * dy > reach * reach)
 					continue;
 				out[n++] = i;
 				sleeping_found = 1;

@@ -5,6 +5,8 @@
 #ifndef BEAMSIM_COMPARE_H
 #define BEAMSIM_COMPARE_H
 
+#include <stdint.h>
+
 #include "beamsim/error.h"
 #include "beamsim/stats.h"
 #include "beamsim/sweep.h"
@@ -62,18 +64,45 @@ typedef enum {
 
 const char *bsim_verdict_name(bsim_verdict v);
 
+/* Lattices: where the paired trials ended (bsim_location_of). The test of
+ * "both sides have the same final-location distribution" is a paired
+ * permutation test: under that hypothesis the two locations of a pair are
+ * exchangeable, so each of the d discordant pairs is swapped or not with
+ * probability 1/2, and the statistic
+ *   T = sum over locations |count_A - count_B|   (= 2 n x total variation)
+ * is compared with its permutation distribution. p = P(T* >= T): all 2^d
+ * swaps are enumerated when d <= 20 (exact), else 20,000 random ones
+ * (Monte Carlo, fixed seed, p = (1 + #{T* >= T}) / 20,001). */
+typedef struct bsim_location_test {
+	int discordant; /* pairs ending in different locations */
+	double tv;      /* total variation distance of the two distributions */
+	double p_value, p_holm;
+	int exact;      /* 1: enumerated; 0: Monte Carlo */
+	long resamples; /* swaps evaluated */
+	int beyond;     /* p_holm < alpha and tv >= margin */
+} bsim_location_test;
+
+#define BSIM_LOCATION_EXACT_MAX 20
+#define BSIM_LOCATION_RESAMPLES 20000
+
+/* The paired permutation test on n pairs of final locations. */
+void bsim_location_test_run(const bsim_trial_result *a, const bsim_trial_result *b, int n,
+                            uint64_t seed, bsim_location_test *out);
+
 typedef struct bsim_compare_group {
 	bsim_event_test ev[BSIM_N_EVENTS];
-	int discordant;  /* pairs with a different outcome or type */
-	int changed;     /* pairs not identical in any trials.csv field */
-	int separated;   /* pairs whose trajectories separated */
-	double t_sep[3]; /* 10%, 50%, 90% quantiles of the separation time
-	                  * over separated pairs, s; -1 if none */
+	bsim_location_test loc; /* lattices only */
+	int discordant;         /* pairs with a different outcome or type */
+	int changed;            /* pairs not identical in any trials.csv field */
+	int separated;          /* pairs whose trajectories separated */
+	double t_sep[3];        /* 10%, 50%, 90% quantiles of the separation time
+	                         * over separated pairs, s; -1 if none */
 	bsim_verdict verdict;
 } bsim_compare_group;
 
 typedef struct bsim_comparison {
 	int n_groups, trials;
+	int lattice; /* 1: the final-location test is in the rule (and the Holm family) */
 	bsim_compare_rule rule;
 	bsim_compare_group *groups;
 	int n_disagree; /* groups with BSIM_VERDICT_DISAGREE */

@@ -28,6 +28,8 @@ typedef struct bsim_report {
 	const bsim_experiment *e;
 	const bsim_override *extra; /* command-line --set, for the replay lines */
 	int n_extra;
+	const bsim_override *extra_b; /* side b's own overrides (compare --protocols) */
+	int n_extra_b;
 	bsim_report_side side[2];
 	const double *t_separate; /* NULL: no trajectories compared */
 	const bsim_comparison *cmp;
@@ -40,8 +42,9 @@ typedef struct bsim_report {
 void bsim_report_md(FILE *f, const bsim_report *r);
 /* report.json: the same content as one JSON object. */
 void bsim_report_json(FILE *f, const bsim_report *r);
-/* pairs.csv: group,trial,outcome_a,type_a,outcome_b,type_b,t_separate
- * (t_separate empty when the pair never separated). */
+/* pairs.csv: group,trial,outcome_a,type_a,outcome_b,type_b,t_separate,
+ * location_a,location_b (t_separate empty when the pair never separated;
+ * the final locations as in trials.csv). */
 void bsim_report_pairs_csv(FILE *f, const bsim_report *r);
 
 #ifdef __cplusplus

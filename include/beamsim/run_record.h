@@ -25,6 +25,8 @@ typedef struct bsim_run_record {
 	uint64_t seed;
 	int trials;
 	bsim_compare_rule rule; /* compare only */
+	/* compare --protocols: the lattice protocol of each side ("" if not) */
+	char protocol[2][16];
 } bsim_run_record;
 
 /* opts with every knob of b not given set to its default. */

@@ -13,6 +13,11 @@
 #include "beamsim/report.h"
 #include "cli_common.h"
 
+const char *cli_compare_label(const cli_compare_job *job, int side)
+{
+	return job->protocol[side] ? job->protocol[side] : job->backend[side]->name;
+}
+
 int cli_path(char *buf, size_t size, const char *dir, const char *name)
 {
 	int n = snprintf(buf, size, "%s/%s", dir, name);
@@ -25,7 +30,7 @@ int cli_path(char *buf, size_t size, const char *dir, const char *name)
 
 static void record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e, int n,
                         const bsim_backend *const *b, const bsim_options *const *opts,
-                        const bsim_compare_rule *rule)
+                        const bsim_compare_rule *rule, const char *const *protocol)
 {
 	memset(rec, 0, sizeof *rec);
 	snprintf(rec->command, sizeof rec->command, "%s", command);
@@ -36,6 +41,8 @@ static void record_fill(bsim_run_record *rec, const char *command, const bsim_ex
 	}
 	rec->seed = e->seed;
 	rec->trials = e->trials;
+	for (int i = 0; protocol && protocol[0] && i < 2; i++)
+		snprintf(rec->protocol[i], sizeof rec->protocol[i], "%s", protocol[i]);
 	if (rule)
 		rec->rule = *rule;
 	else
@@ -69,7 +76,7 @@ int cli_store_sweep(const char *dir, const bsim_experiment *e, const bsim_backen
 	bsim_error err;
 	if (sweep_files(dir, e, b, opts, extra, n_extra, r) != CLI_OK)
 		return CLI_FAIL;
-	record_fill(&rec, "sweep", e, 1, &b, &opts, NULL);
+	record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL);
 	if (bsim_run_record_write(dir, &rec, e, extra, n_extra, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return CLI_FAIL;
@@ -109,7 +116,14 @@ static char *compare_title(const cli_compare_job *job)
 	FILE *f = open_memstream(&buf, &len);
 	if (!f)
 		return NULL;
-	fprintf(f, "# beamsim compare: %s vs %s\n\n", job->backend[0]->name, job->backend[1]->name);
+	fprintf(f, "# beamsim compare: %s vs %s\n\n", cli_compare_label(job, 0),
+	        cli_compare_label(job, 1));
+	if (job->protocol[0])
+		fprintf(f,
+		        "The lattice protocols %s and %s on backend %s: `lattice.protocol=%s` for "
+		        "one side, `=%s` for the other.\n\n",
+		        job->protocol[0], job->protocol[1], job->backend[0]->name, job->protocol[0],
+		        job->protocol[1]);
 	fprintf(f,
 	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; both backends "
 	        "ran every trial with the same random-force schedule, so trial t of group g is "
@@ -133,15 +147,17 @@ static int compare_write(const cli_compare_job *job, const bsim_sweep_result r[2
 	        .e = job->e,
 	        .extra = job->extra,
 	        .n_extra = job->n_extra,
+	        .extra_b = job->extra_b,
+	        .n_extra_b = job->n_extra_b,
 	        .t_separate = t_sep,
 	        .cmp = cmp,
 	        .examples = job->examples,
 	};
 	for (int i = 0; i < 2; i++) {
 		char dir[1100];
-		rep.side[i] = (bsim_report_side){job->backend[i]->name, job->backend[i],
-		                                 job->opts[i], &r[i]};
-		if (cli_path(dir, sizeof dir, job->out, job->backend[i]->name) ||
+		const char *label = cli_compare_label(job, i);
+		rep.side[i] = (bsim_report_side){label, job->backend[i], job->opts[i], &r[i]};
+		if (cli_path(dir, sizeof dir, job->out, label) ||
 		    sweep_files(dir, job->e, job->backend[i], job->opts[i], job->extra,
 		                job->n_extra, &r[i]))
 			return CLI_FAIL;
@@ -157,7 +173,7 @@ static int compare_write(const cli_compare_job *job, const bsim_sweep_result r[2
 		return rc;
 	bsim_run_record rec;
 	bsim_error err;
-	record_fill(&rec, "compare", job->e, 2, job->backend, job->opts, &job->rule);
+	record_fill(&rec, "compare", job->e, 2, job->backend, job->opts, &job->rule, job->protocol);
 	if (bsim_run_record_write(job->out, &rec, job->e, job->extra, job->n_extra, &err) !=
 	    BSIM_OK) {
 		cli_error("%s", err.msg);
@@ -180,6 +196,8 @@ int cli_compare_execute(const cli_compare_job *job, bsim_comparison *cmp)
 	        .n_extra = job->n_extra,
 	        .progress = bsim_progress_update,
 	        .progress_user = &progress,
+	        .extra_b = job->extra_b,
+	        .n_extra_b = job->n_extra_b,
 	};
 	memset(cmp, 0, sizeof *cmp);
 	bsim_progress_init(&progress, job->progress);

@@ -16,6 +16,12 @@ typedef struct cli_compare_job {
 	const bsim_options *opts[2];
 	const bsim_override *extra; /* command-line --set */
 	int n_extra;
+	/* compare --protocols: the lattice protocol of each side, which then
+	 * labels the sides and their directories ({NULL, NULL}: the backends
+	 * do); extra_b sets side b's, after extra (which sets side a's). */
+	const char *protocol[2];
+	const bsim_override *extra_b;
+	int n_extra_b;
 	int threads;
 	bsim_compare_rule rule;
 	int examples;
@@ -33,6 +39,9 @@ int cli_store_sweep(const char *dir, const bsim_experiment *e, const bsim_backen
  * analysis goes to cmp (free with bsim_comparison_free). Returns the exit
  * status of the run (0, 1 or 2), not the verdict. */
 int cli_compare_execute(const cli_compare_job *job, bsim_comparison *cmp);
+
+/* Side i's label and directory name: its protocol or its backend. */
+const char *cli_compare_label(const cli_compare_job *job, int side);
 
 /* "dir/name", 0 or a message and CLI_FAIL if it does not fit. */
 int cli_path(char *buf, size_t size, const char *dir, const char *name);

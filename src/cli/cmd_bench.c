@@ -14,6 +14,7 @@
 #include "beamsim/json.h"
 #include "beamsim/output.h"
 #include "beamsim/sweep.h"
+#include "bench_lattice.h"
 #include "cli_common.h"
 
 #define BENCH_H1 "configs/thesis/h1_symmetric.yaml"
@@ -40,6 +41,10 @@ static const char bench_help[] =
         "                         none: skip)\n"
         "  --vs-opt K=V           an option of the --vs backend, repeatable\n"
         "  --json FILE            also write the results as JSON to FILE\n"
+        "  --lattice              instead: ns per step on n x n gate lattices, n = 1 .. 33,\n"
+        "                         on --backend and --vs, the same schedules at every\n"
+        "                         size (--trials per size, default 200; the --vs\n"
+        "                         backend a twentieth of it, default 10)\n"
         "  -h, --help             show this help\n";
 
 enum {
@@ -50,7 +55,8 @@ enum {
 	OPT_NO_H2,
 	OPT_VS,
 	OPT_VS_OPT,
-	OPT_JSON
+	OPT_JSON,
+	OPT_LATTICE
 };
 
 static const struct option bench_options[] = {
@@ -62,6 +68,7 @@ static const struct option bench_options[] = {
         {"vs", required_argument, NULL, OPT_VS},
         {"vs-opt", required_argument, NULL, OPT_VS_OPT},
         {"json", required_argument, NULL, OPT_JSON},
+        {"lattice", no_argument, NULL, OPT_LATTICE},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -76,6 +83,7 @@ typedef struct bench_args {
 	const char *vs; /* NULL: none */
 	bsim_options vs_opts;
 	const char *json;
+	int lattice;
 } bench_args;
 
 typedef struct bench_run {
@@ -124,6 +132,9 @@ static int bench_parse(int argc, char **argv, bench_args *a)
 			break;
 		case OPT_JSON:
 			a->json = optarg;
+			break;
+		case OPT_LATTICE:
+			a->lattice = 1;
 			break;
 		default:
 			return cli_bad_option("bench", argv, c);
@@ -344,5 +355,17 @@ int cmd_bench(int argc, char **argv)
 	const bsim_backend *vs = backend && a.vs ? cli_backend(a.vs, &a.vs_opts) : NULL;
 	if (!backend || (a.vs && !vs))
 		return CLI_USAGE;
+	if (a.lattice) {
+		bench_lattice_args la = {
+		        .backend = backend,
+		        .vs = vs,
+		        .opts = &a.opts,
+		        .vs_opts = &a.vs_opts,
+		        .trials = a.trials,
+		        .vs_trials = a.trials > 0 ? (a.trials + 19) / 20 : 0,
+		        .json = a.json,
+		};
+		return bench_lattice(&la);
+	}
 	return bench_main(&a, backend, vs);
 }

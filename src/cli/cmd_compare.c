@@ -30,6 +30,8 @@ static const char compare_help[] =
         "\n"
         "A group disagrees when an event's Holm-adjusted p-value is below --alpha and\n"
         "its probabilities differ by at least --margin. Exit status 3 if any does.\n"
+        "On a gate lattice the report adds both sides' final-location distributions\n"
+        "and a paired permutation test of their difference, which joins the rule.\n"
         "\n"
         "Writes DIR/report.md, DIR/report.json, DIR/pairs.csv, DIR/<backend>/summary.json\n"
         "and trials.csv for each backend, and DIR/run.json with DIR/inputs/ for\n"
@@ -38,6 +40,11 @@ static const char compare_help[] =
         "Options:\n"
         "  --out DIR              output directory, created if missing (required)\n"
         "  --backends A,B         the two backends (default thesis,box2d)\n"
+        "  --protocols P,Q        a lattice experiment on one backend (--backend B,\n"
+        "                         default thesis) under two lattice protocols (world,\n"
+        "                         essay) instead of two backends; sides and their\n"
+        "                         directories are named by protocol\n"
+        "  --backend B            the backend of --protocols\n"
         "  --backend-opt B:K=V    option K=V for backend B, repeatable\n"
         "  --threads N            worker threads (default: all cores)\n"
         "  --trials N             trials per group (default: the experiment's)\n"
@@ -51,6 +58,8 @@ static const char compare_help[] =
 
 enum {
 	OPT_BACKENDS = 256,
+	OPT_PROTOCOLS,
+	OPT_BACKEND,
 	OPT_BACKEND_OPT,
 	OPT_THREADS,
 	OPT_TRIALS,
@@ -65,6 +74,8 @@ enum {
 
 static const struct option compare_options[] = {
         {"backends", required_argument, NULL, OPT_BACKENDS},
+        {"protocols", required_argument, NULL, OPT_PROTOCOLS},
+        {"backend", required_argument, NULL, OPT_BACKEND},
         {"backend-opt", required_argument, NULL, OPT_BACKEND_OPT},
         {"threads", required_argument, NULL, OPT_THREADS},
         {"trials", required_argument, NULL, OPT_TRIALS},
@@ -82,6 +93,10 @@ static const struct option compare_options[] = {
 typedef struct compare_args {
 	const char *experiment;
 	char names[2][32];
+	int has_backends, has_backend;
+	char protocol[2][16]; /* --protocols, "" if not given */
+	char protocol_set[2][48];
+	bsim_override protocol_ov[2];
 	bsim_options opts[2];
 	long threads, trials, examples;
 	int has_seed;
@@ -113,17 +128,50 @@ static int backend_opt(compare_args *a, const char *text)
 	const char *colon = strchr(text, ':');
 	for (int i = 0; colon && i < 2; i++)
 		if (strlen(a->names[i]) == (size_t)(colon - text) &&
-		    strncmp(text, a->names[i], (size_t)(colon - text)) == 0)
-			return cli_options_add(&a->opts[i], "compare", colon + 1);
+		    strncmp(text, a->names[i], (size_t)(colon - text)) == 0) {
+			int rc = cli_options_add(&a->opts[i], "compare", colon + 1);
+			/* --protocols: one backend on both sides, the same options */
+			if (rc == CLI_OK && i == 0 && !strcmp(a->names[0], a->names[1]))
+				rc = cli_options_add(&a->opts[1], "compare", colon + 1);
+			return rc;
+		}
 	return cli_usage("compare", "--backend-opt %s: expected B:KEY=VALUE with B one of %s, %s",
 	                 text, a->names[0], a->names[1]);
+}
+
+/* "world,essay" into a->protocol. */
+static int parse_protocols(compare_args *a, const char *text)
+{
+	const char *comma = strchr(text, ',');
+	for (int i = 0; comma && i < 2; i++) {
+		const char *p = i ? comma + 1 : text;
+		size_t len = i ? strlen(p) : (size_t)(comma - text);
+		if ((len == 5 && !strncmp(p, "world", 5)) || (len == 5 && !strncmp(p, "essay", 5)))
+			snprintf(a->protocol[i], sizeof a->protocol[i], "%.*s", (int)len, p);
+	}
+	if (!a->protocol[0][0] || !a->protocol[1][0] || !strcmp(a->protocol[0], a->protocol[1]))
+		return cli_usage("compare",
+		                 "--protocols %s: expected two different lattice protocols, "
+		                 "world,essay or essay,world",
+		                 text);
+	return CLI_OK;
 }
 
 static int compare_option(compare_args *a, int c)
 {
 	switch (c) {
 	case OPT_BACKENDS:
+		a->has_backends = 1;
 		return parse_backends(a, optarg);
+	case OPT_PROTOCOLS:
+		return parse_protocols(a, optarg);
+	case OPT_BACKEND:
+		if (strlen(optarg) >= sizeof a->names[0])
+			return cli_usage("compare", "--backend %s: unknown backend", optarg);
+		a->has_backend = 1;
+		snprintf(a->names[0], sizeof a->names[0], "%s", optarg);
+		snprintf(a->names[1], sizeof a->names[1], "%s", optarg);
+		return CLI_OK;
 	case OPT_BACKEND_OPT:
 		if (a->n_pending == (int)(sizeof a->pending / sizeof a->pending[0]) ||
 		    strlen(optarg) >= sizeof a->pending[0])
@@ -193,7 +241,17 @@ static int compare_parse(int argc, char **argv, compare_args *a)
 		return cli_usage("compare", "--out DIR is required");
 	if (strlen(a->out) > 900)
 		return cli_usage("compare", "--out DIR is longer than 900 characters");
-	if (strcmp(a->names[0], a->names[1]) == 0)
+	if (a->protocol[0][0] && a->has_backends)
+		return cli_usage("compare", "--protocols runs one backend (--backend B), not "
+		                            "--backends");
+	if (!a->protocol[0][0] && a->has_backend)
+		return cli_usage("compare", "--backend B goes with --protocols; two backends are "
+		                            "--backends A,B");
+	if (a->protocol[0][0] && !a->has_backend) {
+		snprintf(a->names[0], sizeof a->names[0], "thesis");
+		snprintf(a->names[1], sizeof a->names[1], "thesis");
+	}
+	if (!a->protocol[0][0] && strcmp(a->names[0], a->names[1]) == 0)
 		return cli_usage("compare", "--backends %s,%s: expected two different backends",
 		                 a->names[0], a->names[1]);
 	for (int i = 0; i < a->n_pending; i++) {
@@ -207,18 +265,20 @@ static int compare_parse(int argc, char **argv, compare_args *a)
 static void compare_summary(const compare_args *a, const bsim_experiment *e,
                             const bsim_comparison *cmp)
 {
+	const char *la = a->protocol[0][0] ? a->protocol[0] : a->names[0];
+	const char *lb = a->protocol[0][0] ? a->protocol[1] : a->names[1];
 	printf("%s vs %s on %s: %d of %d groups disagree (alpha %g, margin %g), %d x %d trials\n",
-	       a->names[0], a->names[1], e->path, cmp->n_disagree, cmp->n_groups, cmp->rule.alpha,
-	       cmp->rule.margin, e->n_groups, e->trials);
+	       la, lb, e->path, cmp->n_disagree, cmp->n_groups, cmp->rule.alpha, cmp->rule.margin,
+	       e->n_groups, e->trials);
 	for (int g = 0; g < cmp->n_groups; g++)
 		if (cmp->groups[g].verdict == BSIM_VERDICT_DISAGREE) {
 			const bsim_event_test *t = &cmp->groups[g].ev[BSIM_EVENT_TRAVERSED];
 			printf("  group %d: p_traverse %.2f vs %.2f, %d discordant pairs\n", g,
 			       t->p_a, t->p_b, cmp->groups[g].discordant);
 		}
-	printf("wrote %s/report.md, %s/report.json, %s/pairs.csv and each backend's sweep in "
+	printf("wrote %s/report.md, %s/report.json, %s/pairs.csv and each side's sweep in "
 	       "%s/%s and %s/%s\n",
-	       a->out, a->out, a->out, a->out, a->names[0], a->out, a->names[1]);
+	       a->out, a->out, a->out, a->out, la, a->out, lb);
 }
 
 static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_backend *b1)
@@ -226,6 +286,17 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 	bsim_experiment e;
 	bsim_error err;
 	struct stat st;
+	int protocols = a->protocol[0][0] != 0;
+	/* --protocols: side a's protocol joins the --set overrides, side b's is
+	 * its own override after them. */
+	for (int i = 0; protocols && i < 2; i++) {
+		snprintf(a->protocol_set[i], sizeof a->protocol_set[i], "lattice.protocol=%s",
+		         a->protocol[i]);
+		a->protocol_ov[i] = (bsim_override){"lattice.protocol", a->protocol[i],
+		                                    i ? "--protocols (side b)" : "--protocols"};
+	}
+	if (protocols && cli_sets_add(&a->sets, "compare", a->protocol_set[0]) != CLI_OK)
+		return CLI_USAGE;
 	int rc = cli_experiment_load(a->experiment, &a->sets, a->trials, &e);
 	if (rc != CLI_OK)
 		return rc;
@@ -243,6 +314,9 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 	        .opts = {&a->opts[0], &a->opts[1]},
 	        .extra = a->sets.ov,
 	        .n_extra = a->sets.n,
+	        .protocol = {protocols ? a->protocol[0] : NULL, protocols ? a->protocol[1] : NULL},
+	        .extra_b = protocols ? &a->protocol_ov[1] : NULL,
+	        .n_extra_b = protocols,
 	        .threads = a->threads > 0 ? (int)a->threads : omp_get_max_threads(),
 	        .rule = a->rule,
 	        .examples = (int)a->examples,

@@ -125,7 +125,14 @@ typedef struct regress_run {
 	bsim_experiment e;
 	const bsim_backend *backend[2];
 	bsim_compare_rule rule;
+	bsim_override protocol_b; /* compare --protocols: side b's protocol */
 } regress_run;
+
+/* The directory and label of side i: its protocol or its backend. */
+static const char *regress_label(const regress_run *run, int i)
+{
+	return run->rec.protocol[i][0] ? run->rec.protocol[i] : run->rec.backend[i];
+}
 
 static int regress_load(const regress_args *a, regress_run *run)
 {
@@ -158,10 +165,17 @@ static int regress_rerun(const regress_args *a, regress_run *run)
 {
 	int threads = a->threads > 0 ? (int)a->threads : omp_get_max_threads();
 	if (run->rec.n_backends == 2) {
+		int protocols = run->rec.protocol[0][0] != 0;
+		run->protocol_b = (bsim_override){"lattice.protocol", run->rec.protocol[1],
+		                                  "--protocols (side b)"};
 		cli_compare_job job = {
 		        .e = &run->e,
 		        .backend = {run->backend[0], run->backend[1]},
 		        .opts = {&run->rec.opts[0], &run->rec.opts[1]},
+		        .protocol = {protocols ? run->rec.protocol[0] : NULL,
+		                     protocols ? run->rec.protocol[1] : NULL},
+		        .extra_b = protocols ? &run->protocol_b : NULL,
+		        .n_extra_b = protocols,
 		        .threads = threads,
 		        .rule = run->rec.rule,
 		        .examples = 3,
@@ -198,7 +212,7 @@ static int regress_read(const regress_args *a, const regress_run *run, int i,
 		bsim_error err;
 		const char *dir = dirs[k];
 		if (run->rec.n_backends == 2) {
-			if (cli_path(sub, sizeof sub, dirs[k], run->rec.backend[i]))
+			if (cli_path(sub, sizeof sub, dirs[k], regress_label(run, i)))
 				return CLI_FAIL;
 			dir = sub;
 		}
@@ -232,8 +246,9 @@ static void regress_md(FILE *f, const regress_args *a, const regress_run *run, r
 		int changed = 0;
 		for (int g = 0; g < parts[i].cmp.n_groups; g++)
 			changed += parts[i].cmp.groups[g].changed;
-		fprintf(f, "## Backend %s\n\n%d of %d trials changed in some trials.csv field.\n\n",
-		        run->rec.backend[i], changed, run->e.n_groups * run->e.trials);
+		fprintf(f, "## %s %s\n\n%d of %d trials changed in some trials.csv field.\n\n",
+		        run->rec.protocol[i][0] ? "Protocol" : "Backend", regress_label(run, i),
+		        changed, run->e.n_groups * run->e.trials);
 		bsim_report_md(f, &parts[i].rep);
 	}
 }
@@ -288,8 +303,11 @@ static int regress_compare(const regress_args *a, regress_run *run)
 		if (bsim_compare_analyse(&p->r[0], &p->r[1], NULL, &run->rule, &p->cmp, &err) !=
 		    BSIM_OK)
 			rc = cli_report(CLI_FAIL, &err);
+		int side_b = n == 1 && run->rec.protocol[1][0];
 		p->rep = (bsim_report){
 		        .e = &run->e,
+		        .extra = side_b ? &run->protocol_b : NULL,
+		        .n_extra = side_b,
 		        .side = {{"baseline", run->backend[n], &run->rec.opts[n], &p->r[0]},
 		                 {"rerun", run->backend[n], &run->rec.opts[n], &p->r[1]}},
 		        .cmp = &p->cmp,
@@ -305,7 +323,7 @@ static int regress_compare(const regress_args *a, regress_run *run)
 			for (int g = 0; g < parts[i].cmp.n_groups; g++)
 				changed += parts[i].cmp.groups[g].changed;
 			printf("%s: %d of %d trials changed, %d of %d groups beyond tolerance\n",
-			       run->rec.backend[i], changed, run->e.n_groups * run->e.trials,
+			       regress_label(run, i), changed, run->e.n_groups * run->e.trials,
 			       parts[i].cmp.n_disagree, parts[i].cmp.n_groups);
 		}
 		printf("wrote %s/regress.md and %s/regress.json\n", a->out, a->out);

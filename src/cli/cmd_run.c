@@ -6,12 +6,14 @@
 
 #include <getopt.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "beamsim/atomic_file.h"
 #include "beamsim/json.h"
+#include "beamsim/lattice.h"
 #include "beamsim/output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
@@ -148,6 +150,8 @@ static void print_ledger_json(const bsim_ledger *l)
 	        {"impact", l->impact},
 	        {"contact", l->contact},
 	        {"correction", l->correction},
+	        {"sleep", l->sleep},
+	        {"reset", l->reset},
 	        {"residual", l->residual},
 	        {"residual_max", l->residual_max},
 	        {"residual_abs", l->residual_abs},
@@ -160,8 +164,37 @@ static void print_ledger_json(const bsim_ledger *l)
 	fputc('}', stdout);
 }
 
+/* The gate path and every beam's peak (the lattice's per-trial data). */
+static void print_path_json(const bsim_trial_result *r, const bsim_trial_log *log)
+{
+	char label[48];
+	bsim_location_label(bsim_location_of(r), label, sizeof label);
+	printf(", \"final_gate\": [%d, %d], \"location\": \"%s\", \"reset_overlaps\": %d",
+	       r->final_ix, r->final_iy, label, r->reset_overlaps);
+	fputs(", \"path\": [", stdout);
+	for (int k = 0; k < log->n_entries; k++) {
+		const bsim_gate_entry *e = &log->entries[k];
+		printf("%s{\"gate\": [%d, %d], \"edge\": \"%s\", \"t\": ", k ? ", " : "", e->ix,
+		       e->iy, bsim_edge_name(e->edge));
+		bsim_json_number(stdout, e->t);
+		fputs(", \"pos\": ", stdout);
+		bsim_json_number(stdout, e->pos);
+		fputs(", \"v\": [", stdout);
+		bsim_json_number(stdout, e->v[0]);
+		fputs(", ", stdout);
+		bsim_json_number(stdout, e->v[1]);
+		fputs("]}", stdout);
+	}
+	fputs("], \"peak_theta\": [", stdout);
+	for (int i = 0; i < log->n_beams; i++) {
+		fputs(i ? ", " : "", stdout);
+		bsim_json_number(stdout, log->peak[i]);
+	}
+	fputc(']', stdout);
+}
+
 static void print_json(const run_args *a, const bsim_backend *b, const bsim_scene *s,
-                       uint64_t mixed, const bsim_trial_result *r)
+                       uint64_t mixed, const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	fputs("{\"scene\": ", stdout);
 	bsim_json_string(stdout, a->scene);
@@ -191,13 +224,15 @@ static void print_json(const run_args *a, const bsim_backend *b, const bsim_scen
 	bsim_json_number(stdout, r->max_theta[0]);
 	fputs(", ", stdout);
 	bsim_json_number(stdout, r->max_theta[1]);
-	fputs("], \"ledger\": ", stdout);
+	fputc(']', stdout);
+	print_path_json(r, log);
+	fputs(", \"ledger\": ", stdout);
 	print_ledger_json(&r->ledger);
 	fputs("}\n", stdout);
 }
 
 static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
-                       const bsim_trial_result *r)
+                       const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	const bsim_ledger *l = &r->ledger;
 	printf("scene       %s (%s), backend %s\n", a->scene, s->name, a->backend);
@@ -216,11 +251,36 @@ static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
 	       r->steps_run);
 	printf("end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,
 	       r->vx_end);
-	printf("peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0], r->max_theta[1]);
+	if (s->has_lattice) {
+		char label[48];
+		bsim_location_label(bsim_location_of(r), label, sizeof label);
+		printf("lattice     %s protocol, ended %s in gate (%d, %d), %d gates entered:",
+		       s->lattice.protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world", label,
+		       r->final_ix, r->final_iy, r->gates_entered);
+		for (int k = 0; k < log->n_entries; k++)
+			printf(" %d:%d", log->entries[k].ix, log->entries[k].iy);
+		int moved = 0;
+		double peak = 0.0;
+		for (int i = 0; i < log->n_beams; i++) {
+			moved += log->peak[i] != 0.0;
+			peak = fmax(peak, log->peak[i]);
+		}
+		printf("\npeak theta  %d beams moved, the largest %.6g rad (run --json: every "
+		       "beam)\n",
+		       moved, peak);
+		if (s->lattice.protocol == BSIM_PROTOCOL_ESSAY)
+			printf("reset       %d entries whose beams at rest overlapped the body\n",
+			       r->reset_overlaps);
+	} else {
+		printf("peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0],
+		       r->max_theta[1]);
+	}
 	printf("energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
 	printf("  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
 	printf("  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
 	       l->damper, l->impact, l->contact, l->correction);
+	if (l->sleep != 0.0 || l->reset != 0.0)
+		printf("  at rest   sleeping %.6g J, essay resets %.6g J\n", l->sleep, l->reset);
 	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step)\n", l->residual,
 	       l->residual_abs, l->residual_max);
 }
@@ -228,10 +288,10 @@ static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
 /* Runs the trial, recording into the trajectory file if one was asked
  * for; the file appears only if the run finished. */
 static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_backend *backend,
-                     uint64_t mixed, bsim_trial_result *res)
+                     uint64_t mixed, bsim_trial_result *res, bsim_trial_log *log)
 {
 	bsim_atomic_file traj = {0};
-	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride};
+	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride, .log = log};
 	bsim_error err;
 	if (a->trajectory) {
 		if (bsim_atomic_file_open(&traj, a->trajectory, &err) != BSIM_OK)
@@ -246,8 +306,7 @@ static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_back
 		return CLI_FAIL;
 	}
 	bsim_error_clear(&err);
-	int rc = bsim_trial_run(runner, scene, backend, &a->opts, mixed,
-	                        a->trajectory ? &rec : NULL, res, &err);
+	int rc = bsim_trial_run(runner, scene, backend, &a->opts, mixed, &rec, res, &err);
 	bsim_runner_free(runner);
 	if (rc != BSIM_OK) {
 		bsim_atomic_file_abort(&traj);
@@ -279,11 +338,15 @@ int cmd_run(int argc, char **argv)
 		uint64_t mixed = bsim_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
 		bsim_trial_result res;
 		memset(&res, 0, sizeof res);
-		rc = run_trial(&a, &scene, backend, mixed, &res);
+		bsim_trial_log *log = bsim_trial_log_alloc();
+		rc = log ? run_trial(&a, &scene, backend, mixed, &res, log) : CLI_FAIL;
+		if (!log)
+			cli_error("out of memory");
 		if (rc == CLI_OK && a.json)
-			print_json(&a, backend, &scene, mixed, &res);
+			print_json(&a, backend, &scene, mixed, &res, log);
 		else if (rc == CLI_OK)
-			print_text(&a, &scene, mixed, &res);
+			print_text(&a, &scene, mixed, &res, log);
+		bsim_trial_log_free(log);
 		bsim_scene_free(&scene);
 	}
 	cli_sets_free(&a.sets);

@@ -1,0 +1,16 @@
+/* beamsim bench --lattice (bench_lattice.c). */
+#ifndef BSIM_BENCH_LATTICE_H
+#define BSIM_BENCH_LATTICE_H
+
+#include "beamsim/backend.h"
+
+typedef struct bench_lattice_args {
+	const bsim_backend *backend, *vs; /* vs may be NULL */
+	const bsim_options *opts, *vs_opts;
+	long trials, vs_trials; /* per size; <= 0: 200 and 20 */
+	const char *json;       /* NULL: none */
+} bench_lattice_args;
+
+int bench_lattice(const bench_lattice_args *a);
+
+#endif
