@@ -200,7 +200,7 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 	snprintf(w->s->lattice.stiffness_file, sizeof w->s->lattice.stiffness_file, "%s", rel);
 	char line[8192];
 	int lineno = 0, iy = 0, rc = BSIM_OK;
-	int max = l->columns < 4096 ? l->columns : 4096;
+	int max = l->columns;
 	char **fields = malloc((size_t)(max + 1) * sizeof *fields);
 	int *cols = malloc((size_t)(max + 1) * sizeof *cols);
 	if (!fields || !cols)
@@ -227,16 +227,18 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 			        path, lineno, l->rows);
 			break;
 		}
-		int k = csv_fields(line, fields, max, cols);
-		if (k != l->columns) {
+		int given = 1;
+		for (const char *c = line; *c; c++)
+			given += *c == ',';
+		if (given != l->columns) {
 			rc = bsim_error_set(
 			        w->err, BSIM_EINPUT,
 			        "%s:%d: lattice.stiffness_file: expected %d values (one per "
-			        "column, ix = %d .. %d), got %s%d",
-			        path, lineno, l->columns, l->ix_min, l->ix_max,
-			        k > max ? "more than " : "", k > max ? max : k);
+			        "column, ix = %d .. %d), got %d",
+			        path, lineno, l->columns, l->ix_min, l->ix_max, given);
 			break;
 		}
+		int k = csv_fields(line, fields, max, cols);
 		for (int c = 0; c < k && rc == BSIM_OK; c++) {
 			char *end;
 			errno = 0;
