@@ -16,6 +16,14 @@
 
 void thesis_beam_direction(const thesis_beam *b, double u[2])
 {
+	/* At rest the rotation is the identity: u0 exactly, as the formula
+	 * below gives it (u0 - u0_perp * (+-0) = u0), without the sine and
+	 * cosine; a lattice has many beams at rest near the body. */
+	if (b->theta == 0.0) {
+		u[0] = b->u0[0];
+		u[1] = b->u0[1];
+		return;
+	}
 	double cs = cos(b->theta), sn = b->sgn * sin(b->theta);
 	u[0] = b->u0[0] * cs - b->u0[1] * sn;
 	u[1] = b->u0[1] * cs + b->u0[0] * sn;
