@@ -310,9 +310,10 @@ void bsim_report_md(FILE *f, const bsim_report *r)
 	fprintf(f,
 	        "Rule: a group disagrees when, for one of the events traversed, left, right, "
 	        "side_exit, stuck, the exact McNemar test on the paired trials gives a p-value "
-	        "below %g after Holm's correction over all %d groups x %d events, and the two "
+	        "below %g after Holm's correction over all %d groups x %d events%s, and the two "
 	        "probabilities differ by at least %g",
-	        c->rule.alpha, c->n_groups, BSIM_N_EVENTS, c->rule.margin);
+	        c->rule.alpha, c->n_groups, BSIM_N_EVENTS,
+	        c->lattice ? " (and the final-location test)" : "", c->rule.margin);
 	fputs(c->rule.exact ? "; or when any trial differs in any trials.csv field.\n\n" : ".\n\n",
 	      f);
 	if (c->lattice)

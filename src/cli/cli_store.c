@@ -125,11 +125,11 @@ static char *compare_title(const cli_compare_job *job)
 		        job->protocol[0], job->protocol[1], job->backend[0]->name, job->protocol[0],
 		        job->protocol[1]);
 	fprintf(f,
-	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; both backends "
+	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; both %s "
 	        "ran every trial with the same random-force schedule, so trial t of group g is "
 	        "a pair.\n\n",
 	        job->e->path, job->e->scene_path, (unsigned long long)job->e->seed,
-	        job->e->n_groups, job->e->trials);
+	        job->e->n_groups, job->e->trials, job->protocol[0] ? "protocols" : "backends");
 	for (int i = 0; i < 2; i++) {
 		fprintf(f, "- %s options: ", job->backend[i]->name);
 		bsim_output_backend_options(f, job->backend[i], job->opts[i]);
