@@ -14,8 +14,12 @@
 
 #include "support.h"
 
+/* trials.csv: the contract's first eleven columns, then the appended ones
+ * (the ledger, the overlap, the group's grid values by key). */
 #define TRIALS_HEADER                                                                              \
-	"group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2\n"
+	"group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"           \
+	"e_start,e_end,work_in,losses,residual,overlap_max,effects.propulsion.force,"              \
+	"effects.random_force.magnitude\n"
 #define TRAJ_HEADER                                                                                \
 	"t,x,y,vx,vy,theta1,omega1,theta2,omega2,f_rand,contact1,contact2,e_kin,e_beam,e_prop\n"
 
@@ -312,6 +316,7 @@ static void test_sweep(void **state)
 	assert_memory_equal(csv, TRIALS_HEADER, strlen(TRIALS_HEADER));
 	assert_int_equal(count_lines(csv), 1 + 2 * 3);
 	assert_contains(csv, "\n1,2,");
+	assert_contains(csv, ",8,20\n"); /* group 1's values */
 	free(csv);
 
 	snprintf(file, sizeof file, "%s/summary.json", out);

@@ -190,8 +190,9 @@ static void test_regress_identical(void **state)
 }
 
 /* A stored sweep whose group 2 (force 9, no noise) traversals were all
- * rewritten as side exits: regress flags group 3 only, exit 3, and its
- * replay lines reproduce the rerun's (true) outcomes. */
+ * rewritten as side exits: regress flags group 2 only, as a deterministic
+ * group whose one pair differs, exit 3, and its replay line reproduces the
+ * rerun's (true) outcome. */
 static void test_regress_catches_changes(void **state)
 {
 	(void)state;
@@ -220,14 +221,14 @@ static void test_regress_catches_changes(void **state)
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 3);
 	char *json = read_in(dir, "regress.json");
 	int disagree = 0;
-	for (const char *p = json; (p = strstr(p, "\"verdict\": \"DISAGREE\"")); p++)
+	for (const char *p = json; (p = strstr(p, "\"verdict\": \"D")); p++)
 		disagree++;
 	assert_int_equal(disagree, 1);
 	assert_non_null(strstr(json, "{\"group\": 2, \"params\": {\"effects.propulsion.force\": 9, "
 	                             "\"effects.random_force.magnitude\": 0}, \"verdict\": "
-	                             "\"DISAGREE\""));
+	                             "\"DIFFERENT\", \"deterministic\": true, \"pairs\": 1"));
 	/* The rerun's side replays; the baseline's was edited, so it cannot. */
-	assert_int_equal(check_replays(json, 1), 3);
+	assert_int_equal(check_replays(json, 1), 1);
 	free(csv);
 	free(edited);
 	free(json);
@@ -263,7 +264,7 @@ static void test_bad_usage(void **state)
 	const char *same[] = {"compare", experiment,      "--backends", "thesis,thesis",
 	                      "--out",   out_dir("bad1"), NULL};
 	assert_int_equal(bsim_test_cli(same, NULL, &err), 2);
-	assert_non_null(strstr(err, "two different backends"));
+	assert_non_null(strstr(err, "two different sides"));
 	free(err);
 	const char *knob[] = {"compare",       experiment, "--backend-opt", "box2d:nope=1", "--out",
 	                      out_dir("bad2"), NULL};
