@@ -273,6 +273,45 @@ int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_over
 	return rc;
 }
 
+/* 1 if keys a and b name the same field or one lies inside the other
+ * ("beams.0" and "beams.0.stiffness"). */
+static int keys_overlap(const char *a, const char *b)
+{
+	size_t la = strlen(a), lb = strlen(b), n = la < lb ? la : lb;
+	if (strncmp(a, b, n) != 0)
+		return 0;
+	return la == lb || (la > n ? a[n] : b[n]) == '.';
+}
+
+/* A fixed override (set: or --set) of a field the grid varies would be
+ * overwritten in every group without a word: refused. */
+static int check_conflicts(const bsim_experiment *e, const bsim_override *extra, int n_extra,
+                           bsim_error *err)
+{
+	for (int a = 0; a < e->n_axes; a++) {
+		const bsim_grid_axis *ax = &e->axes[a];
+		for (int i = 0; i < e->n_set; i++)
+			if (keys_overlap(e->set[i].key, ax->key))
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s: set.%s: the grid varies %s (%s), which would "
+				        "overwrite it in every group; expected a key the "
+				        "grid does not vary",
+				        e->set[i].origin, e->set[i].key, ax->key, ax->origins[0]);
+		for (int i = 0; i < n_extra; i++)
+			if (keys_overlap(extra[i].key, ax->key))
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s: the experiment's grid varies %s (%s), which "
+				        "would overwrite it in every group; expected a key "
+				        "the grid does not vary (to run one value, edit "
+				        "the grid)",
+				        extra[i].origin ? extra[i].origin : extra[i].key, ax->key,
+				        ax->origins[0]);
+	}
+	return BSIM_OK;
+}
+
 /* Reads the scene file once and builds every group's scene from it. */
 static int check_groups(const bsim_experiment *e, const bsim_override *extra, int n_extra,
                         bsim_error *err)
@@ -304,6 +343,8 @@ int bsim_experiment_load(const char *path, const bsim_override *extra, int n_ext
 		return rc;
 	rc = walk_experiment(&d, out, err);
 	ydoc_free(&d);
+	if (!rc)
+		rc = check_conflicts(out, extra, n_extra, err);
 	if (!rc)
 		rc = check_groups(out, extra, n_extra, err);
 	if (rc)
