@@ -219,18 +219,23 @@ static void deterministic_fill(bsim_trial_result *res, double *t_separate, const
 static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_groups, int trials,
                           double wall)
 {
+	r->total_steps = 0;
+	r->trials_run = 0;
 	for (int g = 0; g < n_groups; g++) {
 		bsim_group_result *gr = &r->groups[g];
-		bsim_group_aggregate(&r->trials_out[(size_t)g * trials], trials, gr);
+		const bsim_trial_result *first = &r->trials_out[(size_t)g * trials];
+		bsim_group_aggregate(first, trials, gr);
 		/* No draws, no sampling: p_traverse is exactly what the one trial
 		 * gave, so its interval is that point, not a Wilson interval over
-		 * copies. */
+		 * copies; and only that trial's steps were integrated. */
 		gr->deterministic = deterministic[g];
-		if (gr->deterministic)
+		if (gr->deterministic && trials > 0) {
 			gr->ci95[0] = gr->ci95[1] = gr->p_traverse;
+			gr->steps = first->steps_run;
+		}
+		r->total_steps += gr->steps;
+		r->trials_run += gr->deterministic && trials > 0 ? 1 : trials;
 	}
-	for (size_t i = 0; i < (size_t)n_groups * trials; i++)
-		r->total_steps += r->trials_out[i].steps_run;
 	r->wall_seconds = wall;
 }
 

@@ -28,9 +28,10 @@ typedef struct bsim_sweep_result {
 	bsim_trial_result *trials_out; /* n_groups * trials, index g*trials + t */
 	bsim_group_result *groups;     /* n_groups */
 	double wall_seconds;
-	long total_steps;
-	int has_ledger; /* 1: the trials' ledgers are known (a run, or a trials.csv
-	                 * with the energy columns) */
+	long total_steps; /* steps integrated (a deterministic group's one trial) */
+	long trials_run;  /* trials integrated: copies of a deterministic group's not */
+	int has_ledger;   /* 1: the trials' ledgers are known (a run, or a trials.csv
+	                   * with the energy columns) */
 } bsim_sweep_result;
 
 /* Called from one thread now and then with done/total trials. */

@@ -147,11 +147,13 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 static void sweep_report(const sweep_args *a, const bsim_experiment *e, const bsim_sweep_result *r,
                          int threads)
 {
-	long n = (long)r->n_groups * r->trials;
+	long n = r->trials_run, rows = (long)r->n_groups * r->trials;
 	bsim_output_table(stdout, e, r);
 	printf("\n%ld trials, %ld steps in %.3f s on %d thread%s: %.0f trials/s, %.3g steps/s\n", n,
 	       r->total_steps, r->wall_seconds, threads, threads == 1 ? "" : "s",
 	       cli_per_second(n, r->wall_seconds), cli_per_second(r->total_steps, r->wall_seconds));
+	if (n != rows)
+		printf("(%ld rows: the groups without random force ran one trial each)\n", rows);
 	printf("wrote %s/summary.json and %s/trials.csv\n", a->out, a->out);
 }
 
