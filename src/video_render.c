@@ -288,14 +288,14 @@ static void outcome_text(const bsim_trial_result *r, char *buf, size_t n)
 {
 	switch (r->outcome) {
 	case BSIM_TRAVERSED:
-		snprintf(buf, n, "traversed at t = %.2f s, %s type", r->t_end,
+		snprintf(buf, n, "traversed at t = %.2f s (%s type)", r->t_end,
 		         bsim_type_name(r->type));
 		break;
 	case BSIM_SIDE_EXIT:
 		snprintf(buf, n, "side exit at t = %.2f s", r->t_end);
 		break;
 	default:
-		snprintf(buf, n, "stuck at t = %.2f s, %s", r->t_end,
+		snprintf(buf, n, "stuck at t = %.2f s (%s)", r->t_end,
 		         r->in_contact_end ? "in contact" : "not in contact");
 		break;
 	}
@@ -365,30 +365,44 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	text_box(cr, vw.x0 + 6.0, vw.y0 + vw.h - 6.0, lines, n_lines, 0, 1, fs);
 	cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
 	draw_legend(cr, v, &vw, fs);
-	if (sm.step >= res->steps) {
-		outcome_text(res, buf, sizeof buf);
-		const char *one[1] = {buf};
-		cairo_text_extents_t e;
-		cairo_text_extents(cr, buf, &e);
-		text_box(cr, vw.x0 + 0.5 * (vw.w - e.x_advance) - 0.4 * fs, vw.y0 + 6.0, one, 1, 0,
-		         0, fs);
+	/* The title bar: label on the left, time on the right, and between
+	 * them the outcome once it is decided (in the view's top left corner
+	 * if the bar is too narrow for it). */
+	char outcome[128] = "";
+	if (sm.step >= res->steps)
+		outcome_text(res, outcome, sizeof outcome);
+	snprintf(buf, sizeof buf, "t = %.3f s%s", sm.t,
+	         k >= bsim_video_track_frames(t) ? " (ended)" : "");
+	const char *label = v->labels[p] ? v->labels[p] : "";
+	cairo_text_extents_t e_label, e_time, e_out;
+	cairo_text_extents(cr, buf, &e_time);
+	cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+	cairo_text_extents(cr, label, &e_label);
+	cairo_text_extents(cr, outcome, &e_out);
+	const double gap = 1.5 * fs;
+	const int in_bar =
+	        e_label.x_advance + e_out.x_advance + e_time.x_advance + 2.0 * gap + fs <= pw;
+	if (outcome[0] && !in_bar) {
+		const char *one[1] = {outcome};
+		text_box(cr, vw.x0 + 6.0, vw.y0 + 6.0, one, 1, 0, 0, fs);
 	}
 	cairo_restore(cr);
 
-	/* The title bar: label on the left, time on the right. */
 	cairo_rectangle(cr, px0, 0.0, pw, title_h);
 	set_color(cr, COLOR_TITLE);
 	cairo_fill(cr);
 	set_color(cr, COLOR_TEXT);
 	cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
 	cairo_move_to(cr, px0 + 0.5 * fs, 1.4 * fs);
-	cairo_show_text(cr, v->labels[p] ? v->labels[p] : "");
+	cairo_show_text(cr, label);
+	if (outcome[0] && in_bar) {
+		double x = px0 + 0.5 * fs + e_label.x_advance + gap;
+		double room = pw - fs - e_label.x_advance - e_time.x_advance - 2.0 * gap;
+		cairo_move_to(cr, x + 0.5 * (room - e_out.x_advance), 1.4 * fs);
+		cairo_show_text(cr, outcome);
+	}
 	cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-	snprintf(buf, sizeof buf, "t = %.3f s%s", sm.t,
-	         k >= bsim_video_track_frames(t) ? " (ended)" : "");
-	cairo_text_extents_t e;
-	cairo_text_extents(cr, buf, &e);
-	cairo_move_to(cr, px0 + pw - e.x_advance - 0.5 * fs, 1.4 * fs);
+	cairo_move_to(cr, px0 + pw - e_time.x_advance - 0.5 * fs, 1.4 * fs);
 	cairo_show_text(cr, buf);
 	/* A rule between panels. */
 	if (p > 0) {

@@ -2,9 +2,10 @@
  *
  * The runner's trace callback sees the state after every step n. Every
  * step's body centre goes into the trail; frame k takes the state of step
- *   n_k = floor(k / (fps h))
- * (the last step at or before the frame's time k / fps), with the energies
- * of that state,
+ *   n_k = min(floor(k / (fps h)), N)
+ * (the last step at or before the frame's time k / fps; N the trial's last
+ * step), so a trial has ceil(N h fps) + 1 frames and the last one shows its
+ * end state. Each frame keeps the energies of its state,
  *   E_kin = 1/2 M |v|^2 + sum 1/2 I_i omega_i^2,  E_spring = sum 1/2 k_i theta_i^2,
  *   E_prop = F_prop (y0 - y),
  * and the random force of step n_k. The force comes from a second effect
@@ -41,6 +42,7 @@ struct bsim_video_track {
 	unsigned char *contact; /* n_beams per frame */
 	long n_frames, cap_frames;
 	bsim_effects fx; /* the same schedule as the runner's, for the force */
+	long last_step;  /* a step after the last frame's, kept in the next slot; -1 none */
 	int oom;
 };
 
@@ -87,12 +89,13 @@ static int frames_reserve(bsim_video_track *t, long need)
 	return 0;
 }
 
-static void frame_take(bsim_video_track *t, long step, const bsim_state *s)
+/* Writes the state of step `step` into frame slot k. */
+static void frame_take(bsim_video_track *t, long k, long step, const bsim_state *s)
 {
 	const bsim_scene *sc = t->scene;
-	track_frame *f = &t->frames[t->n_frames];
-	float *th = t->theta + (size_t)t->n_frames * (size_t)t->n_beams;
-	unsigned char *ct = t->contact + (size_t)t->n_frames * (size_t)t->n_beams;
+	track_frame *f = &t->frames[k];
+	float *th = t->theta + (size_t)k * (size_t)t->n_beams;
+	unsigned char *ct = t->contact + (size_t)k * (size_t)t->n_beams;
 	f->step = step;
 	f->x[0] = s->x[0];
 	f->x[1] = s->x[1];
@@ -109,7 +112,6 @@ static void frame_take(bsim_video_track *t, long step, const bsim_state *s)
 	double force[2];
 	bsim_effects_force(&t->fx, step, sc->dt, force);
 	f->f_rand = t->fx.random ? t->fx.random->last : 0.0;
-	t->n_frames++;
 }
 
 static void track_trace(void *user, long step, const bsim_state *s)
@@ -124,13 +126,26 @@ static void track_trace(void *user, long step, const bsim_state *s)
 	t->trail[2 * t->n_trail] = s->x[0];
 	t->trail[2 * t->n_trail + 1] = s->x[1];
 	t->n_trail++;
+	if (frames_reserve(t, t->n_frames + 1)) {
+		t->oom = 1;
+		return;
+	}
+	if (frame_step(t, t->n_frames) > step) {
+		/* Not a frame's step: kept in the next slot in case it is the
+		 * last step of the trial. */
+		frame_take(t, t->n_frames, step, s);
+		t->last_step = step;
+		return;
+	}
 	while (frame_step(t, t->n_frames) <= step) {
 		if (frames_reserve(t, t->n_frames + 1)) {
 			t->oom = 1;
 			return;
 		}
-		frame_take(t, step, s);
+		frame_take(t, t->n_frames, step, s);
+		t->n_frames++;
 	}
+	t->last_step = -1;
 }
 
 int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend,
@@ -151,6 +166,7 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 	t->scene = scene;
 	t->fps = fps;
 	t->n_beams = scene->n_beams;
+	t->last_step = -1;
 	if (bsim_effects_init(&t->fx, scene, seed)) {
 		free(t);
 		bsim_runner_free(runner);
@@ -166,6 +182,15 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 		bsim_video_track_free(t);
 		return rc;
 	}
+	/* Frames 0 .. ceil(N h fps): all those at or before the end, and one
+	 * for the end state; frames past it that floor() also maps to step N
+	 * (when fps h > 1 or the end falls just before a frame time) go. */
+	long n_last = t->n_trail - 1;
+	long frames = (long)ceil((double)n_last * fps * scene->dt - 1e-9) + 1;
+	if (t->n_frames >= frames)
+		t->n_frames = frames;
+	else if (t->last_step == n_last)
+		t->n_frames++; /* the end state, kept in the next slot */
 	*out = t;
 	return BSIM_OK;
 }

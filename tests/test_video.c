@@ -139,11 +139,11 @@ static long run_steps(const char *scene, const char *const *args)
 }
 
 /* Frames of a trial of `steps` steps of dt at fps, plus the hold:
- * floor(steps dt fps) + 1 + round(hold fps), computed here in integers
+ * ceil(steps dt fps) + 1 + round(hold fps), computed here in integers
  * (dt fps = num / den exactly). */
 static long expected_frames(long steps, long num, long den, long hold_frames)
 {
-	return steps * num / den + 1 + hold_frames;
+	return (steps * num + den - 1) / den + 1 + hold_frames;
 }
 
 /* 1 if dir holds no entry but . and .. */
@@ -207,8 +207,10 @@ static void cli_side_by_side(void **state)
 	char gate[1200], out[1400];
 	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
 	snprintf(out, sizeof out, "%s/pair.mp4", bsim_test_dir("pair"));
-	const char *common[] = {"--set", "integration.max_steps=500", "--set",
-	                        "effects.propulsion.force=9", NULL};
+	/* A violent random force: both bodies leave through a side within
+	 * 2 s, at different steps, so the video lasts as the longer trial. */
+	const char *common[] = {"--trial", "1", "--set", "effects.random_force.magnitude=150",
+	                        NULL};
 	const char *thesis[] = {"--backend", "thesis",  common[0], common[1],
 	                        common[2],   common[3], NULL};
 	const char *box2d[] = {"--backend", "box2d",   common[0], common[1],
@@ -457,9 +459,11 @@ static int column(const char *header, const char *name)
 	return -1;
 }
 
-/* Every frame of the gate's video shows the state of step floor(k/(fps
- * h)) of the trajectory beamsim run records for the same trial: position,
- * energies and the random force the runner applies over that step. */
+/* Every frame of the gate's video shows the state of step min(floor(k/(fps
+ * h)), N) of the trajectory beamsim run records for the same trial:
+ * position, energies and the random force the runner applies over that
+ * step; 601 steps end between two frame times, and the last frame is the
+ * trial's end state. */
 static void lib_frames_are_the_runs_states(void **state)
 {
 	(void)state;
@@ -467,7 +471,7 @@ static void lib_frames_are_the_runs_states(void **state)
 	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
 	snprintf(csv, sizeof csv, "%s/t.csv", bsim_test_dir("same"));
 	const char *argv[] = {"run",          gate, "--seed", "3",
-	                      "--trial",      "5",  "--set",  "integration.max_steps=600",
+	                      "--trial",      "5",  "--set",  "integration.max_steps=601",
 	                      "--trajectory", csv,  NULL};
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	char *text = bsim_test_read(csv);
@@ -495,7 +499,7 @@ static void lib_frames_are_the_runs_states(void **state)
 	}
 
 	bsim_scene scene;
-	bsim_override ov = {"integration.max_steps", "600", "test"};
+	bsim_override ov = {"integration.max_steps", "601", "test"};
 	bsim_error err;
 	assert_int_equal(bsim_scene_load(gate, &ov, 1, &scene, &err), BSIM_OK);
 	bsim_options opts = {0};
@@ -505,18 +509,21 @@ static void lib_frames_are_the_runs_states(void **state)
 	                 BSIM_OK);
 	long frames = bsim_video_track_frames(t);
 	assert_int_equal(n_rows, bsim_video_track_result(t)->steps_run + 1);
-	assert_int_equal(frames, (n_rows - 1) * 3 / 25 + 1);
+	const long n_last = n_rows - 1;
+	assert_int_equal(frames, expected_frames(n_last, 3, 25, 0));
 	double worst = 0.0;
 	int forces_seen = 0;
 	for (long k = 0; k < frames; k++) {
 		bsim_video_sample s = bsim_video_track_sample(t, k);
-		long step = k * 25 / 3; /* floor(k / (30 fps x 4 ms)) */
+		long step = k * 25 / 3; /* floor(k / (30 fps x 4 ms)), to the end */
+		if (step > n_last)
+			step = n_last;
 		assert_int_equal(s.step, step);
 		const double got[6] = {s.x[0], s.x[1], s.f_rand, s.e_kin, s.e_spring, s.e_prop};
 		for (int i = 0; i < 6; i++) {
 			/* The last row's f_rand is the last force applied, not the
 			 * next one: compare forces only over steps that were run. */
-			if (i == 2 && step == n_rows - 1)
+			if (i == 2 && step == n_last)
 				continue;
 			double want = rows[step][i];
 			double e = fabs(got[i] - want) / fmax(1.0, fabs(want));
@@ -527,6 +534,7 @@ static void lib_frames_are_the_runs_states(void **state)
 		}
 		forces_seen += s.f_rand != 0.0;
 	}
+	assert_int_equal(bsim_video_track_sample(t, frames - 1).step, n_last);
 	printf("# %ld frames equal the run's trajectory to %.1e (relative)\n", frames, worst);
 	assert_true(forces_seen > frames / 2);
 	free(rows);

@@ -9,9 +9,10 @@
  *   bsim_video_write(v, "trial.mp4", err);                            // whole or nothing
  *
  * Time. Frame k shows the simulated time k / fps: the state after step
- * n_k = floor(k / (fps h)), the last step at or before that time. A trial of
- * N steps (the runner's steps_run, including the run on to classify_y after
- * a traversal) has floor(N h fps) + 1 frames; side by side, the video lasts
+ * n_k = min(floor(k / (fps h)), N), the last step at or before that time,
+ * where N is the trial's last step (the runner's steps_run, including the
+ * run on to classify_y after a traversal). A trial has ceil(N h fps) + 1
+ * frames, the last one its end state; side by side, the video lasts
  * as long as the longest trial, a panel whose trial has ended shows its
  * last state, and the last frame is held for `hold` seconds at the end.
  *
@@ -90,7 +91,7 @@ void bsim_video_track_free(bsim_video_track *t);
 
 /* The trial's result, as bsim_trial_run gives it. */
 const bsim_trial_result *bsim_video_track_result(const bsim_video_track *t);
-/* Frames recorded: floor(steps_run dt fps) + 1. */
+/* Frames recorded: ceil(steps_run dt fps) + 1. */
 long bsim_video_track_frames(const bsim_video_track *t);
 /* Frame k (0 <= k < frames); later k give the last frame. */
 bsim_video_sample bsim_video_track_sample(const bsim_video_track *t, long k);
