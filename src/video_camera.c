@@ -41,6 +41,8 @@ void video_field_bounds(const bsim_scene *s, double field[4])
 /* One axis of the centre: lo..hi the field, half the view's half span. */
 static double axis_centre(double lo, double hi, double half, double body, double r)
 {
+	if (!isfinite(body)) /* a state that blew up: show the field */
+		return 0.5 * (lo + hi);
 	double c;
 	if (hi - lo <= 2.0 * half)
 		c = 0.5 * (lo + hi);

@@ -114,6 +114,8 @@ static void draw_trail(cairo_t *cr, const video_view *vw, const bsim_video_track
 	cairo_move_to(cr, p[0], p[1]);
 	for (long i = 1; i <= last; i++) {
 		video_view_pixel(vw, xy + 2 * i, q);
+		if (!isfinite(q[0]) || !isfinite(q[1]))
+			break;
 		if (i < last && fabs(q[0] - p[0]) < 0.75 && fabs(q[1] - p[1]) < 0.75)
 			continue;
 		cairo_line_to(cr, q[0], q[1]);
@@ -156,6 +158,8 @@ static void draw_beams(cairo_t *cr, const bsim_video *v, const video_view *vw,
 	for (int i = 0; i < s->n_beams; i++) {
 		const bsim_beam_def *b = &s->beams[i];
 		double tip[2];
+		if (!isfinite(sm->theta[i]))
+			continue;
 		beam_tip(b, sm->theta[i], tip);
 		line_world(cr, vw, b->pivot, tip);
 		set_color(cr, bsim_video_stiffness_color(v, b->stiffness));
@@ -173,6 +177,8 @@ static void draw_beams(cairo_t *cr, const bsim_video *v, const video_view *vw,
 
 static void draw_body(cairo_t *cr, const bsim_video *v, const video_view *vw, const double x[2])
 {
+	if (!isfinite(x[0]) || !isfinite(x[1]))
+		return;
 	double p[2];
 	video_view_pixel(vw, x, p);
 	double r = v->scene->body.radius * vw->scale;
@@ -190,7 +196,8 @@ static void draw_force(cairo_t *cr, const bsim_video *v, const video_view *vw,
                        const bsim_video_sample *sm, int axis)
 {
 	const bsim_scene *s = v->scene;
-	if (!s->effects.has_random_force || s->effects.random_magnitude <= 0.0 || sm->f_rand == 0.0)
+	if (!s->effects.has_random_force || s->effects.random_magnitude <= 0.0 ||
+	    sm->f_rand == 0.0 || !isfinite(sm->x[0]) || !isfinite(sm->x[1]))
 		return;
 	double len = s->body.radius * sm->f_rand / s->effects.random_magnitude;
 	double a[2], b[2] = {sm->x[0], sm->x[1]};
@@ -294,9 +301,12 @@ static void outcome_text(const bsim_trial_result *r, char *buf, size_t n)
 	case BSIM_SIDE_EXIT:
 		snprintf(buf, n, "side exit at t = %.2f s", r->t_end);
 		break;
-	default:
+	case BSIM_STUCK:
 		snprintf(buf, n, "stuck at t = %.2f s (%s)", r->t_end,
 		         r->in_contact_end ? "in contact" : "not in contact");
+		break;
+	default:
+		snprintf(buf, n, "%s at t = %.2f s", bsim_outcome_name(r->outcome), r->t_end);
 		break;
 	}
 }
