@@ -167,8 +167,9 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 	bsim_json_number(f, g->ci95[1]);
 	fprintf(f,
 	        "], \"stuck_in_contact\": %d, \"landscape_left\": %d, \"landscape_right\": %d, "
-	        "\"steps\": %ld",
-	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps);
+	        "\"steps\": %ld, \"unstable\": %d, \"deterministic\": %s",
+	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps, g->unstable,
+	        g->deterministic ? "true" : "false");
 	if (r->lattice)
 		json_lattice(f, r, group);
 	fputc('}', f);
@@ -231,29 +232,78 @@ int bsim_output_summary_json(const char *path, const bsim_experiment *e, const c
 
 /* ---- trials.csv -------------------------------------------------------- */
 
-int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_error *err)
+/* A CSV field: as it is, or in double quotes (each " doubled) if it holds a
+ * comma, a quote or a line break. */
+static void csv_field(FILE *f, const char *s)
+{
+	if (!strpbrk(s, ",\"\r\n")) {
+		fputs(s, f);
+		return;
+	}
+	fputc('"', f);
+	for (; *s; s++) {
+		if (*s == '"')
+			fputc('"', f);
+		fputc(*s, f);
+	}
+	fputc('"', f);
+}
+
+/* A number, or an empty field if it was not measured (NaN). */
+static void csv_number(FILE *f, double x)
+{
+	if (!isnan(x))
+		fprintf(f, "%.10g", x);
+}
+
+int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                           bsim_error *err)
 {
 	bsim_atomic_file o;
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
+	int axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
 	fputs("group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"
-	      "final_ix,final_iy,location,path\n",
+	      "e_start,e_end,work_in,losses,residual,overlap_max,final_ix,final_iy,location,path",
 	      o.f);
+	for (int a = 0; a < axes; a++) {
+		fputc(',', o.f);
+		csv_field(o.f, e->axes[a].key);
+	}
+	fputc('\n', o.f);
 	for (int g = 0; g < r->n_groups; g++) {
+		if (axes)
+			bsim_experiment_group_index(e, g, idx);
 		for (int t = 0; t < r->trials; t++) {
 			size_t i = (size_t)g * r->trials + t;
 			const bsim_trial_result *x = &r->trials_out[i];
+			const bsim_ledger *l = &x->ledger;
+			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", g, t,
+			        bsim_outcome_name(x->outcome), bsim_type_name(x->type), x->steps,
+			        x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
+			        x->max_theta[1]);
+			/* losses: sleeping's and the essay protocol's resets too, so that
+			 * e_end - e_start = work_in - losses + residual */
+			fprintf(o.f, ",%.10g,%.10g,%.10g,%.10g,%.10g,", l->e_start, l->e_end,
+			        l->w_prop + l->w_rand,
+			        l->damper + l->impact + l->contact + l->correction + l->sleep +
+			                l->reset,
+			        l->residual);
+			csv_number(o.f, x->overlap_max);
+			/* the final gate and location, and the gates entered in order:
+			 * "ix:iy ix:iy ..." */
 			char label[48];
 			bsim_location_label(bsim_location_of(x), label, sizeof label);
-			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%d,%s,",
-			        g, t, bsim_outcome_name(x->outcome), bsim_type_name(x->type),
-			        x->steps, x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
-			        x->max_theta[1], x->final_ix, x->final_iy, label);
-			/* the gates entered, in order: "ix:iy ix:iy ..." */
-			const bsim_trial_log *l = r->logs ? &r->logs[i] : NULL;
-			for (int k = 0; l && k < l->n_entries; k++)
-				fprintf(o.f, "%s%d:%d", k ? " " : "", l->entries[k].ix,
-				        l->entries[k].iy);
+			fprintf(o.f, ",%d,%d,%s,", x->final_ix, x->final_iy, label);
+			const bsim_trial_log *tl = r->logs ? &r->logs[i] : NULL;
+			for (int k = 0; tl && k < tl->n_entries; k++)
+				fprintf(o.f, "%s%d:%d", k ? " " : "", tl->entries[k].ix,
+				        tl->entries[k].iy);
+			for (int a = 0; a < axes; a++) {
+				fputc(',', o.f);
+				csv_field(o.f, e->axes[a].values[idx[a]]);
+			}
 			fputc('\n', o.f);
 		}
 	}

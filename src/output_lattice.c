@@ -9,10 +9,9 @@
  *                       theta_left,omega_left,theta_right,omega_right
  *                       every gate entry with its state, gate frame (Eq. 2.17)
  *   beam_peaks.csv      group,trial,beam,ix,iy,side,max_theta  (beams that moved)
- *   trajectories.csv    group,trial,location,t,x,y  (the tracked trials, Fig. 3.5b)
  *
- * Units: m, s, m/s, rad, rad/s, N m/rad; x, y in lattice_map and
- * trajectories are the field's X, Y. */
+ * Units: m, s, m/s, rad, rad/s, N m/rad; x, y in lattice_map are the
+ * field's X, Y. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
@@ -153,38 +152,6 @@ static int write_peaks(FILE *f, const bsim_experiment *e, const bsim_override *e
 	return BSIM_OK;
 }
 
-static int write_tracks(FILE *f, const bsim_experiment *e, const bsim_override *extra, int n_extra,
-                        const bsim_sweep_result *r, bsim_error *err)
-{
-	(void)e;
-	(void)extra;
-	(void)n_extra;
-	(void)err;
-	fputs("group,trial,location,t,x,y\n", f);
-	for (int g = 0; g < r->n_groups; g++)
-		for (int t = 0; t < r->trials; t++) {
-			size_t i = (size_t)g * r->trials + t;
-			const bsim_trial_log *l = &r->logs[i];
-			char label[48];
-			bsim_location_label(bsim_location_of(&r->trials_out[i]), label,
-			                    sizeof label);
-			for (int k = 0; k < l->n_track; k++) {
-				const double *p = &l->track[3 * (size_t)k];
-				fprintf(f, "%d,%d,%s,%.6f,%.10g,%.10g\n", g, t, label, p[0], p[1],
-				        p[2]);
-			}
-		}
-	return BSIM_OK;
-}
-
-static int tracked(const bsim_sweep_result *r)
-{
-	for (size_t i = 0; i < (size_t)r->n_groups * r->trials; i++)
-		if (r->logs[i].n_track > 0)
-			return 1;
-	return 0;
-}
-
 int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_override *extra,
                         int n_extra, const bsim_sweep_result *r, bsim_error *err)
 {
@@ -194,13 +161,11 @@ int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_ov
 	} files[] = {
 	        {"lattice_map.csv", write_map},         {"final_locations.csv", write_locations},
 	        {"transitions.csv", write_transitions}, {"gate_entries.csv", write_entries},
-	        {"beam_peaks.csv", write_peaks},        {"trajectories.csv", write_tracks},
+	        {"beam_peaks.csv", write_peaks},
 	};
 	if (!r->lattice || !r->logs)
 		return BSIM_OK;
 	for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
-		if (files[k].fn == write_tracks && !tracked(r))
-			continue;
 		char path[1200];
 		int n = snprintf(path, sizeof path, "%s/%s", dir, files[k].name);
 		if (n < 0 || (size_t)n >= sizeof path)

@@ -6,7 +6,13 @@
  * (experiment seed, g, t) and its result goes to its own slot, so the
  * result is the same whatever the thread count (DESIGN.md "Determinism").
  * A paired sweep runs each trial on a second backend too, in the same slot
- * of a second result (trial_pair.c). */
+ * of a second result (trial_pair.c).
+ *
+ * A group whose scene draws no random numbers (bsim_effects_random) is
+ * deterministic: every trial of it is the same trial. It runs once, as
+ * trial 0, and the other slots are copies, so trials.csv keeps its shape
+ * and its values (identical code and inputs give identical trials), and
+ * nothing downstream counts one trial as many. */
 
 #include "beamsim/sweep.h"
 
@@ -15,6 +21,7 @@
 #include <string.h>
 
 #include "beamsim/clock.h"
+#include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"
 #include "trial_pair.h"
@@ -43,6 +50,9 @@ void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_res
 		case BSIM_STUCK:
 			out->stuck++;
 			out->stuck_in_contact += t->in_contact_end != 0;
+			break;
+		case BSIM_UNSTABLE:
+			out->unstable++;
 			break;
 		}
 	}
@@ -109,6 +119,7 @@ typedef struct sweep_shared {
 	const bsim_sweep_config *cfg;
 	const bsim_scene *scenes;
 	const bsim_scene *scenes_b; /* the second side's (may be scenes) */
+	const int *deterministic;   /* per group */
 	bsim_trial_result *results;
 	bsim_trial_log *logs;
 	const bsim_backend *backend_b; /* NULL: not paired */
@@ -168,18 +179,22 @@ static void sweep_thread(sweep_shared *sh)
 		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
 		const bsim_scene *scene = &sh->scenes[g];
-		int stride = cfg->track_stride > 0 ? cfg->track_stride : 10;
-		log[0]->track_stride = log[1]->track_stride = t < cfg->track_trials ? stride : 0;
-		bsim_recorder rec = {.stride = 1, .log = log[0]};
-		int rc = pair ? trial_pair_run(pair, scene, &sh->scenes_b[g], cfg->backend,
-		                               cfg->opts, sh->backend_b, sh->opts_b, seed,
-		                               0.01 * scene->body.radius, &sh->results[i],
-		                               &sh->results_b[i], log, &sh->t_separate[i], &err)
-		              : bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, &rec,
-		                               &sh->results[i], &err);
-		if (rc == BSIM_OK && bsim_trial_log_copy(&sh->logs[i], log[0]) != BSIM_OK)
+		bsim_recorder rec = {.stride = 1, .log = log[0], .overlap = cfg->measure_overlap};
+		int rc = BSIM_OK, copy = t > 0 && sh->deterministic[g];
+		if (copy)
+			; /* a copy of trial 0, filled in after the run */
+		else if (pair)
+			rc = trial_pair_run(pair, scene, &sh->scenes_b[g], cfg->backend, cfg->opts,
+			                    sh->backend_b, sh->opts_b, seed,
+			                    0.01 * scene->body.radius, &sh->results[i],
+			                    &sh->results_b[i], log, &sh->t_separate[i], &err);
+		else
+			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, &rec,
+			                    &sh->results[i], &err);
+		if (rc == BSIM_OK && !copy && bsim_trial_log_copy(&sh->logs[i], log[0]) != BSIM_OK)
 			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
-		if (rc == BSIM_OK && pair && bsim_trial_log_copy(&sh->logs_b[i], log[1]) != BSIM_OK)
+		if (rc == BSIM_OK && !copy && pair &&
+		    bsim_trial_log_copy(&sh->logs_b[i], log[1]) != BSIM_OK)
 			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
@@ -201,6 +216,7 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_err
 	memset(r, 0, sizeof *r);
 	r->n_groups = n_groups;
 	r->trials = trials;
+	r->has_ledger = 1;
 	r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
 	r->logs = calloc(n ? n : 1, sizeof *r->logs);
 	r->groups = calloc(n_groups ? (size_t)n_groups : 1, sizeof *r->groups);
@@ -211,12 +227,45 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_err
 	return BSIM_OK;
 }
 
-static void result_finish(bsim_sweep_result *r, int n_groups, int trials, double wall)
+/* The copies of a deterministic group's trial 0, its log included. */
+static int deterministic_fill(bsim_trial_result *res, bsim_trial_log *logs, double *t_separate,
+                              const int *deterministic, int n_groups, int trials)
 {
-	for (int g = 0; g < n_groups; g++)
-		bsim_group_aggregate(&r->trials_out[(size_t)g * trials], trials, &r->groups[g]);
-	for (size_t i = 0; i < (size_t)n_groups * trials; i++)
-		r->total_steps += r->trials_out[i].steps_run;
+	for (int g = 0; g < n_groups; g++) {
+		if (!deterministic[g])
+			continue;
+		size_t first = (size_t)g * trials;
+		for (int t = 1; t < trials; t++) {
+			res[first + t] = res[first];
+			if (t_separate)
+				t_separate[first + t] = t_separate[first];
+			if (bsim_trial_log_copy(&logs[first + t], &logs[first]) != BSIM_OK)
+				return BSIM_EFAIL;
+		}
+	}
+	return BSIM_OK;
+}
+
+static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_groups, int trials,
+                          double wall)
+{
+	r->total_steps = 0;
+	r->trials_run = 0;
+	for (int g = 0; g < n_groups; g++) {
+		bsim_group_result *gr = &r->groups[g];
+		const bsim_trial_result *first = &r->trials_out[(size_t)g * trials];
+		bsim_group_aggregate(first, trials, gr);
+		/* No draws, no sampling: p_traverse is exactly what the one trial
+		 * gave, so its interval is that point, not a Wilson interval over
+		 * copies; and only that trial's steps were integrated. */
+		gr->deterministic = deterministic[g];
+		if (gr->deterministic && trials > 0) {
+			gr->ci95[0] = gr->ci95[1] = gr->p_traverse;
+			gr->steps = first->steps_run;
+		}
+		r->total_steps += gr->steps;
+		r->trials_run += gr->deterministic && trials > 0 ? 1 : trials;
+	}
 	r->wall_seconds = wall;
 }
 
@@ -248,11 +297,21 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	if (rc == BSIM_OK && backend_b && cfg->n_extra_b > 0 &&
 	    (rc = scenes_build(e, cfg, 1, &scenes_b, err)) != BSIM_OK)
 		scenes_free(scenes, e->n_groups);
+	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
+	if (rc == BSIM_OK && !deterministic) {
+		scenes_free(scenes, e->n_groups);
+		if (scenes_b)
+			scenes_free(scenes_b, e->n_groups);
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
+	}
+	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
+		deterministic[g] = !bsim_effects_random(&scenes[g]);
 	sweep_shared sh = {
 	        .e = e,
 	        .cfg = cfg,
 	        .scenes = scenes,
 	        .scenes_b = scenes_b ? scenes_b : scenes,
+	        .deterministic = deterministic,
 	        .results = out->trials_out,
 	        .logs = out->logs,
 	        .backend_b = backend_b,
@@ -283,6 +342,7 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
 	}
 	if (rc != BSIM_OK) {
+		free(deterministic);
 		bsim_sweep_result_free(out);
 		if (backend_b) {
 			bsim_sweep_result_free(out_b);
@@ -294,10 +354,24 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	/* The final count may have been reached on another thread. */
 	if (cfg->progress)
 		cfg->progress(cfg->progress_user, sh.total, sh.total);
+	if (deterministic_fill(out->trials_out, out->logs, backend_b ? *t_separate : NULL,
+	                       deterministic, e->n_groups, e->trials) ||
+	    (backend_b && deterministic_fill(out_b->trials_out, out_b->logs, NULL, deterministic,
+	                                     e->n_groups, e->trials))) {
+		free(deterministic);
+		bsim_sweep_result_free(out);
+		if (backend_b) {
+			bsim_sweep_result_free(out_b);
+			free(*t_separate);
+			*t_separate = NULL;
+		}
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate paths");
+	}
 	double wall = bsim_clock_seconds() - t0;
-	result_finish(out, e->n_groups, e->trials, wall);
+	result_finish(out, deterministic, e->n_groups, e->trials, wall);
 	if (backend_b)
-		result_finish(out_b, e->n_groups, e->trials, wall);
+		result_finish(out_b, deterministic, e->n_groups, e->trials, wall);
+	free(deterministic);
 	return BSIM_OK;
 }
 

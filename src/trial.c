@@ -26,8 +26,16 @@
 #include "beamsim/lattice.h"
 #include "trial_essay.h"
 
+/* A beam as the overlap measure sees it: pivot, rest direction, forward
+ * sign, length and the square of the reach L + R within which the body can
+ * touch it. */
+typedef struct beam_shape {
+	double p[2], u0[2], sgn, length, reach2;
+} beam_shape;
+
 struct bsim_runner {
 	bsim_state s0, s1; /* before and after a step */
+	beam_shape *shape; /* per beam */
 	int cap;           /* beams the states hold */
 	bsim_state whole;  /* the whole lattice's state, for recording (essay protocol) */
 	double *peak;      /* per beam of the scene */
@@ -50,6 +58,7 @@ void bsim_runner_free(bsim_runner *r)
 	bsim_state_free(&r->whole);
 	free(r->peak);
 	free(r->negative);
+	free(r->shape);
 	free(r);
 }
 
@@ -59,8 +68,10 @@ static int runner_reserve(bsim_runner *r, int n_beams)
 		return BSIM_OK;
 	bsim_state_free(&r->s0);
 	bsim_state_free(&r->s1);
+	free(r->shape);
 	r->cap = 0;
-	if (bsim_state_alloc(&r->s0, n_beams) || bsim_state_alloc(&r->s1, n_beams))
+	r->shape = malloc((size_t)(n_beams > 0 ? n_beams : 1) * sizeof *r->shape);
+	if (!r->shape || bsim_state_alloc(&r->s0, n_beams) || bsim_state_alloc(&r->s1, n_beams))
 		return BSIM_EFAIL;
 	r->cap = n_beams;
 	return BSIM_OK;
@@ -79,10 +90,45 @@ static int peaks_reserve(bsim_runner *r, int n_beams)
 	return r->peak_cap ? BSIM_OK : BSIM_EFAIL;
 }
 
+static void shapes_init(beam_shape *shape, const bsim_scene *sc)
+{
+	for (int i = 0; i < sc->n_beams; i++) {
+		const bsim_beam_def *b = &sc->beams[i];
+		beam_shape *q = &shape[i];
+		q->p[0] = b->pivot[0];
+		q->p[1] = b->pivot[1];
+		bsim_beam_rest_direction(b, q->u0);
+		q->sgn = bsim_beam_forward_sign(b);
+		q->length = b->length;
+		q->reach2 = (b->length + sc->body.radius) * (b->length + sc->body.radius);
+	}
+}
+
+/* How deep the body of radius R overlaps the beams, m (0 if it does not):
+ * R - min_i |C - Q_i|, Q_i the point of beam i's segment nearest the centre
+ * C (MODEL.md section 3). A beam whose reach L + R does not hold the
+ * centre costs one distance test. */
+static double overlap_depth(const beam_shape *shape, int n, double radius, const bsim_state *s)
+{
+	double depth = 0.0;
+	for (int i = 0; i < n; i++) {
+		const beam_shape *q = &shape[i];
+		double dx = s->x[0] - q->p[0], dy = s->x[1] - q->p[1];
+		if (dx * dx + dy * dy >= q->reach2)
+			continue;
+		double cs = cos(s->theta[i]), sn = q->sgn * sin(s->theta[i]);
+		double ux = q->u0[0] * cs - q->u0[1] * sn, uy = q->u0[1] * cs + q->u0[0] * sn;
+		double along = fmin(fmax(dx * ux + dy * uy, 0.0), q->length);
+		double dist = hypot(dx - along * ux, dy - along * uy);
+		depth = fmax(depth, radius - dist);
+	}
+	return depth;
+}
+
 const char *bsim_outcome_name(bsim_outcome o)
 {
-	static const char *names[] = {"traversed", "side_exit", "stuck"};
-	return (unsigned)o < 3 ? names[o] : "?";
+	static const char *names[] = {"traversed", "side_exit", "stuck", "unstable"};
+	return (unsigned)o < BSIM_N_OUTCOMES ? names[o] : "?";
 }
 
 const char *bsim_type_name(bsim_type t)
@@ -110,7 +156,6 @@ void bsim_trial_log_clear(bsim_trial_log *l)
 		return;
 	free(l->entries);
 	free(l->peak);
-	free(l->track);
 	memset(l, 0, sizeof *l);
 }
 
@@ -140,32 +185,12 @@ int bsim_trial_log_copy(bsim_trial_log *dst, const bsim_trial_log *src)
 	memset(dst, 0, sizeof *dst);
 	dst->entries = dup_items(src->entries, (size_t)src->n_entries, sizeof *src->entries, &oom);
 	dst->peak = dup_items(src->peak, (size_t)src->n_beams, sizeof *src->peak, &oom);
-	dst->track = dup_items(src->track, 3 * (size_t)src->n_track, sizeof *src->track, &oom);
 	if (oom) {
 		bsim_trial_log_clear(dst);
 		return BSIM_EFAIL;
 	}
 	dst->n_entries = dst->cap_entries = src->n_entries;
 	dst->n_beams = dst->cap_beams = src->n_beams;
-	dst->n_track = dst->cap_track = src->n_track;
-	dst->track_stride = src->track_stride;
-	return BSIM_OK;
-}
-
-static int log_track(bsim_trial_log *l, double t, const double x[2])
-{
-	if (l->n_track == l->cap_track) {
-		int cap = l->cap_track ? 2 * l->cap_track : 256;
-		double *p = realloc(l->track, 3 * (size_t)cap * sizeof *p);
-		if (!p)
-			return BSIM_EFAIL;
-		l->track = p;
-		l->cap_track = cap;
-	}
-	double *row = &l->track[3 * (size_t)l->n_track++];
-	row[0] = t;
-	row[1] = x[0];
-	row[2] = x[1];
 	return BSIM_OK;
 }
 
@@ -271,6 +296,26 @@ static void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state
 	l->residual += r;
 	l->residual_abs += fabs(r);
 	l->residual_max = fmax(l->residual_max, fabs(r));
+	l->inflow += fabs(w_prop) + fabs(w_rand);
+}
+
+void bsim_trial_instability_text(const bsim_trial_result *r, double dt, char *buf, size_t size)
+{
+	const bsim_ledger *l = &r->ledger;
+	switch (r->instability) {
+	case BSIM_UNSTABLE_NONFINITE:
+		snprintf(buf, size, "non-finite state at step %d (t = %g s)", r->unstable_step,
+		         r->unstable_step * dt);
+		break;
+	case BSIM_UNSTABLE_ENERGY:
+		snprintf(buf, size,
+		         "energy created: ledger residual %.3g J > %g x %.4g J that flowed in "
+		         "(start %.4g J, end %.4g J)",
+		         l->residual, BSIM_LEDGER_BOUND, l->inflow, l->e_start, l->e_end);
+		break;
+	default:
+		snprintf(buf, size, "%s", "");
+	}
 }
 
 static int state_finite(const bsim_state *s)
@@ -432,6 +477,7 @@ typedef struct trial_ctx {
 	const int *map;       /* world beam -> scene beam, NULL: the same */
 	gate_track gate;
 	bsim_trial_result *out;
+	int overlap; /* the recorder asked for overlap_max */
 } trial_ctx;
 
 /* A full-lattice state for the recorder from the world's state. */
@@ -478,6 +524,8 @@ static int gate_enter(trial_ctx *c, bsim_state **s0, const double p0[2], int ix,
 	if (rc)
 		return rc;
 	c->backend->get_state(c->w, *s0);
+	if (c->overlap) /* the new world's two beams */
+		shapes_init(c->r->shape, c->ws);
 	*e0 = energy_kinetic(c->ws, *s0) + energy_springs(c->ws, *s0);
 	c->out->ledger.reset += e_before - *e0;
 	return BSIM_OK;
@@ -520,10 +568,10 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	               .opts = opts,
 	               .rec = rec,
 	               .log = rec ? rec->log : NULL,
-	               .out = out};
+	               .out = out,
+	               .overlap = rec && rec->overlap};
 	if (c.log)
-		c.log->n_entries = c.log->n_track = 0;
-	const int track = c.log ? c.log->track_stride : 0;
+		c.log->n_entries = 0;
 	int rc = trial_setup(&c, err);
 	if (rc) {
 		trial_essay_release(&r->essay, backend, &c.w);
@@ -537,6 +585,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 
 	bsim_state *s0 = &r->s0, *s1 = &r->s1;
 	backend->get_state(c.w, s0);
+	if (rec && rec->overlap)
+		shapes_init(r->shape, c.ws);
 	const double h = scene->dt;
 	const int n_max = scene->max_steps;
 	const long gate_max = scene->gate_steps > 0 ? scene->gate_steps : n_max;
@@ -560,12 +610,12 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate path");
 	}
 	c.gate.entries = 1;
-	if (track > 0 && log_track(c.log, 0.0, s0->x))
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the track");
-	long tracked = 0;
+	out->ledger.inflow = e0;
 	int stride = rec && rec->stride > 0 ? rec->stride : 1;
 	FILE *csv = rec ? rec->csv : NULL;
 	bsim_trace_fn trace = rec ? rec->trace : NULL;
+	int overlap = rec && rec->overlap;
+	out->overlap_max = overlap ? 0.0 : NAN;
 	double f[2];
 	if (trace)
 		trace(rec->trace_user, 0, s0);
@@ -587,29 +637,28 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		}
 		backend->step(c.w, f, h);
 		backend->get_state(c.w, s1);
+		double e1 = energy_kinetic(c.ws, s1) + energy_springs(c.ws, s1);
+		if (!state_finite(s1) || !isfinite(e1)) {
+			/* s0 stays the last finite state, the one reported. */
+			out->instability = BSIM_UNSTABLE_NONFINITE;
+			out->unstable_step = (int)(n + 1);
+			break;
+		}
 		n++;
 		c.gate.dwell++;
 		run_on += done;
 		if (trace)
 			trace(rec->trace_user, n, s1);
-		if (track > 0 && n % track == 0) {
-			tracked = n;
-			if (log_track(c.log, (double)n * h, s1->x))
-				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the track");
-		}
-		double e1 = energy_kinetic(c.ws, s1) + energy_springs(c.ws, s1);
 		ledger_step(&out->ledger, &fx, s0, s1, e0, e1);
 		e0 = e1;
 		double p0[2] = {s0->x[0], s0->x[1]};
 		bsim_state *t = s0;
 		s0 = s1;
 		s1 = t;
-		if (!state_finite(s0)) {
-			rc = bsim_error_set(err, BSIM_EFAIL,
-			                    "%s backend: non-finite state at step %ld (t = %g s)",
-			                    backend->name, n, (double)n * h);
-			break;
-		}
+		if (overlap)
+			out->overlap_max =
+			        fmax(out->overlap_max, overlap_depth(r->shape, c.ws->n_beams,
+			                                             scene->body.radius, s0));
 		if (done)
 			continue;
 		peaks_update(r, scene, c.map, s0, &n_negative);
@@ -635,8 +684,6 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	}
 	if (csv && recorded != n && rc == BSIM_OK) /* the final state, whatever the stride */
 		record_row(csv, scene, whole_state(&c, s0), (double)n * h, random_value(&fx));
-	if (track > 0 && tracked != n && rc == BSIM_OK && log_track(c.log, (double)n * h, s0->x))
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the track");
 	if (out->outcome != BSIM_TRAVERSED) {
 		out->steps = (int)n;
 		out->t_end = (double)n * h;
@@ -646,9 +693,10 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	for (int i = 0; i < 2 && i < scene->n_beams; i++)
 		out->max_theta[i] = r->peak[i];
 	if (out->outcome == BSIM_TRAVERSED) {
-		out->type = s0->v[0] > 0.0   ? BSIM_TYPE_LEFT
-		            : s0->v[0] < 0.0 ? BSIM_TYPE_RIGHT
-		                             : BSIM_TYPE_NONE;
+		const double band = scene->classify_deadband;
+		out->type = s0->v[0] > band    ? BSIM_TYPE_LEFT
+		            : s0->v[0] < -band ? BSIM_TYPE_RIGHT
+		                               : BSIM_TYPE_NONE;
 		out->landscape_left = out->max_theta[0] > out->max_theta[1];
 	}
 	out->x_end = s0->x[0];
@@ -656,6 +704,17 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	out->vx_end = s0->v[0];
 	out->steps_run = (int)n;
 	out->ledger.e_end = e0;
+	const bsim_ledger *l = &out->ledger;
+	if (!out->instability && l->residual > BSIM_LEDGER_BOUND * l->inflow + BSIM_LEDGER_FLOOR) {
+		out->instability = BSIM_UNSTABLE_ENERGY;
+		out->unstable_step = (int)n;
+	}
+	if (out->instability) {
+		out->outcome = BSIM_UNSTABLE;
+		out->type = BSIM_TYPE_NONE;
+		out->landscape_left = 0;
+		out->in_contact_end = 0;
+	}
 	out->draws = fx.random ? bsim_schedule_draws(fx.random->schedule) : 0;
 	out->final_ix = c.gate.ix;
 	out->final_iy = c.gate.iy;

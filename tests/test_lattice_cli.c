@@ -267,24 +267,22 @@ static void sweep_files(void **state)
 	snprintf(exp, sizeof exp, "%s", c_track_experiment(dir));
 	snprintf(out1, sizeof out1, "%s/t1", dir);
 	snprintf(out2, sizeof out2, "%s/t2", dir);
-	const char *a1[] = {"sweep",          exp, "--out",   out1, "--threads", "1",
-	                    "--trajectories", "2", "--quiet", NULL};
-	const char *a2[] = {"sweep",          exp, "--out",   out2, "--threads", "2",
-	                    "--trajectories", "2", "--quiet", NULL};
+	const char *a1[] = {"sweep", exp, "--out", out1, "--threads", "1", "--quiet", NULL};
+	const char *a2[] = {"sweep", exp, "--out", out2, "--threads", "2", "--quiet", NULL};
 	assert_int_equal(run_ok(a1), 0);
 	assert_int_equal(run_ok(a2), 0);
 	static const struct {
 		const char *name, *header;
 	} files[] = {
 	        {"trials.csv", "group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,"
-	                       "max_theta2,final_ix,final_iy,location,path\n"},
+	                       "max_theta2,e_start,e_end,work_in,losses,residual,overlap_max,"
+	                       "final_ix,final_iy,location,path,"},
 	        {"lattice_map.csv", "group,ix,iy,x_min,x_max,y_min,y_max,pivot_y,k_left,k_right\n"},
 	        {"final_locations.csv", "group,location,kind,ix,iy,count,p,ci95_lo,ci95_hi\n"},
 	        {"transitions.csv", "group,from_ix,from_iy,to_ix,to_iy,count\n"},
 	        {"gate_entries.csv", "group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy,theta_left,"
 	                             "omega_left,theta_right,omega_right\n"},
 	        {"beam_peaks.csv", "group,trial,beam,ix,iy,side,max_theta\n"},
-	        {"trajectories.csv", "group,trial,location,t,x,y\n"},
 	};
 	for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
 		char *x = read_in(out1, files[k].name), *y = read_in(out2, files[k].name);
@@ -315,7 +313,7 @@ static void sweep_files(void **state)
 	     line = strchr(line + 1, '\n')) {
 		char trial[16], path[2048], want[2048] = "";
 		csv_field(line + 1, 1, trial, sizeof trial);
-		csv_field(line + 1, 14, path, sizeof path);
+		csv_field(line + 1, 20, path, sizeof path);
 		for (const char *e = strchr(entries, '\n'); e && e[1]; e = strchr(e + 1, '\n')) {
 			char t[16], ix[16], iy[16];
 			csv_field(e + 1, 1, t, sizeof t);
@@ -387,7 +385,7 @@ static void compare_protocols(void **state)
 	const char *r[] = {"regress", out, "--exact", "--out", rerun, "--quiet", NULL};
 	assert_int_equal(run_ok(r), 0);
 	char *rmd = read_in(rerun, "regress.md");
-	assert_non_null(strstr(rmd, "## Protocol essay\n\n0 of 6 trials changed"));
+	assert_non_null(strstr(rmd, "## essay\n\n0 of 6 trials changed"));
 	free(rmd);
 	const char *bad[] = {"compare", exp, "--protocols", "world,world", "--out", out, NULL};
 	char *err = NULL;

@@ -9,7 +9,17 @@
  *   5. sleeping: beams the body has left and whose energy has decayed are
  *      put exactly to rest (beam_sleep.c).
  * Only the beams near the body (broad_phase.c) and the awake ones are
- * touched, so a step costs the same in a field of one gate or a thousand. */
+ * touched, so a step costs the same in a field of one gate or a thousand.
+ *
+ * contact_mode=essay reads the essay's flowchart (Sec. 2.4, Fig. 2.5)
+ * literally: once a contact turns persistent the program leaves the
+ * collision loop for the constraint loop and stays there "until both beams
+ * are detached", so while any beam is held, a beam that is not held is not
+ * tested for contact at all and can swing through the body (or the body
+ * through it). A beam is held after a step in which it touched the body
+ * (gap <= contact_tol) and the smooth solve pressed on it (P > 0); it is
+ * released by the first step whose solve leaves it unpressed. The default,
+ * physical, tests every beam the step can reach. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,6 +37,10 @@ static const bsim_knob thesis_knobs[] = {
         {"slop", BSIM_KNOB_DOUBLE, "1e-6", NULL, "penetration tolerated before projection, m"},
         {"contact_tol", BSIM_KNOB_DOUBLE, "1e-3", NULL,
          "gap below which a beam is reported as touching the body, m"},
+        {"contact_mode", BSIM_KNOB_CHOICE, "physical", "physical|essay",
+         "physical: every beam the step can reach is tested for contact; essay: the essay's "
+         "flowchart read literally, while one beam is held in persistent contact the others "
+         "are not tested and can pass through the body"},
         {"broad_phase", BSIM_KNOB_INT, "1", NULL,
          "1: test only the beams near the body (a grid over the pivots) and the awake "
          "ones; 0: test every beam every step (same results, for checking)"},
@@ -42,6 +56,7 @@ enum {
 	KNOB_PROJECTION,
 	KNOB_SLOP,
 	KNOB_CONTACT_TOL,
+	KNOB_CONTACT_MODE,
 	KNOB_BROAD_PHASE,
 	KNOB_SLEEP,
 	KNOB_SLEEP_ENERGY
@@ -79,6 +94,7 @@ static void thesis_destroy(bsim_world *w)
 	free(w->candidates);
 	free(w->typed);
 	thesis_grid_free(&w->grid);
+	free(w->held);
 	free(w);
 }
 
@@ -100,9 +116,10 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->is_awake = calloc(nb, sizeof *w->is_awake);
 		w->candidates = malloc(nb * sizeof *w->candidates);
 		w->typed = malloc(nb * sizeof *w->typed);
+		w->held = calloc(nb, sizeof *w->held);
 	}
 	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type || !w->awake ||
-	    !w->is_awake || !w->candidates || !w->typed) {
+	    !w->is_awake || !w->candidates || !w->typed || !w->held) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
@@ -134,6 +151,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	w->projection = bsim_options_int(opts, &thesis_knobs[KNOB_PROJECTION]) != 0;
 	w->slop = bsim_options_double(opts, &thesis_knobs[KNOB_SLOP]);
 	w->contact_tol = fmax(bsim_options_double(opts, &thesis_knobs[KNOB_CONTACT_TOL]), w->slop);
+	w->contact_mode = bsim_options_choice(opts, &thesis_knobs[KNOB_CONTACT_MODE]);
 	w->broad_phase = bsim_options_int(opts, &thesis_knobs[KNOB_BROAD_PHASE]) != 0;
 	int sleep = bsim_options_choice(opts, &thesis_knobs[KNOB_SLEEP]);
 	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
@@ -166,6 +184,21 @@ double thesis_kinetic_energy(const bsim_world *w)
 	return e;
 }
 
+/* contact_mode=essay: the beams held after this step's solve (touching at
+ * its start and pressed by it); 1 if any is. */
+static int essay_hold(bsim_world *w)
+{
+	int any = 0;
+	for (int i = 0; i < w->n_beams; i++)
+		w->held[i] = 0;
+	for (int k = 0; k < w->n_contacts; k++) {
+		const thesis_contact *c = &w->contacts[k];
+		if (c->impulse > 0.0 && c->gap <= w->contact_tol)
+			any = w->held[c->beam] = 1;
+	}
+	return any;
+}
+
 static void thesis_step(bsim_world *w, const double force[2], double h)
 {
 	memset(&w->energy, 0, sizeof w->energy);
@@ -174,10 +207,13 @@ static void thesis_step(bsim_world *w, const double force[2], double h)
 		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
 	w->n_typed = 0;
 	double speed = hypot(w->v[0], w->v[1]) + h * hypot(force[0], force[1]) * w->inv_mass;
+	int holding = w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
 	int m = thesis_broad_phase(w, speed, h);
 	int n = 0;
 	for (int k = 0; k < m; k++) {
 		int i = w->candidates[k];
+		if (holding && !w->held[i])
+			continue; /* essay: the constraint loop tests only held beams */
 		if (thesis_contact_detect(w, i, thesis_step_margin(w, &w->beams[i], speed, h),
 		                          &w->contacts[n]))
 			thesis_beam_wake(w, w->contacts[n++].beam);
@@ -186,6 +222,8 @@ static void thesis_step(bsim_world *w, const double force[2], double h)
 	if (n)
 		thesis_impact_resolve(w, h);
 	thesis_contact_solve(w, force, h);
+	if (w->contact_mode == THESIS_CONTACT_ESSAY)
+		w->any_held = essay_hold(w);
 	if (n)
 		thesis_position_project(w, force);
 	for (int k = 0; k < w->n_contacts; k++)
@@ -230,7 +268,9 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 			w->typed[w->n_typed++] = i;
 		if (s->theta[i] != 0.0 || s->omega[i] != 0.0 || s->contact[i] != BSIM_CONTACT_NONE)
 			thesis_beam_wake(w, i);
+		w->held[i] = 0; /* a state has no loop: contact_mode=essay starts afresh */
 	}
+	w->any_held = 0;
 	return BSIM_OK;
 }
 

@@ -13,6 +13,10 @@ extern "C" {
 
 typedef struct bsim_group_result {
 	int trials, traversed, side_exit, stuck, left, right;
+	int unstable;      /* trials whose backend failed (bsim_instability) */
+	int deterministic; /* 1: the scene draws no random numbers, so every trial
+	                    * is the same trial: it ran once, the others are copies,
+	                    * and ci95 is the point p_traverse */
 	int stuck_in_contact;
 	int landscape_left, landscape_right; /* traversed, by larger peak theta */
 	double p_traverse, ci95[2];          /* Wilson 95% */
@@ -24,10 +28,12 @@ typedef struct bsim_sweep_result {
 	bsim_trial_result *trials_out; /* n_groups * trials, index g*trials + t */
 	bsim_group_result *groups;     /* n_groups */
 	double wall_seconds;
-	long total_steps;
-	/* Each trial's gate path with entry states, peaks of every beam and,
-	 * for the first track_trials of each group, the body's track; same
-	 * index as trials_out. NULL when read back from trials.csv. */
+	long total_steps; /* steps integrated (a deterministic group's one trial) */
+	long trials_run;  /* trials integrated: copies of a deterministic group's not */
+	int has_ledger;   /* 1: the trials' ledgers are known (a run, or a trials.csv
+	                   * with the energy columns) */
+	/* Each trial's gate path with entry states and the peaks of every
+	 * beam; same index as trials_out. NULL when read back from trials.csv. */
 	bsim_trial_log *logs;
 	int lattice;                  /* 1: the groups' scenes are gate lattices */
 	bsim_lattice_def lattice_def; /* group 0's, when lattice */
@@ -44,11 +50,7 @@ typedef struct bsim_sweep_config {
 	int n_extra;
 	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
-	/* The body's track (bsim_trial_log) for trials t < track_trials of
-	 * every group, every track_stride steps (<= 0: 10, 0.04 s at the
-	 * essay's step). */
-	int track_trials;
-	int track_stride;
+	int measure_overlap; /* 1: each trial's overlap_max (plain sweeps only) */
 	/* A paired sweep only: overrides applied after extra to the second
 	 * side's scenes (e.g. lattice.protocol=essay), so the two sides can
 	 * differ in the scene while sharing every schedule. */

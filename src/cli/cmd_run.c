@@ -23,8 +23,11 @@ static const char run_help[] =
         "Usage: beamsim run SCENE [OPTIONS]\n"
         "\n"
         "Runs one trial of the scene file SCENE and prints its outcome, end state,\n"
-        "peak beam angles and energy ledger. The random-force schedule is that of\n"
-        "trial I of group G of a sweep with seed N, so a sweep's trial can be replayed.\n"
+        "peak beam angles, the deepest overlap of body and beams, and the energy\n"
+        "ledger. The random-force schedule is that of trial I of group G of a sweep\n"
+        "with seed N, so a sweep's trial can be replayed. A trial whose state stops\n"
+        "being finite, or whose ledger shows energy created beyond the bound, is\n"
+        "unstable: the reason is printed and the exit status is 1.\n"
         "\n"
         "Options:\n"
         "  --backend B            physics backend (default thesis; see beamsim backends)\n"
@@ -155,6 +158,7 @@ static void print_ledger_json(const bsim_ledger *l)
 	        {"residual", l->residual},
 	        {"residual_max", l->residual_max},
 	        {"residual_abs", l->residual_abs},
+	        {"inflow", l->inflow},
 	};
 	fputc('{', stdout);
 	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
@@ -224,10 +228,19 @@ static void print_json(const run_args *a, const bsim_backend *b, const bsim_scen
 	bsim_json_number(stdout, r->max_theta[0]);
 	fputs(", ", stdout);
 	bsim_json_number(stdout, r->max_theta[1]);
-	fputc(']', stdout);
+	fputs("], \"overlap_max\": ", stdout);
+	bsim_json_number(stdout, r->overlap_max);
 	print_path_json(r, log);
 	fputs(", \"ledger\": ", stdout);
 	print_ledger_json(&r->ledger);
+	fputs(", \"instability\": ", stdout);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, s->dt, why, sizeof why);
+		bsim_json_string(stdout, why);
+	} else {
+		fputs("null", stdout);
+	}
 	fputs("}\n", stdout);
 }
 
@@ -275,14 +288,20 @@ static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
 		printf("peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0],
 		       r->max_theta[1]);
 	}
+	printf("overlap     deepest %.3g m of body and beams\n", r->overlap_max);
 	printf("energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
 	printf("  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
 	printf("  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
 	       l->damper, l->impact, l->contact, l->correction);
 	if (l->sleep != 0.0 || l->reset != 0.0)
 		printf("  at rest   sleeping %.6g J, essay resets %.6g J\n", l->sleep, l->reset);
-	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step)\n", l->residual,
-	       l->residual_abs, l->residual_max);
+	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step; %.4g J flowed in)\n",
+	       l->residual, l->residual_abs, l->residual_max, l->inflow);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, s->dt, why, sizeof why);
+		printf("unstable    %s\n", why);
+	}
 }
 
 /* Runs the trial, recording into the trajectory file if one was asked
@@ -291,7 +310,7 @@ static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_back
                      uint64_t mixed, bsim_trial_result *res, bsim_trial_log *log)
 {
 	bsim_atomic_file traj = {0};
-	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride, .log = log};
+	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride, .overlap = 1, .log = log};
 	bsim_error err;
 	if (a->trajectory) {
 		if (bsim_atomic_file_open(&traj, a->trajectory, &err) != BSIM_OK)
@@ -347,6 +366,12 @@ int cmd_run(int argc, char **argv)
 		else if (rc == CLI_OK)
 			print_text(&a, &scene, mixed, &res, log);
 		bsim_trial_log_free(log);
+		if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {
+			char why[256];
+			bsim_trial_instability_text(&res, scene.dt, why, sizeof why);
+			cli_error("%s backend: unstable trial: %s", backend->name, why);
+			rc = CLI_FAIL;
+		}
 		bsim_scene_free(&scene);
 	}
 	cli_sets_free(&a.sets);
