@@ -18,6 +18,10 @@ extern "C" {
 int bsim_output_summary_json(const char *path, const bsim_experiment *e, const char *backend,
                              const bsim_options *opts, const bsim_sweep_result *r, bsim_error *err);
 int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_error *err);
+/* trajectories.csv: the kept trajectories of r (r->keep per group), rows of
+ * bsim_trajectory_csv_header, group by group, trial by trial. Nothing is
+ * written when r keeps none. */
+int bsim_output_trajectories_csv(const char *path, const bsim_sweep_result *r, bsim_error *err);
 /* Reads a trials.csv written by bsim_output_trials_csv back into r (which
  * it allocates: n_groups x trials rows, each exactly once) and aggregates
  * the groups. The fields not in the file are zero. BSIM_EINPUT with

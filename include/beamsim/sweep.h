@@ -5,6 +5,7 @@
 
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
+#include "beamsim/trajectory.h"
 #include "beamsim/trial.h"
 
 #ifdef __cplusplus
@@ -25,6 +26,8 @@ typedef struct bsim_sweep_result {
 	bsim_group_result *groups;     /* n_groups */
 	double wall_seconds;
 	long total_steps;
+	int keep;              /* trajectories kept per group (its first trials) */
+	bsim_trajectory *kept; /* n_groups * keep, index g*keep + t; NULL if keep = 0 */
 } bsim_sweep_result;
 
 /* Called from one thread now and then with done/total trials. */
@@ -38,6 +41,8 @@ typedef struct bsim_sweep_config {
 	int n_extra;
 	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
+	int keep;        /* keep the trajectories of the first keep trials of each group */
+	int keep_stride; /* of those, a row every keep_stride steps (<= 0: 5) */
 } bsim_sweep_config;
 
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller

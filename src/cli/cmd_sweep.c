@@ -32,6 +32,10 @@ static const char sweep_help[] =
         "  --trials N             trials per group (default: the experiment's)\n"
         "  --seed N               experiment seed (default: the experiment's)\n"
         "  --set KEY=VALUE        override a scene field in every group, repeatable\n"
+        "  --trajectories N       keep the trajectories of the first N trials of each\n"
+        "                         group in DIR/trajectories.csv (and .mat), for\n"
+        "                         `beamsim plot DIR`\n"
+        "  --trajectory-stride N  a trajectory row every N steps (default 5)\n"
         "  --quiet                no progress line, nothing on stdout\n"
         "  -h, --help             show this help\n";
 
@@ -43,7 +47,9 @@ enum {
 	OPT_SEED,
 	OPT_SET,
 	OPT_OUT,
-	OPT_QUIET
+	OPT_QUIET,
+	OPT_TRAJECTORIES,
+	OPT_TRAJECTORY_STRIDE
 };
 
 static const struct option sweep_options[] = {
@@ -55,6 +61,8 @@ static const struct option sweep_options[] = {
         {"set", required_argument, NULL, OPT_SET},
         {"out", required_argument, NULL, OPT_OUT},
         {"quiet", no_argument, NULL, OPT_QUIET},
+        {"trajectories", required_argument, NULL, OPT_TRAJECTORIES},
+        {"trajectory-stride", required_argument, NULL, OPT_TRAJECTORY_STRIDE},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -70,6 +78,7 @@ typedef struct sweep_args {
 	cli_sets sets;
 	const char *out;
 	int quiet;
+	long keep, keep_stride;
 } sweep_args;
 
 /* Fills a; returns -1 to go on, else the exit status. */
@@ -114,6 +123,18 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 		case OPT_QUIET:
 			a->quiet = 1;
 			break;
+		case OPT_TRAJECTORIES:
+			if (cli_parse_long(optarg, 0, INT32_MAX, &a->keep) != 0)
+				rc = cli_usage("sweep",
+				               "--trajectories %s: expected an integer >= 0",
+				               optarg);
+			break;
+		case OPT_TRAJECTORY_STRIDE:
+			if (cli_parse_long(optarg, 1, INT32_MAX, &a->keep_stride) != 0)
+				rc = cli_usage("sweep",
+				               "--trajectory-stride %s: expected an integer >= 1",
+				               optarg);
+			break;
 		default:
 			return cli_bad_option("sweep", argv, c);
 		}
@@ -141,7 +162,8 @@ static void sweep_report(const sweep_args *a, const bsim_experiment *e, const bs
 	printf("\n%ld trials, %ld steps in %.3f s on %d thread%s: %.0f trials/s, %.3g steps/s\n", n,
 	       r->total_steps, r->wall_seconds, threads, threads == 1 ? "" : "s",
 	       cli_per_second(n, r->wall_seconds), cli_per_second(r->total_steps, r->wall_seconds));
-	printf("wrote %s/summary.json and %s/trials.csv\n", a->out, a->out);
+	printf("wrote %s/summary.json and %s/trials.csv%s (and their .mat twins)\n", a->out, a->out,
+	       r->keep ? ", trajectories.csv" : "");
 }
 
 /* Loads, creates DIR (before the run, so an unusable DIR fails at once,
@@ -171,6 +193,8 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 	        .threads = threads,
 	        .extra = a->sets.ov,
 	        .n_extra = a->sets.n,
+	        .keep = (int)a->keep,
+	        .keep_stride = (int)a->keep_stride,
 	};
 	bsim_sweep_result r;
 	rc = cli_sweep_run(&e, &cfg, !a->quiet, &r);
