@@ -5,7 +5,8 @@
  *
  * The force is piecewise constant, a fresh draw every 1/f s (MODEL.md
  * section 2): the histogram counts each draw once, the first recorded row
- * of each interval [j/f, (j+1)/f). */
+ * of each interval [j/f, (j+1)/f) (rows further apart than 1/f miss
+ * some draws, which are then missing from it). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdlib.h>
@@ -93,13 +94,14 @@ static int random_force(figs *f, const csv_table *t, const char *path, const bsi
 		rc = csv_table_numbers(t, path, col[0], 0, 0.0, tt, err);
 	if (!rc)
 		rc = csv_table_numbers(t, path, col[1], 0, 0.0, ff, err);
-	/* One sample per draw. */
+	/* One sample per draw; the last row is the state after the last step,
+	 * where no force acts any more. */
 	long draws = 0, last = -1;
 	double sum = 0.0, sum2 = 0.0;
 	enum { BINS = 32 };
 	const double lo = -4.0 * rm, width = 8.0 * rm / BINS;
 	long hist[BINS] = {0};
-	for (size_t r = 0; !rc && r < n; r++) {
+	for (size_t r = 0; !rc && r + 1 < n; r++) {
 		long j = (long)floor(tt[r] * freq + 1e-9);
 		if (j == last)
 			continue;
