@@ -352,8 +352,12 @@ void fsum_label(const fsum *s, int g, char *buf, size_t size)
 	size_t k = 0;
 	buf[0] = '\0';
 	for (int a = 0; a < s->n_axes && k < size; a++) {
-		int n = snprintf(buf + k, size - k, "%s%s = %s", a ? ", " : "", s->axes[a].key,
-		                 s->axes[a].values[s->g[g].idx[a]]);
+		/* a line of its own from the third on, to fit a figure's width */
+		int n = snprintf(buf + k, size - k, "%s%s = %s",
+		                 a == 0  ? ""
+		                 : a % 2 ? ", "
+		                         : "\n",
+		                 s->axes[a].key, s->axes[a].values[s->g[g].idx[a]]);
 		if (n < 0)
 			break;
 		k += (size_t)n;

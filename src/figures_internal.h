@@ -102,7 +102,8 @@ void fsum_free(fsum *s);
 /* Marks the groups matching the selection of f->def; BSIM_EINPUT if a key
  * is no axis or a value matches no group. */
 int fsum_select(const figs *f, fsum *s, bsim_error *err);
-/* "key = value, key = value" of group g over the axes, into buf. */
+/* "key = value, key = value" of group g over the axes, into buf, two to
+ * a line. */
 void fsum_label(const fsum *s, int g, char *buf, size_t size);
 /* 1 if two value texts name the same value (numerically where both are
  * numbers). */

@@ -261,51 +261,77 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *e
 		free(first);
 		return rc;
 	}
+	/* The panels and, in the cell after them, the key; many panels get
+	 * smaller ones, so that the image stays well under 1 MB. A panel is
+	 * titled by the values of the other axes, named once in the title. */
 	int rows, cols;
 	layout(np, &rows, &cols);
-	fputs("set multiplot layout ", g.f);
-	fprintf(g.f, "%d,%d title ", rows, cols);
-	char title[400];
+	if (rows * cols == np)
+		layout(np + 1, &rows, &cols);
+	const int pw = np > 12 ? 400 : 520, ph = np > 12 ? 300 : 380;
+	const int W = pw * cols, H = ph * rows + 80;
+	fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
+	char title[600], others[400] = "";
+	size_t L = 0;
+	for (int oa = 0; oa < s->n_axes && L < sizeof others; oa++)
+		if (oa != ax && a->n[oa] > 0) {
+			int w = snprintf(others + L, sizeof others - L, "%s%s", L ? ", " : "",
+			                 s->axes[oa].key);
+			L += w > 0 ? (size_t)w : 0;
+		}
 	snprintf(title, sizeof title,
-	         "traversal against %s: %d trials per group, 95%% Wilson bands; dashed: "
-	         "over which beam by the larger peak angle",
-	         A->key, s->trials_per_group);
+	         "traversal against %s, %d trials per group, 95%% Wilson bands%s%s", A->key,
+	         s->trials_per_group, L ? "\npanels: " : "", others);
 	gp_str(g.f, title);
 	fputs(" noenhanced\nset yrange [0:1]\nset ylabel 'fraction of trials'\nset xlabel ", g.f);
 	gp_str(g.f, A->key);
-	fputs(" noenhanced\nset grid\nset style fill transparent solid 0.15 noborder\n", g.f);
+	fputs(" noenhanced\nset grid\nset style fill transparent solid 0.15 noborder\n"
+	      "unset key\n",
+	      g.f);
 	if (!A->numeric)
 		tics(g.f, "x", A, a->pos[ax]);
-	fputs("set key top left box opaque font ',9'\n", g.f);
 	for (int p = 0; p < np; p++) {
-		char label[512];
-		panel_label(s, a, first[p], ax, -1, label, sizeof label);
+		char label[512] = "";
+		size_t k = 0;
+		for (int oa = 0; oa < s->n_axes && k < sizeof label; oa++)
+			if (oa != ax && a->n[oa] > 0) {
+				int w = snprintf(label + k, sizeof label - k, "%s%s", k ? ", " : "",
+				                 s->axes[oa].values[s->g[first[p]].idx[oa]]);
+				k += w > 0 ? (size_t)w : 0;
+			}
 		fputs("set title ", g.f);
 		gp_str(g.f, label);
 		fprintf(g.f,
 		        " noenhanced\n"
-		        "plot '%s' index %d using 1:3:4 with filledcurves lc rgb '%s' notitle, \\\n"
-		        "     '' index %d using 1:6:7 with filledcurves lc rgb '%s' notitle, \\\n"
-		        "     '' index %d using 1:9:10 with filledcurves lc rgb '%s' notitle, \\\n"
-		        "     '' index %d using 1:2 with linespoints lw 2 pt 7 lc rgb '%s' "
-		        "title 'traversed', \\\n"
-		        "     '' index %d using 1:5 with linespoints lw 1.5 pt 5 lc rgb '%s' "
-		        "title 'left type (v_x > 0)', \\\n"
-		        "     '' index %d using 1:8 with linespoints lw 1.5 pt 9 lc rgb '%s' "
-		        "title 'right type (v_x < 0)', \\\n"
-		        "     '' index %d using 1:11 with lines dt 2 lc rgb '%s' "
-		        "title 'over the left beam', \\\n"
-		        "     '' index %d using 1:12 with lines dt 2 lc rgb '%s' "
-		        "title 'over the right beam'\n",
+		        "plot '%s' index %d using 1:3:4 with filledcurves lc rgb '%s', \\\n"
+		        "     '' index %d using 1:6:7 with filledcurves lc rgb '%s', \\\n"
+		        "     '' index %d using 1:9:10 with filledcurves lc rgb '%s', \\\n"
+		        "     '' index %d using 1:2 with linespoints lw 2 pt 7 lc rgb '%s', \\\n"
+		        "     '' index %d using 1:5 with linespoints lw 1.5 pt 5 lc rgb '%s', \\\n"
+		        "     '' index %d using 1:8 with linespoints lw 1.5 pt 9 lc rgb '%s', \\\n"
+		        "     '' index %d using 1:11 with lines dt 2 lc rgb '%s', \\\n"
+		        "     '' index %d using 1:12 with lines dt 2 lc rgb '%s'\n",
 		        file, p, FIG_BLACK, p, FIG_BLUE, p, FIG_RED, p, FIG_BLACK, p, FIG_BLUE, p,
 		        FIG_RED, p, FIG_BLUE, p, FIG_RED);
-		if (p == 0)
-			fputs("unset key\n", g.f);
 	}
+	fprintf(g.f,
+	        "# the key, in a cell of its own\n"
+	        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\nunset grid\n"
+	        "set key center center vertical font ',10'\nset xrange [0:1]\n"
+	        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title 'traversed', \\\n"
+	        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'left type (v_x > 0 at "
+	        "classify y)', \\\n"
+	        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'right type (v_x < 0)', "
+	        "\\\n"
+	        "     NaN with lines dt 2 lc rgb '%s' title 'over the left beam (larger peak "
+	        "angle)', \\\n"
+	        "     NaN with lines dt 2 lc rgb '%s' title 'over the right beam', \\\n"
+	        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
+	        FIG_BLACK, FIG_BLUE, FIG_RED, FIG_BLUE, FIG_RED, FIG_GREY);
 	fputs("unset multiplot\n", g.f);
 	free(first);
 	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, name, 520 * cols, 380 * rows + 40, body, err)
+	rc = body ? figs_render(f, name, W, H, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -378,14 +404,14 @@ static int group_figures(figs *f, traj_job *j, int g, bsim_error *err)
 	int n = j->count[g], trav = 0;
 	for (int i = 0; i < n; i++)
 		trav += p[i].cls >= FPATH_NONE;
-	snprintf(title, sizeof title, "group %d: %s\nthe first %d of %d trials", g, label, n,
-	         j->s->g[g].trials);
+	snprintf(title, sizeof title, "group %d, the first %d of %d trials\n%s", g, n,
+	         j->s->g[g].trials, label);
 	snprintf(name, sizeof name, "trajectories_g%03d", g);
 	rc = figs_bundle(f, name, title, &scene, p, n, err);
 	if (!rc && trav > 0) {
 		snprintf(title, sizeof title,
-		         "group %d: %s\nthe %d traversed of the first %d trials over the landscape",
-		         g, label, trav, n);
+		         "group %d, the %d traversed of the first %d trials over the landscape\n%s",
+		         g, trav, n, label);
 		snprintf(name, sizeof name, "landscape_g%03d", g);
 		rc = figs_over_landscape(f, name, title, &scene, p, n,
 		                         1u << FPATH_LEFT | 1u << FPATH_RIGHT | 1u << FPATH_NONE,
