@@ -123,6 +123,10 @@ static char *run_quick(const char *name, const char *backends, const char *threa
 		assert_memory_equal(png, "\x89PNG\r\n\x1a\n", 8);
 		free(png);
 	}
+	snprintf(path, sizeof path, "%s/accuracy.mat", dir); /* its twin, as test_matlab checks */
+	char *mat = bsim_test_read(path);
+	assert_non_null(mat);
+	free(mat);
 	snprintf(path, sizeof path, "%s/accuracy.md", dir);
 	char *md = bsim_test_read(path);
 	assert_non_null(md);

@@ -13,6 +13,7 @@
 #include "beamsim/accuracy.h"
 #include "beamsim/output.h"
 #include "beamsim/figures.h"
+#include "beamsim/matlab.h"
 #include "cli_common.h"
 
 #define ACC_SCENE "configs/thesis/gate.yaml"
@@ -206,8 +207,12 @@ static int accuracy_main(accuracy_args *a)
 	snprintf(label, sizeof label, "%s%s", a->scene,
 	         a->scene_given ? "" : " (propulsion 9 N, random force 20 N)");
 	if (rc == BSIM_OK) {
+		char mat[1200];
 		snprintf(path, sizeof path, "%s/accuracy.csv", a->out);
+		snprintf(mat, sizeof mat, "%s/accuracy.mat", a->out);
 		rc = bsim_accuracy_write_csv(path, &r, &err);
+		if (rc == BSIM_OK)
+			rc = bsim_matlab_from_csv(path, mat, "accuracy", &err);
 	}
 	if (rc == BSIM_OK) {
 		snprintf(path, sizeof path, "%s/accuracy.md", a->out);
@@ -220,7 +225,7 @@ static int accuracy_main(accuracy_args *a)
 		rc = bsim_figures_draw(a->out, &def, &fig, &err);
 	}
 	if (rc == BSIM_OK) {
-		printf("accuracy: %d rows in %.1f s; wrote %s/accuracy.{csv,md} and the figure "
+		printf("accuracy: %d rows in %.1f s; wrote %s/accuracy.{csv,mat,md} and the figure "
 		       "%s/accuracy.{png,svg,gp}\n",
 		       r.n, r.wall_seconds, a->out, a->out);
 		for (int i = 0; i < fig.n_notes; i++)
