@@ -342,6 +342,9 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *e
 typedef struct traj_job {
 	const fsum *s;
 	const bsim_experiment *e;
+	bsim_experiment e_own;
+	csv_table table; /* trajectories.csv, which paths point into */
+	int have_table;
 	fpaths paths;
 	int *first, *count; /* per group: the first path and how many */
 	char *untraversed;  /* per group: no traversed trial kept, no landscape figure */
@@ -445,80 +448,93 @@ static void untraversed_note(figs *f, const char *dir, const char *flag, int n)
 		          k >= sizeof buf - 16 ? ", ..." : "");
 }
 
-static int trajectories(figs *f, const char *dir, const char *inputs, const fsum *s,
-                        bsim_error *err)
+/* Everything the trajectory figures need, read and checked before any
+ * figure is drawn: the experiment (for each group's scene), the kept
+ * paths with their classes, and where each group's paths start. */
+static int traj_load(figs *f, const char *dir, const char *inputs, const fsum *s, traj_job *j,
+                     int *have, bsim_error *err)
 {
 	char path[1100], exp_path[1100];
 	snprintf(path, sizeof path, "%s/trajectories.csv", dir);
 	snprintf(exp_path, sizeof exp_path, "%s/experiment.yaml", inputs);
 	struct stat st;
+	*have = 0;
+	if (stat(path, &st) != 0)
+		return BSIM_OK;
 	if (stat(exp_path, &st) != 0) {
 		figs_note(f, "%s: no %s, so no scene to draw the trajectories on", dir, exp_path);
 		return BSIM_OK;
 	}
-	traj_job j = {.s = s};
-	bsim_experiment e;
-	int rc = bsim_experiment_load(exp_path, NULL, 0, &e, err);
+	int rc = bsim_experiment_load(exp_path, NULL, 0, &j->e_own, err);
 	if (rc)
 		return rc;
-	j.e = &e;
-	if (e.n_groups != s->n_groups) {
-		bsim_experiment_free(&e);
+	j->e = &j->e_own;
+	*have = 1; /* from here on traj_free releases what is loaded */
+	if (j->e->n_groups != s->n_groups)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: %d groups, but %s/summary.json has %d",
-		                      exp_path, e.n_groups, dir, s->n_groups);
+		                      exp_path, j->e->n_groups, dir, s->n_groups);
+	rc = csv_table_read(path, &j->table, err);
+	if (rc)
+		return rc;
+	j->have_table = 1;
+	rc = fpaths_read(&j->table, path, &j->paths, err);
+	if (!rc)
+		rc = classes_read(dir, s, &j->paths, err);
+	j->first = calloc((size_t)s->n_groups, sizeof *j->first);
+	j->count = calloc((size_t)s->n_groups, sizeof *j->count);
+	j->untraversed = calloc((size_t)s->n_groups, 1);
+	if (!rc && (!j->first || !j->count || !j->untraversed))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; !rc && i < j->paths.n; i++) {
+		int g = j->paths.p[i].group;
+		if (g < 0 || g >= s->n_groups)
+			return bsim_error_set(err, BSIM_EINPUT, "%s: group %d: expected 0 .. %d",
+			                      path, g, s->n_groups - 1);
+		if (j->count[g]++ == 0)
+			j->first[g] = i;
 	}
-	csv_table t;
-	rc = csv_table_read(path, &t, err);
-	if (!rc) {
-		rc = fpaths_read(&t, path, &j.paths, err);
-		if (!rc)
-			rc = classes_read(dir, s, &j.paths, err);
-		j.first = calloc((size_t)s->n_groups, sizeof *j.first);
-		j.count = calloc((size_t)s->n_groups, sizeof *j.count);
-		j.untraversed = calloc((size_t)s->n_groups, 1);
-		if (!rc && (!j.first || !j.count || !j.untraversed))
-			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-		for (int i = 0; !rc && i < j.paths.n; i++) {
-			int g = j.paths.p[i].group;
-			if (g < 0 || g >= s->n_groups) {
-				rc = bsim_error_set(err, BSIM_EINPUT,
-				                    "%s: group %d: expected 0 .. %d", path, g,
-				                    s->n_groups - 1);
-				break;
-			}
-			if (j.count[g]++ == 0)
-				j.first[g] = i;
-		}
-		/* One group's figures per task, as many at a time as threads:
-		 * each is mostly gnuplot's drawing. The error kept is the
-		 * lowest group's, whatever the thread count. */
-		int failed = s->n_groups;
-		bsim_error first_err;
-		bsim_error_clear(&first_err);
-#pragma omp parallel for schedule(dynamic) num_threads(f->threads) if (!rc)
-		for (int g = 0; g < s->n_groups; g++) {
-			if (rc || !s->g[g].selected || j.count[g] == 0)
-				continue;
-			bsim_error e1;
-			if (group_figures(f, &j, g, &e1) != BSIM_OK) {
-#pragma omp critical(bsim_figures_fail)
-				if (g < failed) {
-					failed = g;
-					first_err = e1;
-				}
-			}
-		}
-		if (!rc && failed < s->n_groups)
-			rc = bsim_error_set(err, first_err.code, "%s", first_err.msg);
-		untraversed_note(f, dir, j.untraversed, s->n_groups);
-		free(j.untraversed);
-		free(j.first);
-		free(j.count);
-		fpaths_free(&j.paths);
-		csv_table_free(&t);
-	}
-	bsim_experiment_free(&e);
 	return rc;
+}
+
+static void traj_free(traj_job *j, int have)
+{
+	if (!have)
+		return;
+	free(j->untraversed);
+	free(j->first);
+	free(j->count);
+	fpaths_free(&j->paths);
+	if (j->have_table)
+		csv_table_free(&j->table);
+	bsim_experiment_free(&j->e_own);
+}
+
+/* One group's figures per task, as many at a time as threads: each is
+ * mostly gnuplot's drawing. The error kept is the lowest group's, whatever
+ * the thread count. */
+static int traj_draw(figs *f, const char *dir, traj_job *j, bsim_error *err)
+{
+	const fsum *s = j->s;
+	int failed = s->n_groups;
+	bsim_error first_err;
+	bsim_error_clear(&first_err);
+#pragma omp parallel for schedule(dynamic) num_threads(f->threads)
+	for (int g = 0; g < s->n_groups; g++) {
+		if (!s->g[g].selected || j->count[g] == 0)
+			continue;
+		bsim_error e1;
+		if (group_figures(f, j, g, &e1) != BSIM_OK) {
+#pragma omp critical(bsim_figures_fail)
+			if (g < failed) {
+				failed = g;
+				first_err = e1;
+			}
+		}
+	}
+	if (failed < s->n_groups)
+		return bsim_error_set(err, first_err.code, "%s", first_err.msg);
+	untraversed_note(f, dir, j->untraversed, s->n_groups);
+	return BSIM_OK;
 }
 
 int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
@@ -530,18 +546,22 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 	if (rc)
 		return rc;
 	active a = {{NULL}, {0}};
+	traj_job j = {.s = &s};
+	int have = 0;
+	/* every input read and checked first: a bad one leaves no figure */
 	rc = fsum_select(f, &s, err);
 	if (!rc)
 		rc = active_build(&s, &a, err);
+	if (!rc)
+		rc = traj_load(f, dir, inputs, &s, &j, &have, err);
 	if (!rc)
 		rc = heat_map(f, &s, &a, err);
 	for (int ax = 0; !rc && ax < s.n_axes; ax++)
 		if (a.n[ax] >= 2)
 			rc = versus(f, &s, &a, ax, err);
-	snprintf(path, sizeof path, "%s/trajectories.csv", dir);
-	struct stat st;
-	if (!rc && stat(path, &st) == 0)
-		rc = trajectories(f, dir, inputs, &s, err);
+	if (!rc && have)
+		rc = traj_draw(f, dir, &j, err);
+	traj_free(&j, have);
 	active_free(&a, s.n_axes);
 	fsum_free(&s);
 	return rc;

@@ -330,6 +330,44 @@ static void test_select(void **state)
 	free(err);
 }
 
+/* A malformed file is named with its line, exit 2, and no figure is drawn. */
+static void test_bad_input(void **state)
+{
+	(void)state;
+	char dir[1024];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("bad"));
+	const char *sweep[] = {"sweep",
+	                       bsim_test_src("configs/thesis/h1_symmetric.yaml"),
+	                       "--trials",
+	                       "1",
+	                       "--trajectories",
+	                       "1",
+	                       "--quiet",
+	                       "--out",
+	                       dir,
+	                       NULL};
+	assert_int_equal(run_cli(sweep, NULL, NULL), 0);
+	char path[1200];
+	snprintf(path, sizeof path, "%s/trajectories.csv", dir);
+	char *text = bsim_test_read(path);
+	int lines = 0;
+	for (char *p = text; *p; p++)
+		lines += *p == '\n';
+	FILE *f = fopen(path, "a");
+	fputs("29,0,1.5,0,0\n", f); /* too few fields */
+	fclose(f);
+	free(text);
+	char *err = NULL;
+	const char *argv[] = {"plot", dir, NULL};
+	assert_int_equal(run_cli(argv, NULL, &err), 2);
+	char want[64];
+	snprintf(want, sizeof want, "trajectories.csv:%d: expected 9 fields, got 5", lines + 1);
+	assert_non_null(strstr(err, want));
+	free(err);
+	snprintf(path, sizeof path, "%s/p_traverse.gp", dir);
+	assert_null(bsim_test_read(path));
+}
+
 static void test_not_an_output(void **state)
 {
 	(void)state;
@@ -487,9 +525,9 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_below_surface),        cmocka_unit_test(test_sweep_figures),
 	        cmocka_unit_test(test_paths_over_landscape), cmocka_unit_test(test_select),
-	        cmocka_unit_test(test_not_an_output),        cmocka_unit_test(test_run_figures),
-	        cmocka_unit_test(test_accuracy_front),       cmocka_unit_test(test_compare_figures),
-	        cmocka_unit_test(test_without_gnuplot),
+	        cmocka_unit_test(test_not_an_output),        cmocka_unit_test(test_bad_input),
+	        cmocka_unit_test(test_run_figures),          cmocka_unit_test(test_accuracy_front),
+	        cmocka_unit_test(test_compare_figures),      cmocka_unit_test(test_without_gnuplot),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
