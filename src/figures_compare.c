@@ -1,9 +1,10 @@
 /* Figures of a comparison (figures.h): both backends' p_traverse per group
  * side by side with their Wilson intervals, and the paired differences
- * p_A - p_B with Newcombe's intervals for traversal, side exits and
- * getting stuck, against the rule's margin; a group beyond the rule is
- * marked. The numbers are report.json's. Each backend's own sweep figures
- * go to OUT/<backend>/. */
+ * p_A - p_B with the report's paired intervals (Tango's score interval) for
+ * traversal, the left and right types, side exits, getting stuck and
+ * instability, against the rule's margin; a difference beyond the rule is
+ * marked. The numbers are report.json's. Each side's own sweep figures go
+ * to OUT/<label>/. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +22,20 @@ static double num(struct fy_node *root, const char *path, int *bad)
 	return v;
 }
 
+/* A number that may be absent: an interval bound of a deterministic
+ * group is then its point, the value at field `point` of the event. */
+static double num_or(struct fy_node *root, const char *path, const char *point, int g,
+                     const char *event, int *bad)
+{
+	double v = 0.0;
+	struct fy_node *n = ydoc_lookup(root, path);
+	if (n && ydoc_number(n, &v) == YDOC_NUM_OK)
+		return v;
+	char p[200];
+	snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, event, point);
+	return num(root, p, bad);
+}
+
 static void text(struct fy_node *root, const char *path, char *buf, size_t size)
 {
 	struct fy_node *n = ydoc_lookup(root, path);
@@ -29,13 +44,17 @@ static void text(struct fy_node *root, const char *path, char *buf, size_t size)
 	snprintf(buf, size, "%.*s", t ? (int)len : 0, t ? t : "");
 }
 
-static const char *const events[] = {"traversed", "left", "right", "side_exit", "stuck"};
-enum { N_EV = 5 };
+static const char *const events[] = {"traversed", "left",  "right",
+                                     "side_exit", "stuck", "unstable"};
+enum { N_EV = 6 };
 
 /* The data: one row per selected group. Columns: 1 position, 2 group,
  * 3-8 p and Wilson interval of traversal on A then B, then per event
- * (traversed, left, right, side_exit, stuck) 4 columns from 9 + 4 e:
- * p_A - p_B, Newcombe interval, beyond the rule (1/0); 29 the label. */
+ * (traversed, left, right, side_exit, stuck, unstable) 4 columns from
+ * 9 + 4 e: p_A - p_B, its 95% interval, beyond the rule (1/0); 33 the
+ * label. A group without random force is one trial, compared as one pair
+ * with no interval (report.json gives none): its interval is the point,
+ * and a pair that differs ("DIFFERENT") is beyond the rule. */
 static int compare_data(figs *f, const ydoc *d, const fsum *s, int *n_rows, bsim_error *err)
 {
 	struct fy_node *root = fy_document_root(d->fyd);
@@ -45,44 +64,50 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int *n_rows, bsim
 	if (rc)
 		return rc;
 	fputs("# position group p_a lo hi p_b lo hi (traversed, Wilson 95%), then for traversed, "
-	      "left, right, side_exit, stuck: p_a - p_b lo hi (Newcombe 95%) beyond (1: beyond "
-	      "the rule), label\n",
+	      "left, right, side_exit, stuck, unstable: p_a - p_b lo hi (the report's paired 95% "
+	      "interval) beyond (1: beyond the rule), label\n",
 	      o.f);
 	int k = 0;
 	for (int g = 0; g < s->n_groups; g++) {
 		if (!s->g[g].selected)
 			continue;
-		char p[200];
+		char p[200], verdict[32];
 		int bad = 0;
+		snprintf(p, sizeof p, "groups.%d.verdict", g);
+		text(root, p, verdict, sizeof verdict);
 		double v[6];
-		const char *fields[] = {"p_a", "ci95_a.0", "ci95_a.1",
-		                        "p_b", "ci95_b.0", "ci95_b.1"};
+		static const char *const fields[] = {"p_a", "ci95_a.0", "ci95_a.1",
+		                                     "p_b", "ci95_b.0", "ci95_b.1"};
 		for (int i = 0; i < 6; i++) {
 			snprintf(p, sizeof p, "groups.%d.events.traversed.%s", g, fields[i]);
-			v[i] = num(root, p, &bad);
+			v[i] = num_or(root, p, i < 3 ? "p_a" : "p_b", g, "traversed", &bad);
 		}
 		fprintf(o.f, "%d %d", k++, g);
 		for (int i = 0; i < 6; i++)
 			fprintf(o.f, " %.6g", v[i]);
 		for (int e = 0; e < N_EV; e++) {
-			const char *df[] = {"difference", "difference_ci95.0", "difference_ci95.1"};
+			static const char *const df[] = {"difference", "difference_ci95.0",
+			                                 "difference_ci95.1"};
 			for (int i = 0; i < 3; i++) {
 				snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e],
 				         df[i]);
-				fprintf(o.f, " %.6g", num(root, p, &bad));
+				fprintf(o.f, " %.6g",
+				        num_or(root, p, "difference", g, events[e], &bad));
 			}
 			char b[16];
 			snprintf(p, sizeof p, "groups.%d.events.%s.beyond", g, events[e]);
 			text(root, p, b, sizeof b);
-			fprintf(o.f, " %d", strcmp(b, "true") == 0);
+			snprintf(p, sizeof p, "groups.%d.events.%s.difference", g, events[e]);
+			int beyond = strcmp(b, "true") == 0 ||
+			             (strcmp(verdict, "DIFFERENT") == 0 && num(root, p, &bad) != 0);
+			fprintf(o.f, " %d", beyond);
 		}
 		if (bad) {
 			bsim_atomic_file_abort(&o);
 			return bsim_error_set(
 			        err, BSIM_EINPUT,
-			        "%s: groups.%d.events: expected p_a, ci95_a, p_b, ci95_b, "
-			        "difference and difference_ci95 of traversed, left, "
-			        "right, side_exit and stuck",
+			        "%s: groups.%d.events: expected p_a, p_b and difference "
+			        "of traversed, left, right, side_exit, stuck and unstable",
 			        d->path, g);
 		}
 		char label[256] = "";
@@ -109,7 +134,7 @@ static void diff_series(FILE *o, int e, double dx, int pt, const char *color, co
 	        "pt %d ps 0.6 lc rgb '%s' title '%s', \\\n"
 	        "     '' using ($1 + %g):($%d > 0 ? $%d : NaN):%d:%d with yerrorbars pt %d ps 0.9 "
 	        "lc rgb '" FIG_RED "' notitle",
-	        dx, c + 3, c, c + 1, c + 2, tics ? ":xtic(29)" : "", pt, color, title, dx, c + 3, c,
+	        dx, c + 3, c, c + 1, c + 2, tics ? ":xtic(33)" : "", pt, color, title, dx, c + 3, c,
 	        c + 1, c + 2, pt);
 }
 
@@ -140,8 +165,8 @@ static int compare_figure(figs *f, const ydoc *d, const fsum *s, bsim_error *err
 	char title[400];
 	snprintf(title, sizeof title,
 	         "%s (A) against %s (B), %d paired trials per group\nprobabilities with Wilson "
-	         "95%% intervals, paired differences with Newcombe 95%% intervals; red: beyond "
-	         "the rule",
+	         "95%% intervals, paired differences with the report's paired 95%% intervals; red: "
+	         "beyond the rule",
 	         la, lb, s->trials_per_group);
 	gp_str(o, title);
 	fprintf(o,
@@ -153,7 +178,7 @@ static int compare_figure(figs *f, const ydoc *d, const fsum *s, bsim_error *err
 	fputs("set title '(a) p_{traverse}'\nset yrange [0:1]\nset ylabel 'p_{traverse}'\n"
 	      "unset xlabel\n",
 	      o);
-	fputs("plot 'compare.dat' using ($1 - 0.15):3:4:5:xtic(29) with yerrorbars pt 7 ps 0.6 "
+	fputs("plot 'compare.dat' using ($1 - 0.15):3:4:5:xtic(33) with yerrorbars pt 7 ps 0.6 "
 	      "lc rgb '" FIG_BLUE "' title ",
 	      o);
 	gp_str(o, la);
@@ -167,7 +192,8 @@ static int compare_figure(figs *f, const ydoc *d, const fsum *s, bsim_error *err
 	      "title '+- margin', \\\n",
 	      o);
 	diff_series(o, 0, 0.0, 7, FIG_BLACK, "traversed", 1);
-	fputs("\nset title '(c) traversed left type, right type, side exit, stuck: p_A - p_B'\n"
+	fputs("\nset title '(c) traversed left type, right type, side exit, stuck, unstable: "
+	      "p_A - p_B'\n"
 	      "set xlabel ",
 	      o);
 	gp_str(o, keys);
@@ -175,13 +201,15 @@ static int compare_figure(figs *f, const ydoc *d, const fsum *s, bsim_error *err
 	      "plot '+' using 1:(-margin):(margin) with filledcurves lc rgb '#808080' "
 	      "title '+- margin', \\\n",
 	      o);
-	diff_series(o, 1, -0.27, 5, FIG_BLUE, "left type", 1);
+	diff_series(o, 1, -0.3, 5, FIG_BLUE, "left type", 1);
 	fputs(", \\\n", o);
-	diff_series(o, 2, -0.09, 9, FIG_ORANGE, "right type", 0);
+	diff_series(o, 2, -0.15, 9, FIG_ORANGE, "right type", 0);
 	fputs(", \\\n", o);
-	diff_series(o, 3, 0.09, 7, FIG_GREY, "side exit", 0);
+	diff_series(o, 3, 0.0, 7, FIG_GREY, "side exit", 0);
 	fputs(", \\\n", o);
-	diff_series(o, 4, 0.27, 13, FIG_DKGREY, "stuck", 0);
+	diff_series(o, 4, 0.15, 13, FIG_DKGREY, "stuck", 0);
+	fputs(", \\\n", o);
+	diff_series(o, 5, 0.3, 11, FIG_PURPLE, "unstable", 0);
 	fputs("\nunset multiplot\n", o);
 	char *body = gp_text_take(&g);
 	int w = 300 + 24 * n;
@@ -204,16 +232,20 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 	if (rc)
 		return rc;
 	struct fy_node *root = fy_document_root(d.fyd);
-	char backend[2][64];
-	text(root, "a.backend", backend[0], sizeof backend[0]);
-	text(root, "b.backend", backend[1], sizeof backend[1]);
-	if (!*backend[0] || !*backend[1] || strchr(backend[0], '/') || strchr(backend[1], '/')) {
+	/* Each side's sweep is in DIR/<label>, ':' and '/' of the label
+	 * written '-' (beamsim compare's directories). */
+	char backend[2][128];
+	text(root, "a.label", backend[0], sizeof backend[0]);
+	text(root, "b.label", backend[1], sizeof backend[1]);
+	if (!*backend[0] || !*backend[1]) {
 		ydoc_free(&d);
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s: a.backend, b.backend: expected the two "
-		                      "backends' names",
-		                      path);
+		                      "%s: a.label, b.label: expected the two sides' labels", path);
 	}
+	for (int i = 0; i < 2; i++)
+		for (char *c = backend[i]; *c; c++)
+			if (*c == ':' || *c == '/')
+				*c = '-';
 	/* Groups, labels and the selection from the first backend's summary. */
 	snprintf(sub, sizeof sub, "%s/%s/summary.json", dir, backend[0]);
 	fsum s;

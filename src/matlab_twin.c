@@ -401,16 +401,18 @@ int bsim_matlab_from_json(const char *json_path, const char *mat_path, const cha
 
 /* ---- a sweep's directory ------------------------------------------------ */
 
-/* The params struct of a table with a group column: per axis, the value of
- * each row's group, a number where every value of the axis is one. */
+/* The grid values of each row's group, as columns named by their keys,
+ * for the axes the table does not already hold (trials.csv names them
+ * itself): numbers where every value of the axis is one. *added gets how
+ * many fields went to out. */
 static int group_params(arena *a, const csv_table *t, const char *path, const bsim_experiment *e,
-                        bsim_mat_field *out, bsim_error *err)
+                        bsim_mat_field *out, int *added, bsim_error *err)
 {
 	int gc = csv_table_col(t, "group");
 	double *g = arena_alloc(a, (size_t)t->n_rows * sizeof *g);
-	bsim_mat_field *f = arena_alloc(a, (size_t)(e->n_axes ? e->n_axes : 1) * sizeof *f);
 	int *idx = arena_alloc(a, (size_t)(e->n_axes ? e->n_axes : 1) * sizeof *idx);
-	if (!g || !f || !idx)
+	*added = 0;
+	if (!g || !idx)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %s", path);
 	int rc = csv_table_numbers(t, path, gc, 0, 0.0, g, err);
 	if (rc)
@@ -422,6 +424,8 @@ static int group_params(arena *a, const csv_table *t, const char *path, const bs
 			                      r + 2, e->n_groups - 1, csv_table_cell(t, r, gc));
 	for (int ax = 0; ax < e->n_axes; ax++) {
 		const bsim_grid_axis *axis = &e->axes[ax];
+		if (csv_table_col(t, axis->key) >= 0)
+			continue;
 		int numeric = 1;
 		for (int i = 0; i < axis->n_values && numeric; i++) {
 			char *end;
@@ -441,15 +445,14 @@ static int group_params(arena *a, const csv_table *t, const char *path, const bs
 			else
 				s[r] = text;
 		}
-		f[ax] = numeric ? bsim_mat_column(name, v, (size_t)t->n_rows)
-		                : bsim_mat_strings(name, s, (size_t)t->n_rows);
+		out[(*added)++] = numeric ? bsim_mat_column(name, v, (size_t)t->n_rows)
+		                          : bsim_mat_strings(name, s, (size_t)t->n_rows);
 	}
-	*out = bsim_mat_struct("params", f, e->n_axes);
 	return BSIM_OK;
 }
 
-/* DIR/NAME.csv as DIR/NAME.mat, variable NAME, with params if it has a
- * group column. */
+/* DIR/NAME.csv as DIR/NAME.mat, variable NAME, with the grid values by
+ * name if it has a group column. */
 static int sweep_table(const char *dir, const char *name, const bsim_experiment *e, bsim_error *err)
 {
 	char csv[1200], mat[1200];
@@ -460,14 +463,14 @@ static int sweep_table(const char *dir, const char *name, const bsim_experiment 
 	if (rc)
 		return rc;
 	arena a = {0};
-	int has_group = csv_table_col(&t, "group") >= 0;
-	bsim_mat_field *f = csv_fields(&a, &t, 1);
+	int has_group = csv_table_col(&t, "group") >= 0, added = 0;
+	bsim_mat_field *f = csv_fields(&a, &t, has_group ? e->n_axes : 0);
 	if (!f)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %s", mat);
 	if (!rc && has_group)
-		rc = group_params(&a, &t, csv, e, &f[t.n_cols], err);
+		rc = group_params(&a, &t, csv, e, f + t.n_cols, &added, err);
 	if (!rc)
-		rc = write_var(mat, name, f, t.n_cols + has_group, err);
+		rc = write_var(mat, name, f, t.n_cols + added, err);
 	arena_free(&a);
 	csv_table_free(&t);
 	return rc;

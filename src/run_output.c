@@ -28,6 +28,7 @@ static void ledger_json(FILE *f, const bsim_ledger *l)
 	        {"residual", l->residual},
 	        {"residual_max", l->residual_max},
 	        {"residual_abs", l->residual_abs},
+	        {"inflow", l->inflow},
 	};
 	fputc('{', f);
 	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
@@ -83,8 +84,18 @@ void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *
 	bsim_json_number(f, r->max_theta[0]);
 	fputs(", ", f);
 	bsim_json_number(f, r->max_theta[1]);
-	fputs("], \"ledger\": ", f);
+	fputs("], \"overlap_max\": ", f);
+	bsim_json_number(f, r->overlap_max);
+	fputs(", \"ledger\": ", f);
 	ledger_json(f, &r->ledger);
+	fputs(", \"instability\": ", f);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, info->scene->dt, why, sizeof why);
+		bsim_json_string(f, why);
+	} else {
+		fputs("null", f);
+	}
 	if (record)
 		record_json(f, info);
 	fputs("}\n", f);

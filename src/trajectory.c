@@ -5,6 +5,7 @@
 #include "beamsim/trajectory.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 int bsim_trajectory_width(int n_beams)
 {
@@ -39,6 +40,21 @@ void bsim_trajectory_record(void *user, const bsim_record_row *row)
 		r[3 + tr->n_beams + i] = s->contact[i];
 	}
 	tr->n++;
+}
+
+int bsim_trajectory_copy(bsim_trajectory *dst, const bsim_trajectory *src)
+{
+	const size_t n = (size_t)src->n * (size_t)bsim_trajectory_width(src->n_beams);
+	double *rows = malloc((n ? n : 1) * sizeof *rows);
+	if (!rows)
+		return BSIM_EFAIL;
+	if (n)
+		memcpy(rows, src->rows, n * sizeof *rows);
+	free(dst->rows);
+	*dst = *src;
+	dst->rows = rows;
+	dst->cap = src->n;
+	return BSIM_OK;
 }
 
 void bsim_trajectory_clear(bsim_trajectory *tr)

@@ -44,9 +44,10 @@ int bsim_matlab_from_json(const char *json_path, const char *mat_path, const cha
 
 /* The twins of a sweep's directory: summary.mat (variable `summary`),
  * trials.mat (`trials`) and, when the directory holds it,
- * trajectories.mat (`trajectories`). A table with a `group` column also
- * gets a field `params`: the grid values of each row's group by name
- * (params.effects_propulsion_force(i) of row i), numbers as doubles. */
+ * trajectories.mat (`trajectories`). A table with a `group` column holds
+ * the grid values of each row's group by name, as the columns of
+ * trials.csv do (trajectories.effects_propulsion_force(i) of row i),
+ * numbers as doubles: those the CSV lacks are added. */
 int bsim_matlab_sweep(const char *dir, const bsim_experiment *e, bsim_error *err);
 
 #ifdef __cplusplus

@@ -46,7 +46,8 @@ typedef struct bsim_run_info {
 /* The JSON object of a trial (one line, with a newline): scene, name,
  * backend, backend_options, seed, group, trial, mixed_seed, outcome, type,
  * landscape_left, in_contact_end, steps, steps_run, draws, t_end, x_end,
- * y_end, vx_end, max_theta, ledger. record adds command, beamsim_version,
+ * y_end, vx_end, max_theta, overlap_max, ledger, instability (null or why
+ * the trial was unstable). record adds command, beamsim_version,
  * stride, set and scene_copy, for run.json. */
 void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r, int record);
 

@@ -31,6 +31,10 @@ int bsim_trajectory_width(int n_beams);
  * n_beams it sets on the first row). Sets oom instead of failing. */
 void bsim_trajectory_record(void *user, const bsim_record_row *row);
 
+/* dst becomes a copy of src (dst's rows are freed). BSIM_EFAIL if out
+ * of memory, dst unchanged. */
+int bsim_trajectory_copy(bsim_trajectory *dst, const bsim_trajectory *src);
+
 /* Forgets the rows, keeps the memory. */
 void bsim_trajectory_clear(bsim_trajectory *tr);
 void bsim_trajectory_free(bsim_trajectory *tr);

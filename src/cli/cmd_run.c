@@ -22,8 +22,11 @@ static const char run_help[] =
         "Usage: beamsim run SCENE [OPTIONS]\n"
         "\n"
         "Runs one trial of the scene file SCENE and prints its outcome, end state,\n"
-        "peak beam angles and energy ledger. The random-force schedule is that of\n"
-        "trial I of group G of a sweep with seed N, so a sweep's trial can be replayed.\n"
+        "peak beam angles, the deepest overlap of body and beams, and the energy\n"
+        "ledger. The random-force schedule is that of trial I of group G of a sweep\n"
+        "with seed N, so a sweep's trial can be replayed. A trial whose state stops\n"
+        "being finite, or whose ledger shows energy created beyond the bound, is\n"
+        "unstable: the reason is printed and the exit status is 1.\n"
         "\n"
         "Options:\n"
         "  --backend B            physics backend (default thesis; see beamsim backends)\n"
@@ -166,12 +169,18 @@ static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
 	printf("end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,
 	       r->vx_end);
 	printf("peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0], r->max_theta[1]);
+	printf("overlap     deepest %.3g m of body and beams\n", r->overlap_max);
 	printf("energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
 	printf("  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
 	printf("  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
 	       l->damper, l->impact, l->contact, l->correction);
-	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step)\n", l->residual,
-	       l->residual_abs, l->residual_max);
+	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step; %.4g J flowed in)\n",
+	       l->residual, l->residual_abs, l->residual_max, l->inflow);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, s->dt, why, sizeof why);
+		printf("unstable    %s\n", why);
+	}
 }
 
 /* Runs the trial, recording into the trajectory file and the --out
@@ -180,8 +189,8 @@ static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_re
 {
 	bsim_atomic_file traj = {0};
 	bsim_run_output dir;
-	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride};
-	bsim_recorder dir_rec = {.csv = NULL, .stride = (int)a->stride};
+	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride, .overlap = 1};
+	bsim_recorder dir_rec = {.csv = NULL, .stride = (int)a->stride, .overlap = 1};
 	bsim_error err;
 	const bsim_scene *scene = info->scene;
 	if (a->trajectory) {
@@ -209,7 +218,7 @@ static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_re
 		return CLI_FAIL;
 	}
 	bsim_error_clear(&err);
-	const bsim_recorder *use = a->out ? &dir_rec : a->trajectory ? &rec : NULL;
+	const bsim_recorder *use = a->out ? &dir_rec : &rec;
 	int rc = bsim_trial_run(runner, scene, info->backend, &a->opts, info->mixed_seed, use, res,
 	                        &err);
 	bsim_runner_free(runner);
@@ -272,6 +281,12 @@ int cmd_run(int argc, char **argv)
 			bsim_run_json(stdout, &info, &res, 0);
 		else if (rc == CLI_OK)
 			print_text(&a, &scene, mixed, &res);
+		if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {
+			char why[256];
+			bsim_trial_instability_text(&res, scene.dt, why, sizeof why);
+			cli_error("%s backend: unstable trial: %s", backend->name, why);
+			rc = CLI_FAIL;
+		}
 		bsim_scene_free(&scene);
 	}
 	cli_sets_free(&a.sets);
