@@ -11,14 +11,17 @@
  *   beam_peaks.csv      group,trial,beam,ix,iy,side,max_theta  (beams that moved)
  *
  * Units: m, s, m/s, rad, rad/s, N m/rad; x, y in lattice_map are the
- * field's X, Y. */
+ * field's X, Y. Each file has its MATLAB twin (.mat, a struct of columns
+ * named for the file: lattice_map, final_locations, ...). */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "beamsim/atomic_file.h"
 #include "beamsim/lattice.h"
+#include "beamsim/matlab.h"
 #include "beamsim/output.h"
 
 typedef int (*lattice_writer)(FILE *f, const bsim_experiment *e, const bsim_override *extra,
@@ -180,6 +183,12 @@ int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_ov
 			return rc;
 		}
 		if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+			return BSIM_EFAIL;
+		/* its MATLAB twin (beamsim/matlab.h), a struct named for the file */
+		char mat[1200], var[32];
+		snprintf(var, sizeof var, "%.*s", (int)strcspn(files[k].name, "."), files[k].name);
+		if (bsim_matlab_path(path, mat, sizeof mat, err) != BSIM_OK ||
+		    bsim_matlab_from_csv(path, mat, var, err) != BSIM_OK)
 			return BSIM_EFAIL;
 	}
 	return BSIM_OK;

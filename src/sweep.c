@@ -68,6 +68,9 @@ void bsim_sweep_result_free(bsim_sweep_result *r)
 		for (size_t i = 0; i < (size_t)r->n_groups * r->trials; i++)
 			bsim_trial_log_clear(&r->logs[i]);
 	free(r->logs);
+	for (size_t i = 0; r->kept && i < (size_t)r->n_groups * (size_t)r->keep; i++)
+		bsim_trajectory_free(&r->kept[i]);
+	free(r->kept);
 	free(r->trials_out);
 	free(r->groups);
 	memset(r, 0, sizeof *r);
@@ -126,6 +129,8 @@ typedef struct sweep_shared {
 	const bsim_options *opts_b;
 	bsim_trial_result *results_b;
 	bsim_trial_log *logs_b;
+	bsim_trajectory *kept, *kept_b; /* NULL: none kept */
+	int keep, keep_stride;
 	double *t_separate;
 	long total;
 	long done;
@@ -179,18 +184,30 @@ static void sweep_thread(sweep_shared *sh)
 		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
 		const bsim_scene *scene = &sh->scenes[g];
-		bsim_recorder rec = {.stride = 1, .log = log[0], .overlap = cfg->measure_overlap};
+		bsim_trajectory *keep = t < sh->keep ? &sh->kept[g * sh->keep + t] : NULL;
+		bsim_recorder rec = {.stride = keep ? sh->keep_stride : 1,
+		                     .record = keep ? bsim_trajectory_record : NULL,
+		                     .record_user = keep,
+		                     .log = log[0],
+		                     .overlap = cfg->measure_overlap};
 		int rc = BSIM_OK, copy = t > 0 && sh->deterministic[g];
-		if (copy)
-			; /* a copy of trial 0, filled in after the run */
-		else if (pair)
+		if (copy) {
+			; /* a copy of trial 0, filled in after the run (and its trajectory) */
+		} else if (pair) {
+			pair->keep[0] = keep;
+			pair->keep[1] = keep ? &sh->kept_b[g * sh->keep + t] : NULL;
+			pair->keep_stride = sh->keep_stride;
 			rc = trial_pair_run(pair, scene, &sh->scenes_b[g], cfg->backend, cfg->opts,
 			                    sh->backend_b, sh->opts_b, seed,
 			                    0.01 * scene->body.radius, &sh->results[i],
 			                    &sh->results_b[i], log, &sh->t_separate[i], &err);
-		else
+		} else {
 			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, &rec,
 			                    &sh->results[i], &err);
+			if (rc == BSIM_OK && keep && keep->oom)
+				rc = bsim_error_set(&err, BSIM_EFAIL,
+				                    "out of memory for a kept trajectory");
+		}
 		if (rc == BSIM_OK && !copy && bsim_trial_log_copy(&sh->logs[i], log[0]) != BSIM_OK)
 			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
 		if (rc == BSIM_OK && !copy && pair &&
@@ -210,7 +227,7 @@ static void sweep_thread(sweep_shared *sh)
 	bsim_trial_log_free(log[1]);
 }
 
-static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_error *err)
+static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, int keep, bsim_error *err)
 {
 	size_t n = (size_t)n_groups * (size_t)trials;
 	memset(r, 0, sizeof *r);
@@ -220,7 +237,11 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_err
 	r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
 	r->logs = calloc(n ? n : 1, sizeof *r->logs);
 	r->groups = calloc(n_groups ? (size_t)n_groups : 1, sizeof *r->groups);
-	if (!r->trials_out || !r->groups || !r->logs) {
+	if (keep > 0) {
+		r->keep = keep;
+		r->kept = calloc((size_t)n_groups * (size_t)keep, sizeof *r->kept);
+	}
+	if (!r->trials_out || !r->groups || !r->logs || (keep > 0 && !r->kept)) {
 		bsim_sweep_result_free(r);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %zu trial results", n);
 	}
@@ -242,6 +263,22 @@ static int deterministic_fill(bsim_trial_result *res, bsim_trial_log *logs, doub
 			if (bsim_trial_log_copy(&logs[first + t], &logs[first]) != BSIM_OK)
 				return BSIM_EFAIL;
 		}
+	}
+	return BSIM_OK;
+}
+
+/* The kept trajectories of a deterministic group's copies: trial 0's. */
+static int kept_fill(bsim_sweep_result *r, const int *deterministic, bsim_error *err)
+{
+	for (int g = 0; r->kept && g < r->n_groups; g++) {
+		if (!deterministic[g])
+			continue;
+		const bsim_trajectory *first = &r->kept[(size_t)g * r->keep];
+		for (int t = 1; t < r->keep; t++)
+			if (bsim_trajectory_copy(&r->kept[(size_t)g * r->keep + t], first) !=
+			    BSIM_OK)
+				return bsim_error_set(err, BSIM_EFAIL,
+				                      "out of memory for kept trajectories");
 	}
 	return BSIM_OK;
 }
@@ -280,11 +317,15 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: expected at least one group and trials >= 0", e->path);
 	long total = (long)e->n_groups * e->trials;
-	if (result_alloc(out, e->n_groups, e->trials, err) != BSIM_OK)
+	int keep = cfg->keep < e->trials ? cfg->keep : e->trials;
+	if (keep < 0)
+		keep = 0;
+	if (result_alloc(out, e->n_groups, e->trials, keep, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (backend_b) {
 		*t_separate = calloc(total ? (size_t)total : 1, sizeof **t_separate);
-		if (!*t_separate || result_alloc(out_b, e->n_groups, e->trials, err) != BSIM_OK) {
+		if (!*t_separate ||
+		    result_alloc(out_b, e->n_groups, e->trials, keep, err) != BSIM_OK) {
 			free(*t_separate);
 			*t_separate = NULL;
 			bsim_sweep_result_free(out);
@@ -318,6 +359,10 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	        .opts_b = opts_b,
 	        .results_b = backend_b ? out_b->trials_out : NULL,
 	        .logs_b = backend_b ? out_b->logs : NULL,
+	        .kept = out->kept,
+	        .kept_b = backend_b ? out_b->kept : NULL,
+	        .keep = keep,
+	        .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
 	        .t_separate = backend_b ? *t_separate : NULL,
 	        .total = total,
 	};
@@ -354,10 +399,17 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	/* The final count may have been reached on another thread. */
 	if (cfg->progress)
 		cfg->progress(cfg->progress_user, sh.total, sh.total);
+	rc = BSIM_OK;
 	if (deterministic_fill(out->trials_out, out->logs, backend_b ? *t_separate : NULL,
 	                       deterministic, e->n_groups, e->trials) ||
 	    (backend_b && deterministic_fill(out_b->trials_out, out_b->logs, NULL, deterministic,
-	                                     e->n_groups, e->trials))) {
+	                                     e->n_groups, e->trials)))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate paths");
+	if (rc == BSIM_OK)
+		rc = kept_fill(out, deterministic, err);
+	if (rc == BSIM_OK && backend_b)
+		rc = kept_fill(out_b, deterministic, err);
+	if (rc != BSIM_OK) {
 		free(deterministic);
 		bsim_sweep_result_free(out);
 		if (backend_b) {
@@ -365,7 +417,7 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 			free(*t_separate);
 			*t_separate = NULL;
 		}
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate paths");
+		return rc;
 	}
 	double wall = bsim_clock_seconds() - t0;
 	result_finish(out, deterministic, e->n_groups, e->trials, wall);

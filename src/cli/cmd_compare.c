@@ -62,6 +62,9 @@ static const char compare_help[] =
         "  --alpha A              family-wise error rate (default 0.05)\n"
         "  --margin M             smallest difference that counts (default 0.05)\n"
         "  --examples N           discordant trials shown per disagreeing group (default 3)\n"
+        "  --trajectories N       keep the trajectories of the first N trials of each\n"
+        "                         group, per backend in DIR/<backend>/trajectories.csv\n"
+        "  --trajectory-stride N  a trajectory row every N steps (default 5)\n"
         "  --quiet                no progress line, nothing on stdout\n"
         "  -h, --help             show this help\n";
 
@@ -78,7 +81,9 @@ enum {
 	OPT_EXAMPLES,
 	OPT_QUIET,
 	OPT_PROTOCOLS,
-	OPT_BACKEND
+	OPT_BACKEND,
+	OPT_TRAJECTORIES,
+	OPT_TRAJECTORY_STRIDE
 };
 
 static const struct option compare_options[] = {
@@ -95,6 +100,8 @@ static const struct option compare_options[] = {
         {"margin", required_argument, NULL, OPT_MARGIN},
         {"examples", required_argument, NULL, OPT_EXAMPLES},
         {"quiet", no_argument, NULL, OPT_QUIET},
+        {"trajectories", required_argument, NULL, OPT_TRAJECTORIES},
+        {"trajectory-stride", required_argument, NULL, OPT_TRAJECTORY_STRIDE},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -110,7 +117,7 @@ typedef struct compare_args {
 	char protocol_set[48];
 	bsim_override protocol_b;
 	bsim_options opts[2];
-	long threads, trials, examples;
+	long threads, trials, examples, keep, keep_stride;
 	int has_seed;
 	uint64_t seed;
 	cli_sets sets;
@@ -266,6 +273,17 @@ static int compare_option(compare_args *a, int c)
 		return CLI_OK;
 	case OPT_QUIET:
 		a->quiet = 1;
+		return CLI_OK;
+	case OPT_TRAJECTORIES:
+		if (cli_parse_long(optarg, 0, INT32_MAX, &a->keep) != 0)
+			return cli_usage("compare", "--trajectories %s: expected an integer >= 0",
+			                 optarg);
+		return CLI_OK;
+	case OPT_TRAJECTORY_STRIDE:
+		if (cli_parse_long(optarg, 1, INT32_MAX, &a->keep_stride) != 0)
+			return cli_usage("compare",
+			                 "--trajectory-stride %s: expected an integer >= 1",
+			                 optarg);
 		return CLI_OK;
 	}
 	return CLI_USAGE;
@@ -424,6 +442,8 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 	        .examples = (int)a->examples,
 	        .progress = !a->quiet,
 	        .out = a->out,
+	        .keep = (int)a->keep,
+	        .keep_stride = (int)a->keep_stride,
 	};
 	bsim_comparison cmp;
 	rc = cli_compare_execute(&job, &cmp);
