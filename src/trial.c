@@ -259,7 +259,9 @@ void bsim_recorder_header(FILE *f, int n_beams)
 
 void bsim_recorder_ledger_header(FILE *f)
 {
-	fputs("t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual\n", f);
+	fputs("t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual,sleep,"
+	      "reset\n",
+	      f);
 }
 
 void bsim_recorder_csv_record(void *file, const bsim_record_row *row)
@@ -278,9 +280,9 @@ void bsim_recorder_csv_record(void *file, const bsim_record_row *row)
 static void ledger_row(FILE *f, const bsim_record_row *row)
 {
 	const bsim_ledger *l = row->ledger;
-	fprintf(f, "%.6f,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", row->t,
-	        row->e_kin, row->e_beam, row->e_kin + row->e_beam, l->w_prop, l->w_rand, l->damper,
-	        l->impact, l->contact, l->correction, l->residual);
+	fprintf(f, "%.6f,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n",
+	        row->t, row->e_kin, row->e_beam, row->e_kin + row->e_beam, l->w_prop, l->w_rand,
+	        l->damper, l->impact, l->contact, l->correction, l->residual, l->sleep, l->reset);
 }
 
 /* One recorded row to every sink of rec. */

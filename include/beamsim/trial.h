@@ -191,10 +191,13 @@ void bsim_recorder_header(FILE *f, int n_beams);
 void bsim_recorder_csv_record(void *file, const bsim_record_row *row);
 
 /* The ledger CSV (beamsim run --out): at each recorded time t, s,
- *   t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual
+ *   t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual,
+ *   sleep,reset
  * in J, every flow summed over [0, t], so that at every row
  *   e_mech(t) - e_mech(0) = w_prop + w_rand - damper - impact - contact
- *                           - correction + residual. */
+ *                           - correction - sleep - reset + residual
+ * (sleep and reset: beams put to rest by sleeping and by the essay's lattice
+ * protocol; 0 elsewhere). */
 void bsim_recorder_ledger_header(FILE *f);
 
 typedef struct bsim_runner bsim_runner;
