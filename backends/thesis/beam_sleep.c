@@ -78,6 +78,5 @@ void thesis_beams_sleep(struct bsim_world *w, double speed, double h)
 		b->theta = 0.0;
 		b->omega = 0.0;
 		w->energy.sleep += e;
-		w->sleeps++;
 	}
 }

@@ -75,7 +75,6 @@ struct bsim_world {
 	int *candidates;         /* per step: beams to test, ascending */
 	int *typed;              /* beams whose contact_type is not NONE */
 	int n_typed;
-	long sleeps; /* beams put to rest by sleeping, all steps */
 	/* per step */
 	thesis_contact *contacts; /* n_beams capacity */
 	int n_contacts;
