@@ -65,6 +65,18 @@ void scene_defaults(bsim_scene *s);
  * body centre to the beam segment < radius), or -1; *dist in m. */
 int scene_overlap(const bsim_scene *s, double *dist);
 
+/* A limit of beamsim/limits.h that a scene exceeds: the field to blame,
+ * what it asks for and the limit's name and value. */
+typedef struct scene_excess {
+	const char *field; /* "effects.random_force.frequency", ... */
+	const char *limit; /* "schedule", "beam_steps" */
+	double got, max;
+	const char *what; /* "random-force values per trial (frequency x dt x max_steps)" */
+} scene_excess;
+
+/* 1 and *x if the scene asks for more than a limit allows, else 0. */
+int scene_excess_find(const bsim_scene *s, scene_excess *x);
+
 /* bsim_scene_load on a document already read (the experiment loader reads
  * the scene file once and builds every group from a clone of it). */
 int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,

@@ -155,7 +155,9 @@ constexpr uint16 CATEGORY_BODY = 0x0001, CATEGORY_BEAM = 0x0002;
 void rest_direction(double deg, double u[2])
 {
 	double q = deg / 90.0;
-	if (q == std::floor(q)) {
+	/* (long)q is defined only within long's range: angles beyond 1e15
+	 * quarter turns take the general path. */
+	if (q == std::floor(q) && std::fabs(q) < 1e15) {
 		static const double c[4] = {1, 0, -1, 0}, sn[4] = {0, 1, 0, -1};
 		long k = ((long)q % 4 + 4) % 4;
 		u[0] = c[k];

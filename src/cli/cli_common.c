@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/limits.h"
 #include "beamsim/progress.h"
 
 void cli_error(const char *fmt, ...)
@@ -139,6 +140,16 @@ void cli_sets_free(cli_sets *s)
 	memset(s, 0, sizeof *s);
 }
 
+int cli_limit(const char *cmd, const char *text)
+{
+	bsim_limits l = *bsim_limits_get();
+	bsim_error err;
+	if (bsim_limits_parse(&l, text, &err) != BSIM_OK)
+		return cli_usage(cmd, "%s", err.msg);
+	bsim_limits_set(&l);
+	return CLI_OK;
+}
+
 int cli_options_add(bsim_options *opts, const char *cmd, const char *kv)
 {
 	bsim_error err;
@@ -171,6 +182,11 @@ int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsi
 	if (bsim_experiment_load(path, ov, sets ? sets->n : 0, e, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return err.code ? err.code : CLI_USAGE;
+	}
+	if (trials > 0 && bsim_experiment_check_trials(e, trials, &err) != BSIM_OK) {
+		cli_error("--trials %ld: %s", trials, err.msg);
+		bsim_experiment_free(e);
+		return CLI_USAGE;
 	}
 	if (trials > 0)
 		e->trials = (int)trials;

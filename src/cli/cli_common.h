@@ -55,6 +55,15 @@ typedef struct cli_sets {
 int cli_sets_add(cli_sets *s, const char *cmd, const char *kv);
 void cli_sets_free(cli_sets *s);
 
+/* Applies a --limit NAME=N (beamsim/limits.h) to the process. 0, or a
+ * usage error of cmd. */
+int cli_limit(const char *cmd, const char *text);
+
+/* The help line of --limit, shared by every command that loads inputs. */
+#define CLI_LIMIT_HELP                                                                             \
+	"  --limit NAME=N         raise a limit on what inputs may ask for: input_bytes,\n"        \
+	"                         groups, trials, schedule, beam_steps (README, Robustness)\n"
+
 /* Adds a --backend-opt KEY=VALUE. 0, or a usage error. */
 int cli_options_add(bsim_options *opts, const char *cmd, const char *kv);
 

@@ -46,7 +46,7 @@ static const char compare_help[] =
         "  --alpha A              family-wise error rate (default 0.05)\n"
         "  --margin M             smallest difference that counts (default 0.05)\n"
         "  --examples N           discordant trials shown per disagreeing group (default 3)\n"
-        "  --quiet                no progress line, nothing on stdout\n"
+        "  --quiet                no progress line, nothing on stdout\n" CLI_LIMIT_HELP
         "  -h, --help             show this help\n";
 
 enum {
@@ -60,7 +60,8 @@ enum {
 	OPT_ALPHA,
 	OPT_MARGIN,
 	OPT_EXAMPLES,
-	OPT_QUIET
+	OPT_QUIET,
+	OPT_LIMIT
 };
 
 static const struct option compare_options[] = {
@@ -75,6 +76,7 @@ static const struct option compare_options[] = {
         {"margin", required_argument, NULL, OPT_MARGIN},
         {"examples", required_argument, NULL, OPT_EXAMPLES},
         {"quiet", no_argument, NULL, OPT_QUIET},
+        {"limit", required_argument, NULL, OPT_LIMIT},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -163,6 +165,8 @@ static int compare_option(compare_args *a, int c)
 	case OPT_QUIET:
 		a->quiet = 1;
 		return CLI_OK;
+	case OPT_LIMIT:
+		return cli_limit("compare", optarg);
 	}
 	return CLI_USAGE;
 }

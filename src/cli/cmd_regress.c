@@ -42,10 +42,10 @@ static const char regress_help[] =
         "  --alpha A              family-wise error rate\n"
         "  --margin M             smallest difference that counts\n"
         "  --exact                any changed trial counts\n"
-        "  --quiet                no progress line, nothing on stdout\n"
+        "  --quiet                no progress line, nothing on stdout\n" CLI_LIMIT_HELP
         "  -h, --help             show this help\n";
 
-enum { OPT_OUT = 256, OPT_THREADS, OPT_ALPHA, OPT_MARGIN, OPT_EXACT, OPT_QUIET };
+enum { OPT_OUT = 256, OPT_THREADS, OPT_ALPHA, OPT_MARGIN, OPT_EXACT, OPT_QUIET, OPT_LIMIT };
 
 static const struct option regress_options[] = {
         {"out", required_argument, NULL, OPT_OUT},
@@ -54,6 +54,7 @@ static const struct option regress_options[] = {
         {"margin", required_argument, NULL, OPT_MARGIN},
         {"exact", no_argument, NULL, OPT_EXACT},
         {"quiet", no_argument, NULL, OPT_QUIET},
+        {"limit", required_argument, NULL, OPT_LIMIT},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -94,6 +95,9 @@ static int regress_parse(int argc, char **argv, regress_args *a)
 			break;
 		case OPT_QUIET:
 			a->quiet = 1;
+			break;
+		case OPT_LIMIT:
+			rc = cli_limit("regress", optarg);
 			break;
 		default:
 			return cli_bad_option("regress", argv, c);

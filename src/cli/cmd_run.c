@@ -34,7 +34,7 @@ static const char run_help[] =
         "                         (e.g. --set effects.random_force.magnitude=30)\n"
         "  --trajectory FILE.csv  write the trajectory, one row per recorded step\n"
         "  --stride N             record every N-th step (default 1)\n"
-        "  --json                 print one JSON object instead of text\n"
+        "  --json                 print one JSON object instead of text\n" CLI_LIMIT_HELP
         "  -h, --help             show this help\n";
 
 enum {
@@ -46,7 +46,8 @@ enum {
 	OPT_SET,
 	OPT_TRAJECTORY,
 	OPT_STRIDE,
-	OPT_JSON
+	OPT_JSON,
+	OPT_LIMIT
 };
 
 static const struct option run_options[] = {
@@ -59,6 +60,7 @@ static const struct option run_options[] = {
         {"trajectory", required_argument, NULL, OPT_TRAJECTORY},
         {"stride", required_argument, NULL, OPT_STRIDE},
         {"json", no_argument, NULL, OPT_JSON},
+        {"limit", required_argument, NULL, OPT_LIMIT},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -119,6 +121,9 @@ static int run_parse(int argc, char **argv, run_args *a)
 			break;
 		case OPT_JSON:
 			a->json = 1;
+			break;
+		case OPT_LIMIT:
+			rc = cli_limit("run", optarg);
 			break;
 		default:
 			return cli_bad_option("run", argv, c);

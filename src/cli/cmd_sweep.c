@@ -32,7 +32,7 @@ static const char sweep_help[] =
         "  --trials N             trials per group (default: the experiment's)\n"
         "  --seed N               experiment seed (default: the experiment's)\n"
         "  --set KEY=VALUE        override a scene field in every group, repeatable\n"
-        "  --quiet                no progress line, nothing on stdout\n"
+        "  --quiet                no progress line, nothing on stdout\n" CLI_LIMIT_HELP
         "  -h, --help             show this help\n";
 
 enum {
@@ -43,7 +43,8 @@ enum {
 	OPT_SEED,
 	OPT_SET,
 	OPT_OUT,
-	OPT_QUIET
+	OPT_QUIET,
+	OPT_LIMIT
 };
 
 static const struct option sweep_options[] = {
@@ -55,6 +56,7 @@ static const struct option sweep_options[] = {
         {"set", required_argument, NULL, OPT_SET},
         {"out", required_argument, NULL, OPT_OUT},
         {"quiet", no_argument, NULL, OPT_QUIET},
+        {"limit", required_argument, NULL, OPT_LIMIT},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -113,6 +115,9 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 			break;
 		case OPT_QUIET:
 			a->quiet = 1;
+			break;
+		case OPT_LIMIT:
+			rc = cli_limit("sweep", optarg);
 			break;
 		default:
 			return cli_bad_option("sweep", argv, c);
