@@ -86,6 +86,17 @@ static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 	return BSIM_OK;
 }
 
+/* A paired sweep's journal record. */
+typedef struct pair_record {
+	bsim_trial_result a, b;
+	double t_separate;
+} pair_record;
+
+size_t bsim_sweep_record_size(int paired)
+{
+	return paired ? sizeof(pair_record) : sizeof(bsim_trial_result);
+}
+
 /* What the threads share. first_fail is the index of the lowest failed
  * trial so far (total if none, -1 if a thread could not start). */
 typedef struct sweep_shared {
@@ -101,6 +112,8 @@ typedef struct sweep_shared {
 	long done;
 	long first_fail;
 	bsim_error fail;
+	unsigned char *from_journal; /* total flags: the result came from the journal */
+	int stopped;                 /* a trial was not started because of cfg->stop */
 } sweep_shared;
 
 static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
@@ -117,6 +130,35 @@ static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
 			sh->first_fail = i;
 		}
 	}
+}
+
+/* Trial i's record: its result, or both results and the separation time. */
+static int journal_append(sweep_shared *sh, long i, bsim_error *err)
+{
+	if (!sh->backend_b)
+		return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &sh->results[i], err);
+	pair_record p = {sh->results[i], sh->results_b[i], sh->t_separate[i]};
+	return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &p, err);
+}
+
+/* A journal record back into its slots (bsim_journal_fn). */
+static int journal_take(void *user, uint64_t index, const void *payload)
+{
+	sweep_shared *sh = user;
+	if (index >= (uint64_t)sh->total)
+		return 1;
+	if (sh->backend_b) {
+		pair_record p;
+		memcpy(&p, payload, sizeof p);
+		sh->results[index] = p.a;
+		sh->results_b[index] = p.b;
+		sh->t_separate[index] = p.t_separate;
+	} else {
+		memcpy(&sh->results[index], payload, sizeof sh->results[index]);
+	}
+	sh->done += !sh->from_journal[index];
+	sh->from_journal[index] = 1;
+	return 0;
 }
 
 /* Trials are handed out in index order, so when trial i fails every trial
@@ -142,8 +184,13 @@ static void sweep_thread(sweep_shared *sh)
 		long stop;
 #pragma omp atomic read
 		stop = sh->first_fail;
-		if (!runner || i > stop)
+		if (!runner || i > stop || (sh->from_journal && sh->from_journal[i]))
 			continue;
+		if (cfg->stop && *cfg->stop) {
+#pragma omp atomic write
+			sh->stopped = 1;
+			continue;
+		}
 		long g = i / e->trials, t = i % e->trials;
 		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
@@ -154,6 +201,8 @@ static void sweep_thread(sweep_shared *sh)
 		                               &sh->t_separate[i], &err)
 		              : bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, NULL,
 		                               &sh->results[i], &err);
+		if (rc == BSIM_OK && cfg->journal)
+			rc = journal_append(sh, i, &err);
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
 		long done;
@@ -200,6 +249,9 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	if (e->trials < 0 || e->n_groups < 1)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: expected at least one group and trials >= 0", e->path);
+	bsim_error why;
+	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: %s", e->path, why.msg);
 	long total = (long)e->n_groups * e->trials;
 	if (result_alloc(out, e->n_groups, e->trials, err) != BSIM_OK)
 		return BSIM_EFAIL;
@@ -226,6 +278,15 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	        .t_separate = backend_b ? *t_separate : NULL,
 	        .total = total,
 	};
+	if (rc == BSIM_OK && cfg->journal) {
+		sh.from_journal = calloc(total ? (size_t)total : 1, 1);
+		long kept = 0, cut = 0;
+		rc = !sh.from_journal ? bsim_error_set(err, BSIM_EFAIL, "out of memory")
+		                      : bsim_journal_replay(cfg->journal, journal_take, &sh, &kept,
+		                                            &cut, err);
+		if (rc != BSIM_OK)
+			scenes_free(scenes, e->n_groups);
+	}
 	if (rc == BSIM_OK) {
 		sh.first_fail = sh.total;
 		bsim_error_clear(&sh.fail);
@@ -237,7 +298,11 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 		scenes_free(scenes, e->n_groups);
 		if (sh.first_fail < sh.total)
 			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
+		else if (sh.stopped)
+			rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped after %ld of %ld trials",
+			                    sh.done, sh.total);
 	}
+	free(sh.from_journal);
 	if (rc != BSIM_OK) {
 		bsim_sweep_result_free(out);
 		if (backend_b) {

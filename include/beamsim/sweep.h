@@ -3,8 +3,12 @@
 #ifndef BEAMSIM_SWEEP_H
 #define BEAMSIM_SWEEP_H
 
+#include <signal.h>
+#include <stddef.h>
+
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
+#include "beamsim/journal.h"
 #include "beamsim/trial.h"
 
 #ifdef __cplusplus
@@ -38,10 +42,26 @@ typedef struct bsim_sweep_config {
 	int n_extra;
 	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
+	/* NULL, or a journal (beamsim/journal.h) of records of
+	 * bsim_sweep_record_size bytes, created or resumed for this sweep's
+	 * inputs: the trials it holds are taken from it, not run again, and
+	 * each trial run is appended as it ends. */
+	bsim_journal *journal;
+	/* NULL, or a flag a signal handler sets: once it is nonzero no trial
+	 * starts, those running finish (and are journaled), and the sweep
+	 * returns BSIM_ESTOPPED. */
+	const volatile sig_atomic_t *stop;
 } bsim_sweep_config;
 
+/* The size of one journal record: a bsim_trial_result, or for a paired
+ * sweep both results and the separation time. The record is the result's
+ * bytes as they are in memory, so a resumed sweep's results are the
+ * uninterrupted sweep's to the bit. */
+size_t bsim_sweep_record_size(int paired);
+
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller
- * applies --trials/--seed). */
+ * applies --trials/--seed). BSIM_ESTOPPED (see cfg->stop) says how many
+ * trials were finished. */
 int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
                    bsim_error *err);
 

@@ -10,26 +10,40 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
+#include "beamsim/outdir.h"
 #include "beamsim/progress.h"
+
+static const bsim_outdir *error_outdir;
+
+void cli_error_paths(const bsim_outdir *od)
+{
+	error_outdir = od;
+}
 
 void cli_error(const char *fmt, ...)
 {
 	va_list ap;
-	fputs("beamsim: ", stderr);
+	bsim_error e;
+	char msg[BSIM_ERROR_MSG_MAX];
 	va_start(ap, fmt);
-	vfprintf(stderr, fmt, ap);
+	vsnprintf(msg, sizeof msg, fmt, ap);
 	va_end(ap);
-	fputc('\n', stderr);
+	bsim_outdir_explain(error_outdir, msg, sizeof msg);
+	/* The library's escaping of what the message quotes. */
+	bsim_error_set(&e, BSIM_EFAIL, "%s", msg);
+	fprintf(stderr, "beamsim: %s\n", e.msg);
 }
 
 int cli_usage(const char *cmd, const char *fmt, ...)
 {
 	va_list ap;
-	fprintf(stderr, "beamsim: %s: ", cmd);
+	bsim_error e;
+	char msg[BSIM_ERROR_MSG_MAX];
 	va_start(ap, fmt);
-	vfprintf(stderr, fmt, ap);
+	vsnprintf(msg, sizeof msg, fmt, ap);
 	va_end(ap);
-	fprintf(stderr, "\nTry 'beamsim %s --help'.\n", cmd);
+	bsim_error_set(&e, BSIM_EINPUT, "%s", msg); /* escapes what it quotes */
+	fprintf(stderr, "beamsim: %s: %s\nTry 'beamsim %s --help'.\n", cmd, e.msg, cmd);
 	return CLI_USAGE;
 }
 

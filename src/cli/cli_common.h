@@ -27,8 +27,14 @@ int cmd_compare(int argc, char **argv);
 int cmd_regress(int argc, char **argv);
 int cmd_accuracy(int argc, char **argv);
 
-/* "beamsim: MSG" on stderr. */
+/* "beamsim: MSG" on stderr, one line of printable text, naming files in
+ * the output directory of cli_error_paths by their place in it. */
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+/* While a run writes into od's staging area, messages that name staged
+ * files name them as they will be in the directory; NULL ends it. */
+struct bsim_outdir;
+void cli_error_paths(const struct bsim_outdir *od);
 
 /* A usage error of command cmd: the message, a pointer to --help, and 2. */
 int cli_usage(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

@@ -33,7 +33,9 @@ static const char compare_help[] =
         "\n"
         "Writes DIR/report.md, DIR/report.json, DIR/pairs.csv, DIR/<backend>/summary.json\n"
         "and trials.csv for each backend, and DIR/run.json with DIR/inputs/ for\n"
-        "`beamsim regress DIR`.\n"
+        "`beamsim regress DIR`. The files appear together at the end (DIR/manifest.json);\n"
+        "finished pairs are journaled as they end, so a stopped or killed comparison\n"
+        "continues with --resume and gives the same files.\n"
         "\n"
         "Options:\n"
         "  --out DIR              output directory, created if missing (required)\n"
@@ -46,8 +48,9 @@ static const char compare_help[] =
         "  --alpha A              family-wise error rate (default 0.05)\n"
         "  --margin M             smallest difference that counts (default 0.05)\n"
         "  --examples N           discordant trials shown per disagreeing group (default 3)\n"
-        "  --quiet                no progress line, nothing on stdout\n" CLI_LIMIT_HELP
-        "  -h, --help             show this help\n";
+        "  --quiet                no progress line, nothing on stdout\n"
+        "  --resume               continue the stopped comparison in DIR (same "
+        "inputs)\n" CLI_LIMIT_HELP "  -h, --help             show this help\n";
 
 enum {
 	OPT_BACKENDS = 256,
@@ -61,7 +64,8 @@ enum {
 	OPT_MARGIN,
 	OPT_EXAMPLES,
 	OPT_QUIET,
-	OPT_LIMIT
+	OPT_LIMIT,
+	OPT_RESUME
 };
 
 static const struct option compare_options[] = {
@@ -77,6 +81,7 @@ static const struct option compare_options[] = {
         {"examples", required_argument, NULL, OPT_EXAMPLES},
         {"quiet", no_argument, NULL, OPT_QUIET},
         {"limit", required_argument, NULL, OPT_LIMIT},
+        {"resume", no_argument, NULL, OPT_RESUME},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -92,6 +97,9 @@ typedef struct compare_args {
 	const char *out;
 	bsim_compare_rule rule;
 	int quiet;
+	int resume;
+	int argc; /* the command line, for the line that resumes it */
+	char **argv;
 	/* --backend-opt before --backends is resolved after parsing */
 	int n_pending;
 	char pending[2 * BSIM_OPTIONS_MAX][128];
@@ -167,6 +175,9 @@ static int compare_option(compare_args *a, int c)
 		return CLI_OK;
 	case OPT_LIMIT:
 		return cli_limit("compare", optarg);
+	case OPT_RESUME:
+		a->resume = 1;
+		return CLI_OK;
 	}
 	return CLI_USAGE;
 }
@@ -229,17 +240,24 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 {
 	bsim_experiment e;
 	bsim_error err;
-	struct stat st;
 	int rc = cli_experiment_load(a->experiment, &a->sets, a->trials, &e);
 	if (rc != CLI_OK)
 		return rc;
 	if (a->has_seed)
 		e.seed = a->seed;
-	int created = stat(a->out, &st) != 0;
-	if (bsim_output_mkdir(a->out, &err) != BSIM_OK) {
-		cli_error("%s", err.msg);
+	bsim_run_record rec;
+	const bsim_backend *b[2] = {b0, b1};
+	const bsim_options *opts[2] = {&a->opts[0], &a->opts[1]};
+	cli_record_fill(&rec, "compare", &e, 2, b, opts, &a->rule);
+	char *inputs = bsim_run_record_inputs(&rec, &e, a->sets.ov, a->sets.n, &err);
+	cli_session ss;
+	rc = inputs ? cli_session_open(&ss, a->out, a->resume, inputs, bsim_sweep_record_size(1),
+	                               a->argc, a->argv)
+	            : cli_report(err.code, &err);
+	free(inputs);
+	if (rc != CLI_OK) {
 		bsim_experiment_free(&e);
-		return CLI_FAIL;
+		return rc;
 	}
 	cli_compare_job job = {
 	        .e = &e,
@@ -251,12 +269,13 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 	        .rule = a->rule,
 	        .examples = (int)a->examples,
 	        .progress = !a->quiet,
-	        .out = a->out,
+	        .out = ss.stage,
+	        .journal = ss.journal,
+	        .stop = &cli_stop,
 	};
 	bsim_comparison cmp;
 	rc = cli_compare_execute(&job, &cmp);
-	if (rc != CLI_OK && created)
-		rmdir(a->out); /* removes it only if the run left it empty */
+	rc = cli_session_close(&ss, rc, "compare");
 	if (rc == CLI_OK) {
 		if (!a->quiet)
 			compare_summary(a, &e, &cmp);
@@ -270,6 +289,8 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 int cmd_compare(int argc, char **argv)
 {
 	compare_args a = {
+	        .argc = argc,
+	        .argv = argv,
 	        .names = {"thesis", "box2d"},
 	        .rule = {BSIM_COMPARE_ALPHA, BSIM_COMPARE_MARGIN, 0},
 	        .examples = 3,

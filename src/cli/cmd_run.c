@@ -33,6 +33,7 @@ static const char run_help[] =
         "  --set KEY=VALUE        override a scene field by dotted path, repeatable\n"
         "                         (e.g. --set effects.random_force.magnitude=30)\n"
         "  --trajectory FILE.csv  write the trajectory, one row per recorded step\n"
+        "                         (- for standard output; the report then goes to stderr)\n"
         "  --stride N             record every N-th step (default 1)\n"
         "  --json                 print one JSON object instead of text\n" CLI_LIMIT_HELP
         "  -h, --help             show this help\n";
@@ -139,7 +140,7 @@ static int run_parse(int argc, char **argv, run_args *a)
 	return -1;
 }
 
-static void print_ledger_json(const bsim_ledger *l)
+static void print_ledger_json(FILE *out, const bsim_ledger *l)
 {
 	const struct {
 		const char *name;
@@ -157,77 +158,81 @@ static void print_ledger_json(const bsim_ledger *l)
 	        {"residual_max", l->residual_max},
 	        {"residual_abs", l->residual_abs},
 	};
-	fputc('{', stdout);
+	fputc('{', out);
 	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
-		printf("%s\"%s\": ", i ? ", " : "", terms[i].name);
-		bsim_json_number(stdout, terms[i].value);
+		fprintf(out, "%s\"%s\": ", i ? ", " : "", terms[i].name);
+		bsim_json_number(out, terms[i].value);
 	}
-	fputc('}', stdout);
+	fputc('}', out);
 }
 
-static void print_json(const run_args *a, const bsim_backend *b, const bsim_scene *s,
+static void print_json(FILE *out, const run_args *a, const bsim_backend *b, const bsim_scene *s,
                        uint64_t mixed, const bsim_trial_result *r)
 {
-	fputs("{\"scene\": ", stdout);
-	bsim_json_string(stdout, a->scene);
-	fputs(", \"name\": ", stdout);
-	bsim_json_string(stdout, s->name);
-	fputs(", \"backend\": ", stdout);
-	bsim_json_string(stdout, a->backend);
-	fputs(", \"backend_options\": ", stdout);
-	bsim_output_backend_options(stdout, b, &a->opts);
-	printf(", \"seed\": %" PRIu64 ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": %" PRIu64,
-	       a->seed, a->group, a->trial, mixed);
-	fputs(", \"outcome\": ", stdout);
-	bsim_json_string(stdout, bsim_outcome_name(r->outcome));
-	fputs(", \"type\": ", stdout);
-	bsim_json_string(stdout, bsim_type_name(r->type));
-	printf(", \"landscape_left\": %d, \"in_contact_end\": %d", r->landscape_left,
-	       r->in_contact_end);
-	printf(", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
-	       r->draws);
+	fputs("{\"scene\": ", out);
+	bsim_json_string(out, a->scene);
+	fputs(", \"name\": ", out);
+	bsim_json_string(out, s->name);
+	fputs(", \"backend\": ", out);
+	bsim_json_string(out, a->backend);
+	fputs(", \"backend_options\": ", out);
+	bsim_output_backend_options(out, b, &a->opts);
+	fprintf(out,
+	        ", \"seed\": %" PRIu64 ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": %" PRIu64,
+	        a->seed, a->group, a->trial, mixed);
+	fputs(", \"outcome\": ", out);
+	bsim_json_string(out, bsim_outcome_name(r->outcome));
+	fputs(", \"type\": ", out);
+	bsim_json_string(out, bsim_type_name(r->type));
+	fprintf(out, ", \"landscape_left\": %d, \"in_contact_end\": %d", r->landscape_left,
+	        r->in_contact_end);
+	fprintf(out, ", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
+	        r->draws);
 	const char *names[] = {"t_end", "x_end", "y_end", "vx_end"};
 	const double values[] = {r->t_end, r->x_end, r->y_end, r->vx_end};
 	for (int i = 0; i < 4; i++) {
-		printf(", \"%s\": ", names[i]);
-		bsim_json_number(stdout, values[i]);
+		fprintf(out, ", \"%s\": ", names[i]);
+		bsim_json_number(out, values[i]);
 	}
-	fputs(", \"max_theta\": [", stdout);
-	bsim_json_number(stdout, r->max_theta[0]);
-	fputs(", ", stdout);
-	bsim_json_number(stdout, r->max_theta[1]);
-	fputs("], \"ledger\": ", stdout);
-	print_ledger_json(&r->ledger);
-	fputs("}\n", stdout);
+	fputs(", \"max_theta\": [", out);
+	bsim_json_number(out, r->max_theta[0]);
+	fputs(", ", out);
+	bsim_json_number(out, r->max_theta[1]);
+	fputs("], \"ledger\": ", out);
+	print_ledger_json(out, &r->ledger);
+	fputs("}\n", out);
 }
 
-static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
+static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64_t mixed,
                        const bsim_trial_result *r)
 {
 	const bsim_ledger *l = &r->ledger;
-	printf("scene       %s (%s), backend %s\n", a->scene, s->name, a->backend);
-	printf("seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
-	       ", %lu draws)\n",
-	       a->seed, a->group, a->trial, mixed, r->draws);
-	printf("outcome     %s", bsim_outcome_name(r->outcome));
+	fprintf(out, "scene       %s (%s), backend %s\n", a->scene, s->name, a->backend);
+	fprintf(out,
+	        "seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
+	        ", %lu draws)\n",
+	        a->seed, a->group, a->trial, mixed, r->draws);
+	fprintf(out, "outcome     %s", bsim_outcome_name(r->outcome));
 	if (r->outcome == BSIM_TRAVERSED)
-		printf(", type %s, landscape %s", bsim_type_name(r->type),
-		       r->landscape_left                   ? "left"
-		       : r->max_theta[1] > r->max_theta[0] ? "right"
-		                                           : "none");
+		fprintf(out, ", type %s, landscape %s", bsim_type_name(r->type),
+		        r->landscape_left                   ? "left"
+		        : r->max_theta[1] > r->max_theta[0] ? "right"
+		                                            : "none");
 	else if (r->outcome == BSIM_STUCK)
-		printf(", %s", r->in_contact_end ? "in contact" : "not in contact");
-	printf("\nsteps       %d to the outcome at t = %.6g s, %d run\n", r->steps, r->t_end,
-	       r->steps_run);
-	printf("end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,
-	       r->vx_end);
-	printf("peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0], r->max_theta[1]);
-	printf("energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
-	printf("  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
-	printf("  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
-	       l->damper, l->impact, l->contact, l->correction);
-	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step)\n", l->residual,
-	       l->residual_abs, l->residual_max);
+		fprintf(out, ", %s", r->in_contact_end ? "in contact" : "not in contact");
+	fprintf(out, "\nsteps       %d to the outcome at t = %.6g s, %d run\n", r->steps, r->t_end,
+	        r->steps_run);
+	fprintf(out, "end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,
+	        r->vx_end);
+	fprintf(out, "peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0],
+	        r->max_theta[1]);
+	fprintf(out, "energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
+	fprintf(out, "  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
+	fprintf(out,
+	        "  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
+	        l->damper, l->impact, l->contact, l->correction);
+	fprintf(out, "  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step)\n", l->residual,
+	        l->residual_abs, l->residual_max);
 }
 
 /* Runs the trial, recording into the trajectory file if one was asked
@@ -285,10 +290,13 @@ int cmd_run(int argc, char **argv)
 		bsim_trial_result res;
 		memset(&res, 0, sizeof res);
 		rc = run_trial(&a, &scene, backend, mixed, &res);
+		/* A trajectory on standard output keeps it to itself: the report
+		 * goes to standard error. */
+		FILE *out = a.trajectory && strcmp(a.trajectory, "-") == 0 ? stderr : stdout;
 		if (rc == CLI_OK && a.json)
-			print_json(&a, backend, &scene, mixed, &res);
+			print_json(out, &a, backend, &scene, mixed, &res);
 		else if (rc == CLI_OK)
-			print_text(&a, &scene, mixed, &res);
+			print_text(out, &a, &scene, mixed, &res);
 		bsim_scene_free(&scene);
 	}
 	cli_sets_free(&a.sets);

@@ -22,7 +22,9 @@ static const char sweep_help[] =
         "DIR/summary.json (per-group counts, p_traverse and its 95% Wilson interval)\n"
         "and DIR/trials.csv (one row per trial). The results do not depend on --threads.\n"
         "DIR/run.json and DIR/inputs/ record the run, so `beamsim regress DIR` can\n"
-        "repeat it.\n"
+        "repeat it. The files appear together when the sweep is done (DIR/manifest.json\n"
+        "lists them); finished trials are journaled as they end, so a stopped or killed\n"
+        "sweep continues with --resume and gives the same files.\n"
         "\n"
         "Options:\n"
         "  --out DIR              output directory, created if missing (required)\n"
@@ -32,7 +34,8 @@ static const char sweep_help[] =
         "  --trials N             trials per group (default: the experiment's)\n"
         "  --seed N               experiment seed (default: the experiment's)\n"
         "  --set KEY=VALUE        override a scene field in every group, repeatable\n"
-        "  --quiet                no progress line, nothing on stdout\n" CLI_LIMIT_HELP
+        "  --quiet                no progress line, nothing on stdout\n"
+        "  --resume               continue the stopped run in DIR (same inputs)\n" CLI_LIMIT_HELP
         "  -h, --help             show this help\n";
 
 enum {
@@ -44,7 +47,8 @@ enum {
 	OPT_SET,
 	OPT_OUT,
 	OPT_QUIET,
-	OPT_LIMIT
+	OPT_LIMIT,
+	OPT_RESUME
 };
 
 static const struct option sweep_options[] = {
@@ -57,6 +61,7 @@ static const struct option sweep_options[] = {
         {"out", required_argument, NULL, OPT_OUT},
         {"quiet", no_argument, NULL, OPT_QUIET},
         {"limit", required_argument, NULL, OPT_LIMIT},
+        {"resume", no_argument, NULL, OPT_RESUME},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -72,6 +77,9 @@ typedef struct sweep_args {
 	cli_sets sets;
 	const char *out;
 	int quiet;
+	int resume;
+	int argc; /* the command line, for the line that resumes it */
+	char **argv;
 } sweep_args;
 
 /* Fills a; returns -1 to go on, else the exit status. */
@@ -119,6 +127,9 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 		case OPT_LIMIT:
 			rc = cli_limit("sweep", optarg);
 			break;
+		case OPT_RESUME:
+			a->resume = 1;
+			break;
 		default:
 			return cli_bad_option("sweep", argv, c);
 		}
@@ -149,26 +160,31 @@ static void sweep_report(const sweep_args *a, const bsim_experiment *e, const bs
 	printf("wrote %s/summary.json and %s/trials.csv\n", a->out, a->out);
 }
 
-/* Loads, creates DIR (before the run, so an unusable DIR fails at once,
- * not after hours), runs, writes. A DIR created here is removed again if
- * the run fails, so a failed sweep leaves nothing behind. */
+/* Loads, opens DIR (before the run, so an unusable DIR fails at once, not
+ * after hours) with the journal, runs, writes into the staging area and
+ * commits. A failed or stopped sweep leaves DIR as it was. */
 static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 {
 	bsim_experiment e;
 	bsim_error err;
-	struct stat st;
 	int rc = cli_experiment_load(a->experiment, &a->sets, a->trials, &e);
 	if (rc != CLI_OK)
 		return rc;
 	if (a->has_seed)
 		e.seed = a->seed;
-	int created = stat(a->out, &st) != 0;
-	if (bsim_output_mkdir(a->out, &err) != BSIM_OK) {
-		cli_error("%s", err.msg);
+	bsim_run_record rec;
+	const bsim_options *opts = &a->opts;
+	cli_record_fill(&rec, "sweep", &e, 1, &backend, &opts, NULL);
+	char *inputs = bsim_run_record_inputs(&rec, &e, a->sets.ov, a->sets.n, &err);
+	cli_session ss;
+	rc = inputs ? cli_session_open(&ss, a->out, a->resume, inputs, bsim_sweep_record_size(0),
+	                               a->argc, a->argv)
+	            : cli_report(err.code, &err);
+	free(inputs);
+	if (rc != CLI_OK) {
 		bsim_experiment_free(&e);
-		return CLI_FAIL;
+		return rc;
 	}
-
 	int threads = a->threads > 0 ? (int)a->threads : omp_get_max_threads();
 	bsim_sweep_config cfg = {
 	        .backend = backend,
@@ -176,17 +192,19 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 	        .threads = threads,
 	        .extra = a->sets.ov,
 	        .n_extra = a->sets.n,
+	        .journal = ss.journal,
+	        .stop = &cli_stop,
 	};
 	bsim_sweep_result r;
 	rc = cli_sweep_run(&e, &cfg, !a->quiet, &r);
-	if (rc != CLI_OK) {
-		if (created)
-			rmdir(a->out);
-	} else {
-		rc = cli_store_sweep(a->out, &e, backend, &a->opts, a->sets.ov, a->sets.n, &r);
+	if (rc == CLI_OK) {
+		rc = cli_store_sweep(ss.stage, &e, backend, &a->opts, a->sets.ov, a->sets.n, &r);
+		rc = cli_session_close(&ss, rc, "sweep");
 		if (rc == CLI_OK && !a->quiet)
 			sweep_report(a, &e, &r, threads);
 		bsim_sweep_result_free(&r);
+	} else {
+		rc = cli_session_close(&ss, rc, "sweep");
 	}
 	bsim_experiment_free(&e);
 	return rc;
@@ -194,7 +212,7 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 
 int cmd_sweep(int argc, char **argv)
 {
-	sweep_args a = {.backend = "thesis"};
+	sweep_args a = {.backend = "thesis", .argc = argc, .argv = argv};
 	int rc = sweep_parse(argc, argv, &a);
 	if (rc < 0) {
 		const bsim_backend *backend = cli_backend(a.backend, &a.opts);

@@ -1,4 +1,5 @@
 /* The beamsim program: dispatch to one subcommand per file. */
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -43,7 +44,27 @@ static void usage(FILE *f)
 	      f);
 }
 
-int main(int argc, char **argv)
+/* What the command printed must have reached standard output: a full disk
+ * or a closed pipe is a failed run, not a success with a lost report. */
+static int close_stdout(int rc)
+{
+	int saved = 0;
+	errno = 0;
+	if (ferror(stdout)) {
+		clearerr(stdout); /* flushing again tells why the write failed */
+		saved = fflush(stdout) != 0 && errno ? errno : EIO;
+	} else if (fflush(stdout) != 0) {
+		saved = errno ? errno : EIO;
+	}
+	if (fclose(stdout) != 0 && !saved)
+		saved = errno ? errno : EIO;
+	if (!saved)
+		return rc;
+	fprintf(stderr, "beamsim: standard output: write failed: %s\n", strerror(saved));
+	return rc != CLI_OK ? rc : CLI_FAIL;
+}
+
+static int dispatch(int argc, char **argv)
 {
 	if (argc < 2) {
 		usage(stderr);
@@ -64,4 +85,9 @@ int main(int argc, char **argv)
 	fprintf(stderr, "beamsim: unknown command '%s'\n\n", name);
 	usage(stderr);
 	return CLI_USAGE;
+}
+
+int main(int argc, char **argv)
+{
+	return close_stdout(dispatch(argc, argv));
 }
