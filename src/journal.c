@@ -120,17 +120,25 @@ int bsim_journal_create(bsim_journal **out, const char *path, const char *inputs
 	bsim_journal *j = journal_alloc(path, record_size);
 	size_t n = 0;
 	unsigned char *h = j ? header_encode(inputs, record_size, &n) : NULL;
-	if (!h) {
+	char tmp[1200];
+	if (!h || snprintf(tmp, sizeof tmp, "%s.new", path) >= (int)sizeof tmp) {
 		if (j)
 			journal_free(j);
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		free(h);
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory or path too long", path);
 	}
-	j->fd = open(path, O_RDWR | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0666);
+	/* The header is written under another name and renamed into place: a
+	 * journal that exists has its whole header, whenever the process is
+	 * killed. */
+	j->fd = open(tmp, O_RDWR | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0666);
 	int e = j->fd < 0 ? errno : write_all(j->fd, h, n);
 	if (!e && fsync(j->fd) != 0)
 		e = errno;
+	if (!e && rename(tmp, path) != 0)
+		e = errno;
 	free(h);
 	if (e) {
+		unlink(tmp);
 		journal_free(j);
 		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write the journal: %s", path,
 		                      strerror(e));
