@@ -63,7 +63,7 @@ static int fault_at(text_fault *f, int line, int col, const char *fmt, ...)
 int text_check(const char *buf, size_t len, text_fault *fault)
 {
 	const unsigned char *s = (const unsigned char *)buf;
-	int line = 1, col = 1;
+	int line = 1, col = 1, quotes = 0;
 	for (size_t i = 0; i < len;) {
 		uint32_t cp = 0;
 		int k = utf8_sequence(s + i, len - i, &cp);
@@ -82,6 +82,13 @@ int text_check(const char *buf, size_t len, text_fault *fault)
 			return fault_at(fault, line, col,
 			                "a YAML directive (%%...), which beamsim files do not "
 			                "take");
+		/* Two escaped quotes in a row inside a single-quoted string make
+		 * libfyaml 0.7.12 grow a buffer it never frees (fy_atom_iter). */
+		quotes = cp == '\'' ? quotes + 1 : 0;
+		if (quotes == 4)
+			return fault_at(fault, line, col - 3,
+			                "four apostrophes in a row (write the string in double "
+			                "quotes)");
 		int control = (cp < 0x20 && cp != '\n' && cp != '\r') || cp == 0x7F ||
 		              (cp >= 0x80 && cp <= 0x9F) || cp == 0x2028 || cp == 0x2029;
 		if (control)

@@ -1,10 +1,12 @@
 /* Internal: the bytes of a scene, experiment or --set value checked before
  * libfyaml sees them. libfyaml 0.7.12 (Debian bookworm) hangs on a
  * directive followed by bytes that are not UTF-8 ("%\xcb", two bytes) and
- * crashes on a tab after an explicit key ("? a:\t-", six bytes), and cuts a
- * document silently at a NUL byte. Scene files need none of these, so they
- * are refused with their position: only UTF-8 text, lines ending in LF or
- * CRLF, spaces rather than tabs, no control characters and no directives. */
+ * crashes on a tab after an explicit key ("? a:\t-", six bytes), leaks
+ * memory on escaped quotes in a row inside a single-quoted string, and cuts
+ * a document silently at a NUL byte. Scene files need none of these, so
+ * they are refused with their position: only UTF-8 text, lines ending in LF
+ * or CRLF, spaces rather than tabs, no control characters, no directives
+ * and no four apostrophes in a row. */
 #ifndef BSIM_TEXT_CHECK_H
 #define BSIM_TEXT_CHECK_H
 

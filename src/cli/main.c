@@ -40,7 +40,9 @@ static void usage(FILE *f)
 		fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
 	fputs("\n"
 	      "Exit status: 0 success, 1 a run failed, 2 bad usage or a bad scene or\n"
-	      "experiment file, 3 compare or regress found disagreement beyond tolerance.\n",
+	      "experiment file, 3 compare or regress found disagreement beyond tolerance,\n"
+	      "130 or 143 stopped by SIGINT or SIGTERM (sweep and compare keep their\n"
+	      "finished trials: rerun with --resume).\n",
 	      f);
 }
 
