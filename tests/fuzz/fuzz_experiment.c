@@ -27,8 +27,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 		rc = bsim_experiment_group_scene(&e, groups[i], NULL, 0, &s, &err);
 		if (rc != BSIM_OK) {
 			/* Every group was checked at load: it must build again. */
-			fprintf(stderr, "fuzz: group %d failed after a clean load: %s\n",
-			        groups[i], err.msg);
+			fprintf(stderr, "fuzz: group %d failed after a clean load: %s\n", groups[i],
+			        err.msg);
 			abort();
 		}
 		fuzz_run_scene(&s);

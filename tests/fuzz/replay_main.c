@@ -1,8 +1,8 @@
 /* The fuzz targets without libFuzzer: feeds every file named on the
  * command line (or found in a named directory) to LLVMFuzzerTestOneInput,
- * once each, in name order; -v prints each input's outcome. ctest runs this over tests/fuzz/corpus and
- * tests/fuzz/regressions in the plain and the ASan + UBSan builds, so every
- * input that once crashed stays a test. */
+ * once each, in name order; -v prints each input's outcome. ctest runs this over tests/fuzz/corpus
+ * and tests/fuzz/regressions in the plain and the ASan + UBSan builds, so every input that once
+ * crashed stays a test. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <dirent.h>
