@@ -326,10 +326,13 @@ int cli_session_close(cli_session *s, int rc, const char *command)
 	} else if (rc == BSIM_ESTOPPED) {
 		keep = 1;
 	}
+	/* A journal this session did not open (another run's, refused) is never
+	 * touched; this session's is kept only to be resumed. */
+	int ours = s->journal != NULL;
 	if (s->journal && bsim_journal_close(s->journal, &err) != BSIM_OK && rc == CLI_OK)
 		rc = cli_report(BSIM_EFAIL, &err);
 	s->journal = NULL;
-	if (s->journal_path[0] && !keep && (rc == CLI_OK || rc == CLI_FAIL))
+	if (ours && !keep)
 		unlink(s->journal_path);
 	if (rc == BSIM_ESTOPPED) {
 		int sig = cli_stop ? (int)cli_stop : SIGINT;

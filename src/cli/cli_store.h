@@ -55,10 +55,12 @@ int cli_session_open(cli_session *s, const char *dir, int resume, const char *in
                      size_t record_size, int argc, char **argv);
 
 /* Ends the session with the run's status rc: if 0, commits the files (and
- * removes the journal once they are in place); if the run was stopped,
- * keeps the journal and prints the line that resumes it, returning 128 +
- * the signal's number; after a failed trial the journal is removed. Prints
- * any error; returns the exit status. */
+ * removes the journal once they are in place; a failed commit keeps it, so
+ * --resume writes the files again); if the run was stopped, keeps the
+ * journal and prints the line that resumes it, returning 128 + the
+ * signal's number; after any other failure (a trial that failed is failed
+ * again by a resume) the journal is removed. Prints any error; returns the
+ * exit status. */
 int cli_session_close(cli_session *s, int rc, const char *command);
 
 /* The run record of a sweep (one backend) or comparison (two). */
