@@ -6,7 +6,7 @@ set -euo pipefail
 # libclang-rt-14-dev (libFuzzer, only recommended by clang) and libomp-dev
 # (clang's OpenMP): the fuzzing run of scripts/test.sh.
 pkgs=(build-essential cmake pkg-config libgsl-dev libcmocka-dev libfyaml-dev libbox2d-dev
-      libmatio-dev gnuplot-nox fonts-dejavu-core zlib1g-dev
+      libmatio-dev gnuplot-nox fonts-dejavu-core libcairo2-dev ffmpeg zlib1g-dev
       clang libclang-rt-14-dev libomp-dev)
 missing=()
 for p in "${pkgs[@]}"; do

@@ -223,6 +223,18 @@ int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int sh
 	return cli_report(rc, &err);
 }
 
+char *cli_text_append(char *text, const char *more)
+{
+	size_t n = strlen(text), m = strlen(more);
+	char *t = realloc(text, n + m + 1);
+	if (!t) {
+		free(text);
+		return NULL;
+	}
+	memcpy(t + n, more, m + 1);
+	return t;
+}
+
 double cli_per_second(double count, double wall)
 {
 	return count / (wall > 0 ? wall : 1e-9);

@@ -26,6 +26,7 @@ int cmd_bench(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_regress(int argc, char **argv);
 int cmd_accuracy(int argc, char **argv);
+int cmd_video(int argc, char **argv);
 
 /* "beamsim: MSG" on stderr, one line of printable text, naming files in
  * the output directory of cli_error_paths by their place in it. */
@@ -91,6 +92,10 @@ int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsi
  * status. */
 int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int show_progress,
                   bsim_sweep_result *r);
+
+/* text (malloc'd) with more appended, reallocated; NULL (text freed) if
+ * out of memory. */
+char *cli_text_append(char *text, const char *more);
 
 /* count per second of wall time. A run too short for the clock (wall 0)
  * counts as 1 ns, so a rate is always finite. */

@@ -21,8 +21,11 @@ static const char run_help[] =
         "Usage: beamsim run SCENE [OPTIONS]\n"
         "\n"
         "Runs one trial of the scene file SCENE and prints its outcome, end state,\n"
-        "peak beam angles and energy ledger. The random-force schedule is that of\n"
-        "trial I of group G of a sweep with seed N, so a sweep's trial can be replayed.\n"
+        "peak beam angles, the deepest overlap of body and beams, and the energy\n"
+        "ledger. The random-force schedule is that of trial I of group G of a sweep\n"
+        "with seed N, so a sweep's trial can be replayed. A trial whose state stops\n"
+        "being finite, or whose ledger shows energy created beyond the bound, is\n"
+        "unstable: the reason is printed and the exit status is 1.\n"
         "\n"
         "Options:\n"
         "  --backend B            physics backend (default thesis; see beamsim backends)\n"
@@ -157,6 +160,7 @@ static void print_ledger_json(FILE *out, const bsim_ledger *l)
 	        {"residual", l->residual},
 	        {"residual_max", l->residual_max},
 	        {"residual_abs", l->residual_abs},
+	        {"inflow", l->inflow},
 	};
 	fputc('{', out);
 	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
@@ -198,8 +202,18 @@ static void print_json(FILE *out, const run_args *a, const bsim_backend *b, cons
 	bsim_json_number(out, r->max_theta[0]);
 	fputs(", ", out);
 	bsim_json_number(out, r->max_theta[1]);
-	fputs("], \"ledger\": ", out);
+	fputs("], \"overlap_max\": ", out);
+	bsim_json_number(out, r->overlap_max);
+	fputs(", \"ledger\": ", out);
 	print_ledger_json(out, &r->ledger);
+	fputs(", \"instability\": ", out);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, s->dt, why, sizeof why);
+		bsim_json_string(out, why);
+	} else {
+		fputs("null", out);
+	}
 	fputs("}\n", out);
 }
 
@@ -226,13 +240,20 @@ static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64
 	        r->vx_end);
 	fprintf(out, "peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0],
 	        r->max_theta[1]);
+	fprintf(out, "overlap     deepest %.3g m of body and beams\n", r->overlap_max);
 	fprintf(out, "energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
 	fprintf(out, "  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
 	fprintf(out,
 	        "  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
 	        l->damper, l->impact, l->contact, l->correction);
-	fprintf(out, "  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step)\n", l->residual,
-	        l->residual_abs, l->residual_max);
+	fprintf(out,
+	        "  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step; %.4g J flowed in)\n",
+	        l->residual, l->residual_abs, l->residual_max, l->inflow);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, s->dt, why, sizeof why);
+		fprintf(out, "unstable    %s\n", why);
+	}
 }
 
 /* Runs the trial, recording into the trajectory file if one was asked
@@ -241,7 +262,7 @@ static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_back
                      uint64_t mixed, bsim_trial_result *res)
 {
 	bsim_atomic_file traj = {0};
-	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride};
+	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride, .overlap = 1};
 	bsim_error err;
 	if (a->trajectory) {
 		if (bsim_atomic_file_open(&traj, a->trajectory, &err) != BSIM_OK)
@@ -256,8 +277,7 @@ static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_back
 		return CLI_FAIL;
 	}
 	bsim_error_clear(&err);
-	int rc = bsim_trial_run(runner, scene, backend, &a->opts, mixed,
-	                        a->trajectory ? &rec : NULL, res, &err);
+	int rc = bsim_trial_run(runner, scene, backend, &a->opts, mixed, &rec, res, &err);
 	bsim_runner_free(runner);
 	if (rc != BSIM_OK) {
 		bsim_atomic_file_abort(&traj);
@@ -297,6 +317,12 @@ int cmd_run(int argc, char **argv)
 			print_json(out, &a, backend, &scene, mixed, &res);
 		else if (rc == CLI_OK)
 			print_text(out, &a, &scene, mixed, &res);
+		if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {
+			char why[256];
+			bsim_trial_instability_text(&res, scene.dt, why, sizeof why);
+			cli_error("%s backend: unstable trial: %s", backend->name, why);
+			rc = CLI_FAIL;
+		}
 		bsim_scene_free(&scene);
 	}
 	cli_sets_free(&a.sets);
