@@ -411,7 +411,7 @@ static int commit_fail(bsim_error *err, const char *dir, const char *rel, int e)
 	return bsim_error_set(err, BSIM_EFAIL, "%s/%s: write failed: %s", dir, rel, strerror(e));
 }
 
-int bsim_outdir_commit(bsim_outdir *od, const char *command, bsim_error *err)
+static int commit_set(bsim_outdir *od, const char *command, int add, bsim_error *err)
 {
 	olist now = {0}, before = {0};
 	char bad[PATH_MAX_OUT] = "";
@@ -450,7 +450,14 @@ int bsim_outdir_commit(bsim_outdir *od, const char *command, bsim_error *err)
 			fsync_dir(path);
 		}
 	}
-	for (size_t i = 0; !rc && i < before.n; i++) {
+	/* Added files join the set: the previous ones stay, and stay listed. */
+	for (size_t i = 0; add && !rc && i < before.n; i++)
+		if (!olist_has(&now, before.v[i].rel) &&
+		    olist_add(&now, before.v[i].rel, before.v[i].bytes, before.v[i].crc) != 0)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	if (add)
+		qsort(now.v, now.n, sizeof *now.v, by_rel);
+	for (size_t i = 0; !add && !rc && i < before.n; i++) {
 		struct stat st;
 		if (!olist_has(&now, before.v[i].rel) &&
 		    !join(path, sizeof path, od->dir, before.v[i].rel) && lstat(path, &st) == 0 &&
@@ -468,6 +475,16 @@ int bsim_outdir_commit(bsim_outdir *od, const char *command, bsim_error *err)
 	olist_free(&now);
 	olist_free(&before);
 	return rc;
+}
+
+int bsim_outdir_commit(bsim_outdir *od, const char *command, bsim_error *err)
+{
+	return commit_set(od, command, 0, err);
+}
+
+int bsim_outdir_add(bsim_outdir *od, const char *command, bsim_error *err)
+{
+	return commit_set(od, command, 1, err);
 }
 
 void bsim_outdir_close(bsim_outdir *od)

@@ -310,6 +310,41 @@ static void test_manifest_check(void **state)
 	free(json);
 }
 
+/* plot adds its figures to a sweep's set (the manifest lists them), a
+ * rerun of the sweep removes them with the rest of the old set, and run
+ * --out writes its directory as a set too. */
+static void test_figures_join_the_set(void **state)
+{
+	(void)state;
+	char dir[1400];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("plotted"));
+	const char *sweep[] = {"sweep", h1,        "--trials", "2", "--trajectories",
+	                       "1",     "--quiet", "--out",    dir, NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	const char *plot[] = {"plot", dir, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(plot, NULL, NULL), 0);
+	char *manifest = bsim_test_read(join(dir, "manifest.json"));
+	assert_non_null(strstr(manifest, "\"command\": \"plot\""));
+	assert_non_null(strstr(manifest, "\"path\": \"p_traverse.gp\""));
+	assert_non_null(strstr(manifest, "\"path\": \"trials.csv\""));
+	int has = 0;
+	bsim_error e;
+	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_OK);
+	assert_int_equal(has, 1);
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	assert_int_equal(access(join(dir, "p_traverse.gp"), F_OK), -1);
+	free(manifest);
+
+	char run_dir[1400];
+	snprintf(run_dir, sizeof run_dir, "%s", bsim_test_dir("run_out"));
+	const char *run[] = {"run", gate, "--out", run_dir, NULL};
+	assert_int_equal(bsim_test_cli(run, NULL, NULL), 0);
+	manifest = bsim_test_read(join(run_dir, "manifest.json"));
+	assert_non_null(strstr(manifest, "\"path\": \"trajectory.csv\""));
+	assert_int_equal(bsim_outdir_verify(run_dir, &has, &e), BSIM_OK);
+	free(manifest);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -322,6 +357,7 @@ int main(void)
 	        cmocka_unit_test(test_failed_rerun_keeps_previous_set),
 	        cmocka_unit_test(test_replacing_a_set),
 	        cmocka_unit_test(test_manifest_check),
+	        cmocka_unit_test(test_figures_join_the_set),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

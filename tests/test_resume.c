@@ -83,7 +83,8 @@ static int exists(const char *path)
 }
 
 /* The command line of a run of cmd ("sweep" or "compare") into dir. A
- * comparison runs 8 of the 24 trials per group: Box2D is the slow side. */
+ * comparison runs 8 of the 24 trials per group: Box2D is the slow side; a
+ * sweep keeps the trajectories of two trials per group. */
 static void command(const char **argv, const char *cmd, const char *dir, int resume)
 {
 	int n = 0;
@@ -92,6 +93,10 @@ static void command(const char **argv, const char *cmd, const char *dir, int res
 	if (strcmp(cmd, "compare") == 0) {
 		argv[n++] = "--trials";
 		argv[n++] = "8";
+	} else {
+		/* kept trajectories are not journaled: their trials run again */
+		argv[n++] = "--trajectories";
+		argv[n++] = "2";
 	}
 	argv[n++] = "--quiet";
 	argv[n++] = "--threads";
@@ -104,7 +109,7 @@ static void command(const char **argv, const char *cmd, const char *dir, int res
 }
 
 /* What must be identical: the files holding trials. */
-static const char *const sweep_files[] = {"trials.csv", NULL};
+static const char *const sweep_files[] = {"trials.csv", "trajectories.csv", NULL};
 static const char *const compare_files[] = {"thesis/trials.csv", "box2d/trials.csv", "pairs.csv",
                                             NULL};
 
@@ -141,7 +146,7 @@ static int done_status(int rc)
 static void kill_and_resume(const char *cmd, const char *const *files)
 {
 	char ref[1200], dir[1200];
-	const char *argv[14];
+	const char *argv[16];
 	snprintf(ref, sizeof ref, "%s", bsim_test_dir(cmd));
 	command(argv, cmd, ref, 0);
 	double t0 = now();
@@ -212,7 +217,7 @@ static void test_signals(void **state)
 	(void)state;
 	static const int sigs[] = {SIGINT, SIGTERM};
 	char ref[1200], dir[1200], errfile[1400];
-	const char *argv[14];
+	const char *argv[16];
 	snprintf(ref, sizeof ref, "%s", bsim_test_dir("signal_ref"));
 	command(argv, "sweep", ref, 0);
 	double t0 = now();
@@ -229,7 +234,7 @@ static void test_signals(void **state)
 		if (pid == 0) {
 			int fd = open(errfile, O_WRONLY | O_CREAT | O_TRUNC, 0600);
 			dup2(fd, 2);
-			char *args[16] = {(char *)BSIM_EXE};
+			char *args[18] = {(char *)BSIM_EXE};
 			for (int k = 0; argv[k]; k++)
 				args[k + 1] = (char *)argv[k];
 			execv(BSIM_EXE, args);
@@ -262,7 +267,7 @@ static void test_refusals(void **state)
 {
 	(void)state;
 	char dir[1200];
-	const char *argv[14];
+	const char *argv[16];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("refusals"));
 	command(argv, "sweep", dir, 1);
 	char *err = NULL;

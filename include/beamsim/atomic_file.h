@@ -61,6 +61,10 @@ void bsim_atomic_file_abort(bsim_atomic_file *o);
  * bsim_atomic_file writes through rather than replaces. */
 int bsim_atomic_file_is_through(const char *path);
 
+/* Copies the file from to the path to, atomically as above. BSIM_EFAIL
+ * naming the file that cannot be read or written. */
+int bsim_atomic_file_copy(const char *from, const char *to, bsim_error *err);
+
 #ifdef __cplusplus
 }
 #endif

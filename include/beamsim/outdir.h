@@ -57,6 +57,12 @@ const char *bsim_outdir_work(const bsim_outdir *od);
  * manifest until a later commit succeeds. */
 int bsim_outdir_commit(bsim_outdir *od, const char *command, bsim_error *err);
 
+/* Commits the staged files as additions to the set already in DIR (beamsim
+ * plot's figures beside a sweep's files): the files the previous manifest
+ * lists stay, and stay listed; staged files of the same names replace
+ * them. The new manifest lists both. */
+int bsim_outdir_add(bsim_outdir *od, const char *command, bsim_error *err);
+
 /* Rewrites text (of capacity size) so that it names the files by their
  * place in DIR, not in the staging area: for messages of writers that were
  * given staged paths. */

@@ -27,6 +27,7 @@ typedef struct cli_compare_job {
 	int examples;
 	int progress; /* a progress line on a terminal */
 	const char *out;
+	int keep, keep_stride;             /* trajectories kept per group, see bsim_sweep_config */
 	bsim_journal *journal;             /* NULL: none (bsim_sweep_config) */
 	const volatile sig_atomic_t *stop; /* NULL: none */
 } cli_compare_job;
@@ -42,6 +43,7 @@ typedef struct cli_session {
 	char journal_path[1100];
 	int argc; /* the command line, for the line that resumes it */
 	char **argv;
+	int add; /* set before closing: the files join DIR's set (bsim_outdir_add) */
 } cli_session;
 
 /* Set to the signal's number by SIGINT or SIGTERM during a session: the
