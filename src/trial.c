@@ -150,6 +150,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
                    bsim_trial_result *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
+	out->landscape_beam = -1;
 	if (runner_reserve(r, scene->n_beams))
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	bsim_world *w = NULL;
@@ -178,6 +179,10 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		trace(rec->trace_user, 0, s0);
 
 	int done = 0; /* the outcome is known; running on to classify_y */
+	/* The last position within the beams' reach before success_y: where
+	 * the body left the last barrier it crossed (the landscape label). */
+	int in_reach = 0;
+	double last_reach[2] = {0.0, 0.0};
 	long recorded = -1;
 	long n = 0, run_on = 0;
 	out->outcome = BSIM_STUCK;
@@ -212,6 +217,11 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 			continue;
 		for (int i = 0; i < 2 && i < scene->n_beams; i++)
 			out->max_theta[i] = fmax(out->max_theta[i], s0->theta[i]);
+		if (bsim_landscape_in_reach(scene, s0->x)) {
+			in_reach = 1;
+			last_reach[0] = s0->x[0];
+			last_reach[1] = s0->x[1];
+		}
 		if (fabs(s0->x[0]) >= scene->side_x) {
 			out->outcome = BSIM_SIDE_EXIT;
 			break;
@@ -235,7 +245,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		out->type = s0->v[0] > 0.0   ? BSIM_TYPE_LEFT
 		            : s0->v[0] < 0.0 ? BSIM_TYPE_RIGHT
 		                             : BSIM_TYPE_NONE;
-		out->landscape_left = out->max_theta[0] > out->max_theta[1];
+		out->landscape_beam = in_reach ? bsim_landscape_label(scene, last_reach) : -1;
 	}
 	out->x_end = s0->x[0];
 	out->y_end = s0->x[1];

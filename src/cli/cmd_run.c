@@ -177,8 +177,12 @@ static void print_json(const run_args *a, const bsim_backend *b, const bsim_scen
 	bsim_json_string(stdout, bsim_outcome_name(r->outcome));
 	fputs(", \"type\": ", stdout);
 	bsim_json_string(stdout, bsim_type_name(r->type));
-	printf(", \"landscape_left\": %d, \"in_contact_end\": %d", r->landscape_left,
-	       r->in_contact_end);
+	printf(", \"landscape_left\": %d, \"landscape_beam\": ", r->landscape_beam == 0);
+	if (r->landscape_beam >= 0)
+		printf("%d", r->landscape_beam + 1);
+	else
+		fputs("null", stdout);
+	printf(", \"in_contact_end\": %d", r->in_contact_end);
 	printf(", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
 	       r->draws);
 	const char *names[] = {"t_end", "x_end", "y_end", "vx_end"};
@@ -205,13 +209,18 @@ static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
 	       ", %lu draws)\n",
 	       a->seed, a->group, a->trial, mixed, r->draws);
 	printf("outcome     %s", bsim_outcome_name(r->outcome));
-	if (r->outcome == BSIM_TRAVERSED)
-		printf(", type %s, landscape %s", bsim_type_name(r->type),
-		       r->landscape_left                   ? "left"
-		       : r->max_theta[1] > r->max_theta[0] ? "right"
-		                                           : "none");
-	else if (r->outcome == BSIM_STUCK)
+	if (r->outcome == BSIM_TRAVERSED) {
+		printf(", type %s, landscape ", bsim_type_name(r->type));
+		if (r->landscape_beam < 0)
+			printf("none");
+		else if (r->landscape_beam < 2 && s->n_beams == 2)
+			printf("%s (beam %d)", r->landscape_beam == 0 ? "left" : "right",
+			       r->landscape_beam + 1);
+		else
+			printf("beam %d", r->landscape_beam + 1);
+	} else if (r->outcome == BSIM_STUCK) {
 		printf(", %s", r->in_contact_end ? "in contact" : "not in contact");
+	}
 	printf("\nsteps       %d to the outcome at t = %.6g s, %d run\n", r->steps, r->t_end,
 	       r->steps_run);
 	printf("end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,

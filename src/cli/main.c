@@ -21,6 +21,8 @@ static const cli_command commands[] = {
         {"bench", cmd_bench, "measure the speed of a backend on the essay's experiments"},
         {"accuracy", cmd_accuracy,
          "what accuracy costs in time: error against speed per backend and step"},
+        {"landscape", cmd_landscape,
+         "the potential energy landscape of a scene, its barriers and figures"},
 };
 
 #define N_COMMANDS ((int)(sizeof commands / sizeof commands[0]))
