@@ -71,12 +71,13 @@ int bsim_landscape_in_reach(const bsim_scene *s, const double c[2])
 	return 0;
 }
 
-int bsim_landscape_label(const bsim_scene *s, const double c[2])
+int bsim_landscape_label(const bsim_scene *s, const double c[2], const int *touching)
 {
 	int best = -1;
 	double e_best = 0.0;
 	for (int i = 0; i < s->n_beams; i++) {
-		if (!bsim_landscape_beam_reach(&s->beams[i], s->body.radius, c))
+		if ((touching && !touching[i]) ||
+		    !bsim_landscape_beam_reach(&s->beams[i], s->body.radius, c))
 			continue;
 		const double th = bsim_landscape_theta(&s->beams[i], s->body.radius, c);
 		const double e = 0.5 * s->beams[i].stiffness * th * th;

@@ -10,9 +10,9 @@
  * (y >= far_y = min(success_y, top of the grid)) without entering the
  * reach; for the gate that is the region beyond the pivot row + L + R. A
  * path that enters F stays in it, and the step that enters F leaves the
- * reach at a point c: the path "leaves over beam b" if b = label(c), the
- * beam holding the most spring energy at c (bsim_landscape_label, the
- * label of a trial). For a set A of allowed labels (every label for the
+ * reach at a point c: the path "leaves over beam b" if b holds the most
+ * spring energy at c (bsim_landscape_label with every beam attached, as
+ * the landscape assumes). For a set A of allowed labels (every label for the
  * lowest pass, {b} for beam b's pass):
  *
  *   m      the end of steepest descent from the start s (8 neighbours,

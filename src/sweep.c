@@ -31,9 +31,9 @@ void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_res
 			out->traversed++;
 			out->left += t->type == BSIM_TYPE_LEFT;
 			out->right += t->type == BSIM_TYPE_RIGHT;
-			/* The barrier crossed (bsim_landscape_label); a trial that
-			 * left the reach where no beam, or two equally, held the
-			 * most spring energy counts as neither. */
+			/* The barrier crossed (bsim_landscape_label); a trial whose
+			 * last touch was of no deflected beam, or of two holding
+			 * equal energy, counts as neither. */
 			out->landscape_left += t->landscape_beam == 0;
 			out->landscape_right += t->landscape_beam == 1;
 			break;

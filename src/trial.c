@@ -13,6 +13,7 @@
 
 struct bsim_runner {
 	bsim_state s0, s1; /* before and after a step */
+	int *touching;     /* contacts at the last touching step before success_y */
 	int cap;           /* beams the states hold */
 };
 
@@ -27,6 +28,7 @@ void bsim_runner_free(bsim_runner *r)
 		return;
 	bsim_state_free(&r->s0);
 	bsim_state_free(&r->s1);
+	free(r->touching);
 	free(r);
 }
 
@@ -36,8 +38,10 @@ static int runner_reserve(bsim_runner *r, int n_beams)
 		return BSIM_OK;
 	bsim_state_free(&r->s0);
 	bsim_state_free(&r->s1);
+	free(r->touching);
 	r->cap = 0;
-	if (bsim_state_alloc(&r->s0, n_beams) || bsim_state_alloc(&r->s1, n_beams))
+	r->touching = malloc((n_beams > 0 ? (size_t)n_beams : 1) * sizeof *r->touching);
+	if (!r->touching || bsim_state_alloc(&r->s0, n_beams) || bsim_state_alloc(&r->s1, n_beams))
 		return BSIM_EFAIL;
 	r->cap = n_beams;
 	return BSIM_OK;
@@ -179,10 +183,10 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		trace(rec->trace_user, 0, s0);
 
 	int done = 0; /* the outcome is known; running on to classify_y */
-	/* The last position within the beams' reach before success_y: where
-	 * the body left the last barrier it crossed (the landscape label). */
-	int in_reach = 0;
-	double last_reach[2] = {0.0, 0.0};
+	/* The last step before success_y at which the body touched a beam:
+	 * where and which beams (for the landscape label). */
+	int touched = 0;
+	double last_touch[2] = {0.0, 0.0};
 	long recorded = -1;
 	long n = 0, run_on = 0;
 	out->outcome = BSIM_STUCK;
@@ -217,10 +221,11 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 			continue;
 		for (int i = 0; i < 2 && i < scene->n_beams; i++)
 			out->max_theta[i] = fmax(out->max_theta[i], s0->theta[i]);
-		if (bsim_landscape_in_reach(scene, s0->x)) {
-			in_reach = 1;
-			last_reach[0] = s0->x[0];
-			last_reach[1] = s0->x[1];
+		if (any_contact(s0)) {
+			touched = 1;
+			last_touch[0] = s0->x[0];
+			last_touch[1] = s0->x[1];
+			memcpy(r->touching, s0->contact, (size_t)s0->n_beams * sizeof *r->touching);
 		}
 		if (fabs(s0->x[0]) >= scene->side_x) {
 			out->outcome = BSIM_SIDE_EXIT;
@@ -245,7 +250,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		out->type = s0->v[0] > 0.0   ? BSIM_TYPE_LEFT
 		            : s0->v[0] < 0.0 ? BSIM_TYPE_RIGHT
 		                             : BSIM_TYPE_NONE;
-		out->landscape_beam = in_reach ? bsim_landscape_label(scene, last_reach) : -1;
+		out->landscape_beam =
+		        touched ? bsim_landscape_label(scene, last_touch, r->touching) : -1;
 	}
 	out->x_end = s0->x[0];
 	out->y_end = s0->x[1];

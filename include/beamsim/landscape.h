@@ -48,13 +48,21 @@ int bsim_landscape_beam_reach(const bsim_beam_def *b, double radius, const doubl
 /* 1 if the body centred at c lies within any beam's reach. */
 int bsim_landscape_in_reach(const bsim_scene *s, const double c[2]);
 
-/* The beam whose barrier a path crosses when it leaves the beams' reach at
- * c: the beam holding the most spring energy 1/2 k th^2 there (0-based),
- * -1 if no beam is deflected at c or two hold the same largest energy (the
- * exact midline of a symmetric gate). A traversing trial is labelled with
- * this beam at its last position within the beams' reach before it
- * reaches success_y; the barrier search labels paths the same way. */
-int bsim_landscape_label(const bsim_scene *s, const double c[2]);
+/* The beam whose barrier a body centred at c is on: among the beams with
+ * touching[i] != 0 (all beams if touching is NULL), the one holding the
+ * most spring energy 1/2 k th(c)^2 (0-based); -1 if none of them is
+ * deflected or two hold the same largest energy (the exact midline of a
+ * symmetric gate).
+ *
+ * The landscape label of a traversing trial is this beam at the last step
+ * before success_y at which the body touched any beam, counting only the
+ * beams it touched then: the barrier it came off last. Beams not touching
+ * the body are left out because the landscape assumes every beam within
+ * reach is pushed, and a body that has crossed one beam often runs on
+ * through the reach of the other, still at rest (the essay's trajectory
+ * "below the surface", Fig. 2.7). The barrier search labels exits with
+ * touching NULL: on the landscape every beam within reach is attached. */
+int bsim_landscape_label(const bsim_scene *s, const double c[2], const int *touching);
 
 /* ---- The landscape on a grid ------------------------------------------ */
 

@@ -14,7 +14,7 @@ extern "C" {
 typedef struct bsim_group_result {
 	int trials, traversed, side_exit, stuck, left, right;
 	int stuck_in_contact;
-	int landscape_left, landscape_right; /* traversed over beam 0's / 1's barrier (label) */
+	int landscape_left, landscape_right; /* traversed over beam 0's / 1's barrier */
 	double p_traverse, ci95[2];          /* Wilson 95% */
 	long steps;                          /* steps integrated in the group */
 } bsim_group_result;
