@@ -12,4 +12,5 @@ build/beamsim compare configs/thesis/h1_symmetric.yaml --out out/h1-compare || s
 if [ "$status" -ne 0 ] && [ "$status" -ne 3 ]; then
   exit "$status"
 fi
+build/beamsim landscape configs/thesis/gate.yaml --out out/landscape  # the essay gate's landscape
 echo "report: out/h1-compare/report.md"

@@ -376,12 +376,13 @@ static void gp_text(char *out, size_t size, const char *s)
 static const char PALETTE[] = "set palette defined (0 '#440154', 1 '#3b528b', 2 '#21918c', "
                               "3 '#5ec962', 4 '#fde725')\n";
 
-/* The clip level: a little above the highest pass, never above the
- * landscape's maximum. */
+/* The clip level: a quarter of the way above the highest pass or the
+ * start, whichever is higher, over the landscape's lowest point; never
+ * above its maximum. */
 static double clip_level(const bsim_landscape_grid *g, const bsim_landscape_barriers *br,
                          const double *v, double e_min, int beam_only)
 {
-	double top = -INFINITY, e_max = -INFINITY;
+	double top = beam_only ? -INFINITY : br->start_e, e_max = -INFINITY;
 	for (int r = 0; r <= br->n_beams; r++) {
 		const bsim_landscape_pass *p = table_row(br, r);
 		if (p->kind != BSIM_PASS_NONE)
@@ -391,7 +392,7 @@ static double clip_level(const bsim_landscape_grid *g, const bsim_landscape_barr
 		e_max = fmax(e_max, v[k]);
 	if (!isfinite(top))
 		return e_max;
-	const double c = top + 0.6 * (top - e_min);
+	const double c = top + 0.25 * (top - e_min);
 	return c > e_min && c < e_max ? c : e_max;
 }
 
@@ -479,7 +480,9 @@ static void draw_beams(FILE *f, const bsim_scene *s, const bsim_landscape_barrie
 	}
 }
 
-/* Labels of the passes: "lowest pass 251 J" and one per beam. */
+/* Labels of the passes: the lowest pass to the left of its mark, each
+ * beam's own to the right ("beam 2: 222 J"), so that two at one point
+ * stay legible. */
 static void label_passes(FILE *f, const bsim_landscape_barriers *br, int three_d, int beam_only)
 {
 	for (int r = 0; r <= br->n_beams; r++) {
@@ -487,28 +490,32 @@ static void label_passes(FILE *f, const bsim_landscape_barriers *br, int three_d
 		if (p->kind == BSIM_PASS_NONE)
 			continue;
 		/* A beam's pass that is the lowest pass is labelled once. */
-		if (r > 0 && br->lowest.kind == p->kind && fabs(br->lowest.x - p->x) < 1e-9 &&
-		    fabs(br->lowest.y - p->y) < 1e-9)
+		if (r > 0 && br->lowest.kind == p->kind && br->lowest.x == p->x &&
+		    br->lowest.y == p->y)
 			continue;
 		char text[96];
-		if (p->kind == BSIM_PASS_OPEN)
-			snprintf(text, sizeof text, "%s open", r == 0 ? "lowest:" : "");
+		const double e = beam_only ? p->e_beam : p->e_total;
+		if (r == 0 && p->kind == BSIM_PASS_OPEN)
+			snprintf(text, sizeof text, "open");
+		else if (r == 0)
+			snprintf(text, sizeof text, "lowest pass %.0f J", e);
+		else if (p->kind == BSIM_PASS_OPEN)
+			snprintf(text, sizeof text, "beam %d: open", r);
 		else
-			snprintf(text, sizeof text, "%s %.0f J", r == 0 ? "lowest pass" : "pass",
-			         beam_only ? p->e_beam : p->e_total);
-		if (r > 0 && text[0] == ' ')
-			memmove(text, text + 1, strlen(text));
+			snprintf(text, sizeof text, "beam %d: %.0f J", r, e);
+		const char *where = r == 0 ? "right offset -1,-1" : "left offset 1,1";
 		if (three_d)
 			fprintf(f,
-			        "set label \"%s\" at %.6g,%.6g,%.6g front point pt 7 ps 1.2 lc rgb "
-			        "'red' offset 1,1 tc rgb 'black'\n",
-			        text, p->x, p->y, beam_only ? p->e_beam : p->e_total);
+			        "set label \"%s\" at %.6g,%.6g,%.6g %s front point pt 7 ps 1.2 lc "
+			        "rgb "
+			        "'red' tc rgb 'black'\n",
+			        text, p->x, p->y, e, where);
 		else
 			fprintf(f,
-			        "set label \"%s\" at %.6g,%.6g front point pt 7 ps 1.2 lc rgb "
+			        "set label \"%s\" at %.6g,%.6g %s front point pt 7 ps 1.2 lc rgb "
 			        "'red' "
-			        "offset 1,-1 tc rgb 'white'\n",
-			        text, p->x, p->y);
+			        "tc rgb 'white'\n",
+			        text, p->x, p->y, where);
 	}
 }
 
@@ -615,7 +622,9 @@ static int figure_surface(const char *dir, const char *name, const bsim_scene *s
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	fputs(PALETTE, f);
 	fprintf(f, "set title \"%s: %s (heights clipped at %.0f J)\" noenhanced\n", what,
-	        beam_only ? "E_beam, the springs alone" : "E_total = E_prop + E_beam", clip);
+	        beam_only ? "E_beam, the springs alone; the passes of E_total at their E_beam"
+	                  : "E_total = E_prop + E_beam",
+	        clip);
 	fprintf(f,
 	        "set xlabel 'x (m)'\nset ylabel 'y (m)'\nset zlabel '%s (J)' rotate parallel\n"
 	        "set cbrange [%.6g:%.6g]\nset zrange [%.6g:%.6g]\nunset colorbox\n"
