@@ -3,7 +3,7 @@
 # Run as root on Debian bookworm (or with sudo available).
 set -euo pipefail
 pkgs=(build-essential cmake pkg-config libgsl-dev libcmocka-dev libfyaml-dev libbox2d-dev
-      libmatio-dev gnuplot-nox fonts-dejavu-core)
+      libmatio-dev gnuplot-nox fonts-dejavu-core libcairo2-dev ffmpeg)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -87,6 +87,12 @@ int bsim_accuracy_reference_run(bsim_accuracy_reference *ref, const bsim_scene *
 	bsim_runner_free(r);
 	if (rc == BSIM_OK && t.failed)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory storing the reference");
+	if (rc == BSIM_OK && res.outcome == BSIM_UNSTABLE) {
+		char why[256];
+		bsim_trial_instability_text(&res, scene->dt, why, sizeof why);
+		rc = bsim_error_set(err, BSIM_EFAIL, "%s: the reference run is unstable: %s",
+		                    b->name, why);
+	}
 	if (rc)
 		bsim_accuracy_reference_free(ref);
 	return rc;
@@ -250,13 +256,13 @@ static int row_batch(bsim_accuracy_row *row, bsim_runner *runner, const bsim_sce
 		bsim_error e;
 		int rc = bsim_trial_run(runner, scene, b, &row->opts,
 		                        bsim_seed_mix(cfg->seed, 0, t), NULL, &res, &e);
-		if (rc == BSIM_EFAIL) { /* non-finite: counted, as not traversed */
-			row->failed++;
-			continue;
-		}
 		if (rc) {
 			*err = e;
 			return rc;
+		}
+		if (res.outcome == BSIM_UNSTABLE) { /* counted, as not traversed */
+			row->failed++;
+			continue;
 		}
 		traversed += res.outcome == BSIM_TRAVERSED;
 		sim += res.steps_run * scene->dt;

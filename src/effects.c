@@ -35,6 +35,11 @@ static bsim_effect *effects_add(bsim_effects *fx, const char *name,
 	return e;
 }
 
+int bsim_effects_random(const bsim_scene *scene)
+{
+	return scene->effects.has_random_force;
+}
+
 int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 {
 	memset(fx, 0, sizeof *fx);

@@ -273,6 +273,45 @@ int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_over
 	return rc;
 }
 
+/* 1 if key names the field axis or a field inside it ("beams.0.stiffness"
+ * inside "beams.0"): the grid's value, applied later, replaces all of it. */
+static int key_within(const char *key, const char *axis)
+{
+	size_t n = strlen(axis);
+	return strncmp(key, axis, n) == 0 && (key[n] == '\0' || key[n] == '.');
+}
+
+/* A fixed override (set: or --set) of a field the grid varies would be
+ * overwritten in every group without a word: refused. One of a block that
+ * holds the axis (set body.start, grid body.start.1) keeps its other
+ * fields, so it stands, and the grid's value acts inside it. */
+static int check_conflicts(const bsim_experiment *e, const bsim_override *extra, int n_extra,
+                           bsim_error *err)
+{
+	for (int a = 0; a < e->n_axes; a++) {
+		const bsim_grid_axis *ax = &e->axes[a];
+		for (int i = 0; i < e->n_set; i++)
+			if (key_within(e->set[i].key, ax->key))
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s: set.%s: the grid varies %s (%s), which would "
+				        "overwrite it in every group; expected a key the "
+				        "grid does not vary",
+				        e->set[i].origin, e->set[i].key, ax->key, ax->origins[0]);
+		for (int i = 0; i < n_extra; i++)
+			if (key_within(extra[i].key, ax->key))
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s: the experiment's grid varies %s (%s), which "
+				        "would overwrite it in every group; expected a key "
+				        "the grid does not vary (to run one value, edit "
+				        "the grid)",
+				        extra[i].origin ? extra[i].origin : extra[i].key, ax->key,
+				        ax->origins[0]);
+	}
+	return BSIM_OK;
+}
+
 /* Reads the scene file once and builds every group's scene from it. */
 static int check_groups(const bsim_experiment *e, const bsim_override *extra, int n_extra,
                         bsim_error *err)
@@ -304,6 +343,8 @@ int bsim_experiment_load(const char *path, const bsim_override *extra, int n_ext
 		return rc;
 	rc = walk_experiment(&d, out, err);
 	ydoc_free(&d);
+	if (!rc)
+		rc = check_conflicts(out, extra, n_extra, err);
 	if (!rc)
 		rc = check_groups(out, extra, n_extra, err);
 	if (rc)

@@ -108,8 +108,9 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_group_resul
 	bsim_json_number(f, g->ci95[1]);
 	fprintf(f,
 	        "], \"stuck_in_contact\": %d, \"landscape_left\": %d, \"landscape_right\": %d, "
-	        "\"steps\": %ld}",
-	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps);
+	        "\"steps\": %ld, \"unstable\": %d, \"deterministic\": %s}",
+	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps, g->unstable,
+	        g->deterministic ? "true" : "false");
 }
 
 /* An index per grid axis for bsim_experiment_group_index; never a
@@ -169,20 +170,65 @@ int bsim_output_summary_json(const char *path, const bsim_experiment *e, const c
 
 /* ---- trials.csv -------------------------------------------------------- */
 
-int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_error *err)
+/* A CSV field: as it is, or in double quotes (each " doubled) if it holds a
+ * comma, a quote or a line break. */
+static void csv_field(FILE *f, const char *s)
+{
+	if (!strpbrk(s, ",\"\r\n")) {
+		fputs(s, f);
+		return;
+	}
+	fputc('"', f);
+	for (; *s; s++) {
+		if (*s == '"')
+			fputc('"', f);
+		fputc(*s, f);
+	}
+	fputc('"', f);
+}
+
+/* A number, or an empty field if it was not measured (NaN). */
+static void csv_number(FILE *f, double x)
+{
+	if (!isnan(x))
+		fprintf(f, "%.10g", x);
+}
+
+int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                           bsim_error *err)
 {
 	bsim_atomic_file o;
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
-	fputs("group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2\n",
+	int axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	fputs("group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"
+	      "e_start,e_end,work_in,losses,residual,overlap_max",
 	      o.f);
+	for (int a = 0; a < axes; a++) {
+		fputc(',', o.f);
+		csv_field(o.f, e->axes[a].key);
+	}
+	fputc('\n', o.f);
 	for (int g = 0; g < r->n_groups; g++) {
+		if (axes)
+			bsim_experiment_group_index(e, g, idx);
 		for (int t = 0; t < r->trials; t++) {
 			const bsim_trial_result *x = &r->trials_out[(size_t)g * r->trials + t];
-			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", g, t,
+			const bsim_ledger *l = &x->ledger;
+			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", g, t,
 			        bsim_outcome_name(x->outcome), bsim_type_name(x->type), x->steps,
 			        x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
 			        x->max_theta[1]);
+			fprintf(o.f, ",%.10g,%.10g,%.10g,%.10g,%.10g,", l->e_start, l->e_end,
+			        l->w_prop + l->w_rand,
+			        l->damper + l->impact + l->contact + l->correction, l->residual);
+			csv_number(o.f, x->overlap_max);
+			for (int a = 0; a < axes; a++) {
+				fputc(',', o.f);
+				csv_field(o.f, e->axes[a].values[idx[a]]);
+			}
+			fputc('\n', o.f);
 		}
 	}
 	return bsim_atomic_file_commit(&o, err);

@@ -105,7 +105,7 @@ static int key_event(const bsim_compare_group *cg)
 static void md_separation(FILE *f, const bsim_report *r)
 {
 	const bsim_comparison *c = r->cmp;
-	long pairs = (long)c->n_groups * c->trials;
+	long pairs = c->pairs;
 	if (!r->t_separate)
 		return;
 	fprintf(f,
@@ -118,6 +118,54 @@ static void md_separation(FILE *f, const bsim_report *r)
 	fputs(". Per pair: pairs.csv.\n\n", f);
 }
 
+/* "traversed (none)" for a deterministic group's one trial. */
+static void outcome_short(FILE *f, const bsim_trial_result *x)
+{
+	fputs(bsim_outcome_name(x->outcome), f);
+	if (x->outcome == BSIM_TRAVERSED)
+		fprintf(f, " (%s)", bsim_type_name(x->type));
+}
+
+/* The largest equivalence p-value over the events: the group's, since it
+ * is equivalent only if every event is. */
+static double group_equivalence(const bsim_compare_group *cg)
+{
+	double p = 0.0;
+	for (int ev = 0; ev < BSIM_N_EVENTS; ev++)
+		p = fmax(p, cg->ev[ev].p_equivalence);
+	return p;
+}
+
+static void md_number(FILE *f, const char *fmt, double x)
+{
+	if (isnan(x))
+		fputs(" - |", f);
+	else
+		fprintf(f, fmt, x);
+}
+
+static void md_row_random(FILE *f, const bsim_compare_group *cg)
+{
+	const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];
+	int k = key_event(cg);
+	fprintf(f,
+	        " %.2f [%.2f, %.2f] | %.2f [%.2f, %.2f] | %+.2f [%+.2f, %+.2f] | %d of %d | %.2g, "
+	        "%s | %.2g |",
+	        t->p_a, t->ci_a[0], t->ci_a[1], t->p_b, t->ci_b[0], t->ci_b[1], t->diff,
+	        t->diff_ci[0], t->diff_ci[1], cg->discordant, cg->pairs, cg->ev[k].p_holm,
+	        bsim_event_name((bsim_event)k), group_equivalence(cg));
+	md_number(f, " %.2f |", t->detectable);
+}
+
+static void md_row_deterministic(FILE *f, const bsim_report *r, int g, const bsim_compare_group *cg)
+{
+	fputc(' ', f);
+	outcome_short(f, trial_of(r, 0, g, 0));
+	fputs(" | ", f);
+	outcome_short(f, trial_of(r, 1, g, 0));
+	fprintf(f, " | deterministic | %d of 1 | - | - | - |", cg->discordant);
+}
+
 static void md_table(FILE *f, const bsim_report *r)
 {
 	const bsim_experiment *e = r->e;
@@ -127,28 +175,24 @@ static void md_table(FILE *f, const bsim_report *r)
 		fprintf(f, " %s |", e->axes[a].key);
 	fprintf(f,
 	        " p_traverse %s [95%%] | p_traverse %s [95%%] | difference [95%%] | discordant "
-	        "| min p (Holm), event | t_sep median (s) | verdict |\n|---|",
+	        "| min p (Holm), event | equivalence p | detectable | t_sep median (s) | verdict "
+	        "|\n|---|",
 	        la, lb);
 	for (int a = 0; a < e->n_axes; a++)
 		fputs("---|", f);
-	fputs("---|---|---|---|---|---|---|\n", f);
+	fputs("---|---|---|---|---|---|---|---|---|\n", f);
 	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
 	for (int g = 0; g < r->cmp->n_groups; g++) {
 		const bsim_compare_group *cg = &r->cmp->groups[g];
-		const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];
-		int k = key_event(cg);
 		if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
 			bsim_experiment_group_index(e, g, idx);
 		fprintf(f, "| %d |", g);
 		for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
 			fprintf(f, " %s |", e->axes[a].values[idx[a]]);
-		fprintf(f,
-		        " %.2f [%.2f, %.2f] | %.2f [%.2f, %.2f] | %+.2f [%+.2f, %+.2f] | %d | "
-		        "%.2g, %s "
-		        "|",
-		        t->p_a, t->ci_a[0], t->ci_a[1], t->p_b, t->ci_b[0], t->ci_b[1], t->diff,
-		        t->diff_ci[0], t->diff_ci[1], cg->discordant, cg->ev[k].p_holm,
-		        bsim_event_name((bsim_event)k));
+		if (cg->deterministic)
+			md_row_deterministic(f, r, g, cg);
+		else
+			md_row_random(f, cg);
 		if (cg->t_sep[1] >= 0.0)
 			fprintf(f, " %.3f |", cg->t_sep[1]);
 		else
@@ -162,16 +206,19 @@ static void md_events(FILE *f, const bsim_report *r, const bsim_compare_group *c
 {
 	fprintf(f,
 	        "| event | %s | %s | difference [95%%] | only %s | only %s | McNemar p | Holm p "
-	        "| beyond |\n|---|---|---|---|---|---|---|---|---|\n",
+	        "| equivalence p | detectable | beyond |\n|---|---|---|---|---|---|---|---|---|---|"
+	        "---|\n",
 	        r->side[0].label, r->side[1].label, r->side[0].label, r->side[1].label);
 	for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
 		const bsim_event_test *t = &cg->ev[ev];
 		fprintf(f,
-		        "| %s | %.2f | %.2f | %+.2f [%+.2f, %+.2f] | %d | %d | %.3g | %.3g | %s "
-		        "|\n",
+		        "| %s | %.2f | %.2f | %+.2f [%+.2f, %+.2f] | %d | %d | %.3g | %.3g | %.3g "
+		        "|",
 		        bsim_event_name((bsim_event)ev), t->p_a, t->p_b, t->diff, t->diff_ci[0],
 		        t->diff_ci[1], t->pairs.b, t->pairs.c, t->p_value, t->p_holm,
-		        t->beyond ? "yes" : "no");
+		        t->p_equivalence);
+		md_number(f, " %.2f |", t->detectable);
+		fprintf(f, " %s |\n", t->beyond ? "yes" : "no");
 	}
 	fputc('\n', f);
 }
@@ -179,7 +226,7 @@ static void md_events(FILE *f, const bsim_report *r, const bsim_compare_group *c
 static void md_examples(FILE *f, const bsim_report *r, int g)
 {
 	int shown = 0;
-	for (int t = 0; t < r->cmp->trials && shown < r->examples; t++) {
+	for (int t = 0; t < r->cmp->groups[g].pairs && shown < r->examples; t++) {
 		const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
 		if (!bsim_trial_discordant(a, b))
 			continue;
@@ -204,36 +251,51 @@ static void md_examples(FILE *f, const bsim_report *r, int g)
 	fputc('\n', f);
 }
 
+static int shows_detail(const bsim_compare_group *cg)
+{
+	return cg->verdict == BSIM_VERDICT_DISAGREE || cg->verdict == BSIM_VERDICT_DIFFERENT;
+}
+
 void bsim_report_md(FILE *f, const bsim_report *r)
 {
 	const bsim_comparison *c = r->cmp;
-	int counts[4] = {0};
-	for (int g = 0; g < c->n_groups; g++)
-		counts[c->groups[g].verdict]++;
+	const int *k = c->count;
+	int det = k[BSIM_VERDICT_SAME] + k[BSIM_VERDICT_DIFFERENT];
 	fprintf(f,
-	        "**%d of %d groups disagree** (%d same, %d agree, %d differ within the margin), "
-	        "%d trials per group.\n\n",
-	        c->n_disagree, c->n_groups, counts[BSIM_VERDICT_SAME], counts[BSIM_VERDICT_AGREE],
-	        counts[BSIM_VERDICT_SMALL], c->trials);
+	        "**%d of %d groups disagree.** %d deterministic (no random force: one trial each, "
+	        "compared as one pair): %d same, %d different. %d with random force, %d trials "
+	        "each: %d equivalent within +-%g, %d inconclusive (no difference detected, none "
+	        "excluded), %d significantly different but within the margin, %d disagree.\n\n",
+	        c->n_disagree, c->n_groups, det, k[BSIM_VERDICT_SAME], k[BSIM_VERDICT_DIFFERENT],
+	        c->n_groups - det, c->trials, k[BSIM_VERDICT_EQUIVALENT], c->rule.margin,
+	        k[BSIM_VERDICT_INCONCLUSIVE], k[BSIM_VERDICT_SMALL], k[BSIM_VERDICT_DISAGREE]);
 	fprintf(f,
-	        "Rule: a group disagrees when, for one of the events traversed, left, right, "
-	        "side_exit, stuck, the exact McNemar test on the paired trials gives a p-value "
-	        "below %g after Holm's correction over all %d groups x %d events, and the two "
-	        "probabilities differ by at least %g",
-	        c->rule.alpha, c->n_groups, BSIM_N_EVENTS, c->rule.margin);
-	fputs(c->rule.exact ? "; or when any trial differs in any trials.csv field.\n\n" : ".\n\n",
+	        "Rule: a group with random force disagrees when, for one of the events traversed, "
+	        "left, right, side_exit, stuck, unstable, the exact McNemar test on the paired "
+	        "trials gives a p-value below %g after Holm's correction over its %d tests (groups "
+	        "with random force x events), and the two probabilities differ by at least %g. It "
+	        "is equivalent when, for every event, Tango's two one-sided score tests put the "
+	        "paired difference within +-%g at level %g (equivalence p below it); otherwise it "
+	        "is inconclusive. `detectable` is the smallest difference in p_traverse the "
+	        "corrected test could flag given the group's discordant pairs. A deterministic "
+	        "group disagrees when its one pair differs in outcome or type. Intervals: Wilson "
+	        "for each probability, Tango's score interval for the paired difference",
+	        c->rule.alpha, c->n_tests, c->rule.margin, c->rule.margin, c->rule.alpha);
+	fputs(c->rule.exact ? "; any trial that differs in any trials.csv field also disagrees.\n\n"
+	                    : ".\n\n",
 	      f);
 	md_separation(f, r);
 	md_table(f, r);
 	for (int g = 0; g < c->n_groups; g++) {
 		const bsim_compare_group *cg = &c->groups[g];
-		if (cg->verdict != BSIM_VERDICT_DISAGREE)
+		if (!shows_detail(cg))
 			continue;
 		fprintf(f, "### Group %d: ", g);
 		params_text(f, r->e, g);
-		fprintf(f, "\n\n%d discordant pairs, %d trials changed in any field.\n\n",
-		        cg->discordant, cg->changed);
-		md_events(f, r, cg);
+		fprintf(f, "\n\n%d of %d pairs discordant, %d changed in any field.\n\n",
+		        cg->discordant, cg->pairs, cg->changed);
+		if (!cg->deterministic)
+			md_events(f, r, cg);
 		md_examples(f, r, g);
 	}
 }
@@ -263,27 +325,40 @@ static void json_quantiles(FILE *f, const double q[3])
 	fputc(']', f);
 }
 
-static void json_event(FILE *f, const bsim_event_test *t)
+static void json_event(FILE *f, const bsim_event_test *t, int deterministic)
 {
 	fputs("{\"p_a\": ", f);
 	bsim_json_number(f, t->p_a);
-	fputs(", \"ci95_a\": ", f);
-	json_pair_of_numbers(f, t->ci_a);
+	if (!deterministic) {
+		fputs(", \"ci95_a\": ", f);
+		json_pair_of_numbers(f, t->ci_a);
+	}
 	fputs(", \"p_b\": ", f);
 	bsim_json_number(f, t->p_b);
-	fputs(", \"ci95_b\": ", f);
-	json_pair_of_numbers(f, t->ci_b);
+	if (!deterministic) {
+		fputs(", \"ci95_b\": ", f);
+		json_pair_of_numbers(f, t->ci_b);
+	}
 	fputs(", \"difference\": ", f);
 	bsim_json_number(f, t->diff);
-	fputs(", \"difference_ci95\": ", f);
-	json_pair_of_numbers(f, t->diff_ci);
 	fprintf(f, ", \"both\": %d, \"only_a\": %d, \"only_b\": %d, \"neither\": %d", t->pairs.a,
 	        t->pairs.b, t->pairs.c, t->pairs.d);
+	if (deterministic) {
+		fputc('}', f);
+		return;
+	}
+	fputs(", \"difference_ci95\": ", f);
+	json_pair_of_numbers(f, t->diff_ci);
 	fputs(", \"p_mcnemar\": ", f);
 	bsim_json_number(f, t->p_value);
 	fputs(", \"p_holm\": ", f);
 	bsim_json_number(f, t->p_holm);
-	fprintf(f, ", \"beyond\": %s}", t->beyond ? "true" : "false");
+	fputs(", \"p_equivalence\": ", f);
+	bsim_json_number(f, t->p_equivalence);
+	fputs(", \"detectable\": ", f);
+	bsim_json_number(f, t->detectable);
+	fprintf(f, ", \"beyond\": %s, \"equivalent\": %s}", t->beyond ? "true" : "false",
+	        t->equivalent ? "true" : "false");
 }
 
 static void json_outcome(FILE *f, const bsim_trial_result *x)
@@ -317,7 +392,7 @@ static void json_examples(FILE *f, const bsim_report *r, int g)
 {
 	int shown = 0;
 	fputs(", \"examples\": [", f);
-	for (int t = 0; t < r->cmp->trials && shown < r->examples; t++) {
+	for (int t = 0; t < r->cmp->groups[g].pairs && shown < r->examples; t++) {
 		const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
 		if (!bsim_trial_discordant(a, b))
 			continue;
@@ -369,14 +444,23 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	bsim_json_number(f, c->rule.alpha);
 	fputs(", \"margin\": ", f);
 	bsim_json_number(f, c->rule.margin);
-	fprintf(f, ", \"exact\": %s, \"correction\": \"holm\", \"test\": \"mcnemar_exact\"}",
-	        c->rule.exact ? "true" : "false");
-	fprintf(f, ",\n  \"groups_disagreeing\": %d,\n  \"separation\": ", c->n_disagree);
+	fprintf(f,
+	        ", \"exact\": %s, \"correction\": \"holm\", \"tests\": %d, \"test\": "
+	        "\"mcnemar_exact\", \"interval\": \"tango_score\", \"equivalence\": "
+	        "\"tango_two_one_sided\"}",
+	        c->rule.exact ? "true" : "false", c->n_tests);
+	fprintf(f, ",\n  \"groups_disagreeing\": %d,\n  \"verdicts\": {", c->n_disagree);
+	for (int v = 0; v < BSIM_N_VERDICTS; v++) {
+		fputs(v ? ", " : "", f);
+		bsim_json_string(f, bsim_verdict_name((bsim_verdict)v));
+		fprintf(f, ": %d", c->count[v]);
+	}
+	fputs("},\n  \"separation\": ", f);
 	if (r->t_separate) {
 		fprintf(f,
 		        "{\"distance\": \"0.01 body radius\", \"separated\": %d, \"pairs\": %ld, "
 		        "\"quantiles_10_50_90_s\": ",
-		        c->separated, (long)c->n_groups * c->trials);
+		        c->separated, (long)c->pairs);
 		json_quantiles(f, c->t_sep);
 		fputc('}', f);
 	} else {
@@ -389,8 +473,12 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 		bsim_output_group_params(f, r->e, g);
 		fputs(", \"verdict\": ", f);
 		bsim_json_string(f, bsim_verdict_name(cg->verdict));
-		fprintf(f, ", \"discordant\": %d, \"changed\": %d, \"separated\": %d, ",
-		        cg->discordant, cg->changed, cg->separated);
+		fprintf(f,
+		        ", \"deterministic\": %s, \"pairs\": %d, \"discordant\": %d, \"changed\": "
+		        "%d, "
+		        "\"separated\": %d, ",
+		        cg->deterministic ? "true" : "false", cg->pairs, cg->discordant,
+		        cg->changed, cg->separated);
 		fputs("\"t_separate_quantiles_s\": ", f);
 		json_quantiles(f, cg->t_sep);
 		fputs(",\n     \"events\": {", f);
@@ -398,10 +486,10 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 			fputs(ev ? ",\n       " : "\n       ", f);
 			bsim_json_string(f, bsim_event_name((bsim_event)ev));
 			fputs(": ", f);
-			json_event(f, &cg->ev[ev]);
+			json_event(f, &cg->ev[ev], cg->deterministic);
 		}
 		fputc('}', f);
-		if (cg->verdict == BSIM_VERDICT_DISAGREE)
+		if (shows_detail(cg))
 			json_examples(f, r, g);
 		fputc('}', f);
 	}

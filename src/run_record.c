@@ -120,6 +120,8 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 		fputs(i ? ", " : "", f);
 		fputs("{\"name\": ", f);
 		bsim_json_string(f, rec->backend[i]);
+		fputs(", \"label\": ", f);
+		bsim_json_string(f, rec->label[i][0] ? rec->label[i] : rec->backend[i]);
 		fputs(", \"options\": ", f);
 		json_options(f, &rec->opts[i]);
 		fputc('}', f);
@@ -181,6 +183,11 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 	char field[64];
 	snprintf(field, sizeof field, "backends.%d.name", i);
 	if (need_text(d, root, field, rec->backend[i], sizeof rec->backend[i], err))
+		return BSIM_EINPUT;
+	snprintf(field, sizeof field, "backends.%d.label", i);
+	if (!ydoc_lookup(root, field)) /* written before labels existed */
+		snprintf(rec->label[i], sizeof rec->label[i], "%s", rec->backend[i]);
+	else if (need_text(d, root, field, rec->label[i], sizeof rec->label[i], err))
 		return BSIM_EINPUT;
 	snprintf(field, sizeof field, "backends.%d.options", i);
 	struct fy_node *opts = ydoc_lookup(root, field);

@@ -69,6 +69,7 @@ static const scene_field termination_fields[] = {
         {"success_y", SK_NUMBER, SR_ANY, 0, S(success_y), NULL},   /* m */
         {"side_x", SK_NUMBER, SR_POSITIVE, 0, S(side_x), NULL},    /* m */
         {"classify_y", SK_NUMBER, SR_ANY, 0, S(classify_y), NULL}, /* m, >= success_y */
+        {"classify_deadband", SK_NUMBER, SR_NONNEG, 0, S(classify_deadband), NULL}, /* m/s */
 };
 static const scene_table termination_table = TABLE(termination_fields);
 

@@ -10,6 +10,10 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include <gsl/gsl_cdf.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_roots.h>
+
 void bsim_wilson(int k, int n, double z, double *lo, double *hi)
 {
 	if (n <= 0) {
@@ -102,4 +106,118 @@ void bsim_paired_diff_ci(const bsim_pairs *t, double z, double *lo, double *hi)
 	        (u1 - p1) * (u1 - p1) - 2.0 * phi * (u1 - p1) * (p2 - l2) + (p2 - l2) * (p2 - l2);
 	*lo = fmax(-1.0, d - sqrt(fmax(dl, 0.0)));
 	*hi = fmin(1.0, d + sqrt(fmax(du, 0.0)));
+}
+
+/* Tango (1998). Under H0: p_A - p_B = delta the probabilities of the
+ * discordant cells are q12 = q21 + delta and q21 = q; maximising the
+ * likelihood in q gives the root of
+ *   2n q^2 + B q + C = 0,  B = -b - c + (2n - b + c) delta,
+ *                          C = -c delta (1 - delta),
+ *   q = (sqrt(B^2 - 4 (2n) C) - B) / (4n),
+ * and the score statistic
+ *   T = (b - c - n delta) / sqrt(n (2 q + delta (1 - delta))).
+ * The interval's ends solve T = z (lower) and T = -z (upper); T is
+ * monotone, so each end is one bracketed root (Brent, GSL). */
+double bsim_tango_score(const bsim_pairs *t, double delta)
+{
+	double n = (double)t->a + t->b + t->c + t->d;
+	double b = t->b, c = t->c;
+	double A = 2.0 * n;
+	double B = -b - c + (2.0 * n - b + c) * delta;
+	double C = -c * delta * (1.0 - delta);
+	double q = (sqrt(fmax(B * B - 4.0 * A * C, 0.0)) - B) / (2.0 * A);
+	double var = n * (2.0 * q + delta * (1.0 - delta));
+	double num = b - c - n * delta;
+	if (var <= 0.0) /* only at delta = +-1 with the data at that end */
+		return num > 0.0 ? HUGE_VAL : num < 0.0 ? -HUGE_VAL : 0.0;
+	return num / sqrt(var);
+}
+
+typedef struct tango_root {
+	const bsim_pairs *t;
+	double target;
+} tango_root;
+
+static double tango_f(double delta, void *p)
+{
+	const tango_root *r = p;
+	return bsim_tango_score(r->t, delta) - r->target;
+}
+
+/* The delta in [lo, hi] where T(delta) = target, given T(lo) - target and
+ * T(hi) - target of opposite signs; the end itself if they are not (the
+ * interval reaches -1 or 1). */
+static double tango_solve(const bsim_pairs *t, double target, double lo, double hi)
+{
+	tango_root r = {t, target};
+	gsl_function f = {tango_f, &r};
+	double f_lo = tango_f(lo, &r), f_hi = tango_f(hi, &r);
+	if (f_lo == 0.0)
+		return lo;
+	if (f_hi == 0.0)
+		return hi;
+	if ((f_lo > 0.0) == (f_hi > 0.0))
+		return fabs(f_lo) < fabs(f_hi) ? lo : hi;
+	gsl_root_fsolver *s = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+	if (!s)
+		return 0.5 * (lo + hi);
+	gsl_error_handler_t *old = gsl_set_error_handler_off();
+	double x = 0.5 * (lo + hi);
+	if (gsl_root_fsolver_set(s, &f, lo, hi) == GSL_SUCCESS)
+		for (int i = 0; i < 200; i++) {
+			if (gsl_root_fsolver_iterate(s) != GSL_SUCCESS)
+				break;
+			x = gsl_root_fsolver_root(s);
+			double a = gsl_root_fsolver_x_lower(s), b = gsl_root_fsolver_x_upper(s);
+			if (gsl_root_test_interval(a, b, 1e-15, 1e-13) == GSL_SUCCESS)
+				break;
+		}
+	gsl_set_error_handler(old);
+	gsl_root_fsolver_free(s);
+	return x;
+}
+
+void bsim_tango_ci(const bsim_pairs *t, double z, double *lo, double *hi)
+{
+	int n = t->a + t->b + t->c + t->d;
+	if (n <= 0) {
+		*lo = -1.0;
+		*hi = 1.0;
+		return;
+	}
+	double d = (double)(t->b - t->c) / n;
+	/* T(d) = 0; T grows without bound toward delta = -1 (unless d is -1
+	 * itself) and falls without bound toward +1, so each end lies between
+	 * d and -1 or +1. The ends of the search stop short of +-1, where the
+	 * variance vanishes. */
+	const double edge = 1.0 - 1e-12;
+	*lo = d <= -edge ? -1.0 : tango_solve(t, z, -edge, d);
+	*hi = d >= edge ? 1.0 : tango_solve(t, -z, d, edge);
+}
+
+double bsim_tango_tost(const bsim_pairs *t, double margin)
+{
+	if (margin <= 0.0 || t->a + t->b + t->c + t->d <= 0)
+		return 1.0;
+	if (margin >= 1.0)
+		return 0.0;
+	/* H0: delta <= -margin is rejected for large T(-margin), H0: delta >=
+	 * margin for small T(margin). */
+	double p_low = gsl_cdf_ugaussian_Q(bsim_tango_score(t, -margin));
+	double p_high = gsl_cdf_ugaussian_P(bsim_tango_score(t, margin));
+	return fmax(p_low, p_high);
+}
+
+int bsim_mcnemar_split(int m, double level)
+{
+	int k = -1;
+	/* The p-value rises with k up to m / 2. */
+	for (int j = 0; 2 * j < m && bsim_mcnemar_exact(j, m - j) < level; j++)
+		k = j;
+	return k;
+}
+
+double bsim_normal_upper(double q)
+{
+	return gsl_cdf_ugaussian_Qinv(q);
 }

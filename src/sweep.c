@@ -6,7 +6,13 @@
  * (experiment seed, g, t) and its result goes to its own slot, so the
  * result is the same whatever the thread count (DESIGN.md "Determinism").
  * A paired sweep runs each trial on a second backend too, in the same slot
- * of a second result (trial_pair.c). */
+ * of a second result (trial_pair.c).
+ *
+ * A group whose scene draws no random numbers (bsim_effects_random) is
+ * deterministic: every trial of it is the same trial. It runs once, as
+ * trial 0, and the other slots are copies, so trials.csv keeps its shape
+ * and its values (identical code and inputs give identical trials), and
+ * nothing downstream counts one trial as many. */
 
 #include "beamsim/sweep.h"
 
@@ -15,6 +21,7 @@
 #include <string.h>
 
 #include "beamsim/clock.h"
+#include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"
 #include "trial_pair.h"
@@ -43,6 +50,9 @@ void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_res
 		case BSIM_STUCK:
 			out->stuck++;
 			out->stuck_in_contact += t->in_contact_end != 0;
+			break;
+		case BSIM_UNSTABLE:
+			out->unstable++;
 			break;
 		}
 	}
@@ -92,6 +102,7 @@ typedef struct sweep_shared {
 	const bsim_experiment *e;
 	const bsim_sweep_config *cfg;
 	const bsim_scene *scenes;
+	const int *deterministic; /* per group */
 	bsim_trial_result *results;
 	const bsim_backend *backend_b; /* NULL: not paired */
 	const bsim_options *opts_b;
@@ -130,6 +141,7 @@ static void sweep_thread(sweep_shared *sh)
 	int leader = omp_get_thread_num() == 0;
 	bsim_runner *runner = bsim_runner_alloc();
 	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
+	bsim_recorder overlap = {.stride = 1, .overlap = 1};
 	bsim_error err;
 
 	if (!runner || (sh->backend_b && !pair)) {
@@ -148,12 +160,18 @@ static void sweep_thread(sweep_shared *sh)
 		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
 		const bsim_scene *scene = &sh->scenes[g];
-		int rc = pair ? trial_pair_run(pair, scene, cfg->backend, cfg->opts, sh->backend_b,
-		                               sh->opts_b, seed, 0.01 * scene->body.radius,
-		                               &sh->results[i], &sh->results_b[i],
-		                               &sh->t_separate[i], &err)
-		              : bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, NULL,
-		                               &sh->results[i], &err);
+		int rc = BSIM_OK;
+		if (t > 0 && sh->deterministic[g])
+			; /* a copy of trial 0, filled in after the run */
+		else if (pair)
+			rc = trial_pair_run(pair, scene, cfg->backend, cfg->opts, sh->backend_b,
+			                    sh->opts_b, seed, 0.01 * scene->body.radius,
+			                    &sh->results[i], &sh->results_b[i], &sh->t_separate[i],
+			                    &err);
+		else
+			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed,
+			                    cfg->measure_overlap ? &overlap : NULL, &sh->results[i],
+			                    &err);
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
 		long done;
@@ -172,6 +190,7 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_err
 	memset(r, 0, sizeof *r);
 	r->n_groups = n_groups;
 	r->trials = trials;
+	r->has_ledger = 1;
 	r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
 	r->groups = calloc(n_groups ? (size_t)n_groups : 1, sizeof *r->groups);
 	if (!r->trials_out || !r->groups) {
@@ -181,12 +200,42 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_err
 	return BSIM_OK;
 }
 
-static void result_finish(bsim_sweep_result *r, int n_groups, int trials, double wall)
+/* The copies of a deterministic group's trial 0. */
+static void deterministic_fill(bsim_trial_result *res, double *t_separate, const int *deterministic,
+                               int n_groups, int trials)
 {
-	for (int g = 0; g < n_groups; g++)
-		bsim_group_aggregate(&r->trials_out[(size_t)g * trials], trials, &r->groups[g]);
-	for (size_t i = 0; i < (size_t)n_groups * trials; i++)
-		r->total_steps += r->trials_out[i].steps_run;
+	for (int g = 0; g < n_groups; g++) {
+		if (!deterministic[g])
+			continue;
+		size_t first = (size_t)g * trials;
+		for (int t = 1; t < trials; t++) {
+			res[first + t] = res[first];
+			if (t_separate)
+				t_separate[first + t] = t_separate[first];
+		}
+	}
+}
+
+static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_groups, int trials,
+                          double wall)
+{
+	r->total_steps = 0;
+	r->trials_run = 0;
+	for (int g = 0; g < n_groups; g++) {
+		bsim_group_result *gr = &r->groups[g];
+		const bsim_trial_result *first = &r->trials_out[(size_t)g * trials];
+		bsim_group_aggregate(first, trials, gr);
+		/* No draws, no sampling: p_traverse is exactly what the one trial
+		 * gave, so its interval is that point, not a Wilson interval over
+		 * copies; and only that trial's steps were integrated. */
+		gr->deterministic = deterministic[g];
+		if (gr->deterministic && trials > 0) {
+			gr->ci95[0] = gr->ci95[1] = gr->p_traverse;
+			gr->steps = first->steps_run;
+		}
+		r->total_steps += gr->steps;
+		r->trials_run += gr->deterministic && trials > 0 ? 1 : trials;
+	}
 	r->wall_seconds = wall;
 }
 
@@ -215,10 +264,18 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	}
 	bsim_scene *scenes;
 	int rc = scenes_build(e, cfg, &scenes, err);
+	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
+	if (rc == BSIM_OK && !deterministic) {
+		scenes_free(scenes, e->n_groups);
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
+	}
+	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
+		deterministic[g] = !bsim_effects_random(&scenes[g]);
 	sweep_shared sh = {
 	        .e = e,
 	        .cfg = cfg,
 	        .scenes = scenes,
+	        .deterministic = deterministic,
 	        .results = out->trials_out,
 	        .backend_b = backend_b,
 	        .opts_b = opts_b,
@@ -239,6 +296,7 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
 	}
 	if (rc != BSIM_OK) {
+		free(deterministic);
 		bsim_sweep_result_free(out);
 		if (backend_b) {
 			bsim_sweep_result_free(out_b);
@@ -250,10 +308,15 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	/* The final count may have been reached on another thread. */
 	if (cfg->progress)
 		cfg->progress(cfg->progress_user, sh.total, sh.total);
-	double wall = bsim_clock_seconds() - t0;
-	result_finish(out, e->n_groups, e->trials, wall);
+	deterministic_fill(out->trials_out, backend_b ? *t_separate : NULL, deterministic,
+	                   e->n_groups, e->trials);
 	if (backend_b)
-		result_finish(out_b, e->n_groups, e->trials, wall);
+		deterministic_fill(out_b->trials_out, NULL, deterministic, e->n_groups, e->trials);
+	double wall = bsim_clock_seconds() - t0;
+	result_finish(out, deterministic, e->n_groups, e->trials, wall);
+	if (backend_b)
+		result_finish(out_b, deterministic, e->n_groups, e->trials, wall);
+	free(deterministic);
 	return BSIM_OK;
 }
 

@@ -11,8 +11,16 @@
 #include "beamsim/effects.h"
 #include "beamsim/landscape.h"
 
+/* A beam as the overlap measure sees it: pivot, rest direction, forward
+ * sign, length and the square of the reach L + R within which the body can
+ * touch it. */
+typedef struct beam_shape {
+	double p[2], u0[2], sgn, length, reach2;
+} beam_shape;
+
 struct bsim_runner {
 	bsim_state s0, s1; /* before and after a step */
+	beam_shape *shape; /* per beam */
 	int *touching;     /* contacts at the last touching step before success_y */
 	int cap;           /* beams the states hold */
 };
@@ -28,6 +36,7 @@ void bsim_runner_free(bsim_runner *r)
 		return;
 	bsim_state_free(&r->s0);
 	bsim_state_free(&r->s1);
+	free(r->shape);
 	free(r->touching);
 	free(r);
 }
@@ -38,19 +47,57 @@ static int runner_reserve(bsim_runner *r, int n_beams)
 		return BSIM_OK;
 	bsim_state_free(&r->s0);
 	bsim_state_free(&r->s1);
+	free(r->shape);
 	free(r->touching);
 	r->cap = 0;
-	r->touching = malloc((n_beams > 0 ? (size_t)n_beams : 1) * sizeof *r->touching);
-	if (!r->touching || bsim_state_alloc(&r->s0, n_beams) || bsim_state_alloc(&r->s1, n_beams))
+	r->shape = malloc((size_t)(n_beams > 0 ? n_beams : 1) * sizeof *r->shape);
+	r->touching = malloc((size_t)(n_beams > 0 ? n_beams : 1) * sizeof *r->touching);
+	if (!r->shape || !r->touching || bsim_state_alloc(&r->s0, n_beams) ||
+	    bsim_state_alloc(&r->s1, n_beams))
 		return BSIM_EFAIL;
 	r->cap = n_beams;
 	return BSIM_OK;
 }
 
+static void shapes_init(beam_shape *shape, const bsim_scene *sc)
+{
+	for (int i = 0; i < sc->n_beams; i++) {
+		const bsim_beam_def *b = &sc->beams[i];
+		beam_shape *q = &shape[i];
+		q->p[0] = b->pivot[0];
+		q->p[1] = b->pivot[1];
+		bsim_beam_rest_direction(b, q->u0);
+		q->sgn = bsim_beam_forward_sign(b);
+		q->length = b->length;
+		q->reach2 = (b->length + sc->body.radius) * (b->length + sc->body.radius);
+	}
+}
+
+/* How deep the body of radius R overlaps the beams, m (0 if it does not):
+ * R - min_i |C - Q_i|, Q_i the point of beam i's segment nearest the centre
+ * C (MODEL.md section 3). A beam whose reach L + R does not hold the
+ * centre costs one distance test. */
+static double overlap_depth(const beam_shape *shape, int n, double radius, const bsim_state *s)
+{
+	double depth = 0.0;
+	for (int i = 0; i < n; i++) {
+		const beam_shape *q = &shape[i];
+		double dx = s->x[0] - q->p[0], dy = s->x[1] - q->p[1];
+		if (dx * dx + dy * dy >= q->reach2)
+			continue;
+		double cs = cos(s->theta[i]), sn = q->sgn * sin(s->theta[i]);
+		double ux = q->u0[0] * cs - q->u0[1] * sn, uy = q->u0[1] * cs + q->u0[0] * sn;
+		double along = fmin(fmax(dx * ux + dy * uy, 0.0), q->length);
+		double dist = hypot(dx - along * ux, dy - along * uy);
+		depth = fmax(depth, radius - dist);
+	}
+	return depth;
+}
+
 const char *bsim_outcome_name(bsim_outcome o)
 {
-	static const char *names[] = {"traversed", "side_exit", "stuck"};
-	return (unsigned)o < 3 ? names[o] : "?";
+	static const char *names[] = {"traversed", "side_exit", "stuck", "unstable"};
+	return (unsigned)o < BSIM_N_OUTCOMES ? names[o] : "?";
 }
 
 const char *bsim_type_name(bsim_type t)
@@ -126,6 +173,26 @@ static void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state
 	l->residual += r;
 	l->residual_abs += fabs(r);
 	l->residual_max = fmax(l->residual_max, fabs(r));
+	l->inflow += fabs(w_prop) + fabs(w_rand);
+}
+
+void bsim_trial_instability_text(const bsim_trial_result *r, double dt, char *buf, size_t size)
+{
+	const bsim_ledger *l = &r->ledger;
+	switch (r->instability) {
+	case BSIM_UNSTABLE_NONFINITE:
+		snprintf(buf, size, "non-finite state at step %d (t = %g s)", r->unstable_step,
+		         r->unstable_step * dt);
+		break;
+	case BSIM_UNSTABLE_ENERGY:
+		snprintf(buf, size,
+		         "energy created: ledger residual %.3g J > %g x %.4g J that flowed in "
+		         "(start %.4g J, end %.4g J)",
+		         l->residual, BSIM_LEDGER_BOUND, l->inflow, l->e_start, l->e_end);
+		break;
+	default:
+		snprintf(buf, size, "%s", "");
+	}
 }
 
 static int state_finite(const bsim_state *s)
@@ -169,15 +236,20 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 
 	bsim_state *s0 = &r->s0, *s1 = &r->s1;
 	backend->get_state(w, s0);
+	if (rec && rec->overlap)
+		shapes_init(r->shape, scene);
 	const double h = scene->dt;
 	const int n_max = scene->max_steps;
 	double e0 = energy_kinetic(scene, s0) + energy_springs(scene, s0);
 	out->ledger.e_start = e0;
+	out->ledger.inflow = e0;
 	for (int i = 0; i < 2 && i < scene->n_beams; i++)
 		out->max_theta[i] = s0->theta[i];
 	int stride = rec && rec->stride > 0 ? rec->stride : 1;
 	FILE *csv = rec ? rec->csv : NULL;
 	bsim_trace_fn trace = rec ? rec->trace : NULL;
+	int overlap = rec && rec->overlap;
+	out->overlap_max = overlap ? 0.0 : NAN;
 	double f[2];
 	if (trace)
 		trace(rec->trace_user, 0, s0);
@@ -201,22 +273,26 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		}
 		backend->step(w, f, h);
 		backend->get_state(w, s1);
+		double e1 = energy_kinetic(scene, s1) + energy_springs(scene, s1);
+		if (!state_finite(s1) || !isfinite(e1)) {
+			/* s0 stays the last finite state, the one reported. */
+			out->instability = BSIM_UNSTABLE_NONFINITE;
+			out->unstable_step = (int)(n + 1);
+			break;
+		}
 		n++;
 		run_on += done;
 		if (trace)
 			trace(rec->trace_user, n, s1);
-		double e1 = energy_kinetic(scene, s1) + energy_springs(scene, s1);
 		ledger_step(&out->ledger, &fx, s0, s1, e0, e1);
 		e0 = e1;
 		bsim_state *t = s0;
 		s0 = s1;
 		s1 = t;
-		if (!state_finite(s0)) {
-			rc = bsim_error_set(err, BSIM_EFAIL,
-			                    "%s backend: non-finite state at step %ld (t = %g s)",
-			                    backend->name, n, (double)n * h);
-			break;
-		}
+		if (overlap)
+			out->overlap_max =
+			        fmax(out->overlap_max, overlap_depth(r->shape, scene->n_beams,
+			                                             scene->body.radius, s0));
 		if (done)
 			continue;
 		for (int i = 0; i < 2 && i < scene->n_beams; i++)
@@ -247,9 +323,10 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	if (out->outcome == BSIM_STUCK)
 		out->in_contact_end = any_contact(s0);
 	if (out->outcome == BSIM_TRAVERSED) {
-		out->type = s0->v[0] > 0.0   ? BSIM_TYPE_LEFT
-		            : s0->v[0] < 0.0 ? BSIM_TYPE_RIGHT
-		                             : BSIM_TYPE_NONE;
+		const double band = scene->classify_deadband;
+		out->type = s0->v[0] > band    ? BSIM_TYPE_LEFT
+		            : s0->v[0] < -band ? BSIM_TYPE_RIGHT
+		                               : BSIM_TYPE_NONE;
 		out->landscape_beam =
 		        touched ? bsim_landscape_label(scene, last_touch, r->touching) : -1;
 	}
@@ -258,6 +335,17 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	out->vx_end = s0->v[0];
 	out->steps_run = (int)n;
 	out->ledger.e_end = e0;
+	const bsim_ledger *l = &out->ledger;
+	if (!out->instability && l->residual > BSIM_LEDGER_BOUND * l->inflow + BSIM_LEDGER_FLOOR) {
+		out->instability = BSIM_UNSTABLE_ENERGY;
+		out->unstable_step = (int)n;
+	}
+	if (out->instability) {
+		out->outcome = BSIM_UNSTABLE;
+		out->type = BSIM_TYPE_NONE;
+		out->landscape_beam = -1;
+		out->in_contact_end = 0;
+	}
 	out->draws = fx.random ? bsim_schedule_draws(fx.random->schedule) : 0;
 	bsim_effects_free(&fx);
 	backend->destroy(w);

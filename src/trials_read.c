@@ -1,15 +1,81 @@
 /* trials.csv read back (beamsim regress compares a stored sweep with its
  * rerun through the file, so both sides have exactly the file's
- * precision). */
+ * precision). Columns are found by their header name, so a file with more
+ * columns than this version writes, or one written before the energy
+ * columns existed, reads the same. */
 #define _POSIX_C_SOURCE 200809L
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "beamsim/output.h"
 
-static const char header[] =
-        "group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2";
+enum {
+	COL_GROUP,
+	COL_TRIAL,
+	COL_OUTCOME,
+	COL_TYPE,
+	COL_STEPS,
+	COL_T_END,
+	COL_X_END,
+	COL_Y_END,
+	COL_VX_END,
+	COL_MAX_THETA1,
+	COL_MAX_THETA2,
+	N_REQUIRED,
+	COL_E_START = N_REQUIRED,
+	COL_E_END,
+	COL_WORK_IN,
+	COL_LOSSES,
+	COL_RESIDUAL,
+	N_COLUMNS
+};
+
+static const char *const column_names[N_COLUMNS] = {
+        "group",  "trial",      "outcome",    "type",    "steps", "t_end",   "x_end",  "y_end",
+        "vx_end", "max_theta1", "max_theta2", "e_start", "e_end", "work_in", "losses", "residual",
+};
+
+/* Splits one CSV line in place into at most max fields (RFC 4180 quoting:
+ * "a,""b""" is the field a,"b"). Returns the number of fields, -1 on a
+ * malformed quote. */
+static int csv_split(char *line, char **field, int max)
+{
+	int n = 0;
+	char *r = line, *w = line;
+	while (n < max) {
+		field[n++] = w;
+		if (*r == '"') {
+			r++;
+			while (1) {
+				if (*r == '\0')
+					return -1;
+				if (*r == '"' && r[1] == '"') {
+					*w++ = '"';
+					r += 2;
+				} else if (*r == '"') {
+					r++;
+					break;
+				} else {
+					*w++ = *r++;
+				}
+			}
+			if (*r != ',' && *r != '\0')
+				return -1;
+		} else {
+			while (*r && *r != ',')
+				*w++ = *r++;
+		}
+		if (*r == '\0') {
+			*w = '\0';
+			return n;
+		}
+		*w++ = '\0';
+		r++;
+	}
+	return n;
+}
 
 static int name_index(const char *s, const char *const *names, int n)
 {
@@ -19,45 +85,85 @@ static int name_index(const char *s, const char *const *names, int n)
 	return -1;
 }
 
-/* One row into r; 0 on success. */
-static int parse_row(char *line, const bsim_sweep_result *r, bsim_trial_result *all)
+static int parse_double(const char *s, double *out)
 {
-	static const char *const outcomes[] = {"traversed", "side_exit", "stuck"};
-	static const char *const types[] = {"none", "left", "right"};
-	char *f[11], *save = NULL;
-	int n = 0;
-	for (char *tok = strtok_r(line, ",", &save); tok && n < 11;
-	     tok = strtok_r(NULL, ",", &save))
-		f[n++] = tok;
-	if (n != 11 || strtok_r(NULL, ",", &save))
-		return -1;
 	char *end;
-	long g = strtol(f[0], &end, 10);
+	*out = strtod(s, &end);
+	return *s && !*end ? 0 : -1;
+}
+
+/* One row into r; 0 on success. col[k]: the field index of column k, -1
+ * if the file has none. */
+static int parse_row(char **f, int n, const int *col, const bsim_sweep_result *r,
+                     bsim_trial_result *all)
+{
+	static const char *const outcomes[] = {"traversed", "side_exit", "stuck", "unstable"};
+	static const char *const types[] = {"none", "left", "right"};
+	for (int k = 0; k < N_COLUMNS; k++)
+		if (col[k] >= n)
+			return -1;
+	char *end;
+	long g = strtol(f[col[COL_GROUP]], &end, 10);
 	if (*end || g < 0 || g >= r->n_groups)
 		return -1;
-	long t = strtol(f[1], &end, 10);
+	long t = strtol(f[col[COL_TRIAL]], &end, 10);
 	if (*end || t < 0 || t >= r->trials)
 		return -1;
 	bsim_trial_result *x = &all[g * r->trials + t];
 	if (x->steps_run) /* seen already */
 		return -1;
-	int o = name_index(f[2], outcomes, 3), ty = name_index(f[3], types, 3);
+	int o = name_index(f[col[COL_OUTCOME]], outcomes, BSIM_N_OUTCOMES);
+	int ty = name_index(f[col[COL_TYPE]], types, 3);
 	if (o < 0 || ty < 0)
 		return -1;
 	x->outcome = (bsim_outcome)o;
 	x->type = (bsim_type)ty;
-	x->steps = (int)strtol(f[4], &end, 10);
+	x->steps = (int)strtol(f[col[COL_STEPS]], &end, 10);
 	if (*end)
 		return -1;
 	double *v[6] = {&x->t_end,  &x->x_end,        &x->y_end,
 	                &x->vx_end, &x->max_theta[0], &x->max_theta[1]};
-	for (int i = 0; i < 6; i++) {
-		*v[i] = strtod(f[5 + i], &end);
-		if (*end)
+	for (int i = 0; i < 6; i++)
+		if (parse_double(f[col[COL_T_END + i]], v[i]))
 			return -1;
+	if (col[COL_E_START] >= 0) {
+		/* The split columns come back as the ledger's first entry of
+		 * each sum: enough to compare two files field by field. */
+		bsim_ledger *l = &x->ledger;
+		double *lv[5] = {&l->e_start, &l->e_end, &l->w_prop, &l->damper, &l->residual};
+		for (int i = 0; i < 5; i++)
+			if (parse_double(f[col[COL_E_START + i]], lv[i]))
+				return -1;
 	}
 	x->steps_run = 1; /* marks the row as read; not in the file */
 	return 0;
+}
+
+/* The header: every required column once; the ledger columns all or
+ * none. */
+static int read_header(char *line, int *col, int *n_fields)
+{
+	char *f[256];
+	int n = csv_split(line, f, 256);
+	for (int k = 0; k < N_COLUMNS; k++)
+		col[k] = -1;
+	for (int i = 0; i < n; i++) {
+		int k = name_index(f[i], column_names, N_COLUMNS);
+		if (k >= 0 && col[k] >= 0)
+			return -1;
+		if (k >= 0)
+			col[k] = i;
+	}
+	for (int k = 0; k < N_REQUIRED; k++)
+		if (col[k] < 0)
+			return -1;
+	int ledger = 0;
+	for (int k = N_REQUIRED; k < N_COLUMNS; k++)
+		ledger += col[k] >= 0;
+	if (ledger != 0 && ledger != N_COLUMNS - N_REQUIRED)
+		return -1;
+	*n_fields = n;
+	return n > 0 ? 0 : -1;
 }
 
 int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_sweep_result *r,
@@ -77,26 +183,37 @@ int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_swe
 		bsim_sweep_result_free(r);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %zu trials", total);
 	}
-	char line[1024];
-	int lineno = 0, rc = BSIM_OK;
+	char *line = NULL, *field[256];
+	size_t cap = 0;
+	int lineno = 0, rc = BSIM_OK, col[N_COLUMNS], n_fields = 0;
 	size_t rows = 0;
-	while (rc == BSIM_OK && fgets(line, sizeof line, f)) {
+	while (rc == BSIM_OK && getline(&line, &cap, f) >= 0) {
 		lineno++;
 		line[strcspn(line, "\r\n")] = '\0';
 		if (lineno == 1) {
-			if (strcmp(line, header) != 0)
-				rc = bsim_error_set(err, BSIM_EINPUT,
-				                    "%s:1: expected the header %s", path, header);
+			if (read_header(line, col, &n_fields) != 0)
+				rc = bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s:1: expected a header naming each of group, trial, "
+				        "outcome, type, steps, t_end, x_end, y_end, vx_end, "
+				        "max_theta1, max_theta2 once",
+				        path);
+			r->has_ledger = col[COL_E_START] >= 0;
 			continue;
 		}
-		if (parse_row(line, r, r->trials_out) != 0)
-			rc = bsim_error_set(err, BSIM_EINPUT,
-			                    "%s:%d: expected a row group,trial,... of %d groups x "
-			                    "%d trials, each once",
-			                    path, lineno, n_groups, trials);
+		int n = csv_split(line, field, 256);
+		if (n != n_fields || parse_row(field, n, col, r, r->trials_out) != 0)
+			rc = bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s:%d: expected a row of %d fields group,trial,... of %d "
+			        "groups x %d trials, each once",
+			        path, lineno, n_fields, n_groups, trials);
 		rows++;
 	}
+	free(line);
 	fclose(f);
+	if (rc == BSIM_OK && lineno == 0)
+		rc = bsim_error_set(err, BSIM_EINPUT, "%s: empty file, expected a header", path);
 	if (rc == BSIM_OK && rows != total)
 		rc = bsim_error_set(err, BSIM_EINPUT, "%s: expected %zu rows, got %zu", path, total,
 		                    rows);

@@ -14,8 +14,12 @@
 
 #include "support.h"
 
+/* trials.csv: the contract's first eleven columns, then the appended ones
+ * (the ledger, the overlap, the group's grid values by key). */
 #define TRIALS_HEADER                                                                              \
-	"group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2\n"
+	"group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"           \
+	"e_start,e_end,work_in,losses,residual,overlap_max,effects.propulsion.force,"              \
+	"effects.random_force.magnitude\n"
 #define TRAJ_HEADER                                                                                \
 	"t,x,y,vx,vy,theta1,omega1,theta2,omega2,f_rand,contact1,contact2,e_kin,e_beam,e_prop\n"
 
@@ -312,6 +316,7 @@ static void test_sweep(void **state)
 	assert_memory_equal(csv, TRIALS_HEADER, strlen(TRIALS_HEADER));
 	assert_int_equal(count_lines(csv), 1 + 2 * 3);
 	assert_contains(csv, "\n1,2,");
+	assert_contains(csv, ",8,20\n"); /* group 1's values */
 	free(csv);
 
 	snprintf(file, sizeof file, "%s/summary.json", out);
@@ -370,6 +375,87 @@ static void test_sweep_bad_experiment(void **state)
 	assert_true(stat(out, &st) != 0);
 }
 
+/* The stiff-beam scene on Box2D's explicit spring torque blows up: run
+ * says why and exits 1; a sweep writes the trials as unstable, counts
+ * them in summary.json and exits 1. The implicit thesis spring is fine. */
+static void test_unstable(void **state)
+{
+	(void)state;
+	char scene[1024], exp[1024], out[1100], file[1200];
+	snprintf(scene, sizeof scene, "%s", bsim_test_src("configs/hard/stiff_beam.yaml"));
+	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/hard/stiff_beam_sweep.yaml"));
+	const char *torque[] = {"run",           scene,           "--backend", "box2d",
+	                        "--backend-opt", "spring=torque", NULL};
+	cli_run r = run_cli(torque);
+	assert_int_equal(r.status, 1);
+	assert_contains(r.out, "outcome     unstable");
+	assert_contains(r.out, "unstable    energy created: ledger residual");
+	assert_contains(r.err, "box2d backend: unstable trial: energy created");
+	cli_run_free(&r);
+	const char *thesis[] = {"run", scene, "--json", NULL};
+	r = run_cli(thesis);
+	assert_int_equal(r.status, 0);
+	assert_contains(r.out, "\"instability\": null");
+	cli_run_free(&r);
+
+	snprintf(out, sizeof out, "%s", bsim_test_dir("unstable"));
+	const char *sweep[] = {"sweep",         exp,     "--backend", "box2d", "--backend-opt",
+	                       "spring=torque", "--out", out,         NULL};
+	r = run_cli(sweep);
+	assert_int_equal(r.status, 1);
+	assert_contains(r.err, "trials unstable on the box2d backend");
+	cli_run_free(&r);
+	snprintf(file, sizeof file, "%s/trials.csv", out);
+	char *csv = bsim_test_read(file);
+	assert_non_null(csv);
+	assert_contains(csv, "\n0,0,unstable,none,");
+	free(csv);
+	snprintf(file, sizeof file, "%s/summary.json", out);
+	char *json = bsim_test_read(file);
+	assert_contains(json, "\"unstable\": 10, \"deterministic\": true}");
+	free(json);
+}
+
+/* A group without random force runs once: every row is the same trial and
+ * its interval is the point p_traverse; with random force the rows differ
+ * and the interval is Wilson's. */
+static void test_sweep_deterministic(void **state)
+{
+	(void)state;
+	char dir[1024], exp[1100], out[1100], file[1200];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("det"));
+	char text[2048];
+	snprintf(text, sizeof text,
+	         "scene: %s\ntrials: 4\nseed: 5\ngrid:\n"
+	         "  effects.propulsion.force: [9]\n"
+	         "  effects.random_force.magnitude: [0, 20]\n",
+	         gate);
+	snprintf(exp, sizeof exp, "%s", bsim_test_write(dir, "det.yaml", text));
+	snprintf(out, sizeof out, "%s/out", dir);
+	const char *argv[] = {"sweep", exp, "--quiet", "--out", out, NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 0);
+	cli_run_free(&r);
+	snprintf(file, sizeof file, "%s/trials.csv", out);
+	char *csv = bsim_test_read(file);
+	char *rows[8];
+	int n = 0;
+	for (char *line = strtok(strchr(csv, '\n') + 1, "\n"); line && n < 8;
+	     line = strtok(NULL, "\n"))
+		rows[n++] = strchr(strchr(line, ',') + 1, ','); /* after group,trial */
+	assert_int_equal(n, 8);
+	for (int t = 1; t < 4; t++)
+		assert_string_equal(rows[0], rows[t]);
+	assert_string_not_equal(rows[4], rows[5]);
+	free(csv);
+	snprintf(file, sizeof file, "%s/summary.json", out);
+	char *json = bsim_test_read(file);
+	assert_contains(json, "\"p_traverse\": 1, \"ci95\": [1, 1]");
+	assert_contains(json, "\"deterministic\": true}");
+	assert_contains(json, "\"deterministic\": false}");
+	free(json);
+}
+
 static void test_backends(void **state)
 {
 	(void)state;
@@ -393,6 +479,8 @@ int main(void)
 	        cmocka_unit_test(test_trajectory),
 	        cmocka_unit_test(test_sweep),
 	        cmocka_unit_test(test_sweep_bad_experiment),
+	        cmocka_unit_test(test_unstable),
+	        cmocka_unit_test(test_sweep_deterministic),
 	        cmocka_unit_test(test_backends),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);

@@ -190,8 +190,9 @@ static void test_regress_identical(void **state)
 }
 
 /* A stored sweep whose group 2 (force 9, no noise) traversals were all
- * rewritten as side exits: regress flags group 3 only, exit 3, and its
- * replay lines reproduce the rerun's (true) outcomes. */
+ * rewritten as side exits: regress flags group 2 only, as a deterministic
+ * group whose one pair differs, exit 3, and its replay line reproduces the
+ * rerun's (true) outcome. */
 static void test_regress_catches_changes(void **state)
 {
 	(void)state;
@@ -220,14 +221,14 @@ static void test_regress_catches_changes(void **state)
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 3);
 	char *json = read_in(dir, "regress.json");
 	int disagree = 0;
-	for (const char *p = json; (p = strstr(p, "\"verdict\": \"DISAGREE\"")); p++)
+	for (const char *p = json; (p = strstr(p, "\"verdict\": \"D")); p++)
 		disagree++;
 	assert_int_equal(disagree, 1);
 	assert_non_null(strstr(json, "{\"group\": 2, \"params\": {\"effects.propulsion.force\": 9, "
 	                             "\"effects.random_force.magnitude\": 0}, \"verdict\": "
-	                             "\"DISAGREE\""));
+	                             "\"DIFFERENT\", \"deterministic\": true, \"pairs\": 1"));
 	/* The rerun's side replays; the baseline's was edited, so it cannot. */
-	assert_int_equal(check_replays(json, 1), 3);
+	assert_int_equal(check_replays(json, 1), 1);
 	free(csv);
 	free(edited);
 	free(json);
@@ -256,6 +257,128 @@ static void test_regress_exact(void **state)
 	free(csv);
 }
 
+/* Two settings of one backend: each side's directory is named by its
+ * label, its options are recorded, and regress reruns it. --backend-opt
+ * still reaches every side on its backend; inline options win. */
+static void test_one_backend_two_settings(void **state)
+{
+	(void)state;
+	const char *dir = out_dir("euler");
+	const char *argv[] = {"compare",
+	                      experiment,
+	                      "--backends",
+	                      "thesis,thesis:integrator=euler",
+	                      "--backend-opt",
+	                      "thesis:slop=2e-6",
+	                      "--backend-opt",
+	                      "thesis:integrator=midpoint",
+	                      "--quiet",
+	                      "--out",
+	                      dir,
+	                      NULL};
+	int status = bsim_test_cli(argv, NULL, NULL);
+	assert_true(status == 0 || status == 3);
+	char *a = read_in(dir, "thesis/trials.csv");
+	char *b = read_in(dir, "thesis-integrator=euler/trials.csv");
+	assert_string_not_equal(a, b); /* euler is another integrator */
+	char *run = read_in(dir, "run.json");
+	assert_non_null(strstr(run, "\"label\": \"thesis:integrator=euler\", \"options\": "
+	                            "{\"slop\": \"2e-6\", \"integrator\": \"euler\""));
+	assert_non_null(strstr(run, "\"label\": \"thesis\", \"options\": {\"slop\": \"2e-6\", "
+	                            "\"integrator\": \"midpoint\""));
+	char *md = read_in(dir, "report.md");
+	assert_non_null(strstr(md, "# beamsim compare: thesis vs thesis:integrator=euler"));
+	const char *again[] = {"regress", dir, "--exact", "--out", out_dir("euler_rerun"), NULL};
+	char *out = NULL;
+	assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
+	assert_non_null(strstr(out, "thesis:integrator=euler: 0 of 48 trials changed"));
+	free(out);
+	free(a);
+	free(b);
+	free(run);
+	free(md);
+}
+
+/* The noise-free groups are deterministic: one pair, reported as such,
+ * with no interval or p-value; the others carry Tango's interval, an
+ * equivalence p-value and the smallest detectable difference. */
+static void test_report_deterministic(void **state)
+{
+	(void)state;
+	char *json = read_in(cmp_dir, "report.json");
+	assert_non_null(strstr(json, "{\"group\": 0, \"params\": {\"effects.propulsion.force\": 8, "
+	                             "\"effects.random_force.magnitude\": 0}, \"verdict\": "
+	                             "\"same\", \"deterministic\": true, \"pairs\": 1"));
+	const char *g1 = strstr(json, "{\"group\": 1, ");
+	assert_non_null(g1);
+	assert_non_null(strstr(g1, "\"deterministic\": false, \"pairs\": 12"));
+	assert_non_null(strstr(g1, "\"p_equivalence\": "));
+	assert_non_null(strstr(g1, "\"detectable\": "));
+	assert_non_null(strstr(json, "\"interval\": \"tango_score\""));
+	/* 2 random groups x 6 events in the Holm family */
+	assert_non_null(strstr(json, "\"tests\": 12"));
+	char *md = read_in(cmp_dir, "report.md");
+	assert_non_null(strstr(md, "| 0 | 8 | 0 | stuck | stuck | deterministic | 0 of 1 |"));
+	free(json);
+	free(md);
+}
+
+/* Box2D's explicit spring torque on beams too stiff for it (omega_n h =
+ * 2.8) blows up: the trials are unstable, an event the comparison counts
+ * and flags, never an ordinary outcome. */
+static void test_unstable_event(void **state)
+{
+	(void)state;
+	const char *dir = out_dir("stiff");
+	const char *argv[] = {"compare",    bsim_test_src("configs/hard/stiff_beam_sweep.yaml"),
+	                      "--backends", "thesis,box2d:spring=torque",
+	                      "--out",      dir,
+	                      NULL};
+	char *out = NULL;
+	assert_int_equal(bsim_test_cli(argv, &out, NULL), 3);
+	assert_non_null(strstr(out, "box2d:spring=torque: "));
+	assert_non_null(strstr(out, " unstable trials"));
+	char *json = read_in(dir, "report.json");
+	const char *ev = strstr(json, "{\"group\": 1, ");
+	assert_non_null(ev);
+	ev = strstr(ev, "\"unstable\": {\"p_a\": 0, ");
+	assert_non_null(ev);
+	char *csv = read_in(dir, "box2d-spring=torque/trials.csv");
+	assert_non_null(strstr(csv, ",unstable,none,"));
+	char *thesis = read_in(dir, "thesis/trials.csv");
+	assert_null(strstr(thesis, ",unstable,"));
+	free(out);
+	free(json);
+	free(csv);
+	free(thesis);
+}
+
+/* A trials.csv of the first format (eleven columns, no ledger) is still a
+ * baseline: columns are found by name. */
+static void test_regress_old_format(void **state)
+{
+	(void)state;
+	const char *base = out_dir("oldfmt");
+	const char *sweep[] = {"sweep", experiment, "--quiet", "--out", base, NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	char *csv = read_in(base, "trials.csv");
+	char *old = malloc(strlen(csv) + 1), *w = old;
+	for (char *line = strtok(csv, "\n"); line; line = strtok(NULL, "\n")) {
+		char *p = line;
+		for (int i = 0; i < 11 && p; i++)
+			p = strchr(p + 1, ',');
+		w += sprintf(w, "%.*s\n", (int)(p - line), line);
+	}
+	bsim_test_write(base, "trials.csv", old);
+	const char *argv[] = {"regress", base, "--exact", "--out", out_dir("oldfmt_rerun"), NULL};
+	char *out = NULL;
+	assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
+	assert_non_null(strstr(out, "thesis: 0 of 48 trials changed"));
+	free(out);
+	free(csv);
+	free(old);
+}
+
 static void test_bad_usage(void **state)
 {
 	(void)state;
@@ -263,7 +386,7 @@ static void test_bad_usage(void **state)
 	const char *same[] = {"compare", experiment,      "--backends", "thesis,thesis",
 	                      "--out",   out_dir("bad1"), NULL};
 	assert_int_equal(bsim_test_cli(same, NULL, &err), 2);
-	assert_non_null(strstr(err, "two different backends"));
+	assert_non_null(strstr(err, "two different sides"));
 	free(err);
 	const char *knob[] = {"compare",       experiment, "--backend-opt", "box2d:nope=1", "--out",
 	                      out_dir("bad2"), NULL};
@@ -291,6 +414,10 @@ int main(void)
 	        cmocka_unit_test(test_regress_identical),
 	        cmocka_unit_test(test_regress_catches_changes),
 	        cmocka_unit_test(test_regress_exact),
+	        cmocka_unit_test(test_one_backend_two_settings),
+	        cmocka_unit_test(test_report_deterministic),
+	        cmocka_unit_test(test_unstable_event),
+	        cmocka_unit_test(test_regress_old_format),
 	        cmocka_unit_test(test_bad_usage),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);

@@ -270,7 +270,7 @@ static int run_trial(const bsim_backend *b, const bsim_scene *s, uint64_t seed, 
 	memset(wt, 0, sizeof *wt);
 	wt->s = s;
 	wt->pen_max = -INFINITY;
-	bsim_recorder rec = {NULL, 1, watch_fn, wt};
+	bsim_recorder rec = {.stride = 1, .trace = watch_fn, .trace_user = wt};
 	bsim_runner *r = bsim_runner_alloc();
 	assert_non_null(r);
 	bsim_error err;

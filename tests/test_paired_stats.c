@@ -1,7 +1,9 @@
 /* The paired statistics of beamsim compare against values worked by hand
  * (the binomial tails of McNemar's exact test, Holm's adjustment of a small
- * family) and against the large-sample normal limit (Newcombe's paired
- * interval must approach the Wald interval of the paired difference). */
+ * family), against published intervals (Tango's score interval in Tango
+ * 1998, Agresti & Min 2005 and Fagerland, Lydersen & Laake 2014), and
+ * against the large-sample normal limit (the paired intervals must approach
+ * the Wald interval of the paired difference). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -96,6 +98,127 @@ static void test_paired_ci_shape(void **state)
 	assert_float_equal(lo, -hi, 1e-12);
 }
 
+/* Tango's score interval against the published values, to the three
+ * decimals they are printed with. Tables are (a, b, c, d): both, A only,
+ * B only, neither. */
+static void test_tango_published(void **state)
+{
+	(void)state;
+	static const struct {
+		bsim_pairs t;
+		double level, lo, hi;
+		const char *source;
+	} cases[] = {
+	        /* Tango (1998), the 44-pair example with one discordant pair:
+	         * 90% interval, as for his equivalence test. */
+	        {{43, 0, 1, 0}, 0.90, -0.096, 0.037, "Tango 1998"},
+	        {{4, 9, 3, 16}, 0.95, -0.027, 0.390, "Tango 1998"},
+	        /* Agresti & Min (2005), Statist. Med. 24, 729-740. */
+	        {{53, 16, 8, 9}, 0.95, -0.020, 0.207, "Agresti & Min 2005"},
+	        /* Fagerland, Lydersen & Laake (2014), Statist. Med. 33,
+	         * 2850-2875: airway hyper-responsiveness (Bentur et al.). */
+	        {{1, 1, 7, 12}, 0.95, -0.517, -0.026, "Fagerland et al. 2014"},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		double lo, hi, z = bsim_normal_upper((1.0 - cases[i].level) / 2.0);
+		bsim_tango_ci(&cases[i].t, z, &lo, &hi);
+		print_message("%s: [%.4f, %.4f], published [%.3f, %.3f]\n", cases[i].source, lo, hi,
+		              cases[i].lo, cases[i].hi);
+		assert_float_equal(lo, cases[i].lo, 5e-4);
+		assert_float_equal(hi, cases[i].hi, 5e-4);
+	}
+}
+
+/* With no discordant pair the interval is the closed form +-z^2/(n + z^2)
+ * (T(delta) = -sqrt(n delta / (1 - delta)) for delta > 0), whatever the
+ * concordant pairs are: not a point, as Newcombe's becomes when a and d
+ * are both positive. */
+static void test_tango_no_discordant(void **state)
+{
+	(void)state;
+	const bsim_pairs tables[] = {{40, 0, 0, 60}, {100, 0, 0, 0}, {0, 0, 0, 100}};
+	double z = BSIM_Z95, w = z * z / (100.0 + z * z);
+	for (int i = 0; i < 3; i++) {
+		double lo, hi;
+		bsim_tango_ci(&tables[i], z, &lo, &hi);
+		assert_float_equal(lo, -w, 1e-9);
+		assert_float_equal(hi, w, 1e-9);
+	}
+	double nlo, nhi;
+	bsim_paired_diff_ci(&tables[0], z, &nlo, &nhi);
+	assert_true(nhi - nlo < 0.5 * (2.0 * w)); /* the collapse Tango avoids */
+}
+
+/* Large n: Tango's interval tends to the Wald interval too; it contains
+ * the estimate and mirrors when A and B swap. */
+static void test_tango_limit_and_shape(void **state)
+{
+	(void)state;
+	bsim_pairs t = {.a = 3000, .b = 600, .c = 400, .d = 6000};
+	double n = 10000, d = (t.b - t.c) / n;
+	double se = sqrt(((t.b + t.c) / n - d * d) / n);
+	double lo, hi;
+	bsim_tango_ci(&t, BSIM_Z95, &lo, &hi);
+	assert_float_equal(lo, d - BSIM_Z95 * se, 3e-4);
+	assert_float_equal(hi, d + BSIM_Z95 * se, 3e-4);
+	for (int b = 0; b <= 20; b += 4)
+		for (int c = 0; c <= 20; c += 5) {
+			bsim_pairs u = {.a = 30, .b = b, .c = c, .d = 70 - b - c};
+			bsim_pairs s = {.a = u.a, .b = c, .c = b, .d = u.d};
+			double l1, h1, l2, h2, e = (double)(b - c) / 100.0;
+			bsim_tango_ci(&u, BSIM_Z95, &l1, &h1);
+			bsim_tango_ci(&s, BSIM_Z95, &l2, &h2);
+			assert_true(-1.0 <= l1 && l1 < e && e < h1 && h1 <= 1.0);
+			assert_float_equal(l1, -h2, 1e-9);
+			assert_float_equal(h1, -l2, 1e-9);
+		}
+	/* All n pairs discordant one way: q = (1 - delta) / 2 and
+	 * T = sqrt(n (1 - delta) / (1 + delta)), so the interval is
+	 * [(n - z^2) / (n + z^2), 1]. */
+	bsim_pairs all = {0, 10, 0, 0};
+	double z2 = BSIM_Z95 * BSIM_Z95;
+	bsim_tango_ci(&all, BSIM_Z95, &lo, &hi);
+	assert_true(hi == 1.0);
+	assert_float_equal(lo, (10.0 - z2) / (10.0 + z2), 1e-9);
+}
+
+/* Tango's equivalence test is the interval read at level 1 - 2 alpha: the
+ * difference is shown within +-margin exactly when the 90% interval lies
+ * inside it (alpha 0.05). */
+static void test_tango_tost_matches_interval(void **state)
+{
+	(void)state;
+	double z90 = bsim_normal_upper(0.05);
+	for (int b = 0; b <= 12; b++)
+		for (int c = 0; c <= 12; c += 3)
+			for (double m = 0.02; m < 0.3; m += 0.04) {
+				bsim_pairs t = {.a = 40, .b = b, .c = c, .d = 60 - b - c};
+				double lo, hi;
+				bsim_tango_ci(&t, z90, &lo, &hi);
+				int inside = lo > -m && hi < m;
+				int tost = bsim_tango_tost(&t, m) < 0.05;
+				assert_int_equal(inside, tost);
+			}
+	bsim_pairs none = {40, 0, 0, 60};
+	assert_true(bsim_tango_tost(&none, 0.0) == 1.0);
+	/* 100 identical pairs: 90% interval +-0.026, inside +-0.05. */
+	assert_true(bsim_tango_tost(&none, 0.05) < 0.05);
+}
+
+/* The smallest significant split by hand: 2 (1/2)^m < level decides a
+ * one-way split; with Holm over 150 tests at 0.05 that takes 13 pairs. */
+static void test_mcnemar_split(void **state)
+{
+	(void)state;
+	assert_int_equal(bsim_mcnemar_split(12, 0.05 / 150), -1);
+	assert_int_equal(bsim_mcnemar_split(13, 0.05 / 150), 0);
+	assert_int_equal(bsim_mcnemar_split(5, 0.0625), -1);
+	assert_int_equal(bsim_mcnemar_split(5, 0.0626), 0);
+	/* 10 pairs at 0.05: 1 vs 9 gives 22/1024 = 0.021, 2 vs 8 gives 0.109. */
+	assert_int_equal(bsim_mcnemar_split(10, 0.05), 1);
+	assert_int_equal(bsim_mcnemar_split(0, 0.05), -1);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -104,6 +227,11 @@ int main(void)
 	        cmocka_unit_test(test_holm_by_hand),
 	        cmocka_unit_test(test_paired_ci_normal_limit),
 	        cmocka_unit_test(test_paired_ci_shape),
+	        cmocka_unit_test(test_tango_published),
+	        cmocka_unit_test(test_tango_no_discordant),
+	        cmocka_unit_test(test_tango_limit_and_shape),
+	        cmocka_unit_test(test_tango_tost_matches_interval),
+	        cmocka_unit_test(test_mcnemar_split),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

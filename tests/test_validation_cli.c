@@ -295,6 +295,42 @@ static void bad_experiment_keys(void **state)
 	                     needles3);
 }
 
+/* A fixed value for a field the grid varies would be lost in every group:
+ * refused, from the experiment's set: block and from the command line. */
+static void grid_conflict(void **state)
+{
+	(void)state;
+	const char *needles[] = {"set_grid.yaml:5",
+	                         "set.beams.0.stiffness",
+	                         "the grid varies beams.0.stiffness (",
+	                         "set_grid.yaml:7)",
+	                         "expected a key the grid does not vary",
+	                         NULL};
+	sweep_bad_experiment("set_grid",
+	                     "scene: gate.yaml\ntrials: 2\nseed: 1\nset:\n"
+	                     "  beams.0.stiffness: 300\ngrid:\n"
+	                     "  beams.0.stiffness: [100, 200]\n",
+	                     needles);
+
+	char dir[1024], exp[1200], out[1200], path[1300];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("cli_grid"));
+	bsim_test_write(dir, "gate.yaml", BODY BEAMS);
+	snprintf(exp, sizeof exp, "%s",
+	         bsim_test_write(dir, "cli_grid.yaml",
+	                         "scene: gate.yaml\ntrials: 2\nseed: 1\ngrid:\n"
+	                         "  effects.propulsion.force: [4, 5]\n"));
+	snprintf(out, sizeof out, "%s/out", dir);
+	const char *argv[] = {"sweep", exp, "--set", "effects.propulsion.force=7",
+	                      "--out", out, NULL};
+	const char *needles2[] = {"--set effects.propulsion.force=7",
+	                          "grid varies effects.propulsion.force (", "cli_grid.yaml:5)",
+	                          NULL};
+	expect_input_error(argv, needles2);
+	snprintf(path, sizeof path, "%s/trials.csv", out);
+	char *trials = bsim_test_read(path);
+	assert_null(trials);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -307,7 +343,7 @@ int main(void)
 	        cmocka_unit_test(overlapping_start),   cmocka_unit_test(yaml_syntax_error),
 	        cmocka_unit_test(bad_set_value),       cmocka_unit_test(set_into_unknown_key),
 	        cmocka_unit_test(empty_grid),          cmocka_unit_test(bad_grid_value),
-	        cmocka_unit_test(bad_experiment_keys),
+	        cmocka_unit_test(bad_experiment_keys), cmocka_unit_test(grid_conflict),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -40,6 +40,7 @@ typedef struct thesis_contact {
 
 enum { THESIS_MIDPOINT = 0, THESIS_EULER = 1 };
 enum { THESIS_SIMULTANEOUS = 0, THESIS_NEAREST_FIRST = 1 };
+enum { THESIS_CONTACT_PHYSICAL = 0, THESIS_CONTACT_ESSAY = 1 };
 
 struct bsim_world {
 	double x[2], v[2]; /* body centre and velocity */
@@ -49,7 +50,7 @@ struct bsim_world {
 	double e_tangent, e_tip; /* restitution */
 	double rest_threshold;   /* m/s */
 	/* knobs */
-	int integrator, impact_order, projection;
+	int integrator, impact_order, projection, contact_mode;
 	double slop;        /* penetration tolerated before projection, m */
 	double contact_tol; /* gap counted as touching in the state, m */
 	/* per step */
@@ -57,6 +58,8 @@ struct bsim_world {
 	int n_contacts;
 	int *contact_of;   /* per beam: its index in contacts, or -1 */
 	int *contact_type; /* per beam, at the end of the step */
+	int *held;         /* per beam: in persistent contact (contact_mode=essay) */
+	int any_held;
 	bsim_step_energy energy;
 	int impacts;
 };

@@ -5,7 +5,17 @@
  *      rest_threshold);
  *   3. smooth motion under the external force, springs, dampers and
  *      persistent contact forces;
- *   4. projection of any penetration left by the contacts' curvature. */
+ *   4. projection of any penetration left by the contacts' curvature.
+ *
+ * contact_mode=essay reads the essay's flowchart (Sec. 2.4, Fig. 2.5)
+ * literally: once a contact turns persistent the program leaves the
+ * collision loop for the constraint loop and stays there "until both beams
+ * are detached", so while any beam is held, a beam that is not held is not
+ * tested for contact at all and can swing through the body (or the body
+ * through it). A beam is held after a step in which it touched the body
+ * (gap <= contact_tol) and the smooth solve pressed on it (P > 0); it is
+ * released by the first step whose solve leaves it unpressed. The default,
+ * physical, tests every beam the step can reach. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,8 +33,19 @@ static const bsim_knob thesis_knobs[] = {
         {"slop", BSIM_KNOB_DOUBLE, "1e-6", NULL, "penetration tolerated before projection, m"},
         {"contact_tol", BSIM_KNOB_DOUBLE, "1e-3", NULL,
          "gap below which a beam is reported as touching the body, m"},
+        {"contact_mode", BSIM_KNOB_CHOICE, "physical", "physical|essay",
+         "physical: every beam the step can reach is tested for contact; essay: the essay's "
+         "flowchart read literally, while one beam is held in persistent contact the others "
+         "are not tested and can pass through the body"},
 };
-enum { KNOB_INTEGRATOR, KNOB_IMPACT_ORDER, KNOB_PROJECTION, KNOB_SLOP, KNOB_CONTACT_TOL };
+enum {
+	KNOB_INTEGRATOR,
+	KNOB_IMPACT_ORDER,
+	KNOB_PROJECTION,
+	KNOB_SLOP,
+	KNOB_CONTACT_TOL,
+	KNOB_CONTACT_MODE
+};
 #define N_KNOBS ((int)(sizeof thesis_knobs / sizeof thesis_knobs[0]))
 
 /* The rest direction, exact at multiples of 90 degrees so that a mirrored
@@ -52,6 +73,7 @@ static void thesis_destroy(bsim_world *w)
 	free(w->contacts);
 	free(w->contact_of);
 	free(w->contact_type);
+	free(w->held);
 	free(w);
 }
 
@@ -69,8 +91,9 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->contacts = calloc(nb, sizeof *w->contacts);
 		w->contact_of = malloc(nb * sizeof *w->contact_of);
 		w->contact_type = calloc(nb, sizeof *w->contact_type);
+		w->held = calloc(nb, sizeof *w->held);
 	}
-	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type) {
+	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type || !w->held) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
@@ -102,6 +125,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	w->projection = bsim_options_int(opts, &thesis_knobs[KNOB_PROJECTION]) != 0;
 	w->slop = bsim_options_double(opts, &thesis_knobs[KNOB_SLOP]);
 	w->contact_tol = fmax(bsim_options_double(opts, &thesis_knobs[KNOB_CONTACT_TOL]), w->slop);
+	w->contact_mode = bsim_options_choice(opts, &thesis_knobs[KNOB_CONTACT_MODE]);
 	*out = w;
 	return BSIM_OK;
 }
@@ -124,14 +148,31 @@ static double step_margin(const bsim_world *w, const thesis_beam *b, double spee
 	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
 }
 
+/* contact_mode=essay: the beams held after this step's solve (touching at
+ * its start and pressed by it); 1 if any is. */
+static int essay_hold(bsim_world *w)
+{
+	int any = 0;
+	for (int i = 0; i < w->n_beams; i++)
+		w->held[i] = 0;
+	for (int k = 0; k < w->n_contacts; k++) {
+		const thesis_contact *c = &w->contacts[k];
+		if (c->impulse > 0.0 && c->gap <= w->contact_tol)
+			any = w->held[c->beam] = 1;
+	}
+	return any;
+}
+
 static void thesis_step(bsim_world *w, const double force[2], double h)
 {
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
 	double speed = hypot(w->v[0], w->v[1]) + h * hypot(force[0], force[1]) * w->inv_mass;
-	int n = 0;
+	int n = 0, holding = w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
 	for (int i = 0; i < w->n_beams; i++) {
 		w->contact_type[i] = BSIM_CONTACT_NONE;
+		if (holding && !w->held[i])
+			continue; /* essay: the constraint loop tests only held beams */
 		n += thesis_contact_detect(w, i, step_margin(w, &w->beams[i], speed, h),
 		                           &w->contacts[n]);
 	}
@@ -139,6 +180,8 @@ static void thesis_step(bsim_world *w, const double force[2], double h)
 	if (n)
 		thesis_impact_resolve(w, h);
 	thesis_contact_solve(w, force, h);
+	if (w->contact_mode == THESIS_CONTACT_ESSAY)
+		w->any_held = essay_hold(w);
 	if (n)
 		thesis_position_project(w, force);
 }
@@ -169,7 +212,9 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 		w->beams[i].theta = s->theta[i];
 		w->beams[i].omega = s->omega[i];
 		w->contact_type[i] = s->contact[i];
+		w->held[i] = 0; /* a state has no loop: contact_mode=essay starts afresh */
 	}
+	w->any_held = 0;
 	return BSIM_OK;
 }
 

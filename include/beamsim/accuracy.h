@@ -75,7 +75,7 @@ typedef struct bsim_accuracy_row {
 	double wall_seconds;      /* wall time of the batch and pieces, s */
 	double cost;              /* wall s per simulated s */
 	double speed;             /* simulated s per wall s (x real time) */
-	int failed;               /* trials that ended in a non-finite state */
+	int failed;               /* trials that ended unstable (bsim_instability) */
 } bsim_accuracy_row;
 
 typedef struct bsim_accuracy_result {

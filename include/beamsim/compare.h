@@ -20,6 +20,7 @@ typedef enum {
 	BSIM_EVENT_RIGHT, /* traversed over the right beam */
 	BSIM_EVENT_SIDE_EXIT,
 	BSIM_EVENT_STUCK,
+	BSIM_EVENT_UNSTABLE, /* the backend failed (non-finite, or energy created) */
 	BSIM_N_EVENTS
 } bsim_event;
 
@@ -34,7 +35,19 @@ int bsim_event_of(const bsim_trial_result *r, bsim_event ev);
  * many trials) from failing a guard; set it to 0 for significance alone.
  * exact: any trial not identical in every trials.csv field makes its
  * group disagree (regress --exact: identical code and inputs must give
- * identical trials). */
+ * identical trials).
+ *
+ * A group without random draws (bsim_group_result.deterministic on either
+ * side) is one trial, not a sample: it is compared as one pair, same or
+ * different, with no interval or p-value, and stays out of the Holm
+ * family. A deterministic pair that differs in outcome or type disagrees.
+ *
+ * A group that does not disagree is "equivalent" when, for every event,
+ * Tango's two one-sided tests show the difference within +-margin at level
+ * alpha; otherwise the comparison could not tell ("inconclusive": no
+ * difference detected, none excluded either). Each group's equivalence is
+ * tested at alpha without correction: the claim that every group is
+ * equivalent is an intersection-union test, valid at alpha as it is. */
 typedef struct bsim_compare_rule {
 	double alpha;  /* family-wise error rate, (0, 1) */
 	double margin; /* |p_A - p_B|, [0, 1] */
@@ -48,24 +61,36 @@ typedef struct bsim_event_test {
 	bsim_pairs pairs;        /* a: both, b: only A, c: only B, d: neither */
 	double p_a, p_b;         /* event probabilities */
 	double ci_a[2], ci_b[2]; /* Wilson 95% */
-	double diff, diff_ci[2]; /* p_a - p_b, Newcombe paired 95% */
+	double diff, diff_ci[2]; /* p_a - p_b, Tango's paired score 95% */
 	double p_value, p_holm;  /* exact McNemar, and Holm-adjusted */
+	double p_equivalence;    /* Tango's two one-sided tests against +-margin */
+	double detectable;       /* the smallest |p_a - p_b| the Holm-corrected test
+	                          * could flag here, given this event's discordant
+	                          * pairs (at least the fewest that can be flagged) */
 	int beyond;              /* p_holm < alpha and |diff| >= margin */
+	int equivalent;          /* p_equivalence < alpha */
 } bsim_event_test;
 
+/* The verdicts, from "nothing to see" to "disagree". Deterministic groups
+ * are same or DIFFERENT; the others one of the four below. */
 typedef enum {
-	BSIM_VERDICT_SAME = 0,     /* every pair had the same outcome */
-	BSIM_VERDICT_AGREE = 1,    /* outcomes differ, no event significantly */
-	BSIM_VERDICT_SMALL = 2,    /* significant, but within the margin */
-	BSIM_VERDICT_DISAGREE = 3, /* beyond the rule */
+	BSIM_VERDICT_SAME = 0,         /* deterministic: the one pair alike */
+	BSIM_VERDICT_EQUIVALENT = 1,   /* every event shown within +-margin */
+	BSIM_VERDICT_INCONCLUSIVE = 2, /* no difference detected, none excluded */
+	BSIM_VERDICT_SMALL = 3,        /* significant, but within the margin */
+	BSIM_VERDICT_DISAGREE = 4,     /* beyond the rule */
+	BSIM_VERDICT_DIFFERENT = 5,    /* deterministic: the one pair differs */
+	BSIM_N_VERDICTS
 } bsim_verdict;
 
 const char *bsim_verdict_name(bsim_verdict v);
 
 typedef struct bsim_compare_group {
+	int deterministic; /* one pair: ev has the 0/1 events, no statistics */
+	int pairs;         /* pairs compared: trials, or 1 if deterministic */
 	bsim_event_test ev[BSIM_N_EVENTS];
 	int discordant;  /* pairs with a different outcome or type */
-	int changed;     /* pairs not identical in any trials.csv field */
+	int changed;     /* trials (copies included) not identical in some trials.csv field */
 	int separated;   /* pairs whose trajectories separated */
 	double t_sep[3]; /* 10%, 50%, 90% quantiles of the separation time
 	                  * over separated pairs, s; -1 if none */
@@ -76,8 +101,11 @@ typedef struct bsim_comparison {
 	int n_groups, trials;
 	bsim_compare_rule rule;
 	bsim_compare_group *groups;
-	int n_disagree; /* groups with BSIM_VERDICT_DISAGREE */
-	int separated;  /* pairs that separated, over all groups */
+	int n_tests;    /* the Holm family: random groups x events */
+	int n_disagree; /* groups DISAGREE or DIFFERENT */
+	int count[BSIM_N_VERDICTS];
+	int separated; /* pairs that separated, over all groups */
+	int pairs;     /* pairs compared, over all groups */
 	double t_sep[3];
 } bsim_comparison;
 
@@ -90,8 +118,9 @@ void bsim_comparison_free(bsim_comparison *c);
 
 /* 1 if trials differ in outcome or traversal type. */
 int bsim_trial_discordant(const bsim_trial_result *a, const bsim_trial_result *b);
-/* 1 if trials are identical in every field trials.csv records. */
-int bsim_trial_identical(const bsim_trial_result *a, const bsim_trial_result *b);
+/* 1 if trials are identical in every field trials.csv records (the
+ * ledger's only if ledger is 1). */
+int bsim_trial_identical(const bsim_trial_result *a, const bsim_trial_result *b, int ledger);
 
 #ifdef __cplusplus
 }

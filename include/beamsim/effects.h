@@ -31,6 +31,10 @@ typedef struct bsim_effects {
 	bsim_effect *random; /* the random-force effect, or NULL */
 } bsim_effects;
 
+/* 1 if the scene's effects draw random numbers, so that a trial depends on
+ * its seed; 0 if every trial of the scene is the same trial. */
+int bsim_effects_random(const bsim_scene *scene);
+
 /* Builds the pipeline from scene->effects; seed is the trial's mixed seed. */
 int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed);
 void bsim_effects_free(bsim_effects *fx);

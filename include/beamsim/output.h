@@ -17,11 +17,22 @@ extern "C" {
 
 int bsim_output_summary_json(const char *path, const bsim_experiment *e, const char *backend,
                              const bsim_options *opts, const bsim_sweep_result *r, bsim_error *err);
-int bsim_output_trials_csv(const char *path, const bsim_sweep_result *r, bsim_error *err);
-/* Reads a trials.csv written by bsim_output_trials_csv back into r (which
- * it allocates: n_groups x trials rows, each exactly once) and aggregates
- * the groups. The fields not in the file are zero. BSIM_EINPUT with
- * file and line on a malformed, missing or extra row. */
+/* trials.csv, one row per trial (DESIGN.md "Outputs", extended by
+ * appending): group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,
+ * max_theta1,max_theta2, then the energy ledger e_start,e_end,work_in
+ * (propulsion + random force),losses (dampers + impacts + contact +
+ * correction),residual (J), overlap_max (m; empty if not measured), then one
+ * column per grid axis of e (may be NULL), named by its dotted key, holding
+ * the group's value. */
+int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                           bsim_error *err);
+/* Reads a trials.csv written by bsim_output_trials_csv, by this version or
+ * an earlier one, back into r (which it allocates: n_groups x trials rows,
+ * each exactly once) and aggregates the groups. Columns are found by their
+ * header name; the first eleven are required, the ledger columns are read
+ * when present (r->has_ledger), others are ignored. The fields not in the
+ * file are zero. BSIM_EINPUT with file and line on a malformed, missing or
+ * extra row. */
 int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_sweep_result *r,
                             bsim_error *err);
 

@@ -21,6 +21,7 @@ typedef struct bsim_run_record {
 	char version[32]; /* of the beamsim that wrote it */
 	int n_backends;   /* 1 (sweep) or 2 (compare) */
 	char backend[2][32];
+	char label[2][128];   /* compare's side labels (NAME[:K=V]...); the name if none */
 	bsim_options opts[2]; /* every knob, effective value */
 	uint64_t seed;
 	int trials;

@@ -52,12 +52,14 @@ typedef struct bsim_scene {
 	bsim_beam_def *beams; /* n_beams entries, owned by the scene */
 	bsim_contact_def contact;
 	bsim_effects_def effects;
-	double dt;           /* s, > 0; default 0.004 */
-	int max_steps;       /* > 0; default 3000 */
-	double success_y;    /* m; default 65 */
-	double side_x;       /* m, > 0; default 25 */
-	double classify_y;   /* m, >= success_y; default 80 */
-	double landscape_y0; /* m, zero of the propulsive potential; default 60 */
+	double dt;                /* s, > 0; default 0.004 */
+	int max_steps;            /* > 0; default 3000 */
+	double success_y;         /* m; default 65 */
+	double side_x;            /* m, > 0; default 25 */
+	double classify_y;        /* m, >= success_y; default 80 */
+	double classify_deadband; /* m/s: |v_x| at classify_y below it is type none;
+	                           * default 0.01 */
+	double landscape_y0;      /* m, zero of the propulsive potential; default 60 */
 } bsim_scene;
 
 /* One override of a scene field by dotted path, e.g. key "beams.0.stiffness",

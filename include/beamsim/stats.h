@@ -30,8 +30,37 @@ typedef struct bsim_pairs {
 
 /* The 95% interval of p_A - p_B = (b - c) / n for paired data: Newcombe's
  * hybrid score interval (Statist. Med. 17, 1998, method 10), built from the
- * two Wilson intervals and the correlation of the pairs. */
+ * two Wilson intervals and the correlation of the pairs. It shrinks to a
+ * point when the pairs are perfectly correlated (b = c = 0 with a, d > 0);
+ * beamsim compare uses Tango's interval below. */
 void bsim_paired_diff_ci(const bsim_pairs *t, double z, double *lo, double *hi);
+
+/* Tango's score statistic (Statist. Med. 17, 1998, 891-908) for
+ * H0: p_A - p_B = delta, delta in (-1, 1):
+ *   T(delta) = (b - c - n delta) / sqrt(n (2 q + delta (1 - delta)))
+ * with q the maximum-likelihood estimate of the probability of a (no, yes)
+ * pair under H0. T falls as delta rises; T ~ N(0, 1) under H0. */
+double bsim_tango_score(const bsim_pairs *t, double delta);
+
+/* Tango's score interval for p_A - p_B: every delta with |T(delta)| <= z.
+ * Unlike Wald or Newcombe it keeps a width with no discordant pair at all
+ * (b = c = 0 gives +-z^2 / (n + z^2)) and stays inside [-1, 1]. */
+void bsim_tango_ci(const bsim_pairs *t, double z, double *lo, double *hi);
+
+/* Tango's equivalence test of the paired difference against +-margin:
+ * two one-sided score tests, H0: p_A - p_B <= -margin and
+ * H0: p_A - p_B >= margin. Returns the larger of their p-values; below
+ * alpha, the difference is shown to lie within +-margin (equivalently, the
+ * 1 - 2 alpha Tango interval lies inside it). 1 for margin <= 0. */
+double bsim_tango_tost(const bsim_pairs *t, double margin);
+
+/* Of m discordant pairs, the largest count k going one way for which the
+ * exact McNemar test (k against m - k) has a p-value below level; -1 if
+ * none (too few pairs to reach it). |b - c| >= m - 2k is then significant. */
+int bsim_mcnemar_split(int m, double level);
+
+/* The standard normal quantile z with P(Z > z) = q. */
+double bsim_normal_upper(double q);
 
 #ifdef __cplusplus
 }

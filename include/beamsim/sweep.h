@@ -13,6 +13,10 @@ extern "C" {
 
 typedef struct bsim_group_result {
 	int trials, traversed, side_exit, stuck, left, right;
+	int unstable;      /* trials whose backend failed (bsim_instability) */
+	int deterministic; /* 1: the scene draws no random numbers, so every trial
+	                    * is the same trial: it ran once, the others are copies,
+	                    * and ci95 is the point p_traverse */
 	int stuck_in_contact;
 	int landscape_left, landscape_right; /* traversed over beam 0's / 1's barrier */
 	double p_traverse, ci95[2];          /* Wilson 95% */
@@ -24,7 +28,10 @@ typedef struct bsim_sweep_result {
 	bsim_trial_result *trials_out; /* n_groups * trials, index g*trials + t */
 	bsim_group_result *groups;     /* n_groups */
 	double wall_seconds;
-	long total_steps;
+	long total_steps; /* steps integrated (a deterministic group's one trial) */
+	long trials_run;  /* trials integrated: copies of a deterministic group's not */
+	int has_ledger;   /* 1: the trials' ledgers are known (a run, or a trials.csv
+	                   * with the energy columns) */
 } bsim_sweep_result;
 
 /* Called from one thread now and then with done/total trials. */
@@ -38,6 +45,7 @@ typedef struct bsim_sweep_config {
 	int n_extra;
 	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
+	int measure_overlap; /* 1: each trial's overlap_max (plain sweeps only) */
 } bsim_sweep_config;
 
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller

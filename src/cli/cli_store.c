@@ -13,6 +13,15 @@
 #include "beamsim/report.h"
 #include "cli_common.h"
 
+void cli_label_dir(const char *label, char *buf, size_t size)
+{
+	size_t k = 0;
+	for (; *label && k + 1 < size; label++)
+		buf[k++] = *label == ':' || *label == '/' ? '-' : *label;
+	if (size > 0)
+		buf[k] = '\0';
+}
+
 int cli_path(char *buf, size_t size, const char *dir, const char *name)
 {
 	int n = snprintf(buf, size, "%s/%s", dir, name);
@@ -25,13 +34,14 @@ int cli_path(char *buf, size_t size, const char *dir, const char *name)
 
 static void record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e, int n,
                         const bsim_backend *const *b, const bsim_options *const *opts,
-                        const bsim_compare_rule *rule)
+                        const char *const *label, const bsim_compare_rule *rule)
 {
 	memset(rec, 0, sizeof *rec);
 	snprintf(rec->command, sizeof rec->command, "%s", command);
 	rec->n_backends = n;
 	for (int i = 0; i < n; i++) {
 		snprintf(rec->backend[i], sizeof rec->backend[i], "%s", b[i]->name);
+		snprintf(rec->label[i], sizeof rec->label[i], "%s", label ? label[i] : b[i]->name);
 		bsim_options_effective(b[i], opts[i], &rec->opts[i]);
 	}
 	rec->seed = e->seed;
@@ -52,7 +62,7 @@ static int sweep_files(const char *dir, const bsim_experiment *e, const bsim_bac
 		return CLI_FAIL;
 	if (bsim_output_mkdir(dir, &err) != BSIM_OK ||
 	    bsim_output_summary_json(summary, e, b->name, opts, r, &err) != BSIM_OK ||
-	    bsim_output_trials_csv(trials, r, &err) != BSIM_OK) {
+	    bsim_output_trials_csv(trials, e, r, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return CLI_FAIL;
 	}
@@ -67,7 +77,7 @@ int cli_store_sweep(const char *dir, const bsim_experiment *e, const bsim_backen
 	bsim_error err;
 	if (sweep_files(dir, e, b, opts, r) != CLI_OK)
 		return CLI_FAIL;
-	record_fill(&rec, "sweep", e, 1, &b, &opts, NULL);
+	record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL);
 	if (bsim_run_record_write(dir, &rec, e, extra, n_extra, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return CLI_FAIL;
@@ -107,15 +117,15 @@ static char *compare_title(const cli_compare_job *job)
 	FILE *f = open_memstream(&buf, &len);
 	if (!f)
 		return NULL;
-	fprintf(f, "# beamsim compare: %s vs %s\n\n", job->backend[0]->name, job->backend[1]->name);
+	fprintf(f, "# beamsim compare: %s vs %s\n\n", job->label[0], job->label[1]);
 	fprintf(f,
-	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; both backends "
+	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; both sides "
 	        "ran every trial with the same random-force schedule, so trial t of group g is "
 	        "a pair.\n\n",
 	        job->e->path, job->e->scene_path, (unsigned long long)job->e->seed,
 	        job->e->n_groups, job->e->trials);
 	for (int i = 0; i < 2; i++) {
-		fprintf(f, "- %s options: ", job->backend[i]->name);
+		fprintf(f, "- %s: backend %s, options ", job->label[i], job->backend[i]->name);
 		bsim_output_backend_options(f, job->backend[i], job->opts[i]);
 		fputc('\n', f);
 	}
@@ -136,10 +146,11 @@ static int compare_write(const cli_compare_job *job, const bsim_sweep_result r[2
 	        .examples = job->examples,
 	};
 	for (int i = 0; i < 2; i++) {
-		char dir[1100];
-		rep.side[i] = (bsim_report_side){job->backend[i]->name, job->backend[i],
-		                                 job->opts[i], &r[i]};
-		if (cli_path(dir, sizeof dir, job->out, job->backend[i]->name) ||
+		char dir[1100], name[128];
+		rep.side[i] =
+		        (bsim_report_side){job->label[i], job->backend[i], job->opts[i], &r[i]};
+		cli_label_dir(job->label[i], name, sizeof name);
+		if (cli_path(dir, sizeof dir, job->out, name) ||
 		    sweep_files(dir, job->e, job->backend[i], job->opts[i], &r[i]))
 			return CLI_FAIL;
 	}
@@ -154,7 +165,7 @@ static int compare_write(const cli_compare_job *job, const bsim_sweep_result r[2
 		return rc;
 	bsim_run_record rec;
 	bsim_error err;
-	record_fill(&rec, "compare", job->e, 2, job->backend, job->opts, &job->rule);
+	record_fill(&rec, "compare", job->e, 2, job->backend, job->opts, job->label, &job->rule);
 	if (bsim_run_record_write(job->out, &rec, job->e, job->extra, job->n_extra, &err) !=
 	    BSIM_OK) {
 		cli_error("%s", err.msg);

@@ -178,7 +178,7 @@ static int bench_sweep(const bsim_backend *backend, const bsim_options *opts,
 	*out = (bench_run){
 	        .experiment = label,
 	        .threads = threads,
-	        .trials = (long)r.n_groups * r.trials,
+	        .trials = r.trials_run,
 	        .steps = r.total_steps,
 	        .wall = r.wall_seconds,
 	};

@@ -19,26 +19,35 @@
 static const char compare_help[] =
         "Usage: beamsim compare EXPERIMENT --out DIR [OPTIONS]\n"
         "\n"
-        "Runs every trial of the experiment on two backends with the same random-force\n"
-        "schedule, so trial t of group g is a pair, and reports per group: both\n"
-        "backends' probabilities of traversed, left, right, side_exit and stuck with\n"
-        "Wilson 95% intervals, their paired difference (Newcombe 95% interval), the\n"
-        "exact McNemar test on the discordant pairs, Holm-corrected over all groups\n"
-        "and events, a verdict, and the times at which paired trajectories first\n"
-        "separate by more than 1% of the body radius. Disagreeing groups list example\n"
-        "trials with the `beamsim run` lines that replay them on either backend.\n"
+        "Runs every trial of the experiment on two backends, or two settings of one,\n"
+        "with the same random-force schedule, so trial t of group g is a pair, and\n"
+        "reports per group: both sides' probabilities of traversed, left, right,\n"
+        "side_exit, stuck and unstable with Wilson 95% intervals, their paired\n"
+        "difference (Tango's 95% score interval), the exact McNemar test on the\n"
+        "discordant pairs, Holm-corrected over all groups with random force and events,\n"
+        "Tango's equivalence test against +-margin, the smallest difference the test\n"
+        "could detect, a verdict, and the times at which paired trajectories first\n"
+        "separate by more than 1% of the body radius. A group without random force is\n"
+        "deterministic: it runs once and is compared as one pair, same or different.\n"
+        "Disagreeing groups list example trials with the `beamsim run` lines that\n"
+        "replay them on either side.\n"
         "\n"
         "A group disagrees when an event's Holm-adjusted p-value is below --alpha and\n"
-        "its probabilities differ by at least --margin. Exit status 3 if any does.\n"
+        "its probabilities differ by at least --margin, or, if deterministic, when its\n"
+        "pair differs. Exit status 3 if any does.\n"
         "\n"
-        "Writes DIR/report.md, DIR/report.json, DIR/pairs.csv, DIR/<backend>/summary.json\n"
-        "and trials.csv for each backend, and DIR/run.json with DIR/inputs/ for\n"
+        "Writes DIR/report.md, DIR/report.json, DIR/pairs.csv, DIR/<label>/summary.json\n"
+        "and trials.csv for each side, and DIR/run.json with DIR/inputs/ for\n"
         "`beamsim regress DIR`.\n"
         "\n"
         "Options:\n"
         "  --out DIR              output directory, created if missing (required)\n"
-        "  --backends A,B         the two backends (default thesis,box2d)\n"
-        "  --backend-opt B:K=V    option K=V for backend B, repeatable\n"
+        "  --backends A,B         the two sides (default thesis,box2d); each a backend\n"
+        "                         with options inline, NAME[:K=V]..., e.g.\n"
+        "                         thesis,thesis:integrator=euler; the side's label and\n"
+        "                         directory are the text (':' written '-' in the name)\n"
+        "  --backend-opt B:K=V    option K=V for every side on backend B, repeatable;\n"
+        "                         inline options win\n"
         "  --threads N            worker threads (default: all cores)\n"
         "  --trials N             trials per group (default: the experiment's)\n"
         "  --seed N               experiment seed (default: the experiment's)\n"
@@ -81,7 +90,9 @@ static const struct option compare_options[] = {
 
 typedef struct compare_args {
 	const char *experiment;
-	char names[2][32];
+	char labels[2][128]; /* as given: NAME[:K=V]... */
+	char names[2][32];   /* the backends */
+	char dirs[2][128];   /* the labels as directory names */
 	bsim_options opts[2];
 	long threads, trials, examples;
 	int has_seed;
@@ -90,7 +101,7 @@ typedef struct compare_args {
 	const char *out;
 	bsim_compare_rule rule;
 	int quiet;
-	/* --backend-opt before --backends is resolved after parsing */
+	/* --backend-opt, resolved after parsing, before the inline options */
 	int n_pending;
 	char pending[2 * BSIM_OPTIONS_MAX][128];
 } compare_args;
@@ -99,22 +110,53 @@ static int parse_backends(compare_args *a, const char *text)
 {
 	const char *comma = strchr(text, ',');
 	size_t n0 = comma ? (size_t)(comma - text) : 0;
-	if (!comma || n0 == 0 || n0 >= sizeof a->names[0] || strchr(comma + 1, ',') ||
-	    comma[1] == '\0' || strlen(comma + 1) >= sizeof a->names[1])
-		return cli_usage("compare", "--backends %s: expected two names A,B", text);
-	snprintf(a->names[0], sizeof a->names[0], "%.*s", (int)n0, text);
-	snprintf(a->names[1], sizeof a->names[1], "%s", comma + 1);
+	if (!comma || n0 == 0 || n0 >= sizeof a->labels[0] || strchr(comma + 1, ',') ||
+	    comma[1] == '\0' || strlen(comma + 1) >= sizeof a->labels[1])
+		return cli_usage("compare", "--backends %s: expected two sides A,B", text);
+	snprintf(a->labels[0], sizeof a->labels[0], "%.*s", (int)n0, text);
+	snprintf(a->labels[1], sizeof a->labels[1], "%s", comma + 1);
 	return CLI_OK;
 }
 
-/* "B:K=V" into the options of backend B (one of the two). */
+/* Side i's backend name, its directory name, and its inline options
+ * (after any --backend-opt, so they win). */
+static int side_resolve(compare_args *a, int i)
+{
+	const char *label = a->labels[i];
+	size_t n = strcspn(label, ":");
+	if (n == 0 || n >= sizeof a->names[i])
+		return cli_usage("compare", "--backends: side %s: expected NAME[:KEY=VALUE]...",
+		                 label);
+	snprintf(a->names[i], sizeof a->names[i], "%.*s", (int)n, label);
+	for (const char *p = label + n; *p == ':';) {
+		const char *q = p + 1;
+		size_t len = strcspn(q, ":");
+		char kv[128];
+		snprintf(kv, sizeof kv, "%.*s", (int)len, q);
+		int rc = cli_options_add(&a->opts[i], "compare", kv);
+		if (rc != CLI_OK)
+			return rc;
+		p = q + len;
+	}
+	cli_label_dir(label, a->dirs[i], sizeof a->dirs[i]);
+	return CLI_OK;
+}
+
+/* "B:K=V" into the options of every side whose backend is B. */
 static int backend_opt(compare_args *a, const char *text)
 {
 	const char *colon = strchr(text, ':');
+	int used = 0;
 	for (int i = 0; colon && i < 2; i++)
 		if (strlen(a->names[i]) == (size_t)(colon - text) &&
-		    strncmp(text, a->names[i], (size_t)(colon - text)) == 0)
-			return cli_options_add(&a->opts[i], "compare", colon + 1);
+		    strncmp(text, a->names[i], (size_t)(colon - text)) == 0) {
+			int rc = cli_options_add(&a->opts[i], "compare", colon + 1);
+			if (rc != CLI_OK)
+				return rc;
+			used = 1;
+		}
+	if (used)
+		return CLI_OK;
 	return cli_usage("compare", "--backend-opt %s: expected B:KEY=VALUE with B one of %s, %s",
 	                 text, a->names[0], a->names[1]);
 }
@@ -193,32 +235,84 @@ static int compare_parse(int argc, char **argv, compare_args *a)
 		return cli_usage("compare", "--out DIR is required");
 	if (strlen(a->out) > 900)
 		return cli_usage("compare", "--out DIR is longer than 900 characters");
-	if (strcmp(a->names[0], a->names[1]) == 0)
-		return cli_usage("compare", "--backends %s,%s: expected two different backends",
-		                 a->names[0], a->names[1]);
+	if (strcmp(a->labels[0], a->labels[1]) == 0)
+		return cli_usage(
+		        "compare",
+		        "--backends %s,%s: expected two different sides (a backend against "
+		        "itself takes options inline, e.g. thesis,thesis:integrator=euler)",
+		        a->labels[0], a->labels[1]);
+	/* names first (--backend-opt needs them), then the options in order:
+	 * --backend-opt, then inline */
+	bsim_options inline_opts[2];
+	for (int i = 0; i < 2; i++) {
+		int rc = side_resolve(a, i);
+		if (rc != CLI_OK)
+			return rc;
+		inline_opts[i] = a->opts[i];
+		memset(&a->opts[i], 0, sizeof a->opts[i]);
+	}
+	if (strcmp(a->dirs[0], a->dirs[1]) == 0)
+		return cli_usage("compare", "--backends %s,%s: both sides would write to %s/%s",
+		                 a->labels[0], a->labels[1], a->out, a->dirs[0]);
 	for (int i = 0; i < a->n_pending; i++) {
 		int rc = backend_opt(a, a->pending[i]);
 		if (rc != CLI_OK)
 			return rc;
 	}
+	for (int i = 0; i < 2; i++)
+		for (int k = 0; k < inline_opts[i].n; k++) {
+			char kv[128];
+			snprintf(kv, sizeof kv, "%s=%s", inline_opts[i].key[k],
+			         inline_opts[i].value[k]);
+			int rc = cli_options_add(&a->opts[i], "compare", kv);
+			if (rc != CLI_OK)
+				return rc;
+		}
 	return -1;
+}
+
+/* Unstable trials on each side, over the whole comparison. */
+static void unstable_counts(const bsim_comparison *cmp, int n[2])
+{
+	n[0] = n[1] = 0;
+	for (int g = 0; g < cmp->n_groups; g++) {
+		const bsim_event_test *t = &cmp->groups[g].ev[BSIM_EVENT_UNSTABLE];
+		int w = cmp->groups[g].deterministic ? cmp->trials : 1;
+		n[0] += w * (t->pairs.a + t->pairs.b);
+		n[1] += w * (t->pairs.a + t->pairs.c);
+	}
 }
 
 static void compare_summary(const compare_args *a, const bsim_experiment *e,
                             const bsim_comparison *cmp)
 {
+	const int *k = cmp->count;
 	printf("%s vs %s on %s: %d of %d groups disagree (alpha %g, margin %g), %d x %d trials\n",
-	       a->names[0], a->names[1], e->path, cmp->n_disagree, cmp->n_groups, cmp->rule.alpha,
+	       a->labels[0], a->labels[1], e->path, cmp->n_disagree, cmp->n_groups, cmp->rule.alpha,
 	       cmp->rule.margin, e->n_groups, e->trials);
-	for (int g = 0; g < cmp->n_groups; g++)
-		if (cmp->groups[g].verdict == BSIM_VERDICT_DISAGREE) {
-			const bsim_event_test *t = &cmp->groups[g].ev[BSIM_EVENT_TRAVERSED];
+	printf("  deterministic: %d same, %d different; random: %d equivalent within +-%g, %d "
+	       "inconclusive, %d small, %d disagree\n",
+	       k[BSIM_VERDICT_SAME], k[BSIM_VERDICT_DIFFERENT], k[BSIM_VERDICT_EQUIVALENT],
+	       cmp->rule.margin, k[BSIM_VERDICT_INCONCLUSIVE], k[BSIM_VERDICT_SMALL],
+	       k[BSIM_VERDICT_DISAGREE]);
+	for (int g = 0; g < cmp->n_groups; g++) {
+		const bsim_compare_group *cg = &cmp->groups[g];
+		const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];
+		if (cg->verdict == BSIM_VERDICT_DISAGREE)
 			printf("  group %d: p_traverse %.2f vs %.2f, %d discordant pairs\n", g,
-			       t->p_a, t->p_b, cmp->groups[g].discordant);
-		}
-	printf("wrote %s/report.md, %s/report.json, %s/pairs.csv and each backend's sweep in "
+			       t->p_a, t->p_b, cg->discordant);
+		else if (cg->verdict == BSIM_VERDICT_DIFFERENT)
+			printf("  group %d (deterministic): the one pair differs\n", g);
+	}
+	int unstable[2];
+	unstable_counts(cmp, unstable);
+	for (int i = 0; i < 2; i++)
+		if (unstable[i] > 0)
+			printf("  %s: %d unstable trials (see %s/%s/trials.csv)\n", a->labels[i],
+			       unstable[i], a->out, a->dirs[i]);
+	printf("wrote %s/report.md, %s/report.json, %s/pairs.csv and each side's sweep in "
 	       "%s/%s and %s/%s\n",
-	       a->out, a->out, a->out, a->out, a->names[0], a->out, a->names[1]);
+	       a->out, a->out, a->out, a->out, a->dirs[0], a->out, a->dirs[1]);
 }
 
 static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_backend *b1)
@@ -241,6 +335,7 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 	        .e = &e,
 	        .backend = {b0, b1},
 	        .opts = {&a->opts[0], &a->opts[1]},
+	        .label = {a->labels[0], a->labels[1]},
 	        .extra = a->sets.ov,
 	        .n_extra = a->sets.n,
 	        .threads = a->threads > 0 ? (int)a->threads : omp_get_max_threads(),
@@ -266,7 +361,7 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 int cmd_compare(int argc, char **argv)
 {
 	compare_args a = {
-	        .names = {"thesis", "box2d"},
+	        .labels = {"thesis", "box2d"},
 	        .rule = {BSIM_COMPARE_ALPHA, BSIM_COMPARE_MARGIN, 0},
 	        .examples = 3,
 	};

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "beamsim/atomic_file.h"
+#include "beamsim/effects.h"
 #include "beamsim/json.h"
 #include "beamsim/output.h"
 #include "beamsim/report.h"
@@ -162,6 +163,7 @@ static int regress_rerun(const regress_args *a, regress_run *run)
 		        .e = &run->e,
 		        .backend = {run->backend[0], run->backend[1]},
 		        .opts = {&run->rec.opts[0], &run->rec.opts[1]},
+		        .label = {run->rec.label[0], run->rec.label[1]},
 		        .threads = threads,
 		        .rule = run->rec.rule,
 		        .examples = 3,
@@ -198,7 +200,9 @@ static int regress_read(const regress_args *a, const regress_run *run, int i,
 		bsim_error err;
 		const char *dir = dirs[k];
 		if (run->rec.n_backends == 2) {
-			if (cli_path(sub, sizeof sub, dirs[k], run->rec.backend[i]))
+			char name[128];
+			cli_label_dir(run->rec.label[i], name, sizeof name);
+			if (cli_path(sub, sizeof sub, dirs[k], name))
 				return CLI_FAIL;
 			dir = sub;
 		}
@@ -219,7 +223,32 @@ typedef struct regress_part {
 	bsim_sweep_result r[2];
 	bsim_comparison cmp;
 	bsim_report rep;
+	int changed; /* trials not identical in every field both files hold */
 } regress_part;
+
+/* The groups without random draws, from their scenes: each is one trial,
+ * compared as one pair (beamsim/compare.h). */
+static int mark_deterministic(const bsim_experiment *e, bsim_sweep_result r[2])
+{
+	for (int g = 0; g < e->n_groups; g++) {
+		bsim_scene s;
+		bsim_error err;
+		if (bsim_experiment_group_scene(e, g, NULL, 0, &s, &err) != BSIM_OK)
+			return cli_report(err.code, &err);
+		int det = !bsim_effects_random(&s);
+		bsim_scene_free(&s);
+		r[0].groups[g].deterministic = r[1].groups[g].deterministic = det;
+	}
+	return CLI_OK;
+}
+
+static int trials_changed(const bsim_sweep_result r[2])
+{
+	int changed = 0, ledger = r[0].has_ledger && r[1].has_ledger;
+	for (long i = 0; i < (long)r[0].n_groups * r[0].trials; i++)
+		changed += !bsim_trial_identical(&r[0].trials_out[i], &r[1].trials_out[i], ledger);
+	return changed;
+}
 
 static void regress_md(FILE *f, const regress_args *a, const regress_run *run, regress_part *parts)
 {
@@ -229,11 +258,8 @@ static void regress_md(FILE *f, const regress_args *a, const regress_run *run, r
 	        a->baseline, run->rec.command, run->rec.version, a->out, BSIM_VERSION, run->e.path,
 	        (unsigned long long)run->e.seed, run->e.n_groups, run->e.trials);
 	for (int i = 0; i < run->rec.n_backends; i++) {
-		int changed = 0;
-		for (int g = 0; g < parts[i].cmp.n_groups; g++)
-			changed += parts[i].cmp.groups[g].changed;
-		fprintf(f, "## Backend %s\n\n%d of %d trials changed in some trials.csv field.\n\n",
-		        run->rec.backend[i], changed, run->e.n_groups * run->e.trials);
+		fprintf(f, "## %s\n\n%d of %d trials changed in some trials.csv field.\n\n",
+		        run->rec.label[i], parts[i].changed, run->e.n_groups * run->e.trials);
 		bsim_report_md(f, &parts[i].rep);
 	}
 }
@@ -283,8 +309,11 @@ static int regress_compare(const regress_args *a, regress_run *run)
 		bsim_error err;
 		regress_part *p = &parts[n];
 		rc = regress_read(a, run, n, p->r);
+		if (rc == CLI_OK)
+			rc = mark_deterministic(&run->e, p->r);
 		if (rc != CLI_OK)
 			break;
+		p->changed = trials_changed(p->r);
 		if (bsim_compare_analyse(&p->r[0], &p->r[1], NULL, &run->rule, &p->cmp, &err) !=
 		    BSIM_OK)
 			rc = cli_report(CLI_FAIL, &err);
@@ -301,11 +330,8 @@ static int regress_compare(const regress_args *a, regress_run *run)
 		rc = regress_write(a, run, parts);
 	if (rc == CLI_OK && !a->quiet) {
 		for (int i = 0; i < n; i++) {
-			int changed = 0;
-			for (int g = 0; g < parts[i].cmp.n_groups; g++)
-				changed += parts[i].cmp.groups[g].changed;
 			printf("%s: %d of %d trials changed, %d of %d groups beyond tolerance\n",
-			       run->rec.backend[i], changed, run->e.n_groups * run->e.trials,
+			       run->rec.label[i], parts[i].changed, run->e.n_groups * run->e.trials,
 			       parts[i].cmp.n_disagree, parts[i].cmp.n_groups);
 		}
 		printf("wrote %s/regress.md and %s/regress.json\n", a->out, a->out);

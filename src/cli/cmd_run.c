@@ -21,8 +21,11 @@ static const char run_help[] =
         "Usage: beamsim run SCENE [OPTIONS]\n"
         "\n"
         "Runs one trial of the scene file SCENE and prints its outcome, end state,\n"
-        "peak beam angles and energy ledger. The random-force schedule is that of\n"
-        "trial I of group G of a sweep with seed N, so a sweep's trial can be replayed.\n"
+        "peak beam angles, the deepest overlap of body and beams, and the energy\n"
+        "ledger. The random-force schedule is that of trial I of group G of a sweep\n"
+        "with seed N, so a sweep's trial can be replayed. A trial whose state stops\n"
+        "being finite, or whose ledger shows energy created beyond the bound, is\n"
+        "unstable: the reason is printed and the exit status is 1.\n"
         "\n"
         "Options:\n"
         "  --backend B            physics backend (default thesis; see beamsim backends)\n"
@@ -151,6 +154,7 @@ static void print_ledger_json(const bsim_ledger *l)
 	        {"residual", l->residual},
 	        {"residual_max", l->residual_max},
 	        {"residual_abs", l->residual_abs},
+	        {"inflow", l->inflow},
 	};
 	fputc('{', stdout);
 	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
@@ -195,8 +199,18 @@ static void print_json(const run_args *a, const bsim_backend *b, const bsim_scen
 	bsim_json_number(stdout, r->max_theta[0]);
 	fputs(", ", stdout);
 	bsim_json_number(stdout, r->max_theta[1]);
-	fputs("], \"ledger\": ", stdout);
+	fputs("], \"overlap_max\": ", stdout);
+	bsim_json_number(stdout, r->overlap_max);
+	fputs(", \"ledger\": ", stdout);
 	print_ledger_json(&r->ledger);
+	fputs(", \"instability\": ", stdout);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, s->dt, why, sizeof why);
+		bsim_json_string(stdout, why);
+	} else {
+		fputs("null", stdout);
+	}
 	fputs("}\n", stdout);
 }
 
@@ -226,12 +240,18 @@ static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
 	printf("end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,
 	       r->vx_end);
 	printf("peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0], r->max_theta[1]);
+	printf("overlap     deepest %.3g m of body and beams\n", r->overlap_max);
 	printf("energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
 	printf("  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
 	printf("  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
 	       l->damper, l->impact, l->contact, l->correction);
-	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step)\n", l->residual,
-	       l->residual_abs, l->residual_max);
+	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step; %.4g J flowed in)\n",
+	       l->residual, l->residual_abs, l->residual_max, l->inflow);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, s->dt, why, sizeof why);
+		printf("unstable    %s\n", why);
+	}
 }
 
 /* Runs the trial, recording into the trajectory file if one was asked
@@ -240,7 +260,7 @@ static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_back
                      uint64_t mixed, bsim_trial_result *res)
 {
 	bsim_atomic_file traj = {0};
-	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride};
+	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride, .overlap = 1};
 	bsim_error err;
 	if (a->trajectory) {
 		if (bsim_atomic_file_open(&traj, a->trajectory, &err) != BSIM_OK)
@@ -255,8 +275,7 @@ static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_back
 		return CLI_FAIL;
 	}
 	bsim_error_clear(&err);
-	int rc = bsim_trial_run(runner, scene, backend, &a->opts, mixed,
-	                        a->trajectory ? &rec : NULL, res, &err);
+	int rc = bsim_trial_run(runner, scene, backend, &a->opts, mixed, &rec, res, &err);
 	bsim_runner_free(runner);
 	if (rc != BSIM_OK) {
 		bsim_atomic_file_abort(&traj);
@@ -293,6 +312,12 @@ int cmd_run(int argc, char **argv)
 			print_json(&a, backend, &scene, mixed, &res);
 		else if (rc == CLI_OK)
 			print_text(&a, &scene, mixed, &res);
+		if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {
+			char why[256];
+			bsim_trial_instability_text(&res, scene.dt, why, sizeof why);
+			cli_error("%s backend: unstable trial: %s", backend->name, why);
+			rc = CLI_FAIL;
+		}
 		bsim_scene_free(&scene);
 	}
 	cli_sets_free(&a.sets);

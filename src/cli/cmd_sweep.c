@@ -22,7 +22,10 @@ static const char sweep_help[] =
         "DIR/summary.json (per-group counts, p_traverse and its 95% Wilson interval)\n"
         "and DIR/trials.csv (one row per trial). The results do not depend on --threads.\n"
         "DIR/run.json and DIR/inputs/ record the run, so `beamsim regress DIR` can\n"
-        "repeat it.\n"
+        "repeat it. A group without random force is deterministic: its one trial runs\n"
+        "once and fills every row. Unstable trials (non-finite state, or energy\n"
+        "created beyond the ledger's bound) are counted and written like the others,\n"
+        "and make the exit status 1.\n"
         "\n"
         "Options:\n"
         "  --out DIR              output directory, created if missing (required)\n"
@@ -32,6 +35,8 @@ static const char sweep_help[] =
         "  --trials N             trials per group (default: the experiment's)\n"
         "  --seed N               experiment seed (default: the experiment's)\n"
         "  --set KEY=VALUE        override a scene field in every group, repeatable\n"
+        "  --overlap              measure each trial's deepest body-beam overlap\n"
+        "                         (trials.csv overlap_max; costs time)\n"
         "  --quiet                no progress line, nothing on stdout\n"
         "  -h, --help             show this help\n";
 
@@ -43,6 +48,7 @@ enum {
 	OPT_SEED,
 	OPT_SET,
 	OPT_OUT,
+	OPT_OVERLAP,
 	OPT_QUIET
 };
 
@@ -54,6 +60,7 @@ static const struct option sweep_options[] = {
         {"seed", required_argument, NULL, OPT_SEED},
         {"set", required_argument, NULL, OPT_SET},
         {"out", required_argument, NULL, OPT_OUT},
+        {"overlap", no_argument, NULL, OPT_OVERLAP},
         {"quiet", no_argument, NULL, OPT_QUIET},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -69,6 +76,7 @@ typedef struct sweep_args {
 	uint64_t seed;
 	cli_sets sets;
 	const char *out;
+	int overlap;
 	int quiet;
 } sweep_args;
 
@@ -111,6 +119,9 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 		case OPT_OUT:
 			a->out = optarg;
 			break;
+		case OPT_OVERLAP:
+			a->overlap = 1;
+			break;
 		case OPT_QUIET:
 			a->quiet = 1;
 			break;
@@ -136,12 +147,42 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 static void sweep_report(const sweep_args *a, const bsim_experiment *e, const bsim_sweep_result *r,
                          int threads)
 {
-	long n = (long)r->n_groups * r->trials;
+	long n = r->trials_run, rows = (long)r->n_groups * r->trials;
 	bsim_output_table(stdout, e, r);
 	printf("\n%ld trials, %ld steps in %.3f s on %d thread%s: %.0f trials/s, %.3g steps/s\n", n,
 	       r->total_steps, r->wall_seconds, threads, threads == 1 ? "" : "s",
 	       cli_per_second(n, r->wall_seconds), cli_per_second(r->total_steps, r->wall_seconds));
+	if (n != rows)
+		printf("(%ld rows: the groups without random force ran one trial each)\n", rows);
 	printf("wrote %s/summary.json and %s/trials.csv\n", a->out, a->out);
+}
+
+/* Unstable trials fail the sweep (after its files are written): one line
+ * with their number and the first one's reason and replay. */
+static int sweep_unstable(const sweep_args *a, const bsim_experiment *e,
+                          const bsim_backend *backend, const bsim_sweep_result *r)
+{
+	long count = 0, first = -1;
+	for (long i = 0; i < (long)r->n_groups * r->trials; i++)
+		if (r->trials_out[i].outcome == BSIM_UNSTABLE) {
+			count++;
+			first = first < 0 ? i : first;
+		}
+	if (count == 0)
+		return CLI_OK;
+	bsim_scene scene;
+	bsim_error err;
+	char why[256] = "";
+	long g = first / r->trials, t = first % r->trials;
+	if (bsim_experiment_group_scene(e, (int)g, a->sets.ov, a->sets.n, &scene, &err) ==
+	    BSIM_OK) {
+		bsim_trial_instability_text(&r->trials_out[first], scene.dt, why, sizeof why);
+		bsim_scene_free(&scene);
+	}
+	cli_error("%ld of %ld trials unstable on the %s backend (outcome unstable in "
+	          "%s/trials.csv); the first, group %ld trial %ld: %s",
+	          count, (long)r->n_groups * r->trials, backend->name, a->out, g, t, why);
+	return CLI_FAIL;
 }
 
 /* Loads, creates DIR (before the run, so an unusable DIR fails at once,
@@ -171,6 +212,7 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 	        .threads = threads,
 	        .extra = a->sets.ov,
 	        .n_extra = a->sets.n,
+	        .measure_overlap = a->overlap,
 	};
 	bsim_sweep_result r;
 	rc = cli_sweep_run(&e, &cfg, !a->quiet, &r);
@@ -181,6 +223,8 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 		rc = cli_store_sweep(a->out, &e, backend, &a->opts, a->sets.ov, a->sets.n, &r);
 		if (rc == CLI_OK && !a->quiet)
 			sweep_report(a, &e, &r, threads);
+		if (rc == CLI_OK)
+			rc = sweep_unstable(a, &e, backend, &r);
 		bsim_sweep_result_free(&r);
 	}
 	bsim_experiment_free(&e);

@@ -15,7 +15,7 @@ static const cli_command commands[] = {
         {"run", cmd_run, "run one trial of a scene, print its outcome, record a trajectory"},
         {"sweep", cmd_sweep, "run every group and trial of an experiment in parallel"},
         {"compare", cmd_compare,
-         "run an experiment on two backends and compare them trial by trial"},
+         "run an experiment on two backends, or two settings of one, pair by pair"},
         {"regress", cmd_regress, "rerun a stored sweep or comparison and report what changed"},
         {"backends", cmd_backends, "list the physics backends and their options"},
         {"bench", cmd_bench, "measure the speed of a backend on the essay's experiments"},
@@ -23,6 +23,7 @@ static const cli_command commands[] = {
          "what accuracy costs in time: error against speed per backend and step"},
         {"landscape", cmd_landscape,
          "the potential energy landscape of a scene, its barriers and figures"},
+        {"video", cmd_video, "an MP4 of one trial, on one backend or side by side"},
 };
 
 #define N_COMMANDS ((int)(sizeof commands / sizeof commands[0]))

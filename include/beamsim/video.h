@@ -1,0 +1,165 @@
+/* Videos of trials: one trial of a scene drawn frame by frame with cairo and
+ * encoded as H.264 MP4 by ffmpeg, one panel per backend, side by side.
+ *
+ *   bsim_video_track *t;
+ *   bsim_video_track_record(scene, backend, opts, seed, fps, &t, err);  // runs the trial
+ *   bsim_video_def def = bsim_video_default_def();
+ *   bsim_video *v = NULL;
+ *   bsim_video_alloc(&def, scene, &t, &label, 1, &v, err);
+ *   bsim_video_write(v, "trial.mp4", err);                            // whole or nothing
+ *
+ * Time. Frame k shows the simulated time k / fps: the state after step
+ * n_k = min(floor(k / (fps h)), N), the last step at or before that time,
+ * where N is the trial's last step (the runner's steps_run, including the
+ * run on to classify_y after a traversal). A trial has ceil(N h fps) + 1
+ * frames, the last one its end state; side by side, the video lasts
+ * as long as the longest trial, a panel whose trial has ended shows its
+ * last state, and the last frame is held for `hold` seconds at the end.
+ *
+ * A frame (one panel per track, left to right) shows the beams coloured by
+ * stiffness with the colour scale as a legend, the pivots, the success line
+ * and side boundaries, the body and its trail, the random force as an arrow
+ * from the body centre (length R |F| / Rm: one body radius per Rm), and
+ * overlaid: the backend, the time, the kinetic energy of body and beams,
+ * the springs' energy, the propulsive potential F_prop (y0 - y) (MODEL.md
+ * section 7), the random force, and the outcome from the moment it is
+ * decided. Side by side, each panel also shows the other panels' trails in
+ * grey and marks where the body trajectories part (first more than 1% of
+ * the body radius apart, as beamsim compare measures it).
+ *
+ * Camera. A panel shows the whole field (beams, start, success line, side
+ * boundaries) when that fits with its shorter side spanning at most
+ * view_span metres; a larger field (a lattice of gates) is shown at that
+ * scale with the camera on the body, kept inside the field where the field
+ * is larger than the view (the essay's MAT2AVI over the lattice). */
+#ifndef BEAMSIM_VIDEO_H
+#define BEAMSIM_VIDEO_H
+
+#include <stdint.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/error.h"
+#include "beamsim/scene.h"
+#include "beamsim/trial.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The look and encoding of a video (plain definition; start from
+ * bsim_video_default_def). */
+typedef struct bsim_video_def {
+	int width, height;  /* pixels of a frame, all panels; even, >= 64; 0 = 540 x 540 a panel */
+	double fps;         /* frames per second of simulated time, > 0; default 30 */
+	double hold;        /* s: the last frame is held this long at the end, >= 0; default 1 */
+	double view_span;   /* m: the most of the world a panel's shorter side shows; default 200 */
+	int crf;            /* x264 constant rate factor, 0-51 (lower is better); default 23 */
+	const char *ffmpeg; /* the encoder program, looked up on PATH; default "ffmpeg" */
+} bsim_video_def;
+
+bsim_video_def bsim_video_default_def(void);
+
+/* Checks a definition's ranges; BSIM_EINPUT naming the field otherwise. */
+int bsim_video_def_check(const bsim_video_def *def, bsim_error *err);
+
+/* What a frame of a track shows: the state after step `step`. */
+typedef struct bsim_video_sample {
+	long step;
+	double t;           /* s, step * dt */
+	double x[2];        /* body centre, m */
+	double f_rand;      /* N, the random force the runner applies over the next step */
+	double e_kin;       /* J, body and beams */
+	double e_spring;    /* J, 1/2 k theta^2 summed over beams */
+	double e_prop;      /* J, F_prop (y0 - y) */
+	const float *theta; /* n_beams, rad */
+	const unsigned char *contact; /* n_beams, BSIM_CONTACT_* */
+} bsim_video_sample;
+
+/* One trial recorded for a video: the body centre after every step (the
+ * trail) and the state at every frame time. */
+typedef struct bsim_video_track bsim_video_track;
+
+/* Runs trial `seed` (bsim_seed_mix) of scene on backend exactly as
+ * bsim_trial_run does for `beamsim run`, recording at fps frames per second
+ * of simulated time. The scene must outlive the track. BSIM_EFAIL if the
+ * run fails (the message says why, e.g. a non-finite state) or memory runs
+ * out; BSIM_EINPUT for bad backend options or fps. */
+int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend,
+                            const bsim_options *opts, uint64_t seed, double fps,
+                            bsim_video_track **out, bsim_error *err);
+void bsim_video_track_free(bsim_video_track *t);
+
+/* The trial's result, as bsim_trial_run gives it. */
+const bsim_trial_result *bsim_video_track_result(const bsim_video_track *t);
+/* Frames recorded: ceil(steps_run dt fps) + 1. */
+long bsim_video_track_frames(const bsim_video_track *t);
+/* Frame k (0 <= k < frames); later k give the last frame. */
+bsim_video_sample bsim_video_track_sample(const bsim_video_track *t, long k);
+/* The body centre after step n (0 <= n <= steps_run), m. */
+void bsim_video_track_position(const bsim_video_track *t, long n, double x[2]);
+
+/* The time, s, at which the body centres of two tracks of the same scene
+ * are first more than sep_distance (m) apart, comparing steps both reached;
+ * -1 if they never are. */
+double bsim_video_track_separation(const bsim_video_track *a, const bsim_video_track *b,
+                                   double sep_distance);
+
+/* A video of one to BSIM_VIDEO_PANELS_MAX tracks of the same scene. */
+#define BSIM_VIDEO_PANELS_MAX 4
+typedef struct bsim_video bsim_video;
+
+/* tracks and labels (one a panel, e.g. the backend names) are borrowed
+ * and must outlive v, as must scene. */
+int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
+                     const bsim_video_track *const *tracks, const char *const *labels, int n_panels,
+                     bsim_video **out, bsim_error *err);
+void bsim_video_free(bsim_video *v);
+
+/* Frames of the video, hold included. */
+long bsim_video_frames(const bsim_video *v);
+/* Pixels of a frame (the def's, or the default for the panel count). */
+void bsim_video_size(const bsim_video *v, int *width, int *height);
+
+/* Draws frame k into pixels: width x height values 0x00RRGGBB, row-major
+ * from the top-left (cairo's RGB24). BSIM_EFAIL if cairo fails. */
+int bsim_video_render(bsim_video *v, long k, uint32_t *pixels, bsim_error *err);
+
+/* The stiffness colour of the legend: 0x00RRGGBB for stiffness k, N m/rad,
+ * on this video's scale (the scene's smallest to largest stiffness). */
+uint32_t bsim_video_stiffness_color(const bsim_video *v, double k);
+
+/* The colour the body is filled with, 0x00RRGGBB (nothing else is drawn
+ * in it, so a frame's body can be found by its colour). */
+uint32_t bsim_video_body_color(void);
+
+/* Renders every frame and encodes them with ffmpeg into path: H.264,
+ * yuv420p, fps frames per second. The file appears whole or not at all
+ * (written under a temporary name, renamed when ffmpeg succeeded).
+ * BSIM_EFAIL naming ffmpeg's package if it is missing, ffmpeg's exit
+ * status and last message if it fails, or the path if it cannot be
+ * written. */
+int bsim_video_write(bsim_video *v, const char *path, bsim_error *err);
+
+/* The ffmpeg pipe: raw frames in, an MP4 file out. */
+typedef struct bsim_video_encoder bsim_video_encoder;
+
+/* Starts `program` (ffmpeg; looked up on PATH, no shell) reading width x
+ * height RGB24 frames (0x00RRGGBB values) at fps from a pipe and writing
+ * H.264 (libx264, yuv420p, crf) in MP4 to a temporary file beside path.
+ * BSIM_EFAIL if the program is missing (naming the Debian package ffmpeg)
+ * or cannot be started. */
+int bsim_video_encoder_open(const char *path, const char *program, int width, int height,
+                            double fps, int crf, bsim_video_encoder **out, bsim_error *err);
+/* Writes one frame. BSIM_EFAIL if ffmpeg has stopped reading (the
+ * message then gives its exit status and last message). */
+int bsim_video_encoder_write(bsim_video_encoder *e, const uint32_t *pixels, bsim_error *err);
+/* Ends the stream, waits for ffmpeg, and if it exited with status 0
+ * renames the file into place; else removes it. Frees e either way. */
+int bsim_video_encoder_close(bsim_video_encoder *e, bsim_error *err);
+/* Stops ffmpeg and removes the temporary file; frees e. NULL is a no-op. */
+void bsim_video_encoder_abort(bsim_video_encoder *e);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,151 @@
+/* The runner's verdict on a failing backend, with backends built to fail
+ * in a known way: one whose state turns NaN at a given step, one that
+ * creates energy (a body speeding up with no force), and one that loses
+ * it (a body slowing down with no force). The first two are unstable, with
+ * the reason and the last finite state; the third is an ordinary outcome
+ * (lost energy is inaccuracy, not instability). */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "beamsim/trial.h"
+
+/* A body alone: the beams never move. kind 0: NaN at step 10; 1: speed
+ * grows by 1% a step; 2: speed falls by 1% a step. */
+struct bsim_world {
+	int kind, n_beams;
+	long step;
+	double x[2], v[2];
+};
+
+static int kind_of(const bsim_options *o)
+{
+	const char *v = bsim_options_get(o, "kind");
+	return v ? atoi(v) : 0;
+}
+
+static int fake_create(const bsim_scene *s, const bsim_options *o, bsim_world **out,
+                       bsim_error *err)
+{
+	(void)err;
+	bsim_world *w = calloc(1, sizeof *w);
+	w->kind = kind_of(o);
+	w->n_beams = s->n_beams;
+	memcpy(w->x, s->body.start, sizeof w->x);
+	w->v[1] = 1.0; /* 1 m/s forward: 0.5 J */
+	*out = w;
+	return BSIM_OK;
+}
+
+static void fake_destroy(bsim_world *w)
+{
+	free(w);
+}
+
+static void fake_step(bsim_world *w, const double force[2], double h)
+{
+	(void)force; /* the scene below has no forces */
+	w->step++;
+	double f = w->kind == 1 ? 1.01 : w->kind == 2 ? 0.99 : 1.0;
+	w->v[1] *= f;
+	w->x[1] += h * w->v[1];
+	if (w->kind == 0 && w->step == 10)
+		w->x[0] = NAN;
+}
+
+static void fake_get_state(const bsim_world *w, bsim_state *s)
+{
+	memcpy(s->x, w->x, sizeof s->x);
+	memcpy(s->v, w->v, sizeof s->v);
+	for (int i = 0; i < s->n_beams; i++) {
+		s->theta[i] = s->omega[i] = 0.0;
+		s->contact[i] = 0;
+	}
+	memset(&s->energy, 0, sizeof s->energy);
+}
+
+static const bsim_knob fake_knobs[] = {{"kind", BSIM_KNOB_INT, "0", NULL, "how it fails"}};
+
+static const bsim_backend fake = {
+        .name = "fake",
+        .knobs = fake_knobs,
+        .n_knobs = 1,
+        .create = fake_create,
+        .destroy = fake_destroy,
+        .step = fake_step,
+        .get_state = fake_get_state,
+};
+
+static bsim_trial_result run(int kind)
+{
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 0.0, 0.0);
+	s.effects.has_propulsion = 0;
+	s.max_steps = 200;
+	bsim_options o = {0};
+	bsim_error err;
+	char kv[16];
+	snprintf(kv, sizeof kv, "kind=%d", kind);
+	assert_int_equal(bsim_options_add(&o, kv, &err), BSIM_OK);
+	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_result out;
+	assert_int_equal(bsim_trial_run(r, &s, &fake, &o, 1, NULL, &out, &err), BSIM_OK);
+	bsim_runner_free(r);
+	bsim_scene_free(&s);
+	return out;
+}
+
+static void test_nonfinite(void **state)
+{
+	(void)state;
+	bsim_trial_result r = run(0);
+	assert_int_equal(r.outcome, BSIM_UNSTABLE);
+	assert_int_equal(r.instability, BSIM_UNSTABLE_NONFINITE);
+	assert_int_equal(r.unstable_step, 10);
+	assert_int_equal(r.steps_run, 9); /* the last finite state is reported */
+	assert_true(isfinite(r.x_end) && isfinite(r.y_end) && isfinite(r.ledger.e_end));
+	char why[256];
+	bsim_trial_instability_text(&r, 0.004, why, sizeof why);
+	assert_string_equal(why, "non-finite state at step 10 (t = 0.04 s)");
+}
+
+/* 1% a step for 200 steps: E grows by 1.01^400 = 53 times from 0.5 J with
+ * nothing flowing in but the 0.5 J it started with. */
+static void test_energy_created(void **state)
+{
+	(void)state;
+	bsim_trial_result r = run(1);
+	assert_int_equal(r.outcome, BSIM_UNSTABLE);
+	assert_int_equal(r.instability, BSIM_UNSTABLE_ENERGY);
+	assert_float_equal(r.ledger.e_start, 0.5, 1e-15);
+	assert_float_equal(r.ledger.inflow, 0.5, 1e-15);
+	assert_float_equal(r.ledger.e_end, 0.5 * pow(1.01, 400), 1e-9);
+	assert_float_equal(r.ledger.residual, r.ledger.e_end - r.ledger.e_start, 1e-9);
+	char why[256];
+	bsim_trial_instability_text(&r, 0.004, why, sizeof why);
+	assert_non_null(strstr(why, "energy created: ledger residual"));
+}
+
+static void test_energy_lost(void **state)
+{
+	(void)state;
+	bsim_trial_result r = run(2);
+	assert_int_equal(r.outcome, BSIM_STUCK);
+	assert_int_equal(r.instability, BSIM_STABLE);
+	assert_true(r.ledger.residual < 0.0);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_nonfinite),
+	        cmocka_unit_test(test_energy_created),
+	        cmocka_unit_test(test_energy_lost),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,690 @@
+/* beamsim video: the file is a valid H.264 MP4 (ffprobe) with the frame
+ * size, frame count and duration that the trial's length (from beamsim
+ * run) and the frame rate give, on one backend and side by side; the video
+ * shows the trial beamsim run runs (positions, energies and random force
+ * equal the runner's trajectory at every frame time); on a field larger
+ * than the view the body is in every frame although it travels further
+ * than a view spans (the camera follows it), in the rendered frames and in
+ * the decoded MP4; beams take their stiffness's colour; a failing or
+ * missing ffmpeg and bad arguments write nothing. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "beamsim/schedule.h"
+#include "beamsim/video.h"
+#include "support.h"
+
+/* The gate scene's time step, s (configs/thesis/gate.yaml). */
+#define GATE_DT 0.004
+
+/* Runs a program looked up on PATH with stdout into *out (may be NULL)
+ * and stderr discarded; returns its exit status. */
+static int run_program(const char *const argv[], char **out)
+{
+	FILE *fo = tmpfile();
+	assert_non_null(fo);
+	fflush(NULL);
+	pid_t pid = fork();
+	if (pid == 0) {
+		dup2(fileno(fo), 1);
+		int null = open("/dev/null", O_RDWR);
+		dup2(null, 2);
+		dup2(null, 0);
+		execvp(argv[0], (char *const *)argv);
+		_exit(127);
+	}
+	int status = 0;
+	waitpid(pid, &status, 0);
+	if (out) {
+		rewind(fo);
+		size_t cap = 1 << 16, len = 0;
+		char *buf = malloc(cap);
+		size_t k;
+		while ((k = fread(buf + len, 1, cap - len - 1, fo)) > 0) {
+			len += k;
+			if (len + 1 == cap)
+				buf = realloc(buf, cap *= 2);
+		}
+		buf[len] = '\0';
+		*out = buf;
+	}
+	fclose(fo);
+	return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+typedef struct probe {
+	char codec[32], pix_fmt[32], format[128];
+	int width, height;
+	long frames;
+	double duration;
+} probe;
+
+static void probe_value(const char *text, const char *key, char *buf, size_t n)
+{
+	char needle[64];
+	snprintf(needle, sizeof needle, "\n%s=", key);
+	const char *p = strstr(text, needle);
+	if (!p)
+		fail_msg("ffprobe gave no %s in:\n%s", key, text);
+	p += strlen(needle);
+	size_t len = strcspn(p, "\r\n");
+	snprintf(buf, n, "%.*s", (int)len, p);
+}
+
+/* What ffprobe finds in the file's first video stream (decoding every
+ * frame to count them). */
+static void ffprobe(const char *path, probe *p)
+{
+	const char *argv[] = {"ffprobe",
+	                      "-v",
+	                      "error",
+	                      "-count_frames",
+	                      "-select_streams",
+	                      "v:0",
+	                      "-show_entries",
+	                      "stream=codec_name,pix_fmt,width,height,nb_read_frames,duration:"
+	                      "format=format_name",
+	                      "-of",
+	                      "default=nw=1",
+	                      path,
+	                      NULL};
+	char *out = NULL;
+	assert_int_equal(run_program(argv, &out), 0);
+	char text[4096], v[128];
+	snprintf(text, sizeof text, "\n%s", out);
+	free(out);
+	probe_value(text, "codec_name", p->codec, sizeof p->codec);
+	probe_value(text, "pix_fmt", p->pix_fmt, sizeof p->pix_fmt);
+	probe_value(text, "format_name", p->format, sizeof p->format);
+	probe_value(text, "width", v, sizeof v);
+	p->width = atoi(v);
+	probe_value(text, "height", v, sizeof v);
+	p->height = atoi(v);
+	probe_value(text, "nb_read_frames", v, sizeof v);
+	p->frames = atol(v);
+	probe_value(text, "duration", v, sizeof v);
+	p->duration = atof(v);
+}
+
+/* steps_run of `beamsim run SCENE ARGS... --json`. */
+static long run_steps(const char *scene, const char *const *args)
+{
+	const char *argv[32] = {"run", scene, "--json"};
+	int n = 3;
+	for (int i = 0; args[i]; i++)
+		argv[n++] = args[i];
+	argv[n] = NULL;
+	char *out = NULL;
+	assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
+	const char *p = strstr(out, "\"steps_run\": ");
+	assert_non_null(p);
+	long steps = atol(p + strlen("\"steps_run\": "));
+	free(out);
+	return steps;
+}
+
+/* Frames of a trial of `steps` steps of dt at fps, plus the hold:
+ * ceil(steps dt fps) + 1 + round(hold fps), computed here in integers
+ * (dt fps = num / den exactly). */
+static long expected_frames(long steps, long num, long den, long hold_frames)
+{
+	return (steps * num + den - 1) / den + 1 + hold_frames;
+}
+
+/* 1 if dir holds no entry but . and .. */
+static int dir_empty(const char *dir)
+{
+	DIR *d = opendir(dir);
+	assert_non_null(d);
+	struct dirent *e;
+	int n = 0;
+	while ((e = readdir(d)))
+		if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+			n++;
+	closedir(d);
+	return n == 0;
+}
+
+static void cli_single_backend(void **state)
+{
+	(void)state;
+	char gate[1200], out[1400];
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	const char *dir = bsim_test_dir("single");
+	snprintf(out, sizeof out, "%s/trial.mp4", dir);
+	const char *same[] = {"--seed", "4", "--trial", "2", "--set", "integration.max_steps=500",
+	                      NULL};
+	long steps = run_steps(gate, same);
+	const char *argv[] = {"video",   gate, "--seed", "4",
+	                      "--trial", "2",  "--set",  "integration.max_steps=500",
+	                      "--fps",   "25", "--hold", "0.4",
+	                      "--out",   out,  NULL};
+	char *so = NULL, *se = NULL;
+	int rc = bsim_test_cli(argv, &so, &se);
+	if (rc != 0)
+		fail_msg("exit %d: %s", rc, se);
+	probe p;
+	ffprobe(out, &p);
+	/* 25 fps at 4 ms: one frame every 10 steps; 0.4 s hold: 10 frames. */
+	long frames = expected_frames(steps, 1, 10, 10);
+	printf("# one backend: %ld steps, %ld frames (%s %s %dx%d, %.4f s)\n", steps, p.frames,
+	       p.codec, p.pix_fmt, p.width, p.height, p.duration);
+	assert_string_equal(p.codec, "h264");
+	assert_string_equal(p.pix_fmt, "yuv420p");
+	assert_non_null(strstr(p.format, "mp4"));
+	assert_int_equal(p.width, 540); /* the default, a panel */
+	assert_int_equal(p.height, 540);
+	assert_int_equal(p.frames, frames);
+	assert_true(fabs(p.duration - frames / 25.0) < 1e-3);
+	/* Only the video is left in the directory: no temporary file. */
+	DIR *d = opendir(dir);
+	struct dirent *e;
+	while ((e = readdir(d)))
+		assert_true(e->d_name[0] == '.' || strcmp(e->d_name, "trial.mp4") == 0);
+	closedir(d);
+	free(so);
+	free(se);
+}
+
+static void cli_side_by_side(void **state)
+{
+	(void)state;
+	char gate[1200], out[1400];
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	snprintf(out, sizeof out, "%s/pair.mp4", bsim_test_dir("pair"));
+	/* A violent random force: both bodies leave through a side within
+	 * 2 s, at different steps, so the video lasts as the longer trial. */
+	const char *common[] = {"--trial", "1", "--set", "effects.random_force.magnitude=150",
+	                        NULL};
+	const char *thesis[] = {"--backend", "thesis",  common[0], common[1],
+	                        common[2],   common[3], NULL};
+	const char *box2d[] = {"--backend", "box2d",   common[0], common[1],
+	                       common[2],   common[3], NULL};
+	long s_thesis = run_steps(gate, thesis), s_box2d = run_steps(gate, box2d);
+	long steps = s_thesis > s_box2d ? s_thesis : s_box2d;
+	const char *argv[] = {"video",   gate,      "--backends", "thesis,box2d", common[0],
+	                      common[1], common[2], common[3],    "--size",       "640x320",
+	                      "--out",   out,       NULL};
+	char *se = NULL;
+	int rc = bsim_test_cli(argv, NULL, &se);
+	if (rc != 0)
+		fail_msg("exit %d: %s", rc, se);
+	probe p;
+	ffprobe(out, &p);
+	/* 30 fps at 4 ms: 3 frames every 25 steps; 1 s hold: 30 frames. */
+	long frames = expected_frames(steps, 3, 25, 30);
+	printf("# side by side: %ld / %ld steps, %ld frames (%s %dx%d, %.4f s)\n", s_thesis,
+	       s_box2d, p.frames, p.codec, p.width, p.height, p.duration);
+	assert_string_equal(p.codec, "h264");
+	assert_string_equal(p.pix_fmt, "yuv420p");
+	assert_int_equal(p.width, 640);
+	assert_int_equal(p.height, 320);
+	assert_int_equal(p.frames, frames);
+	assert_true(fabs(p.duration - frames / 30.0) < 1e-3);
+	free(se);
+}
+
+/* The body's pixels in an RGB frame: those within tol of its colour in
+ * every channel; their count and bounding box. */
+typedef struct blob {
+	long n;
+	int x0, y0, x1, y1;
+} blob;
+
+static blob find_color(const unsigned char *rgb, int w, int h, int x_from, int x_to, uint32_t color,
+                       int tol)
+{
+	blob b = {0, w, h, -1, -1};
+	const int c[3] = {(int)(color >> 16) & 255, (int)(color >> 8) & 255, (int)color & 255};
+	for (int y = 0; y < h; y++)
+		for (int x = x_from; x < x_to; x++) {
+			const unsigned char *p = rgb + 3 * ((size_t)y * w + x);
+			if (abs(p[0] - c[0]) > tol || abs(p[1] - c[1]) > tol ||
+			    abs(p[2] - c[2]) > tol)
+				continue;
+			b.n++;
+			b.x0 = x < b.x0 ? x : b.x0;
+			b.x1 = x > b.x1 ? x : b.x1;
+			b.y0 = y < b.y0 ? y : b.y0;
+			b.y1 = y > b.y1 ? y : b.y1;
+		}
+	return b;
+}
+
+static void to_rgb(const uint32_t *px, int n, unsigned char *rgb)
+{
+	for (int i = 0; i < n; i++) {
+		rgb[3 * i] = (unsigned char)(px[i] >> 16);
+		rgb[3 * i + 1] = (unsigned char)(px[i] >> 8);
+		rgb[3 * i + 2] = (unsigned char)px[i];
+	}
+}
+
+static void load(const char *rel, bsim_scene *s)
+{
+	bsim_error err;
+	if (bsim_scene_load(bsim_test_src(rel), NULL, 0, s, &err) != BSIM_OK)
+		fail_msg("%s", err.msg);
+}
+
+/* A 3 x 3 field of gates (200 x 240 m with its margins) in a 320 x 240
+ * frame showing at most 40 m: the body must be whole in every frame while
+ * it travels further than the view is high. */
+static void lib_camera_follows_the_body(void **state)
+{
+	(void)state;
+	bsim_scene scene;
+	load("tests/data/field_3x3.yaml", &scene);
+	bsim_error err;
+	bsim_options opts = {0};
+	bsim_video_track *t = NULL;
+	assert_int_equal(bsim_video_track_record(&scene, &bsim_backend_thesis, &opts,
+	                                         bsim_seed_mix(1, 0, 0), 30.0, &t, &err),
+	                 BSIM_OK);
+	bsim_video_def def = bsim_video_default_def();
+	def.width = 320;
+	def.height = 240;
+	def.view_span = 40.0;
+	def.hold = 0.0;
+	bsim_video *v = NULL;
+	const char *label = "thesis";
+	assert_int_equal(bsim_video_alloc(&def, &scene, (const bsim_video_track *const *)&t, &label,
+	                                  1, &v, &err),
+	                 BSIM_OK);
+	const int w = 320, h = 240;
+	uint32_t *px = malloc(sizeof *px * w * h);
+	unsigned char *rgb = malloc(3 * w * h);
+	double y_min = 1e300, y_max = -1e300, d_min = 1e300, d_max = 0.0;
+	long frames = bsim_video_frames(v);
+	for (long k = 0; k < frames; k++) {
+		assert_int_equal(bsim_video_render(v, k, px, &err), BSIM_OK);
+		to_rgb(px, w * h, rgb);
+		blob b = find_color(rgb, w, h, 0, w, bsim_video_body_color(), 0);
+		bsim_video_sample s = bsim_video_track_sample(t, k);
+		if (b.n == 0)
+			fail_msg("frame %ld: no body (at %.1f, %.1f m)", k, s.x[0], s.x[1]);
+		/* The whole disc, clear of the frame's edges. */
+		double d = b.x1 - b.x0 + 1;
+		if (b.x0 <= 0 || b.y0 <= 0 || b.x1 >= w - 1 || b.y1 >= h - 1 ||
+		    b.n < 0.7 * 3.14159265358979 * d * d / 4)
+			fail_msg("frame %ld: body cut at the frame's edge (%ld px, box %d..%d x "
+			         "%d..%d)",
+			         k, b.n, b.x0, b.x1, b.y0, b.y1);
+		d_min = fmin(d_min, d);
+		d_max = fmax(d_max, d);
+		y_min = fmin(y_min, s.x[1]);
+		y_max = fmax(y_max, s.x[1]);
+	}
+	/* Pixels a metre, from the body's diameter (radius 10 m). */
+	double scale = d_min / 20.0;
+	printf("# field: %ld frames, body %g-%g px across (%.2f px/m), travelled %.1f m "
+	       "= %.0f px, frame %d px high, field %.0f px wide\n",
+	       frames, d_min, d_max, scale, y_max - y_min, (y_max - y_min) * scale, h,
+	       200.0 * scale);
+	assert_true(d_max - d_min <= 2.0);        /* one scale throughout */
+	assert_true(200.0 * scale > w);           /* the field is larger than the view */
+	assert_true((y_max - y_min) * scale > h); /* no fixed camera could keep the body */
+	free(px);
+	free(rgb);
+	bsim_video_free(v);
+	bsim_video_track_free(t);
+	bsim_scene_free(&scene);
+}
+
+/* The field's MP4, decoded: the body (its colour within the encoder's
+ * error) is in every frame. */
+static void cli_field_mp4_follows_the_body(void **state)
+{
+	(void)state;
+	char scene[1200], out[1400], raw[1400];
+	snprintf(scene, sizeof scene, "%s", bsim_test_src("tests/data/field_3x3.yaml"));
+	const char *dir = bsim_test_dir("field");
+	snprintf(out, sizeof out, "%s/field.mp4", dir);
+	snprintf(raw, sizeof raw, "%s/field.rgb", dir);
+	const char *same[] = {NULL};
+	long steps = run_steps(scene, same);
+	const char *argv[] = {"video",  scene, "--view", "40", "--size", "320x240",
+	                      "--hold", "0",   "--out",  out,  NULL};
+	char *se = NULL;
+	int rc = bsim_test_cli(argv, NULL, &se);
+	if (rc != 0)
+		fail_msg("exit %d: %s", rc, se);
+	free(se);
+	probe p;
+	ffprobe(out, &p);
+	long frames = expected_frames(steps, 3, 25, 0);
+	assert_string_equal(p.codec, "h264");
+	assert_int_equal(p.frames, frames);
+	const char *dec[] = {"ffmpeg",   "-v",       "error", "-i", out, "-f",
+	                     "rawvideo", "-pix_fmt", "rgb24", "-y", raw, NULL};
+	assert_int_equal(run_program(dec, NULL), 0);
+	const int w = 320, h = 240;
+	FILE *f = fopen(raw, "rb");
+	assert_non_null(f);
+	unsigned char *rgb = malloc(3 * w * h);
+	long k = 0, n_min = w * h;
+	while (fread(rgb, 3, (size_t)w * h, f) == (size_t)w * h) {
+		blob b = find_color(rgb, w, h, 0, w, bsim_video_body_color(), 40);
+		if (b.n < 1000 || b.x0 <= 0 || b.y0 <= 0 || b.x1 >= w - 1 || b.y1 >= h - 1)
+			fail_msg("decoded frame %ld: body missing or cut (%ld px)", k, b.n);
+		n_min = b.n < n_min ? b.n : n_min;
+		k++;
+	}
+	printf("# field MP4: %ld decoded frames, body >= %ld px in each\n", k, n_min);
+	assert_int_equal(k, frames);
+	fclose(f);
+	free(rgb);
+}
+
+/* The gate with a soft left beam and a stiff right one: each is drawn in
+ * its own colour of the scale, the soft one left of the body, the stiff
+ * one right. */
+static void lib_beams_take_their_stiffness_color(void **state)
+{
+	(void)state;
+	bsim_scene scene;
+	bsim_scene_init_gate(&scene, 7.0, 0.0);
+	scene.beams[0].stiffness = 200.0;
+	scene.beams[1].stiffness = 600.0;
+	scene.max_steps = 10;
+	bsim_error err;
+	bsim_options opts = {0};
+	bsim_video_track *t = NULL;
+	assert_int_equal(
+	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
+	        BSIM_OK);
+	bsim_video_def def = bsim_video_default_def();
+	bsim_video *v = NULL;
+	assert_int_equal(bsim_video_alloc(&def, &scene, (const bsim_video_track *const *)&t, NULL,
+	                                  1, &v, &err),
+	                 BSIM_OK);
+	int w, h;
+	bsim_video_size(v, &w, &h);
+	uint32_t soft = bsim_video_stiffness_color(v, 200.0);
+	uint32_t stiff = bsim_video_stiffness_color(v, 600.0);
+	uint32_t mid = bsim_video_stiffness_color(v, 400.0);
+	assert_true(soft != stiff && mid != soft && mid != stiff);
+	uint32_t *px = malloc(sizeof *px * w * h);
+	unsigned char *rgb = malloc(3 * (size_t)w * h);
+	assert_int_equal(bsim_video_render(v, 0, px, &err), BSIM_OK);
+	to_rgb(px, w * h, rgb);
+	blob body = find_color(rgb, w, h, 0, w, bsim_video_body_color(), 0);
+	int cx = (body.x0 + body.x1) / 2;
+	blob soft_l = find_color(rgb, w, h, 0, cx, soft, 0);
+	blob stiff_l = find_color(rgb, w, h, 0, cx, stiff, 0);
+	blob stiff_r = find_color(rgb, w, h, cx, w, stiff, 0);
+	printf("# beam colours: soft %06x %ld px left, stiff %06x %ld px right, %ld left\n", soft,
+	       soft_l.n, stiff, stiff_r.n, stiff_l.n);
+	/* A 25 m beam at the body's scale (body 20 m across) and 4 px wide. */
+	double beam_px = 25.0 * (body.x1 - body.x0 + 1) / 20.0;
+	assert_true(soft_l.n > 2.0 * beam_px);
+	assert_true(stiff_r.n > 2.0 * beam_px);
+	assert_int_equal(stiff_l.n, 0);
+	free(px);
+	free(rgb);
+	bsim_video_free(v);
+	bsim_video_track_free(t);
+	bsim_scene_free(&scene);
+}
+
+/* Column index of name in a CSV header line. */
+static int column(const char *header, const char *name)
+{
+	int i = 0;
+	size_t n = strlen(name);
+	for (const char *p = header;; i++) {
+		size_t len = strcspn(p, ",\n");
+		if (len == n && strncmp(p, name, n) == 0)
+			return i;
+		if (p[len] != ',')
+			break;
+		p += len + 1;
+	}
+	fail_msg("no column %s", name);
+	return -1;
+}
+
+/* Every frame of the gate's video shows the state of step min(floor(k/(fps
+ * h)), N) of the trajectory beamsim run records for the same trial:
+ * position, energies and the random force the runner applies over that
+ * step; 601 steps end between two frame times, and the last frame is the
+ * trial's end state. */
+static void lib_frames_are_the_runs_states(void **state)
+{
+	(void)state;
+	char gate[1200], csv[1400];
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	snprintf(csv, sizeof csv, "%s/t.csv", bsim_test_dir("same"));
+	const char *argv[] = {"run",          gate, "--seed", "3",
+	                      "--trial",      "5",  "--set",  "integration.max_steps=601",
+	                      "--trajectory", csv,  NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	char *text = bsim_test_read(csv);
+	assert_non_null(text);
+	const char *names[] = {"x", "y", "f_rand", "e_kin", "e_beam", "e_prop"};
+	int col[6];
+	for (int i = 0; i < 6; i++)
+		col[i] = column(text, names[i]);
+	/* Rows: one per step from step 0. */
+	long n_rows = 0, cap = 1024;
+	double(*rows)[6] = malloc(sizeof *rows * cap);
+	for (char *line = strchr(text, '\n') + 1; *line; n_rows++) {
+		if (n_rows == cap)
+			rows = realloc(rows, sizeof *rows * (cap *= 2));
+		char *p = line;
+		for (int c = 0; *p && *p != '\n'; c++) {
+			double x = strtod(p, &p);
+			for (int i = 0; i < 6; i++)
+				if (col[i] == c)
+					rows[n_rows][i] = x;
+			if (*p == ',')
+				p++;
+		}
+		line = *p ? p + 1 : p;
+	}
+
+	bsim_scene scene;
+	bsim_override ov = {"integration.max_steps", "601", "test"};
+	bsim_error err;
+	assert_int_equal(bsim_scene_load(gate, &ov, 1, &scene, &err), BSIM_OK);
+	bsim_options opts = {0};
+	bsim_video_track *t = NULL;
+	assert_int_equal(bsim_video_track_record(&scene, &bsim_backend_thesis, &opts,
+	                                         bsim_seed_mix(3, 0, 5), 30.0, &t, &err),
+	                 BSIM_OK);
+	long frames = bsim_video_track_frames(t);
+	assert_int_equal(n_rows, bsim_video_track_result(t)->steps_run + 1);
+	const long n_last = n_rows - 1;
+	assert_int_equal(frames, expected_frames(n_last, 3, 25, 0));
+	double worst = 0.0;
+	int forces_seen = 0;
+	for (long k = 0; k < frames; k++) {
+		bsim_video_sample s = bsim_video_track_sample(t, k);
+		long step = k * 25 / 3; /* floor(k / (30 fps x 4 ms)), to the end */
+		if (step > n_last)
+			step = n_last;
+		assert_int_equal(s.step, step);
+		const double got[6] = {s.x[0], s.x[1], s.f_rand, s.e_kin, s.e_spring, s.e_prop};
+		for (int i = 0; i < 6; i++) {
+			/* The last row's f_rand is the last force applied, not the
+			 * next one: compare forces only over steps that were run. */
+			if (i == 2 && step == n_last)
+				continue;
+			double want = rows[step][i];
+			double e = fabs(got[i] - want) / fmax(1.0, fabs(want));
+			worst = fmax(worst, e);
+			if (e > 1e-8)
+				fail_msg("frame %ld (step %ld): %s %.10g, run's trajectory %.10g",
+				         k, step, names[i], got[i], want);
+		}
+		forces_seen += s.f_rand != 0.0;
+	}
+	assert_int_equal(bsim_video_track_sample(t, frames - 1).step, n_last);
+	printf("# %ld frames equal the run's trajectory to %.1e (relative)\n", frames, worst);
+	assert_true(forces_seen > frames / 2);
+	free(rows);
+	free(text);
+	bsim_video_track_free(t);
+	bsim_scene_free(&scene);
+}
+
+/* An encoder that exits with status 1 without reading: the error says so
+ * and neither the video nor a temporary file is left. */
+static void lib_failing_encoder_writes_nothing(void **state)
+{
+	(void)state;
+	bsim_scene scene;
+	bsim_scene_init_gate(&scene, 7.0, 20.0);
+	scene.max_steps = 50;
+	bsim_error err;
+	bsim_options opts = {0};
+	bsim_video_track *t = NULL;
+	assert_int_equal(
+	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
+	        BSIM_OK);
+	bsim_video_def def = bsim_video_default_def();
+	def.ffmpeg = "false";
+	bsim_video *v = NULL;
+	assert_int_equal(bsim_video_alloc(&def, &scene, (const bsim_video_track *const *)&t, NULL,
+	                                  1, &v, &err),
+	                 BSIM_OK);
+	const char *dir = bsim_test_dir("failing");
+	char out[1400];
+	snprintf(out, sizeof out, "%s/x.mp4", dir);
+	assert_int_equal(bsim_video_write(v, out, &err), BSIM_EFAIL);
+	printf("# %s\n", err.msg);
+	assert_non_null(strstr(err.msg, "false exited with status 1"));
+	assert_true(dir_empty(dir));
+	/* The process is unharmed by the broken pipe: a second try fails alike. */
+	assert_int_equal(bsim_video_write(v, out, &err), BSIM_EFAIL);
+	assert_true(dir_empty(dir));
+	bsim_video_free(v);
+	bsim_video_track_free(t);
+	bsim_scene_free(&scene);
+}
+
+static void cli_missing_ffmpeg(void **state)
+{
+	(void)state;
+	char gate[1200], out[1400];
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	const char *dir = bsim_test_dir("missing");
+	snprintf(out, sizeof out, "%s/x.mp4", dir);
+	const char *path = getenv("PATH");
+	char *saved = path ? strdup(path) : NULL;
+	setenv("PATH", dir, 1); /* an empty directory: no ffmpeg */
+	const char *argv[] = {"video", gate, "--set", "integration.max_steps=20",
+	                      "--out", out,  NULL};
+	char *se = NULL;
+	int rc = bsim_test_cli(argv, NULL, &se);
+	if (saved)
+		setenv("PATH", saved, 1);
+	free(saved);
+	printf("# %s", se);
+	assert_int_equal(rc, 1);
+	assert_non_null(strstr(se, "ffmpeg not found"));
+	assert_non_null(strstr(se, "Debian package ffmpeg"));
+	assert_true(dir_empty(dir));
+	free(se);
+}
+
+static void cli_bad_arguments(void **state)
+{
+	(void)state;
+	char gate[1200], out[1400];
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	const char *dir = bsim_test_dir("bad");
+	snprintf(out, sizeof out, "%s/x.mp4", dir);
+	const char *bad_scene =
+	        bsim_test_write(dir, "bad.yaml", "body: { mass: -1, radius: 10 }\n");
+	char scene[1400];
+	snprintf(scene, sizeof scene, "%s", bad_scene);
+	const struct {
+		const char *args[6];
+		const char *needle;
+	} cases[] = {
+	        {{"--fps", "0"}, "--fps 0: expected a number in (0, 1000]"},
+	        {{"--fps", "30x"}, "--fps 30x"},
+	        {{"--size", "641x480"}, "expected even WIDTHxHEIGHT"},
+	        {{"--size", "640"}, "--size 640: expected WIDTHxHEIGHT"},
+	        {{"--size", "32x32"}, "from 64x64"},
+	        {{"--hold", "-1"}, "--hold -1"},
+	        {{"--view", "0"}, "--view 0"},
+	        {{"--backend", "nope"}, "nope"},
+	        {{"--backends", "thesis,nope"}, "nope"},
+	        {{"--backends", "thesis,thesis"}, "named twice"},
+	        {{"--backends", "thesis,box2d", "--backend", "thesis"}, "give one of them"},
+	        {{"--backends", "thesis,box2d", "--backend-opt", "substeps=2"}, "B:KEY=VALUE"},
+	        {{"--backend-opt", "nonsense=1"}, "nonsense"},
+	        {{"--set", "body.mass=-1"}, "body.mass"},
+	        {{"--trial", "-3"}, "--trial -3"},
+	        {{"--frames", "3"}, "unknown option --frames"},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		const char *argv[16] = {"video", gate, "--out", out};
+		int n = 4;
+		for (int j = 0; cases[i].args[j]; j++)
+			argv[n++] = cases[i].args[j];
+		argv[n] = NULL;
+		char *se = NULL;
+		int rc = bsim_test_cli(argv, NULL, &se);
+		if (rc != 2 || !strstr(se, cases[i].needle))
+			fail_msg("case %zu: exit %d, stderr \"%s\" (expected 2 and \"%s\")", i, rc,
+			         se, cases[i].needle);
+		free(se);
+		assert_true(dir_empty(dir) || access(out, F_OK) != 0);
+	}
+	/* No --out, no scene, a bad scene file. */
+	const char *no_out[] = {"video", gate, NULL};
+	const char *no_scene[] = {"video", "--out", out, NULL};
+	const char *bad[] = {"video", scene, "--out", out, NULL};
+	const char *const *more[] = {no_out, no_scene, bad};
+	const char *needles[] = {"--out FILE.mp4 is required", "missing SCENE",
+	                         "bad.yaml:1:15: body.mass"};
+	for (int i = 0; i < 3; i++) {
+		char *se = NULL;
+		int rc = bsim_test_cli(more[i], NULL, &se);
+		if (rc != 2 || !strstr(se, needles[i]))
+			fail_msg("exit %d, stderr \"%s\" (expected 2 and \"%s\")", rc, se,
+			         needles[i]);
+		free(se);
+	}
+	assert_int_equal(access(out, F_OK), -1);
+	/* Nothing but the bad scene in the directory. */
+	DIR *d = opendir(dir);
+	struct dirent *e;
+	while ((e = readdir(d)))
+		assert_true(e->d_name[0] == '.' || strcmp(e->d_name, "bad.yaml") == 0);
+	closedir(d);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(cli_single_backend),
+	        cmocka_unit_test(cli_side_by_side),
+	        cmocka_unit_test(lib_camera_follows_the_body),
+	        cmocka_unit_test(cli_field_mp4_follows_the_body),
+	        cmocka_unit_test(lib_beams_take_their_stiffness_color),
+	        cmocka_unit_test(lib_frames_are_the_runs_states),
+	        cmocka_unit_test(lib_failing_encoder_writes_nothing),
+	        cmocka_unit_test(cli_missing_ffmpeg),
+	        cmocka_unit_test(cli_bad_arguments),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
