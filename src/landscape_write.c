@@ -7,8 +7,8 @@
  * The figures read gnuplot "nonuniform matrix" files (first row: the
  * count and the x of each column; then per row its y and the values):
  * the top view at the grid's full resolution, the surfaces subsampled to
- * at most SURFACE_POINTS a side, so that an SVG of pm3d quadrangles stays
- * well under 1 MB. Points where the body cannot be (overlapping a pivot)
+ * at most SURFACE_QUADS quadrangles, so that an SVG of pm3d quadrangles
+ * stays under 1 MB. Points where the body cannot be (overlapping a pivot)
  * are drawn as walls at the clip level. Colours and heights are clipped a
  * little above the highest pass, so that the barriers, not the walls
  * beside the pivots, set the scale; the titles say where. */
@@ -25,7 +25,10 @@
 #include "figure.h"
 #include "mat.h"
 
-enum { SURFACE_POINTS = 66, PATH_MAX_LEN = 1100 };
+/* Most quadrangles of a 3-D surface: an SVG spends about 120 bytes on
+ * each (a lit fill, no mesh lines, which would triple it), so 4000 keep
+ * it under 0.5 MB. */
+enum { SURFACE_QUADS = 4000, PATH_MAX_LEN = 1100 };
 
 /* dir/name into buf. */
 static int file_path(char *buf, size_t size, const char *dir, const char *name, bsim_error *err)
@@ -377,8 +380,9 @@ static const char PALETTE[] = "set palette defined (0 '#440154', 1 '#3b528b', 2 
                               "3 '#5ec962', 4 '#fde725')\n";
 
 /* The clip level: a quarter of the way above the highest pass or the
- * start, whichever is higher, over the landscape's lowest point; never
- * above its maximum. */
+ * start, whichever is higher, over the landscape's lowest point (E_beam
+ * alone: 0.6 of the way above the highest pass); never above the
+ * landscape's maximum. */
 static double clip_level(const bsim_landscape_grid *g, const bsim_landscape_barriers *br,
                          const double *v, double e_min, int beam_only)
 {
@@ -392,7 +396,8 @@ static double clip_level(const bsim_landscape_grid *g, const bsim_landscape_barr
 		e_max = fmax(e_max, v[k]);
 	if (!isfinite(top))
 		return e_max;
-	const double c = top + 0.25 * (top - e_min);
+	/* E_beam alone: the ridge between the passes stands 0.4-0.5 times higher */
+	const double c = top + (beam_only ? 0.6 : 0.25) * (top - e_min);
 	return c > e_min && c < e_max ? c : e_max;
 }
 
@@ -540,7 +545,7 @@ static int figure_top(const char *dir, const bsim_scene *s, const bsim_landscape
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	fputs(PALETTE, f);
 	fprintf(f,
-	        "set title \"%s: E_total = E_prop + E_beam (colours clipped at %.0f J)\" "
+	        "set title \"%s\\nE_total = E_prop + E_beam, colours clipped at %.0f J\" "
 	        "noenhanced\n",
 	        what, clip);
 	fprintf(f,
@@ -598,8 +603,10 @@ static int figure_surface(const char *dir, const char *name, const bsim_scene *s
 {
 	char data[64];
 	snprintf(data, sizeof data, "%s.dat", name);
-	const int longest = g->nx > g->ny ? g->nx : g->ny;
-	const int stride = (longest + SURFACE_POINTS - 2) / (SURFACE_POINTS - 1);
+	int stride = 1;
+	while ((double)((g->nx + stride - 1) / stride) * ((g->ny + stride - 1) / stride) >
+	       SURFACE_QUADS)
+		stride++;
 	const double e_min = grid_min(s, g, v);
 	const double clip = clip_level(g, br, v, e_min, beam_only);
 	/* heights above the clip level are drawn at it */
@@ -621,15 +628,15 @@ static int figure_surface(const char *dir, const char *name, const bsim_scene *s
 	if (!f)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	fputs(PALETTE, f);
-	fprintf(f, "set title \"%s: %s (heights clipped at %.0f J)\" noenhanced\n", what,
+	fprintf(f, "set title \"%s\\n%s, heights clipped at %.0f J\" noenhanced\n", what,
 	        beam_only ? "E_beam, the springs alone; the passes of E_total at their E_beam"
 	                  : "E_total = E_prop + E_beam",
 	        clip);
 	fprintf(f,
 	        "set xlabel 'x (m)'\nset ylabel 'y (m)'\nset zlabel '%s (J)' rotate parallel\n"
 	        "set cbrange [%.6g:%.6g]\nset zrange [%.6g:%.6g]\nunset colorbox\n"
-	        "set view 65,20,1,1.1\nset xyplane 0\nset pm3d depthorder border lc rgb "
-	        "'#333333' lw 0.3\nset grid\n",
+	        "set view 65,20,1,1.1\nset xyplane 0\nset pm3d depthorder lighting "
+	        "primary 0.45 specular 0.1\nset grid\n",
 	        beam_only ? "E_{beam}" : "E_{total}", e_min, clip, e_min, clip);
 	label_passes(f, br, 1, beam_only);
 	fprintf(f, "splot '%s' nonuniform matrix using 1:2:3 with pm3d notitle\n", data);

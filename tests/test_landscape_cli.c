@@ -195,7 +195,7 @@ static void test_options(void **state)
 	                      "--resolution",
 	                      "0.5",
 	                      "--region",
-	                      "-20,20,0,65",
+	                      "-25,25,15,65",
 	                      "--set",
 	                      "beams.0.stiffness=100",
 	                      "--set",
@@ -208,12 +208,20 @@ static void test_options(void **state)
 		fail_msg("exit %d: %s", rc, err ? err : "");
 	char *json = bsim_test_read(path_in(dir, "landscape.json"));
 	assert_non_null(json);
-	assert_true(json_number_after(json, "nx") == 81 && json_number_after(json, "ny") == 131);
+	assert_true(json_number_after(json, "nx") == 101 && json_number_after(json, "ny") == 101);
 	assert_true(json_number_after(json, "spacing") == 0.5);
 	/* the softer left beam: no barrier over it at the gate's 7 N */
 	const char *lowest = strstr(json, "\"lowest_pass\"");
 	assert_non_null(strstr(lowest, "\"kind\": \"open\", \"crossed\": 1"));
 	free(json);
+	/* a square region: the surfaces' most quadrangles, still under 1 MB */
+	const char *figs[] = {"landscape_top.svg", "landscape_beam.svg", "landscape_total.svg",
+	                      "landscape_top.png", "landscape_beam.png", "landscape_total.png"};
+	for (int i = 0; i < 6; i++) {
+		const long size = file_size(path_in(dir, figs[i]));
+		print_message("square region: %s %ld bytes\n", figs[i], size);
+		assert_true(size > 1000 && size < 1000000);
+	}
 	free(out);
 	free(err);
 }
