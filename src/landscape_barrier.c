@@ -29,12 +29,15 @@
  * with a path's cost the max of E instead of the sum, exact for the grid.
  * The grid value converges at first order in the spacing h (the path may
  * have to step a cell up a slope), so the pass is refined on nested
- * windows: a window of +-6 h around the pass, sampled at h/8, is searched
- * again, its edge points entering as sources with their coarser forward
- * value (those below V only: the start side) and as targets with their
- * backward value (below V only: the far side), three times (h/512, 0.5 mm
- * at the default 0.25 m). A window is moved and searched again when its
- * pass lands on its edge. The last level's change of V is its accuracy.
+ * windows (see refine): each holds the stretch of the minimax path within
+ * 3 h |grad E| of V, sampled 4 times finer (at most REFINE_CELLS points),
+ * its edge points entering as sources with their coarser forward value
+ * (those below V only: the start side) and as targets with their backward
+ * value (below V only: the far side); three levels, about 4 mm at the
+ * default 0.25 m. A window whose pass lands on its edge is enlarged and
+ * searched again. The last level's change of V is its accuracy. A pass on
+ * a cliff's top converges only like sqrt(h), th having a square-root
+ * singularity there; its change says so.
  *
  * Why not a nudged elastic band, a string method or a saddle search:
  * they need the gradient of E and stop where its component across the
