@@ -21,7 +21,6 @@
 #include "beamsim/atomic_file.h"
 #include "beamsim/clock.h"
 #include "beamsim/effects.h"
-#include "beamsim/plot.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 
@@ -526,67 +525,4 @@ int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result *r,
 			        r->rows[i].setting, r->rows[i].h, r->rows[i].err_mean,
 			        r->rows[i].speed);
 	return bsim_atomic_file_commit(&o, err);
-}
-
-int bsim_accuracy_write_png(const char *path, const bsim_accuracy_result *r, bsim_error *err)
-{
-	static const uint32_t palette[] = {
-	        0x1F77B4, 0xD62728, 0x2CA02C, 0xFF7F0E, 0x9467BD, 0x8C564B, 0xE377C2, 0x7F7F7F,
-	        0xBCBD22, 0x17BECF, 0x393B79, 0xAD494A, 0x637939, 0x843C39, 0x7B4173, 0x000000,
-	};
-	int n_series = 0;
-	bsim_plot_series *s = calloc((size_t)r->n + 1, sizeof *s);
-	double *x = malloc(((size_t)r->n + 1) * sizeof *x),
-	       *y = malloc(((size_t)r->n + 1) * sizeof *y);
-	char(*labels)[128] = calloc((size_t)r->n + 1, sizeof *labels);
-	if (!s || !x || !y || !labels) {
-		free(s);
-		free(x);
-		free(y);
-		free(labels);
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	}
-	/* The reference step is left out: there the error measures the
-	 * reference against itself (0, or float32 round-off), which says
-	 * nothing of cost and would stretch the axis over ten decades. */
-	double h_ref = r->n > 0 ? r->rows[0].h : 0.0;
-	for (int i = 0; i < r->n; i++)
-		h_ref = fmin(h_ref, r->rows[i].h);
-	/* Rows of one (backend, setting) are consecutive: one curve each. */
-	int k = 0;
-	for (int i = 0; i < r->n;) {
-		int j = i, first = k;
-		while (j < r->n && r->rows[j].backend == r->rows[i].backend &&
-		       strcmp(r->rows[j].setting, r->rows[i].setting) == 0) {
-			if (r->rows[j].h > 1.5 * h_ref) {
-				x[k] = r->rows[j].speed;
-				y[k] = r->rows[j].err_mean;
-				k++;
-			}
-			j++;
-		}
-		bsim_plot_series *c = &s[n_series];
-		snprintf(labels[n_series], sizeof labels[0], "%s %s", r->rows[i].backend,
-		         r->rows[i].setting);
-		c->label = labels[n_series];
-		c->n = k - first;
-		c->x = x + first;
-		c->y = y + first;
-		c->color = palette[n_series % 16];
-		int thesis = strcmp(r->rows[i].backend, "thesis") == 0;
-		c->marker = thesis ? 1 : strstr(r->rows[i].setting, "torque") ? 0 : 2;
-		c->dashed =
-		        strstr(r->rows[i].setting, "euler") || strstr(r->rows[i].setting, "sub=1");
-		n_series++;
-		i = j;
-	}
-	int rc =
-	        bsim_plot_loglog(path, 1100, 650, "consistency error vs speed, h from 0.016 s down",
-	                         "speed: simulated s per wall s (x real time)",
-	                         "consistency error after pieces (m)", s, n_series, err);
-	free(s);
-	free(x);
-	free(y);
-	free(labels);
-	return rc;
 }

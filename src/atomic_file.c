@@ -60,3 +60,27 @@ void bsim_atomic_file_abort(bsim_atomic_file *o)
 	o->f = NULL;
 	unlink(o->tmp);
 }
+
+int bsim_atomic_file_copy(const char *from, const char *to, bsim_error *err)
+{
+	FILE *in = fopen(from, "rb");
+	if (!in)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot read the file: %s", from,
+		                      strerror(errno));
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, to, err) != BSIM_OK) {
+		fclose(in);
+		return BSIM_EFAIL;
+	}
+	char buf[8192];
+	size_t n;
+	while ((n = fread(buf, 1, sizeof buf, in)) > 0)
+		fwrite(buf, 1, n, o.f);
+	int bad = ferror(in);
+	fclose(in);
+	if (bad) {
+		bsim_atomic_file_abort(&o);
+		return bsim_error_set(err, BSIM_EFAIL, "%s: read error", from);
+	}
+	return bsim_atomic_file_commit(&o, err);
+}

@@ -87,17 +87,20 @@ static int script_write(const bsim_figure_def *d, const char *body, bsim_error *
 	fprintf(o.f,
 	        "# %s.gp: drawn by beamsim %s. Rerun with `gnuplot %s.gp` in this directory;\n"
 	        "# it writes %s.png and %s.svg. The drawing is the block inside the loop.\n"
+	        "# `gnuplot -e 'scale=0.75' %s.gp` draws the PNG at 0.75 of its size.\n"
 	        "if (!exists(\"outbase\")) outbase = \"%s\"\n"
+	        "if (!exists(\"scale\")) scale = 1\n"
 	        "do for [fmt in \"png svg\"] {\n"
 	        "if (fmt eq \"png\") {\n"
-	        "  set terminal pngcairo size %d,%d enhanced font \"%s\"\n"
+	        "  set terminal pngcairo size %d*scale,%d*scale enhanced font \"%s\" "
+	        "fontscale scale linewidth scale\n"
 	        "} else {\n"
 	        "  set terminal svg size %d,%d dynamic enhanced font \"%s\"\n"
 	        "}\n"
 	        "set output outbase.\".\".fmt\n"
 	        "reset\n",
-	        d->name, BSIM_VERSION, d->name, d->name, d->name, d->name, d->width, d->height,
-	        d->font, d->width, d->height, d->font);
+	        d->name, BSIM_VERSION, d->name, d->name, d->name, d->name, d->name, d->width,
+	        d->height, d->font, d->width, d->height, d->font);
 	fputs(body, o.f);
 	if (*body && body[strlen(body) - 1] != '\n')
 		fputc('\n', o.f);

@@ -64,6 +64,9 @@ void bsim_sweep_result_free(bsim_sweep_result *r)
 {
 	if (!r)
 		return;
+	for (size_t i = 0; r->kept && i < (size_t)r->n_groups * (size_t)r->keep; i++)
+		bsim_trajectory_free(&r->kept[i]);
+	free(r->kept);
 	free(r->trials_out);
 	free(r->groups);
 	memset(r, 0, sizeof *r);
@@ -107,6 +110,8 @@ typedef struct sweep_shared {
 	const bsim_backend *backend_b; /* NULL: not paired */
 	const bsim_options *opts_b;
 	bsim_trial_result *results_b;
+	bsim_trajectory *kept, *kept_b; /* NULL: none kept */
+	int keep, keep_stride;
 	double *t_separate;
 	long total;
 	long done;
@@ -160,18 +165,32 @@ static void sweep_thread(sweep_shared *sh)
 		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
 		const bsim_scene *scene = &sh->scenes[g];
+		bsim_trajectory *keep = t < sh->keep ? &sh->kept[g * sh->keep + t] : NULL;
+		bsim_recorder rec = {.stride = sh->keep_stride,
+		                     .record = bsim_trajectory_record,
+		                     .record_user = keep,
+		                     .overlap = cfg->measure_overlap};
 		int rc = BSIM_OK;
-		if (t > 0 && sh->deterministic[g])
-			; /* a copy of trial 0, filled in after the run */
-		else if (pair)
+		if (t > 0 && sh->deterministic[g]) {
+			; /* a copy of trial 0, filled in after the run (and its trajectory) */
+		} else if (pair) {
+			pair->keep[0] = keep;
+			pair->keep[1] = keep ? &sh->kept_b[g * sh->keep + t] : NULL;
+			pair->keep_stride = sh->keep_stride;
 			rc = trial_pair_run(pair, scene, cfg->backend, cfg->opts, sh->backend_b,
 			                    sh->opts_b, seed, 0.01 * scene->body.radius,
 			                    &sh->results[i], &sh->results_b[i], &sh->t_separate[i],
 			                    &err);
-		else
-			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed,
-			                    cfg->measure_overlap ? &overlap : NULL, &sh->results[i],
-			                    &err);
+		} else {
+			const bsim_recorder *use = keep                   ? &rec
+			                           : cfg->measure_overlap ? &overlap
+			                                                  : NULL;
+			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, use,
+			                    &sh->results[i], &err);
+			if (rc == BSIM_OK && keep && keep->oom)
+				rc = bsim_error_set(&err, BSIM_EFAIL,
+				                    "out of memory for a kept trajectory");
+		}
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
 		long done;
@@ -184,7 +203,7 @@ static void sweep_thread(sweep_shared *sh)
 	trial_pair_free(pair);
 }
 
-static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_error *err)
+static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, int keep, bsim_error *err)
 {
 	size_t n = (size_t)n_groups * (size_t)trials;
 	memset(r, 0, sizeof *r);
@@ -193,7 +212,11 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, bsim_err
 	r->has_ledger = 1;
 	r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
 	r->groups = calloc(n_groups ? (size_t)n_groups : 1, sizeof *r->groups);
-	if (!r->trials_out || !r->groups) {
+	if (keep > 0) {
+		r->keep = keep;
+		r->kept = calloc((size_t)n_groups * (size_t)keep, sizeof *r->kept);
+	}
+	if (!r->trials_out || !r->groups || (keep > 0 && !r->kept)) {
 		bsim_sweep_result_free(r);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %zu trial results", n);
 	}
@@ -214,6 +237,22 @@ static void deterministic_fill(bsim_trial_result *res, double *t_separate, const
 				t_separate[first + t] = t_separate[first];
 		}
 	}
+}
+
+/* The kept trajectories of a deterministic group's copies: trial 0's. */
+static int kept_fill(bsim_sweep_result *r, const int *deterministic, bsim_error *err)
+{
+	for (int g = 0; r->kept && g < r->n_groups; g++) {
+		if (!deterministic[g])
+			continue;
+		const bsim_trajectory *first = &r->kept[(size_t)g * r->keep];
+		for (int t = 1; t < r->keep; t++)
+			if (bsim_trajectory_copy(&r->kept[(size_t)g * r->keep + t], first) !=
+			    BSIM_OK)
+				return bsim_error_set(err, BSIM_EFAIL,
+				                      "out of memory for kept trajectories");
+	}
+	return BSIM_OK;
 }
 
 static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_groups, int trials,
@@ -250,11 +289,15 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: expected at least one group and trials >= 0", e->path);
 	long total = (long)e->n_groups * e->trials;
-	if (result_alloc(out, e->n_groups, e->trials, err) != BSIM_OK)
+	int keep = cfg->keep < e->trials ? cfg->keep : e->trials;
+	if (keep < 0)
+		keep = 0;
+	if (result_alloc(out, e->n_groups, e->trials, keep, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (backend_b) {
 		*t_separate = calloc(total ? (size_t)total : 1, sizeof **t_separate);
-		if (!*t_separate || result_alloc(out_b, e->n_groups, e->trials, err) != BSIM_OK) {
+		if (!*t_separate ||
+		    result_alloc(out_b, e->n_groups, e->trials, keep, err) != BSIM_OK) {
 			free(*t_separate);
 			*t_separate = NULL;
 			bsim_sweep_result_free(out);
@@ -280,6 +323,10 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	        .backend_b = backend_b,
 	        .opts_b = opts_b,
 	        .results_b = backend_b ? out_b->trials_out : NULL,
+	        .kept = out->kept,
+	        .kept_b = backend_b ? out_b->kept : NULL,
+	        .keep = keep,
+	        .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
 	        .t_separate = backend_b ? *t_separate : NULL,
 	        .total = total,
 	};
@@ -312,6 +359,19 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	                   e->n_groups, e->trials);
 	if (backend_b)
 		deterministic_fill(out_b->trials_out, NULL, deterministic, e->n_groups, e->trials);
+	rc = kept_fill(out, deterministic, err);
+	if (rc == BSIM_OK && backend_b)
+		rc = kept_fill(out_b, deterministic, err);
+	if (rc != BSIM_OK) {
+		free(deterministic);
+		bsim_sweep_result_free(out);
+		if (backend_b) {
+			bsim_sweep_result_free(out_b);
+			free(*t_separate);
+			*t_separate = NULL;
+		}
+		return rc;
+	}
 	double wall = bsim_clock_seconds() - t0;
 	result_finish(out, deterministic, e->n_groups, e->trials, wall);
 	if (backend_b)

@@ -135,16 +135,52 @@ void bsim_recorder_header(FILE *f, int n_beams)
 	fputs(",e_kin,e_beam,e_prop\n", f);
 }
 
-static void record_row(FILE *f, const bsim_scene *sc, const bsim_state *s, double t, double f_rand)
+void bsim_recorder_ledger_header(FILE *f)
 {
-	fprintf(f, "%.6f,%.10g,%.10g,%.10g,%.10g", t, s->x[0], s->x[1], s->v[0], s->v[1]);
+	fputs("t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual\n", f);
+}
+
+void bsim_recorder_csv_record(void *file, const bsim_record_row *row)
+{
+	FILE *f = file;
+	const bsim_state *s = row->state;
+	fprintf(f, "%.6f,%.10g,%.10g,%.10g,%.10g", row->t, s->x[0], s->x[1], s->v[0], s->v[1]);
 	for (int i = 0; i < s->n_beams; i++)
 		fprintf(f, ",%.10g,%.10g", s->theta[i], s->omega[i]);
-	fprintf(f, ",%.10g", f_rand);
+	fprintf(f, ",%.10g", row->f_rand);
 	for (int i = 0; i < s->n_beams; i++)
 		fprintf(f, ",%d", s->contact[i]);
-	fprintf(f, ",%.10g,%.10g,%.10g\n", energy_kinetic(sc, s), energy_springs(sc, s),
-	        bsim_landscape_e_prop(sc, s->x[1]));
+	fprintf(f, ",%.10g,%.10g,%.10g\n", row->e_kin, row->e_beam, row->e_prop);
+}
+
+static void ledger_row(FILE *f, const bsim_record_row *row)
+{
+	const bsim_ledger *l = row->ledger;
+	fprintf(f, "%.6f,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", row->t,
+	        row->e_kin, row->e_beam, row->e_kin + row->e_beam, l->w_prop, l->w_rand, l->damper,
+	        l->impact, l->contact, l->correction, l->residual);
+}
+
+/* One recorded row to every sink of rec. */
+static void record(const bsim_recorder *rec, const bsim_scene *sc, const bsim_state *s, long step,
+                   double f_rand, const bsim_ledger *ledger)
+{
+	bsim_record_row row = {
+	        .step = step,
+	        .t = (double)step * sc->dt,
+	        .state = s,
+	        .f_rand = f_rand,
+	        .ledger = ledger,
+	        .e_kin = energy_kinetic(sc, s),
+	        .e_beam = energy_springs(sc, s),
+	        .e_prop = bsim_landscape_e_prop(sc, s->x[1]),
+	};
+	if (rec->csv)
+		bsim_recorder_csv_record(rec->csv, &row);
+	if (rec->ledger)
+		ledger_row(rec->ledger, &row);
+	if (rec->record)
+		rec->record(rec->record_user, &row);
 }
 
 /* One step's entry in the ledger: the work of each force over the body's
@@ -246,7 +282,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	for (int i = 0; i < 2 && i < scene->n_beams; i++)
 		out->max_theta[i] = s0->theta[i];
 	int stride = rec && rec->stride > 0 ? rec->stride : 1;
-	FILE *csv = rec ? rec->csv : NULL;
+	int recording = rec && (rec->csv || rec->ledger || rec->record);
 	bsim_trace_fn trace = rec ? rec->trace : NULL;
 	int overlap = rec && rec->overlap;
 	out->overlap_max = overlap ? 0.0 : NAN;
@@ -267,8 +303,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		if (stop)
 			break;
 		bsim_effects_force(&fx, n, h, f);
-		if (csv && n % stride == 0) {
-			record_row(csv, scene, s0, (double)n * h, random_value(&fx));
+		if (recording && n % stride == 0) {
+			record(rec, scene, s0, n, random_value(&fx), &out->ledger);
 			recorded = n;
 		}
 		backend->step(w, f, h);
@@ -314,8 +350,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 			done = 1;
 		}
 	}
-	if (csv && recorded != n) /* the final state, whatever the stride */
-		record_row(csv, scene, s0, (double)n * h, random_value(&fx));
+	if (recording && recorded != n) /* the final state, whatever the stride */
+		record(rec, scene, s0, n, random_value(&fx), &out->ledger);
 	if (out->outcome != BSIM_TRAVERSED) {
 		out->steps = (int)n;
 		out->t_end = (double)n * h;

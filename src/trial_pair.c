@@ -59,9 +59,16 @@ static int run_traced(trial_pair *p, int k, const bsim_scene *scene, const bsim_
 	tr->n = 0;
 	tr->oom = 0;
 	bsim_recorder rec = {.csv = NULL, .stride = 1, .trace = trace_push, .trace_user = tr};
+	if (p->keep[k]) {
+		rec.stride = p->keep_stride;
+		rec.record = bsim_trajectory_record;
+		rec.record_user = p->keep[k];
+	}
 	int rc = bsim_trial_run(p->runner, scene, b, opts, seed, &rec, r, err);
 	if (rc == BSIM_OK && tr->oom)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for a %ld-step trace", tr->n);
+	if (rc == BSIM_OK && p->keep[k] && p->keep[k]->oom)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for a kept trajectory");
 	return rc;
 }
 

@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "beamsim/backend.h"
+#include "beamsim/trajectory.h"
 #include "beamsim/trial.h"
 
 /* The body centre after every step of one run. */
@@ -19,6 +20,8 @@ typedef struct trial_trace {
 typedef struct trial_pair {
 	bsim_runner *runner;
 	trial_trace trace[2];
+	bsim_trajectory *keep[2]; /* NULL, or where each run's rows are kept */
+	int keep_stride;
 } trial_pair;
 
 trial_pair *trial_pair_alloc(void);

@@ -94,12 +94,12 @@ int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backen
                       const bsim_accuracy_config *cfg, bsim_accuracy_result *out, bsim_error *err);
 void bsim_accuracy_result_free(bsim_accuracy_result *r);
 
-/* accuracy.csv, accuracy.md and accuracy.png of a result. */
+/* accuracy.csv and accuracy.md of a result; the figure is drawn from
+ * accuracy.csv (beamsim/figures.h). */
 int bsim_accuracy_write_csv(const char *path, const bsim_accuracy_result *r, bsim_error *err);
 int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result *r,
                            const bsim_accuracy_config *cfg, const char *scene_label,
                            bsim_error *err);
-int bsim_accuracy_write_png(const char *path, const bsim_accuracy_result *r, bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -41,6 +41,10 @@ int bsim_atomic_file_commit(bsim_atomic_file *o, bsim_error *err);
  * nothing if o is not open, so it is safe on a zeroed o. */
 void bsim_atomic_file_abort(bsim_atomic_file *o);
 
+/* Copies the file from to the path to, atomically as above. BSIM_EFAIL
+ * naming the file that cannot be read or written. */
+int bsim_atomic_file_copy(const char *from, const char *to, bsim_error *err);
+
 #ifdef __cplusplus
 }
 #endif

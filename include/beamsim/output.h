@@ -26,6 +26,10 @@ int bsim_output_summary_json(const char *path, const bsim_experiment *e, const c
  * the group's value. */
 int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
                            bsim_error *err);
+/* trajectories.csv: the kept trajectories of r (r->keep per group), rows of
+ * bsim_trajectory_csv_header, group by group, trial by trial. Nothing is
+ * written when r keeps none. */
+int bsim_output_trajectories_csv(const char *path, const bsim_sweep_result *r, bsim_error *err);
 /* Reads a trials.csv written by bsim_output_trials_csv, by this version or
  * an earlier one, back into r (which it allocates: n_groups x trials rows,
  * each exactly once) and aggregates the groups. Columns are found by their

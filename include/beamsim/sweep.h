@@ -5,6 +5,7 @@
 
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
+#include "beamsim/trajectory.h"
 #include "beamsim/trial.h"
 
 #ifdef __cplusplus
@@ -28,10 +29,12 @@ typedef struct bsim_sweep_result {
 	bsim_trial_result *trials_out; /* n_groups * trials, index g*trials + t */
 	bsim_group_result *groups;     /* n_groups */
 	double wall_seconds;
-	long total_steps; /* steps integrated (a deterministic group's one trial) */
-	long trials_run;  /* trials integrated: copies of a deterministic group's not */
-	int has_ledger;   /* 1: the trials' ledgers are known (a run, or a trials.csv
-	                   * with the energy columns) */
+	long total_steps;      /* steps integrated (a deterministic group's one trial) */
+	long trials_run;       /* trials integrated: copies of a deterministic group's not */
+	int has_ledger;        /* 1: the trials' ledgers are known (a run, or a trials.csv
+	                        * with the energy columns) */
+	int keep;              /* trajectories kept per group (its first trials) */
+	bsim_trajectory *kept; /* n_groups * keep, index g*keep + t; NULL if keep = 0 */
 } bsim_sweep_result;
 
 /* Called from one thread now and then with done/total trials. */
@@ -46,6 +49,8 @@ typedef struct bsim_sweep_config {
 	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
 	int measure_overlap; /* 1: each trial's overlap_max (plain sweeps only) */
+	int keep;            /* keep the trajectories of the first keep trials of each group */
+	int keep_stride;     /* of those, a row every keep_stride steps (<= 0: 5) */
 } bsim_sweep_config;
 
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller

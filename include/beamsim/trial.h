@@ -95,12 +95,32 @@ typedef struct bsim_trial_result {
  * whatever the stride; for in-memory use of a trajectory (compare). */
 typedef void (*bsim_trace_fn)(void *user, long step, const bsim_state *s);
 
-/* Trajectory recording: one CSV row per step (DESIGN.md "Outputs"). */
+/* One recorded row: the state at time t = step h, the random force that
+ * acts during the step from there, and the energy ledger summed over
+ * [0, t]. */
+typedef struct bsim_record_row {
+	long step;
+	double t;                  /* s */
+	const bsim_state *state;   /* at t */
+	double f_rand;             /* N, lateral, acting on [t, t + h) */
+	const bsim_ledger *ledger; /* summed over the steps before t */
+	double e_kin, e_beam;      /* J: body and beams' kinetic, springs' elastic */
+	double e_prop;             /* J: F_prop (y0 - y), MODEL.md section 7 */
+} bsim_record_row;
+
+/* Called at every recorded row (the rows of the CSV, whatever it is). */
+typedef void (*bsim_record_fn)(void *user, const bsim_record_row *row);
+
+/* Trajectory recording (DESIGN.md "Outputs"). Rows are the state at
+ * t = 0, after every stride-th step, and after the last step. */
 typedef struct bsim_recorder {
-	FILE *csv;           /* NULL: no recording */
+	FILE *csv;           /* NULL: no trajectory CSV */
 	int stride;          /* record every stride-th step (>= 1) */
-	bsim_trace_fn trace; /* NULL: none */
+	bsim_trace_fn trace; /* NULL: none; called after every step, whatever the stride */
 	void *trace_user;
+	FILE *ledger;          /* NULL: none; the ledger CSV, one row per recorded row */
+	bsim_record_fn record; /* NULL: none */
+	void *record_user;
 	/* 1: measure overlap_max, the deepest overlap of the body with any beam
 	 * after each step (R minus the distance from the centre to the beam's
 	 * segment). A solver that keeps contacts apart holds it near 0; it
@@ -110,6 +130,17 @@ typedef struct bsim_recorder {
 
 /* Writes the trajectory CSV header for a scene of n_beams beams. */
 void bsim_recorder_header(FILE *f, int n_beams);
+
+/* A bsim_record_fn writing the row to the trajectory CSV file (a FILE *):
+ * what rec->csv receives, for a second file with the same rows. */
+void bsim_recorder_csv_record(void *file, const bsim_record_row *row);
+
+/* The ledger CSV (beamsim run --out): at each recorded time t, s,
+ *   t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual
+ * in J, every flow summed over [0, t], so that at every row
+ *   e_mech(t) - e_mech(0) = w_prop + w_rand - damper - impact - contact
+ *                           - correction + residual. */
+void bsim_recorder_ledger_header(FILE *f);
 
 typedef struct bsim_runner bsim_runner;
 

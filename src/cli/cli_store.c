@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "beamsim/atomic_file.h"
+#include "beamsim/matlab.h"
 #include "beamsim/output.h"
 #include "beamsim/progress.h"
 #include "beamsim/report.h"
@@ -52,21 +53,46 @@ static void record_fill(bsim_run_record *rec, const char *command, const bsim_ex
 		rec->rule = (bsim_compare_rule){BSIM_COMPARE_ALPHA, BSIM_COMPARE_MARGIN, 0};
 }
 
+/* summary.json, trials.csv, trajectories.csv when trajectories were kept
+ * (a stale one of an earlier run is removed, so the directory never pairs
+ * trials with trajectories of another run), and their .mat twins. */
 static int sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
                        const bsim_options *opts, const bsim_sweep_result *r)
 {
-	char summary[1100], trials[1100];
+	char summary[1100], trials[1100], traj[1100], traj_mat[1100];
 	bsim_error err;
 	if (cli_path(summary, sizeof summary, dir, "summary.json") ||
-	    cli_path(trials, sizeof trials, dir, "trials.csv"))
+	    cli_path(trials, sizeof trials, dir, "trials.csv") ||
+	    cli_path(traj, sizeof traj, dir, "trajectories.csv") ||
+	    cli_path(traj_mat, sizeof traj_mat, dir, "trajectories.mat"))
 		return CLI_FAIL;
+	if (r->keep == 0) {
+		remove(traj);
+		remove(traj_mat);
+	}
 	if (bsim_output_mkdir(dir, &err) != BSIM_OK ||
 	    bsim_output_summary_json(summary, e, b->name, opts, r, &err) != BSIM_OK ||
-	    bsim_output_trials_csv(trials, e, r, &err) != BSIM_OK) {
+	    bsim_output_trials_csv(trials, e, r, &err) != BSIM_OK ||
+	    bsim_output_trajectories_csv(traj, r, &err) != BSIM_OK ||
+	    bsim_matlab_sweep(dir, e, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return CLI_FAIL;
 	}
 	return CLI_OK;
+}
+
+/* DIR/NAME.csv or .json as DIR/NAME.mat, variable NAME. */
+static int twin_file(const char *dir, const char *file, const char *var)
+{
+	char path[1100], mat[1100];
+	bsim_error err;
+	if (cli_path(path, sizeof path, dir, file))
+		return CLI_FAIL;
+	int rc = bsim_matlab_path(path, mat, sizeof mat, &err);
+	if (rc == BSIM_OK)
+		rc = strstr(file, ".json") ? bsim_matlab_from_json(path, mat, var, &err)
+		                           : bsim_matlab_from_csv(path, mat, var, &err);
+	return cli_report(rc, &err);
 }
 
 int cli_store_sweep(const char *dir, const bsim_experiment *e, const bsim_backend *b,
@@ -161,6 +187,10 @@ static int compare_write(const cli_compare_job *job, const bsim_sweep_result r[2
 	if (rc == CLI_OK)
 		rc = report_file(job->out, "report.md", title ? title : "", bsim_report_md, &rep);
 	free(title);
+	if (rc == CLI_OK)
+		rc = twin_file(job->out, "pairs.csv", "pairs");
+	if (rc == CLI_OK)
+		rc = twin_file(job->out, "report.json", "report");
 	if (rc != CLI_OK)
 		return rc;
 	bsim_run_record rec;
@@ -188,6 +218,8 @@ int cli_compare_execute(const cli_compare_job *job, bsim_comparison *cmp)
 	        .n_extra = job->n_extra,
 	        .progress = bsim_progress_update,
 	        .progress_user = &progress,
+	        .keep = job->keep,
+	        .keep_stride = job->keep_stride,
 	};
 	memset(cmp, 0, sizeof *cmp);
 	bsim_progress_init(&progress, job->progress);

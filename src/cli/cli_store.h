@@ -23,6 +23,7 @@ typedef struct cli_compare_job {
 	int examples;
 	int progress; /* a progress line on a terminal */
 	const char *out;
+	int keep, keep_stride; /* trajectories kept per group, see bsim_sweep_config */
 } cli_compare_job;
 
 /* DIR/summary.json, DIR/trials.csv and the run record of a sweep. */

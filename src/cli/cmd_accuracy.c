@@ -12,6 +12,8 @@
 
 #include "beamsim/accuracy.h"
 #include "beamsim/output.h"
+#include "beamsim/figures.h"
+#include "beamsim/matlab.h"
 #include "cli_common.h"
 
 #define ACC_SCENE "configs/thesis/gate.yaml"
@@ -24,7 +26,7 @@ static const char accuracy_help[] =
         "reference trajectory (finest h, most accurate knobs), the energy-ledger\n"
         "residual per simulated second, the error of p_traverse over a batch of\n"
         "trials against the reference setting's, and the wall time per simulated\n"
-        "second. Writes DIR/accuracy.csv, DIR/accuracy.md and DIR/accuracy.png\n"
+        "second. Writes DIR/accuracy.csv, DIR/accuracy.md and the figure DIR/accuracy.png\n"
         "(error against speed, log-log).\n"
         "\n"
         "Options:\n"
@@ -205,20 +207,31 @@ static int accuracy_main(accuracy_args *a)
 	snprintf(label, sizeof label, "%s%s", a->scene,
 	         a->scene_given ? "" : " (propulsion 9 N, random force 20 N)");
 	if (rc == BSIM_OK) {
+		char mat[1200];
 		snprintf(path, sizeof path, "%s/accuracy.csv", a->out);
+		snprintf(mat, sizeof mat, "%s/accuracy.mat", a->out);
 		rc = bsim_accuracy_write_csv(path, &r, &err);
+		if (rc == BSIM_OK)
+			rc = bsim_matlab_from_csv(path, mat, "accuracy", &err);
 	}
 	if (rc == BSIM_OK) {
 		snprintf(path, sizeof path, "%s/accuracy.md", a->out);
 		rc = bsim_accuracy_write_md(path, &r, &cfg, label, &err);
 	}
+	bsim_figures_result fig = {0};
 	if (rc == BSIM_OK) {
-		snprintf(path, sizeof path, "%s/accuracy.png", a->out);
-		rc = bsim_accuracy_write_png(path, &r, &err);
+		bsim_figures_def def = bsim_figures_default();
+		def.kind = BSIM_FIGURES_ACCURACY;
+		rc = bsim_figures_draw(a->out, &def, &fig, &err);
 	}
-	if (rc == BSIM_OK)
-		printf("accuracy: %d rows in %.1f s; wrote %s/accuracy.{csv,md,png}\n", r.n,
-		       r.wall_seconds, a->out);
+	if (rc == BSIM_OK) {
+		printf("accuracy: %d rows in %.1f s; wrote %s/accuracy.{csv,mat,md} and the figure "
+		       "%s/accuracy.{png,svg,gp}\n",
+		       r.n, r.wall_seconds, a->out, a->out);
+		for (int i = 0; i < fig.n_notes; i++)
+			cli_error("%s", fig.notes[i]);
+	}
+	bsim_figures_result_free(&fig);
 	bsim_accuracy_result_free(&r);
 	bsim_scene_free(&scene);
 	return cli_report(rc, &err);

@@ -55,6 +55,9 @@ static const char compare_help[] =
         "  --alpha A              family-wise error rate (default 0.05)\n"
         "  --margin M             smallest difference that counts (default 0.05)\n"
         "  --examples N           discordant trials shown per disagreeing group (default 3)\n"
+        "  --trajectories N       keep the trajectories of the first N trials of each\n"
+        "                         group, per backend in DIR/<backend>/trajectories.csv\n"
+        "  --trajectory-stride N  a trajectory row every N steps (default 5)\n"
         "  --quiet                no progress line, nothing on stdout\n"
         "  -h, --help             show this help\n";
 
@@ -69,7 +72,9 @@ enum {
 	OPT_ALPHA,
 	OPT_MARGIN,
 	OPT_EXAMPLES,
-	OPT_QUIET
+	OPT_QUIET,
+	OPT_TRAJECTORIES,
+	OPT_TRAJECTORY_STRIDE
 };
 
 static const struct option compare_options[] = {
@@ -84,6 +89,8 @@ static const struct option compare_options[] = {
         {"margin", required_argument, NULL, OPT_MARGIN},
         {"examples", required_argument, NULL, OPT_EXAMPLES},
         {"quiet", no_argument, NULL, OPT_QUIET},
+        {"trajectories", required_argument, NULL, OPT_TRAJECTORIES},
+        {"trajectory-stride", required_argument, NULL, OPT_TRAJECTORY_STRIDE},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -94,7 +101,7 @@ typedef struct compare_args {
 	char names[2][32];   /* the backends */
 	char dirs[2][128];   /* the labels as directory names */
 	bsim_options opts[2];
-	long threads, trials, examples;
+	long threads, trials, examples, keep, keep_stride;
 	int has_seed;
 	uint64_t seed;
 	cli_sets sets;
@@ -204,6 +211,17 @@ static int compare_option(compare_args *a, int c)
 		return CLI_OK;
 	case OPT_QUIET:
 		a->quiet = 1;
+		return CLI_OK;
+	case OPT_TRAJECTORIES:
+		if (cli_parse_long(optarg, 0, INT32_MAX, &a->keep) != 0)
+			return cli_usage("compare", "--trajectories %s: expected an integer >= 0",
+			                 optarg);
+		return CLI_OK;
+	case OPT_TRAJECTORY_STRIDE:
+		if (cli_parse_long(optarg, 1, INT32_MAX, &a->keep_stride) != 0)
+			return cli_usage("compare",
+			                 "--trajectory-stride %s: expected an integer >= 1",
+			                 optarg);
 		return CLI_OK;
 	}
 	return CLI_USAGE;
@@ -343,6 +361,8 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 	        .examples = (int)a->examples,
 	        .progress = !a->quiet,
 	        .out = a->out,
+	        .keep = (int)a->keep,
+	        .keep_stride = (int)a->keep_stride,
 	};
 	bsim_comparison cmp;
 	rc = cli_compare_execute(&job, &cmp);

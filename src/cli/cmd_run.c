@@ -11,8 +11,9 @@
 #include <string.h>
 
 #include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "beamsim/matlab.h"
 #include "beamsim/output.h"
+#include "beamsim/run_output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "cli_common.h"
@@ -35,7 +36,11 @@ static const char run_help[] =
         "  --trial I              trial index for the seed (default 0)\n"
         "  --set KEY=VALUE        override a scene field by dotted path, repeatable\n"
         "                         (e.g. --set effects.random_force.magnitude=30)\n"
-        "  --trajectory FILE.csv  write the trajectory, one row per recorded step\n"
+        "  --trajectory FILE.csv  write the trajectory, one row per recorded step, and\n"
+        "                         its MATLAB twin FILE.mat\n"
+        "  --out DIR              write DIR/trajectory.csv, DIR/ledger.csv (the energy\n"
+        "                         ledger over time), their .mat twins and DIR/run.json,\n"
+        "                         for `beamsim plot DIR`\n"
         "  --stride N             record every N-th step (default 1)\n"
         "  --json                 print one JSON object instead of text\n"
         "  -h, --help             show this help\n";
@@ -49,7 +54,8 @@ enum {
 	OPT_SET,
 	OPT_TRAJECTORY,
 	OPT_STRIDE,
-	OPT_JSON
+	OPT_JSON,
+	OPT_OUT
 };
 
 static const struct option run_options[] = {
@@ -62,6 +68,7 @@ static const struct option run_options[] = {
         {"trajectory", required_argument, NULL, OPT_TRAJECTORY},
         {"stride", required_argument, NULL, OPT_STRIDE},
         {"json", no_argument, NULL, OPT_JSON},
+        {"out", required_argument, NULL, OPT_OUT},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -74,6 +81,7 @@ typedef struct run_args {
 	long group, trial, stride;
 	cli_sets sets;
 	const char *trajectory;
+	const char *out;
 	int json;
 } run_args;
 
@@ -123,6 +131,9 @@ static int run_parse(int argc, char **argv, run_args *a)
 		case OPT_JSON:
 			a->json = 1;
 			break;
+		case OPT_OUT:
+			a->out = optarg;
+			break;
 		default:
 			return cli_bad_option("run", argv, c);
 		}
@@ -135,83 +146,6 @@ static int run_parse(int argc, char **argv, run_args *a)
 		                 argc - optind);
 	a->scene = argv[optind];
 	return -1;
-}
-
-static void print_ledger_json(const bsim_ledger *l)
-{
-	const struct {
-		const char *name;
-		double value;
-	} terms[] = {
-	        {"e_start", l->e_start},
-	        {"e_end", l->e_end},
-	        {"w_prop", l->w_prop},
-	        {"w_rand", l->w_rand},
-	        {"damper", l->damper},
-	        {"impact", l->impact},
-	        {"contact", l->contact},
-	        {"correction", l->correction},
-	        {"residual", l->residual},
-	        {"residual_max", l->residual_max},
-	        {"residual_abs", l->residual_abs},
-	        {"inflow", l->inflow},
-	};
-	fputc('{', stdout);
-	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
-		printf("%s\"%s\": ", i ? ", " : "", terms[i].name);
-		bsim_json_number(stdout, terms[i].value);
-	}
-	fputc('}', stdout);
-}
-
-static void print_json(const run_args *a, const bsim_backend *b, const bsim_scene *s,
-                       uint64_t mixed, const bsim_trial_result *r)
-{
-	fputs("{\"scene\": ", stdout);
-	bsim_json_string(stdout, a->scene);
-	fputs(", \"name\": ", stdout);
-	bsim_json_string(stdout, s->name);
-	fputs(", \"backend\": ", stdout);
-	bsim_json_string(stdout, a->backend);
-	fputs(", \"backend_options\": ", stdout);
-	bsim_output_backend_options(stdout, b, &a->opts);
-	printf(", \"seed\": %" PRIu64 ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": %" PRIu64,
-	       a->seed, a->group, a->trial, mixed);
-	fputs(", \"outcome\": ", stdout);
-	bsim_json_string(stdout, bsim_outcome_name(r->outcome));
-	fputs(", \"type\": ", stdout);
-	bsim_json_string(stdout, bsim_type_name(r->type));
-	printf(", \"landscape_left\": %d, \"landscape_beam\": ", r->landscape_beam == 0);
-	if (r->landscape_beam >= 0)
-		printf("%d", r->landscape_beam + 1);
-	else
-		fputs("null", stdout);
-	printf(", \"in_contact_end\": %d", r->in_contact_end);
-	printf(", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
-	       r->draws);
-	const char *names[] = {"t_end", "x_end", "y_end", "vx_end"};
-	const double values[] = {r->t_end, r->x_end, r->y_end, r->vx_end};
-	for (int i = 0; i < 4; i++) {
-		printf(", \"%s\": ", names[i]);
-		bsim_json_number(stdout, values[i]);
-	}
-	fputs(", \"max_theta\": [", stdout);
-	bsim_json_number(stdout, r->max_theta[0]);
-	fputs(", ", stdout);
-	bsim_json_number(stdout, r->max_theta[1]);
-	fputs("], \"overlap_max\": ", stdout);
-	bsim_json_number(stdout, r->overlap_max);
-	fputs(", \"ledger\": ", stdout);
-	print_ledger_json(&r->ledger);
-	fputs(", \"instability\": ", stdout);
-	if (r->instability) {
-		char why[256];
-		bsim_trial_instability_text(r, s->dt, why, sizeof why);
-		bsim_json_string(stdout, why);
-	} else {
-		fputs("null", stdout);
-	}
-	fputs("}\n", stdout);
 }
 
 static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
@@ -254,36 +188,63 @@ static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
 	}
 }
 
-/* Runs the trial, recording into the trajectory file if one was asked
- * for; the file appears only if the run finished. */
-static int run_trial(const run_args *a, const bsim_scene *scene, const bsim_backend *backend,
-                     uint64_t mixed, bsim_trial_result *res)
+/* Runs the trial, recording into the trajectory file and the --out
+ * directory if asked for; the files appear only if the run finished. */
+static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_result *res)
 {
 	bsim_atomic_file traj = {0};
+	bsim_run_output dir;
 	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride, .overlap = 1};
+	bsim_recorder dir_rec = {.csv = NULL, .stride = (int)a->stride, .overlap = 1};
 	bsim_error err;
+	const bsim_scene *scene = info->scene;
 	if (a->trajectory) {
 		if (bsim_atomic_file_open(&traj, a->trajectory, &err) != BSIM_OK)
 			return cli_report(BSIM_EFAIL, &err);
 		bsim_recorder_header(traj.f, scene->n_beams);
 		rec.csv = traj.f;
 	}
+	if (a->out && bsim_run_output_open(&dir, a->out, scene->n_beams, &dir_rec, &err)) {
+		bsim_atomic_file_abort(&traj);
+		return cli_report(BSIM_EFAIL, &err);
+	}
+	/* One recorder writes both when both are asked for: the CSV of
+	 * --trajectory, and the directory's trajectory and ledger. */
+	if (a->out && a->trajectory) {
+		dir_rec.record = bsim_recorder_csv_record;
+		dir_rec.record_user = traj.f;
+	}
 	bsim_runner *runner = bsim_runner_alloc();
 	if (!runner) {
 		bsim_atomic_file_abort(&traj);
+		if (a->out)
+			bsim_run_output_abort(&dir);
 		cli_error("out of memory for a trial runner");
 		return CLI_FAIL;
 	}
 	bsim_error_clear(&err);
-	int rc = bsim_trial_run(runner, scene, backend, &a->opts, mixed, &rec, res, &err);
+	const bsim_recorder *use = a->out ? &dir_rec : &rec;
+	int rc = bsim_trial_run(runner, scene, info->backend, &a->opts, info->mixed_seed, use, res,
+	                        &err);
 	bsim_runner_free(runner);
 	if (rc != BSIM_OK) {
 		bsim_atomic_file_abort(&traj);
+		if (a->out)
+			bsim_run_output_abort(&dir);
 		return cli_report(rc, &err);
 	}
-	if (!a->trajectory)
-		return CLI_OK;
-	rc = bsim_atomic_file_commit(&traj, &err);
+	if (a->trajectory) {
+		char mat[1200];
+		rc = bsim_atomic_file_commit(&traj, &err);
+		if (rc == BSIM_OK)
+			rc = bsim_matlab_path(a->trajectory, mat, sizeof mat, &err);
+		if (rc == BSIM_OK)
+			rc = bsim_matlab_from_csv(a->trajectory, mat, "trajectory", &err);
+	}
+	if (rc == BSIM_OK && a->out)
+		rc = bsim_run_output_commit(&dir, info, res, &err);
+	else if (a->out)
+		bsim_run_output_abort(&dir);
 	return cli_report(rc, &err);
 }
 
@@ -305,11 +266,24 @@ int cmd_run(int argc, char **argv)
 		rc = err.code ? err.code : CLI_USAGE;
 	} else {
 		uint64_t mixed = bsim_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
+		bsim_run_info info = {
+		        .scene_path = a.scene,
+		        .scene = &scene,
+		        .sets = a.sets.ov,
+		        .n_sets = a.sets.n,
+		        .backend = backend,
+		        .opts = &a.opts,
+		        .seed = a.seed,
+		        .group = a.group,
+		        .trial = a.trial,
+		        .mixed_seed = mixed,
+		        .stride = (int)a.stride,
+		};
 		bsim_trial_result res;
 		memset(&res, 0, sizeof res);
-		rc = run_trial(&a, &scene, backend, mixed, &res);
+		rc = run_trial(&a, &info, &res);
 		if (rc == CLI_OK && a.json)
-			print_json(&a, backend, &scene, mixed, &res);
+			bsim_run_json(stdout, &info, &res, 0);
 		else if (rc == CLI_OK)
 			print_text(&a, &scene, mixed, &res);
 		if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {

@@ -37,6 +37,10 @@ static const char sweep_help[] =
         "  --set KEY=VALUE        override a scene field in every group, repeatable\n"
         "  --overlap              measure each trial's deepest body-beam overlap\n"
         "                         (trials.csv overlap_max; costs time)\n"
+        "  --trajectories N       keep the trajectories of the first N trials of each\n"
+        "                         group in DIR/trajectories.csv (and .mat), for\n"
+        "                         `beamsim plot DIR`\n"
+        "  --trajectory-stride N  a trajectory row every N steps (default 5)\n"
         "  --quiet                no progress line, nothing on stdout\n"
         "  -h, --help             show this help\n";
 
@@ -49,7 +53,9 @@ enum {
 	OPT_SET,
 	OPT_OUT,
 	OPT_OVERLAP,
-	OPT_QUIET
+	OPT_QUIET,
+	OPT_TRAJECTORIES,
+	OPT_TRAJECTORY_STRIDE
 };
 
 static const struct option sweep_options[] = {
@@ -62,6 +68,8 @@ static const struct option sweep_options[] = {
         {"out", required_argument, NULL, OPT_OUT},
         {"overlap", no_argument, NULL, OPT_OVERLAP},
         {"quiet", no_argument, NULL, OPT_QUIET},
+        {"trajectories", required_argument, NULL, OPT_TRAJECTORIES},
+        {"trajectory-stride", required_argument, NULL, OPT_TRAJECTORY_STRIDE},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -78,6 +86,7 @@ typedef struct sweep_args {
 	const char *out;
 	int overlap;
 	int quiet;
+	long keep, keep_stride;
 } sweep_args;
 
 /* Fills a; returns -1 to go on, else the exit status. */
@@ -125,6 +134,18 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 		case OPT_QUIET:
 			a->quiet = 1;
 			break;
+		case OPT_TRAJECTORIES:
+			if (cli_parse_long(optarg, 0, INT32_MAX, &a->keep) != 0)
+				rc = cli_usage("sweep",
+				               "--trajectories %s: expected an integer >= 0",
+				               optarg);
+			break;
+		case OPT_TRAJECTORY_STRIDE:
+			if (cli_parse_long(optarg, 1, INT32_MAX, &a->keep_stride) != 0)
+				rc = cli_usage("sweep",
+				               "--trajectory-stride %s: expected an integer >= 1",
+				               optarg);
+			break;
 		default:
 			return cli_bad_option("sweep", argv, c);
 		}
@@ -154,7 +175,8 @@ static void sweep_report(const sweep_args *a, const bsim_experiment *e, const bs
 	       cli_per_second(n, r->wall_seconds), cli_per_second(r->total_steps, r->wall_seconds));
 	if (n != rows)
 		printf("(%ld rows: the groups without random force ran one trial each)\n", rows);
-	printf("wrote %s/summary.json and %s/trials.csv\n", a->out, a->out);
+	printf("wrote %s/summary.json and %s/trials.csv%s (and their .mat twins)\n", a->out, a->out,
+	       r->keep ? ", trajectories.csv" : "");
 }
 
 /* Unstable trials fail the sweep (after its files are written): one line
@@ -213,6 +235,8 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 	        .extra = a->sets.ov,
 	        .n_extra = a->sets.n,
 	        .measure_overlap = a->overlap,
+	        .keep = (int)a->keep,
+	        .keep_stride = (int)a->keep_stride,
 	};
 	bsim_sweep_result r;
 	rc = cli_sweep_run(&e, &cfg, !a->quiet, &r);

@@ -1,0 +1,80 @@
+/* Figures of beamsim's output directories (beamsim plot DIR), drawn by
+ * gnuplot from scripts beamsim writes: every figure is NAME.png and
+ * NAME.svg with its data (NAME.dat, or NAME.*.dat) and its script NAME.gp
+ * side by side, so that a user can restyle it and rerun `gnuplot NAME.gp`.
+ *
+ * What a directory holds decides what is drawn (docs/figures.md):
+ *
+ * - a sweep (summary.json, trials.csv): p_traverse over the grid's first
+ *   two axes as a heat map with each cell's value and 95% interval;
+ *   total, left-type and right-type traversal against each axis with 95%
+ *   bands, one panel per combination of the other axes; and, when it kept
+ *   trajectories (trajectories.csv), each group's bundle coloured by
+ *   outcome and type, and the traversed ones over the potential energy
+ *   landscape, stretches below the surface marked;
+ * - a comparison (report.json, pairs.csv): both backends' p_traverse side
+ *   by side with their paired differences, and each backend's sweep
+ *   figures in DIR/<backend>/;
+ * - a run (trajectory.csv, ledger.csv): the random force over time and its
+ *   histogram against N(0, Rm^2), the energy ledger over time, and the
+ *   trajectory over the landscape;
+ * - the accuracy study (accuracy.csv): consistency error against speed,
+ *   one series per backend and setting, the Pareto front marked.
+ *
+ * Without gnuplot the data and scripts are still written; the result says
+ * how many figures were drawn. */
+#ifndef BEAMSIM_FIGURES_H
+#define BEAMSIM_FIGURES_H
+
+#include "beamsim/error.h"
+#include "beamsim/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+	BSIM_FIGURES_AUTO = 0, /* by the files in the directory */
+	BSIM_FIGURES_SWEEP,
+	BSIM_FIGURES_COMPARE,
+	BSIM_FIGURES_RUN,
+	BSIM_FIGURES_ACCURACY,
+} bsim_figures_kind;
+
+const char *bsim_figures_kind_name(bsim_figures_kind k);
+
+typedef struct bsim_figures_def {
+	bsim_figures_kind kind;
+	const char *out; /* directory for the figures; NULL: the directory read */
+	/* Only groups whose grid value of KEY equals VALUE (numerically if
+	 * both are numbers), for every KEY=VALUE given; the key must be a
+	 * grid axis. */
+	const bsim_override *select;
+	int n_select;
+	int threads; /* figures drawn at once; <= 0: all cores */
+} bsim_figures_def;
+
+bsim_figures_def bsim_figures_default(void);
+
+typedef struct bsim_figures_result {
+	bsim_figures_kind kind;
+	int n;        /* figures written (script and data) */
+	int drawn;    /* of which gnuplot drew the images */
+	char **paths; /* n "OUT/NAME", without extension, in the order written */
+	int n_notes;
+	char **notes; /* what was not drawn and why, one line each */
+} bsim_figures_result;
+
+void bsim_figures_result_free(bsim_figures_result *r);
+
+/* Draws every figure of the directory. BSIM_EINPUT naming the directory
+ * and the files looked for when it holds nothing known, or naming file,
+ * line and field when a file is malformed; BSIM_EFAIL if a file cannot be
+ * written or gnuplot fails on a script. */
+int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures_result *out,
+                      bsim_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,56 @@
+/* MATLAB twins of beamsim's files: every table (CSV) and record (JSON) it
+ * writes also as a .mat file (level 5, zlib-compressed, libmatio) that
+ * MATLAB's `load` and scipy.io.loadmat read directly.
+ *
+ * A twin is made from the file it twins, after that file is complete, so
+ * that both hold the same values and a column added to a CSV appears in its
+ * twin without further code:
+ *
+ * - a CSV table becomes one struct of column vectors, one field per column
+ *   (names made MATLAB identifiers: "max_theta1", "effects_propulsion_force"),
+ *   numbers as n x 1 doubles (an empty cell is NaN), text as n x 1 cell
+ *   arrays of char;
+ * - a JSON object becomes a struct; a list of numbers a 1 x n row; a list
+ *   of objects a table, that is a struct of n x 1 columns (a list of k
+ *   numbers in each object an n x k matrix, an object a nested table); a
+ *   string a char row; true / false 1 / 0; null NaN.
+ *
+ * Each file is written to a temporary name and renamed, like every output
+ * of beamsim: it appears whole or not at all. */
+#ifndef BEAMSIM_MATLAB_H
+#define BEAMSIM_MATLAB_H
+
+#include <stddef.h>
+
+#include "beamsim/error.h"
+#include "beamsim/experiment.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The twin's path: path with a final ".csv" or ".json" replaced by ".mat"
+ * (".mat" appended otherwise). BSIM_EFAIL if it does not fit size. */
+int bsim_matlab_path(const char *path, char *out, size_t size, bsim_error *err);
+
+/* The CSV table at csv_path as the struct variable var in mat_path.
+ * BSIM_EINPUT naming file and line if the table is malformed. */
+int bsim_matlab_from_csv(const char *csv_path, const char *mat_path, const char *var,
+                         bsim_error *err);
+
+/* The JSON file at json_path as the variable var in mat_path. */
+int bsim_matlab_from_json(const char *json_path, const char *mat_path, const char *var,
+                          bsim_error *err);
+
+/* The twins of a sweep's directory: summary.mat (variable `summary`),
+ * trials.mat (`trials`) and, when the directory holds it,
+ * trajectories.mat (`trajectories`). A table with a `group` column holds
+ * the grid values of each row's group by name, as the columns of
+ * trials.csv do (trajectories.effects_propulsion_force(i) of row i),
+ * numbers as doubles: those the CSV lacks are added. */
+int bsim_matlab_sweep(const char *dir, const bsim_experiment *e, bsim_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,77 @@
+/* The record of one trial (beamsim run): its JSON object, and the output
+ * directory of `beamsim run --out DIR`:
+ *
+ *   trajectory.csv     the trajectory, the columns of `run --trajectory`
+ *   ledger.csv         the energy ledger at the same times
+ *                      (bsim_recorder_ledger_header)
+ *   trajectory.mat, ledger.mat   their MATLAB twins
+ *   run.json           what ran and what came of it: the object of
+ *                      `run --json` and "command": "run", "stride", "set"
+ *                      (the --set overrides) and "scene_copy"
+ *   inputs/scene.yaml  the scene file as it was, so that with "set" the
+ *                      scene can be rebuilt (beamsim plot draws the
+ *                      landscape from it)
+ *
+ * Every file is written to a temporary name and renamed once the trial has
+ * run: a failed trial leaves none of them. */
+#ifndef BEAMSIM_RUN_OUTPUT_H
+#define BEAMSIM_RUN_OUTPUT_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "beamsim/atomic_file.h"
+#include "beamsim/backend.h"
+#include "beamsim/scene.h"
+#include "beamsim/trial.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What was run. */
+typedef struct bsim_run_info {
+	const char *scene_path;
+	const bsim_scene *scene;
+	const bsim_override *sets; /* the --set overrides, in order */
+	int n_sets;
+	const bsim_backend *backend;
+	const bsim_options *opts;
+	uint64_t seed;       /* the experiment seed */
+	long group, trial;   /* of the schedule */
+	uint64_t mixed_seed; /* bsim_seed_mix(seed, group, trial) */
+	int stride;          /* recorded every stride-th step */
+} bsim_run_info;
+
+/* The JSON object of a trial (one line, with a newline): scene, name,
+ * backend, backend_options, seed, group, trial, mixed_seed, outcome, type,
+ * landscape_left, landscape_beam (the barrier crossed, 1-based, or null),
+ * in_contact_end, steps, steps_run, draws, t_end, x_end,
+ * y_end, vx_end, max_theta, overlap_max, ledger, instability (null or why
+ * the trial was unstable). record adds command, beamsim_version,
+ * stride, set and scene_copy, for run.json. */
+void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r, int record);
+
+typedef struct bsim_run_output {
+	char dir[1024];
+	char traj_path[1100], ledger_path[1100];
+	bsim_atomic_file traj, ledger;
+} bsim_run_output;
+
+/* Creates dir if missing and opens its trajectory and ledger for rec
+ * (rec->csv and rec->ledger are set; its stride is the caller's). */
+int bsim_run_output_open(bsim_run_output *o, const char *dir, int n_beams, bsim_recorder *rec,
+                         bsim_error *err);
+
+/* Once the trial has run: commits trajectory.csv and ledger.csv, writes
+ * their twins, inputs/scene.yaml and, last, run.json. */
+int bsim_run_output_commit(bsim_run_output *o, const bsim_run_info *info,
+                           const bsim_trial_result *r, bsim_error *err);
+
+/* Removes what is open; nothing of the run is left. */
+void bsim_run_output_abort(bsim_run_output *o);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

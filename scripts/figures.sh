@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Redraws docs/figures/, the essay's figures that the README shows, from
+# fresh runs in out/figures/ (the commands are the README's). The copies in
+# docs/ are the PNGs drawn again by their own scripts at 0.75 of their size.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+b=build/beamsim
+o=out/figures
+d=docs/figures
+mkdir -p "$o" "$d"
+
+# Fig. 2.2: the random force of one trial at Rm = 20 N (the gate's default)
+$b run configs/thesis/gate.yaml --out $o/fig2.2 >/dev/null
+# Fig. 2.7: a trial whose path runs below the landscape (H1 group 13, trial 15)
+$b run configs/thesis/gate.yaml --seed 1 --group 13 --trial 15 \
+  --set effects.propulsion.force=6 --set effects.random_force.magnitude=30 --out $o/fig2.7 >/dev/null
+# Fig. 3.1: H1
+$b sweep configs/thesis/h1_symmetric.yaml --quiet --out $o/h1
+# Figs. 3.2, 3.3: the H2 groups the essay draws, every trajectory kept
+$b sweep configs/thesis/h2_figures.yaml --trajectories 100 --quiet --out $o/h2-figures
+# Fig. 3.4: H2, and the two slices the essay draws
+$b sweep configs/thesis/h2_asymmetric.yaml --quiet --out $o/h2
+for dir in fig2.2 fig2.7 h1 h2-figures; do $b plot $o/$dir --quiet; done
+$b plot $o/h2 --select effects.propulsion.force=8 --select effects.random_force.magnitude=30 \
+  --out $o/fig3.4a --quiet
+$b plot $o/h2 --select effects.propulsion.force=8 --select beams.0.stiffness=300 \
+  --out $o/fig3.4b --quiet
+# Fig. 2.6: the landscape of the essay gate, of the essay's asymmetric 500 : 250 gate, and of
+# H2's 100 : 500 gate
+$b landscape configs/thesis/gate.yaml --out $o/landscape >/dev/null
+$b landscape configs/thesis/gate.yaml --set beams.0.stiffness=500 --set beams.1.stiffness=250 \
+  --out $o/landscape-500-250 >/dev/null
+$b landscape configs/thesis/gate.yaml --set beams.0.stiffness=100 --set beams.1.stiffness=500 \
+  --out $o/landscape-100-500 >/dev/null
+# the accuracy study of docs/accuracy.csv
+mkdir -p $o/accuracy && cp docs/accuracy.csv $o/accuracy/ && $b plot $o/accuracy --quiet
+
+small() { # small DIR NAME COPY: DIR/NAME.gp drawn again at 0.75 as docs/figures/COPY.png
+  (cd "$1" && gnuplot -e "scale=0.75; outbase=\"small-$2\"" "$2.gp" && rm -f "small-$2.svg")
+  mv "$1/small-$2.png" "$d/$3.png"
+}
+small $o/fig2.2 random_force fig2.2-random-force
+small $o/fig2.2 ledger run-ledger
+small $o/fig2.7 landscape_path fig2.7-below-the-surface
+small $o/h1 p_traverse fig3.1-h1-p-traverse
+for g in 9 10 11; do small $o/h2-figures "trajectories_g$(printf %03d $g)" "fig3.2-g$g"; done
+for g in 1 2; do small $o/h2-figures "landscape_g$(printf %03d $g)" "fig3.3-g$g"; done
+small $o/fig3.4a traversal_vs_beams_0_stiffness fig3.4a
+small $o/fig3.4b traversal_vs_effects_random_force_magnitude fig3.4b
+small $o/accuracy accuracy accuracy
+small $o/landscape landscape_beam landscape_beam
+small $o/landscape landscape_total landscape_total
+small $o/landscape landscape_top landscape_top
+small $o/landscape-500-250 landscape_beam landscape_beam_500_250
+small $o/landscape-100-500 landscape_top landscape_top_100_500
+ls -l "$d"

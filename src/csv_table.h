@@ -1,0 +1,51 @@
+/* Internal: a CSV table of beamsim's own making read whole, columns found
+ * by header name, so that a reader keeps working when columns are added.
+ *
+ * beamsim's CSV files are plain: a header line of names, then rows of the
+ * same number of comma-separated fields, no quoting (no field it writes
+ * holds a comma or a newline). Fields stay text; a reader asks for the
+ * numbers it wants. */
+#ifndef BSIM_CSV_TABLE_H
+#define BSIM_CSV_TABLE_H
+
+#include <stddef.h>
+
+#include "beamsim/error.h"
+
+typedef struct csv_table {
+	int n_cols;
+	long n_rows;
+	char **names; /* n_cols, into text */
+	char **cells; /* n_rows * n_cols, row-major, into text */
+	char *text;   /* the file, split in place */
+} csv_table;
+
+/* Reads path. BSIM_EINPUT "FILE:LINE: expected N fields, got M" on a row
+ * of the wrong width, or naming the file if it cannot be read or has no
+ * header. */
+int csv_table_read(const char *path, csv_table *t, bsim_error *err);
+void csv_table_free(csv_table *t);
+
+/* The column named name, -1 if there is none. */
+int csv_table_col(const csv_table *t, const char *name);
+
+/* The text of a cell. */
+const char *csv_table_cell(const csv_table *t, long row, int col);
+
+/* A cell as a number: 0 if the whole text is a number (strtod), else -1.
+ * An empty cell is no number. */
+int csv_table_number(const csv_table *t, long row, int col, double *out);
+
+/* A whole column as numbers into out (n_rows entries): 0, or BSIM_EINPUT
+ * "FILE:LINE: NAME: expected a number, got TEXT" at the first cell that is
+ * not one; an empty cell becomes empty_value if allow_empty. path names
+ * the file in the message. */
+int csv_table_numbers(const csv_table *t, const char *path, int col, int allow_empty,
+                      double empty_value, double *out, bsim_error *err);
+
+/* Required columns: the index of each name in cols, or BSIM_EINPUT naming
+ * the file and the first missing column. */
+int csv_table_require(const csv_table *t, const char *path, const char *const *names, int n,
+                      int *cols, bsim_error *err);
+
+#endif

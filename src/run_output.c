@@ -1,0 +1,171 @@
+/* The record of one trial and the directory of `beamsim run --out`
+ * (beamsim/run_output.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "beamsim/run_output.h"
+
+#include <inttypes.h>
+#include <string.h>
+
+#include "beamsim/json.h"
+#include "beamsim/matlab.h"
+#include "beamsim/output.h"
+#include "beamsim/version.h"
+
+static void ledger_json(FILE *f, const bsim_ledger *l)
+{
+	const struct {
+		const char *name;
+		double value;
+	} terms[] = {
+	        {"e_start", l->e_start},
+	        {"e_end", l->e_end},
+	        {"w_prop", l->w_prop},
+	        {"w_rand", l->w_rand},
+	        {"damper", l->damper},
+	        {"impact", l->impact},
+	        {"contact", l->contact},
+	        {"correction", l->correction},
+	        {"residual", l->residual},
+	        {"residual_max", l->residual_max},
+	        {"residual_abs", l->residual_abs},
+	        {"inflow", l->inflow},
+	};
+	fputc('{', f);
+	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
+		fprintf(f, "%s\"%s\": ", i ? ", " : "", terms[i].name);
+		bsim_json_number(f, terms[i].value);
+	}
+	fputc('}', f);
+}
+
+static void record_json(FILE *f, const bsim_run_info *info)
+{
+	fputs(", \"command\": \"run\", \"beamsim_version\": ", f);
+	bsim_json_string(f, BSIM_VERSION);
+	fprintf(f, ", \"stride\": %d, \"scene_copy\": \"inputs/scene.yaml\", \"set\": {",
+	        info->stride);
+	for (int i = 0; i < info->n_sets; i++) {
+		fputs(i ? ", " : "", f);
+		bsim_json_string(f, info->sets[i].key);
+		fputs(": ", f);
+		bsim_json_string(f, info->sets[i].value);
+	}
+	fputc('}', f);
+}
+
+void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r, int record)
+{
+	fputs("{\"scene\": ", f);
+	bsim_json_string(f, info->scene_path);
+	fputs(", \"name\": ", f);
+	bsim_json_string(f, info->scene->name);
+	fputs(", \"backend\": ", f);
+	bsim_json_string(f, info->backend->name);
+	fputs(", \"backend_options\": ", f);
+	bsim_output_backend_options(f, info->backend, info->opts);
+	fprintf(f,
+	        ", \"seed\": %" PRIu64 ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": %" PRIu64,
+	        info->seed, info->group, info->trial, info->mixed_seed);
+	fputs(", \"outcome\": ", f);
+	bsim_json_string(f, bsim_outcome_name(r->outcome));
+	fputs(", \"type\": ", f);
+	bsim_json_string(f, bsim_type_name(r->type));
+	fprintf(f, ", \"landscape_left\": %d, \"landscape_beam\": ", r->landscape_beam == 0);
+	if (r->landscape_beam >= 0)
+		fprintf(f, "%d", r->landscape_beam + 1);
+	else
+		fputs("null", f);
+	fprintf(f, ", \"in_contact_end\": %d", r->in_contact_end);
+	fprintf(f, ", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
+	        r->draws);
+	const char *names[] = {"t_end", "x_end", "y_end", "vx_end"};
+	const double values[] = {r->t_end, r->x_end, r->y_end, r->vx_end};
+	for (int i = 0; i < 4; i++) {
+		fprintf(f, ", \"%s\": ", names[i]);
+		bsim_json_number(f, values[i]);
+	}
+	fputs(", \"max_theta\": [", f);
+	bsim_json_number(f, r->max_theta[0]);
+	fputs(", ", f);
+	bsim_json_number(f, r->max_theta[1]);
+	fputs("], \"overlap_max\": ", f);
+	bsim_json_number(f, r->overlap_max);
+	fputs(", \"ledger\": ", f);
+	ledger_json(f, &r->ledger);
+	fputs(", \"instability\": ", f);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, info->scene->dt, why, sizeof why);
+		bsim_json_string(f, why);
+	} else {
+		fputs("null", f);
+	}
+	if (record)
+		record_json(f, info);
+	fputs("}\n", f);
+}
+
+int bsim_run_output_open(bsim_run_output *o, const char *dir, int n_beams, bsim_recorder *rec,
+                         bsim_error *err)
+{
+	memset(o, 0, sizeof *o);
+	if (strlen(dir) >= sizeof o->dir - 32)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", dir);
+	snprintf(o->dir, sizeof o->dir, "%s", dir);
+	snprintf(o->traj_path, sizeof o->traj_path, "%s/trajectory.csv", dir);
+	snprintf(o->ledger_path, sizeof o->ledger_path, "%s/ledger.csv", dir);
+	if (bsim_output_mkdir(dir, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (bsim_atomic_file_open(&o->traj, o->traj_path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (bsim_atomic_file_open(&o->ledger, o->ledger_path, err) != BSIM_OK) {
+		bsim_atomic_file_abort(&o->traj);
+		return BSIM_EFAIL;
+	}
+	bsim_recorder_header(o->traj.f, n_beams);
+	bsim_recorder_ledger_header(o->ledger.f);
+	rec->csv = o->traj.f;
+	rec->ledger = o->ledger.f;
+	return BSIM_OK;
+}
+
+void bsim_run_output_abort(bsim_run_output *o)
+{
+	bsim_atomic_file_abort(&o->traj);
+	bsim_atomic_file_abort(&o->ledger);
+}
+
+int bsim_run_output_commit(bsim_run_output *o, const bsim_run_info *info,
+                           const bsim_trial_result *r, bsim_error *err)
+{
+	char path[1200], mat[1200];
+	int rc = bsim_atomic_file_commit(&o->traj, err);
+	if (rc) {
+		bsim_atomic_file_abort(&o->ledger);
+		return rc;
+	}
+	rc = bsim_atomic_file_commit(&o->ledger, err);
+	if (!rc)
+		rc = bsim_matlab_path(o->traj_path, mat, sizeof mat, err);
+	if (!rc)
+		rc = bsim_matlab_from_csv(o->traj_path, mat, "trajectory", err);
+	if (!rc)
+		rc = bsim_matlab_path(o->ledger_path, mat, sizeof mat, err);
+	if (!rc)
+		rc = bsim_matlab_from_csv(o->ledger_path, mat, "ledger", err);
+	snprintf(path, sizeof path, "%s/inputs", o->dir);
+	if (!rc)
+		rc = bsim_output_mkdir(path, err);
+	snprintf(path, sizeof path, "%s/inputs/scene.yaml", o->dir);
+	if (!rc && info->scene_path)
+		rc = bsim_atomic_file_copy(info->scene_path, path, err);
+	snprintf(path, sizeof path, "%s/run.json", o->dir);
+	bsim_atomic_file f;
+	if (!rc)
+		rc = bsim_atomic_file_open(&f, path, err);
+	if (!rc) {
+		bsim_run_json(f.f, info, r, 1);
+		rc = bsim_atomic_file_commit(&f, err);
+	}
+	return rc;
+}

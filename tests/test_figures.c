@@ -1,0 +1,535 @@
+/* beamsim plot (beamsim/figures.h).
+ *
+ * Truths: a figure's numbers are those of the run it draws, recomputed
+ * here independently: p_traverse and Wilson's interval (Wilson 1927, the
+ * closed form) from the outcomes in trials.csv, left / right fractions from
+ * the types; E along a path is F_prop (y0 - y) + 1/2 k (theta1^2 +
+ * theta2^2) of the recorded angles, and a state lies below the landscape
+ * exactly when its beams' energy is short of MODEL.md section 7's
+ * th(x, y), implemented here again, by more than 1 J; the random-force
+ * histogram holds every draw the runner made once and integrates to 1;
+ * the Pareto front of a hand-made accuracy table is the one worked out by
+ * hand. Every figure is PNG + SVG + script + data, none over 1 MB, and
+ * without gnuplot the scripts and data are still written and the message
+ * names the package. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "figure.h"
+#include "figures_internal.h"
+#include "support.h"
+
+/* ---- helpers --------------------------------------------------------------------- */
+
+static int run_cli(const char *const *argv, char **out, char **err)
+{
+	char *o_own = NULL, *e_own = NULL;
+	char **o = out ? out : &o_own, **e = err ? err : &e_own;
+	int rc = bsim_test_cli(argv, o, e);
+	if (rc != 0 && rc != 3)
+		print_error("%s\n%s\n", *o ? *o : "", *e ? *e : "");
+	free(o_own);
+	free(e_own);
+	return rc;
+}
+
+/* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
+ * none over 1 MB; returns the number of figures. */
+static int check_figures(const char *dir)
+{
+	DIR *d = opendir(dir);
+	assert_non_null(d);
+	struct dirent *e;
+	int n = 0;
+	while ((e = readdir(d))) {
+		size_t len = strlen(e->d_name);
+		if (len < 4 || strcmp(e->d_name + len - 3, ".gp") != 0)
+			continue;
+		n++;
+		static const char *const ext[] = {"png", "svg"};
+		for (int i = 0; i < 2 && bsim_figure_available(); i++) {
+			char path[1200];
+			struct stat st;
+			snprintf(path, sizeof path, "%s/%.*s.%s", dir, (int)len - 3, e->d_name,
+			         ext[i]);
+			if (stat(path, &st) != 0)
+				print_error("missing %s\n", path);
+			assert_int_equal(stat(path, &st), 0);
+			if (st.st_size > 1000000)
+				print_error("%s: %ld bytes\n", path, (long)st.st_size);
+			assert_true(st.st_size > 1000 && st.st_size <= 1000000);
+		}
+	}
+	closedir(d);
+	return n;
+}
+
+static void wilson(int k, int n, double *lo, double *hi)
+{
+	const double z = 1.959963984540054, p = (double)k / n;
+	double c = (p + z * z / (2 * n)) / (1 + z * z / n);
+	double h = z / (1 + z * z / n) * sqrt(p * (1 - p) / n + z * z / (4.0 * n * n));
+	*lo = fmax(0.0, c - h);
+	*hi = fmin(1.0, c + h);
+}
+
+/* Blocks are separated by "\n\n\n" in the text: the index of the block
+ * holding each line is counted here. */
+static int data_rows(const char *path, int block, double (*rows)[16], int max)
+{
+	char *text = bsim_test_read(path);
+	assert_non_null(text);
+	int b = 0, n = 0;
+	for (char *p = text; *p;) {
+		char *nl = strchr(p, '\n');
+		if (!nl)
+			nl = p + strlen(p);
+		if (nl == p) { /* an empty line: two in a row end a block */
+			if (nl[1] == '\n')
+				b++, p = nl + 2;
+			else
+				p = nl + 1;
+			continue;
+		}
+		if (*p != '#' && b == block && n < max) {
+			char *q = p, *end;
+			int k = 0;
+			while (k < 16 && q < nl) {
+				rows[n][k] = strtod(q, &end);
+				if (end == q)
+					break;
+				k++;
+				q = end;
+			}
+			if (k)
+				n++;
+		}
+		p = *nl ? nl + 1 : nl;
+	}
+	free(text);
+	return n;
+}
+
+/* ---- the landscape of MODEL.md section 7, written again ---------------------------------- */
+
+/* th of a beam with pivot (px, 30) pointing at the midline: the left one
+ * (px < 0) points +x, the right one -x; phi measured from it, forward
+ * (+y) positive. */
+static double th_model(double px, double x, double y)
+{
+	const double L = 25, R = 10;
+	double along = px < 0 ? x - px : px - x, fwd = y - 30;
+	double rho = hypot(along, fwd), phi = atan2(fwd, along), th;
+	if (rho >= L + R)
+		return 0;
+	if (rho * rho <= L * L + R * R)
+		th = phi + (rho <= R ? 1.5707963267948966 : asin(R / rho));
+	else
+		th = phi + acos((rho * rho + L * L - R * R) / (2 * rho * L));
+	return th > 0 ? th : 0;
+}
+
+static void test_below_surface(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 0.0);
+	const double pts[][2] = {{0, 30}, {-8, 38}, {5, 45}, {0, 52}, {12, 25}};
+	for (size_t i = 0; i < sizeof pts / sizeof pts[0]; i++) {
+		double x = pts[i][0], y = pts[i][1];
+		double th[2] = {th_model(-25, x, y), th_model(25, x, y)};
+		/* on the surface: both beams resting against the body */
+		assert_false(fpath_below(&s, x, y, th));
+		double e = 7.0 * (60 - y) + 200 * (th[0] * th[0] + th[1] * th[1]);
+		assert_true(fabs(fpath_energy(&s, y, th) - e) < 1e-9);
+		/* a beam left behind (detached) where it would be deflected */
+		for (int b = 0; b < 2; b++) {
+			double d[2] = {th[0], th[1]};
+			d[b] = 0.0;
+			int deep = 200 * th[b] * th[b] > FPATH_BELOW_J;
+			assert_int_equal(fpath_below(&s, x, y, d), deep);
+		}
+		/* a beam swung past the body lies above, never below */
+		double up[2] = {th[0] + 0.2, th[1] + 0.2};
+		assert_false(fpath_below(&s, x, y, up));
+	}
+	bsim_scene_free(&s);
+}
+
+/* ---- a sweep ------------------------------------------------------------------------- */
+
+/* A small H1: F_prop 7 and 9 N, Rm 0, 20 and 40 N; group g has F index
+ * g / 3 and Rm index g % 3 (the first axis varies slowest). */
+static const char *sweep_dir(void)
+{
+	static char dir[1024];
+	if (dir[0])
+		return dir;
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("sweep"));
+	char yaml[2048], exp[1100];
+	snprintf(yaml, sizeof yaml,
+	         "scene: %s\ntrials: 12\nseed: 1\ngrid:\n"
+	         "  effects.propulsion.force: [7, 9]\n"
+	         "  effects.random_force.magnitude: [0, 20, 40]\n",
+	         bsim_test_src("configs/thesis/gate.yaml"));
+	snprintf(exp, sizeof exp, "%s", bsim_test_write(dir, "small_h1.yaml", yaml));
+	const char *argv[] = {"sweep", exp, "--trajectories", "3", "--quiet", "--out", dir, NULL};
+	assert_int_equal(run_cli(argv, NULL, NULL), 0);
+	return dir;
+}
+
+/* The sweep, drawn once for the tests that read its figures. */
+static const char *sweep_plotted(void)
+{
+	static int plotted;
+	const char *dir = sweep_dir();
+	if (!plotted) {
+		char *out = NULL;
+		const char *argv[] = {"plot", dir, NULL};
+		assert_int_equal(run_cli(argv, &out, NULL), 0);
+		assert_non_null(strstr(out, "sweep of"));
+		free(out);
+		plotted = 1;
+	}
+	return dir;
+}
+
+static void test_sweep_figures(void **state)
+{
+	(void)state;
+	const char *dir = sweep_plotted();
+	/* p_traverse, two traversal_vs_*, and per group a bundle, plus a
+	 * landscape where a kept trial traversed (F = 9 N, Rm = 0 does) */
+	int n = check_figures(dir);
+	assert_true(n >= 3 + 6 + 1);
+
+	/* The heat map's numbers from the outcomes of trials.csv. */
+	char path[1200];
+	snprintf(path, sizeof path, "%s/trials.csv", dir);
+	char *trials = bsim_test_read(path);
+	int trav[6] = {0}, left[6] = {0}, right[6] = {0};
+	char *save = NULL;
+	for (char *l = strtok_r(trials, "\n", &save); l; l = strtok_r(NULL, "\n", &save)) {
+		int g, t;
+		char outcome[32], type[32];
+		if (sscanf(l, "%d,%d,%31[^,],%31[^,]", &g, &t, outcome, type) != 4)
+			continue;
+		trav[g] += strcmp(outcome, "traversed") == 0;
+		left[g] += strcmp(type, "left") == 0;
+		right[g] += strcmp(type, "right") == 0;
+	}
+	free(trials);
+	static double rows[64][16];
+	snprintf(path, sizeof path, "%s/p_traverse.dat", dir);
+	int nr = data_rows(path, 0, rows, 64);
+	assert_int_equal(nr, 6);
+	for (int i = 0; i < nr; i++) {
+		int g = (int)rows[i][7];
+		double lo, hi;
+		wilson(trav[g], 12, &lo, &hi);
+		if (g % 3 == 0) /* Rm = 0: one trial run and copied, its interval a point */
+			lo = hi = trav[g] / 12.0;
+		assert_int_equal((int)rows[i][0], g / 3);              /* column: F_prop */
+		assert_int_equal((int)rows[i][1], g % 3);              /* row: Rm */
+		assert_true(fabs(rows[i][2] - trav[g] / 12.0) < 1e-6); /* %.6g */
+		assert_true(fabs(rows[i][3] - lo) < 1e-5 && fabs(rows[i][4] - hi) < 1e-5);
+	}
+	/* Traversal against Rm, panel F_prop = 9 N (the second): left and
+	 * right fractions from the types. */
+	snprintf(path, sizeof path, "%s/traversal_vs_effects_random_force_magnitude.dat", dir);
+	nr = data_rows(path, 1, rows, 64);
+	assert_int_equal(nr, 3);
+	for (int i = 0; i < 3; i++) {
+		int g = 3 + i;
+		assert_true(rows[i][0] == 20.0 * i);
+		assert_true(fabs(rows[i][1] - trav[g] / 12.0) < 1e-6);
+		assert_true(fabs(rows[i][4] - left[g] / 12.0) < 1e-6);
+		assert_true(fabs(rows[i][7] - right[g] / 12.0) < 1e-6);
+	}
+}
+
+/* E along the paths and the below-surface flags against the model's
+ * landscape written above. */
+static void test_paths_over_landscape(void **state)
+{
+	(void)state;
+	const char *dir = sweep_plotted();
+	char path[1200];
+	snprintf(path, sizeof path, "%s/landscape_g003.dat", dir); /* F 9 N, Rm 0: traverses */
+	static double rows[20000][16];
+	int nr = data_rows(path, 0, rows, 20000);
+	assert_true(nr > 50);
+	/* each row: x y E class below, thinned from the rows of the
+	 * traversed trials in trajectories.csv, in their order */
+	snprintf(path, sizeof path, "%s/trajectories.csv", dir);
+	char *traj = bsim_test_read(path);
+	int k = 0, below = 0;
+	char *save = NULL;
+	for (char *l = strtok_r(traj, "\n", &save); l && k < nr; l = strtok_r(NULL, "\n", &save)) {
+		int g, t;
+		double tt, x, y, t1, t2;
+		if (sscanf(l, "%d,%d,%lf,%lf,%lf,%lf,%lf", &g, &t, &tt, &x, &y, &t1, &t2) != 7 ||
+		    g != 3)
+			continue;
+		double land = 200 * (pow(th_model(-25, x, y), 2) + pow(th_model(25, x, y), 2));
+		double beam = 200 * (t1 * t1 + t2 * t2);
+		below += land - beam > 1.0;
+		if (fabs(rows[k][0] - x) > 1e-4 || fabs(rows[k][1] - y) > 1e-4)
+			continue; /* a row the figure leaves out */
+		double e = 9.0 * (60 - y) + beam;
+		assert_true(fabs(rows[k][2] - e) <= 1e-5 * fmax(1.0, fabs(e)));
+		assert_int_equal((int)rows[k][4], land - beam > 1.0);
+		k++;
+	}
+	free(traj);
+	assert_int_equal(k, nr);
+	/* every state below the surface is in the stretches of block 1 */
+	snprintf(path, sizeof path, "%s/landscape_g003.dat", dir);
+	int nb = data_rows(path, 1, rows, 20000);
+	assert_true(nb >= below);
+}
+
+static void test_select(void **state)
+{
+	(void)state;
+	const char *dir = sweep_dir();
+	char out_dir[1100];
+	snprintf(out_dir, sizeof out_dir, "%s/f7", dir);
+	const char *argv[] = {"plot",  dir,     "--select", "effects.propulsion.force=7.0",
+	                      "--out", out_dir, "--quiet",  NULL};
+	assert_int_equal(run_cli(argv, NULL, NULL), 0);
+	static double rows[64][16];
+	char path[1200];
+	snprintf(path, sizeof path, "%s/p_traverse.dat", out_dir);
+	int nr = data_rows(path, 0, rows, 64);
+	assert_int_equal(nr, 3); /* the three Rm of F = 7 N, groups 0-2 */
+	for (int i = 0; i < nr; i++)
+		assert_true(rows[i][7] >= 0 && rows[i][7] <= 2);
+	/* one value of F left: nothing drawn against it */
+	snprintf(path, sizeof path, "%s/traversal_vs_effects_propulsion_force.gp", out_dir);
+	assert_null(bsim_test_read(path));
+	check_figures(out_dir);
+
+	char *err = NULL;
+	const char *bad[] = {"plot", dir, "--select", "beams.0.mass=1", "--out", out_dir, NULL};
+	assert_int_equal(run_cli(bad, NULL, &err), 2);
+	assert_non_null(strstr(err, "beams.0.mass is not a grid axis"));
+	free(err);
+	const char *none[] = {"plot", dir, "--select", "effects.propulsion.force=3", NULL};
+	assert_int_equal(run_cli(none, NULL, &err), 2);
+	assert_non_null(strstr(err, "has no value 3"));
+	free(err);
+}
+
+/* A malformed file is named with its line, exit 2, and no figure is drawn. */
+static void test_bad_input(void **state)
+{
+	(void)state;
+	char dir[1024];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("bad"));
+	const char *sweep[] = {"sweep",
+	                       bsim_test_src("configs/thesis/h1_symmetric.yaml"),
+	                       "--trials",
+	                       "1",
+	                       "--trajectories",
+	                       "1",
+	                       "--quiet",
+	                       "--out",
+	                       dir,
+	                       NULL};
+	assert_int_equal(run_cli(sweep, NULL, NULL), 0);
+	char path[1200];
+	snprintf(path, sizeof path, "%s/trajectories.csv", dir);
+	char *text = bsim_test_read(path);
+	int lines = 0;
+	for (char *p = text; *p; p++)
+		lines += *p == '\n';
+	FILE *f = fopen(path, "a");
+	fputs("29,0,1.5,0,0\n", f); /* too few fields */
+	fclose(f);
+	free(text);
+	char *err = NULL;
+	const char *argv[] = {"plot", dir, NULL};
+	assert_int_equal(run_cli(argv, NULL, &err), 2);
+	char want[64];
+	snprintf(want, sizeof want, "trajectories.csv:%d: expected 9 fields, got 5", lines + 1);
+	assert_non_null(strstr(err, want));
+	free(err);
+	snprintf(path, sizeof path, "%s/p_traverse.gp", dir);
+	assert_null(bsim_test_read(path));
+}
+
+static void test_not_an_output(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("empty");
+	char *err = NULL;
+	const char *argv[] = {"plot", dir, NULL};
+	assert_int_equal(run_cli(argv, NULL, &err), 2);
+	assert_non_null(strstr(err, dir));
+	assert_non_null(strstr(err, "summary.json"));
+	free(err);
+}
+
+/* ---- a run ---------------------------------------------------------------------------- */
+
+static void test_run_figures(void **state)
+{
+	(void)state;
+	char dir[1024];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("run"));
+	char *out = NULL;
+	const char *run[] = {
+	        "run", bsim_test_src("configs/thesis/gate.yaml"), "--json", "--out", dir, NULL};
+	assert_int_equal(run_cli(run, &out, NULL), 0);
+	char *p = strstr(out, "\"draws\": ");
+	assert_non_null(p);
+	long draws = strtol(p + 9, NULL, 10);
+	free(out);
+	const char *argv[] = {"plot", dir, "--quiet", NULL};
+	assert_int_equal(run_cli(argv, NULL, NULL), 0);
+	assert_int_equal(check_figures(dir), 3);
+	/* The histogram: every draw of the runner once, density integrating
+	 * to 1. */
+	static double rows[64][16];
+	char path[1200];
+	snprintf(path, sizeof path, "%s/random_force.dat", dir);
+	int nr = data_rows(path, 0, rows, 64);
+	assert_int_equal(nr, 32);
+	double width = rows[1][0] - rows[0][0], integral = 0.0;
+	long count = 0;
+	for (int i = 0; i < nr; i++) {
+		integral += rows[i][1] * width;
+		count += (long)rows[i][2];
+	}
+	assert_int_equal(count, draws);
+	assert_true(fabs(integral - 1.0) < 1e-5); /* densities at %.6g */
+	/* The ledger's sum of flows is E(t) - E(0) less the residual. */
+	static double led[4000][16];
+	snprintf(path, sizeof path, "%s/ledger.dat", dir);
+	nr = data_rows(path, 0, led, 4000);
+	assert_true(nr > 100);
+	for (int i = 0; i < nr; i++)
+		assert_true(fabs(led[i][4] - led[i][11] - led[i][12]) < 1e-6);
+}
+
+/* ---- the accuracy study ------------------------------------------------------------------- */
+
+static void test_accuracy_front(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("accuracy");
+	/* speed, error: a (1000, 1e-3), b (100, 1e-4), c (500, 2e-3) dominated
+	 * by a, d (2000, 5e-3), e (50, 5e-4) dominated by b; the rows at the
+	 * reference step (0.000125 s) are not drawn. Front by speed: d, a, b. */
+	bsim_test_write(dir, "accuracy.csv",
+	                "backend,setting,reference,h_s,err_mean_m,speed_x_realtime\n"
+	                "thesis,s1,1,0.004,1e-3,1000\n"
+	                "thesis,s1,1,0.001,1e-4,100\n"
+	                "thesis,s1,1,0.000125,0,10\n"
+	                "box2d,s2,0,0.004,2e-3,500\n"
+	                "box2d,s2,0,0.008,5e-3,2000\n"
+	                "box2d,s2,0,0.001,5e-4,50\n"
+	                "box2d,s2,0,0.000125,1e-9,5\n");
+	const char *argv[] = {"plot", dir, "--quiet", NULL};
+	assert_int_equal(run_cli(argv, NULL, NULL), 0);
+	static double rows[16][16];
+	char path[1200];
+	snprintf(path, sizeof path, "%s/accuracy.dat", dir);
+	int nr = data_rows(path, 2, rows, 16);
+	assert_int_equal(nr, 3);
+	const double speed[3] = {2000, 1000, 100}, err[3] = {5e-3, 1e-3, 1e-4};
+	for (int i = 0; i < 3; i++) {
+		assert_true(rows[i][0] == speed[i]);
+		assert_true(rows[i][1] == err[i]);
+	}
+	assert_int_equal(data_rows(path, 0, rows, 16), 2); /* s1 without its reference row */
+	assert_int_equal(data_rows(path, 1, rows, 16), 3);
+	check_figures(dir);
+}
+
+/* ---- a comparison ------------------------------------------------------------------------- */
+
+static void test_compare_figures(void **state)
+{
+	(void)state;
+	char dir[1024];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("compare"));
+	const char *cmp[] = {"compare",  bsim_test_src("configs/thesis/h1_symmetric.yaml"),
+	                     "--trials", "6",
+	                     "--quiet",  "--out",
+	                     dir,        NULL};
+	int rc = run_cli(cmp, NULL, NULL);
+	assert_true(rc == 0 || rc == 3);
+	const char *argv[] = {"plot", dir, "--quiet", NULL};
+	assert_int_equal(run_cli(argv, NULL, NULL), 0);
+	assert_int_equal(check_figures(dir), 1);
+	char sub[1100];
+	for (int b = 0; b < 2; b++) {
+		snprintf(sub, sizeof sub, "%s/%s", dir, b ? "box2d" : "thesis");
+		assert_int_equal(check_figures(sub), 3);
+	}
+	/* The paired difference is p_A - p_B of the two probabilities drawn. */
+	static double rows[64][16];
+	char path[1200];
+	snprintf(path, sizeof path, "%s/compare.dat", dir);
+	int nr = data_rows(path, 0, rows, 64);
+	assert_int_equal(nr, 30);
+	for (int i = 0; i < nr; i++)
+		assert_true(fabs(rows[i][8] - (rows[i][2] - rows[i][5])) < 1e-6);
+}
+
+/* ---- without gnuplot ---------------------------------------------------------------------- */
+
+static void test_without_gnuplot(void **state)
+{
+	(void)state;
+	char dir[1024];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("no_gnuplot"));
+	const char *run[] = {"run", bsim_test_src("configs/thesis/gate.yaml"), "--out", dir, NULL};
+	assert_int_equal(run_cli(run, NULL, NULL), 0);
+	char *old = strdup(getenv("PATH") ? getenv("PATH") : "/usr/bin:/bin");
+	setenv("PATH", bsim_test_dir("empty_path"), 1);
+	char *err = NULL;
+	const char *argv[] = {"plot", dir, "--quiet", NULL};
+	int rc = run_cli(argv, NULL, &err);
+	setenv("PATH", old, 1);
+	free(old);
+	assert_int_equal(rc, 0);
+	assert_non_null(strstr(err, "gnuplot-nox"));
+	free(err);
+	static const char *const files[] = {"ledger.gp", "ledger.dat", "random_force.gp",
+	                                    "landscape_path.gp", "landscape_path.surface.dat"};
+	char path[1200];
+	for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+		snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+		char *t = bsim_test_read(path);
+		assert_non_null(t);
+		free(t);
+	}
+	snprintf(path, sizeof path, "%s/ledger.png", dir);
+	assert_null(bsim_test_read(path));
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_below_surface),        cmocka_unit_test(test_sweep_figures),
+	        cmocka_unit_test(test_paths_over_landscape), cmocka_unit_test(test_select),
+	        cmocka_unit_test(test_not_an_output),        cmocka_unit_test(test_bad_input),
+	        cmocka_unit_test(test_run_figures),          cmocka_unit_test(test_accuracy_front),
+	        cmocka_unit_test(test_compare_figures),      cmocka_unit_test(test_without_gnuplot),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
