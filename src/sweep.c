@@ -38,11 +38,11 @@ void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_res
 			out->traversed++;
 			out->left += t->type == BSIM_TYPE_LEFT;
 			out->right += t->type == BSIM_TYPE_RIGHT;
-			/* Equal peaks (e.g. a beam never touched twice) count as
-			 * neither side rather than defaulting to one. */
-			out->landscape_left += t->landscape_left != 0;
-			out->landscape_right +=
-			        !t->landscape_left && t->max_theta[1] > t->max_theta[0];
+			/* The barrier crossed (bsim_landscape_label); a trial whose
+			 * last touch was of no deflected beam, or of two holding
+			 * equal energy, counts as neither. */
+			out->landscape_left += t->landscape_beam == 0;
+			out->landscape_right += t->landscape_beam == 1;
 			break;
 		case BSIM_SIDE_EXIT:
 			out->side_exit++;

@@ -21,6 +21,7 @@ typedef struct beam_shape {
 struct bsim_runner {
 	bsim_state s0, s1; /* before and after a step */
 	beam_shape *shape; /* per beam */
+	int *touching;     /* contacts at the last touching step before success_y */
 	int cap;           /* beams the states hold */
 };
 
@@ -36,6 +37,7 @@ void bsim_runner_free(bsim_runner *r)
 	bsim_state_free(&r->s0);
 	bsim_state_free(&r->s1);
 	free(r->shape);
+	free(r->touching);
 	free(r);
 }
 
@@ -46,9 +48,12 @@ static int runner_reserve(bsim_runner *r, int n_beams)
 	bsim_state_free(&r->s0);
 	bsim_state_free(&r->s1);
 	free(r->shape);
+	free(r->touching);
 	r->cap = 0;
 	r->shape = malloc((size_t)(n_beams > 0 ? n_beams : 1) * sizeof *r->shape);
-	if (!r->shape || bsim_state_alloc(&r->s0, n_beams) || bsim_state_alloc(&r->s1, n_beams))
+	r->touching = malloc((size_t)(n_beams > 0 ? n_beams : 1) * sizeof *r->touching);
+	if (!r->shape || !r->touching || bsim_state_alloc(&r->s0, n_beams) ||
+	    bsim_state_alloc(&r->s1, n_beams))
 		return BSIM_EFAIL;
 	r->cap = n_beams;
 	return BSIM_OK;
@@ -252,6 +257,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
                    bsim_trial_result *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
+	out->landscape_beam = -1;
 	if (runner_reserve(r, scene->n_beams))
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	bsim_world *w = NULL;
@@ -285,6 +291,10 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		trace(rec->trace_user, 0, s0);
 
 	int done = 0; /* the outcome is known; running on to classify_y */
+	/* The last step before success_y at which the body touched a beam:
+	 * where and which beams (for the landscape label). */
+	int touched = 0;
+	double last_touch[2] = {0.0, 0.0};
 	long recorded = -1;
 	long n = 0, run_on = 0;
 	out->outcome = BSIM_STUCK;
@@ -323,6 +333,12 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 			continue;
 		for (int i = 0; i < 2 && i < scene->n_beams; i++)
 			out->max_theta[i] = fmax(out->max_theta[i], s0->theta[i]);
+		if (any_contact(s0)) {
+			touched = 1;
+			last_touch[0] = s0->x[0];
+			last_touch[1] = s0->x[1];
+			memcpy(r->touching, s0->contact, (size_t)s0->n_beams * sizeof *r->touching);
+		}
 		if (fabs(s0->x[0]) >= scene->side_x) {
 			out->outcome = BSIM_SIDE_EXIT;
 			break;
@@ -347,7 +363,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		out->type = s0->v[0] > band    ? BSIM_TYPE_LEFT
 		            : s0->v[0] < -band ? BSIM_TYPE_RIGHT
 		                               : BSIM_TYPE_NONE;
-		out->landscape_left = out->max_theta[0] > out->max_theta[1];
+		out->landscape_beam =
+		        touched ? bsim_landscape_label(scene, last_touch, r->touching) : -1;
 	}
 	out->x_end = s0->x[0];
 	out->y_end = s0->x[1];
@@ -362,7 +379,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	if (out->instability) {
 		out->outcome = BSIM_UNSTABLE;
 		out->type = BSIM_TYPE_NONE;
-		out->landscape_left = 0;
+		out->landscape_beam = -1;
 		out->in_contact_end = 0;
 	}
 	out->draws = fx.random ? bsim_schedule_draws(fx.random->schedule) : 0;

@@ -23,7 +23,7 @@ typedef struct bsim_group_result {
 	                    * is the same trial: it ran once, the others are copies,
 	                    * and ci95 is the point p_traverse */
 	int stuck_in_contact;
-	int landscape_left, landscape_right; /* traversed, by larger peak theta */
+	int landscape_left, landscape_right; /* traversed over beam 0's / 1's barrier */
 	double p_traverse, ci95[2];          /* Wilson 95% */
 	long steps;                          /* steps integrated in the group */
 } bsim_group_result;

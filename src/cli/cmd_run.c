@@ -165,13 +165,18 @@ static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64
 	        ", %lu draws)\n",
 	        a->seed, a->group, a->trial, mixed, r->draws);
 	fprintf(out, "outcome     %s", bsim_outcome_name(r->outcome));
-	if (r->outcome == BSIM_TRAVERSED)
-		fprintf(out, ", type %s, landscape %s", bsim_type_name(r->type),
-		        r->landscape_left                   ? "left"
-		        : r->max_theta[1] > r->max_theta[0] ? "right"
-		                                            : "none");
-	else if (r->outcome == BSIM_STUCK)
+	if (r->outcome == BSIM_TRAVERSED) {
+		fprintf(out, ", type %s, landscape ", bsim_type_name(r->type));
+		if (r->landscape_beam < 0)
+			fprintf(out, "none");
+		else if (r->landscape_beam < 2 && s->n_beams == 2)
+			fprintf(out, "%s (beam %d)", r->landscape_beam == 0 ? "left" : "right",
+			        r->landscape_beam + 1);
+		else
+			fprintf(out, "beam %d", r->landscape_beam + 1);
+	} else if (r->outcome == BSIM_STUCK) {
 		fprintf(out, ", %s", r->in_contact_end ? "in contact" : "not in contact");
+	}
 	fprintf(out, "\nsteps       %d to the outcome at t = %.6g s, %d run\n", r->steps, r->t_end,
 	        r->steps_run);
 	fprintf(out, "end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,

@@ -22,6 +22,8 @@ static const cli_command commands[] = {
         {"bench", cmd_bench, "measure the speed of a backend on the essay's experiments"},
         {"accuracy", cmd_accuracy,
          "what accuracy costs in time: error against speed per backend and step"},
+        {"landscape", cmd_landscape,
+         "the potential energy landscape of a scene, its barriers and figures"},
         {"plot", cmd_plot, "draw the figures of a sweep, comparison, run or accuracy study"},
         {"video", cmd_video, "an MP4 of one trial, on one backend or side by side"},
 };
