@@ -25,6 +25,13 @@ $b plot $o/h2 --select effects.propulsion.force=8 --select effects.random_force.
   --out $o/fig3.4a --quiet
 $b plot $o/h2 --select effects.propulsion.force=8 --select beams.0.stiffness=300 \
   --out $o/fig3.4b --quiet
+# Fig. 2.6: the landscape of the essay gate, of the essay's asymmetric 500 : 250 gate, and of
+# H2's 100 : 500 gate
+$b landscape configs/thesis/gate.yaml --out $o/landscape >/dev/null
+$b landscape configs/thesis/gate.yaml --set beams.0.stiffness=500 --set beams.1.stiffness=250 \
+  --out $o/landscape-500-250 >/dev/null
+$b landscape configs/thesis/gate.yaml --set beams.0.stiffness=100 --set beams.1.stiffness=500 \
+  --out $o/landscape-100-500 >/dev/null
 # the accuracy study of docs/accuracy.csv
 mkdir -p $o/accuracy && cp docs/accuracy.csv $o/accuracy/ && $b plot $o/accuracy --quiet
 
@@ -41,4 +48,9 @@ for g in 1 2; do small $o/h2-figures "landscape_g$(printf %03d $g)" "fig3.3-g$g"
 small $o/fig3.4a traversal_vs_beams_0_stiffness fig3.4a
 small $o/fig3.4b traversal_vs_effects_random_force_magnitude fig3.4b
 small $o/accuracy accuracy accuracy
+small $o/landscape landscape_beam landscape_beam
+small $o/landscape landscape_total landscape_total
+small $o/landscape landscape_top landscape_top
+small $o/landscape-500-250 landscape_beam landscape_beam_500_250
+small $o/landscape-100-500 landscape_top landscape_top_100_500
 ls -l "$d"

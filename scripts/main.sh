@@ -15,4 +15,5 @@ if [ "$status" -ne 0 ] && [ "$status" -ne 3 ]; then
   exit "$status"
 fi
 build/beamsim plot out/h1-compare --quiet
+build/beamsim landscape configs/thesis/gate.yaml --out out/landscape  # the essay gate's landscape
 echo "report: out/h1-compare/report.md, figures: out/h1-compare/compare.png and out/h1-compare/*/"

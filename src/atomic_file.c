@@ -5,12 +5,42 @@
 
 #include <errno.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+int bsim_atomic_file_is_through(const char *path)
+{
+	struct stat st;
+	if (strcmp(path, "-") == 0)
+		return 1;
+	if (lstat(path, &st) != 0)
+		return 0;
+	return S_ISLNK(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode) ||
+	       S_ISBLK(st.st_mode) || S_ISSOCK(st.st_mode);
+}
 
 int bsim_atomic_file_open(bsim_atomic_file *o, const char *path, bsim_error *err)
 {
+	struct stat st;
 	o->f = NULL;
 	o->path = path;
+	o->tmp[0] = '\0';
+	o->mode = BSIM_ATOMIC_RENAME;
+	if (strcmp(path, "-") == 0) {
+		o->mode = BSIM_ATOMIC_STDOUT;
+		o->f = stdout;
+		return BSIM_OK;
+	}
+	if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write: it is a directory", path);
+	if (bsim_atomic_file_is_through(path)) {
+		o->mode = BSIM_ATOMIC_THROUGH;
+		o->f = fopen(path, "w");
+		if (!o->f)
+			return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write: %s", path,
+			                      strerror(errno));
+		return BSIM_OK;
+	}
 	/* The process id keeps two runs writing the same PATH apart. */
 	int n = snprintf(o->tmp, sizeof o->tmp, "%s.tmp.%ld", path, (long)getpid());
 	if (n < 0 || (size_t)n >= sizeof o->tmp)
@@ -19,30 +49,47 @@ int bsim_atomic_file_open(bsim_atomic_file *o, const char *path, bsim_error *err
 		                      strlen(path) > 200 ? "..." : "");
 	o->f = fopen(o->tmp, "w");
 	if (!o->f)
-		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write: %s", o->tmp,
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write: %s", path,
 		                      strerror(errno));
 	return BSIM_OK;
 }
 
-/* Flushes f to disk and closes it: 0, or the errno of the first
- * failure. fsync comes before the rename, else a crash soon after could
- * leave PATH renamed but empty on some file systems. A write that failed
- * earlier shows only as ferror; errno most likely still holds its cause. */
-static int flush_close(FILE *f)
+/* Flushes f to disk and closes it (never standard output): 0, or the
+ * errno of the first failure. fsync comes before the rename, else a crash
+ * soon after could leave PATH renamed but empty on some file systems; a
+ * pipe or a terminal cannot be synced, which is no error. A write that
+ * failed earlier shows only as ferror; errno most likely still holds its
+ * cause. */
+static int flush_close(FILE *f, int close)
 {
 	int saved = 0;
-	if (ferror(f))
+	if (ferror(f)) {
+		/* The failed write's errno is long gone: flushing again most
+		 * likely fails the same way and says why. */
+		clearerr(f);
+		errno = 0;
+		saved = fflush(f) != 0 && errno ? errno : EIO;
+	} else if (fflush(f) != 0)
 		saved = errno ? errno : EIO;
-	else if (fflush(f) != 0 || fsync(fileno(f)) != 0)
+	else if (fsync(fileno(f)) != 0 && errno != EINVAL && errno != EROFS && errno != ENOTSUP)
 		saved = errno;
-	if (fclose(f) != 0 && saved == 0)
-		saved = errno;
+	if (close && fclose(f) != 0 && saved == 0)
+		saved = errno ? errno : EIO;
 	return saved;
 }
 
 int bsim_atomic_file_commit(bsim_atomic_file *o, bsim_error *err)
 {
-	int saved = flush_close(o->f);
+	if (o->mode == BSIM_ATOMIC_STDOUT || o->mode == BSIM_ATOMIC_THROUGH) {
+		int saved = flush_close(o->f, o->mode == BSIM_ATOMIC_THROUGH);
+		o->f = NULL;
+		if (saved == 0)
+			return BSIM_OK;
+		return bsim_error_set(err, BSIM_EFAIL, "%s: write failed: %s",
+		                      o->mode == BSIM_ATOMIC_STDOUT ? "standard output" : o->path,
+		                      strerror(saved));
+	}
+	int saved = flush_close(o->f, 1);
 	o->f = NULL;
 	if (saved == 0 && rename(o->tmp, o->path) == 0)
 		return BSIM_OK;
@@ -56,9 +103,14 @@ void bsim_atomic_file_abort(bsim_atomic_file *o)
 {
 	if (!o->f)
 		return;
-	fclose(o->f);
+	if (o->mode == BSIM_ATOMIC_STDOUT) {
+		fflush(stdout);
+	} else {
+		fclose(o->f);
+		if (o->mode == BSIM_ATOMIC_RENAME)
+			unlink(o->tmp);
+	}
 	o->f = NULL;
-	unlink(o->tmp);
 }
 
 int bsim_atomic_file_copy(const char *from, const char *to, bsim_error *err)

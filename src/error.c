@@ -3,6 +3,8 @@
 #include <stdarg.h>
 #include <stdio.h>
 
+#include "text_check.h"
+
 int bsim_error_set(bsim_error *err, int code, const char *fmt, ...)
 {
 	if (err) {
@@ -10,6 +12,7 @@ int bsim_error_set(bsim_error *err, int code, const char *fmt, ...)
 		va_start(ap, fmt);
 		vsnprintf(err->msg, sizeof err->msg, fmt, ap);
 		va_end(ap);
+		text_escape(err->msg, sizeof err->msg);
 		err->code = code;
 	}
 	return code;

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/limits.h"
 #include "scene_internal.h"
 
 static const char experiment_keys[] = "name, scene, trials, seed, set, grid";
@@ -136,16 +137,28 @@ static int walk_grid(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim
 	e->axes = calloc((size_t)count, sizeof *e->axes);
 	if (!e->axes)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
-	long long groups = 1;
+	/* Counted before any axis is walked: a few hundred bytes of lists can
+	 * ask for 10^9 groups, each a scene to build and check. */
+	double groups = 1, limit = bsim_limits_get()->groups;
+	for (int i = 0; i < count; i++) {
+		struct fy_node *v = fy_node_pair_value(fy_node_mapping_get_by_index(n, i));
+		groups *= v && fy_node_is_sequence(v) ? fy_node_sequence_item_count(v) : 1;
+	}
+	if (groups > limit || groups > INT_MAX) {
+		char hint[160];
+		bsim_limits_hint(hint, sizeof hint, "groups", limit);
+		return ydoc_fail(
+		        d, n, key, "grid", err,
+		        "expected at most %.15g groups (the product of the lists' lengths), "
+		        "got %.15g (%s)",
+		        limit < INT_MAX ? limit : INT_MAX, groups, hint);
+	}
 	for (int i = 0; i < count; i++) {
 		struct fy_node_pair *p = fy_node_mapping_get_by_index(n, i);
 		int rc = walk_axis(d, fy_node_pair_key(p), fy_node_pair_value(p), &e->axes[i], err);
 		e->n_axes = i + 1;
 		if (rc)
 			return rc;
-		groups *= e->axes[i].n_values;
-		if (groups > INT_MAX)
-			return ydoc_expected(d, n, key, "grid", "at most INT_MAX groups", err);
 	}
 	e->n_groups = (int)groups;
 	return BSIM_OK;
@@ -208,7 +221,26 @@ static int walk_experiment(const ydoc *d, bsim_experiment *e, bsim_error *err)
 		if (!ydoc_pair(root, required[i], strlen(required[i])))
 			return ydoc_fail(d, root, NULL, required[i], err, "missing (expected %s)",
 			                 phrase[i]);
+	bsim_error why;
+	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK) {
+		struct fy_node_pair *tp = ydoc_pair(root, "trials", 6);
+		return ydoc_fail(d, fy_node_pair_value(tp), fy_node_pair_key(tp), "trials", err,
+		                 "%s", why.msg);
+	}
 	return BSIM_OK;
+}
+
+int bsim_experiment_check_trials(const bsim_experiment *e, long trials, bsim_error *err)
+{
+	double total = (double)e->n_groups * (double)trials, limit = bsim_limits_get()->trials;
+	if (total <= limit)
+		return BSIM_OK;
+	char hint[160];
+	bsim_limits_hint(hint, sizeof hint, "trials", limit);
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "expected at most %.15g trials in all, got %d groups x %ld trials = "
+	                      "%.15g (%s)",
+	                      limit, e->n_groups, trials, total, hint);
 }
 
 void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx)

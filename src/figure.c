@@ -108,26 +108,31 @@ static int script_write(const bsim_figure_def *d, const char *body, bsim_error *
 	return bsim_atomic_file_commit(&o, err);
 }
 
-/* Runs `gnuplot -e 'outbase="TMP"' NAME.gp` in DIR; its standard output
- * goes to /dev/null, its messages to ours. The exit status, or -1. */
-static int gnuplot_run(const char *dir, const char *name, const char *tmpbase)
+/* Starts `gnuplot -e 'outbase="TMP"' NAME.gp` in DIR, its standard output
+ * to /dev/null and its messages to ours. The process id, or -1. */
+static pid_t gnuplot_start(const char *dir, const char *name, const char *tmpbase)
 {
 	char script[1100], expr[1200];
 	snprintf(script, sizeof script, "%s.gp", name);
 	snprintf(expr, sizeof expr, "outbase=\"%s\"", tmpbase);
 	fflush(NULL);
 	pid_t pid = fork();
+	if (pid != 0)
+		return pid;
+	int null = open("/dev/null", O_WRONLY);
+	if (null >= 0)
+		dup2(null, STDOUT_FILENO);
+	if (chdir(dir) != 0)
+		_exit(126);
+	execlp("gnuplot", "gnuplot", "-e", expr, script, (char *)NULL);
+	_exit(127);
+}
+
+/* The exit status of process pid, or -1. */
+static int gnuplot_wait(pid_t pid)
+{
 	if (pid < 0)
 		return -1;
-	if (pid == 0) {
-		int null = open("/dev/null", O_WRONLY);
-		if (null >= 0)
-			dup2(null, STDOUT_FILENO);
-		if (chdir(dir) != 0)
-			_exit(126);
-		execlp("gnuplot", "gnuplot", "-e", expr, script, (char *)NULL);
-		_exit(127);
-	}
 	int status;
 	while (waitpid(pid, &status, 0) < 0)
 		if (errno != EINTR)
@@ -135,7 +140,33 @@ static int gnuplot_run(const char *dir, const char *name, const char *tmpbase)
 	return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-int bsim_figure_render(const bsim_figure_def *def, const char *body, int *drawn, bsim_error *err)
+/* Moves the images of a finished gnuplot into place, or removes them if
+ * it failed. */
+static int images_commit(const bsim_figure_def *d, const char *tmpbase, int status, bsim_error *err)
+{
+	static const char *const ext[] = {"png", "svg"};
+	char from[1400], to[1400];
+	if (status != 0) {
+		for (int i = 0; i < 2; i++) {
+			snprintf(from, sizeof from, "%s/%s.%s", d->dir, tmpbase, ext[i]);
+			unlink(from);
+		}
+		return bsim_error_set(err, BSIM_EFAIL,
+		                      "gnuplot failed on %s/%s.gp (exit status %d); its data and "
+		                      "script are left for a look",
+		                      d->dir, d->name, status);
+	}
+	for (int i = 0; i < 2; i++) {
+		snprintf(from, sizeof from, "%s/%s.%s", d->dir, tmpbase, ext[i]);
+		snprintf(to, sizeof to, "%s/%s.%s", d->dir, d->name, ext[i]);
+		if (rename(from, to) != 0)
+			return bsim_error_set(err, BSIM_EFAIL, "%s: %s", to, strerror(errno));
+	}
+	return BSIM_OK;
+}
+
+/* def with the defaults filled in. */
+static bsim_figure_def def_resolve(const bsim_figure_def *def)
 {
 	bsim_figure_def d = bsim_figure_default();
 	d.dir = def->dir;
@@ -146,39 +177,53 @@ int bsim_figure_render(const bsim_figure_def *def, const char *body, int *drawn,
 		d.height = def->height;
 	if (def->font)
 		d.font = def->font;
+	return d;
+}
+
+int bsim_figure_render_all(const bsim_figure_def *defs, const char *const *bodies, int n,
+                           int *drawn, bsim_error *err)
+{
 	if (drawn)
 		*drawn = 0;
-	if (!d.dir || !name_ok(d.name))
-		return bsim_error_set(err, BSIM_EFAIL, "figure: bad name '%s'",
-		                      d.name ? d.name : "(null)");
-	int rc = script_write(&d, body, err);
-	if (rc)
-		return rc;
+	for (int i = 0; i < n; i++) {
+		bsim_figure_def d = def_resolve(&defs[i]);
+		if (!d.dir || !name_ok(d.name))
+			return bsim_error_set(err, BSIM_EFAIL, "figure: bad name '%s'",
+			                      d.name ? d.name : "(null)");
+		int rc = script_write(&d, bodies[i], err);
+		if (rc)
+			return rc;
+	}
 	if (!bsim_figure_available())
 		return BSIM_OK;
-
-	char tmpbase[256];
-	snprintf(tmpbase, sizeof tmpbase, "%s.tmp.%ld", d.name, (long)getpid());
-	int status = gnuplot_run(d.dir, d.name, tmpbase);
-	static const char *const ext[] = {"png", "svg"};
-	char from[1400], to[1400];
-	if (status != 0) {
-		for (int i = 0; i < 2; i++) {
-			snprintf(from, sizeof from, "%s/%s.%s", d.dir, tmpbase, ext[i]);
-			unlink(from);
+	pid_t *pids = malloc((n > 0 ? (size_t)n : 1) * sizeof *pids);
+	if (!pids)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; i < n; i++) {
+		char tmpbase[256];
+		snprintf(tmpbase, sizeof tmpbase, "%s.tmp.%ld", defs[i].name, (long)getpid());
+		pids[i] = gnuplot_start(defs[i].dir, defs[i].name, tmpbase);
+	}
+	int rc = BSIM_OK;
+	for (int i = 0; i < n; i++) {
+		bsim_figure_def d = def_resolve(&defs[i]);
+		char tmpbase[256];
+		snprintf(tmpbase, sizeof tmpbase, "%s.tmp.%ld", d.name, (long)getpid());
+		bsim_error e1;
+		int r = images_commit(&d, tmpbase, gnuplot_wait(pids[i]), &e1);
+		if (r && rc == BSIM_OK) {
+			rc = r;
+			if (err)
+				*err = e1;
 		}
-		return bsim_error_set(err, BSIM_EFAIL,
-		                      "gnuplot failed on %s/%s.gp (exit status %d); its data and "
-		                      "script are left for a look",
-		                      d.dir, d.name, status);
 	}
-	for (int i = 0; i < 2; i++) {
-		snprintf(from, sizeof from, "%s/%s.%s", d.dir, tmpbase, ext[i]);
-		snprintf(to, sizeof to, "%s/%s.%s", d.dir, d.name, ext[i]);
-		if (rename(from, to) != 0)
-			return bsim_error_set(err, BSIM_EFAIL, "%s: %s", to, strerror(errno));
-	}
+	free(pids);
 	if (drawn)
-		*drawn = 1;
-	return BSIM_OK;
+		*drawn = rc == BSIM_OK;
+	return rc;
+}
+
+int bsim_figure_render(const bsim_figure_def *def, const char *body, int *drawn, bsim_error *err)
+{
+	return bsim_figure_render_all(def, &body, 1, drawn, err);
 }

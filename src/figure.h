@@ -34,6 +34,13 @@ bsim_figure_def bsim_figure_default(void);
  * BSIM_EFAIL naming the script if it cannot be written or gnuplot fails. */
 int bsim_figure_render(const bsim_figure_def *def, const char *body, int *drawn, bsim_error *err);
 
+/* Renders n figures as bsim_figure_render does, their gnuplot processes
+ * running at the same time (a figure's wall time is mostly gnuplot's). All
+ * scripts are written first; drawn (may be NULL) is 1 if every figure was
+ * drawn. The first error is returned; the other figures are still drawn. */
+int bsim_figure_render_all(const bsim_figure_def *defs, const char *const *bodies, int n,
+                           int *drawn, bsim_error *err);
+
 /* 1 if gnuplot can be run (looked up once per process). */
 int bsim_figure_available(void);
 

@@ -5,9 +5,9 @@
  *
  * The numbers come from summary.json (counts, p_traverse and its Wilson
  * interval as the sweep computed them); the left / right intervals are
- * Wilson intervals of those counts, and the landscape label (the beam with
- * the larger peak angle) is drawn beside the v_x type it is meant to
- * check. A selection (--select KEY=VALUE) keeps the groups that match it;
+ * Wilson intervals of those counts, and the landscape label (the barrier
+ * crossed, bsim_landscape_label) is drawn beside the v_x type it is meant
+ * to check. A selection (--select KEY=VALUE) keeps the groups that match it;
  * an axis left with one value is no longer drawn along. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -323,8 +323,8 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *e
 	        "classify y)', \\\n"
 	        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'right type (v_x < 0)', "
 	        "\\\n"
-	        "     NaN with lines dt 2 lc rgb '%s' title 'over the left beam (larger peak "
-	        "angle)', \\\n"
+	        "     NaN with lines dt 2 lc rgb '%s' title 'over the left beam (landscape "
+	        "label)', \\\n"
 	        "     NaN with lines dt 2 lc rgb '%s' title 'over the right beam', \\\n"
 	        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
 	        FIG_BLACK, FIG_BLUE, FIG_RED, FIG_BLUE, FIG_RED, FIG_GREY);

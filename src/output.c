@@ -300,6 +300,10 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 			for (int k = 0; tl && k < tl->n_entries; k++)
 				fprintf(o.f, "%s%d:%d", k ? " " : "", tl->entries[k].ix,
 				        tl->entries[k].iy);
+			/* A trial without its path (taken from a resumed run's
+			 * journal, which lattices never are) stayed in one gate. */
+			if (!tl || tl->n_entries == 0)
+				fprintf(o.f, "%d:%d", x->final_ix, x->final_iy);
 			for (int a = 0; a < axes; a++) {
 				fputc(',', o.f);
 				csv_field(o.f, e->axes[a].values[idx[a]]);

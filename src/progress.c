@@ -17,6 +17,7 @@ void bsim_progress_init(bsim_progress *p, int enabled)
 	p->shown = 0;
 	p->t_start = bsim_clock_seconds();
 	p->t_last = -1.0;
+	p->base = -1;
 }
 
 /* "0:03", "12:40", "1:02:03". */
@@ -34,6 +35,10 @@ void bsim_progress_update(void *user, long done, long total)
 	bsim_progress *p = user;
 	if (!p || !p->active || total <= 0)
 		return;
+	/* Trials taken from a journal took no time: the ETA counts from the
+	 * first trial this run finished. */
+	if (p->base < 0)
+		p->base = done > 0 ? done - 1 : 0;
 	double now = bsim_clock_seconds();
 	if (done < total && p->t_last >= 0.0 && now - p->t_last < PROGRESS_INTERVAL)
 		return;
@@ -43,8 +48,9 @@ void bsim_progress_update(void *user, long done, long total)
 	double elapsed = now - p->t_start;
 	if (done >= total)
 		format_duration(eta, sizeof eta, elapsed);
-	else if (done > 0)
-		format_duration(eta, sizeof eta, elapsed * (double)(total - done) / (double)done);
+	else if (done > p->base)
+		format_duration(eta, sizeof eta,
+		                elapsed * (double)(total - done) / (double)(done - p->base));
 	/* Trailing spaces wipe what a longer previous line left behind. */
 	fprintf(stderr, "\r  %ld/%ld trials  %d%%  %s %s   ", done, total,
 	        (int)(100.0 * (double)done / (double)total), done >= total ? "took" : "ETA", eta);

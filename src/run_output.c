@@ -105,8 +105,12 @@ void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *
 	bsim_json_string(f, bsim_outcome_name(r->outcome));
 	fputs(", \"type\": ", f);
 	bsim_json_string(f, bsim_type_name(r->type));
-	fprintf(f, ", \"landscape_left\": %d, \"in_contact_end\": %d", r->landscape_left,
-	        r->in_contact_end);
+	fprintf(f, ", \"landscape_left\": %d, \"landscape_beam\": ", r->landscape_beam == 0);
+	if (r->landscape_beam >= 0)
+		fprintf(f, "%d", r->landscape_beam + 1);
+	else
+		fputs("null", f);
+	fprintf(f, ", \"in_contact_end\": %d", r->in_contact_end);
 	fprintf(f, ", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
 	        r->draws);
 	const char *names[] = {"t_end", "x_end", "y_end", "vx_end"};

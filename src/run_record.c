@@ -64,15 +64,10 @@ static int copy_file(const char *from, const char *to, bsim_error *err)
 	return bsim_atomic_file_commit(&o, err);
 }
 
-static int write_experiment(const char *path, const bsim_experiment *e, const bsim_override *extra,
-                            int n_extra, bsim_error *err)
+/* The experiment as it ran, without a word about where it came from. */
+static void experiment_body(FILE *f, const bsim_experiment *e, const bsim_override *extra,
+                            int n_extra)
 {
-	bsim_atomic_file o;
-	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
-		return BSIM_EFAIL;
-	FILE *f = o.f;
-	fprintf(f, "# The experiment of a stored run, written by beamsim %s from\n# %s\n",
-	        BSIM_VERSION, e->path);
 	fprintf(f, "scene: scene.yaml\ntrials: %d\nseed: %" PRIu64 "\n", e->trials, e->seed);
 	if (e->n_set + n_extra > 0)
 		fputs("set:\n", f);
@@ -87,7 +82,63 @@ static int write_experiment(const char *path, const bsim_experiment *e, const bs
 			fprintf(f, "%s%s", i ? ", " : "", e->axes[a].values[i]);
 		fputs("]\n", f);
 	}
+}
+
+static int write_experiment(const char *path, const bsim_experiment *e, const bsim_override *extra,
+                            int n_extra, bsim_error *err)
+{
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fprintf(o.f, "# The experiment of a stored run, written by beamsim %s from\n# %s\n",
+	        BSIM_VERSION, e->path);
+	experiment_body(o.f, e, extra, n_extra);
 	return bsim_atomic_file_commit(&o, err);
+}
+
+/* The scene file's text into f, at most the input limit. */
+static int scene_text(FILE *f, const char *path, bsim_error *err)
+{
+	FILE *in = fopen(path, "rb");
+	if (!in)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file", path);
+	char buf[8192];
+	size_t n;
+	while ((n = fread(buf, 1, sizeof buf, in)) > 0)
+		fwrite(buf, 1, n, f);
+	int bad = ferror(in);
+	fclose(in);
+	return bad ? bsim_error_set(err, BSIM_EFAIL, "%s: read error", path) : BSIM_OK;
+}
+
+char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *e,
+                             const bsim_override *extra, int n_extra, bsim_error *err)
+{
+	char *text = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&text, &len);
+	if (!f) {
+		bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		return NULL;
+	}
+	fprintf(f, "beamsim %s\ncommand %s\n", BSIM_VERSION, rec->command);
+	for (int i = 0; i < rec->n_backends; i++) {
+		fprintf(f, "backend %s", rec->backend[i]);
+		for (int k = 0; k < rec->opts[i].n; k++)
+			fprintf(f, " %s=%s", rec->opts[i].key[k], rec->opts[i].value[k]);
+		fputc('\n', f);
+	}
+	fprintf(f, "groups %d\n--- experiment\n", e->n_groups);
+	experiment_body(f, e, extra, n_extra);
+	fputs("--- scene\n", f);
+	int rc = scene_text(f, e->scene_path, err);
+	if (fclose(f) != 0 && rc == BSIM_OK)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	if (rc != BSIM_OK) {
+		free(text);
+		return NULL;
+	}
+	return text;
 }
 
 static void json_options(FILE *f, const bsim_options *o)

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/limits.h"
 #include "scene_internal.h"
 
 #define BSIM_PI 3.14159265358979323846
@@ -202,6 +203,29 @@ static int lattice_validate(const bsim_scene *s, const char *who, bsim_error *er
 	return BSIM_OK;
 }
 
+int scene_excess_find(const bsim_scene *s, scene_excess *x)
+{
+	const bsim_limits *l = bsim_limits_get();
+	/* In doubles: the products of valid fields can exceed any integer. */
+	double values = (double)s->max_steps * s->dt * s->effects.random_frequency;
+	/* A lattice's step costs the beams near the body, about one gate's
+	 * (docs/lattice.md, bench --lattice), not every beam of the field. */
+	int beams = s->has_lattice ? 2 : s->n_beams;
+	double beam_steps = (double)s->max_steps * (beams > 0 ? beams : 1);
+	if (s->effects.has_random_force && values > l->schedule) {
+		*x = (scene_excess){"effects.random_force.frequency", "schedule", values,
+		                    l->schedule,
+		                    "random-force values per trial (frequency x dt x max_steps)"};
+		return 1;
+	}
+	if (beam_steps > l->beam_steps) {
+		*x = (scene_excess){"integration.max_steps", "beam_steps", beam_steps,
+		                    l->beam_steps, "beam-steps per trial (max_steps x beams)"};
+		return 1;
+	}
+	return 0;
+}
+
 int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 {
 	const char *who = scene_who(s);
@@ -235,6 +259,14 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		                      "%s: body.start: the body (radius %g) overlaps beam %d at "
 		                      "the start (distance %.3g m)",
 		                      who, s->body.radius, beam, d);
+	scene_excess x;
+	if (scene_excess_find(s, &x)) {
+		char hint[160];
+		bsim_limits_hint(hint, sizeof hint, x.limit, x.max);
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: %s: expected at most %.15g %s, got %.3g (%s)", who,
+		                      x.field, x.max, x.what, x.got, hint);
+	}
 	return BSIM_OK;
 }
 

@@ -90,6 +90,18 @@ extern const scene_table scene_lattice_table;
  * success_y, gate_steps = 3000, max_steps = gate_steps (rows + columns). */
 void scene_lattice_defaults(bsim_scene *s);
 
+/* A limit of beamsim/limits.h that a scene exceeds: the field to blame,
+ * what it asks for and the limit's name and value. */
+typedef struct scene_excess {
+	const char *field; /* "effects.random_force.frequency", ... */
+	const char *limit; /* "schedule", "beam_steps" */
+	double got, max;
+	const char *what; /* "random-force values per trial (frequency x dt x max_steps)" */
+} scene_excess;
+
+/* 1 and *x if the scene asks for more than a limit allows, else 0. */
+int scene_excess_find(const bsim_scene *s, scene_excess *x);
+
 /* bsim_scene_load on a document already read (the experiment loader reads
  * the scene file once and builds every group from a clone of it). */
 int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,

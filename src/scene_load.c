@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "beamsim/limits.h"
 #include "scene_internal.h"
 #include "yaml_override.h"
 
@@ -259,6 +260,39 @@ static int check_overlap(walk *w)
 	                 w->s->body.radius, beam, dist);
 }
 
+/* A valid scene that asks for more than a limit allows: the message
+ * blames the override that changed one of the fields involved last, else
+ * the field itself, else the block it would be in. */
+static int check_limits(walk *w)
+{
+	scene_excess x;
+	if (!scene_excess_find(w->s, &x))
+		return BSIM_OK;
+	static const char *const schedule[] = {"effects.random_force.frequency", "integration.dt",
+	                                       "integration.max_steps"};
+	static const char *const steps[] = {"integration.max_steps", "beams"};
+	int is_schedule = !strcmp(x.limit, "schedule");
+	const char *const *paths = is_schedule ? schedule : steps;
+	int n = is_schedule ? 3 : 2;
+	struct fy_node *root = fy_document_root(w->d->fyd);
+	struct fy_node *node = latest_override(w->d, paths, n);
+	const char *field = paths[0];
+	for (int i = 0; i < n; i++) {
+		struct fy_node *at = ydoc_lookup(root, paths[i]);
+		if (node ? at == node : at != NULL) {
+			node = at;
+			field = paths[i];
+			break;
+		}
+	}
+	if (!node) /* all defaults: the block the first field would be in */
+		node = ydoc_lookup(root, is_schedule ? "effects.random_force" : "integration");
+	char hint[160];
+	bsim_limits_hint(hint, sizeof hint, x.limit, x.max);
+	return ydoc_fail(w->d, node ? node : root, NULL, field, w->err,
+	                 "expected at most %.15g %s, got %.3g (%s)", x.max, x.what, x.got, hint);
+}
+
 /* The file's base name without its extension: "configs/gate.yaml" -> "gate". */
 static void default_name(bsim_scene *s, const char *path)
 {
@@ -342,6 +376,8 @@ static int walk_scene(walk *w)
 	if (!rc)
 		rc = check_overlap(w);
 	effects_present(w->s);
+	if (!rc)
+		rc = check_limits(w);
 	return rc;
 }
 

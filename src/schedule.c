@@ -19,6 +19,10 @@ struct bsim_schedule {
 
 static unsigned long total_draws;
 
+/* No schedule grows to this many values (2^40 doubles, 8 TB), so cap
+ * doubling below never overflows. */
+#define SCHEDULE_MAX (1L << 40)
+
 /* SplitMix64's finaliser (Steele, Lea & Flood 2014): a bijection with full
  * avalanche, applied to each input in turn so that nearby (g, t) pairs get
  * unrelated streams. */
@@ -78,13 +82,19 @@ long bsim_schedule_index(const bsim_schedule *s, long n, double h)
 	 * of n*h*f never moves a refresh by a step. */
 	double per = 1.0 / (s->frequency * h);
 	double whole = nearbyint(per);
-	if (whole >= 1.0 && fabs(per - whole) <= 1e-9 * per)
+	if (whole >= 1.0 && whole < 1e15 && fabs(per - whole) <= 1e-9 * per)
 		return n / (long)whole;
-	return (long)floor((double)n * h * s->frequency);
+	/* Validation keeps the index small (bsim_limits schedule); a scene
+	 * built in code may not, and converting a double beyond long's range
+	 * is undefined: such an index is past any schedule that can be drawn. */
+	double j = floor((double)n * h * s->frequency);
+	return j < SCHEDULE_MAX ? (long)j : SCHEDULE_MAX;
 }
 
 double bsim_schedule_value(bsim_schedule *s, long j)
 {
+	if (j < 0 || j >= SCHEDULE_MAX)
+		return NAN; /* the runner stops on a non-finite force */
 	if (j >= s->n_drawn) {
 		if (j >= s->cap) {
 			long cap = s->cap ? s->cap : 256;

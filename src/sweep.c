@@ -38,11 +38,11 @@ void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_res
 			out->traversed++;
 			out->left += t->type == BSIM_TYPE_LEFT;
 			out->right += t->type == BSIM_TYPE_RIGHT;
-			/* Equal peaks (e.g. a beam never touched twice) count as
-			 * neither side rather than defaulting to one. */
-			out->landscape_left += t->landscape_left != 0;
-			out->landscape_right +=
-			        !t->landscape_left && t->max_theta[1] > t->max_theta[0];
+			/* The barrier crossed (bsim_landscape_label); a trial whose
+			 * last touch was of no deflected beam, or of two holding
+			 * equal energy, counts as neither. */
+			out->landscape_left += t->landscape_beam == 0;
+			out->landscape_right += t->landscape_beam == 1;
 			break;
 		case BSIM_SIDE_EXIT:
 			out->side_exit++;
@@ -115,6 +115,17 @@ static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 	return BSIM_OK;
 }
 
+/* A paired sweep's journal record. */
+typedef struct pair_record {
+	bsim_trial_result a, b;
+	double t_separate;
+} pair_record;
+
+size_t bsim_sweep_record_size(int paired)
+{
+	return paired ? sizeof(pair_record) : sizeof(bsim_trial_result);
+}
+
 /* What the threads share. first_fail is the index of the lowest failed
  * trial so far (total if none, -1 if a thread could not start). */
 typedef struct sweep_shared {
@@ -136,6 +147,9 @@ typedef struct sweep_shared {
 	long done;
 	long first_fail;
 	bsim_error fail;
+	unsigned char *from_journal; /* total flags: the result came from the journal */
+	int lattice;                 /* the scenes are lattices: every trial runs */
+	int stopped;                 /* a trial was not started because of cfg->stop */
 } sweep_shared;
 
 static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
@@ -152,6 +166,40 @@ static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
 			sh->first_fail = i;
 		}
 	}
+}
+
+/* Trial i's record: its result, or both results and the separation time. */
+static int journal_append(sweep_shared *sh, long i, bsim_error *err)
+{
+	if (!sh->backend_b)
+		return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &sh->results[i], err);
+	pair_record p = {sh->results[i], sh->results_b[i], sh->t_separate[i]};
+	return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &p, err);
+}
+
+/* A journal record back into its slots (bsim_journal_fn). */
+static int journal_take(void *user, uint64_t index, const void *payload)
+{
+	sweep_shared *sh = user;
+	if (index >= (uint64_t)sh->total)
+		return 1;
+	/* A trial whose trajectory is kept runs again (trajectories are not
+	 * journaled; the trial is the same): its record is passed over. So
+	 * does every trial of a lattice, whose gate path is not journaled. */
+	if ((long)(index % (uint64_t)sh->e->trials) < sh->keep || sh->lattice)
+		return 0;
+	if (sh->backend_b) {
+		pair_record p;
+		memcpy(&p, payload, sizeof p);
+		sh->results[index] = p.a;
+		sh->results_b[index] = p.b;
+		sh->t_separate[index] = p.t_separate;
+	} else {
+		memcpy(&sh->results[index], payload, sizeof sh->results[index]);
+	}
+	sh->done += !sh->from_journal[index];
+	sh->from_journal[index] = 1;
+	return 0;
 }
 
 /* Trials are handed out in index order, so when trial i fails every trial
@@ -178,8 +226,13 @@ static void sweep_thread(sweep_shared *sh)
 		long stop;
 #pragma omp atomic read
 		stop = sh->first_fail;
-		if (!runner || i > stop)
+		if (!runner || i > stop || (sh->from_journal && sh->from_journal[i]))
 			continue;
+		if (cfg->stop && *cfg->stop) {
+#pragma omp atomic write
+			sh->stopped = 1;
+			continue;
+		}
 		long g = i / e->trials, t = i % e->trials;
 		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
@@ -190,9 +243,10 @@ static void sweep_thread(sweep_shared *sh)
 		                     .record_user = keep,
 		                     .log = log[0],
 		                     .overlap = cfg->measure_overlap};
-		int rc = BSIM_OK, copy = t > 0 && sh->deterministic[g];
-		if (copy) {
-			; /* a copy of trial 0, filled in after the run (and its trajectory) */
+		int rc = BSIM_OK, ran = 1;
+		if (t > 0 && sh->deterministic[g]) {
+			ran = 0; /* a copy of trial 0, filled in after the run (and its trajectory)
+			          */
 		} else if (pair) {
 			pair->keep[0] = keep;
 			pair->keep[1] = keep ? &sh->kept_b[g * sh->keep + t] : NULL;
@@ -208,11 +262,14 @@ static void sweep_thread(sweep_shared *sh)
 				rc = bsim_error_set(&err, BSIM_EFAIL,
 				                    "out of memory for a kept trajectory");
 		}
-		if (rc == BSIM_OK && !copy && bsim_trial_log_copy(&sh->logs[i], log[0]) != BSIM_OK)
+		if (rc == BSIM_OK && ran && bsim_trial_log_copy(&sh->logs[i], log[0]) != BSIM_OK)
 			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
-		if (rc == BSIM_OK && !copy && pair &&
+		if (rc == BSIM_OK && ran && pair &&
 		    bsim_trial_log_copy(&sh->logs_b[i], log[1]) != BSIM_OK)
 			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
+		/* Only trials that ran are journaled: copies are filled in again. */
+		if (rc == BSIM_OK && ran && cfg->journal)
+			rc = journal_append(sh, i, &err);
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
 		long done;
@@ -316,6 +373,9 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	if (e->trials < 0 || e->n_groups < 1)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: expected at least one group and trials >= 0", e->path);
+	bsim_error why;
+	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: %s", e->path, why.msg);
 	long total = (long)e->n_groups * e->trials;
 	int keep = cfg->keep < e->trials ? cfg->keep : e->trials;
 	if (keep < 0)
@@ -366,6 +426,19 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	        .t_separate = backend_b ? *t_separate : NULL,
 	        .total = total,
 	};
+	if (rc == BSIM_OK && cfg->journal) {
+		sh.lattice = scenes[0].has_lattice;
+		sh.from_journal = calloc(total ? (size_t)total : 1, 1);
+		long kept = 0, cut = 0;
+		rc = !sh.from_journal ? bsim_error_set(err, BSIM_EFAIL, "out of memory")
+		                      : bsim_journal_replay(cfg->journal, journal_take, &sh, &kept,
+		                                            &cut, err);
+		if (rc != BSIM_OK) {
+			scenes_free(scenes, e->n_groups);
+			if (scenes_b)
+				scenes_free(scenes_b, e->n_groups);
+		}
+	}
 	if (rc == BSIM_OK) {
 		sh.first_fail = sh.total;
 		bsim_error_clear(&sh.fail);
@@ -385,7 +458,11 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 			scenes_free(scenes_b, e->n_groups);
 		if (sh.first_fail < sh.total)
 			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
+		else if (sh.stopped)
+			rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped after %ld of %ld trials",
+			                    sh.done, sh.total);
 	}
+	free(sh.from_journal);
 	if (rc != BSIM_OK) {
 		free(deterministic);
 		bsim_sweep_result_free(out);

@@ -36,10 +36,14 @@ typedef struct beam_shape {
 struct bsim_runner {
 	bsim_state s0, s1; /* before and after a step */
 	beam_shape *shape; /* per beam */
-	int cap;           /* beams the states hold */
-	bsim_state whole;  /* the whole lattice's state, for recording (essay protocol) */
-	double *peak;      /* per beam of the scene */
-	int *negative;     /* beams whose peak starts below 0 */
+	int *touching;     /* per beam of the scene: contacts at the last touching step
+	                    * before success_y (for the landscape label) */
+	int *touch_list;   /* the beams touching[] holds non-zero */
+	int n_touch;
+	int cap;          /* beams the states hold */
+	bsim_state whole; /* the whole lattice's state, for recording (essay protocol) */
+	double *peak;     /* per beam of the scene */
+	int *negative;    /* beams whose peak starts below 0 */
 	int peak_cap;
 	trial_essay essay;
 };
@@ -59,6 +63,8 @@ void bsim_runner_free(bsim_runner *r)
 	free(r->peak);
 	free(r->negative);
 	free(r->shape);
+	free(r->touching);
+	free(r->touch_list);
 	free(r);
 }
 
@@ -77,16 +83,32 @@ static int runner_reserve(bsim_runner *r, int n_beams)
 	return BSIM_OK;
 }
 
+static void touching_clear(bsim_runner *r)
+{
+	for (int k = 0; k < r->n_touch; k++)
+		r->touching[r->touch_list[k]] = 0;
+	r->n_touch = 0;
+}
+
+/* Per beam of the scene: peaks and the touching beams (all zero between
+ * trials: touching_update clears what it set). */
 static int peaks_reserve(bsim_runner *r, int n_beams)
 {
-	if (r->peak_cap >= n_beams && r->peak)
+	if (r->peak_cap >= n_beams && r->peak) {
+		touching_clear(r);
 		return BSIM_OK;
+	}
 	free(r->peak);
 	free(r->negative);
+	free(r->touching);
+	free(r->touch_list);
 	size_t n = n_beams > 0 ? (size_t)n_beams : 1;
 	r->peak = malloc(n * sizeof *r->peak);
 	r->negative = malloc(n * sizeof *r->negative);
-	r->peak_cap = r->peak && r->negative ? n_beams : 0;
+	r->touching = calloc(n, sizeof *r->touching);
+	r->touch_list = malloc(n * sizeof *r->touch_list);
+	r->n_touch = 0;
+	r->peak_cap = r->peak && r->negative && r->touching && r->touch_list ? n_beams : 0;
 	return r->peak_cap ? BSIM_OK : BSIM_EFAIL;
 }
 
@@ -409,6 +431,22 @@ static void peaks_update(bsim_runner *r, const bsim_scene *scene, const int *map
 	*n_negative = m;
 }
 
+/* The contacts of s in touching[] (scene beams: map[i] for the world's beam
+ * i, map NULL: the same), as a copy of the whole contact array would leave
+ * it, at the cost of the beams listed. */
+static void touching_update(bsim_runner *r, const int *map, const bsim_state *s)
+{
+	touching_clear(r);
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k];
+		if (!s->contact[i])
+			continue;
+		int g = scene_beam(map, i);
+		r->touching[g] = s->contact[i];
+		r->touch_list[r->n_touch++] = g;
+	}
+}
+
 /* ---- gates ------------------------------------------------------------- */
 
 typedef struct gate_track {
@@ -601,6 +639,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
                    bsim_trial_result *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
+	out->landscape_beam = -1;
 	trial_ctx c = {.r = r,
 	               .scene = scene,
 	               .backend = backend,
@@ -660,6 +699,10 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		trace(rec->trace_user, 0, s0);
 
 	int done = 0; /* the outcome is known; running on to classify_y */
+	/* The last step before success_y at which the body touched a beam:
+	 * where and which beams (for the landscape label). */
+	int touched = 0;
+	double last_touch[2] = {0.0, 0.0};
 	long recorded = -1;
 	long n = 0, run_on = 0;
 	out->outcome = BSIM_STUCK;
@@ -700,6 +743,12 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		if (done)
 			continue;
 		peaks_update(r, scene, c.map, s0, &n_negative);
+		if (any_contact(s0)) {
+			touched = 1;
+			last_touch[0] = s0->x[0];
+			last_touch[1] = s0->x[1];
+			touching_update(r, c.map, s0);
+		}
 		/* The gate first: a body that leaves the field ends in the gate it
 		 * left from (gates are clamped into the field). */
 		if (scene->has_lattice) {
@@ -735,7 +784,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		out->type = s0->v[0] > band    ? BSIM_TYPE_LEFT
 		            : s0->v[0] < -band ? BSIM_TYPE_RIGHT
 		                               : BSIM_TYPE_NONE;
-		out->landscape_left = out->max_theta[0] > out->max_theta[1];
+		out->landscape_beam =
+		        touched ? bsim_landscape_label(scene, last_touch, r->touching) : -1;
 	}
 	out->x_end = s0->x[0];
 	out->y_end = s0->x[1];
@@ -750,7 +800,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	if (out->instability) {
 		out->outcome = BSIM_UNSTABLE;
 		out->type = BSIM_TYPE_NONE;
-		out->landscape_left = 0;
+		out->landscape_beam = -1;
 		out->in_contact_end = 0;
 	}
 	out->draws = fx.random ? bsim_schedule_draws(fx.random->schedule) : 0;

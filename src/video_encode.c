@@ -27,6 +27,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -128,26 +129,57 @@ static int spawn(bsim_video_encoder *e, int width, int height, double fps, int c
 	snprintf(size, sizeof size, "%dx%d", width, height);
 	snprintf(rate, sizeof rate, "%.10g", fps);
 	snprintf(quality, sizeof quality, "%d", crf);
-	/* file: keeps a path with a colon from being read as a protocol. */
-	snprintf(output, sizeof output, "file:%s", e->out.tmp);
+	/* file: keeps a path with a colon from being read as a protocol. What
+	 * is not a regular file (beamsim/atomic_file.h) is written in place:
+	 * standard output as ffmpeg's own, a pipe or device by its path; those
+	 * cannot seek back to put the index first, so the MP4 is fragmented. */
+	struct stat st;
+	int seekable = e->out.mode == BSIM_ATOMIC_RENAME ||
+	               (e->out.mode == BSIM_ATOMIC_THROUGH && stat(e->path, &st) == 0 &&
+	                S_ISREG(st.st_mode));
+	if (e->out.mode == BSIM_ATOMIC_STDOUT)
+		snprintf(output, sizeof output, "pipe:1");
+	else
+		snprintf(output, sizeof output, "file:%s",
+		         e->out.mode == BSIM_ATOMIC_RENAME ? e->out.tmp : e->path);
 	char *argv[] = {
-	        e->program,    "-hide_banner", "-nostats",
-	        "-loglevel",   "error",        "-f",
-	        "rawvideo",    "-pix_fmt",     (char *)raw_pixel_format(),
-	        "-video_size", size,           "-framerate",
-	        rate,          "-i",           "pipe:0",
-	        "-an",         "-c:v",         "libx264",
-	        "-preset",     "medium",       "-crf",
-	        quality,       "-pix_fmt",     "yuv420p",
-	        "-movflags",   "+faststart",   "-f",
-	        "mp4",         "-y",           output,
+	        e->program,
+	        "-hide_banner",
+	        "-nostats",
+	        "-loglevel",
+	        "error",
+	        "-f",
+	        "rawvideo",
+	        "-pix_fmt",
+	        (char *)raw_pixel_format(),
+	        "-video_size",
+	        size,
+	        "-framerate",
+	        rate,
+	        "-i",
+	        "pipe:0",
+	        "-an",
+	        "-c:v",
+	        "libx264",
+	        "-preset",
+	        "medium",
+	        "-crf",
+	        quality,
+	        "-pix_fmt",
+	        "yuv420p",
+	        "-movflags",
+	        seekable ? "+faststart" : "frag_keyframe+empty_moov",
+	        "-f",
+	        "mp4",
+	        "-y",
+	        output,
 	        NULL,
 	};
 	posix_spawn_file_actions_t fa;
 	if (posix_spawn_file_actions_init(&fa) != 0)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory starting %s", e->program);
 	int rc = posix_spawn_file_actions_adddup2(&fa, read_fd, STDIN_FILENO);
-	if (rc == 0)
+	if (rc == 0 && e->out.mode != BSIM_ATOMIC_STDOUT)
 		rc = posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
 	if (rc == 0)
 		rc = posix_spawn_file_actions_adddup2(&fa, fileno(e->log), STDERR_FILENO);

@@ -11,6 +11,9 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "beamsim/limits.h"
+#include "text_check.h"
+
 typedef struct first_error {
 	int have;
 	int line, col; /* 1-based */
@@ -40,20 +43,35 @@ static struct fy_diag *quiet_diag(void)
 	return diag;
 }
 
-/* Parses a file (fp) or a string (text); aliases and merge keys are resolved
- * so the loaders only ever see plain nodes. */
-static struct fy_document *parse_quiet(FILE *fp, const char *text, first_error *fe)
+/* Parses text (malloc'd, len bytes; libfyaml takes it over) quietly, the
+ * first document only, noting in *more whether a second one follows (which
+ * libfyaml would otherwise drop without a word). Aliases are left as alias
+ * nodes, never expanded: see find_alias. */
+static struct fy_document *parse_quiet(char *text, size_t len, first_error *fe, int *more)
 {
 	memset(fe, 0, sizeof *fe);
+	*more = 0;
 	struct fy_diag *diag = quiet_diag();
-	if (!diag)
+	if (!diag) {
+		free(text);
 		return NULL;
+	}
 	struct fy_parse_cfg cfg;
 	memset(&cfg, 0, sizeof cfg);
-	cfg.flags = FYPCF_QUIET | FYPCF_COLLECT_DIAG | FYPCF_RESOLVE_DOCUMENT;
+	cfg.flags = FYPCF_QUIET | FYPCF_COLLECT_DIAG;
 	cfg.diag = diag;
-	struct fy_document *fyd = fp ? fy_document_build_from_fp(&cfg, fp)
-	                             : fy_document_build_from_string(&cfg, text, strlen(text));
+	struct fy_parser *fyp = fy_parser_create(&cfg);
+	struct fy_document *fyd = NULL;
+	if (!fyp || fy_parser_set_malloc_string(fyp, text, len) != 0) {
+		free(text);
+	} else {
+		fyd = fy_parse_load_document(fyp);
+		struct fy_document *next = fyd ? fy_parse_load_document(fyp) : NULL;
+		if (next) {
+			*more = 1;
+			fy_parse_document_destroy(fyp, next);
+		}
+	}
 	void *it = NULL;
 	struct fy_diag_error *e = fy_diag_errors_iterate(diag, &it);
 	if (e) {
@@ -65,8 +83,175 @@ static struct fy_document *parse_quiet(FILE *fp, const char *text, first_error *
 	/* Turning collection off frees the collected errors (0.7.12 leaks them
 	 * otherwise). */
 	fy_diag_set_collect_errors(diag, false);
+	if (fyp)
+		fy_parser_destroy(fyp);
 	fy_diag_unref(diag);
+	if (fe->have && fyd) {
+		fy_document_destroy(fyd);
+		fyd = NULL;
+	}
 	return fyd;
+}
+
+/* The first alias node below n, with the dotted path of keys leading to it
+ * in path. libfyaml expands aliases by copying, so nine nested aliases of
+ * ten make 10^9 nodes from 400 bytes; scene and experiment files spell
+ * their values out instead. The depth is bounded by libfyaml (64). */
+static struct fy_node *find_alias(struct fy_node *n, char *path, size_t size)
+{
+	if (!n)
+		return NULL;
+	if (fy_node_is_alias(n))
+		return n;
+	size_t used = strlen(path);
+	void *it = NULL;
+	if (fy_node_is_mapping(n)) {
+		struct fy_node_pair *p;
+		while ((p = fy_node_mapping_iterate(n, &it))) {
+			struct fy_node *k = fy_node_pair_key(p);
+			const char *name = k && fy_node_is_scalar(k) && !fy_node_is_alias(k)
+			                           ? fy_node_get_scalar0(k)
+			                           : "?";
+			snprintf(path + used, size - used, "%s%s", used ? "." : "",
+			         name ? name : "?");
+			struct fy_node *a = find_alias(k, path, size);
+			if (!a)
+				a = find_alias(fy_node_pair_value(p), path, size);
+			if (a)
+				return a;
+			path[used] = '\0';
+		}
+	} else if (fy_node_is_sequence(n)) {
+		struct fy_node *c;
+		for (int i = 0; (c = fy_node_sequence_iterate(n, &it)); i++) {
+			snprintf(path + used, size - used, "%s%d", used ? "." : "", i);
+			struct fy_node *a = find_alias(c, path, size);
+			if (a)
+				return a;
+			path[used] = '\0';
+		}
+	}
+	return NULL;
+}
+
+/* Reads at most limit + 1 bytes of fp into a malloc'd buffer. */
+static char *read_all(FILE *fp, size_t limit, size_t *len, int *too_big)
+{
+	size_t cap = 4096, n = 0;
+	char *buf = malloc(cap);
+	*too_big = 0;
+	while (buf) {
+		if (n == cap) {
+			char *b = cap > limit ? NULL : realloc(buf, cap * 2);
+			if (!b) {
+				*too_big = cap > limit;
+				free(buf);
+				return NULL;
+			}
+			buf = b;
+			cap *= 2;
+		}
+		size_t k = fread(buf + n, 1, cap - n, fp);
+		n += k;
+		if (k == 0)
+			break;
+	}
+	if (buf && n > limit) {
+		*too_big = 1;
+		free(buf);
+		return NULL;
+	}
+	if (buf && ferror(fp)) {
+		free(buf);
+		return NULL;
+	}
+	*len = n;
+	return buf;
+}
+
+static int node_mark(struct fy_node *n, int *line, int *col);
+
+/* Why a text was refused, before or by the parser. */
+typedef enum { PF_OK, PF_TEXT, PF_SYNTAX, PF_MORE, PF_ALIAS } parse_kind;
+
+typedef struct parse_fault {
+	parse_kind kind;
+	int line, col;   /* PF_TEXT, PF_SYNTAX */
+	char what[256];  /* PF_TEXT, PF_SYNTAX: what was found */
+	char field[512]; /* PF_ALIAS: the dotted path to the alias */
+	char alias[64];  /* PF_ALIAS: its name */
+	int alias_line, alias_col;
+} parse_fault;
+
+/* Text check, parse, one document, no aliases. text is taken over. On a
+ * fault d->fyd is NULL and *pf says why. */
+static parse_kind parse_checked(ydoc *d, char *text, size_t len, parse_fault *pf)
+{
+	memset(pf, 0, sizeof *pf);
+	text_fault tf;
+	if (!text_check(text, len, &tf)) {
+		free(text);
+		pf->line = tf.line;
+		pf->col = tf.col;
+		snprintf(pf->what, sizeof pf->what, "%s", tf.what);
+		return pf->kind = PF_TEXT;
+	}
+	len = text_strip_cr(text, len);
+	first_error fe;
+	int more = 0;
+	d->fyd = parse_quiet(text, len, &fe, &more);
+	if (fe.have) {
+		pf->line = fe.line;
+		pf->col = fe.col;
+		snprintf(pf->what, sizeof pf->what, "%s", fe.msg);
+		return pf->kind = PF_SYNTAX;
+	}
+	if (more) {
+		ydoc_free(d);
+		return pf->kind = PF_MORE;
+	}
+	struct fy_node *alias =
+	        d->fyd ? find_alias(fy_document_root(d->fyd), pf->field, sizeof pf->field) : NULL;
+	if (alias) {
+		const char *name = fy_node_get_scalar0(alias);
+		snprintf(pf->alias, sizeof pf->alias, "%s", name ? name : "");
+		if (node_mark(alias, &pf->alias_line, &pf->alias_col)) {
+			pf->alias_line++;
+			pf->alias_col++;
+		}
+		ydoc_free(d);
+		return pf->kind = PF_ALIAS;
+	}
+	return PF_OK;
+}
+
+/* The message of a fault in the file or value called name. */
+static int fault_error(const char *name, const parse_fault *pf, bsim_error *err)
+{
+	switch (pf->kind) {
+	case PF_TEXT:
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s:%d:%d: syntax: expected UTF-8 YAML text, got %s", name,
+		                      pf->line, pf->col, pf->what);
+	case PF_SYNTAX:
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s:%d:%d: syntax: expected valid YAML, got %s", name,
+		                      pf->line, pf->col, pf->what);
+	case PF_MORE:
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: syntax: expected one YAML document, got a second after "
+		                      "---",
+		                      name);
+	case PF_ALIAS:
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s:%d:%d: %s: expected the value written out, got the "
+		                      "alias *%s (beamsim does not expand YAML aliases)",
+		                      name, pf->alias_line, pf->alias_col,
+		                      pf->field[0] ? pf->field : "document", pf->alias);
+	case PF_OK:
+		break;
+	}
+	return BSIM_OK;
 }
 
 int ydoc_load(ydoc *d, const char *path, bsim_error *err)
@@ -81,15 +266,27 @@ int ydoc_load(ydoc *d, const char *path, bsim_error *err)
 	if (!fp)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file: %s", path,
 		                      strerror(errno));
-	first_error fe;
-	d->fyd = parse_quiet(fp, NULL, &fe);
+	double limit = bsim_limits_get()->input_bytes;
+	size_t len = 0;
+	int too_big = 0;
+	errno = 0;
+	char *text = read_all(fp, limit < (double)SIZE_MAX / 4 ? (size_t)limit : SIZE_MAX / 4, &len,
+	                      &too_big);
+	int saved = errno;
 	fclose(fp);
-	if (fe.have) {
-		ydoc_free(d);
+	if (!text && too_big) {
+		char hint[160];
+		bsim_limits_hint(hint, sizeof hint, "input_bytes", limit);
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s:%d:%d: syntax: expected valid YAML, got %s", path,
-		                      fe.line, fe.col, fe.msg);
+		                      "%s: expected a file of at most %.15g bytes, got more (%s)",
+		                      path, limit, hint);
 	}
+	if (!text)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file: %s", path,
+		                      saved ? strerror(saved) : "read error");
+	parse_fault pf;
+	if (parse_checked(d, text, len, &pf) != PF_OK)
+		return fault_error(path, &pf, err);
 	/* An empty file (or only comments) has no document at all: treat it as
 	 * a document with no root, which the loaders report as "got nothing". */
 	if (!d->fyd)
@@ -101,17 +298,47 @@ int ydoc_load(ydoc *d, const char *path, bsim_error *err)
 
 struct fy_document *ydoc_parse_text(const char *text, char *msg, size_t size)
 {
-	first_error fe;
-	struct fy_document *fyd = parse_quiet(NULL, text, &fe);
-	if (fe.have && fyd) {
-		fy_document_destroy(fyd);
-		fyd = NULL;
+	size_t len = strlen(text);
+	double limit = bsim_limits_get()->input_bytes;
+	if ((double)len > limit) {
+		char hint[160];
+		bsim_limits_hint(hint, sizeof hint, "input_bytes", limit);
+		snprintf(msg, size, "expected a value of at most %.15g bytes, got %zu (%s)", limit,
+		         len, hint);
+		return NULL;
 	}
-	if (!fyd && msg && size)
-		snprintf(msg, size, "%s", fe.have ? fe.msg : "no value");
-	return fyd;
+	char *copy = malloc(len + 1);
+	if (!copy) {
+		snprintf(msg, size, "out of memory");
+		return NULL;
+	}
+	memcpy(copy, text, len + 1);
+	ydoc d = {NULL, "value"};
+	parse_fault pf;
+	switch (parse_checked(&d, copy, len, &pf)) {
+	case PF_TEXT:
+		snprintf(msg, size, "expected UTF-8 YAML text, got %s at column %d", pf.what,
+		         pf.col);
+		return NULL;
+	case PF_SYNTAX:
+		snprintf(msg, size, "expected a YAML value, got %s (%s)", text, pf.what);
+		return NULL;
+	case PF_MORE:
+		snprintf(msg, size, "expected one YAML value, got a second document after ---");
+		return NULL;
+	case PF_ALIAS:
+		snprintf(msg, size,
+		         "expected the value written out, got the alias *%s (beamsim does not "
+		         "expand YAML aliases)",
+		         pf.alias);
+		return NULL;
+	case PF_OK:
+		break;
+	}
+	if (!d.fyd)
+		snprintf(msg, size, "no value");
+	return d.fyd;
 }
-
 void ydoc_free(ydoc *d)
 {
 	if (d->fyd)

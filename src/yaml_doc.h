@@ -19,13 +19,16 @@ typedef struct ydoc {
 	const char *path; /* the file name used in messages, borrowed */
 } ydoc;
 
-/* Reads and parses path. A syntax error becomes BSIM_EINPUT with
- * "FILE:LINE:COL: syntax: expected valid YAML, got MSG"; libfyaml prints
- * nothing itself. */
+/* Reads and parses path: at most the limit input_bytes (beamsim/limits.h),
+ * UTF-8 text without NUL, tabs, control characters or directives
+ * (text_check.h), one document, no aliases (never expanded). Any fault
+ * becomes BSIM_EINPUT with "FILE:LINE:COL: syntax: expected ..., got ..."
+ * (or the alias's field); libfyaml prints nothing itself. */
 int ydoc_load(ydoc *d, const char *path, bsim_error *err);
 
-/* Parses YAML flow text (an override value) into a new document. On failure
- * returns NULL and, if msg is given, libfyaml's first message. */
+/* Parses YAML flow text (an override value) into a new document, checked
+ * like a file. On failure returns NULL and puts in msg "expected ..., got
+ * ..." saying why. */
 struct fy_document *ydoc_parse_text(const char *text, char *msg, size_t size);
 
 void ydoc_free(ydoc *d);

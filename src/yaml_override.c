@@ -4,6 +4,7 @@
  * like a file. */
 #include "yaml_override.h"
 
+#include <ctype.h>
 #include <string.h>
 
 /* Where the node being edited hangs: a mapping pair, a list item, or the
@@ -47,11 +48,33 @@ static int fail(const bsim_override *o, const char *field, int len, bsim_error *
 	                      field, what);
 }
 
-/* A dotted key has no empty component: "a..b", ".a" and "a." are typos. */
+/* A dotted key is scene keys and list indices joined by dots: letters,
+ * digits and '_', no empty component ("a..b", ".a" and "a." are typos). */
 static int key_ok(const char *key)
 {
 	size_t n = strlen(key);
-	return n && key[0] != '.' && key[n - 1] != '.' && !strstr(key, "..");
+	if (!n || key[0] == '.' || key[n - 1] == '.' || strstr(key, ".."))
+		return 0;
+	for (size_t i = 0; i < n; i++)
+		if (!isalnum((unsigned char)key[i]) && key[i] != '_' && key[i] != '.')
+			return 0;
+	return 1;
+}
+
+/* The key without the spaces around it ("body.mass = 2" is the override
+ * body.mass=2), into buf; 0 if it does not fit. */
+static int key_trim(const char *key, char *buf, size_t size)
+{
+	while (*key == ' ')
+		key++;
+	size_t n = strlen(key);
+	while (n && key[n - 1] == ' ')
+		n--;
+	if (n >= size)
+		return 0;
+	memcpy(buf, key, n);
+	buf[n] = '\0';
+	return 1;
 }
 
 /* One step down a mapping: the child at comp, created (an empty mapping, or
@@ -63,12 +86,17 @@ static int step_mapping(ydoc *d, slot *s, const char *comp, size_t len, struct f
 	if (!p) {
 		struct fy_node *k = fy_node_create_scalar_copy(d->fyd, comp, len);
 		struct fy_node *v = value ? value : fy_node_create_mapping(d->fyd);
-		if (!k || !v)
+		if (k && v) {
+			tag(k, o);
+			tag(v, o);
+		}
+		if (!k || !v || fy_node_mapping_append(s->node, k, v)) {
+			/* value, if it is v, stays the caller's to free. */
+			fy_node_free(k);
+			if (v != value)
+				fy_node_free(v);
 			return -1;
-		tag(k, o);
-		tag(v, o);
-		if (fy_node_mapping_append(s->node, k, v))
-			return -1;
+		}
 		p = ydoc_pair(s->node, comp, len);
 		*s = (slot){v, p, NULL};
 		return 0;
@@ -100,10 +128,10 @@ static int step_list(ydoc *d, slot *s, const char *comp, size_t len, struct fy_n
 }
 
 /* Walks the dotted key from the root and puts value at its end. */
-static int place(ydoc *d, const bsim_override *o, struct fy_node *value, bsim_error *err)
+static int place(ydoc *d, const bsim_override *o, const char *key, struct fy_node *value,
+                 bsim_error *err)
 {
 	slot s = {fy_document_root(d->fyd), NULL, NULL};
-	const char *key = o->key;
 	for (const char *c = key;; c++) {
 		size_t len = strcspn(c, ".");
 		struct fy_node *v = c[len] ? NULL : value;
@@ -138,31 +166,31 @@ static int place(ydoc *d, const bsim_override *o, struct fy_node *value, bsim_er
 
 static int apply_one(ydoc *d, const bsim_override *o, bsim_error *err)
 {
-	if (!o->key || !o->value || !key_ok(o->key)) {
+	char key[256];
+	if (!o->key || !o->value || !key_trim(o->key, key, sizeof key) || !key_ok(key)) {
 		const char *k = o->key ? o->key : "";
 		char what[600];
 		snprintf(what, sizeof what,
 		         "expected a dotted key like beams.0.stiffness, got \"%.500s\"", k);
 		return fail(o, k, (int)strlen(k), err, what);
 	}
-	char msg[256], what[512];
+	char msg[400], what[600];
 	struct fy_document *vd = ydoc_parse_text(o->value, msg, sizeof msg);
 	if (!vd || !fy_document_root(vd)) {
 		if (vd)
 			fy_document_destroy(vd);
-		if (*o->value)
-			snprintf(what, sizeof what, "expected a YAML value, got %s (%s)", o->value,
-			         msg);
+		if (!vd)
+			snprintf(what, sizeof what, "%s", msg);
 		else
 			snprintf(what, sizeof what, "expected a YAML value, got nothing");
-		return fail(o, o->key, (int)strlen(o->key), err, what);
+		return fail(o, key, (int)strlen(key), err, what);
 	}
 	struct fy_node *value = fy_node_copy(d->fyd, fy_document_root(vd));
 	fy_document_destroy(vd);
 	if (!value)
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory applying %s", o->key);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory applying %s", key);
 	tag(value, o);
-	int rc = place(d, o, value, err);
+	int rc = place(d, o, key, value, err);
 	if (rc && !fy_node_get_parent(value) && !fy_node_is_attached(value))
 		fy_node_free(value);
 	return rc;

@@ -1,3 +1,5 @@
+#define _POSIX_C_SOURCE 200809L
+
 #include "support.h"
 
 #include <errno.h>
@@ -5,7 +7,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -121,4 +126,93 @@ const char *bsim_test_src(const char *rel)
 	static char path[1024];
 	snprintf(path, sizeof path, "%s/%s", BSIM_SOURCE_DIR, rel);
 	return path;
+}
+
+static char **argv_build(const char *const argv[])
+{
+	int n = 0;
+	while (argv[n])
+		n++;
+	char **args = calloc((size_t)n + 2, sizeof *args);
+	args[0] = (char *)BSIM_EXE;
+	for (int i = 0; i < n; i++)
+		args[i + 1] = (char *)argv[i];
+	return args;
+}
+
+static int status_code(int status)
+{
+	if (WIFEXITED(status))
+		return WEXITSTATUS(status);
+	return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+}
+
+int bsim_test_cli_with(const char *const argv[], const bsim_test_opts *o, char **out, char **err)
+{
+	char **args = argv_build(argv);
+	FILE *fo = tmpfile(), *fe = tmpfile();
+	fflush(NULL);
+	pid_t pid = fork();
+	if (pid == 0) {
+		int to = o->out ? open(o->out, O_WRONLY) : fileno(fo);
+		dup2(to, 1);
+		dup2(fileno(fe), 2);
+		int devnull = open("/dev/null", O_RDONLY);
+		dup2(devnull, 0);
+		if (o->fsize > 0) {
+			struct rlimit rl = {(rlim_t)o->fsize, (rlim_t)o->fsize};
+			setrlimit(RLIMIT_FSIZE, &rl);
+			signal(SIGXFSZ, SIG_IGN); /* a write beyond fails with EFBIG */
+		}
+		execv(BSIM_EXE, args);
+		_exit(127);
+	}
+	int status = 0;
+	if (o->timeout > 0) {
+		struct timespec step = {0, 10000000};
+		double waited = 0;
+		while (waitpid(pid, &status, WNOHANG) == 0) {
+			if (waited >= o->timeout) {
+				kill(pid, SIGKILL);
+				waitpid(pid, &status, 0);
+				break;
+			}
+			nanosleep(&step, NULL);
+			waited += 0.01;
+		}
+	} else {
+		waitpid(pid, &status, 0);
+	}
+	free(args);
+	if (out)
+		*out = slurp_fd(fileno(fo));
+	if (err)
+		*err = slurp_fd(fileno(fe));
+	fclose(fo);
+	fclose(fe);
+	return status_code(status);
+}
+
+int bsim_test_spawn(const char *const argv[])
+{
+	char **args = argv_build(argv);
+	fflush(NULL);
+	pid_t pid = fork();
+	if (pid == 0) {
+		int devnull = open("/dev/null", O_RDWR);
+		dup2(devnull, 0);
+		dup2(devnull, 1);
+		dup2(devnull, 2);
+		execv(BSIM_EXE, args);
+		_exit(127);
+	}
+	free(args);
+	return (int)pid;
+}
+
+int bsim_test_wait(int pid)
+{
+	int status = 0;
+	waitpid((pid_t)pid, &status, 0);
+	return status_code(status);
 }

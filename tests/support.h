@@ -10,6 +10,24 @@
  * NULL to discard). Returns the exit status, or -1 if it did not exit. */
 int bsim_test_cli(const char *const argv[], char **out, char **err);
 
+/* How bsim_test_cli_with runs the program. */
+typedef struct bsim_test_opts {
+	double timeout;  /* s: killed (SIGKILL) after this long, 0: never */
+	long fsize;      /* bytes: the child's RLIMIT_FSIZE (writes beyond fail), 0: none */
+	const char *out; /* a file to be the child's stdout instead of a capture */
+} bsim_test_opts;
+
+/* bsim_test_cli with options; returns the exit status, 128 + the signal's
+ * number if a signal ended it (as the shell reports it). */
+int bsim_test_cli_with(const char *const argv[], const bsim_test_opts *o, char **out, char **err);
+
+/* Starts BSIM_EXE with argv in the background, stdout and stderr to
+ * /dev/null; returns its pid. */
+int bsim_test_spawn(const char *const argv[]);
+
+/* Waits for a spawned program: its status as bsim_test_cli_with gives it. */
+int bsim_test_wait(int pid);
+
 /* A fresh empty directory under BSIM_TEST_TMP named name; returns its path
  * in a static buffer (valid until the next call). */
 const char *bsim_test_dir(const char *name);

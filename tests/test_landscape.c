@@ -107,12 +107,40 @@ static void test_parts(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The label: the beam holding the most spring energy among those touching;
+ * on the symmetric gate's midline the two tie (mirror symmetry) and
+ * neither is named; off it, the beam on whose side the body is (nearer
+ * its pivot, so deflected more); a beam not touching never counts. */
+static void test_label(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7, 0);
+	const int both[2] = {1, 1}, left_only[2] = {1, 0}, right_only[2] = {0, 1};
+	for (double y = 21; y < 52; y += 0.7) { /* (-2, y) within both reaches */
+		const double mid[2] = {0, y}, off[2] = {-2, y};
+		assert_int_equal(bsim_landscape_label(&s, mid, NULL), -1);
+		assert_int_equal(bsim_landscape_label(&s, mid, both), -1);
+		assert_int_equal(bsim_landscape_label(&s, mid, right_only), 1);
+		assert_int_equal(bsim_landscape_label(&s, off, both), 0);
+		assert_int_equal(bsim_landscape_label(&s, off, right_only), 1);
+		assert_int_equal(bsim_landscape_label(&s, off, left_only), 0);
+	}
+	const double away[2] = {0, 5}; /* behind both beams: none deflected */
+	assert_int_equal(bsim_landscape_label(&s, away, NULL), -1);
+	/* a stiffer right beam holds more energy on the midline */
+	s.beams[1].stiffness = 500;
+	const double mid[2] = {0, 40};
+	assert_int_equal(bsim_landscape_label(&s, mid, NULL), 1);
+	bsim_scene_free(&s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_branches_meet),   cmocka_unit_test(test_reach_and_sign),
 	        cmocka_unit_test(test_square_in_front), cmocka_unit_test(test_mirror),
-	        cmocka_unit_test(test_parts),
+	        cmocka_unit_test(test_parts),           cmocka_unit_test(test_label),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -93,14 +93,14 @@ static void test_group_aggregate(void **state)
 {
 	(void)state;
 	bsim_trial_result t[6] = {0};
-	t[0].outcome = BSIM_TRAVERSED, t[0].type = BSIM_TYPE_LEFT, t[0].landscape_left = 1;
+	t[0].outcome = BSIM_TRAVERSED, t[0].type = BSIM_TYPE_LEFT, t[0].landscape_beam = 0;
 	t[0].max_theta[0] = 0.5, t[0].max_theta[1] = 0.2;
-	t[1].outcome = BSIM_TRAVERSED, t[1].type = BSIM_TYPE_RIGHT;
+	t[1].outcome = BSIM_TRAVERSED, t[1].type = BSIM_TYPE_RIGHT, t[1].landscape_beam = 1;
 	t[1].max_theta[0] = 0.1, t[1].max_theta[1] = 0.4;
 	t[2].outcome = BSIM_SIDE_EXIT;
 	t[3].outcome = BSIM_STUCK, t[3].in_contact_end = 1;
 	t[4].outcome = BSIM_STUCK;
-	t[5].outcome = BSIM_TRAVERSED, t[5].type = BSIM_TYPE_LEFT;
+	t[5].outcome = BSIM_TRAVERSED, t[5].type = BSIM_TYPE_LEFT, t[5].landscape_beam = -1;
 	for (int i = 0; i < 6; i++)
 		t[i].steps_run = 100 + i;
 	bsim_group_result g;

@@ -90,6 +90,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -160,7 +161,9 @@ constexpr uint16 CATEGORY_BODY = 0x0001, CATEGORY_BEAM = 0x0002;
 void rest_direction(double deg, double u[2])
 {
 	double q = deg / 90.0;
-	if (q == std::floor(q)) {
+	/* (long)q is defined only within long's range: angles beyond 1e15
+	 * quarter turns take the general path. */
+	if (q == std::floor(q) && std::fabs(q) < 1e15) {
 		static const double c[4] = {1, 0, -1, 0}, sn[4] = {0, 1, 0, -1};
 		long k = ((long)q % 4 + 4) % 4;
 		u[0] = c[k];
@@ -523,6 +526,66 @@ void box2d_destroy(bsim_world *w)
 	delete w;
 }
 
+/* Box2D holds everything as float32 and asserts (aborting the process)
+ * on a value that is not finite. Every quantity it is given must be zero
+ * or within 1e-30..1e30 in magnitude once scaled: float32 reaches 3e38,
+ * and the margin keeps products and sums of a few such values finite. */
+static int float_range(const char *field, double v, bsim_error *err)
+{
+	double a = std::fabs(v);
+	if (a == 0.0 || (a >= 1e-30 && a <= 1e30))
+		return BSIM_OK;
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "box2d: %s: expected 0 or a magnitude from 1e-30 to 1e30 in Box2D's "
+	                      "units (float32), got %g",
+	                      field, v);
+}
+
+static int scene_in_float_range(const bsim_scene *sc, double s, bsim_error *err)
+{
+	const double s2 = s * s;
+	int rc = BSIM_OK;
+	/* Forces: the propulsion and up to ten standard deviations of noise. */
+	const struct {
+		const char *field;
+		double v;
+	} body[] = {
+	        {"body.mass", sc->body.mass},
+	        {"body.radius", sc->body.radius * s},
+	        {"body.start.0", sc->body.start[0] * s},
+	        {"body.start.1", sc->body.start[1] * s},
+	        {"body.velocity.0", sc->body.velocity[0] * s},
+	        {"body.velocity.1", sc->body.velocity[1] * s},
+	        {"integration.dt", sc->dt},
+	        {"effects.propulsion.force", sc->effects.propulsion_force * s},
+	        {"effects.random_force.magnitude", 10.0 * sc->effects.random_magnitude * s},
+	        {"contact.rest_threshold", sc->contact.rest_threshold * s},
+	};
+	for (const auto &q : body)
+		if ((rc = float_range(q.field, q.v, err)) != BSIM_OK)
+			return rc;
+	for (int i = 0; i < sc->n_beams; i++) {
+		const bsim_beam_def &b = sc->beams[i];
+		const struct {
+			const char *key;
+			double v;
+		} beam[] = {
+		        {"pivot.0", b.pivot[0] * s},        {"pivot.1", b.pivot[1] * s},
+		        {"length", b.length * s},           {"mass", b.mass},
+		        {"inertia", b.inertia * s2},        {"stiffness", b.stiffness * s2},
+		        {"damping", b.damping * s2},        {"initial_theta", b.initial_theta},
+		        {"initial_omega", b.initial_omega},
+		};
+		for (const auto &q : beam) {
+			char field[64];
+			std::snprintf(field, sizeof field, "beams.%d.%s", i, q.key);
+			if ((rc = float_range(field, q.v, err)) != BSIM_OK)
+				return rc;
+		}
+	}
+	return BSIM_OK;
+}
+
 int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
                       bsim_error *err)
 {
@@ -545,6 +608,8 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	if (!(s > 0.0) || !std::isfinite(s))
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "box2d: unit_scale=%g: expected a positive number", s);
+	if ((rc = scene_in_float_range(scene, s, err)) != BSIM_OK)
+		return rc;
 	/* The disk must be larger than Box2D's skin, and its coordinates within
 	 * float32's reach. */
 	if (scene->body.radius * s <= 2.0 * b2_polygonRadius)

@@ -39,10 +39,21 @@ void thesis_grid_free(thesis_grid *g)
 	g->nx = g->ny = 0;
 }
 
+/* The cell of p, clamped to [-1, n] in floating point first, so that a
+ * point however far away (a body flung at 1e300 m/s) converts to int
+ * without overflow. NaN goes to -1. */
+static int grid_index(double t, int n)
+{
+	double c = floor(t);
+	if (!(c > -1.0)) /* also NaN */
+		return -1;
+	return c > (double)n ? n : (int)c;
+}
+
 static void grid_cell_of(const thesis_grid *g, const double p[2], int *cx, int *cy)
 {
-	*cx = (int)floor((p[0] - g->origin[0]) / g->cell);
-	*cy = (int)floor((p[1] - g->origin[1]) / g->cell);
+	*cx = grid_index((p[0] - g->origin[0]) / g->cell, g->nx);
+	*cy = grid_index((p[1] - g->origin[1]) / g->cell, g->ny);
 }
 
 int thesis_grid_build(thesis_grid *g, const struct bsim_world *w)

@@ -69,7 +69,9 @@ enum { SLEEP_AUTO = 0, SLEEP_ON = 1, SLEEP_OFF = 2 };
 static void rest_direction(double deg, double u[2])
 {
 	double q = deg / 90.0;
-	if (q == floor(q)) {
+	/* (long)q is defined only within long's range: angles beyond 1e15
+	 * quarter turns take the general path. */
+	if (q == floor(q) && fabs(q) < 1e15) {
 		static const double c[4] = {1, 0, -1, 0}, s[4] = {0, 1, 0, -1};
 		long k = ((long)q % 4 + 4) % 4;
 		u[0] = c[k];

@@ -13,10 +13,14 @@ enum {
 	BSIM_EFAIL = 1,     /* a run failed (I/O, a non-finite state, ...) */
 	BSIM_EINPUT = 2,    /* bad usage, a bad scene or experiment file */
 	BSIM_EDISAGREE = 3, /* compare/regress found a disagreement */
+	BSIM_ESTOPPED = 4,  /* stopped on request (a signal); the program exits
+	                       with 128 + the signal's number instead */
 };
 
 #define BSIM_ERROR_MSG_MAX 1024
 
+/* msg is one line of printable UTF-8: what a message quotes from the
+ * user's input is escaped (\xNN), so it cannot drive a terminal. */
 typedef struct bsim_error {
 	int code;
 	char msg[BSIM_ERROR_MSG_MAX];

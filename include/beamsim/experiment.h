@@ -42,6 +42,11 @@ int bsim_experiment_load(const char *path, const bsim_override *extra, int n_ext
 
 void bsim_experiment_free(bsim_experiment *e);
 
+/* BSIM_EINPUT with "expected at most N trials in all, got G groups x T
+ * trials = ..." if n_groups x trials exceeds the limit trials
+ * (beamsim/limits.h); for a --trials that replaces the file's. */
+int bsim_experiment_check_trials(const bsim_experiment *e, long trials, bsim_error *err);
+
 /* The value index along each axis for group g (idx has n_axes entries). */
 void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx);
 

@@ -41,6 +41,119 @@ double bsim_landscape_e_prop(const bsim_scene *s, double y);
 double bsim_landscape_energy(const bsim_scene *s, const double c[2], double *theta, double *e_beam,
                              double *e_prop);
 
+/* 1 if a body of the given radius centred at c lies within beam b's reach,
+ * rho < L + R (the disc where th can be non-zero), else 0. */
+int bsim_landscape_beam_reach(const bsim_beam_def *b, double radius, const double c[2]);
+
+/* 1 if the body centred at c lies within any beam's reach. */
+int bsim_landscape_in_reach(const bsim_scene *s, const double c[2]);
+
+/* The beam whose barrier a body centred at c is on: among the beams with
+ * touching[i] != 0 (all beams if touching is NULL), the one holding the
+ * most spring energy 1/2 k th(c)^2 (0-based); -1 if none of them is
+ * deflected or two hold the same largest energy (the exact midline of a
+ * symmetric gate).
+ *
+ * The landscape label of a traversing trial is this beam at the last step
+ * before success_y at which the body touched any beam, counting only the
+ * beams it touched then: the barrier it came off last. Beams not touching
+ * the body are left out because the landscape assumes every beam within
+ * reach is pushed, and a body that has crossed one beam often runs on
+ * through the reach of the other, still at rest (the essay's trajectory
+ * "below the surface", Fig. 2.7). The barrier search labels exits with
+ * touching NULL: on the landscape every beam within reach is attached. */
+int bsim_landscape_label(const bsim_scene *s, const double c[2], const int *touching);
+
+/* ---- The landscape on a grid ------------------------------------------ */
+
+/* Where to sample. The default region is the arena a trial runs in:
+ * x in [-side_x, side_x], y from the body's start to success_y (for the
+ * essay's gate [-25, 25] x [0, 65] m, the gate region with the beams'
+ * whole reach in front of the success line). */
+typedef struct bsim_landscape_grid_def {
+	int has_region;   /* 0: the default region */
+	double region[4]; /* x0, x1, y0, y1, m, x0 < x1, y0 < y1 */
+	double spacing;   /* m, > 0; 0: the region's longer side / 260 (0.25 m on the gate) */
+} bsim_landscape_grid_def;
+
+/* The default region at the default spacing. */
+bsim_landscape_grid_def bsim_landscape_grid_default(void);
+
+/* The landscape sampled at (x0 + i spacing, y0 + j spacing), i < nx,
+ * j < ny; point (i, j) is entry k = j nx + i (x varies fastest). */
+typedef struct bsim_landscape_grid {
+	double x0, y0, spacing; /* m */
+	double region[4];       /* the region asked for, m */
+	int nx, ny, n_beams;
+	double *e_total, *e_beam, *e_prop; /* J, nx ny entries each */
+	double *theta;                     /* rad, beam b at point k: theta[b nx ny + k] */
+} bsim_landscape_grid;
+
+/* Most points a grid may have (memory: about 8 (n_beams + 5) bytes each). */
+#define BSIM_LANDSCAPE_MAX_POINTS 4000000
+
+/* Samples the landscape of s. BSIM_EINPUT for a bad region or spacing
+ * (empty, non-finite, under 3 points a side, over BSIM_LANDSCAPE_MAX_POINTS),
+ * naming the field; BSIM_EFAIL out of memory. */
+int bsim_landscape_grid_alloc(const bsim_scene *s, const bsim_landscape_grid_def *def,
+                              bsim_landscape_grid **out, bsim_error *err);
+void bsim_landscape_grid_free(bsim_landscape_grid *g);
+
+/* ---- Barriers (src/landscape_barrier.c) -------------------------------- */
+
+typedef enum {
+	BSIM_PASS_NONE = 0,  /* no path leaves over this beam to the far side */
+	BSIM_PASS_OPEN = 1,  /* the landscape falls from the start to the far side: no barrier */
+	BSIM_PASS_SADDLE = 2 /* a barrier: the path's highest point, x, y, is the pass */
+} bsim_pass_kind;
+
+/* The lowest pass from the start basin to the far side, over any beam or
+ * over one beam (the beam the path leaves the beams' reach over, as
+ * bsim_landscape_label). */
+typedef struct bsim_landscape_pass {
+	bsim_pass_kind kind;
+	int beam;                       /* the beam crossed, 0-based; -1 none or a tie */
+	double x, y;                    /* m: the pass (SADDLE, refined), the exit (OPEN) */
+	double e_total, e_beam, e_prop; /* J at (x, y) */
+	double floor[2], floor_e;       /* m, J: the lowest point of the start basin */
+	double height;                  /* J, e_total - floor_e: the barrier (0 when OPEN) */
+	double above_start;             /* J, e_total - E_total(start) */
+	double grid_x, grid_y, grid_e;  /* m, m, J: the pass on the grid, before refinement */
+	double refine_spacing;          /* m, spacing of the finest refinement level */
+	double refine_change;           /* J, change of e_total at the last level: its accuracy */
+	int n_path;                     /* points of the path of least resistance */
+	double *path;                   /* (x, y) pairs, m: start, basin floor, pass, far side */
+} bsim_landscape_pass;
+
+typedef struct bsim_landscape_barriers {
+	double start[2], start_e;   /* m, J: the body's start (moved into the grid if outside) */
+	double far_y;               /* m: the far side is y >= far_y beyond the beams' reach */
+	bsim_landscape_pass lowest; /* over any beam */
+	int n_beams;
+	bsim_landscape_pass *beam; /* n_beams: the lowest pass leaving over beam b */
+} bsim_landscape_barriers;
+
+/* Finds the passes of the landscape g of scene s (see landscape_barrier.c
+ * for the definitions and the method). BSIM_EINPUT if the grid has no far
+ * side beyond the beams' reach; BSIM_EFAIL out of memory. */
+int bsim_landscape_barriers_alloc(const bsim_scene *s, const bsim_landscape_grid *g,
+                                  bsim_landscape_barriers **out, bsim_error *err);
+void bsim_landscape_barriers_free(bsim_landscape_barriers *b);
+
+const char *bsim_pass_kind_name(bsim_pass_kind k);
+
+/* ---- Files (src/landscape_write.c) ------------------------------------- */
+
+/* Writes into the existing directory dir: landscape.csv (x, y, e_beam,
+ * e_prop, e_total, theta1..thetaN, one row per grid point), landscape.mat
+ * (the same columns, the grid's shape and the barrier table),
+ * landscape.json (grid, start, passes) and the figures landscape_top
+ * (heat map, contours, beams), landscape_beam and landscape_total (3-D
+ * surfaces without and with the propulsive term), each .gp + data + .png +
+ * .svg. drawn (may be NULL) is 1 if gnuplot drew the figures. */
+int bsim_landscape_write(const char *dir, const bsim_scene *s, const bsim_landscape_grid *g,
+                         const bsim_landscape_barriers *b, int *drawn, bsim_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -14,6 +14,7 @@ typedef struct bsim_progress {
 	int shown;      /* a line is on the screen and needs a newline */
 	double t_start; /* s, monotonic */
 	double t_last;  /* s, when the line was last drawn */
+	long base;      /* done at the first update (a resumed run's journaled trials), or -1 */
 } bsim_progress;
 
 /* Starts the clock. Prints nothing ever if !enabled or stderr is not a

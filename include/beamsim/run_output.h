@@ -46,10 +46,11 @@ typedef struct bsim_run_info {
 
 /* The JSON object of a trial (one line, with a newline): scene, name,
  * backend, backend_options, seed, group, trial, mixed_seed, outcome, type,
- * landscape_left, in_contact_end, steps, steps_run, draws, t_end, x_end,
- * y_end, vx_end, max_theta, overlap_max, final_gate, location,
- * reset_overlaps, path and peak_theta (with a log), ledger, instability
- * (null or why the trial was unstable). record adds command, beamsim_version,
+ * landscape_left, landscape_beam (the barrier crossed, 1-based, or null),
+ * in_contact_end, steps, steps_run, draws, t_end, x_end, y_end, vx_end,
+ * max_theta, overlap_max, final_gate, location, reset_overlaps, path and
+ * peak_theta (with a log), ledger, instability (null or why the trial was
+ * unstable). record adds command, beamsim_version,
  * stride, set and scene_copy, for run.json. */
 void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r, int record);
 

@@ -38,6 +38,16 @@ void bsim_options_effective(const bsim_backend *b, const bsim_options *given, bs
 int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsim_experiment *e,
                           const bsim_override *extra, int n_extra, bsim_error *err);
 
+/* What the trials of a run depend on, as text (malloc'd; NULL and err on
+ * failure): version, command, backends with every option, the number of
+ * groups, the experiment as it ran (seed, trials, every override, the grid)
+ * and the scene file's text. Two runs with equal texts have equal trials;
+ * a resumed run must have the text of the run it continues
+ * (beamsim/journal.h). The comparison rule is not in it: it changes the
+ * report, not the trials. */
+char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *e,
+                             const bsim_override *extra, int n_extra, bsim_error *err);
+
 /* Reads DIR/run.json. BSIM_EINPUT naming the file and field on a missing
  * or malformed record. The experiment to load is DIR/inputs/experiment.yaml. */
 int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err);

@@ -3,9 +3,13 @@
 #ifndef BEAMSIM_SWEEP_H
 #define BEAMSIM_SWEEP_H
 
+#include <signal.h>
+#include <stddef.h>
+
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
 #include "beamsim/trajectory.h"
+#include "beamsim/journal.h"
 #include "beamsim/trial.h"
 
 #ifdef __cplusplus
@@ -19,7 +23,7 @@ typedef struct bsim_group_result {
 	                    * is the same trial: it ran once, the others are copies,
 	                    * and ci95 is the point p_traverse */
 	int stuck_in_contact;
-	int landscape_left, landscape_right; /* traversed, by larger peak theta */
+	int landscape_left, landscape_right; /* traversed over beam 0's / 1's barrier */
 	double p_traverse, ci95[2];          /* Wilson 95% */
 	long steps;                          /* steps integrated in the group */
 } bsim_group_result;
@@ -61,10 +65,26 @@ typedef struct bsim_sweep_config {
 	 * differ in the scene while sharing every schedule. */
 	const bsim_override *extra_b;
 	int n_extra_b;
+	/* NULL, or a journal (beamsim/journal.h) of records of
+	 * bsim_sweep_record_size bytes, created or resumed for this sweep's
+	 * inputs: the trials it holds are taken from it, not run again, and
+	 * each trial run is appended as it ends. */
+	bsim_journal *journal;
+	/* NULL, or a flag a signal handler sets: once it is nonzero no trial
+	 * starts, those running finish (and are journaled), and the sweep
+	 * returns BSIM_ESTOPPED. */
+	const volatile sig_atomic_t *stop;
 } bsim_sweep_config;
 
+/* The size of one journal record: a bsim_trial_result, or for a paired
+ * sweep both results and the separation time. The record is the result's
+ * bytes as they are in memory, so a resumed sweep's results are the
+ * uninterrupted sweep's to the bit. */
+size_t bsim_sweep_record_size(int paired);
+
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller
- * applies --trials/--seed). */
+ * applies --trials/--seed). BSIM_ESTOPPED (see cfg->stop) says how many
+ * trials were finished. */
 int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
                    bsim_error *err);
 

@@ -75,10 +75,14 @@ typedef struct bsim_ledger {
 	double inflow;       /* e_start + sum over steps of |w_prop| + |w_rand| */
 } bsim_ledger;
 
+/* Plain data, no pointers: a sweep's journal (beamsim/journal.h) stores it
+ * byte for byte, and a resumed sweep reads it back so. */
 typedef struct bsim_trial_result {
 	bsim_outcome outcome;
 	bsim_type type;
-	int landscape_left;          /* 1 if beam 0's peak theta > beam 1's (traversed) */
+	int landscape_beam;          /* traversed: the beam whose barrier it crossed, 0-based, -1
+	                              * none (bsim_landscape_label at the last step before
+	                              * success_y at which it touched a beam) */
 	int steps;                   /* steps to the outcome event */
 	double t_end;                /* s, time of the outcome event */
 	double x_end, y_end, vx_end; /* at the end of the run (classify_y for traversed) */

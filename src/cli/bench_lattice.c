@@ -152,12 +152,12 @@ static int bench_one(const bsim_backend *b, const bsim_options *opts, int n, lon
 	return CLI_OK;
 }
 
-static void print_row(const char *backend, const lattice_row *r)
+static void print_row(FILE *f, const char *backend, const lattice_row *r)
 {
-	printf("%-8s %5d x %-3d %6d %7ld %11ld %9.3f %9.1f %8.2f %11.1f %11.2f\n", backend, r->n,
-	       r->n, r->beams, r->trials, r->steps, r->wall, r->ns_per_step, r->ratio,
-	       1e6 * r->setup, r->active_mean);
-	fflush(stdout);
+	fprintf(f, "%-8s %5d x %-3d %6d %7ld %11ld %9.3f %9.1f %8.2f %11.1f %11.2f\n", backend,
+	        r->n, r->n, r->beams, r->trials, r->steps, r->wall, r->ns_per_step, r->ratio,
+	        1e6 * r->setup, r->active_mean);
+	fflush(f);
 }
 
 static void json_rows(FILE *f, const char *backend, const char *mode, const lattice_row *rows,
@@ -198,12 +198,14 @@ int bench_lattice(const bench_lattice_args *a)
 	        "same trials: every field ends a trial where the 1 x 1 field does (the body leaves "
 	        "gate (0, 0))",
 	        "own field: each field's own end and sides; the body goes as far as it gets"};
-	printf("the essay's lattice, n x n gates of k = 400 N m/rad, F_prop = 6 N, Rm = 30 N,\n"
-	       "the same schedules (seed 1) at every size, one thread\n");
+	FILE *out = a->report ? a->report : stdout;
+	fprintf(out,
+	        "the essay's lattice, n x n gates of k = 400 N m/rad, F_prop = 6 N, Rm = 30 N,\n"
+	        "the same schedules (seed 1) at every size, one thread\n");
 	for (int m = 0; m < 2; m++) {
-		printf("\n%s\n\n%-8s %11s %6s %7s %11s %9s %9s %8s %11s %11s\n", titles[m],
-		       "backend", "gates", "beams", "trials", "steps", "wall s", "ns/step", "x 1x1",
-		       "setup us", "awake/step");
+		fprintf(out, "\n%s\n\n%-8s %11s %6s %7s %11s %9s %9s %8s %11s %11s\n", titles[m],
+		        "backend", "gates", "beams", "trials", "steps", "wall s", "ns/step",
+		        "x 1x1", "setup us", "awake/step");
 		for (int k = 0; k < 2; k++) {
 			if (!b[k])
 				continue;
@@ -219,30 +221,30 @@ int bench_lattice(const bench_lattice_args *a)
 			for (int i = 0; i < N_SIZES; i++) {
 				lattice_row *r = &rows[m][k][i];
 				r->ratio = r->ns_per_step / rows[m][k][0].ns_per_step;
-				print_row(b[k]->name, r);
+				print_row(out, b[k]->name, r);
 			}
 		}
 	}
-	printf("\ncost per step at 33 x 33 against 1 x 1:");
+	fprintf(out, "\ncost per step at 33 x 33 against 1 x 1:");
 	for (int k = 0; k < 2; k++)
 		if (b[k])
-			printf(" %s %.2f x (same trials), %.2f x (own field);", b[k]->name,
-			       rows[0][k][N_SIZES - 1].ratio, rows[1][k][N_SIZES - 1].ratio);
-	printf("\n");
+			fprintf(out, " %s %.2f x (same trials), %.2f x (own field);", b[k]->name,
+			        rows[0][k][N_SIZES - 1].ratio, rows[1][k][N_SIZES - 1].ratio);
+	fprintf(out, "\n");
 	if (!a->json)
 		return CLI_OK;
-	bsim_atomic_file out;
+	bsim_atomic_file jf;
 	bsim_error err;
-	if (bsim_atomic_file_open(&out, a->json, &err) != BSIM_OK)
+	if (bsim_atomic_file_open(&jf, a->json, &err) != BSIM_OK)
 		return cli_report(BSIM_EFAIL, &err);
-	fputs("{\"lattice\": [", out.f);
+	fputs("{\"lattice\": [", jf.f);
 	int first = 1;
 	for (int m = 0; m < 2; m++)
 		for (int k = 0; k < 2; k++)
 			if (b[k]) {
-				json_rows(out.f, b[k]->name, mode_names[m], rows[m][k], first);
+				json_rows(jf.f, b[k]->name, mode_names[m], rows[m][k], first);
 				first = 0;
 			}
-	fputs("\n]}\n", out.f);
-	return cli_report(bsim_atomic_file_commit(&out, &err), &err);
+	fputs("\n]}\n", jf.f);
+	return cli_report(bsim_atomic_file_commit(&jf, &err), &err);
 }

@@ -2,6 +2,8 @@
 #ifndef BSIM_BENCH_LATTICE_H
 #define BSIM_BENCH_LATTICE_H
 
+#include <stdio.h>
+
 #include "beamsim/backend.h"
 
 typedef struct bench_lattice_args {
@@ -9,6 +11,7 @@ typedef struct bench_lattice_args {
 	const bsim_options *opts, *vs_opts;
 	long trials, vs_trials; /* per size; <= 0: 200 and 20 */
 	const char *json;       /* NULL: none */
+	FILE *report;           /* the tables (stderr when the JSON goes to stdout) */
 } bench_lattice_args;
 
 int bench_lattice(const bench_lattice_args *a);

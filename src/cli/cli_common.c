@@ -9,26 +9,41 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/limits.h"
+#include "beamsim/outdir.h"
 #include "beamsim/progress.h"
+
+static const bsim_outdir *error_outdir;
+
+void cli_error_paths(const bsim_outdir *od)
+{
+	error_outdir = od;
+}
 
 void cli_error(const char *fmt, ...)
 {
 	va_list ap;
-	fputs("beamsim: ", stderr);
+	bsim_error e;
+	char msg[BSIM_ERROR_MSG_MAX];
 	va_start(ap, fmt);
-	vfprintf(stderr, fmt, ap);
+	vsnprintf(msg, sizeof msg, fmt, ap);
 	va_end(ap);
-	fputc('\n', stderr);
+	bsim_outdir_explain(error_outdir, msg, sizeof msg);
+	/* The library's escaping of what the message quotes. */
+	bsim_error_set(&e, BSIM_EFAIL, "%s", msg);
+	fprintf(stderr, "beamsim: %s\n", e.msg);
 }
 
 int cli_usage(const char *cmd, const char *fmt, ...)
 {
 	va_list ap;
-	fprintf(stderr, "beamsim: %s: ", cmd);
+	bsim_error e;
+	char msg[BSIM_ERROR_MSG_MAX];
 	va_start(ap, fmt);
-	vfprintf(stderr, fmt, ap);
+	vsnprintf(msg, sizeof msg, fmt, ap);
 	va_end(ap);
-	fprintf(stderr, "\nTry 'beamsim %s --help'.\n", cmd);
+	bsim_error_set(&e, BSIM_EINPUT, "%s", msg); /* escapes what it quotes */
+	fprintf(stderr, "beamsim: %s: %s\nTry 'beamsim %s --help'.\n", cmd, e.msg, cmd);
 	return CLI_USAGE;
 }
 
@@ -139,6 +154,16 @@ void cli_sets_free(cli_sets *s)
 	memset(s, 0, sizeof *s);
 }
 
+int cli_limit(const char *cmd, const char *text)
+{
+	bsim_limits l = *bsim_limits_get();
+	bsim_error err;
+	if (bsim_limits_parse(&l, text, &err) != BSIM_OK)
+		return cli_usage(cmd, "%s", err.msg);
+	bsim_limits_set(&l);
+	return CLI_OK;
+}
+
 int cli_options_add(bsim_options *opts, const char *cmd, const char *kv)
 {
 	bsim_error err;
@@ -172,6 +197,11 @@ int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsi
 		cli_error("%s", err.msg);
 		return err.code ? err.code : CLI_USAGE;
 	}
+	if (trials > 0 && bsim_experiment_check_trials(e, trials, &err) != BSIM_OK) {
+		cli_error("--trials %ld: %s", trials, err.msg);
+		bsim_experiment_free(e);
+		return CLI_USAGE;
+	}
 	if (trials > 0)
 		e->trials = (int)trials;
 	return CLI_OK;
@@ -191,6 +221,18 @@ int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int sh
 	int rc = bsim_sweep_run(e, &c, r, &err);
 	bsim_progress_finish(&progress);
 	return cli_report(rc, &err);
+}
+
+char *cli_text_append(char *text, const char *more)
+{
+	size_t n = strlen(text), m = strlen(more);
+	char *t = realloc(text, n + m + 1);
+	if (!t) {
+		free(text);
+		return NULL;
+	}
+	memcpy(t + n, more, m + 1);
+	return t;
 }
 
 double cli_per_second(double count, double wall)

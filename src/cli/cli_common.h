@@ -26,11 +26,18 @@ int cmd_bench(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_regress(int argc, char **argv);
 int cmd_accuracy(int argc, char **argv);
+int cmd_landscape(int argc, char **argv);
 int cmd_plot(int argc, char **argv);
 int cmd_video(int argc, char **argv);
 
-/* "beamsim: MSG" on stderr. */
+/* "beamsim: MSG" on stderr, one line of printable text, naming files in
+ * the output directory of cli_error_paths by their place in it. */
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+/* While a run writes into od's staging area, messages that name staged
+ * files name them as they will be in the directory; NULL ends it. */
+struct bsim_outdir;
+void cli_error_paths(const struct bsim_outdir *od);
 
 /* A usage error of command cmd: the message, a pointer to --help, and 2. */
 int cli_usage(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -57,6 +64,15 @@ typedef struct cli_sets {
 int cli_sets_add(cli_sets *s, const char *cmd, const char *kv);
 void cli_sets_free(cli_sets *s);
 
+/* Applies a --limit NAME=N (beamsim/limits.h) to the process. 0, or a
+ * usage error of cmd. */
+int cli_limit(const char *cmd, const char *text);
+
+/* The help line of --limit, shared by every command that loads inputs. */
+#define CLI_LIMIT_HELP                                                                             \
+	"  --limit NAME=N         raise a limit on what inputs may ask for: input_bytes,\n"        \
+	"                         groups, trials, schedule, beam_steps (README, Robustness)\n"
+
 /* Adds a --backend-opt KEY=VALUE. 0, or a usage error. */
 int cli_options_add(bsim_options *opts, const char *cmd, const char *kv);
 
@@ -78,6 +94,10 @@ int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsi
  * status. */
 int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int show_progress,
                   bsim_sweep_result *r);
+
+/* text (malloc'd) with more appended, reallocated; NULL (text freed) if
+ * out of memory. */
+char *cli_text_append(char *text, const char *more);
 
 /* count per second of wall time. A run too short for the clock (wall 0)
  * counts as 1 ns, so a rate is always finite. */

@@ -3,9 +3,13 @@
 
 #include "cli_store.h"
 
+#include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "beamsim/atomic_file.h"
 #include "beamsim/matlab.h"
@@ -33,10 +37,9 @@ int cli_path(char *buf, size_t size, const char *dir, const char *name)
 	return CLI_OK;
 }
 
-static void record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e, int n,
-                        const bsim_backend *const *b, const bsim_options *const *opts,
-                        const char *const *label, const bsim_compare_rule *rule,
-                        const char *const *protocol)
+void cli_record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e, int n,
+                     const bsim_backend *const *b, const bsim_options *const *opts,
+                     const char *const *label, const bsim_compare_rule *rule)
 {
 	memset(rec, 0, sizeof *rec);
 	snprintf(rec->command, sizeof rec->command, "%s", command);
@@ -48,8 +51,6 @@ static void record_fill(bsim_run_record *rec, const char *command, const bsim_ex
 	}
 	rec->seed = e->seed;
 	rec->trials = e->trials;
-	for (int i = 0; protocol && protocol[0] && i < 2; i++)
-		snprintf(rec->protocol[i], sizeof rec->protocol[i], "%s", protocol[i]);
 	if (rule)
 		rec->rule = *rule;
 	else
@@ -108,7 +109,7 @@ int cli_store_sweep(const char *dir, const bsim_experiment *e, const bsim_backen
 	bsim_error err;
 	if (sweep_files(dir, e, b, opts, extra, n_extra, r) != CLI_OK)
 		return CLI_FAIL;
-	record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL, NULL);
+	cli_record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL);
 	if (bsim_run_record_write(dir, &rec, e, extra, n_extra, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return CLI_FAIL;
@@ -209,8 +210,10 @@ static int compare_write(const cli_compare_job *job, const bsim_sweep_result r[2
 		return rc;
 	bsim_run_record rec;
 	bsim_error err;
-	record_fill(&rec, "compare", job->e, 2, job->backend, job->opts, job->label, &job->rule,
-	            job->protocol);
+	cli_record_fill(&rec, "compare", job->e, 2, job->backend, job->opts, job->label,
+	                &job->rule);
+	for (int i = 0; job->protocol[0] && i < 2; i++)
+		snprintf(rec.protocol[i], sizeof rec.protocol[i], "%s", job->protocol[i]);
 	if (bsim_run_record_write(job->out, &rec, job->e, job->extra, job->n_extra, &err) !=
 	    BSIM_OK) {
 		cli_error("%s", err.msg);
@@ -237,6 +240,8 @@ int cli_compare_execute(const cli_compare_job *job, bsim_comparison *cmp)
 	        .n_extra_b = job->n_extra_b,
 	        .keep = job->keep,
 	        .keep_stride = job->keep_stride,
+	        .journal = job->journal,
+	        .stop = job->stop,
 	};
 	memset(cmp, 0, sizeof *cmp);
 	bsim_progress_init(&progress, job->progress);
@@ -253,5 +258,164 @@ int cli_compare_execute(const cli_compare_job *job, bsim_comparison *cmp)
 	bsim_sweep_result_free(&r[0]);
 	bsim_sweep_result_free(&r[1]);
 	free(t_sep);
+	return rc;
+}
+
+/* ---- sessions: output directory, journal, signals ----------------------- */
+
+volatile sig_atomic_t cli_stop;
+
+/* The first SIGINT or SIGTERM asks the run to stop; a second one ends the
+ * process at once, which loses nothing the journal holds. */
+static void on_signal(int sig)
+{
+	if (cli_stop) {
+		signal(sig, SIG_DFL);
+		raise(sig);
+		return;
+	}
+	cli_stop = sig;
+}
+
+static void signals_install(void)
+{
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = on_signal;
+	sigemptyset(&sa.sa_mask);
+	sa.sa_flags = SA_RESTART;
+	sigaction(SIGINT, &sa, NULL);
+	sigaction(SIGTERM, &sa, NULL);
+}
+
+/* An argument as the shell needs it: bare if it is safe, else quoted. */
+static void shell_word(FILE *f, const char *w)
+{
+	if (*w && strspn(w, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+	                    "_-+=.,:/@%") == strlen(w)) {
+		fputs(w, f);
+		return;
+	}
+	fputc('\'', f);
+	for (; *w; w++)
+		if (*w == '\'')
+			fputs("'\\''", f);
+		else
+			fputc(*w, f);
+	fputc('\'', f);
+}
+
+/* "beamsim sweep ... --resume": the command line that continues the run. */
+static void resume_line(FILE *f, const cli_session *s)
+{
+	int has = 0;
+	fputs("beamsim", f);
+	for (int i = 0; i < s->argc; i++) {
+		fputc(' ', f);
+		shell_word(f, s->argv[i]);
+		has |= strcmp(s->argv[i], "--resume") == 0;
+	}
+	if (!has)
+		fputs(" --resume", f);
+}
+
+int cli_session_open(cli_session *s, const char *dir, int resume, const char *inputs,
+                     size_t record_size, int argc, char **argv)
+{
+	bsim_error err;
+	struct stat st;
+	memset(s, 0, sizeof *s);
+	s->dir = dir;
+	s->argc = argc;
+	s->argv = argv;
+	if (bsim_outdir_open(&s->od, dir, &err) != BSIM_OK)
+		return cli_report(err.code, &err);
+	s->stage = bsim_outdir_stage(s->od);
+	cli_error_paths(s->od);
+	if (!inputs)
+		return CLI_OK;
+	if (cli_path(s->journal_path, sizeof s->journal_path, bsim_outdir_work(s->od), "journal")) {
+		cli_session_close(s, CLI_USAGE, NULL);
+		return CLI_USAGE;
+	}
+	int have = stat(s->journal_path, &st) == 0;
+	int rc = BSIM_OK;
+	if (resume && !have) {
+		int finished = 0;
+		bsim_outdir_verify(dir, &finished, &err);
+		cli_error("--resume: %s holds %s", dir,
+		          finished ? "a finished run, nothing to resume (run without --resume to "
+		                     "replace it)"
+		                   : "no stopped run to resume (run without --resume)");
+		rc = BSIM_EINPUT;
+	} else if (!resume && have) {
+		cli_error(
+		        "%s holds the journal of a stopped run (%s): add --resume to continue it, "
+		        "or delete the journal to start over",
+		        dir, s->journal_path);
+		rc = BSIM_EINPUT;
+	} else if (resume) {
+		rc = bsim_journal_resume(&s->journal, s->journal_path, inputs, record_size, &err);
+		if (rc != BSIM_OK)
+			cli_error("--resume: %s: %s", dir, err.msg);
+	} else {
+		rc = bsim_journal_create(&s->journal, s->journal_path, inputs, record_size, &err);
+		if (rc != BSIM_OK)
+			cli_error("%s", err.msg);
+	}
+	if (rc != BSIM_OK) {
+		cli_session_close(s, rc, NULL);
+		return rc;
+	}
+	cli_stop = 0;
+	signals_install();
+	return CLI_OK;
+}
+
+int cli_session_close(cli_session *s, int rc, const char *command)
+{
+	bsim_error err;
+	int keep = 0;
+	if (rc == CLI_OK && s->od) {
+		int crc = s->add ? bsim_outdir_add(s->od, command, &err)
+		                 : bsim_outdir_commit(s->od, command, &err);
+		if (crc != BSIM_OK) {
+			cli_report(BSIM_EFAIL, &err);
+			rc = CLI_FAIL;
+			keep = 1; /* the trials are done: --resume writes the files again */
+		}
+	} else if (rc == BSIM_ESTOPPED) {
+		keep = 1;
+	}
+	/* A journal this session did not open (another run's, refused) is never
+	 * touched; this session's is kept only to be resumed. */
+	int ours = s->journal != NULL;
+	if (s->journal && bsim_journal_close(s->journal, &err) != BSIM_OK && rc == CLI_OK)
+		rc = cli_report(BSIM_EFAIL, &err);
+	s->journal = NULL;
+	if (ours && !keep)
+		unlink(s->journal_path);
+	if (rc == BSIM_ESTOPPED) {
+		int sig = cli_stop ? (int)cli_stop : SIGINT;
+		fprintf(stderr, "beamsim: %s: the finished trials are kept in %s; to continue: ",
+		        sig == SIGTERM ? "SIGTERM" : "SIGINT", s->journal_path);
+		resume_line(stderr, s);
+		fputc('\n', stderr);
+		rc = 128 + sig;
+	} else if (keep && s->journal_path[0]) {
+		fprintf(stderr,
+		        "beamsim: the finished trials are kept in %s; to write the files "
+		        "again: ",
+		        s->journal_path);
+		resume_line(stderr, s);
+		fputc('\n', stderr);
+	}
+	cli_error_paths(NULL);
+	bsim_outdir_close(s->od);
+	s->od = NULL;
+	if (s->journal_path[0]) {
+		signal(SIGINT, SIG_DFL);
+		signal(SIGTERM, SIG_DFL);
+	}
 	return rc;
 }

@@ -4,8 +4,12 @@
 #ifndef BEAMSIM_CLI_STORE_H
 #define BEAMSIM_CLI_STORE_H
 
+#include <signal.h>
+
 #include "beamsim/compare.h"
 #include "beamsim/experiment.h"
+#include "beamsim/journal.h"
+#include "beamsim/outdir.h"
 #include "beamsim/run_record.h"
 #include "beamsim/sweep.h"
 
@@ -29,8 +33,50 @@ typedef struct cli_compare_job {
 	int examples;
 	int progress; /* a progress line on a terminal */
 	const char *out;
-	int keep, keep_stride; /* trajectories kept per group, see bsim_sweep_config */
+	int keep, keep_stride;             /* trajectories kept per group, see bsim_sweep_config */
+	bsim_journal *journal;             /* NULL: none (bsim_sweep_config) */
+	const volatile sig_atomic_t *stop; /* NULL: none */
 } cli_compare_job;
+
+/* One run's output directory (beamsim/outdir.h) and, for sweep and
+ * compare, its journal (beamsim/journal.h) and the signals that stop it
+ * cleanly. Files are written into stage and appear in dir at the end. */
+typedef struct cli_session {
+	const char *dir;   /* as the user gave it */
+	const char *stage; /* where to write */
+	bsim_outdir *od;
+	bsim_journal *journal;
+	char journal_path[1100];
+	int argc; /* the command line, for the line that resumes it */
+	char **argv;
+	int add; /* set before closing: the files join DIR's set (bsim_outdir_add) */
+} cli_session;
+
+/* Set to the signal's number by SIGINT or SIGTERM during a session: the
+ * sweep's stop flag. */
+extern volatile sig_atomic_t cli_stop;
+
+/* Opens dir (exit 2 if it cannot be used) and, if inputs is not NULL, the
+ * journal for records of record_size bytes: with resume the journal of the
+ * stopped run in dir, which must have these inputs; without, a new one,
+ * refusing a dir that holds a stopped run's journal. Installs the signal
+ * handlers. Prints any error; returns the exit status. */
+int cli_session_open(cli_session *s, const char *dir, int resume, const char *inputs,
+                     size_t record_size, int argc, char **argv);
+
+/* Ends the session with the run's status rc: if 0, commits the files (and
+ * removes the journal once they are in place; a failed commit keeps it, so
+ * --resume writes the files again); if the run was stopped, keeps the
+ * journal and prints the line that resumes it, returning 128 + the
+ * signal's number; after any other failure (a trial that failed is failed
+ * again by a resume) the journal is removed. Prints any error; returns the
+ * exit status. */
+int cli_session_close(cli_session *s, int rc, const char *command);
+
+/* The run record of a sweep (one backend) or comparison (two). */
+void cli_record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e, int n,
+                     const bsim_backend *const *b, const bsim_options *const *opts,
+                     const char *const *label, const bsim_compare_rule *rule);
 
 /* DIR/summary.json, DIR/trials.csv and the run record of a sweep. */
 int cli_store_sweep(const char *dir, const bsim_experiment *e, const bsim_backend *b,

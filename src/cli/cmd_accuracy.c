@@ -15,6 +15,7 @@
 #include "beamsim/figures.h"
 #include "beamsim/matlab.h"
 #include "cli_common.h"
+#include "cli_store.h"
 
 #define ACC_SCENE "configs/thesis/gate.yaml"
 
@@ -199,31 +200,38 @@ static int accuracy_main(accuracy_args *a)
 	        .threads = (int)a->threads,
 	        .progress = isatty(STDERR_FILENO), /* a \r line is noise in a log */
 	};
-	rc = bsim_output_mkdir(a->out, &err);
+	cli_session ss;
+	rc = cli_session_open(&ss, a->out, 0, NULL, 0, 0, NULL);
+	if (rc != CLI_OK) {
+		bsim_scene_free(&scene);
+		return rc;
+	}
 	bsim_accuracy_result r = {0};
-	if (rc == BSIM_OK)
-		rc = bsim_accuracy_run(&scene, backends, n_b, &cfg, &r, &err);
+	rc = bsim_accuracy_run(&scene, backends, n_b, &cfg, &r, &err);
 	char path[1200], label[1200];
 	snprintf(label, sizeof label, "%s%s", a->scene,
 	         a->scene_given ? "" : " (propulsion 9 N, random force 20 N)");
 	if (rc == BSIM_OK) {
 		char mat[1200];
-		snprintf(path, sizeof path, "%s/accuracy.csv", a->out);
-		snprintf(mat, sizeof mat, "%s/accuracy.mat", a->out);
+		snprintf(path, sizeof path, "%s/accuracy.csv", ss.stage);
+		snprintf(mat, sizeof mat, "%s/accuracy.mat", ss.stage);
 		rc = bsim_accuracy_write_csv(path, &r, &err);
 		if (rc == BSIM_OK)
 			rc = bsim_matlab_from_csv(path, mat, "accuracy", &err);
 	}
 	if (rc == BSIM_OK) {
-		snprintf(path, sizeof path, "%s/accuracy.md", a->out);
+		snprintf(path, sizeof path, "%s/accuracy.md", ss.stage);
 		rc = bsim_accuracy_write_md(path, &r, &cfg, label, &err);
 	}
 	bsim_figures_result fig = {0};
 	if (rc == BSIM_OK) {
 		bsim_figures_def def = bsim_figures_default();
 		def.kind = BSIM_FIGURES_ACCURACY;
-		rc = bsim_figures_draw(a->out, &def, &fig, &err);
+		rc = bsim_figures_draw(ss.stage, &def, &fig, &err);
 	}
+	if (rc != BSIM_OK)
+		cli_report(rc, &err);
+	rc = cli_session_close(&ss, rc, "accuracy");
 	if (rc == BSIM_OK) {
 		printf("accuracy: %d rows in %.1f s; wrote %s/accuracy.{csv,mat,md} and the figure "
 		       "%s/accuracy.{png,svg,gp}\n",
@@ -234,7 +242,7 @@ static int accuracy_main(accuracy_args *a)
 	bsim_figures_result_free(&fig);
 	bsim_accuracy_result_free(&r);
 	bsim_scene_free(&scene);
-	return cli_report(rc, &err);
+	return rc;
 }
 
 int cmd_accuracy(int argc, char **argv)

@@ -20,6 +20,10 @@
 #define BENCH_H1 "configs/thesis/h1_symmetric.yaml"
 #define BENCH_H2 "configs/thesis/h2_asymmetric.yaml"
 
+/* Where the tables go: standard output, or standard error when the JSON
+ * goes to standard output (--json -). */
+static FILE *report;
+
 static const char bench_help[] =
         "Usage: beamsim bench [OPTIONS]\n"
         "\n"
@@ -163,17 +167,17 @@ static int bench_find(const char *path)
 
 static void bench_print_header(void)
 {
-	printf("%-36s %7s %7s %12s %9s %10s %9s %13s\n", "experiment", "threads", "trials", "steps",
-	       "wall s", "steps/s", "trials/s", "steps/s/core");
+	fprintf(report, "%-36s %7s %7s %12s %9s %10s %9s %13s\n", "experiment", "threads", "trials",
+	        "steps", "wall s", "steps/s", "trials/s", "steps/s/core");
 }
 
 static void bench_print_run(const bench_run *r)
 {
 	double steps_per_second = cli_per_second(r->steps, r->wall);
-	printf("%-36s %7d %7ld %12ld %9.3f %10.4g %9.1f %13.4g\n", r->experiment, r->threads,
-	       r->trials, r->steps, r->wall, steps_per_second, cli_per_second(r->trials, r->wall),
-	       steps_per_second / r->threads);
-	fflush(stdout);
+	fprintf(report, "%-36s %7d %7ld %12ld %9.3f %10.4g %9.1f %13.4g\n", r->experiment,
+	        r->threads, r->trials, r->steps, r->wall, steps_per_second,
+	        cli_per_second(r->trials, r->wall), steps_per_second / r->threads);
+	fflush(report);
 }
 
 /* One sweep of e on the given threads, timed. label (the path as given)
@@ -290,17 +294,18 @@ static int bench_json(const bench_args *a, const bsim_backend *backend, const bs
 static int bench_vs(const bench_args *a, const bsim_backend *vs, const bsim_experiment *h1,
                     bench_run *runs, int *n_runs)
 {
-	printf("\nbackend %s, 1 thread\n\n", vs->name);
+	fprintf(report, "\nbackend %s, 1 thread\n\n", vs->name);
 	bench_print_header();
 	int rc = bench_sweep(vs, &a->vs_opts, h1, a->experiment, 1, &runs[*n_runs]);
 	if (rc != CLI_OK)
 		return rc;
 	const bench_run *mine = &runs[0], *theirs = &runs[*n_runs];
 	(*n_runs)++;
-	printf("\n%s is %.1f times faster than %s per step and %.1f times per trial "
-	       "(%s, same time step, 1 thread)\n",
-	       a->backend, bench_speedup_per_step(mine, theirs), vs->name,
-	       theirs->wall / mine->wall, a->experiment);
+	fprintf(report,
+	        "\n%s is %.1f times faster than %s per step and %.1f times per trial "
+	        "(%s, same time step, 1 thread)\n",
+	        a->backend, bench_speedup_per_step(mine, theirs), vs->name,
+	        theirs->wall / mine->wall, a->experiment);
 	return CLI_OK;
 }
 
@@ -324,7 +329,7 @@ static int bench_main(const bench_args *a, const bsim_backend *backend, const bs
 	bench_run runs[BENCH_RUNS_MAX];
 	int n_runs = 0;
 	const int h1_threads[] = {1, all};
-	printf("backend %s, %d threads\n\n", a->backend, all);
+	fprintf(report, "backend %s, %d threads\n\n", a->backend, all);
 	bench_print_header();
 	rc = bench_experiment(a, backend, &h1, a->experiment, h1_threads, 2, runs, &n_runs);
 	if (rc == CLI_OK && a->h2)
@@ -333,7 +338,7 @@ static int bench_main(const bench_args *a, const bsim_backend *backend, const bs
 	double h1_h2 = -1.0;
 	if (rc == CLI_OK && a->h2) {
 		h1_h2 = runs[1].wall + runs[2].wall;
-		printf("\nH1 + H2 on %d threads: %.3f s\n", all, h1_h2);
+		fprintf(report, "\nH1 + H2 on %d threads: %.3f s\n", all, h1_h2);
 	}
 	if (rc == CLI_OK && vs)
 		rc = bench_vs(a, vs, &h1, runs, &n_runs);
@@ -355,6 +360,7 @@ int cmd_bench(int argc, char **argv)
 	const bsim_backend *vs = backend && a.vs ? cli_backend(a.vs, &a.vs_opts) : NULL;
 	if (!backend || (a.vs && !vs))
 		return CLI_USAGE;
+	report = a.json && strcmp(a.json, "-") == 0 ? stderr : stdout;
 	if (a.lattice) {
 		bench_lattice_args la = {
 		        .backend = backend,
@@ -364,6 +370,7 @@ int cmd_bench(int argc, char **argv)
 		        .trials = a.trials,
 		        .vs_trials = a.trials > 0 ? (a.trials + 19) / 20 : 0,
 		        .json = a.json,
+		        .report = report,
 		};
 		return bench_lattice(&la);
 	}

@@ -40,7 +40,9 @@ static const char compare_help[] =
         "\n"
         "Writes DIR/report.md, DIR/report.json, DIR/pairs.csv, DIR/<label>/summary.json\n"
         "and trials.csv for each side, and DIR/run.json with DIR/inputs/ for\n"
-        "`beamsim regress DIR`.\n"
+        "`beamsim regress DIR`. The files appear together at the end (DIR/manifest.json);\n"
+        "finished pairs are journaled as they end, so a stopped or killed comparison\n"
+        "continues with --resume and gives the same files.\n"
         "\n"
         "Options:\n"
         "  --out DIR              output directory, created if missing (required)\n"
@@ -66,7 +68,8 @@ static const char compare_help[] =
         "                         group, per backend in DIR/<backend>/trajectories.csv\n"
         "  --trajectory-stride N  a trajectory row every N steps (default 5)\n"
         "  --quiet                no progress line, nothing on stdout\n"
-        "  -h, --help             show this help\n";
+        "  --resume               continue the stopped comparison in DIR (same "
+        "inputs)\n" CLI_LIMIT_HELP "  -h, --help             show this help\n";
 
 enum {
 	OPT_BACKENDS = 256,
@@ -83,7 +86,9 @@ enum {
 	OPT_PROTOCOLS,
 	OPT_BACKEND,
 	OPT_TRAJECTORIES,
-	OPT_TRAJECTORY_STRIDE
+	OPT_TRAJECTORY_STRIDE,
+	OPT_LIMIT,
+	OPT_RESUME
 };
 
 static const struct option compare_options[] = {
@@ -102,6 +107,8 @@ static const struct option compare_options[] = {
         {"quiet", no_argument, NULL, OPT_QUIET},
         {"trajectories", required_argument, NULL, OPT_TRAJECTORIES},
         {"trajectory-stride", required_argument, NULL, OPT_TRAJECTORY_STRIDE},
+        {"limit", required_argument, NULL, OPT_LIMIT},
+        {"resume", no_argument, NULL, OPT_RESUME},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -124,6 +131,9 @@ typedef struct compare_args {
 	const char *out;
 	bsim_compare_rule rule;
 	int quiet;
+	int resume;
+	int argc; /* the command line, for the line that resumes it */
+	char **argv;
 	/* --backend-opt, resolved after parsing, before the inline options */
 	int n_pending;
 	char pending[2 * BSIM_OPTIONS_MAX][128];
@@ -285,6 +295,11 @@ static int compare_option(compare_args *a, int c)
 			                 "--trajectory-stride %s: expected an integer >= 1",
 			                 optarg);
 		return CLI_OK;
+	case OPT_LIMIT:
+		return cli_limit("compare", optarg);
+	case OPT_RESUME:
+		a->resume = 1;
+		return CLI_OK;
 	}
 	return CLI_USAGE;
 }
@@ -404,7 +419,6 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 {
 	bsim_experiment e;
 	bsim_error err;
-	struct stat st;
 	int protocols = a->protocol[0][0] != 0;
 	/* --protocols: side a's protocol joins the --set overrides, side b's
 	 * is its own override after them. */
@@ -421,11 +435,20 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 		return rc;
 	if (a->has_seed)
 		e.seed = a->seed;
-	int created = stat(a->out, &st) != 0;
-	if (bsim_output_mkdir(a->out, &err) != BSIM_OK) {
-		cli_error("%s", err.msg);
+	bsim_run_record rec;
+	const bsim_backend *b[2] = {b0, b1};
+	const bsim_options *opts[2] = {&a->opts[0], &a->opts[1]};
+	const char *labels[2] = {a->labels[0], a->labels[1]};
+	cli_record_fill(&rec, "compare", &e, 2, b, opts, labels, &a->rule);
+	char *inputs = bsim_run_record_inputs(&rec, &e, a->sets.ov, a->sets.n, &err);
+	cli_session ss;
+	rc = inputs ? cli_session_open(&ss, a->out, a->resume, inputs, bsim_sweep_record_size(1),
+	                               a->argc, a->argv)
+	            : cli_report(err.code, &err);
+	free(inputs);
+	if (rc != CLI_OK) {
 		bsim_experiment_free(&e);
-		return CLI_FAIL;
+		return rc;
 	}
 	cli_compare_job job = {
 	        .e = &e,
@@ -441,14 +464,15 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 	        .rule = a->rule,
 	        .examples = (int)a->examples,
 	        .progress = !a->quiet,
-	        .out = a->out,
+	        .out = ss.stage,
+	        .journal = ss.journal,
+	        .stop = &cli_stop,
 	        .keep = (int)a->keep,
 	        .keep_stride = (int)a->keep_stride,
 	};
 	bsim_comparison cmp;
 	rc = cli_compare_execute(&job, &cmp);
-	if (rc != CLI_OK && created)
-		rmdir(a->out); /* removes it only if the run left it empty */
+	rc = cli_session_close(&ss, rc, "compare");
 	if (rc == CLI_OK) {
 		if (!a->quiet)
 			compare_summary(a, &e, &cmp);
@@ -462,6 +486,8 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 int cmd_compare(int argc, char **argv)
 {
 	compare_args a = {
+	        .argc = argc,
+	        .argv = argv,
 	        .labels = {"thesis", "box2d"},
 	        .rule = {BSIM_COMPARE_ALPHA, BSIM_COMPARE_MARGIN, 0},
 	        .examples = 3,

@@ -9,6 +9,7 @@
 
 #include "beamsim/figures.h"
 #include "cli_common.h"
+#include "cli_store.h"
 
 static const char plot_help[] =
         "Usage: beamsim plot DIR [OPTIONS]\n"
@@ -109,26 +110,47 @@ int cmd_plot(int argc, char **argv)
 		cli_sets_free(&a.select);
 		return rc;
 	}
+	/* A reader of DIR: a mix of two runs' files is refused. The figures are
+	 * written into a staging area and join the directory's set at the end
+	 * (beamsim/outdir.h): into DIR itself, beside its files; into ODIR,
+	 * replacing what a previous plot left there. */
+	int has_manifest = 0;
+	bsim_error err;
+	if (bsim_outdir_verify(a.dir, &has_manifest, &err) != BSIM_OK) {
+		cli_error("%s", err.msg);
+		cli_sets_free(&a.select);
+		return CLI_USAGE;
+	}
+	cli_session ss;
+	rc = cli_session_open(&ss, a.out ? a.out : a.dir, 0, NULL, 0, 0, NULL);
+	if (rc != CLI_OK) {
+		cli_sets_free(&a.select);
+		return rc;
+	}
+	ss.add = a.out == NULL;
+	size_t stage_len = strlen(ss.stage);
 	bsim_figures_def def = bsim_figures_default();
-	def.out = a.out;
+	def.out = ss.stage;
 	def.select = a.select.ov;
 	def.n_select = a.select.n;
 	def.threads = (int)a.threads;
 	bsim_figures_result res;
-	bsim_error err;
 	rc = bsim_figures_draw(a.dir, &def, &res, &err);
 	if (rc == BSIM_OK) {
-		if (!a.quiet) {
-			printf("%s of %s: %d figure%s, %d drawn\n",
-			       bsim_figures_kind_name(res.kind), a.dir, res.n,
-			       res.n == 1 ? "" : "s", res.drawn);
-			for (int i = 0; i < res.n; i++)
-				printf("  %s.{png,svg,gp}\n", res.paths[i]);
-		}
 		for (int i = 0; i < res.n_notes; i++)
 			cli_error("%s", res.notes[i]);
 	} else {
 		cli_error("%s", err.msg);
+	}
+	rc = cli_session_close(&ss, rc, "plot");
+	if (rc == BSIM_OK && !a.quiet) {
+		printf("%s of %s: %d figure%s, %d drawn\n", bsim_figures_kind_name(res.kind), a.dir,
+		       res.n, res.n == 1 ? "" : "s", res.drawn);
+		for (int i = 0; i < res.n; i++) {
+			/* "OUT/NAME" as the user knows OUT */
+			const char *name = res.paths[i] + stage_len;
+			printf("  %s%s.{png,svg,gp}\n", a.out ? a.out : a.dir, name);
+		}
 	}
 	bsim_figures_result_free(&res);
 	cli_sets_free(&a.select);

@@ -16,6 +16,7 @@
 #include "beamsim/atomic_file.h"
 #include "beamsim/effects.h"
 #include "beamsim/json.h"
+#include "beamsim/outdir.h"
 #include "beamsim/output.h"
 #include "beamsim/report.h"
 #include "beamsim/version.h"
@@ -43,10 +44,10 @@ static const char regress_help[] =
         "  --alpha A              family-wise error rate\n"
         "  --margin M             smallest difference that counts\n"
         "  --exact                any changed trial counts\n"
-        "  --quiet                no progress line, nothing on stdout\n"
+        "  --quiet                no progress line, nothing on stdout\n" CLI_LIMIT_HELP
         "  -h, --help             show this help\n";
 
-enum { OPT_OUT = 256, OPT_THREADS, OPT_ALPHA, OPT_MARGIN, OPT_EXACT, OPT_QUIET };
+enum { OPT_OUT = 256, OPT_THREADS, OPT_ALPHA, OPT_MARGIN, OPT_EXACT, OPT_QUIET, OPT_LIMIT };
 
 static const struct option regress_options[] = {
         {"out", required_argument, NULL, OPT_OUT},
@@ -55,12 +56,14 @@ static const struct option regress_options[] = {
         {"margin", required_argument, NULL, OPT_MARGIN},
         {"exact", no_argument, NULL, OPT_EXACT},
         {"quiet", no_argument, NULL, OPT_QUIET},
+        {"limit", required_argument, NULL, OPT_LIMIT},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
 
 typedef struct regress_args {
 	const char *baseline, *out;
+	const char *stage; /* where the rerun is written before it appears in out */
 	long threads;
 	double alpha, margin; /* < 0: the stored rule */
 	int exact, quiet;
@@ -95,6 +98,9 @@ static int regress_parse(int argc, char **argv, regress_args *a)
 			break;
 		case OPT_QUIET:
 			a->quiet = 1;
+			break;
+		case OPT_LIMIT:
+			rc = cli_limit("regress", optarg);
 			break;
 		default:
 			return cli_bad_option("regress", argv, c);
@@ -133,6 +139,11 @@ static int regress_load(const regress_args *a, regress_run *run)
 {
 	bsim_error err;
 	char path[1100];
+	int has_manifest = 0;
+	if (bsim_outdir_verify(a->baseline, &has_manifest, &err) != BSIM_OK) {
+		cli_error("%s", err.msg);
+		return CLI_USAGE;
+	}
 	if (bsim_run_record_read(a->baseline, &run->rec, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return CLI_USAGE;
@@ -176,7 +187,7 @@ static int regress_rerun(const regress_args *a, regress_run *run)
 		        .rule = run->rec.rule,
 		        .examples = 3,
 		        .progress = !a->quiet,
-		        .out = a->out,
+		        .out = a->stage,
 		};
 		bsim_comparison cmp;
 		int rc = cli_compare_execute(&job, &cmp);
@@ -192,7 +203,7 @@ static int regress_rerun(const regress_args *a, regress_run *run)
 	int rc = cli_sweep_run(&run->e, &cfg, !a->quiet, &r);
 	if (rc != CLI_OK)
 		return rc;
-	rc = cli_store_sweep(a->out, &run->e, run->backend[0], &run->rec.opts[0], NULL, 0, &r);
+	rc = cli_store_sweep(a->stage, &run->e, run->backend[0], &run->rec.opts[0], NULL, 0, &r);
 	bsim_sweep_result_free(&r);
 	return rc;
 }
@@ -202,7 +213,7 @@ static int regress_rerun(const regress_args *a, regress_run *run)
 static int regress_read(const regress_args *a, const regress_run *run, int i,
                         bsim_sweep_result r[2])
 {
-	const char *dirs[2] = {a->baseline, a->out};
+	const char *dirs[2] = {a->baseline, a->stage};
 	for (int k = 0; k < 2; k++) {
 		char path[1200], sub[1100];
 		bsim_error err;
@@ -291,8 +302,8 @@ static int regress_write(const regress_args *a, const regress_run *run, regress_
 	char md[1100], js[1100];
 	bsim_atomic_file o;
 	bsim_error err;
-	if (cli_path(md, sizeof md, a->out, "regress.md") ||
-	    cli_path(js, sizeof js, a->out, "regress.json"))
+	if (cli_path(md, sizeof md, a->stage, "regress.md") ||
+	    cli_path(js, sizeof js, a->stage, "regress.json"))
 		return CLI_FAIL;
 	int rc = bsim_atomic_file_open(&o, js, &err);
 	if (rc == BSIM_OK) {
@@ -363,19 +374,24 @@ int cmd_regress(int argc, char **argv)
 		return rc;
 	regress_run run;
 	memset(&run, 0, sizeof run);
-	bsim_error err;
-	struct stat st;
 	rc = regress_load(&a, &run);
-	int created = stat(a.out, &st) != 0;
-	if (rc == CLI_OK && bsim_output_mkdir(a.out, &err) != BSIM_OK)
-		rc = cli_report(CLI_FAIL, &err);
-	if (rc == CLI_OK) {
-		rc = regress_rerun(&a, &run);
-		if (rc != CLI_OK && created)
-			rmdir(a.out);
-	}
+	cli_session ss;
 	if (rc == CLI_OK)
-		rc = regress_compare(&a, &run);
+		rc = cli_session_open(&ss, a.out, 0, NULL, 0, argc, argv);
+	if (rc == CLI_OK) {
+		a.stage = ss.stage;
+		rc = regress_rerun(&a, &run);
+		int beyond = CLI_OK;
+		if (rc == CLI_OK)
+			rc = regress_compare(&a, &run);
+		if (rc == CLI_DISAGREE) { /* a finding: the files are written all the same */
+			beyond = rc;
+			rc = CLI_OK;
+		}
+		rc = cli_session_close(&ss, rc, "regress");
+		if (rc == CLI_OK)
+			rc = beyond;
+	}
 	bsim_experiment_free(&run.e);
 	return rc;
 }

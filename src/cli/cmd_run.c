@@ -19,6 +19,7 @@
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "cli_common.h"
+#include "cli_store.h"
 
 static const char run_help[] =
         "Usage: beamsim run SCENE [OPTIONS]\n"
@@ -39,12 +40,13 @@ static const char run_help[] =
         "  --set KEY=VALUE        override a scene field by dotted path, repeatable\n"
         "                         (e.g. --set effects.random_force.magnitude=30)\n"
         "  --trajectory FILE.csv  write the trajectory, one row per recorded step, and\n"
-        "                         its MATLAB twin FILE.mat\n"
+        "                         its MATLAB twin FILE.mat; - is standard output (no\n"
+        "                         twin; the report then goes to standard error)\n"
         "  --out DIR              write DIR/trajectory.csv, DIR/ledger.csv (the energy\n"
         "                         ledger over time), their .mat twins and DIR/run.json,\n"
         "                         for `beamsim plot DIR`\n"
         "  --stride N             record every N-th step (default 1)\n"
-        "  --json                 print one JSON object instead of text\n"
+        "  --json                 print one JSON object instead of text\n" CLI_LIMIT_HELP
         "  -h, --help             show this help\n";
 
 enum {
@@ -57,7 +59,8 @@ enum {
 	OPT_TRAJECTORY,
 	OPT_STRIDE,
 	OPT_JSON,
-	OPT_OUT
+	OPT_OUT,
+	OPT_LIMIT
 };
 
 static const struct option run_options[] = {
@@ -71,6 +74,7 @@ static const struct option run_options[] = {
         {"stride", required_argument, NULL, OPT_STRIDE},
         {"json", no_argument, NULL, OPT_JSON},
         {"out", required_argument, NULL, OPT_OUT},
+        {"limit", required_argument, NULL, OPT_LIMIT},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -136,6 +140,9 @@ static int run_parse(int argc, char **argv, run_args *a)
 		case OPT_OUT:
 			a->out = optarg;
 			break;
+		case OPT_LIMIT:
+			rc = cli_limit("run", optarg);
+			break;
 		default:
 			return cli_bad_option("run", argv, c);
 		}
@@ -150,63 +157,78 @@ static int run_parse(int argc, char **argv, run_args *a)
 	return -1;
 }
 
-static void print_text(const run_args *a, const bsim_scene *s, uint64_t mixed,
+/* A lattice trial's gate path and peaks (run --json has every beam's). */
+static void print_lattice(FILE *out, const bsim_scene *s, const bsim_trial_result *r,
+                          const bsim_trial_log *log)
+{
+	char label[48];
+	bsim_location_label(bsim_location_of(r), label, sizeof label);
+	fprintf(out, "lattice     %s protocol, ended %s in gate (%d, %d), %d gates entered:",
+	        s->lattice.protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world", label, r->final_ix,
+	        r->final_iy, r->gates_entered);
+	for (int k = 0; k < log->n_entries; k++)
+		fprintf(out, " %d:%d", log->entries[k].ix, log->entries[k].iy);
+	int moved = 0;
+	double peak = 0.0;
+	for (int i = 0; i < log->n_beams; i++) {
+		moved += log->peak[i] != 0.0;
+		peak = fmax(peak, log->peak[i]);
+	}
+	fprintf(out,
+	        "\npeak theta  %d beams moved, the largest %.6g rad (run --json: every beam)\n",
+	        moved, peak);
+	if (s->lattice.protocol == BSIM_PROTOCOL_ESSAY)
+		fprintf(out, "reset       %d entries whose beams at rest overlapped the body\n",
+		        r->reset_overlaps);
+}
+
+static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64_t mixed,
                        const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	const bsim_ledger *l = &r->ledger;
-	printf("scene       %s (%s), backend %s\n", a->scene, s->name, a->backend);
-	printf("seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
-	       ", %lu draws)\n",
-	       a->seed, a->group, a->trial, mixed, r->draws);
-	printf("outcome     %s", bsim_outcome_name(r->outcome));
-	if (r->outcome == BSIM_TRAVERSED)
-		printf(", type %s, landscape %s", bsim_type_name(r->type),
-		       r->landscape_left                   ? "left"
-		       : r->max_theta[1] > r->max_theta[0] ? "right"
-		                                           : "none");
-	else if (r->outcome == BSIM_STUCK)
-		printf(", %s", r->in_contact_end ? "in contact" : "not in contact");
-	printf("\nsteps       %d to the outcome at t = %.6g s, %d run\n", r->steps, r->t_end,
-	       r->steps_run);
-	printf("end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,
-	       r->vx_end);
-	if (s->has_lattice) {
-		char label[48];
-		bsim_location_label(bsim_location_of(r), label, sizeof label);
-		printf("lattice     %s protocol, ended %s in gate (%d, %d), %d gates entered:",
-		       s->lattice.protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world", label,
-		       r->final_ix, r->final_iy, r->gates_entered);
-		for (int k = 0; k < log->n_entries; k++)
-			printf(" %d:%d", log->entries[k].ix, log->entries[k].iy);
-		int moved = 0;
-		double peak = 0.0;
-		for (int i = 0; i < log->n_beams; i++) {
-			moved += log->peak[i] != 0.0;
-			peak = fmax(peak, log->peak[i]);
-		}
-		printf("\npeak theta  %d beams moved, the largest %.6g rad (run --json: every "
-		       "beam)\n",
-		       moved, peak);
-		if (s->lattice.protocol == BSIM_PROTOCOL_ESSAY)
-			printf("reset       %d entries whose beams at rest overlapped the body\n",
-			       r->reset_overlaps);
-	} else {
-		printf("peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0],
-		       r->max_theta[1]);
+	fprintf(out, "scene       %s (%s), backend %s\n", a->scene, s->name, a->backend);
+	fprintf(out,
+	        "seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
+	        ", %lu draws)\n",
+	        a->seed, a->group, a->trial, mixed, r->draws);
+	fprintf(out, "outcome     %s", bsim_outcome_name(r->outcome));
+	if (r->outcome == BSIM_TRAVERSED) {
+		fprintf(out, ", type %s, landscape ", bsim_type_name(r->type));
+		if (r->landscape_beam < 0)
+			fprintf(out, "none");
+		else if (r->landscape_beam < 2 && s->n_beams == 2)
+			fprintf(out, "%s (beam %d)", r->landscape_beam == 0 ? "left" : "right",
+			        r->landscape_beam + 1);
+		else
+			fprintf(out, "beam %d", r->landscape_beam + 1);
+	} else if (r->outcome == BSIM_STUCK) {
+		fprintf(out, ", %s", r->in_contact_end ? "in contact" : "not in contact");
 	}
-	printf("overlap     deepest %.3g m of body and beams\n", r->overlap_max);
-	printf("energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
-	printf("  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
-	printf("  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
-	       l->damper, l->impact, l->contact, l->correction);
+	fprintf(out, "\nsteps       %d to the outcome at t = %.6g s, %d run\n", r->steps, r->t_end,
+	        r->steps_run);
+	fprintf(out, "end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,
+	        r->vx_end);
+	if (s->has_lattice)
+		print_lattice(out, s, r, log);
+	else
+		fprintf(out, "peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0],
+		        r->max_theta[1]);
+	fprintf(out, "overlap     deepest %.3g m of body and beams\n", r->overlap_max);
+	fprintf(out, "energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
+	fprintf(out, "  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
+	fprintf(out,
+	        "  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
+	        l->damper, l->impact, l->contact, l->correction);
 	if (l->sleep != 0.0 || l->reset != 0.0)
-		printf("  at rest   sleeping %.6g J, essay resets %.6g J\n", l->sleep, l->reset);
-	printf("  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step; %.4g J flowed in)\n",
-	       l->residual, l->residual_abs, l->residual_max, l->inflow);
+		fprintf(out, "  at rest   sleeping %.6g J, essay resets %.6g J\n", l->sleep,
+		        l->reset);
+	fprintf(out,
+	        "  residual  %.3g J (sum |r| %.3g J, max |r| %.3g J per step; %.4g J flowed in)\n",
+	        l->residual, l->residual_abs, l->residual_max, l->inflow);
 	if (r->instability) {
 		char why[256];
 		bsim_trial_instability_text(r, s->dt, why, sizeof why);
-		printf("unstable    %s\n", why);
+		fprintf(out, "unstable    %s\n", why);
 	}
 }
 
@@ -227,9 +249,20 @@ static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_re
 		bsim_recorder_header(traj.f, scene->n_beams);
 		rec.csv = traj.f;
 	}
-	if (a->out && bsim_run_output_open(&dir, a->out, scene->n_beams, &dir_rec, &err)) {
-		bsim_atomic_file_abort(&traj);
-		return cli_report(BSIM_EFAIL, &err);
+	/* DIR is checked before the trial runs and its files appear together
+	 * (beamsim/outdir.h). */
+	cli_session ss;
+	if (a->out) {
+		int src = cli_session_open(&ss, a->out, 0, NULL, 0, 0, NULL);
+		if (src != CLI_OK) {
+			bsim_atomic_file_abort(&traj);
+			return src;
+		}
+		if (bsim_run_output_open(&dir, ss.stage, scene->n_beams, &dir_rec, &err)) {
+			bsim_atomic_file_abort(&traj);
+			cli_report(BSIM_EFAIL, &err);
+			return cli_session_close(&ss, CLI_FAIL, "run");
+		}
 	}
 	/* One recorder writes both when both are asked for: the CSV of
 	 * --trajectory, and the directory's trajectory and ledger. */
@@ -240,9 +273,11 @@ static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_re
 	bsim_runner *runner = bsim_runner_alloc();
 	if (!runner) {
 		bsim_atomic_file_abort(&traj);
-		if (a->out)
-			bsim_run_output_abort(&dir);
 		cli_error("out of memory for a trial runner");
+		if (a->out) {
+			bsim_run_output_abort(&dir);
+			return cli_session_close(&ss, CLI_FAIL, "run");
+		}
 		return CLI_FAIL;
 	}
 	bsim_error_clear(&err);
@@ -252,23 +287,30 @@ static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_re
 	bsim_runner_free(runner);
 	if (rc != BSIM_OK) {
 		bsim_atomic_file_abort(&traj);
-		if (a->out)
+		cli_report(rc, &err);
+		if (a->out) {
 			bsim_run_output_abort(&dir);
-		return cli_report(rc, &err);
+			return cli_session_close(&ss, rc, "run");
+		}
+		return rc;
 	}
 	if (a->trajectory) {
 		char mat[1200];
 		rc = bsim_atomic_file_commit(&traj, &err);
-		if (rc == BSIM_OK)
+		/* The twin is read back from the file: a pipe, a terminal or
+		 * standard output cannot be, and a link's twin would not be its. */
+		if (rc == BSIM_OK && traj.mode == BSIM_ATOMIC_RENAME) {
 			rc = bsim_matlab_path(a->trajectory, mat, sizeof mat, &err);
-		if (rc == BSIM_OK)
-			rc = bsim_matlab_from_csv(a->trajectory, mat, "trajectory", &err);
+			if (rc == BSIM_OK)
+				rc = bsim_matlab_from_csv(a->trajectory, mat, "trajectory", &err);
+		}
 	}
 	if (rc == BSIM_OK && a->out)
 		rc = bsim_run_output_commit(&dir, info, res, &err);
 	else if (a->out)
 		bsim_run_output_abort(&dir);
-	return cli_report(rc, &err);
+	rc = cli_report(rc, &err);
+	return a->out ? cli_session_close(&ss, rc, "run") : rc;
 }
 
 int cmd_run(int argc, char **argv)
@@ -309,10 +351,13 @@ int cmd_run(int argc, char **argv)
 		rc = log ? run_trial(&a, &info, &res, log) : CLI_FAIL;
 		if (!log)
 			cli_error("out of memory");
+		/* A trajectory on standard output keeps it to itself: the report
+		 * goes to standard error. */
+		FILE *out = a.trajectory && strcmp(a.trajectory, "-") == 0 ? stderr : stdout;
 		if (rc == CLI_OK && a.json)
-			bsim_run_json(stdout, &info, &res, 0);
+			bsim_run_json(out, &info, &res, 0);
 		else if (rc == CLI_OK)
-			print_text(&a, &scene, mixed, &res, log);
+			print_text(out, &a, &scene, mixed, &res, log);
 		if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {
 			char why[256];
 			bsim_trial_instability_text(&res, scene.dt, why, sizeof why);

@@ -25,7 +25,9 @@ static const char sweep_help[] =
         "repeat it. A group without random force is deterministic: its one trial runs\n"
         "once and fills every row. Unstable trials (non-finite state, or energy\n"
         "created beyond the ledger's bound) are counted and written like the others,\n"
-        "and make the exit status 1.\n"
+        "and make the exit status 1. The files appear together when the sweep is done\n"
+        "(DIR/manifest.json lists them); finished trials are journaled as they end, so a\n"
+        "stopped or killed sweep continues with --resume and gives the same files.\n"
         "\n"
         "Options:\n"
         "  --out DIR              output directory, created if missing (required)\n"
@@ -42,6 +44,7 @@ static const char sweep_help[] =
         "                         `beamsim plot DIR`\n"
         "  --trajectory-stride N  a trajectory row every N steps (default 5)\n"
         "  --quiet                no progress line, nothing on stdout\n"
+        "  --resume               continue the stopped run in DIR (same inputs)\n" CLI_LIMIT_HELP
         "  -h, --help             show this help\n"
         "\n"
         "A lattice experiment also writes DIR/lattice_map.csv, final_locations.csv,\n"
@@ -58,7 +61,9 @@ enum {
 	OPT_OVERLAP,
 	OPT_QUIET,
 	OPT_TRAJECTORIES,
-	OPT_TRAJECTORY_STRIDE
+	OPT_TRAJECTORY_STRIDE,
+	OPT_LIMIT,
+	OPT_RESUME
 };
 
 static const struct option sweep_options[] = {
@@ -73,6 +78,8 @@ static const struct option sweep_options[] = {
         {"quiet", no_argument, NULL, OPT_QUIET},
         {"trajectories", required_argument, NULL, OPT_TRAJECTORIES},
         {"trajectory-stride", required_argument, NULL, OPT_TRAJECTORY_STRIDE},
+        {"limit", required_argument, NULL, OPT_LIMIT},
+        {"resume", no_argument, NULL, OPT_RESUME},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -90,6 +97,9 @@ typedef struct sweep_args {
 	int overlap;
 	int quiet;
 	long keep, keep_stride;
+	int resume;
+	int argc; /* the command line, for the line that resumes it */
+	char **argv;
 } sweep_args;
 
 /* Fills a; returns -1 to go on, else the exit status. */
@@ -148,6 +158,12 @@ static int sweep_parse(int argc, char **argv, sweep_args *a)
 				rc = cli_usage("sweep",
 				               "--trajectory-stride %s: expected an integer >= 1",
 				               optarg);
+			break;
+		case OPT_LIMIT:
+			rc = cli_limit("sweep", optarg);
+			break;
+		case OPT_RESUME:
+			a->resume = 1;
 			break;
 		default:
 			return cli_bad_option("sweep", argv, c);
@@ -210,26 +226,34 @@ static int sweep_unstable(const sweep_args *a, const bsim_experiment *e,
 	return CLI_FAIL;
 }
 
-/* Loads, creates DIR (before the run, so an unusable DIR fails at once,
- * not after hours), runs, writes. A DIR created here is removed again if
- * the run fails, so a failed sweep leaves nothing behind. */
+/* Loads, opens DIR (before the run, so an unusable DIR fails at once, not
+ * after hours) with the journal, runs, writes into the staging area and
+ * commits. A failed or stopped sweep leaves DIR as it was. */
 static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 {
 	bsim_experiment e;
 	bsim_error err;
-	struct stat st;
 	int rc = cli_experiment_load(a->experiment, &a->sets, a->trials, &e);
 	if (rc != CLI_OK)
 		return rc;
 	if (a->has_seed)
 		e.seed = a->seed;
-	int created = stat(a->out, &st) != 0;
-	if (bsim_output_mkdir(a->out, &err) != BSIM_OK) {
-		cli_error("%s", err.msg);
+	bsim_run_record rec;
+	const bsim_options *opts = &a->opts;
+	cli_record_fill(&rec, "sweep", &e, 1, &backend, &opts, NULL, NULL);
+	char *inputs = bsim_run_record_inputs(&rec, &e, a->sets.ov, a->sets.n, &err);
+	/* --overlap adds a column to every trial: a run measured so continues so. */
+	if (inputs && a->overlap)
+		inputs = cli_text_append(inputs, "measure_overlap 1\n");
+	cli_session ss;
+	rc = inputs ? cli_session_open(&ss, a->out, a->resume, inputs, bsim_sweep_record_size(0),
+	                               a->argc, a->argv)
+	            : cli_report(err.code, &err);
+	free(inputs);
+	if (rc != CLI_OK) {
 		bsim_experiment_free(&e);
-		return CLI_FAIL;
+		return rc;
 	}
-
 	int threads = a->threads > 0 ? (int)a->threads : omp_get_max_threads();
 	bsim_sweep_config cfg = {
 	        .backend = backend,
@@ -240,19 +264,21 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 	        .measure_overlap = a->overlap,
 	        .keep = (int)a->keep,
 	        .keep_stride = (int)a->keep_stride,
+	        .journal = ss.journal,
+	        .stop = &cli_stop,
 	};
 	bsim_sweep_result r;
 	rc = cli_sweep_run(&e, &cfg, !a->quiet, &r);
-	if (rc != CLI_OK) {
-		if (created)
-			rmdir(a->out);
-	} else {
-		rc = cli_store_sweep(a->out, &e, backend, &a->opts, a->sets.ov, a->sets.n, &r);
+	if (rc == CLI_OK) {
+		rc = cli_store_sweep(ss.stage, &e, backend, &a->opts, a->sets.ov, a->sets.n, &r);
+		rc = cli_session_close(&ss, rc, "sweep");
 		if (rc == CLI_OK && !a->quiet)
 			sweep_report(a, &e, &r, threads);
 		if (rc == CLI_OK)
 			rc = sweep_unstable(a, &e, backend, &r);
 		bsim_sweep_result_free(&r);
+	} else {
+		rc = cli_session_close(&ss, rc, "sweep");
 	}
 	bsim_experiment_free(&e);
 	return rc;
@@ -260,7 +286,7 @@ static int sweep_main(const sweep_args *a, const bsim_backend *backend)
 
 int cmd_sweep(int argc, char **argv)
 {
-	sweep_args a = {.backend = "thesis"};
+	sweep_args a = {.backend = "thesis", .argc = argc, .argv = argv};
 	int rc = sweep_parse(argc, argv, &a);
 	if (rc < 0) {
 		const bsim_backend *backend = cli_backend(a.backend, &a.opts);

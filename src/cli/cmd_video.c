@@ -247,14 +247,14 @@ static int video_parse(int argc, char **argv, video_args *a)
 	return -1;
 }
 
-static void print_outcome(const char *name, const bsim_trial_result *r)
+static void print_outcome(FILE *out, const char *name, const bsim_trial_result *r)
 {
-	printf("%-11s %s at t = %.6g s", name, bsim_outcome_name(r->outcome), r->t_end);
+	fprintf(out, "%-11s %s at t = %.6g s", name, bsim_outcome_name(r->outcome), r->t_end);
 	if (r->outcome == BSIM_TRAVERSED)
-		printf(", %s type", bsim_type_name(r->type));
+		fprintf(out, ", %s type", bsim_type_name(r->type));
 	else if (r->outcome == BSIM_STUCK)
-		printf(", %s", r->in_contact_end ? "in contact" : "not in contact");
-	printf(", %d steps run\n", r->steps_run);
+		fprintf(out, ", %s", r->in_contact_end ? "in contact" : "not in contact");
+	fprintf(out, ", %d steps run\n", r->steps_run);
 }
 
 /* Records every backend's trial and writes the video. */
@@ -276,28 +276,33 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 		                      labels, a->n_backends, &v, &err);
 	if (rc == BSIM_OK)
 		rc = bsim_video_write(v, a->out, &err);
+	/* A video on standard output keeps it to itself: the report goes to
+	 * standard error. */
+	FILE *out = strcmp(a->out, "-") == 0 ? stderr : stdout;
 	if (rc == BSIM_OK) {
-		printf("scene       %s (%s), seed %" PRIu64 ", group %ld, trial %ld\n", a->scene,
-		       scene->name, a->seed, a->group, a->trial);
+		fprintf(out, "scene       %s (%s), seed %" PRIu64 ", group %ld, trial %ld\n",
+		        a->scene, scene->name, a->seed, a->group, a->trial);
 		for (int i = 0; i < a->n_backends; i++)
-			print_outcome(a->names[i], bsim_video_track_result(tracks[i]));
+			print_outcome(out, a->names[i], bsim_video_track_result(tracks[i]));
 		if (a->n_backends > 1) {
 			double t = bsim_video_track_separation(tracks[0], tracks[1],
 			                                       0.01 * scene->body.radius);
 			if (t >= 0.0)
-				printf("paths part  at t = %.6g s (%s and %s more than 1%% of the "
-				       "body radius apart)\n",
-				       t, a->names[0], a->names[1]);
+				fprintf(out,
+				        "paths part  at t = %.6g s (%s and %s more than 1%% of the "
+				        "body radius apart)\n",
+				        t, a->names[0], a->names[1]);
 			else
-				printf("paths part  never (%s and %s stay within 1%% of the body "
-				       "radius)\n",
-				       a->names[0], a->names[1]);
+				fprintf(out,
+				        "paths part  never (%s and %s stay within 1%% of the body "
+				        "radius)\n",
+				        a->names[0], a->names[1]);
 		}
 		int w, h;
 		bsim_video_size(v, &w, &h);
 		long frames = bsim_video_frames(v);
-		printf("wrote       %s: %dx%d, H.264 yuv420p, %g fps, %ld frames, %.6g s\n", a->out,
-		       w, h, a->def.fps, frames, (double)frames / a->def.fps);
+		fprintf(out, "wrote       %s: %dx%d, H.264 yuv420p, %g fps, %ld frames, %.6g s\n",
+		        a->out, w, h, a->def.fps, frames, (double)frames / a->def.fps);
 	}
 	bsim_video_free(v);
 	for (int i = 0; i < a->n_backends; i++)

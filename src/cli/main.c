@@ -1,4 +1,5 @@
 /* The beamsim program: dispatch to one subcommand per file. */
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -21,6 +22,8 @@ static const cli_command commands[] = {
         {"bench", cmd_bench, "measure the speed of a backend on the essay's experiments"},
         {"accuracy", cmd_accuracy,
          "what accuracy costs in time: error against speed per backend and step"},
+        {"landscape", cmd_landscape,
+         "the potential energy landscape of a scene, its barriers and figures"},
         {"plot", cmd_plot, "draw the figures of a sweep, comparison, run or accuracy study"},
         {"video", cmd_video, "an MP4 of one trial, on one backend or side by side"},
 };
@@ -41,11 +44,33 @@ static void usage(FILE *f)
 		fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
 	fputs("\n"
 	      "Exit status: 0 success, 1 a run failed, 2 bad usage or a bad scene or\n"
-	      "experiment file, 3 compare or regress found disagreement beyond tolerance.\n",
+	      "experiment file, 3 compare or regress found disagreement beyond tolerance,\n"
+	      "130 or 143 stopped by SIGINT or SIGTERM (sweep and compare keep their\n"
+	      "finished trials: rerun with --resume).\n",
 	      f);
 }
 
-int main(int argc, char **argv)
+/* What the command printed must have reached standard output: a full disk
+ * or a closed pipe is a failed run, not a success with a lost report. */
+static int close_stdout(int rc)
+{
+	int saved = 0;
+	errno = 0;
+	if (ferror(stdout)) {
+		clearerr(stdout); /* flushing again tells why the write failed */
+		saved = fflush(stdout) != 0 && errno ? errno : EIO;
+	} else if (fflush(stdout) != 0) {
+		saved = errno ? errno : EIO;
+	}
+	if (fclose(stdout) != 0 && !saved)
+		saved = errno ? errno : EIO;
+	if (!saved)
+		return rc;
+	fprintf(stderr, "beamsim: standard output: write failed: %s\n", strerror(saved));
+	return rc != CLI_OK ? rc : CLI_FAIL;
+}
+
+static int dispatch(int argc, char **argv)
 {
 	if (argc < 2) {
 		usage(stderr);
@@ -66,4 +91,9 @@ int main(int argc, char **argv)
 	fprintf(stderr, "beamsim: unknown command '%s'\n\n", name);
 	usage(stderr);
 	return CLI_USAGE;
+}
+
+int main(int argc, char **argv)
+{
+	return close_stdout(dispatch(argc, argv));
 }

@@ -1,0 +1,49 @@
+/* Limits on what an input may ask for. A scene or experiment that is valid
+ * YAML with valid values can still ask for more than a machine has: a grid
+ * of 10^9 groups, a random force refreshed 10^9 times a second, a trial of
+ * 10^12 beam-steps. Loading checks these limits and stops with one message
+ * naming the field, the value and the limit, and how to raise it
+ * (`--limit NAME=N` on the command line, bsim_limits_set in a program).
+ *
+ * The limits are process-wide, like GSL's error handler: set them once
+ * before loading, not while other threads load. */
+#ifndef BEAMSIM_LIMITS_H
+#define BEAMSIM_LIMITS_H
+
+#include "beamsim/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bsim_limits {
+	double input_bytes; /* size of a scene or experiment file, or a --set value */
+	double groups;      /* groups of an experiment's grid */
+	double trials;      /* groups x trials of one sweep or comparison */
+	double schedule;    /* random-force values of one trial: max_steps dt frequency */
+	double beam_steps;  /* max_steps x beams of one trial */
+} bsim_limits;
+
+/* The defaults: 1 MiB, 100,000 groups, 10^7 trials (about 200 bytes of
+ * memory each, twice that in a comparison), 10^6 random-force values (8 MB
+ * per thread) and 10^8 beam-steps (about 15 s of one core for the thesis
+ * backend on a gate). */
+bsim_limits bsim_limits_default(void);
+
+/* The limits in force (the defaults until bsim_limits_set). */
+const bsim_limits *bsim_limits_get(void);
+
+/* Replaces the limits in force; NULL restores the defaults. */
+void bsim_limits_set(const bsim_limits *l);
+
+/* Applies "NAME=N" (e.g. "groups=1e6") to l. BSIM_EINPUT naming the known
+ * names if NAME is unknown, or if N is not a number >= 1. */
+int bsim_limits_parse(bsim_limits *l, const char *text, bsim_error *err);
+
+/* "(limit NAME = N; raise it with --limit NAME=M)" for messages. */
+void bsim_limits_hint(char *buf, unsigned size, const char *name, double value);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

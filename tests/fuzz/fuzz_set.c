@@ -1,0 +1,50 @@
+/* Fuzz target: `--set KEY=VALUE` overrides on the essay's gate, one per
+ * line of the input (split at the first '=', as the program splits its
+ * argument), applied in order; an accepted scene then runs briefly. */
+#include "fuzz_common.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_SETS 8
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+	char *text = malloc(size + 1);
+	if (!text)
+		return 0;
+	memcpy(text, data, size);
+	text[size] = '\0';
+	/* Arguments are C strings: a NUL ends the text, as it would argv. */
+	bsim_override ov[MAX_SETS];
+	int n = 0;
+	for (char *line = text; line && n < MAX_SETS;) {
+		char *next = strchr(line, '\n');
+		if (next)
+			*next++ = '\0';
+		char *eq = strchr(line, '=');
+		if (eq && eq != line) {
+			*eq = '\0';
+			ov[n] = (bsim_override){line, eq + 1, NULL};
+			n++;
+		}
+		line = next;
+	}
+	char path[300];
+	snprintf(path, sizeof path, "%s/gate.yaml", fuzz_dir());
+	bsim_scene s;
+	bsim_error err;
+	bsim_error_clear(&err);
+	int rc = bsim_scene_load(path, ov, n, &s, &err);
+	if (rc != BSIM_OK)
+		fuzz_check_error(rc, &err);
+	else
+		fuzz_accepted();
+	if (rc == BSIM_OK)
+		fuzz_run_scene(&s);
+	if (rc == BSIM_OK)
+		bsim_scene_free(&s);
+	free(text);
+	return 0;
+}

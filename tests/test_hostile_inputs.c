@@ -1,0 +1,334 @@
+/* Hostile inputs through the real program: bytes that crash or hang
+ * libfyaml 0.7.12, text cut at a NUL, exponential aliases, valid values that
+ * ask for more memory or time than a machine has, extreme numbers. Each is
+ * refused within seconds with exit status 2 and one line naming where, the
+ * field or cause and the limit, or (extreme but valid numbers) runs without
+ * undefined behaviour: the sanitized build halts on any. The truth is the
+ * contract (DESIGN.md "Command line"), and, for the libfyaml cases, the
+ * crash and the hang that the same bytes cause without the checks. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "support.h"
+
+/* Any hang shows as a kill after this long, not as a stuck test. */
+#define TIMEOUT 60.0
+
+static const char *gate(void)
+{
+	static char path[1200];
+	snprintf(path, sizeof path, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	return path;
+}
+
+/* Writes n bytes to dir/name (the text may hold NULs); returns the path. */
+static const char *write_bytes(const char *name, const char *bytes, size_t n)
+{
+	static char path[1200];
+	snprintf(path, sizeof path, "%s/%s", bsim_test_dir(name), name);
+	FILE *f = fopen(path, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(bytes, 1, n, f), n);
+	assert_int_equal(fclose(f), 0);
+	return path;
+}
+
+/* argv exits 2 within seconds with one stderr line holding every needle. */
+static double expect_refusal(const char *const argv[], const char *const needles[])
+{
+	bsim_test_opts o = {.timeout = TIMEOUT};
+	char *err = NULL;
+	struct timespec t0, t1;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	int rc = bsim_test_cli_with(argv, &o, NULL, &err);
+	clock_gettime(CLOCK_MONOTONIC, &t1);
+	assert_non_null(err);
+	if (rc != 2)
+		fail_msg("exit status %d (137: killed after %g s), stderr: %s", rc, TIMEOUT, err);
+	for (int i = 0; needles[i]; i++)
+		if (!strstr(err, needles[i]))
+			fail_msg("stderr \"%s\" lacks \"%s\"", err, needles[i]);
+	const char *nl = strchr(err, '\n');
+	if (!nl || nl[1] != '\0')
+		fail_msg("expected one line on stderr, got \"%s\"", err);
+	free(err);
+	return (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+}
+
+static void run_refused(const char *path, const char *const needles[])
+{
+	const char *argv[] = {"run", path, NULL};
+	expect_refusal(argv, needles);
+}
+
+/* The six bytes that make libfyaml 0.7.12 dereference a bad pointer in
+ * fy_indent_vacuum_internal (a tab after an explicit key). */
+static void test_libfyaml_indent_crash(void **state)
+{
+	(void)state;
+	const char *needles[] = {"indent_crash.yaml:1:5: ", "tab character", NULL};
+	run_refused(write_bytes("indent_crash.yaml", "? -:\t-", 6), needles);
+}
+
+/* Two bytes on which libfyaml 0.7.12 loops for ever in fy_scan_directive:
+ * a directive followed by a byte that is not UTF-8; and the same with a
+ * sequence glibc's iconv accepts although it is above U+10FFFF. */
+static void test_libfyaml_directive_hang(void **state)
+{
+	(void)state;
+	const char *needles[] = {"hang.yaml:1:1: ", "directive", NULL};
+	run_refused(write_bytes("hang.yaml", "%\xcb", 2), needles);
+	const char *needles2[] = {"hang2.yaml:1:1: ", "directive", NULL};
+	run_refused(write_bytes("hang2.yaml", "%\xf4\x90\x80\x80", 5), needles2);
+	/* Not UTF-8 elsewhere: the byte, its line and column. */
+	const char *needles3[] = {"high.yaml:2:7: ", "byte 0xF4, which is not UTF-8", NULL};
+	run_refused(write_bytes("high.yaml", "# x\nname: \xf4\x90\x80\x80\n", 15), needles3);
+}
+
+/* A NUL byte used to end the document there, silently dropping the rest. */
+static void test_nul_byte(void **state)
+{
+	(void)state;
+	static const char text[] =
+	        "body: { mass: 1, radius: 10 }\n"
+	        "beams:\n"
+	        "  - { pivot: [-25, 30], length: 25, mass: 0.1, stiffness: 400 }\n"
+	        "\0effects: { propulsion: { force: 7 } }\n";
+	const char *needles[] = {"nul.yaml:4:1: ", "NUL byte", NULL};
+	run_refused(write_bytes("nul.yaml", text, sizeof text - 1), needles);
+}
+
+/* A Latin-1 comment (e9 is "é" in Latin-1, not UTF-8). */
+static void test_latin1_comment(void **state)
+{
+	(void)state;
+	char *g = bsim_test_read(gate());
+	assert_non_null(g);
+	size_t n = strlen(g);
+	char *text = malloc(n + 32);
+	int k = sprintf(text, "# r\xe9glage\n");
+	memcpy(text + k, g, n);
+	const char *needles[] = {"latin1.yaml:1:4: ", "byte 0xE9", NULL};
+	run_refused(write_bytes("latin1.yaml", text, (size_t)k + n), needles);
+	free(text);
+	free(g);
+}
+
+/* A lone carriage return, control characters, a second document. */
+static void test_other_bytes(void **state)
+{
+	(void)state;
+	const char *cr[] = {"cr.yaml:1:2: ", "carriage return", NULL};
+	run_refused(write_bytes("cr.yaml", ":\r:", 3), cr);
+	const char *esc[] = {"esc.yaml:1:7: ", "control character U+001B", NULL};
+	run_refused(write_bytes("esc.yaml", "name: \x1b[31m\n", 12), esc);
+	/* escaped quotes in a row: libfyaml 0.7.12 leaks a buffer on them (the
+	 * sanitized build's leak check fails without the refusal) */
+	const char *quotes[] = {"quotes.yaml:1:9: ", "four apostrophes in a row", NULL};
+	static const char q[] = "name: 'a''''''''''''b'\n";
+	run_refused(write_bytes("quotes.yaml", q, sizeof q - 1), quotes);
+	const char *doc[] = {"two.yaml: ", "one YAML document", NULL};
+	run_refused(write_bytes("two.yaml", "name: a\n---\nname: b\n", 20), doc);
+	/* CRLF line ends are text: the gate with them loads and runs. */
+	char *g = bsim_test_read(gate());
+	char *crlf = malloc(2 * strlen(g) + 1), *w = crlf;
+	for (const char *p = g; *p; p++)
+		w += *p == '\n' ? sprintf(w, "\r\n") : sprintf(w, "%c", *p);
+	const char *argv[] = {"run", write_bytes("crlf.yaml", crlf, (size_t)(w - crlf)), NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	free(crlf);
+	free(g);
+}
+
+/* Nine levels of nine aliases: 9^9 nodes if expanded, 342 bytes. */
+static void test_billion_laughs(void **state)
+{
+	(void)state;
+	char text[1024];
+	int n = sprintf(text, "a: &a [lol, lol, lol, lol, lol, lol, lol, lol, lol]\n");
+	for (char c = 'b'; c <= 'i'; c++)
+		n += sprintf(text + n, "%c: &%c [*%c, *%c, *%c, *%c, *%c, *%c, *%c, *%c, *%c]\n", c,
+		             c, c - 1, c - 1, c - 1, c - 1, c - 1, c - 1, c - 1, c - 1, c - 1);
+	const char *needles[] = {"laughs.yaml:2:", "b.0", "alias *a", NULL};
+	double s = 0;
+	const char *argv[] = {"run", write_bytes("laughs.yaml", text, (size_t)n), NULL};
+	s = expect_refusal(argv, needles);
+	assert_true(s < 10);
+}
+
+/* The size limit, and raising it. */
+static void test_size_limit(void **state)
+{
+	(void)state;
+	char *g = bsim_test_read(gate());
+	size_t n = strlen(g), big = 1100000;
+	char *text = malloc(big + n);
+	memset(text, '#', big);
+	for (size_t i = 80; i < big; i += 81)
+		text[i] = '\n';
+	text[big - 1] = '\n';
+	memcpy(text + big, g, n);
+	const char *path = write_bytes("big.yaml", text, big + n);
+	const char *needles[] = {"big.yaml: ", "at most 1048576 bytes", "--limit input_bytes=N",
+	                         NULL};
+	run_refused(path, needles);
+	const char *raised[] = {"run", path, "--limit", "input_bytes=2e6", NULL};
+	assert_int_equal(bsim_test_cli(raised, NULL, NULL), 0);
+	free(text);
+	free(g);
+}
+
+/* The same hazards through --set, and the --set with spaces that used to
+ * report "out of memory" (and leak: the sanitized build checks leaks). */
+static void test_set_values(void **state)
+{
+	(void)state;
+	static const struct {
+		const char *set;
+		const char *needle;
+	} cases[] = {
+	        {"body.mass=\t2", "tab character"},
+	        {"body.mass=%\xcb", "directive"},
+	        {"body=? -:\t-", "tab character"},
+	        {"name=caf\xe9", "byte 0xE9"},
+	        {"body.mass=*x", "alias *x"},
+	        {"body.mass=[1,", "expected a YAML value"},
+	        {"body.ma ss=2", "expected a dotted key"},
+	        {"effects.random_force.frequency=1e9", "--limit schedule=N"},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		const char *argv[] = {"run", gate(), "--set", cases[i].set, NULL};
+		const char *needles[] = {"--set ", cases[i].needle, NULL};
+		expect_refusal(argv, needles);
+	}
+	char *spaced = NULL, *plain = NULL;
+	const char *a[] = {"run", gate(), "--json", "--set", "body.mass = 2", NULL};
+	const char *b[] = {"run", gate(), "--json", "--set", "body.mass=2", NULL};
+	const char *c[] = {"run", gate(), "--json", NULL};
+	char *heavy = NULL;
+	assert_int_equal(bsim_test_cli(a, &spaced, NULL), 0);
+	assert_int_equal(bsim_test_cli(b, &plain, NULL), 0);
+	assert_int_equal(bsim_test_cli(c, &heavy, NULL), 0);
+	assert_string_equal(spaced, plain);
+	assert_string_not_equal(plain, heavy); /* the override took effect */
+	free(spaced);
+	free(plain);
+	free(heavy);
+}
+
+/* Valid values that ask for too much: each names its field and limit, and
+ * is refused at once, not after validating 10^9 groups or allocating
+ * gigabytes. */
+static void test_limits(void **state)
+{
+	(void)state;
+	char *g = bsim_test_read(gate());
+	char *fast = malloc(strlen(g) + 64);
+	/* frequency 1e9 Hz in the file: 1.2e10 random-force values a trial */
+	char *f = strstr(g, "frequency: 50.0");
+	assert_non_null(f);
+	sprintf(fast, "%.*sfrequency: 1e9%s", (int)(f - g), g, f + strlen("frequency: 50.0"));
+	const char *sched[] = {"frequency.yaml:", "effects.random_force.frequency",
+	                       "random-force values", "--limit schedule=N", NULL};
+	run_refused(write_bytes("frequency.yaml", fast, strlen(fast)), sched);
+	const char *steps[] = {"run",   gate(),
+	                       "--set", "effects.random_force.magnitude=0",
+	                       "--set", "integration.max_steps=2000000000",
+	                       NULL};
+	const char *steps_needles[] = {"integration.max_steps", "beam-steps",
+	                               "--limit beam_steps=N", NULL};
+	expect_refusal(steps, steps_needles);
+
+	/* 10^9 groups from nine lists of ten, in 600 bytes */
+	char exp[2048];
+	int n = sprintf(exp, "scene: %s\ntrials: 10\nseed: 1\ngrid:\n", gate());
+	const char *keys[] = {"body.mass",         "body.radius",     "beams.0.stiffness",
+	                      "beams.1.stiffness", "beams.0.damping", "beams.1.damping",
+	                      "beams.0.mass",      "beams.1.mass",    "contact.restitution"};
+	for (int k = 0; k < 9; k++)
+		n += sprintf(exp + n, "  %s: [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]\n",
+		             keys[k]);
+	const char *path = write_bytes("groups.yaml", exp, (size_t)n);
+	const char *sweep[] = {"sweep", path, "--out", bsim_test_dir("groups_out"), NULL};
+	const char *groups_needles[] = {"groups.yaml:5:3: grid: ", "1000000000", "--limit groups=N",
+	                                NULL};
+	assert_true(expect_refusal(sweep, groups_needles) < 10);
+
+	/* H1 has 30 groups: a limit of 29 refuses it, 30 admits it. */
+	const char *h1 = bsim_test_src("configs/thesis/h1_symmetric.yaml");
+	char h1_path[1200];
+	snprintf(h1_path, sizeof h1_path, "%s", h1);
+	const char *low[] = {"sweep",   h1_path,     "--quiet", "--trials",           "1",
+	                     "--limit", "groups=29", "--out",   bsim_test_dir("low"), NULL};
+	const char *low_needles[] = {"grid: ", "at most 29 groups", "got 30", NULL};
+	expect_refusal(low, low_needles);
+	const char *ok[] = {"sweep",   h1_path,     "--quiet", "--trials",          "1",
+	                    "--limit", "groups=30", "--out",   bsim_test_dir("ok"), NULL};
+	assert_int_equal(bsim_test_cli(ok, NULL, NULL), 0);
+	/* --trials beyond the limit of trials in all */
+	const char *many[] = {
+	        "sweep", h1_path, "--trials", "400000", "--out", bsim_test_dir("many"), NULL};
+	const char *many_needles[] = {"--trials 400000", "30 groups x 400000 trials",
+	                              "--limit trials=N", NULL};
+	expect_refusal(many, many_needles);
+	free(fast);
+	free(g);
+}
+
+/* Extreme but valid numbers: every double-to-integer conversion they reach
+ * is defined (the sanitized build halts on one that is not: UBSan's
+ * float-cast-overflow). Each run ends with a result or a stated failure. */
+static void test_extreme_numbers(void **state)
+{
+	(void)state;
+	static const char *const sets[][2] = {
+	        {"beams.0.rest_angle_deg=1e300", "beams.1.rest_angle_deg=-1e300"},
+	        {"beams.0.rest_angle_deg=9.3e18", "beams.1.rest_angle_deg=180"},
+	        {"integration.dt=1e-300", "effects.random_force.frequency=1e-300"},
+	        {"integration.dt=1e300", "integration.max_steps=2"},
+	        {"effects.random_force.frequency=3e-9", "integration.dt=1e-300"},
+	        {"effects.random_force.frequency=1e5", "integration.dt=1e-8"},
+	        {"body.mass=1e-300", "body.velocity=[1e300, -1e300]"},
+	};
+	const char *backends[] = {"thesis", "box2d"};
+	for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++) {
+		for (int b = 0; b < 2; b++) {
+			const char *argv[] = {"run",       gate(),     "--backend",
+			                      backends[b], "--set",    sets[i][0],
+			                      "--set",     sets[i][1], NULL};
+			char *err = NULL;
+			bsim_test_opts o = {.timeout = TIMEOUT};
+			int rc = bsim_test_cli_with(argv, &o, NULL, &err);
+			if ((rc != 0 && rc != 1 && rc != 2) || strstr(err, "runtime error"))
+				fail_msg("%s --set %s --set %s: exit %d, stderr %s", backends[b],
+				         sets[i][0], sets[i][1], rc, err);
+			free(err);
+		}
+	}
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_libfyaml_indent_crash),
+	        cmocka_unit_test(test_libfyaml_directive_hang),
+	        cmocka_unit_test(test_nul_byte),
+	        cmocka_unit_test(test_latin1_comment),
+	        cmocka_unit_test(test_other_bytes),
+	        cmocka_unit_test(test_billion_laughs),
+	        cmocka_unit_test(test_size_limit),
+	        cmocka_unit_test(test_set_values),
+	        cmocka_unit_test(test_limits),
+	        cmocka_unit_test(test_extreme_numbers),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

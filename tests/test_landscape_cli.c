@@ -1,0 +1,318 @@
+/* beamsim landscape through the real program: the files it writes agree
+ * with the library's landscape point by point (CSV) and with each other
+ * (the MATLAB file read back by libmatio's own reader, the JSON), the
+ * figures are PNG and SVG under 1 MB, --resolution, --region and --set do
+ * what they say, and every bad input exits 2 with a message naming it and
+ * writes nothing. */
+#define _POSIX_C_SOURCE 200809L
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <math.h>
+#include <matio.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "beamsim/landscape.h"
+#include "support.h"
+
+static char out_dir[1024];
+
+static const char *path_in(const char *dir, const char *name)
+{
+	static char p[1200];
+	snprintf(p, sizeof p, "%s/%s", dir, name);
+	return p;
+}
+
+static long file_size(const char *path)
+{
+	struct stat st;
+	return stat(path, &st) == 0 ? (long)st.st_size : -1;
+}
+
+/* The number after "key": in text, searching from start. */
+static double json_number_after(const char *text, const char *key)
+{
+	char pat[128];
+	snprintf(pat, sizeof pat, "\"%s\": ", key);
+	const char *p = strstr(text, pat);
+	assert_non_null(p);
+	return strtod(p + strlen(pat), NULL);
+}
+
+static int setup(void **state)
+{
+	(void)state;
+	snprintf(out_dir, sizeof out_dir, "%s", bsim_test_dir("landscape_gate"));
+	char *out = NULL, *err = NULL;
+	const char *argv[] = {"landscape", bsim_test_src("configs/thesis/gate.yaml"), "--out",
+	                      out_dir, NULL};
+	struct timespec t0, t1;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	int rc = bsim_test_cli(argv, &out, &err);
+	clock_gettime(CLOCK_MONOTONIC, &t1);
+	print_message("beamsim landscape configs/thesis/gate.yaml: %.2f s (this build)\n",
+	              (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
+	if (rc != 0)
+		fail_msg("exit %d: %s", rc, err ? err : "");
+	assert_non_null(strstr(out, "lowest pass"));
+	assert_non_null(strstr(out, "over beam 2"));
+	free(out);
+	free(err);
+	return 0;
+}
+
+/* landscape.csv: the contract's columns, one row per point, each value
+ * the library's landscape at that point. */
+static void test_csv(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_error err;
+	assert_int_equal(
+	        bsim_scene_load(bsim_test_src("configs/thesis/gate.yaml"), NULL, 0, &s, &err),
+	        BSIM_OK);
+	FILE *f = fopen(path_in(out_dir, "landscape.csv"), "r");
+	assert_non_null(f);
+	char line[512];
+	assert_non_null(fgets(line, sizeof line, f));
+	assert_string_equal(line, "x,y,e_beam,e_prop,e_total,theta1,theta2\n");
+	long rows = 0;
+	double worst = 0.0;
+	while (fgets(line, sizeof line, f)) {
+		double v[7];
+		assert_int_equal(sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2],
+		                        &v[3], &v[4], &v[5], &v[6]),
+		                 7);
+		if (rows % 97 == 0) {
+			double th[2], eb, ep;
+			const double e = bsim_landscape_energy(&s, v, th, &eb, &ep);
+			const double ref[5] = {eb, ep, e, th[0], th[1]};
+			for (int i = 0; i < 5; i++)
+				worst = fmax(worst,
+				             fabs(v[2 + i] - ref[i]) / fmax(1.0, fabs(ref[i])));
+		}
+		rows++;
+	}
+	fclose(f);
+	print_message("landscape.csv: %ld rows, largest relative difference %.2g\n", rows, worst);
+	assert_int_equal(rows, 201 * 261); /* 0.25 m over [-25, 25] x [0, 65] */
+	assert_true(worst < 1e-9);         /* %.10g */
+	bsim_scene_free(&s);
+}
+
+/* landscape.mat read back: the grid's columns equal the CSV's, the shape,
+ * and the barrier table's lowest pass equals landscape.json's. */
+static void test_mat(void **state)
+{
+	(void)state;
+	mat_t *mat = Mat_Open(path_in(out_dir, "landscape.mat"), MAT_ACC_RDONLY);
+	assert_non_null(mat);
+	matvar_t *v = Mat_VarRead(mat, "landscape");
+	assert_non_null(v);
+	matvar_t *et = Mat_VarGetStructFieldByName(v, "e_total", 0);
+	matvar_t *nx = Mat_VarGetStructFieldByName(v, "nx", 0);
+	matvar_t *ny = Mat_VarGetStructFieldByName(v, "ny", 0);
+	matvar_t *th2 = Mat_VarGetStructFieldByName(v, "theta2", 0);
+	matvar_t *bar = Mat_VarGetStructFieldByName(v, "barriers", 0);
+	assert_non_null(et);
+	assert_non_null(nx);
+	assert_non_null(ny);
+	assert_non_null(th2);
+	assert_non_null(bar);
+	assert_true(((double *)nx->data)[0] == 201 && ((double *)ny->data)[0] == 261);
+	assert_int_equal(et->dims[0], 201 * 261);
+	/* every e_total against the CSV (printed with 10 digits) */
+	FILE *f = fopen(path_in(out_dir, "landscape.csv"), "r");
+	char line[512];
+	assert_non_null(fgets(line, sizeof line, f));
+	const double *e = et->data;
+	size_t k = 0;
+	double x, y, eb, ep, etot;
+	while (fgets(line, sizeof line, f)) {
+		assert_int_equal(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &x, &y, &eb, &ep, &etot), 5);
+		assert_true(fabs(e[k] - etot) <= 1e-9 * fmax(1.0, fabs(etot)));
+		k++;
+	}
+	fclose(f);
+	assert_int_equal(k, et->dims[0]);
+	matvar_t *be = Mat_VarGetStructFieldByName(bar, "e_total", 0);
+	matvar_t *kind = Mat_VarGetStructFieldByName(bar, "kind", 0);
+	assert_non_null(be);
+	assert_non_null(kind);
+	assert_int_equal(be->dims[0], 3); /* lowest, beam 1, beam 2 */
+	char *json = bsim_test_read(path_in(out_dir, "landscape.json"));
+	assert_non_null(json);
+	const char *lowest = strstr(json, "\"lowest_pass\"");
+	assert_non_null(lowest);
+	assert_true(((double *)be->data)[0] == json_number_after(lowest, "e_total"));
+	assert_non_null(strstr(lowest, "\"kind\": \"saddle\""));
+	free(json);
+	Mat_VarFree(v);
+	Mat_Close(mat);
+}
+
+/* Figures: PNG and SVG, each under 1 MB, scripts beside them. */
+static void test_figures(void **state)
+{
+	(void)state;
+	const char *names[] = {"landscape_top", "landscape_beam", "landscape_total"};
+	for (int i = 0; i < 3; i++) {
+		char n[64];
+		snprintf(n, sizeof n, "%s.gp", names[i]);
+		assert_true(file_size(path_in(out_dir, n)) > 0);
+		snprintf(n, sizeof n, "%s.png", names[i]);
+		const long png = file_size(path_in(out_dir, n));
+		snprintf(n, sizeof n, "%s.svg", names[i]);
+		const long svg = file_size(path_in(out_dir, n));
+		print_message("%s: png %ld bytes, svg %ld bytes\n", names[i], png, svg);
+		assert_true(png > 1000 && png < 1000000);
+		assert_true(svg > 1000 && svg < 1000000);
+		snprintf(n, sizeof n, "%s.png", names[i]);
+		char *img = bsim_test_read(path_in(out_dir, n));
+		assert_non_null(img);
+		assert_memory_equal(img, "\x89PNG", 4);
+		free(img);
+	}
+}
+
+/* --resolution, --region and --set. */
+static void test_options(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("landscape_options");
+	char *out = NULL, *err = NULL;
+	const char *argv[] = {"landscape",
+	                      bsim_test_src("configs/thesis/gate.yaml"),
+	                      "--resolution",
+	                      "0.5",
+	                      "--region",
+	                      "-25,25,15,65",
+	                      "--set",
+	                      "beams.0.stiffness=100",
+	                      "--set",
+	                      "beams.1.stiffness=500",
+	                      "--out",
+	                      dir,
+	                      NULL};
+	int rc = bsim_test_cli(argv, &out, &err);
+	if (rc != 0)
+		fail_msg("exit %d: %s", rc, err ? err : "");
+	char *json = bsim_test_read(path_in(dir, "landscape.json"));
+	assert_non_null(json);
+	assert_true(json_number_after(json, "nx") == 101 && json_number_after(json, "ny") == 101);
+	assert_true(json_number_after(json, "spacing") == 0.5);
+	/* the softer left beam: no barrier over it at the gate's 7 N */
+	const char *lowest = strstr(json, "\"lowest_pass\"");
+	assert_non_null(strstr(lowest, "\"kind\": \"open\", \"crossed\": 1"));
+	free(json);
+	/* a square region: the surfaces' most quadrangles, still under 1 MB */
+	const char *figs[] = {"landscape_top.svg", "landscape_beam.svg", "landscape_total.svg",
+	                      "landscape_top.png", "landscape_beam.png", "landscape_total.png"};
+	for (int i = 0; i < 6; i++) {
+		const long size = file_size(path_in(dir, figs[i]));
+		print_message("square region: %s %ld bytes\n", figs[i], size);
+		assert_true(size > 1000 && size < 1000000);
+	}
+	free(out);
+	free(err);
+}
+
+/* Status 2, stderr holding every needle, and no output directory. */
+static void expect_bad(const char *const argv[], const char *dir, const char *const needles[])
+{
+	char *out = NULL, *err = NULL;
+	int rc = bsim_test_cli(argv, &out, &err);
+	assert_non_null(err);
+	if (rc != 2)
+		fail_msg("exit status %d, stderr: %s", rc, err);
+	for (int i = 0; needles[i]; i++)
+		if (!strstr(err, needles[i]))
+			fail_msg("stderr \"%s\" lacks \"%s\"", err, needles[i]);
+	assert_true(file_size(dir) < 0);
+	free(out);
+	free(err);
+}
+
+static void test_errors(void **state)
+{
+	(void)state;
+	const char *base = bsim_test_dir("landscape_errors");
+	char gone[1100];
+	snprintf(gone, sizeof gone, "%s/never", base);
+	const char *gate = bsim_test_src("configs/thesis/gate.yaml");
+	const char *bad = bsim_test_write(base, "bad.yaml",
+	                                  "body: { mass: 1, radius: 10 }\n"
+	                                  "beams:\n"
+	                                  "  - { pivot: [-25, 30], length: 25, mass: 0.1,\n"
+	                                  "      stiffness: -4 }\n");
+	char bad_path[1100];
+	snprintf(bad_path, sizeof bad_path, "%s", bad);
+	{
+		const char *argv[] = {"landscape", bad_path, "--out", gone, NULL};
+		const char *needles[] = {"bad.yaml:4:18: ", "beams.0.stiffness", NULL};
+		expect_bad(argv, gone, needles);
+	}
+	{
+		const char *argv[] = {"landscape", gate, "--set", "body.radius=-1",
+		                      "--out",     gone, NULL};
+		const char *needles[] = {"--set body.radius=-1", "body.radius", NULL};
+		expect_bad(argv, gone, needles);
+	}
+	{
+		const char *argv[] = {"landscape", gate, "--resolution", "-1", "--out", gone, NULL};
+		const char *needles[] = {"--resolution -1", "spacing > 0", NULL};
+		expect_bad(argv, gone, needles);
+	}
+	{
+		const char *argv[] = {"landscape", gate, "--resolution", "0.001", "--out",
+		                      gone,        NULL};
+		const char *needles[] = {"resolution 0.001 m", "more than", NULL};
+		expect_bad(argv, gone, needles);
+	}
+	{
+		const char *argv[] = {"landscape", gate, "--region", "1,2,3", "--out", gone, NULL};
+		const char *needles[] = {"--region 1,2,3", "X0,X1,Y0,Y1", NULL};
+		expect_bad(argv, gone, needles);
+	}
+	{
+		const char *argv[] = {"landscape", gate, "--region", "5,-5,0,65",
+		                      "--out",     gone, NULL};
+		const char *needles[] = {"--region 5,-5,0,65", "X0 < X1", NULL};
+		expect_bad(argv, gone, needles);
+	}
+	{ /* the far edge at y = 40 m lies within both beams' reach */
+		const char *argv[] = {"landscape", gate, "--region", "-25,25,0,40",
+		                      "--out",     gone, NULL};
+		const char *needles[] = {"far side", "extend the region", NULL};
+		expect_bad(argv, gone, needles);
+	}
+	{
+		const char *argv[] = {"landscape", gate, NULL};
+		const char *needles[] = {"missing --out", NULL};
+		expect_bad(argv, gone, needles);
+	}
+	{
+		const char *argv[] = {"landscape", gate, "--bogus", "--out", gone, NULL};
+		const char *needles[] = {"unknown option --bogus", NULL};
+		expect_bad(argv, gone, needles);
+	}
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_csv),     cmocka_unit_test(test_mat),
+	        cmocka_unit_test(test_figures), cmocka_unit_test(test_options),
+	        cmocka_unit_test(test_errors),
+	};
+	return cmocka_run_group_tests(tests, setup, NULL);
+}

@@ -1,0 +1,363 @@
+/* Output files and directories through the real program. The truths are
+ * the contracts: "-" is standard output; a symlink, FIFO or device is
+ * written through and stays what it was; an output directory that cannot
+ * be written is refused (exit 2) before any work; a directory's files are
+ * replaced as a set (a failed rerun leaves the previous set whole, and its
+ * manifest then still matches it); files a previous run listed and this one
+ * did not write are removed, files beamsim did not write are kept; a write
+ * error on standard output fails the run; messages name the user's paths. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "beamsim/outdir.h"
+#include "support.h"
+
+static char gate[1200], h1[1200];
+
+static int setup(void **state)
+{
+	(void)state;
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	snprintf(h1, sizeof h1, "%s", bsim_test_src("configs/thesis/h1_symmetric.yaml"));
+	return 0;
+}
+
+static char *join(const char *dir, const char *name)
+{
+	static char buf[4][1400];
+	static int k;
+	k = (k + 1) % 4;
+	if (snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name) >= (int)sizeof buf[k])
+		fail_msg("path too long");
+	return buf[k];
+}
+
+static int count_lines(const char *s)
+{
+	int n = 0;
+	for (; *s; s++)
+		n += *s == '\n';
+	return n;
+}
+
+static void test_trajectory_to_stdout(void **state)
+{
+	(void)state;
+	char *out = NULL, *err = NULL;
+	const char *argv[] = {"run", gate, "--trajectory", "-", "--stride", "500", NULL};
+	assert_int_equal(bsim_test_cli(argv, &out, &err), 0);
+	assert_int_equal(strncmp(out, "t,x,y,vx,vy,", 12), 0);
+	/* t = 0, every 500th of 3000 steps, the final state: 8 rows */
+	assert_int_equal(count_lines(out), 8);
+	assert_non_null(strstr(err, "outcome")); /* the report went to stderr */
+	assert_int_equal(access("-", F_OK), -1); /* no file named "-" */
+	free(out);
+	free(err);
+}
+
+static void test_trajectory_through_symlink(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("symlink");
+	char target[1400], link[1400];
+	snprintf(target, sizeof target, "%s", join(dir, "target.csv"));
+	snprintf(link, sizeof link, "%s", join(dir, "link.csv"));
+	assert_int_equal(symlink(target, link), 0);
+	const char *argv[] = {"run", gate, "--trajectory", link, NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	struct stat st;
+	assert_int_equal(lstat(link, &st), 0);
+	assert_true(S_ISLNK(st.st_mode));
+	char *csv = bsim_test_read(target);
+	assert_non_null(csv);
+	assert_int_equal(count_lines(csv), 3002); /* header, t = 0 and 3000 steps */
+	free(csv);
+}
+
+static void test_trajectory_through_fifo_and_device(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("fifo");
+	char fifo[1400], copy[1400];
+	snprintf(fifo, sizeof fifo, "%s", join(dir, "pipe"));
+	snprintf(copy, sizeof copy, "%s", join(dir, "copy.csv"));
+	assert_int_equal(mkfifo(fifo, 0600), 0);
+	fflush(NULL);
+	pid_t reader = fork();
+	if (reader == 0) { /* cat pipe > copy.csv */
+		int in = open(fifo, O_RDONLY), out = open(copy, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+		char buf[4096];
+		ssize_t k;
+		while ((k = read(in, buf, sizeof buf)) > 0)
+			if (write(out, buf, (size_t)k) != k)
+				_exit(1);
+		_exit(close(out) != 0);
+	}
+	const char *argv[] = {"run", gate, "--trajectory", fifo, "--stride", "1000", NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	int status = 0;
+	waitpid(reader, &status, 0);
+	assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+	struct stat st;
+	assert_int_equal(lstat(fifo, &st), 0);
+	assert_true(S_ISFIFO(st.st_mode));
+	char *csv = bsim_test_read(copy);
+	assert_int_equal(count_lines(csv), 5);
+	free(csv);
+	const char *dev[] = {"run", gate, "--trajectory", "/dev/null", NULL};
+	assert_int_equal(bsim_test_cli(dev, NULL, NULL), 0);
+	assert_int_equal(stat("/dev/null", &st), 0);
+	assert_true(S_ISCHR(st.st_mode));
+}
+
+/* A full standard output is a failed run, named as such. */
+static void test_stdout_errors(void **state)
+{
+	(void)state;
+	bsim_test_opts full = {.out = "/dev/full"};
+	const char *cmds[][6] = {
+	        {"backends", NULL},
+	        {"run", gate, NULL},
+	        {"run", gate, "--trajectory", "-", NULL},
+	        {"--help", NULL},
+	};
+	for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++) {
+		char *err = NULL;
+		assert_int_equal(bsim_test_cli_with(cmds[i], &full, NULL, &err), 1);
+		assert_non_null(
+		        strstr(err, "standard output: write failed: No space left on device"));
+		free(err);
+	}
+}
+
+static double seconds_since(const struct timespec *t0)
+{
+	struct timespec t1;
+	clock_gettime(CLOCK_MONOTONIC, &t1);
+	return (double)(t1.tv_sec - t0->tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0->tv_nsec);
+}
+
+/* An unusable --out is refused before the sweep, which would take minutes:
+ * 150,000 trials. */
+static void test_unwritable_out(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("unwritable");
+	char file[1400], under[1400], ro[1400];
+	snprintf(file, sizeof file, "%s", bsim_test_write(dir, "file", "x\n"));
+	snprintf(under, sizeof under, "%s", join(file, "sub"));
+	snprintf(ro, sizeof ro, "%s", join(dir, "readonly"));
+	mkdir(ro, 0500);
+	/* root writes anywhere it has permission bits for; /proc it cannot */
+	const char *locked = geteuid() == 0 ? "/proc/self/fdinfo" : ro;
+	const char *const outs[][2] = {
+	        {file, "expected an output directory, got a file"},
+	        {under, "cannot write to the output directory: Not a directory"},
+	        {locked, "cannot write to the output directory"},
+	};
+	for (size_t i = 0; i < 3; i++) {
+		const char *argv[] = {"sweep", h1, "--trials", "5000", "--out", outs[i][0], NULL};
+		char *err = NULL;
+		struct timespec t0;
+		clock_gettime(CLOCK_MONOTONIC, &t0);
+		bsim_test_opts o = {.timeout = 60};
+		assert_int_equal(bsim_test_cli_with(argv, &o, NULL, &err), 2);
+		assert_true(seconds_since(&t0) < 5);
+		if (!strstr(err, outs[i][1]) || !strstr(err, outs[i][0]))
+			fail_msg("stderr \"%s\" lacks \"%s\"", err, outs[i][1]);
+		free(err);
+	}
+	chmod(ro, 0700);
+}
+
+/* Two runs cannot write one directory at once. */
+static void test_lock(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("locked");
+	int fd = open(dir, O_RDONLY | O_DIRECTORY);
+	assert_true(fd >= 0);
+	assert_int_equal(flock(fd, LOCK_EX | LOCK_NB), 0);
+	const char *argv[] = {"sweep", h1, "--trials", "1", "--quiet", "--out", dir, NULL};
+	char *err = NULL;
+	assert_int_equal(bsim_test_cli(argv, NULL, &err), 2);
+	assert_non_null(strstr(err, "another beamsim run is writing this directory"));
+	close(fd);
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	free(err);
+}
+
+/* A rerun into a directory on a disk that fills up (RLIMIT_FSIZE: no file
+ * may pass 30 kB, trials.csv needs 51 kB) fails naming the user's path,
+ * and the directory keeps the previous run's files, whole, with their
+ * manifest. regress reruns a stored sweep into --out without a journal. */
+static void test_failed_rerun_keeps_previous_set(void **state)
+{
+	(void)state;
+	const char *base1 = bsim_test_dir("base1"), *base2 = NULL;
+	char b1[1400], b2[1400], out[1400];
+	snprintf(b1, sizeof b1, "%s", base1);
+	const char *s1[] = {"sweep", h1, "--trials", "20", "--quiet", "--out", b1, NULL};
+	assert_int_equal(bsim_test_cli(s1, NULL, NULL), 0);
+	base2 = bsim_test_dir("base2");
+	snprintf(b2, sizeof b2, "%s", base2);
+	const char *s2[] = {"sweep", h1,        "--trials", "20", "--seed",
+	                    "2",     "--quiet", "--out",    b2,   NULL};
+	assert_int_equal(bsim_test_cli(s2, NULL, NULL), 0);
+	snprintf(out, sizeof out, "%s", bsim_test_dir("rerun"));
+	const char *r1[] = {"regress", b1, "--quiet", "--out", out, NULL};
+	assert_int_equal(bsim_test_cli(r1, NULL, NULL), 0);
+	char *before = bsim_test_read(join(out, "trials.csv"));
+	char *before_json = bsim_test_read(join(out, "regress.json"));
+
+	const char *r2[] = {"regress", b2, "--quiet", "--out", out, NULL};
+	bsim_test_opts small = {.fsize = 30000};
+	char *err = NULL;
+	assert_int_equal(bsim_test_cli_with(r2, &small, NULL, &err), 1);
+	if (!strstr(err, join(out, "trials.csv")) || strstr(err, ".beamsim") ||
+	    strstr(err, ".tmp."))
+		fail_msg("expected a message naming %s, got \"%s\"", join(out, "trials.csv"), err);
+	char *after = bsim_test_read(join(out, "trials.csv"));
+	char *after_json = bsim_test_read(join(out, "regress.json"));
+	assert_string_equal(before, after);
+	assert_string_equal(before_json, after_json);
+	int has = 0;
+	bsim_error e;
+	assert_int_equal(bsim_outdir_verify(out, &has, &e), BSIM_OK);
+	assert_int_equal(has, 1);
+	assert_int_equal(access(join(out, ".beamsim"), F_OK), -1); /* no staging left */
+	free(before);
+	free(after);
+	free(before_json);
+	free(after_json);
+	free(err);
+}
+
+/* Rerunning a sweep into a comparison's directory removes what the
+ * comparison wrote and the sweep does not (its manifest lists them), keeps
+ * what beamsim never wrote, and writes through a symlinked trials.csv. */
+static void test_replacing_a_set(void **state)
+{
+	(void)state;
+	const char *d = bsim_test_dir("replace");
+	char dir[1400], elsewhere[1400];
+	snprintf(dir, sizeof dir, "%s", d);
+	const char *cmp[] = {"compare", h1, "--trials", "1", "--quiet", "--out", dir, NULL};
+	int rc = bsim_test_cli(cmp, NULL, NULL);
+	assert_true(rc == 0 || rc == 3);
+	assert_int_equal(access(join(dir, "pairs.csv"), F_OK), 0);
+	bsim_test_write(dir, "notes.txt", "mine\n");
+	snprintf(elsewhere, sizeof elsewhere, "%s", join(bsim_test_dir("elsewhere"), "t.csv"));
+	assert_int_equal(symlink(elsewhere, join(dir, "trials.csv")), 0);
+	const char *sweep[] = {"sweep", h1, "--trials", "1", "--quiet", "--out", dir, NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	const char *gone[] = {"pairs.csv", "report.md", "report.json", "thesis/trials.csv",
+	                      "box2d/summary.json"};
+	for (int i = 0; i < 5; i++)
+		if (access(join(dir, gone[i]), F_OK) == 0)
+			fail_msg("%s of the comparison is still there", gone[i]);
+	assert_int_equal(access(join(dir, "notes.txt"), F_OK), 0);
+	struct stat st;
+	assert_int_equal(lstat(join(dir, "trials.csv"), &st), 0);
+	assert_true(S_ISLNK(st.st_mode));
+	char *csv = bsim_test_read(elsewhere);
+	assert_int_equal(count_lines(csv), 31); /* header and 30 groups x 1 trial */
+	int has = 0;
+	bsim_error e;
+	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_OK);
+	assert_int_equal(has, 1);
+	free(csv);
+}
+
+/* The reader's check: a file that is not the one the manifest lists (a mix
+ * of two runs) is named. */
+static void test_manifest_check(void **state)
+{
+	(void)state;
+	const char *d = bsim_test_dir("manifest");
+	char dir[1400];
+	snprintf(dir, sizeof dir, "%s", d);
+	const char *sweep[] = {"sweep", h1, "--trials", "1", "--quiet", "--out", dir, NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	char *json = bsim_test_read(join(dir, "summary.json"));
+	json[strlen(json) - 3] ^= 1; /* one bit of the last line */
+	bsim_test_write(dir, "summary.json", json);
+	int has = 0;
+	bsim_error e;
+	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_EINPUT);
+	assert_non_null(strstr(e.msg, "summary.json"));
+	assert_non_null(strstr(e.msg, "mixes files of two runs"));
+	/* and regress refuses such a baseline */
+	const char *argv[] = {"regress", dir, "--quiet", "--out", bsim_test_dir("mixed_rerun"),
+	                      NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 2);
+	free(json);
+}
+
+/* plot adds its figures to a sweep's set (the manifest lists them), a
+ * rerun of the sweep removes them with the rest of the old set, and run
+ * --out writes its directory as a set too. */
+static void test_figures_join_the_set(void **state)
+{
+	(void)state;
+	char dir[1400];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("plotted"));
+	const char *sweep[] = {"sweep", h1,        "--trials", "2", "--trajectories",
+	                       "1",     "--quiet", "--out",    dir, NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	const char *plot[] = {"plot", dir, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(plot, NULL, NULL), 0);
+	char *manifest = bsim_test_read(join(dir, "manifest.json"));
+	assert_non_null(strstr(manifest, "\"command\": \"plot\""));
+	assert_non_null(strstr(manifest, "\"path\": \"p_traverse.gp\""));
+	assert_non_null(strstr(manifest, "\"path\": \"trials.csv\""));
+	int has = 0;
+	bsim_error e;
+	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_OK);
+	assert_int_equal(has, 1);
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	assert_int_equal(access(join(dir, "p_traverse.gp"), F_OK), -1);
+	free(manifest);
+
+	char run_dir[1400];
+	snprintf(run_dir, sizeof run_dir, "%s", bsim_test_dir("run_out"));
+	const char *run[] = {"run", gate, "--out", run_dir, NULL};
+	assert_int_equal(bsim_test_cli(run, NULL, NULL), 0);
+	manifest = bsim_test_read(join(run_dir, "manifest.json"));
+	assert_non_null(strstr(manifest, "\"path\": \"trajectory.csv\""));
+	assert_int_equal(bsim_outdir_verify(run_dir, &has, &e), BSIM_OK);
+	free(manifest);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_trajectory_to_stdout),
+	        cmocka_unit_test(test_trajectory_through_symlink),
+	        cmocka_unit_test(test_trajectory_through_fifo_and_device),
+	        cmocka_unit_test(test_stdout_errors),
+	        cmocka_unit_test(test_unwritable_out),
+	        cmocka_unit_test(test_lock),
+	        cmocka_unit_test(test_failed_rerun_keeps_previous_set),
+	        cmocka_unit_test(test_replacing_a_set),
+	        cmocka_unit_test(test_manifest_check),
+	        cmocka_unit_test(test_figures_join_the_set),
+	};
+	return cmocka_run_group_tests(tests, setup, NULL);
+}
