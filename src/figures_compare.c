@@ -223,6 +223,59 @@ static int compare_figure(figs *f, const ydoc *d, const fsum *s, bsim_error *err
 	return rc;
 }
 
+/* One line on the final-location test of group g of a lattice comparison
+ * (report.json groups.G.final_locations). */
+static void lattice_test_line(struct fy_node *root, int g, char *buf, size_t size)
+{
+	char p[200], test[80], beyond[16];
+	snprintf(p, sizeof p, "groups.%d.final_locations.test", g);
+	text(root, p, test, sizeof test);
+	int bad = 0;
+	double v[4];
+	static const char *const fields[] = {"p", "p_holm", "total_variation", "discordant"};
+	for (int i = 0; i < 4; i++) {
+		snprintf(p, sizeof p, "groups.%d.final_locations.%s", g, fields[i]);
+		v[i] = num(root, p, &bad);
+	}
+	snprintf(p, sizeof p, "groups.%d.final_locations.beyond", g);
+	text(root, p, beyond, sizeof beyond);
+	if (!*test || bad) {
+		snprintf(buf, size, "(report.json gives no test of the final locations)");
+		return;
+	}
+	snprintf(buf, size,
+	         "%.0f discordant pairs; total variation %.3f; %s test p = %.3g (Holm %.3g)%s",
+	         v[3], v[2], test, v[0], v[1],
+	         strcmp(beyond, "true") == 0 ? ": beyond the rule" : "");
+}
+
+/* A lattice comparison's final-location figures, one per selected group. */
+static int lattice_figures(figs *f, const ydoc *d, const fsum *s, const char *dir,
+                           char backend[2][128], bsim_error *err)
+{
+	struct fy_node *root = fy_document_root(d->fyd);
+	char(*lines)[400] = calloc((size_t)s->n_groups + 1, sizeof *lines);
+	const char **tests = calloc((size_t)s->n_groups + 1, sizeof *tests);
+	char dirs[2][1100], labels[2][128];
+	int rc = BSIM_OK;
+	if (!lines || !tests)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int g = 0; !rc && g < s->n_groups; g++) {
+		lattice_test_line(root, g, lines[g], sizeof lines[g]);
+		tests[g] = lines[g];
+	}
+	text(root, "a.label", labels[0], sizeof labels[0]);
+	text(root, "b.label", labels[1], sizeof labels[1]);
+	for (int i = 0; i < 2; i++)
+		snprintf(dirs[i], sizeof dirs[i], "%s/%s", dir, backend[i]);
+	const char *const dv[2] = {dirs[0], dirs[1]}, *const lv[2] = {labels[0], labels[1]};
+	if (!rc)
+		rc = figs_lattice_compare(f, dv, lv, s, tests, err);
+	free(lines);
+	free(tests);
+	return rc;
+}
+
 int figs_compare(figs *f, const char *dir, bsim_error *err)
 {
 	char path[1100], sub[1100], out[1100], inputs[1100];
@@ -257,6 +310,9 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 	rc = fsum_select(f, &s, err);
 	if (!rc)
 		rc = compare_figure(f, &d, &s, err);
+	snprintf(sub, sizeof sub, "%s/%s", dir, backend[0]);
+	if (!rc && figs_is_lattice(sub))
+		rc = lattice_figures(f, &d, &s, dir, backend, err);
 	fsum_free(&s);
 	ydoc_free(&d);
 	snprintf(inputs, sizeof inputs, "%s/inputs", dir);

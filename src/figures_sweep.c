@@ -113,7 +113,7 @@ static void tics(FILE *f, const char *which, const fsum_axis *ax, const int *pos
 
 /* ---- Fig. 3.1 -------------------------------------------------------------------- */
 
-static int heat_map(figs *f, const fsum *s, const active *a, bsim_error *err)
+static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_error *err)
 {
 	const int ax0 = s->n_axes > 0 ? 0 : -1, ax1 = s->n_axes > 1 ? 1 : -1;
 	const int n0 = ax0 >= 0 ? a->n[0] : 1, n1 = ax1 >= 0 ? a->n[1] : 1;
@@ -159,9 +159,10 @@ static int heat_map(figs *f, const fsum *s, const active *a, bsim_error *err)
 	layout(np, &rows, &cols);
 	int pw = 140 + 95 * n0, ph = 110 + 62 * n1;
 	fprintf(g.f,
-	        "set multiplot layout %d,%d title 'p_{traverse} of %d trials per group, "
+	        "set multiplot layout %d,%d title 'p_{traverse}%s of %d trials per group, "
 	        "[95%% Wilson interval]'\n",
-	        rows, cols, s->trials_per_group);
+	        rows, cols, lattice ? " (reached the end of the lattice)" : "",
+	        s->trials_per_group);
 	fputs("set palette defined (0 '#F7FBFF', 0.5 '#6BAED6', 1 '#08306B')\n"
 	      "set cbrange [0:1]\nset cblabel 'p_{traverse}'\n",
 	      g.f);
@@ -208,7 +209,10 @@ static int heat_map(figs *f, const fsum *s, const active *a, bsim_error *err)
 
 /* ---- Fig. 3.4 -------------------------------------------------------------------- */
 
-static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *err)
+/* A lattice (lattice = 1) draws where the trials ended instead of the
+ * single gate's left and right types: reached the end (traversed), side
+ * exit and stuck, each with its 95% band. */
+static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, bsim_error *err)
 {
 	const fsum_axis *A = &s->axes[ax];
 	const int np = panels(s, a, ax, -1);
@@ -221,8 +225,12 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *e
 	if (rc)
 		return rc;
 	fprintf(o.f,
-	        "# %s traversed lo hi left lo hi right lo hi landscape_left landscape_right "
-	        "(fractions of the trials; Wilson 95%% intervals): one block per panel\n",
+	        lattice ? "# %s end lo hi side_exit lo hi stuck lo hi (fractions of the trials; "
+	                  "end: traversed, reached the end of the lattice; Wilson 95%% "
+	                  "intervals): one block per panel\n"
+	                : "# %s traversed lo hi left lo hi right lo hi landscape_left "
+	                  "landscape_right (fractions of the trials; Wilson 95%% intervals): one "
+	                  "block per panel\n",
 	        A->numeric ? A->key : "position");
 	int *first = malloc((size_t)np * sizeof *first);
 	if (!first) {
@@ -242,6 +250,23 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *e
 				if (first[p] < 0)
 					first[p] = gi;
 				double ll, lh, rl, rh, n = G->trials > 0 ? G->trials : 1;
+				const double x = A->numeric ? A->x[i] : (double)a->pos[ax][i];
+				if (lattice) {
+					/* a group without random force: points */
+					const int point = G->lo == G->hi && G->trials > 1;
+					bsim_wilson(G->side_exit, G->trials, BSIM_Z95, &ll, &lh);
+					bsim_wilson(G->stuck, G->trials, BSIM_Z95, &rl, &rh);
+					if (point) {
+						ll = lh = G->side_exit / n;
+						rl = rh = G->stuck / n;
+					}
+					fprintf(o.f,
+					        "%.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g "
+					        "%.6g\n",
+					        x, G->p, G->lo, G->hi, G->side_exit / n, ll, lh,
+					        G->stuck / n, rl, rh);
+					continue;
+				}
 				bsim_wilson(G->left, G->trials, BSIM_Z95, &ll, &lh);
 				bsim_wilson(G->right, G->trials, BSIM_Z95, &rl, &rh);
 				fprintf(o.f,
@@ -279,9 +304,9 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *e
 			                 s->axes[oa].key);
 			L += w > 0 ? (size_t)w : 0;
 		}
-	snprintf(title, sizeof title,
-	         "traversal against %s, %d trials per group, 95%% Wilson bands%s%s", A->key,
-	         s->trials_per_group, L ? "\npanels: " : "", others);
+	snprintf(title, sizeof title, "%s against %s, %d trials per group, 95%% Wilson bands%s%s",
+	         lattice ? "where the trials ended" : "traversal", A->key, s->trials_per_group,
+	         L ? "\npanels: " : "", others);
 	gp_str(g.f, title);
 	fputs(" noenhanced\nset yrange [0:1]\nset ylabel 'fraction of trials'\nset xlabel ", g.f);
 	gp_str(g.f, A->key);
@@ -301,6 +326,23 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *e
 			}
 		fputs("set title ", g.f);
 		gp_str(g.f, label);
+		if (lattice) {
+			fprintf(g.f,
+			        " noenhanced\n"
+			        "plot '%s' index %d using 1:3:4 with filledcurves lc rgb '%s', \\\n"
+			        "     '' index %d using 1:6:7 with filledcurves lc rgb '%s', \\\n"
+			        "     '' index %d using 1:9:10 with filledcurves lc rgb '%s', \\\n"
+			        "     '' index %d using 1:2 with linespoints lw 2 pt 7 lc rgb "
+			        "'%s', \\\n"
+			        "     '' index %d using 1:5 with linespoints lw 1.5 pt 5 lc rgb "
+			        "'%s', "
+			        "\\\n"
+			        "     '' index %d using 1:8 with linespoints lw 1.5 pt 9 lc rgb "
+			        "'%s'\n",
+			        file, p, FIG_BLUE, p, FIG_GREY, p, FIG_DKGREY, p, FIG_BLUE, p,
+			        FIG_GREY, p, FIG_DKGREY);
+			continue;
+		}
 		fprintf(g.f,
 		        " noenhanced\n"
 		        "plot '%s' index %d using 1:3:4 with filledcurves lc rgb '%s', \\\n"
@@ -314,20 +356,35 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *e
 		        file, p, FIG_BLACK, p, FIG_BLUE, p, FIG_RED, p, FIG_BLACK, p, FIG_BLUE, p,
 		        FIG_RED, p, FIG_BLUE, p, FIG_RED);
 	}
-	fprintf(g.f,
-	        "# the key, in a cell of its own\n"
-	        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\nunset grid\n"
-	        "set key center center vertical font ',10'\nset xrange [0:1]\n"
-	        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title 'traversed', \\\n"
-	        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'left type (v_x > 0 at "
-	        "classify y)', \\\n"
-	        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'right type (v_x < 0)', "
-	        "\\\n"
-	        "     NaN with lines dt 2 lc rgb '%s' title 'over the left beam (landscape "
-	        "label)', \\\n"
-	        "     NaN with lines dt 2 lc rgb '%s' title 'over the right beam', \\\n"
-	        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
-	        FIG_BLACK, FIG_BLUE, FIG_RED, FIG_BLUE, FIG_RED, FIG_GREY);
+	if (lattice)
+		fprintf(g.f,
+		        "# the key, in a cell of its own\n"
+		        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\n"
+		        "unset grid\nset key center center vertical font ',10'\nset xrange [0:1]\n"
+		        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title 'reached the end "
+		        "(traversed)', \\\n"
+		        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'side exit', \\\n"
+		        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'stuck', \\\n"
+		        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
+		        FIG_BLUE, FIG_GREY, FIG_DKGREY, FIG_GREY);
+	else
+		fprintf(g.f,
+		        "# the key, in a cell of its own\n"
+		        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\nunset "
+		        "grid\n"
+		        "set key center center vertical font ',10'\nset xrange [0:1]\n"
+		        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title 'traversed', \\\n"
+		        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'left type (v_x > "
+		        "0 at "
+		        "classify y)', \\\n"
+		        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'right type (v_x "
+		        "< 0)', "
+		        "\\\n"
+		        "     NaN with lines dt 2 lc rgb '%s' title 'over the left beam (landscape "
+		        "label)', \\\n"
+		        "     NaN with lines dt 2 lc rgb '%s' title 'over the right beam', \\\n"
+		        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
+		        FIG_BLACK, FIG_BLUE, FIG_RED, FIG_BLUE, FIG_RED, FIG_GREY);
 	fputs("unset multiplot\n", g.f);
 	free(first);
 	char *body = gp_text_take(&g);
@@ -552,15 +609,22 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 	rc = fsum_select(f, &s, err);
 	if (!rc)
 		rc = active_build(&s, &a, err);
-	if (!rc)
+	/* a lattice gets its own trajectory figures (figures_lattice.c) */
+	lat_job *lat = NULL;
+	if (!rc && figs_is_lattice(dir))
+		rc = figs_lattice_load(f, dir, inputs, &s, &lat, err);
+	else if (!rc)
 		rc = traj_load(f, dir, inputs, &s, &j, &have, err);
 	if (!rc)
-		rc = heat_map(f, &s, &a, err);
+		rc = heat_map(f, &s, &a, lat != NULL, err);
 	for (int ax = 0; !rc && ax < s.n_axes; ax++)
 		if (a.n[ax] >= 2)
-			rc = versus(f, &s, &a, ax, err);
+			rc = versus(f, &s, &a, ax, lat != NULL, err);
 	if (!rc && have)
 		rc = traj_draw(f, dir, &j, err);
+	if (!rc && lat)
+		rc = figs_lattice_draw(f, lat, err);
+	figs_lattice_free(lat);
 	traj_free(&j, have);
 	active_free(&a, s.n_axes);
 	fsum_free(&s);
