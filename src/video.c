@@ -98,6 +98,13 @@ int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
 		v->t_part[p] = bsim_video_track_separation(tracks[p], tracks[q], sep);
 		v->part_from[p] = v->labels[q] ? v->labels[q] : "the other";
 	}
+	if (scene->has_lattice) {
+		v->entered = calloc((size_t)(scene->lattice.columns * scene->lattice.rows), 1);
+		if (!v->entered) {
+			free(v);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
+		}
+	}
 	video_field_bounds(scene, v->field);
 	v->k_min = scene->n_beams ? scene->beams[0].stiffness : 0.0;
 	v->k_max = v->k_min;
@@ -117,6 +124,7 @@ void bsim_video_free(bsim_video *v)
 		cairo_destroy(v->cr);
 	if (v->surface)
 		cairo_surface_destroy(v->surface);
+	free(v->entered);
 	free(v);
 }
 

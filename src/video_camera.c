@@ -12,7 +12,11 @@
  *   else                           c = clamp(body, lo + half, hi - half)
  * (the camera follows the body and stops at the field's edges), and then
  * c is moved the least needed to keep the whole body, radius r, in view,
- * so a body that leaves the field is still followed. */
+ * so a body that leaves the field is still followed.
+ *
+ * Overview. A panel whose camera follows (s > s_fit) also shows the whole
+ * field in its bottom-right corner, at the scale that fits it into at most
+ * 36% of the view's height and 40% of its width. */
 #include <math.h>
 
 #include "video_internal.h"
@@ -70,4 +74,22 @@ void video_view_make(const double field[4], double view_span, double x0, double 
 	out->scale = fmax(s_fit, s_min);
 	out->c[0] = axis_centre(field[0], field[2], 0.5 * w / out->scale, body[0], r);
 	out->c[1] = axis_centre(field[1], field[3], 0.5 * h / out->scale, body[1], r);
+}
+
+int video_overview_make(const double field[4], const video_view *main, video_view *out)
+{
+	const double fw = field[2] - field[0], fh = field[3] - field[1];
+	const double s_fit = fmin(main->w / fw, main->h / fh);
+	if (!(main->scale > s_fit * (1.0 + 1e-9)))
+		return 0;
+	const double margin = 8.0;
+	const double s = fmin(0.36 * main->h / fh, 0.40 * main->w / fw);
+	out->w = fw * s;
+	out->h = fh * s;
+	out->x0 = main->x0 + main->w - out->w - margin;
+	out->y0 = main->y0 + main->h - out->h - margin;
+	out->scale = s;
+	out->c[0] = 0.5 * (field[0] + field[2]);
+	out->c[1] = 0.5 * (field[1] + field[3]);
+	return 1;
 }

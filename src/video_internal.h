@@ -24,12 +24,23 @@ struct bsim_video {
 	double t_part[BSIM_VIDEO_PANELS_MAX]; /* s, when panel p parts from the other (or
 	                                       * panel 0); -1 never, or one panel */
 	const char *part_from[BSIM_VIDEO_PANELS_MAX];
-	long frames;         /* hold included */
-	long frames_sim;     /* the longest track's frames */
-	double field[4];     /* x0, y0, x1, y1, m: what the camera keeps in view */
-	double k_min, k_max; /* N m/rad, the colour scale */
-	void *surface, *cr;  /* cairo_surface_t, cairo_t: made on first render */
+	long frames;            /* hold included */
+	long frames_sim;        /* the longest track's frames */
+	double field[4];        /* x0, y0, x1, y1, m: what the camera keeps in view */
+	double k_min, k_max;    /* N m/rad, the colour scale */
+	unsigned char *entered; /* a lattice: columns x rows, the gates entered so far */
+	void *surface, *cr;     /* cairo_surface_t, cairo_t: made on first render */
 };
+
+/* One entry of the runner's gate path: gate (ix, iy) entered at the end
+ * of step `step` (bsim_gate_entry). */
+typedef struct video_gate_visit {
+	int ix, iy;
+	int step;
+} video_gate_visit;
+
+/* The gate path of a track, in order (n = 0: none). */
+const video_gate_visit *video_track_visits(const bsim_video_track *t, int *n);
 
 /* The body centre after every step of a track: 2 n doubles. */
 const double *video_track_trail(const bsim_video_track *t, long *n);
@@ -48,6 +59,14 @@ void video_field_bounds(const bsim_scene *s, double field[4]);
  * view, and always keeping the whole body in view. */
 void video_view_make(const double field[4], double view_span, double x0, double y0, double w,
                      double h, const double body[2], double r, video_view *out);
+
+/* The overview of a panel whose camera follows the body (the field is
+ * larger than the view): the whole field at a small scale in the view's
+ * bottom-right corner. 0 if the view shows the whole field (no overview). */
+int video_overview_make(const double field[4], const video_view *main, video_view *out);
+
+/* The view of panel p at frame k: its camera on the body of that frame. */
+void video_panel_view(const bsim_video *v, int p, long k, video_view *out);
 
 static inline void video_view_pixel(const video_view *v, const double p[2], double px[2])
 {

@@ -10,13 +10,22 @@
  * Colours are given as 8-bit sRGB values so that a fully covered pixel
  * gets exactly that value (cairo stores d * 65535 and reads back the high
  * byte): the body's colour is found in a frame by tests, and the beams'
- * colours are the legend's. */
+ * colours are the legend's.
+ *
+ * A lattice's frames also show its gates: dashed boundaries (the essay's
+ * Fig. 2.8) and, tinted, the gates the body has entered so far (the
+ * runner's gate path up to the frame's step). When the camera follows the
+ * body, an overview in the bottom-right corner shows the whole field: each
+ * gate's left and right half in the paled colour of the beam that sweeps
+ * it, the gates entered filled in the path colour, the trail, the body as
+ * a dot and the rectangle the camera shows. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include <cairo.h>
 
+#include "beamsim/lattice.h"
 #include "video_internal.h"
 
 #define VIDEO_TAU 6.28318530717958647692 /* a full circle, rad */
@@ -34,6 +43,10 @@ enum {
 	COLOR_TITLE = 0xE9E9E9,
 	COLOR_TEXT = 0x111111,
 	COLOR_BACKGROUND = 0xFFFFFF,
+	COLOR_GATE_LINE = 0x7FC08F, /* gate boundaries, a light green */
+	COLOR_PATH_TINT = 0xFFF0E0, /* the gates entered, in the view */
+	COLOR_PATH = 0xF6B26B,      /* the gates entered, in the overview */
+	COLOR_OVERVIEW_EDGE = 0x555555,
 };
 
 /* Viridis at u = 0, 1/8, ..., 1 (dark purple to yellow). */
@@ -66,6 +79,22 @@ uint32_t video_colormap(double u)
 uint32_t bsim_video_body_color(void)
 {
 	return COLOR_BODY;
+}
+
+uint32_t bsim_video_path_color(void)
+{
+	return COLOR_PATH;
+}
+
+/* c blended toward white by f (0: c, 1: white). */
+static uint32_t paled(uint32_t c, double f)
+{
+	uint32_t out = 0;
+	for (int sh = 16; sh >= 0; sh -= 8) {
+		double ch = (c >> sh) & 255;
+		out |= (uint32_t)lround(ch + f * (255.0 - ch)) << sh;
+	}
+	return out;
 }
 
 uint32_t bsim_video_stiffness_color(const bsim_video *v, double k)
@@ -147,6 +176,148 @@ static void draw_bounds(cairo_t *cr, const bsim_video *v, const video_view *vw)
 	set_color(cr, COLOR_SUCCESS);
 	cairo_stroke(cr);
 	cairo_set_dash(cr, NULL, 0, 0.0);
+}
+
+/* Which gates of a lattice the body has entered by step `step` (the
+ * runner's path): entered[iy columns + ix - ix_min] = 1; the gate of the
+ * last entry so far in *cur. Returns the number of entries so far. */
+static int gates_entered(const bsim_video *v, const bsim_video_track *t, long step,
+                         unsigned char *entered, int cur[2])
+{
+	const bsim_lattice_def *l = &v->scene->lattice;
+	int n, count = 0;
+	const video_gate_visit *e = video_track_visits(t, &n);
+	memset(entered, 0, (size_t)(l->columns * l->rows));
+	cur[0] = cur[1] = 0;
+	for (int i = 0; i < n && e[i].step <= step; i++) {
+		if (e[i].ix >= l->ix_min && e[i].ix <= l->ix_max && e[i].iy >= 0 &&
+		    e[i].iy < l->rows)
+			entered[e[i].iy * l->columns + e[i].ix - l->ix_min] = 1;
+		cur[0] = e[i].ix;
+		cur[1] = e[i].iy;
+		count++;
+	}
+	return count;
+}
+
+static void rect_world(cairo_t *cr, const video_view *vw, double x0, double y0, double x1,
+                       double y1)
+{
+	double a[2], b[2];
+	const double p0[2] = {x0, y0}, p1[2] = {x1, y1};
+	video_view_pixel(vw, p0, a);
+	video_view_pixel(vw, p1, b);
+	cairo_rectangle(cr, fmin(a[0], b[0]), fmin(a[1], b[1]), fabs(b[0] - a[0]),
+	                fabs(b[1] - a[1]));
+}
+
+/* The main view's gates: the entered ones tinted, the boundaries dashed. */
+static void draw_gates(cairo_t *cr, const bsim_video *v, const video_view *vw,
+                       const unsigned char *entered)
+{
+	const bsim_lattice_def *l = &v->scene->lattice;
+	const double w = l->width, d = l->depth;
+	for (int iy = 0; iy < l->rows; iy++)
+		for (int ix = l->ix_min; ix <= l->ix_max; ix++)
+			if (entered[iy * l->columns + ix - l->ix_min])
+				rect_world(cr, vw, w * ix - 0.5 * w, d * iy, w * ix + 0.5 * w,
+				           d * (iy + 1));
+	set_color(cr, COLOR_PATH_TINT);
+	cairo_fill(cr);
+	const double x0 = w * l->ix_min - 0.5 * w, x1 = w * l->ix_max + 0.5 * w;
+	const double y0 = 0.0, y1 = d * l->rows;
+	for (int c = 0; c <= l->columns; c++) {
+		const double a[2] = {x0 + w * c, y0}, b[2] = {x0 + w * c, y1};
+		line_world(cr, vw, a, b);
+	}
+	for (int r = 0; r <= l->rows; r++) {
+		const double a[2] = {x0, y0 + d * r}, b[2] = {x1, y0 + d * r};
+		line_world(cr, vw, a, b);
+	}
+	double dash[] = {4.0, 4.0};
+	cairo_set_dash(cr, dash, 2, 0.0);
+	cairo_set_line_width(cr, 1.0);
+	set_color(cr, COLOR_GATE_LINE);
+	cairo_stroke(cr);
+	cairo_set_dash(cr, NULL, 0, 0.0);
+}
+
+/* The overview ov of the whole field (video_overview_make): a lattice's
+ * gates by stiffness, the entered ones in the path colour, or the beams at
+ * rest of any other scene; the bounds, the trail, the body as a dot and
+ * the main view's rectangle. */
+static void draw_overview(cairo_t *cr, const bsim_video *v, const video_view *ov,
+                          const video_view *main, const bsim_video_track *t, long step,
+                          const double body[2], const unsigned char *entered)
+{
+	const bsim_scene *s = v->scene;
+	cairo_save(cr);
+	cairo_rectangle(cr, ov->x0 - 1.0, ov->y0 - 1.0, ov->w + 2.0, ov->h + 2.0);
+	set_color(cr, COLOR_BACKGROUND);
+	cairo_fill_preserve(cr);
+	set_color(cr, COLOR_OVERVIEW_EDGE);
+	cairo_set_line_width(cr, 1.0);
+	cairo_stroke(cr);
+	cairo_rectangle(cr, ov->x0, ov->y0, ov->w, ov->h);
+	cairo_clip(cr);
+	if (s->has_lattice) {
+		const bsim_lattice_def *l = &s->lattice;
+		const double w = l->width, d = l->depth;
+		for (int iy = 0; iy < l->rows; iy++)
+			for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
+				const int in = entered[iy * l->columns + ix - l->ix_min];
+				for (int side = 0; side < 2; side++) {
+					const bsim_beam_def *b =
+					        &s->beams[bsim_lattice_beam(l, ix, iy, side)];
+					const double xa = w * ix + (side ? 0.0 : -0.5 * w);
+					rect_world(cr, ov, xa, d * iy, xa + 0.5 * w, d * (iy + 1));
+					set_color(cr, in ? COLOR_PATH
+					                 : paled(bsim_video_stiffness_color(
+					                                 v, b->stiffness),
+					                         0.55));
+					cairo_fill(cr);
+				}
+			}
+		const double x0 = w * l->ix_min - 0.5 * w, y1 = d * l->rows;
+		for (int c = 0; c <= l->columns; c++) {
+			const double a[2] = {x0 + w * c, 0.0}, b[2] = {x0 + w * c, y1};
+			line_world(cr, ov, a, b);
+		}
+		for (int r = 0; r <= l->rows; r++) {
+			const double a[2] = {x0, d * r}, b[2] = {x0 + w * l->columns, d * r};
+			line_world(cr, ov, a, b);
+		}
+		set_color(cr, COLOR_BACKGROUND);
+		cairo_set_line_width(cr, 0.8);
+		cairo_stroke(cr);
+	} else {
+		cairo_set_line_width(cr, 1.5);
+		for (int i = 0; i < s->n_beams; i++) {
+			const bsim_beam_def *b = &s->beams[i];
+			double tip[2];
+			beam_tip(b, 0.0, tip);
+			line_world(cr, ov, b->pivot, tip);
+			set_color(cr, paled(bsim_video_stiffness_color(v, b->stiffness), 0.3));
+			cairo_stroke(cr);
+		}
+	}
+	draw_trail(cr, ov, t, step, COLOR_TRAIL, 1.0);
+	double p[2];
+	if (isfinite(body[0]) && isfinite(body[1])) {
+		video_view_pixel(ov, body, p);
+		cairo_new_sub_path(cr);
+		cairo_arc(cr, p[0], p[1], fmax(2.5, s->body.radius * ov->scale), 0.0, VIDEO_TAU);
+		set_color(cr, COLOR_TEXT);
+		cairo_fill(cr);
+	}
+	/* the main view's rectangle */
+	const double half_w = 0.5 * main->w / main->scale, half_h = 0.5 * main->h / main->scale;
+	rect_world(cr, ov, main->c[0] - half_w, main->c[1] - half_h, main->c[0] + half_w,
+	           main->c[1] + half_h);
+	set_color(cr, COLOR_OVERVIEW_EDGE);
+	cairo_set_line_width(cr, 1.0);
+	cairo_stroke(cr);
+	cairo_restore(cr);
 }
 
 static void draw_beams(cairo_t *cr, const bsim_video *v, const video_view *vw,
@@ -291,8 +462,22 @@ static void draw_legend(cairo_t *cr, const bsim_video *v, const video_view *vw, 
 	cairo_show_text(cr, bottom);
 }
 
-static void outcome_text(const bsim_trial_result *r, char *buf, size_t n)
+static void outcome_text(const bsim_scene *s, const bsim_trial_result *r, char *buf, size_t n)
 {
+	if (s->has_lattice && r->outcome != BSIM_UNSTABLE) {
+		const bsim_location loc = bsim_location_of(r);
+		if (loc.kind == BSIM_LOCATION_END)
+			snprintf(buf, n, "reached the end in column %d at t = %.2f s", loc.ix,
+			         r->t_end);
+		else if (loc.kind == BSIM_LOCATION_SIDE)
+			snprintf(buf, n, "left through the %s side in row %d at t = %.2f s",
+			         r->x_end < bsim_scene_centre_x(s) ? "left" : "right", loc.iy,
+			         r->t_end);
+		else
+			snprintf(buf, n, "stuck in gate (%d, %d) at t = %.2f s", loc.ix, loc.iy,
+			         r->t_end);
+		return;
+	}
 	switch (r->outcome) {
 	case BSIM_TRAVERSED:
 		snprintf(buf, n, "traversed at t = %.2f s (%s type)", r->t_end,
@@ -309,6 +494,37 @@ static void outcome_text(const bsim_trial_result *r, char *buf, size_t n)
 		snprintf(buf, n, "%s at t = %.2f s", bsim_outcome_name(r->outcome), r->t_end);
 		break;
 	}
+}
+
+/* The font size of a frame, px: the title bar is two of it high. */
+static double font_size(const bsim_video *v)
+{
+	return fmax(11.0, floor(v->height / 40.0));
+}
+
+void video_panel_view(const bsim_video *v, int p, long k, video_view *out)
+{
+	const double px0 = (double)(p * v->width / v->n_panels);
+	const double pw = (double)((p + 1) * v->width / v->n_panels) - px0;
+	const double title_h = ceil(2.0 * font_size(v));
+	const bsim_video_sample sm = bsim_video_track_sample(v->tracks[p], k);
+	video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h, sm.x,
+	                v->scene->body.radius, out);
+}
+
+int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, const double p[2],
+                              double px[2])
+{
+	if (panel < 0 || panel >= v->n_panels)
+		return 0;
+	if (k >= v->frames_sim)
+		k = v->frames_sim - 1;
+	video_view vw, ov;
+	video_panel_view(v, panel, k, &vw);
+	if (!video_overview_make(v->field, &vw, &ov))
+		return 0;
+	video_view_pixel(&ov, p, px);
+	return 1;
 }
 
 static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double fs)
@@ -329,12 +545,20 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	set_color(cr, COLOR_BACKGROUND);
 	cairo_paint(cr);
 
-	video_view vw;
-	video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h, sm.x,
-	                s->body.radius, &vw);
+	video_view vw, ov;
+	video_panel_view(v, p, k, &vw);
+	const int overview = video_overview_make(v->field, &vw, &ov);
+	unsigned char *entered = NULL;
+	int cur[2] = {0, 0}, n_entered = 0;
+	if (s->has_lattice) {
+		entered = v->entered;
+		n_entered = gates_entered(v, t, sm.step, entered, cur);
+	}
 	cairo_save(cr);
 	cairo_rectangle(cr, vw.x0, vw.y0, vw.w, vw.h);
 	cairo_clip(cr);
+	if (entered)
+		draw_gates(cr, v, &vw, entered);
 	draw_bounds(cr, v, &vw);
 	for (int q = 0; q < v->n_panels; q++)
 		if (q != p)
@@ -356,8 +580,10 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	}
 
 	/* Overlays inside the view. */
-	char l_kin[48], l_spring[48], l_prop[48], l_force[48], l_part[96];
-	const char *lines[5] = {l_kin, l_spring, l_prop};
+	if (overview)
+		draw_overview(cr, v, &ov, &vw, t, sm.step, sm.x, entered);
+	char l_kin[48], l_spring[48], l_prop[48], l_force[48], l_part[96], l_gate[64];
+	const char *lines[6] = {l_kin, l_spring, l_prop};
 	int n_lines = 3;
 	snprintf(l_kin, sizeof l_kin, "E_kin    %7.1f J", sm.e_kin);
 	snprintf(l_spring, sizeof l_spring, "E_spring %7.1f J", sm.e_spring);
@@ -365,6 +591,11 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	if (s->effects.has_random_force) {
 		snprintf(l_force, sizeof l_force, "F_rand   %7.1f N", sm.f_rand);
 		lines[n_lines++] = l_force;
+	}
+	if (entered) {
+		snprintf(l_gate, sizeof l_gate, "gate (%d, %d), %d entered", cur[0], cur[1],
+		         n_entered);
+		lines[n_lines++] = l_gate;
 	}
 	if (t_part >= 0.0 && sm.t >= t_part) {
 		snprintf(l_part, sizeof l_part, "parts from %s at t = %.2f s", v->part_from[p],
@@ -380,7 +611,7 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	 * if the bar is too narrow for it). */
 	char outcome[128] = "";
 	if (sm.step >= res->steps)
-		outcome_text(res, outcome, sizeof outcome);
+		outcome_text(s, res, outcome, sizeof outcome);
 	snprintf(buf, sizeof buf, "t = %.3f s%s", sm.t,
 	         k >= bsim_video_track_frames(t) ? " (ended)" : "");
 	const char *label = v->labels[p] ? v->labels[p] : "";
@@ -438,7 +669,7 @@ int video_render_frame(bsim_video *v, long k, bsim_error *err)
 		v->cr = cairo_create(sf);
 	}
 	cairo_t *cr = v->cr;
-	const double fs = fmax(11.0, floor(v->height / 40.0));
+	const double fs = font_size(v);
 	cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
 	cairo_set_font_size(cr, fs);
 	for (int p = 0; p < v->n_panels; p++)

@@ -12,7 +12,9 @@
  * pipeline built from the same scene and seed: the schedule is a function of
  * (seed, index) alone (beamsim/schedule.h), so it gives the very values the
  * runner applies. Angles are kept as float, enough for a pixel, so a long
- * trial of a large field stays small. */
+ * trial of a large field stays small. The runner's own gate path (its log)
+ * is kept too: the gates entered and the step of each entry, which a
+ * lattice's frames mark. */
 #include "beamsim/video.h"
 
 #include <math.h>
@@ -44,6 +46,8 @@ struct bsim_video_track {
 	bsim_effects fx; /* the same schedule as the runner's, for the force */
 	long last_step;  /* a step after the last frame's, kept in the next slot; -1 none */
 	int oom;
+	video_gate_visit *visits; /* the gate path: the runner's entries in order */
+	int n_visits;
 };
 
 /* The step a frame shows. The 1e-9 keeps a frame time that is a whole
@@ -172,9 +176,23 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 		bsim_runner_free(runner);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
 	}
-	bsim_recorder rec = {.csv = NULL, .stride = 1, .trace = track_trace, .trace_user = t};
-	int rc = bsim_trial_run(runner, scene, backend, opts, seed, &rec, &t->result, err);
+	bsim_trial_log *log = bsim_trial_log_alloc();
+	bsim_recorder rec = {
+	        .csv = NULL, .stride = 1, .trace = track_trace, .trace_user = t, .log = log};
+	int rc = log ? bsim_trial_run(runner, scene, backend, opts, seed, &rec, &t->result, err)
+	             : bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
 	bsim_runner_free(runner);
+	if (rc == BSIM_OK && log->n_entries > 0) {
+		t->visits = malloc((size_t)log->n_entries * sizeof *t->visits);
+		if (!t->visits)
+			t->oom = 1;
+		for (int i = 0; t->visits && i < log->n_entries; i++) {
+			const bsim_gate_entry *e = &log->entries[i];
+			t->visits[i] = (video_gate_visit){e->ix, e->iy, e->step};
+		}
+		t->n_visits = t->visits ? log->n_entries : 0;
+	}
+	bsim_trial_log_free(log);
 	if (rc == BSIM_OK && t->oom)
 		rc = bsim_error_set(err, BSIM_EFAIL,
 		                    "out of memory recording %ld steps for a video", t->n_trail);
@@ -200,6 +218,7 @@ void bsim_video_track_free(bsim_video_track *t)
 	if (!t)
 		return;
 	bsim_effects_free(&t->fx);
+	free(t->visits);
 	free(t->trail);
 	free(t->frames);
 	free(t->theta);
@@ -252,6 +271,12 @@ const double *video_track_trail(const bsim_video_track *t, long *n)
 {
 	*n = t->n_trail;
 	return t->trail;
+}
+
+const video_gate_visit *video_track_visits(const bsim_video_track *t, int *n)
+{
+	*n = t->n_visits;
+	return t->visits;
 }
 
 int video_track_random_axis(const bsim_video_track *t)

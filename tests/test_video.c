@@ -5,8 +5,10 @@
  * equal the runner's trajectory at every frame time); on a field larger
  * than the view the body is in every frame although it travels further
  * than a view spans (the camera follows it), in the rendered frames and in
- * the decoded MP4; beams take their stiffness's colour; a failing or
- * missing ffmpeg and bad arguments write nothing. */
+ * the decoded MP4; beams take their stiffness's colour; on a lattice the
+ * overview fills exactly the gates of the runner's own gate path entered by
+ * the frame's step, and a field that fits the view has no overview; a
+ * failing or missing ffmpeg and bad arguments write nothing. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <setjmp.h>
@@ -25,7 +27,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "beamsim/backend.h"
 #include "beamsim/schedule.h"
+#include "beamsim/trial.h"
 #include "beamsim/video.h"
 #include "support.h"
 
@@ -442,6 +446,102 @@ static void lib_beams_take_their_stiffness_color(void **state)
 	bsim_scene_free(&scene);
 }
 
+/* The C-track (9 x 9 gates) and a trial that follows its spine to the end
+ * (seed 1, trial 592, 30 s): in the overview of a frame, a gate's cell
+ * holds the path colour if and only if the runner's gate path, recorded
+ * here by a run of its own, entered that gate by the frame's step. */
+static void lib_lattice_overview_shows_the_gate_path(void **state)
+{
+	(void)state;
+	bsim_scene scene;
+	load("configs/lattice/c_track.yaml", &scene);
+	const uint64_t seed = bsim_seed_mix(1, 0, 592);
+	bsim_error err;
+	bsim_options opts = {0};
+	/* the truth: the runner's path */
+	bsim_runner *runner = bsim_runner_alloc();
+	bsim_trial_log *log = bsim_trial_log_alloc();
+	bsim_recorder rec = {.stride = 1, .log = log};
+	bsim_trial_result res;
+	assert_int_equal(
+	        bsim_trial_run(runner, &scene, &bsim_backend_thesis, &opts, seed, &rec, &res, &err),
+	        BSIM_OK);
+	assert_true(log->n_entries >= 10); /* it travels far */
+	bsim_video_track *t = NULL;
+	assert_int_equal(
+	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, seed, 30.0, &t, &err),
+	        BSIM_OK);
+	bsim_video_def def = bsim_video_default_def();
+	def.width = def.height = 480;
+	bsim_video *v = NULL;
+	const char *label = "thesis";
+	assert_int_equal(bsim_video_alloc(&def, &scene, (const bsim_video_track *const *)&t, &label,
+	                                  1, &v, &err),
+	                 BSIM_OK);
+	const int w = 480, h = 480;
+	uint32_t *px = malloc(sizeof *px * w * h);
+	const long frames = bsim_video_track_frames(t);
+	const long ks[2] = {frames / 2, frames - 1};
+	for (int f = 0; f < 2; f++) {
+		const long k = ks[f], step = bsim_video_track_sample(t, k).step;
+		assert_int_equal(bsim_video_render(v, k, px, &err), BSIM_OK);
+		int entered = 0, cells = 0;
+		for (int iy = 0; iy < 9; iy++)
+			for (int ix = -4; ix <= 4; ix++) {
+				int in = 0;
+				for (int e = 0; e < log->n_entries; e++)
+					in |= log->entries[e].ix == ix &&
+					      log->entries[e].iy == iy &&
+					      log->entries[e].step <= step;
+				const double lo[2] = {50.0 * ix - 25, 60.0 * iy},
+				             hi[2] = {50.0 * ix + 25, 60.0 * iy + 60};
+				double a[2], b[2];
+				assert_int_equal(bsim_video_overview_pixel(v, 0, k, lo, a), 1);
+				assert_int_equal(bsim_video_overview_pixel(v, 0, k, hi, b), 1);
+				/* the cell's inside, a pixel clear of its edges */
+				long n = 0, path = 0;
+				for (int y = (int)ceil(b[1]) + 1; y < (int)floor(a[1]) - 1; y++)
+					for (int x = (int)ceil(a[0]) + 1; x < (int)floor(b[0]) - 1;
+					     x++) {
+						n++;
+						path += px[y * w + x] == bsim_video_path_color();
+					}
+				assert_true(n >= 40);
+				if (in ? path < 0.3 * n : path != 0)
+					fail_msg("frame %ld (step %ld): gate (%d, %d) %s the path, "
+					         "%ld of %ld pixels in the path colour",
+					         k, step, ix, iy, in ? "in" : "not in", path, n);
+				entered += in;
+				cells++;
+			}
+		printf("# lattice overview, frame %ld: %d of %d gates entered, as the runner's "
+		       "path\n",
+		       k, entered, cells);
+		assert_true(entered >= (f ? 10 : 2));
+	}
+	free(px);
+	bsim_video_free(v);
+	bsim_video_track_free(t);
+	bsim_trial_log_free(log);
+	bsim_runner_free(runner);
+	/* a gate that fits the view: no overview */
+	bsim_scene gate;
+	bsim_scene_init_gate(&gate, 7.0, 0.0);
+	gate.max_steps = 10;
+	assert_int_equal(
+	        bsim_video_track_record(&gate, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
+	        BSIM_OK);
+	assert_int_equal(bsim_video_alloc(&def, &gate, (const bsim_video_track *const *)&t, NULL, 1,
+	                                  &v, &err),
+	                 BSIM_OK);
+	double q[2];
+	assert_int_equal(bsim_video_overview_pixel(v, 0, 0, gate.body.start, q), 0);
+	bsim_video_free(v);
+	bsim_video_track_free(t);
+	bsim_scene_free(&gate);
+	bsim_scene_free(&scene);
+}
+
 /* Column index of name in a CSV header line. */
 static int column(const char *header, const char *name)
 {
@@ -625,6 +725,7 @@ static void cli_bad_arguments(void **state)
 	        {{"--size", "32x32"}, "from 64x64"},
 	        {{"--hold", "-1"}, "--hold -1"},
 	        {{"--view", "0"}, "--view 0"},
+	        {{"--crf", "52"}, "--crf 52: expected an integer 0 to 51"},
 	        {{"--backend", "nope"}, "nope"},
 	        {{"--backends", "thesis,nope"}, "nope"},
 	        {{"--backends", "thesis,thesis"}, "named twice"},
@@ -681,6 +782,7 @@ int main(void)
 	        cmocka_unit_test(lib_camera_follows_the_body),
 	        cmocka_unit_test(cli_field_mp4_follows_the_body),
 	        cmocka_unit_test(lib_beams_take_their_stiffness_color),
+	        cmocka_unit_test(lib_lattice_overview_shows_the_gate_path),
 	        cmocka_unit_test(lib_frames_are_the_runs_states),
 	        cmocka_unit_test(lib_failing_encoder_writes_nothing),
 	        cmocka_unit_test(cli_missing_ffmpeg),

@@ -31,7 +31,13 @@
  * boundaries) when that fits with its shorter side spanning at most
  * view_span metres; a larger field (a lattice of gates) is shown at that
  * scale with the camera on the body, kept inside the field where the field
- * is larger than the view (the essay's MAT2AVI over the lattice). */
+ * is larger than the view (the essay's MAT2AVI over the lattice), with an
+ * overview of the whole field in the bottom-right corner: the trail, the
+ * body, the part of the field in view, and for a lattice its gates by
+ * stiffness with the gates the body has entered so far (the runner's gate
+ * path) filled in the path colour. A lattice's view also shows the gate
+ * boundaries, tints the gates entered, names the gate the body is in, and
+ * states the outcome as the final location (end, side, stuck gate). */
 #ifndef BEAMSIM_VIDEO_H
 #define BEAMSIM_VIDEO_H
 
@@ -131,6 +137,17 @@ uint32_t bsim_video_stiffness_color(const bsim_video *v, double k);
 /* The colour the body is filled with, 0x00RRGGBB (nothing else is drawn
  * in it, so a frame's body can be found by its colour). */
 uint32_t bsim_video_body_color(void);
+
+/* The colour of the gates the body has entered in a lattice's overview,
+ * 0x00RRGGBB (nothing else is drawn in it). */
+uint32_t bsim_video_path_color(void);
+
+/* Where world point p (m) lies in the overview of panel `panel` at frame k,
+ * pixels from the frame's top-left: 1 and px if that frame shows an
+ * overview (its camera follows the body over a field larger than the
+ * view), else 0. */
+int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, const double p[2],
+                              double px[2]);
 
 /* Renders every frame and encodes them with ffmpeg into path: H.264,
  * yuv420p, fps frames per second. The file appears whole or not at all

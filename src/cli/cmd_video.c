@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/lattice.h"
 #include "beamsim/schedule.h"
 #include "beamsim/video.h"
 #include "cli_common.h"
@@ -42,6 +43,7 @@ static const char video_help[] =
         "  --hold S               seconds the last frame is held (default 1)\n"
         "  --view M               metres the shorter side of a panel shows at most; a\n"
         "                         larger field is followed by the camera (default 200)\n"
+        "  --crf N                x264 quality, 0 (lossless) to 51 (smallest); default 23\n"
         "  -h, --help             show this help\n";
 
 enum {
@@ -56,7 +58,8 @@ enum {
 	OPT_FPS,
 	OPT_SIZE,
 	OPT_HOLD,
-	OPT_VIEW
+	OPT_VIEW,
+	OPT_CRF
 };
 
 static const struct option video_options[] = {
@@ -72,6 +75,7 @@ static const struct option video_options[] = {
         {"size", required_argument, NULL, OPT_SIZE},
         {"hold", required_argument, NULL, OPT_HOLD},
         {"view", required_argument, NULL, OPT_VIEW},
+        {"crf", required_argument, NULL, OPT_CRF},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
 };
@@ -207,6 +211,13 @@ static int video_option(video_args *a, int c)
 		return parse_number("--hold", optarg, 0.0, 60.0, 0, &a->def.hold);
 	case OPT_VIEW:
 		return parse_number("--view", optarg, 0.0, 1e6, 1, &a->def.view_span);
+	case OPT_CRF: {
+		long crf;
+		if (cli_parse_long(optarg, 0, 51, &crf) != 0)
+			return cli_usage("video", "--crf %s: expected an integer 0 to 51", optarg);
+		a->def.crf = (int)crf;
+		return CLI_OK;
+	}
 	}
 	return CLI_USAGE;
 }
@@ -247,9 +258,17 @@ static int video_parse(int argc, char **argv, video_args *a)
 	return -1;
 }
 
-static void print_outcome(FILE *out, const char *name, const bsim_trial_result *r)
+static void print_outcome(FILE *out, const char *name, const bsim_scene *s,
+                          const bsim_trial_result *r)
 {
 	fprintf(out, "%-11s %s at t = %.6g s", name, bsim_outcome_name(r->outcome), r->t_end);
+	if (s->has_lattice) {
+		char loc[48];
+		bsim_location_label(bsim_location_of(r), loc, sizeof loc);
+		fprintf(out, ", ended %s, %d gates entered, %d steps run\n", loc, r->gates_entered,
+		        r->steps_run);
+		return;
+	}
 	if (r->outcome == BSIM_TRAVERSED)
 		fprintf(out, ", %s type", bsim_type_name(r->type));
 	else if (r->outcome == BSIM_STUCK)
@@ -283,7 +302,7 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 		fprintf(out, "scene       %s (%s), seed %" PRIu64 ", group %ld, trial %ld\n",
 		        a->scene, scene->name, a->seed, a->group, a->trial);
 		for (int i = 0; i < a->n_backends; i++)
-			print_outcome(out, a->names[i], bsim_video_track_result(tracks[i]));
+			print_outcome(out, a->names[i], scene, bsim_video_track_result(tracks[i]));
 		if (a->n_backends > 1) {
 			double t = bsim_video_track_separation(tracks[0], tracks[1],
 			                                       0.01 * scene->body.radius);
