@@ -32,6 +32,15 @@ $b landscape configs/thesis/gate.yaml --set beams.0.stiffness=500 --set beams.1.
   --out $o/landscape-500-250 >/dev/null
 $b landscape configs/thesis/gate.yaml --set beams.0.stiffness=100 --set beams.1.stiffness=500 \
   --out $o/landscape-100-500 >/dev/null
+# Fig. 3.5: the C-track of the gate lattice, the essay's 20 trials; its 1000 trials on both
+# protocols (the first 200 trajectories kept) and on both backends (compare exits 3 on a
+# disagreement, which is a result here, not a failure)
+$b sweep configs/lattice/c_track_essay.yaml --trajectories 20 --trajectory-stride 25 --quiet \
+  --out $o/c-track-20
+$b compare configs/lattice/c_track_1000.yaml --protocols world,essay --trajectories 200 \
+  --trajectory-stride 25 --quiet --out $o/c-track-protocols || [ $? -eq 3 ]
+$b compare configs/lattice/c_track_1000.yaml --quiet --out $o/c-track-backends || [ $? -eq 3 ]
+for dir in c-track-20 c-track-protocols c-track-backends; do $b plot $o/$dir --quiet; done
 # the accuracy study of docs/accuracy.csv
 mkdir -p $o/accuracy && cp docs/accuracy.csv $o/accuracy/ && $b plot $o/accuracy --quiet
 
@@ -47,6 +56,10 @@ for g in 9 10 11; do small $o/h2-figures "trajectories_g$(printf %03d $g)" "fig3
 for g in 1 2; do small $o/h2-figures "landscape_g$(printf %03d $g)" "fig3.3-g$g"; done
 small $o/fig3.4a traversal_vs_beams_0_stiffness fig3.4a
 small $o/fig3.4b traversal_vs_effects_random_force_magnitude fig3.4b
+small $o/c-track-20 lattice_g000 fig3.5-c-track-20
+small $o/c-track-protocols/world lattice_g000 fig3.5-c-track-200
+small $o/c-track-protocols final_locations_g000 c-track-protocols
+small $o/c-track-backends final_locations_g000 c-track-backends
 small $o/accuracy accuracy accuracy
 small $o/landscape landscape_beam landscape_beam
 small $o/landscape landscape_total landscape_total

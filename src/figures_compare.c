@@ -244,7 +244,7 @@ static void lattice_test_line(struct fy_node *root, int g, char *buf, size_t siz
 		return;
 	}
 	snprintf(buf, size,
-	         "%.0f discordant pairs; total variation %.3f; %s test p = %.3g (Holm %.3g)%s",
+	         "%.0f discordant pairs; total variation %.3f; %s test: p = %.3g (Holm %.3g)%s",
 	         v[3], v[2], test, v[0], v[1],
 	         strcmp(beyond, "true") == 0 ? ": beyond the rule" : "");
 }

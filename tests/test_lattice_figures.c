@@ -562,7 +562,7 @@ static void test_compare(void **state)
 	const char *pp = strstr(fl, "\"p\":");
 	assert_non_null(pp);
 	char want[64];
-	snprintf(want, sizeof want, "test p = %.3g ", strtod(pp + 4, NULL));
+	snprintf(want, sizeof want, "test: p = %.3g ", strtod(pp + 4, NULL));
 	assert_non_null(strstr(gp, want));
 	assert_non_null(strstr(gp, "permutation"));
 	free(gp);
