@@ -12,9 +12,17 @@
  *   trajectories (trajectories.csv), each group's bundle coloured by
  *   outcome and type, and the traversed ones over the potential energy
  *   landscape, stretches below the surface marked;
+ * - a sweep of a gate lattice (lattice_map.csv beside them): per group the
+ *   final-location distribution laid out as the field (stuck gates as a
+ *   map, ends by column, side exits by row and side, 95% intervals) and
+ *   the essay's Fig. 3.5 (the stiffness map, the kept trajectories over it,
+ *   those that reached the end in blue), instead of the bundle and
+ *   landscape; traversal against each axis as reached the end, side exit
+ *   and stuck;
  * - a comparison (report.json, pairs.csv): both backends' p_traverse side
  *   by side with their paired differences, and each backend's sweep
- *   figures in DIR/<backend>/;
+ *   figures in DIR/<backend>/; of lattices also both sides' final-location
+ *   distributions side by side;
  * - a run (trajectory.csv, ledger.csv): the random force over time and its
  *   histogram against N(0, Rm^2), the energy ledger over time, and the
  *   trajectory over the landscape;
