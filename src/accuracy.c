@@ -18,8 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/clock.h"
+#include "atomic_file.h"
+#include "clock.h"
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
@@ -56,7 +56,7 @@ static void reference_keep(void *user, long step, const bsim_state *s)
 		ref->states = grown;
 		t->cap = cap;
 	}
-	if (bsim_state_alloc(&ref->states[ref->n], s->n_beams)) {
+	if (bsim_state_init(&ref->states[ref->n], s->n_beams)) {
 		t->failed = 1;
 		return;
 	}
@@ -166,7 +166,7 @@ int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_sce
 		                      "accuracy: the reference (%g s) is shorter than a piece",
 		                      (ref->n - 1) * ref->grid);
 	bsim_state s;
-	if (bsim_state_alloc(&s, scene->n_beams))
+	if (bsim_state_init(&s, scene->n_beams))
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	double sum = 0.0, worst = 0.0;
 	int rc = BSIM_OK;

@@ -1,5 +1,5 @@
 /* JSON leaf values; see beamsim/json.h. */
-#include "beamsim/json.h"
+#include "json.h"
 
 #include <math.h>
 #include <stdlib.h>

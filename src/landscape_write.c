@@ -20,8 +20,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "figure.h"
 #include "mat.h"
 

@@ -1,6 +1,6 @@
 /* Backend options: `--backend-opt key=value` pairs, checked against the
  * backend's knob table and read with the knob's default. */
-#include "beamsim/backend.h"
+#include "beamsim/options.h"
 
 #include <errno.h>
 #include <math.h>

@@ -13,8 +13,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/version.h"
 

@@ -19,9 +19,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 #include "beamsim/lattice.h"
-#include "beamsim/matlab.h"
+#include "matlab.h"
 #include "beamsim/output.h"
 
 typedef int (*lattice_writer)(FILE *f, const bsim_experiment *e, const bsim_override *extra,

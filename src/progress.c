@@ -1,9 +1,9 @@
 /* The progress line of long runs; see beamsim/progress.h. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "beamsim/progress.h"
+#include "progress.h"
 
-#include "beamsim/clock.h"
+#include "clock.h"
 
 #include <stdio.h>
 #include <unistd.h>

@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/json.h"
+#include "json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/output.h"
 

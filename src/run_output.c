@@ -6,9 +6,9 @@
 #include <inttypes.h>
 #include <string.h>
 
-#include "beamsim/json.h"
+#include "json.h"
 #include "beamsim/lattice.h"
-#include "beamsim/matlab.h"
+#include "matlab.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
 

@@ -15,8 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
 #include "yaml_doc.h"

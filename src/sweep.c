@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/clock.h"
+#include "clock.h"
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"

@@ -77,7 +77,7 @@ static int runner_reserve(bsim_runner *r, int n_beams)
 	free(r->shape);
 	r->cap = 0;
 	r->shape = malloc((size_t)(n_beams > 0 ? n_beams : 1) * sizeof *r->shape);
-	if (!r->shape || bsim_state_alloc(&r->s0, n_beams) || bsim_state_alloc(&r->s1, n_beams))
+	if (!r->shape || bsim_state_init(&r->s0, n_beams) || bsim_state_init(&r->s1, n_beams))
 		return BSIM_EFAIL;
 	r->cap = n_beams;
 	return BSIM_OK;
@@ -618,7 +618,7 @@ static int trial_setup(trial_ctx *c, bsim_error *err)
 	int recording = c->rec && (c->rec->csv || c->rec->ledger || c->rec->record);
 	if (essay && recording && r->whole.n_beams != scene->n_beams) {
 		bsim_state_free(&r->whole);
-		if (bsim_state_alloc(&r->whole, scene->n_beams))
+		if (bsim_state_init(&r->whole, scene->n_beams))
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	c->ws = scene;

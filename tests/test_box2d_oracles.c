@@ -61,7 +61,7 @@ static double check_tangent(double r, double e, double u)
 	s.body.velocity[1] = u;
 	bsim_world *w = create(&s, NULL);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	int impacts = 0, tangent = 0;
 	double impact_loss = 0.0;
@@ -132,7 +132,7 @@ static void run_tip(double e_tip, double out[4])
 	s.body.velocity[1] = 2.0;
 	bsim_world *w = create(&s, NULL);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	int impacts = 0, tip = 0;
 	double vrel_before = 0.0, vrel_after = 0.0;
@@ -210,7 +210,7 @@ static double vibration_error(const char *spring, double h, double rest_deg)
 	bsim_options o = opts_of(spring, NULL);
 	bsim_world *w = create(&s, &o);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	double worst = 0.0, damper = 0.0;
 	long n_steps = lround(3.0 / h);
@@ -269,7 +269,7 @@ static void test_stiff_spring_stability(void **state)
 			bsim_options o = opts_of(weld ? "spring=weld" : "spring=torque", NULL);
 			bsim_world *w = create(&s, &o);
 			bsim_state st;
-			bsim_state_alloc(&st, 1);
+			bsim_state_init(&st, 1);
 			const double zero[2] = {0.0, 0.0};
 			double e0 = 0.5 * k * 0.04, e_max = 0.0, e = e0;
 			for (int n = 0; n < 2000 && isfinite(e) && e < 1e6 * e0; n++) {
@@ -406,8 +406,8 @@ static void test_mirror_deviation(void **state)
 	bsim_world *wa = create(&a, NULL), *wb = create(&b, NULL);
 	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_seed_mix(5, 0, 0));
 	bsim_state sa, sb;
-	bsim_state_alloc(&sa, 2);
-	bsim_state_alloc(&sb, 2);
+	bsim_state_init(&sa, 2);
+	bsim_state_init(&sb, 2);
 	double dev_free = 0.0, dev_contact = 0.0, dev_all = 0.0;
 	int contact_steps = 0, first_contact = -1;
 	for (long n = 0; n < 3000; n++) {
@@ -479,8 +479,8 @@ static void test_set_state(void **state)
 	bsim_scene_init_gate(&s, 7.0, 0.0);
 	bsim_world *w = create(&s, NULL), *w2 = create(&s, NULL);
 	bsim_state st, st2;
-	bsim_state_alloc(&st, 2);
-	bsim_state_alloc(&st2, 2);
+	bsim_state_init(&st, 2);
+	bsim_state_init(&st2, 2);
 	const double f[2] = {0.0, 7.0};
 	for (int n = 0; n < 700; n++) /* into contact with both beams */
 		b2->step(w, f, s.dt);
@@ -501,7 +501,7 @@ static void test_set_state(void **state)
 	              fabs(st2.x[1] - st.x[1]));
 	assert_true(fabs(st2.x[1] - st.x[1]) <= 1e-3);
 	bsim_state bad;
-	bsim_state_alloc(&bad, 3);
+	bsim_state_init(&bad, 3);
 	assert_int_equal(b2->set_state(w2, &bad, &err), BSIM_EINPUT);
 	bsim_state_free(&bad);
 	bsim_state_free(&st);

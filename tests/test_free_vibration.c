@@ -39,7 +39,7 @@ static double vibration_error(double h, double t_end)
 	bsim_scene s;
 	bsim_world *w = beam_released(&s, 400.0, 50.0, 0.1);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	double worst = 0.0;
 	long n_steps = lround(t_end / h);
@@ -86,7 +86,7 @@ static void test_stiff_spring_stable(void **state)
 			        &s, k, damped ? 2.0 * 0.05 * sqrt(k * inertia) : 0.0, 0.2);
 			assert_true(s.beams[0].inertia == inertia);
 			bsim_state st;
-			bsim_state_alloc(&st, 1);
+			bsim_state_init(&st, 1);
 			const double zero[2] = {0.0, 0.0};
 			double e0 = 0.5 * k * 0.04, e_prev = e0;
 			for (int n = 0; n < 5000; n++) {

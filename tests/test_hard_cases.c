@@ -109,7 +109,7 @@ static void zeno_one(const char *bname, double e)
 	s.contact.restitution = s.contact.tip_restitution = e;
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 2);
+	bsim_state_init(&st, 2);
 	const double force[2] = {0.0, s.effects.propulsion_force};
 	const int steps = 5000;
 	/* apex: the largest gap between two touches; the total energy at an apex
@@ -181,7 +181,7 @@ static double_run double_one(const bsim_backend *b, double dx)
 	s.body.start[0] += dx;
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 2);
+	bsim_state_init(&st, 2);
 	const double zero[2] = {0.0, 0.0};
 	double_run r = {0, 0, 0, 0};
 	for (int n = 0; n < s.max_steps; n++) {
@@ -345,7 +345,7 @@ static void wedge_one(const char *bname, double overlap)
 	load("configs/hard/wedge.yaml", &s);
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 2);
+	bsim_state_init(&st, 2);
 	if (overlap > 0.0) {
 		/* both beams touch a centred body at y0 = 2 (20 sin 60 - R):
 		 * distance 20 sin 60 - y/2; y0 + 2 overlap sinks it by overlap */
@@ -405,7 +405,7 @@ static double phase_one(const bsim_backend *b, double u, double phase, int *impa
 	s.body.start[1] = -s.body.radius - u * s.dt * phase;
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	*impacts = 0;
 	int steps = (int)phase + 20;
@@ -434,7 +434,7 @@ static void graze_one(const bsim_backend *b, const char *bname, double eps)
 	s.body.velocity[1] = u;
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	b->get_state(w, &st);
 	double e0 = energy_of(&s, &st);
 	double l0 = s.body.mass * (st.x[0] * st.v[1] - st.x[1] * st.v[0]) +

@@ -38,7 +38,7 @@ static void check_tangent(double r, double e, double u)
 	s.body.start[1] = -s.body.radius - 1e-9; /* touching, below the beam */
 	s.body.velocity[1] = u;
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	step_once(&s, &st);
 
 	double inertia = s.beams[0].inertia, mass = s.body.mass;
@@ -93,7 +93,7 @@ static void test_tip_impact_conserves(void **state)
 	s.body.velocity[0] = -0.6;
 	s.body.velocity[1] = 2.0;
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	step_once(&s, &st);
 
 	double mass = s.body.mass, inertia = s.beams[0].inertia;
@@ -146,9 +146,9 @@ static void test_simultaneous_double_impact(void **state)
 {
 	(void)state;
 	bsim_state c, l, r;
-	bsim_state_alloc(&c, 2);
-	bsim_state_alloc(&l, 2);
-	bsim_state_alloc(&r, 2);
+	bsim_state_init(&c, 2);
+	bsim_state_init(&l, 2);
+	bsim_state_init(&r, 2);
 	for (int same_e = 0; same_e < 2; same_e++) {
 		double e_tip = same_e ? 0.8 : 1.0;
 		run_midline(0.0, e_tip, &c);

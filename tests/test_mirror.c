@@ -34,8 +34,8 @@ static void test_mirror_bitwise_steps(void **state)
 	assert_int_equal(bsim_backend_thesis.create(&b, NULL, &wb, &err), BSIM_OK);
 	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_seed_mix(5, 0, 0));
 	bsim_state sa, sb;
-	bsim_state_alloc(&sa, 2);
-	bsim_state_alloc(&sb, 2);
+	bsim_state_init(&sa, 2);
+	bsim_state_init(&sb, 2);
 	int contact_steps = 0;
 	for (long n = 0; n < 3000; n++) {
 		double fr = bsim_schedule_value(sched, bsim_schedule_index(sched, n, a.dt));

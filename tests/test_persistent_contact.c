@@ -53,7 +53,7 @@ static void test_impact_chain_settles(void **state)
 	bsim_error err;
 	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
 	bsim_state st;
-	bsim_state_alloc(&st, 2);
+	bsim_state_init(&st, 2);
 	const double force[2] = {0.0, f_prop};
 	int impacts = 0, last_impact = -1;
 	double worst = 0.0;

@@ -118,8 +118,8 @@ double thesis_beam_response(const thesis_beam *b, double h, int integrator);
 double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator);
 double thesis_beam_advance(thesis_beam *b, double omega_new, double h, int integrator);
 
-/* contact_solve.c */
-void thesis_contact_solve(struct bsim_world *w, const double force[2], double h);
+/* persistent_contact.c */
+void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h);
 
 /* position_project.c */
 void thesis_position_project(struct bsim_world *w, const double force[2]);

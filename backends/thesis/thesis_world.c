@@ -223,7 +223,7 @@ static void thesis_step(bsim_world *w, const double force[2], double h)
 	w->n_contacts = n;
 	if (n)
 		thesis_impact_resolve(w, h);
-	thesis_contact_solve(w, force, h);
+	thesis_persistent_contact_solve(w, force, h);
 	if (w->contact_mode == THESIS_CONTACT_ESSAY)
 		w->any_held = essay_hold(w);
 	if (n)

@@ -20,7 +20,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 #include "beamsim/backend.h"
 #include "beamsim/scene.h"
 #include "beamsim/trial.h"

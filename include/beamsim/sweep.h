@@ -9,7 +9,7 @@
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
 #include "beamsim/trajectory.h"
-#include "beamsim/journal.h"
+#include "journal.h"
 #include "beamsim/trial.h"
 
 #ifdef __cplusplus

@@ -30,9 +30,9 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/clock.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "clock.h"
+#include "json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/output.h"
 #include "beamsim/schedule.h"

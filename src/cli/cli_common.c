@@ -10,8 +10,8 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
-#include "beamsim/outdir.h"
-#include "beamsim/progress.h"
+#include "outdir.h"
+#include "progress.h"
 
 static const bsim_outdir *error_outdir;
 

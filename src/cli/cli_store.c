@@ -11,10 +11,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/matlab.h"
+#include "atomic_file.h"
+#include "matlab.h"
 #include "beamsim/output.h"
-#include "beamsim/progress.h"
+#include "progress.h"
 #include "beamsim/report.h"
 #include "cli_common.h"
 

@@ -8,8 +8,8 @@
 
 #include "beamsim/compare.h"
 #include "beamsim/experiment.h"
-#include "beamsim/journal.h"
-#include "beamsim/outdir.h"
+#include "journal.h"
+#include "outdir.h"
 #include "beamsim/run_record.h"
 #include "beamsim/sweep.h"
 

@@ -13,7 +13,7 @@
 #include "beamsim/accuracy.h"
 #include "beamsim/output.h"
 #include "beamsim/figures.h"
-#include "beamsim/matlab.h"
+#include "matlab.h"
 #include "cli_common.h"
 #include "cli_store.h"
 

@@ -10,8 +10,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "beamsim/output.h"
 #include "beamsim/sweep.h"
 #include "bench_lattice.h"

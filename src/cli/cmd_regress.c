@@ -13,10 +13,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 #include "beamsim/effects.h"
-#include "beamsim/json.h"
-#include "beamsim/outdir.h"
+#include "json.h"
+#include "outdir.h"
 #include "beamsim/output.h"
 #include "beamsim/report.h"
 #include "beamsim/version.h"

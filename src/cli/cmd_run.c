@@ -11,9 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 #include "beamsim/lattice.h"
-#include "beamsim/matlab.h"
+#include "matlab.h"
 #include "beamsim/output.h"
 #include "beamsim/run_output.h"
 #include "beamsim/schedule.h"

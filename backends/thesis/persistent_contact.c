@@ -23,7 +23,7 @@
 
 #include "thesis/thesis.h"
 
-void thesis_contact_solve(struct bsim_world *w, const double force[2], double h)
+void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h)
 {
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
