@@ -78,12 +78,12 @@ int bsim_accuracy_reference_run(bsim_accuracy_reference *ref, const bsim_scene *
 		                      grid, scene->dt);
 	reference_trace t = {.ref = ref, .stride = stride};
 	bsim_recorder rec = {.stride = 1, .trace = reference_keep, .trace_user = &t};
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	if (!r)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	bsim_trial_result res;
 	int rc = bsim_trial_run(r, scene, b, opts, seed, &rec, &res, err);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	if (rc == BSIM_OK && t.failed)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory storing the reference");
 	if (rc == BSIM_OK && res.outcome == BSIM_UNSTABLE) {
@@ -244,7 +244,7 @@ int bsim_accuracy_settings(const bsim_backend *b, bsim_accuracy_row **out, int *
 }
 
 /* The batch of trials of one row: p_traverse, residual rate and cost. */
-static int row_batch(bsim_accuracy_row *row, bsim_runner *runner, const bsim_scene *scene,
+static int row_batch(bsim_accuracy_row *row, bsim_trial_runner *runner, const bsim_scene *scene,
                      const bsim_backend *b, const bsim_accuracy_config *cfg, bsim_error *err)
 {
 	int traversed = 0;
@@ -254,7 +254,7 @@ static int row_batch(bsim_accuracy_row *row, bsim_runner *runner, const bsim_sce
 		bsim_trial_result res;
 		bsim_error e;
 		int rc = bsim_trial_run(runner, scene, b, &row->opts,
-		                        bsim_seed_mix(cfg->seed, 0, t), NULL, &res, &e);
+		                        bsim_schedule_seed_mix(cfg->seed, 0, t), NULL, &res, &e);
 		if (rc) {
 			*err = e;
 			return rc;
@@ -287,16 +287,16 @@ static int row_run(bsim_accuracy_row *row, const bsim_accuracy_reference *ref,
 	if (rc)
 		return rc;
 	double t0 = bsim_clock_seconds();
-	rc = bsim_accuracy_consistency(ref, &sc, b, &row->opts, bsim_seed_mix(cfg->seed, 0, 0),
-	                               cfg->piece, cfg->n_pieces, &row->err_mean, &row->err_max,
-	                               err);
+	rc = bsim_accuracy_consistency(ref, &sc, b, &row->opts,
+	                               bsim_schedule_seed_mix(cfg->seed, 0, 0), cfg->piece,
+	                               cfg->n_pieces, &row->err_mean, &row->err_max, err);
 	row->wall_seconds = bsim_clock_seconds() - t0;
-	bsim_runner *runner = rc ? NULL : bsim_runner_alloc();
+	bsim_trial_runner *runner = rc ? NULL : bsim_trial_runner_alloc();
 	if (!rc && !runner)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (!rc)
 		rc = row_batch(row, runner, &sc, b, cfg, err);
-	bsim_runner_free(runner);
+	bsim_trial_runner_free(runner);
 	bsim_scene_free(&sc);
 	return rc;
 }
@@ -371,8 +371,8 @@ int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backen
 		rc = scene_at_step(&sc, scene, cfg->h_ref, err);
 		if (rc == BSIM_OK) {
 			rc = bsim_accuracy_reference_run(&refs[bi], &sc, backends[bi], &set[0].opts,
-			                                 bsim_seed_mix(cfg->seed, 0, 0), cfg->h_max,
-			                                 err);
+			                                 bsim_schedule_seed_mix(cfg->seed, 0, 0),
+			                                 cfg->h_max, err);
 			bsim_scene_free(&sc);
 		}
 		free(set);

@@ -10,7 +10,7 @@ static const bsim_backend *const registry[] = {
         NULL,
 };
 
-const bsim_backend *const *bsim_backends(void)
+const bsim_backend *const *bsim_backend_list(void)
 {
 	return registry;
 }

@@ -242,8 +242,8 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, bsim_error *e
 				if (first[p] < 0)
 					first[p] = gi;
 				double ll, lh, rl, rh, n = G->trials > 0 ? G->trials : 1;
-				bsim_wilson(G->left, G->trials, BSIM_Z95, &ll, &lh);
-				bsim_wilson(G->right, G->trials, BSIM_Z95, &rl, &rh);
+				bsim_stats_wilson(G->left, G->trials, BSIM_STATS_Z95, &ll, &lh);
+				bsim_stats_wilson(G->right, G->trials, BSIM_STATS_Z95, &rl, &rh);
 				fprintf(o.f,
 				        "%.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g "
 				        "%.6g\n",

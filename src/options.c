@@ -4,6 +4,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -136,4 +137,17 @@ int bsim_options_choice(const bsim_options *opts, const bsim_knob *knob)
 	const char *v = bsim_options_get(opts, knob->name);
 	int i = v ? choice_index(knob->choices, v) : -1;
 	return i >= 0 ? i : choice_index(knob->choices, knob->default_value);
+}
+
+void bsim_options_effective(const bsim_knob *knobs, int n_knobs, const bsim_options *given,
+                            bsim_options *out)
+{
+	*out = given ? *given : (bsim_options){0};
+	for (int i = 0; i < n_knobs && out->n < BSIM_OPTIONS_MAX; i++) {
+		if (bsim_options_get(out, knobs[i].name) || !knobs[i].default_value)
+			continue;
+		snprintf(out->key[out->n], sizeof out->key[0], "%s", knobs[i].name);
+		snprintf(out->value[out->n], sizeof out->value[0], "%s", knobs[i].default_value);
+		out->n++;
+	}
 }

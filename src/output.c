@@ -109,7 +109,7 @@ static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 	for (int k = 0; k < ls.n_locations; k++) {
 		const bsim_location_count *c = &ls.locations[k];
 		char label[48];
-		bsim_location_label(c->loc, label, sizeof label);
+		bsim_lattice_location_label(c->loc, label, sizeof label);
 		static const char *const kinds[] = {"end", "side", "stuck"};
 		fprintf(f, "%s{\"location\": \"%s\", \"kind\": \"%s\", \"ix\": ", k ? ", " : "",
 		        label, kinds[c->loc.kind]);
@@ -280,8 +280,8 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 			const bsim_trial_result *x = &r->trials_out[i];
 			const bsim_ledger *l = &x->ledger;
 			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", g, t,
-			        bsim_outcome_name(x->outcome), bsim_type_name(x->type), x->steps,
-			        x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
+			        bsim_trial_outcome_name(x->outcome), bsim_trial_type_name(x->type),
+			        x->steps, x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
 			        x->max_theta[1]);
 			/* losses: sleeping's and the essay protocol's resets too, so that
 			 * e_end - e_start = work_in - losses + residual */
@@ -294,7 +294,8 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 			/* the final gate and location, and the gates entered in order:
 			 * "ix:iy ix:iy ..." */
 			char label[48];
-			bsim_location_label(bsim_location_of(x), label, sizeof label);
+			bsim_lattice_location_label(bsim_lattice_location_of(x), label,
+			                            sizeof label);
 			fprintf(o.f, ",%d,%d,%s,", x->final_ix, x->final_iy, label);
 			const bsim_trial_log *tl = r->logs ? &r->logs[i] : NULL;
 			for (int k = 0; tl && k < tl->n_entries; k++)

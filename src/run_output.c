@@ -46,7 +46,7 @@ static void ledger_json(FILE *f, const bsim_ledger *l)
 static void path_json(FILE *f, const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	char label[48];
-	bsim_location_label(bsim_location_of(r), label, sizeof label);
+	bsim_lattice_location_label(bsim_lattice_location_of(r), label, sizeof label);
 	fprintf(f, ", \"final_gate\": [%d, %d], \"location\": \"%s\", \"reset_overlaps\": %d",
 	        r->final_ix, r->final_iy, label, r->reset_overlaps);
 	if (!log)
@@ -55,7 +55,7 @@ static void path_json(FILE *f, const bsim_trial_result *r, const bsim_trial_log 
 	for (int k = 0; k < log->n_entries; k++) {
 		const bsim_gate_entry *e = &log->entries[k];
 		fprintf(f, "%s{\"gate\": [%d, %d], \"edge\": \"%s\", \"t\": ", k ? ", " : "", e->ix,
-		        e->iy, bsim_edge_name(e->edge));
+		        e->iy, bsim_trial_edge_name(e->edge));
 		bsim_json_number(f, e->t);
 		fputs(", \"pos\": ", f);
 		bsim_json_number(f, e->pos);
@@ -88,7 +88,8 @@ static void record_json(FILE *f, const bsim_run_info *info)
 	fputc('}', f);
 }
 
-void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r, int record)
+void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r,
+                          int record)
 {
 	fputs("{\"scene\": ", f);
 	bsim_json_string(f, info->scene_path);
@@ -102,9 +103,9 @@ void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *
 	        ", \"seed\": %" PRIu64 ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": %" PRIu64,
 	        info->seed, info->group, info->trial, info->mixed_seed);
 	fputs(", \"outcome\": ", f);
-	bsim_json_string(f, bsim_outcome_name(r->outcome));
+	bsim_json_string(f, bsim_trial_outcome_name(r->outcome));
 	fputs(", \"type\": ", f);
-	bsim_json_string(f, bsim_type_name(r->type));
+	bsim_json_string(f, bsim_trial_type_name(r->type));
 	fprintf(f, ", \"landscape_left\": %d, \"landscape_beam\": ", r->landscape_beam == 0);
 	if (r->landscape_beam >= 0)
 		fprintf(f, "%d", r->landscape_beam + 1);
@@ -158,8 +159,8 @@ int bsim_run_output_open(bsim_run_output *o, const char *dir, int n_beams, bsim_
 		bsim_atomic_file_abort(&o->traj);
 		return BSIM_EFAIL;
 	}
-	bsim_recorder_header(o->traj.f, n_beams);
-	bsim_recorder_ledger_header(o->ledger.f);
+	bsim_trial_trajectory_header(o->traj.f, n_beams);
+	bsim_trial_ledger_header(o->ledger.f);
 	rec->csv = o->traj.f;
 	rec->ledger = o->ledger.f;
 	return BSIM_OK;
@@ -200,7 +201,7 @@ int bsim_run_output_commit(bsim_run_output *o, const bsim_run_info *info,
 	if (!rc)
 		rc = bsim_atomic_file_open(&f, path, err);
 	if (!rc) {
-		bsim_run_json(f.f, info, r, 1);
+		bsim_run_output_json(f.f, info, r, 1);
 		rc = bsim_atomic_file_commit(&f, err);
 	}
 	return rc;

@@ -21,18 +21,6 @@
 #include "beamsim/version.h"
 #include "yaml_doc.h"
 
-void bsim_options_effective(const bsim_backend *b, const bsim_options *given, bsim_options *out)
-{
-	*out = given ? *given : (bsim_options){0};
-	for (int i = 0; i < b->n_knobs && out->n < BSIM_OPTIONS_MAX; i++) {
-		if (bsim_options_get(out, b->knobs[i].name) || !b->knobs[i].default_value)
-			continue;
-		snprintf(out->key[out->n], sizeof out->key[0], "%s", b->knobs[i].name);
-		snprintf(out->value[out->n], sizeof out->value[0], "%s", b->knobs[i].default_value);
-		out->n++;
-	}
-}
-
 static int path_join(char *buf, size_t size, const char *dir, const char *name, bsim_error *err)
 {
 	int n = snprintf(buf, size, "%s/%s", dir, name);

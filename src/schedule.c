@@ -34,7 +34,7 @@ static uint64_t splitmix64(uint64_t z)
 	return z ^ (z >> 31);
 }
 
-uint64_t bsim_seed_mix(uint64_t seed, uint64_t group, uint64_t trial)
+uint64_t bsim_schedule_seed_mix(uint64_t seed, uint64_t group, uint64_t trial)
 {
 	uint64_t h = splitmix64(seed);
 	h = splitmix64(h ^ group);

@@ -33,7 +33,7 @@ typedef struct beam_shape {
 	double p[2], u0[2], sgn, length, reach2;
 } beam_shape;
 
-struct bsim_runner {
+struct bsim_trial_runner {
 	bsim_state s0, s1; /* before and after a step */
 	beam_shape *shape; /* per beam */
 	int *touching;     /* per beam of the scene: contacts at the last touching step
@@ -48,12 +48,12 @@ struct bsim_runner {
 	trial_essay essay;
 };
 
-bsim_runner *bsim_runner_alloc(void)
+bsim_trial_runner *bsim_trial_runner_alloc(void)
 {
-	return calloc(1, sizeof(bsim_runner));
+	return calloc(1, sizeof(bsim_trial_runner));
 }
 
-void bsim_runner_free(bsim_runner *r)
+void bsim_trial_runner_free(bsim_trial_runner *r)
 {
 	if (!r)
 		return;
@@ -68,7 +68,7 @@ void bsim_runner_free(bsim_runner *r)
 	free(r);
 }
 
-static int runner_reserve(bsim_runner *r, int n_beams)
+static int runner_reserve(bsim_trial_runner *r, int n_beams)
 {
 	if (r->cap == n_beams && r->s0.theta)
 		return BSIM_OK;
@@ -83,7 +83,7 @@ static int runner_reserve(bsim_runner *r, int n_beams)
 	return BSIM_OK;
 }
 
-static void touching_clear(bsim_runner *r)
+static void touching_clear(bsim_trial_runner *r)
 {
 	for (int k = 0; k < r->n_touch; k++)
 		r->touching[r->touch_list[k]] = 0;
@@ -92,7 +92,7 @@ static void touching_clear(bsim_runner *r)
 
 /* Per beam of the scene: peaks and the touching beams (all zero between
  * trials: touching_update clears what it set). */
-static int peaks_reserve(bsim_runner *r, int n_beams)
+static int peaks_reserve(bsim_trial_runner *r, int n_beams)
 {
 	if (r->peak_cap >= n_beams && r->peak) {
 		touching_clear(r);
@@ -119,8 +119,8 @@ static void shapes_init(beam_shape *shape, const bsim_scene *sc)
 		beam_shape *q = &shape[i];
 		q->p[0] = b->pivot[0];
 		q->p[1] = b->pivot[1];
-		bsim_beam_rest_direction(b, q->u0);
-		q->sgn = bsim_beam_forward_sign(b);
+		bsim_scene_beam_rest_direction(b, q->u0);
+		q->sgn = bsim_scene_beam_forward_sign(b);
 		q->length = b->length;
 		q->reach2 = (b->length + sc->body.radius) * (b->length + sc->body.radius);
 	}
@@ -147,19 +147,19 @@ static double overlap_depth(const beam_shape *shape, int n, double radius, const
 	return depth;
 }
 
-const char *bsim_outcome_name(bsim_outcome o)
+const char *bsim_trial_outcome_name(bsim_outcome o)
 {
 	static const char *names[] = {"traversed", "side_exit", "stuck", "unstable"};
 	return (unsigned)o < BSIM_N_OUTCOMES ? names[o] : "?";
 }
 
-const char *bsim_type_name(bsim_type t)
+const char *bsim_trial_type_name(bsim_type t)
 {
 	static const char *names[] = {"none", "left", "right"};
 	return (unsigned)t < 3 ? names[t] : "?";
 }
 
-const char *bsim_edge_name(bsim_edge e)
+const char *bsim_trial_edge_name(bsim_edge e)
 {
 	static const char *names[] = {"start", "bottom", "left", "right", "top"};
 	return (unsigned)e < 5 ? names[e] : "?";
@@ -268,7 +268,7 @@ static double energy_springs(const bsim_scene *sc, const bsim_state *s)
 	return e;
 }
 
-void bsim_recorder_header(FILE *f, int n_beams)
+void bsim_trial_trajectory_header(FILE *f, int n_beams)
 {
 	fputs("t,x,y,vx,vy", f);
 	for (int i = 1; i <= n_beams; i++)
@@ -279,14 +279,14 @@ void bsim_recorder_header(FILE *f, int n_beams)
 	fputs(",e_kin,e_beam,e_prop\n", f);
 }
 
-void bsim_recorder_ledger_header(FILE *f)
+void bsim_trial_ledger_header(FILE *f)
 {
 	fputs("t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual,sleep,"
 	      "reset\n",
 	      f);
 }
 
-void bsim_recorder_csv_record(void *file, const bsim_record_row *row)
+void bsim_trial_trajectory_row(void *file, const bsim_record_row *row)
 {
 	FILE *f = file;
 	const bsim_state *s = row->state;
@@ -322,7 +322,7 @@ static void record(const bsim_recorder *rec, const bsim_scene *sc, const bsim_st
 	        .e_prop = bsim_landscape_e_prop(sc, s->x[1]),
 	};
 	if (rec->csv)
-		bsim_recorder_csv_record(rec->csv, &row);
+		bsim_trial_trajectory_row(rec->csv, &row);
 	if (rec->ledger)
 		ledger_row(rec->ledger, &row);
 	if (rec->record)
@@ -410,7 +410,7 @@ static int scene_beam(const int *map, int i)
 /* Every beam's peak theta over the steps so far: the active beams, beams 0
  * and 1 (trials.csv's two columns), and any beam whose peak is still below
  * 0 (a beam at rest has theta 0). */
-static void peaks_update(bsim_runner *r, const bsim_scene *scene, const int *map,
+static void peaks_update(bsim_trial_runner *r, const bsim_scene *scene, const int *map,
                          const bsim_state *s, int *n_negative)
 {
 	double *peak = r->peak;
@@ -434,7 +434,7 @@ static void peaks_update(bsim_runner *r, const bsim_scene *scene, const int *map
 /* The contacts of s in touching[] (scene beams: map[i] for the world's beam
  * i, map NULL: the same), as a copy of the whole contact array would leave
  * it, at the cost of the beams listed. */
-static void touching_update(bsim_runner *r, const int *map, const bsim_state *s)
+static void touching_update(bsim_trial_runner *r, const int *map, const bsim_state *s)
 {
 	touching_clear(r);
 	for (int k = 0; k < s->n_active; k++) {
@@ -542,7 +542,7 @@ static int entries_of_step(const bsim_scene *scene, const int *map, const gate_t
 /* ---- the run ------------------------------------------------------------- */
 
 typedef struct trial_ctx {
-	bsim_runner *r;
+	bsim_trial_runner *r;
 	const bsim_scene *scene;
 	const bsim_backend *backend;
 	const bsim_options *opts;
@@ -610,7 +610,7 @@ static int gate_enter(trial_ctx *c, bsim_state **s0, const double p0[2], int ix,
 static int trial_setup(trial_ctx *c, bsim_error *err)
 {
 	const bsim_scene *scene = c->scene;
-	bsim_runner *r = c->r;
+	bsim_trial_runner *r = c->r;
 	int essay = scene->has_lattice && scene->lattice.protocol == BSIM_PROTOCOL_ESSAY;
 	int world_beams = essay ? 2 : scene->n_beams;
 	if (runner_reserve(r, world_beams) || peaks_reserve(r, scene->n_beams))
@@ -624,7 +624,7 @@ static int trial_setup(trial_ctx *c, bsim_error *err)
 	c->ws = scene;
 	c->map = NULL;
 	double p[2] = {scene->body.start[0], scene->body.start[1]};
-	bsim_scene_gate_at(scene, p, &c->gate.ix, &c->gate.iy);
+	bsim_lattice_gate_at(scene, p, &c->gate.ix, &c->gate.iy);
 	if (!essay)
 		return c->backend->create(scene, c->opts, &c->w, err);
 	int rc = trial_essay_start(&r->essay, scene, c->backend, c->opts, c->gate.ix, c->gate.iy,
@@ -634,7 +634,7 @@ static int trial_setup(trial_ctx *c, bsim_error *err)
 	return rc;
 }
 
-int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *backend,
+int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_backend *backend,
                    const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
                    bsim_trial_result *out, bsim_error *err)
 {
@@ -668,7 +668,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	const double h = scene->dt;
 	const int n_max = scene->max_steps;
 	const long gate_max = scene->gate_steps > 0 ? scene->gate_steps : n_max;
-	const double centre = bsim_scene_centre_x(scene);
+	const double centre = bsim_lattice_centre_x(scene);
 	double e0 = energy_kinetic(c.ws, s0) + energy_springs(c.ws, s0);
 	out->ledger.e_start = e0;
 	/* Peaks start at the initial angles: every beam of the scene (the
@@ -753,7 +753,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		 * left from (gates are clamped into the field). */
 		if (scene->has_lattice) {
 			int ix, iy;
-			bsim_scene_gate_at(scene, s0->x, &ix, &iy);
+			bsim_lattice_gate_at(scene, s0->x, &ix, &iy);
 			if ((ix != c.gate.ix || iy != c.gate.iy) &&
 			    (rc = gate_enter(&c, &s0, p0, ix, iy, n, &e0, err)) != BSIM_OK)
 				break;

@@ -237,6 +237,7 @@ int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_swe
 	for (size_t i = 0; i < total; i++)
 		r->trials_out[i].steps_run = 0;
 	for (int g = 0; g < n_groups; g++)
-		bsim_group_aggregate(&r->trials_out[(size_t)g * trials], trials, &r->groups[g]);
+		bsim_sweep_group_aggregate(&r->trials_out[(size_t)g * trials], trials,
+		                           &r->groups[g]);
 	return BSIM_OK;
 }

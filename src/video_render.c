@@ -83,8 +83,8 @@ static void set_color(cairo_t *cr, uint32_t c)
 static void beam_tip(const bsim_beam_def *b, double theta, double tip[2])
 {
 	double u0[2];
-	bsim_beam_rest_direction(b, u0);
-	double a = atan2(u0[1], u0[0]) + bsim_beam_forward_sign(b) * theta;
+	bsim_scene_beam_rest_direction(b, u0);
+	double a = atan2(u0[1], u0[0]) + bsim_scene_beam_forward_sign(b) * theta;
 	tip[0] = b->pivot[0] + b->length * cos(a);
 	tip[1] = b->pivot[1] + b->length * sin(a);
 }
@@ -296,7 +296,7 @@ static void outcome_text(const bsim_trial_result *r, char *buf, size_t n)
 	switch (r->outcome) {
 	case BSIM_TRAVERSED:
 		snprintf(buf, n, "traversed at t = %.2f s (%s type)", r->t_end,
-		         bsim_type_name(r->type));
+		         bsim_trial_type_name(r->type));
 		break;
 	case BSIM_SIDE_EXIT:
 		snprintf(buf, n, "side exit at t = %.2f s", r->t_end);
@@ -306,7 +306,7 @@ static void outcome_text(const bsim_trial_result *r, char *buf, size_t n)
 		         r->in_contact_end ? "in contact" : "not in contact");
 		break;
 	default:
-		snprintf(buf, n, "%s at t = %.2f s", bsim_outcome_name(r->outcome), r->t_end);
+		snprintf(buf, n, "%s at t = %.2f s", bsim_trial_outcome_name(r->outcome), r->t_end);
 		break;
 	}
 }

@@ -157,10 +157,10 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 		return bsim_error_set(err, BSIM_EINPUT, "fps: expected a positive number, got %g",
 		                      fps);
 	bsim_video_track *t = calloc(1, sizeof *t);
-	bsim_runner *runner = bsim_runner_alloc();
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	if (!t || !runner) {
 		free(t);
-		bsim_runner_free(runner);
+		bsim_trial_runner_free(runner);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
 	}
 	t->scene = scene;
@@ -169,12 +169,12 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 	t->last_step = -1;
 	if (bsim_effects_init(&t->fx, scene, seed)) {
 		free(t);
-		bsim_runner_free(runner);
+		bsim_trial_runner_free(runner);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
 	}
 	bsim_recorder rec = {.csv = NULL, .stride = 1, .trace = track_trace, .trace_user = t};
 	int rc = bsim_trial_run(runner, scene, backend, opts, seed, &rec, &t->result, err);
-	bsim_runner_free(runner);
+	bsim_trial_runner_free(runner);
 	if (rc == BSIM_OK && t->oom)
 		rc = bsim_error_set(err, BSIM_EFAIL,
 		                    "out of memory recording %ld steps for a video", t->n_trail);

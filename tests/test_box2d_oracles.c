@@ -305,14 +305,14 @@ static void test_stiff_spring_stability(void **state)
 
 static bsim_trial_result run_trial(const bsim_scene *s, const bsim_options *o, uint64_t seed)
 {
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
 	bsim_error err;
 	int rc = bsim_trial_run(r, s, b2, o, seed, NULL, &out, &err);
 	if (rc)
 		print_message("trial: %s\n", err.msg);
 	assert_int_equal(rc, BSIM_OK);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	return out;
 }
 
@@ -357,7 +357,8 @@ static double ledger_ratio(const char *spring, const char *substeps, double *abs
 		bsim_scene s;
 		bsim_scene_init_gate(&s, 7.0, 20.0);
 		bsim_options o = opts_of(spring, substeps);
-		bsim_trial_result out = run_trial(&s, &o, bsim_seed_mix(3, 0, (uint64_t)trial));
+		bsim_trial_result out =
+		        run_trial(&s, &o, bsim_schedule_seed_mix(3, 0, (uint64_t)trial));
 		const bsim_ledger *l = &out.ledger;
 		double scale = fabs(l->w_prop) + fabs(l->w_rand) + l->damper + l->impact;
 		assert_true(l->damper > 0.0 && l->w_prop > 0.0);
@@ -404,7 +405,7 @@ static void test_mirror_deviation(void **state)
 	a.body.start[0] = 1.5;
 	scene_mirror(&a, &b);
 	bsim_world *wa = create(&a, NULL), *wb = create(&b, NULL);
-	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_seed_mix(5, 0, 0));
+	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_schedule_seed_mix(5, 0, 0));
 	bsim_state sa, sb;
 	bsim_state_init(&sa, 2);
 	bsim_state_init(&sb, 2);

@@ -271,13 +271,13 @@ static int run_trial(const bsim_backend *b, const bsim_scene *s, uint64_t seed, 
 	wt->s = s;
 	wt->pen_max = -INFINITY;
 	bsim_recorder rec = {.stride = 1, .trace = watch_fn, .trace_user = wt};
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	assert_non_null(r);
 	bsim_error err;
 	int rc = bsim_trial_run(r, s, b, NULL, seed, &rec, res, &err);
 	if (rc)
 		print_message("trial: %s\n", err.msg);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	return rc;
 }
 
@@ -304,7 +304,8 @@ static void test_mass_ratio(void **state)
 				}
 				watch wt;
 				bsim_trial_result res;
-				int rc = run_trial(b, &s, bsim_seed_mix(1, 0, 0), &wt, &res);
+				int rc = run_trial(b, &s, bsim_schedule_seed_mix(1, 0, 0), &wt,
+				                   &res);
 				const bsim_ledger *l = &res.ledger;
 				double input = l->w_prop + l->w_rand;
 				double excess = l->e_end - (l->e_start + input);
@@ -315,7 +316,7 @@ static void test_mass_ratio(void **state)
 				        "|theta| %.3g, penetration %.3e m, pivot drift %.3e m, "
 				        "E_end - (E_0 + W) = %.3e J (W throughput %.3g J)\n",
 				        BACKENDS[k], beam_mass[m], wnh[j], rc,
-				        bsim_outcome_name(res.outcome), res.steps,
+				        bsim_trial_outcome_name(res.outcome), res.steps,
 				        fmax(fabs(res.max_theta[0]), fabs(res.max_theta[1])),
 				        wt.pen_max, wt.pivot_max, excess, scale);
 				assert_int_equal(rc, BSIM_OK);
@@ -521,8 +522,8 @@ static void test_violent_noise(void **state)
 		for (int t = 0; t < 40; t++) {
 			watch wt;
 			bsim_trial_result res;
-			failed +=
-			        run_trial(b, &s, bsim_seed_mix(6, 0, (uint64_t)t), &wt, &res) != 0;
+			failed += run_trial(b, &s, bsim_schedule_seed_mix(6, 0, (uint64_t)t), &wt,
+			                    &res) != 0;
 			tunnels += wt.tunnels;
 			nonfinite += wt.nonfinite;
 			pen = fmax(pen, wt.pen_max);
@@ -561,9 +562,9 @@ static void test_conservative_long(void **state)
 		print_message("conservative %s: %d steps, %s, end (%.3g, %.3g), energy drift %.3e "
 		              "(max rise %.2e), ledger impact %.3e contact %.3e correction %.3e "
 		              "residual %.3e J, penetration %.2e m, tunnels %d\n",
-		              BACKENDS[k], res.steps_run, bsim_outcome_name(res.outcome), res.x_end,
-		              res.y_end, drift, rise, l->impact, l->contact, l->correction,
-		              l->residual, wt.pen_max, wt.tunnels);
+		              BACKENDS[k], res.steps_run, bsim_trial_outcome_name(res.outcome),
+		              res.x_end, res.y_end, drift, rise, l->impact, l->contact,
+		              l->correction, l->residual, wt.pen_max, wt.tunnels);
 		assert_int_equal(rc, BSIM_OK);
 		assert_int_equal(res.steps_run, 100000);
 		assert_int_equal(wt.nonfinite, 0);

@@ -92,10 +92,10 @@ static bsim_trial_result run(int kind)
 	char kv[16];
 	snprintf(kv, sizeof kv, "kind=%d", kind);
 	assert_int_equal(bsim_options_add(&o, kv, &err), BSIM_OK);
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
 	assert_int_equal(bsim_trial_run(r, &s, &fake, &o, 1, NULL, &out, &err), BSIM_OK);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	bsim_scene_free(&s);
 	return out;
 }

@@ -294,9 +294,9 @@ static void lib_camera_follows_the_body(void **state)
 	bsim_options opts = {0};
 	bsim_video_track *t = NULL;
 	assert_int_equal(bsim_video_track_record(&scene, &bsim_backend_thesis, &opts,
-	                                         bsim_seed_mix(1, 0, 0), 30.0, &t, &err),
+	                                         bsim_schedule_seed_mix(1, 0, 0), 30.0, &t, &err),
 	                 BSIM_OK);
-	bsim_video_def def = bsim_video_default_def();
+	bsim_video_def def = bsim_video_def_default();
 	def.width = 320;
 	def.height = 240;
 	def.view_span = 40.0;
@@ -408,7 +408,7 @@ static void lib_beams_take_their_stiffness_color(void **state)
 	assert_int_equal(
 	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
 	        BSIM_OK);
-	bsim_video_def def = bsim_video_default_def();
+	bsim_video_def def = bsim_video_def_default();
 	bsim_video *v = NULL;
 	assert_int_equal(bsim_video_alloc(&def, &scene, (const bsim_video_track *const *)&t, NULL,
 	                                  1, &v, &err),
@@ -505,7 +505,7 @@ static void lib_frames_are_the_runs_states(void **state)
 	bsim_options opts = {0};
 	bsim_video_track *t = NULL;
 	assert_int_equal(bsim_video_track_record(&scene, &bsim_backend_thesis, &opts,
-	                                         bsim_seed_mix(3, 0, 5), 30.0, &t, &err),
+	                                         bsim_schedule_seed_mix(3, 0, 5), 30.0, &t, &err),
 	                 BSIM_OK);
 	long frames = bsim_video_track_frames(t);
 	assert_int_equal(n_rows, bsim_video_track_result(t)->steps_run + 1);
@@ -557,7 +557,7 @@ static void lib_failing_encoder_writes_nothing(void **state)
 	assert_int_equal(
 	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
 	        BSIM_OK);
-	bsim_video_def def = bsim_video_default_def();
+	bsim_video_def def = bsim_video_def_default();
 	def.ffmpeg = "false";
 	bsim_video *v = NULL;
 	assert_int_equal(bsim_video_alloc(&def, &scene, (const bsim_video_track *const *)&t, NULL,

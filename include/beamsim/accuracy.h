@@ -56,7 +56,7 @@ typedef struct bsim_accuracy_config {
 	double piece;  /* s, duration of restarted pieces (0.064) */
 	int n_pieces;  /* restart points (16) */
 	int n_trials;  /* trials of the p_traverse batch (40) */
-	uint64_t seed; /* schedules: bsim_seed_mix(seed, 0, trial) */
+	uint64_t seed; /* schedules: bsim_schedule_seed_mix(seed, 0, trial) */
 	int threads;   /* <= 0: all */
 	int progress;  /* 1: a progress line on stderr */
 } bsim_accuracy_config;

@@ -33,7 +33,7 @@ typedef struct bsim_backend {
 } bsim_backend;
 
 /* The registry: all backends compiled in, NULL-terminated. */
-const bsim_backend *const *bsim_backends(void);
+const bsim_backend *const *bsim_backend_list(void);
 /* By name; NULL and BSIM_EINPUT naming the known ones if unknown. */
 const bsim_backend *bsim_backend_find(const char *name, bsim_error *err);
 

@@ -140,7 +140,7 @@ int bsim_landscape_barriers_alloc(const bsim_scene *s, const bsim_landscape_grid
                                   bsim_landscape_barriers **out, bsim_error *err);
 void bsim_landscape_barriers_free(bsim_landscape_barriers *b);
 
-const char *bsim_pass_kind_name(bsim_pass_kind k);
+const char *bsim_landscape_pass_kind_name(bsim_pass_kind k);
 
 /* ---- Files (src/landscape_write.c) ------------------------------------- */
 

@@ -42,6 +42,11 @@ long bsim_options_int(const bsim_options *opts, const bsim_knob *knob);
 /* Index of the chosen value in knob->choices. */
 int bsim_options_choice(const bsim_options *opts, const bsim_knob *knob);
 
+/* out = given with every knob of the table not given set to its default:
+ * the options a run really used. */
+void bsim_options_effective(const bsim_knob *knobs, int n_knobs, const bsim_options *given,
+                            bsim_options *out);
+
 #ifdef __cplusplus
 }
 #endif

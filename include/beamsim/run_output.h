@@ -3,7 +3,7 @@
  *
  *   trajectory.csv     the trajectory, the columns of `run --trajectory`
  *   ledger.csv         the energy ledger at the same times
- *                      (bsim_recorder_ledger_header)
+ *                      (bsim_trial_ledger_header)
  *   trajectory.mat, ledger.mat   their MATLAB twins
  *   run.json           what ran and what came of it: the object of
  *                      `run --json` and "command": "run", "stride", "set"
@@ -39,7 +39,7 @@ typedef struct bsim_run_info {
 	const bsim_options *opts;
 	uint64_t seed;             /* the experiment seed */
 	long group, trial;         /* of the schedule */
-	uint64_t mixed_seed;       /* bsim_seed_mix(seed, group, trial) */
+	uint64_t mixed_seed;       /* bsim_schedule_seed_mix(seed, group, trial) */
 	int stride;                /* recorded every stride-th step */
 	const bsim_trial_log *log; /* the trial's gate path and peaks, or NULL */
 } bsim_run_info;
@@ -52,7 +52,8 @@ typedef struct bsim_run_info {
  * peak_theta (with a log), ledger, instability (null or why the trial was
  * unstable). record adds command, beamsim_version,
  * stride, set and scene_copy, for run.json. */
-void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r, int record);
+void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r,
+                          int record);
 
 typedef struct bsim_run_output {
 	char dir[1024];

@@ -30,9 +30,6 @@ typedef struct bsim_run_record {
 	char protocol[2][16];
 } bsim_run_record;
 
-/* opts with every knob of b not given set to its default. */
-void bsim_options_effective(const bsim_backend *b, const bsim_options *given, bsim_options *out);
-
 /* Writes DIR/inputs/scene.yaml, DIR/inputs/experiment.yaml and, last,
  * DIR/run.json, each atomically: a directory with run.json is complete. */
 int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsim_experiment *e,

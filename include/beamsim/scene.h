@@ -124,11 +124,11 @@ int bsim_scene_set_beams(bsim_scene *s, int n_beams);
 /* The unit direction u0 of beam b at rest (rest_angle_deg, 0 = +x), exact
  * at multiples of 90 degrees, so that the beams of a mirrored gate (0 and
  * 180 degrees) are mirrored bit for bit. */
-void bsim_beam_rest_direction(const bsim_beam_def *b, double u0[2]);
+void bsim_scene_beam_rest_direction(const bsim_beam_def *b, double u0[2]);
 
 /* +1 if a forward swing (theta > 0, the tip toward +y) turns beam b
  * counter-clockwise (a beam pointing right at rest), -1 otherwise. */
-double bsim_beam_forward_sign(const bsim_beam_def *b);
+double bsim_scene_beam_forward_sign(const bsim_beam_def *b);
 
 #ifdef __cplusplus
 }

@@ -1,7 +1,7 @@
 /* Random-force schedules (MODEL.md section 2, DESIGN.md "Determinism").
  *
  * F_rand(t) = Rm * z_j for t in [j/f, (j+1)/f), z_j ~ N(0,1) drawn from a GSL
- * generator seeded by bsim_seed_mix(experiment seed, group, trial). Values
+ * generator seeded by bsim_schedule_seed_mix(experiment seed, group, trial). Values
  * are drawn lazily in order and kept, so a schedule can be replayed from any
  * step and costs nothing in a trial that ends early. */
 #ifndef BEAMSIM_SCHEDULE_H
@@ -15,11 +15,11 @@ extern "C" {
 
 /* The fixed mixing function: a SplitMix64 finaliser over the three inputs.
  * It never changes; summary.json of every version depends on it. */
-uint64_t bsim_seed_mix(uint64_t seed, uint64_t group, uint64_t trial);
+uint64_t bsim_schedule_seed_mix(uint64_t seed, uint64_t group, uint64_t trial);
 
 typedef struct bsim_schedule bsim_schedule;
 
-/* magnitude Rm in N, frequency f in Hz (> 0), seed from bsim_seed_mix. */
+/* magnitude Rm in N, frequency f in Hz (> 0), seed from bsim_schedule_seed_mix. */
 bsim_schedule *bsim_schedule_alloc(double magnitude, double frequency, uint64_t seed);
 void bsim_schedule_free(bsim_schedule *s);
 

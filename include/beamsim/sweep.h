@@ -101,7 +101,7 @@ int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg
 void bsim_sweep_result_free(bsim_sweep_result *r);
 
 /* Aggregates one group's trials into counts and the Wilson interval. */
-void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out);
+void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out);
 
 #ifdef __cplusplus
 }

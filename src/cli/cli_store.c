@@ -47,7 +47,7 @@ void cli_record_fill(bsim_run_record *rec, const char *command, const bsim_exper
 	for (int i = 0; i < n; i++) {
 		snprintf(rec->backend[i], sizeof rec->backend[i], "%s", b[i]->name);
 		snprintf(rec->label[i], sizeof rec->label[i], "%s", label ? label[i] : b[i]->name);
-		bsim_options_effective(b[i], opts[i], &rec->opts[i]);
+		bsim_options_effective(b[i]->knobs, b[i]->n_knobs, opts[i], &rec->opts[i]);
 	}
 	rec->seed = e->seed;
 	rec->trials = e->trials;

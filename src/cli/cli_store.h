@@ -85,7 +85,7 @@ int cli_store_sweep(const char *dir, const bsim_experiment *e, const bsim_backen
 
 /* Runs the pairs, writes DIR/<dir>/{summary.json,trials.csv},
  * DIR/pairs.csv, DIR/report.md, DIR/report.json and the run record; the
- * analysis goes to cmp (free with bsim_comparison_free). Returns the exit
+ * analysis goes to cmp (free with bsim_compare_free). Returns the exit
  * status of the run (0, 1 or 2), not the verdict. */
 int cli_compare_execute(const cli_compare_job *job, bsim_comparison *cmp);
 

@@ -82,7 +82,7 @@ int cmd_backends(int argc, char **argv)
 	}
 	if (optind != argc)
 		return cli_usage("backends", "unexpected argument %s", argv[optind]);
-	const bsim_backend *const *all = bsim_backends();
+	const bsim_backend *const *all = bsim_backend_list();
 	for (int i = 0; all[i]; i++) {
 		if (i)
 			putchar('\n');

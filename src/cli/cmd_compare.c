@@ -478,7 +478,7 @@ static int compare_main(compare_args *a, const bsim_backend *b0, const bsim_back
 			compare_summary(a, &e, &cmp);
 		rc = cmp.n_disagree > 0 ? CLI_DISAGREE : CLI_OK;
 	}
-	bsim_comparison_free(&cmp);
+	bsim_compare_free(&cmp);
 	bsim_experiment_free(&e);
 	return rc;
 }

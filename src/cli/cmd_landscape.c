@@ -137,7 +137,7 @@ static void print_row(const char *what, const bsim_landscape_pass *p)
 		snprintf(crossed, sizeof crossed, "beam %d", p->beam + 1);
 	else
 		snprintf(crossed, sizeof crossed, "-");
-	printf("%-12s %-7s %-8s", what, bsim_pass_kind_name(p->kind), crossed);
+	printf("%-12s %-7s %-8s", what, bsim_landscape_pass_kind_name(p->kind), crossed);
 	if (p->kind == BSIM_PASS_NONE) {
 		printf("  no path to the far side leaves the beams' reach over this beam\n");
 		return;

@@ -191,7 +191,7 @@ static int regress_rerun(const regress_args *a, regress_run *run)
 		};
 		bsim_comparison cmp;
 		int rc = cli_compare_execute(&job, &cmp);
-		bsim_comparison_free(&cmp);
+		bsim_compare_free(&cmp);
 		return rc;
 	}
 	bsim_sweep_config cfg = {
@@ -265,7 +265,8 @@ static int trials_changed(const bsim_sweep_result r[2])
 {
 	int changed = 0, ledger = r[0].has_ledger && r[1].has_ledger;
 	for (long i = 0; i < (long)r[0].n_groups * r[0].trials; i++)
-		changed += !bsim_trial_identical(&r[0].trials_out[i], &r[1].trials_out[i], ledger);
+		changed +=
+		        !bsim_compare_identical(&r[0].trials_out[i], &r[1].trials_out[i], ledger);
 	return changed;
 }
 
@@ -361,7 +362,7 @@ static int regress_compare(const regress_args *a, regress_run *run)
 	for (int i = 0; i < 2; i++) {
 		bsim_sweep_result_free(&parts[i].r[0]);
 		bsim_sweep_result_free(&parts[i].r[1]);
-		bsim_comparison_free(&parts[i].cmp);
+		bsim_compare_free(&parts[i].cmp);
 	}
 	return rc != CLI_OK ? rc : beyond > 0 ? CLI_DISAGREE : CLI_OK;
 }

@@ -162,7 +162,7 @@ static void print_lattice(FILE *out, const bsim_scene *s, const bsim_trial_resul
                           const bsim_trial_log *log)
 {
 	char label[48];
-	bsim_location_label(bsim_location_of(r), label, sizeof label);
+	bsim_lattice_location_label(bsim_lattice_location_of(r), label, sizeof label);
 	fprintf(out, "lattice     %s protocol, ended %s in gate (%d, %d), %d gates entered:",
 	        s->lattice.protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world", label, r->final_ix,
 	        r->final_iy, r->gates_entered);
@@ -191,9 +191,9 @@ static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64
 	        "seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
 	        ", %lu draws)\n",
 	        a->seed, a->group, a->trial, mixed, r->draws);
-	fprintf(out, "outcome     %s", bsim_outcome_name(r->outcome));
+	fprintf(out, "outcome     %s", bsim_trial_outcome_name(r->outcome));
 	if (r->outcome == BSIM_TRAVERSED) {
-		fprintf(out, ", type %s, landscape ", bsim_type_name(r->type));
+		fprintf(out, ", type %s, landscape ", bsim_trial_type_name(r->type));
 		if (r->landscape_beam < 0)
 			fprintf(out, "none");
 		else if (r->landscape_beam < 2 && s->n_beams == 2)
@@ -246,7 +246,7 @@ static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_re
 	if (a->trajectory) {
 		if (bsim_atomic_file_open(&traj, a->trajectory, &err) != BSIM_OK)
 			return cli_report(BSIM_EFAIL, &err);
-		bsim_recorder_header(traj.f, scene->n_beams);
+		bsim_trial_trajectory_header(traj.f, scene->n_beams);
 		rec.csv = traj.f;
 	}
 	/* DIR is checked before the trial runs and its files appear together
@@ -267,10 +267,10 @@ static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_re
 	/* One recorder writes both when both are asked for: the CSV of
 	 * --trajectory, and the directory's trajectory and ledger. */
 	if (a->out && a->trajectory) {
-		dir_rec.record = bsim_recorder_csv_record;
+		dir_rec.record = bsim_trial_trajectory_row;
 		dir_rec.record_user = traj.f;
 	}
-	bsim_runner *runner = bsim_runner_alloc();
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	if (!runner) {
 		bsim_atomic_file_abort(&traj);
 		cli_error("out of memory for a trial runner");
@@ -284,7 +284,7 @@ static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_re
 	const bsim_recorder *use = a->out ? &dir_rec : &rec;
 	int rc = bsim_trial_run(runner, scene, info->backend, &a->opts, info->mixed_seed, use, res,
 	                        &err);
-	bsim_runner_free(runner);
+	bsim_trial_runner_free(runner);
 	if (rc != BSIM_OK) {
 		bsim_atomic_file_abort(&traj);
 		cli_report(rc, &err);
@@ -330,7 +330,8 @@ int cmd_run(int argc, char **argv)
 		cli_error("%s", err.msg);
 		rc = err.code ? err.code : CLI_USAGE;
 	} else {
-		uint64_t mixed = bsim_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
+		uint64_t mixed =
+		        bsim_schedule_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
 		bsim_run_info info = {
 		        .scene_path = a.scene,
 		        .scene = &scene,
@@ -355,7 +356,7 @@ int cmd_run(int argc, char **argv)
 		 * goes to standard error. */
 		FILE *out = a.trajectory && strcmp(a.trajectory, "-") == 0 ? stderr : stdout;
 		if (rc == CLI_OK && a.json)
-			bsim_run_json(out, &info, &res, 0);
+			bsim_run_output_json(out, &info, &res, 0);
 		else if (rc == CLI_OK)
 			print_text(out, &a, &scene, mixed, &res, log);
 		if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {

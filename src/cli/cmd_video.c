@@ -249,9 +249,9 @@ static int video_parse(int argc, char **argv, video_args *a)
 
 static void print_outcome(FILE *out, const char *name, const bsim_trial_result *r)
 {
-	fprintf(out, "%-11s %s at t = %.6g s", name, bsim_outcome_name(r->outcome), r->t_end);
+	fprintf(out, "%-11s %s at t = %.6g s", name, bsim_trial_outcome_name(r->outcome), r->t_end);
 	if (r->outcome == BSIM_TRAVERSED)
-		fprintf(out, ", %s type", bsim_type_name(r->type));
+		fprintf(out, ", %s type", bsim_trial_type_name(r->type));
 	else if (r->outcome == BSIM_STUCK)
 		fprintf(out, ", %s", r->in_contact_end ? "in contact" : "not in contact");
 	fprintf(out, ", %d steps run\n", r->steps_run);
@@ -262,7 +262,7 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 {
 	bsim_video_track *tracks[MAX_PANELS] = {0};
 	const char *labels[MAX_PANELS];
-	uint64_t mixed = bsim_seed_mix(a->seed, (uint64_t)a->group, (uint64_t)a->trial);
+	uint64_t mixed = bsim_schedule_seed_mix(a->seed, (uint64_t)a->group, (uint64_t)a->trial);
 	bsim_error err;
 	int rc = BSIM_OK;
 	for (int i = 0; i < a->n_backends && rc == BSIM_OK; i++) {
@@ -320,7 +320,7 @@ int cmd_video(int argc, char **argv)
 	a->seed = 1;
 	a->n_backends = 1;
 	snprintf(a->names[0], sizeof a->names[0], "thesis");
-	a->def = bsim_video_default_def();
+	a->def = bsim_video_def_default();
 	int rc = video_parse(argc, argv, a);
 	if (rc < 0) {
 		const bsim_backend *backends[MAX_PANELS];
