@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 
 #include "atomic_file.h"
+#include "trials_csv.h"
 #include "json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/version.h"
@@ -256,6 +257,12 @@ static void csv_number(FILE *f, double x)
 		fprintf(f, "%.10g", x);
 }
 
+const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
+        "group",  "trial",    "outcome",     "type",       "steps",    "t_end",    "x_end",
+        "y_end",  "vx_end",   "max_theta1",  "max_theta2", "e_start",  "e_end",    "work_in",
+        "losses", "residual", "overlap_max", "final_ix",   "final_iy", "location", "path",
+};
+
 int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
                            bsim_error *err)
 {
@@ -264,9 +271,8 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 		return BSIM_EFAIL;
 	int axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
 	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
-	fputs("group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"
-	      "e_start,e_end,work_in,losses,residual,overlap_max,final_ix,final_iy,location,path",
-	      o.f);
+	for (int c = 0; c < TRIALS_N_COLUMNS; c++)
+		fprintf(o.f, "%s%s", c ? "," : "", bsim_trials_csv_columns[c]);
 	for (int a = 0; a < axes; a++) {
 		fputc(',', o.f);
 		csv_field(o.f, e->axes[a].key);

@@ -156,25 +156,6 @@ constexpr double PIN_MASS_RATIO = 1000.0;
 /* Collision categories: the body meets beams, nothing else meets anything. */
 constexpr uint16 CATEGORY_BODY = 0x0001, CATEGORY_BEAM = 0x0002;
 
-/* The rest direction, exact at multiples of 90 degrees so that a mirrored
- * beam (0 vs 180 degrees) has a mirrored tip bit for bit. */
-void rest_direction(double deg, double u[2])
-{
-	double q = deg / 90.0;
-	/* (long)q is defined only within long's range: angles beyond 1e15
-	 * quarter turns take the general path. */
-	if (q == std::floor(q) && std::fabs(q) < 1e15) {
-		static const double c[4] = {1, 0, -1, 0}, sn[4] = {0, 1, 0, -1};
-		long k = ((long)q % 4 + 4) % 4;
-		u[0] = c[k];
-		u[1] = sn[k];
-		return;
-	}
-	const double rad = deg * 0.017453292519943295; /* pi / 180 */
-	u[0] = std::cos(rad);
-	u[1] = std::sin(rad);
-}
-
 /* One beam: its Box2D body and what a step measures about it. */
 struct beam_rec {
 	b2Body *body = nullptr;
@@ -654,8 +635,8 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 		beam_rec &b = w->beams[(size_t)i];
 		b.pivot[0] = d.pivot[0];
 		b.pivot[1] = d.pivot[1];
-		rest_direction(d.rest_angle_deg, b.u0);
-		b.sgn = b.u0[0] >= 0.0 ? 1.0 : -1.0; /* forward = toward +y */
+		bsim_scene_beam_rest_direction(&d, b.u0);
+		b.sgn = bsim_scene_beam_forward_sign(&d); /* forward = toward +y */
 		b.inertia = d.inertia;
 		b.stiffness = d.stiffness;
 		b.damping = d.damping;

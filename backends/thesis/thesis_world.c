@@ -64,25 +64,6 @@ enum {
 enum { SLEEP_AUTO = 0, SLEEP_ON = 1, SLEEP_OFF = 2 };
 #define N_KNOBS ((int)(sizeof thesis_knobs / sizeof thesis_knobs[0]))
 
-/* The rest direction, exact at multiples of 90 degrees so that a mirrored
- * beam (0 vs 180 degrees) is mirrored bit for bit. */
-static void rest_direction(double deg, double u[2])
-{
-	double q = deg / 90.0;
-	/* (long)q is defined only within long's range: angles beyond 1e15
-	 * quarter turns take the general path. */
-	if (q == floor(q) && fabs(q) < 1e15) {
-		static const double c[4] = {1, 0, -1, 0}, s[4] = {0, 1, 0, -1};
-		long k = ((long)q % 4 + 4) % 4;
-		u[0] = c[k];
-		u[1] = s[k];
-		return;
-	}
-	const double rad = deg * 0.017453292519943295; /* pi / 180 */
-	u[0] = cos(rad);
-	u[1] = sin(rad);
-}
-
 static void thesis_destroy(bsim_world *w)
 {
 	if (!w)
@@ -135,8 +116,8 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		const bsim_beam_def *d = &scene->beams[i];
 		thesis_beam *b = &w->beams[i];
 		memcpy(b->p, d->pivot, sizeof b->p);
-		rest_direction(d->rest_angle_deg, b->u0);
-		b->sgn = b->u0[0] >= 0.0 ? 1.0 : -1.0; /* forward = toward +y */
+		bsim_scene_beam_rest_direction(d, b->u0);
+		b->sgn = bsim_scene_beam_forward_sign(d); /* forward = toward +y */
 		b->length = d->length;
 		b->inertia = d->inertia;
 		b->stiffness = d->stiffness;
