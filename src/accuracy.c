@@ -410,11 +410,9 @@ int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backen
 				}
 				done++;
 				if (cfg->progress)
-					fprintf(stderr, "\raccuracy: %d/%d settings", done, out->n);
+					cfg->progress(cfg->progress_user, done, out->n);
 			}
 		}
-		if (cfg->progress)
-			fputc('\n', stderr);
 		if (failed) {
 			rc = failed;
 			if (err)

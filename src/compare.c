@@ -34,6 +34,11 @@
 static const char *const event_names[BSIM_N_EVENTS] = {"traversed", "left",  "right",
                                                        "side_exit", "stuck", "unstable"};
 
+bsim_compare_rule bsim_compare_rule_default(void)
+{
+	return (bsim_compare_rule){.alpha = 0.05, .margin = 0.05, .exact = 0};
+}
+
 const char *bsim_compare_event_name(bsim_event ev)
 {
 	return ev >= 0 && ev < BSIM_N_EVENTS ? event_names[ev] : "?";

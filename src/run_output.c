@@ -6,11 +6,13 @@
 #include <inttypes.h>
 #include <string.h>
 
+#include "atomic_file.h"
 #include "json.h"
 #include "beamsim/lattice.h"
 #include "matlab.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
+#include "session.h"
 
 static void ledger_json(FILE *f, const bsim_ledger *l)
 {
@@ -142,8 +144,15 @@ void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_r
 	fputs("}\n", f);
 }
 
-int bsim_run_output_open(bsim_run_output *o, const char *dir, int n_beams, bsim_recorder *rec,
-                         bsim_error *err)
+/* The open files of `run --out DIR`, in the staging area. */
+typedef struct run_dir {
+	char dir[1100];
+	char traj_path[1200], ledger_path[1200];
+	bsim_atomic_file traj, ledger;
+} run_dir;
+
+static int run_dir_open(run_dir *o, const char *dir, int n_beams, bsim_recorder *rec,
+                        bsim_error *err)
 {
 	memset(o, 0, sizeof *o);
 	if (strlen(dir) >= sizeof o->dir - 32)
@@ -166,14 +175,16 @@ int bsim_run_output_open(bsim_run_output *o, const char *dir, int n_beams, bsim_
 	return BSIM_OK;
 }
 
-void bsim_run_output_abort(bsim_run_output *o)
+static void run_dir_abort(run_dir *o)
 {
 	bsim_atomic_file_abort(&o->traj);
 	bsim_atomic_file_abort(&o->ledger);
 }
 
-int bsim_run_output_commit(bsim_run_output *o, const bsim_run_info *info,
-                           const bsim_trial_result *r, bsim_error *err)
+/* Once the trial has run: trajectory.csv and ledger.csv, their twins,
+ * inputs/scene.yaml and, last, run.json. */
+static int run_dir_commit(run_dir *o, const bsim_run_info *info, const bsim_trial_result *r,
+                          bsim_error *err)
 {
 	char path[1200], mat[1200];
 	int rc = bsim_atomic_file_commit(&o->traj, err);
@@ -205,4 +216,76 @@ int bsim_run_output_commit(bsim_run_output *o, const bsim_run_info *info,
 		rc = bsim_atomic_file_commit(&f, err);
 	}
 	return rc;
+}
+
+/* The trajectory file's twin: read back from the file, so only for a
+ * regular file (a pipe, a terminal or standard output cannot be, and a
+ * link's twin would not be its). */
+static int trajectory_commit(bsim_atomic_file *traj, const char *path, bsim_error *err)
+{
+	char mat[1200];
+	int through = traj->mode != BSIM_ATOMIC_RENAME;
+	int rc = bsim_atomic_file_commit(traj, err);
+	if (rc == BSIM_OK && !through) {
+		rc = bsim_matlab_path(path, mat, sizeof mat, err);
+		if (rc == BSIM_OK)
+			rc = bsim_matlab_from_csv(path, mat, "trajectory", err);
+	}
+	return rc;
+}
+
+int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, const char *out,
+                          bsim_trial_result *res, bsim_error *err)
+{
+	bsim_atomic_file traj = {0};
+	run_dir dir;
+	bsim_trial_log *log = (bsim_trial_log *)info->log;
+	int stride = info->stride > 0 ? info->stride : 1;
+	bsim_recorder rec = {.stride = stride, .log = log, .overlap = 1};
+	const bsim_scene *scene = info->scene;
+	memset(res, 0, sizeof *res);
+	if (trajectory) {
+		if (bsim_atomic_file_open(&traj, trajectory, err) != BSIM_OK)
+			return BSIM_EFAIL;
+		bsim_trial_trajectory_header(traj.f, scene->n_beams);
+		rec.csv = traj.f;
+	}
+	/* DIR is checked before the trial runs and its files appear together. */
+	bsim_session ss;
+	if (out) {
+		int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
+		if (rc != BSIM_OK) {
+			bsim_atomic_file_abort(&traj);
+			return rc;
+		}
+		if (run_dir_open(&dir, ss.stage, scene->n_beams, &rec, err)) {
+			bsim_atomic_file_abort(&traj);
+			return bsim_session_close(&ss, BSIM_EFAIL, "run", NULL, err);
+		}
+		/* One recorder writes both: the directory's trajectory and
+		 * ledger, and the CSV of the trajectory file. */
+		if (trajectory) {
+			rec.record = bsim_trial_trajectory_row;
+			rec.record_user = traj.f;
+		}
+	}
+	int rc = BSIM_OK;
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
+	if (!runner)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for a trial runner");
+	if (rc == BSIM_OK)
+		rc = bsim_trial_run(runner, scene, info->backend, info->opts, info->mixed_seed,
+		                    &rec, res, err);
+	bsim_trial_runner_free(runner);
+	if (rc == BSIM_OK && trajectory)
+		rc = trajectory_commit(&traj, trajectory, err);
+	else
+		bsim_atomic_file_abort(&traj);
+	if (!out)
+		return rc;
+	if (rc == BSIM_OK)
+		rc = run_dir_commit(&dir, info, res, err);
+	else
+		run_dir_abort(&dir);
+	return bsim_session_close(&ss, rc, "run", NULL, err);
 }

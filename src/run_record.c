@@ -21,6 +21,23 @@
 #include "beamsim/version.h"
 #include "yaml_doc.h"
 
+void bsim_run_record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e,
+                          int n, const bsim_backend *const *b, const bsim_options *const *opts,
+                          const char *const *label, const bsim_compare_rule *rule)
+{
+	memset(rec, 0, sizeof *rec);
+	snprintf(rec->command, sizeof rec->command, "%s", command);
+	rec->n_backends = n;
+	for (int i = 0; i < n; i++) {
+		snprintf(rec->backend[i], sizeof rec->backend[i], "%s", b[i]->name);
+		snprintf(rec->label[i], sizeof rec->label[i], "%s", label ? label[i] : b[i]->name);
+		bsim_options_effective(b[i]->knobs, b[i]->n_knobs, opts[i], &rec->opts[i]);
+	}
+	rec->seed = e->seed;
+	rec->trials = e->trials;
+	rec->rule = rule ? *rule : bsim_compare_rule_default();
+}
+
 static int path_join(char *buf, size_t size, const char *dir, const char *name, bsim_error *err)
 {
 	int n = snprintf(buf, size, "%s/%s", dir, name);

@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "clock.h"
+#include "journal.h"
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"

@@ -12,6 +12,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/version.h"
 #include "support.h"
 
 /* trials.csv: the contract's first eleven columns, then the appended ones
@@ -119,7 +120,18 @@ static void test_version(void **state)
 	const char *argv[] = {"--version", NULL};
 	cli_run r = run_cli(argv);
 	assert_int_equal(r.status, 0);
-	assert_string_equal(r.out, "beamsim 0.1.0\n");
+	/* The first line is the project's version; then what built it: the
+	 * Box2D of the CMake package the build found, and this compiler. */
+	assert_true(strncmp(r.out, "beamsim " BSIM_VERSION "\n",
+	                    strlen("beamsim " BSIM_VERSION "\n")) == 0);
+	assert_contains(r.out, "\ncommit ");
+	assert_contains(r.out, "\nBox2D " BSIM_TEST_BOX2D_VERSION "\n");
+#if defined(__GNUC__) && !defined(__clang__)
+	char compiler[64];
+	snprintf(compiler, sizeof compiler, "\ncompiler gcc %d.%d.%d\n", __GNUC__, __GNUC_MINOR__,
+	         __GNUC_PATCHLEVEL__);
+	assert_contains(r.out, compiler);
+#endif
 	cli_run_free(&r);
 }
 

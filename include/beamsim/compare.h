@@ -56,8 +56,8 @@ typedef struct bsim_compare_rule {
 	int exact;
 } bsim_compare_rule;
 
-#define BSIM_COMPARE_ALPHA  0.05
-#define BSIM_COMPARE_MARGIN 0.05
+/* alpha 0.05, margin 0.05, not exact. */
+bsim_compare_rule bsim_compare_rule_default(void);
 
 typedef struct bsim_event_test {
 	bsim_pairs pairs;        /* a: both, b: only A, c: only B, d: neither */

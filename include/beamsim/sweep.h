@@ -8,13 +8,18 @@
 
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
+#include "beamsim/options.h"
 #include "beamsim/trajectory.h"
-#include "journal.h"
+#include "beamsim/progress.h"
 #include "beamsim/trial.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* A journal of finished trials (kept inside the library: bsim_sweep_dir_run
+ * and bsim_compare_dir_run give a sweep one). */
+typedef struct bsim_journal bsim_journal;
 
 typedef struct bsim_group_result {
 	int trials, traversed, side_exit, stuck, left, right;
@@ -46,9 +51,6 @@ typedef struct bsim_sweep_result {
 	bsim_lattice_def lattice_def; /* group 0's, when lattice */
 } bsim_sweep_result;
 
-/* Called from one thread now and then with done/total trials. */
-typedef void (*bsim_progress_fn)(void *user, long done, long total);
-
 typedef struct bsim_sweep_config {
 	const bsim_backend *backend;
 	const bsim_options *opts;
@@ -65,7 +67,7 @@ typedef struct bsim_sweep_config {
 	 * differ in the scene while sharing every schedule. */
 	const bsim_override *extra_b;
 	int n_extra_b;
-	/* NULL, or a journal (beamsim/journal.h) of records of
+	/* NULL, or a journal of records of
 	 * bsim_sweep_record_size bytes, created or resumed for this sweep's
 	 * inputs: the trials it holds are taken from it, not run again, and
 	 * each trial run is appended as it ends. */

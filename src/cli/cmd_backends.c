@@ -1,24 +1,25 @@
 /* beamsim backends: each backend with its description and knobs. */
-#include <getopt.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "beamsim/backend.h"
 #include "cli_common.h"
+#include "cli_options.h"
 
-static const char backends_help[] =
-        "Usage: beamsim backends\n"
-        "\n"
-        "Lists the physics backends compiled in, with their options: name, type,\n"
-        "default, choices and what each does. Set one with --backend-opt NAME=VALUE\n"
-        "on run, sweep and bench.\n"
-        "\n"
-        "Options:\n"
-        "  -h, --help             show this help\n";
-
-static const struct option backends_options[] = {
-        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
+static const cli_spec backends_spec = {
+        .name = "backends",
+        .usage = "[OPTIONS]",
+        .about = "Lists the physics backends compiled in, with their options: name, type,\n"
+                 "default, choices and what each does.\n"
+                 "\n"
+                 "An option is set with --backend-opt KEY=VALUE on run, sweep, compare,\n"
+                 "video and bench, the same way everywhere:\n"
+                 "  --backend-opt KEY=VALUE     on every backend the command runs\n"
+                 "  --backend-opt B:KEY=VALUE   on backend B only (a B the command does\n"
+                 "                              not run is an error)\n"
+                 "and compare's sides also take options inline, NAME:KEY=VALUE[:KEY=VALUE]...\n"
+                 "(--backends thesis,thesis:integrator=euler), which win over --backend-opt.\n"
+                 "Values are checked against the backend's knob: its type, range or choices.\n",
 };
 
 static const char *knob_type_name(bsim_knob_type t)
@@ -72,16 +73,10 @@ static void backend_print(const bsim_backend *b)
 
 int cmd_backends(int argc, char **argv)
 {
-	int c;
-	opterr = 0;
-	while ((c = getopt_long(argc, argv, ":h", backends_options, NULL)) != -1) {
-		if (c != 'h')
-			return cli_bad_option("backends", argv, c);
-		fputs(backends_help, stdout);
-		return CLI_OK;
-	}
-	if (optind != argc)
-		return cli_usage("backends", "unexpected argument %s", argv[optind]);
+	cli_common c = cli_common_default();
+	int rc = cli_parse(&backends_spec, argc, argv, &c, NULL, NULL);
+	if (rc >= 0)
+		return rc;
 	const bsim_backend *const *all = bsim_backend_list();
 	for (int i = 0; all[i]; i++) {
 		if (i)
