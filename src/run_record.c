@@ -46,29 +46,6 @@ static int path_join(char *buf, size_t size, const char *dir, const char *name, 
 	return BSIM_OK;
 }
 
-static int copy_file(const char *from, const char *to, bsim_error *err)
-{
-	FILE *in = fopen(from, "rb");
-	if (!in)
-		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot read the file", from);
-	bsim_atomic_file o;
-	if (bsim_atomic_file_open(&o, to, err) != BSIM_OK) {
-		fclose(in);
-		return BSIM_EFAIL;
-	}
-	char buf[8192];
-	size_t n;
-	while ((n = fread(buf, 1, sizeof buf, in)) > 0)
-		fwrite(buf, 1, n, o.f);
-	int bad = ferror(in);
-	fclose(in);
-	if (bad) {
-		bsim_atomic_file_abort(&o);
-		return bsim_error_set(err, BSIM_EFAIL, "%s: read error", from);
-	}
-	return bsim_atomic_file_commit(&o, err);
-}
-
 /* The experiment as it ran, without a word about where it came from. */
 static void experiment_body(FILE *f, const bsim_experiment *e, const bsim_override *extra,
                             int n_extra)
@@ -226,7 +203,7 @@ static int copy_stiffness_files(const char *inputs, const bsim_experiment *e,
 		*last = '\0';
 		int rc = bsim_output_mkdir(to, err);
 		*last = '/';
-		if (rc != BSIM_OK || copy_file(from, to, err) != BSIM_OK)
+		if (rc != BSIM_OK || bsim_atomic_file_copy(from, to, err) != BSIM_OK)
 			return BSIM_EFAIL;
 	}
 	return BSIM_OK;
@@ -240,7 +217,7 @@ int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsi
 	    bsim_output_mkdir(inputs, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (path_join(path, sizeof path, inputs, "scene.yaml", err) ||
-	    copy_file(e->scene_path, path, err) != BSIM_OK)
+	    bsim_atomic_file_copy(e->scene_path, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (copy_stiffness_files(inputs, e, extra, n_extra, err) != BSIM_OK)
 		return BSIM_EFAIL;

@@ -19,8 +19,8 @@ static const shared_def shared[CLI_N_OPTS] = {
         [CLI_OPT_BACKEND] = {"backend", 1, "B",
                              "physics backend (default thesis; see beamsim backends)"},
         [CLI_OPT_BACKEND_OPT] = {"backend-opt", 1, "K=V",
-                                 "a backend option, repeatable; B:K=V sets it on backend\n"
-                                 "B only (see beamsim backends --help)"},
+                                 "a backend option, repeatable; B:K=V sets it on\n"
+                                 "backend B (see beamsim backends --help)"},
         [CLI_OPT_THREADS] = {"threads", 1, "N", "worker threads (default: all cores)"},
         [CLI_OPT_TRIALS] = {"trials", 1, "N", "trials per group (default: the experiment's)"},
         [CLI_OPT_SEED] = {"seed", 1, "N", "experiment seed (default: the experiment's)"},
@@ -212,50 +212,43 @@ int cli_parse(const cli_spec *spec, int argc, char **argv, cli_common *c, void *
 	return -1;
 }
 
-/* The backend B of a "B:K=V", or NULL for "K=V" (a colon only counts
- * before the first '='). */
-static int backend_prefix(const char *text, size_t *len)
+int cli_backend_opts(const cli_common *c, const char *cmd, int n, const char *const *names,
+                     bsim_options *const *opts)
 {
-	size_t eq = strcspn(text, "="), colon = strcspn(text, ":");
-	if (colon >= eq)
-		return 0;
-	*len = colon;
-	return 1;
-}
-
-int cli_backend_opts(const cli_common *c, const char *cmd, const char *name, bsim_options *opts,
-                     int *used)
-{
-	for (int i = 0; i < c->n_backend_opts; i++) {
-		const char *t = c->backend_opt[i];
-		size_t len = 0;
-		if (backend_prefix(t, &len)) {
-			if (strlen(name) != len || strncmp(t, name, len) != 0)
-				continue;
-			t += len + 1;
-		}
-		int rc = cli_options_add(opts, cmd, t);
-		if (rc != CLI_OK)
-			return rc;
-		if (used)
-			used[i] = 1;
-	}
-	return CLI_OK;
-}
-
-int cli_backend_opts_unused(const cli_common *c, const char *cmd, const int *used,
-                            const char *const *names, int n)
-{
-	for (int i = 0; i < c->n_backend_opts; i++) {
-		if (used[i])
-			continue;
-		char list[256] = "";
-		for (int k = 0; k < n; k++)
+	char list[256] = "";
+	int distinct = 0;
+	for (int i = 0; i < n; i++) {
+		int seen = 0;
+		for (int k = 0; k < i; k++)
+			seen |= strcmp(names[k], names[i]) == 0;
+		if (!seen)
 			snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s",
-			         k ? (k + 1 == n ? " or " : ", ") : "", names[k]);
-		return cli_usage(cmd,
-		                 "--backend-opt %s: expected B:KEY=VALUE with B %s%s, or KEY=VALUE",
-		                 c->backend_opt[i], n > 1 ? "one of " : "", list);
+			         distinct++ ? ", " : "", names[i]);
+	}
+	for (int o = 0; o < c->n_backend_opts; o++) {
+		const char *t = c->backend_opt[o];
+		/* A colon counts only before the first '=': B:K=V, not K=V:W. */
+		size_t len = strcspn(t, ":=");
+		int prefixed = t[len] == ':', used = 0;
+		if (!prefixed && distinct > 1)
+			return cli_usage(cmd,
+			                 "--backend-opt %s: expected B:KEY=VALUE with several "
+			                 "backends (B one of %s)",
+			                 t, list);
+		for (int i = 0; i < n; i++) {
+			if (prefixed && (strlen(names[i]) != len || strncmp(t, names[i], len) != 0))
+				continue;
+			int rc = cli_options_add(opts[i], cmd, prefixed ? t + len + 1 : t);
+			if (rc != CLI_OK)
+				return rc;
+			used = 1;
+		}
+		if (!used)
+			return cli_usage(
+			        cmd,
+			        "--backend-opt %s: expected B:KEY=VALUE with B %s%s (%.*s is "
+			        "not a backend this command runs)",
+			        t, distinct > 1 ? "one of " : "", list, (int)len, t);
 	}
 	return CLI_OK;
 }
@@ -263,10 +256,8 @@ int cli_backend_opts_unused(const cli_common *c, const char *cmd, const int *use
 const bsim_backend *cli_backend_with_opts(const cli_common *c, const char *cmd, const char *name,
                                           bsim_options *opts)
 {
-	int used[CLI_BACKEND_OPTS_MAX] = {0};
 	memset(opts, 0, sizeof *opts);
-	if (cli_backend_opts(c, cmd, name, opts, used) != CLI_OK ||
-	    cli_backend_opts_unused(c, cmd, used, &name, 1) != CLI_OK)
+	if (cli_backend_opts(c, cmd, 1, &name, &opts) != CLI_OK)
 		return NULL;
 	return cli_backend(name, opts);
 }

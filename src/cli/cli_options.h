@@ -93,17 +93,14 @@ typedef struct cli_spec {
 int cli_parse(const cli_spec *spec, int argc, char **argv, cli_common *c, void *args,
               const char **pos);
 
-/* The --backend-opt values that apply to backend name, added to opts in
- * the order given: K=V applies to every backend the command runs, B:K=V to
- * backend B only. Marks in used[] (CLI_BACKEND_OPTS_MAX entries) those it
- * applied. CLI_OK, or a usage error. */
-int cli_backend_opts(const cli_common *c, const char *cmd, const char *name, bsim_options *opts,
-                     int *used);
-
-/* A usage error for a B:K=V of c that no backend of the command took
- * (names: the backends it runs); CLI_OK if every one was used. */
-int cli_backend_opts_unused(const cli_common *c, const char *cmd, const int *used,
-                            const char *const *names, int n);
+/* The --backend-opt values, in the order given, into opts[i] for each of
+ * the n backends a command runs (names[i]; a name may repeat, as for the
+ * two sides of compare thesis,thesis:integrator=euler). B:K=V sets K on
+ * backend B; K=V is short for it when the command runs one backend.
+ * CLI_OK, or a usage error (a B that is not one of the backends, K=V with
+ * several backends, bad syntax). */
+int cli_backend_opts(const cli_common *c, const char *cmd, int n, const char *const *names,
+                     bsim_options *const *opts);
 
 /* The backend by name with the --backend-opt values for it (opts
  * cleared first) checked; prints the error and returns NULL (exit status

@@ -12,13 +12,14 @@ static const cli_spec backends_spec = {
         .about = "Lists the physics backends compiled in, with their options: name, type,\n"
                  "default, choices and what each does.\n"
                  "\n"
-                 "An option is set with --backend-opt KEY=VALUE on run, sweep, compare,\n"
-                 "video and bench, the same way everywhere:\n"
-                 "  --backend-opt KEY=VALUE     on every backend the command runs\n"
-                 "  --backend-opt B:KEY=VALUE   on backend B only (a B the command does\n"
-                 "                              not run is an error)\n"
+                 "An option is set the same way on every command that runs backends (run,\n"
+                 "sweep, compare, video, bench):\n"
+                 "  --backend-opt B:KEY=VALUE   sets KEY on backend B; a B the command does\n"
+                 "                              not run is an error\n"
+                 "  --backend-opt KEY=VALUE     the same, when the command runs one backend\n"
                  "and compare's sides also take options inline, NAME:KEY=VALUE[:KEY=VALUE]...\n"
                  "(--backends thesis,thesis:integrator=euler), which win over --backend-opt.\n"
+                 "(bench's --vs backend takes --vs-opt KEY=VALUE.)\n"
                  "Values are checked against the backend's knob: its type, range or choices.\n",
 };
 

@@ -130,8 +130,9 @@ static const cli_spec compare_spec = {
 static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compare_dir_def *def)
 {
 	bsim_error err;
-	int used[CLI_BACKEND_OPTS_MAX] = {0};
 	const char *names[2];
+	bsim_options *opts[2] = {&def->side[0].opts, &def->side[1].opts};
+	char spec[2][128];
 	if (a->protocol[0][0]) {
 		if (a->backends)
 			return cli_usage("compare",
@@ -144,12 +145,10 @@ static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compar
 			if (!(s->backend = bsim_backend_find(b, &err)))
 				return cli_report(CLI_USAGE, &err);
 			snprintf(s->label, sizeof s->label, "%s", a->protocol[i]);
-			names[i] = b;
-			if (cli_backend_opts(c, "compare", b, &s->opts, used) != CLI_OK)
-				return CLI_USAGE;
+			names[i] = s->backend->name;
 			def->protocol[i] = a->protocol[i];
 		}
-		return cli_backend_opts_unused(c, "compare", used, names, 1);
+		return cli_backend_opts(c, "compare", 2, names, opts);
 	}
 	if (c->backend)
 		return cli_usage("compare", "--backend B goes with --protocols; two backends are "
@@ -157,25 +156,25 @@ static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compar
 	const char *text = a->backends ? a->backends : "thesis,box2d";
 	const char *comma = strchr(text, ',');
 	size_t n0 = comma ? (size_t)(comma - text) : 0;
-	char spec[2][128];
 	if (!comma || n0 == 0 || n0 >= sizeof spec[0] || strchr(comma + 1, ',') ||
 	    comma[1] == '\0' || strlen(comma + 1) >= sizeof spec[1])
 		return cli_usage("compare", "--backends %s: expected two sides A,B", text);
 	snprintf(spec[0], sizeof spec[0], "%.*s", (int)n0, text);
 	snprintf(spec[1], sizeof spec[1], "%s", comma + 1);
+	/* The backends first (--backend-opt needs them), then the options in
+	 * order: --backend-opt, then inline. */
 	for (int i = 0; i < 2; i++) {
-		bsim_compare_side *s = &def->side[i];
-		size_t len = strcspn(spec[i], ":");
-		char name[32];
-		snprintf(name, sizeof name, "%.*s", (int)(len < sizeof name ? len : 0), spec[i]);
-		memset(s, 0, sizeof *s);
-		if (cli_backend_opts(c, "compare", name, &s->opts, used) != CLI_OK)
-			return CLI_USAGE;
-		if (bsim_compare_side_parse(spec[i], s, &err) != BSIM_OK)
+		memset(&def->side[i], 0, sizeof def->side[i]);
+		if (bsim_compare_side_parse(spec[i], &def->side[i], &err) != BSIM_OK)
 			return cli_usage("compare", "%s", err.msg);
-		names[i] = s->backend->name;
+		names[i] = def->side[i].backend->name;
+		memset(opts[i], 0, sizeof *opts[i]);
 	}
-	return cli_backend_opts_unused(c, "compare", used, names, 2);
+	int rc = cli_backend_opts(c, "compare", 2, names, opts);
+	for (int i = 0; rc == CLI_OK && i < 2; i++)
+		if (bsim_compare_side_parse(spec[i], &def->side[i], &err) != BSIM_OK)
+			rc = cli_usage("compare", "%s", err.msg);
+	return rc;
 }
 
 static void compare_summary(const bsim_compare_dir_def *def, const char *out,
