@@ -138,14 +138,16 @@ static int consistency_piece(const bsim_accuracy_reference *ref, const bsim_scen
 	/* Step n of this h starts at t = n h: the piece starts at t_k. */
 	long n0 = lround(k * ref->grid / h);
 	double f[2];
-	for (long j = 0; j < m; j++) {
+	for (long j = 0; j < m && rc == BSIM_OK; j++) {
 		bsim_effects_force(&fx, n0 + j, h, f);
-		b->step(w, f, h);
+		rc = b->step(w, f, h, err);
 	}
+	if (rc == BSIM_OK)
+		rc = bsim_effects_status(&fx, err);
 	b->get_state(w, s);
 	bsim_effects_free(&fx);
 	b->destroy(w);
-	return BSIM_OK;
+	return rc;
 }
 
 int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_scene *scene,

@@ -209,6 +209,8 @@ static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, b
 	                               &t_sep, err);
 	if (rc != BSIM_OK)
 		return rc;
+	res->solver[0] = r[0].solver;
+	res->solver[1] = r[1].solver;
 	rc = bsim_compare_analyse(&r[0], &r[1], t_sep, &def->rule, &res->cmp, err);
 	if (rc == BSIM_OK)
 		rc = compare_write(job, r, t_sep, &res->cmp, err);

@@ -44,6 +44,51 @@ static void json_member(FILE *f, int *first, const char *key, const char *value)
 	*first = 0;
 }
 
+/* 1 if s is a number as JSON writes one: -?(0|[1-9][0-9]*)(.[0-9]+)?([eE][+-]?[0-9]+)? */
+static int json_number_text(const char *s)
+{
+	const char *p = s + (*s == '-');
+	if (*p == '0')
+		p++;
+	else if (*p >= '1' && *p <= '9')
+		p += strspn(p, "0123456789");
+	else
+		return 0;
+	if (*p == '.') {
+		size_t n = strspn(p + 1, "0123456789");
+		if (n == 0)
+			return 0;
+		p += 1 + n;
+	}
+	if (*p == 'e' || *p == 'E') {
+		p += 1 + (p[1] == '+' || p[1] == '-');
+		size_t n = strspn(p, "0123456789");
+		if (n == 0)
+			return 0;
+		p += n;
+	}
+	return *p == '\0';
+}
+
+/* A knob's value: a number where the knob is a number (as given, if JSON
+ * can read it so: "1e-6" stays 1e-6), else a string. */
+static void json_knob(FILE *f, int *first, const bsim_knob *k, const char *value)
+{
+	double x;
+	if (k->type == BSIM_KNOB_CHOICE || !text_number(value, &x)) {
+		json_member(f, first, k->name, value);
+		return;
+	}
+	fputs(*first ? "" : ", ", f);
+	bsim_json_string(f, k->name);
+	fputs(": ", f);
+	if (json_number_text(value))
+		fputs(value, f);
+	else
+		bsim_json_number(f, x);
+	*first = 0;
+}
+
 /* Knobs first, in the backend's order, so records of one backend line up;
  * then any option the backend does not list (none once checked), so
  * nothing given is hidden. */
@@ -55,7 +100,7 @@ void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_opti
 		const char *v = bsim_options_get(opts, b->knobs[i].name);
 		if (!v)
 			v = b->knobs[i].default_value ? b->knobs[i].default_value : "";
-		json_member(f, &first, b->knobs[i].name, v);
+		json_knob(f, &first, &b->knobs[i], v);
 	}
 	for (int i = 0; opts && i < opts->n; i++) {
 		int known = 0;
@@ -151,6 +196,13 @@ static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 	bsim_lattice_summary_free(&ls);
 }
 
+/* What the backend's solvers gave up on (beamsim/state.h). */
+static void json_solver(FILE *f, const bsim_solver_counts *c)
+{
+	fprintf(f, ", \"solver\": {\"iteration_limit\": %ld, \"clamped\": %ld}", c->iteration_limit,
+	        c->clamped);
+}
+
 static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int group,
                        int *idx)
 {
@@ -171,6 +223,7 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 	        "\"steps\": %ld, \"unstable\": %d, \"deterministic\": %s",
 	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps, g->unstable,
 	        g->deterministic ? "true" : "false");
+	json_solver(f, &g->solver);
 	if (r->lattice)
 		json_lattice(f, r, group);
 	fputc('}', f);
@@ -205,9 +258,15 @@ static void json_summary(FILE *f, const bsim_experiment *e, const char *backend,
 	bsim_output_backend_options(f, bsim_backend_find(backend, NULL), opts);
 	fputs(",\n  \"experiment\": ", f);
 	bsim_json_string(f, e->path);
-	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d", e->seed, r->trials);
+	fputs(",\n  \"seed\": ", f);
+	bsim_json_u64(f, e->seed);
+	fprintf(f, ",\n  \"trials_per_group\": %d", r->trials);
 	fprintf(f, ",\n  \"wall_seconds\": %.3f", r->wall_seconds);
 	json_groups(f, e, r, idx);
+	fputs(",\n  \"totals\": {\"steps\": ", f);
+	fprintf(f, "%ld, \"trials_run\": %ld", r->total_steps, r->trials_run);
+	json_solver(f, &r->solver);
+	fputc('}', f);
 	fputs(",\n  \"version\": ", f);
 	bsim_json_string(f, BSIM_VERSION);
 	fputs(",\n  \"scene\": ", f);

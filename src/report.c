@@ -581,9 +581,9 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	const bsim_comparison *c = r->cmp;
 	fputs("{\n  \"experiment\": ", f);
 	bsim_json_string(f, r->e->path);
-	fprintf(f,
-	        ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d,\n  \"a\": ", r->e->seed,
-	        c->trials);
+	fputs(",\n  \"seed\": ", f);
+	bsim_json_u64(f, r->e->seed);
+	fprintf(f, ",\n  \"trials_per_group\": %d,\n  \"a\": ", c->trials);
 	json_side(f, &r->side[0]);
 	fputs(",\n  \"b\": ", f);
 	json_side(f, &r->side[1]);

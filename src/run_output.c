@@ -101,9 +101,10 @@ void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_r
 	bsim_json_string(f, info->backend->name);
 	fputs(", \"backend_options\": ", f);
 	bsim_output_backend_options(f, info->backend, info->opts);
-	fprintf(f,
-	        ", \"seed\": %" PRIu64 ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": %" PRIu64,
-	        info->seed, info->group, info->trial, info->mixed_seed);
+	fputs(", \"seed\": ", f);
+	bsim_json_u64(f, info->seed);
+	fprintf(f, ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": ", info->group, info->trial);
+	bsim_json_u64(f, info->mixed_seed);
 	fputs(", \"outcome\": ", f);
 	bsim_json_string(f, bsim_trial_outcome_name(r->outcome));
 	fputs(", \"type\": ", f);
@@ -131,6 +132,8 @@ void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_r
 	path_json(f, r, info->log);
 	fputs(", \"ledger\": ", f);
 	ledger_json(f, &r->ledger);
+	fprintf(f, ", \"solver\": {\"iteration_limit\": %ld, \"clamped\": %ld}",
+	        r->solver.iteration_limit, r->solver.clamped);
 	fputs(", \"instability\": ", f);
 	if (r->instability) {
 		char why[256];

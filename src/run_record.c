@@ -123,18 +123,6 @@ char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *
 	return text;
 }
 
-static void json_options(FILE *f, const bsim_options *o)
-{
-	fputc('{', f);
-	for (int i = 0; i < o->n; i++) {
-		fputs(i ? ", " : "", f);
-		bsim_json_string(f, o->key[i]);
-		fputs(": ", f);
-		bsim_json_string(f, o->value[i]);
-	}
-	fputc('}', f);
-}
-
 static int write_json(const char *path, const bsim_run_record *rec, const bsim_experiment *e,
                       bsim_error *err)
 {
@@ -156,7 +144,8 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 		fputs(", \"label\": ", f);
 		bsim_json_string(f, rec->label[i][0] ? rec->label[i] : rec->backend[i]);
 		fputs(", \"options\": ", f);
-		json_options(f, &rec->opts[i]);
+		bsim_output_backend_options(f, bsim_backend_find(rec->backend[i], NULL),
+		                            &rec->opts[i]);
 		fputc('}', f);
 	}
 	fputc(']', f);
@@ -167,7 +156,9 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 		bsim_json_string(f, rec->protocol[1]);
 		fputc(']', f);
 	}
-	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials\": %d", rec->seed, rec->trials);
+	fputs(",\n  \"seed\": ", f);
+	bsim_json_u64(f, rec->seed);
+	fprintf(f, ",\n  \"trials\": %d", rec->trials);
 	fputs(",\n  \"rule\": {\"alpha\": ", f);
 	bsim_json_number(f, rec->rule.alpha);
 	fputs(", \"margin\": ", f);
@@ -326,7 +317,7 @@ int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 	}
 	struct fy_node *sn = ydoc_lookup(root, "seed"), *tn = ydoc_lookup(root, "trials");
 	long long trials = 0;
-	if (!rc && (!sn || !ydoc_uint64(sn, &rec->seed)))
+	if (!rc && (!sn || !ydoc_uint64_text(sn, &rec->seed)))
 		rc = ydoc_expected(&d, sn, NULL, "seed", "an integer >= 0", err);
 	if (!rc && (!tn || !ydoc_int64(tn, &trials) || trials < 1 || trials > INT32_MAX))
 		rc = ydoc_expected(&d, tn, NULL, "trials", "an integer >= 1", err);

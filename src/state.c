@@ -43,6 +43,7 @@ void bsim_state_copy(bsim_state *dst, const bsim_state *src)
 			dst->active[dst->n_active++] = src->active[k];
 	dst->energy = src->energy;
 	dst->impacts = src->impacts;
+	dst->solver = src->solver;
 }
 
 void bsim_state_set_active(bsim_state *s, const int *active, int n)

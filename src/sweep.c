@@ -34,6 +34,8 @@ void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n, bsim_gro
 	for (int i = 0; i < n; i++) {
 		const bsim_trial_result *t = &trials[i];
 		out->steps += t->steps_run;
+		out->solver.iteration_limit += t->solver.iteration_limit;
+		out->solver.clamped += t->solver.clamped;
 		switch (t->outcome) {
 		case BSIM_TRAVERSED:
 			out->traversed++;
@@ -346,6 +348,7 @@ static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_
 {
 	r->total_steps = 0;
 	r->trials_run = 0;
+	r->solver = (bsim_solver_counts){0, 0};
 	for (int g = 0; g < n_groups; g++) {
 		bsim_group_result *gr = &r->groups[g];
 		const bsim_trial_result *first = &r->trials_out[(size_t)g * trials];
@@ -357,8 +360,11 @@ static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_
 		if (gr->deterministic && trials > 0) {
 			gr->ci95[0] = gr->ci95[1] = gr->p_traverse;
 			gr->steps = first->steps_run;
+			gr->solver = first->solver;
 		}
 		r->total_steps += gr->steps;
+		r->solver.iteration_limit += gr->solver.iteration_limit;
+		r->solver.clamped += gr->solver.clamped;
 		r->trials_run += gr->deterministic && trials > 0 ? 1 : trials;
 	}
 	r->wall_seconds = wall;

@@ -553,7 +553,8 @@ typedef struct trial_ctx {
 	const int *map;       /* world beam -> scene beam, NULL: the same */
 	gate_track gate;
 	bsim_trial_result *out;
-	int overlap; /* the recorder asked for overlap_max */
+	int overlap;               /* the recorder asked for overlap_max */
+	bsim_solver_counts solver; /* of the worlds replaced so far (essay protocol) */
 } trial_ctx;
 
 /* A full-lattice state for the recorder from the world's state. */
@@ -595,6 +596,9 @@ static int gate_enter(trial_ctx *c, bsim_state **s0, const double p0[2], int ix,
 	if (c->scene->lattice.protocol != BSIM_PROTOCOL_ESSAY)
 		return BSIM_OK;
 	double e_before = *e0;
+	/* The world is replaced: what its solvers gave up on stays counted. */
+	c->solver.iteration_limit += (*s0)->solver.iteration_limit;
+	c->solver.clamped += (*s0)->solver.clamped;
 	int rc = trial_essay_enter(&c->r->essay, c->scene, c->backend, c->opts, ix, iy, *s0, &c->w,
 	                           &c->out->reset_overlaps, err);
 	if (rc)
@@ -716,7 +720,8 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 			record(rec, scene, whole_state(&c, s0), n, random_value(&fx), &out->ledger);
 			recorded = n;
 		}
-		backend->step(c.w, f, h);
+		if ((rc = backend->step(c.w, f, h, err)) != BSIM_OK)
+			break;
 		backend->get_state(c.w, s1);
 		double e1 = energy_kinetic(c.ws, s1) + energy_springs(c.ws, s1);
 		if (!state_finite(s1) || !isfinite(e1)) {
@@ -804,6 +809,11 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 		out->in_contact_end = 0;
 	}
 	out->draws = fx.random ? bsim_schedule_draws(fx.random->schedule) : 0;
+	out->solver = c.solver;
+	out->solver.iteration_limit += s0->solver.iteration_limit;
+	out->solver.clamped += s0->solver.clamped;
+	if (rc == BSIM_OK)
+		rc = bsim_effects_status(&fx, err);
 	out->final_ix = c.gate.ix;
 	out->final_iy = c.gate.iy;
 	out->gates_entered = c.gate.entries;

@@ -425,7 +425,7 @@ static void test_unstable(void **state)
 	free(csv);
 	snprintf(file, sizeof file, "%s/summary.json", out);
 	char *json = bsim_test_read(file);
-	assert_contains(json, "\"unstable\": 10, \"deterministic\": true}");
+	assert_contains(json, "\"unstable\": 10, \"deterministic\": true, \"solver\": ");
 	free(json);
 }
 
@@ -464,8 +464,8 @@ static void test_sweep_deterministic(void **state)
 	snprintf(file, sizeof file, "%s/summary.json", out);
 	char *json = bsim_test_read(file);
 	assert_contains(json, "\"p_traverse\": 1, \"ci95\": [1, 1]");
-	assert_contains(json, "\"deterministic\": true}");
-	assert_contains(json, "\"deterministic\": false}");
+	assert_contains(json, "\"deterministic\": true, \"solver\": ");
+	assert_contains(json, "\"deterministic\": false, \"solver\": ");
 	free(json);
 }
 

@@ -291,11 +291,14 @@ static void test_one_backend_two_settings(void **state)
 	char *a = read_in(dir, "thesis/trials.csv");
 	char *b = read_in(dir, "thesis-integrator=euler/trials.csv");
 	assert_string_not_equal(a, b); /* euler is another integrator */
+	/* Every knob in the backend's order, numbers as numbers. */
 	char *run = read_in(dir, "run.json");
 	assert_non_null(strstr(run, "\"label\": \"thesis:integrator=euler\", \"options\": "
-	                            "{\"slop\": \"2e-6\", \"integrator\": \"euler\""));
-	assert_non_null(strstr(run, "\"label\": \"thesis\", \"options\": {\"slop\": \"2e-6\", "
-	                            "\"integrator\": \"midpoint\""));
+	                            "{\"integrator\": \"euler\", \"impact_order\": "
+	                            "\"simultaneous\", \"projection\": 1, \"slop\": 2e-6,"));
+	assert_non_null(strstr(run, "\"label\": \"thesis\", \"options\": {\"integrator\": "
+	                            "\"midpoint\", \"impact_order\": \"simultaneous\", "
+	                            "\"projection\": 1, \"slop\": 2e-6,"));
 	char *md = read_in(dir, "report.md");
 	assert_non_null(strstr(md, "# beamsim compare: thesis vs thesis:integrator=euler"));
 	const char *again[] = {"regress", dir, "--exact", "--out", out_dir("euler_rerun"), NULL};

@@ -21,7 +21,7 @@ static void step_once(const bsim_scene *s, bsim_state *st)
 	bsim_error err;
 	assert_int_equal(bsim_backend_thesis.create(s, NULL, &w, &err), BSIM_OK);
 	const double zero[2] = {0.0, 0.0};
-	bsim_backend_thesis.step(w, zero, h);
+	assert_int_equal(bsim_backend_thesis.step(w, zero, h, NULL), BSIM_OK);
 	bsim_backend_thesis.get_state(w, st);
 	bsim_backend_thesis.destroy(w);
 }
@@ -133,7 +133,7 @@ static void run_midline(double offset, double e_tip, bsim_state *st)
 	const double zero[2] = {0.0, 0.0};
 	int impacts = 0;
 	for (int n = 0; n < 40; n++) {
-		bsim_backend_thesis.step(w, zero, h);
+		assert_int_equal(bsim_backend_thesis.step(w, zero, h, NULL), BSIM_OK);
 		bsim_backend_thesis.get_state(w, st);
 		impacts += st->impacts;
 	}

@@ -214,7 +214,8 @@ struct bsim_world {
 	std::vector<int> contact_type;
 	bsim_step_energy energy = {};
 	int impacts = 0;
-	long toi_events = 0; /* continuous-collision sub-solves, all steps */
+	long toi_events = 0;         /* continuous-collision sub-solves, all steps */
+	bsim_solver_counts solver{}; /* clamped substeps, since creation */
 };
 
 /* Adds beam i to the ascending live list. */
@@ -700,6 +701,16 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 
 	/* The live list may have grown in the step (PreSolve). */
 	const size_t n_after = w->track_live ? w->live.size() : w->beams.size();
+	/* Box2D clamps a body's motion per step to b2_maxTranslation (units)
+	 * and b2_maxRotation (rad) by scaling its velocity, which then moves
+	 * exactly that far: a substep that ends there was clamped. */
+	const float hf = (float)h, near = 1.0f - 1e-5f;
+	bool clamped = hf * w->body->GetLinearVelocity().Length() >= near * b2_maxTranslation;
+	for (size_t k = 0; k < n_after && !clamped; k++) {
+		const beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
+		clamped = hf * std::fabs(b.body->GetAngularVelocity()) >= near * b2_maxRotation;
+	}
+	w->solver.clamped += clamped;
 	for (size_t k = 0; k < n_after; k++) {
 		const beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
 		if (b.damping == 0.0)
@@ -710,14 +721,19 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 	}
 }
 
-void box2d_step(bsim_world *w, const double force[2], double h)
+int box2d_step(bsim_world *w, const double force[2], double h, bsim_error *err)
 {
 	w->energy = bsim_step_energy{};
 	w->impacts = 0;
 	const double hs = h / w->substeps;
-	for (int k = 0; k < w->substeps; k++)
-		box2d_substep(w, force, hs);
-	update_contact_types(w);
+	try {
+		for (int k = 0; k < w->substeps; k++)
+			box2d_substep(w, force, hs);
+		update_contact_types(w);
+	} catch (const std::bad_alloc &) {
+		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory in a step");
+	}
+	return BSIM_OK;
 }
 
 void box2d_get_state(const bsim_world *w, bsim_state *st)
@@ -752,6 +768,7 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 	}
 	st->energy = w->energy;
 	st->impacts = w->impacts;
+	st->solver = w->solver;
 }
 
 /* Rebuilds the world at the state: no contact or joint impulses carried

@@ -40,7 +40,7 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - omega_free * c->c;
 		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 	}
-	thesis_lcp_solve(w, cs, n);
+	w->solver.iteration_limit += thesis_lcp_solve(w, cs, n);
 
 	double j[2];
 	thesis_impulse_sum(cs, n, j);

@@ -182,8 +182,10 @@ static int essay_hold(bsim_world *w)
 	return any;
 }
 
-static void thesis_step(bsim_world *w, const double force[2], double h)
+/* Nothing in a step allocates: the world's memory is sized at creation. */
+static int thesis_step(bsim_world *w, const double force[2], double h, bsim_error *err)
 {
+	(void)err;
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
 	for (int k = 0; k < w->n_typed; k++)
@@ -215,6 +217,7 @@ static void thesis_step(bsim_world *w, const double force[2], double h)
 	if (w->sleep)
 		thesis_beams_sleep(w, speed, h);
 	thesis_awake_prune(w);
+	return BSIM_OK;
 }
 
 static void thesis_get_state(const bsim_world *w, bsim_state *s)
@@ -231,6 +234,7 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 	}
 	s->energy = w->energy;
 	s->impacts = w->impacts;
+	s->solver = w->solver;
 }
 
 static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)

@@ -74,9 +74,10 @@ typedef struct bsim_compare_dir_result {
 	bsim_experiment e;
 	bsim_comparison cmp;
 	int threads;
-	char dir[2][128];   /* each side's directory in DIR */
-	long unstable[2];   /* unstable trials on each side */
-	char journal[1100]; /* as in bsim_sweep_dir_result */
+	char dir[2][128];             /* each side's directory in DIR */
+	long unstable[2];             /* unstable trials on each side */
+	bsim_solver_counts solver[2]; /* what each side's solvers gave up on */
+	char journal[1100];           /* as in bsim_sweep_dir_result */
 } bsim_compare_dir_result;
 
 /* Runs the comparison into def->out. BSIM_OK whatever the verdicts

@@ -9,6 +9,8 @@
 
 #include <stdint.h>
 
+#include "beamsim/error.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -29,8 +31,14 @@ void bsim_schedule_reset(bsim_schedule *s, double magnitude, uint64_t seed);
 /* Index j of the value that applies at step n of size h. */
 long bsim_schedule_index(const bsim_schedule *s, long n, double h);
 
-/* The force value j (N): Rm * z_j. Draws z up to j if not drawn yet. */
+/* The force value j (N): Rm * z_j. Draws z up to j if not drawn yet. A
+ * value that cannot be had (no memory for it, or j outside 0 .. 2^40) is
+ * 0, and bsim_schedule_status then fails: never a NaN. */
 double bsim_schedule_value(bsim_schedule *s, long j);
+
+/* BSIM_OK, or BSIM_EFAIL saying which value could not be had and why,
+ * since the last reset. */
+int bsim_schedule_status(const bsim_schedule *s, bsim_error *err);
 
 /* Number of standard-normal draws made since alloc/reset. */
 unsigned long bsim_schedule_draws(const bsim_schedule *s);

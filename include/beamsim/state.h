@@ -24,17 +24,30 @@ typedef struct bsim_step_energy {
 	double sleep;      /* of beams put exactly to rest by sleeping (>= 0) */
 } bsim_step_energy;
 
+/* What a backend's solvers had to give up on, counted since the world was
+ * created. A count is never a failure by itself: the runner reports it
+ * (beamsim run warns, summary.json counts), and the trial's ledger and
+ * finiteness checks still judge the trial (beamsim/trial.h). */
+typedef struct bsim_solver_counts {
+	long iteration_limit; /* solves that stopped at their iteration limit
+	                       * before they converged */
+	long clamped;         /* (sub)steps in which a motion was clamped to a
+	                       * solver's limit (Box2D's b2_maxTranslation and
+	                       * b2_maxRotation) */
+} bsim_solver_counts;
+
 typedef struct bsim_state {
 	double x[2]; /* body centre, m */
 	double v[2]; /* body velocity, m/s */
 	int n_beams;
-	double *theta;           /* n_beams, rad, forward positive */
-	double *omega;           /* n_beams, rad/s */
-	int *contact;            /* n_beams, BSIM_CONTACT_* at the end of the step */
-	bsim_step_energy energy; /* of the last step */
-	int impacts;             /* impacts resolved in the last step */
-	double pivot_drift;      /* m, largest distance of a beam's pinned point from
-	                          * its pivot (0 where the pin is exact by construction) */
+	double *theta;             /* n_beams, rad, forward positive */
+	double *omega;             /* n_beams, rad/s */
+	int *contact;              /* n_beams, BSIM_CONTACT_* at the end of the step */
+	bsim_step_energy energy;   /* of the last step */
+	int impacts;               /* impacts resolved in the last step */
+	bsim_solver_counts solver; /* since the world was created */
+	double pivot_drift;        /* m, largest distance of a beam's pinned point from
+	                            * its pivot (0 where the pin is exact by construction) */
 	/* The beams that may be away from rest, ascending: every beam not
 	 * listed has theta = omega = 0 and no contact, and so have its entries
 	 * in theta, omega and contact. A backend may list more than it must

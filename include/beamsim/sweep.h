@@ -31,6 +31,7 @@ typedef struct bsim_group_result {
 	int landscape_left, landscape_right; /* traversed over beam 0's / 1's barrier */
 	double p_traverse, ci95[2];          /* Wilson 95% */
 	long steps;                          /* steps integrated in the group */
+	bsim_solver_counts solver;           /* of the trials integrated (beamsim/state.h) */
 } bsim_group_result;
 
 typedef struct bsim_sweep_result {
@@ -38,12 +39,13 @@ typedef struct bsim_sweep_result {
 	bsim_trial_result *trials_out; /* n_groups * trials, index g*trials + t */
 	bsim_group_result *groups;     /* n_groups */
 	double wall_seconds;
-	long total_steps;      /* steps integrated (a deterministic group's one trial) */
-	long trials_run;       /* trials integrated: copies of a deterministic group's not */
-	int has_ledger;        /* 1: the trials' ledgers are known (a run, or a trials.csv
-	                        * with the energy columns) */
-	int keep;              /* trajectories kept per group (its first trials) */
-	bsim_trajectory *kept; /* n_groups * keep, index g*keep + t; NULL if keep = 0 */
+	long total_steps;          /* steps integrated (a deterministic group's one trial) */
+	long trials_run;           /* trials integrated: copies of a deterministic group's not */
+	bsim_solver_counts solver; /* over the trials integrated */
+	int has_ledger;            /* 1: the trials' ledgers are known (a run, or a trials.csv
+	                            * with the energy columns) */
+	int keep;                  /* trajectories kept per group (its first trials) */
+	bsim_trajectory *kept;     /* n_groups * keep, index g*keep + t; NULL if keep = 0 */
 	/* Each trial's gate path with entry states and the peaks of every
 	 * beam; same index as trials_out. NULL when read back from trials.csv. */
 	bsim_trial_log *logs;

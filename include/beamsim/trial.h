@@ -100,6 +100,9 @@ typedef struct bsim_trial_result {
 	int final_ix, final_iy;
 	int gates_entered;  /* gates in the path, the start gate included */
 	int reset_overlaps; /* essay protocol: entries whose reset beams overlapped the body */
+	/* What the backend's solvers gave up on over the trial (beamsim/
+	 * state.h), summed over the worlds it ran in. */
+	bsim_solver_counts solver;
 } bsim_trial_result;
 
 /* Which edge of a gate the body crossed to enter it. */
@@ -215,7 +218,8 @@ void bsim_trial_runner_free(bsim_trial_runner *r);
  * essay's (each gate entered gets a fresh world of its two beams at rest,
  * the body's state carried over; the trace then sees that world's state).
  * Returns BSIM_OK (an unstable trial included: its outcome says so),
- * BSIM_EINPUT (backend options) or BSIM_EFAIL (out of memory). */
+ * BSIM_EINPUT (backend options) or BSIM_EFAIL (out of memory, in the
+ * runner, the schedule or the backend's step: never a result). */
 int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_backend *backend,
                    const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
                    bsim_trial_result *out, bsim_error *err);

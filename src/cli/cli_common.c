@@ -351,6 +351,22 @@ int cli_run_end(int rc, const char *journal, int argc, char **argv)
 	return rc;
 }
 
+void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const char *where)
+{
+	char what[160] = "";
+	if (c->iteration_limit > 0)
+		snprintf(what, sizeof what, "stopped at an iteration limit %ld time%s",
+		         c->iteration_limit, c->iteration_limit == 1 ? "" : "s");
+	if (c->clamped > 0)
+		snprintf(what + strlen(what), sizeof what - strlen(what),
+		         "%sclamped the motion to its per-step limits in %ld (sub)step%s",
+		         what[0] ? " and " : "", c->clamped, c->clamped == 1 ? "" : "s");
+	if (what[0])
+		cli_error("warning: the %s backend's solver %s (%s: solver); there the motion is "
+		          "the solver's limit, not the model's",
+		          backend, what, where);
+}
+
 char *cli_text_append(char *text, const char *more)
 {
 	size_t n = strlen(text), m = strlen(more);

@@ -107,6 +107,11 @@ void cli_signals_restore(void);
  * again. Otherwise returns rc. */
 int cli_run_end(int rc, const char *journal, int argc, char **argv);
 
+/* A warning on stderr if the backend's solvers gave up on anything over
+ * what ran (beamsim/state.h): what, how often, and where the counts are
+ * written (where: "summary.json", ...). */
+void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const char *where);
+
 /* text (malloc'd) with more appended, reallocated; NULL (text freed) if
  * out of memory. */
 char *cli_text_append(char *text, const char *more);

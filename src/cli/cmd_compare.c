@@ -256,6 +256,11 @@ int cmd_compare(int argc, char **argv)
 	} else {
 		if (!c.quiet)
 			compare_summary(&def, c.out, &res);
+		for (int i = 0; i < 2; i++) {
+			char where[1200];
+			snprintf(where, sizeof where, "%s/%s/summary.json", c.out, res.dir[i]);
+			cli_solver_warning(def.side[i].backend->name, &res.solver[i], where);
+		}
 		rc = res.cmp.n_disagree > 0 ? CLI_DISAGREE : CLI_OK;
 		bsim_compare_dir_result_free(&res);
 	}

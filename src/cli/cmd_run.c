@@ -220,6 +220,8 @@ int cmd_run(int argc, char **argv)
 		bsim_run_output_json(out, &info, &res, 0);
 	else if (rc == CLI_OK)
 		print_text(out, &a, &scene, mixed, &res, log);
+	if (rc == CLI_OK)
+		cli_solver_warning(backend->name, &res.solver, "run --json");
 	if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {
 		char why[256];
 		bsim_trial_instability_text(&res, scene.dt, why, sizeof why);

@@ -120,6 +120,7 @@ int cmd_sweep(int argc, char **argv)
 	}
 	if (!c.quiet)
 		sweep_report(c.out, &res);
+	cli_solver_warning(def.backend->name, &res.r.solver, "summary.json");
 	/* Unstable trials fail the sweep (after its files are written): one line
 	 * with their number and the first one's reason and replay. */
 	if (res.unstable > 0) {
