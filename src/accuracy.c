@@ -190,58 +190,29 @@ int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_sce
 	return rc;
 }
 
-/* The knob grids. The first setting of each list is the reference's. */
-static const char *const thesis_settings[][2] = {
-        {"integrator=midpoint", "impact_order=simultaneous"},
-        {"integrator=midpoint", "impact_order=nearest_first"},
-        {"integrator=euler", "impact_order=simultaneous"},
-        {"integrator=euler", "impact_order=nearest_first"},
-};
-
 int bsim_accuracy_settings(const bsim_backend *b, bsim_accuracy_row **out, int *n, bsim_error *err)
 {
 	*out = NULL;
 	*n = 0;
-	int thesis = strcmp(b->name, "thesis") == 0, box2d = strcmp(b->name, "box2d") == 0;
-	if (!thesis && !box2d)
-		return bsim_error_set(
-		        err, BSIM_EINPUT,
-		        "accuracy: no knob grid for backend %s (known: thesis, box2d)", b->name);
-	static const int vel[] = {30, 8, 4}, sub[] = {4, 1};
-	static const char *const spring[] = {"torque", "weld"};
-	int count = thesis ? 4 : 12;
-	bsim_accuracy_row *rows = calloc((size_t)count, sizeof *rows);
+	if (b->n_accuracy < 1)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "accuracy: backend %s lists no knob settings to study",
+		                      b->name);
+	bsim_accuracy_row *rows = calloc((size_t)b->n_accuracy, sizeof *rows);
 	if (!rows)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (int i = 0; i < count; i++) {
+	for (int i = 0; i < b->n_accuracy; i++) {
 		bsim_accuracy_row *r = &rows[i];
 		r->backend = b->name;
 		r->reference = i == 0;
-		char kv[3][64];
-		int nkv;
-		if (thesis) {
-			snprintf(kv[0], sizeof kv[0], "%s", thesis_settings[i][0]);
-			snprintf(kv[1], sizeof kv[1], "%s", thesis_settings[i][1]);
-			nkv = 2;
-			snprintf(r->setting, sizeof r->setting, "%s %s", strchr(kv[0], '=') + 1,
-			         strchr(kv[1], '=') + 1);
-		} else { /* spring slowest-varying, then substeps, then iterations */
-			int vi = vel[i % 3], ss = sub[(i / 3) % 2];
-			const char *sp = spring[i / 6];
-			snprintf(kv[0], sizeof kv[0], "velocity_iterations=%d", vi);
-			snprintf(kv[1], sizeof kv[1], "substeps=%d", ss);
-			snprintf(kv[2], sizeof kv[2], "spring=%s", sp);
-			nkv = 3;
-			snprintf(r->setting, sizeof r->setting, "vi=%d sub=%d %s", vi, ss, sp);
+		snprintf(r->setting, sizeof r->setting, "%s", b->accuracy[i].name);
+		if (bsim_options_add_setting(&r->opts, &b->accuracy[i], err) != BSIM_OK) {
+			free(rows);
+			return BSIM_EINPUT;
 		}
-		for (int j = 0; j < nkv; j++)
-			if (bsim_options_add(&r->opts, kv[j], err)) {
-				free(rows);
-				return BSIM_EINPUT;
-			}
 	}
 	*out = rows;
-	*n = count;
+	*n = b->n_accuracy;
 	return BSIM_OK;
 }
 

@@ -151,3 +151,19 @@ void bsim_options_effective(const bsim_knob *knobs, int n_knobs, const bsim_opti
 		out->n++;
 	}
 }
+
+int bsim_options_add_setting(bsim_options *opts, const bsim_knob_setting *setting, bsim_error *err)
+{
+	for (const char *p = setting->options; *p;) {
+		size_t len = strcspn(p, ":");
+		char kv[128];
+		if (len >= sizeof kv)
+			return bsim_error_set(err, BSIM_EINPUT, "setting %s: option too long",
+			                      setting->name);
+		snprintf(kv, sizeof kv, "%.*s", (int)len, p);
+		if (bsim_options_add(opts, kv, err) != BSIM_OK)
+			return BSIM_EINPUT;
+		p += len + (p[len] == ':');
+	}
+	return BSIM_OK;
+}

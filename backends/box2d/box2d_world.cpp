@@ -138,6 +138,23 @@ const bsim_knob box2d_knobs[] = {
          "Box2D's own sleeping for the beams, never for the body; auto: on for lattice "
          "scenes"},
 };
+/* The accuracy study's settings (beamsim accuracy): spring slowest-varying,
+ * then substeps, then velocity iterations; the first, the reference, is
+ * the most accurate. */
+const bsim_knob_setting box2d_accuracy[] = {
+        {"vi=30 sub=4 torque", "velocity_iterations=30:substeps=4:spring=torque"},
+        {"vi=8 sub=4 torque", "velocity_iterations=8:substeps=4:spring=torque"},
+        {"vi=4 sub=4 torque", "velocity_iterations=4:substeps=4:spring=torque"},
+        {"vi=30 sub=1 torque", "velocity_iterations=30:substeps=1:spring=torque"},
+        {"vi=8 sub=1 torque", "velocity_iterations=8:substeps=1:spring=torque"},
+        {"vi=4 sub=1 torque", "velocity_iterations=4:substeps=1:spring=torque"},
+        {"vi=30 sub=4 weld", "velocity_iterations=30:substeps=4:spring=weld"},
+        {"vi=8 sub=4 weld", "velocity_iterations=8:substeps=4:spring=weld"},
+        {"vi=4 sub=4 weld", "velocity_iterations=4:substeps=4:spring=weld"},
+        {"vi=30 sub=1 weld", "velocity_iterations=30:substeps=1:spring=weld"},
+        {"vi=8 sub=1 weld", "velocity_iterations=8:substeps=1:spring=weld"},
+        {"vi=4 sub=1 weld", "velocity_iterations=4:substeps=1:spring=weld"},
+};
 enum { KNOB_VEL_IT, KNOB_POS_IT, KNOB_SUBSTEPS, KNOB_SPRING, KNOB_UNIT_SCALE, KNOB_SLEEP };
 enum { SLEEP_AUTO = 0, SLEEP_ON = 1, SLEEP_OFF = 2 };
 constexpr int N_KNOBS = (int)(sizeof box2d_knobs / sizeof box2d_knobs[0]);
@@ -810,4 +827,6 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         box2d_step,
         box2d_get_state,
         box2d_set_state,
+        box2d_accuracy,
+        (int)(sizeof box2d_accuracy / sizeof box2d_accuracy[0]),
 };

@@ -50,6 +50,15 @@ static const bsim_knob thesis_knobs[] = {
         {"sleep_energy", BSIM_KNOB_DOUBLE, "1e-6", NULL,
          "energy below which a beam the body has left sleeps, J"},
 };
+/* The accuracy study's settings (beamsim accuracy): the integrators and
+ * impact orders; the first, the reference, is the most accurate. */
+static const bsim_knob_setting thesis_accuracy[] = {
+        {"midpoint simultaneous", "integrator=midpoint:impact_order=simultaneous"},
+        {"midpoint nearest_first", "integrator=midpoint:impact_order=nearest_first"},
+        {"euler simultaneous", "integrator=euler:impact_order=simultaneous"},
+        {"euler nearest_first", "integrator=euler:impact_order=nearest_first"},
+};
+
 enum {
 	KNOB_INTEGRATOR,
 	KNOB_IMPACT_ORDER,
@@ -272,4 +281,6 @@ const bsim_backend bsim_backend_thesis = {
         .step = thesis_step,
         .get_state = thesis_get_state,
         .set_state = thesis_set_state,
+        .accuracy = thesis_accuracy,
+        .n_accuracy = (int)(sizeof thesis_accuracy / sizeof thesis_accuracy[0]),
 };

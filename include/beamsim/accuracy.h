@@ -93,8 +93,9 @@ typedef struct bsim_accuracy_result {
 	double wall_seconds;
 } bsim_accuracy_result;
 
-/* The knob settings studied for a backend ("thesis", "box2d"): n settings
- * into a malloc'd array (caller frees); the reference knobs are one of them. */
+/* The knob settings studied for backend b, its accuracy list
+ * (beamsim/backend.h): n settings into a malloc'd array (caller frees), the
+ * first the reference. BSIM_EINPUT if b lists none. */
 int bsim_accuracy_settings(const bsim_backend *b, bsim_accuracy_row **out, int *n, bsim_error *err);
 
 /* The whole study over the backends. Results other than the timings do not

@@ -33,6 +33,11 @@ typedef struct bsim_backend {
 	int (*step)(bsim_world *w, const double force[2], double h, bsim_error *err);
 	void (*get_state)(const bsim_world *w, bsim_state *out);
 	int (*set_state)(bsim_world *w, const bsim_state *s, bsim_error *err);
+	/* The knob settings the accuracy study compares (beamsim/accuracy.h),
+	 * beside the knobs they set; the first is the most accurate, whose run
+	 * at the finest step is the study's reference. */
+	const bsim_knob_setting *accuracy;
+	int n_accuracy;
 } bsim_backend;
 
 /* The registry: all backends compiled in, NULL-terminated. */

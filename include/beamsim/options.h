@@ -32,6 +32,17 @@ typedef struct bsim_knob {
 	const char *help;
 } bsim_knob;
 
+/* A setting of several knobs under a short name: options is
+ * "KEY=VALUE:KEY=VALUE..." (the syntax of compare's inline options). */
+typedef struct bsim_knob_setting {
+	const char *name;    /* "midpoint simultaneous" */
+	const char *options; /* "integrator=midpoint:impact_order=simultaneous" */
+} bsim_knob_setting;
+
+/* Adds a setting's options to opts (later ones win). BSIM_EINPUT naming
+ * the setting on bad syntax. */
+int bsim_options_add_setting(bsim_options *opts, const bsim_knob_setting *setting, bsim_error *err);
+
 /* Checks every option names a knob and parses as its type (BSIM_EINPUT
  * naming the option and what was expected otherwise). */
 int bsim_options_check(const bsim_options *opts, const bsim_knob *knobs, int n_knobs,

@@ -70,6 +70,11 @@ static void backend_print(const bsim_backend *b)
 		       knob_type_name(k->type), w[2], k->default_value ? k->default_value : "-",
 		       w[3], k->choices ? k->choices : "-", k->help ? k->help : "");
 	}
+	if (b->n_accuracy > 0)
+		printf("\n  beamsim accuracy compares %d settings (the first is the reference):\n",
+		       b->n_accuracy);
+	for (int i = 0; i < b->n_accuracy; i++)
+		printf("    %-24s %s\n", b->accuracy[i].name, b->accuracy[i].options);
 }
 
 int cmd_backends(int argc, char **argv)
