@@ -406,6 +406,11 @@ static void test_bad_usage(void **state)
 	assert_int_equal(bsim_test_cli(knob, NULL, &err), 2);
 	assert_non_null(strstr(err, "nope"));
 	free(err);
+	const char *plain[] = {"compare",        experiment, "--backend-opt", "substeps=2", "--out",
+	                       out_dir("bad3b"), NULL};
+	assert_int_equal(bsim_test_cli(plain, NULL, &err), 2);
+	assert_non_null(strstr(err, "expected B:KEY=VALUE with several backends"));
+	free(err);
 	const char *who[] = {"compare",       experiment, "--backend-opt", "ode:x=1", "--out",
 	                     out_dir("bad3"), NULL};
 	assert_int_equal(bsim_test_cli(who, NULL, &err), 2);
