@@ -15,6 +15,11 @@ const bsim_backend *const *bsim_backend_list(void)
 	return registry;
 }
 
+const bsim_backend *bsim_backend_default(void)
+{
+	return &bsim_backend_thesis;
+}
+
 const bsim_backend *bsim_backend_find(const char *name, bsim_error *err)
 {
 	char known[256] = "";

@@ -14,6 +14,16 @@
 #include "beamsim/version.h"
 #include "session.h"
 
+bsim_run_info bsim_run_info_default(void)
+{
+	bsim_run_info i;
+	memset(&i, 0, sizeof i);
+	i.backend = bsim_backend_default();
+	i.seed = 1;
+	i.stride = 1;
+	return i;
+}
+
 static void ledger_json(FILE *f, const bsim_ledger *l)
 {
 	const struct {

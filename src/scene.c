@@ -14,6 +14,13 @@
 
 #define BSIM_PI 3.14159265358979323846
 
+bsim_scene bsim_scene_default(void)
+{
+	bsim_scene d;
+	scene_defaults(&d);
+	return d;
+}
+
 void scene_defaults(bsim_scene *s)
 {
 	memset(s, 0, sizeof *s);

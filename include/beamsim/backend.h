@@ -42,6 +42,8 @@ typedef struct bsim_backend {
 
 /* The registry: all backends compiled in, NULL-terminated. */
 const bsim_backend *const *bsim_backend_list(void);
+/* The backend a run uses when none is named: the essay's solver, thesis. */
+const bsim_backend *bsim_backend_default(void);
 /* By name; NULL and BSIM_EINPUT naming the known ones if unknown. */
 const bsim_backend *bsim_backend_find(const char *name, bsim_error *err);
 

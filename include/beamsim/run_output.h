@@ -43,6 +43,12 @@ typedef struct bsim_run_info {
 	const bsim_trial_log *log; /* the trial's gate path and peaks, or NULL */
 } bsim_run_info;
 
+/* What `beamsim run` runs when told nothing: the default backend
+ * (bsim_backend_default) without options, trial 0 of group 0 of experiment
+ * seed 1, every step recorded. scene_path, scene and mixed_seed are the
+ * caller's to set (bsim_schedule_seed_mix(seed, group, trial)). */
+bsim_run_info bsim_run_info_default(void);
+
 /* The JSON object of a trial (one line, with a newline): scene, name,
  * backend, backend_options, seed, group, trial, mixed_seed, outcome, type,
  * landscape_left, landscape_beam (the barrier crossed, 1-based, or null),

@@ -315,7 +315,7 @@ int cmd_bench(int argc, char **argv)
 	cli_common c = cli_common_default();
 	bench_args a = {.experiment = BENCH_H1, .h2 = 1, .vs = "box2d"};
 	int rc = cli_parse(&bench_spec, argc, argv, &c, &a, NULL);
-	a.backend = c.backend ? c.backend : "thesis";
+	a.backend = c.backend ? c.backend : bsim_backend_default()->name;
 	a.trials = c.trials;
 	/* --backend-opt is --backend's, --vs-opt --vs's. */
 	const bsim_backend *backend = NULL, *vs = NULL;

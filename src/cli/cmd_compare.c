@@ -138,7 +138,7 @@ static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compar
 			return cli_usage("compare",
 			                 "--protocols runs one backend (--backend B), not "
 			                 "--backends");
-		const char *b = c->backend ? c->backend : "thesis";
+		const char *b = c->backend ? c->backend : bsim_backend_default()->name;
 		for (int i = 0; i < 2; i++) {
 			bsim_compare_side *s = &def->side[i];
 			memset(s, 0, sizeof *s);

@@ -172,9 +172,10 @@ static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64
 int cmd_run(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	run_args a = {.seed = 1, .stride = 1};
+	const bsim_run_info defaults = bsim_run_info_default();
+	run_args a = {.seed = defaults.seed, .stride = defaults.stride};
 	int rc = cli_parse(&run_spec, argc, argv, &c, &a, &a.scene);
-	a.backend = c.backend ? c.backend : "thesis";
+	a.backend = c.backend ? c.backend : bsim_backend_default()->name;
 	a.seed = c.has_seed ? c.seed : a.seed;
 	const bsim_backend *backend = NULL;
 	if (rc < 0 && !(backend = cli_backend_with_opts(&c, "run", a.backend, &a.opts)))

@@ -81,8 +81,9 @@ int cmd_sweep(int argc, char **argv)
 	int rc = cli_parse(&sweep_spec, argc, argv, &c, &a, &experiment);
 	bsim_sweep_dir_def def = bsim_sweep_dir_default();
 	if (rc < 0) {
-		def.backend = cli_backend_with_opts(&c, "sweep", c.backend ? c.backend : "thesis",
-		                                    &def.opts);
+		def.backend = cli_backend_with_opts(
+		        &c, "sweep", c.backend ? c.backend : bsim_backend_default()->name,
+		        &def.opts);
 		rc = def.backend ? -1 : CLI_USAGE;
 	}
 	if (rc >= 0) {

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/run_output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/video.h"
 #include "cli_common.h"
@@ -242,9 +243,9 @@ int cmd_video(int argc, char **argv)
 		cli_error("out of memory");
 		return CLI_FAIL;
 	}
-	a->seed = 1;
+	a->seed = bsim_run_info_default().seed; /* the trial beamsim run runs */
 	a->n_backends = 1;
-	snprintf(a->names[0], sizeof a->names[0], "thesis");
+	snprintf(a->names[0], sizeof a->names[0], "%s", bsim_backend_default()->name);
 	a->def = bsim_video_def_default();
 	cli_common c = cli_common_default();
 	int rc = cli_parse(&video_spec, argc, argv, &c, a, &a->scene);
