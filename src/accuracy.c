@@ -18,8 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/clock.h"
+#include "atomic_file.h"
+#include "clock.h"
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
@@ -56,7 +56,7 @@ static void reference_keep(void *user, long step, const bsim_state *s)
 		ref->states = grown;
 		t->cap = cap;
 	}
-	if (bsim_state_alloc(&ref->states[ref->n], s->n_beams)) {
+	if (bsim_state_init(&ref->states[ref->n], s->n_beams)) {
 		t->failed = 1;
 		return;
 	}
@@ -78,12 +78,12 @@ int bsim_accuracy_reference_run(bsim_accuracy_reference *ref, const bsim_scene *
 		                      grid, scene->dt);
 	reference_trace t = {.ref = ref, .stride = stride};
 	bsim_recorder rec = {.stride = 1, .trace = reference_keep, .trace_user = &t};
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	if (!r)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	bsim_trial_result res;
 	int rc = bsim_trial_run(r, scene, b, opts, seed, &rec, &res, err);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	if (rc == BSIM_OK && t.failed)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory storing the reference");
 	if (rc == BSIM_OK && res.outcome == BSIM_UNSTABLE) {
@@ -138,14 +138,16 @@ static int consistency_piece(const bsim_accuracy_reference *ref, const bsim_scen
 	/* Step n of this h starts at t = n h: the piece starts at t_k. */
 	long n0 = lround(k * ref->grid / h);
 	double f[2];
-	for (long j = 0; j < m; j++) {
+	for (long j = 0; j < m && rc == BSIM_OK; j++) {
 		bsim_effects_force(&fx, n0 + j, h, f);
-		b->step(w, f, h);
+		rc = b->step(w, f, h, err);
 	}
+	if (rc == BSIM_OK)
+		rc = bsim_effects_status(&fx, err);
 	b->get_state(w, s);
 	bsim_effects_free(&fx);
 	b->destroy(w);
-	return BSIM_OK;
+	return rc;
 }
 
 int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_scene *scene,
@@ -166,7 +168,7 @@ int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_sce
 		                      "accuracy: the reference (%g s) is shorter than a piece",
 		                      (ref->n - 1) * ref->grid);
 	bsim_state s;
-	if (bsim_state_alloc(&s, scene->n_beams))
+	if (bsim_state_init(&s, scene->n_beams))
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	double sum = 0.0, worst = 0.0;
 	int rc = BSIM_OK;
@@ -188,63 +190,34 @@ int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_sce
 	return rc;
 }
 
-/* The knob grids. The first setting of each list is the reference's. */
-static const char *const thesis_settings[][2] = {
-        {"integrator=midpoint", "impact_order=simultaneous"},
-        {"integrator=midpoint", "impact_order=nearest_first"},
-        {"integrator=euler", "impact_order=simultaneous"},
-        {"integrator=euler", "impact_order=nearest_first"},
-};
-
 int bsim_accuracy_settings(const bsim_backend *b, bsim_accuracy_row **out, int *n, bsim_error *err)
 {
 	*out = NULL;
 	*n = 0;
-	int thesis = strcmp(b->name, "thesis") == 0, box2d = strcmp(b->name, "box2d") == 0;
-	if (!thesis && !box2d)
-		return bsim_error_set(
-		        err, BSIM_EINPUT,
-		        "accuracy: no knob grid for backend %s (known: thesis, box2d)", b->name);
-	static const int vel[] = {30, 8, 4}, sub[] = {4, 1};
-	static const char *const spring[] = {"torque", "weld"};
-	int count = thesis ? 4 : 12;
-	bsim_accuracy_row *rows = calloc((size_t)count, sizeof *rows);
+	if (b->n_accuracy < 1)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "accuracy: backend %s lists no knob settings to study",
+		                      b->name);
+	bsim_accuracy_row *rows = calloc((size_t)b->n_accuracy, sizeof *rows);
 	if (!rows)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (int i = 0; i < count; i++) {
+	for (int i = 0; i < b->n_accuracy; i++) {
 		bsim_accuracy_row *r = &rows[i];
 		r->backend = b->name;
 		r->reference = i == 0;
-		char kv[3][64];
-		int nkv;
-		if (thesis) {
-			snprintf(kv[0], sizeof kv[0], "%s", thesis_settings[i][0]);
-			snprintf(kv[1], sizeof kv[1], "%s", thesis_settings[i][1]);
-			nkv = 2;
-			snprintf(r->setting, sizeof r->setting, "%s %s", strchr(kv[0], '=') + 1,
-			         strchr(kv[1], '=') + 1);
-		} else { /* spring slowest-varying, then substeps, then iterations */
-			int vi = vel[i % 3], ss = sub[(i / 3) % 2];
-			const char *sp = spring[i / 6];
-			snprintf(kv[0], sizeof kv[0], "velocity_iterations=%d", vi);
-			snprintf(kv[1], sizeof kv[1], "substeps=%d", ss);
-			snprintf(kv[2], sizeof kv[2], "spring=%s", sp);
-			nkv = 3;
-			snprintf(r->setting, sizeof r->setting, "vi=%d sub=%d %s", vi, ss, sp);
+		snprintf(r->setting, sizeof r->setting, "%s", b->accuracy[i].name);
+		if (bsim_options_add_setting(&r->opts, &b->accuracy[i], err) != BSIM_OK) {
+			free(rows);
+			return BSIM_EINPUT;
 		}
-		for (int j = 0; j < nkv; j++)
-			if (bsim_options_add(&r->opts, kv[j], err)) {
-				free(rows);
-				return BSIM_EINPUT;
-			}
 	}
 	*out = rows;
-	*n = count;
+	*n = b->n_accuracy;
 	return BSIM_OK;
 }
 
 /* The batch of trials of one row: p_traverse, residual rate and cost. */
-static int row_batch(bsim_accuracy_row *row, bsim_runner *runner, const bsim_scene *scene,
+static int row_batch(bsim_accuracy_row *row, bsim_trial_runner *runner, const bsim_scene *scene,
                      const bsim_backend *b, const bsim_accuracy_config *cfg, bsim_error *err)
 {
 	int traversed = 0;
@@ -254,7 +227,7 @@ static int row_batch(bsim_accuracy_row *row, bsim_runner *runner, const bsim_sce
 		bsim_trial_result res;
 		bsim_error e;
 		int rc = bsim_trial_run(runner, scene, b, &row->opts,
-		                        bsim_seed_mix(cfg->seed, 0, t), NULL, &res, &e);
+		                        bsim_schedule_seed_mix(cfg->seed, 0, t), NULL, &res, &e);
 		if (rc) {
 			*err = e;
 			return rc;
@@ -287,16 +260,16 @@ static int row_run(bsim_accuracy_row *row, const bsim_accuracy_reference *ref,
 	if (rc)
 		return rc;
 	double t0 = bsim_clock_seconds();
-	rc = bsim_accuracy_consistency(ref, &sc, b, &row->opts, bsim_seed_mix(cfg->seed, 0, 0),
-	                               cfg->piece, cfg->n_pieces, &row->err_mean, &row->err_max,
-	                               err);
+	rc = bsim_accuracy_consistency(ref, &sc, b, &row->opts,
+	                               bsim_schedule_seed_mix(cfg->seed, 0, 0), cfg->piece,
+	                               cfg->n_pieces, &row->err_mean, &row->err_max, err);
 	row->wall_seconds = bsim_clock_seconds() - t0;
-	bsim_runner *runner = rc ? NULL : bsim_runner_alloc();
+	bsim_trial_runner *runner = rc ? NULL : bsim_trial_runner_alloc();
 	if (!rc && !runner)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (!rc)
 		rc = row_batch(row, runner, &sc, b, cfg, err);
-	bsim_runner_free(runner);
+	bsim_trial_runner_free(runner);
 	bsim_scene_free(&sc);
 	return rc;
 }
@@ -371,8 +344,8 @@ int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backen
 		rc = scene_at_step(&sc, scene, cfg->h_ref, err);
 		if (rc == BSIM_OK) {
 			rc = bsim_accuracy_reference_run(&refs[bi], &sc, backends[bi], &set[0].opts,
-			                                 bsim_seed_mix(cfg->seed, 0, 0), cfg->h_max,
-			                                 err);
+			                                 bsim_schedule_seed_mix(cfg->seed, 0, 0),
+			                                 cfg->h_max, err);
 			bsim_scene_free(&sc);
 		}
 		free(set);
@@ -410,11 +383,9 @@ int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backen
 				}
 				done++;
 				if (cfg->progress)
-					fprintf(stderr, "\raccuracy: %d/%d settings", done, out->n);
+					cfg->progress(cfg->progress_user, done, out->n);
 			}
 		}
-		if (cfg->progress)
-			fputc('\n', stderr);
 		if (failed) {
 			rc = failed;
 			if (err)

@@ -1,7 +1,7 @@
 /* Whole-or-nothing files; see beamsim/atomic_file.h. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 
 #include <errno.h>
 #include <string.h>

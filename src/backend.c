@@ -1,4 +1,4 @@
-/* The backend registry and the state buffers every backend fills. */
+/* The backend registry. */
 #include "beamsim/backend.h"
 
 #include <stdlib.h>
@@ -10,9 +10,14 @@ static const bsim_backend *const registry[] = {
         NULL,
 };
 
-const bsim_backend *const *bsim_backends(void)
+const bsim_backend *const *bsim_backend_list(void)
 {
 	return registry;
+}
+
+const bsim_backend *bsim_backend_default(void)
+{
+	return &bsim_backend_thesis;
 }
 
 const bsim_backend *bsim_backend_find(const char *name, bsim_error *err)
@@ -28,59 +33,4 @@ const bsim_backend *bsim_backend_find(const char *name, bsim_error *err)
 	bsim_error_set(err, BSIM_EINPUT, "--backend %s: unknown backend (expected one of %s)", name,
 	               known);
 	return NULL;
-}
-
-int bsim_state_alloc(bsim_state *s, int n_beams)
-{
-	memset(s, 0, sizeof *s);
-	s->n_beams = n_beams;
-	size_t n = n_beams > 0 ? (size_t)n_beams : 1;
-	s->theta = calloc(n, sizeof *s->theta);
-	s->omega = calloc(n, sizeof *s->omega);
-	s->contact = calloc(n, sizeof *s->contact);
-	s->active = calloc(n, sizeof *s->active);
-	if (!s->theta || !s->omega || !s->contact || !s->active) {
-		bsim_state_free(s);
-		return BSIM_EFAIL;
-	}
-	return BSIM_OK;
-}
-
-void bsim_state_free(bsim_state *s)
-{
-	free(s->theta);
-	free(s->omega);
-	free(s->contact);
-	free(s->active);
-	memset(s, 0, sizeof *s);
-}
-
-void bsim_state_copy(bsim_state *dst, const bsim_state *src)
-{
-	int n = src->n_beams < dst->n_beams ? src->n_beams : dst->n_beams;
-	memcpy(dst->x, src->x, sizeof dst->x);
-	memcpy(dst->v, src->v, sizeof dst->v);
-	memcpy(dst->theta, src->theta, (size_t)n * sizeof *dst->theta);
-	memcpy(dst->omega, src->omega, (size_t)n * sizeof *dst->omega);
-	memcpy(dst->contact, src->contact, (size_t)n * sizeof *dst->contact);
-	dst->n_active = 0;
-	for (int k = 0; k < src->n_active; k++)
-		if (src->active[k] < dst->n_beams)
-			dst->active[dst->n_active++] = src->active[k];
-	dst->energy = src->energy;
-	dst->impacts = src->impacts;
-}
-
-void bsim_state_set_active(bsim_state *s, const int *active, int n)
-{
-	for (int k = 0; k < s->n_active; k++) {
-		int i = s->active[k];
-		s->theta[i] = 0.0;
-		s->omega[i] = 0.0;
-		s->contact[i] = BSIM_CONTACT_NONE;
-	}
-	s->n_active = 0;
-	for (int k = 0; k < n; k++)
-		if (active[k] >= 0 && active[k] < s->n_beams)
-			s->active[s->n_active++] = active[k];
 }

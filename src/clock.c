@@ -1,6 +1,6 @@
 #define _POSIX_C_SOURCE 200809L
 
-#include "beamsim/clock.h"
+#include "clock.h"
 
 #include <time.h>
 

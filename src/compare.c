@@ -34,12 +34,17 @@
 static const char *const event_names[BSIM_N_EVENTS] = {"traversed", "left",  "right",
                                                        "side_exit", "stuck", "unstable"};
 
-const char *bsim_event_name(bsim_event ev)
+bsim_compare_rule bsim_compare_rule_default(void)
+{
+	return (bsim_compare_rule){.alpha = 0.05, .margin = 0.05, .exact = 0};
+}
+
+const char *bsim_compare_event_name(bsim_event ev)
 {
 	return ev >= 0 && ev < BSIM_N_EVENTS ? event_names[ev] : "?";
 }
 
-int bsim_event_of(const bsim_trial_result *r, bsim_event ev)
+int bsim_compare_event_of(const bsim_trial_result *r, bsim_event ev)
 {
 	switch (ev) {
 	case BSIM_EVENT_TRAVERSED:
@@ -59,7 +64,7 @@ int bsim_event_of(const bsim_trial_result *r, bsim_event ev)
 	}
 }
 
-const char *bsim_verdict_name(bsim_verdict v)
+const char *bsim_compare_verdict_name(bsim_verdict v)
 {
 	switch (v) {
 	case BSIM_VERDICT_SAME:
@@ -80,16 +85,17 @@ const char *bsim_verdict_name(bsim_verdict v)
 	return "?";
 }
 
-int bsim_trial_discordant(const bsim_trial_result *a, const bsim_trial_result *b)
+int bsim_compare_discordant(const bsim_trial_result *a, const bsim_trial_result *b)
 {
 	return a->outcome != b->outcome || a->type != b->type ||
-	       !bsim_location_equal(bsim_location_of(a), bsim_location_of(b));
+	       !bsim_lattice_location_equal(bsim_lattice_location_of(a),
+	                                    bsim_lattice_location_of(b));
 }
 
-int bsim_trial_identical(const bsim_trial_result *a, const bsim_trial_result *b, int ledger)
+int bsim_compare_identical(const bsim_trial_result *a, const bsim_trial_result *b, int ledger)
 {
 	const bsim_ledger *la = &a->ledger, *lb = &b->ledger;
-	int same = !bsim_trial_discordant(a, b) && a->steps == b->steps && a->t_end == b->t_end &&
+	int same = !bsim_compare_discordant(a, b) && a->steps == b->steps && a->t_end == b->t_end &&
 	           a->x_end == b->x_end && a->y_end == b->y_end && a->vx_end == b->vx_end &&
 	           a->max_theta[0] == b->max_theta[0] && a->max_theta[1] == b->max_theta[1] &&
 	           a->final_ix == b->final_ix && a->final_iy == b->final_iy;
@@ -107,7 +113,7 @@ static void event_table(const bsim_trial_result *a, const bsim_trial_result *b, 
 {
 	memset(t, 0, sizeof *t);
 	for (int i = 0; i < n; i++) {
-		int x = bsim_event_of(&a[i], ev), y = bsim_event_of(&b[i], ev);
+		int x = bsim_compare_event_of(&a[i], ev), y = bsim_compare_event_of(&b[i], ev);
 		t->pairs.a += x && y;
 		t->pairs.b += x && !y;
 		t->pairs.c += !x && y;
@@ -123,11 +129,11 @@ static void event_table(const bsim_trial_result *a, const bsim_trial_result *b, 
 static void event_stats(bsim_event_test *t, int n, double margin)
 {
 	int ka = t->pairs.a + t->pairs.b, kb = t->pairs.a + t->pairs.c;
-	bsim_wilson(ka, n, BSIM_Z95, &t->ci_a[0], &t->ci_a[1]);
-	bsim_wilson(kb, n, BSIM_Z95, &t->ci_b[0], &t->ci_b[1]);
-	bsim_tango_ci(&t->pairs, BSIM_Z95, &t->diff_ci[0], &t->diff_ci[1]);
-	t->p_value = bsim_mcnemar_exact(t->pairs.b, t->pairs.c);
-	t->p_equivalence = bsim_tango_tost(&t->pairs, margin);
+	bsim_stats_wilson(ka, n, BSIM_STATS_Z95, &t->ci_a[0], &t->ci_a[1]);
+	bsim_stats_wilson(kb, n, BSIM_STATS_Z95, &t->ci_b[0], &t->ci_b[1]);
+	bsim_stats_tango_ci(&t->pairs, BSIM_STATS_Z95, &t->diff_ci[0], &t->diff_ci[1]);
+	t->p_value = bsim_stats_mcnemar_exact(t->pairs.b, t->pairs.c);
+	t->p_equivalence = bsim_stats_tango_tost(&t->pairs, margin);
 }
 
 /* A deterministic group's event: the one pair, no statistics. */
@@ -146,13 +152,13 @@ static double event_detectable(const bsim_event_test *t, int n, double level)
 {
 	int m = t->pairs.b + t->pairs.c;
 	int fewest = 1;
-	while (fewest <= n && bsim_mcnemar_split(fewest, level) < 0)
+	while (fewest <= n && bsim_stats_mcnemar_split(fewest, level) < 0)
 		fewest++;
 	if (fewest > n)
 		return NAN;
 	if (m < fewest)
 		m = fewest;
-	int k = bsim_mcnemar_split(m, level);
+	int k = bsim_stats_mcnemar_split(m, level);
 	return (double)(m - 2 * k) / n;
 }
 
@@ -195,8 +201,8 @@ static long swap_pair(long *diff, int ca, int cb, long t)
 	return t + labs(diff[ca]) + labs(diff[cb]);
 }
 
-void bsim_location_test_run(const bsim_trial_result *a, const bsim_trial_result *b, int n,
-                            uint64_t seed, bsim_location_test *out)
+void bsim_compare_location_test(const bsim_trial_result *a, const bsim_trial_result *b, int n,
+                                uint64_t seed, bsim_location_test *out)
 {
 	memset(out, 0, sizeof *out);
 	out->p_value = out->p_holm = 1.0;
@@ -208,8 +214,8 @@ void bsim_location_test_run(const bsim_trial_result *a, const bsim_trial_result 
 	if (!locs || !ca || !cb || !diff || !work)
 		goto done;
 	for (int i = 0; i < n; i++) {
-		locs[2 * i] = bsim_location_of(&a[i]);
-		locs[2 * i + 1] = bsim_location_of(&b[i]);
+		locs[2 * i] = bsim_lattice_location_of(&a[i]);
+		locs[2 * i + 1] = bsim_lattice_location_of(&b[i]);
 	}
 	qsort(locs, 2 * (size_t)n, sizeof *locs, location_sort_cmp);
 	int m = 0;
@@ -218,8 +224,8 @@ void bsim_location_test_run(const bsim_trial_result *a, const bsim_trial_result 
 			locs[m++] = locs[i];
 	int d = 0;
 	for (int i = 0; i < n; i++) {
-		int x = location_index(locs, m, bsim_location_of(&a[i]));
-		int y = location_index(locs, m, bsim_location_of(&b[i]));
+		int x = location_index(locs, m, bsim_lattice_location_of(&a[i]));
+		int y = location_index(locs, m, bsim_lattice_location_of(&b[i]));
 		diff[x]++;
 		diff[y]--;
 		if (x != y) {
@@ -364,7 +370,7 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 	if (!out->groups || !p || !buf) {
 		free(p);
 		free(buf);
-		bsim_comparison_free(out);
+		bsim_compare_free(out);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory comparing %d groups", G);
 	}
 	int n_sep = 0;
@@ -386,16 +392,16 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 			}
 		}
 		if (out->lattice && !cg->deterministic) {
-			bsim_location_test_run(ra, rb, cg->pairs, 0x5eed0000u + (uint64_t)g,
-			                       &cg->loc);
+			bsim_compare_location_test(ra, rb, cg->pairs, 0x5eed0000u + (uint64_t)g,
+			                           &cg->loc);
 			p[out->n_tests++] = cg->loc.p_value;
 		}
 		for (int i = 0; i < cg->pairs; i++)
-			cg->discordant += bsim_trial_discordant(&ra[i], &rb[i]);
+			cg->discordant += bsim_compare_discordant(&ra[i], &rb[i]);
 		/* Over every trial, copies included: a stored file edited in
 		 * any row is a change. */
 		for (int i = 0; i < n; i++)
-			cg->changed += !bsim_trial_identical(&ra[i], &rb[i], ledger);
+			cg->changed += !bsim_compare_identical(&ra[i], &rb[i], ledger);
 		out->pairs += cg->pairs;
 		cg->t_sep[0] = cg->t_sep[1] = cg->t_sep[2] = -1.0;
 		if (t_separate) {
@@ -403,7 +409,7 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 			quantiles(buf, cg->separated, cg->t_sep);
 		}
 	}
-	bsim_holm(p, out->n_tests, p);
+	bsim_stats_holm(p, out->n_tests, p);
 	double level = out->n_tests > 0 ? rule->alpha / out->n_tests : rule->alpha;
 	for (int g = 0, k = 0; g < G; g++) {
 		bsim_compare_group *cg = &out->groups[g];
@@ -431,7 +437,7 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 	return BSIM_OK;
 }
 
-void bsim_comparison_free(bsim_comparison *c)
+void bsim_compare_free(bsim_comparison *c)
 {
 	if (!c)
 		return;

@@ -59,6 +59,11 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	return BSIM_OK;
 }
 
+int bsim_effects_status(const bsim_effects *fx, bsim_error *err)
+{
+	return fx->random ? bsim_schedule_status(fx->random->schedule, err) : BSIM_OK;
+}
+
 void bsim_effects_free(bsim_effects *fx)
 {
 	for (int i = 0; i < fx->n; i++)

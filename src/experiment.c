@@ -193,6 +193,15 @@ static int walk_key(const ydoc *d, const char *name, struct fy_node *k, struct f
 		return walk_set(d, v, k, e, err);
 	if (!strcmp(name, "grid"))
 		return walk_grid(d, v, k, e, err);
+	/* A scene given where an experiment belongs (beamsim sweep SCENE). */
+	struct fy_node *root = fy_document_root(d->fyd);
+	if (ydoc_pair(root, "body", 4) &&
+	    (ydoc_pair(root, "beams", 5) || ydoc_pair(root, "lattice", 7)))
+		return ydoc_fail(
+		        d, k, NULL, name, err,
+		        "this is a scene file (body: and beams: or lattice:), not an "
+		        "experiment: run it with beamsim run, or name it in an experiment's "
+		        "scene: with a grid:");
 	return ydoc_fail(d, k, NULL, name, err, "unknown key (expected one of %s)",
 	                 experiment_keys);
 }

@@ -26,7 +26,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 #include "beamsim/version.h"
 
 bsim_figure_def bsim_figure_default(void)

@@ -10,7 +10,7 @@
 
 #include <stdio.h>
 
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 #include "beamsim/figures.h"
 #include "beamsim/scene.h"
 #include "csv_table.h"

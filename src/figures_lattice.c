@@ -279,7 +279,7 @@ static void fraction(const flat *a, int k, double v[3])
 		v[1] = v[2] = v[0];
 		return;
 	}
-	bsim_wilson(k, n, BSIM_Z95, &v[1], &v[2]);
+	bsim_stats_wilson(k, n, BSIM_STATS_Z95, &v[1], &v[2]);
 }
 
 static int sum_ints(const int *x, int n)
@@ -456,7 +456,7 @@ static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
 					continue;
 				const bsim_beam_def *b = &sc->beams[i];
 				double u[2];
-				bsim_beam_rest_direction(b, u);
+				bsim_scene_beam_rest_direction(b, u);
 				fprintf(o.f, "%.10g %.10g %.10g %.10g\n", b->pivot[0], b->pivot[1],
 				        b->length * u[0], b->length * u[1]);
 			}

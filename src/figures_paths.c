@@ -157,7 +157,7 @@ static void scene_objects(FILE *f, const bsim_scene *s)
 	for (int i = 0; i < s->n_beams; i++) {
 		const bsim_beam_def *b = &s->beams[i];
 		double u[2];
-		bsim_beam_rest_direction(b, u);
+		bsim_scene_beam_rest_direction(b, u);
 		fprintf(f,
 		        "set arrow from %g,%g to %g,%g nohead front lw 3 lc rgb '%s'\n"
 		        "set object circle at %g,%g size 0.9 front fc rgb '%s' fs solid 1.0\n",

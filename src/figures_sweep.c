@@ -254,8 +254,8 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 				if (lattice) {
 					/* a group without random force: points */
 					const int point = G->lo == G->hi && G->trials > 1;
-					bsim_wilson(G->side_exit, G->trials, BSIM_Z95, &ll, &lh);
-					bsim_wilson(G->stuck, G->trials, BSIM_Z95, &rl, &rh);
+					bsim_stats_wilson(G->side_exit, G->trials, BSIM_STATS_Z95, &ll, &lh);
+					bsim_stats_wilson(G->stuck, G->trials, BSIM_STATS_Z95, &rl, &rh);
 					if (point) {
 						ll = lh = G->side_exit / n;
 						rl = rh = G->stuck / n;
@@ -267,8 +267,8 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 					        G->stuck / n, rl, rh);
 					continue;
 				}
-				bsim_wilson(G->left, G->trials, BSIM_Z95, &ll, &lh);
-				bsim_wilson(G->right, G->trials, BSIM_Z95, &rl, &rh);
+				bsim_stats_wilson(G->left, G->trials, BSIM_STATS_Z95, &ll, &lh);
+				bsim_stats_wilson(G->right, G->trials, BSIM_STATS_Z95, &rl, &rh);
 				fprintf(o.f,
 				        "%.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g "
 				        "%.6g\n",

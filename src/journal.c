@@ -1,7 +1,7 @@
 /* The journal of finished work; see beamsim/journal.h. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "beamsim/journal.h"
+#include "journal.h"
 
 #include <errno.h>
 #include <fcntl.h>

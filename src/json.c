@@ -1,6 +1,7 @@
 /* JSON leaf values; see beamsim/json.h. */
-#include "beamsim/json.h"
+#include "json.h"
 
+#include <inttypes.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -54,4 +55,12 @@ void bsim_json_number(FILE *f, double x)
 			break;
 	}
 	fputs(buf, f);
+}
+
+void bsim_json_u64(FILE *f, uint64_t x)
+{
+	if (x <= (UINT64_C(1) << 53))
+		fprintf(f, "%" PRIu64, x);
+	else
+		fprintf(f, "\"%" PRIu64 "\"", x);
 }

@@ -12,8 +12,8 @@
 double bsim_landscape_theta(const bsim_beam_def *b, double radius, const double c[2])
 {
 	double u0[2];
-	bsim_beam_rest_direction(b, u0);
-	const double sgn = bsim_beam_forward_sign(b);
+	bsim_scene_beam_rest_direction(b, u0);
+	const double sgn = bsim_scene_beam_forward_sign(b);
 	const double dx = c[0] - b->pivot[0], dy = c[1] - b->pivot[1];
 	const double along = u0[0] * dx + u0[1] * dy;       /* rho cos(phi) */
 	const double fwd = sgn * (u0[0] * dy - u0[1] * dx); /* rho sin(phi) */

@@ -969,7 +969,7 @@ static int pass_copy(bsim_landscape_pass *to, const bsim_landscape_pass *from, b
 
 /* ---- Public ----------------------------------------------------------------- */
 
-const char *bsim_pass_kind_name(bsim_pass_kind k)
+const char *bsim_landscape_pass_kind_name(bsim_pass_kind k)
 {
 	static const char *names[] = {"none", "open", "saddle"};
 	return (unsigned)k < 3 ? names[k] : "?";

@@ -20,8 +20,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "figure.h"
 #include "mat.h"
 
@@ -139,7 +139,7 @@ static int write_mat(const char *dir, const bsim_scene *s, const bsim_landscape_
 		for (int c = 0; c < TABLE_COLUMNS; c++)
 			tab[(size_t)c * (size_t)rows + (size_t)r] =
 			        p->kind == BSIM_PASS_NONE && c >= 2 && c < 17 ? NAN : v[c];
-		kinds[r] = bsim_pass_kind_name(p->kind);
+		kinds[r] = bsim_landscape_pass_kind_name(p->kind);
 	}
 	bsim_mat_field tcols[TABLE_COLUMNS + 1];
 	for (int c = 0; c < TABLE_COLUMNS; c++)
@@ -195,7 +195,7 @@ static void json_point(FILE *f, const char *key, double x, double y, double e)
 static void json_pass(FILE *f, const bsim_landscape_pass *p)
 {
 	fputs("{\"kind\": ", f);
-	bsim_json_string(f, bsim_pass_kind_name(p->kind));
+	bsim_json_string(f, bsim_landscape_pass_kind_name(p->kind));
 	fputs(", \"crossed\": ", f);
 	if (p->beam >= 0)
 		fprintf(f, "%d", p->beam + 1);
@@ -444,7 +444,7 @@ static void draw_beams(FILE *f, const bsim_scene *s, const bsim_landscape_barrie
 	for (int b = 0; b < s->n_beams; b++) {
 		const bsim_beam_def *d = &s->beams[b];
 		double u0[2];
-		bsim_beam_rest_direction(d, u0);
+		bsim_scene_beam_rest_direction(d, u0);
 		fprintf(f,
 		        "set object circle at %.6g,%.6g size %.6g fs empty border lc rgb '#bbbbbb' "
 		        "dt 2 lw 1 front\n",
@@ -473,8 +473,8 @@ static void draw_beams(FILE *f, const bsim_scene *s, const bsim_landscape_barrie
 		if (th <= 0.0)
 			continue;
 		double u0[2];
-		bsim_beam_rest_direction(d, u0);
-		const double sg = bsim_beam_forward_sign(d), ct = cos(th), st = sin(th);
+		bsim_scene_beam_rest_direction(d, u0);
+		const double sg = bsim_scene_beam_forward_sign(d), ct = cos(th), st = sin(th);
 		/* u0 turned by th in the forward sense */
 		const double ux = ct * u0[0] - sg * st * u0[1], uy = sg * st * u0[0] + ct * u0[1];
 		fprintf(f,

@@ -34,7 +34,7 @@ static int clamp_int(double v, int lo, int hi)
 	return (int)v;
 }
 
-void bsim_scene_gate_at(const bsim_scene *s, const double p[2], int *ix, int *iy)
+void bsim_lattice_gate_at(const bsim_scene *s, const double p[2], int *ix, int *iy)
 {
 	if (!s->has_lattice) {
 		*ix = *iy = 0;
@@ -45,7 +45,7 @@ void bsim_scene_gate_at(const bsim_scene *s, const double p[2], int *ix, int *iy
 	*iy = clamp_int(floor(p[1] / l->depth), 0, l->rows - 1);
 }
 
-double bsim_scene_centre_x(const bsim_scene *s)
+double bsim_lattice_centre_x(const bsim_scene *s)
 {
 	if (!s->has_lattice)
 		return 0.0;
@@ -94,7 +94,7 @@ void scene_lattice_defaults(bsim_scene *s)
 	s->max_steps = s->gate_steps * (l->rows + l->columns);
 }
 
-int bsim_scene_init_lattice(bsim_scene *s, int columns, int rows, double f_prop, double rm)
+int bsim_lattice_scene_init(bsim_scene *s, int columns, int rows, double f_prop, double rm)
 {
 	bsim_scene_init_gate(s, f_prop, rm);
 	bsim_lattice_def *l = &s->lattice;
@@ -113,7 +113,7 @@ int bsim_scene_init_lattice(bsim_scene *s, int columns, int rows, double f_prop,
 	return rc;
 }
 
-bsim_location bsim_location_of(const bsim_trial_result *r)
+bsim_location bsim_lattice_location_of(const bsim_trial_result *r)
 {
 	bsim_location loc = {BSIM_LOCATION_STUCK, r->final_ix, r->final_iy};
 	if (r->outcome == BSIM_TRAVERSED) {
@@ -126,12 +126,12 @@ bsim_location bsim_location_of(const bsim_trial_result *r)
 	return loc;
 }
 
-int bsim_location_equal(bsim_location a, bsim_location b)
+int bsim_lattice_location_equal(bsim_location a, bsim_location b)
 {
 	return a.kind == b.kind && a.ix == b.ix && a.iy == b.iy;
 }
 
-void bsim_location_label(bsim_location loc, char *buf, size_t size)
+void bsim_lattice_location_label(bsim_location loc, char *buf, size_t size)
 {
 	switch (loc.kind) {
 	case BSIM_LOCATION_END:
@@ -230,13 +230,14 @@ int bsim_lattice_summarise(const bsim_trial_result *trials, const bsim_trial_log
 	}
 	/* final locations */
 	for (int i = 0; i < n; i++) {
-		out->locations[i].loc = bsim_location_of(&trials[i]);
+		out->locations[i].loc = bsim_lattice_location_of(&trials[i]);
 		out->locations[i].count = 1;
 	}
 	qsort(out->locations, (size_t)n, sizeof *out->locations, location_count_cmp);
 	int m = 0;
 	for (int i = 0; i < n; i++) {
-		if (m > 0 && bsim_location_equal(out->locations[m - 1].loc, out->locations[i].loc))
+		if (m > 0 &&
+		    bsim_lattice_location_equal(out->locations[m - 1].loc, out->locations[i].loc))
 			out->locations[m - 1].count++;
 		else
 			out->locations[m++] = out->locations[i];
@@ -245,7 +246,7 @@ int bsim_lattice_summarise(const bsim_trial_result *trials, const bsim_trial_log
 	for (int k = 0; k < m; k++) {
 		bsim_location_count *c = &out->locations[k];
 		c->p = n > 0 ? (double)c->count / n : 0.0;
-		bsim_wilson(c->count, n, BSIM_Z95, &c->ci95[0], &c->ci95[1]);
+		bsim_stats_wilson(c->count, n, BSIM_STATS_Z95, &c->ci95[0], &c->ci95[1]);
 	}
 	/* transitions and time per row */
 	int s = 0;

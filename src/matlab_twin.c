@@ -5,7 +5,7 @@
  * YAML), the reader of every other beamsim input; a number is a plain
  * scalar that reads as one, so a quoted "7" stays text. */
 #define _POSIX_C_SOURCE 200809L
-#include "beamsim/matlab.h"
+#include "matlab.h"
 
 #include <math.h>
 #include <stdio.h>

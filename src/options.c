@@ -1,9 +1,10 @@
 /* Backend options: `--backend-opt key=value` pairs, checked against the
  * backend's knob table and read with the knob's default. */
-#include "beamsim/backend.h"
+#include "beamsim/options.h"
 
 #include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -136,4 +137,33 @@ int bsim_options_choice(const bsim_options *opts, const bsim_knob *knob)
 	const char *v = bsim_options_get(opts, knob->name);
 	int i = v ? choice_index(knob->choices, v) : -1;
 	return i >= 0 ? i : choice_index(knob->choices, knob->default_value);
+}
+
+void bsim_options_effective(const bsim_knob *knobs, int n_knobs, const bsim_options *given,
+                            bsim_options *out)
+{
+	*out = given ? *given : (bsim_options){0};
+	for (int i = 0; i < n_knobs && out->n < BSIM_OPTIONS_MAX; i++) {
+		if (bsim_options_get(out, knobs[i].name) || !knobs[i].default_value)
+			continue;
+		snprintf(out->key[out->n], sizeof out->key[0], "%s", knobs[i].name);
+		snprintf(out->value[out->n], sizeof out->value[0], "%s", knobs[i].default_value);
+		out->n++;
+	}
+}
+
+int bsim_options_add_setting(bsim_options *opts, const bsim_knob_setting *setting, bsim_error *err)
+{
+	for (const char *p = setting->options; *p;) {
+		size_t len = strcspn(p, ":");
+		char kv[128];
+		if (len >= sizeof kv)
+			return bsim_error_set(err, BSIM_EINPUT, "setting %s: option too long",
+			                      setting->name);
+		snprintf(kv, sizeof kv, "%.*s", (int)len, p);
+		if (bsim_options_add(opts, kv, err) != BSIM_OK)
+			return BSIM_EINPUT;
+		p += len + (p[len] == ':');
+	}
+	return BSIM_OK;
 }

@@ -8,7 +8,7 @@
  * kernel drops it when the process dies, however it dies. */
 #define _DEFAULT_SOURCE
 
-#include "beamsim/outdir.h"
+#include "outdir.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -22,8 +22,8 @@
 
 #include <zlib.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "beamsim/version.h"
 #include "yaml_doc.h"
 

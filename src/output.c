@@ -13,8 +13,9 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "trials_csv.h"
+#include "json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/version.h"
 
@@ -43,6 +44,51 @@ static void json_member(FILE *f, int *first, const char *key, const char *value)
 	*first = 0;
 }
 
+/* 1 if s is a number as JSON writes one: -?(0|[1-9][0-9]*)(.[0-9]+)?([eE][+-]?[0-9]+)? */
+static int json_number_text(const char *s)
+{
+	const char *p = s + (*s == '-');
+	if (*p == '0')
+		p++;
+	else if (*p >= '1' && *p <= '9')
+		p += strspn(p, "0123456789");
+	else
+		return 0;
+	if (*p == '.') {
+		size_t n = strspn(p + 1, "0123456789");
+		if (n == 0)
+			return 0;
+		p += 1 + n;
+	}
+	if (*p == 'e' || *p == 'E') {
+		p += 1 + (p[1] == '+' || p[1] == '-');
+		size_t n = strspn(p, "0123456789");
+		if (n == 0)
+			return 0;
+		p += n;
+	}
+	return *p == '\0';
+}
+
+/* A knob's value: a number where the knob is a number (as given, if JSON
+ * can read it so: "1e-6" stays 1e-6), else a string. */
+static void json_knob(FILE *f, int *first, const bsim_knob *k, const char *value)
+{
+	double x;
+	if (k->type == BSIM_KNOB_CHOICE || !text_number(value, &x)) {
+		json_member(f, first, k->name, value);
+		return;
+	}
+	fputs(*first ? "" : ", ", f);
+	bsim_json_string(f, k->name);
+	fputs(": ", f);
+	if (json_number_text(value))
+		fputs(value, f);
+	else
+		bsim_json_number(f, x);
+	*first = 0;
+}
+
 /* Knobs first, in the backend's order, so records of one backend line up;
  * then any option the backend does not list (none once checked), so
  * nothing given is hidden. */
@@ -54,7 +100,7 @@ void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_opti
 		const char *v = bsim_options_get(opts, b->knobs[i].name);
 		if (!v)
 			v = b->knobs[i].default_value ? b->knobs[i].default_value : "";
-		json_member(f, &first, b->knobs[i].name, v);
+		json_knob(f, &first, &b->knobs[i], v);
 	}
 	for (int i = 0; opts && i < opts->n; i++) {
 		int known = 0;
@@ -109,7 +155,7 @@ static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 	for (int k = 0; k < ls.n_locations; k++) {
 		const bsim_location_count *c = &ls.locations[k];
 		char label[48];
-		bsim_location_label(c->loc, label, sizeof label);
+		bsim_lattice_location_label(c->loc, label, sizeof label);
 		static const char *const kinds[] = {"end", "side", "stuck"};
 		fprintf(f, "%s{\"location\": \"%s\", \"kind\": \"%s\", \"ix\": ", k ? ", " : "",
 		        label, kinds[c->loc.kind]);
@@ -150,6 +196,13 @@ static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 	bsim_lattice_summary_free(&ls);
 }
 
+/* What the backend's solvers gave up on (beamsim/state.h). */
+static void json_solver(FILE *f, const bsim_solver_counts *c)
+{
+	fprintf(f, ", \"solver\": {\"iteration_limit\": %ld, \"clamped\": %ld}", c->iteration_limit,
+	        c->clamped);
+}
+
 static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int group,
                        int *idx)
 {
@@ -170,6 +223,7 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 	        "\"steps\": %ld, \"unstable\": %d, \"deterministic\": %s",
 	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps, g->unstable,
 	        g->deterministic ? "true" : "false");
+	json_solver(f, &g->solver);
 	if (r->lattice)
 		json_lattice(f, r, group);
 	fputc('}', f);
@@ -204,9 +258,15 @@ static void json_summary(FILE *f, const bsim_experiment *e, const char *backend,
 	bsim_output_backend_options(f, bsim_backend_find(backend, NULL), opts);
 	fputs(",\n  \"experiment\": ", f);
 	bsim_json_string(f, e->path);
-	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d", e->seed, r->trials);
+	fputs(",\n  \"seed\": ", f);
+	bsim_json_u64(f, e->seed);
+	fprintf(f, ",\n  \"trials_per_group\": %d", r->trials);
 	fprintf(f, ",\n  \"wall_seconds\": %.3f", r->wall_seconds);
 	json_groups(f, e, r, idx);
+	fputs(",\n  \"totals\": {\"steps\": ", f);
+	fprintf(f, "%ld, \"trials_run\": %ld", r->total_steps, r->trials_run);
+	json_solver(f, &r->solver);
+	fputc('}', f);
 	fputs(",\n  \"version\": ", f);
 	bsim_json_string(f, BSIM_VERSION);
 	fputs(",\n  \"scene\": ", f);
@@ -256,6 +316,12 @@ static void csv_number(FILE *f, double x)
 		fprintf(f, "%.10g", x);
 }
 
+const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
+        "group",  "trial",    "outcome",     "type",       "steps",    "t_end",    "x_end",
+        "y_end",  "vx_end",   "max_theta1",  "max_theta2", "e_start",  "e_end",    "work_in",
+        "losses", "residual", "overlap_max", "final_ix",   "final_iy", "location", "path",
+};
+
 int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
                            bsim_error *err)
 {
@@ -264,9 +330,8 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 		return BSIM_EFAIL;
 	int axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
 	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
-	fputs("group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"
-	      "e_start,e_end,work_in,losses,residual,overlap_max,final_ix,final_iy,location,path",
-	      o.f);
+	for (int c = 0; c < TRIALS_N_COLUMNS; c++)
+		fprintf(o.f, "%s%s", c ? "," : "", bsim_trials_csv_columns[c]);
 	for (int a = 0; a < axes; a++) {
 		fputc(',', o.f);
 		csv_field(o.f, e->axes[a].key);
@@ -280,8 +345,8 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 			const bsim_trial_result *x = &r->trials_out[i];
 			const bsim_ledger *l = &x->ledger;
 			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", g, t,
-			        bsim_outcome_name(x->outcome), bsim_type_name(x->type), x->steps,
-			        x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
+			        bsim_trial_outcome_name(x->outcome), bsim_trial_type_name(x->type),
+			        x->steps, x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
 			        x->max_theta[1]);
 			/* losses: sleeping's and the essay protocol's resets too, so that
 			 * e_end - e_start = work_in - losses + residual */
@@ -294,7 +359,8 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 			/* the final gate and location, and the gates entered in order:
 			 * "ix:iy ix:iy ..." */
 			char label[48];
-			bsim_location_label(bsim_location_of(x), label, sizeof label);
+			bsim_lattice_location_label(bsim_lattice_location_of(x), label,
+			                            sizeof label);
 			fprintf(o.f, ",%d,%d,%s,", x->final_ix, x->final_iy, label);
 			const bsim_trial_log *tl = r->logs ? &r->logs[i] : NULL;
 			for (int k = 0; tl && k < tl->n_entries; k++)

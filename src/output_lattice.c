@@ -19,9 +19,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 #include "beamsim/lattice.h"
-#include "beamsim/matlab.h"
+#include "matlab.h"
 #include "beamsim/output.h"
 
 typedef int (*lattice_writer)(FILE *f, const bsim_experiment *e, const bsim_override *extra,
@@ -72,7 +72,7 @@ static int write_summaries(FILE *f, const bsim_sweep_result *r, int transitions,
 		for (int k = 0; !transitions && k < ls.n_locations; k++) {
 			const bsim_location_count *c = &ls.locations[k];
 			char label[48];
-			bsim_location_label(c->loc, label, sizeof label);
+			bsim_lattice_location_label(c->loc, label, sizeof label);
 			fprintf(f, "%d,%s,%s,", g, label, kinds[c->loc.kind]);
 			if (c->loc.kind != BSIM_LOCATION_SIDE)
 				fprintf(f, "%d", c->loc.ix);
@@ -124,8 +124,8 @@ static int write_entries(FILE *f, const bsim_experiment *e, const bsim_override 
 				        "%d,%d,%d,%d,%d,%s,%d,%.6f,%.10g,%.10g,%.10g,%.10g,%.10g,%."
 				        "10g,"
 				        "%.10g,%.10g,%.10g\n",
-				        g, t, k, x->ix, x->iy, bsim_edge_name(x->edge), x->step,
-				        x->t, x->pos, x->x[0], x->x[1], x->v[0], x->v[1],
+				        g, t, k, x->ix, x->iy, bsim_trial_edge_name(x->edge),
+				        x->step, x->t, x->pos, x->x[0], x->x[1], x->v[0], x->v[1],
 				        x->theta[0], x->omega[0], x->theta[1], x->omega[1]);
 			}
 		}

@@ -1,7 +1,7 @@
 /* trajectories.csv of a sweep (beamsim/output.h): the kept trajectories in
  * one long table, so that one read gives every trial and a group's bundle
  * is the rows of its group. */
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 #include "beamsim/output.h"
 
 int bsim_output_trajectories_csv(const char *path, const bsim_sweep_result *r, bsim_error *err)

@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/json.h"
+#include "json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/output.h"
 
@@ -80,13 +80,13 @@ static const bsim_trial_result *trial_of(const bsim_report *r, int side, int g, 
 /* "traversed (left) at 3.24 s"; on a lattice "... at 3.24 s, end:-2" */
 static void outcome_text(FILE *f, const bsim_report *r, const bsim_trial_result *x)
 {
-	fputs(bsim_outcome_name(x->outcome), f);
+	fputs(bsim_trial_outcome_name(x->outcome), f);
 	if (x->outcome == BSIM_TRAVERSED)
-		fprintf(f, " (%s)", bsim_type_name(x->type));
+		fprintf(f, " (%s)", bsim_trial_type_name(x->type));
 	fprintf(f, " at %.3f s", x->t_end);
 	if (r->cmp->lattice) {
 		char label[48];
-		bsim_location_label(bsim_location_of(x), label, sizeof label);
+		bsim_lattice_location_label(bsim_lattice_location_of(x), label, sizeof label);
 		fprintf(f, ", %s", label);
 	}
 }
@@ -129,9 +129,9 @@ static void md_separation(FILE *f, const bsim_report *r)
 /* "traversed (none)" for a deterministic group's one trial. */
 static void outcome_short(FILE *f, const bsim_trial_result *x)
 {
-	fputs(bsim_outcome_name(x->outcome), f);
+	fputs(bsim_trial_outcome_name(x->outcome), f);
 	if (x->outcome == BSIM_TRAVERSED)
-		fprintf(f, " (%s)", bsim_type_name(x->type));
+		fprintf(f, " (%s)", bsim_trial_type_name(x->type));
 }
 
 /* The largest equivalence p-value over the events: the group's, since it
@@ -161,7 +161,7 @@ static void md_row_random(FILE *f, const bsim_compare_group *cg)
 	        "%s | %.2g |",
 	        t->p_a, t->ci_a[0], t->ci_a[1], t->p_b, t->ci_b[0], t->ci_b[1], t->diff,
 	        t->diff_ci[0], t->diff_ci[1], cg->discordant, cg->pairs, cg->ev[k].p_holm,
-	        bsim_event_name((bsim_event)k), group_equivalence(cg));
+	        bsim_compare_event_name((bsim_event)k), group_equivalence(cg));
 	md_number(f, " %.2f |", t->detectable);
 }
 
@@ -205,7 +205,7 @@ static void md_table(FILE *f, const bsim_report *r)
 			fprintf(f, " %.3f |", cg->t_sep[1]);
 		else
 			fputs(" - |", f);
-		fprintf(f, " %s |\n", bsim_verdict_name(cg->verdict));
+		fprintf(f, " %s |\n", bsim_compare_verdict_name(cg->verdict));
 	}
 	fputc('\n', f);
 }
@@ -222,8 +222,8 @@ static void md_events(FILE *f, const bsim_report *r, const bsim_compare_group *c
 		fprintf(f,
 		        "| %s | %.2f | %.2f | %+.2f [%+.2f, %+.2f] | %d | %d | %.3g | %.3g | %.3g "
 		        "|",
-		        bsim_event_name((bsim_event)ev), t->p_a, t->p_b, t->diff, t->diff_ci[0],
-		        t->diff_ci[1], t->pairs.b, t->pairs.c, t->p_value, t->p_holm,
+		        bsim_compare_event_name((bsim_event)ev), t->p_a, t->p_b, t->diff,
+		        t->diff_ci[0], t->diff_ci[1], t->pairs.b, t->pairs.c, t->p_value, t->p_holm,
 		        t->p_equivalence);
 		md_number(f, " %.2f |", t->detectable);
 		fprintf(f, " %s |\n", t->beyond ? "yes" : "no");
@@ -236,7 +236,7 @@ static void md_examples(FILE *f, const bsim_report *r, int g)
 	int shown = 0;
 	for (int t = 0; t < r->cmp->groups[g].pairs && shown < r->examples; t++) {
 		const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
-		if (!bsim_trial_discordant(a, b))
+		if (!bsim_compare_discordant(a, b))
 			continue;
 		shown++;
 		fprintf(f, "- trial %d: %s ", t, r->side[0].label);
@@ -319,9 +319,9 @@ static void md_locations(FILE *f, const bsim_report *r)
 			        j < ls[1].n_locations ? &ls[1].locations[j] : NULL;
 			char la[48], lb[48];
 			if (x)
-				bsim_location_label(x->loc, la, sizeof la);
+				bsim_lattice_location_label(x->loc, la, sizeof la);
 			if (y)
-				bsim_location_label(y->loc, lb, sizeof lb);
+				bsim_lattice_location_label(y->loc, lb, sizeof lb);
 			int order = !x ? 1 : !y ? -1 : 0;
 			if (x && y) {
 				bsim_location p = x->loc, q = y->loc;
@@ -467,9 +467,9 @@ static void json_event(FILE *f, const bsim_event_test *t, int deterministic)
 static void json_outcome(FILE *f, const bsim_trial_result *x)
 {
 	fputs("{\"outcome\": ", f);
-	bsim_json_string(f, bsim_outcome_name(x->outcome));
+	bsim_json_string(f, bsim_trial_outcome_name(x->outcome));
 	fputs(", \"type\": ", f);
-	bsim_json_string(f, bsim_type_name(x->type));
+	bsim_json_string(f, bsim_trial_type_name(x->type));
 	fputs(", \"t_end\": ", f);
 	bsim_json_number(f, x->t_end);
 	fputc('}', f);
@@ -497,7 +497,7 @@ static void json_examples(FILE *f, const bsim_report *r, int g)
 	fputs(", \"examples\": [", f);
 	for (int t = 0; t < r->cmp->groups[g].pairs && shown < r->examples; t++) {
 		const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
-		if (!bsim_trial_discordant(a, b))
+		if (!bsim_compare_discordant(a, b))
 			continue;
 		fprintf(f, "%s\n      {\"trial\": %d, \"a\": ", shown ? "," : "", t);
 		json_outcome(f, a);
@@ -525,7 +525,7 @@ static void json_location_list(FILE *f, const bsim_lattice_summary *ls)
 	for (int k = 0; k < ls->n_locations; k++) {
 		const bsim_location_count *c = &ls->locations[k];
 		char label[48];
-		bsim_location_label(c->loc, label, sizeof label);
+		bsim_lattice_location_label(c->loc, label, sizeof label);
 		fprintf(f, "%s{\"location\": \"%s\", \"count\": %d, \"p\": ", k ? ", " : "", label,
 		        c->count);
 		bsim_json_number(f, c->p);
@@ -581,9 +581,9 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	const bsim_comparison *c = r->cmp;
 	fputs("{\n  \"experiment\": ", f);
 	bsim_json_string(f, r->e->path);
-	fprintf(f,
-	        ",\n  \"seed\": %" PRIu64 ",\n  \"trials_per_group\": %d,\n  \"a\": ", r->e->seed,
-	        c->trials);
+	fputs(",\n  \"seed\": ", f);
+	bsim_json_u64(f, r->e->seed);
+	fprintf(f, ",\n  \"trials_per_group\": %d,\n  \"a\": ", c->trials);
 	json_side(f, &r->side[0]);
 	fputs(",\n  \"b\": ", f);
 	json_side(f, &r->side[1]);
@@ -602,7 +602,7 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	fprintf(f, ",\n  \"groups_disagreeing\": %d,\n  \"verdicts\": {", c->n_disagree);
 	for (int v = 0; v < BSIM_N_VERDICTS; v++) {
 		fputs(v ? ", " : "", f);
-		bsim_json_string(f, bsim_verdict_name((bsim_verdict)v));
+		bsim_json_string(f, bsim_compare_verdict_name((bsim_verdict)v));
 		fprintf(f, ": %d", c->count[v]);
 	}
 	fputs("},\n  \"separation\": ", f);
@@ -622,7 +622,7 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 		fprintf(f, "%s\n    {\"group\": %d, \"params\": ", g ? "," : "", g);
 		bsim_output_group_params(f, r->e, g);
 		fputs(", \"verdict\": ", f);
-		bsim_json_string(f, bsim_verdict_name(cg->verdict));
+		bsim_json_string(f, bsim_compare_verdict_name(cg->verdict));
 		fprintf(f,
 		        ", \"deterministic\": %s, \"pairs\": %d, \"discordant\": %d, \"changed\": "
 		        "%d, "
@@ -634,7 +634,7 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 		fputs(",\n     \"events\": {", f);
 		for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
 			fputs(ev ? ",\n       " : "\n       ", f);
-			bsim_json_string(f, bsim_event_name((bsim_event)ev));
+			bsim_json_string(f, bsim_compare_event_name((bsim_event)ev));
 			fputs(": ", f);
 			json_event(f, &cg->ev[ev], cg->deterministic);
 		}
@@ -657,15 +657,15 @@ void bsim_report_pairs_csv(FILE *f, const bsim_report *r)
 		for (int t = 0; t < c->trials; t++) {
 			const bsim_trial_result *a = trial_of(r, 0, g, t),
 			                        *b = trial_of(r, 1, g, t);
-			fprintf(f, "%d,%d,%s,%s,%s,%s,", g, t, bsim_outcome_name(a->outcome),
-			        bsim_type_name(a->type), bsim_outcome_name(b->outcome),
-			        bsim_type_name(b->type));
+			fprintf(f, "%d,%d,%s,%s,%s,%s,", g, t, bsim_trial_outcome_name(a->outcome),
+			        bsim_trial_type_name(a->type), bsim_trial_outcome_name(b->outcome),
+			        bsim_trial_type_name(b->type));
 			double ts = r->t_separate ? r->t_separate[(size_t)g * c->trials + t] : -1.0;
 			if (ts >= 0.0)
 				fprintf(f, "%.10g", ts);
 			char la[48], lb[48];
-			bsim_location_label(bsim_location_of(a), la, sizeof la);
-			bsim_location_label(bsim_location_of(b), lb, sizeof lb);
+			bsim_lattice_location_label(bsim_lattice_location_of(a), la, sizeof la);
+			bsim_lattice_location_label(bsim_lattice_location_of(b), lb, sizeof lb);
 			fprintf(f, ",%s,%s\n", la, lb);
 		}
 }

@@ -6,11 +6,23 @@
 #include <inttypes.h>
 #include <string.h>
 
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "beamsim/lattice.h"
-#include "beamsim/matlab.h"
+#include "matlab.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
+#include "session.h"
+
+bsim_run_info bsim_run_info_default(void)
+{
+	bsim_run_info i;
+	memset(&i, 0, sizeof i);
+	i.backend = bsim_backend_default();
+	i.seed = 1;
+	i.stride = 1;
+	return i;
+}
 
 static void ledger_json(FILE *f, const bsim_ledger *l)
 {
@@ -46,7 +58,7 @@ static void ledger_json(FILE *f, const bsim_ledger *l)
 static void path_json(FILE *f, const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	char label[48];
-	bsim_location_label(bsim_location_of(r), label, sizeof label);
+	bsim_lattice_location_label(bsim_lattice_location_of(r), label, sizeof label);
 	fprintf(f, ", \"final_gate\": [%d, %d], \"location\": \"%s\", \"reset_overlaps\": %d",
 	        r->final_ix, r->final_iy, label, r->reset_overlaps);
 	if (!log)
@@ -55,7 +67,7 @@ static void path_json(FILE *f, const bsim_trial_result *r, const bsim_trial_log 
 	for (int k = 0; k < log->n_entries; k++) {
 		const bsim_gate_entry *e = &log->entries[k];
 		fprintf(f, "%s{\"gate\": [%d, %d], \"edge\": \"%s\", \"t\": ", k ? ", " : "", e->ix,
-		        e->iy, bsim_edge_name(e->edge));
+		        e->iy, bsim_trial_edge_name(e->edge));
 		bsim_json_number(f, e->t);
 		fputs(", \"pos\": ", f);
 		bsim_json_number(f, e->pos);
@@ -88,7 +100,8 @@ static void record_json(FILE *f, const bsim_run_info *info)
 	fputc('}', f);
 }
 
-void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r, int record)
+void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r,
+                          int record)
 {
 	fputs("{\"scene\": ", f);
 	bsim_json_string(f, info->scene_path);
@@ -98,13 +111,14 @@ void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *
 	bsim_json_string(f, info->backend->name);
 	fputs(", \"backend_options\": ", f);
 	bsim_output_backend_options(f, info->backend, info->opts);
-	fprintf(f,
-	        ", \"seed\": %" PRIu64 ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": %" PRIu64,
-	        info->seed, info->group, info->trial, info->mixed_seed);
+	fputs(", \"seed\": ", f);
+	bsim_json_u64(f, info->seed);
+	fprintf(f, ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": ", info->group, info->trial);
+	bsim_json_u64(f, info->mixed_seed);
 	fputs(", \"outcome\": ", f);
-	bsim_json_string(f, bsim_outcome_name(r->outcome));
+	bsim_json_string(f, bsim_trial_outcome_name(r->outcome));
 	fputs(", \"type\": ", f);
-	bsim_json_string(f, bsim_type_name(r->type));
+	bsim_json_string(f, bsim_trial_type_name(r->type));
 	fprintf(f, ", \"landscape_left\": %d, \"landscape_beam\": ", r->landscape_beam == 0);
 	if (r->landscape_beam >= 0)
 		fprintf(f, "%d", r->landscape_beam + 1);
@@ -128,6 +142,8 @@ void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *
 	path_json(f, r, info->log);
 	fputs(", \"ledger\": ", f);
 	ledger_json(f, &r->ledger);
+	fprintf(f, ", \"solver\": {\"iteration_limit\": %ld, \"clamped\": %ld}",
+	        r->solver.iteration_limit, r->solver.clamped);
 	fputs(", \"instability\": ", f);
 	if (r->instability) {
 		char why[256];
@@ -141,8 +157,15 @@ void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *
 	fputs("}\n", f);
 }
 
-int bsim_run_output_open(bsim_run_output *o, const char *dir, int n_beams, bsim_recorder *rec,
-                         bsim_error *err)
+/* The open files of `run --out DIR`, in the staging area. */
+typedef struct run_dir {
+	char dir[1100];
+	char traj_path[1200], ledger_path[1200];
+	bsim_atomic_file traj, ledger;
+} run_dir;
+
+static int run_dir_open(run_dir *o, const char *dir, int n_beams, bsim_recorder *rec,
+                        bsim_error *err)
 {
 	memset(o, 0, sizeof *o);
 	if (strlen(dir) >= sizeof o->dir - 32)
@@ -158,21 +181,23 @@ int bsim_run_output_open(bsim_run_output *o, const char *dir, int n_beams, bsim_
 		bsim_atomic_file_abort(&o->traj);
 		return BSIM_EFAIL;
 	}
-	bsim_recorder_header(o->traj.f, n_beams);
-	bsim_recorder_ledger_header(o->ledger.f);
+	bsim_trial_trajectory_header(o->traj.f, n_beams);
+	bsim_trial_ledger_header(o->ledger.f);
 	rec->csv = o->traj.f;
 	rec->ledger = o->ledger.f;
 	return BSIM_OK;
 }
 
-void bsim_run_output_abort(bsim_run_output *o)
+static void run_dir_abort(run_dir *o)
 {
 	bsim_atomic_file_abort(&o->traj);
 	bsim_atomic_file_abort(&o->ledger);
 }
 
-int bsim_run_output_commit(bsim_run_output *o, const bsim_run_info *info,
-                           const bsim_trial_result *r, bsim_error *err)
+/* Once the trial has run: trajectory.csv and ledger.csv, their twins,
+ * inputs/scene.yaml and, last, run.json. */
+static int run_dir_commit(run_dir *o, const bsim_run_info *info, const bsim_trial_result *r,
+                          bsim_error *err)
 {
 	char path[1200], mat[1200];
 	int rc = bsim_atomic_file_commit(&o->traj, err);
@@ -200,8 +225,80 @@ int bsim_run_output_commit(bsim_run_output *o, const bsim_run_info *info,
 	if (!rc)
 		rc = bsim_atomic_file_open(&f, path, err);
 	if (!rc) {
-		bsim_run_json(f.f, info, r, 1);
+		bsim_run_output_json(f.f, info, r, 1);
 		rc = bsim_atomic_file_commit(&f, err);
 	}
 	return rc;
+}
+
+/* The trajectory file's twin: read back from the file, so only for a
+ * regular file (a pipe, a terminal or standard output cannot be, and a
+ * link's twin would not be its). */
+static int trajectory_commit(bsim_atomic_file *traj, const char *path, bsim_error *err)
+{
+	char mat[1200];
+	int through = traj->mode != BSIM_ATOMIC_RENAME;
+	int rc = bsim_atomic_file_commit(traj, err);
+	if (rc == BSIM_OK && !through) {
+		rc = bsim_matlab_path(path, mat, sizeof mat, err);
+		if (rc == BSIM_OK)
+			rc = bsim_matlab_from_csv(path, mat, "trajectory", err);
+	}
+	return rc;
+}
+
+int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, const char *out,
+                          bsim_trial_result *res, bsim_error *err)
+{
+	bsim_atomic_file traj = {0};
+	run_dir dir;
+	bsim_trial_log *log = (bsim_trial_log *)info->log;
+	int stride = info->stride > 0 ? info->stride : 1;
+	bsim_recorder rec = {.stride = stride, .log = log, .overlap = 1};
+	const bsim_scene *scene = info->scene;
+	memset(res, 0, sizeof *res);
+	if (trajectory) {
+		if (bsim_atomic_file_open(&traj, trajectory, err) != BSIM_OK)
+			return BSIM_EFAIL;
+		bsim_trial_trajectory_header(traj.f, scene->n_beams);
+		rec.csv = traj.f;
+	}
+	/* DIR is checked before the trial runs and its files appear together. */
+	bsim_session ss;
+	if (out) {
+		int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
+		if (rc != BSIM_OK) {
+			bsim_atomic_file_abort(&traj);
+			return rc;
+		}
+		if (run_dir_open(&dir, ss.stage, scene->n_beams, &rec, err)) {
+			bsim_atomic_file_abort(&traj);
+			return bsim_session_close(&ss, BSIM_EFAIL, "run", NULL, err);
+		}
+		/* One recorder writes both: the directory's trajectory and
+		 * ledger, and the CSV of the trajectory file. */
+		if (trajectory) {
+			rec.record = bsim_trial_trajectory_row;
+			rec.record_user = traj.f;
+		}
+	}
+	int rc = BSIM_OK;
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
+	if (!runner)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for a trial runner");
+	if (rc == BSIM_OK)
+		rc = bsim_trial_run(runner, scene, info->backend, info->opts, info->mixed_seed,
+		                    &rec, res, err);
+	bsim_trial_runner_free(runner);
+	if (rc == BSIM_OK && trajectory)
+		rc = trajectory_commit(&traj, trajectory, err);
+	else
+		bsim_atomic_file_abort(&traj);
+	if (!out)
+		return rc;
+	if (rc == BSIM_OK)
+		rc = run_dir_commit(&dir, info, res, err);
+	else
+		run_dir_abort(&dir);
+	return bsim_session_close(&ss, rc, "run", NULL, err);
 }

@@ -15,22 +15,27 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
 #include "yaml_doc.h"
 
-void bsim_options_effective(const bsim_backend *b, const bsim_options *given, bsim_options *out)
+void bsim_run_record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e,
+                          int n, const bsim_backend *const *b, const bsim_options *const *opts,
+                          const char *const *label, const bsim_compare_rule *rule)
 {
-	*out = given ? *given : (bsim_options){0};
-	for (int i = 0; i < b->n_knobs && out->n < BSIM_OPTIONS_MAX; i++) {
-		if (bsim_options_get(out, b->knobs[i].name) || !b->knobs[i].default_value)
-			continue;
-		snprintf(out->key[out->n], sizeof out->key[0], "%s", b->knobs[i].name);
-		snprintf(out->value[out->n], sizeof out->value[0], "%s", b->knobs[i].default_value);
-		out->n++;
+	memset(rec, 0, sizeof *rec);
+	snprintf(rec->command, sizeof rec->command, "%s", command);
+	rec->n_backends = n;
+	for (int i = 0; i < n; i++) {
+		snprintf(rec->backend[i], sizeof rec->backend[i], "%s", b[i]->name);
+		snprintf(rec->label[i], sizeof rec->label[i], "%s", label ? label[i] : b[i]->name);
+		bsim_options_effective(b[i]->knobs, b[i]->n_knobs, opts[i], &rec->opts[i]);
 	}
+	rec->seed = e->seed;
+	rec->trials = e->trials;
+	rec->rule = rule ? *rule : bsim_compare_rule_default();
 }
 
 static int path_join(char *buf, size_t size, const char *dir, const char *name, bsim_error *err)
@@ -39,29 +44,6 @@ static int path_join(char *buf, size_t size, const char *dir, const char *name, 
 	if (n < 0 || (size_t)n >= size)
 		return bsim_error_set(err, BSIM_EFAIL, "%s/%s: path too long", dir, name);
 	return BSIM_OK;
-}
-
-static int copy_file(const char *from, const char *to, bsim_error *err)
-{
-	FILE *in = fopen(from, "rb");
-	if (!in)
-		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot read the file", from);
-	bsim_atomic_file o;
-	if (bsim_atomic_file_open(&o, to, err) != BSIM_OK) {
-		fclose(in);
-		return BSIM_EFAIL;
-	}
-	char buf[8192];
-	size_t n;
-	while ((n = fread(buf, 1, sizeof buf, in)) > 0)
-		fwrite(buf, 1, n, o.f);
-	int bad = ferror(in);
-	fclose(in);
-	if (bad) {
-		bsim_atomic_file_abort(&o);
-		return bsim_error_set(err, BSIM_EFAIL, "%s: read error", from);
-	}
-	return bsim_atomic_file_commit(&o, err);
 }
 
 /* The experiment as it ran, without a word about where it came from. */
@@ -141,18 +123,6 @@ char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *
 	return text;
 }
 
-static void json_options(FILE *f, const bsim_options *o)
-{
-	fputc('{', f);
-	for (int i = 0; i < o->n; i++) {
-		fputs(i ? ", " : "", f);
-		bsim_json_string(f, o->key[i]);
-		fputs(": ", f);
-		bsim_json_string(f, o->value[i]);
-	}
-	fputc('}', f);
-}
-
 static int write_json(const char *path, const bsim_run_record *rec, const bsim_experiment *e,
                       bsim_error *err)
 {
@@ -174,7 +144,8 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 		fputs(", \"label\": ", f);
 		bsim_json_string(f, rec->label[i][0] ? rec->label[i] : rec->backend[i]);
 		fputs(", \"options\": ", f);
-		json_options(f, &rec->opts[i]);
+		bsim_output_backend_options(f, bsim_backend_find(rec->backend[i], NULL),
+		                            &rec->opts[i]);
 		fputc('}', f);
 	}
 	fputc(']', f);
@@ -185,7 +156,9 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 		bsim_json_string(f, rec->protocol[1]);
 		fputc(']', f);
 	}
-	fprintf(f, ",\n  \"seed\": %" PRIu64 ",\n  \"trials\": %d", rec->seed, rec->trials);
+	fputs(",\n  \"seed\": ", f);
+	bsim_json_u64(f, rec->seed);
+	fprintf(f, ",\n  \"trials\": %d", rec->trials);
 	fputs(",\n  \"rule\": {\"alpha\": ", f);
 	bsim_json_number(f, rec->rule.alpha);
 	fputs(", \"margin\": ", f);
@@ -221,7 +194,7 @@ static int copy_stiffness_files(const char *inputs, const bsim_experiment *e,
 		*last = '\0';
 		int rc = bsim_output_mkdir(to, err);
 		*last = '/';
-		if (rc != BSIM_OK || copy_file(from, to, err) != BSIM_OK)
+		if (rc != BSIM_OK || bsim_atomic_file_copy(from, to, err) != BSIM_OK)
 			return BSIM_EFAIL;
 	}
 	return BSIM_OK;
@@ -235,7 +208,7 @@ int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsi
 	    bsim_output_mkdir(inputs, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (path_join(path, sizeof path, inputs, "scene.yaml", err) ||
-	    copy_file(e->scene_path, path, err) != BSIM_OK)
+	    bsim_atomic_file_copy(e->scene_path, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (copy_stiffness_files(inputs, e, extra, n_extra, err) != BSIM_OK)
 		return BSIM_EFAIL;
@@ -344,7 +317,7 @@ int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 	}
 	struct fy_node *sn = ydoc_lookup(root, "seed"), *tn = ydoc_lookup(root, "trials");
 	long long trials = 0;
-	if (!rc && (!sn || !ydoc_uint64(sn, &rec->seed)))
+	if (!rc && (!sn || !ydoc_uint64_text(sn, &rec->seed)))
 		rc = ydoc_expected(&d, sn, NULL, "seed", "an integer >= 0", err);
 	if (!rc && (!tn || !ydoc_int64(tn, &trials) || trials < 1 || trials > INT32_MAX))
 		rc = ydoc_expected(&d, tn, NULL, "trials", "an integer >= 1", err);

@@ -14,6 +14,13 @@
 
 #define BSIM_PI 3.14159265358979323846
 
+bsim_scene bsim_scene_default(void)
+{
+	bsim_scene d;
+	scene_defaults(&d);
+	return d;
+}
+
 void scene_defaults(bsim_scene *s)
 {
 	memset(s, 0, sizeof *s);
@@ -63,7 +70,7 @@ void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm)
 	s->effects.random_magnitude = rm;
 }
 
-void bsim_beam_rest_direction(const bsim_beam_def *b, double u0[2])
+void bsim_scene_beam_rest_direction(const bsim_beam_def *b, double u0[2])
 {
 	double q = b->rest_angle_deg / 90.0;
 	if (q == floor(q) && fabs(q) < 1e15) {
@@ -78,10 +85,10 @@ void bsim_beam_rest_direction(const bsim_beam_def *b, double u0[2])
 	u0[1] = sin(rad);
 }
 
-double bsim_beam_forward_sign(const bsim_beam_def *b)
+double bsim_scene_beam_forward_sign(const bsim_beam_def *b)
 {
 	double u0[2];
-	bsim_beam_rest_direction(b, u0);
+	bsim_scene_beam_rest_direction(b, u0);
 	return u0[0] >= 0.0 ? 1.0 : -1.0;
 }
 
@@ -93,8 +100,8 @@ int scene_overlap(const bsim_scene *s, double *dist)
 		/* Forward-positive theta moves the tip toward +y: a beam pointing
 		 * left (cos(rest) < 0) turns clockwise for positive theta. */
 		double u0[2];
-		bsim_beam_rest_direction(b, u0);
-		double sn = bsim_beam_forward_sign(b) * sin(b->initial_theta);
+		bsim_scene_beam_rest_direction(b, u0);
+		double sn = bsim_scene_beam_forward_sign(b) * sin(b->initial_theta);
 		double cs = cos(b->initial_theta);
 		double ux = u0[0] * cs - u0[1] * sn, uy = u0[1] * cs + u0[0] * sn;
 		double dx = c[0] - b->pivot[0], dy = c[1] - b->pivot[1];

@@ -170,6 +170,12 @@ int scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, struct 
 		char field[300], keys[512];
 		ydoc_join(field, sizeof field, prefix, name ? name : "?");
 		int i = find_field(t, name);
+		/* An experiment given where a scene belongs (beamsim run EXP). */
+		if (i < 0 && !prefix[0] && ydoc_pair(map, "scene", 5) && ydoc_pair(map, "grid", 4))
+			return ydoc_fail(
+			        w->d, k, map, field, w->err,
+			        "this is an experiment file (scene: and grid:), not a scene: "
+			        "run it with beamsim sweep or compare, or run its scene");
 		if (i < 0) {
 			scene_keys(t, keys, sizeof keys);
 			return ydoc_fail(w->d, k, map, field, w->err,

@@ -15,6 +15,8 @@ struct bsim_schedule {
 	double *z;        /* standard-normal values drawn so far */
 	long n_drawn, cap;
 	unsigned long draws;
+	long failed; /* 0, or the index that could not be given a value */
+	int oom;     /* 1: failed for want of memory; 0: beyond any schedule */
 };
 
 static unsigned long total_draws;
@@ -34,7 +36,7 @@ static uint64_t splitmix64(uint64_t z)
 	return z ^ (z >> 31);
 }
 
-uint64_t bsim_seed_mix(uint64_t seed, uint64_t group, uint64_t trial)
+uint64_t bsim_schedule_seed_mix(uint64_t seed, uint64_t group, uint64_t trial)
 {
 	uint64_t h = splitmix64(seed);
 	h = splitmix64(h ^ group);
@@ -73,6 +75,8 @@ void bsim_schedule_reset(bsim_schedule *s, double magnitude, uint64_t seed)
 	s->magnitude = magnitude;
 	s->n_drawn = 0;
 	s->draws = 0;
+	s->failed = 0;
+	s->oom = 0;
 }
 
 long bsim_schedule_index(const bsim_schedule *s, long n, double h)
@@ -93,16 +97,23 @@ long bsim_schedule_index(const bsim_schedule *s, long n, double h)
 
 double bsim_schedule_value(bsim_schedule *s, long j)
 {
-	if (j < 0 || j >= SCHEDULE_MAX)
-		return NAN; /* the runner stops on a non-finite force */
+	/* A value that cannot be had is no value: 0, and the failure kept for
+	 * bsim_schedule_status, which fails the trial. */
+	if (j < 0 || j >= SCHEDULE_MAX) {
+		s->failed = s->failed ? s->failed : (j < 0 ? -1 : j);
+		return 0.0;
+	}
 	if (j >= s->n_drawn) {
 		if (j >= s->cap) {
 			long cap = s->cap ? s->cap : 256;
 			while (cap <= j)
 				cap *= 2;
 			double *z = realloc(s->z, (size_t)cap * sizeof *z);
-			if (!z)
-				return NAN; /* the runner stops on a non-finite force */
+			if (!z) {
+				s->failed = s->failed ? s->failed : j;
+				s->oom = 1;
+				return 0.0;
+			}
 			s->z = z;
 			s->cap = cap;
 		}
@@ -113,6 +124,18 @@ double bsim_schedule_value(bsim_schedule *s, long j)
 		}
 	}
 	return s->magnitude * s->z[j];
+}
+
+int bsim_schedule_status(const bsim_schedule *s, bsim_error *err)
+{
+	if (!s->failed)
+		return BSIM_OK;
+	if (s->oom)
+		return bsim_error_set(err, BSIM_EFAIL,
+		                      "out of memory for the random force's value %ld", s->failed);
+	return bsim_error_set(
+	        err, BSIM_EFAIL,
+	        "random force: value %ld is beyond any schedule (at most 2^40 values)", s->failed);
 }
 
 unsigned long bsim_schedule_draws(const bsim_schedule *s)

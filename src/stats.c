@@ -14,7 +14,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_roots.h>
 
-void bsim_wilson(int k, int n, double z, double *lo, double *hi)
+void bsim_stats_wilson(int k, int n, double z, double *lo, double *hi)
 {
 	if (n <= 0) {
 		*lo = 0.0;
@@ -33,7 +33,7 @@ void bsim_wilson(int k, int n, double z, double *lo, double *hi)
 
 /* McNemar, exact: P(X <= k) for X ~ Binomial(m, 1/2) summed in log space,
  * so m in the thousands neither overflows nor underflows early. */
-double bsim_mcnemar_exact(int b, int c)
+double bsim_stats_mcnemar_exact(int b, int c)
 {
 	int m = b + c, k = b < c ? b : c;
 	if (m <= 0)
@@ -59,7 +59,7 @@ static int holm_cmp(const void *x, const void *y)
 
 /* Holm: sort p ascending; the k-th smallest (k = 0..n-1) is scaled by
  * (n - k) and the running maximum keeps the adjusted values monotone. */
-void bsim_holm(const double *p, int n, double *adj)
+void bsim_stats_holm(const double *p, int n, double *adj)
 {
 	holm_item *it = malloc((size_t)(n > 0 ? n : 1) * sizeof *it);
 	if (!it) { /* Bonferroni is never smaller than Holm: still valid */
@@ -85,7 +85,7 @@ void bsim_holm(const double *p, int n, double *adj)
  *   U = d + sqrt((u1 - p1)^2 - 2 phi (u1 - p1)(p2 - l2) + (p2 - l2)^2)
  * clipped to [-1, 1]. Identical outcomes (b = c = 0) give an interval
  * around 0 as wide as the sample allows, not a point. */
-void bsim_paired_diff_ci(const bsim_pairs *t, double z, double *lo, double *hi)
+void bsim_stats_newcombe_ci(const bsim_pairs *t, double z, double *lo, double *hi)
 {
 	int n = t->a + t->b + t->c + t->d;
 	if (n <= 0) {
@@ -94,8 +94,8 @@ void bsim_paired_diff_ci(const bsim_pairs *t, double z, double *lo, double *hi)
 		return;
 	}
 	double l1, u1, l2, u2;
-	bsim_wilson(t->a + t->b, n, z, &l1, &u1);
-	bsim_wilson(t->a + t->c, n, z, &l2, &u2);
+	bsim_stats_wilson(t->a + t->b, n, z, &l1, &u1);
+	bsim_stats_wilson(t->a + t->c, n, z, &l2, &u2);
 	double p1 = (double)(t->a + t->b) / n, p2 = (double)(t->a + t->c) / n;
 	double d = p1 - p2;
 	double den = (double)(t->a + t->b) * (t->c + t->d) * (t->a + t->c) * (t->b + t->d);
@@ -118,7 +118,7 @@ void bsim_paired_diff_ci(const bsim_pairs *t, double z, double *lo, double *hi)
  *   T = (b - c - n delta) / sqrt(n (2 q + delta (1 - delta))).
  * The interval's ends solve T = z (lower) and T = -z (upper); T is
  * monotone, so each end is one bracketed root (Brent, GSL). */
-double bsim_tango_score(const bsim_pairs *t, double delta)
+double bsim_stats_tango_score(const bsim_pairs *t, double delta)
 {
 	double n = (double)t->a + t->b + t->c + t->d;
 	double b = t->b, c = t->c;
@@ -141,7 +141,7 @@ typedef struct tango_root {
 static double tango_f(double delta, void *p)
 {
 	const tango_root *r = p;
-	return bsim_tango_score(r->t, delta) - r->target;
+	return bsim_stats_tango_score(r->t, delta) - r->target;
 }
 
 /* The delta in [lo, hi] where T(delta) = target, given T(lo) - target and
@@ -177,7 +177,7 @@ static double tango_solve(const bsim_pairs *t, double target, double lo, double 
 	return x;
 }
 
-void bsim_tango_ci(const bsim_pairs *t, double z, double *lo, double *hi)
+void bsim_stats_tango_ci(const bsim_pairs *t, double z, double *lo, double *hi)
 {
 	int n = t->a + t->b + t->c + t->d;
 	if (n <= 0) {
@@ -195,7 +195,7 @@ void bsim_tango_ci(const bsim_pairs *t, double z, double *lo, double *hi)
 	*hi = d >= edge ? 1.0 : tango_solve(t, -z, d, edge);
 }
 
-double bsim_tango_tost(const bsim_pairs *t, double margin)
+double bsim_stats_tango_tost(const bsim_pairs *t, double margin)
 {
 	if (margin <= 0.0 || t->a + t->b + t->c + t->d <= 0)
 		return 1.0;
@@ -203,21 +203,21 @@ double bsim_tango_tost(const bsim_pairs *t, double margin)
 		return 0.0;
 	/* H0: delta <= -margin is rejected for large T(-margin), H0: delta >=
 	 * margin for small T(margin). */
-	double p_low = gsl_cdf_ugaussian_Q(bsim_tango_score(t, -margin));
-	double p_high = gsl_cdf_ugaussian_P(bsim_tango_score(t, margin));
+	double p_low = gsl_cdf_ugaussian_Q(bsim_stats_tango_score(t, -margin));
+	double p_high = gsl_cdf_ugaussian_P(bsim_stats_tango_score(t, margin));
 	return fmax(p_low, p_high);
 }
 
-int bsim_mcnemar_split(int m, double level)
+int bsim_stats_mcnemar_split(int m, double level)
 {
 	int k = -1;
 	/* The p-value rises with k up to m / 2. */
-	for (int j = 0; 2 * j < m && bsim_mcnemar_exact(j, m - j) < level; j++)
+	for (int j = 0; 2 * j < m && bsim_stats_mcnemar_exact(j, m - j) < level; j++)
 		k = j;
 	return k;
 }
 
-double bsim_normal_upper(double q)
+double bsim_stats_normal_upper(double q)
 {
 	return gsl_cdf_ugaussian_Qinv(q);
 }

@@ -20,19 +20,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/clock.h"
+#include "clock.h"
+#include "journal.h"
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"
 #include "trial_pair.h"
 
-void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out)
+void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out)
 {
 	memset(out, 0, sizeof *out);
 	out->trials = n;
 	for (int i = 0; i < n; i++) {
 		const bsim_trial_result *t = &trials[i];
 		out->steps += t->steps_run;
+		out->solver.iteration_limit += t->solver.iteration_limit;
+		out->solver.clamped += t->solver.clamped;
 		switch (t->outcome) {
 		case BSIM_TRAVERSED:
 			out->traversed++;
@@ -57,7 +60,7 @@ void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_res
 		}
 	}
 	out->p_traverse = n > 0 ? (double)out->traversed / n : 0.0;
-	bsim_wilson(out->traversed, n, BSIM_Z95, &out->ci95[0], &out->ci95[1]);
+	bsim_stats_wilson(out->traversed, n, BSIM_STATS_Z95, &out->ci95[0], &out->ci95[1]);
 }
 
 void bsim_sweep_result_free(bsim_sweep_result *r)
@@ -211,13 +214,13 @@ static void sweep_thread(sweep_shared *sh)
 	const bsim_experiment *e = sh->e;
 	const bsim_sweep_config *cfg = sh->cfg;
 	int leader = omp_get_thread_num() == 0;
-	bsim_runner *runner = bsim_runner_alloc();
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
 	bsim_trial_log *log[2] = {bsim_trial_log_alloc(), bsim_trial_log_alloc()};
 	bsim_error err;
 
 	if (!runner || (sh->backend_b && !pair) || !log[0] || !log[1]) {
-		bsim_runner_free(runner);
+		bsim_trial_runner_free(runner);
 		runner = NULL;
 		shared_fail(sh, -1, BSIM_EFAIL, "out of memory for a trial runner");
 	}
@@ -234,7 +237,7 @@ static void sweep_thread(sweep_shared *sh)
 			continue;
 		}
 		long g = i / e->trials, t = i % e->trials;
-		uint64_t seed = bsim_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
+		uint64_t seed = bsim_schedule_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
 		const bsim_scene *scene = &sh->scenes[g];
 		bsim_trajectory *keep = t < sh->keep ? &sh->kept[g * sh->keep + t] : NULL;
@@ -278,7 +281,7 @@ static void sweep_thread(sweep_shared *sh)
 		if (leader && cfg->progress)
 			cfg->progress(cfg->progress_user, done, sh->total);
 	}
-	bsim_runner_free(runner);
+	bsim_trial_runner_free(runner);
 	trial_pair_free(pair);
 	bsim_trial_log_free(log[0]);
 	bsim_trial_log_free(log[1]);
@@ -345,10 +348,11 @@ static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_
 {
 	r->total_steps = 0;
 	r->trials_run = 0;
+	r->solver = (bsim_solver_counts){0, 0};
 	for (int g = 0; g < n_groups; g++) {
 		bsim_group_result *gr = &r->groups[g];
 		const bsim_trial_result *first = &r->trials_out[(size_t)g * trials];
-		bsim_group_aggregate(first, trials, gr);
+		bsim_sweep_group_aggregate(first, trials, gr);
 		/* No draws, no sampling: p_traverse is exactly what the one trial
 		 * gave, so its interval is that point, not a Wilson interval over
 		 * copies; and only that trial's steps were integrated. */
@@ -356,8 +360,11 @@ static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_
 		if (gr->deterministic && trials > 0) {
 			gr->ci95[0] = gr->ci95[1] = gr->p_traverse;
 			gr->steps = first->steps_run;
+			gr->solver = first->solver;
 		}
 		r->total_steps += gr->steps;
+		r->solver.iteration_limit += gr->solver.iteration_limit;
+		r->solver.clamped += gr->solver.clamped;
 		r->trials_run += gr->deterministic && trials > 0 ? 1 : trials;
 	}
 	r->wall_seconds = wall;

@@ -33,7 +33,7 @@ typedef struct beam_shape {
 	double p[2], u0[2], sgn, length, reach2;
 } beam_shape;
 
-struct bsim_runner {
+struct bsim_trial_runner {
 	bsim_state s0, s1; /* before and after a step */
 	beam_shape *shape; /* per beam */
 	int *touching;     /* per beam of the scene: contacts at the last touching step
@@ -48,12 +48,12 @@ struct bsim_runner {
 	trial_essay essay;
 };
 
-bsim_runner *bsim_runner_alloc(void)
+bsim_trial_runner *bsim_trial_runner_alloc(void)
 {
-	return calloc(1, sizeof(bsim_runner));
+	return calloc(1, sizeof(bsim_trial_runner));
 }
 
-void bsim_runner_free(bsim_runner *r)
+void bsim_trial_runner_free(bsim_trial_runner *r)
 {
 	if (!r)
 		return;
@@ -68,7 +68,7 @@ void bsim_runner_free(bsim_runner *r)
 	free(r);
 }
 
-static int runner_reserve(bsim_runner *r, int n_beams)
+static int runner_reserve(bsim_trial_runner *r, int n_beams)
 {
 	if (r->cap == n_beams && r->s0.theta)
 		return BSIM_OK;
@@ -77,13 +77,13 @@ static int runner_reserve(bsim_runner *r, int n_beams)
 	free(r->shape);
 	r->cap = 0;
 	r->shape = malloc((size_t)(n_beams > 0 ? n_beams : 1) * sizeof *r->shape);
-	if (!r->shape || bsim_state_alloc(&r->s0, n_beams) || bsim_state_alloc(&r->s1, n_beams))
+	if (!r->shape || bsim_state_init(&r->s0, n_beams) || bsim_state_init(&r->s1, n_beams))
 		return BSIM_EFAIL;
 	r->cap = n_beams;
 	return BSIM_OK;
 }
 
-static void touching_clear(bsim_runner *r)
+static void touching_clear(bsim_trial_runner *r)
 {
 	for (int k = 0; k < r->n_touch; k++)
 		r->touching[r->touch_list[k]] = 0;
@@ -92,7 +92,7 @@ static void touching_clear(bsim_runner *r)
 
 /* Per beam of the scene: peaks and the touching beams (all zero between
  * trials: touching_update clears what it set). */
-static int peaks_reserve(bsim_runner *r, int n_beams)
+static int peaks_reserve(bsim_trial_runner *r, int n_beams)
 {
 	if (r->peak_cap >= n_beams && r->peak) {
 		touching_clear(r);
@@ -119,8 +119,8 @@ static void shapes_init(beam_shape *shape, const bsim_scene *sc)
 		beam_shape *q = &shape[i];
 		q->p[0] = b->pivot[0];
 		q->p[1] = b->pivot[1];
-		bsim_beam_rest_direction(b, q->u0);
-		q->sgn = bsim_beam_forward_sign(b);
+		bsim_scene_beam_rest_direction(b, q->u0);
+		q->sgn = bsim_scene_beam_forward_sign(b);
 		q->length = b->length;
 		q->reach2 = (b->length + sc->body.radius) * (b->length + sc->body.radius);
 	}
@@ -147,19 +147,19 @@ static double overlap_depth(const beam_shape *shape, int n, double radius, const
 	return depth;
 }
 
-const char *bsim_outcome_name(bsim_outcome o)
+const char *bsim_trial_outcome_name(bsim_outcome o)
 {
 	static const char *names[] = {"traversed", "side_exit", "stuck", "unstable"};
 	return (unsigned)o < BSIM_N_OUTCOMES ? names[o] : "?";
 }
 
-const char *bsim_type_name(bsim_type t)
+const char *bsim_trial_type_name(bsim_type t)
 {
 	static const char *names[] = {"none", "left", "right"};
 	return (unsigned)t < 3 ? names[t] : "?";
 }
 
-const char *bsim_edge_name(bsim_edge e)
+const char *bsim_trial_edge_name(bsim_edge e)
 {
 	static const char *names[] = {"start", "bottom", "left", "right", "top"};
 	return (unsigned)e < 5 ? names[e] : "?";
@@ -268,7 +268,7 @@ static double energy_springs(const bsim_scene *sc, const bsim_state *s)
 	return e;
 }
 
-void bsim_recorder_header(FILE *f, int n_beams)
+void bsim_trial_trajectory_header(FILE *f, int n_beams)
 {
 	fputs("t,x,y,vx,vy", f);
 	for (int i = 1; i <= n_beams; i++)
@@ -279,14 +279,14 @@ void bsim_recorder_header(FILE *f, int n_beams)
 	fputs(",e_kin,e_beam,e_prop\n", f);
 }
 
-void bsim_recorder_ledger_header(FILE *f)
+void bsim_trial_ledger_header(FILE *f)
 {
 	fputs("t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual,sleep,"
 	      "reset\n",
 	      f);
 }
 
-void bsim_recorder_csv_record(void *file, const bsim_record_row *row)
+void bsim_trial_trajectory_row(void *file, const bsim_record_row *row)
 {
 	FILE *f = file;
 	const bsim_state *s = row->state;
@@ -322,7 +322,7 @@ static void record(const bsim_recorder *rec, const bsim_scene *sc, const bsim_st
 	        .e_prop = bsim_landscape_e_prop(sc, s->x[1]),
 	};
 	if (rec->csv)
-		bsim_recorder_csv_record(rec->csv, &row);
+		bsim_trial_trajectory_row(rec->csv, &row);
 	if (rec->ledger)
 		ledger_row(rec->ledger, &row);
 	if (rec->record)
@@ -410,7 +410,7 @@ static int scene_beam(const int *map, int i)
 /* Every beam's peak theta over the steps so far: the active beams, beams 0
  * and 1 (trials.csv's two columns), and any beam whose peak is still below
  * 0 (a beam at rest has theta 0). */
-static void peaks_update(bsim_runner *r, const bsim_scene *scene, const int *map,
+static void peaks_update(bsim_trial_runner *r, const bsim_scene *scene, const int *map,
                          const bsim_state *s, int *n_negative)
 {
 	double *peak = r->peak;
@@ -434,7 +434,7 @@ static void peaks_update(bsim_runner *r, const bsim_scene *scene, const int *map
 /* The contacts of s in touching[] (scene beams: map[i] for the world's beam
  * i, map NULL: the same), as a copy of the whole contact array would leave
  * it, at the cost of the beams listed. */
-static void touching_update(bsim_runner *r, const int *map, const bsim_state *s)
+static void touching_update(bsim_trial_runner *r, const int *map, const bsim_state *s)
 {
 	touching_clear(r);
 	for (int k = 0; k < s->n_active; k++) {
@@ -542,7 +542,7 @@ static int entries_of_step(const bsim_scene *scene, const int *map, const gate_t
 /* ---- the run ------------------------------------------------------------- */
 
 typedef struct trial_ctx {
-	bsim_runner *r;
+	bsim_trial_runner *r;
 	const bsim_scene *scene;
 	const bsim_backend *backend;
 	const bsim_options *opts;
@@ -553,7 +553,8 @@ typedef struct trial_ctx {
 	const int *map;       /* world beam -> scene beam, NULL: the same */
 	gate_track gate;
 	bsim_trial_result *out;
-	int overlap; /* the recorder asked for overlap_max */
+	int overlap;               /* the recorder asked for overlap_max */
+	bsim_solver_counts solver; /* of the worlds replaced so far (essay protocol) */
 } trial_ctx;
 
 /* A full-lattice state for the recorder from the world's state. */
@@ -595,6 +596,9 @@ static int gate_enter(trial_ctx *c, bsim_state **s0, const double p0[2], int ix,
 	if (c->scene->lattice.protocol != BSIM_PROTOCOL_ESSAY)
 		return BSIM_OK;
 	double e_before = *e0;
+	/* The world is replaced: what its solvers gave up on stays counted. */
+	c->solver.iteration_limit += (*s0)->solver.iteration_limit;
+	c->solver.clamped += (*s0)->solver.clamped;
 	int rc = trial_essay_enter(&c->r->essay, c->scene, c->backend, c->opts, ix, iy, *s0, &c->w,
 	                           &c->out->reset_overlaps, err);
 	if (rc)
@@ -610,7 +614,7 @@ static int gate_enter(trial_ctx *c, bsim_state **s0, const double p0[2], int ix,
 static int trial_setup(trial_ctx *c, bsim_error *err)
 {
 	const bsim_scene *scene = c->scene;
-	bsim_runner *r = c->r;
+	bsim_trial_runner *r = c->r;
 	int essay = scene->has_lattice && scene->lattice.protocol == BSIM_PROTOCOL_ESSAY;
 	int world_beams = essay ? 2 : scene->n_beams;
 	if (runner_reserve(r, world_beams) || peaks_reserve(r, scene->n_beams))
@@ -618,13 +622,13 @@ static int trial_setup(trial_ctx *c, bsim_error *err)
 	int recording = c->rec && (c->rec->csv || c->rec->ledger || c->rec->record);
 	if (essay && recording && r->whole.n_beams != scene->n_beams) {
 		bsim_state_free(&r->whole);
-		if (bsim_state_alloc(&r->whole, scene->n_beams))
+		if (bsim_state_init(&r->whole, scene->n_beams))
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	c->ws = scene;
 	c->map = NULL;
 	double p[2] = {scene->body.start[0], scene->body.start[1]};
-	bsim_scene_gate_at(scene, p, &c->gate.ix, &c->gate.iy);
+	bsim_lattice_gate_at(scene, p, &c->gate.ix, &c->gate.iy);
 	if (!essay)
 		return c->backend->create(scene, c->opts, &c->w, err);
 	int rc = trial_essay_start(&r->essay, scene, c->backend, c->opts, c->gate.ix, c->gate.iy,
@@ -634,7 +638,7 @@ static int trial_setup(trial_ctx *c, bsim_error *err)
 	return rc;
 }
 
-int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *backend,
+int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_backend *backend,
                    const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
                    bsim_trial_result *out, bsim_error *err)
 {
@@ -668,7 +672,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 	const double h = scene->dt;
 	const int n_max = scene->max_steps;
 	const long gate_max = scene->gate_steps > 0 ? scene->gate_steps : n_max;
-	const double centre = bsim_scene_centre_x(scene);
+	const double centre = bsim_lattice_centre_x(scene);
 	double e0 = energy_kinetic(c.ws, s0) + energy_springs(c.ws, s0);
 	out->ledger.e_start = e0;
 	/* Peaks start at the initial angles: every beam of the scene (the
@@ -716,7 +720,8 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 			record(rec, scene, whole_state(&c, s0), n, random_value(&fx), &out->ledger);
 			recorded = n;
 		}
-		backend->step(c.w, f, h);
+		if ((rc = backend->step(c.w, f, h, err)) != BSIM_OK)
+			break;
 		backend->get_state(c.w, s1);
 		double e1 = energy_kinetic(c.ws, s1) + energy_springs(c.ws, s1);
 		if (!state_finite(s1) || !isfinite(e1)) {
@@ -753,7 +758,7 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		 * left from (gates are clamped into the field). */
 		if (scene->has_lattice) {
 			int ix, iy;
-			bsim_scene_gate_at(scene, s0->x, &ix, &iy);
+			bsim_lattice_gate_at(scene, s0->x, &ix, &iy);
 			if ((ix != c.gate.ix || iy != c.gate.iy) &&
 			    (rc = gate_enter(&c, &s0, p0, ix, iy, n, &e0, err)) != BSIM_OK)
 				break;
@@ -804,6 +809,11 @@ int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *
 		out->in_contact_end = 0;
 	}
 	out->draws = fx.random ? bsim_schedule_draws(fx.random->schedule) : 0;
+	out->solver = c.solver;
+	out->solver.iteration_limit += s0->solver.iteration_limit;
+	out->solver.clamped += s0->solver.clamped;
+	if (rc == BSIM_OK)
+		rc = bsim_effects_status(&fx, err);
 	out->final_ix = c.gate.ix;
 	out->final_iy = c.gate.iy;
 	out->gates_entered = c.gate.entries;

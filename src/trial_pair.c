@@ -13,7 +13,7 @@
 trial_pair *trial_pair_alloc(void)
 {
 	trial_pair *p = calloc(1, sizeof *p);
-	if (p && !(p->runner = bsim_runner_alloc())) {
+	if (p && !(p->runner = bsim_trial_runner_alloc())) {
 		free(p);
 		p = NULL;
 	}
@@ -24,7 +24,7 @@ void trial_pair_free(trial_pair *p)
 {
 	if (!p)
 		return;
-	bsim_runner_free(p->runner);
+	bsim_trial_runner_free(p->runner);
 	free(p->trace[0].xy);
 	free(p->trace[1].xy);
 	free(p);

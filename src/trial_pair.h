@@ -18,7 +18,7 @@ typedef struct trial_trace {
 
 /* Per-thread memory: a runner and two traces, reused trial after trial. */
 typedef struct trial_pair {
-	bsim_runner *runner;
+	bsim_trial_runner *runner;
 	trial_trace trace[2];
 	bsim_trajectory *keep[2]; /* NULL, or where each run's rows are kept */
 	int keep_stride;

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "beamsim/output.h"
+#include "trials_csv.h"
 
 enum {
 	COL_GROUP,
@@ -36,11 +37,22 @@ enum {
 	N_COLUMNS
 };
 
-static const char *const column_names[N_COLUMNS] = {
-        "group", "trial",   "outcome", "type",       "steps",      "t_end",
-        "x_end", "y_end",   "vx_end",  "max_theta1", "max_theta2", "e_start",
-        "e_end", "work_in", "losses",  "residual",   "final_ix",   "final_iy",
+/* Each column's place in the list of trials.csv (trials_csv.h). */
+static const int column_of[N_COLUMNS] = {
+        TRIALS_GROUP,      TRIALS_TRIAL,    TRIALS_OUTCOME,  TRIALS_TYPE,    TRIALS_STEPS,
+        TRIALS_T_END,      TRIALS_X_END,    TRIALS_Y_END,    TRIALS_VX_END,  TRIALS_MAX_THETA1,
+        TRIALS_MAX_THETA2, TRIALS_E_START,  TRIALS_E_END,    TRIALS_WORK_IN, TRIALS_LOSSES,
+        TRIALS_RESIDUAL,   TRIALS_FINAL_IX, TRIALS_FINAL_IY,
 };
+
+/* The column k of this reader whose name s is, or -1. */
+static int column_index(const char *s)
+{
+	for (int k = 0; k < N_COLUMNS; k++)
+		if (strcmp(s, bsim_trials_csv_columns[column_of[k]]) == 0)
+			return k;
+	return -1;
+}
 
 /* Splits one CSV line in place into at most max fields (RFC 4180 quoting:
  * "a,""b""" is the field a,"b"). Returns the number of fields, -1 on a
@@ -82,14 +94,6 @@ static int csv_split(char *line, char **field, int max)
 	return n;
 }
 
-static int name_index(const char *s, const char *const *names, int n)
-{
-	for (int i = 0; i < n; i++)
-		if (strcmp(s, names[i]) == 0)
-			return i;
-	return -1;
-}
-
 static int parse_double(const char *s, double *out)
 {
 	char *end;
@@ -102,8 +106,6 @@ static int parse_double(const char *s, double *out)
 static int parse_row(char **f, int n, const int *col, const bsim_sweep_result *r,
                      bsim_trial_result *all)
 {
-	static const char *const outcomes[] = {"traversed", "side_exit", "stuck", "unstable"};
-	static const char *const types[] = {"none", "left", "right"};
 	for (int k = 0; k < N_COLUMNS; k++)
 		if (col[k] >= n)
 			return -1;
@@ -117,8 +119,11 @@ static int parse_row(char **f, int n, const int *col, const bsim_sweep_result *r
 	bsim_trial_result *x = &all[g * r->trials + t];
 	if (x->steps_run) /* seen already */
 		return -1;
-	int o = name_index(f[col[COL_OUTCOME]], outcomes, BSIM_N_OUTCOMES);
-	int ty = name_index(f[col[COL_TYPE]], types, 3);
+	int o = -1, ty = -1;
+	for (int i = 0; i < BSIM_N_OUTCOMES; i++)
+		o = strcmp(f[col[COL_OUTCOME]], bsim_trial_outcome_name((bsim_outcome)i)) ? o : i;
+	for (int i = 0; i < 3; i++)
+		ty = strcmp(f[col[COL_TYPE]], bsim_trial_type_name((bsim_type)i)) ? ty : i;
 	if (o < 0 || ty < 0)
 		return -1;
 	x->outcome = (bsim_outcome)o;
@@ -161,7 +166,7 @@ static int read_header(char *line, int *col, int *n_fields)
 	for (int k = 0; k < N_COLUMNS; k++)
 		col[k] = -1;
 	for (int i = 0; i < n; i++) {
-		int k = name_index(f[i], column_names, N_COLUMNS);
+		int k = column_index(f[i]);
 		if (k >= 0 && col[k] >= 0)
 			return -1;
 		if (k >= 0)
@@ -237,6 +242,7 @@ int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_swe
 	for (size_t i = 0; i < total; i++)
 		r->trials_out[i].steps_run = 0;
 	for (int g = 0; g < n_groups; g++)
-		bsim_group_aggregate(&r->trials_out[(size_t)g * trials], trials, &r->groups[g]);
+		bsim_sweep_group_aggregate(&r->trials_out[(size_t)g * trials], trials,
+		                           &r->groups[g]);
 	return BSIM_OK;
 }

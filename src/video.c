@@ -14,7 +14,7 @@
 
 #include "video_internal.h"
 
-bsim_video_def bsim_video_default_def(void)
+bsim_video_def bsim_video_def_default(void)
 {
 	bsim_video_def d = {
 	        .width = 0,

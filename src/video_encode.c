@@ -32,7 +32,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "beamsim/atomic_file.h"
+#include "atomic_file.h"
 #include "beamsim/video.h"
 
 extern char **environ;

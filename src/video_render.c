@@ -112,8 +112,8 @@ static void set_color(cairo_t *cr, uint32_t c)
 static void beam_tip(const bsim_beam_def *b, double theta, double tip[2])
 {
 	double u0[2];
-	bsim_beam_rest_direction(b, u0);
-	double a = atan2(u0[1], u0[0]) + bsim_beam_forward_sign(b) * theta;
+	bsim_scene_beam_rest_direction(b, u0);
+	double a = atan2(u0[1], u0[0]) + bsim_scene_beam_forward_sign(b) * theta;
 	tip[0] = b->pivot[0] + b->length * cos(a);
 	tip[1] = b->pivot[1] + b->length * sin(a);
 }
@@ -465,13 +465,13 @@ static void draw_legend(cairo_t *cr, const bsim_video *v, const video_view *vw, 
 static void outcome_text(const bsim_scene *s, const bsim_trial_result *r, char *buf, size_t n)
 {
 	if (s->has_lattice && r->outcome != BSIM_UNSTABLE) {
-		const bsim_location loc = bsim_location_of(r);
+		const bsim_location loc = bsim_lattice_location_of(r);
 		if (loc.kind == BSIM_LOCATION_END)
 			snprintf(buf, n, "reached the end in column %d at t = %.2f s", loc.ix,
 			         r->t_end);
 		else if (loc.kind == BSIM_LOCATION_SIDE)
 			snprintf(buf, n, "left through the %s side in row %d at t = %.2f s",
-			         r->x_end < bsim_scene_centre_x(s) ? "left" : "right", loc.iy,
+			         r->x_end < bsim_lattice_centre_x(s) ? "left" : "right", loc.iy,
 			         r->t_end);
 		else
 			snprintf(buf, n, "stuck in gate (%d, %d) at t = %.2f s", loc.ix, loc.iy,
@@ -481,7 +481,7 @@ static void outcome_text(const bsim_scene *s, const bsim_trial_result *r, char *
 	switch (r->outcome) {
 	case BSIM_TRAVERSED:
 		snprintf(buf, n, "traversed at t = %.2f s (%s type)", r->t_end,
-		         bsim_type_name(r->type));
+		         bsim_trial_type_name(r->type));
 		break;
 	case BSIM_SIDE_EXIT:
 		snprintf(buf, n, "side exit at t = %.2f s", r->t_end);
@@ -491,7 +491,7 @@ static void outcome_text(const bsim_scene *s, const bsim_trial_result *r, char *
 		         r->in_contact_end ? "in contact" : "not in contact");
 		break;
 	default:
-		snprintf(buf, n, "%s at t = %.2f s", bsim_outcome_name(r->outcome), r->t_end);
+		snprintf(buf, n, "%s at t = %.2f s", bsim_trial_outcome_name(r->outcome), r->t_end);
 		break;
 	}
 }

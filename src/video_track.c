@@ -161,10 +161,10 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 		return bsim_error_set(err, BSIM_EINPUT, "fps: expected a positive number, got %g",
 		                      fps);
 	bsim_video_track *t = calloc(1, sizeof *t);
-	bsim_runner *runner = bsim_runner_alloc();
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	if (!t || !runner) {
 		free(t);
-		bsim_runner_free(runner);
+		bsim_trial_runner_free(runner);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
 	}
 	t->scene = scene;
@@ -173,7 +173,7 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 	t->last_step = -1;
 	if (bsim_effects_init(&t->fx, scene, seed)) {
 		free(t);
-		bsim_runner_free(runner);
+		bsim_trial_runner_free(runner);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
 	}
 	bsim_trial_log *log = bsim_trial_log_alloc();
@@ -181,7 +181,7 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 	        .csv = NULL, .stride = 1, .trace = track_trace, .trace_user = t, .log = log};
 	int rc = log ? bsim_trial_run(runner, scene, backend, opts, seed, &rec, &t->result, err)
 	             : bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
-	bsim_runner_free(runner);
+	bsim_trial_runner_free(runner);
 	if (rc == BSIM_OK && log->n_entries > 0) {
 		t->visits = malloc((size_t)log->n_entries * sizeof *t->visits);
 		if (!t->visits)

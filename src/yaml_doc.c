@@ -547,6 +547,19 @@ int ydoc_uint64(struct fy_node *n, uint64_t *out)
 	return 1;
 }
 
+int ydoc_uint64_text(struct fy_node *n, uint64_t *out)
+{
+	if (!n || !fy_node_is_scalar(n))
+		return 0;
+	const char *t = fy_node_get_scalar0(n);
+	int neg;
+	uint64_t mag;
+	if (!t || !*t || !parse_decimal(t, &neg, &mag) || (neg && mag != 0))
+		return 0;
+	*out = mag;
+	return 1;
+}
+
 int ydoc_index(const char *comp, size_t len, int *out)
 {
 	if (len == 0 || len > 9)

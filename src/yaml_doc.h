@@ -78,6 +78,9 @@ int ydoc_number(struct fy_node *n, double *out);
 /* Plain decimal integers only ("3000", "+7", "-1"); 1 on success. */
 int ydoc_int64(struct fy_node *n, long long *out);
 int ydoc_uint64(struct fy_node *n, uint64_t *out);
+/* The same, the digits plain or quoted ("18446744073709551615": JSON
+ * files write seeds above 2^53 as strings). */
+int ydoc_uint64_text(struct fy_node *n, uint64_t *out);
 
 /* The pair of a mapping whose scalar key is exactly comp[0..len). */
 struct fy_node_pair *ydoc_pair(struct fy_node *map, const char *comp, size_t len);

@@ -61,12 +61,12 @@ static double check_tangent(double r, double e, double u)
 	s.body.velocity[1] = u;
 	bsim_world *w = create(&s, NULL);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	int impacts = 0, tangent = 0;
 	double impact_loss = 0.0;
 	for (int n = 0; n < 20; n++) {
-		b2->step(w, zero, 0.004);
+		assert_int_equal(b2->step(w, zero, 0.004, NULL), BSIM_OK);
 		b2->get_state(w, &st);
 		impacts += st.impacts;
 		impact_loss += st.energy.impact;
@@ -132,12 +132,12 @@ static void run_tip(double e_tip, double out[4])
 	s.body.velocity[1] = 2.0;
 	bsim_world *w = create(&s, NULL);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	int impacts = 0, tip = 0;
 	double vrel_before = 0.0, vrel_after = 0.0;
 	for (int n_step = 0; n_step < 10; n_step++) {
-		b2->step(w, zero, 0.004);
+		assert_int_equal(b2->step(w, zero, 0.004, NULL), BSIM_OK);
 		b2->get_state(w, &st);
 		tip |= st.contact[0] == BSIM_CONTACT_TIP;
 		assert_true(st.contact[0] != BSIM_CONTACT_TANGENT);
@@ -210,12 +210,12 @@ static double vibration_error(const char *spring, double h, double rest_deg)
 	bsim_options o = opts_of(spring, NULL);
 	bsim_world *w = create(&s, &o);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	double worst = 0.0, damper = 0.0;
 	long n_steps = lround(3.0 / h);
 	for (long n = 1; n <= n_steps; n++) {
-		b2->step(w, zero, h);
+		assert_int_equal(b2->step(w, zero, h, NULL), BSIM_OK);
 		b2->get_state(w, &st);
 		double exact = oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
 		worst = fmax(worst, fabs(st.theta[0] - exact));
@@ -269,11 +269,11 @@ static void test_stiff_spring_stability(void **state)
 			bsim_options o = opts_of(weld ? "spring=weld" : "spring=torque", NULL);
 			bsim_world *w = create(&s, &o);
 			bsim_state st;
-			bsim_state_alloc(&st, 1);
+			bsim_state_init(&st, 1);
 			const double zero[2] = {0.0, 0.0};
 			double e0 = 0.5 * k * 0.04, e_max = 0.0, e = e0;
 			for (int n = 0; n < 2000 && isfinite(e) && e < 1e6 * e0; n++) {
-				b2->step(w, zero, h);
+				assert_int_equal(b2->step(w, zero, h, NULL), BSIM_OK);
 				b2->get_state(w, &st);
 				e = 0.5 * k * st.theta[0] * st.theta[0] +
 				    0.5 * inertia * st.omega[0] * st.omega[0];
@@ -305,14 +305,14 @@ static void test_stiff_spring_stability(void **state)
 
 static bsim_trial_result run_trial(const bsim_scene *s, const bsim_options *o, uint64_t seed)
 {
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
 	bsim_error err;
 	int rc = bsim_trial_run(r, s, b2, o, seed, NULL, &out, &err);
 	if (rc)
 		print_message("trial: %s\n", err.msg);
 	assert_int_equal(rc, BSIM_OK);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	return out;
 }
 
@@ -357,7 +357,8 @@ static double ledger_ratio(const char *spring, const char *substeps, double *abs
 		bsim_scene s;
 		bsim_scene_init_gate(&s, 7.0, 20.0);
 		bsim_options o = opts_of(spring, substeps);
-		bsim_trial_result out = run_trial(&s, &o, bsim_seed_mix(3, 0, (uint64_t)trial));
+		bsim_trial_result out =
+		        run_trial(&s, &o, bsim_schedule_seed_mix(3, 0, (uint64_t)trial));
 		const bsim_ledger *l = &out.ledger;
 		double scale = fabs(l->w_prop) + fabs(l->w_rand) + l->damper + l->impact;
 		assert_true(l->damper > 0.0 && l->w_prop > 0.0);
@@ -404,17 +405,17 @@ static void test_mirror_deviation(void **state)
 	a.body.start[0] = 1.5;
 	scene_mirror(&a, &b);
 	bsim_world *wa = create(&a, NULL), *wb = create(&b, NULL);
-	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_seed_mix(5, 0, 0));
+	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_schedule_seed_mix(5, 0, 0));
 	bsim_state sa, sb;
-	bsim_state_alloc(&sa, 2);
-	bsim_state_alloc(&sb, 2);
+	bsim_state_init(&sa, 2);
+	bsim_state_init(&sb, 2);
 	double dev_free = 0.0, dev_contact = 0.0, dev_all = 0.0;
 	int contact_steps = 0, first_contact = -1;
 	for (long n = 0; n < 3000; n++) {
 		double fr = bsim_schedule_value(sched, bsim_schedule_index(sched, n, a.dt));
 		const double fa[2] = {fr, 8.0}, fb[2] = {-fr, 8.0};
-		b2->step(wa, fa, a.dt);
-		b2->step(wb, fb, b.dt);
+		assert_int_equal(b2->step(wa, fa, a.dt, NULL), BSIM_OK);
+		assert_int_equal(b2->step(wb, fb, b.dt, NULL), BSIM_OK);
 		b2->get_state(wa, &sa);
 		b2->get_state(wb, &sb);
 		double dev = fmax(fmax(fabs(sa.x[0] + sb.x[0]), fabs(sa.x[1] - sb.x[1])),
@@ -479,11 +480,11 @@ static void test_set_state(void **state)
 	bsim_scene_init_gate(&s, 7.0, 0.0);
 	bsim_world *w = create(&s, NULL), *w2 = create(&s, NULL);
 	bsim_state st, st2;
-	bsim_state_alloc(&st, 2);
-	bsim_state_alloc(&st2, 2);
+	bsim_state_init(&st, 2);
+	bsim_state_init(&st2, 2);
 	const double f[2] = {0.0, 7.0};
 	for (int n = 0; n < 700; n++) /* into contact with both beams */
-		b2->step(w, f, s.dt);
+		assert_int_equal(b2->step(w, f, s.dt, NULL), BSIM_OK);
 	b2->get_state(w, &st);
 	assert_true(st.theta[0] > 0.05 && st.theta[1] > 0.05);
 	bsim_error err;
@@ -492,8 +493,8 @@ static void test_set_state(void **state)
 	assert_true(fabs(st2.x[1] - st.x[1]) <= 1e-5 && fabs(st2.theta[0] - st.theta[0]) <= 1e-6);
 	assert_true(fabs(st2.omega[1] - st.omega[1]) <= 1e-6);
 	for (int n = 0; n < 100; n++) {
-		b2->step(w, f, s.dt);
-		b2->step(w2, f, s.dt);
+		assert_int_equal(b2->step(w, f, s.dt, NULL), BSIM_OK);
+		assert_int_equal(b2->step(w2, f, s.dt, NULL), BSIM_OK);
 	}
 	b2->get_state(w, &st);
 	b2->get_state(w2, &st2);
@@ -501,7 +502,7 @@ static void test_set_state(void **state)
 	              fabs(st2.x[1] - st.x[1]));
 	assert_true(fabs(st2.x[1] - st.x[1]) <= 1e-3);
 	bsim_state bad;
-	bsim_state_alloc(&bad, 3);
+	bsim_state_init(&bad, 3);
 	assert_int_equal(b2->set_state(w2, &bad, &err), BSIM_EINPUT);
 	bsim_state_free(&bad);
 	bsim_state_free(&st);
@@ -509,6 +510,45 @@ static void test_set_state(void **state)
 	b2->destroy(w);
 	b2->destroy(w2);
 	bsim_scene_free(&s);
+}
+
+/* Box2D limits a body's motion per step to b2_maxTranslation units (2)
+ * by scaling its velocity; the adapter counts such steps. A body far from
+ * the beam at 1000 m/s (4 m a step of 4 ms) moves exactly 2 m a step and
+ * every step is clamped; at 400 m/s (1.6 m a step) none is and it moves
+ * 1.6 m. At unit_scale 0.5 the 2 units are 4 m, and 1000 m/s is clamped
+ * to 4 m a step. */
+static void check_clamp(double speed, const char *scale, double moved, long clamped)
+{
+	bsim_scene s;
+	scene_one_beam(&s);
+	s.body.start[0] = -300.0;
+	s.body.velocity[0] = -speed;
+	bsim_options o = {0};
+	bsim_error err;
+	if (scale)
+		assert_int_equal(bsim_options_add(&o, scale, &err), BSIM_OK);
+	bsim_world *w = create(&s, &o);
+	bsim_state st;
+	bsim_state_init(&st, 1);
+	const double zero[2] = {0.0, 0.0};
+	for (int n = 0; n < 5; n++)
+		assert_int_equal(b2->step(w, zero, 0.004, NULL), BSIM_OK);
+	b2->get_state(w, &st);
+	assert_int_equal(st.solver.clamped, clamped);
+	assert_int_equal(st.solver.iteration_limit, 0);
+	assert_float_equal(st.x[0], -300.0 - 5 * moved, 1e-4 * 5 * moved);
+	bsim_state_free(&st);
+	b2->destroy(w);
+	bsim_scene_free(&s);
+}
+
+static void test_clamped_motion(void **state)
+{
+	(void)state;
+	check_clamp(1000.0, NULL, 2.0, 5);
+	check_clamp(400.0, NULL, 1.6, 0);
+	check_clamp(1000.0, "unit_scale=0.5", 4.0, 5);
 }
 
 int main(void)
@@ -523,6 +563,7 @@ int main(void)
 	        cmocka_unit_test(test_mirror_deviation),
 	        cmocka_unit_test(test_bad_options),
 	        cmocka_unit_test(test_set_state),
+	        cmocka_unit_test(test_clamped_motion),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

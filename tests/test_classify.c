@@ -21,11 +21,11 @@ static bsim_trial_result coast(double vx, double deadband)
 	s.classify_deadband = deadband;
 	bsim_error err;
 	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
 	assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL, 1, NULL, &out, &err),
 	                 BSIM_OK);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	bsim_scene_free(&s);
 	assert_int_equal(out.outcome, BSIM_TRAVERSED);
 	assert_true(out.vx_end == vx);

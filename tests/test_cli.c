@@ -12,6 +12,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/version.h"
 #include "support.h"
 
 /* trials.csv: the contract's first eleven columns, then the appended ones
@@ -119,7 +120,18 @@ static void test_version(void **state)
 	const char *argv[] = {"--version", NULL};
 	cli_run r = run_cli(argv);
 	assert_int_equal(r.status, 0);
-	assert_string_equal(r.out, "beamsim 0.1.0\n");
+	/* The first line is the project's version; then what built it: the
+	 * Box2D of the CMake package the build found, and this compiler. */
+	assert_true(strncmp(r.out, "beamsim " BSIM_VERSION "\n",
+	                    strlen("beamsim " BSIM_VERSION "\n")) == 0);
+	assert_contains(r.out, "\ncommit ");
+	assert_contains(r.out, "\nBox2D " BSIM_TEST_BOX2D_VERSION "\n");
+#if defined(__GNUC__) && !defined(__clang__)
+	char compiler[64];
+	snprintf(compiler, sizeof compiler, "\ncompiler gcc %d.%d.%d\n", __GNUC__, __GNUC_MINOR__,
+	         __GNUC_PATCHLEVEL__);
+	assert_contains(r.out, compiler);
+#endif
 	cli_run_free(&r);
 }
 
@@ -413,7 +425,7 @@ static void test_unstable(void **state)
 	free(csv);
 	snprintf(file, sizeof file, "%s/summary.json", out);
 	char *json = bsim_test_read(file);
-	assert_contains(json, "\"unstable\": 10, \"deterministic\": true}");
+	assert_contains(json, "\"unstable\": 10, \"deterministic\": true, \"solver\": ");
 	free(json);
 }
 
@@ -452,8 +464,8 @@ static void test_sweep_deterministic(void **state)
 	snprintf(file, sizeof file, "%s/summary.json", out);
 	char *json = bsim_test_read(file);
 	assert_contains(json, "\"p_traverse\": 1, \"ci95\": [1, 1]");
-	assert_contains(json, "\"deterministic\": true}");
-	assert_contains(json, "\"deterministic\": false}");
+	assert_contains(json, "\"deterministic\": true, \"solver\": ");
+	assert_contains(json, "\"deterministic\": false, \"solver\": ");
 	free(json);
 }
 
@@ -464,6 +476,55 @@ static void test_backends(void **state)
 	cli_run r = run_cli(argv);
 	assert_int_equal(r.status, 0);
 	assert_contains(r.out, "thesis");
+	cli_run_free(&r);
+}
+
+/* A misspelt command or option is answered with the nearest one (edit
+ * distance), exit 2; a word near nothing gets the list, not a guess. */
+static void test_did_you_mean(void **state)
+{
+	(void)state;
+	const char *runn[] = {"runn", gate, NULL};
+	cli_run r = run_cli(runn);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err, "unknown command 'runn'; did you mean 'run'?");
+	cli_run_free(&r);
+	const char *trails[] = {"sweep", "x.yaml", "--trails", "3", NULL};
+	r = run_cli(trails);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err, "unknown option --trails (did you mean --trials?)");
+	cli_run_free(&r);
+	const char *far[] = {"xyzzy", NULL};
+	r = run_cli(far);
+	assert_int_equal(r.status, 2);
+	assert_true(strstr(r.err, "did you mean") == NULL);
+	assert_contains(r.err, "Commands:");
+	cli_run_free(&r);
+}
+
+/* --backend-opt B:K=V sets K on backend B, on run as on compare: for the
+ * backend run runs it is K=V (the JSON's options show it); for another it
+ * is refused, naming the backends the command runs. */
+static void test_backend_opt_story(void **state)
+{
+	(void)state;
+	const char *mine[] = {"run",    gate, "--backend-opt", "thesis:integrator=euler",
+	                      "--json", NULL};
+	cli_run r = run_cli(mine);
+	assert_int_equal(r.status, 0);
+	assert_contains(r.out, "\"integrator\": \"euler\"");
+	cli_run_free(&r);
+	const char *other[] = {"run", gate, "--backend-opt", "box2d:substeps=2", NULL};
+	r = run_cli(other);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err,
+	                "--backend-opt box2d:substeps=2: expected B:KEY=VALUE with B thesis");
+	cli_run_free(&r);
+	const char *help[] = {"backends", "--help", NULL};
+	r = run_cli(help);
+	assert_int_equal(r.status, 0);
+	assert_contains(r.out, "--backend-opt B:KEY=VALUE");
+	assert_contains(r.out, "--backend-opt KEY=VALUE");
 	cli_run_free(&r);
 }
 
@@ -483,6 +544,8 @@ int main(void)
 	        cmocka_unit_test(test_unstable),
 	        cmocka_unit_test(test_sweep_deterministic),
 	        cmocka_unit_test(test_backends),
+	        cmocka_unit_test(test_did_you_mean),
+	        cmocka_unit_test(test_backend_opt_story),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

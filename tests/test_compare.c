@@ -98,7 +98,7 @@ static void test_verdicts(void **state)
 	assert_float_equal(t->p_a, 0.75, 1e-15);
 	assert_float_equal(t->p_b, 0.05, 1e-15);
 	assert_float_equal(t->diff, 0.7, 1e-15);
-	assert_float_equal(t->p_value, bsim_mcnemar_exact(140, 0), 1e-300);
+	assert_float_equal(t->p_value, bsim_stats_mcnemar_exact(140, 0), 1e-300);
 	assert_true(t->p_holm >= t->p_value && t->beyond && !t->equivalent);
 	assert_int_equal(c.groups[2].ev[BSIM_EVENT_STUCK].pairs.c, 140);
 	assert_int_equal(c.groups[1].discordant, 3);
@@ -115,7 +115,7 @@ static void test_verdicts(void **state)
 		fewest++;
 	assert_int_equal(fewest, 10);
 	assert_float_equal(c.groups[0].ev[BSIM_EVENT_TRAVERSED].detectable, fewest / 200.0, 1e-15);
-	bsim_comparison_free(&c);
+	bsim_compare_free(&c);
 }
 
 /* A margin above the difference turns the disagreement into "small"; the
@@ -130,7 +130,7 @@ static void test_rule_knobs(void **state)
 	assert_int_equal(bsim_compare_analyse(&ra, &rb, NULL, &wide, &c, &err), BSIM_OK);
 	assert_int_equal(c.groups[2].verdict, BSIM_VERDICT_SMALL);
 	assert_int_equal(c.n_disagree, 1); /* the deterministic pair that differs */
-	bsim_comparison_free(&c);
+	bsim_compare_free(&c);
 
 	bsim_compare_rule exact = {0.05, 0.05, 1};
 	assert_int_equal(bsim_compare_analyse(&ra, &rb, NULL, &exact, &c, &err), BSIM_OK);
@@ -138,7 +138,7 @@ static void test_rule_knobs(void **state)
 	assert_int_equal(c.groups[1].verdict, BSIM_VERDICT_DISAGREE);
 	assert_int_equal(c.groups[0].verdict, BSIM_VERDICT_EQUIVALENT);
 	assert_int_equal(c.groups[5].verdict, BSIM_VERDICT_SAME);
-	bsim_comparison_free(&c);
+	bsim_compare_free(&c);
 }
 
 /* Too few trials to show anything: identical outcomes over 20 pairs are
@@ -156,11 +156,11 @@ static void test_inconclusive(void **state)
 	assert_int_equal(bsim_compare_analyse(&small_a, &small_b, NULL, &rule, &c, &err), BSIM_OK);
 	assert_int_equal(c.groups[0].verdict, BSIM_VERDICT_INCONCLUSIVE);
 	assert_int_equal(c.n_disagree, 0);
-	bsim_comparison_free(&c);
+	bsim_compare_free(&c);
 	rule.margin = 0.15;
 	assert_int_equal(bsim_compare_analyse(&small_a, &small_b, NULL, &rule, &c, &err), BSIM_OK);
 	assert_int_equal(c.groups[0].verdict, BSIM_VERDICT_EQUIVALENT);
-	bsim_comparison_free(&c);
+	bsim_compare_free(&c);
 }
 
 /* Separation quantiles by nearest rank over the separated pairs only; a
@@ -188,7 +188,7 @@ static void test_separation_quantiles(void **state)
 	assert_true(c.groups[1].t_sep[1] == -1.0);
 	assert_int_equal(c.groups[4].separated, 1);
 	assert_int_equal(c.separated, 11);
-	bsim_comparison_free(&c);
+	bsim_compare_free(&c);
 }
 
 static void test_shape_mismatch(void **state)

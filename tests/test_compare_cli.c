@@ -291,11 +291,14 @@ static void test_one_backend_two_settings(void **state)
 	char *a = read_in(dir, "thesis/trials.csv");
 	char *b = read_in(dir, "thesis-integrator=euler/trials.csv");
 	assert_string_not_equal(a, b); /* euler is another integrator */
+	/* Every knob in the backend's order, numbers as numbers. */
 	char *run = read_in(dir, "run.json");
 	assert_non_null(strstr(run, "\"label\": \"thesis:integrator=euler\", \"options\": "
-	                            "{\"slop\": \"2e-6\", \"integrator\": \"euler\""));
-	assert_non_null(strstr(run, "\"label\": \"thesis\", \"options\": {\"slop\": \"2e-6\", "
-	                            "\"integrator\": \"midpoint\""));
+	                            "{\"integrator\": \"euler\", \"impact_order\": "
+	                            "\"simultaneous\", \"projection\": 1, \"slop\": 2e-6,"));
+	assert_non_null(strstr(run, "\"label\": \"thesis\", \"options\": {\"integrator\": "
+	                            "\"midpoint\", \"impact_order\": \"simultaneous\", "
+	                            "\"projection\": 1, \"slop\": 2e-6,"));
 	char *md = read_in(dir, "report.md");
 	assert_non_null(strstr(md, "# beamsim compare: thesis vs thesis:integrator=euler"));
 	const char *again[] = {"regress", dir, "--exact", "--out", out_dir("euler_rerun"), NULL};
@@ -402,6 +405,11 @@ static void test_bad_usage(void **state)
 	                      out_dir("bad2"), NULL};
 	assert_int_equal(bsim_test_cli(knob, NULL, &err), 2);
 	assert_non_null(strstr(err, "nope"));
+	free(err);
+	const char *plain[] = {"compare",        experiment, "--backend-opt", "substeps=2", "--out",
+	                       out_dir("bad3b"), NULL};
+	assert_int_equal(bsim_test_cli(plain, NULL, &err), 2);
+	assert_non_null(strstr(err, "expected B:KEY=VALUE with several backends"));
 	free(err);
 	const char *who[] = {"compare",       experiment, "--backend-opt", "ode:x=1", "--out",
 	                     out_dir("bad3"), NULL};

@@ -30,8 +30,8 @@ static double beam_overlap(const bsim_scene *s, int i, const bsim_state *st)
 {
 	const bsim_beam_def *b = &s->beams[i];
 	double u0[2];
-	bsim_beam_rest_direction(b, u0);
-	double cs = cos(st->theta[i]), sn = bsim_beam_forward_sign(b) * sin(st->theta[i]);
+	bsim_scene_beam_rest_direction(b, u0);
+	double cs = cos(st->theta[i]), sn = bsim_scene_beam_forward_sign(b) * sin(st->theta[i]);
 	double u[2] = {u0[0] * cs - u0[1] * sn, u0[1] * cs + u0[0] * sn};
 	double dx = st->x[0] - b->pivot[0], dy = st->x[1] - b->pivot[1];
 	double along = fmin(fmax(dx * u[0] + dy * u[1], 0.0), b->length);
@@ -65,11 +65,11 @@ static bsim_trial_result run(const bsim_scene *s, const char *mode, uint64_t see
 	memset(w, 0, sizeof *w);
 	w->s = s;
 	bsim_recorder rec = {.stride = 1, .trace = watch_fn, .trace_user = w, .overlap = 1};
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
 	assert_int_equal(bsim_trial_run(r, s, &bsim_backend_thesis, &o, seed, &rec, &out, &err),
 	                 BSIM_OK);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	return out;
 }
 
@@ -82,7 +82,7 @@ static void test_pass_through(void **state)
 	double physical = 0.0, essay = 0.0;
 	int essay_steps = 0;
 	for (int t = 0; t < 20; t++) {
-		uint64_t seed = bsim_seed_mix(1, 17, (uint64_t)t);
+		uint64_t seed = bsim_schedule_seed_mix(1, 17, (uint64_t)t);
 		watch w;
 		bsim_trial_result r = run(&s, "physical", seed, &w);
 		physical = fmax(physical, w.deepest);
@@ -112,7 +112,7 @@ static void test_one_beam_same(void **state)
 	assert_int_equal(bsim_scene_set_beams(&s, 1), BSIM_OK);
 	int touched = 0;
 	for (int t = 0; t < 5; t++) {
-		uint64_t seed = bsim_seed_mix(2, 0, (uint64_t)t);
+		uint64_t seed = bsim_schedule_seed_mix(2, 0, (uint64_t)t);
 		watch w;
 		bsim_trial_result a = run(&s, "physical", seed, &w);
 		bsim_trial_result b = run(&s, "essay", seed, &w);

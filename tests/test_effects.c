@@ -25,7 +25,7 @@ static void test_no_random_force_no_draws(void **state)
 	assert_null(fx.random);
 	bsim_effects_free(&fx);
 
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
 	bsim_error err;
 	unsigned long before = bsim_schedule_total_draws();
@@ -43,7 +43,7 @@ static void test_no_random_force_no_draws(void **state)
 	                 BSIM_OK);
 	assert_int_equal(out.draws, (unsigned long)((out.steps_run - 1) / 5 + 1));
 	assert_int_equal(bsim_schedule_total_draws() - before, out.draws);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	bsim_scene_free(&s);
 }
 
@@ -67,7 +67,7 @@ static void test_empty_pipeline(void **state)
 static void test_schedule_hold_and_scale(void **state)
 {
 	(void)state;
-	bsim_schedule *s = bsim_schedule_alloc(20.0, 50.0, bsim_seed_mix(1, 2, 3));
+	bsim_schedule *s = bsim_schedule_alloc(20.0, 50.0, bsim_schedule_seed_mix(1, 2, 3));
 	for (long n = 0; n < 1000; n++)
 		assert_int_equal(bsim_schedule_index(s, n, 0.004), n / 5);
 	assert_int_equal(bsim_schedule_index(s, 7, 0.003), (long)floor(7 * 0.003 * 50.0));
@@ -92,15 +92,16 @@ static void test_schedule_hold_and_scale(void **state)
 static void test_seed_mixing(void **state)
 {
 	(void)state;
-	uint64_t base = bsim_seed_mix(1, 0, 0);
-	assert_true(base == bsim_seed_mix(1, 0, 0));
-	assert_true(base != bsim_seed_mix(1, 0, 1));
-	assert_true(base != bsim_seed_mix(1, 1, 0));
-	assert_true(base != bsim_seed_mix(2, 0, 0));
-	assert_true(bsim_seed_mix(1, 1, 0) != bsim_seed_mix(1, 0, 1)); /* not symmetric */
-	bsim_schedule *a = bsim_schedule_alloc(1.0, 50.0, bsim_seed_mix(1, 4, 7));
-	bsim_schedule *b = bsim_schedule_alloc(1.0, 50.0, bsim_seed_mix(1, 4, 7));
-	bsim_schedule *c = bsim_schedule_alloc(1.0, 50.0, bsim_seed_mix(1, 4, 8));
+	uint64_t base = bsim_schedule_seed_mix(1, 0, 0);
+	assert_true(base == bsim_schedule_seed_mix(1, 0, 0));
+	assert_true(base != bsim_schedule_seed_mix(1, 0, 1));
+	assert_true(base != bsim_schedule_seed_mix(1, 1, 0));
+	assert_true(base != bsim_schedule_seed_mix(2, 0, 0));
+	assert_true(bsim_schedule_seed_mix(1, 1, 0) !=
+	            bsim_schedule_seed_mix(1, 0, 1)); /* not symmetric */
+	bsim_schedule *a = bsim_schedule_alloc(1.0, 50.0, bsim_schedule_seed_mix(1, 4, 7));
+	bsim_schedule *b = bsim_schedule_alloc(1.0, 50.0, bsim_schedule_seed_mix(1, 4, 7));
+	bsim_schedule *c = bsim_schedule_alloc(1.0, 50.0, bsim_schedule_seed_mix(1, 4, 8));
 	int same_c = 0;
 	for (int j = 0; j < 100; j++) {
 		assert_true(bsim_schedule_value(a, j) == bsim_schedule_value(b, j));

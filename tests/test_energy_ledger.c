@@ -17,12 +17,12 @@
 
 static bsim_trial_result run(const bsim_scene *s, uint64_t seed)
 {
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
 	bsim_error err;
 	assert_int_equal(bsim_trial_run(r, s, &bsim_backend_thesis, NULL, seed, NULL, &out, &err),
 	                 BSIM_OK);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	return out;
 }
 
@@ -55,7 +55,7 @@ static void test_driven_damped_noisy(void **state)
 	for (int trial = 0; trial < 10; trial++) {
 		bsim_scene s;
 		bsim_scene_init_gate(&s, 7.0, 20.0);
-		bsim_trial_result out = run(&s, bsim_seed_mix(3, 0, (uint64_t)trial));
+		bsim_trial_result out = run(&s, bsim_schedule_seed_mix(3, 0, (uint64_t)trial));
 		const bsim_ledger *l = &out.ledger;
 		double scale = fabs(l->w_prop) + fabs(l->w_rand) + l->damper + l->impact;
 		double balance = (l->e_end - l->e_start) - (l->w_prop + l->w_rand - l->damper -

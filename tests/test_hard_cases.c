@@ -109,7 +109,7 @@ static void zeno_one(const char *bname, double e)
 	s.contact.restitution = s.contact.tip_restitution = e;
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 2);
+	bsim_state_init(&st, 2);
 	const double force[2] = {0.0, s.effects.propulsion_force};
 	const int steps = 5000;
 	/* apex: the largest gap between two touches; the total energy at an apex
@@ -117,7 +117,7 @@ static void zeno_one(const char *bname, double e)
 	double g_prev = 0.0, g_prev2 = 0.0, apex[64], apex_rise = 0.0;
 	int n_apex = 0, impacts = 0, max_per_step = 0, last_impact = 0, persistent_from = 0;
 	for (int n = 1; n <= steps; n++) {
-		b->step(w, force, s.dt);
+		assert_int_equal(b->step(w, force, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		double g = min_gap(&s, &st);
 		if (n >= 3 && g_prev > 1e-3 && g_prev > g_prev2 && g_prev >= g && n_apex < 64) {
@@ -181,11 +181,11 @@ static double_run double_one(const bsim_backend *b, double dx)
 	s.body.start[0] += dx;
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 2);
+	bsim_state_init(&st, 2);
 	const double zero[2] = {0.0, 0.0};
 	double_run r = {0, 0, 0, 0};
 	for (int n = 0; n < s.max_steps; n++) {
-		b->step(w, zero, s.dt);
+		assert_int_equal(b->step(w, zero, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		r.vx_max = fmax(r.vx_max, fabs(st.v[0]));
 	}
@@ -271,13 +271,13 @@ static int run_trial(const bsim_backend *b, const bsim_scene *s, uint64_t seed, 
 	wt->s = s;
 	wt->pen_max = -INFINITY;
 	bsim_recorder rec = {.stride = 1, .trace = watch_fn, .trace_user = wt};
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	assert_non_null(r);
 	bsim_error err;
 	int rc = bsim_trial_run(r, s, b, NULL, seed, &rec, res, &err);
 	if (rc)
 		print_message("trial: %s\n", err.msg);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	return rc;
 }
 
@@ -304,7 +304,8 @@ static void test_mass_ratio(void **state)
 				}
 				watch wt;
 				bsim_trial_result res;
-				int rc = run_trial(b, &s, bsim_seed_mix(1, 0, 0), &wt, &res);
+				int rc = run_trial(b, &s, bsim_schedule_seed_mix(1, 0, 0), &wt,
+				                   &res);
 				const bsim_ledger *l = &res.ledger;
 				double input = l->w_prop + l->w_rand;
 				double excess = l->e_end - (l->e_start + input);
@@ -315,7 +316,7 @@ static void test_mass_ratio(void **state)
 				        "|theta| %.3g, penetration %.3e m, pivot drift %.3e m, "
 				        "E_end - (E_0 + W) = %.3e J (W throughput %.3g J)\n",
 				        BACKENDS[k], beam_mass[m], wnh[j], rc,
-				        bsim_outcome_name(res.outcome), res.steps,
+				        bsim_trial_outcome_name(res.outcome), res.steps,
 				        fmax(fabs(res.max_theta[0]), fabs(res.max_theta[1])),
 				        wt.pen_max, wt.pivot_max, excess, scale);
 				assert_int_equal(rc, BSIM_OK);
@@ -345,7 +346,7 @@ static void wedge_one(const char *bname, double overlap)
 	load("configs/hard/wedge.yaml", &s);
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 2);
+	bsim_state_init(&st, 2);
 	if (overlap > 0.0) {
 		/* both beams touch a centred body at y0 = 2 (20 sin 60 - R):
 		 * distance 20 sin 60 - y/2; y0 + 2 overlap sinks it by overlap */
@@ -360,7 +361,7 @@ static void wedge_one(const char *bname, double overlap)
 	double vmax = 0.0, y_half = 0.0, x_half = 0.0, pen_end = 0.0;
 	int n = 0;
 	for (n = 1; n <= s.max_steps; n++) {
-		b->step(w, force, s.dt);
+		assert_int_equal(b->step(w, force, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		vmax = fmax(vmax, hypot(st.v[0], st.v[1]));
 		if (n == s.max_steps / 2) {
@@ -405,12 +406,12 @@ static double phase_one(const bsim_backend *b, double u, double phase, int *impa
 	s.body.start[1] = -s.body.radius - u * s.dt * phase;
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	*impacts = 0;
 	int steps = (int)phase + 20;
 	for (int n = 0; n < steps; n++) {
-		b->step(w, zero, s.dt);
+		assert_int_equal(b->step(w, zero, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		*impacts += st.impacts;
 	}
@@ -434,7 +435,7 @@ static void graze_one(const bsim_backend *b, const char *bname, double eps)
 	s.body.velocity[1] = u;
 	bsim_world *w = create(b, &s);
 	bsim_state st;
-	bsim_state_alloc(&st, 1);
+	bsim_state_init(&st, 1);
 	b->get_state(w, &st);
 	double e0 = energy_of(&s, &st);
 	double l0 = s.body.mass * (st.x[0] * st.v[1] - st.x[1] * st.v[0]) +
@@ -443,7 +444,7 @@ static void graze_one(const bsim_backend *b, const char *bname, double eps)
 	int tangent = 0, tip = 0, impacts = 0;
 	double pen = -INFINITY;
 	for (int n = 0; n < 400; n++) {
-		b->step(w, zero, s.dt);
+		assert_int_equal(b->step(w, zero, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		tangent |= st.contact[0] == BSIM_CONTACT_TANGENT;
 		tip |= st.contact[0] == BSIM_CONTACT_TIP;
@@ -521,8 +522,8 @@ static void test_violent_noise(void **state)
 		for (int t = 0; t < 40; t++) {
 			watch wt;
 			bsim_trial_result res;
-			failed +=
-			        run_trial(b, &s, bsim_seed_mix(6, 0, (uint64_t)t), &wt, &res) != 0;
+			failed += run_trial(b, &s, bsim_schedule_seed_mix(6, 0, (uint64_t)t), &wt,
+			                    &res) != 0;
 			tunnels += wt.tunnels;
 			nonfinite += wt.nonfinite;
 			pen = fmax(pen, wt.pen_max);
@@ -561,9 +562,9 @@ static void test_conservative_long(void **state)
 		print_message("conservative %s: %d steps, %s, end (%.3g, %.3g), energy drift %.3e "
 		              "(max rise %.2e), ledger impact %.3e contact %.3e correction %.3e "
 		              "residual %.3e J, penetration %.2e m, tunnels %d\n",
-		              BACKENDS[k], res.steps_run, bsim_outcome_name(res.outcome), res.x_end,
-		              res.y_end, drift, rise, l->impact, l->contact, l->correction,
-		              l->residual, wt.pen_max, wt.tunnels);
+		              BACKENDS[k], res.steps_run, bsim_trial_outcome_name(res.outcome),
+		              res.x_end, res.y_end, drift, rise, l->impact, l->contact,
+		              l->correction, l->residual, wt.pen_max, wt.tunnels);
 		assert_int_equal(rc, BSIM_OK);
 		assert_int_equal(res.steps_run, 100000);
 		assert_int_equal(wt.nonfinite, 0);

@@ -364,7 +364,7 @@ static void test_free_lane(void **state)
 		assert_int_equal(bsim_scene_set_beams(&s, 1), BSIM_OK);
 		bsim_landscape_barriers *b = barriers(&s, 0);
 		print_message("F = %g N: %s, crossed %d\n", forces[i],
-		              bsim_pass_kind_name(b->lowest.kind), b->lowest.beam);
+		              bsim_landscape_pass_kind_name(b->lowest.kind), b->lowest.beam);
 		assert_int_equal(b->lowest.kind, BSIM_PASS_OPEN);
 		assert_true(b->lowest.height == 0.0);
 		bsim_landscape_barriers_free(b);

@@ -297,7 +297,7 @@ static void test_errors(void **state)
 	}
 	{
 		const char *argv[] = {"landscape", gate, NULL};
-		const char *needles[] = {"missing --out", NULL};
+		const char *needles[] = {"--out DIR is required", NULL};
 		expect_bad(argv, gone, needles);
 	}
 	{

@@ -85,7 +85,7 @@ static void geometry_is_the_essays(void **state)
 	const int want[][2] = {{0, 0}, {0, 0}, {1, 1}, {-1, 1}, {-4, 0}, {4, 8}};
 	for (int k = 0; k < 6; k++) {
 		int ix, iy;
-		bsim_scene_gate_at(&s, pts[k], &ix, &iy);
+		bsim_lattice_gate_at(&s, pts[k], &ix, &iy);
 		assert_int_equal(ix, want[k][0]);
 		assert_int_equal(iy, want[k][1]);
 	}
@@ -134,13 +134,14 @@ static void run(const bsim_scene *s, const bsim_backend *b, const char *opt, uin
 	bsim_error err;
 	if (opt)
 		assert_int_equal(bsim_options_add(&opts, opt, &err), BSIM_OK);
-	bsim_runner *runner = bsim_runner_alloc();
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	o->log = bsim_trial_log_alloc();
 	bsim_recorder rec = {.stride = 1, .log = o->log};
-	int rc = bsim_trial_run(runner, s, b, &opts, bsim_seed_mix(1, 0, trial), &rec, &o->r, &err);
+	int rc = bsim_trial_run(runner, s, b, &opts, bsim_schedule_seed_mix(1, 0, trial), &rec,
+	                        &o->r, &err);
 	if (rc)
 		fail_msg("%s", err.msg);
-	bsim_runner_free(runner);
+	bsim_trial_runner_free(runner);
 }
 
 static void run_free(run_out *o)
@@ -190,8 +191,8 @@ static void far_gates_change_nothing(void **state)
 {
 	(void)state;
 	bsim_scene small, big;
-	bsim_scene_init_lattice(&small, 3, 3, 6.0, 30.0);
-	bsim_scene_init_lattice(&big, 33, 33, 6.0, 30.0);
+	bsim_lattice_scene_init(&small, 3, 3, 6.0, 30.0);
+	bsim_lattice_scene_init(&big, 33, 33, 6.0, 30.0);
 	bsim_scene *both[2] = {&small, &big};
 	for (int k = 0; k < 2; k++) { /* end where the body leaves gate (0, 0) */
 		both[k]->success_y = 60;
@@ -231,20 +232,21 @@ static void sleeping_keeps_outcomes(const bsim_backend *b, const char *scene, in
 		run(&s, b, "sleep=off", (uint64_t)t, &c);
 		on[t] = a.r;
 		off[t] = c.r;
-		changed += !bsim_location_equal(bsim_location_of(&a.r), bsim_location_of(&c.r));
+		changed += !bsim_lattice_location_equal(bsim_lattice_location_of(&a.r),
+		                                        bsim_lattice_location_of(&c.r));
 		slept += a.r.ledger.sleep;
 		assert_true(c.r.ledger.sleep == 0.0);
 		run_free(&a);
 		run_free(&c);
 	}
 	bsim_location_test lt;
-	bsim_location_test_run(on, off, trials, 7, &lt);
+	bsim_compare_location_test(on, off, trials, 7, &lt);
 	int b_only = 0, c_only = 0;
 	for (int t = 0; t < trials; t++) {
 		b_only += on[t].outcome == BSIM_TRAVERSED && off[t].outcome != BSIM_TRAVERSED;
 		c_only += on[t].outcome != BSIM_TRAVERSED && off[t].outcome == BSIM_TRAVERSED;
 	}
-	double p_mcnemar = bsim_mcnemar_exact(b_only, c_only);
+	double p_mcnemar = bsim_stats_mcnemar_exact(b_only, c_only);
 	print_message("%s: sleeping changed the final location of %d of %d trials; permutation "
 	              "p = %.3g, traversal McNemar p = %.3g (%d / %d); energy put to rest %.3g J "
 	              "per trial\n",
@@ -300,8 +302,8 @@ static void essay_is_world_on_one_gate(void **state)
 	for (int k = 0; k < 2; k++)
 		for (uint64_t t = 0; t < 4; t++) {
 			bsim_scene w, e;
-			bsim_scene_init_lattice(&w, 1, 1, 6.0, 30.0);
-			bsim_scene_init_lattice(&e, 1, 1, 6.0, 30.0);
+			bsim_lattice_scene_init(&w, 1, 1, 6.0, 30.0);
+			bsim_lattice_scene_init(&e, 1, 1, 6.0, 30.0);
 			e.lattice.protocol = BSIM_PROTOCOL_ESSAY;
 			run_out a, b;
 			run(&w, backends[k], "sleep=off", t, &a);
@@ -345,7 +347,7 @@ static void essay_resets_the_gate_left(void **state)
 {
 	(void)state;
 	bsim_scene s;
-	bsim_scene_init_lattice(&s, 1, 2, 0.0, 0.0);
+	bsim_lattice_scene_init(&s, 1, 2, 0.0, 0.0);
 	for (int i = 0; i < s.n_beams; i++)
 		s.beams[i].stiffness = 100.0;
 	s.body.velocity[1] = 30.0; /* m/s: through row 0's beams at once */
@@ -358,14 +360,14 @@ static void essay_resets_the_gate_left(void **state)
 		assert_true(o.log->n_entries >= 2);
 		assert_int_equal(o.log->entries[1].iy, 1);
 		beam_watch w = {&s, o.log->entries[1].step, 0.0, 0.0};
-		bsim_runner *runner = bsim_runner_alloc();
+		bsim_trial_runner *runner = bsim_trial_runner_alloc();
 		bsim_recorder rec = {.stride = 1, .trace = watch, .trace_user = &w};
 		bsim_trial_result r;
 		bsim_error err;
 		assert_int_equal(bsim_trial_run(runner, &s, &bsim_backend_thesis, NULL,
-		                                bsim_seed_mix(1, 0, 0), &rec, &r, &err),
+		                                bsim_schedule_seed_mix(1, 0, 0), &rec, &r, &err),
 		                 BSIM_OK);
-		bsim_runner_free(runner);
+		bsim_trial_runner_free(runner);
 		assert_true(w.e_at_entry > 1.0); /* row 0's beams were swinging */
 		assert_true(fabs(r.ledger.residual) < 1e-9);
 		if (protocol) {
@@ -420,7 +422,7 @@ static void lcp_many_contacts(void **state)
 			cs[0].c = cs[1].c = 0.0;
 		}
 		memcpy(gs, cs, sizeof cs);
-		thesis_lcp_solve(&w, cs, n);
+		assert_int_equal(thesis_lcp_solve(&w, cs, n), 0); /* converged */
 		double scale = 0.0;
 		for (int i = 0; i < n; i++) {
 			double wi = cs[i].vrel - cs[i].bound;
@@ -508,7 +510,7 @@ static void three_beams_static_equilibrium(void **state)
 	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
 	const double f[2] = {0.0, 40.0};
 	for (int n = 0; n < s.max_steps; n++)
-		bsim_backend_thesis.step(w, f, s.dt);
+		assert_int_equal(bsim_backend_thesis.step(w, f, s.dt, NULL), BSIM_OK);
 	/* contacts of the final state, and the spring torques */
 	double sum[2] = {0.0, 0.0};
 	int touching = 0;
@@ -563,8 +565,8 @@ static void permutation_is_mcnemar_for_two_locations(void **state)
 	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
 		fill_pairs(a, b, 80, cases[k][0], cases[k][1]);
 		bsim_location_test t;
-		bsim_location_test_run(a, b, 80, 1, &t);
-		double want = bsim_mcnemar_exact(cases[k][0], cases[k][1]);
+		bsim_compare_location_test(a, b, 80, 1, &t);
+		double want = bsim_stats_mcnemar_exact(cases[k][0], cases[k][1]);
 		assert_true(t.exact);
 		assert_int_equal(t.discordant, cases[k][0] + cases[k][1]);
 		assert_true(fabs(t.p_value - want) < 1e-12);
@@ -572,9 +574,9 @@ static void permutation_is_mcnemar_for_two_locations(void **state)
 	/* more than 20 discordant pairs: Monte Carlo, within its error */
 	fill_pairs(a, b, 80, 21, 9);
 	bsim_location_test t;
-	bsim_location_test_run(a, b, 80, 1, &t);
+	bsim_compare_location_test(a, b, 80, 1, &t);
 	assert_false(t.exact);
-	double want = bsim_mcnemar_exact(21, 9);
+	double want = bsim_stats_mcnemar_exact(21, 9);
 	print_message("Monte Carlo p = %.4f, exact McNemar %.4f\n", t.p_value, want);
 	assert_true(fabs(t.p_value - want) < 0.01);
 	assert_true(fabs(t.tv - 12.0 / 80.0) < 1e-12);
@@ -606,10 +608,10 @@ static void summary_counts(void **state)
 	assert_int_equal(bsim_lattice_summarise(r, logs, 3, 2, &ls), BSIM_OK);
 	assert_int_equal(ls.n_locations, 2);
 	char label[48];
-	bsim_location_label(ls.locations[0].loc, label, sizeof label);
+	bsim_lattice_location_label(ls.locations[0].loc, label, sizeof label);
 	assert_string_equal(label, "end:0");
 	assert_int_equal(ls.locations[0].count, 2);
-	bsim_location_label(ls.locations[1].loc, label, sizeof label);
+	bsim_lattice_location_label(ls.locations[1].loc, label, sizeof label);
 	assert_string_equal(label, "stuck:1:1");
 	/* by from, then to, rows first: (0,0)->(1,0), (0,0)->(0,1) twice,
 	 * (1,0)->(1,1) */
@@ -624,7 +626,7 @@ static void summary_counts(void **state)
 	assert_true(fabs(ls.row_time[0] - 4.0) < 1e-12);
 	assert_true(fabs(ls.row_time[1] - 16.0 / 3.0) < 1e-12);
 	double lo, hi;
-	bsim_wilson(2, 3, BSIM_Z95, &lo, &hi);
+	bsim_stats_wilson(2, 3, BSIM_STATS_Z95, &lo, &hi);
 	assert_true(ls.locations[0].ci95[0] == lo && ls.locations[0].ci95[1] == hi);
 	bsim_lattice_summary_free(&ls);
 }

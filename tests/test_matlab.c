@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/matlab.h"
+#include "matlab.h"
 #include "mat.h"
 #include "support.h"
 

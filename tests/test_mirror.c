@@ -32,16 +32,16 @@ static void test_mirror_bitwise_steps(void **state)
 	bsim_error err;
 	assert_int_equal(bsim_backend_thesis.create(&a, NULL, &wa, &err), BSIM_OK);
 	assert_int_equal(bsim_backend_thesis.create(&b, NULL, &wb, &err), BSIM_OK);
-	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_seed_mix(5, 0, 0));
+	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_schedule_seed_mix(5, 0, 0));
 	bsim_state sa, sb;
-	bsim_state_alloc(&sa, 2);
-	bsim_state_alloc(&sb, 2);
+	bsim_state_init(&sa, 2);
+	bsim_state_init(&sb, 2);
 	int contact_steps = 0;
 	for (long n = 0; n < 3000; n++) {
 		double fr = bsim_schedule_value(sched, bsim_schedule_index(sched, n, a.dt));
 		const double fa[2] = {fr, 8.0}, fb[2] = {-fr, 8.0};
-		bsim_backend_thesis.step(wa, fa, a.dt);
-		bsim_backend_thesis.step(wb, fb, b.dt);
+		assert_int_equal(bsim_backend_thesis.step(wa, fa, a.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_thesis.step(wb, fb, b.dt, NULL), BSIM_OK);
 		bsim_backend_thesis.get_state(wa, &sa);
 		bsim_backend_thesis.get_state(wb, &sb);
 		assert_true(sa.x[0] == -sb.x[0] && sa.x[1] == sb.x[1]);
@@ -66,7 +66,7 @@ static void test_mirror_bitwise_steps(void **state)
 static void test_mirror_trials(void **state)
 {
 	(void)state;
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	int traversed = 0;
 	for (int t = 0; t < 40; t++) {
 		bsim_scene a, b;
@@ -75,7 +75,7 @@ static void test_mirror_trials(void **state)
 		b.effects.random_magnitude = -a.effects.random_magnitude;
 		bsim_trial_result ra, rb;
 		bsim_error err;
-		uint64_t seed = bsim_seed_mix(9, 1, (uint64_t)t);
+		uint64_t seed = bsim_schedule_seed_mix(9, 1, (uint64_t)t);
 		assert_int_equal(
 		        bsim_trial_run(r, &a, &bsim_backend_thesis, NULL, seed, NULL, &ra, &err),
 		        BSIM_OK);
@@ -94,7 +94,7 @@ static void test_mirror_trials(void **state)
 		bsim_scene_free(&b);
 	}
 	print_message("mirror: %d of 40 trials traversed\n", traversed);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 }
 
 int main(void)

@@ -14,8 +14,8 @@
 
 #include <cmocka.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "support.h"
 
 /* The JSON text of x (static storage). */

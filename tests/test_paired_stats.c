@@ -18,15 +18,15 @@ static void test_mcnemar_by_hand(void **state)
 {
 	(void)state;
 	/* 0 of 5 discordant pairs one way: 2 * (1/2)^5. */
-	assert_float_equal(bsim_mcnemar_exact(0, 5), 0.0625, 1e-14);
+	assert_float_equal(bsim_stats_mcnemar_exact(0, 5), 0.0625, 1e-14);
 	/* 1 of 10: 2 * (1 + 10) / 1024. */
-	assert_float_equal(bsim_mcnemar_exact(1, 9), 22.0 / 1024.0, 1e-14);
-	assert_float_equal(bsim_mcnemar_exact(9, 1), 22.0 / 1024.0, 1e-14);
+	assert_float_equal(bsim_stats_mcnemar_exact(1, 9), 22.0 / 1024.0, 1e-14);
+	assert_float_equal(bsim_stats_mcnemar_exact(9, 1), 22.0 / 1024.0, 1e-14);
 	/* Balanced and empty: no evidence at all. */
-	assert_true(bsim_mcnemar_exact(5, 5) == 1.0);
-	assert_true(bsim_mcnemar_exact(0, 0) == 1.0);
+	assert_true(bsim_stats_mcnemar_exact(5, 5) == 1.0);
+	assert_true(bsim_stats_mcnemar_exact(0, 0) == 1.0);
 	/* 2 of 20: 2 * (1 + 20 + 190) / 2^20. */
-	assert_float_equal(bsim_mcnemar_exact(2, 18), 422.0 / 1048576.0, 1e-15);
+	assert_float_equal(bsim_stats_mcnemar_exact(2, 18), 422.0 / 1048576.0, 1e-15);
 }
 
 /* For many pairs the exact test meets the continuity-corrected normal
@@ -37,7 +37,7 @@ static void test_mcnemar_normal_limit(void **state)
 	int b = 1000, c = 1100;
 	double z = (fabs((double)(b - c)) - 1.0) / sqrt((double)(b + c));
 	double normal = erfc(z / sqrt(2.0));
-	double exact = bsim_mcnemar_exact(b, c);
+	double exact = bsim_stats_mcnemar_exact(b, c);
 	assert_true(exact > 0.0 && exact < 1.0);
 	assert_float_equal(exact / normal, 1.0, 0.03);
 }
@@ -49,14 +49,14 @@ static void test_holm_by_hand(void **state)
 	 * 0.04 x1 = 0.04 raised to the running maximum 0.06. */
 	double p[4] = {0.01, 0.04, 0.03, 0.005};
 	double adj[4];
-	bsim_holm(p, 4, adj);
+	bsim_stats_holm(p, 4, adj);
 	assert_float_equal(adj[0], 0.03, 1e-15);
 	assert_float_equal(adj[1], 0.06, 1e-15);
 	assert_float_equal(adj[2], 0.06, 1e-15);
 	assert_float_equal(adj[3], 0.02, 1e-15);
 	/* Capped at 1, and in place. */
 	double q[3] = {0.5, 0.9, 0.4};
-	bsim_holm(q, 3, q);
+	bsim_stats_holm(q, 3, q);
 	assert_true(q[0] == 1.0 && q[1] == 1.0 && q[2] == 1.0);
 }
 
@@ -68,9 +68,9 @@ static void test_paired_ci_normal_limit(void **state)
 	double n = 10000, d = (t.b - t.c) / n;
 	double se = sqrt(((t.b + t.c) / n - d * d) / n);
 	double lo, hi;
-	bsim_paired_diff_ci(&t, BSIM_Z95, &lo, &hi);
-	assert_float_equal(lo, d - BSIM_Z95 * se, 3e-4);
-	assert_float_equal(hi, d + BSIM_Z95 * se, 3e-4);
+	bsim_stats_newcombe_ci(&t, BSIM_STATS_Z95, &lo, &hi);
+	assert_float_equal(lo, d - BSIM_STATS_Z95 * se, 3e-4);
+	assert_float_equal(hi, d + BSIM_STATS_Z95 * se, 3e-4);
 }
 
 /* Shape: contains the estimate, mirrors when A and B swap, stays within
@@ -85,15 +85,15 @@ static void test_paired_ci_shape(void **state)
 			bsim_pairs s = {.a = t.a, .b = c, .c = b, .d = t.d};
 			int n = t.a + t.b + t.c + t.d;
 			double lo, hi, slo, shi, d = (double)(b - c) / n;
-			bsim_paired_diff_ci(&t, BSIM_Z95, &lo, &hi);
-			bsim_paired_diff_ci(&s, BSIM_Z95, &slo, &shi);
+			bsim_stats_newcombe_ci(&t, BSIM_STATS_Z95, &lo, &hi);
+			bsim_stats_newcombe_ci(&s, BSIM_STATS_Z95, &slo, &shi);
 			assert_true(-1.0 <= lo && lo <= d && d <= hi && hi <= 1.0);
 			assert_float_equal(lo, -shi, 1e-12);
 			assert_float_equal(hi, -slo, 1e-12);
 		}
 	bsim_pairs same = {.a = 40, .b = 0, .c = 0, .d = 60};
 	double lo, hi;
-	bsim_paired_diff_ci(&same, BSIM_Z95, &lo, &hi);
+	bsim_stats_newcombe_ci(&same, BSIM_STATS_Z95, &lo, &hi);
 	assert_true(lo < 0.0 && hi > 0.0);
 	assert_float_equal(lo, -hi, 1e-12);
 }
@@ -120,8 +120,8 @@ static void test_tango_published(void **state)
 	        {{1, 1, 7, 12}, 0.95, -0.517, -0.026, "Fagerland et al. 2014"},
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-		double lo, hi, z = bsim_normal_upper((1.0 - cases[i].level) / 2.0);
-		bsim_tango_ci(&cases[i].t, z, &lo, &hi);
+		double lo, hi, z = bsim_stats_normal_upper((1.0 - cases[i].level) / 2.0);
+		bsim_stats_tango_ci(&cases[i].t, z, &lo, &hi);
 		print_message("%s: [%.4f, %.4f], published [%.3f, %.3f]\n", cases[i].source, lo, hi,
 		              cases[i].lo, cases[i].hi);
 		assert_float_equal(lo, cases[i].lo, 5e-4);
@@ -137,15 +137,15 @@ static void test_tango_no_discordant(void **state)
 {
 	(void)state;
 	const bsim_pairs tables[] = {{40, 0, 0, 60}, {100, 0, 0, 0}, {0, 0, 0, 100}};
-	double z = BSIM_Z95, w = z * z / (100.0 + z * z);
+	double z = BSIM_STATS_Z95, w = z * z / (100.0 + z * z);
 	for (int i = 0; i < 3; i++) {
 		double lo, hi;
-		bsim_tango_ci(&tables[i], z, &lo, &hi);
+		bsim_stats_tango_ci(&tables[i], z, &lo, &hi);
 		assert_float_equal(lo, -w, 1e-9);
 		assert_float_equal(hi, w, 1e-9);
 	}
 	double nlo, nhi;
-	bsim_paired_diff_ci(&tables[0], z, &nlo, &nhi);
+	bsim_stats_newcombe_ci(&tables[0], z, &nlo, &nhi);
 	assert_true(nhi - nlo < 0.5 * (2.0 * w)); /* the collapse Tango avoids */
 }
 
@@ -158,16 +158,16 @@ static void test_tango_limit_and_shape(void **state)
 	double n = 10000, d = (t.b - t.c) / n;
 	double se = sqrt(((t.b + t.c) / n - d * d) / n);
 	double lo, hi;
-	bsim_tango_ci(&t, BSIM_Z95, &lo, &hi);
-	assert_float_equal(lo, d - BSIM_Z95 * se, 3e-4);
-	assert_float_equal(hi, d + BSIM_Z95 * se, 3e-4);
+	bsim_stats_tango_ci(&t, BSIM_STATS_Z95, &lo, &hi);
+	assert_float_equal(lo, d - BSIM_STATS_Z95 * se, 3e-4);
+	assert_float_equal(hi, d + BSIM_STATS_Z95 * se, 3e-4);
 	for (int b = 0; b <= 20; b += 4)
 		for (int c = 0; c <= 20; c += 5) {
 			bsim_pairs u = {.a = 30, .b = b, .c = c, .d = 70 - b - c};
 			bsim_pairs s = {.a = u.a, .b = c, .c = b, .d = u.d};
 			double l1, h1, l2, h2, e = (double)(b - c) / 100.0;
-			bsim_tango_ci(&u, BSIM_Z95, &l1, &h1);
-			bsim_tango_ci(&s, BSIM_Z95, &l2, &h2);
+			bsim_stats_tango_ci(&u, BSIM_STATS_Z95, &l1, &h1);
+			bsim_stats_tango_ci(&s, BSIM_STATS_Z95, &l2, &h2);
 			assert_true(-1.0 <= l1 && l1 < e && e < h1 && h1 <= 1.0);
 			assert_float_equal(l1, -h2, 1e-9);
 			assert_float_equal(h1, -l2, 1e-9);
@@ -176,8 +176,8 @@ static void test_tango_limit_and_shape(void **state)
 	 * T = sqrt(n (1 - delta) / (1 + delta)), so the interval is
 	 * [(n - z^2) / (n + z^2), 1]. */
 	bsim_pairs all = {0, 10, 0, 0};
-	double z2 = BSIM_Z95 * BSIM_Z95;
-	bsim_tango_ci(&all, BSIM_Z95, &lo, &hi);
+	double z2 = BSIM_STATS_Z95 * BSIM_STATS_Z95;
+	bsim_stats_tango_ci(&all, BSIM_STATS_Z95, &lo, &hi);
 	assert_true(hi == 1.0);
 	assert_float_equal(lo, (10.0 - z2) / (10.0 + z2), 1e-9);
 }
@@ -188,21 +188,21 @@ static void test_tango_limit_and_shape(void **state)
 static void test_tango_tost_matches_interval(void **state)
 {
 	(void)state;
-	double z90 = bsim_normal_upper(0.05);
+	double z90 = bsim_stats_normal_upper(0.05);
 	for (int b = 0; b <= 12; b++)
 		for (int c = 0; c <= 12; c += 3)
 			for (double m = 0.02; m < 0.3; m += 0.04) {
 				bsim_pairs t = {.a = 40, .b = b, .c = c, .d = 60 - b - c};
 				double lo, hi;
-				bsim_tango_ci(&t, z90, &lo, &hi);
+				bsim_stats_tango_ci(&t, z90, &lo, &hi);
 				int inside = lo > -m && hi < m;
-				int tost = bsim_tango_tost(&t, m) < 0.05;
+				int tost = bsim_stats_tango_tost(&t, m) < 0.05;
 				assert_int_equal(inside, tost);
 			}
 	bsim_pairs none = {40, 0, 0, 60};
-	assert_true(bsim_tango_tost(&none, 0.0) == 1.0);
+	assert_true(bsim_stats_tango_tost(&none, 0.0) == 1.0);
 	/* 100 identical pairs: 90% interval +-0.026, inside +-0.05. */
-	assert_true(bsim_tango_tost(&none, 0.05) < 0.05);
+	assert_true(bsim_stats_tango_tost(&none, 0.05) < 0.05);
 }
 
 /* The smallest significant split by hand: 2 (1/2)^m < level decides a
@@ -210,13 +210,13 @@ static void test_tango_tost_matches_interval(void **state)
 static void test_mcnemar_split(void **state)
 {
 	(void)state;
-	assert_int_equal(bsim_mcnemar_split(12, 0.05 / 150), -1);
-	assert_int_equal(bsim_mcnemar_split(13, 0.05 / 150), 0);
-	assert_int_equal(bsim_mcnemar_split(5, 0.0625), -1);
-	assert_int_equal(bsim_mcnemar_split(5, 0.0626), 0);
+	assert_int_equal(bsim_stats_mcnemar_split(12, 0.05 / 150), -1);
+	assert_int_equal(bsim_stats_mcnemar_split(13, 0.05 / 150), 0);
+	assert_int_equal(bsim_stats_mcnemar_split(5, 0.0625), -1);
+	assert_int_equal(bsim_stats_mcnemar_split(5, 0.0626), 0);
 	/* 10 pairs at 0.05: 1 vs 9 gives 22/1024 = 0.021, 2 vs 8 gives 0.109. */
-	assert_int_equal(bsim_mcnemar_split(10, 0.05), 1);
-	assert_int_equal(bsim_mcnemar_split(0, 0.05), -1);
+	assert_int_equal(bsim_stats_mcnemar_split(10, 0.05), 1);
+	assert_int_equal(bsim_stats_mcnemar_split(0, 0.05), -1);
 }
 
 int main(void)

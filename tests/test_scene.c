@@ -191,6 +191,16 @@ static void defaults_fill_what_a_file_leaves_out(void **state)
 	assert_true(s.dt == 0.004 && s.max_steps == 3000);
 	assert_true(s.success_y == 65 && s.side_x == 25 && s.classify_y == 80);
 	assert_true(s.landscape_y0 == 60);
+	/* bsim_scene_default is the same defaults, for scenes built in code:
+	 * every field the file left out equal to the file's. */
+	bsim_scene d = bsim_scene_default();
+	assert_true(d.n_beams == 0 && d.beams == NULL && !d.effects.has_propulsion);
+	assert_memory_equal(&d.contact, &s.contact, sizeof d.contact);
+	assert_memory_equal(&d.effects, &s.effects, sizeof d.effects);
+	assert_true(d.dt == s.dt && d.max_steps == s.max_steps && d.success_y == s.success_y);
+	assert_true(d.side_x == s.side_x && d.classify_y == s.classify_y);
+	assert_true(d.classify_deadband == s.classify_deadband && d.landscape_y0 == s.landscape_y0);
+	assert_true(d.gate_steps == s.gate_steps && d.has_lattice == s.has_lattice);
 	bsim_scene_free(&s);
 }
 

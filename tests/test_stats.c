@@ -14,7 +14,7 @@
 static void check(int k, int n, double lo, double hi)
 {
 	double l, h;
-	bsim_wilson(k, n, BSIM_Z95, &l, &h);
+	bsim_stats_wilson(k, n, BSIM_STATS_Z95, &l, &h);
 	/* Published to 4 decimals. */
 	assert_float_equal(l, lo, 5e-5);
 	assert_float_equal(h, hi, 5e-5);
@@ -42,9 +42,9 @@ static void test_wilson_exact_ends(void **state)
 {
 	(void)state;
 	double lo, hi;
-	bsim_wilson(0, 100, BSIM_Z95, &lo, &hi);
+	bsim_stats_wilson(0, 100, BSIM_STATS_Z95, &lo, &hi);
 	assert_true(lo == 0.0);
-	bsim_wilson(100, 100, BSIM_Z95, &lo, &hi);
+	bsim_stats_wilson(100, 100, BSIM_STATS_Z95, &lo, &hi);
 	assert_true(hi == 1.0);
 }
 
@@ -52,7 +52,7 @@ static void test_wilson_empty(void **state)
 {
 	(void)state;
 	double lo = -1, hi = -1;
-	bsim_wilson(0, 0, BSIM_Z95, &lo, &hi);
+	bsim_stats_wilson(0, 0, BSIM_STATS_Z95, &lo, &hi);
 	assert_true(lo == 0.0);
 	assert_true(hi == 1.0);
 }
@@ -66,12 +66,12 @@ static void test_wilson_shape(void **state)
 	double plo = -1.0, phi = -1.0;
 	for (int k = 0; k <= n; k++) {
 		double lo, hi, mlo, mhi;
-		bsim_wilson(k, n, BSIM_Z95, &lo, &hi);
+		bsim_stats_wilson(k, n, BSIM_STATS_Z95, &lo, &hi);
 		assert_true(lo >= 0.0 && hi <= 1.0 && lo <= hi);
 		assert_true(lo <= (double)k / n && (double)k / n <= hi);
 		assert_true(lo > plo || (k == 0 && lo == 0.0));
 		assert_true(hi > phi);
-		bsim_wilson(n - k, n, BSIM_Z95, &mlo, &mhi);
+		bsim_stats_wilson(n - k, n, BSIM_STATS_Z95, &mlo, &mhi);
 		assert_float_equal(lo, 1.0 - mhi, 1e-12);
 		assert_float_equal(hi, 1.0 - mlo, 1e-12);
 		plo = lo;
@@ -84,8 +84,8 @@ static void test_wilson_narrows(void **state)
 {
 	(void)state;
 	double lo1, hi1, lo2, hi2;
-	bsim_wilson(30, 100, BSIM_Z95, &lo1, &hi1);
-	bsim_wilson(300, 1000, BSIM_Z95, &lo2, &hi2);
+	bsim_stats_wilson(30, 100, BSIM_STATS_Z95, &lo1, &hi1);
+	bsim_stats_wilson(300, 1000, BSIM_STATS_Z95, &lo2, &hi2);
 	assert_true(hi2 - lo2 < hi1 - lo1);
 }
 
@@ -104,7 +104,7 @@ static void test_group_aggregate(void **state)
 	for (int i = 0; i < 6; i++)
 		t[i].steps_run = 100 + i;
 	bsim_group_result g;
-	bsim_group_aggregate(t, 6, &g);
+	bsim_sweep_group_aggregate(t, 6, &g);
 	assert_int_equal(g.trials, 6);
 	assert_int_equal(g.traversed, 3);
 	assert_int_equal(g.side_exit, 1);
@@ -117,7 +117,7 @@ static void test_group_aggregate(void **state)
 	assert_int_equal(g.steps, 615);
 	assert_float_equal(g.p_traverse, 0.5, 1e-15);
 	double lo, hi;
-	bsim_wilson(3, 6, BSIM_Z95, &lo, &hi);
+	bsim_stats_wilson(3, 6, BSIM_STATS_Z95, &lo, &hi);
 	assert_true(g.ci95[0] == lo && g.ci95[1] == hi);
 }
 

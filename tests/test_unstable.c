@@ -3,24 +3,32 @@
  * creates energy (a body speeding up with no force), and one that loses
  * it (a body slowing down with no force). The first two are unstable, with
  * the reason and the last finite state; the third is an ordinary outcome
- * (lost energy is inaccuracy, not instability). */
+ * (lost energy is inaccuracy, not instability). A backend whose step
+ * fails (out of memory) makes the trial an error, never a result; one
+ * whose solvers count what they gave up on has its counts in the result. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
 
+#include "beamsim/schedule.h"
+#include "beamsim/sweep.h"
 #include "beamsim/trial.h"
 
 /* A body alone: the beams never move. kind 0: NaN at step 10; 1: speed
- * grows by 1% a step; 2: speed falls by 1% a step. */
+ * grows by 1% a step; 2: speed falls by 1% a step; 3: the step fails at
+ * step 7; 4: every third step a solve reaches its limit, every step two
+ * substeps are clamped. */
 struct bsim_world {
 	int kind, n_beams;
 	long step;
 	double x[2], v[2];
+	bsim_solver_counts solver;
 };
 
 static int kind_of(const bsim_options *o)
@@ -47,15 +55,22 @@ static void fake_destroy(bsim_world *w)
 	free(w);
 }
 
-static void fake_step(bsim_world *w, const double force[2], double h)
+static int fake_step(bsim_world *w, const double force[2], double h, bsim_error *err)
 {
 	(void)force; /* the scene below has no forces */
 	w->step++;
+	if (w->kind == 3 && w->step == 7)
+		return bsim_error_set(err, BSIM_EFAIL, "fake: out of memory at step 7");
+	if (w->kind == 4) {
+		w->solver.iteration_limit += w->step % 3 == 0;
+		w->solver.clamped += 2;
+	}
 	double f = w->kind == 1 ? 1.01 : w->kind == 2 ? 0.99 : 1.0;
 	w->v[1] *= f;
 	w->x[1] += h * w->v[1];
 	if (w->kind == 0 && w->step == 10)
 		w->x[0] = NAN;
+	return BSIM_OK;
 }
 
 static void fake_get_state(const bsim_world *w, bsim_state *s)
@@ -67,6 +82,7 @@ static void fake_get_state(const bsim_world *w, bsim_state *s)
 		s->contact[i] = 0;
 	}
 	memset(&s->energy, 0, sizeof s->energy);
+	s->solver = w->solver;
 }
 
 static const bsim_knob fake_knobs[] = {{"kind", BSIM_KNOB_INT, "0", NULL, "how it fails"}};
@@ -92,10 +108,10 @@ static bsim_trial_result run(int kind)
 	char kv[16];
 	snprintf(kv, sizeof kv, "kind=%d", kind);
 	assert_int_equal(bsim_options_add(&o, kv, &err), BSIM_OK);
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
 	assert_int_equal(bsim_trial_run(r, &s, &fake, &o, 1, NULL, &out, &err), BSIM_OK);
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	bsim_scene_free(&s);
 	return out;
 }
@@ -140,12 +156,63 @@ static void test_energy_lost(void **state)
 	assert_true(r.ledger.residual < 0.0);
 }
 
+static void test_step_fails(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 0.0, 0.0);
+	s.effects.has_propulsion = 0;
+	s.max_steps = 200;
+	bsim_options o = {0};
+	bsim_error err;
+	assert_int_equal(bsim_options_add(&o, "kind=3", &err), BSIM_OK);
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
+	bsim_trial_result out;
+	assert_int_equal(bsim_trial_run(r, &s, &fake, &o, 1, NULL, &out, &err), BSIM_EFAIL);
+	assert_string_equal(err.msg, "fake: out of memory at step 7");
+	bsim_trial_runner_free(r);
+	bsim_scene_free(&s);
+}
+
+/* 200 steps: 66 of them a multiple of 3, two clamped substeps each. */
+static void test_solver_counts(void **state)
+{
+	(void)state;
+	bsim_trial_result r = run(4);
+	assert_int_equal(r.steps_run, 200);
+	assert_int_equal(r.solver.iteration_limit, 66);
+	assert_int_equal(r.solver.clamped, 400);
+	bsim_group_result g;
+	bsim_trial_result two[2] = {r, r};
+	bsim_sweep_group_aggregate(two, 2, &g);
+	assert_int_equal(g.solver.iteration_limit, 132);
+	assert_int_equal(g.solver.clamped, 800);
+}
+
+/* A value no schedule reaches is 0 and the schedule's status fails, naming
+ * it: never a NaN. */
+static void test_schedule_status(void **state)
+{
+	(void)state;
+	bsim_schedule *s = bsim_schedule_alloc(20.0, 50.0, 7);
+	bsim_error err;
+	assert_non_null(s);
+	assert_true(isfinite(bsim_schedule_value(s, 3)));
+	assert_int_equal(bsim_schedule_status(s, &err), BSIM_OK);
+	assert_true(bsim_schedule_value(s, -1) == 0.0);
+	assert_int_equal(bsim_schedule_status(s, &err), BSIM_EFAIL);
+	assert_non_null(strstr(err.msg, "value -1"));
+	bsim_schedule_reset(s, 20.0, 7);
+	assert_int_equal(bsim_schedule_status(s, &err), BSIM_OK);
+	bsim_schedule_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_nonfinite),
-	        cmocka_unit_test(test_energy_created),
-	        cmocka_unit_test(test_energy_lost),
+	        cmocka_unit_test(test_nonfinite),     cmocka_unit_test(test_energy_created),
+	        cmocka_unit_test(test_energy_lost),   cmocka_unit_test(test_step_fails),
+	        cmocka_unit_test(test_solver_counts), cmocka_unit_test(test_schedule_status),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -331,6 +331,27 @@ static void grid_conflict(void **state)
 	assert_null(trials);
 }
 
+/* A file of the other kind: an experiment given to run, a scene given to
+ * sweep or compare, is named as what it is, with the command that takes it. */
+static void wrong_kind_of_file(void **state)
+{
+	(void)state;
+	char exp[1024], scene[1024];
+	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/thesis/h1_symmetric.yaml"));
+	snprintf(scene, sizeof scene, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	const char *out = bsim_test_dir("wrong_kind");
+	const char *run[] = {"run", exp, NULL};
+	const char *run_needles[] = {"h1_symmetric.yaml:2:1: scene: this is an experiment file",
+	                             "beamsim sweep or compare", NULL};
+	expect_input_error(run, run_needles);
+	const char *sweep[] = {"sweep", scene, "--out", out, NULL};
+	const char *compare[] = {"compare", scene, "--out", out, NULL};
+	const char *scene_needles[] = {"gate.yaml:3:1: body: this is a scene file", "beamsim run",
+	                               NULL};
+	expect_input_error(sweep, scene_needles);
+	expect_input_error(compare, scene_needles);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -344,6 +365,7 @@ int main(void)
 	        cmocka_unit_test(bad_set_value),       cmocka_unit_test(set_into_unknown_key),
 	        cmocka_unit_test(empty_grid),          cmocka_unit_test(bad_grid_value),
 	        cmocka_unit_test(bad_experiment_keys), cmocka_unit_test(grid_conflict),
+	        cmocka_unit_test(wrong_kind_of_file),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -298,9 +298,9 @@ static void lib_camera_follows_the_body(void **state)
 	bsim_options opts = {0};
 	bsim_video_track *t = NULL;
 	assert_int_equal(bsim_video_track_record(&scene, &bsim_backend_thesis, &opts,
-	                                         bsim_seed_mix(1, 0, 0), 30.0, &t, &err),
+	                                         bsim_schedule_seed_mix(1, 0, 0), 30.0, &t, &err),
 	                 BSIM_OK);
-	bsim_video_def def = bsim_video_default_def();
+	bsim_video_def def = bsim_video_def_default();
 	def.width = 320;
 	def.height = 240;
 	def.view_span = 40.0;
@@ -412,7 +412,7 @@ static void lib_beams_take_their_stiffness_color(void **state)
 	assert_int_equal(
 	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
 	        BSIM_OK);
-	bsim_video_def def = bsim_video_default_def();
+	bsim_video_def def = bsim_video_def_default();
 	bsim_video *v = NULL;
 	assert_int_equal(bsim_video_alloc(&def, &scene, (const bsim_video_track *const *)&t, NULL,
 	                                  1, &v, &err),
@@ -455,11 +455,11 @@ static void lib_lattice_overview_shows_the_gate_path(void **state)
 	(void)state;
 	bsim_scene scene;
 	load("configs/lattice/c_track.yaml", &scene);
-	const uint64_t seed = bsim_seed_mix(1, 0, 592);
+	const uint64_t seed = bsim_schedule_seed_mix(1, 0, 592);
 	bsim_error err;
 	bsim_options opts = {0};
 	/* the truth: the runner's path */
-	bsim_runner *runner = bsim_runner_alloc();
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	bsim_trial_log *log = bsim_trial_log_alloc();
 	bsim_recorder rec = {.stride = 1, .log = log};
 	bsim_trial_result res;
@@ -471,7 +471,7 @@ static void lib_lattice_overview_shows_the_gate_path(void **state)
 	assert_int_equal(
 	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, seed, 30.0, &t, &err),
 	        BSIM_OK);
-	bsim_video_def def = bsim_video_default_def();
+	bsim_video_def def = bsim_video_def_default();
 	def.width = def.height = 480;
 	bsim_video *v = NULL;
 	const char *label = "thesis";
@@ -523,7 +523,7 @@ static void lib_lattice_overview_shows_the_gate_path(void **state)
 	bsim_video_free(v);
 	bsim_video_track_free(t);
 	bsim_trial_log_free(log);
-	bsim_runner_free(runner);
+	bsim_trial_runner_free(runner);
 	/* a gate that fits the view: no overview */
 	bsim_scene gate;
 	bsim_scene_init_gate(&gate, 7.0, 0.0);
@@ -605,7 +605,7 @@ static void lib_frames_are_the_runs_states(void **state)
 	bsim_options opts = {0};
 	bsim_video_track *t = NULL;
 	assert_int_equal(bsim_video_track_record(&scene, &bsim_backend_thesis, &opts,
-	                                         bsim_seed_mix(3, 0, 5), 30.0, &t, &err),
+	                                         bsim_schedule_seed_mix(3, 0, 5), 30.0, &t, &err),
 	                 BSIM_OK);
 	long frames = bsim_video_track_frames(t);
 	assert_int_equal(n_rows, bsim_video_track_result(t)->steps_run + 1);
@@ -657,7 +657,7 @@ static void lib_failing_encoder_writes_nothing(void **state)
 	assert_int_equal(
 	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
 	        BSIM_OK);
-	bsim_video_def def = bsim_video_default_def();
+	bsim_video_def def = bsim_video_def_default();
 	def.ffmpeg = "false";
 	bsim_video *v = NULL;
 	assert_int_equal(bsim_video_alloc(&def, &scene, (const bsim_video_track *const *)&t, NULL,

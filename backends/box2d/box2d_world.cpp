@@ -138,6 +138,23 @@ const bsim_knob box2d_knobs[] = {
          "Box2D's own sleeping for the beams, never for the body; auto: on for lattice "
          "scenes"},
 };
+/* The accuracy study's settings (beamsim accuracy): spring slowest-varying,
+ * then substeps, then velocity iterations; the first, the reference, is
+ * the most accurate. */
+const bsim_knob_setting box2d_accuracy[] = {
+        {"vi=30 sub=4 torque", "velocity_iterations=30:substeps=4:spring=torque"},
+        {"vi=8 sub=4 torque", "velocity_iterations=8:substeps=4:spring=torque"},
+        {"vi=4 sub=4 torque", "velocity_iterations=4:substeps=4:spring=torque"},
+        {"vi=30 sub=1 torque", "velocity_iterations=30:substeps=1:spring=torque"},
+        {"vi=8 sub=1 torque", "velocity_iterations=8:substeps=1:spring=torque"},
+        {"vi=4 sub=1 torque", "velocity_iterations=4:substeps=1:spring=torque"},
+        {"vi=30 sub=4 weld", "velocity_iterations=30:substeps=4:spring=weld"},
+        {"vi=8 sub=4 weld", "velocity_iterations=8:substeps=4:spring=weld"},
+        {"vi=4 sub=4 weld", "velocity_iterations=4:substeps=4:spring=weld"},
+        {"vi=30 sub=1 weld", "velocity_iterations=30:substeps=1:spring=weld"},
+        {"vi=8 sub=1 weld", "velocity_iterations=8:substeps=1:spring=weld"},
+        {"vi=4 sub=1 weld", "velocity_iterations=4:substeps=1:spring=weld"},
+};
 enum { KNOB_VEL_IT, KNOB_POS_IT, KNOB_SUBSTEPS, KNOB_SPRING, KNOB_UNIT_SCALE, KNOB_SLEEP };
 enum { SLEEP_AUTO = 0, SLEEP_ON = 1, SLEEP_OFF = 2 };
 constexpr int N_KNOBS = (int)(sizeof box2d_knobs / sizeof box2d_knobs[0]);
@@ -155,25 +172,6 @@ constexpr double PIN_MASS_RATIO = 1000.0;
 
 /* Collision categories: the body meets beams, nothing else meets anything. */
 constexpr uint16 CATEGORY_BODY = 0x0001, CATEGORY_BEAM = 0x0002;
-
-/* The rest direction, exact at multiples of 90 degrees so that a mirrored
- * beam (0 vs 180 degrees) has a mirrored tip bit for bit. */
-void rest_direction(double deg, double u[2])
-{
-	double q = deg / 90.0;
-	/* (long)q is defined only within long's range: angles beyond 1e15
-	 * quarter turns take the general path. */
-	if (q == std::floor(q) && std::fabs(q) < 1e15) {
-		static const double c[4] = {1, 0, -1, 0}, sn[4] = {0, 1, 0, -1};
-		long k = ((long)q % 4 + 4) % 4;
-		u[0] = c[k];
-		u[1] = sn[k];
-		return;
-	}
-	const double rad = deg * 0.017453292519943295; /* pi / 180 */
-	u[0] = std::cos(rad);
-	u[1] = std::sin(rad);
-}
 
 /* One beam: its Box2D body and what a step measures about it. */
 struct beam_rec {
@@ -233,7 +231,8 @@ struct bsim_world {
 	std::vector<int> contact_type;
 	bsim_step_energy energy = {};
 	int impacts = 0;
-	long toi_events = 0; /* continuous-collision sub-solves, all steps */
+	long toi_events = 0;         /* continuous-collision sub-solves, all steps */
+	bsim_solver_counts solver{}; /* clamped substeps, since creation */
 };
 
 /* Adds beam i to the ascending live list. */
@@ -654,8 +653,8 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 		beam_rec &b = w->beams[(size_t)i];
 		b.pivot[0] = d.pivot[0];
 		b.pivot[1] = d.pivot[1];
-		rest_direction(d.rest_angle_deg, b.u0);
-		b.sgn = b.u0[0] >= 0.0 ? 1.0 : -1.0; /* forward = toward +y */
+		bsim_scene_beam_rest_direction(&d, b.u0);
+		b.sgn = bsim_scene_beam_forward_sign(&d); /* forward = toward +y */
 		b.inertia = d.inertia;
 		b.stiffness = d.stiffness;
 		b.damping = d.damping;
@@ -719,6 +718,16 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 
 	/* The live list may have grown in the step (PreSolve). */
 	const size_t n_after = w->track_live ? w->live.size() : w->beams.size();
+	/* Box2D clamps a body's motion per step to b2_maxTranslation (units)
+	 * and b2_maxRotation (rad) by scaling its velocity, which then moves
+	 * exactly that far: a substep that ends there was clamped. */
+	const float hf = (float)h, near = 1.0f - 1e-5f;
+	bool clamped = hf * w->body->GetLinearVelocity().Length() >= near * b2_maxTranslation;
+	for (size_t k = 0; k < n_after && !clamped; k++) {
+		const beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
+		clamped = hf * std::fabs(b.body->GetAngularVelocity()) >= near * b2_maxRotation;
+	}
+	w->solver.clamped += clamped;
 	for (size_t k = 0; k < n_after; k++) {
 		const beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
 		if (b.damping == 0.0)
@@ -729,14 +738,19 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 	}
 }
 
-void box2d_step(bsim_world *w, const double force[2], double h)
+int box2d_step(bsim_world *w, const double force[2], double h, bsim_error *err)
 {
 	w->energy = bsim_step_energy{};
 	w->impacts = 0;
 	const double hs = h / w->substeps;
-	for (int k = 0; k < w->substeps; k++)
-		box2d_substep(w, force, hs);
-	update_contact_types(w);
+	try {
+		for (int k = 0; k < w->substeps; k++)
+			box2d_substep(w, force, hs);
+		update_contact_types(w);
+	} catch (const std::bad_alloc &) {
+		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory in a step");
+	}
+	return BSIM_OK;
 }
 
 void box2d_get_state(const bsim_world *w, bsim_state *st)
@@ -771,6 +785,7 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 	}
 	st->energy = w->energy;
 	st->impacts = w->impacts;
+	st->solver = w->solver;
 }
 
 /* Rebuilds the world at the state: no contact or joint impulses carried
@@ -812,4 +827,6 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         box2d_step,
         box2d_get_state,
         box2d_set_state,
+        box2d_accuracy,
+        (int)(sizeof box2d_accuracy / sizeof box2d_accuracy[0]),
 };

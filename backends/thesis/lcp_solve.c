@@ -20,8 +20,10 @@
  * pivot, an S with K_SS singular is skipped and the solution with linearly
  * independent rows is found). Beyond that, or if round-off leaves no set
  * within tolerance, projected Gauss-Seidel iterates to convergence; each
- * such solve is counted (thesis_lcp_fallbacks). test_lattice checks both
- * paths against the complementarity conditions. */
+ * such solve is counted (thesis_lcp_fallbacks), and one that reaches its
+ * iteration limit first is reported to the caller, which counts it in the
+ * world's solver counts. test_lattice checks both paths against the
+ * complementarity conditions. */
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_permutation.h>
@@ -31,6 +33,8 @@
 
 /* Contacts solved exactly by enumeration: 2^n active sets. */
 #define LCP_EXACT_MAX 10
+/* Projected Gauss-Seidel's sweeps at most. */
+#define LCP_ITERATIONS_MAX 100000
 
 static double k_entry(const struct bsim_world *w, const thesis_contact *a, const thesis_contact *b)
 {
@@ -68,11 +72,13 @@ static void lcp_two(const struct bsim_world *w, thesis_contact *c0, thesis_conta
 		c1->impulse = p1;
 }
 
-static void lcp_gauss_seidel(const struct bsim_world *w, thesis_contact *cs, int n)
+/* Sweeps until no impulse changes by more than 1e-14 N s; 1 if it stopped
+ * at its iteration limit instead. */
+static int lcp_gauss_seidel(const struct bsim_world *w, thesis_contact *cs, int n)
 {
 	for (int i = 0; i < n; i++)
 		cs[i].impulse = 0.0;
-	for (int iter = 0; iter < 100000; iter++) {
+	for (int iter = 0; iter < LCP_ITERATIONS_MAX; iter++) {
 		double change = 0.0;
 		for (int i = 0; i < n; i++) {
 			double wi = cs[i].vrel - cs[i].bound;
@@ -83,8 +89,9 @@ static void lcp_gauss_seidel(const struct bsim_world *w, thesis_contact *cs, int
 			cs[i].impulse = p;
 		}
 		if (change <= 1e-14)
-			break;
+			return 0;
 	}
+	return 1;
 }
 
 static int popcount(unsigned v)
@@ -175,7 +182,7 @@ long thesis_lcp_fallbacks(void)
 	return n;
 }
 
-void thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n)
+int thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n)
 {
 	if (n == 1) {
 		double q = cs[0].vrel - cs[0].bound;
@@ -184,11 +191,12 @@ void thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n)
 		lcp_two(w, &cs[0], &cs[1]);
 	} else if (n > 2) {
 		if (n <= LCP_EXACT_MAX && lcp_enumerate(w, cs, n))
-			return;
+			return 0;
 #pragma omp atomic update
 		lcp_fallbacks++;
-		lcp_gauss_seidel(w, cs, n);
+		return lcp_gauss_seidel(w, cs, n);
 	}
+	return 0;
 }
 
 void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2])

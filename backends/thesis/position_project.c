@@ -19,7 +19,7 @@ static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const 
 		cs[k].bound = 0.0;
 		cs[k].inv_i = 1.0 / w->beams[cs[k].beam].inertia;
 	}
-	thesis_lcp_solve(w, cs, n);
+	w->solver.iteration_limit += thesis_lcp_solve(w, cs, n);
 	double dx = 0.0, dy = 0.0, de = 0.0;
 	for (int k = 0; k < n; k++) {
 		thesis_beam *b = &w->beams[cs[k].beam];
@@ -36,6 +36,9 @@ static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const 
 	w->energy.correction += (force[0] * dx + force[1] * dy) - de;
 }
 
+/* Projections per step at most. */
+#define PROJECT_PASSES_MAX 3
+
 /* Re-detects the step's contacts at the new positions (they are the only
  * beams the step could have reached) and projects out penetration. */
 void thesis_position_project(struct bsim_world *w, const double force[2])
@@ -45,12 +48,16 @@ void thesis_position_project(struct bsim_world *w, const double force[2])
 	int n = 0;
 	for (int k = 0; k < w->n_contacts; k++)
 		n += thesis_contact_detect(w, cs[k].beam, margin, &cs[n]);
-	for (int pass = 0; w->projection && pass < 3; pass++) {
+	for (int pass = 0; w->projection; pass++) {
 		int deep = 0;
 		for (int k = 0; k < n; k++)
 			deep |= cs[k].gap < -w->slop;
 		if (!deep)
 			break;
+		if (pass == PROJECT_PASSES_MAX) { /* still deeper than slop */
+			w->solver.iteration_limit++;
+			break;
+		}
 		project_once(w, cs, n, force);
 		int m = 0;
 		for (int k = 0; k < n; k++)

@@ -84,6 +84,7 @@ struct bsim_world {
 	int any_held;
 	bsim_step_energy energy;
 	int impacts;
+	bsim_solver_counts solver; /* since creation */
 };
 
 /* broad_phase.c */
@@ -102,8 +103,9 @@ void thesis_beam_direction(const thesis_beam *b, double u[2]);
 int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out);
 void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c);
 
-/* lcp_solve.c */
-void thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n);
+/* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
+ * counts it in w->solver), else 0. */
+int thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n);
 /* Solves with more than 2 contacts that fell back to Gauss-Seidel, all
  * worlds, since the program started. */
 long thesis_lcp_fallbacks(void);
@@ -118,8 +120,8 @@ double thesis_beam_response(const thesis_beam *b, double h, int integrator);
 double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator);
 double thesis_beam_advance(thesis_beam *b, double omega_new, double h, int integrator);
 
-/* contact_solve.c */
-void thesis_contact_solve(struct bsim_world *w, const double force[2], double h);
+/* persistent_contact.c */
+void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h);
 
 /* position_project.c */
 void thesis_position_project(struct bsim_world *w, const double force[2]);

@@ -50,6 +50,15 @@ static const bsim_knob thesis_knobs[] = {
         {"sleep_energy", BSIM_KNOB_DOUBLE, "1e-6", NULL,
          "energy below which a beam the body has left sleeps, J"},
 };
+/* The accuracy study's settings (beamsim accuracy): the integrators and
+ * impact orders; the first, the reference, is the most accurate. */
+static const bsim_knob_setting thesis_accuracy[] = {
+        {"midpoint simultaneous", "integrator=midpoint:impact_order=simultaneous"},
+        {"midpoint nearest_first", "integrator=midpoint:impact_order=nearest_first"},
+        {"euler simultaneous", "integrator=euler:impact_order=simultaneous"},
+        {"euler nearest_first", "integrator=euler:impact_order=nearest_first"},
+};
+
 enum {
 	KNOB_INTEGRATOR,
 	KNOB_IMPACT_ORDER,
@@ -63,25 +72,6 @@ enum {
 };
 enum { SLEEP_AUTO = 0, SLEEP_ON = 1, SLEEP_OFF = 2 };
 #define N_KNOBS ((int)(sizeof thesis_knobs / sizeof thesis_knobs[0]))
-
-/* The rest direction, exact at multiples of 90 degrees so that a mirrored
- * beam (0 vs 180 degrees) is mirrored bit for bit. */
-static void rest_direction(double deg, double u[2])
-{
-	double q = deg / 90.0;
-	/* (long)q is defined only within long's range: angles beyond 1e15
-	 * quarter turns take the general path. */
-	if (q == floor(q) && fabs(q) < 1e15) {
-		static const double c[4] = {1, 0, -1, 0}, s[4] = {0, 1, 0, -1};
-		long k = ((long)q % 4 + 4) % 4;
-		u[0] = c[k];
-		u[1] = s[k];
-		return;
-	}
-	const double rad = deg * 0.017453292519943295; /* pi / 180 */
-	u[0] = cos(rad);
-	u[1] = sin(rad);
-}
 
 static void thesis_destroy(bsim_world *w)
 {
@@ -135,8 +125,8 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		const bsim_beam_def *d = &scene->beams[i];
 		thesis_beam *b = &w->beams[i];
 		memcpy(b->p, d->pivot, sizeof b->p);
-		rest_direction(d->rest_angle_deg, b->u0);
-		b->sgn = b->u0[0] >= 0.0 ? 1.0 : -1.0; /* forward = toward +y */
+		bsim_scene_beam_rest_direction(d, b->u0);
+		b->sgn = bsim_scene_beam_forward_sign(d); /* forward = toward +y */
 		b->length = d->length;
 		b->inertia = d->inertia;
 		b->stiffness = d->stiffness;
@@ -201,8 +191,10 @@ static int essay_hold(bsim_world *w)
 	return any;
 }
 
-static void thesis_step(bsim_world *w, const double force[2], double h)
+/* Nothing in a step allocates: the world's memory is sized at creation. */
+static int thesis_step(bsim_world *w, const double force[2], double h, bsim_error *err)
 {
+	(void)err;
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
 	for (int k = 0; k < w->n_typed; k++)
@@ -223,7 +215,7 @@ static void thesis_step(bsim_world *w, const double force[2], double h)
 	w->n_contacts = n;
 	if (n)
 		thesis_impact_resolve(w, h);
-	thesis_contact_solve(w, force, h);
+	thesis_persistent_contact_solve(w, force, h);
 	if (w->contact_mode == THESIS_CONTACT_ESSAY)
 		w->any_held = essay_hold(w);
 	if (n)
@@ -234,6 +226,7 @@ static void thesis_step(bsim_world *w, const double force[2], double h)
 	if (w->sleep)
 		thesis_beams_sleep(w, speed, h);
 	thesis_awake_prune(w);
+	return BSIM_OK;
 }
 
 static void thesis_get_state(const bsim_world *w, bsim_state *s)
@@ -250,6 +243,7 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 	}
 	s->energy = w->energy;
 	s->impacts = w->impacts;
+	s->solver = w->solver;
 }
 
 static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
@@ -287,4 +281,6 @@ const bsim_backend bsim_backend_thesis = {
         .step = thesis_step,
         .get_state = thesis_get_state,
         .set_state = thesis_set_state,
+        .accuracy = thesis_accuracy,
+        .n_accuracy = (int)(sizeof thesis_accuracy / sizeof thesis_accuracy[0]),
 };

@@ -21,6 +21,8 @@
 #include <stdio.h>
 
 #include "beamsim/backend.h"
+#include "beamsim/figures.h"
+#include "beamsim/progress.h"
 #include "beamsim/scene.h"
 
 #ifdef __cplusplus
@@ -51,15 +53,22 @@ int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_sce
                               bsim_error *err);
 
 typedef struct bsim_accuracy_config {
-	double h_ref;  /* s, finest step and the reference's (0.000125) */
-	double h_max;  /* s, coarsest step (0.016); steps are h_max / 2^i */
-	double piece;  /* s, duration of restarted pieces (0.064) */
-	int n_pieces;  /* restart points (16) */
-	int n_trials;  /* trials of the p_traverse batch (40) */
-	uint64_t seed; /* schedules: bsim_seed_mix(seed, 0, trial) */
-	int threads;   /* <= 0: all */
-	int progress;  /* 1: a progress line on stderr */
+	double h_ref;              /* s, finest step and the reference's (0.000125) */
+	double h_max;              /* s, coarsest step (0.016); steps are h_max / 2^i */
+	double piece;              /* s, duration of restarted pieces (0.064) */
+	int n_pieces;              /* restart points (16) */
+	int n_trials;              /* trials of the p_traverse batch (40) */
+	uint64_t seed;             /* schedules: bsim_schedule_seed_mix(seed, 0, trial) */
+	int threads;               /* <= 0: all */
+	bsim_progress_fn progress; /* may be NULL: settings done of all */
+	void *progress_user;
 } bsim_accuracy_config;
+
+/* The study of docs/accuracy.md: h from 0.016 s halved down to 0.000125 s,
+ * 16 pieces of 0.064 s, 40 trials, seed 1, all threads. */
+bsim_accuracy_config bsim_accuracy_default(void);
+/* A quick study for tests: h down to 0.0005 s, 4 pieces, 8 trials. */
+bsim_accuracy_config bsim_accuracy_quick(void);
 
 /* One row: a backend, a knob setting and a time step. */
 typedef struct bsim_accuracy_row {
@@ -84,8 +93,9 @@ typedef struct bsim_accuracy_result {
 	double wall_seconds;
 } bsim_accuracy_result;
 
-/* The knob settings studied for a backend ("thesis", "box2d"): n settings
- * into a malloc'd array (caller frees); the reference knobs are one of them. */
+/* The knob settings studied for backend b, its accuracy list
+ * (beamsim/backend.h): n settings into a malloc'd array (caller frees), the
+ * first the reference. BSIM_EINPUT if b lists none. */
 int bsim_accuracy_settings(const bsim_backend *b, bsim_accuracy_row **out, int *n, bsim_error *err);
 
 /* The whole study over the backends. Results other than the timings do not
@@ -100,6 +110,16 @@ int bsim_accuracy_write_csv(const char *path, const bsim_accuracy_result *r, bsi
 int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result *r,
                            const bsim_accuracy_config *cfg, const char *scene_label,
                            bsim_error *err);
+
+/* The study written into the output directory out as one set (checked
+ * before the study runs): accuracy.csv, accuracy.mat, accuracy.md (naming
+ * the scene by scene_label) and the figure accuracy (.png, .svg, .gp,
+ * .dat). fig gets the figure's result (its notes say what gnuplot could
+ * not draw); free it and res on BSIM_OK. */
+int bsim_accuracy_store(const char *out, const bsim_scene *scene, const char *scene_label,
+                        const bsim_backend *const *backends, int n_backends,
+                        const bsim_accuracy_config *cfg, bsim_accuracy_result *res,
+                        bsim_figures_result *fig, bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -26,9 +26,9 @@ typedef enum {
 	BSIM_N_EVENTS
 } bsim_event;
 
-const char *bsim_event_name(bsim_event ev);
+const char *bsim_compare_event_name(bsim_event ev);
 /* 1 if trial r shows event ev. */
-int bsim_event_of(const bsim_trial_result *r, bsim_event ev);
+int bsim_compare_event_of(const bsim_trial_result *r, bsim_event ev);
 
 /* When a group disagrees: some event's McNemar p-value, Holm-adjusted over
  * every (group, event) test of the comparison, is below alpha AND that
@@ -56,8 +56,8 @@ typedef struct bsim_compare_rule {
 	int exact;
 } bsim_compare_rule;
 
-#define BSIM_COMPARE_ALPHA  0.05
-#define BSIM_COMPARE_MARGIN 0.05
+/* alpha 0.05, margin 0.05, not exact. */
+bsim_compare_rule bsim_compare_rule_default(void);
 
 typedef struct bsim_event_test {
 	bsim_pairs pairs;        /* a: both, b: only A, c: only B, d: neither */
@@ -85,9 +85,9 @@ typedef enum {
 	BSIM_N_VERDICTS
 } bsim_verdict;
 
-const char *bsim_verdict_name(bsim_verdict v);
+const char *bsim_compare_verdict_name(bsim_verdict v);
 
-/* Lattices: where the paired trials ended (bsim_location_of). The test of
+/* Lattices: where the paired trials ended (bsim_lattice_location_of). The test of
  * "both sides have the same final-location distribution" is a paired
  * permutation test: under that hypothesis the two locations of a pair are
  * exchangeable, so each of the d discordant pairs is swapped or not with
@@ -109,8 +109,8 @@ typedef struct bsim_location_test {
 #define BSIM_LOCATION_RESAMPLES 20000
 
 /* The paired permutation test on n pairs of final locations. */
-void bsim_location_test_run(const bsim_trial_result *a, const bsim_trial_result *b, int n,
-                            uint64_t seed, bsim_location_test *out);
+void bsim_compare_location_test(const bsim_trial_result *a, const bsim_trial_result *b, int n,
+                                uint64_t seed, bsim_location_test *out);
 
 typedef struct bsim_compare_group {
 	int deterministic; /* one pair: ev has the 0/1 events, no statistics */
@@ -144,13 +144,13 @@ typedef struct bsim_comparison {
 int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
                          const double *t_separate, const bsim_compare_rule *rule,
                          bsim_comparison *out, bsim_error *err);
-void bsim_comparison_free(bsim_comparison *c);
+void bsim_compare_free(bsim_comparison *c);
 
 /* 1 if trials differ in outcome or traversal type. */
-int bsim_trial_discordant(const bsim_trial_result *a, const bsim_trial_result *b);
+int bsim_compare_discordant(const bsim_trial_result *a, const bsim_trial_result *b);
 /* 1 if trials are identical in every field trials.csv records (the
  * ledger's only if ledger is 1). */
-int bsim_trial_identical(const bsim_trial_result *a, const bsim_trial_result *b, int ledger);
+int bsim_compare_identical(const bsim_trial_result *a, const bsim_trial_result *b, int ledger);
 
 #ifdef __cplusplus
 }

@@ -39,6 +39,11 @@ int bsim_effects_random(const bsim_scene *scene);
 int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed);
 void bsim_effects_free(bsim_effects *fx);
 
+/* BSIM_OK, or BSIM_EFAIL if an effect could not give its force (the random
+ * force's schedule, bsim_schedule_status): the forces applied are not the
+ * scene's, so the trial is not a result. */
+int bsim_effects_status(const bsim_effects *fx, bsim_error *err);
+
 /* Sum of all effects' forces on the body at step n. */
 static inline void bsim_effects_force(bsim_effects *fx, long n, double h, double f[2])
 {

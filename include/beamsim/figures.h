@@ -82,6 +82,14 @@ void bsim_figures_result_free(bsim_figures_result *r);
 int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures_result *out,
                       bsim_error *err);
 
+/* beamsim plot DIR: checks DIR's files against its manifest (a mix of two
+ * runs is refused, BSIM_EINPUT), draws its figures and commits them as
+ * one set: into def->out, or, with def->out NULL, into DIR itself, where
+ * they join the files already there (DIR/manifest.json lists both).
+ * out->paths name the figures where they are once this returns. */
+int bsim_figures_plot(const char *dir, const bsim_figures_def *def, bsim_figures_result *out,
+                      bsim_error *err);
+
 #ifdef __cplusplus
 }
 #endif

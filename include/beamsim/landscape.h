@@ -140,7 +140,7 @@ int bsim_landscape_barriers_alloc(const bsim_scene *s, const bsim_landscape_grid
                                   bsim_landscape_barriers **out, bsim_error *err);
 void bsim_landscape_barriers_free(bsim_landscape_barriers *b);
 
-const char *bsim_pass_kind_name(bsim_pass_kind k);
+const char *bsim_landscape_pass_kind_name(bsim_pass_kind k);
 
 /* ---- Files (src/landscape_write.c) ------------------------------------- */
 
@@ -153,6 +153,14 @@ const char *bsim_pass_kind_name(bsim_pass_kind k);
  * .svg. drawn (may be NULL) is 1 if gnuplot drew the figures. */
 int bsim_landscape_write(const char *dir, const bsim_scene *s, const bsim_landscape_grid *g,
                          const bsim_landscape_barriers *b, int *drawn, bsim_error *err);
+
+/* The landscape of s on the grid def, its barriers and files, computed and
+ * written into the output directory out as one set (out is checked before
+ * anything is computed). *g and *b get the grid and the barriers (free them
+ * on BSIM_OK); BSIM_EINPUT for an unusable out or a bad grid, naming it. */
+int bsim_landscape_store(const char *out, const bsim_scene *s, const bsim_landscape_grid_def *def,
+                         bsim_landscape_grid **g, bsim_landscape_barriers **b, int *drawn,
+                         bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -30,11 +30,11 @@ void bsim_lattice_beam_gate(const bsim_lattice_def *l, int i, int *ix, int *iy, 
 /* The gate holding point p, clamped into the lattice (a body below row 0
  * is in row 0, one beyond the last column in the last column); (0, 0)
  * for a scene without a lattice. */
-void bsim_scene_gate_at(const bsim_scene *s, const double p[2], int *ix, int *iy);
+void bsim_lattice_gate_at(const bsim_scene *s, const double p[2], int *ix, int *iy);
 
 /* The field's centre line X = w (ix_min + ix_max) / 2, from which side_x
  * is measured; 0 for a scene without a lattice. */
-double bsim_scene_centre_x(const bsim_scene *s);
+double bsim_lattice_centre_x(const bsim_scene *s);
 
 /* Builds s->beams from s->lattice: every beam gets lattice.beam, then its
  * stiffness from k_left / k_right (rows x columns, row iy = 0 first, NULL:
@@ -45,7 +45,7 @@ int bsim_lattice_build(bsim_scene *s, const double *k_left, const double *k_righ
  * gates (columns odd, centred on ix = 0) of the Table 2.1 gate, k = 400,
  * with the lattice's termination defaults and the given propulsion and
  * random force (0 = absent). The body starts at (0, 0). */
-int bsim_scene_init_lattice(bsim_scene *s, int columns, int rows, double f_prop, double rm);
+int bsim_lattice_scene_init(bsim_scene *s, int columns, int rows, double f_prop, double rm);
 
 /* Where a trial ended (MODEL.md section 8): through the end boundary in
  * column ix, out through a side at row iy, or stuck in gate (ix, iy). */
@@ -60,12 +60,12 @@ typedef struct bsim_location {
 	int ix, iy; /* END: ix (iy = 0); SIDE: iy (ix = 0); STUCK: both */
 } bsim_location;
 
-bsim_location bsim_location_of(const bsim_trial_result *r);
+bsim_location bsim_lattice_location_of(const bsim_trial_result *r);
 /* 1 if a and b are the same location. */
-int bsim_location_equal(bsim_location a, bsim_location b);
+int bsim_lattice_location_equal(bsim_location a, bsim_location b);
 /* "end:-2", "side:3", "stuck:0:2"; the labels of trials.csv, summary.json
  * and the final-location CSV. */
-void bsim_location_label(bsim_location loc, char *buf, size_t size);
+void bsim_lattice_location_label(bsim_location loc, char *buf, size_t size);
 
 /* ---- a group of lattice trials ------------------------------------------ */
 

@@ -3,7 +3,7 @@
  *
  *   trajectory.csv     the trajectory, the columns of `run --trajectory`
  *   ledger.csv         the energy ledger at the same times
- *                      (bsim_recorder_ledger_header)
+ *                      (bsim_trial_ledger_header)
  *   trajectory.mat, ledger.mat   their MATLAB twins
  *   run.json           what ran and what came of it: the object of
  *                      `run --json` and "command": "run", "stride", "set"
@@ -12,15 +12,14 @@
  *                      scene can be rebuilt (beamsim plot draws the
  *                      landscape from it)
  *
- * Every file is written to a temporary name and renamed once the trial has
- * run: a failed trial leaves none of them. */
+ * The directory is written as one set (DIR/manifest.json last) once the
+ * trial has run: a failed trial leaves none of its files. */
 #ifndef BEAMSIM_RUN_OUTPUT_H
 #define BEAMSIM_RUN_OUTPUT_H
 
 #include <stdint.h>
 #include <stdio.h>
 
-#include "beamsim/atomic_file.h"
 #include "beamsim/backend.h"
 #include "beamsim/scene.h"
 #include "beamsim/trial.h"
@@ -39,10 +38,16 @@ typedef struct bsim_run_info {
 	const bsim_options *opts;
 	uint64_t seed;             /* the experiment seed */
 	long group, trial;         /* of the schedule */
-	uint64_t mixed_seed;       /* bsim_seed_mix(seed, group, trial) */
+	uint64_t mixed_seed;       /* bsim_schedule_seed_mix(seed, group, trial) */
 	int stride;                /* recorded every stride-th step */
 	const bsim_trial_log *log; /* the trial's gate path and peaks, or NULL */
 } bsim_run_info;
+
+/* What `beamsim run` runs when told nothing: the default backend
+ * (bsim_backend_default) without options, trial 0 of group 0 of experiment
+ * seed 1, every step recorded. scene_path, scene and mixed_seed are the
+ * caller's to set (bsim_schedule_seed_mix(seed, group, trial)). */
+bsim_run_info bsim_run_info_default(void);
 
 /* The JSON object of a trial (one line, with a newline): scene, name,
  * backend, backend_options, seed, group, trial, mixed_seed, outcome, type,
@@ -52,26 +57,22 @@ typedef struct bsim_run_info {
  * peak_theta (with a log), ledger, instability (null or why the trial was
  * unstable). record adds command, beamsim_version,
  * stride, set and scene_copy, for run.json. */
-void bsim_run_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r, int record);
+void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r,
+                          int record);
 
-typedef struct bsim_run_output {
-	char dir[1024];
-	char traj_path[1100], ledger_path[1100];
-	bsim_atomic_file traj, ledger;
-} bsim_run_output;
-
-/* Creates dir if missing and opens its trajectory and ledger for rec
- * (rec->csv and rec->ledger are set; its stride is the caller's). */
-int bsim_run_output_open(bsim_run_output *o, const char *dir, int n_beams, bsim_recorder *rec,
-                         bsim_error *err);
-
-/* Once the trial has run: commits trajectory.csv and ledger.csv, writes
- * their twins, inputs/scene.yaml and, last, run.json. */
-int bsim_run_output_commit(bsim_run_output *o, const bsim_run_info *info,
-                           const bsim_trial_result *r, bsim_error *err);
-
-/* Removes what is open; nothing of the run is left. */
-void bsim_run_output_abort(bsim_run_output *o);
+/* Runs the trial info describes (bsim_trial_run with the mixed seed,
+ * recording every info->stride-th step, info->log filled if not NULL) and
+ * writes what is asked for:
+ *   trajectory  FILE.csv with the trajectory (bsim_trial_trajectory_header)
+ *               and, when FILE is a regular file, its twin FILE.mat; "-" is
+ *               standard output; NULL: none;
+ *   out         the directory above, checked before the trial runs and
+ *               written as one set (docs/files.md); NULL: none.
+ * The files appear only if the trial ran (an unstable trial did run: its
+ * outcome says so). res gets the result. BSIM_EINPUT if out cannot be
+ * used or an option is bad; BSIM_EFAIL if the trial or a file fails. */
+int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, const char *out,
+                          bsim_trial_result *res, bsim_error *err);
 
 #ifdef __cplusplus
 }

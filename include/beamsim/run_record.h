@@ -30,8 +30,13 @@ typedef struct bsim_run_record {
 	char protocol[2][16];
 } bsim_run_record;
 
-/* opts with every knob of b not given set to its default. */
-void bsim_options_effective(const bsim_backend *b, const bsim_options *given, bsim_options *out);
+/* The record of a sweep (n = 1 backend) or comparison (n = 2 sides):
+ * each side's backend, label (NULL: the backend's name) and every knob's
+ * effective value, the experiment's seed and trials, and the rule (NULL:
+ * bsim_compare_rule_default()). */
+void bsim_run_record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e,
+                          int n, const bsim_backend *const *b, const bsim_options *const *opts,
+                          const char *const *label, const bsim_compare_rule *rule);
 
 /* Writes DIR/inputs/scene.yaml, DIR/inputs/experiment.yaml and, last,
  * DIR/run.json, each atomically: a directory with run.json is complete. */

@@ -107,6 +107,14 @@ typedef struct bsim_override {
 int bsim_scene_load(const char *path, const bsim_override *overrides, int n_overrides,
                     bsim_scene *out, bsim_error *err);
 
+/* A scene with no body and no beams, every other field at the default a
+ * scene file gets where it leaves the key out (docs/files.md): contact
+ * 0.8 / 1 / 0.05 m/s, random force at 50 Hz when present, dt 0.004 s, 3000
+ * steps, success_y 65 m, side_x 25 m, classify_y 80 m, classify_deadband
+ * 0.01 m/s, landscape_y0 60 m, no effects. Set body and beams (and effects)
+ * before bsim_scene_validate; free with bsim_scene_free. */
+bsim_scene bsim_scene_default(void);
+
 /* Fills the essay's single-gate scene (MODEL.md section 1, Table 2.1) with
  * the given propulsion and random force magnitude (0 = effect absent). */
 void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm);
@@ -124,11 +132,11 @@ int bsim_scene_set_beams(bsim_scene *s, int n_beams);
 /* The unit direction u0 of beam b at rest (rest_angle_deg, 0 = +x), exact
  * at multiples of 90 degrees, so that the beams of a mirrored gate (0 and
  * 180 degrees) are mirrored bit for bit. */
-void bsim_beam_rest_direction(const bsim_beam_def *b, double u0[2]);
+void bsim_scene_beam_rest_direction(const bsim_beam_def *b, double u0[2]);
 
 /* +1 if a forward swing (theta > 0, the tip toward +y) turns beam b
  * counter-clockwise (a beam pointing right at rest), -1 otherwise. */
-double bsim_beam_forward_sign(const bsim_beam_def *b);
+double bsim_scene_beam_forward_sign(const bsim_beam_def *b);
 
 #ifdef __cplusplus
 }

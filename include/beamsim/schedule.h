@@ -1,7 +1,7 @@
 /* Random-force schedules (MODEL.md section 2, DESIGN.md "Determinism").
  *
  * F_rand(t) = Rm * z_j for t in [j/f, (j+1)/f), z_j ~ N(0,1) drawn from a GSL
- * generator seeded by bsim_seed_mix(experiment seed, group, trial). Values
+ * generator seeded by bsim_schedule_seed_mix(experiment seed, group, trial). Values
  * are drawn lazily in order and kept, so a schedule can be replayed from any
  * step and costs nothing in a trial that ends early. */
 #ifndef BEAMSIM_SCHEDULE_H
@@ -9,17 +9,19 @@
 
 #include <stdint.h>
 
+#include "beamsim/error.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
 /* The fixed mixing function: a SplitMix64 finaliser over the three inputs.
  * It never changes; summary.json of every version depends on it. */
-uint64_t bsim_seed_mix(uint64_t seed, uint64_t group, uint64_t trial);
+uint64_t bsim_schedule_seed_mix(uint64_t seed, uint64_t group, uint64_t trial);
 
 typedef struct bsim_schedule bsim_schedule;
 
-/* magnitude Rm in N, frequency f in Hz (> 0), seed from bsim_seed_mix. */
+/* magnitude Rm in N, frequency f in Hz (> 0), seed from bsim_schedule_seed_mix. */
 bsim_schedule *bsim_schedule_alloc(double magnitude, double frequency, uint64_t seed);
 void bsim_schedule_free(bsim_schedule *s);
 
@@ -29,8 +31,14 @@ void bsim_schedule_reset(bsim_schedule *s, double magnitude, uint64_t seed);
 /* Index j of the value that applies at step n of size h. */
 long bsim_schedule_index(const bsim_schedule *s, long n, double h);
 
-/* The force value j (N): Rm * z_j. Draws z up to j if not drawn yet. */
+/* The force value j (N): Rm * z_j. Draws z up to j if not drawn yet. A
+ * value that cannot be had (no memory for it, or j outside 0 .. 2^40) is
+ * 0, and bsim_schedule_status then fails: never a NaN. */
 double bsim_schedule_value(bsim_schedule *s, long j);
+
+/* BSIM_OK, or BSIM_EFAIL saying which value could not be had and why,
+ * since the last reset. */
+int bsim_schedule_status(const bsim_schedule *s, bsim_error *err);
 
 /* Number of standard-normal draws made since alloc/reset. */
 unsigned long bsim_schedule_draws(const bsim_schedule *s);

@@ -8,13 +8,18 @@
 
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
+#include "beamsim/options.h"
 #include "beamsim/trajectory.h"
-#include "beamsim/journal.h"
+#include "beamsim/progress.h"
 #include "beamsim/trial.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* A journal of finished trials (kept inside the library: bsim_sweep_dir_run
+ * and bsim_compare_dir_run give a sweep one). */
+typedef struct bsim_journal bsim_journal;
 
 typedef struct bsim_group_result {
 	int trials, traversed, side_exit, stuck, left, right;
@@ -26,6 +31,7 @@ typedef struct bsim_group_result {
 	int landscape_left, landscape_right; /* traversed over beam 0's / 1's barrier */
 	double p_traverse, ci95[2];          /* Wilson 95% */
 	long steps;                          /* steps integrated in the group */
+	bsim_solver_counts solver;           /* of the trials integrated (beamsim/state.h) */
 } bsim_group_result;
 
 typedef struct bsim_sweep_result {
@@ -33,21 +39,19 @@ typedef struct bsim_sweep_result {
 	bsim_trial_result *trials_out; /* n_groups * trials, index g*trials + t */
 	bsim_group_result *groups;     /* n_groups */
 	double wall_seconds;
-	long total_steps;      /* steps integrated (a deterministic group's one trial) */
-	long trials_run;       /* trials integrated: copies of a deterministic group's not */
-	int has_ledger;        /* 1: the trials' ledgers are known (a run, or a trials.csv
-	                        * with the energy columns) */
-	int keep;              /* trajectories kept per group (its first trials) */
-	bsim_trajectory *kept; /* n_groups * keep, index g*keep + t; NULL if keep = 0 */
+	long total_steps;          /* steps integrated (a deterministic group's one trial) */
+	long trials_run;           /* trials integrated: copies of a deterministic group's not */
+	bsim_solver_counts solver; /* over the trials integrated */
+	int has_ledger;            /* 1: the trials' ledgers are known (a run, or a trials.csv
+	                            * with the energy columns) */
+	int keep;                  /* trajectories kept per group (its first trials) */
+	bsim_trajectory *kept;     /* n_groups * keep, index g*keep + t; NULL if keep = 0 */
 	/* Each trial's gate path with entry states and the peaks of every
 	 * beam; same index as trials_out. NULL when read back from trials.csv. */
 	bsim_trial_log *logs;
 	int lattice;                  /* 1: the groups' scenes are gate lattices */
 	bsim_lattice_def lattice_def; /* group 0's, when lattice */
 } bsim_sweep_result;
-
-/* Called from one thread now and then with done/total trials. */
-typedef void (*bsim_progress_fn)(void *user, long done, long total);
 
 typedef struct bsim_sweep_config {
 	const bsim_backend *backend;
@@ -65,7 +69,7 @@ typedef struct bsim_sweep_config {
 	 * differ in the scene while sharing every schedule. */
 	const bsim_override *extra_b;
 	int n_extra_b;
-	/* NULL, or a journal (beamsim/journal.h) of records of
+	/* NULL, or a journal of records of
 	 * bsim_sweep_record_size bytes, created or resumed for this sweep's
 	 * inputs: the trials it holds are taken from it, not run again, and
 	 * each trial run is appended as it ends. */
@@ -101,7 +105,7 @@ int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg
 void bsim_sweep_result_free(bsim_sweep_result *r);
 
 /* Aggregates one group's trials into counts and the Wilson interval. */
-void bsim_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out);
+void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out);
 
 #ifdef __cplusplus
 }

@@ -100,6 +100,9 @@ typedef struct bsim_trial_result {
 	int final_ix, final_iy;
 	int gates_entered;  /* gates in the path, the start gate included */
 	int reset_overlaps; /* essay protocol: entries whose reset beams overlapped the body */
+	/* What the backend's solvers gave up on over the trial (beamsim/
+	 * state.h), summed over the worlds it ran in. */
+	bsim_solver_counts solver;
 } bsim_trial_result;
 
 /* Which edge of a gate the body crossed to enter it. */
@@ -111,7 +114,7 @@ typedef enum {
 	BSIM_EDGE_TOP = 4,    /* from the gate above (iy + 1) */
 } bsim_edge;
 
-const char *bsim_edge_name(bsim_edge e);
+const char *bsim_trial_edge_name(bsim_edge e);
 
 /* One entry into a gate: the state with which a single-gate map (entry ->
  * exit) would start, in the gate's own frame (Eq. 2.17: x = X - width ix,
@@ -188,11 +191,11 @@ typedef struct bsim_recorder {
 } bsim_recorder;
 
 /* Writes the trajectory CSV header for a scene of n_beams beams. */
-void bsim_recorder_header(FILE *f, int n_beams);
+void bsim_trial_trajectory_header(FILE *f, int n_beams);
 
 /* A bsim_record_fn writing the row to the trajectory CSV file (a FILE *):
  * what rec->csv receives, for a second file with the same rows. */
-void bsim_recorder_csv_record(void *file, const bsim_record_row *row);
+void bsim_trial_trajectory_row(void *file, const bsim_record_row *row);
 
 /* The ledger CSV (beamsim run --out): at each recorded time t, s,
  *   t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual,
@@ -202,26 +205,27 @@ void bsim_recorder_csv_record(void *file, const bsim_record_row *row);
  *                           - correction - sleep - reset + residual
  * (sleep and reset: beams put to rest by sleeping and by the essay's lattice
  * protocol; 0 elsewhere). */
-void bsim_recorder_ledger_header(FILE *f);
+void bsim_trial_ledger_header(FILE *f);
 
-typedef struct bsim_runner bsim_runner;
+typedef struct bsim_trial_runner bsim_trial_runner;
 
 /* A runner holds the reusable per-thread memory (state buffers, schedule). */
-bsim_runner *bsim_runner_alloc(void);
-void bsim_runner_free(bsim_runner *r);
+bsim_trial_runner *bsim_trial_runner_alloc(void);
+void bsim_trial_runner_free(bsim_trial_runner *r);
 
-/* Runs one trial. seed: the mixed seed (bsim_seed_mix). rec may be NULL.
+/* Runs one trial. seed: the mixed seed (bsim_schedule_seed_mix). rec may be NULL.
  * A lattice scene runs under its lattice.protocol: the whole world, or the
  * essay's (each gate entered gets a fresh world of its two beams at rest,
  * the body's state carried over; the trace then sees that world's state).
  * Returns BSIM_OK (an unstable trial included: its outcome says so),
- * BSIM_EINPUT (backend options) or BSIM_EFAIL (out of memory). */
-int bsim_trial_run(bsim_runner *r, const bsim_scene *scene, const bsim_backend *backend,
+ * BSIM_EINPUT (backend options) or BSIM_EFAIL (out of memory, in the
+ * runner, the schedule or the backend's step: never a result). */
+int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_backend *backend,
                    const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
                    bsim_trial_result *out, bsim_error *err);
 
-const char *bsim_outcome_name(bsim_outcome o);
-const char *bsim_type_name(bsim_type t);
+const char *bsim_trial_outcome_name(bsim_outcome o);
+const char *bsim_trial_type_name(bsim_type t);
 
 /* Why trial r (run with time step dt, s) is unstable, in one line:
  * "non-finite state at step 512 (t = 2.048 s)" or "energy created: ledger

@@ -3,7 +3,7 @@
  *
  *   bsim_video_track *t;
  *   bsim_video_track_record(scene, backend, opts, seed, fps, &t, err);  // runs the trial
- *   bsim_video_def def = bsim_video_default_def();
+ *   bsim_video_def def = bsim_video_def_default();
  *   bsim_video *v = NULL;
  *   bsim_video_alloc(&def, scene, &t, &label, 1, &v, err);
  *   bsim_video_write(v, "trial.mp4", err);                            // whole or nothing
@@ -53,7 +53,7 @@ extern "C" {
 #endif
 
 /* The look and encoding of a video (plain definition; start from
- * bsim_video_default_def). */
+ * bsim_video_def_default). */
 typedef struct bsim_video_def {
 	int width, height;  /* pixels of a frame, all panels; even, >= 64; 0 = 540 x 540 a panel */
 	double fps;         /* frames per second of simulated time, > 0; default 30 */
@@ -63,7 +63,7 @@ typedef struct bsim_video_def {
 	const char *ffmpeg; /* the encoder program, looked up on PATH; default "ffmpeg" */
 } bsim_video_def;
 
-bsim_video_def bsim_video_default_def(void);
+bsim_video_def bsim_video_def_default(void);
 
 /* Checks a definition's ranges; BSIM_EINPUT naming the field otherwise. */
 int bsim_video_def_check(const bsim_video_def *def, bsim_error *err);
@@ -85,7 +85,7 @@ typedef struct bsim_video_sample {
  * trail) and the state at every frame time. */
 typedef struct bsim_video_track bsim_video_track;
 
-/* Runs trial `seed` (bsim_seed_mix) of scene on backend exactly as
+/* Runs trial `seed` (bsim_schedule_seed_mix) of scene on backend exactly as
  * bsim_trial_run does for `beamsim run`, recording at fps frames per second
  * of simulated time. The scene must outlive the track. BSIM_EFAIL if the
  * run fails (the message says why, e.g. a non-finite state) or memory runs

@@ -1,6 +1,6 @@
 /* beamsim bench --lattice: the cost of a step against the size of the
  * field. For n = 1, 3, 5, 9, 17, 33 the essay's lattice of n x n gates
- * (bsim_scene_init_lattice: the Table 2.1 gate, k = 400 N m/rad, F_prop =
+ * (bsim_lattice_scene_init: the Table 2.1 gate, k = 400 N m/rad, F_prop =
  * 6 N, Rm = 30 N) runs the same trials (seed 1, group 0, trials 0 .. N-1:
  * the same schedules at every size) on one thread, on each backend, and the
  * wall time per integrated step is reported with its ratio to the 1 x 1
@@ -30,9 +30,9 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/clock.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "clock.h"
+#include "json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/output.h"
 #include "beamsim/schedule.h"
@@ -64,7 +64,7 @@ static void count_active(void *user, long step, const bsim_state *s)
 
 /* Runs trials 0 .. trials-1 of scene; their steps into *steps, the wall
  * time returned. */
-static double time_trials(bsim_runner *runner, const bsim_scene *scene, const bsim_backend *b,
+static double time_trials(bsim_trial_runner *runner, const bsim_scene *scene, const bsim_backend *b,
                           const bsim_options *opts, long trials, long *steps, int *rc,
                           bsim_error *err)
 {
@@ -72,8 +72,8 @@ static double time_trials(bsim_runner *runner, const bsim_scene *scene, const bs
 	double t0 = bsim_clock_seconds();
 	for (long t = 0; t < trials && *rc == BSIM_OK; t++) {
 		bsim_trial_result res;
-		*rc = bsim_trial_run(runner, scene, b, opts, bsim_seed_mix(1, 0, (uint64_t)t), NULL,
-		                     &res, err);
+		*rc = bsim_trial_run(runner, scene, b, opts,
+		                     bsim_schedule_seed_mix(1, 0, (uint64_t)t), NULL, &res, err);
 		*steps += res.steps_run;
 	}
 	return bsim_clock_seconds() - t0;
@@ -86,14 +86,14 @@ static int bench_one(const bsim_backend *b, const bsim_options *opts, int n, lon
 	bsim_error err;
 	if (round == 0)
 		memset(row, 0, sizeof *row);
-	if (bsim_scene_init_lattice(&scene, n, n, 6.0, 30.0) != BSIM_OK) {
+	if (bsim_lattice_scene_init(&scene, n, n, 6.0, 30.0) != BSIM_OK) {
 		bsim_scene_free(&scene);
 		cli_error("out of memory for a %d x %d lattice", n, n);
 		return CLI_FAIL;
 	}
 	if (same_trials) { /* the 1 x 1 field's termination */
 		bsim_scene one;
-		if (bsim_scene_init_lattice(&one, 1, 1, 6.0, 30.0) != BSIM_OK) {
+		if (bsim_lattice_scene_init(&one, 1, 1, 6.0, 30.0) != BSIM_OK) {
 			bsim_scene_free(&one);
 			bsim_scene_free(&scene);
 			cli_error("out of memory for a 1 x 1 lattice");
@@ -106,7 +106,7 @@ static int bench_one(const bsim_backend *b, const bsim_options *opts, int n, lon
 		scene.gate_steps = one.gate_steps;
 		bsim_scene_free(&one);
 	}
-	bsim_runner *runner = bsim_runner_alloc();
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	if (!runner) {
 		bsim_scene_free(&scene);
 		cli_error("out of memory for a trial runner");
@@ -129,7 +129,7 @@ static int bench_one(const bsim_backend *b, const bsim_options *opts, int n, lon
 	if (round == 0 || per_trial < row->setup)
 		row->setup = per_trial;
 	if (round > 0) {
-		bsim_runner_free(runner);
+		bsim_trial_runner_free(runner);
 		bsim_scene_free(&scene);
 		if (rc != BSIM_OK)
 			return cli_report(rc, &err);
@@ -140,10 +140,10 @@ static int bench_one(const bsim_backend *b, const bsim_options *opts, int n, lon
 	bsim_recorder rec = {.stride = 1, .trace = count_active, .trace_user = acc};
 	for (long t = 0; t < (trials < 10 ? trials : 10) && rc == BSIM_OK; t++) {
 		bsim_trial_result res;
-		rc = bsim_trial_run(runner, &scene, b, opts, bsim_seed_mix(1, 0, (uint64_t)t), &rec,
-		                    &res, &err);
+		rc = bsim_trial_run(runner, &scene, b, opts,
+		                    bsim_schedule_seed_mix(1, 0, (uint64_t)t), &rec, &res, &err);
 	}
-	bsim_runner_free(runner);
+	bsim_trial_runner_free(runner);
 	bsim_scene_free(&scene);
 	if (rc != BSIM_OK)
 		return cli_report(rc, &err);

@@ -4,21 +4,14 @@
 #include "cli_common.h"
 
 #include <errno.h>
+#include <signal.h>
 #include <getopt.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "beamsim/limits.h"
-#include "beamsim/outdir.h"
-#include "beamsim/progress.h"
-
-static const bsim_outdir *error_outdir;
-
-void cli_error_paths(const bsim_outdir *od)
-{
-	error_outdir = od;
-}
+#include "cli_progress.h"
 
 void cli_error(const char *fmt, ...)
 {
@@ -28,7 +21,6 @@ void cli_error(const char *fmt, ...)
 	va_start(ap, fmt);
 	vsnprintf(msg, sizeof msg, fmt, ap);
 	va_end(ap);
-	bsim_outdir_explain(error_outdir, msg, sizeof msg);
 	/* The library's escaping of what the message quotes. */
 	bsim_error_set(&e, BSIM_EFAIL, "%s", msg);
 	fprintf(stderr, "beamsim: %s\n", e.msg);
@@ -47,7 +39,48 @@ int cli_usage(const char *cmd, const char *fmt, ...)
 	return CLI_USAGE;
 }
 
-int cli_bad_option(const char *cmd, char **argv, int c)
+/* Levenshtein distance of a and b, at most 64 characters of b counted. */
+static int edit_distance(const char *a, const char *b)
+{
+	int row[65], lb = (int)strlen(b);
+	lb = lb > 64 ? 64 : lb;
+	for (int j = 0; j <= lb; j++)
+		row[j] = j;
+	for (int i = 1; a[i - 1]; i++) {
+		int diag = row[0];
+		row[0] = i;
+		for (int j = 1; j <= lb; j++) {
+			int up = row[j];
+			int sub = diag + (a[i - 1] != b[j - 1]);
+			int del = row[j] + 1, ins = row[j - 1] + 1;
+			row[j] = sub < del ? (sub < ins ? sub : ins) : (del < ins ? del : ins);
+			diag = up;
+		}
+	}
+	return row[lb];
+}
+
+const char *cli_nearest(const char *word, const char *const *names, int n)
+{
+	const char *best = NULL;
+	int best_d = 0, ties = 0, len = (int)strlen(word);
+	if (len == 0 || len > 64)
+		return NULL;
+	for (int i = 0; i < n; i++) {
+		int d = edit_distance(word, names[i]);
+		if (!best || d < best_d) {
+			best = names[i];
+			best_d = d;
+			ties = 0;
+		} else if (d == best_d) {
+			ties++;
+		}
+	}
+	int limit = len / 3 > 1 ? len / 3 : 1;
+	return best && best_d <= limit && !ties ? best : NULL;
+}
+
+int cli_bad_option_near(const char *cmd, char **argv, int c, const char *const *names, int n)
 {
 	/* With opterr = 0 the offending option is the argument just consumed;
 	 * optopt is 0 for an unknown long option, else the option's value. */
@@ -57,9 +90,20 @@ int cli_bad_option(const char *cmd, char **argv, int c)
 		return cli_usage(cmd, "option %s needs a value", arg);
 	if (strncmp(arg, "--", 2) != 0)
 		return cli_usage(cmd, "unknown option -%c", optopt);
-	if (optopt == 0)
-		return cli_usage(cmd, "unknown option %.*s", name_len, arg);
-	return cli_usage(cmd, "option %.*s takes no value", name_len, arg);
+	if (optopt != 0)
+		return cli_usage(cmd, "option %.*s takes no value", name_len, arg);
+	char word[80];
+	snprintf(word, sizeof word, "%.*s", name_len - 2 > 0 ? name_len - 2 : 0, arg + 2);
+	const char *near = names ? cli_nearest(word, names, n) : NULL;
+	if (near)
+		return cli_usage(cmd, "unknown option %.*s (did you mean --%s?)", name_len, arg,
+		                 near);
+	return cli_usage(cmd, "unknown option %.*s", name_len, arg);
+}
+
+int cli_bad_option(const char *cmd, char **argv, int c)
+{
+	return cli_bad_option_near(cmd, argv, c, NULL, 0);
 }
 
 int cli_parse_long(const char *text, long min, long max, long *out)
@@ -212,15 +256,115 @@ int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsi
 int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int show_progress,
                   bsim_sweep_result *r)
 {
-	bsim_progress progress;
+	cli_progress progress;
 	bsim_sweep_config c = *cfg;
 	bsim_error err;
-	bsim_progress_init(&progress, show_progress);
-	c.progress = bsim_progress_update;
+	cli_progress_init(&progress, show_progress, "trials");
+	c.progress = cli_progress_update;
 	c.progress_user = &progress;
 	int rc = bsim_sweep_run(e, &c, r, &err);
-	bsim_progress_finish(&progress);
+	cli_progress_finish(&progress);
 	return cli_report(rc, &err);
+}
+
+/* ---- signals and the line that resumes a run ---------------------------- */
+
+volatile sig_atomic_t cli_stop;
+
+static void on_signal(int sig)
+{
+	if (cli_stop) {
+		signal(sig, SIG_DFL);
+		raise(sig);
+		return;
+	}
+	cli_stop = sig;
+}
+
+void cli_signals_install(void)
+{
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = on_signal;
+	sigemptyset(&sa.sa_mask);
+	sa.sa_flags = SA_RESTART;
+	cli_stop = 0;
+	sigaction(SIGINT, &sa, NULL);
+	sigaction(SIGTERM, &sa, NULL);
+}
+
+void cli_signals_restore(void)
+{
+	signal(SIGINT, SIG_DFL);
+	signal(SIGTERM, SIG_DFL);
+}
+
+/* An argument as the shell needs it: bare if it is safe, else quoted. */
+static void shell_word(FILE *f, const char *w)
+{
+	if (*w && strspn(w, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+	                    "_-+=.,:/@%") == strlen(w)) {
+		fputs(w, f);
+		return;
+	}
+	fputc('\'', f);
+	for (; *w; w++)
+		if (*w == '\'')
+			fputs("'\\''", f);
+		else
+			fputc(*w, f);
+	fputc('\'', f);
+}
+
+/* "beamsim sweep ... --resume": the command line that continues the run. */
+static void resume_line(FILE *f, int argc, char **argv)
+{
+	int has = 0;
+	fputs("beamsim", f);
+	for (int i = 0; i < argc; i++) {
+		fputc(' ', f);
+		shell_word(f, argv[i]);
+		has |= strcmp(argv[i], "--resume") == 0;
+	}
+	if (!has)
+		fputs(" --resume", f);
+}
+
+int cli_run_end(int rc, const char *journal, int argc, char **argv)
+{
+	if (rc == BSIM_ESTOPPED) {
+		int sig = cli_stop ? (int)cli_stop : SIGINT;
+		fprintf(stderr, "beamsim: %s: the finished trials are kept in %s; to continue: ",
+		        sig == SIGTERM ? "SIGTERM" : "SIGINT", journal);
+		resume_line(stderr, argc, argv);
+		fputc('\n', stderr);
+		return 128 + sig;
+	}
+	if (rc != BSIM_OK && journal[0]) {
+		fprintf(stderr,
+		        "beamsim: the finished trials are kept in %s; to write the files "
+		        "again: ",
+		        journal);
+		resume_line(stderr, argc, argv);
+		fputc('\n', stderr);
+	}
+	return rc;
+}
+
+void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const char *where)
+{
+	char what[160] = "";
+	if (c->iteration_limit > 0)
+		snprintf(what, sizeof what, "stopped at an iteration limit %ld time%s",
+		         c->iteration_limit, c->iteration_limit == 1 ? "" : "s");
+	if (c->clamped > 0)
+		snprintf(what + strlen(what), sizeof what - strlen(what),
+		         "%sclamped the motion to its per-step limits in %ld (sub)step%s",
+		         what[0] ? " and " : "", c->clamped, c->clamped == 1 ? "" : "s");
+	if (what[0])
+		cli_error("warning: the %s backend's solver %s (%s: solver); there the motion is "
+		          "the solver's limit, not the model's",
+		          backend, what, where);
 }
 
 char *cli_text_append(char *text, const char *more)

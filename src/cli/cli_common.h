@@ -1,15 +1,17 @@
-/* What the subcommands of the beamsim program share: argument parsing,
- * --set and --backend-opt collection, backend and experiment loading,
- * running a sweep with a progress line, and error printing. JSON values
- * and atomic file writes come from the library (beamsim/json.h,
- * beamsim/atomic_file.h), shared with the sweep's output files. */
+/* What the subcommands of the beamsim program share: error printing,
+ * value parsing, --set and --backend-opt collection, backend look-up,
+ * the signals that stop a run, and the line that resumes it. The shared
+ * options and the parser are cli_options.h. */
 #ifndef BEAMSIM_CLI_COMMON_H
 #define BEAMSIM_CLI_COMMON_H
 
 #include <stdint.h>
 #include <stdio.h>
 
+#include <signal.h>
+
 #include "beamsim/backend.h"
+#include "beamsim/experiment.h"
 #include "beamsim/scene.h"
 #include "beamsim/sweep.h"
 
@@ -30,21 +32,21 @@ int cmd_landscape(int argc, char **argv);
 int cmd_plot(int argc, char **argv);
 int cmd_video(int argc, char **argv);
 
-/* "beamsim: MSG" on stderr, one line of printable text, naming files in
- * the output directory of cli_error_paths by their place in it. */
+/* "beamsim: MSG" on stderr, one line of printable text. */
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-
-/* While a run writes into od's staging area, messages that name staged
- * files name them as they will be in the directory; NULL ends it. */
-struct bsim_outdir;
-void cli_error_paths(const struct bsim_outdir *od);
 
 /* A usage error of command cmd: the message, a pointer to --help, and 2. */
 int cli_usage(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* The getopt_long result '?' or ':' as a usage error. Call with the
- * option character getopt_long returned. */
+ * option character getopt_long returned; names (may be NULL): the long
+ * options the command knows, for "did you mean --trials?". */
 int cli_bad_option(const char *cmd, char **argv, int c);
+int cli_bad_option_near(const char *cmd, char **argv, int c, const char *const *names, int n);
+
+/* Of the n names, the one word is a likely misspelling of (at most a
+ * third of its letters apart, and nearer than any other), or NULL. */
+const char *cli_nearest(const char *word, const char *const *names, int n);
 
 /* Strict number parsing: the whole text, within [min, max]. 0 on success. */
 int cli_parse_long(const char *text, long min, long max, long *out);
@@ -68,11 +70,6 @@ void cli_sets_free(cli_sets *s);
  * usage error of cmd. */
 int cli_limit(const char *cmd, const char *text);
 
-/* The help line of --limit, shared by every command that loads inputs. */
-#define CLI_LIMIT_HELP                                                                             \
-	"  --limit NAME=N         raise a limit on what inputs may ask for: input_bytes,\n"        \
-	"                         groups, trials, schedule, beam_steps (README, Robustness)\n"
-
 /* Adds a --backend-opt KEY=VALUE. 0, or a usage error. */
 int cli_options_add(bsim_options *opts, const char *cmd, const char *kv);
 
@@ -94,6 +91,26 @@ int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsi
  * status. */
 int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int show_progress,
                   bsim_sweep_result *r);
+
+/* Set to the signal's number by SIGINT or SIGTERM while the handlers of
+ * cli_signals_install are in place: the stop flag of a long run. The
+ * first signal asks the run to stop; a second ends the process at once,
+ * which loses nothing the run's journal holds. */
+extern volatile sig_atomic_t cli_stop;
+void cli_signals_install(void);
+void cli_signals_restore(void);
+
+/* The end of a run that kept its journal (journal: its path, "" if none):
+ * if it was stopped (rc BSIM_ESTOPPED), the signal and the command line
+ * that continues it (argv with --resume), returning 128 + the signal's
+ * number; if its files could not be written, the line that writes them
+ * again. Otherwise returns rc. */
+int cli_run_end(int rc, const char *journal, int argc, char **argv);
+
+/* A warning on stderr if the backend's solvers gave up on anything over
+ * what ran (beamsim/state.h): what, how often, and where the counts are
+ * written (where: "summary.json", ...). */
+void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const char *where);
 
 /* text (malloc'd) with more appended, reallocated; NULL (text freed) if
  * out of memory. */

@@ -1,24 +1,26 @@
 /* beamsim backends: each backend with its description and knobs. */
-#include <getopt.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "beamsim/backend.h"
 #include "cli_common.h"
+#include "cli_options.h"
 
-static const char backends_help[] =
-        "Usage: beamsim backends\n"
-        "\n"
-        "Lists the physics backends compiled in, with their options: name, type,\n"
-        "default, choices and what each does. Set one with --backend-opt NAME=VALUE\n"
-        "on run, sweep and bench.\n"
-        "\n"
-        "Options:\n"
-        "  -h, --help             show this help\n";
-
-static const struct option backends_options[] = {
-        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
+static const cli_spec backends_spec = {
+        .name = "backends",
+        .usage = "[OPTIONS]",
+        .about = "Lists the physics backends compiled in, with their options: name, type,\n"
+                 "default, choices and what each does.\n"
+                 "\n"
+                 "An option is set the same way on every command that runs backends (run,\n"
+                 "sweep, compare, video, bench):\n"
+                 "  --backend-opt B:KEY=VALUE   sets KEY on backend B; a B the command does\n"
+                 "                              not run is an error\n"
+                 "  --backend-opt KEY=VALUE     the same, when the command runs one backend\n"
+                 "and compare's sides also take options inline, NAME:KEY=VALUE[:KEY=VALUE]...\n"
+                 "(--backends thesis,thesis:integrator=euler), which win over --backend-opt.\n"
+                 "(bench's --vs backend takes --vs-opt KEY=VALUE.)\n"
+                 "Values are checked against the backend's knob: its type, range or choices.\n",
 };
 
 static const char *knob_type_name(bsim_knob_type t)
@@ -68,21 +70,20 @@ static void backend_print(const bsim_backend *b)
 		       knob_type_name(k->type), w[2], k->default_value ? k->default_value : "-",
 		       w[3], k->choices ? k->choices : "-", k->help ? k->help : "");
 	}
+	if (b->n_accuracy > 0)
+		printf("\n  beamsim accuracy compares %d settings (the first is the reference):\n",
+		       b->n_accuracy);
+	for (int i = 0; i < b->n_accuracy; i++)
+		printf("    %-24s %s\n", b->accuracy[i].name, b->accuracy[i].options);
 }
 
 int cmd_backends(int argc, char **argv)
 {
-	int c;
-	opterr = 0;
-	while ((c = getopt_long(argc, argv, ":h", backends_options, NULL)) != -1) {
-		if (c != 'h')
-			return cli_bad_option("backends", argv, c);
-		fputs(backends_help, stdout);
-		return CLI_OK;
-	}
-	if (optind != argc)
-		return cli_usage("backends", "unexpected argument %s", argv[optind]);
-	const bsim_backend *const *all = bsim_backends();
+	cli_common c = cli_common_default();
+	int rc = cli_parse(&backends_spec, argc, argv, &c, NULL, NULL);
+	if (rc >= 0)
+		return rc;
+	const bsim_backend *const *all = bsim_backend_list();
 	for (int i = 0; all[i]; i++) {
 		if (i)
 			putchar('\n');

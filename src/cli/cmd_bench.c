@@ -4,18 +4,18 @@
  * step, same schedules) with the ratio of the two. */
 #define _POSIX_C_SOURCE 200809L
 
-#include <getopt.h>
 #include <omp.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "beamsim/atomic_file.h"
-#include "beamsim/json.h"
+#include "atomic_file.h"
+#include "json.h"
 #include "beamsim/output.h"
 #include "beamsim/sweep.h"
 #include "bench_lattice.h"
 #include "cli_common.h"
+#include "cli_options.h"
 
 #define BENCH_H1 "configs/thesis/h1_symmetric.yaml"
 #define BENCH_H2 "configs/thesis/h2_asymmetric.yaml"
@@ -24,61 +24,28 @@
  * goes to standard output (--json -). */
 static FILE *report;
 
-static const char bench_help[] =
-        "Usage: beamsim bench [OPTIONS]\n"
-        "\n"
-        "Runs an experiment (default " BENCH_H1 ") on one thread and\n"
-        "on all threads and reports wall time, steps/s, trials/s and steps/s per core;\n"
-        "then runs " BENCH_H2 " on all threads and reports the\n"
-        "wall time of H1 + H2. Then runs the experiment on one thread with a second\n"
-        "backend (--vs, default box2d) at the same time step and prints how many\n"
-        "times faster the first is, per step and per trial. The default experiment\n"
-        "paths are relative to the current directory (run it from the source tree).\n"
-        "\n"
-        "Options:\n"
-        "  --backend B            physics backend (default thesis; see beamsim backends)\n"
-        "  --backend-opt K=V      a backend option, repeatable\n"
-        "  --experiment FILE      benchmark this experiment instead of H1 (no H2 step)\n"
-        "  --trials N             trials per group (default: the experiment's)\n"
-        "  --no-h2                skip the H1 + H2 step\n"
-        "  --vs B                 the backend to compare speed with (default box2d;\n"
-        "                         none: skip)\n"
-        "  --vs-opt K=V           an option of the --vs backend, repeatable\n"
-        "  --json FILE            also write the results as JSON to FILE\n"
-        "  --lattice              instead: ns per step on n x n gate lattices, n = 1 .. 33,\n"
-        "                         on --backend and --vs, the same schedules at every\n"
-        "                         size (--trials per size, default 200; the --vs\n"
-        "                         backend a twentieth of it, default 10)\n"
-        "  -h, --help             show this help\n";
+enum { OWN_EXPERIMENT, OWN_NO_H2, OWN_VS, OWN_VS_OPT, OWN_JSON, OWN_LATTICE };
 
-enum {
-	OPT_BACKEND = 256,
-	OPT_BACKEND_OPT,
-	OPT_EXPERIMENT,
-	OPT_TRIALS,
-	OPT_NO_H2,
-	OPT_VS,
-	OPT_VS_OPT,
-	OPT_JSON,
-	OPT_LATTICE
+static const cli_own bench_own[] = {
+        [OWN_EXPERIMENT] = {"experiment", 1, "FILE",
+                            "benchmark this experiment instead of H1 (no H2 step)"},
+        [OWN_NO_H2] = {"no-h2", 0, NULL, "skip the H1 + H2 step"},
+        [OWN_VS] = {"vs", 1, "B", "the backend to compare speed with (default box2d;\nnone: skip)"},
+        [OWN_VS_OPT] = {"vs-opt", 1, "K=V", "an option of the --vs backend, repeatable"},
+        [OWN_JSON] = {"json", 1, "FILE", "also write the results as JSON to FILE"},
+        [OWN_LATTICE] = {"lattice", 0, NULL,
+                         "instead: ns per step on n x n gate lattices, n = 1 .. 33,\n"
+                         "on --backend and --vs, the same schedules at every\n"
+                         "size (--trials per size, default 200; the --vs\n"
+                         "backend a twentieth of it, default 10)"},
 };
 
-static const struct option bench_options[] = {
-        {"backend", required_argument, NULL, OPT_BACKEND},
-        {"backend-opt", required_argument, NULL, OPT_BACKEND_OPT},
-        {"experiment", required_argument, NULL, OPT_EXPERIMENT},
-        {"trials", required_argument, NULL, OPT_TRIALS},
-        {"no-h2", no_argument, NULL, OPT_NO_H2},
-        {"vs", required_argument, NULL, OPT_VS},
-        {"vs-opt", required_argument, NULL, OPT_VS_OPT},
-        {"json", required_argument, NULL, OPT_JSON},
-        {"lattice", no_argument, NULL, OPT_LATTICE},
-        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
+static const char *const bench_help[CLI_N_OPTS] = {
+        [CLI_OPT_BACKEND_OPT] = "an option of --backend, repeatable (--vs-opt for --vs)",
 };
 
 typedef struct bench_args {
-	const char *backend;
+	const char *backend; /* --backend */
 	bsim_options opts;
 	const char *experiment;
 	int custom; /* --experiment given */
@@ -99,60 +66,53 @@ typedef struct bench_run {
 
 #define BENCH_RUNS_MAX 4
 
-/* Fills a; returns -1 to go on, else the exit status. */
-static int bench_parse(int argc, char **argv, bench_args *a)
+static int bench_option(void *args, int i, const char *value)
 {
-	int c;
-	opterr = 0;
-	while ((c = getopt_long(argc, argv, ":h", bench_options, NULL)) != -1) {
-		int rc = CLI_OK;
-		switch (c) {
-		case 'h':
-			fputs(bench_help, stdout);
-			return CLI_OK;
-		case OPT_BACKEND:
-			a->backend = optarg;
-			break;
-		case OPT_BACKEND_OPT:
-			rc = cli_options_add(&a->opts, "bench", optarg);
-			break;
-		case OPT_EXPERIMENT:
-			a->experiment = optarg;
-			a->custom = 1;
-			break;
-		case OPT_TRIALS:
-			if (cli_parse_long(optarg, 1, INT32_MAX, &a->trials) != 0)
-				rc = cli_usage("bench", "--trials %s: expected an integer >= 1",
-				               optarg);
-			break;
-		case OPT_NO_H2:
-			a->h2 = 0;
-			break;
-		case OPT_VS:
-			a->vs = strcmp(optarg, "none") == 0 ? NULL : optarg;
-			break;
-		case OPT_VS_OPT:
-			rc = cli_options_add(&a->vs_opts, "bench", optarg);
-			break;
-		case OPT_JSON:
-			a->json = optarg;
-			break;
-		case OPT_LATTICE:
-			a->lattice = 1;
-			break;
-		default:
-			return cli_bad_option("bench", argv, c);
-		}
-		if (rc != CLI_OK)
-			return rc;
-	}
-	if (optind != argc)
-		return cli_usage("bench", "unexpected argument %s", argv[optind]);
-	/* H1 + H2 is the essay's pair; it means nothing for another file. */
-	if (a->custom)
+	bench_args *a = args;
+	switch (i) {
+	case OWN_EXPERIMENT:
+		a->experiment = value;
+		a->custom = 1;
+		/* H1 + H2 is the essay's pair; it means nothing for another file. */
 		a->h2 = 0;
-	return -1;
+		return CLI_OK;
+	case OWN_NO_H2:
+		a->h2 = 0;
+		return CLI_OK;
+	case OWN_VS:
+		a->vs = strcmp(value, "none") == 0 ? NULL : value;
+		return CLI_OK;
+	case OWN_VS_OPT:
+		return cli_options_add(&a->vs_opts, "bench", value);
+	case OWN_JSON:
+		a->json = value;
+		return CLI_OK;
+	case OWN_LATTICE:
+		a->lattice = 1;
+		return CLI_OK;
+	}
+	return CLI_USAGE;
 }
+
+static const cli_spec bench_spec = {
+        .name = "bench",
+        .usage = "[OPTIONS]",
+        .about = "Runs an experiment (default " BENCH_H1 ") on one thread and\n"
+                 "on all threads and reports wall time, steps/s, trials/s and steps/s per "
+                 "core;\n"
+                 "then runs " BENCH_H2 " on all threads and reports the\n"
+                 "wall time of H1 + H2. Then runs the experiment on one thread with a second\n"
+                 "backend (--vs, default box2d) at the same time step and prints how many\n"
+                 "times faster the first is, per step and per trial. The default experiment\n"
+                 "paths are relative to the current directory (run it from the source "
+                 "tree).\n",
+        .common = CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_BACKEND_OPT) |
+                  CLI_USES(CLI_OPT_TRIALS),
+        .help = bench_help,
+        .own = bench_own,
+        .n_own = 6,
+        .option = bench_option,
+};
 
 /* The default experiments are found relative to the current directory. */
 static int bench_find(const char *path)
@@ -352,14 +312,23 @@ static int bench_main(const bench_args *a, const bsim_backend *backend, const bs
 
 int cmd_bench(int argc, char **argv)
 {
-	bench_args a = {.backend = "thesis", .experiment = BENCH_H1, .h2 = 1, .vs = "box2d"};
-	int rc = bench_parse(argc, argv, &a);
+	cli_common c = cli_common_default();
+	bench_args a = {.experiment = BENCH_H1, .h2 = 1, .vs = "box2d"};
+	int rc = cli_parse(&bench_spec, argc, argv, &c, &a, NULL);
+	a.backend = c.backend ? c.backend : bsim_backend_default()->name;
+	a.trials = c.trials;
+	/* --backend-opt is --backend's, --vs-opt --vs's. */
+	const bsim_backend *backend = NULL, *vs = NULL;
+	if (rc < 0 && cli_backend_opts(&c, "bench", 1, &a.backend,
+	                               (bsim_options *const[]){&a.opts}) != CLI_OK)
+		rc = CLI_USAGE;
+	if (rc < 0 && !(backend = cli_backend(a.backend, &a.opts)))
+		rc = CLI_USAGE;
+	if (rc < 0 && a.vs && !(vs = cli_backend(a.vs, &a.vs_opts)))
+		rc = CLI_USAGE;
+	cli_common_free(&c);
 	if (rc >= 0)
 		return rc;
-	const bsim_backend *backend = cli_backend(a.backend, &a.opts);
-	const bsim_backend *vs = backend && a.vs ? cli_backend(a.vs, &a.vs_opts) : NULL;
-	if (!backend || (a.vs && !vs))
-		return CLI_USAGE;
 	report = a.json && strcmp(a.json, "-") == 0 ? stderr : stdout;
 	if (a.lattice) {
 		bench_lattice_args la = {

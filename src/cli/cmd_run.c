@@ -4,79 +4,37 @@
  * sweep can be replayed and recorded. */
 #define _POSIX_C_SOURCE 200809L
 
-#include <getopt.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "beamsim/atomic_file.h"
 #include "beamsim/lattice.h"
-#include "beamsim/matlab.h"
-#include "beamsim/output.h"
 #include "beamsim/run_output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "cli_common.h"
-#include "cli_store.h"
+#include "cli_options.h"
 
-static const char run_help[] =
-        "Usage: beamsim run SCENE [OPTIONS]\n"
-        "\n"
-        "Runs one trial of the scene file SCENE and prints its outcome, end state,\n"
-        "peak beam angles, the deepest overlap of body and beams, and the energy\n"
-        "ledger. The random-force schedule is that of trial I of group G of a sweep\n"
-        "with seed N, so a sweep's trial can be replayed. A trial whose state stops\n"
-        "being finite, or whose ledger shows energy created beyond the bound, is\n"
-        "unstable: the reason is printed and the exit status is 1.\n"
-        "\n"
-        "Options:\n"
-        "  --backend B            physics backend (default thesis; see beamsim backends)\n"
-        "  --backend-opt K=V      a backend option, repeatable\n"
-        "  --seed N               experiment seed (default 1)\n"
-        "  --group G              group index for the seed (default 0)\n"
-        "  --trial I              trial index for the seed (default 0)\n"
-        "  --set KEY=VALUE        override a scene field by dotted path, repeatable\n"
-        "                         (e.g. --set effects.random_force.magnitude=30)\n"
-        "  --trajectory FILE.csv  write the trajectory, one row per recorded step, and\n"
-        "                         its MATLAB twin FILE.mat; - is standard output (no\n"
-        "                         twin; the report then goes to standard error)\n"
-        "  --out DIR              write DIR/trajectory.csv, DIR/ledger.csv (the energy\n"
-        "                         ledger over time), their .mat twins and DIR/run.json,\n"
-        "                         for `beamsim plot DIR`\n"
-        "  --stride N             record every N-th step (default 1)\n"
-        "  --json                 print one JSON object instead of text\n" CLI_LIMIT_HELP
-        "  -h, --help             show this help\n";
+enum { OWN_GROUP, OWN_TRIAL, OWN_TRAJECTORY, OWN_STRIDE, OWN_JSON };
 
-enum {
-	OPT_BACKEND = 256,
-	OPT_BACKEND_OPT,
-	OPT_SEED,
-	OPT_GROUP,
-	OPT_TRIAL,
-	OPT_SET,
-	OPT_TRAJECTORY,
-	OPT_STRIDE,
-	OPT_JSON,
-	OPT_OUT,
-	OPT_LIMIT
+static const cli_own run_own[] = {
+        [OWN_GROUP] = {"group", 1, "G", "group index for the seed (default 0)"},
+        [OWN_TRIAL] = {"trial", 1, "I", "trial index for the seed (default 0)"},
+        [OWN_TRAJECTORY] = {"trajectory", 1, "FILE.csv",
+                            "write the trajectory, one row per recorded step, and\n"
+                            "its MATLAB twin FILE.mat; - is standard output (no\n"
+                            "twin; the report then goes to standard error)"},
+        [OWN_STRIDE] = {"stride", 1, "N", "record every N-th step (default 1)"},
+        [OWN_JSON] = {"json", 0, NULL, "print one JSON object instead of text"},
 };
 
-static const struct option run_options[] = {
-        {"backend", required_argument, NULL, OPT_BACKEND},
-        {"backend-opt", required_argument, NULL, OPT_BACKEND_OPT},
-        {"seed", required_argument, NULL, OPT_SEED},
-        {"group", required_argument, NULL, OPT_GROUP},
-        {"trial", required_argument, NULL, OPT_TRIAL},
-        {"set", required_argument, NULL, OPT_SET},
-        {"trajectory", required_argument, NULL, OPT_TRAJECTORY},
-        {"stride", required_argument, NULL, OPT_STRIDE},
-        {"json", no_argument, NULL, OPT_JSON},
-        {"out", required_argument, NULL, OPT_OUT},
-        {"limit", required_argument, NULL, OPT_LIMIT},
-        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
+static const char *const run_help[CLI_N_OPTS] = {
+        [CLI_OPT_SEED] = "experiment seed (default 1)",
+        [CLI_OPT_OUT] = "write DIR/trajectory.csv, DIR/ledger.csv (the energy\n"
+                        "ledger over time), their .mat twins and DIR/run.json,\n"
+                        "for `beamsim plot DIR`",
 };
 
 typedef struct run_args {
@@ -85,84 +43,63 @@ typedef struct run_args {
 	bsim_options opts;
 	uint64_t seed;
 	long group, trial, stride;
-	cli_sets sets;
 	const char *trajectory;
-	const char *out;
 	int json;
 } run_args;
 
-/* Fills a; returns -1 to go on, else the exit status. */
-static int run_parse(int argc, char **argv, run_args *a)
+static int run_option(void *args, int i, const char *value)
 {
-	int c;
-	opterr = 0;
-	while ((c = getopt_long(argc, argv, ":h", run_options, NULL)) != -1) {
-		int rc = CLI_OK;
-		switch (c) {
-		case 'h':
-			fputs(run_help, stdout);
-			return CLI_OK;
-		case OPT_BACKEND:
-			a->backend = optarg;
-			break;
-		case OPT_BACKEND_OPT:
-			rc = cli_options_add(&a->opts, "run", optarg);
-			break;
-		case OPT_SEED:
-			if (cli_parse_u64(optarg, &a->seed) != 0)
-				rc = cli_usage("run", "--seed %s: expected an integer >= 0",
-				               optarg);
-			break;
-		case OPT_GROUP:
-			if (cli_parse_long(optarg, 0, INT32_MAX, &a->group) != 0)
-				rc = cli_usage("run", "--group %s: expected an integer >= 0",
-				               optarg);
-			break;
-		case OPT_TRIAL:
-			if (cli_parse_long(optarg, 0, INT32_MAX, &a->trial) != 0)
-				rc = cli_usage("run", "--trial %s: expected an integer >= 0",
-				               optarg);
-			break;
-		case OPT_SET:
-			rc = cli_sets_add(&a->sets, "run", optarg);
-			break;
-		case OPT_TRAJECTORY:
-			a->trajectory = optarg;
-			break;
-		case OPT_STRIDE:
-			if (cli_parse_long(optarg, 1, INT32_MAX, &a->stride) != 0)
-				rc = cli_usage("run", "--stride %s: expected an integer >= 1",
-				               optarg);
-			break;
-		case OPT_JSON:
-			a->json = 1;
-			break;
-		case OPT_OUT:
-			a->out = optarg;
-			break;
-		case OPT_LIMIT:
-			rc = cli_limit("run", optarg);
-			break;
-		default:
-			return cli_bad_option("run", argv, c);
-		}
-		if (rc != CLI_OK)
-			return rc;
+	run_args *a = args;
+	switch (i) {
+	case OWN_GROUP:
+		if (cli_parse_long(value, 0, INT32_MAX, &a->group) != 0)
+			return cli_usage("run", "--group %s: expected an integer >= 0", value);
+		return CLI_OK;
+	case OWN_TRIAL:
+		if (cli_parse_long(value, 0, INT32_MAX, &a->trial) != 0)
+			return cli_usage("run", "--trial %s: expected an integer >= 0", value);
+		return CLI_OK;
+	case OWN_TRAJECTORY:
+		a->trajectory = value;
+		return CLI_OK;
+	case OWN_STRIDE:
+		if (cli_parse_long(value, 1, INT32_MAX, &a->stride) != 0)
+			return cli_usage("run", "--stride %s: expected an integer >= 1", value);
+		return CLI_OK;
+	case OWN_JSON:
+		a->json = 1;
+		return CLI_OK;
 	}
-	if (optind + 1 != argc)
-		return cli_usage("run",
-		                 optind == argc ? "missing SCENE" : "expected one SCENE, got %d",
-		                 argc - optind);
-	a->scene = argv[optind];
-	return -1;
+	return CLI_USAGE;
 }
+
+static const cli_spec run_spec = {
+        .name = "run",
+        .usage = "SCENE [OPTIONS]",
+        .about = "Runs one trial of the scene file SCENE and prints its outcome, end state,\n"
+                 "peak beam angles, the deepest overlap of body and beams, and the energy\n"
+                 "ledger. The random-force schedule is that of trial I of group G of a sweep\n"
+                 "with seed N, so a sweep's trial can be replayed. A trial whose state stops\n"
+                 "being finite, or whose ledger shows energy created beyond the bound, is\n"
+                 "unstable: the reason is printed and the exit status is 1. Beams are\n"
+                 "numbered from 1 in what run prints and writes (beam 1, theta1), as in\n"
+                 "every output; the scene's list, and so --set, counts from 0 (beams.0).\n",
+        .positional = "SCENE",
+        .common = CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_BACKEND_OPT) |
+                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) |
+                  CLI_USES(CLI_OPT_LIMIT),
+        .help = run_help,
+        .own = run_own,
+        .n_own = 5,
+        .option = run_option,
+};
 
 /* A lattice trial's gate path and peaks (run --json has every beam's). */
 static void print_lattice(FILE *out, const bsim_scene *s, const bsim_trial_result *r,
                           const bsim_trial_log *log)
 {
 	char label[48];
-	bsim_location_label(bsim_location_of(r), label, sizeof label);
+	bsim_lattice_location_label(bsim_lattice_location_of(r), label, sizeof label);
 	fprintf(out, "lattice     %s protocol, ended %s in gate (%d, %d), %d gates entered:",
 	        s->lattice.protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world", label, r->final_ix,
 	        r->final_iy, r->gates_entered);
@@ -191,9 +128,9 @@ static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64
 	        "seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
 	        ", %lu draws)\n",
 	        a->seed, a->group, a->trial, mixed, r->draws);
-	fprintf(out, "outcome     %s", bsim_outcome_name(r->outcome));
+	fprintf(out, "outcome     %s", bsim_trial_outcome_name(r->outcome));
 	if (r->outcome == BSIM_TRAVERSED) {
-		fprintf(out, ", type %s, landscape ", bsim_type_name(r->type));
+		fprintf(out, ", type %s, landscape ", bsim_trial_type_name(r->type));
 		if (r->landscape_beam < 0)
 			fprintf(out, "none");
 		else if (r->landscape_beam < 2 && s->n_beams == 2)
@@ -232,141 +169,68 @@ static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64
 	}
 }
 
-/* Runs the trial, recording into the trajectory file and the --out
- * directory if asked for; the files appear only if the run finished. */
-static int run_trial(const run_args *a, const bsim_run_info *info, bsim_trial_result *res,
-                     bsim_trial_log *log)
-{
-	bsim_atomic_file traj = {0};
-	bsim_run_output dir;
-	bsim_recorder rec = {.csv = NULL, .stride = (int)a->stride, .log = log, .overlap = 1};
-	bsim_recorder dir_rec = {.csv = NULL, .stride = (int)a->stride, .log = log, .overlap = 1};
-	bsim_error err;
-	const bsim_scene *scene = info->scene;
-	if (a->trajectory) {
-		if (bsim_atomic_file_open(&traj, a->trajectory, &err) != BSIM_OK)
-			return cli_report(BSIM_EFAIL, &err);
-		bsim_recorder_header(traj.f, scene->n_beams);
-		rec.csv = traj.f;
-	}
-	/* DIR is checked before the trial runs and its files appear together
-	 * (beamsim/outdir.h). */
-	cli_session ss;
-	if (a->out) {
-		int src = cli_session_open(&ss, a->out, 0, NULL, 0, 0, NULL);
-		if (src != CLI_OK) {
-			bsim_atomic_file_abort(&traj);
-			return src;
-		}
-		if (bsim_run_output_open(&dir, ss.stage, scene->n_beams, &dir_rec, &err)) {
-			bsim_atomic_file_abort(&traj);
-			cli_report(BSIM_EFAIL, &err);
-			return cli_session_close(&ss, CLI_FAIL, "run");
-		}
-	}
-	/* One recorder writes both when both are asked for: the CSV of
-	 * --trajectory, and the directory's trajectory and ledger. */
-	if (a->out && a->trajectory) {
-		dir_rec.record = bsim_recorder_csv_record;
-		dir_rec.record_user = traj.f;
-	}
-	bsim_runner *runner = bsim_runner_alloc();
-	if (!runner) {
-		bsim_atomic_file_abort(&traj);
-		cli_error("out of memory for a trial runner");
-		if (a->out) {
-			bsim_run_output_abort(&dir);
-			return cli_session_close(&ss, CLI_FAIL, "run");
-		}
-		return CLI_FAIL;
-	}
-	bsim_error_clear(&err);
-	const bsim_recorder *use = a->out ? &dir_rec : &rec;
-	int rc = bsim_trial_run(runner, scene, info->backend, &a->opts, info->mixed_seed, use, res,
-	                        &err);
-	bsim_runner_free(runner);
-	if (rc != BSIM_OK) {
-		bsim_atomic_file_abort(&traj);
-		cli_report(rc, &err);
-		if (a->out) {
-			bsim_run_output_abort(&dir);
-			return cli_session_close(&ss, rc, "run");
-		}
-		return rc;
-	}
-	if (a->trajectory) {
-		char mat[1200];
-		rc = bsim_atomic_file_commit(&traj, &err);
-		/* The twin is read back from the file: a pipe, a terminal or
-		 * standard output cannot be, and a link's twin would not be its. */
-		if (rc == BSIM_OK && traj.mode == BSIM_ATOMIC_RENAME) {
-			rc = bsim_matlab_path(a->trajectory, mat, sizeof mat, &err);
-			if (rc == BSIM_OK)
-				rc = bsim_matlab_from_csv(a->trajectory, mat, "trajectory", &err);
-		}
-	}
-	if (rc == BSIM_OK && a->out)
-		rc = bsim_run_output_commit(&dir, info, res, &err);
-	else if (a->out)
-		bsim_run_output_abort(&dir);
-	rc = cli_report(rc, &err);
-	return a->out ? cli_session_close(&ss, rc, "run") : rc;
-}
-
 int cmd_run(int argc, char **argv)
 {
-	run_args a = {.backend = "thesis", .seed = 1, .stride = 1};
-	int rc = run_parse(argc, argv, &a);
+	cli_common c = cli_common_default();
+	const bsim_run_info defaults = bsim_run_info_default();
+	run_args a = {.seed = defaults.seed, .stride = defaults.stride};
+	int rc = cli_parse(&run_spec, argc, argv, &c, &a, &a.scene);
+	a.backend = c.backend ? c.backend : bsim_backend_default()->name;
+	a.seed = c.has_seed ? c.seed : a.seed;
+	const bsim_backend *backend = NULL;
+	if (rc < 0 && !(backend = cli_backend_with_opts(&c, "run", a.backend, &a.opts)))
+		rc = CLI_USAGE;
 	if (rc >= 0) {
-		cli_sets_free(&a.sets);
+		cli_common_free(&c);
 		return rc;
 	}
-	const bsim_backend *backend = cli_backend(a.backend, &a.opts);
 	bsim_scene scene;
 	bsim_error err;
-	if (!backend) {
-		rc = CLI_USAGE;
-	} else if (bsim_scene_load(a.scene, a.sets.ov, a.sets.n, &scene, &err) != BSIM_OK) {
+	if (bsim_scene_load(a.scene, c.sets.ov, c.sets.n, &scene, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
-		rc = err.code ? err.code : CLI_USAGE;
-	} else {
-		uint64_t mixed = bsim_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
-		bsim_run_info info = {
-		        .scene_path = a.scene,
-		        .scene = &scene,
-		        .sets = a.sets.ov,
-		        .n_sets = a.sets.n,
-		        .backend = backend,
-		        .opts = &a.opts,
-		        .seed = a.seed,
-		        .group = a.group,
-		        .trial = a.trial,
-		        .mixed_seed = mixed,
-		        .stride = (int)a.stride,
-		};
-		bsim_trial_result res;
-		memset(&res, 0, sizeof res);
-		bsim_trial_log *log = bsim_trial_log_alloc();
-		info.log = log;
-		rc = log ? run_trial(&a, &info, &res, log) : CLI_FAIL;
-		if (!log)
-			cli_error("out of memory");
-		/* A trajectory on standard output keeps it to itself: the report
-		 * goes to standard error. */
-		FILE *out = a.trajectory && strcmp(a.trajectory, "-") == 0 ? stderr : stdout;
-		if (rc == CLI_OK && a.json)
-			bsim_run_json(out, &info, &res, 0);
-		else if (rc == CLI_OK)
-			print_text(out, &a, &scene, mixed, &res, log);
-		if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {
-			char why[256];
-			bsim_trial_instability_text(&res, scene.dt, why, sizeof why);
-			cli_error("%s backend: unstable trial: %s", backend->name, why);
-			rc = CLI_FAIL;
-		}
-		bsim_trial_log_free(log);
-		bsim_scene_free(&scene);
+		cli_common_free(&c);
+		return err.code ? err.code : CLI_USAGE;
 	}
-	cli_sets_free(&a.sets);
+	uint64_t mixed = bsim_schedule_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
+	bsim_trial_log *log = bsim_trial_log_alloc();
+	bsim_run_info info = {
+	        .scene_path = a.scene,
+	        .scene = &scene,
+	        .sets = c.sets.ov,
+	        .n_sets = c.sets.n,
+	        .backend = backend,
+	        .opts = &a.opts,
+	        .seed = a.seed,
+	        .group = a.group,
+	        .trial = a.trial,
+	        .mixed_seed = mixed,
+	        .stride = (int)a.stride,
+	        .log = log,
+	};
+	bsim_trial_result res;
+	memset(&res, 0, sizeof res);
+	if (!log)
+		rc = cli_report(bsim_error_set(&err, BSIM_EFAIL, "out of memory"), &err);
+	else
+		rc = cli_report(bsim_run_output_trial(&info, a.trajectory, c.out, &res, &err),
+		                &err);
+	/* A trajectory on standard output keeps it to itself: the report
+	 * goes to standard error. */
+	FILE *out = a.trajectory && strcmp(a.trajectory, "-") == 0 ? stderr : stdout;
+	if (rc == CLI_OK && a.json)
+		bsim_run_output_json(out, &info, &res, 0);
+	else if (rc == CLI_OK)
+		print_text(out, &a, &scene, mixed, &res, log);
+	if (rc == CLI_OK)
+		cli_solver_warning(backend->name, &res.solver, "run --json");
+	if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {
+		char why[256];
+		bsim_trial_instability_text(&res, scene.dt, why, sizeof why);
+		cli_error("%s backend: unstable trial: %s", backend->name, why);
+		rc = CLI_FAIL;
+	}
+	bsim_trial_log_free(log);
+	bsim_scene_free(&scene);
+	cli_common_free(&c);
 	return rc;
 }

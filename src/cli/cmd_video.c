@@ -4,96 +4,48 @@
  * (beamsim/video.h). */
 #define _POSIX_C_SOURCE 200809L
 
-#include <getopt.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "beamsim/lattice.h"
+#include "beamsim/run_output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/video.h"
 #include "cli_common.h"
+#include "cli_options.h"
 
-static const char video_help[] =
-        "Usage: beamsim video SCENE --out FILE.mp4 [OPTIONS]\n"
-        "\n"
-        "Writes an MP4 (H.264, yuv420p) of one trial of the scene file SCENE: the\n"
-        "trial beamsim run runs with the same --seed, --group, --trial and --set. A\n"
-        "frame shows the beams coloured by stiffness (with the scale), the body and\n"
-        "its trail, the random force as an arrow (one body radius per Rm), the time,\n"
-        "the kinetic, spring and propulsive potential energies, and the outcome once\n"
-        "it is decided. A field larger than the view is followed by the camera.\n"
-        "With --backends A,B the backends run the same schedule side by side, each\n"
-        "panel showing the other's trail in grey and where the two paths part.\n"
-        "Frames are drawn with cairo and encoded by ffmpeg (Debian package ffmpeg).\n"
-        "The file appears whole or not at all.\n"
-        "\n"
-        "Options:\n"
-        "  --out FILE.mp4         the video to write (required)\n"
-        "  --backend B            physics backend (default thesis; see beamsim backends)\n"
-        "  --backends A,B         several backends side by side (up to 4)\n"
-        "  --backend-opt K=V      a backend option; B:K=V for backend B of --backends\n"
-        "  --seed N               experiment seed (default 1)\n"
-        "  --group G              group index for the seed (default 0)\n"
-        "  --trial I              trial index for the seed (default 0)\n"
-        "  --set KEY=VALUE        override a scene field by dotted path, repeatable\n"
-        "  --fps F                frames per second of simulated time (default 30)\n"
-        "  --size WxH             frame size in pixels, even (default 540x540 a panel)\n"
-        "  --hold S               seconds the last frame is held (default 1)\n"
-        "  --view M               metres the shorter side of a panel shows at most; a\n"
-        "                         larger field is followed by the camera (default 200)\n"
-        "  --crf N                x264 quality, 0 (lossless) to 51 (smallest); default 23\n"
-        "  -h, --help             show this help\n";
+enum { OWN_BACKENDS, OWN_GROUP, OWN_TRIAL, OWN_FPS, OWN_SIZE, OWN_HOLD, OWN_VIEW, OWN_CRF };
 
-enum {
-	OPT_OUT = 256,
-	OPT_BACKEND,
-	OPT_BACKENDS,
-	OPT_BACKEND_OPT,
-	OPT_SEED,
-	OPT_GROUP,
-	OPT_TRIAL,
-	OPT_SET,
-	OPT_FPS,
-	OPT_SIZE,
-	OPT_HOLD,
-	OPT_VIEW,
-	OPT_CRF
+static const cli_own video_own[] = {
+        [OWN_BACKENDS] = {"backends", 1, "A,B", "several backends side by side (up to 4)"},
+        [OWN_GROUP] = {"group", 1, "G", "group index for the seed (default 0)"},
+        [OWN_TRIAL] = {"trial", 1, "I", "trial index for the seed (default 0)"},
+        [OWN_FPS] = {"fps", 1, "F", "frames per second of simulated time (default 30)"},
+        [OWN_SIZE] = {"size", 1, "WxH", "frame size in pixels, even (default 540x540 a panel)"},
+        [OWN_HOLD] = {"hold", 1, "S", "seconds the last frame is held (default 1)"},
+        [OWN_VIEW] = {"view", 1, "M",
+                      "metres the shorter side of a panel shows at most; a\n"
+                      "larger field is followed by the camera (default 200)"},
+        [OWN_CRF] = {"crf", 1, "N", "x264 quality, 0 (lossless) to 51 (smallest); default 23"},
 };
 
-static const struct option video_options[] = {
-        {"out", required_argument, NULL, OPT_OUT},
-        {"backend", required_argument, NULL, OPT_BACKEND},
-        {"backends", required_argument, NULL, OPT_BACKENDS},
-        {"backend-opt", required_argument, NULL, OPT_BACKEND_OPT},
-        {"seed", required_argument, NULL, OPT_SEED},
-        {"group", required_argument, NULL, OPT_GROUP},
-        {"trial", required_argument, NULL, OPT_TRIAL},
-        {"set", required_argument, NULL, OPT_SET},
-        {"fps", required_argument, NULL, OPT_FPS},
-        {"size", required_argument, NULL, OPT_SIZE},
-        {"hold", required_argument, NULL, OPT_HOLD},
-        {"view", required_argument, NULL, OPT_VIEW},
-        {"crf", required_argument, NULL, OPT_CRF},
-        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
+static const char *const video_help[CLI_N_OPTS] = {
+        [CLI_OPT_OUT] = "the video to write (required)",
+        [CLI_OPT_SEED] = "experiment seed (default 1)",
 };
 
 #define MAX_PANELS BSIM_VIDEO_PANELS_MAX
 
 typedef struct video_args {
 	const char *scene, *out;
-	int n_backends, has_backend, has_backends;
+	int n_backends, has_backends;
 	char names[MAX_PANELS][32];
 	bsim_options opts[MAX_PANELS];
 	uint64_t seed;
 	long group, trial;
-	cli_sets sets;
 	bsim_video_def def;
-	/* --backend-opt is resolved once the backends are known */
-	int n_pending;
-	char pending[MAX_PANELS * BSIM_OPTIONS_MAX][128];
 } video_args;
 
 static int parse_backends(video_args *a, const char *text)
@@ -115,25 +67,6 @@ static int parse_backends(video_args *a, const char *text)
 			return CLI_OK;
 		p += n + 1;
 	}
-}
-
-/* "K=V" for the only backend, or "B:K=V" for backend B. */
-static int backend_opt(video_args *a, const char *text)
-{
-	const char *colon = strchr(text, ':'), *eq = strchr(text, '=');
-	if (colon && (!eq || colon < eq)) {
-		for (int i = 0; i < a->n_backends; i++)
-			if (strlen(a->names[i]) == (size_t)(colon - text) &&
-			    strncmp(text, a->names[i], (size_t)(colon - text)) == 0)
-				return cli_options_add(&a->opts[i], "video", colon + 1);
-		return cli_usage("video", "--backend-opt %s: %.*s is not one of the backends", text,
-		                 (int)(colon - text), text);
-	}
-	if (a->n_backends > 1)
-		return cli_usage("video",
-		                 "--backend-opt %s: expected B:KEY=VALUE with several backends",
-		                 text);
-	return cli_options_add(&a->opts[0], "video", text);
 }
 
 static int parse_number(const char *opt, const char *text, double lo, double hi, int open_lo,
@@ -167,54 +100,33 @@ static int parse_size(video_args *a, const char *text)
 	return CLI_OK;
 }
 
-static int video_option(video_args *a, int c)
+static int video_option(void *args, int i, const char *value)
 {
-	switch (c) {
-	case OPT_OUT:
-		a->out = optarg;
-		return CLI_OK;
-	case OPT_BACKEND:
-		a->has_backend = 1;
-		a->n_backends = 1;
-		if (strlen(optarg) >= sizeof a->names[0])
-			return cli_usage("video", "--backend %s: unknown backend", optarg);
-		snprintf(a->names[0], sizeof a->names[0], "%s", optarg);
-		return CLI_OK;
-	case OPT_BACKENDS:
+	video_args *a = args;
+	switch (i) {
+	case OWN_BACKENDS:
 		a->has_backends = 1;
-		return parse_backends(a, optarg);
-	case OPT_BACKEND_OPT:
-		if (a->n_pending == (int)(sizeof a->pending / sizeof a->pending[0]) ||
-		    strlen(optarg) >= sizeof a->pending[0])
-			return cli_usage("video", "--backend-opt %s: too many or too long", optarg);
-		snprintf(a->pending[a->n_pending++], sizeof a->pending[0], "%s", optarg);
+		return parse_backends(a, value);
+	case OWN_GROUP:
+		if (cli_parse_long(value, 0, INT32_MAX, &a->group) != 0)
+			return cli_usage("video", "--group %s: expected an integer >= 0", value);
 		return CLI_OK;
-	case OPT_SEED:
-		if (cli_parse_u64(optarg, &a->seed) != 0)
-			return cli_usage("video", "--seed %s: expected an integer >= 0", optarg);
+	case OWN_TRIAL:
+		if (cli_parse_long(value, 0, INT32_MAX, &a->trial) != 0)
+			return cli_usage("video", "--trial %s: expected an integer >= 0", value);
 		return CLI_OK;
-	case OPT_GROUP:
-		if (cli_parse_long(optarg, 0, INT32_MAX, &a->group) != 0)
-			return cli_usage("video", "--group %s: expected an integer >= 0", optarg);
-		return CLI_OK;
-	case OPT_TRIAL:
-		if (cli_parse_long(optarg, 0, INT32_MAX, &a->trial) != 0)
-			return cli_usage("video", "--trial %s: expected an integer >= 0", optarg);
-		return CLI_OK;
-	case OPT_SET:
-		return cli_sets_add(&a->sets, "video", optarg);
-	case OPT_FPS:
-		return parse_number("--fps", optarg, 0.0, 1000.0, 1, &a->def.fps);
-	case OPT_SIZE:
-		return parse_size(a, optarg);
-	case OPT_HOLD:
-		return parse_number("--hold", optarg, 0.0, 60.0, 0, &a->def.hold);
-	case OPT_VIEW:
-		return parse_number("--view", optarg, 0.0, 1e6, 1, &a->def.view_span);
-	case OPT_CRF: {
+	case OWN_FPS:
+		return parse_number("--fps", value, 0.0, 1000.0, 1, &a->def.fps);
+	case OWN_SIZE:
+		return parse_size(a, value);
+	case OWN_HOLD:
+		return parse_number("--hold", value, 0.0, 60.0, 0, &a->def.hold);
+	case OWN_VIEW:
+		return parse_number("--view", value, 0.0, 1e6, 1, &a->def.view_span);
+	case OWN_CRF: {
 		long crf;
-		if (cli_parse_long(optarg, 0, 51, &crf) != 0)
-			return cli_usage("video", "--crf %s: expected an integer 0 to 51", optarg);
+		if (cli_parse_long(value, 0, 51, &crf) != 0)
+			return cli_usage("video", "--crf %s: expected an integer 0 to 51", value);
 		a->def.crf = (int)crf;
 		return CLI_OK;
 	}
@@ -222,55 +134,67 @@ static int video_option(video_args *a, int c)
 	return CLI_USAGE;
 }
 
-/* Fills a; returns -1 to go on, else the exit status. */
-static int video_parse(int argc, char **argv, video_args *a)
+static const cli_spec video_spec = {
+        .name = "video",
+        .usage = "SCENE --out FILE.mp4 [OPTIONS]",
+        .about = "Writes an MP4 (H.264, yuv420p) of one trial of the scene file SCENE: the\n"
+                 "trial beamsim run runs with the same --seed, --group, --trial and --set. A\n"
+                 "frame shows the beams coloured by stiffness (with the scale), the body and\n"
+                 "its trail, the random force as an arrow (one body radius per Rm), the time,\n"
+                 "the kinetic, spring and propulsive potential energies, and the outcome once\n"
+                 "it is decided. A field larger than the view is followed by the camera.\n"
+                 "With --backends A,B the backends run the same schedule side by side, each\n"
+                 "panel showing the other's trail in grey and where the two paths part.\n"
+                 "Frames are drawn with cairo and encoded by ffmpeg (Debian package ffmpeg).\n"
+                 "The file appears whole or not at all.\n",
+        .positional = "SCENE",
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND) |
+                  CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET),
+        .help = video_help,
+        .out_arg = "FILE.mp4",
+        .out_required = 1,
+        .own = video_own,
+        .n_own = 8,
+        .option = video_option,
+};
+
+/* After parsing: the backends (--backend or --backends) and their options. */
+static int video_resolve(const cli_common *c, video_args *a)
 {
-	int c;
-	opterr = 0;
-	while ((c = getopt_long(argc, argv, ":h", video_options, NULL)) != -1) {
-		if (c == 'h') {
-			fputs(video_help, stdout);
-			return CLI_OK;
-		}
-		if (c == '?' || c == ':')
-			return cli_bad_option("video", argv, c);
-		int rc = video_option(a, c);
-		if (rc != CLI_OK)
-			return rc;
-	}
-	if (optind + 1 != argc)
-		return cli_usage("video",
-		                 optind == argc ? "missing SCENE" : "expected one SCENE, got %d",
-		                 argc - optind);
-	a->scene = argv[optind];
-	if (!a->out)
-		return cli_usage("video", "--out FILE.mp4 is required");
-	if (a->has_backend && a->has_backends)
+	a->out = c->out;
+	a->seed = c->has_seed ? c->seed : a->seed;
+	if (c->backend && a->has_backends)
 		return cli_usage("video", "--backend and --backends: give one of them");
+	if (c->backend) {
+		if (strlen(c->backend) >= sizeof a->names[0])
+			return cli_usage("video", "--backend %s: unknown backend", c->backend);
+		snprintf(a->names[0], sizeof a->names[0], "%s", c->backend);
+	}
 	if (a->def.width && a->def.width / a->n_backends < 64)
 		return cli_usage("video", "--size %dx%d: less than 64 pixels a panel for %d panels",
 		                 a->def.width, a->def.height, a->n_backends);
-	for (int i = 0; i < a->n_pending; i++) {
-		int rc = backend_opt(a, a->pending[i]);
-		if (rc != CLI_OK)
-			return rc;
+	const char *names[MAX_PANELS];
+	bsim_options *opts[MAX_PANELS];
+	for (int i = 0; i < a->n_backends; i++) {
+		names[i] = a->names[i];
+		opts[i] = &a->opts[i];
 	}
-	return -1;
+	return cli_backend_opts(c, "video", a->n_backends, names, opts);
 }
 
 static void print_outcome(FILE *out, const char *name, const bsim_scene *s,
                           const bsim_trial_result *r)
 {
-	fprintf(out, "%-11s %s at t = %.6g s", name, bsim_outcome_name(r->outcome), r->t_end);
+	fprintf(out, "%-11s %s at t = %.6g s", name, bsim_trial_outcome_name(r->outcome), r->t_end);
 	if (s->has_lattice) {
 		char loc[48];
-		bsim_location_label(bsim_location_of(r), loc, sizeof loc);
+		bsim_lattice_location_label(bsim_lattice_location_of(r), loc, sizeof loc);
 		fprintf(out, ", ended %s, %d gates entered, %d steps run\n", loc, r->gates_entered,
 		        r->steps_run);
 		return;
 	}
 	if (r->outcome == BSIM_TRAVERSED)
-		fprintf(out, ", %s type", bsim_type_name(r->type));
+		fprintf(out, ", %s type", bsim_trial_type_name(r->type));
 	else if (r->outcome == BSIM_STUCK)
 		fprintf(out, ", %s", r->in_contact_end ? "in contact" : "not in contact");
 	fprintf(out, ", %d steps run\n", r->steps_run);
@@ -281,7 +205,7 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 {
 	bsim_video_track *tracks[MAX_PANELS] = {0};
 	const char *labels[MAX_PANELS];
-	uint64_t mixed = bsim_seed_mix(a->seed, (uint64_t)a->group, (uint64_t)a->trial);
+	uint64_t mixed = bsim_schedule_seed_mix(a->seed, (uint64_t)a->group, (uint64_t)a->trial);
 	bsim_error err;
 	int rc = BSIM_OK;
 	for (int i = 0; i < a->n_backends && rc == BSIM_OK; i++) {
@@ -336,11 +260,14 @@ int cmd_video(int argc, char **argv)
 		cli_error("out of memory");
 		return CLI_FAIL;
 	}
-	a->seed = 1;
+	a->seed = bsim_run_info_default().seed; /* the trial beamsim run runs */
 	a->n_backends = 1;
-	snprintf(a->names[0], sizeof a->names[0], "thesis");
-	a->def = bsim_video_default_def();
-	int rc = video_parse(argc, argv, a);
+	snprintf(a->names[0], sizeof a->names[0], "%s", bsim_backend_default()->name);
+	a->def = bsim_video_def_default();
+	cli_common c = cli_common_default();
+	int rc = cli_parse(&video_spec, argc, argv, &c, a, &a->scene);
+	if (rc < 0 && (rc = video_resolve(&c, a)) == CLI_OK)
+		rc = -1;
 	if (rc < 0) {
 		const bsim_backend *backends[MAX_PANELS];
 		rc = CLI_OK;
@@ -350,7 +277,7 @@ int cmd_video(int argc, char **argv)
 		bsim_scene scene;
 		bsim_error err;
 		if (rc == CLI_OK &&
-		    bsim_scene_load(a->scene, a->sets.ov, a->sets.n, &scene, &err) != BSIM_OK) {
+		    bsim_scene_load(a->scene, c.sets.ov, c.sets.n, &scene, &err) != BSIM_OK) {
 			cli_error("%s", err.msg);
 			rc = err.code ? err.code : CLI_USAGE;
 		} else if (rc == CLI_OK) {
@@ -358,7 +285,7 @@ int cmd_video(int argc, char **argv)
 			bsim_scene_free(&scene);
 		}
 	}
-	cli_sets_free(&a->sets);
+	cli_common_free(&c);
 	free(a);
 	return rc;
 }

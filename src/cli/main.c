@@ -82,13 +82,26 @@ static int dispatch(int argc, char **argv)
 		return CLI_OK;
 	}
 	if (strcmp(name, "--version") == 0 || strcmp(name, "-V") == 0) {
-		printf("beamsim %s\n", BSIM_VERSION);
+		const char *commit = bsim_version_commit();
+		printf("beamsim %s\n", bsim_version());
+		printf("commit %s\nBox2D %s\ncompiler %s\n", commit[0] ? commit : "unknown",
+		       bsim_version_box2d(), bsim_version_compiler());
 		return CLI_OK;
 	}
-	for (int i = 0; i < N_COMMANDS; i++)
+	const char *names[N_COMMANDS];
+	for (int i = 0; i < N_COMMANDS; i++) {
 		if (strcmp(name, commands[i].name) == 0)
 			return commands[i].run(argc - 1, argv + 1);
-	fprintf(stderr, "beamsim: unknown command '%s'\n\n", name);
+		names[i] = commands[i].name;
+	}
+	const char *near = cli_nearest(name, names, N_COMMANDS);
+	if (near) {
+		cli_error("unknown command '%s'; did you mean '%s'? (beamsim --help lists them)",
+		          name, near);
+		return CLI_USAGE;
+	}
+	cli_error("unknown command '%s'", name);
+	fputc('\n', stderr);
 	usage(stderr);
 	return CLI_USAGE;
 }

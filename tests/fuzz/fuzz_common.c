@@ -94,7 +94,7 @@ void fuzz_run_scene(const bsim_scene *scene)
 	/* Enough steps for contacts at the start, few enough to stay fast. */
 	if (s.max_steps > 200)
 		s.max_steps = 200;
-	bsim_runner *r = bsim_runner_alloc();
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	for (int i = 0; r && i < 2; i++) {
 		const bsim_backend *b = bsim_backend_find(names[i], NULL);
 		bsim_trial_result res;
@@ -104,6 +104,6 @@ void fuzz_run_scene(const bsim_scene *scene)
 		if (rc != BSIM_OK)
 			fuzz_check_error(rc, &err);
 	}
-	bsim_runner_free(r);
+	bsim_trial_runner_free(r);
 	bsim_scene_free(&s);
 }

@@ -5,6 +5,7 @@
 #ifndef BEAMSIM_JSON_H
 #define BEAMSIM_JSON_H
 
+#include <stdint.h>
 #include <stdio.h>
 
 #ifdef __cplusplus
@@ -19,6 +20,12 @@ void bsim_json_string(FILE *f, const char *s);
 /* x as the shortest of %.15g, %.16g, %.17g that reads back as the same
  * double; null if x is not finite (JSON has no NaN or infinity). */
 void bsim_json_number(FILE *f, double x);
+
+/* An unsigned 64-bit integer (a seed): a number up to 2^53, which every
+ * reader holds exactly in a double; above, a string of its decimal digits,
+ * which a double-based reader (MATLAB's jsondecode, JavaScript) would
+ * otherwise round. */
+void bsim_json_u64(FILE *f, uint64_t x);
 
 #ifdef __cplusplus
 }

@@ -1,9 +1,9 @@
-/* The progress line of long runs; see beamsim/progress.h. */
+/* The progress line of long runs; see cli_progress.h. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "beamsim/progress.h"
+#include "cli_progress.h"
 
-#include "beamsim/clock.h"
+#include "clock.h"
 
 #include <stdio.h>
 #include <unistd.h>
@@ -11,9 +11,10 @@
 /* Redraw interval, s: fast enough to look live, slow enough to cost nothing. */
 #define PROGRESS_INTERVAL 0.1
 
-void bsim_progress_init(bsim_progress *p, int enabled)
+void cli_progress_init(cli_progress *p, int enabled, const char *unit)
 {
 	p->active = enabled && isatty(STDERR_FILENO);
+	p->unit = unit;
 	p->shown = 0;
 	p->t_start = bsim_clock_seconds();
 	p->t_last = -1.0;
@@ -30,9 +31,9 @@ static void format_duration(char *buf, size_t n, double s)
 		snprintf(buf, n, "%ld:%02ld", t / 60, t % 60);
 }
 
-void bsim_progress_update(void *user, long done, long total)
+void cli_progress_update(void *user, long done, long total)
 {
-	bsim_progress *p = user;
+	cli_progress *p = user;
 	if (!p || !p->active || total <= 0)
 		return;
 	/* Trials taken from a journal took no time: the ETA counts from the
@@ -52,13 +53,13 @@ void bsim_progress_update(void *user, long done, long total)
 		format_duration(eta, sizeof eta,
 		                elapsed * (double)(total - done) / (double)(done - p->base));
 	/* Trailing spaces wipe what a longer previous line left behind. */
-	fprintf(stderr, "\r  %ld/%ld trials  %d%%  %s %s   ", done, total,
+	fprintf(stderr, "\r  %ld/%ld %s  %d%%  %s %s   ", done, total, p->unit,
 	        (int)(100.0 * (double)done / (double)total), done >= total ? "took" : "ETA", eta);
 	fflush(stderr);
 	p->shown = 1;
 }
 
-void bsim_progress_finish(bsim_progress *p)
+void cli_progress_finish(cli_progress *p)
 {
 	if (p->active && p->shown)
 		fputc('\n', stderr);

@@ -23,7 +23,7 @@
 
 #include "thesis/thesis.h"
 
-void thesis_contact_solve(struct bsim_world *w, const double force[2], double h)
+void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h)
 {
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
@@ -40,7 +40,7 @@ void thesis_contact_solve(struct bsim_world *w, const double force[2], double h)
 		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - omega_free * c->c;
 		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 	}
-	thesis_lcp_solve(w, cs, n);
+	w->solver.iteration_limit += thesis_lcp_solve(w, cs, n);
 
 	double j[2];
 	thesis_impulse_sum(cs, n, j);

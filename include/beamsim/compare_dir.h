@@ -1,0 +1,94 @@
+/* A comparison stored in an output directory (beamsim compare EXPERIMENT
+ * --out DIR): every trial of an experiment run on two sides with the same
+ * random-force schedules, so that trial t of group g is a pair
+ * (beamsim/sweep.h), the pairs analysed (beamsim/compare.h), and DIR
+ * written as one set: report.md, report.json, pairs.csv, each side's sweep
+ * files in DIR/<label>/ (beamsim/sweep_dir.h), their .mat twins, and
+ * run.json with inputs/ (beamsim/run_record.h). DIR, the journal and
+ * resume behave as for a sweep (beamsim/sweep_dir.h).
+ *
+ * A side is a backend with options, written NAME[:KEY=VALUE]... as on the
+ * command line ("thesis", "box2d:spring=torque:substeps=4"); that text is
+ * its label. Or, on a gate lattice, the two sides are one backend under two
+ * lattice protocols (protocol), and the protocols label them. */
+#ifndef BEAMSIM_COMPARE_DIR_H
+#define BEAMSIM_COMPARE_DIR_H
+
+#include <signal.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/compare.h"
+#include "beamsim/experiment.h"
+#include "beamsim/sweep.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bsim_compare_side {
+	const bsim_backend *backend;
+	bsim_options opts;
+	char label[128]; /* NAME[:K=V]..., or the protocol */
+} bsim_compare_side;
+
+/* Parses a side "NAME[:KEY=VALUE]..." into side (label = spec, backend
+ * found by name, options in order, later ones win), after the options
+ * already in side->opts, which the spec's override. BSIM_EINPUT naming the
+ * spec and what was expected. */
+int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err);
+
+/* The directory of a side's files in DIR: the label with ':' and '/'
+ * written '-' ("thesis:integrator=euler" -> "thesis-integrator=euler"). */
+void bsim_compare_dir_label(const char *label, char *buf, size_t size);
+
+typedef struct bsim_compare_dir_def {
+	const char *experiment; /* the experiment file */
+	const char *out;        /* the output directory */
+	const bsim_override *sets;
+	int n_sets;
+	long trials; /* > 0: trials per group instead of the file's */
+	int has_seed;
+	uint64_t seed;
+	bsim_compare_side side[2];
+	/* "world" and "essay" (lattice.protocol), or both NULL: the sides
+	 * differ by backend and options. With protocols both sides must name
+	 * one backend. */
+	const char *protocol[2];
+	int threads; /* <= 0: all cores */
+	bsim_compare_rule rule;
+	int examples;          /* discordant trials listed per disagreeing group */
+	int keep, keep_stride; /* trajectories kept per group, see bsim_sweep_config */
+	int resume;
+	bsim_progress_fn progress;
+	void *progress_user;
+	const volatile sig_atomic_t *stop;
+} bsim_compare_dir_def;
+
+/* thesis against box2d, no options, bsim_compare_rule_default(), 3
+ * examples, all cores. */
+bsim_compare_dir_def bsim_compare_dir_default(void);
+
+typedef struct bsim_compare_dir_result {
+	bsim_experiment e;
+	bsim_comparison cmp;
+	int threads;
+	char dir[2][128];             /* each side's directory in DIR */
+	long unstable[2];             /* unstable trials on each side */
+	bsim_solver_counts solver[2]; /* what each side's solvers gave up on */
+	char journal[1100];           /* as in bsim_sweep_dir_result */
+} bsim_compare_dir_result;
+
+/* Runs the comparison into def->out. BSIM_OK whatever the verdicts
+ * (res->cmp.n_disagree says whether any group disagrees); the errors as
+ * bsim_sweep_dir_run's, and BSIM_EINPUT for sides that are the same or
+ * would write to the same directory. */
+int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_result *res,
+                         bsim_error *err);
+void bsim_compare_dir_result_free(bsim_compare_dir_result *res);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,73 @@
+/* The state a backend reports after each step (beamsim/backend.h): body,
+ * beams, contacts, the step's energy flows, and the beams that may be away
+ * from rest. The caller owns a state's storage: bsim_state_init sizes it for
+ * a scene's beams, bsim_state_free releases it. */
+#ifndef BEAMSIM_STATE_H
+#define BEAMSIM_STATE_H
+
+#include "beamsim/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum { BSIM_CONTACT_NONE = 0, BSIM_CONTACT_TANGENT = 1, BSIM_CONTACT_TIP = 2 };
+
+/* Energy flows of the last step, J, as measured by the backend. With the
+ * runner's work of the external force they close the energy ledger:
+ * dE = W_ext - damper - impact - contact - correction - sleep. */
+typedef struct bsim_step_energy {
+	double damper;     /* dissipated by the beam dampers (>= 0) */
+	double impact;     /* lost in impacts, incl. plastic entry to rest (>= 0) */
+	double contact;    /* -(work of persistent contact forces), ~0 */
+	double correction; /* energy change from position correction */
+	double sleep;      /* of beams put exactly to rest by sleeping (>= 0) */
+} bsim_step_energy;
+
+/* What a backend's solvers had to give up on, counted since the world was
+ * created. A count is never a failure by itself: the runner reports it
+ * (beamsim run warns, summary.json counts), and the trial's ledger and
+ * finiteness checks still judge the trial (beamsim/trial.h). */
+typedef struct bsim_solver_counts {
+	long iteration_limit; /* solves that stopped at their iteration limit
+	                       * before they converged */
+	long clamped;         /* (sub)steps in which a motion was clamped to a
+	                       * solver's limit (Box2D's b2_maxTranslation and
+	                       * b2_maxRotation) */
+} bsim_solver_counts;
+
+typedef struct bsim_state {
+	double x[2]; /* body centre, m */
+	double v[2]; /* body velocity, m/s */
+	int n_beams;
+	double *theta;             /* n_beams, rad, forward positive */
+	double *omega;             /* n_beams, rad/s */
+	int *contact;              /* n_beams, BSIM_CONTACT_* at the end of the step */
+	bsim_step_energy energy;   /* of the last step */
+	int impacts;               /* impacts resolved in the last step */
+	bsim_solver_counts solver; /* since the world was created */
+	double pivot_drift;        /* m, largest distance of a beam's pinned point from
+	                            * its pivot (0 where the pin is exact by construction) */
+	/* The beams that may be away from rest, ascending: every beam not
+	 * listed has theta = omega = 0 and no contact, and so have its entries
+	 * in theta, omega and contact. A backend may list more than it must
+	 * (all n_beams, say); readers that loop over active[] instead of all
+	 * beams cost what the beams near the body cost. */
+	int n_active;
+	int *active; /* n_beams capacity */
+} bsim_state;
+
+/* Sizes s for n_beams beams, everything zero. BSIM_EFAIL out of memory
+ * (s is then empty, and bsim_state_free on it is harmless). */
+int bsim_state_init(bsim_state *s, int n_beams);
+void bsim_state_free(bsim_state *s);
+void bsim_state_copy(bsim_state *dst, const bsim_state *src);
+/* For a backend's get_state: zeroes the entries of the beams s lists now,
+ * then lists the n given ones (ascending), whose entries the backend then
+ * writes. Costs the two lists, not n_beams. */
+void bsim_state_set_active(bsim_state *s, const int *active, int n);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,100 @@
+/* A sweep stored in an output directory (beamsim sweep EXPERIMENT --out
+ * DIR): the experiment loaded with its overrides, every trial run
+ * (beamsim/sweep.h), and DIR written as one set (docs/files.md):
+ * summary.json, trials.csv, trajectories.csv when trajectories are kept,
+ * the lattice's files for a lattice, their .mat twins, and the record that
+ * lets the run be repeated, run.json and inputs/ (beamsim/run_record.h).
+ *
+ *   bsim_sweep_dir_def def = bsim_sweep_dir_default();
+ *   def.experiment = "configs/thesis/h1_symmetric.yaml";
+ *   def.out = "out/h1";
+ *   bsim_sweep_dir_result res;
+ *   if (bsim_sweep_dir_run(&def, &res, &err) == BSIM_OK) {
+ *           ... res.e, res.r ...
+ *           bsim_sweep_dir_result_free(&res);
+ *   }
+ *
+ * DIR is checked (created if missing, writable, not in use by another run)
+ * before any trial runs. The files appear together when the whole sweep has
+ * succeeded; until then DIR holds what it held. Finished trials are
+ * journaled as they end (DIR/.beamsim/journal), so a run stopped through
+ * def.stop or killed continues with def.resume and writes the files an
+ * uninterrupted run writes, byte for byte. */
+#ifndef BEAMSIM_SWEEP_DIR_H
+#define BEAMSIM_SWEEP_DIR_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/experiment.h"
+#include "beamsim/sweep.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct bsim_sweep_dir_def {
+	const char *experiment;    /* the experiment file */
+	const char *out;           /* the output directory */
+	const bsim_override *sets; /* applied to every group, after the file's set: */
+	int n_sets;
+	long trials;  /* > 0: trials per group instead of the file's */
+	int has_seed; /* 1: seed instead of the file's */
+	uint64_t seed;
+	const bsim_backend *backend; /* default: thesis */
+	bsim_options opts;           /* the backend's options (beamsim/options.h) */
+	int threads;                 /* <= 0: all cores */
+	int overlap;                 /* 1: each trial's deepest body-beam overlap */
+	int keep;                    /* trajectories kept per group (trajectories.csv) */
+	int keep_stride;             /* a kept row every keep_stride steps (<= 0: 5) */
+	int resume;                  /* 1: continue the stopped run in out (same inputs) */
+	bsim_progress_fn progress;   /* may be NULL */
+	void *progress_user;
+	/* NULL, or a flag (set by a signal handler, say): once nonzero no trial
+	 * starts, those running finish and are journaled, and the run returns
+	 * BSIM_ESTOPPED with the journal kept for resume. */
+	const volatile sig_atomic_t *stop;
+} bsim_sweep_dir_def;
+
+/* The thesis backend, no options, all cores, nothing kept. */
+bsim_sweep_dir_def bsim_sweep_dir_default(void);
+
+typedef struct bsim_sweep_dir_result {
+	bsim_experiment e;   /* as run: --trials and --seed applied */
+	bsim_sweep_result r; /* every trial and group */
+	int threads;         /* threads used */
+	/* Unstable trials (bsim_instability): how many, the first's index
+	 * g * trials + t (-1 if none) and why, in one line. */
+	long unstable, first_unstable;
+	char unstable_why[256];
+	/* When the run stopped (BSIM_ESTOPPED), or its files could not be
+	 * committed after every trial had run: the journal that resume
+	 * continues from. "" otherwise. */
+	char journal[1100];
+} bsim_sweep_dir_result;
+
+/* Runs the sweep into def->out. BSIM_OK with res filled (free it with
+ * bsim_sweep_dir_result_free; unstable trials are an ordinary result,
+ * counted); BSIM_EINPUT for a bad experiment, backend option or directory,
+ * or a refused resume; BSIM_EFAIL when the run or a file fails;
+ * BSIM_ESTOPPED when def->stop stopped it. On any error res holds nothing
+ * to free but res->journal. */
+int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err);
+
+/* Reads a stored sweep back: DIR's run.json (beamsim/run_record.h), the
+ * experiment of DIR/inputs/ and the trials of trials.csv, with each
+ * group's deterministic flag from its scene. side: NULL for a sweep's
+ * directory, or the label of one side of a comparison's (its trials are in
+ * DIR/<bsim_compare_dir_label(side)>/). BSIM_EINPUT naming the file and
+ * field if DIR is not such a directory or its files do not match its
+ * manifest. */
+int bsim_sweep_dir_read(const char *dir, const char *side, bsim_sweep_dir_result *res,
+                        bsim_error *err);
+
+void bsim_sweep_dir_result_free(bsim_sweep_dir_result *res);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,263 @@
+/* The shared options and the parser of every command; see cli_options.h. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "cli_options.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct shared_def {
+	const char *name;
+	int has_arg;
+	const char *arg;
+	const char *help;
+} shared_def;
+
+static const shared_def shared[CLI_N_OPTS] = {
+        [CLI_OPT_BACKEND] = {"backend", 1, "B",
+                             "physics backend (default thesis; see beamsim backends)"},
+        [CLI_OPT_BACKEND_OPT] = {"backend-opt", 1, "K=V",
+                                 "a backend option, repeatable; B:K=V sets it on\n"
+                                 "backend B (see beamsim backends --help)"},
+        [CLI_OPT_THREADS] = {"threads", 1, "N", "worker threads (default: all cores)"},
+        [CLI_OPT_TRIALS] = {"trials", 1, "N", "trials per group (default: the experiment's)"},
+        [CLI_OPT_SEED] = {"seed", 1, "N", "experiment seed (default: the experiment's)"},
+        [CLI_OPT_SET] = {"set", 1, "KEY=VALUE",
+                         "override a scene field by dotted path, repeatable\n"
+                         "(e.g. --set beams.0.stiffness=250: beams.0 is beam 1)"},
+        [CLI_OPT_OUT] = {"out", 1, "DIR", "output directory, created if missing (required)"},
+        [CLI_OPT_QUIET] = {"quiet", 0, NULL, "no progress line, nothing on stdout"},
+        [CLI_OPT_LIMIT] = {"limit", 1, "NAME=N",
+                           "raise a limit on what inputs may ask for: input_bytes,\n"
+                           "groups, trials, schedule, beam_steps (README, Robustness)"},
+        [CLI_OPT_RESUME] = {"resume", 0, NULL, "continue the stopped run in DIR (same inputs)"},
+        [CLI_OPT_TRAJECTORIES] = {"trajectories", 1, "N",
+                                  "keep the trajectories of the first N trials of each\n"
+                                  "group in DIR/trajectories.csv (and .mat), for\n"
+                                  "`beamsim plot DIR`"},
+        [CLI_OPT_TRAJECTORY_STRIDE] = {"trajectory-stride", 1, "N",
+                                       "a trajectory row every N steps (default 5)"},
+        [CLI_OPT_ALPHA] = {"alpha", 1, "A", "family-wise error rate (default 0.05)"},
+        [CLI_OPT_MARGIN] = {"margin", 1, "M", "smallest difference that counts (default 0.05)"},
+};
+
+cli_common cli_common_default(void)
+{
+	cli_common c;
+	memset(&c, 0, sizeof c);
+	return c;
+}
+
+void cli_common_free(cli_common *c)
+{
+	cli_sets_free(&c->sets);
+}
+
+/* "  --name ARG" padded to the help column, then the help, continuation
+ * lines indented to it. */
+static void help_line(FILE *f, const char *name, const char *arg, const char *help)
+{
+	char head[64];
+	snprintf(head, sizeof head, "--%s%s%s", name, arg ? " " : "", arg ? arg : "");
+	fprintf(f, "  %-22s ", head);
+	for (const char *p = help; *p; p++) {
+		fputc(*p, f);
+		if (*p == '\n')
+			fprintf(f, "%25s", "");
+	}
+	fputc('\n', f);
+}
+
+static void help_print(const cli_spec *spec)
+{
+	FILE *f = stdout;
+	fprintf(f, "Usage: beamsim %s %s\n\n%s\nOptions:\n", spec->name, spec->usage, spec->about);
+	for (int o = 0; o < CLI_N_OPTS; o++) {
+		if (!(spec->common & CLI_USES(o)))
+			continue;
+		const char *help = spec->help && spec->help[o] ? spec->help[o] : shared[o].help;
+		const char *arg = o == CLI_OPT_OUT && spec->out_arg ? spec->out_arg : shared[o].arg;
+		help_line(f, shared[o].name, arg, help);
+	}
+	for (int i = 0; i < spec->n_own; i++)
+		help_line(f, spec->own[i].name, spec->own[i].arg, spec->own[i].help);
+	fputs("  -h, --help             show this help\n", f);
+	if (spec->after)
+		fprintf(f, "\n%s", spec->after);
+}
+
+/* One shared option's value into c. */
+static int shared_take(const cli_spec *spec, cli_common *c, int o, const char *v)
+{
+	const char *cmd = spec->name;
+	switch ((cli_opt)o) {
+	case CLI_OPT_BACKEND:
+		c->backend = v;
+		return CLI_OK;
+	case CLI_OPT_BACKEND_OPT:
+		if (c->n_backend_opts == CLI_BACKEND_OPTS_MAX)
+			return cli_usage(cmd, "--backend-opt %s: more than %d options", v,
+			                 CLI_BACKEND_OPTS_MAX);
+		c->backend_opt[c->n_backend_opts++] = v;
+		return CLI_OK;
+	case CLI_OPT_THREADS:
+		if (cli_parse_long(v, 1, 4096, &c->threads) != 0)
+			return cli_usage(cmd, "--threads %s: expected an integer >= 1", v);
+		return CLI_OK;
+	case CLI_OPT_TRIALS:
+		if (cli_parse_long(v, 1, INT32_MAX, &c->trials) != 0)
+			return cli_usage(cmd, "--trials %s: expected an integer >= 1", v);
+		return CLI_OK;
+	case CLI_OPT_SEED:
+		c->has_seed = 1;
+		if (cli_parse_u64(v, &c->seed) != 0)
+			return cli_usage(cmd, "--seed %s: expected an integer >= 0", v);
+		return CLI_OK;
+	case CLI_OPT_SET:
+		return cli_sets_add(&c->sets, cmd, v);
+	case CLI_OPT_OUT:
+		c->out = v;
+		return CLI_OK;
+	case CLI_OPT_QUIET:
+		c->quiet = 1;
+		return CLI_OK;
+	case CLI_OPT_LIMIT:
+		return cli_limit(cmd, v);
+	case CLI_OPT_RESUME:
+		c->resume = 1;
+		return CLI_OK;
+	case CLI_OPT_TRAJECTORIES:
+		if (cli_parse_long(v, 0, INT32_MAX, &c->keep) != 0)
+			return cli_usage(cmd, "--trajectories %s: expected an integer >= 0", v);
+		return CLI_OK;
+	case CLI_OPT_TRAJECTORY_STRIDE:
+		if (cli_parse_long(v, 1, INT32_MAX, &c->keep_stride) != 0)
+			return cli_usage(cmd, "--trajectory-stride %s: expected an integer >= 1",
+			                 v);
+		return CLI_OK;
+	case CLI_OPT_ALPHA:
+		c->has_alpha = 1;
+		return cli_parse_fraction(cmd, "--alpha", v, 1, &c->alpha);
+	case CLI_OPT_MARGIN:
+		c->has_margin = 1;
+		return cli_parse_fraction(cmd, "--margin", v, 0, &c->margin);
+	case CLI_N_OPTS:
+		break;
+	}
+	return CLI_USAGE;
+}
+
+#define CLI_OWN_MAX 32
+
+int cli_parse(const cli_spec *spec, int argc, char **argv, cli_common *c, void *args,
+              const char **pos)
+{
+	/* getopt_long's table: the shared options the command takes (val = the
+	 * option, < CLI_N_OPTS), its own (val = 256 + index) and --help. */
+	struct option table[CLI_N_OPTS + CLI_OWN_MAX + 2];
+	const char *names[CLI_N_OPTS + CLI_OWN_MAX + 1];
+	int n = 0;
+	for (int o = 0; o < CLI_N_OPTS; o++)
+		if (spec->common & CLI_USES(o)) {
+			table[n] = (struct option){
+			        shared[o].name, shared[o].has_arg ? required_argument : no_argument,
+			        NULL, o};
+			names[n++] = shared[o].name;
+		}
+	for (int i = 0; i < spec->n_own && i < CLI_OWN_MAX; i++) {
+		table[n] = (struct option){spec->own[i].name,
+		                           spec->own[i].has_arg ? required_argument : no_argument,
+		                           NULL, 256 + i};
+		names[n++] = spec->own[i].name;
+	}
+	table[n] = (struct option){"help", no_argument, NULL, 'h'};
+	names[n] = "help";
+	table[n + 1] = (struct option){NULL, 0, NULL, 0};
+	int k;
+	opterr = 0;
+	optind = 1;
+	while ((k = getopt_long(argc, argv, ":h", table, NULL)) != -1) {
+		int rc;
+		if (k == 'h') {
+			help_print(spec);
+			return CLI_OK;
+		}
+		if (k == '?' || k == ':')
+			return cli_bad_option_near(spec->name, argv, k, names, n + 1);
+		if (k >= 256)
+			rc = spec->option(args, k - 256, optarg);
+		else
+			rc = shared_take(spec, c, k, optarg);
+		if (rc != CLI_OK)
+			return rc;
+	}
+	if (spec->positional) {
+		if (optind + 1 != argc)
+			return cli_usage(spec->name,
+			                 optind == argc ? "missing %s" : "expected one %s, got %d",
+			                 spec->positional, argc - optind);
+		*pos = argv[optind];
+	} else if (optind != argc) {
+		return cli_usage(spec->name, "unexpected argument %s", argv[optind]);
+	}
+	if (spec->out_required && !c->out)
+		return cli_usage(spec->name, "--out %s is required",
+		                 spec->out_arg ? spec->out_arg : "DIR");
+	/* DIR/.beamsim/staging/NAME/... must fit the path buffers. */
+	if (c->out && strlen(c->out) > 900)
+		return cli_usage(spec->name, "--out %s is longer than 900 characters",
+		                 spec->out_arg ? spec->out_arg : "DIR");
+	return -1;
+}
+
+int cli_backend_opts(const cli_common *c, const char *cmd, int n, const char *const *names,
+                     bsim_options *const *opts)
+{
+	char list[256] = "";
+	int distinct = 0;
+	for (int i = 0; i < n; i++) {
+		int seen = 0;
+		for (int k = 0; k < i; k++)
+			seen |= strcmp(names[k], names[i]) == 0;
+		if (!seen)
+			snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s",
+			         distinct++ ? ", " : "", names[i]);
+	}
+	for (int o = 0; o < c->n_backend_opts; o++) {
+		const char *t = c->backend_opt[o];
+		/* A colon counts only before the first '=': B:K=V, not K=V:W. */
+		size_t len = strcspn(t, ":=");
+		int prefixed = t[len] == ':', used = 0;
+		if (!prefixed && distinct > 1)
+			return cli_usage(cmd,
+			                 "--backend-opt %s: expected B:KEY=VALUE with several "
+			                 "backends (B one of %s)",
+			                 t, list);
+		for (int i = 0; i < n; i++) {
+			if (prefixed && (strlen(names[i]) != len || strncmp(t, names[i], len) != 0))
+				continue;
+			int rc = cli_options_add(opts[i], cmd, prefixed ? t + len + 1 : t);
+			if (rc != CLI_OK)
+				return rc;
+			used = 1;
+		}
+		if (!used)
+			return cli_usage(
+			        cmd,
+			        "--backend-opt %s: expected B:KEY=VALUE with B %s%s (%.*s is "
+			        "not a backend this command runs)",
+			        t, distinct > 1 ? "one of " : "", list, (int)len, t);
+	}
+	return CLI_OK;
+}
+
+const bsim_backend *cli_backend_with_opts(const cli_common *c, const char *cmd, const char *name,
+                                          bsim_options *opts)
+{
+	memset(opts, 0, sizeof *opts);
+	if (cli_backend_opts(c, cmd, 1, &name, &opts) != CLI_OK)
+		return NULL;
+	return cli_backend(name, opts);
+}

@@ -1,0 +1,51 @@
+/* What the stored runs (sweep_dir.c, compare_dir.c, regress.c) write alike:
+ * a sweep's files in a directory, MATLAB twins, text files written by a
+ * function, and the count of unstable trials. */
+#ifndef BSIM_STORE_H
+#define BSIM_STORE_H
+
+#include <stdio.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/compare_dir.h"
+#include "beamsim/experiment.h"
+#include "beamsim/sweep.h"
+#include "beamsim/sweep_dir.h"
+
+/* dir/summary.json, trials.csv, trajectories.csv when trajectories were
+ * kept (a stale one of an earlier run is removed, so a directory never
+ * pairs trials with trajectories of another run), a lattice's files, and
+ * their .mat twins; dir is created if missing. */
+int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
+                           const bsim_options *opts, const bsim_override *extra, int n_extra,
+                           const bsim_sweep_result *r, bsim_error *err);
+
+/* dir/file (a .csv or .json) as dir/NAME.mat, variable var. */
+int bsim_store_twin(const char *dir, const char *file, const char *var, bsim_error *err);
+
+/* dir/name written by fn(f, arg) after head (may be NULL), atomically. */
+typedef void (*bsim_store_text_fn)(FILE *f, const void *arg);
+int bsim_store_text(const char *dir, const char *name, const char *head, bsim_store_text_fn fn,
+                    const void *arg, bsim_error *err);
+
+/* The unstable trials of r: how many, the first's index (-1 if none) and
+ * why, in one line, from the scene of its group (e with extra). */
+long bsim_store_unstable(const bsim_experiment *e, const bsim_override *extra, int n_extra,
+                         const bsim_sweep_result *r, long *first, char *why, size_t size);
+
+/* Loads the experiment at path with the overrides and, if trials > 0,
+ * that many trials per group (BSIM_EINPUT "--trials N: ..." beyond the
+ * limit). */
+int bsim_store_experiment(const char *path, const bsim_override *sets, int n_sets, long trials,
+                          bsim_experiment *e, bsim_error *err);
+
+/* A stored run repeated (beamsim/regress.h) into the staging area stage:
+ * the loaded experiment e as it is (its set: holds the original run's
+ * overrides, def's sets and seed are not applied), no journal. The
+ * comparison's result holds no experiment. */
+int bsim_store_sweep_rerun(const bsim_sweep_dir_def *def, const bsim_experiment *e,
+                           const char *stage, bsim_sweep_result *r, bsim_error *err);
+int bsim_store_compare_rerun(const bsim_compare_dir_def *def, const bsim_experiment *e,
+                             const char *stage, bsim_compare_dir_result *res, bsim_error *err);
+
+#endif
