@@ -2,6 +2,9 @@
 
 #include "support.h"
 
+#include "figure.h"
+
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -215,4 +218,40 @@ int bsim_test_wait(int pid)
 	int status = 0;
 	waitpid((pid_t)pid, &status, 0);
 	return status_code(status);
+}
+
+/* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
+ * each over 1 kB and at most 1 MB; the number of figures, or -1 (said on
+ * stderr) if one is missing or out of that range. */
+int bsim_test_check_figures(const char *dir)
+{
+	DIR *d = opendir(dir);
+	if (!d) {
+		fprintf(stderr, "cannot open %s\n", dir);
+		return -1;
+	}
+	struct dirent *e;
+	int n = 0, bad = 0;
+	while ((e = readdir(d))) {
+		size_t len = strlen(e->d_name);
+		if (len < 4 || strcmp(e->d_name + len - 3, ".gp") != 0)
+			continue;
+		n++;
+		static const char *const ext[] = {"png", "svg"};
+		for (int i = 0; i < 2 && bsim_figure_available(); i++) {
+			char path[1200];
+			struct stat st;
+			snprintf(path, sizeof path, "%s/%.*s.%s", dir, (int)len - 3, e->d_name,
+			         ext[i]);
+			if (stat(path, &st) != 0) {
+				fprintf(stderr, "missing %s\n", path);
+				bad = 1;
+			} else if (st.st_size <= 1000 || st.st_size > 1000000) {
+				fprintf(stderr, "%s: %ld bytes\n", path, (long)st.st_size);
+				bad = 1;
+			}
+		}
+	}
+	closedir(d);
+	return bad ? -1 : n;
 }

@@ -41,4 +41,9 @@ char *bsim_test_read(const char *path);
 /* Path of a file in the source tree (static buffer). */
 const char *bsim_test_src(const char *rel);
 
+/* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
+ * each over 1 kB and at most 1 MB; the number of figures, or -1 (said on
+ * stderr) if one is missing or out of that range. */
+int bsim_test_check_figures(const char *dir);
+
 #endif

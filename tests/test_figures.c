@@ -44,37 +44,6 @@ static int run_cli(const char *const *argv, char **out, char **err)
 	return rc;
 }
 
-/* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
- * none over 1 MB; returns the number of figures. */
-static int check_figures(const char *dir)
-{
-	DIR *d = opendir(dir);
-	assert_non_null(d);
-	struct dirent *e;
-	int n = 0;
-	while ((e = readdir(d))) {
-		size_t len = strlen(e->d_name);
-		if (len < 4 || strcmp(e->d_name + len - 3, ".gp") != 0)
-			continue;
-		n++;
-		static const char *const ext[] = {"png", "svg"};
-		for (int i = 0; i < 2 && bsim_figure_available(); i++) {
-			char path[1200];
-			struct stat st;
-			snprintf(path, sizeof path, "%s/%.*s.%s", dir, (int)len - 3, e->d_name,
-			         ext[i]);
-			if (stat(path, &st) != 0)
-				print_error("missing %s\n", path);
-			assert_int_equal(stat(path, &st), 0);
-			if (st.st_size > 1000000)
-				print_error("%s: %ld bytes\n", path, (long)st.st_size);
-			assert_true(st.st_size > 1000 && st.st_size <= 1000000);
-		}
-	}
-	closedir(d);
-	return n;
-}
-
 static void wilson(int k, int n, double *lo, double *hi)
 {
 	const double z = 1.959963984540054, p = (double)k / n;
@@ -211,7 +180,7 @@ static void test_sweep_figures(void **state)
 	const char *dir = sweep_plotted();
 	/* p_traverse, two traversal_vs_*, and per group a bundle, plus a
 	 * landscape where a kept trial traversed (F = 9 N, Rm = 0 does) */
-	int n = check_figures(dir);
+	int n = bsim_test_check_figures(dir);
 	assert_true(n >= 3 + 6 + 1);
 
 	/* The heat map's numbers from the outcomes of trials.csv. */
@@ -319,7 +288,7 @@ static void test_select(void **state)
 	/* one value of F left: nothing drawn against it */
 	snprintf(path, sizeof path, "%s/traversal_vs_effects_propulsion_force.gp", out_dir);
 	assert_null(bsim_test_read(path));
-	check_figures(out_dir);
+	assert_true(bsim_test_check_figures(out_dir) >= 0);
 
 	char *err = NULL;
 	const char *bad[] = {"plot", dir, "--select", "beams.0.mass=1", "--out", out_dir, NULL};
@@ -403,7 +372,7 @@ static void test_run_figures(void **state)
 	free(out);
 	const char *argv[] = {"plot", dir, "--quiet", NULL};
 	assert_int_equal(run_cli(argv, NULL, NULL), 0);
-	assert_int_equal(check_figures(dir), 3);
+	assert_int_equal(bsim_test_check_figures(dir), 3);
 	/* The histogram: every draw of the runner once, density integrating
 	 * to 1. */
 	static double rows[64][16];
@@ -460,7 +429,7 @@ static void test_accuracy_front(void **state)
 	}
 	assert_int_equal(data_rows(path, 0, rows, 16), 2); /* s1 without its reference row */
 	assert_int_equal(data_rows(path, 1, rows, 16), 3);
-	check_figures(dir);
+	assert_true(bsim_test_check_figures(dir) >= 0);
 }
 
 /* ---- a comparison ------------------------------------------------------------------------- */
@@ -478,11 +447,11 @@ static void test_compare_figures(void **state)
 	assert_true(rc == 0 || rc == 3);
 	const char *argv[] = {"plot", dir, "--quiet", NULL};
 	assert_int_equal(run_cli(argv, NULL, NULL), 0);
-	assert_int_equal(check_figures(dir), 1);
+	assert_int_equal(bsim_test_check_figures(dir), 1);
 	char sub[1100];
 	for (int b = 0; b < 2; b++) {
 		snprintf(sub, sizeof sub, "%s/%s", dir, b ? "box2d" : "thesis");
-		assert_int_equal(check_figures(sub), 3);
+		assert_int_equal(bsim_test_check_figures(sub), 3);
 	}
 	/* The paired difference is p_A - p_B of the two probabilities drawn. */
 	static double rows[64][16];

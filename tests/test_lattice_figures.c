@@ -43,37 +43,6 @@ static int run_cli(const char *const *argv, char **out, char **err)
 	return rc;
 }
 
-/* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
- * none over 1 MB; returns the number of figures. */
-static int check_figures(const char *dir)
-{
-	DIR *d = opendir(dir);
-	assert_non_null(d);
-	struct dirent *e;
-	int n = 0;
-	while ((e = readdir(d))) {
-		size_t len = strlen(e->d_name);
-		if (len < 4 || strcmp(e->d_name + len - 3, ".gp") != 0)
-			continue;
-		n++;
-		static const char *const ext[] = {"png", "svg"};
-		for (int i = 0; i < 2 && bsim_figure_available(); i++) {
-			char path[1200];
-			struct stat st;
-			snprintf(path, sizeof path, "%s/%.*s.%s", dir, (int)len - 3, e->d_name,
-			         ext[i]);
-			if (stat(path, &st) != 0)
-				print_error("missing %s\n", path);
-			assert_int_equal(stat(path, &st), 0);
-			if (st.st_size > 1000000)
-				print_error("%s: %ld bytes\n", path, (long)st.st_size);
-			assert_true(st.st_size > 1000 && st.st_size <= 1000000);
-		}
-	}
-	closedir(d);
-	return n;
-}
-
 static int exists(const char *dir, const char *file)
 {
 	char path[1200];
@@ -313,7 +282,7 @@ static void test_sweep_figures(void **state)
 	const char *dir = lattice_sweep();
 	/* p_traverse, traversal against Rm, and per group final_locations and
 	 * lattice; not the single gate's bundle and landscape */
-	assert_int_equal(check_figures(dir), 2 + 2 * 2);
+	assert_int_equal(bsim_test_check_figures(dir), 2 + 2 * 2);
 	assert_true(exists(dir, "lattice_g001.png") || !bsim_figure_available());
 	assert_false(exists(dir, "trajectories_g000.gp"));
 	assert_false(exists(dir, "landscape_g001.gp"));
@@ -521,13 +490,14 @@ static void test_compare(void **state)
 	const char *plot[] = {"plot", dir, NULL};
 	assert_int_equal(run_cli(plot, &out, NULL), 0);
 	free(out);
-	assert_int_equal(check_figures(dir), 2); /* compare and final_locations_g000 */
+	assert_int_equal(bsim_test_check_figures(dir), 2); /* compare and final_locations_g000 */
 	char sub[1100], path[1200], pairs[1200];
 	snprintf(pairs, sizeof pairs, "%s/pairs.csv", dir);
 	snprintf(path, sizeof path, "%s/final_locations_g000.dat", dir);
 	for (int s = 0; s < 2; s++) {
 		snprintf(sub, sizeof sub, "%s/%s", dir, s ? "essay" : "world");
-		assert_int_equal(check_figures(sub), 3); /* p_traverse, final_locations, lattice */
+		assert_int_equal(bsim_test_check_figures(sub),
+		                 3); /* p_traverse, final_locations, lattice */
 		char trials[1200];
 		snprintf(trials, sizeof trials, "%s/trials.csv", sub);
 		counts c;
