@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include "atomic_file.h"
@@ -141,6 +142,201 @@ static void bin_sample(const bsim_markov_bins *b, const bsim_lattice_def *l, dou
 	}
 }
 
+static const char *const edge_names[] = {"start", "bottom", "left", "right", "top"};
+
+/* ---- observed entries ------------------------------------------------------ */
+
+void bsim_markov_entries_free(bsim_markov_entries *e)
+{
+	if (!e)
+		return;
+	free(e->edge);
+	free(e->pos);
+	free(e->x);
+	free(e->v);
+	memset(e, 0, sizeof *e);
+}
+
+static uint64_t fnv1a_bytes(uint64_t h, const char *s, size_t n)
+{
+	for (size_t i = 0; i < n; i++) {
+		h ^= (unsigned char)s[i];
+		h *= 0x100000001b3ULL;
+	}
+	return h;
+}
+
+static char *read_all(const char *path);
+
+static int entries_push(bsim_markov_entries *e, int *cap, int edge, double pos, const double x[2],
+                        const double v[2])
+{
+	if (e->n == *cap) {
+		int nc = *cap ? 2 * *cap : 1024;
+		int *ne = realloc(e->edge, (size_t)nc * sizeof *ne);
+		if (ne)
+			e->edge = ne;
+		double *np = realloc(e->pos, (size_t)nc * sizeof *np);
+		if (np)
+			e->pos = np;
+		double(*nx)[2] = realloc(e->x, (size_t)nc * sizeof *nx);
+		if (nx)
+			e->x = nx;
+		double(*nv)[2] = realloc(e->v, (size_t)nc * sizeof *nv);
+		if (nv)
+			e->v = nv;
+		if (!ne || !np || !nx || !nv)
+			return -1;
+		*cap = nc;
+	}
+	e->edge[e->n] = edge;
+	e->pos[e->n] = pos;
+	memcpy(e->x[e->n], x, sizeof e->x[0]);
+	memcpy(e->v[e->n], v, sizeof e->v[0]);
+	e->n++;
+	return 0;
+}
+
+int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entries *out,
+                             bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	uint64_t h = 0xcbf29ce484222325ULL;
+	int cap = 0;
+	static const char *const want[] = {"edge", "pos", "x", "y", "vx", "vy"};
+	for (int f = 0; f < n; f++) {
+		char path[1200];
+		struct stat st;
+		if (stat(paths[f], &st) == 0 && S_ISDIR(st.st_mode))
+			snprintf(path, sizeof path, "%s/gate_entries.csv", paths[f]);
+		else
+			snprintf(path, sizeof path, "%s", paths[f]);
+		char *text = read_all(path);
+		if (!text) {
+			bsim_markov_entries_free(out);
+			return bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s: cannot read (%s): expected the gate_entries.csv of a "
+			        "lattice sweep",
+			        path, strerror(errno));
+		}
+		h = fnv1a_bytes(h, text, strlen(text));
+		int col[6] = {-1, -1, -1, -1, -1, -1}, line = 1, rc = 0;
+		char *save = NULL, *row = strtok_r(text, "\n", &save);
+		/* the header names the columns */
+		int c = 0;
+		for (char *p = row; p && *p; c++) {
+			size_t len = strcspn(p, ",\r");
+			for (int k = 0; k < 6; k++)
+				if (len == strlen(want[k]) && strncmp(p, want[k], len) == 0)
+					col[k] = c;
+			p += len;
+			if (*p == ',')
+				p++;
+			else
+				break;
+		}
+		for (int k = 0; k < 6 && rc == 0; k++)
+			if (col[k] < 0)
+				rc = bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s:1: no column %s: expected the gate_entries.csv of "
+				        "a lattice sweep (edge, pos, x, y, vx, vy)",
+				        path, want[k]);
+		while (rc == 0 && (row = strtok_r(NULL, "\n", &save))) {
+			line++;
+			char edge[16] = "";
+			double val[6] = {0};
+			int got = 0;
+			c = 0;
+			for (char *p = row;; c++) {
+				size_t len = strcspn(p, ",\r");
+				for (int k = 0; k < 6; k++) {
+					if (col[k] != c)
+						continue;
+					if (k == 0) {
+						snprintf(edge, sizeof edge, "%.*s", (int)len, p);
+						got++;
+					} else {
+						char *end;
+						val[k] = strtod(p, &end);
+						got += end == p + len && len > 0 &&
+						       isfinite(val[k]);
+					}
+				}
+				p += len;
+				if (*p != ',')
+					break;
+				p++;
+			}
+			int e = -1;
+			for (int k = 0; k < 5; k++)
+				if (strcmp(edge, edge_names[k]) == 0)
+					e = k;
+			if (got != 6 || e < 0) {
+				rc = bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s:%d: expected an entry with edge (start, bottom, "
+				        "left, right, top) and numbers pos, x, y, vx, vy",
+				        path, line);
+				break;
+			}
+			if (e == BSIM_EDGE_START)
+				continue;
+			const double x[2] = {val[2], val[3]}, v[2] = {val[4], val[5]};
+			if (entries_push(out, &cap, e, val[1], x, v))
+				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		}
+		free(text);
+		if (rc) {
+			bsim_markov_entries_free(out);
+			return rc;
+		}
+	}
+	snprintf(out->id, sizeof out->id, "%016llx %d", (unsigned long long)h, out->n);
+	return BSIM_OK;
+}
+
+/* The entries of each bin: bin b's are idx[first[b] .. first[b + 1]). */
+typedef struct entry_index {
+	int *first, *idx;
+} entry_index;
+
+static int entry_index_init(entry_index *x, const bsim_markov_entries *e, const bsim_markov_bins *b,
+                            const bsim_lattice_def *l)
+{
+	const int nb = bsim_markov_bins_count(b);
+	x->first = calloc((size_t)nb + 1, sizeof *x->first);
+	x->idx = malloc((size_t)(e && e->n ? e->n : 1) * sizeof *x->idx);
+	int *bin = malloc((size_t)(e && e->n ? e->n : 1) * sizeof *bin);
+	if (!x->first || !x->idx || !bin) {
+		free(bin);
+		return -1;
+	}
+	for (int i = 0; e && i < e->n; i++) {
+		bin[i] = bsim_markov_bin_of(b, l, e->edge[i], e->pos[i], e->v[i]);
+		x->first[bin[i] + 1]++;
+	}
+	for (int k = 0; k < nb; k++)
+		x->first[k + 1] += x->first[k];
+	int *fill = calloc((size_t)nb, sizeof *fill);
+	if (!fill) {
+		free(bin);
+		return -1;
+	}
+	for (int i = 0; e && i < e->n; i++)
+		x->idx[x->first[bin[i]] + fill[bin[i]]++] = i;
+	free(fill);
+	free(bin);
+	return 0;
+}
+
+static void entry_index_free(entry_index *x)
+{
+	free(x->first);
+	free(x->idx);
+}
+
 /* ---- one single gate ----------------------------------------------------- */
 
 /* The gate of the lattice's start, moved to its own frame, as the essay's
@@ -210,6 +406,7 @@ typedef struct gate_runner {
 	bsim_state s0, s1;
 	gsl_rng *rng;
 	gate_scene g;
+	const entry_index *ex; /* NULL: no observed entries */
 } gate_runner;
 
 /* One single-gate trial from entry bin `bin` (0: the start) with trial index
@@ -223,7 +420,17 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	if (bin > 0) {
 		gsl_rng_set(r->rng, bsim_schedule_seed_mix(def->seed ^ 0x6d61726b6f76ULL,
 		                                           (uint64_t)bin, (uint64_t)t));
-		bin_sample(&def->bins, l, s->dt, bin, r->rng, s->body.start, s->body.velocity);
+		const int lo = r->ex ? r->ex->first[bin] : 0,
+		          hi = r->ex ? r->ex->first[bin + 1] : 0;
+		if (hi > lo) { /* an observed entry of this bin */
+			int i = r->ex->idx[lo + (int)gsl_rng_uniform_int(r->rng,
+			                                                 (unsigned long)(hi - lo))];
+			memcpy(s->body.start, def->entries->x[i], sizeof s->body.start);
+			memcpy(s->body.velocity, def->entries->v[i], sizeof s->body.velocity);
+		} else {
+			bin_sample(&def->bins, l, s->dt, bin, r->rng, s->body.start,
+			           s->body.velocity);
+		}
 	}
 	bsim_world *w = NULL;
 	if (be->create(s, opts, &w, err) != BSIM_OK)
@@ -318,6 +525,10 @@ static char *key_text(const bsim_scene *lattice, const bsim_markov_def *def, con
 	        s->effects.propulsion_force, s->effects.has_random_force,
 	        s->effects.random_magnitude, s->effects.random_frequency);
 	fprintf(f, "dt %.17g gate_steps %d max_steps %d\n", s->dt, s->gate_steps, s->max_steps);
+	fprintf(f, "entries %s\n",
+	        def->entries         ? def->entries->id
+	        : def->entries_id[0] ? def->entries_id
+	                             : "none");
 	fprintf(f, "bins %d %d %d %.17g\ntrials %d\nseed %llu\n", def->bins.n_pos,
 	        def->bins.n_speed, def->bins.n_dir, def->bins.v_max, def->trials,
 	        (unsigned long long)def->seed);
@@ -453,8 +664,6 @@ static int map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	return 1;
 }
 
-static const char *const edge_names[] = {"start", "bottom", "left", "right", "top"};
-
 static void bin_edge(const bsim_markov_bins *b, int bin, char *out, size_t size)
 {
 	if (bin == 0) {
@@ -531,7 +740,11 @@ static int def_write(const char *stage, const bsim_markov_def *def, const bsim_b
 		fputs(i ? ", " : "", o.f);
 		bsim_json_string(o.f, kv);
 	}
-	fputs("]}\n", o.f);
+	fputs("], \"entries\": ", o.f);
+	bsim_json_string(o.f, def->entries         ? def->entries->id
+	                      : def->entries_id[0] ? def->entries_id
+	                                           : "none");
+	fputs("}\n", o.f);
 	return bsim_atomic_file_commit(&o, err);
 }
 
@@ -546,6 +759,12 @@ static int map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	int *exit = malloc((size_t)units * sizeof *exit);
 	if (!exit)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	entry_index ex = {0};
+	if (def->entries && entry_index_init(&ex, def->entries, &def->bins, &lattice->lattice)) {
+		free(exit);
+		entry_index_free(&ex);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
 	int failed = 0;
 	bsim_error first = {0};
 	long first_unit = units;
@@ -557,6 +776,7 @@ static int map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		int ok = bsim_state_init(&r.s0, 2) == BSIM_OK &&
 		         bsim_state_init(&r.s1, 2) == BSIM_OK;
 		r.rng = gsl_rng_alloc(gsl_rng_mt19937);
+		r.ex = def->entries ? &ex : NULL;
 		gate_scene_init(&r.g, lattice, m->k);
 		const double start[2] = {r.g.s.body.start[0], r.g.s.body.start[1]};
 #pragma omp for schedule(dynamic, 16)
@@ -604,6 +824,7 @@ static int map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	for (long u = 0; !failed && u < units; u++)
 		m->counts[(u / T) * nb + exit[u]]++;
 	free(exit);
+	entry_index_free(&ex);
 	return failed ? BSIM_EFAIL : BSIM_OK;
 }
 
@@ -779,6 +1000,11 @@ static int def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 				p += 2;
 		}
 	}
+	char id[64] = "";
+	ok = ok && (p = strstr(text, "\"entries\": \"")) &&
+	     sscanf(p, "\"entries\": \"%63[^\"]\"", id) == 1;
+	if (ok && strcmp(id, "none") != 0)
+		snprintf(def->entries_id, sizeof def->entries_id, "%s", id);
 	free(text);
 	if (!ok)
 		return bsim_error_set(err, BSIM_EINPUT,

@@ -373,6 +373,66 @@ static void test_bins(void **state)
 	bsim_scene_free(&s);
 }
 
+/* Observed entries: a bin's states are drawn from them (a map built from
+ * entries that all lie in one bin differs from the uniform one in that bin
+ * and nowhere else), they are part of the key, and a malformed file is
+ * named with its line. */
+static void test_entries(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 1, 6, 30), BSIM_OK);
+	const char *dir = exe_dir("entries");
+	/* every entry: bottom edge near x = 20, straight up at 1 m/s */
+	char text[4096] = "group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy\n"
+	                  "0,0,0,0,0,start,0,0,0,0,0,0,0\n";
+	for (int i = 0; i < 20; i++) {
+		char row[128];
+		snprintf(row, sizeof row, "0,%d,1,0,0,bottom,10,0.04,%g,%g,0.01,0,1\n", i,
+		         20.0 + 0.1 * i, 20.0 + 0.1 * i);
+		strcat(text, row);
+	}
+	char path[1200];
+	snprintf(path, sizeof path, "%s", bsim_test_write(dir, "gate_entries.csv", text));
+	bsim_markov_entries e;
+	bsim_error err;
+	const char *paths[] = {dir};
+	assert_int_equal(bsim_markov_entries_load(paths, 1, &e, &err), BSIM_OK);
+	assert_int_equal(e.n, 20); /* the start rows left out */
+	const bsim_markov_bins b = {2, 1, 1, 40.0};
+	const int bin = bsim_markov_bin_of(&b, &s.lattice, BSIM_EDGE_BOTTOM, 20.0, e.v[0]);
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = b;
+	def.trials = 60;
+	bsim_markov_set uni, obs;
+	char d1[1100], d2[1100];
+	snprintf(d1, sizeof d1, "%s/uniform", dir);
+	snprintf(d2, sizeof d2, "%s/observed", dir);
+	assert_int_equal(bsim_markov_build(&s, &def, d1, &uni, &err), BSIM_OK);
+	def.entries = &e;
+	assert_int_equal(bsim_markov_build(&s, &def, d2, &obs, &err), BSIM_OK);
+	assert_true(uni.maps[0].key != obs.maps[0].key);
+	const int nb = uni.maps[0].n_bins;
+	int differ = 0;
+	for (int a = 0; a < nb; a++) {
+		int same = memcmp(uni.maps[0].counts + a * nb, obs.maps[0].counts + a * nb,
+		                  (size_t)nb * sizeof(int)) == 0;
+		if (a != bin)
+			assert_true(same);
+		differ += !same;
+	}
+	assert_int_equal(differ, 1);
+	bsim_markov_set_free(&uni);
+	bsim_markov_set_free(&obs);
+	bsim_markov_entries_free(&e);
+	/* a malformed row: file and line */
+	strcat(text, "0,99,1,0,0,sideways,10,0.04,1,1,1,0,1\n");
+	bsim_test_write(dir, "gate_entries.csv", text);
+	assert_int_equal(bsim_markov_entries_load(paths, 1, &e, &err), BSIM_EINPUT);
+	assert_non_null(strstr(err.msg, "gate_entries.csv:23: expected an entry"));
+	bsim_scene_free(&s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -382,6 +442,7 @@ int main(void)
 	        cmocka_unit_test(test_conservation),
 	        cmocka_unit_test(test_one_gate_against_simulation),
 	        cmocka_unit_test(test_threads_and_cache),
+	        cmocka_unit_test(test_entries),
 	        cmocka_unit_test(test_bad_inputs),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -66,15 +66,36 @@ bsim_markov_bins bsim_markov_bins_default(void);
 /* The number of entry bins, the start's included: 1 + 4 n_pos n_speed n_dir. */
 int bsim_markov_bins_count(const bsim_markov_bins *b);
 
+/* Gate entries observed in simulation (gate_entries.csv of lattice sweeps,
+ * the start rows left out): when a map is built with them, the states of
+ * an entry bin are drawn from the entries that fall in it (uniformly in
+ * the bin only where none does), so the states within a bin are those a
+ * lattice delivers. */
+typedef struct bsim_markov_entries {
+	int n;
+	int *edge;
+	double *pos;
+	double (*x)[2], (*v)[2]; /* body centre (gate frame) and velocity */
+	char id[64];             /* "HASH COUNT": FNV-1a of the files' bytes, entries */
+} bsim_markov_entries;
+
+/* Reads the entries of n files (a gate_entries.csv, or a directory holding
+ * one). BSIM_EINPUT naming file and line if one is malformed. */
+int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entries *out,
+                             bsim_error *err);
+void bsim_markov_entries_free(bsim_markov_entries *e);
+
 /* How a map is built. */
 typedef struct bsim_markov_def {
 	bsim_markov_bins bins;
-	int trials;                  /* single-gate trials per entry bin */
-	uint64_t seed;               /* of the entry states and the schedules */
-	const bsim_backend *backend; /* NULL: the default backend */
-	const bsim_options *opts;    /* NULL: no options */
-	int threads;                 /* <= 0: all cores; the map is the same for any */
-	bsim_progress_fn progress;   /* may be NULL; counts single-gate trials */
+	int trials;                         /* single-gate trials per entry bin */
+	uint64_t seed;                      /* of the entry states and the schedules */
+	const bsim_backend *backend;        /* NULL: the default backend */
+	const bsim_options *opts;           /* NULL: no options */
+	int threads;                        /* <= 0: all cores; the map is the same for any */
+	const bsim_markov_entries *entries; /* NULL: states uniform in each bin */
+	char entries_id[64];                /* the entries' id when read back from markov.json */
+	bsim_progress_fn progress;          /* may be NULL; counts single-gate trials */
 	void *progress_user;
 } bsim_markov_def;
 

@@ -14,12 +14,16 @@
 #include "cli_options.h"
 #include "cli_progress.h"
 
-enum { OWN_BINS, OWN_VMAX, OWN_MAP, OWN_BOOTSTRAP };
+enum { OWN_BINS, OWN_VMAX, OWN_ENTRIES, OWN_MAP, OWN_BOOTSTRAP };
+
+#define MAX_ENTRIES 16
 
 typedef struct markov_args {
 	bsim_markov_def def;
 	const char *map;
 	long bootstrap;
+	int n_entries;
+	const char *entries[MAX_ENTRIES];
 } markov_args;
 
 static int markov_option(void *args, int i, const char *value)
@@ -45,6 +49,11 @@ static int markov_option(void *args, int i, const char *value)
 		    !isfinite(a->def.bins.v_max))
 			return cli_usage("markov", "--vmax %s: expected a speed > 0 in m/s", value);
 		return CLI_OK;
+	case OWN_ENTRIES:
+		if (a->n_entries == MAX_ENTRIES)
+			return cli_usage("markov", "--entries %s: at most %d", value, MAX_ENTRIES);
+		a->entries[a->n_entries++] = value;
+		return CLI_OK;
 	case OWN_MAP:
 		a->map = value;
 		return CLI_OK;
@@ -62,6 +71,10 @@ static const cli_own build_own[] = {
                       "entry bins of position along the edge, speed and\n"
                       "direction (default 4,4,3)"},
         [OWN_VMAX] = {"vmax", 1, "V", "m/s, the top of the speed bins (default 40)"},
+        [OWN_ENTRIES] = {"entries", 1, "PATH",
+                         "gate_entries.csv of a lattice sweep (or its directory),\n"
+                         "repeatable: a bin's states are drawn from the entries\n"
+                         "that fall in it (default: uniformly in the bin)"},
 };
 
 static const char *const build_help[CLI_N_OPTS] = {
@@ -88,7 +101,7 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 2,
+        .n_own = 3,
         .option = markov_option,
 };
 
@@ -171,7 +184,17 @@ static int markov_build(int argc, char **argv)
 		a.def.seed = c.seed;
 	bsim_experiment e;
 	bsim_error err;
+	bsim_markov_entries entries = {0};
+	if (a.n_entries > 0) {
+		if ((rc = bsim_markov_entries_load(a.entries, a.n_entries, &entries, &err)) !=
+		    BSIM_OK) {
+			cli_common_free(&c);
+			return cli_report(rc, &err);
+		}
+		a.def.entries = &entries;
+	}
 	if ((rc = bsim_experiment_load(path, c.sets.ov, c.sets.n, &e, &err)) != BSIM_OK) {
+		bsim_markov_entries_free(&entries);
 		cli_common_free(&c);
 		return cli_report(rc, &err);
 	}
@@ -208,6 +231,7 @@ static int markov_build(int argc, char **argv)
 		       built, cpu, reused, bsim_markov_bins_count(&a.def.bins), a.def.trials,
 		       c.out);
 	bsim_experiment_free(&e);
+	bsim_markov_entries_free(&entries);
 	cli_common_free(&c);
 	return cli_report(rc, &err);
 }
