@@ -7,6 +7,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -254,4 +255,53 @@ int bsim_test_check_figures(const char *dir)
 	}
 	closedir(d);
 	return bad ? -1 : n;
+}
+
+/* Wilson's score interval at 95% in closed form (Wilson 1927), written here
+ * apart from the library's. */
+void bsim_test_wilson(int k, int n, double *lo, double *hi)
+{
+	const double z = 1.959963984540054, p = (double)k / n;
+	double c = (p + z * z / (2 * n)) / (1 + z * z / n);
+	double h = z / (1 + z * z / n) * sqrt(p * (1 - p) / n + z * z / (4.0 * n * n));
+	*lo = fmax(0.0, c - h);
+	*hi = fmin(1.0, c + h);
+}
+
+int bsim_test_data_rows(const char *path, int block, double (*rows)[16], int max)
+{
+	char *text = bsim_test_read(path);
+	if (!text) { /* a test's failure, as its assertion was */
+		fprintf(stderr, "cannot read %s\n", path);
+		abort();
+	}
+	int b = 0, n = 0;
+	for (char *p = text; *p;) {
+		char *nl = strchr(p, '\n');
+		if (!nl)
+			nl = p + strlen(p);
+		if (nl == p) { /* an empty line: two in a row end a block */
+			if (nl[1] == '\n')
+				b++, p = nl + 2;
+			else
+				p = nl + 1;
+			continue;
+		}
+		if (*p != '#' && b == block && n < max) {
+			char *q = p, *end;
+			int k = 0;
+			while (k < 16 && q < nl) {
+				rows[n][k] = strtod(q, &end);
+				if (end == q)
+					break;
+				k++;
+				q = end;
+			}
+			if (k)
+				n++;
+		}
+		p = *nl ? nl + 1 : nl;
+	}
+	free(text);
+	return n;
 }

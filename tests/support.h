@@ -46,4 +46,12 @@ const char *bsim_test_src(const char *rel);
  * stderr) if one is missing or out of that range. */
 int bsim_test_check_figures(const char *dir);
 
+/* Wilson's 95% score interval of k successes in n, in closed form. */
+void bsim_test_wilson(int k, int n, double *lo, double *hi);
+
+/* The numbers of the rows of block `block` of a gnuplot data file (blocks
+ * separated by two blank lines), up to 16 a row, at most max rows; aborts
+ * the test if the file cannot be read. */
+int bsim_test_data_rows(const char *path, int block, double (*rows)[16], int max);
+
 #endif

@@ -44,52 +44,6 @@ static int run_cli(const char *const *argv, char **out, char **err)
 	return rc;
 }
 
-static void wilson(int k, int n, double *lo, double *hi)
-{
-	const double z = 1.959963984540054, p = (double)k / n;
-	double c = (p + z * z / (2 * n)) / (1 + z * z / n);
-	double h = z / (1 + z * z / n) * sqrt(p * (1 - p) / n + z * z / (4.0 * n * n));
-	*lo = fmax(0.0, c - h);
-	*hi = fmin(1.0, c + h);
-}
-
-/* Blocks are separated by "\n\n\n" in the text: the index of the block
- * holding each line is counted here. */
-static int data_rows(const char *path, int block, double (*rows)[16], int max)
-{
-	char *text = bsim_test_read(path);
-	assert_non_null(text);
-	int b = 0, n = 0;
-	for (char *p = text; *p;) {
-		char *nl = strchr(p, '\n');
-		if (!nl)
-			nl = p + strlen(p);
-		if (nl == p) { /* an empty line: two in a row end a block */
-			if (nl[1] == '\n')
-				b++, p = nl + 2;
-			else
-				p = nl + 1;
-			continue;
-		}
-		if (*p != '#' && b == block && n < max) {
-			char *q = p, *end;
-			int k = 0;
-			while (k < 16 && q < nl) {
-				rows[n][k] = strtod(q, &end);
-				if (end == q)
-					break;
-				k++;
-				q = end;
-			}
-			if (k)
-				n++;
-		}
-		p = *nl ? nl + 1 : nl;
-	}
-	free(text);
-	return n;
-}
-
 /* ---- the landscape of MODEL.md section 7, written again ---------------------------------- */
 
 /* th of a beam with pivot (px, 30) pointing at the midline: the left one
@@ -201,12 +155,12 @@ static void test_sweep_figures(void **state)
 	free(trials);
 	static double rows[64][16];
 	snprintf(path, sizeof path, "%s/p_traverse.dat", dir);
-	int nr = data_rows(path, 0, rows, 64);
+	int nr = bsim_test_data_rows(path, 0, rows, 64);
 	assert_int_equal(nr, 6);
 	for (int i = 0; i < nr; i++) {
 		int g = (int)rows[i][7];
 		double lo, hi;
-		wilson(trav[g], 12, &lo, &hi);
+		bsim_test_wilson(trav[g], 12, &lo, &hi);
 		if (g % 3 == 0) /* Rm = 0: one trial run and copied, its interval a point */
 			lo = hi = trav[g] / 12.0;
 		assert_int_equal((int)rows[i][0], g / 3);              /* column: F_prop */
@@ -217,7 +171,7 @@ static void test_sweep_figures(void **state)
 	/* Traversal against Rm, panel F_prop = 9 N (the second): left and
 	 * right fractions from the types. */
 	snprintf(path, sizeof path, "%s/traversal_vs_effects_random_force_magnitude.dat", dir);
-	nr = data_rows(path, 1, rows, 64);
+	nr = bsim_test_data_rows(path, 1, rows, 64);
 	assert_int_equal(nr, 3);
 	for (int i = 0; i < 3; i++) {
 		int g = 3 + i;
@@ -237,7 +191,7 @@ static void test_paths_over_landscape(void **state)
 	char path[1200];
 	snprintf(path, sizeof path, "%s/landscape_g003.dat", dir); /* F 9 N, Rm 0: traverses */
 	static double rows[20000][16];
-	int nr = data_rows(path, 0, rows, 20000);
+	int nr = bsim_test_data_rows(path, 0, rows, 20000);
 	assert_true(nr > 50);
 	/* each row: x y E class below, thinned from the rows of the
 	 * traversed trials in trajectories.csv, in their order */
@@ -265,7 +219,7 @@ static void test_paths_over_landscape(void **state)
 	assert_int_equal(k, nr);
 	/* every state below the surface is in the stretches of block 1 */
 	snprintf(path, sizeof path, "%s/landscape_g003.dat", dir);
-	int nb = data_rows(path, 1, rows, 20000);
+	int nb = bsim_test_data_rows(path, 1, rows, 20000);
 	assert_true(nb >= below);
 }
 
@@ -281,7 +235,7 @@ static void test_select(void **state)
 	static double rows[64][16];
 	char path[1200];
 	snprintf(path, sizeof path, "%s/p_traverse.dat", out_dir);
-	int nr = data_rows(path, 0, rows, 64);
+	int nr = bsim_test_data_rows(path, 0, rows, 64);
 	assert_int_equal(nr, 3); /* the three Rm of F = 7 N, groups 0-2 */
 	for (int i = 0; i < nr; i++)
 		assert_true(rows[i][7] >= 0 && rows[i][7] <= 2);
@@ -378,7 +332,7 @@ static void test_run_figures(void **state)
 	static double rows[64][16];
 	char path[1200];
 	snprintf(path, sizeof path, "%s/random_force.dat", dir);
-	int nr = data_rows(path, 0, rows, 64);
+	int nr = bsim_test_data_rows(path, 0, rows, 64);
 	assert_int_equal(nr, 32);
 	double width = rows[1][0] - rows[0][0], integral = 0.0;
 	long count = 0;
@@ -391,7 +345,7 @@ static void test_run_figures(void **state)
 	/* The ledger's sum of flows is E(t) - E(0) less the residual. */
 	static double led[4000][16];
 	snprintf(path, sizeof path, "%s/ledger.dat", dir);
-	nr = data_rows(path, 0, led, 4000);
+	nr = bsim_test_data_rows(path, 0, led, 4000);
 	assert_true(nr > 100);
 	for (int i = 0; i < nr; i++)
 		assert_true(fabs(led[i][4] - led[i][11] - led[i][12]) < 1e-6);
@@ -420,15 +374,16 @@ static void test_accuracy_front(void **state)
 	static double rows[16][16];
 	char path[1200];
 	snprintf(path, sizeof path, "%s/accuracy.dat", dir);
-	int nr = data_rows(path, 2, rows, 16);
+	int nr = bsim_test_data_rows(path, 2, rows, 16);
 	assert_int_equal(nr, 3);
 	const double speed[3] = {2000, 1000, 100}, err[3] = {5e-3, 1e-3, 1e-4};
 	for (int i = 0; i < 3; i++) {
 		assert_true(rows[i][0] == speed[i]);
 		assert_true(rows[i][1] == err[i]);
 	}
-	assert_int_equal(data_rows(path, 0, rows, 16), 2); /* s1 without its reference row */
-	assert_int_equal(data_rows(path, 1, rows, 16), 3);
+	assert_int_equal(bsim_test_data_rows(path, 0, rows, 16),
+	                 2); /* s1 without its reference row */
+	assert_int_equal(bsim_test_data_rows(path, 1, rows, 16), 3);
 	assert_true(bsim_test_check_figures(dir) >= 0);
 }
 
@@ -457,7 +412,7 @@ static void test_compare_figures(void **state)
 	static double rows[64][16];
 	char path[1200];
 	snprintf(path, sizeof path, "%s/compare.dat", dir);
-	int nr = data_rows(path, 0, rows, 64);
+	int nr = bsim_test_data_rows(path, 0, rows, 64);
 	assert_int_equal(nr, 30);
 	for (int i = 0; i < nr; i++)
 		assert_true(fabs(rows[i][8] - (rows[i][2] - rows[i][5])) < 1e-6);
