@@ -16,6 +16,7 @@
 #include <time.h>
 
 #include "atomic_file.h"
+#include "csv_table.h"
 #include "beamsim/effects.h"
 #include "beamsim/output.h"
 #include "beamsim/schedule.h"
@@ -166,8 +167,6 @@ static uint64_t fnv1a_bytes(uint64_t h, const char *s, size_t n)
 	return h;
 }
 
-static char *read_all(const char *path);
-
 static int entries_push(bsim_markov_entries *e, int *cap, int edge, double pos, const double x[2],
                         const double v[2])
 {
@@ -202,96 +201,52 @@ int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entrie
 {
 	memset(out, 0, sizeof *out);
 	uint64_t h = 0xcbf29ce484222325ULL;
-	int cap = 0;
+	int cap = 0, rc = BSIM_OK;
 	static const char *const want[] = {"edge", "pos", "x", "y", "vx", "vy"};
-	for (int f = 0; f < n; f++) {
+	for (int f = 0; f < n && rc == BSIM_OK; f++) {
 		char path[1200];
 		struct stat st;
 		if (stat(paths[f], &st) == 0 && S_ISDIR(st.st_mode))
 			snprintf(path, sizeof path, "%s/gate_entries.csv", paths[f]);
 		else
 			snprintf(path, sizeof path, "%s", paths[f]);
-		char *text = read_all(path);
-		if (!text) {
-			bsim_markov_entries_free(out);
-			return bsim_error_set(
-			        err, BSIM_EINPUT,
-			        "%s: cannot read (%s): expected the gate_entries.csv of a "
-			        "lattice sweep",
-			        path, strerror(errno));
-		}
-		h = fnv1a_bytes(h, text, strlen(text));
-		int col[6] = {-1, -1, -1, -1, -1, -1}, line = 1, rc = 0;
-		char *save = NULL, *row = strtok_r(text, "\n", &save);
-		/* the header names the columns */
-		int c = 0;
-		for (char *p = row; p && *p; c++) {
-			size_t len = strcspn(p, ",\r");
-			for (int k = 0; k < 6; k++)
-				if (len == strlen(want[k]) && strncmp(p, want[k], len) == 0)
-					col[k] = c;
-			p += len;
-			if (*p == ',')
-				p++;
-			else
-				break;
-		}
-		for (int k = 0; k < 6 && rc == 0; k++)
-			if (col[k] < 0)
-				rc = bsim_error_set(
-				        err, BSIM_EINPUT,
-				        "%s:1: no column %s: expected the gate_entries.csv of "
-				        "a lattice sweep (edge, pos, x, y, vx, vy)",
-				        path, want[k]);
-		while (rc == 0 && (row = strtok_r(NULL, "\n", &save))) {
-			line++;
-			char edge[16] = "";
-			double val[6] = {0};
-			int got = 0;
-			c = 0;
-			for (char *p = row;; c++) {
-				size_t len = strcspn(p, ",\r");
-				for (int k = 0; k < 6; k++) {
-					if (col[k] != c)
-						continue;
-					if (k == 0) {
-						snprintf(edge, sizeof edge, "%.*s", (int)len, p);
-						got++;
-					} else {
-						char *end;
-						val[k] = strtod(p, &end);
-						got += end == p + len && len > 0 &&
-						       isfinite(val[k]);
-					}
-				}
-				p += len;
-				if (*p != ',')
-					break;
-				p++;
-			}
+		csv_table t;
+		int col[6];
+		if ((rc = csv_table_read(path, &t, err)) != BSIM_OK)
+			break;
+		rc = csv_table_require(&t, path, want, 6, col, err);
+		for (long r = 0; rc == BSIM_OK && r < t.n_rows; r++) {
+			const char *edge = csv_table_cell(&t, r, col[0]);
 			int e = -1;
 			for (int k = 0; k < 5; k++)
 				if (strcmp(edge, edge_names[k]) == 0)
 					e = k;
-			if (got != 6 || e < 0) {
+			double val[6];
+			int bad = e < 0;
+			for (int k = 1; k < 6 && !bad; k++)
+				bad = csv_table_number(&t, r, col[k], &val[k]) != 0 ||
+				      !isfinite(val[k]);
+			if (bad) {
 				rc = bsim_error_set(
 				        err, BSIM_EINPUT,
-				        "%s:%d: expected an entry with edge (start, bottom, "
+				        "%s:%ld: expected an entry with edge (start, bottom, "
 				        "left, right, top) and numbers pos, x, y, vx, vy",
-				        path, line);
+				        path, r + 2);
 				break;
 			}
 			if (e == BSIM_EDGE_START)
 				continue;
+			h = fnv1a_bytes(h, (const char *)&e, sizeof e);
+			h = fnv1a_bytes(h, (const char *)(val + 1), 5 * sizeof val[0]);
 			const double x[2] = {val[2], val[3]}, v[2] = {val[4], val[5]};
 			if (entries_push(out, &cap, e, val[1], x, v))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
-		free(text);
-		if (rc) {
-			bsim_markov_entries_free(out);
-			return rc;
-		}
+		csv_table_free(&t);
+	}
+	if (rc != BSIM_OK) {
+		bsim_markov_entries_free(out);
+		return rc;
 	}
 	snprintf(out->id, sizeof out->id, "%016llx %d", (unsigned long long)h, out->n);
 	return BSIM_OK;
