@@ -307,6 +307,32 @@ static void test_threads_and_cache(void **state)
 	assert_int_equal(bsim_test_cli(pred_ok, &out, NULL), 0);
 	assert_non_null(strstr(out, "gates visited: mean"));
 	free(out);
+	/* --out: every location of the field once, the probabilities summing to 1 */
+	char pdir[1100];
+	snprintf(pdir, sizeof pdir, "%s/prediction", d1);
+	const char *pred_out[] = {
+	        "markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
+	        "--map",  d2,        "--out",
+	        pdir,     NULL};
+	assert_int_equal(bsim_test_cli(pred_out, NULL, NULL), 0);
+	char csv[1200];
+	snprintf(csv, sizeof csv, "%s/prediction.csv", pdir);
+	char *text = bsim_test_read(csv);
+	assert_non_null(text);
+	int rows = 0;
+	double sum = 0.0;
+	char *save = NULL;
+	strtok_r(text, "\n", &save); /* the header */
+	for (char *line; (line = strtok_r(NULL, "\n", &save));) {
+		sum += atof(strrchr(line, ',') + 1);
+		rows++;
+	}
+	free(text);
+	assert_int_equal(rows, 9 + 9 + 81);
+	assert_true(fabs(sum - 1.0) < 1e-9);
+	snprintf(csv, sizeof csv, "%s/prediction.mat", pdir);
+	struct stat st;
+	assert_int_equal(stat(csv, &st), 0);
 }
 
 /* Bad inputs: exit 2, one line naming the thing, nothing written. */

@@ -166,6 +166,11 @@ int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
                         bsim_markov_prediction *out, bsim_error *err);
 void bsim_markov_prediction_free(bsim_markov_prediction *p);
 
+/* Writes p into the output directory dir: prediction.csv (location, kind,
+ * ix, iy, p: every final location of the field), prediction_gates.csv
+ * (gates, p) and their .mat twins. */
+int bsim_markov_prediction_store(const char *dir, const bsim_markov_prediction *p, bsim_error *err);
+
 /* The entry bin of a state in a gate's frame entered through edge
  * (BSIM_EDGE_BOTTOM .. BSIM_EDGE_TOP) at pos along it with velocity v; the
  * start is bin 0. For tools that bin a simulation's gate entries. */

@@ -115,6 +115,11 @@ static int map_option(void *args, int i, const char *value)
 	return markov_option(args, OWN_MAP + i, value);
 }
 
+static const char *const predict_help[CLI_N_OPTS] = {
+        [CLI_OPT_OUT] = "also write prediction.csv, prediction_gates.csv and their\n"
+                        ".mat twins into DIR",
+};
+
 static const cli_spec predict_spec = {
         .name = "markov predict",
         .usage = "LATTICE_SCENE --map DIR [OPTIONS]",
@@ -123,7 +128,8 @@ static const cli_spec predict_spec = {
                  "through column ix, a side at row iy, stuck in gate (ix, iy)) and of the\n"
                  "number of gates visited.\n",
         .positional = "LATTICE_SCENE",
-        .common = CLI_USES(CLI_OPT_SET),
+        .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT),
+        .help = predict_help,
         .own = predict_own,
         .n_own = 1,
         .option = map_option,
@@ -260,6 +266,8 @@ static int markov_predict(int argc, char **argv)
 	rc = bsim_markov_load(&scene, a.map, &opts, &set, &err);
 	if (rc == BSIM_OK)
 		rc = bsim_markov_predict(&scene, &set, &p, &err);
+	if (rc == BSIM_OK && c.out)
+		rc = bsim_markov_prediction_store(c.out, &p, &err);
 	if (rc == BSIM_OK) {
 		printf("lattice     %s (%s): %d x %d gates, %d maps, %d states (%s)\n", path,
 		       scene.name, scene.lattice.columns, scene.lattice.rows, set.n, p.n_states,
