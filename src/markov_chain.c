@@ -347,12 +347,30 @@ int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
 		if (series(&c, start, out->p, &out->p_gates, &out->n_gates, &out->left_in_field))
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		if (rc == BSIM_OK && c.n_states <= BSIM_MARKOV_LU_MAX) {
-			memset(out->p, 0, (size_t)c.n_loc * sizeof *out->p);
-			if (lu_solve(&c, start, out->p))
-				rc = bsim_error_set(
-				        err, BSIM_EFAIL,
-				        "the chain's LU solve failed (out of memory or a "
-				        "singular I - Q: a set of states never left)");
+			/* Two solutions of one chain: they must agree to within what
+			 * the series left in the field. */
+			double *by_series = malloc((size_t)c.n_loc * sizeof *by_series);
+			if (!by_series)
+				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+			else {
+				memcpy(by_series, out->p, (size_t)c.n_loc * sizeof *out->p);
+				memset(out->p, 0, (size_t)c.n_loc * sizeof *out->p);
+				if (lu_solve(&c, start, out->p))
+					rc = bsim_error_set(
+					        err, BSIM_EFAIL,
+					        "the chain's LU solve failed (out of memory or a "
+					        "singular I - Q: a set of states never left)");
+				for (int i = 0; rc == BSIM_OK && i < c.n_loc; i++)
+					if (!(fabs(out->p[i] - by_series[i]) <=
+					      1e-9 + out->left_in_field))
+						rc = bsim_error_set(
+						        err, BSIM_EFAIL,
+						        "the chain's LU and series solutions "
+						        "differ "
+						        "at location %d: %.12g against %.12g",
+						        i, out->p[i], by_series[i]);
+				free(by_series);
+			}
 			out->exact = 1;
 		}
 		for (int k = 1; rc == BSIM_OK && k <= out->n_gates; k++)

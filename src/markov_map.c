@@ -6,6 +6,7 @@
 #include "beamsim/markov.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <gsl/gsl_rng.h>
 #include <math.h>
 #include <omp.h>
@@ -25,6 +26,7 @@
 #include "beamsim/version.h"
 #include "json.h"
 #include "session.h"
+#include "yaml_doc.h"
 
 /* The map file format; part of every key, so a new format never reads an
  * old map. */
@@ -594,20 +596,35 @@ static int map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	char line[256];
 	int lineno = 0, ok = fgets(line, sizeof line, f) && strncmp(line, "entry,exit,", 11) == 0;
 	lineno++;
-	while (ok && fgets(line, sizeof line, f)) {
+	const char *bad = ok ? NULL : "header";
+	while (!bad && fgets(line, sizeof line, f)) {
 		lineno++;
-		int a, b, c;
-		if (sscanf(line, "%d,%d,%d", &a, &b, &c) != 3 || a < 0 || a >= m->n_bins || b < 0 ||
-		    b >= m->n_bins || c < 0)
-			ok = 0;
-		else
-			m->counts[(size_t)a * m->n_bins + b] = c;
+		/* entry, exit: bins; count: trials */
+		static const char *const field[3] = {"entry", "exit", "count"};
+		long v[3];
+		char *p = line;
+		for (int i = 0; !bad && i < 3; i++) {
+			char *end;
+			errno = 0;
+			v[i] = strtol(p, &end, 10);
+			long hi = i < 2 ? m->n_bins - 1 : INT_MAX;
+			if (end == p || errno || v[i] < 0 || v[i] > hi || (*end != ',' && i < 2) ||
+			    (i == 2 && *end != ',' && *end != '\n' && *end != '\0'))
+				bad = field[i];
+			p = end + 1;
+		}
+		if (!bad)
+			m->counts[(size_t)v[0] * m->n_bins + v[1]] = (int)v[2];
 	}
 	fclose(f);
-	if (!ok) {
-		bsim_error_set(err, BSIM_EINPUT,
-		               "%s:%d: expected entry,exit,count with bins below %d", path, lineno,
-		               m->n_bins);
+	if (bad) {
+		bsim_error_set(
+		        err, BSIM_EINPUT, "%s:%d: %s: expected %s", path, lineno, bad,
+		        strcmp(bad, "header") == 0 ? "entry,exit,count,..."
+		        : strcmp(bad, "count") == 0
+		                ? "a count of trials >= 0"
+		                : (snprintf(line, sizeof line, "a bin 0 to %d", m->n_bins - 1),
+		                   line));
 		return -1;
 	}
 	snprintf(path, sizeof path, "%s/map_%016llx.cost", dir, (unsigned long long)m->key);
@@ -918,54 +935,120 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 	return rc;
 }
 
-/* markov.json's def (the subset written by def_write). */
+/* One field of markov.json: the node at slash-separated path, or an error
+ * "FILE:LINE:COL: FIELD: expected WHAT, got ..." naming it. */
+static struct fy_node *def_field(const ydoc *d, const char *path, const char *what, bsim_error *err)
+{
+	struct fy_node *root = fy_document_root(d->fyd);
+	struct fy_node *n = root ? fy_node_by_path(root, path, -1, FYNWF_DONT_FOLLOW) : NULL;
+	if (!n || ydoc_is_null(n)) {
+		ydoc_expected(d, n, root, path + 1, what, err);
+		return NULL;
+	}
+	return n;
+}
+
+static int def_int(const ydoc *d, const char *path, int lo, int hi, int *out, bsim_error *err)
+{
+	char what[64];
+	snprintf(what, sizeof what, "an integer %d to %d", lo, hi);
+	struct fy_node *n = def_field(d, path, what, err);
+	long long v;
+	if (!n)
+		return BSIM_EINPUT;
+	if (!ydoc_int64(n, &v) || v < lo || v > hi)
+		return ydoc_expected(d, n, NULL, path + 1, what, err);
+	*out = (int)v;
+	return BSIM_OK;
+}
+
+/* A quoted string of markov.json, into buf. */
+static int def_string(const ydoc *d, const char *path, char *buf, size_t size, bsim_error *err)
+{
+	struct fy_node *n = def_field(d, path, "a string", err);
+	if (!n)
+		return BSIM_EINPUT;
+	const char *t = fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
+	if (!t || strlen(t) >= size)
+		return ydoc_expected(d, n, NULL, path + 1, "a short string", err);
+	snprintf(buf, size, "%s", t);
+	return BSIM_OK;
+}
+
+/* markov.json's def, read as JSON (a YAML flow document) with libfyaml:
+ * every field def_write writes, each fault naming its file position and
+ * field. */
 static int def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err)
 {
 	char path[1200];
 	snprintf(path, sizeof path, "%s/markov.json", dir);
-	char *text = read_all(path);
-	if (!text)
+	FILE *probe = fopen(path, "r");
+	if (!probe)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: cannot read (%s): not a map directory of beamsim markov "
 		                      "build",
 		                      path, strerror(errno));
+	fclose(probe);
 	*def = bsim_markov_def_default();
-	unsigned long long seed = 0;
-	char backend[64] = "";
-	int format = 0;
-	int ok = sscanf(text, "{\"format\": %d", &format) == 1 && format == MAP_FORMAT;
-	const char *p;
-	ok = ok && (p = strstr(text, "\"bins\": {\"position\": ")) &&
-	     sscanf(p,
-	            "\"bins\": {\"position\": %d, \"speed\": %d, \"direction\": %d, \"v_max\": %lf",
-	            &def->bins.n_pos, &def->bins.n_speed, &def->bins.n_dir, &def->bins.v_max) == 4;
-	ok = ok && (p = strstr(text, "\"trials\": ")) &&
-	     sscanf(p, "\"trials\": %d, \"seed\": %llu", &def->trials, &seed) == 2;
-	ok = ok && (p = strstr(text, "\"backend\": \"")) &&
-	     sscanf(p, "\"backend\": \"%63[^\"]\"", backend) == 1;
 	memset(opts, 0, sizeof *opts);
-	if (ok && (p = strstr(text, "\"options\": ["))) {
-		p += strlen("\"options\": [");
-		while (ok && *p == '"') {
-			char kv[128];
-			ok = sscanf(p, "\"%127[^\"]\"", kv) == 1 &&
-			     bsim_options_add(opts, kv, err) == BSIM_OK;
-			p += strlen(kv) + 2;
-			if (*p == ',')
-				p += 2;
+	ydoc d;
+	int rc = ydoc_load(&d, path, err);
+	if (rc != BSIM_OK)
+		return rc;
+	int format = 0;
+	uint64_t seed = 0;
+	char backend[64] = "", id[64] = "";
+	rc = def_int(&d, "/format", MAP_FORMAT, MAP_FORMAT, &format, err);
+	if (rc == BSIM_OK)
+		rc = def_int(&d, "/bins/position", 1, 64, &def->bins.n_pos, err);
+	if (rc == BSIM_OK)
+		rc = def_int(&d, "/bins/speed", 1, 64, &def->bins.n_speed, err);
+	if (rc == BSIM_OK)
+		rc = def_int(&d, "/bins/direction", 1, 64, &def->bins.n_dir, err);
+	if (rc == BSIM_OK) {
+		struct fy_node *n = def_field(&d, "/bins/v_max", "a speed > 0, m/s", err);
+		rc = !n ? BSIM_EINPUT
+		     : ydoc_number(n, &def->bins.v_max) != YDOC_NUM_OK || !(def->bins.v_max > 0)
+		             ? ydoc_expected(&d, n, NULL, "bins/v_max", "a speed > 0, m/s", err)
+		             : BSIM_OK;
+	}
+	if (rc == BSIM_OK)
+		rc = def_int(&d, "/trials", 1, 1000000, &def->trials, err);
+	if (rc == BSIM_OK) {
+		/* above 2^53 written as a string (bsim_json_u64) */
+		struct fy_node *n = def_field(&d, "/seed", "a seed, an integer >= 0", err);
+		const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
+		char *end = NULL;
+		errno = 0;
+		seed = t && *t >= '0' && *t <= '9' ? strtoull(t, &end, 10) : 0;
+		rc = !n ? BSIM_EINPUT
+		     : !end || *end || errno
+		             ? ydoc_expected(&d, n, NULL, "seed", "a seed, an integer >= 0", err)
+		             : BSIM_OK;
+	}
+	if (rc == BSIM_OK)
+		rc = def_string(&d, "/backend", backend, sizeof backend, err);
+	if (rc == BSIM_OK) {
+		struct fy_node *n = def_field(&d, "/options", "a list of \"KEY=VALUE\"", err);
+		if (!n)
+			rc = BSIM_EINPUT;
+		else if (!fy_node_is_sequence(n))
+			rc = ydoc_expected(&d, n, NULL, "options", "a list of \"KEY=VALUE\"", err);
+		void *it = NULL;
+		struct fy_node *kv;
+		while (rc == BSIM_OK && (kv = fy_node_sequence_iterate(n, &it))) {
+			const char *t = fy_node_is_scalar(kv) ? fy_node_get_scalar0(kv) : NULL;
+			rc = t ? bsim_options_add(opts, t, err)
+			       : ydoc_expected(&d, kv, n, "options", "\"KEY=VALUE\"", err);
 		}
 	}
-	char id[64] = "";
-	ok = ok && (p = strstr(text, "\"entries\": \"")) &&
-	     sscanf(p, "\"entries\": \"%63[^\"]\"", id) == 1;
-	if (ok && strcmp(id, "none") != 0)
+	if (rc == BSIM_OK)
+		rc = def_string(&d, "/entries", id, sizeof id, err);
+	ydoc_free(&d);
+	if (rc != BSIM_OK)
+		return rc;
+	if (strcmp(id, "none") != 0)
 		snprintf(def->entries_id, sizeof def->entries_id, "%s", id);
-	free(text);
-	if (!ok)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s: expected the map settings beamsim markov build writes "
-		                      "(format %d)",
-		                      path, MAP_FORMAT);
 	def->seed = seed;
 	def->backend = bsim_backend_find(backend, err);
 	def->opts = opts;

@@ -378,6 +378,81 @@ static void test_bad_inputs(void **state)
 	free(track);
 }
 
+/* A damaged map directory: the file, line (and column) and field named,
+ * exit 2. Each damage is made on a fresh build and undone. */
+static void test_bad_map_files(void **state)
+{
+	(void)state;
+	char dir[1024], path[1200];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("bad_maps"));
+	/* bsim_test_src's buffer is static: a copy per path */
+	char *essay = strdup(bsim_test_src("configs/lattice/c_track_essay.yaml"));
+	char *track = strdup(bsim_test_src("configs/lattice/c_track.yaml"));
+	const char *build[] = {"markov", "build",   essay,   "--bins", "1,1,1", "--trials",
+	                       "2",      "--quiet", "--out", dir,      NULL};
+	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
+	const char *pred[] = {"markov", "predict", track, "--map", dir, NULL};
+
+	/* markov.json: a field of the wrong kind, a bin count out of range */
+	snprintf(path, sizeof path, "%s/markov.json", dir);
+	char *json = bsim_test_read(path);
+	assert_non_null(json);
+	struct {
+		const char *from, *to, *says;
+	} json_cases[] = {
+	        {"\"trials\": 2", "\"trials\": \"two\"",
+	         "trials: expected an integer 1 to 1000000, got \"two\""},
+	        {"\"speed\": 1", "\"speed\": 0", "bins/speed: expected an integer 1 to 64, got 0"},
+	};
+	for (int i = 0; i < 2; i++) {
+		char *at = strstr(json, json_cases[i].from);
+		assert_non_null(at);
+		char text[2048];
+		snprintf(text, sizeof text, "%.*s%s%s", (int)(at - json), json, json_cases[i].to,
+		         at + strlen(json_cases[i].from));
+		bsim_test_write(dir, "markov.json", text);
+		char *err = NULL;
+		assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
+		if (!strstr(err, "markov.json:1:") || !strstr(err, json_cases[i].says))
+			print_error("case %d: %s\n", i, err);
+		assert_non_null(strstr(err, "markov.json:1:"));
+		assert_non_null(strstr(err, json_cases[i].says));
+		free(err);
+	}
+	bsim_test_write(dir, "markov.json", json);
+	assert_int_equal(bsim_test_cli(pred, NULL, NULL), 0);
+	free(json);
+
+	/* a map's CSV: an exit bin past the last of 1 + 4 bins */
+	char cmd[1400];
+	snprintf(cmd, sizeof cmd, "ls %s/map_*.csv | head -1", dir);
+	FILE *ls = popen(cmd, "r");
+	assert_non_null(ls);
+	assert_non_null(fgets(path, sizeof path, ls));
+	pclose(ls);
+	path[strcspn(path, "\n")] = '\0';
+	char *csv = bsim_test_read(path);
+	assert_non_null(csv);
+	char *row2 = strchr(csv, '\n');
+	assert_non_null(row2);
+	char *comma = strchr(row2 + 1, ',');
+	assert_non_null(comma);
+	char text[8192];
+	snprintf(text, sizeof text, "%.*s,9%s", (int)(comma - csv), csv, strchr(comma + 1, ','));
+	const char *name = strrchr(path, '/') + 1;
+	bsim_test_write(dir, name, text);
+	char *err = NULL;
+	assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
+	if (!strstr(err, ":2: exit: expected a bin 0 to 4"))
+		print_error("%s\n", err);
+	assert_non_null(strstr(err, name));
+	assert_non_null(strstr(err, ":2: exit: expected a bin 0 to 4"));
+	free(err);
+	free(csv);
+	free(essay);
+	free(track);
+}
+
 /* Bins: the edges, positions, speeds and directions land where the
  * header says. */
 static void test_bins(void **state)
@@ -470,6 +545,7 @@ int main(void)
 	        cmocka_unit_test(test_threads_and_cache),
 	        cmocka_unit_test(test_entries),
 	        cmocka_unit_test(test_bad_inputs),
+	        cmocka_unit_test(test_bad_map_files),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
