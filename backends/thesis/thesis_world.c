@@ -133,6 +133,9 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		b->damping = d->damping;
 		b->theta = d->initial_theta;
 		b->omega = d->initial_omega;
+		b->u_theta = 0.0; /* the rest direction, u0: never read from here */
+		b->u[0] = b->u0[0];
+		b->u[1] = b->u0[1];
 		w->contact_of[i] = -1;
 	}
 	w->e_tangent = scene->contact.restitution;
