@@ -254,8 +254,10 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 				if (lattice) {
 					/* a group without random force: points */
 					const int point = G->lo == G->hi && G->trials > 1;
-					bsim_stats_wilson(G->side_exit, G->trials, BSIM_STATS_Z95, &ll, &lh);
-					bsim_stats_wilson(G->stuck, G->trials, BSIM_STATS_Z95, &rl, &rh);
+					bsim_stats_wilson(G->side_exit, G->trials, BSIM_STATS_Z95,
+					                  &ll, &lh);
+					bsim_stats_wilson(G->stuck, G->trials, BSIM_STATS_Z95, &rl,
+					                  &rh);
 					if (point) {
 						ll = lh = G->side_exit / n;
 						rl = rh = G->stuck / n;

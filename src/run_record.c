@@ -134,6 +134,14 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 	bsim_json_string(f, rec->command);
 	fputs(",\n  \"beamsim_version\": ", f);
 	bsim_json_string(f, BSIM_VERSION);
+	/* What made the record, beyond the version: the checkout's commit ("" if
+	 * not built from one), the Box2D of the box2d backend, the compiler. */
+	fputs(",\n  \"beamsim_commit\": ", f);
+	bsim_json_string(f, bsim_version_commit());
+	fputs(",\n  \"box2d_version\": ", f);
+	bsim_json_string(f, bsim_version_box2d());
+	fputs(",\n  \"compiler\": ", f);
+	bsim_json_string(f, bsim_version_compiler());
 	fputs(",\n  \"source_experiment\": ", f);
 	bsim_json_string(f, e->path);
 	fputs(",\n  \"experiment\": \"inputs/experiment.yaml\",\n  \"backends\": [", f);

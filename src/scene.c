@@ -262,10 +262,11 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 	double d = 0;
 	int beam = scene_overlap(s, &d);
 	if (beam >= 0)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s: body.start: the body (radius %g) overlaps beam %d at "
-		                      "the start (distance %.3g m)",
-		                      who, s->body.radius, beam, d);
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "%s: body.start: the body (radius %g) overlaps beam %d (beams.%d) at "
+		        "the start (distance %.3g m)",
+		        who, s->body.radius, beam + 1, beam, d);
 	scene_excess x;
 	if (scene_excess_find(s, &x)) {
 		char hint[160];

@@ -261,9 +261,10 @@ static int check_overlap(walk *w)
 		n = ydoc_lookup(root, "body.start");
 	if (!n)
 		n = ydoc_lookup(root, "body");
-	return ydoc_fail(w->d, n, NULL, "body.start", w->err,
-	                 "the body (radius %g) overlaps beam %d at the start (distance %.3g m)",
-	                 w->s->body.radius, beam, dist);
+	return ydoc_fail(
+	        w->d, n, NULL, "body.start", w->err,
+	        "the body (radius %g) overlaps beam %d (beams.%d) at the start (distance %.3g m)",
+	        w->s->body.radius, beam + 1, beam, dist);
 }
 
 /* A valid scene that asks for more than a limit allows: the message

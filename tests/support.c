@@ -2,8 +2,12 @@
 
 #include "support.h"
 
+#include "figure.h"
+
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -215,4 +219,89 @@ int bsim_test_wait(int pid)
 	int status = 0;
 	waitpid((pid_t)pid, &status, 0);
 	return status_code(status);
+}
+
+/* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
+ * each over 1 kB and at most 1 MB; the number of figures, or -1 (said on
+ * stderr) if one is missing or out of that range. */
+int bsim_test_check_figures(const char *dir)
+{
+	DIR *d = opendir(dir);
+	if (!d) {
+		fprintf(stderr, "cannot open %s\n", dir);
+		return -1;
+	}
+	struct dirent *e;
+	int n = 0, bad = 0;
+	while ((e = readdir(d))) {
+		size_t len = strlen(e->d_name);
+		if (len < 4 || strcmp(e->d_name + len - 3, ".gp") != 0)
+			continue;
+		n++;
+		static const char *const ext[] = {"png", "svg"};
+		for (int i = 0; i < 2 && bsim_figure_available(); i++) {
+			char path[1200];
+			struct stat st;
+			snprintf(path, sizeof path, "%s/%.*s.%s", dir, (int)len - 3, e->d_name,
+			         ext[i]);
+			if (stat(path, &st) != 0) {
+				fprintf(stderr, "missing %s\n", path);
+				bad = 1;
+			} else if (st.st_size <= 1000 || st.st_size > 1000000) {
+				fprintf(stderr, "%s: %ld bytes\n", path, (long)st.st_size);
+				bad = 1;
+			}
+		}
+	}
+	closedir(d);
+	return bad ? -1 : n;
+}
+
+/* Wilson's score interval at 95% in closed form (Wilson 1927), written here
+ * apart from the library's. */
+void bsim_test_wilson(int k, int n, double *lo, double *hi)
+{
+	const double z = 1.959963984540054, p = (double)k / n;
+	double c = (p + z * z / (2 * n)) / (1 + z * z / n);
+	double h = z / (1 + z * z / n) * sqrt(p * (1 - p) / n + z * z / (4.0 * n * n));
+	*lo = fmax(0.0, c - h);
+	*hi = fmin(1.0, c + h);
+}
+
+int bsim_test_data_rows(const char *path, int block, double (*rows)[16], int max)
+{
+	char *text = bsim_test_read(path);
+	if (!text) { /* a test's failure, as its assertion was */
+		fprintf(stderr, "cannot read %s\n", path);
+		abort();
+	}
+	int b = 0, n = 0;
+	for (char *p = text; *p;) {
+		char *nl = strchr(p, '\n');
+		if (!nl)
+			nl = p + strlen(p);
+		if (nl == p) { /* an empty line: two in a row end a block */
+			if (nl[1] == '\n')
+				b++, p = nl + 2;
+			else
+				p = nl + 1;
+			continue;
+		}
+		if (*p != '#' && b == block && n < max) {
+			char *q = p, *end;
+			int k = 0;
+			while (k < 16 && q < nl) {
+				rows[n][k] = strtod(q, &end);
+				if (end == q)
+					break;
+				k++;
+				q = end;
+			}
+			if (k)
+				n++;
+		}
+		p = *nl ? nl + 1 : nl;
+	}
+	free(text);
+	return n;
 }

@@ -41,4 +41,17 @@ char *bsim_test_read(const char *path);
 /* Path of a file in the source tree (static buffer). */
 const char *bsim_test_src(const char *rel);
 
+/* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
+ * each over 1 kB and at most 1 MB; the number of figures, or -1 (said on
+ * stderr) if one is missing or out of that range. */
+int bsim_test_check_figures(const char *dir);
+
+/* Wilson's 95% score interval of k successes in n, in closed form. */
+void bsim_test_wilson(int k, int n, double *lo, double *hi);
+
+/* The numbers of the rows of block `block` of a gnuplot data file (blocks
+ * separated by two blank lines), up to 16 a row, at most max rows; aborts
+ * the test if the file cannot be read. */
+int bsim_test_data_rows(const char *path, int block, double (*rows)[16], int max);
+
 #endif

@@ -196,6 +196,10 @@ static void test_regress_identical(void **state)
 	/* The rerun is itself a baseline. */
 	char *a = read_in(dir, "run.json");
 	assert_non_null(strstr(a, "\"command\": \"compare\""));
+	/* What built it: the Box2D CMake found, a compiler named. */
+	assert_non_null(strstr(a, "\"box2d_version\": \"" BSIM_TEST_BOX2D_VERSION "\""));
+	assert_non_null(strstr(a, "\"compiler\": \"gcc ") || strstr(a, "\"compiler\": \"clang "));
+	assert_non_null(strstr(a, "\"beamsim_commit\": \""));
 	free(a);
 }
 

@@ -44,83 +44,6 @@ static int run_cli(const char *const *argv, char **out, char **err)
 	return rc;
 }
 
-/* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
- * none over 1 MB; returns the number of figures. */
-static int check_figures(const char *dir)
-{
-	DIR *d = opendir(dir);
-	assert_non_null(d);
-	struct dirent *e;
-	int n = 0;
-	while ((e = readdir(d))) {
-		size_t len = strlen(e->d_name);
-		if (len < 4 || strcmp(e->d_name + len - 3, ".gp") != 0)
-			continue;
-		n++;
-		static const char *const ext[] = {"png", "svg"};
-		for (int i = 0; i < 2 && bsim_figure_available(); i++) {
-			char path[1200];
-			struct stat st;
-			snprintf(path, sizeof path, "%s/%.*s.%s", dir, (int)len - 3, e->d_name,
-			         ext[i]);
-			if (stat(path, &st) != 0)
-				print_error("missing %s\n", path);
-			assert_int_equal(stat(path, &st), 0);
-			if (st.st_size > 1000000)
-				print_error("%s: %ld bytes\n", path, (long)st.st_size);
-			assert_true(st.st_size > 1000 && st.st_size <= 1000000);
-		}
-	}
-	closedir(d);
-	return n;
-}
-
-static void wilson(int k, int n, double *lo, double *hi)
-{
-	const double z = 1.959963984540054, p = (double)k / n;
-	double c = (p + z * z / (2 * n)) / (1 + z * z / n);
-	double h = z / (1 + z * z / n) * sqrt(p * (1 - p) / n + z * z / (4.0 * n * n));
-	*lo = fmax(0.0, c - h);
-	*hi = fmin(1.0, c + h);
-}
-
-/* Blocks are separated by "\n\n\n" in the text: the index of the block
- * holding each line is counted here. */
-static int data_rows(const char *path, int block, double (*rows)[16], int max)
-{
-	char *text = bsim_test_read(path);
-	assert_non_null(text);
-	int b = 0, n = 0;
-	for (char *p = text; *p;) {
-		char *nl = strchr(p, '\n');
-		if (!nl)
-			nl = p + strlen(p);
-		if (nl == p) { /* an empty line: two in a row end a block */
-			if (nl[1] == '\n')
-				b++, p = nl + 2;
-			else
-				p = nl + 1;
-			continue;
-		}
-		if (*p != '#' && b == block && n < max) {
-			char *q = p, *end;
-			int k = 0;
-			while (k < 16 && q < nl) {
-				rows[n][k] = strtod(q, &end);
-				if (end == q)
-					break;
-				k++;
-				q = end;
-			}
-			if (k)
-				n++;
-		}
-		p = *nl ? nl + 1 : nl;
-	}
-	free(text);
-	return n;
-}
-
 /* ---- the landscape of MODEL.md section 7, written again ---------------------------------- */
 
 /* th of a beam with pivot (px, 30) pointing at the midline: the left one
@@ -211,7 +134,7 @@ static void test_sweep_figures(void **state)
 	const char *dir = sweep_plotted();
 	/* p_traverse, two traversal_vs_*, and per group a bundle, plus a
 	 * landscape where a kept trial traversed (F = 9 N, Rm = 0 does) */
-	int n = check_figures(dir);
+	int n = bsim_test_check_figures(dir);
 	assert_true(n >= 3 + 6 + 1);
 
 	/* The heat map's numbers from the outcomes of trials.csv. */
@@ -232,12 +155,12 @@ static void test_sweep_figures(void **state)
 	free(trials);
 	static double rows[64][16];
 	snprintf(path, sizeof path, "%s/p_traverse.dat", dir);
-	int nr = data_rows(path, 0, rows, 64);
+	int nr = bsim_test_data_rows(path, 0, rows, 64);
 	assert_int_equal(nr, 6);
 	for (int i = 0; i < nr; i++) {
 		int g = (int)rows[i][7];
 		double lo, hi;
-		wilson(trav[g], 12, &lo, &hi);
+		bsim_test_wilson(trav[g], 12, &lo, &hi);
 		if (g % 3 == 0) /* Rm = 0: one trial run and copied, its interval a point */
 			lo = hi = trav[g] / 12.0;
 		assert_int_equal((int)rows[i][0], g / 3);              /* column: F_prop */
@@ -248,7 +171,7 @@ static void test_sweep_figures(void **state)
 	/* Traversal against Rm, panel F_prop = 9 N (the second): left and
 	 * right fractions from the types. */
 	snprintf(path, sizeof path, "%s/traversal_vs_effects_random_force_magnitude.dat", dir);
-	nr = data_rows(path, 1, rows, 64);
+	nr = bsim_test_data_rows(path, 1, rows, 64);
 	assert_int_equal(nr, 3);
 	for (int i = 0; i < 3; i++) {
 		int g = 3 + i;
@@ -268,7 +191,7 @@ static void test_paths_over_landscape(void **state)
 	char path[1200];
 	snprintf(path, sizeof path, "%s/landscape_g003.dat", dir); /* F 9 N, Rm 0: traverses */
 	static double rows[20000][16];
-	int nr = data_rows(path, 0, rows, 20000);
+	int nr = bsim_test_data_rows(path, 0, rows, 20000);
 	assert_true(nr > 50);
 	/* each row: x y E class below, thinned from the rows of the
 	 * traversed trials in trajectories.csv, in their order */
@@ -296,7 +219,7 @@ static void test_paths_over_landscape(void **state)
 	assert_int_equal(k, nr);
 	/* every state below the surface is in the stretches of block 1 */
 	snprintf(path, sizeof path, "%s/landscape_g003.dat", dir);
-	int nb = data_rows(path, 1, rows, 20000);
+	int nb = bsim_test_data_rows(path, 1, rows, 20000);
 	assert_true(nb >= below);
 }
 
@@ -312,14 +235,14 @@ static void test_select(void **state)
 	static double rows[64][16];
 	char path[1200];
 	snprintf(path, sizeof path, "%s/p_traverse.dat", out_dir);
-	int nr = data_rows(path, 0, rows, 64);
+	int nr = bsim_test_data_rows(path, 0, rows, 64);
 	assert_int_equal(nr, 3); /* the three Rm of F = 7 N, groups 0-2 */
 	for (int i = 0; i < nr; i++)
 		assert_true(rows[i][7] >= 0 && rows[i][7] <= 2);
 	/* one value of F left: nothing drawn against it */
 	snprintf(path, sizeof path, "%s/traversal_vs_effects_propulsion_force.gp", out_dir);
 	assert_null(bsim_test_read(path));
-	check_figures(out_dir);
+	assert_true(bsim_test_check_figures(out_dir) >= 0);
 
 	char *err = NULL;
 	const char *bad[] = {"plot", dir, "--select", "beams.0.mass=1", "--out", out_dir, NULL};
@@ -403,13 +326,13 @@ static void test_run_figures(void **state)
 	free(out);
 	const char *argv[] = {"plot", dir, "--quiet", NULL};
 	assert_int_equal(run_cli(argv, NULL, NULL), 0);
-	assert_int_equal(check_figures(dir), 3);
+	assert_int_equal(bsim_test_check_figures(dir), 3);
 	/* The histogram: every draw of the runner once, density integrating
 	 * to 1. */
 	static double rows[64][16];
 	char path[1200];
 	snprintf(path, sizeof path, "%s/random_force.dat", dir);
-	int nr = data_rows(path, 0, rows, 64);
+	int nr = bsim_test_data_rows(path, 0, rows, 64);
 	assert_int_equal(nr, 32);
 	double width = rows[1][0] - rows[0][0], integral = 0.0;
 	long count = 0;
@@ -422,7 +345,7 @@ static void test_run_figures(void **state)
 	/* The ledger's sum of flows is E(t) - E(0) less the residual. */
 	static double led[4000][16];
 	snprintf(path, sizeof path, "%s/ledger.dat", dir);
-	nr = data_rows(path, 0, led, 4000);
+	nr = bsim_test_data_rows(path, 0, led, 4000);
 	assert_true(nr > 100);
 	for (int i = 0; i < nr; i++)
 		assert_true(fabs(led[i][4] - led[i][11] - led[i][12]) < 1e-6);
@@ -451,16 +374,17 @@ static void test_accuracy_front(void **state)
 	static double rows[16][16];
 	char path[1200];
 	snprintf(path, sizeof path, "%s/accuracy.dat", dir);
-	int nr = data_rows(path, 2, rows, 16);
+	int nr = bsim_test_data_rows(path, 2, rows, 16);
 	assert_int_equal(nr, 3);
 	const double speed[3] = {2000, 1000, 100}, err[3] = {5e-3, 1e-3, 1e-4};
 	for (int i = 0; i < 3; i++) {
 		assert_true(rows[i][0] == speed[i]);
 		assert_true(rows[i][1] == err[i]);
 	}
-	assert_int_equal(data_rows(path, 0, rows, 16), 2); /* s1 without its reference row */
-	assert_int_equal(data_rows(path, 1, rows, 16), 3);
-	check_figures(dir);
+	assert_int_equal(bsim_test_data_rows(path, 0, rows, 16),
+	                 2); /* s1 without its reference row */
+	assert_int_equal(bsim_test_data_rows(path, 1, rows, 16), 3);
+	assert_true(bsim_test_check_figures(dir) >= 0);
 }
 
 /* ---- a comparison ------------------------------------------------------------------------- */
@@ -478,17 +402,17 @@ static void test_compare_figures(void **state)
 	assert_true(rc == 0 || rc == 3);
 	const char *argv[] = {"plot", dir, "--quiet", NULL};
 	assert_int_equal(run_cli(argv, NULL, NULL), 0);
-	assert_int_equal(check_figures(dir), 1);
+	assert_int_equal(bsim_test_check_figures(dir), 1);
 	char sub[1100];
 	for (int b = 0; b < 2; b++) {
 		snprintf(sub, sizeof sub, "%s/%s", dir, b ? "box2d" : "thesis");
-		assert_int_equal(check_figures(sub), 3);
+		assert_int_equal(bsim_test_check_figures(sub), 3);
 	}
 	/* The paired difference is p_A - p_B of the two probabilities drawn. */
 	static double rows[64][16];
 	char path[1200];
 	snprintf(path, sizeof path, "%s/compare.dat", dir);
-	int nr = data_rows(path, 0, rows, 64);
+	int nr = bsim_test_data_rows(path, 0, rows, 64);
 	assert_int_equal(nr, 30);
 	for (int i = 0; i < nr; i++)
 		assert_true(fabs(rows[i][8] - (rows[i][2] - rows[i][5])) < 1e-6);

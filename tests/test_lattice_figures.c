@@ -43,89 +43,12 @@ static int run_cli(const char *const *argv, char **out, char **err)
 	return rc;
 }
 
-/* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
- * none over 1 MB; returns the number of figures. */
-static int check_figures(const char *dir)
-{
-	DIR *d = opendir(dir);
-	assert_non_null(d);
-	struct dirent *e;
-	int n = 0;
-	while ((e = readdir(d))) {
-		size_t len = strlen(e->d_name);
-		if (len < 4 || strcmp(e->d_name + len - 3, ".gp") != 0)
-			continue;
-		n++;
-		static const char *const ext[] = {"png", "svg"};
-		for (int i = 0; i < 2 && bsim_figure_available(); i++) {
-			char path[1200];
-			struct stat st;
-			snprintf(path, sizeof path, "%s/%.*s.%s", dir, (int)len - 3, e->d_name,
-			         ext[i]);
-			if (stat(path, &st) != 0)
-				print_error("missing %s\n", path);
-			assert_int_equal(stat(path, &st), 0);
-			if (st.st_size > 1000000)
-				print_error("%s: %ld bytes\n", path, (long)st.st_size);
-			assert_true(st.st_size > 1000 && st.st_size <= 1000000);
-		}
-	}
-	closedir(d);
-	return n;
-}
-
 static int exists(const char *dir, const char *file)
 {
 	char path[1200];
 	struct stat st;
 	snprintf(path, sizeof path, "%s/%s", dir, file);
 	return stat(path, &st) == 0;
-}
-
-static void wilson(int k, int n, double *lo, double *hi)
-{
-	const double z = 1.959963984540054, p = (double)k / n;
-	double c = (p + z * z / (2 * n)) / (1 + z * z / n);
-	double h = z / (1 + z * z / n) * sqrt(p * (1 - p) / n + z * z / (4.0 * n * n));
-	*lo = fmax(0.0, c - h);
-	*hi = fmin(1.0, c + h);
-}
-
-/* The numbers of the rows of block `block` of a gnuplot data file (blocks
- * separated by two blank lines), up to 16 a row. */
-static int data_rows(const char *path, int block, double (*rows)[16], int max)
-{
-	char *text = bsim_test_read(path);
-	assert_non_null(text);
-	int b = 0, n = 0;
-	for (char *p = text; *p;) {
-		char *nl = strchr(p, '\n');
-		if (!nl)
-			nl = p + strlen(p);
-		if (nl == p) {
-			if (nl[1] == '\n')
-				b++, p = nl + 2;
-			else
-				p = nl + 1;
-			continue;
-		}
-		if (*p != '#' && b == block && n < max) {
-			char *q = p, *end;
-			int k = 0;
-			while (k < 16 && q < nl) {
-				rows[n][k] = strtod(q, &end);
-				if (end == q)
-					break;
-				k++;
-				q = end;
-			}
-			if (k)
-				n++;
-		}
-		p = *nl ? nl + 1 : nl;
-	}
-	free(text);
-	return n;
 }
 
 /* ---- a CSV file by column name ---------------------------------------------------------- */
@@ -237,7 +160,7 @@ static void count_trials(const char *path, int g, counts *c)
 static void check_fraction(const double *row, int k, int n, int point)
 {
 	double lo, hi;
-	wilson(k, n, &lo, &hi);
+	bsim_test_wilson(k, n, &lo, &hi);
 	if (point)
 		lo = hi = (double)k / n;
 	assert_true(fabs(row[0] - (double)k / n) < 1e-6);
@@ -249,14 +172,14 @@ static void check_locations(const char *path, int b0, const counts *c, int point
 {
 	static double rows[128][16];
 	int total = 0;
-	assert_int_equal(data_rows(path, b0, rows, 128), COLS);
+	assert_int_equal(bsim_test_data_rows(path, b0, rows, 128), COLS);
 	for (int i = 0; i < COLS; i++) {
 		assert_int_equal((int)rows[i][0], IX_MIN + i);
 		assert_int_equal((int)rows[i][4], c->end[i]);
 		check_fraction(&rows[i][1], c->end[i], c->n, point);
 		total += c->end[i];
 	}
-	assert_int_equal(data_rows(path, b0 + 1, rows, 128), ROWS);
+	assert_int_equal(bsim_test_data_rows(path, b0 + 1, rows, 128), ROWS);
 	for (int i = 0; i < ROWS; i++) {
 		assert_int_equal((int)rows[i][0], i);
 		for (int s = 0; s < 2; s++) {
@@ -265,7 +188,7 @@ static void check_locations(const char *path, int b0, const counts *c, int point
 			total += c->side[s][i];
 		}
 	}
-	assert_int_equal(data_rows(path, b0 + 2, rows, 128), ROWS * COLS);
+	assert_int_equal(bsim_test_data_rows(path, b0 + 2, rows, 128), ROWS * COLS);
 	for (int i = 0; i < ROWS * COLS; i++) {
 		int ix = (int)rows[i][0], iy = (int)rows[i][1];
 		assert_true(ix >= IX_MIN && ix < IX_MIN + COLS && iy >= 0 && iy < ROWS);
@@ -313,7 +236,7 @@ static void test_sweep_figures(void **state)
 	const char *dir = lattice_sweep();
 	/* p_traverse, traversal against Rm, and per group final_locations and
 	 * lattice; not the single gate's bundle and landscape */
-	assert_int_equal(check_figures(dir), 2 + 2 * 2);
+	assert_int_equal(bsim_test_check_figures(dir), 2 + 2 * 2);
 	assert_true(exists(dir, "lattice_g001.png") || !bsim_figure_available());
 	assert_false(exists(dir, "trajectories_g000.gp"));
 	assert_false(exists(dir, "landscape_g001.gp"));
@@ -335,7 +258,7 @@ static void test_final_locations(void **state)
 	/* where the trials ended against Rm: end, side exit and stuck */
 	static double rows[8][16];
 	snprintf(path, sizeof path, "%s/traversal_vs_effects_random_force_magnitude.dat", dir);
-	assert_int_equal(data_rows(path, 0, rows, 8), 2);
+	assert_int_equal(bsim_test_data_rows(path, 0, rows, 8), 2);
 	for (int g = 0; g < 2; g++) {
 		counts c;
 		count_trials(trials, g, &c);
@@ -385,7 +308,7 @@ static void test_stiffness_map(void **state)
 	static double rows[400][16];
 	char path[1200];
 	snprintf(path, sizeof path, "%s/lattice_g001.dat", dir);
-	int n = data_rows(path, 0, rows, 400);
+	int n = bsim_test_data_rows(path, 0, rows, 400);
 	assert_int_equal(n, 2 * ROWS * COLS);
 	int soft = 0;
 	for (int i = 0; i < n; i++) {
@@ -397,7 +320,7 @@ static void test_stiffness_map(void **state)
 		assert_true(r[2] == 60.0 * y && r[3] == 60.0 * y + 60);
 	}
 	assert_int_equal(soft, 2 * 16); /* the C: 16 soft gates */
-	n = data_rows(path, 1, rows, 400);
+	n = bsim_test_data_rows(path, 1, rows, 400);
 	assert_int_equal(n, 2 * ROWS * COLS);
 	for (int i = 0; i < n; i++) {
 		const double *r = rows[i];
@@ -474,7 +397,7 @@ static void test_paths(void **state)
 	const int tg = table_col(&tr, "group"), tt = table_col(&tr, "trial"),
 	          tx = table_col(&tr, "x"), ty = table_col(&tr, "y");
 	static double rows[50000][16];
-	int nr = data_rows(fig, 3, rows, 50000), k = 0, first = 1;
+	int nr = bsim_test_data_rows(fig, 3, rows, 50000), k = 0, first = 1;
 	long recorded = 0;
 	double last[2] = {NAN, NAN};
 	for (int i = 0; i < n[1]; i++) {
@@ -521,13 +444,14 @@ static void test_compare(void **state)
 	const char *plot[] = {"plot", dir, NULL};
 	assert_int_equal(run_cli(plot, &out, NULL), 0);
 	free(out);
-	assert_int_equal(check_figures(dir), 2); /* compare and final_locations_g000 */
+	assert_int_equal(bsim_test_check_figures(dir), 2); /* compare and final_locations_g000 */
 	char sub[1100], path[1200], pairs[1200];
 	snprintf(pairs, sizeof pairs, "%s/pairs.csv", dir);
 	snprintf(path, sizeof path, "%s/final_locations_g000.dat", dir);
 	for (int s = 0; s < 2; s++) {
 		snprintf(sub, sizeof sub, "%s/%s", dir, s ? "essay" : "world");
-		assert_int_equal(check_figures(sub), 3); /* p_traverse, final_locations, lattice */
+		assert_int_equal(bsim_test_check_figures(sub),
+		                 3); /* p_traverse, final_locations, lattice */
 		char trials[1200];
 		snprintf(trials, sizeof trials, "%s/trials.csv", sub);
 		counts c;

@@ -265,9 +265,9 @@ static void override_errors_name_the_override(void **state)
 	bsim_override through[] = {{"body.mass.x", "1", "o"}};
 	expect_error(gate, through, 1, "o: body.mass.x: expected a mapping or list at body.mass");
 	bsim_override start[] = {{"body.start", "[0, 25]", "s"}};
-	expect_error(
-	        gate, start, 1,
-	        "s: body.start: the body (radius 10) overlaps beam 0 at the start (distance 5 m)");
+	expect_error(gate, start, 1,
+	             "s: body.start: the body (radius 10) overlaps beam 1 (beams.0) at the start "
+	             "(distance 5 m)");
 	/* An unknown key inside an override's own mapping still names it. */
 	bsim_override inner[] = {{"effects.propulsion", "{forc: 3}", "p"}};
 	expect_error(gate, inner, 1,
@@ -289,7 +289,7 @@ static void validate_checks_code_built_scenes(void **state)
 	c.beams[1].length = 25;
 	c.body.start[1] = 25; /* 5 m below the left beam */
 	assert_int_equal(bsim_scene_validate(&c, &err), BSIM_EINPUT);
-	assert_non_null(strstr(err.msg, "overlaps beam 0"));
+	assert_non_null(strstr(err.msg, "overlaps beam 1 (beams.0)"));
 	c.body.start[1] = 0;
 	assert_int_equal(bsim_scene_set_beams(&c, 3), BSIM_OK);
 	assert_true(c.beams[2].length == 0 && c.beams[1].length == 25);

@@ -172,9 +172,9 @@ static void overlapping_start(void **state)
 {
 	(void)state;
 	/* 5 m below the left beam with a 10 m radius. */
-	const char *needles[] = {"overlap.yaml:1:", "body.start",
-	                         "the body (radius 10) overlaps beam 0 at the start (distance 5 m)",
-	                         NULL};
+	const char *needles[] = {
+	        "overlap.yaml:1:", "body.start",
+	        "the body (radius 10) overlaps beam 1 (beams.0) at the start (distance 5 m)", NULL};
 	run_bad_scene("overlap", "body: { mass: 1, radius: 10, start: [-10, 25] }\n" BEAMS,
 	              needles);
 }

@@ -31,6 +31,7 @@ int cmd_accuracy(int argc, char **argv);
 int cmd_landscape(int argc, char **argv);
 int cmd_plot(int argc, char **argv);
 int cmd_video(int argc, char **argv);
+int cmd_markov(int argc, char **argv);
 
 /* "beamsim: MSG" on stderr, one line of printable text. */
 void cli_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -35,26 +35,28 @@ static int plot_option(void *args, int i, const char *value)
 static const cli_spec plot_spec = {
         .name = "plot",
         .usage = "DIR [OPTIONS]",
-        .about = "Draws the figures of DIR, the output directory of beamsim sweep, compare,\n"
-                 "run --out or accuracy, as NAME.png and NAME.svg with the data and the gnuplot\n"
-                 "script NAME.gp beside them (rerun `gnuplot NAME.gp` there to redraw):\n"
-                 "  sweep     p_traverse.*: p_traverse over the first two grid axes with 95%\n"
-                 "            intervals; traversal_vs_KEY.*: traversed, left and right type\n"
-                 "            against each axis with 95% bands, a panel per value of the other\n"
-                 "            axes; with kept trajectories (sweep --trajectories N),\n"
-                 "            trajectories_gNNN.* (each group's bundle by outcome and type) and\n"
-                 "            landscape_gNNN.* (the traversed ones over the energy landscape)\n"
-                 "  lattice   a sweep of a gate lattice: per group final_locations_gNNN.* (where\n"
-                 "            the trials ended, laid out as the field, with 95% intervals) and\n"
-                 "            lattice_gNNN.* (the stiffness map and the kept trajectories over it,\n"
-                 "            the essay's Fig. 3.5) instead of the bundle and landscape; compare of\n"
-                 "            lattices adds final_locations_gNNN.*, both sides side by side\n"
-                 "  compare   compare.*: both backends' p_traverse and their paired\n"
-                 "            differences; each backend's sweep figures in DIR/<backend>/\n"
-                 "  run --out random_force.*, ledger.*, landscape_path.*\n"
-                 "  accuracy  accuracy.*: error against speed, the Pareto front marked\n"
-                 "Without gnuplot (Debian package gnuplot-nox) the data and scripts are\n"
-                 "written and the images are not.\n",
+        .about =
+                "Draws the figures of DIR, the output directory of beamsim sweep, compare,\n"
+                "run --out or accuracy, as NAME.png and NAME.svg with the data and the gnuplot\n"
+                "script NAME.gp beside them (rerun `gnuplot NAME.gp` there to redraw):\n"
+                "  sweep     p_traverse.*: p_traverse over the first two grid axes with 95%\n"
+                "            intervals; traversal_vs_KEY.*: traversed, left and right type\n"
+                "            against each axis with 95% bands, a panel per value of the other\n"
+                "            axes; with kept trajectories (sweep --trajectories N),\n"
+                "            trajectories_gNNN.* (each group's bundle by outcome and type) and\n"
+                "            landscape_gNNN.* (the traversed ones over the energy landscape)\n"
+                "  lattice   a sweep of a gate lattice: per group final_locations_gNNN.* (where\n"
+                "            the trials ended, laid out as the field, with 95% intervals) and\n"
+                "            lattice_gNNN.* (the stiffness map and the kept trajectories over it,\n"
+                "            the essay's Fig. 3.5) instead of the bundle and landscape; compare "
+                "of\n"
+                "            lattices adds final_locations_gNNN.*, both sides side by side\n"
+                "  compare   compare.*: both backends' p_traverse and their paired\n"
+                "            differences; each backend's sweep figures in DIR/<backend>/\n"
+                "  run --out random_force.*, ledger.*, landscape_path.*\n"
+                "  accuracy  accuracy.*: error against speed, the Pareto front marked\n"
+                "Without gnuplot (Debian package gnuplot-nox) the data and scripts are\n"
+                "written and the images are not.\n",
         .positional = "DIR",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET),
         .help = plot_help,

@@ -24,6 +24,8 @@ static const cli_command commands[] = {
          "what accuracy costs in time: error against speed per backend and step"},
         {"landscape", cmd_landscape,
          "the potential energy landscape of a scene, its barriers and figures"},
+        {"markov", cmd_markov,
+         "predict a gate lattice from single-gate maps: build, predict, validate"},
         {"plot", cmd_plot, "draw the figures of a sweep, comparison, run or accuracy study"},
         {"video", cmd_video, "an MP4 of one trial, on one backend or side by side"},
 };

@@ -1,0 +1,247 @@
+/* Predicting a gate lattice from single gates: the Markov chain of the
+ * essay's Sec. 3.3 and 4.3 (Zheng, Xuan & Li, IEEE RA-L 2022).
+ *
+ * The single-gate map. A gate is entered across one of its edges with some
+ * state and left across an edge with another, or the body stays stuck in
+ * it (gate_steps steps). The entry state, in the gate's own frame (Eq.
+ * 2.17), is binned:
+ *   edge       bottom, left, right, top (the side it came in through), and
+ *              the start, the body's initial state, as a bin of its own;
+ *   position   along the edge: x in [-w/2, w/2] on the bottom and top, y in
+ *              [0, d] on the sides, n_pos equal bins;
+ *   speed      |v| in [0, v_max], n_speed equal bins, faster in the last;
+ *   direction  the angle of v from the edge's inward normal, in
+ *              [-90, 90] degrees, n_dir equal bins (beyond: the end bins).
+ * For each bin, `trials` single gates (the two beams at rest, as the essay
+ * resets them on entry) start from states drawn uniformly in the bin, each
+ * with a fresh random-force schedule, and run until the body leaves the
+ * gate's rectangle or gate_steps steps pass. The exit state is binned as
+ * the entry state of the gate it enters, so a map is a matrix of counts
+ * counts[entry][exit], exit 0 being "stuck". One map per pair of beam
+ * stiffnesses (left, right) the lattice uses.
+ *
+ * The chain. The transient states are (gate, entry bin); the absorbing ones
+ * the final locations of MODEL.md section 8: the end through column ix
+ * (the top edge of the last row), a side at row iy (the outer edge of the
+ * outer columns, where side_x lies), stuck in gate (ix, iy). With Q the
+ * transient-to-transient and R the transient-to-absorbing probabilities and
+ * s the start state, the final-location distribution is
+ *   p = s (I - Q)^-1 R,
+ * solved exactly by LU decomposition (GSL) when the chain has at most
+ * BSIM_MARKOV_LU_MAX states, else by the series s (I + Q + Q^2 + ...) R
+ * summed until the probability still in the field is below 1e-12. The
+ * series' k-th term is the k-th gate entered, so it also gives the
+ * distribution of the number of gates visited, the start gate counted.
+ *
+ * What the chain assumes: the essay's protocol (beams reset on entry, the
+ * gates behind and beside the body absent), and that the exit depends on
+ * the entry only through its bin. A body leaving row 0 downwards re-enters
+ * row 0 in the chain (the lattice keeps it in row 0's gate); a trial's
+ * overall max_steps is not modelled. */
+#ifndef BEAMSIM_MARKOV_H
+#define BEAMSIM_MARKOV_H
+
+#include <stdint.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/error.h"
+#include "beamsim/lattice.h"
+#include "beamsim/options.h"
+#include "beamsim/progress.h"
+#include "beamsim/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The entry-state bins. */
+typedef struct bsim_markov_bins {
+	int n_pos, n_speed, n_dir;
+	double v_max; /* m/s: speeds above it fall in the last speed bin */
+} bsim_markov_bins;
+
+/* 4 positions, 4 speeds up to 40 m/s, 3 directions. */
+bsim_markov_bins bsim_markov_bins_default(void);
+
+/* The number of entry bins, the start's included: 1 + 4 n_pos n_speed n_dir. */
+int bsim_markov_bins_count(const bsim_markov_bins *b);
+
+/* Gate entries observed in simulation (gate_entries.csv of lattice sweeps,
+ * the start rows left out): when a map is built with them, the states of
+ * an entry bin are drawn from the entries that fall in it (uniformly in
+ * the bin only where none does), so the states within a bin are those a
+ * lattice delivers. */
+typedef struct bsim_markov_entries {
+	int n;
+	int *edge;
+	double *pos;
+	double (*x)[2], (*v)[2]; /* body centre (gate frame) and velocity */
+	char id[64];             /* "HASH COUNT": FNV-1a of the files' bytes, entries */
+} bsim_markov_entries;
+
+/* Reads the entries of n files (a gate_entries.csv, or a directory holding
+ * one). BSIM_EINPUT naming file and line if one is malformed. */
+int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entries *out,
+                             bsim_error *err);
+void bsim_markov_entries_free(bsim_markov_entries *e);
+
+/* How a map is built. */
+typedef struct bsim_markov_def {
+	bsim_markov_bins bins;
+	int trials;                         /* single-gate trials per entry bin */
+	uint64_t seed;                      /* of the entry states and the schedules */
+	const bsim_backend *backend;        /* NULL: the default backend */
+	const bsim_options *opts;           /* NULL: no options */
+	int threads;                        /* <= 0: all cores; the map is the same for any */
+	const bsim_markov_entries *entries; /* NULL: states uniform in each bin */
+	char entries_id[64];                /* the entries' id when read back from markov.json */
+	bsim_progress_fn progress;          /* may be NULL; counts single-gate trials */
+	void *progress_user;
+} bsim_markov_def;
+
+/* bsim_markov_bins_default(), 200 trials per bin, seed 1, the default
+ * backend, all cores. */
+bsim_markov_def bsim_markov_def_default(void);
+
+/* One single-gate map. */
+typedef struct bsim_markov_map {
+	double k[2];    /* N m/rad, the gate's left and right beam */
+	uint64_t key;   /* FNV-1a hash of key_text: the map's file name */
+	char *key_text; /* everything the map depends on, a line each */
+	int n_bins;     /* bsim_markov_bins_count */
+	int trials;     /* per entry bin */
+	int *counts;    /* n_bins x n_bins, [entry * n_bins + exit], exit 0 = stuck */
+	double seconds; /* CPU time of its simulation now, s (0 if read from the cache) */
+	double cost;    /* CPU time its simulation took when it was built, s */
+	int cached;     /* 1: read from the cache, 0: simulated now */
+} bsim_markov_map;
+
+/* The maps of one lattice: one per stiffness pair it uses. */
+typedef struct bsim_markov_set {
+	bsim_markov_def def; /* as built (backend and opts: the caller's) */
+	int n;
+	bsim_markov_map *maps;
+	int built, reused; /* maps simulated now, maps read from the cache */
+	double seconds;    /* CPU time of the simulation of those built, s */
+} bsim_markov_set;
+
+/* The maps lattice needs, from the cache directory dir: a map whose key is
+ * there is read, the others are simulated and stored there (dir/maps/
+ * HASH.csv and HASH.key, and dir/markov.json, the def last used). A key
+ * holds every input of the map (the gate, its beams and stiffness pair,
+ * the body, contact, effects, time step, gate_steps, the backend and its
+ * options, bins, trials, seed and the map format's version), so a changed
+ * parameter never reuses a map. BSIM_EINPUT if lattice is not a lattice or
+ * its side boundary is not the field's edge; an unstable single gate is
+ * BSIM_EFAIL, never a count. */
+int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, const char *dir,
+                      bsim_markov_set *out, bsim_error *err);
+
+/* The maps lattice needs, read from dir only, with the def stored in
+ * dir/markov.json (opts: filled into *opts, which must outlive the set).
+ * BSIM_EINPUT naming the stiffness pair whose map is missing, with the
+ * command that builds it. */
+int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *opts,
+                     bsim_markov_set *out, bsim_error *err);
+
+void bsim_markov_set_free(bsim_markov_set *s);
+
+/* The chains small enough for the exact LU solve. */
+#define BSIM_MARKOV_LU_MAX 1000
+
+typedef struct bsim_markov_prediction {
+	int n_locations;
+	bsim_location *loc; /* ends by ix, sides by iy, stuck gates by (iy, ix) */
+	double *p;          /* their probabilities */
+	int n_gates;        /* p_gates has n_gates + 1 entries */
+	double *p_gates;    /* p_gates[k]: k gates visited, the start counted */
+	double mean_gates;
+	double left_in_field; /* probability the series had not absorbed when it stopped */
+	int n_states;         /* transient states (gate, entry bin) */
+	int exact;            /* 1: p by LU, 0: by the series */
+} bsim_markov_prediction;
+
+/* The chain of lattice composed from set's maps, solved. */
+int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
+                        bsim_markov_prediction *out, bsim_error *err);
+void bsim_markov_prediction_free(bsim_markov_prediction *p);
+
+/* Writes p into the output directory dir: prediction.csv (location, kind,
+ * ix, iy, p: every final location of the field), prediction_gates.csv
+ * (gates, p) and their .mat twins. */
+int bsim_markov_prediction_store(const char *dir, const bsim_markov_prediction *p, bsim_error *err);
+
+/* The entry bin of a state in a gate's frame entered through edge
+ * (BSIM_EDGE_BOTTOM .. BSIM_EDGE_TOP) at pos along it with velocity v; the
+ * start is bin 0. For tools that bin a simulation's gate entries. */
+int bsim_markov_bin_of(const bsim_markov_bins *b, const bsim_lattice_def *l, int edge, double pos,
+                       const double v[2]);
+
+/* ---- validation against the simulation ---------------------------------
+ *
+ * beamsim markov validate: every group of a lattice experiment simulated
+ * directly (bsim_sweep_run, on the maps' backend) under the essay's
+ * protocol and the whole world, and predicted by the chain from the maps
+ * in map_dir. The distance is the total variation
+ *   TV(p, q) = 1/2 sum over final locations |p - q|.
+ * Beside it, the simulation's own sampling error: the mean (and 95th
+ * percentile) of TV between the simulated distribution and multinomial
+ * resamples of it with the same number of trials (a parametric bootstrap),
+ * and the map's: the mean TV between the chain and chains of maps whose
+ * rows are resampled the same way. Cost: the simulation's CPU time against
+ * the prediction's (the mean of repeated predictions), and the number of
+ * lattices after which building the maps pays off. */
+
+typedef struct bsim_markov_validate_def {
+	const char *experiment; /* a lattice experiment file */
+	const char *map_dir;
+	const char *out;           /* the output directory */
+	const bsim_override *sets; /* --set, every group */
+	int n_sets;
+	long trials;  /* 0: the experiment's */
+	int has_seed; /* 1: seed replaces the experiment's */
+	uint64_t seed;
+	int threads;               /* <= 0: all cores */
+	int bootstrap;             /* resamples of the simulation; default 2000 */
+	int map_resamples;         /* resamples of the maps; default 40 */
+	bsim_progress_fn progress; /* may be NULL; counts trials simulated */
+	void *progress_user;
+} bsim_markov_validate_def;
+
+bsim_markov_validate_def bsim_markov_validate_default(void);
+
+/* One group under one protocol. */
+typedef struct bsim_markov_check {
+	int group;
+	bsim_protocol protocol;
+	int trials;
+	double tv;                     /* chain against simulation */
+	double tv_sampling;            /* mean TV of the simulation's resamples */
+	double tv_sampling95;          /* their 95th percentile */
+	double tv_map;                 /* mean TV of the chain from resampled maps */
+	double gates_sim, gates_chain; /* mean gates visited */
+	double sim_cpu;                /* s, the direct simulation */
+	double predict;                /* s, one prediction */
+	int n_states, exact;
+} bsim_markov_check;
+
+typedef struct bsim_markov_validation {
+	int n;
+	bsim_markov_check *checks; /* group-major, essay then world */
+	double map_cost;           /* s of CPU the maps took to build */
+	int bins, trials_per_bin;
+} bsim_markov_validation;
+
+/* Runs the validation and writes out: validate.json (every check),
+ * validate.csv (group, protocol, location, simulated p with its Wilson 95%
+ * interval, predicted p), gates.csv (the distribution of gates visited,
+ * simulated and predicted), their .mat twins, and the figure
+ * validate_gNNN (.png .svg .gp) per group. */
+int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_validation *out,
+                         bsim_error *err);
+void bsim_markov_validation_free(bsim_markov_validation *v);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,381 @@
+/* beamsim markov: the Markov chain that predicts a gate lattice from
+ * single-gate maps (beamsim/markov.h). build, predict and validate parse
+ * and print; the library simulates, composes, solves and writes. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/experiment.h"
+#include "beamsim/markov.h"
+#include "cli_common.h"
+#include "cli_options.h"
+#include "cli_progress.h"
+
+enum { OWN_BINS, OWN_VMAX, OWN_ENTRIES, OWN_MAP, OWN_BOOTSTRAP };
+
+#define MAX_ENTRIES 16
+
+typedef struct markov_args {
+	bsim_markov_def def;
+	const char *map;
+	long bootstrap;
+	int n_entries;
+	const char *entries[MAX_ENTRIES];
+} markov_args;
+
+static int markov_option(void *args, int i, const char *value)
+{
+	markov_args *a = args;
+	char *end;
+	switch (i) {
+	case OWN_BINS: {
+		bsim_markov_bins *b = &a->def.bins;
+		if (sscanf(value, "%d,%d,%d", &b->n_pos, &b->n_speed, &b->n_dir) != 3 ||
+		    b->n_pos < 1 || b->n_speed < 1 || b->n_dir < 1 || b->n_pos > 64 ||
+		    b->n_speed > 64 || b->n_dir > 64 ||
+		    strspn(value, "0123456789,") != strlen(value))
+			return cli_usage("markov",
+			                 "--bins %s: expected P,S,D: 1 to 64 bins of "
+			                 "position, speed and direction, e.g. --bins 4,4,3",
+			                 value);
+		return CLI_OK;
+	}
+	case OWN_VMAX:
+		a->def.bins.v_max = strtod(value, &end);
+		if (end == value || *end || !(a->def.bins.v_max > 0) ||
+		    !isfinite(a->def.bins.v_max))
+			return cli_usage("markov", "--vmax %s: expected a speed > 0 in m/s", value);
+		return CLI_OK;
+	case OWN_ENTRIES:
+		if (a->n_entries == MAX_ENTRIES)
+			return cli_usage("markov", "--entries %s: at most %d", value, MAX_ENTRIES);
+		a->entries[a->n_entries++] = value;
+		return CLI_OK;
+	case OWN_MAP:
+		a->map = value;
+		return CLI_OK;
+	case OWN_BOOTSTRAP:
+		if (cli_parse_long(value, 0, 1000000, &a->bootstrap) != 0)
+			return cli_usage("markov",
+			                 "--bootstrap %s: expected an integer 0 to 1000000", value);
+		return CLI_OK;
+	}
+	return CLI_USAGE;
+}
+
+static const cli_own build_own[] = {
+        [OWN_BINS] = {"bins", 1, "P,S,D",
+                      "entry bins of position along the edge, speed and\n"
+                      "direction (default 4,4,3)"},
+        [OWN_VMAX] = {"vmax", 1, "V", "m/s, the top of the speed bins (default 40)"},
+        [OWN_ENTRIES] = {"entries", 1, "PATH",
+                         "gate_entries.csv of a lattice sweep (or its directory),\n"
+                         "repeatable: a bin's states are drawn from the entries\n"
+                         "that fall in it (default: uniformly in the bin)"},
+};
+
+static const char *const build_help[CLI_N_OPTS] = {
+        [CLI_OPT_OUT] = "the map directory: maps already there with the same key are\n"
+                        "reused, the others are built there (required)",
+        [CLI_OPT_TRIALS] = "single-gate trials per entry bin (default 200)",
+        [CLI_OPT_SEED] = "seed of the entry states and schedules (default 1)",
+};
+
+static const cli_spec build_spec = {
+        .name = "markov build",
+        .usage = "EXPERIMENT --out DIR [OPTIONS]",
+        .about = "Builds the single-gate maps the lattices of EXPERIMENT need, one per pair of\n"
+                 "beam stiffnesses: for every entry bin (edge, position along it, speed,\n"
+                 "direction; and the start) single gates with their beams at rest, as the\n"
+                 "essay's protocol resets them, run from states drawn in the bin with fresh\n"
+                 "random-force schedules until the body leaves the gate or is stuck; the\n"
+                 "counts of where it left are the map. DIR caches them: map_HASH.csv (entry,\n"
+                 "exit, count), map_HASH.key (everything the map depends on), markov.json.\n",
+        .positional = "EXPERIMENT",
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
+                  CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_BACKEND) |
+                  CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_QUIET),
+        .help = build_help,
+        .out_required = 1,
+        .own = build_own,
+        .n_own = 3,
+        .option = markov_option,
+};
+
+static const cli_own predict_own[] = {
+        {"map", 1, "DIR", "the map directory of beamsim markov build (required)"},
+};
+
+/* predict's and validate's own options: --map, --bootstrap. */
+static int map_option(void *args, int i, const char *value)
+{
+	return markov_option(args, OWN_MAP + i, value);
+}
+
+static const char *const predict_help[CLI_N_OPTS] = {
+        [CLI_OPT_OUT] = "also write prediction.csv, prediction_gates.csv and their\n"
+                        ".mat twins into DIR",
+};
+
+static const cli_spec predict_spec = {
+        .name = "markov predict",
+        .usage = "LATTICE_SCENE --map DIR [OPTIONS]",
+        .about = "Composes the maps in DIR over the lattice of LATTICE_SCENE into an absorbing\n"
+                 "Markov chain and prints the distribution of the final location (the end\n"
+                 "through column ix, a side at row iy, stuck in gate (ix, iy)) and of the\n"
+                 "number of gates visited.\n",
+        .positional = "LATTICE_SCENE",
+        .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT),
+        .help = predict_help,
+        .own = predict_own,
+        .n_own = 1,
+        .option = map_option,
+};
+
+static const cli_own validate_own[] = {
+        {"map", 1, "DIR", "the map directory of beamsim markov build (required)"},
+        {"bootstrap", 1, "B", "resamples of the simulation (default 2000)"},
+};
+
+static const char *const validate_help[CLI_N_OPTS] = {
+        [CLI_OPT_OUT] = "output directory (required)",
+};
+
+static const cli_spec validate_spec = {
+        .name = "markov validate",
+        .usage = "LATTICE_EXPERIMENT --map DIR --out DIR [OPTIONS]",
+        .about = "Simulates every group of LATTICE_EXPERIMENT directly, under the essay's\n"
+                 "protocol and as a whole world, predicts it with the chain of the maps in\n"
+                 "--map, and writes into --out: validate.json (total variation distance of\n"
+                 "the final-location distributions with the simulation's and the maps'\n"
+                 "sampling errors, mean gates visited, CPU time of simulation and\n"
+                 "prediction, the lattices after which building the maps pays off),\n"
+                 "validate.csv, gates.csv, their .mat twins and validate_gNNN (.png .svg).\n",
+        .positional = "LATTICE_EXPERIMENT",
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
+                  CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_QUIET),
+        .help = validate_help,
+        .out_required = 1,
+        .own = validate_own,
+        .n_own = 2,
+        .option = map_option,
+};
+
+static int markov_build(int argc, char **argv)
+{
+	cli_common c = cli_common_default();
+	markov_args a = {.def = bsim_markov_def_default()};
+	const char *path = NULL;
+	int rc = cli_parse(&build_spec, argc, argv, &c, &a, &path);
+	if (rc >= 0) {
+		cli_common_free(&c);
+		return rc;
+	}
+	bsim_options opts = {0};
+	const bsim_backend *be =
+	        cli_backend_with_opts(&c, "markov build", c.backend ? c.backend : "thesis", &opts);
+	if (!be) {
+		cli_common_free(&c);
+		return CLI_USAGE;
+	}
+	a.def.backend = be;
+	a.def.opts = &opts;
+	a.def.threads = (int)c.threads;
+	if (c.trials > 0)
+		a.def.trials = (int)c.trials;
+	if (c.has_seed)
+		a.def.seed = c.seed;
+	bsim_experiment e;
+	bsim_error err;
+	bsim_markov_entries entries = {0};
+	if (a.n_entries > 0) {
+		if ((rc = bsim_markov_entries_load(a.entries, a.n_entries, &entries, &err)) !=
+		    BSIM_OK) {
+			cli_common_free(&c);
+			return cli_report(rc, &err);
+		}
+		a.def.entries = &entries;
+	}
+	if ((rc = bsim_experiment_load(path, c.sets.ov, c.sets.n, &e, &err)) != BSIM_OK) {
+		bsim_markov_entries_free(&entries);
+		cli_common_free(&c);
+		return cli_report(rc, &err);
+	}
+	cli_progress progress;
+	cli_progress_init(&progress, !c.quiet, "single gates");
+	a.def.progress = cli_progress_update;
+	a.def.progress_user = &progress;
+	int built = 0, reused = 0;
+	double cpu = 0.0;
+	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++) {
+		bsim_scene scene;
+		rc = bsim_experiment_group_scene(&e, g, c.sets.ov, c.sets.n, &scene, &err);
+		if (rc != BSIM_OK)
+			break;
+		bsim_markov_set set;
+		rc = bsim_markov_build(&scene, &a.def, c.out, &set, &err);
+		bsim_scene_free(&scene);
+		if (rc != BSIM_OK)
+			break;
+		built += set.built;
+		reused += set.reused;
+		cpu += set.seconds;
+		for (int i = 0; i < set.n && !c.quiet; i++)
+			printf("group %d  k = %g, %g N m/rad  map_%016llx  %s\n", g,
+			       set.maps[i].k[0], set.maps[i].k[1],
+			       (unsigned long long)set.maps[i].key,
+			       set.maps[i].cached ? "reused" : "built");
+		bsim_markov_set_free(&set);
+	}
+	cli_progress_finish(&progress);
+	if (rc == BSIM_OK && !c.quiet)
+		printf("%d maps built (%.1f s of CPU), %d reused; %d entry bins x %d trials each, "
+		       "in %s\n",
+		       built, cpu, reused, bsim_markov_bins_count(&a.def.bins), a.def.trials,
+		       c.out);
+	bsim_experiment_free(&e);
+	bsim_markov_entries_free(&entries);
+	cli_common_free(&c);
+	return cli_report(rc, &err);
+}
+
+static int markov_predict(int argc, char **argv)
+{
+	cli_common c = cli_common_default();
+	markov_args a = {.def = bsim_markov_def_default()};
+	const char *path = NULL;
+	int rc = cli_parse(&predict_spec, argc, argv, &c, &a, &path);
+	if (rc < 0 && !a.map)
+		rc = cli_usage("markov predict", "--map DIR is required");
+	if (rc >= 0) {
+		cli_common_free(&c);
+		return rc;
+	}
+	bsim_scene scene;
+	bsim_error err;
+	if ((rc = bsim_scene_load(path, c.sets.ov, c.sets.n, &scene, &err)) != BSIM_OK) {
+		cli_common_free(&c);
+		return cli_report(rc, &err);
+	}
+	bsim_options opts;
+	bsim_markov_set set;
+	bsim_markov_prediction p = {0};
+	rc = bsim_markov_load(&scene, a.map, &opts, &set, &err);
+	if (rc == BSIM_OK)
+		rc = bsim_markov_predict(&scene, &set, &p, &err);
+	if (rc == BSIM_OK && c.out)
+		rc = bsim_markov_prediction_store(c.out, &p, &err);
+	if (rc == BSIM_OK) {
+		printf("lattice     %s (%s): %d x %d gates, %d maps, %d states (%s)\n", path,
+		       scene.name, scene.lattice.columns, scene.lattice.rows, set.n, p.n_states,
+		       p.exact ? "LU" : "series");
+		printf("\nlocation       p\n");
+		for (int i = 0; i < p.n_locations; i++) {
+			if (p.p[i] < 5e-5)
+				continue;
+			char label[48];
+			bsim_lattice_location_label(p.loc[i], label, sizeof label);
+			printf("%-12s %7.4f\n", label, p.p[i]);
+		}
+		printf("\ngates visited: mean %.2f (%d terms of the series)", p.mean_gates,
+		       p.n_gates);
+		if (p.left_in_field > 1e-12)
+			printf(" (the series stopped with %.2g still in the field)",
+			       p.left_in_field);
+		printf("\n");
+	}
+	bsim_markov_prediction_free(&p);
+	bsim_markov_set_free(&set);
+	bsim_scene_free(&scene);
+	cli_common_free(&c);
+	return cli_report(rc, &err);
+}
+
+static int markov_validate(int argc, char **argv)
+{
+	cli_common c = cli_common_default();
+	markov_args a = {.def = bsim_markov_def_default(), .bootstrap = -1};
+	const char *path = NULL;
+	int rc = cli_parse(&validate_spec, argc, argv, &c, &a, &path);
+	if (rc < 0 && !a.map)
+		rc = cli_usage("markov validate", "--map DIR is required");
+	if (rc >= 0) {
+		cli_common_free(&c);
+		return rc;
+	}
+	bsim_markov_validate_def def = bsim_markov_validate_default();
+	def.experiment = path;
+	def.map_dir = a.map;
+	def.out = c.out;
+	def.sets = c.sets.ov;
+	def.n_sets = c.sets.n;
+	def.trials = c.trials;
+	def.has_seed = c.has_seed;
+	def.seed = c.seed;
+	def.threads = (int)c.threads;
+	if (a.bootstrap >= 0)
+		def.bootstrap = (int)a.bootstrap;
+	cli_progress progress;
+	cli_progress_init(&progress, !c.quiet, "trials");
+	def.progress = cli_progress_update;
+	def.progress_user = &progress;
+	bsim_markov_validation v;
+	bsim_error err;
+	rc = bsim_markov_validate(&def, &v, &err);
+	cli_progress_finish(&progress);
+	if (rc == BSIM_OK && !c.quiet) {
+		printf("maps        %s: %d entry bins x %d trials, %.1f s of CPU to build\n\n",
+		       a.map, v.bins, v.trials_per_bin, v.map_cost);
+		printf("group protocol trials    TV  sampling (95%%)   map   gates sim/chain  "
+		       "sim CPU s  predict s   speedup\n");
+		for (int i = 0; i < v.n; i++) {
+			const bsim_markov_check *k = &v.checks[i];
+			printf("%5d %-8s %6d %5.3f  %5.3f (%5.3f)  %5.3f   %5.2f / %5.2f  %9.3f  "
+			       "%9.2e  "
+			       "%8.3g\n",
+			       k->group, k->protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world",
+			       k->trials, k->tv, k->tv_sampling, k->tv_sampling95, k->tv_map,
+			       k->gates_sim, k->gates_chain, k->sim_cpu, k->predict,
+			       k->sim_cpu / k->predict);
+		}
+		printf("\nwrote       %s/: validate.json, validate.csv, gates.csv (+ .mat), "
+		       "validate_gNNN (.png .svg .gp)\n",
+		       c.out);
+	}
+	bsim_markov_validation_free(&v);
+	cli_common_free(&c);
+	return cli_report(rc, &err);
+}
+
+int cmd_markov(int argc, char **argv)
+{
+	static const char *const subs[] = {"build", "predict", "validate"};
+	if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
+		FILE *f = argc < 2 ? stderr : stdout;
+		fputs("Usage: beamsim markov build EXPERIMENT --out DIR [OPTIONS]\n"
+		      "       beamsim markov predict LATTICE_SCENE --map DIR [OPTIONS]\n"
+		      "       beamsim markov validate LATTICE_EXPERIMENT --map DIR --out DIR "
+		      "[OPTIONS]\n"
+		      "       beamsim markov SUBCOMMAND --help\n"
+		      "\n"
+		      "Predicts where a body ends in a gate lattice from single-gate maps: the\n"
+		      "absorbing Markov chain of the essay's Sec. 3.3 (docs/markov.md).\n",
+		      f);
+		return argc < 2 ? CLI_USAGE : CLI_OK;
+	}
+	if (strcmp(argv[1], "build") == 0)
+		return markov_build(argc - 1, argv + 1);
+	if (strcmp(argv[1], "predict") == 0)
+		return markov_predict(argc - 1, argv + 1);
+	if (strcmp(argv[1], "validate") == 0)
+		return markov_validate(argc - 1, argv + 1);
+	const char *near = cli_nearest(argv[1], subs, 3);
+	if (near)
+		return cli_usage("markov", "unknown subcommand '%s'; did you mean '%s'?", argv[1],
+		                 near);
+	return cli_usage("markov", "unknown subcommand '%s' (expected build, predict or validate)",
+	                 argv[1]);
+}

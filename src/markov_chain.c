@@ -1,0 +1,365 @@
+/* The absorbing Markov chain of a gate lattice composed from single-gate
+ * maps, and its solution (beamsim/markov.h).
+ *
+ * States. Transient: (gate, entry bin), index g n_bins + bin with g = iy
+ * columns + (ix - ix_min). Absorbing: the final locations, index
+ *   ix - ix_min                              the end through column ix
+ *   columns + iy                             a side at row iy
+ *   columns + rows + iy columns + ix - ix_min  stuck in gate (ix, iy)
+ * Gate g's map row `bin` sends probability counts / trials to each exit: 0
+ * to stuck in g; an entry bin of the gate the body enters, or, past the
+ * field's edge, the end (the top of the last row) or a side (the outer
+ * edge of an outer column). A body leaving row 0 downwards stays in row 0's
+ * gate in the lattice; the chain lets it enter that gate again through its
+ * bottom edge, with the same position, speed and direction bins.
+ *
+ * Solution. p = s (I - Q)^-1 R. Exactly: y (I - Q) = s, i.e. (I - Q)^T y^T
+ * = s^T, by LU (GSL) for at most BSIM_MARKOV_LU_MAX states; y is the
+ * expected number of visits of each state and p = y R. Always, the series
+ * s Q^(k-1) R, k = 1, 2, ..., whose k-th term is the probability of ending
+ * after the k-th gate entered: the distribution of gates visited, and p
+ * where the chain is too large for LU. It stops when less than 1e-12 is
+ * left in the field (or after 1e6 terms, said in left_in_field). */
+#include "beamsim/markov.h"
+
+#include <gsl/gsl_linalg.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SERIES_TOL 1e-12
+#define SERIES_MAX 1000000
+
+/* One nonzero transition of a map row. */
+typedef struct arc {
+	int exit;
+	double p;
+} arc;
+
+/* A map's rows as arcs: row a is arcs[first[a] .. first[a + 1]). */
+typedef struct sparse_map {
+	int *first;
+	arc *arcs;
+} sparse_map;
+
+static int sparse_init(sparse_map *s, const bsim_markov_map *m)
+{
+	const int nb = m->n_bins;
+	long nnz = 0;
+	for (long i = 0; i < (long)nb * nb; i++)
+		nnz += m->counts[i] != 0;
+	s->first = malloc((size_t)(nb + 1) * sizeof *s->first);
+	s->arcs = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *s->arcs);
+	if (!s->first || !s->arcs)
+		return -1;
+	int k = 0;
+	for (int a = 0; a < nb; a++) {
+		s->first[a] = k;
+		long total = 0;
+		for (int x = 0; x < nb; x++)
+			total += m->counts[(size_t)a * nb + x];
+		for (int x = 0; x < nb; x++) {
+			int c = m->counts[(size_t)a * nb + x];
+			if (c)
+				s->arcs[k++] = (arc){x, (double)c / (double)total};
+		}
+	}
+	s->first[nb] = k;
+	return 0;
+}
+
+/* Where exit x of gate (ix, iy) leads: *state >= 0 a transient state, else
+ * *loc an absorbing location. */
+typedef struct chain {
+	const bsim_lattice_def *l;
+	const bsim_markov_bins *b;
+	int nb, cols, rows, n_loc, n_states;
+	int per_edge;   /* bins per edge */
+	int *gate_map;  /* gate -> map index */
+	sparse_map *sm; /* per map */
+	/* The composed chain: state s's arcs are to[first[s] .. first[s + 1])
+	 * with probabilities p[]; to >= 0 a state, else -1 - location. */
+	int *first, *to;
+	double *p;
+} chain;
+
+static void target(const chain *c, int g, int x, int *state, int *loc)
+{
+	const int ix = g % c->cols, iy = g / c->cols;
+	*state = -1;
+	*loc = -1;
+	if (x == 0) {
+		*loc = c->cols + c->rows + g;
+		return;
+	}
+	int edge = BSIM_EDGE_BOTTOM + (x - 1) / c->per_edge;
+	int jx = ix, jy = iy;
+	switch (edge) {
+	case BSIM_EDGE_BOTTOM: /* into the gate above */
+		if (++jy == c->rows) {
+			*loc = ix;
+			return;
+		}
+		break;
+	case BSIM_EDGE_TOP: /* into the gate below */
+		if (--jy < 0) {
+			jy = 0;
+			x -= (BSIM_EDGE_TOP - BSIM_EDGE_BOTTOM) * c->per_edge;
+		}
+		break;
+	case BSIM_EDGE_LEFT: /* into the gate on the right */
+		if (++jx == c->cols) {
+			*loc = c->cols + iy;
+			return;
+		}
+		break;
+	default: /* into the gate on the left */
+		if (--jx < 0) {
+			*loc = c->cols + iy;
+			return;
+		}
+		break;
+	}
+	*state = (jy * c->cols + jx) * c->nb + x;
+}
+
+void bsim_markov_prediction_free(bsim_markov_prediction *p)
+{
+	if (!p)
+		return;
+	free(p->loc);
+	free(p->p);
+	free(p->p_gates);
+	memset(p, 0, sizeof *p);
+}
+
+static void chain_free(chain *c, int n_maps)
+{
+	for (int i = 0; c->sm && i < n_maps; i++) {
+		free(c->sm[i].first);
+		free(c->sm[i].arcs);
+	}
+	free(c->sm);
+	free(c->gate_map);
+	free(c->first);
+	free(c->to);
+	free(c->p);
+}
+
+static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set *set,
+                      bsim_error *err)
+{
+	memset(c, 0, sizeof *c);
+	const bsim_lattice_def *l = &lattice->lattice;
+	c->l = l;
+	c->b = &set->def.bins;
+	c->nb = bsim_markov_bins_count(c->b);
+	c->per_edge = c->b->n_pos * c->b->n_speed * c->b->n_dir;
+	c->cols = l->columns;
+	c->rows = l->rows;
+	c->n_loc = c->cols + c->rows + c->cols * c->rows;
+	c->n_states = c->cols * c->rows * c->nb;
+	c->gate_map = malloc((size_t)c->cols * c->rows * sizeof *c->gate_map);
+	c->sm = calloc((size_t)(set->n > 0 ? set->n : 1), sizeof *c->sm);
+	if (!c->gate_map || !c->sm)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; i < set->n; i++) {
+		if (set->maps[i].n_bins != c->nb)
+			return bsim_error_set(err, BSIM_EINPUT, "map %d has %d bins, the set %d", i,
+			                      set->maps[i].n_bins, c->nb);
+		if (sparse_init(&c->sm[i], &set->maps[i]) != 0)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	for (int iy = 0; iy < c->rows; iy++)
+		for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
+			double k[2] = {lattice->beams[bsim_lattice_beam(l, ix, iy, 0)].stiffness,
+			               lattice->beams[bsim_lattice_beam(l, ix, iy, 1)].stiffness};
+			int j = 0;
+			while (j < set->n &&
+			       !(set->maps[j].k[0] == k[0] && set->maps[j].k[1] == k[1]))
+				j++;
+			if (j == set->n)
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "no map for gate (%d, %d), k = %g, %g N m/rad", ix, iy,
+				        k[0], k[1]);
+			c->gate_map[iy * c->cols + ix - l->ix_min] = j;
+		}
+	/* Compose: every state's arcs resolved once. */
+	long nnz = 0;
+	for (int g = 0; g < c->cols * c->rows; g++) {
+		const sparse_map *sm = &c->sm[c->gate_map[g]];
+		nnz += sm->first[c->nb];
+	}
+	c->first = malloc(((size_t)c->n_states + 1) * sizeof *c->first);
+	c->to = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *c->to);
+	c->p = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *c->p);
+	if (!c->first || !c->to || !c->p)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	int k = 0;
+	for (int s = 0; s < c->n_states; s++) {
+		c->first[s] = k;
+		int g = s / c->nb, a = s % c->nb;
+		const sparse_map *sm = &c->sm[c->gate_map[g]];
+		for (int j = sm->first[a]; j < sm->first[a + 1]; j++, k++) {
+			int state, loc;
+			target(c, g, sm->arcs[j].exit, &state, &loc);
+			c->to[k] = state >= 0 ? state : -1 - loc;
+			c->p[k] = sm->arcs[j].p;
+		}
+	}
+	c->first[c->n_states] = k;
+	return BSIM_OK;
+}
+
+/* The series from the start state: p_loc (n_loc), p_gates (grown as
+ * needed), the probability left. */
+static int series(const chain *c, int start, double *p_loc, double **p_gates, int *n_gates,
+                  double *left)
+{
+	double *cur = calloc((size_t)c->n_states, sizeof *cur);
+	double *next = calloc((size_t)c->n_states, sizeof *next);
+	int cap = 64;
+	double *pg = calloc((size_t)cap + 1, sizeof *pg);
+	if (!cur || !next || !pg) {
+		free(cur);
+		free(next);
+		free(pg);
+		return -1;
+	}
+	cur[start] = 1.0;
+	double in_field = 1.0;
+	int k = 0;
+	while (in_field > SERIES_TOL && k < SERIES_MAX) {
+		k++;
+		if (k > cap) {
+			double *np = realloc(pg, ((size_t)2 * cap + 1) * sizeof *pg);
+			if (!np) {
+				free(cur);
+				free(next);
+				free(pg);
+				return -1;
+			}
+			memset(np + cap + 1, 0, (size_t)cap * sizeof *np);
+			pg = np;
+			cap *= 2;
+		}
+		double absorbed = 0.0;
+		in_field = 0.0;
+		for (int s = 0; s < c->n_states; s++) {
+			double m = cur[s];
+			if (m == 0.0)
+				continue;
+			cur[s] = 0.0;
+			for (int j = c->first[s]; j < c->first[s + 1]; j++) {
+				int to = c->to[j];
+				double q = m * c->p[j];
+				if (to >= 0) {
+					next[to] += q;
+					in_field += q;
+				} else {
+					p_loc[-1 - to] += q;
+					absorbed += q;
+				}
+			}
+		}
+		pg[k] = absorbed;
+		double *t = cur;
+		cur = next;
+		next = t;
+	}
+	free(cur);
+	free(next);
+	*p_gates = pg;
+	*n_gates = k;
+	*left = in_field;
+	return 0;
+}
+
+/* p_loc by LU of (I - Q)^T y = e_start. */
+static int lu_solve(const chain *c, int start, double *p_loc)
+{
+	const int n = c->n_states;
+	gsl_matrix *A = gsl_matrix_calloc((size_t)n, (size_t)n);
+	gsl_vector *e = gsl_vector_calloc((size_t)n);
+	gsl_vector *y = gsl_vector_alloc((size_t)n);
+	gsl_permutation *perm = gsl_permutation_alloc((size_t)n);
+	int rc = -1, sign;
+	if (!A || !e || !y || !perm)
+		goto done;
+	for (int s = 0; s < n; s++) {
+		gsl_matrix_set(A, (size_t)s, (size_t)s, 1.0);
+		for (int j = c->first[s]; j < c->first[s + 1]; j++) {
+			int to = c->to[j];
+			if (to >= 0) /* A = (I - Q)^T: A[to][s] -= Q[s][to] */
+				gsl_matrix_set(A, (size_t)to, (size_t)s,
+				               gsl_matrix_get(A, (size_t)to, (size_t)s) - c->p[j]);
+		}
+	}
+	gsl_vector_set(e, (size_t)start, 1.0);
+	if (gsl_linalg_LU_decomp(A, perm, &sign) || gsl_linalg_LU_solve(A, perm, e, y))
+		goto done;
+	for (int s = 0; s < n; s++) {
+		double visits = gsl_vector_get(y, (size_t)s);
+		if (visits == 0.0)
+			continue;
+		for (int j = c->first[s]; j < c->first[s + 1]; j++)
+			if (c->to[j] < 0)
+				p_loc[-1 - c->to[j]] += visits * c->p[j];
+	}
+	rc = 0;
+done:
+	gsl_matrix_free(A);
+	gsl_vector_free(e);
+	gsl_vector_free(y);
+	gsl_permutation_free(perm);
+	return rc;
+}
+
+int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
+                        bsim_markov_prediction *out, bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	if (!lattice->has_lattice)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: not a gate lattice", lattice->name);
+	chain c;
+	int rc = chain_init(&c, lattice, set, err);
+	const bsim_lattice_def *l = &lattice->lattice;
+	if (rc == BSIM_OK) {
+		out->n_locations = c.n_loc;
+		out->n_states = c.n_states;
+		out->loc = malloc((size_t)c.n_loc * sizeof *out->loc);
+		out->p = calloc((size_t)c.n_loc, sizeof *out->p);
+		if (!out->loc || !out->p)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	if (rc == BSIM_OK) {
+		for (int i = 0; i < c.cols; i++)
+			out->loc[i] = (bsim_location){BSIM_LOCATION_END, l->ix_min + i, 0};
+		for (int i = 0; i < c.rows; i++)
+			out->loc[c.cols + i] = (bsim_location){BSIM_LOCATION_SIDE, 0, i};
+		for (int g = 0; g < c.cols * c.rows; g++)
+			out->loc[c.cols + c.rows + g] = (bsim_location){
+			        BSIM_LOCATION_STUCK, l->ix_min + g % c.cols, g / c.cols};
+		int ix, iy;
+		bsim_lattice_gate_at(lattice, lattice->body.start, &ix, &iy);
+		int start = ((iy * c.cols) + ix - l->ix_min) * c.nb;
+		if (series(&c, start, out->p, &out->p_gates, &out->n_gates, &out->left_in_field))
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		if (rc == BSIM_OK && c.n_states <= BSIM_MARKOV_LU_MAX) {
+			memset(out->p, 0, (size_t)c.n_loc * sizeof *out->p);
+			if (lu_solve(&c, start, out->p))
+				rc = bsim_error_set(
+				        err, BSIM_EFAIL,
+				        "the chain's LU solve failed (out of memory or a "
+				        "singular I - Q: a set of states never left)");
+			out->exact = 1;
+		}
+		for (int k = 1; rc == BSIM_OK && k <= out->n_gates; k++)
+			out->mean_gates += k * out->p_gates[k];
+	}
+	chain_free(&c, set->n);
+	if (rc != BSIM_OK)
+		bsim_markov_prediction_free(out);
+	return rc;
+}

@@ -1,0 +1,52 @@
+#!/bin/sh
+# The installed package as a user meets it: `cmake --install` into a fresh
+# prefix, examples/ configured and built against it with
+# find_package(beamsim CONFIG) (shared and static), the same program
+# compiled with `pkg-config --cflags --libs beamsim` alone, and all three
+# runs giving the installed program's own answer: the sweep's p_traverse
+# per group equals that of `beamsim sweep` on the same experiment, trials
+# and seed.
+#   install_package.sh BUILD_DIR SOURCE_DIR WORK_DIR
+set -eu
+build=$1 src=$2 work=$3
+rm -rf "$work"
+mkdir -p "$work"
+prefix=$work/prefix
+cmake --install "$build" --prefix "$prefix" >"$work/install.log"
+exp=$prefix/share/beamsim/configs/thesis/h1_symmetric.yaml
+test -f "$exp" || { echo "not installed: $exp"; exit 1; }
+
+cmake -S "$src/examples" -B "$work/examples" -DCMAKE_PREFIX_PATH="$prefix" \
+      -DCMAKE_BUILD_TYPE=Release >"$work/configure.log"
+cmake --build "$work/examples" >"$work/build.log"
+
+pcdir=$(dirname "$(find "$prefix" -name beamsim.pc)")
+libdir=$(dirname "$pcdir")
+PKG_CONFIG_PATH=$pcdir cc -std=c17 -Wall -Werror -o "$work/pc_example" \
+    "$src/examples/trial_and_sweep.c" $(PKG_CONFIG_PATH=$pcdir pkg-config --cflags --libs beamsim)
+
+"$work/examples/trial_and_sweep" "$exp" 20 >"$work/shared.txt"
+"$work/examples/trial_and_sweep_static" "$exp" 20 >"$work/static.txt"
+LD_LIBRARY_PATH=$libdir "$work/pc_example" "$exp" 20 >"$work/pc.txt"
+
+# The shared library brings only the bsim_ functions.
+if nm -D --defined-only "$libdir/libbeamsim.so" | awk '{print $3}' | grep -v '^bsim_' | grep .; then
+    echo "libbeamsim.so exports symbols outside bsim_"; exit 1
+fi
+
+# Wall time aside, the three runs print the same.
+for f in shared static pc; do
+    sed 's/ in [0-9.]* s$//' "$work/$f.txt" >"$work/$f.cmp"
+done
+cmp "$work/shared.cmp" "$work/static.cmp"
+cmp "$work/shared.cmp" "$work/pc.cmp"
+grep -q '^thesis ' "$work/shared.txt" && grep -q '^box2d ' "$work/shared.txt"
+
+# The library's sweep is the program's.
+"$prefix/bin/beamsim" sweep "$exp" --trials 20 --quiet --out "$work/cli"
+grep -o '"p_traverse": *[0-9.e+-]*' "$work/cli/summary.json" | sed 's/.*: *//' |
+    awk '{printf "%.3f\n", $1}' >"$work/cli_p.txt"
+grep '^group' "$work/shared.txt" | awk '{print $4}' >"$work/lib_p.txt"
+test -s "$work/lib_p.txt"
+cmp "$work/lib_p.txt" "$work/cli_p.txt"
+echo "installed package: shared, static and pkg-config builds agree with beamsim sweep"

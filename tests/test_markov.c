@@ -1,0 +1,475 @@
+/* The Markov chain of a gate lattice (beamsim/markov.h) against
+ * independent truths:
+ *   - on one gate the chain is the map itself, and on a column of two
+ *     gates with a loop between them it is the closed form of a geometric
+ *     series, by LU and by the series alike;
+ *   - probability is conserved: the final locations and the gates visited
+ *     each sum to one on the C-track;
+ *   - on a field of one gate, where the essay's protocol is exact, the
+ *     chain's probability of each outcome agrees with direct simulation of
+ *     independent trials within their sampling error;
+ *   - the map is the same with 1 and 2 threads; its cache reuses a map only
+ *     when nothing it depends on changed;
+ *   - a bad input exits 2 naming what is wrong and writes nothing. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <cmocka.h>
+
+#include "beamsim/lattice.h"
+#include "beamsim/markov.h"
+#include "beamsim/schedule.h"
+#include "beamsim/trial.h"
+#include "support.h"
+
+static void near(double a, double b, double eps, int line)
+{
+	if (!(fabs(a - b) <= eps))
+		fail_msg("line %d: %.17g is not %.17g within %g", line, a, b, eps);
+}
+#define assert_double_equal(a, b, eps) near((a), (b), (eps), __LINE__)
+
+/* Bins of one position, speed and direction: bin 0 the start, 1 bottom, 2
+ * left, 3 right, 4 top (the edge the next gate is entered through). */
+enum { START = 0, BOTTOM = 1, LEFT = 2, RIGHT = 3, TOP = 4, NB = 5 };
+
+static bsim_markov_set hand_set(double k, const int rows[][NB], int n_rows, const int *which)
+{
+	bsim_markov_set s = {0};
+	s.def = bsim_markov_def_default();
+	s.def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
+	s.n = 1;
+	s.maps = calloc(1, sizeof *s.maps);
+	s.maps[0].k[0] = s.maps[0].k[1] = k;
+	s.maps[0].n_bins = NB;
+	s.maps[0].counts = calloc(NB * NB, sizeof(int));
+	for (int i = 0; i < n_rows; i++)
+		memcpy(s.maps[0].counts + which[i] * NB, rows[i], sizeof rows[i]);
+	return s;
+}
+
+static double p_of(const bsim_markov_prediction *p, bsim_location_kind kind, int ix, int iy)
+{
+	for (int i = 0; i < p->n_locations; i++)
+		if (p->loc[i].kind == kind && p->loc[i].ix == ix && p->loc[i].iy == iy)
+			return p->p[i];
+	fail_msg("no location %d %d %d", kind, ix, iy);
+	return NAN;
+}
+
+/* One gate: the chain's final locations are the start row of the map. */
+static void test_one_gate_is_the_map(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 1, 6, 30), BSIM_OK);
+	/* counts out of 100: stuck 40, on into the gate above (the end) 30,
+	 * out left 20 (a side), out right 10 (a side) */
+	const int rows[][NB] = {{40, 30, 10, 20, 0}};
+	const int which[] = {START};
+	bsim_markov_set set = hand_set(400, rows, 1, which);
+	bsim_markov_prediction p;
+	bsim_error err;
+	assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
+	assert_true(p.exact);
+	assert_double_equal(p_of(&p, BSIM_LOCATION_END, 0, 0), 0.30, 1e-15);
+	assert_double_equal(p_of(&p, BSIM_LOCATION_SIDE, 0, 0), 0.30, 1e-15);
+	assert_double_equal(p_of(&p, BSIM_LOCATION_STUCK, 0, 0), 0.40, 1e-15);
+	assert_double_equal(p.p_gates[1], 1.0, 1e-15);
+	assert_double_equal(p.mean_gates, 1.0, 1e-15);
+	bsim_markov_prediction_free(&p);
+	bsim_markov_set_free(&set);
+	bsim_scene_free(&s);
+}
+
+/* Two gates in a column with a loop: from the start, a goes up into gate
+ * (0, 1) (its bottom bin), the rest is stuck; from its bottom bin gate 1
+ * sends b to the end, c back down into gate 0 (its top bin), the rest
+ * stuck; from its top bin gate 0 sends d up again, the rest out to a side.
+ * With r = c d the loop's gain:
+ *   P(end) = a b / (1 - r), P(side:0) = a c (1 - d) / (1 - r),
+ *   P(k gates) = a b r^j for k = 2 + 2 j, a c (1 - d) r^j for k = 3 + 2 j. */
+static void test_two_gates_geometric(void **state)
+{
+	(void)state;
+	const double a = 0.6, b = 0.5, c = 0.3, d = 0.7, r = c * d;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 2, 6, 30), BSIM_OK);
+	const int rows[][NB] = {
+	        {40, 60, 0, 0, 0},  /* start: stuck 0.4, up 0.6 */
+	        {20, 50, 0, 0, 30}, /* bottom bin: stuck 0.2, end 0.5, down 0.3 */
+	        {0, 70, 30, 0, 0},  /* top bin: up 0.7, out right 0.3 (a side) */
+	};
+	const int which[] = {START, BOTTOM, TOP};
+	bsim_markov_set set = hand_set(400, rows, 3, which);
+	bsim_markov_prediction p;
+	bsim_error err;
+	assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
+	assert_true(p.exact);
+	assert_double_equal(p_of(&p, BSIM_LOCATION_END, 0, 0), a * b / (1 - r), 1e-13);
+	assert_double_equal(p_of(&p, BSIM_LOCATION_SIDE, 0, 0), a * c * (1 - d) / (1 - r), 1e-13);
+	assert_double_equal(p_of(&p, BSIM_LOCATION_STUCK, 0, 0), 0.4, 1e-13);
+	assert_double_equal(p_of(&p, BSIM_LOCATION_STUCK, 0, 1), a * 0.2 / (1 - r), 1e-13);
+	for (int j = 0; j < 5; j++) {
+		assert_double_equal(p.p_gates[2 + 2 * j], a * b * pow(r, j) + a * 0.2 * pow(r, j),
+		                    1e-13);
+		assert_double_equal(p.p_gates[3 + 2 * j], a * c * (1 - d) * pow(r, j), 1e-13);
+	}
+	/* The series alone gives the same: the LU's answer is not the only one. */
+	double sum = 0.0;
+	for (int k = 1; k <= p.n_gates; k++)
+		sum += p.p_gates[k];
+	assert_double_equal(sum, 1.0, 1e-12);
+	bsim_markov_prediction_free(&p);
+	bsim_markov_set_free(&set);
+	bsim_scene_free(&s);
+}
+
+static const char *exe_dir(const char *name)
+{
+	static char buf[1024];
+	snprintf(buf, sizeof buf, "%s", bsim_test_dir(name));
+	return buf;
+}
+
+/* The C-track with maps of few trials: everything sums to one, by the
+ * series (too many states for LU), and the answer is a distribution over
+ * the field's own locations. */
+static void test_conservation(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_error err;
+	assert_int_equal(
+	        bsim_scene_load(bsim_test_src("configs/lattice/c_track.yaml"), NULL, 0, &s, &err),
+	        BSIM_OK);
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){2, 2, 2, 40.0};
+	def.trials = 4;
+	bsim_markov_set set;
+	const char *dir = exe_dir("conservation");
+	assert_int_equal(bsim_markov_build(&s, &def, dir, &set, &err), BSIM_OK);
+	assert_int_equal(set.n, 2); /* k = 100 and 400 */
+	bsim_markov_prediction p;
+	assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
+	double sum = 0.0, sum_gates = 0.0;
+	for (int i = 0; i < p.n_locations; i++) {
+		assert_true(p.p[i] >= 0.0);
+		sum += p.p[i];
+	}
+	for (int k = 1; k <= p.n_gates; k++)
+		sum_gates += p.p_gates[k];
+	assert_int_equal(p.n_locations, 9 + 9 + 81);
+	assert_false(p.exact);
+	assert_true(p.left_in_field <= 1e-12);
+	assert_double_equal(sum, 1.0, 1e-11);
+	assert_double_equal(sum_gates, 1.0, 1e-11);
+	bsim_markov_prediction_free(&p);
+	bsim_markov_set_free(&set);
+	bsim_scene_free(&s);
+}
+
+/* One gate, where the essay's protocol is the whole world: the chain from a
+ * map of 400 start trials against 400 independent trials of the lattice
+ * run directly, each outcome within 4.5 standard errors of the difference
+ * (the maps' and the simulation's sampling errors together). */
+static void test_one_gate_against_simulation(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 1, 6, 30), BSIM_OK);
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
+	def.trials = 400;
+	def.seed = 11;
+	bsim_markov_set set;
+	bsim_error err;
+	assert_int_equal(bsim_markov_build(&s, &def, exe_dir("one_gate"), &set, &err), BSIM_OK);
+	bsim_markov_prediction p;
+	assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
+	const int N = 400;
+	double sim[3] = {0, 0, 0};
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
+	const bsim_options none = {0};
+	for (int t = 0; t < N; t++) {
+		bsim_trial_result res;
+		assert_int_equal(bsim_trial_run(r, &s, bsim_backend_default(), &none,
+		                                bsim_schedule_seed_mix(99, 0, (uint64_t)t), NULL,
+		                                &res, &err),
+		                 BSIM_OK);
+		sim[bsim_lattice_location_of(&res).kind] += 1.0 / N;
+	}
+	bsim_trial_runner_free(r);
+	const double chain[3] = {p_of(&p, BSIM_LOCATION_END, 0, 0),
+	                         p_of(&p, BSIM_LOCATION_SIDE, 0, 0),
+	                         p_of(&p, BSIM_LOCATION_STUCK, 0, 0)};
+	int informative = 0;
+	for (int k = 0; k < 3; k++) {
+		double q = 0.5 * (sim[k] + chain[k]);
+		double se = sqrt(2.0 * q * (1.0 - q) / N) + 1e-9;
+		print_message("outcome %d: chain %.3f, simulation %.3f (se %.3f)\n", k, chain[k],
+		              sim[k], se);
+		assert_true(fabs(sim[k] - chain[k]) <= 4.5 * se);
+		informative += q > 0.05 && q < 0.95;
+	}
+	assert_true(informative >= 2); /* the test can tell outcomes apart */
+	bsim_markov_prediction_free(&p);
+	bsim_markov_set_free(&set);
+	bsim_scene_free(&s);
+}
+
+static char *map_text(const char *dir)
+{
+	char cmd[1400];
+	snprintf(cmd, sizeof cmd, "cat %s/map_*.csv", dir);
+	FILE *f = popen(cmd, "r");
+	assert_non_null(f);
+	size_t cap = 1 << 20, len = 0;
+	char *buf = malloc(cap);
+	len = fread(buf, 1, cap - 1, f);
+	buf[len] = '\0';
+	pclose(f);
+	return buf;
+}
+
+/* Threads change nothing; the cache reuses only what nothing changed. */
+static void test_threads_and_cache(void **state)
+{
+	(void)state;
+	char d1[1024], d2[1024];
+	snprintf(d1, sizeof d1, "%s", bsim_test_dir("threads1"));
+	snprintf(d2, sizeof d2, "%s", bsim_test_dir("threads2"));
+	const char *exp = bsim_test_src("configs/lattice/c_track_essay.yaml");
+	const char *b1[] = {"markov", "build",   exp,     "--trials", "3", "--threads",
+	                    "1",      "--quiet", "--out", d1,         NULL};
+	const char *b2[] = {"markov", "build",   exp,     "--trials", "3", "--threads",
+	                    "2",      "--quiet", "--out", d2,         NULL};
+	assert_int_equal(bsim_test_cli(b1, NULL, NULL), 0);
+	assert_int_equal(bsim_test_cli(b2, NULL, NULL), 0);
+	char *t1 = map_text(d1), *t2 = map_text(d2);
+	assert_true(strlen(t1) > 1000);
+	assert_string_equal(t1, t2);
+	free(t1);
+	free(t2);
+
+	/* The same again: both maps reused. */
+	char *out = NULL;
+	const char *again[] = {"markov", "build", exp, "--trials", "3", "--out", d1, NULL};
+	assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
+	assert_non_null(strstr(out, "0 maps built"));
+	assert_non_null(strstr(out, "2 reused"));
+	free(out);
+	/* Anything the maps depend on: new maps, none reused. */
+	const char *changes[][4] = {{"--trials", "3", "--set", "contact.restitution=0.7"},
+	                            {"--trials", "3", "--set", "lattice.beam.damping=40"},
+	                            {"--trials", "3", "--set", "integration.dt=0.002"},
+	                            {"--trials", "3", "--seed", "2"},
+	                            {"--trials", "4", "--threads", "2"},
+	                            {"--trials", "3", "--backend-opt", "integrator=euler"}};
+	for (int i = 0; i < 6; i++) {
+		const char *argv[] = {
+		        "markov",      "build", exp, changes[i][0], changes[i][1], changes[i][2],
+		        changes[i][3], "--out", d1,  NULL};
+		out = NULL;
+		assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
+		if (!strstr(out, "2 maps built") || !strstr(out, "0 reused"))
+			print_error("%s %s: %s\n", changes[i][2], changes[i][3], out);
+		assert_non_null(strstr(out, "2 maps built"));
+		assert_non_null(strstr(out, "0 reused"));
+		free(out);
+	}
+	/* predict reads only what the last build's settings and this scene's
+	 * physics key: a scene the maps were not built for is refused. */
+	char *err = NULL;
+	const char *pred[] = {"markov",
+	                      "predict",
+	                      bsim_test_src("configs/lattice/c_track.yaml"),
+	                      "--set",
+	                      "effects.random_force.magnitude=29",
+	                      "--map",
+	                      d2,
+	                      NULL};
+	assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
+	assert_non_null(strstr(err, "no map for k = 400, 400 N m/rad"));
+	assert_non_null(strstr(err, "beamsim markov build"));
+	free(err);
+	out = NULL;
+	const char *pred_ok[] = {"markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
+	                         "--map",  d2,        NULL};
+	assert_int_equal(bsim_test_cli(pred_ok, &out, NULL), 0);
+	assert_non_null(strstr(out, "gates visited: mean"));
+	free(out);
+	/* --out: every location of the field once, the probabilities summing to 1 */
+	char pdir[1100];
+	snprintf(pdir, sizeof pdir, "%s/prediction", d1);
+	const char *pred_out[] = {
+	        "markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
+	        "--map",  d2,        "--out",
+	        pdir,     NULL};
+	assert_int_equal(bsim_test_cli(pred_out, NULL, NULL), 0);
+	char csv[1200];
+	snprintf(csv, sizeof csv, "%s/prediction.csv", pdir);
+	char *text = bsim_test_read(csv);
+	assert_non_null(text);
+	int rows = 0;
+	double sum = 0.0;
+	char *save = NULL;
+	strtok_r(text, "\n", &save); /* the header */
+	for (char *line; (line = strtok_r(NULL, "\n", &save));) {
+		sum += atof(strrchr(line, ',') + 1);
+		rows++;
+	}
+	free(text);
+	assert_int_equal(rows, 9 + 9 + 81);
+	assert_true(fabs(sum - 1.0) < 1e-9);
+	snprintf(csv, sizeof csv, "%s/prediction.mat", pdir);
+	struct stat st;
+	assert_int_equal(stat(csv, &st), 0);
+}
+
+/* Bad inputs: exit 2, one line naming the thing, nothing written. */
+static void test_bad_inputs(void **state)
+{
+	(void)state;
+	const char *dir = exe_dir("bad");
+	char target[1100];
+	snprintf(target, sizeof target, "%s/out", dir);
+	/* bsim_test_src's buffer is static: a copy per path */
+	char *h1 = strdup(bsim_test_src("configs/thesis/h1_symmetric.yaml"));
+	char *essay = strdup(bsim_test_src("configs/lattice/c_track_essay.yaml"));
+	char *track = strdup(bsim_test_src("configs/lattice/c_track.yaml"));
+	struct {
+		const char *argv[12];
+		const char *says;
+	} cases[] = {
+	        {{"markov", "build", h1, "--out", target, NULL}, "not a gate lattice"},
+	        {{"markov", "build", essay, "--bins", "4,0,3", "--out", target, NULL},
+	         "--bins 4,0,3: expected P,S,D"},
+	        {{"markov", "build", essay, "--set", "termination.side_x=300", "--out", target,
+	          NULL},
+	         "termination.side_x: the chain needs the side boundary"},
+	        {{"markov", "predict", track, NULL}, "--map DIR is required"},
+	        {{"markov", "predict", track, "--map", dir, NULL}, "markov.json: cannot read"},
+	        {{"markov", "validate", essay, "--map", dir, "--out", target, NULL},
+	         "markov.json: cannot read"},
+	        {{"markov", "buld", NULL}, "did you mean 'build'"},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		char *err = NULL;
+		int rc = bsim_test_cli(cases[i].argv, NULL, &err);
+		if (rc != 2 || !strstr(err ? err : "", cases[i].says))
+			print_error("case %zu: exit %d, %s\n", i, rc, err ? err : "");
+		assert_int_equal(rc, 2);
+		assert_non_null(strstr(err, cases[i].says));
+		free(err);
+		struct stat st;
+		assert_int_not_equal(stat(target, &st), 0);
+	}
+	free(h1);
+	free(essay);
+	free(track);
+}
+
+/* Bins: the edges, positions, speeds and directions land where the
+ * header says. */
+static void test_bins(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 1, 6, 30), BSIM_OK);
+	const bsim_markov_bins b = {4, 4, 3, 40.0};
+	assert_int_equal(bsim_markov_bins_count(&b), 1 + 4 * 48);
+	const double up[2] = {0.0, 1.0}, fast_left[2] = {-39.0, 0.5}, back[2] = {-5.0, 0.0};
+	/* bottom edge, first position bin, slowest, straight in: the middle direction */
+	assert_int_equal(bsim_markov_bin_of(&b, &s.lattice, BSIM_EDGE_BOTTOM, -24.0, up), 1 + 1);
+	/* right edge (moving -x), last position bin, last speed bin, straight in */
+	assert_int_equal(bsim_markov_bin_of(&b, &s.lattice, BSIM_EDGE_RIGHT, 59.0, fast_left),
+	                 1 + ((2 * 4 + 3) * 4 + 3) * 3 + 1);
+	/* a body moving out is clamped to an end direction bin */
+	int k = bsim_markov_bin_of(&b, &s.lattice, BSIM_EDGE_LEFT, 30.0, back);
+	assert_true((k - 1) % 3 == 0 || (k - 1) % 3 == 2);
+	bsim_scene_free(&s);
+}
+
+/* Observed entries: a bin's states are drawn from them (a map built from
+ * entries that all lie in one bin differs from the uniform one in that bin
+ * and nowhere else), they are part of the key, and a malformed file is
+ * named with its line. */
+static void test_entries(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 1, 6, 30), BSIM_OK);
+	const char *dir = exe_dir("entries");
+	/* every entry: bottom edge near x = 20, straight up at 1 m/s */
+	char text[4096] = "group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy\n"
+	                  "0,0,0,0,0,start,0,0,0,0,0,0,0\n";
+	for (int i = 0; i < 20; i++) {
+		char row[128];
+		snprintf(row, sizeof row, "0,%d,1,0,0,bottom,10,0.04,%g,%g,0.01,0,1\n", i,
+		         20.0 + 0.1 * i, 20.0 + 0.1 * i);
+		strcat(text, row);
+	}
+	char path[1200];
+	snprintf(path, sizeof path, "%s", bsim_test_write(dir, "gate_entries.csv", text));
+	bsim_markov_entries e;
+	bsim_error err;
+	const char *paths[] = {dir};
+	assert_int_equal(bsim_markov_entries_load(paths, 1, &e, &err), BSIM_OK);
+	assert_int_equal(e.n, 20); /* the start rows left out */
+	const bsim_markov_bins b = {2, 1, 1, 40.0};
+	const int bin = bsim_markov_bin_of(&b, &s.lattice, BSIM_EDGE_BOTTOM, 20.0, e.v[0]);
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = b;
+	def.trials = 60;
+	bsim_markov_set uni, obs;
+	char d1[1100], d2[1100];
+	snprintf(d1, sizeof d1, "%s/uniform", dir);
+	snprintf(d2, sizeof d2, "%s/observed", dir);
+	assert_int_equal(bsim_markov_build(&s, &def, d1, &uni, &err), BSIM_OK);
+	def.entries = &e;
+	assert_int_equal(bsim_markov_build(&s, &def, d2, &obs, &err), BSIM_OK);
+	assert_true(uni.maps[0].key != obs.maps[0].key);
+	const int nb = uni.maps[0].n_bins;
+	int differ = 0;
+	for (int a = 0; a < nb; a++) {
+		int same = memcmp(uni.maps[0].counts + a * nb, obs.maps[0].counts + a * nb,
+		                  (size_t)nb * sizeof(int)) == 0;
+		if (a != bin)
+			assert_true(same);
+		differ += !same;
+	}
+	assert_int_equal(differ, 1);
+	bsim_markov_set_free(&uni);
+	bsim_markov_set_free(&obs);
+	bsim_markov_entries_free(&e);
+	/* a malformed row: file and line */
+	strcat(text, "0,99,1,0,0,sideways,10,0.04,1,1,1,0,1\n");
+	bsim_test_write(dir, "gate_entries.csv", text);
+	assert_int_equal(bsim_markov_entries_load(paths, 1, &e, &err), BSIM_EINPUT);
+	assert_non_null(strstr(err.msg, "gate_entries.csv:23: expected an entry"));
+	bsim_scene_free(&s);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_one_gate_is_the_map),
+	        cmocka_unit_test(test_two_gates_geometric),
+	        cmocka_unit_test(test_bins),
+	        cmocka_unit_test(test_conservation),
+	        cmocka_unit_test(test_one_gate_against_simulation),
+	        cmocka_unit_test(test_threads_and_cache),
+	        cmocka_unit_test(test_entries),
+	        cmocka_unit_test(test_bad_inputs),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
