@@ -519,7 +519,7 @@ static void three_beams_static_equilibrium(void **state)
 		if (!thesis_contact_detect(w, i, 1e-3, &c))
 			continue;
 		touching++;
-		const thesis_beam *b = &w->beams[i];
+		thesis_beam *b = &w->beams[i];
 		double u[2];
 		thesis_beam_direction(b, u);
 		double lever = (w->x[0] - b->p[0]) * u[0] + (w->x[1] - b->p[1]) * u[1];

@@ -14,7 +14,7 @@
 
 #include "thesis/thesis.h"
 
-void thesis_beam_direction(const thesis_beam *b, double u[2])
+void thesis_beam_direction(thesis_beam *b, double u[2])
 {
 	/* At rest the rotation is the identity: u0 exactly, as the formula
 	 * below gives it (u0 - u0_perp * (+-0) = u0), without the sine and
@@ -24,14 +24,21 @@ void thesis_beam_direction(const thesis_beam *b, double u[2])
 		u[1] = b->u0[1];
 		return;
 	}
-	double cs = cos(b->theta), sn = b->sgn * sin(b->theta);
-	u[0] = b->u0[0] * cs - b->u0[1] * sn;
-	u[1] = b->u0[1] * cs + b->u0[0] * sn;
+	/* The same angle gives the same bits: the sine and cosine once per
+	 * angle, however often a step asks (NaN never equals itself). */
+	if (b->theta != b->u_theta) {
+		double cs = cos(b->theta), sn = b->sgn * sin(b->theta);
+		b->u[0] = b->u0[0] * cs - b->u0[1] * sn;
+		b->u[1] = b->u0[1] * cs + b->u0[0] * sn;
+		b->u_theta = b->theta;
+	}
+	u[0] = b->u[0];
+	u[1] = b->u[1];
 }
 
 int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out)
 {
-	const thesis_beam *b = &w->beams[i];
+	thesis_beam *b = &w->beams[i]; /* its direction cached */
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
 	double reach = b->length + w->radius + margin;
 	if (dx * dx + dy * dy > reach * reach)

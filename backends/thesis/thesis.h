@@ -23,6 +23,10 @@ typedef struct thesis_beam {
 	double damping;   /* N m s/rad */
 	double theta;     /* rad */
 	double omega;     /* rad/s */
+	/* The direction at angle u_theta (contact_detect.c): detection and the
+	 * projection's re-detection of one step meet the same angle. */
+	double u_theta; /* rad */
+	double u[2];
 } thesis_beam;
 
 typedef struct thesis_contact {
@@ -99,7 +103,7 @@ void thesis_beams_sleep(struct bsim_world *w, double speed, double h);
 void thesis_awake_prune(struct bsim_world *w);
 
 /* contact_detect.c */
-void thesis_beam_direction(const thesis_beam *b, double u[2]);
+void thesis_beam_direction(thesis_beam *b, double u[2]);
 int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out);
 void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c);
 
