@@ -17,7 +17,7 @@ static void propulsion_apply(bsim_effect *e, long n, double h, double f[2])
 /* F_rand = (Rm z_j, 0), z_j held for 1/f seconds: essay Eq. 2.3. */
 static void random_force_apply(bsim_effect *e, long n, double h, double f[2])
 {
-	double value = bsim_schedule_value(e->schedule, bsim_schedule_index(e->schedule, n, h));
+	double value = bsim_schedule_at_step(e->schedule, n, h);
 	f[0] += value;
 	e->last = value;
 }

@@ -2,6 +2,7 @@
  * a GSL Mersenne Twister seeded per (experiment seed, group, trial). */
 #include "beamsim/schedule.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -15,6 +16,11 @@ struct bsim_schedule {
 	double *z;        /* standard-normal values drawn so far */
 	long n_drawn, cap;
 	unsigned long draws;
+	unsigned long counted; /* draws already added to total_draws */
+	/* The value held over steps [held_lo, held_hi) at step h (s), so that
+	 * a step inside the hold reads it without computing its index. */
+	long held_lo, held_hi;
+	double held_h, held_value;
 	long failed; /* 0, or the index that could not be given a value */
 	int oom;     /* 1: failed for want of memory; 0: beyond any schedule */
 };
@@ -58,10 +64,19 @@ bsim_schedule *bsim_schedule_alloc(double magnitude, double frequency, uint64_t 
 	return s;
 }
 
+/* The draws of s not yet in total_draws go there: once per trial, not per
+ * draw, so threads do not share a counter's cache line every few steps. */
+static void schedule_count(bsim_schedule *s)
+{
+	__atomic_fetch_add(&total_draws, s->draws - s->counted, __ATOMIC_RELAXED);
+	s->counted = s->draws;
+}
+
 void bsim_schedule_free(bsim_schedule *s)
 {
 	if (!s)
 		return;
+	schedule_count(s);
 	gsl_rng_free(s->rng);
 	free(s->z);
 	free(s);
@@ -71,28 +86,57 @@ void bsim_schedule_reset(bsim_schedule *s, double magnitude, uint64_t seed)
 {
 	/* gsl_rng_set takes an unsigned long (64 bits here); MT19937 uses its
 	 * low 32 bits, so fold the high half in. */
+	schedule_count(s);
 	gsl_rng_set(s->rng, (unsigned long)(seed ^ (seed >> 32)));
 	s->magnitude = magnitude;
 	s->n_drawn = 0;
 	s->draws = 0;
+	s->counted = 0;
+	s->held_lo = s->held_hi = 0;
 	s->failed = 0;
 	s->oom = 0;
+}
+
+/* Steps per value when 1/(f h) is a whole number of steps (5 for 50 Hz at
+ * 4 ms), else 0. */
+static long schedule_steps_per_value(const bsim_schedule *s, double h)
+{
+	double per = 1.0 / (s->frequency * h);
+	double whole = nearbyint(per);
+	if (whole >= 1.0 && whole < 1e15 && fabs(per - whole) <= 1e-9 * per)
+		return (long)whole;
+	return 0;
 }
 
 long bsim_schedule_index(const bsim_schedule *s, long n, double h)
 {
 	/* Value j applies on [j/f, (j+1)/f). When 1/(f h) is a whole number of
-	 * steps (5 for 50 Hz at 4 ms) use integer division, so that rounding
-	 * of n*h*f never moves a refresh by a step. */
-	double per = 1.0 / (s->frequency * h);
-	double whole = nearbyint(per);
-	if (whole >= 1.0 && whole < 1e15 && fabs(per - whole) <= 1e-9 * per)
-		return n / (long)whole;
+	 * steps use integer division, so that rounding of n*h*f never moves a
+	 * refresh by a step. */
+	long whole = schedule_steps_per_value(s, h);
+	if (whole)
+		return n / whole;
 	/* Validation keeps the index small (bsim_limits schedule); a scene
 	 * built in code may not, and converting a double beyond long's range
 	 * is undefined: such an index is past any schedule that can be drawn. */
 	double j = floor((double)n * h * s->frequency);
 	return j < SCHEDULE_MAX ? (long)j : SCHEDULE_MAX;
+}
+
+double bsim_schedule_at_step(bsim_schedule *s, long n, double h)
+{
+	if (n >= s->held_lo && n < s->held_hi && h == s->held_h)
+		return s->held_value;
+	long j = bsim_schedule_index(s, n, h);
+	double value = bsim_schedule_value(s, j);
+	long whole = schedule_steps_per_value(s, h);
+	if (whole && !s->failed && n >= 0 && n < LONG_MAX - whole) {
+		s->held_lo = j * whole;
+		s->held_hi = s->held_lo + whole;
+		s->held_h = h;
+		s->held_value = value;
+	}
+	return value;
 }
 
 double bsim_schedule_value(bsim_schedule *s, long j)
@@ -120,7 +164,6 @@ double bsim_schedule_value(bsim_schedule *s, long j)
 		while (s->n_drawn <= j) {
 			s->z[s->n_drawn++] = gsl_ran_gaussian_ziggurat(s->rng, 1.0);
 			s->draws++;
-			__atomic_fetch_add(&total_draws, 1UL, __ATOMIC_RELAXED);
 		}
 	}
 	return s->magnitude * s->z[j];

@@ -133,12 +133,17 @@ static void sort_small(int *v, int n)
 	}
 }
 
+/* A world of this many beams or fewer tests them all: the grid's query
+ * costs more than the few reach tests it would save (the essay's gate has
+ * two beams), and the result is the same bit for bit. */
+#define BROAD_PHASE_MIN_BEAMS 8
+
 /* Fills w->candidates with the beams the step must test; returns how many. */
 int thesis_broad_phase(struct bsim_world *w, double speed, double h)
 {
 	int *out = w->candidates;
 	int n = 0;
-	if (!w->broad_phase) {
+	if (!w->broad_phase || w->n_beams <= BROAD_PHASE_MIN_BEAMS) {
 		for (int i = 0; i < w->n_beams; i++)
 			out[n++] = i;
 		return n;

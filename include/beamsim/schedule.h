@@ -36,6 +36,11 @@ long bsim_schedule_index(const bsim_schedule *s, long n, double h);
  * 0, and bsim_schedule_status then fails: never a NaN. */
 double bsim_schedule_value(bsim_schedule *s, long j);
 
+/* The force value at step n of size h (N): bsim_schedule_value of
+ * bsim_schedule_index, the same bits, with the value held over its steps
+ * kept so that the steps between two refreshes read it at no cost. */
+double bsim_schedule_at_step(bsim_schedule *s, long n, double h);
+
 /* BSIM_OK, or BSIM_EFAIL saying which value could not be had and why,
  * since the last reset. */
 int bsim_schedule_status(const bsim_schedule *s, bsim_error *err);
@@ -43,8 +48,9 @@ int bsim_schedule_status(const bsim_schedule *s, bsim_error *err);
 /* Number of standard-normal draws made since alloc/reset. */
 unsigned long bsim_schedule_draws(const bsim_schedule *s);
 
-/* Total draws made by all schedules of this process (for tests that prove
- * a scene without random force makes none). */
+/* Total draws made by all schedules of this process that have since been
+ * reset or freed (for tests that prove a scene without random force makes
+ * none; a trial frees its schedule when it ends). */
 unsigned long bsim_schedule_total_draws(void);
 
 #ifdef __cplusplus
