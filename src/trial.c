@@ -24,6 +24,7 @@
 #include "beamsim/effects.h"
 #include "beamsim/landscape.h"
 #include "beamsim/lattice.h"
+#include "fminmax.h"
 #include "trial_essay.h"
 
 /* A beam as the overlap measure sees it: pivot, rest direction, forward
@@ -355,7 +356,7 @@ static void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state
 	l->sleep += se->sleep;
 	l->residual += r;
 	l->residual_abs += fabs(r);
-	l->residual_max = fmax(l->residual_max, fabs(r));
+	l->residual_max = bsim_fmax(l->residual_max, fabs(r));
 	l->inflow += fabs(w_prop) + fabs(w_rand);
 }
 
@@ -416,15 +417,15 @@ static void peaks_update(bsim_trial_runner *r, const bsim_scene *scene, const in
 	double *peak = r->peak;
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k], g = scene_beam(map, i);
-		peak[g] = fmax(peak[g], s->theta[i]);
+		peak[g] = bsim_fmax(peak[g], s->theta[i]);
 	}
 	if (!map)
 		for (int i = 0; i < 2 && i < scene->n_beams; i++)
-			peak[i] = fmax(peak[i], s->theta[i]);
+			peak[i] = bsim_fmax(peak[i], s->theta[i]);
 	int m = 0; /* only without a map: the essay's beams all start at rest */
 	for (int k = 0; k < *n_negative; k++) {
 		int i = r->negative[k];
-		peak[i] = fmax(peak[i], s->theta[i]);
+		peak[i] = bsim_fmax(peak[i], s->theta[i]);
 		if (peak[i] < 0.0)
 			r->negative[m++] = i;
 	}

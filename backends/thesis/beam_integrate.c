@@ -22,11 +22,20 @@ static double midpoint_d(const thesis_beam *b, double h)
 	       h * h * b->stiffness / (4.0 * b->inertia);
 }
 
+/* D and 1/(I D) for steps of h, computed once: a step reads them for every
+ * beam in contact, the same bits as computing them there. */
+void thesis_beam_prepare(thesis_beam *b, double h)
+{
+	b->h_d = h;
+	b->d = midpoint_d(b, h);
+	b->response = 1.0 / (b->inertia * b->d);
+}
+
 double thesis_beam_response(const thesis_beam *b, double h, int integrator)
 {
 	if (integrator == THESIS_EULER)
 		return 1.0 / b->inertia;
-	return 1.0 / (b->inertia * midpoint_d(b, h));
+	return h == b->h_d ? b->response : 1.0 / (b->inertia * midpoint_d(b, h));
 }
 
 double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator)
@@ -34,7 +43,7 @@ double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator)
 	if (integrator == THESIS_EULER)
 		return b->omega -
 		       h * (b->stiffness * b->theta + b->damping * b->omega) / b->inertia;
-	double d = midpoint_d(b, h);
+	double d = h == b->h_d ? b->d : midpoint_d(b, h);
 	return (b->omega * (2.0 - d) - h * b->stiffness * b->theta / b->inertia) / d;
 }
 

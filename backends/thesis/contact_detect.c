@@ -36,47 +36,86 @@ void thesis_beam_direction(thesis_beam *b, double u[2])
 	u[1] = b->u[1];
 }
 
-int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out)
+/* The body's centre x against the beam at its angle: b->geo. */
+static void geometry_compute(thesis_beam *b, const double x[2])
 {
-	thesis_beam *b = &w->beams[i]; /* its direction cached */
-	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-	double reach = b->length + w->radius + margin;
-	if (dx * dx + dy * dy > reach * reach)
-		return 0; /* outside the beam's disc: no trigonometry needed */
-
+	thesis_geometry *g = &b->geo;
+	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
 	double u[2];
 	thesis_beam_direction(b, u);
 	double s = dx * u[0] + dy * u[1];
-	double n[2], a[2], dist;
+	double a[2];
+	g->x[0] = x[0];
+	g->x[1] = x[1];
+	g->theta = b->theta;
 	if (s > 0.0 && s < b->length) {
 		double cross = u[0] * dy - u[1] * dx; /* u x (C - P) */
 		double side = cross >= 0.0 ? 1.0 : -1.0;
-		dist = fabs(cross);
-		n[0] = -side * u[1];
-		n[1] = side * u[0];
+		g->dist = fabs(cross);
+		g->n[0] = -side * u[1];
+		g->n[1] = side * u[0];
 		a[0] = s * u[0];
 		a[1] = s * u[1];
-		out->type = BSIM_CONTACT_TANGENT;
+		g->type = BSIM_CONTACT_TANGENT;
 	} else {
 		double l = s > 0.0 ? b->length : 0.0;
 		a[0] = l * u[0];
 		a[1] = l * u[1];
 		double qx = dx - a[0], qy = dy - a[1];
-		dist = sqrt(qx * qx + qy * qy);
-		if (dist == 0.0)
-			return 0; /* centre on the segment's end: no normal */
-		n[0] = qx / dist;
-		n[1] = qy / dist;
-		out->type = BSIM_CONTACT_TIP;
+		g->dist = sqrt(qx * qx + qy * qy);
+		if (g->dist == 0.0) {
+			g->type = BSIM_CONTACT_NONE; /* centre on the segment's end: no normal */
+			return;
+		}
+		g->n[0] = qx / g->dist;
+		g->n[1] = qy / g->dist;
+		g->type = BSIM_CONTACT_TIP;
 	}
-	out->gap = dist - w->radius;
+	g->c = b->sgn * (a[0] * g->n[1] - a[1] * g->n[0]);
+}
+
+/* 1 if the body certainly lies farther than R + margin from the beam,
+ * judged from the last geometry without trigonometry. The distance from a
+ * point to the segment changes by at most how far the point moves, and
+ * turning the beam by dtheta moves no point of it farther than L |dtheta|:
+ *   dist >= dist_g - |x - x_g| - L |theta - theta_g|.
+ * A cushion of 1e-9 of the lengths involved covers the round-off of both
+ * distances, so the bound never rejects what the exact test would keep. */
+static int geometry_far(const thesis_beam *b, const double x[2], double radius, double margin)
+{
+	const thesis_geometry *g = &b->geo;
+	double ex = x[0] - g->x[0], ey = x[1] - g->x[1];
+	double cushion = 1e-9 * (g->dist + b->length + radius + margin);
+	double slack = g->dist - b->length * fabs(b->theta - g->theta) - radius - margin - cushion;
+	return slack > 0.0 && ex * ex + ey * ey < slack * slack; /* false for NaN */
+}
+
+int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out)
+{
+	thesis_beam *b = &w->beams[i]; /* its geometry kept */
+	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+	double reach = b->length + w->radius + margin;
+	if (dx * dx + dy * dy > reach * reach)
+		return 0; /* outside the beam's disc: no trigonometry needed */
+	const thesis_geometry *g = &b->geo;
+	/* The same configuration gives the same bits: a step's detection
+	 * meets the geometry the last step's projection computed. */
+	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta)) {
+		if (geometry_far(b, w->x, w->radius, margin))
+			return 0;
+		geometry_compute(b, w->x);
+	}
+	if (g->type == BSIM_CONTACT_NONE)
+		return 0;
+	out->gap = g->dist - w->radius;
 	if (out->gap > margin)
 		return 0;
 	out->beam = i;
-	out->n[0] = n[0];
-	out->n[1] = n[1];
-	out->c = b->sgn * (a[0] * n[1] - a[1] * n[0]);
-	out->e = out->type == BSIM_CONTACT_TIP ? w->e_tip : w->e_tangent;
+	out->type = g->type;
+	out->n[0] = g->n[0];
+	out->n[1] = g->n[1];
+	out->c = g->c;
+	out->e = g->type == BSIM_CONTACT_TIP ? w->e_tip : w->e_tangent;
 	out->impulse = 0.0;
 	return 1;
 }

@@ -18,6 +18,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "fminmax.h"
 #include "thesis/thesis.h"
 
 static void impact_bounds(const struct bsim_world *w, thesis_contact *c)
@@ -78,9 +79,9 @@ int thesis_impact_resolve(struct bsim_world *w, double h)
 	for (int i = 0; i < w->n_contacts; i++) {
 		thesis_contact c = cs[i];
 		thesis_contact_velocity(w, &c);
-		if (c.gap + h * fmin(c.vrel, 0.0) > w->slop)
+		if (c.gap + h * bsim_fmin(c.vrel, 0.0) > w->slop)
 			continue;
-		c.inv_i = 1.0 / w->beams[c.beam].inertia;
+		c.inv_i = w->beams[c.beam].inv_inertia;
 		approaching |= c.vrel < 0.0;
 		cs[i] = cs[n];
 		cs[n++] = c;

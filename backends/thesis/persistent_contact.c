@@ -21,6 +21,7 @@
  * omega_m,i) is reported, negated, as energy.contact. */
 #include <math.h>
 
+#include "fminmax.h"
 #include "thesis/thesis.h"
 
 void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h)
@@ -34,10 +35,10 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 		thesis_contact *c = &cs[k];
 		const thesis_beam *b = &w->beams[c->beam];
 		double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
-		double omega_free = thesis_beam_free_omega(b, h, w->integrator);
-		double gap = fmax(c->gap, 0.0);
+		c->omega_free = thesis_beam_free_omega(b, h, w->integrator);
+		double gap = bsim_fmax(c->gap, 0.0);
 		c->inv_i = thesis_beam_response(b, h, w->integrator);
-		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - omega_free * c->c;
+		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
 		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 	}
 	w->solver.iteration_limit += thesis_lcp_solve(w, cs, n);
@@ -67,9 +68,11 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 		w->contact_of[i] = -1;
 		if (k < 0 && b->theta == 0.0 && b->omega == 0.0)
 			continue;
-		double omega_new = thesis_beam_free_omega(b, h, w->integrator);
-		if (k >= 0) {
-			omega_new -= cs[k].impulse * cs[k].c * cs[k].inv_i;
+		double omega_new;
+		if (k < 0) {
+			omega_new = thesis_beam_free_omega(b, h, w->integrator);
+		} else {
+			omega_new = cs[k].omega_free - cs[k].impulse * cs[k].c * cs[k].inv_i;
 			double omega_m = w->integrator == THESIS_EULER
 			                         ? omega_new
 			                         : 0.5 * (b->omega + omega_new);

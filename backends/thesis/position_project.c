@@ -17,7 +17,7 @@ static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const 
 	for (int k = 0; k < n; k++) {
 		cs[k].vrel = cs[k].gap;
 		cs[k].bound = 0.0;
-		cs[k].inv_i = 1.0 / w->beams[cs[k].beam].inertia;
+		cs[k].inv_i = w->beams[cs[k].beam].inv_inertia;
 	}
 	w->solver.iteration_limit += thesis_lcp_solve(w, cs, n);
 	double dx = 0.0, dy = 0.0, de = 0.0;

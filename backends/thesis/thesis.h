@@ -13,33 +13,52 @@
 
 #include "beamsim/backend.h"
 
+/* The geometry of the body against one beam at one configuration: the
+ * body's centre x and the beam's angle theta it was computed at, and the
+ * nearest point's distance, normal and lever (contact_detect.c). */
+typedef struct thesis_geometry {
+	double x[2], theta; /* m, rad; theta NaN: none computed yet */
+	int type;           /* BSIM_CONTACT_TANGENT or _TIP; NONE: centre on an end */
+	double dist;        /* centre to segment, m */
+	double n[2];        /* unit normal from the beam toward the body */
+	double c;           /* generalised lever sgn (a x n), m */
+} thesis_geometry;
+
 typedef struct thesis_beam {
-	double p[2];      /* pivot, m */
-	double u0[2];     /* rest direction, exact for multiples of 90 degrees */
-	double sgn;       /* +1: forward swing is counter-clockwise */
-	double length;    /* m */
-	double inertia;   /* kg m^2 about the pivot */
-	double stiffness; /* N m/rad */
-	double damping;   /* N m s/rad */
-	double theta;     /* rad */
-	double omega;     /* rad/s */
+	double p[2];        /* pivot, m */
+	double u0[2];       /* rest direction, exact for multiples of 90 degrees */
+	double sgn;         /* +1: forward swing is counter-clockwise */
+	double length;      /* m */
+	double inertia;     /* kg m^2 about the pivot */
+	double stiffness;   /* N m/rad */
+	double damping;     /* N m s/rad */
+	double inv_inertia; /* 1/I, 1/(kg m^2) */
+	/* For the step size h_d: the midpoint rule's D and the response
+	 * 1/(I D) (beam_integrate.c), computed once rather than per use. */
+	double h_d, d, response;
+	double theta; /* rad */
+	double omega; /* rad/s */
 	/* The direction at angle u_theta (contact_detect.c): detection and the
 	 * projection's re-detection of one step meet the same angle. */
 	double u_theta; /* rad */
 	double u[2];
+	/* The last geometry computed against the body: reused when nothing
+	 * moved, and a bound on the distance when something did. */
+	thesis_geometry geo;
 } thesis_beam;
 
 typedef struct thesis_contact {
 	int beam;
-	int type;       /* BSIM_CONTACT_TANGENT or BSIM_CONTACT_TIP */
-	double gap;     /* distance to the segment minus R, m (< 0: penetration) */
-	double n[2];    /* unit normal from the beam toward the body */
-	double c;       /* generalised lever sgn (a x n), m */
-	double inv_i;   /* 1/I for impacts and projection, 1/(I D) in a step */
-	double e;       /* restitution of this contact */
-	double vrel;    /* relative normal velocity, m/s (< 0: approaching) */
-	double bound;   /* lower bound on the solved velocity, m/s */
-	double impulse; /* N s */
+	int type;          /* BSIM_CONTACT_TANGENT or BSIM_CONTACT_TIP */
+	double gap;        /* distance to the segment minus R, m (< 0: penetration) */
+	double n[2];       /* unit normal from the beam toward the body */
+	double c;          /* generalised lever sgn (a x n), m */
+	double inv_i;      /* 1/I for impacts and projection, 1/(I D) in a step */
+	double e;          /* restitution of this contact */
+	double vrel;       /* relative normal velocity, m/s (< 0: approaching) */
+	double omega_free; /* the beam's omega at the step's end without contact, rad/s */
+	double bound;      /* lower bound on the solved velocity, m/s */
+	double impulse;    /* N s */
 } thesis_contact;
 
 /* The broad phase's uniform grid over the pivots (broad_phase.c). */
@@ -89,6 +108,7 @@ struct bsim_world {
 	bsim_step_energy energy;
 	int impacts;
 	bsim_solver_counts solver; /* since creation */
+	double h_prepared;         /* the step size the beams' constants are for, s */
 };
 
 /* broad_phase.c */
@@ -120,6 +140,7 @@ void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2]);
 int thesis_impact_resolve(struct bsim_world *w, double h);
 
 /* beam_integrate.c */
+void thesis_beam_prepare(thesis_beam *b, double h);
 double thesis_beam_response(const thesis_beam *b, double h, int integrator);
 double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator);
 double thesis_beam_advance(thesis_beam *b, double omega_new, double h, int integrator);

@@ -117,6 +117,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	}
 	memcpy(w->x, scene->body.start, sizeof w->x);
 	memcpy(w->v, scene->body.velocity, sizeof w->v);
+	w->h_prepared = NAN;
 	w->mass = scene->body.mass;
 	w->inv_mass = 1.0 / scene->body.mass;
 	w->radius = scene->body.radius;
@@ -129,6 +130,9 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		b->sgn = bsim_scene_beam_forward_sign(d); /* forward = toward +y */
 		b->length = d->length;
 		b->inertia = d->inertia;
+		b->inv_inertia = 1.0 / d->inertia;
+		b->h_d = NAN; /* thesis_beam_prepare at the first step */
+		b->geo.theta = NAN;
 		b->stiffness = d->stiffness;
 		b->damping = d->damping;
 		b->theta = d->initial_theta;
@@ -203,6 +207,11 @@ static int thesis_step(bsim_world *w, const double force[2], double h, bsim_erro
 	for (int k = 0; k < w->n_typed; k++)
 		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
 	w->n_typed = 0;
+	if (h != w->h_prepared) {
+		for (int i = 0; i < w->n_beams; i++)
+			thesis_beam_prepare(&w->beams[i], h);
+		w->h_prepared = h;
+	}
 	/* A bound for the margin only: speeds and forces are far from overflow,
 	 * so sqrt serves where hypot's scaling would cost a tenth of a step. */
 	double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
