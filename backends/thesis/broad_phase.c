@@ -24,17 +24,6 @@
 
 #include "thesis/thesis.h"
 
-double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b, double speed, double h)
-{
-	/* At rest the formula below is 2 h |v| + slop exactly (every other
-	 * term is +0), without its division. */
-	if (b->theta == 0.0 && b->omega == 0.0)
-		return 2.0 * (h * speed) + w->slop;
-	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
-	               b->inertia;
-	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
-}
-
 void thesis_grid_free(thesis_grid *g)
 {
 	free(g->start);

@@ -119,8 +119,3 @@ int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thes
 	out->impulse = 0.0;
 	return 1;
 }
-
-void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c)
-{
-	c->vrel = (w->v[0] * c->n[0] + w->v[1] * c->n[1]) - w->beams[c->beam].omega * c->c;
-}

@@ -11,6 +11,8 @@
 #ifndef BSIM_THESIS_H
 #define BSIM_THESIS_H
 
+#include <math.h>
+
 #include "beamsim/backend.h"
 
 /* The geometry of the body against one beam at one configuration: the
@@ -34,7 +36,7 @@ typedef struct thesis_beam {
 	double damping;     /* N m s/rad */
 	double inv_inertia; /* 1/I, 1/(kg m^2) */
 	/* For the step size h_d: the midpoint rule's D and the response
-	 * 1/(I D) (beam_integrate.c), computed once rather than per use. */
+	 * 1/(I D) (beam_integrate.h), computed once rather than per use. */
 	double h_d, d, response;
 	double theta; /* rad */
 	double omega; /* rad/s */
@@ -112,7 +114,6 @@ struct bsim_world {
 };
 
 /* broad_phase.c */
-double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b, double speed, double h);
 int thesis_grid_build(thesis_grid *g, const struct bsim_world *w);
 void thesis_grid_free(thesis_grid *g);
 int thesis_broad_phase(struct bsim_world *w, double speed, double h);
@@ -125,7 +126,6 @@ void thesis_awake_prune(struct bsim_world *w);
 /* contact_detect.c */
 void thesis_beam_direction(thesis_beam *b, double u[2]);
 int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out);
-void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c);
 
 /* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
  * counts it in w->solver), else 0. */
@@ -139,12 +139,6 @@ void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2]);
 /* impact_resolve.c */
 int thesis_impact_resolve(struct bsim_world *w, double h);
 
-/* beam_integrate.c */
-void thesis_beam_prepare(thesis_beam *b, double h);
-double thesis_beam_response(const thesis_beam *b, double h, int integrator);
-double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator);
-double thesis_beam_advance(thesis_beam *b, double omega_new, double h, int integrator);
-
 /* persistent_contact.c */
 void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h);
 
@@ -153,5 +147,28 @@ void thesis_position_project(struct bsim_world *w, const double force[2]);
 
 /* the kinetic energy of body and beams, J */
 double thesis_kinetic_energy(const struct bsim_world *w);
+
+/* The beam integrator, inline (beam_integrate.h). */
+#include "thesis/beam_integrate.h"
+
+/* How far beam i and the body can close within a step (broad_phase.c
+ * derives it), m; inline: every step asks it of every beam in reach. */
+static inline double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b,
+                                        double speed, double h)
+{
+	/* At rest the formula below is 2 h |v| + slop exactly (every other
+	 * term is +0), without its division. */
+	if (b->theta == 0.0 && b->omega == 0.0)
+		return 2.0 * (h * speed) + w->slop;
+	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
+	               b->inertia;
+	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
+}
+
+/* v_rel = v . n - omega c (contact_detect.c). */
+static inline void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c)
+{
+	c->vrel = (w->v[0] * c->n[0] + w->v[1] * c->n[1]) - w->beams[c->beam].omega * c->c;
+}
 
 #endif

@@ -14,9 +14,13 @@
  * euler: semi-implicit Euler, omega' = omega + h/I (tau - k theta - d omega),
  * theta' = theta + h omega'; the essay-style explicit update, stable only
  * for h omega_n < 2, kept for accuracy studies. */
-#include "thesis/thesis.h"
+#ifndef BSIM_THESIS_BEAM_INTEGRATE_H
+#define BSIM_THESIS_BEAM_INTEGRATE_H
 
-static double midpoint_d(const thesis_beam *b, double h)
+/* Inline: a step calls these for every awake beam, and the calls cost as
+ * much as the arithmetic. Included by thesis.h. */
+
+static inline double thesis_beam_midpoint_d(const thesis_beam *b, double h)
 {
 	return 1.0 + h * b->damping / (2.0 * b->inertia) +
 	       h * h * b->stiffness / (4.0 * b->inertia);
@@ -24,34 +28,36 @@ static double midpoint_d(const thesis_beam *b, double h)
 
 /* D and 1/(I D) for steps of h, computed once: a step reads them for every
  * beam in contact, the same bits as computing them there. */
-void thesis_beam_prepare(thesis_beam *b, double h)
+static inline void thesis_beam_prepare(thesis_beam *b, double h)
 {
 	b->h_d = h;
-	b->d = midpoint_d(b, h);
+	b->d = thesis_beam_midpoint_d(b, h);
 	b->response = 1.0 / (b->inertia * b->d);
 }
 
-double thesis_beam_response(const thesis_beam *b, double h, int integrator)
+static inline double thesis_beam_response(const thesis_beam *b, double h, int integrator)
 {
 	if (integrator == THESIS_EULER)
 		return 1.0 / b->inertia;
-	return h == b->h_d ? b->response : 1.0 / (b->inertia * midpoint_d(b, h));
+	return h == b->h_d ? b->response : 1.0 / (b->inertia * thesis_beam_midpoint_d(b, h));
 }
 
-double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator)
+static inline double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator)
 {
 	if (integrator == THESIS_EULER)
 		return b->omega -
 		       h * (b->stiffness * b->theta + b->damping * b->omega) / b->inertia;
-	double d = h == b->h_d ? b->d : midpoint_d(b, h);
+	double d = h == b->h_d ? b->d : thesis_beam_midpoint_d(b, h);
 	return (b->omega * (2.0 - d) - h * b->stiffness * b->theta / b->inertia) / d;
 }
 
 /* Moves theta to the end of the step; returns the damper's loss, J. */
-double thesis_beam_advance(thesis_beam *b, double omega_new, double h, int integrator)
+static inline double thesis_beam_advance(thesis_beam *b, double omega_new, double h, int integrator)
 {
 	double omega_m = integrator == THESIS_EULER ? omega_new : 0.5 * (b->omega + omega_new);
 	b->theta += h * omega_m;
 	b->omega = omega_new;
 	return h * b->damping * omega_m * omega_m;
 }
+
+#endif
