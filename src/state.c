@@ -48,6 +48,15 @@ void bsim_state_copy(bsim_state *dst, const bsim_state *src)
 
 void bsim_state_set_active(bsim_state *s, const int *active, int n)
 {
+	/* The same list as now (a step's usual case): its entries are about to
+	 * be written, and the others are already zero. */
+	if (n == s->n_active) {
+		int k = 0;
+		while (k < n && active[k] == s->active[k])
+			k++;
+		if (k == n)
+			return;
+	}
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k];
 		s->theta[i] = 0.0;
