@@ -24,6 +24,11 @@
 
 #include "thesis/thesis.h"
 
+/* A world of this many beams or fewer tests them all: the grid's query
+ * costs more than the few reach tests it would save (the essay's gate has
+ * two beams), and the result is the same bit for bit. */
+#define BROAD_PHASE_MIN_BEAMS 8
+
 void thesis_grid_free(thesis_grid *g)
 {
 	free(g->start);
@@ -126,10 +131,27 @@ static void sort_small(int *v, int n)
 	}
 }
 
-/* A world of this many beams or fewer tests them all: the grid's query
- * costs more than the few reach tests it would save (the essay's gate has
- * two beams), and the result is the same bit for bit. */
-#define BROAD_PHASE_MIN_BEAMS 8
+/* With every beam at rest the step's margin is 2 h |v| + slop, |v| = |v| +
+ * h |F| / M from two square roots. |a| + |b| >= sqrt(a^2 + b^2) bounds
+ * both without them; the factor 1 + 1e-12 covers the square roots'
+ * rounding, so a beam out of reach of the bound is out of reach of the
+ * margin, and the test changes no result. NaN or overflow: not clear. */
+int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], double h)
+{
+	if (w->n_beams > BROAD_PHASE_MIN_BEAMS)
+		return 0;
+	double speed = (fabs(w->v[0]) + fabs(w->v[1])) +
+	               h * (fabs(force[0]) + fabs(force[1])) * w->inv_mass;
+	double margin = 2.0 * (h * (speed * (1.0 + 1e-12))) + w->slop;
+	for (int i = 0; i < w->n_beams; i++) {
+		const thesis_beam *b = &w->beams[i];
+		double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+		double reach = b->length + w->radius + margin;
+		if (!(dx * dx + dy * dy > reach * reach))
+			return 0;
+	}
+	return 1;
+}
 
 /* Fills w->candidates with the beams the step must test; returns how many. */
 int thesis_broad_phase(struct bsim_world *w, double speed, double h)

@@ -198,6 +198,29 @@ static int essay_hold(bsim_world *w)
 	return any;
 }
 
+/* The contacts the step can reach into w->contacts; returns how many, and
+ * the speed bound of the margins in *speed. */
+static int step_detect(bsim_world *w, const double force[2], double h, double *speed)
+{
+	/* A bound for the margin only: speeds and forces are far from overflow,
+	 * so sqrt serves where hypot's scaling would cost a tenth of a step. */
+	double v = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
+	           h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
+	int holding = w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
+	int m = thesis_broad_phase(w, v, h);
+	int n = 0;
+	for (int k = 0; k < m; k++) {
+		int i = w->candidates[k];
+		if (holding && !w->held[i])
+			continue; /* essay: the constraint loop tests only held beams */
+		if (thesis_contact_detect(w, i, thesis_step_margin(w, &w->beams[i], v, h),
+		                          &w->contacts[n]))
+			thesis_beam_wake(w, w->contacts[n++].beam);
+	}
+	*speed = v;
+	return n;
+}
+
 /* Nothing in a step allocates: the world's memory is sized at creation. */
 static int thesis_step(bsim_world *w, const double force[2], double h, bsim_error *err)
 {
@@ -212,21 +235,11 @@ static int thesis_step(bsim_world *w, const double force[2], double h, bsim_erro
 			thesis_beam_prepare(&w->beams[i], h);
 		w->h_prepared = h;
 	}
-	/* A bound for the margin only: speeds and forces are far from overflow,
-	 * so sqrt serves where hypot's scaling would cost a tenth of a step. */
-	double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
-	               h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
-	int holding = w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
-	int m = thesis_broad_phase(w, speed, h);
-	int n = 0;
-	for (int k = 0; k < m; k++) {
-		int i = w->candidates[k];
-		if (holding && !w->held[i])
-			continue; /* essay: the constraint loop tests only held beams */
-		if (thesis_contact_detect(w, i, thesis_step_margin(w, &w->beams[i], speed, h),
-		                          &w->contacts[n]))
-			thesis_beam_wake(w, w->contacts[n++].beam);
-	}
+	/* Free flight among beams at rest (none awake, none in reach): no
+	 * contact, no beam to move, no square root for the margin. */
+	int in_flight = w->n_awake == 0 && thesis_broad_phase_clear(w, force, h);
+	double speed = 0.0;
+	int n = in_flight ? 0 : step_detect(w, force, h, &speed);
 	w->n_contacts = n;
 	if (n)
 		thesis_impact_resolve(w, h);
@@ -238,9 +251,11 @@ static int thesis_step(bsim_world *w, const double force[2], double h, bsim_erro
 	for (int k = 0; k < w->n_contacts; k++)
 		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE)
 			w->typed[w->n_typed++] = w->contacts[k].beam;
-	if (w->sleep)
-		thesis_beams_sleep(w, speed, h);
-	thesis_awake_prune(w);
+	if (!in_flight) {
+		if (w->sleep)
+			thesis_beams_sleep(w, speed, h);
+		thesis_awake_prune(w);
+	}
 	return BSIM_OK;
 }
 
