@@ -3,8 +3,9 @@
  * body, the distance bound that skips far beams, the beam constants for the
  * step size, the random force's held value) steps exactly as a world
  * created afresh from the same state, which has none of them. Also the
- * inlined fmax/fmin against the C library's, and the schedule's held value
- * against its definition, value(index(n)). */
+ * inlined fmax/fmin against IEEE 754's maximumNumber/minimumNumber and the
+ * C library, and the schedule's held value against its definition,
+ * value(index(n)). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -12,27 +13,53 @@
 #include <string.h>
 
 #include <cmocka.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
 
 #include "beamsim/backend.h"
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
+#include "beamsim/trial.h"
 #include "fminmax.h"
 #include "support.h"
+#include "thesis/thesis.h"
 
-static void test_fminmax_as_libm(void **state)
+/* maximumNumber / minimumNumber (IEEE 754-2019): the larger (smaller) of
+ * the two in the order -inf < ... < -0 < +0 < ... < +inf, a NaN operand
+ * ignored; so commutative to the bit, and equal to the C library's fmax and
+ * fmin wherever C fixes their result (all but a pair of zeros). */
+static int order_less(double a, double b)
+{
+	return a < b || (a == b && signbit(a) && !signbit(b));
+}
+
+static void test_fminmax_ieee(void **state)
 {
 	(void)state;
 	const double v[] = {0.0, -0.0, 1.0, -1.0, NAN, -NAN, INFINITY, -INFINITY, 1e-310, 3.5};
 	const int n = (int)(sizeof v / sizeof v[0]);
-	/* volatile: the library's functions are called, not folded */
 	double (*volatile lib_max)(double, double) = fmax;
 	double (*volatile lib_min)(double, double) = fmin;
 	for (int i = 0; i < n; i++)
 		for (int j = 0; j < n; j++) {
-			double a = lib_max(v[i], v[j]), b = bsim_fmax(v[i], v[j]);
-			double c = lib_min(v[i], v[j]), d = bsim_fmin(v[i], v[j]);
-			assert_memory_equal(&a, &b, sizeof a);
-			assert_memory_equal(&c, &d, sizeof c);
+			double a = v[i], b = v[j];
+			double mx = bsim_fmax(a, b), mn = bsim_fmin(a, b);
+			double mx2 = bsim_fmax(b, a), mn2 = bsim_fmin(b, a);
+			if (isnan(a) && isnan(b)) {
+				assert_true(isnan(mx) && isnan(mn));
+				continue;
+			}
+			double want_max = isnan(a) ? b : isnan(b) ? a : order_less(a, b) ? b : a;
+			double want_min = isnan(a) ? b : isnan(b) ? a : order_less(a, b) ? a : b;
+			assert_memory_equal(&mx, &want_max, sizeof mx);
+			assert_memory_equal(&mn, &want_min, sizeof mn);
+			assert_memory_equal(&mx, &mx2, sizeof mx);
+			assert_memory_equal(&mn, &mn2, sizeof mn);
+			if (!(a == 0.0 && b == 0.0)) {
+				double lx = lib_max(a, b), ln = lib_min(a, b);
+				assert_memory_equal(&mx, &lx, sizeof mx);
+				assert_memory_equal(&mn, &ln, sizeof mn);
+			}
 		}
 }
 
@@ -145,13 +172,94 @@ static void test_lattice_as_fresh(void **state)
 	bsim_scene_free(&s);
 }
 
+/* Free flight's shortcut (no beam in reach, none moving: no detection)
+ * against detection every step (broad_phase=0): the same trials to the bit,
+ * from starts below the gate at which the body flies free, then meets the
+ * beams. */
+static void test_free_flight_as_detection(void **state)
+{
+	(void)state;
+	bsim_options every;
+	bsim_error err;
+	memset(&every, 0, sizeof every);
+	assert_int_equal(bsim_options_add(&every, "broad_phase=0", &err), BSIM_OK);
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
+	for (int k = 0; k < 4; k++) {
+		bsim_scene s;
+		bsim_scene_init_gate(&s, 6.0 + k, k ? 10.0 : 0.0);
+		s.body.start[1] = -15.0 * k;
+		bsim_trial_result a, b;
+		assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL, 5 + (uint64_t)k,
+		                                NULL, &a, &err),
+		                 BSIM_OK);
+		assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, &every,
+		                                5 + (uint64_t)k, NULL, &b, &err),
+		                 BSIM_OK);
+		assert_true(a.max_theta[0] > 0.0 || a.max_theta[1] > 0.0); /* the beams were met */
+		assert_memory_equal(&a.ledger, &b.ledger, sizeof a.ledger);
+		assert_memory_equal(&a.x_end, &b.x_end, sizeof a.x_end);
+		assert_memory_equal(&a.y_end, &b.y_end, sizeof a.y_end);
+		assert_memory_equal(a.max_theta, b.max_theta, sizeof a.max_theta);
+		assert_int_equal(a.steps_run, b.steps_run);
+		assert_int_equal(a.outcome, b.outcome);
+		bsim_scene_free(&s);
+	}
+	bsim_trial_runner_free(r);
+}
+
+/* The free-flight bound itself, at the edge of reach: the body's centre
+ * placed at random within 1% of L + R + margin of a beam, at
+ * speeds that make the margin matter. Whenever the bound calls the step
+ * clear, the exact test (contact_detect.c's, with the step's margin)
+ * finds every beam out of reach; and it does call many steps clear. */
+static void test_free_flight_bound(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	bsim_world *w = NULL;
+	bsim_error err;
+	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+	const double h = s.dt;
+	int clear = 0;
+	for (int t = 0; t < 200000; t++) {
+		double f[2] = {gsl_ran_gaussian(rng, 30.0), 7.0};
+		w->v[0] = gsl_ran_gaussian(rng, 50.0);
+		w->v[1] = gsl_ran_gaussian(rng, 50.0);
+		double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
+		               h * sqrt(f[0] * f[0] + f[1] * f[1]) * w->inv_mass;
+		const thesis_beam *b = &w->beams[t % 2];
+		double reach = b->length + w->radius + thesis_step_margin(w, b, speed, h);
+		double r = reach * (1.0 + gsl_ran_flat(rng, -1e-2, 1e-2));
+		double phi = gsl_ran_flat(rng, 0.0, 6.283185307179586);
+		w->x[0] = b->p[0] + r * cos(phi);
+		w->x[1] = b->p[1] + r * sin(phi);
+		if (!thesis_broad_phase_clear(w, f, h))
+			continue;
+		clear++;
+		for (int i = 0; i < w->n_beams; i++) {
+			const thesis_beam *c = &w->beams[i];
+			double dx = w->x[0] - c->p[0], dy = w->x[1] - c->p[1];
+			double ri = c->length + w->radius + thesis_step_margin(w, c, speed, h);
+			assert_true(dx * dx + dy * dy > ri * ri);
+		}
+	}
+	assert_true(clear > 20000); /* about 46,000 of 200,000 */
+	gsl_rng_free(rng);
+	bsim_backend_thesis.destroy(w);
+	bsim_scene_free(&s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_fminmax_as_libm),
+	        cmocka_unit_test(test_fminmax_ieee),
 	        cmocka_unit_test(test_schedule_held_value),
 	        cmocka_unit_test(test_gate_as_fresh),
 	        cmocka_unit_test(test_lattice_as_fresh),
+	        cmocka_unit_test(test_free_flight_as_detection),
+	        cmocka_unit_test(test_free_flight_bound),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

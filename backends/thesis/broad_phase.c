@@ -138,8 +138,8 @@ static void sort_small(int *v, int n)
  * margin, and the test changes no result. NaN or overflow: not clear. */
 int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], double h)
 {
-	if (w->n_beams > BROAD_PHASE_MIN_BEAMS)
-		return 0;
+	if (!w->broad_phase || w->n_beams > BROAD_PHASE_MIN_BEAMS)
+		return 0; /* broad_phase=0: every beam tested, for checking */
 	double speed = (fabs(w->v[0]) + fabs(w->v[1])) +
 	               h * (fabs(force[0]) + fabs(force[1])) * w->inv_mass;
 	double margin = 2.0 * (h * (speed * (1.0 + 1e-12))) + w->slop;

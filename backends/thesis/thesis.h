@@ -118,7 +118,7 @@ int thesis_grid_build(thesis_grid *g, const struct bsim_world *w);
 void thesis_grid_free(thesis_grid *g);
 int thesis_broad_phase(struct bsim_world *w, double speed, double h);
 /* 1 if no beam, all at rest, can reach the body this step (a world the
- * broad phase tests whole only); 0 if one may. */
+ * broad phase tests whole only; never with broad_phase=0); 0 if one may. */
 int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], double h);
 
 /* beam_sleep.c */
