@@ -99,6 +99,27 @@ void figs_note(figs *f, const char *fmt, ...)
 	list_add(&f->res->notes, &f->res->n_notes, strdup(buf));
 }
 
+int figs_each_group(figs *f, int n_groups, figs_group_fn draw, void *job, bsim_error *err)
+{
+	int failed = n_groups;
+	bsim_error first_err;
+	bsim_error_clear(&first_err);
+#pragma omp parallel for schedule(dynamic) num_threads(f->threads)
+	for (int g = 0; g < n_groups; g++) {
+		bsim_error e1;
+		if (draw(f, job, g, &e1) == BSIM_OK)
+			continue;
+#pragma omp critical(bsim_figures_fail)
+		if (g < failed) {
+			failed = g;
+			first_err = e1;
+		}
+	}
+	if (failed < n_groups)
+		return bsim_error_set(err, first_err.code, "%s", first_err.msg);
+	return BSIM_OK;
+}
+
 int gp_text_open(gp_text *t, bsim_error *err)
 {
 	t->buf = NULL;

@@ -47,6 +47,15 @@ int figs_data_commit(bsim_atomic_file *o, bsim_error *err);
 int figs_render(figs *f, const char *name, int width, int height, const char *body,
                 bsim_error *err);
 
+/* Draws group g's figures of job; BSIM_OK also for a group with nothing
+ * to draw. */
+typedef int (*figs_group_fn)(figs *f, void *job, int g, bsim_error *err);
+
+/* draw for every group, as many at a time as f's threads (each is mostly
+ * gnuplot's drawing). The error kept is the lowest group's, whatever the
+ * thread count. */
+int figs_each_group(figs *f, int n_groups, figs_group_fn draw, void *job, bsim_error *err);
+
 /* Records a line about what was not drawn and why. */
 void figs_note(figs *f, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

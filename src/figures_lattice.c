@@ -901,28 +901,15 @@ void figs_lattice_free(lat_job *j)
 	free(j);
 }
 
+static int lat_group_fn(figs *f, void *job, int g, bsim_error *err)
+{
+	lat_job *j = job;
+	return j->s->g[g].selected ? lat_group(f, j, g, err) : BSIM_OK;
+}
+
 int figs_lattice_draw(figs *f, lat_job *j, bsim_error *err)
 {
-	/* one group's figures per task, as many at a time as threads; the
-	 * error kept is the lowest group's, whatever the thread count */
-	const fsum *s = j->s;
-	int failed = s->n_groups;
-	bsim_error first_err;
-	bsim_error_clear(&first_err);
-#pragma omp parallel for schedule(dynamic) num_threads(f->threads)
-	for (int g = 0; g < s->n_groups; g++) {
-		bsim_error e1;
-		if (!s->g[g].selected || lat_group(f, j, g, &e1) == BSIM_OK)
-			continue;
-#pragma omp critical(bsim_figures_fail)
-		if (g < failed) {
-			failed = g;
-			first_err = e1;
-		}
-	}
-	if (failed < s->n_groups)
-		return bsim_error_set(err, first_err.code, "%s", first_err.msg);
-	return BSIM_OK;
+	return figs_each_group(f, j->s->n_groups, lat_group_fn, j, err);
 }
 
 int figs_is_lattice(const char *dir)

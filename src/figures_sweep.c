@@ -568,32 +568,20 @@ static void traj_free(traj_job *j, int have)
 	bsim_experiment_free(&j->e_own);
 }
 
-/* One group's figures per task, as many at a time as threads: each is
- * mostly gnuplot's drawing. The error kept is the lowest group's, whatever
- * the thread count. */
+static int traj_group(figs *f, void *job, int g, bsim_error *err)
+{
+	traj_job *j = job;
+	if (!j->s->g[g].selected || j->count[g] == 0)
+		return BSIM_OK;
+	return group_figures(f, j, g, err);
+}
+
 static int traj_draw(figs *f, const char *dir, traj_job *j, bsim_error *err)
 {
-	const fsum *s = j->s;
-	int failed = s->n_groups;
-	bsim_error first_err;
-	bsim_error_clear(&first_err);
-#pragma omp parallel for schedule(dynamic) num_threads(f->threads)
-	for (int g = 0; g < s->n_groups; g++) {
-		if (!s->g[g].selected || j->count[g] == 0)
-			continue;
-		bsim_error e1;
-		if (group_figures(f, j, g, &e1) != BSIM_OK) {
-#pragma omp critical(bsim_figures_fail)
-			if (g < failed) {
-				failed = g;
-				first_err = e1;
-			}
-		}
-	}
-	if (failed < s->n_groups)
-		return bsim_error_set(err, first_err.code, "%s", first_err.msg);
-	untraversed_note(f, dir, j->untraversed, s->n_groups);
-	return BSIM_OK;
+	int rc = figs_each_group(f, j->s->n_groups, traj_group, j, err);
+	if (rc == BSIM_OK)
+		untraversed_note(f, dir, j->untraversed, j->s->n_groups);
+	return rc;
 }
 
 int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
