@@ -1,11 +1,15 @@
 /* beamsim bench: the speed of a backend on the essay's experiments, on one
- * thread and on all of them, the wall time of H1 + H2 together, and the
- * speed of a second backend on the same H1 trials (same scenes, same time
- * step, same schedules) with the ratio of the two. */
+ * thread (--repeat times, with the median) and on all of them, the wall
+ * time of H1 + H2 together, free flight against a minimal loop
+ * (bench_free.c), and the speed of a second backend on the same H1 trials
+ * (same scenes, same time step, same schedules) with the ratio of the two
+ * and the share of the second backend's time spent reading the clock for
+ * its own profiling (bench_clock.c). */
 #define _POSIX_C_SOURCE 200809L
 
 #include <omp.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -13,6 +17,8 @@
 #include "json.h"
 #include "beamsim/output.h"
 #include "beamsim/sweep.h"
+#include "bench_clock.h"
+#include "bench_free.h"
 #include "bench_lattice.h"
 #include "cli_common.h"
 #include "cli_options.h"
@@ -24,7 +30,7 @@
  * goes to standard output (--json -). */
 static FILE *report;
 
-enum { OWN_EXPERIMENT, OWN_NO_H2, OWN_VS, OWN_VS_OPT, OWN_JSON, OWN_LATTICE };
+enum { OWN_EXPERIMENT, OWN_NO_H2, OWN_VS, OWN_VS_OPT, OWN_JSON, OWN_LATTICE, OWN_REPEAT };
 
 static const cli_own bench_own[] = {
         [OWN_EXPERIMENT] = {"experiment", 1, "FILE",
@@ -38,6 +44,9 @@ static const cli_own bench_own[] = {
                          "on --backend and --vs, the same schedules at every\n"
                          "size (--trials per size, default 200; the --vs\n"
                          "backend a twentieth of it, default 10)"},
+        [OWN_REPEAT] = {"repeat", 1, "N",
+                        "run the experiment on one thread N times (default 1)\n"
+                        "and report the median, minimum and maximum"},
 };
 
 static const char *const bench_help[CLI_N_OPTS] = {
@@ -55,6 +64,7 @@ typedef struct bench_args {
 	bsim_options vs_opts;
 	const char *json;
 	int lattice;
+	int repeat; /* one-thread runs of the experiment */
 } bench_args;
 
 typedef struct bench_run {
@@ -64,7 +74,15 @@ typedef struct bench_run {
 	double wall;
 } bench_run;
 
-#define BENCH_RUNS_MAX 4
+#define BENCH_REPEAT_MAX 100
+#define BENCH_RUNS_MAX   (BENCH_REPEAT_MAX + 3)
+
+/* What the second backend's run spent reading the clock for its own
+ * profiling (Box2D's b2Timer; none for the thesis backend). */
+typedef struct bench_timers {
+	unsigned long reads; /* during its run */
+	double read_seconds; /* one read, s */
+} bench_timers;
 
 static int bench_option(void *args, int i, const char *value)
 {
@@ -90,6 +108,17 @@ static int bench_option(void *args, int i, const char *value)
 	case OWN_LATTICE:
 		a->lattice = 1;
 		return CLI_OK;
+	case OWN_REPEAT: {
+		char *end;
+		long n = strtol(value, &end, 10);
+		if (*end || n < 1 || n > BENCH_REPEAT_MAX) {
+			cli_error("bench: --repeat: expected a whole number from 1 to %d, got '%s'",
+			          BENCH_REPEAT_MAX, value);
+			return CLI_USAGE;
+		}
+		a->repeat = (int)n;
+		return CLI_OK;
+	}
 	}
 	return CLI_USAGE;
 }
@@ -97,20 +126,22 @@ static int bench_option(void *args, int i, const char *value)
 static const cli_spec bench_spec = {
         .name = "bench",
         .usage = "[OPTIONS]",
-        .about = "Runs an experiment (default " BENCH_H1 ") on one thread and\n"
-                 "on all threads and reports wall time, steps/s, trials/s and steps/s per "
-                 "core;\n"
-                 "then runs " BENCH_H2 " on all threads and reports the\n"
-                 "wall time of H1 + H2. Then runs the experiment on one thread with a second\n"
-                 "backend (--vs, default box2d) at the same time step and prints how many\n"
-                 "times faster the first is, per step and per trial. The default experiment\n"
-                 "paths are relative to the current directory (run it from the source "
-                 "tree).\n",
+        .about = "Runs an experiment (default " BENCH_H1 ") on one thread\n"
+                 "(--repeat times) and on all threads and reports wall time, steps/s,\n"
+                 "trials/s and steps/s per core; then runs " BENCH_H2 " on\n"
+                 "all threads and reports the wall time of H1 + H2. Then the experiment as\n"
+                 "free flight (the body far below every beam) on one thread against a\n"
+                 "minimal loop of the same steps' physics. Then the experiment on one thread\n"
+                 "with a second backend (--vs, default box2d) at the same time step: how\n"
+                 "many times faster the first is, per step and per trial, and what share of\n"
+                 "the second's time went to reading the clock for its own profiling. The\n"
+                 "default experiment paths are relative to the current directory (run it\n"
+                 "from the source tree).\n",
         .common = CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_BACKEND_OPT) |
                   CLI_USES(CLI_OPT_TRIALS),
         .help = bench_help,
         .own = bench_own,
-        .n_own = 6,
+        .n_own = 7,
         .option = bench_option,
 };
 
@@ -162,19 +193,6 @@ static int bench_sweep(const bsim_backend *backend, const bsim_options *opts,
 	return CLI_OK;
 }
 
-/* Runs e on each of the thread counts, appending to runs. */
-static int bench_experiment(const bench_args *a, const bsim_backend *backend,
-                            const bsim_experiment *e, const char *path, const int *threads,
-                            int n_threads, bench_run *runs, int *n_runs)
-{
-	int rc = CLI_OK;
-	for (int i = 0; i < n_threads && rc == CLI_OK; i++) {
-		rc = bench_sweep(backend, &a->opts, e, path, threads[i], &runs[*n_runs]);
-		*n_runs += rc == CLI_OK;
-	}
-	return rc;
-}
-
 static void bench_json_run(FILE *f, const bench_run *r)
 {
 	fputs("{\"experiment\": ", f);
@@ -196,29 +214,66 @@ static double bench_speedup_per_step(const bench_run *mine, const bench_run *the
 	       cli_per_second(theirs->steps, theirs->wall);
 }
 
-/* h1_h2 < 0: no H1 + H2 step, written as null. vs: the second backend,
- * whose run is the last of runs (NULL: none). */
+/* Everything one bench run measured. */
+typedef struct bench_results {
+	bench_run runs[BENCH_RUNS_MAX]; /* in order: one thread, all, H2, the second backend */
+	int n_runs, n_single;
+	int median;   /* index of the median one-thread run (by wall time) */
+	int all, h2;  /* index of the all-threads H1 and H2 runs, -1: none */
+	int vs;       /* index of the second backend's run, -1: none */
+	double h1_h2; /* s, < 0: not run */
+	int have_free;
+	bench_free_result free;
+	bench_timers timers;
+} bench_results;
+
+/* The time the second backend's run spent reading the clock, s. */
+static double bench_timer_seconds(const bench_results *b)
+{
+	return (double)b->timers.reads * b->timers.read_seconds;
+}
+
+static void bench_json_free(FILE *f, const bench_free_result *r)
+{
+	double ns = 1e9 * r->beamsim_seconds / (double)r->steps;
+	double ns_min = 1e9 * r->minimal_seconds / (double)r->steps;
+	fprintf(f, "{\"trials\": %ld, \"steps\": %ld, \"ns_per_step\": ", r->trials, r->steps);
+	bsim_json_number(f, ns);
+	fputs(", \"minimal_ns_per_step\": ", f);
+	bsim_json_number(f, ns_min);
+	fputs(", \"ratio\": ", f);
+	bsim_json_number(f, ns / ns_min);
+	fputc('}', f);
+}
+
 static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *backend,
-                             const bsim_backend *vs, int threads, const bench_run *runs, int n_runs,
-                             double h1_h2)
+                             const bsim_backend *vs, int threads, const bench_results *b)
 {
 	fputs("{\"backend\": ", f);
 	bsim_json_string(f, a->backend);
 	fputs(", \"options\": ", f);
 	bsim_output_backend_options(f, backend, &a->opts);
 	fprintf(f, ", \"threads\": %d, \"runs\": [", threads);
-	for (int i = 0; i < n_runs; i++) {
+	for (int i = 0; i < b->n_runs; i++) {
 		fputs(i ? ",\n  " : "\n  ", f);
-		bench_json_run(f, &runs[i]);
+		bench_json_run(f, &b->runs[i]);
 	}
-	fputs("],\n \"h1_h2_seconds\": ", f);
-	if (h1_h2 >= 0)
-		bsim_json_number(f, h1_h2);
+	fprintf(f, "],\n \"repeat\": %d, \"one_thread_median\": ", b->n_single);
+	bench_json_run(f, &b->runs[b->median]);
+	fputs(",\n \"h1_h2_seconds\": ", f);
+	if (b->h1_h2 >= 0)
+		bsim_json_number(f, b->h1_h2);
+	else
+		fputs("null", f);
+	fputs(",\n \"free_flight\": ", f);
+	if (b->have_free)
+		bench_json_free(f, &b->free);
 	else
 		fputs("null", f);
 	fputs(",\n \"vs\": ", f);
 	if (vs) {
-		const bench_run *mine = &runs[0], *theirs = &runs[n_runs - 1];
+		const bench_run *mine = &b->runs[b->median], *theirs = &b->runs[b->vs];
+		double timer_s = bench_timer_seconds(b);
 		fputs("{\"backend\": ", f);
 		bsim_json_string(f, vs->name);
 		fputs(", \"options\": ", f);
@@ -229,6 +284,14 @@ static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *b
 		bsim_json_number(f, bench_speedup_per_step(mine, theirs));
 		fputs(", \"speedup_per_trial\": ", f);
 		bsim_json_number(f, theirs->wall / mine->wall);
+		fprintf(f, ", \"clock_reads\": %lu, \"clock_reads_per_step\": ", b->timers.reads);
+		bsim_json_number(f, (double)b->timers.reads / (double)theirs->steps);
+		fputs(", \"clock_read_ns\": ", f);
+		bsim_json_number(f, 1e9 * b->timers.read_seconds);
+		fputs(", \"clock_share\": ", f);
+		bsim_json_number(f, timer_s / theirs->wall);
+		fputs(", \"speedup_per_trial_without_clock\": ", f);
+		bsim_json_number(f, (theirs->wall - timer_s) / mine->wall);
 		fputc('}', f);
 	} else {
 		fputs("null", f);
@@ -237,35 +300,100 @@ static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *b
 }
 
 static int bench_json(const bench_args *a, const bsim_backend *backend, const bsim_backend *vs,
-                      int threads, const bench_run *runs, int n_runs, double h1_h2)
+                      int threads, const bench_results *b)
 {
 	bsim_atomic_file o;
 	bsim_error err;
 	if (bsim_atomic_file_open(&o, a->json, &err) != BSIM_OK)
 		return cli_report(BSIM_EFAIL, &err);
-	bench_json_write(o.f, a, backend, vs, threads, runs, n_runs, h1_h2);
+	bench_json_write(o.f, a, backend, vs, threads, b);
 	return cli_report(bsim_atomic_file_commit(&o, &err), &err);
 }
 
-/* Both experiments are loaded before anything runs, so a bad file fails
- * at once rather than after the first timing. */
 /* The second backend on the first run's trials: one thread each, so the
- * ratio compares the solvers, not the scheduling. */
+ * ratio compares the solvers, not the scheduling; its clock reads counted. */
 static int bench_vs(const bench_args *a, const bsim_backend *vs, const bsim_experiment *h1,
-                    bench_run *runs, int *n_runs)
+                    bench_results *b)
 {
 	fprintf(report, "\nbackend %s, 1 thread\n\n", vs->name);
 	bench_print_header();
-	int rc = bench_sweep(vs, &a->vs_opts, h1, a->experiment, 1, &runs[*n_runs]);
+	unsigned long reads0 = bench_clock_reads();
+	int rc = bench_sweep(vs, &a->vs_opts, h1, a->experiment, 1, &b->runs[b->n_runs]);
 	if (rc != CLI_OK)
 		return rc;
-	const bench_run *mine = &runs[0], *theirs = &runs[*n_runs];
-	(*n_runs)++;
+	b->timers.reads = bench_clock_reads() - reads0;
+	b->timers.read_seconds = bench_clock_read_seconds();
+	b->vs = b->n_runs++;
+	const bench_run *mine = &b->runs[b->median], *theirs = &b->runs[b->vs];
+	double timer_s = bench_timer_seconds(b);
 	fprintf(report,
 	        "\n%s is %.1f times faster than %s per step and %.1f times per trial "
 	        "(%s, same time step, 1 thread)\n",
 	        a->backend, bench_speedup_per_step(mine, theirs), vs->name,
 	        theirs->wall / mine->wall, a->experiment);
+	fprintf(report,
+	        "%s read the clock %.1f times a step for its own profiling (%.1f ns a read): "
+	        "%.0f%% of its time;\nwithout those reads %s would be %.1f times faster per "
+	        "trial\n",
+	        vs->name, (double)b->timers.reads / (double)theirs->steps,
+	        1e9 * b->timers.read_seconds, 100.0 * timer_s / theirs->wall, a->backend,
+	        (theirs->wall - timer_s) / mine->wall);
+	return CLI_OK;
+}
+
+static int cmp_wall(const void *x, const void *y)
+{
+	double a = ((const bench_run *)x)->wall, b = ((const bench_run *)y)->wall;
+	return (a > b) - (a < b);
+}
+
+/* The one-thread runs, --repeat of them, and the index of the median. */
+static int bench_single(const bench_args *a, const bsim_backend *backend, const bsim_experiment *h1,
+                        bench_results *b)
+{
+	for (int i = 0; i < a->repeat; i++) {
+		int rc = bench_sweep(backend, &a->opts, h1, a->experiment, 1, &b->runs[b->n_runs]);
+		if (rc != CLI_OK)
+			return rc;
+		b->n_runs++;
+	}
+	b->n_single = a->repeat;
+	bench_run sorted[BENCH_REPEAT_MAX];
+	memcpy(sorted, b->runs, (size_t)a->repeat * sizeof *sorted);
+	qsort(sorted, (size_t)a->repeat, sizeof *sorted, cmp_wall);
+	b->median = 0;
+	for (int i = 0; i < a->repeat; i++)
+		if (b->runs[i].wall == sorted[a->repeat / 2].wall)
+			b->median = i;
+	if (a->repeat > 1) {
+		double med =
+		        cli_per_second(sorted[a->repeat / 2].steps, sorted[a->repeat / 2].wall);
+		fprintf(report, "%-36s one thread, %d runs: median %.4g steps/s (%.4g .. %.4g)\n",
+		        "", a->repeat, med,
+		        cli_per_second(sorted[a->repeat - 1].steps, sorted[a->repeat - 1].wall),
+		        cli_per_second(sorted[0].steps, sorted[0].wall));
+	}
+	return CLI_OK;
+}
+
+static int bench_free_flight(const bench_args *a, const bsim_backend *backend, bench_results *b)
+{
+	bench_free_args fa = {
+	        .experiment = a->experiment,
+	        .trials = a->trials,
+	        .backend = backend,
+	        .opts = &a->opts,
+	};
+	int rc = bench_free(&fa, &b->free);
+	if (rc != CLI_OK)
+		return rc;
+	b->have_free = 1;
+	double ns = 1e9 * b->free.beamsim_seconds / (double)b->free.steps;
+	double ns_min = 1e9 * b->free.minimal_seconds / (double)b->free.steps;
+	fprintf(report,
+	        "\nfree flight (%s, the body 10 km below the beams, 1 thread, %ld steps): "
+	        "%s %.1f ns/step,\nminimal loop %.1f ns/step: %.1f times the minimal loop\n",
+	        a->experiment, b->free.steps, a->backend, ns, ns_min, ns / ns_min);
 	return CLI_OK;
 }
 
@@ -286,34 +414,48 @@ static int bench_main(const bench_args *a, const bsim_backend *backend, const bs
 		return rc;
 	}
 
-	bench_run runs[BENCH_RUNS_MAX];
-	int n_runs = 0;
-	const int h1_threads[] = {1, all};
+	bench_results *b = calloc(1, sizeof *b);
+	if (!b) {
+		bsim_experiment_free(&h1);
+		if (a->h2)
+			bsim_experiment_free(&h2);
+		cli_error("out of memory");
+		return CLI_FAIL;
+	}
+	b->all = b->h2 = b->vs = -1;
+	b->h1_h2 = -1.0;
 	fprintf(report, "backend %s, %d threads\n\n", a->backend, all);
 	bench_print_header();
-	rc = bench_experiment(a, backend, &h1, a->experiment, h1_threads, 2, runs, &n_runs);
-	if (rc == CLI_OK && a->h2)
-		rc = bench_experiment(a, backend, &h2, BENCH_H2, &all, 1, runs, &n_runs);
+	rc = bench_single(a, backend, &h1, b);
+	if (rc == CLI_OK && (rc = bench_sweep(backend, &a->opts, &h1, a->experiment, all,
+	                                      &b->runs[b->n_runs])) == CLI_OK)
+		b->all = b->n_runs++;
+	if (rc == CLI_OK && a->h2 &&
+	    (rc = bench_sweep(backend, &a->opts, &h2, BENCH_H2, all, &b->runs[b->n_runs])) ==
+	            CLI_OK)
+		b->h2 = b->n_runs++;
 	/* The all-threads H1 run above is the H1 half of H1 + H2. */
-	double h1_h2 = -1.0;
 	if (rc == CLI_OK && a->h2) {
-		h1_h2 = runs[1].wall + runs[2].wall;
-		fprintf(report, "\nH1 + H2 on %d threads: %.3f s\n", all, h1_h2);
+		b->h1_h2 = b->runs[b->all].wall + b->runs[b->h2].wall;
+		fprintf(report, "\nH1 + H2 on %d threads: %.3f s\n", all, b->h1_h2);
 	}
+	if (rc == CLI_OK)
+		rc = bench_free_flight(a, backend, b);
 	if (rc == CLI_OK && vs)
-		rc = bench_vs(a, vs, &h1, runs, &n_runs);
+		rc = bench_vs(a, vs, &h1, b);
 	bsim_experiment_free(&h1);
 	if (a->h2)
 		bsim_experiment_free(&h2);
-	if (rc != CLI_OK)
-		return rc;
-	return a->json ? bench_json(a, backend, vs, all, runs, n_runs, h1_h2) : CLI_OK;
+	if (rc == CLI_OK && a->json)
+		rc = bench_json(a, backend, vs, all, b);
+	free(b);
+	return rc;
 }
 
 int cmd_bench(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	bench_args a = {.experiment = BENCH_H1, .h2 = 1, .vs = "box2d"};
+	bench_args a = {.experiment = BENCH_H1, .h2 = 1, .vs = "box2d", .repeat = 1};
 	int rc = cli_parse(&bench_spec, argc, argv, &c, &a, NULL);
 	a.backend = c.backend ? c.backend : bsim_backend_default()->name;
 	a.trials = c.trials;

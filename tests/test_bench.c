@@ -1,0 +1,115 @@
+/* beamsim bench's figures read against what they must be:
+ *   - Box2D 2.4.1 reads its clock, for its b2Profile, twice for the step and
+ *     twice each for collide, solve, the broad phase and continuous
+ *     collision (b2_world.cpp) and seven times per island (b2_island.cpp):
+ *     10 + 7 k reads a step with k = 1 .. 3 islands for the gate's body and
+ *     two beams, so between 17 and 31; the thesis backend never reads it;
+ *   - taking that time out of Box2D's lowers the ratio, by its share;
+ *   - free flight runs every trial to its last step (trials x max_steps);
+ *   - --repeat N gives N one-thread runs and the median of them. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "support.h"
+
+/* The number after "key": in text, searching from start. */
+static double number_after(const char *text, const char *key)
+{
+	char pat[128];
+	snprintf(pat, sizeof pat, "\"%s\": ", key);
+	const char *p = strstr(text, pat);
+	assert_non_null(p);
+	return strtod(p + strlen(pat), NULL);
+}
+
+static char *bench_json(const char *name, const char *backend, const char *vs, const char *repeat)
+{
+	const char *dir = bsim_test_dir(name);
+	char json[1200];
+	snprintf(json, sizeof json, "%s/bench.json", dir);
+	char h1[1200];
+	snprintf(h1, sizeof h1, "%s", bsim_test_src("configs/thesis/h1_symmetric.yaml"));
+	const char *argv[] = {"bench",     "--experiment", h1,     "--trials", "2",
+	                      "--backend", backend,        "--vs", vs,         "--repeat",
+	                      repeat,      "--json",       json,   NULL};
+	char *out = NULL, *err = NULL;
+	int rc = bsim_test_cli(argv, &out, &err);
+	if (rc != 0)
+		fail_msg("bench exited %d: %s", rc, err);
+	free(out);
+	free(err);
+	char *text = bsim_test_read(json);
+	assert_non_null(text);
+	return text;
+}
+
+static void box2d_reads_its_clock(void **state)
+{
+	(void)state;
+	char *j = bench_json("bench_thesis", "thesis", "box2d", "3");
+	const char *vs = strstr(j, "\"vs\": {");
+	assert_non_null(vs);
+	double per_step = number_after(vs, "clock_reads_per_step");
+	assert_true(per_step >= 17.0 && per_step <= 31.0);
+	double share = number_after(vs, "clock_share");
+	assert_true(share > 0.0 && share < 1.0);
+	double with = number_after(vs, "speedup_per_trial");
+	double without = number_after(vs, "speedup_per_trial_without_clock");
+	assert_true(fabs(without - with * (1.0 - share)) <= 1e-9 * with);
+
+	/* free flight: every trial to its last step, 3000 of them */
+	const char *ff = strstr(j, "\"free_flight\": {");
+	assert_non_null(ff);
+	double trials = number_after(ff, "trials"), steps = number_after(ff, "steps");
+	assert_true(trials > 0 && steps == 3000.0 * trials);
+	assert_true(number_after(ff, "ns_per_step") > 0.0 &&
+	            number_after(ff, "minimal_ns_per_step") > 0.0);
+
+	/* three one-thread runs, the median theirs */
+	assert_int_equal((int)number_after(j, "repeat"), 3);
+	double wall[3];
+	const char *p = strstr(j, "\"runs\": [");
+	assert_non_null(p);
+	for (int i = 0; i < 3; i++) {
+		p = strstr(p, "\"threads\": 1,");
+		assert_non_null(p);
+		wall[i] = number_after(p, "wall_seconds");
+		p++;
+	}
+	double median = number_after(strstr(j, "\"one_thread_median\""), "wall_seconds");
+	int below = 0, above = 0;
+	for (int i = 0; i < 3; i++) {
+		below += wall[i] < median;
+		above += wall[i] > median;
+	}
+	assert_true(below <= 1 && above <= 1);
+	free(j);
+}
+
+/* The other way round: the thesis backend as the second one reads no clock. */
+static void thesis_reads_none(void **state)
+{
+	(void)state;
+	char *j = bench_json("bench_box2d", "box2d", "thesis", "1");
+	const char *vs = strstr(j, "\"vs\": {");
+	assert_non_null(vs);
+	assert_true(number_after(vs, "clock_reads") == 0.0);
+	assert_true(number_after(vs, "clock_share") == 0.0);
+	free(j);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(box2d_reads_its_clock),
+	        cmocka_unit_test(thesis_reads_none),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
