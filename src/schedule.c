@@ -127,9 +127,9 @@ double bsim_schedule_at_step(bsim_schedule *s, long n, double h)
 {
 	if (n >= s->held_lo && n < s->held_hi && h == s->held_h)
 		return s->held_value;
-	long j = bsim_schedule_index(s, n, h);
-	double value = bsim_schedule_value(s, j);
 	long whole = schedule_steps_per_value(s, h);
+	long j = whole ? n / whole : bsim_schedule_index(s, n, h);
+	double value = bsim_schedule_value(s, j);
 	if (whole && !s->failed && n >= 0 && n < LONG_MAX - whole) {
 		s->held_lo = j * whole;
 		s->held_hi = s->held_lo + whole;
