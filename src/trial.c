@@ -379,23 +379,12 @@ void bsim_trial_instability_text(const bsim_trial_result *r, double dt, char *bu
 	}
 }
 
-/* A step's energy, energy_kinetic + energy_springs to the bit, and whether
- * the state is finite, in one pass over the active beams (each sum keeps
- * its own order). */
-static double energy_step(const bsim_scene *sc, const bsim_state *s, int *finite)
+static int state_finite(const bsim_state *s)
 {
-	double e_kin = 0.5 * sc->body.mass * (s->v[0] * s->v[0] + s->v[1] * s->v[1]);
-	double e_spring = 0.0;
 	double sum = s->x[0] + s->x[1] + s->v[0] + s->v[1];
-	for (int k = 0; k < s->n_active; k++) {
-		int i = s->active[k];
-		const bsim_beam_def *b = &sc->beams[i];
-		e_kin += 0.5 * b->inertia * s->omega[i] * s->omega[i];
-		e_spring += 0.5 * b->stiffness * s->theta[i] * s->theta[i];
-		sum += s->theta[i] + s->omega[i];
-	}
-	*finite = isfinite(sum);
-	return e_kin + e_spring;
+	for (int k = 0; k < s->n_active; k++)
+		sum += s->theta[s->active[k]] + s->omega[s->active[k]];
+	return isfinite(sum);
 }
 
 static int any_contact(const bsim_state *s)
@@ -735,9 +724,8 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 		if ((rc = backend->step(c.w, f, h, err)) != BSIM_OK)
 			break;
 		backend->get_state(c.w, s1);
-		int finite;
-		double e1 = energy_step(c.ws, s1, &finite);
-		if (!finite || !isfinite(e1)) {
+		double e1 = energy_kinetic(c.ws, s1) + energy_springs(c.ws, s1);
+		if (!state_finite(s1) || !isfinite(e1)) {
 			/* s0 stays the last finite state, the one reported. */
 			out->instability = BSIM_UNSTABLE_NONFINITE;
 			out->unstable_step = (int)(n + 1);
