@@ -305,3 +305,15 @@ int bsim_test_data_rows(const char *path, int block, double (*rows)[16], int max
 	free(text);
 	return n;
 }
+
+double bsim_test_json_number(const char *text, const char *key)
+{
+	char pat[128];
+	snprintf(pat, sizeof pat, "\"%s\": ", key);
+	const char *p = text ? strstr(text, pat) : NULL;
+	if (!p) {
+		fprintf(stderr, "no \"%s\" in the JSON\n", key);
+		abort();
+	}
+	return strtod(p + strlen(pat), NULL);
+}

@@ -46,6 +46,10 @@ const char *bsim_test_src(const char *rel);
  * stderr) if one is missing or out of that range. */
 int bsim_test_check_figures(const char *dir);
 
+/* The number after "key": in JSON text (the first such key from text on);
+ * aborts the test if there is none. */
+double bsim_test_json_number(const char *text, const char *key);
+
 /* Wilson's 95% score interval of k successes in n, in closed form. */
 void bsim_test_wilson(int k, int n, double *lo, double *hi);
 

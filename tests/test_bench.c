@@ -19,16 +19,6 @@
 
 #include "support.h"
 
-/* The number after "key": in text, searching from start. */
-static double number_after(const char *text, const char *key)
-{
-	char pat[128];
-	snprintf(pat, sizeof pat, "\"%s\": ", key);
-	const char *p = strstr(text, pat);
-	assert_non_null(p);
-	return strtod(p + strlen(pat), NULL);
-}
-
 static char *bench_json(const char *name, const char *backend, const char *vs, const char *repeat)
 {
 	const char *dir = bsim_test_dir(name);
@@ -56,34 +46,35 @@ static void box2d_reads_its_clock(void **state)
 	char *j = bench_json("bench_thesis", "thesis", "box2d", "3");
 	const char *vs = strstr(j, "\"vs\": {");
 	assert_non_null(vs);
-	double per_step = number_after(vs, "clock_reads_per_step");
+	double per_step = bsim_test_json_number(vs, "clock_reads_per_step");
 	assert_true(per_step >= 17.0 && per_step <= 31.0);
-	double share = number_after(vs, "clock_share");
+	double share = bsim_test_json_number(vs, "clock_share");
 	assert_true(share > 0.0 && share < 1.0);
-	double with = number_after(vs, "speedup_per_trial");
-	double without = number_after(vs, "speedup_per_trial_without_clock");
+	double with = bsim_test_json_number(vs, "speedup_per_trial");
+	double without = bsim_test_json_number(vs, "speedup_per_trial_without_clock");
 	assert_true(fabs(without - with * (1.0 - share)) <= 1e-9 * with);
 
 	/* free flight: every trial to its last step, 3000 of them */
 	const char *ff = strstr(j, "\"free_flight\": {");
 	assert_non_null(ff);
-	double trials = number_after(ff, "trials"), steps = number_after(ff, "steps");
+	double trials = bsim_test_json_number(ff, "trials"),
+	       steps = bsim_test_json_number(ff, "steps");
 	assert_true(trials > 0 && steps == 3000.0 * trials);
-	assert_true(number_after(ff, "ns_per_step") > 0.0 &&
-	            number_after(ff, "minimal_ns_per_step") > 0.0);
+	assert_true(bsim_test_json_number(ff, "ns_per_step") > 0.0 &&
+	            bsim_test_json_number(ff, "minimal_ns_per_step") > 0.0);
 
 	/* three one-thread runs, the median theirs */
-	assert_int_equal((int)number_after(j, "repeat"), 3);
+	assert_int_equal((int)bsim_test_json_number(j, "repeat"), 3);
 	double wall[3];
 	const char *p = strstr(j, "\"runs\": [");
 	assert_non_null(p);
 	for (int i = 0; i < 3; i++) {
 		p = strstr(p, "\"threads\": 1,");
 		assert_non_null(p);
-		wall[i] = number_after(p, "wall_seconds");
+		wall[i] = bsim_test_json_number(p, "wall_seconds");
 		p++;
 	}
-	double median = number_after(strstr(j, "\"one_thread_median\""), "wall_seconds");
+	double median = bsim_test_json_number(strstr(j, "\"one_thread_median\""), "wall_seconds");
 	int below = 0, above = 0;
 	for (int i = 0; i < 3; i++) {
 		below += wall[i] < median;
@@ -100,8 +91,8 @@ static void thesis_reads_none(void **state)
 	char *j = bench_json("bench_box2d", "box2d", "thesis", "1");
 	const char *vs = strstr(j, "\"vs\": {");
 	assert_non_null(vs);
-	assert_true(number_after(vs, "clock_reads") == 0.0);
-	assert_true(number_after(vs, "clock_share") == 0.0);
+	assert_true(bsim_test_json_number(vs, "clock_reads") == 0.0);
+	assert_true(bsim_test_json_number(vs, "clock_share") == 0.0);
 	free(j);
 }
 

@@ -38,16 +38,6 @@ static long file_size(const char *path)
 	return stat(path, &st) == 0 ? (long)st.st_size : -1;
 }
 
-/* The number after "key": in text, searching from start. */
-static double json_number_after(const char *text, const char *key)
-{
-	char pat[128];
-	snprintf(pat, sizeof pat, "\"%s\": ", key);
-	const char *p = strstr(text, pat);
-	assert_non_null(p);
-	return strtod(p + strlen(pat), NULL);
-}
-
 static int setup(void **state)
 {
 	(void)state;
@@ -153,7 +143,7 @@ static void test_mat(void **state)
 	assert_non_null(json);
 	const char *lowest = strstr(json, "\"lowest_pass\"");
 	assert_non_null(lowest);
-	assert_true(((double *)be->data)[0] == json_number_after(lowest, "e_total"));
+	assert_true(((double *)be->data)[0] == bsim_test_json_number(lowest, "e_total"));
 	assert_non_null(strstr(lowest, "\"kind\": \"saddle\""));
 	free(json);
 	Mat_VarFree(v);
@@ -208,8 +198,9 @@ static void test_options(void **state)
 		fail_msg("exit %d: %s", rc, err ? err : "");
 	char *json = bsim_test_read(path_in(dir, "landscape.json"));
 	assert_non_null(json);
-	assert_true(json_number_after(json, "nx") == 101 && json_number_after(json, "ny") == 101);
-	assert_true(json_number_after(json, "spacing") == 0.5);
+	assert_true(bsim_test_json_number(json, "nx") == 101 &&
+	            bsim_test_json_number(json, "ny") == 101);
+	assert_true(bsim_test_json_number(json, "spacing") == 0.5);
 	/* the softer left beam: no barrier over it at the gate's 7 N */
 	const char *lowest = strstr(json, "\"lowest_pass\"");
 	assert_non_null(strstr(lowest, "\"kind\": \"open\", \"crossed\": 1"));
