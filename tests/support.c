@@ -2,7 +2,7 @@
 
 #include "support.h"
 
-#include "figure.h"
+#include "util/figure.h"
 
 #include <dirent.h>
 #include <errno.h>

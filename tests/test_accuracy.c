@@ -17,7 +17,7 @@
 #include <cmocka.h>
 
 #include "beamsim/accuracy.h"
-#include "figure.h"
+#include "util/figure.h"
 #include "support.h"
 
 /* Two beams of the essay's gate released from 0.3 and -0.2 rad, the body

@@ -18,8 +18,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "figure.h"
-#include "mat.h"
+#include "util/figure.h"
+#include "store/mat.h"
 #include "support.h"
 
 static void test_mat_roundtrip(void **state)

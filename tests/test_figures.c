@@ -26,8 +26,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "figure.h"
-#include "figures_internal.h"
+#include "util/figure.h"
+#include "figures/figures_internal.h"
 #include "support.h"
 
 /* ---- helpers --------------------------------------------------------------------- */

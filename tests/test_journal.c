@@ -18,7 +18,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "journal.h"
+#include "util/journal.h"
 #include "support.h"
 
 #define N    400

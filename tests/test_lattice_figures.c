@@ -26,7 +26,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "figure.h"
+#include "util/figure.h"
 #include "support.h"
 
 /* ---- helpers ---------------------------------------------------------------------------- */

@@ -21,8 +21,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "matlab.h"
-#include "mat.h"
+#include "store/matlab.h"
+#include "store/mat.h"
 #include "support.h"
 
 /* ---- a CSV read by the test itself ------------------------------------------ */

@@ -25,7 +25,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "outdir.h"
+#include "store/outdir.h"
 #include "support.h"
 
 static char gate[1200], h1[1200];

@@ -14,8 +14,8 @@
 
 #include <cmocka.h>
 
-#include "atomic_file.h"
-#include "json.h"
+#include "util/atomic_file.h"
+#include "util/json.h"
 #include "support.h"
 
 /* The JSON text of x (static storage). */

@@ -26,7 +26,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "outdir.h"
+#include "store/outdir.h"
 #include "support.h"
 
 #define CYCLES 10 /* kill-and-resume cycles per command */

@@ -20,7 +20,7 @@
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
-#include "fminmax.h"
+#include "util/fminmax.h"
 #include "support.h"
 #include "thesis/thesis.h"
 

@@ -18,7 +18,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "fminmax.h"
+#include "util/fminmax.h"
 #include "thesis/thesis.h"
 
 static void impact_bounds(const struct bsim_world *w, thesis_contact *c)

@@ -21,7 +21,7 @@
  * omega_m,i) is reported, negated, as energy.contact. */
 #include <math.h>
 
-#include "fminmax.h"
+#include "util/fminmax.h"
 #include "thesis/thesis.h"
 
 void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h)

@@ -1,7 +1,7 @@
 /* Shared parts of the beamsim subcommands; see cli_common.h. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "cli_common.h"
+#include "cli/cli_common.h"
 
 #include <errno.h>
 #include <signal.h>
@@ -11,7 +11,7 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
-#include "cli_progress.h"
+#include "cli/cli_progress.h"
 
 void cli_error(const char *fmt, ...)
 {

@@ -1,7 +1,7 @@
 /* The shared options and the parser of every command; see cli_options.h. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "cli_options.h"
+#include "cli/cli_options.h"
 
 #include <getopt.h>
 #include <stdio.h>

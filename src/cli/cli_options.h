@@ -15,7 +15,7 @@
 #include <stdint.h>
 
 #include "beamsim/backend.h"
-#include "cli_common.h"
+#include "cli/cli_common.h"
 
 typedef enum cli_opt {
 	CLI_OPT_BACKEND,

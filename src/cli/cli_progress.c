@@ -1,9 +1,9 @@
 /* The progress line of long runs; see cli_progress.h. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "cli_progress.h"
+#include "cli/cli_progress.h"
 
-#include "clock.h"
+#include "util/clock.h"
 
 #include <stdio.h>
 #include <unistd.h>

@@ -9,9 +9,9 @@
 #include <string.h>
 
 #include "beamsim/accuracy.h"
-#include "cli_common.h"
-#include "cli_options.h"
-#include "cli_progress.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
+#include "cli/cli_progress.h"
 
 #define ACC_SCENE "configs/thesis/gate.yaml"
 

@@ -3,8 +3,8 @@
 #include <string.h>
 
 #include "beamsim/backend.h"
-#include "cli_common.h"
-#include "cli_options.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
 
 static const cli_spec backends_spec = {
         .name = "backends",

@@ -13,15 +13,15 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "atomic_file.h"
-#include "json.h"
+#include "util/atomic_file.h"
+#include "util/json.h"
 #include "beamsim/output.h"
 #include "beamsim/sweep.h"
-#include "bench_clock.h"
-#include "bench_free.h"
-#include "bench_lattice.h"
-#include "cli_common.h"
-#include "cli_options.h"
+#include "bench/bench_clock.h"
+#include "bench/bench_free.h"
+#include "bench/bench_lattice.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
 
 #define BENCH_H1 "configs/thesis/h1_symmetric.yaml"
 #define BENCH_H2 "configs/thesis/h2_asymmetric.yaml"

@@ -10,9 +10,9 @@
 #include <string.h>
 
 #include "beamsim/compare_dir.h"
-#include "cli_common.h"
-#include "cli_options.h"
-#include "cli_progress.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
+#include "cli/cli_progress.h"
 
 enum { OWN_BACKENDS, OWN_PROTOCOLS, OWN_EXAMPLES };
 

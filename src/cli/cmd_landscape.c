@@ -9,8 +9,8 @@
 #include <string.h>
 
 #include "beamsim/landscape.h"
-#include "cli_common.h"
-#include "cli_options.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
 
 enum { OWN_RESOLUTION, OWN_REGION };
 

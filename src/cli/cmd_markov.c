@@ -10,9 +10,9 @@
 
 #include "beamsim/experiment.h"
 #include "beamsim/markov.h"
-#include "cli_common.h"
-#include "cli_options.h"
-#include "cli_progress.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
+#include "cli/cli_progress.h"
 
 enum { OWN_BINS, OWN_VMAX, OWN_ENTRIES, OWN_MAP, OWN_BOOTSTRAP };
 

@@ -6,8 +6,8 @@
 #include <string.h>
 
 #include "beamsim/figures.h"
-#include "cli_common.h"
-#include "cli_options.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
 
 static const cli_own plot_own[] = {
         {"select", 1, "KEY=VALUE",

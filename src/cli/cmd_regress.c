@@ -6,9 +6,9 @@
 #include <stdio.h>
 
 #include "beamsim/regress.h"
-#include "cli_common.h"
-#include "cli_options.h"
-#include "cli_progress.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
+#include "cli/cli_progress.h"
 
 static const cli_own regress_own[] = {
         {"exact", 0, NULL, "any changed trial counts"},

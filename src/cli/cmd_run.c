@@ -14,8 +14,8 @@
 #include "beamsim/run_output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
-#include "cli_common.h"
-#include "cli_options.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
 
 enum { OWN_GROUP, OWN_TRIAL, OWN_TRAJECTORY, OWN_STRIDE, OWN_JSON };
 

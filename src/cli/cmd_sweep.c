@@ -7,9 +7,9 @@
 
 #include "beamsim/output.h"
 #include "beamsim/sweep_dir.h"
-#include "cli_common.h"
-#include "cli_options.h"
-#include "cli_progress.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
+#include "cli/cli_progress.h"
 
 static const cli_own sweep_own[] = {
         {"overlap", 0, NULL,

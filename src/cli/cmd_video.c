@@ -13,8 +13,8 @@
 #include "beamsim/run_output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/video.h"
-#include "cli_common.h"
-#include "cli_options.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
 
 enum { OWN_BACKENDS, OWN_GROUP, OWN_TRIAL, OWN_FPS, OWN_SIZE, OWN_HOLD, OWN_VIEW, OWN_CRF };
 

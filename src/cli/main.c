@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "beamsim/version.h"
-#include "cli_common.h"
+#include "cli/cli_common.h"
 
 typedef struct cli_command {
 	const char *name;

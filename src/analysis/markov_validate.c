@@ -1,0 +1,502 @@
+/* The chain against the simulation it replaces (beamsim markov validate;
+ * beamsim/markov.h): distances with the sampling errors beside them, the
+ * cost of both, and the files and figure that show them. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+#include <gsl/gsl_sort.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "util/atomic_file.h"
+#include "beamsim/experiment.h"
+#include "beamsim/markov.h"
+#include "beamsim/output.h"
+#include "beamsim/stats.h"
+#include "beamsim/sweep.h"
+#include "util/clock.h"
+#include "util/figure.h"
+#include "util/json.h"
+#include "store/matlab.h"
+#include "store/session.h"
+
+bsim_markov_validate_def bsim_markov_validate_default(void)
+{
+	return (bsim_markov_validate_def){.bootstrap = 2000, .map_resamples = 40};
+}
+
+void bsim_markov_validation_free(bsim_markov_validation *v)
+{
+	if (!v)
+		return;
+	free(v->checks);
+	memset(v, 0, sizeof *v);
+}
+
+/* The index of a final location in a prediction's list (its order). */
+static int loc_index(const bsim_lattice_def *l, bsim_location loc)
+{
+	switch (loc.kind) {
+	case BSIM_LOCATION_END:
+		return loc.ix - l->ix_min;
+	case BSIM_LOCATION_SIDE:
+		return l->columns + loc.iy;
+	default:
+		return l->columns + l->rows + loc.iy * l->columns + loc.ix - l->ix_min;
+	}
+}
+
+static double tv(const double *p, const double *q, int n)
+{
+	double s = 0.0;
+	for (int i = 0; i < n; i++)
+		s += fabs(p[i] - q[i]);
+	return 0.5 * s;
+}
+
+/* Mean and 95th percentile of TV(p, resample of p with n trials). */
+static void bootstrap_sim(gsl_rng *rng, const double *p, int n_loc, int trials, int B, double *mean,
+                          double *q95)
+{
+	unsigned int *k = malloc((size_t)n_loc * sizeof *k);
+	double *q = malloc((size_t)n_loc * sizeof *q), *d = malloc((size_t)B * sizeof *d);
+	*mean = NAN;
+	*q95 = NAN;
+	if (k && q && d && B > 0) {
+		double s = 0.0;
+		for (int b = 0; b < B; b++) {
+			gsl_ran_multinomial(rng, (size_t)n_loc, (unsigned)trials, p, k);
+			for (int i = 0; i < n_loc; i++)
+				q[i] = (double)k[i] / trials;
+			d[b] = tv(p, q, n_loc);
+			s += d[b];
+		}
+		gsl_sort(d, 1, (size_t)B);
+		*mean = s / B;
+		*q95 = d[(size_t)(0.95 * (B - 1))];
+	}
+	free(k);
+	free(q);
+	free(d);
+}
+
+/* Mean TV between the chain of set and chains of its maps with each row
+ * resampled multinomially (the same number of trials per bin). */
+static int bootstrap_maps(gsl_rng *rng, const bsim_scene *scene, const bsim_markov_set *set,
+                          const bsim_markov_prediction *pred, int B, double *mean, bsim_error *err)
+{
+	*mean = NAN;
+	if (B <= 0 || set->n == 0)
+		return BSIM_OK;
+	bsim_markov_set rs = *set;
+	rs.maps = calloc((size_t)set->n, sizeof *rs.maps);
+	const int nb = set->maps[0].n_bins;
+	double *p = malloc((size_t)nb * sizeof *p);
+	unsigned int *k = malloc((size_t)nb * sizeof *k);
+	int rc = rs.maps && p && k ? BSIM_OK : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; rc == BSIM_OK && i < set->n; i++) {
+		rs.maps[i] = set->maps[i];
+		rs.maps[i].counts = malloc((size_t)nb * nb * sizeof *rs.maps[i].counts);
+		if (!rs.maps[i].counts)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	double s = 0.0;
+	for (int b = 0; rc == BSIM_OK && b < B; b++) {
+		for (int i = 0; i < set->n; i++)
+			for (int a = 0; a < nb; a++) {
+				const int *row = set->maps[i].counts + (size_t)a * nb;
+				long total = 0;
+				for (int x = 0; x < nb; x++)
+					total += row[x];
+				for (int x = 0; x < nb; x++)
+					p[x] = (double)row[x];
+				gsl_ran_multinomial(rng, (size_t)nb, (unsigned)total, p, k);
+				for (int x = 0; x < nb; x++)
+					rs.maps[i].counts[(size_t)a * nb + x] = (int)k[x];
+			}
+		bsim_markov_prediction q;
+		rc = bsim_markov_predict(scene, &rs, &q, err);
+		if (rc == BSIM_OK)
+			s += tv(pred->p, q.p, pred->n_locations);
+		bsim_markov_prediction_free(&q);
+	}
+	if (rc == BSIM_OK)
+		*mean = s / B;
+	for (int i = 0; rs.maps && i < set->n; i++)
+		free(rs.maps[i].counts);
+	free(rs.maps);
+	free(p);
+	free(k);
+	return rc;
+}
+
+/* The seconds one prediction takes: the mean of as many as fit in 0.2 s
+ * (at least 3). */
+static int time_predict(const bsim_scene *scene, const bsim_markov_set *set, double *seconds,
+                        bsim_error *err)
+{
+	int n = 0;
+	double t0 = bsim_clock_seconds(), t;
+	do {
+		bsim_markov_prediction q;
+		int rc = bsim_markov_predict(scene, set, &q, err);
+		bsim_markov_prediction_free(&q);
+		if (rc != BSIM_OK)
+			return rc;
+		n++;
+		t = bsim_clock_seconds() - t0;
+	} while (n < 3 || t < 0.2);
+	*seconds = t / n;
+	return BSIM_OK;
+}
+
+static const char *const protocol_names[] = {"essay", "world"};
+
+/* ---- files ------------------------------------------------------------------ */
+
+typedef struct group_data {
+	bsim_markov_prediction pred;
+	double *p_sim[2];
+	int trials[2];
+	double *gates_sim[2]; /* [k] for k = 0 .. n_gates_sim[i] */
+	int n_gates_sim[2];
+} group_data;
+
+static int write_csv(const char *stage, const bsim_experiment *e, const bsim_markov_validation *v,
+                     const group_data *gd, bsim_error *err)
+{
+	char path[1200];
+	snprintf(path, sizeof path, "%s/validate.csv", stage);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fputs("group,protocol,location,p_sim,lo,hi,p_chain,trials\n", o.f);
+	for (int g = 0; g < e->n_groups; g++)
+		for (int pr = 0; pr < 2; pr++) {
+			const bsim_markov_prediction *p = &gd[g].pred;
+			for (int i = 0; i < p->n_locations; i++) {
+				int n = gd[g].trials[pr];
+				double ps = gd[g].p_sim[pr][i], lo, hi;
+				bsim_stats_wilson((int)lround(ps * n), n, BSIM_STATS_Z95, &lo, &hi);
+				char label[48];
+				bsim_lattice_location_label(p->loc[i], label, sizeof label);
+				fprintf(o.f, "%d,%s,%s,%.9g,%.9g,%.9g,%.9g,%d\n", g,
+				        protocol_names[pr], label, ps, lo, hi, p->p[i], n);
+			}
+		}
+	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	snprintf(path, sizeof path, "%s/gates.csv", stage);
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fputs("group,source,gates,p\n", o.f);
+	for (int g = 0; g < e->n_groups; g++) {
+		for (int pr = 0; pr < 2; pr++)
+			for (int k = 1; k <= gd[g].n_gates_sim[pr]; k++)
+				fprintf(o.f, "%d,%s,%d,%.9g\n", g, protocol_names[pr], k,
+				        gd[g].gates_sim[pr][k]);
+		for (int k = 1; k <= gd[g].pred.n_gates; k++)
+			if (gd[g].pred.p_gates[k] > 1e-12)
+				fprintf(o.f, "%d,chain,%d,%.9g\n", g, k, gd[g].pred.p_gates[k]);
+	}
+	(void)v;
+	return bsim_atomic_file_commit(&o, err);
+}
+
+static int write_json(const char *stage, const bsim_markov_validate_def *def,
+                      const bsim_experiment *e, const bsim_markov_validation *v, bsim_error *err)
+{
+	char path[1200];
+	snprintf(path, sizeof path, "%s/validate.json", stage);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	FILE *f = o.f;
+	fputs("{\"experiment\": ", f);
+	bsim_json_string(f, e->path);
+	fputs(", \"map_dir\": ", f);
+	bsim_json_string(f, def->map_dir);
+	fprintf(f, ", \"entry_bins\": %d, \"trials_per_bin\": %d, \"map_cpu_seconds\": ", v->bins,
+	        v->trials_per_bin);
+	bsim_json_number(f, v->map_cost);
+	fputs(", \"checks\": [", f);
+	for (int i = 0; i < v->n; i++) {
+		const bsim_markov_check *c = &v->checks[i];
+		double saved = c->sim_cpu - c->predict;
+		fprintf(f, "%s\n  {\"group\": %d, \"protocol\": \"%s\", \"trials\": %d, \"tv\": ",
+		        i ? "," : "", c->group,
+		        c->protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world", c->trials);
+		bsim_json_number(f, c->tv);
+		fputs(", \"tv_sampling\": ", f);
+		bsim_json_number(f, c->tv_sampling);
+		fputs(", \"tv_sampling95\": ", f);
+		bsim_json_number(f, c->tv_sampling95);
+		fputs(", \"tv_map\": ", f);
+		bsim_json_number(f, c->tv_map);
+		fputs(", \"gates_sim\": ", f);
+		bsim_json_number(f, c->gates_sim);
+		fputs(", \"gates_chain\": ", f);
+		bsim_json_number(f, c->gates_chain);
+		fputs(", \"sim_cpu_seconds\": ", f);
+		bsim_json_number(f, c->sim_cpu);
+		fputs(", \"predict_seconds\": ", f);
+		bsim_json_number(f, c->predict);
+		fputs(", \"speedup\": ", f);
+		bsim_json_number(f, c->sim_cpu / c->predict);
+		fputs(", \"break_even_lattices\": ", f);
+		bsim_json_number(f, saved > 0 ? ceil(v->map_cost / saved) : NAN);
+		fprintf(f, ", \"states\": %d, \"exact\": %s}", c->n_states,
+		        c->exact ? "true" : "false");
+	}
+	fputs("\n]}\n", f);
+	return bsim_atomic_file_commit(&o, err);
+}
+
+/* validate_gNNN: per protocol, the locations either side puts above 0.2%:
+ * simulated bars with their intervals, the chain's points. */
+static int write_figure(const char *stage, int g, const group_data *d,
+                        const bsim_markov_validation *v, int *drawn, bsim_error *err)
+{
+	char path[1200], name[32];
+	snprintf(name, sizeof name, "validate_g%03d", g);
+	snprintf(path, sizeof path, "%s/%s.dat", stage, name);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	const bsim_markov_prediction *p = &d->pred;
+	int rows[2] = {0, 0};
+	for (int pr = 0; pr < 2; pr++) {
+		fprintf(o.f, "# %s: index label p_sim lo hi p_chain\n", protocol_names[pr]);
+		for (int i = 0; i < p->n_locations; i++) {
+			double ps = d->p_sim[pr][i];
+			if (ps < 0.002 && p->p[i] < 0.002)
+				continue;
+			double lo, hi;
+			int n = d->trials[pr];
+			bsim_stats_wilson((int)lround(ps * n), n, BSIM_STATS_Z95, &lo, &hi);
+			char label[48];
+			bsim_lattice_location_label(p->loc[i], label, sizeof label);
+			fprintf(o.f, "%d \"%s\" %.6g %.6g %.6g %.6g\n", rows[pr]++, label, ps, lo,
+			        hi, p->p[i]);
+		}
+		fputs("\n\n", o.f);
+	}
+	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	char body[4096];
+	const bsim_markov_check *c = &v->checks[2 * g];
+	snprintf(
+	        body, sizeof body,
+	        "set multiplot layout 2,1 title \"group %d: final locations, simulated (bars, "
+	        "Wilson 95%%) and predicted by the chain (points)\"\n"
+	        "set style fill solid 0.5 border -1\nset boxwidth 0.6\nset ylabel \"probability\"\n"
+	        "set xtics rotate by 60 right font \",8\"\nset yrange [0:*]\nset grid ytics\n"
+	        "set key top right\n"
+	        "set title \"essay protocol: TV %.3f (simulation's sampling %.3f, map's %.3f)\"\n"
+	        "plot '%s.dat' index 0 using 1:3:xtic(2) with boxes lc rgb '#4477aa' title "
+	        "'simulated', '' index 0 using 1:3:4:5 with yerrorbars lc rgb 'black' pt -1 "
+	        "notitle, '' index 0 using 1:6 with points pt 7 ps 0.8 lc rgb '#cc3311' "
+	        "title 'chain'\n"
+	        "set title \"whole world: TV %.3f (simulation's sampling %.3f)\"\n"
+	        "plot '%s.dat' index 1 using 1:3:xtic(2) with boxes lc rgb '#4477aa' title "
+	        "'simulated', '' index 1 using 1:3:4:5 with yerrorbars lc rgb 'black' pt -1 "
+	        "notitle, '' index 1 using 1:6 with points pt 7 ps 0.8 lc rgb '#cc3311' "
+	        "title 'chain'\nunset multiplot\n",
+	        g, c[0].tv, c[0].tv_sampling, c[0].tv_map, name, c[1].tv, c[1].tv_sampling, name);
+	bsim_figure_def fd = bsim_figure_default();
+	fd.dir = stage;
+	fd.name = name;
+	fd.width = 1100;
+	fd.height = 800;
+	return bsim_figure_render(&fd, body, drawn, err);
+}
+
+/* ---- the run ------------------------------------------------------------------ */
+
+static int simulate(const bsim_experiment *e, const bsim_markov_validate_def *def,
+                    const bsim_markov_set *set, int pr, bsim_sweep_result *res, double *cpu,
+                    bsim_error *err)
+{
+	int n = def->n_sets + 1;
+	bsim_override *ov = malloc((size_t)n * sizeof *ov);
+	if (!ov)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	memcpy(ov, def->sets, (size_t)def->n_sets * sizeof *ov);
+	ov[def->n_sets] =
+	        (bsim_override){"lattice.protocol", protocol_names[pr], "markov validate"};
+	bsim_sweep_config cfg = {.backend = set->def.backend,
+	                         .opts = set->def.opts,
+	                         .threads = def->threads,
+	                         .extra = ov,
+	                         .n_extra = n,
+	                         .progress = def->progress,
+	                         .progress_user = def->progress_user};
+	clock_t c0 = clock();
+	int rc = bsim_sweep_run(e, &cfg, res, err);
+	*cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
+	free(ov);
+	return rc;
+}
+
+static int group_validate(const bsim_markov_validate_def *def, const bsim_experiment *e, int g,
+                          const bsim_sweep_result res[2], const double cpu[2], gsl_rng *rng,
+                          group_data *d, bsim_markov_validation *v, bsim_error *err)
+{
+	bsim_scene scene;
+	int rc = bsim_experiment_group_scene(e, g, def->sets, def->n_sets, &scene, err);
+	if (rc != BSIM_OK)
+		return rc;
+	bsim_options opts;
+	bsim_markov_set set;
+	rc = bsim_markov_load(&scene, def->map_dir, &opts, &set, err);
+	if (rc == BSIM_OK)
+		rc = bsim_markov_predict(&scene, &set, &d->pred, err);
+	double predict = 0.0, tv_map = NAN;
+	if (rc == BSIM_OK)
+		rc = time_predict(&scene, &set, &predict, err);
+	if (rc == BSIM_OK)
+		rc = bootstrap_maps(rng, &scene, &set, &d->pred, def->map_resamples, &tv_map, err);
+	if (rc == BSIM_OK) {
+		v->bins = set.n ? set.maps[0].n_bins : 0;
+		v->trials_per_bin = set.def.trials;
+		for (int i = 0; i < set.n; i++)
+			v->map_cost += set.maps[i].cost;
+	}
+	const bsim_lattice_def *l = &scene.lattice;
+	const int nl = d->pred.n_locations;
+	for (int pr = 0; rc == BSIM_OK && pr < 2; pr++) {
+		const int T = res[pr].trials;
+		const bsim_trial_result *t = res[pr].trials_out + (size_t)g * T;
+		d->trials[pr] = T;
+		d->p_sim[pr] = calloc((size_t)nl, sizeof *d->p_sim[pr]);
+		int max_gates = 1;
+		for (int i = 0; i < T; i++)
+			max_gates = t[i].gates_entered > max_gates ? t[i].gates_entered : max_gates;
+		d->gates_sim[pr] = calloc((size_t)max_gates + 1, sizeof *d->gates_sim[pr]);
+		d->n_gates_sim[pr] = max_gates;
+		if (!d->p_sim[pr] || !d->gates_sim[pr]) {
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+			break;
+		}
+		double gates = 0.0;
+		for (int i = 0; i < T; i++) {
+			d->p_sim[pr][loc_index(l, bsim_lattice_location_of(&t[i]))] += 1.0 / T;
+			d->gates_sim[pr][t[i].gates_entered] += 1.0 / T;
+			gates += (double)t[i].gates_entered / T;
+		}
+		bsim_markov_check *c = &v->checks[2 * g + pr];
+		c->group = g;
+		c->protocol = pr == 0 ? BSIM_PROTOCOL_ESSAY : BSIM_PROTOCOL_WORLD;
+		c->trials = T;
+		c->tv = tv(d->p_sim[pr], d->pred.p, nl);
+		bootstrap_sim(rng, d->p_sim[pr], nl, T, def->bootstrap, &c->tv_sampling,
+		              &c->tv_sampling95);
+		c->tv_map = tv_map;
+		c->gates_sim = gates;
+		c->gates_chain = d->pred.mean_gates;
+		c->sim_cpu = cpu[pr] / e->n_groups;
+		c->predict = predict;
+		c->n_states = d->pred.n_states;
+		c->exact = d->pred.exact;
+	}
+	bsim_markov_set_free(&set);
+	bsim_scene_free(&scene);
+	return rc;
+}
+
+int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_validation *out,
+                         bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	bsim_experiment e;
+	int rc = bsim_experiment_load(def->experiment, def->sets, def->n_sets, &e, err);
+	if (rc != BSIM_OK)
+		return rc;
+	if (def->trials > 0 &&
+	    (rc = bsim_experiment_check_trials(&e, def->trials, err)) != BSIM_OK) {
+		bsim_experiment_free(&e);
+		return rc;
+	}
+	if (def->trials > 0)
+		e.trials = (int)def->trials;
+	if (def->has_seed)
+		e.seed = def->seed;
+	/* The maps of every group first: a missing one is an input error
+	 * before any trial runs. */
+	bsim_markov_set set0 = {0};
+	bsim_options opts0;
+	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++) {
+		bsim_scene scene;
+		rc = bsim_experiment_group_scene(&e, g, def->sets, def->n_sets, &scene, err);
+		if (rc != BSIM_OK)
+			break;
+		bsim_markov_set_free(&set0);
+		rc = bsim_markov_load(&scene, def->map_dir, &opts0, &set0, err);
+		bsim_scene_free(&scene);
+	}
+	bsim_session ss;
+	if (rc == BSIM_OK)
+		rc = bsim_session_open(&ss, def->out, 0, NULL, 0, err);
+	if (rc != BSIM_OK) {
+		bsim_markov_set_free(&set0);
+		bsim_experiment_free(&e);
+		return rc;
+	}
+	bsim_sweep_result res[2];
+	memset(res, 0, sizeof res);
+	double cpu[2] = {0, 0};
+	for (int pr = 0; pr < 2 && rc == BSIM_OK; pr++)
+		rc = simulate(&e, def, &set0, pr, &res[pr], &cpu[pr], err);
+	group_data *gd = calloc((size_t)e.n_groups, sizeof *gd);
+	out->checks = calloc((size_t)2 * e.n_groups, sizeof *out->checks);
+	if (rc == BSIM_OK && (!gd || !out->checks))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	out->n = 2 * e.n_groups;
+	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+	if (rng)
+		gsl_rng_set(rng, (unsigned long)e.seed);
+	else if (rc == BSIM_OK)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++)
+		rc = group_validate(def, &e, g, res, cpu, rng, &gd[g], out, err);
+	if (rc == BSIM_OK)
+		out->map_cost /= e.n_groups;
+	if (rc == BSIM_OK)
+		rc = write_csv(ss.stage, &e, out, gd, err);
+	if (rc == BSIM_OK)
+		rc = write_json(ss.stage, def, &e, out, err);
+	const char *const twins[][2] = {{"validate.csv", "validate"},
+	                                {"gates.csv", "gates"},
+	                                {"validate.json", "validate"}};
+	for (int i = 0; i < 3 && rc == BSIM_OK; i++) {
+		char src[1200], mat[1200];
+		snprintf(src, sizeof src, "%s/%s", ss.stage, twins[i][0]);
+		snprintf(mat, sizeof mat, "%s/%.*s%s", ss.stage, (int)strcspn(twins[i][0], "."),
+		         twins[i][0], i == 2 ? "_summary.mat" : ".mat");
+		rc = i == 2 ? bsim_matlab_from_json(src, mat, twins[i][1], err)
+		            : bsim_matlab_from_csv(src, mat, twins[i][1], err);
+	}
+	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++)
+		rc = write_figure(ss.stage, g, &gd[g], out, NULL, err);
+	rc = bsim_session_close(&ss, rc, "markov validate", NULL, err);
+	for (int g = 0; gd && g < e.n_groups; g++) {
+		bsim_markov_prediction_free(&gd[g].pred);
+		for (int pr = 0; pr < 2; pr++) {
+			free(gd[g].p_sim[pr]);
+			free(gd[g].gates_sim[pr]);
+		}
+	}
+	free(gd);
+	gsl_rng_free(rng);
+	for (int pr = 0; pr < 2; pr++)
+		bsim_sweep_result_free(&res[pr]);
+	bsim_markov_set_free(&set0);
+	bsim_experiment_free(&e);
+	if (rc != BSIM_OK)
+		bsim_markov_validation_free(out);
+	return rc;
+}

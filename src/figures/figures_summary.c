@@ -1,0 +1,242 @@
+/* A sweep's summary.json read for its figures (figures_internal.h): the
+ * groups' counts, p_traverse and interval, and the grid axes rebuilt from
+ * the groups' params, the first axis varying slowest, the values in the
+ * order they first appear. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "figures/figures_internal.h"
+#include "util/yaml_doc.h"
+
+static int text_number(const char *s, double *x)
+{
+	char *end;
+	if (!s || !*s)
+		return 0;
+	*x = strtod(s, &end);
+	return *end == '\0' && isfinite(*x);
+}
+
+int fsum_same_value(const char *a, const char *b)
+{
+	double x, y;
+	if (text_number(a, &x) && text_number(b, &y))
+		return x == y;
+	return strcmp(a, b) == 0;
+}
+
+void fsum_free(fsum *s)
+{
+	for (int a = 0; a < s->n_axes; a++) {
+		free(s->axes[a].key);
+		for (int i = 0; i < s->axes[a].n_values; i++)
+			free(s->axes[a].values[i]);
+		free(s->axes[a].values);
+		free(s->axes[a].x);
+	}
+	for (int g = 0; g < s->n_groups; g++)
+		free(s->g[g].idx);
+	free(s->axes);
+	free(s->g);
+	memset(s, 0, sizeof *s);
+}
+
+static char *scalar_dup(struct fy_node *n)
+{
+	size_t len;
+	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
+	if (!t)
+		return NULL;
+	char *s = malloc(len + 1);
+	if (s) {
+		memcpy(s, t, len);
+		s[len] = '\0';
+	}
+	return s;
+}
+
+/* The index of value v on axis a, added if new; -1 out of memory. */
+static int axis_value(fsum_axis *a, const char *v)
+{
+	for (int i = 0; i < a->n_values; i++)
+		if (strcmp(a->values[i], v) == 0)
+			return i;
+	char **vals = realloc(a->values, (size_t)(a->n_values + 1) * sizeof *vals);
+	if (!vals)
+		return -1;
+	a->values = vals;
+	if (!(vals[a->n_values] = strdup(v)))
+		return -1;
+	return a->n_values++;
+}
+
+static int group_count(const ydoc *d, struct fy_node *gn, const char *field, int g, int *out,
+                       bsim_error *err)
+{
+	long long v;
+	struct fy_node *n = ydoc_lookup(gn, field);
+	char where[64];
+	snprintf(where, sizeof where, "groups.%d.%s", g, field);
+	if (!n || !ydoc_int64(n, &v) || v < 0 || v > 2147483647)
+		return ydoc_expected(d, n, gn, where, "an integer >= 0", err);
+	*out = (int)v;
+	return BSIM_OK;
+}
+
+static int read_group(const ydoc *d, struct fy_node *gn, int g, fsum *s, bsim_error *err)
+{
+	fsum_group *G = &s->g[g];
+	char where[64];
+	snprintf(where, sizeof where, "groups.%d.params", g);
+	struct fy_node *params = ydoc_lookup(gn, "params");
+	if (!params || !fy_node_is_mapping(params) ||
+	    (g > 0 && fy_node_mapping_item_count(params) != s->n_axes))
+		return ydoc_expected(d, params, gn, where, "a mapping of the grid's keys", err);
+	if (g == 0) {
+		s->n_axes = fy_node_mapping_item_count(params);
+		s->axes = calloc((size_t)(s->n_axes ? s->n_axes : 1), sizeof *s->axes);
+		if (!s->axes)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	G->idx = calloc((size_t)(s->n_axes ? s->n_axes : 1), sizeof *G->idx);
+	if (!G->idx)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	void *it = NULL;
+	struct fy_node_pair *p;
+	for (int a = 0; (p = fy_node_mapping_iterate(params, &it)) != NULL; a++) {
+		char *key = scalar_dup(fy_node_pair_key(p));
+		char *val = scalar_dup(fy_node_pair_value(p));
+		int bad = !key || !val;
+		if (!bad && g == 0)
+			s->axes[a].key = key, key = NULL;
+		else if (!bad)
+			bad = strcmp(s->axes[a].key, key) != 0;
+		if (!bad)
+			bad = (G->idx[a] = axis_value(&s->axes[a], val)) < 0;
+		free(key);
+		free(val);
+		if (bad)
+			return ydoc_expected(d, fy_node_pair_key(p), params, where,
+			                     "the grid's keys in the order of group 0", err);
+	}
+	int rc = BSIM_OK;
+	struct {
+		const char *field;
+		int *out;
+	} counts[] = {
+	        {"trials", &G->trials},
+	        {"traversed", &G->traversed},
+	        {"side_exit", &G->side_exit},
+	        {"stuck", &G->stuck},
+	        {"left", &G->left},
+	        {"right", &G->right},
+	        {"landscape_left", &G->land_left},
+	        {"landscape_right", &G->land_right},
+	};
+	for (size_t i = 0; !rc && i < sizeof counts / sizeof counts[0]; i++)
+		rc = group_count(d, gn, counts[i].field, g, counts[i].out, err);
+	struct fy_node *pn = ydoc_lookup(gn, "p_traverse"), *lo = ydoc_lookup(gn, "ci95.0"),
+	               *hi = ydoc_lookup(gn, "ci95.1");
+	snprintf(where, sizeof where, "groups.%d.p_traverse", g);
+	if (!rc && (!pn || ydoc_number(pn, &G->p)))
+		rc = ydoc_expected(d, pn, gn, where, "a number", err);
+	snprintf(where, sizeof where, "groups.%d.ci95", g);
+	if (!rc && (!lo || !hi || ydoc_number(lo, &G->lo) || ydoc_number(hi, &G->hi)))
+		rc = ydoc_expected(d, ydoc_lookup(gn, "ci95"), gn, where, "[lo, hi]", err);
+	G->selected = 1;
+	return rc;
+}
+
+int fsum_read(const char *path, fsum *s, bsim_error *err)
+{
+	memset(s, 0, sizeof *s);
+	ydoc d;
+	int rc = ydoc_load(&d, path, err);
+	if (rc)
+		return rc;
+	struct fy_node *root = fy_document_root(d.fyd);
+	struct fy_node *groups = ydoc_lookup(root, "groups");
+	struct fy_node *b = ydoc_lookup(root, "backend");
+	struct fy_node *tpg = ydoc_lookup(root, "trials_per_group");
+	long long trials = 0;
+	const char *bt = b ? ydoc_plain(b) : NULL;
+	size_t blen = 0;
+	if (b && fy_node_is_scalar(b))
+		bt = fy_node_get_scalar(b, &blen);
+	if (!groups || !fy_node_is_sequence(groups) || fy_node_sequence_item_count(groups) < 1)
+		rc = ydoc_expected(&d, groups, root, "groups", "a list of groups", err);
+	else if (!tpg || !ydoc_int64(tpg, &trials) || trials < 0)
+		rc = ydoc_expected(&d, tpg, root, "trials_per_group", "an integer >= 0", err);
+	if (!rc) {
+		snprintf(s->backend, sizeof s->backend, "%.*s", bt ? (int)blen : 0, bt ? bt : "");
+		s->trials_per_group = (int)trials;
+		s->n_groups = fy_node_sequence_item_count(groups);
+		s->g = calloc((size_t)s->n_groups, sizeof *s->g);
+		if (!s->g)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	for (int g = 0; !rc && g < s->n_groups; g++)
+		rc = read_group(&d, fy_node_sequence_get_by_index(groups, g), g, s, err);
+	for (int a = 0; !rc && a < s->n_axes; a++) {
+		fsum_axis *ax = &s->axes[a];
+		ax->x = calloc((size_t)ax->n_values, sizeof *ax->x);
+		if (!ax->x) {
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+			break;
+		}
+		ax->numeric = 1;
+		for (int i = 0; i < ax->n_values; i++)
+			ax->numeric &= text_number(ax->values[i], &ax->x[i]);
+	}
+	ydoc_free(&d);
+	if (rc)
+		fsum_free(s);
+	return rc;
+}
+
+int fsum_select(const figs *f, fsum *s, bsim_error *err)
+{
+	for (int i = 0; i < f->def->n_select; i++) {
+		const bsim_override *o = &f->def->select[i];
+		int a = 0;
+		while (a < s->n_axes && strcmp(s->axes[a].key, o->key) != 0)
+			a++;
+		if (a == s->n_axes)
+			return bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "--select %s=%s: %s is not a grid axis of this run "
+			        "(its axes: %s%s%s)",
+			        o->key, o->value, o->key, s->n_axes ? s->axes[0].key : "none",
+			        s->n_axes > 1 ? ", " : "", s->n_axes > 1 ? s->axes[1].key : "");
+		int any = 0;
+		for (int g = 0; g < s->n_groups; g++) {
+			int match = fsum_same_value(s->axes[a].values[s->g[g].idx[a]], o->value);
+			s->g[g].selected &= match;
+			any |= match;
+		}
+		if (!any)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "--select %s=%s: %s has no value %s in this run",
+			                      o->key, o->value, o->key, o->value);
+	}
+	return BSIM_OK;
+}
+
+void fsum_label(const fsum *s, int g, char *buf, size_t size)
+{
+	size_t k = 0;
+	buf[0] = '\0';
+	for (int a = 0; a < s->n_axes && k < size; a++) {
+		/* a line of its own from the third on, to fit a figure's width */
+		int n = snprintf(buf + k, size - k, "%s%s = %s",
+		                 a == 0  ? ""
+		                 : a % 2 ? ", "
+		                         : "\n",
+		                 s->axes[a].key, s->axes[a].values[s->g[g].idx[a]]);
+		if (n < 0)
+			break;
+		k += (size_t)n;
+	}
+}

@@ -1,0 +1,622 @@
+/* Figures of a sweep (figures.h): p_traverse as a heat map over the grid's
+ * first two axes (essay Fig. 3.1), traversal and its left / right types
+ * against each axis with 95% bands (Fig. 3.4), and the kept trajectories
+ * (Figs. 3.2, 3.3).
+ *
+ * The numbers come from summary.json (counts, p_traverse and its Wilson
+ * interval as the sweep computed them); the left / right intervals are
+ * Wilson intervals of those counts, and the landscape label (the barrier
+ * crossed, bsim_landscape_label) is drawn beside the v_x type it is meant
+ * to check. A selection (--select KEY=VALUE) keeps the groups that match it;
+ * an axis left with one value is no longer drawn along. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "beamsim/experiment.h"
+#include "store/mat.h"
+#include "beamsim/stats.h"
+#include "figures/figures_internal.h"
+
+/* Positions of the selected values of each axis (-1: not selected) and
+ * their number. */
+typedef struct active {
+	int *pos[64];
+	int n[64];
+} active;
+
+static int active_build(const fsum *s, active *a, bsim_error *err)
+{
+	memset(a, 0, sizeof *a);
+	if (s->n_axes > 64)
+		return bsim_error_set(err, BSIM_EINPUT, "more than 64 grid axes");
+	for (int ax = 0; ax < s->n_axes; ax++) {
+		a->pos[ax] = malloc((size_t)s->axes[ax].n_values * sizeof(int));
+		if (!a->pos[ax])
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		for (int i = 0; i < s->axes[ax].n_values; i++) {
+			int used = 0;
+			for (int g = 0; g < s->n_groups && !used; g++)
+				used = s->g[g].selected && s->g[g].idx[ax] == i;
+			a->pos[ax][i] = used ? a->n[ax]++ : -1;
+		}
+	}
+	return BSIM_OK;
+}
+
+static void active_free(active *a, int n_axes)
+{
+	for (int ax = 0; ax < n_axes && ax < 64; ax++)
+		free(a->pos[ax]);
+}
+
+/* The panel of group g over the axes other than skip0 and skip1 (-1:
+ * none): its index among the combinations of their selected values, the
+ * first such axis slowest. */
+static int panel_of(const fsum *s, const active *a, int g, int skip0, int skip1)
+{
+	int p = 0;
+	for (int ax = 0; ax < s->n_axes; ax++)
+		if (ax != skip0 && ax != skip1)
+			p = p * a->n[ax] + a->pos[ax][s->g[g].idx[ax]];
+	return p;
+}
+
+static int panels(const fsum *s, const active *a, int skip0, int skip1)
+{
+	int n = 1;
+	for (int ax = 0; ax < s->n_axes; ax++)
+		if (ax != skip0 && ax != skip1)
+			n *= a->n[ax];
+	return n;
+}
+
+/* "key = value, ..." of the other axes of group g, "" if there are none. */
+static void panel_label(const fsum *s, const active *a, int g, int skip0, int skip1, char *buf,
+                        size_t size)
+{
+	size_t k = 0;
+	buf[0] = '\0';
+	for (int ax = 0; ax < s->n_axes && k < size; ax++) {
+		if (ax == skip0 || ax == skip1 || a->n[ax] < 1)
+			continue;
+		int n = snprintf(buf + k, size - k, "%s%s = %s", k ? ", " : "", s->axes[ax].key,
+		                 s->axes[ax].values[s->g[g].idx[ax]]);
+		k += n > 0 ? (size_t)n : 0;
+	}
+}
+
+/* A layout of n panels, about 3:2. */
+static void layout(int n, int *rows, int *cols)
+{
+	*cols = (int)ceil(sqrt(1.5 * n));
+	if (*cols > n)
+		*cols = n;
+	*rows = (n + *cols - 1) / *cols;
+}
+
+/* gnuplot tics naming each selected value of an axis at its position. */
+static void tics(FILE *f, const char *which, const fsum_axis *ax, const int *pos)
+{
+	fprintf(f, "set %stics (", which);
+	int k = 0;
+	for (int i = 0; i < ax->n_values; i++)
+		if (pos[i] >= 0) {
+			fputs(k++ ? ", " : "", f);
+			gp_str(f, ax->values[i]);
+			fprintf(f, " %d", pos[i]);
+		}
+	fputs(") noenhanced\n", f);
+}
+
+/* ---- Fig. 3.1 -------------------------------------------------------------------- */
+
+static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_error *err)
+{
+	const int ax0 = s->n_axes > 0 ? 0 : -1, ax1 = s->n_axes > 1 ? 1 : -1;
+	const int n0 = ax0 >= 0 ? a->n[0] : 1, n1 = ax1 >= 0 ? a->n[1] : 1;
+	const int np = panels(s, a, ax0, ax1);
+	char path[1100];
+	bsim_atomic_file o;
+	int rc = figs_data_open(f, "p_traverse.dat", &o, path, err);
+	if (rc)
+		return rc;
+	fputs("# column row p_traverse ci95_lo ci95_hi traversed trials group: one block per "
+	      "panel\n",
+	      o.f);
+	int *first = malloc((size_t)np * sizeof *first);
+	if (!first) {
+		bsim_atomic_file_abort(&o);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	for (int p = 0; p < np; p++) {
+		first[p] = -1;
+		fprintf(o.f, "%s# panel %d\n", p ? "\n\n" : "", p);
+		for (int g = 0; g < s->n_groups; g++) {
+			const fsum_group *G = &s->g[g];
+			if (!G->selected || panel_of(s, a, g, ax0, ax1) != p)
+				continue;
+			if (first[p] < 0)
+				first[p] = g;
+			fprintf(o.f, "%d %d %.6g %.6g %.6g %d %d %d\n",
+			        ax0 >= 0 ? a->pos[0][G->idx[0]] : 0,
+			        ax1 >= 0 ? a->pos[1][G->idx[1]] : 0, G->p, G->lo, G->hi,
+			        G->traversed, G->trials, g);
+		}
+	}
+	if ((rc = figs_data_commit(&o, err))) {
+		free(first);
+		return rc;
+	}
+	gp_text g;
+	if ((rc = gp_text_open(&g, err))) {
+		free(first);
+		return rc;
+	}
+	int rows, cols;
+	layout(np, &rows, &cols);
+	int pw = 140 + 95 * n0, ph = 110 + 62 * n1;
+	fprintf(g.f,
+	        "set multiplot layout %d,%d title 'p_{traverse}%s of %d trials per group, "
+	        "[95%% Wilson interval]'\n",
+	        rows, cols, lattice ? " (reached the end of the lattice)" : "",
+	        s->trials_per_group);
+	fputs("set palette defined (0 '#F7FBFF', 0.5 '#6BAED6', 1 '#08306B')\n"
+	      "set cbrange [0:1]\nset cblabel 'p_{traverse}'\n",
+	      g.f);
+	fprintf(g.f, "set xrange [-0.5:%g]\nset yrange [-0.5:%g]\n", n0 - 0.5, n1 - 0.5);
+	if (ax0 >= 0) {
+		tics(g.f, "x", &s->axes[0], a->pos[0]);
+		fputs("set xlabel ", g.f);
+		gp_str(g.f, s->axes[0].key);
+		fputs(" noenhanced\n", g.f);
+	} else {
+		fputs("unset xtics\n", g.f);
+	}
+	if (ax1 >= 0) {
+		tics(g.f, "y", &s->axes[1], a->pos[1]);
+		fputs("set ylabel ", g.f);
+		gp_str(g.f, s->axes[1].key);
+		fputs(" noenhanced\n", g.f);
+	} else {
+		fputs("unset ytics\n", g.f);
+	}
+	fputs("set tics out nomirror\n", g.f);
+	for (int p = 0; p < np; p++) {
+		char label[512];
+		panel_label(s, a, first[p], ax0, ax1, label, sizeof label);
+		fputs("set title ", g.f);
+		gp_str(g.f, label);
+		fprintf(g.f,
+		        " noenhanced\n"
+		        "plot 'p_traverse.dat' index %d using 1:2:(0.5):(0.5):3 with boxxyerror "
+		        "fs solid 1.0 fc palette notitle, \\\n"
+		        "     '' index %d using 1:2:(sprintf(\"%%.2f\\n[%%.2f, %%.2f]\", $3, $4, "
+		        "$5)):($3 > 0.55 ? 0xFFFFFF : 0) with labels tc rgb variable font ',9' "
+		        "notitle\n",
+		        p, p);
+	}
+	fputs("unset multiplot\n", g.f);
+	free(first);
+	char *body = gp_text_take(&g);
+	rc = body ? figs_render(f, "p_traverse", pw * cols, ph * rows + 40, body, err)
+	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	free(body);
+	return rc;
+}
+
+/* ---- Fig. 3.4 -------------------------------------------------------------------- */
+
+/* A lattice (lattice = 1) draws where the trials ended instead of the
+ * single gate's left and right types: reached the end (traversed), side
+ * exit and stuck, each with its 95% band. */
+static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, bsim_error *err)
+{
+	const fsum_axis *A = &s->axes[ax];
+	const int np = panels(s, a, ax, -1);
+	char ident[64], name[128], file[160], path[1100];
+	bsim_mat_name(A->key, ident, sizeof ident);
+	snprintf(name, sizeof name, "traversal_vs_%s", ident);
+	snprintf(file, sizeof file, "%s.dat", name);
+	bsim_atomic_file o;
+	int rc = figs_data_open(f, file, &o, path, err);
+	if (rc)
+		return rc;
+	fprintf(o.f,
+	        lattice ? "# %s end lo hi side_exit lo hi stuck lo hi (fractions of the trials; "
+	                  "end: traversed, reached the end of the lattice; Wilson 95%% "
+	                  "intervals): one block per panel\n"
+	                : "# %s traversed lo hi left lo hi right lo hi landscape_left "
+	                  "landscape_right (fractions of the trials; Wilson 95%% intervals): one "
+	                  "block per panel\n",
+	        A->numeric ? A->key : "position");
+	int *first = malloc((size_t)np * sizeof *first);
+	if (!first) {
+		bsim_atomic_file_abort(&o);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	for (int p = 0; p < np; p++) {
+		first[p] = -1;
+		fprintf(o.f, "%s# panel %d\n", p ? "\n\n" : "", p);
+		/* along the axis in the order of its values */
+		for (int i = 0; i < A->n_values; i++)
+			for (int gi = 0; gi < s->n_groups; gi++) {
+				const fsum_group *G = &s->g[gi];
+				if (!G->selected || G->idx[ax] != i ||
+				    panel_of(s, a, gi, ax, -1) != p)
+					continue;
+				if (first[p] < 0)
+					first[p] = gi;
+				double ll, lh, rl, rh, n = G->trials > 0 ? G->trials : 1;
+				const double x = A->numeric ? A->x[i] : (double)a->pos[ax][i];
+				if (lattice) {
+					/* a group without random force: points */
+					const int point = G->lo == G->hi && G->trials > 1;
+					bsim_stats_wilson(G->side_exit, G->trials, BSIM_STATS_Z95,
+					                  &ll, &lh);
+					bsim_stats_wilson(G->stuck, G->trials, BSIM_STATS_Z95, &rl,
+					                  &rh);
+					if (point) {
+						ll = lh = G->side_exit / n;
+						rl = rh = G->stuck / n;
+					}
+					fprintf(o.f,
+					        "%.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g "
+					        "%.6g\n",
+					        x, G->p, G->lo, G->hi, G->side_exit / n, ll, lh,
+					        G->stuck / n, rl, rh);
+					continue;
+				}
+				bsim_stats_wilson(G->left, G->trials, BSIM_STATS_Z95, &ll, &lh);
+				bsim_stats_wilson(G->right, G->trials, BSIM_STATS_Z95, &rl, &rh);
+				fprintf(o.f,
+				        "%.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g "
+				        "%.6g\n",
+				        A->numeric ? A->x[i] : (double)a->pos[ax][i], G->p, G->lo,
+				        G->hi, G->left / n, ll, lh, G->right / n, rl, rh,
+				        G->land_left / n, G->land_right / n);
+			}
+	}
+	if ((rc = figs_data_commit(&o, err))) {
+		free(first);
+		return rc;
+	}
+	gp_text g;
+	if ((rc = gp_text_open(&g, err))) {
+		free(first);
+		return rc;
+	}
+	/* The panels and, in the cell after them, the key; many panels get
+	 * smaller ones, so that the image stays well under 1 MB. A panel is
+	 * titled by the values of the other axes, named once in the title. */
+	int rows, cols;
+	layout(np, &rows, &cols);
+	if (rows * cols == np)
+		layout(np + 1, &rows, &cols);
+	const int pw = np > 12 ? 400 : 520, ph = np > 12 ? 300 : 380;
+	const int W = pw * cols, H = ph * rows + 80;
+	fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
+	char title[600], others[400] = "";
+	size_t L = 0;
+	for (int oa = 0; oa < s->n_axes && L < sizeof others; oa++)
+		if (oa != ax && a->n[oa] > 0) {
+			int w = snprintf(others + L, sizeof others - L, "%s%s", L ? ", " : "",
+			                 s->axes[oa].key);
+			L += w > 0 ? (size_t)w : 0;
+		}
+	snprintf(title, sizeof title, "%s against %s, %d trials per group, 95%% Wilson bands%s%s",
+	         lattice ? "where the trials ended" : "traversal", A->key, s->trials_per_group,
+	         L ? "\npanels: " : "", others);
+	gp_str(g.f, title);
+	fputs(" noenhanced\nset yrange [0:1]\nset ylabel 'fraction of trials'\nset xlabel ", g.f);
+	gp_str(g.f, A->key);
+	fputs(" noenhanced\nset grid\nset style fill transparent solid 0.15 noborder\n"
+	      "unset key\n",
+	      g.f);
+	if (!A->numeric)
+		tics(g.f, "x", A, a->pos[ax]);
+	for (int p = 0; p < np; p++) {
+		char label[512] = "";
+		size_t k = 0;
+		for (int oa = 0; oa < s->n_axes && k < sizeof label; oa++)
+			if (oa != ax && a->n[oa] > 0) {
+				int w = snprintf(label + k, sizeof label - k, "%s%s", k ? ", " : "",
+				                 s->axes[oa].values[s->g[first[p]].idx[oa]]);
+				k += w > 0 ? (size_t)w : 0;
+			}
+		fputs("set title ", g.f);
+		gp_str(g.f, label);
+		if (lattice) {
+			fprintf(g.f,
+			        " noenhanced\n"
+			        "plot '%s' index %d using 1:3:4 with filledcurves lc rgb '%s', \\\n"
+			        "     '' index %d using 1:6:7 with filledcurves lc rgb '%s', \\\n"
+			        "     '' index %d using 1:9:10 with filledcurves lc rgb '%s', \\\n"
+			        "     '' index %d using 1:2 with linespoints lw 2 pt 7 lc rgb "
+			        "'%s', \\\n"
+			        "     '' index %d using 1:5 with linespoints lw 1.5 pt 5 lc rgb "
+			        "'%s', "
+			        "\\\n"
+			        "     '' index %d using 1:8 with linespoints lw 1.5 pt 9 lc rgb "
+			        "'%s'\n",
+			        file, p, FIG_BLUE, p, FIG_GREY, p, FIG_DKGREY, p, FIG_BLUE, p,
+			        FIG_GREY, p, FIG_DKGREY);
+			continue;
+		}
+		fprintf(g.f,
+		        " noenhanced\n"
+		        "plot '%s' index %d using 1:3:4 with filledcurves lc rgb '%s', \\\n"
+		        "     '' index %d using 1:6:7 with filledcurves lc rgb '%s', \\\n"
+		        "     '' index %d using 1:9:10 with filledcurves lc rgb '%s', \\\n"
+		        "     '' index %d using 1:2 with linespoints lw 2 pt 7 lc rgb '%s', \\\n"
+		        "     '' index %d using 1:5 with linespoints lw 1.5 pt 5 lc rgb '%s', \\\n"
+		        "     '' index %d using 1:8 with linespoints lw 1.5 pt 9 lc rgb '%s', \\\n"
+		        "     '' index %d using 1:11 with lines dt 2 lc rgb '%s', \\\n"
+		        "     '' index %d using 1:12 with lines dt 2 lc rgb '%s'\n",
+		        file, p, FIG_BLACK, p, FIG_BLUE, p, FIG_RED, p, FIG_BLACK, p, FIG_BLUE, p,
+		        FIG_RED, p, FIG_BLUE, p, FIG_RED);
+	}
+	if (lattice)
+		fprintf(g.f,
+		        "# the key, in a cell of its own\n"
+		        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\n"
+		        "unset grid\nset key center center vertical font ',10'\nset xrange [0:1]\n"
+		        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title 'reached the end "
+		        "(traversed)', \\\n"
+		        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'side exit', \\\n"
+		        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'stuck', \\\n"
+		        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
+		        FIG_BLUE, FIG_GREY, FIG_DKGREY, FIG_GREY);
+	else
+		fprintf(g.f,
+		        "# the key, in a cell of its own\n"
+		        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\nunset "
+		        "grid\n"
+		        "set key center center vertical font ',10'\nset xrange [0:1]\n"
+		        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title 'traversed', \\\n"
+		        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'left type (v_x > "
+		        "0 at "
+		        "classify y)', \\\n"
+		        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'right type (v_x "
+		        "< 0)', "
+		        "\\\n"
+		        "     NaN with lines dt 2 lc rgb '%s' title 'over the left beam (landscape "
+		        "label)', \\\n"
+		        "     NaN with lines dt 2 lc rgb '%s' title 'over the right beam', \\\n"
+		        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
+		        FIG_BLACK, FIG_BLUE, FIG_RED, FIG_BLUE, FIG_RED, FIG_GREY);
+	fputs("unset multiplot\n", g.f);
+	free(first);
+	char *body = gp_text_take(&g);
+	rc = body ? figs_render(f, name, W, H, body, err)
+	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	free(body);
+	return rc;
+}
+
+/* ---- Figs. 3.2, 3.3: the kept trajectories -------------------------------------------- */
+
+typedef struct traj_job {
+	const fsum *s;
+	const bsim_experiment *e;
+	bsim_experiment e_own;
+	csv_table table; /* trajectories.csv, which paths point into */
+	int have_table;
+	fpaths paths;
+	int *first, *count; /* per group: the first path and how many */
+	char *untraversed;  /* per group: no traversed trial kept, no landscape figure */
+} traj_job;
+
+/* The classes of the paths from trials.csv (outcome and type by name). */
+static int classes_read(const char *dir, const fsum *s, fpaths *ps, bsim_error *err)
+{
+	char path[1100];
+	snprintf(path, sizeof path, "%s/trials.csv", dir);
+	const long per = s->trials_per_group;
+	int *which = malloc(((size_t)s->n_groups * (size_t)per + 1) * sizeof *which);
+	if (!which)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (long i = 0; i < (long)s->n_groups * per; i++)
+		which[i] = -1;
+	for (int i = 0; i < ps->n; i++) {
+		const fpath *p = &ps->p[i];
+		if (p->group >= 0 && p->group < s->n_groups && p->trial >= 0 && p->trial < per)
+			which[(long)p->group * per + p->trial] = i;
+	}
+	csv_table t;
+	int rc = csv_table_read(path, &t, err);
+	if (rc) {
+		free(which);
+		return rc;
+	}
+	static const char *const need[] = {"group", "trial", "outcome", "type"};
+	int col[4];
+	rc = csv_table_require(&t, path, need, 4, col, err);
+	for (long r = 0; !rc && r < t.n_rows; r++) {
+		double g, tr;
+		if (csv_table_number(&t, r, col[0], &g) || csv_table_number(&t, r, col[1], &tr) ||
+		    g < 0 || g >= s->n_groups || tr < 0 || tr >= per) {
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "%s:%ld: group, trial: expected integers within the "
+			                    "%d groups x %ld trials of summary.json",
+			                    path, r + 2, s->n_groups, per);
+			break;
+		}
+		int i = which[(long)g * per + (long)tr];
+		if (i >= 0)
+			ps->p[i].cls = fpath_class(csv_table_cell(&t, r, col[2]),
+			                           csv_table_cell(&t, r, col[3]));
+	}
+	free(which);
+	csv_table_free(&t);
+	return rc;
+}
+
+static int group_figures(figs *f, traj_job *j, int g, bsim_error *err)
+{
+	bsim_scene scene;
+	int rc = bsim_experiment_group_scene(j->e, g, NULL, 0, &scene, err);
+	if (rc)
+		return rc;
+	char label[512], title[700], name[64];
+	fsum_label(j->s, g, label, sizeof label);
+	const fpath *p = j->paths.p + j->first[g];
+	int n = j->count[g], trav = 0;
+	for (int i = 0; i < n; i++)
+		trav += p[i].cls >= FPATH_NONE;
+	snprintf(title, sizeof title, "group %d, the first %d of %d trials\n%s", g, n,
+	         j->s->g[g].trials, label);
+	snprintf(name, sizeof name, "trajectories_g%03d", g);
+	rc = figs_bundle(f, name, title, &scene, p, n, err);
+	if (!rc && trav > 0) {
+		snprintf(title, sizeof title,
+		         "group %d, the %d traversed of the first %d trials over the landscape\n%s",
+		         g, trav, n, label);
+		snprintf(name, sizeof name, "landscape_g%03d", g);
+		rc = figs_over_landscape(f, name, title, &scene, p, n,
+		                         1u << FPATH_LEFT | 1u << FPATH_RIGHT | 1u << FPATH_NONE,
+		                         err);
+	}
+	j->untraversed[g] = !rc && trav == 0;
+	bsim_scene_free(&scene);
+	return rc;
+}
+
+/* One line naming the groups drawn without a landscape figure. */
+static void untraversed_note(figs *f, const char *dir, const char *flag, int n)
+{
+	char buf[400];
+	size_t k = 0;
+	int count = 0;
+	for (int g = 0; flag && g < n; g++) {
+		if (!flag[g])
+			continue;
+		count++;
+		if (k < sizeof buf - 16) {
+			int w = snprintf(buf + k, sizeof buf - k, "%s%d", k ? ", " : "", g);
+			k += w > 0 ? (size_t)w : 0;
+		}
+	}
+	if (count)
+		figs_note(f,
+		          "%s: no landscape figure for %d group%s without a traversed trial "
+		          "among the kept ones: %s%s",
+		          dir, count, count == 1 ? "" : "s", buf,
+		          k >= sizeof buf - 16 ? ", ..." : "");
+}
+
+/* Everything the trajectory figures need, read and checked before any
+ * figure is drawn: the experiment (for each group's scene), the kept
+ * paths with their classes, and where each group's paths start. */
+static int traj_load(figs *f, const char *dir, const char *inputs, const fsum *s, traj_job *j,
+                     int *have, bsim_error *err)
+{
+	char path[1100], exp_path[1100];
+	snprintf(path, sizeof path, "%s/trajectories.csv", dir);
+	snprintf(exp_path, sizeof exp_path, "%s/experiment.yaml", inputs);
+	struct stat st;
+	*have = 0;
+	if (stat(path, &st) != 0)
+		return BSIM_OK;
+	if (stat(exp_path, &st) != 0) {
+		figs_note(f, "%s: no %s, so no scene to draw the trajectories on", dir, exp_path);
+		return BSIM_OK;
+	}
+	int rc = bsim_experiment_load(exp_path, NULL, 0, &j->e_own, err);
+	if (rc)
+		return rc;
+	j->e = &j->e_own;
+	*have = 1; /* from here on traj_free releases what is loaded */
+	if (j->e->n_groups != s->n_groups)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: %d groups, but %s/summary.json has %d",
+		                      exp_path, j->e->n_groups, dir, s->n_groups);
+	rc = csv_table_read(path, &j->table, err);
+	if (rc)
+		return rc;
+	j->have_table = 1;
+	rc = fpaths_read(&j->table, path, &j->paths, err);
+	if (!rc)
+		rc = classes_read(dir, s, &j->paths, err);
+	j->first = calloc((size_t)s->n_groups, sizeof *j->first);
+	j->count = calloc((size_t)s->n_groups, sizeof *j->count);
+	j->untraversed = calloc((size_t)s->n_groups, 1);
+	if (!rc && (!j->first || !j->count || !j->untraversed))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; !rc && i < j->paths.n; i++) {
+		int g = j->paths.p[i].group;
+		if (g < 0 || g >= s->n_groups)
+			return bsim_error_set(err, BSIM_EINPUT, "%s: group %d: expected 0 .. %d",
+			                      path, g, s->n_groups - 1);
+		if (j->count[g]++ == 0)
+			j->first[g] = i;
+	}
+	return rc;
+}
+
+static void traj_free(traj_job *j, int have)
+{
+	if (!have)
+		return;
+	free(j->untraversed);
+	free(j->first);
+	free(j->count);
+	fpaths_free(&j->paths);
+	if (j->have_table)
+		csv_table_free(&j->table);
+	bsim_experiment_free(&j->e_own);
+}
+
+static int traj_group(figs *f, void *job, int g, bsim_error *err)
+{
+	traj_job *j = job;
+	if (!j->s->g[g].selected || j->count[g] == 0)
+		return BSIM_OK;
+	return group_figures(f, j, g, err);
+}
+
+static int traj_draw(figs *f, const char *dir, traj_job *j, bsim_error *err)
+{
+	int rc = figs_each_group(f, j->s->n_groups, traj_group, j, err);
+	if (rc == BSIM_OK)
+		untraversed_note(f, dir, j->untraversed, j->s->n_groups);
+	return rc;
+}
+
+int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
+{
+	char path[1100];
+	snprintf(path, sizeof path, "%s/summary.json", dir);
+	fsum s;
+	int rc = fsum_read(path, &s, err);
+	if (rc)
+		return rc;
+	active a = {{NULL}, {0}};
+	traj_job j = {.s = &s};
+	int have = 0;
+	/* every input read and checked first: a bad one leaves no figure */
+	rc = fsum_select(f, &s, err);
+	if (!rc)
+		rc = active_build(&s, &a, err);
+	/* a lattice gets its own trajectory figures (figures_lattice.c) */
+	lat_job *lat = NULL;
+	if (!rc && figs_is_lattice(dir))
+		rc = figs_lattice_load(f, dir, inputs, &s, &lat, err);
+	else if (!rc)
+		rc = traj_load(f, dir, inputs, &s, &j, &have, err);
+	if (!rc)
+		rc = heat_map(f, &s, &a, lat != NULL, err);
+	for (int ax = 0; !rc && ax < s.n_axes; ax++)
+		if (a.n[ax] >= 2)
+			rc = versus(f, &s, &a, ax, lat != NULL, err);
+	if (!rc && have)
+		rc = traj_draw(f, dir, &j, err);
+	if (!rc && lat)
+		rc = figs_lattice_draw(f, lat, err);
+	figs_lattice_free(lat);
+	traj_free(&j, have);
+	active_free(&a, s.n_axes);
+	fsum_free(&s);
+	return rc;
+}

@@ -1,0 +1,418 @@
+/* Experiment files (DESIGN.md "Experiment file"): a scene, fixed overrides,
+ * a grid whose cartesian product is the groups (first axis slowest), trials
+ * per group and a seed. Every group's scene is built and validated at load,
+ * so a bad grid value fails before any trial runs. */
+#include "beamsim/experiment.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/limits.h"
+#include "model/scene_internal.h"
+
+static const char experiment_keys[] = "name, scene, trials, seed, set, grid";
+
+static char *dup_text(const char *t)
+{
+	char *s = t ? malloc(strlen(t) + 1) : NULL;
+	if (s)
+		strcpy(s, t);
+	return s;
+}
+
+/* "EXPFILE:LINE" of a value: the origin its override carries. */
+static char *value_origin(const ydoc *d, struct fy_node *n, struct fy_node *key)
+{
+	char buf[1100];
+	snprintf(buf, sizeof buf, "%s:%d", d->path, ydoc_line(n, key));
+	return dup_text(buf);
+}
+
+static const char *key_text(struct fy_node *k)
+{
+	const char *t = k && fy_node_is_scalar(k) ? fy_node_get_scalar0(k) : NULL;
+	return t && *t ? t : NULL;
+}
+
+/* The scene path is relative to the experiment file's directory. */
+static int walk_scene_path(const ydoc *d, struct fy_node *n, struct fy_node *key,
+                           bsim_experiment *e, bsim_error *err)
+{
+	const char *t = ydoc_is_null(n) || !fy_node_is_scalar(n) ? NULL : fy_node_get_scalar0(n);
+	if (!t)
+		return ydoc_expected(d, n, key, "scene", "a scene file name", err);
+	const char *slash = strrchr(d->path, '/');
+	int dir = t[0] == '/' || !slash ? 0 : (int)(slash - d->path + 1);
+	int len = snprintf(e->scene_path, sizeof e->scene_path, "%.*s%s", dir, d->path, t);
+	if (len < 0 || (size_t)len >= sizeof e->scene_path)
+		return ydoc_expected(d, n, key, "scene", "a shorter path", err);
+	FILE *f = fopen(e->scene_path, "rb");
+	if (!f) {
+		char what[1200];
+		snprintf(what, sizeof what, "a readable scene file (%s: %s)", e->scene_path,
+		         strerror(errno));
+		return ydoc_expected(d, n, key, "scene", what, err);
+	}
+	fclose(f);
+	return BSIM_OK;
+}
+
+static int walk_set(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim_experiment *e,
+                    bsim_error *err)
+{
+	if (ydoc_is_null(n))
+		return BSIM_OK;
+	if (!fy_node_is_mapping(n))
+		return ydoc_expected(d, n, key, "set", "a mapping of dotted keys to values", err);
+	int count = fy_node_mapping_item_count(n);
+	e->set = calloc((size_t)count, sizeof *e->set);
+	if (!e->set)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
+	for (int i = 0; i < count; i++) {
+		struct fy_node_pair *p = fy_node_mapping_get_by_index(n, i);
+		struct fy_node *k = fy_node_pair_key(p), *v = fy_node_pair_value(p);
+		const char *name = key_text(k);
+		char field[512];
+		ydoc_join(field, sizeof field, "set.", name ? name : "?");
+		if (!name)
+			return ydoc_expected(d, k, n, "set", "a dotted scene key", err);
+		if (ydoc_is_null(v))
+			return ydoc_expected(d, v, k, field, "a value", err);
+		bsim_override *o = &e->set[e->n_set++];
+		o->key = dup_text(name);
+		o->value = ydoc_flow_text(v);
+		o->origin = value_origin(d, v, k);
+		if (!o->key || !o->value || !o->origin)
+			return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
+	}
+	return BSIM_OK;
+}
+
+static int walk_axis(const ydoc *d, struct fy_node *k, struct fy_node *v, bsim_grid_axis *a,
+                     bsim_error *err)
+{
+	const char *name = key_text(k);
+	char field[512];
+	ydoc_join(field, sizeof field, "grid.", name ? name : "?");
+	if (!name)
+		return ydoc_expected(d, k, NULL, "grid", "a dotted scene key", err);
+	int count = v && fy_node_is_sequence(v) ? fy_node_sequence_item_count(v) : 0;
+	if (count == 0)
+		return ydoc_expected(d, v, k, field, "a non-empty list of values", err);
+	a->key = dup_text(name);
+	a->values = calloc((size_t)count, sizeof *a->values);
+	a->origins = calloc((size_t)count, sizeof *a->origins);
+	if (!a->key || !a->values || !a->origins)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
+	for (int i = 0; i < count; i++) {
+		struct fy_node *item = fy_node_sequence_get_by_index(v, i);
+		if (!item || !fy_node_is_scalar(item) || ydoc_is_null(item)) {
+			char f[540], idx[16];
+			snprintf(idx, sizeof idx, ".%d", i);
+			ydoc_join(f, sizeof f, field, idx);
+			return ydoc_expected(d, item, k, f, "a scalar value", err);
+		}
+		a->values[i] = ydoc_flow_text(item);
+		a->origins[i] = value_origin(d, item, k);
+		a->n_values = i + 1;
+		if (!a->values[i] || !a->origins[i])
+			return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
+	}
+	return BSIM_OK;
+}
+
+/* The groups are the cartesian product of the axes; at least one axis with
+ * at least one value, and a count that fits an int. */
+static int walk_grid(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim_experiment *e,
+                     bsim_error *err)
+{
+	int count = n && fy_node_is_mapping(n) ? fy_node_mapping_item_count(n) : 0;
+	if (count == 0)
+		return ydoc_expected(d, n, key, "grid",
+		                     "at least one axis (a dotted scene key with a list of values)",
+		                     err);
+	e->axes = calloc((size_t)count, sizeof *e->axes);
+	if (!e->axes)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
+	/* Counted before any axis is walked: a few hundred bytes of lists can
+	 * ask for 10^9 groups, each a scene to build and check. */
+	double groups = 1, limit = bsim_limits_get()->groups;
+	for (int i = 0; i < count; i++) {
+		struct fy_node *v = fy_node_pair_value(fy_node_mapping_get_by_index(n, i));
+		groups *= v && fy_node_is_sequence(v) ? fy_node_sequence_item_count(v) : 1;
+	}
+	if (groups > limit || groups > INT_MAX) {
+		char hint[160];
+		bsim_limits_hint(hint, sizeof hint, "groups", limit);
+		return ydoc_fail(
+		        d, n, key, "grid", err,
+		        "expected at most %.15g groups (the product of the lists' lengths), "
+		        "got %.15g (%s)",
+		        limit < INT_MAX ? limit : INT_MAX, groups, hint);
+	}
+	for (int i = 0; i < count; i++) {
+		struct fy_node_pair *p = fy_node_mapping_get_by_index(n, i);
+		int rc = walk_axis(d, fy_node_pair_key(p), fy_node_pair_value(p), &e->axes[i], err);
+		e->n_axes = i + 1;
+		if (rc)
+			return rc;
+	}
+	e->n_groups = (int)groups;
+	return BSIM_OK;
+}
+
+static int walk_trials(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim_experiment *e,
+                       bsim_error *err)
+{
+	long long v = 0;
+	if (!ydoc_int64(n, &v) || v <= 0 || v > INT_MAX)
+		return ydoc_expected(d, n, key, "trials", "a positive integer", err);
+	e->trials = (int)v;
+	return BSIM_OK;
+}
+
+static int walk_key(const ydoc *d, const char *name, struct fy_node *k, struct fy_node *v,
+                    bsim_experiment *e, bsim_error *err)
+{
+	if (!strcmp(name, "name"))
+		return v && fy_node_is_scalar(v) && !ydoc_is_null(v)
+		               ? BSIM_OK
+		               : ydoc_expected(d, v, k, "name", "a non-empty string", err);
+	if (!strcmp(name, "scene"))
+		return walk_scene_path(d, v, k, e, err);
+	if (!strcmp(name, "trials"))
+		return walk_trials(d, v, k, e, err);
+	if (!strcmp(name, "seed"))
+		return ydoc_uint64(v, &e->seed)
+		               ? BSIM_OK
+		               : ydoc_expected(d, v, k, "seed", "an integer >= 0", err);
+	if (!strcmp(name, "set"))
+		return walk_set(d, v, k, e, err);
+	if (!strcmp(name, "grid"))
+		return walk_grid(d, v, k, e, err);
+	/* A scene given where an experiment belongs (beamsim sweep SCENE). */
+	struct fy_node *root = fy_document_root(d->fyd);
+	if (ydoc_pair(root, "body", 4) &&
+	    (ydoc_pair(root, "beams", 5) || ydoc_pair(root, "lattice", 7)))
+		return ydoc_fail(
+		        d, k, NULL, name, err,
+		        "this is a scene file (body: and beams: or lattice:), not an "
+		        "experiment: run it with beamsim run, or name it in an experiment's "
+		        "scene: with a grid:");
+	return ydoc_fail(d, k, NULL, name, err, "unknown key (expected one of %s)",
+	                 experiment_keys);
+}
+
+static int walk_experiment(const ydoc *d, bsim_experiment *e, bsim_error *err)
+{
+	static const char *const required[] = {"scene", "trials", "seed", "grid"};
+	static const char *const phrase[] = {"a scene file name", "a positive integer",
+	                                     "an integer >= 0",
+	                                     "a mapping of dotted keys to lists"};
+	struct fy_node *root = fy_document_root(d->fyd);
+	if (!root || !fy_node_is_mapping(root))
+		return ydoc_expected(d, root, NULL, "experiment",
+		                     "a mapping of experiment keys (scene, trials, seed, grid)",
+		                     err);
+	void *it = NULL;
+	struct fy_node_pair *p;
+	while ((p = fy_node_mapping_iterate(root, &it))) {
+		struct fy_node *k = fy_node_pair_key(p);
+		const char *name = key_text(k);
+		int rc = walk_key(d, name ? name : "?", k, fy_node_pair_value(p), e, err);
+		if (rc)
+			return rc;
+	}
+	for (int i = 0; i < 4; i++)
+		if (!ydoc_pair(root, required[i], strlen(required[i])))
+			return ydoc_fail(d, root, NULL, required[i], err, "missing (expected %s)",
+			                 phrase[i]);
+	bsim_error why;
+	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK) {
+		struct fy_node_pair *tp = ydoc_pair(root, "trials", 6);
+		return ydoc_fail(d, fy_node_pair_value(tp), fy_node_pair_key(tp), "trials", err,
+		                 "%s", why.msg);
+	}
+	return BSIM_OK;
+}
+
+int bsim_experiment_check_trials(const bsim_experiment *e, long trials, bsim_error *err)
+{
+	double total = (double)e->n_groups * (double)trials, limit = bsim_limits_get()->trials;
+	if (total <= limit)
+		return BSIM_OK;
+	char hint[160];
+	bsim_limits_hint(hint, sizeof hint, "trials", limit);
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "expected at most %.15g trials in all, got %d groups x %ld trials = "
+	                      "%.15g (%s)",
+	                      limit, e->n_groups, trials, total, hint);
+}
+
+void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx)
+{
+	for (int a = e->n_axes - 1; a >= 0; a--) {
+		idx[a] = g % e->axes[a].n_values;
+		g /= e->axes[a].n_values;
+	}
+}
+
+/* set, then extra (the command line), then the group's grid values: later
+ * overrides win. The strings are borrowed from e and extra. */
+static bsim_override *group_overrides(const bsim_experiment *e, int g, const bsim_override *extra,
+                                      int n_extra, int *n)
+{
+	*n = e->n_set + n_extra + e->n_axes;
+	bsim_override *ov = malloc((size_t)(*n ? *n : 1) * sizeof *ov);
+	int *idx = malloc((size_t)(e->n_axes ? e->n_axes : 1) * sizeof *idx);
+	if (!ov || !idx) {
+		free(ov);
+		free(idx);
+		return NULL;
+	}
+	bsim_experiment_group_index(e, g, idx);
+	for (int i = 0; i < e->n_set; i++)
+		ov[i] = e->set[i];
+	for (int i = 0; i < n_extra; i++)
+		ov[e->n_set + i] = extra[i];
+	for (int a = 0; a < e->n_axes; a++) {
+		const bsim_grid_axis *ax = &e->axes[a];
+		ov[e->n_set + n_extra + a] =
+		        (bsim_override){ax->key, ax->values[idx[a]], ax->origins[idx[a]]};
+	}
+	free(idx);
+	return ov;
+}
+
+static int load_group(const ydoc *scene, const bsim_experiment *e, int g,
+                      const bsim_override *extra, int n_extra, bsim_scene *out, bsim_error *err)
+{
+	int n = 0;
+	bsim_override *ov = group_overrides(e, g, extra, n_extra, &n);
+	if (!ov)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
+	int rc = scene_load_parsed(scene, ov, n, out, err);
+	free(ov);
+	return rc;
+}
+
+int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_override *extra,
+                                int n_extra, bsim_scene *out, bsim_error *err)
+{
+	if (g < 0 || g >= e->n_groups)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: group %d: expected 0 to %d", e->path,
+		                      g, e->n_groups - 1);
+	ydoc scene;
+	int rc = ydoc_load(&scene, e->scene_path, err);
+	if (rc)
+		return rc;
+	rc = load_group(&scene, e, g, extra, n_extra, out, err);
+	ydoc_free(&scene);
+	return rc;
+}
+
+/* 1 if key names the field axis or a field inside it ("beams.0.stiffness"
+ * inside "beams.0"): the grid's value, applied later, replaces all of it. */
+static int key_within(const char *key, const char *axis)
+{
+	size_t n = strlen(axis);
+	return strncmp(key, axis, n) == 0 && (key[n] == '\0' || key[n] == '.');
+}
+
+/* A fixed override (set: or --set) of a field the grid varies would be
+ * overwritten in every group without a word: refused. One of a block that
+ * holds the axis (set body.start, grid body.start.1) keeps its other
+ * fields, so it stands, and the grid's value acts inside it. */
+static int check_conflicts(const bsim_experiment *e, const bsim_override *extra, int n_extra,
+                           bsim_error *err)
+{
+	for (int a = 0; a < e->n_axes; a++) {
+		const bsim_grid_axis *ax = &e->axes[a];
+		for (int i = 0; i < e->n_set; i++)
+			if (key_within(e->set[i].key, ax->key))
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s: set.%s: the grid varies %s (%s), which would "
+				        "overwrite it in every group; expected a key the "
+				        "grid does not vary",
+				        e->set[i].origin, e->set[i].key, ax->key, ax->origins[0]);
+		for (int i = 0; i < n_extra; i++)
+			if (key_within(extra[i].key, ax->key))
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s: the experiment's grid varies %s (%s), which "
+				        "would overwrite it in every group; expected a key "
+				        "the grid does not vary (to run one value, edit "
+				        "the grid)",
+				        extra[i].origin ? extra[i].origin : extra[i].key, ax->key,
+				        ax->origins[0]);
+	}
+	return BSIM_OK;
+}
+
+/* Reads the scene file once and builds every group's scene from it. */
+static int check_groups(const bsim_experiment *e, const bsim_override *extra, int n_extra,
+                        bsim_error *err)
+{
+	ydoc scene;
+	int rc = ydoc_load(&scene, e->scene_path, err);
+	for (int g = 0; !rc && g < e->n_groups; g++) {
+		bsim_scene s;
+		rc = load_group(&scene, e, g, extra, n_extra, &s, err);
+		bsim_scene_free(&s);
+	}
+	if (scene.fyd)
+		ydoc_free(&scene);
+	return rc;
+}
+
+int bsim_experiment_load(const char *path, const bsim_override *extra, int n_extra,
+                         bsim_experiment *out, bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	if (strlen(path) >= sizeof out->path)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: expected a path shorter than %zu characters", path,
+		                      sizeof out->path);
+	snprintf(out->path, sizeof out->path, "%s", path);
+	ydoc d;
+	int rc = ydoc_load(&d, out->path, err);
+	if (rc)
+		return rc;
+	rc = walk_experiment(&d, out, err);
+	ydoc_free(&d);
+	if (!rc)
+		rc = check_conflicts(out, extra, n_extra, err);
+	if (!rc)
+		rc = check_groups(out, extra, n_extra, err);
+	if (rc)
+		bsim_experiment_free(out);
+	return rc;
+}
+
+void bsim_experiment_free(bsim_experiment *e)
+{
+	if (!e)
+		return;
+	for (int i = 0; i < e->n_set; i++) {
+		free((char *)e->set[i].key);
+		free((char *)e->set[i].value);
+		free((char *)e->set[i].origin);
+	}
+	free(e->set);
+	for (int a = 0; a < e->n_axes; a++) {
+		bsim_grid_axis *ax = &e->axes[a];
+		for (int i = 0; i < ax->n_values; i++) {
+			free(ax->values[i]);
+			free(ax->origins[i]);
+		}
+		free(ax->key);
+		free(ax->values);
+		free(ax->origins);
+	}
+	free(e->axes);
+	memset(e, 0, sizeof *e);
+}

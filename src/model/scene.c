@@ -1,0 +1,321 @@
+/* Scenes built in code: the essay's gate, defaults, validation, copies
+ * (MODEL.md sections 1-6). A scene owns its beams array; every function that
+ * fills a scene from scratch overwrites it without freeing, so free the old
+ * contents first with bsim_scene_free. */
+#include "beamsim/scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/limits.h"
+#include "model/scene_internal.h"
+
+#define BSIM_PI 3.14159265358979323846
+
+bsim_scene bsim_scene_default(void)
+{
+	bsim_scene d;
+	scene_defaults(&d);
+	return d;
+}
+
+void scene_defaults(bsim_scene *s)
+{
+	memset(s, 0, sizeof *s);
+	s->contact.restitution = 0.8;     /* essay Table 2.1 */
+	s->contact.tip_restitution = 1.0; /* the essay's tip impacts are elastic */
+	s->contact.rest_threshold = 0.05; /* m/s */
+	s->effects.random_frequency = 50; /* Hz */
+	s->dt = 0.004;                    /* s */
+	s->max_steps = 3000;              /* 12 s */
+	s->success_y = 65;                /* m: pivot row 30 + L 25 + R 10 */
+	s->side_x = 25;                   /* m: the gate's half width */
+	s->classify_y = 80;               /* m */
+	/* m/s: five times the lateral speed that solve order and float32
+	 * rounding give Box2D in the exactly symmetric noise-free gate
+	 * (2.1 mm/s), where the type is round-off, not a side. */
+	s->classify_deadband = 0.01;
+	s->landscape_y0 = 60; /* m: essay Eq. 2.16 */
+}
+
+static void gate_beam(bsim_beam_def *b, double px, double rest_deg)
+{
+	memset(b, 0, sizeof *b);
+	b->pivot[0] = px;
+	b->pivot[1] = 30;
+	b->rest_angle_deg = rest_deg;
+	b->length = 25;                                   /* m */
+	b->mass = 0.1;                                    /* kg */
+	b->inertia = b->mass * b->length * b->length / 3; /* rod about its end */
+	b->stiffness = 400;                               /* N m/rad */
+	b->damping = 50;                                  /* N m s/rad */
+}
+
+void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm)
+{
+	scene_defaults(s);
+	snprintf(s->name, sizeof s->name, "thesis-gate");
+	s->body.mass = 1;    /* kg */
+	s->body.radius = 10; /* m */
+	/* On allocation failure the scene has no beams and fails validation. */
+	if (bsim_scene_set_beams(s, 2) == BSIM_OK) {
+		gate_beam(&s->beams[0], -25, 0);  /* left, pointing at the midline */
+		gate_beam(&s->beams[1], 25, 180); /* right, mirrored */
+	}
+	s->effects.has_propulsion = 1;
+	s->effects.propulsion_force = f_prop;
+	s->effects.has_random_force = rm > 0; /* Rm = 0: no draws at all */
+	s->effects.random_magnitude = rm;
+}
+
+void bsim_scene_beam_rest_direction(const bsim_beam_def *b, double u0[2])
+{
+	double q = b->rest_angle_deg / 90.0;
+	if (q == floor(q) && fabs(q) < 1e15) {
+		static const double c[4] = {1, 0, -1, 0}, s[4] = {0, 1, 0, -1};
+		long k = ((long)fmod(q, 4.0) + 4) % 4;
+		u0[0] = c[k];
+		u0[1] = s[k];
+		return;
+	}
+	const double rad = b->rest_angle_deg * (BSIM_PI / 180);
+	u0[0] = cos(rad);
+	u0[1] = sin(rad);
+}
+
+double bsim_scene_beam_forward_sign(const bsim_beam_def *b)
+{
+	double u0[2];
+	bsim_scene_beam_rest_direction(b, u0);
+	return u0[0] >= 0.0 ? 1.0 : -1.0;
+}
+
+int scene_overlap(const bsim_scene *s, double *dist)
+{
+	const double *c = s->body.start;
+	for (int i = 0; i < s->n_beams; i++) {
+		const bsim_beam_def *b = &s->beams[i];
+		/* Forward-positive theta moves the tip toward +y: a beam pointing
+		 * left (cos(rest) < 0) turns clockwise for positive theta. */
+		double u0[2];
+		bsim_scene_beam_rest_direction(b, u0);
+		double sn = bsim_scene_beam_forward_sign(b) * sin(b->initial_theta);
+		double cs = cos(b->initial_theta);
+		double ux = u0[0] * cs - u0[1] * sn, uy = u0[1] * cs + u0[0] * sn;
+		double dx = c[0] - b->pivot[0], dy = c[1] - b->pivot[1];
+		double along = fmin(fmax(dx * ux + dy * uy, 0), b->length);
+		double d = hypot(dx - along * ux, dy - along * uy);
+		if (d < s->body.radius) {
+			*dist = d;
+			return i;
+		}
+	}
+	return -1;
+}
+
+static const char *scene_who(const bsim_scene *s)
+{
+	if (s->path[0])
+		return s->path;
+	return s->name[0] ? s->name : "scene";
+}
+
+static int check_value(const bsim_scene *s, const scene_field *f, const char *base,
+                       const char *field, bsim_error *err)
+{
+	const char *who = scene_who(s);
+	const char *p = base + f->offset;
+	double v[2] = {0, 0};
+	int n = 1;
+	if (f->kind == SK_INT) {
+		int k = *(const int *)p;
+		if (k < (f->range == SR_NONNEG ? 0 : 1))
+			return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s, got %d", who,
+			                      field, scene_phrase(f), k);
+		return BSIM_OK;
+	}
+	if (f->kind == SK_NAME)
+		return memchr(p, '\0', sizeof s->name)
+		               ? BSIM_OK
+		               : bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s", who, field,
+		                                "a string of at most 127 characters");
+	memcpy(v, p, (f->kind == SK_VEC2 ? 2 : 1) * sizeof(double));
+	n = f->kind == SK_VEC2 ? 2 : 1;
+	for (int i = 0; i < n; i++) {
+		if (!isfinite(v[i]))
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "%s: %s: expected a finite number, got %g", who,
+			                      field, v[i]);
+		if (!scene_in_range(f->range, v[i]))
+			return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s, got %g", who,
+			                      field, scene_phrase(f), v[i]);
+	}
+	return BSIM_OK;
+}
+
+/* Checks every field of table t over the struct at base. Blocks with a
+ * presence flag that is 0 are not simulated, so not checked. */
+static int check_table(const bsim_scene *s, const scene_table *t, const char *base,
+                       const char *prefix, bsim_error *err)
+{
+	for (int i = 0; i < t->n_fields; i++) {
+		const scene_field *f = &t->fields[i];
+		char field[256];
+		ydoc_join(field, sizeof field, prefix, f->key);
+		int rc = BSIM_OK;
+		if (f->kind == SK_BLOCK) {
+			if (f->offset != SCENE_NO_FLAG && !*(const int *)(base + f->offset))
+				continue;
+			char sub[260];
+			ydoc_join(sub, sizeof sub, field, ".");
+			rc = check_table(s, f->sub, base, sub, err);
+		} else if (f->kind == SK_NUMBER || f->kind == SK_INT || f->kind == SK_VEC2 ||
+		           f->kind == SK_NAME) {
+			rc = check_value(s, f, base, field, err);
+		}
+		if (rc)
+			return rc;
+	}
+	return BSIM_OK;
+}
+
+/* A lattice's shape must match its beams, and the body must start inside
+ * the field (between the sides; below the end). */
+static int lattice_validate(const bsim_scene *s, const char *who, bsim_error *err)
+{
+	const bsim_lattice_def *l = &s->lattice;
+	if (l->rows < 1 || l->columns < 1 || l->ix_max - l->ix_min + 1 != l->columns)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: lattice: expected at least one gate (columns = ix_max - "
+		                      "ix_min + 1 >= 1, rows >= 1), got %d x %d",
+		                      who, l->columns, l->rows);
+	if (!(l->width > 0) || !(l->depth > 0) || !isfinite(l->width) || !isfinite(l->depth) ||
+	    !isfinite(l->pivot_y))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: lattice.gate: expected positive width and depth, got %g "
+		                      "and %g",
+		                      who, l->width, l->depth);
+	if ((long)s->n_beams != 2L * l->columns * l->rows)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: lattice: expected %ld beams (2 per gate), got %d", who,
+		                      2L * l->columns * l->rows, s->n_beams);
+	double centre = 0.5 * l->width * (l->ix_min + l->ix_max);
+	if (!(fabs(s->body.start[0] - centre) < s->side_x))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.start: expected a point between the lattice's "
+		                      "sides (|x - %g| < side_x = %g), got x = %g",
+		                      who, centre, s->side_x, s->body.start[0]);
+	return BSIM_OK;
+}
+
+int scene_excess_find(const bsim_scene *s, scene_excess *x)
+{
+	const bsim_limits *l = bsim_limits_get();
+	/* In doubles: the products of valid fields can exceed any integer. */
+	double values = (double)s->max_steps * s->dt * s->effects.random_frequency;
+	/* A lattice's step costs the beams near the body, about one gate's
+	 * (docs/lattice.md, bench --lattice), not every beam of the field. */
+	int beams = s->has_lattice ? 2 : s->n_beams;
+	double beam_steps = (double)s->max_steps * (beams > 0 ? beams : 1);
+	if (s->effects.has_random_force && values > l->schedule) {
+		*x = (scene_excess){"effects.random_force.frequency", "schedule", values,
+		                    l->schedule,
+		                    "random-force values per trial (frequency x dt x max_steps)"};
+		return 1;
+	}
+	if (beam_steps > l->beam_steps) {
+		*x = (scene_excess){"integration.max_steps", "beam_steps", beam_steps,
+		                    l->beam_steps, "beam-steps per trial (max_steps x beams)"};
+		return 1;
+	}
+	return 0;
+}
+
+int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
+{
+	const char *who = scene_who(s);
+	int rc = check_table(s, &scene_top_table, (const char *)s, "", err);
+	if (rc)
+		return rc;
+	if (s->n_beams < 1 || !s->beams)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: beams: expected %s, got %d beams", who,
+		                      "a non-empty list of beams", s->n_beams);
+	for (int i = 0; i < s->n_beams; i++) {
+		char prefix[64];
+		snprintf(prefix, sizeof prefix, "beams.%d.", i);
+		rc = check_table(s, &scene_beam_table, (const char *)&s->beams[i], prefix, err);
+		if (rc)
+			return rc;
+	}
+	if (s->has_lattice) {
+		rc = lattice_validate(s, who, err);
+		if (rc)
+			return rc;
+	}
+	if (s->classify_y < s->success_y)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: termination.classify_y: expected a number >= success_y "
+		                      "(%g), got %g",
+		                      who, s->success_y, s->classify_y);
+	double d = 0;
+	int beam = scene_overlap(s, &d);
+	if (beam >= 0)
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "%s: body.start: the body (radius %g) overlaps beam %d (beams.%d) at "
+		        "the start (distance %.3g m)",
+		        who, s->body.radius, beam + 1, beam, d);
+	scene_excess x;
+	if (scene_excess_find(s, &x)) {
+		char hint[160];
+		bsim_limits_hint(hint, sizeof hint, x.limit, x.max);
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: %s: expected at most %.15g %s, got %.3g (%s)", who,
+		                      x.field, x.max, x.what, x.got, hint);
+	}
+	return BSIM_OK;
+}
+
+int bsim_scene_copy(bsim_scene *dst, const bsim_scene *src)
+{
+	*dst = *src;
+	dst->beams = NULL;
+	dst->n_beams = 0;
+	if (src->n_beams <= 0)
+		return BSIM_OK;
+	dst->beams = malloc((size_t)src->n_beams * sizeof *dst->beams);
+	if (!dst->beams)
+		return BSIM_EFAIL;
+	memcpy(dst->beams, src->beams, (size_t)src->n_beams * sizeof *dst->beams);
+	dst->n_beams = src->n_beams;
+	return BSIM_OK;
+}
+
+void bsim_scene_free(bsim_scene *s)
+{
+	if (!s)
+		return;
+	free(s->beams);
+	s->beams = NULL;
+	s->n_beams = 0;
+}
+
+int bsim_scene_set_beams(bsim_scene *s, int n_beams)
+{
+	if (n_beams < 0)
+		return BSIM_EINPUT;
+	if (n_beams == 0) {
+		bsim_scene_free(s);
+		return BSIM_OK;
+	}
+	bsim_beam_def *b = realloc(s->beams, (size_t)n_beams * sizeof *b);
+	if (!b)
+		return BSIM_EFAIL;
+	if (n_beams > s->n_beams)
+		memset(b + s->n_beams, 0, (size_t)(n_beams - s->n_beams) * sizeof *b);
+	s->beams = b;
+	s->n_beams = n_beams;
+	return BSIM_OK;
+}

@@ -1,0 +1,110 @@
+/* Internal: what scene.c, scene_schema.c and scene_load.c share. The scene
+ * schema is a table per YAML mapping (key, type, range, offset), so the file
+ * loader and bsim_scene_validate check the same things from one list. */
+#ifndef BSIM_SCENE_INTERNAL_H
+#define BSIM_SCENE_INTERNAL_H
+
+#include <stddef.h>
+
+#include "beamsim/scene.h"
+#include "util/yaml_doc.h"
+
+typedef enum scene_kind {
+	SK_NUMBER,  /* double, finite, in range */
+	SK_INT,     /* int > 0 */
+	SK_VEC2,    /* double[2], finite: [x, y] */
+	SK_NAME,    /* char[128], non-empty */
+	SK_BLOCK,   /* a nested mapping (sub) */
+	SK_BEAMS,   /* the list of beams (sub describes one beam) */
+	SK_INDEX,   /* int, any sign */
+	SK_LATTICE, /* the lattice block (scene_lattice.c) */
+	SK_LATER,   /* read by the block's own code after the table's walk */
+} scene_kind;
+
+typedef enum scene_range {
+	SR_ANY,      /* any finite number */
+	SR_POSITIVE, /* > 0 */
+	SR_NONNEG,   /* >= 0 */
+	SR_UNIT,     /* in [0, 1] */
+} scene_range;
+
+/* For an SK_BLOCK without a presence flag. */
+#define SCENE_NO_FLAG ((size_t)-1)
+
+typedef struct scene_table scene_table;
+
+typedef struct scene_field {
+	const char *key;
+	scene_kind kind;
+	scene_range range;
+	int required;
+	/* Byte offset of the value in the struct the table describes; for an
+	 * SK_BLOCK, of the int set to 1 when the block is present (effects
+	 * simulate only what is listed), or SCENE_NO_FLAG. */
+	size_t offset;
+	const scene_table *sub;
+} scene_field;
+
+struct scene_table {
+	const scene_field *fields;
+	int n_fields;
+};
+
+extern const scene_table scene_top_table;  /* offsets into bsim_scene */
+extern const scene_table scene_beam_table; /* offsets into bsim_beam_def */
+
+/* What a field expects, for messages: "a positive number", "a mapping". */
+const char *scene_phrase(const scene_field *f);
+
+int scene_in_range(scene_range r, double v);
+
+/* "pivot, rest_angle_deg, ..." for unknown-key messages. */
+void scene_keys(const scene_table *t, char *buf, size_t size);
+
+/* Everything that has a default gets it; the rest is zero. */
+void scene_defaults(bsim_scene *s);
+
+/* Index of the first beam the body overlaps at the start (distance from the
+ * body centre to the beam segment < radius), or -1; *dist in m. */
+int scene_overlap(const bsim_scene *s, double *dist);
+
+/* A walk of a scene document into a scene (scene_load.c). */
+typedef struct scene_walk {
+	const ydoc *d;
+	bsim_scene *s;
+	bsim_error *err;
+} scene_walk;
+
+/* Walks one mapping (NULL: an empty one) against table t into base: unknown
+ * keys are errors, known ones are stored, missing required ones reported. */
+int scene_walk_table(scene_walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
+                     char *base, const char *prefix);
+
+/* The lattice: block (scene_lattice.c): its keys, maps and CSV file, then
+ * the beams built from it. */
+int scene_walk_lattice(scene_walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key);
+extern const scene_table scene_lattice_table;
+
+/* The termination defaults of a lattice (lattice.c): success_y = depth
+ * rows, side_x = width columns / 2, classify_y = success_y, landscape y0 =
+ * success_y, gate_steps = 3000, max_steps = gate_steps (rows + columns). */
+void scene_lattice_defaults(bsim_scene *s);
+
+/* A limit of beamsim/limits.h that a scene exceeds: the field to blame,
+ * what it asks for and the limit's name and value. */
+typedef struct scene_excess {
+	const char *field; /* "effects.random_force.frequency", ... */
+	const char *limit; /* "schedule", "beam_steps" */
+	double got, max;
+	const char *what; /* "random-force values per trial (frequency x dt x max_steps)" */
+} scene_excess;
+
+/* 1 and *x if the scene asks for more than a limit allows, else 0. */
+int scene_excess_find(const bsim_scene *s, scene_excess *x);
+
+/* bsim_scene_load on a document already read (the experiment loader reads
+ * the scene file once and builds every group from a clone of it). */
+int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,
+                      bsim_error *err);
+
+#endif

@@ -1,0 +1,432 @@
+/* Scene files: read with libfyaml, apply the overrides to the document, walk
+ * it into a bsim_scene by the schema tables (scene_schema.c), then the
+ * checks that involve several fields. Every failure is one BSIM_EINPUT
+ * message "WHERE: FIELD: expected WHAT, got GOT" (yaml_doc.h). */
+#include "beamsim/scene.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "beamsim/limits.h"
+#include "model/scene_internal.h"
+#include "util/yaml_override.h"
+
+typedef scene_walk walk;
+
+#define walk_table scene_walk_table
+
+/* "expected WHAT, got <the node>" at node n (or its key). */
+static int expected(walk *w, struct fy_node *n, struct fy_node *key, const char *field,
+                    const char *what)
+{
+	return ydoc_expected(w->d, n, key, field, what, w->err);
+}
+
+static int walk_number(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
+                       const char *field, double *out)
+{
+	int rc = ydoc_number(n, out);
+	if (rc == YDOC_NUM_NONFINITE)
+		return expected(w, n, key, field, "a finite number");
+	if (rc != YDOC_NUM_OK || !scene_in_range(f->range, *out))
+		return expected(w, n, key, field, scene_phrase(f));
+	return BSIM_OK;
+}
+
+static int walk_int(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
+                    const char *field, int *out)
+{
+	long long v = 0;
+	long long lo = f->kind == SK_INDEX ? -1000000 : f->range == SR_NONNEG ? 0 : 1;
+	long long hi = f->kind == SK_INDEX ? 1000000 : INT_MAX;
+	if (!ydoc_int64(n, &v) || v < lo || v > hi)
+		return expected(w, n, key, field, scene_phrase(f));
+	*out = (int)v;
+	return BSIM_OK;
+}
+
+static int walk_vec2(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
+                     const char *field, double *out)
+{
+	if (!n || !fy_node_is_sequence(n) || fy_node_sequence_item_count(n) != 2)
+		return expected(w, n, key, field, scene_phrase(f));
+	static const scene_field coord = {"", SK_NUMBER, SR_ANY, 0, 0, NULL};
+	for (int i = 0; i < 2; i++) {
+		char item[300], idx[16];
+		snprintf(idx, sizeof idx, ".%d", i);
+		ydoc_join(item, sizeof item, field, idx);
+		int rc = walk_number(w, &coord, fy_node_sequence_get_by_index(n, i), n, item,
+		                     &out[i]);
+		if (rc)
+			return rc;
+	}
+	return BSIM_OK;
+}
+
+static int walk_name(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
+                     const char *field, char *out)
+{
+	size_t len = 0;
+	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
+	if (!t || len == 0 || ydoc_is_null(n))
+		return expected(w, n, key, field, scene_phrase(f));
+	if (len >= sizeof w->s->name)
+		return expected(w, n, key, field, "a name of at most 127 characters");
+	memcpy(out, t, len);
+	out[len] = '\0';
+	return BSIM_OK;
+}
+
+/* Each list item is one beam: defaults first, then its keys. The inertia
+ * default (a uniform rod about its end, m L^2 / 3) needs mass and length, so
+ * it is filled in after the walk. */
+static int walk_beams(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key)
+{
+	int count = n && fy_node_is_sequence(n) ? fy_node_sequence_item_count(n) : 0;
+	if (count == 0)
+		return expected(w, n, key, f->key, scene_phrase(f));
+	if (bsim_scene_set_beams(w->s, count) != BSIM_OK)
+		return bsim_error_set(w->err, BSIM_EFAIL, "%s: out of memory", w->d->path);
+	for (int i = 0; i < count; i++) {
+		struct fy_node *item = fy_node_sequence_get_by_index(n, i);
+		bsim_beam_def *b = &w->s->beams[i];
+		char field[32], prefix[32];
+		snprintf(field, sizeof field, "beams.%d", i);
+		snprintf(prefix, sizeof prefix, "beams.%d.", i);
+		if (!item || !fy_node_is_mapping(item))
+			return expected(w, item, key, field, "a mapping (one beam)");
+		memset(b, 0, sizeof *b);
+		b->inertia = NAN; /* not given yet */
+		int rc = walk_table(w, f->sub, item, key, (char *)b, prefix);
+		if (rc)
+			return rc;
+		if (isnan(b->inertia))
+			b->inertia = b->mass * b->length * b->length / 3;
+	}
+	return BSIM_OK;
+}
+
+static int walk_block(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
+                      char *base, const char *field)
+{
+	/* "effects:" with nothing under it is an empty block. */
+	if (!ydoc_is_null(n) && !fy_node_is_mapping(n))
+		return expected(w, n, key, field, scene_phrase(f));
+	if (f->offset != SCENE_NO_FLAG)
+		*(int *)(base + f->offset) = 1;
+	char prefix[300];
+	ydoc_join(prefix, sizeof prefix, field, ".");
+	return walk_table(w, f->sub, ydoc_is_null(n) ? NULL : n, key, base, prefix);
+}
+
+static int walk_field(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
+                      char *base, const char *field)
+{
+	switch (f->kind) {
+	case SK_NUMBER:
+		return walk_number(w, f, n, key, field, (double *)(base + f->offset));
+	case SK_INT:
+		return walk_int(w, f, n, key, field, (int *)(base + f->offset));
+	case SK_VEC2:
+		return walk_vec2(w, f, n, key, field, (double *)(base + f->offset));
+	case SK_NAME:
+		return walk_name(w, f, n, key, field, base + f->offset);
+	case SK_BLOCK:
+		return walk_block(w, f, n, key, base, field);
+	case SK_BEAMS:
+		return walk_beams(w, f, n, key);
+	case SK_INDEX:
+		return walk_int(w, f, n, key, field, (int *)(base + f->offset));
+	case SK_LATTICE:
+		return scene_walk_lattice(w, f, n, key);
+	case SK_LATER:
+		return BSIM_OK;
+	}
+	return BSIM_OK;
+}
+
+static int find_field(const scene_table *t, const char *key)
+{
+	for (int i = 0; key && i < t->n_fields; i++)
+		if (!strcmp(t->fields[i].key, key))
+			return i;
+	return -1;
+}
+
+/* Walks one mapping (NULL: an empty one) against table t: unknown keys are
+ * errors, known ones are stored, missing required ones are reported at the
+ * mapping (or at alt, the key naming it, when it is empty). */
+int scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
+                     char *base, const char *prefix)
+{
+	unsigned seen = 0;
+	void *it = NULL;
+	struct fy_node_pair *p;
+	while (map && (p = fy_node_mapping_iterate(map, &it))) {
+		struct fy_node *k = fy_node_pair_key(p);
+		const char *name = k && fy_node_is_scalar(k) ? fy_node_get_scalar0(k) : NULL;
+		char field[300], keys[512];
+		ydoc_join(field, sizeof field, prefix, name ? name : "?");
+		int i = find_field(t, name);
+		/* An experiment given where a scene belongs (beamsim run EXP). */
+		if (i < 0 && !prefix[0] && ydoc_pair(map, "scene", 5) && ydoc_pair(map, "grid", 4))
+			return ydoc_fail(
+			        w->d, k, map, field, w->err,
+			        "this is an experiment file (scene: and grid:), not a scene: "
+			        "run it with beamsim sweep or compare, or run its scene");
+		if (i < 0) {
+			scene_keys(t, keys, sizeof keys);
+			return ydoc_fail(w->d, k, map, field, w->err,
+			                 "unknown key (expected one of %s)", keys);
+		}
+		seen |= 1u << i;
+		int rc = walk_field(w, &t->fields[i], fy_node_pair_value(p), k, base, field);
+		if (rc)
+			return rc;
+	}
+	for (int i = 0; i < t->n_fields; i++) {
+		const scene_field *f = &t->fields[i];
+		if (f->required && !(seen & (1u << i))) {
+			char field[300];
+			ydoc_join(field, sizeof field, prefix, f->key);
+			return ydoc_fail(w->d, map, alt, field, w->err, "missing (expected %s)",
+			                 scene_phrase(f));
+		}
+	}
+	return BSIM_OK;
+}
+
+/* Of the nodes at paths (some may be absent), the one an override set last,
+ * or NULL when none came from an override: errors that involve several
+ * fields blame the latest change. All overrides of one load are one array,
+ * so a later one has the higher address. */
+static struct fy_node *latest_override(const ydoc *d, const char *const *paths, int n)
+{
+	struct fy_node *root = fy_document_root(d->fyd), *best = NULL;
+	const bsim_override *best_o = NULL;
+	for (int i = 0; i < n; i++) {
+		struct fy_node *node = ydoc_lookup(root, paths[i]);
+		const bsim_override *o = node ? ydoc_origin(node) : NULL;
+		if (o && (!best_o || o > best_o)) {
+			best = node;
+			best_o = o;
+		}
+	}
+	return best;
+}
+
+/* classify_y >= success_y: blame the one an override changed last, else
+ * classify_y (or success_y when only it is in the file). */
+static int check_termination(walk *w)
+{
+	const bsim_scene *s = w->s;
+	if (s->classify_y >= s->success_y)
+		return BSIM_OK;
+	const char *paths[] = {"termination.classify_y", "termination.success_y"};
+	struct fy_node *root = fy_document_root(w->d->fyd);
+	struct fy_node *classify = ydoc_lookup(root, paths[0]);
+	struct fy_node *n = latest_override(w->d, paths, 2);
+	if (!n)
+		n = classify ? classify : ydoc_lookup(root, paths[1]);
+	char got[128];
+	ydoc_describe(n, got, sizeof got);
+	if (n == classify)
+		return ydoc_fail(w->d, n, NULL, paths[0], w->err,
+		                 "expected a number >= termination.success_y (%g), got %s",
+		                 s->success_y, got);
+	return ydoc_fail(w->d, n, NULL, paths[1], w->err,
+	                 "expected a number <= termination.classify_y (%g), got %s", s->classify_y,
+	                 got);
+}
+
+/* The body must not start inside a beam (MODEL.md section 3). The message
+ * points at body.start, or at the override that last moved the body or that
+ * beam. */
+static int check_overlap(walk *w)
+{
+	double dist = 0;
+	int beam = scene_overlap(w->s, &dist);
+	if (beam < 0)
+		return BSIM_OK;
+	char p[4][64];
+	static const char *const keys[4] = {"pivot", "rest_angle_deg", "length", "initial_theta"};
+	for (int i = 0; i < 4; i++)
+		snprintf(p[i], sizeof p[i], "beams.%d.%s", beam, keys[i]);
+	const char *paths[] = {"body.start", "body.radius", p[0], p[1], p[2], p[3]};
+	struct fy_node *root = fy_document_root(w->d->fyd);
+	struct fy_node *n = latest_override(w->d, paths, 6);
+	if (!n)
+		n = ydoc_lookup(root, "body.start");
+	if (!n)
+		n = ydoc_lookup(root, "body");
+	return ydoc_fail(
+	        w->d, n, NULL, "body.start", w->err,
+	        "the body (radius %g) overlaps beam %d (beams.%d) at the start (distance %.3g m)",
+	        w->s->body.radius, beam + 1, beam, dist);
+}
+
+/* A valid scene that asks for more than a limit allows: the message
+ * blames the override that changed one of the fields involved last, else
+ * the field itself, else the block it would be in. */
+static int check_limits(walk *w)
+{
+	scene_excess x;
+	if (!scene_excess_find(w->s, &x))
+		return BSIM_OK;
+	static const char *const schedule[] = {"effects.random_force.frequency", "integration.dt",
+	                                       "integration.max_steps"};
+	static const char *const steps[] = {"integration.max_steps", "beams"};
+	int is_schedule = !strcmp(x.limit, "schedule");
+	const char *const *paths = is_schedule ? schedule : steps;
+	int n = is_schedule ? 3 : 2;
+	struct fy_node *root = fy_document_root(w->d->fyd);
+	struct fy_node *node = latest_override(w->d, paths, n);
+	const char *field = paths[0];
+	for (int i = 0; i < n; i++) {
+		struct fy_node *at = ydoc_lookup(root, paths[i]);
+		if (node ? at == node : at != NULL) {
+			node = at;
+			field = paths[i];
+			break;
+		}
+	}
+	if (!node) /* all defaults: the block the first field would be in */
+		node = ydoc_lookup(root, is_schedule ? "effects.random_force" : "integration");
+	char hint[160];
+	bsim_limits_hint(hint, sizeof hint, x.limit, x.max);
+	return ydoc_fail(w->d, node ? node : root, NULL, field, w->err,
+	                 "expected at most %.15g %s, got %.3g (%s)", x.max, x.what, x.got, hint);
+}
+
+/* The file's base name without its extension: "configs/gate.yaml" -> "gate". */
+static void default_name(bsim_scene *s, const char *path)
+{
+	const char *base = strrchr(path, '/');
+	base = base ? base + 1 : path;
+	size_t len = strcspn(base, ".");
+	if (len == 0)
+		len = strlen(base);
+	if (len >= sizeof s->name)
+		len = sizeof s->name - 1;
+	memcpy(s->name, base, len);
+	s->name[len] = '\0';
+}
+
+/* An effect block that asks for nothing simulates nothing: "Rm = 0 means no
+ * random force at all (no draws)" (MODEL.md section 2), and likewise a
+ * propulsion of 0 N. */
+static void effects_present(bsim_scene *s)
+{
+	if (s->effects.propulsion_force == 0)
+		s->effects.has_propulsion = 0;
+	if (s->effects.random_magnitude == 0)
+		s->effects.has_random_force = 0;
+}
+
+/* A scene has beams: or lattice:, not both, not neither. */
+static int check_beams_or_lattice(walk *w, struct fy_node *root)
+{
+	struct fy_node_pair *beams = ydoc_pair(root, "beams", 5);
+	struct fy_node_pair *lattice = ydoc_pair(root, "lattice", 7);
+	if (beams && lattice)
+		return ydoc_fail(w->d, fy_node_pair_key(lattice), root, "lattice", w->err,
+		                 "expected either beams: or lattice:, not both");
+	if (!beams && !lattice)
+		return ydoc_fail(w->d, root, NULL, "beams", w->err,
+		                 "missing (expected a non-empty list of beams, or a lattice: "
+		                 "block)");
+	return BSIM_OK;
+}
+
+/* The lattice's termination defaults where the file and overrides leave a
+ * key out (scene_lattice_defaults). */
+static void lattice_defaults(walk *w, struct fy_node *root)
+{
+	bsim_scene *s = w->s, given = *s;
+	scene_lattice_defaults(s);
+	static const char *const keys[] = {"termination.success_y",  "termination.side_x",
+	                                   "termination.classify_y", "landscape.y0",
+	                                   "termination.gate_steps", "integration.max_steps"};
+	if (ydoc_lookup(root, keys[0]))
+		s->success_y = given.success_y;
+	if (ydoc_lookup(root, keys[1]))
+		s->side_x = given.side_x;
+	if (ydoc_lookup(root, keys[2]))
+		s->classify_y = given.classify_y;
+	else
+		s->classify_y = s->success_y;
+	if (ydoc_lookup(root, keys[3]))
+		s->landscape_y0 = given.landscape_y0;
+	if (ydoc_lookup(root, keys[4]))
+		s->gate_steps = given.gate_steps;
+	if (ydoc_lookup(root, keys[5]))
+		s->max_steps = given.max_steps;
+	else
+		s->max_steps = s->gate_steps * (s->lattice.rows + s->lattice.columns);
+}
+
+static int walk_scene(walk *w)
+{
+	struct fy_node *root = fy_document_root(w->d->fyd);
+	if (!root || !fy_node_is_mapping(root))
+		return expected(w, root, NULL, "scene",
+		                "a mapping of scene keys (body, beams, ...)");
+	int rc = walk_table(w, &scene_top_table, root, NULL, (char *)w->s, "");
+	if (!rc)
+		rc = check_beams_or_lattice(w, root);
+	if (!rc && w->s->has_lattice)
+		lattice_defaults(w, root);
+	if (!rc)
+		rc = check_termination(w);
+	if (!rc)
+		rc = check_overlap(w);
+	effects_present(w->s);
+	if (!rc)
+		rc = check_limits(w);
+	return rc;
+}
+
+int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,
+                      bsim_error *err)
+{
+	scene_defaults(out);
+	if (strlen(file->path) >= sizeof out->path)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: expected a path shorter than %zu characters", file->path,
+		                      sizeof out->path);
+	ydoc d = *file;
+	d.fyd = fy_document_clone(file->fyd);
+	if (!d.fyd)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", file->path);
+	walk w = {&d, out, err};
+	int rc = yov_apply(&d, ov, n, err);
+	if (!rc)
+		rc = walk_scene(&w);
+	ydoc_free(&d);
+	if (!rc) {
+		snprintf(out->path, sizeof out->path, "%s", file->path);
+		if (!out->name[0])
+			default_name(out, file->path);
+		rc = bsim_scene_validate(out, err);
+	}
+	if (rc) {
+		bsim_scene_free(out);
+		scene_defaults(out);
+	}
+	return rc;
+}
+
+int bsim_scene_load(const char *path, const bsim_override *overrides, int n_overrides,
+                    bsim_scene *out, bsim_error *err)
+{
+	ydoc d;
+	scene_defaults(out);
+	int rc = ydoc_load(&d, path, err);
+	if (rc)
+		return rc;
+	rc = scene_load_parsed(&d, overrides, n_overrides, out, err);
+	ydoc_free(&d);
+	return rc;
+}

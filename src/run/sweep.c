@@ -1,0 +1,526 @@
+/* A sweep: every (group, trial) of an experiment on one backend.
+ *
+ * The (group, trial) pairs form one flat list, index g*trials + t, handed
+ * out dynamically to OpenMP threads (trials end at very different times, so
+ * a static split would leave threads idle). A trial's seed depends only on
+ * (experiment seed, g, t) and its result goes to its own slot, so the
+ * result is the same whatever the thread count (DESIGN.md "Determinism").
+ * A paired sweep runs each trial on a second backend too, in the same slot
+ * of a second result (trial_pair.c).
+ *
+ * A group whose scene draws no random numbers (bsim_effects_random) is
+ * deterministic: every trial of it is the same trial. It runs once, as
+ * trial 0, and the other slots are copies, so trials.csv keeps its shape
+ * and its values (identical code and inputs give identical trials), and
+ * nothing downstream counts one trial as many. */
+
+#include "beamsim/sweep.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/clock.h"
+#include "util/journal.h"
+#include "beamsim/effects.h"
+#include "beamsim/schedule.h"
+#include "beamsim/stats.h"
+#include "run/trial_pair.h"
+
+void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out)
+{
+	memset(out, 0, sizeof *out);
+	out->trials = n;
+	for (int i = 0; i < n; i++) {
+		const bsim_trial_result *t = &trials[i];
+		out->steps += t->steps_run;
+		out->solver.iteration_limit += t->solver.iteration_limit;
+		out->solver.clamped += t->solver.clamped;
+		switch (t->outcome) {
+		case BSIM_TRAVERSED:
+			out->traversed++;
+			out->left += t->type == BSIM_TYPE_LEFT;
+			out->right += t->type == BSIM_TYPE_RIGHT;
+			/* The barrier crossed (bsim_landscape_label); a trial whose
+			 * last touch was of no deflected beam, or of two holding
+			 * equal energy, counts as neither. */
+			out->landscape_left += t->landscape_beam == 0;
+			out->landscape_right += t->landscape_beam == 1;
+			break;
+		case BSIM_SIDE_EXIT:
+			out->side_exit++;
+			break;
+		case BSIM_STUCK:
+			out->stuck++;
+			out->stuck_in_contact += t->in_contact_end != 0;
+			break;
+		case BSIM_UNSTABLE:
+			out->unstable++;
+			break;
+		}
+	}
+	out->p_traverse = n > 0 ? (double)out->traversed / n : 0.0;
+	bsim_stats_wilson(out->traversed, n, BSIM_STATS_Z95, &out->ci95[0], &out->ci95[1]);
+}
+
+void bsim_sweep_result_free(bsim_sweep_result *r)
+{
+	if (!r)
+		return;
+	if (r->logs)
+		for (size_t i = 0; i < (size_t)r->n_groups * r->trials; i++)
+			bsim_trial_log_clear(&r->logs[i]);
+	free(r->logs);
+	for (size_t i = 0; r->kept && i < (size_t)r->n_groups * (size_t)r->keep; i++)
+		bsim_trajectory_free(&r->kept[i]);
+	free(r->kept);
+	free(r->trials_out);
+	free(r->groups);
+	memset(r, 0, sizeof *r);
+}
+
+static void scenes_free(bsim_scene *scenes, int n)
+{
+	for (int g = 0; g < n; g++)
+		bsim_scene_free(&scenes[g]);
+	free(scenes);
+}
+
+/* Every group's scene, built once: a trial only reads its scene. The
+ * second side of a paired sweep adds its own overrides after extra. */
+static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, int side_b,
+                        bsim_scene **out, bsim_error *err)
+{
+	bsim_scene *scenes = calloc((size_t)e->n_groups, sizeof *scenes);
+	*out = NULL;
+	if (!scenes)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %d scenes", e->n_groups);
+	int n_ov = cfg->n_extra + (side_b ? cfg->n_extra_b : 0);
+	bsim_override *ov = calloc(n_ov > 0 ? (size_t)n_ov : 1, sizeof *ov);
+	if (!ov) {
+		free(scenes);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %d scenes", e->n_groups);
+	}
+	for (int i = 0; i < cfg->n_extra; i++)
+		ov[i] = cfg->extra[i];
+	for (int i = 0; side_b && i < cfg->n_extra_b; i++)
+		ov[cfg->n_extra + i] = cfg->extra_b[i];
+	for (int g = 0; g < e->n_groups; g++) {
+		int rc = bsim_experiment_group_scene(e, g, ov, n_ov, &scenes[g], err);
+		if (rc != BSIM_OK) {
+			scenes_free(scenes, g);
+			free(ov);
+			return rc;
+		}
+	}
+	free(ov);
+	*out = scenes;
+	return BSIM_OK;
+}
+
+/* A paired sweep's journal record. */
+typedef struct pair_record {
+	bsim_trial_result a, b;
+	double t_separate;
+} pair_record;
+
+size_t bsim_sweep_record_size(int paired)
+{
+	return paired ? sizeof(pair_record) : sizeof(bsim_trial_result);
+}
+
+/* What the threads share. first_fail is the index of the lowest failed
+ * trial so far (total if none, -1 if a thread could not start). */
+typedef struct sweep_shared {
+	const bsim_experiment *e;
+	const bsim_sweep_config *cfg;
+	const bsim_scene *scenes;
+	const bsim_scene *scenes_b; /* the second side's (may be scenes) */
+	const int *deterministic;   /* per group */
+	bsim_trial_result *results;
+	bsim_trial_log *logs;
+	const bsim_backend *backend_b; /* NULL: not paired */
+	const bsim_options *opts_b;
+	bsim_trial_result *results_b;
+	bsim_trial_log *logs_b;
+	bsim_trajectory *kept, *kept_b; /* NULL: none kept */
+	int keep, keep_stride;
+	double *t_separate;
+	long total;
+	long done;
+	long first_fail;
+	bsim_error fail;
+	unsigned char *from_journal; /* total flags: the result came from the journal */
+	int lattice;                 /* the scenes are lattices: every trial runs */
+	int stopped;                 /* a trial was not started because of cfg->stop */
+} sweep_shared;
+
+static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
+{
+#pragma omp critical(bsim_sweep_fail)
+	{
+		if (i < sh->first_fail) {
+			if (i < 0)
+				bsim_error_set(&sh->fail, code, "%s", msg);
+			else
+				bsim_error_set(&sh->fail, code, "group %ld, trial %ld: %s",
+				               i / sh->e->trials, i % sh->e->trials, msg);
+#pragma omp atomic write
+			sh->first_fail = i;
+		}
+	}
+}
+
+/* Trial i's record: its result, or both results and the separation time. */
+static int journal_append(sweep_shared *sh, long i, bsim_error *err)
+{
+	if (!sh->backend_b)
+		return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &sh->results[i], err);
+	pair_record p = {sh->results[i], sh->results_b[i], sh->t_separate[i]};
+	return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &p, err);
+}
+
+/* A journal record back into its slots (bsim_journal_fn). */
+static int journal_take(void *user, uint64_t index, const void *payload)
+{
+	sweep_shared *sh = user;
+	if (index >= (uint64_t)sh->total)
+		return 1;
+	/* A trial whose trajectory is kept runs again (trajectories are not
+	 * journaled; the trial is the same): its record is passed over. So
+	 * does every trial of a lattice, whose gate path is not journaled. */
+	if ((long)(index % (uint64_t)sh->e->trials) < sh->keep || sh->lattice)
+		return 0;
+	if (sh->backend_b) {
+		pair_record p;
+		memcpy(&p, payload, sizeof p);
+		sh->results[index] = p.a;
+		sh->results_b[index] = p.b;
+		sh->t_separate[index] = p.t_separate;
+	} else {
+		memcpy(&sh->results[index], payload, sizeof sh->results[index]);
+	}
+	sh->done += !sh->from_journal[index];
+	sh->from_journal[index] = 1;
+	return 0;
+}
+
+/* Trials are handed out in index order, so when trial i fails every trial
+ * before it has started; skipping only those after it lets the others
+ * finish and makes the reported error the first by (g, t) whatever the
+ * thread count. */
+static void sweep_thread(sweep_shared *sh)
+{
+	const bsim_experiment *e = sh->e;
+	const bsim_sweep_config *cfg = sh->cfg;
+	int leader = omp_get_thread_num() == 0;
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
+	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
+	bsim_trial_log *log[2] = {bsim_trial_log_alloc(), bsim_trial_log_alloc()};
+	bsim_error err;
+
+	if (!runner || (sh->backend_b && !pair) || !log[0] || !log[1]) {
+		bsim_trial_runner_free(runner);
+		runner = NULL;
+		shared_fail(sh, -1, BSIM_EFAIL, "out of memory for a trial runner");
+	}
+#pragma omp for schedule(dynamic)
+	for (long i = 0; i < sh->total; i++) {
+		long stop;
+#pragma omp atomic read
+		stop = sh->first_fail;
+		if (!runner || i > stop || (sh->from_journal && sh->from_journal[i]))
+			continue;
+		if (cfg->stop && *cfg->stop) {
+#pragma omp atomic write
+			sh->stopped = 1;
+			continue;
+		}
+		long g = i / e->trials, t = i % e->trials;
+		uint64_t seed = bsim_schedule_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
+		bsim_error_clear(&err);
+		const bsim_scene *scene = &sh->scenes[g];
+		bsim_trajectory *keep = t < sh->keep ? &sh->kept[g * sh->keep + t] : NULL;
+		bsim_recorder rec = {.stride = keep ? sh->keep_stride : 1,
+		                     .record = keep ? bsim_trajectory_record : NULL,
+		                     .record_user = keep,
+		                     .log = log[0],
+		                     .overlap = cfg->measure_overlap};
+		int rc = BSIM_OK, ran = 1;
+		if (t > 0 && sh->deterministic[g]) {
+			ran = 0; /* a copy of trial 0, filled in after the run (and its trajectory)
+			          */
+		} else if (pair) {
+			pair->keep[0] = keep;
+			pair->keep[1] = keep ? &sh->kept_b[g * sh->keep + t] : NULL;
+			pair->keep_stride = sh->keep_stride;
+			rc = trial_pair_run(pair, scene, &sh->scenes_b[g], cfg->backend, cfg->opts,
+			                    sh->backend_b, sh->opts_b, seed,
+			                    0.01 * scene->body.radius, &sh->results[i],
+			                    &sh->results_b[i], log, &sh->t_separate[i], &err);
+		} else {
+			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, &rec,
+			                    &sh->results[i], &err);
+			if (rc == BSIM_OK && keep && keep->oom)
+				rc = bsim_error_set(&err, BSIM_EFAIL,
+				                    "out of memory for a kept trajectory");
+		}
+		if (rc == BSIM_OK && ran && bsim_trial_log_copy(&sh->logs[i], log[0]) != BSIM_OK)
+			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
+		if (rc == BSIM_OK && ran && pair &&
+		    bsim_trial_log_copy(&sh->logs_b[i], log[1]) != BSIM_OK)
+			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
+		/* Only trials that ran are journaled: copies are filled in again. */
+		if (rc == BSIM_OK && ran && cfg->journal)
+			rc = journal_append(sh, i, &err);
+		if (rc != BSIM_OK)
+			shared_fail(sh, i, rc, err.msg);
+		long done;
+#pragma omp atomic capture
+		done = ++sh->done;
+		if (leader && cfg->progress)
+			cfg->progress(cfg->progress_user, done, sh->total);
+	}
+	bsim_trial_runner_free(runner);
+	trial_pair_free(pair);
+	bsim_trial_log_free(log[0]);
+	bsim_trial_log_free(log[1]);
+}
+
+static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, int keep, bsim_error *err)
+{
+	size_t n = (size_t)n_groups * (size_t)trials;
+	memset(r, 0, sizeof *r);
+	r->n_groups = n_groups;
+	r->trials = trials;
+	r->has_ledger = 1;
+	r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
+	r->logs = calloc(n ? n : 1, sizeof *r->logs);
+	r->groups = calloc(n_groups ? (size_t)n_groups : 1, sizeof *r->groups);
+	if (keep > 0) {
+		r->keep = keep;
+		r->kept = calloc((size_t)n_groups * (size_t)keep, sizeof *r->kept);
+	}
+	if (!r->trials_out || !r->groups || !r->logs || (keep > 0 && !r->kept)) {
+		bsim_sweep_result_free(r);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %zu trial results", n);
+	}
+	return BSIM_OK;
+}
+
+/* The copies of a deterministic group's trial 0, its log included. */
+static int deterministic_fill(bsim_trial_result *res, bsim_trial_log *logs, double *t_separate,
+                              const int *deterministic, int n_groups, int trials)
+{
+	for (int g = 0; g < n_groups; g++) {
+		if (!deterministic[g])
+			continue;
+		size_t first = (size_t)g * trials;
+		for (int t = 1; t < trials; t++) {
+			res[first + t] = res[first];
+			if (t_separate)
+				t_separate[first + t] = t_separate[first];
+			if (bsim_trial_log_copy(&logs[first + t], &logs[first]) != BSIM_OK)
+				return BSIM_EFAIL;
+		}
+	}
+	return BSIM_OK;
+}
+
+/* The kept trajectories of a deterministic group's copies: trial 0's. */
+static int kept_fill(bsim_sweep_result *r, const int *deterministic, bsim_error *err)
+{
+	for (int g = 0; r->kept && g < r->n_groups; g++) {
+		if (!deterministic[g])
+			continue;
+		const bsim_trajectory *first = &r->kept[(size_t)g * r->keep];
+		for (int t = 1; t < r->keep; t++)
+			if (bsim_trajectory_copy(&r->kept[(size_t)g * r->keep + t], first) !=
+			    BSIM_OK)
+				return bsim_error_set(err, BSIM_EFAIL,
+				                      "out of memory for kept trajectories");
+	}
+	return BSIM_OK;
+}
+
+static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_groups, int trials,
+                          double wall)
+{
+	r->total_steps = 0;
+	r->trials_run = 0;
+	r->solver = (bsim_solver_counts){0, 0};
+	for (int g = 0; g < n_groups; g++) {
+		bsim_group_result *gr = &r->groups[g];
+		const bsim_trial_result *first = &r->trials_out[(size_t)g * trials];
+		bsim_sweep_group_aggregate(first, trials, gr);
+		/* No draws, no sampling: p_traverse is exactly what the one trial
+		 * gave, so its interval is that point, not a Wilson interval over
+		 * copies; and only that trial's steps were integrated. */
+		gr->deterministic = deterministic[g];
+		if (gr->deterministic && trials > 0) {
+			gr->ci95[0] = gr->ci95[1] = gr->p_traverse;
+			gr->steps = first->steps_run;
+			gr->solver = first->solver;
+		}
+		r->total_steps += gr->steps;
+		r->solver.iteration_limit += gr->solver.iteration_limit;
+		r->solver.clamped += gr->solver.clamped;
+		r->trials_run += gr->deterministic && trials > 0 ? 1 : trials;
+	}
+	r->wall_seconds = wall;
+}
+
+/* A plain sweep (backend_b NULL) or a paired one. */
+static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                        const bsim_backend *backend_b, const bsim_options *opts_b,
+                        bsim_sweep_result *out, bsim_sweep_result *out_b, double **t_separate,
+                        bsim_error *err)
+{
+	double t0 = bsim_clock_seconds();
+	if (e->trials < 0 || e->n_groups < 1)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: expected at least one group and trials >= 0", e->path);
+	bsim_error why;
+	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: %s", e->path, why.msg);
+	long total = (long)e->n_groups * e->trials;
+	int keep = cfg->keep < e->trials ? cfg->keep : e->trials;
+	if (keep < 0)
+		keep = 0;
+	if (result_alloc(out, e->n_groups, e->trials, keep, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (backend_b) {
+		*t_separate = calloc(total ? (size_t)total : 1, sizeof **t_separate);
+		if (!*t_separate ||
+		    result_alloc(out_b, e->n_groups, e->trials, keep, err) != BSIM_OK) {
+			free(*t_separate);
+			*t_separate = NULL;
+			bsim_sweep_result_free(out);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory for %ld pairs",
+			                      total);
+		}
+	}
+	bsim_scene *scenes, *scenes_b = NULL;
+	int rc = scenes_build(e, cfg, 0, &scenes, err);
+	if (rc == BSIM_OK && backend_b && cfg->n_extra_b > 0 &&
+	    (rc = scenes_build(e, cfg, 1, &scenes_b, err)) != BSIM_OK)
+		scenes_free(scenes, e->n_groups);
+	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
+	if (rc == BSIM_OK && !deterministic) {
+		scenes_free(scenes, e->n_groups);
+		if (scenes_b)
+			scenes_free(scenes_b, e->n_groups);
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
+	}
+	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
+		deterministic[g] = !bsim_effects_random(&scenes[g]);
+	sweep_shared sh = {
+	        .e = e,
+	        .cfg = cfg,
+	        .scenes = scenes,
+	        .scenes_b = scenes_b ? scenes_b : scenes,
+	        .deterministic = deterministic,
+	        .results = out->trials_out,
+	        .logs = out->logs,
+	        .backend_b = backend_b,
+	        .opts_b = opts_b,
+	        .results_b = backend_b ? out_b->trials_out : NULL,
+	        .logs_b = backend_b ? out_b->logs : NULL,
+	        .kept = out->kept,
+	        .kept_b = backend_b ? out_b->kept : NULL,
+	        .keep = keep,
+	        .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
+	        .t_separate = backend_b ? *t_separate : NULL,
+	        .total = total,
+	};
+	if (rc == BSIM_OK && cfg->journal) {
+		sh.lattice = scenes[0].has_lattice;
+		sh.from_journal = calloc(total ? (size_t)total : 1, 1);
+		long kept = 0, cut = 0;
+		rc = !sh.from_journal ? bsim_error_set(err, BSIM_EFAIL, "out of memory")
+		                      : bsim_journal_replay(cfg->journal, journal_take, &sh, &kept,
+		                                            &cut, err);
+		if (rc != BSIM_OK) {
+			scenes_free(scenes, e->n_groups);
+			if (scenes_b)
+				scenes_free(scenes_b, e->n_groups);
+		}
+	}
+	if (rc == BSIM_OK) {
+		sh.first_fail = sh.total;
+		bsim_error_clear(&sh.fail);
+		int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
+		if (threads > sh.total)
+			threads = sh.total > 0 ? (int)sh.total : 1;
+#pragma omp parallel num_threads(threads)
+		sweep_thread(&sh);
+		out->lattice = scenes[0].has_lattice;
+		out->lattice_def = scenes[0].lattice;
+		if (backend_b) {
+			out_b->lattice = sh.scenes_b[0].has_lattice;
+			out_b->lattice_def = sh.scenes_b[0].lattice;
+		}
+		scenes_free(scenes, e->n_groups);
+		if (scenes_b)
+			scenes_free(scenes_b, e->n_groups);
+		if (sh.first_fail < sh.total)
+			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
+		else if (sh.stopped)
+			rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped after %ld of %ld trials",
+			                    sh.done, sh.total);
+	}
+	free(sh.from_journal);
+	if (rc != BSIM_OK) {
+		free(deterministic);
+		bsim_sweep_result_free(out);
+		if (backend_b) {
+			bsim_sweep_result_free(out_b);
+			free(*t_separate);
+			*t_separate = NULL;
+		}
+		return rc;
+	}
+	/* The final count may have been reached on another thread. */
+	if (cfg->progress)
+		cfg->progress(cfg->progress_user, sh.total, sh.total);
+	rc = BSIM_OK;
+	if (deterministic_fill(out->trials_out, out->logs, backend_b ? *t_separate : NULL,
+	                       deterministic, e->n_groups, e->trials) ||
+	    (backend_b && deterministic_fill(out_b->trials_out, out_b->logs, NULL, deterministic,
+	                                     e->n_groups, e->trials)))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate paths");
+	if (rc == BSIM_OK)
+		rc = kept_fill(out, deterministic, err);
+	if (rc == BSIM_OK && backend_b)
+		rc = kept_fill(out_b, deterministic, err);
+	if (rc != BSIM_OK) {
+		free(deterministic);
+		bsim_sweep_result_free(out);
+		if (backend_b) {
+			bsim_sweep_result_free(out_b);
+			free(*t_separate);
+			*t_separate = NULL;
+		}
+		return rc;
+	}
+	double wall = bsim_clock_seconds() - t0;
+	result_finish(out, deterministic, e->n_groups, e->trials, wall);
+	if (backend_b)
+		result_finish(out_b, deterministic, e->n_groups, e->trials, wall);
+	free(deterministic);
+	return BSIM_OK;
+}
+
+int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
+                   bsim_error *err)
+{
+	return sweep_common(e, cfg, NULL, NULL, out, NULL, NULL, err);
+}
+
+int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                          const bsim_backend *backend_b, const bsim_options *opts_b,
+                          bsim_sweep_result *out_a, bsim_sweep_result *out_b, double **t_separate,
+                          bsim_error *err)
+{
+	return sweep_common(e, cfg, backend_b, opts_b, out_a, out_b, t_separate, err);
+}

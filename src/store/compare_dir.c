@@ -1,0 +1,366 @@
+/* A comparison stored in an output directory; see beamsim/compare_dir.h.
+ * The same order as a stored sweep (sweep_dir.c): inputs, then DIR and its
+ * journal, then the pairs, then the files as one set. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/compare_dir.h"
+
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/output.h"
+#include "beamsim/report.h"
+#include "beamsim/run_record.h"
+#include "store/session.h"
+#include "store/store.h"
+
+bsim_compare_dir_def bsim_compare_dir_default(void)
+{
+	bsim_compare_dir_def d;
+	memset(&d, 0, sizeof d);
+	d.side[0].backend = &bsim_backend_thesis;
+	d.side[1].backend = &bsim_backend_box2d;
+	snprintf(d.side[0].label, sizeof d.side[0].label, "%s", bsim_backend_thesis.name);
+	snprintf(d.side[1].label, sizeof d.side[1].label, "%s", bsim_backend_box2d.name);
+	d.rule = bsim_compare_rule_default();
+	d.examples = 3;
+	return d;
+}
+
+void bsim_compare_dir_label(const char *label, char *buf, size_t size)
+{
+	size_t k = 0;
+	for (; *label && k + 1 < size; label++)
+		buf[k++] = *label == ':' || *label == '/' ? '-' : *label;
+	if (size > 0)
+		buf[k] = '\0';
+}
+
+int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err)
+{
+	size_t n = strcspn(spec, ":");
+	char name[32];
+	if (n == 0 || n >= sizeof name || strlen(spec) >= sizeof side->label)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "--backends: side %s: expected NAME[:KEY=VALUE]...", spec);
+	snprintf(name, sizeof name, "%.*s", (int)n, spec);
+	bsim_error e;
+	side->backend = bsim_backend_find(name, &e);
+	if (!side->backend)
+		return bsim_error_set(err, BSIM_EINPUT, "--backends: side %s: %s", spec, e.msg);
+	for (const char *p = spec + n; *p == ':';) {
+		const char *q = p + 1;
+		size_t len = strcspn(q, ":");
+		char kv[128];
+		snprintf(kv, sizeof kv, "%.*s", (int)len, q);
+		if (bsim_options_add(&side->opts, kv, err) != BSIM_OK)
+			return BSIM_EINPUT;
+		p = q + len;
+	}
+	snprintf(side->label, sizeof side->label, "%s", spec);
+	return BSIM_OK;
+}
+
+void bsim_compare_dir_result_free(bsim_compare_dir_result *res)
+{
+	bsim_compare_free(&res->cmp);
+	bsim_experiment_free(&res->e);
+}
+
+typedef struct compare_job {
+	const bsim_compare_dir_def *def;
+	const bsim_experiment *e;
+	const bsim_backend *backend[2];
+	const bsim_options *opts[2];
+	const char *label[2];
+	const char *dir[2];
+	const bsim_override *sets; /* every group's, side a's protocol included */
+	int n_sets;
+	bsim_override protocol_b; /* side b's protocol, after the sets */
+	const char *out;          /* the staging area */
+	bsim_journal *journal;    /* NULL: none */
+	bsim_run_record rec;
+} compare_job;
+
+/* The report's heading: what was compared, how to reproduce it. */
+static char *compare_title(const compare_job *job)
+{
+	char *buf = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&buf, &len);
+	if (!f)
+		return NULL;
+	const char *const *protocol = job->def->protocol;
+	fprintf(f, "# beamsim compare: %s vs %s\n\n", job->label[0], job->label[1]);
+	if (protocol[0])
+		fprintf(f,
+		        "The lattice protocols %s and %s on backend %s: `lattice.protocol=%s` for "
+		        "one side, `=%s` for the other.\n\n",
+		        protocol[0], protocol[1], job->backend[0]->name, protocol[0], protocol[1]);
+	fprintf(f,
+	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; both sides "
+	        "ran every trial with the same random-force schedule, so trial t of group g is "
+	        "a pair.\n\n",
+	        job->e->path, job->e->scene_path, (unsigned long long)job->e->seed,
+	        job->e->n_groups, job->e->trials);
+	for (int i = 0; i < 2; i++) {
+		fprintf(f, "- %s: backend %s, options ", job->label[i], job->backend[i]->name);
+		bsim_output_backend_options(f, job->backend[i], job->opts[i]);
+		fputc('\n', f);
+	}
+	fputc('\n', f);
+	fclose(f);
+	return buf;
+}
+
+static void write_pairs(FILE *f, const void *r)
+{
+	bsim_report_pairs_csv(f, r);
+}
+
+static void write_json(FILE *f, const void *r)
+{
+	bsim_report_json(f, r);
+}
+
+static void write_md(FILE *f, const void *r)
+{
+	bsim_report_md(f, r);
+}
+
+static int compare_write(const compare_job *job, const bsim_sweep_result r[2], const double *t_sep,
+                         const bsim_comparison *cmp, bsim_error *err)
+{
+	const bsim_compare_dir_def *def = job->def;
+	int protocols = def->protocol[0] != NULL;
+	bsim_report rep = {
+	        .e = job->e,
+	        .extra = job->sets,
+	        .n_extra = job->n_sets,
+	        .extra_b = protocols ? &job->protocol_b : NULL,
+	        .n_extra_b = protocols,
+	        .t_separate = t_sep,
+	        .cmp = cmp,
+	        .examples = def->examples,
+	};
+	for (int i = 0; i < 2; i++) {
+		char dir[1100];
+		rep.side[i] =
+		        (bsim_report_side){job->label[i], job->backend[i], job->opts[i], &r[i]};
+		if (bsim_session_path(dir, sizeof dir, job->out, job->dir[i], err) ||
+		    bsim_store_sweep_files(dir, job->e, job->backend[i], job->opts[i], job->sets,
+		                           job->n_sets, &r[i], err))
+			return BSIM_EFAIL;
+	}
+	char *title = compare_title(job);
+	int rc = bsim_store_text(job->out, "pairs.csv", NULL, write_pairs, &rep, err);
+	if (rc == BSIM_OK)
+		rc = bsim_store_text(job->out, "report.json", NULL, write_json, &rep, err);
+	if (rc == BSIM_OK)
+		rc = bsim_store_text(job->out, "report.md", title ? title : "", write_md, &rep,
+		                     err);
+	free(title);
+	if (rc == BSIM_OK)
+		rc = bsim_store_twin(job->out, "pairs.csv", "pairs", err);
+	if (rc == BSIM_OK)
+		rc = bsim_store_twin(job->out, "report.json", "report", err);
+	if (rc == BSIM_OK)
+		rc = bsim_run_record_write(job->out, &job->rec, job->e, job->sets, job->n_sets,
+		                           err);
+	return rc;
+}
+
+/* Unstable trials on each side, over the whole comparison. */
+static void unstable_counts(const bsim_comparison *cmp, long n[2])
+{
+	n[0] = n[1] = 0;
+	for (int g = 0; g < cmp->n_groups; g++) {
+		const bsim_event_test *t = &cmp->groups[g].ev[BSIM_EVENT_UNSTABLE];
+		int w = cmp->groups[g].deterministic ? cmp->trials : 1;
+		n[0] += w * (t->pairs.a + t->pairs.b);
+		n[1] += w * (t->pairs.a + t->pairs.c);
+	}
+}
+
+static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, bsim_error *err)
+{
+	const bsim_compare_dir_def *def = job->def;
+	int protocols = def->protocol[0] != NULL;
+	bsim_sweep_result r[2];
+	double *t_sep = NULL;
+	bsim_sweep_config cfg = {
+	        .backend = job->backend[0],
+	        .opts = job->opts[0],
+	        .threads = res->threads,
+	        .extra = job->sets,
+	        .n_extra = job->n_sets,
+	        .progress = def->progress,
+	        .progress_user = def->progress_user,
+	        .extra_b = protocols ? &job->protocol_b : NULL,
+	        .n_extra_b = protocols,
+	        .keep = def->keep,
+	        .keep_stride = def->keep_stride,
+	        .journal = job->journal,
+	        .stop = def->stop,
+	};
+	int rc = bsim_sweep_run_paired(job->e, &cfg, job->backend[1], job->opts[1], &r[0], &r[1],
+	                               &t_sep, err);
+	if (rc != BSIM_OK)
+		return rc;
+	res->solver[0] = r[0].solver;
+	res->solver[1] = r[1].solver;
+	rc = bsim_compare_analyse(&r[0], &r[1], t_sep, &def->rule, &res->cmp, err);
+	if (rc == BSIM_OK)
+		rc = compare_write(job, r, t_sep, &res->cmp, err);
+	bsim_sweep_result_free(&r[0]);
+	bsim_sweep_result_free(&r[1]);
+	free(t_sep);
+	return rc;
+}
+
+/* The sides' backends, options, labels and directories; BSIM_EINPUT if
+ * they cannot be told apart. */
+static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
+                       bsim_compare_dir_result *res, bsim_error *err)
+{
+	for (int i = 0; i < 2; i++) {
+		const bsim_compare_side *s = &def->side[i];
+		job->backend[i] = s->backend ? s->backend : &bsim_backend_thesis;
+		job->opts[i] = &s->opts;
+		job->label[i] = def->protocol[0] ? def->protocol[i]
+		                : s->label[0]    ? s->label
+		                                 : job->backend[i]->name;
+		if (strlen(job->label[i]) >= sizeof res->dir[i])
+			return bsim_error_set(err, BSIM_EINPUT, "side %s: label too long",
+			                      job->label[i]);
+		bsim_compare_dir_label(job->label[i], res->dir[i], sizeof res->dir[i]);
+		job->dir[i] = res->dir[i];
+		const bsim_backend *b = job->backend[i];
+		if (bsim_options_check(&s->opts, b->knobs, b->n_knobs, b->name, err) != BSIM_OK)
+			return BSIM_EINPUT;
+	}
+	if (def->protocol[0]) {
+		static const char *const known[] = {"world", "essay"};
+		int ok = def->protocol[1] && strcmp(def->protocol[0], def->protocol[1]) != 0;
+		for (int i = 0; ok && i < 2; i++)
+			ok = strcmp(def->protocol[i], known[0]) == 0 ||
+			     strcmp(def->protocol[i], known[1]) == 0;
+		if (!ok)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "--protocols %s,%s: expected two different lattice "
+			                      "protocols, world,essay or essay,world",
+			                      def->protocol[0],
+			                      def->protocol[1] ? def->protocol[1] : "");
+		if (job->backend[0] != job->backend[1])
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "--protocols runs one backend, not %s and %s",
+			                      job->backend[0]->name, job->backend[1]->name);
+		return BSIM_OK;
+	}
+	if (strcmp(job->label[0], job->label[1]) == 0)
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "--backends %s,%s: expected two different sides (a backend against "
+		        "itself takes options inline, e.g. thesis,thesis:integrator=euler)",
+		        job->label[0], job->label[1]);
+	if (strcmp(res->dir[0], res->dir[1]) == 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "--backends %s,%s: both sides would write to %s/%s",
+		                      job->label[0], job->label[1], def->out, res->dir[0]);
+	return BSIM_OK;
+}
+
+/* The record of the run in job->rec. */
+static void record_fill(compare_job *job)
+{
+	const bsim_compare_dir_def *def = job->def;
+	bsim_run_record_fill(&job->rec, "compare", job->e, 2, job->backend, job->opts, job->label,
+	                     &def->rule);
+	for (int i = 0; def->protocol[0] && i < 2; i++)
+		snprintf(job->rec.protocol[i], sizeof job->rec.protocol[i], "%s", def->protocol[i]);
+}
+
+int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_result *res,
+                         bsim_error *err)
+{
+	memset(res, 0, sizeof *res);
+	compare_job job = {.def = def, .sets = def->sets, .n_sets = def->n_sets};
+	int rc = sides_check(def, &job, res, err);
+	if (rc != BSIM_OK)
+		return rc;
+	/* --protocols: side a's protocol joins the overrides of every group,
+	 * written as the --set it amounts to; side b's is its own override
+	 * after them. */
+	bsim_override *sets = NULL;
+	char origin[64];
+	if (def->protocol[0]) {
+		sets = calloc((size_t)def->n_sets + 1, sizeof *sets);
+		if (!sets)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		for (int i = 0; i < def->n_sets; i++)
+			sets[i] = def->sets[i];
+		snprintf(origin, sizeof origin, "--set lattice.protocol=%s", def->protocol[0]);
+		sets[def->n_sets] = (bsim_override){"lattice.protocol", def->protocol[0], origin};
+		job.sets = sets;
+		job.n_sets = def->n_sets + 1;
+		job.protocol_b = (bsim_override){"lattice.protocol", def->protocol[1],
+		                                 "--protocols (side b)"};
+	}
+	rc = bsim_store_experiment(def->experiment, job.sets, job.n_sets, def->trials, &res->e,
+	                           err);
+	if (rc != BSIM_OK) {
+		free(sets);
+		return rc;
+	}
+	if (def->has_seed)
+		res->e.seed = def->seed;
+	job.e = &res->e;
+	record_fill(&job);
+	char *inputs = bsim_run_record_inputs(&job.rec, &res->e, job.sets, job.n_sets, err);
+	bsim_session ss;
+	rc = inputs ? bsim_session_open(&ss, def->out, def->resume, inputs,
+	                                bsim_sweep_record_size(1), err)
+	            : err->code;
+	free(inputs);
+	if (rc == BSIM_OK) {
+		res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
+		job.out = ss.stage;
+		job.journal = ss.journal;
+		rc = compare_pairs(&job, res, err);
+		int kept = 0;
+		rc = bsim_session_close(&ss, rc, "compare", &kept, err);
+		if (kept)
+			snprintf(res->journal, sizeof res->journal, "%s", ss.journal_path);
+	}
+	free(sets);
+	if (rc != BSIM_OK) {
+		bsim_compare_dir_result_free(res);
+		return rc;
+	}
+	unstable_counts(&res->cmp, res->unstable);
+	return BSIM_OK;
+}
+
+int bsim_store_compare_rerun(const bsim_compare_dir_def *def, const bsim_experiment *e,
+                             const char *stage, bsim_compare_dir_result *res, bsim_error *err)
+{
+	memset(res, 0, sizeof *res);
+	compare_job job = {
+	        .def = def, .e = e, .sets = def->sets, .n_sets = def->n_sets, .out = stage};
+	int rc = sides_check(def, &job, res, err);
+	if (rc != BSIM_OK)
+		return rc;
+	if (def->protocol[0])
+		job.protocol_b = (bsim_override){"lattice.protocol", def->protocol[1],
+		                                 "--protocols (side b)"};
+	record_fill(&job);
+	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
+	rc = compare_pairs(&job, res, err);
+	if (rc == BSIM_OK)
+		unstable_counts(&res->cmp, res->unstable);
+	else
+		bsim_compare_free(&res->cmp);
+	return rc;
+}

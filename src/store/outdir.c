@@ -1,0 +1,528 @@
+/* Output directories committed as a whole; see beamsim/outdir.h.
+ *
+ * Layout while a run is under way:
+ *   DIR/                  the previous run's files and manifest, untouched
+ *   DIR/.beamsim/staging/ this run's files under their final names
+ *   DIR/.beamsim/journal  finished trials, for --resume (beamsim/journal.h)
+ * The lock is an flock on DIR itself: it needs no file of its own and the
+ * kernel drops it when the process dies, however it dies. */
+#define _DEFAULT_SOURCE
+
+#include "store/outdir.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <zlib.h>
+
+#include "util/atomic_file.h"
+#include "util/json.h"
+#include "beamsim/version.h"
+#include "util/yaml_doc.h"
+
+#define PATH_MAX_OUT 1200
+
+struct bsim_outdir {
+	char dir[1024];
+	char work[1040];
+	char stage[1060];
+	int lock_fd;
+	int created;
+	int committed;
+};
+
+typedef struct ofile {
+	char *rel; /* path below DIR */
+	long long bytes;
+	unsigned long crc;
+} ofile;
+
+typedef struct olist {
+	ofile *v;
+	size_t n, cap;
+} olist;
+
+static void olist_free(olist *l)
+{
+	for (size_t i = 0; i < l->n; i++)
+		free(l->v[i].rel);
+	free(l->v);
+	memset(l, 0, sizeof *l);
+}
+
+static int olist_add(olist *l, const char *rel, long long bytes, unsigned long crc)
+{
+	if (l->n == l->cap) {
+		size_t cap = l->cap ? 2 * l->cap : 16;
+		ofile *v = realloc(l->v, cap * sizeof *v);
+		if (!v)
+			return -1;
+		l->v = v;
+		l->cap = cap;
+	}
+	char *copy = malloc(strlen(rel) + 1);
+	if (!copy)
+		return -1;
+	strcpy(copy, rel);
+	l->v[l->n++] = (ofile){copy, bytes, crc};
+	return 0;
+}
+
+static int olist_has(const olist *l, const char *rel)
+{
+	for (size_t i = 0; i < l->n; i++)
+		if (strcmp(l->v[i].rel, rel) == 0)
+			return 1;
+	return 0;
+}
+
+static int by_rel(const void *a, const void *b)
+{
+	return strcmp(((const ofile *)a)->rel, ((const ofile *)b)->rel);
+}
+
+/* buf = a "/" b (b empty: a): 0, or ENAMETOOLONG if it does not fit. */
+static int join(char *buf, size_t size, const char *a, const char *b)
+{
+	int n = snprintf(buf, size, "%s%s%s", a, b[0] ? "/" : "", b);
+	return n < 0 || (size_t)n >= size ? ENAMETOOLONG : 0;
+}
+
+/* mkdir -p: 0 or the errno of the failure. */
+static int mkdir_p(const char *dir)
+{
+	char path[PATH_MAX_OUT];
+	struct stat st;
+	if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path)
+		return ENAMETOOLONG;
+	for (char *p = path + 1; *p; p++) {
+		if (*p != '/')
+			continue;
+		*p = '\0';
+		if (mkdir(path, 0777) != 0 && errno != EEXIST)
+			return errno;
+		*p = '/';
+	}
+	if (mkdir(path, 0777) != 0 && errno != EEXIST)
+		return errno;
+	if (stat(path, &st) != 0)
+		return errno;
+	return S_ISDIR(st.st_mode) ? 0 : ENOTDIR;
+}
+
+/* rm -r of what beamsim made: files, links and directories, never
+ * following a link. */
+static void rm_tree(const char *path)
+{
+	struct stat st;
+	if (lstat(path, &st) != 0)
+		return;
+	if (S_ISDIR(st.st_mode)) {
+		DIR *d = opendir(path);
+		struct dirent *e;
+		while (d && (e = readdir(d))) {
+			if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+				continue;
+			char sub[PATH_MAX_OUT];
+			if (join(sub, sizeof sub, path, e->d_name) == 0)
+				rm_tree(sub);
+		}
+		if (d)
+			closedir(d);
+		rmdir(path);
+	} else {
+		unlink(path);
+	}
+}
+
+/* Size and CRC-32 of a file's content (following links, as a reader
+ * does); with sync, also flushed to disk (the writer may not have). 0 or
+ * an errno. */
+static int crc_file(const char *path, int sync, long long *bytes, unsigned long *crc)
+{
+	int fd = open(path, O_RDONLY);
+	if (fd < 0)
+		return errno;
+	unsigned char buf[65536];
+	uLong c = crc32(0L, Z_NULL, 0);
+	long long n = 0;
+	ssize_t k;
+	while ((k = read(fd, buf, sizeof buf)) > 0) {
+		c = crc32(c, buf, (uInt)k);
+		n += k;
+	}
+	int saved = k < 0 ? errno : 0;
+	if (!saved && sync && fsync(fd) != 0 && errno != EINVAL)
+		saved = errno;
+	close(fd);
+	*bytes = n;
+	*crc = c;
+	return saved;
+}
+
+/* Every file below root/rel, as paths relative to root. */
+static int collect(const char *root, const char *rel, olist *l, char *bad, size_t bad_size)
+{
+	char path[PATH_MAX_OUT];
+	if (join(path, sizeof path, root, rel))
+		return ENAMETOOLONG;
+	DIR *d = opendir(path);
+	if (!d) {
+		snprintf(bad, bad_size, "%s", rel);
+		return errno;
+	}
+	struct dirent *e;
+	int rc = 0;
+	while (!rc && (e = readdir(d))) {
+		if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+			continue;
+		char sub[PATH_MAX_OUT], full[PATH_MAX_OUT];
+		struct stat st;
+		if (rel[0] ? join(sub, sizeof sub, rel, e->d_name)
+		           : join(sub, sizeof sub, e->d_name, "")) {
+			rc = ENAMETOOLONG;
+		} else if (join(full, sizeof full, root, sub)) {
+			rc = ENAMETOOLONG;
+		} else if (lstat(full, &st) != 0) {
+			rc = errno;
+		} else if (S_ISDIR(st.st_mode)) {
+			rc = collect(root, sub, l, bad, bad_size);
+			continue;
+		} else {
+			long long bytes = 0;
+			unsigned long crc = 0;
+			rc = crc_file(full, 1, &bytes, &crc);
+			if (!rc && olist_add(l, sub, bytes, crc) != 0)
+				rc = ENOMEM;
+		}
+		if (rc)
+			snprintf(bad, bad_size, "%.*s", (int)bad_size - 1,
+			         rc == ENAMETOOLONG ? e->d_name : sub);
+	}
+	closedir(d);
+	return rc;
+}
+
+static int input_error(bsim_error *err, const char *dir, int e)
+{
+	return bsim_error_set(err, BSIM_EINPUT, "%s: cannot write to the output directory: %s", dir,
+	                      strerror(e));
+}
+
+int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_error *err)
+{
+	*out = NULL;
+	bsim_outdir *od = calloc(1, sizeof *od);
+	if (!od)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	od->lock_fd = -1;
+	size_t len = strlen(dir);
+	while (len > 1 && dir[len - 1] == '/')
+		len--;
+	if (len == 0 || len >= sizeof od->dir - 40) {
+		free(od);
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%.200s: expected a directory name of 1 to %zu "
+		                      "characters",
+		                      dir, sizeof od->dir - 41);
+	}
+	memcpy(od->dir, dir, len);
+	join(od->work, sizeof od->work, od->dir, ".beamsim");
+	join(od->stage, sizeof od->stage, od->work, "staging");
+
+	struct stat st;
+	int rc = 0;
+	if (stat(od->dir, &st) == 0) {
+		if (!S_ISDIR(st.st_mode)) {
+			free(od);
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "%s: expected an output directory, got a file", dir);
+		}
+	} else {
+		od->created = 1;
+		rc = mkdir_p(od->dir);
+	}
+	if (!rc) {
+		od->lock_fd = open(od->dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+		rc = od->lock_fd < 0 ? errno : 0;
+	}
+	if (!rc && flock(od->lock_fd, LOCK_EX | LOCK_NB) != 0) {
+		int e = errno;
+		bsim_outdir_close(od);
+		if (e == EWOULDBLOCK)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "%s: another beamsim run is writing this directory",
+			                      dir);
+		return input_error(err, dir, e);
+	}
+	/* Creating the work area and the staging area is the test that DIR
+	 * can be written (access() says yes to root on a read-only disk). A
+	 * staging area left by a run that was killed is stale: the lock says
+	 * no run owns it. */
+	if (!rc && mkdir(od->work, 0777) != 0 && errno != EEXIST)
+		rc = errno;
+	if (!rc) {
+		rm_tree(od->stage);
+		if (mkdir(od->stage, 0777) != 0)
+			rc = errno;
+	}
+	if (rc) {
+		bsim_outdir_close(od);
+		return input_error(err, dir, rc);
+	}
+	*out = od;
+	return BSIM_OK;
+}
+
+const char *bsim_outdir_dir(const bsim_outdir *od)
+{
+	return od->dir;
+}
+
+const char *bsim_outdir_stage(const bsim_outdir *od)
+{
+	return od->stage;
+}
+
+const char *bsim_outdir_work(const bsim_outdir *od)
+{
+	return od->work;
+}
+
+void bsim_outdir_explain(const bsim_outdir *od, char *text, size_t size)
+{
+	if (!od)
+		return;
+	size_t ls = strlen(od->stage), ld = strlen(od->dir);
+	char *at;
+	while ((at = strstr(text, od->stage)) != NULL) {
+		memmove(at + ld, at + ls, strlen(at + ls) + 1);
+		memcpy(at, od->dir, ld);
+	}
+	(void)size; /* the directory's name is shorter than the staging area's */
+}
+
+/* Puts the staged file at its place: a rename, or written through when the
+ * place holds a symlink, FIFO or device (beamsim/atomic_file.h). */
+static int put(const char *staged, const char *final)
+{
+	if (!bsim_atomic_file_is_through(final))
+		return rename(staged, final) == 0 ? 0 : errno;
+	FILE *in = fopen(staged, "rb"), *out = in ? fopen(final, "w") : NULL;
+	int saved = in && out ? 0 : errno;
+	char buf[65536];
+	size_t k;
+	while (!saved && (k = fread(buf, 1, sizeof buf, in)) > 0)
+		if (fwrite(buf, 1, k, out) != k)
+			saved = errno ? errno : EIO;
+	if (!saved && in && ferror(in))
+		saved = EIO;
+	if (out && fflush(out) != 0 && !saved)
+		saved = errno;
+	if (out && fsync(fileno(out)) != 0 && errno != EINVAL && errno != EROFS && !saved)
+		saved = errno;
+	if (out && fclose(out) != 0 && !saved)
+		saved = errno;
+	if (in)
+		fclose(in);
+	if (!saved)
+		unlink(staged);
+	return saved;
+}
+
+static void fsync_dir(const char *dir)
+{
+	int fd = open(dir, O_RDONLY | O_DIRECTORY);
+	if (fd >= 0) {
+		fsync(fd);
+		close(fd);
+	}
+}
+
+/* The files a manifest lists (none if there is no manifest). */
+static int manifest_read(const char *dir, olist *l, int *has, bsim_error *err)
+{
+	char path[PATH_MAX_OUT];
+	struct stat st;
+	*has = 0;
+	if (join(path, sizeof path, dir, BSIM_OUTDIR_MANIFEST) || stat(path, &st) != 0)
+		return BSIM_OK;
+	ydoc d;
+	if (ydoc_load(&d, path, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	*has = 1;
+	struct fy_node *files = ydoc_lookup(fy_document_root(d.fyd), "files");
+	int rc = BSIM_OK;
+	if (!files || !fy_node_is_sequence(files))
+		rc = ydoc_expected(&d, files, NULL, "files", "a list of files", err);
+	int n = rc ? 0 : fy_node_sequence_item_count(files);
+	for (int i = 0; !rc && i < n; i++) {
+		struct fy_node *f = fy_node_sequence_get_by_index(files, i);
+		struct fy_node *pn = ydoc_lookup(f, "path"), *cn = ydoc_lookup(f, "crc32");
+		const char *rel = pn && fy_node_is_scalar(pn) ? fy_node_get_scalar0(pn) : NULL;
+		const char *crc = cn && fy_node_is_scalar(cn) ? fy_node_get_scalar0(cn) : NULL;
+		long long bytes = -1;
+		char *end = NULL;
+		unsigned long c = crc ? strtoul(crc, &end, 16) : 0;
+		if (!rel || !*rel || strstr(rel, "..") || rel[0] == '/' ||
+		    !ydoc_int64(ydoc_lookup(f, "bytes"), &bytes) || bytes < 0 || !crc || *end ||
+		    strlen(crc) != 8)
+			rc = ydoc_expected(&d, f, files, "files", "{path, bytes, crc32} of a file",
+			                   err);
+		else if (olist_add(l, rel, bytes, c) != 0)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	ydoc_free(&d);
+	return rc;
+}
+
+static int manifest_write(const char *dir, const char *command, const olist *l, bsim_error *err)
+{
+	char path[PATH_MAX_OUT];
+	if (join(path, sizeof path, dir, BSIM_OUTDIR_MANIFEST))
+		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", dir);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fputs("{\n  \"format\": \"beamsim-manifest-1\",\n  \"command\": ", o.f);
+	bsim_json_string(o.f, command);
+	fputs(",\n  \"beamsim_version\": ", o.f);
+	bsim_json_string(o.f, BSIM_VERSION);
+	fputs(",\n  \"files\": [", o.f);
+	for (size_t i = 0; i < l->n; i++) {
+		fputs(i ? ",\n    {\"path\": " : "\n    {\"path\": ", o.f);
+		bsim_json_string(o.f, l->v[i].rel);
+		fprintf(o.f, ", \"bytes\": %lld, \"crc32\": \"%08lx\"}", l->v[i].bytes,
+		        l->v[i].crc);
+	}
+	fputs("\n  ]\n}\n", o.f);
+	return bsim_atomic_file_commit(&o, err);
+}
+
+static int commit_fail(bsim_error *err, const char *dir, const char *rel, int e)
+{
+	return bsim_error_set(err, BSIM_EFAIL, "%s/%s: write failed: %s", dir, rel, strerror(e));
+}
+
+static int commit_set(bsim_outdir *od, const char *command, int add, bsim_error *err)
+{
+	olist now = {0}, before = {0};
+	char bad[PATH_MAX_OUT] = "";
+	int has = 0, rc = BSIM_OK;
+	int e = collect(od->stage, "", &now, bad, sizeof bad);
+	if (e) {
+		olist_free(&now);
+		return commit_fail(err, od->dir, bad, e);
+	}
+	qsort(now.v, now.n, sizeof *now.v, by_rel);
+	/* A damaged old manifest lists nothing to remove: only what a
+	 * manifest names is ever deleted. */
+	bsim_error ignored;
+	if (manifest_read(od->dir, &before, &has, &ignored) != BSIM_OK)
+		olist_free(&before);
+	char path[PATH_MAX_OUT], staged[PATH_MAX_OUT];
+	if (join(path, sizeof path, od->dir, BSIM_OUTDIR_MANIFEST) == 0 && unlink(path) == 0)
+		fsync_dir(od->dir);
+	for (size_t i = 0; !rc && i < now.n; i++) {
+		const char *rel = now.v[i].rel;
+		e = join(path, sizeof path, od->dir, rel);
+		if (!e)
+			e = join(staged, sizeof staged, od->stage, rel);
+		char *slash = strrchr(path, '/');
+		if (!e) {
+			*slash = '\0';
+			e = mkdir_p(path);
+			*slash = '/';
+		}
+		if (!e)
+			e = put(staged, path);
+		if (e)
+			rc = commit_fail(err, od->dir, rel, e);
+		else if (strchr(rel, '/')) {
+			*slash = '\0';
+			fsync_dir(path);
+		}
+	}
+	/* Added files join the set: the previous ones stay, and stay listed. */
+	for (size_t i = 0; add && !rc && i < before.n; i++)
+		if (!olist_has(&now, before.v[i].rel) &&
+		    olist_add(&now, before.v[i].rel, before.v[i].bytes, before.v[i].crc) != 0)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	if (add)
+		qsort(now.v, now.n, sizeof *now.v, by_rel);
+	for (size_t i = 0; !add && !rc && i < before.n; i++) {
+		struct stat st;
+		if (!olist_has(&now, before.v[i].rel) &&
+		    !join(path, sizeof path, od->dir, before.v[i].rel) && lstat(path, &st) == 0 &&
+		    S_ISREG(st.st_mode))
+			unlink(path);
+	}
+	if (!rc) {
+		fsync_dir(od->dir);
+		rc = manifest_write(od->dir, command, &now, err);
+	}
+	if (!rc) {
+		rm_tree(od->stage);
+		od->committed = 1;
+	}
+	olist_free(&now);
+	olist_free(&before);
+	return rc;
+}
+
+int bsim_outdir_commit(bsim_outdir *od, const char *command, bsim_error *err)
+{
+	return commit_set(od, command, 0, err);
+}
+
+int bsim_outdir_add(bsim_outdir *od, const char *command, bsim_error *err)
+{
+	return commit_set(od, command, 1, err);
+}
+
+void bsim_outdir_close(bsim_outdir *od)
+{
+	if (!od)
+		return;
+	rm_tree(od->stage);
+	rmdir(od->work); /* kept while a journal is in it */
+	if (od->created && !od->committed)
+		rmdir(od->dir);
+	if (od->lock_fd >= 0)
+		close(od->lock_fd);
+	free(od);
+}
+
+int bsim_outdir_verify(const char *dir, int *has_manifest, bsim_error *err)
+{
+	olist l = {0};
+	int rc = manifest_read(dir, &l, has_manifest, err);
+	for (size_t i = 0; !rc && i < l.n; i++) {
+		char path[PATH_MAX_OUT];
+		long long bytes = 0;
+		unsigned long crc = 0;
+		int e = join(path, sizeof path, dir, l.v[i].rel);
+		if (!e)
+			e = crc_file(path, 0, &bytes, &crc);
+		if (e)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "%s: listed in %s/%s but unreadable: %s", path, dir,
+			                    BSIM_OUTDIR_MANIFEST, strerror(e));
+		else if (bytes != l.v[i].bytes || crc != l.v[i].crc)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "%s: expected the file %s/%s lists (%lld bytes, CRC-32 "
+			                    "%08lx), got %lld bytes, CRC-32 %08lx: the directory "
+			                    "mixes files of two runs",
+			                    path, dir, BSIM_OUTDIR_MANIFEST, l.v[i].bytes,
+			                    l.v[i].crc, bytes, crc);
+	}
+	olist_free(&l);
+	return rc;
+}

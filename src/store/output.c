@@ -1,0 +1,538 @@
+/* The output files of a sweep (DESIGN.md "Outputs"): summary.json,
+ * trials.csv and the p_traverse table. Both files go through
+ * bsim_atomic_file, so a reader never sees a torn one. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/output.h"
+
+#include <errno.h>
+#include <math.h>
+#include <inttypes.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "util/atomic_file.h"
+#include "store/trials_csv.h"
+#include "util/json.h"
+#include "beamsim/lattice.h"
+#include "beamsim/version.h"
+
+/* A grid value is a JSON number when its YAML text is a finite number. */
+static int text_number(const char *s, double *out)
+{
+	char *end;
+	while (*s == ' ' || *s == '\t')
+		s++;
+	if (*s == '\0')
+		return 0;
+	errno = 0;
+	*out = strtod(s, &end);
+	while (*end == ' ' || *end == '\t')
+		end++;
+	return errno == 0 && *end == '\0' && isfinite(*out);
+}
+
+/* "key": "value", after a comma unless it is the first member. */
+static void json_member(FILE *f, int *first, const char *key, const char *value)
+{
+	fputs(*first ? "" : ", ", f);
+	bsim_json_string(f, key);
+	fputs(": ", f);
+	bsim_json_string(f, value);
+	*first = 0;
+}
+
+/* 1 if s is a number as JSON writes one: -?(0|[1-9][0-9]*)(.[0-9]+)?([eE][+-]?[0-9]+)? */
+static int json_number_text(const char *s)
+{
+	const char *p = s + (*s == '-');
+	if (*p == '0')
+		p++;
+	else if (*p >= '1' && *p <= '9')
+		p += strspn(p, "0123456789");
+	else
+		return 0;
+	if (*p == '.') {
+		size_t n = strspn(p + 1, "0123456789");
+		if (n == 0)
+			return 0;
+		p += 1 + n;
+	}
+	if (*p == 'e' || *p == 'E') {
+		p += 1 + (p[1] == '+' || p[1] == '-');
+		size_t n = strspn(p, "0123456789");
+		if (n == 0)
+			return 0;
+		p += n;
+	}
+	return *p == '\0';
+}
+
+/* A knob's value: a number where the knob is a number (as given, if JSON
+ * can read it so: "1e-6" stays 1e-6), else a string. */
+static void json_knob(FILE *f, int *first, const bsim_knob *k, const char *value)
+{
+	double x;
+	if (k->type == BSIM_KNOB_CHOICE || !text_number(value, &x)) {
+		json_member(f, first, k->name, value);
+		return;
+	}
+	fputs(*first ? "" : ", ", f);
+	bsim_json_string(f, k->name);
+	fputs(": ", f);
+	if (json_number_text(value))
+		fputs(value, f);
+	else
+		bsim_json_number(f, x);
+	*first = 0;
+}
+
+/* Knobs first, in the backend's order, so records of one backend line up;
+ * then any option the backend does not list (none once checked), so
+ * nothing given is hidden. */
+void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_options *opts)
+{
+	int first = 1;
+	fputc('{', f);
+	for (int i = 0; b && i < b->n_knobs; i++) {
+		const char *v = bsim_options_get(opts, b->knobs[i].name);
+		if (!v)
+			v = b->knobs[i].default_value ? b->knobs[i].default_value : "";
+		json_knob(f, &first, &b->knobs[i], v);
+	}
+	for (int i = 0; opts && i < opts->n; i++) {
+		int known = 0;
+		for (int j = 0; b && j < b->n_knobs; j++)
+			known |= strcmp(b->knobs[j].name, opts->key[i]) == 0;
+		if (!known)
+			json_member(f, &first, opts->key[i], opts->value[i]);
+	}
+	fputc('}', f);
+}
+
+static void json_params(FILE *f, const bsim_experiment *e, const int *idx)
+{
+	fputc('{', f);
+	for (int a = 0; a < e->n_axes; a++) {
+		const char *text = e->axes[a].values[idx[a]];
+		double x;
+		fputs(a ? ", " : "", f);
+		bsim_json_string(f, e->axes[a].key);
+		fputs(": ", f);
+		if (text_number(text, &x))
+			bsim_json_number(f, x);
+		else
+			bsim_json_string(f, text);
+	}
+	fputc('}', f);
+}
+
+void bsim_output_group_params(FILE *f, const bsim_experiment *e, int g)
+{
+	int idx[BSIM_OUTPUT_AXES_MAX];
+	if (e->n_axes > BSIM_OUTPUT_AXES_MAX) {
+		fputs("{}", f);
+		return;
+	}
+	bsim_experiment_group_index(e, g, idx);
+	json_params(f, e, idx);
+}
+
+/* A lattice group's final-location distribution, transitions and time per
+ * row (beamsim/lattice.h). */
+static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
+{
+	bsim_lattice_summary ls;
+	const bsim_trial_result *t = &r->trials_out[(size_t)group * r->trials];
+	const bsim_trial_log *l = r->logs ? &r->logs[(size_t)group * r->trials] : NULL;
+	if (bsim_lattice_summarise(t, l, r->trials, r->lattice_def.rows, &ls) != BSIM_OK) {
+		fputs(", \"lattice\": null", f);
+		return;
+	}
+	fputs(", \"lattice\": {\"final_locations\": [", f);
+	for (int k = 0; k < ls.n_locations; k++) {
+		const bsim_location_count *c = &ls.locations[k];
+		char label[48];
+		bsim_lattice_location_label(c->loc, label, sizeof label);
+		static const char *const kinds[] = {"end", "side", "stuck"};
+		fprintf(f, "%s{\"location\": \"%s\", \"kind\": \"%s\", \"ix\": ", k ? ", " : "",
+		        label, kinds[c->loc.kind]);
+		if (c->loc.kind == BSIM_LOCATION_SIDE)
+			fputs("null", f);
+		else
+			fprintf(f, "%d", c->loc.ix);
+		fputs(", \"iy\": ", f);
+		if (c->loc.kind == BSIM_LOCATION_END)
+			fputs("null", f);
+		else
+			fprintf(f, "%d", c->loc.iy);
+		fprintf(f, ", \"count\": %d, \"p\": ", c->count);
+		bsim_json_number(f, c->p);
+		fputs(", \"ci95\": [", f);
+		bsim_json_number(f, c->ci95[0]);
+		fputs(", ", f);
+		bsim_json_number(f, c->ci95[1]);
+		fputs("]}", f);
+	}
+	fputs("], \"transitions\": [", f);
+	for (int k = 0; k < ls.n_transitions; k++) {
+		const bsim_transition *x = &ls.transitions[k];
+		fprintf(f, "%s{\"from\": [%d, %d], \"to\": [%d, %d], \"count\": %d}", k ? ", " : "",
+		        x->from[0], x->from[1], x->to[0], x->to[1], x->count);
+	}
+	fputs("], \"rows\": [", f);
+	for (int iy = 0; iy < ls.rows; iy++) {
+		fprintf(f, "%s{\"iy\": %d, \"trials\": %d, \"mean_time_s\": ", iy ? ", " : "", iy,
+		        ls.row_trials[iy]);
+		if (ls.row_trials[iy] > 0)
+			bsim_json_number(f, ls.row_time[iy]);
+		else
+			fputs("null", f);
+		fputc('}', f);
+	}
+	fputs("]}", f);
+	bsim_lattice_summary_free(&ls);
+}
+
+/* What the backend's solvers gave up on (beamsim/state.h). */
+static void json_solver(FILE *f, const bsim_solver_counts *c)
+{
+	fprintf(f, ", \"solver\": {\"iteration_limit\": %ld, \"clamped\": %ld}", c->iteration_limit,
+	        c->clamped);
+}
+
+static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int group,
+                       int *idx)
+{
+	const bsim_group_result *g = &r->groups[group];
+	fputs("{\"params\": ", f);
+	json_params(f, e, idx);
+	fprintf(f,
+	        ", \"trials\": %d, \"traversed\": %d, \"side_exit\": %d, \"stuck\": %d, "
+	        "\"left\": %d, \"right\": %d, \"p_traverse\": ",
+	        g->trials, g->traversed, g->side_exit, g->stuck, g->left, g->right);
+	bsim_json_number(f, g->p_traverse);
+	fputs(", \"ci95\": [", f);
+	bsim_json_number(f, g->ci95[0]);
+	fputs(", ", f);
+	bsim_json_number(f, g->ci95[1]);
+	fprintf(f,
+	        "], \"stuck_in_contact\": %d, \"landscape_left\": %d, \"landscape_right\": %d, "
+	        "\"steps\": %ld, \"unstable\": %d, \"deterministic\": %s",
+	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps, g->unstable,
+	        g->deterministic ? "true" : "false");
+	json_solver(f, &g->solver);
+	if (r->lattice)
+		json_lattice(f, r, group);
+	fputc('}', f);
+}
+
+/* An index per grid axis for bsim_experiment_group_index; never a
+ * zero-size calloc, so NULL always means out of memory. */
+static int *group_index_alloc(const bsim_experiment *e)
+{
+	return calloc(e->n_axes > 0 ? (size_t)e->n_axes : 1, sizeof(int));
+}
+
+/* One group per line: the file stays small, diffs line up with groups, and
+ * the wall_seconds line is the only one that differs between equal runs. */
+static void json_groups(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int *idx)
+{
+	fputs(",\n  \"groups\": [", f);
+	for (int g = 0; g < r->n_groups; g++) {
+		bsim_experiment_group_index(e, g, idx);
+		fputs(g ? ",\n    " : "\n    ", f);
+		json_group(f, e, r, g, idx);
+	}
+	fputs("\n  ]", f);
+}
+
+static void json_summary(FILE *f, const bsim_experiment *e, const char *backend,
+                         const bsim_options *opts, const bsim_sweep_result *r, int *idx)
+{
+	fputs("{\n  \"backend\": ", f);
+	bsim_json_string(f, backend);
+	fputs(",\n  \"backend_options\": ", f);
+	bsim_output_backend_options(f, bsim_backend_find(backend, NULL), opts);
+	fputs(",\n  \"experiment\": ", f);
+	bsim_json_string(f, e->path);
+	fputs(",\n  \"seed\": ", f);
+	bsim_json_u64(f, e->seed);
+	fprintf(f, ",\n  \"trials_per_group\": %d", r->trials);
+	fprintf(f, ",\n  \"wall_seconds\": %.3f", r->wall_seconds);
+	json_groups(f, e, r, idx);
+	fputs(",\n  \"totals\": {\"steps\": ", f);
+	fprintf(f, "%ld, \"trials_run\": %ld", r->total_steps, r->trials_run);
+	json_solver(f, &r->solver);
+	fputc('}', f);
+	fputs(",\n  \"version\": ", f);
+	bsim_json_string(f, BSIM_VERSION);
+	fputs(",\n  \"scene\": ", f);
+	bsim_json_string(f, e->scene_path);
+	fputs("\n}\n", f);
+}
+
+int bsim_output_summary_json(const char *path, const bsim_experiment *e, const char *backend,
+                             const bsim_options *opts, const bsim_sweep_result *r, bsim_error *err)
+{
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	int *idx = group_index_alloc(e);
+	if (!idx) {
+		bsim_atomic_file_abort(&o);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	json_summary(o.f, e, backend, opts, r, idx);
+	free(idx);
+	return bsim_atomic_file_commit(&o, err);
+}
+
+/* ---- trials.csv -------------------------------------------------------- */
+
+/* A CSV field: as it is, or in double quotes (each " doubled) if it holds a
+ * comma, a quote or a line break. */
+static void csv_field(FILE *f, const char *s)
+{
+	if (!strpbrk(s, ",\"\r\n")) {
+		fputs(s, f);
+		return;
+	}
+	fputc('"', f);
+	for (; *s; s++) {
+		if (*s == '"')
+			fputc('"', f);
+		fputc(*s, f);
+	}
+	fputc('"', f);
+}
+
+/* A number, or an empty field if it was not measured (NaN). */
+static void csv_number(FILE *f, double x)
+{
+	if (!isnan(x))
+		fprintf(f, "%.10g", x);
+}
+
+const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
+        "group",  "trial",    "outcome",     "type",       "steps",    "t_end",    "x_end",
+        "y_end",  "vx_end",   "max_theta1",  "max_theta2", "e_start",  "e_end",    "work_in",
+        "losses", "residual", "overlap_max", "final_ix",   "final_iy", "location", "path",
+};
+
+int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                           bsim_error *err)
+{
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	int axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	for (int c = 0; c < TRIALS_N_COLUMNS; c++)
+		fprintf(o.f, "%s%s", c ? "," : "", bsim_trials_csv_columns[c]);
+	for (int a = 0; a < axes; a++) {
+		fputc(',', o.f);
+		csv_field(o.f, e->axes[a].key);
+	}
+	fputc('\n', o.f);
+	for (int g = 0; g < r->n_groups; g++) {
+		if (axes)
+			bsim_experiment_group_index(e, g, idx);
+		for (int t = 0; t < r->trials; t++) {
+			size_t i = (size_t)g * r->trials + t;
+			const bsim_trial_result *x = &r->trials_out[i];
+			const bsim_ledger *l = &x->ledger;
+			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", g, t,
+			        bsim_trial_outcome_name(x->outcome), bsim_trial_type_name(x->type),
+			        x->steps, x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
+			        x->max_theta[1]);
+			/* losses: sleeping's and the essay protocol's resets too, so that
+			 * e_end - e_start = work_in - losses + residual */
+			fprintf(o.f, ",%.10g,%.10g,%.10g,%.10g,%.10g,", l->e_start, l->e_end,
+			        l->w_prop + l->w_rand,
+			        l->damper + l->impact + l->contact + l->correction + l->sleep +
+			                l->reset,
+			        l->residual);
+			csv_number(o.f, x->overlap_max);
+			/* the final gate and location, and the gates entered in order:
+			 * "ix:iy ix:iy ..." */
+			char label[48];
+			bsim_lattice_location_label(bsim_lattice_location_of(x), label,
+			                            sizeof label);
+			fprintf(o.f, ",%d,%d,%s,", x->final_ix, x->final_iy, label);
+			const bsim_trial_log *tl = r->logs ? &r->logs[i] : NULL;
+			for (int k = 0; tl && k < tl->n_entries; k++)
+				fprintf(o.f, "%s%d:%d", k ? " " : "", tl->entries[k].ix,
+				        tl->entries[k].iy);
+			/* A trial without its path (taken from a resumed run's
+			 * journal, which lattices never are) stayed in one gate. */
+			if (!tl || tl->n_entries == 0)
+				fprintf(o.f, "%d:%d", x->final_ix, x->final_iy);
+			for (int a = 0; a < axes; a++) {
+				fputc(',', o.f);
+				csv_field(o.f, e->axes[a].values[idx[a]]);
+			}
+			fputc('\n', o.f);
+		}
+	}
+	return bsim_atomic_file_commit(&o, err);
+}
+
+/* ---- the p_traverse table ------------------------------------------------ */
+
+/* Where each group sits in the tables: cell[(rest * n1 + i1) * n0 + i0] is
+ * the group at axis-0 value i0, axis-1 value i1 and index rest over the
+ * remaining axes (axis 2 slowest). Built from bsim_experiment_group_index,
+ * so it does not assume an order of groups. */
+typedef struct table_layout {
+	int n0, n1, n_rest;
+	int *cell;
+} table_layout;
+
+static int layout_build(table_layout *l, const bsim_experiment *e)
+{
+	l->n0 = e->n_axes > 0 ? e->axes[0].n_values : 1;
+	l->n1 = e->n_axes > 1 ? e->axes[1].n_values : 1;
+	l->n_rest = 1;
+	for (int a = 2; a < e->n_axes; a++)
+		l->n_rest *= e->axes[a].n_values;
+	size_t n = (size_t)l->n0 * l->n1 * l->n_rest;
+	int *idx = group_index_alloc(e);
+	l->cell = malloc(n * sizeof *l->cell);
+	if (!idx || !l->cell) {
+		free(idx);
+		free(l->cell);
+		return -1;
+	}
+	for (size_t i = 0; i < n; i++)
+		l->cell[i] = -1;
+	for (int g = 0; g < e->n_groups; g++) {
+		bsim_experiment_group_index(e, g, idx);
+		int rest = 0;
+		for (int a = 2; a < e->n_axes; a++)
+			rest = rest * e->axes[a].n_values + idx[a];
+		int i0 = e->n_axes > 0 ? idx[0] : 0, i1 = e->n_axes > 1 ? idx[1] : 0;
+		l->cell[((size_t)rest * l->n1 + i1) * l->n0 + i0] = g;
+	}
+	free(idx);
+	return 0;
+}
+
+static int max_len(const bsim_grid_axis *axis, int floor)
+{
+	int w = floor;
+	for (int i = 0; i < axis->n_values; i++) {
+		int len = (int)strlen(axis->values[i]);
+		w = len > w ? len : w;
+	}
+	return w;
+}
+
+/* "beams.0.stiffness = 100, contact.restitution = 0.8" for table rest. */
+static void table_heading(FILE *f, const bsim_experiment *e, int rest)
+{
+	int div = 1;
+	for (int a = 2; a < e->n_axes; a++)
+		div *= e->axes[a].n_values;
+	for (int a = 2; a < e->n_axes; a++) {
+		div /= e->axes[a].n_values;
+		int i = (rest / div) % e->axes[a].n_values;
+		fprintf(f, "%s%s = %s", a > 2 ? ", " : "", e->axes[a].key, e->axes[a].values[i]);
+	}
+	fputc('\n', f);
+}
+
+static void table_rule(FILE *f, int w, char c)
+{
+	for (int i = 0; i < w; i++)
+		fputc(c, f);
+}
+
+/* One table: a header naming both axes, column values, a rule, and one row
+ * of p_traverse per axis-1 value.
+ *
+ *                                 | effects.propulsion.force
+ *  effects.random_force.magnitude |    4     5     6
+ *  -------------------------------+------------------
+ *                               0 | 0.00  0.12  0.40 */
+static void table_one(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r,
+                      const table_layout *l, int rest)
+{
+	const bsim_grid_axis *a0 = &e->axes[0];
+	const bsim_grid_axis *a1 = e->n_axes > 1 ? &e->axes[1] : NULL;
+	const char *row_key = a1 ? a1->key : "p_traverse";
+	int cw = max_len(a0, 4);
+	int rw = a1 ? max_len(a1, (int)strlen(row_key)) : (int)strlen(row_key);
+
+	fprintf(f, "%*s | %s\n%-*s |", rw, "", a0->key, rw, a1 ? row_key : "");
+	for (int i0 = 0; i0 < l->n0; i0++)
+		fprintf(f, "%s%*s", i0 ? "  " : " ", cw, a0->values[i0]);
+	fputc('\n', f);
+	table_rule(f, rw + 1, '-');
+	fputc('+', f);
+	table_rule(f, l->n0 * (cw + 2), '-');
+	fputc('\n', f);
+	for (int i1 = 0; i1 < l->n1; i1++) {
+		fprintf(f, "%*s |", rw, a1 ? a1->values[i1] : row_key);
+		for (int i0 = 0; i0 < l->n0; i0++) {
+			int g = l->cell[((size_t)rest * l->n1 + i1) * l->n0 + i0];
+			if (g >= 0 && g < r->n_groups)
+				fprintf(f, "%s%*.2f", i0 ? "  " : " ", cw, r->groups[g].p_traverse);
+			else
+				fprintf(f, "%s%*s", i0 ? "  " : " ", cw, "-");
+		}
+		fputc('\n', f);
+	}
+}
+
+void bsim_output_table(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r)
+{
+	fprintf(f, "p_traverse, %d trials per group\n", r->trials);
+	if (e->n_axes == 0) {
+		if (r->n_groups > 0)
+			fprintf(f, "%.2f [%.2f, %.2f]\n", r->groups[0].p_traverse,
+			        r->groups[0].ci95[0], r->groups[0].ci95[1]);
+		return;
+	}
+	table_layout l;
+	if (layout_build(&l, e) != 0) {
+		fputs("(out of memory for the table)\n", f);
+		return;
+	}
+	for (int rest = 0; rest < l.n_rest; rest++) {
+		fputc('\n', f);
+		if (e->n_axes > 2)
+			table_heading(f, e, rest);
+		table_one(f, e, r, &l, rest);
+	}
+	free(l.cell);
+}
+
+/* ---- directories ---------------------------------------------------------- */
+
+int bsim_output_mkdir(const char *dir, bsim_error *err)
+{
+	char path[1024];
+	struct stat st;
+	int n = snprintf(path, sizeof path, "%s", dir);
+	if (n <= 0 || (size_t)n >= sizeof path)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: bad directory name", dir);
+	/* Each parent in turn, like mkdir -p; existing ones are fine. */
+	for (char *p = path + 1; *p; p++) {
+		if (*p != '/')
+			continue;
+		*p = '\0';
+		if (mkdir(path, 0777) != 0 && errno != EEXIST)
+			return bsim_error_set(err, BSIM_EFAIL, "%s: cannot create: %s", path,
+			                      strerror(errno));
+		*p = '/';
+	}
+	if (mkdir(path, 0777) != 0 && errno != EEXIST)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot create: %s", dir,
+		                      strerror(errno));
+	if (stat(path, &st) != 0 || !S_ISDIR(st.st_mode))
+		return bsim_error_set(err, BSIM_EFAIL, "%s: not a directory", dir);
+	return BSIM_OK;
+}

@@ -1,0 +1,195 @@
+/* The files of a lattice sweep (docs/lattice.md "Files"), beside
+ * summary.json and trials.csv, each written atomically:
+ *
+ *   lattice_map.csv     group,ix,iy,x_min,x_max,y_min,y_max,pivot_y,k_left,k_right
+ *                       one row per gate: the stiffness map (Fig. 3.5a)
+ *   final_locations.csv group,location,kind,ix,iy,count,p,ci95_lo,ci95_hi
+ *   transitions.csv     group,from_ix,from_iy,to_ix,to_iy,count
+ *   gate_entries.csv    group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy,
+ *                       theta_left,omega_left,theta_right,omega_right
+ *                       every gate entry with its state, gate frame (Eq. 2.17)
+ *   beam_peaks.csv      group,trial,beam,ix,iy,side,max_theta  (beams that moved)
+ *
+ * Units: m, s, m/s, rad, rad/s, N m/rad; x, y in lattice_map are the
+ * field's X, Y. Each file has its MATLAB twin (.mat, a struct of columns
+ * named for the file: lattice_map, final_locations, ...). */
+#define _POSIX_C_SOURCE 200809L
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/atomic_file.h"
+#include "beamsim/lattice.h"
+#include "store/matlab.h"
+#include "beamsim/output.h"
+
+typedef int (*lattice_writer)(FILE *f, const bsim_experiment *e, const bsim_override *extra,
+                              int n_extra, const bsim_sweep_result *r, bsim_error *err);
+
+static int write_map(FILE *f, const bsim_experiment *e, const bsim_override *extra, int n_extra,
+                     const bsim_sweep_result *r, bsim_error *err)
+{
+	fputs("group,ix,iy,x_min,x_max,y_min,y_max,pivot_y,k_left,k_right\n", f);
+	for (int g = 0; g < r->n_groups; g++) {
+		bsim_scene s;
+		int rc = bsim_experiment_group_scene(e, g, extra, n_extra, &s, err);
+		if (rc)
+			return rc;
+		const bsim_lattice_def *l = &s.lattice;
+		for (int iy = 0; s.has_lattice && iy < l->rows; iy++)
+			for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
+				const bsim_beam_def *bl = &s.beams[bsim_lattice_beam(l, ix, iy, 0)];
+				const bsim_beam_def *br = &s.beams[bsim_lattice_beam(l, ix, iy, 1)];
+				fprintf(f, "%d,%d,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n",
+				        g, ix, iy, l->width * ix - 0.5 * l->width,
+				        l->width * ix + 0.5 * l->width, l->depth * iy,
+				        l->depth * (iy + 1), l->depth * iy + l->pivot_y,
+				        bl->stiffness, br->stiffness);
+			}
+		bsim_scene_free(&s);
+	}
+	return BSIM_OK;
+}
+
+static int write_summaries(FILE *f, const bsim_sweep_result *r, int transitions, bsim_error *err)
+{
+	fputs(transitions ? "group,from_ix,from_iy,to_ix,to_iy,count\n"
+	                  : "group,location,kind,ix,iy,count,p,ci95_lo,ci95_hi\n",
+	      f);
+	static const char *const kinds[] = {"end", "side", "stuck"};
+	for (int g = 0; g < r->n_groups; g++) {
+		bsim_lattice_summary ls;
+		size_t i0 = (size_t)g * r->trials;
+		if (bsim_lattice_summarise(&r->trials_out[i0], r->logs ? &r->logs[i0] : NULL,
+		                           r->trials, r->lattice_def.rows, &ls) != BSIM_OK)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		for (int k = 0; transitions && k < ls.n_transitions; k++) {
+			const bsim_transition *x = &ls.transitions[k];
+			fprintf(f, "%d,%d,%d,%d,%d,%d\n", g, x->from[0], x->from[1], x->to[0],
+			        x->to[1], x->count);
+		}
+		for (int k = 0; !transitions && k < ls.n_locations; k++) {
+			const bsim_location_count *c = &ls.locations[k];
+			char label[48];
+			bsim_lattice_location_label(c->loc, label, sizeof label);
+			fprintf(f, "%d,%s,%s,", g, label, kinds[c->loc.kind]);
+			if (c->loc.kind != BSIM_LOCATION_SIDE)
+				fprintf(f, "%d", c->loc.ix);
+			fputc(',', f);
+			if (c->loc.kind != BSIM_LOCATION_END)
+				fprintf(f, "%d", c->loc.iy);
+			fprintf(f, ",%d,%.10g,%.10g,%.10g\n", c->count, c->p, c->ci95[0],
+			        c->ci95[1]);
+		}
+		bsim_lattice_summary_free(&ls);
+	}
+	return BSIM_OK;
+}
+
+static int write_locations(FILE *f, const bsim_experiment *e, const bsim_override *extra,
+                           int n_extra, const bsim_sweep_result *r, bsim_error *err)
+{
+	(void)e;
+	(void)extra;
+	(void)n_extra;
+	return write_summaries(f, r, 0, err);
+}
+
+static int write_transitions(FILE *f, const bsim_experiment *e, const bsim_override *extra,
+                             int n_extra, const bsim_sweep_result *r, bsim_error *err)
+{
+	(void)e;
+	(void)extra;
+	(void)n_extra;
+	return write_summaries(f, r, 1, err);
+}
+
+static int write_entries(FILE *f, const bsim_experiment *e, const bsim_override *extra, int n_extra,
+                         const bsim_sweep_result *r, bsim_error *err)
+{
+	(void)e;
+	(void)extra;
+	(void)n_extra;
+	(void)err;
+	fputs("group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy,theta_left,omega_left,theta_right,"
+	      "omega_right\n",
+	      f);
+	for (int g = 0; g < r->n_groups; g++)
+		for (int t = 0; t < r->trials; t++) {
+			const bsim_trial_log *l = &r->logs[(size_t)g * r->trials + t];
+			for (int k = 0; k < l->n_entries; k++) {
+				const bsim_gate_entry *x = &l->entries[k];
+				fprintf(f,
+				        "%d,%d,%d,%d,%d,%s,%d,%.6f,%.10g,%.10g,%.10g,%.10g,%.10g,%."
+				        "10g,"
+				        "%.10g,%.10g,%.10g\n",
+				        g, t, k, x->ix, x->iy, bsim_trial_edge_name(x->edge),
+				        x->step, x->t, x->pos, x->x[0], x->x[1], x->v[0], x->v[1],
+				        x->theta[0], x->omega[0], x->theta[1], x->omega[1]);
+			}
+		}
+	return BSIM_OK;
+}
+
+static int write_peaks(FILE *f, const bsim_experiment *e, const bsim_override *extra, int n_extra,
+                       const bsim_sweep_result *r, bsim_error *err)
+{
+	(void)e;
+	(void)extra;
+	(void)n_extra;
+	(void)err;
+	fputs("group,trial,beam,ix,iy,side,max_theta\n", f);
+	for (int g = 0; g < r->n_groups; g++)
+		for (int t = 0; t < r->trials; t++) {
+			const bsim_trial_log *l = &r->logs[(size_t)g * r->trials + t];
+			for (int b = 0; b < l->n_beams; b++) {
+				if (l->peak[b] == 0.0)
+					continue;
+				int ix, iy, side;
+				bsim_lattice_beam_gate(&r->lattice_def, b, &ix, &iy, &side);
+				fprintf(f, "%d,%d,%d,%d,%d,%s,%.10g\n", g, t, b, ix, iy,
+				        side ? "right" : "left", l->peak[b]);
+			}
+		}
+	return BSIM_OK;
+}
+
+int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_override *extra,
+                        int n_extra, const bsim_sweep_result *r, bsim_error *err)
+{
+	static const struct {
+		const char *name;
+		lattice_writer fn;
+	} files[] = {
+	        {"lattice_map.csv", write_map},         {"final_locations.csv", write_locations},
+	        {"transitions.csv", write_transitions}, {"gate_entries.csv", write_entries},
+	        {"beam_peaks.csv", write_peaks},
+	};
+	if (!r->lattice || !r->logs)
+		return BSIM_OK;
+	for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
+		char path[1200];
+		int n = snprintf(path, sizeof path, "%s/%s", dir, files[k].name);
+		if (n < 0 || (size_t)n >= sizeof path)
+			return bsim_error_set(err, BSIM_EFAIL, "%s/%s: path too long", dir,
+			                      files[k].name);
+		bsim_atomic_file o;
+		if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+			return BSIM_EFAIL;
+		int rc = files[k].fn(o.f, e, extra, n_extra, r, err);
+		if (rc != BSIM_OK) {
+			bsim_atomic_file_abort(&o);
+			return rc;
+		}
+		if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+			return BSIM_EFAIL;
+		/* its MATLAB twin (beamsim/matlab.h), a struct named for the file */
+		char mat[1200], var[32];
+		snprintf(var, sizeof var, "%.*s", (int)strcspn(files[k].name, "."), files[k].name);
+		if (bsim_matlab_path(path, mat, sizeof mat, err) != BSIM_OK ||
+		    bsim_matlab_from_csv(path, mat, var, err) != BSIM_OK)
+			return BSIM_EFAIL;
+	}
+	return BSIM_OK;
+}

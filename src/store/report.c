@@ -1,0 +1,671 @@
+/* The comparison report (beamsim/report.h).
+ *
+ * Every number in report.md is also in report.json; the Markdown rounds
+ * for reading, the JSON keeps full precision. Replay lines name the scene,
+ * the backend with the options given, the seed, group and trial, and every
+ * override in the order the experiment applied it (set:, --set, grid), so
+ * `beamsim run` rebuilds exactly the scene and schedule of that trial. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/report.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/json.h"
+#include "beamsim/lattice.h"
+#include "beamsim/output.h"
+
+/* A word for a POSIX shell: as it is if it is made of safe characters,
+ * else in single quotes with each ' written as '\''. */
+static void shell_word(FILE *f, const char *s)
+{
+	if (*s && strspn(s, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789"
+	                    "_-+=.,/:@%") == strlen(s)) {
+		fputs(s, f);
+		return;
+	}
+	fputc('\'', f);
+	for (; *s; s++)
+		if (*s == '\'')
+			fputs("'\\''", f);
+		else
+			fputc(*s, f);
+	fputc('\'', f);
+}
+
+static void set_word(FILE *f, const char *key, const char *value)
+{
+	char buf[1200];
+	snprintf(buf, sizeof buf, "%s=%s", key, value);
+	fputs(" --set ", f);
+	shell_word(f, buf);
+}
+
+static void replay_line(FILE *f, const bsim_report *r, int side, int g, int t)
+{
+	const bsim_experiment *e = r->e;
+	const bsim_report_side *s = &r->side[side];
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	fputs("beamsim run ", f);
+	shell_word(f, e->scene_path);
+	fprintf(f, " --backend %s", s->backend->name);
+	for (int i = 0; s->opts && i < s->opts->n; i++) {
+		char buf[128];
+		snprintf(buf, sizeof buf, "%s=%s", s->opts->key[i], s->opts->value[i]);
+		fputs(" --backend-opt ", f);
+		shell_word(f, buf);
+	}
+	fprintf(f, " --seed %" PRIu64 " --group %d --trial %d", e->seed, g, t);
+	for (int i = 0; i < e->n_set; i++)
+		set_word(f, e->set[i].key, e->set[i].value);
+	for (int i = 0; i < r->n_extra; i++)
+		set_word(f, r->extra[i].key, r->extra[i].value);
+	for (int i = 0; side == 1 && i < r->n_extra_b; i++)
+		set_word(f, r->extra_b[i].key, r->extra_b[i].value);
+	if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
+		bsim_experiment_group_index(e, g, idx);
+	for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
+		set_word(f, e->axes[a].key, e->axes[a].values[idx[a]]);
+}
+
+static const bsim_trial_result *trial_of(const bsim_report *r, int side, int g, int t)
+{
+	const bsim_sweep_result *run = r->side[side].run;
+	return &run->trials_out[(size_t)g * run->trials + t];
+}
+
+/* "traversed (left) at 3.24 s"; on a lattice "... at 3.24 s, end:-2" */
+static void outcome_text(FILE *f, const bsim_report *r, const bsim_trial_result *x)
+{
+	fputs(bsim_trial_outcome_name(x->outcome), f);
+	if (x->outcome == BSIM_TRAVERSED)
+		fprintf(f, " (%s)", bsim_trial_type_name(x->type));
+	fprintf(f, " at %.3f s", x->t_end);
+	if (r->cmp->lattice) {
+		char label[48];
+		bsim_lattice_location_label(bsim_lattice_location_of(x), label, sizeof label);
+		fprintf(f, ", %s", label);
+	}
+}
+
+static void params_text(FILE *f, const bsim_experiment *e, int g)
+{
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
+		bsim_experiment_group_index(e, g, idx);
+	for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
+		fprintf(f, "%s%s = %s", a ? ", " : "", e->axes[a].key, e->axes[a].values[idx[a]]);
+}
+
+/* The event with the smallest adjusted p-value: what a row shows. */
+static int key_event(const bsim_compare_group *cg)
+{
+	int k = BSIM_EVENT_TRAVERSED;
+	for (int ev = 1; ev < BSIM_N_EVENTS; ev++)
+		if (cg->ev[ev].p_holm < cg->ev[k].p_holm)
+			k = ev;
+	return k;
+}
+
+static void md_separation(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	long pairs = c->pairs;
+	if (!r->t_separate)
+		return;
+	fprintf(f,
+	        "Paired trajectories (same scene, same random-force schedule) separated by more "
+	        "than 1%% of the body radius in %d of %ld pairs",
+	        c->separated, pairs);
+	if (c->separated > 0)
+		fprintf(f, "; separation time quantiles 10%% / 50%% / 90%%: %.3f / %.3f / %.3f s",
+		        c->t_sep[0], c->t_sep[1], c->t_sep[2]);
+	fputs(". Per pair: pairs.csv.\n\n", f);
+}
+
+/* "traversed (none)" for a deterministic group's one trial. */
+static void outcome_short(FILE *f, const bsim_trial_result *x)
+{
+	fputs(bsim_trial_outcome_name(x->outcome), f);
+	if (x->outcome == BSIM_TRAVERSED)
+		fprintf(f, " (%s)", bsim_trial_type_name(x->type));
+}
+
+/* The largest equivalence p-value over the events: the group's, since it
+ * is equivalent only if every event is. */
+static double group_equivalence(const bsim_compare_group *cg)
+{
+	double p = 0.0;
+	for (int ev = 0; ev < BSIM_N_EVENTS; ev++)
+		p = fmax(p, cg->ev[ev].p_equivalence);
+	return p;
+}
+
+static void md_number(FILE *f, const char *fmt, double x)
+{
+	if (isnan(x))
+		fputs(" - |", f);
+	else
+		fprintf(f, fmt, x);
+}
+
+static void md_row_random(FILE *f, const bsim_compare_group *cg)
+{
+	const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];
+	int k = key_event(cg);
+	fprintf(f,
+	        " %.2f [%.2f, %.2f] | %.2f [%.2f, %.2f] | %+.2f [%+.2f, %+.2f] | %d of %d | %.2g, "
+	        "%s | %.2g |",
+	        t->p_a, t->ci_a[0], t->ci_a[1], t->p_b, t->ci_b[0], t->ci_b[1], t->diff,
+	        t->diff_ci[0], t->diff_ci[1], cg->discordant, cg->pairs, cg->ev[k].p_holm,
+	        bsim_compare_event_name((bsim_event)k), group_equivalence(cg));
+	md_number(f, " %.2f |", t->detectable);
+}
+
+static void md_row_deterministic(FILE *f, const bsim_report *r, int g, const bsim_compare_group *cg)
+{
+	fputc(' ', f);
+	outcome_short(f, trial_of(r, 0, g, 0));
+	fputs(" | ", f);
+	outcome_short(f, trial_of(r, 1, g, 0));
+	fprintf(f, " | deterministic | %d of 1 | - | - | - |", cg->discordant);
+}
+
+static void md_table(FILE *f, const bsim_report *r)
+{
+	const bsim_experiment *e = r->e;
+	const char *la = r->side[0].label, *lb = r->side[1].label;
+	fputs("| group |", f);
+	for (int a = 0; a < e->n_axes; a++)
+		fprintf(f, " %s |", e->axes[a].key);
+	fprintf(f,
+	        " p_traverse %s [95%%] | p_traverse %s [95%%] | difference [95%%] | discordant "
+	        "| min p (Holm), event | equivalence p | detectable | t_sep median (s) | verdict "
+	        "|\n|---|",
+	        la, lb);
+	for (int a = 0; a < e->n_axes; a++)
+		fputs("---|", f);
+	fputs("---|---|---|---|---|---|---|---|---|\n", f);
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	for (int g = 0; g < r->cmp->n_groups; g++) {
+		const bsim_compare_group *cg = &r->cmp->groups[g];
+		if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
+			bsim_experiment_group_index(e, g, idx);
+		fprintf(f, "| %d |", g);
+		for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
+			fprintf(f, " %s |", e->axes[a].values[idx[a]]);
+		if (cg->deterministic)
+			md_row_deterministic(f, r, g, cg);
+		else
+			md_row_random(f, cg);
+		if (cg->t_sep[1] >= 0.0)
+			fprintf(f, " %.3f |", cg->t_sep[1]);
+		else
+			fputs(" - |", f);
+		fprintf(f, " %s |\n", bsim_compare_verdict_name(cg->verdict));
+	}
+	fputc('\n', f);
+}
+
+static void md_events(FILE *f, const bsim_report *r, const bsim_compare_group *cg)
+{
+	fprintf(f,
+	        "| event | %s | %s | difference [95%%] | only %s | only %s | McNemar p | Holm p "
+	        "| equivalence p | detectable | beyond |\n|---|---|---|---|---|---|---|---|---|---|"
+	        "---|\n",
+	        r->side[0].label, r->side[1].label, r->side[0].label, r->side[1].label);
+	for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
+		const bsim_event_test *t = &cg->ev[ev];
+		fprintf(f,
+		        "| %s | %.2f | %.2f | %+.2f [%+.2f, %+.2f] | %d | %d | %.3g | %.3g | %.3g "
+		        "|",
+		        bsim_compare_event_name((bsim_event)ev), t->p_a, t->p_b, t->diff,
+		        t->diff_ci[0], t->diff_ci[1], t->pairs.b, t->pairs.c, t->p_value, t->p_holm,
+		        t->p_equivalence);
+		md_number(f, " %.2f |", t->detectable);
+		fprintf(f, " %s |\n", t->beyond ? "yes" : "no");
+	}
+	fputc('\n', f);
+}
+
+static void md_examples(FILE *f, const bsim_report *r, int g)
+{
+	int shown = 0;
+	for (int t = 0; t < r->cmp->groups[g].pairs && shown < r->examples; t++) {
+		const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
+		if (!bsim_compare_discordant(a, b))
+			continue;
+		shown++;
+		fprintf(f, "- trial %d: %s ", t, r->side[0].label);
+		outcome_text(f, r, a);
+		fprintf(f, ", %s ", r->side[1].label);
+		outcome_text(f, r, b);
+		if (r->t_separate) {
+			double ts = r->t_separate[(size_t)g * r->cmp->trials + t];
+			if (ts >= 0.0)
+				fprintf(f, "; separated at %.3f s", ts);
+		}
+		fputs("\n\n  ```\n", f);
+		for (int s = 0; s < 2; s++) {
+			fputs("  ", f);
+			replay_line(f, r, s, g, t);
+			fputc('\n', f);
+		}
+		fputs("  ```\n", f);
+	}
+	fputc('\n', f);
+}
+
+static int shows_detail(const bsim_compare_group *cg)
+{
+	return cg->verdict == BSIM_VERDICT_DISAGREE || cg->verdict == BSIM_VERDICT_DIFFERENT;
+}
+
+/* One side's distribution of final locations of group g. */
+static int side_locations(const bsim_report *r, int side, int g, bsim_lattice_summary *ls)
+{
+	const bsim_sweep_result *run = r->side[side].run;
+	return bsim_lattice_summarise(&run->trials_out[(size_t)g * run->trials], NULL, run->trials,
+	                              run->lattice_def.rows, ls);
+}
+
+static const char *location_test_name(const bsim_location_test *t)
+{
+	return t->exact ? "exact (all swaps)" : "Monte Carlo (20,000 swaps)";
+}
+
+/* Both sides' final-location distributions (lattices), group by group, and
+ * the paired permutation test of their difference. */
+static void md_locations(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	fprintf(f,
+	        "## Final locations\n\nWhere each trial ended: `end:ix` reached the end through "
+	        "column ix, `side:iy` left the field through a side at row iy, `stuck:ix:iy` "
+	        "stuck in gate (ix, iy). Test of the difference: a paired permutation test on "
+	        "the final locations (the two locations of a discordant pair swapped with "
+	        "probability 1/2; statistic: the total variation distance), exact when at "
+	        "most %d pairs are discordant, else Monte Carlo; in the Holm family above.\n\n",
+	        BSIM_LOCATION_EXACT_MAX);
+	for (int g = 0; g < c->n_groups; g++) {
+		const bsim_location_test *t = &c->groups[g].loc;
+		bsim_lattice_summary ls[2];
+		if (c->groups[g].deterministic)
+			continue; /* one pair: its locations are in the group's row */
+		if (side_locations(r, 0, g, &ls[0]) != BSIM_OK)
+			return;
+		if (side_locations(r, 1, g, &ls[1]) != BSIM_OK) {
+			bsim_lattice_summary_free(&ls[0]);
+			return;
+		}
+		fprintf(f, "### Group %d: ", g);
+		params_text(f, r->e, g);
+		fprintf(f,
+		        "\n\n%d discordant pairs; total variation %.3f; permutation p = %.3g "
+		        "(%s), Holm %.3g%s.\n\n| location | %s [95%%] | %s [95%%] "
+		        "|\n|---|---|---|\n",
+		        t->discordant, t->tv, t->p_value, location_test_name(t), t->p_holm,
+		        t->beyond ? ", **beyond the rule**" : "", r->side[0].label,
+		        r->side[1].label);
+		/* the union of both sides' locations, in the summaries' order */
+		int i = 0, j = 0;
+		while (i < ls[0].n_locations || j < ls[1].n_locations) {
+			const bsim_location_count *x =
+			        i < ls[0].n_locations ? &ls[0].locations[i] : NULL;
+			const bsim_location_count *y =
+			        j < ls[1].n_locations ? &ls[1].locations[j] : NULL;
+			char la[48], lb[48];
+			if (x)
+				bsim_lattice_location_label(x->loc, la, sizeof la);
+			if (y)
+				bsim_lattice_location_label(y->loc, lb, sizeof lb);
+			int order = !x ? 1 : !y ? -1 : 0;
+			if (x && y) {
+				bsim_location p = x->loc, q = y->loc;
+				order = p.kind != q.kind ? (p.kind < q.kind ? -1 : 1)
+				        : p.iy != q.iy   ? (p.iy < q.iy ? -1 : 1)
+				        : p.ix != q.ix   ? (p.ix < q.ix ? -1 : 1)
+				                         : 0;
+			}
+			const bsim_location_count *show = order <= 0 ? x : y;
+			fprintf(f, "| %s |", order <= 0 ? la : lb);
+			if (order <= 0)
+				fprintf(f, " %.3f [%.3f, %.3f] |", x->p, x->ci95[0], x->ci95[1]);
+			else
+				fputs(" 0 |", f);
+			if (order >= 0)
+				fprintf(f, " %.3f [%.3f, %.3f] |\n", y->p, y->ci95[0], y->ci95[1]);
+			else
+				fputs(" 0 |\n", f);
+			(void)show;
+			i += order <= 0;
+			j += order >= 0;
+		}
+		fputc('\n', f);
+		bsim_lattice_summary_free(&ls[0]);
+		bsim_lattice_summary_free(&ls[1]);
+	}
+}
+
+void bsim_report_md(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	const int *k = c->count;
+	int det = k[BSIM_VERDICT_SAME] + k[BSIM_VERDICT_DIFFERENT];
+	fprintf(f,
+	        "**%d of %d groups disagree.** %d deterministic (no random force: one trial each, "
+	        "compared as one pair): %d same, %d different. %d with random force, %d trials "
+	        "each: %d equivalent within +-%g, %d inconclusive (no difference detected, none "
+	        "excluded), %d significantly different but within the margin, %d disagree.\n\n",
+	        c->n_disagree, c->n_groups, det, k[BSIM_VERDICT_SAME], k[BSIM_VERDICT_DIFFERENT],
+	        c->n_groups - det, c->trials, k[BSIM_VERDICT_EQUIVALENT], c->rule.margin,
+	        k[BSIM_VERDICT_INCONCLUSIVE], k[BSIM_VERDICT_SMALL], k[BSIM_VERDICT_DISAGREE]);
+	fprintf(f,
+	        "Rule: a group with random force disagrees when, for one of the events traversed, "
+	        "left, right, side_exit, stuck, unstable, the exact McNemar test on the paired "
+	        "trials gives a p-value below %g after Holm's correction over its %d tests (groups "
+	        "with random force x events), and the two probabilities differ by at least %g. It "
+	        "is equivalent when, for every event, Tango's two one-sided score tests put the "
+	        "paired difference within +-%g at level %g (equivalence p below it); otherwise it "
+	        "is inconclusive. `detectable` is the smallest difference in p_traverse the "
+	        "corrected test could flag given the group's discordant pairs. A deterministic "
+	        "group disagrees when its one pair differs in outcome or type. Intervals: Wilson "
+	        "for each probability, Tango's score interval for the paired difference",
+	        c->rule.alpha, c->n_tests, c->rule.margin, c->rule.margin, c->rule.alpha);
+	fputs(c->rule.exact ? "; any trial that differs in any trials.csv field also disagrees.\n\n"
+	                    : ".\n\n",
+	      f);
+	if (c->lattice)
+		fputs("On a lattice a group with random force also disagrees when its "
+		      "final-location "
+		      "test (in the Holm family above) has a p-value below alpha and the total "
+		      "variation distance between the two distributions is at least the margin "
+		      "(section Final locations).\n\n",
+		      f);
+	md_separation(f, r);
+	md_table(f, r);
+	if (c->lattice)
+		md_locations(f, r);
+	for (int g = 0; g < c->n_groups; g++) {
+		const bsim_compare_group *cg = &c->groups[g];
+		if (!shows_detail(cg))
+			continue;
+		fprintf(f, "### Group %d: ", g);
+		params_text(f, r->e, g);
+		fprintf(f, "\n\n%d of %d pairs discordant, %d changed in any field.\n\n",
+		        cg->discordant, cg->pairs, cg->changed);
+		if (!cg->deterministic)
+			md_events(f, r, cg);
+		md_examples(f, r, g);
+	}
+}
+
+/* ---- report.json ---------------------------------------------------------- */
+
+static void json_pair_of_numbers(FILE *f, const double v[2])
+{
+	fputc('[', f);
+	bsim_json_number(f, v[0]);
+	fputs(", ", f);
+	bsim_json_number(f, v[1]);
+	fputc(']', f);
+}
+
+static void json_quantiles(FILE *f, const double q[3])
+{
+	if (q[0] < 0.0) {
+		fputs("null", f);
+		return;
+	}
+	fputc('[', f);
+	for (int k = 0; k < 3; k++) {
+		fputs(k ? ", " : "", f);
+		bsim_json_number(f, q[k]);
+	}
+	fputc(']', f);
+}
+
+static void json_event(FILE *f, const bsim_event_test *t, int deterministic)
+{
+	fputs("{\"p_a\": ", f);
+	bsim_json_number(f, t->p_a);
+	if (!deterministic) {
+		fputs(", \"ci95_a\": ", f);
+		json_pair_of_numbers(f, t->ci_a);
+	}
+	fputs(", \"p_b\": ", f);
+	bsim_json_number(f, t->p_b);
+	if (!deterministic) {
+		fputs(", \"ci95_b\": ", f);
+		json_pair_of_numbers(f, t->ci_b);
+	}
+	fputs(", \"difference\": ", f);
+	bsim_json_number(f, t->diff);
+	fprintf(f, ", \"both\": %d, \"only_a\": %d, \"only_b\": %d, \"neither\": %d", t->pairs.a,
+	        t->pairs.b, t->pairs.c, t->pairs.d);
+	if (deterministic) {
+		fputc('}', f);
+		return;
+	}
+	fputs(", \"difference_ci95\": ", f);
+	json_pair_of_numbers(f, t->diff_ci);
+	fputs(", \"p_mcnemar\": ", f);
+	bsim_json_number(f, t->p_value);
+	fputs(", \"p_holm\": ", f);
+	bsim_json_number(f, t->p_holm);
+	fputs(", \"p_equivalence\": ", f);
+	bsim_json_number(f, t->p_equivalence);
+	fputs(", \"detectable\": ", f);
+	bsim_json_number(f, t->detectable);
+	fprintf(f, ", \"beyond\": %s, \"equivalent\": %s}", t->beyond ? "true" : "false",
+	        t->equivalent ? "true" : "false");
+}
+
+static void json_outcome(FILE *f, const bsim_trial_result *x)
+{
+	fputs("{\"outcome\": ", f);
+	bsim_json_string(f, bsim_trial_outcome_name(x->outcome));
+	fputs(", \"type\": ", f);
+	bsim_json_string(f, bsim_trial_type_name(x->type));
+	fputs(", \"t_end\": ", f);
+	bsim_json_number(f, x->t_end);
+	fputc('}', f);
+}
+
+/* The replay line as a JSON string: written to memory first. */
+static void json_replay(FILE *f, const bsim_report *r, int side, int g, int t)
+{
+	char *buf = NULL;
+	size_t len = 0;
+	FILE *m = open_memstream(&buf, &len);
+	if (!m) {
+		fputs("null", f);
+		return;
+	}
+	replay_line(m, r, side, g, t);
+	fclose(m);
+	bsim_json_string(f, buf);
+	free(buf);
+}
+
+static void json_examples(FILE *f, const bsim_report *r, int g)
+{
+	int shown = 0;
+	fputs(", \"examples\": [", f);
+	for (int t = 0; t < r->cmp->groups[g].pairs && shown < r->examples; t++) {
+		const bsim_trial_result *a = trial_of(r, 0, g, t), *b = trial_of(r, 1, g, t);
+		if (!bsim_compare_discordant(a, b))
+			continue;
+		fprintf(f, "%s\n      {\"trial\": %d, \"a\": ", shown ? "," : "", t);
+		json_outcome(f, a);
+		fputs(", \"b\": ", f);
+		json_outcome(f, b);
+		fputs(", \"t_separate\": ", f);
+		double ts = r->t_separate ? r->t_separate[(size_t)g * r->cmp->trials + t] : -1.0;
+		if (ts >= 0.0)
+			bsim_json_number(f, ts);
+		else
+			fputs("null", f);
+		fputs(", \"replay_a\": ", f);
+		json_replay(f, r, 0, g, t);
+		fputs(", \"replay_b\": ", f);
+		json_replay(f, r, 1, g, t);
+		fputc('}', f);
+		shown++;
+	}
+	fputc(']', f);
+}
+
+static void json_location_list(FILE *f, const bsim_lattice_summary *ls)
+{
+	fputc('[', f);
+	for (int k = 0; k < ls->n_locations; k++) {
+		const bsim_location_count *c = &ls->locations[k];
+		char label[48];
+		bsim_lattice_location_label(c->loc, label, sizeof label);
+		fprintf(f, "%s{\"location\": \"%s\", \"count\": %d, \"p\": ", k ? ", " : "", label,
+		        c->count);
+		bsim_json_number(f, c->p);
+		fputs(", \"ci95\": ", f);
+		json_pair_of_numbers(f, c->ci95);
+		fputc('}', f);
+	}
+	fputc(']', f);
+}
+
+static void json_locations(FILE *f, const bsim_report *r, int g)
+{
+	const bsim_location_test *t = &r->cmp->groups[g].loc;
+	bsim_lattice_summary ls[2];
+	fputs(",\n     \"final_locations\": {\"test\": ", f);
+	bsim_json_string(f, t->exact ? "paired permutation, exact"
+	                             : "paired permutation, monte carlo");
+	fprintf(f, ", \"resamples\": %ld, \"discordant\": %d, \"total_variation\": ", t->resamples,
+	        t->discordant);
+	bsim_json_number(f, t->tv);
+	fputs(", \"p\": ", f);
+	bsim_json_number(f, t->p_value);
+	fputs(", \"p_holm\": ", f);
+	bsim_json_number(f, t->p_holm);
+	fprintf(f, ", \"beyond\": %s", t->beyond ? "true" : "false");
+	for (int side = 0; side < 2; side++) {
+		fputs(side ? ", \"b\": " : ", \"a\": ", f);
+		if (side_locations(r, side, g, &ls[side]) != BSIM_OK) {
+			fputs("null", f);
+			continue;
+		}
+		json_location_list(f, &ls[side]);
+		bsim_lattice_summary_free(&ls[side]);
+	}
+	fputc('}', f);
+}
+
+static void json_side(FILE *f, const bsim_report_side *s)
+{
+	fputs("{\"label\": ", f);
+	bsim_json_string(f, s->label);
+	fputs(", \"backend\": ", f);
+	bsim_json_string(f, s->backend->name);
+	fputs(", \"backend_options\": ", f);
+	bsim_output_backend_options(f, s->backend, s->opts);
+	fputs(", \"wall_seconds\": ", f);
+	bsim_json_number(f, s->run->wall_seconds);
+	fputc('}', f);
+}
+
+void bsim_report_json(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	fputs("{\n  \"experiment\": ", f);
+	bsim_json_string(f, r->e->path);
+	fputs(",\n  \"seed\": ", f);
+	bsim_json_u64(f, r->e->seed);
+	fprintf(f, ",\n  \"trials_per_group\": %d,\n  \"a\": ", c->trials);
+	json_side(f, &r->side[0]);
+	fputs(",\n  \"b\": ", f);
+	json_side(f, &r->side[1]);
+	fputs(",\n  \"rule\": {\"alpha\": ", f);
+	bsim_json_number(f, c->rule.alpha);
+	fputs(", \"margin\": ", f);
+	bsim_json_number(f, c->rule.margin);
+	fprintf(f,
+	        ", \"exact\": %s, \"correction\": \"holm\", \"tests\": %d, \"test\": "
+	        "\"mcnemar_exact\", \"interval\": \"tango_score\", \"equivalence\": "
+	        "\"tango_two_one_sided\"",
+	        c->rule.exact ? "true" : "false", c->n_tests);
+	if (c->lattice)
+		fputs(", \"final_location_test\": \"paired_permutation\"", f);
+	fputc('}', f);
+	fprintf(f, ",\n  \"groups_disagreeing\": %d,\n  \"verdicts\": {", c->n_disagree);
+	for (int v = 0; v < BSIM_N_VERDICTS; v++) {
+		fputs(v ? ", " : "", f);
+		bsim_json_string(f, bsim_compare_verdict_name((bsim_verdict)v));
+		fprintf(f, ": %d", c->count[v]);
+	}
+	fputs("},\n  \"separation\": ", f);
+	if (r->t_separate) {
+		fprintf(f,
+		        "{\"distance\": \"0.01 body radius\", \"separated\": %d, \"pairs\": %ld, "
+		        "\"quantiles_10_50_90_s\": ",
+		        c->separated, (long)c->pairs);
+		json_quantiles(f, c->t_sep);
+		fputc('}', f);
+	} else {
+		fputs("null", f);
+	}
+	fputs(",\n  \"groups\": [", f);
+	for (int g = 0; g < c->n_groups; g++) {
+		const bsim_compare_group *cg = &c->groups[g];
+		fprintf(f, "%s\n    {\"group\": %d, \"params\": ", g ? "," : "", g);
+		bsim_output_group_params(f, r->e, g);
+		fputs(", \"verdict\": ", f);
+		bsim_json_string(f, bsim_compare_verdict_name(cg->verdict));
+		fprintf(f,
+		        ", \"deterministic\": %s, \"pairs\": %d, \"discordant\": %d, \"changed\": "
+		        "%d, "
+		        "\"separated\": %d, ",
+		        cg->deterministic ? "true" : "false", cg->pairs, cg->discordant,
+		        cg->changed, cg->separated);
+		fputs("\"t_separate_quantiles_s\": ", f);
+		json_quantiles(f, cg->t_sep);
+		fputs(",\n     \"events\": {", f);
+		for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
+			fputs(ev ? ",\n       " : "\n       ", f);
+			bsim_json_string(f, bsim_compare_event_name((bsim_event)ev));
+			fputs(": ", f);
+			json_event(f, &cg->ev[ev], cg->deterministic);
+		}
+		fputc('}', f);
+		if (c->lattice && !cg->deterministic)
+			json_locations(f, r, g);
+		if (shows_detail(cg))
+			json_examples(f, r, g);
+		fputc('}', f);
+	}
+	fputs("\n  ]\n}\n", f);
+}
+
+void bsim_report_pairs_csv(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	fputs("group,trial,outcome_a,type_a,outcome_b,type_b,t_separate,location_a,location_b\n",
+	      f);
+	for (int g = 0; g < c->n_groups; g++)
+		for (int t = 0; t < c->trials; t++) {
+			const bsim_trial_result *a = trial_of(r, 0, g, t),
+			                        *b = trial_of(r, 1, g, t);
+			fprintf(f, "%d,%d,%s,%s,%s,%s,", g, t, bsim_trial_outcome_name(a->outcome),
+			        bsim_trial_type_name(a->type), bsim_trial_outcome_name(b->outcome),
+			        bsim_trial_type_name(b->type));
+			double ts = r->t_separate ? r->t_separate[(size_t)g * c->trials + t] : -1.0;
+			if (ts >= 0.0)
+				fprintf(f, "%.10g", ts);
+			char la[48], lb[48];
+			bsim_lattice_location_label(bsim_lattice_location_of(a), la, sizeof la);
+			bsim_lattice_location_label(bsim_lattice_location_of(b), lb, sizeof lb);
+			fprintf(f, ",%s,%s\n", la, lb);
+		}
+}

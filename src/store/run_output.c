@@ -1,0 +1,304 @@
+/* The record of one trial and the directory of `beamsim run --out`
+ * (beamsim/run_output.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "beamsim/run_output.h"
+
+#include <inttypes.h>
+#include <string.h>
+
+#include "util/atomic_file.h"
+#include "util/json.h"
+#include "beamsim/lattice.h"
+#include "store/matlab.h"
+#include "beamsim/output.h"
+#include "beamsim/version.h"
+#include "store/session.h"
+
+bsim_run_info bsim_run_info_default(void)
+{
+	bsim_run_info i;
+	memset(&i, 0, sizeof i);
+	i.backend = bsim_backend_default();
+	i.seed = 1;
+	i.stride = 1;
+	return i;
+}
+
+static void ledger_json(FILE *f, const bsim_ledger *l)
+{
+	const struct {
+		const char *name;
+		double value;
+	} terms[] = {
+	        {"e_start", l->e_start},
+	        {"e_end", l->e_end},
+	        {"w_prop", l->w_prop},
+	        {"w_rand", l->w_rand},
+	        {"damper", l->damper},
+	        {"impact", l->impact},
+	        {"contact", l->contact},
+	        {"correction", l->correction},
+	        {"sleep", l->sleep},
+	        {"reset", l->reset},
+	        {"residual", l->residual},
+	        {"residual_max", l->residual_max},
+	        {"residual_abs", l->residual_abs},
+	        {"inflow", l->inflow},
+	};
+	fputc('{', f);
+	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
+		fprintf(f, "%s\"%s\": ", i ? ", " : "", terms[i].name);
+		bsim_json_number(f, terms[i].value);
+	}
+	fputc('}', f);
+}
+
+/* The final gate and location, the gate path and every beam's peak (the
+ * lattice's per-trial data; the path and peaks only with a log). */
+static void path_json(FILE *f, const bsim_trial_result *r, const bsim_trial_log *log)
+{
+	char label[48];
+	bsim_lattice_location_label(bsim_lattice_location_of(r), label, sizeof label);
+	fprintf(f, ", \"final_gate\": [%d, %d], \"location\": \"%s\", \"reset_overlaps\": %d",
+	        r->final_ix, r->final_iy, label, r->reset_overlaps);
+	if (!log)
+		return;
+	fputs(", \"path\": [", f);
+	for (int k = 0; k < log->n_entries; k++) {
+		const bsim_gate_entry *e = &log->entries[k];
+		fprintf(f, "%s{\"gate\": [%d, %d], \"edge\": \"%s\", \"t\": ", k ? ", " : "", e->ix,
+		        e->iy, bsim_trial_edge_name(e->edge));
+		bsim_json_number(f, e->t);
+		fputs(", \"pos\": ", f);
+		bsim_json_number(f, e->pos);
+		fputs(", \"v\": [", f);
+		bsim_json_number(f, e->v[0]);
+		fputs(", ", f);
+		bsim_json_number(f, e->v[1]);
+		fputs("]}", f);
+	}
+	fputs("], \"peak_theta\": [", f);
+	for (int i = 0; i < log->n_beams; i++) {
+		fputs(i ? ", " : "", f);
+		bsim_json_number(f, log->peak[i]);
+	}
+	fputc(']', f);
+}
+
+static void record_json(FILE *f, const bsim_run_info *info)
+{
+	fputs(", \"command\": \"run\", \"beamsim_version\": ", f);
+	bsim_json_string(f, BSIM_VERSION);
+	fprintf(f, ", \"stride\": %d, \"scene_copy\": \"inputs/scene.yaml\", \"set\": {",
+	        info->stride);
+	for (int i = 0; i < info->n_sets; i++) {
+		fputs(i ? ", " : "", f);
+		bsim_json_string(f, info->sets[i].key);
+		fputs(": ", f);
+		bsim_json_string(f, info->sets[i].value);
+	}
+	fputc('}', f);
+}
+
+void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r,
+                          int record)
+{
+	fputs("{\"scene\": ", f);
+	bsim_json_string(f, info->scene_path);
+	fputs(", \"name\": ", f);
+	bsim_json_string(f, info->scene->name);
+	fputs(", \"backend\": ", f);
+	bsim_json_string(f, info->backend->name);
+	fputs(", \"backend_options\": ", f);
+	bsim_output_backend_options(f, info->backend, info->opts);
+	fputs(", \"seed\": ", f);
+	bsim_json_u64(f, info->seed);
+	fprintf(f, ", \"group\": %ld, \"trial\": %ld, \"mixed_seed\": ", info->group, info->trial);
+	bsim_json_u64(f, info->mixed_seed);
+	fputs(", \"outcome\": ", f);
+	bsim_json_string(f, bsim_trial_outcome_name(r->outcome));
+	fputs(", \"type\": ", f);
+	bsim_json_string(f, bsim_trial_type_name(r->type));
+	fprintf(f, ", \"landscape_left\": %d, \"landscape_beam\": ", r->landscape_beam == 0);
+	if (r->landscape_beam >= 0)
+		fprintf(f, "%d", r->landscape_beam + 1);
+	else
+		fputs("null", f);
+	fprintf(f, ", \"in_contact_end\": %d", r->in_contact_end);
+	fprintf(f, ", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
+	        r->draws);
+	const char *names[] = {"t_end", "x_end", "y_end", "vx_end"};
+	const double values[] = {r->t_end, r->x_end, r->y_end, r->vx_end};
+	for (int i = 0; i < 4; i++) {
+		fprintf(f, ", \"%s\": ", names[i]);
+		bsim_json_number(f, values[i]);
+	}
+	fputs(", \"max_theta\": [", f);
+	bsim_json_number(f, r->max_theta[0]);
+	fputs(", ", f);
+	bsim_json_number(f, r->max_theta[1]);
+	fputs("], \"overlap_max\": ", f);
+	bsim_json_number(f, r->overlap_max);
+	path_json(f, r, info->log);
+	fputs(", \"ledger\": ", f);
+	ledger_json(f, &r->ledger);
+	fprintf(f, ", \"solver\": {\"iteration_limit\": %ld, \"clamped\": %ld}",
+	        r->solver.iteration_limit, r->solver.clamped);
+	fputs(", \"instability\": ", f);
+	if (r->instability) {
+		char why[256];
+		bsim_trial_instability_text(r, info->scene->dt, why, sizeof why);
+		bsim_json_string(f, why);
+	} else {
+		fputs("null", f);
+	}
+	if (record)
+		record_json(f, info);
+	fputs("}\n", f);
+}
+
+/* The open files of `run --out DIR`, in the staging area. */
+typedef struct run_dir {
+	char dir[1100];
+	char traj_path[1200], ledger_path[1200];
+	bsim_atomic_file traj, ledger;
+} run_dir;
+
+static int run_dir_open(run_dir *o, const char *dir, int n_beams, bsim_recorder *rec,
+                        bsim_error *err)
+{
+	memset(o, 0, sizeof *o);
+	if (strlen(dir) >= sizeof o->dir - 32)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", dir);
+	snprintf(o->dir, sizeof o->dir, "%s", dir);
+	snprintf(o->traj_path, sizeof o->traj_path, "%s/trajectory.csv", dir);
+	snprintf(o->ledger_path, sizeof o->ledger_path, "%s/ledger.csv", dir);
+	if (bsim_output_mkdir(dir, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (bsim_atomic_file_open(&o->traj, o->traj_path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (bsim_atomic_file_open(&o->ledger, o->ledger_path, err) != BSIM_OK) {
+		bsim_atomic_file_abort(&o->traj);
+		return BSIM_EFAIL;
+	}
+	bsim_trial_trajectory_header(o->traj.f, n_beams);
+	bsim_trial_ledger_header(o->ledger.f);
+	rec->csv = o->traj.f;
+	rec->ledger = o->ledger.f;
+	return BSIM_OK;
+}
+
+static void run_dir_abort(run_dir *o)
+{
+	bsim_atomic_file_abort(&o->traj);
+	bsim_atomic_file_abort(&o->ledger);
+}
+
+/* Once the trial has run: trajectory.csv and ledger.csv, their twins,
+ * inputs/scene.yaml and, last, run.json. */
+static int run_dir_commit(run_dir *o, const bsim_run_info *info, const bsim_trial_result *r,
+                          bsim_error *err)
+{
+	char path[1200], mat[1200];
+	int rc = bsim_atomic_file_commit(&o->traj, err);
+	if (rc) {
+		bsim_atomic_file_abort(&o->ledger);
+		return rc;
+	}
+	rc = bsim_atomic_file_commit(&o->ledger, err);
+	if (!rc)
+		rc = bsim_matlab_path(o->traj_path, mat, sizeof mat, err);
+	if (!rc)
+		rc = bsim_matlab_from_csv(o->traj_path, mat, "trajectory", err);
+	if (!rc)
+		rc = bsim_matlab_path(o->ledger_path, mat, sizeof mat, err);
+	if (!rc)
+		rc = bsim_matlab_from_csv(o->ledger_path, mat, "ledger", err);
+	snprintf(path, sizeof path, "%s/inputs", o->dir);
+	if (!rc)
+		rc = bsim_output_mkdir(path, err);
+	snprintf(path, sizeof path, "%s/inputs/scene.yaml", o->dir);
+	if (!rc && info->scene_path)
+		rc = bsim_atomic_file_copy(info->scene_path, path, err);
+	snprintf(path, sizeof path, "%s/run.json", o->dir);
+	bsim_atomic_file f;
+	if (!rc)
+		rc = bsim_atomic_file_open(&f, path, err);
+	if (!rc) {
+		bsim_run_output_json(f.f, info, r, 1);
+		rc = bsim_atomic_file_commit(&f, err);
+	}
+	return rc;
+}
+
+/* The trajectory file's twin: read back from the file, so only for a
+ * regular file (a pipe, a terminal or standard output cannot be, and a
+ * link's twin would not be its). */
+static int trajectory_commit(bsim_atomic_file *traj, const char *path, bsim_error *err)
+{
+	char mat[1200];
+	int through = traj->mode != BSIM_ATOMIC_RENAME;
+	int rc = bsim_atomic_file_commit(traj, err);
+	if (rc == BSIM_OK && !through) {
+		rc = bsim_matlab_path(path, mat, sizeof mat, err);
+		if (rc == BSIM_OK)
+			rc = bsim_matlab_from_csv(path, mat, "trajectory", err);
+	}
+	return rc;
+}
+
+int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, const char *out,
+                          bsim_trial_result *res, bsim_error *err)
+{
+	bsim_atomic_file traj = {0};
+	run_dir dir;
+	bsim_trial_log *log = (bsim_trial_log *)info->log;
+	int stride = info->stride > 0 ? info->stride : 1;
+	bsim_recorder rec = {.stride = stride, .log = log, .overlap = 1};
+	const bsim_scene *scene = info->scene;
+	memset(res, 0, sizeof *res);
+	if (trajectory) {
+		if (bsim_atomic_file_open(&traj, trajectory, err) != BSIM_OK)
+			return BSIM_EFAIL;
+		bsim_trial_trajectory_header(traj.f, scene->n_beams);
+		rec.csv = traj.f;
+	}
+	/* DIR is checked before the trial runs and its files appear together. */
+	bsim_session ss;
+	if (out) {
+		int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
+		if (rc != BSIM_OK) {
+			bsim_atomic_file_abort(&traj);
+			return rc;
+		}
+		if (run_dir_open(&dir, ss.stage, scene->n_beams, &rec, err)) {
+			bsim_atomic_file_abort(&traj);
+			return bsim_session_close(&ss, BSIM_EFAIL, "run", NULL, err);
+		}
+		/* One recorder writes both: the directory's trajectory and
+		 * ledger, and the CSV of the trajectory file. */
+		if (trajectory) {
+			rec.record = bsim_trial_trajectory_row;
+			rec.record_user = traj.f;
+		}
+	}
+	int rc = BSIM_OK;
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
+	if (!runner)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for a trial runner");
+	if (rc == BSIM_OK)
+		rc = bsim_trial_run(runner, scene, info->backend, info->opts, info->mixed_seed,
+		                    &rec, res, err);
+	bsim_trial_runner_free(runner);
+	if (rc == BSIM_OK && trajectory)
+		rc = trajectory_commit(&traj, trajectory, err);
+	else
+		bsim_atomic_file_abort(&traj);
+	if (!out)
+		return rc;
+	if (rc == BSIM_OK)
+		rc = run_dir_commit(&dir, info, res, err);
+	else
+		run_dir_abort(&dir);
+	return bsim_session_close(&ss, rc, "run", NULL, err);
+}

@@ -1,0 +1,100 @@
+/* Output directories with their journals; see session.h. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "store/session.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+int bsim_session_path(char *buf, size_t size, const char *dir, const char *name, bsim_error *err)
+{
+	int n = snprintf(buf, size, "%s/%s", dir, name);
+	if (n < 0 || (size_t)n >= size)
+		return bsim_error_set(err, BSIM_EFAIL, "%s/%s: path too long", dir, name);
+	return BSIM_OK;
+}
+
+int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *inputs,
+                      size_t record_size, bsim_error *err)
+{
+	struct stat st;
+	memset(s, 0, sizeof *s);
+	s->dir = dir;
+	if (bsim_outdir_open(&s->od, dir, err) != BSIM_OK)
+		return err->code;
+	s->stage = bsim_outdir_stage(s->od);
+	if (!inputs)
+		return BSIM_OK;
+	int rc = bsim_session_path(s->journal_path, sizeof s->journal_path, bsim_outdir_work(s->od),
+	                           "journal", err);
+	if (rc != BSIM_OK) {
+		bsim_session_close(s, BSIM_EINPUT, NULL, NULL, err);
+		return BSIM_EINPUT;
+	}
+	int have = stat(s->journal_path, &st) == 0;
+	if (resume && !have) {
+		int finished = 0;
+		bsim_error ignore;
+		bsim_outdir_verify(dir, &finished, &ignore);
+		rc = bsim_error_set(err, BSIM_EINPUT, "--resume: %s holds %s", dir,
+		                    finished ? "a finished run, nothing to resume (run without "
+		                               "--resume to replace it)"
+		                             : "no stopped run to resume (run without --resume)");
+	} else if (!resume && have) {
+		rc = bsim_error_set(err, BSIM_EINPUT,
+		                    "%s holds the journal of a stopped run (%s): add --resume to "
+		                    "continue it, or delete the journal to start over",
+		                    dir, s->journal_path);
+	} else if (resume) {
+		rc = bsim_journal_resume(&s->journal, s->journal_path, inputs, record_size, err);
+		if (rc != BSIM_OK) {
+			char msg[sizeof err->msg];
+			snprintf(msg, sizeof msg, "%s", err->msg);
+			bsim_error_set(err, rc, "--resume: %s: %s", dir, msg);
+		}
+	} else {
+		rc = bsim_journal_create(&s->journal, s->journal_path, inputs, record_size, err);
+	}
+	if (rc != BSIM_OK) {
+		/* The refused journal is another run's: it stays. */
+		s->journal_path[0] = '\0';
+		bsim_session_close(s, rc, NULL, NULL, err);
+	}
+	return rc;
+}
+
+int bsim_session_close(bsim_session *s, int rc, const char *command, int *kept, bsim_error *err)
+{
+	bsim_error e;
+	int keep = 0;
+	if (rc == BSIM_OK && s->od) {
+		int crc = s->add ? bsim_outdir_add(s->od, command, &e)
+		                 : bsim_outdir_commit(s->od, command, &e);
+		if (crc != BSIM_OK) {
+			*err = e;
+			rc = BSIM_EFAIL;
+			keep = 1; /* the trials are done: a resumed run writes the files again */
+		}
+	} else if (rc == BSIM_ESTOPPED) {
+		keep = 1;
+	}
+	/* A journal this session did not open (another run's, refused) is never
+	 * touched; this session's is kept only to be resumed. */
+	int ours = s->journal != NULL;
+	if (s->journal && bsim_journal_close(s->journal, &e) != BSIM_OK && rc == BSIM_OK) {
+		*err = e;
+		rc = BSIM_EFAIL;
+	}
+	s->journal = NULL;
+	if (ours && !keep)
+		unlink(s->journal_path);
+	if (kept)
+		*kept = ours && keep;
+	if (rc != BSIM_OK)
+		bsim_outdir_explain(s->od, err->msg, sizeof err->msg);
+	bsim_outdir_close(s->od);
+	s->od = NULL;
+	return rc;
+}

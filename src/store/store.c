@@ -1,0 +1,101 @@
+/* Files every stored run writes alike; see store.h. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "store/store.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/atomic_file.h"
+#include "beamsim/output.h"
+#include "store/matlab.h"
+#include "store/session.h"
+
+int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
+                           const bsim_options *opts, const bsim_override *extra, int n_extra,
+                           const bsim_sweep_result *r, bsim_error *err)
+{
+	char summary[1100], trials[1100], traj[1100], traj_mat[1100];
+	if (bsim_session_path(summary, sizeof summary, dir, "summary.json", err) ||
+	    bsim_session_path(trials, sizeof trials, dir, "trials.csv", err) ||
+	    bsim_session_path(traj, sizeof traj, dir, "trajectories.csv", err) ||
+	    bsim_session_path(traj_mat, sizeof traj_mat, dir, "trajectories.mat", err))
+		return BSIM_EFAIL;
+	if (r->keep == 0) {
+		remove(traj);
+		remove(traj_mat);
+	}
+	if (bsim_output_mkdir(dir, err) != BSIM_OK ||
+	    bsim_output_summary_json(summary, e, b->name, opts, r, err) != BSIM_OK ||
+	    bsim_output_trials_csv(trials, e, r, err) != BSIM_OK ||
+	    bsim_output_lattice(dir, e, extra, n_extra, r, err) != BSIM_OK ||
+	    bsim_output_trajectories_csv(traj, r, err) != BSIM_OK ||
+	    bsim_matlab_sweep(dir, e, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	return BSIM_OK;
+}
+
+int bsim_store_twin(const char *dir, const char *file, const char *var, bsim_error *err)
+{
+	char path[1100], mat[1100];
+	if (bsim_session_path(path, sizeof path, dir, file, err))
+		return BSIM_EFAIL;
+	int rc = bsim_matlab_path(path, mat, sizeof mat, err);
+	if (rc == BSIM_OK)
+		rc = strstr(file, ".json") ? bsim_matlab_from_json(path, mat, var, err)
+		                           : bsim_matlab_from_csv(path, mat, var, err);
+	return rc;
+}
+
+int bsim_store_text(const char *dir, const char *name, const char *head, bsim_store_text_fn fn,
+                    const void *arg, bsim_error *err)
+{
+	char path[1100];
+	bsim_atomic_file o;
+	if (bsim_session_path(path, sizeof path, dir, name, err) ||
+	    bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (head)
+		fputs(head, o.f);
+	fn(o.f, arg);
+	return bsim_atomic_file_commit(&o, err);
+}
+
+long bsim_store_unstable(const bsim_experiment *e, const bsim_override *extra, int n_extra,
+                         const bsim_sweep_result *r, long *first, char *why, size_t size)
+{
+	long count = 0;
+	*first = -1;
+	if (size > 0)
+		why[0] = '\0';
+	for (long i = 0; i < (long)r->n_groups * r->trials; i++)
+		if (r->trials_out[i].outcome == BSIM_UNSTABLE) {
+			count++;
+			*first = *first < 0 ? i : *first;
+		}
+	bsim_scene scene;
+	bsim_error err;
+	if (count > 0 && bsim_experiment_group_scene(e, (int)(*first / r->trials), extra, n_extra,
+	                                             &scene, &err) == BSIM_OK) {
+		bsim_trial_instability_text(&r->trials_out[*first], scene.dt, why, size);
+		bsim_scene_free(&scene);
+	}
+	return count;
+}
+
+int bsim_store_experiment(const char *path, const bsim_override *sets, int n_sets, long trials,
+                          bsim_experiment *e, bsim_error *err)
+{
+	int rc = bsim_experiment_load(path, sets, n_sets, e, err);
+	if (rc != BSIM_OK)
+		return rc ? rc : BSIM_EINPUT;
+	if (trials > 0 && bsim_experiment_check_trials(e, trials, err) != BSIM_OK) {
+		char msg[sizeof err->msg];
+		snprintf(msg, sizeof msg, "%s", err->msg);
+		bsim_experiment_free(e);
+		return bsim_error_set(err, BSIM_EINPUT, "--trials %ld: %s", trials, msg);
+	}
+	if (trials > 0)
+		e->trials = (int)trials;
+	return BSIM_OK;
+}

@@ -1,0 +1,192 @@
+/* A sweep stored in an output directory; see beamsim/sweep_dir.h.
+ *
+ * The order is what makes the directory trustworthy: the inputs are
+ * loaded and DIR is opened (with its journal) before any trial runs, so a
+ * bad file or an unusable DIR fails at once, not after hours; the files
+ * are written into the staging area and committed as one set last. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "beamsim/sweep_dir.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/compare_dir.h"
+#include "beamsim/effects.h"
+#include "beamsim/output.h"
+#include "beamsim/run_record.h"
+#include "store/session.h"
+#include "store/store.h"
+
+bsim_sweep_dir_def bsim_sweep_dir_default(void)
+{
+	bsim_sweep_dir_def d;
+	memset(&d, 0, sizeof d);
+	d.backend = &bsim_backend_thesis;
+	return d;
+}
+
+void bsim_sweep_dir_result_free(bsim_sweep_dir_result *res)
+{
+	bsim_sweep_result_free(&res->r);
+	bsim_experiment_free(&res->e);
+}
+
+/* res->journal names the journal if the session kept it. */
+static int session_end(bsim_session *ss, int rc, const char *command, char *journal, size_t size,
+                       bsim_error *err)
+{
+	int kept = 0;
+	rc = bsim_session_close(ss, rc, command, &kept, err);
+	if (kept)
+		snprintf(journal, size, "%s", ss->journal_path);
+	return rc;
+}
+
+int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err)
+{
+	memset(res, 0, sizeof *res);
+	res->first_unstable = -1;
+	const bsim_backend *b = def->backend ? def->backend : &bsim_backend_thesis;
+	if (bsim_options_check(&def->opts, b->knobs, b->n_knobs, b->name, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	bsim_experiment *e = &res->e;
+	int rc =
+	        bsim_store_experiment(def->experiment, def->sets, def->n_sets, def->trials, e, err);
+	if (rc != BSIM_OK)
+		return rc;
+	if (def->has_seed)
+		e->seed = def->seed;
+	bsim_run_record rec;
+	const bsim_options *opts = &def->opts;
+	bsim_run_record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL);
+	char *inputs = bsim_run_record_inputs(&rec, e, def->sets, def->n_sets, err);
+	/* The overlap adds a column to every trial: a run measured so continues so. */
+	if (inputs && def->overlap) {
+		char *more = realloc(inputs, strlen(inputs) + sizeof "measure_overlap 1\n");
+		if (more)
+			strcat(more, "measure_overlap 1\n");
+		else
+			free(inputs);
+		inputs = more;
+		if (!inputs)
+			bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	bsim_session ss;
+	rc = inputs ? bsim_session_open(&ss, def->out, def->resume, inputs,
+	                                bsim_sweep_record_size(0), err)
+	            : err->code;
+	free(inputs);
+	if (rc != BSIM_OK) {
+		bsim_experiment_free(e);
+		return rc;
+	}
+	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
+	bsim_sweep_config cfg = {
+	        .backend = b,
+	        .opts = &def->opts,
+	        .threads = res->threads,
+	        .extra = def->sets,
+	        .n_extra = def->n_sets,
+	        .progress = def->progress,
+	        .progress_user = def->progress_user,
+	        .measure_overlap = def->overlap,
+	        .keep = def->keep,
+	        .keep_stride = def->keep_stride,
+	        .journal = ss.journal,
+	        .stop = def->stop,
+	};
+	rc = bsim_sweep_run(e, &cfg, &res->r, err);
+	if (rc == BSIM_OK) {
+		rc = bsim_store_sweep_files(ss.stage, e, b, &def->opts, def->sets, def->n_sets,
+		                            &res->r, err);
+		if (rc == BSIM_OK)
+			rc = bsim_run_record_write(ss.stage, &rec, e, def->sets, def->n_sets, err);
+	}
+	rc = session_end(&ss, rc, "sweep", res->journal, sizeof res->journal, err);
+	if (rc != BSIM_OK) {
+		bsim_sweep_dir_result_free(res);
+		return rc;
+	}
+	res->unstable =
+	        bsim_store_unstable(e, def->sets, def->n_sets, &res->r, &res->first_unstable,
+	                            res->unstable_why, sizeof res->unstable_why);
+	return BSIM_OK;
+}
+
+int bsim_store_sweep_rerun(const bsim_sweep_dir_def *def, const bsim_experiment *e,
+                           const char *stage, bsim_sweep_result *r, bsim_error *err)
+{
+	const bsim_backend *b = def->backend ? def->backend : &bsim_backend_thesis;
+	bsim_sweep_config cfg = {
+	        .backend = b,
+	        .opts = &def->opts,
+	        .threads = def->threads > 0 ? def->threads : omp_get_max_threads(),
+	        .progress = def->progress,
+	        .progress_user = def->progress_user,
+	};
+	int rc = bsim_sweep_run(e, &cfg, r, err);
+	if (rc != BSIM_OK)
+		return rc;
+	bsim_run_record rec;
+	const bsim_options *opts = &def->opts;
+	bsim_run_record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL);
+	rc = bsim_store_sweep_files(stage, e, b, &def->opts, NULL, 0, r, err);
+	if (rc == BSIM_OK)
+		rc = bsim_run_record_write(stage, &rec, e, NULL, 0, err);
+	if (rc != BSIM_OK)
+		bsim_sweep_result_free(r);
+	return rc;
+}
+
+int bsim_sweep_dir_read(const char *dir, const char *side, bsim_sweep_dir_result *res,
+                        bsim_error *err)
+{
+	bsim_run_record rec;
+	char path[1200], sub[1100];
+	int has_manifest = 0;
+	memset(res, 0, sizeof *res);
+	res->first_unstable = -1;
+	if (bsim_outdir_verify(dir, &has_manifest, err) != BSIM_OK ||
+	    bsim_run_record_read(dir, &rec, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	if (bsim_session_path(path, sizeof path, dir, "inputs/experiment.yaml", err))
+		return BSIM_EINPUT;
+	int rc = bsim_store_experiment(path, NULL, 0, rec.trials, &res->e, err);
+	if (rc != BSIM_OK)
+		return rc;
+	res->e.seed = rec.seed;
+	const char *from = dir;
+	if (side) {
+		char name[128];
+		bsim_compare_dir_label(side, name, sizeof name);
+		if (bsim_session_path(sub, sizeof sub, dir, name, err)) {
+			bsim_experiment_free(&res->e);
+			return BSIM_EINPUT;
+		}
+		from = sub;
+	}
+	if (bsim_session_path(path, sizeof path, from, "trials.csv", err) ||
+	    (rc = bsim_output_trials_read(path, res->e.n_groups, res->e.trials, &res->r, err)) !=
+	            BSIM_OK) {
+		bsim_experiment_free(&res->e);
+		return rc ? rc : BSIM_EINPUT;
+	}
+	/* The groups without random draws, from their scenes: each is one
+	 * trial, compared as one pair (beamsim/compare.h). With --protocols
+	 * the sides' scenes differ only in the lattice protocol, which does
+	 * not draw. */
+	for (int g = 0; g < res->e.n_groups; g++) {
+		bsim_scene s;
+		if ((rc = bsim_experiment_group_scene(&res->e, g, NULL, 0, &s, err)) != BSIM_OK) {
+			bsim_sweep_dir_result_free(res);
+			return rc;
+		}
+		res->r.groups[g].deterministic = !bsim_effects_random(&s);
+		bsim_scene_free(&s);
+	}
+	res->unstable = bsim_store_unstable(&res->e, NULL, 0, &res->r, &res->first_unstable,
+	                                    res->unstable_why, sizeof res->unstable_why);
+	return BSIM_OK;
+}

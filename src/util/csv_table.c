@@ -1,0 +1,189 @@
+/* CSV tables read by header name (csv_table.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "util/csv_table.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The whole file as one NUL-terminated string. */
+static char *slurp(const char *path, size_t *len)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	size_t cap = 1 << 16, n = 0;
+	char *buf = malloc(cap);
+	while (buf) {
+		if (n + 1 >= cap) {
+			char *b = realloc(buf, cap * 2);
+			if (!b) {
+				free(buf);
+				buf = NULL;
+				break;
+			}
+			buf = b;
+			cap *= 2;
+		}
+		size_t k = fread(buf + n, 1, cap - n - 1, f);
+		n += k;
+		if (k == 0)
+			break;
+	}
+	int bad = ferror(f);
+	fclose(f);
+	if (!buf || bad) {
+		free(buf);
+		return NULL;
+	}
+	buf[n] = '\0';
+	*len = n;
+	return buf;
+}
+
+/* Splits line in place at commas into out (at most max fields); the
+ * number of fields found (may exceed max). */
+static int split(char *line, char **out, int max)
+{
+	int n = 0;
+	for (char *p = line;; p++) {
+		char *c = strchr(p, ',');
+		if (n < max)
+			out[n] = p;
+		n++;
+		if (!c)
+			break;
+		*c = '\0';
+		p = c;
+	}
+	return n;
+}
+
+static int count_fields(const char *line)
+{
+	int n = 1;
+	for (; *line; line++)
+		n += *line == ',';
+	return n;
+}
+
+void csv_table_free(csv_table *t)
+{
+	free(t->names);
+	free(t->cells);
+	free(t->text);
+	memset(t, 0, sizeof *t);
+}
+
+int csv_table_read(const char *path, csv_table *t, bsim_error *err)
+{
+	memset(t, 0, sizeof *t);
+	size_t len;
+	t->text = slurp(path, &len);
+	if (!t->text)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file (%s)", path,
+		                      strerror(errno ? errno : EIO));
+	/* Lines, in place: strip \r\n, skip a last empty line. */
+	long n_lines = 0;
+	for (size_t i = 0; i < len; i++)
+		n_lines += t->text[i] == '\n';
+	n_lines += len > 0 && t->text[len - 1] != '\n';
+	if (n_lines < 1) {
+		csv_table_free(t);
+		return bsim_error_set(err, BSIM_EINPUT, "%s:1: expected a header line", path);
+	}
+	char **lines = malloc((size_t)n_lines * sizeof *lines);
+	if (!lines) {
+		csv_table_free(t);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
+	}
+	long k = 0;
+	for (char *p = t->text; *p && k < n_lines;) {
+		char *nl = strchr(p, '\n');
+		lines[k++] = p;
+		if (nl)
+			*nl = '\0';
+		size_t l = strlen(p);
+		if (l && p[l - 1] == '\r')
+			p[l - 1] = '\0';
+		if (!nl)
+			break;
+		p = nl + 1;
+	}
+	n_lines = k;
+	t->n_cols = count_fields(lines[0]);
+	t->n_rows = n_lines - 1;
+	t->names = malloc((size_t)t->n_cols * sizeof *t->names);
+	t->cells = malloc(((size_t)t->n_rows * t->n_cols + 1) * sizeof *t->cells);
+	if (!t->names || !t->cells) {
+		free(lines);
+		csv_table_free(t);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
+	}
+	split(lines[0], t->names, t->n_cols);
+	for (long r = 0; r < t->n_rows; r++) {
+		int got = split(lines[r + 1], t->cells + (size_t)r * t->n_cols, t->n_cols);
+		if (got != t->n_cols) {
+			int cols = t->n_cols;
+			free(lines);
+			csv_table_free(t);
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "%s:%ld: expected %d fields, got %d", path, r + 2,
+			                      cols, got);
+		}
+	}
+	free(lines);
+	return BSIM_OK;
+}
+
+int csv_table_col(const csv_table *t, const char *name)
+{
+	for (int c = 0; c < t->n_cols; c++)
+		if (strcmp(t->names[c], name) == 0)
+			return c;
+	return -1;
+}
+
+const char *csv_table_cell(const csv_table *t, long row, int col)
+{
+	return t->cells[(size_t)row * t->n_cols + col];
+}
+
+int csv_table_number(const csv_table *t, long row, int col, double *out)
+{
+	const char *s = csv_table_cell(t, row, col);
+	char *end;
+	if (!*s)
+		return -1;
+	*out = strtod(s, &end); /* an underflow to 0 or subnormal is still that number */
+	return *end == '\0' ? 0 : -1;
+}
+
+int csv_table_numbers(const csv_table *t, const char *path, int col, int allow_empty,
+                      double empty_value, double *out, bsim_error *err)
+{
+	for (long r = 0; r < t->n_rows; r++) {
+		if (allow_empty && !*csv_table_cell(t, r, col)) {
+			out[r] = empty_value;
+			continue;
+		}
+		if (csv_table_number(t, r, col, &out[r]) != 0)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "%s:%ld: %s: expected a number, got '%s'", path,
+			                      r + 2, t->names[col], csv_table_cell(t, r, col));
+	}
+	return BSIM_OK;
+}
+
+int csv_table_require(const csv_table *t, const char *path, const char *const *names, int n,
+                      int *cols, bsim_error *err)
+{
+	for (int i = 0; i < n; i++) {
+		cols[i] = csv_table_col(t, names[i]);
+		if (cols[i] < 0)
+			return bsim_error_set(err, BSIM_EINPUT, "%s:1: expected a column '%s'",
+			                      path, names[i]);
+	}
+	return BSIM_OK;
+}

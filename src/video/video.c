@@ -1,0 +1,186 @@
+/* A video of one trial: panels, frame count, the stiffness scale, and the
+ * loop that renders every frame and feeds it to the encoder pipe
+ * (beamsim/video.h). Frame k of a track is its state at time k / fps
+ * (video_track.c); after a track's last frame its panel shows that frame,
+ * and after the longest track's last frame the video holds it for `hold`
+ * seconds. */
+#include "beamsim/video.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cairo.h>
+
+#include "video/video_internal.h"
+
+bsim_video_def bsim_video_def_default(void)
+{
+	bsim_video_def d = {
+	        .width = 0,
+	        .height = 0,
+	        .fps = 30.0,
+	        .hold = 1.0,
+	        .view_span = 200.0,
+	        .crf = 23,
+	        .ffmpeg = "ffmpeg",
+	};
+	return d;
+}
+
+int bsim_video_def_check(const bsim_video_def *d, bsim_error *err)
+{
+	if (!(d->fps > 0.0) || !isfinite(d->fps) || d->fps > 1000.0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "fps: expected a number in (0, 1000], got %g", d->fps);
+	if (!(d->hold >= 0.0) || d->hold > 60.0)
+		return bsim_error_set(err, BSIM_EINPUT, "hold: expected 0 to 60 s, got %g",
+		                      d->hold);
+	if (!(d->view_span > 0.0) || !isfinite(d->view_span))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "view_span: expected a positive number of metres, got %g",
+		                      d->view_span);
+	if (d->crf < 0 || d->crf > 51)
+		return bsim_error_set(err, BSIM_EINPUT, "crf: expected 0 to 51, got %d", d->crf);
+	if (d->width == 0 && d->height == 0)
+		return BSIM_OK;
+	if (d->width < 64 || d->height < 64 || d->width > 7680 || d->height > 4320 ||
+	    d->width % 2 || d->height % 2)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "size %dx%d: expected even width and height, 64x64 to "
+		                      "7680x4320 (H.264 in yuv420p halves the colour planes)",
+		                      d->width, d->height);
+	return BSIM_OK;
+}
+
+int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
+                     const bsim_video_track *const *tracks, const char *const *labels, int n_panels,
+                     bsim_video **out, bsim_error *err)
+{
+	*out = NULL;
+	int rc = bsim_video_def_check(def, err);
+	if (rc != BSIM_OK)
+		return rc;
+	if (n_panels < 1 || n_panels > BSIM_VIDEO_PANELS_MAX)
+		return bsim_error_set(err, BSIM_EINPUT, "a video has 1 to %d panels, not %d",
+		                      BSIM_VIDEO_PANELS_MAX, n_panels);
+	const int width = def->width ? def->width : 540 * n_panels;
+	const int height = def->height ? def->height : 540;
+	if (width / n_panels < 32)
+		return bsim_error_set(err, BSIM_EINPUT, "size %dx%d: too narrow for %d panels",
+		                      width, height, n_panels);
+	bsim_video *v = calloc(1, sizeof *v);
+	if (!v)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
+	v->def = *def;
+	if (!v->def.ffmpeg)
+		v->def.ffmpeg = "ffmpeg";
+	v->width = width;
+	v->height = height;
+	v->n_panels = n_panels;
+	v->scene = scene;
+	for (int p = 0; p < n_panels; p++) {
+		v->tracks[p] = tracks[p];
+		v->labels[p] = labels ? labels[p] : NULL;
+		long f = bsim_video_track_frames(tracks[p]);
+		if (f > v->frames_sim)
+			v->frames_sim = f;
+	}
+	v->frames = v->frames_sim + lround(v->def.hold * v->def.fps);
+	/* Side by side, each panel parts from the first; the first from the
+	 * second. 1% of the body radius, as beamsim compare measures it. */
+	const double sep = 0.01 * scene->body.radius;
+	for (int p = 0; p < n_panels; p++) {
+		int q = p == 0 ? 1 : 0;
+		v->t_part[p] = -1.0;
+		if (n_panels < 2)
+			continue;
+		v->t_part[p] = bsim_video_track_separation(tracks[p], tracks[q], sep);
+		v->part_from[p] = v->labels[q] ? v->labels[q] : "the other";
+	}
+	if (scene->has_lattice) {
+		v->entered = calloc((size_t)(scene->lattice.columns * scene->lattice.rows), 1);
+		if (!v->entered) {
+			free(v);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
+		}
+	}
+	video_field_bounds(scene, v->field);
+	v->k_min = scene->n_beams ? scene->beams[0].stiffness : 0.0;
+	v->k_max = v->k_min;
+	for (int i = 1; i < scene->n_beams; i++) {
+		v->k_min = fmin(v->k_min, scene->beams[i].stiffness);
+		v->k_max = fmax(v->k_max, scene->beams[i].stiffness);
+	}
+	*out = v;
+	return BSIM_OK;
+}
+
+void bsim_video_free(bsim_video *v)
+{
+	if (!v)
+		return;
+	if (v->cr)
+		cairo_destroy(v->cr);
+	if (v->surface)
+		cairo_surface_destroy(v->surface);
+	free(v->entered);
+	free(v);
+}
+
+long bsim_video_frames(const bsim_video *v)
+{
+	return v->frames;
+}
+
+void bsim_video_size(const bsim_video *v, int *width, int *height)
+{
+	*width = v->width;
+	*height = v->height;
+}
+
+int bsim_video_render(bsim_video *v, long k, uint32_t *pixels, bsim_error *err)
+{
+	if (k < 0 || k >= v->frames)
+		return bsim_error_set(err, BSIM_EINPUT, "frame %ld: the video has frames 0 to %ld",
+		                      k, v->frames - 1);
+	/* The hold repeats the last simulated frame. */
+	int rc = video_render_frame(v, k < v->frames_sim ? k : v->frames_sim - 1, err);
+	if (rc != BSIM_OK)
+		return rc;
+	cairo_surface_t *sf = v->surface;
+	const unsigned char *data = cairo_image_surface_get_data(sf);
+	const int stride = cairo_image_surface_get_stride(sf);
+	for (int y = 0; y < v->height; y++) {
+		const uint32_t *row = (const uint32_t *)(const void *)(data + (size_t)y * stride);
+		uint32_t *dst = pixels + (size_t)y * (size_t)v->width;
+		for (int x = 0; x < v->width; x++)
+			dst[x] = row[x] & 0xFFFFFFu;
+	}
+	return BSIM_OK;
+}
+
+int bsim_video_write(bsim_video *v, const char *path, bsim_error *err)
+{
+	uint32_t *pixels = malloc((size_t)v->width * (size_t)v->height * sizeof *pixels);
+	if (!pixels)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a %d x %d frame",
+		                      v->width, v->height);
+	bsim_video_encoder *enc = NULL;
+	int rc = bsim_video_encoder_open(path, v->def.ffmpeg, v->width, v->height, v->def.fps,
+	                                 v->def.crf, &enc, err);
+	for (long k = 0; rc == BSIM_OK && k < v->frames; k++) {
+		/* Held frames are the same picture: draw it once. */
+		if (k <= v->frames_sim)
+			rc = bsim_video_render(v, k, pixels, err);
+		if (rc == BSIM_OK)
+			rc = bsim_video_encoder_write(enc, pixels, err);
+	}
+	if (rc == BSIM_OK) {
+		rc = bsim_video_encoder_close(enc, err);
+	} else {
+		bsim_video_encoder_abort(enc);
+	}
+	free(pixels);
+	return rc;
+}
