@@ -5,6 +5,8 @@
 
 #include "beamsim/markov.h"
 
+#include "model/lattice_crossing.h"
+
 #include <errno.h>
 #include <limits.h>
 #include <gsl/gsl_rng.h>
@@ -324,13 +326,6 @@ static void gate_scene_init(gate_scene *g, const bsim_scene *lattice, const doub
 	g->s.body.start[1] -= l->depth * iy;
 }
 
-/* Where the straight path p0 -> p1 crosses coordinate `at` along axis, as
- * a fraction of the step (2: it does not). */
-static double crossing(const double p0[2], const double p1[2], int axis, double at)
-{
-	double d = p1[axis] - p0[axis];
-	return d != 0.0 ? (at - p0[axis]) / d : 2.0;
-}
 
 /* The exit of a step from p0 inside the gate to s->x outside it: the entry
  * bin of the gate it enters (the boundary crossed first). */
@@ -338,20 +333,20 @@ static int exit_bin(const bsim_markov_bins *b, const bsim_lattice_def *l, const 
                     const bsim_state *s)
 {
 	const double *p1 = s->x, w2 = 0.5 * l->width, d = l->depth;
-	double fx = 2.0, fy = 2.0;
+	double fx = LATTICE_NO_CROSSING, fy = LATTICE_NO_CROSSING;
 	int ex = 0, ey = 0;
 	if (p1[0] < -w2) {
-		fx = crossing(p0, p1, 0, -w2);
+		fx = lattice_crossing(p0, p1, 0, -w2);
 		ex = BSIM_EDGE_RIGHT; /* into the gate on the left, through its right edge */
 	} else if (p1[0] >= w2) {
-		fx = crossing(p0, p1, 0, w2);
+		fx = lattice_crossing(p0, p1, 0, w2);
 		ex = BSIM_EDGE_LEFT;
 	}
 	if (p1[1] < 0.0) {
-		fy = crossing(p0, p1, 1, 0.0);
+		fy = lattice_crossing(p0, p1, 1, 0.0);
 		ey = BSIM_EDGE_TOP;
 	} else if (p1[1] >= d) {
-		fy = crossing(p0, p1, 1, d);
+		fy = lattice_crossing(p0, p1, 1, d);
 		ey = BSIM_EDGE_BOTTOM;
 	}
 	if (ex && (!ey || fx <= fy))

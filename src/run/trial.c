@@ -24,6 +24,7 @@
 #include "beamsim/effects.h"
 #include "beamsim/landscape.h"
 #include "beamsim/lattice.h"
+#include "model/lattice_crossing.h"
 #include "util/fminmax.h"
 #include "run/trial_essay.h"
 
@@ -491,14 +492,6 @@ static void entry_fill(bsim_gate_entry *e, const bsim_scene *scene, const int *m
 	}
 }
 
-/* Where the straight path p0 -> p1 crosses x = bx (axis 0) or y = by (axis
- * 1), as a fraction of the step. */
-static double crossing(const double p0[2], const double p1[2], int axis, double at)
-{
-	double d = p1[axis] - p0[axis];
-	return d != 0.0 ? (at - p0[axis]) / d : 0.0;
-}
-
 /* The gates the body entered in a step that took it from gate (g->ix,
  * g->iy) at p0 to gate (ix, iy) at p1: one, or two when it cut a corner
  * (the first boundary crossed first). Each goes to e[]; returns how many. */
@@ -510,8 +503,8 @@ static int entries_of_step(const bsim_scene *scene, const int *map, const gate_t
 	const double *p1 = s->x;
 	double bx = l->width * (ix > g->ix ? ix : g->ix) - 0.5 * l->width;
 	double by = l->depth * (iy > g->iy ? iy : g->iy);
-	double fx = ix != g->ix ? crossing(p0, p1, 0, bx) : 2.0;
-	double fy = iy != g->iy ? crossing(p0, p1, 1, by) : 2.0;
+	double fx = ix != g->ix ? lattice_crossing(p0, p1, 0, bx) : LATTICE_NO_CROSSING;
+	double fy = iy != g->iy ? lattice_crossing(p0, p1, 1, by) : LATTICE_NO_CROSSING;
 	bsim_edge ex = ix > g->ix ? BSIM_EDGE_LEFT : BSIM_EDGE_RIGHT;
 	bsim_edge ey = iy > g->iy ? BSIM_EDGE_BOTTOM : BSIM_EDGE_TOP;
 	/* the crossing point, along the edge, in the entered gate's frame */
