@@ -27,7 +27,7 @@
 #include <sys/stat.h>
 
 #include "util/figure.h"
-#include "figures/figures_internal.h"
+#include "figures/figures_paths.h"
 #include "support.h"
 
 /* ---- helpers --------------------------------------------------------------------- */

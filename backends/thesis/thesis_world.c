@@ -171,18 +171,6 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	return BSIM_OK;
 }
 
-/* Beams at rest have omega = 0 and add nothing: the awake ones, in
- * ascending order, give the sum over all beams to the bit. */
-double thesis_kinetic_energy(const bsim_world *w)
-{
-	double e = 0.5 * w->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);
-	for (int k = 0; k < w->n_awake; k++) {
-		const thesis_beam *b = &w->beams[w->awake[k]];
-		e += 0.5 * b->inertia * b->omega * b->omega;
-	}
-	return e;
-}
-
 /* contact_mode=essay: the beams held after this step's solve (touching at
  * its start and pressed by it); 1 if any is. */
 static int essay_hold(bsim_world *w)

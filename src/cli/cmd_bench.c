@@ -17,9 +17,9 @@
 #include "util/json.h"
 #include "beamsim/output.h"
 #include "beamsim/sweep.h"
-#include "bench/bench_clock.h"
-#include "bench/bench_free.h"
-#include "bench/bench_lattice.h"
+#include "cli/bench_clock.h"
+#include "cli/bench_free.h"
+#include "cli/bench_lattice.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 

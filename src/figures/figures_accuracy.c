@@ -10,7 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "figures/figures_internal.h"
+#include "figures/figures_kinds.h"
+#include "figures/figures_toolkit.h"
+#include "util/csv_table.h"
 
 static const char *const palette[] = {FIG_BLUE, FIG_RED,    FIG_GREEN, FIG_ORANGE,
                                       FIG_SKY,  FIG_PURPLE, FIG_BLACK, "#8C6D31"};

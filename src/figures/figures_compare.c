@@ -10,7 +10,10 @@
 #include <string.h>
 
 #include "beamsim/output.h"
-#include "figures/figures_internal.h"
+#include "figures/figures_kinds.h"
+#include "figures/figures_lattice.h"
+#include "figures/figures_summary.h"
+#include "figures/figures_toolkit.h"
 #include "util/yaml_doc.h"
 
 static double num(struct fy_node *root, const char *path, int *bad)

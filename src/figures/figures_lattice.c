@@ -37,7 +37,10 @@
 #include "beamsim/experiment.h"
 #include "beamsim/lattice.h"
 #include "beamsim/stats.h"
-#include "figures/figures_internal.h"
+#include "figures/figures_lattice.h"
+#include "figures/figures_summary.h"
+#include "figures/figures_toolkit.h"
+#include "util/csv_table.h"
 
 /* ---- the data of a lattice run -------------------------------------------------------- */
 

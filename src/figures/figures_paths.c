@@ -18,7 +18,9 @@
 #include <string.h>
 
 #include "beamsim/landscape.h"
-#include "figures/figures_internal.h"
+#include "figures/figures_paths.h"
+#include "figures/figures_toolkit.h"
+#include "util/csv_table.h"
 
 static const struct {
 	const char *name, *color;

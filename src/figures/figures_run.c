@@ -13,7 +13,10 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "figures/figures_internal.h"
+#include "figures/figures_kinds.h"
+#include "figures/figures_paths.h"
+#include "figures/figures_toolkit.h"
+#include "util/csv_table.h"
 #include "util/yaml_doc.h"
 
 /* The scene of the run: inputs/scene.yaml with run.json's "set"

@@ -1,4 +1,4 @@
-/* A sweep's summary.json read for its figures (figures_internal.h): the
+/* A sweep's summary.json read for its figures (figures_summary.h): the
  * groups' counts, p_traverse and interval, and the grid axes rebuilt from
  * the groups' params, the first axis varying slowest, the values in the
  * order they first appear. */
@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "figures/figures_internal.h"
+#include "figures/figures_summary.h"
 #include "util/yaml_doc.h"
 
 static int text_number(const char *s, double *x)

@@ -18,7 +18,12 @@
 #include "beamsim/experiment.h"
 #include "store/mat.h"
 #include "beamsim/stats.h"
-#include "figures/figures_internal.h"
+#include "figures/figures_kinds.h"
+#include "figures/figures_lattice.h"
+#include "figures/figures_paths.h"
+#include "figures/figures_summary.h"
+#include "figures/figures_toolkit.h"
+#include "util/csv_table.h"
 
 /* Positions of the selected values of each axis (-1: not selected) and
  * their number. */

@@ -80,9 +80,12 @@ typedef struct scene_walk {
 int scene_walk_table(scene_walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
                      char *base, const char *prefix);
 
-/* The lattice: block (scene_lattice.c): its keys, maps and CSV file, then
- * the beams built from it. */
-int scene_walk_lattice(scene_walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key);
+/* The lattice: block (scene_lattice.c). The loader walks its keys
+ * (scene_lattice_table) between the two calls: begin sets the gate's
+ * defaults, finish checks the ranges, reads the stiffness maps and CSV file
+ * and builds the beams. */
+void scene_lattice_begin(bsim_scene *s);
+int scene_lattice_finish(scene_walk *w, struct fy_node *n, struct fy_node *key);
 extern const scene_table scene_lattice_table;
 
 /* The termination defaults of a lattice (lattice.c): success_y = depth

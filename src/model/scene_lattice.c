@@ -315,22 +315,21 @@ static int lattice_maps_read(scene_walk *w, struct fy_node *map, lattice_maps *m
 	return BSIM_OK;
 }
 
-int scene_walk_lattice(scene_walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key)
+void scene_lattice_begin(bsim_scene *s)
 {
-	bsim_scene *s = w->s;
 	bsim_lattice_def *l = &s->lattice;
-	if (!n || !fy_node_is_mapping(n))
-		return ydoc_expected(w->d, n, key, "lattice",
-		                     "a mapping (columns, rows, gate, beam, stiffness, ...)",
-		                     w->err);
 	memset(l, 0, sizeof *l);
 	l->width = 50;   /* m, MODEL.md section 8 */
 	l->depth = 60;   /* m */
 	l->pivot_y = 30; /* m */
 	l->beam.inertia = NAN;
-	int rc = scene_walk_table(w, f->sub, n, key, (char *)s, "lattice.");
-	if (!rc)
-		rc = lattice_range(w, n, key);
+}
+
+int scene_lattice_finish(scene_walk *w, struct fy_node *n, struct fy_node *key)
+{
+	bsim_scene *s = w->s;
+	bsim_lattice_def *l = &s->lattice;
+	int rc = lattice_range(w, n, key);
 	if (rc)
 		return rc;
 	if (isnan(l->beam.inertia))

@@ -121,6 +121,19 @@ static int walk_block(walk *w, const scene_field *f, struct fy_node *n, struct f
 	return walk_table(w, f->sub, ydoc_is_null(n) ? NULL : n, key, base, prefix);
 }
 
+/* The lattice: block: its keys as a table, between the lattice module's
+ * defaults and its checks and beams (scene_lattice.c). */
+static int walk_lattice(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key)
+{
+	if (!n || !fy_node_is_mapping(n))
+		return ydoc_expected(w->d, n, key, "lattice",
+		                     "a mapping (columns, rows, gate, beam, stiffness, ...)",
+		                     w->err);
+	scene_lattice_begin(w->s);
+	int rc = walk_table(w, f->sub, n, key, (char *)w->s, "lattice.");
+	return rc ? rc : scene_lattice_finish(w, n, key);
+}
+
 static int walk_field(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
                       char *base, const char *field)
 {
@@ -140,7 +153,7 @@ static int walk_field(walk *w, const scene_field *f, struct fy_node *n, struct f
 	case SK_INDEX:
 		return walk_int(w, f, n, key, field, (int *)(base + f->offset));
 	case SK_LATTICE:
-		return scene_walk_lattice(w, f, n, key);
+		return walk_lattice(w, f, n, key);
 	case SK_LATER:
 		return BSIM_OK;
 	}

@@ -1,0 +1,16 @@
+/* The figures of each kind of directory, as the dispatcher (figures.c)
+ * calls them: figures_sweep.c, figures_compare.c, figures_run.c,
+ * figures_accuracy.c. */
+#ifndef BSIM_FIGURES_FIGURES_KINDS_H
+#define BSIM_FIGURES_FIGURES_KINDS_H
+
+#include "figures/figures_toolkit.h"
+
+/* inputs: the directory holding experiment.yaml and scene.yaml of the run
+ * (DIR/inputs, or the comparison's for one of its backends). */
+int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err);
+int figs_compare(figs *f, const char *dir, bsim_error *err);
+int figs_run(figs *f, const char *dir, bsim_error *err);
+int figs_accuracy(figs *f, const char *dir, bsim_error *err);
+
+#endif
