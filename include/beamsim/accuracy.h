@@ -14,8 +14,8 @@
  * p_traverse (against the reference setting's, same seeds), the energy
  * ledger residual per simulated second (sum |r| / sum t, J/s) and the cost
  * (wall seconds per simulated second). All times in s, lengths in m. */
-#ifndef BEAMSIM_ACCURACY_H
-#define BEAMSIM_ACCURACY_H
+#ifndef BSIM_ACCURACY_H
+#define BSIM_ACCURACY_H
 
 #include <stdint.h>
 #include <stdio.h>

@@ -4,8 +4,8 @@
  * integration; nothing else. The runner owns time, the external force on the
  * body, termination and recording, so that every backend runs the same
  * scenes with the same random-force schedules. */
-#ifndef BEAMSIM_BACKEND_H
-#define BEAMSIM_BACKEND_H
+#ifndef BSIM_BACKEND_H
+#define BSIM_BACKEND_H
 
 #include "beamsim/error.h"
 #include "beamsim/options.h"

@@ -2,8 +2,8 @@
  * schedules (beamsim compare) or a stored sweep and its rerun (beamsim
  * regress). Trial t of group g in one is the pair of trial t of group g in
  * the other, so every test here is a paired one. */
-#ifndef BEAMSIM_COMPARE_H
-#define BEAMSIM_COMPARE_H
+#ifndef BSIM_COMPARE_H
+#define BSIM_COMPARE_H
 
 #include <stdint.h>
 

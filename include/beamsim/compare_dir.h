@@ -11,8 +11,8 @@
  * command line ("thesis", "box2d:spring=torque:substeps=4"); that text is
  * its label. Or, on a gate lattice, the two sides are one backend under two
  * lattice protocols (protocol), and the protocols label them. */
-#ifndef BEAMSIM_COMPARE_DIR_H
-#define BEAMSIM_COMPARE_DIR_H
+#ifndef BSIM_COMPARE_DIR_H
+#define BSIM_COMPARE_DIR_H
 
 #include <signal.h>
 #include <stddef.h>

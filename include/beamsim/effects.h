@@ -1,8 +1,8 @@
 /* The effect pipeline (DESIGN.md "Effects"): built once from the scene's
  * list; an effect that is not listed is not in the pipeline at all, so it
  * costs nothing per step and a scene without random force never draws. */
-#ifndef BEAMSIM_EFFECTS_H
-#define BEAMSIM_EFFECTS_H
+#ifndef BSIM_EFFECTS_H
+#define BSIM_EFFECTS_H
 
 #include <stdint.h>
 

@@ -1,7 +1,7 @@
 /* Error codes and messages: every fallible call returns a code and fills a
  * bsim_error with one readable line (file, line, field, what was expected). */
-#ifndef BEAMSIM_ERROR_H
-#define BEAMSIM_ERROR_H
+#ifndef BSIM_ERROR_H
+#define BSIM_ERROR_H
 
 #ifdef __cplusplus
 extern "C" {

@@ -1,8 +1,8 @@
 /* An experiment: a scene, fixed overrides, a grid of parameter values whose
  * cartesian product is the groups, trials per group and a seed
  * (DESIGN.md "Experiment file"). */
-#ifndef BEAMSIM_EXPERIMENT_H
-#define BEAMSIM_EXPERIMENT_H
+#ifndef BSIM_EXPERIMENT_H
+#define BSIM_EXPERIMENT_H
 
 #include <stdint.h>
 

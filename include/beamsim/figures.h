@@ -31,8 +31,8 @@
  *
  * Without gnuplot the data and scripts are still written; the result says
  * how many figures were drawn. */
-#ifndef BEAMSIM_FIGURES_H
-#define BEAMSIM_FIGURES_H
+#ifndef BSIM_FIGURES_H
+#define BSIM_FIGURES_H
 
 #include "beamsim/error.h"
 #include "beamsim/scene.h"

@@ -18,8 +18,8 @@
  * The two branches meet at rho^2 = L^2 + R^2, where the tangent point is
  * the tip. This is the one home of the landscape's math: the runner's
  * e_prop, the landscape label of a trial and `beamsim landscape` use it. */
-#ifndef BEAMSIM_LANDSCAPE_H
-#define BEAMSIM_LANDSCAPE_H
+#ifndef BSIM_LANDSCAPE_H
+#define BSIM_LANDSCAPE_H
 
 #include "beamsim/scene.h"
 

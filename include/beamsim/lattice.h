@@ -7,8 +7,8 @@
  * and its position in the gate's own frame is Eq. 2.17 read backwards,
  *   x = X - w ix,   y = Y - d iy.
  * A scene without a lattice is one gate, (0, 0), covering the plane. */
-#ifndef BEAMSIM_LATTICE_H
-#define BEAMSIM_LATTICE_H
+#ifndef BSIM_LATTICE_H
+#define BSIM_LATTICE_H
 
 #include <stddef.h>
 

@@ -7,8 +7,8 @@
  *
  * The limits are process-wide, like GSL's error handler: set them once
  * before loading, not while other threads load. */
-#ifndef BEAMSIM_LIMITS_H
-#define BEAMSIM_LIMITS_H
+#ifndef BSIM_LIMITS_H
+#define BSIM_LIMITS_H
 
 #include "beamsim/error.h"
 

@@ -38,8 +38,8 @@
  * the entry only through its bin. A body leaving row 0 downwards re-enters
  * row 0 in the chain (the lattice keeps it in row 0's gate); a trial's
  * overall max_steps is not modelled. */
-#ifndef BEAMSIM_MARKOV_H
-#define BEAMSIM_MARKOV_H
+#ifndef BSIM_MARKOV_H
+#define BSIM_MARKOV_H
 
 #include <stdint.h>
 

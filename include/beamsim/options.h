@@ -1,8 +1,8 @@
 /* Backend options: typed key/value knobs (`--backend-opt key=value`),
  * checked against a backend's knob table (beamsim/backend.h) and read with
  * each knob's default. */
-#ifndef BEAMSIM_OPTIONS_H
-#define BEAMSIM_OPTIONS_H
+#ifndef BSIM_OPTIONS_H
+#define BSIM_OPTIONS_H
 
 #include "beamsim/error.h"
 

@@ -2,8 +2,8 @@
  * summary.json, trials.csv and the text table of p_traverse. Files are
  * written through beamsim/atomic_file.h, so a reader never sees half a
  * file and an interrupted run leaves none. */
-#ifndef BEAMSIM_OUTPUT_H
-#define BEAMSIM_OUTPUT_H
+#ifndef BSIM_OUTPUT_H
+#define BSIM_OUTPUT_H
 
 #include <stdio.h>
 

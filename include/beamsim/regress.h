@@ -6,8 +6,8 @@
  * tests of beamsim/compare.h: DIR/regress.md and DIR/regress.json. Both
  * sides are read from their trials.csv, so they have the file's precision;
  * identical code and inputs give identical trials. */
-#ifndef BEAMSIM_REGRESS_H
-#define BEAMSIM_REGRESS_H
+#ifndef BSIM_REGRESS_H
+#define BSIM_REGRESS_H
 
 #include "beamsim/compare.h"
 #include "beamsim/experiment.h"

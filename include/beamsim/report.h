@@ -2,8 +2,8 @@
  * report.md for people, report.json for tools) and the per-pair table
  * pairs.csv. beamsim regress reuses the sections for a stored run against
  * its rerun. */
-#ifndef BEAMSIM_REPORT_H
-#define BEAMSIM_REPORT_H
+#ifndef BSIM_REPORT_H
+#define BSIM_REPORT_H
 
 #include <stdio.h>
 

@@ -14,8 +14,8 @@
  *
  * The directory is written as one set (DIR/manifest.json last) once the
  * trial has run: a failed trial leaves none of its files. */
-#ifndef BEAMSIM_RUN_OUTPUT_H
-#define BEAMSIM_RUN_OUTPUT_H
+#ifndef BSIM_RUN_OUTPUT_H
+#define BSIM_RUN_OUTPUT_H
 
 #include <stdint.h>
 #include <stdio.h>

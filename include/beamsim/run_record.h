@@ -3,8 +3,8 @@
  * backends with every knob's effective value, seed, trials, the comparison
  * rule) and DIR/inputs/ (the scene file as it was, and the experiment with
  * its command-line --set overrides folded into `set:`). */
-#ifndef BEAMSIM_RUN_RECORD_H
-#define BEAMSIM_RUN_RECORD_H
+#ifndef BSIM_RUN_RECORD_H
+#define BSIM_RUN_RECORD_H
 
 #include <stdint.h>
 

@@ -1,8 +1,8 @@
 /* A scene: one body, any number of beams, the contact law, the effects to
  * simulate, and the integration and termination settings (DESIGN.md "Scene
  * file", MODEL.md sections 1-6). All quantities SI. */
-#ifndef BEAMSIM_SCENE_H
-#define BEAMSIM_SCENE_H
+#ifndef BSIM_SCENE_H
+#define BSIM_SCENE_H
 
 #include "beamsim/error.h"
 

@@ -4,8 +4,8 @@
  * generator seeded by bsim_schedule_seed_mix(experiment seed, group, trial). Values
  * are drawn lazily in order and kept, so a schedule can be replayed from any
  * step and costs nothing in a trial that ends early. */
-#ifndef BEAMSIM_SCHEDULE_H
-#define BEAMSIM_SCHEDULE_H
+#ifndef BSIM_SCHEDULE_H
+#define BSIM_SCHEDULE_H
 
 #include <stdint.h>
 

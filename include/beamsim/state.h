@@ -2,8 +2,8 @@
  * beams, contacts, the step's energy flows, and the beams that may be away
  * from rest. The caller owns a state's storage: bsim_state_init sizes it for
  * a scene's beams, bsim_state_free releases it. */
-#ifndef BEAMSIM_STATE_H
-#define BEAMSIM_STATE_H
+#ifndef BSIM_STATE_H
+#define BSIM_STATE_H
 
 #include "beamsim/error.h"
 

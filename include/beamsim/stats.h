@@ -1,6 +1,6 @@
 /* Statistics of traversal counts. */
-#ifndef BEAMSIM_STATS_H
-#define BEAMSIM_STATS_H
+#ifndef BSIM_STATS_H
+#define BSIM_STATS_H
 
 #ifdef __cplusplus
 extern "C" {

@@ -1,7 +1,7 @@
 /* A sweep: every (group, trial) of an experiment on one backend, in parallel
  * (OpenMP), with results independent of the number of threads. */
-#ifndef BEAMSIM_SWEEP_H
-#define BEAMSIM_SWEEP_H
+#ifndef BSIM_SWEEP_H
+#define BSIM_SWEEP_H
 
 #include <signal.h>
 #include <stddef.h>

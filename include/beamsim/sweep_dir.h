@@ -20,8 +20,8 @@
  * journaled as they end (DIR/.beamsim/journal), so a run stopped through
  * def.stop or killed continues with def.resume and writes the files an
  * uninterrupted run writes, byte for byte. */
-#ifndef BEAMSIM_SWEEP_DIR_H
-#define BEAMSIM_SWEEP_DIR_H
+#ifndef BSIM_SWEEP_DIR_H
+#define BSIM_SWEEP_DIR_H
 
 #include <signal.h>
 #include <stdint.h>

@@ -7,8 +7,8 @@
  * the beams' energy E_beam = sum 1/2 k_i theta_i^2 and the propulsive
  * potential along it. The rows are those of bsim_recorder: t = 0, every
  * stride-th step and the last step. */
-#ifndef BEAMSIM_TRAJECTORY_H
-#define BEAMSIM_TRAJECTORY_H
+#ifndef BSIM_TRAJECTORY_H
+#define BSIM_TRAJECTORY_H
 
 #include "beamsim/error.h"
 #include "beamsim/trial.h"

@@ -1,7 +1,7 @@
 /* The trial runner (MODEL.md section 6): owns time, the effect pipeline,
  * termination, outcomes, the energy ledger and optional recording. */
-#ifndef BEAMSIM_TRIAL_H
-#define BEAMSIM_TRIAL_H
+#ifndef BSIM_TRIAL_H
+#define BSIM_TRIAL_H
 
 #include <stdint.h>
 #include <stdio.h>

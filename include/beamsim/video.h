@@ -38,8 +38,8 @@
  * path) filled in the path colour. A lattice's view also shows the gate
  * boundaries, tints the gates entered, names the gate the body is in, and
  * states the outcome as the final location (end, side, stuck gate). */
-#ifndef BEAMSIM_VIDEO_H
-#define BEAMSIM_VIDEO_H
+#ifndef BSIM_VIDEO_H
+#define BSIM_VIDEO_H
 
 #include <stdint.h>
 

@@ -5,8 +5,8 @@
  * to figs_render, which writes NAME.gp and has gnuplot draw NAME.png and
  * NAME.svg (figure.h). Every file goes through these two calls, so a
  * different way of committing files changes them alone. */
-#ifndef BSIM_FIGURES_INTERNAL_H
-#define BSIM_FIGURES_INTERNAL_H
+#ifndef BSIM_FIGURES_FIGURES_INTERNAL_H
+#define BSIM_FIGURES_FIGURES_INTERNAL_H
 
 #include <stdio.h>
 
