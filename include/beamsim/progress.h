@@ -5,6 +5,8 @@
 #ifndef BSIM_PROGRESS_H
 #define BSIM_PROGRESS_H
 
+#include "beamsim/base.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

@@ -8,6 +8,7 @@
 
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/compare.h"
 #include "beamsim/experiment.h"
@@ -34,14 +35,16 @@ typedef struct bsim_run_record {
  * each side's backend, label (NULL: the backend's name) and every knob's
  * effective value, the experiment's seed and trials, and the rule (NULL:
  * bsim_compare_rule_default()). */
-void bsim_run_record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e,
-                          int n, const bsim_backend *const *b, const bsim_options *const *opts,
-                          const char *const *label, const bsim_compare_rule *rule);
+BSIM_API void bsim_run_record_fill(bsim_run_record *rec, const char *command,
+                                   const bsim_experiment *e, int n, const bsim_backend *const *b,
+                                   const bsim_options *const *opts, const char *const *label,
+                                   const bsim_compare_rule *rule);
 
 /* Writes DIR/inputs/scene.yaml, DIR/inputs/experiment.yaml and, last,
  * DIR/run.json, each atomically: a directory with run.json is complete. */
-int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsim_experiment *e,
-                          const bsim_override *extra, int n_extra, bsim_error *err);
+BSIM_API int bsim_run_record_write(const char *dir, const bsim_run_record *rec,
+                                   const bsim_experiment *e, const bsim_override *extra,
+                                   int n_extra, bsim_error *err);
 
 /* What the trials of a run depend on, as text (malloc'd; NULL and err on
  * failure): version, command, backends with every option, the number of
@@ -50,12 +53,12 @@ int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsi
  * a resumed run must have the text of the run it continues
  * (beamsim/journal.h). The comparison rule is not in it: it changes the
  * report, not the trials. */
-char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *e,
-                             const bsim_override *extra, int n_extra, bsim_error *err);
+BSIM_API char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *e,
+                                      const bsim_override *extra, int n_extra, bsim_error *err);
 
 /* Reads DIR/run.json. BSIM_EINPUT naming the file and field on a missing
  * or malformed record. The experiment to load is DIR/inputs/experiment.yaml. */
-int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err);
+BSIM_API int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err);
 
 #ifdef __cplusplus
 }
