@@ -1,6 +1,6 @@
 /* The output files of a sweep (DESIGN.md "Outputs", a contract):
  * summary.json, trials.csv and the text table of p_traverse. Files are
- * written through beamsim/atomic_file.h, so a reader never sees half a
+ * written through util/atomic_file.h, so a reader never sees half a
  * file and an interrupted run leaves none. */
 #ifndef BSIM_OUTPUT_H
 #define BSIM_OUTPUT_H

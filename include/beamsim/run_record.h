@@ -51,7 +51,7 @@ BSIM_API int bsim_run_record_write(const char *dir, const bsim_run_record *rec,
  * groups, the experiment as it ran (seed, trials, every override, the grid)
  * and the scene file's text. Two runs with equal texts have equal trials;
  * a resumed run must have the text of the run it continues
- * (beamsim/journal.h). The comparison rule is not in it: it changes the
+ * (util/journal.h). The comparison rule is not in it: it changes the
  * report, not the trials. */
 BSIM_API char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *e,
                                       const bsim_override *extra, int n_extra, bsim_error *err);

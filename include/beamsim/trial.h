@@ -76,7 +76,7 @@ typedef struct bsim_ledger {
 	double inflow;       /* e_start + sum over steps of |w_prop| + |w_rand| */
 } bsim_ledger;
 
-/* Plain data, no pointers: a sweep's journal (beamsim/journal.h) stores it
+/* Plain data, no pointers: a sweep's journal (util/journal.h) stores it
  * byte for byte, and a resumed sweep reads it back so. */
 typedef struct bsim_trial_result {
 	bsim_outcome outcome;
