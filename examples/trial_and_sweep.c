@@ -8,14 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include <beamsim/backend.h>
-#include <beamsim/experiment.h>
-#include <beamsim/options.h>
-#include <beamsim/scene.h>
-#include <beamsim/schedule.h>
-#include <beamsim/sweep.h>
-#include <beamsim/trial.h>
-#include <beamsim/version.h>
+#include <beamsim/beamsim.h>
 
 static int fail(const bsim_error *err)
 {

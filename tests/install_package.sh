@@ -5,7 +5,8 @@
 # compiled with `pkg-config --cflags --libs beamsim` alone, and all three
 # runs giving the installed program's own answer: the sweep's p_traverse
 # per group equals that of `beamsim sweep` on the same experiment, trials
-# and seed.
+# and seed. The shared library exports exactly the functions and objects
+# the installed headers declare BSIM_API.
 #   install_package.sh BUILD_DIR SOURCE_DIR WORK_DIR
 set -eu
 build=$1 src=$2 work=$3
@@ -32,6 +33,30 @@ LD_LIBRARY_PATH=$libdir "$work/pc_example" "$exp" 20 >"$work/pc.txt"
 # The shared library brings only the bsim_ functions.
 if nm -D --defined-only "$libdir/libbeamsim.so" | awk '{print $3}' | grep -v '^bsim_' | grep .; then
     echo "libbeamsim.so exports symbols outside bsim_"; exit 1
+fi
+
+# The ABI is the API: the functions and objects libbeamsim.so exports are
+# those the installed headers declare BSIM_API (beamsim/base.h), no more (an
+# internal function exported by accident) and no fewer (a declaration
+# without a definition, which would fail only in a user's link). A
+# declaration may run over lines; it ends at its ';'. Its name is the word
+# before its first '(', or for an object the word before its ';' or '['.
+nm -D --defined-only "$libdir/libbeamsim.so" | awk '$2 ~ /^[TDRB]$/ {print $3}' |
+    sort -u >"$work/exported.txt"
+awk '/^BSIM_API / {d = ""; on = 1} on {d = d " " $0} on && /;/ {print d; on = 0}' \
+    "$prefix/include/beamsim/"*.h |
+    sed -E -e 's/^([^(]*[^a-zA-Z0-9_])?([a-zA-Z_][a-zA-Z0-9_]*) *\(.*/\2/' \
+           -e 's/^.*[^a-zA-Z0-9_]([a-zA-Z_][a-zA-Z0-9_]*) *[;[].*/\1/' |
+    sort -u >"$work/declared.txt"
+undeclared=$(comm -23 "$work/exported.txt" "$work/declared.txt")
+if [ -n "$undeclared" ]; then
+    echo "libbeamsim.so exports what no installed header declares BSIM_API:" $undeclared
+    exit 1
+fi
+unexported=$(comm -13 "$work/exported.txt" "$work/declared.txt")
+if [ -n "$unexported" ]; then
+    echo "declared BSIM_API but not exported by libbeamsim.so:" $unexported
+    exit 1
 fi
 
 # Wall time aside, the three runs print the same.

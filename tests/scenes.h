@@ -1,6 +1,6 @@
 /* Scenes built in code for the physics tests (no files involved). */
-#ifndef BSIM_TEST_SCENES_H
-#define BSIM_TEST_SCENES_H
+#ifndef BSIM_TESTS_SCENES_H
+#define BSIM_TESTS_SCENES_H
 
 #include "beamsim/scene.h"
 

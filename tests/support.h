@@ -1,7 +1,7 @@
 /* Helpers shared by the tests: running the real program, temporary
  * directories, reading files. */
-#ifndef BSIM_TEST_SUPPORT_H
-#define BSIM_TEST_SUPPORT_H
+#ifndef BSIM_TESTS_SUPPORT_H
+#define BSIM_TESTS_SUPPORT_H
 
 #include <stddef.h>
 

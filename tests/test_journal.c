@@ -1,4 +1,4 @@
-/* The journal of finished work (beamsim/journal.h), on its own: records
+/* The journal of finished work (util/journal.h), on its own: records
  * appended from several threads all come back, byte for byte; a torn or
  * damaged tail is cut off and only it; a journal of other inputs or
  * another record size is refused, naming what differs. */

@@ -1,4 +1,4 @@
-/* MATLAB twins (beamsim/matlab.h) and the trajectories that sweeps keep.
+/* MATLAB twins (store/matlab.h) and the trajectories that sweeps keep.
  *
  * Truths: every .mat file read back with libmatio holds, field by field,
  * exactly the values of the CSV or JSON file it twins (numbers as the

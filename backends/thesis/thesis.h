@@ -8,8 +8,8 @@
  * unit normal n (beam -> body) at lever a = Q - P, the generalised lever is
  * c = sgn (a x n): the body's normal velocity gains P/M per impulse P and
  * the beam's omega loses P c / I, and v_rel = v . n - omega c. */
-#ifndef BSIM_THESIS_H
-#define BSIM_THESIS_H
+#ifndef BSIM_THESIS_THESIS_H
+#define BSIM_THESIS_THESIS_H
 
 #include <math.h>
 

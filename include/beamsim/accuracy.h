@@ -14,12 +14,13 @@
  * p_traverse (against the reference setting's, same seeds), the energy
  * ledger residual per simulated second (sum |r| / sum t, J/s) and the cost
  * (wall seconds per simulated second). All times in s, lengths in m. */
-#ifndef BEAMSIM_ACCURACY_H
-#define BEAMSIM_ACCURACY_H
+#ifndef BSIM_ACCURACY_H
+#define BSIM_ACCURACY_H
 
 #include <stdint.h>
 #include <stdio.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/figures.h"
 #include "beamsim/progress.h"
@@ -39,18 +40,18 @@ typedef struct bsim_accuracy_reference {
 
 /* Runs one trial of scene (its dt is the step; grid a multiple of it) with
  * the schedule of seed and keeps the states on the grid. */
-int bsim_accuracy_reference_run(bsim_accuracy_reference *ref, const bsim_scene *scene,
-                                const bsim_backend *b, const bsim_options *opts, uint64_t seed,
-                                double grid, bsim_error *err);
-void bsim_accuracy_reference_free(bsim_accuracy_reference *ref);
+BSIM_API int bsim_accuracy_reference_run(bsim_accuracy_reference *ref, const bsim_scene *scene,
+                                         const bsim_backend *b, const bsim_options *opts,
+                                         uint64_t seed, double grid, bsim_error *err);
+BSIM_API void bsim_accuracy_reference_free(bsim_accuracy_reference *ref);
 
 /* The consistency error of (b, opts, scene->dt): n_pieces pieces of
  * duration piece (a multiple of ref->grid) restarted at evenly spaced grid
  * points, and its mean and largest value over the pieces (m). */
-int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_scene *scene,
-                              const bsim_backend *b, const bsim_options *opts, uint64_t seed,
-                              double piece, int n_pieces, double *mean, double *max,
-                              bsim_error *err);
+BSIM_API int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_scene *scene,
+                                       const bsim_backend *b, const bsim_options *opts,
+                                       uint64_t seed, double piece, int n_pieces, double *mean,
+                                       double *max, bsim_error *err);
 
 typedef struct bsim_accuracy_config {
 	double h_ref;              /* s, finest step and the reference's (0.000125) */
@@ -66,9 +67,9 @@ typedef struct bsim_accuracy_config {
 
 /* The study of docs/accuracy.md: h from 0.016 s halved down to 0.000125 s,
  * 16 pieces of 0.064 s, 40 trials, seed 1, all threads. */
-bsim_accuracy_config bsim_accuracy_default(void);
+BSIM_API bsim_accuracy_config bsim_accuracy_default(void);
 /* A quick study for tests: h down to 0.0005 s, 4 pieces, 8 trials. */
-bsim_accuracy_config bsim_accuracy_quick(void);
+BSIM_API bsim_accuracy_config bsim_accuracy_quick(void);
 
 /* One row: a backend, a knob setting and a time step. */
 typedef struct bsim_accuracy_row {
@@ -96,30 +97,33 @@ typedef struct bsim_accuracy_result {
 /* The knob settings studied for backend b, its accuracy list
  * (beamsim/backend.h): n settings into a malloc'd array (caller frees), the
  * first the reference. BSIM_EINPUT if b lists none. */
-int bsim_accuracy_settings(const bsim_backend *b, bsim_accuracy_row **out, int *n, bsim_error *err);
+BSIM_API int bsim_accuracy_settings(const bsim_backend *b, bsim_accuracy_row **out, int *n,
+                                    bsim_error *err);
 
 /* The whole study over the backends. Results other than the timings do not
  * depend on the number of threads. */
-int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backends, int n_backends,
-                      const bsim_accuracy_config *cfg, bsim_accuracy_result *out, bsim_error *err);
-void bsim_accuracy_result_free(bsim_accuracy_result *r);
+BSIM_API int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backends,
+                               int n_backends, const bsim_accuracy_config *cfg,
+                               bsim_accuracy_result *out, bsim_error *err);
+BSIM_API void bsim_accuracy_result_free(bsim_accuracy_result *r);
 
 /* accuracy.csv and accuracy.md of a result; the figure is drawn from
  * accuracy.csv (beamsim/figures.h). */
-int bsim_accuracy_write_csv(const char *path, const bsim_accuracy_result *r, bsim_error *err);
-int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result *r,
-                           const bsim_accuracy_config *cfg, const char *scene_label,
-                           bsim_error *err);
+BSIM_API int bsim_accuracy_write_csv(const char *path, const bsim_accuracy_result *r,
+                                     bsim_error *err);
+BSIM_API int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result *r,
+                                    const bsim_accuracy_config *cfg, const char *scene_label,
+                                    bsim_error *err);
 
 /* The study written into the output directory out as one set (checked
  * before the study runs): accuracy.csv, accuracy.mat, accuracy.md (naming
  * the scene by scene_label) and the figure accuracy (.png, .svg, .gp,
  * .dat). fig gets the figure's result (its notes say what gnuplot could
  * not draw); free it and res on BSIM_OK. */
-int bsim_accuracy_store(const char *out, const bsim_scene *scene, const char *scene_label,
-                        const bsim_backend *const *backends, int n_backends,
-                        const bsim_accuracy_config *cfg, bsim_accuracy_result *res,
-                        bsim_figures_result *fig, bsim_error *err);
+BSIM_API int bsim_accuracy_store(const char *out, const bsim_scene *scene, const char *scene_label,
+                                 const bsim_backend *const *backends, int n_backends,
+                                 const bsim_accuracy_config *cfg, bsim_accuracy_result *res,
+                                 bsim_figures_result *fig, bsim_error *err);
 
 #ifdef __cplusplus
 }

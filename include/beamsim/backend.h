@@ -4,9 +4,10 @@
  * integration; nothing else. The runner owns time, the external force on the
  * body, termination and recording, so that every backend runs the same
  * scenes with the same random-force schedules. */
-#ifndef BEAMSIM_BACKEND_H
-#define BEAMSIM_BACKEND_H
+#ifndef BSIM_BACKEND_H
+#define BSIM_BACKEND_H
 
+#include "beamsim/base.h"
 #include "beamsim/error.h"
 #include "beamsim/options.h"
 #include "beamsim/scene.h"
@@ -41,14 +42,14 @@ typedef struct bsim_backend {
 } bsim_backend;
 
 /* The registry: all backends compiled in, NULL-terminated. */
-const bsim_backend *const *bsim_backend_list(void);
+BSIM_API const bsim_backend *const *bsim_backend_list(void);
 /* The backend a run uses when none is named: the essay's solver, thesis. */
-const bsim_backend *bsim_backend_default(void);
+BSIM_API const bsim_backend *bsim_backend_default(void);
 /* By name; NULL and BSIM_EINPUT naming the known ones if unknown. */
-const bsim_backend *bsim_backend_find(const char *name, bsim_error *err);
+BSIM_API const bsim_backend *bsim_backend_find(const char *name, bsim_error *err);
 
-extern const bsim_backend bsim_backend_thesis;
-extern const bsim_backend bsim_backend_box2d;
+BSIM_API extern const bsim_backend bsim_backend_thesis;
+BSIM_API extern const bsim_backend bsim_backend_box2d;
 
 #ifdef __cplusplus
 }

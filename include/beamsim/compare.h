@@ -2,11 +2,12 @@
  * schedules (beamsim compare) or a stored sweep and its rerun (beamsim
  * regress). Trial t of group g in one is the pair of trial t of group g in
  * the other, so every test here is a paired one. */
-#ifndef BEAMSIM_COMPARE_H
-#define BEAMSIM_COMPARE_H
+#ifndef BSIM_COMPARE_H
+#define BSIM_COMPARE_H
 
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/error.h"
 #include "beamsim/stats.h"
 #include "beamsim/sweep.h"
@@ -26,9 +27,9 @@ typedef enum {
 	BSIM_N_EVENTS
 } bsim_event;
 
-const char *bsim_compare_event_name(bsim_event ev);
+BSIM_API const char *bsim_compare_event_name(bsim_event ev);
 /* 1 if trial r shows event ev. */
-int bsim_compare_event_of(const bsim_trial_result *r, bsim_event ev);
+BSIM_API int bsim_compare_event_of(const bsim_trial_result *r, bsim_event ev);
 
 /* When a group disagrees: some event's McNemar p-value, Holm-adjusted over
  * every (group, event) test of the comparison, is below alpha AND that
@@ -57,7 +58,7 @@ typedef struct bsim_compare_rule {
 } bsim_compare_rule;
 
 /* alpha 0.05, margin 0.05, not exact. */
-bsim_compare_rule bsim_compare_rule_default(void);
+BSIM_API bsim_compare_rule bsim_compare_rule_default(void);
 
 typedef struct bsim_event_test {
 	bsim_pairs pairs;        /* a: both, b: only A, c: only B, d: neither */
@@ -85,7 +86,7 @@ typedef enum {
 	BSIM_N_VERDICTS
 } bsim_verdict;
 
-const char *bsim_compare_verdict_name(bsim_verdict v);
+BSIM_API const char *bsim_compare_verdict_name(bsim_verdict v);
 
 /* Lattices: where the paired trials ended (bsim_lattice_location_of). The test of
  * "both sides have the same final-location distribution" is a paired
@@ -109,8 +110,8 @@ typedef struct bsim_location_test {
 #define BSIM_LOCATION_RESAMPLES 20000
 
 /* The paired permutation test on n pairs of final locations. */
-void bsim_compare_location_test(const bsim_trial_result *a, const bsim_trial_result *b, int n,
-                                uint64_t seed, bsim_location_test *out);
+BSIM_API void bsim_compare_location_test(const bsim_trial_result *a, const bsim_trial_result *b,
+                                         int n, uint64_t seed, bsim_location_test *out);
 
 typedef struct bsim_compare_group {
 	int deterministic; /* one pair: ev has the 0/1 events, no statistics */
@@ -141,16 +142,17 @@ typedef struct bsim_comparison {
 
 /* Compares a and b (same groups and trials). t_separate may be NULL (no
  * trajectories, e.g. regress). BSIM_EINPUT if the shapes differ. */
-int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
-                         const double *t_separate, const bsim_compare_rule *rule,
-                         bsim_comparison *out, bsim_error *err);
-void bsim_compare_free(bsim_comparison *c);
+BSIM_API int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
+                                  const double *t_separate, const bsim_compare_rule *rule,
+                                  bsim_comparison *out, bsim_error *err);
+BSIM_API void bsim_compare_free(bsim_comparison *c);
 
 /* 1 if trials differ in outcome or traversal type. */
-int bsim_compare_discordant(const bsim_trial_result *a, const bsim_trial_result *b);
+BSIM_API int bsim_compare_discordant(const bsim_trial_result *a, const bsim_trial_result *b);
 /* 1 if trials are identical in every field trials.csv records (the
  * ledger's only if ledger is 1). */
-int bsim_compare_identical(const bsim_trial_result *a, const bsim_trial_result *b, int ledger);
+BSIM_API int bsim_compare_identical(const bsim_trial_result *a, const bsim_trial_result *b,
+                                    int ledger);
 
 #ifdef __cplusplus
 }

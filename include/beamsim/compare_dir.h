@@ -11,13 +11,14 @@
  * command line ("thesis", "box2d:spring=torque:substeps=4"); that text is
  * its label. Or, on a gate lattice, the two sides are one backend under two
  * lattice protocols (protocol), and the protocols label them. */
-#ifndef BEAMSIM_COMPARE_DIR_H
-#define BEAMSIM_COMPARE_DIR_H
+#ifndef BSIM_COMPARE_DIR_H
+#define BSIM_COMPARE_DIR_H
 
 #include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/compare.h"
 #include "beamsim/experiment.h"
@@ -37,11 +38,11 @@ typedef struct bsim_compare_side {
  * found by name, options in order, later ones win), after the options
  * already in side->opts, which the spec's override. BSIM_EINPUT naming the
  * spec and what was expected. */
-int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err);
+BSIM_API int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err);
 
 /* The directory of a side's files in DIR: the label with ':' and '/'
  * written '-' ("thesis:integrator=euler" -> "thesis-integrator=euler"). */
-void bsim_compare_dir_label(const char *label, char *buf, size_t size);
+BSIM_API void bsim_compare_dir_label(const char *label, char *buf, size_t size);
 
 typedef struct bsim_compare_dir_def {
 	const char *experiment; /* the experiment file */
@@ -68,7 +69,7 @@ typedef struct bsim_compare_dir_def {
 
 /* thesis against box2d, no options, bsim_compare_rule_default(), 3
  * examples, all cores. */
-bsim_compare_dir_def bsim_compare_dir_default(void);
+BSIM_API bsim_compare_dir_def bsim_compare_dir_default(void);
 
 typedef struct bsim_compare_dir_result {
 	bsim_experiment e;
@@ -84,9 +85,9 @@ typedef struct bsim_compare_dir_result {
  * (res->cmp.n_disagree says whether any group disagrees); the errors as
  * bsim_sweep_dir_run's, and BSIM_EINPUT for sides that are the same or
  * would write to the same directory. */
-int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_result *res,
-                         bsim_error *err);
-void bsim_compare_dir_result_free(bsim_compare_dir_result *res);
+BSIM_API int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_result *res,
+                                  bsim_error *err);
+BSIM_API void bsim_compare_dir_result_free(bsim_compare_dir_result *res);
 
 #ifdef __cplusplus
 }

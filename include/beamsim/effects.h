@@ -1,11 +1,12 @@
 /* The effect pipeline (DESIGN.md "Effects"): built once from the scene's
  * list; an effect that is not listed is not in the pipeline at all, so it
  * costs nothing per step and a scene without random force never draws. */
-#ifndef BEAMSIM_EFFECTS_H
-#define BEAMSIM_EFFECTS_H
+#ifndef BSIM_EFFECTS_H
+#define BSIM_EFFECTS_H
 
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/scene.h"
 #include "beamsim/schedule.h"
 
@@ -33,16 +34,16 @@ typedef struct bsim_effects {
 
 /* 1 if the scene's effects draw random numbers, so that a trial depends on
  * its seed; 0 if every trial of the scene is the same trial. */
-int bsim_effects_random(const bsim_scene *scene);
+BSIM_API int bsim_effects_random(const bsim_scene *scene);
 
 /* Builds the pipeline from scene->effects; seed is the trial's mixed seed. */
-int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed);
-void bsim_effects_free(bsim_effects *fx);
+BSIM_API int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed);
+BSIM_API void bsim_effects_free(bsim_effects *fx);
 
 /* BSIM_OK, or BSIM_EFAIL if an effect could not give its force (the random
  * force's schedule, bsim_schedule_status): the forces applied are not the
  * scene's, so the trial is not a result. */
-int bsim_effects_status(const bsim_effects *fx, bsim_error *err);
+BSIM_API int bsim_effects_status(const bsim_effects *fx, bsim_error *err);
 
 /* Sum of all effects' forces on the body at step n. */
 static inline void bsim_effects_force(bsim_effects *fx, long n, double h, double f[2])

@@ -1,7 +1,9 @@
 /* Error codes and messages: every fallible call returns a code and fills a
  * bsim_error with one readable line (file, line, field, what was expected). */
-#ifndef BEAMSIM_ERROR_H
-#define BEAMSIM_ERROR_H
+#ifndef BSIM_ERROR_H
+#define BSIM_ERROR_H
+
+#include "beamsim/base.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -27,11 +29,11 @@ typedef struct bsim_error {
 } bsim_error;
 
 /* Sets err (if not NULL) and returns code. printf-style message. */
-int bsim_error_set(bsim_error *err, int code, const char *fmt, ...)
+BSIM_API int bsim_error_set(bsim_error *err, int code, const char *fmt, ...)
         __attribute__((format(printf, 3, 4)));
 
 /* Clears err to BSIM_OK with an empty message. */
-void bsim_error_clear(bsim_error *err);
+BSIM_API void bsim_error_clear(bsim_error *err);
 
 #ifdef __cplusplus
 }

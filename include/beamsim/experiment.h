@@ -1,11 +1,12 @@
 /* An experiment: a scene, fixed overrides, a grid of parameter values whose
  * cartesian product is the groups, trials per group and a seed
  * (DESIGN.md "Experiment file"). */
-#ifndef BEAMSIM_EXPERIMENT_H
-#define BEAMSIM_EXPERIMENT_H
+#ifndef BSIM_EXPERIMENT_H
+#define BSIM_EXPERIMENT_H
 
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/error.h"
 #include "beamsim/scene.h"
 
@@ -37,22 +38,23 @@ typedef struct bsim_experiment {
  * every group is loaded and validated here, so a bad grid value fails before
  * any trial runs. extra: command-line --set overrides applied to every group
  * (after `set:`, before the grid values). */
-int bsim_experiment_load(const char *path, const bsim_override *extra, int n_extra,
-                         bsim_experiment *out, bsim_error *err);
+BSIM_API int bsim_experiment_load(const char *path, const bsim_override *extra, int n_extra,
+                                  bsim_experiment *out, bsim_error *err);
 
-void bsim_experiment_free(bsim_experiment *e);
+BSIM_API void bsim_experiment_free(bsim_experiment *e);
 
 /* BSIM_EINPUT with "expected at most N trials in all, got G groups x T
  * trials = ..." if n_groups x trials exceeds the limit trials
  * (beamsim/limits.h); for a --trials that replaces the file's. */
-int bsim_experiment_check_trials(const bsim_experiment *e, long trials, bsim_error *err);
+BSIM_API int bsim_experiment_check_trials(const bsim_experiment *e, long trials, bsim_error *err);
 
 /* The value index along each axis for group g (idx has n_axes entries). */
-void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx);
+BSIM_API void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx);
 
 /* Builds the scene of group g: scene file + set + extra + grid values. */
-int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_override *extra,
-                                int n_extra, bsim_scene *out, bsim_error *err);
+BSIM_API int bsim_experiment_group_scene(const bsim_experiment *e, int g,
+                                         const bsim_override *extra, int n_extra, bsim_scene *out,
+                                         bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -31,9 +31,10 @@
  *
  * Without gnuplot the data and scripts are still written; the result says
  * how many figures were drawn. */
-#ifndef BEAMSIM_FIGURES_H
-#define BEAMSIM_FIGURES_H
+#ifndef BSIM_FIGURES_H
+#define BSIM_FIGURES_H
 
+#include "beamsim/base.h"
 #include "beamsim/error.h"
 #include "beamsim/scene.h"
 
@@ -49,7 +50,7 @@ typedef enum {
 	BSIM_FIGURES_ACCURACY,
 } bsim_figures_kind;
 
-const char *bsim_figures_kind_name(bsim_figures_kind k);
+BSIM_API const char *bsim_figures_kind_name(bsim_figures_kind k);
 
 typedef struct bsim_figures_def {
 	bsim_figures_kind kind;
@@ -62,7 +63,7 @@ typedef struct bsim_figures_def {
 	int threads; /* figures drawn at once; <= 0: all cores */
 } bsim_figures_def;
 
-bsim_figures_def bsim_figures_default(void);
+BSIM_API bsim_figures_def bsim_figures_default(void);
 
 typedef struct bsim_figures_result {
 	bsim_figures_kind kind;
@@ -73,22 +74,22 @@ typedef struct bsim_figures_result {
 	char **notes; /* what was not drawn and why, one line each */
 } bsim_figures_result;
 
-void bsim_figures_result_free(bsim_figures_result *r);
+BSIM_API void bsim_figures_result_free(bsim_figures_result *r);
 
 /* Draws every figure of the directory. BSIM_EINPUT naming the directory
  * and the files looked for when it holds nothing known, or naming file,
  * line and field when a file is malformed; BSIM_EFAIL if a file cannot be
  * written or gnuplot fails on a script. */
-int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures_result *out,
-                      bsim_error *err);
+BSIM_API int bsim_figures_draw(const char *dir, const bsim_figures_def *def,
+                               bsim_figures_result *out, bsim_error *err);
 
 /* beamsim plot DIR: checks DIR's files against its manifest (a mix of two
  * runs is refused, BSIM_EINPUT), draws its figures and commits them as
  * one set: into def->out, or, with def->out NULL, into DIR itself, where
  * they join the files already there (DIR/manifest.json lists both).
  * out->paths name the figures where they are once this returns. */
-int bsim_figures_plot(const char *dir, const bsim_figures_def *def, bsim_figures_result *out,
-                      bsim_error *err);
+BSIM_API int bsim_figures_plot(const char *dir, const bsim_figures_def *def,
+                               bsim_figures_result *out, bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -18,9 +18,10 @@
  * The two branches meet at rho^2 = L^2 + R^2, where the tangent point is
  * the tip. This is the one home of the landscape's math: the runner's
  * e_prop, the landscape label of a trial and `beamsim landscape` use it. */
-#ifndef BEAMSIM_LANDSCAPE_H
-#define BEAMSIM_LANDSCAPE_H
+#ifndef BSIM_LANDSCAPE_H
+#define BSIM_LANDSCAPE_H
 
+#include "beamsim/base.h"
 #include "beamsim/scene.h"
 
 #ifdef __cplusplus
@@ -30,23 +31,23 @@ extern "C" {
 /* th of beam b, rad, against a body of the given radius (m) centred at c
  * (m). A centre closer to the pivot than the radius (the body would cover
  * the pivot) takes the tangent branch with asin clamped at pi/2. */
-double bsim_landscape_theta(const bsim_beam_def *b, double radius, const double c[2]);
+BSIM_API double bsim_landscape_theta(const bsim_beam_def *b, double radius, const double c[2]);
 
 /* E_prop = F_prop (y0 - y), J: the propulsive potential with its zero at
  * the scene's landscape_y0; 0 if the scene has no propulsion. */
-double bsim_landscape_e_prop(const bsim_scene *s, double y);
+BSIM_API double bsim_landscape_e_prop(const bsim_scene *s, double y);
 
 /* E_total at the body centre c, J. theta (n_beams entries), e_beam and
  * e_prop receive the parts if not NULL. */
-double bsim_landscape_energy(const bsim_scene *s, const double c[2], double *theta, double *e_beam,
-                             double *e_prop);
+BSIM_API double bsim_landscape_energy(const bsim_scene *s, const double c[2], double *theta,
+                                      double *e_beam, double *e_prop);
 
 /* 1 if a body of the given radius centred at c lies within beam b's reach,
  * rho < L + R (the disc where th can be non-zero), else 0. */
-int bsim_landscape_beam_reach(const bsim_beam_def *b, double radius, const double c[2]);
+BSIM_API int bsim_landscape_beam_reach(const bsim_beam_def *b, double radius, const double c[2]);
 
 /* 1 if the body centred at c lies within any beam's reach. */
-int bsim_landscape_in_reach(const bsim_scene *s, const double c[2]);
+BSIM_API int bsim_landscape_in_reach(const bsim_scene *s, const double c[2]);
 
 /* The beam whose barrier a body centred at c is on: among the beams with
  * touching[i] != 0 (all beams if touching is NULL), the one holding the
@@ -62,7 +63,7 @@ int bsim_landscape_in_reach(const bsim_scene *s, const double c[2]);
  * through the reach of the other, still at rest (the essay's trajectory
  * "below the surface", Fig. 2.7). The barrier search labels exits with
  * touching NULL: on the landscape every beam within reach is attached. */
-int bsim_landscape_label(const bsim_scene *s, const double c[2], const int *touching);
+BSIM_API int bsim_landscape_label(const bsim_scene *s, const double c[2], const int *touching);
 
 /* ---- The landscape on a grid ------------------------------------------ */
 
@@ -77,7 +78,7 @@ typedef struct bsim_landscape_grid_def {
 } bsim_landscape_grid_def;
 
 /* The default region at the default spacing. */
-bsim_landscape_grid_def bsim_landscape_grid_default(void);
+BSIM_API bsim_landscape_grid_def bsim_landscape_grid_default(void);
 
 /* The landscape sampled at (x0 + i spacing, y0 + j spacing), i < nx,
  * j < ny; point (i, j) is entry k = j nx + i (x varies fastest). */
@@ -95,9 +96,9 @@ typedef struct bsim_landscape_grid {
 /* Samples the landscape of s. BSIM_EINPUT for a bad region or spacing
  * (empty, non-finite, under 3 points a side, over BSIM_LANDSCAPE_MAX_POINTS),
  * naming the field; BSIM_EFAIL out of memory. */
-int bsim_landscape_grid_alloc(const bsim_scene *s, const bsim_landscape_grid_def *def,
-                              bsim_landscape_grid **out, bsim_error *err);
-void bsim_landscape_grid_free(bsim_landscape_grid *g);
+BSIM_API int bsim_landscape_grid_alloc(const bsim_scene *s, const bsim_landscape_grid_def *def,
+                                       bsim_landscape_grid **out, bsim_error *err);
+BSIM_API void bsim_landscape_grid_free(bsim_landscape_grid *g);
 
 /* ---- Barriers (src/landscape_barrier.c) -------------------------------- */
 
@@ -136,11 +137,11 @@ typedef struct bsim_landscape_barriers {
 /* Finds the passes of the landscape g of scene s (see landscape_barrier.c
  * for the definitions and the method). BSIM_EINPUT if the grid has no far
  * side beyond the beams' reach; BSIM_EFAIL out of memory. */
-int bsim_landscape_barriers_alloc(const bsim_scene *s, const bsim_landscape_grid *g,
-                                  bsim_landscape_barriers **out, bsim_error *err);
-void bsim_landscape_barriers_free(bsim_landscape_barriers *b);
+BSIM_API int bsim_landscape_barriers_alloc(const bsim_scene *s, const bsim_landscape_grid *g,
+                                           bsim_landscape_barriers **out, bsim_error *err);
+BSIM_API void bsim_landscape_barriers_free(bsim_landscape_barriers *b);
 
-const char *bsim_landscape_pass_kind_name(bsim_pass_kind k);
+BSIM_API const char *bsim_landscape_pass_kind_name(bsim_pass_kind k);
 
 /* ---- Files (src/landscape_write.c) ------------------------------------- */
 
@@ -151,16 +152,17 @@ const char *bsim_landscape_pass_kind_name(bsim_pass_kind k);
  * (heat map, contours, beams), landscape_beam and landscape_total (3-D
  * surfaces without and with the propulsive term), each .gp + data + .png +
  * .svg. drawn (may be NULL) is 1 if gnuplot drew the figures. */
-int bsim_landscape_write(const char *dir, const bsim_scene *s, const bsim_landscape_grid *g,
-                         const bsim_landscape_barriers *b, int *drawn, bsim_error *err);
+BSIM_API int bsim_landscape_write(const char *dir, const bsim_scene *s,
+                                  const bsim_landscape_grid *g, const bsim_landscape_barriers *b,
+                                  int *drawn, bsim_error *err);
 
 /* The landscape of s on the grid def, its barriers and files, computed and
  * written into the output directory out as one set (out is checked before
  * anything is computed). *g and *b get the grid and the barriers (free them
  * on BSIM_OK); BSIM_EINPUT for an unusable out or a bad grid, naming it. */
-int bsim_landscape_store(const char *out, const bsim_scene *s, const bsim_landscape_grid_def *def,
-                         bsim_landscape_grid **g, bsim_landscape_barriers **b, int *drawn,
-                         bsim_error *err);
+BSIM_API int bsim_landscape_store(const char *out, const bsim_scene *s,
+                                  const bsim_landscape_grid_def *def, bsim_landscape_grid **g,
+                                  bsim_landscape_barriers **b, int *drawn, bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -7,11 +7,12 @@
  * and its position in the gate's own frame is Eq. 2.17 read backwards,
  *   x = X - w ix,   y = Y - d iy.
  * A scene without a lattice is one gate, (0, 0), covering the plane. */
-#ifndef BEAMSIM_LATTICE_H
-#define BEAMSIM_LATTICE_H
+#ifndef BSIM_LATTICE_H
+#define BSIM_LATTICE_H
 
 #include <stddef.h>
 
+#include "beamsim/base.h"
 #include "beamsim/scene.h"
 #include "beamsim/trial.h"
 
@@ -23,29 +24,30 @@ enum { BSIM_SIDE_LEFT = 0, BSIM_SIDE_RIGHT = 1 };
 
 /* Index in scene->beams of the left (side 0) or right (side 1) beam of
  * gate (ix, iy); -1 outside the lattice. */
-int bsim_lattice_beam(const bsim_lattice_def *l, int ix, int iy, int side);
+BSIM_API int bsim_lattice_beam(const bsim_lattice_def *l, int ix, int iy, int side);
 /* The gate and side of beam index i (the inverse of bsim_lattice_beam). */
-void bsim_lattice_beam_gate(const bsim_lattice_def *l, int i, int *ix, int *iy, int *side);
+BSIM_API void bsim_lattice_beam_gate(const bsim_lattice_def *l, int i, int *ix, int *iy, int *side);
 
 /* The gate holding point p, clamped into the lattice (a body below row 0
  * is in row 0, one beyond the last column in the last column); (0, 0)
  * for a scene without a lattice. */
-void bsim_lattice_gate_at(const bsim_scene *s, const double p[2], int *ix, int *iy);
+BSIM_API void bsim_lattice_gate_at(const bsim_scene *s, const double p[2], int *ix, int *iy);
 
 /* The field's centre line X = w (ix_min + ix_max) / 2, from which side_x
  * is measured; 0 for a scene without a lattice. */
-double bsim_lattice_centre_x(const bsim_scene *s);
+BSIM_API double bsim_lattice_centre_x(const bsim_scene *s);
 
 /* Builds s->beams from s->lattice: every beam gets lattice.beam, then its
  * stiffness from k_left / k_right (rows x columns, row iy = 0 first, NULL:
  * lattice.beam.stiffness). Sets has_lattice and columns from ix_min/max. */
-int bsim_lattice_build(bsim_scene *s, const double *k_left, const double *k_right);
+BSIM_API int bsim_lattice_build(bsim_scene *s, const double *k_left, const double *k_right);
 
 /* The essay's lattice (MODEL.md section 8) built in code: columns x rows
  * gates (columns odd, centred on ix = 0) of the Table 2.1 gate, k = 400,
  * with the lattice's termination defaults and the given propulsion and
  * random force (0 = absent). The body starts at (0, 0). */
-int bsim_lattice_scene_init(bsim_scene *s, int columns, int rows, double f_prop, double rm);
+BSIM_API int bsim_lattice_scene_init(bsim_scene *s, int columns, int rows, double f_prop,
+                                     double rm);
 
 /* Where a trial ended (MODEL.md section 8): through the end boundary in
  * column ix, out through a side at row iy, or stuck in gate (ix, iy). */
@@ -60,12 +62,12 @@ typedef struct bsim_location {
 	int ix, iy; /* END: ix (iy = 0); SIDE: iy (ix = 0); STUCK: both */
 } bsim_location;
 
-bsim_location bsim_lattice_location_of(const bsim_trial_result *r);
+BSIM_API bsim_location bsim_lattice_location_of(const bsim_trial_result *r);
 /* 1 if a and b are the same location. */
-int bsim_lattice_location_equal(bsim_location a, bsim_location b);
+BSIM_API int bsim_lattice_location_equal(bsim_location a, bsim_location b);
 /* "end:-2", "side:3", "stuck:0:2"; the labels of trials.csv, summary.json
  * and the final-location CSV. */
-void bsim_lattice_location_label(bsim_location loc, char *buf, size_t size);
+BSIM_API void bsim_lattice_location_label(bsim_location loc, char *buf, size_t size);
 
 /* ---- a group of lattice trials ------------------------------------------ */
 
@@ -93,14 +95,14 @@ typedef struct bsim_lattice_summary {
 
 /* Summarises n trials of one group (logs: their gate paths, may be NULL:
  * no transitions or row times) of a lattice of `rows` rows. */
-int bsim_lattice_summarise(const bsim_trial_result *trials, const bsim_trial_log *logs, int n,
-                           int rows, bsim_lattice_summary *out);
-void bsim_lattice_summary_free(bsim_lattice_summary *s);
+BSIM_API int bsim_lattice_summarise(const bsim_trial_result *trials, const bsim_trial_log *logs,
+                                    int n, int rows, bsim_lattice_summary *out);
+BSIM_API void bsim_lattice_summary_free(bsim_lattice_summary *s);
 
 /* Time the trial spent in each row, s: row_time[iy] for iy < rows, from
  * the log's entries (a row not entered gets 0). */
-void bsim_lattice_row_times(const bsim_trial_result *r, const bsim_trial_log *log, int rows,
-                            double *row_time);
+BSIM_API void bsim_lattice_row_times(const bsim_trial_result *r, const bsim_trial_log *log,
+                                     int rows, double *row_time);
 
 #ifdef __cplusplus
 }

@@ -7,9 +7,10 @@
  *
  * The limits are process-wide, like GSL's error handler: set them once
  * before loading, not while other threads load. */
-#ifndef BEAMSIM_LIMITS_H
-#define BEAMSIM_LIMITS_H
+#ifndef BSIM_LIMITS_H
+#define BSIM_LIMITS_H
 
+#include "beamsim/base.h"
 #include "beamsim/error.h"
 
 #ifdef __cplusplus
@@ -28,20 +29,20 @@ typedef struct bsim_limits {
  * memory each, twice that in a comparison), 10^6 random-force values (8 MB
  * per thread) and 10^8 beam-steps (about 15 s of one core for the thesis
  * backend on a gate). */
-bsim_limits bsim_limits_default(void);
+BSIM_API bsim_limits bsim_limits_default(void);
 
 /* The limits in force (the defaults until bsim_limits_set). */
-const bsim_limits *bsim_limits_get(void);
+BSIM_API const bsim_limits *bsim_limits_get(void);
 
 /* Replaces the limits in force; NULL restores the defaults. */
-void bsim_limits_set(const bsim_limits *l);
+BSIM_API void bsim_limits_set(const bsim_limits *l);
 
 /* Applies "NAME=N" (e.g. "groups=1e6") to l. BSIM_EINPUT naming the known
  * names if NAME is unknown, or if N is not a number >= 1. */
-int bsim_limits_parse(bsim_limits *l, const char *text, bsim_error *err);
+BSIM_API int bsim_limits_parse(bsim_limits *l, const char *text, bsim_error *err);
 
 /* "(limit NAME = N; raise it with --limit NAME=M)" for messages. */
-void bsim_limits_hint(char *buf, unsigned size, const char *name, double value);
+BSIM_API void bsim_limits_hint(char *buf, unsigned size, const char *name, double value);
 
 #ifdef __cplusplus
 }

@@ -38,11 +38,12 @@
  * the entry only through its bin. A body leaving row 0 downwards re-enters
  * row 0 in the chain (the lattice keeps it in row 0's gate); a trial's
  * overall max_steps is not modelled. */
-#ifndef BEAMSIM_MARKOV_H
-#define BEAMSIM_MARKOV_H
+#ifndef BSIM_MARKOV_H
+#define BSIM_MARKOV_H
 
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/error.h"
 #include "beamsim/lattice.h"
@@ -61,10 +62,10 @@ typedef struct bsim_markov_bins {
 } bsim_markov_bins;
 
 /* 4 positions, 4 speeds up to 40 m/s, 3 directions. */
-bsim_markov_bins bsim_markov_bins_default(void);
+BSIM_API bsim_markov_bins bsim_markov_bins_default(void);
 
 /* The number of entry bins, the start's included: 1 + 4 n_pos n_speed n_dir. */
-int bsim_markov_bins_count(const bsim_markov_bins *b);
+BSIM_API int bsim_markov_bins_count(const bsim_markov_bins *b);
 
 /* Gate entries observed in simulation (gate_entries.csv of lattice sweeps,
  * the start rows left out): when a map is built with them, the states of
@@ -81,9 +82,9 @@ typedef struct bsim_markov_entries {
 
 /* Reads the entries of n files (a gate_entries.csv, or a directory holding
  * one). BSIM_EINPUT naming file and line if one is malformed. */
-int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entries *out,
-                             bsim_error *err);
-void bsim_markov_entries_free(bsim_markov_entries *e);
+BSIM_API int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entries *out,
+                                      bsim_error *err);
+BSIM_API void bsim_markov_entries_free(bsim_markov_entries *e);
 
 /* How a map is built. */
 typedef struct bsim_markov_def {
@@ -101,7 +102,7 @@ typedef struct bsim_markov_def {
 
 /* bsim_markov_bins_default(), 200 trials per bin, seed 1, the default
  * backend, all cores. */
-bsim_markov_def bsim_markov_def_default(void);
+BSIM_API bsim_markov_def bsim_markov_def_default(void);
 
 /* One single-gate map. */
 typedef struct bsim_markov_map {
@@ -134,17 +135,17 @@ typedef struct bsim_markov_set {
  * parameter never reuses a map. BSIM_EINPUT if lattice is not a lattice or
  * its side boundary is not the field's edge; an unstable single gate is
  * BSIM_EFAIL, never a count. */
-int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, const char *dir,
-                      bsim_markov_set *out, bsim_error *err);
+BSIM_API int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def,
+                               const char *dir, bsim_markov_set *out, bsim_error *err);
 
 /* The maps lattice needs, read from dir only, with the def stored in
  * dir/markov.json (opts: filled into *opts, which must outlive the set).
  * BSIM_EINPUT naming the stiffness pair whose map is missing, with the
  * command that builds it. */
-int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *opts,
-                     bsim_markov_set *out, bsim_error *err);
+BSIM_API int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *opts,
+                              bsim_markov_set *out, bsim_error *err);
 
-void bsim_markov_set_free(bsim_markov_set *s);
+BSIM_API void bsim_markov_set_free(bsim_markov_set *s);
 
 /* The chains small enough for the exact LU solve. */
 #define BSIM_MARKOV_LU_MAX 1000
@@ -162,20 +163,21 @@ typedef struct bsim_markov_prediction {
 } bsim_markov_prediction;
 
 /* The chain of lattice composed from set's maps, solved. */
-int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
-                        bsim_markov_prediction *out, bsim_error *err);
-void bsim_markov_prediction_free(bsim_markov_prediction *p);
+BSIM_API int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
+                                 bsim_markov_prediction *out, bsim_error *err);
+BSIM_API void bsim_markov_prediction_free(bsim_markov_prediction *p);
 
 /* Writes p into the output directory dir: prediction.csv (location, kind,
  * ix, iy, p: every final location of the field), prediction_gates.csv
  * (gates, p) and their .mat twins. */
-int bsim_markov_prediction_store(const char *dir, const bsim_markov_prediction *p, bsim_error *err);
+BSIM_API int bsim_markov_prediction_store(const char *dir, const bsim_markov_prediction *p,
+                                          bsim_error *err);
 
 /* The entry bin of a state in a gate's frame entered through edge
  * (BSIM_EDGE_BOTTOM .. BSIM_EDGE_TOP) at pos along it with velocity v; the
  * start is bin 0. For tools that bin a simulation's gate entries. */
-int bsim_markov_bin_of(const bsim_markov_bins *b, const bsim_lattice_def *l, int edge, double pos,
-                       const double v[2]);
+BSIM_API int bsim_markov_bin_of(const bsim_markov_bins *b, const bsim_lattice_def *l, int edge,
+                                double pos, const double v[2]);
 
 /* ---- validation against the simulation ---------------------------------
  *
@@ -208,7 +210,7 @@ typedef struct bsim_markov_validate_def {
 	void *progress_user;
 } bsim_markov_validate_def;
 
-bsim_markov_validate_def bsim_markov_validate_default(void);
+BSIM_API bsim_markov_validate_def bsim_markov_validate_default(void);
 
 /* One group under one protocol. */
 typedef struct bsim_markov_check {
@@ -237,9 +239,9 @@ typedef struct bsim_markov_validation {
  * interval, predicted p), gates.csv (the distribution of gates visited,
  * simulated and predicted), their .mat twins, and the figure
  * validate_gNNN (.png .svg .gp) per group. */
-int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_validation *out,
-                         bsim_error *err);
-void bsim_markov_validation_free(bsim_markov_validation *v);
+BSIM_API int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_validation *out,
+                                  bsim_error *err);
+BSIM_API void bsim_markov_validation_free(bsim_markov_validation *v);
 
 #ifdef __cplusplus
 }

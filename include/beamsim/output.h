@@ -1,12 +1,13 @@
 /* The output files of a sweep (DESIGN.md "Outputs", a contract):
  * summary.json, trials.csv and the text table of p_traverse. Files are
- * written through beamsim/atomic_file.h, so a reader never sees half a
+ * written through util/atomic_file.h, so a reader never sees half a
  * file and an interrupted run leaves none. */
-#ifndef BEAMSIM_OUTPUT_H
-#define BEAMSIM_OUTPUT_H
+#ifndef BSIM_OUTPUT_H
+#define BSIM_OUTPUT_H
 
 #include <stdio.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
 #include "beamsim/sweep.h"
@@ -15,8 +16,9 @@
 extern "C" {
 #endif
 
-int bsim_output_summary_json(const char *path, const bsim_experiment *e, const char *backend,
-                             const bsim_options *opts, const bsim_sweep_result *r, bsim_error *err);
+BSIM_API int bsim_output_summary_json(const char *path, const bsim_experiment *e,
+                                      const char *backend, const bsim_options *opts,
+                                      const bsim_sweep_result *r, bsim_error *err);
 /* trials.csv, one row per trial (DESIGN.md "Outputs", extended by
  * appending): group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,
  * max_theta1,max_theta2, then the energy ledger e_start,e_end,work_in
@@ -24,12 +26,13 @@ int bsim_output_summary_json(const char *path, const bsim_experiment *e, const c
  * correction),residual (J), overlap_max (m; empty if not measured), then one
  * column per grid axis of e (may be NULL), named by its dotted key, holding
  * the group's value. */
-int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
-                           bsim_error *err);
+BSIM_API int bsim_output_trials_csv(const char *path, const bsim_experiment *e,
+                                    const bsim_sweep_result *r, bsim_error *err);
 /* trajectories.csv: the kept trajectories of r (r->keep per group), rows of
  * bsim_trajectory_csv_header, group by group, trial by trial. Nothing is
  * written when r keeps none. */
-int bsim_output_trajectories_csv(const char *path, const bsim_sweep_result *r, bsim_error *err);
+BSIM_API int bsim_output_trajectories_csv(const char *path, const bsim_sweep_result *r,
+                                          bsim_error *err);
 /* Reads a trials.csv written by bsim_output_trials_csv, by this version or
  * an earlier one, back into r (which it allocates: n_groups x trials rows,
  * each exactly once) and aggregates the groups. Columns are found by their
@@ -37,35 +40,36 @@ int bsim_output_trajectories_csv(const char *path, const bsim_sweep_result *r, b
  * when present (r->has_ledger), others are ignored. The fields not in the
  * file are zero. BSIM_EINPUT with file and line on a malformed, missing or
  * extra row. */
-int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_sweep_result *r,
-                            bsim_error *err);
+BSIM_API int bsim_output_trials_read(const char *path, int n_groups, int trials,
+                                     bsim_sweep_result *r, bsim_error *err);
 
 /* A lattice sweep's own files in dir (docs/lattice.md "Files"):
  * lattice_map.csv, final_locations.csv, transitions.csv, gate_entries.csv
  * and beam_peaks.csv. Nothing
  * for a sweep of gate scenes. extra: the command line's --set, to rebuild
  * the groups' stiffness maps. */
-int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_override *extra,
-                        int n_extra, const bsim_sweep_result *r, bsim_error *err);
+BSIM_API int bsim_output_lattice(const char *dir, const bsim_experiment *e,
+                                 const bsim_override *extra, int n_extra,
+                                 const bsim_sweep_result *r, bsim_error *err);
 
 /* p_traverse over the first two grid axes (columns: axis 0, rows: axis 1),
  * one table per combination of the other axes. */
-void bsim_output_table(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r);
+BSIM_API void bsim_output_table(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r);
 
 /* A JSON object of every knob of backend b (may be NULL) with its
  * effective value, given in opts or the default, then any option of opts
  * that b does not list: a record alone says how the backend was run.
  * Shared by summary.json, run --json and bench --json. */
-void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_options *opts);
+BSIM_API void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_options *opts);
 
 /* The JSON object {axis key: value} of group g, values as numbers where
  * they are numbers (as in summary.json); {} beyond BSIM_OUTPUT_AXES_MAX
  * axes. */
 #define BSIM_OUTPUT_AXES_MAX 32
-void bsim_output_group_params(FILE *f, const bsim_experiment *e, int g);
+BSIM_API void bsim_output_group_params(FILE *f, const bsim_experiment *e, int g);
 
 /* Creates dir (and parents) if missing. */
-int bsim_output_mkdir(const char *dir, bsim_error *err);
+BSIM_API int bsim_output_mkdir(const char *dir, bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -2,8 +2,10 @@
  * thread with how much of the work is done (sweeps, comparisons and
  * regressions count trials; the accuracy study counts settings). The
  * beamsim program draws it as a line with an ETA on a terminal. */
-#ifndef BEAMSIM_PROGRESS_H
-#define BEAMSIM_PROGRESS_H
+#ifndef BSIM_PROGRESS_H
+#define BSIM_PROGRESS_H
+
+#include "beamsim/base.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -6,9 +6,10 @@
  * tests of beamsim/compare.h: DIR/regress.md and DIR/regress.json. Both
  * sides are read from their trials.csv, so they have the file's precision;
  * identical code and inputs give identical trials. */
-#ifndef BEAMSIM_REGRESS_H
-#define BEAMSIM_REGRESS_H
+#ifndef BSIM_REGRESS_H
+#define BSIM_REGRESS_H
 
+#include "beamsim/base.h"
 #include "beamsim/compare.h"
 #include "beamsim/experiment.h"
 #include "beamsim/run_record.h"
@@ -29,7 +30,7 @@ typedef struct bsim_regress_def {
 } bsim_regress_def;
 
 /* The stored rule, all cores. */
-bsim_regress_def bsim_regress_default(void);
+BSIM_API bsim_regress_def bsim_regress_default(void);
 
 typedef struct bsim_regress_side {
 	char label[128];
@@ -51,8 +52,9 @@ typedef struct bsim_regress_result {
  * same); BSIM_EINPUT if the baseline is not a stored run, its files do not
  * match their manifest, or out cannot be used; BSIM_EFAIL if the rerun
  * fails. */
-int bsim_regress_run(const bsim_regress_def *def, bsim_regress_result *res, bsim_error *err);
-void bsim_regress_result_free(bsim_regress_result *res);
+BSIM_API int bsim_regress_run(const bsim_regress_def *def, bsim_regress_result *res,
+                              bsim_error *err);
+BSIM_API void bsim_regress_result_free(bsim_regress_result *res);
 
 #ifdef __cplusplus
 }

@@ -2,11 +2,12 @@
  * report.md for people, report.json for tools) and the per-pair table
  * pairs.csv. beamsim regress reuses the sections for a stored run against
  * its rerun. */
-#ifndef BEAMSIM_REPORT_H
-#define BEAMSIM_REPORT_H
+#ifndef BSIM_REPORT_H
+#define BSIM_REPORT_H
 
 #include <stdio.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/compare.h"
 #include "beamsim/experiment.h"
@@ -39,13 +40,13 @@ typedef struct bsim_report {
 /* The body of report.md: the verdict, the rule, the separation times, one
  * table row per group, then each disagreeing group in detail with example
  * trials and the `beamsim run` lines that replay them. */
-void bsim_report_md(FILE *f, const bsim_report *r);
+BSIM_API void bsim_report_md(FILE *f, const bsim_report *r);
 /* report.json: the same content as one JSON object. */
-void bsim_report_json(FILE *f, const bsim_report *r);
+BSIM_API void bsim_report_json(FILE *f, const bsim_report *r);
 /* pairs.csv: group,trial,outcome_a,type_a,outcome_b,type_b,t_separate,
  * location_a,location_b (t_separate empty when the pair never separated;
  * the final locations as in trials.csv). */
-void bsim_report_pairs_csv(FILE *f, const bsim_report *r);
+BSIM_API void bsim_report_pairs_csv(FILE *f, const bsim_report *r);
 
 #ifdef __cplusplus
 }

@@ -14,12 +14,13 @@
  *
  * The directory is written as one set (DIR/manifest.json last) once the
  * trial has run: a failed trial leaves none of its files. */
-#ifndef BEAMSIM_RUN_OUTPUT_H
-#define BEAMSIM_RUN_OUTPUT_H
+#ifndef BSIM_RUN_OUTPUT_H
+#define BSIM_RUN_OUTPUT_H
 
 #include <stdint.h>
 #include <stdio.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/scene.h"
 #include "beamsim/trial.h"
@@ -47,7 +48,7 @@ typedef struct bsim_run_info {
  * (bsim_backend_default) without options, trial 0 of group 0 of experiment
  * seed 1, every step recorded. scene_path, scene and mixed_seed are the
  * caller's to set (bsim_schedule_seed_mix(seed, group, trial)). */
-bsim_run_info bsim_run_info_default(void);
+BSIM_API bsim_run_info bsim_run_info_default(void);
 
 /* The JSON object of a trial (one line, with a newline): scene, name,
  * backend, backend_options, seed, group, trial, mixed_seed, outcome, type,
@@ -57,8 +58,8 @@ bsim_run_info bsim_run_info_default(void);
  * peak_theta (with a log), ledger, instability (null or why the trial was
  * unstable). record adds command, beamsim_version,
  * stride, set and scene_copy, for run.json. */
-void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r,
-                          int record);
+BSIM_API void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r,
+                                   int record);
 
 /* Runs the trial info describes (bsim_trial_run with the mixed seed,
  * recording every info->stride-th step, info->log filled if not NULL) and
@@ -71,8 +72,8 @@ void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_r
  * The files appear only if the trial ran (an unstable trial did run: its
  * outcome says so). res gets the result. BSIM_EINPUT if out cannot be
  * used or an option is bad; BSIM_EFAIL if the trial or a file fails. */
-int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, const char *out,
-                          bsim_trial_result *res, bsim_error *err);
+BSIM_API int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory,
+                                   const char *out, bsim_trial_result *res, bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -3,11 +3,12 @@
  * backends with every knob's effective value, seed, trials, the comparison
  * rule) and DIR/inputs/ (the scene file as it was, and the experiment with
  * its command-line --set overrides folded into `set:`). */
-#ifndef BEAMSIM_RUN_RECORD_H
-#define BEAMSIM_RUN_RECORD_H
+#ifndef BSIM_RUN_RECORD_H
+#define BSIM_RUN_RECORD_H
 
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/compare.h"
 #include "beamsim/experiment.h"
@@ -34,28 +35,30 @@ typedef struct bsim_run_record {
  * each side's backend, label (NULL: the backend's name) and every knob's
  * effective value, the experiment's seed and trials, and the rule (NULL:
  * bsim_compare_rule_default()). */
-void bsim_run_record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e,
-                          int n, const bsim_backend *const *b, const bsim_options *const *opts,
-                          const char *const *label, const bsim_compare_rule *rule);
+BSIM_API void bsim_run_record_fill(bsim_run_record *rec, const char *command,
+                                   const bsim_experiment *e, int n, const bsim_backend *const *b,
+                                   const bsim_options *const *opts, const char *const *label,
+                                   const bsim_compare_rule *rule);
 
 /* Writes DIR/inputs/scene.yaml, DIR/inputs/experiment.yaml and, last,
  * DIR/run.json, each atomically: a directory with run.json is complete. */
-int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsim_experiment *e,
-                          const bsim_override *extra, int n_extra, bsim_error *err);
+BSIM_API int bsim_run_record_write(const char *dir, const bsim_run_record *rec,
+                                   const bsim_experiment *e, const bsim_override *extra,
+                                   int n_extra, bsim_error *err);
 
 /* What the trials of a run depend on, as text (malloc'd; NULL and err on
  * failure): version, command, backends with every option, the number of
  * groups, the experiment as it ran (seed, trials, every override, the grid)
  * and the scene file's text. Two runs with equal texts have equal trials;
  * a resumed run must have the text of the run it continues
- * (beamsim/journal.h). The comparison rule is not in it: it changes the
+ * (util/journal.h). The comparison rule is not in it: it changes the
  * report, not the trials. */
-char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *e,
-                             const bsim_override *extra, int n_extra, bsim_error *err);
+BSIM_API char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *e,
+                                      const bsim_override *extra, int n_extra, bsim_error *err);
 
 /* Reads DIR/run.json. BSIM_EINPUT naming the file and field on a missing
  * or malformed record. The experiment to load is DIR/inputs/experiment.yaml. */
-int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err);
+BSIM_API int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err);
 
 #ifdef __cplusplus
 }

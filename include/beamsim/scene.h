@@ -1,9 +1,10 @@
 /* A scene: one body, any number of beams, the contact law, the effects to
  * simulate, and the integration and termination settings (DESIGN.md "Scene
  * file", MODEL.md sections 1-6). All quantities SI. */
-#ifndef BEAMSIM_SCENE_H
-#define BEAMSIM_SCENE_H
+#ifndef BSIM_SCENE_H
+#define BSIM_SCENE_H
 
+#include "beamsim/base.h"
 #include "beamsim/error.h"
 
 #ifdef __cplusplus
@@ -104,8 +105,8 @@ typedef struct bsim_override {
 /* Loads and validates a scene file, applying the overrides in order (later
  * ones win). On failure returns BSIM_EINPUT with one message naming the file
  * (or the override's origin), line, field and what was expected. */
-int bsim_scene_load(const char *path, const bsim_override *overrides, int n_overrides,
-                    bsim_scene *out, bsim_error *err);
+BSIM_API int bsim_scene_load(const char *path, const bsim_override *overrides, int n_overrides,
+                             bsim_scene *out, bsim_error *err);
 
 /* A scene with no body and no beams, every other field at the default a
  * scene file gets where it leaves the key out (docs/files.md): contact
@@ -113,30 +114,30 @@ int bsim_scene_load(const char *path, const bsim_override *overrides, int n_over
  * steps, success_y 65 m, side_x 25 m, classify_y 80 m, classify_deadband
  * 0.01 m/s, landscape_y0 60 m, no effects. Set body and beams (and effects)
  * before bsim_scene_validate; free with bsim_scene_free. */
-bsim_scene bsim_scene_default(void);
+BSIM_API bsim_scene bsim_scene_default(void);
 
 /* Fills the essay's single-gate scene (MODEL.md section 1, Table 2.1) with
  * the given propulsion and random force magnitude (0 = effect absent). */
-void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm);
+BSIM_API void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm);
 
 /* Range and geometry checks (positive masses, no initial overlap, ...) on a
  * scene built in code; bsim_scene_load runs the same checks. */
-int bsim_scene_validate(const bsim_scene *s, bsim_error *err);
+BSIM_API int bsim_scene_validate(const bsim_scene *s, bsim_error *err);
 
-int bsim_scene_copy(bsim_scene *dst, const bsim_scene *src);
-void bsim_scene_free(bsim_scene *s);
+BSIM_API int bsim_scene_copy(bsim_scene *dst, const bsim_scene *src);
+BSIM_API void bsim_scene_free(bsim_scene *s);
 
 /* Sets the number of beams, (re)allocating the array; new beams are zeroed. */
-int bsim_scene_set_beams(bsim_scene *s, int n_beams);
+BSIM_API int bsim_scene_set_beams(bsim_scene *s, int n_beams);
 
 /* The unit direction u0 of beam b at rest (rest_angle_deg, 0 = +x), exact
  * at multiples of 90 degrees, so that the beams of a mirrored gate (0 and
  * 180 degrees) are mirrored bit for bit. */
-void bsim_scene_beam_rest_direction(const bsim_beam_def *b, double u0[2]);
+BSIM_API void bsim_scene_beam_rest_direction(const bsim_beam_def *b, double u0[2]);
 
 /* +1 if a forward swing (theta > 0, the tip toward +y) turns beam b
  * counter-clockwise (a beam pointing right at rest), -1 otherwise. */
-double bsim_scene_beam_forward_sign(const bsim_beam_def *b);
+BSIM_API double bsim_scene_beam_forward_sign(const bsim_beam_def *b);
 
 #ifdef __cplusplus
 }

@@ -4,11 +4,12 @@
  * generator seeded by bsim_schedule_seed_mix(experiment seed, group, trial). Values
  * are drawn lazily in order and kept, so a schedule can be replayed from any
  * step and costs nothing in a trial that ends early. */
-#ifndef BEAMSIM_SCHEDULE_H
-#define BEAMSIM_SCHEDULE_H
+#ifndef BSIM_SCHEDULE_H
+#define BSIM_SCHEDULE_H
 
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/error.h"
 
 #ifdef __cplusplus
@@ -17,41 +18,41 @@ extern "C" {
 
 /* The fixed mixing function: a SplitMix64 finaliser over the three inputs.
  * It never changes; summary.json of every version depends on it. */
-uint64_t bsim_schedule_seed_mix(uint64_t seed, uint64_t group, uint64_t trial);
+BSIM_API uint64_t bsim_schedule_seed_mix(uint64_t seed, uint64_t group, uint64_t trial);
 
 typedef struct bsim_schedule bsim_schedule;
 
 /* magnitude Rm in N, frequency f in Hz (> 0), seed from bsim_schedule_seed_mix. */
-bsim_schedule *bsim_schedule_alloc(double magnitude, double frequency, uint64_t seed);
-void bsim_schedule_free(bsim_schedule *s);
+BSIM_API bsim_schedule *bsim_schedule_alloc(double magnitude, double frequency, uint64_t seed);
+BSIM_API void bsim_schedule_free(bsim_schedule *s);
 
 /* Restarts the schedule with a new seed (no allocation: reuse across trials). */
-void bsim_schedule_reset(bsim_schedule *s, double magnitude, uint64_t seed);
+BSIM_API void bsim_schedule_reset(bsim_schedule *s, double magnitude, uint64_t seed);
 
 /* Index j of the value that applies at step n of size h. */
-long bsim_schedule_index(const bsim_schedule *s, long n, double h);
+BSIM_API long bsim_schedule_index(const bsim_schedule *s, long n, double h);
 
 /* The force value j (N): Rm * z_j. Draws z up to j if not drawn yet. A
  * value that cannot be had (no memory for it, or j outside 0 .. 2^40) is
  * 0, and bsim_schedule_status then fails: never a NaN. */
-double bsim_schedule_value(bsim_schedule *s, long j);
+BSIM_API double bsim_schedule_value(bsim_schedule *s, long j);
 
 /* The force value at step n of size h (N): bsim_schedule_value of
  * bsim_schedule_index, the same bits, with the value held over its steps
  * kept so that the steps between two refreshes read it at no cost. */
-double bsim_schedule_at_step(bsim_schedule *s, long n, double h);
+BSIM_API double bsim_schedule_at_step(bsim_schedule *s, long n, double h);
 
 /* BSIM_OK, or BSIM_EFAIL saying which value could not be had and why,
  * since the last reset. */
-int bsim_schedule_status(const bsim_schedule *s, bsim_error *err);
+BSIM_API int bsim_schedule_status(const bsim_schedule *s, bsim_error *err);
 
 /* Number of standard-normal draws made since alloc/reset. */
-unsigned long bsim_schedule_draws(const bsim_schedule *s);
+BSIM_API unsigned long bsim_schedule_draws(const bsim_schedule *s);
 
 /* Total draws made by all schedules of this process that have since been
  * reset or freed (for tests that prove a scene without random force makes
  * none; a trial frees its schedule when it ends). */
-unsigned long bsim_schedule_total_draws(void);
+BSIM_API unsigned long bsim_schedule_total_draws(void);
 
 #ifdef __cplusplus
 }

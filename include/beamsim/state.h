@@ -2,9 +2,10 @@
  * beams, contacts, the step's energy flows, and the beams that may be away
  * from rest. The caller owns a state's storage: bsim_state_init sizes it for
  * a scene's beams, bsim_state_free releases it. */
-#ifndef BEAMSIM_STATE_H
-#define BEAMSIM_STATE_H
+#ifndef BSIM_STATE_H
+#define BSIM_STATE_H
 
+#include "beamsim/base.h"
 #include "beamsim/error.h"
 
 #ifdef __cplusplus
@@ -59,13 +60,13 @@ typedef struct bsim_state {
 
 /* Sizes s for n_beams beams, everything zero. BSIM_EFAIL out of memory
  * (s is then empty, and bsim_state_free on it is harmless). */
-int bsim_state_init(bsim_state *s, int n_beams);
-void bsim_state_free(bsim_state *s);
-void bsim_state_copy(bsim_state *dst, const bsim_state *src);
+BSIM_API int bsim_state_init(bsim_state *s, int n_beams);
+BSIM_API void bsim_state_free(bsim_state *s);
+BSIM_API void bsim_state_copy(bsim_state *dst, const bsim_state *src);
 /* For a backend's get_state: zeroes the entries of the beams s lists now,
  * then lists the n given ones (ascending), whose entries the backend then
  * writes. Costs the two lists, not n_beams. */
-void bsim_state_set_active(bsim_state *s, const int *active, int n);
+BSIM_API void bsim_state_set_active(bsim_state *s, const int *active, int n);
 
 #ifdef __cplusplus
 }

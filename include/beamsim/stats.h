@@ -1,6 +1,8 @@
 /* Statistics of traversal counts. */
-#ifndef BEAMSIM_STATS_H
-#define BEAMSIM_STATS_H
+#ifndef BSIM_STATS_H
+#define BSIM_STATS_H
+
+#include "beamsim/base.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -8,19 +10,19 @@ extern "C" {
 
 /* Wilson score interval for k successes in n trials at confidence z
  * (1.959964 for 95%). n = 0 gives [0, 1]. */
-void bsim_stats_wilson(int k, int n, double z, double *lo, double *hi);
+BSIM_API void bsim_stats_wilson(int k, int n, double z, double *lo, double *hi);
 
 #define BSIM_STATS_Z95 1.959963984540054
 
 /* Exact two-sided McNemar test: of the b + c discordant pairs, b went one
  * way and c the other; under "no difference" b ~ Binomial(b + c, 1/2).
  * Returns min(1, 2 P(X <= min(b, c))); 1 when there is no discordant pair. */
-double bsim_stats_mcnemar_exact(int b, int c);
+BSIM_API double bsim_stats_mcnemar_exact(int b, int c);
 
 /* Holm's step-down adjustment of n p-values (family-wise error control under
  * any dependence): adj[i] = max over the j sorted before i of
  * min(1, (n - rank_j) p_j). p and adj may be the same array. */
-void bsim_stats_holm(const double *p, int n, double *adj);
+BSIM_API void bsim_stats_holm(const double *p, int n, double *adj);
 
 /* A 2x2 table of paired binary outcomes (the same trial on backends A and
  * B): a both yes, b A yes and B no, c A no and B yes, d both no. */
@@ -33,34 +35,34 @@ typedef struct bsim_pairs {
  * two Wilson intervals and the correlation of the pairs. It shrinks to a
  * point when the pairs are perfectly correlated (b = c = 0 with a, d > 0);
  * beamsim compare uses Tango's interval below. */
-void bsim_stats_newcombe_ci(const bsim_pairs *t, double z, double *lo, double *hi);
+BSIM_API void bsim_stats_newcombe_ci(const bsim_pairs *t, double z, double *lo, double *hi);
 
 /* Tango's score statistic (Statist. Med. 17, 1998, 891-908) for
  * H0: p_A - p_B = delta, delta in (-1, 1):
  *   T(delta) = (b - c - n delta) / sqrt(n (2 q + delta (1 - delta)))
  * with q the maximum-likelihood estimate of the probability of a (no, yes)
  * pair under H0. T falls as delta rises; T ~ N(0, 1) under H0. */
-double bsim_stats_tango_score(const bsim_pairs *t, double delta);
+BSIM_API double bsim_stats_tango_score(const bsim_pairs *t, double delta);
 
 /* Tango's score interval for p_A - p_B: every delta with |T(delta)| <= z.
  * Unlike Wald or Newcombe it keeps a width with no discordant pair at all
  * (b = c = 0 gives +-z^2 / (n + z^2)) and stays inside [-1, 1]. */
-void bsim_stats_tango_ci(const bsim_pairs *t, double z, double *lo, double *hi);
+BSIM_API void bsim_stats_tango_ci(const bsim_pairs *t, double z, double *lo, double *hi);
 
 /* Tango's equivalence test of the paired difference against +-margin:
  * two one-sided score tests, H0: p_A - p_B <= -margin and
  * H0: p_A - p_B >= margin. Returns the larger of their p-values; below
  * alpha, the difference is shown to lie within +-margin (equivalently, the
  * 1 - 2 alpha Tango interval lies inside it). 1 for margin <= 0. */
-double bsim_stats_tango_tost(const bsim_pairs *t, double margin);
+BSIM_API double bsim_stats_tango_tost(const bsim_pairs *t, double margin);
 
 /* Of m discordant pairs, the largest count k going one way for which the
  * exact McNemar test (k against m - k) has a p-value below level; -1 if
  * none (too few pairs to reach it). |b - c| >= m - 2k is then significant. */
-int bsim_stats_mcnemar_split(int m, double level);
+BSIM_API int bsim_stats_mcnemar_split(int m, double level);
 
 /* The standard normal quantile z with P(Z > z) = q. */
-double bsim_stats_normal_upper(double q);
+BSIM_API double bsim_stats_normal_upper(double q);
 
 #ifdef __cplusplus
 }

@@ -1,11 +1,12 @@
 /* A sweep: every (group, trial) of an experiment on one backend, in parallel
  * (OpenMP), with results independent of the number of threads. */
-#ifndef BEAMSIM_SWEEP_H
-#define BEAMSIM_SWEEP_H
+#ifndef BSIM_SWEEP_H
+#define BSIM_SWEEP_H
 
 #include <signal.h>
 #include <stddef.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
 #include "beamsim/options.h"
@@ -84,13 +85,13 @@ typedef struct bsim_sweep_config {
  * sweep both results and the separation time. The record is the result's
  * bytes as they are in memory, so a resumed sweep's results are the
  * uninterrupted sweep's to the bit. */
-size_t bsim_sweep_record_size(int paired);
+BSIM_API size_t bsim_sweep_record_size(int paired);
 
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller
  * applies --trials/--seed). BSIM_ESTOPPED (see cfg->stop) says how many
  * trials were finished. */
-int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
-                   bsim_error *err);
+BSIM_API int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                            bsim_sweep_result *out, bsim_error *err);
 
 /* The same sweep run as pairs (beamsim compare): every trial runs on
  * cfg->backend into out_a and, with the same schedule, on backend_b into
@@ -98,14 +99,15 @@ int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_
  * the time, s, at which the pair's body centres first lie more than 1% of
  * the body radius apart, -1 if never while both ran. out_a and out_b each
  * equal what bsim_sweep_run gives for its backend. */
-int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
-                          const bsim_backend *backend_b, const bsim_options *opts_b,
-                          bsim_sweep_result *out_a, bsim_sweep_result *out_b, double **t_separate,
-                          bsim_error *err);
-void bsim_sweep_result_free(bsim_sweep_result *r);
+BSIM_API int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                   const bsim_backend *backend_b, const bsim_options *opts_b,
+                                   bsim_sweep_result *out_a, bsim_sweep_result *out_b,
+                                   double **t_separate, bsim_error *err);
+BSIM_API void bsim_sweep_result_free(bsim_sweep_result *r);
 
 /* Aggregates one group's trials into counts and the Wilson interval. */
-void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out);
+BSIM_API void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n,
+                                         bsim_group_result *out);
 
 #ifdef __cplusplus
 }

@@ -20,12 +20,13 @@
  * journaled as they end (DIR/.beamsim/journal), so a run stopped through
  * def.stop or killed continues with def.resume and writes the files an
  * uninterrupted run writes, byte for byte. */
-#ifndef BEAMSIM_SWEEP_DIR_H
-#define BEAMSIM_SWEEP_DIR_H
+#ifndef BSIM_SWEEP_DIR_H
+#define BSIM_SWEEP_DIR_H
 
 #include <signal.h>
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
 #include "beamsim/sweep.h"
@@ -58,7 +59,7 @@ typedef struct bsim_sweep_dir_def {
 } bsim_sweep_dir_def;
 
 /* The thesis backend, no options, all cores, nothing kept. */
-bsim_sweep_dir_def bsim_sweep_dir_default(void);
+BSIM_API bsim_sweep_dir_def bsim_sweep_dir_default(void);
 
 typedef struct bsim_sweep_dir_result {
 	bsim_experiment e;   /* as run: --trials and --seed applied */
@@ -80,7 +81,8 @@ typedef struct bsim_sweep_dir_result {
  * or a refused resume; BSIM_EFAIL when the run or a file fails;
  * BSIM_ESTOPPED when def->stop stopped it. On any error res holds nothing
  * to free but res->journal. */
-int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err);
+BSIM_API int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res,
+                                bsim_error *err);
 
 /* Reads a stored sweep back: DIR's run.json (beamsim/run_record.h), the
  * experiment of DIR/inputs/ and the trials of trials.csv, with each
@@ -89,10 +91,10 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
  * DIR/<bsim_compare_dir_label(side)>/). BSIM_EINPUT naming the file and
  * field if DIR is not such a directory or its files do not match its
  * manifest. */
-int bsim_sweep_dir_read(const char *dir, const char *side, bsim_sweep_dir_result *res,
-                        bsim_error *err);
+BSIM_API int bsim_sweep_dir_read(const char *dir, const char *side, bsim_sweep_dir_result *res,
+                                 bsim_error *err);
 
-void bsim_sweep_dir_result_free(bsim_sweep_dir_result *res);
+BSIM_API void bsim_sweep_dir_result_free(bsim_sweep_dir_result *res);
 
 #ifdef __cplusplus
 }

@@ -1,11 +1,12 @@
 /* The trial runner (MODEL.md section 6): owns time, the effect pipeline,
  * termination, outcomes, the energy ledger and optional recording. */
-#ifndef BEAMSIM_TRIAL_H
-#define BEAMSIM_TRIAL_H
+#ifndef BSIM_TRIAL_H
+#define BSIM_TRIAL_H
 
 #include <stdint.h>
 #include <stdio.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/scene.h"
 
@@ -75,7 +76,7 @@ typedef struct bsim_ledger {
 	double inflow;       /* e_start + sum over steps of |w_prop| + |w_rand| */
 } bsim_ledger;
 
-/* Plain data, no pointers: a sweep's journal (beamsim/journal.h) stores it
+/* Plain data, no pointers: a sweep's journal (util/journal.h) stores it
  * byte for byte, and a resumed sweep reads it back so. */
 typedef struct bsim_trial_result {
 	bsim_outcome outcome;
@@ -114,7 +115,7 @@ typedef enum {
 	BSIM_EDGE_TOP = 4,    /* from the gate above (iy + 1) */
 } bsim_edge;
 
-const char *bsim_trial_edge_name(bsim_edge e);
+BSIM_API const char *bsim_trial_edge_name(bsim_edge e);
 
 /* One entry into a gate: the state with which a single-gate map (entry ->
  * exit) would start, in the gate's own frame (Eq. 2.17: x = X - width ix,
@@ -144,13 +145,13 @@ typedef struct bsim_trial_log {
 	double *peak; /* n_beams: peak theta of every beam, rad */
 } bsim_trial_log;
 
-bsim_trial_log *bsim_trial_log_alloc(void);
-void bsim_trial_log_free(bsim_trial_log *l);
+BSIM_API bsim_trial_log *bsim_trial_log_alloc(void);
+BSIM_API void bsim_trial_log_free(bsim_trial_log *l);
 /* dst = a copy of src's entries and peaks (dst's own memory;
  * dst zeroed or a log from here). */
-int bsim_trial_log_copy(bsim_trial_log *dst, const bsim_trial_log *src);
+BSIM_API int bsim_trial_log_copy(bsim_trial_log *dst, const bsim_trial_log *src);
 /* Frees what a log holds, not the log itself (for logs in arrays). */
-void bsim_trial_log_clear(bsim_trial_log *l);
+BSIM_API void bsim_trial_log_clear(bsim_trial_log *l);
 
 /* Called with the state at t = 0 and after every step (step = 1, 2, ...),
  * whatever the stride; for in-memory use of a trajectory (compare). */
@@ -191,11 +192,11 @@ typedef struct bsim_recorder {
 } bsim_recorder;
 
 /* Writes the trajectory CSV header for a scene of n_beams beams. */
-void bsim_trial_trajectory_header(FILE *f, int n_beams);
+BSIM_API void bsim_trial_trajectory_header(FILE *f, int n_beams);
 
 /* A bsim_record_fn writing the row to the trajectory CSV file (a FILE *):
  * what rec->csv receives, for a second file with the same rows. */
-void bsim_trial_trajectory_row(void *file, const bsim_record_row *row);
+BSIM_API void bsim_trial_trajectory_row(void *file, const bsim_record_row *row);
 
 /* The ledger CSV (beamsim run --out): at each recorded time t, s,
  *   t,e_kin,e_beam,e_mech,w_prop,w_rand,damper,impact,contact,correction,residual,
@@ -205,13 +206,13 @@ void bsim_trial_trajectory_row(void *file, const bsim_record_row *row);
  *                           - correction - sleep - reset + residual
  * (sleep and reset: beams put to rest by sleeping and by the essay's lattice
  * protocol; 0 elsewhere). */
-void bsim_trial_ledger_header(FILE *f);
+BSIM_API void bsim_trial_ledger_header(FILE *f);
 
 typedef struct bsim_trial_runner bsim_trial_runner;
 
 /* A runner holds the reusable per-thread memory (state buffers, schedule). */
-bsim_trial_runner *bsim_trial_runner_alloc(void);
-void bsim_trial_runner_free(bsim_trial_runner *r);
+BSIM_API bsim_trial_runner *bsim_trial_runner_alloc(void);
+BSIM_API void bsim_trial_runner_free(bsim_trial_runner *r);
 
 /* Runs one trial. seed: the mixed seed (bsim_schedule_seed_mix). rec may be NULL.
  * A lattice scene runs under its lattice.protocol: the whole world, or the
@@ -220,17 +221,18 @@ void bsim_trial_runner_free(bsim_trial_runner *r);
  * Returns BSIM_OK (an unstable trial included: its outcome says so),
  * BSIM_EINPUT (backend options) or BSIM_EFAIL (out of memory, in the
  * runner, the schedule or the backend's step: never a result). */
-int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_backend *backend,
-                   const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
-                   bsim_trial_result *out, bsim_error *err);
+BSIM_API int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene,
+                            const bsim_backend *backend, const bsim_options *opts, uint64_t seed,
+                            const bsim_recorder *rec, bsim_trial_result *out, bsim_error *err);
 
-const char *bsim_trial_outcome_name(bsim_outcome o);
-const char *bsim_trial_type_name(bsim_type t);
+BSIM_API const char *bsim_trial_outcome_name(bsim_outcome o);
+BSIM_API const char *bsim_trial_type_name(bsim_type t);
 
 /* Why trial r (run with time step dt, s) is unstable, in one line:
  * "non-finite state at step 512 (t = 2.048 s)" or "energy created: ledger
  * residual 3.67e+06 J > 1 x 1061 J that flowed in"; "" if it is not. */
-void bsim_trial_instability_text(const bsim_trial_result *r, double dt, char *buf, size_t size);
+BSIM_API void bsim_trial_instability_text(const bsim_trial_result *r, double dt, char *buf,
+                                          size_t size);
 
 #ifdef __cplusplus
 }

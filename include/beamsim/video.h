@@ -38,11 +38,12 @@
  * path) filled in the path colour. A lattice's view also shows the gate
  * boundaries, tints the gates entered, names the gate the body is in, and
  * states the outcome as the final location (end, side, stuck gate). */
-#ifndef BEAMSIM_VIDEO_H
-#define BEAMSIM_VIDEO_H
+#ifndef BSIM_VIDEO_H
+#define BSIM_VIDEO_H
 
 #include <stdint.h>
 
+#include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/error.h"
 #include "beamsim/scene.h"
@@ -63,10 +64,10 @@ typedef struct bsim_video_def {
 	const char *ffmpeg; /* the encoder program, looked up on PATH; default "ffmpeg" */
 } bsim_video_def;
 
-bsim_video_def bsim_video_def_default(void);
+BSIM_API bsim_video_def bsim_video_def_default(void);
 
 /* Checks a definition's ranges; BSIM_EINPUT naming the field otherwise. */
-int bsim_video_def_check(const bsim_video_def *def, bsim_error *err);
+BSIM_API int bsim_video_def_check(const bsim_video_def *def, bsim_error *err);
 
 /* What a frame of a track shows: the state after step `step`. */
 typedef struct bsim_video_sample {
@@ -90,25 +91,25 @@ typedef struct bsim_video_track bsim_video_track;
  * of simulated time. The scene must outlive the track. BSIM_EFAIL if the
  * run fails (the message says why, e.g. a non-finite state) or memory runs
  * out; BSIM_EINPUT for bad backend options or fps. */
-int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend,
-                            const bsim_options *opts, uint64_t seed, double fps,
-                            bsim_video_track **out, bsim_error *err);
-void bsim_video_track_free(bsim_video_track *t);
+BSIM_API int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend,
+                                     const bsim_options *opts, uint64_t seed, double fps,
+                                     bsim_video_track **out, bsim_error *err);
+BSIM_API void bsim_video_track_free(bsim_video_track *t);
 
 /* The trial's result, as bsim_trial_run gives it. */
-const bsim_trial_result *bsim_video_track_result(const bsim_video_track *t);
+BSIM_API const bsim_trial_result *bsim_video_track_result(const bsim_video_track *t);
 /* Frames recorded: ceil(steps_run dt fps) + 1. */
-long bsim_video_track_frames(const bsim_video_track *t);
+BSIM_API long bsim_video_track_frames(const bsim_video_track *t);
 /* Frame k (0 <= k < frames); later k give the last frame. */
-bsim_video_sample bsim_video_track_sample(const bsim_video_track *t, long k);
+BSIM_API bsim_video_sample bsim_video_track_sample(const bsim_video_track *t, long k);
 /* The body centre after step n (0 <= n <= steps_run), m. */
-void bsim_video_track_position(const bsim_video_track *t, long n, double x[2]);
+BSIM_API void bsim_video_track_position(const bsim_video_track *t, long n, double x[2]);
 
 /* The time, s, at which the body centres of two tracks of the same scene
  * are first more than sep_distance (m) apart, comparing steps both reached;
  * -1 if they never are. */
-double bsim_video_track_separation(const bsim_video_track *a, const bsim_video_track *b,
-                                   double sep_distance);
+BSIM_API double bsim_video_track_separation(const bsim_video_track *a, const bsim_video_track *b,
+                                            double sep_distance);
 
 /* A video of one to BSIM_VIDEO_PANELS_MAX tracks of the same scene. */
 #define BSIM_VIDEO_PANELS_MAX 4
@@ -116,38 +117,38 @@ typedef struct bsim_video bsim_video;
 
 /* tracks and labels (one a panel, e.g. the backend names) are borrowed
  * and must outlive v, as must scene. */
-int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
-                     const bsim_video_track *const *tracks, const char *const *labels, int n_panels,
-                     bsim_video **out, bsim_error *err);
-void bsim_video_free(bsim_video *v);
+BSIM_API int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
+                              const bsim_video_track *const *tracks, const char *const *labels,
+                              int n_panels, bsim_video **out, bsim_error *err);
+BSIM_API void bsim_video_free(bsim_video *v);
 
 /* Frames of the video, hold included. */
-long bsim_video_frames(const bsim_video *v);
+BSIM_API long bsim_video_frames(const bsim_video *v);
 /* Pixels of a frame (the def's, or the default for the panel count). */
-void bsim_video_size(const bsim_video *v, int *width, int *height);
+BSIM_API void bsim_video_size(const bsim_video *v, int *width, int *height);
 
 /* Draws frame k into pixels: width x height values 0x00RRGGBB, row-major
  * from the top-left (cairo's RGB24). BSIM_EFAIL if cairo fails. */
-int bsim_video_render(bsim_video *v, long k, uint32_t *pixels, bsim_error *err);
+BSIM_API int bsim_video_render(bsim_video *v, long k, uint32_t *pixels, bsim_error *err);
 
 /* The stiffness colour of the legend: 0x00RRGGBB for stiffness k, N m/rad,
  * on this video's scale (the scene's smallest to largest stiffness). */
-uint32_t bsim_video_stiffness_color(const bsim_video *v, double k);
+BSIM_API uint32_t bsim_video_stiffness_color(const bsim_video *v, double k);
 
 /* The colour the body is filled with, 0x00RRGGBB (nothing else is drawn
  * in it, so a frame's body can be found by its colour). */
-uint32_t bsim_video_body_color(void);
+BSIM_API uint32_t bsim_video_body_color(void);
 
 /* The colour of the gates the body has entered in a lattice's overview,
  * 0x00RRGGBB (nothing else is drawn in it). */
-uint32_t bsim_video_path_color(void);
+BSIM_API uint32_t bsim_video_path_color(void);
 
 /* Where world point p (m) lies in the overview of panel `panel` at frame k,
  * pixels from the frame's top-left: 1 and px if that frame shows an
  * overview (its camera follows the body over a field larger than the
  * view), else 0. */
-int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, const double p[2],
-                              double px[2]);
+BSIM_API int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, const double p[2],
+                                       double px[2]);
 
 /* Renders every frame and encodes them with ffmpeg into path: H.264,
  * yuv420p, fps frames per second. The file appears whole or not at all
@@ -155,7 +156,7 @@ int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, const doub
  * BSIM_EFAIL naming ffmpeg's package if it is missing, ffmpeg's exit
  * status and last message if it fails, or the path if it cannot be
  * written. */
-int bsim_video_write(bsim_video *v, const char *path, bsim_error *err);
+BSIM_API int bsim_video_write(bsim_video *v, const char *path, bsim_error *err);
 
 /* The ffmpeg pipe: raw frames in, an MP4 file out. */
 typedef struct bsim_video_encoder bsim_video_encoder;
@@ -165,16 +166,18 @@ typedef struct bsim_video_encoder bsim_video_encoder;
  * H.264 (libx264, yuv420p, crf) in MP4 to a temporary file beside path.
  * BSIM_EFAIL if the program is missing (naming the Debian package ffmpeg)
  * or cannot be started. */
-int bsim_video_encoder_open(const char *path, const char *program, int width, int height,
-                            double fps, int crf, bsim_video_encoder **out, bsim_error *err);
+BSIM_API int bsim_video_encoder_open(const char *path, const char *program, int width, int height,
+                                     double fps, int crf, bsim_video_encoder **out,
+                                     bsim_error *err);
 /* Writes one frame. BSIM_EFAIL if ffmpeg has stopped reading (the
  * message then gives its exit status and last message). */
-int bsim_video_encoder_write(bsim_video_encoder *e, const uint32_t *pixels, bsim_error *err);
+BSIM_API int bsim_video_encoder_write(bsim_video_encoder *e, const uint32_t *pixels,
+                                      bsim_error *err);
 /* Ends the stream, waits for ffmpeg, and if it exited with status 0
  * renames the file into place; else removes it. Frees e either way. */
-int bsim_video_encoder_close(bsim_video_encoder *e, bsim_error *err);
+BSIM_API int bsim_video_encoder_close(bsim_video_encoder *e, bsim_error *err);
 /* Stops ffmpeg and removes the temporary file; frees e. NULL is a no-op. */
-void bsim_video_encoder_abort(bsim_video_encoder *e);
+BSIM_API void bsim_video_encoder_abort(bsim_video_encoder *e);
 
 #ifdef __cplusplus
 }

@@ -2,8 +2,8 @@
  * value parsing, --set and --backend-opt collection, backend look-up,
  * the signals that stop a run, and the line that resumes it. The shared
  * options and the parser are cli_options.h. */
-#ifndef BEAMSIM_CLI_COMMON_H
-#define BEAMSIM_CLI_COMMON_H
+#ifndef BSIM_CLI_CLI_COMMON_H
+#define BSIM_CLI_CLI_COMMON_H
 
 #include <stdint.h>
 #include <stdio.h>

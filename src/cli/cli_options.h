@@ -9,8 +9,8 @@
  *   cli_common c = cli_common_default();
  *   int rc = cli_parse(&spec, argc, argv, &c, &my_args);  // -1: go on
  */
-#ifndef BSIM_CLI_OPTIONS_H
-#define BSIM_CLI_OPTIONS_H
+#ifndef BSIM_CLI_CLI_OPTIONS_H
+#define BSIM_CLI_CLI_OPTIONS_H
 
 #include <stdint.h>
 

@@ -2,8 +2,8 @@
  * progress and an ETA on a terminal, quiet when not on one).
  *
  *   "\r  1234/3000 trials  41%  ETA 0:03" on stderr, redrawn in place. */
-#ifndef BSIM_CLI_PROGRESS_H
-#define BSIM_CLI_PROGRESS_H
+#ifndef BSIM_CLI_CLI_PROGRESS_H
+#define BSIM_CLI_CLI_PROGRESS_H
 
 typedef struct cli_progress {
 	int active;       /* enabled and stderr is a terminal */

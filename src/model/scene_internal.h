@@ -1,8 +1,8 @@
 /* Internal: what scene.c, scene_schema.c and scene_load.c share. The scene
  * schema is a table per YAML mapping (key, type, range, offset), so the file
  * loader and bsim_scene_validate check the same things from one list. */
-#ifndef BSIM_SCENE_INTERNAL_H
-#define BSIM_SCENE_INTERNAL_H
+#ifndef BSIM_MODEL_SCENE_INTERNAL_H
+#define BSIM_MODEL_SCENE_INTERNAL_H
 
 #include <stddef.h>
 

@@ -11,8 +11,8 @@
  *
  * The file is written under a temporary name, flushed to disk and renamed,
  * so it appears whole or not at all, like every output of beamsim. */
-#ifndef BSIM_MAT_H
-#define BSIM_MAT_H
+#ifndef BSIM_STORE_MAT_H
+#define BSIM_STORE_MAT_H
 
 #include <stddef.h>
 

@@ -17,8 +17,8 @@
  *
  * Each file is written to a temporary name and renamed, like every output
  * of beamsim: it appears whole or not at all. */
-#ifndef BEAMSIM_MATLAB_H
-#define BEAMSIM_MATLAB_H
+#ifndef BSIM_STORE_MATLAB_H
+#define BSIM_STORE_MATLAB_H
 
 #include <stddef.h>
 

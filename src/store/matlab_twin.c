@@ -1,4 +1,4 @@
-/* MATLAB twins of CSV and JSON files (beamsim/matlab.h).
+/* MATLAB twins of CSV and JSON files (store/matlab.h).
  *
  * Both converters build a tree of bsim_mat_field (mat.h) whose arrays live
  * in an arena freed after the write. JSON is read with libfyaml (JSON is

@@ -1,9 +1,9 @@
-/* Output directories committed as a whole; see beamsim/outdir.h.
+/* Output directories committed as a whole; see store/outdir.h.
  *
  * Layout while a run is under way:
  *   DIR/                  the previous run's files and manifest, untouched
  *   DIR/.beamsim/staging/ this run's files under their final names
- *   DIR/.beamsim/journal  finished trials, for --resume (beamsim/journal.h)
+ *   DIR/.beamsim/journal  finished trials, for --resume (util/journal.h)
  * The lock is an flock on DIR itself: it needs no file of its own and the
  * kernel drops it when the process dies, however it dies. */
 #define _DEFAULT_SOURCE
@@ -310,7 +310,7 @@ void bsim_outdir_explain(const bsim_outdir *od, char *text, size_t size)
 }
 
 /* Puts the staged file at its place: a rename, or written through when the
- * place holds a symlink, FIFO or device (beamsim/atomic_file.h). */
+ * place holds a symlink, FIFO or device (util/atomic_file.h). */
 static int put(const char *staged, const char *final)
 {
 	if (!bsim_atomic_file_is_through(final))

@@ -23,9 +23,9 @@
  * stopped before its commit leaves DIR exactly as it was.
  *
  * DIR/.beamsim/ also holds what a stopped run keeps for `--resume` (its
- * journal, beamsim/journal.h); it is removed with the last of its contents. */
-#ifndef BEAMSIM_OUTDIR_H
-#define BEAMSIM_OUTDIR_H
+ * journal, util/journal.h); it is removed with the last of its contents. */
+#ifndef BSIM_STORE_OUTDIR_H
+#define BSIM_STORE_OUTDIR_H
 
 #include <stddef.h>
 

@@ -184,7 +184,7 @@ int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_ov
 		}
 		if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
 			return BSIM_EFAIL;
-		/* its MATLAB twin (beamsim/matlab.h), a struct named for the file */
+		/* its MATLAB twin (store/matlab.h), a struct named for the file */
 		char mat[1200], var[32];
 		snprintf(var, sizeof var, "%.*s", (int)strcspn(files[k].name, "."), files[k].name);
 		if (bsim_matlab_path(path, mat, sizeof mat, err) != BSIM_OK ||

@@ -3,8 +3,8 @@
  * directory-writing workflows (sweep_dir.c, compare_dir.c, regress.c,
  * run_output.c, landscape_store.c, accuracy_store.c, figures_plot.c)
  * share. Files are written into stage and appear in dir at the end. */
-#ifndef BSIM_SESSION_H
-#define BSIM_SESSION_H
+#ifndef BSIM_STORE_SESSION_H
+#define BSIM_STORE_SESSION_H
 
 #include <stddef.h>
 

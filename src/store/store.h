@@ -1,8 +1,8 @@
 /* What the stored runs (sweep_dir.c, compare_dir.c, regress.c) write alike:
  * a sweep's files in a directory, MATLAB twins, text files written by a
  * function, and the count of unstable trials. */
-#ifndef BSIM_STORE_H
-#define BSIM_STORE_H
+#ifndef BSIM_STORE_STORE_H
+#define BSIM_STORE_STORE_H
 
 #include <stdio.h>
 

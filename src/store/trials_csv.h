@@ -2,8 +2,8 @@
  * the eleven of DESIGN.md "Outputs", then those appended since): the one
  * list the writer (output.c) and the reader (trials_read.c) share. After
  * them come the grid axes of the experiment, one column each. */
-#ifndef BSIM_TRIALS_CSV_H
-#define BSIM_TRIALS_CSV_H
+#ifndef BSIM_STORE_TRIALS_CSV_H
+#define BSIM_STORE_TRIALS_CSV_H
 
 enum {
 	TRIALS_GROUP,

@@ -1,4 +1,4 @@
-/* Whole-or-nothing files; see beamsim/atomic_file.h. */
+/* Whole-or-nothing files; see util/atomic_file.h. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "util/atomic_file.h"

@@ -16,8 +16,8 @@
  *   fprintf(o.f, ...);
  *   return bsim_atomic_file_commit(&o, err); // or bsim_atomic_file_abort(&o)
  */
-#ifndef BEAMSIM_ATOMIC_FILE_H
-#define BEAMSIM_ATOMIC_FILE_H
+#ifndef BSIM_UTIL_ATOMIC_FILE_H
+#define BSIM_UTIL_ATOMIC_FILE_H
 
 #include <stdio.h>
 

@@ -1,6 +1,6 @@
 /* Wall-clock time for timings and ETAs. */
-#ifndef BEAMSIM_CLOCK_H
-#define BEAMSIM_CLOCK_H
+#ifndef BSIM_UTIL_CLOCK_H
+#define BSIM_UTIL_CLOCK_H
 
 #ifdef __cplusplus
 extern "C" {

@@ -5,8 +5,8 @@
  * same number of comma-separated fields, no quoting (no field it writes
  * holds a comma or a newline). Fields stay text; a reader asks for the
  * numbers it wants. */
-#ifndef BSIM_CSV_TABLE_H
-#define BSIM_CSV_TABLE_H
+#ifndef BSIM_UTIL_CSV_TABLE_H
+#define BSIM_UTIL_CSV_TABLE_H
 
 #include <stddef.h>
 

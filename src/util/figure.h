@@ -12,8 +12,8 @@
  * it succeeds, so a figure appears whole or not at all. Without gnuplot on
  * the PATH the script and data are still written and the caller is told
  * (drawn = 0), with a message naming the package to install. */
-#ifndef BSIM_FIGURE_H
-#define BSIM_FIGURE_H
+#ifndef BSIM_UTIL_FIGURE_H
+#define BSIM_UTIL_FIGURE_H
 
 #include "beamsim/error.h"
 

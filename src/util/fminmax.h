@@ -7,8 +7,8 @@
  * the order). Inline also because without -ffinite-math-only the compiler
  * calls the library through the PLT, which in a step's inner loops costs
  * more than the comparison. tests/test_step_caches.c checks them. */
-#ifndef BSIM_FMINMAX_H
-#define BSIM_FMINMAX_H
+#ifndef BSIM_UTIL_FMINMAX_H
+#define BSIM_UTIL_FMINMAX_H
 
 #include <math.h>
 

@@ -1,4 +1,4 @@
-/* The journal of finished work; see beamsim/journal.h. */
+/* The journal of finished work; see util/journal.h. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "util/journal.h"

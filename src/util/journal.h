@@ -19,8 +19,8 @@
  *           index and payload
  * Reading stops at the first record that is torn or fails its CRC, and the
  * file is cut there before anything more is appended. */
-#ifndef BEAMSIM_JOURNAL_H
-#define BEAMSIM_JOURNAL_H
+#ifndef BSIM_UTIL_JOURNAL_H
+#define BSIM_UTIL_JOURNAL_H
 
 #include <stddef.h>
 #include <stdint.h>

@@ -1,4 +1,4 @@
-/* JSON leaf values; see beamsim/json.h. */
+/* JSON leaf values; see util/json.h. */
 #include "util/json.h"
 
 #include <inttypes.h>

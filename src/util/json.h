@@ -2,8 +2,8 @@
  * run --json, bench --json). Only the two leaf values that need care live
  * here; callers write the braces, commas and keys themselves, so each
  * output keeps the exact layout its contract (DESIGN.md "Outputs") gives. */
-#ifndef BEAMSIM_JSON_H
-#define BEAMSIM_JSON_H
+#ifndef BSIM_UTIL_JSON_H
+#define BSIM_UTIL_JSON_H
 
 #include <stdint.h>
 #include <stdio.h>

@@ -7,8 +7,8 @@
  * they are refused with their position: only UTF-8 text, lines ending in LF
  * or CRLF, spaces rather than tabs, no control characters, no directives
  * and no four apostrophes in a row. */
-#ifndef BSIM_TEXT_CHECK_H
-#define BSIM_TEXT_CHECK_H
+#ifndef BSIM_UTIL_TEXT_CHECK_H
+#define BSIM_UTIL_TEXT_CHECK_H
 
 #include <stddef.h>
 

@@ -3,8 +3,8 @@
  * GOT". WHERE is the file position of the offending node, or the origin of
  * the override that put the node there (overrides tag the nodes they create
  * with fy_node_set_meta, see yaml_override.c). */
-#ifndef BSIM_YAML_DOC_H
-#define BSIM_YAML_DOC_H
+#ifndef BSIM_UTIL_YAML_DOC_H
+#define BSIM_UTIL_YAML_DOC_H
 
 #include <stddef.h>
 #include <stdint.h>

@@ -1,7 +1,7 @@
 /* Internal: applying "--set KEY=VALUE" overrides to a YAML document by
  * dotted path (DESIGN.md "Command line"). */
-#ifndef BSIM_YAML_OVERRIDE_H
-#define BSIM_YAML_OVERRIDE_H
+#ifndef BSIM_UTIL_YAML_OVERRIDE_H
+#define BSIM_UTIL_YAML_OVERRIDE_H
 
 #include "util/yaml_doc.h"
 

@@ -130,7 +130,7 @@ static int spawn(bsim_video_encoder *e, int width, int height, double fps, int c
 	snprintf(rate, sizeof rate, "%.10g", fps);
 	snprintf(quality, sizeof quality, "%d", crf);
 	/* file: keeps a path with a colon from being read as a protocol. What
-	 * is not a regular file (beamsim/atomic_file.h) is written in place:
+	 * is not a regular file (util/atomic_file.h) is written in place:
 	 * standard output as ffmpeg's own, a pipe or device by its path; those
 	 * cannot seek back to put the index first, so the MP4 is fragmented. */
 	struct stat st;

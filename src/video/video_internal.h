@@ -1,6 +1,6 @@
 /* Internal: what the video's files share (beamsim/video.h is the API). */
-#ifndef BSIM_VIDEO_INTERNAL_H
-#define BSIM_VIDEO_INTERNAL_H
+#ifndef BSIM_VIDEO_VIDEO_INTERNAL_H
+#define BSIM_VIDEO_VIDEO_INTERNAL_H
 
 #include "beamsim/video.h"
 

@@ -1,8 +1,8 @@
 /* What the fuzz targets share: a scratch directory for the input file
  * (the loaders under test read files, as the program does), and the checks
  * every outcome must pass. */
-#ifndef BSIM_FUZZ_COMMON_H
-#define BSIM_FUZZ_COMMON_H
+#ifndef BSIM_FUZZ_FUZZ_COMMON_H
+#define BSIM_FUZZ_FUZZ_COMMON_H
 
 #include <stddef.h>
 #include <stdint.h>
