@@ -14,7 +14,8 @@ compiled objects:
 4. header guards follow one rule: BSIM_<NAME>_H for a public header,
    BSIM_<FOLDER>_<NAME>_H for the others;
 5. every function a public header declares is defined in that header's
-   layer, so that a header is one layer's API.
+   layer, so that a header is one layer's API;
+6. beamsim/beamsim.h includes every public header.
 
 Usage: layers.py SOURCE_DIR BUILD_DIR. Prints every breach and exits 1 if
 there is one."""
@@ -73,7 +74,7 @@ PUBLIC = {
     "figures": "figures",
     "video": "video",
     "accuracy": "analysis",
-    "landscape_map": "analysis",
+    "landscape_barriers": "analysis",
     "markov": "analysis",
 }
 
@@ -249,6 +250,16 @@ def check_guards(src, breaches):
             breaches.append(f"{rel}: header guard {got}, expected {want}")
 
 
+def check_umbrella(src, breaches):
+    inc = os.path.join(src, "include", "beamsim")
+    umbrella = open(os.path.join(inc, "beamsim.h"), encoding="utf-8").read()
+    names = {os.path.basename(h) for h in glob.glob(os.path.join(inc, "*.h"))}
+    names |= {os.path.basename(h)[:-3] for h in glob.glob(os.path.join(inc, "*.h.in"))}
+    for n in sorted(names - {"beamsim.h"}):
+        if f'#include "beamsim/{n}"' not in umbrella:
+            breaches.append(f"include/beamsim/beamsim.h does not include beamsim/{n}")
+
+
 def main():
     if len(sys.argv) != 3:
         print(__doc__.splitlines()[-2], file=sys.stderr)
@@ -261,6 +272,7 @@ def main():
     check_homes(src, objects, breaches)
     check_sizes(src, breaches)
     check_guards(src, breaches)
+    check_umbrella(src, breaches)
     for b in breaches:
         print(b)
     print(f"layers: {len(breaches)} breach(es)")

@@ -29,6 +29,7 @@
 #include <cmocka.h>
 
 #include "beamsim/landscape.h"
+#include "beamsim/landscape_barriers.h"
 #include "scenes.h"
 
 /* The essay gate with stiffnesses k1, k2 and propulsion f (0: none). */

@@ -21,6 +21,7 @@
 
 #include "beamsim/backend.h"
 #include "beamsim/landscape.h"
+#include "beamsim/landscape_barriers.h"
 #include "scenes.h"
 
 typedef struct push_result {

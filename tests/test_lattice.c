@@ -32,6 +32,7 @@
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"
 #include "beamsim/trial.h"
+#include "beamsim/lattice_outcome.h"
 #include "support.h"
 #include "thesis/thesis.h"
 

@@ -28,6 +28,7 @@
 #include "beamsim/markov.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "beamsim/lattice_outcome.h"
 #include "support.h"
 
 static void near(double a, double b, double eps, int line)

@@ -11,6 +11,7 @@
 #include "beamsim/error.h"
 #include "beamsim/stats.h"
 #include "beamsim/sweep.h"
+#include "beamsim/lattice_outcome.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -50,6 +50,7 @@
 #include "beamsim/options.h"
 #include "beamsim/progress.h"
 #include "beamsim/scene.h"
+#include "beamsim/lattice_outcome.h"
 
 #ifdef __cplusplus
 extern "C" {

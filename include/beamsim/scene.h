@@ -5,6 +5,7 @@
 #define BSIM_SCENE_H
 
 #include "beamsim/base.h"
+#include "beamsim/override.h"
 #include "beamsim/error.h"
 
 #ifdef __cplusplus
@@ -92,15 +93,6 @@ typedef struct bsim_scene {
 	int has_lattice; /* 1: beams were built from lattice */
 	bsim_lattice_def lattice;
 } bsim_scene;
-
-/* One override of a scene field by dotted path, e.g. key "beams.0.stiffness",
- * value "250" (any YAML flow text: "7", "[0, 5]", "{force: 7}"). origin names
- * where it came from for error messages: "--set" or "h2.yaml:14". */
-typedef struct bsim_override {
-	const char *key;
-	const char *value;
-	const char *origin;
-} bsim_override;
 
 /* Loads and validates a scene file, applying the overrides in order (later
  * ones win). On failure returns BSIM_EINPUT with one message naming the file

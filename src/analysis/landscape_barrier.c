@@ -65,6 +65,7 @@
  * along it (8 neighbours, E_min the lowest of those points): it follows
  * the valley floor up to the pass and down the far side. */
 #include "beamsim/landscape.h"
+#include "beamsim/landscape_barriers.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,6 +1,7 @@
 /* The landscape of a scene computed and stored in an output directory
  * (beamsim landscape SCENE --out DIR); see beamsim/landscape.h. */
 #include "beamsim/landscape.h"
+#include "beamsim/landscape_barriers.h"
 
 #include "store/session.h"
 

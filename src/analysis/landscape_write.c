@@ -14,6 +14,7 @@
  * beside the pivots, set the scale; the titles say where. */
 #define _POSIX_C_SOURCE 200809L
 #include "beamsim/landscape.h"
+#include "beamsim/landscape_barriers.h"
 
 #include <math.h>
 #include <stdio.h>

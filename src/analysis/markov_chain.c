@@ -21,6 +21,7 @@
  * where the chain is too large for LU. It stops when less than 1e-12 is
  * left in the field (or after 1e6 terms, said in left_in_field). */
 #include "beamsim/markov.h"
+#include "beamsim/lattice_outcome.h"
 
 #include <gsl/gsl_linalg.h>
 #include <math.h>

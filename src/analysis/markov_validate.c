@@ -18,6 +18,7 @@
 #include "beamsim/output.h"
 #include "beamsim/stats.h"
 #include "beamsim/sweep.h"
+#include "beamsim/lattice_outcome.h"
 #include "util/clock.h"
 #include "util/figure.h"
 #include "util/json.h"

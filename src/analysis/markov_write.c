@@ -6,6 +6,7 @@
 
 #include "util/atomic_file.h"
 #include "beamsim/markov.h"
+#include "beamsim/lattice_outcome.h"
 #include "store/matlab.h"
 #include "store/session.h"
 

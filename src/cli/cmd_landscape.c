@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "beamsim/landscape.h"
+#include "beamsim/landscape_barriers.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 

@@ -10,6 +10,7 @@
 
 #include "beamsim/experiment.h"
 #include "beamsim/markov.h"
+#include "beamsim/lattice_outcome.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"

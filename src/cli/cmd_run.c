@@ -14,6 +14,7 @@
 #include "beamsim/run_output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "beamsim/lattice_outcome.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 

@@ -13,6 +13,7 @@
 #include "beamsim/run_output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/video.h"
+#include "beamsim/lattice_outcome.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 

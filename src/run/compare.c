@@ -30,6 +30,7 @@
 #include <string.h>
 
 #include "beamsim/lattice.h"
+#include "beamsim/lattice_outcome.h"
 
 static const char *const event_names[BSIM_N_EVENTS] = {"traversed", "left",  "right",
                                                        "side_exit", "stuck", "unstable"};

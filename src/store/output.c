@@ -18,6 +18,7 @@
 #include "util/json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/version.h"
+#include "beamsim/lattice_outcome.h"
 
 /* A grid value is a JSON number when its YAML text is a finite number. */
 static int text_number(const char *s, double *out)

@@ -23,6 +23,7 @@
 #include "beamsim/lattice.h"
 #include "store/matlab.h"
 #include "beamsim/output.h"
+#include "beamsim/lattice_outcome.h"
 
 typedef int (*lattice_writer)(FILE *f, const bsim_experiment *e, const bsim_override *extra,
                               int n_extra, const bsim_sweep_result *r, bsim_error *err);

@@ -17,6 +17,7 @@
 #include "util/json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/output.h"
+#include "beamsim/lattice_outcome.h"
 
 /* A word for a POSIX shell: as it is if it is made of safe characters,
  * else in single quotes with each ' written as '\''. */

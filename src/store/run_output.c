@@ -12,6 +12,7 @@
 #include "store/matlab.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
+#include "beamsim/lattice_outcome.h"
 #include "store/session.h"
 
 bsim_run_info bsim_run_info_default(void)

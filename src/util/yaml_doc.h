@@ -12,7 +12,7 @@
 #include <libfyaml.h>
 
 #include "beamsim/error.h"
-#include "beamsim/scene.h"
+#include "beamsim/override.h"
 
 typedef struct ydoc {
 	struct fy_document *fyd;

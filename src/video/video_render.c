@@ -26,6 +26,7 @@
 #include <cairo.h>
 
 #include "beamsim/lattice.h"
+#include "beamsim/lattice_outcome.h"
 #include "video/video_internal.h"
 
 #define VIDEO_TAU 6.28318530717958647692 /* a full circle, rad */
