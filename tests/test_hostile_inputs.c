@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include "support.h"
@@ -187,6 +188,31 @@ static void test_size_limit(void **state)
 	free(g);
 }
 
+/* What is not a regular file is refused at once: a FIFO with no writer
+ * (reading it used to wait for one for ever), a directory, a device, as a
+ * scene and as a CSV input (gate entries of markov build). */
+static void test_not_regular(void **state)
+{
+	(void)state;
+	char dir[1200], fifo[1300];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("not_regular"));
+	snprintf(fifo, sizeof fifo, "%s/pipe.yaml", dir);
+	assert_int_equal(mkfifo(fifo, 0600), 0);
+	const char *fifo_says[] = {"pipe.yaml: ", "expected a YAML file, got a FIFO", NULL};
+	run_refused(fifo, fifo_says);
+	const char *folder[] = {"not_regular: ", "expected a YAML file, got a directory", NULL};
+	run_refused(dir, folder);
+	const char *device[] = {"/dev/zero: ", "expected a YAML file, got a character device",
+	                        NULL};
+	run_refused("/dev/zero", device);
+	char out[1300];
+	snprintf(out, sizeof out, "%s/maps", dir);
+	const char *track = bsim_test_src("configs/markov/c_track.yaml");
+	const char *argv[] = {"markov", "build", track, "--entries", fifo, "--out", out, NULL};
+	const char *csv[] = {"pipe.yaml: ", "expected a CSV file, got a FIFO", NULL};
+	expect_refusal(argv, csv);
+}
+
 /* The same hazards through --set, and the --set with spaces that used to
  * report "out of memory" (and leak: the sanitized build checks leaks). */
 static void test_set_values(void **state)
@@ -326,6 +352,7 @@ int main(void)
 	        cmocka_unit_test(test_other_bytes),
 	        cmocka_unit_test(test_billion_laughs),
 	        cmocka_unit_test(test_size_limit),
+	        cmocka_unit_test(test_not_regular),
 	        cmocka_unit_test(test_set_values),
 	        cmocka_unit_test(test_limits),
 	        cmocka_unit_test(test_extreme_numbers),

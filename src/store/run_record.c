@@ -16,7 +16,9 @@
 #include <string.h>
 
 #include "util/atomic_file.h"
+#include "util/file_read.h"
 #include "util/json.h"
+#include "beamsim/limits.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
 #include "util/yaml_doc.h"
@@ -81,16 +83,14 @@ static int write_experiment(const char *path, const bsim_experiment *e, const bs
 /* The scene file's text into f, at most the input limit. */
 static int scene_text(FILE *f, const char *path, bsim_error *err)
 {
-	FILE *in = fopen(path, "rb");
-	if (!in)
-		return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file", path);
-	char buf[8192];
-	size_t n;
-	while ((n = fread(buf, 1, sizeof buf, in)) > 0)
-		fwrite(buf, 1, n, f);
-	int bad = ferror(in);
-	fclose(in);
-	return bad ? bsim_error_set(err, BSIM_EFAIL, "%s: read error", path) : BSIM_OK;
+	file_text t;
+	int rc = file_read(path, "a scene file", bsim_limits_get()->input_bytes, "input_bytes", &t,
+	                   err);
+	if (rc != BSIM_OK)
+		return rc;
+	fwrite(t.text, 1, t.len, f);
+	file_text_free(&t);
+	return BSIM_OK;
 }
 
 char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *e,

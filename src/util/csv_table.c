@@ -2,45 +2,12 @@
 #define _POSIX_C_SOURCE 200809L
 #include "util/csv_table.h"
 
-#include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* The whole file as one NUL-terminated string. */
-static char *slurp(const char *path, size_t *len)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return NULL;
-	size_t cap = 1 << 16, n = 0;
-	char *buf = malloc(cap);
-	while (buf) {
-		if (n + 1 >= cap) {
-			char *b = realloc(buf, cap * 2);
-			if (!b) {
-				free(buf);
-				buf = NULL;
-				break;
-			}
-			buf = b;
-			cap *= 2;
-		}
-		size_t k = fread(buf + n, 1, cap - n - 1, f);
-		n += k;
-		if (k == 0)
-			break;
-	}
-	int bad = ferror(f);
-	fclose(f);
-	if (!buf || bad) {
-		free(buf);
-		return NULL;
-	}
-	buf[n] = '\0';
-	*len = n;
-	return buf;
-}
+#include "util/file_read.h"
 
 /* Splits line in place at commas into out (at most max fields); the
  * number of fields found (may exceed max). */
@@ -79,11 +46,14 @@ void csv_table_free(csv_table *t)
 int csv_table_read(const char *path, csv_table *t, bsim_error *err)
 {
 	memset(t, 0, sizeof *t);
-	size_t len;
-	t->text = slurp(path, &len);
-	if (!t->text)
-		return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file (%s)", path,
-		                      strerror(errno ? errno : EIO));
+	/* No size limit: tables are beamsim's own outputs, as large as the
+	 * runs that wrote them. */
+	file_text f;
+	int rc = file_read(path, "a CSV file", INFINITY, NULL, &f, err);
+	if (rc != BSIM_OK)
+		return rc;
+	t->text = f.text;
+	size_t len = f.len;
 	/* Lines, in place: strip \r\n, skip a last empty line. */
 	long n_lines = 0;
 	for (size_t i = 0; i < len; i++)

@@ -3,15 +3,14 @@
 #include "util/yaml_doc.h"
 
 #include <ctype.h>
-#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "beamsim/limits.h"
+#include "util/file_read.h"
 #include "util/text_check.h"
 
 typedef struct first_error {
@@ -134,41 +133,6 @@ static struct fy_node *find_alias(struct fy_node *n, char *path, size_t size)
 	return NULL;
 }
 
-/* Reads at most limit + 1 bytes of fp into a malloc'd buffer. */
-static char *read_all(FILE *fp, size_t limit, size_t *len, int *too_big)
-{
-	size_t cap = 4096, n = 0;
-	char *buf = malloc(cap);
-	*too_big = 0;
-	while (buf) {
-		if (n == cap) {
-			char *b = cap > limit ? NULL : realloc(buf, cap * 2);
-			if (!b) {
-				*too_big = cap > limit;
-				free(buf);
-				return NULL;
-			}
-			buf = b;
-			cap *= 2;
-		}
-		size_t k = fread(buf + n, 1, cap - n, fp);
-		n += k;
-		if (k == 0)
-			break;
-	}
-	if (buf && n > limit) {
-		*too_big = 1;
-		free(buf);
-		return NULL;
-	}
-	if (buf && ferror(fp)) {
-		free(buf);
-		return NULL;
-	}
-	*len = n;
-	return buf;
-}
-
 static int node_mark(struct fy_node *n, int *line, int *col);
 
 /* Why a text was refused, before or by the parser. */
@@ -258,34 +222,13 @@ int ydoc_load(ydoc *d, const char *path, bsim_error *err)
 {
 	memset(d, 0, sizeof *d);
 	d->path = path;
-	struct stat st;
-	if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-		return bsim_error_set(err, BSIM_EINPUT, "%s: expected a YAML file, got a directory",
-		                      path);
-	FILE *fp = fopen(path, "rb");
-	if (!fp)
-		return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file: %s", path,
-		                      strerror(errno));
-	double limit = bsim_limits_get()->input_bytes;
-	size_t len = 0;
-	int too_big = 0;
-	errno = 0;
-	char *text = read_all(fp, limit < (double)SIZE_MAX / 4 ? (size_t)limit : SIZE_MAX / 4, &len,
-	                      &too_big);
-	int saved = errno;
-	fclose(fp);
-	if (!text && too_big) {
-		char hint[160];
-		bsim_limits_hint(hint, sizeof hint, "input_bytes", limit);
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s: expected a file of at most %.15g bytes, got more (%s)",
-		                      path, limit, hint);
-	}
-	if (!text)
-		return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file: %s", path,
-		                      saved ? strerror(saved) : "read error");
+	file_text f;
+	int rc = file_read(path, "a YAML file", bsim_limits_get()->input_bytes, "input_bytes", &f,
+	                   err);
+	if (rc != BSIM_OK)
+		return rc;
 	parse_fault pf;
-	if (parse_checked(d, text, len, &pf) != PF_OK)
+	if (parse_checked(d, f.text, f.len, &pf) != PF_OK)
 		return fault_error(path, &pf, err);
 	/* An empty file (or only comments) has no document at all: treat it as
 	 * a document with no root, which the loaders report as "got nothing". */

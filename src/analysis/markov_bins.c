@@ -1,0 +1,129 @@
+/* The entry bins of the single-gate maps (beamsim/markov.h): the bin of
+ * an entry state, and states drawn uniformly in a bin for the single
+ * gates that have no observed entry to start from. */
+#include "analysis/markov_internal.h"
+
+#include <math.h>
+
+static const double PI = 3.14159265358979323846;
+
+bsim_markov_bins bsim_markov_bins_default(void)
+{
+	return (bsim_markov_bins){.n_pos = 4, .n_speed = 4, .n_dir = 3, .v_max = 40.0};
+}
+
+int bsim_markov_bins_count(const bsim_markov_bins *b)
+{
+	return 1 + 4 * b->n_pos * b->n_speed * b->n_dir;
+}
+
+/* Bin 0 is the start; bin 1 + ((e n_pos + ip) n_speed + is) n_dir + id is
+ * edge e (0 bottom, 1 left, 2 right, 3 top), position ip, speed is and
+ * direction id. An edge's inward normal n and tangent t (gate frame), and
+ * the range of the position along it:
+ *   bottom  n = (0, 1),  t = (1, 0), pos = x in [-w/2, w/2]
+ *   left    n = (1, 0),  t = (0, 1), pos = y in [0, d]
+ *   right   n = (-1, 0), t = (0, 1), pos = y in [0, d]
+ *   top     n = (0, -1), t = (1, 0), pos = x in [-w/2, w/2]
+ * The direction is atan2(v.t, v.n), in [-pi/2, pi/2] for a body moving in. */
+
+static void edge_frame(int edge, double n[2], double t[2])
+{
+	static const double N[4][2] = {{0, 1}, {1, 0}, {-1, 0}, {0, -1}};
+	int e = edge - BSIM_EDGE_BOTTOM;
+	n[0] = N[e][0];
+	n[1] = N[e][1];
+	t[0] = fabs(N[e][1]);
+	t[1] = fabs(N[e][0]);
+}
+
+static void edge_range(int edge, const bsim_lattice_def *l, double *lo, double *hi)
+{
+	if (edge == BSIM_EDGE_BOTTOM || edge == BSIM_EDGE_TOP) {
+		*lo = -0.5 * l->width;
+		*hi = 0.5 * l->width;
+	} else {
+		*lo = 0.0;
+		*hi = l->depth;
+	}
+}
+
+static int clamp_bin(double u, int n)
+{
+	int i = (int)floor(u * n);
+	return i < 0 ? 0 : i >= n ? n - 1 : i;
+}
+
+int bsim_markov_bin_of(const bsim_markov_bins *b, const bsim_lattice_def *l, int edge, double pos,
+                       const double v[2])
+{
+	if (edge < BSIM_EDGE_BOTTOM || edge > BSIM_EDGE_TOP)
+		return 0;
+	double lo, hi, n[2], t[2];
+	edge_range(edge, l, &lo, &hi);
+	edge_frame(edge, n, t);
+	int ip = clamp_bin((pos - lo) / (hi - lo), b->n_pos);
+	double speed = hypot(v[0], v[1]);
+	int is = clamp_bin(speed / b->v_max, b->n_speed);
+	double a = atan2(v[0] * t[0] + v[1] * t[1], v[0] * n[0] + v[1] * n[1]);
+	int id = clamp_bin((a + 0.5 * PI) / PI, b->n_dir);
+	return 1 + (((edge - BSIM_EDGE_BOTTOM) * b->n_pos + ip) * b->n_speed + is) * b->n_dir + id;
+}
+
+/* A state drawn uniformly in entry bin (> 0): position on the edge, moved
+ * inside by half a step's normal travel (the lattice sees an entry at the
+ * end of the step that crossed). */
+void markov_bin_sample(const bsim_markov_bins *b, const bsim_lattice_def *l, double h, int bin,
+                       gsl_rng *rng, double x[2], double v[2])
+{
+	int k = bin - 1;
+	int id = k % b->n_dir;
+	k /= b->n_dir;
+	int is = k % b->n_speed;
+	k /= b->n_speed;
+	int ip = k % b->n_pos;
+	int edge = BSIM_EDGE_BOTTOM + k / b->n_pos;
+	double lo, hi, n[2], t[2];
+	edge_range(edge, l, &lo, &hi);
+	edge_frame(edge, n, t);
+	double pos = lo + (hi - lo) * (ip + gsl_rng_uniform(rng)) / b->n_pos;
+	double speed = b->v_max * (is + gsl_rng_uniform(rng)) / b->n_speed;
+	double a = -0.5 * PI + PI * (id + gsl_rng_uniform(rng)) / b->n_dir;
+	v[0] = speed * (cos(a) * n[0] + sin(a) * t[0]);
+	v[1] = speed * (cos(a) * n[1] + sin(a) * t[1]);
+	double inset = 0.5 * fabs(v[0] * n[0] + v[1] * n[1]) * h + 1e-9;
+	const double w2 = 0.5 * l->width, d = l->depth;
+	switch (edge) {
+	case BSIM_EDGE_BOTTOM:
+		x[0] = pos;
+		x[1] = inset;
+		break;
+	case BSIM_EDGE_TOP:
+		x[0] = pos;
+		x[1] = d - inset;
+		break;
+	case BSIM_EDGE_LEFT:
+		x[0] = -w2 + inset;
+		x[1] = pos;
+		break;
+	default:
+		x[0] = w2 - inset;
+		x[1] = pos;
+		break;
+	}
+}
+
+static const char *const edge_names[] = {"start", "bottom", "left", "right", "top"};
+
+const char *markov_edge_name(int edge)
+{
+	return edge_names[edge];
+}
+
+const char *markov_bin_edge(const bsim_markov_bins *b, int bin)
+{
+	if (bin == 0)
+		return edge_names[BSIM_EDGE_START];
+	int per = b->n_pos * b->n_speed * b->n_dir;
+	return edge_names[1 + (bin - 1) / per];
+}

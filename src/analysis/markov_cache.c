@@ -1,0 +1,343 @@
+/* The cache of single-gate maps (beamsim/markov.h): a map's key, the text
+ * of every input it depends on, and the map directory that holds maps
+ * under the hash of their keys:
+ *   DIR/map_HASH.key   the key text
+ *   DIR/map_HASH.csv   entry,exit,count,...: the nonzero counts
+ *   DIR/map_HASH.cost  the CPU time the map took to build
+ *   DIR/markov.json    the def of the last build, for bsim_markov_load
+ * A map is reused only if its .key file holds the whole key text, so a
+ * hash collision never reuses a map either. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "analysis/markov_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "beamsim/output.h"
+#include "beamsim/version.h"
+#include "util/atomic_file.h"
+#include "util/file_read.h"
+#include "util/hash.h"
+#include "util/json.h"
+#include "util/yaml_doc.h"
+
+/* The map file format; part of every key, so a new format never reads an
+ * old map. */
+#define MAP_FORMAT 1
+
+/* Every input of a map, a line each, numbers to the last bit (%.17g). */
+char *markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                      const bsim_options *opts, const double k[2])
+{
+	markov_gate_scene g;
+	markov_gate_scene_init(&g, lattice, k);
+	const bsim_scene *s = &g.s;
+	char *text = NULL;
+	size_t size = 0;
+	FILE *f = open_memstream(&text, &size);
+	if (!f)
+		return NULL;
+	fprintf(f, "beamsim-markov-map %d\nbeamsim %s\nbackend %s ", MAP_FORMAT, BSIM_VERSION,
+	        be->name);
+	bsim_output_backend_options(f, be, opts);
+	fprintf(f, "\ngate width %.17g depth %.17g\n", lattice->lattice.width,
+	        lattice->lattice.depth);
+	for (int i = 0; i < 2; i++) {
+		const bsim_beam_def *b = &s->beams[i];
+		fprintf(f,
+		        "beam %d pivot %.17g %.17g rest_angle_deg %.17g length %.17g mass %.17g "
+		        "inertia %.17g stiffness %.17g damping %.17g\n",
+		        i + 1, b->pivot[0], b->pivot[1], b->rest_angle_deg, b->length, b->mass,
+		        b->inertia, b->stiffness, b->damping);
+	}
+	fprintf(f, "body mass %.17g radius %.17g start %.17g %.17g velocity %.17g %.17g\n",
+	        s->body.mass, s->body.radius, s->body.start[0], s->body.start[1],
+	        s->body.velocity[0], s->body.velocity[1]);
+	fprintf(f, "contact %.17g %.17g %.17g\n", s->contact.restitution,
+	        s->contact.tip_restitution, s->contact.rest_threshold);
+	fprintf(f, "effects propulsion %d %.17g random %d %.17g %.17g\n", s->effects.has_propulsion,
+	        s->effects.propulsion_force, s->effects.has_random_force,
+	        s->effects.random_magnitude, s->effects.random_frequency);
+	fprintf(f, "dt %.17g gate_steps %d max_steps %d\n", s->dt, s->gate_steps, s->max_steps);
+	fprintf(f, "entries %s\n",
+	        def->entries         ? def->entries->id
+	        : def->entries_id[0] ? def->entries_id
+	                             : "none");
+	fprintf(f, "bins %d %d %d %.17g\ntrials %d\nseed %llu\n", def->bins.n_pos,
+	        def->bins.n_speed, def->bins.n_dir, def->bins.v_max, def->trials,
+	        (unsigned long long)def->seed);
+	if (fclose(f) != 0) {
+		free(text);
+		return NULL;
+	}
+	return text;
+}
+
+uint64_t markov_key(const char *key_text)
+{
+	return hash_fnv1a64(key_text, strlen(key_text), HASH_FNV1A64_SEED);
+}
+
+/* Whether path, a map's .key file, holds exactly key_text: a file that
+ * is longer (it is not read past that length), shorter or unreadable does
+ * not. */
+static int key_same(const char *path, const char *key_text)
+{
+	size_t len = strlen(key_text);
+	file_text t;
+	bsim_error ignored;
+	if (file_read(path, "a map key", (double)len, NULL, &t, &ignored) != BSIM_OK)
+		return 0;
+	int same = t.len == len && memcmp(t.text, key_text, len) == 0;
+	file_text_free(&t);
+	return same;
+}
+
+int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
+{
+	char path[1200];
+	snprintf(path, sizeof path, "%s/map_%016llx.key", dir, (unsigned long long)m->key);
+	if (!key_same(path, m->key_text))
+		return 0;
+	snprintf(path, sizeof path, "%s/map_%016llx.csv", dir, (unsigned long long)m->key);
+	FILE *f = fopen(path, "r");
+	if (!f)
+		return 0;
+	char line[256];
+	int lineno = 0, ok = fgets(line, sizeof line, f) && strncmp(line, "entry,exit,", 11) == 0;
+	lineno++;
+	const char *bad = ok ? NULL : "header";
+	while (!bad && fgets(line, sizeof line, f)) {
+		lineno++;
+		/* entry, exit: bins; count: trials */
+		static const char *const field[3] = {"entry", "exit", "count"};
+		long v[3];
+		char *p = line;
+		for (int i = 0; !bad && i < 3; i++) {
+			char *end;
+			errno = 0;
+			v[i] = strtol(p, &end, 10);
+			long hi = i < 2 ? m->n_bins - 1 : INT_MAX;
+			if (end == p || errno || v[i] < 0 || v[i] > hi || (*end != ',' && i < 2) ||
+			    (i == 2 && *end != ',' && *end != '\n' && *end != '\0'))
+				bad = field[i];
+			p = end + 1;
+		}
+		if (!bad)
+			m->counts[(size_t)v[0] * m->n_bins + v[1]] = (int)v[2];
+	}
+	fclose(f);
+	if (bad) {
+		bsim_error_set(
+		        err, BSIM_EINPUT, "%s:%d: %s: expected %s", path, lineno, bad,
+		        strcmp(bad, "header") == 0 ? "entry,exit,count,..."
+		        : strcmp(bad, "count") == 0
+		                ? "a count of trials >= 0"
+		                : (snprintf(line, sizeof line, "a bin 0 to %d", m->n_bins - 1),
+		                   line));
+		return -1;
+	}
+	snprintf(path, sizeof path, "%s/map_%016llx.cost", dir, (unsigned long long)m->key);
+	if ((f = fopen(path, "r"))) {
+		if (fscanf(f, "cpu_seconds %lf", &m->cost) != 1)
+			m->cost = 0.0;
+		fclose(f);
+	}
+	return 1;
+}
+
+int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_markov_bins *b,
+                     bsim_error *err)
+{
+	char path[1200];
+	snprintf(path, sizeof path, "%s/map_%016llx.key", stage, (unsigned long long)m->key);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fputs(m->key_text, o.f);
+	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	snprintf(path, sizeof path, "%s/map_%016llx.csv", stage, (unsigned long long)m->key);
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fputs("entry,exit,count,entry_edge,exit_edge,p\n", o.f);
+	for (int a = 0; a < m->n_bins; a++) {
+		long total = 0;
+		for (int x = 0; x < m->n_bins; x++)
+			total += m->counts[(size_t)a * m->n_bins + x];
+		for (int x = 0; x < m->n_bins; x++) {
+			int c = m->counts[(size_t)a * m->n_bins + x];
+			if (c == 0)
+				continue;
+			fprintf(o.f, "%d,%d,%d,%s,%s,%.9g\n", a, x, c, markov_bin_edge(b, a),
+			        x == 0 ? "stuck" : markov_bin_edge(b, x), (double)c / total);
+		}
+	}
+	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	/* What the map cost, for the break-even of building it. */
+	snprintf(path, sizeof path, "%s/map_%016llx.cost", stage, (unsigned long long)m->key);
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fprintf(o.f, "cpu_seconds %.6g\n", m->seconds);
+	return bsim_atomic_file_commit(&o, err);
+}
+
+int markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
+                     const bsim_options *opts, bsim_error *err)
+{
+	char path[1200];
+	snprintf(path, sizeof path, "%s/markov.json", stage);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fprintf(o.f,
+	        "{\"format\": %d, \"beamsim_version\": \"%s\", \"bins\": {\"position\": %d, "
+	        "\"speed\": %d, \"direction\": %d, \"v_max\": ",
+	        MAP_FORMAT, BSIM_VERSION, def->bins.n_pos, def->bins.n_speed, def->bins.n_dir);
+	bsim_json_number(o.f, def->bins.v_max);
+	fprintf(o.f, "}, \"trials\": %d, \"seed\": ", def->trials);
+	bsim_json_u64(o.f, def->seed);
+	fputs(", \"backend\": ", o.f);
+	bsim_json_string(o.f, be->name);
+	fputs(", \"options\": [", o.f);
+	for (int i = 0; opts && i < opts->n; i++) {
+		char kv[128];
+		snprintf(kv, sizeof kv, "%s=%s", opts->key[i], opts->value[i]);
+		fputs(i ? ", " : "", o.f);
+		bsim_json_string(o.f, kv);
+	}
+	fputs("], \"entries\": ", o.f);
+	bsim_json_string(o.f, def->entries         ? def->entries->id
+	                      : def->entries_id[0] ? def->entries_id
+	                                           : "none");
+	fputs("}\n", o.f);
+	return bsim_atomic_file_commit(&o, err);
+}
+
+/* One field of markov.json: the node at slash-separated path, or an error
+ * "FILE:LINE:COL: FIELD: expected WHAT, got ..." naming it. */
+static struct fy_node *def_field(const ydoc *d, const char *path, const char *what, bsim_error *err)
+{
+	struct fy_node *root = fy_document_root(d->fyd);
+	struct fy_node *n = root ? fy_node_by_path(root, path, -1, FYNWF_DONT_FOLLOW) : NULL;
+	if (!n || ydoc_is_null(n)) {
+		ydoc_expected(d, n, root, path + 1, what, err);
+		return NULL;
+	}
+	return n;
+}
+
+static int def_int(const ydoc *d, const char *path, int lo, int hi, int *out, bsim_error *err)
+{
+	char what[64];
+	snprintf(what, sizeof what, "an integer %d to %d", lo, hi);
+	struct fy_node *n = def_field(d, path, what, err);
+	long long v;
+	if (!n)
+		return BSIM_EINPUT;
+	if (!ydoc_int64(n, &v) || v < lo || v > hi)
+		return ydoc_expected(d, n, NULL, path + 1, what, err);
+	*out = (int)v;
+	return BSIM_OK;
+}
+
+/* A quoted string of markov.json, into buf. */
+static int def_string(const ydoc *d, const char *path, char *buf, size_t size, bsim_error *err)
+{
+	struct fy_node *n = def_field(d, path, "a string", err);
+	if (!n)
+		return BSIM_EINPUT;
+	const char *t = fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
+	if (!t || strlen(t) >= size)
+		return ydoc_expected(d, n, NULL, path + 1, "a short string", err);
+	snprintf(buf, size, "%s", t);
+	return BSIM_OK;
+}
+
+/* markov.json's def, read as JSON (a YAML flow document) with libfyaml:
+ * every field markov_def_write writes, each fault naming its file position
+ * and field. */
+int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err)
+{
+	char path[1200];
+	snprintf(path, sizeof path, "%s/markov.json", dir);
+	/* Without blocking: a FIFO there is refused by ydoc_load. */
+	int probe = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+	if (probe < 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: cannot read (%s): not a map directory of beamsim markov "
+		                      "build",
+		                      path, strerror(errno));
+	close(probe);
+	*def = bsim_markov_def_default();
+	memset(opts, 0, sizeof *opts);
+	ydoc d;
+	int rc = ydoc_load(&d, path, err);
+	if (rc != BSIM_OK)
+		return rc;
+	int format = 0;
+	uint64_t seed = 0;
+	char backend[64] = "", id[64] = "";
+	rc = def_int(&d, "/format", MAP_FORMAT, MAP_FORMAT, &format, err);
+	if (rc == BSIM_OK)
+		rc = def_int(&d, "/bins/position", 1, 64, &def->bins.n_pos, err);
+	if (rc == BSIM_OK)
+		rc = def_int(&d, "/bins/speed", 1, 64, &def->bins.n_speed, err);
+	if (rc == BSIM_OK)
+		rc = def_int(&d, "/bins/direction", 1, 64, &def->bins.n_dir, err);
+	if (rc == BSIM_OK) {
+		struct fy_node *n = def_field(&d, "/bins/v_max", "a speed > 0, m/s", err);
+		rc = !n ? BSIM_EINPUT
+		     : ydoc_number(n, &def->bins.v_max) != YDOC_NUM_OK || !(def->bins.v_max > 0)
+		             ? ydoc_expected(&d, n, NULL, "bins/v_max", "a speed > 0, m/s", err)
+		             : BSIM_OK;
+	}
+	if (rc == BSIM_OK)
+		rc = def_int(&d, "/trials", 1, 1000000, &def->trials, err);
+	if (rc == BSIM_OK) {
+		/* above 2^53 written as a string (bsim_json_u64) */
+		struct fy_node *n = def_field(&d, "/seed", "a seed, an integer >= 0", err);
+		const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
+		char *end = NULL;
+		errno = 0;
+		seed = t && *t >= '0' && *t <= '9' ? strtoull(t, &end, 10) : 0;
+		rc = !n ? BSIM_EINPUT
+		     : !end || *end || errno
+		             ? ydoc_expected(&d, n, NULL, "seed", "a seed, an integer >= 0", err)
+		             : BSIM_OK;
+	}
+	if (rc == BSIM_OK)
+		rc = def_string(&d, "/backend", backend, sizeof backend, err);
+	if (rc == BSIM_OK) {
+		struct fy_node *n = def_field(&d, "/options", "a list of \"KEY=VALUE\"", err);
+		if (!n)
+			rc = BSIM_EINPUT;
+		else if (!fy_node_is_sequence(n))
+			rc = ydoc_expected(&d, n, NULL, "options", "a list of \"KEY=VALUE\"", err);
+		void *it = NULL;
+		struct fy_node *kv;
+		while (rc == BSIM_OK && (kv = fy_node_sequence_iterate(n, &it))) {
+			const char *t = fy_node_is_scalar(kv) ? fy_node_get_scalar0(kv) : NULL;
+			rc = t ? bsim_options_add(opts, t, err)
+			       : ydoc_expected(&d, kv, n, "options", "\"KEY=VALUE\"", err);
+		}
+	}
+	if (rc == BSIM_OK)
+		rc = def_string(&d, "/entries", id, sizeof id, err);
+	ydoc_free(&d);
+	if (rc != BSIM_OK)
+		return rc;
+	if (strcmp(id, "none") != 0)
+		snprintf(def->entries_id, sizeof def->entries_id, "%s", id);
+	def->seed = seed;
+	def->backend = bsim_backend_find(backend, err);
+	def->opts = opts;
+	return def->backend ? BSIM_OK : BSIM_EINPUT;
+}

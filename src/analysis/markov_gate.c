@@ -1,0 +1,225 @@
+/* The single gates that fill a Markov map (beamsim/markov.h): the gate of
+ * a stiffness pair in its own frame, one trial from a state of an entry
+ * bin until the body leaves the gate's rectangle (the exit binned as the
+ * entry of the gate it enters) or is stuck, and the trials of every bin
+ * on the threads, counted in trial order so that the map is the same for
+ * any number of threads. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "analysis/markov_internal.h"
+
+#include <gsl/gsl_rng.h>
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/effects.h"
+#include "beamsim/schedule.h"
+#include "beamsim/state.h"
+#include "model/lattice_crossing.h"
+
+void markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice, const double k[2])
+{
+	const bsim_lattice_def *l = &lattice->lattice;
+	int ix, iy;
+	bsim_lattice_gate_at(lattice, lattice->body.start, &ix, &iy);
+	g->s = *lattice;
+	g->s.has_lattice = 0;
+	g->s.n_beams = 2;
+	g->s.beams = g->beams;
+	for (int side = 0; side < 2; side++) {
+		g->beams[side] = lattice->beams[bsim_lattice_beam(l, ix, iy, side)];
+		g->beams[side].pivot[0] -= l->width * ix;
+		g->beams[side].pivot[1] -= l->depth * iy;
+		g->beams[side].stiffness = k[side];
+		g->beams[side].initial_theta = 0.0;
+		g->beams[side].initial_omega = 0.0;
+	}
+	g->s.body.start[0] -= l->width * ix;
+	g->s.body.start[1] -= l->depth * iy;
+}
+
+/* The exit of a step from p0 inside the gate to s->x outside it: the entry
+ * bin of the gate it enters (the boundary crossed first). */
+static int exit_bin(const bsim_markov_bins *b, const bsim_lattice_def *l, const double p0[2],
+                    const bsim_state *s)
+{
+	const double *p1 = s->x, w2 = 0.5 * l->width, d = l->depth;
+	double fx = LATTICE_NO_CROSSING, fy = LATTICE_NO_CROSSING;
+	int ex = 0, ey = 0;
+	if (p1[0] < -w2) {
+		fx = lattice_crossing(p0, p1, 0, -w2);
+		ex = BSIM_EDGE_RIGHT; /* into the gate on the left, through its right edge */
+	} else if (p1[0] >= w2) {
+		fx = lattice_crossing(p0, p1, 0, w2);
+		ex = BSIM_EDGE_LEFT;
+	}
+	if (p1[1] < 0.0) {
+		fy = lattice_crossing(p0, p1, 1, 0.0);
+		ey = BSIM_EDGE_TOP;
+	} else if (p1[1] >= d) {
+		fy = lattice_crossing(p0, p1, 1, d);
+		ey = BSIM_EDGE_BOTTOM;
+	}
+	if (ex && (!ey || fx <= fy))
+		return bsim_markov_bin_of(b, l, ex, p0[1] + fx * (p1[1] - p0[1]), s->v);
+	return bsim_markov_bin_of(b, l, ey, p0[0] + fy * (p1[0] - p0[0]), s->v);
+}
+
+/* What a thread keeps from one single-gate trial to the next. */
+typedef struct gate_runner {
+	bsim_state s0, s1;
+	gsl_rng *rng;
+	markov_gate_scene g;
+	const markov_entry_index *ex; /* NULL: no observed entries */
+} gate_runner;
+
+/* One single-gate trial from entry bin `bin` (0: the start) with trial index
+ * t: the exit bin, 0 if stuck; -1 with err on failure. */
+static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_markov_def *def,
+                      const bsim_backend *be, const bsim_options *opts, int bin, int t,
+                      bsim_error *err)
+{
+	const bsim_lattice_def *l = &lattice->lattice;
+	bsim_scene *s = &r->g.s;
+	if (bin > 0) {
+		gsl_rng_set(r->rng, bsim_schedule_seed_mix(def->seed ^ 0x6d61726b6f76ULL,
+		                                           (uint64_t)bin, (uint64_t)t));
+		const int lo = r->ex ? r->ex->first[bin] : 0,
+		          hi = r->ex ? r->ex->first[bin + 1] : 0;
+		if (hi > lo) { /* an observed entry of this bin */
+			int i = r->ex->idx[lo + (int)gsl_rng_uniform_int(r->rng,
+			                                                 (unsigned long)(hi - lo))];
+			memcpy(s->body.start, def->entries->x[i], sizeof s->body.start);
+			memcpy(s->body.velocity, def->entries->v[i], sizeof s->body.velocity);
+		} else {
+			markov_bin_sample(&def->bins, l, s->dt, bin, r->rng, s->body.start,
+			                  s->body.velocity);
+		}
+	}
+	bsim_world *w = NULL;
+	if (be->create(s, opts, &w, err) != BSIM_OK)
+		return -1;
+	bsim_effects fx;
+	if (bsim_effects_init(&fx, s,
+	                      bsim_schedule_seed_mix(def->seed, (uint64_t)bin, (uint64_t)t))) {
+		be->destroy(w);
+		bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		return -1;
+	}
+	const long n_max = lattice->gate_steps > 0 ? lattice->gate_steps : lattice->max_steps;
+	const double w2 = 0.5 * l->width, d = l->depth;
+	be->get_state(w, &r->s0);
+	int out = 0;
+	for (long n = 0; n < n_max; n++) {
+		double f[2];
+		bsim_effects_force(&fx, n, s->dt, f);
+		if (be->step(w, f, s->dt, err) != BSIM_OK) {
+			out = -1;
+			break;
+		}
+		be->get_state(w, &r->s1);
+		if (!isfinite(r->s1.x[0]) || !isfinite(r->s1.x[1]) || !isfinite(r->s1.v[0]) ||
+		    !isfinite(r->s1.v[1])) {
+			bsim_error_set(err, BSIM_EFAIL,
+			               "a single gate (k = %g, %g N m/rad, entry bin %d, trial %d) "
+			               "became unstable at step %ld",
+			               s->beams[0].stiffness, s->beams[1].stiffness, bin, t, n + 1);
+			out = -1;
+			break;
+		}
+		const double *p = r->s1.x;
+		if (p[0] < -w2 || p[0] >= w2 || p[1] < 0.0 || p[1] >= d) {
+			out = exit_bin(&def->bins, l, r->s0.x, &r->s1);
+			break;
+		}
+		bsim_state tmp = r->s0;
+		r->s0 = r->s1;
+		r->s1 = tmp;
+	}
+	if (out >= 0 && bsim_effects_status(&fx, err) != BSIM_OK)
+		out = -1;
+	bsim_effects_free(&fx);
+	be->destroy(w);
+	return out;
+}
+
+int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
+                        const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
+                        long *done, long total, bsim_error *err)
+{
+	const int nb = m->n_bins, T = def->trials;
+	const long units = (long)nb * T;
+	int *exit = malloc((size_t)units * sizeof *exit);
+	if (!exit)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	markov_entry_index ex = {0};
+	if (def->entries &&
+	    markov_entry_index_init(&ex, def->entries, &def->bins, &lattice->lattice)) {
+		free(exit);
+		markov_entry_index_free(&ex);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	int failed = 0;
+	bsim_error first = {0};
+	long first_unit = units;
+	int threads = def->threads > 0 ? def->threads : 0;
+#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads())
+	{
+		gate_runner r;
+		memset(&r, 0, sizeof r);
+		int ok = bsim_state_init(&r.s0, 2) == BSIM_OK &&
+		         bsim_state_init(&r.s1, 2) == BSIM_OK;
+		r.rng = gsl_rng_alloc(gsl_rng_mt19937);
+		r.ex = def->entries ? &ex : NULL;
+		markov_gate_scene_init(&r.g, lattice, m->k);
+		const double start[2] = {r.g.s.body.start[0], r.g.s.body.start[1]};
+#pragma omp for schedule(dynamic, 16)
+		for (long u = 0; u < units; u++) {
+			if (!ok || !r.rng) {
+				exit[u] = -1;
+#pragma omp critical(markov_fail)
+				if (u < first_unit) {
+					first_unit = u;
+					bsim_error_set(&first, BSIM_EFAIL, "out of memory");
+				}
+				continue;
+			}
+			bsim_error e;
+			r.g.s.body.start[0] = start[0];
+			r.g.s.body.start[1] = start[1];
+			r.g.s.body.velocity[0] = lattice->body.velocity[0];
+			r.g.s.body.velocity[1] = lattice->body.velocity[1];
+			exit[u] = gate_trial(&r, lattice, def, be, opts, (int)(u / T), (int)(u % T),
+			                     &e);
+			if (exit[u] < 0) {
+#pragma omp critical(markov_fail)
+				if (u < first_unit) {
+					first_unit = u;
+					first = e;
+				}
+			}
+			long now;
+#pragma omp atomic capture
+			now = ++*done;
+			if (def->progress && (now % 256 == 0 || now == total)) {
+#pragma omp critical(markov_progress)
+				def->progress(def->progress_user, now, total);
+			}
+		}
+		gsl_rng_free(r.rng);
+		bsim_state_free(&r.s0);
+		bsim_state_free(&r.s1);
+	}
+	if (first_unit < units) {
+		failed = 1;
+		if (err)
+			*err = first;
+	}
+	for (long u = 0; !failed && u < units; u++)
+		m->counts[(u / T) * nb + exit[u]]++;
+	free(exit);
+	markov_entry_index_free(&ex);
+	return failed ? BSIM_EFAIL : BSIM_OK;
+}

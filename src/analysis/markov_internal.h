@@ -1,0 +1,89 @@
+/* Internal: what the files of the single-gate maps (beamsim/markov.h)
+ * share. markov_bins.c lays out the entry bins and draws states in them,
+ * markov_entries.c reads observed entries and indexes them by bin,
+ * markov_gate.c runs the single gates that fill a map, markov_cache.c
+ * keys maps and reads and writes a map directory, and markov_map.c builds
+ * or loads the maps of a lattice from those. */
+#ifndef BSIM_ANALYSIS_MARKOV_INTERNAL_H
+#define BSIM_ANALYSIS_MARKOV_INTERNAL_H
+
+#include <gsl/gsl_rng.h>
+#include <stdint.h>
+
+#include "beamsim/markov.h"
+#include "beamsim/trial.h" /* BSIM_EDGE_* */
+
+/* ---- bins (markov_bins.c) ---- */
+
+/* The name of an edge, BSIM_EDGE_START .. BSIM_EDGE_TOP: "start",
+ * "bottom", "left", "right", "top" (gate_entries.csv and map files). */
+const char *markov_edge_name(int edge);
+
+/* The name of the edge of entry bin `bin`, "start" for bin 0. */
+const char *markov_bin_edge(const bsim_markov_bins *b, int bin);
+
+/* A state drawn uniformly in entry bin `bin` (> 0) of a gate with time
+ * step h: body centre x (gate frame) and velocity v. */
+void markov_bin_sample(const bsim_markov_bins *b, const bsim_lattice_def *l, double h, int bin,
+                       gsl_rng *rng, double x[2], double v[2]);
+
+/* ---- observed entries by bin (markov_entries.c) ---- */
+
+/* The entries of each bin: bin b's are idx[first[b] .. first[b + 1]). */
+typedef struct markov_entry_index {
+	int *first, *idx;
+} markov_entry_index;
+
+/* 0, or -1 out of memory (then markov_entry_index_free all the same). */
+int markov_entry_index_init(markov_entry_index *x, const bsim_markov_entries *e,
+                            const bsim_markov_bins *b, const bsim_lattice_def *l);
+void markov_entry_index_free(markov_entry_index *x);
+
+/* ---- single gates (markov_gate.c) ---- */
+
+/* The gate of the lattice's start, moved to its own frame, as the essay's
+ * protocol builds it on entry: its two beams at rest, with stiffness k. */
+typedef struct markov_gate_scene {
+	bsim_scene s;
+	bsim_beam_def beams[2];
+} markov_gate_scene;
+
+void markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice, const double k[2]);
+
+/* Map m's counts (n_bins, k and counts allocated) from def->trials single
+ * gates per entry bin, on def->threads threads; *done counts the trials
+ * run of total, for def->progress. BSIM_EFAIL with the error of the first
+ * failed trial (in trial order, whatever the threads). */
+int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
+                        const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
+                        long *done, long total, bsim_error *err);
+
+/* ---- the map directory (markov_cache.c) ---- */
+
+/* Every input of the map of stiffness pair k, a line each (malloc'd; NULL
+ * out of memory). */
+char *markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                      const bsim_options *opts, const double k[2]);
+
+/* The key of a key text: the map's file name, map_KEY. */
+uint64_t markov_key(const char *key_text);
+
+/* Reads map m (key, key_text, n_bins and counts set) from dir: 1 if there
+ * with the same key text, 0 if not there or another key, -1 with err if
+ * its counts are malformed. */
+int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err);
+
+/* Writes map m's key, counts and cost into stage. */
+int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_markov_bins *b,
+                     bsim_error *err);
+
+/* Writes stage/markov.json, the def of the build. */
+int markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
+                     const bsim_options *opts, bsim_error *err);
+
+/* Reads dir/markov.json into def (its options into opts), every fault
+ * naming the file position and field. Each field is checked on its own;
+ * the def as a whole is checked where maps are built or loaded. */
+int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err);
+
+#endif

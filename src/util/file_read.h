@@ -1,0 +1,35 @@
+/* Internal: a file read whole into memory, the one way beamsim does it
+ * (YAML documents, CSV tables, the scene text of a run record, a Markov
+ * map's key). Only a regular file is read: a directory, a FIFO, a device
+ * or a socket is refused at once, never waited on, since the file is
+ * opened without blocking and checked (fstat) before the first byte is
+ * read. At most a given number of bytes is read, so a file too large is
+ * refused without first filling memory with it. Every message names the
+ * file. */
+#ifndef BSIM_UTIL_FILE_READ_H
+#define BSIM_UTIL_FILE_READ_H
+
+#include <stddef.h>
+
+#include "beamsim/error.h"
+
+typedef struct file_text {
+	char *text; /* malloc'd; a NUL after the len bytes (the file may hold NULs of its own) */
+	size_t len;
+} file_text;
+
+/* Reads the regular file path whole into *out, at most max_bytes (INFINITY
+ * for no limit but memory). what names the file expected, for the message
+ * on anything else ("a YAML file"); limit_name, if not NULL, is the
+ * `--limit NAME=N` that raises max_bytes. On failure out is empty and:
+ *   BSIM_EINPUT "PATH: cannot read the file: REASON"
+ *   BSIM_EINPUT "PATH: expected WHAT, got a directory" (a FIFO, a device, ...)
+ *   BSIM_EINPUT "PATH: expected a file of at most N bytes, got more
+ *               (limit NAME = N; raise it with --limit NAME=N)"
+ *   BSIM_EFAIL  "PATH: out of memory" */
+int file_read(const char *path, const char *what, double max_bytes, const char *limit_name,
+              file_text *out, bsim_error *err);
+
+void file_text_free(file_text *t);
+
+#endif
