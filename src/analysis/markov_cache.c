@@ -276,7 +276,6 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 		                      "build",
 		                      path, strerror(errno));
 	close(probe);
-	*def = bsim_markov_def_default();
 	memset(opts, 0, sizeof *opts);
 	ydoc d;
 	int rc = ydoc_load(&d, path, err);

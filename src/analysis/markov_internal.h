@@ -82,7 +82,8 @@ int markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_b
                      const bsim_options *opts, bsim_error *err);
 
 /* Reads dir/markov.json into def (its options into opts), every fault
- * naming the file position and field. Each field is checked on its own;
+ * naming the file position and field; a field the file leaves out keeps
+ * the value def holds (the caller's defaults). Each field is checked on its own;
  * the def as a whole is checked where maps are built or loaded. */
 int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err);
 

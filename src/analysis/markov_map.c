@@ -212,7 +212,7 @@ int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *o
 	int rc = check_lattice(lattice, err);
 	if (rc != BSIM_OK)
 		return rc;
-	bsim_markov_def def;
+	bsim_markov_def def = bsim_markov_def_default();
 	if ((rc = markov_def_read(dir, &def, opts, err)) != BSIM_OK ||
 	    (rc = def_check(&def, err)) != BSIM_OK)
 		return rc;
