@@ -17,6 +17,18 @@
 extern "C" {
 #endif
 
+/* The sizes of paths, in one place. A directory a caller names (an output
+ * directory, a stored run) may be up to BSIM_DIR_MAX bytes. beamsim appends
+ * names of at most BSIM_NAME_MAX bytes to it (a staging area, a side's
+ * folder, inputs/scene.yaml, NAME.tmp.PID); a buffer holding a directory it
+ * derived has BSIM_PATH_MAX - BSIM_NAME_MAX bytes, one holding any path
+ * BSIM_PATH_MAX, so that a file name appended to a derived directory always
+ * fits. A path that would not fit is refused with "path too long", never
+ * cut. */
+#define BSIM_DIR_MAX 900
+#define BSIM_NAME_MAX 200
+#define BSIM_PATH_MAX 1400
+
 typedef struct bsim_limits {
 	double input_bytes; /* size of a scene or experiment file, or a --set value */
 	double groups;      /* groups of an experiment's grid */

@@ -27,6 +27,7 @@
 #include <stdint.h>
 
 #include "beamsim/base.h"
+#include "beamsim/limits.h"
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
 #include "beamsim/sweep.h"
@@ -72,7 +73,7 @@ typedef struct bsim_sweep_dir_result {
 	/* When the run stopped (BSIM_ESTOPPED), or its files could not be
 	 * committed after every trial had run: the journal that resume
 	 * continues from. "" otherwise. */
-	char journal[1100];
+	char journal[BSIM_PATH_MAX];
 } bsim_sweep_dir_result;
 
 /* Runs the sweep into def->out. BSIM_OK with res filled (free it with

@@ -7,6 +7,7 @@
 
 #include "store/matlab.h"
 #include "store/session.h"
+#include "beamsim/limits.h"
 
 bsim_accuracy_config bsim_accuracy_default(void)
 {
@@ -40,7 +41,7 @@ int bsim_accuracy_store(const char *out, const bsim_scene *scene, const char *sc
 	int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
-	char path[1200], mat[1200];
+	char path[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
 	rc = bsim_accuracy_run(scene, backends, n_backends, cfg, res, err);
 	if (rc == BSIM_OK) {
 		snprintf(path, sizeof path, "%s/accuracy.csv", ss.stage);

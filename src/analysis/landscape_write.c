@@ -25,11 +25,12 @@
 #include "util/json.h"
 #include "util/figure.h"
 #include "store/mat.h"
+#include "beamsim/limits.h"
 
 /* Most quadrangles of a 3-D surface: an SVG spends about 120 bytes on
  * each (a lit fill, no mesh lines, which would triple it), so 4000 keep
  * it under 0.5 MB. */
-enum { SURFACE_QUADS = 4000, PATH_MAX_LEN = 1100 };
+enum { SURFACE_QUADS = 4000 };
 
 /* dir/name into buf. */
 static int file_path(char *buf, size_t size, const char *dir, const char *name, bsim_error *err)
@@ -48,7 +49,7 @@ static size_t grid_points(const bsim_landscape_grid *g)
 
 static int write_csv(const char *dir, const bsim_landscape_grid *g, bsim_error *err)
 {
-	char path[PATH_MAX_LEN];
+	char path[BSIM_PATH_MAX];
 	int rc = file_path(path, sizeof path, dir, "landscape.csv", err);
 	bsim_atomic_file o;
 	if (rc || (rc = bsim_atomic_file_open(&o, path, err)))
@@ -85,7 +86,7 @@ enum { TABLE_COLUMNS = 19 };
 static int write_mat(const char *dir, const bsim_scene *s, const bsim_landscape_grid *g,
                      const bsim_landscape_barriers *br, bsim_error *err)
 {
-	char path[PATH_MAX_LEN];
+	char path[BSIM_PATH_MAX];
 	int rc = file_path(path, sizeof path, dir, "landscape.mat", err);
 	if (rc)
 		return rc;
@@ -231,7 +232,7 @@ static void json_pass(FILE *f, const bsim_landscape_pass *p)
 static int write_json(const char *dir, const bsim_scene *s, const bsim_landscape_grid *g,
                       const bsim_landscape_barriers *br, bsim_error *err)
 {
-	char path[PATH_MAX_LEN];
+	char path[BSIM_PATH_MAX];
 	int rc = file_path(path, sizeof path, dir, "landscape.json", err);
 	bsim_atomic_file o;
 	if (rc || (rc = bsim_atomic_file_open(&o, path, err)))
@@ -303,7 +304,7 @@ static int write_matrix(const char *dir, const char *name, const bsim_scene *s,
                         const bsim_landscape_grid *g, const double *v, int stride, double wall,
                         bsim_error *err)
 {
-	char path[PATH_MAX_LEN];
+	char path[BSIM_PATH_MAX];
 	int rc = file_path(path, sizeof path, dir, name, err);
 	bsim_atomic_file o;
 	if (rc || (rc = bsim_atomic_file_open(&o, path, err)))
@@ -343,7 +344,7 @@ static int write_matrix(const char *dir, const char *name, const bsim_scene *s,
 static int write_paths(const char *dir, const bsim_scene *s, const bsim_landscape_barriers *br,
                        bsim_error *err)
 {
-	char path[PATH_MAX_LEN];
+	char path[BSIM_PATH_MAX];
 	int rc = file_path(path, sizeof path, dir, "landscape_paths.dat", err);
 	bsim_atomic_file o;
 	if (rc || (rc = bsim_atomic_file_open(&o, path, err)))

@@ -26,6 +26,7 @@
 #include "util/hash.h"
 #include "util/json.h"
 #include "util/yaml_doc.h"
+#include "beamsim/limits.h"
 
 /* The map file format; part of every key, so a new format never reads an
  * old map. */
@@ -101,7 +102,7 @@ static int key_same(const char *path, const char *key_text)
 
 int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 {
-	char path[1200];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/map_%016llx.key", dir, (unsigned long long)m->key);
 	if (!key_same(path, m->key_text))
 		return 0;
@@ -155,7 +156,7 @@ int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_markov_bins *b,
                      bsim_error *err)
 {
-	char path[1200];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/map_%016llx.key", stage, (unsigned long long)m->key);
 	bsim_atomic_file o;
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
@@ -192,7 +193,7 @@ int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_mar
 int markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
                      const bsim_options *opts, bsim_error *err)
 {
-	char path[1200];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/markov.json", stage);
 	bsim_atomic_file o;
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
@@ -266,7 +267,7 @@ static int def_string(const ydoc *d, const char *path, char *buf, size_t size, b
  * and field. */
 int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err)
 {
-	char path[1200];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/markov.json", dir);
 	/* Without blocking: a FIFO there is refused by ydoc_load. */
 	int probe = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);

@@ -14,6 +14,7 @@
 
 #include "util/csv_table.h"
 #include "util/hash.h"
+#include "beamsim/limits.h"
 
 void bsim_markov_entries_free(bsim_markov_entries *e)
 {
@@ -63,7 +64,7 @@ int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entrie
 	int cap = 0, rc = BSIM_OK;
 	static const char *const want[] = {"edge", "pos", "x", "y", "vx", "vy"};
 	for (int f = 0; f < n && rc == BSIM_OK; f++) {
-		char path[1200];
+		char path[BSIM_PATH_MAX];
 		struct stat st;
 		if (stat(paths[f], &st) == 0 && S_ISDIR(st.st_mode))
 			snprintf(path, sizeof path, "%s/gate_entries.csv", paths[f]);

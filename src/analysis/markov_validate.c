@@ -24,6 +24,7 @@
 #include "util/json.h"
 #include "store/matlab.h"
 #include "store/session.h"
+#include "beamsim/limits.h"
 
 bsim_markov_validate_def bsim_markov_validate_default(void)
 {
@@ -170,7 +171,7 @@ typedef struct group_data {
 static int write_csv(const char *stage, const bsim_experiment *e, const bsim_markov_validation *v,
                      const group_data *gd, bsim_error *err)
 {
-	char path[1200];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/validate.csv", stage);
 	bsim_atomic_file o;
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
@@ -211,7 +212,7 @@ static int write_csv(const char *stage, const bsim_experiment *e, const bsim_mar
 static int write_json(const char *stage, const bsim_markov_validate_def *def,
                       const bsim_experiment *e, const bsim_markov_validation *v, bsim_error *err)
 {
-	char path[1200];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/validate.json", stage);
 	bsim_atomic_file o;
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
@@ -262,7 +263,7 @@ static int write_json(const char *stage, const bsim_markov_validate_def *def,
 static int write_figure(const char *stage, int g, const group_data *d,
                         const bsim_markov_validation *v, int *drawn, bsim_error *err)
 {
-	char path[1200], name[32];
+	char path[BSIM_PATH_MAX], name[32];
 	snprintf(name, sizeof name, "validate_g%03d", g);
 	snprintf(path, sizeof path, "%s/%s.dat", stage, name);
 	bsim_atomic_file o;
@@ -474,7 +475,7 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 	                                {"gates.csv", "gates"},
 	                                {"validate.json", "validate"}};
 	for (int i = 0; i < 3 && rc == BSIM_OK; i++) {
-		char src[1200], mat[1200];
+		char src[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
 		snprintf(src, sizeof src, "%s/%s", ss.stage, twins[i][0]);
 		snprintf(mat, sizeof mat, "%s/%.*s%s", ss.stage, (int)strcspn(twins[i][0], "."),
 		         twins[i][0], i == 2 ? "_summary.mat" : ".mat");

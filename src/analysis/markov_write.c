@@ -9,10 +9,11 @@
 #include "beamsim/lattice_outcome.h"
 #include "store/matlab.h"
 #include "store/session.h"
+#include "beamsim/limits.h"
 
 static int write_tables(const char *stage, const bsim_markov_prediction *p, bsim_error *err)
 {
-	char path[1200];
+	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	snprintf(path, sizeof path, "%s/prediction.csv", stage);
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
@@ -46,7 +47,7 @@ int bsim_markov_prediction_store(const char *dir, const bsim_markov_prediction *
 	rc = write_tables(ss.stage, p, err);
 	static const char *const names[] = {"prediction", "prediction_gates"};
 	for (int i = 0; i < 2 && rc == BSIM_OK; i++) {
-		char csv[1200], mat[1200];
+		char csv[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
 		snprintf(csv, sizeof csv, "%s/%s.csv", ss.stage, names[i]);
 		snprintf(mat, sizeof mat, "%s/%s.mat", ss.stage, names[i]);
 		rc = bsim_matlab_from_csv(csv, mat, names[i], err);

@@ -13,6 +13,7 @@
 #include "util/figure.h"
 #include "figures/figures_kinds.h"
 #include "figures/figures_toolkit.h"
+#include "beamsim/limits.h"
 
 const char *bsim_figures_kind_name(bsim_figures_kind k)
 {
@@ -39,7 +40,7 @@ void bsim_figures_result_free(bsim_figures_result *r)
 
 static int has(const char *dir, const char *file)
 {
-	char path[1200];
+	char path[BSIM_PATH_MAX];
 	struct stat st;
 	snprintf(path, sizeof path, "%s/%s", dir, file);
 	return stat(path, &st) == 0 && S_ISREG(st.st_mode);
@@ -63,7 +64,7 @@ int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures
 {
 	memset(out, 0, sizeof *out);
 	bsim_figures_def d = def ? *def : bsim_figures_default();
-	if (strlen(dir) > 900 || (d.out && strlen(d.out) > 900))
+	if (strlen(dir) > BSIM_DIR_MAX || (d.out && strlen(d.out) > BSIM_DIR_MAX))
 		return bsim_error_set(err, BSIM_EINPUT, "%s: path too long", dir);
 	struct stat st;
 	if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
@@ -86,7 +87,7 @@ int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures
 	int rc = bsim_output_mkdir(f.out, err);
 	if (rc)
 		return rc;
-	char inputs[1100];
+	char inputs[BSIM_PATH_MAX];
 	snprintf(inputs, sizeof inputs, "%s/inputs", dir);
 	switch (kind) {
 	case BSIM_FIGURES_SWEEP:

@@ -13,6 +13,7 @@
 #include "figures/figures_kinds.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
+#include "beamsim/limits.h"
 
 static const char *const palette[] = {FIG_BLUE, FIG_RED,    FIG_GREEN, FIG_ORANGE,
                                       FIG_SKY,  FIG_PURPLE, FIG_BLACK, "#8C6D31"};
@@ -38,7 +39,7 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 		                      "%s: --select chooses groups of a sweep; the accuracy study "
 		                      "has none",
 		                      dir);
-	char path[1100], file[1100];
+	char path[BSIM_PATH_MAX], file[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/accuracy.csv", dir);
 	csv_table t;
 	int rc = csv_table_read(path, &t, err);

@@ -15,6 +15,7 @@
 #include "figures/figures_summary.h"
 #include "figures/figures_toolkit.h"
 #include "util/yaml_doc.h"
+#include "beamsim/limits.h"
 
 static double num(struct fy_node *root, const char *path, int *bad)
 {
@@ -61,7 +62,7 @@ enum { N_EV = 6 };
 static int compare_data(figs *f, const ydoc *d, const fsum *s, int *n_rows, bsim_error *err)
 {
 	struct fy_node *root = fy_document_root(d->fyd);
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	int rc = figs_data_open(f, "compare.dat", &o, path, err);
 	if (rc)
@@ -259,7 +260,7 @@ static int lattice_figures(figs *f, const ydoc *d, const fsum *s, const char *di
 	struct fy_node *root = fy_document_root(d->fyd);
 	char(*lines)[400] = calloc((size_t)s->n_groups + 1, sizeof *lines);
 	const char **tests = calloc((size_t)s->n_groups + 1, sizeof *tests);
-	char dirs[2][1100], labels[2][128];
+	char dirs[2][BSIM_PATH_MAX], labels[2][128];
 	int rc = BSIM_OK;
 	if (!lines || !tests)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
@@ -281,7 +282,7 @@ static int lattice_figures(figs *f, const ydoc *d, const fsum *s, const char *di
 
 int figs_compare(figs *f, const char *dir, bsim_error *err)
 {
-	char path[1100], sub[1100], out[1100], inputs[1100];
+	char path[BSIM_PATH_MAX], sub[BSIM_PATH_MAX], out[BSIM_PATH_MAX], inputs[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/report.json", dir);
 	ydoc d;
 	int rc = ydoc_load(&d, path, err);

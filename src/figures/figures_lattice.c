@@ -41,6 +41,7 @@
 #include "figures/figures_summary.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
+#include "beamsim/limits.h"
 
 /* ---- the data of a lattice run -------------------------------------------------------- */
 
@@ -87,7 +88,7 @@ static void flats_free(flats *l)
 
 static int file_exists(const char *dir, const char *file)
 {
-	char path[1200];
+	char path[BSIM_PATH_MAX];
 	struct stat st;
 	snprintf(path, sizeof path, "%s/%s", dir, file);
 	return stat(path, &st) == 0 && S_ISREG(st.st_mode);
@@ -96,7 +97,7 @@ static int file_exists(const char *dir, const char *file)
 /* lattice_map.csv: every gate of every group once. */
 static int map_read(const char *dir, flats *l, bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/lattice_map.csv", dir);
 	csv_table t;
 	int rc = csv_table_read(path, &t, err);
@@ -188,7 +189,7 @@ static int map_read(const char *dir, flats *l, bsim_error *err)
 /* trials.csv: each trial's final location counted. */
 static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/trials.csv", dir);
 	csv_table t;
 	int rc = csv_table_read(path, &t, err);
@@ -426,7 +427,7 @@ static void gate_marks(FILE *g, const flat *a, const bsim_scene *sc, const doubl
 static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
                               const bsim_scene *sc, const lpath *p, int n, bsim_error *err)
 {
-	char name[64], file[80], path[1100];
+	char name[64], file[80], path[BSIM_PATH_MAX];
 	snprintf(name, sizeof name, "lattice_g%03d", gi);
 	snprintf(file, sizeof file, "%s.dat", name);
 	bsim_atomic_file o;
@@ -703,7 +704,7 @@ static void locations_region(FILE *g, const char *file, int b0, const flat *a, d
 static int locations_figure(figs *f, const char *name, const char *title, const flat *const *runs,
                             const char *const *labels, int n_runs, bsim_error *err)
 {
-	char file[200], path[1100];
+	char file[200], path[BSIM_PATH_MAX];
 	snprintf(file, sizeof file, "%s.dat", name);
 	bsim_atomic_file o;
 	int rc = figs_data_open(f, file, &o, path, err);
@@ -779,7 +780,7 @@ static void lat_free(lat_job *j)
 /* The kept trajectories as paths: runs of rows of one (group, trial). */
 static int paths_read(const char *dir, lat_job *j, bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/trajectories.csv", dir);
 	int rc = csv_table_read(path, &j->table, err);
 	if (rc)
@@ -873,7 +874,7 @@ int figs_lattice_load(figs *f, const char *dir, const char *inputs, const fsum *
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	j->s = s;
 	int rc = flats_read(dir, s, &j->l, err);
-	char exp_path[1100];
+	char exp_path[BSIM_PATH_MAX];
 	snprintf(exp_path, sizeof exp_path, "%s/experiment.yaml", inputs);
 	struct stat st;
 	if (!rc && stat(exp_path, &st) == 0) {

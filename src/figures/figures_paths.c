@@ -21,6 +21,7 @@
 #include "figures/figures_paths.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
+#include "beamsim/limits.h"
 
 static const struct {
 	const char *name, *color;
@@ -219,7 +220,7 @@ static int thin_keep(thin *t, double x, double y, double e, int below, int last)
 int figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *scene,
                 const fpath *p, int n, bsim_error *err)
 {
-	char file[200], path[1100];
+	char file[200], path[BSIM_PATH_MAX];
 	snprintf(file, sizeof file, "%s.dat", name);
 	bsim_atomic_file o;
 	int rc = figs_data_open(f, file, &o, path, err);
@@ -294,7 +295,7 @@ int figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *
 static int surface_write(figs *f, const char *file, const bsim_scene *s, const double box[4],
                          double cap, double *e_min, bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	int rc = figs_data_open(f, file, &o, path, err);
 	if (rc)
@@ -346,7 +347,7 @@ static double surface_cap(const bsim_scene *s, const fpath *p, int n, unsigned m
 static int paths_write(figs *f, const char *file, const bsim_scene *s, const fpath *p, int n,
                        unsigned mask, long *below, long *total, bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	int rc = figs_data_open(f, file, &o, path, err);
 	if (rc)

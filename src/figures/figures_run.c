@@ -18,6 +18,7 @@
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
 #include "util/yaml_doc.h"
+#include "beamsim/limits.h"
 
 /* The scene of the run: inputs/scene.yaml with run.json's "set"
  * overrides; outcome and type of the trial into the buffers. *found is 0
@@ -25,7 +26,7 @@
 static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *type, int *found,
                      bsim_error *err)
 {
-	char path[1100], scene_path[1100];
+	char path[BSIM_PATH_MAX], scene_path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/run.json", dir);
 	snprintf(scene_path, sizeof scene_path, "%s/inputs/scene.yaml", dir);
 	struct stat st;
@@ -115,7 +116,7 @@ static int random_force(figs *f, const csv_table *t, const char *path, const bsi
 		int b = (int)floor((ff[r] - lo) / width);
 		hist[b < 0 ? 0 : b >= BINS ? BINS - 1 : b]++;
 	}
-	char file[1100];
+	char file[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	if (!rc)
 		rc = figs_data_open(f, "random_force.dat", &o, file, err);
@@ -169,7 +170,7 @@ static int random_force(figs *f, const csv_table *t, const char *path, const bsi
 
 static int ledger(figs *f, const char *dir, bsim_error *err)
 {
-	char path[1100], file[1100];
+	char path[BSIM_PATH_MAX], file[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/ledger.csv", dir);
 	csv_table t;
 	int rc = csv_table_read(path, &t, err);
@@ -259,7 +260,7 @@ int figs_run(figs *f, const char *dir, bsim_error *err)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: --select chooses groups of a sweep; a run has none",
 		                      dir);
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/trajectory.csv", dir);
 	bsim_scene scene;
 	char outcome[32] = "", type[32] = "";

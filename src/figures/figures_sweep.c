@@ -24,6 +24,7 @@
 #include "figures/figures_summary.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
+#include "beamsim/limits.h"
 
 /* Positions of the selected values of each axis (-1: not selected) and
  * their number. */
@@ -123,7 +124,7 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	const int ax0 = s->n_axes > 0 ? 0 : -1, ax1 = s->n_axes > 1 ? 1 : -1;
 	const int n0 = ax0 >= 0 ? a->n[0] : 1, n1 = ax1 >= 0 ? a->n[1] : 1;
 	const int np = panels(s, a, ax0, ax1);
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	int rc = figs_data_open(f, "p_traverse.dat", &o, path, err);
 	if (rc)
@@ -221,7 +222,7 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 {
 	const fsum_axis *A = &s->axes[ax];
 	const int np = panels(s, a, ax, -1);
-	char ident[64], name[128], file[160], path[1100];
+	char ident[64], name[128], file[160], path[BSIM_PATH_MAX];
 	bsim_mat_name(A->key, ident, sizeof ident);
 	snprintf(name, sizeof name, "traversal_vs_%s", ident);
 	snprintf(file, sizeof file, "%s.dat", name);
@@ -417,7 +418,7 @@ typedef struct traj_job {
 /* The classes of the paths from trials.csv (outcome and type by name). */
 static int classes_read(const char *dir, const fsum *s, fpaths *ps, bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/trials.csv", dir);
 	const long per = s->trials_per_group;
 	int *which = malloc(((size_t)s->n_groups * (size_t)per + 1) * sizeof *which);
@@ -518,7 +519,7 @@ static void untraversed_note(figs *f, const char *dir, const char *flag, int n)
 static int traj_load(figs *f, const char *dir, const char *inputs, const fsum *s, traj_job *j,
                      int *have, bsim_error *err)
 {
-	char path[1100], exp_path[1100];
+	char path[BSIM_PATH_MAX], exp_path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/trajectories.csv", dir);
 	snprintf(exp_path, sizeof exp_path, "%s/experiment.yaml", inputs);
 	struct stat st;
@@ -591,7 +592,7 @@ static int traj_draw(figs *f, const char *dir, traj_job *j, bsim_error *err)
 
 int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/summary.json", dir);
 	fsum s;
 	int rc = fsum_read(path, &s, err);

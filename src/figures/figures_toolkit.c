@@ -8,11 +8,12 @@
 #include <string.h>
 
 #include "util/figure.h"
+#include "beamsim/limits.h"
 
 int figs_data_open(const figs *f, const char *file, bsim_atomic_file *o, char *path,
                    bsim_error *err)
 {
-	if (snprintf(path, 1100, "%s/%s", f->out, file) >= 1100)
+	if (snprintf(path, BSIM_PATH_MAX, "%s/%s", f->out, file) >= BSIM_PATH_MAX)
 		return bsim_error_set(err, BSIM_EFAIL, "%s/%s: path too long", f->out, file);
 	return bsim_atomic_file_open(o, path, err);
 }

@@ -14,6 +14,7 @@
 
 #include "beamsim/figures.h"
 #include "util/atomic_file.h"
+#include "beamsim/limits.h"
 
 /* Colours that stay apart for colour-blind readers (Okabe & Ito) and in
  * grey print, as gnuplot colour specs. */
@@ -37,7 +38,7 @@ typedef struct figs {
 
 /* Files. */
 
-/* Opens OUT/file for writing; path (size >= 1100) gets its name. */
+/* Opens OUT/file for writing; path (BSIM_PATH_MAX bytes) gets its name. */
 int figs_data_open(const figs *f, const char *file, bsim_atomic_file *o, char *path,
                    bsim_error *err);
 int figs_data_commit(bsim_atomic_file *o, bsim_error *err);

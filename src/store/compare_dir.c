@@ -15,6 +15,7 @@
 #include "beamsim/run_record.h"
 #include "store/session.h"
 #include "store/store.h"
+#include "beamsim/limits.h"
 
 bsim_compare_dir_def bsim_compare_dir_default(void)
 {
@@ -146,7 +147,7 @@ static int compare_write(const compare_job *job, const bsim_sweep_result r[2], c
 	        .examples = def->examples,
 	};
 	for (int i = 0; i < 2; i++) {
-		char dir[1100];
+		char dir[BSIM_PATH_MAX];
 		rep.side[i] =
 		        (bsim_report_side){job->label[i], job->backend[i], job->opts[i], &r[i]};
 		if (bsim_session_path(dir, sizeof dir, job->out, job->dir[i], err) ||

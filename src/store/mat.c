@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "beamsim/version.h"
+#include "beamsim/limits.h"
 
 bsim_mat_field bsim_mat_column(const char *name, const double *data, size_t rows)
 {
@@ -154,7 +155,7 @@ static int sync_path(const char *path)
 
 int bsim_mat_write(const char *path, const bsim_mat_field *vars, int n_vars, bsim_error *err)
 {
-	char tmp[1100];
+	char tmp[BSIM_PATH_MAX];
 	if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid()) >= (int)sizeof tmp)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", path);
 	char header[116];

@@ -15,6 +15,7 @@
 #include "util/csv_table.h"
 #include "store/mat.h"
 #include "util/yaml_doc.h"
+#include "beamsim/limits.h"
 
 /* ---- an arena of allocations freed together -------------------------- */
 
@@ -455,7 +456,7 @@ static int group_params(arena *a, const csv_table *t, const char *path, const bs
  * name if it has a group column. */
 static int sweep_table(const char *dir, const char *name, const bsim_experiment *e, bsim_error *err)
 {
-	char csv[1200], mat[1200];
+	char csv[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
 	snprintf(csv, sizeof csv, "%s/%s.csv", dir, name);
 	snprintf(mat, sizeof mat, "%s/%s.mat", dir, name);
 	csv_table t;
@@ -478,8 +479,8 @@ static int sweep_table(const char *dir, const char *name, const bsim_experiment 
 
 int bsim_matlab_sweep(const char *dir, const bsim_experiment *e, bsim_error *err)
 {
-	char json[1200], mat[1200], traj[1200];
-	if (strlen(dir) > 1000)
+	char json[BSIM_PATH_MAX], mat[BSIM_PATH_MAX], traj[BSIM_PATH_MAX];
+	if (strlen(dir) + sizeof "/trajectories.csv" > sizeof json)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", dir);
 	snprintf(json, sizeof json, "%s/summary.json", dir);
 	snprintf(mat, sizeof mat, "%s/summary.mat", dir);

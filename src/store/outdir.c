@@ -26,8 +26,8 @@
 #include "util/json.h"
 #include "beamsim/version.h"
 #include "util/yaml_doc.h"
+#include "beamsim/limits.h"
 
-#define PATH_MAX_OUT 1200
 
 struct bsim_outdir {
 	char dir[1024];
@@ -98,7 +98,7 @@ static int join(char *buf, size_t size, const char *a, const char *b)
 /* mkdir -p: 0 or the errno of the failure. */
 static int mkdir_p(const char *dir)
 {
-	char path[PATH_MAX_OUT];
+	char path[BSIM_PATH_MAX];
 	struct stat st;
 	if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path)
 		return ENAMETOOLONG;
@@ -130,7 +130,7 @@ static void rm_tree(const char *path)
 		while (d && (e = readdir(d))) {
 			if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
 				continue;
-			char sub[PATH_MAX_OUT];
+			char sub[BSIM_PATH_MAX];
 			if (join(sub, sizeof sub, path, e->d_name) == 0)
 				rm_tree(sub);
 		}
@@ -170,7 +170,7 @@ static int crc_file(const char *path, int sync, long long *bytes, unsigned long 
 /* Every file below root/rel, as paths relative to root. */
 static int collect(const char *root, const char *rel, olist *l, char *bad, size_t bad_size)
 {
-	char path[PATH_MAX_OUT];
+	char path[BSIM_PATH_MAX];
 	if (join(path, sizeof path, root, rel))
 		return ENAMETOOLONG;
 	DIR *d = opendir(path);
@@ -183,7 +183,7 @@ static int collect(const char *root, const char *rel, olist *l, char *bad, size_
 	while (!rc && (e = readdir(d))) {
 		if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
 			continue;
-		char sub[PATH_MAX_OUT], full[PATH_MAX_OUT];
+		char sub[BSIM_PATH_MAX], full[BSIM_PATH_MAX];
 		struct stat st;
 		if (rel[0] ? join(sub, sizeof sub, rel, e->d_name)
 		           : join(sub, sizeof sub, e->d_name, "")) {
@@ -349,7 +349,7 @@ static void fsync_dir(const char *dir)
 /* The files a manifest lists (none if there is no manifest). */
 static int manifest_read(const char *dir, olist *l, int *has, bsim_error *err)
 {
-	char path[PATH_MAX_OUT];
+	char path[BSIM_PATH_MAX];
 	struct stat st;
 	*has = 0;
 	if (join(path, sizeof path, dir, BSIM_OUTDIR_MANIFEST) || stat(path, &st) != 0)
@@ -385,7 +385,7 @@ static int manifest_read(const char *dir, olist *l, int *has, bsim_error *err)
 
 static int manifest_write(const char *dir, const char *command, const olist *l, bsim_error *err)
 {
-	char path[PATH_MAX_OUT];
+	char path[BSIM_PATH_MAX];
 	if (join(path, sizeof path, dir, BSIM_OUTDIR_MANIFEST))
 		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", dir);
 	bsim_atomic_file o;
@@ -414,7 +414,7 @@ static int commit_fail(bsim_error *err, const char *dir, const char *rel, int e)
 static int commit_set(bsim_outdir *od, const char *command, int add, bsim_error *err)
 {
 	olist now = {0}, before = {0};
-	char bad[PATH_MAX_OUT] = "";
+	char bad[BSIM_PATH_MAX] = "";
 	int has = 0, rc = BSIM_OK;
 	int e = collect(od->stage, "", &now, bad, sizeof bad);
 	if (e) {
@@ -427,7 +427,7 @@ static int commit_set(bsim_outdir *od, const char *command, int add, bsim_error 
 	bsim_error ignored;
 	if (manifest_read(od->dir, &before, &has, &ignored) != BSIM_OK)
 		olist_free(&before);
-	char path[PATH_MAX_OUT], staged[PATH_MAX_OUT];
+	char path[BSIM_PATH_MAX], staged[BSIM_PATH_MAX];
 	if (join(path, sizeof path, od->dir, BSIM_OUTDIR_MANIFEST) == 0 && unlink(path) == 0)
 		fsync_dir(od->dir);
 	for (size_t i = 0; !rc && i < now.n; i++) {
@@ -505,7 +505,7 @@ int bsim_outdir_verify(const char *dir, int *has_manifest, bsim_error *err)
 	olist l = {0};
 	int rc = manifest_read(dir, &l, has_manifest, err);
 	for (size_t i = 0; !rc && i < l.n; i++) {
-		char path[PATH_MAX_OUT];
+		char path[BSIM_PATH_MAX];
 		long long bytes = 0;
 		unsigned long crc = 0;
 		int e = join(path, sizeof path, dir, l.v[i].rel);

@@ -24,6 +24,7 @@
 #include "store/matlab.h"
 #include "beamsim/output.h"
 #include "beamsim/lattice_outcome.h"
+#include "beamsim/limits.h"
 
 typedef int (*lattice_writer)(FILE *f, const bsim_experiment *e, const bsim_override *extra,
                               int n_extra, const bsim_sweep_result *r, bsim_error *err);
@@ -170,7 +171,7 @@ int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_ov
 	if (!r->lattice || !r->logs)
 		return BSIM_OK;
 	for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
-		char path[1200];
+		char path[BSIM_PATH_MAX];
 		int n = snprintf(path, sizeof path, "%s/%s", dir, files[k].name);
 		if (n < 0 || (size_t)n >= sizeof path)
 			return bsim_error_set(err, BSIM_EFAIL, "%s/%s: path too long", dir,
@@ -186,7 +187,7 @@ int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_ov
 		if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
 			return BSIM_EFAIL;
 		/* its MATLAB twin (store/matlab.h), a struct named for the file */
-		char mat[1200], var[32];
+		char mat[BSIM_PATH_MAX], var[32];
 		snprintf(var, sizeof var, "%.*s", (int)strcspn(files[k].name, "."), files[k].name);
 		if (bsim_matlab_path(path, mat, sizeof mat, err) != BSIM_OK ||
 		    bsim_matlab_from_csv(path, mat, var, err) != BSIM_OK)

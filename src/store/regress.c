@@ -17,6 +17,7 @@
 #include "util/json.h"
 #include "store/session.h"
 #include "store/store.h"
+#include "beamsim/limits.h"
 
 bsim_regress_def bsim_regress_default(void)
 {
@@ -31,7 +32,7 @@ bsim_regress_def bsim_regress_default(void)
 static int regress_load(const bsim_regress_def *def, bsim_regress_result *res,
                         const bsim_backend *backend[2], bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	int has_manifest = 0;
 	if (bsim_outdir_verify(def->baseline, &has_manifest, err) != BSIM_OK ||
 	    bsim_run_record_read(def->baseline, &res->rec, err) != BSIM_OK)
@@ -94,7 +95,7 @@ static int regress_rerun(const bsim_regress_def *def, bsim_regress_result *res,
 static int side_read(const bsim_regress_result *res, const char *dir, int i, bsim_sweep_result *r,
                      bsim_error *err)
 {
-	char path[1200], sub[1100];
+	char path[BSIM_PATH_MAX], sub[BSIM_PATH_MAX];
 	if (res->rec.n_backends == 2) {
 		char name[128];
 		bsim_compare_dir_label(res->rec.label[i], name, sizeof name);

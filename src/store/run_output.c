@@ -14,6 +14,7 @@
 #include "beamsim/version.h"
 #include "beamsim/lattice_outcome.h"
 #include "store/session.h"
+#include "beamsim/limits.h"
 
 bsim_run_info bsim_run_info_default(void)
 {
@@ -160,8 +161,8 @@ void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_r
 
 /* The open files of `run --out DIR`, in the staging area. */
 typedef struct run_dir {
-	char dir[1100];
-	char traj_path[1200], ledger_path[1200];
+	char dir[BSIM_PATH_MAX - BSIM_NAME_MAX];
+	char traj_path[BSIM_PATH_MAX], ledger_path[BSIM_PATH_MAX];
 	bsim_atomic_file traj, ledger;
 } run_dir;
 
@@ -200,7 +201,7 @@ static void run_dir_abort(run_dir *o)
 static int run_dir_commit(run_dir *o, const bsim_run_info *info, const bsim_trial_result *r,
                           bsim_error *err)
 {
-	char path[1200], mat[1200];
+	char path[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
 	int rc = bsim_atomic_file_commit(&o->traj, err);
 	if (rc) {
 		bsim_atomic_file_abort(&o->ledger);
@@ -237,7 +238,7 @@ static int run_dir_commit(run_dir *o, const bsim_run_info *info, const bsim_tria
  * link's twin would not be its). */
 static int trajectory_commit(bsim_atomic_file *traj, const char *path, bsim_error *err)
 {
-	char mat[1200];
+	char mat[BSIM_PATH_MAX];
 	int through = traj->mode != BSIM_ATOMIC_RENAME;
 	int rc = bsim_atomic_file_commit(traj, err);
 	if (rc == BSIM_OK && !through) {

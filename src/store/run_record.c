@@ -192,7 +192,7 @@ static int copy_stiffness_files(const char *inputs, const bsim_experiment *e,
 			return BSIM_OK; /* a gate experiment: no group is a lattice */
 		if (!name[0])
 			continue;
-		char from[1400], to[1400];
+		char from[BSIM_PATH_MAX], to[BSIM_PATH_MAX];
 		const char *slash = strrchr(e->scene_path, '/');
 		int dir = slash ? (int)(slash - e->scene_path + 1) : 0;
 		snprintf(from, sizeof from, "%.*s%s", dir, e->scene_path, name);
@@ -211,7 +211,7 @@ static int copy_stiffness_files(const char *inputs, const bsim_experiment *e,
 int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsim_experiment *e,
                           const bsim_override *extra, int n_extra, bsim_error *err)
 {
-	char inputs[1100], path[1200];
+	char inputs[BSIM_PATH_MAX], path[BSIM_PATH_MAX];
 	if (path_join(inputs, sizeof inputs, dir, "inputs", err) ||
 	    bsim_output_mkdir(inputs, err) != BSIM_OK)
 		return BSIM_EFAIL;
@@ -288,7 +288,7 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 
 int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	ydoc d;
 	memset(rec, 0, sizeof *rec);
 	if (path_join(path, sizeof path, dir, "run.json", err))

@@ -11,13 +11,14 @@
 #include "beamsim/error.h"
 #include "util/journal.h"
 #include "store/outdir.h"
+#include "beamsim/limits.h"
 
 typedef struct bsim_session {
 	const char *dir;   /* as the caller gave it */
 	const char *stage; /* where to write */
 	bsim_outdir *od;
 	bsim_journal *journal;
-	char journal_path[1100];
+	char journal_path[BSIM_PATH_MAX];
 	int add; /* set before closing: the files join DIR's set (bsim_outdir_add) */
 } bsim_session;
 

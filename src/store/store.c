@@ -10,12 +10,13 @@
 #include "beamsim/output.h"
 #include "store/matlab.h"
 #include "store/session.h"
+#include "beamsim/limits.h"
 
 int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
                            const bsim_options *opts, const bsim_override *extra, int n_extra,
                            const bsim_sweep_result *r, bsim_error *err)
 {
-	char summary[1100], trials[1100], traj[1100], traj_mat[1100];
+	char summary[BSIM_PATH_MAX], trials[BSIM_PATH_MAX], traj[BSIM_PATH_MAX], traj_mat[BSIM_PATH_MAX];
 	if (bsim_session_path(summary, sizeof summary, dir, "summary.json", err) ||
 	    bsim_session_path(trials, sizeof trials, dir, "trials.csv", err) ||
 	    bsim_session_path(traj, sizeof traj, dir, "trajectories.csv", err) ||
@@ -37,7 +38,7 @@ int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim
 
 int bsim_store_twin(const char *dir, const char *file, const char *var, bsim_error *err)
 {
-	char path[1100], mat[1100];
+	char path[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
 	if (bsim_session_path(path, sizeof path, dir, file, err))
 		return BSIM_EFAIL;
 	int rc = bsim_matlab_path(path, mat, sizeof mat, err);
@@ -50,7 +51,7 @@ int bsim_store_twin(const char *dir, const char *file, const char *var, bsim_err
 int bsim_store_text(const char *dir, const char *name, const char *head, bsim_store_text_fn fn,
                     const void *arg, bsim_error *err)
 {
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	if (bsim_session_path(path, sizeof path, dir, name, err) ||
 	    bsim_atomic_file_open(&o, path, err) != BSIM_OK)

@@ -18,6 +18,7 @@
 #include "beamsim/run_record.h"
 #include "store/session.h"
 #include "store/store.h"
+#include "beamsim/limits.h"
 
 bsim_sweep_dir_def bsim_sweep_dir_default(void)
 {
@@ -144,7 +145,7 @@ int bsim_sweep_dir_read(const char *dir, const char *side, bsim_sweep_dir_result
                         bsim_error *err)
 {
 	bsim_run_record rec;
-	char path[1200], sub[1100];
+	char path[BSIM_PATH_MAX], sub[BSIM_PATH_MAX];
 	int has_manifest = 0;
 	memset(res, 0, sizeof *res);
 	res->first_unstable = -1;

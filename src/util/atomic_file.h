@@ -22,13 +22,11 @@
 #include <stdio.h>
 
 #include "beamsim/error.h"
+#include "beamsim/limits.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* Room for a 1 KiB path plus ".tmp." and a process id. */
-#define BSIM_ATOMIC_FILE_TMP_MAX 1100
 
 typedef enum {
 	BSIM_ATOMIC_RENAME = 0, /* a regular file (or none yet): temporary + rename */
@@ -39,7 +37,7 @@ typedef enum {
 typedef struct bsim_atomic_file {
 	FILE *f;          /* write here; NULL once committed or aborted */
 	const char *path; /* the final name, not copied: must outlive o */
-	char tmp[BSIM_ATOMIC_FILE_TMP_MAX];
+	char tmp[BSIM_PATH_MAX]; /* path + ".tmp." + a process id */
 	bsim_atomic_mode mode;
 } bsim_atomic_file;
 

@@ -28,6 +28,7 @@
 
 #include "util/atomic_file.h"
 #include "beamsim/version.h"
+#include "beamsim/limits.h"
 
 bsim_figure_def bsim_figure_default(void)
 {
@@ -112,7 +113,7 @@ static int script_write(const bsim_figure_def *d, const char *body, bsim_error *
  * to /dev/null and its messages to ours. The process id, or -1. */
 static pid_t gnuplot_start(const char *dir, const char *name, const char *tmpbase)
 {
-	char script[1100], expr[1200];
+	char script[BSIM_PATH_MAX], expr[BSIM_PATH_MAX];
 	snprintf(script, sizeof script, "%s.gp", name);
 	snprintf(expr, sizeof expr, "outbase=\"%s\"", tmpbase);
 	fflush(NULL);
@@ -145,7 +146,7 @@ static int gnuplot_wait(pid_t pid)
 static int images_commit(const bsim_figure_def *d, const char *tmpbase, int status, bsim_error *err)
 {
 	static const char *const ext[] = {"png", "svg"};
-	char from[1400], to[1400];
+	char from[BSIM_PATH_MAX], to[BSIM_PATH_MAX];
 	if (status != 0) {
 		for (int i = 0; i < 2; i++) {
 			snprintf(from, sizeof from, "%s/%s.%s", d->dir, tmpbase, ext[i]);

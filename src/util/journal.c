@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "util/journal.h"
+#include "beamsim/limits.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -26,7 +27,7 @@ struct bsim_journal {
 	pthread_mutex_t lock;
 	double last_sync; /* s, monotonic */
 	int failed;       /* an append failed: refuse the rest */
-	char path[1100];
+	char path[BSIM_PATH_MAX];
 };
 
 static double now_seconds(void)
@@ -120,7 +121,7 @@ int bsim_journal_create(bsim_journal **out, const char *path, const char *inputs
 	bsim_journal *j = journal_alloc(path, record_size);
 	size_t n = 0;
 	unsigned char *h = j ? header_encode(inputs, record_size, &n) : NULL;
-	char tmp[1200];
+	char tmp[BSIM_PATH_MAX];
 	if (!h || snprintf(tmp, sizeof tmp, "%s.new", path) >= (int)sizeof tmp) {
 		if (j)
 			journal_free(j);

@@ -34,12 +34,13 @@
 
 #include "util/atomic_file.h"
 #include "beamsim/video.h"
+#include "beamsim/limits.h"
 
 extern char **environ;
 
 struct bsim_video_encoder {
 	bsim_atomic_file out; /* ffmpeg writes out.tmp; renamed on success */
-	char path[BSIM_ATOMIC_FILE_TMP_MAX];
+	char path[BSIM_PATH_MAX];
 	char program[256];
 	pid_t pid; /* 0 once reaped */
 	int status;
@@ -125,7 +126,7 @@ static int set_cloexec(int fd)
 static int spawn(bsim_video_encoder *e, int width, int height, double fps, int crf, int read_fd,
                  bsim_error *err)
 {
-	char size[48], rate[48], quality[16], output[BSIM_ATOMIC_FILE_TMP_MAX + 8];
+	char size[48], rate[48], quality[16], output[BSIM_PATH_MAX + 8];
 	snprintf(size, sizeof size, "%dx%d", width, height);
 	snprintf(rate, sizeof rate, "%.10g", fps);
 	snprintf(quality, sizeof quality, "%d", crf);
