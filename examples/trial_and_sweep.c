@@ -53,8 +53,7 @@ static int sweep(const char *path, int trials)
 	if (bsim_experiment_load(path, NULL, 0, &e, &err) != BSIM_OK)
 		return fail(&err);
 	e.trials = trials;
-	const bsim_options none = {0};
-	bsim_sweep_config cfg = {.backend = bsim_backend_default(), .opts = &none};
+	bsim_sweep_config cfg = bsim_sweep_config_default();
 	bsim_sweep_result res;
 	int rc = bsim_sweep_run(&e, &cfg, &res, &err);
 	if (rc != BSIM_OK) {

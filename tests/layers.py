@@ -15,7 +15,9 @@ compiled objects:
    BSIM_<FOLDER>_<NAME>_H for the others;
 5. every function a public header declares is defined in that header's
    layer, so that a header is one layer's API;
-6. beamsim/beamsim.h includes every public header.
+6. beamsim/beamsim.h includes every public header;
+7. every definition struct of the public API (bsim_*_def, bsim_*_config)
+   has its default function, named bsim_<struct>_default.
 
 Usage: layers.py SOURCE_DIR BUILD_DIR. Prints every breach and exits 1 if
 there is one."""
@@ -260,6 +262,15 @@ def check_umbrella(src, breaches):
             breaches.append(f"include/beamsim/beamsim.h does not include beamsim/{n}")
 
 
+def check_defaults(src, breaches):
+    text = ""
+    for h in sorted(glob.glob(os.path.join(src, "include", "beamsim", "*.h"))):
+        text += strip_comments(open(h, encoding="utf-8").read())
+    for name in sorted(set(re.findall(r"typedef struct (bsim_\w+_(?:def|config)) \{", text))):
+        if not re.search(r"\b" + name + r"_default\s*\(\s*void\s*\)", text):
+            breaches.append(f"{name} has no default function {name}_default(void)")
+
+
 def main():
     if len(sys.argv) != 3:
         print(__doc__.splitlines()[-2], file=sys.stderr)
@@ -273,6 +284,7 @@ def main():
     check_sizes(src, breaches)
     check_guards(src, breaches)
     check_umbrella(src, breaches)
+    check_defaults(src, breaches)
     for b in breaches:
         print(b)
     print(f"layers: {len(breaches)} breach(es)")

@@ -124,7 +124,7 @@ static void test_figure_drawn(void **state)
 		skip();
 	const char *dir = bsim_test_dir("figure");
 	bsim_test_write(dir, "sine.dat", "0 0\n1 0.84\n2 0.91\n3 0.14\n");
-	bsim_figure_def d = bsim_figure_default();
+	bsim_figure_def d = bsim_figure_def_default();
 	d.dir = dir;
 	d.name = "sine";
 	d.width = 640;
@@ -168,7 +168,7 @@ static void test_figure_error_named(void **state)
 	if (!bsim_figure_available())
 		skip();
 	const char *dir = bsim_test_dir("figure_bad");
-	bsim_figure_def d = bsim_figure_default();
+	bsim_figure_def d = bsim_figure_def_default();
 	d.dir = dir;
 	d.name = "bad";
 	bsim_error err;
@@ -189,7 +189,7 @@ static void test_figure_without_gnuplot(void **state)
 	const char *dir = bsim_test_dir("figure_nognuplot");
 	char *old = getenv("PATH") ? strdup(getenv("PATH")) : NULL;
 	setenv("PATH", dir, 1); /* an empty directory: no gnuplot */
-	bsim_figure_def d = bsim_figure_default();
+	bsim_figure_def d = bsim_figure_def_default();
 	d.dir = dir;
 	d.name = "f";
 	int drawn = -1;
@@ -212,7 +212,7 @@ static void test_figure_without_gnuplot(void **state)
 static void test_figure_bad_name(void **state)
 {
 	(void)state;
-	bsim_figure_def d = bsim_figure_default();
+	bsim_figure_def d = bsim_figure_def_default();
 	d.dir = "/tmp";
 	d.name = "a'b";
 	bsim_error err;

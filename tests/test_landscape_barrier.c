@@ -44,7 +44,7 @@ static void gate(bsim_scene *s, double k1, double k2, double f)
 
 static bsim_landscape_barriers *barriers(const bsim_scene *s, double spacing)
 {
-	bsim_landscape_grid_def def = bsim_landscape_grid_default();
+	bsim_landscape_grid_def def = bsim_landscape_grid_def_default();
 	def.spacing = spacing;
 	bsim_landscape_grid *g;
 	bsim_landscape_barriers *b;

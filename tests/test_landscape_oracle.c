@@ -147,7 +147,7 @@ static void rest_at_basin_floor(const bsim_backend *be, double tol)
 	bsim_landscape_grid *g;
 	bsim_landscape_barriers *br;
 	bsim_error err;
-	bsim_landscape_grid_def def = bsim_landscape_grid_default();
+	bsim_landscape_grid_def def = bsim_landscape_grid_def_default();
 	assert_int_equal(bsim_landscape_grid_alloc(&s, &def, &g, &err), BSIM_OK);
 	assert_int_equal(bsim_landscape_barriers_alloc(&s, g, &br, &err), BSIM_OK);
 	assert_int_equal(br->lowest.kind, BSIM_PASS_SADDLE);

@@ -204,6 +204,39 @@ static void defaults_fill_what_a_file_leaves_out(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The parts' default functions against the essay's gate and lattice as the
+ * shipped files give them (Table 2.1, Sec. 2.6), and against what a file
+ * that leaves the keys out gets. */
+static void part_defaults_are_the_essays(void **state)
+{
+	(void)state;
+	bsim_scene g, l, m;
+	load_ok(bsim_test_src("configs/thesis/gate.yaml"), NULL, 0, &g);
+	load_ok(bsim_test_src("configs/lattice/uniform_9x9.yaml"), NULL, 0, &l);
+	load_ok(write_minimal("part_defaults"), NULL, 0, &m);
+	bsim_beam_def b = bsim_beam_def_default(), want = g.beams[0];
+	want.pivot[0] = want.pivot[1] = 0;
+	want.rest_angle_deg = 0;
+	assert_memory_equal(&b, &want, sizeof b);
+	bsim_body_def body = bsim_body_def_default();
+	assert_memory_equal(&body, &g.body, sizeof body);
+	bsim_contact_def c = bsim_contact_def_default();
+	assert_memory_equal(&c, &g.contact, sizeof c);
+	assert_memory_equal(&c, &m.contact, sizeof c);
+	bsim_effects_def e = bsim_effects_def_default();
+	assert_false(e.has_propulsion || e.has_random_force);
+	assert_memory_equal(&e, &m.effects, sizeof e);
+	bsim_lattice_def ld = bsim_lattice_def_default();
+	assert_true(ld.columns == l.lattice.columns && ld.rows == l.lattice.rows);
+	assert_true(ld.ix_min == l.lattice.ix_min && ld.ix_max == l.lattice.ix_max);
+	assert_true(ld.width == l.lattice.width && ld.depth == l.lattice.depth);
+	assert_true(ld.pivot_y == l.lattice.pivot_y && ld.protocol == l.lattice.protocol);
+	assert_memory_equal(&ld.beam, &l.lattice.beam, sizeof ld.beam);
+	bsim_scene_free(&g);
+	bsim_scene_free(&l);
+	bsim_scene_free(&m);
+}
+
 static void zero_magnitude_means_no_random_force(void **state)
 {
 	(void)state;
@@ -451,6 +484,7 @@ int main(void)
 	        cmocka_unit_test(later_override_wins),
 	        cmocka_unit_test(override_inserts_missing_block),
 	        cmocka_unit_test(defaults_fill_what_a_file_leaves_out),
+	        cmocka_unit_test(part_defaults_are_the_essays),
 	        cmocka_unit_test(zero_magnitude_means_no_random_force),
 	        cmocka_unit_test(errors_name_file_line_field),
 	        cmocka_unit_test(override_errors_name_the_override),

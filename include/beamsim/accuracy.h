@@ -67,7 +67,7 @@ typedef struct bsim_accuracy_config {
 
 /* The study of docs/accuracy.md: h from 0.016 s halved down to 0.000125 s,
  * 16 pieces of 0.064 s, 40 trials, seed 1, all threads. */
-BSIM_API bsim_accuracy_config bsim_accuracy_default(void);
+BSIM_API bsim_accuracy_config bsim_accuracy_config_default(void);
 /* A quick study for tests: h down to 0.0005 s, 4 pieces, 8 trials. */
 BSIM_API bsim_accuracy_config bsim_accuracy_quick(void);
 

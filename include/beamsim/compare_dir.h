@@ -70,7 +70,7 @@ typedef struct bsim_compare_dir_def {
 
 /* thesis against box2d, no options, bsim_compare_rule_default(), 3
  * examples, all cores. */
-BSIM_API bsim_compare_dir_def bsim_compare_dir_default(void);
+BSIM_API bsim_compare_dir_def bsim_compare_dir_def_default(void);
 
 typedef struct bsim_compare_dir_result {
 	bsim_experiment e;

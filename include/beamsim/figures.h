@@ -63,7 +63,7 @@ typedef struct bsim_figures_def {
 	int threads; /* figures drawn at once; <= 0: all cores */
 } bsim_figures_def;
 
-BSIM_API bsim_figures_def bsim_figures_default(void);
+BSIM_API bsim_figures_def bsim_figures_def_default(void);
 
 typedef struct bsim_figures_result {
 	bsim_figures_kind kind;

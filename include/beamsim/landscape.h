@@ -78,7 +78,7 @@ typedef struct bsim_landscape_grid_def {
 } bsim_landscape_grid_def;
 
 /* The default region at the default spacing. */
-BSIM_API bsim_landscape_grid_def bsim_landscape_grid_default(void);
+BSIM_API bsim_landscape_grid_def bsim_landscape_grid_def_default(void);
 
 /* The landscape sampled at (x0 + i spacing, y0 + j spacing), i < nx,
  * j < ny; point (i, j) is entry k = j nx + i (x varies fastest). */

@@ -211,7 +211,7 @@ typedef struct bsim_markov_validate_def {
 	void *progress_user;
 } bsim_markov_validate_def;
 
-BSIM_API bsim_markov_validate_def bsim_markov_validate_default(void);
+BSIM_API bsim_markov_validate_def bsim_markov_validate_def_default(void);
 
 /* One group under one protocol. */
 typedef struct bsim_markov_check {

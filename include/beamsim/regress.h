@@ -30,7 +30,7 @@ typedef struct bsim_regress_def {
 } bsim_regress_def;
 
 /* The stored rule, all cores. */
-BSIM_API bsim_regress_def bsim_regress_default(void);
+BSIM_API bsim_regress_def bsim_regress_def_default(void);
 
 typedef struct bsim_regress_side {
 	char label[128];

@@ -108,6 +108,24 @@ BSIM_API int bsim_scene_load(const char *path, const bsim_override *overrides, i
  * before bsim_scene_validate; free with bsim_scene_free. */
 BSIM_API bsim_scene bsim_scene_default(void);
 
+/* The parts of a scene at their defaults. Where a scene file may leave a
+ * key out, the default is what it gets (bsim_scene_default uses these);
+ * where a file must give a key (a beam's and the body's sizes, a lattice's
+ * columns and rows), the default is the essay's value (Table 2.1, Sec.
+ * 2.6), for a scene built in code:
+ *   beam: pivot (0, 0), rest 0 deg, 25 m, 0.1 kg, inertia m L^2 / 3,
+ *         400 N m/rad, 50 N m s/rad, at rest;
+ *   body: 1 kg, radius 10 m, at (0, 0), at rest;
+ *   contact: restitution 0.8, tip restitution 1, rest threshold 0.05 m/s;
+ *   effects: none (the random force at 50 Hz once it is switched on);
+ *   lattice: 9 x 9 gates (ix -4..4) of 50 m x 60 m, pivots 30 m up, the
+ *            beam above, the whole-world protocol, no stiffness map. */
+BSIM_API bsim_beam_def bsim_beam_def_default(void);
+BSIM_API bsim_body_def bsim_body_def_default(void);
+BSIM_API bsim_contact_def bsim_contact_def_default(void);
+BSIM_API bsim_effects_def bsim_effects_def_default(void);
+BSIM_API bsim_lattice_def bsim_lattice_def_default(void);
+
 /* Fills the essay's single-gate scene (MODEL.md section 1, Table 2.1) with
  * the given propulsion and random force magnitude (0 = effect absent). */
 BSIM_API void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm);

@@ -81,6 +81,11 @@ typedef struct bsim_sweep_config {
 	const volatile sig_atomic_t *stop;
 } bsim_sweep_config;
 
+/* The default backend (beamsim/backend.h) with its default options, all
+ * threads, no overrides, no progress, nothing kept, no journal, no stop
+ * flag. */
+BSIM_API bsim_sweep_config bsim_sweep_config_default(void);
+
 /* The size of one journal record: a bsim_trial_result, or for a paired
  * sweep both results and the separation time. The record is the result's
  * bytes as they are in memory, so a resumed sweep's results are the

@@ -5,7 +5,7 @@
  * the lattice's files for a lattice, their .mat twins, and the record that
  * lets the run be repeated, run.json and inputs/ (beamsim/run_record.h).
  *
- *   bsim_sweep_dir_def def = bsim_sweep_dir_default();
+ *   bsim_sweep_dir_def def = bsim_sweep_dir_def_default();
  *   def.experiment = "configs/thesis/h1_symmetric.yaml";
  *   def.out = "out/h1";
  *   bsim_sweep_dir_result res;
@@ -60,7 +60,7 @@ typedef struct bsim_sweep_dir_def {
 } bsim_sweep_dir_def;
 
 /* The thesis backend, no options, all cores, nothing kept. */
-BSIM_API bsim_sweep_dir_def bsim_sweep_dir_default(void);
+BSIM_API bsim_sweep_dir_def bsim_sweep_dir_def_default(void);
 
 typedef struct bsim_sweep_dir_result {
 	bsim_experiment e;   /* as run: --trials and --seed applied */

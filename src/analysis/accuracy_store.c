@@ -9,7 +9,7 @@
 #include "store/session.h"
 #include "beamsim/limits.h"
 
-bsim_accuracy_config bsim_accuracy_default(void)
+bsim_accuracy_config bsim_accuracy_config_default(void)
 {
 	return (bsim_accuracy_config){
 	        .h_ref = 0.000125,
@@ -23,7 +23,7 @@ bsim_accuracy_config bsim_accuracy_default(void)
 
 bsim_accuracy_config bsim_accuracy_quick(void)
 {
-	bsim_accuracy_config c = bsim_accuracy_default();
+	bsim_accuracy_config c = bsim_accuracy_config_default();
 	c.h_ref = 0.0005;
 	c.n_pieces = 4;
 	c.n_trials = 8;
@@ -55,7 +55,7 @@ int bsim_accuracy_store(const char *out, const bsim_scene *scene, const char *sc
 		rc = bsim_accuracy_write_md(path, res, cfg, scene_label, err);
 	}
 	if (rc == BSIM_OK) {
-		bsim_figures_def def = bsim_figures_default();
+		bsim_figures_def def = bsim_figures_def_default();
 		def.kind = BSIM_FIGURES_ACCURACY;
 		rc = bsim_figures_draw(ss.stage, &def, fig, err);
 	}

@@ -668,7 +668,7 @@ int bsim_landscape_write(const char *dir, const bsim_scene *s, const bsim_landsc
 	bsim_figure_def defs[3];
 	char *bodies[3] = {NULL, NULL, NULL};
 	for (int i = 0; i < 3; i++) {
-		defs[i] = bsim_figure_default();
+		defs[i] = bsim_figure_def_default();
 		defs[i].dir = dir;
 	}
 	if (!rc)

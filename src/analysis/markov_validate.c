@@ -26,7 +26,7 @@
 #include "store/session.h"
 #include "beamsim/limits.h"
 
-bsim_markov_validate_def bsim_markov_validate_default(void)
+bsim_markov_validate_def bsim_markov_validate_def_default(void)
 {
 	return (bsim_markov_validate_def){.bootstrap = 2000, .map_resamples = 40};
 }
@@ -309,7 +309,7 @@ static int write_figure(const char *stage, int g, const group_data *d,
 	        "notitle, '' index 1 using 1:6 with points pt 7 ps 0.8 lc rgb '#cc3311' "
 	        "title 'chain'\nunset multiplot\n",
 	        g, c[0].tv, c[0].tv_sampling, c[0].tv_map, name, c[1].tv, c[1].tv_sampling, name);
-	bsim_figure_def fd = bsim_figure_default();
+	bsim_figure_def fd = bsim_figure_def_default();
 	fd.dir = stage;
 	fd.name = name;
 	fd.width = 1100;

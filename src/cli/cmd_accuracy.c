@@ -132,7 +132,7 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 		bsim_scene_free(&scene);
 		return cli_usage("accuracy", "--backends: no backend named");
 	}
-	bsim_accuracy_config cfg = a->quick ? bsim_accuracy_quick() : bsim_accuracy_default();
+	bsim_accuracy_config cfg = a->quick ? bsim_accuracy_quick() : bsim_accuracy_config_default();
 	if (a->pieces)
 		cfg.n_pieces = (int)a->pieces;
 	if (c->trials)

@@ -215,7 +215,7 @@ int cmd_compare(int argc, char **argv)
 	cli_common c = cli_common_default();
 	compare_args a = {.examples = 3};
 	const char *experiment = NULL;
-	bsim_compare_dir_def def = bsim_compare_dir_default();
+	bsim_compare_dir_def def = bsim_compare_dir_def_default();
 	int rc = cli_parse(&compare_spec, argc, argv, &c, &a, &experiment);
 	if (rc < 0 && (rc = sides_resolve(&c, &a, &def)) == CLI_OK)
 		rc = -1;

@@ -156,7 +156,7 @@ static void print_table(const landscape_args *a, const bsim_scene *s, const bsim
 int cmd_landscape(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	landscape_args a = {.grid = bsim_landscape_grid_default()};
+	landscape_args a = {.grid = bsim_landscape_grid_def_default()};
 	int rc = cli_parse(&landscape_spec, argc, argv, &c, &a, &a.scene);
 	if (rc >= 0) {
 		cli_common_free(&c);

@@ -307,7 +307,7 @@ static int markov_validate(int argc, char **argv)
 		cli_common_free(&c);
 		return rc;
 	}
-	bsim_markov_validate_def def = bsim_markov_validate_default();
+	bsim_markov_validate_def def = bsim_markov_validate_def_default();
 	def.experiment = path;
 	def.map_dir = a.map;
 	def.out = c.out;

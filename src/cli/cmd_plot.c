@@ -77,7 +77,7 @@ int cmd_plot(int argc, char **argv)
 		cli_common_free(&c);
 		return rc;
 	}
-	bsim_figures_def def = bsim_figures_default();
+	bsim_figures_def def = bsim_figures_def_default();
 	def.out = c.out;
 	def.select = select.ov;
 	def.n_select = select.n;

@@ -64,7 +64,7 @@ int cmd_regress(int argc, char **argv)
 	}
 	cli_progress progress;
 	cli_progress_init(&progress, !c.quiet, "trials");
-	bsim_regress_def def = bsim_regress_default();
+	bsim_regress_def def = bsim_regress_def_default();
 	def.baseline = baseline;
 	def.out = c.out;
 	def.threads = (int)c.threads;

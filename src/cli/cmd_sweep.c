@@ -79,7 +79,7 @@ int cmd_sweep(int argc, char **argv)
 	sweep_args a = {0};
 	const char *experiment = NULL;
 	int rc = cli_parse(&sweep_spec, argc, argv, &c, &a, &experiment);
-	bsim_sweep_dir_def def = bsim_sweep_dir_default();
+	bsim_sweep_dir_def def = bsim_sweep_dir_def_default();
 	if (rc < 0) {
 		def.backend = cli_backend_with_opts(
 		        &c, "sweep", c.backend ? c.backend : bsim_backend_default()->name,

@@ -21,7 +21,7 @@ const char *bsim_figures_kind_name(bsim_figures_kind k)
 	return (unsigned)k < 5 ? names[k] : "?";
 }
 
-bsim_figures_def bsim_figures_default(void)
+bsim_figures_def bsim_figures_def_default(void)
 {
 	bsim_figures_def d = {.kind = BSIM_FIGURES_AUTO};
 	return d;
@@ -63,7 +63,7 @@ int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures
                       bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
-	bsim_figures_def d = def ? *def : bsim_figures_default();
+	bsim_figures_def d = def ? *def : bsim_figures_def_default();
 	if (strlen(dir) > BSIM_DIR_MAX || (d.out && strlen(d.out) > BSIM_DIR_MAX))
 		return bsim_error_set(err, BSIM_EINPUT, "%s: path too long", dir);
 	struct stat st;

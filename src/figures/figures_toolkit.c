@@ -39,7 +39,7 @@ static void list_add(char ***list, int *n, char *s)
 
 int figs_render(figs *f, const char *name, int width, int height, const char *body, bsim_error *err)
 {
-	bsim_figure_def d = bsim_figure_default();
+	bsim_figure_def d = bsim_figure_def_default();
 	d.dir = f->out;
 	d.name = name;
 	d.width = width;

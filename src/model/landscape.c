@@ -91,7 +91,7 @@ int bsim_landscape_label(const bsim_scene *s, const double c[2], const int *touc
 	return best >= 0 ? best : -1;
 }
 
-bsim_landscape_grid_def bsim_landscape_grid_default(void)
+bsim_landscape_grid_def bsim_landscape_grid_def_default(void)
 {
 	bsim_landscape_grid_def d = {.has_region = 0, .region = {0, 0, 0, 0}, .spacing = 0.0};
 	return d;

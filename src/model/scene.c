@@ -21,13 +21,65 @@ bsim_scene bsim_scene_default(void)
 	return d;
 }
 
+bsim_beam_def bsim_beam_def_default(void)
+{
+	bsim_beam_def b;
+	memset(&b, 0, sizeof b);
+	b.length = 25;                                 /* m, essay Table 2.1 */
+	b.mass = 0.1;                                  /* kg */
+	b.inertia = b.mass * b.length * b.length / 3; /* rod about its end */
+	b.stiffness = 400;                             /* N m/rad */
+	b.damping = 50;                                /* N m s/rad */
+	return b;
+}
+
+bsim_body_def bsim_body_def_default(void)
+{
+	bsim_body_def b;
+	memset(&b, 0, sizeof b);
+	b.mass = 1;    /* kg, essay Table 2.1 */
+	b.radius = 10; /* m */
+	return b;
+}
+
+bsim_contact_def bsim_contact_def_default(void)
+{
+	bsim_contact_def c;
+	memset(&c, 0, sizeof c);
+	c.restitution = 0.8;     /* essay Table 2.1 */
+	c.tip_restitution = 1.0; /* the essay's tip impacts are elastic */
+	c.rest_threshold = 0.05; /* m/s */
+	return c;
+}
+
+bsim_effects_def bsim_effects_def_default(void)
+{
+	bsim_effects_def e;
+	memset(&e, 0, sizeof e);
+	e.random_frequency = 50; /* Hz, the essay's refresh rate */
+	return e;
+}
+
+bsim_lattice_def bsim_lattice_def_default(void)
+{
+	bsim_lattice_def l;
+	memset(&l, 0, sizeof l);
+	l.columns = l.rows = 9; /* essay Sec. 2.6 */
+	l.ix_min = -4;
+	l.ix_max = 4;
+	l.width = 50;   /* m, MODEL.md section 8 */
+	l.depth = 60;   /* m */
+	l.pivot_y = 30; /* m */
+	l.beam = bsim_beam_def_default();
+	l.protocol = BSIM_PROTOCOL_WORLD;
+	return l;
+}
+
 void scene_defaults(bsim_scene *s)
 {
 	memset(s, 0, sizeof *s);
-	s->contact.restitution = 0.8;     /* essay Table 2.1 */
-	s->contact.tip_restitution = 1.0; /* the essay's tip impacts are elastic */
-	s->contact.rest_threshold = 0.05; /* m/s */
-	s->effects.random_frequency = 50; /* Hz */
+	s->contact = bsim_contact_def_default();
+	s->effects = bsim_effects_def_default();
 	s->dt = 0.004;                    /* s */
 	s->max_steps = 3000;              /* 12 s */
 	s->success_y = 65;                /* m: pivot row 30 + L 25 + R 10 */
@@ -42,23 +94,17 @@ void scene_defaults(bsim_scene *s)
 
 static void gate_beam(bsim_beam_def *b, double px, double rest_deg)
 {
-	memset(b, 0, sizeof *b);
+	*b = bsim_beam_def_default();
 	b->pivot[0] = px;
-	b->pivot[1] = 30;
+	b->pivot[1] = 30; /* m */
 	b->rest_angle_deg = rest_deg;
-	b->length = 25;                                   /* m */
-	b->mass = 0.1;                                    /* kg */
-	b->inertia = b->mass * b->length * b->length / 3; /* rod about its end */
-	b->stiffness = 400;                               /* N m/rad */
-	b->damping = 50;                                  /* N m s/rad */
 }
 
 void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm)
 {
 	scene_defaults(s);
 	snprintf(s->name, sizeof s->name, "thesis-gate");
-	s->body.mass = 1;    /* kg */
-	s->body.radius = 10; /* m */
+	s->body = bsim_body_def_default();
 	/* On allocation failure the scene has no beams and fails validation. */
 	if (bsim_scene_set_beams(s, 2) == BSIM_OK) {
 		gate_beam(&s->beams[0], -25, 0);  /* left, pointing at the midline */

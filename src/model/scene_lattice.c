@@ -317,11 +317,14 @@ static int lattice_maps_read(scene_walk *w, struct fy_node *map, lattice_maps *m
 
 void scene_lattice_begin(bsim_scene *s)
 {
+	/* The gate's geometry at its defaults; what a file must give (columns,
+	 * rows, the beam) starts at zero, the beam's inertia unset. */
+	const bsim_lattice_def d = bsim_lattice_def_default();
 	bsim_lattice_def *l = &s->lattice;
 	memset(l, 0, sizeof *l);
-	l->width = 50;   /* m, MODEL.md section 8 */
-	l->depth = 60;   /* m */
-	l->pivot_y = 30; /* m */
+	l->width = d.width;
+	l->depth = d.depth;
+	l->pivot_y = d.pivot_y;
 	l->beam.inertia = NAN;
 }
 

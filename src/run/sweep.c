@@ -124,6 +124,14 @@ typedef struct pair_record {
 	double t_separate;
 } pair_record;
 
+bsim_sweep_config bsim_sweep_config_default(void)
+{
+	bsim_sweep_config c;
+	memset(&c, 0, sizeof c);
+	c.backend = bsim_backend_default();
+	return c;
+}
+
 size_t bsim_sweep_record_size(int paired)
 {
 	return paired ? sizeof(pair_record) : sizeof(bsim_trial_result);

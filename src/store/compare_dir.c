@@ -17,7 +17,7 @@
 #include "store/store.h"
 #include "beamsim/limits.h"
 
-bsim_compare_dir_def bsim_compare_dir_default(void)
+bsim_compare_dir_def bsim_compare_dir_def_default(void)
 {
 	bsim_compare_dir_def d;
 	memset(&d, 0, sizeof d);

@@ -19,7 +19,7 @@
 #include "store/store.h"
 #include "beamsim/limits.h"
 
-bsim_regress_def bsim_regress_default(void)
+bsim_regress_def bsim_regress_def_default(void)
 {
 	bsim_regress_def d;
 	memset(&d, 0, sizeof d);
@@ -59,7 +59,7 @@ static int regress_rerun(const bsim_regress_def *def, bsim_regress_result *res,
 {
 	const bsim_run_record *rec = &res->rec;
 	if (rec->n_backends == 2) {
-		bsim_compare_dir_def d = bsim_compare_dir_default();
+		bsim_compare_dir_def d = bsim_compare_dir_def_default();
 		for (int i = 0; i < 2; i++) {
 			d.side[i].backend = backend[i];
 			d.side[i].opts = rec->opts[i];
@@ -76,7 +76,7 @@ static int regress_rerun(const bsim_regress_def *def, bsim_regress_result *res,
 			bsim_compare_free(&r.cmp);
 		return rc;
 	}
-	bsim_sweep_dir_def d = bsim_sweep_dir_default();
+	bsim_sweep_dir_def d = bsim_sweep_dir_def_default();
 	d.backend = backend[0];
 	d.opts = rec->opts[0];
 	d.threads = def->threads;

@@ -20,7 +20,7 @@
 #include "store/store.h"
 #include "beamsim/limits.h"
 
-bsim_sweep_dir_def bsim_sweep_dir_default(void)
+bsim_sweep_dir_def bsim_sweep_dir_def_default(void)
 {
 	bsim_sweep_dir_def d;
 	memset(&d, 0, sizeof d);

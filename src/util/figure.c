@@ -30,7 +30,7 @@
 #include "beamsim/version.h"
 #include "beamsim/limits.h"
 
-bsim_figure_def bsim_figure_default(void)
+bsim_figure_def bsim_figure_def_default(void)
 {
 	bsim_figure_def d = {
 	        .dir = NULL, .name = NULL, .width = 900, .height = 600, .font = "sans,11"};
@@ -169,7 +169,7 @@ static int images_commit(const bsim_figure_def *d, const char *tmpbase, int stat
 /* def with the defaults filled in. */
 static bsim_figure_def def_resolve(const bsim_figure_def *def)
 {
-	bsim_figure_def d = bsim_figure_default();
+	bsim_figure_def d = bsim_figure_def_default();
 	d.dir = def->dir;
 	d.name = def->name;
 	if (def->width > 0)

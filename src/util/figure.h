@@ -26,7 +26,7 @@ typedef struct bsim_figure_def {
 } bsim_figure_def;
 
 /* dir and name NULL, 900 x 600, "sans,11". */
-bsim_figure_def bsim_figure_default(void);
+bsim_figure_def bsim_figure_def_default(void);
 
 /* Writes DIR/NAME.gp around body (gnuplot commands, newline-separated) and,
  * if gnuplot is on the PATH, runs it to draw NAME.png and NAME.svg. drawn
