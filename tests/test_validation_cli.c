@@ -22,26 +22,6 @@
 	"  - { pivot: [25, 30], rest_angle_deg: 180, length: 25, mass: 0.1,\n"                     \
 	"      stiffness: 400 }\n"
 
-/* Runs argv and checks status 2 and that the single stderr line holds every
- * needle (NULL-terminated). */
-static void expect_input_error(const char *const argv[], const char *const needles[])
-{
-	char *out = NULL, *err = NULL;
-	int rc = bsim_test_cli(argv, &out, &err);
-	assert_non_null(err);
-	if (rc != 2)
-		fail_msg("exit status %d, stderr: %s", rc, err);
-	for (int i = 0; needles[i]; i++)
-		if (!strstr(err, needles[i]))
-			fail_msg("stderr \"%s\" lacks \"%s\"", err, needles[i]);
-	/* One message: libfyaml must not print diagnostics of its own. */
-	const char *nl = strchr(err, '\n');
-	if (!nl || nl[1] != '\0')
-		fail_msg("expected one line on stderr, got \"%s\"", err);
-	free(out);
-	free(err);
-}
-
 /* beamsim run on a scene file with the given text. */
 static void run_bad_scene(const char *name, const char *text, const char *const needles[])
 {
@@ -51,7 +31,7 @@ static void run_bad_scene(const char *name, const char *text, const char *const 
 	char path[1200];
 	snprintf(path, sizeof path, "%s", bsim_test_write(dir, file, text));
 	const char *argv[] = {"run", path, NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 }
 
 static void unknown_key(void **state)
@@ -202,14 +182,14 @@ static void bad_set_value(void **state)
 	const char *argv[] = {"run", path, "--set", "body.mass=-1", NULL};
 	const char *needles[] = {"--set body.mass=-1", "body.mass",
 	                         "expected a positive number, got -1", NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 	const char *argv2[] = {"run", path, "--set", "body.start=[1, 2", NULL};
 	const char *needles2[] = {"body.start=[1, 2", "body.start", "expected a YAML value", NULL};
-	expect_input_error(argv2, needles2);
+	bsim_test_expect_input_error(argv2, needles2);
 	const char *argv3[] = {"run", path, "--set", "beams.7.mass=1", NULL};
 	const char *needles3[] = {"beams.7.mass=1", "beams.7", "expected an index from 0 to 1",
 	                          NULL};
-	expect_input_error(argv3, needles3);
+	bsim_test_expect_input_error(argv3, needles3);
 }
 
 static void set_into_unknown_key(void **state)
@@ -221,7 +201,7 @@ static void set_into_unknown_key(void **state)
 	const char *needles[] = {"--set effects.random_force.magnitud=3",
 	                         "effects.random_force.magnitud",
 	                         "unknown key (expected one of magnitude, frequency)", NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 }
 
 /* beamsim sweep on an experiment with the given text (next to a good
@@ -236,7 +216,7 @@ static void sweep_bad_experiment(const char *name, const char *text, const char 
 	snprintf(exp, sizeof exp, "%s", bsim_test_write(dir, file, text));
 	snprintf(out, sizeof out, "%s/out", dir);
 	const char *argv[] = {"sweep", exp, "--trials", "1", "--out", out, NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 	char path[1300];
 	snprintf(path, sizeof path, "%s/summary.json", out);
 	char *summary = bsim_test_read(path);
@@ -325,7 +305,7 @@ static void grid_conflict(void **state)
 	const char *needles2[] = {"--set effects.propulsion.force=7",
 	                          "grid varies effects.propulsion.force (", "cli_grid.yaml:5)",
 	                          NULL};
-	expect_input_error(argv, needles2);
+	bsim_test_expect_input_error(argv, needles2);
 	snprintf(path, sizeof path, "%s/trials.csv", out);
 	char *trials = bsim_test_read(path);
 	assert_null(trials);
@@ -343,13 +323,13 @@ static void wrong_kind_of_file(void **state)
 	const char *run[] = {"run", exp, NULL};
 	const char *run_needles[] = {"h1_symmetric.yaml:2:1: scene: this is an experiment file",
 	                             "beamsim sweep or compare", NULL};
-	expect_input_error(run, run_needles);
+	bsim_test_expect_input_error(run, run_needles);
 	const char *sweep[] = {"sweep", scene, "--out", out, NULL};
 	const char *compare[] = {"compare", scene, "--out", out, NULL};
 	const char *scene_needles[] = {"gate.yaml:3:1: body: this is a scene file", "beamsim run",
 	                               NULL};
-	expect_input_error(sweep, scene_needles);
-	expect_input_error(compare, scene_needles);
+	bsim_test_expect_input_error(sweep, scene_needles);
+	bsim_test_expect_input_error(compare, scene_needles);
 }
 
 int main(void)
