@@ -205,8 +205,10 @@ static void set_into_unknown_key(void **state)
 }
 
 /* beamsim sweep on an experiment with the given text (next to a good
- * gate.yaml); the output directory must stay without results. */
-static void sweep_bad_experiment(const char *name, const char *text, const char *const needles[])
+ * gate.yaml), with --limit limit if it is not NULL; the output directory
+ * must stay without results. */
+static void sweep_bad_experiment_limit(const char *name, const char *text, const char *limit,
+                                       const char *const needles[])
 {
 	char dir[1024], exp[1200], out[1200];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir(name));
@@ -215,7 +217,9 @@ static void sweep_bad_experiment(const char *name, const char *text, const char 
 	snprintf(file, sizeof file, "%s.yaml", name);
 	snprintf(exp, sizeof exp, "%s", bsim_test_write(dir, file, text));
 	snprintf(out, sizeof out, "%s/out", dir);
-	const char *argv[] = {"sweep", exp, "--trials", "1", "--out", out, NULL};
+	const char *argv[] = {"sweep", exp, "--trials", "1", "--out", out, "--limit", limit, NULL};
+	if (!limit)
+		argv[6] = NULL;
 	bsim_test_expect_input_error(argv, needles);
 	char path[1300];
 	snprintf(path, sizeof path, "%s/summary.json", out);
@@ -224,6 +228,11 @@ static void sweep_bad_experiment(const char *name, const char *text, const char 
 	char *trials = bsim_test_read(path);
 	assert_null(summary);
 	assert_null(trials);
+}
+
+static void sweep_bad_experiment(const char *name, const char *text, const char *const needles[])
+{
+	sweep_bad_experiment_limit(name, text, NULL, needles);
 }
 
 static void empty_grid(void **state)
@@ -251,6 +260,23 @@ static void bad_grid_value(void **state)
 	                     "  effects.propulsion.force: [4, 5]\n"
 	                     "  body.mass: [1, -1]\n",
 	                     needles);
+}
+
+/* Each grid value is tried in one group before the product is counted or
+ * built: the 8th of 8 values of the slowest axis of 96,000 groups (the
+ * product, in order, builds 84,000 groups before it) is named although the
+ * limit of 100 groups would refuse the grid, and so with no more than 100
+ * groups' work; the message is the one the product gives. */
+static void grid_value_first(void **state)
+{
+	(void)state;
+	char *text = bsim_test_read(bsim_test_src(
+	        "tests/fuzz/regressions/experiment/bad_8th_value_of_96000_groups.yaml"));
+	assert_non_null(text);
+	const char *needles[] = {"grid_8th.yaml:5: ", "body.mass",
+	                         "expected a positive number, got -1", NULL};
+	sweep_bad_experiment_limit("grid_8th", text, "groups=100", needles);
+	free(text);
 }
 
 static void bad_experiment_keys(void **state)
@@ -345,7 +371,7 @@ int main(void)
 	        cmocka_unit_test(bad_set_value),       cmocka_unit_test(set_into_unknown_key),
 	        cmocka_unit_test(empty_grid),          cmocka_unit_test(bad_grid_value),
 	        cmocka_unit_test(bad_experiment_keys), cmocka_unit_test(grid_conflict),
-	        cmocka_unit_test(wrong_kind_of_file),
+	        cmocka_unit_test(wrong_kind_of_file),  cmocka_unit_test(grid_value_first),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
