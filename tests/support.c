@@ -1,4 +1,13 @@
+/* Helpers shared by the tests (support.h): one way to run the program and
+ * wait on what it does, temporary directories and files. */
 #define _POSIX_C_SOURCE 200809L
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
 
 #include "support.h"
 
@@ -7,15 +16,16 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <glob.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 static char *slurp_fd(int fd)
@@ -44,39 +54,6 @@ static char *slurp_fd(int fd)
 	return buf;
 }
 
-int bsim_test_cli(const char *const argv[], char **out, char **err)
-{
-	int n = 0;
-	while (argv[n])
-		n++;
-	char **args = calloc((size_t)n + 2, sizeof *args);
-	args[0] = (char *)BSIM_EXE;
-	for (int i = 0; i < n; i++)
-		args[i + 1] = (char *)argv[i];
-
-	FILE *fo = tmpfile(), *fe = tmpfile();
-	fflush(NULL);
-	pid_t pid = fork();
-	if (pid == 0) {
-		dup2(fileno(fo), 1);
-		dup2(fileno(fe), 2);
-		int devnull = open("/dev/null", O_RDONLY);
-		dup2(devnull, 0);
-		execv(BSIM_EXE, args);
-		_exit(127);
-	}
-	int status = 0;
-	waitpid(pid, &status, 0);
-	free(args);
-	if (out)
-		*out = slurp_fd(fileno(fo));
-	if (err)
-		*err = slurp_fd(fileno(fe));
-	fclose(fo);
-	fclose(fe);
-	return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 static void mkdirs(const char *path)
 {
 	char tmp[1024];
@@ -91,13 +68,18 @@ static void mkdirs(const char *path)
 	mkdir(tmp, 0755);
 }
 
+int bsim_test_remove(const char *path)
+{
+	char cmd[1500];
+	snprintf(cmd, sizeof cmd, "rm -rf '%s'", path);
+	return system(cmd) == 0 ? 0 : -1;
+}
+
 const char *bsim_test_dir(const char *name)
 {
 	static char path[1024];
-	char cmd[1200];
 	snprintf(path, sizeof path, "%s/%s", BSIM_TEST_TMP, name);
-	snprintf(cmd, sizeof cmd, "rm -rf '%s'", path);
-	if (system(cmd) != 0)
+	if (bsim_test_remove(path) != 0)
 		return path;
 	mkdirs(path);
 	return path;
@@ -132,13 +114,80 @@ const char *bsim_test_src(const char *rel)
 	return path;
 }
 
-static char **argv_build(const char *const argv[])
+char *bsim_test_read_glob(const char *pattern)
+{
+	glob_t g;
+	if (glob(pattern, 0, NULL, &g) != 0)
+		return NULL;
+	size_t len = 0;
+	char *all = calloc(1, 1);
+	for (size_t i = 0; all && i < g.gl_pathc; i++) {
+		char *t = bsim_test_read(g.gl_pathv[i]);
+		size_t n = t ? strlen(t) : 0;
+		char *more = realloc(all, len + n + 1);
+		if (more) {
+			memcpy(more + len, t ? t : "", n + 1);
+			len += n;
+		} else {
+			free(all);
+		}
+		all = more;
+		free(t);
+	}
+	globfree(&g);
+	return all;
+}
+
+const char *bsim_test_glob_first(const char *pattern)
+{
+	static char path[1200];
+	glob_t g;
+	if (glob(pattern, 0, NULL, &g) != 0)
+		return NULL;
+	snprintf(path, sizeof path, "%s", g.gl_pathv[0]);
+	globfree(&g);
+	return path;
+}
+
+const char *bsim_test_join(const char *dir, const char *name)
+{
+	static char buf[4][1400];
+	static int k;
+	k = (k + 1) % 4;
+	if (snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name) >= (int)sizeof buf[k])
+		fail_msg("path too long: %s/%s", dir, name);
+	return buf[k];
+}
+
+int bsim_test_exists(const char *path)
+{
+	return access(path, F_OK) == 0;
+}
+
+long bsim_test_size(const char *path)
+{
+	struct stat st;
+	return stat(path, &st) == 0 ? (long)st.st_size : -1;
+}
+
+int bsim_test_count_lines(const char *text)
+{
+	int n = 0;
+	for (; *text; text++)
+		n += *text == '\n';
+	return n;
+}
+
+/* The argument vector of prog: prog, then argv. */
+static char **argv_build(const char *prog, const char *const argv[])
 {
 	int n = 0;
 	while (argv[n])
 		n++;
 	char **args = calloc((size_t)n + 2, sizeof *args);
-	args[0] = (char *)BSIM_EXE;
+	if (!args)
+		abort();
+	args[0] = (char *)prog;
 	for (int i = 0; i < n; i++)
 		args[i + 1] = (char *)argv[i];
 	return args;
@@ -151,43 +200,52 @@ static int status_code(int status)
 	return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
 }
 
-int bsim_test_cli_with(const char *const argv[], const bsim_test_opts *o, char **out, char **err)
+/* Starts file with args (looked up on PATH if search): stdin /dev/null,
+ * stdout out_fd and stderr err_fd (-1: /dev/null) unless o names files for
+ * them, and o's limits. The child exits 127 if it cannot start. */
+static pid_t launch(const char *file, char *const args[], int search, const bsim_test_opts *o,
+                    int out_fd, int err_fd)
 {
-	char **args = argv_build(argv);
-	FILE *fo = tmpfile(), *fe = tmpfile();
 	fflush(NULL);
 	pid_t pid = fork();
-	if (pid == 0) {
-		int to = o->out ? open(o->out, O_WRONLY) : fileno(fo);
-		dup2(to, 1);
-		dup2(fileno(fe), 2);
-		int devnull = open("/dev/null", O_RDONLY);
-		dup2(devnull, 0);
-		if (o->fsize > 0) {
-			struct rlimit rl = {(rlim_t)o->fsize, (rlim_t)o->fsize};
-			setrlimit(RLIMIT_FSIZE, &rl);
-			signal(SIGXFSZ, SIG_IGN); /* a write beyond fails with EFBIG */
-		}
-		execv(BSIM_EXE, args);
+	if (pid != 0)
+		return pid;
+	int null = open("/dev/null", O_RDWR);
+	int to = out_fd < 0 ? null : out_fd, te = err_fd < 0 ? null : err_fd;
+	if (o && o->out)
+		to = open(o->out, O_WRONLY);
+	if (o && o->err)
+		te = open(o->err, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+	if (null < 0 || to < 0 || te < 0)
 		_exit(127);
+	dup2(null, 0);
+	dup2(to, 1);
+	dup2(te, 2);
+	if (o && o->fsize > 0) {
+		struct rlimit rl = {(rlim_t)o->fsize, (rlim_t)o->fsize};
+		setrlimit(RLIMIT_FSIZE, &rl);
+		signal(SIGXFSZ, SIG_IGN); /* a write beyond fails with EFBIG */
 	}
+	if (o && o->timeout > 0)
+		alarm((unsigned)ceil(o->timeout)); /* kept across exec */
+	if (search)
+		execvp(file, args);
+	else
+		execv(file, args);
+	_exit(127);
+}
+
+/* Runs to the end with stdout and stderr captured (unless o redirects
+ * them) into *out and *err (either may be NULL). */
+static int run_captured(const char *file, char *const args[], int search, const bsim_test_opts *o,
+                        char **out, char **err)
+{
+	FILE *fo = tmpfile(), *fe = tmpfile();
+	if (!fo || !fe)
+		abort();
+	pid_t pid = launch(file, args, search, o, fileno(fo), fileno(fe));
 	int status = 0;
-	if (o->timeout > 0) {
-		struct timespec step = {0, 10000000};
-		double waited = 0;
-		while (waitpid(pid, &status, WNOHANG) == 0) {
-			if (waited >= o->timeout) {
-				kill(pid, SIGKILL);
-				waitpid(pid, &status, 0);
-				break;
-			}
-			nanosleep(&step, NULL);
-			waited += 0.01;
-		}
-	} else {
-		waitpid(pid, &status, 0);
-	}
-	free(args);
+	waitpid(pid, &status, 0);
 	if (out)
 		*out = slurp_fd(fileno(fo));
 	if (err)
@@ -197,21 +255,58 @@ int bsim_test_cli_with(const char *const argv[], const bsim_test_opts *o, char *
 	return status_code(status);
 }
 
-int bsim_test_spawn(const char *const argv[])
+int bsim_test_cli_with(const char *const argv[], const bsim_test_opts *o, char **out, char **err)
 {
-	char **args = argv_build(argv);
-	fflush(NULL);
-	pid_t pid = fork();
-	if (pid == 0) {
-		int devnull = open("/dev/null", O_RDWR);
-		dup2(devnull, 0);
-		dup2(devnull, 1);
-		dup2(devnull, 2);
-		execv(BSIM_EXE, args);
-		_exit(127);
-	}
+	char **args = argv_build(BSIM_EXE, argv);
+	int rc = run_captured(BSIM_EXE, args, 0, o, out, err);
+	free(args);
+	return rc;
+}
+
+int bsim_test_cli(const char *const argv[], char **out, char **err)
+{
+	return bsim_test_cli_with(argv, NULL, out, err);
+}
+
+void bsim_test_check_input_error(int rc, const char *err, const char *const needles[], int one_line)
+{
+	assert_non_null(err);
+	if (rc != 2)
+		fail_msg("exit status %d, stderr: %s", rc, err);
+	for (int i = 0; needles[i]; i++)
+		if (!strstr(err, needles[i]))
+			fail_msg("stderr \"%s\" lacks \"%s\"", err, needles[i]);
+	/* One message: libfyaml must not print diagnostics of its own. */
+	const char *nl = strchr(err, '\n');
+	if (one_line && (!nl || nl[1] != '\0'))
+		fail_msg("expected one line on stderr, got \"%s\"", err);
+}
+
+void bsim_test_expect_input_error(const char *const argv[], const char *const needles[])
+{
+	char *out = NULL, *err = NULL;
+	int rc = bsim_test_cli(argv, &out, &err);
+	bsim_test_check_input_error(rc, err, needles, 1);
+	free(out);
+	free(err);
+}
+
+int bsim_test_run(const char *const argv[], char **out)
+{
+	return run_captured(argv[0], (char *const *)argv, 1, NULL, out, NULL);
+}
+
+int bsim_test_spawn_with(const char *const argv[], const bsim_test_opts *o)
+{
+	char **args = argv_build(BSIM_EXE, argv);
+	pid_t pid = launch(BSIM_EXE, args, 0, o, -1, -1);
 	free(args);
 	return (int)pid;
+}
+
+int bsim_test_spawn(const char *const argv[])
+{
+	return bsim_test_spawn_with(argv, NULL);
 }
 
 int bsim_test_wait(int pid)
@@ -219,6 +314,76 @@ int bsim_test_wait(int pid)
 	int status = 0;
 	waitpid((pid_t)pid, &status, 0);
 	return status_code(status);
+}
+
+long bsim_test_journal_records(const char *path)
+{
+	int fd = open(path, O_RDONLY);
+	if (fd < 0)
+		return -1;
+	/* "BSIMJNL1", u32 record size, u32 inputs length, inputs, u32 CRC;
+	 * then records of u32 magic, u64 index, payload, u32 CRC. */
+	unsigned char h[16];
+	struct stat st;
+	long n = 0;
+	if (read(fd, h, sizeof h) == (ssize_t)sizeof h && fstat(fd, &st) == 0) {
+		uint32_t size, len;
+		memcpy(&size, h + 8, 4);
+		memcpy(&len, h + 12, 4);
+		long header = 16 + (long)len + 4, record = 16 + (long)size;
+		if ((long)st.st_size > header)
+			n = ((long)st.st_size - header) / record;
+	}
+	close(fd);
+	return n;
+}
+
+static int has_records(const char *path, long n)
+{
+	return bsim_test_journal_records(path) >= n;
+}
+
+static int has_entry(const char *dir, long n)
+{
+	(void)n;
+	DIR *d = opendir(dir);
+	if (!d)
+		return 0;
+	struct dirent *e;
+	int found = 0;
+	while (!found && (e = readdir(d)))
+		found = strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+	closedir(d);
+	return found;
+}
+
+/* Looks every millisecond whether ready(path, n) holds, until it does (1)
+ * or the program pid has ended (0, its status in *status). A poll, not a
+ * deadline: what ends the wait is the program's doing. */
+static int await(int pid, int (*ready)(const char *, long), const char *path, long n, int *status)
+{
+	const struct timespec tick = {0, 1000000};
+	for (;;) {
+		if (ready(path, n))
+			return 1;
+		int st = 0;
+		pid_t w = waitpid((pid_t)pid, &st, WNOHANG);
+		if (w != 0) {
+			*status = w == (pid_t)pid ? status_code(st) : -1;
+			return 0;
+		}
+		nanosleep(&tick, NULL);
+	}
+}
+
+int bsim_test_await_records(int pid, const char *path, long n, int *status)
+{
+	return await(pid, has_records, path, n, status);
+}
+
+int bsim_test_await_entry(int pid, const char *dir, int *status)
+{
+	return await(pid, has_entry, dir, 0, status);
 }
 
 /* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),

@@ -1,5 +1,5 @@
-/* Helpers shared by the tests: running the real program, temporary
- * directories, reading files. */
+/* Helpers shared by the tests: running the real program (and others) and
+ * waiting on what it does, temporary directories, reading files. */
 #ifndef BSIM_TESTS_SUPPORT_H
 #define BSIM_TESTS_SUPPORT_H
 
@@ -7,36 +7,89 @@
 
 /* Runs BSIM_EXE with argv (NULL-terminated, without the program name),
  * capturing stdout and stderr into malloc'd strings (caller frees; may pass
- * NULL to discard). Returns the exit status, or -1 if it did not exit. */
+ * NULL to discard). Returns the exit status, 128 + the signal's number if a
+ * signal ended it (as the shell reports it). */
 int bsim_test_cli(const char *const argv[], char **out, char **err);
 
-/* How bsim_test_cli_with runs the program. */
+/* How bsim_test_cli_with and bsim_test_spawn_with run the program; a zero
+ * field is the default. */
 typedef struct bsim_test_opts {
-	double timeout;  /* s: killed (SIGKILL) after this long, 0: never */
+	double timeout;  /* s: ended by SIGALRM after this long, 0: never */
 	long fsize;      /* bytes: the child's RLIMIT_FSIZE (writes beyond fail), 0: none */
 	const char *out; /* a file to be the child's stdout instead of a capture */
+	const char *err; /* a file to be the child's stderr (created) instead of a capture */
 } bsim_test_opts;
 
-/* bsim_test_cli with options; returns the exit status, 128 + the signal's
- * number if a signal ended it (as the shell reports it). */
+/* bsim_test_cli with options (o may be NULL). */
 int bsim_test_cli_with(const char *const argv[], const bsim_test_opts *o, char **out, char **err);
 
-/* Starts BSIM_EXE with argv in the background, stdout and stderr to
- * /dev/null; returns its pid. */
-int bsim_test_spawn(const char *const argv[]);
+/* Asserts that argv exits with status 2 and one line on stderr holding
+ * every needle (NULL-terminated): the form of every input error. */
+void bsim_test_expect_input_error(const char *const argv[], const char *const needles[]);
 
-/* Waits for a spawned program: its status as bsim_test_cli_with gives it. */
+/* The same checks on a run already made: status rc, stderr err (one_line:
+ * and nothing but that line). */
+void bsim_test_check_input_error(int rc, const char *err, const char *const needles[],
+                                 int one_line);
+
+/* Runs another program, argv[0] looked up on PATH, with stdout into *out
+ * (may be NULL) and stderr discarded; returns its status as above. */
+int bsim_test_run(const char *const argv[], char **out);
+
+/* Starts BSIM_EXE with argv in the background, stdout and stderr to
+ * /dev/null (or o->out, o->err; o may be NULL); returns its pid. */
+int bsim_test_spawn(const char *const argv[]);
+int bsim_test_spawn_with(const char *const argv[], const bsim_test_opts *o);
+
+/* Waits for a spawned program: its status as bsim_test_cli gives it. */
 int bsim_test_wait(int pid);
+
+/* The whole records in a journal (beamsim's util/journal.h format: its
+ * header says how long they are), or -1 if there is no journal at path. */
+long bsim_test_journal_records(const char *path);
+
+/* Waits until the journal at path holds at least n records while the
+ * spawned pid runs: 1 if it does (the program still running), or 0 with
+ * *status (as bsim_test_wait gives it) if the program ended first. The
+ * journal is created whole (header and all) after the program installs its
+ * SIGINT and SIGTERM handlers, so n = 0 waits for that. */
+int bsim_test_await_records(int pid, const char *path, long n, int *status);
+
+/* Waits until the directory dir has an entry while the spawned pid runs:
+ * 1, or 0 with *status if the program ended first. */
+int bsim_test_await_entry(int pid, const char *dir, int *status);
 
 /* A fresh empty directory under BSIM_TEST_TMP named name; returns its path
  * in a static buffer (valid until the next call). */
 const char *bsim_test_dir(const char *name);
+
+/* Removes path and all below it (rm -rf): 0, or -1 on failure. */
+int bsim_test_remove(const char *path);
 
 /* Writes text to dir/name and returns the path (static buffer). */
 const char *bsim_test_write(const char *dir, const char *name, const char *text);
 
 /* Reads a whole file into a malloc'd, NUL-terminated string (NULL on error). */
 char *bsim_test_read(const char *path);
+
+/* The files matching a glob(3) pattern, in name order: all of them
+ * concatenated (bsim_test_read_glob, NULL if none), or the first one's path
+ * (bsim_test_glob_first, a static buffer; NULL if none). */
+char *bsim_test_read_glob(const char *pattern);
+const char *bsim_test_glob_first(const char *pattern);
+
+/* "dir/name" in one of four static buffers used in turn (so a few may be
+ * held at once); aborts the test if it does not fit. */
+const char *bsim_test_join(const char *dir, const char *name);
+
+/* 1 if there is a file or directory at path (access(2), F_OK). */
+int bsim_test_exists(const char *path);
+
+/* A file's size in bytes, -1 if it does not exist. */
+long bsim_test_size(const char *path);
+
+/* The number of '\n' in text. */
+int bsim_test_count_lines(const char *text);
 
 /* Path of a file in the source tree (static buffer). */
 const char *bsim_test_src(const char *rel);

@@ -246,14 +246,6 @@ static void test_run(void **state)
 	cli_run_free(&r);
 }
 
-static int count_lines(const char *s)
-{
-	int n = 0;
-	for (; *s; s++)
-		n += *s == '\n';
-	return n;
-}
-
 /* No PATH.tmp.PID is left behind in dir. */
 static void assert_no_tmp(const char *dir)
 {
@@ -280,7 +272,7 @@ static void test_trajectory(void **state)
 	assert_non_null(csv);
 	assert_memory_equal(csv, TRAJ_HEADER, strlen(TRAJ_HEADER));
 	/* One row per state: t = 0 and after every step. */
-	assert_int_equal(count_lines(csv) - 1, steps_run + 1);
+	assert_int_equal(bsim_test_count_lines(csv) - 1, steps_run + 1);
 	free(csv);
 	assert_no_tmp(dir);
 
@@ -291,7 +283,7 @@ static void test_trajectory(void **state)
 	cli_run_free(&r);
 	csv = bsim_test_read(path);
 	assert_non_null(csv);
-	int rows = count_lines(csv) - 1;
+	int rows = bsim_test_count_lines(csv) - 1;
 	assert_true(rows >= steps_run / 10 && rows <= steps_run / 10 + 2);
 	free(csv);
 }
@@ -327,7 +319,7 @@ static void test_sweep(void **state)
 	char *csv = bsim_test_read(file);
 	assert_non_null(csv);
 	assert_memory_equal(csv, TRIALS_HEADER, strlen(TRIALS_HEADER));
-	assert_int_equal(count_lines(csv), 1 + 2 * 3);
+	assert_int_equal(bsim_test_count_lines(csv), 1 + 2 * 3);
 	assert_contains(csv, "\n1,2,");
 	assert_contains(csv, ",8,20\n"); /* group 1's values */
 	free(csv);

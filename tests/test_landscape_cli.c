@@ -25,19 +25,6 @@
 
 static char out_dir[1024];
 
-static const char *path_in(const char *dir, const char *name)
-{
-	static char p[1200];
-	snprintf(p, sizeof p, "%s/%s", dir, name);
-	return p;
-}
-
-static long file_size(const char *path)
-{
-	struct stat st;
-	return stat(path, &st) == 0 ? (long)st.st_size : -1;
-}
-
 static int setup(void **state)
 {
 	(void)state;
@@ -70,7 +57,7 @@ static void test_csv(void **state)
 	assert_int_equal(
 	        bsim_scene_load(bsim_test_src("configs/thesis/gate.yaml"), NULL, 0, &s, &err),
 	        BSIM_OK);
-	FILE *f = fopen(path_in(out_dir, "landscape.csv"), "r");
+	FILE *f = fopen(bsim_test_join(out_dir, "landscape.csv"), "r");
 	assert_non_null(f);
 	char line[512];
 	assert_non_null(fgets(line, sizeof line, f));
@@ -104,7 +91,7 @@ static void test_csv(void **state)
 static void test_mat(void **state)
 {
 	(void)state;
-	mat_t *mat = Mat_Open(path_in(out_dir, "landscape.mat"), MAT_ACC_RDONLY);
+	mat_t *mat = Mat_Open(bsim_test_join(out_dir, "landscape.mat"), MAT_ACC_RDONLY);
 	assert_non_null(mat);
 	matvar_t *v = Mat_VarRead(mat, "landscape");
 	assert_non_null(v);
@@ -121,7 +108,7 @@ static void test_mat(void **state)
 	assert_true(((double *)nx->data)[0] == 201 && ((double *)ny->data)[0] == 261);
 	assert_int_equal(et->dims[0], 201 * 261);
 	/* every e_total against the CSV (printed with 10 digits) */
-	FILE *f = fopen(path_in(out_dir, "landscape.csv"), "r");
+	FILE *f = fopen(bsim_test_join(out_dir, "landscape.csv"), "r");
 	char line[512];
 	assert_non_null(fgets(line, sizeof line, f));
 	const double *e = et->data;
@@ -139,7 +126,7 @@ static void test_mat(void **state)
 	assert_non_null(be);
 	assert_non_null(kind);
 	assert_int_equal(be->dims[0], 3); /* lowest, beam 1, beam 2 */
-	char *json = bsim_test_read(path_in(out_dir, "landscape.json"));
+	char *json = bsim_test_read(bsim_test_join(out_dir, "landscape.json"));
 	assert_non_null(json);
 	const char *lowest = strstr(json, "\"lowest_pass\"");
 	assert_non_null(lowest);
@@ -158,16 +145,16 @@ static void test_figures(void **state)
 	for (int i = 0; i < 3; i++) {
 		char n[64];
 		snprintf(n, sizeof n, "%s.gp", names[i]);
-		assert_true(file_size(path_in(out_dir, n)) > 0);
+		assert_true(bsim_test_size(bsim_test_join(out_dir, n)) > 0);
 		snprintf(n, sizeof n, "%s.png", names[i]);
-		const long png = file_size(path_in(out_dir, n));
+		const long png = bsim_test_size(bsim_test_join(out_dir, n));
 		snprintf(n, sizeof n, "%s.svg", names[i]);
-		const long svg = file_size(path_in(out_dir, n));
+		const long svg = bsim_test_size(bsim_test_join(out_dir, n));
 		print_message("%s: png %ld bytes, svg %ld bytes\n", names[i], png, svg);
 		assert_true(png > 1000 && png < 1000000);
 		assert_true(svg > 1000 && svg < 1000000);
 		snprintf(n, sizeof n, "%s.png", names[i]);
-		char *img = bsim_test_read(path_in(out_dir, n));
+		char *img = bsim_test_read(bsim_test_join(out_dir, n));
 		assert_non_null(img);
 		assert_memory_equal(img, "\x89PNG", 4);
 		free(img);
@@ -196,7 +183,7 @@ static void test_options(void **state)
 	int rc = bsim_test_cli(argv, &out, &err);
 	if (rc != 0)
 		fail_msg("exit %d: %s", rc, err ? err : "");
-	char *json = bsim_test_read(path_in(dir, "landscape.json"));
+	char *json = bsim_test_read(bsim_test_join(dir, "landscape.json"));
 	assert_non_null(json);
 	assert_true(bsim_test_json_number(json, "nx") == 101 &&
 	            bsim_test_json_number(json, "ny") == 101);
@@ -209,7 +196,7 @@ static void test_options(void **state)
 	const char *figs[] = {"landscape_top.svg", "landscape_beam.svg", "landscape_total.svg",
 	                      "landscape_top.png", "landscape_beam.png", "landscape_total.png"};
 	for (int i = 0; i < 6; i++) {
-		const long size = file_size(path_in(dir, figs[i]));
+		const long size = bsim_test_size(bsim_test_join(dir, figs[i]));
 		print_message("square region: %s %ld bytes\n", figs[i], size);
 		assert_true(size > 1000 && size < 1000000);
 	}
@@ -222,13 +209,8 @@ static void expect_bad(const char *const argv[], const char *dir, const char *co
 {
 	char *out = NULL, *err = NULL;
 	int rc = bsim_test_cli(argv, &out, &err);
-	assert_non_null(err);
-	if (rc != 2)
-		fail_msg("exit status %d, stderr: %s", rc, err);
-	for (int i = 0; needles[i]; i++)
-		if (!strstr(err, needles[i]))
-			fail_msg("stderr \"%s\" lacks \"%s\"", err, needles[i]);
-	assert_true(file_size(dir) < 0);
+	bsim_test_check_input_error(rc, err, needles, 0);
+	assert_true(bsim_test_size(dir) < 0);
 	free(out);
 	free(err);
 }

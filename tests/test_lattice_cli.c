@@ -28,23 +28,6 @@
 
 #define BODY "body: { mass: 1, radius: 10 }\n"
 
-static void expect_input_error(const char *const argv[], const char *const needles[])
-{
-	char *out = NULL, *err = NULL;
-	int rc = bsim_test_cli(argv, &out, &err);
-	assert_non_null(err);
-	if (rc != 2)
-		fail_msg("exit status %d, stderr: %s", rc, err);
-	for (int i = 0; needles[i]; i++)
-		if (!strstr(err, needles[i]))
-			fail_msg("stderr \"%s\" lacks \"%s\"", err, needles[i]);
-	const char *nl = strchr(err, '\n');
-	if (!nl || nl[1] != '\0')
-		fail_msg("expected one line on stderr, got \"%s\"", err);
-	free(out);
-	free(err);
-}
-
 /* beamsim run on a scene (and a CSV beside it, if csv is not NULL). */
 static void bad_lattice(const char *name, const char *scene, const char *csv,
                         const char *const needles[])
@@ -55,7 +38,7 @@ static void bad_lattice(const char *name, const char *scene, const char *csv,
 		bsim_test_write(dir, "map.csv", csv);
 	snprintf(path, sizeof path, "%s", bsim_test_write(dir, "scene.yaml", scene));
 	const char *argv[] = {"run", path, NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 }
 
 #define LATTICE_3X3                                                                                \
@@ -179,7 +162,7 @@ static void bad_protocol(void **state)
 	                      "lattice.protocol=gate", NULL};
 	const char *needles[] = {"--set lattice.protocol=gate: lattice.protocol: expected world",
 	                         NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 }
 
 /* A bad scene leaves no output directory behind. */
@@ -198,7 +181,7 @@ static void sweep_writes_nothing(void **state)
 	snprintf(out, sizeof out, "%s/out", dir);
 	const char *argv[] = {"sweep", exp, "--out", out, "--quiet", NULL};
 	const char *needles[] = {"scene.yaml:6:16: ", "lattice.stiffness", NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 	struct stat st;
 	assert_true(stat(out, &st) != 0);
 }
@@ -214,14 +197,6 @@ static char *read_in(const char *dir, const char *name)
 	if (!t)
 		fail_msg("%s missing", path);
 	return t;
-}
-
-static int count_lines(const char *t)
-{
-	int n = 0;
-	for (; *t; t++)
-		n += *t == '\n';
-	return n;
 }
 
 static int run_ok(const char *const argv[])
@@ -294,7 +269,7 @@ static void sweep_files(void **state)
 	}
 	/* 81 gates in the map, the C-track's soft gate (-3, 4) */
 	char *map = read_in(out1, "lattice_map.csv");
-	assert_int_equal(count_lines(map), 1 + 81);
+	assert_int_equal(bsim_test_count_lines(map), 1 + 81);
 	assert_non_null(strstr(map, "\n0,-3,4,-175,-125,240,300,270,100,100\n"));
 	free(map);
 	/* final locations add up to the trials */
@@ -411,7 +386,7 @@ static void compare_backends_on_lattice(void **state)
 	char path[1400];
 	snprintf(path, sizeof path, "%s/box2d", out);
 	char *peaks = read_in(path, "beam_peaks.csv");
-	assert_true(count_lines(peaks) > 1);
+	assert_true(bsim_test_count_lines(peaks) > 1);
 	free(peaks);
 }
 

@@ -43,14 +43,6 @@ static int run_cli(const char *const *argv, char **out, char **err)
 	return rc;
 }
 
-static int exists(const char *dir, const char *file)
-{
-	char path[1200];
-	struct stat st;
-	snprintf(path, sizeof path, "%s/%s", dir, file);
-	return stat(path, &st) == 0;
-}
-
 /* ---- a CSV file by column name ---------------------------------------------------------- */
 
 typedef struct table {
@@ -237,9 +229,10 @@ static void test_sweep_figures(void **state)
 	/* p_traverse, traversal against Rm, and per group final_locations and
 	 * lattice; not the single gate's bundle and landscape */
 	assert_int_equal(bsim_test_check_figures(dir), 2 + 2 * 2);
-	assert_true(exists(dir, "lattice_g001.png") || !bsim_figure_available());
-	assert_false(exists(dir, "trajectories_g000.gp"));
-	assert_false(exists(dir, "landscape_g001.gp"));
+	assert_true(bsim_test_exists(bsim_test_join(dir, "lattice_g001.png")) ||
+	            !bsim_figure_available());
+	assert_false(bsim_test_exists(bsim_test_join(dir, "trajectories_g000.gp")));
+	assert_false(bsim_test_exists(bsim_test_join(dir, "landscape_g001.gp")));
 }
 
 static void test_final_locations(void **state)
@@ -576,8 +569,8 @@ static void test_bad_input(void **state)
 		assert_non_null(strstr(err, where));
 		assert_non_null(strstr(err, cases[i].want));
 		free(err);
-		assert_false(exists(dir, "p_traverse.gp"));
-		assert_false(exists(dir, "final_locations_g000.gp"));
+		assert_false(bsim_test_exists(bsim_test_join(dir, "p_traverse.gp")));
+		assert_false(bsim_test_exists(bsim_test_join(dir, "final_locations_g000.gp")));
 	}
 }
 

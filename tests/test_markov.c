@@ -229,16 +229,9 @@ static void test_one_gate_against_simulation(void **state)
 
 static char *map_text(const char *dir)
 {
-	char cmd[1400];
-	snprintf(cmd, sizeof cmd, "cat %s/map_*.csv", dir);
-	FILE *f = popen(cmd, "r");
-	assert_non_null(f);
-	size_t cap = 1 << 20, len = 0;
-	char *buf = malloc(cap);
-	len = fread(buf, 1, cap - 1, f);
-	buf[len] = '\0';
-	pclose(f);
-	return buf;
+	char *text = bsim_test_read_glob(bsim_test_join(dir, "map_*.csv"));
+	assert_non_null(text);
+	return text;
 }
 
 /* Threads change nothing; the cache reuses only what nothing changed. */
@@ -425,13 +418,9 @@ static void test_bad_map_files(void **state)
 	free(json);
 
 	/* a map's CSV: an exit bin past the last of 1 + 4 bins */
-	char cmd[1400];
-	snprintf(cmd, sizeof cmd, "ls %s/map_*.csv | head -1", dir);
-	FILE *ls = popen(cmd, "r");
-	assert_non_null(ls);
-	assert_non_null(fgets(path, sizeof path, ls));
-	pclose(ls);
-	path[strcspn(path, "\n")] = '\0';
+	const char *first = bsim_test_glob_first(bsim_test_join(dir, "map_*.csv"));
+	assert_non_null(first);
+	snprintf(path, sizeof path, "%s", first);
 	char *csv = bsim_test_read(path);
 	assert_non_null(csv);
 	char *row2 = strchr(csv, '\n');

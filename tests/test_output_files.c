@@ -38,24 +38,6 @@ static int setup(void **state)
 	return 0;
 }
 
-static char *join(const char *dir, const char *name)
-{
-	static char buf[4][1400];
-	static int k;
-	k = (k + 1) % 4;
-	if (snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name) >= (int)sizeof buf[k])
-		fail_msg("path too long");
-	return buf[k];
-}
-
-static int count_lines(const char *s)
-{
-	int n = 0;
-	for (; *s; s++)
-		n += *s == '\n';
-	return n;
-}
-
 static void test_trajectory_to_stdout(void **state)
 {
 	(void)state;
@@ -64,7 +46,7 @@ static void test_trajectory_to_stdout(void **state)
 	assert_int_equal(bsim_test_cli(argv, &out, &err), 0);
 	assert_int_equal(strncmp(out, "t,x,y,vx,vy,", 12), 0);
 	/* t = 0, every 500th of 3000 steps, the final state: 8 rows */
-	assert_int_equal(count_lines(out), 8);
+	assert_int_equal(bsim_test_count_lines(out), 8);
 	assert_non_null(strstr(err, "outcome")); /* the report went to stderr */
 	assert_int_equal(access("-", F_OK), -1); /* no file named "-" */
 	free(out);
@@ -76,8 +58,8 @@ static void test_trajectory_through_symlink(void **state)
 	(void)state;
 	const char *dir = bsim_test_dir("symlink");
 	char target[1400], link[1400];
-	snprintf(target, sizeof target, "%s", join(dir, "target.csv"));
-	snprintf(link, sizeof link, "%s", join(dir, "link.csv"));
+	snprintf(target, sizeof target, "%s", bsim_test_join(dir, "target.csv"));
+	snprintf(link, sizeof link, "%s", bsim_test_join(dir, "link.csv"));
 	assert_int_equal(symlink(target, link), 0);
 	const char *argv[] = {"run", gate, "--trajectory", link, NULL};
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
@@ -86,7 +68,7 @@ static void test_trajectory_through_symlink(void **state)
 	assert_true(S_ISLNK(st.st_mode));
 	char *csv = bsim_test_read(target);
 	assert_non_null(csv);
-	assert_int_equal(count_lines(csv), 3002); /* header, t = 0 and 3000 steps */
+	assert_int_equal(bsim_test_count_lines(csv), 3002); /* header, t = 0 and 3000 steps */
 	free(csv);
 }
 
@@ -95,8 +77,8 @@ static void test_trajectory_through_fifo_and_device(void **state)
 	(void)state;
 	const char *dir = bsim_test_dir("fifo");
 	char fifo[1400], copy[1400];
-	snprintf(fifo, sizeof fifo, "%s", join(dir, "pipe"));
-	snprintf(copy, sizeof copy, "%s", join(dir, "copy.csv"));
+	snprintf(fifo, sizeof fifo, "%s", bsim_test_join(dir, "pipe"));
+	snprintf(copy, sizeof copy, "%s", bsim_test_join(dir, "copy.csv"));
 	assert_int_equal(mkfifo(fifo, 0600), 0);
 	fflush(NULL);
 	pid_t reader = fork();
@@ -118,7 +100,7 @@ static void test_trajectory_through_fifo_and_device(void **state)
 	assert_int_equal(lstat(fifo, &st), 0);
 	assert_true(S_ISFIFO(st.st_mode));
 	char *csv = bsim_test_read(copy);
-	assert_int_equal(count_lines(csv), 5);
+	assert_int_equal(bsim_test_count_lines(csv), 5);
 	free(csv);
 	const char *dev[] = {"run", gate, "--trajectory", "/dev/null", NULL};
 	assert_int_equal(bsim_test_cli(dev, NULL, NULL), 0);
@@ -161,8 +143,8 @@ static void test_unwritable_out(void **state)
 	const char *dir = bsim_test_dir("unwritable");
 	char file[1400], under[1400], ro[1400];
 	snprintf(file, sizeof file, "%s", bsim_test_write(dir, "file", "x\n"));
-	snprintf(under, sizeof under, "%s", join(file, "sub"));
-	snprintf(ro, sizeof ro, "%s", join(dir, "readonly"));
+	snprintf(under, sizeof under, "%s", bsim_test_join(file, "sub"));
+	snprintf(ro, sizeof ro, "%s", bsim_test_join(dir, "readonly"));
 	mkdir(ro, 0500);
 	/* root writes anywhere it has permission bits for; /proc it cannot */
 	const char *locked = geteuid() == 0 ? "/proc/self/fdinfo" : ro;
@@ -223,25 +205,26 @@ static void test_failed_rerun_keeps_previous_set(void **state)
 	snprintf(out, sizeof out, "%s", bsim_test_dir("rerun"));
 	const char *r1[] = {"regress", b1, "--quiet", "--out", out, NULL};
 	assert_int_equal(bsim_test_cli(r1, NULL, NULL), 0);
-	char *before = bsim_test_read(join(out, "trials.csv"));
-	char *before_json = bsim_test_read(join(out, "regress.json"));
+	char *before = bsim_test_read(bsim_test_join(out, "trials.csv"));
+	char *before_json = bsim_test_read(bsim_test_join(out, "regress.json"));
 
 	const char *r2[] = {"regress", b2, "--quiet", "--out", out, NULL};
 	bsim_test_opts small = {.fsize = 30000};
 	char *err = NULL;
 	assert_int_equal(bsim_test_cli_with(r2, &small, NULL, &err), 1);
-	if (!strstr(err, join(out, "trials.csv")) || strstr(err, ".beamsim") ||
+	if (!strstr(err, bsim_test_join(out, "trials.csv")) || strstr(err, ".beamsim") ||
 	    strstr(err, ".tmp."))
-		fail_msg("expected a message naming %s, got \"%s\"", join(out, "trials.csv"), err);
-	char *after = bsim_test_read(join(out, "trials.csv"));
-	char *after_json = bsim_test_read(join(out, "regress.json"));
+		fail_msg("expected a message naming %s, got \"%s\"",
+		         bsim_test_join(out, "trials.csv"), err);
+	char *after = bsim_test_read(bsim_test_join(out, "trials.csv"));
+	char *after_json = bsim_test_read(bsim_test_join(out, "regress.json"));
 	assert_string_equal(before, after);
 	assert_string_equal(before_json, after_json);
 	int has = 0;
 	bsim_error e;
 	assert_int_equal(bsim_outdir_verify(out, &has, &e), BSIM_OK);
 	assert_int_equal(has, 1);
-	assert_int_equal(access(join(out, ".beamsim"), F_OK), -1); /* no staging left */
+	assert_int_equal(access(bsim_test_join(out, ".beamsim"), F_OK), -1); /* no staging left */
 	free(before);
 	free(after);
 	free(before_json);
@@ -261,23 +244,24 @@ static void test_replacing_a_set(void **state)
 	const char *cmp[] = {"compare", h1, "--trials", "1", "--quiet", "--out", dir, NULL};
 	int rc = bsim_test_cli(cmp, NULL, NULL);
 	assert_true(rc == 0 || rc == 3);
-	assert_int_equal(access(join(dir, "pairs.csv"), F_OK), 0);
+	assert_int_equal(access(bsim_test_join(dir, "pairs.csv"), F_OK), 0);
 	bsim_test_write(dir, "notes.txt", "mine\n");
-	snprintf(elsewhere, sizeof elsewhere, "%s", join(bsim_test_dir("elsewhere"), "t.csv"));
-	assert_int_equal(symlink(elsewhere, join(dir, "trials.csv")), 0);
+	snprintf(elsewhere, sizeof elsewhere, "%s",
+	         bsim_test_join(bsim_test_dir("elsewhere"), "t.csv"));
+	assert_int_equal(symlink(elsewhere, bsim_test_join(dir, "trials.csv")), 0);
 	const char *sweep[] = {"sweep", h1, "--trials", "1", "--quiet", "--out", dir, NULL};
 	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
 	const char *gone[] = {"pairs.csv", "report.md", "report.json", "thesis/trials.csv",
 	                      "box2d/summary.json"};
 	for (int i = 0; i < 5; i++)
-		if (access(join(dir, gone[i]), F_OK) == 0)
+		if (access(bsim_test_join(dir, gone[i]), F_OK) == 0)
 			fail_msg("%s of the comparison is still there", gone[i]);
-	assert_int_equal(access(join(dir, "notes.txt"), F_OK), 0);
+	assert_int_equal(access(bsim_test_join(dir, "notes.txt"), F_OK), 0);
 	struct stat st;
-	assert_int_equal(lstat(join(dir, "trials.csv"), &st), 0);
+	assert_int_equal(lstat(bsim_test_join(dir, "trials.csv"), &st), 0);
 	assert_true(S_ISLNK(st.st_mode));
 	char *csv = bsim_test_read(elsewhere);
-	assert_int_equal(count_lines(csv), 31); /* header and 30 groups x 1 trial */
+	assert_int_equal(bsim_test_count_lines(csv), 31); /* header and 30 groups x 1 trial */
 	int has = 0;
 	bsim_error e;
 	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_OK);
@@ -295,7 +279,7 @@ static void test_manifest_check(void **state)
 	snprintf(dir, sizeof dir, "%s", d);
 	const char *sweep[] = {"sweep", h1, "--trials", "1", "--quiet", "--out", dir, NULL};
 	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
-	char *json = bsim_test_read(join(dir, "summary.json"));
+	char *json = bsim_test_read(bsim_test_join(dir, "summary.json"));
 	json[strlen(json) - 3] ^= 1; /* one bit of the last line */
 	bsim_test_write(dir, "summary.json", json);
 	int has = 0;
@@ -323,7 +307,7 @@ static void test_figures_join_the_set(void **state)
 	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
 	const char *plot[] = {"plot", dir, "--quiet", NULL};
 	assert_int_equal(bsim_test_cli(plot, NULL, NULL), 0);
-	char *manifest = bsim_test_read(join(dir, "manifest.json"));
+	char *manifest = bsim_test_read(bsim_test_join(dir, "manifest.json"));
 	assert_non_null(strstr(manifest, "\"command\": \"plot\""));
 	assert_non_null(strstr(manifest, "\"path\": \"p_traverse.gp\""));
 	assert_non_null(strstr(manifest, "\"path\": \"trials.csv\""));
@@ -332,14 +316,14 @@ static void test_figures_join_the_set(void **state)
 	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_OK);
 	assert_int_equal(has, 1);
 	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
-	assert_int_equal(access(join(dir, "p_traverse.gp"), F_OK), -1);
+	assert_int_equal(access(bsim_test_join(dir, "p_traverse.gp"), F_OK), -1);
 	free(manifest);
 
 	char run_dir[1400];
 	snprintf(run_dir, sizeof run_dir, "%s", bsim_test_dir("run_out"));
 	const char *run[] = {"run", gate, "--out", run_dir, NULL};
 	assert_int_equal(bsim_test_cli(run, NULL, NULL), 0);
-	manifest = bsim_test_read(join(run_dir, "manifest.json"));
+	manifest = bsim_test_read(bsim_test_join(run_dir, "manifest.json"));
 	assert_non_null(strstr(manifest, "\"path\": \"trajectory.csv\""));
 	assert_int_equal(bsim_outdir_verify(run_dir, &has, &e), BSIM_OK);
 	free(manifest);

@@ -1,12 +1,16 @@
 /* Stopping and resuming sweeps and comparisons through the real program.
  * The truth is the uninterrupted run: however often a run is killed (kill
- * -9 at random moments: while loading, running trials, writing or
- * committing its files) and resumed, the files it ends with are those of a
+ * -9 at moments drawn at random among what the run does: while loading,
+ * once its journal has grown by some records, once it stages its files)
+ * and resumed, the files it ends with are those of a
  * run never interrupted, byte for byte (trials.csv, and pairs.csv of a
  * comparison), and whenever a manifest is present it matches the files
  * beside it. SIGINT and SIGTERM stop cleanly with 128 + the signal's
  * number, keep the journal and print the line that resumes. A resume with
- * other inputs, or without a run to resume, is refused. */
+ * other inputs, or without a run to resume, is refused. Every kill and
+ * signal waits on what the program does (its journal, its staging area),
+ * never on time: the program installs its SIGINT and SIGTERM handlers
+ * before it creates the journal. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <setjmp.h>
@@ -16,20 +20,19 @@
 
 #include <cmocka.h>
 
-#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <time.h>
-#include <unistd.h>
 
 #include "store/outdir.h"
 #include "support.h"
 
 #define CYCLES 10 /* kill-and-resume cycles per command */
+/* A kill after the journal has grown comes after 1 to this many new
+ * records: one group's trials, fewer than a sweep or a comparison of the
+ * experiment below journals. */
+#define MAX_RECORDS 24
 
 static char experiment[1200];
 
@@ -52,34 +55,6 @@ static int setup(void **state)
 	snprintf(experiment, sizeof experiment, "%s",
 	         bsim_test_write(bsim_test_dir("exp"), "small.yaml", text));
 	return 0;
-}
-
-static double now(void)
-{
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static void sleep_for(double s)
-{
-	struct timespec t = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
-	nanosleep(&t, NULL);
-}
-
-static char *join(const char *dir, const char *name)
-{
-	static char buf[4][1400];
-	static int k;
-	k = (k + 1) % 4;
-	if (snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name) >= (int)sizeof buf[k])
-		fail_msg("path too long");
-	return buf[k];
-}
-
-static int exists(const char *path)
-{
-	return access(path, F_OK) == 0;
 }
 
 /* The command line of a run of cmd ("sweep" or "compare") into dir. A
@@ -125,11 +100,12 @@ static void check_manifest(const char *dir)
 static void same_files(const char *ref, const char *dir, const char *const *files)
 {
 	for (int i = 0; files[i]; i++) {
-		char *a = bsim_test_read(join(ref, files[i]));
-		char *b = bsim_test_read(join(dir, files[i]));
+		char *a = bsim_test_read(bsim_test_join(ref, files[i]));
+		char *b = bsim_test_read(bsim_test_join(dir, files[i]));
 		assert_non_null(a);
 		if (!b || strcmp(a, b) != 0)
-			fail_msg("%s differs from the uninterrupted run's", join(dir, files[i]));
+			fail_msg("%s differs from the uninterrupted run's",
+			         bsim_test_join(dir, files[i]));
 		free(a);
 		free(b);
 	}
@@ -140,18 +116,45 @@ static int done_status(int rc)
 	return rc == 0 || rc == 3; /* compare: 3 reports disagreeing groups */
 }
 
-/* Kills runs of cmd at random moments (uniform over 1.2 times the length
- * of an uninterrupted run), one to three times, resumes until one
- * finishes, and compares with the uninterrupted run. */
+/* Where a run is killed: at once (while it loads), once its journal has
+ * grown by 1 to MAX_RECORDS records (while trials run), or once a file is
+ * staged (while it writes and commits its files). */
+enum { AT_START, AT_RECORDS, AT_STAGED };
+
+/* Starts argv and kills it at the moment at: the exit status, or that of
+ * the run if it ended first. */
+static int kill_at(const char *const *argv, const char *dir, int at)
+{
+	const char *journal = bsim_test_join(dir, ".beamsim/journal");
+	long have = bsim_test_journal_records(journal);
+	long want = (have > 0 ? have : 0) + 1 + rand() % MAX_RECORDS;
+	char staging[1400];
+	snprintf(staging, sizeof staging, "%s", bsim_test_join(dir, ".beamsim/staging"));
+	/* a killed run's staging area is stale: the next run clears it; gone
+	 * already, it cannot be mistaken for this run's files */
+	if (at == AT_STAGED)
+		assert_int_equal(bsim_test_remove(staging), 0);
+	int pid = bsim_test_spawn(argv), rc = 0, running = 1;
+	if (at == AT_RECORDS)
+		running = bsim_test_await_records(pid, journal, want, &rc);
+	else if (at == AT_STAGED)
+		running = bsim_test_await_entry(pid, staging, &rc);
+	if (!running)
+		return rc;
+	kill(pid, SIGKILL);
+	return bsim_test_wait(pid);
+}
+
+/* Kills runs of cmd one to three times each cycle (the first time while
+ * trials run, later at any moment), resumes until one finishes, and
+ * compares with the uninterrupted run. */
 static void kill_and_resume(const char *cmd, const char *const *files)
 {
 	char ref[1200], dir[1200];
 	const char *argv[16];
 	snprintf(ref, sizeof ref, "%s", bsim_test_dir(cmd));
 	command(argv, cmd, ref, 0);
-	double t0 = now();
 	assert_true(done_status(bsim_test_cli(argv, NULL, NULL)));
-	double full = now() - t0;
 	srand(12345);
 	int kills = 0, mid_run = 0;
 	for (int c = 0; c < CYCLES; c++) {
@@ -160,7 +163,7 @@ static void kill_and_resume(const char *cmd, const char *const *files)
 		snprintf(dir, sizeof dir, "%s", bsim_test_dir(name));
 		int finished = 0;
 		for (int round = 0; !finished; round++) {
-			int resume = exists(join(dir, ".beamsim/journal"));
+			int resume = bsim_test_exists(bsim_test_join(dir, ".beamsim/journal"));
 			command(argv, cmd, dir, resume);
 			if (round >= 1 + c % 3) { /* the last round runs to the end */
 				int rc = bsim_test_cli(argv, NULL, NULL);
@@ -170,10 +173,7 @@ static void kill_and_resume(const char *cmd, const char *const *files)
 				finished = 1;
 				break;
 			}
-			int pid = bsim_test_spawn(argv);
-			sleep_for(1.2 * full * rand() / RAND_MAX);
-			kill(pid, SIGKILL);
-			int rc = bsim_test_wait(pid);
+			int rc = kill_at(argv, dir, round == 0 ? AT_RECORDS : rand() % 3);
 			if (rc != 128 + SIGKILL) { /* it ended before the kill */
 				if (!done_status(rc))
 					fail_msg("cycle %d: %s ended with %d", c, cmd, rc);
@@ -182,19 +182,18 @@ static void kill_and_resume(const char *cmd, const char *const *files)
 			}
 			kills++;
 			/* a journal with records, and no finished set yet */
-			struct stat st;
-			if (stat(join(dir, ".beamsim/journal"), &st) == 0 && st.st_size > 2000 &&
-			    !exists(join(dir, "manifest.json")))
+			long records =
+			        bsim_test_journal_records(bsim_test_join(dir, ".beamsim/journal"));
+			if (records > 0 && !bsim_test_exists(bsim_test_join(dir, "manifest.json")))
 				mid_run++;
 			check_manifest(dir);
 		}
 		same_files(ref, dir, files);
 		check_manifest(dir);
-		assert_false(exists(join(dir, ".beamsim")));
+		assert_false(bsim_test_exists(bsim_test_join(dir, ".beamsim")));
 	}
-	print_message("%s: %d kills (%d while trials ran) in %d cycles; an uninterrupted run "
-	              "takes %.2f s\n",
-	              cmd, kills, mid_run, CYCLES, full);
+	print_message("%s: %d kills (%d while trials ran) in %d cycles\n", cmd, kills, mid_run,
+	              CYCLES);
 	assert_true(kills >= CYCLES);
 	assert_true(mid_run >= CYCLES / 2);
 }
@@ -211,7 +210,8 @@ static void test_compare_killed(void **state)
 	kill_and_resume("compare", compare_files);
 }
 
-/* SIGINT and SIGTERM: a clean stop, the journal kept, the resume line. */
+/* SIGINT and SIGTERM: a clean stop, the journal kept, the resume line. The
+ * signal comes once a trial is journaled: its handler is in place. */
 static void test_signals(void **state)
 {
 	(void)state;
@@ -220,31 +220,22 @@ static void test_signals(void **state)
 	const char *argv[16];
 	snprintf(ref, sizeof ref, "%s", bsim_test_dir("signal_ref"));
 	command(argv, "sweep", ref, 0);
-	double t0 = now();
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
-	double full = now() - t0;
 	for (int i = 0; i < 2; i++) {
 		char name[32];
 		snprintf(name, sizeof name, "signal_%d", sigs[i]);
 		snprintf(dir, sizeof dir, "%s", bsim_test_dir(name));
-		snprintf(errfile, sizeof errfile, "%s", join(dir, "../stderr.txt"));
+		snprintf(errfile, sizeof errfile, "%s", bsim_test_join(dir, "../stderr.txt"));
 		command(argv, "sweep", dir, 0);
-		fflush(NULL);
-		pid_t pid = fork();
-		if (pid == 0) {
-			int fd = open(errfile, O_WRONLY | O_CREAT | O_TRUNC, 0600);
-			dup2(fd, 2);
-			char *args[18] = {(char *)BSIM_EXE};
-			for (int k = 0; argv[k]; k++)
-				args[k + 1] = (char *)argv[k];
-			execv(BSIM_EXE, args);
-			_exit(127);
+		bsim_test_opts o = {.err = errfile};
+		int pid = bsim_test_spawn_with(argv, &o), rc = 0;
+		if (bsim_test_await_records(pid, bsim_test_join(dir, ".beamsim/journal"), 1, &rc)) {
+			kill(pid, sigs[i]);
+			rc = bsim_test_wait(pid);
 		}
-		sleep_for(0.5 * full);
-		kill(pid, sigs[i]);
-		int rc = bsim_test_wait((int)pid);
 		char *err = bsim_test_read(errfile);
 		if (rc == 0) { /* finished before the signal: nothing to check */
+			print_message("the sweep finished before the signal\n");
 			free(err);
 			continue;
 		}
@@ -252,8 +243,8 @@ static void test_signals(void **state)
 		assert_non_null(strstr(err, sigs[i] == SIGINT ? "SIGINT" : "SIGTERM"));
 		assert_non_null(strstr(err, "--resume"));
 		assert_non_null(strstr(err, "stopped after"));
-		assert_true(exists(join(dir, ".beamsim/journal")));
-		assert_false(exists(join(dir, "trials.csv")));
+		assert_true(bsim_test_exists(bsim_test_join(dir, ".beamsim/journal")));
+		assert_false(bsim_test_exists(bsim_test_join(dir, "trials.csv")));
 		command(argv, "sweep", dir, 1);
 		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 		same_files(ref, dir, sweep_files);
@@ -274,15 +265,15 @@ static void test_refusals(void **state)
 	assert_int_equal(bsim_test_cli(argv, NULL, &err), 2);
 	assert_non_null(strstr(err, "no stopped run to resume"));
 	free(err);
-	/* a stopped run: SIGINT right after it starts */
+	/* a stopped run: SIGINT as soon as its journal is there */
 	command(argv, "sweep", dir, 0);
-	int pid = bsim_test_spawn(argv);
-	for (int k = 0; k < 500 && !exists(join(dir, ".beamsim/journal")); k++)
-		sleep_for(0.002);
-	kill(pid, SIGINT);
-	int rc = bsim_test_wait(pid);
+	int pid = bsim_test_spawn(argv), rc = 0;
+	if (bsim_test_await_records(pid, bsim_test_join(dir, ".beamsim/journal"), 0, &rc)) {
+		kill(pid, SIGINT);
+		rc = bsim_test_wait(pid);
+	}
 	if (rc == 0) {
-		skip(); /* finished within the time it took to see the journal */
+		skip(); /* finished before it was seen to start */
 		return;
 	}
 	assert_int_equal(rc, 128 + SIGINT);

@@ -22,26 +22,6 @@
 	"  - { pivot: [25, 30], rest_angle_deg: 180, length: 25, mass: 0.1,\n"                     \
 	"      stiffness: 400 }\n"
 
-/* Runs argv and checks status 2 and that the single stderr line holds every
- * needle (NULL-terminated). */
-static void expect_input_error(const char *const argv[], const char *const needles[])
-{
-	char *out = NULL, *err = NULL;
-	int rc = bsim_test_cli(argv, &out, &err);
-	assert_non_null(err);
-	if (rc != 2)
-		fail_msg("exit status %d, stderr: %s", rc, err);
-	for (int i = 0; needles[i]; i++)
-		if (!strstr(err, needles[i]))
-			fail_msg("stderr \"%s\" lacks \"%s\"", err, needles[i]);
-	/* One message: libfyaml must not print diagnostics of its own. */
-	const char *nl = strchr(err, '\n');
-	if (!nl || nl[1] != '\0')
-		fail_msg("expected one line on stderr, got \"%s\"", err);
-	free(out);
-	free(err);
-}
-
 /* beamsim run on a scene file with the given text. */
 static void run_bad_scene(const char *name, const char *text, const char *const needles[])
 {
@@ -51,7 +31,7 @@ static void run_bad_scene(const char *name, const char *text, const char *const 
 	char path[1200];
 	snprintf(path, sizeof path, "%s", bsim_test_write(dir, file, text));
 	const char *argv[] = {"run", path, NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 }
 
 static void unknown_key(void **state)
@@ -202,14 +182,14 @@ static void bad_set_value(void **state)
 	const char *argv[] = {"run", path, "--set", "body.mass=-1", NULL};
 	const char *needles[] = {"--set body.mass=-1", "body.mass",
 	                         "expected a positive number, got -1", NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 	const char *argv2[] = {"run", path, "--set", "body.start=[1, 2", NULL};
 	const char *needles2[] = {"body.start=[1, 2", "body.start", "expected a YAML value", NULL};
-	expect_input_error(argv2, needles2);
+	bsim_test_expect_input_error(argv2, needles2);
 	const char *argv3[] = {"run", path, "--set", "beams.7.mass=1", NULL};
 	const char *needles3[] = {"beams.7.mass=1", "beams.7", "expected an index from 0 to 1",
 	                          NULL};
-	expect_input_error(argv3, needles3);
+	bsim_test_expect_input_error(argv3, needles3);
 }
 
 static void set_into_unknown_key(void **state)
@@ -221,12 +201,14 @@ static void set_into_unknown_key(void **state)
 	const char *needles[] = {"--set effects.random_force.magnitud=3",
 	                         "effects.random_force.magnitud",
 	                         "unknown key (expected one of magnitude, frequency)", NULL};
-	expect_input_error(argv, needles);
+	bsim_test_expect_input_error(argv, needles);
 }
 
 /* beamsim sweep on an experiment with the given text (next to a good
- * gate.yaml); the output directory must stay without results. */
-static void sweep_bad_experiment(const char *name, const char *text, const char *const needles[])
+ * gate.yaml), with --limit limit if it is not NULL; the output directory
+ * must stay without results. */
+static void sweep_bad_experiment_limit(const char *name, const char *text, const char *limit,
+                                       const char *const needles[])
 {
 	char dir[1024], exp[1200], out[1200];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir(name));
@@ -235,8 +217,10 @@ static void sweep_bad_experiment(const char *name, const char *text, const char 
 	snprintf(file, sizeof file, "%s.yaml", name);
 	snprintf(exp, sizeof exp, "%s", bsim_test_write(dir, file, text));
 	snprintf(out, sizeof out, "%s/out", dir);
-	const char *argv[] = {"sweep", exp, "--trials", "1", "--out", out, NULL};
-	expect_input_error(argv, needles);
+	const char *argv[] = {"sweep", exp, "--trials", "1", "--out", out, "--limit", limit, NULL};
+	if (!limit)
+		argv[6] = NULL;
+	bsim_test_expect_input_error(argv, needles);
 	char path[1300];
 	snprintf(path, sizeof path, "%s/summary.json", out);
 	char *summary = bsim_test_read(path);
@@ -244,6 +228,11 @@ static void sweep_bad_experiment(const char *name, const char *text, const char 
 	char *trials = bsim_test_read(path);
 	assert_null(summary);
 	assert_null(trials);
+}
+
+static void sweep_bad_experiment(const char *name, const char *text, const char *const needles[])
+{
+	sweep_bad_experiment_limit(name, text, NULL, needles);
 }
 
 static void empty_grid(void **state)
@@ -271,6 +260,23 @@ static void bad_grid_value(void **state)
 	                     "  effects.propulsion.force: [4, 5]\n"
 	                     "  body.mass: [1, -1]\n",
 	                     needles);
+}
+
+/* Each grid value is tried in one group before the product is counted or
+ * built: the 8th of 8 values of the slowest axis of 96,000 groups (the
+ * product, in order, builds 84,000 groups before it) is named although the
+ * limit of 100 groups would refuse the grid, and so with no more than 100
+ * groups' work; the message is the one the product gives. */
+static void grid_value_first(void **state)
+{
+	(void)state;
+	char *text = bsim_test_read(bsim_test_src(
+	        "tests/fuzz/regressions/experiment/bad_8th_value_of_96000_groups.yaml"));
+	assert_non_null(text);
+	const char *needles[] = {"grid_8th.yaml:5: ", "body.mass",
+	                         "expected a positive number, got -1", NULL};
+	sweep_bad_experiment_limit("grid_8th", text, "groups=100", needles);
+	free(text);
 }
 
 static void bad_experiment_keys(void **state)
@@ -325,7 +331,7 @@ static void grid_conflict(void **state)
 	const char *needles2[] = {"--set effects.propulsion.force=7",
 	                          "grid varies effects.propulsion.force (", "cli_grid.yaml:5)",
 	                          NULL};
-	expect_input_error(argv, needles2);
+	bsim_test_expect_input_error(argv, needles2);
 	snprintf(path, sizeof path, "%s/trials.csv", out);
 	char *trials = bsim_test_read(path);
 	assert_null(trials);
@@ -343,13 +349,13 @@ static void wrong_kind_of_file(void **state)
 	const char *run[] = {"run", exp, NULL};
 	const char *run_needles[] = {"h1_symmetric.yaml:2:1: scene: this is an experiment file",
 	                             "beamsim sweep or compare", NULL};
-	expect_input_error(run, run_needles);
+	bsim_test_expect_input_error(run, run_needles);
 	const char *sweep[] = {"sweep", scene, "--out", out, NULL};
 	const char *compare[] = {"compare", scene, "--out", out, NULL};
 	const char *scene_needles[] = {"gate.yaml:3:1: body: this is a scene file", "beamsim run",
 	                               NULL};
-	expect_input_error(sweep, scene_needles);
-	expect_input_error(compare, scene_needles);
+	bsim_test_expect_input_error(sweep, scene_needles);
+	bsim_test_expect_input_error(compare, scene_needles);
 }
 
 int main(void)
@@ -365,7 +371,7 @@ int main(void)
 	        cmocka_unit_test(bad_set_value),       cmocka_unit_test(set_into_unknown_key),
 	        cmocka_unit_test(empty_grid),          cmocka_unit_test(bad_grid_value),
 	        cmocka_unit_test(bad_experiment_keys), cmocka_unit_test(grid_conflict),
-	        cmocka_unit_test(wrong_kind_of_file),
+	        cmocka_unit_test(wrong_kind_of_file),  cmocka_unit_test(grid_value_first),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

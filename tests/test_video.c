@@ -19,12 +19,10 @@
 #include <cmocka.h>
 
 #include <dirent.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "beamsim/backend.h"
@@ -35,41 +33,6 @@
 
 /* The gate scene's time step, s (configs/thesis/gate.yaml). */
 #define GATE_DT 0.004
-
-/* Runs a program looked up on PATH with stdout into *out (may be NULL)
- * and stderr discarded; returns its exit status. */
-static int run_program(const char *const argv[], char **out)
-{
-	FILE *fo = tmpfile();
-	assert_non_null(fo);
-	fflush(NULL);
-	pid_t pid = fork();
-	if (pid == 0) {
-		dup2(fileno(fo), 1);
-		int null = open("/dev/null", O_RDWR);
-		dup2(null, 2);
-		dup2(null, 0);
-		execvp(argv[0], (char *const *)argv);
-		_exit(127);
-	}
-	int status = 0;
-	waitpid(pid, &status, 0);
-	if (out) {
-		rewind(fo);
-		size_t cap = 1 << 16, len = 0;
-		char *buf = malloc(cap);
-		size_t k;
-		while ((k = fread(buf + len, 1, cap - len - 1, fo)) > 0) {
-			len += k;
-			if (len + 1 == cap)
-				buf = realloc(buf, cap *= 2);
-		}
-		buf[len] = '\0';
-		*out = buf;
-	}
-	fclose(fo);
-	return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 typedef struct probe {
 	char codec[32], pix_fmt[32], format[128];
@@ -108,7 +71,7 @@ static void ffprobe(const char *path, probe *p)
 	                      path,
 	                      NULL};
 	char *out = NULL;
-	assert_int_equal(run_program(argv, &out), 0);
+	assert_int_equal(bsim_test_run(argv, &out), 0);
 	char text[4096], v[128];
 	snprintf(text, sizeof text, "\n%s", out);
 	free(out);
@@ -376,7 +339,7 @@ static void cli_field_mp4_follows_the_body(void **state)
 	assert_int_equal(p.frames, frames);
 	const char *dec[] = {"ffmpeg",   "-v",       "error", "-i", out, "-f",
 	                     "rawvideo", "-pix_fmt", "rgb24", "-y", raw, NULL};
-	assert_int_equal(run_program(dec, NULL), 0);
+	assert_int_equal(bsim_test_run(dec, NULL), 0);
 	const int w = 320, h = 240;
 	FILE *f = fopen(raw, "rb");
 	assert_non_null(f);

@@ -1,7 +1,9 @@
 /* Experiment files (DESIGN.md "Experiment file"): a scene, fixed overrides,
  * a grid whose cartesian product is the groups (first axis slowest), trials
  * per group and a seed. Every group's scene is built and validated at load,
- * so a bad grid value fails before any trial runs. */
+ * so a bad grid value fails before any trial runs; each value is tried
+ * first in one group of its own, so a bad one is named before the product
+ * is counted or expanded. */
 #include "beamsim/experiment.h"
 
 #include <errno.h>
@@ -124,8 +126,9 @@ static int walk_axis(const ydoc *d, struct fy_node *k, struct fy_node *v, bsim_g
 	return BSIM_OK;
 }
 
-/* The groups are the cartesian product of the axes; at least one axis with
- * at least one value, and a count that fits an int. */
+/* The groups are the cartesian product of the axes: at least one axis
+ * with at least one value (their count is checked by check_counts, once
+ * the values have been). */
 static int walk_grid(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim_experiment *e,
                      bsim_error *err)
 {
@@ -137,22 +140,6 @@ static int walk_grid(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim
 	e->axes = calloc((size_t)count, sizeof *e->axes);
 	if (!e->axes)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
-	/* Counted before any axis is walked: a few hundred bytes of lists can
-	 * ask for 10^9 groups, each a scene to build and check. */
-	double groups = 1, limit = bsim_limits_get()->groups;
-	for (int i = 0; i < count; i++) {
-		struct fy_node *v = fy_node_pair_value(fy_node_mapping_get_by_index(n, i));
-		groups *= v && fy_node_is_sequence(v) ? fy_node_sequence_item_count(v) : 1;
-	}
-	if (groups > limit || groups > INT_MAX) {
-		char hint[160];
-		bsim_limits_hint(hint, sizeof hint, "groups", limit);
-		return ydoc_fail(
-		        d, n, key, "grid", err,
-		        "expected at most %.15g groups (the product of the lists' lengths), "
-		        "got %.15g (%s)",
-		        limit < INT_MAX ? limit : INT_MAX, groups, hint);
-	}
 	for (int i = 0; i < count; i++) {
 		struct fy_node_pair *p = fy_node_mapping_get_by_index(n, i);
 		int rc = walk_axis(d, fy_node_pair_key(p), fy_node_pair_value(p), &e->axes[i], err);
@@ -160,7 +147,6 @@ static int walk_grid(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim
 		if (rc)
 			return rc;
 	}
-	e->n_groups = (int)groups;
 	return BSIM_OK;
 }
 
@@ -230,6 +216,29 @@ static int walk_experiment(const ydoc *d, bsim_experiment *e, bsim_error *err)
 		if (!ydoc_pair(root, required[i], strlen(required[i])))
 			return ydoc_fail(d, root, NULL, required[i], err, "missing (expected %s)",
 			                 phrase[i]);
+	return BSIM_OK;
+}
+
+/* The product of the lists' lengths within the limit groups (a few hundred
+ * bytes of lists can ask for 10^9 groups, each a scene to build and check)
+ * and an int, then groups x trials within the limit trials. */
+static int check_counts(const ydoc *d, bsim_experiment *e, bsim_error *err)
+{
+	struct fy_node *root = fy_document_root(d->fyd);
+	double groups = 1, limit = bsim_limits_get()->groups;
+	for (int a = 0; a < e->n_axes; a++)
+		groups *= e->axes[a].n_values;
+	if (groups > limit || groups > INT_MAX) {
+		struct fy_node_pair *gp = ydoc_pair(root, "grid", 4);
+		char hint[160];
+		bsim_limits_hint(hint, sizeof hint, "groups", limit);
+		return ydoc_fail(
+		        d, fy_node_pair_value(gp), fy_node_pair_key(gp), "grid", err,
+		        "expected at most %.15g groups (the product of the lists' lengths), "
+		        "got %.15g (%s)",
+		        limit < INT_MAX ? limit : INT_MAX, groups, hint);
+	}
+	e->n_groups = (int)groups;
 	bsim_error why;
 	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK) {
 		struct fy_node_pair *tp = ydoc_pair(root, "trials", 6);
@@ -262,18 +271,13 @@ void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx)
 
 /* set, then extra (the command line), then the group's grid values: later
  * overrides win. The strings are borrowed from e and extra. */
-static bsim_override *group_overrides(const bsim_experiment *e, int g, const bsim_override *extra,
-                                      int n_extra, int *n)
+static bsim_override *group_overrides(const bsim_experiment *e, const int *idx,
+                                      const bsim_override *extra, int n_extra, int *n)
 {
 	*n = e->n_set + n_extra + e->n_axes;
 	bsim_override *ov = malloc((size_t)(*n ? *n : 1) * sizeof *ov);
-	int *idx = malloc((size_t)(e->n_axes ? e->n_axes : 1) * sizeof *idx);
-	if (!ov || !idx) {
-		free(ov);
-		free(idx);
+	if (!ov)
 		return NULL;
-	}
-	bsim_experiment_group_index(e, g, idx);
 	for (int i = 0; i < e->n_set; i++)
 		ov[i] = e->set[i];
 	for (int i = 0; i < n_extra; i++)
@@ -283,19 +287,31 @@ static bsim_override *group_overrides(const bsim_experiment *e, int g, const bsi
 		ov[e->n_set + n_extra + a] =
 		        (bsim_override){ax->key, ax->values[idx[a]], ax->origins[idx[a]]};
 	}
-	free(idx);
 	return ov;
+}
+
+/* The scene of the group with value index idx[a] on each axis. */
+static int load_at(const ydoc *scene, const bsim_experiment *e, const int *idx,
+                   const bsim_override *extra, int n_extra, bsim_scene *out, bsim_error *err)
+{
+	int n = 0;
+	bsim_override *ov = group_overrides(e, idx, extra, n_extra, &n);
+	if (!ov)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
+	int rc = scene_load_parsed(scene, ov, n, out, err);
+	free(ov);
+	return rc;
 }
 
 static int load_group(const ydoc *scene, const bsim_experiment *e, int g,
                       const bsim_override *extra, int n_extra, bsim_scene *out, bsim_error *err)
 {
-	int n = 0;
-	bsim_override *ov = group_overrides(e, g, extra, n_extra, &n);
-	if (!ov)
+	int *idx = malloc((size_t)(e->n_axes ? e->n_axes : 1) * sizeof *idx);
+	if (!idx)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
-	int rc = scene_load_parsed(scene, ov, n, out, err);
-	free(ov);
+	bsim_experiment_group_index(e, g, idx);
+	int rc = load_at(scene, e, idx, extra, n_extra, out, err);
+	free(idx);
 	return rc;
 }
 
@@ -353,19 +369,51 @@ static int check_conflicts(const bsim_experiment *e, const bsim_override *extra,
 	return BSIM_OK;
 }
 
-/* Reads the scene file once and builds every group's scene from it. */
-static int check_groups(const bsim_experiment *e, const bsim_override *extra, int n_extra,
-                        bsim_error *err)
+/* Each grid value in one group before the product is counted or expanded:
+ * the first group, then every other value of each axis with the other axes
+ * at their first. A value bad in itself is bad in every group that holds
+ * it, and the first of those in group order is this one's: taken fastest
+ * axis first, values in order (the order of their group numbers), the
+ * first bad value found is the one the whole product would have named
+ * first, with the same message. At most 1 + sum(n_values - 1) scenes, which
+ * is at most the number of groups: beyond the limit groups, check_counts
+ * refuses without them. */
+static int check_values(const ydoc *scene, const bsim_experiment *e, const bsim_override *extra,
+                        int n_extra, bsim_error *err)
 {
-	ydoc scene;
-	int rc = ydoc_load(&scene, e->scene_path, err);
+	double scenes = 1;
+	for (int a = 0; a < e->n_axes; a++)
+		scenes += e->axes[a].n_values - 1;
+	if (scenes > bsim_limits_get()->groups)
+		return BSIM_OK;
+	int *idx = calloc((size_t)(e->n_axes ? e->n_axes : 1), sizeof *idx);
+	if (!idx)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
+	bsim_scene s;
+	int rc = load_at(scene, e, idx, extra, n_extra, &s, err);
+	bsim_scene_free(&s);
+	for (int a = e->n_axes - 1; !rc && a >= 0; a--) {
+		for (int i = 1; !rc && i < e->axes[a].n_values; i++) {
+			idx[a] = i;
+			rc = load_at(scene, e, idx, extra, n_extra, &s, err);
+			bsim_scene_free(&s);
+		}
+		idx[a] = 0;
+	}
+	free(idx);
+	return rc;
+}
+
+/* Builds every group's scene from the scene file read once. */
+static int check_groups(const ydoc *scene, const bsim_experiment *e, const bsim_override *extra,
+                        int n_extra, bsim_error *err)
+{
+	int rc = BSIM_OK;
 	for (int g = 0; !rc && g < e->n_groups; g++) {
 		bsim_scene s;
-		rc = load_group(&scene, e, g, extra, n_extra, &s, err);
+		rc = load_group(scene, e, g, extra, n_extra, &s, err);
 		bsim_scene_free(&s);
 	}
-	if (scene.fyd)
-		ydoc_free(&scene);
 	return rc;
 }
 
@@ -378,16 +426,24 @@ int bsim_experiment_load(const char *path, const bsim_override *extra, int n_ext
 		                      "%s: expected a path shorter than %zu characters", path,
 		                      sizeof out->path);
 	snprintf(out->path, sizeof out->path, "%s", path);
-	ydoc d;
+	ydoc d, scene = {0};
 	int rc = ydoc_load(&d, out->path, err);
 	if (rc)
 		return rc;
 	rc = walk_experiment(&d, out, err);
+	if (!rc)
+		rc = ydoc_load(&scene, out->scene_path, err);
+	if (!rc)
+		rc = check_values(&scene, out, extra, n_extra, err);
+	if (!rc)
+		rc = check_counts(&d, out, err);
 	ydoc_free(&d);
 	if (!rc)
 		rc = check_conflicts(out, extra, n_extra, err);
 	if (!rc)
-		rc = check_groups(out, extra, n_extra, err);
+		rc = check_groups(&scene, out, extra, n_extra, err);
+	if (scene.fyd)
+		ydoc_free(&scene);
 	if (rc)
 		bsim_experiment_free(out);
 	return rc;
