@@ -12,6 +12,7 @@
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
+#include "beamsim/limits.h"
 
 #define ACC_SCENE "configs/thesis/gate.yaml"
 
@@ -143,7 +144,7 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 	cli_progress_init(&progress, 1, "settings");
 	cfg.progress = cli_progress_update;
 	cfg.progress_user = &progress;
-	char label[1200];
+	char label[BSIM_PATH_MAX];
 	snprintf(label, sizeof label, "%s%s", a->scene,
 	         a->scene_given ? "" : " (propulsion 9 N, random force 20 N)");
 	bsim_accuracy_result r;

@@ -13,6 +13,7 @@
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
+#include "beamsim/limits.h"
 
 enum { OWN_BACKENDS, OWN_PROTOCOLS, OWN_EXAMPLES };
 
@@ -257,7 +258,7 @@ int cmd_compare(int argc, char **argv)
 		if (!c.quiet)
 			compare_summary(&def, c.out, &res);
 		for (int i = 0; i < 2; i++) {
-			char where[1200];
+			char where[BSIM_PATH_MAX];
 			snprintf(where, sizeof where, "%s/%s/summary.json", c.out, res.dir[i]);
 			cli_solver_warning(def.side[i].backend->name, &res.solver[i], where);
 		}

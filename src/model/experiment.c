@@ -28,7 +28,7 @@ static char *dup_text(const char *t)
 /* "EXPFILE:LINE" of a value: the origin its override carries. */
 static char *value_origin(const ydoc *d, struct fy_node *n, struct fy_node *key)
 {
-	char buf[1100];
+	char buf[BSIM_PATH_MAX];
 	snprintf(buf, sizeof buf, "%s:%d", d->path, ydoc_line(n, key));
 	return dup_text(buf);
 }
@@ -53,7 +53,7 @@ static int walk_scene_path(const ydoc *d, struct fy_node *n, struct fy_node *key
 		return ydoc_expected(d, n, key, "scene", "a shorter path", err);
 	FILE *f = fopen(e->scene_path, "rb");
 	if (!f) {
-		char what[1200];
+		char what[BSIM_PATH_MAX];
 		snprintf(what, sizeof what, "a readable scene file (%s: %s)", e->scene_path,
 		         strerror(errno));
 		return ydoc_expected(d, n, key, "scene", what, err);
