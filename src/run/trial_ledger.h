@@ -1,0 +1,94 @@
+/* Internal: the energy ledger of a trial (trial.h bsim_ledger, MODEL.md
+ * section 10) and the two tests that find a trial's numbers untrustworthy
+ * (bsim_instability). The runner calls the energies, the ledger's step and
+ * the finiteness test every step: they are inline, so that its loop makes
+ * no call for them.
+ *
+ * The energies visit only the beams the backend lists as active
+ * (bsim_state.active: the others are exactly at rest), so in a lattice they
+ * cost what the beams near the body cost. Summed over the active beams in
+ * ascending order they are the sums over all beams to the bit (a beam at
+ * rest adds +0). */
+#ifndef BSIM_TRIAL_LEDGER_H
+#define BSIM_TRIAL_LEDGER_H
+
+#include <math.h>
+
+#include "beamsim/effects.h"
+#include "beamsim/trial.h"
+#include "util/fminmax.h"
+
+/* Kinetic energy of body and beams, J. Beams at rest add nothing. */
+static inline double energy_kinetic(const bsim_scene *sc, const bsim_state *s)
+{
+	double e = 0.5 * sc->body.mass * (s->v[0] * s->v[0] + s->v[1] * s->v[1]);
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k];
+		e += 0.5 * sc->beams[i].inertia * s->omega[i] * s->omega[i];
+	}
+	return e;
+}
+
+/* Elastic energy of the beam springs, J. */
+static inline double energy_springs(const bsim_scene *sc, const bsim_state *s)
+{
+	double e = 0.0;
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k];
+		e += 0.5 * sc->beams[i].stiffness * s->theta[i] * s->theta[i];
+	}
+	return e;
+}
+
+/* The ledger's E: kinetic plus elastic, J. */
+static inline double energy_mech(const bsim_scene *sc, const bsim_state *s)
+{
+	return energy_kinetic(sc, s) + energy_springs(sc, s);
+}
+
+/* Whether every number of s that can move is finite (one sum: a NaN or an
+ * infinity anywhere makes it non-finite). */
+static inline int state_finite(const bsim_state *s)
+{
+	double sum = s->x[0] + s->x[1] + s->v[0] + s->v[1];
+	for (int k = 0; k < s->n_active; k++)
+		sum += s->theta[s->active[k]] + s->omega[s->active[k]];
+	return isfinite(sum);
+}
+
+/* One step's entry in the ledger, s0 -> s1 with energies e0 -> e1: the work
+ * of each force over the body's displacement, the backend's losses, and
+ * what is left over. */
+static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state *s0,
+                               const bsim_state *s1, double e0, double e1)
+{
+	const double d[2] = {s1->x[0] - s0->x[0], s1->x[1] - s0->x[1]};
+	double w_prop = 0.0, w_rand = 0.0;
+	for (int i = 0; i < fx->n; i++) {
+		double work = fx->e[i].last * d[fx->e[i].axis];
+		if (&fx->e[i] == fx->random)
+			w_rand += work;
+		else
+			w_prop += work;
+	}
+	const bsim_step_energy *se = &s1->energy;
+	double r = (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -
+	                        se->correction - se->sleep);
+	l->w_prop += w_prop;
+	l->w_rand += w_rand;
+	l->damper += se->damper;
+	l->impact += se->impact;
+	l->contact += se->contact;
+	l->correction += se->correction;
+	l->sleep += se->sleep;
+	l->residual += r;
+	l->residual_abs += fabs(r);
+	l->residual_max = bsim_fmax(l->residual_max, fabs(r));
+	l->inflow += fabs(w_prop) + fabs(w_rand);
+}
+
+/* The ledger's close after step n, the energy e_end: an ordinary result
+ * whose residual exceeds the bound becomes unstable (energy created). */
+void trial_ledger_close(bsim_trial_result *out, double e_end, long n);
+
+#endif

@@ -1,0 +1,110 @@
+/* Internal: what a trial remembers of the beams beyond their state (trial.c
+ * keeps one per runner): every beam's peak angle (trials.csv's max_theta,
+ * the log's peaks) and the beams touching the body at the last step before
+ * success_y at which any did (for the landscape label of a traversal).
+ * The runner updates both every step: those updates are inline.
+ *
+ * Beams are the scene's: under the essay's protocol the world's beam i is
+ * the scene's map[i] (map NULL: the same). */
+#ifndef BSIM_TRIAL_PEAKS_H
+#define BSIM_TRIAL_PEAKS_H
+
+#include "beamsim/scene.h"
+#include "beamsim/state.h"
+#include "util/fminmax.h"
+
+typedef struct trial_peaks {
+	double *peak;  /* per beam of the scene, rad */
+	int *negative; /* beams whose peak is still below 0 */
+	int n_negative;
+	int cap; /* beams the arrays hold */
+	/* The last touching step before success_y: where the body was, and per
+	 * beam of the scene its contacts then (all zero between trials:
+	 * trial_peaks_start clears what the last trial set). */
+	int touched; /* the body touched a beam at all */
+	double last_touch[2];
+	int *touching;
+	int *touch_list; /* the beams touching[] holds non-zero */
+	int n_touch;
+} trial_peaks;
+
+/* Room for a scene of n_beams beams. */
+int trial_peaks_reserve(trial_peaks *p, int n_beams);
+void trial_peaks_free(trial_peaks *p);
+
+/* Peaks at the initial angles s0 (map: every beam of the scene starts at
+ * rest), no contact yet. */
+void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
+                       const bsim_state *s0);
+
+/* The landscape label of a traversal: the beam whose barrier the body
+ * crossed (bsim_landscape_label at the last touching step), -1 if it
+ * touched none. */
+int trial_peaks_label(const trial_peaks *p, const bsim_scene *scene);
+
+static inline int scene_beam(const int *map, int i)
+{
+	return map ? map[i] : i;
+}
+
+/* Every beam's peak theta over the steps so far, s the state after the
+ * latest: the active beams, beams 0 and 1 (trials.csv's two columns), and
+ * any beam whose peak is still below 0 (a beam at rest has theta 0). */
+static inline void trial_peaks_update(trial_peaks *p, const bsim_scene *scene, const int *map,
+                                      const bsim_state *s)
+{
+	double *peak = p->peak;
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k], g = scene_beam(map, i);
+		peak[g] = bsim_fmax(peak[g], s->theta[i]);
+	}
+	if (!map)
+		for (int i = 0; i < 2 && i < scene->n_beams; i++)
+			peak[i] = bsim_fmax(peak[i], s->theta[i]);
+	int m = 0; /* only without a map: the essay's beams all start at rest */
+	for (int k = 0; k < p->n_negative; k++) {
+		int i = p->negative[k];
+		peak[i] = bsim_fmax(peak[i], s->theta[i]);
+		if (peak[i] < 0.0)
+			p->negative[m++] = i;
+	}
+	p->n_negative = m;
+}
+
+static inline int any_contact(const bsim_state *s)
+{
+	for (int k = 0; k < s->n_active; k++)
+		if (s->contact[s->active[k]])
+			return 1;
+	return 0;
+}
+
+static inline void touching_clear(trial_peaks *p)
+{
+	for (int k = 0; k < p->n_touch; k++)
+		p->touching[p->touch_list[k]] = 0;
+	p->n_touch = 0;
+}
+
+/* If the body touches a beam in s: where it is and the contacts of s in
+ * touching[], as a copy of the whole contact array would leave it, at the
+ * cost of the beams listed. */
+static inline void trial_peaks_contacts(trial_peaks *p, const int *map, const bsim_state *s)
+{
+	if (!any_contact(s))
+		return;
+	p->touched = 1;
+	p->last_touch[0] = s->x[0];
+	p->last_touch[1] = s->x[1];
+	touching_clear(p);
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k];
+		if (!s->contact[i])
+			continue;
+		int g = scene_beam(map, i);
+		p->touching[g] = s->contact[i];
+		p->touch_list[p->n_touch++] = g;
+	}
+}
+
+#endif
