@@ -1,6 +1,6 @@
 /* Internal: the essay's lattice protocol for the runner (trial.c). */
-#ifndef BSIM_TRIAL_ESSAY_H
-#define BSIM_TRIAL_ESSAY_H
+#ifndef BSIM_RUN_TRIAL_ESSAY_H
+#define BSIM_RUN_TRIAL_ESSAY_H
 
 #include "beamsim/backend.h"
 #include "beamsim/scene.h"

@@ -2,8 +2,8 @@
  * lattice.h), followed step by step, and the path of gates it entered
  * (bsim_gate_entry, the trial log). A scene without a lattice is one gate,
  * (0, 0). */
-#ifndef BSIM_TRIAL_GATES_H
-#define BSIM_TRIAL_GATES_H
+#ifndef BSIM_RUN_TRIAL_GATES_H
+#define BSIM_RUN_TRIAL_GATES_H
 
 #include "beamsim/trial.h"
 

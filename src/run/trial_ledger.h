@@ -9,8 +9,8 @@
  * cost what the beams near the body cost. Summed over the active beams in
  * ascending order they are the sums over all beams to the bit (a beam at
  * rest adds +0). */
-#ifndef BSIM_TRIAL_LEDGER_H
-#define BSIM_TRIAL_LEDGER_H
+#ifndef BSIM_RUN_TRIAL_LEDGER_H
+#define BSIM_RUN_TRIAL_LEDGER_H
 
 #include <math.h>
 

@@ -1,6 +1,6 @@
 /* Internal: how the runner fills a trial's log (trial.h bsim_trial_log). */
-#ifndef BSIM_TRIAL_LOG_H
-#define BSIM_TRIAL_LOG_H
+#ifndef BSIM_RUN_TRIAL_LOG_H
+#define BSIM_RUN_TRIAL_LOG_H
 
 #include "beamsim/trial.h"
 

@@ -1,7 +1,7 @@
 /* Internal: how deep the body overlaps the beams (bsim_recorder.overlap,
  * the trial's overlap_max), from the beams' shapes taken once per world. */
-#ifndef BSIM_TRIAL_OVERLAP_H
-#define BSIM_TRIAL_OVERLAP_H
+#ifndef BSIM_RUN_TRIAL_OVERLAP_H
+#define BSIM_RUN_TRIAL_OVERLAP_H
 
 #include "beamsim/scene.h"
 #include "beamsim/state.h"

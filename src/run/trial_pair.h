@@ -1,7 +1,7 @@
 /* Internal: one trial run on two backends with the same schedule, and the
  * time at which their body trajectories first separate (beamsim compare). */
-#ifndef BSIM_TRIAL_PAIR_H
-#define BSIM_TRIAL_PAIR_H
+#ifndef BSIM_RUN_TRIAL_PAIR_H
+#define BSIM_RUN_TRIAL_PAIR_H
 
 #include <stdint.h>
 

@@ -6,8 +6,8 @@
  *
  * Beams are the scene's: under the essay's protocol the world's beam i is
  * the scene's map[i] (map NULL: the same). */
-#ifndef BSIM_TRIAL_PEAKS_H
-#define BSIM_TRIAL_PEAKS_H
+#ifndef BSIM_RUN_TRIAL_PEAKS_H
+#define BSIM_RUN_TRIAL_PEAKS_H
 
 #include "beamsim/scene.h"
 #include "beamsim/state.h"

@@ -1,7 +1,7 @@
 /* Internal: a trial's recorded rows to the recorder's sinks (trial.h
  * bsim_recorder), every stride-th step and the last. */
-#ifndef BSIM_TRIAL_RECORD_H
-#define BSIM_TRIAL_RECORD_H
+#ifndef BSIM_RUN_TRIAL_RECORD_H
+#define BSIM_RUN_TRIAL_RECORD_H
 
 #include "beamsim/trial.h"
 
