@@ -14,6 +14,7 @@
 #include "beamsim/report.h"
 #include "beamsim/run_record.h"
 #include "store/session.h"
+#include "store/rerun.h"
 #include "store/store.h"
 #include "beamsim/limits.h"
 

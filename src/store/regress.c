@@ -16,6 +16,7 @@
 #include "beamsim/version.h"
 #include "util/json.h"
 #include "store/session.h"
+#include "store/rerun.h"
 #include "store/store.h"
 #include "beamsim/limits.h"
 

@@ -1,16 +1,15 @@
 /* What the stored runs (sweep_dir.c, compare_dir.c, regress.c) write alike:
  * a sweep's files in a directory, MATLAB twins, text files written by a
- * function, and the count of unstable trials. */
+ * function, and the count of unstable trials. The reruns regress asks of
+ * the stored sweeps and comparisons are in store/rerun.h. */
 #ifndef BSIM_STORE_STORE_H
 #define BSIM_STORE_STORE_H
 
 #include <stdio.h>
 
 #include "beamsim/backend.h"
-#include "beamsim/compare_dir.h"
 #include "beamsim/experiment.h"
 #include "beamsim/sweep.h"
-#include "beamsim/sweep_dir.h"
 
 /* dir/summary.json, trials.csv, trajectories.csv when trajectories were
  * kept (a stale one of an earlier run is removed, so a directory never
@@ -38,14 +37,5 @@ long bsim_store_unstable(const bsim_experiment *e, const bsim_override *extra, i
  * limit). */
 int bsim_store_experiment(const char *path, const bsim_override *sets, int n_sets, long trials,
                           bsim_experiment *e, bsim_error *err);
-
-/* A stored run repeated (beamsim/regress.h) into the staging area stage:
- * the loaded experiment e as it is (its set: holds the original run's
- * overrides, def's sets and seed are not applied), no journal. The
- * comparison's result holds no experiment. */
-int bsim_store_sweep_rerun(const bsim_sweep_dir_def *def, const bsim_experiment *e,
-                           const char *stage, bsim_sweep_result *r, bsim_error *err);
-int bsim_store_compare_rerun(const bsim_compare_dir_def *def, const bsim_experiment *e,
-                             const char *stage, bsim_compare_dir_result *res, bsim_error *err);
 
 #endif

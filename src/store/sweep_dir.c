@@ -17,6 +17,7 @@
 #include "beamsim/output.h"
 #include "beamsim/run_record.h"
 #include "store/session.h"
+#include "store/rerun.h"
 #include "store/store.h"
 #include "beamsim/limits.h"
 
