@@ -342,8 +342,8 @@ int cli_run_end(int rc, const char *journal, int argc, char **argv)
 	}
 	if (rc != BSIM_OK && journal[0]) {
 		fprintf(stderr,
-		        "beamsim: the finished trials are kept in %s; to write the files "
-		        "again: ",
+		        "beamsim: the finished trials are kept in %s; to continue once the "
+		        "cause is fixed: ",
 		        journal);
 		resume_line(stderr, argc, argv);
 		fputc('\n', stderr);

@@ -285,7 +285,7 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 	char path[BSIM_PATH_MAX], sub[BSIM_PATH_MAX], out[BSIM_PATH_MAX], inputs[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/report.json", dir);
 	ydoc d;
-	int rc = ydoc_load(&d, path, err);
+	int rc = ydoc_load_own(&d, path, err);
 	if (rc)
 		return rc;
 	struct fy_node *root = fy_document_root(d.fyd);

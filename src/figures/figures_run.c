@@ -34,7 +34,7 @@ static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *ty
 	if (!*found)
 		return BSIM_OK;
 	ydoc d;
-	int rc = ydoc_load(&d, path, err);
+	int rc = ydoc_load_own(&d, path, err);
 	if (rc)
 		return rc;
 	struct fy_node *root = fy_document_root(d.fyd);

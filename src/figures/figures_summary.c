@@ -153,7 +153,7 @@ int fsum_read(const char *path, fsum *s, bsim_error *err)
 {
 	memset(s, 0, sizeof *s);
 	ydoc d;
-	int rc = ydoc_load(&d, path, err);
+	int rc = ydoc_load_own(&d, path, err);
 	if (rc)
 		return rc;
 	struct fy_node *root = fy_document_root(d.fyd);

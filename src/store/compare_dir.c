@@ -83,6 +83,7 @@ typedef struct compare_job {
 	bsim_override protocol_b; /* side b's protocol, after the sets */
 	const char *out;          /* the staging area */
 	bsim_journal *journal;    /* NULL: none */
+	int *done;                /* NULL, or set to 1 once every pair is journaled */
 	bsim_run_record rec;
 } compare_job;
 
@@ -211,6 +212,8 @@ static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, b
 	                               &t_sep, err);
 	if (rc != BSIM_OK)
 		return rc;
+	if (job->done)
+		*job->done = 1;
 	res->solver[0] = r[0].solver;
 	res->solver[1] = r[1].solver;
 	rc = bsim_compare_analyse(&r[0], &r[1], t_sep, &def->rule, &res->cmp, err);
@@ -330,6 +333,7 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 		res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
 		job.out = ss.stage;
 		job.journal = ss.journal;
+		job.done = &ss.done;
 		rc = compare_pairs(&job, res, err);
 		int kept = 0;
 		rc = bsim_session_close(&ss, rc, "compare", &kept, err);

@@ -386,7 +386,7 @@ int bsim_matlab_from_json(const char *json_path, const char *mat_path, const cha
                           bsim_error *err)
 {
 	ydoc d;
-	int rc = ydoc_load(&d, json_path, err);
+	int rc = ydoc_load_own(&d, json_path, err);
 	if (rc)
 		return rc;
 	arena a = {0};

@@ -355,7 +355,7 @@ static int manifest_read(const char *dir, olist *l, int *has, bsim_error *err)
 	if (join(path, sizeof path, dir, BSIM_OUTDIR_MANIFEST) || stat(path, &st) != 0)
 		return BSIM_OK;
 	ydoc d;
-	if (ydoc_load(&d, path, err) != BSIM_OK)
+	if (ydoc_load_own(&d, path, err) != BSIM_OK)
 		return BSIM_EINPUT;
 	*has = 1;
 	struct fy_node *files = ydoc_lookup(fy_document_root(d.fyd), "files");

@@ -293,7 +293,7 @@ int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 	memset(rec, 0, sizeof *rec);
 	if (path_join(path, sizeof path, dir, "run.json", err))
 		return BSIM_EINPUT;
-	if (ydoc_load(&d, path, err) != BSIM_OK) {
+	if (ydoc_load_own(&d, path, err) != BSIM_OK) {
 		char msg[sizeof err->msg];
 		snprintf(msg, sizeof msg, "%s", err->msg);
 		return bsim_error_set(err, BSIM_EINPUT,

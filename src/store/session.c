@@ -77,7 +77,8 @@ int bsim_session_close(bsim_session *s, int rc, const char *command, int *kept, 
 			rc = BSIM_EFAIL;
 			keep = 1; /* the trials are done: a resumed run writes the files again */
 		}
-	} else if (rc == BSIM_ESTOPPED) {
+	} else if (rc == BSIM_ESTOPPED || s->done ||
+	           (s->journal && bsim_journal_failed(s->journal))) {
 		keep = 1;
 	}
 	/* A journal this session did not open (another run's, refused) is never

@@ -19,7 +19,8 @@ typedef struct bsim_session {
 	bsim_outdir *od;
 	bsim_journal *journal;
 	char journal_path[BSIM_PATH_MAX];
-	int add; /* set before closing: the files join DIR's set (bsim_outdir_add) */
+	int add;  /* set before closing: the files join DIR's set (bsim_outdir_add) */
+	int done; /* set once every trial is journaled: a later failure keeps the journal */
 } bsim_session;
 
 /* Opens dir (BSIM_EINPUT if it cannot be used) and, if inputs is not NULL,
@@ -32,11 +33,15 @@ int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *
 /* Ends the session with the run's status rc (err holding its message if
  * rc is not BSIM_OK): if BSIM_OK, commits the files (and removes the
  * journal once they are in place; a failed commit keeps it, so a resumed
- * run writes the files again); if the run was stopped (BSIM_ESTOPPED),
- * keeps the journal; after any other failure (a trial that failed fails
- * again when resumed) removes it. Returns the final status, with err
- * naming files by their place in dir, not in the staging area; *kept (may
- * be NULL) is 1 if the journal was kept, its path in s->journal_path. */
+ * run writes the files again). Finished work is never thrown away: the
+ * journal is kept if the run was stopped (BSIM_ESTOPPED), if it failed
+ * after its trials were done (s->done: writing the files, a full disk),
+ * or if the journal itself could not be written (a full disk: what was
+ * appended before is kept). Only after a trial that failed (it fails again
+ * when resumed) is it removed. The staging area is always discarded.
+ * Returns the final status, with err naming files by their place in dir,
+ * not in the staging area; *kept (may be NULL) is 1 if the journal was
+ * kept, its path in s->journal_path. */
 int bsim_session_close(bsim_session *s, int rc, const char *command, int *kept, bsim_error *err);
 
 /* "dir/name" into buf; BSIM_EFAIL naming both if it does not fit. */

@@ -101,6 +101,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	};
 	rc = bsim_sweep_run(e, &cfg, &res->r, err);
 	if (rc == BSIM_OK) {
+		ss.done = 1;
 		rc = bsim_store_sweep_files(ss.stage, e, b, &def->opts, def->sets, def->n_sets,
 		                            &res->r, err);
 		if (rc == BSIM_OK)

@@ -26,7 +26,7 @@ struct bsim_journal {
 	unsigned char *buf; /* one encoded record */
 	pthread_mutex_t lock;
 	double last_sync; /* s, monotonic */
-	int failed;       /* an append failed: refuse the rest */
+	int failed;       /* the errno of the append that failed: the rest are refused with it */
 	char path[BSIM_PATH_MAX];
 };
 
@@ -272,7 +272,7 @@ int bsim_journal_replay(bsim_journal *j, bsim_journal_fn fn, void *user, long *n
 	if (!e && (flags < 0 || fcntl(j->fd, F_SETFL, flags | O_APPEND) != 0))
 		e = errno;
 	if (e) {
-		j->failed = 1;
+		j->failed = e;
 		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot continue the journal: %s",
 		                      j->path, strerror(e));
 	}
@@ -285,7 +285,9 @@ int bsim_journal_append(bsim_journal *j, uint64_t index, const void *payload, bs
 	int e = 0;
 	pthread_mutex_lock(&j->lock);
 	if (j->failed) {
-		e = EIO;
+		/* The cause, not a generic I/O error: which thread's append is
+		 * reported is up to the caller (a sweep names the lowest trial). */
+		e = j->failed;
 	} else {
 		memcpy(j->buf, &m, 4);
 		memcpy(j->buf + 4, &index, 8);
@@ -299,7 +301,7 @@ int bsim_journal_append(bsim_journal *j, uint64_t index, const void *payload, bs
 				e = errno;
 			j->last_sync = t;
 		}
-		j->failed = e != 0;
+		j->failed = e;
 	}
 	pthread_mutex_unlock(&j->lock);
 	if (e)
@@ -323,6 +325,11 @@ int bsim_journal_close(bsim_journal *j, bsim_error *err)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write the journal: %s", path,
 		                      strerror(e));
 	return BSIM_OK;
+}
+
+int bsim_journal_failed(const bsim_journal *j)
+{
+	return j->failed;
 }
 
 const char *bsim_journal_path(const bsim_journal *j)

@@ -62,6 +62,10 @@ int bsim_journal_append(bsim_journal *j, uint64_t index, const void *payload, bs
 /* Syncs to disk and closes; NULL is fine. */
 int bsim_journal_close(bsim_journal *j, bsim_error *err);
 
+/* The errno with which an append (or the replay) failed, 0 if none did:
+ * what was appended before it is in the file and worth keeping. */
+int bsim_journal_failed(const bsim_journal *j);
+
 /* The file's path. */
 const char *bsim_journal_path(const bsim_journal *j);
 

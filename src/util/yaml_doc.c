@@ -218,13 +218,14 @@ static int fault_error(const char *name, const parse_fault *pf, bsim_error *err)
 	return BSIM_OK;
 }
 
-int ydoc_load(ydoc *d, const char *path, bsim_error *err)
+/* Reads path, at most max_bytes (the limit limit_name, or INFINITY). */
+static int load(ydoc *d, const char *path, double max_bytes, const char *limit_name,
+                bsim_error *err)
 {
 	memset(d, 0, sizeof *d);
 	d->path = path;
 	file_text f;
-	int rc = file_read(path, "a YAML file", bsim_limits_get()->input_bytes, "input_bytes", &f,
-	                   err);
+	int rc = file_read(path, "a YAML file", max_bytes, limit_name, &f, err);
 	if (rc != BSIM_OK)
 		return rc;
 	parse_fault pf;
@@ -237,6 +238,16 @@ int ydoc_load(ydoc *d, const char *path, bsim_error *err)
 	if (!d->fyd)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
 	return BSIM_OK;
+}
+
+int ydoc_load(ydoc *d, const char *path, bsim_error *err)
+{
+	return load(d, path, bsim_limits_get()->input_bytes, "input_bytes", err);
+}
+
+int ydoc_load_own(ydoc *d, const char *path, bsim_error *err)
+{
+	return load(d, path, INFINITY, NULL, err);
 }
 
 struct fy_document *ydoc_parse_text(const char *text, char *msg, size_t size)

@@ -26,6 +26,12 @@ typedef struct ydoc {
  * (or the alias's field); libfyaml prints nothing itself. */
 int ydoc_load(ydoc *d, const char *path, bsim_error *err);
 
+/* ydoc_load of a file beamsim wrote itself (summary.json, report.json,
+ * run.json, manifest.json, ...): checked the same way but without the
+ * input_bytes limit, which is a bound on what a user's file may ask for,
+ * not on what a large run writes. Bounded by memory only. */
+int ydoc_load_own(ydoc *d, const char *path, bsim_error *err);
+
 /* Parses YAML flow text (an override value) into a new document, checked
  * like a file. On failure returns NULL and puts in msg "expected ..., got
  * ..." saying why. */
