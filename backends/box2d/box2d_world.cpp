@@ -631,12 +631,17 @@ static int body_motion_in_range(const bsim_scene *sc, double s, double h, bsim_e
 	const char *field =
 	        fp >= fr ? "effects.propulsion.force" : "effects.random_force.magnitude";
 	const double fv = fp >= fr ? sc->effects.propulsion_force : sc->effects.random_magnitude;
+	/* The field's own usable range, the other force as it is. */
+	const double other = fp >= fr ? fr : fp;
+	const double fv_max = std::sqrt(std::fmax(0.0, f_max * f_max - other * other)) /
+	                      (fp >= fr ? 1.0 : 10.0);
 	if (std::fabs(std::log10(m)) > std::fabs(std::log10(f)))
 		return bsim_error_set(
 		        err, BSIM_EINPUT,
 		        "box2d: body.mass: %g kg is beyond what Box2D's float32 can integrate "
 		        "(|F| dt^2 / m must stay below %g units a substep and |F| / m below %g, "
-		        "got %.3g N x (%g s)^2 / %g kg = %.3g units at unit_scale %g; usable down "
+		        "got %.3g N x (%g s)^2 / %g kg = %.3g units at unit_scale %g, |F| the "
+		        "propulsion and ten standard deviations of the random force; usable down "
 		        "to %.3g kg at this force and step)",
 		        m, MOTION_MAX, ACCEL_MAX, f, h, m, motion, s, m_min);
 	return bsim_error_set(err, BSIM_EINPUT,
@@ -644,7 +649,7 @@ static int body_motion_in_range(const bsim_scene *sc, double s, double h, bsim_e
 	                      "(|F| dt^2 / m must stay below %g units a substep and |F| / m below "
 	                      "%g, got %.3g N x (%g s)^2 / %g kg = %.3g units at unit_scale %g; "
 	                      "usable up to %.3g N at this mass and step)",
-	                      field, fv, MOTION_MAX, ACCEL_MAX, f, h, m, motion, s, f_max);
+	                      field, fv, MOTION_MAX, ACCEL_MAX, f, h, m, motion, s, fv_max);
 }
 
 int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
