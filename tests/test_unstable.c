@@ -1,9 +1,10 @@
 /* The runner's verdict on a failing backend, with backends built to fail
  * in a known way: one whose state turns NaN at a given step, one that
- * creates energy (a body speeding up with no force), and one that loses
- * it (a body slowing down with no force). The first two are unstable, with
- * the reason and the last finite state; the third is an ordinary outcome
- * (lost energy is inaccuracy, not instability). A backend whose step
+ * creates energy (a body speeding up with no force), one that loses most
+ * of it (a body slowing down fast with no force) and one that loses a
+ * third. The first three are unstable, with the reason and the last finite
+ * state; the fourth is an ordinary outcome (energy lost within
+ * BSIM_LEDGER_LOST_BOUND is inaccuracy, not instability). A backend whose step
  * fails (out of memory) makes the trial an error, never a result; one
  * whose solvers count what they gave up on has its counts in the result. */
 #include <math.h>
@@ -23,7 +24,7 @@
 /* A body alone: the beams never move. kind 0: NaN at step 10; 1: speed
  * grows by 1% a step; 2: speed falls by 1% a step; 3: the step fails at
  * step 7; 4: every third step a solve reaches its limit, every step two
- * substeps are clamped. */
+ * substeps are clamped; 5: speed falls by 0.1% a step. */
 struct bsim_world {
 	int kind, n_beams;
 	long step;
@@ -65,7 +66,7 @@ static int fake_step(bsim_world *w, const double force[2], double h, bsim_error 
 		w->solver.iteration_limit += w->step % 3 == 0;
 		w->solver.clamped += 2;
 	}
-	double f = w->kind == 1 ? 1.01 : w->kind == 2 ? 0.99 : 1.0;
+	double f = w->kind == 1 ? 1.01 : w->kind == 2 ? 0.99 : w->kind == 5 ? 0.999 : 1.0;
 	w->v[1] *= f;
 	w->x[1] += h * w->v[1];
 	if (w->kind == 0 && w->step == 10)
@@ -147,13 +148,33 @@ static void test_energy_created(void **state)
 	assert_non_null(strstr(why, "energy created: ledger residual"));
 }
 
-static void test_energy_lost(void **state)
+/* 1% a step for 200 steps: E falls to 0.99^400 = 1.8% of the 0.5 J that
+ * flowed in, 98% of it vanished with no loss booked: beyond the bound of
+ * 75%, unstable, and the reason says which side. */
+static void test_energy_vanished(void **state)
 {
 	(void)state;
 	bsim_trial_result r = run(2);
+	assert_int_equal(r.outcome, BSIM_UNSTABLE);
+	assert_int_equal(r.instability, BSIM_UNSTABLE_ENERGY_LOST);
+	assert_float_equal(r.ledger.inflow, 0.5, 1e-15);
+	assert_float_equal(r.ledger.e_end, 0.5 * pow(0.99, 400), 1e-9);
+	assert_float_equal(r.ledger.residual, r.ledger.e_end - 0.5, 1e-9);
+	char why[256];
+	bsim_trial_instability_text(&r, 0.004, why, sizeof why);
+	assert_non_null(strstr(why, "energy vanished: ledger residual -0.491 J < -0.75 x 0.5 J"));
+}
+
+/* 0.1% a step: E falls to 0.999^400 = 67% of 0.5 J, a third vanished:
+ * inaccuracy within the bound, an ordinary outcome. */
+static void test_energy_lost(void **state)
+{
+	(void)state;
+	bsim_trial_result r = run(5);
 	assert_int_equal(r.outcome, BSIM_STUCK);
 	assert_int_equal(r.instability, BSIM_STABLE);
-	assert_true(r.ledger.residual < 0.0);
+	assert_float_equal(r.ledger.e_end, 0.5 * pow(0.999, 400), 1e-9);
+	assert_true(r.ledger.residual < -0.3 * r.ledger.inflow);
 }
 
 static void test_step_fails(void **state)
@@ -211,7 +232,8 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_nonfinite),     cmocka_unit_test(test_energy_created),
-	        cmocka_unit_test(test_energy_lost),   cmocka_unit_test(test_step_fails),
+	        cmocka_unit_test(test_energy_vanished), cmocka_unit_test(test_energy_lost),
+	        cmocka_unit_test(test_step_fails),
 	        cmocka_unit_test(test_solver_counts), cmocka_unit_test(test_schedule_status),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -585,6 +585,73 @@ static int scene_in_float_range(const bsim_scene *sc, double s, bsim_error *err)
 	return BSIM_OK;
 }
 
+/* Box2D's island solver integrates a substep of h as v' = v + h F / m,
+ * then takes the translation h v' and compares its square with
+ * b2_maxTranslation^2 to clamp it. All in float32: once |h v'| passes
+ * sqrt(FLT_MAX) = 1.8e19 units the square is infinite, the clamp's ratio
+ * 2 / inf is 0, and the body's velocity is set to 0 every substep: it never
+ * moves, and the trial would end an ordinary `stuck` at its start. So the
+ * body's motion in one substep, from its velocity and from the force over
+ * one substep, must stay below MOTION_MAX units (a margin of 18 under
+ * 1.8e19), and the acceleration F s / m, which float32 holds before h
+ * multiplies it, below 1e30. Both are known before the run, so they are
+ * refused here; what happens in flight (a clamp that removes energy) is
+ * the ledger's to flag. */
+const double MOTION_MAX = 1e18; /* units per substep */
+const double ACCEL_MAX = 1e30;  /* units / s^2 */
+
+static int body_motion_in_range(const bsim_scene *sc, double s, double h, bsim_error *err)
+{
+	const double m = sc->body.mass;
+	for (int k = 0; k < 2; k++) {
+		double motion = std::fabs(sc->body.velocity[k]) * s * h;
+		if (motion > MOTION_MAX)
+			return bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "box2d: body.velocity.%d: %g m/s is beyond what Box2D's float32 "
+			        "can integrate (|v| dt / substeps x unit_scale must stay below %g "
+			        "units a substep, got %.3g; usable up to %.3g m/s at this step)",
+			        k, sc->body.velocity[k], MOTION_MAX, motion, MOTION_MAX / (s * h));
+	}
+	/* The propulsion acts along y, the random force (up to ten standard
+	 * deviations) along x. */
+	const double fp = std::fabs(sc->effects.propulsion_force);
+	const double fr = 10.0 * sc->effects.random_magnitude;
+	const double f = std::hypot(fp, fr);
+	if (f == 0.0 || m == 0.0)
+		return BSIM_OK;
+	const double accel = f * s / m;
+	const double motion = accel * h * h;
+	if (accel <= ACCEL_MAX && motion <= MOTION_MAX)
+		return BSIM_OK;
+	const double f_max = std::fmin(ACCEL_MAX, MOTION_MAX / (h * h)) * m / s;
+	const double m_min = f * s / std::fmin(ACCEL_MAX, MOTION_MAX / (h * h));
+	/* Blame the quantity further from 1 in orders of magnitude: the force
+	 * of 1e25 N, the mass of 1e-29 kg. */
+	const char *field =
+	        fp >= fr ? "effects.propulsion.force" : "effects.random_force.magnitude";
+	const double fv = fp >= fr ? sc->effects.propulsion_force : sc->effects.random_magnitude;
+	/* The field's own usable range, the other force as it is. */
+	const double other = fp >= fr ? fr : fp;
+	const double fv_max = std::sqrt(std::fmax(0.0, f_max * f_max - other * other)) /
+	                      (fp >= fr ? 1.0 : 10.0);
+	if (std::fabs(std::log10(m)) > std::fabs(std::log10(f)))
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "box2d: body.mass: %g kg is beyond what Box2D's float32 can integrate "
+		        "(|F| dt^2 / m must stay below %g units a substep and |F| / m below %g, "
+		        "got %.3g N x (%g s)^2 / %g kg = %.3g units at unit_scale %g, |F| the "
+		        "propulsion and ten standard deviations of the random force; usable down "
+		        "to %.3g kg at this force and step)",
+		        m, MOTION_MAX, ACCEL_MAX, f, h, m, motion, s, m_min);
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "box2d: %s: %g N is beyond what Box2D's float32 can integrate "
+	                      "(|F| dt^2 / m must stay below %g units a substep and |F| / m below "
+	                      "%g, got %.3g N x (%g s)^2 / %g kg = %.3g units at unit_scale %g; "
+	                      "usable up to %.3g N at this mass and step)",
+	                      field, fv, MOTION_MAX, ACCEL_MAX, f, h, m, motion, s, fv_max);
+}
+
 int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
                       bsim_error *err)
 {
@@ -608,6 +675,8 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "box2d: unit_scale=%g: expected a positive number", s);
 	if ((rc = scene_in_float_range(scene, s, err)) != BSIM_OK)
+		return rc;
+	if ((rc = body_motion_in_range(scene, s, scene->dt / (double)substeps, err)) != BSIM_OK)
 		return rc;
 	/* The disk must be larger than Box2D's skin, and its coordinates within
 	 * float32's reach. */

@@ -38,13 +38,18 @@ typedef enum {
  *              BSIM_LEDGER_BOUND times the energy that flowed in (the
  *              starting energy plus the absolute work of the external
  *              forces, step by step): the backend created more energy than
- *              the forces put in. A negative residual (energy lost without
- *              account, e.g. an implicit spring's numerical damping) is an
- *              accuracy matter, measured by beamsim accuracy, not this. */
+ *              the forces put in;
+ *   energy_lost: the residual is negative and larger in magnitude than
+ *              BSIM_LEDGER_LOST_BOUND times the energy that flowed in: most
+ *              of what came in vanished beyond the losses the ledger books
+ *              (a solver's clamp that stopped the body, say). A smaller
+ *              negative residual (an implicit spring's numerical damping)
+ *              is an accuracy matter, measured by beamsim accuracy. */
 typedef enum {
 	BSIM_STABLE = 0,
 	BSIM_UNSTABLE_NONFINITE = 1,
 	BSIM_UNSTABLE_ENERGY = 2,
+	BSIM_UNSTABLE_ENERGY_LOST = 3,
 } bsim_instability;
 
 /* The bound of the energy test above. Measured (H1 and H2, 19,200 trials
@@ -54,6 +59,15 @@ typedef enum {
  * 1.9 and above once an explicit spring passes its stability limit
  * (omega_n h > 2), where the energy grows without bound. */
 #define BSIM_LEDGER_BOUND 1.0
+/* The bound on the other side: energy vanished without account, as a
+ * fraction of what flowed in. The residual cannot fall below minus the
+ * inflow (the end energy and the booked losses are not negative), which it
+ * reaches when everything vanished. Measured on the stored reference runs
+ * (docs/robustness.md), residual / (start energy + net work) at its most
+ * negative: -3e-14 on thesis midpoint, -0.43 on thesis euler (H2), -0.34
+ * on Box2D weld (H1); the inflow, which counts the work of every step in
+ * absolute value, is at least that denominator. */
+#define BSIM_LEDGER_LOST_BOUND 0.75
 /* A floor under the bound, J, so that round-off in a scene through which
  * no energy flows is not a failure. */
 #define BSIM_LEDGER_FLOOR 1e-6
@@ -229,8 +243,10 @@ BSIM_API const char *bsim_trial_outcome_name(bsim_outcome o);
 BSIM_API const char *bsim_trial_type_name(bsim_type t);
 
 /* Why trial r (run with time step dt, s) is unstable, in one line:
- * "non-finite state at step 512 (t = 2.048 s)" or "energy created: ledger
- * residual 3.67e+06 J > 1 x 1061 J that flowed in"; "" if it is not. */
+ * "non-finite state at step 512 (t = 2.048 s)", "energy created: ledger
+ * residual 3.67e+06 J > 1 x 1061 J that flowed in" or "energy vanished:
+ * ledger residual -5e+39 J < -0.75 x 5e+39 J that flowed in"; "" if it is
+ * not. */
 BSIM_API void bsim_trial_instability_text(const bsim_trial_result *r, double dt, char *buf,
                                           size_t size);
 

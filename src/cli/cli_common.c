@@ -362,9 +362,67 @@ void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const 
 		         "%sclamped the motion to its per-step limits in %ld (sub)step%s",
 		         what[0] ? " and " : "", c->clamped, c->clamped == 1 ? "" : "s");
 	if (what[0])
-		cli_error("warning: the %s backend's solver %s (%s: solver); there the motion is "
+		cli_error("warning: the %s backend's solver %s (%s: solver%s); there the motion is "
 		          "the solver's limit, not the model's",
-		          backend, what, where);
+		          backend, what, where,
+		          strstr(where, "summary.json")
+		                  ? "; per trial, trials.csv: iteration_limits, clamps"
+		                  : "");
+}
+
+double cli_experiment_beam_steps(const char *path, const cli_sets *sets, long trials)
+{
+	bsim_experiment e;
+	bsim_error err;
+	const bsim_override *ov = sets ? sets->ov : NULL;
+	int n_ov = sets ? sets->n : 0;
+	if (bsim_experiment_load(path, ov, n_ov, &e, &err) != BSIM_OK)
+		return 0.0;
+	if (trials > 0 && bsim_experiment_check_trials(&e, trials, &err) != BSIM_OK) {
+		bsim_experiment_free(&e);
+		return 0.0;
+	}
+	double total = 0.0;
+	for (int g = 0; g < e.n_groups; g++) {
+		bsim_scene s;
+		if (bsim_experiment_group_scene(&e, g, ov, n_ov, &s, &err) != BSIM_OK) {
+			total = 0.0;
+			break;
+		}
+		double n =
+		        s.effects.has_random_force ? (trials > 0 ? (double)trials : e.trials) : 1;
+		total += n * s.max_steps * s.n_beams;
+		bsim_scene_free(&s);
+	}
+	bsim_experiment_free(&e);
+	return total;
+}
+
+/* The cost of a beam-step, ns of one core, with its basis: what the
+ * estimate line says it assumed. The thesis backend's step costs the
+ * beams near the body, so on a lattice the estimate is an upper bound. */
+static double beam_step_ns(const char *backend, const char **basis)
+{
+	if (strcmp(backend, "box2d") == 0) {
+		*basis = "Box2D measured at 0.21 s a step of a 333 x 300 lattice's 199,800 beams";
+		return 1050.0;
+	}
+	*basis = "the thesis backend's 1e8 beam-steps in about 15 s of one core "
+	         "(docs/robustness.md, beam_steps)";
+	return 150.0;
+}
+
+void cli_estimate_line(const char *backend, double beam_steps)
+{
+	const char *basis;
+	double ns = beam_step_ns(backend, &basis);
+	double hours = beam_steps * ns * 1e-9 / 3600.0;
+	if (hours > 1.0)
+		cli_error(
+		        "note: this run may take up to about %.3g hours of one core: at most %.3g "
+		        "beam-steps (trials x max_steps x beams) at a stated constant of ~%g ns a "
+		        "beam-step on %s (%s)",
+		        hours, beam_steps, ns, backend, basis);
 }
 
 char *cli_text_append(char *text, const char *more)

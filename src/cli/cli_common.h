@@ -113,6 +113,19 @@ int cli_run_end(int rc, const char *journal, int argc, char **argv);
  * written (where: "summary.json", ...). */
 void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const char *where);
 
+/* The beam-steps a run may take at most: trials x max_steps x beams
+ * (every beam of a lattice), summed over the groups of the experiment at
+ * path with the --set overrides (a group without random force runs one
+ * trial); trials > 0 replaces the file's. 0 if the experiment does not
+ * load or asks for more trials than the limit (the run itself then says
+ * why). */
+double cli_experiment_beam_steps(const char *path, const cli_sets *sets, long trials);
+
+/* One line on stderr before a run that may take more than an hour of one
+ * core: the estimate, the beam-steps it is made of and the cost of a
+ * beam-step it assumes for the backend, with that cost's basis. */
+void cli_estimate_line(const char *backend, double beam_steps);
+
 /* text (malloc'd) with more appended, reallocated; NULL (text freed) if
  * out of memory. */
 char *cli_text_append(char *text, const char *more);

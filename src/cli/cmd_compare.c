@@ -245,6 +245,12 @@ int cmd_compare(int argc, char **argv)
 	def.progress = cli_progress_update;
 	def.progress_user = &progress;
 	def.stop = &cli_stop;
+	/* Both sides run every trial; the costlier backend's constant bounds
+	 * the estimate. */
+	const char *costlier = def.side[0].backend ? def.side[0].backend->name : "thesis";
+	if (def.side[1].backend && strcmp(def.side[1].backend->name, "box2d") == 0)
+		costlier = "box2d";
+	cli_estimate_line(costlier, 2.0 * cli_experiment_beam_steps(experiment, &c.sets, c.trials));
 	bsim_compare_dir_result res;
 	bsim_error err;
 	cli_signals_install();

@@ -192,6 +192,7 @@ int cmd_run(int argc, char **argv)
 		cli_common_free(&c);
 		return err.code ? err.code : CLI_USAGE;
 	}
+	cli_estimate_line(backend->name, (double)scene.max_steps * scene.n_beams);
 	uint64_t mixed = bsim_schedule_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
 	bsim_trial_log *log = bsim_trial_log_alloc();
 	bsim_run_info info = {

@@ -107,6 +107,8 @@ int cmd_sweep(int argc, char **argv)
 	def.progress = cli_progress_update;
 	def.progress_user = &progress;
 	def.stop = &cli_stop;
+	cli_estimate_line(def.backend->name,
+	                  cli_experiment_beam_steps(experiment, &c.sets, c.trials));
 	bsim_sweep_dir_result res;
 	bsim_error err;
 	cli_signals_install();

@@ -100,7 +100,12 @@ typedef struct scene_excess {
 	const char *limit; /* "schedule", "beam_steps" */
 	double got, max;
 	const char *what; /* "random-force values per trial (frequency x dt x max_steps)" */
+	int beams;        /* beam_steps: the scene's beams, a lattice's every one */
 } scene_excess;
+
+/* What x's count is made of, for its message: " = 3000 steps x 199800
+ * beams" for beam_steps, "" for the others. */
+void scene_excess_detail(const bsim_scene *s, const scene_excess *x, char *buf, size_t size);
 
 /* 1 and *x if the scene asks for more than a limit allows, else 0. */
 int scene_excess_find(const bsim_scene *s, scene_excess *x);

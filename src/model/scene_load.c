@@ -290,10 +290,11 @@ static int check_limits(walk *w)
 		return BSIM_OK;
 	static const char *const schedule[] = {"effects.random_force.frequency", "integration.dt",
 	                                       "integration.max_steps"};
-	static const char *const steps[] = {"integration.max_steps", "beams"};
+	static const char *const steps[] = {"integration.max_steps", "beams", "lattice.columns",
+	                                    "lattice.rows"};
 	int is_schedule = !strcmp(x.limit, "schedule");
 	const char *const *paths = is_schedule ? schedule : steps;
-	int n = is_schedule ? 3 : 2;
+	int n = is_schedule ? 3 : 4;
 	struct fy_node *root = fy_document_root(w->d->fyd);
 	struct fy_node *node = latest_override(w->d, paths, n);
 	const char *field = paths[0];
@@ -307,10 +308,12 @@ static int check_limits(walk *w)
 	}
 	if (!node) /* all defaults: the block the first field would be in */
 		node = ydoc_lookup(root, is_schedule ? "effects.random_force" : "integration");
-	char hint[160];
+	char hint[160], detail[128];
 	bsim_limits_hint(hint, sizeof hint, x.limit, x.max);
+	scene_excess_detail(w->s, &x, detail, sizeof detail);
 	return ydoc_fail(w->d, node ? node : root, NULL, field, w->err,
-	                 "expected at most %.15g %s, got %.3g (%s)", x.max, x.what, x.got, hint);
+	                 "expected at most %.15g %s, got %.3g%s (%s)", x.max, x.what, x.got, detail,
+	                 hint);
 }
 
 /* The file's base name without its extension: "configs/gate.yaml" -> "gate". */

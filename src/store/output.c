@@ -204,6 +204,19 @@ static void json_solver(FILE *f, const bsim_solver_counts *c)
 	        c->clamped);
 }
 
+/* How many of a group's trials hit an iteration limit, and a clamp: the
+ * trials whose motion is partly the solver's, not the model's. */
+static void json_solver_trials(FILE *f, const bsim_sweep_result *r, int group)
+{
+	long limited = 0, clamped = 0;
+	for (int t = 0; r->trials_out && t < r->trials; t++) {
+		const bsim_trial_result *x = &r->trials_out[(size_t)group * r->trials + t];
+		limited += x->solver.iteration_limit > 0;
+		clamped += x->solver.clamped > 0;
+	}
+	fprintf(f, ", \"trials_iteration_limit\": %ld, \"trials_clamped\": %ld", limited, clamped);
+}
+
 static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int group,
                        int *idx)
 {
@@ -225,6 +238,7 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps, g->unstable,
 	        g->deterministic ? "true" : "false");
 	json_solver(f, &g->solver);
+	json_solver_trials(f, r, group);
 	if (r->lattice)
 		json_lattice(f, r, group);
 	fputc('}', f);
@@ -321,6 +335,7 @@ const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
         "group",  "trial",    "outcome",     "type",       "steps",    "t_end",    "x_end",
         "y_end",  "vx_end",   "max_theta1",  "max_theta2", "e_start",  "e_end",    "work_in",
         "losses", "residual", "overlap_max", "final_ix",   "final_iy", "location", "path",
+        "iteration_limits", "clamps",
 };
 
 int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
@@ -371,6 +386,8 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 			 * journal, which lattices never are) stayed in one gate. */
 			if (!tl || tl->n_entries == 0)
 				fprintf(o.f, "%d:%d", x->final_ix, x->final_iy);
+			/* what the backend's solvers gave up on in this trial */
+			fprintf(o.f, ",%ld,%ld", x->solver.iteration_limit, x->solver.clamped);
 			for (int a = 0; a < axes; a++) {
 				fputc(',', o.f);
 				csv_field(o.f, e->axes[a].values[idx[a]]);

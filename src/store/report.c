@@ -351,6 +351,46 @@ static void md_locations(FILE *f, const bsim_report *r)
 	}
 }
 
+/* The trials of group g on one side whose solver hit an iteration limit,
+ * and those it clamped. */
+static void solver_trials(const bsim_report *r, int side, int g, int *limited, int *clamped)
+{
+	*limited = *clamped = 0;
+	for (int t = 0; t < r->side[side].run->trials; t++) {
+		const bsim_trial_result *x = trial_of(r, side, g, t);
+		*limited += x->solver.iteration_limit > 0;
+		*clamped += x->solver.clamped > 0;
+	}
+}
+
+/* The groups with trials whose motion is partly a solver's limit rather
+ * than the model's (trials.csv iteration_limits, clamps): their
+ * probabilities compare the solvers' give-ups as much as the physics. */
+static void md_solver(FILE *f, const bsim_report *r)
+{
+	int any = 0;
+	for (int g = 0; g < r->cmp->n_groups; g++) {
+		int n[2][2];
+		for (int s = 0; s < 2; s++)
+			solver_trials(r, s, g, &n[s][0], &n[s][1]);
+		if (!n[0][0] && !n[0][1] && !n[1][0] && !n[1][1])
+			continue;
+		if (!any)
+			fputs("**Solver limits.** Groups with trials whose motion was partly a "
+			      "solver's limit, not the model's (trials.csv iteration_limits, "
+			      "clamps):\n\n",
+			      f);
+		any = 1;
+		fprintf(f, "- group %d: ", g);
+		for (int s = 0; s < 2; s++)
+			fprintf(f, "%s%s %d hit an iteration limit, %d clamped", s ? "; " : "",
+			        r->side[s].label, n[s][0], n[s][1]);
+		fputs("\n", f);
+	}
+	if (any)
+		fputc('\n', f);
+}
+
 void bsim_report_md(FILE *f, const bsim_report *r)
 {
 	const bsim_comparison *c = r->cmp;
@@ -388,6 +428,7 @@ void bsim_report_md(FILE *f, const bsim_report *r)
 		      f);
 	md_separation(f, r);
 	md_table(f, r);
+	md_solver(f, r);
 	if (c->lattice)
 		md_locations(f, r);
 	for (int g = 0; g < c->n_groups; g++) {

@@ -2,8 +2,9 @@
  * rerun through the file, so both sides have exactly the file's
  * precision). Columns are found by their header name, so a file with more
  * columns than this version writes, or one written before the energy
- * columns or the lattice's final gate (final_ix, final_iy; 0 when absent,
- * what a gate scene writes) existed, reads the same. */
+ * columns, the lattice's final gate (final_ix, final_iy; 0 when absent,
+ * what a gate scene writes) or the solver's counts (iteration_limits,
+ * clamps; 0 when absent) existed, reads the same. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
@@ -34,6 +35,8 @@ enum {
 	LEDGER_END,
 	COL_FINAL_IX = LEDGER_END,
 	COL_FINAL_IY,
+	COL_ITERATION_LIMITS,
+	COL_CLAMPS,
 	N_COLUMNS
 };
 
@@ -42,7 +45,8 @@ static const int column_of[N_COLUMNS] = {
         TRIALS_GROUP,      TRIALS_TRIAL,    TRIALS_OUTCOME,  TRIALS_TYPE,    TRIALS_STEPS,
         TRIALS_T_END,      TRIALS_X_END,    TRIALS_Y_END,    TRIALS_VX_END,  TRIALS_MAX_THETA1,
         TRIALS_MAX_THETA2, TRIALS_E_START,  TRIALS_E_END,    TRIALS_WORK_IN, TRIALS_LOSSES,
-        TRIALS_RESIDUAL,   TRIALS_FINAL_IX, TRIALS_FINAL_IY,
+        TRIALS_RESIDUAL,   TRIALS_FINAL_IX, TRIALS_FINAL_IY, TRIALS_ITERATION_LIMITS,
+        TRIALS_CLAMPS,
 };
 
 /* The column k of this reader whose name s is, or -1. */
@@ -151,6 +155,14 @@ static int parse_row(char **f, int n, const int *col, const bsim_sweep_result *r
 			continue;
 		*gate[i] = (int)strtol(f[col[COL_FINAL_IX + i]], &end, 10);
 		if (*end)
+			return -1;
+	}
+	long *solver[2] = {&x->solver.iteration_limit, &x->solver.clamped};
+	for (int i = 0; i < 2; i++) {
+		if (col[COL_ITERATION_LIMITS + i] < 0)
+			continue;
+		*solver[i] = strtol(f[col[COL_ITERATION_LIMITS + i]], &end, 10);
+		if (*end || *solver[i] < 0)
 			return -1;
 	}
 	x->steps_run = 1; /* marks the row as read; not in the file */

@@ -1,0 +1,219 @@
+/* Failures said, per trial, and limits that hold (the program run on the
+ * shipped scenes):
+ *  - a scene beyond what Box2D's float32 can integrate (a force of 1e25 N,
+ *    a mass of 1e-29 kg, a velocity of 1e25 m/s) is refused by the box2d
+ *    backend with exit 2 naming the field; the thesis backend, in double,
+ *    runs the same scene to its ordinary end (the body leaves the gate in
+ *    one step, as x' = x + h^2 F / m says);
+ *  - a trial whose energy vanishes (Box2D clamping a 10 km/s body to
+ *    b2_maxTranslation = 2 units a step: 500 m/s at h = 4 ms) is unstable,
+ *    "energy vanished", exit 1 - never an ordinary outcome;
+ *  - trials.csv says per trial how often the solver hit an iteration limit
+ *    or a clamp, summary.json how many trials of each group did, and an
+ *    older trials.csv without those columns still reads;
+ *  - beam_steps counts every beam of a lattice (2 a gate), and a run that
+ *    may take more than an hour says so, with its basis, before it starts. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "beamsim/output.h"
+#include "beamsim/sweep.h"
+#include "support.h"
+
+static const char *gate(void)
+{
+	return bsim_test_src("configs/thesis/gate.yaml");
+}
+
+static void test_box2d_force_refused(void **state)
+{
+	(void)state;
+	const char *argv[] = {"run",   gate(),  "--backend",
+	                      "box2d", "--set", "effects.propulsion.force=1e25",
+	                      NULL};
+	const char *needles[] = {"effects.propulsion.force: 1e+25 N",
+	                         "beyond what Box2D's float32 can integrate", "usable up to", NULL};
+	bsim_test_expect_input_error(argv, needles);
+	const char *mass[] = {"run", gate(), "--backend", "box2d", "--set", "body.mass=1e-29",
+	                      NULL};
+	const char *mass_needles[] = {"body.mass: 1e-29 kg", "usable down to", NULL};
+	bsim_test_expect_input_error(mass, mass_needles);
+	const char *vel[] = {"run", gate(), "--backend", "box2d", "--set", "body.velocity.1=1e25",
+	                     NULL};
+	const char *vel_needles[] = {"body.velocity.1: 1e+25 m/s", NULL};
+	bsim_test_expect_input_error(vel, vel_needles);
+}
+
+/* The thesis backend integrates in double: F = 1e25 N on 1 kg for one step
+ * of 4 ms moves the body h^2 F / m = 1.6e20 m, far past success_y. */
+static void test_thesis_force_runs(void **state)
+{
+	(void)state;
+	const char *argv[] = {"run",    gate(), "--set", "effects.propulsion.force=1e25",
+	                      "--json", NULL};
+	char *out = NULL;
+	int rc = bsim_test_cli(argv, &out, NULL);
+	assert_int_equal(rc, 0);
+	assert_non_null(strstr(out, "\"outcome\": \"traversed\""));
+	assert_int_equal((int)bsim_test_json_number(out, "steps"), 1);
+	free(out);
+}
+
+/* Box2D clamps the translation to 2 units a step: a body started at
+ * 10 km/s (5e7 J) keeps at most 500 m/s (1.25e5 J), so nearly all the
+ * energy that came in vanishes without a loss booked for it. */
+static void test_box2d_clamp_unstable(void **state)
+{
+	(void)state;
+	const char *argv[] = {"run",    gate(),  "--backend",
+	                      "box2d",  "--set", "body.velocity.1=1e4",
+	                      "--json", NULL};
+	char *out = NULL, *err = NULL;
+	int rc = bsim_test_cli(argv, &out, &err);
+	assert_int_equal(rc, 1);
+	assert_non_null(strstr(out, "\"outcome\": \"unstable\""));
+	assert_non_null(strstr(out, "energy vanished"));
+	assert_true(bsim_test_json_number(out, "clamped") > 0);
+	free(out);
+	free(err);
+}
+
+/* The 3 x 3 field at dt = 30 s: the thesis solver's impact iteration gives
+ * up (7 times in this trial, run --json says); the sweep's trials.csv has
+ * the count in its row and summary.json one trial hit in the group. */
+static void test_solver_columns(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("solver_columns");
+	char exp[512];
+	snprintf(exp, sizeof exp,
+	         "scene: %s\ntrials: 1\nseed: 1\nset:\n  integration.dt: 30\n"
+	         "  effects.random_force.magnitude: 0\ngrid:\n  effects.propulsion.force: [9]\n",
+	         bsim_test_src("tests/data/field_3x3.yaml"));
+	const char *path = bsim_test_write(dir, "exp.yaml", exp);
+	const char *out_dir = bsim_test_join(dir, "out");
+	const char *argv[] = {"sweep", path, "--out", out_dir, "--quiet", NULL};
+	char *err = NULL;
+	assert_int_equal(bsim_test_cli(argv, NULL, &err), 0);
+	assert_non_null(strstr(err, "per trial, trials.csv: iteration_limits, clamps"));
+	free(err);
+	char *csv = bsim_test_read(bsim_test_join(out_dir, "trials.csv"));
+	assert_non_null(csv);
+	assert_non_null(strstr(csv, ",path,iteration_limits,clamps,effects.propulsion.force\n"));
+	/* the one row ends with the counts (7 limits, no clamp), then the
+	 * grid's column */
+	assert_non_null(strstr(csv, ",7,0,9\n"));
+	free(csv);
+	char *sum = bsim_test_read(bsim_test_join(out_dir, "summary.json"));
+	assert_non_null(sum);
+	assert_int_equal((int)bsim_test_json_number(sum, "iteration_limit"), 7);
+	assert_int_equal((int)bsim_test_json_number(sum, "trials_iteration_limit"), 1);
+	assert_int_equal((int)bsim_test_json_number(sum, "trials_clamped"), 0);
+	free(sum);
+	bsim_test_remove(dir);
+}
+
+/* A trials.csv written before the solver's columns reads, its counts 0. */
+static void test_old_trials_csv(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("old_csv");
+	const char *path = bsim_test_write(
+	        dir, "trials.csv",
+	        "group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"
+	        "e_start,e_end,work_in,losses,residual,overlap_max,final_ix,final_iy,location,"
+	        "path\n"
+	        "0,0,stuck,none,3000,12,0,28.3,0,0.5,0.5,0,53.7,113.3,59.6,1e-12,,0,0,stuck:0:0,"
+	        "0:0\n");
+	bsim_sweep_result r;
+	bsim_error err;
+	assert_int_equal(bsim_output_trials_read(path, 1, 1, &r, &err), BSIM_OK);
+	assert_int_equal(r.trials_out[0].outcome, BSIM_STUCK);
+	assert_int_equal(r.trials_out[0].solver.iteration_limit, 0);
+	assert_int_equal(r.trials_out[0].solver.clamped, 0);
+	bsim_sweep_result_free(&r);
+	path = bsim_test_write(
+	        dir, "new.csv",
+	        "group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"
+	        "e_start,e_end,work_in,losses,residual,overlap_max,final_ix,final_iy,location,"
+	        "path,iteration_limits,clamps\n"
+	        "0,0,side_exit,none,9,270,100,20,3,0.5,0.5,0,53.7,113.3,59.6,1e-12,,1,0,side:1,"
+	        "0:0 1:0,7,2\n");
+	assert_int_equal(bsim_output_trials_read(path, 1, 1, &r, &err), BSIM_OK);
+	assert_int_equal(r.trials_out[0].solver.iteration_limit, 7);
+	assert_int_equal(r.trials_out[0].solver.clamped, 2);
+	bsim_sweep_result_free(&r);
+	bsim_test_remove(dir);
+}
+
+/* beam_steps counts the lattice's every beam: 9 x 9 gates of 2 beams,
+ * 162, times 54,000 steps = 8.75e6; and 333 x 300 gates on Box2D, 199,800
+ * beams, refused at the default limit (it ran 0.21 s a step). */
+static void test_lattice_beam_steps(void **state)
+{
+	(void)state;
+	const char *lattice = bsim_test_src("configs/lattice/uniform_9x9.yaml");
+	const char *argv[] = {"run", lattice, "--limit", "beam_steps=1000000", NULL};
+	const char *needles[] = {"integration.max_steps: expected at most 1000000 beam-steps",
+	                         "got 8.75e+06 = 54000 steps x 162 beams (a 9 x 9 lattice", NULL};
+	bsim_test_expect_input_error(argv, needles);
+	const char *big[] = {"run",       lattice,
+	                     "--backend", "box2d",
+	                     "--set",     "integration.max_steps=3000",
+	                     "--set",     "lattice.columns=333",
+	                     "--set",     "lattice.rows=300",
+	                     "--set",     "termination.side_x=10000",
+	                     NULL};
+	const char *big_needles[] = {"lattice.rows: expected at most 100000000 beam-steps",
+	                             "= 3000 steps x 199800 beams (a 333 x 300 lattice", NULL};
+	bsim_test_expect_input_error(big, big_needles);
+}
+
+/* H1 on Box2D with max_steps 10^6: 6 groups without random force run one
+ * trial, 24 with it 100 each: 2406 x 10^6 x 2 beams = 4.81e9 beam-steps,
+ * 1.4 hours at the stated 1050 ns. The line comes before the output
+ * directory is opened (which /proc refuses, so nothing runs). */
+static void test_estimate_line(void **state)
+{
+	(void)state;
+	const char *argv[] = {"sweep",     bsim_test_src("configs/thesis/h1_symmetric.yaml"),
+	                      "--backend", "box2d",
+	                      "--set",     "integration.max_steps=1000000",
+	                      "--limit",   "beam_steps=1e12",
+	                      "--out",     "/proc/beamsim-none",
+	                      NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	assert_int_equal(rc, 2);
+	assert_non_null(strstr(err, "note: this run may take up to about 1.4 hours of one core: "
+	                            "at most 4.81e+09 beam-steps"));
+	assert_non_null(strstr(err, "1050 ns a beam-step on box2d"));
+	free(err);
+	/* The same on the thesis backend at its default steps: no line. */
+	const char *quiet[] = {"sweep", bsim_test_src("configs/thesis/h1_symmetric.yaml"), "--out",
+	                       "/proc/beamsim-none", NULL};
+	rc = bsim_test_cli(quiet, NULL, &err);
+	assert_int_equal(rc, 2);
+	assert_null(strstr(err, "note:"));
+	free(err);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_box2d_force_refused),
+	        cmocka_unit_test(test_thesis_force_runs),
+	        cmocka_unit_test(test_box2d_clamp_unstable),
+	        cmocka_unit_test(test_solver_columns),
+	        cmocka_unit_test(test_old_trials_csv),
+	        cmocka_unit_test(test_lattice_beam_steps),
+	        cmocka_unit_test(test_estimate_line),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
