@@ -1,6 +1,6 @@
 /* Helpers shared by the tests (support.h): one way to run the program and
  * wait on what it does, temporary directories and files. */
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700 /* posix_openpt */
 
 #include <setjmp.h>
 #include <stdarg.h>
@@ -25,6 +25,7 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -235,6 +236,39 @@ static pid_t launch(const char *file, char *const args[], int search, const bsim
 	_exit(127);
 }
 
+/* A pseudo-terminal: its terminal side's descriptor, the other side's in
+ * *master, both closed on exec. What is written to the terminal reads back
+ * as written ("\n" not made "\r\n"). Fails the test if there is none. */
+static int pty_open(int *master)
+{
+	int m = posix_openpt(O_RDWR | O_NOCTTY);
+	if (m < 0 || grantpt(m) != 0 || unlockpt(m) != 0)
+		fail_msg("no pseudo-terminal: %s", strerror(errno));
+	const char *name = ptsname(m);
+	int t = name ? open(name, O_RDWR | O_NOCTTY) : -1;
+	struct termios tio;
+	if (t < 0 || tcgetattr(t, &tio) != 0)
+		fail_msg("no pseudo-terminal: %s", strerror(errno));
+	tio.c_oflag &= ~(tcflag_t)OPOST;
+	tcsetattr(t, TCSANOW, &tio);
+	fcntl(m, F_SETFD, FD_CLOEXEC);
+	fcntl(t, F_SETFD, FD_CLOEXEC);
+	*master = m;
+	return t;
+}
+
+/* Copies what fd gives into file until its writers are gone: a terminal's
+ * other side reads EIO once no process holds the terminal open. */
+static void drain(int fd, FILE *file)
+{
+	char buf[4096];
+	ssize_t k;
+	while ((k = read(fd, buf, sizeof buf)) > 0 || (k < 0 && errno == EINTR))
+		if (k > 0)
+			fwrite(buf, 1, (size_t)k, file);
+	fflush(file);
+}
+
 /* Runs to the end with stdout and stderr captured (unless o redirects
  * them) into *out and *err (either may be NULL). */
 static int run_captured(const char *file, char *const args[], int search, const bsim_test_opts *o,
@@ -243,7 +277,13 @@ static int run_captured(const char *file, char *const args[], int search, const 
 	FILE *fo = tmpfile(), *fe = tmpfile();
 	if (!fo || !fe)
 		abort();
-	pid_t pid = launch(file, args, search, o, fileno(fo), fileno(fe));
+	int master = -1, term = o && o->tty ? pty_open(&master) : -1;
+	pid_t pid = launch(file, args, search, o, fileno(fo), term >= 0 ? term : fileno(fe));
+	if (term >= 0) {
+		close(term);
+		drain(master, fe);
+		close(master);
+	}
 	int status = 0;
 	waitpid(pid, &status, 0);
 	if (out)

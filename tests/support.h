@@ -18,6 +18,7 @@ typedef struct bsim_test_opts {
 	long fsize;      /* bytes: the child's RLIMIT_FSIZE (writes beyond fail), 0: none */
 	const char *out; /* a file to be the child's stdout instead of a capture */
 	const char *err; /* a file to be the child's stderr (created) instead of a capture */
+	int tty;         /* 1: stderr a pseudo-terminal, which bsim_test_cli_with captures */
 } bsim_test_opts;
 
 /* bsim_test_cli with options (o may be NULL). */
