@@ -7,8 +7,9 @@
  *   - without one, the content itself: a map CSV cut mid-row, header only,
  *     a count past the trials, counts summing past them, a NaN p; a
  *     trials.csv cut mid-row (plot too) or holding only its header;
- *   - a FIFO as run.json or as a lattice's stiffness_file, a directory as
- *     stiffness_file, a symbolic link to /dev/zero as trials.csv.
+ *   - a FIFO as run.json, as a lattice's stiffness_file or as the journal
+ *     --resume reads, a directory as stiffness_file, a symbolic link to
+ *     /dev/zero as trials.csv.
  * Each damage is made on a real small output of the program. A FIFO must
  * be refused at once: the harness's time limit only keeps a regression
  * from hanging the suite; the assertion is the exit status and message. */
@@ -288,6 +289,24 @@ static void test_sweep_files(void **state)
 	}
 }
 
+/* A FIFO in the place of a stopped run's journal: --resume refuses it at
+ * once (the journal is opened for reading and writing, so the open would
+ * not block, the first read would). */
+static void test_journal_fifo(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("journal_fifo");
+	char work[1200], journal[1300], out[1200];
+	snprintf(out, sizeof out, "%s", dir);
+	snprintf(work, sizeof work, "%s/.beamsim", dir);
+	snprintf(journal, sizeof journal, "%s/journal", work);
+	assert_int_equal(mkdir(work, 0700), 0);
+	assert_int_equal(mkfifo(journal, 0600), 0);
+	const char *argv[] = {"sweep", experiment, "--quiet", "--out", out, "--resume", NULL};
+	const char *fifo[] = {"journal: expected the journal of a stopped run, got a FIFO", NULL};
+	expect_refused(argv, fifo);
+}
+
 /* The lattice's stiffness_file: a FIFO or a directory refused at open,
  * naming the scene's line and column of the field. */
 static void test_stiffness_file(void **state)
@@ -329,10 +348,9 @@ static int setup(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_map_with_manifest),
-	        cmocka_unit_test(test_map_content),
-	        cmocka_unit_test(test_sweep_files),
-	        cmocka_unit_test(test_stiffness_file),
+	        cmocka_unit_test(test_map_with_manifest), cmocka_unit_test(test_map_content),
+	        cmocka_unit_test(test_sweep_files),       cmocka_unit_test(test_stiffness_file),
+	        cmocka_unit_test(test_journal_fifo),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }
