@@ -14,14 +14,18 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "beamsim/output.h"
 #include "beamsim/version.h"
+#include "store/outdir.h"
 #include "util/atomic_file.h"
+#include "util/csv_table.h"
 #include "util/file_read.h"
 #include "util/hash.h"
 #include "util/json.h"
@@ -100,6 +104,69 @@ static int key_same(const char *path, const char *key_text)
 	return same;
 }
 
+/* A map's file beside its key, or 0 with *absent if there is none. */
+static int map_file(const char *dir, const bsim_markov_map *m, const char *ext, double max_bytes,
+                    file_text *t, int *absent, bsim_error *err)
+{
+	char path[BSIM_PATH_MAX];
+	struct stat st;
+	snprintf(path, sizeof path, "%s/map_%016llx.%s", dir, (unsigned long long)m->key, ext);
+	*absent = lstat(path, &st) != 0 && errno == ENOENT;
+	if (*absent)
+		return BSIM_OK;
+	int rc = file_read(path, "a map file", max_bytes, NULL, t, err);
+	if (rc == BSIM_OK && strcmp(ext, "csv") == 0 &&
+	    (rc = csv_text_check(path, t->text, t->len, err)) != BSIM_OK)
+		file_text_free(t);
+	return rc;
+}
+
+/* One row of a map's CSV, "entry,exit,count,entry_edge,exit_edge,p", into
+ * v (entry, exit, count) and *p; the name of the first bad field, or NULL. */
+static const char *map_row(char *line, const bsim_markov_map *m, long v[3], double *p,
+                           const char **got)
+{
+	static const char *const field[6] = {"entry",      "exit",      "count",
+	                                     "entry_edge", "exit_edge", "p"};
+	char *f[6];
+	int n = 0;
+	for (char *c = line; n < 6; c++) {
+		f[n++] = c;
+		c = strchr(c, ',');
+		if (!c)
+			break;
+		*c = '\0';
+	}
+	*got = "nothing";
+	if (n < 6)
+		return field[n];
+	*got = f[5];
+	if (strchr(f[5], ','))
+		return "p";
+	for (int i = 0; i < 3; i++) {
+		*got = f[i];
+		char *end;
+		errno = 0;
+		v[i] = strtol(f[i], &end, 10);
+		long lo = i < 2 ? 0 : 1, hi = i < 2 ? m->n_bins - 1 : m->trials;
+		if (end == f[i] || *end || errno || v[i] < lo || v[i] > hi)
+			return field[i];
+	}
+	*got = "nothing";
+	if (!*f[3])
+		return field[3];
+	if (!*f[4])
+		return field[4];
+	*got = f[5];
+	char *end;
+	*p = strtod(f[5], &end);
+	/* written as count / trials to 9 digits */
+	if (end == f[5] || *end || !isfinite(*p) || *p < 0.0 || *p > 1.0 ||
+	    fabs(*p - (double)v[2] / m->trials) > 1e-8)
+		return "p";
+	return NULL;
+}
+
 int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
@@ -107,48 +174,100 @@ int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	if (!key_same(path, m->key_text))
 		return 0;
 	snprintf(path, sizeof path, "%s/map_%016llx.csv", dir, (unsigned long long)m->key);
-	FILE *f = fopen(path, "r");
-	if (!f)
+	/* At most a row per cell, each well under 256 bytes. */
+	double max_bytes = ((double)m->n_bins * m->n_bins + 1.0) * 256.0;
+	file_text t;
+	int absent = 0;
+	if (map_file(dir, m, "csv", max_bytes, &t, &absent, err) != BSIM_OK)
+		return -1;
+	if (absent)
 		return 0;
-	char line[256];
-	int lineno = 0, ok = fgets(line, sizeof line, f) && strncmp(line, "entry,exit,", 11) == 0;
-	lineno++;
-	const char *bad = ok ? NULL : "header";
-	while (!bad && fgets(line, sizeof line, f)) {
-		lineno++;
-		/* entry, exit: bins; count: trials */
-		static const char *const field[3] = {"entry", "exit", "count"};
-		long v[3];
-		char *p = line;
-		for (int i = 0; !bad && i < 3; i++) {
-			char *end;
-			errno = 0;
-			v[i] = strtol(p, &end, 10);
-			long hi = i < 2 ? m->n_bins - 1 : INT_MAX;
-			if (end == p || errno || v[i] < 0 || v[i] > hi || (*end != ',' && i < 2) ||
-			    (i == 2 && *end != ',' && *end != '\n' && *end != '\0'))
-				bad = field[i];
-			p = end + 1;
-		}
-		if (!bad)
-			m->counts[(size_t)v[0] * m->n_bins + v[1]] = (int)v[2];
-	}
-	fclose(f);
-	if (bad) {
-		bsim_error_set(
-		        err, BSIM_EINPUT, "%s:%d: %s: expected %s", path, lineno, bad,
-		        strcmp(bad, "header") == 0 ? "entry,exit,count,..."
-		        : strcmp(bad, "count") == 0
-		                ? "a count of trials >= 0"
-		                : (snprintf(line, sizeof line, "a bin 0 to %d", m->n_bins - 1),
-		                   line));
+	const int nb = m->n_bins;
+	long *sum = calloc((size_t)nb, sizeof *sum);
+	int *last = calloc((size_t)nb, sizeof *last);
+	char what[128];
+	const char *bad = NULL;
+	int lineno = 1;
+	char *line = t.text, *nl = strchr(line, '\n');
+	if (!sum || !last) {
+		free(sum);
+		free(last);
+		file_text_free(&t);
+		bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
 		return -1;
 	}
-	snprintf(path, sizeof path, "%s/map_%016llx.cost", dir, (unsigned long long)m->key);
-	if ((f = fopen(path, "r"))) {
-		if (fscanf(f, "cpu_seconds %lf", &m->cost) != 1)
-			m->cost = 0.0;
-		fclose(f);
+	if (!nl || (*nl = '\0', strcmp(line, "entry,exit,count,entry_edge,exit_edge,p") != 0)) {
+		bad = "header";
+		snprintf(what, sizeof what, "entry,exit,count,entry_edge,exit_edge,p");
+	}
+	while (!bad && *(line = nl + 1)) {
+		lineno++;
+		nl = strchr(line, '\n'); /* every line has one: csv_text_check */
+		*nl = '\0';
+		long v[3];
+		double p;
+		const char *got = "";
+		bad = map_row(line, m, v, &p, &got);
+		if (bad && strcmp(bad, "count") == 0)
+			snprintf(what, sizeof what, "a count of trials 1 to %d, got %.20s",
+			         m->trials, got);
+		else if (bad && strcmp(bad, "p") == 0)
+			snprintf(what, sizeof what,
+			         "a probability in [0, 1], count / %d trials, got %.20s", m->trials,
+			         got);
+		else if (bad && strstr(bad, "_edge"))
+			snprintf(what, sizeof what, "the name of a bin, got %.20s", got);
+		else if (bad)
+			snprintf(what, sizeof what, "a bin 0 to %d, got %.20s", nb - 1, got);
+		else if (m->counts[(size_t)v[0] * nb + v[1]]) {
+			bad = "exit";
+			snprintf(what, sizeof what, "each entry,exit pair once, got %ld,%ld again",
+			         v[0], v[1]);
+		} else {
+			m->counts[(size_t)v[0] * nb + v[1]] = (int)v[2];
+			sum[v[0]] += v[2];
+			last[v[0]] = lineno;
+		}
+	}
+	/* Every entry bin ran the map's trials, each ending somewhere. */
+	for (int a = 0; !bad && a < nb; a++)
+		if (sum[a] != m->trials) {
+			bad = "count";
+			lineno = last[a] ? last[a] : lineno;
+			snprintf(
+			        what, sizeof what,
+			        "the counts of entry bin %d to sum to the map's %d trials, got %ld",
+			        a, m->trials, sum[a]);
+		}
+	free(sum);
+	free(last);
+	file_text_free(&t);
+	if (bad) {
+		memset(m->counts, 0, (size_t)nb * nb * sizeof *m->counts);
+		bsim_error_set(err, BSIM_EINPUT, "%s:%d: %s: expected %s", path, lineno, bad, what);
+		return -1;
+	}
+	/* What the map cost when it was built; a map without the file cost
+	 * nothing known. */
+	m->cost = 0.0;
+	if (map_file(dir, m, "cost", 256.0, &t, &absent, err) != BSIM_OK)
+		return -1;
+	if (!absent) {
+		char *end = NULL;
+		if (strncmp(t.text, "cpu_seconds ", 12) == 0)
+			m->cost = strtod(t.text + 12, &end);
+		int ok = end && end != t.text + 12 && (*end == '\n' || *end == '\0') &&
+		         isfinite(m->cost) && m->cost >= 0.0;
+		file_text_free(&t);
+		if (!ok) {
+			snprintf(path, sizeof path, "%s/map_%016llx.cost", dir,
+			         (unsigned long long)m->key);
+			bsim_error_set(err, BSIM_EINPUT,
+			               "%s:1: cpu_seconds: expected \"cpu_seconds S\", S >= 0 the "
+			               "CPU time of the map's build",
+			               path);
+			return -1;
+		}
 	}
 	return 1;
 }
@@ -268,6 +387,12 @@ static int def_string(const ydoc *d, const char *path, char *buf, size_t size, b
 int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
+	/* The directory as its last build committed it: with a manifest,
+	 * every map file has the size and CRC-32 listed there (a map's CSV
+	 * put in another's place is refused here). */
+	int has_manifest = 0;
+	if (bsim_outdir_verify(dir, &has_manifest, err) != BSIM_OK)
+		return BSIM_EINPUT;
 	snprintf(path, sizeof path, "%s/markov.json", dir);
 	/* Without blocking: a FIFO there is refused by ydoc_load. */
 	int probe = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "store/outdir.h"
 #include "util/csv_table.h"
 #include "util/hash.h"
 #include "beamsim/limits.h"
@@ -66,10 +67,16 @@ int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entrie
 	for (int f = 0; f < n && rc == BSIM_OK; f++) {
 		char path[BSIM_PATH_MAX];
 		struct stat st;
-		if (stat(paths[f], &st) == 0 && S_ISDIR(st.st_mode))
+		int is_dir = stat(paths[f], &st) == 0 && S_ISDIR(st.st_mode);
+		if (is_dir)
 			snprintf(path, sizeof path, "%s/gate_entries.csv", paths[f]);
 		else
 			snprintf(path, sizeof path, "%s", paths[f]);
+		/* A sweep's directory is read as its run committed it: with a
+		 * manifest, each file has the listed size and CRC-32. */
+		int has_manifest = 0;
+		if (is_dir && (rc = bsim_outdir_verify(paths[f], &has_manifest, err)) != BSIM_OK)
+			break;
 		csv_table t;
 		int col[6];
 		if ((rc = csv_table_read(path, &t, err)) != BSIM_OK)

@@ -590,6 +590,46 @@ static int traj_draw(figs *f, const char *dir, traj_job *j, bsim_error *err)
 	return rc;
 }
 
+/* trials.csv whole and of this summary: every row complete (csv_table_read
+ * refuses a file cut mid-row), and each trial of the groups x trials
+ * summary.json counts once. The figures come from summary.json; a
+ * trials.csv that does not add up to it means the directory is damaged,
+ * and then no figure is drawn from it. */
+static int trials_check(const char *dir, const fsum *s, bsim_error *err)
+{
+	char path[BSIM_PATH_MAX];
+	snprintf(path, sizeof path, "%s/trials.csv", dir);
+	const long per = s->trials_per_group, total = (long)s->n_groups * per;
+	csv_table t;
+	int rc = csv_table_read(path, &t, err);
+	if (rc)
+		return rc;
+	static const char *const need[] = {"group", "trial"};
+	int col[2];
+	char *seen = calloc((size_t)total + 1, 1);
+	rc = csv_table_require(&t, path, need, 2, col, err);
+	if (!rc && !seen)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (long r = 0; !rc && r < t.n_rows; r++) {
+		double g, tr;
+		if (csv_table_number(&t, r, col[0], &g) || csv_table_number(&t, r, col[1], &tr) ||
+		    g < 0 || g >= s->n_groups || tr < 0 || tr >= per || g != (long)g ||
+		    tr != (long)tr || seen[(long)g * per + (long)tr]++)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "%s:%ld: group, trial: expected each trial of the %d "
+			                    "groups x %ld trials of summary.json once",
+			                    path, r + 2, s->n_groups, per);
+	}
+	if (!rc && t.n_rows != total)
+		rc = bsim_error_set(err, BSIM_EINPUT,
+		                    "%s:%ld: expected %ld rows (the %d groups x %ld trials of "
+		                    "summary.json), got %ld by the end of the file",
+		                    path, t.n_rows + 1, total, s->n_groups, per, t.n_rows);
+	free(seen);
+	csv_table_free(&t);
+	return rc;
+}
+
 int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
@@ -602,7 +642,9 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 	traj_job j = {.s = &s};
 	int have = 0;
 	/* every input read and checked first: a bad one leaves no figure */
-	rc = fsum_select(f, &s, err);
+	rc = trials_check(dir, &s, err);
+	if (!rc)
+		rc = fsum_select(f, &s, err);
 	if (!rc)
 		rc = active_build(&s, &a, err);
 	/* a lattice gets its own trajectory figures (figures_lattice.c) */

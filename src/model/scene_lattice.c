@@ -7,11 +7,14 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "beamsim/lattice.h"
 #include "model/scene_internal.h"
@@ -192,11 +195,31 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 	if (csv_path(w->d->path, rel, path, sizeof path))
 		return ydoc_expected(w->d, n, key, "lattice.stiffness_file", "a shorter path",
 		                     w->err);
-	FILE *f = fopen(path, "r");
-	if (!f)
+	/* Without blocking, and checked before the first read: a FIFO would
+	 * wait for a writer for ever, a directory fails only at the read. */
+	int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+	struct stat st;
+	if (fd < 0 || fstat(fd, &st) != 0) {
+		int e = errno;
+		if (fd >= 0)
+			close(fd);
 		return ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
-		                 "expected a readable CSV file, got %s (%s)", path,
-		                 strerror(errno));
+		                 "expected a readable CSV file, got %s (%s)", path, strerror(e));
+	}
+	if (!S_ISREG(st.st_mode)) {
+		close(fd);
+		return ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
+		                 "expected a regular CSV file, got %s (%s)", path,
+		                 S_ISDIR(st.st_mode)    ? "a directory"
+		                 : S_ISFIFO(st.st_mode) ? "a FIFO"
+		                 : S_ISCHR(st.st_mode)  ? "a character device"
+		                                        : "not a regular file");
+	}
+	FILE *f = fdopen(fd, "r");
+	if (!f) {
+		close(fd);
+		return bsim_error_set(w->err, BSIM_EFAIL, "%s: out of memory", path);
+	}
 	snprintf(w->s->lattice.stiffness_file, sizeof w->s->lattice.stiffness_file, "%s", rel);
 	char line[8192];
 	int lineno = 0, iy = 0, rc = BSIM_OK;
@@ -255,8 +278,9 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 		iy++;
 	}
 	if (rc == BSIM_OK && ferror(f))
-		rc = bsim_error_set(w->err, BSIM_EINPUT, "%s: lattice.stiffness_file: read error",
-		                    path);
+		rc = bsim_error_set(w->err, BSIM_EINPUT,
+		                    "%s:%d: lattice.stiffness_file: read error: %s", path,
+		                    lineno + 1, strerror(errno));
 	if (rc == BSIM_OK && iy != l->rows)
 		rc = bsim_error_set(w->err, BSIM_EINPUT,
 		                    "%s:%d: lattice.stiffness_file: expected %d rows (one per iy, "

@@ -359,8 +359,15 @@ static int manifest_read(const char *dir, olist *l, int *has, bsim_error *err)
 		return BSIM_EINPUT;
 	*has = 1;
 	struct fy_node *files = ydoc_lookup(fy_document_root(d.fyd), "files");
+	struct fy_node *format = ydoc_lookup(fy_document_root(d.fyd), "format");
+	const char *ft = format && fy_node_is_scalar(format) ? fy_node_get_scalar0(format) : NULL;
 	int rc = BSIM_OK;
-	if (!files || !fy_node_is_sequence(files))
+	/* The one format there has been; a manifest of a later one is not
+	 * read as if it were this. */
+	if (format && (!ft || strcmp(ft, "beamsim-manifest-1") != 0))
+		rc = ydoc_expected(&d, format, NULL, "format",
+		                   "\"beamsim-manifest-1\" (a manifest this beamsim reads)", err);
+	if (!rc && (!files || !fy_node_is_sequence(files)))
 		rc = ydoc_expected(&d, files, NULL, "files", "a list of files", err);
 	int n = rc ? 0 : fy_node_sequence_item_count(files);
 	for (int i = 0; !rc && i < n; i++) {
@@ -500,28 +507,76 @@ void bsim_outdir_close(bsim_outdir *od)
 	free(od);
 }
 
+/* What a file that is not a regular one is, for the message. */
+static const char *kind_of(mode_t m)
+{
+	return S_ISDIR(m)    ? "a directory"
+	       : S_ISFIFO(m) ? "a FIFO"
+	       : S_ISCHR(m)  ? "a character device"
+	       : S_ISBLK(m)  ? "a block device"
+	       : S_ISSOCK(m) ? "a socket"
+	                     : "a special file";
+}
+
+/* One listed file checked against its entry: opened without blocking (a
+ * FIFO put in its place must not stop the reader), refused unless it is a
+ * regular file of the listed size, then read to at most one byte past
+ * that size (a file that grows is not followed) for its CRC-32. */
+static int verify_one(const char *dir, const char *path, const ofile *want, bsim_error *err)
+{
+	int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+	struct stat st;
+	if (fd < 0 || fstat(fd, &st) != 0) {
+		int e = errno;
+		if (fd >= 0)
+			close(fd);
+		return bsim_error_set(err, BSIM_EINPUT, "%s: listed in %s/%s but unreadable: %s",
+		                      path, dir, BSIM_OUTDIR_MANIFEST, strerror(e));
+	}
+	if (!S_ISREG(st.st_mode)) {
+		close(fd);
+		return bsim_error_set(
+		        err, BSIM_EINPUT, "%s: expected the file %s/%s lists (%lld bytes), got %s",
+		        path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, kind_of(st.st_mode));
+	}
+	unsigned char buf[65536];
+	uLong c = crc32(0L, Z_NULL, 0);
+	long long n = 0;
+	ssize_t k = 0;
+	while (n <= want->bytes && (k = read(fd, buf, sizeof buf)) != 0) {
+		if (k < 0 && errno == EINTR)
+			continue;
+		if (k < 0)
+			break;
+		c = crc32(c, buf, (uInt)k);
+		n += k;
+	}
+	int e = k < 0 ? errno : 0;
+	close(fd);
+	if (e)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: listed in %s/%s but unreadable: %s",
+		                      path, dir, BSIM_OUTDIR_MANIFEST, strerror(e));
+	if (n != want->bytes || c != want->crc)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: expected the file %s/%s lists (%lld bytes, CRC-32 "
+		                      "%08lx), got %s%lld bytes, CRC-32 %08lx: the directory "
+		                      "mixes files of two runs, or the file was changed",
+		                      path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, want->crc,
+		                      n > want->bytes ? "more than " : "", n, c);
+	return BSIM_OK;
+}
+
 int bsim_outdir_verify(const char *dir, int *has_manifest, bsim_error *err)
 {
 	olist l = {0};
 	int rc = manifest_read(dir, &l, has_manifest, err);
 	for (size_t i = 0; !rc && i < l.n; i++) {
 		char path[BSIM_PATH_MAX];
-		long long bytes = 0;
-		unsigned long crc = 0;
-		int e = join(path, sizeof path, dir, l.v[i].rel);
-		if (!e)
-			e = crc_file(path, 0, &bytes, &crc);
-		if (e)
-			rc = bsim_error_set(err, BSIM_EINPUT,
-			                    "%s: listed in %s/%s but unreadable: %s", path, dir,
-			                    BSIM_OUTDIR_MANIFEST, strerror(e));
-		else if (bytes != l.v[i].bytes || crc != l.v[i].crc)
-			rc = bsim_error_set(err, BSIM_EINPUT,
-			                    "%s: expected the file %s/%s lists (%lld bytes, CRC-32 "
-			                    "%08lx), got %lld bytes, CRC-32 %08lx: the directory "
-			                    "mixes files of two runs",
-			                    path, dir, BSIM_OUTDIR_MANIFEST, l.v[i].bytes,
-			                    l.v[i].crc, bytes, crc);
+		if (join(path, sizeof path, dir, l.v[i].rel))
+			rc = bsim_error_set(err, BSIM_EINPUT, "%s/%s: path too long", dir,
+			                    l.v[i].rel);
+		else
+			rc = verify_one(dir, path, &l.v[i], err);
 	}
 	olist_free(&l);
 	return rc;

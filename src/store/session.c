@@ -34,7 +34,16 @@ int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *
 		return BSIM_EINPUT;
 	}
 	int have = stat(s->journal_path, &st) == 0;
-	if (resume && !have) {
+	if (have && !S_ISREG(st.st_mode)) {
+		/* The journal is opened for reading and writing: a FIFO in its
+		 * place would block the first read for ever. */
+		rc = bsim_error_set(err, BSIM_EINPUT,
+		                    "%s: expected the journal of a stopped run, got %s",
+		                    s->journal_path,
+		                    S_ISDIR(st.st_mode)    ? "a directory"
+		                    : S_ISFIFO(st.st_mode) ? "a FIFO"
+		                                           : "a file that is not a regular one");
+	} else if (resume && !have) {
 		int finished = 0;
 		bsim_error ignore;
 		bsim_outdir_verify(dir, &finished, &ignore);

@@ -13,6 +13,8 @@
 
 #include "beamsim/output.h"
 #include "store/trials_csv.h"
+#include "util/csv_table.h"
+#include "util/file_read.h"
 
 enum {
 	COL_GROUP,
@@ -200,26 +202,36 @@ int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_swe
                             bsim_error *err)
 {
 	memset(r, 0, sizeof *r);
-	FILE *f = fopen(path, "r");
-	if (!f)
-		return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file", path);
+	/* A regular file only (a link to /dev/zero or a FIFO is refused at
+	 * once), bounded, and whole: its last row ends in a line feed. */
+	file_text ft;
+	int rc = file_read(path, "a CSV file", CSV_TABLE_MAX_BYTES, NULL, &ft, err);
+	if (rc != BSIM_OK)
+		return rc;
+	if ((rc = csv_text_check(path, ft.text, ft.len, err)) != BSIM_OK) {
+		file_text_free(&ft);
+		return rc;
+	}
 	size_t total = (size_t)n_groups * (size_t)trials;
 	r->n_groups = n_groups;
 	r->trials = trials;
 	r->trials_out = calloc(total ? total : 1, sizeof *r->trials_out);
 	r->groups = calloc(n_groups > 0 ? (size_t)n_groups : 1, sizeof *r->groups);
 	if (!r->trials_out || !r->groups) {
-		fclose(f);
+		file_text_free(&ft);
 		bsim_sweep_result_free(r);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %zu trials", total);
 	}
-	char *line = NULL, *field[256];
-	size_t cap = 0;
-	int lineno = 0, rc = BSIM_OK, col[N_COLUMNS], n_fields = 0;
+	char *line, *next = ft.text, *field[256];
+	int lineno = 0, col[N_COLUMNS], n_fields = 0;
 	size_t rows = 0;
-	while (rc == BSIM_OK && getline(&line, &cap, f) >= 0) {
+	while (rc == BSIM_OK && *next) {
+		line = next;
+		char *nl = strchr(line, '\n'); /* there is one: csv_text_check */
+		*nl = '\0';
+		next = nl + 1;
 		lineno++;
-		line[strcspn(line, "\r\n")] = '\0';
+		line[strcspn(line, "\r")] = '\0';
 		if (lineno == 1) {
 			if (read_header(line, col, &n_fields) != 0)
 				rc = bsim_error_set(
@@ -240,13 +252,14 @@ int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_swe
 			        path, lineno, n_fields, n_groups, trials);
 		rows++;
 	}
-	free(line);
-	fclose(f);
+	file_text_free(&ft);
 	if (rc == BSIM_OK && lineno == 0)
 		rc = bsim_error_set(err, BSIM_EINPUT, "%s: empty file, expected a header", path);
 	if (rc == BSIM_OK && rows != total)
-		rc = bsim_error_set(err, BSIM_EINPUT, "%s: expected %zu rows, got %zu", path, total,
-		                    rows);
+		rc = bsim_error_set(err, BSIM_EINPUT,
+		                    "%s:%d: expected %zu rows (%d groups x %d trials), got %zu "
+		                    "by the end of the file",
+		                    path, lineno, total, n_groups, trials, rows);
 	if (rc != BSIM_OK) {
 		bsim_sweep_result_free(r);
 		return rc;

@@ -35,6 +35,27 @@ static int count_fields(const char *line)
 	return n;
 }
 
+int csv_text_check(const char *path, const char *text, size_t len, bsim_error *err)
+{
+	long line = 1;
+	for (size_t i = 0; i < len; i++) {
+		if (text[i] == '\0')
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "%s:%ld: expected text, got a NUL byte (at byte %zu)",
+			                      path, line, i);
+		line += text[i] == '\n';
+	}
+	/* Every line beamsim writes ends in a line feed: a last line without
+	 * one is a row cut short (a full disk, a copy interrupted), whose last
+	 * field may still read as a number. */
+	if (len > 0 && text[len - 1] != '\n')
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s:%ld: expected a whole line ending in a line feed, got "
+		                      "the file cut short in this line",
+		                      path, line);
+	return BSIM_OK;
+}
+
 void csv_table_free(csv_table *t)
 {
 	free(t->names);
@@ -46,14 +67,19 @@ void csv_table_free(csv_table *t)
 int csv_table_read(const char *path, csv_table *t, bsim_error *err)
 {
 	memset(t, 0, sizeof *t);
-	/* No size limit: tables are beamsim's own outputs, as large as the
-	 * runs that wrote them. */
+	/* Only a regular file, never waited on, and at most CSV_TABLE_MAX_BYTES
+	 * of it: a link to /dev/zero or a file that keeps growing must not
+	 * fill memory. */
 	file_text f;
-	int rc = file_read(path, "a CSV file", INFINITY, NULL, &f, err);
+	int rc = file_read(path, "a CSV file", CSV_TABLE_MAX_BYTES, NULL, &f, err);
 	if (rc != BSIM_OK)
 		return rc;
 	t->text = f.text;
 	size_t len = f.len;
+	if ((rc = csv_text_check(path, f.text, len, err)) != BSIM_OK) {
+		csv_table_free(t);
+		return rc;
+	}
 	/* Lines, in place: strip \r\n, skip a last empty line. */
 	long n_lines = 0;
 	for (size_t i = 0; i < len; i++)

@@ -20,9 +20,20 @@ typedef struct csv_table {
 	char *text;   /* the file, split in place */
 } csv_table;
 
-/* Reads path. BSIM_EINPUT "FILE:LINE: expected N fields, got M" on a row
- * of the wrong width, or naming the file if it cannot be read or has no
- * header. */
+/* The largest table read, bytes (16 GiB: 80 million trials.csv rows). */
+#define CSV_TABLE_MAX_BYTES 17179869184.0
+
+/* The checks every stored CSV text passes before it is split: no NUL byte,
+ * and a last line that ends in a line feed (beamsim ends every line it
+ * writes, so a file without one was cut mid-row). BSIM_EINPUT
+ * "FILE:LINE: expected ..." naming the line otherwise. */
+int csv_text_check(const char *path, const char *text, size_t len, bsim_error *err);
+
+/* Reads path: a regular file (a FIFO, a device or a directory is refused
+ * at once, without waiting on it) of at most CSV_TABLE_MAX_BYTES that
+ * passes csv_text_check. BSIM_EINPUT "FILE:LINE: expected N fields, got M"
+ * on a row of the wrong width, or naming the file if it cannot be read or
+ * has no header. */
 int csv_table_read(const char *path, csv_table *t, bsim_error *err);
 void csv_table_free(csv_table *t);
 
