@@ -41,6 +41,7 @@
 #ifndef BSIM_VIDEO_H
 #define BSIM_VIDEO_H
 
+#include <signal.h>
 #include <stdint.h>
 
 #include "beamsim/base.h"
@@ -62,6 +63,10 @@ typedef struct bsim_video_def {
 	double view_span;   /* m: the most of the world a panel's shorter side shows; default 200 */
 	int crf;            /* x264 constant rate factor, 0-51 (lower is better); default 23 */
 	const char *ffmpeg; /* the encoder program, looked up on PATH; default "ffmpeg" */
+	/* May be NULL. When *stop becomes nonzero (a signal handler sets it),
+	 * bsim_video_write draws no further frame, removes its temporary file
+	 * and returns BSIM_ESTOPPED. */
+	const volatile sig_atomic_t *stop;
 } bsim_video_def;
 
 BSIM_API bsim_video_def bsim_video_def_default(void);

@@ -215,11 +215,23 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 		                             &tracks[i], &err);
 	}
 	bsim_video *v = NULL;
+	a->def.stop = &cli_stop;
 	if (rc == BSIM_OK)
 		rc = bsim_video_alloc(&a->def, scene, (const bsim_video_track *const *)tracks,
 		                      labels, a->n_backends, &v, &err);
-	if (rc == BSIM_OK)
+	/* While ffmpeg writes its temporary file, SIGINT and SIGTERM stop the
+	 * video and remove it; before, they end the program, which has
+	 * written nothing yet. */
+	if (rc == BSIM_OK) {
+		cli_signals_install();
 		rc = bsim_video_write(v, a->out, &err);
+		cli_signals_restore();
+	}
+	if (rc == BSIM_ESTOPPED) {
+		int sig = cli_stop ? (int)cli_stop : SIGINT;
+		cli_error("%s: %s", sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
+		rc = 128 + sig;
+	}
 	/* A video on standard output keeps it to itself: the report goes to
 	 * standard error. */
 	FILE *out = strcmp(a->out, "-") == 0 ? stderr : stdout;
@@ -251,7 +263,7 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 	bsim_video_free(v);
 	for (int i = 0; i < a->n_backends; i++)
 		bsim_video_track_free(tracks[i]);
-	return cli_report(rc, &err);
+	return rc > BSIM_ESTOPPED ? rc : cli_report(rc, &err);
 }
 
 int cmd_video(int argc, char **argv)

@@ -170,12 +170,18 @@ int bsim_video_write(bsim_video *v, const char *path, bsim_error *err)
 	int rc = bsim_video_encoder_open(path, v->def.ffmpeg, v->width, v->height, v->def.fps,
 	                                 v->def.crf, &enc, err);
 	for (long k = 0; rc == BSIM_OK && k < v->frames; k++) {
+		if (v->def.stop && *v->def.stop)
+			break;
 		/* Held frames are the same picture: draw it once. */
 		if (k <= v->frames_sim)
 			rc = bsim_video_render(v, k, pixels, err);
 		if (rc == BSIM_OK)
 			rc = bsim_video_encoder_write(enc, pixels, err);
 	}
+	/* A signal also reaches ffmpeg when it comes from the terminal, so a
+	 * frame that could not be written then is the stop, not a failure. */
+	if (enc && v->def.stop && *v->def.stop)
+		rc = bsim_error_set(err, BSIM_ESTOPPED, "%s: stopped; no video written", path);
 	if (rc == BSIM_OK) {
 		rc = bsim_video_encoder_close(enc, err);
 	} else {
