@@ -682,7 +682,9 @@ static void cli_bad_arguments(void **state)
 		const char *args[6];
 		const char *needle;
 	} cases[] = {
-	        {{"--fps", "0"}, "--fps 0: expected a number in (0, 1000]"},
+	        {{"--fps", "0"}, "--fps 0: expected a number in [0.01, 1000]"},
+	        {{"--fps", "1e-9"}, "--fps 1e-9: expected a number in [0.01, 1000]"},
+	        {{"--fps", "1001"}, "--fps 1001: expected a number in [0.01, 1000]"},
 	        {{"--fps", "30x"}, "--fps 30x"},
 	        {{"--size", "641x480"}, "expected even WIDTHxHEIGHT"},
 	        {{"--size", "640"}, "--size 640: expected WIDTHxHEIGHT"},

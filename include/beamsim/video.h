@@ -58,7 +58,7 @@ extern "C" {
  * bsim_video_def_default). */
 typedef struct bsim_video_def {
 	int width, height;  /* pixels of a frame, all panels; even, >= 64; 0 = 540 x 540 a panel */
-	double fps;         /* frames per second of simulated time, > 0; default 30 */
+	double fps;         /* frames per second of simulated time, 0.01 to 1000; default 30 */
 	double hold;        /* s: the last frame is held this long at the end, >= 0; default 1 */
 	double view_span;   /* m: the most of the world a panel's shorter side shows; default 200 */
 	int crf;            /* x264 constant rate factor, 0-51 (lower is better); default 23 */

@@ -23,7 +23,8 @@ static const cli_own video_own[] = {
         [OWN_BACKENDS] = {"backends", 1, "A,B", "several backends side by side (up to 4)"},
         [OWN_GROUP] = {"group", 1, "G", "group index for the seed (default 0)"},
         [OWN_TRIAL] = {"trial", 1, "I", "trial index for the seed (default 0)"},
-        [OWN_FPS] = {"fps", 1, "F", "frames per second of simulated time (default 30)"},
+        [OWN_FPS] = {"fps", 1, "F",
+                     "frames per second of simulated time, 0.01 to 1000 (default 30)"},
         [OWN_SIZE] = {"size", 1, "WxH", "frame size in pixels, even (default 540x540 a panel)"},
         [OWN_HOLD] = {"hold", 1, "S", "seconds the last frame is held (default 1)"},
         [OWN_VIEW] = {"view", 1, "M",
@@ -117,7 +118,9 @@ static int video_option(void *args, int i, const char *value)
 			return cli_usage("video", "--trial %s: expected an integer >= 0", value);
 		return CLI_OK;
 	case OWN_FPS:
-		return parse_number("--fps", value, 0.0, 1000.0, 1, &a->def.fps);
+		/* Below 0.01 a frame lasts over 100 s; ffmpeg's MP4 muxer refuses
+		 * frames of 1e6 s ("Application provided duration ... is invalid"). */
+		return parse_number("--fps", value, 0.01, 1000.0, 0, &a->def.fps);
 	case OWN_SIZE:
 		return parse_size(a, value);
 	case OWN_HOLD:
