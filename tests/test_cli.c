@@ -286,6 +286,19 @@ static void test_trajectory(void **state)
 	int rows = bsim_test_count_lines(csv) - 1;
 	assert_true(rows >= steps_run / 10 && rows <= steps_run / 10 + 2);
 	free(csv);
+
+	/* A path with no room for FILE.tmp.PID is a usage error, before the run. */
+	char long_path[1300];
+	memset(long_path, 'a', sizeof long_path - 1);
+	long_path[0] = '/';
+	long_path[sizeof long_path - 1] = '\0';
+	const char *too_long[] = {"run", gate, "--trajectory", long_path, NULL};
+	const char *says[] = {"--trajectory /aaa", "path too long (1299 bytes, at most 1199)",
+	                      NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(too_long, NULL, &err);
+	bsim_test_check_input_error(rc, err, says, 0);
+	free(err);
 }
 
 /* Keys appear in this order in text. */

@@ -15,6 +15,7 @@
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "beamsim/lattice_outcome.h"
+#include "beamsim/limits.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 
@@ -61,6 +62,12 @@ static int run_option(void *args, int i, const char *value)
 			return cli_usage("run", "--trial %s: expected an integer >= 0", value);
 		return CLI_OK;
 	case OWN_TRAJECTORY:
+		/* Room for the names beamsim appends (FILE.tmp.PID, the .mat twin). */
+		if (strlen(value) >= BSIM_PATH_MAX - BSIM_NAME_MAX)
+			return cli_usage(
+			        "run",
+			        "--trajectory %.40s...: path too long (%zu bytes, at most %d)",
+			        value, strlen(value), BSIM_PATH_MAX - BSIM_NAME_MAX - 1);
 		a->trajectory = value;
 		return CLI_OK;
 	case OWN_STRIDE:
