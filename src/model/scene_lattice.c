@@ -299,6 +299,18 @@ static int lattice_maps_read(scene_walk *w, struct fy_node *map, lattice_maps *m
 	if (file && gate_map)
 		return ydoc_fail(w->d, file, kfile, "lattice.stiffness_file", w->err,
 		                 "expected either stiffness or stiffness_file, not both");
+	/* A per-gate map and a per-beam one give every beam twice: which one a
+	 * reader of the scene meant is not for beamsim to guess. */
+	for (int i = 1; i < 3 && (file || gate_map); i++) {
+		struct fy_node *k;
+		struct fy_node *n = child(map, names[i], &k);
+		if (n)
+			return ydoc_fail(w->d, n, k,
+			                 i == 1 ? "lattice.stiffness_left"
+			                        : "lattice.stiffness_right",
+			                 w->err, "expected either %s or %s, not both",
+			                 file ? "stiffness_file" : "stiffness", names[i]);
+	}
 	for (int i = 0; i < 3; i++) {
 		struct fy_node *k;
 		struct fy_node *n = child(map, names[i], &k);
