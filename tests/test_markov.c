@@ -30,6 +30,7 @@
 #include "beamsim/markov.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "beamsim/version.h"
 #include "beamsim/lattice_outcome.h"
 #include "support.h"
 
@@ -399,8 +400,11 @@ static void test_bad_map_files(void **state)
 	        {"\"trials\": 2", "\"trials\": \"two\"",
 	         "trials: expected an integer 1 to 1000000, got \"two\""},
 	        {"\"speed\": 1", "\"speed\": 0", "bins/speed: expected an integer 1 to 64, got 0"},
+	        {"\"beamsim_version\": \"" BSIM_VERSION "\"", "\"beamsim_version\": \"0.0.0-old\"",
+	         "beamsim_version: expected maps of this beamsim, " BSIM_VERSION
+	         ", got maps built by beamsim 0.0.0-old"},
 	};
-	for (int i = 0; i < 2; i++) {
+	for (int i = 0; i < 3; i++) {
 		char *at = strstr(json, json_cases[i].from);
 		assert_non_null(at);
 		char text[2048];
