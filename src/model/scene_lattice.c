@@ -15,6 +15,7 @@
 
 #include "beamsim/lattice.h"
 #include "model/scene_internal.h"
+#include "util/decimal.h"
 
 /* Gates a lattice may have: 1e5 gates is 2e5 beams, far beyond any study. */
 #define LATTICE_GATES_MAX 100000
@@ -244,7 +245,7 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 			errno = 0;
 			double v = strtod(fields[c], &end);
 			if (end == fields[c] || *end != '\0' || errno == ERANGE || !isfinite(v) ||
-			    v < 0.0)
+			    v < 0.0 || decimal_other_base(fields[c]))
 				rc = bsim_error_set(w->err, BSIM_EINPUT,
 				                    "%s:%d:%d: lattice.stiffness_file: expected a "
 				                    "number >= 0 (N m/rad), got %.40s",

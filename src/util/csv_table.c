@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "util/decimal.h"
 #include "util/file_read.h"
 
 /* Splits line in place at commas into out (at most max fields); the
@@ -124,7 +125,7 @@ int csv_table_number(const csv_table *t, long row, int col, double *out)
 {
 	const char *s = csv_table_cell(t, row, col);
 	char *end;
-	if (!*s)
+	if (!*s || decimal_other_base(s))
 		return -1;
 	*out = strtod(s, &end); /* an underflow to 0 or subnormal is still that number */
 	return *end == '\0' ? 0 : -1;
