@@ -391,6 +391,45 @@ static void test_decimal_numbers(void **state)
 	expect_refusal(mk, mk_says);
 }
 
+/* dir/name holding n bytes (NULs too). */
+static void put_bytes(const char *dir, const char *name, const char *bytes, size_t n)
+{
+	char path[1300];
+	snprintf(path, sizeof path, "%s/%s", dir, name);
+	FILE *f = fopen(path, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(bytes, 1, n, f), n);
+	assert_int_equal(fclose(f), 0);
+}
+
+/* A NUL byte in a CSV is named with its line and column (it used to read
+ * as a line too long, or to end the line unseen). */
+static void test_nul_in_csv(void **state)
+{
+	(void)state;
+	char dir[1200], scene[1300];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("nul_csv"));
+	snprintf(scene, sizeof scene, "%s", bsim_test_write(dir, "scene.yaml", LATTICE_3X3));
+	static const char map[] = "1, 2, 3\n4,\0 5, 6\n7, 8, 9\n";
+	put_bytes(dir, "map.csv", map, sizeof map - 1);
+	const char *lat[] = {"run", scene, NULL};
+	const char *lat_says[] = {
+	        "map.csv:2:3: lattice.stiffness_file: expected text, got a NUL byte", NULL};
+	expect_refusal(lat, lat_says);
+
+	static const char entries[] = "group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy\n"
+	                              "0,0,0,0,0,start,0,0,0,0,0,0,0\n"
+	                              "0,0,1,\0001,0,left,1280,5.12,1,-24.99,19.98,2.67,0.075\n";
+	put_bytes(dir, "gate_entries.csv", entries, sizeof entries - 1);
+	char path[1300], out[1300];
+	snprintf(path, sizeof path, "%s/gate_entries.csv", dir);
+	snprintf(out, sizeof out, "%s/maps", dir);
+	const char *track = bsim_test_src("configs/markov/c_track.yaml");
+	const char *mk[] = {"markov", "build", track, "--entries", path, "--out", out, NULL};
+	const char *mk_says[] = {"gate_entries.csv:3:7: expected text, got a NUL byte", NULL};
+	expect_refusal(mk, mk_says);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -406,6 +445,7 @@ int main(void)
 	        cmocka_unit_test(test_limits),
 	        cmocka_unit_test(test_extreme_numbers),
 	        cmocka_unit_test(test_decimal_numbers),
+	        cmocka_unit_test(test_nul_in_csv),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

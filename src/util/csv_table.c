@@ -55,6 +55,19 @@ int csv_table_read(const char *path, csv_table *t, bsim_error *err)
 		return rc;
 	t->text = f.text;
 	size_t len = f.len;
+	/* A NUL would end a line's text early, unseen: named where it is. */
+	const char *nul = memchr(t->text, '\0', len);
+	if (nul) {
+		long line = 1, col = 1;
+		for (const char *c = t->text; c < nul; c++, col++)
+			if (*c == '\n') {
+				line++;
+				col = 0;
+			}
+		csv_table_free(t);
+		return bsim_error_set(err, BSIM_EINPUT, "%s:%ld:%ld: expected text, got a NUL byte",
+		                      path, line, col);
+	}
 	/* Lines, in place: strip \r\n, skip a last empty line. */
 	long n_lines = 0;
 	for (size_t i = 0; i < len; i++)
