@@ -113,6 +113,12 @@ int cli_run_end(int rc, const char *journal, int argc, char **argv);
  * written (where: "summary.json", ...). */
 void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const char *where);
 
+/* path as the terminal may show it: control characters and bytes that are
+ * not UTF-8 as \xNN (a newline in a file name must not start a line of
+ * the report). In one of 4 static buffers used in turn, so up to 4 may be
+ * given to one printf. */
+const char *cli_path(const char *path);
+
 /* text (malloc'd) with more appended, reallocated; NULL (text freed) if
  * out of memory. */
 char *cli_text_append(char *text, const char *more);

@@ -247,7 +247,7 @@ static int markov_build(int argc, char **argv)
 		printf("%d maps built (%.1f s of CPU), %d reused; %d entry bins x %d trials each, "
 		       "in %s\n",
 		       built, cpu, reused, bsim_markov_bins_count(&a.def.bins), a.def.trials,
-		       c.out);
+		       cli_path(c.out));
 	bsim_experiment_free(&e);
 	bsim_markov_entries_free(&entries);
 	cli_common_free(&c);
@@ -355,7 +355,7 @@ static int markov_validate(int argc, char **argv)
 		}
 		printf("\nwrote       %s/: validate.json, validate.csv, gates.csv (+ .mat), "
 		       "validate_gNNN (.png .svg .gp)\n",
-		       c.out);
+		       cli_path(c.out));
 	}
 	bsim_markov_validation_free(&v);
 	cli_common_free(&c);

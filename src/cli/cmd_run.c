@@ -131,7 +131,7 @@ static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64
                        const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	const bsim_ledger *l = &r->ledger;
-	fprintf(out, "scene       %s (%s), backend %s\n", a->scene, s->name, a->backend);
+	fprintf(out, "scene       %s (%s), backend %s\n", cli_path(a->scene), s->name, a->backend);
 	fprintf(out,
 	        "seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
 	        ", %lu draws)\n",

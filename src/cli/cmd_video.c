@@ -240,7 +240,7 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 	FILE *out = strcmp(a->out, "-") == 0 ? stderr : stdout;
 	if (rc == BSIM_OK) {
 		fprintf(out, "scene       %s (%s), seed %" PRIu64 ", group %ld, trial %ld\n",
-		        a->scene, scene->name, a->seed, a->group, a->trial);
+		        cli_path(a->scene), scene->name, a->seed, a->group, a->trial);
 		for (int i = 0; i < a->n_backends; i++)
 			print_outcome(out, a->names[i], scene, bsim_video_track_result(tracks[i]));
 		if (a->n_backends > 1) {
@@ -261,7 +261,7 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 		bsim_video_size(v, &w, &h);
 		long frames = bsim_video_frames(v);
 		fprintf(out, "wrote       %s: %dx%d, H.264 yuv420p, %g fps, %ld frames, %.6g s\n",
-		        a->out, w, h, a->def.fps, frames, (double)frames / a->def.fps);
+		        cli_path(a->out), w, h, a->def.fps, frames, (double)frames / a->def.fps);
 	}
 	bsim_video_free(v);
 	for (int i = 0; i < a->n_backends; i++)
