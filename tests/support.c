@@ -426,6 +426,20 @@ int bsim_test_await_entry(int pid, const char *dir, int *status)
 	return await(pid, has_entry, dir, 0, status);
 }
 
+static int has_matches(const char *pattern, long n)
+{
+	glob_t g;
+	long found = glob(pattern, 0, NULL, &g) == 0 ? (long)g.gl_pathc : 0;
+	if (found)
+		globfree(&g);
+	return found >= n;
+}
+
+int bsim_test_await_glob(int pid, const char *pattern, long n, int *status)
+{
+	return await(pid, has_matches, pattern, n, status);
+}
+
 /* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
  * each over 1 kB and at most 1 MB; the number of figures, or -1 (said on
  * stderr) if one is missing or out of that range. */

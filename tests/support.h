@@ -60,6 +60,10 @@ int bsim_test_await_records(int pid, const char *path, long n, int *status);
  * 1, or 0 with *status if the program ended first. */
 int bsim_test_await_entry(int pid, const char *dir, int *status);
 
+/* Waits until at least n paths match the glob pattern while the spawned
+ * pid runs: 1, or 0 with *status if the program ended first. */
+int bsim_test_await_glob(int pid, const char *pattern, long n, int *status);
+
 /* A fresh empty directory under BSIM_TEST_TMP named name; returns its path
  * in a static buffer (valid until the next call). */
 const char *bsim_test_dir(const char *name);

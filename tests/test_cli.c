@@ -286,6 +286,19 @@ static void test_trajectory(void **state)
 	int rows = bsim_test_count_lines(csv) - 1;
 	assert_true(rows >= steps_run / 10 && rows <= steps_run / 10 + 2);
 	free(csv);
+
+	/* A path with no room for FILE.tmp.PID is a usage error, before the run. */
+	char long_path[1300];
+	memset(long_path, 'a', sizeof long_path - 1);
+	long_path[0] = '/';
+	long_path[sizeof long_path - 1] = '\0';
+	const char *too_long[] = {"run", gate, "--trajectory", long_path, NULL};
+	const char *says[] = {"--trajectory /aaa", "path too long (1299 bytes, at most 1199)",
+	                      NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(too_long, NULL, &err);
+	bsim_test_check_input_error(rc, err, says, 0);
+	free(err);
 }
 
 /* Keys appear in this order in text. */
@@ -520,6 +533,36 @@ static void test_backend_opt_story(void **state)
 	cli_run_free(&r);
 }
 
+/* File names are printed escaped: a newline in one does not start a line of
+ * the report (nor could an escape sequence reach the terminal). */
+static void test_names_escaped(void **state)
+{
+	(void)state;
+	char dir[1024], scene[1100], out_dir[1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("names"));
+	char *text = bsim_test_read(gate);
+	assert_non_null(text);
+	snprintf(scene, sizeof scene, "%s", bsim_test_write(dir, "ga\nte.yaml", text));
+	free(text);
+	const char *run[] = {"run", scene, "--set", "integration.max_steps=5", NULL};
+	char *out = NULL;
+	assert_int_equal(bsim_test_cli(run, &out, NULL), 0);
+	assert_non_null(strstr(out, "ga\\x0Ate.yaml (thesis-gate)"));
+	assert_null(strstr(out, "ga\nte"));
+	free(out);
+	snprintf(out_dir, sizeof out_dir, "%s/o\x1b[2Jut", dir);
+	const char *sweep[] = {"sweep",    bsim_test_src("configs/thesis/h2_asymmetric.yaml"),
+	                       "--trials", "1",
+	                       "--set",    "integration.max_steps=5",
+	                       "--out",    out_dir,
+	                       NULL};
+	out = NULL;
+	assert_int_equal(bsim_test_cli(sweep, &out, NULL), 0);
+	assert_non_null(strstr(out, "o\\x1B[2Jut/summary.json"));
+	assert_null(strchr(out, '\x1b'));
+	free(out);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -531,6 +574,7 @@ int main(void)
 	        cmocka_unit_test(test_bad_scene),
 	        cmocka_unit_test(test_run),
 	        cmocka_unit_test(test_trajectory),
+	        cmocka_unit_test(test_names_escaped),
 	        cmocka_unit_test(test_sweep),
 	        cmocka_unit_test(test_sweep_bad_experiment),
 	        cmocka_unit_test(test_unstable),

@@ -357,6 +357,99 @@ static void test_extreme_numbers(void **state)
 	}
 }
 
+#define LATTICE_3X3                                                                                \
+	"body: { mass: 1, radius: 10 }\n"                                                          \
+	"lattice:\n  columns: 3\n  rows: 3\n"                                                      \
+	"  beam: { length: 25, mass: 0.1, stiffness: 400, damping: 50 }\n"                         \
+	"  stiffness_file: map.csv\n"
+
+/* Numbers are decimal: strtod read "0x190" as 400, and a leading zero is
+ * octal to YAML 1.1; both are refused in scenes, --set values, a lattice's
+ * CSV and the CSV tables beamsim reads back, while "1e3", "-0.5", ".5" stay
+ * numbers. */
+static void test_decimal_numbers(void **state)
+{
+	(void)state;
+	const char *g = gate();
+	const char *hex[] = {"run", g, "--set", "body.mass=0x190", NULL};
+	const char *hex_says[] = {"body.mass: expected a positive number, got 0x190", NULL};
+	expect_refusal(hex, hex_says);
+	const char *oct[] = {"run", g, "--set", "integration.max_steps=010", NULL};
+	const char *oct_says[] = {"integration.max_steps: expected a positive integer, got 010",
+	                          NULL};
+	expect_refusal(oct, oct_says);
+	const char *fine[] = {"run",   g,
+	                      "--set", "body.mass=1e3",
+	                      "--set", "body.velocity.0=-0.5",
+	                      "--set", "contact.restitution=.5",
+	                      "--set", "integration.max_steps=5",
+	                      NULL};
+	assert_int_equal(bsim_test_cli(fine, NULL, NULL), 0);
+
+	char dir[1200], scene[1300];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("decimal"));
+	snprintf(scene, sizeof scene, "%s", bsim_test_write(dir, "scene.yaml", LATTICE_3X3));
+	bsim_test_write(dir, "map.csv", "1, 0x190, 3\n4, 5, 6\n7, 8, 9\n");
+	const char *lat[] = {"run", scene, NULL};
+	const char *lat_says[] = {"map.csv:1:", "lattice.stiffness_file", "got 0x190", NULL};
+	expect_refusal(lat, lat_says);
+	bsim_test_write(dir, "map.csv", "1e3, .5, 0.5\n4, 5, 6\n7, 8, 9\n");
+	const char *lat_ok[] = {"run", scene, "--set", "integration.max_steps=5", NULL};
+	assert_int_equal(bsim_test_cli(lat_ok, NULL, NULL), 0);
+
+	const char *entries =
+	        bsim_test_write(dir, "gate_entries.csv",
+	                        "group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy\n"
+	                        "0,0,0,0,0,start,0,0,0,0,0,0,0\n"
+	                        "0,0,1,1,0,left,1280,5.12,0x10,-24.99,19.98,2.67,0.075\n");
+	char path[1300], out[1300];
+	snprintf(path, sizeof path, "%s", entries);
+	snprintf(out, sizeof out, "%s/maps", dir);
+	const char *track = bsim_test_src("configs/markov/c_track.yaml");
+	const char *mk[] = {"markov", "build", track, "--entries", path, "--out", out, NULL};
+	const char *mk_says[] = {"gate_entries.csv:3: expected an entry", NULL};
+	expect_refusal(mk, mk_says);
+}
+
+/* dir/name holding n bytes (NULs too). */
+static void put_bytes(const char *dir, const char *name, const char *bytes, size_t n)
+{
+	char path[1300];
+	snprintf(path, sizeof path, "%s/%s", dir, name);
+	FILE *f = fopen(path, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(bytes, 1, n, f), n);
+	assert_int_equal(fclose(f), 0);
+}
+
+/* A NUL byte in a CSV is named with its line and column (it used to read
+ * as a line too long, or to end the line unseen). */
+static void test_nul_in_csv(void **state)
+{
+	(void)state;
+	char dir[1200], scene[1300];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("nul_csv"));
+	snprintf(scene, sizeof scene, "%s", bsim_test_write(dir, "scene.yaml", LATTICE_3X3));
+	static const char map[] = "1, 2, 3\n4,\0 5, 6\n7, 8, 9\n";
+	put_bytes(dir, "map.csv", map, sizeof map - 1);
+	const char *lat[] = {"run", scene, NULL};
+	const char *lat_says[] = {
+	        "map.csv:2:3: lattice.stiffness_file: expected text, got a NUL byte", NULL};
+	expect_refusal(lat, lat_says);
+
+	static const char entries[] = "group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy\n"
+	                              "0,0,0,0,0,start,0,0,0,0,0,0,0\n"
+	                              "0,0,1,\0001,0,left,1280,5.12,1,-24.99,19.98,2.67,0.075\n";
+	put_bytes(dir, "gate_entries.csv", entries, sizeof entries - 1);
+	char path[1300], out[1300];
+	snprintf(path, sizeof path, "%s/gate_entries.csv", dir);
+	snprintf(out, sizeof out, "%s/maps", dir);
+	const char *track = bsim_test_src("configs/markov/c_track.yaml");
+	const char *mk[] = {"markov", "build", track, "--entries", path, "--out", out, NULL};
+	const char *mk_says[] = {"gate_entries.csv:3:7: expected text, got a NUL byte", NULL};
+	expect_refusal(mk, mk_says);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -371,6 +464,8 @@ int main(void)
 	        cmocka_unit_test(test_set_values),
 	        cmocka_unit_test(test_limits),
 	        cmocka_unit_test(test_extreme_numbers),
+	        cmocka_unit_test(test_decimal_numbers),
+	        cmocka_unit_test(test_nul_in_csv),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -57,6 +57,23 @@ static void map_wrong_rows(void **state)
 	            needles);
 }
 
+/* A per-gate map with a per-beam one: refused, naming both keys. */
+static void map_and_beam_maps(void **state)
+{
+	(void)state;
+	const char *gate[] = {"scene.yaml:7:", "lattice.stiffness_left",
+	                      "expected either stiffness or stiffness_left, not both", NULL};
+	bad_lattice("lat_both", BODY LATTICE_3X3 "  stiffness: [[1, 2, 3], [4, 5, 6], [7, 8, 9]]\n"
+	                                         "  stiffness_left: [[1, 2, 3], [4, 5, 6], [7, 8, 9]]\n",
+	            NULL, gate);
+	const char *file[] = {"scene.yaml:7:", "lattice.stiffness_right",
+	                      "expected either stiffness_file or stiffness_right, not both", NULL};
+	bad_lattice("lat_both_file",
+	            BODY LATTICE_3X3 "  stiffness_file: map.csv\n"
+	                             "  stiffness_right: [[1, 2, 3], [4, 5, 6], [7, 8, 9]]\n",
+	            "1,2,3\n4,5,6\n7,8,9\n", file);
+}
+
 static void map_wrong_columns(void **state)
 {
 	(void)state;
@@ -394,6 +411,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(map_wrong_rows),    cmocka_unit_test(map_wrong_columns),
+	        cmocka_unit_test(map_and_beam_maps),
 	        cmocka_unit_test(map_negative),      cmocka_unit_test(beam_negative),
 	        cmocka_unit_test(csv_negative),      cmocka_unit_test(csv_wrong_shape),
 	        cmocka_unit_test(empty_lattice),     cmocka_unit_test(lattice_and_beams),

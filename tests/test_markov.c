@@ -15,12 +15,14 @@
 
 #include <math.h>
 #include <setjmp.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmocka.h>
 
@@ -28,6 +30,7 @@
 #include "beamsim/markov.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "beamsim/version.h"
 #include "beamsim/lattice_outcome.h"
 #include "support.h"
 
@@ -400,8 +403,11 @@ static void test_bad_map_files(void **state)
 	        {"\"trials\": 2", "\"trials\": \"two\"",
 	         "trials: expected an integer 1 to 1000000, got \"two\""},
 	        {"\"speed\": 1", "\"speed\": 0", "bins/speed: expected an integer 1 to 64, got 0"},
+	        {"\"beamsim_version\": \"" BSIM_VERSION "\"", "\"beamsim_version\": \"0.0.0-old\"",
+	         "beamsim_version: expected maps of this beamsim, " BSIM_VERSION
+	         ", got maps built by beamsim 0.0.0-old"},
 	};
-	for (int i = 0; i < 2; i++) {
+	for (int i = 0; i < 3; i++) {
 		char *at = strstr(json, json_cases[i].from);
 		assert_non_null(at);
 		char text[2048];
@@ -527,6 +533,74 @@ static void test_entries(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The maps files of dir (key, counts; not the CPU times) concatenated. */
+static char *maps_of(const char *dir)
+{
+	char *keys = bsim_test_read_glob(bsim_test_join(dir, "map_*.key"));
+	char *csv = map_text(dir);
+	assert_non_null(keys);
+	char *both = malloc(strlen(keys) + strlen(csv) + 1);
+	assert_non_null(both);
+	strcpy(both, keys);
+	strcat(both, csv);
+	free(keys);
+	free(csv);
+	return both;
+}
+
+/* A build stopped by SIGINT or SIGTERM once its first map is committed
+ * (the manifest appears with it) exits 128 + the signal, keeping that map;
+ * one killed (SIGKILL) keeps it too; the same command then builds only the
+ * other, and the directory's maps are those of a build never stopped. */
+static void test_interrupted_build(void **state)
+{
+	(void)state;
+	const char *exp = bsim_test_src("configs/lattice/c_track_essay.yaml");
+	char whole[1024];
+	snprintf(whole, sizeof whole, "%s", bsim_test_dir("build_whole"));
+	const char *b[] = {"markov", "build",   exp,     "--trials", "400", "--bins",
+	                   "2,2,2",  "--quiet", "--out", whole,      NULL};
+	assert_int_equal(bsim_test_cli(b, NULL, NULL), 0);
+	char *want = maps_of(whole);
+	static const int sigs[] = {SIGINT, SIGTERM, SIGKILL};
+	for (int i = 0; i < 3; i++) {
+		char dir[1024], errfile[1100];
+		snprintf(dir, sizeof dir, "%s", bsim_test_dir("build_stopped"));
+		snprintf(errfile, sizeof errfile, "%s.err", dir);
+		const char *argv[] = {"markov", "build",   exp,     "--trials", "400", "--bins",
+		                      "2,2,2",  "--quiet", "--out", dir,        NULL};
+		const bsim_test_opts o = {.err = errfile};
+		int pid = bsim_test_spawn_with(argv, &o);
+		int status = -1;
+		assert_int_equal(
+		        bsim_test_await_glob(pid, bsim_test_join(dir, "manifest.json"), 1, &status),
+		        1);
+		kill(pid, sigs[i]);
+		status = bsim_test_wait(pid);
+		assert_int_equal(status, 128 + sigs[i]);
+		char *err = bsim_test_read(errfile);
+		assert_non_null(err);
+		if (sigs[i] != SIGKILL) {
+			assert_non_null(strstr(err, "stopped after 1 of the 2 maps to build"));
+			assert_non_null(strstr(err, "the same command builds the rest"));
+		}
+		free(err);
+		unlink(errfile);
+		const char *again[] = {"markov", "build", exp,     "--trials", "400",
+		                       "--bins", "2,2,2", "--out", dir,        NULL};
+		char *out = NULL;
+		assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
+		assert_non_null(strstr(out, "1 maps built"));
+		assert_non_null(strstr(out, "1 reused"));
+		free(out);
+		char *got = maps_of(dir);
+		assert_string_equal(got, want);
+		free(got);
+		assert_true(bsim_test_exists(bsim_test_join(dir, "markov.json")));
+	}
+	free(want);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -536,6 +610,7 @@ int main(void)
 	        cmocka_unit_test(test_conservation),
 	        cmocka_unit_test(test_one_gate_against_simulation),
 	        cmocka_unit_test(test_threads_and_cache),
+	        cmocka_unit_test(test_interrupted_build),
 	        cmocka_unit_test(test_entries),
 	        cmocka_unit_test(test_bad_inputs),
 	        cmocka_unit_test(test_bad_map_files),

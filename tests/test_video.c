@@ -20,6 +20,7 @@
 
 #include <dirent.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -681,7 +682,9 @@ static void cli_bad_arguments(void **state)
 		const char *args[6];
 		const char *needle;
 	} cases[] = {
-	        {{"--fps", "0"}, "--fps 0: expected a number in (0, 1000]"},
+	        {{"--fps", "0"}, "--fps 0: expected a number in [0.01, 1000]"},
+	        {{"--fps", "1e-9"}, "--fps 1e-9: expected a number in [0.01, 1000]"},
+	        {{"--fps", "1001"}, "--fps 1001: expected a number in [0.01, 1000]"},
 	        {{"--fps", "30x"}, "--fps 30x"},
 	        {{"--size", "641x480"}, "expected even WIDTHxHEIGHT"},
 	        {{"--size", "640"}, "--size 640: expected WIDTHxHEIGHT"},
@@ -737,6 +740,62 @@ static void cli_bad_arguments(void **state)
 	closedir(d);
 }
 
+/* SIGINT or SIGTERM while ffmpeg writes (its temporary file out.mp4.tmp.PID
+ * is there) stops the video with 128 + the signal and removes the file;
+ * temporary files of processes no longer alive (a video killed with
+ * SIGKILL) are removed by the next video to the same path, those of a
+ * live process are left alone. */
+static void cli_stopped_video_leaves_no_temporary(void **state)
+{
+	(void)state;
+	char gate[1200], out[1400], dir[1100], errfile[1400], pattern[1500];
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("stopped"));
+	snprintf(out, sizeof out, "%s/x.mp4", dir);
+	snprintf(errfile, sizeof errfile, "%s.err", dir);
+	snprintf(pattern, sizeof pattern, "%s.tmp.*", out);
+	static const int sigs[] = {SIGINT, SIGTERM};
+	for (int i = 0; i < 2; i++) {
+		/* 60 s held at 1000 frames a second: far longer than the wait */
+		const char *argv[] = {"video",  gate,    "--set",  "integration.max_steps=20",
+		                      "--fps",  "1000",  "--hold", "60",
+		                      "--size", "64x64", "--out",  out,
+		                      NULL};
+		const bsim_test_opts o = {.err = errfile};
+		int pid = bsim_test_spawn_with(argv, &o);
+		int status = -1;
+		assert_int_equal(bsim_test_await_glob(pid, pattern, 1, &status), 1);
+		kill(pid, sigs[i]);
+		assert_int_equal(bsim_test_wait(pid), 128 + sigs[i]);
+		char *se = bsim_test_read(errfile);
+		assert_non_null(se);
+		printf("# %s", se);
+		assert_non_null(strstr(se, sigs[i] == SIGINT ? "SIGINT" : "SIGTERM"));
+		assert_non_null(strstr(se, "stopped; no video written"));
+		free(se);
+		assert_true(dir_empty(dir));
+	}
+	unlink(errfile);
+
+	/* A stale file: a process that has ended (spawned and reaped). */
+	const char *quick[] = {"backends", NULL};
+	int dead = bsim_test_spawn(quick);
+	assert_int_equal(bsim_test_wait(dead), 0);
+	char name[64], live[64];
+	snprintf(name, sizeof name, "x.mp4.tmp.%d", dead);
+	snprintf(live, sizeof live, "x.mp4.tmp.%d", (int)getpid());
+	char stale[1500];
+	snprintf(stale, sizeof stale, "%s", bsim_test_write(dir, name, "half a video"));
+	char alive[1500];
+	snprintf(alive, sizeof alive, "%s", bsim_test_write(dir, live, "being written"));
+	const char *argv[] = {"video", gate, "--set", "integration.max_steps=20", "--size", "64x64",
+	                      "--out", out,  NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	assert_true(bsim_test_exists(out));
+	assert_false(bsim_test_exists(stale));
+	assert_true(bsim_test_exists(alive));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -749,6 +808,7 @@ int main(void)
 	        cmocka_unit_test(lib_frames_are_the_runs_states),
 	        cmocka_unit_test(lib_failing_encoder_writes_nothing),
 	        cmocka_unit_test(cli_missing_ffmpeg),
+	        cmocka_unit_test(cli_stopped_video_leaves_no_temporary),
 	        cmocka_unit_test(cli_bad_arguments),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

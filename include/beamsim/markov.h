@@ -41,6 +41,7 @@
 #ifndef BSIM_MARKOV_H
 #define BSIM_MARKOV_H
 
+#include <signal.h>
 #include <stdint.h>
 
 #include "beamsim/base.h"
@@ -99,6 +100,11 @@ typedef struct bsim_markov_def {
 	char entries_id[64];                /* the entries' id when read back from markov.json */
 	bsim_progress_fn progress;          /* may be NULL; counts single-gate trials */
 	void *progress_user;
+	/* May be NULL. When *stop becomes nonzero (a signal handler sets it),
+	 * no further single gate starts, the map under way is dropped, the
+	 * maps finished are kept in the map directory, and the build returns
+	 * BSIM_ESTOPPED. */
+	const volatile sig_atomic_t *stop;
 } bsim_markov_def;
 
 /* bsim_markov_bins_default(), 200 trials per bin, seed 1, the default

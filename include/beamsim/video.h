@@ -41,6 +41,7 @@
 #ifndef BSIM_VIDEO_H
 #define BSIM_VIDEO_H
 
+#include <signal.h>
 #include <stdint.h>
 
 #include "beamsim/base.h"
@@ -57,11 +58,15 @@ extern "C" {
  * bsim_video_def_default). */
 typedef struct bsim_video_def {
 	int width, height;  /* pixels of a frame, all panels; even, >= 64; 0 = 540 x 540 a panel */
-	double fps;         /* frames per second of simulated time, > 0; default 30 */
+	double fps;         /* frames per second of simulated time, 0.01 to 1000; default 30 */
 	double hold;        /* s: the last frame is held this long at the end, >= 0; default 1 */
 	double view_span;   /* m: the most of the world a panel's shorter side shows; default 200 */
 	int crf;            /* x264 constant rate factor, 0-51 (lower is better); default 23 */
 	const char *ffmpeg; /* the encoder program, looked up on PATH; default "ffmpeg" */
+	/* May be NULL. When *stop becomes nonzero (a signal handler sets it),
+	 * bsim_video_write draws no further frame, removes its temporary file
+	 * and returns BSIM_ESTOPPED. */
+	const volatile sig_atomic_t *stop;
 } bsim_video_def;
 
 BSIM_API bsim_video_def bsim_video_def_default(void);

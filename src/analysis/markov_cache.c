@@ -409,8 +409,18 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 		return rc;
 	int format = 0;
 	uint64_t seed = 0;
-	char backend[64] = "", id[64] = "";
+	char backend[64] = "", id[64] = "", version[64] = "";
 	rc = def_int(&d, "/format", MAP_FORMAT, MAP_FORMAT, &format, err);
+	/* Maps of another version are another simulator's: the keys name the
+	 * version too, so none would be found; saying so here names why. */
+	if (rc == BSIM_OK)
+		rc = def_string(&d, "/beamsim_version", version, sizeof version, err);
+	if (rc == BSIM_OK && strcmp(version, BSIM_VERSION) != 0)
+		rc = ydoc_fail(&d, def_field(&d, "/beamsim_version", "a string", err), NULL,
+		               "beamsim_version", err,
+		               "expected maps of this beamsim, %s, got maps built by beamsim %s "
+		               "(build them again with beamsim markov build)",
+		               BSIM_VERSION, version);
 	if (rc == BSIM_OK)
 		rc = def_int(&d, "/bins/position", 1, 64, &def->bins.n_pos, err);
 	if (rc == BSIM_OK)

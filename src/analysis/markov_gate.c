@@ -161,7 +161,7 @@ int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		markov_entry_index_free(&ex);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
-	int failed = 0;
+	int failed = 0, stopped = 0;
 	bsim_error first = {0};
 	long first_unit = units;
 	int threads = def->threads > 0 ? def->threads : 0;
@@ -184,6 +184,12 @@ int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 					first_unit = u;
 					bsim_error_set(&first, BSIM_EFAIL, "out of memory");
 				}
+				continue;
+			}
+			if (def->stop && *def->stop) {
+				exit[u] = -1;
+#pragma omp atomic write
+				stopped = 1;
 				continue;
 			}
 			bsim_error e;
@@ -212,7 +218,9 @@ int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		bsim_state_free(&r.s0);
 		bsim_state_free(&r.s1);
 	}
-	if (first_unit < units) {
+	if (stopped) {
+		failed = 1;
+	} else if (first_unit < units) {
 		failed = 1;
 		if (err)
 			*err = first;
@@ -221,5 +229,5 @@ int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		m->counts[(u / T) * nb + exit[u]]++;
 	free(exit);
 	markov_entry_index_free(&ex);
-	return failed ? BSIM_EFAIL : BSIM_OK;
+	return stopped ? BSIM_ESTOPPED : failed ? BSIM_EFAIL : BSIM_OK;
 }

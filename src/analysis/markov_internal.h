@@ -53,7 +53,8 @@ void markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice, con
 /* Map m's counts (n_bins, k and counts allocated) from def->trials single
  * gates per entry bin, on def->threads threads; *done counts the trials
  * run of total, for def->progress. BSIM_EFAIL with the error of the first
- * failed trial (in trial order, whatever the threads). */
+ * failed trial (in trial order, whatever the threads); BSIM_ESTOPPED,
+ * err untouched and the counts not counted, if def->stop was set. */
 int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
                         long *done, long total, bsim_error *err);

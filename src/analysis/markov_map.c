@@ -6,11 +6,14 @@
 
 #include "analysis/markov_internal.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
+#include "store/outdir.h"
 #include "store/session.h"
 
 bsim_markov_def bsim_markov_def_default(void)
@@ -117,11 +120,27 @@ void bsim_markov_set_free(bsim_markov_set *s)
 	memset(s, 0, sizeof *s);
 }
 
-/* The maps of lattice's pairs: read from dir where there; with a stage,
- * the others simulated into it; without, the first missing is an error. */
-static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const char *dir,
-                    const char *stage, bsim_markov_set *out, bsim_error *err)
+/* A map just written into the session's stage joins the directory's set
+ * at once, so a build stopped or killed later keeps it; the stage is made
+ * again for the next. */
+static int map_commit(bsim_session *ss, bsim_error *err)
 {
+	if (bsim_outdir_add(ss->od, "markov build", err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (mkdir(ss->stage, 0777) != 0 && errno != EEXIST)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot create: %s", ss->stage,
+		                      strerror(errno));
+	return BSIM_OK;
+}
+
+/* The maps of lattice's pairs: read from dir where there; with a session,
+ * the others simulated into its stage and committed one by one (def->stop
+ * is looked at between single gates); without, the first missing is an
+ * error. */
+static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const char *dir,
+                    bsim_session *ss, bsim_markov_set *out, bsim_error *err)
+{
+	const char *stage = ss ? ss->stage : NULL;
 	const bsim_backend *be = def->backend ? def->backend : bsim_backend_default();
 	const bsim_options none = {0};
 	const bsim_options *opts = def->opts ? def->opts : &none;
@@ -161,19 +180,29 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		else
 			total += (long)m->n_bins * def->trials;
 	}
+	int to_build = n - out->reused;
 	for (int i = 0; i < n && rc == BSIM_OK && stage; i++) {
 		bsim_markov_map *m = &out->maps[i];
 		if (have[i])
 			continue;
 		clock_t c0 = clock();
-		rc = markov_map_simulate(lattice, def, be, opts, m, &done, total, err);
+		rc = def->stop && *def->stop
+		             ? BSIM_ESTOPPED
+		             : markov_map_simulate(lattice, def, be, opts, m, &done, total, err);
 		m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 		m->cost = m->seconds;
 		out->seconds += m->seconds;
 		if (rc == BSIM_OK)
 			rc = markov_map_write(stage, m, &def->bins, err);
-		out->built++;
+		if (rc == BSIM_OK)
+			rc = map_commit(ss, err);
+		if (rc == BSIM_OK)
+			out->built++;
 	}
+	if (rc == BSIM_ESTOPPED)
+		bsim_error_set(err, BSIM_ESTOPPED,
+		               "stopped after %d of the %d maps to build; those are kept in %s",
+		               out->built, to_build, dir);
 	free(have);
 	free(pairs);
 	if (rc != BSIM_OK)
@@ -194,7 +223,7 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 	if ((rc = bsim_session_open(&ss, dir, 0, NULL, 0, err)) != BSIM_OK)
 		return rc;
 	ss.add = 1; /* the maps join those already cached */
-	rc = set_fill(lattice, def, dir, ss.stage, out, err);
+	rc = set_fill(lattice, def, dir, &ss, out, err);
 	if (rc == BSIM_OK)
 		rc = markov_def_write(ss.stage, def,
 		                      def->backend ? def->backend : bsim_backend_default(),

@@ -12,6 +12,7 @@
 
 #include "beamsim/limits.h"
 #include "cli/cli_progress.h"
+#include "util/text_check.h"
 
 void cli_error(const char *fmt, ...)
 {
@@ -335,7 +336,7 @@ int cli_run_end(int rc, const char *journal, int argc, char **argv)
 	if (rc == BSIM_ESTOPPED) {
 		int sig = cli_stop ? (int)cli_stop : SIGINT;
 		fprintf(stderr, "beamsim: %s: the finished trials are kept in %s; to continue: ",
-		        sig == SIGTERM ? "SIGTERM" : "SIGINT", journal);
+		        sig == SIGTERM ? "SIGTERM" : "SIGINT", cli_path(journal));
 		resume_line(stderr, argc, argv);
 		fputc('\n', stderr);
 		return 128 + sig;
@@ -344,7 +345,7 @@ int cli_run_end(int rc, const char *journal, int argc, char **argv)
 		fprintf(stderr,
 		        "beamsim: the finished trials are kept in %s; to continue once the "
 		        "cause is fixed: ",
-		        journal);
+		        cli_path(journal));
 		resume_line(stderr, argc, argv);
 		fputc('\n', stderr);
 	}
@@ -423,6 +424,17 @@ void cli_estimate_line(const char *backend, double beam_steps)
 		        "beam-steps (trials x max_steps x beams) at a stated constant of ~%g ns a "
 		        "beam-step on %s (%s)",
 		        hours, beam_steps, ns, backend, basis);
+}
+
+const char *cli_path(const char *path)
+{
+	/* Room for every byte of the longest path as \xNN. */
+	static char ring[4][4 * BSIM_PATH_MAX + 1];
+	static int next;
+	char *b = ring[next++ % 4];
+	snprintf(b, sizeof ring[0], "%s", path);
+	text_escape(b, sizeof ring[0]);
+	return b;
 }
 
 char *cli_text_append(char *text, const char *more)

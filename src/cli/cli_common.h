@@ -126,6 +126,12 @@ double cli_experiment_beam_steps(const char *path, const cli_sets *sets, long tr
  * beam-step it assumes for the backend, with that cost's basis. */
 void cli_estimate_line(const char *backend, double beam_steps);
 
+/* path as the terminal may show it: control characters and bytes that are
+ * not UTF-8 as \xNN (a newline in a file name must not start a line of
+ * the report). In one of 4 static buffers used in turn, so up to 4 may be
+ * given to one printf. */
+const char *cli_path(const char *path);
+
 /* text (malloc'd) with more appended, reallocated; NULL (text freed) if
  * out of memory. */
 char *cli_text_append(char *text, const char *more);

@@ -133,7 +133,8 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 		bsim_scene_free(&scene);
 		return cli_usage("accuracy", "--backends: no backend named");
 	}
-	bsim_accuracy_config cfg = a->quick ? bsim_accuracy_quick() : bsim_accuracy_config_default();
+	bsim_accuracy_config cfg =
+	        a->quick ? bsim_accuracy_quick() : bsim_accuracy_config_default();
 	if (a->pieces)
 		cfg.n_pieces = (int)a->pieces;
 	if (c->trials)
@@ -155,7 +156,7 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 	if (rc == BSIM_OK) {
 		printf("accuracy: %d rows in %.1f s; wrote %s/accuracy.{csv,mat,md} and the figure "
 		       "%s/accuracy.{png,svg,gp}\n",
-		       r.n, r.wall_seconds, c->out, c->out);
+		       r.n, r.wall_seconds, cli_path(c->out), cli_path(c->out));
 		for (int i = 0; i < fig.n_notes; i++)
 			cli_error("%s", fig.notes[i]);
 		bsim_figures_result_free(&fig);

@@ -205,10 +205,11 @@ static void compare_summary(const bsim_compare_dir_def *def, const char *out,
 	for (int i = 0; i < 2; i++)
 		if (res->unstable[i] > 0)
 			printf("  %s: %ld unstable trials (see %s/%s/trials.csv)\n", i ? lb : la,
-			       res->unstable[i], out, res->dir[i]);
+			       res->unstable[i], cli_path(out), res->dir[i]);
+	const char *o = cli_path(out);
 	printf("wrote %s/report.md, %s/report.json, %s/pairs.csv and each side's sweep in "
 	       "%s/%s and %s/%s\n",
-	       out, out, out, out, res->dir[0], out, res->dir[1]);
+	       o, o, o, o, res->dir[0], o, res->dir[1]);
 }
 
 int cmd_compare(int argc, char **argv)

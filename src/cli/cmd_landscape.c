@@ -177,7 +177,7 @@ int cmd_landscape(int argc, char **argv)
 		print_table(&a, &scene, g, b);
 		printf("\nwrote       %s/: landscape.csv, landscape.mat, landscape.json, "
 		       "landscape_top, landscape_beam, landscape_total (.png .svg .gp)\n",
-		       c.out);
+		       cli_path(c.out));
 		if (!drawn)
 			cli_error(
 			        "gnuplot not found: the figures' .gp scripts and data are in %s; "

@@ -209,6 +209,8 @@ static int markov_build(int argc, char **argv)
 	cli_progress_init(&progress, !c.quiet, "single gates");
 	a.def.progress = cli_progress_update;
 	a.def.progress_user = &progress;
+	a.def.stop = &cli_stop;
+	cli_signals_install();
 	int built = 0, reused = 0;
 	double cpu = 0.0;
 	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++) {
@@ -232,15 +234,24 @@ static int markov_build(int argc, char **argv)
 		bsim_markov_set_free(&set);
 	}
 	cli_progress_finish(&progress);
+	cli_signals_restore();
+	if (rc == BSIM_ESTOPPED) {
+		/* Each finished map is in the directory already: the same command
+		 * reuses them and builds the rest. */
+		int sig = cli_stop ? (int)cli_stop : SIGINT;
+		cli_error("%s: %s; the same command builds the rest",
+		          sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
+		rc = 128 + sig;
+	}
 	if (rc == BSIM_OK && !c.quiet)
 		printf("%d maps built (%.1f s of CPU), %d reused; %d entry bins x %d trials each, "
 		       "in %s\n",
 		       built, cpu, reused, bsim_markov_bins_count(&a.def.bins), a.def.trials,
-		       c.out);
+		       cli_path(c.out));
 	bsim_experiment_free(&e);
 	bsim_markov_entries_free(&entries);
 	cli_common_free(&c);
-	return cli_report(rc, &err);
+	return rc > BSIM_ESTOPPED ? rc : cli_report(rc, &err);
 }
 
 static int markov_predict(int argc, char **argv)
@@ -344,7 +355,7 @@ static int markov_validate(int argc, char **argv)
 		}
 		printf("\nwrote       %s/: validate.json, validate.csv, gates.csv (+ .mat), "
 		       "validate_gNNN (.png .svg .gp)\n",
-		       c.out);
+		       cli_path(c.out));
 	}
 	bsim_markov_validation_free(&v);
 	cli_common_free(&c);

@@ -90,10 +90,10 @@ int cmd_plot(int argc, char **argv)
 			cli_error("%s", res.notes[i]);
 		if (!c.quiet) {
 			printf("%s of %s: %d figure%s, %d drawn\n",
-			       bsim_figures_kind_name(res.kind), dir, res.n, res.n == 1 ? "" : "s",
-			       res.drawn);
+			       bsim_figures_kind_name(res.kind), cli_path(dir), res.n,
+			       res.n == 1 ? "" : "s", res.drawn);
 			for (int i = 0; i < res.n; i++)
-				printf("  %s.{png,svg,gp}\n", res.paths[i]);
+				printf("  %s.{png,svg,gp}\n", cli_path(res.paths[i]));
 		}
 		bsim_figures_result_free(&res);
 	}

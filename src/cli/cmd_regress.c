@@ -88,7 +88,8 @@ int cmd_regress(int argc, char **argv)
 			printf("%s: %d of %d trials changed, %d of %d groups beyond tolerance\n",
 			       res.side[i].label, res.side[i].changed, res.side[i].trials,
 			       res.side[i].cmp.n_disagree, res.side[i].cmp.n_groups);
-		printf("wrote %s/regress.md and %s/regress.json\n", c.out, c.out);
+		printf("wrote %s/regress.md and %s/regress.json\n", cli_path(c.out),
+		       cli_path(c.out));
 	}
 	rc = res.beyond > 0 ? CLI_DISAGREE : CLI_OK;
 	bsim_regress_result_free(&res);

@@ -15,6 +15,7 @@
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "beamsim/lattice_outcome.h"
+#include "beamsim/limits.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 
@@ -61,6 +62,12 @@ static int run_option(void *args, int i, const char *value)
 			return cli_usage("run", "--trial %s: expected an integer >= 0", value);
 		return CLI_OK;
 	case OWN_TRAJECTORY:
+		/* Room for the names beamsim appends (FILE.tmp.PID, the .mat twin). */
+		if (strlen(value) >= BSIM_PATH_MAX - BSIM_NAME_MAX)
+			return cli_usage(
+			        "run",
+			        "--trajectory %.40s...: path too long (%zu bytes, at most %d)",
+			        value, strlen(value), BSIM_PATH_MAX - BSIM_NAME_MAX - 1);
 		a->trajectory = value;
 		return CLI_OK;
 	case OWN_STRIDE:
@@ -124,7 +131,7 @@ static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64
                        const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	const bsim_ledger *l = &r->ledger;
-	fprintf(out, "scene       %s (%s), backend %s\n", a->scene, s->name, a->backend);
+	fprintf(out, "scene       %s (%s), backend %s\n", cli_path(a->scene), s->name, a->backend);
 	fprintf(out,
 	        "seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
 	        ", %lu draws)\n",

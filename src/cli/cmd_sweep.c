@@ -69,8 +69,8 @@ static void sweep_report(const char *out, const bsim_sweep_dir_result *res)
 	       cli_per_second(n, r->wall_seconds), cli_per_second(r->total_steps, r->wall_seconds));
 	if (n != rows)
 		printf("(%ld rows: the groups without random force ran one trial each)\n", rows);
-	printf("wrote %s/summary.json and %s/trials.csv%s (and their .mat twins)\n", out, out,
-	       r->keep ? ", trajectories.csv" : "");
+	printf("wrote %s/summary.json and %s/trials.csv%s (and their .mat twins)\n", cli_path(out),
+	       cli_path(out), r->keep ? ", trajectories.csv" : "");
 }
 
 int cmd_sweep(int argc, char **argv)

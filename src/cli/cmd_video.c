@@ -23,7 +23,8 @@ static const cli_own video_own[] = {
         [OWN_BACKENDS] = {"backends", 1, "A,B", "several backends side by side (up to 4)"},
         [OWN_GROUP] = {"group", 1, "G", "group index for the seed (default 0)"},
         [OWN_TRIAL] = {"trial", 1, "I", "trial index for the seed (default 0)"},
-        [OWN_FPS] = {"fps", 1, "F", "frames per second of simulated time (default 30)"},
+        [OWN_FPS] = {"fps", 1, "F",
+                     "frames per second of simulated time, 0.01 to 1000 (default 30)"},
         [OWN_SIZE] = {"size", 1, "WxH", "frame size in pixels, even (default 540x540 a panel)"},
         [OWN_HOLD] = {"hold", 1, "S", "seconds the last frame is held (default 1)"},
         [OWN_VIEW] = {"view", 1, "M",
@@ -117,7 +118,9 @@ static int video_option(void *args, int i, const char *value)
 			return cli_usage("video", "--trial %s: expected an integer >= 0", value);
 		return CLI_OK;
 	case OWN_FPS:
-		return parse_number("--fps", value, 0.0, 1000.0, 1, &a->def.fps);
+		/* Below 0.01 a frame lasts over 100 s; ffmpeg's MP4 muxer refuses
+		 * frames of 1e6 s ("Application provided duration ... is invalid"). */
+		return parse_number("--fps", value, 0.01, 1000.0, 0, &a->def.fps);
 	case OWN_SIZE:
 		return parse_size(a, value);
 	case OWN_HOLD:
@@ -215,17 +218,29 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 		                             &tracks[i], &err);
 	}
 	bsim_video *v = NULL;
+	a->def.stop = &cli_stop;
 	if (rc == BSIM_OK)
 		rc = bsim_video_alloc(&a->def, scene, (const bsim_video_track *const *)tracks,
 		                      labels, a->n_backends, &v, &err);
-	if (rc == BSIM_OK)
+	/* While ffmpeg writes its temporary file, SIGINT and SIGTERM stop the
+	 * video and remove it; before, they end the program, which has
+	 * written nothing yet. */
+	if (rc == BSIM_OK) {
+		cli_signals_install();
 		rc = bsim_video_write(v, a->out, &err);
+		cli_signals_restore();
+	}
+	if (rc == BSIM_ESTOPPED) {
+		int sig = cli_stop ? (int)cli_stop : SIGINT;
+		cli_error("%s: %s", sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
+		rc = 128 + sig;
+	}
 	/* A video on standard output keeps it to itself: the report goes to
 	 * standard error. */
 	FILE *out = strcmp(a->out, "-") == 0 ? stderr : stdout;
 	if (rc == BSIM_OK) {
 		fprintf(out, "scene       %s (%s), seed %" PRIu64 ", group %ld, trial %ld\n",
-		        a->scene, scene->name, a->seed, a->group, a->trial);
+		        cli_path(a->scene), scene->name, a->seed, a->group, a->trial);
 		for (int i = 0; i < a->n_backends; i++)
 			print_outcome(out, a->names[i], scene, bsim_video_track_result(tracks[i]));
 		if (a->n_backends > 1) {
@@ -246,12 +261,12 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 		bsim_video_size(v, &w, &h);
 		long frames = bsim_video_frames(v);
 		fprintf(out, "wrote       %s: %dx%d, H.264 yuv420p, %g fps, %ld frames, %.6g s\n",
-		        a->out, w, h, a->def.fps, frames, (double)frames / a->def.fps);
+		        cli_path(a->out), w, h, a->def.fps, frames, (double)frames / a->def.fps);
 	}
 	bsim_video_free(v);
 	for (int i = 0; i < a->n_backends; i++)
 		bsim_video_track_free(tracks[i]);
-	return cli_report(rc, &err);
+	return rc > BSIM_ESTOPPED ? rc : cli_report(rc, &err);
 }
 
 int cmd_video(int argc, char **argv)

@@ -18,6 +18,7 @@
 
 #include "beamsim/lattice.h"
 #include "model/scene_internal.h"
+#include "util/decimal.h"
 
 /* Gates a lattice may have: 1e5 gates is 2e5 beams, far beyond any study. */
 #define LATTICE_GATES_MAX 100000
@@ -176,6 +177,26 @@ static int csv_fields(char *line, char **f, int max, int *cols)
 	return n + 1; /* more than max */
 }
 
+/* One line of f into buf (size bytes, NUL-terminated), NUL bytes in it
+ * kept: its length in bytes, -1 at the end of the file, or size if the line
+ * does not fit (the rest left unread). */
+static long read_line(FILE *f, char *buf, size_t size)
+{
+	size_t n = 0;
+	int c = EOF;
+	while (n + 1 < size && (c = getc(f)) != EOF) {
+		buf[n++] = (char)c;
+		if (c == '\n')
+			break;
+	}
+	buf[n] = '\0';
+	if (n == 0 && c == EOF)
+		return -1;
+	if (n + 1 == size && buf[n - 1] != '\n' && (c = getc(f)) != EOF)
+		return (long)size;
+	return (long)n;
+}
+
 /* The stiffness map from a CSV file beside the scene: one line per row
  * (iy = 0 first), columns comma-separated values; blank lines and lines
  * starting with # are skipped. */
@@ -222,23 +243,34 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 	}
 	snprintf(w->s->lattice.stiffness_file, sizeof w->s->lattice.stiffness_file, "%s", rel);
 	char line[8192];
+	long got;
 	int lineno = 0, iy = 0, rc = BSIM_OK;
 	int max = l->columns;
 	char **fields = malloc((size_t)(max + 1) * sizeof *fields);
 	int *cols = malloc((size_t)(max + 1) * sizeof *cols);
 	if (!fields || !cols)
 		rc = bsim_error_set(w->err, BSIM_EFAIL, "%s: out of memory", path);
-	while (rc == BSIM_OK && fgets(line, sizeof line, f)) {
+	while (rc == BSIM_OK && (got = read_line(f, line, sizeof line)) >= 0) {
 		lineno++;
-		size_t len = strcspn(line, "\r\n");
-		if (line[len] == '\0' && !feof(f)) {
+		/* A NUL would end the line's text early, unseen. */
+		const char *nul = memchr(line, '\0',
+		                         got == (long)sizeof line ? sizeof line - 1 : (size_t)got);
+		if (nul) {
+			rc = bsim_error_set(
+			        w->err, BSIM_EINPUT,
+			        "%s:%d:%d: lattice.stiffness_file: expected text, got a "
+			        "NUL byte",
+			        path, lineno, (int)(nul - line) + 1);
+			break;
+		}
+		if (got == (long)sizeof line) {
 			rc = bsim_error_set(w->err, BSIM_EINPUT,
 			                    "%s:%d: lattice.stiffness_file: expected lines shorter "
 			                    "than %zu characters",
 			                    path, lineno, sizeof line - 1);
 			break;
 		}
-		line[len] = '\0';
+		line[strcspn(line, "\r\n")] = '\0';
 		const char *first = line + strspn(line, " \t");
 		if (*first == '\0' || *first == '#')
 			continue;
@@ -267,7 +299,7 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 			errno = 0;
 			double v = strtod(fields[c], &end);
 			if (end == fields[c] || *end != '\0' || errno == ERANGE || !isfinite(v) ||
-			    v < 0.0)
+			    v < 0.0 || decimal_other_base(fields[c]))
 				rc = bsim_error_set(w->err, BSIM_EINPUT,
 				                    "%s:%d:%d: lattice.stiffness_file: expected a "
 				                    "number >= 0 (N m/rad), got %.40s",
@@ -323,6 +355,18 @@ static int lattice_maps_read(scene_walk *w, struct fy_node *map, lattice_maps *m
 	if (file && gate_map)
 		return ydoc_fail(w->d, file, kfile, "lattice.stiffness_file", w->err,
 		                 "expected either stiffness or stiffness_file, not both");
+	/* A per-gate map and a per-beam one give every beam twice: which one a
+	 * reader of the scene meant is not for beamsim to guess. */
+	for (int i = 1; i < 3 && (file || gate_map); i++) {
+		struct fy_node *k;
+		struct fy_node *n = child(map, names[i], &k);
+		if (n)
+			return ydoc_fail(w->d, n, k,
+			                 i == 1 ? "lattice.stiffness_left"
+			                        : "lattice.stiffness_right",
+			                 w->err, "expected either %s or %s, not both",
+			                 file ? "stiffness_file" : "stiffness", names[i]);
+	}
 	for (int i = 0; i < 3; i++) {
 		struct fy_node *k;
 		struct fy_node *n = child(map, names[i], &k);

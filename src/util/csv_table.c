@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "util/decimal.h"
 #include "util/file_read.h"
 
 /* Splits line in place at commas into out (at most max fields); the
@@ -37,13 +38,17 @@ static int count_fields(const char *line)
 
 int csv_text_check(const char *path, const char *text, size_t len, bsim_error *err)
 {
-	long line = 1;
-	for (size_t i = 0; i < len; i++) {
+	/* A NUL would end a line's text early, unseen: named where it is. */
+	long line = 1, col = 1;
+	for (size_t i = 0; i < len; i++, col++) {
 		if (text[i] == '\0')
 			return bsim_error_set(err, BSIM_EINPUT,
-			                      "%s:%ld: expected text, got a NUL byte (at byte %zu)",
-			                      path, line, i);
-		line += text[i] == '\n';
+			                      "%s:%ld:%ld: expected text, got a NUL byte", path, line,
+			                      col);
+		if (text[i] == '\n') {
+			line++;
+			col = 0;
+		}
 	}
 	/* Every line beamsim writes ends in a line feed: a last line without
 	 * one is a row cut short (a full disk, a copy interrupted), whose last
@@ -150,7 +155,7 @@ int csv_table_number(const csv_table *t, long row, int col, double *out)
 {
 	const char *s = csv_table_cell(t, row, col);
 	char *end;
-	if (!*s)
+	if (!*s || decimal_other_base(s))
 		return -1;
 	*out = strtod(s, &end); /* an underflow to 0 or subnormal is still that number */
 	return *end == '\0' ? 0 : -1;

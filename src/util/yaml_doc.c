@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
+#include "util/decimal.h"
 #include "util/file_read.h"
 #include "util/text_check.h"
 
@@ -451,7 +452,7 @@ int ydoc_number(struct fy_node *n, double *out)
 		return YDOC_NUM_NONFINITE;
 	char *end = NULL;
 	double v = strtod(t, &end);
-	if (end == t || *end != '\0' || isspace((unsigned char)*t))
+	if (end == t || *end != '\0' || isspace((unsigned char)*t) || decimal_other_base(t))
 		return YDOC_NUM_NONE;
 	if (!isfinite(v))
 		return YDOC_NUM_NONFINITE; /* "nan", "inf", or an overflow like 1e999 */
@@ -466,7 +467,7 @@ static int parse_decimal(const char *t, int *neg, uint64_t *mag)
 	*neg = 0;
 	if (*t == '+' || *t == '-')
 		*neg = *t++ == '-';
-	if (!isdigit((unsigned char)*t))
+	if (!isdigit((unsigned char)*t) || decimal_other_base(t))
 		return 0;
 	uint64_t v = 0;
 	for (; isdigit((unsigned char)*t); t++) {

@@ -30,9 +30,9 @@ bsim_video_def bsim_video_def_default(void)
 
 int bsim_video_def_check(const bsim_video_def *d, bsim_error *err)
 {
-	if (!(d->fps > 0.0) || !isfinite(d->fps) || d->fps > 1000.0)
+	if (!(d->fps >= 0.01) || d->fps > 1000.0)
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "fps: expected a number in (0, 1000], got %g", d->fps);
+		                      "fps: expected 0.01 to 1000 frames per second, got %g", d->fps);
 	if (!(d->hold >= 0.0) || d->hold > 60.0)
 		return bsim_error_set(err, BSIM_EINPUT, "hold: expected 0 to 60 s, got %g",
 		                      d->hold);
@@ -170,12 +170,18 @@ int bsim_video_write(bsim_video *v, const char *path, bsim_error *err)
 	int rc = bsim_video_encoder_open(path, v->def.ffmpeg, v->width, v->height, v->def.fps,
 	                                 v->def.crf, &enc, err);
 	for (long k = 0; rc == BSIM_OK && k < v->frames; k++) {
+		if (v->def.stop && *v->def.stop)
+			break;
 		/* Held frames are the same picture: draw it once. */
 		if (k <= v->frames_sim)
 			rc = bsim_video_render(v, k, pixels, err);
 		if (rc == BSIM_OK)
 			rc = bsim_video_encoder_write(enc, pixels, err);
 	}
+	/* A signal also reaches ffmpeg when it comes from the terminal, so a
+	 * frame that could not be written then is the stop, not a failure. */
+	if (enc && v->def.stop && *v->def.stop)
+		rc = bsim_error_set(err, BSIM_ESTOPPED, "%s: stopped; no video written", path);
 	if (rc == BSIM_OK) {
 		rc = bsim_video_encoder_close(enc, err);
 	} else {

@@ -20,8 +20,10 @@
  * the library leaves the process's signal handling as it found it. */
 #define _POSIX_C_SOURCE 200809L
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <signal.h>
 #include <spawn.h>
 #include <stdio.h>
@@ -74,6 +76,44 @@ static void last_log_line(FILE *log, char *buf, size_t n)
 			buf[m] = '\0';
 		}
 	}
+}
+
+/* Removes the temporary files PATH.tmp.PID that processes no longer alive
+ * left beside path (a run killed while ffmpeg wrote): a PID that is alive
+ * may be another run writing the same file, and is left alone. */
+static void remove_stale(const char *path)
+{
+	char dir[BSIM_PATH_MAX];
+	const char *slash = strrchr(path, '/');
+	const char *base = slash ? slash + 1 : path;
+	if (slash)
+		snprintf(dir, sizeof dir, "%.*s", (int)(slash - path + (slash == path)), path);
+	else
+		snprintf(dir, sizeof dir, ".");
+	size_t blen = strlen(base);
+	DIR *d = opendir(dir);
+	struct dirent *de;
+	while (d && (de = readdir(d))) {
+		const char *n = de->d_name;
+		if (strncmp(n, base, blen) != 0 || strncmp(n + blen, ".tmp.", 5) != 0)
+			continue;
+		const char *digits = n + blen + 5;
+		char *end;
+		errno = 0;
+		long pid = strtol(digits, &end, 10);
+		if (*digits < '1' || *digits > '9' || *end || errno || pid > INT_MAX ||
+		    pid == (long)getpid())
+			continue;
+		if (kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+			continue;
+		char stale[BSIM_PATH_MAX];
+		struct stat st;
+		if (snprintf(stale, sizeof stale, "%s/%s", dir, n) < (int)sizeof stale &&
+		    lstat(stale, &st) == 0 && S_ISREG(st.st_mode))
+			unlink(stale);
+	}
+	if (d)
+		closedir(d);
 }
 
 /* "exited with status 1: <its last line>" or "was killed by signal 9". */
@@ -216,6 +256,7 @@ int bsim_video_encoder_open(const char *path, const char *program, int width, in
 	}
 	snprintf(e->path, sizeof e->path, "%s", path);
 	snprintf(e->program, sizeof e->program, "%s", program);
+	remove_stale(e->path);
 	int rc = bsim_atomic_file_open(&e->out, e->path, err);
 	if (rc != BSIM_OK) {
 		free(e);
