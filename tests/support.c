@@ -397,12 +397,20 @@ static int has_entry(const char *dir, long n)
 	return found;
 }
 
+/* A guard against a program that hangs, never what a test waits for: far
+ * beyond any run the tests start, even on a loaded machine. */
+#define AWAIT_DEADLINE_S 300.0
+
 /* Looks every millisecond whether ready(path, n) holds, until it does (1)
- * or the program pid has ended (0, its status in *status). A poll, not a
- * deadline: what ends the wait is the program's doing. */
+ * or the program pid has ended (0, its status in *status): what ends the
+ * wait is the program's doing. A program that does neither within
+ * AWAIT_DEADLINE_S is killed and the test fails, naming what it waited
+ * for. */
 static int await(int pid, int (*ready)(const char *, long), const char *path, long n, int *status)
 {
 	const struct timespec tick = {0, 1000000};
+	struct timespec t0, t;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
 	for (;;) {
 		if (ready(path, n))
 			return 1;
@@ -411,6 +419,14 @@ static int await(int pid, int (*ready)(const char *, long), const char *path, lo
 		if (w != 0) {
 			*status = w == (pid_t)pid ? status_code(st) : -1;
 			return 0;
+		}
+		clock_gettime(CLOCK_MONOTONIC, &t);
+		if ((double)(t.tv_sec - t0.tv_sec) > AWAIT_DEADLINE_S) {
+			kill((pid_t)pid, SIGKILL);
+			waitpid((pid_t)pid, &st, 0);
+			fail_msg("waited %g s for %s (%ld) while the program neither got there nor "
+			         "ended: killed it",
+			         AWAIT_DEADLINE_S, path, n);
 		}
 		nanosleep(&tick, NULL);
 	}

@@ -49,7 +49,11 @@ int bsim_test_wait(int pid);
  * header says how long they are), or -1 if there is no journal at path. */
 long bsim_test_journal_records(const char *path);
 
-/* Waits until the journal at path holds at least n records while the
+/* The waits below poll every millisecond for an event of the program's
+ * (never a fixed time); a program that neither gets there nor ends within
+ * a generous guard (300 s) is killed and the test fails.
+ *
+ * Waits until the journal at path holds at least n records while the
  * spawned pid runs: 1 if it does (the program still running), or 0 with
  * *status (as bsim_test_wait gives it) if the program ended first. The
  * journal is created whole (header and all) after the program installs its

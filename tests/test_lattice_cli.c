@@ -63,8 +63,9 @@ static void map_and_beam_maps(void **state)
 	(void)state;
 	const char *gate[] = {"scene.yaml:7:", "lattice.stiffness_left",
 	                      "expected either stiffness or stiffness_left, not both", NULL};
-	bad_lattice("lat_both", BODY LATTICE_3X3 "  stiffness: [[1, 2, 3], [4, 5, 6], [7, 8, 9]]\n"
-	                                         "  stiffness_left: [[1, 2, 3], [4, 5, 6], [7, 8, 9]]\n",
+	bad_lattice("lat_both",
+	            BODY LATTICE_3X3 "  stiffness: [[1, 2, 3], [4, 5, 6], [7, 8, 9]]\n"
+	                             "  stiffness_left: [[1, 2, 3], [4, 5, 6], [7, 8, 9]]\n",
 	            NULL, gate);
 	const char *file[] = {"scene.yaml:7:", "lattice.stiffness_right",
 	                      "expected either stiffness_file or stiffness_right, not both", NULL};
@@ -410,14 +411,21 @@ static void compare_backends_on_lattice(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(map_wrong_rows),    cmocka_unit_test(map_wrong_columns),
+	        cmocka_unit_test(map_wrong_rows),
+	        cmocka_unit_test(map_wrong_columns),
 	        cmocka_unit_test(map_and_beam_maps),
-	        cmocka_unit_test(map_negative),      cmocka_unit_test(beam_negative),
-	        cmocka_unit_test(csv_negative),      cmocka_unit_test(csv_wrong_shape),
-	        cmocka_unit_test(empty_lattice),     cmocka_unit_test(lattice_and_beams),
-	        cmocka_unit_test(bad_protocol),      cmocka_unit_test(sweep_writes_nothing),
-	        cmocka_unit_test(sweep_files),       cmocka_unit_test(regress_lattice),
-	        cmocka_unit_test(compare_protocols), cmocka_unit_test(compare_backends_on_lattice),
+	        cmocka_unit_test(map_negative),
+	        cmocka_unit_test(beam_negative),
+	        cmocka_unit_test(csv_negative),
+	        cmocka_unit_test(csv_wrong_shape),
+	        cmocka_unit_test(empty_lattice),
+	        cmocka_unit_test(lattice_and_beams),
+	        cmocka_unit_test(bad_protocol),
+	        cmocka_unit_test(sweep_writes_nothing),
+	        cmocka_unit_test(sweep_files),
+	        cmocka_unit_test(regress_lattice),
+	        cmocka_unit_test(compare_protocols),
+	        cmocka_unit_test(compare_backends_on_lattice),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

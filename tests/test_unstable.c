@@ -231,10 +231,10 @@ static void test_schedule_status(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_nonfinite),     cmocka_unit_test(test_energy_created),
+	        cmocka_unit_test(test_nonfinite),       cmocka_unit_test(test_energy_created),
 	        cmocka_unit_test(test_energy_vanished), cmocka_unit_test(test_energy_lost),
-	        cmocka_unit_test(test_step_fails),
-	        cmocka_unit_test(test_solver_counts), cmocka_unit_test(test_schedule_status),
+	        cmocka_unit_test(test_step_fails),      cmocka_unit_test(test_solver_counts),
+	        cmocka_unit_test(test_schedule_status),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

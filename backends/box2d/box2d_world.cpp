@@ -633,8 +633,8 @@ static int body_motion_in_range(const bsim_scene *sc, double s, double h, bsim_e
 	const double fv = fp >= fr ? sc->effects.propulsion_force : sc->effects.random_magnitude;
 	/* The field's own usable range, the other force as it is. */
 	const double other = fp >= fr ? fr : fp;
-	const double fv_max = std::sqrt(std::fmax(0.0, f_max * f_max - other * other)) /
-	                      (fp >= fr ? 1.0 : 10.0);
+	const double fv_max =
+	        std::sqrt(std::fmax(0.0, f_max * f_max - other * other)) / (fp >= fr ? 1.0 : 10.0);
 	if (std::fabs(std::log10(m)) > std::fabs(std::log10(f)))
 		return bsim_error_set(
 		        err, BSIM_EINPUT,

@@ -79,7 +79,7 @@ typedef struct bsim_compare_dir_result {
 	char dir[2][128];             /* each side's directory in DIR */
 	long unstable[2];             /* unstable trials on each side */
 	bsim_solver_counts solver[2]; /* what each side's solvers gave up on */
-	char journal[BSIM_PATH_MAX];           /* as in bsim_sweep_dir_result */
+	char journal[BSIM_PATH_MAX];  /* as in bsim_sweep_dir_result */
 } bsim_compare_dir_result;
 
 /* Runs the comparison into def->out. BSIM_OK whatever the verdicts

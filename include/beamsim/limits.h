@@ -25,7 +25,7 @@ extern "C" {
  * BSIM_PATH_MAX, so that a file name appended to a derived directory always
  * fits. A path that would not fit is refused with "path too long", never
  * cut. */
-#define BSIM_DIR_MAX 900
+#define BSIM_DIR_MAX  900
 #define BSIM_NAME_MAX 200
 #define BSIM_PATH_MAX 1400
 

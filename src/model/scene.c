@@ -25,11 +25,11 @@ bsim_beam_def bsim_beam_def_default(void)
 {
 	bsim_beam_def b;
 	memset(&b, 0, sizeof b);
-	b.length = 25;                                 /* m, essay Table 2.1 */
-	b.mass = 0.1;                                  /* kg */
+	b.length = 25;                                /* m, essay Table 2.1 */
+	b.mass = 0.1;                                 /* kg */
 	b.inertia = b.mass * b.length * b.length / 3; /* rod about its end */
-	b.stiffness = 400;                             /* N m/rad */
-	b.damping = 50;                                /* N m s/rad */
+	b.stiffness = 400;                            /* N m/rad */
+	b.damping = 50;                               /* N m s/rad */
 	return b;
 }
 
@@ -80,11 +80,11 @@ void scene_defaults(bsim_scene *s)
 	memset(s, 0, sizeof *s);
 	s->contact = bsim_contact_def_default();
 	s->effects = bsim_effects_def_default();
-	s->dt = 0.004;                    /* s */
-	s->max_steps = 3000;              /* 12 s */
-	s->success_y = 65;                /* m: pivot row 30 + L 25 + R 10 */
-	s->side_x = 25;                   /* m: the gate's half width */
-	s->classify_y = 80;               /* m */
+	s->dt = 0.004;       /* s */
+	s->max_steps = 3000; /* 12 s */
+	s->success_y = 65;   /* m: pivot row 30 + L 25 + R 10 */
+	s->side_x = 25;      /* m: the gate's half width */
+	s->classify_y = 80;  /* m */
 	/* m/s: five times the lateral speed that solve order and float32
 	 * rounding give Box2D in the exactly symmetric noise-free gate
 	 * (2.1 mm/s), where the type is round-off, not a side. */
@@ -267,14 +267,20 @@ int scene_excess_find(const bsim_scene *s, scene_excess *x)
 	 * and the limit holds for any backend. */
 	double beam_steps = (double)s->max_steps * (s->n_beams > 0 ? s->n_beams : 1);
 	if (s->effects.has_random_force && values > l->schedule) {
-		*x = (scene_excess){"effects.random_force.frequency", "schedule", values,
+		*x = (scene_excess){"effects.random_force.frequency",
+		                    "schedule",
+		                    values,
 		                    l->schedule,
-		                    "random-force values per trial (frequency x dt x max_steps)", 0};
+		                    "random-force values per trial (frequency x dt x max_steps)",
+		                    0};
 		return 1;
 	}
 	if (beam_steps > l->beam_steps) {
-		*x = (scene_excess){"integration.max_steps", "beam_steps", beam_steps,
-		                    l->beam_steps, "beam-steps per trial (max_steps x beams)",
+		*x = (scene_excess){"integration.max_steps",
+		                    "beam_steps",
+		                    beam_steps,
+		                    l->beam_steps,
+		                    "beam-steps per trial (max_steps x beams)",
 		                    s->n_beams};
 		return 1;
 	}

@@ -28,7 +28,6 @@
 #include "util/yaml_doc.h"
 #include "beamsim/limits.h"
 
-
 struct bsim_outdir {
 	char dir[1024];
 	char work[1040];

@@ -332,10 +332,18 @@ static void csv_number(FILE *f, double x)
 }
 
 const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
-        "group",  "trial",    "outcome",     "type",       "steps",    "t_end",    "x_end",
-        "y_end",  "vx_end",   "max_theta1",  "max_theta2", "e_start",  "e_end",    "work_in",
-        "losses", "residual", "overlap_max", "final_ix",   "final_iy", "location", "path",
-        "iteration_limits", "clamps",
+        "group",       "trial",
+        "outcome",     "type",
+        "steps",       "t_end",
+        "x_end",       "y_end",
+        "vx_end",      "max_theta1",
+        "max_theta2",  "e_start",
+        "e_end",       "work_in",
+        "losses",      "residual",
+        "overlap_max", "final_ix",
+        "final_iy",    "location",
+        "path",        "iteration_limits",
+        "clamps",
 };
 
 int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,

@@ -16,7 +16,8 @@ int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim
                            const bsim_options *opts, const bsim_override *extra, int n_extra,
                            const bsim_sweep_result *r, bsim_error *err)
 {
-	char summary[BSIM_PATH_MAX], trials[BSIM_PATH_MAX], traj[BSIM_PATH_MAX], traj_mat[BSIM_PATH_MAX];
+	char summary[BSIM_PATH_MAX], trials[BSIM_PATH_MAX], traj[BSIM_PATH_MAX],
+	        traj_mat[BSIM_PATH_MAX];
 	if (bsim_session_path(summary, sizeof summary, dir, "summary.json", err) ||
 	    bsim_session_path(trials, sizeof trials, dir, "trials.csv", err) ||
 	    bsim_session_path(traj, sizeof traj, dir, "trajectories.csv", err) ||

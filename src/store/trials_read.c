@@ -44,10 +44,25 @@ enum {
 
 /* Each column's place in the list of trials.csv (trials_csv.h). */
 static const int column_of[N_COLUMNS] = {
-        TRIALS_GROUP,      TRIALS_TRIAL,    TRIALS_OUTCOME,  TRIALS_TYPE,    TRIALS_STEPS,
-        TRIALS_T_END,      TRIALS_X_END,    TRIALS_Y_END,    TRIALS_VX_END,  TRIALS_MAX_THETA1,
-        TRIALS_MAX_THETA2, TRIALS_E_START,  TRIALS_E_END,    TRIALS_WORK_IN, TRIALS_LOSSES,
-        TRIALS_RESIDUAL,   TRIALS_FINAL_IX, TRIALS_FINAL_IY, TRIALS_ITERATION_LIMITS,
+        TRIALS_GROUP,
+        TRIALS_TRIAL,
+        TRIALS_OUTCOME,
+        TRIALS_TYPE,
+        TRIALS_STEPS,
+        TRIALS_T_END,
+        TRIALS_X_END,
+        TRIALS_Y_END,
+        TRIALS_VX_END,
+        TRIALS_MAX_THETA1,
+        TRIALS_MAX_THETA2,
+        TRIALS_E_START,
+        TRIALS_E_END,
+        TRIALS_WORK_IN,
+        TRIALS_LOSSES,
+        TRIALS_RESIDUAL,
+        TRIALS_FINAL_IX,
+        TRIALS_FINAL_IY,
+        TRIALS_ITERATION_LIMITS,
         TRIALS_CLAMPS,
 };
 

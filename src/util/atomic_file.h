@@ -35,8 +35,8 @@ typedef enum {
 } bsim_atomic_mode;
 
 typedef struct bsim_atomic_file {
-	FILE *f;          /* write here; NULL once committed or aborted */
-	const char *path; /* the final name, not copied: must outlive o */
+	FILE *f;                 /* write here; NULL once committed or aborted */
+	const char *path;        /* the final name, not copied: must outlive o */
 	char tmp[BSIM_PATH_MAX]; /* path + ".tmp." + a process id */
 	bsim_atomic_mode mode;
 } bsim_atomic_file;

@@ -43,8 +43,8 @@ int csv_text_check(const char *path, const char *text, size_t len, bsim_error *e
 	for (size_t i = 0; i < len; i++, col++) {
 		if (text[i] == '\0')
 			return bsim_error_set(err, BSIM_EINPUT,
-			                      "%s:%ld:%ld: expected text, got a NUL byte", path, line,
-			                      col);
+			                      "%s:%ld:%ld: expected text, got a NUL byte", path,
+			                      line, col);
 		if (text[i] == '\n') {
 			line++;
 			col = 0;

@@ -32,7 +32,8 @@ int bsim_video_def_check(const bsim_video_def *d, bsim_error *err)
 {
 	if (!(d->fps >= 0.01) || d->fps > 1000.0)
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "fps: expected 0.01 to 1000 frames per second, got %g", d->fps);
+		                      "fps: expected 0.01 to 1000 frames per second, got %g",
+		                      d->fps);
 	if (!(d->hold >= 0.0) || d->hold > 60.0)
 		return bsim_error_set(err, BSIM_EINPUT, "hold: expected 0 to 60 s, got %g",
 		                      d->hold);
