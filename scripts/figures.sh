@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Redraws docs/figures/, the essay's figures that the README shows, from
-# fresh runs in out/figures/ (the commands are the README's). The copies in
+# Redraws docs/figures/, the essay's figures that the docs show, from
+# fresh runs in out/figures/ (the commands are the docs'). The copies in
 # docs/ are the PNGs drawn again by their own scripts at 0.75 of their size.
 set -euo pipefail
 cd "$(dirname "$0")/.."
