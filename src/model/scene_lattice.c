@@ -19,6 +19,7 @@
 #include "beamsim/lattice.h"
 #include "model/scene_internal.h"
 #include "util/decimal.h"
+#include "util/file_read.h"
 
 /* Gates a lattice may have: 1e5 gates is 2e5 beams, far beyond any study. */
 #define LATTICE_GATES_MAX 100000
@@ -218,23 +219,16 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 		                     w->err);
 	/* Without blocking, and checked before the first read: a FIFO would
 	 * wait for a writer for ever, a directory fails only at the read. */
-	int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
 	struct stat st;
-	if (fd < 0 || fstat(fd, &st) != 0) {
-		int e = errno;
-		if (fd >= 0)
-			close(fd);
+	int fd = file_open_checked(path, &st);
+	if (fd < 0)
 		return ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
-		                 "expected a readable CSV file, got %s (%s)", path, strerror(e));
-	}
+		                 "expected a readable CSV file, got %s (%s)", path,
+		                 strerror(errno));
 	if (!S_ISREG(st.st_mode)) {
 		close(fd);
 		return ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
-		                 "expected a regular CSV file, got %s (%s)", path,
-		                 S_ISDIR(st.st_mode)    ? "a directory"
-		                 : S_ISFIFO(st.st_mode) ? "a FIFO"
-		                 : S_ISCHR(st.st_mode)  ? "a character device"
-		                                        : "not a regular file");
+		                 "expected a regular CSV file, got %s (%s)", path, file_kind(&st));
 	}
 	FILE *f = fdopen(fd, "r");
 	if (!f) {

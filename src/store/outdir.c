@@ -27,6 +27,7 @@
 #include "beamsim/version.h"
 #include "util/yaml_doc.h"
 #include "beamsim/limits.h"
+#include "util/file_read.h"
 
 struct bsim_outdir {
 	char dir[1024];
@@ -506,37 +507,22 @@ void bsim_outdir_close(bsim_outdir *od)
 	free(od);
 }
 
-/* What a file that is not a regular one is, for the message. */
-static const char *kind_of(mode_t m)
-{
-	return S_ISDIR(m)    ? "a directory"
-	       : S_ISFIFO(m) ? "a FIFO"
-	       : S_ISCHR(m)  ? "a character device"
-	       : S_ISBLK(m)  ? "a block device"
-	       : S_ISSOCK(m) ? "a socket"
-	                     : "a special file";
-}
-
 /* One listed file checked against its entry: opened without blocking (a
  * FIFO put in its place must not stop the reader), refused unless it is a
  * regular file of the listed size, then read to at most one byte past
  * that size (a file that grows is not followed) for its CRC-32. */
 static int verify_one(const char *dir, const char *path, const ofile *want, bsim_error *err)
 {
-	int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
 	struct stat st;
-	if (fd < 0 || fstat(fd, &st) != 0) {
-		int e = errno;
-		if (fd >= 0)
-			close(fd);
+	int fd = file_open_checked(path, &st);
+	if (fd < 0)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: listed in %s/%s but unreadable: %s",
-		                      path, dir, BSIM_OUTDIR_MANIFEST, strerror(e));
-	}
+		                      path, dir, BSIM_OUTDIR_MANIFEST, strerror(errno));
 	if (!S_ISREG(st.st_mode)) {
 		close(fd);
-		return bsim_error_set(
-		        err, BSIM_EINPUT, "%s: expected the file %s/%s lists (%lld bytes), got %s",
-		        path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, kind_of(st.st_mode));
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: expected the file %s/%s lists (%lld bytes), got %s",
+		                      path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, file_kind(&st));
 	}
 	unsigned char buf[65536];
 	uLong c = crc32(0L, Z_NULL, 0);

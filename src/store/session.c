@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "store/session.h"
+#include "util/file_read.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -39,10 +40,7 @@ int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *
 		 * place would block the first read for ever. */
 		rc = bsim_error_set(err, BSIM_EINPUT,
 		                    "%s: expected the journal of a stopped run, got %s",
-		                    s->journal_path,
-		                    S_ISDIR(st.st_mode)    ? "a directory"
-		                    : S_ISFIFO(st.st_mode) ? "a FIFO"
-		                                           : "a file that is not a regular one");
+		                    s->journal_path, file_kind(&st));
 	} else if (resume && !have) {
 		int finished = 0;
 		bsim_error ignore;

@@ -27,9 +27,9 @@ static int cannot_read(const char *path, int e, bsim_error *err)
 	                      e ? strerror(e) : "read error");
 }
 
-/* What a file that is not a regular one is, for the message. */
-static const char *kind_of(mode_t m)
+const char *file_kind(const struct stat *st)
 {
+	mode_t m = st->st_mode;
 	return S_ISDIR(m)    ? "a directory"
 	       : S_ISFIFO(m) ? "a FIFO"
 	       : S_ISCHR(m)  ? "a character device"
@@ -90,26 +90,31 @@ static char *read_fd(int fd, size_t cap, size_t limit, size_t *n)
 	return buf;
 }
 
+int file_open_checked(const char *path, struct stat *st)
+{
+	int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+	if (fd >= 0 && fstat(fd, st) != 0) {
+		int e = errno;
+		close(fd);
+		errno = e;
+		fd = -1;
+	}
+	return fd;
+}
+
 int file_read(const char *path, const char *what, double max_bytes, const char *limit_name,
               file_text *out, bsim_error *err)
 {
 	out->text = NULL;
 	out->len = 0;
-	/* O_NONBLOCK: opening a FIFO for reading would otherwise wait for a
-	 * writer; O_NOCTTY: a terminal never becomes the controlling one. */
-	int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+	struct stat st;
+	int fd = file_open_checked(path, &st);
 	if (fd < 0)
 		return cannot_read(path, errno, err);
-	struct stat st;
-	if (fstat(fd, &st) != 0) {
-		int e = errno;
-		close(fd);
-		return cannot_read(path, e, err);
-	}
 	if (!S_ISREG(st.st_mode)) {
 		close(fd);
 		return bsim_error_set(err, BSIM_EINPUT, "%s: expected %s, got %s", path, what,
-		                      kind_of(st.st_mode));
+		                      file_kind(&st));
 	}
 	if ((double)st.st_size > max_bytes) {
 		close(fd);

@@ -10,6 +10,7 @@
 #define BSIM_UTIL_FILE_READ_H
 
 #include <stddef.h>
+#include <sys/stat.h>
 
 #include "beamsim/error.h"
 
@@ -31,5 +32,16 @@ int file_read(const char *path, const char *what, double max_bytes, const char *
               file_text *out, bsim_error *err);
 
 void file_text_free(file_text *t);
+
+/* Opens path for reading without blocking (O_NONBLOCK: a FIFO waits for no
+ * writer; O_NOCTTY: a terminal never becomes the controlling one) and
+ * fstat's it into *st, so that a caller checks what it is before the first
+ * read: the descriptor, or -1 with errno set and nothing left open. */
+int file_open_checked(const char *path, struct stat *st);
+
+/* What a file that is not a regular one is, for messages: "a directory",
+ * "a FIFO", "a character device", "a block device", "a socket" or "a
+ * special file". */
+const char *file_kind(const struct stat *st);
 
 #endif
