@@ -300,23 +300,6 @@ void cli_signals_restore(void)
 	signal(SIGTERM, SIG_DFL);
 }
 
-/* An argument as the shell needs it: bare if it is safe, else quoted. */
-static void shell_word(FILE *f, const char *w)
-{
-	if (*w && strspn(w, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
-	                    "_-+=.,:/@%") == strlen(w)) {
-		fputs(w, f);
-		return;
-	}
-	fputc('\'', f);
-	for (; *w; w++)
-		if (*w == '\'')
-			fputs("'\\''", f);
-		else
-			fputc(*w, f);
-	fputc('\'', f);
-}
-
 /* "beamsim sweep ... --resume": the command line that continues the run. */
 static void resume_line(FILE *f, int argc, char **argv)
 {
@@ -324,7 +307,7 @@ static void resume_line(FILE *f, int argc, char **argv)
 	fputs("beamsim", f);
 	for (int i = 0; i < argc; i++) {
 		fputc(' ', f);
-		shell_word(f, argv[i]);
+		text_shell_word(f, argv[i]);
 		has |= strcmp(argv[i], "--resume") == 0;
 	}
 	if (!has)

@@ -18,31 +18,14 @@
 #include "beamsim/lattice.h"
 #include "beamsim/output.h"
 #include "beamsim/lattice_outcome.h"
-
-/* A word for a POSIX shell: as it is if it is made of safe characters,
- * else in single quotes with each ' written as '\''. */
-static void shell_word(FILE *f, const char *s)
-{
-	if (*s && strspn(s, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789"
-	                    "_-+=.,/:@%") == strlen(s)) {
-		fputs(s, f);
-		return;
-	}
-	fputc('\'', f);
-	for (; *s; s++)
-		if (*s == '\'')
-			fputs("'\\''", f);
-		else
-			fputc(*s, f);
-	fputc('\'', f);
-}
+#include "util/text_check.h"
 
 static void set_word(FILE *f, const char *key, const char *value)
 {
 	char buf[1200];
 	snprintf(buf, sizeof buf, "%s=%s", key, value);
 	fputs(" --set ", f);
-	shell_word(f, buf);
+	text_shell_word(f, buf);
 }
 
 static void replay_line(FILE *f, const bsim_report *r, int side, int g, int t)
@@ -51,13 +34,13 @@ static void replay_line(FILE *f, const bsim_report *r, int side, int g, int t)
 	const bsim_report_side *s = &r->side[side];
 	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
 	fputs("beamsim run ", f);
-	shell_word(f, e->scene_path);
+	text_shell_word(f, e->scene_path);
 	fprintf(f, " --backend %s", s->backend->name);
 	for (int i = 0; s->opts && i < s->opts->n; i++) {
 		char buf[128];
 		snprintf(buf, sizeof buf, "%s=%s", s->opts->key[i], s->opts->value[i]);
 		fputs(" --backend-opt ", f);
-		shell_word(f, buf);
+		text_shell_word(f, buf);
 	}
 	fprintf(f, " --seed %" PRIu64 " --group %d --trial %d", e->seed, g, t);
 	for (int i = 0; i < e->n_set; i++)

@@ -11,6 +11,7 @@
 #define BSIM_UTIL_TEXT_CHECK_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 typedef struct text_fault {
 	int line, col;  /* 1-based; col counts characters, not bytes */
@@ -29,5 +30,10 @@ size_t text_strip_cr(char *buf, size_t len);
  * UTF-8 become \xNN, cut to fit. Error messages quote what the user wrote,
  * and a terminal must not interpret it. */
 void text_escape(char *buf, size_t size);
+
+/* s written to f as one word for a POSIX shell: as it is if it is made of
+ * safe characters, else in single quotes with each ' written as '\''
+ * (replay and resume lines a user pastes back). */
+void text_shell_word(FILE *f, const char *s);
 
 #endif
