@@ -37,8 +37,9 @@ typedef struct bsim_limits {
 	double beam_steps;  /* max_steps x beams of one trial */
 } bsim_limits;
 
-/* The defaults: 1 MiB, 100,000 groups, 10^7 trials (about 200 bytes of
- * memory each, twice that in a comparison), 10^6 random-force values (8 MB
+/* The defaults: 1 MiB, 100,000 groups, 10^7 trials (a sweep of gates
+ * streams its trials to disk; a sweep of a lattice and a comparison hold
+ * them in memory: docs/robustness.md "Memory"), 10^6 random-force values (8 MB
  * per thread) and 10^8 beam-steps (about 15 s of one core for the thesis
  * backend on a gate). */
 BSIM_API bsim_limits bsim_limits_default(void);

@@ -33,7 +33,23 @@ typedef struct bsim_group_result {
 	double p_traverse, ci95[2];          /* Wilson 95% */
 	long steps;                          /* steps integrated in the group */
 	bsim_solver_counts solver;           /* of the trials integrated (beamsim/state.h) */
+	/* Trials (copies too) that hit an iteration limit, and a clamp: the
+	 * trials whose motion is partly the solver's, not the model's. */
+	int trials_iteration_limit, trials_clamped;
 } bsim_group_result;
+
+/* Consecutive trials of a sweep, handed to a sink (bsim_sweep_config.sink)
+ * in index order: trial first + k is results[k], with its gate path and
+ * peaks in logs[k]. Valid only during the call. */
+typedef struct bsim_sweep_block {
+	long first; /* index g * trials + t of results[0] */
+	long n;
+	const bsim_trial_result *results;
+	const bsim_trial_log *logs;
+} bsim_sweep_block;
+
+/* A sink's answer other than BSIM_OK (err set) stops the sweep with it. */
+typedef int (*bsim_sweep_sink_fn)(void *user, const bsim_sweep_block *block, bsim_error *err);
 
 typedef struct bsim_sweep_result {
 	int n_groups, trials;
@@ -52,6 +68,10 @@ typedef struct bsim_sweep_result {
 	bsim_trial_log *logs;
 	int lattice;                  /* 1: the groups' scenes are gate lattices */
 	bsim_lattice_def lattice_def; /* group 0's, when lattice */
+	/* A streamed sweep's first unstable trial (its index, -1 none) and its
+	 * result, since trials_out is not kept. */
+	long first_unstable;
+	bsim_trial_result first_unstable_result;
 } bsim_sweep_result;
 
 typedef struct bsim_sweep_config {
@@ -79,7 +99,22 @@ typedef struct bsim_sweep_config {
 	 * starts, those running finish (and are journaled), and the sweep
 	 * returns BSIM_ESTOPPED. */
 	const volatile sig_atomic_t *stop;
+	/* NULL, or where a plain sweep (bsim_sweep_run) streams its trials:
+	 * they run in blocks of BSIM_SWEEP_BLOCK consecutive indices, each
+	 * block goes to sink once it is finished, in index order, and is then
+	 * forgotten, so memory does not grow with the number of trials. The
+	 * result then has no trials_out and no logs, only the groups (and any
+	 * kept trajectories). A lattice's outputs need every trial's path at the
+	 * end: give a sink only to sweeps of gates (bsim_sweep_run refuses a
+	 * lattice with one, BSIM_EINPUT). */
+	bsim_sweep_sink_fn sink;
+	void *sink_user;
 } bsim_sweep_config;
+
+/* Trials per block of a streamed sweep: about 30 MB of results and gate
+ * paths in memory at a time, and few enough blocks that the threads wait
+ * at a block's end only for its slowest trial. */
+#define BSIM_SWEEP_BLOCK 65536
 
 /* The default backend (beamsim/backend.h) with its default options, all
  * threads, no overrides, no progress, nothing kept, no journal, no stop

@@ -20,6 +20,7 @@
 #include "cli/bench_clock.h"
 #include "cli/bench_free.h"
 #include "cli/bench_lattice.h"
+#include "cli/bench_memory.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 
@@ -30,7 +31,16 @@
  * goes to standard output (--json -). */
 static FILE *report;
 
-enum { OWN_EXPERIMENT, OWN_NO_H2, OWN_VS, OWN_VS_OPT, OWN_JSON, OWN_LATTICE, OWN_REPEAT };
+enum {
+	OWN_EXPERIMENT,
+	OWN_NO_H2,
+	OWN_VS,
+	OWN_VS_OPT,
+	OWN_JSON,
+	OWN_LATTICE,
+	OWN_REPEAT,
+	OWN_MEMORY
+};
 
 static const cli_own bench_own[] = {
         [OWN_EXPERIMENT] = {"experiment", 1, "FILE",
@@ -47,6 +57,11 @@ static const cli_own bench_own[] = {
         [OWN_REPEAT] = {"repeat", 1, "N",
                         "run the experiment on one thread N times (default 1)\n"
                         "and report the median, minimum and maximum"},
+        [OWN_MEMORY] = {"memory", 0, NULL,
+                        "instead: peak resident memory of a sweep of --trials\n"
+                        "trials (default 2,000,000) and of a tenth of it, and of\n"
+                        "run --trajectory over 1,000,000 and 100,000 steps,\n"
+                        "each a child process; the growth per trial and per step"},
 };
 
 static const char *const bench_help[CLI_N_OPTS] = {
@@ -64,6 +79,7 @@ typedef struct bench_args {
 	bsim_options vs_opts;
 	const char *json;
 	int lattice;
+	int memory;
 	int repeat; /* one-thread runs of the experiment */
 } bench_args;
 
@@ -108,6 +124,9 @@ static int bench_option(void *args, int i, const char *value)
 	case OWN_LATTICE:
 		a->lattice = 1;
 		return CLI_OK;
+	case OWN_MEMORY:
+		a->memory = 1;
+		return CLI_OK;
 	case OWN_REPEAT: {
 		char *end;
 		long n = strtol(value, &end, 10);
@@ -141,7 +160,7 @@ static const cli_spec bench_spec = {
                   CLI_USES(CLI_OPT_TRIALS),
         .help = bench_help,
         .own = bench_own,
-        .n_own = 7,
+        .n_own = 8,
         .option = bench_option,
 };
 
@@ -472,6 +491,10 @@ int cmd_bench(int argc, char **argv)
 	if (rc >= 0)
 		return rc;
 	report = a.json && strcmp(a.json, "-") == 0 ? stderr : stdout;
+	if (a.memory) {
+		bench_memory_args ma = {.trials = a.trials, .json = a.json, .report = report};
+		return bench_memory(&ma);
+	}
 	if (a.lattice) {
 		bench_lattice_args la = {
 		        .backend = backend,

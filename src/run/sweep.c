@@ -14,11 +14,16 @@
  * and its values (identical code and inputs give identical trials), and
  * nothing downstream counts one trial as many. */
 
+#define _POSIX_C_SOURCE 200809L
 #include "beamsim/sweep.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "util/clock.h"
 #include "util/journal.h"
@@ -27,40 +32,52 @@
 #include "beamsim/stats.h"
 #include "run/trial_pair.h"
 
+/* One trial into its group's counts (group_finish completes them). */
+static void group_add(bsim_group_result *out, const bsim_trial_result *t)
+{
+	out->trials++;
+	out->steps += t->steps_run;
+	out->solver.iteration_limit += t->solver.iteration_limit;
+	out->solver.clamped += t->solver.clamped;
+	out->trials_iteration_limit += t->solver.iteration_limit > 0;
+	out->trials_clamped += t->solver.clamped > 0;
+	switch (t->outcome) {
+	case BSIM_TRAVERSED:
+		out->traversed++;
+		out->left += t->type == BSIM_TYPE_LEFT;
+		out->right += t->type == BSIM_TYPE_RIGHT;
+		/* The barrier crossed (bsim_landscape_label); a trial whose
+		 * last touch was of no deflected beam, or of two holding
+		 * equal energy, counts as neither. */
+		out->landscape_left += t->landscape_beam == 0;
+		out->landscape_right += t->landscape_beam == 1;
+		break;
+	case BSIM_SIDE_EXIT:
+		out->side_exit++;
+		break;
+	case BSIM_STUCK:
+		out->stuck++;
+		out->stuck_in_contact += t->in_contact_end != 0;
+		break;
+	case BSIM_UNSTABLE:
+		out->unstable++;
+		break;
+	}
+}
+
+static void group_finish(bsim_group_result *out)
+{
+	int n = out->trials;
+	out->p_traverse = n > 0 ? (double)out->traversed / n : 0.0;
+	bsim_stats_wilson(out->traversed, n, BSIM_STATS_Z95, &out->ci95[0], &out->ci95[1]);
+}
+
 void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n, bsim_group_result *out)
 {
 	memset(out, 0, sizeof *out);
-	out->trials = n;
-	for (int i = 0; i < n; i++) {
-		const bsim_trial_result *t = &trials[i];
-		out->steps += t->steps_run;
-		out->solver.iteration_limit += t->solver.iteration_limit;
-		out->solver.clamped += t->solver.clamped;
-		switch (t->outcome) {
-		case BSIM_TRAVERSED:
-			out->traversed++;
-			out->left += t->type == BSIM_TYPE_LEFT;
-			out->right += t->type == BSIM_TYPE_RIGHT;
-			/* The barrier crossed (bsim_landscape_label); a trial whose
-			 * last touch was of no deflected beam, or of two holding
-			 * equal energy, counts as neither. */
-			out->landscape_left += t->landscape_beam == 0;
-			out->landscape_right += t->landscape_beam == 1;
-			break;
-		case BSIM_SIDE_EXIT:
-			out->side_exit++;
-			break;
-		case BSIM_STUCK:
-			out->stuck++;
-			out->stuck_in_contact += t->in_contact_end != 0;
-			break;
-		case BSIM_UNSTABLE:
-			out->unstable++;
-			break;
-		}
-	}
-	out->p_traverse = n > 0 ? (double)out->traversed / n : 0.0;
-	bsim_stats_wilson(out->traversed, n, BSIM_STATS_Z95, &out->ci95[0], &out->ci95[1]);
+	for (int i = 0; i < n; i++)
+		group_add(out, &trials[i]);
+	group_finish(out);
 }
 
 void bsim_sweep_result_free(bsim_sweep_result *r)
@@ -155,12 +172,17 @@ typedef struct sweep_shared {
 	int keep, keep_stride;
 	double *t_separate;
 	long total;
+	long first, end; /* the trials of this block; slot k holds trial first + k */
 	long done;
 	long first_fail;
 	bsim_error fail;
-	unsigned char *from_journal; /* total flags: the result came from the journal */
-	int lattice;                 /* the scenes are lattices: every trial runs */
-	int stopped;                 /* a trial was not started because of cfg->stop */
+	unsigned char *from_journal; /* per slot: the result came from the journal */
+	/* A streamed sweep's journal records, by trial index, in a file of
+	 * their own (-1: none), and which trials have one (a bit each). */
+	int spill_fd;
+	unsigned char *journaled;
+	int lattice; /* the scenes are lattices: every trial runs */
+	int stopped; /* a trial was not started because of cfg->stop */
 } sweep_shared;
 
 static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
@@ -182,9 +204,10 @@ static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
 /* Trial i's record: its result, or both results and the separation time. */
 static int journal_append(sweep_shared *sh, long i, bsim_error *err)
 {
+	long k = i - sh->first;
 	if (!sh->backend_b)
-		return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &sh->results[i], err);
-	pair_record p = {sh->results[i], sh->results_b[i], sh->t_separate[i]};
+		return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &sh->results[k], err);
+	pair_record p = {sh->results[k], sh->results_b[k], sh->t_separate[k]};
 	return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &p, err);
 }
 
@@ -199,6 +222,15 @@ static int journal_take(void *user, uint64_t index, const void *payload)
 	 * does every trial of a lattice, whose gate path is not journaled. */
 	if ((long)(index % (uint64_t)sh->e->trials) < sh->keep || sh->lattice)
 		return 0;
+	if (sh->journaled) {
+		/* Streamed: the record waits in the spill file for its block. */
+		size_t size = sizeof(bsim_trial_result);
+		if (pwrite(sh->spill_fd, payload, size, (off_t)(index * size)) != (ssize_t)size)
+			return -1;
+		sh->done += !(sh->journaled[index / 8] & (1u << (index % 8)));
+		sh->journaled[index / 8] |= (unsigned char)(1u << (index % 8));
+		return 0;
+	}
 	if (sh->backend_b) {
 		pair_record p;
 		memcpy(&p, payload, sizeof p);
@@ -233,11 +265,11 @@ static void sweep_thread(sweep_shared *sh)
 		shared_fail(sh, -1, BSIM_EFAIL, "out of memory for a trial runner");
 	}
 #pragma omp for schedule(dynamic)
-	for (long i = 0; i < sh->total; i++) {
-		long stop;
+	for (long i = sh->first; i < sh->end; i++) {
+		long stop, k = i - sh->first;
 #pragma omp atomic read
 		stop = sh->first_fail;
-		if (!runner || i > stop || (sh->from_journal && sh->from_journal[i]))
+		if (!runner || i > stop || (sh->from_journal && sh->from_journal[k]))
 			continue;
 		if (cfg->stop && *cfg->stop) {
 #pragma omp atomic write
@@ -264,19 +296,19 @@ static void sweep_thread(sweep_shared *sh)
 			pair->keep_stride = sh->keep_stride;
 			rc = trial_pair_run(pair, scene, &sh->scenes_b[g], cfg->backend, cfg->opts,
 			                    sh->backend_b, sh->opts_b, seed,
-			                    0.01 * scene->body.radius, &sh->results[i],
-			                    &sh->results_b[i], log, &sh->t_separate[i], &err);
+			                    0.01 * scene->body.radius, &sh->results[k],
+			                    &sh->results_b[k], log, &sh->t_separate[k], &err);
 		} else {
 			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, &rec,
-			                    &sh->results[i], &err);
+			                    &sh->results[k], &err);
 			if (rc == BSIM_OK && keep && keep->oom)
 				rc = bsim_error_set(&err, BSIM_EFAIL,
 				                    "out of memory for a kept trajectory");
 		}
-		if (rc == BSIM_OK && ran && bsim_trial_log_copy(&sh->logs[i], log[0]) != BSIM_OK)
+		if (rc == BSIM_OK && ran && bsim_trial_log_copy(&sh->logs[k], log[0]) != BSIM_OK)
 			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
 		if (rc == BSIM_OK && ran && pair &&
-		    bsim_trial_log_copy(&sh->logs_b[i], log[1]) != BSIM_OK)
+		    bsim_trial_log_copy(&sh->logs_b[k], log[1]) != BSIM_OK)
 			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
 		/* Only trials that ran are journaled: copies are filled in again. */
 		if (rc == BSIM_OK && ran && cfg->journal)
@@ -302,6 +334,7 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, int keep
 	r->n_groups = n_groups;
 	r->trials = trials;
 	r->has_ledger = 1;
+	r->first_unstable = -1;
 	r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
 	r->logs = calloc(n ? n : 1, sizeof *r->logs);
 	r->groups = calloc(n_groups ? (size_t)n_groups : 1, sizeof *r->groups);
@@ -440,6 +473,8 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	        .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
 	        .t_separate = backend_b ? *t_separate : NULL,
 	        .total = total,
+	        .end = total,
+	        .spill_fd = -1,
 	};
 	if (rc == BSIM_OK && cfg->journal) {
 		sh.lattice = scenes[0].has_lattice;
@@ -519,9 +554,226 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	return BSIM_OK;
 }
 
+/* ---- a streamed sweep ---------------------------------------------------
+ *
+ * The trials run in blocks of BSIM_SWEEP_BLOCK consecutive indices: a
+ * block's slots are filled (from the journal, or by running the trials on
+ * every thread), its deterministic copies filled in, its trials added to
+ * their groups' counts, and the block handed to the sink; then the next
+ * block reuses the slots. What stays is per group (counts, a deterministic
+ * group's one trial) and one bit per trial (journaled or not). A resumed
+ * run's journal is read once, before the first block: each record goes to
+ * a spill file at its trial's place (unlinked at once, so nothing is left
+ * behind), from which its block reads it back. */
+
+typedef struct stream_state {
+	bsim_trial_result *results; /* BSIM_SWEEP_BLOCK slots */
+	bsim_trial_log *logs;
+	unsigned char *from_journal;
+	bsim_trial_result *det_first; /* per group: a deterministic group's trial 0 */
+	bsim_trial_log *det_log;
+} stream_state;
+
+static void stream_free(stream_state *st, int n_groups)
+{
+	for (long k = 0; st->logs && k < BSIM_SWEEP_BLOCK; k++)
+		bsim_trial_log_clear(&st->logs[k]);
+	for (int g = 0; st->det_log && g < n_groups; g++)
+		bsim_trial_log_clear(&st->det_log[g]);
+	free(st->results);
+	free(st->logs);
+	free(st->from_journal);
+	free(st->det_first);
+	free(st->det_log);
+}
+
+/* The journal's records into the spill file, a bit per trial. */
+static int stream_replay(sweep_shared *sh, bsim_error *err)
+{
+	char path[2048];
+	const char *jp = bsim_journal_path(sh->cfg->journal);
+	if (snprintf(path, sizeof path, "%s.byindex", jp) >= (int)sizeof path)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", jp);
+	sh->spill_fd = open(path, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+	if (sh->spill_fd < 0)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot create (%s)", path,
+		                      strerror(errno));
+	unlink(path);
+	sh->journaled = calloc((size_t)sh->total / 8 + 1, 1);
+	if (!sh->journaled)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	long kept = 0, cut = 0;
+	return bsim_journal_replay(sh->cfg->journal, journal_take, sh, &kept, &cut, err);
+}
+
+/* Block [sh->first, sh->end)'s journaled trials into their slots. */
+static int stream_load(sweep_shared *sh, bsim_error *err)
+{
+	size_t size = sizeof(bsim_trial_result);
+	for (long i = sh->first; sh->journaled && i < sh->end; i++) {
+		if (!(sh->journaled[i / 8] & (1u << (i % 8))))
+			continue;
+		long k = i - sh->first;
+		if (pread(sh->spill_fd, &sh->results[k], size, (off_t)((size_t)i * size)) !=
+		    (ssize_t)size)
+			return bsim_error_set(err, BSIM_EFAIL,
+			                      "cannot read back the journal's trial %ld (%s)", i,
+			                      strerror(errno));
+		sh->from_journal[k] = 1;
+	}
+	return BSIM_OK;
+}
+
+/* A finished block: copies filled in, counted, handed to the sink. */
+static int stream_block(sweep_shared *sh, stream_state *st, bsim_sweep_result *out, bsim_error *err)
+{
+	int trials = sh->e->trials;
+	for (long i = sh->first; i < sh->end; i++) {
+		long k = i - sh->first;
+		int g = (int)(i / trials), t = (int)(i % trials);
+		if (sh->deterministic[g] && t == 0) {
+			st->det_first[g] = st->results[k];
+			if (bsim_trial_log_copy(&st->det_log[g], &st->logs[k]) != BSIM_OK)
+				return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		} else if (sh->deterministic[g]) {
+			st->results[k] = st->det_first[g];
+			if (bsim_trial_log_copy(&st->logs[k], &st->det_log[g]) != BSIM_OK)
+				return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		}
+		group_add(&out->groups[g], &st->results[k]);
+		if (st->results[k].outcome == BSIM_UNSTABLE && out->first_unstable < 0) {
+			out->first_unstable = i;
+			out->first_unstable_result = st->results[k];
+		}
+	}
+	bsim_sweep_block b = {sh->first, sh->end - sh->first, st->results, st->logs};
+	return sh->cfg->sink(sh->cfg->sink_user, &b, err);
+}
+
+static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                          bsim_sweep_result *out, bsim_error *err)
+{
+	double t0 = bsim_clock_seconds();
+	if (e->trials < 0 || e->n_groups < 1)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: expected at least one group and trials >= 0", e->path);
+	bsim_error why;
+	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: %s", e->path, why.msg);
+	long total = (long)e->n_groups * e->trials;
+	int keep = cfg->keep < e->trials ? cfg->keep : e->trials;
+	keep = keep < 0 ? 0 : keep;
+	if (result_alloc(out, e->n_groups, 0, keep, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	out->trials = e->trials;
+	free(out->trials_out);
+	free(out->logs);
+	out->trials_out = NULL;
+	out->logs = NULL;
+
+	bsim_scene *scenes = NULL;
+	stream_state st = {0};
+	int *deterministic = NULL;
+	int rc = scenes_build(e, cfg, 0, &scenes, err);
+	if (rc == BSIM_OK && scenes[0].has_lattice)
+		rc = bsim_error_set(err, BSIM_EINPUT,
+		                    "%s: a lattice's trials cannot be streamed (their paths are "
+		                    "needed at the end)",
+		                    e->path);
+	if (rc == BSIM_OK) {
+		deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
+		st.results = calloc(BSIM_SWEEP_BLOCK, sizeof *st.results);
+		st.logs = calloc(BSIM_SWEEP_BLOCK, sizeof *st.logs);
+		st.from_journal = calloc(BSIM_SWEEP_BLOCK, 1);
+		st.det_first = calloc((size_t)e->n_groups, sizeof *st.det_first);
+		st.det_log = calloc((size_t)e->n_groups, sizeof *st.det_log);
+		if (!deterministic || !st.results || !st.logs || !st.from_journal ||
+		    !st.det_first || !st.det_log)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups",
+			                    e->n_groups);
+	}
+	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
+		deterministic[g] = !bsim_effects_random(&scenes[g]);
+	sweep_shared sh = {
+	        .e = e,
+	        .cfg = cfg,
+	        .scenes = scenes,
+	        .scenes_b = scenes,
+	        .deterministic = deterministic,
+	        .results = st.results,
+	        .logs = st.logs,
+	        .kept = out->kept,
+	        .keep = keep,
+	        .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
+	        .total = total,
+	        .from_journal = st.from_journal,
+	        .spill_fd = -1,
+	        .first_fail = total,
+	};
+	if (rc == BSIM_OK && cfg->journal)
+		rc = stream_replay(&sh, err);
+	int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
+	if (threads > BSIM_SWEEP_BLOCK)
+		threads = BSIM_SWEEP_BLOCK;
+	for (long first = 0; rc == BSIM_OK && first < total; first += BSIM_SWEEP_BLOCK) {
+		sh.first = first;
+		sh.end = total - first < BSIM_SWEEP_BLOCK ? total : first + BSIM_SWEEP_BLOCK;
+		memset(st.results, 0, BSIM_SWEEP_BLOCK * sizeof *st.results);
+		memset(st.from_journal, 0, BSIM_SWEEP_BLOCK);
+		rc = stream_load(&sh, err);
+		if (rc != BSIM_OK)
+			break;
+		long n = sh.end - sh.first;
+		bsim_error_clear(&sh.fail);
+#pragma omp parallel num_threads(threads < n ? threads : (int)n)
+		sweep_thread(&sh);
+		if (sh.first_fail < total)
+			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
+		else if (sh.stopped)
+			rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped after %ld of %ld trials",
+			                    sh.done, total);
+		else
+			rc = stream_block(&sh, &st, out, err);
+	}
+	if (sh.spill_fd >= 0)
+		close(sh.spill_fd);
+	free(sh.journaled);
+	if (rc == BSIM_OK && cfg->progress)
+		cfg->progress(cfg->progress_user, total, total);
+	if (rc == BSIM_OK)
+		rc = kept_fill(out, deterministic, err);
+	if (rc == BSIM_OK) {
+		out->lattice = 0;
+		out->wall_seconds = bsim_clock_seconds() - t0;
+		for (int g = 0; g < e->n_groups; g++) {
+			bsim_group_result *gr = &out->groups[g];
+			group_finish(gr);
+			gr->deterministic = deterministic[g];
+			if (gr->deterministic && e->trials > 0) {
+				gr->ci95[0] = gr->ci95[1] = gr->p_traverse;
+				gr->steps = st.det_first[g].steps_run;
+				gr->solver = st.det_first[g].solver;
+			}
+			out->total_steps += gr->steps;
+			out->solver.iteration_limit += gr->solver.iteration_limit;
+			out->solver.clamped += gr->solver.clamped;
+			out->trials_run += gr->deterministic && e->trials > 0 ? 1 : e->trials;
+		}
+	}
+	if (scenes)
+		scenes_free(scenes, e->n_groups);
+	stream_free(&st, e->n_groups);
+	free(deterministic);
+	if (rc != BSIM_OK)
+		bsim_sweep_result_free(out);
+	return rc;
+}
+
 int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
                    bsim_error *err)
 {
+	if (cfg->sink)
+		return sweep_streamed(e, cfg, out, err);
 	return sweep_common(e, cfg, NULL, NULL, out, NULL, NULL, err);
 }
 

@@ -206,15 +206,10 @@ static void json_solver(FILE *f, const bsim_solver_counts *c)
 
 /* How many of a group's trials hit an iteration limit, and a clamp: the
  * trials whose motion is partly the solver's, not the model's. */
-static void json_solver_trials(FILE *f, const bsim_sweep_result *r, int group)
+static void json_solver_trials(FILE *f, const bsim_group_result *g)
 {
-	long limited = 0, clamped = 0;
-	for (int t = 0; r->trials_out && t < r->trials; t++) {
-		const bsim_trial_result *x = &r->trials_out[(size_t)group * r->trials + t];
-		limited += x->solver.iteration_limit > 0;
-		clamped += x->solver.clamped > 0;
-	}
-	fprintf(f, ", \"trials_iteration_limit\": %ld, \"trials_clamped\": %ld", limited, clamped);
+	fprintf(f, ", \"trials_iteration_limit\": %d, \"trials_clamped\": %d",
+	        g->trials_iteration_limit, g->trials_clamped);
 }
 
 static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int group,
@@ -238,7 +233,7 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps, g->unstable,
 	        g->deterministic ? "true" : "false");
 	json_solver(f, &g->solver);
-	json_solver_trials(f, r, group);
+	json_solver_trials(f, g);
 	if (r->lattice)
 		json_lattice(f, r, group);
 	fputc('}', f);
@@ -346,64 +341,90 @@ const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
         "clamps",
 };
 
+int trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
+                    bsim_error *err)
+{
+	memset(w, 0, sizeof *w);
+	if (bsim_atomic_file_open(&w->o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	w->e = e;
+	w->axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
+	w->group = -1;
+	for (int c = 0; c < TRIALS_N_COLUMNS; c++)
+		fprintf(w->o.f, "%s%s", c ? "," : "", bsim_trials_csv_columns[c]);
+	for (int a = 0; a < w->axes; a++) {
+		fputc(',', w->o.f);
+		csv_field(w->o.f, e->axes[a].key);
+	}
+	fputc('\n', w->o.f);
+	return BSIM_OK;
+}
+
+void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
+                     const bsim_trial_result *results, const bsim_trial_log *logs)
+{
+	FILE *f = w->o.f;
+	for (long k = 0; k < n; k++) {
+		int g = (int)((first + k) / trials), t = (int)((first + k) % trials);
+		if (w->axes && g != w->group)
+			bsim_experiment_group_index(w->e, g, w->idx);
+		w->group = g;
+		const bsim_trial_result *x = &results[k];
+		const bsim_ledger *l = &x->ledger;
+		fprintf(f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", g, t,
+		        bsim_trial_outcome_name(x->outcome), bsim_trial_type_name(x->type),
+		        x->steps, x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
+		        x->max_theta[1]);
+		/* losses: sleeping's and the essay protocol's resets too, so that
+		 * e_end - e_start = work_in - losses + residual */
+		fprintf(f, ",%.10g,%.10g,%.10g,%.10g,%.10g,", l->e_start, l->e_end,
+		        l->w_prop + l->w_rand,
+		        l->damper + l->impact + l->contact + l->correction + l->sleep + l->reset,
+		        l->residual);
+		csv_number(f, x->overlap_max);
+		/* the final gate and location, and the gates entered in order:
+		 * "ix:iy ix:iy ..." */
+		char label[48];
+		bsim_lattice_location_label(bsim_lattice_location_of(x), label, sizeof label);
+		fprintf(f, ",%d,%d,%s,", x->final_ix, x->final_iy, label);
+		const bsim_trial_log *tl = logs ? &logs[k] : NULL;
+		for (int j = 0; tl && j < tl->n_entries; j++)
+			fprintf(f, "%s%d:%d", j ? " " : "", tl->entries[j].ix, tl->entries[j].iy);
+		/* A trial without its path (taken from a resumed run's
+		 * journal, which lattices never are) stayed in one gate. */
+		if (!tl || tl->n_entries == 0)
+			fprintf(f, "%d:%d", x->final_ix, x->final_iy);
+		/* what the backend's solvers gave up on in this trial */
+		fprintf(f, ",%ld,%ld", x->solver.iteration_limit, x->solver.clamped);
+		for (int a = 0; a < w->axes; a++) {
+			fputc(',', f);
+			csv_field(f, w->e->axes[a].values[w->idx[a]]);
+		}
+		fputc('\n', f);
+	}
+}
+
+int trials_csv_commit(trials_csv_writer *w, bsim_error *err)
+{
+	return bsim_atomic_file_commit(&w->o, err);
+}
+
+void trials_csv_abort(trials_csv_writer *w)
+{
+	bsim_atomic_file_abort(&w->o);
+}
+
 int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
                            bsim_error *err)
 {
-	bsim_atomic_file o;
-	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+	trials_csv_writer w;
+	if (trials_csv_open(&w, path, e, err) != BSIM_OK)
 		return BSIM_EFAIL;
-	int axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
-	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
-	for (int c = 0; c < TRIALS_N_COLUMNS; c++)
-		fprintf(o.f, "%s%s", c ? "," : "", bsim_trials_csv_columns[c]);
-	for (int a = 0; a < axes; a++) {
-		fputc(',', o.f);
-		csv_field(o.f, e->axes[a].key);
-	}
-	fputc('\n', o.f);
-	for (int g = 0; g < r->n_groups; g++) {
-		if (axes)
-			bsim_experiment_group_index(e, g, idx);
-		for (int t = 0; t < r->trials; t++) {
-			size_t i = (size_t)g * r->trials + t;
-			const bsim_trial_result *x = &r->trials_out[i];
-			const bsim_ledger *l = &x->ledger;
-			fprintf(o.f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", g, t,
-			        bsim_trial_outcome_name(x->outcome), bsim_trial_type_name(x->type),
-			        x->steps, x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
-			        x->max_theta[1]);
-			/* losses: sleeping's and the essay protocol's resets too, so that
-			 * e_end - e_start = work_in - losses + residual */
-			fprintf(o.f, ",%.10g,%.10g,%.10g,%.10g,%.10g,", l->e_start, l->e_end,
-			        l->w_prop + l->w_rand,
-			        l->damper + l->impact + l->contact + l->correction + l->sleep +
-			                l->reset,
-			        l->residual);
-			csv_number(o.f, x->overlap_max);
-			/* the final gate and location, and the gates entered in order:
-			 * "ix:iy ix:iy ..." */
-			char label[48];
-			bsim_lattice_location_label(bsim_lattice_location_of(x), label,
-			                            sizeof label);
-			fprintf(o.f, ",%d,%d,%s,", x->final_ix, x->final_iy, label);
-			const bsim_trial_log *tl = r->logs ? &r->logs[i] : NULL;
-			for (int k = 0; tl && k < tl->n_entries; k++)
-				fprintf(o.f, "%s%d:%d", k ? " " : "", tl->entries[k].ix,
-				        tl->entries[k].iy);
-			/* A trial without its path (taken from a resumed run's
-			 * journal, which lattices never are) stayed in one gate. */
-			if (!tl || tl->n_entries == 0)
-				fprintf(o.f, "%d:%d", x->final_ix, x->final_iy);
-			/* what the backend's solvers gave up on in this trial */
-			fprintf(o.f, ",%ld,%ld", x->solver.iteration_limit, x->solver.clamped);
-			for (int a = 0; a < axes; a++) {
-				fputc(',', o.f);
-				csv_field(o.f, e->axes[a].values[idx[a]]);
-			}
-			fputc('\n', o.f);
-		}
-	}
-	return bsim_atomic_file_commit(&o, err);
+	for (int g = 0; g < r->n_groups; g++)
+		trials_csv_rows(&w, (long)g * r->trials, r->trials, r->trials,
+		                &r->trials_out[(size_t)g * r->trials],
+		                r->logs ? &r->logs[(size_t)g * r->trials] : NULL);
+	return trials_csv_commit(&w, err);
 }
 
 /* ---- the p_traverse table ------------------------------------------------ */

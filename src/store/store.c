@@ -29,7 +29,7 @@ int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim
 	}
 	if (bsim_output_mkdir(dir, err) != BSIM_OK ||
 	    bsim_output_summary_json(summary, e, b->name, opts, r, err) != BSIM_OK ||
-	    bsim_output_trials_csv(trials, e, r, err) != BSIM_OK ||
+	    (r->trials_out && bsim_output_trials_csv(trials, e, r, err) != BSIM_OK) ||
 	    bsim_output_lattice(dir, e, extra, n_extra, r, err) != BSIM_OK ||
 	    bsim_output_trajectories_csv(traj, r, err) != BSIM_OK ||
 	    bsim_matlab_sweep(dir, e, err) != BSIM_OK)
@@ -70,16 +70,27 @@ long bsim_store_unstable(const bsim_experiment *e, const bsim_override *extra, i
 	*first = -1;
 	if (size > 0)
 		why[0] = '\0';
-	for (long i = 0; i < (long)r->n_groups * r->trials; i++)
-		if (r->trials_out[i].outcome == BSIM_UNSTABLE) {
-			count++;
-			*first = *first < 0 ? i : *first;
-		}
+	const bsim_trial_result *x = NULL;
+	if (r->trials_out) {
+		for (long i = 0; i < (long)r->n_groups * r->trials; i++)
+			if (r->trials_out[i].outcome == BSIM_UNSTABLE) {
+				count++;
+				*first = *first < 0 ? i : *first;
+			}
+		x = *first >= 0 ? &r->trials_out[*first] : NULL;
+	} else {
+		/* A streamed sweep keeps the counts and its first unstable trial. */
+		for (int g = 0; g < r->n_groups; g++)
+			count += r->groups[g].unstable;
+		*first = r->first_unstable;
+		x = *first >= 0 ? &r->first_unstable_result : NULL;
+	}
 	bsim_scene scene;
 	bsim_error err;
-	if (count > 0 && bsim_experiment_group_scene(e, (int)(*first / r->trials), extra, n_extra,
-	                                             &scene, &err) == BSIM_OK) {
-		bsim_trial_instability_text(&r->trials_out[*first], scene.dt, why, size);
+	if (count > 0 && x &&
+	    bsim_experiment_group_scene(e, (int)(*first / r->trials), extra, n_extra, &scene,
+	                                &err) == BSIM_OK) {
+		bsim_trial_instability_text(x, scene.dt, why, size);
 		bsim_scene_free(&scene);
 	}
 	return count;

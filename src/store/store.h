@@ -14,7 +14,8 @@
 /* dir/summary.json, trials.csv, trajectories.csv when trajectories were
  * kept (a stale one of an earlier run is removed, so a directory never
  * pairs trials with trajectories of another run), a lattice's files, and
- * their .mat twins; dir is created if missing. */
+ * their .mat twins; dir is created if missing. trials.csv only if r has its
+ * trials (trials_out): a streamed sweep has written it as it ran. */
 int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
                            const bsim_options *opts, const bsim_override *extra, int n_extra,
                            const bsim_sweep_result *r, bsim_error *err);

@@ -8,7 +8,9 @@
 
 #include "beamsim/sweep_dir.h"
 
+#include <errno.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,6 +21,7 @@
 #include "store/session.h"
 #include "store/rerun.h"
 #include "store/store.h"
+#include "store/trials_csv.h"
 #include "beamsim/limits.h"
 
 bsim_sweep_dir_def bsim_sweep_dir_def_default(void)
@@ -33,6 +36,38 @@ void bsim_sweep_dir_result_free(bsim_sweep_dir_result *res)
 {
 	bsim_sweep_result_free(&res->r);
 	bsim_experiment_free(&res->e);
+}
+
+/* trials.csv written as a streamed sweep's blocks arrive. A write error
+ * (a full disk) stops the sweep; its finished trials are in the journal. */
+typedef struct trials_sink {
+	trials_csv_writer w;
+	char path[BSIM_PATH_MAX];
+	int trials;
+	int failed;
+} trials_sink;
+
+static int trials_sink_take(void *user, const bsim_sweep_block *b, bsim_error *err)
+{
+	trials_sink *s = user;
+	trials_csv_rows(&s->w, b->first, b->n, s->trials, b->results, b->logs);
+	if (fflush(s->w.o.f) == 0 && !ferror(s->w.o.f))
+		return BSIM_OK;
+	s->failed = 1;
+	return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write (%s)", s->path, strerror(errno));
+}
+
+/* 1 if the experiment's trials can stream to disk: its scenes are gates,
+ * not lattices, whose outputs need every trial's path at the end. */
+static int streams(const bsim_experiment *e, const bsim_override *sets, int n_sets)
+{
+	bsim_scene scene;
+	bsim_error ignore;
+	if (bsim_experiment_group_scene(e, 0, sets, n_sets, &scene, &ignore) != BSIM_OK)
+		return 0;
+	int lattice = scene.has_lattice;
+	bsim_scene_free(&scene);
+	return !lattice;
 }
 
 /* res->journal names the journal if the session kept it. */
@@ -99,7 +134,25 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	        .journal = ss.journal,
 	        .stop = def->stop,
 	};
-	rc = bsim_sweep_run(e, &cfg, &res->r, err);
+	/* A sweep of gates streams its trials into trials.csv as they finish. */
+	trials_sink sink = {.trials = e->trials};
+	if (streams(e, def->sets, def->n_sets)) {
+		rc = bsim_session_path(sink.path, sizeof sink.path, ss.stage, "trials.csv", err);
+		if (rc == BSIM_OK)
+			rc = bsim_output_mkdir(ss.stage, err);
+		if (rc == BSIM_OK)
+			rc = trials_csv_open(&sink.w, sink.path, e, err);
+		cfg.sink = trials_sink_take;
+		cfg.sink_user = &sink;
+	}
+	if (rc == BSIM_OK)
+		rc = bsim_sweep_run(e, &cfg, &res->r, err);
+	if (rc == BSIM_OK && cfg.sink)
+		rc = trials_csv_commit(&sink.w, err);
+	else if (cfg.sink)
+		trials_csv_abort(&sink.w);
+	if (sink.failed)
+		ss.done = 1; /* the trials journaled before the disk filled are kept */
 	if (rc == BSIM_OK) {
 		ss.done = 1;
 		rc = bsim_store_sweep_files(ss.stage, e, b, &def->opts, def->sets, def->n_sets,

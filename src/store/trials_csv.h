@@ -5,6 +5,11 @@
 #ifndef BSIM_STORE_TRIALS_CSV_H
 #define BSIM_STORE_TRIALS_CSV_H
 
+#include "beamsim/experiment.h"
+#include "beamsim/output.h"
+#include "beamsim/trial.h"
+#include "util/atomic_file.h"
+
 enum {
 	TRIALS_GROUP,
 	TRIALS_TRIAL,
@@ -34,5 +39,24 @@ enum {
 
 /* Their names, as in the header line. */
 extern const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS];
+
+/* trials.csv written as the trials come (a streamed sweep hands them over
+ * block by block): open writes the header, rows appends trials first ..
+ * first + n - 1 of a sweep of `trials` per group (logs may be NULL), commit
+ * puts the whole file in place (util/atomic_file.h), abort leaves nothing. */
+typedef struct trials_csv_writer {
+	bsim_atomic_file o;
+	const bsim_experiment *e;
+	int axes;
+	int group; /* the group whose axis values idx holds */
+	int idx[BSIM_OUTPUT_AXES_MAX];
+} trials_csv_writer;
+
+int trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
+                    bsim_error *err);
+void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
+                     const bsim_trial_result *results, const bsim_trial_log *logs);
+int trials_csv_commit(trials_csv_writer *w, bsim_error *err);
+void trials_csv_abort(trials_csv_writer *w);
 
 #endif

@@ -1,0 +1,215 @@
+/* A streamed sweep (bsim_sweep_config.sink) against the same sweep held in
+ * memory: the trials handed to the sink, block by block, are the in-memory
+ * sweep's trials, in index order, none missing or repeated; the groups'
+ * counts are the same; a deterministic group whose copies span a block
+ * boundary is filled in across it; a sweep stopped half-way and resumed
+ * from its journal streams the same trials; a sink that fails stops the
+ * sweep with its error. The experiment has more trials than one block
+ * (BSIM_SWEEP_BLOCK), so the block boundaries are crossed. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/beamsim.h"
+#include "util/journal.h"
+#include "support.h"
+
+/* Group 0 draws random forces; group 1 has none, so it is deterministic,
+ * and its trials (35,000 .. 69,999) straddle the block boundary at 65,536.
+ * Trials of 20 steps keep the 70,000 of them quick. */
+#define TRIALS 35000
+
+static bsim_experiment exp_;
+static bsim_sweep_result whole; /* the sweep in memory: the reference */
+
+static int setup(void **state)
+{
+	(void)state;
+	char text[1024];
+	snprintf(text, sizeof text,
+	         "scene: %s\ntrials: %d\nseed: 5\nset:\n  integration.max_steps: 20\n"
+	         "grid:\n  effects.random_force.magnitude: [30, 0]\n",
+	         bsim_test_src("configs/thesis/gate.yaml"), TRIALS);
+	const char *path = bsim_test_write(bsim_test_dir("stream"), "exp.yaml", text);
+	bsim_error err;
+	bsim_limits l = bsim_limits_default();
+	l.trials = 1e6;
+	bsim_limits_set(&l);
+	if (bsim_experiment_load(path, NULL, 0, &exp_, &err) != BSIM_OK)
+		fail_msg("%s", err.msg);
+	bsim_sweep_config cfg = bsim_sweep_config_default();
+	if (bsim_sweep_run(&exp_, &cfg, &whole, &err) != BSIM_OK)
+		fail_msg("%s", err.msg);
+	return 0;
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	bsim_sweep_result_free(&whole);
+	bsim_experiment_free(&exp_);
+	bsim_limits_set(NULL);
+	return 0;
+}
+
+/* What a sink saw: the next index it expects, and any disagreement. */
+typedef struct seen {
+	long next;
+	long blocks;
+	long differ; /* trials not identical to the in-memory sweep's */
+	long paths;  /* trials whose gate path is not the in-memory one */
+	int fail_at; /* > 0: fail on this block (1-based) */
+} seen;
+
+static int take(void *user, const bsim_sweep_block *b, bsim_error *err)
+{
+	seen *s = user;
+	s->blocks++;
+	if (s->fail_at == s->blocks)
+		return bsim_error_set(err, BSIM_EFAIL, "the disk is full (a test)");
+	assert_int_equal(b->first, s->next);
+	assert_true(b->n > 0 && b->n <= BSIM_SWEEP_BLOCK);
+	for (long k = 0; k < b->n; k++) {
+		const bsim_trial_result *x = &whole.trials_out[b->first + k];
+		const bsim_trial_log *lx = &whole.logs[b->first + k];
+		s->differ += !bsim_compare_identical(&b->results[k], x, 1) ||
+		             b->results[k].steps_run != x->steps_run ||
+		             b->results[k].draws != x->draws;
+		s->paths += b->logs[k].n_entries != lx->n_entries;
+	}
+	s->next += b->n;
+	return BSIM_OK;
+}
+
+static void groups_equal(const bsim_sweep_result *r)
+{
+	for (int g = 0; g < exp_.n_groups; g++) {
+		const bsim_group_result *a = &r->groups[g], *b = &whole.groups[g];
+		assert_int_equal(a->trials, b->trials);
+		assert_int_equal(a->traversed, b->traversed);
+		assert_int_equal(a->side_exit, b->side_exit);
+		assert_int_equal(a->stuck, b->stuck);
+		assert_int_equal(a->unstable, b->unstable);
+		assert_int_equal(a->left, b->left);
+		assert_int_equal(a->stuck_in_contact, b->stuck_in_contact);
+		assert_int_equal(a->deterministic, b->deterministic);
+		assert_int_equal(a->steps, b->steps);
+		assert_true(a->p_traverse == b->p_traverse);
+		assert_true(a->ci95[0] == b->ci95[0] && a->ci95[1] == b->ci95[1]);
+	}
+	assert_int_equal(r->total_steps, whole.total_steps);
+	assert_int_equal(r->trials_run, whole.trials_run);
+}
+
+static void streams_the_same_trials(void **state)
+{
+	(void)state;
+	assert_true(whole.groups[1].deterministic && !whole.groups[0].deterministic);
+	assert_true((long)exp_.n_groups * TRIALS > BSIM_SWEEP_BLOCK);
+	seen s = {0};
+	bsim_sweep_config cfg = bsim_sweep_config_default();
+	cfg.sink = take;
+	cfg.sink_user = &s;
+	cfg.threads = 2;
+	bsim_sweep_result r;
+	bsim_error err;
+	assert_int_equal(bsim_sweep_run(&exp_, &cfg, &r, &err), BSIM_OK);
+	assert_int_equal(s.next, (long)exp_.n_groups * TRIALS);
+	assert_int_equal(s.blocks, 2);
+	assert_int_equal(s.differ, 0);
+	assert_int_equal(s.paths, 0);
+	assert_null(r.trials_out);
+	assert_null(r.logs);
+	groups_equal(&r);
+	bsim_sweep_result_free(&r);
+}
+
+/* Stops the sweep once `after` trials are done (the progress callback
+ * runs on the leading thread as trials end). */
+typedef struct stopper {
+	volatile sig_atomic_t flag;
+	long after;
+} stopper;
+
+static void stop_after(void *user, long done, long total)
+{
+	(void)total;
+	stopper *st = user;
+	if (done >= st->after)
+		st->flag = 1;
+}
+
+static void resumed_from_the_journal(void **state)
+{
+	(void)state;
+	char path[1200];
+	snprintf(path, sizeof path, "%s/journal", bsim_test_dir("stream_resume"));
+	size_t size = bsim_sweep_record_size(0);
+	bsim_journal *j;
+	bsim_error err;
+	assert_int_equal(bsim_journal_create(&j, path, "stream test\n", size, &err), BSIM_OK);
+	long cut = 0, kept = 0;
+	assert_int_equal(bsim_journal_replay(j, NULL, NULL, &kept, &cut, &err), BSIM_OK);
+
+	/* First run: stopped past the first block, so the journal holds
+	 * trials of both blocks. */
+	seen s1 = {0};
+	stopper st = {0, BSIM_SWEEP_BLOCK + 100};
+	bsim_sweep_config cfg = bsim_sweep_config_default();
+	cfg.sink = take;
+	cfg.sink_user = &s1;
+	cfg.journal = j;
+	cfg.threads = 2;
+	cfg.stop = &st.flag;
+	cfg.progress = stop_after;
+	cfg.progress_user = &st;
+	bsim_sweep_result r;
+	assert_int_equal(bsim_sweep_run(&exp_, &cfg, &r, &err), BSIM_ESTOPPED);
+	assert_int_equal(s1.differ, 0);
+	assert_int_equal(bsim_journal_close(j, &err), BSIM_OK);
+
+	/* Resumed: every trial streamed once, the same as in memory. */
+	assert_int_equal(bsim_journal_resume(&j, path, "stream test\n", size, &err), BSIM_OK);
+	seen s2 = {0};
+	cfg = bsim_sweep_config_default();
+	cfg.sink = take;
+	cfg.sink_user = &s2;
+	cfg.journal = j;
+	assert_int_equal(bsim_sweep_run(&exp_, &cfg, &r, &err), BSIM_OK);
+	assert_int_equal(bsim_journal_close(j, &err), BSIM_OK);
+	assert_int_equal(s2.next, (long)exp_.n_groups * TRIALS);
+	assert_int_equal(s2.differ, 0);
+	groups_equal(&r);
+	bsim_sweep_result_free(&r);
+}
+
+static void failing_sink_stops_the_sweep(void **state)
+{
+	(void)state;
+	seen s = {.fail_at = 1};
+	bsim_sweep_config cfg = bsim_sweep_config_default();
+	cfg.sink = take;
+	cfg.sink_user = &s;
+	bsim_sweep_result r;
+	bsim_error err;
+	assert_int_equal(bsim_sweep_run(&exp_, &cfg, &r, &err), BSIM_EFAIL);
+	assert_non_null(strstr(err.msg, "the disk is full"));
+	assert_int_equal(s.blocks, 1); /* nothing after the failed block ran */
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(streams_the_same_trials),
+	        cmocka_unit_test(resumed_from_the_journal),
+	        cmocka_unit_test(failing_sink_stops_the_sweep),
+	};
+	return cmocka_run_group_tests(tests, setup, teardown);
+}
