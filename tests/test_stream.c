@@ -5,7 +5,8 @@
  * boundary is filled in across it; a sweep stopped half-way and resumed
  * from its journal streams the same trials; a sink that fails stops the
  * sweep with its error. The experiment has more trials than one block
- * (BSIM_SWEEP_BLOCK), so the block boundaries are crossed. */
+ * (BSIM_SWEEP_BLOCK), so the block boundaries are crossed. A lattice's
+ * summaries built block by block equal those of all its trials at once. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -206,12 +207,77 @@ static void failing_sink_stops_the_sweep(void **state)
 	assert_int_equal(s.blocks, 1); /* nothing after the failed block ran */
 }
 
+/* A lattice group's summary built block by block (a streamed lattice
+ * sweep) against the same trials summarised at once: the same locations,
+ * transitions and counts, and the same times per row to the bit, however
+ * the trials are split. */
+static void lattice_summary_in_blocks(void **state)
+{
+	(void)state;
+	char text[1024];
+	snprintf(text, sizeof text,
+	         "scene: %s\ntrials: 300\nseed: 9\nset:\n  integration.max_steps: 2000\n"
+	         "grid:\n  effects.random_force.magnitude: [30]\n",
+	         bsim_test_src("configs/lattice/uniform_9x9.yaml"));
+	const char *path = bsim_test_write(bsim_test_dir("stream_lattice"), "exp.yaml", text);
+	bsim_experiment e;
+	bsim_error err;
+	if (bsim_experiment_load(path, NULL, 0, &e, &err) != BSIM_OK)
+		fail_msg("%s", err.msg);
+	bsim_sweep_config cfg = bsim_sweep_config_default();
+	bsim_sweep_result r;
+	assert_int_equal(bsim_sweep_run(&e, &cfg, &r, &err), BSIM_OK);
+	assert_true(r.lattice);
+	int n = r.trials, rows = r.lattice_def.rows;
+	bsim_lattice_summary all;
+	assert_int_equal(bsim_lattice_summarise(r.trials_out, r.logs, n, rows, &all), BSIM_OK);
+	assert_true(all.n_transitions > 1 && all.n_locations > 1);
+	static const int pieces[] = {1, 7, 64, 299};
+	for (size_t p = 0; p < sizeof pieces / sizeof pieces[0]; p++) {
+		bsim_lattice_summary s;
+		assert_int_equal(bsim_lattice_summary_begin(&s, rows), BSIM_OK);
+		for (int i = 0; i < n; i += pieces[p]) {
+			int m = n - i < pieces[p] ? n - i : pieces[p];
+			assert_int_equal(
+			        bsim_lattice_summary_add(&s, &r.trials_out[i], &r.logs[i], m),
+			        BSIM_OK);
+		}
+		bsim_lattice_summary_end(&s);
+		assert_int_equal(s.trials, all.trials);
+		assert_int_equal(s.n_locations, all.n_locations);
+		for (int k = 0; k < s.n_locations; k++) {
+			assert_true(bsim_lattice_location_equal(s.locations[k].loc,
+			                                        all.locations[k].loc));
+			assert_int_equal(s.locations[k].count, all.locations[k].count);
+			assert_true(s.locations[k].p == all.locations[k].p);
+			assert_true(s.locations[k].ci95[0] == all.locations[k].ci95[0]);
+		}
+		assert_int_equal(s.n_transitions, all.n_transitions);
+		for (int k = 0; k < s.n_transitions; k++) {
+			assert_memory_equal(s.transitions[k].from, all.transitions[k].from,
+			                    sizeof s.transitions[k].from);
+			assert_memory_equal(s.transitions[k].to, all.transitions[k].to,
+			                    sizeof s.transitions[k].to);
+			assert_int_equal(s.transitions[k].count, all.transitions[k].count);
+		}
+		for (int iy = 0; iy < rows; iy++) {
+			assert_int_equal(s.row_trials[iy], all.row_trials[iy]);
+			assert_true(s.row_time[iy] == all.row_time[iy]);
+		}
+		bsim_lattice_summary_free(&s);
+	}
+	bsim_lattice_summary_free(&all);
+	bsim_sweep_result_free(&r);
+	bsim_experiment_free(&e);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(streams_the_same_trials),
 	        cmocka_unit_test(resumed_from_the_journal),
 	        cmocka_unit_test(failing_sink_stops_the_sweep),
+	        cmocka_unit_test(lattice_summary_in_blocks),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -65,6 +65,16 @@ BSIM_API int bsim_lattice_summarise(const bsim_trial_result *trials, const bsim_
                                     int n, int rows, bsim_lattice_summary *out);
 BSIM_API void bsim_lattice_summary_free(bsim_lattice_summary *s);
 
+/* The same summary built a block of trials at a time (a streamed sweep):
+ * begin, add each block in trial order, end; the result is what
+ * bsim_lattice_summarise gives for all the trials at once. Until end,
+ * p and ci95 are not set and row_time holds sums. BSIM_EFAIL: out of
+ * memory (free s with bsim_lattice_summary_free). */
+BSIM_API int bsim_lattice_summary_begin(bsim_lattice_summary *s, int rows);
+BSIM_API int bsim_lattice_summary_add(bsim_lattice_summary *s, const bsim_trial_result *trials,
+                                      const bsim_trial_log *logs, int n);
+BSIM_API void bsim_lattice_summary_end(bsim_lattice_summary *s);
+
 /* Time the trial spent in each row, s: row_time[iy] for iy < rows, from
  * the log's entries (a row not entered gets 0). */
 BSIM_API void bsim_lattice_row_times(const bsim_trial_result *r, const bsim_trial_log *log,

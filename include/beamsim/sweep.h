@@ -9,6 +9,7 @@
 #include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"
+#include "beamsim/lattice_outcome.h"
 #include "beamsim/options.h"
 #include "beamsim/trajectory.h"
 #include "beamsim/progress.h"
@@ -72,6 +73,10 @@ typedef struct bsim_sweep_result {
 	 * result, since trials_out is not kept. */
 	long first_unstable;
 	bsim_trial_result first_unstable_result;
+	/* A streamed lattice sweep's final locations, transitions and time per
+	 * row, per group (n_groups), since its trials are not kept; NULL
+	 * otherwise (bsim_lattice_summarise them from trials_out and logs). */
+	bsim_lattice_summary *lattice_summaries;
 } bsim_sweep_result;
 
 typedef struct bsim_sweep_config {
@@ -104,9 +109,8 @@ typedef struct bsim_sweep_config {
 	 * block goes to sink once it is finished, in index order, and is then
 	 * forgotten, so memory does not grow with the number of trials. The
 	 * result then has no trials_out and no logs, only the groups (and any
-	 * kept trajectories). A lattice's outputs need every trial's path at the
-	 * end: give a sink only to sweeps of gates (bsim_sweep_run refuses a
-	 * lattice with one, BSIM_EINPUT). */
+	 * kept trajectories), and for a lattice each group's summary
+	 * (lattice_summaries). */
 	bsim_sweep_sink_fn sink;
 	void *sink_user;
 } bsim_sweep_config;

@@ -102,77 +102,125 @@ void bsim_lattice_row_times(const bsim_trial_result *r, const bsim_trial_log *lo
 }
 
 /* Distinct locations and transitions are counted by sorting and merging
- * runs of equal items. */
-int bsim_lattice_summarise(const bsim_trial_result *trials, const bsim_trial_log *logs, int n,
-                           int rows, bsim_lattice_summary *out)
+ * runs of equal items: a block's items are sorted together with the
+ * distinct ones so far (each with its count) and runs merged by adding
+ * counts, so the result does not depend on how the trials were split into
+ * blocks. Time per row is summed in trial order and divided at the end. */
+int bsim_lattice_summary_begin(bsim_lattice_summary *s, int rows)
 {
-	memset(out, 0, sizeof *out);
-	out->trials = n;
-	out->rows = rows;
+	memset(s, 0, sizeof *s);
+	s->rows = rows;
+	s->row_trials = calloc(rows > 0 ? (size_t)rows : 1, sizeof *s->row_trials);
+	s->row_time = calloc(rows > 0 ? (size_t)rows : 1, sizeof *s->row_time);
+	if (!s->row_trials || !s->row_time) {
+		bsim_lattice_summary_free(s);
+		return BSIM_EFAIL;
+	}
+	return BSIM_OK;
+}
+
+/* Sorts the n items of a (the first n_old distinct already, with their
+ * counts) and merges runs of equal ones: the count of distinct items. */
+static int merge_runs(void *a, int n, size_t size, int (*cmp)(const void *, const void *),
+                      int *(*count)(void *))
+{
+	qsort(a, (size_t)n, size, cmp);
+	char *p = a;
+	int m = 0;
+	for (int i = 0; i < n; i++) {
+		if (m > 0 && cmp(p + (size_t)(m - 1) * size, p + (size_t)i * size) == 0)
+			*count(p + (size_t)(m - 1) * size) += *count(p + (size_t)i * size);
+		else
+			memmove(p + (size_t)(m++) * size, p + (size_t)i * size, size);
+	}
+	return m;
+}
+
+static int *location_count_of(void *x)
+{
+	return &((bsim_location_count *)x)->count;
+}
+
+static int *transition_count_of(void *x)
+{
+	return &((bsim_transition *)x)->count;
+}
+
+int bsim_lattice_summary_add(bsim_lattice_summary *s, const bsim_trial_result *trials,
+                             const bsim_trial_log *logs, int n)
+{
 	int n_steps = 0;
 	for (int i = 0; logs && i < n; i++)
 		n_steps += logs[i].n_entries > 0 ? logs[i].n_entries - 1 : 0;
-	out->locations = calloc(n > 0 ? (size_t)n : 1, sizeof *out->locations);
-	out->transitions = calloc(n_steps > 0 ? (size_t)n_steps : 1, sizeof *out->transitions);
-	out->row_trials = calloc(rows > 0 ? (size_t)rows : 1, sizeof *out->row_trials);
-	out->row_time = calloc(rows > 0 ? (size_t)rows : 1, sizeof *out->row_time);
-	double *t = calloc(rows > 0 ? (size_t)rows : 1, sizeof *t);
-	if (!out->locations || !out->transitions || !out->row_trials || !out->row_time || !t) {
-		free(t);
-		bsim_lattice_summary_free(out);
+	size_t n_loc = (size_t)s->n_locations + (size_t)n;
+	size_t n_tr = (size_t)s->n_transitions + (size_t)n_steps;
+	bsim_location_count *loc = realloc(s->locations, (n_loc ? n_loc : 1) * sizeof *loc);
+	if (!loc)
 		return BSIM_EFAIL;
-	}
+	s->locations = loc;
+	bsim_transition *tr = realloc(s->transitions, (n_tr ? n_tr : 1) * sizeof *tr);
+	if (!tr)
+		return BSIM_EFAIL;
+	s->transitions = tr;
+	double *t = calloc(s->rows > 0 ? (size_t)s->rows : 1, sizeof *t);
+	if (!t)
+		return BSIM_EFAIL;
 	/* final locations */
 	for (int i = 0; i < n; i++) {
-		out->locations[i].loc = bsim_lattice_location_of(&trials[i]);
-		out->locations[i].count = 1;
+		bsim_location_count *c = &loc[s->n_locations + i];
+		memset(c, 0, sizeof *c);
+		c->loc = bsim_lattice_location_of(&trials[i]);
+		c->count = 1;
 	}
-	qsort(out->locations, (size_t)n, sizeof *out->locations, location_count_cmp);
-	int m = 0;
-	for (int i = 0; i < n; i++) {
-		if (m > 0 &&
-		    bsim_lattice_location_equal(out->locations[m - 1].loc, out->locations[i].loc))
-			out->locations[m - 1].count++;
-		else
-			out->locations[m++] = out->locations[i];
-	}
-	out->n_locations = m;
-	for (int k = 0; k < m; k++) {
-		bsim_location_count *c = &out->locations[k];
-		c->p = n > 0 ? (double)c->count / n : 0.0;
-		bsim_stats_wilson(c->count, n, BSIM_STATS_Z95, &c->ci95[0], &c->ci95[1]);
-	}
+	s->n_locations =
+	        merge_runs(loc, (int)n_loc, sizeof *loc, location_count_cmp, location_count_of);
 	/* transitions and time per row */
-	int s = 0;
+	int k0 = s->n_transitions;
 	for (int i = 0; logs && i < n; i++) {
 		const bsim_trial_log *l = &logs[i];
 		for (int k = 0; k + 1 < l->n_entries; k++) {
-			bsim_transition *x = &out->transitions[s++];
+			bsim_transition *x = &tr[k0++];
 			x->from[0] = l->entries[k].ix;
 			x->from[1] = l->entries[k].iy;
 			x->to[0] = l->entries[k + 1].ix;
 			x->to[1] = l->entries[k + 1].iy;
 			x->count = 1;
 		}
-		bsim_lattice_row_times(&trials[i], l, rows, t);
-		for (int iy = 0; iy < rows; iy++)
+		bsim_lattice_row_times(&trials[i], l, s->rows, t);
+		for (int iy = 0; iy < s->rows; iy++)
 			if (t[iy] > 0.0) {
-				out->row_trials[iy]++;
-				out->row_time[iy] += t[iy];
+				s->row_trials[iy]++;
+				s->row_time[iy] += t[iy];
 			}
 	}
 	free(t);
-	qsort(out->transitions, (size_t)s, sizeof *out->transitions, transition_cmp);
-	m = 0;
-	for (int i = 0; i < s; i++) {
-		if (m > 0 && transition_cmp(&out->transitions[m - 1], &out->transitions[i]) == 0)
-			out->transitions[m - 1].count++;
-		else
-			out->transitions[m++] = out->transitions[i];
+	s->n_transitions =
+	        merge_runs(tr, (int)n_tr, sizeof *tr, transition_cmp, transition_count_of);
+	s->trials += n;
+	return BSIM_OK;
+}
+
+void bsim_lattice_summary_end(bsim_lattice_summary *s)
+{
+	for (int k = 0; k < s->n_locations; k++) {
+		bsim_location_count *c = &s->locations[k];
+		c->p = s->trials > 0 ? (double)c->count / s->trials : 0.0;
+		bsim_stats_wilson(c->count, s->trials, BSIM_STATS_Z95, &c->ci95[0], &c->ci95[1]);
 	}
-	out->n_transitions = m;
-	for (int iy = 0; iy < rows; iy++)
-		if (out->row_trials[iy] > 0)
-			out->row_time[iy] /= out->row_trials[iy];
+	for (int iy = 0; iy < s->rows; iy++)
+		if (s->row_trials[iy] > 0)
+			s->row_time[iy] /= s->row_trials[iy];
+}
+
+int bsim_lattice_summarise(const bsim_trial_result *trials, const bsim_trial_log *logs, int n,
+                           int rows, bsim_lattice_summary *out)
+{
+	if (bsim_lattice_summary_begin(out, rows) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (bsim_lattice_summary_add(out, trials, logs, n) != BSIM_OK) {
+		bsim_lattice_summary_free(out);
+		return BSIM_EFAIL;
+	}
+	bsim_lattice_summary_end(out);
 	return BSIM_OK;
 }

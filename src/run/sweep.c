@@ -92,6 +92,9 @@ void bsim_sweep_result_free(bsim_sweep_result *r)
 		bsim_trajectory_free(&r->kept[i]);
 	free(r->kept);
 	free(r->trials_out);
+	for (int g = 0; r->lattice_summaries && g < r->n_groups; g++)
+		bsim_lattice_summary_free(&r->lattice_summaries[g]);
+	free(r->lattice_summaries);
 	free(r->groups);
 	memset(r, 0, sizeof *r);
 }
@@ -646,6 +649,16 @@ static int stream_block(sweep_shared *sh, stream_state *st, bsim_sweep_result *o
 			out->first_unstable_result = st->results[k];
 		}
 	}
+	/* A lattice group's summary grows by the block's run of its trials. */
+	for (long i = sh->first; out->lattice_summaries && i < sh->end;) {
+		int g = (int)(i / trials);
+		long end = (long)(g + 1) * trials < sh->end ? (long)(g + 1) * trials : sh->end;
+		long k = i - sh->first;
+		if (bsim_lattice_summary_add(&out->lattice_summaries[g], &st->results[k],
+		                             &st->logs[k], (int)(end - i)) != BSIM_OK)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		i = end;
+	}
 	bsim_sweep_block b = {sh->first, sh->end - sh->first, st->results, st->logs};
 	return sh->cfg->sink(sh->cfg->sink_user, &b, err);
 }
@@ -675,11 +688,18 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	stream_state st = {0};
 	int *deterministic = NULL;
 	int rc = scenes_build(e, cfg, 0, &scenes, err);
-	if (rc == BSIM_OK && scenes[0].has_lattice)
-		rc = bsim_error_set(err, BSIM_EINPUT,
-		                    "%s: a lattice's trials cannot be streamed (their paths are "
-		                    "needed at the end)",
-		                    e->path);
+	if (rc == BSIM_OK && scenes[0].has_lattice) {
+		out->lattice = 1;
+		out->lattice_def = scenes[0].lattice;
+		out->lattice_summaries =
+		        calloc((size_t)e->n_groups, sizeof *out->lattice_summaries);
+		for (int g = 0; out->lattice_summaries && g < e->n_groups && rc == BSIM_OK; g++)
+			rc = bsim_lattice_summary_begin(&out->lattice_summaries[g],
+			                                out->lattice_def.rows);
+		if (!out->lattice_summaries || rc != BSIM_OK)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups",
+			                    e->n_groups);
+	}
 	if (rc == BSIM_OK) {
 		deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
 		st.results = calloc(BSIM_SWEEP_BLOCK, sizeof *st.results);
@@ -709,6 +729,7 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	        .from_journal = st.from_journal,
 	        .spill_fd = -1,
 	        .first_fail = total,
+	        .lattice = out->lattice,
 	};
 	if (rc == BSIM_OK && cfg->journal)
 		rc = stream_replay(&sh, err);
@@ -743,7 +764,6 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	if (rc == BSIM_OK)
 		rc = kept_fill(out, deterministic, err);
 	if (rc == BSIM_OK) {
-		out->lattice = 0;
 		out->wall_seconds = bsim_clock_seconds() - t0;
 		for (int g = 0; g < e->n_groups; g++) {
 			bsim_group_result *gr = &out->groups[g];
@@ -758,6 +778,8 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 			out->solver.iteration_limit += gr->solver.iteration_limit;
 			out->solver.clamped += gr->solver.clamped;
 			out->trials_run += gr->deterministic && e->trials > 0 ? 1 : e->trials;
+			if (out->lattice_summaries)
+				bsim_lattice_summary_end(&out->lattice_summaries[g]);
 		}
 	}
 	if (scenes)

@@ -15,6 +15,7 @@
 
 #include "util/atomic_file.h"
 #include "store/trials_csv.h"
+#include "store/lattice_files.h"
 #include "util/json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/version.h"
@@ -145,13 +146,12 @@ void bsim_output_group_params(FILE *f, const bsim_experiment *e, int g)
  * row (beamsim/lattice.h). */
 static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 {
-	bsim_lattice_summary ls;
-	const bsim_trial_result *t = &r->trials_out[(size_t)group * r->trials];
-	const bsim_trial_log *l = r->logs ? &r->logs[(size_t)group * r->trials] : NULL;
-	if (bsim_lattice_summarise(t, l, r->trials, r->lattice_def.rows, &ls) != BSIM_OK) {
+	bsim_lattice_summary own, *s = &own;
+	if (lattice_group_summary(r, group, &s) != BSIM_OK) {
 		fputs(", \"lattice\": null", f);
 		return;
 	}
+	const bsim_lattice_summary ls = *s;
 	fputs(", \"lattice\": {\"final_locations\": [", f);
 	for (int k = 0; k < ls.n_locations; k++) {
 		const bsim_location_count *c = &ls.locations[k];
@@ -194,7 +194,8 @@ static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 		fputc('}', f);
 	}
 	fputs("]}", f);
-	bsim_lattice_summary_free(&ls);
+	if (s == &own)
+		bsim_lattice_summary_free(&own);
 }
 
 /* What the backend's solvers gave up on (beamsim/state.h). */

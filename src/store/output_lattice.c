@@ -25,6 +25,7 @@
 #include "beamsim/output.h"
 #include "beamsim/lattice_outcome.h"
 #include "beamsim/limits.h"
+#include "store/lattice_files.h"
 
 typedef int (*lattice_writer)(FILE *f, const bsim_experiment *e, const bsim_override *extra,
                               int n_extra, const bsim_sweep_result *r, bsim_error *err);
@@ -61,18 +62,16 @@ static int write_summaries(FILE *f, const bsim_sweep_result *r, int transitions,
 	      f);
 	static const char *const kinds[] = {"end", "side", "stuck"};
 	for (int g = 0; g < r->n_groups; g++) {
-		bsim_lattice_summary ls;
-		size_t i0 = (size_t)g * r->trials;
-		if (bsim_lattice_summarise(&r->trials_out[i0], r->logs ? &r->logs[i0] : NULL,
-		                           r->trials, r->lattice_def.rows, &ls) != BSIM_OK)
+		bsim_lattice_summary own, *ls = &own;
+		if (lattice_group_summary(r, g, &ls) != BSIM_OK)
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-		for (int k = 0; transitions && k < ls.n_transitions; k++) {
-			const bsim_transition *x = &ls.transitions[k];
+		for (int k = 0; transitions && k < ls->n_transitions; k++) {
+			const bsim_transition *x = &ls->transitions[k];
 			fprintf(f, "%d,%d,%d,%d,%d,%d\n", g, x->from[0], x->from[1], x->to[0],
 			        x->to[1], x->count);
 		}
-		for (int k = 0; !transitions && k < ls.n_locations; k++) {
-			const bsim_location_count *c = &ls.locations[k];
+		for (int k = 0; !transitions && k < ls->n_locations; k++) {
+			const bsim_location_count *c = &ls->locations[k];
 			char label[48];
 			bsim_lattice_location_label(c->loc, label, sizeof label);
 			fprintf(f, "%d,%s,%s,", g, label, kinds[c->loc.kind]);
@@ -84,7 +83,8 @@ static int write_summaries(FILE *f, const bsim_sweep_result *r, int transitions,
 			fprintf(f, ",%d,%.10g,%.10g,%.10g\n", c->count, c->p, c->ci95[0],
 			        c->ci95[1]);
 		}
-		bsim_lattice_summary_free(&ls);
+		if (ls == &own)
+			bsim_lattice_summary_free(&own);
 	}
 	return BSIM_OK;
 }
@@ -107,6 +107,64 @@ static int write_transitions(FILE *f, const bsim_experiment *e, const bsim_overr
 	return write_summaries(f, r, 1, err);
 }
 
+int lattice_group_summary(const bsim_sweep_result *r, int g, bsim_lattice_summary **ls)
+{
+	if (r->lattice_summaries) {
+		*ls = &r->lattice_summaries[g];
+		return BSIM_OK;
+	}
+	size_t i0 = (size_t)g * r->trials;
+	return bsim_lattice_summarise(&r->trials_out[i0], r->logs ? &r->logs[i0] : NULL, r->trials,
+	                              r->lattice_def.rows, *ls);
+}
+
+void lattice_entries_header(FILE *f)
+{
+	fputs("group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy,theta_left,omega_left,theta_right,"
+	      "omega_right\n",
+	      f);
+}
+
+void lattice_entries_rows(FILE *f, long first, long n, int trials, const bsim_trial_log *logs)
+{
+	for (long i = 0; i < n; i++) {
+		int g = (int)((first + i) / trials), t = (int)((first + i) % trials);
+		const bsim_trial_log *l = &logs[i];
+		for (int k = 0; k < l->n_entries; k++) {
+			const bsim_gate_entry *x = &l->entries[k];
+			fprintf(f,
+			        "%d,%d,%d,%d,%d,%s,%d,%.6f,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%."
+			        "10g,"
+			        "%.10g,%.10g\n",
+			        g, t, k, x->ix, x->iy, bsim_trial_edge_name(x->edge), x->step, x->t,
+			        x->pos, x->x[0], x->x[1], x->v[0], x->v[1], x->theta[0],
+			        x->omega[0], x->theta[1], x->omega[1]);
+		}
+	}
+}
+
+void lattice_peaks_header(FILE *f)
+{
+	fputs("group,trial,beam,ix,iy,side,max_theta\n", f);
+}
+
+void lattice_peaks_rows(FILE *f, const bsim_lattice_def *def, long first, long n, int trials,
+                        const bsim_trial_log *logs)
+{
+	for (long i = 0; i < n; i++) {
+		int g = (int)((first + i) / trials), t = (int)((first + i) % trials);
+		const bsim_trial_log *l = &logs[i];
+		for (int b = 0; b < l->n_beams; b++) {
+			if (l->peak[b] == 0.0)
+				continue;
+			int ix, iy, side;
+			bsim_lattice_beam_gate(def, b, &ix, &iy, &side);
+			fprintf(f, "%d,%d,%d,%d,%d,%s,%.10g\n", g, t, b, ix, iy,
+			        side ? "right" : "left", l->peak[b]);
+		}
+	}
+}
+
 static int write_entries(FILE *f, const bsim_experiment *e, const bsim_override *extra, int n_extra,
                          const bsim_sweep_result *r, bsim_error *err)
 {
@@ -114,23 +172,8 @@ static int write_entries(FILE *f, const bsim_experiment *e, const bsim_override 
 	(void)extra;
 	(void)n_extra;
 	(void)err;
-	fputs("group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy,theta_left,omega_left,theta_right,"
-	      "omega_right\n",
-	      f);
-	for (int g = 0; g < r->n_groups; g++)
-		for (int t = 0; t < r->trials; t++) {
-			const bsim_trial_log *l = &r->logs[(size_t)g * r->trials + t];
-			for (int k = 0; k < l->n_entries; k++) {
-				const bsim_gate_entry *x = &l->entries[k];
-				fprintf(f,
-				        "%d,%d,%d,%d,%d,%s,%d,%.6f,%.10g,%.10g,%.10g,%.10g,%.10g,%."
-				        "10g,"
-				        "%.10g,%.10g,%.10g\n",
-				        g, t, k, x->ix, x->iy, bsim_trial_edge_name(x->edge),
-				        x->step, x->t, x->pos, x->x[0], x->x[1], x->v[0], x->v[1],
-				        x->theta[0], x->omega[0], x->theta[1], x->omega[1]);
-			}
-		}
+	lattice_entries_header(f);
+	lattice_entries_rows(f, 0, (long)r->n_groups * r->trials, r->trials, r->logs);
 	return BSIM_OK;
 }
 
@@ -141,19 +184,9 @@ static int write_peaks(FILE *f, const bsim_experiment *e, const bsim_override *e
 	(void)extra;
 	(void)n_extra;
 	(void)err;
-	fputs("group,trial,beam,ix,iy,side,max_theta\n", f);
-	for (int g = 0; g < r->n_groups; g++)
-		for (int t = 0; t < r->trials; t++) {
-			const bsim_trial_log *l = &r->logs[(size_t)g * r->trials + t];
-			for (int b = 0; b < l->n_beams; b++) {
-				if (l->peak[b] == 0.0)
-					continue;
-				int ix, iy, side;
-				bsim_lattice_beam_gate(&r->lattice_def, b, &ix, &iy, &side);
-				fprintf(f, "%d,%d,%d,%d,%d,%s,%.10g\n", g, t, b, ix, iy,
-				        side ? "right" : "left", l->peak[b]);
-			}
-		}
+	lattice_peaks_header(f);
+	lattice_peaks_rows(f, &r->lattice_def, 0, (long)r->n_groups * r->trials, r->trials,
+	                   r->logs);
 	return BSIM_OK;
 }
 
@@ -168,9 +201,12 @@ int bsim_output_lattice(const char *dir, const bsim_experiment *e, const bsim_ov
 	        {"transitions.csv", write_transitions}, {"gate_entries.csv", write_entries},
 	        {"beam_peaks.csv", write_peaks},
 	};
-	if (!r->lattice || !r->logs)
+	if (!r->lattice || (!r->logs && !r->lattice_summaries))
 		return BSIM_OK;
-	for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
+	/* A streamed sweep wrote its trials' entries and peaks as they came
+	 * (the last two files): only the map and the summaries are left. */
+	size_t n_files = r->logs ? sizeof files / sizeof files[0] : 3;
+	for (size_t k = 0; k < n_files; k++) {
 		char path[BSIM_PATH_MAX];
 		int n = snprintf(path, sizeof path, "%s/%s", dir, files[k].name);
 		if (n < 0 || (size_t)n >= sizeof path)

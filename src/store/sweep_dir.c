@@ -22,6 +22,8 @@
 #include "store/rerun.h"
 #include "store/store.h"
 #include "store/trials_csv.h"
+#include "store/lattice_files.h"
+#include "util/atomic_file.h"
 #include "beamsim/limits.h"
 
 bsim_sweep_dir_def bsim_sweep_dir_def_default(void)
@@ -38,36 +40,99 @@ void bsim_sweep_dir_result_free(bsim_sweep_dir_result *res)
 	bsim_experiment_free(&res->e);
 }
 
-/* trials.csv written as a streamed sweep's blocks arrive. A write error
- * (a full disk) stops the sweep; its finished trials are in the journal. */
+/* The per-trial files written as a streamed sweep's blocks arrive:
+ * trials.csv, and for a lattice gate_entries.csv and beam_peaks.csv. A
+ * write error (a full disk) stops the sweep; its finished trials are in
+ * the journal. */
+enum { SINK_TRIALS, SINK_ENTRIES, SINK_PEAKS, SINK_FILES };
+static const char *const sink_names[SINK_FILES] = {"trials.csv", "gate_entries.csv",
+                                                   "beam_peaks.csv"};
+
 typedef struct trials_sink {
 	trials_csv_writer w;
-	char path[BSIM_PATH_MAX];
+	bsim_atomic_file lattice[SINK_FILES]; /* ENTRIES and PEAKS */
+	char path[SINK_FILES][BSIM_PATH_MAX];
+	int n_files; /* 1, or 3 for a lattice */
 	int trials;
+	bsim_lattice_def def; /* a lattice's: group 0's, as its outputs use */
 	int failed;
 } trials_sink;
+
+static FILE *sink_file(trials_sink *s, int k)
+{
+	return k == SINK_TRIALS ? s->w.o.f : s->lattice[k].f;
+}
 
 static int trials_sink_take(void *user, const bsim_sweep_block *b, bsim_error *err)
 {
 	trials_sink *s = user;
 	trials_csv_rows(&s->w, b->first, b->n, s->trials, b->results, b->logs);
-	if (fflush(s->w.o.f) == 0 && !ferror(s->w.o.f))
-		return BSIM_OK;
-	s->failed = 1;
-	return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write (%s)", s->path, strerror(errno));
+	if (s->n_files > 1) {
+		lattice_entries_rows(s->lattice[SINK_ENTRIES].f, b->first, b->n, s->trials,
+		                     b->logs);
+		lattice_peaks_rows(s->lattice[SINK_PEAKS].f, &s->def, b->first, b->n, s->trials,
+		                   b->logs);
+	}
+	for (int k = 0; k < s->n_files; k++) {
+		FILE *f = sink_file(s, k);
+		if (fflush(f) != 0 || ferror(f)) {
+			s->failed = 1;
+			return bsim_error_set(err, BSIM_EFAIL, "%s: cannot write (%s)", s->path[k],
+			                      strerror(errno));
+		}
+	}
+	return BSIM_OK;
 }
 
-/* 1 if the experiment's trials can stream to disk: its scenes are gates,
- * not lattices, whose outputs need every trial's path at the end. */
-static int streams(const bsim_experiment *e, const bsim_override *sets, int n_sets)
+/* Opens the files in stage, headers written. */
+static int sink_open(trials_sink *s, const char *stage, const bsim_experiment *e,
+                     const bsim_override *sets, int n_sets, bsim_error *err)
 {
 	bsim_scene scene;
-	bsim_error ignore;
-	if (bsim_experiment_group_scene(e, 0, sets, n_sets, &scene, &ignore) != BSIM_OK)
-		return 0;
-	int lattice = scene.has_lattice;
+	int rc = bsim_experiment_group_scene(e, 0, sets, n_sets, &scene, err);
+	if (rc != BSIM_OK)
+		return rc;
+	s->n_files = scene.has_lattice ? SINK_FILES : 1;
+	s->def = scene.lattice;
+	s->trials = e->trials;
 	bsim_scene_free(&scene);
-	return !lattice;
+	if (bsim_output_mkdir(stage, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	for (int k = 0; k < s->n_files; k++)
+		if (bsim_session_path(s->path[k], sizeof s->path[k], stage, sink_names[k], err))
+			return BSIM_EFAIL;
+	if (trials_csv_open(&s->w, s->path[SINK_TRIALS], e, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	for (int k = 1; k < s->n_files; k++)
+		if (bsim_atomic_file_open(&s->lattice[k], s->path[k], err) != BSIM_OK)
+			return BSIM_EFAIL;
+	if (s->n_files > 1) {
+		lattice_entries_header(s->lattice[SINK_ENTRIES].f);
+		lattice_peaks_header(s->lattice[SINK_PEAKS].f);
+	}
+	return BSIM_OK;
+}
+
+/* Commits the files (rc BSIM_OK) or leaves none; then the lattice files'
+ * twins (trials.csv's comes with the sweep's other twins). */
+static int sink_close(trials_sink *s, int rc, const char *stage, bsim_error *err)
+{
+	if (rc == BSIM_OK)
+		rc = trials_csv_commit(&s->w, err);
+	else
+		trials_csv_abort(&s->w);
+	for (int k = 1; k < SINK_FILES; k++) {
+		if (rc == BSIM_OK && s->lattice[k].f)
+			rc = bsim_atomic_file_commit(&s->lattice[k], err);
+		else
+			bsim_atomic_file_abort(&s->lattice[k]);
+	}
+	for (int k = 1; rc == BSIM_OK && k < s->n_files; k++) {
+		char var[32];
+		snprintf(var, sizeof var, "%.*s", (int)strcspn(sink_names[k], "."), sink_names[k]);
+		rc = bsim_store_twin(stage, sink_names[k], var, err);
+	}
+	return rc;
 }
 
 /* res->journal names the journal if the session kept it. */
@@ -134,23 +199,14 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	        .journal = ss.journal,
 	        .stop = def->stop,
 	};
-	/* A sweep of gates streams its trials into trials.csv as they finish. */
-	trials_sink sink = {.trials = e->trials};
-	if (streams(e, def->sets, def->n_sets)) {
-		rc = bsim_session_path(sink.path, sizeof sink.path, ss.stage, "trials.csv", err);
-		if (rc == BSIM_OK)
-			rc = bsim_output_mkdir(ss.stage, err);
-		if (rc == BSIM_OK)
-			rc = trials_csv_open(&sink.w, sink.path, e, err);
-		cfg.sink = trials_sink_take;
-		cfg.sink_user = &sink;
-	}
+	/* The trials stream into their files as they finish. */
+	trials_sink sink = {0};
+	rc = sink_open(&sink, ss.stage, e, def->sets, def->n_sets, err);
+	cfg.sink = trials_sink_take;
+	cfg.sink_user = &sink;
 	if (rc == BSIM_OK)
 		rc = bsim_sweep_run(e, &cfg, &res->r, err);
-	if (rc == BSIM_OK && cfg.sink)
-		rc = trials_csv_commit(&sink.w, err);
-	else if (cfg.sink)
-		trials_csv_abort(&sink.w);
+	rc = sink_close(&sink, rc, ss.stage, err);
 	if (sink.failed)
 		ss.done = 1; /* the trials journaled before the disk filled are kept */
 	if (rc == BSIM_OK) {
