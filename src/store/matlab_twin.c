@@ -1,9 +1,11 @@
 /* MATLAB twins of CSV and JSON files (store/matlab.h).
  *
  * Both converters build a tree of bsim_mat_field (mat.h) whose arrays live
- * in an arena freed after the write. JSON is read with libfyaml (JSON is
- * YAML), the reader of every other beamsim input; a number is a plain
- * scalar that reads as one, so a quoted "7" stays text. */
+ * in an arena or the table's columns, freed after the write. A CSV table
+ * is read as a stream into the arrays written (a twin may be of a million
+ * rows); JSON is read with libfyaml (JSON is YAML), the reader of every
+ * other beamsim input; a number is a plain scalar that reads as one, so a
+ * quoted "7" stays text. */
 #define _POSIX_C_SOURCE 200809L
 #include "store/matlab.h"
 
