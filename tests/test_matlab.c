@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/limits.h"
 #include "store/matlab.h"
 #include "store/mat.h"
 #include "support.h"
@@ -513,6 +514,129 @@ static void test_json_shapes(void **state)
 	assert_null(bsim_test_read(out));
 }
 
+/* A table written row by row for the streaming converter: numbers with an
+ * empty cell now and then (NaN), text of three words from the first row,
+ * a column of numbers that turns text near the end (read a second time),
+ * one empty until its first text, and one row longer than the converter's
+ * first read (256 KiB) so that a line spans reads. */
+static void write_table(const char *path, int rows)
+{
+	FILE *f = fopen(path, "w");
+	assert_non_null(f);
+	static const char *const words[] = {"traversed", "stuck", "unstable"};
+	fputs("i,x,word,late,gap,hole\n", f);
+	for (int r = 0; r < rows; r++) {
+		fprintf(f, "%d,%.17g,", r, (r - 2500) * 1.25e-3 / 3);
+		if (r == rows / 3) {
+			for (int k = 0; k < 300000; k++)
+				fputc('a' + k % 26, f);
+		} else {
+			fputs(words[r % 3], f);
+		}
+		if (r < rows - 100)
+			fprintf(f, ",%d.5", r);
+		else
+			fprintf(f, ",w%d", r % 5);
+		fprintf(f, r < rows / 2 ? "," : ",g%d", r % 4);
+		fprintf(f, r % 7 ? ",%de-3\n" : ",\n", r);
+	}
+	assert_int_equal(fclose(f), 0);
+}
+
+/* The streaming converter's twin holds every cell of the CSV, read back
+ * with libmatio: numbers as strtod reads them, NaN for an empty cell, text
+ * byte for byte; a column is numbers only if every non-empty cell is. */
+static void test_streamed_csv(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("streamed");
+	char csv[1100], mat[1100];
+	snprintf(csv, sizeof csv, "%s/t.csv", dir);
+	snprintf(mat, sizeof mat, "%s/t.mat", dir);
+	write_table(csv, 5000);
+	bsim_error err;
+	assert_int_equal(bsim_matlab_from_csv(csv, mat, "t", &err), BSIM_OK);
+	assert_string_equal(err.msg, "");
+	tcsv t = tcsv_read(csv);
+	assert_int_equal(t.rows, 5000);
+	mat_t *m;
+	matvar_t *st = mat_var(mat, "t", &m);
+	check_table(&t, st);
+	static const char *const numbers[] = {"i", "x", "hole"}, *const text[] = {"word", "late",
+	                                                                          "gap"};
+	for (int i = 0; i < 3; i++) {
+		assert_int_equal(field(st, numbers[i])->class_type, MAT_C_DOUBLE);
+		assert_int_equal(field(st, text[i])->class_type, MAT_C_CELL);
+	}
+	assert_true(isnan(((double *)field(st, "hole")->data)[0]));
+	check_string(Mat_VarGetCell(field(st, "gap"), 0), "");
+	check_string(Mat_VarGetCell(field(st, "late"), 0), "0.5");
+	Mat_VarFree(st);
+	Mat_Close(m);
+	tcsv_free(&t);
+}
+
+/* A table over the limit mat_rows: no twin (an earlier one removed), one
+ * line saying so, BSIM_OK; at the limit the twin is written; a malformed
+ * table over the limit is still an error. A sweep over the limit finishes
+ * (exit 0) without trials.mat, and regress reads it back. */
+static void test_mat_rows_limit(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("mat_rows");
+	char csv[1100], mat[1100];
+	snprintf(csv, sizeof csv, "%s/t11.csv", dir);
+	snprintf(mat, sizeof mat, "%s/t11.mat", dir);
+	write_table(csv, 11);
+	bsim_test_write(dir, "t11.mat", "an earlier table's twin");
+	bsim_limits l = bsim_limits_default();
+	l.mat_rows = 10;
+	bsim_limits_set(&l);
+	bsim_error err;
+	assert_int_equal(bsim_matlab_from_csv(csv, mat, "t", &err), BSIM_OK);
+	assert_string_equal(err.msg, "t11.csv: 11 rows, over the limit mat_rows = 10: no t11.mat; "
+	                             "MATLAB's readtable reads the CSV (raise with --limit "
+	                             "mat_rows=11)");
+	assert_false(bsim_test_exists(mat));
+	snprintf(csv, sizeof csv, "%s/t10.csv", dir);
+	snprintf(mat, sizeof mat, "%s/t10.mat", dir);
+	write_table(csv, 10);
+	assert_int_equal(bsim_matlab_from_csv(csv, mat, "t", &err), BSIM_OK);
+	assert_string_equal(err.msg, "");
+	assert_true(bsim_test_exists(mat));
+	snprintf(csv, sizeof csv, "%s",
+	         bsim_test_write(dir, "bad.csv",
+	                         "a,b\n1,2\n3\n4,5\n6,7\n8,9\n1,2\n3,4\n5,6\n7,8\n"
+	                         "9,0\n1,2\n"));
+	snprintf(mat, sizeof mat, "%s/bad.mat", dir);
+	assert_int_equal(bsim_matlab_from_csv(csv, mat, "bad", &err), BSIM_EINPUT);
+	assert_string_equal(strstr(err.msg, "bad.csv:3"), "bad.csv:3: expected 2 fields, got 1");
+	bsim_limits_set(NULL);
+
+	char out[1100], again[1100];
+	snprintf(out, sizeof out, "%s/sweep", dir);
+	snprintf(again, sizeof again, "%s/regress", dir);
+	const char *argv[] = {"sweep",    bsim_test_src("configs/thesis/h1_symmetric.yaml"),
+	                      "--trials", "3",
+	                      "--limit",  "mat_rows=50",
+	                      "--quiet",  "--out",
+	                      out,        NULL};
+	char *text = NULL;
+	assert_int_equal(bsim_test_cli(argv, NULL, &text), 0);
+	assert_string_equal(text, "beamsim: trials.csv: 90 rows, over the limit mat_rows = 50: no "
+	                          "trials.mat; MATLAB's readtable reads the CSV (raise with "
+	                          "--limit mat_rows=90)\n");
+	free(text);
+	assert_false(bsim_test_exists(bsim_test_join(out, "trials.mat")));
+	assert_true(bsim_test_exists(bsim_test_join(out, "summary.mat")));
+	text = bsim_test_read(bsim_test_join(out, "manifest.json"));
+	assert_non_null(strstr(text, "\"trials.csv\""));
+	assert_null(strstr(text, "trials.mat"));
+	free(text);
+	const char *re[] = {"regress", out, "--exact", "--quiet", "--out", again, NULL};
+	assert_int_equal(bsim_test_cli(re, NULL, NULL), 0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -522,6 +646,8 @@ int main(void)
 	        cmocka_unit_test(test_run_out_twins),
 	        cmocka_unit_test(test_compare_twins),
 	        cmocka_unit_test(test_json_shapes),
+	        cmocka_unit_test(test_streamed_csv),
+	        cmocka_unit_test(test_mat_rows_limit),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -35,13 +35,16 @@ typedef struct bsim_limits {
 	double trials;      /* groups x trials of one sweep or comparison */
 	double schedule;    /* random-force values of one trial: max_steps dt frequency */
 	double beam_steps;  /* max_steps x beams of one trial */
+	double mat_rows;    /* rows of a CSV table given a .mat twin */
 } bsim_limits;
 
-/* The defaults: 1 MiB, 100,000 groups, 10^7 trials (a sweep of gates
- * streams its trials to disk; a sweep of a lattice and a comparison hold
- * them in memory: docs/robustness.md "Memory"), 10^6 random-force values (8 MB
- * per thread) and 10^8 beam-steps (about 15 s of one core for the thesis
- * backend on a gate). */
+/* The defaults: 1 MiB, 100,000 groups, 10^7 trials (a sweep streams its
+ * trials to disk; a comparison holds them in memory: docs/robustness.md
+ * "Memory"), 10^6 random-force values (8 MB per thread), 10^8 beam-steps
+ * (about 15 s of one core for the thesis backend on a gate) and 1,500,000
+ * rows of a table with a .mat twin (about 230 bytes a row of trials.csv
+ * while the twin is written, 130 of a trajectory; a larger table gets no
+ * twin, and the run goes on). */
 BSIM_API bsim_limits bsim_limits_default(void);
 
 /* The limits in force (the defaults until bsim_limits_set). */

@@ -31,7 +31,8 @@ static const shared_def shared[CLI_N_OPTS] = {
         [CLI_OPT_QUIET] = {"quiet", 0, NULL, "no progress line, nothing on stdout"},
         [CLI_OPT_LIMIT] = {"limit", 1, "NAME=N",
                            "raise a limit on what inputs may ask for: input_bytes,\n"
-                           "groups, trials, schedule, beam_steps (docs/robustness.md)"},
+                           "groups, trials, schedule, beam_steps, mat_rows\n"
+                           "(docs/robustness.md)"},
         [CLI_OPT_RESUME] = {"resume", 0, NULL, "continue the stopped run in DIR (same inputs)"},
         [CLI_OPT_TRAJECTORIES] = {"trajectories", 1, "N",
                                   "keep the trajectories of the first N trials of each\n"

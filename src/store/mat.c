@@ -74,33 +74,114 @@ void bsim_mat_name(const char *key, char *out, size_t size)
 	out[n] = '\0';
 }
 
-/* A char row vector holding s (matio copies the bytes). */
+/* What a write lends matio (MAT_F_DONT_COPY_DATA: matio neither copies nor
+ * frees it) beside the caller's arrays: each cell array's elements, and
+ * one char variable per distinct string, shared by every element that
+ * holds it. Freed after Mat_VarFree of the variable. */
+typedef struct lent {
+	matvar_t **cells;    /* a cell array's rows elements */
+	matvar_t **distinct; /* its n_distinct strings */
+	size_t n_distinct;
+	struct lent *next;
+} lent;
+
+static void lent_free(lent *l)
+{
+	while (l) {
+		lent *next = l->next;
+		for (size_t i = 0; i < l->n_distinct; i++)
+			Mat_VarFree(l->distinct[i]);
+		free(l->distinct);
+		free(l->cells);
+		free(l);
+		l = next;
+	}
+}
+
+/* A char row vector holding s, lent to matio (s outlives the write). */
 static matvar_t *var_string(const char *name, const char *s)
 {
 	size_t dims[2] = {1, strlen(s)};
-	return Mat_VarCreate(name, MAT_C_CHAR, MAT_T_UTF8, 2, dims, (void *)s, 0);
+	return Mat_VarCreate(name, MAT_C_CHAR, MAT_T_UTF8, 2, dims, (void *)s,
+	                     MAT_F_DONT_COPY_DATA);
 }
 
-static matvar_t *var_build(const bsim_mat_field *f);
+static matvar_t *var_build(const bsim_mat_field *f, lent **lent);
 
-static matvar_t *var_cell(const bsim_mat_field *f)
+static size_t str_hash(const char *s)
 {
-	size_t dims[2] = {f->rows, 1};
-	matvar_t *cell = Mat_VarCreate(f->name, MAT_C_CELL, MAT_T_CELL, 2, dims, NULL, 0);
-	if (!cell)
-		return NULL;
-	for (size_t i = 0; i < f->rows; i++) {
-		matvar_t *s = var_string(NULL, f->strings[i] ? f->strings[i] : "");
-		if (!s) {
-			Mat_VarFree(cell);
-			return NULL;
-		}
-		Mat_VarSetCell(cell, (int)i, s); /* the cell owns s now */
-	}
-	return cell;
+	size_t h = 1469598103934665603u; /* FNV-1a */
+	for (; *s; s++)
+		h = (h ^ (unsigned char)*s) * 1099511628211u;
+	return h;
 }
 
-static matvar_t *var_struct(const bsim_mat_field *f)
+/* A cell array of f->rows strings. matio writes each element in full, so
+ * elements with equal text may be one variable: the file is the same, and
+ * a column of a few distinct words (a trial's outcome) costs a pointer a
+ * row instead of a variable (about 250 bytes) a row. */
+static matvar_t *var_cell(const bsim_mat_field *f, lent **lentp)
+{
+	lent *l = calloc(1, sizeof *l);
+	if (!l)
+		return NULL;
+	l->next = *lentp;
+	*lentp = l;
+	size_t n_slots = 64, cap = 0;
+	size_t *slot = calloc(n_slots, sizeof *slot); /* index + 1 into distinct, 0 free */
+	l->cells = malloc((f->rows ? f->rows : 1) * sizeof *l->cells);
+	int ok = slot && l->cells;
+	for (size_t i = 0; ok && i < f->rows; i++) {
+		const char *s = f->strings[i] ? f->strings[i] : "";
+		if (i > 0 && s == f->strings[i - 1]) {
+			l->cells[i] = l->cells[i - 1];
+			continue;
+		}
+		size_t j = str_hash(s) & (n_slots - 1);
+		while (slot[j] && strcmp((const char *)l->distinct[slot[j] - 1]->data, s) != 0)
+			j = (j + 1) & (n_slots - 1);
+		if (slot[j]) {
+			l->cells[i] = l->distinct[slot[j] - 1];
+			continue;
+		}
+		if (l->n_distinct == cap) {
+			cap = cap ? 2 * cap : 16;
+			matvar_t **d = realloc(l->distinct, cap * sizeof *d);
+			if (!(ok = d != NULL))
+				break;
+			l->distinct = d;
+		}
+		matvar_t *v = var_string(NULL, s);
+		if (!(ok = v != NULL))
+			break;
+		l->distinct[l->n_distinct++] = v;
+		slot[j] = l->n_distinct;
+		l->cells[i] = v;
+		if (2 * l->n_distinct > n_slots) { /* rehash at half full */
+			size_t n = 2 * n_slots;
+			size_t *grown = calloc(n, sizeof *grown);
+			if (!(ok = grown != NULL))
+				break;
+			for (size_t k = 0; k < l->n_distinct; k++) {
+				size_t m = str_hash((const char *)l->distinct[k]->data) & (n - 1);
+				while (grown[m])
+					m = (m + 1) & (n - 1);
+				grown[m] = k + 1;
+			}
+			free(slot);
+			slot = grown;
+			n_slots = n;
+		}
+	}
+	free(slot);
+	if (!ok)
+		return NULL;
+	size_t dims[2] = {f->rows, 1};
+	return Mat_VarCreate(f->name, MAT_C_CELL, MAT_T_CELL, 2, dims, f->rows ? l->cells : NULL,
+	                     f->rows ? MAT_F_DONT_COPY_DATA : 0);
+}
+
+static matvar_t *var_struct(const bsim_mat_field *f, lent **lentp)
 {
 	const char **names = calloc((size_t)f->n_fields + 1, sizeof *names);
 	if (!names)
@@ -113,7 +194,7 @@ static matvar_t *var_struct(const bsim_mat_field *f)
 	if (!st)
 		return NULL;
 	for (int i = 0; i < f->n_fields; i++) {
-		matvar_t *v = var_build(&f->fields[i]);
+		matvar_t *v = var_build(&f->fields[i], lentp);
 		if (!v) {
 			Mat_VarFree(st);
 			return NULL;
@@ -123,21 +204,24 @@ static matvar_t *var_struct(const bsim_mat_field *f)
 	return st;
 }
 
-static matvar_t *var_build(const bsim_mat_field *f)
+/* f as a matio variable whose data are f's arrays, lent (they outlive the
+ * write); what else it needs goes to *lentp. */
+static matvar_t *var_build(const bsim_mat_field *f, lent **lentp)
 {
 	switch (f->kind) {
 	case BSIM_MAT_DOUBLE: {
 		size_t dims[2] = {f->rows, f->cols};
 		static const double empty = 0.0;
 		const double *d = f->data && f->rows > 0 && f->cols > 0 ? f->data : &empty;
-		return Mat_VarCreate(f->name, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, (void *)d, 0);
+		return Mat_VarCreate(f->name, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, (void *)d,
+		                     MAT_F_DONT_COPY_DATA);
 	}
 	case BSIM_MAT_STRINGS:
-		return var_cell(f);
+		return var_cell(f, lentp);
 	case BSIM_MAT_STRING:
 		return var_string(f->name, f->strings && f->strings[0] ? f->strings[0] : "");
 	case BSIM_MAT_STRUCT:
-		return var_struct(f);
+		return var_struct(f, lentp);
 	}
 	return NULL;
 }
@@ -166,9 +250,11 @@ int bsim_mat_write(const char *path, const bsim_mat_field *vars, int n_vars, bsi
 		                      strerror(errno));
 	int ok = 1;
 	for (int i = 0; i < n_vars && ok; i++) {
-		matvar_t *v = var_build(&vars[i]);
+		lent *l = NULL;
+		matvar_t *v = var_build(&vars[i], &l);
 		ok = v && Mat_VarWrite(mat, v, MAT_COMPRESSION_ZLIB) == 0;
 		Mat_VarFree(v);
+		lent_free(l);
 	}
 	ok = Mat_Close(mat) == 0 && ok;
 	if (ok && sync_path(tmp) == 0 && rename(tmp, path) == 0)

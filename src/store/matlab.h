@@ -34,7 +34,20 @@ extern "C" {
 int bsim_matlab_path(const char *path, char *out, size_t size, bsim_error *err);
 
 /* The CSV table at csv_path as the struct variable var in mat_path.
- * BSIM_EINPUT naming file and line if the table is malformed. */
+ * BSIM_EINPUT naming file and line if the table is malformed (the messages
+ * of util/csv_table.h).
+ *
+ * The table is read as a stream and held as it is written: 8 bytes a cell
+ * of a numeric column, a pointer a cell (8 bytes, and 8 more for matio's
+ * cell array) of a text column plus about 260 bytes per distinct string.
+ * A table of more rows than the limit mat_rows (beamsim/limits.h) gets no
+ * twin: it is still checked (a malformed one is BSIM_EINPUT as above), any
+ * earlier file at mat_path is removed (a twin never belongs to another
+ * table), one line says so on standard error ("beamsim: trials.csv: 2000000
+ * rows, over the limit mat_rows = N: no trials.mat; ..."), and the result
+ * is BSIM_OK with that line, without "beamsim: ", in err->msg (err->code
+ * BSIM_OK): a caller goes on, and the run succeeds without the twin. On
+ * any other BSIM_OK err->msg is empty. */
 int bsim_matlab_from_csv(const char *csv_path, const char *mat_path, const char *var,
                          bsim_error *err);
 
@@ -47,7 +60,8 @@ int bsim_matlab_from_json(const char *json_path, const char *mat_path, const cha
  * trajectories.mat (`trajectories`). A table with a `group` column holds
  * the grid values of each row's group by name, as the columns of
  * trials.csv do (trajectories.effects_propulsion_force(i) of row i),
- * numbers as doubles: those the CSV lacks are added. */
+ * numbers as doubles: those the CSV lacks are added. A table over the
+ * limit mat_rows gets no twin, as bsim_matlab_from_csv says. */
 int bsim_matlab_sweep(const char *dir, const bsim_experiment *e, bsim_error *err);
 
 #ifdef __cplusplus

@@ -1,9 +1,11 @@
 /* MATLAB twins of CSV and JSON files (store/matlab.h).
  *
  * Both converters build a tree of bsim_mat_field (mat.h) whose arrays live
- * in an arena freed after the write. JSON is read with libfyaml (JSON is
- * YAML), the reader of every other beamsim input; a number is a plain
- * scalar that reads as one, so a quoted "7" stays text. */
+ * in an arena or the table's columns, freed after the write. A CSV table
+ * is read as a stream into the arrays written (a twin may be of a million
+ * rows); JSON is read with libfyaml (JSON is YAML), the reader of every
+ * other beamsim input; a number is a plain scalar that reads as one, so a
+ * quoted "7" stays text. */
 #define _POSIX_C_SOURCE 200809L
 #include "store/matlab.h"
 
@@ -12,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "util/csv_stream.h"
 #include "util/csv_table.h"
 #include "store/mat.h"
 #include "util/yaml_doc.h"
@@ -92,43 +95,299 @@ int bsim_matlab_path(const char *path, char *out, size_t size, bsim_error *err)
 
 /* ---- CSV --------------------------------------------------------------- */
 
-/* Column c of t as a field: doubles if every non-empty cell is a number
- * (empty ones NaN), else text. */
-static int csv_column(arena *a, const csv_table *t, int c, bsim_mat_field *out)
+/* A CSV table is read as a stream, row by row, each column kept as it
+ * will be written: numbers as one array of doubles (8 bytes a cell), text
+ * as a pointer a cell to one copy of each distinct string. A column is
+ * numbers if every non-empty cell is one (an empty cell is NaN), else text,
+ * decided on the whole table: a column read as numbers whose later cell is
+ * text has lost the text of its earlier numbers, so the table is read a
+ * second time with that column as text from the start (a column empty
+ * until its first text needs no second reading: its earlier cells are ""). */
+
+typedef struct twin_col {
+	double *v;      /* numbers, while the column is numeric */
+	const char **s; /* text (interned), once it is text */
+	int text;
+	int numbers; /* a number seen while numeric */
+} twin_col;
+
+/* Strings kept once each, in arena blocks that never move. */
+typedef struct intern {
+	const char **slot; /* n_slots (a power of 2), NULL free */
+	size_t n_slots, n;
+	char *block;
+	size_t used, size;
+} intern;
+
+/* The group column of a sweep's table, checked as csv_table_numbers and
+ * the group range check did: the first cell that is no number, else the
+ * first out of range, reported once the file is known to be sound. */
+typedef struct group_check {
+	int col;
+	long bad_line, range_line;
+	char *bad, *range; /* the cells' text */
+} group_check;
+
+typedef struct twin_table {
+	arena a;
+	int n_cols;
+	long n_rows;
+	const char **names;
+	twin_col *cols;
+	intern in;
+	int over; /* more rows than the limit mat_rows: nothing kept */
+	int lost; /* a column turned text after numbers: nothing kept, read again */
+} twin_table;
+
+static size_t str_hash(const char *s)
 {
-	const char *name = mat_ident(a, t->names[c]);
-	int numeric = 1;
-	for (long r = 0; r < t->n_rows && numeric; r++) {
-		double v;
-		numeric = !*csv_table_cell(t, r, c) || csv_table_number(t, r, c, &v) == 0;
+	size_t h = 1469598103934665603u; /* FNV-1a */
+	for (; *s; s++)
+		h = (h ^ (unsigned char)*s) * 1099511628211u;
+	return h;
+}
+
+static const char *intern_str(arena *a, intern *in, const char *s)
+{
+	size_t len = strlen(s);
+	if (2 * (in->n + 1) > in->n_slots) {
+		size_t n = in->n_slots ? 2 * in->n_slots : 256;
+		const char **grown = calloc(n, sizeof *grown);
+		if (!grown)
+			return NULL;
+		for (size_t k = 0; k < in->n_slots; k++) {
+			if (!in->slot[k])
+				continue;
+			size_t m = str_hash(in->slot[k]) & (n - 1);
+			while (grown[m])
+				m = (m + 1) & (n - 1);
+			grown[m] = in->slot[k];
+		}
+		free(in->slot);
+		in->slot = grown;
+		in->n_slots = n;
 	}
-	if (numeric) {
-		double *v = arena_alloc(a, (size_t)t->n_rows * sizeof *v);
-		if (!v || !name)
+	size_t j = str_hash(s) & (in->n_slots - 1);
+	while (in->slot[j] && strcmp(in->slot[j], s) != 0)
+		j = (j + 1) & (in->n_slots - 1);
+	if (in->slot[j])
+		return in->slot[j];
+	if (in->used + len + 1 > in->size) {
+		size_t size = len + 1 > 65536 ? len + 1 : 65536;
+		if (!(in->block = arena_alloc(a, size)))
+			return NULL;
+		in->used = 0;
+		in->size = size;
+	}
+	char *d = in->block + in->used;
+	memcpy(d, s, len + 1);
+	in->used += len + 1;
+	in->n++;
+	return in->slot[j] = d;
+}
+
+static void twin_drop(twin_table *t)
+{
+	for (int c = 0; t->cols && c < t->n_cols; c++) {
+		free(t->cols[c].v);
+		free(t->cols[c].s);
+		t->cols[c].v = NULL;
+		t->cols[c].s = NULL;
+	}
+}
+
+static void twin_free(twin_table *t)
+{
+	twin_drop(t);
+	free(t->cols);
+	free(t->in.slot);
+	arena_free(&t->a);
+	memset(t, 0, sizeof *t);
+}
+
+static void group_check_row(group_check *g, const csv_stream *s, int n_groups)
+{
+	const char *cell = s->cells[g->col];
+	double v;
+	if (csv_number(cell, &v) != 0) {
+		if (!g->bad_line) {
+			g->bad_line = s->line;
+			g->bad = strdup(cell);
+		}
+	} else if (!g->range_line && (v != floor(v) || v < 0 || v >= n_groups)) {
+		g->range_line = s->line;
+		g->range = strdup(cell);
+	}
+}
+
+/* Grows every kept column to cap rows. */
+static int twin_grow(twin_table *t, size_t cap)
+{
+	for (int c = 0; c < t->n_cols; c++) {
+		twin_col *col = &t->cols[c];
+		void *p = col->text ? realloc(col->s, cap * sizeof *col->s)
+		                    : realloc(col->v, cap * sizeof *col->v);
+		if (!p)
 			return -1;
-		for (long r = 0; r < t->n_rows; r++)
-			if (csv_table_number(t, r, c, &v[r]) != 0)
-				v[r] = NAN;
-		*out = bsim_mat_column(name, v, (size_t)t->n_rows);
-		return 0;
+		if (col->text)
+			col->s = p;
+		else
+			col->v = p;
 	}
-	const char **s = arena_alloc(a, (size_t)t->n_rows * sizeof *s);
-	if (!s || !name)
-		return -1;
-	for (long r = 0; r < t->n_rows; r++)
-		s[r] = csv_table_cell(t, r, c);
-	*out = bsim_mat_strings(name, s, (size_t)t->n_rows);
 	return 0;
 }
 
-/* The fields of every column, plus room for n_extra more at the end. */
-static bsim_mat_field *csv_fields(arena *a, const csv_table *t, int n_extra)
+/* Cell c of row r into its column; 1 if a numeric column turned text
+ * after holding numbers (the table must be read again), -1 out of memory. */
+static int twin_cell(twin_table *t, int c, long r, size_t cap, const char *cell)
 {
-	bsim_mat_field *f = arena_alloc(a, (size_t)(t->n_cols + n_extra) * sizeof *f);
-	for (int c = 0; f && c < t->n_cols; c++)
-		if (csv_column(a, t, c, &f[c]) != 0)
+	twin_col *col = &t->cols[c];
+	int keep = !t->over && !t->lost;
+	if (!col->text) {
+		double x;
+		int num = csv_number(cell, &x) == 0;
+		if (num || !*cell) {
+			if (keep)
+				col->v[r] = num ? x : NAN;
+			col->numbers |= num;
+			return 0;
+		}
+		col->text = 1;
+		free(col->v);
+		col->v = NULL;
+		if (col->numbers) {
+			twin_drop(t);
+			t->lost = 1;
+			return 1;
+		}
+		if (keep) {
+			if (!(col->s = malloc(cap * sizeof *col->s)))
+				return -1;
+			for (long k = 0; k < r; k++)
+				col->s[k] = "";
+		}
+	}
+	if (keep && !(col->s[r] = intern_str(&t->a, &t->in, cell)))
+		return -1;
+	return 0;
+}
+
+/* One reading of csv_path into t; columns with text[c] set are text from
+ * the start. t->lost is set if a column must be read again as text. */
+static int twin_pass(const char *path, twin_table *t, const unsigned char *text, group_check *g,
+                     int n_groups, bsim_error *err)
+{
+	memset(t, 0, sizeof *t);
+	csv_stream s;
+	int rc = csv_stream_open(path, &s, err);
+	if (rc)
+		return rc;
+	t->n_cols = s.n_cols;
+	t->names = arena_alloc(&t->a, (size_t)s.n_cols * sizeof *t->names);
+	t->cols = calloc((size_t)s.n_cols, sizeof *t->cols);
+	for (int c = 0; t->names && c < s.n_cols; c++)
+		t->names[c] = arena_strdup(&t->a, s.names[c], strlen(s.names[c]));
+	if (g) {
+		g->col = -1;
+		for (int c = s.n_cols - 1; c >= 0; c--)
+			if (strcmp(s.names[c], "group") == 0)
+				g->col = c;
+	}
+	const double limit = bsim_limits_get()->mat_rows;
+	size_t cap = 0;
+	int got = 0, oom = !t->cols || t->a.oom;
+	for (int c = 0; !oom && c < t->n_cols; c++)
+		t->cols[c].text = text ? text[c] : 0;
+	/* A table over the limit keeps nothing: it is only checked. */
+	t->over = csv_count_lines(path) - 1 > limit;
+	while (!oom && (got = csv_stream_next(&s, err)) == 1) {
+		long r = t->n_rows++;
+		if (g && g->col >= 0)
+			group_check_row(g, &s, n_groups);
+		if (!t->over && (double)t->n_rows > limit) {
+			t->over = 1;
+			twin_drop(t);
+		}
+		if (!t->over && !t->lost && (size_t)r == cap) {
+			cap = cap ? 2 * cap : 16;
+			oom = twin_grow(t, cap) != 0;
+		}
+		for (int c = 0; !oom && !t->over && c < t->n_cols; c++) {
+			oom = twin_cell(t, c, r, cap, s.cells[c]) < 0;
+		}
+	}
+	csv_stream_close(&s);
+	if (oom)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
+	return got < 0 ? (err ? err->code : BSIM_EINPUT) : BSIM_OK;
+}
+
+/* Reads csv_path into t, a second time if a column turned text late. */
+static int twin_read(const char *path, twin_table *t, group_check *g, int n_groups, bsim_error *err)
+{
+	if (g)
+		memset(g, 0, sizeof *g);
+	int rc = twin_pass(path, t, NULL, g, n_groups, err);
+	if (rc == BSIM_OK && t->lost && !t->over) {
+		unsigned char *text = malloc((size_t)t->n_cols);
+		for (int c = 0; text && c < t->n_cols; c++)
+			text[c] = (unsigned char)t->cols[c].text;
+		twin_free(t);
+		if (g) {
+			free(g->bad);
+			free(g->range);
+			memset(g, 0, sizeof *g);
+		}
+		rc = text ? twin_pass(path, t, text, g, n_groups, err)
+		          : bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
+		free(text);
+		if (rc == BSIM_OK && t->lost && !t->over)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "%s: expected the same table twice, got "
+			                    "a file that changed while it was read",
+			                    path);
+	}
+	if (rc != BSIM_OK)
+		twin_free(t);
+	return rc;
+}
+
+/* The fields of every column, plus room for n_extra more at the end. */
+static bsim_mat_field *twin_fields(twin_table *t, int n_extra)
+{
+	bsim_mat_field *f = arena_alloc(&t->a, (size_t)(t->n_cols + n_extra) * sizeof *f);
+	for (int c = 0; f && c < t->n_cols; c++) {
+		const char *name = mat_ident(&t->a, t->names[c]);
+		if (!name)
 			return NULL;
+		const twin_col *col = &t->cols[c];
+		f[c] = col->text ? bsim_mat_strings(name, col->s, (size_t)t->n_rows)
+		                 : bsim_mat_column(name, col->v, (size_t)t->n_rows);
+	}
 	return f;
+}
+
+static const char *base_name(const char *path)
+{
+	const char *slash = strrchr(path, '/');
+	return slash ? slash + 1 : path;
+}
+
+/* A table over the limit: no twin (and none left of an earlier table),
+ * one line on standard error, and the line in err with BSIM_OK. */
+static int twin_skip(const char *csv_path, const char *mat_path, const twin_table *t,
+                     bsim_error *err)
+{
+	remove(mat_path);
+	char note[BSIM_ERROR_MSG_MAX];
+	snprintf(note, sizeof note,
+	         "%s: %ld rows, over the limit mat_rows = %.15g: no %s; MATLAB's readtable "
+	         "reads the CSV (raise with --limit mat_rows=%ld)",
+	         base_name(csv_path), t->n_rows, bsim_limits_get()->mat_rows, base_name(mat_path),
+	         t->n_rows);
+	bsim_error_set(err, BSIM_OK, "%s", note);
+	fprintf(stderr, "beamsim: %s\n", err ? err->msg : note);
+	return BSIM_OK;
 }
 
 static int write_var(const char *mat_path, const char *var, bsim_mat_field *fields, int n,
@@ -141,16 +400,19 @@ static int write_var(const char *mat_path, const char *var, bsim_mat_field *fiel
 int bsim_matlab_from_csv(const char *csv_path, const char *mat_path, const char *var,
                          bsim_error *err)
 {
-	csv_table t;
-	int rc = csv_table_read(csv_path, &t, err);
+	twin_table t;
+	int rc = twin_read(csv_path, &t, NULL, 0, err);
 	if (rc)
 		return rc;
-	arena a = {0};
-	bsim_mat_field *f = csv_fields(&a, &t, 0);
-	rc = f ? write_var(mat_path, var, f, t.n_cols, err)
-	       : bsim_error_set(err, BSIM_EFAIL, "out of memory for %s", mat_path);
-	arena_free(&a);
-	csv_table_free(&t);
+	bsim_error_clear(err);
+	if (t.over) {
+		rc = twin_skip(csv_path, mat_path, &t, err);
+	} else {
+		bsim_mat_field *f = twin_fields(&t, 0);
+		rc = f ? write_var(mat_path, var, f, t.n_cols, err)
+		       : bsim_error_set(err, BSIM_EFAIL, "out of memory for %s", mat_path);
+	}
+	twin_free(&t);
 	return rc;
 }
 
@@ -406,26 +668,21 @@ int bsim_matlab_from_json(const char *json_path, const char *mat_path, const cha
  * for the axes the table does not already hold (trials.csv names them
  * itself): numbers where every value of the axis is one. *added gets how
  * many fields went to out. */
-static int group_params(arena *a, const csv_table *t, const char *path, const bsim_experiment *e,
+static int group_params(twin_table *t, int gc, const char *path, const bsim_experiment *e,
                         bsim_mat_field *out, int *added, bsim_error *err)
 {
-	int gc = csv_table_col(t, "group");
-	double *g = arena_alloc(a, (size_t)t->n_rows * sizeof *g);
+	arena *a = &t->a;
+	const double *g = t->cols[gc].v;
 	int *idx = arena_alloc(a, (size_t)(e->n_axes ? e->n_axes : 1) * sizeof *idx);
 	*added = 0;
-	if (!g || !idx)
+	if (!idx)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %s", path);
-	int rc = csv_table_numbers(t, path, gc, 0, 0.0, g, err);
-	if (rc)
-		return rc;
-	for (long r = 0; r < t->n_rows; r++)
-		if (g[r] != floor(g[r]) || g[r] < 0 || g[r] >= e->n_groups)
-			return bsim_error_set(err, BSIM_EINPUT,
-			                      "%s:%ld: group: expected 0 .. %d, got %s", path,
-			                      r + 2, e->n_groups - 1, csv_table_cell(t, r, gc));
 	for (int ax = 0; ax < e->n_axes; ax++) {
 		const bsim_grid_axis *axis = &e->axes[ax];
-		if (csv_table_col(t, axis->key) >= 0)
+		int held = 0;
+		for (int c = 0; c < t->n_cols && !held; c++)
+			held = strcmp(t->names[c], axis->key) == 0;
+		if (held)
 			continue;
 		int numeric = 1;
 		for (int i = 0; i < axis->n_values && numeric; i++) {
@@ -459,21 +716,36 @@ static int sweep_table(const char *dir, const char *name, const bsim_experiment 
 	char csv[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
 	snprintf(csv, sizeof csv, "%s/%s.csv", dir, name);
 	snprintf(mat, sizeof mat, "%s/%s.mat", dir, name);
-	csv_table t;
-	int rc = csv_table_read(csv, &t, err);
-	if (rc)
+	twin_table t;
+	group_check g;
+	int rc = twin_read(csv, &t, &g, e->n_groups, err);
+	if (rc == BSIM_OK && g.bad_line)
+		rc = bsim_error_set(err, BSIM_EINPUT, "%s:%ld: %s: expected a number, got '%s'",
+		                    csv, g.bad_line, "group", g.bad ? g.bad : "");
+	else if (rc == BSIM_OK && g.range_line)
+		rc = bsim_error_set(err, BSIM_EINPUT, "%s:%ld: group: expected 0 .. %d, got %s",
+		                    csv, g.range_line, e->n_groups - 1, g.range ? g.range : "");
+	free(g.bad);
+	free(g.range);
+	if (rc) {
+		twin_free(&t);
 		return rc;
-	arena a = {0};
-	int has_group = csv_table_col(&t, "group") >= 0, added = 0;
-	bsim_mat_field *f = csv_fields(&a, &t, has_group ? e->n_axes : 0);
+	}
+	bsim_error_clear(err);
+	if (t.over) {
+		rc = twin_skip(csv, mat, &t, err);
+		twin_free(&t);
+		return rc;
+	}
+	int has_group = g.col >= 0, added = 0;
+	bsim_mat_field *f = twin_fields(&t, has_group ? e->n_axes : 0);
 	if (!f)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %s", mat);
 	if (!rc && has_group)
-		rc = group_params(&a, &t, csv, e, f + t.n_cols, &added, err);
+		rc = group_params(&t, g.col, csv, e, f + t.n_cols, &added, err);
 	if (!rc)
 		rc = write_var(mat, name, f, t.n_cols + added, err);
-	arena_free(&a);
-	csv_table_free(&t);
+	twin_free(&t);
 	return rc;
 }
 

@@ -153,7 +153,11 @@ const char *csv_table_cell(const csv_table *t, long row, int col)
 
 int csv_table_number(const csv_table *t, long row, int col, double *out)
 {
-	const char *s = csv_table_cell(t, row, col);
+	return csv_number(csv_table_cell(t, row, col), out);
+}
+
+int csv_number(const char *s, double *out)
+{
 	char *end;
 	if (!*s || decimal_other_base(s))
 		return -1;

@@ -47,6 +47,9 @@ const char *csv_table_cell(const csv_table *t, long row, int col);
  * An empty cell is no number. */
 int csv_table_number(const csv_table *t, long row, int col, double *out);
 
+/* The text s as a number, the same way: 0 if it is one, else -1. */
+int csv_number(const char *s, double *out);
+
 /* A whole column as numbers into out (n_rows entries): 0, or BSIM_EINPUT
  * "FILE:LINE: NAME: expected a number, got TEXT" at the first cell that is
  * not one; an empty cell becomes empty_value if allow_empty. path names

@@ -11,7 +11,7 @@
 #define LIMITS_DEFAULT                                                                             \
 	{                                                                                          \
 		.input_bytes = 1048576, .groups = 1e5, .trials = 1e7, .schedule = 1e6,             \
-		.beam_steps = 1e8,                                                                 \
+		.beam_steps = 1e8, .mat_rows = 1.5e6,                                              \
 	}
 
 static bsim_limits current = LIMITS_DEFAULT;
@@ -40,6 +40,7 @@ static const struct {
         {"trials", offsetof(bsim_limits, trials)},
         {"schedule", offsetof(bsim_limits, schedule)},
         {"beam_steps", offsetof(bsim_limits, beam_steps)},
+        {"mat_rows", offsetof(bsim_limits, mat_rows)},
 };
 
 int bsim_limits_parse(bsim_limits *l, const char *text, bsim_error *err)
@@ -61,7 +62,7 @@ int bsim_limits_parse(bsim_limits *l, const char *text, bsim_error *err)
 	}
 	return bsim_error_set(err, BSIM_EINPUT,
 	                      "--limit %s: expected one of input_bytes, groups, trials, "
-	                      "schedule, beam_steps as NAME=N",
+	                      "schedule, beam_steps, mat_rows as NAME=N",
 	                      text);
 }
 

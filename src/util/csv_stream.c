@@ -1,0 +1,220 @@
+/* CSV tables read row by row (csv_stream.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "util/csv_stream.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "util/csv_table.h"
+#include "util/file_read.h"
+
+/* The first read's buffer; it grows to hold the longest line. */
+#define CSV_STREAM_CHUNK 262144
+
+static int cannot_read(const char *path, int e, bsim_error *err)
+{
+	return bsim_error_set(err, BSIM_EINPUT, "%s: cannot read the file: %s", path,
+	                      e ? strerror(e) : "read error");
+}
+
+static int too_big(const char *path, bsim_error *err)
+{
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "%s: expected a file of at most %.15g bytes, got more", path,
+	                      CSV_TABLE_MAX_BYTES);
+}
+
+/* More bytes after s->end, the buffer compacted and grown as needed. */
+static int fill(csv_stream *s, bsim_error *err)
+{
+	if (s->start > 0) {
+		memmove(s->buf, s->buf + s->start, s->end - s->start);
+		s->end -= s->start;
+		s->start = 0;
+	}
+	if (s->end == s->cap) {
+		size_t cap = 2 * s->cap;
+		char *b = realloc(s->buf, cap);
+		if (!b)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", s->path);
+		s->buf = b;
+		s->cap = cap;
+	}
+	for (;;) {
+		ssize_t k = read(s->fd, s->buf + s->end, s->cap - s->end);
+		if (k < 0 && errno == EINTR)
+			continue;
+		if (k < 0)
+			return cannot_read(s->path, errno, err);
+		s->eof = k == 0;
+		s->end += (size_t)k;
+		s->bytes += (double)k;
+		return s->bytes > CSV_TABLE_MAX_BYTES ? too_big(s->path, err) : BSIM_OK;
+	}
+}
+
+/* The next line, its line feed (and a CR before it) cut off: 1 and *line,
+ * 0 at the end of the file, -1 on a NUL byte or a last line cut short
+ * (csv_text_check's messages) or a read error. */
+static int next_line(csv_stream *s, char **line, bsim_error *err)
+{
+	size_t scanned = 0; /* bytes after start known to hold no line feed */
+	for (;;) {
+		char *p = s->buf + s->start;
+		size_t avail = s->end - s->start;
+		char *nl = memchr(p + scanned, '\n', avail - scanned);
+		scanned = avail;
+		if (nl || (s->eof && avail > 0)) {
+			size_t len = nl ? (size_t)(nl - p) : avail;
+			s->line++;
+			char *z = memchr(p, '\0', len);
+			if (z) {
+				bsim_error_set(err, BSIM_EINPUT,
+				               "%s:%ld:%ld: expected text, got a NUL byte", s->path,
+				               s->line, (long)(z - p) + 1);
+				return -1;
+			}
+			if (!nl) {
+				bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s:%ld: expected a whole line ending in a line feed, "
+				        "got the file cut short in this line",
+				        s->path, s->line);
+				return -1;
+			}
+			*nl = '\0';
+			if (len > 0 && p[len - 1] == '\r')
+				p[len - 1] = '\0';
+			s->start += len + 1;
+			*line = p;
+			return 1;
+		}
+		if (s->eof)
+			return 0;
+		if (fill(s, err) != BSIM_OK)
+			return -1;
+	}
+}
+
+static int count_fields(const char *line)
+{
+	int n = 1;
+	for (; *line; line++)
+		n += *line == ',';
+	return n;
+}
+
+/* Splits line in place at commas into out (n fields, counted before). */
+static void split(char *line, char **out, int n)
+{
+	out[0] = line;
+	for (int i = 1; i < n; i++) {
+		line = strchr(line, ',');
+		*line++ = '\0';
+		out[i] = line;
+	}
+}
+
+void csv_stream_close(csv_stream *s)
+{
+	if (s->fd >= 0)
+		close(s->fd);
+	if (s->names) {
+		free(s->names[0]);
+		free(s->names);
+	}
+	free(s->cells);
+	free(s->buf);
+	memset(s, 0, sizeof *s);
+	s->fd = -1;
+}
+
+int csv_stream_open(const char *path, csv_stream *s, bsim_error *err)
+{
+	memset(s, 0, sizeof *s);
+	s->path = path;
+	struct stat st;
+	s->fd = file_open_checked(path, &st);
+	if (s->fd < 0)
+		return cannot_read(path, errno, err);
+	int rc = BSIM_OK;
+	if (!S_ISREG(st.st_mode))
+		rc = bsim_error_set(err, BSIM_EINPUT, "%s: expected a CSV file, got %s", path,
+		                    file_kind(&st));
+	else if ((double)st.st_size > CSV_TABLE_MAX_BYTES)
+		rc = too_big(path, err);
+	else if (!(s->buf = malloc(CSV_STREAM_CHUNK)))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
+	s->cap = CSV_STREAM_CHUNK;
+	char *header = NULL;
+	int got = rc ? -1 : next_line(s, &header, err);
+	if (!rc && got == 0)
+		rc = bsim_error_set(err, BSIM_EINPUT, "%s:1: expected a header line", path);
+	else if (!rc && got < 0)
+		rc = err ? err->code : BSIM_EINPUT;
+	if (!rc) {
+		s->n_cols = count_fields(header);
+		s->names = calloc((size_t)s->n_cols, sizeof *s->names);
+		s->cells = calloc((size_t)s->n_cols, sizeof *s->cells);
+		char *copy = strdup(header);
+		if (!s->names || !s->cells || !copy) {
+			free(copy);
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
+		} else {
+			split(copy, s->names, s->n_cols);
+		}
+	}
+	if (rc)
+		csv_stream_close(s);
+	return rc;
+}
+
+int csv_stream_next(csv_stream *s, bsim_error *err)
+{
+	char *line;
+	int got;
+	while ((got = next_line(s, &line, err)) == 1) {
+		int n = count_fields(line);
+		if (n == s->n_cols && s->bad_line == 0) {
+			split(line, s->cells, n);
+			return 1;
+		}
+		if (s->bad_line == 0) {
+			s->bad_line = s->line;
+			s->bad_got = n;
+		}
+	}
+	if (got == 0 && s->bad_line > 0) {
+		bsim_error_set(err, BSIM_EINPUT, "%s:%ld: expected %d fields, got %d", s->path,
+		               s->bad_line, s->n_cols, s->bad_got);
+		return -1;
+	}
+	return got;
+}
+
+double csv_count_lines(const char *path)
+{
+	struct stat st;
+	int fd = file_open_checked(path, &st);
+	if (fd < 0)
+		return -1;
+	char *buf = S_ISREG(st.st_mode) ? malloc(CSV_STREAM_CHUNK) : NULL;
+	double n = buf ? 0 : -1;
+	for (ssize_t k; buf;) {
+		k = read(fd, buf, CSV_STREAM_CHUNK);
+		if (k < 0 && errno == EINTR)
+			continue;
+		if (k <= 0) {
+			n = k < 0 ? -1 : n;
+			break;
+		}
+		for (char *p = buf, *end = buf + k; (p = memchr(p, '\n', (size_t)(end - p))); p++)
+			n++;
+	}
+	free(buf);
+	close(fd);
+	return n;
+}
