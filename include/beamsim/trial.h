@@ -161,8 +161,8 @@ typedef struct bsim_trial_log {
 
 BSIM_API bsim_trial_log *bsim_trial_log_alloc(void);
 BSIM_API void bsim_trial_log_free(bsim_trial_log *l);
-/* dst = a copy of src's entries and peaks (dst's own memory;
- * dst zeroed or a log from here). */
+/* dst = a copy of src's entries and peaks, in dst's own memory (dst
+ * zeroed or a log from here, whose memory is reused). */
 BSIM_API int bsim_trial_log_copy(bsim_trial_log *dst, const bsim_trial_log *src);
 /* Frees what a log holds, not the log itself (for logs in arrays). */
 BSIM_API void bsim_trial_log_clear(bsim_trial_log *l);

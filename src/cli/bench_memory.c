@@ -7,8 +7,14 @@
  *   sweep       the essay's gate (configs/thesis/gate.yaml) with
  *               integration.max_steps = 50, one group of N trials and of
  *               N / 10 trials (N = --trials, default 2,000,000), all
- *               threads, into a fresh directory: trials.csv, summary.json
- *               and their .mat twins;
+ *               threads, into a fresh directory: trials.csv and
+ *               summary.json, without the .mat twin of trials.csv
+ *               (--limit mat_rows=1), so that what is measured is the
+ *               sweep's own memory;
+ *   twin        the N-trial sweep again with its trials.mat (mat_rows
+ *               raised to N): what the twin adds per row beyond the
+ *               sweep's own peak (it holds the table's columns while it is
+ *               written; by default only up to 1,500,000 rows);
  *   trajectory  `run --trajectory` of the gate with no propulsion and no
  *               random force (the body stays where it is: nothing ends the
  *               trial before max_steps) for S and S / 10 steps (S =
@@ -40,9 +46,9 @@ extern char **environ;
 #define BENCH_GATE "configs/thesis/gate.yaml"
 
 typedef struct mem_run {
-	const char *what;
-	long size;  /* trials or steps */
-	double rss; /* bytes */
+	const char *what; /* sweep, twin, trajectory */
+	long size;        /* trials or steps */
+	double rss;       /* bytes */
 	double wall;
 } mem_run;
 
@@ -80,11 +86,11 @@ static int child_peak(const char *const argv[], double *rss, double *wall)
 	return CLI_OK;
 }
 
-static int sweep_peak(const char *tmp, const char *gate, long trials, mem_run *out)
+static int sweep_peak(const char *tmp, const char *gate, long trials, int twin, mem_run *out)
 {
 	char exp[BSIM_PATH_MAX], dir[BSIM_PATH_MAX];
 	snprintf(exp, sizeof exp, "%s/sweep_%ld.yaml", tmp, trials);
-	snprintf(dir, sizeof dir, "%s/sweep_%ld", tmp, trials);
+	snprintf(dir, sizeof dir, "%s/sweep_%ld_%d", tmp, trials, twin);
 	FILE *f = fopen(exp, "w");
 	if (!f) {
 		cli_error("bench: %s: %s", exp, strerror(errno));
@@ -98,11 +104,12 @@ static int sweep_peak(const char *tmp, const char *gate, long trials, mem_run *o
 		cli_error("bench: %s: cannot write", exp);
 		return CLI_FAIL;
 	}
-	char limit[64];
+	char limit[64], rows[64];
 	snprintf(limit, sizeof limit, "trials=%ld", trials);
-	const char *argv[] = {"beamsim", "sweep",   exp,   "--out", dir,
-	                      "--quiet", "--limit", limit, NULL};
-	*out = (mem_run){.what = "sweep", .size = trials};
+	snprintf(rows, sizeof rows, "mat_rows=%ld", twin ? trials : 1);
+	const char *argv[] = {"beamsim", "sweep", exp,       "--out", dir, "--quiet",
+	                      "--limit", limit,   "--limit", rows,    NULL};
+	*out = (mem_run){.what = twin ? "sweep+twin" : "sweep", .size = trials};
 	return child_peak(argv, &out->rss, &out->wall);
 }
 
@@ -151,7 +158,7 @@ static void json_run(FILE *f, const mem_run *m)
 	fputc('}', f);
 }
 
-static int write_json(const char *path, const mem_run run[4])
+static int write_json(const char *path, const mem_run run[5])
 {
 	bsim_atomic_file o;
 	bsim_error err;
@@ -171,6 +178,10 @@ static int write_json(const char *path, const mem_run run[4])
 		bsim_json_number(o.f, growth(&run[2 * k], &run[2 * k + 1]));
 		fputc('}', o.f);
 	}
+	fputs(", \"twin\": ", o.f);
+	json_run(o.f, &run[4]);
+	fputs(", \"twin_bytes_per_row\": ", o.f);
+	bsim_json_number(o.f, (run[4].rss - run[1].rss) / (double)run[1].size);
 	fputs("}}\n", o.f);
 	if (bsim_atomic_file_commit(&o, &err) != BSIM_OK) {
 		cli_error("bench: %s", err.msg);
@@ -205,11 +216,12 @@ int bench_memory(const bench_memory_args *a)
 	FILE *r = a->report;
 	fprintf(r, "Peak resident memory (ru_maxrss of each run as a child process)\n");
 	fprintf(r, "%-12s %18s %13s %11s\n", "run", "size", "peak", "wall");
-	mem_run run[4];
-	int rc = sweep_peak(tmp, gate, trials / 10 > 0 ? trials / 10 : 1, &run[0]);
+	mem_run run[5];
+	long small = trials / 10 > 0 ? trials / 10 : 1;
+	int rc = sweep_peak(tmp, gate, small, 0, &run[0]);
 	if (rc == CLI_OK) {
 		print_run(r, &run[0], "trials");
-		rc = sweep_peak(tmp, gate, trials, &run[1]);
+		rc = sweep_peak(tmp, gate, trials, 0, &run[1]);
 	}
 	if (rc == CLI_OK) {
 		print_run(r, &run[1], "trials");
@@ -221,8 +233,16 @@ int bench_memory(const bench_memory_args *a)
 	}
 	if (rc == CLI_OK) {
 		print_run(r, &run[3], "steps");
-		fprintf(r, "\ngrowth: %.1f bytes per trial, %.1f bytes per step\n",
-		        growth(&run[0], &run[1]), growth(&run[2], &run[3]));
+		rc = sweep_peak(tmp, gate, trials, 1, &run[4]);
+	}
+	if (rc == CLI_OK) {
+		print_run(r, &run[4], "trials");
+		fprintf(r,
+		        "\ngrowth: %.1f bytes per trial (the sweep), %.1f bytes per step (the "
+		        "trajectory and its twin);\nthe .mat twin of trials.csv: %.1f bytes per "
+		        "row\n",
+		        growth(&run[0], &run[1]), growth(&run[2], &run[3]),
+		        (run[4].rss - run[1].rss) / (double)run[1].size);
 	}
 	tmp_remove(tmp);
 	if (rc == CLI_OK && a->json)

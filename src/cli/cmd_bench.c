@@ -59,9 +59,10 @@ static const cli_own bench_own[] = {
                         "and report the median, minimum and maximum"},
         [OWN_MEMORY] = {"memory", 0, NULL,
                         "instead: peak resident memory of a sweep of --trials\n"
-                        "trials (default 2,000,000) and of a tenth of it, and of\n"
-                        "run --trajectory over 1,000,000 and 100,000 steps,\n"
-                        "each a child process; the growth per trial and per step"},
+                        "trials (default 2,000,000) and of a tenth of it (without\n"
+                        "and with the .mat twin of trials.csv), and of run\n"
+                        "--trajectory over 1,000,000 and 100,000 steps, each a\n"
+                        "child process; the growth per trial, per row and per step"},
 };
 
 static const char *const bench_help[CLI_N_OPTS] = {

@@ -26,32 +26,30 @@ void bsim_trial_log_free(bsim_trial_log *l)
 	free(l);
 }
 
-/* A malloc'd copy of n items of size bytes (NULL for none). */
-static void *dup_items(const void *src, size_t n, size_t size, int *oom)
-{
-	if (n == 0)
-		return NULL;
-	void *p = malloc(n * size);
-	if (!p) {
-		*oom = 1;
-		return NULL;
-	}
-	memcpy(p, src, n * size);
-	return p;
-}
-
 int bsim_trial_log_copy(bsim_trial_log *dst, const bsim_trial_log *src)
 {
-	int oom = 0;
-	memset(dst, 0, sizeof *dst);
-	dst->entries = dup_items(src->entries, (size_t)src->n_entries, sizeof *src->entries, &oom);
-	dst->peak = dup_items(src->peak, (size_t)src->n_beams, sizeof *src->peak, &oom);
-	if (oom) {
-		bsim_trial_log_clear(dst);
-		return BSIM_EFAIL;
+	/* A log's slot is reused trial after trial (a streamed sweep's
+	 * blocks): its memory is kept and grown, never dropped. */
+	if (dst->cap_entries < src->n_entries) {
+		bsim_gate_entry *p = realloc(dst->entries, (size_t)src->n_entries * sizeof *p);
+		if (!p)
+			return BSIM_EFAIL;
+		dst->entries = p;
+		dst->cap_entries = src->n_entries;
 	}
-	dst->n_entries = dst->cap_entries = src->n_entries;
-	dst->n_beams = dst->cap_beams = src->n_beams;
+	if (dst->cap_beams < src->n_beams) {
+		double *p = realloc(dst->peak, (size_t)src->n_beams * sizeof *p);
+		if (!p)
+			return BSIM_EFAIL;
+		dst->peak = p;
+		dst->cap_beams = src->n_beams;
+	}
+	if (src->n_entries > 0)
+		memcpy(dst->entries, src->entries, (size_t)src->n_entries * sizeof *src->entries);
+	if (src->n_beams > 0)
+		memcpy(dst->peak, src->peak, (size_t)src->n_beams * sizeof *src->peak);
+	dst->n_entries = src->n_entries;
+	dst->n_beams = src->n_beams;
 	return BSIM_OK;
 }
 
