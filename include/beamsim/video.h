@@ -1,6 +1,16 @@
 /* Videos of trials: one trial of a scene drawn frame by frame with cairo and
  * encoded as H.264 MP4 by ffmpeg, one panel per backend, side by side.
  *
+ * Two ways to make one. bsim_video_stream runs the trials and draws each
+ * frame as they reach it: what it holds does not grow with the steps
+ * (beamsim video uses it):
+ *
+ *   bsim_video_def def = bsim_video_def_default();
+ *   bsim_video_stream(&def, scene, &backend, &opts, &label, 1, seed, "trial.mp4", &rep, err);
+ *
+ * Or record the trials first, for any frame in any order (stills, tests),
+ * holding every step's centre and every frame's beams:
+ *
  *   bsim_video_track *t;
  *   bsim_video_track_record(scene, backend, opts, seed, fps, &t, err);  // runs the trial
  *   bsim_video_def def = bsim_video_def_default();
@@ -162,6 +172,37 @@ BSIM_API int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, c
  * status and last message if it fails, or the path if it cannot be
  * written. */
 BSIM_API int bsim_video_write(bsim_video *v, const char *path, bsim_error *err);
+
+/* What bsim_video_stream made. */
+typedef struct bsim_video_report {
+	bsim_trial_result results[BSIM_VIDEO_PANELS_MAX]; /* each panel's trial, as
+	                                                   * bsim_trial_run gives it */
+	double t_part; /* s, when the first two panels' body centres are first more than
+	                * 1% of the body radius apart; -1 never, or one panel */
+	long frames;   /* frames written, the hold included */
+	int width, height;
+	/* What it held, which does not grow with the steps (docs/video.md,
+	 * "Memory"): */
+	long trail_points; /* the trails' points at the end, every panel and view scale:
+	                    * at most one per 0.75 px travelled in each */
+	long steps_held;   /* the most steps' centres a panel handed over with one frame:
+	                    * at most 1 / (fps h) + 1 */
+} bsim_video_report;
+
+/* Writes the video of trial `seed` (bsim_schedule_seed_mix) of scene on
+ * each of n_panels backends (opts[p] their options, or opts NULL; labels
+ * one a panel or NULL) to path, as bsim_video_write writes the video of
+ * the tracks bsim_video_track_record would record: the same frames. It
+ * runs each trial twice, first for its end, outcome and gate path, then
+ * drawing and encoding each frame as the trials reach it (a thread a
+ * panel), so nothing it holds grows with the steps. The report (may be
+ * NULL) is filled when it returns BSIM_OK. Fails as bsim_video_write does,
+ * as bsim_video_track_record does, and with BSIM_EFAIL if a trial's second
+ * run does not end as its first. */
+BSIM_API int bsim_video_stream(const bsim_video_def *def, const bsim_scene *scene,
+                               const bsim_backend *const *backends, const bsim_options *const *opts,
+                               const char *const *labels, int n_panels, uint64_t seed,
+                               const char *path, bsim_video_report *report, bsim_error *err);
 
 /* The ffmpeg pipe: raw frames in, an MP4 file out. */
 typedef struct bsim_video_encoder bsim_video_encoder;
