@@ -845,9 +845,14 @@ static void lib_stream_memory_does_not_grow_with_steps(void **state)
 	bsim_video_report rep;
 	bsim_error err;
 	const long before = peak_rss();
+	bsim_video_stream *vs = NULL;
 	assert_int_equal(
-	        bsim_video_stream(&def, &scene, &backend, NULL, NULL, 1, 1, out, &rep, &err),
+	        bsim_video_stream_alloc(&def, &scene, &backend, NULL, NULL, 1, 1, &vs, &err),
 	        BSIM_OK);
+	assert_int_equal(bsim_video_stream_write(vs, out, &rep, &err), BSIM_OK);
+	/* once a stream */
+	assert_int_equal(bsim_video_stream_write(vs, out, NULL, &err), BSIM_EINPUT);
+	bsim_video_stream_free(vs);
 	const long grown = peak_rss() - before;
 	const long steps = rep.results[0].steps_run;
 	const long per_frame = (long)ceil(1.0 / (def.fps * scene.dt));
@@ -960,10 +965,16 @@ static void lib_stream_draws_the_recorded_frames(void **state)
 		char out[1400];
 		snprintf(out, sizeof out, "%s/case%d.raw", dir, c);
 		bsim_video_report rep;
-		assert_int_equal(bsim_video_stream(&def, cases[c].scene, cases[c].backends, NULL,
-		                                   labels, cases[c].n, cases[c].seed, out, &rep,
-		                                   &err),
+		bsim_video_stream *vs = NULL;
+		assert_int_equal(bsim_video_stream_alloc(&def, cases[c].scene, cases[c].backends,
+		                                         NULL, labels, cases[c].n, cases[c].seed,
+		                                         &vs, &err),
 		                 BSIM_OK);
+		for (int p = 0; p < cases[c].n; p++)
+			assert_int_equal(bsim_video_stream_result(vs, p)->steps_run, steps[p]);
+		assert_null(bsim_video_stream_result(vs, cases[c].n));
+		assert_int_equal(bsim_video_stream_write(vs, out, &rep, &err), BSIM_OK);
+		bsim_video_stream_free(vs);
 		const size_t frame_px = (size_t)cases[c].w * cases[c].h;
 		assert_int_equal(rep.frames, frames);
 		assert_true(rep.t_part == t_part);

@@ -1,12 +1,15 @@
 /* Videos of trials: one trial of a scene drawn frame by frame with cairo and
  * encoded as H.264 MP4 by ffmpeg, one panel per backend, side by side.
  *
- * Two ways to make one. bsim_video_stream runs the trials and draws each
- * frame as they reach it: what it holds does not grow with the steps
- * (beamsim video uses it):
+ * Two ways to make one. A stream runs the trials and draws each frame as
+ * they reach it: what it holds does not grow with the steps (beamsim video
+ * uses it):
  *
  *   bsim_video_def def = bsim_video_def_default();
- *   bsim_video_stream(&def, scene, &backend, &opts, &label, 1, seed, "trial.mp4", &rep, err);
+ *   bsim_video_stream *s;
+ *   bsim_video_stream_alloc(&def, scene, &backend, NULL, &label, 1, seed, &s, err);
+ *   bsim_video_stream_write(s, "trial.mp4", &report, err);          // whole or nothing
+ *   bsim_video_stream_free(s);
  *
  * Or record the trials first, for any frame in any order (stills, tests),
  * holding every step's centre and every frame's beams:
@@ -173,7 +176,7 @@ BSIM_API int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, c
  * written. */
 BSIM_API int bsim_video_write(bsim_video *v, const char *path, bsim_error *err);
 
-/* What bsim_video_stream made. */
+/* What bsim_video_stream_write made. */
 typedef struct bsim_video_report {
 	bsim_trial_result results[BSIM_VIDEO_PANELS_MAX]; /* each panel's trial, as
 	                                                   * bsim_trial_run gives it */
@@ -189,20 +192,35 @@ typedef struct bsim_video_report {
 	                    * at most 1 / (fps h) + 1 */
 } bsim_video_report;
 
-/* Writes the video of trial `seed` (bsim_schedule_seed_mix) of scene on
- * each of n_panels backends (opts[p] their options, or opts NULL; labels
- * one a panel or NULL) to path, as bsim_video_write writes the video of
- * the tracks bsim_video_track_record would record: the same frames. It
- * runs each trial twice, first for its end, outcome and gate path, then
- * drawing and encoding each frame as the trials reach it (a thread a
- * panel), so nothing it holds grows with the steps. The report (may be
- * NULL) is filled when it returns BSIM_OK. Fails as bsim_video_write does,
- * as bsim_video_track_record does, and with BSIM_EFAIL if a trial's second
- * run does not end as its first. */
-BSIM_API int bsim_video_stream(const bsim_video_def *def, const bsim_scene *scene,
-                               const bsim_backend *const *backends, const bsim_options *const *opts,
-                               const char *const *labels, int n_panels, uint64_t seed,
-                               const char *path, bsim_video_report *report, bsim_error *err);
+/* A video made as its trials run: nothing it holds grows with the steps. */
+typedef struct bsim_video_stream bsim_video_stream;
+
+/* The video of trial `seed` (bsim_schedule_seed_mix) of scene on each of
+ * n_panels backends (opts[p] their options, or opts NULL; labels one a
+ * panel or NULL; all borrowed, as is scene, until the stream is freed):
+ * the frames bsim_video_write writes for the tracks bsim_video_track_record
+ * would record. Runs each trial once, for its end, outcome and gate path
+ * (what a frame must know before the trial gets there). Fails as
+ * bsim_video_def_check and bsim_video_track_record do. */
+BSIM_API int bsim_video_stream_alloc(const bsim_video_def *def, const bsim_scene *scene,
+                                     const bsim_backend *const *backends,
+                                     const bsim_options *const *opts, const char *const *labels,
+                                     int n_panels, uint64_t seed, bsim_video_stream **out,
+                                     bsim_error *err);
+BSIM_API void bsim_video_stream_free(bsim_video_stream *s);
+
+/* Panel p's trial as bsim_trial_run gives it; NULL for no such panel. */
+BSIM_API const bsim_trial_result *bsim_video_stream_result(const bsim_video_stream *s, int panel);
+
+/* Runs the trials again, a thread a panel, drawing and encoding each frame
+ * as they reach it, and writes the video to path, whole or not at all, as
+ * bsim_video_write does (def.stop included: the trials then run on to
+ * their end without drawing before it returns). Once a stream; the report
+ * (may be NULL) is filled when it returns BSIM_OK. Fails as
+ * bsim_video_write does, and with BSIM_EFAIL if a trial's second run does
+ * not end as its first. */
+BSIM_API int bsim_video_stream_write(bsim_video_stream *s, const char *path,
+                                     bsim_video_report *report, bsim_error *err);
 
 /* The ffmpeg pipe: raw frames in, an MP4 file out. */
 typedef struct bsim_video_encoder bsim_video_encoder;

@@ -204,8 +204,8 @@ static void print_outcome(FILE *out, const char *name, const bsim_scene *s,
 	fprintf(out, ", %d steps run\n", r->steps_run);
 }
 
-/* Streams the video of the trial on every backend (bsim_video_stream: its
- * memory does not grow with the trial's steps) and reports it. */
+/* Streams the video of the trial on every backend (bsim_video_stream_*:
+ * its memory does not grow with the trial's steps) and reports it. */
 static int video_main(video_args *a, const bsim_backend *const *backends, const bsim_scene *scene)
 {
 	const char *labels[MAX_PANELS];
@@ -217,13 +217,19 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 	uint64_t mixed = bsim_schedule_seed_mix(a->seed, (uint64_t)a->group, (uint64_t)a->trial);
 	bsim_error err;
 	bsim_video_report rep;
+	bsim_video_stream *vs = NULL;
 	a->def.stop = &cli_stop;
-	/* SIGINT and SIGTERM stop the video and remove ffmpeg's temporary
-	 * file (before it exists, nothing has been written). */
-	cli_signals_install();
-	int rc = bsim_video_stream(&a->def, scene, backends, opts, labels, a->n_backends, mixed,
-	                           a->out, &rep, &err);
-	cli_signals_restore();
+	int rc = bsim_video_stream_alloc(&a->def, scene, backends, opts, labels, a->n_backends,
+	                                 mixed, &vs, &err);
+	/* While ffmpeg writes its temporary file, SIGINT and SIGTERM stop the
+	 * video and remove it; before, they end the program, which has
+	 * written nothing yet. */
+	if (rc == BSIM_OK) {
+		cli_signals_install();
+		rc = bsim_video_stream_write(vs, a->out, &rep, &err);
+		cli_signals_restore();
+	}
+	bsim_video_stream_free(vs);
 	if (rc == BSIM_ESTOPPED) {
 		int sig = cli_stop ? (int)cli_stop : SIGINT;
 		cli_error("%s: %s", sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);

@@ -1,4 +1,4 @@
-/* Writing a video as its trials run (bsim_video_stream, beamsim/video.h).
+/* Writing a video as its trials run (bsim_video_stream_*, beamsim/video.h).
  *
  * A recorded track (video_track.c) keeps every step's centre and every
  * frame's beam angles before the first frame is drawn, so its memory grows
@@ -6,14 +6,16 @@
  * what the frame being drawn needs, in two passes over the same trial
  * (same seed, same trial: the runner is deterministic):
  *
- * Pass 1 runs each panel's trial without recording anything per step, for
+ * Pass 1 (bsim_video_stream_alloc) runs each panel's trial without
+ * recording anything per step, for
  * what a frame must know before the trial reaches it: the last step N (the
  * frame count, and which frame is the end state), the outcome and the step
  * it is decided at (the title shows it from there, but a traversal's type
  * is known only at classify_y, later), and the runner's gate path (an entry
  * a gate, which a lattice's frames tint).
  *
- * Pass 2 runs them again, one thread a panel, all in step: a panel's trace
+ * Pass 2 (bsim_video_stream_write) runs them again, one thread a panel,
+ * all in step: a panel's trace
  * callback (the runner's, called after every step) collects the centres of
  * the steps since the last frame and, at a frame's step, the frame's state
  * (video_frame_take), hands both to the drawing thread and goes on to the
@@ -89,6 +91,13 @@ typedef struct stream {
 	int n;
 	stream_panel panels[BSIM_VIDEO_PANELS_MAX];
 } stream;
+
+struct bsim_video_stream {
+	stream s;
+	bsim_video *v;
+	int sync;    /* the lock and condition are made */
+	int written; /* a stream writes one video */
+};
 
 static int buf_init(stream_buf *b, int n_beams)
 {
@@ -336,8 +345,17 @@ static int stream_write(stream *s, bsim_video *v, const char *path, bsim_video_r
 		if (rc == BSIM_OK)
 			rc = bsim_video_encoder_write(enc, pixels, err);
 	}
-	/* A stop ends the workers' drawing, not their trials: those run on to
-	 * their end (the runner cannot be interrupted), without frames. */
+	/* A signal also reaches ffmpeg when it comes from the terminal, so a
+	 * frame that could not be written then is the stop, not a failure. */
+	if (enc && v->def.stop && *v->def.stop)
+		rc = bsim_error_set(err, BSIM_ESTOPPED, "%s: stopped; no video written", path);
+	/* A stop or a failure removes the temporary file at once. It ends the
+	 * workers' drawing, not their trials: those run on to their end (the
+	 * runner cannot be interrupted), without frames. */
+	if (rc != BSIM_OK) {
+		bsim_video_encoder_abort(enc);
+		enc = NULL;
+	}
 	pthread_mutex_lock(&s->lock);
 	atomic_store(&s->cancel, 1);
 	pthread_cond_broadcast(&s->cond);
@@ -345,10 +363,6 @@ static int stream_write(stream *s, bsim_video *v, const char *path, bsim_video_r
 	for (int p = 0; p < s->n; p++)
 		if (s->panels[p].started)
 			pthread_join(s->panels[p].thread, NULL);
-	/* A signal also reaches ffmpeg when it comes from the terminal, so a
-	 * frame that could not be written then is the stop, not a failure. */
-	if (enc && v->def.stop && *v->def.stop)
-		rc = bsim_error_set(err, BSIM_ESTOPPED, "%s: stopped; no video written", path);
 	for (int p = 0; p < s->n && rc == BSIM_OK; p++) {
 		const stream_panel *sp = &s->panels[p];
 		const bsim_trial_result *r1 = bsim_video_track_result(sp->summary);
@@ -378,32 +392,44 @@ static int stream_write(stream *s, bsim_video *v, const char *path, bsim_video_r
 	return rc;
 }
 
-int bsim_video_stream(const bsim_video_def *def, const bsim_scene *scene,
-                      const bsim_backend *const *backends, const bsim_options *const *opts,
-                      const char *const *labels, int n_panels, uint64_t seed, const char *path,
-                      bsim_video_report *report, bsim_error *err)
+void bsim_video_stream_free(bsim_video_stream *vs)
 {
-	bsim_video_report rep_local;
-	bsim_video_report *rep = report ? report : &rep_local;
-	memset(rep, 0, sizeof *rep);
-	rep->t_part = -1.0;
+	if (!vs)
+		return;
+	if (vs->sync) {
+		pthread_cond_destroy(&vs->s.cond);
+		pthread_mutex_destroy(&vs->s.lock);
+	}
+	for (int p = 0; p < vs->s.n; p++)
+		bsim_video_track_free(vs->s.panels[p].summary);
+	video_teardown(vs->v);
+	free(vs);
+}
+
+int bsim_video_stream_alloc(const bsim_video_def *def, const bsim_scene *scene,
+                            const bsim_backend *const *backends, const bsim_options *const *opts,
+                            const char *const *labels, int n_panels, uint64_t seed,
+                            bsim_video_stream **out, bsim_error *err)
+{
+	*out = NULL;
 	int rc = bsim_video_def_check(def, err);
 	if (rc != BSIM_OK)
 		return rc;
 	if (n_panels < 1 || n_panels > BSIM_VIDEO_PANELS_MAX)
 		return bsim_error_set(err, BSIM_EINPUT, "a video has 1 to %d panels, not %d",
 		                      BSIM_VIDEO_PANELS_MAX, n_panels);
-	stream *s = calloc(1, sizeof *s);
+	bsim_video_stream *vs = calloc(1, sizeof *vs);
 	bsim_video *v = calloc(1, sizeof *v);
-	if (!s || !v) {
-		free(s);
+	if (!vs || !v) {
+		free(vs);
 		free(v);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
 	}
+	vs->v = v;
+	stream *s = &vs->s;
 	s->scene = scene;
 	s->seed = seed;
 	s->fps = def->fps;
-	s->n = n_panels;
 	/* Pass 1: each trial's end, outcome and gate path. */
 	for (int p = 0; p < n_panels && rc == BSIM_OK; p++) {
 		stream_panel *sp = &s->panels[p];
@@ -414,6 +440,7 @@ int bsim_video_stream(const bsim_video_def *def, const bsim_scene *scene,
 		                         err);
 		if (rc != BSIM_OK)
 			break;
+		s->n = p + 1;
 		const bsim_trial_result *r = bsim_video_track_result(sp->summary);
 		sp->n_last = r->steps_run;
 		sp->frames = bsim_video_track_frames(sp->summary);
@@ -423,42 +450,59 @@ int bsim_video_stream(const bsim_video_def *def, const bsim_scene *scene,
 		pn->last_step = sp->n_last;
 		pn->visits = video_track_visits(sp->summary, &pn->n_visits);
 		pn->random_axis = video_track_random_axis(sp->summary);
-		rep->results[p] = *r;
 	}
 	if (rc == BSIM_OK)
 		rc = video_setup(v, def, scene, labels, n_panels, err);
-	if (rc == BSIM_OK && def->stop && *def->stop)
-		rc = bsim_error_set(err, BSIM_ESTOPPED, "%s: stopped; no video written", path);
-	int sync = 0;
 	if (rc == BSIM_OK) {
 		if (pthread_mutex_init(&s->lock, NULL) == 0) {
 			if (pthread_cond_init(&s->cond, NULL) == 0)
-				sync = 2;
+				vs->sync = 1;
 			else
 				pthread_mutex_destroy(&s->lock);
 		}
-		if (!sync)
+		if (!vs->sync)
 			rc = bsim_error_set(err, BSIM_EFAIL, "cannot make a lock for a video");
 	}
+	if (rc != BSIM_OK) {
+		bsim_video_stream_free(vs);
+		return rc;
+	}
+	*out = vs;
+	return BSIM_OK;
+}
+
+const bsim_trial_result *bsim_video_stream_result(const bsim_video_stream *vs, int panel)
+{
+	if (panel < 0 || panel >= vs->s.n)
+		return NULL;
+	return bsim_video_track_result(vs->s.panels[panel].summary);
+}
+
+int bsim_video_stream_write(bsim_video_stream *vs, const char *path, bsim_video_report *report,
+                            bsim_error *err)
+{
+	bsim_video_report rep_local;
+	bsim_video_report *rep = report ? report : &rep_local;
+	memset(rep, 0, sizeof *rep);
+	rep->t_part = -1.0;
+	if (vs->written)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: a video stream writes one video",
+		                      path);
+	vs->written = 1;
+	bsim_video *v = vs->v;
+	stream *s = &vs->s;
 	/* Pass 2. */
-	if (rc == BSIM_OK)
-		rc = stream_write(s, v, path, rep, err);
-	if (rc == BSIM_OK) {
-		rep->t_part = n_panels > 1 ? v->t_part[0] : -1.0;
-		rep->frames = v->frames;
-		rep->width = v->width;
-		rep->height = v->height;
-		for (int p = 0; p < n_panels; p++)
-			for (int i = 0; i < v->panels[p].n_own; i++)
-				rep->trail_points += v->panels[p].own[i].n;
+	int rc = stream_write(s, v, path, rep, err);
+	if (rc != BSIM_OK)
+		return rc;
+	rep->t_part = s->n > 1 ? v->t_part[0] : -1.0;
+	rep->frames = v->frames;
+	rep->width = v->width;
+	rep->height = v->height;
+	for (int p = 0; p < s->n; p++) {
+		rep->results[p] = *bsim_video_track_result(s->panels[p].summary);
+		for (int i = 0; i < v->panels[p].n_own; i++)
+			rep->trail_points += v->panels[p].own[i].n;
 	}
-	if (sync) {
-		pthread_cond_destroy(&s->cond);
-		pthread_mutex_destroy(&s->lock);
-	}
-	for (int p = 0; p < n_panels; p++)
-		bsim_video_track_free(s->panels[p].summary);
-	video_teardown(v);
-	free(s);
-	return rc;
+	return BSIM_OK;
 }
