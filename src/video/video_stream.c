@@ -7,25 +7,23 @@
  * (same seed, same trial: the runner is deterministic):
  *
  * Pass 1 (bsim_video_stream_alloc) runs each panel's trial without
- * recording anything per step, for
- * what a frame must know before the trial reaches it: the last step N (the
- * frame count, and which frame is the end state), the outcome and the step
- * it is decided at (the title shows it from there, but a traversal's type
- * is known only at classify_y, later), and the runner's gate path (an entry
- * a gate, which a lattice's frames tint).
+ * recording anything per step, for what a frame must know before the trial
+ * reaches it: the last step N (the frame count, and which frame is the end
+ * state), the outcome and the step it is decided at (the title shows it
+ * from there, but a traversal's type is known only at classify_y, later),
+ * and the runner's gate path (an entry a gate, which a lattice's frames
+ * tint).
  *
- * Pass 2 (bsim_video_stream_write) runs them again, one thread a panel,
- * all in step: a panel's trace
- * callback (the runner's, called after every step) collects the centres of
- * the steps since the last frame and, at a frame's step, the frame's state
- * (video_frame_take), hands both to the drawing thread and goes on to the
- * next frame while that one is drawn; it waits only if the frame before is
- * still not taken. The drawing thread waits for frame k from every panel
- * whose trial has not ended, compares the centres step by step where two
- * panels part (bsim_video_track_separation's rule), adds them to the trails
- * thinned for each view (video_trail.c), draws and encodes the frame. The
- * second run must end as the first did (steps run, outcome), else the
- * stream fails: a backend that does not repeat a trial cannot be streamed.
+ * Pass 2 (bsim_video_stream_write) runs them again, one thread a panel, all
+ * in step: a panel's trace callback (the runner's, called after every step)
+ * collects the centres of the steps since the last frame and, at a frame's
+ * step, the frame's state (video_frame_take), hands both to the drawing
+ * thread and goes on to the next frame while that one is drawn; it waits
+ * only if the frame before is still not taken. The drawing thread waits for frame k from every
+ * panel whose trial has not ended, compares the centres step by step where two panels part
+ * (bsim_video_track_separation's rule), adds them to the trails thinned for each view
+ * (video_trail.c), draws and encodes the frame. The second run must end as the first did (steps
+ * run, outcome), else the stream fails: a backend that does not repeat a trial cannot be streamed.
  *
  * Held at any time: three frames' state a panel (n_beams angles as float
  * and contacts; the one drawn, the one handed over, the one being made),
