@@ -8,7 +8,9 @@
  * the decoded MP4; beams take their stiffness's colour; on a lattice the
  * overview fills exactly the gates of the runner's own gate path entered by
  * the frame's step, and a field that fits the view has no overview; a
- * failing or missing ffmpeg and bad arguments write nothing. */
+ * failing or missing ffmpeg and bad arguments write nothing. A streamed
+ * video (what beamsim video writes) has the very pixels of the recorded
+ * one, frame for frame, and what it holds does not grow with the steps. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <setjmp.h>
@@ -24,6 +26,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "beamsim/backend.h"
@@ -796,9 +800,215 @@ static void cli_stopped_video_leaves_no_temporary(void **state)
 	assert_true(bsim_test_exists(alive));
 }
 
+/* An "ffmpeg" that writes the raw frames it reads into the output file
+ * (its last argument, file:PATH), so a test reads back what was sent. */
+static const char *raw_encoder(const char *dir)
+{
+	static char path[1500];
+	snprintf(path, sizeof path, "%s",
+	         bsim_test_write(
+	                 dir, "raw-ffmpeg",
+	                 "#!/bin/sh\nfor a; do out=$a; done\nexec cat > \"${out#file:}\"\n"));
+	assert_int_equal(chmod(path, 0755), 0);
+	return path;
+}
+
+/* Peak resident memory of this process, bytes. */
+static long peak_rss(void)
+{
+	struct rusage u;
+	assert_int_equal(getrusage(RUSAGE_SELF, &u), 0);
+	return u.ru_maxrss * 1024L;
+}
+
+/* A million steps of a body at rest, streamed at one frame per 5000 steps
+ * (201 frames): the stream hands over one frame interval of centres at a
+ * time, keeps one trail point, and the process's peak memory grows by far
+ * less than the 16 MB that one centre a step would take (a recorded
+ * track's trail alone). First in the program, so that the peak before is
+ * the program's start, not an earlier test's. */
+static void lib_stream_memory_does_not_grow_with_steps(void **state)
+{
+	(void)state;
+	bsim_scene scene;
+	bsim_scene_init_gate(&scene, 0.0, 0.0);
+	scene.max_steps = 1000000;
+	const char *dir = bsim_test_dir("stream-memory");
+	char out[1400];
+	snprintf(out, sizeof out, "%s/long.raw", dir);
+	bsim_video_def def = bsim_video_def_default();
+	def.fps = 0.05;
+	def.width = def.height = 64;
+	def.hold = 0.0;
+	def.ffmpeg = raw_encoder(dir);
+	const bsim_backend *backend = &bsim_backend_thesis;
+	bsim_video_report rep;
+	bsim_error err;
+	const long before = peak_rss();
+	bsim_video_stream *vs = NULL;
+	assert_int_equal(
+	        bsim_video_stream_alloc(&def, &scene, &backend, NULL, NULL, 1, 1, &vs, &err),
+	        BSIM_OK);
+	assert_int_equal(bsim_video_stream_write(vs, out, &rep, &err), BSIM_OK);
+	/* once a stream */
+	assert_int_equal(bsim_video_stream_write(vs, out, NULL, &err), BSIM_EINPUT);
+	bsim_video_stream_free(vs);
+	const long grown = peak_rss() - before;
+	const long steps = rep.results[0].steps_run;
+	const long per_frame = (long)ceil(1.0 / (def.fps * scene.dt));
+	printf("# %ld steps, %ld frames: %ld trail points, at most %ld steps held (a frame is "
+	       "%ld steps), peak memory grew %ld KB\n",
+	       steps, rep.frames, rep.trail_points, rep.steps_held, per_frame, grown / 1024);
+	assert_int_equal(steps, 1000000);
+	assert_int_equal(rep.frames, 201);
+	assert_int_equal(bsim_test_size(out), 201L * 64 * 64 * 4);
+	assert_true(rep.steps_held <= per_frame + 1);
+	assert_true(rep.trail_points <= 2); /* at rest: the start, a list a view scale */
+#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+	/* Not under a sanitizer: AddressSanitizer's quarantine keeps freed
+	 * memory (up to 256 MB), so the peak grows with what the runner and
+	 * cairo allocate and free, not with what is held, and ThreadSanitizer
+	 * shadows every byte touched; the counts above are the check there. */
+	assert_true(grown < 8L * 1024 * 1024);
+#endif
+	bsim_scene_free(&scene);
+}
+
+/* Records the tracks of trial `seed` on the backends and renders every
+ * frame of their video, hold included, into one buffer. */
+static uint32_t *recorded_frames(const bsim_scene *scene, const bsim_backend *const *backends,
+                                 const char *const *labels, int n, uint64_t seed,
+                                 const bsim_video_def *def, long *frames, double *t_part,
+                                 long *steps)
+{
+	bsim_error err;
+	bsim_options opts = {0};
+	bsim_video_track *t[4] = {0};
+	for (int p = 0; p < n; p++)
+		assert_int_equal(bsim_video_track_record(scene, backends[p], &opts, seed, def->fps,
+		                                         &t[p], &err),
+		                 BSIM_OK);
+	bsim_video *v = NULL;
+	assert_int_equal(bsim_video_alloc(def, scene, (const bsim_video_track *const *)t, labels, n,
+	                                  &v, &err),
+	                 BSIM_OK);
+	int w, h;
+	bsim_video_size(v, &w, &h);
+	*frames = bsim_video_frames(v);
+	uint32_t *px = malloc(sizeof *px * (size_t)w * h * *frames);
+	assert_non_null(px);
+	for (long k = 0; k < *frames; k++)
+		assert_int_equal(bsim_video_render(v, k, px + (size_t)k * w * h, &err), BSIM_OK);
+	*t_part = n > 1 ? bsim_video_track_separation(t[0], t[1], 0.01 * scene->body.radius) : -1;
+	for (int p = 0; p < n; p++) {
+		steps[p] = bsim_video_track_result(t[p])->steps_run;
+		bsim_video_track_free(t[p]);
+	}
+	bsim_video_free(v);
+	return px;
+}
+
+/* The streamed video's frames, as sent to the encoder, equal the recorded
+ * video's rendered frames byte for byte: a gate trial side by side whose
+ * paths part and whose panels end at different steps (the ring, the ended
+ * panel, the ghost trail up to its end), and a field the camera follows
+ * with its overview. */
+static void lib_stream_draws_the_recorded_frames(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("stream-same");
+	const char *encoder = raw_encoder(dir);
+	bsim_scene gate, field;
+	bsim_override ov[] = {{"effects.propulsion.force", "6", "test"},
+	                      {"effects.random_force.magnitude", "30", "test"}};
+	bsim_error err;
+	assert_int_equal(
+	        bsim_scene_load(bsim_test_src("configs/thesis/gate.yaml"), ov, 2, &gate, &err),
+	        BSIM_OK);
+	load("tests/data/field_3x3.yaml", &field);
+	const struct {
+		const bsim_scene *scene;
+		const bsim_backend *backends[2];
+		int n;
+		uint64_t seed;
+		int w, h;
+		double view;
+	} cases[] = {
+	        {&gate,
+	         {&bsim_backend_thesis, &bsim_backend_box2d},
+	         2,
+	         bsim_schedule_seed_mix(1, 13, 15),
+	         320,
+	         160,
+	         200.0},
+	        {&field,
+	         {&bsim_backend_thesis},
+	         1,
+	         bsim_schedule_seed_mix(1, 0, 0),
+	         320,
+	         240,
+	         40.0},
+	};
+	const char *labels[] = {"thesis", "box2d"};
+	for (int c = 0; c < 2; c++) {
+		bsim_video_def def = bsim_video_def_default();
+		def.width = cases[c].w;
+		def.height = cases[c].h;
+		def.view_span = cases[c].view;
+		def.hold = 0.1;
+		def.ffmpeg = encoder;
+		long frames, steps[2];
+		double t_part;
+		uint32_t *want =
+		        recorded_frames(cases[c].scene, cases[c].backends, labels, cases[c].n,
+		                        cases[c].seed, &def, &frames, &t_part, steps);
+		char out[1400];
+		snprintf(out, sizeof out, "%s/case%d.raw", dir, c);
+		bsim_video_report rep;
+		bsim_video_stream *vs = NULL;
+		assert_int_equal(bsim_video_stream_alloc(&def, cases[c].scene, cases[c].backends,
+		                                         NULL, labels, cases[c].n, cases[c].seed,
+		                                         &vs, &err),
+		                 BSIM_OK);
+		for (int p = 0; p < cases[c].n; p++)
+			assert_int_equal(bsim_video_stream_result(vs, p)->steps_run, steps[p]);
+		assert_null(bsim_video_stream_result(vs, cases[c].n));
+		assert_int_equal(bsim_video_stream_write(vs, out, &rep, &err), BSIM_OK);
+		bsim_video_stream_free(vs);
+		const size_t frame_px = (size_t)cases[c].w * cases[c].h;
+		assert_int_equal(rep.frames, frames);
+		assert_true(rep.t_part == t_part);
+		for (int p = 0; p < cases[c].n; p++)
+			assert_int_equal(rep.results[p].steps_run, steps[p]);
+		char *got = bsim_test_read(out);
+		assert_non_null(got);
+		assert_int_equal(bsim_test_size(out), (long)(frames * frame_px * 4));
+		long differ = 0;
+		for (long k = 0; k < frames; k++) {
+			const uint32_t *g =
+			        (const uint32_t *)(const void *)(got + k * frame_px * 4);
+			for (size_t i = 0; i < frame_px; i++)
+				differ += (g[i] & 0xFFFFFFu) != want[k * frame_px + i];
+		}
+		printf("# case %d: %ld frames, %d panel(s), parts at %g s, %ld trail points "
+		       "kept of %ld steps: %ld pixels differ\n",
+		       c, frames, cases[c].n, t_part, rep.trail_points,
+		       steps[0] + (cases[c].n > 1 ? steps[1] : 0), differ);
+		assert_int_equal(differ, 0);
+		if (c == 0)
+			assert_true(t_part > 0.0 && steps[0] != steps[1]);
+		free(got);
+		free(want);
+	}
+	bsim_scene_free(&gate);
+	bsim_scene_free(&field);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(lib_stream_memory_does_not_grow_with_steps),
+	        cmocka_unit_test(lib_stream_draws_the_recorded_frames),
 	        cmocka_unit_test(cli_single_backend),
 	        cmocka_unit_test(cli_side_by_side),
 	        cmocka_unit_test(lib_camera_follows_the_body),

@@ -1,6 +1,19 @@
 /* Videos of trials: one trial of a scene drawn frame by frame with cairo and
  * encoded as H.264 MP4 by ffmpeg, one panel per backend, side by side.
  *
+ * Two ways to make one. A stream runs the trials and draws each frame as
+ * they reach it: what it holds does not grow with the steps (beamsim video
+ * uses it):
+ *
+ *   bsim_video_def def = bsim_video_def_default();
+ *   bsim_video_stream *s;
+ *   bsim_video_stream_alloc(&def, scene, &backend, NULL, &label, 1, seed, &s, err);
+ *   bsim_video_stream_write(s, "trial.mp4", &report, err);          // whole or nothing
+ *   bsim_video_stream_free(s);
+ *
+ * Or record the trials first, for any frame in any order (stills, tests),
+ * holding every step's centre and every frame's beams:
+ *
  *   bsim_video_track *t;
  *   bsim_video_track_record(scene, backend, opts, seed, fps, &t, err);  // runs the trial
  *   bsim_video_def def = bsim_video_def_default();
@@ -162,6 +175,52 @@ BSIM_API int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, c
  * status and last message if it fails, or the path if it cannot be
  * written. */
 BSIM_API int bsim_video_write(bsim_video *v, const char *path, bsim_error *err);
+
+/* What bsim_video_stream_write made. */
+typedef struct bsim_video_report {
+	bsim_trial_result results[BSIM_VIDEO_PANELS_MAX]; /* each panel's trial, as
+	                                                   * bsim_trial_run gives it */
+	double t_part; /* s, when the first two panels' body centres are first more than
+	                * 1% of the body radius apart; -1 never, or one panel */
+	long frames;   /* frames written, the hold included */
+	int width, height;
+	/* What it held, which does not grow with the steps (docs/video.md,
+	 * "Memory"): */
+	long trail_points; /* the trails' points at the end, every panel and view scale:
+	                    * at most one per 0.75 px travelled in each */
+	long steps_held;   /* the most steps' centres a panel handed over with one frame:
+	                    * at most 1 / (fps h) + 1 */
+} bsim_video_report;
+
+/* A video made as its trials run: nothing it holds grows with the steps. */
+typedef struct bsim_video_stream bsim_video_stream;
+
+/* The video of trial `seed` (bsim_schedule_seed_mix) of scene on each of
+ * n_panels backends (opts[p] their options, or opts NULL; labels one a
+ * panel or NULL; all borrowed, as is scene, until the stream is freed):
+ * the frames bsim_video_write writes for the tracks bsim_video_track_record
+ * would record. Runs each trial once, for its end, outcome and gate path
+ * (what a frame must know before the trial gets there). Fails as
+ * bsim_video_def_check and bsim_video_track_record do. */
+BSIM_API int bsim_video_stream_alloc(const bsim_video_def *def, const bsim_scene *scene,
+                                     const bsim_backend *const *backends,
+                                     const bsim_options *const *opts, const char *const *labels,
+                                     int n_panels, uint64_t seed, bsim_video_stream **out,
+                                     bsim_error *err);
+BSIM_API void bsim_video_stream_free(bsim_video_stream *s);
+
+/* Panel p's trial as bsim_trial_run gives it; NULL for no such panel. */
+BSIM_API const bsim_trial_result *bsim_video_stream_result(const bsim_video_stream *s, int panel);
+
+/* Runs the trials again, a thread a panel, drawing and encoding each frame
+ * as they reach it, and writes the video to path, whole or not at all, as
+ * bsim_video_write does (def.stop included: the trials then run on to
+ * their end without drawing before it returns). Once a stream; the report
+ * (may be NULL) is filled when it returns BSIM_OK. Fails as
+ * bsim_video_write does, and with BSIM_EFAIL if a trial's second run does
+ * not end as its first. */
+BSIM_API int bsim_video_stream_write(bsim_video_stream *s, const char *path,
+                                     bsim_video_report *report, bsim_error *err);
 
 /* The ffmpeg pipe: raw frames in, an MP4 file out. */
 typedef struct bsim_video_encoder bsim_video_encoder;

@@ -204,32 +204,32 @@ static void print_outcome(FILE *out, const char *name, const bsim_scene *s,
 	fprintf(out, ", %d steps run\n", r->steps_run);
 }
 
-/* Records every backend's trial and writes the video. */
+/* Streams the video of the trial on every backend (bsim_video_stream_*:
+ * its memory does not grow with the trial's steps) and reports it. */
 static int video_main(video_args *a, const bsim_backend *const *backends, const bsim_scene *scene)
 {
-	bsim_video_track *tracks[MAX_PANELS] = {0};
 	const char *labels[MAX_PANELS];
+	const bsim_options *opts[MAX_PANELS];
+	for (int i = 0; i < a->n_backends; i++) {
+		labels[i] = a->names[i];
+		opts[i] = &a->opts[i];
+	}
 	uint64_t mixed = bsim_schedule_seed_mix(a->seed, (uint64_t)a->group, (uint64_t)a->trial);
 	bsim_error err;
-	int rc = BSIM_OK;
-	for (int i = 0; i < a->n_backends && rc == BSIM_OK; i++) {
-		labels[i] = a->names[i];
-		rc = bsim_video_track_record(scene, backends[i], &a->opts[i], mixed, a->def.fps,
-		                             &tracks[i], &err);
-	}
-	bsim_video *v = NULL;
+	bsim_video_report rep;
+	bsim_video_stream *vs = NULL;
 	a->def.stop = &cli_stop;
-	if (rc == BSIM_OK)
-		rc = bsim_video_alloc(&a->def, scene, (const bsim_video_track *const *)tracks,
-		                      labels, a->n_backends, &v, &err);
+	int rc = bsim_video_stream_alloc(&a->def, scene, backends, opts, labels, a->n_backends,
+	                                 mixed, &vs, &err);
 	/* While ffmpeg writes its temporary file, SIGINT and SIGTERM stop the
 	 * video and remove it; before, they end the program, which has
 	 * written nothing yet. */
 	if (rc == BSIM_OK) {
 		cli_signals_install();
-		rc = bsim_video_write(v, a->out, &err);
+		rc = bsim_video_stream_write(vs, a->out, &rep, &err);
 		cli_signals_restore();
 	}
+	bsim_video_stream_free(vs);
 	if (rc == BSIM_ESTOPPED) {
 		int sig = cli_stop ? (int)cli_stop : SIGINT;
 		cli_error("%s: %s", sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
@@ -242,10 +242,9 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 		fprintf(out, "scene       %s (%s), seed %" PRIu64 ", group %ld, trial %ld\n",
 		        cli_path(a->scene), scene->name, a->seed, a->group, a->trial);
 		for (int i = 0; i < a->n_backends; i++)
-			print_outcome(out, a->names[i], scene, bsim_video_track_result(tracks[i]));
+			print_outcome(out, a->names[i], scene, &rep.results[i]);
 		if (a->n_backends > 1) {
-			double t = bsim_video_track_separation(tracks[0], tracks[1],
-			                                       0.01 * scene->body.radius);
+			double t = rep.t_part;
 			if (t >= 0.0)
 				fprintf(out,
 				        "paths part  at t = %.6g s (%s and %s more than 1%% of the "
@@ -257,15 +256,10 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 				        "radius)\n",
 				        a->names[0], a->names[1]);
 		}
-		int w, h;
-		bsim_video_size(v, &w, &h);
-		long frames = bsim_video_frames(v);
 		fprintf(out, "wrote       %s: %dx%d, H.264 yuv420p, %g fps, %ld frames, %.6g s\n",
-		        cli_path(a->out), w, h, a->def.fps, frames, (double)frames / a->def.fps);
+		        cli_path(a->out), rep.width, rep.height, a->def.fps, rep.frames,
+		        (double)rep.frames / a->def.fps);
 	}
-	bsim_video_free(v);
-	for (int i = 0; i < a->n_backends; i++)
-		bsim_video_track_free(tracks[i]);
 	return rc > BSIM_ESTOPPED ? rc : cli_report(rc, &err);
 }
 

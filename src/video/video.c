@@ -54,11 +54,21 @@ int bsim_video_def_check(const bsim_video_def *d, bsim_error *err)
 	return BSIM_OK;
 }
 
-int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
-                     const bsim_video_track *const *tracks, const char *const *labels, int n_panels,
-                     bsim_video **out, bsim_error *err)
+/* The list of panel p's trails at scale s, shared by the views of that
+ * scale; NULL if memory runs out. */
+static video_trail *trail_at(video_panel *pn, double s)
 {
-	*out = NULL;
+	for (int i = 0; i < pn->n_own; i++)
+		if (pn->own[i].scale == s)
+			return &pn->own[i];
+	video_trail *t = &pn->own[pn->n_own++];
+	*t = (video_trail){.scale = s, .broken = -1};
+	return t;
+}
+
+int video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scene,
+                const char *const *labels, int n_panels, bsim_error *err)
+{
 	int rc = bsim_video_def_check(def, err);
 	if (rc != BSIM_OK)
 		return rc;
@@ -70,9 +80,6 @@ int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
 	if (width / n_panels < 32)
 		return bsim_error_set(err, BSIM_EINPUT, "size %dx%d: too narrow for %d panels",
 		                      width, height, n_panels);
-	bsim_video *v = calloc(1, sizeof *v);
-	if (!v)
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
 	v->def = *def;
 	if (!v->def.ffmpeg)
 		v->def.ffmpeg = "ffmpeg";
@@ -81,30 +88,20 @@ int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
 	v->n_panels = n_panels;
 	v->scene = scene;
 	for (int p = 0; p < n_panels; p++) {
-		v->tracks[p] = tracks[p];
 		v->labels[p] = labels ? labels[p] : NULL;
-		long f = bsim_video_track_frames(tracks[p]);
-		if (f > v->frames_sim)
-			v->frames_sim = f;
+		if (v->panels[p].frames > v->frames_sim)
+			v->frames_sim = v->panels[p].frames;
+		v->t_part[p] = -1.0;
+		if (n_panels > 1) {
+			int q = p == 0 ? 1 : 0;
+			v->part_from[p] = labels && labels[q] ? labels[q] : "the other";
+		}
 	}
 	v->frames = v->frames_sim + lround(v->def.hold * v->def.fps);
-	/* Side by side, each panel parts from the first; the first from the
-	 * second. 1% of the body radius, as beamsim compare measures it. */
-	const double sep = 0.01 * scene->body.radius;
-	for (int p = 0; p < n_panels; p++) {
-		int q = p == 0 ? 1 : 0;
-		v->t_part[p] = -1.0;
-		if (n_panels < 2)
-			continue;
-		v->t_part[p] = bsim_video_track_separation(tracks[p], tracks[q], sep);
-		v->part_from[p] = v->labels[q] ? v->labels[q] : "the other";
-	}
 	if (scene->has_lattice) {
 		v->entered = calloc((size_t)(scene->lattice.columns * scene->lattice.rows), 1);
-		if (!v->entered) {
-			free(v);
+		if (!v->entered)
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
-		}
 	}
 	video_field_bounds(scene, v->field);
 	v->k_min = scene->n_beams ? scene->beams[0].stiffness : 0.0;
@@ -113,11 +110,31 @@ int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
 		v->k_min = fmin(v->k_min, scene->beams[i].stiffness);
 		v->k_max = fmax(v->k_max, scene->beams[i].stiffness);
 	}
-	*out = v;
+	/* Each panel's trail is drawn in every panel's view (its own or as a
+	 * ghost) and in its own overview: one list a scale. */
+	double s_main[BSIM_VIDEO_PANELS_MAX], s_over[BSIM_VIDEO_PANELS_MAX];
+	int over[BSIM_VIDEO_PANELS_MAX];
+	for (int p = 0; p < n_panels; p++)
+		over[p] = video_panel_scales(v, p, &s_main[p], &s_over[p]);
+	for (int q = 0; q < n_panels; q++) {
+		video_panel *pn = &v->panels[q];
+		for (int j = 0; j < n_panels; j++)
+			pn->trail[j] = trail_at(pn, s_main[j]);
+		pn->trail[n_panels] = over[q] ? trail_at(pn, s_over[q]) : NULL;
+	}
 	return BSIM_OK;
 }
 
-void bsim_video_free(bsim_video *v)
+int video_panel_trail_add(bsim_video *v, int p, long step, const double x[2])
+{
+	video_panel *pn = &v->panels[p];
+	for (int i = 0; i < pn->n_own; i++)
+		if (video_trail_add(&pn->own[i], step, x))
+			return -1;
+	return 0;
+}
+
+void video_teardown(bsim_video *v)
 {
 	if (!v)
 		return;
@@ -125,8 +142,65 @@ void bsim_video_free(bsim_video *v)
 		cairo_destroy(v->cr);
 	if (v->surface)
 		cairo_surface_destroy(v->surface);
+	for (int p = 0; p < v->n_panels; p++)
+		for (int i = 0; i < v->panels[p].n_own; i++)
+			video_trail_free(&v->panels[p].own[i]);
 	free(v->entered);
 	free(v);
+}
+
+int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
+                     const bsim_video_track *const *tracks, const char *const *labels, int n_panels,
+                     bsim_video **out, bsim_error *err)
+{
+	*out = NULL;
+	bsim_video *v = calloc(1, sizeof *v);
+	if (!v)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
+	for (int p = 0; p < n_panels && p < BSIM_VIDEO_PANELS_MAX; p++) {
+		video_panel *pn = &v->panels[p];
+		const bsim_video_track *t = tracks[p];
+		long n;
+		pn->track = t;
+		pn->result = bsim_video_track_result(t);
+		pn->frames = bsim_video_track_frames(t);
+		video_track_trail(t, &n);
+		pn->last_step = n - 1;
+		pn->visits = video_track_visits(t, &pn->n_visits);
+		pn->random_axis = video_track_random_axis(t);
+	}
+	int rc = video_setup(v, def, scene, labels, n_panels, err);
+	if (rc != BSIM_OK) {
+		video_teardown(v);
+		return rc;
+	}
+	/* Side by side, each panel parts from the first; the first from the
+	 * second. 1% of the body radius, as beamsim compare measures it. */
+	const double sep = 0.01 * scene->body.radius;
+	for (int p = 0; p < n_panels && n_panels > 1; p++) {
+		int q = p == 0 ? 1 : 0;
+		v->t_part[p] = bsim_video_track_separation(tracks[p], tracks[q], sep);
+		if (v->t_part[p] >= 0.0)
+			bsim_video_track_position(tracks[p], lround(v->t_part[p] / scene->dt),
+			                          v->panels[p].part_x);
+	}
+	/* The trails, thinned as a stream thins them. */
+	for (int p = 0; p < n_panels; p++) {
+		long n;
+		const double *xy = video_track_trail(tracks[p], &n);
+		for (long i = 0; i < n; i++)
+			if (video_panel_trail_add(v, p, i, xy + 2 * i)) {
+				video_teardown(v);
+				return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
+			}
+	}
+	*out = v;
+	return BSIM_OK;
+}
+
+void bsim_video_free(bsim_video *v)
+{
+	video_teardown(v);
 }
 
 long bsim_video_frames(const bsim_video *v)

@@ -128,29 +128,47 @@ static void line_world(cairo_t *cr, const video_view *vw, const double a[2], con
 	cairo_line_to(cr, pb[0], pb[1]);
 }
 
-/* The body's path from step 0 to step `last`, leaving out points within
- * 0.75 px of the last one drawn (a long trial has many steps a pixel). */
-static void draw_trail(cairo_t *cr, const video_view *vw, const bsim_video_track *t, long last,
-                       uint32_t color, double width)
+/* Panel q's path from step 0 to step `last` in a view, from its trail
+ * thinned at that view's scale (video_trail.c): the kept points before
+ * `last` and the centre at `last`, or up to the first centre that is not
+ * finite. */
+static void draw_trail(cairo_t *cr, const video_view *vw, const bsim_video *v, int q,
+                       const video_trail *tr, long last, uint32_t color, double width)
 {
-	long n;
-	const double *xy = video_track_trail(t, &n);
-	if (last >= n)
-		last = n - 1;
-	if (last < 1)
+	const video_panel *pn = &v->panels[q];
+	const long hi = pn->track ? pn->last_step : pn->now.step;
+	if (last > hi)
+		last = hi;
+	if (last < 1 || !tr || tr->n == 0)
 		return;
-	double p[2], q[2];
-	video_view_pixel(vw, xy, p);
+	double p[2];
+	video_view_pixel(vw, tr->p[0].x, p);
 	cairo_move_to(cr, p[0], p[1]);
-	for (long i = 1; i <= last; i++) {
-		video_view_pixel(vw, xy + 2 * i, q);
-		if (!isfinite(q[0]) || !isfinite(q[1]))
-			break;
-		if (i < last && fabs(q[0] - p[0]) < 0.75 && fabs(q[1] - p[1]) < 0.75)
-			continue;
-		cairo_line_to(cr, q[0], q[1]);
-		p[0] = q[0];
-		p[1] = q[1];
+	const int broken = tr->broken >= 0 && tr->broken <= last;
+	long i = 1;
+	for (; i < tr->n && tr->p[i].step < last; i++) {
+		video_view_pixel(vw, tr->p[i].x, p);
+		cairo_line_to(cr, p[0], p[1]);
+	}
+	if (!broken) {
+		double x[2];
+		if (pn->track) {
+			bsim_video_track_position(pn->track, last, x);
+		} else if (last == pn->now.step) {
+			x[0] = pn->now.x[0];
+			x[1] = pn->now.x[1];
+		} else {
+			/* a step another panel ended at, marked as it passed */
+			x[0] = tr->p[i - 1].x[0];
+			x[1] = tr->p[i - 1].x[1];
+			for (int m = 0; m < pn->n_marks; m++)
+				if (pn->marks[m].step == last) {
+					x[0] = pn->marks[m].x[0];
+					x[1] = pn->marks[m].x[1];
+				}
+		}
+		video_view_pixel(vw, x, p);
+		cairo_line_to(cr, p[0], p[1]);
 	}
 	set_color(cr, color);
 	cairo_set_line_width(cr, width);
@@ -182,12 +200,11 @@ static void draw_bounds(cairo_t *cr, const bsim_video *v, const video_view *vw)
 /* Which gates of a lattice the body has entered by step `step` (the
  * runner's path): entered[iy columns + ix - ix_min] = 1; the gate of the
  * last entry so far in *cur. Returns the number of entries so far. */
-static int gates_entered(const bsim_video *v, const bsim_video_track *t, long step,
-                         unsigned char *entered, int cur[2])
+static int gates_entered(const bsim_video *v, int p, long step, unsigned char *entered, int cur[2])
 {
 	const bsim_lattice_def *l = &v->scene->lattice;
-	int n, count = 0;
-	const video_gate_visit *e = video_track_visits(t, &n);
+	int n = v->panels[p].n_visits, count = 0;
+	const video_gate_visit *e = v->panels[p].visits;
 	memset(entered, 0, (size_t)(l->columns * l->rows));
 	cur[0] = cur[1] = 0;
 	for (int i = 0; i < n && e[i].step <= step; i++) {
@@ -248,8 +265,8 @@ static void draw_gates(cairo_t *cr, const bsim_video *v, const video_view *vw,
  * rest of any other scene; the bounds, the trail, the body as a dot and
  * the main view's rectangle. */
 static void draw_overview(cairo_t *cr, const bsim_video *v, const video_view *ov,
-                          const video_view *main, const bsim_video_track *t, long step,
-                          const double body[2], const unsigned char *entered)
+                          const video_view *main, int panel, long step, const double body[2],
+                          const unsigned char *entered)
 {
 	const bsim_scene *s = v->scene;
 	cairo_save(cr);
@@ -302,7 +319,7 @@ static void draw_overview(cairo_t *cr, const bsim_video *v, const video_view *ov
 			cairo_stroke(cr);
 		}
 	}
-	draw_trail(cr, ov, t, step, COLOR_TRAIL, 1.0);
+	draw_trail(cr, ov, v, panel, v->panels[panel].trail[v->n_panels], step, COLOR_TRAIL, 1.0);
 	double p[2];
 	if (isfinite(body[0]) && isfinite(body[1])) {
 		video_view_pixel(ov, body, p);
@@ -508,9 +525,25 @@ void video_panel_view(const bsim_video *v, int p, long k, video_view *out)
 	const double px0 = (double)(p * v->width / v->n_panels);
 	const double pw = (double)((p + 1) * v->width / v->n_panels) - px0;
 	const double title_h = ceil(2.0 * font_size(v));
-	const bsim_video_sample sm = bsim_video_track_sample(v->tracks[p], k);
+	const bsim_video_sample sm = video_panel_sample(v, p, k);
 	video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h, sm.x,
 	                v->scene->body.radius, out);
+}
+
+int video_panel_scales(const bsim_video *v, int p, double *s_main, double *s_over)
+{
+	const double px0 = (double)(p * v->width / v->n_panels);
+	const double pw = (double)((p + 1) * v->width / v->n_panels) - px0;
+	const double title_h = ceil(2.0 * font_size(v));
+	video_view vw, ov;
+	video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h,
+	                v->scene->body.start, v->scene->body.radius, &vw);
+	*s_main = vw.scale;
+	*s_over = 0.0;
+	if (!video_overview_make(v->field, &vw, &ov))
+		return 0;
+	*s_over = ov.scale;
+	return 1;
 }
 
 int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, const double p[2],
@@ -531,13 +564,12 @@ int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, const doub
 static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double fs)
 {
 	const bsim_scene *s = v->scene;
-	const bsim_video_track *t = v->tracks[p];
+	const video_panel *pn = &v->panels[p];
 	const double px0 = (double)(p * v->width / v->n_panels);
 	const double pw = (double)((p + 1) * v->width / v->n_panels) - px0;
 	const double title_h = ceil(2.0 * fs);
-	const bsim_video_sample sm = bsim_video_track_sample(t, k);
-	const bsim_trial_result *res = bsim_video_track_result(t);
-	const double dt = s->dt;
+	const bsim_video_sample sm = video_panel_sample(v, p, k);
+	const bsim_trial_result *res = pn->result;
 	char buf[160];
 
 	cairo_save(cr);
@@ -553,7 +585,7 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	int cur[2] = {0, 0}, n_entered = 0;
 	if (s->has_lattice) {
 		entered = v->entered;
-		n_entered = gates_entered(v, t, sm.step, entered, cur);
+		n_entered = gates_entered(v, p, sm.step, entered, cur);
 	}
 	cairo_save(cr);
 	cairo_rectangle(cr, vw.x0, vw.y0, vw.w, vw.h);
@@ -563,16 +595,15 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	draw_bounds(cr, v, &vw);
 	for (int q = 0; q < v->n_panels; q++)
 		if (q != p)
-			draw_trail(cr, &vw, v->tracks[q], sm.step, COLOR_GHOST, 1.2);
-	draw_trail(cr, &vw, t, sm.step, COLOR_TRAIL, 1.5);
+			draw_trail(cr, &vw, v, q, v->panels[q].trail[p], sm.step, COLOR_GHOST, 1.2);
+	draw_trail(cr, &vw, v, p, pn->trail[p], sm.step, COLOR_TRAIL, 1.5);
 	draw_beams(cr, v, &vw, &sm);
 	draw_body(cr, v, &vw, sm.x);
-	draw_force(cr, v, &vw, &sm, video_track_random_axis(t));
+	draw_force(cr, v, &vw, &sm, pn->random_axis);
 	const double t_part = v->t_part[p];
 	if (t_part >= 0.0 && sm.t >= t_part) {
-		double xp[2], pp[2];
-		bsim_video_track_position(t, lround(t_part / dt), xp);
-		video_view_pixel(&vw, xp, pp);
+		double pp[2];
+		video_view_pixel(&vw, pn->part_x, pp);
 		cairo_new_sub_path(cr);
 		cairo_arc(cr, pp[0], pp[1], 5.0, 0.0, VIDEO_TAU);
 		set_color(cr, COLOR_TEXT);
@@ -582,7 +613,7 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 
 	/* Overlays inside the view. */
 	if (overview)
-		draw_overview(cr, v, &ov, &vw, t, sm.step, sm.x, entered);
+		draw_overview(cr, v, &ov, &vw, p, sm.step, sm.x, entered);
 	char l_kin[48], l_spring[48], l_prop[48], l_force[48], l_part[96], l_gate[64];
 	const char *lines[6] = {l_kin, l_spring, l_prop};
 	int n_lines = 3;
@@ -613,8 +644,7 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	char outcome[128] = "";
 	if (sm.step >= res->steps)
 		outcome_text(s, res, outcome, sizeof outcome);
-	snprintf(buf, sizeof buf, "t = %.3f s%s", sm.t,
-	         k >= bsim_video_track_frames(t) ? " (ended)" : "");
+	snprintf(buf, sizeof buf, "t = %.3f s%s", sm.t, k >= pn->frames ? " (ended)" : "");
 	const char *label = v->labels[p] ? v->labels[p] : "";
 	cairo_text_extents_t e_label, e_time, e_out;
 	cairo_text_extents(cr, buf, &e_time);

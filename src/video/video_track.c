@@ -11,10 +11,16 @@
  * and the random force of step n_k. The force comes from a second effect
  * pipeline built from the same scene and seed: the schedule is a function of
  * (seed, index) alone (beamsim/schedule.h), so it gives the very values the
- * runner applies. Angles are kept as float, enough for a pixel, so a long
- * trial of a large field stays small. The runner's own gate path (its log)
- * is kept too: the gates entered and the step of each entry, which a
- * lattice's frames mark. */
+ * runner applies. Angles are kept as float, enough for a pixel. The
+ * runner's own gate path (its log) is kept too: the gates entered and the
+ * step of each entry, which a lattice's frames mark.
+ *
+ * A recorded track answers for any frame and any step, so it grows with the
+ * trial: 16 bytes a step for the trail and 56 + 5 n_beams bytes a frame.
+ * It is for stills, tests and short trials; beamsim video streams instead
+ * (video_stream.c), running the trial twice: first as a summary (result,
+ * frame count and gate path only, video_track_summary), then drawing each
+ * frame as the trial reaches it. */
 #include "beamsim/video.h"
 
 #include <math.h>
@@ -25,12 +31,9 @@
 #include "beamsim/landscape.h"
 #include "video/video_internal.h"
 
-/* Frame scalars; the angles and contacts live in the track's arrays. */
-typedef struct track_frame {
-	long step;
-	double x[2];
-	double f_rand, e_kin, e_spring, e_prop;
-} track_frame;
+/* Frame scalars (video_frame); the angles and contacts live in the
+ * track's arrays. */
+typedef video_frame track_frame;
 
 struct bsim_video_track {
 	const bsim_scene *scene;
@@ -48,14 +51,37 @@ struct bsim_video_track {
 	int oom;
 	video_gate_visit *visits; /* the gate path: the runner's entries in order */
 	int n_visits;
+	int summary; /* 1: a stream's first pass, no trail and no frames */
 };
 
 /* The step a frame shows. The 1e-9 keeps a frame time that is a whole
  * number of steps (k = 3 at 30 fps and 4 ms: 25 steps) on that step
  * whatever the rounding of k / (fps h). */
+long video_frame_step(double fps, double dt, long k)
+{
+	return (long)floor((double)k / (fps * dt) + 1e-9);
+}
+
 static long frame_step(const bsim_video_track *t, long k)
 {
-	return (long)floor((double)k / (t->fps * t->scene->dt) + 1e-9);
+	return video_frame_step(t->fps, t->scene->dt, k);
+}
+
+/* As bsim_video_track_record counts them: the frames whose step is at or
+ * before n_last, and one more for the end state if no frame falls on
+ * n_last, at most ceil(n_last h fps) + 1. */
+long video_frame_count(double fps, double dt, long n_last)
+{
+	long k = (long)floor((double)n_last * fps * dt) - 2;
+	if (k < 0 || video_frame_step(fps, dt, k) > n_last)
+		k = 0;
+	while (video_frame_step(fps, dt, k) <= n_last)
+		k++;
+	/* k frames at or before n_last; frame k - 1 is n_last's if any is */
+	const long frames = (long)ceil((double)n_last * fps * dt - 1e-9) + 1;
+	if (k >= frames)
+		return frames;
+	return video_frame_step(fps, dt, k - 1) == n_last ? k : k + 1;
 }
 
 static int grow(void **p, long *cap, long need, size_t size)
@@ -93,19 +119,15 @@ static int frames_reserve(bsim_video_track *t, long need)
 	return 0;
 }
 
-/* Writes the state of step `step` into frame slot k. */
-static void frame_take(bsim_video_track *t, long k, long step, const bsim_state *s)
+void video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const bsim_state *s,
+                      video_frame *f, float *th, unsigned char *ct)
 {
-	const bsim_scene *sc = t->scene;
-	track_frame *f = &t->frames[k];
-	float *th = t->theta + (size_t)k * (size_t)t->n_beams;
-	unsigned char *ct = t->contact + (size_t)k * (size_t)t->n_beams;
 	f->step = step;
 	f->x[0] = s->x[0];
 	f->x[1] = s->x[1];
 	f->e_kin = 0.5 * sc->body.mass * (s->v[0] * s->v[0] + s->v[1] * s->v[1]);
 	f->e_spring = 0.0;
-	for (int i = 0; i < t->n_beams; i++) {
+	for (int i = 0; i < sc->n_beams; i++) {
 		const bsim_beam_def *b = &sc->beams[i];
 		f->e_kin += 0.5 * b->inertia * s->omega[i] * s->omega[i];
 		f->e_spring += 0.5 * b->stiffness * s->theta[i] * s->theta[i];
@@ -114,8 +136,16 @@ static void frame_take(bsim_video_track *t, long k, long step, const bsim_state 
 	}
 	f->e_prop = bsim_landscape_e_prop(sc, s->x[1]);
 	double force[2];
-	bsim_effects_force(&t->fx, step, sc->dt, force);
-	f->f_rand = t->fx.random ? t->fx.random->last : 0.0;
+	bsim_effects_force(fx, step, sc->dt, force);
+	f->f_rand = fx->random ? fx->random->last : 0.0;
+}
+
+/* Writes the state of step `step` into frame slot k. */
+static void frame_take(bsim_video_track *t, long k, long step, const bsim_state *s)
+{
+	video_frame_take(t->scene, &t->fx, step, s, &t->frames[k],
+	                 t->theta + (size_t)k * (size_t)t->n_beams,
+	                 t->contact + (size_t)k * (size_t)t->n_beams);
 }
 
 static void track_trace(void *user, long step, const bsim_state *s)
@@ -152,9 +182,9 @@ static void track_trace(void *user, long step, const bsim_state *s)
 	t->last_step = -1;
 }
 
-int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend,
-                            const bsim_options *opts, uint64_t seed, double fps,
-                            bsim_video_track **out, bsim_error *err)
+static int track_run(const bsim_scene *scene, const bsim_backend *backend, const bsim_options *opts,
+                     uint64_t seed, double fps, int summary, bsim_video_track **out,
+                     bsim_error *err)
 {
 	*out = NULL;
 	if (!(fps > 0.0) || !isfinite(fps))
@@ -171,14 +201,18 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 	t->fps = fps;
 	t->n_beams = scene->n_beams;
 	t->last_step = -1;
+	t->summary = summary;
 	if (bsim_effects_init(&t->fx, scene, seed)) {
 		free(t);
 		bsim_trial_runner_free(runner);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
 	}
 	bsim_trial_log *log = bsim_trial_log_alloc();
-	bsim_recorder rec = {
-	        .csv = NULL, .stride = 1, .trace = track_trace, .trace_user = t, .log = log};
+	bsim_recorder rec = {.csv = NULL,
+	                     .stride = 1,
+	                     .trace = summary ? NULL : track_trace,
+	                     .trace_user = t,
+	                     .log = log};
 	int rc = log ? bsim_trial_run(runner, scene, backend, opts, seed, &rec, &t->result, err)
 	             : bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
 	bsim_trial_runner_free(runner);
@@ -200,6 +234,11 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 		bsim_video_track_free(t);
 		return rc;
 	}
+	if (summary) {
+		t->n_frames = video_frame_count(fps, scene->dt, t->result.steps_run);
+		*out = t;
+		return BSIM_OK;
+	}
 	/* Frames 0 .. ceil(N h fps): all those at or before the end, and one
 	 * for the end state; frames past it that floor() also maps to step N
 	 * (when fps h > 1 or the end falls just before a frame time) go. */
@@ -211,6 +250,25 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 		t->n_frames++; /* the end state, kept in the next slot */
 	*out = t;
 	return BSIM_OK;
+}
+
+int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend,
+                            const bsim_options *opts, uint64_t seed, double fps,
+                            bsim_video_track **out, bsim_error *err)
+{
+	return track_run(scene, backend, opts, seed, fps, 0, out, err);
+}
+
+int video_track_summary(const bsim_scene *scene, const bsim_backend *backend,
+                        const bsim_options *opts, uint64_t seed, double fps, bsim_video_track **out,
+                        bsim_error *err)
+{
+	return track_run(scene, backend, opts, seed, fps, 1, out, err);
+}
+
+bsim_effects *video_track_effects(bsim_video_track *t)
+{
+	return &t->fx;
 }
 
 void bsim_video_track_free(bsim_video_track *t)
