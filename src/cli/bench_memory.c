@@ -52,13 +52,20 @@ typedef struct mem_run {
 	double wall;
 } mem_run;
 
+/* The directory of the runs' files; their standard error goes to a file
+ * in it, shown only if a run fails. */
+static const char *tmp_dir;
+
 /* argv run as a child with its output discarded; its peak resident set,
  * bytes, in *rss. */
 static int child_peak(const char *const argv[], double *rss, double *wall)
 {
+	char log[BSIM_PATH_MAX];
+	snprintf(log, sizeof log, "%s/stderr.txt", tmp_dir);
 	posix_spawn_file_actions_t fa;
 	posix_spawn_file_actions_init(&fa);
 	posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+	posix_spawn_file_actions_addopen(&fa, 2, log, O_WRONLY | O_CREAT | O_TRUNC, 0600);
 	pid_t pid;
 	struct timeval t0, t1;
 	gettimeofday(&t0, NULL);
@@ -79,6 +86,12 @@ static int child_peak(const char *const argv[], double *rss, double *wall)
 	if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
 		cli_error("bench: beamsim %s %s failed (status %d)", argv[1], argv[2],
 		          WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+		FILE *f = fopen(log, "r");
+		char line[512];
+		while (f && fgets(line, sizeof line, f))
+			fputs(line, stderr);
+		if (f)
+			fclose(f);
 		return CLI_FAIL;
 	}
 	*rss = 1024.0 * (double)ru.ru_maxrss; /* Linux: kilobytes */
@@ -211,6 +224,7 @@ int bench_memory(const bench_memory_args *a)
 		cli_error("bench: cannot make a temporary directory: %s", strerror(errno));
 		return CLI_FAIL;
 	}
+	tmp_dir = tmp;
 	long trials = a->trials > 0 ? a->trials : 2000000;
 	long steps = a->steps > 0 ? a->steps : 1000000;
 	FILE *r = a->report;
