@@ -576,10 +576,21 @@ static void test_streamed_csv(void **state)
 	tcsv_free(&t);
 }
 
+/* What bsim_note passed to the handler the test set. */
+static char noted[BSIM_ERROR_MSG_MAX];
+static int notes;
+
+static void note_keep(void *user, const char *text)
+{
+	(void)user;
+	snprintf(noted, sizeof noted, "%s", text);
+	notes++;
+}
+
 /* A table over the limit mat_rows: no twin (an earlier one removed), one
- * line saying so, BSIM_OK; at the limit the twin is written; a malformed
- * table over the limit is still an error. A sweep over the limit finishes
- * (exit 0) without trials.mat, and regress reads it back. */
+ * note saying so (to the handler a program sets), BSIM_OK; at the limit the twin is written; a
+ * malformed table over the limit is still an error. A sweep over the limit finishes (exit 0)
+ * without trials.mat, and regress reads it back. */
 static void test_mat_rows_limit(void **state)
 {
 	(void)state;
@@ -593,10 +604,14 @@ static void test_mat_rows_limit(void **state)
 	l.mat_rows = 10;
 	bsim_limits_set(&l);
 	bsim_error err;
+	bsim_note_set_handler(note_keep, NULL);
 	assert_int_equal(bsim_matlab_from_csv(csv, mat, "t", &err), BSIM_OK);
+	bsim_note_set_handler(NULL, NULL);
 	assert_string_equal(err.msg, "t11.csv: 11 rows, over the limit mat_rows = 10: no t11.mat; "
 	                             "MATLAB's readtable reads the CSV (raise with --limit "
 	                             "mat_rows=11)");
+	assert_int_equal(notes, 1);
+	assert_string_equal(noted, err.msg);
 	assert_false(bsim_test_exists(mat));
 	snprintf(csv, sizeof csv, "%s/t10.csv", dir);
 	snprintf(mat, sizeof mat, "%s/t10.mat", dir);

@@ -35,6 +35,16 @@ BSIM_API int bsim_error_set(bsim_error *err, int code, const char *fmt, ...)
 /* Clears err to BSIM_OK with an empty message. */
 BSIM_API void bsim_error_clear(bsim_error *err);
 
+/* A note: what a call that succeeded did not do as asked and the caller
+ * should hear of (a table too large for its .mat twin), one line. Notes
+ * go to the handler set here, GSL-style, process-wide; the default (fn
+ * NULL) writes "beamsim: TEXT" and a line feed to standard error. A
+ * program that reports otherwise (a GUI, Python) sets its own; set it once,
+ * before running, not while other threads run. */
+typedef void (*bsim_note_fn)(void *user, const char *text);
+BSIM_API void bsim_note_set_handler(bsim_note_fn fn, void *user);
+BSIM_API void bsim_note(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
 #ifdef __cplusplus
 }
 #endif

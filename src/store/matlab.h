@@ -43,9 +43,10 @@ int bsim_matlab_path(const char *path, char *out, size_t size, bsim_error *err);
  * A table of more rows than the limit mat_rows (beamsim/limits.h) gets no
  * twin: it is still checked (a malformed one is BSIM_EINPUT as above), any
  * earlier file at mat_path is removed (a twin never belongs to another
- * table), one line says so on standard error ("beamsim: trials.csv: 2000000
- * rows, over the limit mat_rows = N: no trials.mat; ..."), and the result
- * is BSIM_OK with that line, without "beamsim: ", in err->msg (err->code
+ * table), a note says so (bsim_note, beamsim/error.h: by default on
+ * standard error, "beamsim: trials.csv: 2000000 rows, over the limit
+ * mat_rows = N: no trials.mat; ..."), and the result is BSIM_OK with the
+ * note in err->msg (err->code
  * BSIM_OK): a caller goes on, and the run succeeds without the twin. On
  * any other BSIM_OK err->msg is empty. */
 int bsim_matlab_from_csv(const char *csv_path, const char *mat_path, const char *var,

@@ -373,8 +373,8 @@ static const char *base_name(const char *path)
 	return slash ? slash + 1 : path;
 }
 
-/* A table over the limit: no twin (and none left of an earlier table),
- * one line on standard error, and the line in err with BSIM_OK. */
+/* A table over the limit: no twin (and none left of an earlier table), a
+ * note (bsim_note), and the note in err with BSIM_OK. */
 static int twin_skip(const char *csv_path, const char *mat_path, const twin_table *t,
                      bsim_error *err)
 {
@@ -386,7 +386,7 @@ static int twin_skip(const char *csv_path, const char *mat_path, const twin_tabl
 	         base_name(csv_path), t->n_rows, bsim_limits_get()->mat_rows, base_name(mat_path),
 	         t->n_rows);
 	bsim_error_set(err, BSIM_OK, "%s", note);
-	fprintf(stderr, "beamsim: %s\n", err ? err->msg : note);
+	bsim_note("%s", note);
 	return BSIM_OK;
 }
 
