@@ -80,8 +80,8 @@ const char *fuzz_write(const char *name, const uint8_t *data, size_t size)
 	return path;
 }
 
-/* Whole file into a malloc'd buffer (NULL on error, a finding: the
- * fixture is the target's own). */
+/* Whole file into a malloc'd buffer; aborts on error (the fixture is the
+ * target's own). */
 static uint8_t *slurp(const char *path, size_t *size)
 {
 	FILE *f = fopen(path, "rb");
@@ -106,8 +106,8 @@ static int by_name(const void *a, const void *b)
 	return strcmp(((const fuzz_file *)a)->rel, ((const fuzz_file *)b)->rel);
 }
 
-/* Copies src/rel (a directory) into dst/rel, listing its regular files in
- * fx with their bytes. */
+/* Copies src/rel (a directory) into fx->root/rel, listing its regular
+ * files in fx with their bytes. */
 static void copy_tree(fuzz_fixture *fx, const char *src, const char *rel)
 {
 	char from[600];

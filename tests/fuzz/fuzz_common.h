@@ -1,6 +1,7 @@
 /* What the fuzz targets share: a scratch directory for the input file
- * (the loaders under test read files, as the program does), and the checks
- * every outcome must pass. */
+ * (the loaders under test read files, as the program does), small stored
+ * output directories to start from, and the checks every outcome must
+ * pass. */
 #ifndef BSIM_FUZZ_FUZZ_COMMON_H
 #define BSIM_FUZZ_FUZZ_COMMON_H
 
