@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # A bounded fuzzing run: builds the libFuzzer targets of tests/fuzz with
 # clang (ASan + UBSan) in build-fuzz/ and runs each for SECONDS seconds
-# (default 15, so about two minutes for the eight targets) from the seed
+# (default 12: about two minutes for the eight targets) from the seed
 # corpus and every input that once failed (tests/fuzz/regressions), with
 # the target's dictionary. Targets may be named after SECONDS to run only
 # those. The corpus grows in build-fuzz/corpus/, never in the tree. An
@@ -10,7 +10,7 @@
 # tests/fuzz/regressions/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds=${1:-15}
+seconds=${1:-12}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
