@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every test: install what is missing, build plain and sanitized, and run the
 # whole suite in both builds (the sanitized one under ASan + UBSan), then
-# fuzz each input parser for 20 s (scripts/fuzz.sh). Each stage runs even
+# fuzz each input surface for 12 s (scripts/fuzz.sh). Each stage runs even
 # if one before it failed (a test stage only if its build succeeded); a
 # table of the stages and their results follows, then ctest's own summary
 # lines of both suites. Exit status 1 if any stage failed.
@@ -59,7 +59,7 @@ if [ "$asan_built" = passed ]; then
 else
   skip "tests (ASan + UBSan)" "its build failed"
 fi
-stage "fuzzing (libFuzzer, ASan + UBSan, about a minute)" scripts/fuzz.sh 20
+stage "fuzzing (libFuzzer, ASan + UBSan, about two minutes)" scripts/fuzz.sh 12
 
 status=0
 echo

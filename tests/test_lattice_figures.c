@@ -518,14 +518,17 @@ static void test_bad_input(void **state)
 {
 	(void)state;
 	static const struct {
-		const char *file, *line, *want;
+		const char *file, *line, *loc, *want;
 	} cases[] = {
-	        {"trials.csv", NULL, "location: expected end:IX, side:IY"},
-	        {"lattice_map.csv", "0,2,3,75,125,180,240,210,400,400\n", "group 0 twice"},
+	        {"trials.csv", NULL, "stuck:7:0", "location: expected end:IX, side:IY"},
+	        {"lattice_map.csv", "0,2,3,75,125,180,240,210,400,400\n", NULL, "group 0 twice"},
+	        /* 2^32: sscanf's %d once read it as gate ix 0 */
+	        {"trials.csv", NULL, "stuck:4294967296:0", "location: expected end:IX, side:IY"},
 	};
-	for (int i = 0; i < 2; i++) {
+	static const char *const dirs[] = {"bad_trials", "bad_map", "bad_trials_2p32"};
+	for (int i = 0; i < 3; i++) {
 		char dir[1024];
-		snprintf(dir, sizeof dir, "%s", bsim_test_dir(i ? "bad_map" : "bad_trials"));
+		snprintf(dir, sizeof dir, "%s", bsim_test_dir(dirs[i]));
 		const char *sweep[] = {
 		        "sweep",    bsim_test_src("configs/lattice/c_track_essay.yaml"),
 		        "--trials", "2",
@@ -550,8 +553,8 @@ static void test_bad_input(void **state)
 			assert_non_null(loc);
 			char *rest = strchr(loc + 1, ',');
 			char edited[8192];
-			snprintf(edited, sizeof edited, "%.*s,stuck:7:0%s\n", (int)(loc - text),
-			         text, rest);
+			snprintf(edited, sizeof edited, "%.*s,%s%s\n", (int)(loc - text), text,
+			         cases[i].loc, rest);
 			FILE *f = fopen(path, "w");
 			fputs(edited, f);
 			fclose(f);

@@ -350,6 +350,11 @@ static void test_bad_inputs(void **state)
 	        {{"markov", "build", h1, "--out", target, NULL}, "not a gate lattice"},
 	        {{"markov", "build", essay, "--bins", "4,0,3", "--out", target, NULL},
 	         "--bins 4,0,3: expected P,S,D"},
+	        /* 2^32 + 2: sscanf's %d once read it as 2 (found by reading the fuzzed parser) */
+	        {{"markov", "build", essay, "--bins", "4294967298,2,2", "--out", target, NULL},
+	         "--bins 4294967298,2,2: expected P,S,D"},
+	        {{"markov", "build", essay, "--bins", "4, 4,3", "--out", target, NULL},
+	         "--bins 4, 4,3: expected P,S,D"},
 	        {{"markov", "build", essay, "--set", "termination.side_x=300", "--out", target,
 	          NULL},
 	         "termination.side_x: the chain needs the side boundary"},

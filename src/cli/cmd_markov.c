@@ -33,15 +33,29 @@ static int markov_option(void *args, int i, const char *value)
 	char *end;
 	switch (i) {
 	case OWN_BINS: {
-		bsim_markov_bins *b = &a->def.bins;
-		if (sscanf(value, "%d,%d,%d", &b->n_pos, &b->n_speed, &b->n_dir) != 3 ||
-		    b->n_pos < 1 || b->n_speed < 1 || b->n_dir < 1 || b->n_pos > 64 ||
-		    b->n_speed > 64 || b->n_dir > 64 ||
-		    strspn(value, "0123456789,") != strlen(value))
+		/* Three integers, each read in full: sscanf's %d would take
+		 * 4294967298 for 2. */
+		long n[3];
+		const char *p = value;
+		int ok = 1;
+		for (int k = 0; k < 3 && ok; k++) {
+			char field[8];
+			size_t len = strspn(p, "0123456789");
+			ok = len > 0 && len < sizeof field && p[len] == (k < 2 ? ',' : '\0');
+			if (ok) {
+				snprintf(field, sizeof field, "%.*s", (int)len, p);
+				ok = cli_parse_long(field, 1, 64, &n[k]) == 0;
+				p += len + 1;
+			}
+		}
+		if (!ok)
 			return cli_usage("markov",
 			                 "--bins %s: expected P,S,D: 1 to 64 bins of "
 			                 "position, speed and direction, e.g. --bins 4,4,3",
 			                 value);
+		a->def.bins.n_pos = (int)n[0];
+		a->def.bins.n_speed = (int)n[1];
+		a->def.bins.n_dir = (int)n[2];
 		return CLI_OK;
 	}
 	case OWN_VMAX:

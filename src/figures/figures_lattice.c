@@ -29,6 +29,8 @@
  * so its fractions are points (their interval is the point), as summary.json
  * has them. */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -186,6 +188,22 @@ static int map_read(const char *dir, flats *l, bsim_error *err)
 	return rc;
 }
 
+/* An integer of a location ("end:-3"), digits with an optional minus sign
+ * up to sep, read in full: sscanf's %d has no defined result beyond int's
+ * range (it read 4294967296 as 0). *next: past sep. */
+static int loc_int(const char *s, char sep, const char **next, int *out)
+{
+	char *end;
+	errno = 0;
+	long v = strtol(s, &end, 10);
+	if (end == s || (*s != '-' && (*s < '0' || *s > '9')) || *end != sep || errno == ERANGE ||
+	    v < INT_MIN || v > INT_MAX)
+		return -1;
+	*out = (int)v;
+	*next = end + (sep != '\0');
+	return 0;
+}
+
 /* trials.csv: each trial's final location counted. */
 static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *err)
 {
@@ -222,20 +240,22 @@ static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *
 		}
 		flat *a = &l->g[(int)g];
 		const char *loc = csv_table_cell(&t, r, col[4]);
-		int ix = 0, iy = 0, used = 0, ok = 0;
-		if (sscanf(loc, "end:%d%n", &ix, &used) == 1 && !loc[used]) {
+		int ix = 0, iy = 0, ok = 0;
+		const char *p;
+		if (!strncmp(loc, "end:", 4) && !loc_int(loc + 4, '\0', &p, &ix)) {
 			ok = ix >= a->ix_min && ix <= a->ix_max;
 			if (ok) {
 				a->end[ix - a->ix_min]++;
 				a->where[(int)tr] = FLAT_END;
 			}
-		} else if (sscanf(loc, "side:%d%n", &iy, &used) == 1 && !loc[used]) {
+		} else if (!strncmp(loc, "side:", 5) && !loc_int(loc + 5, '\0', &p, &iy)) {
 			ok = iy >= 0 && iy < a->rows && !csv_table_number(&t, r, col[3], &x_end);
 			if (ok) {
 				a->side[(x_end < a->centre_x ? 0 : a->rows) + iy]++;
 				a->where[(int)tr] = FLAT_SIDE;
 			}
-		} else if (sscanf(loc, "stuck:%d:%d%n", &ix, &iy, &used) == 2 && !loc[used]) {
+		} else if (!strncmp(loc, "stuck:", 6) && !loc_int(loc + 6, ':', &p, &ix) &&
+		           !loc_int(p, '\0', &p, &iy)) {
 			ok = ix >= a->ix_min && ix <= a->ix_max && iy >= 0 && iy < a->rows;
 			if (ok) {
 				a->stuck[iy * a->cols + ix - a->ix_min]++;

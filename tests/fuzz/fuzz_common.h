@@ -1,6 +1,7 @@
 /* What the fuzz targets share: a scratch directory for the input file
- * (the loaders under test read files, as the program does), and the checks
- * every outcome must pass. */
+ * (the loaders under test read files, as the program does), small stored
+ * output directories to start from, and the checks every outcome must
+ * pass. */
 #ifndef BSIM_FUZZ_FUZZ_COMMON_H
 #define BSIM_FUZZ_FUZZ_COMMON_H
 
@@ -16,6 +17,35 @@ const char *fuzz_dir(void);
 
 /* Writes data to fuzz_dir()/name and returns the path (static buffer). */
 const char *fuzz_write(const char *name, const uint8_t *data, size_t size);
+
+/* A small valid output directory of beamsim (tests/fuzz/stored/NAME, the
+ * files beamsim wrote, without their .mat twins), copied into the scratch
+ * directory once; each input then replaces one of its files. */
+#define FUZZ_FIXTURE_FILES 32
+
+typedef struct fuzz_file {
+	char rel[300];  /* the path in the directory, "inputs/scene.yaml" */
+	char path[700]; /* the copy's path */
+	uint8_t *data;  /* the original bytes */
+	size_t size;
+} fuzz_file;
+
+typedef struct fuzz_fixture {
+	char root[300]; /* the copy */
+	int n;
+	fuzz_file file[FUZZ_FIXTURE_FILES]; /* sorted by rel */
+	int manifest;                       /* the index of manifest.json, -1: none */
+	int dirty[FUZZ_FIXTURE_FILES];      /* differs from the original */
+} fuzz_fixture;
+
+/* Copies tests/fuzz/stored/name into fuzz_dir()/name (aborts on error). */
+void fuzz_fixture_open(fuzz_fixture *fx, const char *name);
+
+/* Puts back the files the last input changed, then replaces file i (i <
+ * 0: none) with data and makes manifest.json's entry for it (its size
+ * and CRC-32) match, so that the readers get past their manifest check
+ * to the file. */
+void fuzz_fixture_replace(fuzz_fixture *fx, int i, const uint8_t *data, size_t size);
 
 /* A loader's failure must be one readable line with a code: aborts (a
  * finding) if rc is not BSIM_EINPUT or BSIM_EFAIL or the message is empty

@@ -74,7 +74,8 @@ static int replay_dir(const char *dir, int *count)
 			sprintf(names[n++], "%s/%s", dir, ent->d_name);
 	}
 	closedir(d);
-	qsort(names, n, sizeof *names, by_name);
+	if (n > 1) /* qsort of no array is undefined, even of 0 items */
+		qsort(names, n, sizeof *names, by_name);
 	int bad = 0;
 	for (size_t i = 0; i < n; i++) {
 		bad |= replay_file(names[i]);
