@@ -160,7 +160,9 @@ static void test_lattice_beam_steps(void **state)
 	(void)state;
 	const char *lattice = bsim_test_src("configs/lattice/uniform_9x9.yaml");
 	const char *argv[] = {"run", lattice, "--limit", "beam_steps=1000000", NULL};
-	const char *needles[] = {"integration.max_steps: expected at most 1000000 beam-steps",
+	/* The limit names the key the scene gives the length by. */
+	const char *needles[] = {"uniform_9x9.yaml:17:37: integration.duration: expected at most "
+	                         "1000000 beam-steps",
 	                         "got 8.75e+06 = 54000 steps x 162 beams (a 9 x 9 lattice", NULL};
 	bsim_test_expect_input_error(argv, needles);
 	const char *big[] = {"run",       lattice,

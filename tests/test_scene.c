@@ -11,6 +11,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "beamsim/experiment.h"
@@ -307,6 +308,185 @@ static void override_errors_name_the_override(void **state)
 	             "p: effects.propulsion.forc: unknown key (expected one of force)");
 }
 
+/* A trial's length in seconds (docs/files.md "A trial's length"). The
+ * independent truth of the derived count: the steps cover the duration
+ * (n dt >= duration, to the 1e-9 relative the rule forgives) and one step
+ * fewer would not ((n - 1) dt < duration). */
+static void assert_covers(int n, double dt, double duration)
+{
+	if (!(n * dt >= duration * (1 - 1e-9) && (n - 1) * dt < duration))
+		fail_msg("%d steps of %g s for %g s", n, dt, duration);
+}
+
+static const char *write_length(const char *dir_name, const char *name, const char *tail)
+{
+	char text[1024];
+	snprintf(text, sizeof text, "%s%s", minimal_scene, tail);
+	return bsim_test_write(bsim_test_dir(dir_name), name, text);
+}
+
+static void duration_gives_the_steps(void **state)
+{
+	(void)state;
+	static const struct {
+		const char *dt, *duration;
+		int steps;
+	} cases[] = {
+	        {"0.004", "12", 3000},
+	        {"0.004", "16.1", 4025}, /* 16.1 / 0.004 = 4025.0000000000005 in doubles */
+	        {"0.004", "0.8", 200}, {"0.004", "216", 54000},
+	        {"0.1", "0.3", 3}, /* 0.3 / 0.1 = 2.9999999999999996 */
+	        {"0.003", "1", 334}, /* not a whole number of steps: rounded up */
+	        {"0.004", "1e-6", 1},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		char tail[128];
+		snprintf(tail, sizeof tail, "integration: { dt: %s, duration: %s }\n", cases[i].dt,
+		         cases[i].duration);
+		bsim_scene s;
+		load_ok(write_length("duration", "d.yaml", tail), NULL, 0, &s);
+		assert_covers(s.max_steps, s.dt, atof(cases[i].duration));
+		assert_int_equal(s.max_steps, cases[i].steps);
+		bsim_scene_free(&s);
+	}
+	/* The shipped gate says 12 s: the essay's 3000 steps of 0.004 s. */
+	bsim_scene g;
+	load_ok(bsim_test_src("configs/thesis/gate.yaml"), NULL, 0, &g);
+	assert_true(g.dt == 0.004 && g.max_steps == 3000);
+	bsim_scene_free(&g);
+}
+
+/* Changing dt keeps the duration: 12 s at 0.001 s is 12,000 steps, also
+ * when the file gives both keys (they agree at the file's own dt). A scene
+ * that gives steps keeps its steps. */
+static void dt_override_keeps_the_duration(void **state)
+{
+	(void)state;
+	bsim_override dt[] = {{"integration.dt", "0.001", "--set integration.dt=0.001"}};
+	bsim_scene s;
+	load_ok(bsim_test_src("configs/thesis/gate.yaml"), dt, 1, &s);
+	assert_true(s.dt == 0.001);
+	assert_int_equal(s.max_steps, 12000);
+	assert_covers(s.max_steps, s.dt, 12);
+	bsim_scene_free(&s);
+	const char *both =
+	        write_length("dt_keeps", "both.yaml",
+	                     "integration: { dt: 0.004, max_steps: 3000, duration: 12 }\n");
+	load_ok(both, NULL, 0, &s);
+	assert_int_equal(s.max_steps, 3000);
+	bsim_scene_free(&s);
+	load_ok(both, dt, 1, &s);
+	assert_int_equal(s.max_steps, 12000);
+	bsim_scene_free(&s);
+	const char *steps = write_length("dt_keeps", "steps.yaml",
+	                                 "integration: { dt: 0.004, max_steps: 3000 }\n");
+	load_ok(steps, dt, 1, &s);
+	assert_int_equal(s.max_steps, 3000);
+	bsim_scene_free(&s);
+}
+
+/* An override of either key replaces the trial's length the file gives;
+ * of two overrides, the later counts. */
+static void override_of_steps_or_duration_replaces_the_length(void **state)
+{
+	(void)state;
+	const char *gate = bsim_test_src("configs/thesis/gate.yaml");
+	bsim_override steps[] = {{"integration.max_steps", "500", "a"}};
+	bsim_scene s;
+	load_ok(gate, steps, 1, &s);
+	assert_int_equal(s.max_steps, 500);
+	bsim_scene_free(&s);
+	/* steps given stay steps when dt changes after them */
+	bsim_override steps_dt[] = {{"integration.max_steps", "500", "a"},
+	                            {"integration.dt", "0.001", "b"}};
+	load_ok(gate, steps_dt, 2, &s);
+	assert_int_equal(s.max_steps, 500);
+	bsim_scene_free(&s);
+	const char *file_steps = write_length("override_length", "steps.yaml",
+	                                      "integration: { dt: 0.004, max_steps: 3000 }\n");
+	bsim_override time[] = {{"integration.duration", "4", "a"}};
+	load_ok(file_steps, time, 1, &s);
+	assert_int_equal(s.max_steps, 1000);
+	bsim_scene_free(&s);
+	bsim_override both[] = {{"integration.duration", "4", "a"},
+	                        {"integration.max_steps", "700", "b"}};
+	load_ok(file_steps, both, 2, &s);
+	assert_int_equal(s.max_steps, 700);
+	bsim_scene_free(&s);
+	bsim_override both_rev[] = {{"integration.max_steps", "700", "a"},
+	                            {"integration.duration", "4", "b"}};
+	load_ok(file_steps, both_rev, 2, &s);
+	assert_int_equal(s.max_steps, 1000);
+	bsim_scene_free(&s);
+}
+
+/* Both keys of a pair given in one place must agree; the message names the
+ * file, line, field and both values. */
+static void inconsistent_steps_and_time_are_refused(void **state)
+{
+	(void)state;
+	const char *p = write_length("inconsistent", "bad.yaml",
+	                             "integration: { dt: 0.004, max_steps: 2500, duration: 12 }\n");
+	expect_error(p, NULL, 0,
+	             "bad.yaml:4:38: integration.max_steps: expected 3000 (integration.duration "
+	             "12 s at integration.dt 0.004 s; give one of the two), got 2500");
+	/* One override's mapping is one place too. */
+	const char *gate = bsim_test_src("configs/thesis/gate.yaml");
+	bsim_override block[] = {{"integration", "{max_steps: 10, duration: 1}", "o"}};
+	expect_error(gate, block, 1,
+	             "o: integration.max_steps: expected 250 (integration.duration 1 s at "
+	             "integration.dt 0.004 s; give one of the two), got 10");
+	p = write_length("inconsistent", "gate.yaml",
+	                 "termination: { gate_steps: 400, gate_time: 2 }\n");
+	expect_error(p, NULL, 0,
+	             "gate.yaml:4:28: termination.gate_steps: expected 500 (termination.gate_time "
+	             "2 s at integration.dt 0.004 s; give one of the two), got 400");
+	p = write_length("inconsistent", "neg.yaml", "integration: { duration: -1 }\n");
+	expect_error(p, NULL, 0,
+	             "neg.yaml:4:26: integration.duration: expected a positive number (s), got -1");
+	bsim_override huge[] = {{"integration.duration", "1e300", "h"}};
+	expect_error(gate, huge, 1,
+	             "h: integration.duration: expected at most 2147483647 steps of "
+	             "integration.dt 0.004 s, got 1e300 s");
+}
+
+/* A lattice's per-gate limit in seconds: its steps at the scene's dt, and
+ * the total default gate_steps (rows + columns) from them. */
+static void lattice_gate_time_gives_gate_steps(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("gate_time");
+	const char *p = bsim_test_write(dir, "lattice.yaml",
+	                                "body: { mass: 1, radius: 10 }\n"
+	                                "lattice:\n  columns: 3\n  rows: 2\n"
+	                                "  beam: { length: 25, mass: 0.1, stiffness: 400 }\n"
+	                                "termination: { gate_time: 2 }\n");
+	bsim_scene s;
+	load_ok(p, NULL, 0, &s);
+	assert_int_equal(s.gate_steps, 500);
+	assert_covers(s.gate_steps, s.dt, 2);
+	assert_int_equal(s.max_steps, 500 * (2 + 3));
+	bsim_scene_free(&s);
+	bsim_override dt[] = {{"integration.dt", "0.002", "d"}};
+	load_ok(p, dt, 1, &s);
+	assert_int_equal(s.gate_steps, 1000);
+	assert_int_equal(s.max_steps, 1000 * (2 + 3));
+	bsim_scene_free(&s);
+	/* The shipped lattices: 12 s a gate, 216 s in all, at 0.004 s. */
+	const char *files[] = {"configs/lattice/c_track.yaml", "configs/lattice/uniform_9x9.yaml",
+	                       "configs/lattice/mixed_9x9.yaml"};
+	for (int i = 0; i < 3; i++) {
+		load_ok(bsim_test_src(files[i]), NULL, 0, &s);
+		assert_int_equal(s.gate_steps, 3000);
+		assert_int_equal(s.max_steps, 54000);
+		bsim_scene_free(&s);
+		load_ok(bsim_test_src(files[i]), dt, 1, &s);
+		assert_int_equal(s.gate_steps, 6000);
+		assert_int_equal(s.max_steps, 108000);
+		bsim_scene_free(&s);
+	}
+}
+
 static void validate_checks_code_built_scenes(void **state)
 {
 	(void)state;
@@ -488,6 +668,11 @@ int main(void)
 	        cmocka_unit_test(zero_magnitude_means_no_random_force),
 	        cmocka_unit_test(errors_name_file_line_field),
 	        cmocka_unit_test(override_errors_name_the_override),
+	        cmocka_unit_test(duration_gives_the_steps),
+	        cmocka_unit_test(dt_override_keeps_the_duration),
+	        cmocka_unit_test(override_of_steps_or_duration_replaces_the_length),
+	        cmocka_unit_test(inconsistent_steps_and_time_are_refused),
+	        cmocka_unit_test(lattice_gate_time_gives_gate_steps),
 	        cmocka_unit_test(validate_checks_code_built_scenes),
 	        cmocka_unit_test(h1_has_30_groups_first_axis_slowest),
 	        cmocka_unit_test(h2_has_162_groups_and_set_block),

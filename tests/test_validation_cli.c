@@ -90,6 +90,29 @@ static void non_integer_max_steps(void **state)
 	run_bad_scene("steps", BODY BEAMS "integration: { max_steps: 2.5 }\n", needles);
 }
 
+/* A trial's length given twice in one file, as steps and in seconds, that
+ * disagree: exit 2 naming the file, line, field and both values; likewise
+ * the per-gate limit. */
+static void inconsistent_duration(void **state)
+{
+	(void)state;
+	const char *needles[] = {"duration.yaml:6:38: ", "integration.max_steps",
+	                         "expected 3000 (integration.duration 12 s at integration.dt "
+	                         "0.004 s; give one of the two), got 2999",
+	                         NULL};
+	run_bad_scene("duration",
+	              BODY BEAMS "integration: { dt: 0.004, max_steps: 2999, duration: 12 }\n",
+	              needles);
+	const char *gate[] = {"gate_time.yaml:7:28: ", "termination.gate_steps",
+	                      "expected 2500 (termination.gate_time 10 s at integration.dt "
+	                      "0.004 s; give one of the two), got 3000",
+	                      NULL};
+	run_bad_scene("gate_time",
+	              BODY BEAMS "integration: { duration: 12 }\n"
+	                         "termination: { gate_steps: 3000, gate_time: 10 }\n",
+	              gate);
+}
+
 static void nan_value(void **state)
 {
 	(void)state;
@@ -372,6 +395,7 @@ int main(void)
 	        cmocka_unit_test(empty_grid),          cmocka_unit_test(bad_grid_value),
 	        cmocka_unit_test(bad_experiment_keys), cmocka_unit_test(grid_conflict),
 	        cmocka_unit_test(wrong_kind_of_file),  cmocka_unit_test(grid_value_first),
+	        cmocka_unit_test(inconsistent_duration),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -79,7 +79,8 @@ typedef struct bsim_scene {
 	bsim_contact_def contact;
 	bsim_effects_def effects;
 	double dt;                /* s, > 0; default 0.004 */
-	int max_steps;            /* > 0; default 3000 */
+	int max_steps;            /* > 0; default 3000; a file may give integration.duration
+	                           * (s) instead, which the loader makes steps of dt */
 	double success_y;         /* m; default 65 */
 	double side_x;            /* m, > 0; default 25 */
 	double classify_y;        /* m, >= success_y; default 80 */
@@ -88,7 +89,8 @@ typedef struct bsim_scene {
 	double landscape_y0;      /* m, zero of the propulsive potential; default 60 */
 	/* Stuck: the body stayed gate_steps steps in one gate (a lattice;
 	 * default 3000, the essay's single-gate limit), or max_steps in all.
-	 * 0: the same as max_steps. */
+	 * 0: the same as max_steps. A file may give termination.gate_time (s)
+	 * instead. */
 	int gate_steps;
 	int has_lattice; /* 1: beams were built from lattice */
 	bsim_lattice_def lattice;

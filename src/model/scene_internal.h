@@ -93,6 +93,16 @@ extern const scene_table scene_lattice_table;
  * success_y, gate_steps = 3000, max_steps = gate_steps (rows + columns). */
 void scene_lattice_defaults(bsim_scene *s);
 
+/* The steps of dt that make up t seconds: round(t / dt) when t / dt is
+ * within 1e-9 relative of an integer, else ceil(t / dt) (scene_horizon.c). */
+double scene_steps_for(double t, double dt);
+
+/* After the walk of a scene document (w->d, overrides applied; file the
+ * document before them): integration.duration and termination.gate_time
+ * into max_steps and gate_steps at the scene's dt, or refused where the
+ * file (or one override) gives a time and steps that disagree. */
+int scene_horizon(scene_walk *w, const ydoc *file);
+
 /* A limit of beamsim/limits.h that a scene exceeds: the field to blame,
  * what it asks for and the limit's name and value. */
 typedef struct scene_excess {

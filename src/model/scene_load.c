@@ -289,12 +289,12 @@ static int check_limits(walk *w)
 	if (!scene_excess_find(w->s, &x))
 		return BSIM_OK;
 	static const char *const schedule[] = {"effects.random_force.frequency", "integration.dt",
-	                                       "integration.max_steps"};
-	static const char *const steps[] = {"integration.max_steps", "beams", "lattice.columns",
-	                                    "lattice.rows"};
+	                                       "integration.max_steps", "integration.duration"};
+	static const char *const steps[] = {"integration.max_steps", "integration.duration",
+	                                    "beams", "lattice.columns", "lattice.rows"};
 	int is_schedule = !strcmp(x.limit, "schedule");
 	const char *const *paths = is_schedule ? schedule : steps;
-	int n = is_schedule ? 3 : 4;
+	int n = is_schedule ? 4 : 5;
 	struct fy_node *root = fy_document_root(w->d->fyd);
 	struct fy_node *node = latest_override(w->d, paths, n);
 	const char *field = paths[0];
@@ -357,14 +357,16 @@ static int check_beams_or_lattice(walk *w, struct fy_node *root)
 }
 
 /* The lattice's termination defaults where the file and overrides leave a
- * key out (scene_lattice_defaults). */
+ * key out (scene_lattice_defaults); a length given in seconds counts as
+ * given (scene_horizon has made it steps). */
 static void lattice_defaults(walk *w, struct fy_node *root)
 {
 	bsim_scene *s = w->s, given = *s;
 	scene_lattice_defaults(s);
 	static const char *const keys[] = {"termination.success_y",  "termination.side_x",
 	                                   "termination.classify_y", "landscape.y0",
-	                                   "termination.gate_steps", "integration.max_steps"};
+	                                   "termination.gate_steps", "integration.max_steps",
+	                                   "termination.gate_time",  "integration.duration"};
 	if (ydoc_lookup(root, keys[0]))
 		s->success_y = given.success_y;
 	if (ydoc_lookup(root, keys[1]))
@@ -375,15 +377,15 @@ static void lattice_defaults(walk *w, struct fy_node *root)
 		s->classify_y = s->success_y;
 	if (ydoc_lookup(root, keys[3]))
 		s->landscape_y0 = given.landscape_y0;
-	if (ydoc_lookup(root, keys[4]))
+	if (ydoc_lookup(root, keys[4]) || ydoc_lookup(root, keys[6]))
 		s->gate_steps = given.gate_steps;
-	if (ydoc_lookup(root, keys[5]))
+	if (ydoc_lookup(root, keys[5]) || ydoc_lookup(root, keys[7]))
 		s->max_steps = given.max_steps;
 	else
 		s->max_steps = s->gate_steps * (s->lattice.rows + s->lattice.columns);
 }
 
-static int walk_scene(walk *w)
+static int walk_scene(walk *w, const ydoc *file)
 {
 	struct fy_node *root = fy_document_root(w->d->fyd);
 	if (!root || !fy_node_is_mapping(root))
@@ -392,6 +394,8 @@ static int walk_scene(walk *w)
 	int rc = walk_table(w, &scene_top_table, root, NULL, (char *)w->s, "");
 	if (!rc)
 		rc = check_beams_or_lattice(w, root);
+	if (!rc)
+		rc = scene_horizon(w, file);
 	if (!rc && w->s->has_lattice)
 		lattice_defaults(w, root);
 	if (!rc)
@@ -419,7 +423,7 @@ int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_sce
 	walk w = {&d, out, err};
 	int rc = yov_apply(&d, ov, n, err);
 	if (!rc)
-		rc = walk_scene(&w);
+		rc = walk_scene(&w, file);
 	ydoc_free(&d);
 	if (!rc) {
 		snprintf(out->path, sizeof out->path, "%s", file->path);

@@ -62,6 +62,7 @@ static const scene_table effects_table = TABLE(effects_fields);
 static const scene_field integration_fields[] = {
         {"dt", SK_NUMBER, SR_POSITIVE, 0, S(dt), NULL}, /* s */
         {"max_steps", SK_INT, SR_POSITIVE, 0, S(max_steps), NULL},
+        {"duration", SK_LATER, SR_POSITIVE, 0, 0, NULL}, /* s: max_steps (scene_horizon.c) */
 };
 static const scene_table integration_table = TABLE(integration_fields);
 
@@ -71,6 +72,7 @@ static const scene_field termination_fields[] = {
         {"classify_y", SK_NUMBER, SR_ANY, 0, S(classify_y), NULL}, /* m, >= success_y */
         {"classify_deadband", SK_NUMBER, SR_NONNEG, 0, S(classify_deadband), NULL}, /* m/s */
         {"gate_steps", SK_INT, SR_NONNEG, 0, S(gate_steps), NULL}, /* 0: max_steps */
+        {"gate_time", SK_LATER, SR_NONNEG, 0, 0, NULL}, /* s: gate_steps (scene_horizon.c) */
 };
 static const scene_table termination_table = TABLE(termination_fields);
 
