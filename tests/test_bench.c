@@ -54,6 +54,27 @@ static void box2d_reads_its_clock(void **state)
 	double without = bsim_test_json_number(vs, "speedup_per_trial_without_clock");
 	assert_true(fabs(without - with * (1.0 - share)) <= 1e-9 * with);
 
+	/* five interleaved pairs (the default): ratio_paired is their median */
+	assert_int_equal((int)bsim_test_json_number(vs, "pairs"), 5);
+	const char *r = strstr(vs, "\"pair_ratios\": [");
+	assert_non_null(r);
+	r += strlen("\"pair_ratios\": [");
+	double ratio[5];
+	for (int i = 0; i < 5; i++) {
+		char *end;
+		ratio[i] = strtod(r, &end);
+		assert_true(end != r && ratio[i] > 0.0);
+		r = end + strspn(end, ", ");
+	}
+	assert_int_equal(*r, ']');
+	double paired = bsim_test_json_number(vs, "ratio_paired");
+	int under = 0, over = 0;
+	for (int i = 0; i < 5; i++) {
+		under += ratio[i] < paired;
+		over += ratio[i] > paired;
+	}
+	assert_true(under <= 2 && over <= 2);
+
 	/* free flight: every trial to its last step, 3000 of them */
 	const char *ff = strstr(j, "\"free_flight\": {");
 	assert_non_null(ff);

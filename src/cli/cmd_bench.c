@@ -39,7 +39,8 @@ enum {
 	OWN_JSON,
 	OWN_LATTICE,
 	OWN_REPEAT,
-	OWN_MEMORY
+	OWN_MEMORY,
+	OWN_PAIRS
 };
 
 static const cli_own bench_own[] = {
@@ -63,6 +64,10 @@ static const cli_own bench_own[] = {
                         "and with the .mat twin of trials.csv), and of run\n"
                         "--trajectory over 1,000,000 and 100,000 steps, each a\n"
                         "child process; the growth per trial, per row and per step"},
+        [OWN_PAIRS] = {"pairs", 1, "N",
+                       "after the --vs run, N pairs of one-thread runs of the\n"
+                       "experiment, the two backends interleaved (default 5;\n"
+                       "0: none): the median of the pairs' ratios per step"},
 };
 
 static const char *const bench_help[CLI_N_OPTS] = {
@@ -82,6 +87,7 @@ typedef struct bench_args {
 	int lattice;
 	int memory;
 	int repeat; /* one-thread runs of the experiment */
+	int pairs;  /* interleaved runs of the two backends */
 } bench_args;
 
 typedef struct bench_run {
@@ -92,6 +98,7 @@ typedef struct bench_run {
 } bench_run;
 
 #define BENCH_REPEAT_MAX 100
+#define BENCH_PAIRS_MAX  100
 #define BENCH_RUNS_MAX   (BENCH_REPEAT_MAX + 3)
 
 /* What the second backend's run spent reading the clock for its own
@@ -128,6 +135,17 @@ static int bench_option(void *args, int i, const char *value)
 	case OWN_MEMORY:
 		a->memory = 1;
 		return CLI_OK;
+	case OWN_PAIRS: {
+		char *end;
+		long n = strtol(value, &end, 10);
+		if (*end || end == value || n < 0 || n > BENCH_PAIRS_MAX) {
+			cli_error("bench: --pairs: expected a whole number from 0 to %d, got '%s'",
+			          BENCH_PAIRS_MAX, value);
+			return CLI_USAGE;
+		}
+		a->pairs = (int)n;
+		return CLI_OK;
+	}
 	case OWN_REPEAT: {
 		char *end;
 		long n = strtol(value, &end, 10);
@@ -161,7 +179,7 @@ static const cli_spec bench_spec = {
                   CLI_USES(CLI_OPT_TRIALS),
         .help = bench_help,
         .own = bench_own,
-        .n_own = 8,
+        .n_own = 9,
         .option = bench_option,
 };
 
@@ -245,6 +263,10 @@ typedef struct bench_results {
 	int have_free;
 	bench_free_result free;
 	bench_timers timers;
+	/* The interleaved pairs: each pair's ratio per step (first backend's
+	 * steps/s over the second's), in the order run. */
+	int n_pairs;
+	double pair_ratio[BENCH_PAIRS_MAX];
 } bench_results;
 
 /* The time the second backend's run spent reading the clock, s. */
@@ -264,6 +286,23 @@ static void bench_json_free(FILE *f, const bench_free_result *r)
 	fputs(", \"ratio\": ", f);
 	bsim_json_number(f, ns / ns_min);
 	fputc('}', f);
+}
+
+static int cmp_double(const void *x, const void *y)
+{
+	double a = *(const double *)x, b = *(const double *)y;
+	return (a > b) - (a < b);
+}
+
+/* The median of the pairs' ratios (the mean of the middle two for an even
+ * count). */
+static double bench_pairs_median(const bench_results *b)
+{
+	double r[BENCH_PAIRS_MAX];
+	memcpy(r, b->pair_ratio, (size_t)b->n_pairs * sizeof *r);
+	qsort(r, (size_t)b->n_pairs, sizeof *r, cmp_double);
+	int n = b->n_pairs;
+	return n % 2 ? r[n / 2] : 0.5 * (r[n / 2 - 1] + r[n / 2]);
 }
 
 static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *backend,
@@ -312,6 +351,16 @@ static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *b
 		bsim_json_number(f, timer_s / theirs->wall);
 		fputs(", \"speedup_per_trial_without_clock\": ", f);
 		bsim_json_number(f, (theirs->wall - timer_s) / mine->wall);
+		fprintf(f, ", \"pairs\": %d, \"pair_ratios\": [", b->n_pairs);
+		for (int i = 0; i < b->n_pairs; i++) {
+			fputs(i ? ", " : "", f);
+			bsim_json_number(f, b->pair_ratio[i]);
+		}
+		fputs("], \"ratio_paired\": ", f);
+		if (b->n_pairs > 0)
+			bsim_json_number(f, bench_pairs_median(b));
+		else
+			fputs("null", f);
 		fputc('}', f);
 	} else {
 		fputs("null", f);
@@ -358,6 +407,39 @@ static int bench_vs(const bench_args *a, const bsim_backend *vs, const bsim_expe
 	        vs->name, (double)b->timers.reads / (double)theirs->steps,
 	        1e9 * b->timers.read_seconds, 100.0 * timer_s / theirs->wall, a->backend,
 	        (theirs->wall - timer_s) / mine->wall);
+	return CLI_OK;
+}
+
+/* The ratio per step measured fairly on a shared machine: the two backends
+ * run one after the other, a pair at a time, so that a change of load
+ * between runs moves both sides of a pair alike; the median of the pairs'
+ * ratios is the figure (ratio_paired), their spread says how noisy the
+ * machine was. */
+static int bench_pairs(const bench_args *a, const bsim_backend *backend, const bsim_backend *vs,
+                       const bsim_experiment *h1, bench_results *b)
+{
+	if (a->pairs <= 0)
+		return CLI_OK;
+	fprintf(report, "\n%d pairs, one thread, %s then %s:\n\n", a->pairs, a->backend, vs->name);
+	bench_print_header();
+	for (int i = 0; i < a->pairs; i++) {
+		bench_run mine, theirs;
+		int rc = bench_sweep(backend, &a->opts, h1, a->experiment, 1, &mine);
+		if (rc == CLI_OK)
+			rc = bench_sweep(vs, &a->vs_opts, h1, a->experiment, 1, &theirs);
+		if (rc != CLI_OK)
+			return rc;
+		b->pair_ratio[b->n_pairs++] = bench_speedup_per_step(&mine, &theirs);
+	}
+	double lo = b->pair_ratio[0], hi = lo;
+	for (int i = 1; i < b->n_pairs; i++) {
+		lo = b->pair_ratio[i] < lo ? b->pair_ratio[i] : lo;
+		hi = b->pair_ratio[i] > hi ? b->pair_ratio[i] : hi;
+	}
+	fprintf(report,
+	        "\npaired: %s is %.2f times faster than %s per step, the median of %d pairs' "
+	        "ratios (%.2f .. %.2f)\n",
+	        a->backend, bench_pairs_median(b), vs->name, b->n_pairs, lo, hi);
 	return CLI_OK;
 }
 
@@ -463,6 +545,8 @@ static int bench_main(const bench_args *a, const bsim_backend *backend, const bs
 		rc = bench_free_flight(a, backend, b);
 	if (rc == CLI_OK && vs)
 		rc = bench_vs(a, vs, &h1, b);
+	if (rc == CLI_OK && vs)
+		rc = bench_pairs(a, backend, vs, &h1, b);
 	bsim_experiment_free(&h1);
 	if (a->h2)
 		bsim_experiment_free(&h2);
@@ -475,7 +559,7 @@ static int bench_main(const bench_args *a, const bsim_backend *backend, const bs
 int cmd_bench(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	bench_args a = {.experiment = BENCH_H1, .h2 = 1, .vs = "box2d", .repeat = 1};
+	bench_args a = {.experiment = BENCH_H1, .h2 = 1, .vs = "box2d", .repeat = 1, .pairs = 5};
 	int rc = cli_parse(&bench_spec, argc, argv, &c, &a, NULL);
 	a.backend = c.backend ? c.backend : bsim_backend_default()->name;
 	a.trials = c.trials;
