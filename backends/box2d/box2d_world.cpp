@@ -19,7 +19,8 @@
  * 390 rad/s (the gate sees < 20 m/s and < 10 rad/s).
  *
  * Bodies.
- *   body:  dynamic bullet disk, fixed rotation, mass M at its centre.
+ *   body:  dynamic disk, a bullet (continuous collision) unless
+ *          continuous=off, fixed rotation, mass M at its centre.
  *   beam i: dynamic body whose origin is the pivot P, angle a_i = sgn theta_i
  *          (sgn = +1 if the rest direction u0 has x >= 0, else -1: theta > 0
  *          swings the tip forward, +y), one two-sided edge from (0, 0) to
@@ -137,6 +138,10 @@ const bsim_knob box2d_knobs[] = {
         {"sleep", BSIM_KNOB_CHOICE, "auto", "auto|on|off",
          "Box2D's own sleeping for the beams, never for the body; auto: on for lattice "
          "scenes"},
+        {"continuous", BSIM_KNOB_CHOICE, "on", "on|off",
+         "continuous collision for the body (a Box2D bullet, time of impact against the "
+         "beams); off: discrete steps, enough while the body moves less than its radius a "
+         "step"},
 };
 /* The accuracy study's settings (beamsim accuracy): spring slowest-varying,
  * then substeps, then velocity iterations; the first, the reference, is
@@ -155,7 +160,16 @@ const bsim_knob_setting box2d_accuracy[] = {
         {"vi=8 sub=1 weld", "velocity_iterations=8:substeps=1:spring=weld"},
         {"vi=4 sub=1 weld", "velocity_iterations=4:substeps=1:spring=weld"},
 };
-enum { KNOB_VEL_IT, KNOB_POS_IT, KNOB_SUBSTEPS, KNOB_SPRING, KNOB_UNIT_SCALE, KNOB_SLEEP };
+enum {
+	KNOB_VEL_IT,
+	KNOB_POS_IT,
+	KNOB_SUBSTEPS,
+	KNOB_SPRING,
+	KNOB_UNIT_SCALE,
+	KNOB_SLEEP,
+	KNOB_CONTINUOUS
+};
+enum { CONTINUOUS_ON = 0, CONTINUOUS_OFF = 1 };
 enum { SLEEP_AUTO = 0, SLEEP_ON = 1, SLEEP_OFF = 2 };
 constexpr int N_KNOBS = (int)(sizeof box2d_knobs / sizeof box2d_knobs[0]);
 
@@ -211,7 +225,8 @@ struct bsim_world {
 	int velocity_iterations = 8, position_iterations = 3, substeps = 1;
 	int spring = SPRING_WELD;
 	double s = 1.0;     /* Box2D units per metre */
-	bool sleep = false; /* Box2D's sleeping for the beams */
+	bool sleep = false;     /* Box2D's sleeping for the beams */
+	bool continuous = true; /* the body a bullet, continuous physics on */
 	/* Live beams: those that may have moved, ascending. In a lattice only
 	 * the beams the body has touched are visited each step; elsewhere every
 	 * beam is, as it always was. */
@@ -365,7 +380,7 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 	const bsim_scene &sc = w->scene;
 	w->world = new b2World(b2Vec2(0.0f, 0.0f)); /* horizontal plane: no gravity */
 	w->world->SetAllowSleeping(w->sleep);
-	w->world->SetContinuousPhysics(true);
+	w->world->SetContinuousPhysics(w->continuous);
 	w->world->SetWarmStarting(true);
 	w->listener = new contact_ledger(w);
 	w->world->SetContactListener(w->listener);
@@ -378,7 +393,7 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 	bd.position.Set((float)(x[0] * s), (float)(x[1] * s));
 	bd.linearVelocity.Set((float)(v[0] * s), (float)(v[1] * s));
 	bd.fixedRotation = true; /* forces act at the centre; frictionless */
-	bd.bullet = true;
+	bd.bullet = w->continuous;
 	bd.allowSleep = false; /* the body never sleeps; only beams do */
 	bd.userData.pointer = 0;
 	w->body = w->world->CreateBody(&bd);
@@ -712,6 +727,8 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	w->s = s;
 	int sleep = bsim_options_choice(opts, &box2d_knobs[KNOB_SLEEP]);
 	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
+	w->continuous =
+	        bsim_options_choice(opts, &box2d_knobs[KNOB_CONTINUOUS]) == CONTINUOUS_ON;
 	w->track_live = scene->has_lattice != 0;
 	int n = scene->n_beams;
 	w->beams.resize((size_t)n);
