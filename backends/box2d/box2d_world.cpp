@@ -224,7 +224,7 @@ struct bsim_world {
 	/* knobs */
 	int velocity_iterations = 8, position_iterations = 3, substeps = 1;
 	int spring = SPRING_WELD;
-	double s = 1.0;     /* Box2D units per metre */
+	double s = 1.0;         /* Box2D units per metre */
 	bool sleep = false;     /* Box2D's sleeping for the beams */
 	bool continuous = true; /* the body a bullet, continuous physics on */
 	/* Live beams: those that may have moved, ascending. In a lattice only
@@ -727,8 +727,7 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	w->s = s;
 	int sleep = bsim_options_choice(opts, &box2d_knobs[KNOB_SLEEP]);
 	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
-	w->continuous =
-	        bsim_options_choice(opts, &box2d_knobs[KNOB_CONTINUOUS]) == CONTINUOUS_ON;
+	w->continuous = bsim_options_choice(opts, &box2d_knobs[KNOB_CONTINUOUS]) == CONTINUOUS_ON;
 	w->track_live = scene->has_lattice != 0;
 	int n = scene->n_beams;
 	w->beams.resize((size_t)n);
