@@ -330,7 +330,10 @@ static void sweep_thread(sweep_shared *sh)
 	bsim_trial_log_free(log[1]);
 }
 
-static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, int keep, bsim_error *err)
+/* The result's arrays; the per-trial ones (trials_out, logs) only if
+ * per_trial (a streamed sweep keeps none). */
+static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, int keep, int per_trial,
+                        bsim_error *err)
 {
 	size_t n = (size_t)n_groups * (size_t)trials;
 	memset(r, 0, sizeof *r);
@@ -338,14 +341,16 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, int keep
 	r->trials = trials;
 	r->has_ledger = 1;
 	r->first_unstable = -1;
-	r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
-	r->logs = calloc(n ? n : 1, sizeof *r->logs);
+	if (per_trial) {
+		r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
+		r->logs = calloc(n ? n : 1, sizeof *r->logs);
+	}
 	r->groups = calloc(n_groups ? (size_t)n_groups : 1, sizeof *r->groups);
 	if (keep > 0) {
 		r->keep = keep;
 		r->kept = calloc((size_t)n_groups * (size_t)keep, sizeof *r->kept);
 	}
-	if (!r->trials_out || !r->groups || !r->logs || (keep > 0 && !r->kept)) {
+	if ((per_trial && (!r->trials_out || !r->logs)) || !r->groups || (keep > 0 && !r->kept)) {
 		bsim_sweep_result_free(r);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %zu trial results", n);
 	}
@@ -387,24 +392,25 @@ static int kept_fill(bsim_sweep_result *r, const int *deterministic, bsim_error 
 	return BSIM_OK;
 }
 
-static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_groups, int trials,
-                          double wall)
+/* The totals once every group's counts are in (group_finish done):
+ * first[g] is group g's trial 0. No draws, no sampling: a deterministic
+ * group's p_traverse is exactly what the one trial gave, so its interval
+ * is that point, not a Wilson interval over copies; and only that trial's
+ * steps were integrated. */
+static void result_totals(bsim_sweep_result *r, const int *deterministic, int trials,
+                          const bsim_trial_result *first, size_t first_stride, double wall)
 {
 	r->total_steps = 0;
 	r->trials_run = 0;
 	r->solver = (bsim_solver_counts){0, 0};
-	for (int g = 0; g < n_groups; g++) {
+	for (int g = 0; g < r->n_groups; g++) {
 		bsim_group_result *gr = &r->groups[g];
-		const bsim_trial_result *first = &r->trials_out[(size_t)g * trials];
-		bsim_sweep_group_aggregate(first, trials, gr);
-		/* No draws, no sampling: p_traverse is exactly what the one trial
-		 * gave, so its interval is that point, not a Wilson interval over
-		 * copies; and only that trial's steps were integrated. */
+		const bsim_trial_result *f = &first[(size_t)g * first_stride];
 		gr->deterministic = deterministic[g];
 		if (gr->deterministic && trials > 0) {
 			gr->ci95[0] = gr->ci95[1] = gr->p_traverse;
-			gr->steps = first->steps_run;
-			gr->solver = first->solver;
+			gr->steps = f->steps_run;
+			gr->solver = f->solver;
 		}
 		r->total_steps += gr->steps;
 		r->solver.iteration_limit += gr->solver.iteration_limit;
@@ -414,6 +420,32 @@ static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_
 	r->wall_seconds = wall;
 }
 
+static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_groups, int trials,
+                          double wall)
+{
+	for (int g = 0; g < n_groups; g++)
+		bsim_sweep_group_aggregate(&r->trials_out[(size_t)g * trials], trials,
+		                           &r->groups[g]);
+	result_totals(r, deterministic, trials, r->trials_out, (size_t)trials, wall);
+}
+
+/* What both kinds of sweep check first: e's groups and trials, and the
+ * trajectories kept per group (cfg->keep, at most the trials). */
+static int sweep_check(const bsim_experiment *e, const bsim_sweep_config *cfg, int *keep,
+                       bsim_error *err)
+{
+	if (e->trials < 0 || e->n_groups < 1)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: expected at least one group and trials >= 0", e->path);
+	bsim_error why;
+	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: %s", e->path, why.msg);
+	*keep = cfg->keep < e->trials ? cfg->keep : e->trials;
+	if (*keep < 0)
+		*keep = 0;
+	return BSIM_OK;
+}
+
 /* A plain sweep (backend_b NULL) or a paired one. */
 static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
                         const bsim_backend *backend_b, const bsim_options *opts_b,
@@ -421,22 +453,16 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
                         bsim_error *err)
 {
 	double t0 = bsim_clock_seconds();
-	if (e->trials < 0 || e->n_groups < 1)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s: expected at least one group and trials >= 0", e->path);
-	bsim_error why;
-	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK)
-		return bsim_error_set(err, BSIM_EINPUT, "%s: %s", e->path, why.msg);
+	int keep = 0, rc0 = sweep_check(e, cfg, &keep, err);
+	if (rc0 != BSIM_OK)
+		return rc0;
 	long total = (long)e->n_groups * e->trials;
-	int keep = cfg->keep < e->trials ? cfg->keep : e->trials;
-	if (keep < 0)
-		keep = 0;
-	if (result_alloc(out, e->n_groups, e->trials, keep, err) != BSIM_OK)
+	if (result_alloc(out, e->n_groups, e->trials, keep, 1, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (backend_b) {
 		*t_separate = calloc(total ? (size_t)total : 1, sizeof **t_separate);
 		if (!*t_separate ||
-		    result_alloc(out_b, e->n_groups, e->trials, keep, err) != BSIM_OK) {
+		    result_alloc(out_b, e->n_groups, e->trials, keep, 1, err) != BSIM_OK) {
 			free(*t_separate);
 			*t_separate = NULL;
 			bsim_sweep_result_free(out);
@@ -667,22 +693,12 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
                           bsim_sweep_result *out, bsim_error *err)
 {
 	double t0 = bsim_clock_seconds();
-	if (e->trials < 0 || e->n_groups < 1)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s: expected at least one group and trials >= 0", e->path);
-	bsim_error why;
-	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK)
-		return bsim_error_set(err, BSIM_EINPUT, "%s: %s", e->path, why.msg);
+	int keep = 0, rc0 = sweep_check(e, cfg, &keep, err);
+	if (rc0 != BSIM_OK)
+		return rc0;
 	long total = (long)e->n_groups * e->trials;
-	int keep = cfg->keep < e->trials ? cfg->keep : e->trials;
-	keep = keep < 0 ? 0 : keep;
-	if (result_alloc(out, e->n_groups, 0, keep, err) != BSIM_OK)
+	if (result_alloc(out, e->n_groups, e->trials, keep, 0, err) != BSIM_OK)
 		return BSIM_EFAIL;
-	out->trials = e->trials;
-	free(out->trials_out);
-	free(out->logs);
-	out->trials_out = NULL;
-	out->logs = NULL;
 
 	bsim_scene *scenes = NULL;
 	stream_state st = {0};
@@ -764,23 +780,13 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	if (rc == BSIM_OK)
 		rc = kept_fill(out, deterministic, err);
 	if (rc == BSIM_OK) {
-		out->wall_seconds = bsim_clock_seconds() - t0;
 		for (int g = 0; g < e->n_groups; g++) {
-			bsim_group_result *gr = &out->groups[g];
-			group_finish(gr);
-			gr->deterministic = deterministic[g];
-			if (gr->deterministic && e->trials > 0) {
-				gr->ci95[0] = gr->ci95[1] = gr->p_traverse;
-				gr->steps = st.det_first[g].steps_run;
-				gr->solver = st.det_first[g].solver;
-			}
-			out->total_steps += gr->steps;
-			out->solver.iteration_limit += gr->solver.iteration_limit;
-			out->solver.clamped += gr->solver.clamped;
-			out->trials_run += gr->deterministic && e->trials > 0 ? 1 : e->trials;
+			group_finish(&out->groups[g]);
 			if (out->lattice_summaries)
 				bsim_lattice_summary_end(&out->lattice_summaries[g]);
 		}
+		result_totals(out, deterministic, e->trials, st.det_first, 1,
+		              bsim_clock_seconds() - t0);
 	}
 	if (scenes)
 		scenes_free(scenes, e->n_groups);
