@@ -261,3 +261,18 @@ void fuzz_run_scene(const bsim_scene *scene)
 	bsim_trial_runner_free(r);
 	bsim_scene_free(&s);
 }
+
+void fuzz_load_and_run(const char *path, const bsim_override *ov, int n_ov)
+{
+	bsim_scene s;
+	bsim_error err;
+	bsim_error_clear(&err);
+	int rc = bsim_scene_load(path, ov, n_ov, &s, &err);
+	if (rc != BSIM_OK) {
+		fuzz_check_error(rc, &err);
+		return;
+	}
+	fuzz_accepted();
+	fuzz_run_scene(&s);
+	bsim_scene_free(&s);
+}

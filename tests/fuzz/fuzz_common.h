@@ -56,6 +56,11 @@ void fuzz_check_error(int rc, const bsim_error *err);
  * loader accepts must not crash a backend or be undefined behaviour. */
 void fuzz_run_scene(const bsim_scene *s);
 
+/* Loads the scene file at path with the overrides, as `beamsim run` does:
+ * a refusal goes through fuzz_check_error, an accepted scene is noted and
+ * run (fuzz_run_scene). */
+void fuzz_load_and_run(const char *path, const bsim_override *ov, int n_ov);
+
 /* Set by replay_main -v: each input's outcome on stdout, "accepted" or the
  * loader's message. */
 extern int fuzz_verbose;

@@ -33,18 +33,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	}
 	char path[300];
 	snprintf(path, sizeof path, "%s/gate.yaml", fuzz_dir());
-	bsim_scene s;
-	bsim_error err;
-	bsim_error_clear(&err);
-	int rc = bsim_scene_load(path, ov, n, &s, &err);
-	if (rc != BSIM_OK)
-		fuzz_check_error(rc, &err);
-	else
-		fuzz_accepted();
-	if (rc == BSIM_OK)
-		fuzz_run_scene(&s);
-	if (rc == BSIM_OK)
-		bsim_scene_free(&s);
+	fuzz_load_and_run(path, ov, n);
 	free(text);
 	return 0;
 }

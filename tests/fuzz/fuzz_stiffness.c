@@ -28,16 +28,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 		         fuzz_write("lattice.yaml", (const uint8_t *)lattice_yaml,
 		                    sizeof lattice_yaml - 1));
 	fuzz_write("stiffness.csv", data, size);
-	bsim_scene s;
-	bsim_error err;
-	bsim_error_clear(&err);
-	int rc = bsim_scene_load(scene, NULL, 0, &s, &err);
-	if (rc != BSIM_OK) {
-		fuzz_check_error(rc, &err);
-		return 0;
-	}
-	fuzz_accepted();
-	fuzz_run_scene(&s);
-	bsim_scene_free(&s);
+	fuzz_load_and_run(scene, NULL, 0);
 	return 0;
 }
