@@ -22,6 +22,7 @@
 #include "figures/figures_lattice.h"
 #include "figures/figures_paths.h"
 #include "figures/figures_summary.h"
+#include "figures/figures_survival.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
 #include "beamsim/limits.h"
@@ -658,6 +659,8 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 	for (int ax = 0; !rc && ax < s.n_axes; ax++)
 		if (a.n[ax] >= 2)
 			rc = versus(f, &s, &a, ax, lat != NULL, err);
+	if (!rc)
+		rc = figs_survival(f, dir, &s, err);
 	if (!rc && have)
 		rc = traj_draw(f, dir, &j, err);
 	if (!rc && lat)
