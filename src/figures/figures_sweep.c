@@ -654,13 +654,14 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 		rc = figs_lattice_load(f, dir, inputs, &s, &lat, err);
 	else if (!rc)
 		rc = traj_load(f, dir, inputs, &s, &j, &have, err);
+	/* survival.csv and horizon.csv are read whole before it draws */
+	if (!rc)
+		rc = figs_survival(f, dir, &s, err);
 	if (!rc)
 		rc = heat_map(f, &s, &a, lat != NULL, err);
 	for (int ax = 0; !rc && ax < s.n_axes; ax++)
 		if (a.n[ax] >= 2)
 			rc = versus(f, &s, &a, ax, lat != NULL, err);
-	if (!rc)
-		rc = figs_survival(f, dir, &s, err);
 	if (!rc && have)
 		rc = traj_draw(f, dir, &j, err);
 	if (!rc && lat)
