@@ -105,10 +105,11 @@ static void test_solver_columns(void **state)
 	free(err);
 	char *csv = bsim_test_read(bsim_test_join(out_dir, "trials.csv"));
 	assert_non_null(csv);
-	assert_non_null(strstr(csv, ",path,iteration_limits,clamps,effects.propulsion.force\n"));
-	/* the one row ends with the counts (7 limits, no clamp), then the
-	 * grid's column */
-	assert_non_null(strstr(csv, ",7,0,9\n"));
+	assert_non_null(
+	        strstr(csv, ",path,iteration_limits,clamps,t_exit,effects.propulsion.force\n"));
+	/* the one row ends with the counts (7 limits, no clamp), the side
+	 * exit's t_exit, then the grid's column */
+	assert_non_null(strstr(csv, ",7,0,1080,9\n"));
 	free(csv);
 	char *sum = bsim_test_read(bsim_test_join(out_dir, "summary.json"));
 	assert_non_null(sum);

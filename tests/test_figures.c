@@ -406,7 +406,7 @@ static void test_compare_figures(void **state)
 	char sub[1100];
 	for (int b = 0; b < 2; b++) {
 		snprintf(sub, sizeof sub, "%s/%s", dir, b ? "box2d" : "thesis");
-		assert_int_equal(bsim_test_check_figures(sub), 3);
+		assert_int_equal(bsim_test_check_figures(sub), 4); /* survival too */
 	}
 	/* The paired difference is p_A - p_B of the two probabilities drawn. */
 	static double rows[64][16];

@@ -228,7 +228,7 @@ static void test_sweep_figures(void **state)
 	const char *dir = lattice_sweep();
 	/* p_traverse, traversal against Rm, and per group final_locations and
 	 * lattice; not the single gate's bundle and landscape */
-	assert_int_equal(bsim_test_check_figures(dir), 2 + 2 * 2);
+	assert_int_equal(bsim_test_check_figures(dir), 3 + 2 * 2);
 	assert_true(bsim_test_exists(bsim_test_join(dir, "lattice_g001.png")) ||
 	            !bsim_figure_available());
 	assert_false(bsim_test_exists(bsim_test_join(dir, "trajectories_g000.gp")));
@@ -444,7 +444,7 @@ static void test_compare(void **state)
 	for (int s = 0; s < 2; s++) {
 		snprintf(sub, sizeof sub, "%s/%s", dir, s ? "essay" : "world");
 		assert_int_equal(bsim_test_check_figures(sub),
-		                 3); /* p_traverse, final_locations, lattice */
+		                 4); /* p_traverse, survival, final_locations, lattice */
 		char trials[1200];
 		snprintf(trials, sizeof trials, "%s/trials.csv", sub);
 		counts c;

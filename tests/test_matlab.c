@@ -638,9 +638,16 @@ static void test_mat_rows_limit(void **state)
 	                      out,        NULL};
 	char *text = NULL;
 	assert_int_equal(bsim_test_cli(argv, NULL, &text), 0);
-	assert_string_equal(text, "beamsim: trials.csv: 90 rows, over the limit mat_rows = 50: no "
-	                          "trials.mat; MATLAB's readtable reads the CSV (raise with "
-	                          "--limit mat_rows=90)\n");
+	assert_string_equal(text,
+	                    "beamsim: trials.csv: 90 rows, over the limit mat_rows = 50: no "
+	                    "trials.mat; MATLAB's readtable reads the CSV (raise with "
+	                    "--limit mat_rows=90)\n"
+	                    "beamsim: survival.csv: 97 rows, over the limit mat_rows = 50: no "
+	                    "survival.mat; MATLAB's readtable reads the CSV (raise with "
+	                    "--limit mat_rows=97)\n"
+	                    "beamsim: horizon.csv: 1440 rows, over the limit mat_rows = 50: no "
+	                    "horizon.mat; MATLAB's readtable reads the CSV (raise with "
+	                    "--limit mat_rows=1440)\n");
 	free(text);
 	assert_false(bsim_test_exists(bsim_test_join(out, "trials.mat")));
 	assert_true(bsim_test_exists(bsim_test_join(out, "summary.mat")));

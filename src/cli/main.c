@@ -24,6 +24,8 @@ static const cli_command commands[] = {
          "what accuracy costs in time: error against speed per backend and step"},
         {"landscape", cmd_landscape,
          "the potential energy landscape of a scene, its barriers and figures"},
+        {"escape", cmd_escape,
+         "escape rate of a sweep's groups against barrier over noise power (Kramers)"},
         {"markov", cmd_markov,
          "predict a gate lattice from single-gate maps: build, predict, validate"},
         {"plot", cmd_plot, "draw the figures of a sweep, comparison, run or accuracy study"},

@@ -22,6 +22,7 @@
 #include "figures/figures_lattice.h"
 #include "figures/figures_paths.h"
 #include "figures/figures_summary.h"
+#include "figures/figures_survival.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
 #include "beamsim/limits.h"
@@ -653,6 +654,9 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 		rc = figs_lattice_load(f, dir, inputs, &s, &lat, err);
 	else if (!rc)
 		rc = traj_load(f, dir, inputs, &s, &j, &have, err);
+	/* survival.csv and horizon.csv are read whole before it draws */
+	if (!rc)
+		rc = figs_survival(f, dir, &s, err);
 	if (!rc)
 		rc = heat_map(f, &s, &a, lat != NULL, err);
 	for (int ax = 0; !rc && ax < s.n_axes; ax++)

@@ -765,5 +765,14 @@ int bsim_matlab_sweep(const char *dir, const bsim_experiment *e, bsim_error *err
 		fclose(f);
 		rc = sweep_table(dir, "trajectories", e, err);
 	}
+	/* the time to leave the gate (store/survival_files.h), when written */
+	const char *more[] = {"survival", "horizon"};
+	for (int k = 0; k < 2 && !rc; k++) {
+		snprintf(traj, sizeof traj, "%s/%s.csv", dir, more[k]);
+		if ((f = fopen(traj, "r")) != NULL) {
+			fclose(f);
+			rc = sweep_table(dir, more[k], e, err);
+		}
+	}
 	return rc;
 }

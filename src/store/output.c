@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 
 #include "util/atomic_file.h"
+#include "store/survival_files.h"
 #include "store/trials_csv.h"
 #include "store/lattice_files.h"
 #include "util/json.h"
@@ -339,7 +340,7 @@ const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
         "overlap_max", "final_ix",
         "final_iy",    "location",
         "path",        "iteration_limits",
-        "clamps",
+        "clamps",      "t_exit",
 };
 
 int trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
@@ -396,7 +397,9 @@ void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 		if (!tl || tl->n_entries == 0)
 			fprintf(f, "%d:%d", x->final_ix, x->final_iy);
 		/* what the backend's solvers gave up on in this trial */
-		fprintf(f, ",%ld,%ld", x->solver.iteration_limit, x->solver.clamped);
+		fprintf(f, ",%ld,%ld,", x->solver.iteration_limit, x->solver.clamped);
+		/* when it left the gate (the field), empty if censored */
+		csv_number(f, survival_exit_time(x));
 		for (int a = 0; a < w->axes; a++) {
 			fputc(',', f);
 			csv_field(f, w->e->axes[a].values[w->idx[a]]);

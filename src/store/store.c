@@ -10,7 +10,23 @@
 #include "beamsim/output.h"
 #include "store/matlab.h"
 #include "store/session.h"
+#include "store/survival_files.h"
 #include "beamsim/limits.h"
+
+/* survival.csv and horizon.csv of a sweep held in memory (a streamed
+ * sweep's come from its sink, sweep_dir.c). */
+static int survival_files(const char *dir, const bsim_experiment *e, const bsim_override *extra,
+                          int n_extra, const bsim_sweep_result *r, bsim_error *err)
+{
+	survival_acc a;
+	int rc = survival_acc_init(&a, e, extra, n_extra, err);
+	if (rc == BSIM_OK)
+		survival_acc_add(&a, 0, (long)r->n_groups * r->trials, r->trials, r->trials_out);
+	if (rc == BSIM_OK)
+		rc = survival_acc_write(&a, dir, err);
+	survival_acc_free(&a);
+	return rc == BSIM_OK ? BSIM_OK : BSIM_EFAIL;
+}
 
 int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
                            const bsim_options *opts, const bsim_override *extra, int n_extra,
@@ -30,6 +46,7 @@ int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim
 	if (bsim_output_mkdir(dir, err) != BSIM_OK ||
 	    bsim_output_summary_json(summary, e, b->name, opts, r, err) != BSIM_OK ||
 	    (r->trials_out && bsim_output_trials_csv(trials, e, r, err) != BSIM_OK) ||
+	    (r->trials_out && survival_files(dir, e, extra, n_extra, r, err) != BSIM_OK) ||
 	    bsim_output_lattice(dir, e, extra, n_extra, r, err) != BSIM_OK ||
 	    bsim_output_trajectories_csv(traj, r, err) != BSIM_OK ||
 	    bsim_matlab_sweep(dir, e, err) != BSIM_OK)

@@ -21,6 +21,7 @@
 #include "store/session.h"
 #include "store/rerun.h"
 #include "store/store.h"
+#include "store/survival_files.h"
 #include "store/trials_csv.h"
 #include "store/lattice_files.h"
 #include "util/atomic_file.h"
@@ -55,6 +56,7 @@ typedef struct trials_sink {
 	int n_files; /* 1, or 3 for a lattice */
 	int trials;
 	bsim_lattice_def def; /* a lattice's: group 0's, as its outputs use */
+	survival_acc surv;    /* each group's exit times: survival.csv, horizon.csv */
 	int failed;
 } trials_sink;
 
@@ -67,6 +69,7 @@ static int trials_sink_take(void *user, const bsim_sweep_block *b, bsim_error *e
 {
 	trials_sink *s = user;
 	trials_csv_rows(&s->w, b->first, b->n, s->trials, b->results, b->logs);
+	survival_acc_add(&s->surv, b->first, b->n, s->trials, b->results);
 	if (s->n_files > 1) {
 		lattice_entries_rows(s->lattice[SINK_ENTRIES].f, b->first, b->n, s->trials,
 		                     b->logs);
@@ -96,6 +99,8 @@ static int sink_open(trials_sink *s, const char *stage, const bsim_experiment *e
 	s->def = scene.lattice;
 	s->trials = e->trials;
 	bsim_scene_free(&scene);
+	if ((rc = survival_acc_init(&s->surv, e, sets, n_sets, err)) != BSIM_OK)
+		return rc;
 	if (bsim_output_mkdir(stage, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	for (int k = 0; k < s->n_files; k++)
@@ -119,7 +124,10 @@ static int sink_close(trials_sink *s, int rc, const char *stage, bsim_error *err
 {
 	if (rc == BSIM_OK)
 		rc = trials_csv_commit(&s->w, err);
-	else
+	if (rc == BSIM_OK)
+		rc = survival_acc_write(&s->surv, stage, err);
+	survival_acc_free(&s->surv);
+	if (rc != BSIM_OK)
 		trials_csv_abort(&s->w);
 	for (int k = 1; k < SINK_FILES; k++) {
 		if (rc == BSIM_OK && s->lattice[k].f)

@@ -4,7 +4,8 @@
  * columns than this version writes, or one written before the energy
  * columns, the lattice's final gate (final_ix, final_iy; 0 when absent,
  * what a gate scene writes) or the solver's counts (iteration_limits,
- * clamps; 0 when absent) existed, reads the same. */
+ * clamps; 0 when absent) existed, reads the same. t_exit is not read: it
+ * is t_end for an exit and empty otherwise, so outcome and t_end give it. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>

@@ -1,0 +1,181 @@
+/* The survival figure of a sweep: left, the Kaplan-Meier estimate S(t) of
+ * the time to leave the gate with its Greenwood band; right, the shares
+ * traversed and still in the gate (stuck) had the trials been stopped at
+ * horizon h, with Wilson bands and the scene's horizon marked. A reader
+ * sees whether p_traverse still climbs at the horizon the sweep used. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "figures/figures_survival.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/csv_table.h"
+
+static const char *const colour[FIGS_SURVIVAL_GROUPS] = {
+        FIG_BLUE, FIG_RED, FIG_GREEN, FIG_ORANGE, FIG_PURPLE, FIG_SKY, FIG_BLACK, FIG_DKGREY};
+
+/* Reads the named columns of dir/name into t and col. */
+static int table(const char *dir, const char *name, const char *const *need, int n, csv_table *t,
+                 int *col, char *path, bsim_error *err)
+{
+	snprintf(path, BSIM_PATH_MAX, "%s/%s", dir, name);
+	int rc = csv_table_read(path, t, err);
+	if (rc)
+		return rc;
+	if ((rc = csv_table_require(t, path, need, n, col, err)))
+		csv_table_free(t);
+	return rc;
+}
+
+/* Rows of table t for group g as "v1 v2 ..." lines of the columns col[1..n-1]
+ * (col[0] is the group). */
+static int block(FILE *o, const csv_table *t, const char *path, const int *col, int n, int g,
+                 bsim_error *err)
+{
+	for (long r = 0; r < t->n_rows; r++) {
+		double v, gr;
+		if (csv_table_number(t, r, col[0], &gr))
+			return bsim_error_set(err, BSIM_EINPUT, "%s:%ld: group: expected a number",
+			                      path, r + 2);
+		if ((int)gr != g)
+			continue;
+		for (int k = 1; k < n; k++) {
+			if (csv_table_number(t, r, col[k], &v))
+				return bsim_error_set(err, BSIM_EINPUT,
+				                      "%s:%ld: expected a number in column %d",
+				                      path, r + 2, col[k] + 1);
+			fprintf(o, "%s%.8g", k > 1 ? " " : "", v);
+		}
+		fputc('\n', o);
+	}
+	return BSIM_OK;
+}
+
+int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
+{
+	char path[BSIM_PATH_MAX], spath[BSIM_PATH_MAX], hpath[BSIM_PATH_MAX];
+	snprintf(path, sizeof path, "%s/survival.csv", dir);
+	FILE *probe = fopen(path, "r");
+	if (!probe)
+		return BSIM_OK;
+	fclose(probe);
+	static const char *const sneed[] = {"group", "t", "survival", "ci_low", "ci_high"};
+	static const char *const hneed[] = {"group",       "h",       "p_traverse", "traverse_lo",
+	                                    "traverse_hi", "p_stuck", "stuck_lo",   "stuck_hi"};
+	csv_table st, ht;
+	int scol[5], hcol[8];
+	int rc = table(dir, "survival.csv", sneed, 5, &st, scol, spath, err);
+	if (rc)
+		return rc;
+	if ((rc = table(dir, "horizon.csv", hneed, 8, &ht, hcol, hpath, err))) {
+		csv_table_free(&st);
+		return rc;
+	}
+	/* the groups shown: the selected ones with the most exits by the horizon */
+	int shown[FIGS_SURVIVAL_GROUPS], n_shown = 0, n_sel = 0;
+	for (int g = 0; g < s->n_groups; g++) {
+		if (!s->g[g].selected)
+			continue;
+		n_sel++;
+		int exits = s->g[g].traversed + s->g[g].side_exit;
+		int at = n_shown < FIGS_SURVIVAL_GROUPS ? n_shown++ : -1;
+		if (at < 0) {
+			int worst = 0;
+			for (int k = 1; k < n_shown; k++)
+				if (s->g[shown[k]].traversed + s->g[shown[k]].side_exit <
+				    s->g[shown[worst]].traversed + s->g[shown[worst]].side_exit)
+					worst = k;
+			if (s->g[shown[worst]].traversed + s->g[shown[worst]].side_exit >= exits)
+				continue;
+			at = worst;
+		}
+		shown[at] = g;
+	}
+	/* in group order */
+	for (int i = 1; i < n_shown; i++)
+		for (int k = i; k > 0 && shown[k - 1] > shown[k]; k--) {
+			int x = shown[k];
+			shown[k] = shown[k - 1];
+			shown[k - 1] = x;
+		}
+	if (n_sel > n_shown)
+		figs_note(f,
+		          "survival: %d of the %d selected groups drawn (those with the most "
+		          "exits); --select KEY=VALUE draws others",
+		          n_shown, n_sel);
+	bsim_atomic_file o;
+	rc = figs_data_open(f, "survival.dat", &o, path, err);
+	if (!rc) {
+		fputs("# t S lo hi (Kaplan-Meier, Greenwood 95%), one block per group shown; then "
+		      "h p_traverse lo hi p_stuck lo hi (Wilson 95%), one block per group\n",
+		      o.f);
+		for (int i = 0; !rc && i < n_shown; i++) {
+			fprintf(o.f, "%s# group %d\n", i ? "\n\n" : "", shown[i]);
+			rc = block(o.f, &st, spath, scol, 5, shown[i], err);
+		}
+		for (int i = 0; !rc && i < n_shown; i++) {
+			fprintf(o.f, "\n\n# group %d\n", shown[i]);
+			rc = block(o.f, &ht, hpath, hcol, 8, shown[i], err);
+		}
+		if (rc)
+			bsim_atomic_file_abort(&o);
+		else
+			rc = figs_data_commit(&o, err);
+	}
+	/* the horizon each group ran to: the last h of its block */
+	double horizon = 0.0;
+	for (long r = 0; !rc && r < ht.n_rows; r++) {
+		double h;
+		if (csv_table_number(&ht, r, hcol[1], &h) == 0 && h > horizon)
+			horizon = h;
+	}
+	csv_table_free(&st);
+	csv_table_free(&ht);
+	if (rc || n_shown == 0)
+		return rc;
+	gp_text g;
+	if ((rc = gp_text_open(&g, err)))
+		return rc;
+	fprintf(g.f,
+	        "set multiplot layout 1,2 title 'time to leave the gate, %d trials per group' "
+	        "noenhanced\n"
+	        "set grid\nset style fill transparent solid 0.12 noborder\n"
+	        "set yrange [0:1]\nset xrange [0:%.6g]\nset key top right font ',9' "
+	        "noenhanced\n"
+	        "set arrow 1 from %.6g, graph 0 to %.6g, graph 1 nohead dt 3 lc rgb '%s'\n"
+	        "set title 'still in the gate, S(t) (Kaplan-Meier, 95%% Greenwood band)'\n"
+	        "set xlabel 't (s)'\nset ylabel 'S(t)'\nplot ",
+	        s->trials_per_group, horizon * 1.02, horizon, horizon, FIG_GREY);
+	for (int i = 0; i < n_shown; i++) {
+		char label[300];
+		fsum_label(s, shown[i], label, sizeof label);
+		for (char *c = label; *c; c++)
+			*c = *c == '\n' ? ' ' : *c;
+		fprintf(g.f,
+		        "%s'survival.dat' index %d using 1:3:4 with filledcurves lc rgb '%s' "
+		        "notitle, "
+		        "\\\n     '' index %d using 1:2 with steps lw 2 lc rgb '%s' title ",
+		        i ? ", \\\n     " : "", i, colour[i], i, colour[i]);
+		gp_str(g.f, label);
+	}
+	fprintf(g.f,
+	        "\nset title 'had the trials stopped at h: traversed (solid), stuck (dashed); "
+	        "dotted: the horizon'\n"
+	        "set xlabel 'horizon h (s)'\nset ylabel 'fraction of trials'\nunset key\nplot ");
+	for (int i = 0; i < n_shown; i++)
+		fprintf(g.f,
+		        "%s'survival.dat' index %d using 1:3:4 with filledcurves lc rgb '%s', \\\n"
+		        "     '' index %d using 1:2 with lines lw 2 lc rgb '%s', \\\n"
+		        "     '' index %d using 1:6:7 with filledcurves lc rgb '%s', \\\n"
+		        "     '' index %d using 1:5 with lines lw 2 dt 2 lc rgb '%s'",
+		        i ? ", \\\n     " : "", n_shown + i, colour[i], n_shown + i, colour[i],
+		        n_shown + i, colour[i], n_shown + i, colour[i]);
+	fputs("\nunset multiplot\n", g.f);
+	char *body = gp_text_take(&g);
+	rc = body ? figs_render(f, "survival", 1300, 560, body, err)
+	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	free(body);
+	return rc;
+}
