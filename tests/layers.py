@@ -76,6 +76,7 @@ PUBLIC = {
     "figures": "figures",
     "video": "video",
     "accuracy": "analysis",
+    "essay_compare": "analysis",
     "landscape_barriers": "analysis",
     "markov": "analysis",
 }

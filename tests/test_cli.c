@@ -91,7 +91,8 @@ static void check_help(const char *cmd, const char *const *mentions)
 static void test_help(void **state)
 {
 	(void)state;
-	static const char *const top[] = {"run", "sweep", "backends", "bench", "--version", NULL};
+	static const char *const top[] = {"run",   "sweep",     "backends", "bench",
+	                                  "essay", "--version", NULL};
 	static const char *const run[] = {
 	        "SCENE", "--backend",    "--backend-opt", "--seed", "--group", "--trial",
 	        "--set", "--trajectory", "--stride",      "--json", NULL};
@@ -99,6 +100,8 @@ static void test_help(void **state)
 	                                    "--threads",  "--trials", "--seed",    "--set",
 	                                    "--quiet",    NULL};
 	static const char *const backends[] = {"backends", "--help", NULL};
+	static const char *const essay[] = {"--out",  "--trials",  "--mode", "--sensitivity",
+	                                    "--seed", "--threads", NULL};
 	static const char *const bench[] = {"--backend", "--backend-opt", "--experiment",
 	                                    "--trials",  "--no-h2",       "--json",
 	                                    NULL};
@@ -112,6 +115,7 @@ static void test_help(void **state)
 	check_help("sweep", sweep);
 	check_help("backends", backends);
 	check_help("bench", bench);
+	check_help("essay", essay);
 }
 
 static void test_version(void **state)

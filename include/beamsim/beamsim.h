@@ -12,6 +12,7 @@
 #include "beamsim/compare_dir.h"
 #include "beamsim/effects.h"
 #include "beamsim/error.h"
+#include "beamsim/essay_compare.h"
 #include "beamsim/experiment.h"
 #include "beamsim/figures.h"
 #include "beamsim/landscape.h"

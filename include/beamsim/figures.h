@@ -27,7 +27,9 @@
  *   histogram against N(0, Rm^2), the energy ledger over time, and the
  *   trajectory over the landscape;
  * - the accuracy study (accuracy.csv): consistency error against speed,
- *   one series per backend and setting, the Pareto front marked.
+ *   one series per backend and setting, the Pareto front marked;
+ * - the essay comparison (essay.csv): each level the essay reports beside
+ *   beamsim's probability and interval in each mode.
  *
  * Without gnuplot the data and scripts are still written; the result says
  * how many figures were drawn. */
@@ -48,6 +50,7 @@ typedef enum {
 	BSIM_FIGURES_COMPARE,
 	BSIM_FIGURES_RUN,
 	BSIM_FIGURES_ACCURACY,
+	BSIM_FIGURES_ESSAY, /* essay.csv of beamsim essay */
 } bsim_figures_kind;
 
 BSIM_API const char *bsim_figures_kind_name(bsim_figures_kind k);

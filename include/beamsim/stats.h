@@ -64,6 +64,31 @@ BSIM_API int bsim_stats_mcnemar_split(int m, double level);
 /* The standard normal quantile z with P(Z > z) = q. */
 BSIM_API double bsim_stats_normal_upper(double q);
 
+/* Fisher's exact test of x1/n1 against x2/n2 (independent samples): the
+ * two-sided p-value of the hypergeometric count, summed over the tables no
+ * more likely than the observed one (R's fisher.test). 1 if n1 or n2 is 0. */
+BSIM_API double bsim_stats_fisher_exact(int x1, int n1, int x2, int n2);
+
+/* The 95% interval of p1 - p2 for independent samples: Newcombe's hybrid
+ * score interval from the two Wilson intervals (Statist. Med. 17, 1998,
+ * method 10). */
+BSIM_API void bsim_stats_newcombe_diff_ci(int x1, int n1, int x2, int n2, double z, double *lo,
+                                          double *hi);
+
+/* A linear trend of proportions in a score: the least-squares slope
+ * (proportion per unit of score) with its Wald interval, and the
+ * Cochran-Armitage statistic z with its two-sided p-value. */
+typedef struct bsim_stats_trend {
+	double slope, lo, hi;
+	double z, p;
+} bsim_stats_trend;
+
+/* The Cochran-Armitage trend test of x[i]/n[i] in scores s[i], i < k, at
+ * confidence z for the slope's interval. p = 1 and z = 0 when every
+ * group has the same outcome (no variance). */
+BSIM_API void bsim_stats_cochran_armitage(const int *x, const int *n, const double *s, int k,
+                                          double z, bsim_stats_trend *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -28,6 +28,7 @@ int cmd_bench(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_regress(int argc, char **argv);
 int cmd_accuracy(int argc, char **argv);
+int cmd_essay(int argc, char **argv);
 int cmd_landscape(int argc, char **argv);
 int cmd_escape(int argc, char **argv);
 int cmd_plot(int argc, char **argv);

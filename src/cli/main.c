@@ -22,6 +22,8 @@ static const cli_command commands[] = {
         {"bench", cmd_bench, "measure the speed of a backend on the essay's experiments"},
         {"accuracy", cmd_accuracy,
          "what accuracy costs in time: error against speed per backend and step"},
+        {"essay", cmd_essay,
+         "the essay's reported numbers and trends against beamsim, mode by mode"},
         {"landscape", cmd_landscape,
          "the potential energy landscape of a scene, its barriers and figures"},
         {"escape", cmd_escape,

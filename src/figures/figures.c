@@ -17,8 +17,8 @@
 
 const char *bsim_figures_kind_name(bsim_figures_kind k)
 {
-	static const char *names[] = {"auto", "sweep", "compare", "run", "accuracy"};
-	return (unsigned)k < 5 ? names[k] : "?";
+	static const char *names[] = {"auto", "sweep", "compare", "run", "accuracy", "essay"};
+	return (unsigned)k < 6 ? names[k] : "?";
 }
 
 bsim_figures_def bsim_figures_def_default(void)
@@ -56,6 +56,8 @@ static bsim_figures_kind recognise(const char *dir)
 		return BSIM_FIGURES_RUN;
 	if (has(dir, "accuracy.csv"))
 		return BSIM_FIGURES_ACCURACY;
+	if (has(dir, "essay.csv"))
+		return BSIM_FIGURES_ESSAY;
 	return BSIM_FIGURES_AUTO;
 }
 
@@ -75,7 +77,7 @@ int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures
 		        err, BSIM_EINPUT,
 		        "%s: no output of beamsim found (expected summary.json and "
 		        "trials.csv of a sweep, report.json and pairs.csv of compare, "
-		        "trajectory.csv and ledger.csv of run --out, or accuracy.csv)",
+		        "trajectory.csv and ledger.csv of run --out, accuracy.csv or essay.csv)",
 		        dir);
 	figs f = {
 	        .out = d.out ? d.out : dir,
@@ -101,6 +103,9 @@ int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures
 		break;
 	case BSIM_FIGURES_ACCURACY:
 		rc = figs_accuracy(&f, dir, err);
+		break;
+	case BSIM_FIGURES_ESSAY:
+		rc = figs_essay(&f, dir, err);
 		break;
 	default:
 		break;

@@ -1,6 +1,6 @@
 /* The figures of each kind of directory, as the dispatcher (figures.c)
  * calls them: figures_sweep.c, figures_compare.c, figures_run.c,
- * figures_accuracy.c. */
+ * figures_accuracy.c, figures_essay.c. */
 #ifndef BSIM_FIGURES_FIGURES_KINDS_H
 #define BSIM_FIGURES_FIGURES_KINDS_H
 
@@ -12,5 +12,6 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err);
 int figs_compare(figs *f, const char *dir, bsim_error *err);
 int figs_run(figs *f, const char *dir, bsim_error *err);
 int figs_accuracy(figs *f, const char *dir, bsim_error *err);
+int figs_essay(figs *f, const char *dir, bsim_error *err);
 
 #endif

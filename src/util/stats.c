@@ -221,3 +221,87 @@ double bsim_stats_normal_upper(double q)
 {
 	return gsl_cdf_ugaussian_Qinv(q);
 }
+
+/* Fisher's exact test of x1/n1 against x2/n2: conditional on the margins,
+ * the count x1 is hypergeometric,
+ *   P(X = x) = C(n1, x) C(n2, t - x) / C(n1 + n2, t),  t = x1 + x2,
+ * and the two-sided p-value sums P(X = x) over every x no more likely than
+ * the observed one (R's fisher.test: "no more likely" with a relative
+ * tolerance of 1e-7 against round-off). Log space: n in the thousands. */
+static double hyper_log(int x, int n1, int n2, int t)
+{
+	return lgamma(n1 + 1.0) - lgamma(x + 1.0) - lgamma(n1 - x + 1.0) + lgamma(n2 + 1.0) -
+	       lgamma(t - x + 1.0) - lgamma(n2 - t + x + 1.0) - lgamma(n1 + n2 + 1.0) +
+	       lgamma(t + 1.0) + lgamma(n1 + n2 - t + 1.0);
+}
+
+double bsim_stats_fisher_exact(int x1, int n1, int x2, int n2)
+{
+	if (n1 <= 0 || n2 <= 0)
+		return 1.0;
+	int t = x1 + x2;
+	int lo = t - n2 > 0 ? t - n2 : 0, hi = t < n1 ? t : n1;
+	double l0 = hyper_log(x1, n1, n2, t), p = 0.0;
+	for (int x = lo; x <= hi; x++) {
+		double l = hyper_log(x, n1, n2, t);
+		if (l <= l0 + 1e-7)
+			p += exp(l);
+	}
+	return p < 1.0 ? p : 1.0;
+}
+
+/* Newcombe's hybrid score interval for p1 - p2 of independent samples
+ * (Statist. Med. 17, 1998, 873-890, method 10): with [l_i, u_i] the Wilson
+ * intervals and d = p1 - p2,
+ *   [d - sqrt((p1 - l1)^2 + (u2 - p2)^2), d + sqrt((u1 - p1)^2 + (p2 - l2)^2)]. */
+void bsim_stats_newcombe_diff_ci(int x1, int n1, int x2, int n2, double z, double *lo, double *hi)
+{
+	double l1, u1, l2, u2;
+	bsim_stats_wilson(x1, n1, z, &l1, &u1);
+	bsim_stats_wilson(x2, n2, z, &l2, &u2);
+	double p1 = n1 > 0 ? (double)x1 / n1 : 0.0, p2 = n2 > 0 ? (double)x2 / n2 : 0.0;
+	double d = p1 - p2;
+	*lo = d - sqrt((p1 - l1) * (p1 - l1) + (u2 - p2) * (u2 - p2));
+	*hi = d + sqrt((u1 - p1) * (u1 - p1) + (p2 - l2) * (p2 - l2));
+}
+
+/* Cochran-Armitage test for a linear trend of k proportions x_i/n_i in
+ * scores s_i (Agresti, Categorical Data Analysis, 2002, Sec. 5.3.5): with
+ * the pooled p = sum x / sum n and sbar = sum n_i s_i / sum n,
+ *   z = sum x_i (s_i - sbar) / sqrt(p (1 - p) sum n_i (s_i - sbar)^2),
+ * N(0, 1) under "no trend". The slope is the weighted least-squares line
+ * of p_i on s_i, b = sum n_i (s_i - sbar) p_i / Sxx, Sxx = sum n_i
+ * (s_i - sbar)^2, and its Wald interval uses each group's own binomial
+ * variance: Var b = sum n_i (s_i - sbar)^2 p_i (1 - p_i) / Sxx^2. */
+void bsim_stats_cochran_armitage(const int *x, const int *n, const double *s, int k, double z,
+                                 bsim_stats_trend *out)
+{
+	double N = 0.0, X = 0.0, S = 0.0;
+	for (int i = 0; i < k; i++) {
+		N += n[i];
+		X += x[i];
+		S += n[i] * s[i];
+	}
+	*out = (bsim_stats_trend){.p = 1.0};
+	if (N <= 0.0)
+		return;
+	double sbar = S / N, p = X / N, t = 0.0, sxx = 0.0, b = 0.0, var = 0.0;
+	for (int i = 0; i < k; i++) {
+		double ds = s[i] - sbar, pi = n[i] > 0 ? (double)x[i] / n[i] : 0.0;
+		t += x[i] * ds;
+		sxx += n[i] * ds * ds;
+		b += n[i] * ds * pi;
+		var += n[i] * ds * ds * pi * (1.0 - pi);
+	}
+	if (sxx <= 0.0)
+		return;
+	out->slope = b / sxx;
+	double se = sqrt(var) / sxx;
+	out->lo = out->slope - z * se;
+	out->hi = out->slope + z * se;
+	double v0 = p * (1.0 - p) * sxx;
+	if (v0 > 0.0) {
+		out->z = t / sqrt(v0);
+		out->p = fmin(1.0, 2.0 * gsl_cdf_ugaussian_Q(fabs(out->z)));
+	}
+}

@@ -1,0 +1,160 @@
+/* beamsim essay: every number the essay's text reports and every trend it
+ * states, run in beamsim's modes, each with an interval, a test against
+ * the essay and a verdict (beamsim/essay_compare.h). Parses and prints. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "beamsim/essay_compare.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
+#include "cli/cli_progress.h"
+
+enum { OWN_MODE, OWN_LATTICE_TRIALS, OWN_SENSITIVITY, OWN_CONFIGS };
+
+#define ESSAY_MODES_MAX 5
+
+static const cli_own essay_own[] = {
+        [OWN_MODE] = {"mode", 1, "OPTS",
+                      "a mode: KEY=VALUE:KEY=VALUE, backend options and scene keys\n"
+                      "(a key with a dot, e.g. contact.tip_restitution=0.8), or\n"
+                      "`default`; repeat for several (default: default,\n"
+                      "contact_mode=essay, and\n"
+                      "contact_mode=essay:contact.tip_restitution=0.8)"},
+        [OWN_LATTICE_TRIALS] = {"lattice-trials", 1, "N",
+                                "trials of the C-track (default: as --trials)"},
+        [OWN_SENSITIVITY] = {"sensitivity", 0, NULL,
+                             "also vary what the essay leaves unstated (rest threshold,\n"
+                             "restitution, tip restitution, duration, side boundary) at the\n"
+                             "symmetric groups: sensitivity.csv"},
+        [OWN_CONFIGS] = {"configs", 1, "DIR",
+                         "the shipped configs (thesis/gate.yaml, lattice/c_track.yaml;\n"
+                         "default configs)"},
+};
+
+static const char *const essay_help[CLI_N_OPTS] = {
+        [CLI_OPT_BACKEND] = "backend (default thesis)",
+        [CLI_OPT_TRIALS] = "trials per group (default 1000; the essay's 100)",
+        [CLI_OPT_SEED] = "seed of the schedules (default 1)",
+        [CLI_OPT_THREADS] = "threads (default all); results do not depend on it",
+        [CLI_OPT_OUT] = "output directory (required; created if missing)",
+};
+
+typedef struct essay_args {
+	const char *modes[ESSAY_MODES_MAX];
+	int n_modes;
+	long lattice_trials;
+	int sensitivity;
+	const char *configs;
+} essay_args;
+
+static int essay_option(void *args, int i, const char *value)
+{
+	essay_args *a = args;
+	switch (i) {
+	case OWN_MODE:
+		if (a->n_modes == ESSAY_MODES_MAX)
+			return cli_usage("essay", "--mode: at most %d modes", ESSAY_MODES_MAX);
+		a->modes[a->n_modes++] = strcmp(value, "default") == 0 ? "" : value;
+		return CLI_OK;
+	case OWN_LATTICE_TRIALS:
+		if (cli_parse_long(value, 1, 1000000, &a->lattice_trials))
+			return cli_usage("essay", "--lattice-trials %s: expected an integer >= 1",
+			                 value);
+		return CLI_OK;
+	case OWN_SENSITIVITY:
+		a->sensitivity = 1;
+		return CLI_OK;
+	case OWN_CONFIGS:
+		a->configs = value;
+		return CLI_OK;
+	}
+	return CLI_USAGE;
+}
+
+static const cli_spec essay_spec = {
+        .name = "essay",
+        .usage = "--out DIR [OPTIONS]",
+        .about = "Every traversal probability the essay's text reports (Figs. 3.2 and 3.3: left\n"
+                 "and right types at 500:500, 300:500, 100:500; Sec. 3.3: the C-track) and\n"
+                 "every trend it states (H1: p rises with F_prop, rises with Rm from 0 to 20 N\n"
+                 "and falls from 20 to 40 N, most at 9 N; Fig. 3.4a and b), run in each mode.\n"
+                 "A level is tested against the essay's count (Fisher's exact test), a trend\n"
+                 "by Cochran-Armitage or a Wald z test; `consistent` or `differs` at 0.05\n"
+                 "(docs/essay.md). Writes DIR/essay.csv (+ .mat), DIR/essay.md, the figure\n"
+                 "DIR/essay.png and with --sensitivity DIR/sensitivity.csv (+ .mat).\n",
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_TRIALS) |
+                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET),
+        .help = essay_help,
+        .out_required = 1,
+        .own = essay_own,
+        .n_own = 4,
+        .option = essay_option,
+};
+
+int cmd_essay(int argc, char **argv)
+{
+	cli_common c = cli_common_default();
+	essay_args a = {.configs = "configs"};
+	int rc = cli_parse(&essay_spec, argc, argv, &c, &a, NULL);
+	if (rc >= 0) {
+		cli_common_free(&c);
+		return rc;
+	}
+	bsim_essay_config cfg = bsim_essay_config_default();
+	cfg.configs = a.configs;
+	if (c.backend)
+		cfg.backend = c.backend;
+	if (a.n_modes > 0) {
+		cfg.modes = a.modes;
+		cfg.n_modes = a.n_modes;
+	}
+	if (c.trials)
+		cfg.trials = (int)c.trials;
+	cfg.lattice_trials = a.lattice_trials ? (int)a.lattice_trials : cfg.trials;
+	cfg.sens_trials = a.sensitivity ? cfg.trials : 0;
+	if (c.has_seed)
+		cfg.seed = c.seed;
+	cfg.threads = (int)c.threads;
+	cli_progress progress;
+	cli_progress_init(&progress, !c.quiet, "trials");
+	cfg.progress = cli_progress_update;
+	cfg.progress_user = &progress;
+	cfg.stop = &cli_stop;
+	cli_signals_install();
+	bsim_essay_result r;
+	bsim_figures_result fig;
+	bsim_error err;
+	rc = bsim_essay_compare_store(c.out, &cfg, &r, &fig, &err);
+	cli_progress_finish(&progress);
+	cli_signals_restore();
+	if (rc == BSIM_ESTOPPED) {
+		/* Nothing is written before every sweep has run. */
+		int sig = cli_stop ? (int)cli_stop : SIGINT;
+		cli_error("%s: %s; nothing written", sig == SIGTERM ? "SIGTERM" : "SIGINT",
+		          err.msg);
+		cli_common_free(&c);
+		return 128 + sig;
+	}
+	rc = cli_report(rc, &err);
+	if (rc == BSIM_OK) {
+		int differ = 0;
+		for (int i = 0; i < r.n; i++)
+			differ += !r.rows[i].consistent;
+		if (!c.quiet)
+			printf("essay: %d rows (%d consistent, %d differ), %ld trials in %.1f s; "
+			       "wrote %s/essay.{csv,mat,md}%s and the figure "
+			       "%s/essay.{png,svg,gp}\n",
+			       r.n, r.n - differ, differ, r.trials_run, r.wall_seconds,
+			       cli_path(c.out), r.n_sens ? ", sensitivity.{csv,mat}" : "",
+			       cli_path(c.out));
+		for (int i = 0; i < fig.n_notes; i++)
+			cli_error("%s", fig.notes[i]);
+		bsim_figures_result_free(&fig);
+		bsim_essay_result_free(&r);
+	}
+	cli_common_free(&c);
+	return rc;
+}
