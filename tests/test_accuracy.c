@@ -3,7 +3,8 @@
  * smooth motion (two beams in free damped vibration, no impacts):
  * e(h) / e(h/2) ~ 2^q; (b) the command runs (--quick) and writes a CSV row
  * per (backend, setting, h) of finite numbers and its figure (drawn by
- * gnuplot when it is installed, the script in any case); (c) the errors do
+ * gnuplot when it is installed, the script in any case) and equal_error.csv
+ * (a line per error target and backend); (c) the errors do
  * not depend on the number of threads. */
 #include <math.h>
 #include <setjmp.h>
@@ -131,7 +132,17 @@ static char *run_quick(const char *name, const char *backends, const char *threa
 	char *md = bsim_test_read(path);
 	assert_non_null(md);
 	assert_non_null(strstr(md, "| backend |"));
+	assert_non_null(strstr(md, "## At equal error"));
 	free(md);
+	/* equal_error.csv: a line per default target and backend (its selection
+	 * is test_accuracy_equal's). */
+	snprintf(path, sizeof path, "%s/equal_error.csv", dir);
+	char *eq = bsim_test_read(path);
+	assert_non_null(eq);
+	assert_non_null(strstr(eq, "ratio_equal_error"));
+	int n_backends = 1 + (strchr(backends, ',') != NULL);
+	assert_int_equal(bsim_test_count_lines(eq), 1 + 5 * n_backends);
+	free(eq);
 	snprintf(path, sizeof path, "%s/accuracy.csv", dir);
 	char *csv = bsim_test_read(path);
 	assert_non_null(csv);
@@ -153,7 +164,7 @@ static void test_cli_quick(void **state)
 		char copy[512];
 		snprintf(copy, sizeof copy, "%s", line);
 		assert_int_equal(csv_check_row(copy, &fields), 0);
-		assert_int_equal(fields, 15);
+		assert_int_equal(fields, 17);
 		rows++;
 	}
 	/* 6 steps (0.016 .. 0.0005 s) x 4 thesis and 12 box2d settings. */

@@ -6,7 +6,8 @@
  *     two beams, so between 17 and 31; the thesis backend never reads it;
  *   - taking that time out of Box2D's lowers the ratio, by its share;
  *   - free flight runs every trial to its last step (trials x max_steps);
- *   - --repeat N gives N one-thread runs and the median of them. */
+ *   - --repeat N gives N one-thread runs and the median of them;
+ *   - the paired ratios, by wall and by CPU time, are the medians of theirs. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -40,6 +41,31 @@ static char *bench_json(const char *name, const char *backend, const char *vs, c
 	return text;
 }
 
+/* The array name of five positive ratios in vs, and median the middle one. */
+static void pairs_median(const char *vs, const char *name, const char *median)
+{
+	char key[64];
+	snprintf(key, sizeof key, "\"%s\": [", name);
+	const char *r = strstr(vs, key);
+	assert_non_null(r);
+	r += strlen(key);
+	double ratio[5];
+	for (int i = 0; i < 5; i++) {
+		char *end;
+		ratio[i] = strtod(r, &end);
+		assert_true(end != r && ratio[i] > 0.0);
+		r = end + strspn(end, ", ");
+	}
+	assert_int_equal(*r, ']');
+	double paired = bsim_test_json_number(vs, median);
+	int under = 0, over = 0;
+	for (int i = 0; i < 5; i++) {
+		under += ratio[i] < paired;
+		over += ratio[i] > paired;
+	}
+	assert_true(under <= 2 && over <= 2);
+}
+
 static void box2d_reads_its_clock(void **state)
 {
 	(void)state;
@@ -54,26 +80,11 @@ static void box2d_reads_its_clock(void **state)
 	double without = bsim_test_json_number(vs, "speedup_per_trial_without_clock");
 	assert_true(fabs(without - with * (1.0 - share)) <= 1e-9 * with);
 
-	/* five interleaved pairs (the default): ratio_paired is their median */
+	/* five interleaved pairs (the default): ratio_paired is the median of
+	 * their wall-time ratios, ratio_paired_cpu of their CPU-time ones */
 	assert_int_equal((int)bsim_test_json_number(vs, "pairs"), 5);
-	const char *r = strstr(vs, "\"pair_ratios\": [");
-	assert_non_null(r);
-	r += strlen("\"pair_ratios\": [");
-	double ratio[5];
-	for (int i = 0; i < 5; i++) {
-		char *end;
-		ratio[i] = strtod(r, &end);
-		assert_true(end != r && ratio[i] > 0.0);
-		r = end + strspn(end, ", ");
-	}
-	assert_int_equal(*r, ']');
-	double paired = bsim_test_json_number(vs, "ratio_paired");
-	int under = 0, over = 0;
-	for (int i = 0; i < 5; i++) {
-		under += ratio[i] < paired;
-		over += ratio[i] > paired;
-	}
-	assert_true(under <= 2 && over <= 2);
+	pairs_median(vs, "pair_ratios", "ratio_paired");
+	pairs_median(vs, "pair_ratios_cpu", "ratio_paired_cpu");
 
 	/* free flight: every trial to its last step, 3000 of them */
 	const char *ff = strstr(j, "\"free_flight\": {");

@@ -460,6 +460,31 @@ static void test_mirror_deviation(void **state)
 
 /* ---- the interface -------------------------------------------------------- */
 
+/* The expert setting of docs/backends.md ("Box2D as an expert would set
+ * it"): accepted, and on the gate without random force (H1's deterministic
+ * groups: stuck at 8 N, through at 9 N) the same outcome as the defaults. */
+static void test_expert_setting(void **state)
+{
+	(void)state;
+	bsim_options expert = opts_of("continuous=off", "sleep=on");
+	bsim_error err;
+	assert_int_equal(bsim_options_add(&expert, "velocity_iterations=4", &err), BSIM_OK);
+	const double force[] = {8.0, 9.0};
+	const bsim_outcome want[] = {BSIM_STUCK, BSIM_TRAVERSED};
+	for (int k = 0; k < 2; k++) {
+		bsim_scene s;
+		bsim_scene_init_gate(&s, force[k], 0.0);
+		bsim_trial_result a = run_trial(&s, NULL, 1), b = run_trial(&s, &expert, 1);
+		print_message(
+		        "box2d gate, F = %g N: %s in %d steps (defaults), %s in %d (expert)\n",
+		        force[k], bsim_trial_outcome_name(a.outcome), a.steps,
+		        bsim_trial_outcome_name(b.outcome), b.steps);
+		assert_int_equal(a.outcome, want[k]);
+		assert_int_equal(b.outcome, a.outcome);
+		bsim_scene_free(&s);
+	}
+}
+
 static void test_bad_options(void **state)
 {
 	(void)state;
@@ -568,6 +593,7 @@ int main(void)
 	        cmocka_unit_test(test_conservative_drift),
 	        cmocka_unit_test(test_driven_damped_noisy),
 	        cmocka_unit_test(test_mirror_deviation),
+	        cmocka_unit_test(test_expert_setting),
 	        cmocka_unit_test(test_bad_options),
 	        cmocka_unit_test(test_set_state),
 	        cmocka_unit_test(test_clamped_motion),

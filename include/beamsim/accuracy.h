@@ -53,6 +53,8 @@ BSIM_API int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const
                                        uint64_t seed, double piece, int n_pieces, double *mean,
                                        double *max, bsim_error *err);
 
+#define BSIM_ACCURACY_TARGETS_MAX 16
+
 typedef struct bsim_accuracy_config {
 	double h_ref;              /* s, finest step and the reference's (0.000125) */
 	double h_max;              /* s, coarsest step (0.016); steps are h_max / 2^i */
@@ -63,10 +65,19 @@ typedef struct bsim_accuracy_config {
 	int threads;               /* <= 0: all */
 	bsim_progress_fn progress; /* may be NULL: settings done of all */
 	void *progress_user;
+	/* NULL, or one per backend: options added to every setting of that
+	 * backend, the reference's included (they win over the setting's), and
+	 * named after the setting in its rows (e.g. continuous=off). */
+	const bsim_options *backend_opts;
+	/* The error targets of the equal-error comparison, m (0.02, 0.01,
+	 * 0.005, 0.002, 0.001). */
+	int n_targets;
+	double targets[BSIM_ACCURACY_TARGETS_MAX];
 } bsim_accuracy_config;
 
 /* The study of docs/accuracy.md: h from 0.016 s halved down to 0.000125 s,
- * 16 pieces of 0.064 s, 40 trials, seed 1, all threads. */
+ * 16 pieces of 0.064 s, 40 trials, seed 1, all threads; error targets
+ * 0.02, 0.01, 0.005, 0.002 and 0.001 m. */
 BSIM_API bsim_accuracy_config bsim_accuracy_config_default(void);
 /* A quick study for tests: h down to 0.0005 s, 4 pieces, 8 trials. */
 BSIM_API bsim_accuracy_config bsim_accuracy_quick(void);
@@ -83,7 +94,9 @@ typedef struct bsim_accuracy_row {
 	double p, p_ref, p_err;   /* p_traverse, the reference's, |p - p_ref| */
 	double sim_seconds;       /* simulated by the batch, s */
 	double wall_seconds;      /* wall time of the batch and pieces, s */
+	double cpu_seconds;       /* CPU time of the batch (its thread's), s */
 	double cost;              /* wall s per simulated s */
+	double cpu_cost;          /* CPU s of the batch per simulated s */
 	double speed;             /* simulated s per wall s (x real time) */
 	int failed;               /* trials that ended unstable (bsim_instability) */
 } bsim_accuracy_row;
@@ -107,6 +120,33 @@ BSIM_API int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *cons
                                bsim_accuracy_result *out, bsim_error *err);
 BSIM_API void bsim_accuracy_result_free(bsim_accuracy_result *r);
 
+/* Equal error: for a target mean consistency error and a backend, the
+ * cheapest row of that backend reaching it (err_mean <= target) by CPU time
+ * per simulated second, among rows that are not the reference (whose error
+ * is 0 by construction) and had no unstable trial; and the ratio of its
+ * cost to the first backend's (the first of r's rows) at the same target. */
+typedef struct bsim_accuracy_equal {
+	double target;       /* m */
+	const char *backend; /* the row's backend name */
+	int row;             /* in r->rows; -1: no row of the backend reaches the target */
+	double cpu_cost;     /* CPU s per simulated s of that row; NAN if none */
+	double ratio;        /* cpu_cost / the first backend's; NAN if either has none */
+} bsim_accuracy_equal;
+
+/* The equal-error picks of r for n_targets targets (m, > 0): n_targets x
+ * (backends in r, in order of first appearance) entries, target by target,
+ * into a malloc'd array (caller frees). */
+BSIM_API int bsim_accuracy_equal_error(const bsim_accuracy_result *r, const double *targets,
+                                       int n_targets, bsim_accuracy_equal **out, int *n,
+                                       bsim_error *err);
+
+/* equal_error.csv of the picks: target_m, backend, setting, h_s, err_mean_m,
+ * cpu_per_sim_s and ratio_equal_error (this backend's cost over the first
+ * backend's); a target a backend does not reach has empty cells. */
+BSIM_API int bsim_accuracy_write_equal_csv(const char *path, const bsim_accuracy_result *r,
+                                           const bsim_accuracy_equal *eq, int n_eq,
+                                           bsim_error *err);
+
 /* accuracy.csv and accuracy.md of a result; the figure is drawn from
  * accuracy.csv (beamsim/figures.h). */
 BSIM_API int bsim_accuracy_write_csv(const char *path, const bsim_accuracy_result *r,
@@ -116,10 +156,10 @@ BSIM_API int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result
                                     bsim_error *err);
 
 /* The study written into the output directory out as one set (checked
- * before the study runs): accuracy.csv, accuracy.mat, accuracy.md (naming
- * the scene by scene_label) and the figure accuracy (.png, .svg, .gp,
- * .dat). fig gets the figure's result (its notes say what gnuplot could
- * not draw); free it and res on BSIM_OK. */
+ * before the study runs): accuracy.csv, accuracy.mat, equal_error.csv (at
+ * cfg's targets), accuracy.md (naming the scene by scene_label, with the
+ * equal-error table) and the figure accuracy (.png, .svg, .gp, .dat). fig gets the figure's result
+ * (its notes say what gnuplot could not draw); free it and res on BSIM_OK. */
 BSIM_API int bsim_accuracy_store(const char *out, const bsim_scene *scene, const char *scene_label,
                                  const bsim_backend *const *backends, int n_backends,
                                  const bsim_accuracy_config *cfg, bsim_accuracy_result *res,

@@ -10,7 +10,9 @@
  * has e ~ C h^q in smooth motion; impacts resolved at step ends give
  * O(h) near collisions whatever the integrator.
  * Residual rate = sum over the batch of sum_steps |r| / sum of simulated
- * time, J/s. Cost = wall time of the batch / its simulated time. */
+ * time, J/s. Cost = wall time of the batch / its simulated time, and the
+ * same with the CPU time of the batch's thread, which other programs on the
+ * machine do not inflate. */
 #include "beamsim/accuracy.h"
 
 #include <math.h>
@@ -222,7 +224,7 @@ static int row_batch(bsim_accuracy_row *row, bsim_trial_runner *runner, const bs
 {
 	int traversed = 0;
 	double sim = 0.0, resid = 0.0;
-	double t0 = bsim_clock_seconds();
+	double t0 = bsim_clock_seconds(), c0 = bsim_clock_thread_cpu_seconds();
 	for (int t = 0; t < cfg->n_trials; t++) {
 		bsim_trial_result res;
 		bsim_error e;
@@ -241,13 +243,16 @@ static int row_batch(bsim_accuracy_row *row, bsim_trial_runner *runner, const bs
 		resid += res.ledger.residual_abs;
 	}
 	double wall = bsim_clock_seconds() - t0;
+	double cpu = bsim_clock_thread_cpu_seconds() - c0;
 	row->wall_seconds += wall;
+	row->cpu_seconds = cpu;
 	row->sim_seconds = sim;
 	row->p = (double)traversed / cfg->n_trials;
 	row->residual_rate = sim > 0 ? resid / sim : NAN;
 	wall = wall > 1e-9 ? wall : 1e-9; /* a clock too coarse: 1 ns */
 	row->cost = sim > 0 ? wall / sim : NAN;
 	row->speed = sim > 0 ? sim / wall : NAN;
+	row->cpu_cost = sim > 0 ? fmax(cpu, 1e-9) / sim : NAN;
 	return BSIM_OK;
 }
 
@@ -294,6 +299,28 @@ static int by_weight_desc(const void *a, const void *b)
 	return *(const int *)a - *(const int *)b;
 }
 
+/* The options extra added to every setting, and to its name. */
+static int settings_extend(bsim_accuracy_row *set, int n_set, const bsim_options *extra,
+                           bsim_error *err)
+{
+	for (int s = 0; s < n_set; s++)
+		for (int k = 0; k < extra->n; k++) {
+			char kv[128];
+			snprintf(kv, sizeof kv, "%s=%s", extra->key[k], extra->value[k]);
+			int rc = bsim_options_add(&set[s].opts, kv, err);
+			if (rc)
+				return rc;
+			size_t len = strlen(set[s].setting), add = strlen(kv);
+			if (len + 1 + add >= sizeof set[s].setting)
+				return bsim_error_set(err, BSIM_EINPUT,
+				                      "accuracy: setting %s with %s: name too long",
+				                      set[s].setting, kv);
+			set[s].setting[len] = ' ';
+			memcpy(set[s].setting + len + 1, kv, add + 1);
+		}
+	return BSIM_OK;
+}
+
 int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backends, int n_backends,
                       const bsim_accuracy_config *cfg, bsim_accuracy_result *out, bsim_error *err)
 {
@@ -319,6 +346,12 @@ int bsim_accuracy_run(const bsim_scene *scene, const bsim_backend *const *backen
 		rc = bsim_accuracy_settings(backends[bi], &set, &n_set, err);
 		if (rc)
 			break;
+		if (cfg->backend_opts)
+			rc = settings_extend(set, n_set, &cfg->backend_opts[bi], err);
+		if (rc) {
+			free(set);
+			break;
+		}
 		bsim_accuracy_row *grown =
 		        realloc(out->rows, (size_t)(out->n + n_set * n_h) * sizeof *grown);
 		int *gb = realloc(row_backend, (size_t)(out->n + n_set * n_h) * sizeof *gb);
@@ -427,14 +460,17 @@ int bsim_accuracy_write_csv(const char *path, const bsim_accuracy_result *r, bsi
 	if (rc)
 		return rc;
 	fputs("backend,setting,reference,h_s,err_mean_m,err_max_m,residual_J_per_s,p_traverse,"
-	      "p_ref,p_err,sim_seconds,wall_seconds,wall_per_sim_s,speed_x_realtime,failed\n",
+	      "p_ref,p_err,sim_seconds,wall_seconds,wall_per_sim_s,speed_x_realtime,failed,"
+	      "cpu_seconds,cpu_per_sim_s\n",
 	      o.f);
 	for (int i = 0; i < r->n; i++) {
 		const bsim_accuracy_row *w = &r->rows[i];
-		fprintf(o.f, "%s,%s,%d,%.9g,%.6e,%.6e,%.6e,%.4f,%.4f,%.4f,%.6g,%.6g,%.6e,%.6g,%d\n",
+		fprintf(o.f,
+		        "%s,%s,%d,%.9g,%.6e,%.6e,%.6e,%.4f,%.4f,%.4f,%.6g,%.6g,%.6e,%.6g,%d,%.6g,"
+		        "%.6e\n",
 		        w->backend, w->setting, w->reference, w->h, w->err_mean, w->err_max,
 		        w->residual_rate, w->p, w->p_ref, w->p_err, w->sim_seconds, w->wall_seconds,
-		        w->cost, w->speed, w->failed);
+		        w->cost, w->speed, w->failed, w->cpu_seconds, w->cpu_cost);
 	}
 	return bsim_atomic_file_commit(&o, err);
 }
@@ -451,6 +487,34 @@ static int pareto(const bsim_accuracy_result *r, int lo, int hi, int i)
 			return 0;
 	}
 	return 1;
+}
+
+/* The equal-error table: per target, each backend's cheapest row reaching
+ * it and its cost over the first backend's (equal_error.csv). */
+static void equal_error_md(FILE *f, const bsim_accuracy_result *r, const bsim_accuracy_equal *eq,
+                           int n_eq)
+{
+	fprintf(f,
+	        "\n## At equal error\n\n"
+	        "For each target of mean consistency error, each backend's cheapest setting "
+	        "reaching it: the least CPU time (the thread's, per simulated second) among its "
+	        "rows with err mean at most the target, leaving out the reference (its error is "
+	        "0 by construction) and rows with an unstable trial. ratio: that cost over "
+	        "%s's at the same target (`ratio_equal_error` in equal_error.csv).\n\n"
+	        "| target (m) | backend | setting | h (s) | err mean (m) | CPU/sim | ratio |\n"
+	        "|---:|---|---|---:|---:|---:|---:|\n",
+	        eq[0].backend);
+	for (int i = 0; i < n_eq; i++) {
+		const bsim_accuracy_equal *e = &eq[i];
+		if (e->row < 0) {
+			fprintf(f, "| %g | %s | none reaches it | | | | |\n", e->target,
+			        e->backend);
+			continue;
+		}
+		const bsim_accuracy_row *w = &r->rows[e->row];
+		fprintf(f, "| %g | %s | %s | %g | %.3g | %.3g | %.3g |\n", e->target, e->backend,
+		        w->setting, w->h, w->err_mean, e->cpu_cost, e->ratio);
+	}
 }
 
 int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result *r,
@@ -495,5 +559,15 @@ int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result *r,
 			fprintf(f, "| %s | %s | %g | %.3g | %.4g |\n", r->rows[i].backend,
 			        r->rows[i].setting, r->rows[i].h, r->rows[i].err_mean,
 			        r->rows[i].speed);
+	bsim_accuracy_equal *eq = NULL;
+	int n_eq = 0;
+	rc = bsim_accuracy_equal_error(r, cfg->targets, cfg->n_targets, &eq, &n_eq, err);
+	if (rc == BSIM_OK && n_eq > 0)
+		equal_error_md(f, r, eq, n_eq);
+	free(eq);
+	if (rc) {
+		bsim_atomic_file_abort(&o);
+		return rc;
+	}
 	return bsim_atomic_file_commit(&o, err);
 }

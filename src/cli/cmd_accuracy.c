@@ -4,6 +4,7 @@
  * 0.000125 s; --quick stops at 0.0005 s with fewer pieces and trials. */
 #define _POSIX_C_SOURCE 200809L
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,7 +17,7 @@
 
 #define ACC_SCENE "configs/thesis/gate.yaml"
 
-enum { OWN_SCENE, OWN_BACKENDS, OWN_PIECES, OWN_QUICK };
+enum { OWN_SCENE, OWN_BACKENDS, OWN_PIECES, OWN_QUICK, OWN_TARGETS };
 
 static const cli_own accuracy_own[] = {
         [OWN_SCENE] = {"scene", 1, "FILE",
@@ -25,6 +26,9 @@ static const cli_own accuracy_own[] = {
         [OWN_BACKENDS] = {"backends", 1, "LIST", "comma-separated (default thesis,box2d)"},
         [OWN_PIECES] = {"pieces", 1, "N", "restarted pieces (default 16)"},
         [OWN_QUICK] = {"quick", 0, NULL, "h down to 0.0005 s, 4 pieces, 8 trials (for tests)"},
+        [OWN_TARGETS] = {"targets", 1, "LIST",
+                         "comma-separated mean consistency errors (m) of the\n"
+                         "equal-error comparison (default 0.02,0.01,0.005,0.002,0.001)"},
 };
 
 static const char *const accuracy_help[CLI_N_OPTS] = {
@@ -33,6 +37,8 @@ static const char *const accuracy_help[CLI_N_OPTS] = {
         [CLI_OPT_THREADS] = "threads (default all); results other than timings do\n"
                             "not depend on it",
         [CLI_OPT_OUT] = "output directory (required; created if missing)",
+        [CLI_OPT_BACKEND_OPT] = "B:K=V adds option K=V to every setting of backend B\n"
+                                "(e.g. box2d:continuous=off), repeatable",
 };
 
 typedef struct accuracy_args {
@@ -40,7 +46,32 @@ typedef struct accuracy_args {
 	int scene_given;
 	long pieces;
 	int quick;
+	int n_targets; /* 0: the default targets */
+	double targets[BSIM_ACCURACY_TARGETS_MAX];
 } accuracy_args;
+
+/* --targets: up to BSIM_ACCURACY_TARGETS_MAX numbers > 0. */
+static int parse_targets(accuracy_args *a, const char *value)
+{
+	char list[512];
+	if (snprintf(list, sizeof list, "%s", value) >= (int)sizeof list)
+		return cli_usage("accuracy", "--targets: list too long");
+	a->n_targets = 0;
+	char *save = NULL;
+	for (char *t = strtok_r(list, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+		char *end;
+		double v = strtod(t, &end);
+		if (end == t || *end != '\0' || !isfinite(v) || v <= 0.0)
+			return cli_usage("accuracy", "--targets: %s: expected a number > 0 (m)", t);
+		if (a->n_targets == BSIM_ACCURACY_TARGETS_MAX)
+			return cli_usage("accuracy", "--targets: at most %d",
+			                 BSIM_ACCURACY_TARGETS_MAX);
+		a->targets[a->n_targets++] = v;
+	}
+	if (a->n_targets == 0)
+		return cli_usage("accuracy", "--targets: no number given");
+	return CLI_OK;
+}
 
 static int accuracy_option(void *args, int i, const char *value)
 {
@@ -61,6 +92,8 @@ static int accuracy_option(void *args, int i, const char *value)
 	case OWN_QUICK:
 		a->quick = 1;
 		return CLI_OK;
+	case OWN_TARGETS:
+		return parse_targets(a, value);
 	}
 	return CLI_USAGE;
 }
@@ -74,18 +107,46 @@ static const cli_spec accuracy_spec = {
                  "residual per simulated second, the error of p_traverse over a batch of\n"
                  "trials against the reference setting's, and the wall time per simulated\n"
                  "second. The knob settings of each backend are listed beside its knobs\n"
-                 "(beamsim backends). Writes DIR/accuracy.csv, DIR/accuracy.md and the\n"
+                 "(beamsim backends). Then, for each error target (--targets), each\n"
+                 "backend's cheapest setting reaching it (CPU time per simulated second)\n"
+                 "and its cost over the first backend's: the speed ratio at equal error.\n"
+                 "Writes DIR/accuracy.csv, DIR/equal_error.csv, DIR/accuracy.md and the\n"
                  "figure DIR/accuracy.png (error against speed, log-log).\n",
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_TRIALS) |
-                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_BACKEND_OPT) |
+                  CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS),
         .help = accuracy_help,
         .out_required = 1,
         .own = accuracy_own,
-        .n_own = 4,
+        .n_own = 5,
         .option = accuracy_option,
 };
 
 #define ACC_BACKENDS_MAX 8
+
+/* One line per backend after the first: its cost over the first's at each
+ * target (the md report has the settings). */
+static void print_equal_error(const bsim_accuracy_result *r, const bsim_accuracy_config *cfg)
+{
+	bsim_accuracy_equal *eq;
+	int n;
+	bsim_error err;
+	if (bsim_accuracy_equal_error(r, cfg->targets, cfg->n_targets, &eq, &n, &err) || n == 0)
+		return;
+	int n_b = n / cfg->n_targets;
+	for (int b = 1; b < n_b; b++) {
+		printf("at equal error, %s / %s (CPU per simulated s):", eq[b].backend,
+		       eq[0].backend);
+		for (int t = 0; t < cfg->n_targets; t++) {
+			const bsim_accuracy_equal *e = &eq[t * n_b + b];
+			if (isfinite(e->ratio))
+				printf(" %g m: %.3g", e->target, e->ratio);
+			else
+				printf(" %g m: -", e->target);
+		}
+		putchar('\n');
+	}
+	free(eq);
+}
 
 static int accuracy_main(const cli_common *c, accuracy_args *a)
 {
@@ -113,6 +174,9 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 		return cli_report(rc, &err);
 
 	const bsim_backend *backends[ACC_BACKENDS_MAX];
+	const char *names[ACC_BACKENDS_MAX];
+	bsim_options extra[ACC_BACKENDS_MAX] = {0};
+	bsim_options *extra_of[ACC_BACKENDS_MAX];
 	int n_b = 0;
 	char list[256];
 	snprintf(list, sizeof list, "%s", a->backends);
@@ -123,6 +187,8 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 			return cli_usage("accuracy", "--backends: at most %d", ACC_BACKENDS_MAX);
 		}
 		bsim_options none = {0};
+		names[n_b] = t;
+		extra_of[n_b] = &extra[n_b];
 		backends[n_b] = cli_backend(t, &none);
 		if (!backends[n_b++]) {
 			bsim_scene_free(&scene);
@@ -133,14 +199,27 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 		bsim_scene_free(&scene);
 		return cli_usage("accuracy", "--backends: no backend named");
 	}
+	rc = cli_backend_opts(c, "accuracy", n_b, names, extra_of);
+	for (int i = 0; i < n_b && rc == CLI_OK; i++)
+		if (!cli_backend(names[i], &extra[i])) /* checks the options */
+			rc = CLI_USAGE;
+	if (rc != CLI_OK) {
+		bsim_scene_free(&scene);
+		return rc;
+	}
 	bsim_accuracy_config cfg =
 	        a->quick ? bsim_accuracy_quick() : bsim_accuracy_config_default();
 	if (a->pieces)
 		cfg.n_pieces = (int)a->pieces;
+	if (a->n_targets) {
+		cfg.n_targets = a->n_targets;
+		memcpy(cfg.targets, a->targets, sizeof cfg.targets);
+	}
 	if (c->trials)
 		cfg.n_trials = (int)c->trials;
 	cfg.seed = c->has_seed ? c->seed : cfg.seed;
 	cfg.threads = (int)c->threads;
+	cfg.backend_opts = extra;
 	cli_progress progress;
 	cli_progress_init(&progress, 1, "settings");
 	cfg.progress = cli_progress_update;
@@ -154,9 +233,10 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 	cli_progress_finish(&progress);
 	rc = cli_report(rc, &err);
 	if (rc == BSIM_OK) {
-		printf("accuracy: %d rows in %.1f s; wrote %s/accuracy.{csv,mat,md} and the figure "
-		       "%s/accuracy.{png,svg,gp}\n",
-		       r.n, r.wall_seconds, cli_path(c->out), cli_path(c->out));
+		printf("accuracy: %d rows in %.1f s; wrote %s/accuracy.{csv,mat,md}, "
+		       "%s/equal_error.csv and the figure %s/accuracy.{png,svg,gp}\n",
+		       r.n, r.wall_seconds, cli_path(c->out), cli_path(c->out), cli_path(c->out));
+		print_equal_error(&r, &cfg);
 		for (int i = 0; i < fig.n_notes; i++)
 			cli_error("%s", fig.notes[i]);
 		bsim_figures_result_free(&fig);

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "util/atomic_file.h"
+#include "util/clock.h"
 #include "util/json.h"
 #include "beamsim/output.h"
 #include "beamsim/sweep.h"
@@ -67,7 +68,8 @@ static const cli_own bench_own[] = {
         [OWN_PAIRS] = {"pairs", 1, "N",
                        "after the --vs run, N pairs of one-thread runs of the\n"
                        "experiment, the two backends interleaved (default 5;\n"
-                       "0: none): the median of the pairs' ratios per step"},
+                       "0: none): the median of the pairs' ratios per step, by\n"
+                       "wall time and by CPU time"},
 };
 
 static const char *const bench_help[CLI_N_OPTS] = {
@@ -95,6 +97,7 @@ typedef struct bench_run {
 	int threads;
 	long trials, steps;
 	double wall;
+	double cpu; /* s, the process's CPU time: what other programs' load does not inflate */
 } bench_run;
 
 #define BENCH_REPEAT_MAX 100
@@ -216,7 +219,9 @@ static int bench_sweep(const bsim_backend *backend, const bsim_options *opts,
 {
 	bsim_sweep_config cfg = {.backend = backend, .opts = opts, .threads = threads};
 	bsim_sweep_result r;
+	double cpu0 = bsim_clock_process_cpu_seconds();
 	int rc = cli_sweep_run(e, &cfg, 1, &r);
+	double cpu = bsim_clock_process_cpu_seconds() - cpu0;
 	if (rc != CLI_OK)
 		return rc;
 	*out = (bench_run){
@@ -225,6 +230,7 @@ static int bench_sweep(const bsim_backend *backend, const bsim_options *opts,
 	        .trials = r.trials_run,
 	        .steps = r.total_steps,
 	        .wall = r.wall_seconds,
+	        .cpu = cpu,
 	};
 	bsim_sweep_result_free(&r);
 	bench_print_run(out);
@@ -238,6 +244,8 @@ static void bench_json_run(FILE *f, const bench_run *r)
 	fprintf(f, ", \"threads\": %d, \"trials\": %ld, \"steps\": %ld, \"wall_seconds\": ",
 	        r->threads, r->trials, r->steps);
 	bsim_json_number(f, r->wall);
+	fputs(", \"cpu_seconds\": ", f);
+	bsim_json_number(f, r->cpu);
 	fputs(", \"steps_per_second\": ", f);
 	bsim_json_number(f, cli_per_second(r->steps, r->wall));
 	fputs(", \"trials_per_second\": ", f);
@@ -267,6 +275,7 @@ typedef struct bench_results {
 	 * steps/s over the second's), in the order run. */
 	int n_pairs;
 	double pair_ratio[BENCH_PAIRS_MAX];
+	double pair_ratio_cpu[BENCH_PAIRS_MAX]; /* the same by CPU time per step */
 } bench_results;
 
 /* The time the second backend's run spent reading the clock, s. */
@@ -296,13 +305,22 @@ static int cmp_double(const void *x, const void *y)
 
 /* The median of the pairs' ratios (the mean of the middle two for an even
  * count). */
-static double bench_pairs_median(const bench_results *b)
+static double bench_median(const double *ratio, int n)
 {
 	double r[BENCH_PAIRS_MAX];
-	memcpy(r, b->pair_ratio, (size_t)b->n_pairs * sizeof *r);
-	qsort(r, (size_t)b->n_pairs, sizeof *r, cmp_double);
-	int n = b->n_pairs;
+	memcpy(r, ratio, (size_t)n * sizeof *r);
+	qsort(r, (size_t)n, sizeof *r, cmp_double);
 	return n % 2 ? r[n / 2] : 0.5 * (r[n / 2 - 1] + r[n / 2]);
+}
+
+static void bench_json_ratios(FILE *f, const char *name, const double *ratio, int n)
+{
+	fprintf(f, ", \"%s\": [", name);
+	for (int i = 0; i < n; i++) {
+		fputs(i ? ", " : "", f);
+		bsim_json_number(f, ratio[i]);
+	}
+	fputc(']', f);
 }
 
 static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *backend,
@@ -351,14 +369,17 @@ static void bench_json_write(FILE *f, const bench_args *a, const bsim_backend *b
 		bsim_json_number(f, timer_s / theirs->wall);
 		fputs(", \"speedup_per_trial_without_clock\": ", f);
 		bsim_json_number(f, (theirs->wall - timer_s) / mine->wall);
-		fprintf(f, ", \"pairs\": %d, \"pair_ratios\": [", b->n_pairs);
-		for (int i = 0; i < b->n_pairs; i++) {
-			fputs(i ? ", " : "", f);
-			bsim_json_number(f, b->pair_ratio[i]);
-		}
-		fputs("], \"ratio_paired\": ", f);
+		fprintf(f, ", \"pairs\": %d", b->n_pairs);
+		bench_json_ratios(f, "pair_ratios", b->pair_ratio, b->n_pairs);
+		fputs(", \"ratio_paired\": ", f);
 		if (b->n_pairs > 0)
-			bsim_json_number(f, bench_pairs_median(b));
+			bsim_json_number(f, bench_median(b->pair_ratio, b->n_pairs));
+		else
+			fputs("null", f);
+		bench_json_ratios(f, "pair_ratios_cpu", b->pair_ratio_cpu, b->n_pairs);
+		fputs(", \"ratio_paired_cpu\": ", f);
+		if (b->n_pairs > 0)
+			bsim_json_number(f, bench_median(b->pair_ratio_cpu, b->n_pairs));
 		else
 			fputs("null", f);
 		fputc('}', f);
@@ -410,11 +431,26 @@ static int bench_vs(const bench_args *a, const bsim_backend *vs, const bsim_expe
 	return CLI_OK;
 }
 
+static void bench_pairs_print(const bench_args *a, const bsim_backend *vs, const char *what,
+                              const double *ratio, int n)
+{
+	double lo = ratio[0], hi = lo;
+	for (int i = 1; i < n; i++) {
+		lo = ratio[i] < lo ? ratio[i] : lo;
+		hi = ratio[i] > hi ? ratio[i] : hi;
+	}
+	fprintf(report,
+	        "paired: %s is %.2f times faster than %s %s, the median of %d pairs' ratios "
+	        "(%.2f .. %.2f)\n",
+	        a->backend, bench_median(ratio, n), vs->name, what, n, lo, hi);
+}
+
 /* The ratio per step measured fairly on a shared machine: the two backends
  * run one after the other, a pair at a time, so that a change of load
  * between runs moves both sides of a pair alike; the median of the pairs'
  * ratios is the figure (ratio_paired), their spread says how noisy the
- * machine was. */
+ * machine was. The same by the process's CPU time (ratio_paired_cpu), which
+ * the other programs of a shared machine inflate far less than wall time. */
 static int bench_pairs(const bench_args *a, const bsim_backend *backend, const bsim_backend *vs,
                        const bsim_experiment *h1, bench_results *b)
 {
@@ -429,17 +465,13 @@ static int bench_pairs(const bench_args *a, const bsim_backend *backend, const b
 			rc = bench_sweep(vs, &a->vs_opts, h1, a->experiment, 1, &theirs);
 		if (rc != CLI_OK)
 			return rc;
+		b->pair_ratio_cpu[b->n_pairs] =
+		        (theirs.cpu / (double)theirs.steps) / (mine.cpu / (double)mine.steps);
 		b->pair_ratio[b->n_pairs++] = bench_speedup_per_step(&mine, &theirs);
 	}
-	double lo = b->pair_ratio[0], hi = lo;
-	for (int i = 1; i < b->n_pairs; i++) {
-		lo = b->pair_ratio[i] < lo ? b->pair_ratio[i] : lo;
-		hi = b->pair_ratio[i] > hi ? b->pair_ratio[i] : hi;
-	}
-	fprintf(report,
-	        "\npaired: %s is %.2f times faster than %s per step, the median of %d pairs' "
-	        "ratios (%.2f .. %.2f)\n",
-	        a->backend, bench_pairs_median(b), vs->name, b->n_pairs, lo, hi);
+	fprintf(report, "\n");
+	bench_pairs_print(a, vs, "per step", b->pair_ratio, b->n_pairs);
+	bench_pairs_print(a, vs, "in CPU time per step", b->pair_ratio_cpu, b->n_pairs);
 	return CLI_OK;
 }
 
