@@ -86,10 +86,10 @@ static void test_verdicts(void **state)
 	/* Deterministic groups: one pair, outside the Holm family, no p-value.
 	 * The family (bsim_compare_family): groups 0 and 3 only traverse, left
 	 * or right, so traversed is always and right is 1 - left: left alone;
-	 * groups 1 and 2 traverse or get stuck: traversed and left (right =
-	 * traversed - left, stuck = 1 - traversed). */
+	 * groups 1 and 2 traverse or get stuck: left and right (traversed =
+	 * left + right, stuck = 1 - left - right). */
 	assert_int_equal(c.groups[0].family, 1u << BSIM_EVENT_LEFT);
-	assert_int_equal(c.groups[1].family, 1u << BSIM_EVENT_TRAVERSED | 1u << BSIM_EVENT_LEFT);
+	assert_int_equal(c.groups[1].family, 1u << BSIM_EVENT_LEFT | 1u << BSIM_EVENT_RIGHT);
 	assert_int_equal(c.groups[4].family, 0);
 	assert_int_equal(c.n_tests, 6);
 	assert_true(isnan(c.groups[0].ev[BSIM_EVENT_TRAVERSED].p_holm));
@@ -109,7 +109,11 @@ static void test_verdicts(void **state)
 	assert_float_equal(t->p_b, 0.05, 1e-15);
 	assert_float_equal(t->diff, 0.7, 1e-15);
 	assert_float_equal(t->p_value, bsim_stats_mcnemar_exact(140, 0), 1e-300);
-	assert_true(t->p_holm >= t->p_value && t->beyond && !t->equivalent);
+	/* traversed = left + right: out of the family, which flags its parts */
+	assert_true(!t->in_family && isnan(t->p_holm) && !t->beyond && !t->equivalent);
+	const bsim_event_test *l = &c.groups[2].ev[BSIM_EVENT_LEFT];
+	assert_int_equal(l->pairs.b, 70);
+	assert_true(l->in_family && l->p_holm >= l->p_value && l->beyond);
 	assert_int_equal(c.groups[2].ev[BSIM_EVENT_STUCK].pairs.c, 140);
 	assert_int_equal(c.groups[1].discordant, 3);
 	assert_int_equal(c.groups[3].changed, 1);
@@ -210,8 +214,8 @@ static void test_separation_quantiles(void **state)
 }
 
 /* The Holm family by its definition: of the events whose cells occur, those
- * not a linear combination of the ones before (unstable, traversed,
- * side_exit, left, right, stuck) and the constant. Cells: bit 0 traversed
+ * not a linear combination of the ones before (unstable, left, right,
+ * side_exit, traversed, stuck) and the constant. Cells: bit 0 traversed
  * left, 1 right, 2 none, 3 side exit, 4 stuck, 5 unstable. */
 static void test_family_by_hand(void **state)
 {
@@ -223,11 +227,12 @@ static void test_family_by_hand(void **state)
 	assert_int_equal(bsim_compare_family(0), 0);
 	assert_int_equal(bsim_compare_family(S), 0);      /* every trial stuck: nothing varies */
 	assert_int_equal(bsim_compare_family(X | S), EX); /* stuck = 1 - side_exit */
-	assert_int_equal(bsim_compare_family(L | R | S), T | EL); /* right = traversed - left */
-	assert_int_equal(bsim_compare_family(L | R | X), T | EL); /* side_exit = 1 - traversed */
-	assert_int_equal(bsim_compare_family(L | R | NONE | S), T | EL | ER);
+	assert_int_equal(bsim_compare_family(L | R | S), EL | ER); /* traversed = left + right */
+	assert_int_equal(bsim_compare_family(L | R | X), EL | ER); /* side_exit = 1 - both */
+	assert_int_equal(bsim_compare_family(L | S), EL);          /* traversed = left */
+	assert_int_equal(bsim_compare_family(L | R | NONE | S), EL | ER | T);
 	assert_int_equal(bsim_compare_family(S | U), EU);
-	assert_int_equal(bsim_compare_family(L | R | X | S | U), EU | T | EX | EL);
+	assert_int_equal(bsim_compare_family(L | R | X | S | U), EU | EL | ER | EX);
 	/* All six cells: five free probabilities. */
 	assert_int_equal(bsim_compare_family(L | R | NONE | X | S | U), EU | T | EX | EL | ER);
 }
@@ -237,7 +242,7 @@ static void test_family_by_hand(void **state)
  * unstable, the ceiling of stuck). Group 1: 3 of 100 traverse on A, 2 on B,
  * the rest stuck: still every event within 0.05 of 0 or 1. Both are
  * uninformative, not equivalent, and outside the Holm family but for
- * group 1's traversed. Group 2: as group 1, but half the trials leave by a
+ * group 1's left. Group 2: as group 1, but half the trials leave by a
  * side: side exits are informative and equivalent, so the group is. */
 static void test_uninformative(void **state)
 {
@@ -273,12 +278,11 @@ static void test_uninformative(void **state)
 	}
 	assert_true(c.groups[2].ev[BSIM_EVENT_SIDE_EXIT].informative);
 	assert_false(c.groups[2].ev[BSIM_EVENT_TRAVERSED].informative);
-	/* Family: group 0 none; group 1 traversed (left = traversed, stuck
-	 * = 1 - traversed); group 2 traversed and side_exit. */
+	/* Family: group 0 none; group 1 left (traversed = left, stuck = 1 -
+	 * left); group 2 left and side_exit. */
 	assert_int_equal(c.groups[0].family, 0);
-	assert_int_equal(c.groups[1].family, 1u << BSIM_EVENT_TRAVERSED);
-	assert_int_equal(c.groups[2].family,
-	                 1u << BSIM_EVENT_TRAVERSED | 1u << BSIM_EVENT_SIDE_EXIT);
+	assert_int_equal(c.groups[1].family, 1u << BSIM_EVENT_LEFT);
+	assert_int_equal(c.groups[2].family, 1u << BSIM_EVENT_LEFT | 1u << BSIM_EVENT_SIDE_EXIT);
 	assert_int_equal(c.n_tests, 3);
 	bsim_compare_free(&c);
 }
@@ -287,8 +291,8 @@ static void test_uninformative(void **state)
  * on A and get stuck on B, the rest stuck on both; McNemar p = 2 (1/2)^7 =
  * 0.0156 for traversed, left and stuck alike. Holm over the old family of
  * all 6 events makes it 6 x 0.0156 = 0.094: not flagged. The family is
- * traversed alone (left = traversed, stuck = 1 - traversed, the rest never
- * occur): 0.0156 < 0.05 and 0.07 >= the margin, so the group disagrees. */
+ * left alone (traversed = left, stuck = 1 - left, the rest never occur):
+ * 0.0156 < 0.05 and 0.07 >= the margin, so the group disagrees. */
 static void test_family_power(void **state)
 {
 	(void)state;
@@ -312,7 +316,8 @@ static void test_family_power(void **state)
 	bsim_stats_holm(old, BSIM_N_EVENTS, old);
 	assert_true(old[BSIM_EVENT_TRAVERSED] >= 0.05);
 	assert_int_equal(c.n_tests, 1);
-	assert_float_equal(c.groups[0].ev[BSIM_EVENT_TRAVERSED].p_holm, 2.0 / 128.0, 1e-15);
+	assert_float_equal(c.groups[0].ev[BSIM_EVENT_LEFT].p_holm, 2.0 / 128.0, 1e-15);
+	assert_true(c.groups[0].ev[BSIM_EVENT_LEFT].beyond);
 	assert_int_equal(c.groups[0].verdict, BSIM_VERDICT_DISAGREE);
 	bsim_compare_free(&c);
 }

@@ -94,20 +94,20 @@ typedef struct bsim_event_test {
  * outcome cells (traversed left, right or none, side exit, stuck,
  * unstable) that occur in the group on either side. Each event is the set
  * of its cells, and since every trial is in exactly one cell the cells'
- * indicators sum to 1. Events are taken in the order unstable, traversed,
- * side_exit, left, right, stuck, each only if its indicator over the
+ * indicators sum to 1. Events are taken in the order unstable, left,
+ * right, side_exit, traversed, stuck, each only if its indicator over the
  * occurring cells is not a linear combination of those taken and the
  * constant 1: then its null hypothesis (p_A = p_B) is implied by theirs.
  * So an event that never occurs on either side (structurally zero here:
  * its McNemar p is 1 whatever happens, and it would only raise Holm's
  * multiplier) is out; so is the outcome that is the complement of the
- * others that occur (stuck, or side_exit when nothing is stuck), and of
- * traversed, left and right the last unless some traversal is of type
- * none. The occurring cells do not change when the two sides of any pair
- * are swapped, so under the null hypothesis of exchangeable pairs each
- * kept test stays exact given the choice. cells: the occurring cells, bit
- * c for cell c in the order traversed left, right, none, side_exit, stuck,
- * unstable; returns the family's events as bits 1 << bsim_event. */
+ * others that occur (stuck, or side_exit when nothing is stuck), and
+ * traversed unless some traversal is of type none (else it is left +
+ * right: the components are kept, as they tell which beam the body went
+ * over and neither is preferred to the other). The occurring cells do not change when the two sides
+ * of any pair are swapped, so under the null hypothesis of exchangeable pairs each kept test stays
+ * exact given the choice. cells: the occurring cells, bit c for cell c in the order traversed left,
+ * right, none, side_exit, stuck, unstable; returns the family's events as bits 1 << bsim_event. */
 BSIM_API unsigned bsim_compare_family(unsigned cells);
 
 /* The verdicts, from "nothing to see" to "disagree". Deterministic groups

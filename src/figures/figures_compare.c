@@ -143,7 +143,7 @@ static void diff_series(FILE *o, int e, double dx, int pt, const char *color, co
 	        c + 1, c + 2, pt);
 }
 
-/* "; 6 same, 15 equivalent, 6 uninformative, ..." from report.json's
+/* "\nverdicts: 6 same, 15 equivalent, 6 uninformative, ..." from report.json's
  * verdicts, uninformative (both sides at the floor or the ceiling) counted
  * apart from equivalent; empty if the report has no verdict counts. */
 static void verdict_counts(struct fy_node *root, char *buf, size_t size)
@@ -163,7 +163,8 @@ static void verdict_counts(struct fy_node *root, char *buf, size_t size)
 		double v = num(root, p, &bad);
 		if (bad)
 			continue;
-		int w = snprintf(buf + L, size - L, "%s%.0f %s", L ? ", " : "; ", v, names[i]);
+		int w = snprintf(buf + L, size - L, "%s%.0f %s", L ? ", " : "\nverdicts: ", v,
+		                 names[i]);
 		L += w > 0 ? (size_t)w : 0;
 	}
 }

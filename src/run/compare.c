@@ -12,8 +12,8 @@
  * stays below alpha however many groups an experiment has. The family
  * leaves out each group's events whose hypotheses the others imply
  * (bsim_compare_family, beamsim/compare.h): an event that never occurs,
- * the complement of the other outcomes, and one of traversed, left and
- * right when traversed = left + right.
+ * the complement of the other outcomes, and traversed when it is left +
+ * right (the components tell which beam, and are symmetric).
  *
  * mde80, the minimum detectable difference: the |p_A - p_B| that the exact
  * McNemar test at alpha / (family size), Holm's first and strictest step,
@@ -204,9 +204,9 @@ enum { N_CELLS = 6 };
 static const unsigned event_cells[BSIM_N_EVENTS] = {
         [BSIM_EVENT_TRAVERSED] = 07,  [BSIM_EVENT_LEFT] = 01,   [BSIM_EVENT_RIGHT] = 02,
         [BSIM_EVENT_SIDE_EXIT] = 010, [BSIM_EVENT_STUCK] = 020, [BSIM_EVENT_UNSTABLE] = 040};
-static const bsim_event family_order[BSIM_N_EVENTS] = {BSIM_EVENT_UNSTABLE,  BSIM_EVENT_TRAVERSED,
-                                                       BSIM_EVENT_SIDE_EXIT, BSIM_EVENT_LEFT,
-                                                       BSIM_EVENT_RIGHT,     BSIM_EVENT_STUCK};
+static const bsim_event family_order[BSIM_N_EVENTS] = {BSIM_EVENT_UNSTABLE,  BSIM_EVENT_LEFT,
+                                                       BSIM_EVENT_RIGHT,     BSIM_EVENT_SIDE_EXIT,
+                                                       BSIM_EVENT_TRAVERSED, BSIM_EVENT_STUCK};
 
 /* Reduces v against the rows taken (each with its pivot column) and adds
  * it as a row if anything is left: Gaussian elimination on 0/1 vectors of
