@@ -3,7 +3,9 @@
  * equivalent when there are enough trials and inconclusive when there are
  * not, a large one-sided difference is a disagreement, a deterministic
  * group is one pair (same or different) outside the Holm family, and the
- * margin and the exact rule act as documented. */
+ * margin and the exact rule act as documented; the Holm family by its
+ * definition, groups at the floor uninformative, and the smaller family
+ * flagging what the redundant one missed. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -81,9 +83,17 @@ static void test_verdicts(void **state)
 	assert_int_equal(c.n_disagree, 2);
 	assert_int_equal(c.count[BSIM_VERDICT_EQUIVALENT], 3);
 
-	/* Deterministic groups: one pair, outside the Holm family of 4 random
-	 * groups x 6 events, no p-value. */
-	assert_int_equal(c.n_tests, 4 * BSIM_N_EVENTS);
+	/* Deterministic groups: one pair, outside the Holm family, no p-value.
+	 * The family (bsim_compare_family): groups 0 and 3 only traverse, left
+	 * or right, so traversed is always and right is 1 - left: left alone;
+	 * groups 1 and 2 traverse or get stuck: left and right (traversed =
+	 * left + right, stuck = 1 - left - right). */
+	assert_int_equal(c.groups[0].family, 1u << BSIM_EVENT_LEFT);
+	assert_int_equal(c.groups[1].family, 1u << BSIM_EVENT_LEFT | 1u << BSIM_EVENT_RIGHT);
+	assert_int_equal(c.groups[4].family, 0);
+	assert_int_equal(c.n_tests, 6);
+	assert_true(isnan(c.groups[0].ev[BSIM_EVENT_TRAVERSED].p_holm));
+	assert_false(c.groups[0].ev[BSIM_EVENT_TRAVERSED].in_family);
 	assert_int_equal(c.groups[4].pairs, 1);
 	assert_int_equal(c.groups[4].discordant, 1);
 	assert_true(isnan(c.groups[4].ev[BSIM_EVENT_TRAVERSED].p_value));
@@ -99,22 +109,34 @@ static void test_verdicts(void **state)
 	assert_float_equal(t->p_b, 0.05, 1e-15);
 	assert_float_equal(t->diff, 0.7, 1e-15);
 	assert_float_equal(t->p_value, bsim_stats_mcnemar_exact(140, 0), 1e-300);
-	assert_true(t->p_holm >= t->p_value && t->beyond && !t->equivalent);
+	/* traversed = left + right: out of the family, which flags its parts */
+	assert_true(!t->in_family && isnan(t->p_holm) && !t->beyond && !t->equivalent);
+	const bsim_event_test *l = &c.groups[2].ev[BSIM_EVENT_LEFT];
+	assert_int_equal(l->pairs.b, 70);
+	assert_true(l->in_family && l->p_holm >= l->p_value && l->beyond);
 	assert_int_equal(c.groups[2].ev[BSIM_EVENT_STUCK].pairs.c, 140);
 	assert_int_equal(c.groups[1].discordant, 3);
 	assert_int_equal(c.groups[3].changed, 1);
 	assert_int_equal(c.groups[3].discordant, 0);
 
-	/* Detectable by hand: 24 tests at 0.05 need p < 2.08e-3; a one-way
-	 * split of m pairs gives 2 (1/2)^m: 3.9e-3 for 9, 1.95e-3 for 10, so
-	 * with no discordant pair the smallest flaggable difference is 10 of
-	 * 200 pairs. */
-	double level = 0.05 / 24.0;
+	/* The smallest significant difference by hand: 6 tests at 0.05 need
+	 * p < 8.3e-3; a one-way split of m pairs gives 2 (1/2)^m: 1.56e-2 for
+	 * 7, 7.8e-3 for 8, so with no discordant pair the bound is 8 of 200
+	 * pairs. */
+	double level = 0.05 / 6.0;
 	int fewest = 1;
 	while (2.0 * pow(0.5, fewest) >= level)
 		fewest++;
-	assert_int_equal(fewest, 10);
-	assert_float_equal(c.groups[0].ev[BSIM_EVENT_TRAVERSED].detectable, fewest / 200.0, 1e-15);
+	assert_int_equal(fewest, 8);
+	assert_float_equal(c.groups[0].ev[BSIM_EVENT_TRAVERSED].min_significant, fewest / 200.0,
+	                   1e-15);
+	/* mde80 with no discordant pair: every discordant pair one way (psi =
+	 * delta), the power P(m >= 8) for m ~ Binomial(200, delta) is 0.8. */
+	double mde = c.groups[0].ev[BSIM_EVENT_TRAVERSED].mde80, tail = 0.0;
+	for (int m = 0; m < fewest; m++)
+		tail += exp(lgamma(201.0) - lgamma(m + 1.0) - lgamma(201.0 - m) + m * log(mde) +
+		            (200 - m) * log1p(-mde));
+	assert_float_equal(1.0 - tail, 0.8, 1e-9);
 	bsim_compare_free(&c);
 }
 
@@ -191,6 +213,115 @@ static void test_separation_quantiles(void **state)
 	bsim_compare_free(&c);
 }
 
+/* The Holm family by its definition: of the events whose cells occur, those
+ * not a linear combination of the ones before (unstable, left, right,
+ * side_exit, traversed, stuck) and the constant. Cells: bit 0 traversed
+ * left, 1 right, 2 none, 3 side exit, 4 stuck, 5 unstable. */
+static void test_family_by_hand(void **state)
+{
+	(void)state;
+	enum { L = 1, R = 2, NONE = 4, X = 8, S = 16, U = 32 };
+	const unsigned T = 1u << BSIM_EVENT_TRAVERSED, EL = 1u << BSIM_EVENT_LEFT,
+	               ER = 1u << BSIM_EVENT_RIGHT, EX = 1u << BSIM_EVENT_SIDE_EXIT,
+	               EU = 1u << BSIM_EVENT_UNSTABLE;
+	assert_int_equal(bsim_compare_family(0), 0);
+	assert_int_equal(bsim_compare_family(S), 0);      /* every trial stuck: nothing varies */
+	assert_int_equal(bsim_compare_family(X | S), EX); /* stuck = 1 - side_exit */
+	assert_int_equal(bsim_compare_family(L | R | S), EL | ER); /* traversed = left + right */
+	assert_int_equal(bsim_compare_family(L | R | X), EL | ER); /* side_exit = 1 - both */
+	assert_int_equal(bsim_compare_family(L | S), EL);          /* traversed = left */
+	assert_int_equal(bsim_compare_family(L | R | NONE | S), EL | ER | T);
+	assert_int_equal(bsim_compare_family(S | U), EU);
+	assert_int_equal(bsim_compare_family(L | R | X | S | U), EU | EL | ER | EX);
+	/* All six cells: five free probabilities. */
+	assert_int_equal(bsim_compare_family(L | R | NONE | X | S | U), EU | T | EX | EL | ER);
+}
+
+/* Groups at the floor or the ceiling. Group 0: every trial stuck on both
+ * sides (never traverses: the floor of traversed, left, right, side_exit,
+ * unstable, the ceiling of stuck). Group 1: 3 of 100 traverse on A, 2 on B,
+ * the rest stuck: still every event within 0.05 of 0 or 1. Both are
+ * uninformative, not equivalent, and outside the Holm family but for
+ * group 1's left. Group 2: as group 1, but half the trials leave by a
+ * side: side exits are informative and equivalent, so the group is. */
+static void test_uninformative(void **state)
+{
+	(void)state;
+	enum { G3 = 3, N3 = 100 };
+	static bsim_trial_result a[G3 * N3], b[G3 * N3];
+	for (int i = 0; i < G3 * N3; i++)
+		stuck(&a[i]);
+	for (int t = 0; t < 3; t++)
+		traversed(&a[N3 + t], BSIM_TYPE_LEFT), traversed(&a[2 * N3 + t], BSIM_TYPE_LEFT);
+	memcpy(b, a, sizeof a);
+	stuck(&b[N3 + 2]);
+	stuck(&b[2 * N3 + 2]);
+	for (int t = 50; t < N3; t++)
+		a[2 * N3 + t].outcome = b[2 * N3 + t].outcome = BSIM_SIDE_EXIT;
+	bsim_sweep_result x = {.n_groups = G3, .trials = N3, .trials_out = a};
+	bsim_sweep_result y = {.n_groups = G3, .trials = N3, .trials_out = b};
+	bsim_comparison c;
+	bsim_error err;
+	bsim_compare_rule rule = {0.05, 0.05, 0};
+	assert_int_equal(bsim_compare_analyse(&x, &y, NULL, &rule, &c, &err), BSIM_OK);
+	assert_int_equal(c.groups[0].verdict, BSIM_VERDICT_UNINFORMATIVE);
+	assert_int_equal(c.groups[1].verdict, BSIM_VERDICT_UNINFORMATIVE);
+	assert_int_equal(c.groups[2].verdict, BSIM_VERDICT_EQUIVALENT);
+	assert_int_equal(c.count[BSIM_VERDICT_UNINFORMATIVE], 2);
+	assert_int_equal(c.count[BSIM_VERDICT_EQUIVALENT], 1);
+	assert_int_equal(c.n_disagree, 0);
+	for (int e = 0; e < BSIM_N_EVENTS; e++) {
+		assert_false(c.groups[0].ev[e].informative);
+		assert_false(c.groups[1].ev[e].informative);
+		/* the floor's equivalence is shown, and still says nothing */
+		assert_true(c.groups[0].ev[e].equivalent);
+	}
+	assert_true(c.groups[2].ev[BSIM_EVENT_SIDE_EXIT].informative);
+	assert_false(c.groups[2].ev[BSIM_EVENT_TRAVERSED].informative);
+	/* Family: group 0 none; group 1 left (traversed = left, stuck = 1 -
+	 * left); group 2 left and side_exit. */
+	assert_int_equal(c.groups[0].family, 0);
+	assert_int_equal(c.groups[1].family, 1u << BSIM_EVENT_LEFT);
+	assert_int_equal(c.groups[2].family, 1u << BSIM_EVENT_LEFT | 1u << BSIM_EVENT_SIDE_EXIT);
+	assert_int_equal(c.n_tests, 3);
+	bsim_compare_free(&c);
+}
+
+/* A difference the redundant family missed: 7 of 100 pairs traverse (left)
+ * on A and get stuck on B, the rest stuck on both; McNemar p = 2 (1/2)^7 =
+ * 0.0156 for traversed, left and stuck alike. Holm over the old family of
+ * all 6 events makes it 6 x 0.0156 = 0.094: not flagged. The family is
+ * left alone (traversed = left, stuck = 1 - left, the rest never occur):
+ * 0.0156 < 0.05 and 0.07 >= the margin, so the group disagrees. */
+static void test_family_power(void **state)
+{
+	(void)state;
+	enum { N1 = 100 };
+	static bsim_trial_result a[N1], b[N1];
+	for (int t = 0; t < N1; t++) {
+		stuck(&a[t]);
+		stuck(&b[t]);
+	}
+	for (int t = 0; t < 7; t++)
+		traversed(&a[t], BSIM_TYPE_LEFT);
+	bsim_sweep_result x = {.n_groups = 1, .trials = N1, .trials_out = a};
+	bsim_sweep_result y = {.n_groups = 1, .trials = N1, .trials_out = b};
+	bsim_comparison c;
+	bsim_error err;
+	bsim_compare_rule rule = {0.05, 0.05, 0};
+	assert_int_equal(bsim_compare_analyse(&x, &y, NULL, &rule, &c, &err), BSIM_OK);
+	double old[BSIM_N_EVENTS];
+	for (int e = 0; e < BSIM_N_EVENTS; e++)
+		old[e] = c.groups[0].ev[e].p_value;
+	bsim_stats_holm(old, BSIM_N_EVENTS, old);
+	assert_true(old[BSIM_EVENT_TRAVERSED] >= 0.05);
+	assert_int_equal(c.n_tests, 1);
+	assert_float_equal(c.groups[0].ev[BSIM_EVENT_LEFT].p_holm, 2.0 / 128.0, 1e-15);
+	assert_true(c.groups[0].ev[BSIM_EVENT_LEFT].beyond);
+	assert_int_equal(c.groups[0].verdict, BSIM_VERDICT_DISAGREE);
+	bsim_compare_free(&c);
+}
+
 static void test_shape_mismatch(void **state)
 {
 	(void)state;
@@ -207,7 +338,8 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_verdicts),       cmocka_unit_test(test_rule_knobs),
 	        cmocka_unit_test(test_inconclusive),   cmocka_unit_test(test_separation_quantiles),
-	        cmocka_unit_test(test_shape_mismatch),
+	        cmocka_unit_test(test_shape_mismatch), cmocka_unit_test(test_family_by_hand),
+	        cmocka_unit_test(test_uninformative),  cmocka_unit_test(test_family_power),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -318,7 +318,8 @@ static void test_one_backend_two_settings(void **state)
 
 /* The noise-free groups are deterministic: one pair, reported as such,
  * with no interval or p-value; the others carry Tango's interval, an
- * equivalence p-value and the smallest detectable difference. */
+ * equivalence p-value, mde80 and the smallest significant difference, and
+ * the Holm family counts the events marked in it. */
 static void test_report_deterministic(void **state)
 {
 	(void)state;
@@ -330,10 +331,17 @@ static void test_report_deterministic(void **state)
 	assert_non_null(g1);
 	assert_non_null(strstr(g1, "\"deterministic\": false, \"pairs\": 12"));
 	assert_non_null(strstr(g1, "\"p_equivalence\": "));
-	assert_non_null(strstr(g1, "\"detectable\": "));
+	assert_non_null(strstr(g1, "\"mde80\": "));
+	assert_non_null(strstr(g1, "\"min_significant\": "));
 	assert_non_null(strstr(json, "\"interval\": \"tango_score\""));
-	/* 2 random groups x 6 events in the Holm family */
-	assert_non_null(strstr(json, "\"tests\": 12"));
+	/* The family's size is the number of events in it, group by group. */
+	const char *at = strstr(json, "\"tests\": ");
+	assert_non_null(at);
+	int tests = atoi(at + strlen("\"tests\": ")), in = 0;
+	for (const char *p = json; (p = strstr(p, "\"in_family\": true")); p++)
+		in++;
+	assert_int_equal(tests, in);
+	assert_true(tests > 0 && tests < 2 * 6);
 	char *md = read_in(cmp_dir, "report.md");
 	assert_non_null(strstr(md, "| 0 | 8 | 0 | stuck | stuck | deterministic | 0 of 1 |"));
 	free(json);

@@ -46,11 +46,18 @@ BSIM_API int bsim_compare_event_of(const bsim_trial_result *r, bsim_event ev);
  * different, with no interval or p-value, and stays out of the Holm
  * family. A deterministic pair that differs in outcome or type disagrees.
  *
- * A group that does not disagree is "equivalent" when, for every event,
- * Tango's two one-sided tests show the difference within +-margin at level
- * alpha; otherwise the comparison could not tell ("inconclusive": no
- * difference detected, none excluded either). Each group's equivalence is
- * tested at alpha without correction: the claim that every group is
+ * The Holm family holds, for each random group, the events whose
+ * hypotheses are not implied by the others' (bsim_compare_family).
+ *
+ * An event is "informative" unless both probabilities lie within the margin
+ * of 0 or both within the margin of 1: at the floor or the ceiling two
+ * backends agree within the margin whatever their physics. A group that
+ * does not disagree is "equivalent" when at least one event is informative
+ * and, for every informative event, Tango's two one-sided tests show the
+ * difference within +-margin at level alpha; "uninformative" when no event
+ * is informative; otherwise the comparison could not tell ("inconclusive":
+ * no difference detected, none excluded either). Each group's equivalence
+ * is tested at alpha without correction: the claim that every group is
  * equivalent is an intersection-union test, valid at alpha as it is. */
 typedef struct bsim_compare_rule {
 	double alpha;  /* family-wise error rate, (0, 1) */
@@ -68,22 +75,51 @@ typedef struct bsim_event_test {
 	double diff, diff_ci[2]; /* p_a - p_b, Tango's paired score 95% */
 	double p_value, p_holm;  /* exact McNemar, and Holm-adjusted */
 	double p_equivalence;    /* Tango's two one-sided tests against +-margin */
-	double detectable;       /* the smallest |p_a - p_b| the Holm-corrected test
-	                          * could flag here, given this event's discordant
-	                          * pairs (at least the fewest that can be flagged) */
-	int beyond;              /* p_holm < alpha and |diff| >= margin */
+	double mde80;            /* the |p_a - p_b| the exact McNemar test at the
+	                          * family's level (alpha / n_tests) detects with
+	                          * power 0.8 at this event's discordance
+	                          * (bsim_stats_mcnemar_mde) */
+	double min_significant;  /* the smallest |b - c| / n that is significant at
+	                          * that level with this event's number of
+	                          * discordant pairs (at least the fewest that can
+	                          * be), i.e. with them split as unevenly as a
+	                          * significant result needs: a bound, not a power */
+	int in_family;           /* tested in the rule (bsim_compare_family) */
+	int informative;         /* not both p within margin of 0, nor both of 1 */
+	int beyond;              /* in the family, p_holm < alpha, |diff| >= margin */
 	int equivalent;          /* p_equivalence < alpha */
 } bsim_event_test;
 
+/* The events of a random group's Holm family, by structure and by the
+ * outcome cells (traversed left, right or none, side exit, stuck,
+ * unstable) that occur in the group on either side. Each event is the set
+ * of its cells, and since every trial is in exactly one cell the cells'
+ * indicators sum to 1. Events are taken in the order unstable, left,
+ * right, side_exit, traversed, stuck, each only if its indicator over the
+ * occurring cells is not a linear combination of those taken and the
+ * constant 1: then its null hypothesis (p_A = p_B) is implied by theirs.
+ * So an event that never occurs on either side (structurally zero here:
+ * its McNemar p is 1 whatever happens, and it would only raise Holm's
+ * multiplier) is out; so is the outcome that is the complement of the
+ * others that occur (stuck, or side_exit when nothing is stuck), and
+ * traversed unless some traversal is of type none (else it is left +
+ * right: the components are kept, as they tell which beam the body went
+ * over and neither is preferred to the other). The occurring cells do not change when the two sides
+ * of any pair are swapped, so under the null hypothesis of exchangeable pairs each kept test stays
+ * exact given the choice. cells: the occurring cells, bit c for cell c in the order traversed left,
+ * right, none, side_exit, stuck, unstable; returns the family's events as bits 1 << bsim_event. */
+BSIM_API unsigned bsim_compare_family(unsigned cells);
+
 /* The verdicts, from "nothing to see" to "disagree". Deterministic groups
- * are same or DIFFERENT; the others one of the four below. */
+ * are same or DIFFERENT; the others one of the five between. */
 typedef enum {
-	BSIM_VERDICT_SAME = 0,         /* deterministic: the one pair alike */
-	BSIM_VERDICT_EQUIVALENT = 1,   /* every event shown within +-margin */
-	BSIM_VERDICT_INCONCLUSIVE = 2, /* no difference detected, none excluded */
-	BSIM_VERDICT_SMALL = 3,        /* significant, but within the margin */
-	BSIM_VERDICT_DISAGREE = 4,     /* beyond the rule */
-	BSIM_VERDICT_DIFFERENT = 5,    /* deterministic: the one pair differs */
+	BSIM_VERDICT_SAME = 0,          /* deterministic: the one pair alike */
+	BSIM_VERDICT_EQUIVALENT = 1,    /* every informative event shown within +-margin */
+	BSIM_VERDICT_UNINFORMATIVE = 2, /* every event at the floor or the ceiling */
+	BSIM_VERDICT_INCONCLUSIVE = 3,  /* no difference detected, none excluded */
+	BSIM_VERDICT_SMALL = 4,         /* significant, but within the margin */
+	BSIM_VERDICT_DISAGREE = 5,      /* beyond the rule */
+	BSIM_VERDICT_DIFFERENT = 6,     /* deterministic: the one pair differs */
 	BSIM_N_VERDICTS
 } bsim_verdict;
 
@@ -120,6 +156,7 @@ typedef struct bsim_compare_group {
 	bsim_event_test ev[BSIM_N_EVENTS];
 	bsim_location_test loc; /* lattices only */
 	int discordant;         /* pairs with a different outcome or type */
+	unsigned family;        /* the events in the Holm family, 1 << bsim_event */
 	int changed;     /* trials (copies included) not identical in some trials.csv field */
 	int separated;   /* pairs whose trajectories separated */
 	double t_sep[3]; /* 10%, 50%, 90% quantiles of the separation time
@@ -132,8 +169,9 @@ typedef struct bsim_comparison {
 	int lattice; /* 1: the final-location test is in the rule (and the Holm family) */
 	bsim_compare_rule rule;
 	bsim_compare_group *groups;
-	int n_tests;    /* the Holm family: random groups x events (x the final-location
-	                 * test, on a lattice) */
+	int n_tests;    /* the Holm family's size: each random group's family events
+	                 * (bsim_compare_family), and its final-location test on a
+	                 * lattice */
 	int n_disagree; /* groups DISAGREE or DIFFERENT */
 	int count[BSIM_N_VERDICTS];
 	int separated; /* pairs that separated, over all groups */

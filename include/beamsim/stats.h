@@ -61,6 +61,27 @@ BSIM_API double bsim_stats_tango_tost(const bsim_pairs *t, double margin);
  * none (too few pairs to reach it). |b - c| >= m - 2k is then significant. */
 BSIM_API int bsim_stats_mcnemar_split(int m, double level);
 
+/* The exact McNemar test's thresholds for every count of discordant pairs:
+ * k[m] = bsim_stats_mcnemar_split(m, level) for m = 0..n (k has n + 1
+ * entries), in O(n^2) operations instead of O(n^3). */
+BSIM_API void bsim_stats_mcnemar_splits(int n, double level, int *k);
+
+/* The exact power of the two-sided exact McNemar test with thresholds k
+ * (bsim_stats_mcnemar_splits) on n pairs when a pair is discordant with
+ * probability psi and the difference is delta = p_A - p_B,
+ * 0 <= |delta| <= psi <= 1: the probability that its p-value is below the
+ * level of k. */
+BSIM_API double bsim_stats_mcnemar_power(int n, const int *k, double psi, double delta);
+
+/* The minimum detectable difference: the smallest delta > 0 that the exact
+ * McNemar test with thresholds k detects with the given power on n pairs of
+ * discordance psi. A difference needs at least that much discordance, so
+ * where delta would exceed psi the discordance is taken as delta (every
+ * discordant pair one way); psi = 0 (no discordant pair) gives the
+ * difference detected that way. NaN when even every pair discordant one
+ * way (delta = 1) falls short of the power. */
+BSIM_API double bsim_stats_mcnemar_mde(int n, const int *k, double psi, double power);
+
 /* The standard normal quantile z with P(Z > z) = q. */
 BSIM_API double bsim_stats_normal_upper(double q);
 

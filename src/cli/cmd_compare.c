@@ -189,10 +189,11 @@ static void compare_summary(const bsim_compare_dir_def *def, const char *out,
 	       la, lb, res->e.path, cmp->n_disagree, cmp->n_groups, cmp->rule.alpha,
 	       cmp->rule.margin, res->e.n_groups, res->e.trials);
 	printf("  deterministic: %d same, %d different; random: %d equivalent within +-%g, %d "
-	       "inconclusive, %d small, %d disagree\n",
+	       "uninformative (at the floor or ceiling), %d inconclusive, %d small, %d disagree "
+	       "(Holm over %d tests)\n",
 	       k[BSIM_VERDICT_SAME], k[BSIM_VERDICT_DIFFERENT], k[BSIM_VERDICT_EQUIVALENT],
-	       cmp->rule.margin, k[BSIM_VERDICT_INCONCLUSIVE], k[BSIM_VERDICT_SMALL],
-	       k[BSIM_VERDICT_DISAGREE]);
+	       cmp->rule.margin, k[BSIM_VERDICT_UNINFORMATIVE], k[BSIM_VERDICT_INCONCLUSIVE],
+	       k[BSIM_VERDICT_SMALL], k[BSIM_VERDICT_DISAGREE], cmp->n_tests);
 	for (int g = 0; g < cmp->n_groups; g++) {
 		const bsim_compare_group *cg = &cmp->groups[g];
 		const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];

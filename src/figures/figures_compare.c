@@ -3,8 +3,9 @@
  * p_A - p_B with the report's paired intervals (Tango's score interval) for
  * traversal, the left and right types, side exits, getting stuck and
  * instability, against the rule's margin; a difference beyond the rule is
- * marked. The numbers are report.json's. Each side's own sweep figures go
- * to OUT/<label>/. */
+ * marked; the title counts the verdicts, uninformative groups (every event
+ * at the floor or the ceiling) apart from equivalent ones. The numbers are
+ * report.json's. Each side's own sweep figures go to OUT/<label>/. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdlib.h>
 #include <string.h>
@@ -142,6 +143,32 @@ static void diff_series(FILE *o, int e, double dx, int pt, const char *color, co
 	        c + 1, c + 2, pt);
 }
 
+/* "\nverdicts: 6 same, 15 equivalent, 6 uninformative, ..." from report.json's
+ * verdicts, uninformative (both sides at the floor or the ceiling) counted
+ * apart from equivalent; empty if the report has no verdict counts. */
+static void verdict_counts(struct fy_node *root, char *buf, size_t size)
+{
+	static const char *const names[] = {"same",          "different",    "equivalent",
+	                                    "uninformative", "inconclusive", "small",
+	                                    "disagree"};
+	static const char *const keys[] = {"same",          "DIFFERENT",    "equivalent",
+	                                   "uninformative", "inconclusive", "small",
+	                                   "DISAGREE"};
+	size_t L = 0;
+	buf[0] = '\0';
+	for (size_t i = 0; i < sizeof keys / sizeof keys[0] && L < size; i++) {
+		char p[64];
+		int bad = 0;
+		snprintf(p, sizeof p, "verdicts.%s", keys[i]);
+		double v = num(root, p, &bad);
+		if (bad)
+			continue;
+		int w = snprintf(buf + L, size - L, "%s%.0f %s", L ? ", " : "\nverdicts: ", v,
+		                 names[i]);
+		L += w > 0 ? (size_t)w : 0;
+	}
+}
+
 static int compare_figure(figs *f, const ydoc *d, const fsum *s, bsim_error *err)
 {
 	int n = 0, rc = compare_data(f, d, s, &n, err);
@@ -166,12 +193,13 @@ static int compare_figure(figs *f, const ydoc *d, const fsum *s, bsim_error *err
 		return rc;
 	FILE *o = g.f;
 	fprintf(o, "set multiplot layout 3,1 title ");
-	char title[400];
+	char title[600], verdicts[200];
+	verdict_counts(root, verdicts, sizeof verdicts);
 	snprintf(title, sizeof title,
-	         "%s (A) against %s (B), %d paired trials per group\nprobabilities with Wilson "
+	         "%s (A) against %s (B), %d paired trials per group%s\nprobabilities with Wilson "
 	         "95%% intervals, paired differences with the report's paired 95%% intervals; red: "
 	         "beyond the rule",
-	         la, lb, s->trials_per_group);
+	         la, lb, s->trials_per_group, verdicts);
 	gp_str(o, title);
 	fprintf(o,
 	        " noenhanced\nset xrange [-0.7:%g]\nset grid ytics\nset key outside right top\n"

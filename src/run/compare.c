@@ -7,15 +7,30 @@
  *   p_A - p_B = (b - c)/n                   Tango's score 95% (stats.h)
  *   McNemar exact: b ~ Binomial(b + c, 1/2) under "no difference"
  *   equivalence: Tango's two one-sided tests against +-margin
- * The McNemar p-values of all random groups' tests are Holm-adjusted
+ * The McNemar p-values of the random groups' tests are Holm-adjusted
  * together, so the chance that any agreeing group is called disagreeing
- * stays below alpha however many groups an experiment has.
+ * stays below alpha however many groups an experiment has. The family
+ * leaves out each group's events whose hypotheses the others imply
+ * (bsim_compare_family, beamsim/compare.h): an event that never occurs,
+ * the complement of the other outcomes, and traversed when it is left +
+ * right (the components tell which beam, and are symmetric).
  *
- * The smallest detectable difference of a test: with m = b + c discordant
- * pairs (at least the fewest that can reach significance at all), the
- * test flags a split of k against m - k only when its exact p-value is
- * below alpha / (family size), Holm's first and strictest step; the
+ * mde80, the minimum detectable difference: the |p_A - p_B| that the exact
+ * McNemar test at alpha / (family size), Holm's first and strictest step,
+ * detects with power 0.8 when a pair is discordant with the event's
+ * observed probability psi = (b + c) / n (bsim_stats_mcnemar_mde, with the
+ * exact power; where the difference would exceed psi, psi is taken as the
+ * difference: every discordant pair one way). min_significant, a bound and
+ * not a power: with m = b + c discordant pairs (at least the fewest that
+ * can reach significance at all), the test flags a split of k against
+ * m - k only when its exact p-value is below alpha / (family size); the
  * largest such k gives |p_A - p_B| >= (m - 2k) / n.
+ *
+ * An event at the floor or the ceiling (both p within the margin of 0, or
+ * both of 1) is not informative: there any two backends agree within the
+ * margin. A group is equivalent when at least one event is informative and
+ * every informative one is shown within the margin; uninformative when
+ * none is.
  *
  * A deterministic group (no random draws on either side) is one trial run
  * once: one pair, same or different, outside the family.
@@ -72,6 +87,8 @@ const char *bsim_compare_verdict_name(bsim_verdict v)
 		return "same";
 	case BSIM_VERDICT_EQUIVALENT:
 		return "equivalent";
+	case BSIM_VERDICT_UNINFORMATIVE:
+		return "uninformative";
 	case BSIM_VERDICT_INCONCLUSIVE:
 		return "inconclusive";
 	case BSIM_VERDICT_SMALL:
@@ -144,23 +161,99 @@ static void event_point(bsim_event_test *t)
 	t->ci_b[0] = t->ci_b[1] = t->p_b;
 	t->diff_ci[0] = t->diff_ci[1] = t->diff;
 	t->p_value = t->p_holm = t->p_equivalence = NAN;
-	t->detectable = NAN;
+	t->mde80 = t->min_significant = NAN;
 }
 
 /* The smallest |p_A - p_B| the family's test can flag with the event's
- * discordant pairs; NaN if no split of n pairs can be flagged at all. */
-static double event_detectable(const bsim_event_test *t, int n, double level)
+ * discordant pairs, k[m] the test's split of m pairs at the family's level
+ * (bsim_stats_mcnemar_splits); NaN if no split of n pairs can be flagged. */
+static double event_min_significant(const bsim_event_test *t, int n, const int *k)
 {
 	int m = t->pairs.b + t->pairs.c;
 	int fewest = 1;
-	while (fewest <= n && bsim_stats_mcnemar_split(fewest, level) < 0)
+	while (fewest <= n && k[fewest] < 0)
 		fewest++;
 	if (fewest > n)
 		return NAN;
 	if (m < fewest)
 		m = fewest;
-	int k = bsim_stats_mcnemar_split(m, level);
-	return (double)(m - 2 * k) / n;
+	return (double)(m - 2 * k[m]) / n;
+}
+
+/* ---- the Holm family ----------------------------------------------------- */
+
+/* A trial's outcome cell: traversed left, right or none, side exit, stuck,
+ * unstable (the bits of bsim_compare_family's mask). */
+static int cell_of(const bsim_trial_result *r)
+{
+	switch (r->outcome) {
+	case BSIM_TRAVERSED:
+		return r->type == BSIM_TYPE_LEFT ? 0 : r->type == BSIM_TYPE_RIGHT ? 1 : 2;
+	case BSIM_SIDE_EXIT:
+		return 3;
+	case BSIM_STUCK:
+		return 4;
+	default:
+		return 5;
+	}
+}
+
+enum { N_CELLS = 6 };
+
+/* Each event's cells, and the order in which the family takes them. */
+static const unsigned event_cells[BSIM_N_EVENTS] = {
+        [BSIM_EVENT_TRAVERSED] = 07,  [BSIM_EVENT_LEFT] = 01,   [BSIM_EVENT_RIGHT] = 02,
+        [BSIM_EVENT_SIDE_EXIT] = 010, [BSIM_EVENT_STUCK] = 020, [BSIM_EVENT_UNSTABLE] = 040};
+static const bsim_event family_order[BSIM_N_EVENTS] = {BSIM_EVENT_UNSTABLE,  BSIM_EVENT_LEFT,
+                                                       BSIM_EVENT_RIGHT,     BSIM_EVENT_SIDE_EXIT,
+                                                       BSIM_EVENT_TRAVERSED, BSIM_EVENT_STUCK};
+
+/* Reduces v against the rows taken (each with its pivot column) and adds
+ * it as a row if anything is left: Gaussian elimination on 0/1 vectors of
+ * at most 6 cells, exact in doubles. 1 if v was independent. */
+static int basis_add(double rows[][N_CELLS], int *pivot, int *n_rows, double v[N_CELLS])
+{
+	for (int r = 0; r < *n_rows; r++) {
+		double f = v[pivot[r]] / rows[r][pivot[r]];
+		for (int c = 0; c < N_CELLS; c++)
+			v[c] -= f * rows[r][c];
+	}
+	for (int c = 0; c < N_CELLS; c++)
+		if (fabs(v[c]) > 1e-9) {
+			memcpy(rows[*n_rows], v, sizeof rows[0]);
+			pivot[(*n_rows)++] = c;
+			return 1;
+		}
+	return 0;
+}
+
+unsigned bsim_compare_family(unsigned cells)
+{
+	double rows[N_CELLS + 1][N_CELLS], v[N_CELLS];
+	int pivot[N_CELLS + 1], n_rows = 0;
+	unsigned family = 0;
+	/* The constant 1 first: an event that occurs in every trial (or in
+	 * none) says nothing. */
+	for (int c = 0; c < N_CELLS; c++)
+		v[c] = cells >> c & 1u;
+	basis_add(rows, pivot, &n_rows, v);
+	for (int i = 0; i < BSIM_N_EVENTS; i++) {
+		bsim_event e = family_order[i];
+		for (int c = 0; c < N_CELLS; c++)
+			v[c] = (cells & event_cells[e]) >> c & 1u;
+		if (basis_add(rows, pivot, &n_rows, v))
+			family |= 1u << e;
+	}
+	return family;
+}
+
+/* The cells occurring in n pairs, on either side. */
+static unsigned cells_of(const bsim_trial_result *a, const bsim_trial_result *b, int n)
+{
+	unsigned cells = 0;
+	for (int i = 0; i < n; i++)
+		cells |= 1u << cell_of(&a[i]) | 1u << cell_of(&b[i]);
+	return cells;
 }
 
 /* ---- the final-location permutation test ------------------------------- */
@@ -324,15 +417,25 @@ static void group_verdict(bsim_compare_group *g, const bsim_compare_rule *rule, 
 		                                           : BSIM_VERDICT_SAME;
 		return;
 	}
-	int significant = 0, beyond = 0, equivalent = 1;
+	int significant = 0, beyond = 0, equivalent = 1, informative = 0;
 	for (int e = 0; e < BSIM_N_EVENTS; e++) {
 		bsim_event_test *t = &g->ev[e];
-		int sig = t->p_holm < rule->alpha;
+		int sig = t->in_family && t->p_holm < rule->alpha;
 		t->beyond = sig && fabs(t->diff) >= rule->margin;
 		t->equivalent = t->p_equivalence < rule->alpha;
+		/* by counts, so that 5 of 100 is within a margin of 0.05 */
+		int ka = t->pairs.a + t->pairs.b, kb = t->pairs.a + t->pairs.c, n = g->pairs;
+		int floor = n <= 0 ||
+		            ((double)ka / n <= rule->margin && (double)kb / n <= rule->margin);
+		int ceiling = (double)(n - ka) / n <= rule->margin &&
+		              (double)(n - kb) / n <= rule->margin;
+		t->informative = !floor && !ceiling;
 		significant |= sig;
 		beyond |= t->beyond;
-		equivalent &= t->equivalent;
+		if (t->informative) {
+			informative = 1;
+			equivalent &= t->equivalent;
+		}
 	}
 	if (lattice) {
 		int sig = g->loc.p_holm < rule->alpha;
@@ -344,6 +447,8 @@ static void group_verdict(bsim_compare_group *g, const bsim_compare_rule *rule, 
 		g->verdict = BSIM_VERDICT_DISAGREE;
 	else if (significant)
 		g->verdict = BSIM_VERDICT_SMALL;
+	else if (!informative)
+		g->verdict = BSIM_VERDICT_UNINFORMATIVE;
 	else
 		g->verdict = equivalent ? BSIM_VERDICT_EQUIVALENT : BSIM_VERDICT_INCONCLUSIVE;
 }
@@ -368,9 +473,11 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 	out->groups = calloc(G > 0 ? (size_t)G : 1, sizeof *out->groups);
 	double *p = calloc((size_t)(G > 0 ? G : 1) * (BSIM_N_EVENTS + 1), sizeof *p);
 	double *buf = malloc((size_t)(total > 0 ? total : 1) * sizeof *buf);
-	if (!out->groups || !p || !buf) {
+	int *splits = malloc(((size_t)(n > 0 ? n : 0) + 1) * sizeof *splits);
+	if (!out->groups || !p || !buf || !splits) {
 		free(p);
 		free(buf);
+		free(splits);
 		bsim_compare_free(out);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory comparing %d groups", G);
 	}
@@ -382,15 +489,20 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 		cg->deterministic = (a->groups && a->groups[g].deterministic) ||
 		                    (b->groups && b->groups[g].deterministic);
 		cg->pairs = cg->deterministic && n > 0 ? 1 : n;
+		if (!cg->deterministic)
+			cg->family = bsim_compare_family(cells_of(ra, rb, cg->pairs));
 		for (int e = 0; e < BSIM_N_EVENTS; e++) {
 			bsim_event_test *t = &cg->ev[e];
 			event_table(ra, rb, cg->pairs, (bsim_event)e, t);
 			if (cg->deterministic) {
 				event_point(t);
-			} else {
-				event_stats(t, cg->pairs, rule->margin);
-				p[out->n_tests++] = t->p_value;
+				continue;
 			}
+			event_stats(t, cg->pairs, rule->margin);
+			t->in_family = (cg->family >> e & 1u) != 0;
+			t->p_holm = NAN;
+			if (t->in_family)
+				p[out->n_tests++] = t->p_value;
 		}
 		if (out->lattice && !cg->deterministic) {
 			bsim_compare_location_test(ra, rb, cg->pairs, 0x5eed0000u + (uint64_t)g,
@@ -412,11 +524,17 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 	}
 	bsim_stats_holm(p, out->n_tests, p);
 	double level = out->n_tests > 0 ? rule->alpha / out->n_tests : rule->alpha;
+	bsim_stats_mcnemar_splits(n, level, splits);
 	for (int g = 0, k = 0; g < G; g++) {
 		bsim_compare_group *cg = &out->groups[g];
 		for (int e = 0; !cg->deterministic && e < BSIM_N_EVENTS; e++) {
-			cg->ev[e].p_holm = p[k++];
-			cg->ev[e].detectable = event_detectable(&cg->ev[e], cg->pairs, level);
+			bsim_event_test *t = &cg->ev[e];
+			if (t->in_family)
+				t->p_holm = p[k++];
+			double psi =
+			        cg->pairs > 0 ? (double)(t->pairs.b + t->pairs.c) / cg->pairs : 0.0;
+			t->mde80 = bsim_stats_mcnemar_mde(cg->pairs, splits, psi, 0.8);
+			t->min_significant = event_min_significant(t, cg->pairs, splits);
 		}
 		if (out->lattice && !cg->deterministic)
 			cg->loc.p_holm = p[k++];
@@ -435,6 +553,7 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 	}
 	free(p);
 	free(buf);
+	free(splits);
 	return BSIM_OK;
 }
 

@@ -84,12 +84,13 @@ static void params_text(FILE *f, const bsim_experiment *e, int g)
 		fprintf(f, "%s%s = %s", a ? ", " : "", e->axes[a].key, e->axes[a].values[idx[a]]);
 }
 
-/* The event with the smallest adjusted p-value: what a row shows. */
+/* The event of the family with the smallest adjusted p-value: what a row
+ * shows; -1 if the family has none of the group's events. */
 static int key_event(const bsim_compare_group *cg)
 {
-	int k = BSIM_EVENT_TRAVERSED;
-	for (int ev = 1; ev < BSIM_N_EVENTS; ev++)
-		if (cg->ev[ev].p_holm < cg->ev[k].p_holm)
+	int k = -1;
+	for (int ev = 0; ev < BSIM_N_EVENTS; ev++)
+		if (cg->ev[ev].in_family && (k < 0 || cg->ev[ev].p_holm < cg->ev[k].p_holm))
 			k = ev;
 	return k;
 }
@@ -108,6 +109,53 @@ static void md_separation(FILE *f, const bsim_report *r)
 		fprintf(f, "; separation time quantiles 10%% / 50%% / 90%%: %.3f / %.3f / %.3f s",
 		        c->t_sep[0], c->t_sep[1], c->t_sep[2]);
 	fputs(". Per pair: pairs.csv.\n\n", f);
+}
+
+/* One event's paired tables of the groups with random force, summed: under
+ * "no difference in any group" every discordant pair is still equally
+ * likely to go either way, so McNemar's test and Tango's interval apply to
+ * the sum. 0 if no group has random force. */
+static int pooled(const bsim_comparison *c, int ev, bsim_pairs *t, double ci[2], double *p)
+{
+	int groups = 0;
+	*t = (bsim_pairs){0, 0, 0, 0};
+	for (int g = 0; g < c->n_groups; g++) {
+		const bsim_compare_group *cg = &c->groups[g];
+		if (cg->deterministic)
+			continue;
+		groups++;
+		t->a += cg->ev[ev].pairs.a;
+		t->b += cg->ev[ev].pairs.b;
+		t->c += cg->ev[ev].pairs.c;
+		t->d += cg->ev[ev].pairs.d;
+	}
+	bsim_stats_tango_ci(t, BSIM_STATS_Z95, &ci[0], &ci[1]);
+	*p = bsim_stats_mcnemar_exact(t->b, t->c);
+	return groups;
+}
+
+static void md_pooled(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	bsim_pairs t;
+	double ci[2], p;
+	int groups = pooled(c, 0, &t, ci, &p);
+	if (groups == 0)
+		return;
+	fprintf(f,
+	        "Pooled over the %d group%s with random force (%d pairs; outside the rule, which "
+	        "is group by group):\n\n| event | only %s | only %s | difference [95%%] | "
+	        "McNemar p |\n|---|---|---|---|---|\n",
+	        groups, groups == 1 ? "" : "s", t.a + t.b + t.c + t.d, r->side[0].label,
+	        r->side[1].label);
+	for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
+		pooled(c, ev, &t, ci, &p);
+		int n = t.a + t.b + t.c + t.d;
+		fprintf(f, "| %s | %d | %d | %+.4f [%+.4f, %+.4f] | %.2g |\n",
+		        bsim_compare_event_name((bsim_event)ev), t.b, t.c,
+		        n > 0 ? (double)(t.b - t.c) / n : 0.0, ci[0], ci[1], p);
+	}
+	fputc('\n', f);
 }
 
 /* "traversed (none)" for a deterministic group's one trial. */
@@ -140,13 +188,15 @@ static void md_row_random(FILE *f, const bsim_compare_group *cg)
 {
 	const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];
 	int k = key_event(cg);
-	fprintf(f,
-	        " %.2f [%.2f, %.2f] | %.2f [%.2f, %.2f] | %+.2f [%+.2f, %+.2f] | %d of %d | %.2g, "
-	        "%s | %.2g |",
+	fprintf(f, " %.2f [%.2f, %.2f] | %.2f [%.2f, %.2f] | %+.2f [%+.2f, %+.2f] | %d of %d |",
 	        t->p_a, t->ci_a[0], t->ci_a[1], t->p_b, t->ci_b[0], t->ci_b[1], t->diff,
-	        t->diff_ci[0], t->diff_ci[1], cg->discordant, cg->pairs, cg->ev[k].p_holm,
-	        bsim_compare_event_name((bsim_event)k), group_equivalence(cg));
-	md_number(f, " %.2f |", t->detectable);
+	        t->diff_ci[0], t->diff_ci[1], cg->discordant, cg->pairs);
+	if (k >= 0)
+		fprintf(f, " %.2g, %s |", cg->ev[k].p_holm, bsim_compare_event_name((bsim_event)k));
+	else
+		fputs(" - (no event varies) |", f);
+	fprintf(f, " %.2g |", group_equivalence(cg));
+	md_number(f, " %.2f |", t->mde80);
 }
 
 static void md_row_deterministic(FILE *f, const bsim_report *r, int g, const bsim_compare_group *cg)
@@ -167,8 +217,8 @@ static void md_table(FILE *f, const bsim_report *r)
 		fprintf(f, " %s |", e->axes[a].key);
 	fprintf(f,
 	        " p_traverse %s [95%%] | p_traverse %s [95%%] | difference [95%%] | discordant "
-	        "| min p (Holm), event | equivalence p | detectable | t_sep median (s) | verdict "
-	        "|\n|---|",
+	        "| min p (Holm), event | equivalence p | mde80 traversed | t_sep median (s) | "
+	        "verdict |\n|---|",
 	        la, lb);
 	for (int a = 0; a < e->n_axes; a++)
 		fputs("---|", f);
@@ -198,18 +248,22 @@ static void md_events(FILE *f, const bsim_report *r, const bsim_compare_group *c
 {
 	fprintf(f,
 	        "| event | %s | %s | difference [95%%] | only %s | only %s | McNemar p | Holm p "
-	        "| equivalence p | detectable | beyond |\n|---|---|---|---|---|---|---|---|---|---|"
-	        "---|\n",
+	        "| equivalence p | informative | mde80 | min significant | beyond "
+	        "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
 	        r->side[0].label, r->side[1].label, r->side[0].label, r->side[1].label);
 	for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
 		const bsim_event_test *t = &cg->ev[ev];
-		fprintf(f,
-		        "| %s | %.2f | %.2f | %+.2f [%+.2f, %+.2f] | %d | %d | %.3g | %.3g | %.3g "
-		        "|",
+		fprintf(f, "| %s | %.2f | %.2f | %+.2f [%+.2f, %+.2f] | %d | %d | %.3g |",
 		        bsim_compare_event_name((bsim_event)ev), t->p_a, t->p_b, t->diff,
-		        t->diff_ci[0], t->diff_ci[1], t->pairs.b, t->pairs.c, t->p_value, t->p_holm,
-		        t->p_equivalence);
-		md_number(f, " %.2f |", t->detectable);
+		        t->diff_ci[0], t->diff_ci[1], t->pairs.b, t->pairs.c, t->p_value);
+		if (t->in_family)
+			fprintf(f, " %.3g |", t->p_holm);
+		else
+			fputs(" not in the family |", f);
+		fprintf(f, " %.3g | %s |", t->p_equivalence,
+		        t->informative ? "yes" : "no (floor or ceiling)");
+		md_number(f, " %.2f |", t->mde80);
+		md_number(f, " %.2f |", t->min_significant);
 		fprintf(f, " %s |\n", t->beyond ? "yes" : "no");
 	}
 	fputc('\n', f);
@@ -374,6 +428,17 @@ static void md_solver(FILE *f, const bsim_report *r)
 		fputc('\n', f);
 }
 
+/* Equivalent groups whose traversal is at the floor or the ceiling on both
+ * sides: equivalent in their other events, not in traversal. */
+static int equivalent_untraversed(const bsim_comparison *c)
+{
+	int k = 0;
+	for (int g = 0; g < c->n_groups; g++)
+		k += c->groups[g].verdict == BSIM_VERDICT_EQUIVALENT &&
+		     !c->groups[g].ev[BSIM_EVENT_TRAVERSED].informative;
+	return k;
+}
+
 void bsim_report_md(FILE *f, const bsim_report *r)
 {
 	const bsim_comparison *c = r->cmp;
@@ -382,23 +447,37 @@ void bsim_report_md(FILE *f, const bsim_report *r)
 	fprintf(f,
 	        "**%d of %d groups disagree.** %d deterministic (no random force: one trial each, "
 	        "compared as one pair): %d same, %d different. %d with random force, %d trials "
-	        "each: %d equivalent within +-%g, %d inconclusive (no difference detected, none "
-	        "excluded), %d significantly different but within the margin, %d disagree.\n\n",
+	        "each: %d equivalent within +-%g (%d of them with p_traverse at the floor or the "
+	        "ceiling on both sides: equivalent in their other events, not in traversal), %d "
+	        "uninformative (every event at the floor or the ceiling), %d inconclusive (no "
+	        "difference detected, none excluded), %d significantly different but within the "
+	        "margin, %d disagree.\n\n",
 	        c->n_disagree, c->n_groups, det, k[BSIM_VERDICT_SAME], k[BSIM_VERDICT_DIFFERENT],
 	        c->n_groups - det, c->trials, k[BSIM_VERDICT_EQUIVALENT], c->rule.margin,
+	        equivalent_untraversed(c), k[BSIM_VERDICT_UNINFORMATIVE],
 	        k[BSIM_VERDICT_INCONCLUSIVE], k[BSIM_VERDICT_SMALL], k[BSIM_VERDICT_DISAGREE]);
 	fprintf(f,
-	        "Rule: a group with random force disagrees when, for one of the events traversed, "
-	        "left, right, side_exit, stuck, unstable, the exact McNemar test on the paired "
-	        "trials gives a p-value below %g after Holm's correction over its %d tests (groups "
-	        "with random force x events), and the two probabilities differ by at least %g. It "
-	        "is equivalent when, for every event, Tango's two one-sided score tests put the "
-	        "paired difference within +-%g at level %g (equivalence p below it); otherwise it "
-	        "is inconclusive. `detectable` is the smallest difference in p_traverse the "
-	        "corrected test could flag given the group's discordant pairs. A deterministic "
-	        "group disagrees when its one pair differs in outcome or type. Intervals: Wilson "
-	        "for each probability, Tango's score interval for the paired difference",
-	        c->rule.alpha, c->n_tests, c->rule.margin, c->rule.margin, c->rule.alpha);
+	        "Rule: a group with random force disagrees when, for one of its events in the "
+	        "family, the exact McNemar test on the paired trials gives a p-value below %g "
+	        "after Holm's correction over the family's %d tests, and the two probabilities "
+	        "differ by at least %g. The family holds each group's events (traversed, left, "
+	        "right, side_exit, stuck, unstable) whose hypotheses the others do not imply: not "
+	        "an event that occurs on neither side, not the outcome that is the complement of "
+	        "the others, and not traversed when it is left + right (the components are "
+	        "kept). An event is informative unless both probabilities lie within %g of 0 or "
+	        "both within %g of 1. A group is equivalent when at least one event is "
+	        "informative and, for every informative event, Tango's two one-sided score tests "
+	        "put the paired difference within +-%g at level %g (equivalence p below it); "
+	        "uninformative when no event is; otherwise inconclusive. `mde80` is the difference "
+	        "the McNemar test at level %g / %d detects with power 0.8 at the event's observed "
+	        "rate of discordant pairs (exact power; with the rate taken as the difference "
+	        "where it is smaller); `min significant`, a bound and not a power, the smallest "
+	        "difference significant at that level with the event's number of discordant "
+	        "pairs. A deterministic group disagrees when its one pair differs in outcome or "
+	        "type. Intervals: Wilson for each probability, Tango's score interval for the "
+	        "paired difference",
+	        c->rule.alpha, c->n_tests, c->rule.margin, c->rule.margin, c->rule.margin,
+	        c->rule.margin, c->rule.alpha, c->rule.alpha, c->n_tests > 0 ? c->n_tests : 1);
 	fputs(c->rule.exact ? "; any trial that differs in any trials.csv field also disagrees.\n\n"
 	                    : ".\n\n",
 	      f);
@@ -410,6 +489,7 @@ void bsim_report_md(FILE *f, const bsim_report *r)
 		      "(section Final locations).\n\n",
 		      f);
 	md_separation(f, r);
+	md_pooled(f, r);
 	md_table(f, r);
 	md_solver(f, r);
 	if (c->lattice)
@@ -483,10 +563,15 @@ static void json_event(FILE *f, const bsim_event_test *t, int deterministic)
 	bsim_json_number(f, t->p_holm);
 	fputs(", \"p_equivalence\": ", f);
 	bsim_json_number(f, t->p_equivalence);
-	fputs(", \"detectable\": ", f);
-	bsim_json_number(f, t->detectable);
-	fprintf(f, ", \"beyond\": %s, \"equivalent\": %s}", t->beyond ? "true" : "false",
-	        t->equivalent ? "true" : "false");
+	fputs(", \"mde80\": ", f);
+	bsim_json_number(f, t->mde80);
+	fputs(", \"min_significant\": ", f);
+	bsim_json_number(f, t->min_significant);
+	fprintf(f,
+	        ", \"in_family\": %s, \"informative\": %s, \"beyond\": %s, \"equivalent\": "
+	        "%s}",
+	        t->in_family ? "true" : "false", t->informative ? "true" : "false",
+	        t->beyond ? "true" : "false", t->equivalent ? "true" : "false");
 }
 
 static void json_outcome(FILE *f, const bsim_trial_result *x)
@@ -588,6 +673,32 @@ static void json_locations(FILE *f, const bsim_report *r, int g)
 	fputc('}', f);
 }
 
+static void json_pooled(FILE *f, const bsim_comparison *c)
+{
+	bsim_pairs t;
+	double ci[2], p;
+	fputs(",\n  \"pooled\": ", f);
+	if (pooled(c, 0, &t, ci, &p) == 0) {
+		fputs("null", f);
+		return;
+	}
+	for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
+		pooled(c, ev, &t, ci, &p);
+		int n = t.a + t.b + t.c + t.d;
+		fputs(ev ? ", " : "{", f);
+		bsim_json_string(f, bsim_compare_event_name((bsim_event)ev));
+		fprintf(f, ": {\"pairs\": %d, \"only_a\": %d, \"only_b\": %d, \"difference\": ", n,
+		        t.b, t.c);
+		bsim_json_number(f, n > 0 ? (double)(t.b - t.c) / n : 0.0);
+		fputs(", \"difference_ci95\": ", f);
+		json_pair_of_numbers(f, ci);
+		fputs(", \"p_mcnemar\": ", f);
+		bsim_json_number(f, p);
+		fputc('}', f);
+	}
+	fputc('}', f);
+}
+
 static void json_side(FILE *f, const bsim_report_side *s)
 {
 	fputs("{\"label\": ", f);
@@ -619,7 +730,7 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	fprintf(f,
 	        ", \"exact\": %s, \"correction\": \"holm\", \"tests\": %d, \"test\": "
 	        "\"mcnemar_exact\", \"interval\": \"tango_score\", \"equivalence\": "
-	        "\"tango_two_one_sided\"",
+	        "\"tango_two_one_sided\", \"mde_power\": 0.8",
 	        c->rule.exact ? "true" : "false", c->n_tests);
 	if (c->lattice)
 		fputs(", \"final_location_test\": \"paired_permutation\"", f);
@@ -641,6 +752,7 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	} else {
 		fputs("null", f);
 	}
+	json_pooled(f, c);
 	fputs(",\n  \"groups\": [", f);
 	for (int g = 0; g < c->n_groups; g++) {
 		const bsim_compare_group *cg = &c->groups[g];
