@@ -53,8 +53,19 @@
  * b2_polygonRadius = 2 b2_linearSlop (units) and its position solver rests a
  * contact at a penetration of b2_linearSlop, so the disk's Box2D radius is
  *   R_b = R s - b2_polygonRadius + b2_linearSlop:
- * a resting contact then sits at the model's distance R, and a contact
- * starts (and takes its restitution) at a gap of b2_linearSlop / s (0.05 m).
+ * a contact pushed in deeper is corrected back to the model's distance R,
+ * and a contact starts (and takes its restitution) at a gap of
+ * b2_linearSlop / s: with b2_linearSlop = 0.005 units (b2_common.h,
+ * b2_lengthUnitsPerMeter = 1), 0.005 m at the default s = 1, 0.05 m at
+ * s = 0.1. The velocity solver stops an approach wherever the contact has
+ * started, so a resting contact sits at a gap anywhere from 0 to that
+ * (4-5 mm on a stuck H2 trial, docs/backends.md).
+ * The contact flag the state reports is not Box2D's manifold but the one
+ * every backend reports (model/contact_flag.h): at the step's end the gap,
+ * measured from the reported state (x, theta) with the shared geometry, is
+ * below BSIM_CONTACT_TOL (6 mm, above that band at s = 1), or the beam's
+ * contact had a nonzero normal impulse in the step (PostSolve, any substep
+ * or TOI sub-solve).
  * Restitution: e = contact.restitution on the fixtures, and in PreSolve the
  * vertex manifolds (b2CollideEdgeAndCircle's e_circles: the tip, feature 1,
  * or the pivot end, feature 0) get tip_restitution; the pivot end is a point
@@ -98,6 +109,7 @@
 #include <vector>
 
 #include "beamsim/backend.h"
+#include "model/contact_flag.h"
 
 namespace
 {
@@ -210,6 +222,8 @@ struct beam_rec {
 	double row_v[2] = {0, 0};            /* body velocity, m/s */
 	double row_w = 0.0;                  /* beam angular velocity, rad/s (Box2D sense) */
 	double row_u[2] = {0, 0};            /* beam pivot velocity, m/s (0 if pinned) */
+	/* a nonzero normal impulse with the body in this step (the flag) */
+	bool pushed = false;
 };
 
 class contact_ledger;
@@ -233,7 +247,8 @@ struct bsim_world {
 	bool track_live = false;
 	std::vector<int> live;
 	std::vector<char> is_live;
-	std::vector<int> typed; /* beams whose contact_type is not NONE */
+	std::vector<int> typed;  /* beams whose contact_type is not NONE */
+	std::vector<int> pushed; /* beams whose pushed is set */
 	/* Box2D */
 	b2World *world = nullptr;
 	b2Body *body = nullptr;
@@ -243,7 +258,7 @@ struct bsim_world {
 	b2Vec2 body_start;        /* Box2D position before the step */
 	double v_pre[2] = {0, 0}; /* body velocity the solve starts from, m/s */
 	/* results of the last step */
-	std::vector<int> contact_type;
+	std::vector<int> contact_type; /* the contact flag (model/contact_flag.h) */
 	bsim_step_energy energy = {};
 	int impacts = 0;
 	long toi_events = 0;         /* continuous-collision sub-solves, all steps */
@@ -320,7 +335,16 @@ class contact_ledger : public b2ContactListener
 	void PostSolve(b2Contact *contact, const b2ContactImpulse *impulse) override
 	{
 		beam_rec *b = beam_of(contact);
-		if (!b || !b->row || impulse->count < 1)
+		if (!b)
+			return;
+		float sum = 0.0f;
+		for (int j = 0; j < impulse->count; j++)
+			sum += impulse->normalImpulses[j];
+		if (sum > 0.0f && !b->pushed) {
+			b->pushed = true;
+			w_->pushed.push_back(b->index);
+		}
+		if (!b->row || impulse->count < 1)
 			return;
 		b->row = false;
 		const double s = w_->s;
@@ -466,7 +490,9 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 		b.omega_applied = b.sgn * (double)b.body->GetAngularVelocity();
 		b.w_pre = b.body->GetAngularVelocity();
 		b.row = false;
+		b.pushed = false;
 	}
+	w->pushed.clear();
 	w->live.clear();
 	w->is_live.assign(w->beams.size(), 0);
 	for (size_t i = 0; i < w->beams.size(); i++)
@@ -476,24 +502,34 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 		}
 }
 
-/* The model's contact state of beam i at the current positions: Box2D's own
- * edge-circle test (touching within b2_linearSlop / s of the distance R). */
-int contact_type_of(const bsim_world *w, const beam_rec &b)
+/* The contact flag of beam i after a step (model/contact_flag.h), from the
+ * state get_state reports: x = position / s, theta = sgn angle. */
+int contact_flag_of(const bsim_world *w, const beam_rec &b)
 {
-	const b2Fixture *fe = b.body->GetFixtureList();
-	const b2Fixture *fc = w->body->GetFixtureList();
-	b2Manifold m;
-	b2CollideEdgeAndCircle(
-	        &m, static_cast<const b2EdgeShape *>(fe->GetShape()), b.body->GetTransform(),
-	        static_cast<const b2CircleShape *>(fc->GetShape()), w->body->GetTransform());
-	if (m.pointCount == 0)
-		return BSIM_CONTACT_NONE;
-	return m.type == b2Manifold::e_circles ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
+	const double s = w->s;
+	const b2Vec2 p = w->body->GetPosition();
+	const double x[2] = {p.x / s, p.y / s};
+	double u[2];
+	int type;
+	bsim_beam_direction(b.u0, b.sgn, b.sgn * (double)b.body->GetAngle(), u);
+	double dist2 =
+	        bsim_beam_distance2(b.pivot, u, w->scene.beams[(size_t)b.index].length, x, &type);
+	return bsim_contact_flag(dist2, w->scene.body.radius, type, b.pushed);
+}
+
+/* Beam i's flag is set: listed, and live. */
+void flag_set(bsim_world *w, int i, int flag)
+{
+	w->contact_type[(size_t)i] = flag;
+	w->typed.push_back(i);
+	mark_live(w, i);
 }
 
 /* In a lattice: only the beams whose fattened bounding box overlaps the
- * body's (Box2D's contact list of the body; a touching beam is always among
- * them) can touch it. */
+ * body's (Box2D's contact list of the body: fattened by b2_aabbExtension =
+ * 0.1 units, so every beam within 6 mm is among them up to unit_scale
+ * 30) and the pushed ones
+ * can be flagged. */
 void update_contact_types_live(bsim_world *w)
 {
 	for (int i : w->typed)
@@ -504,31 +540,39 @@ void update_contact_types_live(bsim_world *w)
 		if (!id)
 			continue;
 		int i = (int)(id - 1);
-		int type = contact_type_of(w, w->beams[(size_t)i]);
-		if (type == BSIM_CONTACT_NONE)
-			continue;
-		w->contact_type[(size_t)i] = type;
-		w->typed.push_back(i);
-		mark_live(w, i);
+		int flag = contact_flag_of(w, w->beams[(size_t)i]);
+		if (flag != BSIM_CONTACT_NONE && w->contact_type[(size_t)i] == BSIM_CONTACT_NONE)
+			flag_set(w, i, flag);
+	}
+	for (int i : w->pushed) {
+		int flag = contact_flag_of(w, w->beams[(size_t)i]);
+		if (w->contact_type[(size_t)i] == BSIM_CONTACT_NONE)
+			flag_set(w, i, flag);
 	}
 }
 
+/* The contact flag of every beam after a step (or at a new state); the
+ * step's pushes are then spent. */
 void update_contact_types(bsim_world *w)
 {
 	if (w->track_live) {
 		update_contact_types_live(w);
-		return;
+	} else {
+		const double s = w->s;
+		const b2Vec2 c = w->body->GetPosition();
+		const double reach_extra = w->scene.body.radius + 1.0; /* m, generous */
+		for (size_t i = 0; i < w->beams.size(); i++) {
+			const beam_rec &b = w->beams[i];
+			double dx = c.x / s - b.pivot[0], dy = c.y / s - b.pivot[1];
+			double reach = w->scene.beams[i].length + reach_extra;
+			w->contact_type[i] = dx * dx + dy * dy > reach * reach && !b.pushed
+			                             ? BSIM_CONTACT_NONE
+			                             : contact_flag_of(w, b);
+		}
 	}
-	const double s = w->s;
-	const b2Vec2 c = w->body->GetPosition();
-	const double reach_extra = w->scene.body.radius + 1.0; /* m, generous */
-	for (size_t i = 0; i < w->beams.size(); i++) {
-		const beam_rec &b = w->beams[i];
-		double dx = c.x / s - b.pivot[0], dy = c.y / s - b.pivot[1];
-		double reach = w->scene.beams[i].length + reach_extra;
-		w->contact_type[i] = dx * dx + dy * dy > reach * reach ? BSIM_CONTACT_NONE
-		                                                       : contact_type_of(w, b);
-	}
+	for (int i : w->pushed)
+		w->beams[(size_t)i].pushed = false;
+	w->pushed.clear();
 }
 
 void box2d_destroy(bsim_world *w)
@@ -883,17 +927,18 @@ int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
 	try {
 		world_free_box2d(w);
 		world_build(w, st->x, st->v, st->theta, st->omega);
-		for (int i = 0; i < st->n_beams; i++)
-			if (st->contact[i] != BSIM_CONTACT_NONE)
-				mark_live(w, i);
+		/* The contact flags are the state's, as they were reported. */
 		w->typed.clear();
-		for (size_t i = 0; i < w->beams.size(); i++)
-			if (w->contact_type[i] != BSIM_CONTACT_NONE)
-				w->typed.push_back((int)i);
+		for (int i = 0; i < st->n_beams; i++) {
+			w->contact_type[(size_t)i] = st->contact[i];
+			if (st->contact[i] != BSIM_CONTACT_NONE) {
+				mark_live(w, i);
+				w->typed.push_back(i);
+			}
+		}
 	} catch (const std::bad_alloc &) {
 		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory");
 	}
-	update_contact_types(w);
 	w->energy = bsim_step_energy{};
 	w->impacts = 0;
 	return BSIM_OK;

@@ -153,22 +153,16 @@ int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], 
 	return 1;
 }
 
-/* Fills w->candidates with the beams the step must test; returns how many. */
-int thesis_broad_phase(struct bsim_world *w, double speed, double h)
+/* Appends to out[n..] the beams at rest (not awake) whose pivot lies in a
+ * grid cell within r of the body's centre and within L + R + margin of it;
+ * returns the new count, *found set if any was. */
+static int grid_query(const struct bsim_world *w, double r, double margin, int *out, int n,
+                      int *found)
 {
-	int *out = w->candidates;
-	int n = 0;
-	if (!w->broad_phase || w->n_beams <= BROAD_PHASE_MIN_BEAMS) {
-		for (int i = 0; i < w->n_beams; i++)
-			out[n++] = i;
-		return n;
-	}
-	for (int k = 0; k < w->n_awake; k++)
-		out[n++] = w->awake[k];
 	const thesis_grid *g = &w->grid;
-	double r = g->cell + 2.0 * h * speed + w->slop;
 	double lo[2] = {w->x[0] - r, w->x[1] - r}, hi[2] = {w->x[0] + r, w->x[1] + r};
 	int c0x, c0y, c1x, c1y;
+	*found = 0;
 	/* Far outside the grid: no cell is near (and no int overflow). */
 	if (hi[0] < g->origin[0] || hi[1] < g->origin[1] ||
 	    lo[0] > g->origin[0] + g->cell * g->nx || lo[1] > g->origin[1] + g->cell * g->ny)
@@ -181,8 +175,6 @@ int thesis_broad_phase(struct bsim_world *w, double speed, double h)
 	c1y = c1y >= g->ny ? g->ny - 1 : c1y;
 	/* A beam at rest is a candidate only if the body is within its reach
 	 * (the test contact_detect.c makes first, here without the call). */
-	double margin = 2.0 * h * speed + w->slop;
-	int sleeping_found = 0;
 	for (int cy = c0y; cy <= c1y; cy++)
 		for (int cx = c0x; cx <= c1x; cx++) {
 			size_t c = (size_t)cy * g->nx + cx;
@@ -196,10 +188,45 @@ int thesis_broad_phase(struct bsim_world *w, double speed, double h)
 				if (dx * dx + dy * dy > reach * reach)
 					continue;
 				out[n++] = i;
-				sleeping_found = 1;
+				*found = 1;
 			}
 		}
+	return n;
+}
+
+/* Fills w->candidates with the beams the step must test; returns how many. */
+int thesis_broad_phase(struct bsim_world *w, double speed, double h)
+{
+	int *out = w->candidates;
+	int n = 0;
+	if (!w->broad_phase || w->n_beams <= BROAD_PHASE_MIN_BEAMS) {
+		for (int i = 0; i < w->n_beams; i++)
+			out[n++] = i;
+		return n;
+	}
+	for (int k = 0; k < w->n_awake; k++)
+		out[n++] = w->awake[k];
+	int sleeping_found;
+	n = grid_query(w, w->grid.cell + 2.0 * h * speed + w->slop, 2.0 * h * speed + w->slop, out,
+	               n, &sleeping_found);
 	if (sleeping_found)
 		sort_small(out, n);
 	return n;
+}
+
+/* The same query with a margin of its own (the cell side c >= L + R, so a
+ * square of r = c + margin holds every reach). Unsorted. */
+int thesis_broad_phase_near(struct bsim_world *w, double margin)
+{
+	int *out = w->candidates;
+	int n = 0;
+	if (!w->broad_phase || w->n_beams <= BROAD_PHASE_MIN_BEAMS) {
+		for (int i = 0; i < w->n_beams; i++)
+			out[n++] = i;
+		return n;
+	}
+	for (int k = 0; k < w->n_awake; k++)
+		out[n++] = w->awake[k];
+	int found;
+	return grid_query(w, w->grid.cell + margin, margin, out, n, &found);
 }

@@ -119,3 +119,13 @@ int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thes
 	out->impulse = 0.0;
 	return 1;
 }
+
+int thesis_contact_near(const struct bsim_world *w, int i, double margin)
+{
+	const thesis_beam *b = &w->beams[i];
+	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+	double reach = b->length + w->radius + margin;
+	if (dx * dx + dy * dy > reach * reach)
+		return 0;
+	return !geometry_far(b, w->x, w->radius, margin);
+}

@@ -35,6 +35,8 @@ static void impact_apply(struct bsim_world *w, const thesis_contact *cs, int n)
 	for (int i = 0; i < n; i++) {
 		thesis_beam *b = &w->beams[cs[i].beam];
 		b->omega -= cs[i].impulse * cs[i].c / b->inertia;
+		if (cs[i].impulse > 0.0)
+			thesis_beam_pushed(w, cs[i].beam);
 	}
 }
 

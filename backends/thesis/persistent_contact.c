@@ -59,8 +59,11 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 	 * at rest and untouched stays at rest and costs nothing: only the awake
 	 * ones (every contact's beam among them) are visited, in ascending
 	 * order, so the ledger's sums are those over all beams. */
-	for (int k = 0; k < n; k++)
+	for (int k = 0; k < n; k++) {
 		w->contact_of[cs[k].beam] = k;
+		if (cs[k].impulse > 0.0)
+			thesis_beam_pushed(w, cs[k].beam);
+	}
 	for (int a = 0; a < w->n_awake; a++) {
 		int i = w->awake[a];
 		thesis_beam *b = &w->beams[i];

@@ -86,7 +86,7 @@ struct bsim_world {
 	/* knobs */
 	int integrator, impact_order, projection, contact_mode;
 	double slop;         /* penetration tolerated before projection, m */
-	double contact_tol;  /* gap counted as touching in the state, m */
+	double contact_tol;  /* gap the solver counts as touching (held, awake), m */
 	int broad_phase;     /* 1: grid query for beams at rest; 0: test every beam */
 	int sleep;           /* 1: beams below sleep_energy, body far, are put to rest */
 	double sleep_energy; /* J */
@@ -104,9 +104,19 @@ struct bsim_world {
 	thesis_contact *contacts; /* n_beams capacity */
 	int n_contacts;
 	int *contact_of;   /* per beam: its index in contacts, or -1 */
-	int *contact_type; /* per beam, at the end of the step */
+	int *contact_type; /* per beam, at the end of the step, within contact_tol:
+	                    * what keeps a beam awake and from sleeping */
 	int *held;         /* per beam: in persistent contact (contact_mode=essay) */
 	int any_held;
+	/* The contact flag reported in the state (contact_report.c), and the
+	 * beams pushed in this step (a nonzero impact or persistent-contact
+	 * impulse), which it counts. */
+	int *flag;    /* per beam, BSIM_CONTACT_* */
+	int *flagged; /* beams whose flag is not NONE */
+	int n_flagged;
+	unsigned char *pushed; /* per beam */
+	int *pushed_list;      /* beams whose pushed is set */
+	int n_pushed;
 	bsim_step_energy energy;
 	int impacts;
 	bsim_solver_counts solver; /* since creation */
@@ -117,6 +127,9 @@ struct bsim_world {
 int thesis_grid_build(thesis_grid *g, const struct bsim_world *w);
 void thesis_grid_free(thesis_grid *g);
 int thesis_broad_phase(struct bsim_world *w, double speed, double h);
+/* Fills w->candidates with every beam whose pivot may be within L + R +
+ * margin of the body's centre now (awake or not); returns how many. */
+int thesis_broad_phase_near(struct bsim_world *w, double margin);
 /* 1 if no beam, all at rest, can reach the body this step (a world the
  * broad phase tests whole only; never with broad_phase=0); 0 if one may. */
 int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], double h);
@@ -129,6 +142,12 @@ void thesis_awake_prune(struct bsim_world *w);
 /* contact_detect.c */
 void thesis_beam_direction(thesis_beam *b, double u[2]);
 int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out);
+/* 0 if beam i certainly lies farther than R + margin from the body (its
+ * reach, or the bound from its last geometry), 1 if it may not. */
+int thesis_contact_near(const struct bsim_world *w, int i, double margin);
+
+/* contact_report.c: the state's contact flag after a step (or at creation). */
+void thesis_contact_report(struct bsim_world *w);
 
 /* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
  * counts it in w->solver), else 0. */
@@ -178,6 +197,16 @@ static inline double thesis_step_margin(const struct bsim_world *w, const thesis
 	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
 	               b->inertia;
 	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
+}
+
+/* Beam i exchanged a nonzero impulse with the body in this step (the
+ * contact flag counts it, contact_report.c). */
+static inline void thesis_beam_pushed(struct bsim_world *w, int i)
+{
+	if (w->pushed[i])
+		return;
+	w->pushed[i] = 1;
+	w->pushed_list[w->n_pushed++] = i;
 }
 
 /* v_rel = v . n - omega c (contact_detect.c). */

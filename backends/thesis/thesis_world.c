@@ -7,7 +7,9 @@
  *      persistent contact forces;
  *   4. projection of any penetration left by the contacts' curvature;
  *   5. sleeping: beams the body has left and whose energy has decayed are
- *      put exactly to rest (beam_sleep.c).
+ *      put exactly to rest (beam_sleep.c);
+ *   6. the contact flag the state reports (contact_report.c), which moves
+ *      nothing.
  * Only the beams near the body (broad_phase.c) and the awake ones are
  * touched, so a step costs the same in a field of one gate or a thousand.
  *
@@ -36,7 +38,9 @@ static const bsim_knob thesis_knobs[] = {
          "1: project out penetration deeper than slop after each step; 0: leave it"},
         {"slop", BSIM_KNOB_DOUBLE, "1e-6", NULL, "penetration tolerated before projection, m"},
         {"contact_tol", BSIM_KNOB_DOUBLE, "1e-3", NULL,
-         "gap below which a beam is reported as touching the body, m"},
+         "gap below which the solver counts a beam as touching the body (held under "
+         "contact_mode=essay, kept awake), m; the reported contact flag is the same on "
+         "every backend (gap under 6 mm, or an impulse in the step)"},
         {"contact_mode", BSIM_KNOB_CHOICE, "physical", "physical|essay",
          "physical: every beam the step can reach is tested for contact; essay: the essay's "
          "flowchart read literally, while one beam is held in persistent contact the others "
@@ -85,6 +89,10 @@ static void thesis_destroy(bsim_world *w)
 	free(w->is_awake);
 	free(w->candidates);
 	free(w->typed);
+	free(w->flag);
+	free(w->flagged);
+	free(w->pushed);
+	free(w->pushed_list);
 	thesis_grid_free(&w->grid);
 	free(w->held);
 	free(w);
@@ -109,9 +117,14 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->candidates = malloc(nb * sizeof *w->candidates);
 		w->typed = malloc(nb * sizeof *w->typed);
 		w->held = calloc(nb, sizeof *w->held);
+		w->flag = calloc(nb, sizeof *w->flag);
+		w->flagged = malloc(nb * sizeof *w->flagged);
+		w->pushed = calloc(nb, sizeof *w->pushed);
+		w->pushed_list = malloc(nb * sizeof *w->pushed_list);
 	}
 	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type || !w->awake ||
-	    !w->is_awake || !w->candidates || !w->typed || !w->held) {
+	    !w->is_awake || !w->candidates || !w->typed || !w->held || !w->flag || !w->flagged ||
+	    !w->pushed || !w->pushed_list) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
@@ -167,6 +180,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
+	thesis_contact_report(w); /* a body that starts touching a beam */
 	*out = w;
 	return BSIM_OK;
 }
@@ -244,6 +258,7 @@ static int thesis_step(bsim_world *w, const double force[2], double h, bsim_erro
 			thesis_beams_sleep(w, speed, h);
 		thesis_awake_prune(w);
 	}
+	thesis_contact_report(w);
 	return BSIM_OK;
 }
 
@@ -257,7 +272,7 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 		int i = s->active[k];
 		s->theta[i] = w->beams[i].theta;
 		s->omega[i] = w->beams[i].omega;
-		s->contact[i] = w->contact_type[i];
+		s->contact[i] = w->flag[i];
 	}
 	s->energy = w->energy;
 	s->impacts = w->impacts;
@@ -273,13 +288,20 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 	memcpy(w->v, s->v, sizeof w->v);
 	w->n_awake = 0;
 	w->n_typed = 0;
+	w->n_flagged = 0;
+	for (int k = 0; k < w->n_pushed; k++)
+		w->pushed[w->pushed_list[k]] = 0;
+	w->n_pushed = 0;
 	memset(w->is_awake, 0, (size_t)w->n_beams * sizeof *w->is_awake);
 	for (int i = 0; i < w->n_beams; i++) {
 		w->beams[i].theta = s->theta[i];
 		w->beams[i].omega = s->omega[i];
 		w->contact_type[i] = s->contact[i];
-		if (s->contact[i] != BSIM_CONTACT_NONE)
+		w->flag[i] = s->contact[i];
+		if (s->contact[i] != BSIM_CONTACT_NONE) {
 			w->typed[w->n_typed++] = i;
+			w->flagged[w->n_flagged++] = i;
+		}
 		if (s->theta[i] != 0.0 || s->omega[i] != 0.0 || s->contact[i] != BSIM_CONTACT_NONE)
 			thesis_beam_wake(w, i);
 		w->held[i] = 0; /* a state has no loop: contact_mode=essay starts afresh */

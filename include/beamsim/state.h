@@ -14,6 +14,18 @@ extern "C" {
 
 enum { BSIM_CONTACT_NONE = 0, BSIM_CONTACT_TANGENT = 1, BSIM_CONTACT_TIP = 2 };
 
+/* The contact flag, the same on every backend: beam i is in contact in a
+ * step (contact[i] not NONE) when at the step's end the gap between the
+ * body's disk and the beam's segment is below BSIM_CONTACT_TOL, or when the
+ * beam exchanged a nonzero impulse with the body during the step (an impact
+ * is flagged on the step it happens in). contact[i] is then the contact's
+ * type at the step's end: TANGENT when the nearest point of the segment lies
+ * inside it, TIP at either end. 6 mm: above the gaps at which both solvers
+ * hold a resting contact, the thesis backend's within 1e-6 m, Box2D's
+ * anywhere below b2_linearSlop / unit_scale = 5 mm (float32 adds 2e-6 m),
+ * and 0.06% of the body's radius (docs/backends.md, "The contact flag"). */
+#define BSIM_CONTACT_TOL 6e-3 /* m */
+
 /* Energy flows of the last step, J, as measured by the backend. With the
  * runner's work of the external force they close the energy ledger:
  * dE = W_ext - damper - impact - contact - correction - sleep. */
@@ -43,7 +55,7 @@ typedef struct bsim_state {
 	int n_beams;
 	double *theta;             /* n_beams, rad, forward positive */
 	double *omega;             /* n_beams, rad/s */
-	int *contact;              /* n_beams, BSIM_CONTACT_* at the end of the step */
+	int *contact;              /* n_beams, the contact flag of the step (above) */
 	bsim_step_energy energy;   /* of the last step */
 	int impacts;               /* impacts resolved in the last step */
 	bsim_solver_counts solver; /* since the world was created */

@@ -5,6 +5,8 @@
 
 #include <math.h>
 
+#include "model/contact_flag.h"
+
 void trial_overlap_shapes(beam_shape *shape, const bsim_scene *sc)
 {
 	for (int i = 0; i < sc->n_beams; i++) {
@@ -20,8 +22,9 @@ void trial_overlap_shapes(beam_shape *shape, const bsim_scene *sc)
 }
 
 /* R - min_i |C - Q_i|, Q_i the point of beam i's segment nearest the
- * centre C (MODEL.md section 3). A beam whose reach L + R does not hold
- * the centre costs one distance test. */
+ * centre C (MODEL.md section 3), measured as the contact flag measures
+ * it (model/contact_flag.h). A beam whose reach L + R does not hold the
+ * centre costs one distance test. */
 double trial_overlap_depth(const beam_shape *shape, int n, double radius, const bsim_state *s)
 {
 	double depth = 0.0;
@@ -30,11 +33,10 @@ double trial_overlap_depth(const beam_shape *shape, int n, double radius, const 
 		double dx = s->x[0] - q->p[0], dy = s->x[1] - q->p[1];
 		if (dx * dx + dy * dy >= q->reach2)
 			continue;
-		double cs = cos(s->theta[i]), sn = q->sgn * sin(s->theta[i]);
-		double ux = q->u0[0] * cs - q->u0[1] * sn, uy = q->u0[1] * cs + q->u0[0] * sn;
-		double along = fmin(fmax(dx * ux + dy * uy, 0.0), q->length);
-		double dist = hypot(dx - along * ux, dy - along * uy);
-		depth = fmax(depth, radius - dist);
+		double u[2];
+		int type;
+		bsim_beam_direction(q->u0, q->sgn, s->theta[i], u);
+		depth = fmax(depth, radius - bsim_beam_distance(q->p, u, q->length, s->x, &type));
 	}
 	return depth;
 }

@@ -1,0 +1,54 @@
+/* The contact flag the thesis backend reports in its state, the one every
+ * backend reports (model/contact_flag.h, beamsim/state.h): beam i is in
+ * contact during a step when at the step's end its gap to the body is below
+ * BSIM_CONTACT_TOL (6 mm), or when it took a nonzero impact or
+ * persistent-contact impulse in the step (w->pushed, impact_resolve.c and
+ * persistent_contact.c), so that an impact is flagged on its own step even
+ * when the body has bounced off by the step's end.
+ *
+ * The gap is measured from the step's final positions with the shared
+ * geometry (bsim_beam_distance2), not from the solver's contacts: a beam the
+ * solver did not test in the step (beyond its margin) is still flagged if
+ * the body ends within 6 mm of it. The beams measured are those the broad
+ * phase finds within L + R + 6 mm of the body, minus those whose last
+ * geometry bounds them farther (thesis_contact_near: no trigonometry), plus
+ * the pushed ones. A flagged beam is woken, so that the state lists it.
+ * Nothing here moves anything: the solver's own touching test, which keeps
+ * beams awake and from sleeping, is contact_type (contact_tol). */
+#include "model/contact_flag.h"
+#include "thesis/thesis.h"
+
+static void report_beam(struct bsim_world *w, int i)
+{
+	thesis_beam *b = &w->beams[i];
+	int pushed = w->pushed[i];
+	if (w->flag[i] != BSIM_CONTACT_NONE ||
+	    (!pushed && !thesis_contact_near(w, i, BSIM_CONTACT_TOL)))
+		return;
+	double u[2];
+	int type;
+	thesis_beam_direction(b, u);
+	double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
+	int flag = bsim_contact_flag(dist2, w->radius, type, pushed);
+	if (flag == BSIM_CONTACT_NONE)
+		return;
+	w->flag[i] = flag;
+	w->flagged[w->n_flagged++] = i;
+	thesis_beam_wake(w, i);
+}
+
+void thesis_contact_report(struct bsim_world *w)
+{
+	for (int k = 0; k < w->n_flagged; k++)
+		w->flag[w->flagged[k]] = BSIM_CONTACT_NONE;
+	w->n_flagged = 0;
+	int n = thesis_broad_phase_near(w, BSIM_CONTACT_TOL);
+	for (int k = 0; k < n; k++)
+		report_beam(w, w->candidates[k]);
+	for (int k = 0; k < w->n_pushed; k++) {
+		int i = w->pushed_list[k];
+		report_beam(w, i);
+		w->pushed[i] = 0;
+	}
+	w->n_pushed = 0;
+}

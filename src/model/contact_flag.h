@@ -1,0 +1,69 @@
+/* Internal: the one contact flag every backend reports (bsim_state.contact,
+ * the trajectory's contact columns), and the geometry of a beam's gap
+ * behind it, shared so that the backends and the runner cannot drift apart.
+ *
+ * Beam i is in contact during a step when, at the step's end,
+ *   gap_i = |C - Q_i| - R < BSIM_CONTACT_TOL        (beamsim/state.h, 6 mm)
+ * (C the body's centre, Q_i the nearest point of the beam's segment, R the
+ * body's radius: MODEL.md section 3, from the state the backend reports),
+ * or the beam exchanged a nonzero normal impulse with the body during the
+ * step (an impact, a persistent-contact or a Box2D contact impulse). The
+ * flag's value is the contact's type at the step's end: TANGENT when the
+ * nearest point lies inside the segment, TIP at either end. */
+#ifndef BSIM_MODEL_CONTACT_FLAG_H
+#define BSIM_MODEL_CONTACT_FLAG_H
+
+#include "beamsim/state.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The direction of a beam at angle theta, rest direction u0 and forward
+ * sign sgn (bsim_scene_beam_rest_direction, bsim_scene_beam_forward_sign):
+ * u = R(sgn theta) u0. */
+void bsim_beam_direction(const double u0[2], double sgn, double theta, double u[2]);
+
+/* C - Q for a body's centre x against the segment from the pivot p along
+ * u of the given length, in d; *type the contact's type there
+ * (BSIM_CONTACT_TANGENT or _TIP). Inline: the backends ask it every step. */
+static inline void bsim_beam_offset(const double p[2], const double u[2], double length,
+                                    const double x[2], int *type, double d[2])
+{
+	double dx = x[0] - p[0], dy = x[1] - p[1];
+	double s = dx * u[0] + dy * u[1];
+	*type = s > 0.0 && s < length ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
+	double along = s > 0.0 ? (s < length ? s : length) : 0.0;
+	d[0] = dx - along * u[0];
+	d[1] = dy - along * u[1];
+}
+
+/* |C - Q|^2, m^2: the squared distance of the centre from the segment. */
+static inline double bsim_beam_distance2(const double p[2], const double u[2], double length,
+                                         const double x[2], int *type)
+{
+	double d[2];
+	bsim_beam_offset(p, u, length, x, type, d);
+	return d[0] * d[0] + d[1] * d[1];
+}
+
+/* |C - Q|, m, the same distance (hypot: no overflow, for the runner's
+ * overlap measure). */
+double bsim_beam_distance(const double p[2], const double u[2], double length, const double x[2],
+                          int *type);
+
+/* The flag of a beam at squared distance dist2 (bsim_beam_distance2) from
+ * the centre of a body of radius R at the step's end: type if the gap
+ * |C - Q| - R is below BSIM_CONTACT_TOL (|C - Q|^2 < (R + tol)^2, no square
+ * root in every step) or pushed (a nonzero impulse in the step), else
+ * BSIM_CONTACT_NONE. */
+static inline int bsim_contact_flag(double dist2, double radius, int type, int pushed)
+{
+	const double reach = radius + BSIM_CONTACT_TOL;
+	return pushed || dist2 < reach * reach ? type : BSIM_CONTACT_NONE;
+}
+
+#ifdef __cplusplus
+}
+#endif
+#endif
