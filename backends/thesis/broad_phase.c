@@ -135,14 +135,16 @@ static void sort_small(int *v, int n)
  * h |F| / M from two square roots. |a| + |b| >= sqrt(a^2 + b^2) bounds
  * both without them; the factor 1 + 1e-12 covers the square roots'
  * rounding, so a beam out of reach of the bound is out of reach of the
- * margin, and the test changes no result. NaN or overflow: not clear. */
+ * margin, and the test changes no result. The contact flag's tolerance is
+ * added, so that a clear step also ends more than BSIM_CONTACT_TOL from
+ * every beam (contact_report.c). NaN or overflow: not clear. */
 int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], double h)
 {
 	if (!w->broad_phase || w->n_beams > BROAD_PHASE_MIN_BEAMS)
 		return 0; /* broad_phase=0: every beam tested, for checking */
 	double speed = (fabs(w->v[0]) + fabs(w->v[1])) +
 	               h * (fabs(force[0]) + fabs(force[1])) * w->inv_mass;
-	double margin = 2.0 * (h * (speed * (1.0 + 1e-12))) + w->slop;
+	double margin = 2.0 * (h * (speed * (1.0 + 1e-12))) + w->slop + BSIM_CONTACT_TOL;
 	for (int i = 0; i < w->n_beams; i++) {
 		const thesis_beam *b = &w->beams[i];
 		double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];

@@ -14,7 +14,11 @@
  * geometry bounds them farther (thesis_contact_near: no trigonometry), plus
  * the pushed ones. A flagged beam is woken, so that the state lists it.
  * Nothing here moves anything: the solver's own touching test, which keeps
- * beams awake and from sleeping, is contact_type (contact_tol). */
+ * beams awake and from sleeping, is contact_type (contact_tol).
+ *
+ * A step in free flight (thesis_broad_phase_clear, whose margin includes
+ * BSIM_CONTACT_TOL) ends more than 6 mm from every beam and pushes none, so
+ * it only clears the last step's flags (thesis_contact_clear). */
 #include "model/contact_flag.h"
 #include "thesis/thesis.h"
 
@@ -37,11 +41,16 @@ static void report_beam(struct bsim_world *w, int i)
 	thesis_beam_wake(w, i);
 }
 
-void thesis_contact_report(struct bsim_world *w)
+void thesis_contact_clear(struct bsim_world *w)
 {
 	for (int k = 0; k < w->n_flagged; k++)
 		w->flag[w->flagged[k]] = BSIM_CONTACT_NONE;
 	w->n_flagged = 0;
+}
+
+void thesis_contact_report(struct bsim_world *w)
+{
+	thesis_contact_clear(w);
 	int n = thesis_broad_phase_near(w, BSIM_CONTACT_TOL);
 	for (int k = 0; k < n; k++)
 		report_beam(w, w->candidates[k]);

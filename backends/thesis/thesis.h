@@ -148,6 +148,7 @@ int thesis_contact_near(const struct bsim_world *w, int i, double margin);
 
 /* contact_report.c: the state's contact flag after a step (or at creation). */
 void thesis_contact_report(struct bsim_world *w);
+void thesis_contact_clear(struct bsim_world *w);
 
 /* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
  * counts it in w->solver), else 0. */

@@ -258,7 +258,10 @@ static int thesis_step(bsim_world *w, const double force[2], double h, bsim_erro
 			thesis_beams_sleep(w, speed, h);
 		thesis_awake_prune(w);
 	}
-	thesis_contact_report(w);
+	if (in_flight)
+		thesis_contact_clear(w);
+	else
+		thesis_contact_report(w);
 	return BSIM_OK;
 }
 
