@@ -187,6 +187,9 @@ static void test_unknown_backend(void **state)
 	assert_int_equal(r.status, 2);
 	assert_contains(r.err, "nosuch");
 	cli_run_free(&r);
+	/* a knob's value out of its range */
+	const char *mass[] = {"run", gate, "--backend-opt", "impact_mass=0", NULL};
+	bsim_test_expect_input_error(mass, (const char *const[]){"impact_mass", "> 0", NULL});
 }
 
 static void test_bad_scene(void **state)

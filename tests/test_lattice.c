@@ -423,7 +423,7 @@ static void lcp_many_contacts(void **state)
 			cs[0].c = cs[1].c = 0.0;
 		}
 		memcpy(gs, cs, sizeof cs);
-		assert_int_equal(thesis_lcp_solve(&w, cs, n), 0); /* converged */
+		assert_int_equal(thesis_lcp_solve(w.inv_mass, cs, n), 0); /* converged */
 		double scale = 0.0;
 		for (int i = 0; i < n; i++) {
 			double wi = cs[i].vrel - cs[i].bound;

@@ -14,7 +14,15 @@
  * Several contacts at once: simultaneous (default) solves all impulses as
  * one complementarity problem with the bound v_rel+ >= -e v_rel- (exactly
  * mirror symmetric); nearest_first is the essay's order: the contact with
- * the smaller gap first, then the others, repeated while any approaches. */
+ * the smaller gap first, then the others, repeated while any approaches.
+ *
+ * The knob impact_mass puts m_i in place of M in this solve only (1/m_eff
+ * and v += J n / m_i): essay Eq. 2.4 read literally, m_i r v_ni + I omega_i
+ * = m_i r v_nf + I omega_f, with m_i = 0.1 kg the beam's mass where the
+ * body's M belongs (MODEL.md section 2). Such an impact conserves
+ * m_i r v + I omega, not the angular momentum of body and beam, and in
+ * general not energy either: the kinetic energy (with M) it removes, or
+ * adds, is what energy.impact records (negative where it adds). */
 #include <math.h>
 #include <stddef.h>
 
@@ -30,8 +38,8 @@ static void impact_apply(struct bsim_world *w, const thesis_contact *cs, int n)
 {
 	double j[2];
 	thesis_impulse_sum(cs, n, j);
-	w->v[0] += j[0] * w->inv_mass;
-	w->v[1] += j[1] * w->inv_mass;
+	w->v[0] += j[0] * w->impact_inv_mass;
+	w->v[1] += j[1] * w->impact_inv_mass;
 	for (int i = 0; i < n; i++) {
 		thesis_beam *b = &w->beams[cs[i].beam];
 		b->omega -= cs[i].impulse * cs[i].c / b->inertia;
@@ -66,7 +74,7 @@ static void impact_nearest_first(struct bsim_world *w, thesis_contact *cs, int n
 			return;
 		}
 		impact_bounds(w, next);
-		thesis_lcp_solve(w, next, 1);
+		thesis_lcp_solve(w->impact_inv_mass, next, 1);
 		impact_apply(w, next, 1);
 		if (next->impulse > 0.0 && next->vrel < -w->rest_threshold)
 			w->impacts++;
@@ -97,7 +105,7 @@ int thesis_impact_resolve(struct bsim_world *w, double h)
 	} else {
 		for (int i = 0; i < n; i++)
 			impact_bounds(w, &cs[i]);
-		w->solver.iteration_limit += thesis_lcp_solve(w, cs, n);
+		w->solver.iteration_limit += thesis_lcp_solve(w->impact_inv_mass, cs, n);
 		impact_apply(w, cs, n);
 		for (int i = 0; i < n; i++)
 			w->impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->rest_threshold;

@@ -41,7 +41,7 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
 		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 	}
-	w->solver.iteration_limit += thesis_lcp_solve(w, cs, n);
+	w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
 
 	double j[2];
 	thesis_impulse_sum(cs, n, j);

@@ -19,7 +19,7 @@ static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const 
 		cs[k].bound = 0.0;
 		cs[k].inv_i = w->beams[cs[k].beam].inv_inertia;
 	}
-	w->solver.iteration_limit += thesis_lcp_solve(w, cs, n);
+	w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
 	double dx = 0.0, dy = 0.0, de = 0.0;
 	for (int k = 0; k < n; k++) {
 		thesis_beam *b = &w->beams[cs[k].beam];

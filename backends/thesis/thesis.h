@@ -79,6 +79,9 @@ enum { THESIS_CONTACT_PHYSICAL = 0, THESIS_CONTACT_ESSAY = 1 };
 struct bsim_world {
 	double x[2], v[2]; /* body centre and velocity */
 	double mass, inv_mass, radius;
+	/* 1/impact_mass, 1/kg: the body's inverse mass in the impact solve
+	 * only (impact_resolve.c); 1/M unless the knob is given. */
+	double impact_inv_mass;
 	int n_beams;
 	thesis_beam *beams;
 	double e_tangent, e_tip; /* restitution */
@@ -151,8 +154,9 @@ void thesis_contact_report(struct bsim_world *w);
 void thesis_contact_clear(struct bsim_world *w);
 
 /* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
- * counts it in w->solver), else 0. */
-int thesis_lcp_solve(const struct bsim_world *w, thesis_contact *cs, int n);
+ * counts it in w->solver), else 0. inv_mass is the body's 1/M, 1/kg (for
+ * impacts, 1/impact_mass). */
+int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n);
 /* Solves with more than 2 contacts that fell back to Gauss-Seidel, all
  * worlds, since the program started. */
 long thesis_lcp_fallbacks(void);

@@ -27,8 +27,9 @@ static const cli_own essay_own[] = {
                                 "trials of the C-track (default: as --trials)"},
         [OWN_SENSITIVITY] = {"sensitivity", 0, NULL,
                              "also vary what the essay leaves unstated (rest threshold,\n"
-                             "restitution, tip restitution, duration, side boundary) at the\n"
-                             "symmetric groups: sensitivity.csv"},
+                             "restitution, tip restitution, duration, side boundary, the\n"
+                             "thesis backend's impact_mass) at the symmetric groups:\n"
+                             "sensitivity.csv"},
         [OWN_CONFIGS] = {"configs", 1, "DIR",
                          "the shipped configs (thesis/gate.yaml, lattice/c_track.yaml;\n"
                          "default configs)"},

@@ -92,9 +92,10 @@ static void json_knob(FILE *f, int *first, const bsim_knob *k, const char *value
 	*first = 0;
 }
 
-/* Knobs first, in the backend's order, so records of one backend line up;
- * then any option the backend does not list (none once checked), so
- * nothing given is hidden. */
+/* Knobs first, in the backend's order, so records of one backend line up
+ * (a knob without a default value, not given, is left out: its absence is
+ * its default, as in bsim_options_effective); then any option the backend
+ * does not list (none once checked), so nothing given is hidden. */
 void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_options *opts)
 {
 	int first = 1;
@@ -102,8 +103,9 @@ void bsim_output_backend_options(FILE *f, const bsim_backend *b, const bsim_opti
 	for (int i = 0; b && i < b->n_knobs; i++) {
 		const char *v = bsim_options_get(opts, b->knobs[i].name);
 		if (!v)
-			v = b->knobs[i].default_value ? b->knobs[i].default_value : "";
-		json_knob(f, &first, &b->knobs[i], v);
+			v = b->knobs[i].default_value;
+		if (v)
+			json_knob(f, &first, &b->knobs[i], v);
 	}
 	for (int i = 0; opts && i < opts->n; i++) {
 		int known = 0;
