@@ -24,6 +24,7 @@
  *   the difference of the two differences with its Wald 95% interval
  *   (multinomial variance within a group, (pL + pR - (pL - pR)^2) / n;
  *   binomial between groups) and the z test; verdict as for a trend. */
+#define _POSIX_C_SOURCE 200809L /* strtok_r */
 #include "beamsim/essay_compare.h"
 
 #include <math.h>
