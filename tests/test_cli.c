@@ -118,6 +118,42 @@ static void test_help(void **state)
 	check_help("essay", essay);
 }
 
+/* beamsim help COMMAND [SUBCOMMAND] prints exactly what COMMAND
+ * [SUBCOMMAND] --help prints; an unknown command is a usage error naming
+ * the nearest one; the general help points to the guide and the configs. */
+static void test_help_command(void **state)
+{
+	(void)state;
+	static const char *const pairs[][5] = {
+	        {"help", "sweep", NULL, "sweep", "--help"},
+	        {"help", "markov", "build", "markov", "build"},
+	};
+	for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; i++) {
+		const char *via_help[] = {pairs[i][0], pairs[i][1], pairs[i][2], NULL};
+		const char *direct[] = {pairs[i][3], pairs[i][4], pairs[i][2] ? "--help" : NULL,
+		                        NULL};
+		cli_run a = run_cli(via_help), b = run_cli(direct);
+		assert_int_equal(a.status, 0);
+		assert_int_equal(b.status, 0);
+		assert_string_equal(a.out, b.out);
+		assert_contains(a.out, "Usage: beamsim ");
+		cli_run_free(&a);
+		cli_run_free(&b);
+	}
+	const char *typo[] = {"help", "swep", NULL};
+	cli_run r = run_cli(typo);
+	assert_int_equal(r.status, 2);
+	assert_contains(r.err, "did you mean 'sweep'");
+	cli_run_free(&r);
+	const char *top[] = {"help", NULL};
+	r = run_cli(top);
+	assert_int_equal(r.status, 0);
+	assert_contains(r.out, "beamsim help COMMAND");
+	assert_contains(r.out, "docs/");
+	assert_contains(r.out, "share/beamsim/configs");
+	cli_run_free(&r);
+}
+
 static void test_version(void **state)
 {
 	(void)state;
@@ -575,6 +611,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_help),
 	        cmocka_unit_test(test_version),
+	        cmocka_unit_test(test_help_command),
 	        cmocka_unit_test(test_bad_usage),
 	        cmocka_unit_test(test_sweep_needs_out),
 	        cmocka_unit_test(test_unknown_backend),

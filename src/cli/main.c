@@ -30,7 +30,8 @@ static const cli_command commands[] = {
          "escape rate of a sweep's groups against barrier over noise power (Kramers)"},
         {"markov", cmd_markov,
          "predict a gate lattice from single-gate maps: build, predict, validate"},
-        {"plot", cmd_plot, "draw the figures of a sweep, comparison, run or accuracy study"},
+        {"plot", cmd_plot,
+         "draw the figures of a sweep, comparison, run, accuracy study or essay comparison"},
         {"video", cmd_video, "an MP4 of one trial, on one backend or side by side"},
 };
 
@@ -39,7 +40,7 @@ static const cli_command commands[] = {
 static void usage(FILE *f)
 {
 	fputs("Usage: beamsim COMMAND [OPTIONS]\n"
-	      "       beamsim COMMAND --help\n"
+	      "       beamsim COMMAND --help   (or: beamsim help COMMAND)\n"
 	      "       beamsim --version\n"
 	      "\n"
 	      "Simulates a self-propelled disk traversing elastic beam gates.\n"
@@ -52,7 +53,11 @@ static void usage(FILE *f)
 	      "Exit status: 0 success, 1 a run failed, 2 bad usage or a bad scene or\n"
 	      "experiment file, 3 compare or regress found disagreement beyond tolerance,\n"
 	      "130 or 143 stopped by SIGINT or SIGTERM (sweep and compare keep their\n"
-	      "finished trials: rerun with --resume).\n",
+	      "finished trials: rerun with --resume).\n"
+	      "\n"
+	      "Guide: README.md and docs/ of the source tree. Scenes and experiments to\n"
+	      "start from: configs/ there, installed in share/beamsim/configs (thesis/ the\n"
+	      "essay's gate and experiments, lattice/ its 9 x 9 field, hard/ hard cases).\n",
 	      f);
 }
 
@@ -76,6 +81,28 @@ static int close_stdout(int rc)
 	return rc != CLI_OK ? rc : CLI_FAIL;
 }
 
+/* The command called name, or NULL after saying it is unknown (with the
+ * nearest name, or the usage). */
+static const cli_command *find_command(const char *name)
+{
+	const char *names[N_COMMANDS];
+	for (int i = 0; i < N_COMMANDS; i++) {
+		if (strcmp(name, commands[i].name) == 0)
+			return &commands[i];
+		names[i] = commands[i].name;
+	}
+	const char *near = cli_nearest(name, names, N_COMMANDS);
+	if (near) {
+		cli_error("unknown command '%s'; did you mean '%s'? (beamsim --help lists them)",
+		          name, near);
+		return NULL;
+	}
+	cli_error("unknown command '%s'", name);
+	fputc('\n', stderr);
+	usage(stderr);
+	return NULL;
+}
+
 static int dispatch(int argc, char **argv)
 {
 	if (argc < 2) {
@@ -83,6 +110,20 @@ static int dispatch(int argc, char **argv)
 		return CLI_USAGE;
 	}
 	const char *name = argv[1];
+	if (strcmp(name, "help") == 0 && argc > 2) {
+		/* beamsim help COMMAND [SUBCOMMAND]: the command's own help, as
+		 * COMMAND [SUBCOMMAND] --help. */
+		if (argc > 4) {
+			cli_error("help: expected a command and at most a subcommand, got %d words",
+			          argc - 2);
+			return CLI_USAGE;
+		}
+		const cli_command *c = find_command(argv[2]);
+		char help[] = "--help";
+		char *help_argv[4] = {argv[2], argc > 3 ? argv[3] : help, argc > 3 ? help : NULL,
+		                      NULL};
+		return c ? c->run(argc - 1, help_argv) : CLI_USAGE;
+	}
 	if (strcmp(name, "--help") == 0 || strcmp(name, "-h") == 0 || strcmp(name, "help") == 0) {
 		usage(stdout);
 		return CLI_OK;
@@ -94,22 +135,8 @@ static int dispatch(int argc, char **argv)
 		       bsim_version_box2d(), bsim_version_compiler());
 		return CLI_OK;
 	}
-	const char *names[N_COMMANDS];
-	for (int i = 0; i < N_COMMANDS; i++) {
-		if (strcmp(name, commands[i].name) == 0)
-			return commands[i].run(argc - 1, argv + 1);
-		names[i] = commands[i].name;
-	}
-	const char *near = cli_nearest(name, names, N_COMMANDS);
-	if (near) {
-		cli_error("unknown command '%s'; did you mean '%s'? (beamsim --help lists them)",
-		          name, near);
-		return CLI_USAGE;
-	}
-	cli_error("unknown command '%s'", name);
-	fputc('\n', stderr);
-	usage(stderr);
-	return CLI_USAGE;
+	const cli_command *c = find_command(name);
+	return c ? c->run(argc - 1, argv + 1) : CLI_USAGE;
 }
 
 int main(int argc, char **argv)
