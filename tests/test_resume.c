@@ -242,6 +242,9 @@ static void test_signals(void **state)
 		assert_int_equal(rc, 128 + sigs[i]);
 		assert_non_null(strstr(err, sigs[i] == SIGINT ? "SIGINT" : "SIGTERM"));
 		assert_non_null(strstr(err, "--resume"));
+		/* The line to continue starts with the program as invoked. */
+		if (!strpbrk(BSIM_EXE, " '\"$\\`"))
+			assert_non_null(strstr(err, "to continue: " BSIM_EXE " sweep "));
 		assert_non_null(strstr(err, "stopped after"));
 		assert_true(bsim_test_exists(bsim_test_join(dir, ".beamsim/journal")));
 		assert_false(bsim_test_exists(bsim_test_join(dir, "trials.csv")));

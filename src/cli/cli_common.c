@@ -271,6 +271,7 @@ int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int sh
 /* ---- signals and the line that resumes a run ---------------------------- */
 
 volatile sig_atomic_t cli_stop;
+const char *cli_program = "beamsim";
 
 static void on_signal(int sig)
 {
@@ -300,11 +301,12 @@ void cli_signals_restore(void)
 	signal(SIGTERM, SIG_DFL);
 }
 
-/* "beamsim sweep ... --resume": the command line that continues the run. */
+/* "build/beamsim sweep ... --resume": the command line that continues the
+ * run, starting with the program as it was invoked. */
 static void resume_line(FILE *f, int argc, char **argv)
 {
 	int has = 0;
-	fputs("beamsim", f);
+	text_shell_word(f, cli_program);
 	for (int i = 0; i < argc; i++) {
 		fputc(' ', f);
 		text_shell_word(f, argv[i]);

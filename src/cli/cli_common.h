@@ -100,6 +100,9 @@ int cli_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, int sh
  * first signal asks the run to stop; a second ends the process at once,
  * which loses nothing the run's journal holds. */
 extern volatile sig_atomic_t cli_stop;
+/* The program as it was invoked (argv[0]; "beamsim" until main sets it),
+ * so that a printed command line runs as typed (build/beamsim ...). */
+extern const char *cli_program;
 void cli_signals_install(void);
 void cli_signals_restore(void);
 

@@ -141,5 +141,7 @@ static int dispatch(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+	if (argc > 0 && argv[0] && argv[0][0])
+		cli_program = argv[0];
 	return close_stdout(dispatch(argc, argv));
 }
