@@ -34,6 +34,7 @@
 #include "store/session.h"
 #include "store/store.h"
 #include "util/atomic_file.h"
+#include "util/csv_table.h"
 #include "util/figure.h"
 #include "util/survival.h"
 
@@ -162,22 +163,6 @@ static int barrier_of(const bsim_scene *s, const bsim_landscape_grid_def *def, e
 	return rc;
 }
 
-/* A CSV field: quoted if it holds a comma or a quote. */
-static void csv_text(FILE *f, const char *s)
-{
-	if (!strpbrk(s, ",\"\n")) {
-		fputs(s, f);
-		return;
-	}
-	fputc('"', f);
-	for (; *s; s++) {
-		if (*s == '"')
-			fputc('"', f);
-		fputc(*s, f);
-	}
-	fputc('"', f);
-}
-
 static void num(FILE *f, double v)
 {
 	if (isfinite(v))
@@ -213,7 +198,7 @@ static int write_csv(const char *stage, const esc_job *j, bsim_error *err)
 	      o.f);
 	for (int a = 0; a < e->n_axes; a++) {
 		fputc(',', o.f);
-		csv_text(o.f, e->axes[a].key);
+		csv_field_write(o.f, e->axes[a].key);
 	}
 	fputc('\n', o.f);
 	int idx[64];
@@ -243,7 +228,7 @@ static int write_csv(const char *stage, const esc_job *j, bsim_error *err)
 			bsim_experiment_group_index(e, k, idx);
 		for (int a = 0; a < e->n_axes && a < 64; a++) {
 			fputc(',', o.f);
-			csv_text(o.f, e->axes[a].values[idx[a]]);
+			csv_field_write(o.f, e->axes[a].values[idx[a]]);
 		}
 		fputc('\n', o.f);
 	}

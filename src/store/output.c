@@ -17,6 +17,7 @@
 #include "store/survival_files.h"
 #include "store/trials_csv.h"
 #include "store/lattice_files.h"
+#include "util/csv_table.h"
 #include "util/json.h"
 #include "beamsim/lattice.h"
 #include "beamsim/version.h"
@@ -306,25 +307,8 @@ int bsim_output_summary_json(const char *path, const bsim_experiment *e, const c
 
 /* ---- trials.csv -------------------------------------------------------- */
 
-/* A CSV field: as it is, or in double quotes (each " doubled) if it holds a
- * comma, a quote or a line break. */
-static void csv_field(FILE *f, const char *s)
-{
-	if (!strpbrk(s, ",\"\r\n")) {
-		fputs(s, f);
-		return;
-	}
-	fputc('"', f);
-	for (; *s; s++) {
-		if (*s == '"')
-			fputc('"', f);
-		fputc(*s, f);
-	}
-	fputc('"', f);
-}
-
 /* A number, or an empty field if it was not measured (NaN). */
-static void csv_number(FILE *f, double x)
+static void number_field(FILE *f, double x)
 {
 	if (!isnan(x))
 		fprintf(f, "%.10g", x);
@@ -358,7 +342,7 @@ int trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experimen
 		fprintf(w->o.f, "%s%s", c ? "," : "", bsim_trials_csv_columns[c]);
 	for (int a = 0; a < w->axes; a++) {
 		fputc(',', w->o.f);
-		csv_field(w->o.f, e->axes[a].key);
+		csv_field_write(w->o.f, e->axes[a].key);
 	}
 	fputc('\n', w->o.f);
 	return BSIM_OK;
@@ -385,7 +369,7 @@ void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 		        l->w_prop + l->w_rand,
 		        l->damper + l->impact + l->contact + l->correction + l->sleep + l->reset,
 		        l->residual);
-		csv_number(f, x->overlap_max);
+		number_field(f, x->overlap_max);
 		/* the final gate and location, and the gates entered in order:
 		 * "ix:iy ix:iy ..." */
 		char label[48];
@@ -401,10 +385,10 @@ void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 		/* what the backend's solvers gave up on in this trial */
 		fprintf(f, ",%ld,%ld,", x->solver.iteration_limit, x->solver.clamped);
 		/* when it left the gate (the field), empty if censored */
-		csv_number(f, survival_exit_time(x));
+		number_field(f, survival_exit_time(x));
 		for (int a = 0; a < w->axes; a++) {
 			fputc(',', f);
-			csv_field(f, w->e->axes[a].values[w->idx[a]]);
+			csv_field_write(f, w->e->axes[a].values[w->idx[a]]);
 		}
 		fputc('\n', f);
 	}

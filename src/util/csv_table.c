@@ -36,6 +36,21 @@ static int count_fields(const char *line)
 	return n;
 }
 
+void csv_field_write(FILE *f, const char *s)
+{
+	if (!strpbrk(s, ",\"\r\n")) {
+		fputs(s, f);
+		return;
+	}
+	fputc('"', f);
+	for (; *s; s++) {
+		if (*s == '"')
+			fputc('"', f);
+		fputc(*s, f);
+	}
+	fputc('"', f);
+}
+
 int csv_text_check(const char *path, const char *text, size_t len, bsim_error *err)
 {
 	/* A NUL would end a line's text early, unseen: named where it is. */

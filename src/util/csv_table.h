@@ -9,6 +9,7 @@
 #define BSIM_UTIL_CSV_TABLE_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #include "beamsim/error.h"
 
@@ -22,6 +23,11 @@ typedef struct csv_table {
 
 /* The largest table read, bytes (16 GiB: 80 million trials.csv rows). */
 #define CSV_TABLE_MAX_BYTES 17179869184.0
+
+/* Writes s as one CSV field: as it is, or in double quotes (each "
+ * doubled) if it holds a comma, a quote or a line break, so that text a
+ * user gave (a grid key or value) cannot shift the columns. */
+void csv_field_write(FILE *f, const char *s);
 
 /* The checks every stored CSV text passes before it is split: no NUL byte,
  * and a last line that ends in a line feed (beamsim ends every line it
