@@ -196,11 +196,16 @@ static int grid_query(const struct bsim_world *w, double r, double margin, int *
 	return n;
 }
 
-/* Fills w->candidates with the beams the step must test; returns how many. */
-int thesis_broad_phase(struct bsim_world *w, double speed, double h)
+/* Fills w->candidates with the awake beams and those at rest within reach
+ * plus margin, searched in the square of half-side r (c + margin: the cell
+ * side c >= L + R, so it holds every reach); returns how many, *sleeping_found set if any beam at
+ * rest was added (then the list is no longer in ascending order). A world
+ * of few beams, or broad_phase=0, lists them all, in order. */
+static int candidates_within(struct bsim_world *w, double r, double margin, int *sleeping_found)
 {
 	int *out = w->candidates;
 	int n = 0;
+	*sleeping_found = 0;
 	if (!w->broad_phase || w->n_beams <= BROAD_PHASE_MIN_BEAMS) {
 		for (int i = 0; i < w->n_beams; i++)
 			out[n++] = i;
@@ -208,27 +213,24 @@ int thesis_broad_phase(struct bsim_world *w, double speed, double h)
 	}
 	for (int k = 0; k < w->n_awake; k++)
 		out[n++] = w->awake[k];
+	return grid_query(w, r, margin, out, n, sleeping_found);
+}
+
+/* Fills w->candidates with the beams the step must test, in ascending
+ * order; returns how many. */
+int thesis_broad_phase(struct bsim_world *w, double speed, double h)
+{
 	int sleeping_found;
-	n = grid_query(w, w->grid.cell + 2.0 * h * speed + w->slop, 2.0 * h * speed + w->slop, out,
-	               n, &sleeping_found);
+	int n = candidates_within(w, w->grid.cell + 2.0 * h * speed + w->slop,
+	                          2.0 * h * speed + w->slop, &sleeping_found);
 	if (sleeping_found)
-		sort_small(out, n);
+		sort_small(w->candidates, n);
 	return n;
 }
 
-/* The same query with a margin of its own (the cell side c >= L + R, so a
- * square of r = c + margin holds every reach). Unsorted. */
+/* The same query with a margin of its own. Unsorted. */
 int thesis_broad_phase_near(struct bsim_world *w, double margin)
 {
-	int *out = w->candidates;
-	int n = 0;
-	if (!w->broad_phase || w->n_beams <= BROAD_PHASE_MIN_BEAMS) {
-		for (int i = 0; i < w->n_beams; i++)
-			out[n++] = i;
-		return n;
-	}
-	for (int k = 0; k < w->n_awake; k++)
-		out[n++] = w->awake[k];
 	int found;
-	return grid_query(w, w->grid.cell + margin, margin, out, n, &found);
+	return candidates_within(w, w->grid.cell + margin, margin, &found);
 }
