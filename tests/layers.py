@@ -55,6 +55,7 @@ PUBLIC = {
     "backend": "model",
     "effects": "model",
     "experiment": "model",
+    "key_names": "model",
     "landscape": "model",
     "lattice": "model",
     "options": "model",

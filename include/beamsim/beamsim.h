@@ -14,6 +14,7 @@
 #include "beamsim/error.h"
 #include "beamsim/essay_compare.h"
 #include "beamsim/experiment.h"
+#include "beamsim/key_names.h"
 #include "beamsim/figures.h"
 #include "beamsim/landscape.h"
 #include "beamsim/landscape_barriers.h"
