@@ -7,9 +7,11 @@
  * equal the row's text; the grid values the report names are those the
  * group index gives (first axis slowest). The same on a lattice
  * experiment, on a comparison's second side (by backend options, and by
- * lattice protocol), and for video. A scene given --group says that it
- * applies no grid values; a group or trial out of range exits 2 naming the
- * range; a comparison's directory without a side names its sides. */
+ * lattice protocol), and for video. A stored row that the replay does not
+ * give (steps altered in a directory without its manifest) exits 3. A
+ * scene given --group says that it applies no grid values; a group or
+ * trial out of range exits 2 naming the range; a comparison's directory
+ * without a side names its sides. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <setjmp.h>
@@ -154,6 +156,45 @@ static void rows_replay_exactly(void **state)
 	}
 }
 
+/* A stored row altered (steps + 1; the manifest removed, which would
+ * refuse the file): the replay says it differs and exits 3. */
+static void altered_row_exits_3(void **state)
+{
+	(void)state;
+	char dir[1300], csv[1400], row[256], altered[320];
+	snprintf(dir, sizeof dir, "%s", bsim_test_join(work, "altered"));
+	const char *sweep[] = {"sweep",     experiment, "--out",   dir,
+	                       "--threads", "2",        "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	assert_int_equal(bsim_test_remove(bsim_test_join(dir, "manifest.json")), 0);
+	snprintf(csv, sizeof csv, "%s/trials.csv", dir);
+	csv_row(csv, 6, 1, row, sizeof row);
+	char outcome[32], type[32], rest[200];
+	int steps;
+	assert_int_equal(sscanf(row, "6,1,%31[^,],%31[^,],%d,%199s", outcome, type, &steps, rest),
+	                 4);
+	snprintf(altered, sizeof altered, "6,1,%s,%s,%d,%s", outcome, type, steps + 1, rest);
+	char *text = bsim_test_read(csv);
+	assert_non_null(text);
+	char *at = strstr(text, row);
+	assert_non_null(at);
+	size_t head = (size_t)(at - text), n = strlen(row);
+	char *changed = malloc(strlen(text) + 16);
+	assert_non_null(changed);
+	sprintf(changed, "%.*s%s%s", (int)head, text, altered, at + n);
+	bsim_test_write(dir, "trials.csv", changed);
+	free(changed);
+	free(text);
+	const char *argv[] = {"run", dir, "--group", "6", "--trial", "1", NULL};
+	char *out = NULL, *err = NULL;
+	assert_int_equal(bsim_test_cli(argv, &out, &err), 3);
+	assert_non_null(strstr(out, "(differs from the replay)"));
+	assert_non_null(strstr(err, "differs from its row"));
+	assert_non_null(strstr(err, altered));
+	free(out);
+	free(err);
+}
+
 /* A lattice experiment (the C track, two trials), one row. */
 static void lattice_row_replays(void **state)
 {
@@ -179,7 +220,7 @@ static void lattice_row_replays(void **state)
 static void compare_sides_replay(void **state)
 {
 	(void)state;
-	char dir[1300], csv[1400], want[256], got[256];
+	char dir[1300], csv[1400], want[256], got[256], other[256];
 	snprintf(dir, sizeof dir, "%s", bsim_test_join(work, "compare"));
 	const char *side = "thesis:integrator=euler";
 	const char *compare[] = {
@@ -190,6 +231,10 @@ static void compare_sides_replay(void **state)
 	assert_true(rc == 0 || rc == 3);
 	snprintf(csv, sizeof csv, "%s/thesis-integrator=euler/trials.csv", dir);
 	csv_row(csv, 7, 1, want, sizeof want);
+	/* the sides part in this trial, so a replay of the wrong one shows */
+	snprintf(csv, sizeof csv, "%s/thesis/trials.csv", dir);
+	csv_row(csv, 7, 1, other, sizeof other);
+	assert_string_not_equal(want, other);
 	const char *from_exp[] = {"run", experiment, "--backend", side,     "--group",
 	                          "7",   "--trial",  "1",         "--json", NULL};
 	replay_row(from_exp, 7, 1, got, sizeof got);
@@ -210,18 +255,22 @@ static void compare_sides_replay(void **state)
 	snprintf(lat, sizeof lat, "%s", bsim_test_src("configs/lattice/c_track_essay.yaml"));
 	snprintf(pdir, sizeof pdir, "%s", bsim_test_join(work, "protocols"));
 	const char *protocols[] = {"compare", lat,     "--protocols", "world,essay", "--trials",
-	                           "2",       "--out", pdir,          "--quiet",     NULL};
+	                           "3",       "--out", pdir,          "--quiet",     NULL};
 	rc = bsim_test_cli(protocols, NULL, NULL);
 	assert_true(rc == 0 || rc == 3);
 	snprintf(csv, sizeof csv, "%s/essay/trials.csv", pdir);
-	csv_row(csv, 0, 1, want, sizeof want);
+	csv_row(csv, 0, 2, want, sizeof want);
+	/* the sides part in this trial, so a replay of the wrong one shows */
+	snprintf(csv, sizeof csv, "%s/world/trials.csv", pdir);
+	csv_row(csv, 0, 2, other, sizeof other);
+	assert_string_not_equal(want, other);
 	const char *essay_dir[] = {"run",     pdir, "--backend", "essay",
-	                           "--trial", "1",  "--json",    NULL};
-	replay_row(essay_dir, 0, 1, got, sizeof got);
+	                           "--trial", "2",  "--json",    NULL};
+	replay_row(essay_dir, 0, 2, got, sizeof got);
 	assert_string_equal(got, want);
 	const char *essay_exp[] = {"run",     lat, "--set",  "lattice.protocol=essay",
-	                           "--trial", "1", "--json", NULL};
-	replay_row(essay_exp, 0, 1, got, sizeof got);
+	                           "--trial", "2", "--json", NULL};
+	replay_row(essay_exp, 0, 2, got, sizeof got);
 	assert_string_equal(got, want);
 }
 
@@ -303,9 +352,10 @@ static void video_replays(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(rows_replay_exactly),  cmocka_unit_test(lattice_row_replays),
-	        cmocka_unit_test(compare_sides_replay), cmocka_unit_test(scene_group_note),
-	        cmocka_unit_test(out_of_range_exits_2), cmocka_unit_test(video_replays),
+	        cmocka_unit_test(rows_replay_exactly), cmocka_unit_test(altered_row_exits_3),
+	        cmocka_unit_test(lattice_row_replays), cmocka_unit_test(compare_sides_replay),
+	        cmocka_unit_test(scene_group_note),    cmocka_unit_test(out_of_range_exits_2),
+	        cmocka_unit_test(video_replays),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }
