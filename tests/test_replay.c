@@ -272,6 +272,10 @@ static void compare_sides_replay(void **state)
 	                           "--trial", "2", "--json", NULL};
 	replay_row(essay_exp, 0, 2, got, sizeof got);
 	assert_string_equal(got, want);
+	/* the side's label given to an experiment: what it amounts to */
+	const char *label[] = {"run", lat, "--backend", "essay", NULL};
+	const char *const l_needles[] = {"--backend essay", "--set lattice.protocol=essay", NULL};
+	bsim_test_expect_input_error(label, l_needles);
 }
 
 /* A scene has no grid: --group says so and names the ways to replay. */

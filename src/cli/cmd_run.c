@@ -217,6 +217,13 @@ static void print_text(FILE *out, const run_args *a, const cli_replay *rp, uint6
 static const bsim_backend *run_backend(const cli_common *c, run_args *a)
 {
 	const char *spec = c->backend ? c->backend : bsim_backend_default()->name;
+	/* A side of compare --protocols is named by its protocol. */
+	if (strcmp(spec, "world") == 0 || strcmp(spec, "essay") == 0) {
+		cli_error("--backend %s: a lattice protocol, not a backend: a side of compare "
+		          "--protocols is --set lattice.protocol=%s (with --backend B)",
+		          spec, spec);
+		return NULL;
+	}
 	size_t n = strcspn(spec, ":");
 	char name[32];
 	snprintf(name, sizeof name, "%.*s", (int)(n < sizeof name ? n : sizeof name - 1), spec);
