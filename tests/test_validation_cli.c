@@ -360,8 +360,10 @@ static void grid_conflict(void **state)
 	assert_null(trials);
 }
 
-/* A file of the other kind: an experiment given to run, a scene given to
- * sweep or compare, is named as what it is, with the command that takes it. */
+/* A file of the other kind: an experiment given to a command that takes a
+ * scene (landscape; run and video take both, test_replay), a scene given to
+ * sweep or compare, is named as what it is, with the command that takes
+ * it. */
 static void wrong_kind_of_file(void **state)
 {
 	(void)state;
@@ -369,7 +371,7 @@ static void wrong_kind_of_file(void **state)
 	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/thesis/h1_symmetric.yaml"));
 	snprintf(scene, sizeof scene, "%s", bsim_test_src("configs/thesis/gate.yaml"));
 	const char *out = bsim_test_dir("wrong_kind");
-	const char *run[] = {"run", exp, NULL};
+	const char *run[] = {"landscape", exp, "--out", out, NULL};
 	const char *run_needles[] = {"h1_symmetric.yaml:2:1: scene: this is an experiment file",
 	                             "beamsim sweep or compare", NULL};
 	bsim_test_expect_input_error(run, run_needles);

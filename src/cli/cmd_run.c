@@ -18,12 +18,15 @@
 #include "beamsim/limits.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
+#include "cli/cli_replay.h"
 
 enum { OWN_GROUP, OWN_TRIAL, OWN_TRAJECTORY, OWN_STRIDE, OWN_JSON };
 
 static const cli_own run_own[] = {
-        [OWN_GROUP] = {"group", 1, "G", "group index for the seed (default 0)"},
-        [OWN_TRIAL] = {"trial", 1, "I", "trial index for the seed (default 0)"},
+        [OWN_GROUP] = {"group", 1, "G",
+                       "group, from 0: an experiment's grid values and the\n"
+                       "seed (default 0)"},
+        [OWN_TRIAL] = {"trial", 1, "I", "trial of the group, from 0 (default 0)"},
         [OWN_TRAJECTORY] = {"trajectory", 1, "FILE.csv",
                             "write the trajectory, one row per recorded step, and\n"
                             "its MATLAB twin FILE.mat; - is standard output (no\n"
@@ -33,7 +36,8 @@ static const cli_own run_own[] = {
 };
 
 static const char *const run_help[CLI_N_OPTS] = {
-        [CLI_OPT_SEED] = "experiment seed (default 1)",
+        [CLI_OPT_SEED] = "experiment seed (default: the experiment's, a scene's 1;\n"
+                         "not with DIR, whose seed is stored)",
         [CLI_OPT_OUT] = "write DIR/trajectory.csv, DIR/ledger.csv (the energy\n"
                         "ledger over time), their .mat twins and DIR/run.json,\n"
                         "for `beamsim plot DIR`",
@@ -45,6 +49,7 @@ typedef struct run_args {
 	bsim_options opts;
 	uint64_t seed;
 	long group, trial, stride;
+	int has_group;
 	const char *trajectory;
 	int json;
 } run_args;
@@ -56,6 +61,7 @@ static int run_option(void *args, int i, const char *value)
 	case OWN_GROUP:
 		if (cli_parse_long(value, 0, INT32_MAX, &a->group) != 0)
 			return cli_usage("run", "--group %s: expected an integer >= 0", value);
+		a->has_group = 1;
 		return CLI_OK;
 	case OWN_TRIAL:
 		if (cli_parse_long(value, 0, INT32_MAX, &a->trial) != 0)
@@ -83,16 +89,27 @@ static int run_option(void *args, int i, const char *value)
 
 static const cli_spec run_spec = {
         .name = "run",
-        .usage = "SCENE [OPTIONS]",
-        .about = "Runs one trial of the scene file SCENE and prints its outcome, end state,\n"
-                 "peak beam angles, the deepest overlap of body and beams, and the energy\n"
-                 "ledger. The random-force schedule is that of trial I of group G of a sweep\n"
-                 "with seed N, so a sweep's trial can be replayed. A trial whose state stops\n"
+        .usage = "SCENE|EXPERIMENT|DIR [OPTIONS]",
+        .about = "Runs one trial and prints its outcome, end state, peak beam angles, the\n"
+                 "deepest overlap of body and beams, and the energy ledger. The trial is\n"
+                 "  of a scene file SCENE: the random-force schedule of trial I of group G\n"
+                 "    of a sweep with seed N; a scene has no grid, so no grid values apply;\n"
+                 "  of an experiment file EXPERIMENT: trial I of group G as `beamsim sweep\n"
+                 "    EXPERIMENT` runs it, the group's grid values applied (printed), the\n"
+                 "    experiment's seed unless --seed N; --backend may be a compare side,\n"
+                 "    NAME:K=V..., and a --protocols side is --set lattice.protocol=P;\n"
+                 "  of the output directory DIR of beamsim sweep or compare: trial I of\n"
+                 "    group G as that run ran it (run.json, inputs/: its experiment, seed,\n"
+                 "    backend and options, so --seed, --set and --backend-opt are\n"
+                 "    refused); a comparison's side is --backend LABEL. The\n"
+                 "    stored trials.csv row is printed; if the replay differs from it in\n"
+                 "    outcome, type, steps, t_end, x_end or y_end the exit status is 3.\n"
+                 "Groups and trials count from 0, as in trials.csv. A trial whose state stops\n"
                  "being finite, or whose ledger shows energy created beyond the bound, is\n"
                  "unstable: the reason is printed and the exit status is 1. Beams are\n"
                  "numbered from 1 in what run prints and writes (beam 1, theta1), as in\n"
                  "every output; the scene's list, and so --set, counts from 0 (beams.0).\n",
-        .positional = "SCENE",
+        .positional = "SCENE|EXPERIMENT|DIR",
         .common = CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_BACKEND_OPT) |
                   CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) |
                   CLI_USES(CLI_OPT_LIMIT),
@@ -127,11 +144,20 @@ static void print_lattice(FILE *out, const bsim_scene *s, const bsim_trial_resul
 		        r->reset_overlaps);
 }
 
-static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64_t mixed,
+static void print_text(FILE *out, const run_args *a, const cli_replay *rp, uint64_t mixed,
                        const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	const bsim_ledger *l = &r->ledger;
-	fprintf(out, "scene       %s (%s), backend %s\n", cli_path(a->scene), s->name, a->backend);
+	const bsim_scene *s = &rp->scene;
+	if (rp->kind == CLI_REPLAY_SCENE) {
+		fprintf(out, "scene       %s (%s), backend %s\n", cli_path(a->scene), s->name,
+		        a->backend);
+	} else {
+		fprintf(out, "%-11s %s, scene %s (%s), backend %s\n",
+		        rp->kind == CLI_REPLAY_STORED ? rp->command : "experiment",
+		        cli_path(rp->path), cli_path(rp->scene_path), s->name, a->backend);
+		fprintf(out, "grid        %s\n", rp->grid);
+	}
 	fprintf(out,
 	        "seed        %" PRIu64 ", group %ld, trial %ld (mixed seed %" PRIu64
 	        ", %lu draws)\n",
@@ -175,6 +201,50 @@ static void print_text(FILE *out, const run_args *a, const bsim_scene *s, uint64
 		bsim_trial_instability_text(r, s->dt, why, sizeof why);
 		fprintf(out, "unstable    %s\n", why);
 	}
+	if (rp->kind != CLI_REPLAY_SCENE) {
+		char row[256];
+		cli_replay_row(row, sizeof row, a->group, a->trial, r);
+		fprintf(out,
+		        "row         %s (trials.csv: group,trial,outcome,type,steps,t_end,"
+		        "x_end,y_end)\n",
+		        row);
+	}
+}
+
+/* The backend of --backend (default: the default backend) with the
+ * --backend-opt values, then the options of a compare side's label
+ * NAME:K=V... (they win, as in compare). NULL with the error printed. */
+static const bsim_backend *run_backend(const cli_common *c, run_args *a)
+{
+	const char *spec = c->backend ? c->backend : bsim_backend_default()->name;
+	/* A side of compare --protocols is named by its protocol. */
+	if (strcmp(spec, "world") == 0 || strcmp(spec, "essay") == 0) {
+		cli_error("--backend %s: a lattice protocol, not a backend: a side of compare "
+		          "--protocols is --set lattice.protocol=%s (with --backend B)",
+		          spec, spec);
+		return NULL;
+	}
+	size_t n = strcspn(spec, ":");
+	char name[32];
+	snprintf(name, sizeof name, "%.*s", (int)(n < sizeof name ? n : sizeof name - 1), spec);
+	const bsim_backend *b = cli_backend_with_opts(c, "run", name, &a->opts);
+	for (const char *p = spec + n; b && *p == ':';) {
+		size_t len = strcspn(p + 1, ":");
+		char kv[128];
+		snprintf(kv, sizeof kv, "%.*s", (int)(len < sizeof kv ? len : sizeof kv - 1),
+		         p + 1);
+		if (cli_options_add(&a->opts, "run", kv) != CLI_OK)
+			return NULL;
+		p += len + 1;
+	}
+	bsim_error err;
+	if (b && spec[n] &&
+	    bsim_options_check(&a->opts, b->knobs, b->n_knobs, b->name, &err) != BSIM_OK) {
+		cli_error("--backend %s: %s", spec, err.msg);
+		return NULL;
+	}
+	a->backend = spec;
+	return b;
 }
 
 int cmd_run(int argc, char **argv)
@@ -183,30 +253,37 @@ int cmd_run(int argc, char **argv)
 	const bsim_run_info defaults = bsim_run_info_default();
 	run_args a = {.seed = defaults.seed, .stride = defaults.stride};
 	int rc = cli_parse(&run_spec, argc, argv, &c, &a, &a.scene);
-	a.backend = c.backend ? c.backend : bsim_backend_default()->name;
-	a.seed = c.has_seed ? c.seed : a.seed;
+	/* A stored run's directory names its own backend (--backend: a side). */
+	int stored = rc < 0 && cli_replay_is_dir(a.scene);
 	const bsim_backend *backend = NULL;
-	if (rc < 0 && !(backend = cli_backend_with_opts(&c, "run", a.backend, &a.opts)))
+	if (rc < 0 && !stored && !(backend = run_backend(&c, &a)))
 		rc = CLI_USAGE;
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
 	}
-	bsim_scene scene;
-	bsim_error err;
-	if (bsim_scene_load(a.scene, c.sets.ov, c.sets.n, &scene, &err) != BSIM_OK) {
-		cli_error("%s", err.msg);
+	cli_replay rp;
+	rc = cli_replay_open("run", a.scene, &c, a.group, a.trial, a.has_group, defaults.seed, &rp);
+	if (rc != CLI_OK) {
 		cli_common_free(&c);
-		return err.code ? err.code : CLI_USAGE;
+		return rc;
 	}
-	cli_estimate_line(backend->name, (double)scene.max_steps * scene.n_beams);
+	if (stored) {
+		backend = rp.backend;
+		a.opts = rp.opts;
+		a.backend = rp.label;
+	}
+	a.seed = rp.seed;
+	const bsim_scene *scene = &rp.scene;
+	cli_estimate_line(backend->name, (double)scene->max_steps * scene->n_beams);
 	uint64_t mixed = bsim_schedule_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
 	bsim_trial_log *log = bsim_trial_log_alloc();
+	int of_scene = rp.kind == CLI_REPLAY_SCENE;
 	bsim_run_info info = {
-	        .scene_path = a.scene,
-	        .scene = &scene,
-	        .sets = c.sets.ov,
-	        .n_sets = c.sets.n,
+	        .scene_path = rp.scene_path,
+	        .scene = scene,
+	        .sets = of_scene ? c.sets.ov : rp.ov,
+	        .n_sets = of_scene ? c.sets.n : rp.n_ov,
 	        .backend = backend,
 	        .opts = &a.opts,
 	        .seed = a.seed,
@@ -217,6 +294,7 @@ int cmd_run(int argc, char **argv)
 	        .log = log,
 	};
 	bsim_trial_result res;
+	bsim_error err;
 	memset(&res, 0, sizeof res);
 	if (!log)
 		rc = cli_report(bsim_error_set(&err, BSIM_EFAIL, "out of memory"), &err);
@@ -226,20 +304,27 @@ int cmd_run(int argc, char **argv)
 	/* A trajectory on standard output keeps it to itself: the report
 	 * goes to standard error. */
 	FILE *out = a.trajectory && strcmp(a.trajectory, "-") == 0 ? stderr : stdout;
-	if (rc == CLI_OK && a.json)
+	if (rc == CLI_OK && a.json) {
 		bsim_run_output_json(out, &info, &res, 0);
-	else if (rc == CLI_OK)
-		print_text(out, &a, &scene, mixed, &res, log);
+		if (!of_scene)
+			cli_error("%s", rp.grid);
+	} else if (rc == CLI_OK) {
+		print_text(out, &a, &rp, mixed, &res, log);
+	}
 	if (rc == CLI_OK)
 		cli_solver_warning(backend->name, &res.solver, "run --json");
 	if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {
 		char why[256];
-		bsim_trial_instability_text(&res, scene.dt, why, sizeof why);
+		bsim_trial_instability_text(&res, scene->dt, why, sizeof why);
 		cli_error("%s backend: unstable trial: %s", backend->name, why);
 		rc = CLI_FAIL;
 	}
+	/* A stored run's row, against the replay (after an unstable trial's
+	 * line, which has its own exit status). */
+	if (rc == CLI_OK)
+		rc = cli_replay_check(&rp, &res, a.json ? stderr : out);
 	bsim_trial_log_free(log);
-	bsim_scene_free(&scene);
+	cli_replay_free(&rp);
 	cli_common_free(&c);
 	return rc;
 }

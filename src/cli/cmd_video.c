@@ -16,13 +16,16 @@
 #include "beamsim/lattice_outcome.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
+#include "cli/cli_replay.h"
 
 enum { OWN_BACKENDS, OWN_GROUP, OWN_TRIAL, OWN_FPS, OWN_SIZE, OWN_HOLD, OWN_VIEW, OWN_CRF };
 
 static const cli_own video_own[] = {
         [OWN_BACKENDS] = {"backends", 1, "A,B", "several backends side by side (up to 4)"},
-        [OWN_GROUP] = {"group", 1, "G", "group index for the seed (default 0)"},
-        [OWN_TRIAL] = {"trial", 1, "I", "trial index for the seed (default 0)"},
+        [OWN_GROUP] = {"group", 1, "G",
+                       "group, from 0: an experiment's grid values and the\n"
+                       "seed (default 0)"},
+        [OWN_TRIAL] = {"trial", 1, "I", "trial of the group, from 0 (default 0)"},
         [OWN_FPS] = {"fps", 1, "F",
                      "frames per second of simulated time, 0.01 to 1000 (default 30)"},
         [OWN_SIZE] = {"size", 1, "WxH", "frame size in pixels, even (default 540x540 a panel)"},
@@ -35,7 +38,8 @@ static const cli_own video_own[] = {
 
 static const char *const video_help[CLI_N_OPTS] = {
         [CLI_OPT_OUT] = "the video to write (required)",
-        [CLI_OPT_SEED] = "experiment seed (default 1)",
+        [CLI_OPT_SEED] = "experiment seed (default: the experiment's, a scene's 1;\n"
+                         "not with DIR, whose seed is stored)",
 };
 
 #define MAX_PANELS BSIM_VIDEO_PANELS_MAX
@@ -47,6 +51,7 @@ typedef struct video_args {
 	bsim_options opts[MAX_PANELS];
 	uint64_t seed;
 	long group, trial;
+	int has_group;
 	bsim_video_def def;
 } video_args;
 
@@ -112,6 +117,7 @@ static int video_option(void *args, int i, const char *value)
 	case OWN_GROUP:
 		if (cli_parse_long(value, 0, INT32_MAX, &a->group) != 0)
 			return cli_usage("video", "--group %s: expected an integer >= 0", value);
+		a->has_group = 1;
 		return CLI_OK;
 	case OWN_TRIAL:
 		if (cli_parse_long(value, 0, INT32_MAX, &a->trial) != 0)
@@ -140,9 +146,11 @@ static int video_option(void *args, int i, const char *value)
 
 static const cli_spec video_spec = {
         .name = "video",
-        .usage = "SCENE --out FILE.mp4 [OPTIONS]",
-        .about = "Writes an MP4 (H.264, yuv420p) of one trial of the scene file SCENE: the\n"
-                 "trial beamsim run runs with the same --seed, --group, --trial and --set. A\n"
+        .usage = "SCENE|EXPERIMENT|DIR --out FILE.mp4 [OPTIONS]",
+        .about = "Writes an MP4 (H.264, yuv420p) of one trial: the trial beamsim run runs\n"
+                 "with the same SCENE, EXPERIMENT or DIR (trial I of group G of an\n"
+                 "experiment as its sweep runs it, or of the sweep or comparison stored\n"
+                 "in DIR; see beamsim run --help), --seed, --group, --trial and --set. A\n"
                  "frame shows the beams coloured by stiffness (with the scale), the body and\n"
                  "its trail, the random force as an arrow (one body radius per Rm), the time,\n"
                  "the kinetic, spring and propulsive potential energies, and the outcome once\n"
@@ -151,7 +159,7 @@ static const cli_spec video_spec = {
                  "panel showing the other's trail in grey and where the two paths part.\n"
                  "Frames are drawn with cairo and encoded by ffmpeg (Debian package ffmpeg).\n"
                  "The file appears whole or not at all.\n",
-        .positional = "SCENE",
+        .positional = "SCENE|EXPERIMENT|DIR",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND) |
                   CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET),
         .help = video_help,
@@ -163,10 +171,18 @@ static const cli_spec video_spec = {
 };
 
 /* After parsing: the backends (--backend or --backends) and their options. */
-static int video_resolve(const cli_common *c, video_args *a)
+static int video_resolve(const cli_common *c, video_args *a, int stored)
 {
 	a->out = c->out;
 	a->seed = c->has_seed ? c->seed : a->seed;
+	/* A stored run's side is its backend, with its options. */
+	if (stored && a->has_backends)
+		return cli_usage("video",
+		                 "--backends: %s holds a stored run with its own backend "
+		                 "(a comparison's side: --backend LABEL)",
+		                 a->scene);
+	if (stored)
+		return CLI_OK;
 	if (c->backend && a->has_backends)
 		return cli_usage("video", "--backend and --backends: give one of them");
 	if (c->backend) {
@@ -206,8 +222,9 @@ static void print_outcome(FILE *out, const char *name, const bsim_scene *s,
 
 /* Streams the video of the trial on every backend (bsim_video_stream_*:
  * its memory does not grow with the trial's steps) and reports it. */
-static int video_main(video_args *a, const bsim_backend *const *backends, const bsim_scene *scene)
+static int video_main(video_args *a, const bsim_backend *const *backends, const cli_replay *rp)
 {
+	const bsim_scene *scene = &rp->scene;
 	const char *labels[MAX_PANELS];
 	const bsim_options *opts[MAX_PANELS];
 	for (int i = 0; i < a->n_backends; i++) {
@@ -240,7 +257,9 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 	FILE *out = strcmp(a->out, "-") == 0 ? stderr : stdout;
 	if (rc == BSIM_OK) {
 		fprintf(out, "scene       %s (%s), seed %" PRIu64 ", group %ld, trial %ld\n",
-		        cli_path(a->scene), scene->name, a->seed, a->group, a->trial);
+		        cli_path(rp->scene_path), scene->name, a->seed, a->group, a->trial);
+		if (rp->kind != CLI_REPLAY_SCENE)
+			fprintf(out, "grid        %s of %s\n", rp->grid, cli_path(rp->path));
 		for (int i = 0; i < a->n_backends; i++)
 			print_outcome(out, a->names[i], scene, &rep.results[i]);
 		if (a->n_backends > 1) {
@@ -259,6 +278,7 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 		fprintf(out, "wrote       %s: %dx%d, H.264 yuv420p, %g fps, %ld frames, %.6g s\n",
 		        cli_path(a->out), rep.width, rep.height, a->def.fps, rep.frames,
 		        (double)rep.frames / a->def.fps);
+		return cli_replay_check(rp, &rep.results[0], out);
 	}
 	return rc > BSIM_ESTOPPED ? rc : cli_report(rc, &err);
 }
@@ -276,23 +296,28 @@ int cmd_video(int argc, char **argv)
 	a->def = bsim_video_def_default();
 	cli_common c = cli_common_default();
 	int rc = cli_parse(&video_spec, argc, argv, &c, a, &a->scene);
-	if (rc < 0 && (rc = video_resolve(&c, a)) == CLI_OK)
+	int stored = rc < 0 && cli_replay_is_dir(a->scene);
+	if (rc < 0 && (rc = video_resolve(&c, a, stored)) == CLI_OK)
 		rc = -1;
 	if (rc < 0) {
 		const bsim_backend *backends[MAX_PANELS];
 		rc = CLI_OK;
-		for (int i = 0; i < a->n_backends && rc == CLI_OK; i++)
+		for (int i = 0; !stored && i < a->n_backends && rc == CLI_OK; i++)
 			if (!(backends[i] = cli_backend(a->names[i], &a->opts[i])))
 				rc = CLI_USAGE;
-		bsim_scene scene;
-		bsim_error err;
-		if (rc == CLI_OK &&
-		    bsim_scene_load(a->scene, c.sets.ov, c.sets.n, &scene, &err) != BSIM_OK) {
-			cli_error("%s", err.msg);
-			rc = err.code ? err.code : CLI_USAGE;
-		} else if (rc == CLI_OK) {
-			rc = video_main(a, backends, &scene);
-			bsim_scene_free(&scene);
+		cli_replay rp;
+		if (rc == CLI_OK)
+			rc = cli_replay_open("video", a->scene, &c, a->group, a->trial,
+			                     a->has_group, a->seed, &rp);
+		if (rc == CLI_OK) {
+			if (stored) {
+				backends[0] = rp.backend;
+				a->opts[0] = rp.opts;
+				snprintf(a->names[0], sizeof a->names[0], "%.31s", rp.label);
+			}
+			a->seed = rp.seed;
+			rc = video_main(a, backends, &rp);
+			cli_replay_free(&rp);
 		}
 	}
 	cli_common_free(&c);
