@@ -532,15 +532,28 @@ static int column(const char *header, const char *name)
  * position, energies and the random force the runner applies over that
  * step; 601 steps end between two frame times, and the last frame is the
  * trial's end state. */
-static void lib_frames_are_the_runs_states(void **state)
+/* The frames of a video of trial 5 of seed 3 of the scene rel (with
+ * steps steps and --set extra, if not NULL) against the rows of `run
+ * --trajectory` of the same trial. */
+static void frames_match_run(const char *rel, const char *steps, const char *extra)
 {
-	(void)state;
-	char gate[1200], csv[1400];
-	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	char gate[1200], csv[1400], max_steps[64];
+	snprintf(gate, sizeof gate, "%s", bsim_test_src(rel));
 	snprintf(csv, sizeof csv, "%s/t.csv", bsim_test_dir("same"));
-	const char *argv[] = {"run",          gate, "--seed", "3",
-	                      "--trial",      "5",  "--set",  "integration.max_steps=601",
-	                      "--trajectory", csv,  NULL};
+	snprintf(max_steps, sizeof max_steps, "integration.max_steps=%s", steps);
+	const char *argv[] = {"run",
+	                      gate,
+	                      "--seed",
+	                      "3",
+	                      "--trial",
+	                      "5",
+	                      "--set",
+	                      max_steps,
+	                      "--trajectory",
+	                      csv,
+	                      extra ? "--set" : NULL,
+	                      extra,
+	                      NULL};
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	char *text = bsim_test_read(csv);
 	assert_non_null(text);
@@ -567,9 +580,15 @@ static void lib_frames_are_the_runs_states(void **state)
 	}
 
 	bsim_scene scene;
-	bsim_override ov = {"integration.max_steps", "601", "test"};
+	bsim_override ov[2] = {{"integration.max_steps", steps, "test"}, {NULL, NULL, "test"}};
+	char key[64] = "";
+	if (extra) {
+		snprintf(key, sizeof key, "%.*s", (int)(strchr(extra, '=') - extra), extra);
+		ov[1].key = key;
+		ov[1].value = strchr(extra, '=') + 1;
+	}
 	bsim_error err;
-	assert_int_equal(bsim_scene_load(gate, &ov, 1, &scene, &err), BSIM_OK);
+	assert_int_equal(bsim_scene_load(gate, ov, extra ? 2 : 1, &scene, &err), BSIM_OK);
 	bsim_options opts = {0};
 	bsim_video_track *t = NULL;
 	assert_int_equal(bsim_video_track_record(&scene, &bsim_backend_thesis, &opts,
@@ -609,6 +628,21 @@ static void lib_frames_are_the_runs_states(void **state)
 	free(text);
 	bsim_video_track_free(t);
 	bsim_scene_free(&scene);
+}
+
+static void lib_frames_are_the_runs_states(void **state)
+{
+	(void)state;
+	frames_match_run("configs/thesis/gate.yaml", "601", NULL);
+}
+
+/* Under the essay's lattice protocol the world holds only the active
+ * gate's two beams; the video draws the whole field from the lattice's
+ * state, as the trajectory records it. */
+static void lib_essay_protocol_frames_are_the_runs_states(void **state)
+{
+	(void)state;
+	frames_match_run("configs/lattice/c_track.yaml", "3001", "lattice.protocol=essay");
 }
 
 /* An encoder that exits with status 1 without reading: the error says so
@@ -1016,6 +1050,7 @@ int main(void)
 	        cmocka_unit_test(lib_beams_take_their_stiffness_color),
 	        cmocka_unit_test(lib_lattice_overview_shows_the_gate_path),
 	        cmocka_unit_test(lib_frames_are_the_runs_states),
+	        cmocka_unit_test(lib_essay_protocol_frames_are_the_runs_states),
 	        cmocka_unit_test(lib_failing_encoder_writes_nothing),
 	        cmocka_unit_test(cli_missing_ffmpeg),
 	        cmocka_unit_test(cli_stopped_video_leaves_no_temporary),

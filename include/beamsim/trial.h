@@ -194,6 +194,11 @@ typedef struct bsim_recorder {
 	int stride;          /* record every stride-th step (>= 1) */
 	bsim_trace_fn trace; /* NULL: none; called after every step, whatever the stride */
 	void *trace_user;
+	/* Under the essay's lattice protocol the trace sees the active gate's
+	 * world (two beams) unless this is 1: then the whole lattice's state,
+	 * as recorded rows are (beams of gates left keep their last angles),
+	 * for observers that draw the whole field (video). */
+	int trace_whole;
 	FILE *ledger;          /* NULL: none; the ledger CSV, one row per recorded row */
 	bsim_record_fn record; /* NULL: none */
 	void *record_user;
@@ -231,7 +236,8 @@ BSIM_API void bsim_trial_runner_free(bsim_trial_runner *r);
 /* Runs one trial. seed: the mixed seed (bsim_schedule_seed_mix). rec may be NULL.
  * A lattice scene runs under its lattice.protocol: the whole world, or the
  * essay's (each gate entered gets a fresh world of its two beams at rest,
- * the body's state carried over; the trace then sees that world's state).
+ * the body's state carried over; the trace then sees that world's state
+ * unless rec->trace_whole).
  * Returns BSIM_OK (an unstable trial included: its outcome says so),
  * BSIM_EINPUT (backend options) or BSIM_EFAIL (out of memory, in the
  * runner, the schedule or the backend's step: never a result). */

@@ -94,7 +94,8 @@ typedef struct trial_ctx {
 	int overlap;               /* the recorder asked for overlap_max */
 	int recording, stride;     /* rows to the recorder's sinks, every stride-th step */
 	bsim_trace_fn trace;
-	long recorded; /* the last step recorded, -1: none */
+	int trace_whole; /* the trace sees the whole lattice (essay protocol) */
+	long recorded;   /* the last step recorded, -1: none */
 } trial_ctx;
 
 /* What the step loop carries from step to step. Apart from the context,
@@ -118,7 +119,7 @@ static int trial_world(trial_ctx *c, bsim_error *err)
 	int world_beams = essay ? 2 : scene->n_beams;
 	if (runner_reserve(r, world_beams) || trial_peaks_reserve(&r->peaks, scene->n_beams))
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	if (essay && c->recording && r->whole.n_beams != scene->n_beams) {
+	if (essay && (c->recording || c->trace_whole) && r->whole.n_beams != scene->n_beams) {
 		bsim_state_free(&r->whole);
 		if (bsim_state_init(&r->whole, scene->n_beams))
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
@@ -149,6 +150,7 @@ static int trial_open(trial_ctx *c, uint64_t seed, bsim_error *err)
 	c->recording = rec && (rec->csv || rec->ledger || rec->record);
 	c->stride = rec && rec->stride > 0 ? rec->stride : 1;
 	c->trace = rec ? rec->trace : NULL;
+	c->trace_whole = c->trace && rec->trace_whole;
 	int rc = trial_world(c, err);
 	if (rc) {
 		trial_essay_release(&c->r->essay, c->backend, &c->w);
@@ -159,6 +161,13 @@ static int trial_open(trial_ctx *c, uint64_t seed, bsim_error *err)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	return BSIM_OK;
+}
+
+/* The state the trace sees: the world's, or mapped onto the whole
+ * lattice's (trace_whole under the essay's protocol). */
+static const bsim_state *trial_trace_state(trial_ctx *c, const bsim_state *s)
+{
+	return c->trace_whole ? trial_record_state(&c->r->whole, c->map, s) : s;
 }
 
 /* The state at t = 0 in s0, and all that starts from it: the ledger, the
@@ -184,7 +193,7 @@ static int trial_begin(trial_ctx *c, trial_loop *lp, bsim_state *s0, bsim_error 
 		rc = trial_gate_log_start(c->log, &c->gate, scene, c->map, s0, err);
 	out->overlap_max = c->overlap ? 0.0 : NAN;
 	if (c->trace)
-		c->trace(c->rec->trace_user, 0, s0);
+		c->trace(c->rec->trace_user, 0, trial_trace_state(c, s0));
 	c->recorded = -1;
 	out->outcome = BSIM_STUCK;
 	return rc;
@@ -360,7 +369,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 		c.gate.dwell++;
 		lp.run_on += lp.done;
 		if (c.trace)
-			c.trace(rec->trace_user, lp.n, s1);
+			c.trace(rec->trace_user, lp.n, trial_trace_state(&c, s1));
 		ledger_step(&out->ledger, &fx, s0, s1, lp.e0, e1);
 		lp.e0 = e1;
 		double p0[2] = {s0->x[0], s0->x[1]};

@@ -183,8 +183,12 @@ static void *stream_worker(void *arg)
 	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	bsim_trial_log *log = bsim_trial_log_alloc();
 	/* The recorder of bsim_video_track_record: trace and gate log. */
-	bsim_recorder rec = {
-	        .csv = NULL, .stride = 1, .trace = stream_trace, .trace_user = sp, .log = log};
+	bsim_recorder rec = {.csv = NULL,
+	                     .stride = 1,
+	                     .trace = stream_trace,
+	                     .trace_user = sp,
+	                     .trace_whole = 1,
+	                     .log = log};
 	if (!runner || !log)
 		sp->rc = bsim_error_set(&sp->err, BSIM_EFAIL, "out of memory for a video");
 	else

@@ -212,6 +212,7 @@ static int track_run(const bsim_scene *scene, const bsim_backend *backend, const
 	                     .stride = 1,
 	                     .trace = summary ? NULL : track_trace,
 	                     .trace_user = t,
+	                     .trace_whole = 1,
 	                     .log = log};
 	int rc = log ? bsim_trial_run(runner, scene, backend, opts, seed, &rec, &t->result, err)
 	             : bsim_error_set(err, BSIM_EFAIL, "out of memory for a video track");
