@@ -332,6 +332,15 @@ static void test_trajectory(void **state)
 	assert_true(rows >= steps_run / 10 && rows <= steps_run / 10 + 2);
 	free(csv);
 
+	/* run --out DIR lists what it wrote. */
+	char out_dir[1100];
+	snprintf(out_dir, sizeof out_dir, "%s/run_out", dir);
+	const char *run_out[] = {"run", gate, "--out", out_dir, NULL};
+	r = run_cli(run_out);
+	assert_int_equal(r.status, 0);
+	assert_true(bsim_test_check_wrote(r.out, out_dir) >= 4);
+	cli_run_free(&r);
+
 	/* A path with no room for FILE.tmp.PID is a usage error, before the run. */
 	char long_path[1300];
 	memset(long_path, 'a', sizeof long_path - 1);
@@ -371,6 +380,8 @@ static void test_sweep(void **state)
 	assert_int_equal(r.status, 0);
 	assert_contains(r.out, "effects.propulsion.force");
 	assert_contains(r.out, "trials/s");
+	/* every file of the manifest on a line of its own */
+	assert_true(bsim_test_check_wrote(r.out, out) >= 6);
 	cli_run_free(&r);
 
 	snprintf(file, sizeof file, "%s/trials.csv", out);
@@ -703,7 +714,7 @@ static void test_names_escaped(void **state)
 	                       NULL};
 	out = NULL;
 	assert_int_equal(bsim_test_cli(sweep, &out, NULL), 0);
-	assert_non_null(strstr(out, "o\\x1B[2Jut/summary.json"));
+	assert_non_null(strstr(out, "o\\x1B[2Jut/ (manifest.json lists these)"));
 	assert_null(strchr(out, '\x1b'));
 	free(out);
 }

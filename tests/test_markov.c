@@ -365,7 +365,10 @@ static void test_threads_and_cache(void **state)
 	        "markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
 	        "--map",  d2,        "--out",
 	        pdir,     NULL};
-	assert_int_equal(bsim_test_cli(pred_out, NULL, NULL), 0);
+	out = NULL;
+	assert_int_equal(bsim_test_cli(pred_out, &out, NULL), 0);
+	assert_int_equal(bsim_test_check_wrote(out, pdir), 4); /* prediction*.csv and .mat */
+	free(out);
 	char csv[1200];
 	snprintf(csv, sizeof csv, "%s/prediction.csv", pdir);
 	char *text = bsim_test_read(csv);

@@ -10,6 +10,7 @@
 
 #include "beamsim/landscape.h"
 #include "beamsim/landscape_barriers.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 
@@ -175,9 +176,8 @@ int cmd_landscape(int argc, char **argv)
 	rc = cli_report(bsim_landscape_store(c.out, &scene, &a.grid, &g, &b, &drawn, &err), &err);
 	if (rc == BSIM_OK) {
 		print_table(&a, &scene, g, b);
-		printf("\nwrote       %s/: landscape.csv, landscape.mat, landscape.json, "
-		       "landscape_top, landscape_beam, landscape_total (.png .svg .gp)\n",
-		       cli_path(c.out));
+		printf("\n");
+		cli_wrote(stdout, c.out);
 		if (!drawn)
 			cli_error(
 			        "gnuplot not found: the figures' .gp scripts and data are in %s; "

@@ -11,6 +11,7 @@
 #include "beamsim/experiment.h"
 #include "beamsim/markov.h"
 #include "beamsim/lattice_outcome.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
@@ -281,6 +282,8 @@ static int markov_build(int argc, char **argv)
 		       "in %s\n",
 		       built, cpu, reused, bsim_markov_bins_count(&a.def.bins), a.def.trials,
 		       cli_path(c.out));
+	if (rc == BSIM_OK && !c.quiet)
+		cli_wrote(stdout, c.out);
 	bsim_experiment_free(&e);
 	bsim_markov_entries_free(&entries);
 	cli_common_free(&c);
@@ -324,6 +327,8 @@ static void predict_print(const char *path, const bsim_scene *scene, const bsim_
 	}
 	if (!out)
 		printf("per location: --locations prints them, --out DIR writes prediction.csv\n");
+	else
+		cli_wrote(stdout, out);
 }
 
 /* --json: one object with the totals and every final location. */
@@ -453,9 +458,8 @@ static int markov_validate(int argc, char **argv)
 			       k->gates_sim, k->gates_chain, k->sim_cpu, k->predict,
 			       k->sim_cpu / k->predict);
 		}
-		printf("\nwrote       %s/: validate.json, validate.csv, gates.csv (+ .mat), "
-		       "validate_gNNN (.png .svg .gp)\n",
-		       cli_path(c.out));
+		printf("\n");
+		cli_wrote(stdout, c.out);
 	}
 	bsim_markov_validation_free(&v);
 	cli_common_free(&c);

@@ -16,6 +16,7 @@
 #include "beamsim/trial.h"
 #include "beamsim/lattice_outcome.h"
 #include "beamsim/limits.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 
@@ -230,6 +231,8 @@ int cmd_run(int argc, char **argv)
 		bsim_run_output_json(out, &info, &res, 0);
 	else if (rc == CLI_OK)
 		print_text(out, &a, &scene, mixed, &res, log);
+	if (rc == CLI_OK && !a.json && c.out)
+		cli_wrote(out, c.out);
 	if (rc == CLI_OK)
 		cli_solver_warning(backend->name, &res.solver, "run --json");
 	if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {

@@ -9,6 +9,7 @@
 #include "beamsim/output.h"
 #include "beamsim/sweep_dir.h"
 #include "beamsim/limits.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_outcomes.h"
@@ -77,11 +78,9 @@ static void sweep_report(const char *out, const bsim_sweep_dir_result *res, cons
 	       cli_per_second(n, r->wall_seconds), cli_per_second(r->total_steps, r->wall_seconds));
 	if (n != rows)
 		printf("(%ld rows: the groups without random force ran one trial each)\n", rows);
-	/* A table over mat_rows has no twin (a note said so). */
-	int twins = rows <= bsim_limits_get()->mat_rows;
-	printf("wrote %s/summary.json and %s/trials.csv%s (and their .mat twins%s)\n",
-	       cli_path(out), cli_path(out), r->keep ? ", trajectories.csv" : "",
-	       twins ? "" : " but trials.mat: see the note above");
+	/* A table over mat_rows has no twin (a note said so): the list
+	 * shows the files there are. */
+	cli_wrote(stdout, out);
 }
 
 int cmd_sweep(int argc, char **argv)
