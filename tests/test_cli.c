@@ -332,6 +332,18 @@ static void test_trajectory(void **state)
 	assert_true(rows >= steps_run / 10 && rows <= steps_run / 10 + 2);
 	free(csv);
 
+	/* A trajectory in folders that do not exist yet: created, as --out's. */
+	char nested[1200];
+	snprintf(nested, sizeof nested, "%s/new/deeper/t.csv", dir);
+	const char *in_new[] = {"run", gate, "--trajectory", nested, NULL};
+	r = run_cli(in_new);
+	assert_int_equal(r.status, 0);
+	cli_run_free(&r);
+	csv = bsim_test_read(nested);
+	assert_non_null(csv);
+	assert_int_equal(bsim_test_count_lines(csv) - 1, steps_run + 1);
+	free(csv);
+
 	/* run --out DIR lists what it wrote. */
 	char out_dir[1100];
 	snprintf(out_dir, sizeof out_dir, "%s/run_out", dir);

@@ -28,7 +28,8 @@ static const cli_own run_own[] = {
         [OWN_TRAJECTORY] = {"trajectory", 1, "FILE.csv",
                             "write the trajectory, one row per recorded step, and\n"
                             "its MATLAB twin FILE.mat; - is standard output (no\n"
-                            "twin; the report then goes to standard error)"},
+                            "twin; the report then goes to standard error);\n"
+                            "missing folders of FILE are created"},
         [OWN_STRIDE] = {"stride", 1, "N", "record every N-th step (default 1)"},
         [OWN_JSON] = {"json", 0, NULL, "print one JSON object instead of text"},
 };
