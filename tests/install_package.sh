@@ -2,7 +2,9 @@
 # The installed package as a user meets it: `cmake --install` into a fresh
 # prefix, examples/ configured and built against it with
 # find_package(beamsim CONFIG) (shared and static), the same program
-# compiled with `pkg-config --cflags --libs beamsim` alone, and all three
+# compiled with `pkg-config --cflags --libs beamsim` alone (and with the
+# README's compile line exactly, run without LD_LIBRARY_PATH: the .pc file's
+# rpath finds the library in a prefix that is not a system one), and all
 # runs giving the installed program's own answer: the sweep's p_traverse
 # per group equals that of `beamsim sweep` on the same experiment, trials
 # and seed. The shared library exports exactly the functions and objects
@@ -26,9 +28,26 @@ libdir=$(dirname "$pcdir")
 PKG_CONFIG_PATH=$pcdir cc -std=c17 -Wall -Werror -o "$work/pc_example" \
     "$src/examples/trial_and_sweep.c" $(PKG_CONFIG_PATH=$pcdir pkg-config --cflags --libs beamsim)
 
+# README's compile line exactly, with its prefix $HOME/beamsim this one,
+# run from the source tree's parent of examples/ into a.out in WORK: the
+# program finds libbeamsim.so.0 through the rpath the .pc file gives, with
+# no LD_LIBRARY_PATH.
+readme_cc=$(grep '^    cc examples/trial_and_sweep.c ' "$src/README.md" | sed 's/^    //')
+test -n "$readme_cc" || { echo "README.md has no 'cc examples/trial_and_sweep.c' line"; exit 1; }
+mkdir -p "$work/readme"
+(cd "$work/readme" && ln -sf "$src/examples" examples &&
+ HOME=$work/home && mkdir -p "$HOME" && ln -sfn "$prefix" "$HOME/beamsim" &&
+ export HOME && sh -c "$readme_cc")
+test -x "$work/readme/a.out" || { echo "README's line built no a.out: $readme_cc"; exit 1; }
+case $(grep '^Libs:' "$pcdir/beamsim.pc") in
+*-rpath*) ;;
+*) echo "beamsim.pc's Libs line has no rpath"; exit 1 ;;
+esac
+
 "$work/examples/trial_and_sweep" "$exp" 20 >"$work/shared.txt"
 "$work/examples/trial_and_sweep_static" "$exp" 20 >"$work/static.txt"
-LD_LIBRARY_PATH=$libdir "$work/pc_example" "$exp" 20 >"$work/pc.txt"
+env -u LD_LIBRARY_PATH "$work/pc_example" "$exp" 20 >"$work/pc.txt"
+env -u LD_LIBRARY_PATH "$work/readme/a.out" "$exp" 20 >"$work/readme.txt"
 
 # The shared library brings only the bsim_ functions.
 if nm -D --defined-only "$libdir/libbeamsim.so" | awk '{print $3}' | grep -v '^bsim_' | grep .; then
@@ -60,11 +79,12 @@ if [ -n "$unexported" ]; then
 fi
 
 # Wall time aside, the three runs print the same.
-for f in shared static pc; do
+for f in shared static pc readme; do
     sed 's/ in [0-9.]* s$//' "$work/$f.txt" >"$work/$f.cmp"
 done
 cmp "$work/shared.cmp" "$work/static.cmp"
 cmp "$work/shared.cmp" "$work/pc.cmp"
+cmp "$work/shared.cmp" "$work/readme.cmp"
 grep -q '^thesis ' "$work/shared.txt" && grep -q '^box2d ' "$work/shared.txt"
 
 # The library's sweep is the program's.

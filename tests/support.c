@@ -552,3 +552,32 @@ double bsim_test_json_number(const char *text, const char *key)
 	}
 	return strtod(p + strlen(pat), NULL);
 }
+
+int bsim_test_check_wrote(const char *out, const char *dir)
+{
+	char path[2048];
+	snprintf(path, sizeof path, "%s/manifest.json", dir);
+	char *m = bsim_test_read(path);
+	if (!m)
+		fail_msg("%s missing", path);
+	snprintf(path, sizeof path, "wrote %s/ (manifest.json lists these):\n", dir);
+	if (!strstr(out, path))
+		fail_msg("no '%s' in:\n%s", path, out);
+	const char *after = strstr(out, path) + strlen(path);
+	int n = 0;
+	static const char key[] = "{\"path\": \"";
+	for (const char *p = strstr(m, key); p; p = strstr(p + 1, key)) {
+		const char *name = p + strlen(key);
+		size_t len = strcspn(name, "\"");
+		char line[1100];
+		snprintf(line, sizeof line, "  %.*s", (int)len, name);
+		/* the name, then two spaces and its words or the line's end */
+		const char *at = strstr(after, line);
+		if (!at || (at[2 + len] != ' ' && at[2 + len] != '\n'))
+			fail_msg("%.*s (in %s/manifest.json) is not in the wrote lines:\n%s",
+			         (int)len, name, dir, out);
+		n++;
+	}
+	free(m);
+	return n;
+}

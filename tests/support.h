@@ -112,6 +112,11 @@ int bsim_test_check_figures(const char *dir);
  * aborts the test if there is none. */
 double bsim_test_json_number(const char *text, const char *key);
 
+/* Asserts that out (a command's stdout) has the line "wrote DIR/ ..."
+ * followed by a line "  PATH ..." for every file DIR/manifest.json lists;
+ * returns their number. */
+int bsim_test_check_wrote(const char *out, const char *dir);
+
 /* Wilson's 95% score interval of k successes in n, in closed form. */
 void bsim_test_wilson(int k, int n, double *lo, double *hi);
 

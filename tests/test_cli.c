@@ -1,5 +1,7 @@
 /* The beamsim program as a user meets it (DESIGN.md "Command line",
  * "Outputs"): help, version, exit statuses, run, sweep, backends. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -330,6 +332,27 @@ static void test_trajectory(void **state)
 	assert_true(rows >= steps_run / 10 && rows <= steps_run / 10 + 2);
 	free(csv);
 
+	/* A trajectory in folders that do not exist yet: created, as --out's. */
+	char nested[1200];
+	snprintf(nested, sizeof nested, "%s/new/deeper/t.csv", dir);
+	const char *in_new[] = {"run", gate, "--trajectory", nested, NULL};
+	r = run_cli(in_new);
+	assert_int_equal(r.status, 0);
+	cli_run_free(&r);
+	csv = bsim_test_read(nested);
+	assert_non_null(csv);
+	assert_int_equal(bsim_test_count_lines(csv) - 1, steps_run + 1);
+	free(csv);
+
+	/* run --out DIR lists what it wrote. */
+	char out_dir[1100];
+	snprintf(out_dir, sizeof out_dir, "%s/run_out", dir);
+	const char *run_out[] = {"run", gate, "--out", out_dir, NULL};
+	r = run_cli(run_out);
+	assert_int_equal(r.status, 0);
+	assert_true(bsim_test_check_wrote(r.out, out_dir) >= 4);
+	cli_run_free(&r);
+
 	/* A path with no room for FILE.tmp.PID is a usage error, before the run. */
 	char long_path[1300];
 	memset(long_path, 'a', sizeof long_path - 1);
@@ -369,6 +392,8 @@ static void test_sweep(void **state)
 	assert_int_equal(r.status, 0);
 	assert_contains(r.out, "effects.propulsion.force");
 	assert_contains(r.out, "trials/s");
+	/* every file of the manifest on a line of its own */
+	assert_true(bsim_test_check_wrote(r.out, out) >= 6);
 	cli_run_free(&r);
 
 	snprintf(file, sizeof file, "%s/trials.csv", out);
@@ -419,6 +444,106 @@ static void test_sweep(void **state)
 }
 
 /* A bad experiment writes nothing, not even the directory. */
+/* Per group of trials.csv (read independently of the program's counts):
+ * trials, traversed, left, right, side exits, stuck, unstable. */
+typedef struct csv_counts {
+	int trials, traversed, left, right, side, stuck, unstable;
+} csv_counts;
+
+static void count_trials_csv(const char *path, csv_counts *c, int n_groups)
+{
+	char *csv = bsim_test_read(path);
+	assert_non_null(csv);
+	memset(c, 0, (size_t)n_groups * sizeof *c);
+	char *save = NULL;
+	strtok_r(csv, "\n", &save); /* the header */
+	for (char *line = strtok_r(NULL, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+		int g;
+		char outcome[32], type[16];
+		assert_int_equal(sscanf(line, "%d,%*d,%31[^,],%15[^,]", &g, outcome, type), 3);
+		assert_true(g >= 0 && g < n_groups);
+		csv_counts *k = &c[g];
+		k->trials++;
+		if (strcmp(outcome, "traversed") == 0) {
+			k->traversed++;
+			k->left += strcmp(type, "left") == 0;
+			k->right += strcmp(type, "right") == 0;
+		}
+		k->side += strcmp(outcome, "side_exit") == 0;
+		k->stuck += strcmp(outcome, "stuck") == 0;
+		k->unstable += strcmp(outcome, "unstable") == 0;
+	}
+	free(csv);
+}
+
+/* A printed "p [lo, hi]" against k of n and Wilson's interval, to the
+ * printed digits. */
+static void check_fraction(double p, double lo, double hi, int k, int n, double tol)
+{
+	double wlo, whi;
+	bsim_test_wilson(k, n, &wlo, &whi);
+	assert_true(fabs(p - (double)k / n) <= tol);
+	assert_true(fabs(lo - wlo) <= tol);
+	assert_true(fabs(hi - whi) <= tol);
+}
+
+/* An asymmetric gate (beam 1 stiffer): the sweep prints each group's
+ * p_traverse and its left/right split, which match the counts of
+ * trials.csv and Wilson's interval; a sweep with no traversal on the
+ * symmetric gate prints no split. */
+static void test_sweep_split(void **state)
+{
+	(void)state;
+	char dir[1024], exp[1100], out[1100], text[2048];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("sweep_split"));
+	snprintf(text, sizeof text,
+	         "scene: %s\ntrials: 12\nseed: 3\nset:\n  integration.max_steps: 3000\n"
+	         "  beams.1.stiffness: 500\n"
+	         "grid:\n  effects.propulsion.force: [7, 9]\n"
+	         "  effects.random_force.magnitude: [20]\n  beams.0.stiffness: [100, 150]\n",
+	         gate);
+	snprintf(exp, sizeof exp, "%s", bsim_test_write(dir, "h2.yaml", text));
+	snprintf(out, sizeof out, "%s/out", dir);
+	const char *argv[] = {"sweep", exp, "--out", out, NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 0);
+	csv_counts c[4];
+	count_trials_csv(bsim_test_join(out, "trials.csv"), c, 4);
+	const char *p = strstr(r.out, "left/(left+right)\n");
+	assert_non_null(p);
+	p = strchr(p, '\n') + 1;
+	int typed = 0;
+	for (int g = 0; g < 4; g++) {
+		double f, rf, k0, pt, lo, hi, pl, llo, lhi;
+		int left, right, n;
+		n = sscanf(p, "%lf %lf %lf %lf [%lf, %lf] %d %d %lf [%lf, %lf]", &f, &rf, &k0, &pt,
+		           &lo, &hi, &left, &right, &pl, &llo, &lhi);
+		assert_true(n >= 8);
+		/* group g's values: force slowest, stiffness fastest */
+		assert_true(f == (g < 2 ? 7 : 9) && rf == 20 && k0 == (g % 2 ? 150 : 100));
+		assert_int_equal(c[g].trials, 12);
+		check_fraction(pt, lo, hi, c[g].traversed, c[g].trials, 0.0051);
+		assert_int_equal(left, c[g].left);
+		assert_int_equal(right, c[g].right);
+		if (left + right > 0) {
+			assert_int_equal(n, 11);
+			check_fraction(pl, llo, lhi, left, left + right, 0.0051);
+			typed++;
+		}
+		p = strchr(p, '\n') + 1;
+	}
+	assert_true(typed > 0);
+	cli_run_free(&r);
+
+	/* The symmetric gate with no traversal: nothing to split. */
+	const char *none[] = {"sweep", small_experiment(dir),     "--out", out,
+	                      "--set", "integration.max_steps=5", NULL};
+	r = run_cli(none);
+	assert_int_equal(r.status, 0);
+	assert_null(strstr(r.out, "left/(left+right)"));
+	cli_run_free(&r);
+}
+
 static void test_sweep_bad_experiment(void **state)
 {
 	(void)state;
@@ -601,7 +726,7 @@ static void test_names_escaped(void **state)
 	                       NULL};
 	out = NULL;
 	assert_int_equal(bsim_test_cli(sweep, &out, NULL), 0);
-	assert_non_null(strstr(out, "o\\x1B[2Jut/summary.json"));
+	assert_non_null(strstr(out, "o\\x1B[2Jut/ (manifest.json lists these)"));
 	assert_null(strchr(out, '\x1b'));
 	free(out);
 }
@@ -620,6 +745,7 @@ int main(void)
 	        cmocka_unit_test(test_trajectory),
 	        cmocka_unit_test(test_names_escaped),
 	        cmocka_unit_test(test_sweep),
+	        cmocka_unit_test(test_sweep_split),
 	        cmocka_unit_test(test_sweep_bad_experiment),
 	        cmocka_unit_test(test_unstable),
 	        cmocka_unit_test(test_sweep_deterministic),

@@ -42,6 +42,7 @@ static int setup(void **state)
 		fail_msg("exit %d: %s", rc, err ? err : "");
 	assert_non_null(strstr(out, "lowest pass"));
 	assert_non_null(strstr(out, "over beam 2"));
+	assert_true(bsim_test_check_wrote(out, out_dir) >= 10);
 	free(out);
 	free(err);
 	return 0;
@@ -159,6 +160,45 @@ static void test_figures(void **state)
 		assert_memory_equal(img, "\x89PNG", 4);
 		free(img);
 	}
+}
+
+/* --json prints landscape.json as written, --quiet prints nothing; both
+ * still write the files. */
+static void test_json_quiet(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("landscape_json");
+	char d[1100];
+	snprintf(d, sizeof d, "%s", dir);
+	char *out = NULL;
+	const char *json[] = {"landscape",
+	                      bsim_test_src("configs/thesis/gate.yaml"),
+	                      "--resolution",
+	                      "1",
+	                      "--json",
+	                      "--out",
+	                      d,
+	                      NULL};
+	assert_int_equal(bsim_test_cli(json, &out, NULL), 0);
+	char *file = bsim_test_read(bsim_test_join(d, "landscape.json"));
+	assert_non_null(file);
+	assert_string_equal(out, file);
+	assert_non_null(strstr(out, "\"lowest_pass\""));
+	free(out);
+	free(file);
+	const char *quiet[] = {"landscape",
+	                       bsim_test_src("configs/thesis/gate.yaml"),
+	                       "--resolution",
+	                       "1",
+	                       "--quiet",
+	                       "--out",
+	                       d,
+	                       NULL};
+	out = NULL;
+	assert_int_equal(bsim_test_cli(quiet, &out, NULL), 0);
+	assert_string_equal(out, "");
+	free(out);
+	assert_true(bsim_test_size(bsim_test_join(d, "landscape.csv")) > 0);
 }
 
 /* --resolution, --region and --set. */
@@ -283,9 +323,9 @@ static void test_errors(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_csv),     cmocka_unit_test(test_mat),
-	        cmocka_unit_test(test_figures), cmocka_unit_test(test_options),
-	        cmocka_unit_test(test_errors),
+	        cmocka_unit_test(test_csv),        cmocka_unit_test(test_mat),
+	        cmocka_unit_test(test_figures),    cmocka_unit_test(test_options),
+	        cmocka_unit_test(test_json_quiet), cmocka_unit_test(test_errors),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

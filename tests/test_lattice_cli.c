@@ -328,6 +328,54 @@ static void sweep_files(void **state)
 	free(summary);
 }
 
+/* The sweep prints the end / side / stuck split of the trials: the counts
+ * of trials.csv's outcomes (end: traversed, side: side_exit), each with
+ * its fraction and Wilson's 95% interval. */
+static void sweep_prints_split(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("lat_split");
+	char exp[1200], out[1300];
+	snprintf(exp, sizeof exp, "%s", c_track_experiment(dir));
+	snprintf(out, sizeof out, "%s/o", dir);
+	const char *argv[] = {"sweep",    exp,  "--out", out, "--set", "integration.max_steps=2500",
+	                      "--trials", "10", NULL};
+	char *stdout_text = NULL;
+	assert_int_equal(bsim_test_cli(argv, &stdout_text, NULL), 0);
+	assert_non_null(stdout_text);
+	int counts[3] = {0, 0, 0}, n = 0;
+	static const char *const outcomes[] = {"traversed", "side_exit", "stuck"};
+	char *trials = read_in(out, "trials.csv");
+	for (const char *line = strchr(trials, '\n'); line && line[1];
+	     line = strchr(line + 1, '\n')) {
+		char outcome[32];
+		csv_field(line + 1, 2, outcome, sizeof outcome);
+		for (int k = 0; k < 3; k++)
+			counts[k] += strcmp(outcome, outcomes[k]) == 0;
+		n++;
+	}
+	free(trials);
+	assert_int_equal(n, 10);
+	static const char *const kinds[] = {"\n  end ", "\n  side ", "\n  stuck "};
+	for (int k = 0; k < 3; k++) {
+		const char *p = strstr(stdout_text, kinds[k]);
+		if (!p)
+			fail_msg("no '%s' line in:\n%s", kinds[k] + 1, stdout_text);
+		int count, of;
+		double f, lo, hi, wlo, whi;
+		assert_int_equal(sscanf(p + strlen(kinds[k]), "%d of %d %lf [%lf, %lf]", &count,
+		                        &of, &f, &lo, &hi),
+		                 5);
+		assert_int_equal(count, counts[k]);
+		assert_int_equal(of, n);
+		bsim_test_wilson(counts[k], n, &wlo, &whi);
+		assert_true(f > (double)counts[k] / n - 6e-4 && f < (double)counts[k] / n + 6e-4);
+		assert_true(lo > wlo - 6e-4 && lo < wlo + 6e-4);
+		assert_true(hi > whi - 6e-4 && hi < whi + 6e-4);
+	}
+	free(stdout_text);
+}
+
 /* regress --exact reruns a stored lattice sweep (the map's CSV copied into
  * inputs/) to the same trials. */
 static void regress_lattice(void **state)
@@ -423,6 +471,7 @@ int main(void)
 	        cmocka_unit_test(bad_protocol),
 	        cmocka_unit_test(sweep_writes_nothing),
 	        cmocka_unit_test(sweep_files),
+	        cmocka_unit_test(sweep_prints_split),
 	        cmocka_unit_test(regress_lattice),
 	        cmocka_unit_test(compare_protocols),
 	        cmocka_unit_test(compare_backends_on_lattice),

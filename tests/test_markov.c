@@ -237,6 +237,60 @@ static char *map_text(const char *dir)
 	return text;
 }
 
+/* markov predict's printed totals are prediction.csv's probabilities
+ * summed by kind (to the 4 printed decimals), as are --json's; the
+ * per-location list comes only with --locations or --json, and --quiet
+ * prints nothing. pred: the predict command line without --out. */
+static void check_predict_totals(const char *printed, const char *csv, const char *const *pred)
+{
+	static const char *const kinds[] = {"end", "side", "stuck"};
+	double sum[3] = {0, 0, 0};
+	char *text = bsim_test_read(csv), *save = NULL;
+	assert_non_null(text);
+	strtok_r(text, "\n", &save); /* the header */
+	for (char *line; (line = strtok_r(NULL, "\n", &save));) {
+		char kind[16];
+		assert_int_equal(sscanf(line, "%*[^,],%15[^,]", kind), 1);
+		for (int k = 0; k < 3; k++)
+			if (strcmp(kind, kinds[k]) == 0)
+				sum[k] += atof(strrchr(line, ',') + 1);
+	}
+	free(text);
+	const char *argv[16];
+	int n = 0;
+	while (pred[n] && n < 12) {
+		argv[n] = pred[n];
+		n++;
+	}
+	argv[n + 1] = NULL;
+	char *json = NULL, *quiet = NULL, *list = NULL;
+	argv[n] = "--json";
+	assert_int_equal(bsim_test_cli(argv, &json, NULL), 0);
+	argv[n] = "--quiet";
+	assert_int_equal(bsim_test_cli(argv, &quiet, NULL), 0);
+	argv[n] = "--locations";
+	assert_int_equal(bsim_test_cli(argv, &list, NULL), 0);
+	const char *totals = strstr(json, "\"totals\": {");
+	assert_non_null(totals);
+	for (int k = 0; k < 3; k++) {
+		char head[32];
+		snprintf(head, sizeof head, "\n%-12s ", kinds[k]);
+		const char *line = strstr(printed, head);
+		if (!line)
+			fail_msg("no '%s' total in:\n%s", kinds[k], printed);
+		near(atof(line + strlen(head)), sum[k], 5.1e-5, __LINE__);
+		near(bsim_test_json_number(totals, kinds[k]), sum[k], 1e-9, __LINE__);
+	}
+	assert_null(strstr(printed, "\nstuck:"));
+	assert_non_null(strstr(printed, "--out DIR writes prediction.csv"));
+	assert_non_null(strstr(list, "\nstuck:"));
+	assert_non_null(strstr(json, "\"locations\": [{\"location\": "));
+	assert_string_equal(quiet, "");
+	free(json);
+	free(quiet);
+	free(list);
+}
+
 /* Threads change nothing; the cache reuses only what nothing changed. */
 static void test_threads_and_cache(void **state)
 {
@@ -303,7 +357,7 @@ static void test_threads_and_cache(void **state)
 	                         "--map",  d2,        NULL};
 	assert_int_equal(bsim_test_cli(pred_ok, &out, NULL), 0);
 	assert_non_null(strstr(out, "gates visited: mean"));
-	free(out);
+	char *totals_text = out;
 	/* --out: every location of the field once, the probabilities summing to 1 */
 	char pdir[1100];
 	snprintf(pdir, sizeof pdir, "%s/prediction", d1);
@@ -311,7 +365,10 @@ static void test_threads_and_cache(void **state)
 	        "markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
 	        "--map",  d2,        "--out",
 	        pdir,     NULL};
-	assert_int_equal(bsim_test_cli(pred_out, NULL, NULL), 0);
+	out = NULL;
+	assert_int_equal(bsim_test_cli(pred_out, &out, NULL), 0);
+	assert_int_equal(bsim_test_check_wrote(out, pdir), 4); /* prediction*.csv and .mat */
+	free(out);
 	char csv[1200];
 	snprintf(csv, sizeof csv, "%s/prediction.csv", pdir);
 	char *text = bsim_test_read(csv);
@@ -327,6 +384,8 @@ static void test_threads_and_cache(void **state)
 	free(text);
 	assert_int_equal(rows, 9 + 9 + 81);
 	assert_true(fabs(sum - 1.0) < 1e-9);
+	check_predict_totals(totals_text, csv, pred_ok);
+	free(totals_text);
 	snprintf(csv, sizeof csv, "%s/prediction.mat", pdir);
 	struct stat st;
 	assert_int_equal(stat(csv, &st), 0);

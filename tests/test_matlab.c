@@ -200,6 +200,28 @@ static const char *h1_sweep(const char *name, int keep, char *dir, size_t size)
 	return dir;
 }
 
+/* The .mat at path holds the variable note saying that its group and
+ * trial columns are 0-based (want 1), or has no note (want 0). */
+static void check_note(const char *path, int want)
+{
+	mat_t *mat = Mat_Open(path, MAT_ACC_RDONLY);
+	assert_non_null(mat);
+	matvar_t *v = Mat_VarRead(mat, "note");
+	if (!want) {
+		assert_null(v);
+	} else {
+		assert_non_null(v);
+		assert_int_equal(v->class_type, MAT_C_CHAR);
+		size_t n = v->dims[0] * v->dims[1];
+		char text[512];
+		snprintf(text, sizeof text, "%.*s", (int)n, (const char *)v->data);
+		if (!strstr(text, "0-based") || !strstr(text, "g+1"))
+			fail_msg("%s: note \"%s\"", path, text);
+	}
+	Mat_VarFree(v);
+	Mat_Close(mat);
+}
+
 /* trials.mat and trajectories.mat against their CSVs; the grid values of
  * each row (trials.csv's own columns, added to trajectories.mat) against
  * the grid. */
@@ -213,6 +235,7 @@ static void check_sweep_table(const char *dir, const char *name)
 	mat_t *mat;
 	matvar_t *st = mat_var(path, name, &mat);
 	check_table(&t, st);
+	check_note(path, 1);
 	const double *F = field(st, "effects_propulsion_force")->data;
 	const double *R = field(st, "effects_random_force_magnitude")->data;
 	int gc = tcsv_col(&t, "group");
@@ -257,6 +280,23 @@ static void test_sweep_twins(void **state)
 			assert_true(((double *)col->data)[i] == json_number(d, p));
 		}
 	}
+	/* What trials.mat's note says: group g (0-based) is row g+1 of the
+	 * groups' fields, here C index g: its trials count its rows. */
+	snprintf(path, sizeof path, "%s/trials.mat", dir);
+	mat_t *tm;
+	matvar_t *tr = mat_var(path, "trials", &tm);
+	const double *tg = field(tr, "group")->data;
+	const double *gt = field(g, "trials")->data;
+	for (int i = 0; i < 30; i++) {
+		int rows = 0;
+		for (size_t r = 0; r < field(tr, "group")->dims[0]; r++)
+			rows += tg[r] == i;
+		assert_true(gt[i] == rows);
+	}
+	Mat_VarFree(tr);
+	Mat_Close(tm);
+	snprintf(path, sizeof path, "%s/summary.mat", dir);
+	check_note(path, 0); /* no group column: groups are its rows */
 	matvar_t *ci = field(g, "ci95");
 	assert_int_equal(ci->dims[0], 30);
 	assert_int_equal(ci->dims[1], 2);

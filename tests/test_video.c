@@ -733,6 +733,7 @@ static void cli_bad_arguments(void **state)
 	        {{"--backend", "nope"}, "nope"},
 	        {{"--backends", "thesis,nope"}, "nope"},
 	        {{"--backends", "thesis,thesis"}, "named twice"},
+	        {{"--backends", "a,b,c,d,e"}, "expected 1 to 4 names"},
 	        {{"--backends", "thesis,box2d", "--backend", "thesis"}, "give one of them"},
 	        {{"--backends", "thesis,box2d", "--backend-opt", "substeps=2"}, "B:KEY=VALUE"},
 	        {{"--backend-opt", "nonsense=1"}, "nonsense"},
@@ -754,6 +755,14 @@ static void cli_bad_arguments(void **state)
 		free(se);
 		assert_true(dir_empty(dir) || access(out, F_OK) != 0);
 	}
+	/* The help says what the parser takes: 1 to BSIM_VIDEO_PANELS_MAX names. */
+	const char *help[] = {"video", "--help", NULL};
+	char *so = NULL, want[32];
+	assert_int_equal(bsim_test_cli(help, &so, NULL), 0);
+	snprintf(want, sizeof want, "1 to %d names", BSIM_VIDEO_PANELS_MAX);
+	assert_non_null(strstr(so, want));
+	assert_null(strstr(so, "up to 4"));
+	free(so);
 	/* No --out, no scene, a bad scene file. */
 	const char *no_out[] = {"video", gate, NULL};
 	const char *no_scene[] = {"video", "--out", out, NULL};

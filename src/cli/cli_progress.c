@@ -11,6 +11,18 @@
 /* Redraw interval, s: fast enough to look live, slow enough to cost nothing. */
 #define PROGRESS_INTERVAL 0.1
 
+/* When an ETA may be shown. Its rate counts from the first update, which a
+ * sweep makes when its first thread ends its first trial: the start-up
+ * (loading, building the worlds) is left out, and a rate measured from one
+ * update of that thread to the next spans about one trial of every thread.
+ * A rate over 3% of the items, or over 2 s, has averaged out the trials'
+ * spread of durations well enough that the first ETA shown is within a
+ * small factor of the time left; one over the first few trials alone is
+ * not (it said 56:34 for a sweep of 30 s: the start-up and the trials the
+ * other threads finished with the first were counted against one trial). */
+#define ETA_MIN_FRACTION 0.03
+#define ETA_MIN_SECONDS  2.0
+
 void cli_progress_init(cli_progress *p, int enabled, const char *unit)
 {
 	p->active = enabled && isatty(STDERR_FILENO);
@@ -18,7 +30,21 @@ void cli_progress_init(cli_progress *p, int enabled, const char *unit)
 	p->shown = 0;
 	p->t_start = bsim_clock_seconds();
 	p->t_last = -1.0;
-	p->base = -1;
+	p->done0 = -1;
+	p->t0 = 0.0;
+}
+
+double cli_progress_eta(long done, long total, long done0, double t0, double now)
+{
+	if (done >= total)
+		return 0.0;
+	long n = done - done0;
+	double measured = now - t0;
+	if (n < 1 || !(measured > 0.0))
+		return -1.0;
+	if ((double)n < ETA_MIN_FRACTION * (double)(total - done0) && measured < ETA_MIN_SECONDS)
+		return -1.0;
+	return measured * (double)(total - done) / (double)n;
 }
 
 /* "0:03", "12:40", "1:02:03". */
@@ -36,22 +62,21 @@ void cli_progress_update(void *user, long done, long total)
 	cli_progress *p = user;
 	if (!p || !p->active || total <= 0)
 		return;
-	/* Trials taken from a journal took no time: the ETA counts from the
-	 * first trial this run finished. */
-	if (p->base < 0)
-		p->base = done > 0 ? done - 1 : 0;
 	double now = bsim_clock_seconds();
+	if (p->done0 < 0) {
+		p->done0 = done;
+		p->t0 = now;
+	}
 	if (done < total && p->t_last >= 0.0 && now - p->t_last < PROGRESS_INTERVAL)
 		return;
 	p->t_last = now;
 
 	char eta[32] = "-:--";
-	double elapsed = now - p->t_start;
+	double left = cli_progress_eta(done, total, p->done0, p->t0, now);
 	if (done >= total)
-		format_duration(eta, sizeof eta, elapsed);
-	else if (done > p->base)
-		format_duration(eta, sizeof eta,
-		                elapsed * (double)(total - done) / (double)(done - p->base));
+		format_duration(eta, sizeof eta, now - p->t_start);
+	else if (left >= 0.0)
+		format_duration(eta, sizeof eta, left);
 	/* Trailing spaces wipe what a longer previous line left behind. */
 	fprintf(stderr, "\r  %ld/%ld %s  %d%%  %s %s   ", done, total, p->unit,
 	        (int)(100.0 * (double)done / (double)total), done >= total ? "took" : "ETA", eta);

@@ -11,7 +11,11 @@ typedef struct cli_progress {
 	const char *unit; /* what is counted: "trials" */
 	double t_start;   /* s, monotonic */
 	double t_last;    /* s, when the line was last drawn */
-	long base;        /* done at the first update (a resumed run's journaled trials), or -1 */
+	/* done and the time, s, at the first update, or done0 = -1 before it:
+	 * the rate counts from there, so neither the start-up nor a resumed
+	 * run's journaled trials (which took no time) enter it. */
+	long done0;
+	double t0;
 } cli_progress;
 
 /* Starts the clock. Prints nothing ever if !enabled or stderr is not a
@@ -21,6 +25,12 @@ void cli_progress_init(cli_progress *p, int enabled, const char *unit);
 /* A bsim_progress_fn (beamsim/progress.h): user is the cli_progress.
  * Redraws at most ten times a second, and always for the last item. */
 void cli_progress_update(void *user, long done, long total);
+
+/* The ETA rule: the seconds left of a run with done of total items finished
+ * at time now (s), from its rate since done0 were finished at time t0, or
+ * -1 while that rate rests on too little: fewer than 3% of the items this
+ * run does (total - done0) and less than 2 s measured. 0 once done. */
+double cli_progress_eta(long done, long total, long done0, double t0, double now);
 
 /* Ends the line with a newline if one was drawn. */
 void cli_progress_finish(cli_progress *p);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "beamsim/accuracy.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
@@ -233,10 +234,9 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 	cli_progress_finish(&progress);
 	rc = cli_report(rc, &err);
 	if (rc == BSIM_OK) {
-		printf("accuracy: %d rows in %.1f s; wrote %s/accuracy.{csv,mat,md}, "
-		       "%s/equal_error.csv and the figure %s/accuracy.{png,svg,gp}\n",
-		       r.n, r.wall_seconds, cli_path(c->out), cli_path(c->out), cli_path(c->out));
+		printf("accuracy: %d rows in %.1f s\n", r.n, r.wall_seconds);
 		print_equal_error(&r, &cfg);
+		cli_wrote(stdout, c->out);
 		for (int i = 0; i < fig.n_notes; i++)
 			cli_error("%s", fig.notes[i]);
 		bsim_figures_result_free(&fig);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "beamsim/compare_dir.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
@@ -207,10 +208,7 @@ static void compare_summary(const bsim_compare_dir_def *def, const char *out,
 		if (res->unstable[i] > 0)
 			printf("  %s: %ld unstable trials (see %s/%s/trials.csv)\n", i ? lb : la,
 			       res->unstable[i], cli_path(out), res->dir[i]);
-	const char *o = cli_path(out);
-	printf("wrote %s/report.md, %s/report.json, %s/pairs.csv and each side's sweep in "
-	       "%s/%s and %s/%s\n",
-	       o, o, o, o, res->dir[0], o, res->dir[1]);
+	cli_wrote(stdout, out);
 }
 
 int cmd_compare(int argc, char **argv)

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include "analysis/escape.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 
@@ -94,8 +95,7 @@ int cmd_escape(int argc, char **argv)
 		else
 			printf("fit         none: fewer than 3 groups with a barrier, noise and a "
 			       "traversal\n");
-		printf("wrote       %s/: kramers.csv, kramers.mat, kramers.json%s\n",
-		       cli_path(c.out), s.fitted ? ", kramers (.png .svg .gp .dat)" : "");
+		cli_wrote(stdout, c.out);
 		if (s.fitted && !s.drawn)
 			cli_error(
 			        "gnuplot not found: kramers.gp and its data are in %s; install the "

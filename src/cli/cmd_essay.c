@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "beamsim/essay_compare.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
@@ -144,13 +145,11 @@ int cmd_essay(int argc, char **argv)
 		int differ = 0;
 		for (int i = 0; i < r.n; i++)
 			differ += !r.rows[i].consistent;
-		if (!c.quiet)
-			printf("essay: %d rows (%d consistent, %d differ), %ld trials in %.1f s; "
-			       "wrote %s/essay.{csv,mat,md}%s and the figure "
-			       "%s/essay.{png,svg,gp}\n",
-			       r.n, r.n - differ, differ, r.trials_run, r.wall_seconds,
-			       cli_path(c.out), r.n_sens ? ", sensitivity.{csv,mat}" : "",
-			       cli_path(c.out));
+		if (!c.quiet) {
+			printf("essay: %d rows (%d consistent, %d differ), %ld trials in %.1f s\n",
+			       r.n, r.n - differ, differ, r.trials_run, r.wall_seconds);
+			cli_wrote(stdout, c.out);
+		}
 		for (int i = 0; i < fig.n_notes; i++)
 			cli_error("%s", fig.notes[i]);
 		bsim_figures_result_free(&fig);

@@ -10,10 +10,13 @@
 
 #include "beamsim/landscape.h"
 #include "beamsim/landscape_barriers.h"
+#include "beamsim/limits.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
+#include "util/file_read.h"
 
-enum { OWN_RESOLUTION, OWN_REGION };
+enum { OWN_RESOLUTION, OWN_REGION, OWN_JSON };
 
 static const cli_own landscape_own[] = {
         [OWN_RESOLUTION] = {"resolution", 1, "H",
@@ -22,11 +25,15 @@ static const cli_own landscape_own[] = {
         [OWN_REGION] = {"region", 1, "X0,X1,Y0,Y1",
                         "the region in m (default: x within the side\n"
                         "boundaries, y from the body's start to success_y)"},
+        [OWN_JSON] = {"json", 0, NULL,
+                      "print DIR/landscape.json (the grid, the start and every\n"
+                      "pass with its path) instead of the table"},
 };
 
 typedef struct landscape_args {
 	const char *scene;
 	bsim_landscape_grid_def grid;
+	int json;
 } landscape_args;
 
 /* Four numbers separated by commas, each finite. 0 on success. */
@@ -69,6 +76,9 @@ static int landscape_option(void *args, int i, const char *value)
 			                 "and Y0 < Y1, e.g. --region -25,25,0,65",
 			                 value);
 		return CLI_OK;
+	case OWN_JSON:
+		a->json = 1;
+		return CLI_OK;
 	}
 	return CLI_USAGE;
 }
@@ -95,11 +105,12 @@ static const cli_spec landscape_spec = {
                  "                   the top view and the surfaces without and with "
                  "propulsion\n",
         .positional = "SCENE",
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_LIMIT),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_LIMIT) |
+                  CLI_USES(CLI_OPT_QUIET),
         .help = landscape_help,
         .out_required = 1,
         .own = landscape_own,
-        .n_own = 2,
+        .n_own = 3,
         .option = landscape_option,
 };
 
@@ -153,6 +164,20 @@ static void print_table(const landscape_args *a, const bsim_scene *s, const bsim
 		       "give where the descent leaves the beams' reach\n");
 }
 
+/* --json: the landscape.json just written, as it is. */
+static int print_json(const char *dir)
+{
+	char path[BSIM_PATH_MAX];
+	file_text t;
+	bsim_error err;
+	snprintf(path, sizeof path, "%s/landscape.json", dir);
+	if (file_read(path, "landscape.json", INFINITY, NULL, &t, &err) != BSIM_OK)
+		return cli_report(err.code, &err);
+	fwrite(t.text, 1, t.len, stdout);
+	file_text_free(&t);
+	return CLI_OK;
+}
+
 int cmd_landscape(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
@@ -173,18 +198,19 @@ int cmd_landscape(int argc, char **argv)
 	}
 	int drawn = 0;
 	rc = cli_report(bsim_landscape_store(c.out, &scene, &a.grid, &g, &b, &drawn, &err), &err);
-	if (rc == BSIM_OK) {
+	if (rc == BSIM_OK && !c.quiet && a.json)
+		rc = print_json(c.out);
+	else if (rc == BSIM_OK && !c.quiet) {
 		print_table(&a, &scene, g, b);
-		printf("\nwrote       %s/: landscape.csv, landscape.mat, landscape.json, "
-		       "landscape_top, landscape_beam, landscape_total (.png .svg .gp)\n",
-		       cli_path(c.out));
-		if (!drawn)
-			cli_error(
-			        "gnuplot not found: the figures' .gp scripts and data are in %s; "
-			        "install the Debian package gnuplot-nox and run `gnuplot NAME.gp` "
-			        "there",
-			        c.out);
+		printf("\n");
+		cli_wrote(stdout, c.out);
 	}
+	/* The figures' note is a warning: --quiet keeps stdout quiet, not it. */
+	if (rc == BSIM_OK && !drawn)
+		cli_error("gnuplot not found: the figures' .gp scripts and data are in %s; "
+		          "install the Debian package gnuplot-nox and run `gnuplot NAME.gp` "
+		          "there",
+		          c.out);
 	bsim_landscape_barriers_free(b);
 	bsim_landscape_grid_free(g);
 	bsim_scene_free(&scene);

@@ -11,11 +11,13 @@
 #include "beamsim/experiment.h"
 #include "beamsim/markov.h"
 #include "beamsim/lattice_outcome.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
+#include "util/json.h"
 
-enum { OWN_BINS, OWN_VMAX, OWN_ENTRIES, OWN_MAP, OWN_BOOTSTRAP };
+enum { OWN_BINS, OWN_VMAX, OWN_ENTRIES, OWN_MAP, OWN_BOOTSTRAP, OWN_LOCATIONS, OWN_JSON };
 
 #define MAX_ENTRIES 16
 
@@ -23,6 +25,7 @@ typedef struct markov_args {
 	bsim_markov_def def;
 	const char *map;
 	long bootstrap;
+	int locations, json; /* predict: --locations, --json */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
 } markov_args;
@@ -77,6 +80,12 @@ static int markov_option(void *args, int i, const char *value)
 			return cli_usage("markov",
 			                 "--bootstrap %s: expected an integer 0 to 1000000", value);
 		return CLI_OK;
+	case OWN_LOCATIONS:
+		a->locations = 1;
+		return CLI_OK;
+	case OWN_JSON:
+		a->json = 1;
+		return CLI_OK;
 	}
 	return CLI_USAGE;
 }
@@ -122,12 +131,20 @@ static const cli_spec build_spec = {
 
 static const cli_own predict_own[] = {
         {"map", 1, "DIR", "the map directory of beamsim markov build (required)"},
+        {"locations", 0, NULL, "also print every final location with its probability"},
+        {"json", 0, NULL, "print one JSON object (totals, every location) instead\nof text"},
 };
 
-/* predict's and validate's own options: --map, --bootstrap. */
+/* predict's and validate's own options: --map, then predict's --locations
+ * and --json, or validate's --bootstrap. */
 static int map_option(void *args, int i, const char *value)
 {
 	return markov_option(args, OWN_MAP + i, value);
+}
+
+static int predict_option(void *args, int i, const char *value)
+{
+	return markov_option(args, i == 0 ? OWN_MAP : OWN_LOCATIONS + i - 1, value);
 }
 
 static const char *const predict_help[CLI_N_OPTS] = {
@@ -139,15 +156,18 @@ static const cli_spec predict_spec = {
         .name = "markov predict",
         .usage = "LATTICE_SCENE --map DIR [OPTIONS]",
         .about = "Composes the maps in DIR over the lattice of LATTICE_SCENE into an absorbing\n"
-                 "Markov chain and prints the distribution of the final location (the end\n"
-                 "through column ix, a side at row iy, stuck in gate (ix, iy)) and of the\n"
-                 "number of gates visited.\n",
+                 "Markov chain and prints the probabilities of ending through the end, out\n"
+                 "a side and stuck in a gate, and the mean number of gates visited. The\n"
+                 "distribution over every final location (the end through column ix, a side\n"
+                 "at row iy, stuck in gate (ix, iy)) is --out DIR's prediction.csv, or\n"
+                 "printed with --locations or --json. The chain counts gates, not seconds:\n"
+                 "it has no expected time.\n",
         .positional = "LATTICE_SCENE",
-        .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT),
+        .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_QUIET),
         .help = predict_help,
         .own = predict_own,
-        .n_own = 1,
-        .option = map_option,
+        .n_own = 3,
+        .option = predict_option,
 };
 
 static const cli_own validate_own[] = {
@@ -262,10 +282,95 @@ static int markov_build(int argc, char **argv)
 		       "in %s\n",
 		       built, cpu, reused, bsim_markov_bins_count(&a.def.bins), a.def.trials,
 		       cli_path(c.out));
+	if (rc == BSIM_OK && !c.quiet)
+		cli_wrote(stdout, c.out);
 	bsim_experiment_free(&e);
 	bsim_markov_entries_free(&entries);
 	cli_common_free(&c);
 	return rc > BSIM_ESTOPPED ? rc : cli_report(rc, &err);
+}
+
+/* The probabilities of the end, a side and stuck: p summed by kind. */
+static void predict_totals(const bsim_markov_prediction *p, double total[3])
+{
+	total[0] = total[1] = total[2] = 0.0;
+	for (int i = 0; i < p->n_locations; i++)
+		total[p->loc[i].kind] += p->p[i];
+}
+
+static void predict_print(const char *path, const bsim_scene *scene, const bsim_markov_set *set,
+                          const bsim_markov_prediction *p, const char *out, int locations)
+{
+	static const char *const kinds[] = {"end", "side", "stuck"};
+	double total[3];
+	predict_totals(p, total);
+	printf("lattice     %s (%s): %d x %d gates, %d maps, %d states (%s)\n", cli_path(path),
+	       scene->name, scene->lattice.columns, scene->lattice.rows, set->n, p->n_states,
+	       p->exact ? "LU" : "series");
+	printf("\nfinal location      p\n");
+	for (int k = 0; k < 3; k++)
+		printf("%-12s %7.4f\n", kinds[k], total[k]);
+	printf("%-12s %7.4f\n", "(sum)", total[0] + total[1] + total[2]);
+	printf("\ngates visited: mean %.2f (%d terms of the series)", p->mean_gates, p->n_gates);
+	if (p->left_in_field > 1e-12)
+		printf(" (the series stopped with %.2g still in the field)", p->left_in_field);
+	printf("\nexpected time: none (the chain counts gates, not seconds)\n");
+	if (locations) {
+		printf("\nlocation       p\n");
+		for (int i = 0; i < p->n_locations; i++) {
+			if (p->p[i] < 5e-5)
+				continue;
+			char label[48];
+			bsim_lattice_location_label(p->loc[i], label, sizeof label);
+			printf("%-12s %7.4f\n", label, p->p[i]);
+		}
+	}
+	if (!out)
+		printf("per location: --locations prints them, --out DIR writes prediction.csv\n");
+	else
+		cli_wrote(stdout, out);
+}
+
+/* --json: one object with the totals and every final location. */
+static void predict_json(const char *path, const bsim_scene *scene, const bsim_markov_set *set,
+                         const bsim_markov_prediction *p)
+{
+	static const char *const kinds[] = {"end", "side", "stuck"};
+	double total[3];
+	predict_totals(p, total);
+	FILE *f = stdout;
+	fputs("{\"scene\": ", f);
+	bsim_json_string(f, path);
+	fputs(", \"name\": ", f);
+	bsim_json_string(f, scene->name);
+	fprintf(f,
+	        ", \"columns\": %d, \"rows\": %d, \"maps\": %d, \"states\": %d, \"solve\": "
+	        "\"%s\", \"totals\": {",
+	        scene->lattice.columns, scene->lattice.rows, set->n, p->n_states,
+	        p->exact ? "LU" : "series");
+	for (int k = 0; k < 3; k++) {
+		fprintf(f, "%s\"%s\": ", k ? ", " : "", kinds[k]);
+		bsim_json_number(f, total[k]);
+	}
+	fputs("}, \"mean_gates\": ", f);
+	bsim_json_number(f, p->mean_gates);
+	fputs(", \"left_in_field\": ", f);
+	bsim_json_number(f, p->left_in_field);
+	fputs(", \"locations\": [", f);
+	for (int i = 0; i < p->n_locations; i++) {
+		char label[48];
+		bsim_lattice_location_label(p->loc[i], label, sizeof label);
+		fprintf(f, "%s{\"location\": \"%s\", \"kind\": \"%s\", \"p\": ", i ? ", " : "",
+		        label, kinds[p->loc[i].kind]);
+		bsim_json_number(f, p->p[i]);
+		fputc('}', f);
+	}
+	fputs("], \"p_gates\": [", f);
+	for (int k = 0; k <= p->n_gates; k++) {
+		fputs(k ? ", " : "", f);
+		bsim_json_number(f, p->p_gates[k]);
+	}
+	fputs("]}\n", f);
 }
 
 static int markov_predict(int argc, char **argv)
@@ -294,25 +399,11 @@ static int markov_predict(int argc, char **argv)
 		rc = bsim_markov_predict(&scene, &set, &p, &err);
 	if (rc == BSIM_OK && c.out)
 		rc = bsim_markov_prediction_store(c.out, &p, &err);
-	if (rc == BSIM_OK) {
-		printf("lattice     %s (%s): %d x %d gates, %d maps, %d states (%s)\n", path,
-		       scene.name, scene.lattice.columns, scene.lattice.rows, set.n, p.n_states,
-		       p.exact ? "LU" : "series");
-		printf("\nlocation       p\n");
-		for (int i = 0; i < p.n_locations; i++) {
-			if (p.p[i] < 5e-5)
-				continue;
-			char label[48];
-			bsim_lattice_location_label(p.loc[i], label, sizeof label);
-			printf("%-12s %7.4f\n", label, p.p[i]);
-		}
-		printf("\ngates visited: mean %.2f (%d terms of the series)", p.mean_gates,
-		       p.n_gates);
-		if (p.left_in_field > 1e-12)
-			printf(" (the series stopped with %.2g still in the field)",
-			       p.left_in_field);
-		printf("\n");
-	}
+	/* --quiet wins over --json: nothing on stdout. */
+	if (rc == BSIM_OK && !c.quiet && a.json)
+		predict_json(path, &scene, &set, &p);
+	else if (rc == BSIM_OK && !c.quiet)
+		predict_print(path, &scene, &set, &p, c.out, a.locations);
 	bsim_markov_prediction_free(&p);
 	bsim_markov_set_free(&set);
 	bsim_scene_free(&scene);
@@ -367,9 +458,8 @@ static int markov_validate(int argc, char **argv)
 			       k->gates_sim, k->gates_chain, k->sim_cpu, k->predict,
 			       k->sim_cpu / k->predict);
 		}
-		printf("\nwrote       %s/: validate.json, validate.csv, gates.csv (+ .mat), "
-		       "validate_gNNN (.png .svg .gp)\n",
-		       cli_path(c.out));
+		printf("\n");
+		cli_wrote(stdout, c.out);
 	}
 	bsim_markov_validation_free(&v);
 	cli_common_free(&c);

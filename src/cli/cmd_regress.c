@@ -6,6 +6,7 @@
 #include <stdio.h>
 
 #include "beamsim/regress.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
@@ -88,8 +89,7 @@ int cmd_regress(int argc, char **argv)
 			printf("%s: %d of %d trials changed, %d of %d groups beyond tolerance\n",
 			       res.side[i].label, res.side[i].changed, res.side[i].trials,
 			       res.side[i].cmp.n_disagree, res.side[i].cmp.n_groups);
-		printf("wrote %s/regress.md and %s/regress.json\n", cli_path(c.out),
-		       cli_path(c.out));
+		cli_wrote(stdout, c.out);
 	}
 	rc = res.beyond > 0 ? CLI_DISAGREE : CLI_OK;
 	bsim_regress_result_free(&res);

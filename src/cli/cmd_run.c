@@ -16,6 +16,7 @@
 #include "beamsim/trial.h"
 #include "beamsim/lattice_outcome.h"
 #include "beamsim/limits.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_replay.h"
@@ -30,7 +31,8 @@ static const cli_own run_own[] = {
         [OWN_TRAJECTORY] = {"trajectory", 1, "FILE.csv",
                             "write the trajectory, one row per recorded step, and\n"
                             "its MATLAB twin FILE.mat; - is standard output (no\n"
-                            "twin; the report then goes to standard error)"},
+                            "twin; the report then goes to standard error);\n"
+                            "missing folders of FILE are created"},
         [OWN_STRIDE] = {"stride", 1, "N", "record every N-th step (default 1)"},
         [OWN_JSON] = {"json", 0, NULL, "print one JSON object instead of text"},
 };
@@ -311,6 +313,8 @@ int cmd_run(int argc, char **argv)
 	} else if (rc == CLI_OK) {
 		print_text(out, &a, &rp, mixed, &res, log);
 	}
+	if (rc == CLI_OK && !a.json && c.out)
+		cli_wrote(out, c.out);
 	if (rc == CLI_OK)
 		cli_solver_warning(backend->name, &res.solver, "run --json");
 	if (rc == CLI_OK && res.outcome == BSIM_UNSTABLE) {

@@ -1,5 +1,6 @@
 /* beamsim sweep: every group and trial of an experiment, in parallel, into
- * DIR (beamsim/sweep_dir.h), with the p_traverse table on stdout. */
+ * DIR (beamsim/sweep_dir.h), with the p_traverse table and the groups'
+ * splits (cli_outcomes.h) on stdout. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
@@ -8,8 +9,10 @@
 #include "beamsim/output.h"
 #include "beamsim/sweep_dir.h"
 #include "beamsim/limits.h"
+#include "cli/cli_wrote.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
+#include "cli/cli_outcomes.h"
 #include "cli/cli_progress.h"
 
 static const cli_own sweep_own[] = {
@@ -56,25 +59,28 @@ static const cli_spec sweep_spec = {
         .own = sweep_own,
         .n_own = 1,
         .option = sweep_option,
-        .after = "A lattice experiment also writes DIR/lattice_map.csv, final_locations.csv,\n"
+        .after = "Under the p_traverse table: each group's left/right split of the traversals\n"
+                 "(when some group has both types or the beams differ), or for a lattice its\n"
+                 "end/side/stuck split, as fractions with 95% Wilson intervals.\n"
+                 "A lattice experiment also writes DIR/lattice_map.csv, final_locations.csv,\n"
                  "transitions.csv, gate_entries.csv and beam_peaks.csv (docs/lattice.md).\n",
 };
 
-static void sweep_report(const char *out, const bsim_sweep_dir_result *res)
+static void sweep_report(const char *out, const bsim_sweep_dir_result *res, const cli_sets *sets)
 {
 	const bsim_sweep_result *r = &res->r;
 	long n = r->trials_run, rows = (long)r->n_groups * r->trials;
 	bsim_output_table(stdout, &res->e, r);
+	cli_outcomes_print(stdout, &res->e, r,
+	                   !r->lattice && cli_outcomes_asymmetric(&res->e, sets));
 	printf("\n%ld trials, %ld steps in %.3f s on %d thread%s: %.0f trials/s, %.3g steps/s\n", n,
 	       r->total_steps, r->wall_seconds, res->threads, res->threads == 1 ? "" : "s",
 	       cli_per_second(n, r->wall_seconds), cli_per_second(r->total_steps, r->wall_seconds));
 	if (n != rows)
 		printf("(%ld rows: the groups without random force ran one trial each)\n", rows);
-	/* A table over mat_rows has no twin (a note said so). */
-	int twins = rows <= bsim_limits_get()->mat_rows;
-	printf("wrote %s/summary.json and %s/trials.csv%s (and their .mat twins%s)\n",
-	       cli_path(out), cli_path(out), r->keep ? ", trajectories.csv" : "",
-	       twins ? "" : " but trials.mat: see the note above");
+	/* A table over mat_rows has no twin (a note said so): the list
+	 * shows the files there are. */
+	cli_wrote(stdout, out);
 }
 
 int cmd_sweep(int argc, char **argv)
@@ -126,7 +132,7 @@ int cmd_sweep(int argc, char **argv)
 		return rc;
 	}
 	if (!c.quiet)
-		sweep_report(c.out, &res);
+		sweep_report(c.out, &res, &c.sets);
 	cli_solver_warning(def.backend->name, &res.r.solver, "summary.json");
 	/* Unstable trials fail the sweep (after its files are written): one line
 	 * with their number and the first one's reason and replay. */

@@ -21,7 +21,9 @@
 enum { OWN_BACKENDS, OWN_GROUP, OWN_TRIAL, OWN_FPS, OWN_SIZE, OWN_HOLD, OWN_VIEW, OWN_CRF };
 
 static const cli_own video_own[] = {
-        [OWN_BACKENDS] = {"backends", 1, "A,B", "several backends side by side (up to 4)"},
+        [OWN_BACKENDS] = {"backends", 1, "A,B",
+                          "backends side by side, a panel each, each named once\n"
+                          "(1 to 4 names of `beamsim backends`: thesis,box2d)"},
         [OWN_GROUP] = {"group", 1, "G",
                        "group, from 0: an experiment's grid values and the\n"
                        "seed (default 0)"},

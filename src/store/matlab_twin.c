@@ -390,11 +390,34 @@ static int twin_skip(const char *csv_path, const char *mat_path, const twin_tabl
 	return BSIM_OK;
 }
 
+/* A table with a group or trial column gets a second variable, note: its
+ * indices are beamsim's, 0-based, and MATLAB's start at 1. */
+static const char *index_note(const bsim_mat_field *fields, int n)
+{
+	int group = 0, trial = 0;
+	for (int i = 0; i < n; i++) {
+		group |= strcmp(fields[i].name, "group") == 0;
+		trial |= strcmp(fields[i].name, "trial") == 0;
+	}
+	if (group && trial)
+		return "group and trial are 0-based, as in the CSV: group g is row g+1 of "
+		       "summary.mat's groups fields (summary.groups.p_traverse(g+1)), and "
+		       "`beamsim run SCENE --group g --trial t` replays trial t of group g";
+	if (group)
+		return "group is 0-based, as in the CSV: group g is row g+1 of summary.mat's "
+		       "groups fields (summary.groups.p_traverse(g+1))";
+	if (trial)
+		return "trial is 0-based, as in the CSV: `beamsim run SCENE --trial t` "
+		       "replays trial t";
+	return NULL;
+}
+
 static int write_var(const char *mat_path, const char *var, bsim_mat_field *fields, int n,
                      bsim_error *err)
 {
-	bsim_mat_field v = bsim_mat_struct(var, fields, n);
-	return bsim_mat_write(mat_path, &v, 1, err);
+	const char *note = index_note(fields, n);
+	bsim_mat_field v[2] = {bsim_mat_struct(var, fields, n), bsim_mat_string("note", &note)};
+	return bsim_mat_write(mat_path, v, note ? 2 : 1, err);
 }
 
 int bsim_matlab_from_csv(const char *csv_path, const char *mat_path, const char *var,

@@ -390,6 +390,36 @@ static int manifest_read(const char *dir, olist *l, int *has, bsim_error *err)
 	return rc;
 }
 
+int bsim_outdir_files(const char *dir, char ***paths, size_t *n, bsim_error *err)
+{
+	olist l = {0};
+	int has;
+	*paths = NULL;
+	*n = 0;
+	int rc = manifest_read(dir, &l, &has, err);
+	if (rc == BSIM_OK && l.n > 0) {
+		*paths = malloc(l.n * sizeof **paths);
+		if (!*paths) {
+			olist_free(&l);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		}
+		for (size_t i = 0; i < l.n; i++)
+			(*paths)[i] = l.v[i].rel; /* handed over */
+		*n = l.n;
+		free(l.v);
+		return BSIM_OK;
+	}
+	olist_free(&l);
+	return rc;
+}
+
+void bsim_outdir_files_free(char **paths, size_t n)
+{
+	for (size_t i = 0; paths && i < n; i++)
+		free(paths[i]);
+	free(paths);
+}
+
 static int manifest_write(const char *dir, const char *command, const olist *l, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];

@@ -80,6 +80,13 @@ void bsim_outdir_close(bsim_outdir *od);
  * first file that does not match (files of two runs). */
 int bsim_outdir_verify(const char *dir, int *has_manifest, bsim_error *err);
 
+/* The files DIR/manifest.json lists, in its order (by path): *paths a
+ * malloc'd array of *n malloc'd paths below DIR (free with
+ * bsim_outdir_files_free); none if there is no manifest. BSIM_EINPUT if
+ * the manifest cannot be read. */
+int bsim_outdir_files(const char *dir, char ***paths, size_t *n, bsim_error *err);
+void bsim_outdir_files_free(char **paths, size_t n);
+
 #ifdef __cplusplus
 }
 #endif

@@ -249,6 +249,20 @@ static int trajectory_commit(bsim_atomic_file *traj, const char *path, bsim_erro
 	return rc;
 }
 
+/* The folders above the trajectory file, created if missing as --out's
+ * are (mkdir -p): a new folder for one file should not need its own step. */
+static int trajectory_parent(const char *path, bsim_error *err)
+{
+	char dir[BSIM_PATH_MAX];
+	const char *slash = strrchr(path, '/');
+	if (strcmp(path, "-") == 0 || !slash || slash == path)
+		return BSIM_OK;
+	if ((size_t)(slash - path) >= sizeof dir)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: path too long", path);
+	snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+	return bsim_output_mkdir(dir, err);
+}
+
 int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, const char *out,
                           bsim_trial_result *res, bsim_error *err)
 {
@@ -260,7 +274,8 @@ int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, con
 	const bsim_scene *scene = info->scene;
 	memset(res, 0, sizeof *res);
 	if (trajectory) {
-		if (bsim_atomic_file_open(&traj, trajectory, err) != BSIM_OK)
+		if (trajectory_parent(trajectory, err) != BSIM_OK ||
+		    bsim_atomic_file_open(&traj, trajectory, err) != BSIM_OK)
 			return BSIM_EFAIL;
 		bsim_trial_trajectory_header(traj.f, scene->n_beams);
 		rec.csv = traj.f;
