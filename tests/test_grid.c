@@ -156,6 +156,63 @@ static void test_grid_equals_edited_file(void **state)
 	free(err);
 }
 
+/* compare takes --grid too: its pairs and each side's trials equal those
+ * of the file edited to the same grid; a --grid given twice for one KEY
+ * runs the later values. */
+static void test_compare_grid(void **state)
+{
+	(void)state;
+	char text[4096], exp_path[1200], out_cli[1200], out_file[1200];
+	snprintf(exp_path, sizeof exp_path, "%s",
+	         bsim_test_write(dir, "cmp.yaml",
+	                         experiment_text(text, sizeof text, "", base_grid)));
+	snprintf(out_cli, sizeof out_cli, "%s", bsim_test_join(dir, "cmp_cli"));
+	snprintf(out_file, sizeof out_file, "%s", bsim_test_join(dir, "cmp_file"));
+	const char *by_cli[] = {"compare",
+	                        exp_path,
+	                        "--backends",
+	                        "thesis,thesis:integrator=euler",
+	                        "--out",
+	                        out_cli,
+	                        "--quiet",
+	                        "--grid",
+	                        "effects.propulsion.force=1,2",
+	                        "--grid",
+	                        "beams.0.stiffness=200:300:50",
+	                        "--grid",
+	                        "effects.propulsion.force=8",
+	                        NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(by_cli, NULL, &err);
+	if (rc != 0 && rc != 3)
+		fail_msg("beamsim compare exited %d: %s", rc, err ? err : "");
+	free(err);
+	bsim_test_write(dir, "cmp.yaml",
+	                experiment_text(text, sizeof text, "",
+	                                "  effects.propulsion.force: [8]\n"
+	                                "  effects.random_force.magnitude: [10, 40]\n"
+	                                "  beams.0.stiffness: [200, 250, 300]\n"));
+	const char *by_file[] = {
+	        "compare", exp_path, "--backends", "thesis,thesis:integrator=euler",
+	        "--out",   out_file, "--quiet",    NULL};
+	err = NULL;
+	int rc_file = bsim_test_cli(by_file, NULL, &err);
+	assert_int_equal(rc_file, rc);
+	free(err);
+	const char *files[] = {"pairs.csv", "thesis/trials.csv",
+	                       "thesis-integrator=euler/trials.csv", NULL};
+	for (int i = 0; files[i]; i++) {
+		char *a = read_in(out_cli, files[i]), *b = read_in(out_file, files[i]);
+		if (strcmp(a, b) != 0)
+			fail_msg("compare --grid: %s differs from the edited file's", files[i]);
+		free(a);
+		free(b);
+	}
+	char *a = read_in(out_cli, "thesis/trials.csv");
+	assert_int_equal(bsim_test_count_lines(a), 1 + 1 * 2 * 3 * 4);
+	free(a);
+}
+
 /* The values A:B:STEP gives, read back from the stored experiment, against
  * A + i STEP for i = 0, 1, ... while within 1e-9 of a STEP of B, each
  * written in %.10g (the shortest decimal of these sums). */
@@ -326,6 +383,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_grid_equals_edited_file),
+	        cmocka_unit_test(test_compare_grid),
 	        cmocka_unit_test(test_range_expansion),
 	        cmocka_unit_test(test_errors),
 	        cmocka_unit_test(test_error_no_key),
