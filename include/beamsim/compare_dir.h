@@ -50,6 +50,9 @@ typedef struct bsim_compare_dir_def {
 	const char *out;        /* the output directory */
 	const bsim_override *sets;
 	int n_sets;
+	/* Grid axes that replace or join the file's (bsim_experiment_load_grid). */
+	const bsim_grid_axis *grid;
+	int n_grid;
 	long trials; /* > 0: trials per group instead of the file's */
 	int has_seed;
 	uint64_t seed;

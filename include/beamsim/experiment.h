@@ -41,6 +41,19 @@ typedef struct bsim_experiment {
 BSIM_API int bsim_experiment_load(const char *path, const bsim_override *extra, int n_extra,
                                   bsim_experiment *out, bsim_error *err);
 
+/* bsim_experiment_load with the grid changed beside the file (beamsim
+ * sweep --grid KEY=...): each of the n_grid axes replaces the file's axis
+ * of the same key where it stands, or, if the file has none, is appended
+ * after the file's axes, in the order given; an entry of the file's set:
+ * for the axis's field (or a field inside it) is dropped, the axis giving
+ * that field its values. The axes are copied; each value's origin (NULL:
+ * "--grid") names it in error messages. The experiment then holds the grid
+ * that runs, so the record of a run (beamsim/run_record.h) repeats it.
+ * With n_grid 0, bsim_experiment_load. */
+BSIM_API int bsim_experiment_load_grid(const char *path, const bsim_override *extra, int n_extra,
+                                       const bsim_grid_axis *grid, int n_grid, bsim_experiment *out,
+                                       bsim_error *err);
+
 BSIM_API void bsim_experiment_free(bsim_experiment *e);
 
 /* BSIM_EINPUT with "expected at most N trials in all, got G groups x T

@@ -75,6 +75,12 @@ typedef struct bsim_figures_result {
 	char **paths; /* n "OUT/NAME", without extension, in the order written */
 	int n_notes;
 	char **notes; /* what was not drawn and why, one line each */
+	/* With a selection (def.select), every grid axis of the run, one line
+	 * each in the grid's order: "KEY = V (selected of N values)" for an
+	 * axis the selection names, "KEY: V1, V2, ... (all N values)" for one
+	 * that remains; after a first line "G of N groups selected". NULL
+	 * without a selection. */
+	char *selection;
 } bsim_figures_result;
 
 BSIM_API void bsim_figures_result_free(bsim_figures_result *r);

@@ -47,6 +47,7 @@
 #include "beamsim/base.h"
 #include "beamsim/backend.h"
 #include "beamsim/error.h"
+#include "beamsim/experiment.h"
 #include "beamsim/lattice.h"
 #include "beamsim/options.h"
 #include "beamsim/progress.h"
@@ -207,6 +208,9 @@ typedef struct bsim_markov_validate_def {
 	const char *out;           /* the output directory */
 	const bsim_override *sets; /* --set, every group */
 	int n_sets;
+	/* Grid axes that replace or join the file's (bsim_experiment_load_grid). */
+	const bsim_grid_axis *grid;
+	int n_grid;
 	long trials;  /* 0: the experiment's */
 	int has_seed; /* 1: seed replaces the experiment's */
 	uint64_t seed;

@@ -41,6 +41,9 @@ typedef struct bsim_sweep_dir_def {
 	const char *out;           /* the output directory */
 	const bsim_override *sets; /* applied to every group, after the file's set: */
 	int n_sets;
+	/* Grid axes that replace or join the file's (bsim_experiment_load_grid). */
+	const bsim_grid_axis *grid;
+	int n_grid;
 	long trials;  /* > 0: trials per group instead of the file's */
 	int has_seed; /* 1: seed instead of the file's */
 	uint64_t seed;

@@ -3,7 +3,9 @@
 
 #include "cli/cli_common.h"
 
+#include <ctype.h>
 #include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <getopt.h>
 #include <stdarg.h>
@@ -12,6 +14,7 @@
 
 #include "beamsim/limits.h"
 #include "cli/cli_progress.h"
+#include "util/decimal.h"
 #include "util/text_check.h"
 
 void cli_error(const char *fmt, ...)
@@ -188,6 +191,19 @@ int cli_sets_add(cli_sets *s, const char *cmd, const char *kv)
 	return CLI_OK;
 }
 
+static void grid_axis_free(bsim_grid_axis *a)
+{
+	for (int i = 0; i < a->n_values; i++) {
+		free(a->values[i]);
+		if (a->origins) /* NULL while the values are being made */
+			free(a->origins[i]);
+	}
+	free(a->key);
+	free(a->values);
+	free(a->origins);
+	memset(a, 0, sizeof *a);
+}
+
 void cli_sets_free(cli_sets *s)
 {
 	for (int i = 0; i < s->n; i++) {
@@ -196,7 +212,175 @@ void cli_sets_free(cli_sets *s)
 		free((char *)s->ov[i].origin);
 	}
 	free(s->ov);
+	for (int a = 0; a < s->n_grid; a++)
+		grid_axis_free(&s->grid[a]);
+	free(s->grid);
 	memset(s, 0, sizeof *s);
+}
+
+/* t without the spaces around it, into buf (size > strlen(t)). */
+static const char *trimmed(const char *t, size_t len, char *buf)
+{
+	while (len && *t == ' ')
+		t++, len--;
+	while (len && t[len - 1] == ' ')
+		len--;
+	memcpy(buf, t, len);
+	buf[len] = '\0';
+	return buf;
+}
+
+/* 1 if t is a finite decimal number, all of it. */
+static int grid_number(const char *t, double *x)
+{
+	char *end;
+	if (!*t || decimal_other_base(t) || isspace((unsigned char)*t))
+		return 0;
+	*x = strtod(t, &end);
+	return *end == '\0' && isfinite(*x);
+}
+
+#define GRID_EXPECTED "KEY=V1,V2,... or KEY=A:B:STEP"
+
+/* The values of "V1,V2,..." into a (values only). */
+static int grid_list(bsim_grid_axis *a, const char *cmd, const char *text, const char *list,
+                     char *buf)
+{
+	int n = 1;
+	for (const char *p = list; *p; p++)
+		n += *p == ',';
+	double limit = bsim_limits_get()->groups;
+	if (n > limit) {
+		char hint[160];
+		bsim_limits_hint(hint, sizeof hint, "groups", limit);
+		return cli_usage(cmd, "--grid %s: expected at most %.15g values (%s), got %d", text,
+		                 limit, hint, n);
+	}
+	a->values = calloc((size_t)n, sizeof *a->values);
+	if (!a->values)
+		return CLI_FAIL;
+	for (const char *p = list;; p++) {
+		size_t len = strcspn(p, ",");
+		double x;
+		trimmed(p, len, buf);
+		if (!buf[0])
+			return cli_usage(cmd,
+			                 "--grid %s: expected a non-empty list of numbers "
+			                 "(" GRID_EXPECTED "), got an empty value",
+			                 text);
+		if (!grid_number(buf, &x))
+			return cli_usage(cmd,
+			                 "--grid %s: expected decimal numbers (" GRID_EXPECTED
+			                 "), got \"%s\"",
+			                 text, buf);
+		if (!(a->values[a->n_values++] = strdup(buf)))
+			return CLI_FAIL;
+		p += len;
+		if (!*p)
+			return CLI_OK;
+	}
+}
+
+/* The values of "A:B:STEP" into a (values only). */
+static int grid_range(bsim_grid_axis *a, const char *cmd, const char *text, const char *range,
+                      char *buf)
+{
+	char part[3][128];
+	double x[3];
+	const char *p = range;
+	for (int k = 0; k < 3; k++) {
+		size_t len = strcspn(p, ":");
+		if ((k < 2) != (p[len] == ':') || len >= sizeof part[k])
+			return cli_usage(cmd, "--grid %s: expected A:B:STEP, three numbers", text);
+		trimmed(p, len, part[k]);
+		if (!grid_number(part[k], &x[k]))
+			return cli_usage(cmd,
+			                 "--grid %s: expected A:B:STEP, three decimal numbers, got "
+			                 "\"%s\"",
+			                 text, part[k]);
+		p += len + 1;
+	}
+	if (x[2] == 0)
+		return cli_usage(cmd, "--grid %s: expected a STEP other than 0 in A:B:STEP", text);
+	double steps = (x[1] - x[0]) / x[2];
+	if (steps < 0)
+		return cli_usage(cmd,
+		                 "--grid %s: expected a STEP of the sign of B - A in A:B:STEP (%s "
+		                 "to %s is %s)",
+		                 text, part[0], part[1], x[1] >= x[0] ? "upwards" : "downwards");
+	/* B counts when it is reached within 1e-9 of a STEP. */
+	double n = floor(steps + 1e-9) + 1, limit = bsim_limits_get()->groups;
+	if (!(n <= limit)) {
+		char hint[160];
+		bsim_limits_hint(hint, sizeof hint, "groups", limit);
+		return cli_usage(cmd, "--grid %s: expected at most %.15g values (%s), got %.15g",
+		                 text, limit, hint, n);
+	}
+	a->values = calloc((size_t)n, sizeof *a->values);
+	if (!a->values)
+		return CLI_FAIL;
+	for (long i = 0; i < (long)n; i++) {
+		if (decimal_step(part[0], part[2], i, buf, 128) != 0)
+			snprintf(buf, 128, "%.17g", x[0] + (double)i * x[2]);
+		if (!(a->values[a->n_values++] = strdup(buf)))
+			return CLI_FAIL;
+	}
+	return CLI_OK;
+}
+
+int cli_grid_add(cli_sets *s, const char *cmd, const char *text)
+{
+	const char *eq = strchr(text, '=');
+	size_t n = strlen(text);
+	char *buf = malloc(n + 128);
+	if (!buf) {
+		cli_error("out of memory");
+		return CLI_FAIL;
+	}
+	if (!eq || !trimmed(text, (size_t)(eq - text), buf)[0]) {
+		free(buf);
+		return cli_usage(cmd,
+		                 "--grid %s: expected " GRID_EXPECTED
+		                 ", e.g. --grid beams.0.stiffness=100,200 or "
+		                 "--grid effects.propulsion.force=7:9:0.5",
+		                 text);
+	}
+	bsim_grid_axis a = {.key = strdup(buf)};
+	int rc = a.key ? CLI_OK : CLI_FAIL;
+	if (rc == CLI_OK)
+		rc = strchr(eq + 1, ':') ? grid_range(&a, cmd, text, eq + 1, buf)
+		                         : grid_list(&a, cmd, text, eq + 1, buf);
+	if (rc == CLI_OK && !(a.origins = calloc((size_t)a.n_values, sizeof *a.origins)))
+		rc = CLI_FAIL;
+	for (int i = 0; rc == CLI_OK && i < a.n_values; i++) {
+		a.origins[i] = malloc(n + sizeof "--grid ");
+		if (!a.origins[i])
+			rc = CLI_FAIL;
+		else
+			snprintf(a.origins[i], n + sizeof "--grid ", "--grid %s", text);
+	}
+	free(buf);
+	int at = 0;
+	while (rc == CLI_OK && at < s->n_grid && strcmp(s->grid[at].key, a.key) != 0)
+		at++;
+	if (rc == CLI_OK && at == s->n_grid) {
+		bsim_grid_axis *g = realloc(s->grid, (size_t)(at + 1) * sizeof *g);
+		if (!g) {
+			rc = CLI_FAIL;
+		} else {
+			s->grid = g;
+			memset(&s->grid[s->n_grid++], 0, sizeof *g);
+		}
+	}
+	if (rc != CLI_OK) {
+		if (rc == CLI_FAIL)
+			cli_error("out of memory");
+		grid_axis_free(&a);
+		return rc;
+	}
+	grid_axis_free(&s->grid[at]);
+	s->grid[at] = a;
+	return CLI_OK;
 }
 
 int cli_limit(const char *cmd, const char *text)
@@ -238,7 +422,8 @@ int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsi
 {
 	bsim_error err;
 	const bsim_override *ov = sets ? sets->ov : NULL;
-	if (bsim_experiment_load(path, ov, sets ? sets->n : 0, e, &err) != BSIM_OK) {
+	if (bsim_experiment_load_grid(path, ov, sets ? sets->n : 0, sets ? sets->grid : NULL,
+	                              sets ? sets->n_grid : 0, e, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return err.code ? err.code : CLI_USAGE;
 	}
@@ -362,7 +547,8 @@ double cli_experiment_beam_steps(const char *path, const cli_sets *sets, long tr
 	bsim_error err;
 	const bsim_override *ov = sets ? sets->ov : NULL;
 	int n_ov = sets ? sets->n : 0;
-	if (bsim_experiment_load(path, ov, n_ov, &e, &err) != BSIM_OK)
+	if (bsim_experiment_load_grid(path, ov, n_ov, sets ? sets->grid : NULL,
+	                              sets ? sets->n_grid : 0, &e, &err) != BSIM_OK)
 		return 0.0;
 	if (trials > 0 && bsim_experiment_check_trials(&e, trials, &err) != BSIM_OK) {
 		bsim_experiment_free(&e);

@@ -59,14 +59,26 @@ int cli_parse_u64(const char *text, uint64_t *out);
  * in (0, 1) if open, else in [0, 1]. 0, or a usage error of cmd naming opt. */
 int cli_parse_fraction(const char *cmd, const char *opt, const char *text, int open, double *out);
 
-/* The --set KEY=VALUE overrides of one command, in order. */
+/* The --set KEY=VALUE overrides of one command, in order, and its --grid
+ * axes, which replace or join the experiment's grid
+ * (bsim_experiment_load_grid). */
 typedef struct cli_sets {
 	int n, cap;
 	bsim_override *ov; /* key, value and origin strings owned here */
+	int n_grid;
+	bsim_grid_axis *grid; /* in the order given; every string owned here */
 } cli_sets;
 
 /* Adds "KEY=VALUE" with origin "--set KEY=VALUE". 0, or a usage error. */
 int cli_sets_add(cli_sets *s, const char *cmd, const char *kv);
+/* Adds a --grid axis: "KEY=V1,V2,..." (decimal numbers, kept as written)
+ * or "KEY=A:B:STEP" (A, A + STEP, ... up to B, B included when reached
+ * within 1e-9 of STEP, each written in the fewest decimals that hold it,
+ * util/decimal.h), every value's origin "--grid TEXT". A KEY given again
+ * replaces its earlier values. At most the limit groups values
+ * (beamsim/limits.h). 0, or a usage error naming --grid, the text and
+ * what was expected. */
+int cli_grid_add(cli_sets *s, const char *cmd, const char *text);
 void cli_sets_free(cli_sets *s);
 
 /* Applies a --limit NAME=N (beamsim/limits.h) to the process. 0, or a
@@ -84,7 +96,8 @@ const bsim_backend *cli_backend(const char *name, const bsim_options *opts);
  * the exit status (the codes are equal). */
 int cli_report(int rc, const bsim_error *err);
 
-/* Loads an experiment with the --set overrides (sets may be NULL) and,
+/* Loads an experiment with the --set overrides and --grid axes (sets may
+ * be NULL) and,
  * if trials > 0, that many trials per group. Prints any error; returns
  * the exit status (2 for a bad file). */
 int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsim_experiment *e);
@@ -120,7 +133,7 @@ void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const 
 
 /* The beam-steps a run may take at most: trials x max_steps x beams
  * (every beam of a lattice), summed over the groups of the experiment at
- * path with the --set overrides (a group without random force runs one
+ * path with the --set overrides and --grid axes (a group without random force runs one
  * trial); trials > 0 replaces the file's. 0 if the experiment does not
  * load or asks for more trials than the limit (the run itself then says
  * why). */

@@ -27,6 +27,11 @@ static const shared_def shared[CLI_N_OPTS] = {
         [CLI_OPT_SET] = {"set", 1, "KEY=VALUE",
                          "override a scene field by dotted path, repeatable\n"
                          "(e.g. --set beams.0.stiffness=250: beams.0 is beam 1)"},
+        [CLI_OPT_GRID] = {"grid", 1, "KEY=VALUES",
+                          "vary a scene field over VALUES, repeatable: V1,V2,...\n"
+                          "or A:B:STEP (B included); replaces the experiment's\n"
+                          "grid axis of KEY, or adds one after its axes\n"
+                          "(e.g. --grid beams.0.stiffness=100:500:100)"},
         [CLI_OPT_OUT] = {"out", 1, "DIR", "output directory, created if missing (required)"},
         [CLI_OPT_QUIET] = {"quiet", 0, NULL, "no progress line, nothing on stdout"},
         [CLI_OPT_LIMIT] = {"limit", 1, "NAME=N",
@@ -118,6 +123,11 @@ static int shared_take(const cli_spec *spec, cli_common *c, int o, const char *v
 		return CLI_OK;
 	case CLI_OPT_SET:
 		return cli_sets_add(&c->sets, cmd, v);
+	case CLI_OPT_GRID:
+		if (c->n_grid == CLI_GRID_MAX)
+			return cli_usage(cmd, "--grid %s: more than %d axes", v, CLI_GRID_MAX);
+		c->grid[c->n_grid++] = v;
+		return CLI_OK;
 	case CLI_OPT_OUT:
 		c->out = v;
 		return CLI_OK;
@@ -202,6 +212,11 @@ int cli_parse(const cli_spec *spec, int argc, char **argv, cli_common *c, void *
 		*pos = argv[optind];
 	} else if (optind != argc) {
 		return cli_usage(spec->name, "unexpected argument %s", argv[optind]);
+	}
+	for (int i = 0; i < c->n_grid; i++) {
+		int rc = cli_grid_add(&c->sets, spec->name, c->grid[i]);
+		if (rc != CLI_OK)
+			return rc;
 	}
 	if (spec->out_required && !c->out)
 		return cli_usage(spec->name, "--out %s is required",

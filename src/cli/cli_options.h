@@ -24,6 +24,7 @@ typedef enum cli_opt {
 	CLI_OPT_TRIALS,
 	CLI_OPT_SEED,
 	CLI_OPT_SET,
+	CLI_OPT_GRID,
 	CLI_OPT_OUT,
 	CLI_OPT_QUIET,
 	CLI_OPT_LIMIT,
@@ -38,6 +39,7 @@ typedef enum cli_opt {
 #define CLI_USES(o) (1u << (o))
 
 #define CLI_BACKEND_OPTS_MAX (4 * BSIM_OPTIONS_MAX)
+#define CLI_GRID_MAX         64
 
 /* The values of the shared options. */
 typedef struct cli_common {
@@ -48,7 +50,11 @@ typedef struct cli_common {
 	long trials;  /* 0: the input's */
 	int has_seed;
 	uint64_t seed;
+	/* --set, and --grid's axes: those are expanded once every option is
+	 * read, so that a --limit groups=N anywhere on the line counts */
 	cli_sets sets;
+	int n_grid;
+	const char *grid[CLI_GRID_MAX];
 	const char *out;
 	int quiet, resume;
 	long keep, keep_stride;

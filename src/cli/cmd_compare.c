@@ -87,39 +87,39 @@ static int compare_option(void *args, int i, const char *value)
 static const cli_spec compare_spec = {
         .name = "compare",
         .usage = "EXPERIMENT --out DIR [OPTIONS]",
-        .about =
-                "Runs every trial of the experiment on two backends, or two settings of one,\n"
-                "with the same random-force schedule, so trial t of group g is a pair, and\n"
-                "reports per group: both sides' probabilities of traversed, left, right,\n"
-                "side_exit, stuck and unstable with Wilson 95% intervals, their paired\n"
-                "difference (Tango's 95% score interval), the exact McNemar test on the\n"
-                "discordant pairs, Holm-corrected over all groups with random force and events,\n"
-                "Tango's equivalence test against +-margin, the smallest difference the test\n"
-                "could detect, a verdict, and the times at which paired trajectories first\n"
-                "separate by more than 1% of the body radius. A group without random force is\n"
-                "deterministic: it runs once and is compared as one pair, same or different.\n"
-                "Disagreeing groups list example trials with the `beamsim run` lines that\n"
-                "replay them on either side.\n"
-                "\n"
-                "A group disagrees when an event's Holm-adjusted p-value is below --alpha and\n"
-                "its probabilities differ by at least --margin, or, if deterministic, when its\n"
-                "pair differs. Exit status 3 if any does. On a gate lattice the report adds\n"
-                "both sides' final-location distributions and a paired permutation test of\n"
-                "their difference, which joins the rule.\n"
-                "\n"
-                "Writes DIR/report.md, DIR/report.json, DIR/pairs.csv, DIR/<label>/summary.json\n"
-                "and trials.csv for each side, and DIR/run.json with DIR/inputs/ for\n"
-                "`beamsim regress DIR`. The files appear together at the end (DIR/manifest.json);\n"
-                "finished pairs are journaled as they end, so a stopped or killed comparison\n"
-                "continues with --resume and gives the same files.\n"
-                "\n",
+        .about = "Runs every trial of the experiment on two backends, or two settings of one,\n"
+                 "with the same random-force schedule, so trial t of group g is a pair, and\n"
+                 "reports per group: both sides' probabilities of traversed, left, right,\n"
+                 "side_exit, stuck and unstable with Wilson 95% intervals, their paired\n"
+                 "difference (Tango's 95% score interval), the exact McNemar test on the\n"
+                 "discordant pairs, Holm-corrected over all groups with random force and events,\n"
+                 "Tango's equivalence test against +-margin, the smallest difference the test\n"
+                 "could detect, a verdict, and the times at which paired trajectories first\n"
+                 "separate by more than 1% of the body radius. A group without random force is\n"
+                 "deterministic: it runs once and is compared as one pair, same or different.\n"
+                 "Disagreeing groups list example trials with the `beamsim run` lines that\n"
+                 "replay them on either side.\n"
+                 "\n"
+                 "A group disagrees when an event's Holm-adjusted p-value is below --alpha and\n"
+                 "its probabilities differ by at least --margin, or, if deterministic, when its\n"
+                 "pair differs. Exit status 3 if any does. On a gate lattice the report adds\n"
+                 "both sides' final-location distributions and a paired permutation test of\n"
+                 "their difference, which joins the rule.\n"
+                 "\n"
+                 "Writes DIR/report.md, DIR/report.json, DIR/pairs.csv, DIR/<label>/summary.json\n"
+                 "and trials.csv for each side, and DIR/run.json with DIR/inputs/ (the grid that\n"
+                 "ran, --grid axes included) for `beamsim regress DIR`. The files appear\n"
+                 "together at the end (DIR/manifest.json);\n"
+                 "finished pairs are journaled as they end, so a stopped or killed comparison\n"
+                 "continues with --resume and gives the same files.\n"
+                 "\n",
         .positional = "EXPERIMENT",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND_OPT) |
                   CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_TRIALS) |
-                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_ALPHA) |
-                  CLI_USES(CLI_OPT_MARGIN) | CLI_USES(CLI_OPT_TRAJECTORIES) |
-                  CLI_USES(CLI_OPT_TRAJECTORY_STRIDE) | CLI_USES(CLI_OPT_QUIET) |
-                  CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_LIMIT),
+                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
+                  CLI_USES(CLI_OPT_ALPHA) | CLI_USES(CLI_OPT_MARGIN) |
+                  CLI_USES(CLI_OPT_TRAJECTORIES) | CLI_USES(CLI_OPT_TRAJECTORY_STRIDE) |
+                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_LIMIT),
         .help = compare_help,
         .out_required = 1,
         .own = compare_own,
@@ -230,6 +230,8 @@ int cmd_compare(int argc, char **argv)
 	def.out = c.out;
 	def.sets = c.sets.ov;
 	def.n_sets = c.sets.n;
+	def.grid = c.sets.grid;
+	def.n_grid = c.sets.n_grid;
 	def.trials = c.trials;
 	def.has_seed = c.has_seed;
 	def.seed = c.seed;

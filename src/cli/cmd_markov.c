@@ -121,7 +121,8 @@ static const cli_spec build_spec = {
         .positional = "EXPERIMENT",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
                   CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_BACKEND) |
-                  CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_QUIET),
+                  CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
+                  CLI_USES(CLI_OPT_QUIET),
         .help = build_help,
         .out_required = 1,
         .own = build_own,
@@ -191,7 +192,8 @@ static const cli_spec validate_spec = {
                  "validate.csv, gates.csv, their .mat twins and validate_gNNN (.png .svg).\n",
         .positional = "LATTICE_EXPERIMENT",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
-                  CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_QUIET),
+                  CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
+                  CLI_USES(CLI_OPT_QUIET),
         .help = validate_help,
         .out_required = 1,
         .own = validate_own,
@@ -234,10 +236,11 @@ static int markov_build(int argc, char **argv)
 		}
 		a.def.entries = &entries;
 	}
-	if ((rc = bsim_experiment_load(path, c.sets.ov, c.sets.n, &e, &err)) != BSIM_OK) {
+	/* c.trials is the single gates' per bin, not the experiment's */
+	if ((rc = cli_experiment_load(path, &c.sets, 0, &e)) != CLI_OK) {
 		bsim_markov_entries_free(&entries);
 		cli_common_free(&c);
-		return cli_report(rc, &err);
+		return rc;
 	}
 	cli_progress progress;
 	cli_progress_init(&progress, !c.quiet, "single gates");
@@ -429,6 +432,8 @@ static int markov_validate(int argc, char **argv)
 	def.out = c.out;
 	def.sets = c.sets.ov;
 	def.n_sets = c.sets.n;
+	def.grid = c.sets.grid;
+	def.n_grid = c.sets.n_grid;
 	def.trials = c.trials;
 	def.has_seed = c.has_seed;
 	def.seed = c.seed;

@@ -12,7 +12,8 @@
 static const cli_own plot_own[] = {
         {"select", 1, "KEY=VALUE",
          "only the groups whose grid value of KEY is VALUE,\n"
-         "repeatable (e.g. --select effects.propulsion.force=8)"},
+         "repeatable (e.g. --select effects.propulsion.force=8);\n"
+         "lists every grid axis with what the selection kept"},
 };
 
 static const char *const plot_help[CLI_N_OPTS] = {
@@ -92,6 +93,14 @@ int cmd_plot(int argc, char **argv)
 			printf("%s of %s: %d figure%s, %d drawn\n",
 			       bsim_figures_kind_name(res.kind), cli_path(dir), res.n,
 			       res.n == 1 ? "" : "s", res.drawn);
+			/* every axis: what the selection kept of it */
+			for (const char *p = res.selection; p && *p;) {
+				size_t len = strcspn(p, "\n");
+				int first = p == res.selection;
+				printf("%s%.*s%s\n", first ? "  " : "    ", (int)len, p,
+				       first ? ":" : "");
+				p += len + (p[len] != '\0');
+			}
 			for (int i = 0; i < res.n; i++)
 				printf("  %s.{png,svg,gp}\n", cli_path(res.paths[i]));
 		}

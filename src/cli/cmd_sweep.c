@@ -39,10 +39,10 @@ static const cli_spec sweep_spec = {
                  "DIR/summary.json (per-group counts, p_traverse and its 95% Wilson interval)\n"
                  "and DIR/trials.csv (one row per trial). The results do not depend on "
                  "--threads.\n"
-                 "DIR/run.json and DIR/inputs/ record the run, so `beamsim regress DIR` can\n"
-                 "repeat it. A group without random force is deterministic: its one trial "
-                 "runs\n"
-                 "once and fills every row. Unstable trials (non-finite state, or energy\n"
+                 "DIR/run.json and DIR/inputs/ record the run (the grid that ran, --grid\n"
+                 "axes and --set included), so `beamsim regress DIR` can repeat it. A group\n"
+                 "without random force is deterministic: its one trial runs once and fills\n"
+                 "every row. Unstable trials (non-finite state, or energy\n"
                  "created beyond the ledger's bound) are counted and written like the others,\n"
                  "and make the exit status 1. The files appear together when the sweep is "
                  "done\n"
@@ -53,8 +53,9 @@ static const cli_spec sweep_spec = {
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND) |
                   CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_THREADS) |
                   CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) |
-                  CLI_USES(CLI_OPT_TRAJECTORIES) | CLI_USES(CLI_OPT_TRAJECTORY_STRIDE) |
-                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_LIMIT),
+                  CLI_USES(CLI_OPT_GRID) | CLI_USES(CLI_OPT_TRAJECTORIES) |
+                  CLI_USES(CLI_OPT_TRAJECTORY_STRIDE) | CLI_USES(CLI_OPT_QUIET) |
+                  CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_LIMIT),
         .out_required = 1,
         .own = sweep_own,
         .n_own = 1,
@@ -106,6 +107,8 @@ int cmd_sweep(int argc, char **argv)
 	def.out = c.out;
 	def.sets = c.sets.ov;
 	def.n_sets = c.sets.n;
+	def.grid = c.sets.grid;
+	def.n_grid = c.sets.n_grid;
 	def.trials = c.trials;
 	def.has_seed = c.has_seed;
 	def.seed = c.seed;

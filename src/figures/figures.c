@@ -35,6 +35,7 @@ void bsim_figures_result_free(bsim_figures_result *r)
 		free(r->notes[i]);
 	free(r->paths);
 	free(r->notes);
+	free(r->selection);
 	memset(r, 0, sizeof *r);
 }
 

@@ -196,6 +196,79 @@ int fsum_read(const char *path, fsum *s, bsim_error *err)
 	return rc;
 }
 
+/* Values shown of one axis in a line; more are counted, not listed. */
+#define FSUM_LIST_MAX 12
+
+/* "k1, k2, k3": every axis. */
+static void list_axes(FILE *f, const fsum *s)
+{
+	for (int a = 0; a < s->n_axes; a++)
+		fprintf(f, "%s%s", a ? ", " : "", s->axes[a].key);
+	if (s->n_axes == 0)
+		fputs("none", f);
+}
+
+/* "v1, v2, ...": the values of ax with mark[i] (mark NULL: all). */
+static void list_values(FILE *f, const fsum_axis *ax, const int *mark)
+{
+	int k = 0;
+	for (int i = 0; i < ax->n_values; i++) {
+		if (mark && !mark[i])
+			continue;
+		if (k < FSUM_LIST_MAX)
+			fprintf(f, "%s%s", k ? ", " : "", ax->values[i]);
+		else if (k == FSUM_LIST_MAX)
+			fputs(", ...", f);
+		k++;
+	}
+}
+
+/* The lines of bsim_figures_result.selection: every axis, the selected
+ * ones with their value, the others with the values left. */
+static char *selection_text(const figs *f, const fsum *s)
+{
+	char *text = NULL;
+	size_t len = 0;
+	FILE *m = open_memstream(&text, &len);
+	if (!m)
+		return NULL;
+	int groups = 0;
+	for (int g = 0; g < s->n_groups; g++)
+		groups += s->g[g].selected;
+	fprintf(m, "%d of %d groups selected", groups, s->n_groups);
+	for (int a = 0; a < s->n_axes; a++) {
+		const fsum_axis *ax = &s->axes[a];
+		int *left = calloc((size_t)ax->n_values, sizeof *left), n_left = 0, named = 0;
+		if (!left) {
+			fclose(m);
+			free(text);
+			return NULL;
+		}
+		for (int g = 0; g < s->n_groups; g++)
+			if (s->g[g].selected)
+				left[s->g[g].idx[a]] = 1;
+		for (int i = 0; i < ax->n_values; i++)
+			n_left += left[i];
+		for (int i = 0; i < f->def->n_select; i++)
+			named |= strcmp(f->def->select[i].key, ax->key) == 0;
+		fprintf(m, "\n%s%s", ax->key, named ? " = " : ": ");
+		list_values(m, ax, left);
+		if (named)
+			fprintf(m, " (selected of %d value%s)", ax->n_values,
+			        ax->n_values == 1 ? "" : "s");
+		else if (n_left == ax->n_values)
+			fprintf(m, " (all %d value%s)", ax->n_values, ax->n_values == 1 ? "" : "s");
+		else
+			fprintf(m, " (%d of %d values)", n_left, ax->n_values);
+		free(left);
+	}
+	if (fclose(m) != 0) {
+		free(text);
+		return NULL;
+	}
+	return text;
+}
+
 int fsum_select(const figs *f, fsum *s, bsim_error *err)
 {
 	for (int i = 0; i < f->def->n_select; i++) {
@@ -203,24 +276,44 @@ int fsum_select(const figs *f, fsum *s, bsim_error *err)
 		int a = 0;
 		while (a < s->n_axes && strcmp(s->axes[a].key, o->key) != 0)
 			a++;
+		char *list = NULL;
+		size_t len = 0;
+		FILE *m = open_memstream(&list, &len);
+		if (!m)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		if (a == s->n_axes)
-			return bsim_error_set(
-			        err, BSIM_EINPUT,
-			        "--select %s=%s: %s is not a grid axis of this run "
-			        "(its axes: %s%s%s)",
-			        o->key, o->value, o->key, s->n_axes ? s->axes[0].key : "none",
-			        s->n_axes > 1 ? ", " : "", s->n_axes > 1 ? s->axes[1].key : "");
+			list_axes(m, s);
+		else
+			list_values(m, &s->axes[a], NULL);
+		if (fclose(m) != 0) {
+			free(list);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		}
 		int any = 0;
-		for (int g = 0; g < s->n_groups; g++) {
+		for (int g = 0; a < s->n_axes && g < s->n_groups; g++) {
 			int match = fsum_same_value(s->axes[a].values[s->g[g].idx[a]], o->value);
 			s->g[g].selected &= match;
 			any |= match;
 		}
-		if (!any)
-			return bsim_error_set(err, BSIM_EINPUT,
-			                      "--select %s=%s: %s has no value %s in this run",
-			                      o->key, o->value, o->key, o->value);
+		int rc = BSIM_OK;
+		if (a == s->n_axes)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "--select %s=%s: %s is not a grid axis of this run "
+			                    "(its axes: %s)",
+			                    o->key, o->value, o->key, list);
+		else if (!any)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "--select %s=%s: %s has no value %s in this run (its "
+			                    "values: %s)",
+			                    o->key, o->value, o->key, o->value, list);
+		free(list);
+		if (rc)
+			return rc;
 	}
+	/* once: a comparison's sides are selected the same way */
+	if (f->def->n_select > 0 && !f->res->selection &&
+	    !(f->res->selection = selection_text(f, s)))
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	return BSIM_OK;
 }
 

@@ -149,10 +149,19 @@ int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 	        "set xlabel 't (s)'\nset ylabel 'S(t)'\nplot ",
 	        s->trials_per_group, horizon * 1.02, horizon, horizon, FIG_GREY);
 	for (int i = 0; i < n_shown; i++) {
-		char label[300];
-		fsum_label(s, shown[i], label, sizeof label);
-		for (char *c = label; *c; c++)
-			*c = *c == '\n' ? ' ' : *c;
+		/* the key's one line: every axis, ", " where the label breaks */
+		char text[300], label[450];
+		size_t k = 0;
+		fsum_label(s, shown[i], text, sizeof text);
+		for (const char *c = text; *c && k + 3 < sizeof label; c++) {
+			if (*c == '\n') {
+				label[k++] = ',';
+				label[k++] = ' ';
+			} else {
+				label[k++] = *c;
+			}
+		}
+		label[k] = '\0';
 		fprintf(g.f,
 		        "%s'survival.dat' index %d using 1:3:4 with filledcurves lc rgb '%s' "
 		        "notitle, "

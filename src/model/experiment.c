@@ -219,10 +219,95 @@ static int walk_experiment(const ydoc *d, bsim_experiment *e, bsim_error *err)
 	return BSIM_OK;
 }
 
+static void axis_free(bsim_grid_axis *ax)
+{
+	for (int i = 0; i < ax->n_values; i++) {
+		free(ax->values[i]);
+		free(ax->origins[i]);
+	}
+	free(ax->key);
+	free(ax->values);
+	free(ax->origins);
+	memset(ax, 0, sizeof *ax);
+}
+
+/* A copy of from into to (which holds nothing). */
+static int axis_copy(bsim_grid_axis *to, const bsim_grid_axis *from)
+{
+	size_t n = (size_t)(from->n_values > 0 ? from->n_values : 1);
+	to->key = dup_text(from->key);
+	to->values = calloc(n, sizeof *to->values);
+	to->origins = calloc(n, sizeof *to->origins);
+	if (!to->key || !to->values || !to->origins)
+		return -1;
+	for (int i = 0; i < from->n_values; i++) {
+		to->values[i] = dup_text(from->values[i]);
+		to->origins[i] = dup_text(from->origins[i] ? from->origins[i] : "--grid");
+		to->n_values = i + 1;
+		if (!to->values[i] || !to->origins[i])
+			return -1;
+	}
+	return 0;
+}
+
+/* 1 if key names the field axis or a field inside it ("beams.0.stiffness"
+ * inside "beams.0"): the grid's value, applied later, replaces all of it. */
+static int key_within(const char *key, const char *axis)
+{
+	size_t n = strlen(axis);
+	return strncmp(key, axis, n) == 0 && (key[n] == '\0' || key[n] == '.');
+}
+
+/* The axes given beside the file (beamsim --grid): each replaces the
+ * file's axis of its key where it stands, or is appended after the file's
+ * in the order given; a set: entry of its field (or inside it) is dropped,
+ * as the axis gives that field its values now. */
+static int apply_grid(bsim_experiment *e, const bsim_grid_axis *grid, int n_grid, bsim_error *err)
+{
+	for (int k = 0; k < n_grid; k++) {
+		const bsim_grid_axis *g = &grid[k];
+		if (!g->key || !g->key[0] || g->n_values < 1)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "%s: expected a dotted scene key with a non-empty "
+			                      "list of values",
+			                      g->n_values > 0 && g->origins && g->origins[0]
+			                              ? g->origins[0]
+			                              : "--grid");
+		int a = 0;
+		while (a < e->n_axes && strcmp(e->axes[a].key, g->key) != 0)
+			a++;
+		if (a == e->n_axes) {
+			bsim_grid_axis *axes = realloc(e->axes, (size_t)(a + 1) * sizeof *axes);
+			if (!axes)
+				return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory",
+				                      e->path);
+			e->axes = axes;
+			memset(&e->axes[a], 0, sizeof e->axes[a]);
+			e->n_axes = a + 1;
+		}
+		axis_free(&e->axes[a]);
+		if (axis_copy(&e->axes[a], g) != 0)
+			return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
+		int kept = 0;
+		for (int i = 0; i < e->n_set; i++) {
+			bsim_override *o = &e->set[i];
+			if (key_within(o->key, g->key)) {
+				free((char *)o->key);
+				free((char *)o->value);
+				free((char *)o->origin);
+			} else {
+				e->set[kept++] = *o;
+			}
+		}
+		e->n_set = kept;
+	}
+	return BSIM_OK;
+}
+
 /* The product of the lists' lengths within the limit groups (a few hundred
  * bytes of lists can ask for 10^9 groups, each a scene to build and check)
  * and an int, then groups x trials within the limit trials. */
-static int check_counts(const ydoc *d, bsim_experiment *e, bsim_error *err)
+static int check_counts(const ydoc *d, bsim_experiment *e, int n_grid, bsim_error *err)
 {
 	struct fy_node *root = fy_document_root(d->fyd);
 	double groups = 1, limit = bsim_limits_get()->groups;
@@ -232,6 +317,22 @@ static int check_counts(const ydoc *d, bsim_experiment *e, bsim_error *err)
 		struct fy_node_pair *gp = ydoc_pair(root, "grid", 4);
 		char hint[160];
 		bsim_limits_hint(hint, sizeof hint, "groups", limit);
+		if (n_grid > 0) {
+			/* the options that made the grid this large, as given */
+			char given[512] = "";
+			for (int k = 0; k < e->n_axes; k++) {
+				const char *o = e->axes[k].origins[0];
+				size_t at = strlen(given);
+				if (o && strncmp(o, "--", 2) == 0)
+					snprintf(given + at, sizeof given - at, "%s%s",
+					         at ? ", " : "", o);
+			}
+			return bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s: expected at most %.15g groups (the product of the lists' "
+			        "lengths, with %s's grid), got %.15g (%s)",
+			        given, limit < INT_MAX ? limit : INT_MAX, d->path, groups, hint);
+		}
 		return ydoc_fail(
 		        d, fy_node_pair_value(gp), fy_node_pair_key(gp), "grid", err,
 		        "expected at most %.15g groups (the product of the lists' lengths), "
@@ -330,14 +431,6 @@ int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_over
 	return rc;
 }
 
-/* 1 if key names the field axis or a field inside it ("beams.0.stiffness"
- * inside "beams.0"): the grid's value, applied later, replaces all of it. */
-static int key_within(const char *key, const char *axis)
-{
-	size_t n = strlen(axis);
-	return strncmp(key, axis, n) == 0 && (key[n] == '\0' || key[n] == '.');
-}
-
 /* A fixed override (set: or --set) of a field the grid varies would be
  * overwritten in every group without a word: refused. One of a block that
  * holds the axis (set body.start, grid body.start.1) keeps its other
@@ -361,10 +454,10 @@ static int check_conflicts(const bsim_experiment *e, const bsim_override *extra,
 				        err, BSIM_EINPUT,
 				        "%s: the experiment's grid varies %s (%s), which "
 				        "would overwrite it in every group; expected a key "
-				        "the grid does not vary (to run one value, edit "
-				        "the grid)",
+				        "the grid does not vary (to run one value, give "
+				        "--grid %s=VALUE)",
 				        extra[i].origin ? extra[i].origin : extra[i].key, ax->key,
-				        ax->origins[0]);
+				        ax->origins[0], ax->key);
 	}
 	return BSIM_OK;
 }
@@ -420,6 +513,13 @@ static int check_groups(const ydoc *scene, const bsim_experiment *e, const bsim_
 int bsim_experiment_load(const char *path, const bsim_override *extra, int n_extra,
                          bsim_experiment *out, bsim_error *err)
 {
+	return bsim_experiment_load_grid(path, extra, n_extra, NULL, 0, out, err);
+}
+
+int bsim_experiment_load_grid(const char *path, const bsim_override *extra, int n_extra,
+                              const bsim_grid_axis *grid, int n_grid, bsim_experiment *out,
+                              bsim_error *err)
+{
 	memset(out, 0, sizeof *out);
 	if (strlen(path) >= sizeof out->path)
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -432,11 +532,13 @@ int bsim_experiment_load(const char *path, const bsim_override *extra, int n_ext
 		return rc;
 	rc = walk_experiment(&d, out, err);
 	if (!rc)
+		rc = apply_grid(out, grid, n_grid, err);
+	if (!rc)
 		rc = ydoc_load(&scene, out->scene_path, err);
 	if (!rc)
 		rc = check_values(&scene, out, extra, n_extra, err);
 	if (!rc)
-		rc = check_counts(&d, out, err);
+		rc = check_counts(&d, out, n_grid, err);
 	ydoc_free(&d);
 	if (!rc)
 		rc = check_conflicts(out, extra, n_extra, err);
@@ -459,16 +561,8 @@ void bsim_experiment_free(bsim_experiment *e)
 		free((char *)e->set[i].origin);
 	}
 	free(e->set);
-	for (int a = 0; a < e->n_axes; a++) {
-		bsim_grid_axis *ax = &e->axes[a];
-		for (int i = 0; i < ax->n_values; i++) {
-			free(ax->values[i]);
-			free(ax->origins[i]);
-		}
-		free(ax->key);
-		free(ax->values);
-		free(ax->origins);
-	}
+	for (int a = 0; a < e->n_axes; a++)
+		axis_free(&e->axes[a]);
 	free(e->axes);
 	memset(e, 0, sizeof *e);
 }

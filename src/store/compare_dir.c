@@ -313,8 +313,8 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 		job.protocol_b = (bsim_override){"lattice.protocol", def->protocol[1],
 		                                 "--protocols (side b)"};
 	}
-	rc = bsim_store_experiment(def->experiment, job.sets, job.n_sets, def->trials, &res->e,
-	                           err);
+	rc = bsim_store_experiment(def->experiment, job.sets, job.n_sets, def->grid, def->n_grid,
+	                           def->trials, &res->e, err);
 	if (rc != BSIM_OK) {
 		free(sets);
 		return rc;

@@ -3,7 +3,8 @@
  * The stored experiment is regenerated from the loaded one rather than
  * copied: its `scene:` must name the copied scene, and the command line's
  * --set overrides, applied after `set:` and before the grid, become the
- * last entries of `set:`, which is where they act. run.json is JSON, which
+ * last entries of `set:`, which is where they act; its --grid axes are
+ * in `grid:`, where they replaced or joined the file's. run.json is JSON, which
  * is YAML, so it reads back through libfyaml like every other input. */
 #define _POSIX_C_SOURCE 200809L
 
@@ -64,7 +65,12 @@ static void experiment_body(FILE *f, const bsim_experiment *e, const bsim_overri
 		fprintf(f, "  %s: [", e->axes[a].key);
 		for (int i = 0; i < e->axes[a].n_values; i++)
 			fprintf(f, "%s%s", i ? ", " : "", e->axes[a].values[i]);
-		fputs("]\n", f);
+		/* an axis of the command line says so, as a --set does */
+		const char *origin = e->axes[a].origins[0];
+		if (origin && strncmp(origin, "--", 2) == 0)
+			fprintf(f, "]  # %s\n", origin);
+		else
+			fputs("]\n", f);
 	}
 }
 

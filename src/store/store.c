@@ -113,10 +113,11 @@ long bsim_store_unstable(const bsim_experiment *e, const bsim_override *extra, i
 	return count;
 }
 
-int bsim_store_experiment(const char *path, const bsim_override *sets, int n_sets, long trials,
-                          bsim_experiment *e, bsim_error *err)
+int bsim_store_experiment(const char *path, const bsim_override *sets, int n_sets,
+                          const bsim_grid_axis *grid, int n_grid, long trials, bsim_experiment *e,
+                          bsim_error *err)
 {
-	int rc = bsim_experiment_load(path, sets, n_sets, e, err);
+	int rc = bsim_experiment_load_grid(path, sets, n_sets, grid, n_grid, e, err);
 	if (rc != BSIM_OK)
 		return rc ? rc : BSIM_EINPUT;
 	if (trials > 0 && bsim_experiment_check_trials(e, trials, err) != BSIM_OK) {

@@ -162,8 +162,8 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	if (bsim_options_check(&def->opts, b->knobs, b->n_knobs, b->name, err) != BSIM_OK)
 		return BSIM_EINPUT;
 	bsim_experiment *e = &res->e;
-	int rc =
-	        bsim_store_experiment(def->experiment, def->sets, def->n_sets, def->trials, e, err);
+	int rc = bsim_store_experiment(def->experiment, def->sets, def->n_sets, def->grid,
+	                               def->n_grid, def->trials, e, err);
 	if (rc != BSIM_OK)
 		return rc;
 	if (def->has_seed)
@@ -273,7 +273,7 @@ int bsim_sweep_dir_read(const char *dir, const char *side, bsim_sweep_dir_result
 		return BSIM_EINPUT;
 	if (bsim_session_path(path, sizeof path, dir, "inputs/experiment.yaml", err))
 		return BSIM_EINPUT;
-	int rc = bsim_store_experiment(path, NULL, 0, rec.trials, &res->e, err);
+	int rc = bsim_store_experiment(path, NULL, 0, NULL, 0, rec.trials, &res->e, err);
 	if (rc != BSIM_OK)
 		return rc;
 	res->e.seed = rec.seed;
