@@ -325,6 +325,53 @@ static void out_of_range_exits_2(void **state)
 	bsim_test_expect_input_error(seed, s_needles);
 }
 
+/* A sweep run with --grid (an axis replaced, one added) replays from its
+ * experiment with the same --grid, and from its directory, which records
+ * the grid; --grid on a scene or a stored run is refused. */
+static void grid_rows_replay(void **state)
+{
+	(void)state;
+	char dir[1300], csv[1400];
+	snprintf(dir, sizeof dir, "%s", bsim_test_join(work, "grid-sweep"));
+	snprintf(csv, sizeof csv, "%s/trials.csv", dir);
+	const char *sweep[] = {"sweep",   experiment,
+	                       "--grid",  "beams.0.stiffness=200:300:100",
+	                       "--grid",  "body.mass=1.5",
+	                       "--out",   dir,
+	                       "--quiet", NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(sweep, NULL, &err);
+	if (rc != 0)
+		fail_msg("sweep --grid: exit %d: %s", rc, err);
+	free(err);
+	const int picks[][2] = {{3, 1}, {6, 2}, {5, 0}};
+	for (int k = 0; k < 3; k++) {
+		int g = picks[k][0], t = picks[k][1];
+		char gs[8], ts[8], want[256], got[256];
+		snprintf(gs, sizeof gs, "%d", g);
+		snprintf(ts, sizeof ts, "%d", t);
+		csv_row(csv, g, t, want, sizeof want);
+		const char *from_exp[] = {"run",     experiment,
+		                          "--grid",  "beams.0.stiffness=200:300:100",
+		                          "--grid",  "body.mass=1.5",
+		                          "--group", gs,
+		                          "--trial", ts,
+		                          "--json",  NULL};
+		replay_row(from_exp, g, t, got, sizeof got);
+		assert_string_equal(got, want);
+		const char *from_dir[] = {"run", dir, "--group", gs, "--trial", ts, "--json", NULL};
+		replay_row(from_dir, g, t, got, sizeof got);
+		assert_string_equal(got, want);
+	}
+	const char *on_scene[] = {"run", bsim_test_src("configs/thesis/gate.yaml"), "--grid",
+	                          "body.mass=1,2", NULL};
+	const char *const scene_needles[] = {"--grid body.mass", "has no grid", NULL};
+	bsim_test_expect_input_error(on_scene, scene_needles);
+	const char *on_dir[] = {"run", dir, "--grid", "body.mass=1,2", NULL};
+	const char *const dir_needles[] = {"--grid", "inputs/experiment.yaml", NULL};
+	bsim_test_expect_input_error(on_dir, dir_needles);
+}
+
 /* video EXPERIMENT --group --trial: the trial, its grid values, a file. */
 static void video_replays(void **state)
 {
@@ -359,7 +406,7 @@ int main(void)
 	        cmocka_unit_test(rows_replay_exactly), cmocka_unit_test(altered_row_exits_3),
 	        cmocka_unit_test(lattice_row_replays), cmocka_unit_test(compare_sides_replay),
 	        cmocka_unit_test(scene_group_note),    cmocka_unit_test(out_of_range_exits_2),
-	        cmocka_unit_test(video_replays),
+	        cmocka_unit_test(video_replays),       cmocka_unit_test(grid_rows_replay),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

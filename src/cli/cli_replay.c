@@ -145,6 +145,7 @@ static int open_stored(cli_replay *r, const cli_common *c)
 	 * refused, not quietly ignored. */
 	const char *refused = c->has_seed             ? "--seed"
 	                      : c->sets.n > 0         ? "--set"
+	                      : c->sets.n_grid > 0    ? "--grid"
 	                      : c->n_backend_opts > 0 ? "--backend-opt"
 	                                              : NULL;
 	if (refused) {
@@ -219,6 +220,13 @@ int cli_replay_open(const char *cmd, const char *path, const cli_common *c, long
 		return open_stored(r, c);
 	if (is_experiment(path))
 		return open_experiment(r, c);
+	if (c->sets.n_grid > 0) {
+		cli_error(
+		        "--grid %s: %s is a scene, which has no grid; --grid changes an "
+		        "experiment's grid (give the experiment, or --set KEY=VALUE for one value)",
+		        c->sets.grid[0].key, cli_path(path));
+		return CLI_USAGE;
+	}
 	bsim_error err;
 	if (bsim_scene_load(path, c->sets.ov, c->sets.n, &r->scene, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);

@@ -113,8 +113,8 @@ static const cli_spec run_spec = {
                  "every output; the scene's list, and so --set, counts from 0 (beams.0).\n",
         .positional = "SCENE|EXPERIMENT|DIR",
         .common = CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_BACKEND_OPT) |
-                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) |
-                  CLI_USES(CLI_OPT_LIMIT),
+                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
+                  CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_LIMIT),
         .help = run_help,
         .own = run_own,
         .n_own = 5,

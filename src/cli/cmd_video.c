@@ -163,7 +163,8 @@ static const cli_spec video_spec = {
                  "The file appears whole or not at all.\n",
         .positional = "SCENE|EXPERIMENT|DIR",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND) |
-                  CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET),
+                  CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) |
+                  CLI_USES(CLI_OPT_GRID),
         .help = video_help,
         .out_arg = "FILE.mp4",
         .out_required = 1,

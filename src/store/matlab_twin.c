@@ -402,13 +402,15 @@ static const char *index_note(const bsim_mat_field *fields, int n)
 	if (group && trial)
 		return "group and trial are 0-based, as in the CSV: group g is row g+1 of "
 		       "summary.mat's groups fields (summary.groups.p_traverse(g+1)), and "
-		       "`beamsim run SCENE --group g --trial t` replays trial t of group g";
+		       "`beamsim run DIR --group g --trial t` (DIR: this sweep's directory) "
+		       "replays "
+		       "trial t of group g";
 	if (group)
 		return "group is 0-based, as in the CSV: group g is row g+1 of summary.mat's "
 		       "groups fields (summary.groups.p_traverse(g+1))";
 	if (trial)
-		return "trial is 0-based, as in the CSV: `beamsim run SCENE --trial t` "
-		       "replays trial t";
+		return "trial is 0-based, as in the CSV: `beamsim run DIR --trial t` (DIR: "
+		       "this run's directory) replays trial t";
 	return NULL;
 }
 
