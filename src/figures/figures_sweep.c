@@ -154,7 +154,7 @@ static void axes_along(const fsum *s, const active *a, int *ax0, int *ax1)
 /* ---- Fig. 3.1 -------------------------------------------------------------------- */
 
 /* Pixels of a text of n characters at the figures' 11 pt font. */
-#define TEXT_PX(n) (7 * (n) + 24)
+#define TEXT_PX(n) (15 * (n) / 2 + 60)
 
 static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_error *err)
 {
