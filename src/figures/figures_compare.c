@@ -74,25 +74,40 @@ enum { N_EV = 6 };
  * with no interval (report.json gives none): its interval is the point,
  * and a pair that differs ("DIFFERENT") is beyond the rule. */
 typedef struct cmp_layout {
-	int n;          /* groups drawn */
-	double x_max;   /* the last position */
-	int any[N_EV];  /* an event with a difference or an interval off zero */
-	gp_text tics;   /* "set xtics (...)" naming the fast axes' values */
-	gp_text blank;  /* the same positions, unnamed */
-	gp_text blocks; /* "set x2tics (...)" naming the first axis's value per block */
-	int longest;    /* longest tick label, characters */
+	int n;            /* groups drawn */
+	double x_max;     /* the last position */
+	int any[N_EV];    /* an event with a difference or an interval off zero */
+	int beyond[N_EV]; /* an event with a group beyond the rule */
+	gp_text tics;     /* "set xtics (...)" naming the fast axes' values */
+	gp_text blank;    /* the same positions, unnamed */
+	gp_text blocks;   /* "set x2tics (...)" naming the first axis's value per block */
+	int longest;      /* longest tick label, characters */
 } cmp_layout;
 
-/* Group g's label over the axes other than the first (the block's), or
- * over all when there is one axis: values only, the axis named by the
- * x label. */
+/* The axes drawn along: those with more than one selected value. With two
+ * or more, the first of them makes blocks of groups and the others label
+ * the ticks; with one, it labels the ticks. -1: none. */
+static int block_axis(const fsum *s)
+{
+	int first = -1, n = 0;
+	for (int a = 0; a < s->n_axes; a++)
+		if (s->axes[a].n_selected > 1) {
+			if (first < 0)
+				first = a;
+			n++;
+		}
+	return n >= 2 ? first : -1;
+}
+
+/* Group g's tick label: the values of the varying axes other than the
+ * block's, named by the x label. */
 static void fast_label(const fsum *s, int g, char *buf, size_t size)
 {
 	size_t L = 0;
 	buf[0] = '\0';
-	const int from = s->n_axes >= 2 ? 1 : 0;
-	for (int a = from; a < s->n_axes && L < size; a++) {
-		if (s->axes[a].n_selected == 1)
+	const int skip = block_axis(s);
+	for (int a = 0; a < s->n_axes && L < size; a++) {
+		if (s->axes[a].n_selected <= 1 || a == skip)
 			continue;
 		int w = snprintf(buf + L, size - L, "%s%s", L ? ", " : "",
 		                 s->axes[a].values[s->g[g].idx[a]]);
@@ -117,17 +132,17 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, cmp_layout *lay, 
 	int k = 0, prev_block = -1, block_start = 0;
 	double x = -1.0;
 	/* blocks of the first axis when there are two or more, a gap between */
-	const int blocked = s->n_axes >= 2 && s->axes[0].n_selected > 1;
+	const int bx = block_axis(s), blocked = bx >= 0;
 	fputs("set xtics (", lay->tics.f);
 	fputs("set xtics (", lay->blank.f);
 	fputs("set x2tics (", lay->blocks.f);
 	for (int g = 0; g < s->n_groups; g++) {
 		if (!s->g[g].selected)
 			continue;
-		const int block = blocked ? s->g[g].idx[0] : 0;
+		const int block = blocked ? s->g[g].idx[bx] : 0;
 		if (block != prev_block && prev_block >= 0) {
 			char kv[200];
-			figs_key_value(s->axes[0].key, s->axes[0].values[prev_block], kv,
+			figs_key_value(s->axes[bx].key, s->axes[bx].values[prev_block], kv,
 			               sizeof kv);
 			fputs(block_start ? ", " : "", lay->blocks.f);
 			gp_str(lay->blocks.f, kv);
@@ -159,8 +174,8 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, cmp_layout *lay, 
 			for (int i = 0; i < 3; i++) {
 				snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e],
 				         df[i]);
-				fprintf(o.f, " %.6g",
-				        num_or(root, p, "difference", g, events[e], &bad));
+				double dv = num_or(root, p, "difference", g, events[e], &bad);
+				fprintf(o.f, " %.6g", dv);
 			}
 			char b[16];
 			snprintf(p, sizeof p, "groups.%d.events.%s.beyond", g, events[e]);
@@ -169,7 +184,16 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, cmp_layout *lay, 
 			int beyond = strcmp(b, "true") == 0 ||
 			             (strcmp(verdict, "DIFFERENT") == 0 && num(root, p, &bad) != 0);
 			fprintf(o.f, " %d", beyond);
-			lay->any[e] |= beyond || num(root, p, &bad) != 0;
+			lay->any[e] |= beyond;
+			/* an event that happened on either side gets its panel */
+			for (int side = 0; side < 2; side++) {
+				int absent = 0;
+				snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e],
+				         side ? "p_b" : "p_a");
+				double pv = num(root, p, &absent);
+				lay->any[e] |= absent || pv != 0;
+			}
+			lay->beyond[e] |= beyond;
 		}
 		if (bad) {
 			bsim_atomic_file_abort(&o);
@@ -191,7 +215,7 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, cmp_layout *lay, 
 	}
 	if (blocked && prev_block >= 0) {
 		char kv[200];
-		figs_key_value(s->axes[0].key, s->axes[0].values[prev_block], kv, sizeof kv);
+		figs_key_value(s->axes[bx].key, s->axes[bx].values[prev_block], kv, sizeof kv);
 		fputs(block_start ? ", " : "", lay->blocks.f);
 		gp_str(lay->blocks.f, kv);
 		fprintf(lay->blocks.f, " %g", 0.5 * (block_start + x));
@@ -206,15 +230,16 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, cmp_layout *lay, 
 
 /* One event's differences: points within the rule in colour, beyond in
  * red. */
-static void diff_series(FILE *o, int e, int pt, const char *color, const char *title)
+static void diff_series(FILE *o, int e, int pt, const char *color, const char *title, int beyond)
 {
 	int c = 9 + 4 * e;
 	fprintf(o,
 	        "     'compare.dat' using 1:($%d > 0 ? NaN : $%d):%d:%d with yerrorbars "
 	        "pt %d ps 0.7 lc rgb '%s' title '%s', \\\n"
 	        "     '' using 1:($%d > 0 ? $%d : NaN):%d:%d with yerrorbars pt %d ps 0.9 "
-	        "lc rgb '" FIG_RED "' title 'beyond the rule'\n",
-	        c + 3, c, c + 1, c + 2, pt, color, title, c + 3, c, c + 1, c + 2, pt);
+	        "lc rgb '" FIG_RED "' %s\n",
+	        c + 3, c, c + 1, c + 2, pt, color, title, c + 3, c, c + 1, c + 2, pt,
+	        beyond ? "title 'beyond the rule'" : "notitle");
 }
 
 /* "\nverdicts: 6 same, 15 equivalent, 6 uninformative, ..." from report.json's
@@ -275,9 +300,8 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	if (bad)
 		margin = 0.0;
 	/* one panel per event that happened; the others named in the title */
-	static const char *const names[] = {
-	        "traversed", "traversed, left type", "traversed, right type", "side exit", "stuck",
-	        "unstable"};
+	static const char *const names[] = {"traversed", "left type", "right type",
+	                                    "side exit", "stuck",     "unstable"};
 	static const char *const colours[] = {FIG_BLACK, FIG_BLUE,   FIG_ORANGE,
 	                                      FIG_GREY,  FIG_DKGREY, FIG_PURPLE};
 	static const int points[] = {7, 5, 9, 7, 13, 11};
@@ -294,8 +318,8 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	}
 	char xlabel[600] = "";
 	size_t XL = 0;
-	for (int a = s->n_axes >= 2 ? 1 : 0; a < s->n_axes && XL < sizeof xlabel; a++) {
-		if (s->axes[a].n_selected == 1)
+	for (int a = 0, bx = block_axis(s); a < s->n_axes && XL < sizeof xlabel; a++) {
+		if (s->axes[a].n_selected <= 1 || a == bx)
 			continue;
 		char lab[300];
 		bsim_key_label(s->axes[a].key, 1, lab, sizeof lab);
@@ -317,7 +341,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	         "intervals, paired differences p_A - p_B with the report's paired 95%% "
 	         "intervals; red: beyond the rule",
 	         s->header, s->trials_per_group, verdicts + (verdicts[0] == '\n'),
-	         NL ? (verdicts[0] ? "; " : "") : "", NL ? "no difference in " : "", none);
+	         NL ? (verdicts[0] ? "; " : "") : "", NL ? "on neither side: " : "", none);
 	fprintf(o, "set multiplot layout %d,1 title ", rows);
 	gp_str(o, title);
 	fprintf(o,
@@ -327,7 +351,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	        "unset xlabel\n",
 	        lay.x_max + 0.7, margin);
 	/* (a): the blocks of the first axis named above */
-	if (s->n_axes >= 2 && s->axes[0].n_selected > 1)
+	if (block_axis(s) >= 0)
 		fprintf(o, "set x2range [-0.7:%g]\n%sset x2tics scale 0 font ',10'\n",
 		        lay.x_max + 0.7, blocks);
 	fputs(blank, o);
@@ -357,11 +381,12 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 			gp_str(o, xlabel);
 			fputs(" enhanced\n", o);
 		}
-		fprintf(o, "set title '(%c) %s: p_A - p_B'\n", panel++, names[e]);
+		fprintf(o, "set title '(%c) %s%s: p_A - p_B'\n", panel++,
+		        e == 1 || e == 2 ? "traversed, " : "", names[e]);
 		fputs("plot '+' using 1:(-margin):(margin) with filledcurves lc rgb '#808080' "
 		      "title '+- margin', \\\n",
 		      o);
-		diff_series(o, e, points[e], colours[e], names[e]);
+		diff_series(o, e, points[e], colours[e], names[e], lay.beyond[e]);
 	}
 	fputs("unset multiplot\n", o);
 	free(tics);
