@@ -52,10 +52,12 @@ static const struct {
         {"essay.png", "the essay's reported traversal probabilities beside beamsim's, with "
                       "95% intervals"},
         /* landscape, markov, escape */
-        {"landscape_beam.png", "the potential energy of the beams over the body's position"},
-        {"landscape_total.png", "the total potential energy (beams and propulsion) over the "
-                                "body's position"},
-        {"landscape_top.png", "the landscape from above: passes and paths of least resistance"},
+        {"landscape_beam.png", "3-D surface of E_beam, the springs' energy alone, over the "
+                               "body's position (essay Fig. 2.6a)"},
+        {"landscape_total.png", "3-D surface of E_total, springs and propulsion, over the "
+                                "body's position (essay Fig. 2.6b)"},
+        {"landscape_top.png", "E_total from above with contours, the passes and the paths of "
+                              "least resistance (essay Fig. 2.6c)"},
         {"landscape*.png", "the potential energy landscape (%s)"},
         {"validate_g*.png", "group %s: the Markov chain's predicted final locations against "
                             "simulated ones"},
@@ -81,6 +83,17 @@ static const struct {
         {"beam_peaks.csv", "each beam's largest angle"},
         {"accuracy.csv", "consistency error and speed per backend and setting"},
         {"essay.csv", "the essay's reported values beside beamsim's"},
+        {"essay.md", "the essay's numbers and trends against beamsim, as a table"},
+        {"report.md", "the comparison's report as a table"},
+        {"landscape.csv", "the landscape on its grid: energies and beam angles per point"},
+        {"landscape.json", "the landscape's grid, beams, lowest pass and barriers"},
+        {"gates.csv", "per gate of the lattice"},
+        {"validate.csv", "the Markov chain's predictions against the simulation"},
+        {"validate.json", "the Markov chain's validation: distances and sampling errors"},
+        {"kramers.csv", "escape times against Kramers' rate"},
+        {"kramers.json", "the escape study's fit and settings"},
+        {"regress.json", "the rerun against the stored run"},
+        {"regress.md", "the rerun against the stored run, as a table"},
         {"*.gp", "gnuplot script (rerun with `gnuplot %s.gp` here)"},
         {"*.dat", "data of a figure"},
         {"*.svg", "figure as SVG"},
