@@ -374,7 +374,7 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 	const int pw = np > 12 ? 400 : 520, ph = np > 12 ? 300 : 380;
 	const int key_w = lattice ? 230 : 330;
 	int W = np == 1 ? 640 + key_w : pw * cols, H = np == 1 ? 560 : ph * rows + 90;
-	char title[1200], others[600] = "", axis_label[300];
+	char title[2000], others[600] = "", axis_label[300];
 	size_t L = 0;
 	for (int oa = 0; oa < s->n_axes && L < sizeof others; oa++)
 		if (oa != ax && a->n[oa] > 1) {
