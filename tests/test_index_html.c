@@ -19,6 +19,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "beamsim/key_names.h"
 #include "store/index_html.h"
 #include "support.h"
 
@@ -123,8 +124,14 @@ static void test_captions(void **state)
 	char buf[512];
 	bsim_index_caption("landscape_g003.png", buf, sizeof buf);
 	assert_non_null(strstr(buf, "group 3:"));
+	/* the axis by its display name, as the figure's x label names it */
+	char label[256];
 	bsim_index_caption("traversal_vs_beams_0_stiffness.png", buf, sizeof buf);
-	assert_non_null(strstr(buf, "beams_0_stiffness"));
+	bsim_key_label("beams.0.stiffness", 0, label, sizeof label);
+	assert_non_null(strstr(buf, label));
+	bsim_index_caption("traversal_vs_effects_random_force_magnitude.png", buf, sizeof buf);
+	bsim_key_label("effects.random_force.magnitude", 0, label, sizeof label);
+	assert_non_null(strstr(buf, label));
 	bsim_index_caption("validate_g010.png", buf, sizeof buf);
 	assert_non_null(strstr(buf, "group 10:"));
 	bsim_index_caption("summary.json", buf, sizeof buf);

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "beamsim/key_names.h"
 #include "util/atomic_file.h"
 #include "beamsim/limits.h"
 #include "beamsim/version.h"
@@ -27,7 +28,7 @@ static const struct {
         {"p_traverse.png", "traversal probability p_traverse of every group over the grid's "
                            "first two axes, with 95% Wilson intervals"},
         {"traversal_vs_*.png", "traversal (and its left / right types, or where a lattice's "
-                               "trials ended) against %s, 95% Wilson bands"},
+                               "trials ended) against the %k, 95% Wilson bands"},
         {"trajectories_g*.png", "group %s: its kept trajectories, coloured by outcome and "
                                 "traversal type"},
         {"landscape_g*.png", "group %s: its traversed trajectories over the potential energy "
@@ -118,6 +119,29 @@ static int match(const char *pattern, const char *name, char *star, size_t size)
 	return 1;
 }
 
+/* The scene key whose name in a file name is ident ("beams_0_stiffness":
+ * each '_' is a '.' or itself), as its display label; ident itself when
+ * no key of the names table matches. */
+static void key_of_ident(const char *ident, char *buf, size_t size)
+{
+	char key[128];
+	int pos[8], n = 0;
+	snprintf(key, sizeof key, "%s", ident);
+	for (int i = 0; key[i] && n < 8; i++)
+		if (key[i] == '_')
+			pos[n++] = i;
+	for (unsigned m = 0; m < (1u << n); m++) {
+		for (int b = 0; b < n; b++)
+			key[pos[b]] = (m >> b) & 1u ? '_' : '.';
+		bsim_key_name k;
+		if (bsim_key_name_find(key, &k)) {
+			bsim_key_label(key, 0, buf, size);
+			return;
+		}
+	}
+	snprintf(buf, size, "%s", ident);
+}
+
 void bsim_index_caption(const char *base, char *buf, size_t size)
 {
 	char star[256];
@@ -125,7 +149,12 @@ void bsim_index_caption(const char *base, char *buf, size_t size)
 		if (!match(captions[i].pattern, base, star, sizeof star))
 			continue;
 		const char *c = captions[i].caption, *p = strstr(c, "%s");
-		if (!p) {
+		const char *k = strstr(c, "%k");
+		if (k) {
+			char label[256];
+			key_of_ident(star, label, sizeof label);
+			snprintf(buf, size, "%.*s%s%s", (int)(k - c), c, label, k + 2);
+		} else if (!p) {
 			snprintf(buf, size, "%s", c);
 		} else {
 			/* group numbers without their leading zeros */
@@ -258,7 +287,7 @@ static void html_url(FILE *f, const char *s)
 	}
 }
 
-static void link(FILE *f, const char *rel, const char *text)
+static void html_link(FILE *f, const char *rel, const char *text)
 {
 	fputs("<a href=\"", f);
 	html_url(f, rel);
@@ -323,7 +352,7 @@ static void page(FILE *f, const flist *l, const char *dir, const char *command, 
 				continue;
 			used[j] = 1;
 			fputs(k++ ? " &middot; " : " Files: ", f);
-			link(f, o, base_of(o));
+			html_link(f, o, base_of(o));
 		}
 		fputs("</figcaption>\n</figure>\n", f);
 	}
@@ -332,7 +361,7 @@ static void page(FILE *f, const flist *l, const char *dir, const char *command, 
 		if (used[i])
 			continue;
 		fputs("<li>", f);
-		link(f, l->rel[i], l->rel[i]);
+		html_link(f, l->rel[i], l->rel[i]);
 		bsim_index_caption(base_of(l->rel[i]), caption, sizeof caption);
 		if (*caption) {
 			fputs(": ", f);
@@ -341,7 +370,7 @@ static void page(FILE *f, const flist *l, const char *dir, const char *command, 
 		fputs("</li>\n", f);
 	}
 	fputs("<li>", f);
-	link(f, "manifest.json", "manifest.json");
+	html_link(f, "manifest.json", "manifest.json");
 	fputs(": every file of this directory with its size and CRC-32</li>\n</ul>\n", f);
 	/* LOADED/ALL once every image has loaded or failed (the load event) */
 	fputs("<script>\nwindow.addEventListener('load', function () {\n"

@@ -12,7 +12,8 @@
 
 /* The caption of a file (by its base name, "landscape_g003.png"), from a
  * table of name patterns: "" for a name the table does not know. A
- * pattern's '*' stands for any text; a caption's "%s" is that text. */
+ * pattern's '*' stands for any text; a caption's "%s" is that text, "%k"
+ * the scene key it names ("beams_0_stiffness") by its display label. */
 void bsim_index_caption(const char *base, char *buf, size_t size);
 
 /* Writes stage/index.html if stage (or, with add, also dir: the set the
