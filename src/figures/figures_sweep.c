@@ -390,6 +390,11 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 	         s->header, L ? "\npanels: " : "", others);
 	if (W < TEXT_PX(widest_line(title)))
 		W = TEXT_PX(widest_line(title));
+	/* a single panel placed by hand: below the title's lines */
+	int title_lines = 1;
+	for (const char *c = title; *c; c++)
+		title_lines += *c == '\n';
+	const double top = 1.0 - (18.0 * title_lines + 14.0) / H;
 	if (np == 1)
 		fputs("set multiplot title ", g.f);
 	else
@@ -418,7 +423,7 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 		      "set x2label 'stiffness ratio k_{1}/k_{2}' enhanced\n",
 		      g.f);
 	if (np == 1)
-		fprintf(g.f, "set origin 0,0\nset size %.4f,0.86\n", 640.0 / W);
+		fprintf(g.f, "set origin 0,0\nset size %.4f,%.4f\n", 640.0 / W, top);
 	if (!A->numeric)
 		tics(g.f, "x", A, a->pos[ax]);
 	for (int p = 0; p < np; p++) {
@@ -467,7 +472,8 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 		        FIG_RED, p, FIG_BLUE, p, FIG_RED);
 	}
 	if (np == 1)
-		fprintf(g.f, "set origin %.4f,0\nset size %.4f,0.86\n", 640.0 / W, 1.0 - 640.0 / W);
+		fprintf(g.f, "set origin %.4f,0\nset size %.4f,%.4f\n", 640.0 / W, 1.0 - 640.0 / W,
+		        top);
 	fputs("unset link x2\nunset x2tics\nunset x2label\n", g.f);
 	if (lattice)
 		fprintf(g.f,
