@@ -342,7 +342,15 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	         "intervals; red: beyond the rule",
 	         s->header, s->trials_per_group, verdicts + (verdicts[0] == '\n'),
 	         NL ? (verdicts[0] ? "; " : "") : "", NL ? "on neither side: " : "", none);
-	fprintf(o, "set multiplot layout %d,1 title ", rows);
+	/* the panels placed by hand, all the same height: the last one also
+	 * holds the tick labels and the x label below it */
+	int title_lines = 1;
+	for (const char *c = title; *c; c++)
+		title_lines += *c == '\n';
+	const int ph = 210, top = 18 * title_lines + 20, bottom = 7 * lay.longest + 50;
+	const int blocks_px = block_axis(s) >= 0 ? 24 : 0; /* (a)'s block names */
+	const int h = top + rows * ph + bottom + blocks_px;
+	fputs("set multiplot title ", o);
 	gp_str(o, title);
 	fprintf(o,
 	        " noenhanced\nset xrange [-0.7:%g]\nset grid ytics\nset key outside right top "
@@ -355,6 +363,8 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 		fprintf(o, "set x2range [-0.7:%g]\n%sset x2tics scale 0 font ',10'\n",
 		        lay.x_max + 0.7, blocks);
 	fputs(blank, o);
+	fprintf(o, "set origin 0,%.5f\nset size 1,%.5f\n", (double)(bottom + (rows - 1) * ph) / h,
+	        (double)(ph + blocks_px) / h);
 	fputs("set title '(a) p_{traverse}'\nset yrange [0:1]\n"
 	      "set ylabel 'p_{traverse}'\n",
 	      o);
@@ -375,6 +385,11 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 		if (e > 0 && !lay.any[e])
 			continue;
 		drawn++;
+		if (drawn < rows)
+			fprintf(o, "set origin 0,%.5f\nset size 1,%.5f\n",
+			        (double)(bottom + (rows - drawn) * ph) / h, (double)ph / h);
+		else
+			fprintf(o, "set origin 0,0\nset size 1,%.5f\n", (double)(ph + bottom) / h);
 		if (drawn == rows) {
 			fputs(tics, o);
 			fputs("set xtics rotate by 90 right font ',9'\nset xlabel ", o);
@@ -393,7 +408,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	free(blank);
 	free(blocks);
 	char *body = gp_text_take(&g);
-	int w = 360 + 24 * (int)(lay.x_max + 1), h = 150 + 210 * rows + 7 * lay.longest;
+	int w = 360 + 24 * (int)(lay.x_max + 1);
 	if (w < text_px(title))
 		w = text_px(title);
 	rc = body ? figs_render(f, "compare",
