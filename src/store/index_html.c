@@ -62,7 +62,8 @@ static const struct {
         {"landscape*.png", "the potential energy landscape (%s)"},
         {"validate_g*.png", "group %s: the Markov chain's predicted final locations against "
                             "simulated ones"},
-        {"kramers.png", "escape rates against Kramers' formula"},
+        {"kramers.png", "ln k, the traversal rate, against dE / D (Kramers' law) with the "
+                        "fit, and its residuals"},
         {"*.png", "figure %s"},
         /* data */
         {"summary.json", "per group: counts, p_traverse and its 95% Wilson interval"},
