@@ -26,6 +26,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "beamsim/key_names.h"
 #include "util/figure.h"
 #include "figures/figures_paths.h"
 #include "support.h"
@@ -255,6 +256,78 @@ static void test_select(void **state)
 	free(err);
 }
 
+/* The text of OUT/NAME.gp, which the test frees. */
+static char *script(const char *dir, const char *name)
+{
+	char path[1200];
+	snprintf(path, sizeof path, "%s/%s.gp", dir, name);
+	char *t = bsim_test_read(path);
+	if (!t)
+		fail_msg("no %s", path);
+	return t;
+}
+
+/* The PNG size a script asks for: "size W*scale,H*scale". */
+static void script_size(const char *gp, int *w, int *h)
+{
+	const char *at = strstr(gp, "pngcairo size ");
+	assert_non_null(at);
+	assert_int_equal(sscanf(at, "pngcairo size %d*scale,%d*scale", w, h), 2);
+}
+
+/* Axes, panels and titles name keys by the names table (key_names.h), the
+ * backend and the fixed values; a group without random force is one
+ * trial; a figure with one row of cells or one panel is sized for it. */
+static void test_names_and_titles(void **state)
+{
+	(void)state;
+	const char *dir = sweep_plotted();
+	char want[400], kv[200];
+	char *gp = script(dir, "p_traverse");
+	bsim_key_label("effects.propulsion.force", 1, want, sizeof want);
+	assert_non_null(strstr(gp, want));
+	bsim_key_label("effects.random_force.magnitude", 1, want, sizeof want);
+	assert_non_null(strstr(gp, want));
+	assert_null(strstr(gp, "set xlabel 'effects.propulsion.force'"));
+	assert_non_null(strstr(gp, "thesis backend"));
+	free(gp);
+	/* panels of traversal against F titled by Rm's values */
+	gp = script(dir, "traversal_vs_effects_propulsion_force");
+	bsim_key_value("effects.random_force.magnitude", "20", 0, kv, sizeof kv);
+	snprintf(want, sizeof want, "set title '%s'", kv);
+	assert_non_null(strstr(gp, want));
+	free(gp);
+	/* group 0 (Rm = 0) ran one trial; group 1 (Rm = 20 N) twelve */
+	gp = script(dir, "trajectories_g000");
+	assert_non_null(strstr(gp, "one deterministic trial"));
+	assert_null(strstr(gp, "the first"));
+	free(gp);
+	gp = script(dir, "trajectories_g001");
+	assert_non_null(strstr(gp, "the first 3 of 12 trials"));
+	free(gp);
+
+	/* F = 9 N alone: one row of cells, no 1 x 1 panels; the fixed value
+	 * in the title; one panel against Rm, its key beside it */
+	char out_dir[1100];
+	snprintf(out_dir, sizeof out_dir, "%s/f9", dir);
+	const char *argv[] = {"plot",  dir,     "--select", "effects.propulsion.force=9",
+	                      "--out", out_dir, "--quiet",  NULL};
+	assert_int_equal(run_cli(argv, NULL, NULL), 0);
+	gp = script(out_dir, "p_traverse");
+	assert_non_null(strstr(gp, "set multiplot layout 1,1 "));
+	bsim_key_value("effects.propulsion.force", "9", 0, kv, sizeof kv);
+	assert_non_null(strstr(gp, kv));
+	int w, h;
+	script_size(gp, &w, &h);
+	assert_true(w < 2 * h + 1000 && h < 600); /* one row of three cells */
+	free(gp);
+	gp = script(out_dir, "traversal_vs_effects_random_force_magnitude");
+	assert_null(strstr(gp, "layout"));
+	script_size(gp, &w, &h);
+	assert_true(w <= 1200);
+	free(gp);
+}
+
 /* A malformed file is named with its line, exit 2, and no figure is drawn. */
 static void test_bad_input(void **state)
 {
@@ -416,6 +489,15 @@ static void test_compare_figures(void **state)
 	assert_int_equal(nr, 30);
 	for (int i = 0; i < nr; i++)
 		assert_true(fabs(rows[i][8] - (rows[i][2] - rows[i][5])) < 1e-6);
+	/* the title names both backends; the groups are in blocks of F_prop
+	 * named above, the ticks Rm's values (not "4,0") */
+	char *gp = script(dir, "compare");
+	assert_non_null(strstr(gp, "A: thesis backend, B: box2d backend"));
+	char kv[200];
+	bsim_key_value("effects.propulsion.force", "4", 0, kv, sizeof kv);
+	assert_non_null(strstr(gp, kv));
+	assert_null(strstr(gp, "'4,0'"));
+	free(gp);
 }
 
 /* ---- without gnuplot ---------------------------------------------------------------------- */
@@ -453,11 +535,17 @@ static void test_without_gnuplot(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_below_surface),        cmocka_unit_test(test_sweep_figures),
-	        cmocka_unit_test(test_paths_over_landscape), cmocka_unit_test(test_select),
-	        cmocka_unit_test(test_not_an_output),        cmocka_unit_test(test_bad_input),
-	        cmocka_unit_test(test_run_figures),          cmocka_unit_test(test_accuracy_front),
-	        cmocka_unit_test(test_compare_figures),      cmocka_unit_test(test_without_gnuplot),
+	        cmocka_unit_test(test_below_surface),
+	        cmocka_unit_test(test_sweep_figures),
+	        cmocka_unit_test(test_paths_over_landscape),
+	        cmocka_unit_test(test_select),
+	        cmocka_unit_test(test_names_and_titles),
+	        cmocka_unit_test(test_not_an_output),
+	        cmocka_unit_test(test_bad_input),
+	        cmocka_unit_test(test_run_figures),
+	        cmocka_unit_test(test_accuracy_front),
+	        cmocka_unit_test(test_compare_figures),
+	        cmocka_unit_test(test_without_gnuplot),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

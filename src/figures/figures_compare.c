@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/key_names.h"
 #include "beamsim/output.h"
 #include "figures/figures_kinds.h"
 #include "figures/figures_lattice.h"
@@ -49,6 +50,18 @@ static void text(struct fy_node *root, const char *path, char *buf, size_t size)
 	snprintf(buf, size, "%.*s", t ? (int)len : 0, t ? t : "");
 }
 
+/* Pixels of the widest line of a text at the figures' 11 pt font. */
+static int text_px(const char *t)
+{
+	int w = 0;
+	while (*t) {
+		int n = (int)strcspn(t, "\n");
+		w = n > w ? n : w;
+		t += n + (t[n] == '\n');
+	}
+	return 15 * w / 2 + 60;
+}
+
 static const char *const events[] = {"traversed", "left",  "right",
                                      "side_exit", "stuck", "unstable"};
 enum { N_EV = 6 };
@@ -60,7 +73,51 @@ enum { N_EV = 6 };
  * label. A group without random force is one trial, compared as one pair
  * with no interval (report.json gives none): its interval is the point,
  * and a pair that differs ("DIFFERENT") is beyond the rule. */
-static int compare_data(figs *f, const ydoc *d, const fsum *s, int *n_rows, bsim_error *err)
+typedef struct cmp_layout {
+	int n;            /* groups drawn */
+	double x_max;     /* the last position */
+	int any[N_EV];    /* an event with a difference or an interval off zero */
+	int beyond[N_EV]; /* an event with a group beyond the rule */
+	gp_text tics;     /* "set xtics (...)" naming the fast axes' values */
+	gp_text blank;    /* the same positions, unnamed */
+	gp_text blocks;   /* "set x2tics (...)" naming the first axis's value per block */
+	int longest;      /* longest tick label, characters */
+} cmp_layout;
+
+/* The axes drawn along: those with more than one selected value. With two
+ * or more, the first of them makes blocks of groups and the others label
+ * the ticks; with one, it labels the ticks. -1: none. */
+static int block_axis(const fsum *s)
+{
+	int first = -1, n = 0;
+	for (int a = 0; a < s->n_axes; a++)
+		if (s->axes[a].n_selected > 1) {
+			if (first < 0)
+				first = a;
+			n++;
+		}
+	return n >= 2 ? first : -1;
+}
+
+/* Group g's tick label: the values of the varying axes other than the
+ * block's, named by the x label. */
+static void fast_label(const fsum *s, int g, char *buf, size_t size)
+{
+	size_t L = 0;
+	buf[0] = '\0';
+	const int skip = block_axis(s);
+	for (int a = 0; a < s->n_axes && L < size; a++) {
+		if (s->axes[a].n_selected <= 1 || a == skip)
+			continue;
+		int w = snprintf(buf + L, size - L, "%s%s", L ? ", " : "",
+		                 s->axes[a].values[s->g[g].idx[a]]);
+		L += w > 0 ? (size_t)w : 0;
+	}
+	if (!buf[0])
+		snprintf(buf, size, "group %d", g);
+}
+
+static int compare_data(figs *f, const ydoc *d, const fsum *s, cmp_layout *lay, bsim_error *err)
 {
 	struct fy_node *root = fy_document_root(d->fyd);
 	char path[BSIM_PATH_MAX];
@@ -72,10 +129,30 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int *n_rows, bsim
 	      "left, right, side_exit, stuck, unstable: p_a - p_b lo hi (the report's paired 95% "
 	      "interval) beyond (1: beyond the rule), label\n",
 	      o.f);
-	int k = 0;
+	int k = 0, prev_block = -1, block_start = 0;
+	double x = -1.0;
+	/* blocks of the first axis when there are two or more, a gap between */
+	const int bx = block_axis(s), blocked = bx >= 0;
+	fputs("set xtics (", lay->tics.f);
+	fputs("set xtics (", lay->blank.f);
+	fputs("set x2tics (", lay->blocks.f);
 	for (int g = 0; g < s->n_groups; g++) {
 		if (!s->g[g].selected)
 			continue;
+		const int block = blocked ? s->g[g].idx[bx] : 0;
+		if (block != prev_block && prev_block >= 0) {
+			char kv[200];
+			figs_key_value(s->axes[bx].key, s->axes[bx].values[prev_block], kv,
+			               sizeof kv);
+			fputs(block_start ? ", " : "", lay->blocks.f);
+			gp_str(lay->blocks.f, kv);
+			fprintf(lay->blocks.f, " %g", 0.5 * (block_start + x));
+			x += 1.0;
+		}
+		if (block != prev_block)
+			block_start = (int)(x + 1.0);
+		prev_block = block;
+		x += 1.0;
 		char p[200], verdict[32];
 		int bad = 0;
 		snprintf(p, sizeof p, "groups.%d.verdict", g);
@@ -87,7 +164,8 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int *n_rows, bsim
 			snprintf(p, sizeof p, "groups.%d.events.traversed.%s", g, fields[i]);
 			v[i] = num_or(root, p, i < 3 ? "p_a" : "p_b", g, "traversed", &bad);
 		}
-		fprintf(o.f, "%d %d", k++, g);
+		fprintf(o.f, "%g %d", x, g);
+		k++;
 		for (int i = 0; i < 6; i++)
 			fprintf(o.f, " %.6g", v[i]);
 		for (int e = 0; e < N_EV; e++) {
@@ -96,8 +174,8 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int *n_rows, bsim
 			for (int i = 0; i < 3; i++) {
 				snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e],
 				         df[i]);
-				fprintf(o.f, " %.6g",
-				        num_or(root, p, "difference", g, events[e], &bad));
+				double dv = num_or(root, p, "difference", g, events[e], &bad);
+				fprintf(o.f, " %.6g", dv);
 			}
 			char b[16];
 			snprintf(p, sizeof p, "groups.%d.events.%s.beyond", g, events[e]);
@@ -106,6 +184,16 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int *n_rows, bsim
 			int beyond = strcmp(b, "true") == 0 ||
 			             (strcmp(verdict, "DIFFERENT") == 0 && num(root, p, &bad) != 0);
 			fprintf(o.f, " %d", beyond);
+			lay->any[e] |= beyond;
+			/* an event that happened on either side gets its panel */
+			for (int side = 0; side < 2; side++) {
+				int absent = 0;
+				snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e],
+				         side ? "p_b" : "p_a");
+				double pv = num(root, p, &absent);
+				lay->any[e] |= absent || pv != 0;
+			}
+			lay->beyond[e] |= beyond;
 		}
 		if (bad) {
 			bsim_atomic_file_abort(&o);
@@ -115,32 +203,43 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int *n_rows, bsim
 			        "of traversed, left, right, side_exit, stuck and unstable",
 			        d->path, g);
 		}
-		char label[256] = "";
-		size_t L = 0;
-		for (int a = 0; a < s->n_axes && L < sizeof label; a++) {
-			int w = snprintf(label + L, sizeof label - L, "%s%s", a ? "," : "",
-			                 s->axes[a].values[s->g[g].idx[a]]);
-			L += w > 0 ? (size_t)w : 0;
-		}
+		char label[256];
+		fast_label(s, g, label, sizeof label);
 		fprintf(o.f, " \"%s\"\n", label);
+		fputs(k > 1 ? ", " : "", lay->tics.f);
+		gp_str(lay->tics.f, label);
+		fprintf(lay->tics.f, " %g", x);
+		fprintf(lay->blank.f, "%s'' %g", k > 1 ? ", " : "", x);
+		int len = (int)strlen(label);
+		lay->longest = len > lay->longest ? len : lay->longest;
 	}
-	*n_rows = k;
+	if (blocked && prev_block >= 0) {
+		char kv[200];
+		figs_key_value(s->axes[bx].key, s->axes[bx].values[prev_block], kv, sizeof kv);
+		fputs(block_start ? ", " : "", lay->blocks.f);
+		gp_str(lay->blocks.f, kv);
+		fprintf(lay->blocks.f, " %g", 0.5 * (block_start + x));
+	}
+	fputs(") noenhanced\n", lay->tics.f);
+	fputs(")\n", lay->blank.f);
+	fputs(") noenhanced\n", lay->blocks.f);
+	lay->x_max = x;
+	lay->n = k;
 	return figs_data_commit(&o, err);
 }
 
 /* One event's differences: points within the rule in colour, beyond in
- * red, offset dx from the group's position. */
-static void diff_series(FILE *o, int e, double dx, int pt, const char *color, const char *title,
-                        int tics)
+ * red. */
+static void diff_series(FILE *o, int e, int pt, const char *color, const char *title, int beyond)
 {
 	int c = 9 + 4 * e;
 	fprintf(o,
-	        "     'compare.dat' using ($1 + %g):($%d > 0 ? NaN : $%d):%d:%d%s with yerrorbars "
-	        "pt %d ps 0.6 lc rgb '%s' title '%s', \\\n"
-	        "     '' using ($1 + %g):($%d > 0 ? $%d : NaN):%d:%d with yerrorbars pt %d ps 0.9 "
-	        "lc rgb '" FIG_RED "' notitle",
-	        dx, c + 3, c, c + 1, c + 2, tics ? ":xtic(33)" : "", pt, color, title, dx, c + 3, c,
-	        c + 1, c + 2, pt);
+	        "     'compare.dat' using 1:($%d > 0 ? NaN : $%d):%d:%d with yerrorbars "
+	        "pt %d ps 0.7 lc rgb '%s' title '%s', \\\n"
+	        "     '' using 1:($%d > 0 ? $%d : NaN):%d:%d with yerrorbars pt %d ps 0.9 "
+	        "lc rgb '" FIG_RED "' %s\n",
+	        c + 3, c, c + 1, c + 2, pt, color, title, c + 3, c, c + 1, c + 2, pt,
+	        beyond ? "title 'beyond the rule'" : "notitle");
 }
 
 /* "\nverdicts: 6 same, 15 equivalent, 6 uninformative, ..." from report.json's
@@ -169,87 +268,154 @@ static void verdict_counts(struct fy_node *root, char *buf, size_t size)
 	}
 }
 
-static int compare_figure(figs *f, const ydoc *d, const fsum *s, bsim_error *err)
+static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, bsim_error *err)
 {
-	int n = 0, rc = compare_data(f, d, s, &n, err);
-	if (rc)
+	cmp_layout lay;
+	memset(&lay, 0, sizeof lay);
+	int rc = gp_text_open(&lay.tics, err);
+	if (!rc)
+		rc = gp_text_open(&lay.blank, err);
+	if (!rc)
+		rc = gp_text_open(&lay.blocks, err);
+	if (!rc)
+		rc = compare_data(f, d, s, &lay, err);
+	char *tics = gp_text_take(&lay.tics), *blank = gp_text_take(&lay.blank),
+	     *blocks = gp_text_take(&lay.blocks);
+	if (!rc && (!tics || !blank || !blocks))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	if (rc) {
+		free(tics);
+		free(blank);
+		free(blocks);
 		return rc;
+	}
 	struct fy_node *root = fy_document_root(d->fyd);
-	char la[64], lb[64];
+	char la[64], lb[64], who[200];
 	text(root, "a.label", la, sizeof la);
 	text(root, "b.label", lb, sizeof lb);
+	snprintf(who, sizeof who, "A: %s backend, B: %s backend", la, lb);
+	fsum_header(s, inputs, who);
 	int bad = 0;
 	double margin = num(root, "rule.margin", &bad);
 	if (bad)
 		margin = 0.0;
-	char keys[400] = "";
-	size_t L = 0;
-	for (int a = 0; a < s->n_axes && L < sizeof keys; a++) {
-		int w = snprintf(keys + L, sizeof keys - L, "%s%s", a ? ", " : "", s->axes[a].key);
-		L += w > 0 ? (size_t)w : 0;
+	/* one panel per event that happened; the others named in the title */
+	static const char *const names[] = {"traversed", "left type", "right type",
+	                                    "side exit", "stuck",     "unstable"};
+	static const char *const colours[] = {FIG_BLACK, FIG_BLUE,   FIG_ORANGE,
+	                                      FIG_GREY,  FIG_DKGREY, FIG_PURPLE};
+	static const int points[] = {7, 5, 9, 7, 13, 11};
+	char none[200] = "";
+	size_t NL = 0;
+	int rows = 2;
+	for (int e = 1; e < N_EV; e++) {
+		if (lay.any[e]) {
+			rows++;
+			continue;
+		}
+		int w = snprintf(none + NL, sizeof none - NL, "%s%s", NL ? ", " : "", names[e]);
+		NL += w > 0 ? (size_t)w : 0;
+	}
+	char xlabel[600] = "";
+	size_t XL = 0;
+	for (int a = 0, bx = block_axis(s); a < s->n_axes && XL < sizeof xlabel; a++) {
+		if (s->axes[a].n_selected <= 1 || a == bx)
+			continue;
+		char lab[300];
+		bsim_key_label(s->axes[a].key, 1, lab, sizeof lab);
+		int w = snprintf(xlabel + XL, sizeof xlabel - XL, "%s%s", XL ? ", " : "", lab);
+		XL += w > 0 ? (size_t)w : 0;
 	}
 	gp_text g;
-	if ((rc = gp_text_open(&g, err)))
+	if ((rc = gp_text_open(&g, err))) {
+		free(tics);
+		free(blank);
+		free(blocks);
 		return rc;
+	}
 	FILE *o = g.f;
-	fprintf(o, "set multiplot layout 3,1 title ");
-	char title[600], verdicts[200];
+	char title[1400], verdicts[200];
 	verdict_counts(root, verdicts, sizeof verdicts);
 	snprintf(title, sizeof title,
-	         "%s (A) against %s (B), %d paired trials per group%s\nprobabilities with Wilson "
-	         "95%% intervals, paired differences with the report's paired 95%% intervals; red: "
-	         "beyond the rule",
-	         la, lb, s->trials_per_group, verdicts);
+	         "%s, %d paired trials per group\n%s%s%s%s\nprobabilities with Wilson 95%% "
+	         "intervals, paired differences p_A - p_B with the report's paired 95%% "
+	         "intervals; red: beyond the rule",
+	         s->header, s->trials_per_group, verdicts + (verdicts[0] == '\n'),
+	         NL ? (verdicts[0] ? "; " : "") : "", NL ? "on neither side: " : "", none);
+	/* the panels placed by hand, all the same height: the last one also
+	 * holds the tick labels and the x label below it */
+	int title_lines = 1;
+	for (const char *c = title; *c; c++)
+		title_lines += *c == '\n';
+	const int ph = 210, top = 18 * title_lines + 20, bottom = 7 * lay.longest + 50;
+	const int blocks_px = block_axis(s) >= 0 ? 24 : 0; /* (a)'s block names */
+	const int h = top + rows * ph + bottom + blocks_px;
+	fputs("set multiplot title ", o);
 	gp_str(o, title);
 	fprintf(o,
-	        " noenhanced\nset xrange [-0.7:%g]\nset grid ytics\nset key outside right top\n"
-	        "set lmargin 10\nset rmargin 24\n"
-	        "set xtics rotate by 90 right font ',%d' noenhanced\n"
-	        "margin = %.17g\nset style fill transparent solid 0.15 noborder\n",
-	        n - 0.3, n > 60 ? 7 : 9, margin);
-	fputs("set title '(a) p_{traverse}'\nset yrange [0:1]\nset ylabel 'p_{traverse}'\n"
-	      "unset xlabel\n",
+	        " noenhanced\nset xrange [-0.7:%g]\nset grid ytics\nset key outside right top "
+	        "font ',9'\nset lmargin 10\nset rmargin 26\nmargin = %.17g\n"
+	        "set style fill transparent solid 0.15 noborder\nset tics nomirror\n"
+	        "unset xlabel\n",
+	        lay.x_max + 0.7, margin);
+	/* (a): the blocks of the first axis named above */
+	if (block_axis(s) >= 0)
+		fprintf(o, "set x2range [-0.7:%g]\n%sset x2tics scale 0 font ',10'\n",
+		        lay.x_max + 0.7, blocks);
+	fputs(blank, o);
+	fprintf(o, "set origin 0,%.5f\nset size 1,%.5f\n", (double)(bottom + (rows - 1) * ph) / h,
+	        (double)(ph + blocks_px) / h);
+	fputs("set title '(a) p_{traverse}'\nset yrange [0:1]\n"
+	      "set ylabel 'p_{traverse}'\n",
 	      o);
-	fputs("plot 'compare.dat' using ($1 - 0.15):3:4:5:xtic(33) with yerrorbars pt 7 ps 0.6 "
-	      "lc rgb '" FIG_BLUE "' title ",
+	fputs("plot 'compare.dat' using ($1 - 0.12):3:4:5 with yerrorbars pt 7 ps 0.6 lc rgb "
+	      "'" FIG_BLUE "' title ",
 	      o);
 	gp_str(o, la);
-	fputs(" noenhanced, \\\n     '' using ($1 + 0.15):6:7:8 with yerrorbars pt 9 ps 0.7 lc "
-	      "rgb '" FIG_ORANGE "' title ",
+	fputs(" noenhanced, \\\n     '' using ($1 + 0.12):6:7:8 with yerrorbars pt 9 ps 0.7 "
+	      "lc rgb '" FIG_ORANGE "' title ",
 	      o);
 	gp_str(o, lb);
-	fputs(" noenhanced\n", o);
-	fputs("set title '(b) traversed: p_A - p_B'\nset yrange [*:*]\nset ylabel 'p_A - p_B'\n"
-	      "plot '+' using 1:(-margin):(margin) with filledcurves lc rgb '#808080' "
-	      "title '+- margin', \\\n",
+	fputs(" noenhanced\nunset x2tics\nset yrange [*:*]\n"
+	      "set ylabel 'p_A - p_B'\n",
 	      o);
-	diff_series(o, 0, 0.0, 7, FIG_BLACK, "traversed", 1);
-	fputs("\nset title '(c) traversed left type, right type, side exit, stuck, unstable: "
-	      "p_A - p_B'\n"
-	      "set xlabel ",
-	      o);
-	gp_str(o, keys);
-	fputs(" noenhanced\n"
-	      "plot '+' using 1:(-margin):(margin) with filledcurves lc rgb '#808080' "
-	      "title '+- margin', \\\n",
-	      o);
-	diff_series(o, 1, -0.3, 5, FIG_BLUE, "left type", 1);
-	fputs(", \\\n", o);
-	diff_series(o, 2, -0.15, 9, FIG_ORANGE, "right type", 0);
-	fputs(", \\\n", o);
-	diff_series(o, 3, 0.0, 7, FIG_GREY, "side exit", 0);
-	fputs(", \\\n", o);
-	diff_series(o, 4, 0.15, 13, FIG_DKGREY, "stuck", 0);
-	fputs(", \\\n", o);
-	diff_series(o, 5, 0.3, 11, FIG_PURPLE, "unstable", 0);
-	fputs("\nunset multiplot\n", o);
+	char panel = 'b';
+	int drawn = 1;
+	for (int e = 0; e < N_EV; e++) {
+		if (e > 0 && !lay.any[e])
+			continue;
+		drawn++;
+		if (drawn < rows)
+			fprintf(o, "set origin 0,%.5f\nset size 1,%.5f\n",
+			        (double)(bottom + (rows - drawn) * ph) / h, (double)ph / h);
+		else
+			fprintf(o, "set origin 0,0\nset size 1,%.5f\n", (double)(ph + bottom) / h);
+		if (drawn == rows) {
+			fputs(tics, o);
+			fputs("set xtics rotate by 90 right font ',9'\nset xlabel ", o);
+			gp_str(o, xlabel);
+			fputs(" enhanced\n", o);
+		}
+		fprintf(o, "set title '(%c) %s%s: p_A - p_B'\n", panel++,
+		        e == 1 || e == 2 ? "traversed, " : "", names[e]);
+		fputs("plot '+' using 1:(-margin):(margin) with filledcurves lc rgb '#808080' "
+		      "title '+- margin', \\\n",
+		      o);
+		diff_series(o, e, points[e], colours[e], names[e], lay.beyond[e]);
+	}
+	fputs("unset multiplot\n", o);
+	free(tics);
+	free(blank);
+	free(blocks);
 	char *body = gp_text_take(&g);
-	int w = 300 + 24 * n;
+	int w = 360 + 24 * (int)(lay.x_max + 1);
+	if (w < text_px(title))
+		w = text_px(title);
 	rc = body ? figs_render(f, "compare",
 	                        w < 1000   ? 1000
 	                        : w > 2600 ? 2600
 	                                   : w,
-	                        1000, body, err)
+	                        h, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -340,8 +506,9 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 		return rc;
 	}
 	rc = fsum_select(f, &s, err);
+	snprintf(inputs, sizeof inputs, "%s/inputs", dir);
 	if (!rc)
-		rc = compare_figure(f, &d, &s, err);
+		rc = compare_figure(f, &d, &s, inputs, err);
 	snprintf(sub, sizeof sub, "%s/%s", dir, backend[0]);
 	if (!rc && figs_is_lattice(sub))
 		rc = lattice_figures(f, &d, &s, dir, backend, err);

@@ -15,6 +15,25 @@ static const char *const palette[] = {FIG_BLUE, FIG_RED, FIG_GREEN, FIG_ORANGE, 
 
 #define ESSAY_MODES_MAX 5
 
+/* The backend essay.md names ("Backend thesis, seed 1, ..."), "" if none. */
+static void essay_backend(const char *dir, char *buf, size_t size)
+{
+	char path[BSIM_PATH_MAX];
+	snprintf(path, sizeof path, "%s/essay.md", dir);
+	buf[0] = '\0';
+	FILE *in = fopen(path, "r");
+	if (!in)
+		return;
+	char line[512];
+	while (fgets(line, sizeof line, in))
+		if (strncmp(line, "Backend ", 8) == 0) {
+			size_t n = strcspn(line + 8, ", \n'");
+			snprintf(buf, size, "%.*s", (int)(n < 60 ? n : 60), line + 8);
+			break;
+		}
+	fclose(in);
+}
+
 int figs_essay(figs *f, const char *dir, bsim_error *err)
 {
 	if (f->def->n_select > 0)
@@ -79,8 +98,14 @@ int figs_essay(figs *f, const char *dir, bsim_error *err)
 		csv_table_free(&t);
 		return rc;
 	}
-	fputs("set title 'traversal probabilities the essay reports (its n = 100; the C-track 20) "
-	      "and beamsim''s, 95% intervals'\n"
+	char backend[64];
+	essay_backend(dir, backend, sizeof backend);
+	fprintf(g.f,
+	        "set title 'traversal probabilities the essay reports (its n = 100; the C-track "
+	        "20) "
+	        "and beamsim''s%s%s%s, 95%% intervals' noenhanced\n",
+	        *backend ? " (" : "", backend, *backend ? " backend)" : "");
+	fputs(""
 	      "set ylabel 'probability'\nset yrange [-0.02:1.05]\nset grid ytics\n"
 	      "set key outside top center horizontal maxcols 2 noenhanced\nset bmargin 12\n"
 	      "set xtics rotate by 60 right font ',8' noenhanced (",

@@ -511,12 +511,12 @@ static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
 		k_max += 1.0;
 	}
 	const int ends = sum_ints(a->end, a->cols);
-	char title[900];
+	char title[1800];
 	snprintf(title, sizeof title,
-	         "group %d, %s: %d of %d trials reached the end (%.0f%%)\n"
+	         "group %d: %d of %d trials reached the end (%.0f%%)\n%s\n"
 	         "each gate's left and right half coloured by the stiffness of the beam that "
 	         "sweeps it; gate columns i_x on top, rows i_y on the right",
-	         gi, label, ends, a->trials, a->trials ? 100.0 * ends / a->trials : 0.0);
+	         gi, ends, a->trials, a->trials ? 100.0 * ends / a->trials : 0.0, label);
 	fprintf(s, "set multiplot layout 1,%d title ", n > 0 ? 2 : 1);
 	gp_str(s, title);
 	fprintf(s,
@@ -741,7 +741,7 @@ static int locations_figure(figs *f, const char *name, const char *title, const 
 	if ((rc = gp_text_open(&g, err)))
 		return rc;
 	/* the note on intervals: a location never reached is drawn without one */
-	char full[1600];
+	char full[2200];
 	double zero[3];
 	fraction(runs[0], 0, zero);
 	snprintf(full, sizeof full,
@@ -854,15 +854,25 @@ static int paths_read(const char *dir, lat_job *j, bsim_error *err)
 	return rc;
 }
 
+/* The run's header and group g's values on one line, for a title. */
+static void group_label(const fsum *s, int g, char *buf, size_t size)
+{
+	char l[512];
+	fsum_label(s, g, l, sizeof l);
+	for (char *c = l; *c; c++)
+		*c = *c == '\n' ? ' ' : *c;
+	snprintf(buf, size, "%s%s%s", s->header, *l ? "; " : "", l);
+}
+
 /* Both figures of group g. */
 static int lat_group(figs *f, lat_job *j, int g, bsim_error *err)
 {
 	const fsum *s = j->s;
 	const flat *a = &j->l.g[g];
-	char label[512], title[800], name[64];
-	fsum_label(s, g, label, sizeof label);
+	char label[1300], title[1500], name[64];
+	group_label(s, g, label, sizeof label);
 	snprintf(name, sizeof name, "final_locations_g%03d", g);
-	snprintf(title, sizeof title, "where the trials of group %d ended: %s", g, label);
+	snprintf(title, sizeof title, "where the trials of group %d ended\n%s", g, label);
 	const char *run_label = *s->backend ? s->backend : "trials";
 	int rc = locations_figure(f, name, title, &a, &run_label, 1, err);
 	if (rc || !j->have_e)
@@ -967,10 +977,10 @@ int figs_lattice_compare(figs *f, const char *const dirs[2], const char *const l
 			        dirs[0], dirs[1], g);
 			break;
 		}
-		char label[512], title[1200], name[64];
-		fsum_label(s, g, label, sizeof label);
+		char label[1300], title[1900], name[64];
+		group_label(s, g, label, sizeof label);
 		snprintf(title, sizeof title,
-		         "where the trials of group %d ended, %s against %s on the same schedules: "
+		         "where the trials of group %d ended, %s against %s on the same schedules\n"
 		         "%s\n%s",
 		         g, labels[0], labels[1], label, tests[g]);
 		snprintf(name, sizeof name, "final_locations_g%03d", g);

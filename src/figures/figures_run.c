@@ -13,6 +13,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "beamsim/key_names.h"
 #include "figures/figures_kinds.h"
 #include "figures/figures_paths.h"
 #include "figures/figures_toolkit.h"
@@ -77,10 +78,63 @@ static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *ty
 	return rc;
 }
 
+/* "thesis backend; R_m = 20 N": the run's backend and its --set values from
+ * run.json, in plain text (gp 0) or gnuplot's enhanced text (gp 1); no
+ * single quote, so it goes inside a quoted gnuplot string as it is. */
+static void run_header(const char *dir, int gp, char *buf, size_t size)
+{
+	char path[BSIM_PATH_MAX];
+	snprintf(path, sizeof path, "%s/run.json", dir);
+	buf[0] = '\0';
+	ydoc d;
+	bsim_error ignore;
+	if (ydoc_load_own(&d, path, &ignore) != BSIM_OK)
+		return;
+	struct fy_node *root = fy_document_root(d.fyd);
+	struct fy_node *b = ydoc_lookup(root, "backend"), *set = ydoc_lookup(root, "set");
+	size_t len = 0;
+	const char *bt = b && fy_node_is_scalar(b) ? fy_node_get_scalar(b, &len) : NULL;
+	int n = snprintf(buf, size, "%.*s backend", bt ? (int)len : 0, bt ? bt : "?");
+	size_t k = n > 0 ? (size_t)n : 0;
+	void *it = NULL;
+	struct fy_node_pair *p;
+	int i = 0;
+	while (set && fy_node_is_mapping(set) && (p = fy_node_mapping_iterate(set, &it)) &&
+	       k < size) {
+		struct fy_node *kn = fy_node_pair_key(p);
+		size_t kl = 0;
+		const char *kt = kn && fy_node_is_scalar(kn) ? fy_node_get_scalar(kn, &kl) : NULL;
+		char *key = kt ? strndup(kt, kl) : NULL;
+		char *val = ydoc_flow_text(fy_node_pair_value(p));
+		if (key && val) {
+			char v[64], kv[300];
+			size_t j = 0;
+			/* the value's characters that enhanced text would read */
+			for (const char *c = val; *c && j + 2 < sizeof v; c++) {
+				if (*c == '\'' || *c == '"')
+					continue;
+				if (gp && strchr("_^{}@&~\\", *c))
+					v[j++] = '\\';
+				v[j++] = *c;
+			}
+			v[j] = '\0';
+			if (gp)
+				bsim_key_value(key, v, 1, kv, sizeof kv);
+			else
+				figs_key_value(key, v, kv, sizeof kv);
+			n = snprintf(buf + k, size - k, "%s%s", i++ ? ", " : "; ", kv);
+			k += n > 0 ? (size_t)n : 0;
+		}
+		free(key);
+		free(val);
+	}
+	ydoc_free(&d);
+}
+
 /* ---- Fig. 2.2 -------------------------------------------------------------------- */
 
-static int random_force(figs *f, const csv_table *t, const char *path, const bsim_scene *s,
-                        bsim_error *err)
+static int random_force(figs *f, const char *hdr, const csv_table *t, const char *path,
+                        const bsim_scene *s, bsim_error *err)
 {
 	const double rm = s->effects.random_magnitude, freq = s->effects.random_frequency;
 	if (!s->effects.has_random_force || rm <= 0.0) {
@@ -142,7 +196,7 @@ static int random_force(figs *f, const csv_table *t, const char *path, const bsi
 		return rc;
 	fprintf(g.f,
 	        "set multiplot layout 2,1 title 'random force, R_m = %g N, a draw every %g s: "
-	        "%ld draws, mean %.3g N, standard deviation %.3g N'\n"
+	        "%ld draws, mean %.3g N, standard deviation %.3g N'.\"\\n\".'%s'\n"
 	        "Rm = %.17g\n"
 	        "normal(x) = exp(-0.5 * (x / Rm)**2) / (Rm * sqrt(2 * pi))\n"
 	        "set title '(a) distribution of the draws against N(0, R_m^2)'\n"
@@ -157,7 +211,7 @@ static int random_force(figs *f, const csv_table *t, const char *path, const bsi
 	        "set yrange [%g:%g]\nunset key\nset grid\n"
 	        "plot 'random_force.dat' index 1 using 1:2 with steps lw 1.2 lc rgb '%s'\n"
 	        "unset multiplot\n",
-	        rm, 1.0 / freq, draws, mean, sd, rm, lo, -lo, FIG_SKY, width, FIG_SKY, FIG_RED,
+	        rm, 1.0 / freq, draws, mean, sd, hdr, rm, lo, -lo, FIG_SKY, width, FIG_SKY, FIG_RED,
 	        -3.5 * rm, 3.5 * rm, FIG_BLUE);
 	char *body = gp_text_take(&g);
 	rc = body ? figs_render(f, "random_force", 900, 800, body, err)
@@ -170,6 +224,8 @@ static int random_force(figs *f, const csv_table *t, const char *path, const bsi
 
 static int ledger(figs *f, const char *dir, bsim_error *err)
 {
+	char hdr[600];
+	run_header(dir, 1, hdr, sizeof hdr);
 	char path[BSIM_PATH_MAX], file[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/ledger.csv", dir);
 	csv_table t;
@@ -224,7 +280,7 @@ static int ledger(figs *f, const char *dir, bsim_error *err)
 		return rc;
 	fprintf(g.f,
 	        "set multiplot layout 3,1 title 'energy ledger: dE = W_{prop} + W_{rand} - "
-	        "damper - impact - contact - correction + residual'\n"
+	        "damper - impact - contact - correction + residual'.\"\\n\".'%s'\n"
 	        "set xrange [0:%g]\nset grid\nset key outside right top font ',9'\n"
 	        "set lmargin 12\nset rmargin 28\n"
 	        "set title '(a) the energy of body and beams'\nset ylabel 'J'\nunset xlabel\n"
@@ -245,7 +301,7 @@ static int ledger(figs *f, const char *dir, bsim_error *err)
 	        "set xlabel 't (s)'\nset format y '%%.1e'\n"
 	        "plot 'ledger.dat' using 1:13 with lines lw 1.5 lc rgb '%s' title 'residual'\n"
 	        "unset multiplot\n",
-	        t_end > 0 ? t_end : 1.0, FIG_ORANGE, FIG_GREEN, FIG_BLACK, FIG_BLUE, FIG_SKY,
+	        hdr, t_end > 0 ? t_end : 1.0, FIG_ORANGE, FIG_GREEN, FIG_BLACK, FIG_BLUE, FIG_SKY,
 	        FIG_RED, FIG_PURPLE, FIG_YELLOW, FIG_DKGREY, FIG_BLACK, FIG_ORANGE, worst, FIG_RED);
 	char *body = gp_text_take(&g);
 	rc = body ? figs_render(f, "ledger", 1000, 900, body, err)
@@ -278,7 +334,10 @@ int figs_run(figs *f, const char *dir, bsim_error *err)
 	csv_table t;
 	rc = csv_table_read(path, &t, err);
 	if (!rc) {
-		rc = random_force(f, &t, path, &scene, err);
+		char hdr[600], plain[600];
+		run_header(dir, 1, hdr, sizeof hdr);
+		run_header(dir, 0, plain, sizeof plain);
+		rc = random_force(f, hdr, &t, path, &scene, err);
 		if (!rc)
 			rc = ledger(f, dir, err);
 		fpaths ps = {0};
@@ -290,11 +349,11 @@ int figs_run(figs *f, const char *dir, bsim_error *err)
 			                    ps.n_beams, scene.n_beams);
 		if (!rc && ps.n > 0) {
 			ps.p[0].cls = fpath_class(outcome, type);
-			char title[400];
-			snprintf(title, sizeof title, "%s: one trial, %s%s%s, over its landscape",
-			         scene.name, outcome,
-			         *type && strcmp(type, "none") ? ", type " : "",
-			         strcmp(type, "none") ? type : "");
+			char title[1100];
+			snprintf(title, sizeof title,
+			         "%s: one trial, %s%s%s, over its landscape\n%s", scene.name,
+			         outcome, *type && strcmp(type, "none") ? ", type " : "",
+			         strcmp(type, "none") ? type : "", plain);
 			rc = figs_over_landscape(f, "landscape_path", title, &scene, ps.p, 1, ~0u,
 			                         err);
 		}

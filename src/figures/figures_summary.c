@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "figures/figures_summary.h"
+#include "beamsim/limits.h"
 #include "util/yaml_doc.h"
 
 static int text_number(const char *s, double *x)
@@ -146,6 +147,9 @@ static int read_group(const ydoc *d, struct fy_node *gn, int g, fsum *s, bsim_er
 	if (!rc && (!lo || !hi || ydoc_number(lo, &G->lo) || ydoc_number(hi, &G->hi)))
 		rc = ydoc_expected(d, ydoc_lookup(gn, "ci95"), gn, where, "[lo, hi]", err);
 	G->selected = 1;
+	struct fy_node *det = ydoc_lookup(gn, "deterministic");
+	const char *dt = det ? ydoc_plain(det) : NULL;
+	G->deterministic = dt && strcmp(dt, "true") == 0;
 	return rc;
 }
 
@@ -269,8 +273,24 @@ static char *selection_text(const figs *f, const fsum *s)
 	return text;
 }
 
+/* Each axis's number of values among the selected groups. */
+static void count_selected(fsum *s)
+{
+	for (int a = 0; a < s->n_axes; a++) {
+		fsum_axis *ax = &s->axes[a];
+		ax->n_selected = 0;
+		for (int i = 0; i < ax->n_values; i++) {
+			int used = 0;
+			for (int g = 0; g < s->n_groups && !used; g++)
+				used = s->g[g].selected && s->g[g].idx[a] == i;
+			ax->n_selected += used;
+		}
+	}
+}
+
 int fsum_select(const figs *f, fsum *s, bsim_error *err)
 {
+	count_selected(s);
 	for (int i = 0; i < f->def->n_select; i++) {
 		const bsim_override *o = &f->def->select[i];
 		int a = 0;
@@ -310,6 +330,7 @@ int fsum_select(const figs *f, fsum *s, bsim_error *err)
 		if (rc)
 			return rc;
 	}
+	count_selected(s);
 	/* once: a comparison's sides are selected the same way */
 	if (f->def->n_select > 0 && !f->res->selection &&
 	    !(f->res->selection = selection_text(f, s)))
@@ -317,19 +338,89 @@ int fsum_select(const figs *f, fsum *s, bsim_error *err)
 	return BSIM_OK;
 }
 
+/* Records key = value for the header; a later value of a key replaces
+ * the earlier one (--set after the file's set:). */
+static void fixed_add(fsum *s, const char *key, const char *value)
+{
+	int i = 0;
+	while (i < s->n_fixed && strcmp(s->fixed_key[i], key) != 0)
+		i++;
+	if (i == 16)
+		return;
+	snprintf(s->fixed_key[i], sizeof s->fixed_key[0], "%s", key);
+	snprintf(s->fixed_value[i], sizeof s->fixed_value[0], "%s", value);
+	if (i == s->n_fixed)
+		s->n_fixed++;
+}
+
+int fsum_fixed_number(const fsum *s, const char *key, double *x)
+{
+	for (int i = 0; i < s->n_fixed; i++)
+		if (strcmp(s->fixed_key[i], key) == 0)
+			return text_number(s->fixed_value[i], x);
+	return 0;
+}
+
+void fsum_header(fsum *s, const char *inputs, const char *who)
+{
+	s->n_fixed = 0;
+	char path[BSIM_PATH_MAX];
+	snprintf(path, sizeof path, "%s/experiment.yaml", inputs ? inputs : "");
+	ydoc d;
+	bsim_error ignore;
+	if (inputs && ydoc_load_own(&d, path, &ignore) == BSIM_OK) {
+		struct fy_node *set = ydoc_lookup(fy_document_root(d.fyd), "set");
+		void *it = NULL;
+		struct fy_node_pair *p;
+		while (set && fy_node_is_mapping(set) &&
+		       (p = fy_node_mapping_iterate(set, &it)) != NULL) {
+			char *key = scalar_dup(fy_node_pair_key(p));
+			char *val = ydoc_flow_text(fy_node_pair_value(p));
+			if (key && val)
+				fixed_add(s, key, val);
+			free(key);
+			free(val);
+		}
+		ydoc_free(&d);
+	}
+	for (int a = 0; a < s->n_axes; a++) {
+		if (s->axes[a].n_selected != 1)
+			continue;
+		for (int g = 0; g < s->n_groups; g++)
+			if (s->g[g].selected) {
+				fixed_add(s, s->axes[a].key, s->axes[a].values[s->g[g].idx[a]]);
+				break;
+			}
+	}
+	int n = snprintf(s->header, sizeof s->header, "%s", who);
+	size_t k = n > 0 ? (size_t)n : 0;
+	for (int i = 0; i < s->n_fixed && k < sizeof s->header; i++) {
+		char kv[200];
+		figs_key_value(s->fixed_key[i], s->fixed_value[i], kv, sizeof kv);
+		n = snprintf(s->header + k, sizeof s->header - k, "%s%s", i ? ", " : "; ", kv);
+		k += n > 0 ? (size_t)n : 0;
+	}
+}
+
 void fsum_label(const fsum *s, int g, char *buf, size_t size)
 {
 	size_t k = 0;
+	int shown = 0;
 	buf[0] = '\0';
 	for (int a = 0; a < s->n_axes && k < size; a++) {
+		if (s->axes[a].n_selected == 1)
+			continue;
+		char kv[200];
+		figs_key_value(s->axes[a].key, s->axes[a].values[s->g[g].idx[a]], kv, sizeof kv);
 		/* a line of its own from the third on, to fit a figure's width */
-		int n = snprintf(buf + k, size - k, "%s%s = %s",
-		                 a == 0  ? ""
-		                 : a % 2 ? ", "
-		                         : "\n",
-		                 s->axes[a].key, s->axes[a].values[s->g[g].idx[a]]);
+		int n = snprintf(buf + k, size - k, "%s%s",
+		                 shown == 0  ? ""
+		                 : shown % 2 ? ", "
+		                             : "\n",
+		                 kv);
 		if (n < 0)
 			break;
 		k += (size_t)n;
+		shown++;
 	}
 }

@@ -138,16 +138,20 @@ int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 	gp_text g;
 	if ((rc = gp_text_open(&g, err)))
 		return rc;
+	char title[900];
+	snprintf(title, sizeof title, "time to leave the gate, %d trials per group\n%s",
+	         s->trials_per_group, s->header);
+	fputs("set multiplot layout 1,2 title ", g.f);
+	gp_str(g.f, title);
 	fprintf(g.f,
-	        "set multiplot layout 1,2 title 'time to leave the gate, %d trials per group' "
-	        "noenhanced\n"
+	        " noenhanced\n"
 	        "set grid\nset style fill transparent solid 0.12 noborder\n"
 	        "set yrange [0:1]\nset xrange [0:%.6g]\nset key top right font ',9' "
 	        "noenhanced\n"
 	        "set arrow 1 from %.6g, graph 0 to %.6g, graph 1 nohead dt 3 lc rgb '%s'\n"
 	        "set title 'still in the gate, S(t) (Kaplan-Meier, 95%% Greenwood band)'\n"
 	        "set xlabel 't (s)'\nset ylabel 'S(t)'\nplot ",
-	        s->trials_per_group, horizon * 1.02, horizon, horizon, FIG_GREY);
+	        horizon * 1.02, horizon, horizon, FIG_GREY);
 	for (int i = 0; i < n_shown; i++) {
 		/* the key's one line: every axis, ", " where the label breaks */
 		char text[300], label[450];

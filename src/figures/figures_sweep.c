@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 
 #include "beamsim/experiment.h"
+#include "beamsim/key_names.h"
 #include "store/mat.h"
 #include "beamsim/stats.h"
 #include "figures/figures_kinds.h"
@@ -80,17 +81,19 @@ static int panels(const fsum *s, const active *a, int skip0, int skip1)
 	return n;
 }
 
-/* "key = value, ..." of the other axes of group g, "" if there are none. */
+/* "F_prop = 8 N, ..." of the other axes of group g with more than one
+ * value (a single value is in the figure's title), "" if there are none. */
 static void panel_label(const fsum *s, const active *a, int g, int skip0, int skip1, char *buf,
                         size_t size)
 {
 	size_t k = 0;
 	buf[0] = '\0';
 	for (int ax = 0; ax < s->n_axes && k < size; ax++) {
-		if (ax == skip0 || ax == skip1 || a->n[ax] < 1)
+		if (ax == skip0 || ax == skip1 || a->n[ax] < 2)
 			continue;
-		int n = snprintf(buf + k, size - k, "%s%s = %s", k ? ", " : "", s->axes[ax].key,
-		                 s->axes[ax].values[s->g[g].idx[ax]]);
+		char kv[200];
+		figs_key_value(s->axes[ax].key, s->axes[ax].values[s->g[g].idx[ax]], kv, sizeof kv);
+		int n = snprintf(buf + k, size - k, "%s%s", k ? ", " : "", kv);
 		k += n > 0 ? (size_t)n : 0;
 	}
 }
@@ -104,26 +107,62 @@ static void layout(int n, int *rows, int *cols)
 	*rows = (n + *cols - 1) / *cols;
 }
 
-/* gnuplot tics naming each selected value of an axis at its position. */
-static void tics(FILE *f, const char *which, const fsum_axis *ax, const int *pos)
+/* gnuplot tics naming each selected value of an axis at its position;
+ * the length of the longest, in characters. */
+static int tics(FILE *f, const char *which, const fsum_axis *ax, const int *pos)
 {
 	fprintf(f, "set %stics (", which);
-	int k = 0;
+	int k = 0, longest = 1;
 	for (int i = 0; i < ax->n_values; i++)
 		if (pos[i] >= 0) {
 			fputs(k++ ? ", " : "", f);
 			gp_str(f, ax->values[i]);
 			fprintf(f, " %d", pos[i]);
+			int n = (int)strlen(ax->values[i]);
+			longest = n > longest ? n : longest;
 		}
 	fputs(") noenhanced\n", f);
+	return longest;
+}
+
+/* The widest line of text, in characters. */
+static int widest_line(const char *t)
+{
+	int w = 0;
+	while (*t) {
+		int n = (int)strcspn(t, "\n");
+		w = n > w ? n : w;
+		t += n + (t[n] == '\n');
+	}
+	return w;
+}
+
+/* The axes drawn along: the first two with more than one selected value,
+ * -1 for none. */
+static void axes_along(const fsum *s, const active *a, int *ax0, int *ax1)
+{
+	*ax0 = *ax1 = -1;
+	for (int ax = 0; ax < s->n_axes; ax++)
+		if (a->n[ax] >= 2) {
+			if (*ax0 < 0)
+				*ax0 = ax;
+			else if (*ax1 < 0)
+				*ax1 = ax;
+		}
 }
 
 /* ---- Fig. 3.1 -------------------------------------------------------------------- */
 
+/* Pixels of a text of n characters at the figures' 11 pt font. */
+#define TEXT_PX(n) (15 * (n) / 2 + 60)
+
 static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_error *err)
 {
-	const int ax0 = s->n_axes > 0 ? 0 : -1, ax1 = s->n_axes > 1 ? 1 : -1;
-	const int n0 = ax0 >= 0 ? a->n[0] : 1, n1 = ax1 >= 0 ? a->n[1] : 1;
+	/* drawn along the axes with several values; one with a single value
+	 * is named in the title instead */
+	int ax0, ax1;
+	axes_along(s, a, &ax0, &ax1);
+	const int n0 = ax0 >= 0 ? a->n[ax0] : 1, n1 = ax1 >= 0 ? a->n[ax1] : 1;
 	const int np = panels(s, a, ax0, ax1);
 	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
@@ -148,8 +187,8 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 			if (first[p] < 0)
 				first[p] = g;
 			fprintf(o.f, "%d %d %.6g %.6g %.6g %d %d %d\n",
-			        ax0 >= 0 ? a->pos[0][G->idx[0]] : 0,
-			        ax1 >= 0 ? a->pos[1][G->idx[1]] : 0, G->p, G->lo, G->hi,
+			        ax0 >= 0 ? a->pos[ax0][G->idx[ax0]] : 0,
+			        ax1 >= 0 ? a->pos[ax1][G->idx[ax1]] : 0, G->p, G->lo, G->hi,
 			        G->traversed, G->trials, g);
 		}
 	}
@@ -164,36 +203,57 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	}
 	int rows, cols;
 	layout(np, &rows, &cols);
-	int pw = 140 + 95 * n0, ph = 110 + 62 * n1;
-	fprintf(g.f,
-	        "set multiplot layout %d,%d title 'p_{traverse}%s of %d trials per group, "
-	        "[95%% Wilson interval]'\n",
-	        rows, cols, lattice ? " (reached the end of the lattice)" : "",
-	        s->trials_per_group);
-	fputs("set palette defined (0 '#F7FBFF', 0.5 '#6BAED6', 1 '#08306B')\n"
-	      "set cbrange [0:1]\nset cblabel 'p_{traverse}'\n",
+	char title[1000];
+	snprintf(title, sizeof title,
+	         "traversal probability p_traverse%s, %d trials per group, [95%% Wilson "
+	         "interval]\n%s",
+	         lattice ? " (reached the end of the lattice)" : "", s->trials_per_group,
+	         s->header);
+	fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
+	gp_str(g.f, title);
+	fputs(" noenhanced\n"
+	      "set palette defined (0 '#F7FBFF', 0.5 '#6BAED6', 1 '#08306B')\n"
+	      "set cbrange [0:1]\nset cblabel 'p_{traverse}'\nset cbtics 0.2\n",
 	      g.f);
 	fprintf(g.f, "set xrange [-0.5:%g]\nset yrange [-0.5:%g]\n", n0 - 0.5, n1 - 0.5);
+	/* a cell fits its two lines of numbers and its tick label; the panel
+	 * its y labels, the colour box and its title */
+	int xtic = 4, ytic = 4, xlab = 0, ylab = 0;
+	char label[400];
 	if (ax0 >= 0) {
-		tics(g.f, "x", &s->axes[0], a->pos[0]);
+		xtic = tics(g.f, "x", &s->axes[ax0], a->pos[ax0]);
 		fputs("set xlabel ", g.f);
-		gp_str(g.f, s->axes[0].key);
-		fputs(" noenhanced\n", g.f);
+		gp_key_label(g.f, s->axes[ax0].key);
+		fputs("\n", g.f);
+		xlab = bsim_key_label(s->axes[ax0].key, 0, label, sizeof label);
 	} else {
 		fputs("unset xtics\n", g.f);
 	}
 	if (ax1 >= 0) {
-		tics(g.f, "y", &s->axes[1], a->pos[1]);
+		ytic = tics(g.f, "y", &s->axes[ax1], a->pos[ax1]);
 		fputs("set ylabel ", g.f);
-		gp_str(g.f, s->axes[1].key);
-		fputs(" noenhanced\n", g.f);
+		gp_key_label(g.f, s->axes[ax1].key);
+		fputs("\n", g.f);
+		ylab = 1;
 	} else {
 		fputs("unset ytics\n", g.f);
 	}
 	fputs("set tics out nomirror\n", g.f);
+	if (ax0 < 0)
+		fputs("unset xtics\n", g.f);
+	if (ax1 < 0)
+		fputs("unset ytics\n", g.f);
+	const int cell_w = xtic * 7 + 16 > 95 ? xtic * 7 + 16 : 95, cell_h = 62;
+	int pw = 40 + (ylab ? 30 : 0) + 7 * ytic + cell_w * n0 + 130;
+	int ph = 120 + cell_h * n1;
+	if (pw < TEXT_PX(xlab) + 170)
+		pw = TEXT_PX(xlab) + 170;
+	if (ph < 300)
+		ph = 300;
 	for (int p = 0; p < np; p++) {
-		char label[512];
 		panel_label(s, a, first[p], ax0, ax1, label, sizeof label);
+		if (pw < TEXT_PX(widest_line(label)) + 150)
+			pw = TEXT_PX(widest_line(label)) + 150;
 		fputs("set title ", g.f);
 		gp_str(g.f, label);
 		fprintf(g.f,
@@ -207,8 +267,11 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	}
 	fputs("unset multiplot\n", g.f);
 	free(first);
+	int W = pw * cols, H = ph * rows + 60;
+	if (W < TEXT_PX(widest_line(title)))
+		W = TEXT_PX(widest_line(title));
 	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, "p_traverse", pw * cols, ph * rows + 40, body, err)
+	rc = body ? figs_render(f, "p_traverse", W, H, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -260,7 +323,8 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 				const double x = A->numeric ? A->x[i] : (double)a->pos[ax][i];
 				if (lattice) {
 					/* a group without random force: points */
-					const int point = G->lo == G->hi && G->trials > 1;
+					const int point = G->deterministic ||
+					                  (G->lo == G->hi && G->trials > 1);
 					bsim_stats_wilson(G->side_exit, G->trials, BSIM_STATS_Z95,
 					                  &ll, &lh);
 					bsim_stats_wilson(G->stuck, G->trials, BSIM_STATS_Z95, &rl,
@@ -278,6 +342,10 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 				}
 				bsim_stats_wilson(G->left, G->trials, BSIM_STATS_Z95, &ll, &lh);
 				bsim_stats_wilson(G->right, G->trials, BSIM_STATS_Z95, &rl, &rh);
+				if (G->deterministic) { /* one trial: its outcome, no interval */
+					ll = lh = G->left / n;
+					rl = rh = G->right / n;
+				}
 				fprintf(o.f,
 				        "%.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g %.6g "
 				        "%.6g\n",
@@ -297,40 +365,78 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 	}
 	/* The panels and, in the cell after them, the key; many panels get
 	 * smaller ones, so that the image stays well under 1 MB. A panel is
-	 * titled by the values of the other axes, named once in the title. */
+	 * titled by the values of the other axes, named once in the title. A
+	 * single panel has its key beside it in a narrower cell. */
 	int rows, cols;
 	layout(np, &rows, &cols);
-	if (rows * cols == np)
+	if (rows * cols == np && np > 1)
 		layout(np + 1, &rows, &cols);
 	const int pw = np > 12 ? 400 : 520, ph = np > 12 ? 300 : 380;
-	const int W = pw * cols, H = ph * rows + 80;
-	fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
-	char title[600], others[400] = "";
+	const int key_w = lattice ? 230 : 330;
+	int W = np == 1 ? 640 + key_w : pw * cols, H = np == 1 ? 560 : ph * rows + 90;
+	char title[2000], others[600] = "", axis_label[300];
 	size_t L = 0;
 	for (int oa = 0; oa < s->n_axes && L < sizeof others; oa++)
-		if (oa != ax && a->n[oa] > 0) {
-			int w = snprintf(others + L, sizeof others - L, "%s%s", L ? ", " : "",
-			                 s->axes[oa].key);
+		if (oa != ax && a->n[oa] > 1) {
+			char lab[300];
+			bsim_key_label(s->axes[oa].key, 0, lab, sizeof lab);
+			int w = snprintf(others + L, sizeof others - L, "%s%s", L ? ", " : "", lab);
 			L += w > 0 ? (size_t)w : 0;
 		}
-	snprintf(title, sizeof title, "%s against %s, %d trials per group, 95%% Wilson bands%s%s",
-	         lattice ? "where the trials ended" : "traversal", A->key, s->trials_per_group,
-	         L ? "\npanels: " : "", others);
+	bsim_key_label(A->key, 0, axis_label, sizeof axis_label);
+	snprintf(title, sizeof title,
+	         "%s against %s, %d trials per group, 95%% Wilson bands\n%s%s%s",
+	         lattice ? "where the trials ended" : "traversal", axis_label, s->trials_per_group,
+	         s->header, L ? "\npanels: " : "", others);
+	if (W < TEXT_PX(widest_line(title)))
+		W = TEXT_PX(widest_line(title));
+	/* a single panel placed by hand: below the title's lines */
+	int title_lines = 1;
+	for (const char *c = title; *c; c++)
+		title_lines += *c == '\n';
+	const double top = 1.0 - (18.0 * title_lines + 14.0) / H;
+	if (np == 1)
+		fputs("set multiplot title ", g.f);
+	else
+		fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
 	gp_str(g.f, title);
 	fputs(" noenhanced\nset yrange [0:1]\nset ylabel 'fraction of trials'\nset xlabel ", g.f);
-	gp_str(g.f, A->key);
-	fputs(" noenhanced\nset grid\nset style fill transparent solid 0.15 noborder\n"
+	gp_key_label(g.f, A->key);
+	fputs("\nset grid\nset style fill transparent solid 0.15 noborder\n"
 	      "unset key\n",
 	      g.f);
+	/* k_1 against a fixed k_2 (or the other way round): the essay's
+	 * stiffness ratio k_1/k_2 (H2, Fig. 3.4) on the top axis */
+	double other;
+	int ratio = 0;
+	if (A->numeric && strcmp(A->key, "beams.0.stiffness") == 0 &&
+	    fsum_fixed_number(s, "beams.1.stiffness", &other) && other > 0) {
+		fprintf(g.f, "set link x2 via x/%.17g inverse x*%.17g\n", other, other);
+		ratio = 1;
+	} else if (A->numeric && strcmp(A->key, "beams.1.stiffness") == 0 &&
+	           fsum_fixed_number(s, "beams.0.stiffness", &other) && other > 0) {
+		fprintf(g.f, "set link x2 via %.17g/x inverse %.17g/x\n", other, other);
+		ratio = 1;
+	}
+	if (ratio)
+		fputs("set x2tics nomirror\nset xtics nomirror\n"
+		      "set x2label 'stiffness ratio k_{1}/k_{2}' enhanced\n",
+		      g.f);
+	if (np == 1)
+		fprintf(g.f, "set origin 0,0\nset size %.4f,%.4f\n", 640.0 / W, top);
 	if (!A->numeric)
 		tics(g.f, "x", A, a->pos[ax]);
 	for (int p = 0; p < np; p++) {
 		char label[512] = "";
 		size_t k = 0;
 		for (int oa = 0; oa < s->n_axes && k < sizeof label; oa++)
-			if (oa != ax && a->n[oa] > 0) {
+			if (oa != ax && a->n[oa] > 1) {
+				char kv[200];
+				figs_key_value(s->axes[oa].key,
+				               s->axes[oa].values[s->g[first[p]].idx[oa]], kv,
+				               sizeof kv);
 				int w = snprintf(label + k, sizeof label - k, "%s%s", k ? ", " : "",
-				                 s->axes[oa].values[s->g[first[p]].idx[oa]]);
+				                 kv);
 				k += w > 0 ? (size_t)w : 0;
 			}
 		fputs("set title ", g.f);
@@ -365,6 +471,10 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 		        file, p, FIG_BLACK, p, FIG_BLUE, p, FIG_RED, p, FIG_BLACK, p, FIG_BLUE, p,
 		        FIG_RED, p, FIG_BLUE, p, FIG_RED);
 	}
+	if (np == 1)
+		fprintf(g.f, "set origin %.4f,0\nset size %.4f,%.4f\n", 640.0 / W, 1.0 - 640.0 / W,
+		        top);
+	fputs("unset link x2\nunset x2tics\nunset x2label\n", g.f);
 	if (lattice)
 		fprintf(g.f,
 		        "# the key, in a cell of its own\n"
@@ -467,20 +577,36 @@ static int group_figures(figs *f, traj_job *j, int g, bsim_error *err)
 	int rc = bsim_experiment_group_scene(j->e, g, NULL, 0, &scene, err);
 	if (rc)
 		return rc;
-	char label[512], title[700], name[64];
+	char label[512], title[1400], name[64];
 	fsum_label(j->s, g, label, sizeof label);
 	const fpath *p = j->paths.p + j->first[g];
-	int n = j->count[g], trav = 0;
+	/* a group without random force ran one trial, whose rows fill the
+	 * group: one path, not the first n of many */
+	const int det = j->s->g[g].deterministic;
+	int n = det ? 1 : j->count[g], trav = 0;
 	for (int i = 0; i < n; i++)
 		trav += p[i].cls >= FPATH_NONE;
-	snprintf(title, sizeof title, "group %d, the first %d of %d trials\n%s", g, n,
-	         j->s->g[g].trials, label);
+	if (det)
+		snprintf(title, sizeof title,
+		         "group %d: one deterministic trial (no random force)\n%s%s%s", g,
+		         j->s->header, *label ? "\n" : "", label);
+	else
+		snprintf(title, sizeof title, "group %d, the first %d of %d trials\n%s%s%s", g, n,
+		         j->s->g[g].trials, j->s->header, *label ? "\n" : "", label);
 	snprintf(name, sizeof name, "trajectories_g%03d", g);
 	rc = figs_bundle(f, name, title, &scene, p, n, err);
 	if (!rc && trav > 0) {
-		snprintf(title, sizeof title,
-		         "group %d, the %d traversed of the first %d trials over the landscape\n%s",
-		         g, trav, n, label);
+		if (det)
+			snprintf(title, sizeof title,
+			         "group %d: one deterministic trial (no random force), traversed, "
+			         "over "
+			         "the landscape\n%s%s%s",
+			         g, j->s->header, *label ? "\n" : "", label);
+		else
+			snprintf(title, sizeof title,
+			         "group %d, the %d traversed of the first %d trials over the "
+			         "landscape\n%s%s%s",
+			         g, trav, n, j->s->header, *label ? "\n" : "", label);
 		snprintf(name, sizeof name, "landscape_g%03d", g);
 		rc = figs_over_landscape(f, name, title, &scene, p, n,
 		                         1u << FPATH_LEFT | 1u << FPATH_RIGHT | 1u << FPATH_NONE,
@@ -648,6 +774,11 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 		rc = fsum_select(f, &s, err);
 	if (!rc)
 		rc = active_build(&s, &a, err);
+	if (!rc) {
+		char who[128];
+		snprintf(who, sizeof who, "%s backend", s.backend);
+		fsum_header(&s, inputs, who);
+	}
 	/* a lattice gets its own trajectory figures (figures_lattice.c) */
 	lat_job *lat = NULL;
 	if (!rc && figs_is_lattice(dir))

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/key_names.h"
 #include "util/figure.h"
 #include "beamsim/limits.h"
 
@@ -120,4 +121,17 @@ void gp_str(FILE *f, const char *s)
 			fputc(*s, f);
 	}
 	fputc('\'', f);
+}
+
+void gp_key_label(FILE *f, const char *key)
+{
+	char buf[400];
+	bsim_key_label(key, 1, buf, sizeof buf);
+	gp_str(f, buf);
+	fputs(" enhanced", f);
+}
+
+void figs_key_value(const char *key, const char *value, char *buf, size_t size)
+{
+	bsim_key_value(key, value, 0, buf, size);
 }

@@ -79,4 +79,12 @@ char *gp_text_take(gp_text *t);
  * "^" stay characters. */
 void gp_str(FILE *f, const char *s);
 
+/* Display names of scene keys (beamsim/key_names.h). */
+
+/* The axis label of a scene key ("propulsive force F_{prop} (N)"), quoted
+ * and followed by " enhanced": written after "set xlabel ". */
+void gp_key_label(FILE *f, const char *key);
+/* "F_prop = 8 N", plain text for a title or key drawn noenhanced. */
+void figs_key_value(const char *key, const char *value, char *buf, size_t size);
+
 #endif

@@ -107,7 +107,7 @@ int bsim_key_name_find(const char *key, bsim_key_name *out)
 	int n;
 	const key_row *r = beam_row(key, &n);
 	if (r) {
-		char who[16], name[96], symbol[32], gp[48];
+		char who[24], name[96], symbol[32], gp[48];
 		if (n < 2)
 			snprintf(who, sizeof who, "%s", n == 0 ? "left beam" : "right beam");
 		else

@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "store/session.h"
+#include "store/index_html.h"
 #include "util/file_read.h"
 
 #include <stdio.h>
@@ -77,8 +78,11 @@ int bsim_session_close(bsim_session *s, int rc, const char *command, int *kept, 
 	bsim_error e;
 	int keep = 0;
 	if (rc == BSIM_OK && s->od) {
-		int crc = s->add ? bsim_outdir_add(s->od, command, &e)
-		                 : bsim_outdir_commit(s->od, command, &e);
+		/* a directory with figures gets its page, committed with them */
+		int crc = bsim_index_html_write(s->stage, s->dir, s->add, command, &e);
+		if (crc == BSIM_OK)
+			crc = s->add ? bsim_outdir_add(s->od, command, &e)
+			             : bsim_outdir_commit(s->od, command, &e);
 		if (crc != BSIM_OK) {
 			*err = e;
 			rc = BSIM_EFAIL;

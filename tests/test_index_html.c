@@ -1,0 +1,198 @@
+/* index.html of output directories with figures (store/index_html.h).
+ *
+ * Truths: the page shows every .png under the directory, found here by an
+ * independent walk of the directory; a real browser (headless chromium)
+ * loads the page and every image on it (the page's script counts the
+ * images with a natural width in <body data-images="LOADED/ALL">); every
+ * figure has a caption of its own, not the catch-all; manifest.json lists
+ * the page; a directory without figures gets no page. */
+#define _POSIX_C_SOURCE 200809L
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "beamsim/key_names.h"
+#include "store/index_html.h"
+#include "support.h"
+
+/* The .png files under root (relative paths, at most max). */
+static int pngs(const char *root, const char *rel, char names[][256], int n, int max)
+{
+	char path[1400];
+	snprintf(path, sizeof path, "%s%s%s", root, *rel ? "/" : "", rel);
+	DIR *d = opendir(path);
+	assert_non_null(d);
+	struct dirent *e;
+	while ((e = readdir(d)) != NULL) {
+		if (e->d_name[0] == '.')
+			continue;
+		char sub[600], full[1700];
+		snprintf(sub, sizeof sub, "%s%s%s", rel, *rel ? "/" : "", e->d_name);
+		snprintf(full, sizeof full, "%s/%s", root, sub);
+		struct stat st;
+		assert_int_equal(stat(full, &st), 0);
+		size_t len = strlen(sub);
+		if (S_ISDIR(st.st_mode))
+			n = pngs(root, sub, names, n, max);
+		else if (len > 4 && len < sizeof names[0] && strcmp(sub + len - 4, ".png") == 0 &&
+		         n < max)
+			memcpy(names[n++], sub, len + 1);
+	}
+	closedir(d);
+	return n;
+}
+
+/* chromium's dumped DOM of dir/index.html (malloc'd). Fails the test,
+ * saying what to do, if chromium is not installed. */
+static char *dump_dom(const char *dir)
+{
+	const char *probe[] = {"chromium", "--version", NULL};
+	if (bsim_test_run(probe, NULL) != 0)
+		fail_msg("chromium is not installed: run scripts/deps.sh (it installs the Debian "
+		         "package chromium), then run this test again");
+	char url[1200], profile[1200];
+	snprintf(url, sizeof url, "file://%s/index.html", dir);
+	snprintf(profile, sizeof profile, "--user-data-dir=%s", bsim_test_dir("chromium_profile"));
+	/* --no-sandbox: the sandbox refuses to run as root (CI, containers);
+	 * --virtual-time-budget: the DOM is dumped once the page has loaded */
+	const char *argv[] = {"chromium",
+	                      "--headless",
+	                      "--no-sandbox",
+	                      "--disable-gpu",
+	                      "--no-first-run",
+	                      profile,
+	                      "--virtual-time-budget=5000",
+	                      "--dump-dom",
+	                      url,
+	                      NULL};
+	char *out = NULL;
+	assert_int_equal(bsim_test_run(argv, &out), 0);
+	assert_non_null(out);
+	return out;
+}
+
+/* Every png under dir is on the page with a caption of its own, the page
+ * is in the manifest, and a browser loads all of it. */
+static void check_page(const char *dir)
+{
+	static char names[256][256];
+	int n = pngs(dir, "", names, 0, 256);
+	assert_true(n > 0);
+	char *page = bsim_test_read(bsim_test_join(dir, "index.html"));
+	assert_non_null(page);
+	for (int i = 0; i < n; i++) {
+		char want[300] = "<img src=\"";
+		strcat(want, names[i]); /* names are < 256 characters */
+		strcat(want, "\"");
+		if (!strstr(page, want))
+			fail_msg("%s/index.html does not show %s", dir, names[i]);
+		const char *base = strrchr(names[i], '/');
+		char caption[512];
+		bsim_index_caption(base ? base + 1 : names[i], caption, sizeof caption);
+		/* a row of the table, not the catch-all "figure NAME" */
+		if (strncmp(caption, "figure ", 7) == 0 || !*caption)
+			fail_msg("%s has no caption of its own", names[i]);
+	}
+	char *manifest = bsim_test_read(bsim_test_join(dir, "manifest.json"));
+	assert_non_null(manifest);
+	assert_non_null(strstr(manifest, "\"index.html\""));
+	free(manifest);
+
+	char *dom = dump_dom(dir);
+	char want[64];
+	snprintf(want, sizeof want, "data-images=\"%d/%d\"", n, n);
+	if (!strstr(dom, want)) {
+		const char *got = strstr(dom, "data-images=");
+		fail_msg("%s/index.html in chromium: expected %s, got %.24s", dir, want,
+		         got ? got : "no data-images");
+	}
+	free(dom);
+	free(page);
+}
+
+static void test_captions(void **state)
+{
+	(void)state;
+	char buf[512];
+	bsim_index_caption("landscape_g003.png", buf, sizeof buf);
+	assert_non_null(strstr(buf, "group 3:"));
+	/* the axis by its display name, as the figure's x label names it */
+	char label[256];
+	bsim_index_caption("traversal_vs_beams_0_stiffness.png", buf, sizeof buf);
+	bsim_key_label("beams.0.stiffness", 0, label, sizeof label);
+	assert_non_null(strstr(buf, label));
+	bsim_index_caption("traversal_vs_effects_random_force_magnitude.png", buf, sizeof buf);
+	bsim_key_label("effects.random_force.magnitude", 0, label, sizeof label);
+	assert_non_null(strstr(buf, label));
+	bsim_index_caption("validate_g010.png", buf, sizeof buf);
+	assert_non_null(strstr(buf, "group 10:"));
+	bsim_index_caption("summary.json", buf, sizeof buf);
+	assert_true(buf[0] != '\0');
+	bsim_index_caption("something.xyz", buf, sizeof buf);
+	assert_string_equal(buf, "");
+}
+
+static const char *experiment(const char *dir)
+{
+	char yaml[2048];
+	snprintf(yaml, sizeof yaml,
+	         "scene: %s\ntrials: 4\nseed: 1\ngrid:\n"
+	         "  effects.propulsion.force: [9]\n"
+	         "  effects.random_force.magnitude: [0, 30]\n",
+	         bsim_test_src("configs/thesis/gate.yaml"));
+	return bsim_test_write(dir, "small.yaml", yaml);
+}
+
+static void test_sweep_page(void **state)
+{
+	(void)state;
+	char dir[1024], exp[1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("index_sweep"));
+	snprintf(exp, sizeof exp, "%s", experiment(bsim_test_dir("index_inputs")));
+	const char *sweep[] = {"sweep", exp, "--trajectories", "2", "--quiet", "--out", dir, NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	/* no figures yet: no page */
+	assert_false(bsim_test_exists(bsim_test_join(dir, "index.html")));
+	const char *plot[] = {"plot", dir, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(plot, NULL, NULL), 0);
+	check_page(dir);
+	/* the page links the data beside the figures */
+	char *page = bsim_test_read(bsim_test_join(dir, "index.html"));
+	assert_non_null(strstr(page, "href=\"summary.json\""));
+	assert_non_null(strstr(page, "href=\"p_traverse.dat\""));
+	free(page);
+}
+
+static void test_compare_page(void **state)
+{
+	(void)state;
+	char dir[1024], exp[1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("index_compare"));
+	snprintf(exp, sizeof exp, "%s", experiment(bsim_test_dir("index_inputs2")));
+	const char *cmp[] = {"compare", exp, "--trials", "4", "--quiet", "--out", dir, NULL};
+	int rc = bsim_test_cli(cmp, NULL, NULL);
+	assert_true(rc == 0 || rc == 3);
+	const char *plot[] = {"plot", dir, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(plot, NULL, NULL), 0);
+	/* the sides' figures in their folders are on the top page */
+	assert_true(bsim_test_exists(bsim_test_join(dir, "thesis/p_traverse.png")));
+	check_page(dir);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_captions),
+	        cmocka_unit_test(test_sweep_page),
+	        cmocka_unit_test(test_compare_page),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
