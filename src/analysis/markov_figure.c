@@ -151,7 +151,7 @@ int markov_field_figure(const char *stage, const char *name, const char *title,
 	fprintf(f,
 	        "\"end\" %g) scale 0\nset xlabel 'column ix'\nset ylabel 'row iy'\n"
 	        "set border 0\nunset key\nset style fill solid 1.0 border lc rgb '#D0D0D0'\n"
-	        "set colorbox\n",
+	        "set colorbox\nset rmargin 13\n", /* room for the colour bar's label */
 	        rows - 1 + OUTSIDE_GAP);
 	for (int k = 0; k < n_panels; k++) {
 		if (!panel[k].p) {
@@ -167,8 +167,8 @@ int markov_field_figure(const char *stage, const char *name, const char *title,
 				tot[j] -= t2[j];
 			fprintf(f,
 			        "set palette defined (-1 '#B2182B', 0 '#F7F7F7', 1 '#2166AC')\n"
-			        "set cbrange [%g:%g]\nset cblabel 'difference of probability (in "
-			        "the cells: points of %%)'\n"
+			        "set cbrange [%g:%g]\nset cblabel 'difference (in the cells: %% "
+			        "points)'\n"
 			        "set title \"%s\\nend %+.1f%%, side %+.1f%%, stuck %+.1f%%\" "
 			        "noenhanced\n",
 			        -fmax(dmax, 1e-3), fmax(dmax, 1e-3), panel[k].title, 100 * tot[0],
@@ -176,8 +176,7 @@ int markov_field_figure(const char *stage, const char *name, const char *title,
 		} else
 			fprintf(f,
 			        "set palette defined (0 '#FFFFFF', 0.5 '#9ECAE1', 1 '#3182BD')\n"
-			        "set cbrange [0:%g]\nset cblabel 'probability of ending there (in "
-			        "the cells: %%)'\n"
+			        "set cbrange [0:%g]\nset cblabel 'probability (in the cells: %%)'\n"
 			        "set title \"%s\\nend %.1f%%, side %.1f%%, stuck %.1f%%\" "
 			        "noenhanced\n",
 			        fmax(vmax, 1e-3), panel[k].title, 100 * tot[0], 100 * tot[1],
@@ -196,7 +195,7 @@ int markov_field_figure(const char *stage, const char *name, const char *title,
 	bsim_figure_def fd = bsim_figure_def_default();
 	fd.dir = stage;
 	fd.name = name;
-	fd.width = per_row > 1 ? 520 * per_row : 760;
+	fd.width = per_row > 1 ? 560 * per_row : 760;
 	fd.height = 110 + 520 * n_rows;
 	int rc = bsim_figure_render(&fd, body, drawn, err);
 	free(body);

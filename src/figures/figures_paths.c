@@ -540,7 +540,7 @@ int figs_over_landscape(figs *f, const char *name, const char *title, const bsim
 	        " noenhanced\n" BSIM_FIGURE_LANDSCAPE_PALETTE
 	        "set cbrange [%g:%g]\nset cblabel '" BSIM_FIGURE_LANDSCAPE_CBLABEL "'\n"
 	        "# (a) from above: the landscape, its contours every 50 J, the paths\n"
-	        "set origin 0,0\nset size 0.42,0.86\nset colorbox\n"
+	        "set origin 0,0\nset size 0.42,0.9\nset colorbox\n"
 	        "set title '(a) from above; below the surface in black'\n"
 	        "set view map\nset size ratio -1\nset xrange [%g:%g]\nset yrange [%g:%g]\n"
 	        "set xlabel 'x (m)'\nset ylabel 'y (m)'\nunset key\n"
@@ -577,7 +577,7 @@ int figs_over_landscape(figs *f, const char *name, const char *title, const bsim
 	        "# (b) in 3-D, seen as landscape_total of beamsim landscape: the surface cut\n"
 	        "# above the top of the colours and at its steps; then, over it, each path at\n"
 	        "# its own energy, a stretch below the surface in black\n"
-	        "set origin 0.36,0\nset size 0.64,0.86\nunset colorbox\n"
+	        "set origin 0.36,0\nset size 0.64,0.9\nunset colorbox\n"
 	        "set title '(b) E along the paths over the surface E_{total}(x, y)'\n"
 	        "set view 55,300,1,1.05\nset size noratio\nset xyplane 0\n"
 	        "set zlabel 'E (J)' rotate parallel\nset zrange [%g:%g]\n"
@@ -585,7 +585,7 @@ int figs_over_landscape(figs *f, const char *name, const char *title, const bsim
 	        "splot '%s' using 1:2:5 with pm3d notitle\n"
 	        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\n"
 	        "unset zlabel\nunset grid\n"
-	        "set key at screen 0.99, screen 0.80 right top opaque box\n"
+	        "set key at screen 0.99, screen 0.84 right top opaque box\n"
 	        "splot ",
 	        e_min, e_max, surf);
 	int k = 0;
