@@ -219,23 +219,28 @@ static void scene_box(const bsim_scene *s, double box[4])
 
 /* ---- thinning ------------------------------------------------------------------------- */
 
-/* A drawn path leaves out a row within DRAW_STEP_M of the last row drawn
- * (and, over the landscape, within DRAW_STEP_J in E) unless it ends the
- * path or goes below the surface or back: 0.5 m is 4 pixels of a 700-pixel
- * plot of 95 m, and keeps the SVG of a hundred paths under 1 MB. The
- * recorded rows are all in the trajectory file. */
-#define DRAW_STEP_M 0.5
-#define DRAW_STEP_J 5.0
+/* A drawn path leaves out a row within step_m of the last row drawn (and,
+ * over the landscape, within step_j in E) unless it ends the path or goes
+ * below the surface or back. In the bundle 0.5 m is 4 pixels of a
+ * 700-pixel plot of 95 m; over the landscape, where the plane is 500
+ * pixels tall and each path is drawn twice in both panels (its white
+ * outline, then its colour), 0.8 m is 4 pixels. Both keep the SVG of a
+ * hundred paths under 1 MB. The recorded rows are all in the trajectory
+ * file. */
+#define BUNDLE_STEP_M 0.5
+#define OVER_STEP_M   0.8
+#define OVER_STEP_J   8.0
 
 typedef struct thin {
 	double x, y, e;
 	int below, started;
 } thin;
 
-static int thin_keep(thin *t, double x, double y, double e, int below, int last)
+static int thin_keep(thin *t, double x, double y, double e, int below, int last, double step_m,
+                     double step_j)
 {
 	int keep = !t->started || last || below != t->below ||
-	           hypot(x - t->x, y - t->y) >= DRAW_STEP_M || fabs(e - t->e) >= DRAW_STEP_J;
+	           hypot(x - t->x, y - t->y) >= step_m || fabs(e - t->e) >= step_j;
 	if (keep)
 		*t = (thin){x, y, e, below, 1};
 	return keep;
@@ -273,7 +278,8 @@ int figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *
 			first = 0;
 			thin t = {0};
 			for (long k = 0; k < p[i].n; k++)
-				if (thin_keep(&t, p[i].x[k], p[i].y[k], 0.0, 0, k == p[i].n - 1))
+				if (thin_keep(&t, p[i].x[k], p[i].y[k], 0.0, 0, k == p[i].n - 1,
+				              BUNDLE_STEP_M, INFINITY))
 					fprintf(o.f, "%.6g %.6g\n", p[i].x[k], p[i].y[k]);
 		}
 	}
@@ -356,8 +362,9 @@ static void cut_steps(double *w, int nx, int ny, double range)
 /* The surface E_total(x, y) on a grid of about 1 m over the shown plane,
  * one y row per block (gnuplot's grid format): x y E_total, E_drawn (cut
  * at cap, for the map: near a pivot th(x, y) nears pi and E_total climbs
- * to thousands of joules where no path goes), E_3d (NaN above cap and at
- * the steps, for the 3-D surface). e_min gets the lowest value. */
+ * to thousands of joules where no path goes), E_3d (the 3-D surface, every
+ * second point in x and y: NaN above cap, at the steps and at the points
+ * between). e_min gets the lowest value. */
 static int surface_write(figs *f, const char *file, const bsim_scene *s, const double box[4],
                          double cap, double *e_min, bsim_error *err)
 {
@@ -381,7 +388,28 @@ static int surface_write(figs *f, const char *file, const bsim_scene *s, const d
 			*e_min = fmin(*e_min, e[k]);
 			w[k] = e[k] > cap ? NAN : e[k];
 		}
-	cut_steps(w, nx, ny, cap - *e_min);
+	/* the 3-D surface is every second point in x and y (`every 2:2`: a
+	 * quarter of the quadrangles, to keep the SVG small); its steps are
+	 * found at that spacing, and every other point is NaN */
+	const int n3x = (nx + 1) / 2, n3y = (ny + 1) / 2;
+	double *w3 = malloc((size_t)n3x * (size_t)n3y * sizeof *w3);
+	if (!w3) {
+		free(e);
+		free(w);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	for (int j = 0; j < n3y; j++)
+		for (int i = 0; i < n3x; i++)
+			w3[(size_t)j * (size_t)n3x + (size_t)i] =
+			        w[(size_t)(2 * j) * (size_t)nx + (size_t)(2 * i)];
+	cut_steps(w3, n3x, n3y, cap - *e_min);
+	for (int j = 0; j < ny; j++)
+		for (int i = 0; i < nx; i++)
+			w[(size_t)j * (size_t)nx + (size_t)i] =
+			        i % 2 || j % 2
+			                ? NAN
+			                : w3[(size_t)(j / 2) * (size_t)n3x + (size_t)(i / 2)];
+	free(w3);
 	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	int rc = figs_data_open(f, file, &o, path, err);
@@ -458,7 +486,8 @@ static int paths_write(figs *f, const char *file, const bsim_scene *s, const fpa
 			int b = fpath_below(s, p[i].x[k], p[i].y[k], th);
 			double e = fpath_energy(s, p[i].y[k], th);
 			*below += b;
-			if (thin_keep(&t, p[i].x[k], p[i].y[k], e, b, k == p[i].n - 1))
+			if (thin_keep(&t, p[i].x[k], p[i].y[k], e, b, k == p[i].n - 1, OVER_STEP_M,
+			              OVER_STEP_J))
 				fprintf(o.f, "%.6g %.6g %.6g %d %d\n", p[i].x[k], p[i].y[k], e,
 				        p[i].cls, b);
 		}
@@ -582,7 +611,7 @@ int figs_over_landscape(figs *f, const char *name, const char *title, const bsim
 	        "set view 55,300,1,1.05\nset size noratio\nset xyplane 0\n"
 	        "set zlabel 'E (J)' rotate parallel\nset zrange [%g:%g]\n"
 	        "set pm3d depthorder lighting primary 0.5 specular 0.1\n"
-	        "splot '%s' using 1:2:5 with pm3d notitle\n"
+	        "splot '%s' every 2:2 using 1:2:5 with pm3d notitle\n"
 	        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\n"
 	        "unset zlabel\nunset grid\n"
 	        "set key at screen 0.99, screen 0.84 right top opaque box\n"
