@@ -301,7 +301,8 @@ static int simulate(const bsim_experiment *e, const bsim_markov_validate_def *de
 	bsim_override *ov = malloc((size_t)n * sizeof *ov);
 	if (!ov)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	memcpy(ov, def->sets, (size_t)def->n_sets * sizeof *ov);
+	if (def->n_sets > 0) /* sets is NULL without --set */
+		memcpy(ov, def->sets, (size_t)def->n_sets * sizeof *ov);
 	ov[def->n_sets] =
 	        (bsim_override){"lattice.protocol", protocol_names[pr], "markov validate"};
 	bsim_sweep_config cfg = {.backend = set->def.backend,
@@ -344,8 +345,10 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 		int *idx = malloc((size_t)(na > 0 ? na : 1) * sizeof *idx);
 		if (ov && idx) {
 			bsim_experiment_group_index(e, g, idx);
-			memcpy(ov, e->set, (size_t)e->n_set * sizeof *ov);
-			memcpy(ov + e->n_set, def->sets, (size_t)def->n_sets * sizeof *ov);
+			if (e->n_set > 0)
+				memcpy(ov, e->set, (size_t)e->n_set * sizeof *ov);
+			if (def->n_sets > 0)
+				memcpy(ov + e->n_set, def->sets, (size_t)def->n_sets * sizeof *ov);
 			for (int a = 0; a < na; a++)
 				ov[e->n_set + def->n_sets + a] = (bsim_override){
 				        e->axes[a].key, e->axes[a].values[idx[a]], NULL};
