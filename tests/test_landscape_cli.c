@@ -235,7 +235,8 @@ static double saturation(unsigned rgb)
  * saturated above 0.6, so none of the map's; the 3-D surfaces are
  * depth-sorted pm3d with NaN (not a wall) where the body would overlap a
  * pivot (the gate's pivots at (+-25, 30) m, R = 10 m) and no two
- * neighbours drawn a wall apart (more than 0.6 of the drawn range). */
+ * neighbours drawn a wall apart (more than 0.6 of the drawn range); every
+ * figure's files in the manifest. */
 static void test_figure_style(void **state)
 {
 	(void)state;
@@ -252,6 +253,18 @@ static void test_figure_style(void **state)
 	free(out);
 	free(err);
 	const char *names[] = {"landscape_top", "landscape_beam", "landscape_total"};
+	char *manifest = bsim_test_read(bsim_test_join(dir, "manifest.json"));
+	assert_non_null(manifest);
+	for (int i = 0; i < 3; i++) {
+		const char *ext[] = {"gp", "dat", "png", "svg"};
+		for (int k = 0; k < 4; k++) {
+			char want[80];
+			snprintf(want, sizeof want, "\"%s.%s\"", names[i], ext[k]);
+			if (!strstr(manifest, want))
+				fail_msg("%s not in the manifest", want);
+		}
+	}
+	free(manifest);
 	for (int i = 0; i < 3; i++) {
 		char n[64];
 		snprintf(n, sizeof n, "%s.gp", names[i]);
