@@ -51,6 +51,7 @@ small() { # small DIR NAME COPY: DIR/NAME.gp drawn again at 0.75 as docs/figures
 small $o/fig2.2 random_force fig2.2-random-force
 small $o/fig2.2 ledger run-ledger
 small $o/fig2.7 landscape_path fig2.7-below-the-surface
+small $o/fig2.7 landscape_path_single fig2.7c-single-beam
 small $o/h1 p_traverse fig3.1-h1-p-traverse
 for g in 9 10 11; do small $o/h2-figures "trajectories_g$(printf %03d $g)" "fig3.2-g$g"; done
 for g in 1 2; do small $o/h2-figures "landscape_g$(printf %03d $g)" "fig3.3-g$g"; done

@@ -64,6 +64,98 @@ static double th_model(double px, double x, double y)
 	return th > 0 ? th : 0;
 }
 
+/* ---- colours and titles of a landscape figure ---------------------------------------- */
+
+/* Saturation of HSV, (max - min) / max of the channels: 0 grey, 1 pure. */
+static double saturation(unsigned rgb)
+{
+	const double r = rgb >> 16 & 255, g = rgb >> 8 & 255, b = rgb & 255;
+	const double hi = fmax(r, fmax(g, b)), lo = fmin(r, fmin(g, b));
+	return hi > 0 ? (hi - lo) / hi : 0.0;
+}
+
+/* A landscape figure's script: a colour bar naming the potential energy,
+ * its palette grey to blue-green (nothing in it saturated above 0.4), each
+ * traversal's path in a colour saturated above 0.6 and none of the
+ * palette's, and every needle in the figure's title. */
+static void check_landscape_script(const char *gp, const char *const needles[])
+{
+	assert_non_null(strstr(gp, "set colorbox"));
+	assert_non_null(strstr(gp, "set cblabel 'potential energy"));
+	const char *p = strstr(gp, "set palette defined (");
+	assert_non_null(p);
+	unsigned pal[16];
+	int np = 0;
+	for (const char *h = strchr(p, '#'); h && h < strchr(p, ')') && np < 16;
+	     h = strchr(h + 1, '#'))
+		pal[np++] = (unsigned)strtoul(h + 1, NULL, 16);
+	assert_true(np >= 2);
+	for (int k = 0; k < np; k++)
+		assert_true(saturation(pal[k]) < 0.4);
+	int paths = 0;
+	for (const char *t = strstr(gp, "title 'traversed"); t;
+	     t = strstr(t + 1, "title 'traversed")) {
+		const char *lc = t;
+		while (lc > gp && strncmp(lc, "lc rgb '#", 9) != 0)
+			lc--;
+		unsigned c = (unsigned)strtoul(lc + 9, NULL, 16);
+		assert_true(saturation(c) > 0.6);
+		for (int k = 0; k < np; k++)
+			assert_true(c != pal[k]);
+		paths++;
+	}
+	assert_true(paths > 0);
+	const char *title = strstr(gp, "set multiplot title ");
+	assert_non_null(title);
+	char t[800];
+	snprintf(t, sizeof t, "%.*s", (int)strcspn(title, "\n"), title);
+	for (int i = 0; needles[i]; i++)
+		if (!strstr(t, needles[i]))
+			fail_msg("'%s' not in the title %s", needles[i], t);
+}
+
+/* Rows of a landscape's NAME.surface.dat: x y E_total E_drawn E_3d. E_total
+ * must be f(x, y) (the model, written here again); E_drawn is E_total cut
+ * at one level, and the 3-D surface is NaN wherever the map is cut and
+ * E_total where it is drawn. The count of rows. */
+static int check_surface(const char *path, double (*f)(double x, double y))
+{
+	FILE *in = fopen(path, "r");
+	assert_non_null(in);
+	char line[256];
+	int n = 0, cut = 0;
+	while (fgets(line, sizeof line, in)) {
+		if (line[0] == '#' || line[0] == '\n')
+			continue;
+		double x, y, e, d;
+		char e3[64];
+		assert_int_equal(sscanf(line, "%lf %lf %lf %lf %63s", &x, &y, &e, &d, e3), 5);
+		const double want = f(x, y);
+		assert_true(fabs(e - want) <= 1e-4 * fmax(1.0, fabs(want)));
+		if (d < e) {
+			assert_string_equal(e3, "NaN");
+			cut++;
+		} else if (strcmp(e3, "NaN") != 0)
+			assert_true(fabs(strtod(e3, NULL) - e) <= 1e-4 * fmax(1.0, fabs(e)));
+		n++;
+	}
+	fclose(in);
+	assert_true(cut > 0); /* near the pivots */
+	return n;
+}
+
+/* E_total of the gate at F_prop = 9 N (k = 400 N m/rad each), of beam 2
+ * alone at F_prop = 6 N. */
+static double e_gate_f9(double x, double y)
+{
+	return 9.0 * (60 - y) + 200 * (pow(th_model(-25, x, y), 2) + pow(th_model(25, x, y), 2));
+}
+
+static double e_beam2_f6(double x, double y)
+{
+	return 6.0 * (60 - y) + 200 * pow(th_model(25, x, y), 2);
+}
+
 static void test_below_surface(void **state)
 {
 	(void)state;
@@ -222,6 +314,71 @@ static void test_paths_over_landscape(void **state)
 	snprintf(path, sizeof path, "%s/landscape_g003.dat", dir);
 	int nb = bsim_test_data_rows(path, 1, rows, 20000);
 	assert_true(nb >= below);
+	/* the surface is the model's; the script's colours and title */
+	snprintf(path, sizeof path, "%s/landscape_g003.surface.dat", dir);
+	assert_true(check_surface(path, e_gate_f9) > 1000);
+	snprintf(path, sizeof path, "%s/landscape_g003.gp", dir);
+	char *gp = bsim_test_read(path);
+	assert_non_null(gp);
+	const char *const needles[] = {"backend thesis", "F_prop = 9 N", "R_m = 0 N", NULL};
+	check_landscape_script(gp, needles);
+	free(gp);
+}
+
+/* Fig. 2.7 as docs/figures.md reproduces it: landscape_path titled with
+ * the backend and the --set values, and landscape_path_single, the path
+ * over beam 2's landscape alone (Fig. 2.7c), its surface F_prop (60 - y) +
+ * 1/2 k th_2^2 and fewer of its states below it than below the whole
+ * landscape; all five files of both figures in the manifest. */
+static void test_fig27(void **state)
+{
+	(void)state;
+	char dir[1024];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("fig2.7"));
+	const char *run[] = {"run",     bsim_test_src("configs/thesis/gate.yaml"),
+	                     "--seed",  "1",
+	                     "--group", "13",
+	                     "--trial", "15",
+	                     "--set",   "effects.propulsion.force=6",
+	                     "--set",   "effects.random_force.magnitude=30",
+	                     "--out",   dir,
+	                     NULL};
+	assert_int_equal(run_cli(run, NULL, NULL), 0);
+	const char *argv[] = {"plot", dir, "--quiet", NULL};
+	assert_int_equal(run_cli(argv, NULL, NULL), 0);
+	assert_int_equal(bsim_test_check_figures(dir), 4);
+	char path[1200];
+	const char *const needles[] = {"backend thesis", "F_prop = 6 N", "R_m = 30 N", NULL};
+	const char *const single[] = {"F_prop = 6 N", "over beam 2", NULL};
+	const char *names[] = {"landscape_path", "landscape_path_single"};
+	for (int i = 0; i < 2; i++) {
+		snprintf(path, sizeof path, "%s/%s.gp", dir, names[i]);
+		char *gp = bsim_test_read(path);
+		assert_non_null(gp);
+		check_landscape_script(gp, i ? single : needles);
+		free(gp);
+	}
+	snprintf(path, sizeof path, "%s/landscape_path_single.surface.dat", dir);
+	check_surface(path, e_beam2_f6);
+	static double rows[20000][16];
+	snprintf(path, sizeof path, "%s/landscape_path.dat", dir);
+	const int below = bsim_test_data_rows(path, 1, rows, 20000);
+	snprintf(path, sizeof path, "%s/landscape_path_single.dat", dir);
+	const int below_single = bsim_test_data_rows(path, 1, rows, 20000);
+	print_message("rows below the surface: %d whole, %d beam 2 alone\n", below, below_single);
+	assert_true(below > 10 && below_single < below);
+	snprintf(path, sizeof path, "%s/manifest.json", dir);
+	char *manifest = bsim_test_read(path);
+	assert_non_null(manifest);
+	const char *ext[] = {"gp", "png", "svg", "dat", "surface.dat"};
+	for (int i = 0; i < 2; i++)
+		for (int k = 0; k < 5; k++) {
+			char want[100];
+			snprintf(want, sizeof want, "\"%s.%s\"", names[i], ext[k]);
+			if (!strstr(manifest, want))
+				fail_msg("%s not in the manifest", want);
+		}
+	free(manifest);
 }
 
 static void test_select(void **state)
@@ -546,6 +703,7 @@ int main(void)
 	        cmocka_unit_test(test_accuracy_front),
 	        cmocka_unit_test(test_compare_figures),
 	        cmocka_unit_test(test_without_gnuplot),
+	        cmocka_unit_test(test_fig27),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -244,6 +244,157 @@ static void test_options(void **state)
 	free(err);
 }
 
+/* ---- the figures' conventions -------------------------------------------------- */
+
+/* The colours of a gnuplot palette "set palette defined (v '#RRGGBB', ...)"
+ * in gp, into rgb; their count. */
+static int palette_colors(const char *gp, unsigned rgb[], int max)
+{
+	const char *p = strstr(gp, "set palette defined (");
+	int n = 0;
+	if (!p)
+		return 0;
+	const char *end = strchr(p, ')');
+	for (const char *h = strchr(p, '#'); h && h < end && n < max; h = strchr(h + 1, '#'))
+		rgb[n++] = (unsigned)strtoul(h + 1, NULL, 16);
+	return n;
+}
+
+/* Saturation of HSV, (max - min) / max of the channels: 0 grey, 1 pure. */
+static double saturation(unsigned rgb)
+{
+	const double r = rgb >> 16 & 255, g = rgb >> 8 & 255, b = rgb & 255;
+	const double hi = fmax(r, fmax(g, b)), lo = fmin(r, fmin(g, b));
+	return hi > 0 ? (hi - lo) / hi : 0.0;
+}
+
+/* Each figure: the landscapes' palette (grey to blue-green: no colour in it
+ * saturated above 0.4) with a colour bar naming the potential energy and
+ * its unit; the title holds the values given by --set in the model's
+ * symbols and units; the path of least resistance (top view) in a colour
+ * saturated above 0.6, so none of the map's; the 3-D surfaces are
+ * depth-sorted pm3d with NaN (not a wall) where the body would overlap a
+ * pivot (the gate's pivots at (+-25, 30) m, R = 10 m) and no two
+ * neighbours drawn a wall apart (more than 0.6 of the drawn range); every
+ * figure's files in the manifest. */
+static void test_figure_style(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("landscape_style");
+	char *out = NULL, *err = NULL;
+	const char *argv[] = {"landscape", bsim_test_src("configs/thesis/gate.yaml"),
+	                      "--set",     "beams.0.stiffness=150",
+	                      "--set",     "effects.propulsion.force=8",
+	                      "--out",     dir,
+	                      NULL};
+	int rc = bsim_test_cli(argv, &out, &err);
+	if (rc != 0)
+		fail_msg("exit %d: %s", rc, err ? err : "");
+	free(out);
+	free(err);
+	const char *names[] = {"landscape_top", "landscape_beam", "landscape_total"};
+	char *manifest = bsim_test_read(bsim_test_join(dir, "manifest.json"));
+	assert_non_null(manifest);
+	for (int i = 0; i < 3; i++) {
+		const char *ext[] = {"gp", "dat", "png", "svg"};
+		for (int k = 0; k < 4; k++) {
+			char want[80];
+			snprintf(want, sizeof want, "\"%s.%s\"", names[i], ext[k]);
+			if (!strstr(manifest, want))
+				fail_msg("%s not in the manifest", want);
+		}
+	}
+	free(manifest);
+	for (int i = 0; i < 3; i++) {
+		char n[64];
+		snprintf(n, sizeof n, "%s.gp", names[i]);
+		char *gp = bsim_test_read(bsim_test_join(dir, n));
+		assert_non_null(gp);
+		unsigned pal[16];
+		int np = palette_colors(gp, pal, 16);
+		assert_true(np >= 2);
+		for (int k = 0; k < np; k++)
+			assert_true(saturation(pal[k]) < 0.4);
+		assert_non_null(strstr(gp, "set colorbox"));
+		assert_non_null(strstr(gp, "set cblabel 'potential energy"));
+		assert_non_null(strstr(gp, "(J)'"));
+		const char *title = strstr(gp, "set title");
+		assert_non_null(title);
+		const char *eol = strchr(title, '\n');
+		char t[600];
+		snprintf(t, sizeof t, "%.*s", (int)(eol - title), title);
+		assert_non_null(strstr(t, "k_1 = 150 N m/rad"));
+		assert_non_null(strstr(t, "k_2 = 400 N m/rad"));
+		assert_non_null(strstr(t, "F_prop = 8 N"));
+		assert_non_null(strstr(t, "no backend"));
+		if (i == 0) {
+			const char *path = strstr(gp, "title 'path of least resistance'");
+			assert_non_null(path);
+			const char *lc = path;
+			while (lc > gp && strncmp(lc, "lc rgb '#", 9) != 0)
+				lc--;
+			unsigned c = (unsigned)strtoul(lc + 9, NULL, 16);
+			assert_true(saturation(c) > 0.6);
+			for (int k = 0; k < np; k++)
+				assert_true(c != pal[k]);
+		} else {
+			assert_non_null(strstr(gp, "set pm3d depthorder"));
+			assert_null(strstr(gp, "unset colorbox"));
+		}
+		free(gp);
+	}
+	for (int i = 1; i < 3; i++) {
+		char n[64];
+		snprintf(n, sizeof n, "%s.dat", names[i]);
+		FILE *f = fopen(bsim_test_join(dir, n), "r");
+		assert_non_null(f);
+		/* grid format: a row of x per block */
+		static double e[200][200];
+		int nj = 0, ni = 0, i_row = 0, pivots = 0;
+		char line[256];
+		double lo = INFINITY, hi = -INFINITY;
+		while (fgets(line, sizeof line, f)) {
+			if (line[0] == '#')
+				continue;
+			if (line[0] == '\n') {
+				if (i_row > 0) {
+					ni = i_row;
+					nj++;
+				}
+				i_row = 0;
+				continue;
+			}
+			double x, y;
+			char v[64];
+			assert_int_equal(sscanf(line, "%lf %lf %63s", &x, &y, v), 3);
+			assert_true(nj < 200 && i_row < 200);
+			double z = strcmp(v, "NaN") == 0 ? NAN : strtod(v, NULL);
+			e[nj][i_row++] = z;
+			if (hypot(fabs(x) - 25, y - 30) < 10) {
+				assert_true(isnan(z));
+				pivots++;
+			}
+			if (!isnan(z)) {
+				lo = fmin(lo, z);
+				hi = fmax(hi, z);
+			}
+		}
+		fclose(f);
+		assert_true(nj > 10 && ni > 10 && pivots > 0);
+		double worst = 0.0;
+		for (int j = 0; j < nj; j++)
+			for (int k = 0; k < ni; k++) {
+				if (k + 1 < ni && !isnan(e[j][k]) && !isnan(e[j][k + 1]))
+					worst = fmax(worst, fabs(e[j][k + 1] - e[j][k]));
+				if (j + 1 < nj && !isnan(e[j][k]) && !isnan(e[j + 1][k]))
+					worst = fmax(worst, fabs(e[j + 1][k] - e[j][k]));
+			}
+		print_message("%s: steepest step drawn %.3g of the range\n", names[i],
+		              worst / (hi - lo));
+		assert_true(worst < 0.6 * (hi - lo));
+	}
+}
+
 /* Status 2, stderr holding every needle, and no output directory. */
 static void expect_bad(const char *const argv[], const char *dir, const char *const needles[])
 {
@@ -323,9 +474,10 @@ static void test_errors(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_csv),        cmocka_unit_test(test_mat),
-	        cmocka_unit_test(test_figures),    cmocka_unit_test(test_options),
-	        cmocka_unit_test(test_json_quiet), cmocka_unit_test(test_errors),
+	        cmocka_unit_test(test_csv),          cmocka_unit_test(test_mat),
+	        cmocka_unit_test(test_figures),      cmocka_unit_test(test_options),
+	        cmocka_unit_test(test_json_quiet),   cmocka_unit_test(test_errors),
+	        cmocka_unit_test(test_figure_style),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -367,7 +367,8 @@ static void test_threads_and_cache(void **state)
 	        pdir,     NULL};
 	out = NULL;
 	assert_int_equal(bsim_test_cli(pred_out, &out, NULL), 0);
-	assert_int_equal(bsim_test_check_wrote(out, pdir), 4); /* prediction*.csv and .mat */
+	/* prediction*.csv and .mat, prediction.{png,svg,gp,dat} and index.html */
+	assert_int_equal(bsim_test_check_wrote(out, pdir), 9);
 	free(out);
 	char csv[1200];
 	snprintf(csv, sizeof csv, "%s/prediction.csv", pdir);
@@ -389,6 +390,166 @@ static void test_threads_and_cache(void **state)
 	snprintf(csv, sizeof csv, "%s/prediction.mat", pdir);
 	struct stat st;
 	assert_int_equal(stat(csv, &st), 0);
+}
+
+/* ---- the figures of the field ------------------------------------------------- */
+
+/* Block `block` of a field figure's data (x y value location "text"): the
+ * value of location loc, NAN if absent. */
+static double field_value(const char *dat, int block, const char *loc)
+{
+	FILE *f = fopen(dat, "r");
+	assert_non_null(f);
+	char line[512];
+	int b = 0, blank = 0;
+	double v = NAN;
+	while (fgets(line, sizeof line, f)) {
+		if (line[0] == '\n') {
+			blank++;
+			continue;
+		}
+		if (blank >= 2)
+			b++;
+		blank = 0;
+		if (line[0] == '#' || b != block)
+			continue;
+		double x, y, val;
+		char name[64];
+		if (sscanf(line, "%lf %lf %lf %63s", &x, &y, &val, name) == 4 &&
+		    strcmp(name, loc) == 0)
+			v = val;
+	}
+	fclose(f);
+	return v;
+}
+
+/* "end 3.8%, side 20.0%, stuck 76.3%" of the probabilities by location. */
+static void totals_text(char *buf, size_t size, const double tot[3])
+{
+	snprintf(buf, size, "end %.1f%%, side %.1f%%, stuck %.1f%%", 100 * tot[0], 100 * tot[1],
+	         100 * tot[2]);
+}
+
+static int kind_of(const char *loc)
+{
+	return strncmp(loc, "end:", 4) == 0 ? 0 : strncmp(loc, "side:", 5) == 0 ? 1 : 2;
+}
+
+/* markov predict --out and markov validate draw the final locations as
+ * the field: the figure files are there and in the manifest, every cell's
+ * value is the location's probability in the CSV the command writes (the
+ * difference panels the chain's less the simulation's), the panels' titles
+ * hold the totals of end, side and stuck summed here from those CSVs, the
+ * figure's title the backend and the propulsive force, and no tic label is
+ * rotated (the field has none to rotate). */
+static void test_field_figures(void **state)
+{
+	(void)state;
+	char maps[1024], pdir[1100], vdir[1100], path[1200];
+	snprintf(maps, sizeof maps, "%s", bsim_test_dir("field_maps"));
+	snprintf(pdir, sizeof pdir, "%s/prediction", maps);
+	snprintf(vdir, sizeof vdir, "%s/validation", maps);
+	char exp[1200]; /* bsim_test_src's buffer is reused by the next call */
+	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
+	const char *build[] = {"markov",  "build", exp,  "--trials", "10",
+	                       "--quiet", "--out", maps, NULL};
+	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
+	const char *pred[] = {"markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
+	                      "--map",  maps,      "--out",
+	                      pdir,     NULL};
+	assert_int_equal(bsim_test_cli(pred, NULL, NULL), 0);
+	/* maps of 10 trials a bin: with 3, most bins empty, the chain's map
+	 * resamples take a minute */
+	const char *val[] = {"markov",      "validate", exp,       "--map", maps, "--trials", "30",
+	                     "--bootstrap", "50",       "--quiet", "--out", vdir, NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(val, NULL, &err);
+	if (rc != 0)
+		fail_msg("validate: exit %d: %s", rc, err ? err : "");
+	free(err);
+	assert_int_equal(bsim_test_check_figures(pdir), 1);
+	assert_int_equal(bsim_test_check_figures(vdir), 1);
+
+	/* predict: prediction.dat against prediction.csv */
+	snprintf(path, sizeof path, "%s/prediction.csv", pdir);
+	char *csv = bsim_test_read(path);
+	assert_non_null(csv);
+	char dat[1200];
+	snprintf(dat, sizeof dat, "%s/prediction.dat", pdir);
+	double tot[3] = {0, 0, 0};
+	int n = 0;
+	char *save = NULL;
+	strtok_r(csv, "\n", &save);
+	for (char *line; (line = strtok_r(NULL, "\n", &save)); n++) {
+		char loc[64];
+		assert_int_equal(sscanf(line, "%63[^,]", loc), 1);
+		const double p = atof(strrchr(line, ',') + 1);
+		tot[kind_of(loc)] += p;
+		assert_true(fabs(field_value(dat, 0, loc) - p) <= 1e-7 * fmax(p, 1e-3));
+	}
+	free(csv);
+	assert_int_equal(n, 99);
+	snprintf(path, sizeof path, "%s/prediction.gp", pdir);
+	char *gp = bsim_test_read(path);
+	assert_non_null(gp);
+	char want[120];
+	totals_text(want, sizeof want, tot);
+	assert_non_null(strstr(gp, want));
+	assert_non_null(strstr(gp, "backend thesis"));
+	assert_non_null(strstr(gp, "F_prop = 6 N"));
+	assert_non_null(strstr(gp, "set colorbox"));
+	free(gp);
+
+	/* validate: the simulated panels (b, c) and the differences (d, e,
+	 * blocks 4 and 5 after an empty place) against validate.csv */
+	snprintf(path, sizeof path, "%s/validate.csv", vdir);
+	csv = bsim_test_read(path);
+	assert_non_null(csv);
+	snprintf(dat, sizeof dat, "%s/validate_g000.dat", vdir);
+	double sim_tot[2][3] = {{0}};
+	n = 0;
+	save = NULL;
+	strtok_r(csv, "\n", &save);
+	for (char *line; (line = strtok_r(NULL, "\n", &save)); n++) {
+		int g;
+		char proto[16], loc[64];
+		double ps, lo, hi, pc;
+		assert_int_equal(sscanf(line, "%d,%15[^,],%63[^,],%lf,%lf,%lf,%lf", &g, proto, loc,
+		                        &ps, &lo, &hi, &pc),
+		                 7);
+		const int pr = strcmp(proto, "essay") == 0 ? 0 : 1;
+		sim_tot[pr][kind_of(loc)] += ps;
+		assert_true(fabs(field_value(dat, 0, loc) - pc) <= 1e-7 * fmax(pc, 1e-3));
+		assert_true(fabs(field_value(dat, 1 + pr, loc) - ps) <= 1e-7 * fmax(ps, 1e-3));
+		assert_true(fabs(field_value(dat, 4 + pr, loc) - (pc - ps)) <= 1e-6);
+	}
+	free(csv);
+	assert_int_equal(n, 2 * 99);
+	snprintf(path, sizeof path, "%s/validate_g000.gp", vdir);
+	gp = bsim_test_read(path);
+	assert_non_null(gp);
+	for (int pr = 0; pr < 2; pr++) {
+		totals_text(want, sizeof want, sim_tot[pr]);
+		assert_non_null(strstr(gp, want));
+	}
+	assert_null(strstr(gp, "rotate"));
+	assert_non_null(strstr(gp, "backend thesis"));
+	free(gp);
+
+	/* the figures in the manifests */
+	const char *ext[] = {"gp", "png", "svg", "dat"};
+	for (int k = 0; k < 4; k++) {
+		snprintf(path, sizeof path, "%s/manifest.json", pdir);
+		char *m = bsim_test_read(path);
+		snprintf(want, sizeof want, "\"prediction.%s\"", ext[k]);
+		assert_non_null(strstr(m, want));
+		free(m);
+		snprintf(path, sizeof path, "%s/manifest.json", vdir);
+		m = bsim_test_read(path);
+		snprintf(want, sizeof want, "\"validate_g000.%s\"", ext[k]);
+		assert_non_null(strstr(m, want));
+		free(m);
+	}
 }
 
 /* Bad inputs: exit 2, one line naming the thing, nothing written. */
@@ -678,6 +839,7 @@ int main(void)
 	        cmocka_unit_test(test_entries),
 	        cmocka_unit_test(test_bad_inputs),
 	        cmocka_unit_test(test_bad_map_files),
+	        cmocka_unit_test(test_field_figures),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -175,11 +175,15 @@ BSIM_API int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_se
                                  bsim_markov_prediction *out, bsim_error *err);
 BSIM_API void bsim_markov_prediction_free(bsim_markov_prediction *p);
 
-/* Writes p into the output directory dir: prediction.csv (location, kind,
- * ix, iy, p: every final location of the field), prediction_gates.csv
- * (gates, p) and their .mat twins. */
-BSIM_API int bsim_markov_prediction_store(const char *dir, const bsim_markov_prediction *p,
-                                          bsim_error *err);
+/* Writes p, the prediction of lattice by the chain of set's maps, into
+ * the output directory dir: prediction.csv (location, kind, ix, iy, p:
+ * every final location of the field), prediction_gates.csv (gates, p),
+ * their .mat twins and the figure prediction (.png .svg .gp .dat): the
+ * final locations drawn as the field with the totals of end, side and
+ * stuck. */
+BSIM_API int bsim_markov_prediction_store(const char *dir, const bsim_scene *lattice,
+                                          const bsim_markov_set *set,
+                                          const bsim_markov_prediction *p, bsim_error *err);
 
 /* The entry bin of a state in a gate's frame entered through edge
  * (BSIM_EDGE_BOTTOM .. BSIM_EDGE_TOP) at pos along it with velocity v; the

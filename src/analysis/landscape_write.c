@@ -24,13 +24,14 @@
 #include "util/atomic_file.h"
 #include "util/json.h"
 #include "util/figure.h"
+#include "beamsim/key_names.h"
 #include "store/mat.h"
 #include "beamsim/limits.h"
 
 /* Most quadrangles of a 3-D surface: an SVG spends about 120 bytes on
  * each (a lit fill, no mesh lines, which would triple it), so 4000 keep
  * it under 0.5 MB. */
-enum { SURFACE_QUADS = 4000 };
+enum { SURFACE_QUADS = 2000 };
 
 /* dir/name into buf. */
 static int file_path(char *buf, size_t size, const char *dir, const char *name, bsim_error *err)
@@ -377,10 +378,6 @@ static void gp_text(char *out, size_t size, const char *s)
 	out[n] = '\0';
 }
 
-/* A palette from dark blue through green to yellow (viridis). */
-static const char PALETTE[] = "set palette defined (0 '#440154', 1 '#3b528b', 2 '#21918c', "
-                              "3 '#5ec962', 4 '#fde725')\n";
-
 /* The clip level: a quarter of the way above the highest pass or the
  * start, whichever is higher, over the landscape's lowest point (E_beam
  * alone: 0.6 of the way above the highest pass); never above the
@@ -423,18 +420,29 @@ static double contour_step(double range)
 	return (m < 1.5 ? 1 : m < 3.5 ? 2 : m < 7.5 ? 5 : 10) * p;
 }
 
+/* The title's first line: the scene, what the landscape is (the model's,
+ * no backend: it is computed, not simulated) and the parameters that shape
+ * it, as bsim_key_value writes them ("k_1 = 300 N m/rad, F_prop = 8 N"). */
 static void describe_scene(char *out, size_t size, const bsim_scene *s)
 {
-	char name[128], ks[160] = "";
+	char name[128];
 	gp_text(name, sizeof name, s->name[0] ? s->name : "scene");
-	size_t n = 0;
-	for (int b = 0; b < s->n_beams && b < 6 && n < sizeof ks - 16; b++)
-		n += (size_t)snprintf(ks + n, sizeof ks - n, "%s%g", b ? " : " : "",
-		                      s->beams[b].stiffness);
-	if (s->n_beams > 6)
-		snprintf(ks + n, sizeof ks - n, " ...");
-	snprintf(out, size, "%s, k = %s N m/rad, F_prop = %g N", name, ks,
+	size_t n = (size_t)snprintf(out, size, "%s: landscape of the model (no backend), ", name);
+	for (int b = 0; b < s->n_beams && b < 6 && n + 64 < size; b++) {
+		char key[32], val[32], kv[96];
+		snprintf(key, sizeof key, "beams.%d.stiffness", b);
+		snprintf(val, sizeof val, "%g", s->beams[b].stiffness);
+		bsim_key_value(key, val, 0, kv, sizeof kv);
+		n += (size_t)snprintf(out + n, size - n, "%s, ", kv);
+	}
+	if (s->n_beams > 6 && n + 8 < size)
+		n += (size_t)snprintf(out + n, size - n, "..., ");
+	char val[32], kv[96];
+	snprintf(val, sizeof val, "%g",
 	         s->effects.has_propulsion ? s->effects.propulsion_force : 0.0);
+	bsim_key_value("effects.propulsion.force", val, 0, kv, sizeof kv);
+	if (n < size)
+		snprintf(out + n, size - n, "%s", kv);
 }
 
 /* The beams at rest (grey, dashed), their reach, and the body at the
@@ -448,11 +456,11 @@ static void draw_beams(FILE *f, const bsim_scene *s, const bsim_landscape_barrie
 		double u0[2];
 		bsim_scene_beam_rest_direction(d, u0);
 		fprintf(f,
-		        "set object circle at %.6g,%.6g size %.6g fs empty border lc rgb '#bbbbbb' "
+		        "set object circle at %.6g,%.6g size %.6g fs empty border lc rgb '#404040' "
 		        "dt 2 lw 1 front\n",
 		        d->pivot[0], d->pivot[1], d->length + R);
 		fprintf(f,
-		        "set arrow from %.6g,%.6g to %.6g,%.6g nohead lw 2 lc rgb '#dddddd' dt 2 "
+		        "set arrow from %.6g,%.6g to %.6g,%.6g nohead lw 2 lc rgb '#202020' dt 2 "
 		        "front\n",
 		        d->pivot[0], d->pivot[1], d->pivot[0] + d->length * u0[0],
 		        d->pivot[1] + d->length * u0[1]);
@@ -466,7 +474,7 @@ static void draw_beams(FILE *f, const bsim_scene *s, const bsim_landscape_barrie
 		return;
 	const double c[2] = {p->x, p->y};
 	fprintf(f,
-	        "set object circle at %.6g,%.6g size %.6g fs empty border lc rgb 'white' dt 3 lw "
+	        "set object circle at %.6g,%.6g size %.6g fs empty border lc rgb '#202020' dt 3 lw "
 	        "1.5 front\n",
 	        c[0], c[1], R);
 	for (int b = 0; b < s->n_beams; b++) {
@@ -511,18 +519,18 @@ static void label_passes(FILE *f, const bsim_landscape_barriers *br, int three_d
 		else
 			snprintf(text, sizeof text, "beam %d: %.0f J", r, e);
 		const char *where = r == 0 ? "right offset -1,-1" : "left offset 1,1";
+		/* boxed on white (set style textbox in the callers), drawn in front
+		 * of the surface, so that no part of it hides a label */
 		if (three_d)
 			fprintf(f,
-			        "set label \"%s\" at %.6g,%.6g,%.6g %s front point pt 7 ps 1.2 lc "
-			        "rgb "
-			        "'red' tc rgb 'black'\n",
-			        text, p->x, p->y, e, where);
+			        "set label \"%s\" at %.6g,%.6g,%.6g %s front boxed point pt 7 ps "
+			        "1.4 lc rgb '%s' tc rgb 'black'\n",
+			        text, p->x, p->y, e, where, BSIM_FIGURE_PATH_RIGHT);
 		else
 			fprintf(f,
-			        "set label \"%s\" at %.6g,%.6g %s front point pt 7 ps 1.2 lc rgb "
-			        "'red' "
-			        "tc rgb 'white'\n",
-			        text, p->x, p->y, where);
+			        "set label \"%s\" at %.6g,%.6g %s front boxed point pt 7 ps 1.2 "
+			        "lc rgb '%s' tc rgb 'black'\n",
+			        text, p->x, p->y, where, BSIM_FIGURE_PATH_RIGHT);
 	}
 }
 
@@ -545,7 +553,7 @@ static int figure_top(const char *dir, const bsim_scene *s, const bsim_landscape
 	FILE *f = open_memstream(&body, &len);
 	if (!f)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	fputs(PALETTE, f);
+	fputs(BSIM_FIGURE_LANDSCAPE_PALETTE, f);
 	fprintf(f,
 	        "set title \"%s\\nE_total = E_prop + E_beam, colours clipped at %.0f J\" "
 	        "noenhanced\n",
@@ -553,8 +561,9 @@ static int figure_top(const char *dir, const bsim_scene *s, const bsim_landscape
 	fprintf(f,
 	        "set xrange [%.6g:%.6g]\nset yrange [%.6g:%.6g]\nset cbrange [%.6g:%.6g]\n"
 	        "set size ratio -1\nset xlabel 'x (m)'\nset ylabel 'y (m)'\n"
-	        "set cblabel 'E_{total} (J)'\nset key bottom left opaque box\n",
-	        g->x0, x1, g->y0, y1, e_min, clip);
+	        "set cblabel '%s'\nset colorbox\nset key bottom left opaque box\n"
+	        "set style textbox opaque fc rgb 'white' noborder\n",
+	        g->x0, x1, g->y0, y1, e_min, clip, BSIM_FIGURE_LANDSCAPE_CBLABEL);
 	/* Contour lines into a table, then drawn over the image. */
 	const double step = contour_step(clip - e_min);
 	fprintf(f,
@@ -568,21 +577,23 @@ static int figure_top(const char *dir, const bsim_scene *s, const bsim_landscape
 	draw_beams(f, s, br);
 	label_passes(f, br, 0, 0);
 	fprintf(f,
-	        "set label \"start\" at %.6g,%.6g front point pt 9 ps 1.5 lc rgb 'white' offset "
-	        "1,0.5 tc rgb 'white'\n",
+	        "set label \"start\" at %.6g,%.6g front point pt 9 ps 1.5 lc rgb 'black' offset "
+	        "1,0.5 tc rgb 'black' boxed\n",
 	        br->start[0], br->start[1]);
 	fputs("plot 'landscape_top.dat' nonuniform matrix using 1:2:3 with image notitle, \\\n", f);
-	fputs("     'landscape_top_contours.dat' using 1:2 with lines lc rgb '#dddddd' lw 0.6 "
+	fputs("     'landscape_top_contours.dat' using 1:2 with lines lc rgb '#606060' lw 0.5 "
 	      "notitle, \\\n",
 	      f);
-	fputs("     'landscape_paths.dat' index 0 using 1:2 with lines lc rgb 'red' lw 2.5 "
-	      "title 'path of least resistance'",
+	fputs("     'landscape_paths.dat' index 0 using 1:2 with lines lc rgb 'white' lw 5 "
+	      "notitle, \\\n"
+	      "     'landscape_paths.dat' index 0 using 1:2 with lines lc rgb "
+	      "'" BSIM_FIGURE_PATH_RIGHT "' lw 2.5 title 'path of least resistance'",
 	      f);
 	for (int b = 0; b < br->n_beams; b++)
 		if (br->beam[b].n_path > 0)
 			fprintf(f,
 			        ", \\\n     'landscape_paths.dat' index %d using 1:2 with lines "
-			        "lc rgb '#ff9da7' lw 1.2 dt 2 %s",
+			        "lc rgb '#000000' lw 1.2 dt 2 %s",
 			        b + 1, b == 0 ? "title 'over each beam'" : "notitle");
 	fputc('\n', f);
 	if (fclose(f) != 0) {
@@ -596,8 +607,109 @@ static int figure_top(const char *dir, const bsim_scene *s, const bsim_landscape
 	return BSIM_OK;
 }
 
+/* The surface as drawn: every stride-th point of v (the last row and
+ * column always in), NaN where it is not drawn. gnuplot's pm3d leaves out
+ * each quadrangle with a NaN corner, so a NaN point cuts the surface there:
+ * - where the body cannot be (overlapping a pivot) and above the clip level
+ *   (near a pivot th(x, y) nears pi and E thousands of joules);
+ * - at a cliff, the step of the landscape at the rim of a beam's reach
+ *   (rho = L + R, MODEL.md section 7): between neighbours that differ by
+ *   more than CLIFF_SHARE of the drawn range and by more than CLIFF_RATIO
+ *   times the steps on either side, the higher one. Drawn, a step is one
+ *   quadrangle standing upright, which no lighting makes legible. */
+#define CLIFF_SHARE 0.12
+#define CLIFF_RATIO 3.0
+
+static int next_index(int i, int stride, int n)
+{
+	return i + stride < n || i == n - 1 ? i + stride : n - 1;
+}
+
+static int write_surface(const char *dir, const char *file, const bsim_scene *s,
+                         const bsim_landscape_grid *g, const double *v, int stride, double e_min,
+                         double clip, bsim_error *err)
+{
+	int ni = 0, nj = 0;
+	for (int i = 0; i < g->nx; i = next_index(i, stride, g->nx))
+		ni++;
+	for (int j = 0; j < g->ny; j = next_index(j, stride, g->ny))
+		nj++;
+	double *xs = malloc((size_t)ni * sizeof *xs), *ys = malloc((size_t)nj * sizeof *ys);
+	double *w = malloc((size_t)ni * (size_t)nj * sizeof *w);
+	unsigned char *cut = calloc((size_t)ni * (size_t)nj, 1);
+	if (!xs || !ys || !w || !cut) {
+		free(xs);
+		free(ys);
+		free(w);
+		free(cut);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	int a = 0;
+	for (int i = 0; i < g->nx; i = next_index(i, stride, g->nx))
+		xs[a++] = g->x0 + i * g->spacing;
+	a = 0;
+	for (int j = 0; j < g->ny; j = next_index(j, stride, g->ny)) {
+		ys[a] = g->y0 + j * g->spacing;
+		int b = 0;
+		for (int i = 0; i < g->nx; i = next_index(i, stride, g->nx)) {
+			const double e = v[(size_t)j * (size_t)g->nx + (size_t)i];
+			w[(size_t)a * (size_t)ni + (size_t)b] =
+			        on_pivot(s, xs[b], ys[a]) || e > clip ? NAN : e;
+			b++;
+		}
+		a++;
+	}
+	/* cliffs along x (di = 1) and along y (di = ni) */
+	const double big = CLIFF_SHARE * (clip - e_min);
+	for (int dir_y = 0; dir_y < 2; dir_y++) {
+		const int outer = dir_y ? ni : nj, inner = dir_y ? nj : ni;
+		for (int o = 0; o < outer; o++)
+			for (int k = 0; k + 1 < inner; k++) {
+				size_t p0 = dir_y ? (size_t)k * (size_t)ni + (size_t)o
+				                  : (size_t)o * (size_t)ni + (size_t)k;
+				const size_t step = dir_y ? (size_t)ni : 1;
+				const double d = w[p0 + step] - w[p0];
+				if (!(fabs(d) > big))
+					continue;
+				const double before = k > 0 ? fabs(w[p0] - w[p0 - step]) : 0.0;
+				const double after =
+				        k + 2 < inner ? fabs(w[p0 + 2 * step] - w[p0 + step]) : 0.0;
+				if (fabs(d) > CLIFF_RATIO * fmax(isnan(before) ? 0 : before,
+				                                 isnan(after) ? 0 : after))
+					cut[d > 0 ? p0 + step : p0] = 1;
+			}
+	}
+	char path[BSIM_PATH_MAX];
+	int rc = file_path(path, sizeof path, dir, file, err);
+	bsim_atomic_file o;
+	if (!rc)
+		rc = bsim_atomic_file_open(&o, path, err);
+	if (!rc) {
+		/* gnuplot's grid format (a row of x per block), which takes NaN
+		 * without the warning a matrix gives */
+		fputs("# x y (m), E (J) as drawn: NaN where the surface is cut\n", o.f);
+		for (int j = 0; j < nj; j++) {
+			for (int i = 0; i < ni; i++) {
+				const size_t k = (size_t)j * (size_t)ni + (size_t)i;
+				if (cut[k] || isnan(w[k]))
+					fprintf(o.f, "%.8g %.8g NaN\n", xs[i], ys[j]);
+				else
+					fprintf(o.f, "%.8g %.8g %.6g\n", xs[i], ys[j], w[k]);
+			}
+			fputc('\n', o.f);
+		}
+		rc = bsim_atomic_file_commit(&o, err);
+	}
+	free(xs);
+	free(ys);
+	free(w);
+	free(cut);
+	return rc;
+}
+
 /* A 3-D surface of v (E_beam or E_total) with the passes marked (essay
- * Fig. 2.6a, b, d). */
+ * Fig. 2.6a, b, d), in the landscapes' colours with a colour bar, seen
+ * from the start's side. */
 static int figure_surface(const char *dir, const char *name, const bsim_scene *s,
                           const bsim_landscape_grid *g, const bsim_landscape_barriers *br,
                           const double *v, int beam_only, bsim_figure_def *def, char **out,
@@ -611,15 +723,7 @@ static int figure_surface(const char *dir, const char *name, const bsim_scene *s
 		stride++;
 	const double e_min = grid_min(s, g, v);
 	const double clip = clip_level(g, br, v, e_min, beam_only);
-	/* heights above the clip level are drawn at it */
-	const size_t n = grid_points(g);
-	double *vc = malloc(n * sizeof *vc);
-	if (!vc)
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (size_t k = 0; k < n; k++)
-		vc[k] = fmin(v[k], clip);
-	int rc = write_matrix(dir, data, s, g, vc, stride < 1 ? 1 : stride, clip, err);
-	free(vc);
+	int rc = write_surface(dir, data, s, g, v, stride, e_min, clip, err);
 	if (rc)
 		return rc;
 	char what[320];
@@ -629,26 +733,35 @@ static int figure_surface(const char *dir, const char *name, const bsim_scene *s
 	FILE *f = open_memstream(&body, &len);
 	if (!f)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	fputs(PALETTE, f);
-	fprintf(f, "set title \"%s\\n%s, heights clipped at %.0f J\" noenhanced\n", what,
+	fputs(BSIM_FIGURE_LANDSCAPE_PALETTE, f);
+	fprintf(f,
+	        "set title \"%s\\n%s; drawn up to %.0f J, cut at the steps and pivots\" "
+	        "noenhanced\n",
+	        what,
 	        beam_only ? "E_beam, the springs alone; the passes of E_total at their E_beam"
 	                  : "E_total = E_prop + E_beam",
 	        clip);
 	fprintf(f,
 	        "set xlabel 'x (m)'\nset ylabel 'y (m)'\nset zlabel '%s (J)' rotate parallel\n"
-	        "set cbrange [%.6g:%.6g]\nset zrange [%.6g:%.6g]\nunset colorbox\n"
-	        "set view 65,20,1,1.1\nset xyplane 0\nset pm3d depthorder lighting "
-	        "primary 0.45 specular 0.1\nset grid\n",
-	        beam_only ? "E_{beam}" : "E_{total}", e_min, clip, e_min, clip);
+	        "set cbrange [%.6g:%.6g]\nset zrange [%.6g:%.6g]\n"
+	        "set colorbox vertical user origin 0.88,0.2 size 0.025,0.55\n"
+	        "set cblabel '%s'\n"
+	        "set view 58,300,1,1.05\nset xyplane 0\nset hidden3d\n"
+	        "set pm3d depthorder interpolate 2,2 lighting primary 0.5 specular 0.15\n"
+	        "set grid\nset style textbox opaque fc rgb 'white' noborder\n"
+	        "set rmargin at screen 0.84\n",
+	        beam_only ? "E_{beam}" : "E_{total}", e_min, clip, e_min, clip,
+	        beam_only ? "potential energy of the springs E_{beam} (J)"
+	                  : BSIM_FIGURE_LANDSCAPE_CBLABEL);
 	label_passes(f, br, 1, beam_only);
-	fprintf(f, "splot '%s' nonuniform matrix using 1:2:3 with pm3d notitle\n", data);
+	fprintf(f, "splot '%s' using 1:2:3 with pm3d notitle\n", data);
 	if (fclose(f) != 0) {
 		free(body);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	def->name = name;
-	def->width = 900;
-	def->height = 700;
+	def->width = 1000;
+	def->height = 750;
 	*out = body;
 	return BSIM_OK;
 }

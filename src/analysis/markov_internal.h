@@ -10,7 +10,9 @@
 #include <gsl/gsl_rng.h>
 #include <stdint.h>
 
+#include "beamsim/lattice_outcome.h"
 #include "beamsim/markov.h"
+#include "beamsim/override.h"
 #include "beamsim/trial.h" /* BSIM_EDGE_* */
 
 /* ---- bins (markov_bins.c) ---- */
@@ -87,5 +89,30 @@ int markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_b
  * the value def holds (the caller's defaults). Each field is checked on its own;
  * the def as a whole is checked where maps are built or loaded. */
 int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err);
+
+/* ---- figures of final locations (markov_figure.c) ---- */
+
+/* A panel of a field figure: the probability of each location (p), or,
+ * with minus, the difference p - minus; p NULL leaves its place empty. */
+typedef struct markov_field_panel {
+	const char *title;
+	const double *p, *minus;
+} markov_field_panel;
+
+/* Sums of p over the ends, the sides and the stuck gates. */
+void markov_field_totals(const bsim_location *loc, const double *p, int n, double tot[3]);
+
+/* "backend thesis, F_prop = 6 N, k_1 = 100 N m/rad": the backend (may be
+ * NULL) and overrides in the model's symbols (beamsim/key_names.h). */
+void markov_title_params(char *buf, size_t size, const char *backend, const bsim_override *ov,
+                         int n);
+
+/* Writes stage/NAME.dat and draws NAME: the n_panels panels, per_row to a
+ * row, each a map of the field's n locations loc (every final location of
+ * the lattice: its ends, sides and gates) with the totals of end, side and
+ * stuck in the panel's title. */
+int markov_field_figure(const char *stage, const char *name, const char *title,
+                        const bsim_location *loc, int n, const markov_field_panel *panel,
+                        int n_panels, int per_row, int *drawn, bsim_error *err);
 
 #endif

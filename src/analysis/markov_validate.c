@@ -12,7 +12,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "analysis/markov_internal.h"
 #include "util/atomic_file.h"
+#include "beamsim/backend.h"
 #include "beamsim/experiment.h"
 #include "beamsim/markov.h"
 #include "beamsim/output.h"
@@ -166,6 +168,7 @@ typedef struct group_data {
 	int trials[2];
 	double *gates_sim[2]; /* [k] for k = 0 .. n_gates_sim[i] */
 	int n_gates_sim[2];
+	char title[400]; /* backend and parameters, for the figure */
 } group_data;
 
 static int write_csv(const char *stage, const bsim_experiment *e, const bsim_markov_validation *v,
@@ -258,63 +261,34 @@ static int write_json(const char *stage, const bsim_markov_validate_def *def,
 	return bsim_atomic_file_commit(&o, err);
 }
 
-/* validate_gNNN: per protocol, the locations either side puts above 0.2%:
- * simulated bars with their intervals, the chain's points. */
+/* validate_gNNN: the field three times, the chain's prediction and the
+ * simulated final locations of both protocols, on one scale, and under the
+ * simulations the chain's difference from each; the totals of end, side
+ * and stuck in every panel's title, the distances in the figure's. */
 static int write_figure(const char *stage, int g, const group_data *d,
                         const bsim_markov_validation *v, int *drawn, bsim_error *err)
 {
-	char path[BSIM_PATH_MAX], name[32];
+	char name[32], title[900];
 	snprintf(name, sizeof name, "validate_g%03d", g);
-	snprintf(path, sizeof path, "%s/%s.dat", stage, name);
-	bsim_atomic_file o;
-	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
-		return BSIM_EFAIL;
-	const bsim_markov_prediction *p = &d->pred;
-	int rows[2] = {0, 0};
-	for (int pr = 0; pr < 2; pr++) {
-		fprintf(o.f, "# %s: index label p_sim lo hi p_chain\n", protocol_names[pr]);
-		for (int i = 0; i < p->n_locations; i++) {
-			double ps = d->p_sim[pr][i];
-			if (ps < 0.002 && p->p[i] < 0.002)
-				continue;
-			double lo, hi;
-			int n = d->trials[pr];
-			bsim_stats_wilson((int)lround(ps * n), n, BSIM_STATS_Z95, &lo, &hi);
-			char label[48];
-			bsim_lattice_location_label(p->loc[i], label, sizeof label);
-			fprintf(o.f, "%d \"%s\" %.6g %.6g %.6g %.6g\n", rows[pr]++, label, ps, lo,
-			        hi, p->p[i]);
-		}
-		fputs("\n\n", o.f);
-	}
-	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
-		return BSIM_EFAIL;
-	char body[4096];
 	const bsim_markov_check *c = &v->checks[2 * g];
-	snprintf(
-	        body, sizeof body,
-	        "set multiplot layout 2,1 title \"group %d: final locations, simulated (bars, "
-	        "Wilson 95%%) and predicted by the chain (points)\"\n"
-	        "set style fill solid 0.5 border -1\nset boxwidth 0.6\nset ylabel \"probability\"\n"
-	        "set xtics rotate by 60 right font \",8\"\nset yrange [0:*]\nset grid ytics\n"
-	        "set key top right\n"
-	        "set title \"essay protocol: TV %.3f (simulation's sampling %.3f, map's %.3f)\"\n"
-	        "plot '%s.dat' index 0 using 1:3:xtic(2) with boxes lc rgb '#4477aa' title "
-	        "'simulated', '' index 0 using 1:3:4:5 with yerrorbars lc rgb 'black' pt -1 "
-	        "notitle, '' index 0 using 1:6 with points pt 7 ps 0.8 lc rgb '#cc3311' "
-	        "title 'chain'\n"
-	        "set title \"whole world: TV %.3f (simulation's sampling %.3f)\"\n"
-	        "plot '%s.dat' index 1 using 1:3:xtic(2) with boxes lc rgb '#4477aa' title "
-	        "'simulated', '' index 1 using 1:3:4:5 with yerrorbars lc rgb 'black' pt -1 "
-	        "notitle, '' index 1 using 1:6 with points pt 7 ps 0.8 lc rgb '#cc3311' "
-	        "title 'chain'\nunset multiplot\n",
-	        g, c[0].tv, c[0].tv_sampling, c[0].tv_map, name, c[1].tv, c[1].tv_sampling, name);
-	bsim_figure_def fd = bsim_figure_def_default();
-	fd.dir = stage;
-	fd.name = name;
-	fd.width = 1100;
-	fd.height = 800;
-	return bsim_figure_render(&fd, body, drawn, err);
+	const bsim_markov_prediction *p = &d->pred;
+	snprintf(title, sizeof title,
+	         "group %d: final locations predicted by the chain and simulated (%d trials "
+	         "per protocol)\n%s\nTV essay protocol %.3f (simulation's sampling %.3f, "
+	         "map's %.3f); whole world %.3f (sampling %.3f)",
+	         g, d->trials[0], d->title, c[0].tv, c[0].tv_sampling, c[0].tv_map, c[1].tv,
+	         c[1].tv_sampling);
+	/* (d) and (e) under (b) and (c): the second row's first place empty */
+	const markov_field_panel panel[6] = {
+	        {"(a) predicted by the chain", p->p, NULL},
+	        {"(b) simulated, essay protocol", d->p_sim[0], NULL},
+	        {"(c) simulated, whole world", d->p_sim[1], NULL},
+	        {"", NULL, NULL},
+	        {"(d) chain - essay protocol", p->p, d->p_sim[0]},
+	        {"(e) chain - whole world", p->p, d->p_sim[1]},
+	};
+	return markov_field_figure(stage, name, title, p->loc, p->n_locations, panel, 6, 3, drawn,
+	                           err);
 }
 
 /* ---- the run ------------------------------------------------------------------ */
@@ -327,7 +301,8 @@ static int simulate(const bsim_experiment *e, const bsim_markov_validate_def *de
 	bsim_override *ov = malloc((size_t)n * sizeof *ov);
 	if (!ov)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	memcpy(ov, def->sets, (size_t)def->n_sets * sizeof *ov);
+	if (def->n_sets > 0) /* sets is NULL without --set */
+		memcpy(ov, def->sets, (size_t)def->n_sets * sizeof *ov);
 	ov[def->n_sets] =
 	        (bsim_override){"lattice.protocol", protocol_names[pr], "markov validate"};
 	bsim_sweep_config cfg = {.backend = set->def.backend,
@@ -363,6 +338,26 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 	if (rc == BSIM_OK)
 		rc = bootstrap_maps(rng, &scene, &set, &d->pred, def->map_resamples, &tv_map, err);
 	if (rc == BSIM_OK) {
+		/* the figure's title: the backend, the experiment's set:, the
+		 * command line's --set and the group's grid values */
+		const int na = e->n_axes, n = e->n_set + def->n_sets + na;
+		bsim_override *ov = malloc((size_t)(n > 0 ? n : 1) * sizeof *ov);
+		int *idx = malloc((size_t)(na > 0 ? na : 1) * sizeof *idx);
+		if (ov && idx) {
+			bsim_experiment_group_index(e, g, idx);
+			if (e->n_set > 0)
+				memcpy(ov, e->set, (size_t)e->n_set * sizeof *ov);
+			if (def->n_sets > 0)
+				memcpy(ov + e->n_set, def->sets, (size_t)def->n_sets * sizeof *ov);
+			for (int a = 0; a < na; a++)
+				ov[e->n_set + def->n_sets + a] = (bsim_override){
+				        e->axes[a].key, e->axes[a].values[idx[a]], NULL};
+			const bsim_backend *b =
+			        set.def.backend ? set.def.backend : bsim_backend_default();
+			markov_title_params(d->title, sizeof d->title, b ? b->name : NULL, ov, n);
+		}
+		free(ov);
+		free(idx);
 		v->bins = set.n ? set.maps[0].n_bins : 0;
 		v->trials_per_bin = set.def.trials;
 		for (int i = 0; i < set.n; i++)

@@ -149,8 +149,8 @@ static int predict_option(void *args, int i, const char *value)
 }
 
 static const char *const predict_help[CLI_N_OPTS] = {
-        [CLI_OPT_OUT] = "also write prediction.csv, prediction_gates.csv and their\n"
-                        ".mat twins into DIR",
+        [CLI_OPT_OUT] = "also write prediction.csv, prediction_gates.csv, their\n"
+                        ".mat twins and the figure prediction.png (the field) into DIR",
 };
 
 static const cli_spec predict_spec = {
@@ -401,7 +401,7 @@ static int markov_predict(int argc, char **argv)
 	if (rc == BSIM_OK)
 		rc = bsim_markov_predict(&scene, &set, &p, &err);
 	if (rc == BSIM_OK && c.out)
-		rc = bsim_markov_prediction_store(c.out, &p, &err);
+		rc = bsim_markov_prediction_store(c.out, &scene, &set, &p, &err);
 	/* --quiet wins over --json: nothing on stdout. */
 	if (rc == BSIM_OK && !c.quiet && a.json)
 		predict_json(path, &scene, &set, &p);

@@ -22,6 +22,8 @@
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
 #include "beamsim/limits.h"
+#include "util/figure.h"
+#include "beamsim/key_names.h"
 
 static const struct {
 	const char *name, *color;
@@ -30,9 +32,9 @@ static const struct {
         [FPATH_OTHER] = {"other outcome", FIG_PURPLE, 1.0},
         [FPATH_STUCK] = {"stuck", FIG_DKGREY, 1.0},
         [FPATH_SIDE_EXIT] = {"side exit", FIG_GREY, 1.0},
-        [FPATH_NONE] = {"traversed, v_x = 0", FIG_GREEN, 1.5},
-        [FPATH_RIGHT] = {"traversed, right type", FIG_RED, 1.5},
-        [FPATH_LEFT] = {"traversed, left type", FIG_BLUE, 1.5},
+        [FPATH_NONE] = {"traversed, v_x = 0", BSIM_FIGURE_PATH_NONE, 1.5},
+        [FPATH_RIGHT] = {"traversed, right type", BSIM_FIGURE_PATH_RIGHT, 1.5},
+        [FPATH_LEFT] = {"traversed, left type", BSIM_FIGURE_PATH_LEFT, 1.5},
 };
 
 int fpath_class(const char *outcome, const char *type)
@@ -63,6 +65,30 @@ int fpath_below(const bsim_scene *s, double x, double y, const double *theta)
 	bsim_landscape_energy(s, c, NULL, &e_land, NULL);
 	double e_beam = fpath_energy(s, y, theta) - bsim_landscape_e_prop(s, y);
 	return e_land - e_beam > FPATH_BELOW_J;
+}
+
+void fpath_params(char *buf, size_t size, const char *backend, const char *const *keys,
+                  const char *const *values, int n)
+{
+	size_t k = 0;
+	buf[0] = '\0';
+	if (backend && *backend)
+		k = (size_t)snprintf(buf, size, "backend %s", backend);
+	const int first = k > 0; /* the backend is the line's first item */
+	for (int i = 0; i < n && k < size; i++) {
+		char kv[200];
+		bsim_key_value(keys[i], values[i], 0, kv, sizeof kv);
+		/* three items to a line, to fit a figure's width */
+		const int item = i + first;
+		int m = snprintf(buf + k, size - k, "%s%s",
+		                 item == 0       ? ""
+		                 : item % 3 == 0 ? ",\n"
+		                                 : ", ",
+		                 kv);
+		if (m < 0)
+			break;
+		k += (size_t)m;
+	}
 }
 
 /* ---- reading --------------------------------------------------------------------- */
@@ -193,23 +219,28 @@ static void scene_box(const bsim_scene *s, double box[4])
 
 /* ---- thinning ------------------------------------------------------------------------- */
 
-/* A drawn path leaves out a row within DRAW_STEP_M of the last row drawn
- * (and, over the landscape, within DRAW_STEP_J in E) unless it ends the
- * path or goes below the surface or back: 0.5 m is 4 pixels of a 700-pixel
- * plot of 95 m, and keeps the SVG of a hundred paths under 1 MB. The
- * recorded rows are all in the trajectory file. */
-#define DRAW_STEP_M 0.5
-#define DRAW_STEP_J 5.0
+/* A drawn path leaves out a row within step_m of the last row drawn (and,
+ * over the landscape, within step_j in E) unless it ends the path or goes
+ * below the surface or back. In the bundle 0.5 m is 4 pixels of a
+ * 700-pixel plot of 95 m; over the landscape, where the plane is 500
+ * pixels tall and each path is drawn twice in both panels (its white
+ * outline, then its colour), 0.8 m is 4 pixels. Both keep the SVG of a
+ * hundred paths under 1 MB. The recorded rows are all in the trajectory
+ * file. */
+#define BUNDLE_STEP_M 0.5
+#define OVER_STEP_M   0.8
+#define OVER_STEP_J   8.0
 
 typedef struct thin {
 	double x, y, e;
 	int below, started;
 } thin;
 
-static int thin_keep(thin *t, double x, double y, double e, int below, int last)
+static int thin_keep(thin *t, double x, double y, double e, int below, int last, double step_m,
+                     double step_j)
 {
 	int keep = !t->started || last || below != t->below ||
-	           hypot(x - t->x, y - t->y) >= DRAW_STEP_M || fabs(e - t->e) >= DRAW_STEP_J;
+	           hypot(x - t->x, y - t->y) >= step_m || fabs(e - t->e) >= step_j;
 	if (keep)
 		*t = (thin){x, y, e, below, 1};
 	return keep;
@@ -247,7 +278,8 @@ int figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *
 			first = 0;
 			thin t = {0};
 			for (long k = 0; k < p[i].n; k++)
-				if (thin_keep(&t, p[i].x[k], p[i].y[k], 0.0, 0, k == p[i].n - 1))
+				if (thin_keep(&t, p[i].x[k], p[i].y[k], 0.0, 0, k == p[i].n - 1,
+				              BUNDLE_STEP_M, INFINITY))
 					fprintf(o.f, "%.6g %.6g\n", p[i].x[k], p[i].y[k]);
 		}
 	}
@@ -288,37 +320,122 @@ int figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *
 
 /* ---- Figs. 2.7 and 3.3: over the landscape ------------------------------------------- */
 
+/* Cuts a step of the landscape out of the 3-D surface: between two
+ * neighbours that differ by more than CLIFF_SHARE of the drawn range and by
+ * more than CLIFF_RATIO times the steps on either side (the rim of a
+ * beam's reach, rho = L + R), the higher one becomes NaN, and pm3d leaves
+ * out the quadrangles around it. Drawn, a step is an upright quadrangle
+ * that hides what is behind it. */
+#define CLIFF_SHARE 0.12
+#define CLIFF_RATIO 3.0
+
+static void cut_steps(double *w, int nx, int ny, double range)
+{
+	unsigned char *cut = calloc((size_t)nx * (size_t)ny, 1);
+	if (!cut)
+		return; /* drawn uncut */
+	for (int along_y = 0; along_y < 2; along_y++) {
+		const int outer = along_y ? nx : ny, inner = along_y ? ny : nx;
+		const size_t step = along_y ? (size_t)nx : 1;
+		for (int o = 0; o < outer; o++)
+			for (int k = 0; k + 1 < inner; k++) {
+				const size_t p0 = along_y ? (size_t)k * (size_t)nx + (size_t)o
+				                          : (size_t)o * (size_t)nx + (size_t)k;
+				const double d = w[p0 + step] - w[p0];
+				if (!(fabs(d) > CLIFF_SHARE * range))
+					continue;
+				double before = k > 0 ? fabs(w[p0] - w[p0 - step]) : 0.0;
+				double after =
+				        k + 2 < inner ? fabs(w[p0 + 2 * step] - w[p0 + step]) : 0.0;
+				before = isnan(before) ? 0.0 : before;
+				after = isnan(after) ? 0.0 : after;
+				if (fabs(d) > CLIFF_RATIO * fmax(before, after))
+					cut[d > 0 ? p0 + step : p0] = 1;
+			}
+	}
+	for (size_t k = 0; k < (size_t)nx * (size_t)ny; k++)
+		if (cut[k])
+			w[k] = NAN;
+	free(cut);
+}
+
 /* The surface E_total(x, y) on a grid of about 1 m over the shown plane,
- * one x row per block (gnuplot's grid format), and the surface as drawn:
- * cut at cap, since near a pivot th(x, y) nears pi and E_total climbs to
- * thousands of joules where no path goes. e_min gets the lowest value. */
+ * one y row per block (gnuplot's grid format): x y E_total, E_drawn (cut
+ * at cap, for the map: near a pivot th(x, y) nears pi and E_total climbs
+ * to thousands of joules where no path goes), E_3d (the 3-D surface, every
+ * second point in x and y: NaN above cap, at the steps and at the points
+ * between). e_min gets the lowest value. */
 static int surface_write(figs *f, const char *file, const bsim_scene *s, const double box[4],
                          double cap, double *e_min, bsim_error *err)
 {
-	char path[BSIM_PATH_MAX];
-	bsim_atomic_file o;
-	int rc = figs_data_open(f, file, &o, path, err);
-	if (rc)
-		return rc;
 	const int nx = 51;
 	const double dx = (box[1] - box[0] - 6.0) / (nx - 1);
 	const int ny = (int)ceil((box[3] - box[2]) / dx) + 1;
 	const double dy = (box[3] - box[2]) / (ny - 1);
-	*e_min = INFINITY;
-	fprintf(o.f,
-	        "# x y (m), E_total (J): the landscape F_prop (y0 - y) + sum 1/2 k th(x, y)^2,\n"
-	        "# then E_total as drawn, cut at %.6g J\n",
-	        cap);
-	for (int i = 0; i < nx; i++) {
-		for (int j = 0; j < ny; j++) {
-			const double c[2] = {box[0] + 3.0 + i * dx, box[2] + j * dy};
-			double e = bsim_landscape_energy(s, c, NULL, NULL, NULL);
-			*e_min = fmin(*e_min, e);
-			fprintf(o.f, "%.5g %.5g %.6g %.6g\n", c[0], c[1], e, fmin(e, cap));
-		}
-		fputc('\n', o.f);
+	double *e = malloc((size_t)nx * (size_t)ny * sizeof *e);
+	double *w = malloc((size_t)nx * (size_t)ny * sizeof *w);
+	if (!e || !w) {
+		free(e);
+		free(w);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
-	return figs_data_commit(&o, err);
+	*e_min = INFINITY;
+	for (int j = 0; j < ny; j++)
+		for (int i = 0; i < nx; i++) {
+			const double c[2] = {box[0] + 3.0 + i * dx, box[2] + j * dy};
+			const size_t k = (size_t)j * (size_t)nx + (size_t)i;
+			e[k] = bsim_landscape_energy(s, c, NULL, NULL, NULL);
+			*e_min = fmin(*e_min, e[k]);
+			w[k] = e[k] > cap ? NAN : e[k];
+		}
+	/* the 3-D surface is every second point in x and y (`every 2:2`: a
+	 * quarter of the quadrangles, to keep the SVG small); its steps are
+	 * found at that spacing, and every other point is NaN */
+	const int n3x = (nx + 1) / 2, n3y = (ny + 1) / 2;
+	double *w3 = malloc((size_t)n3x * (size_t)n3y * sizeof *w3);
+	if (!w3) {
+		free(e);
+		free(w);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	for (int j = 0; j < n3y; j++)
+		for (int i = 0; i < n3x; i++)
+			w3[(size_t)j * (size_t)n3x + (size_t)i] =
+			        w[(size_t)(2 * j) * (size_t)nx + (size_t)(2 * i)];
+	cut_steps(w3, n3x, n3y, cap - *e_min);
+	for (int j = 0; j < ny; j++)
+		for (int i = 0; i < nx; i++)
+			w[(size_t)j * (size_t)nx + (size_t)i] =
+			        i % 2 || j % 2
+			                ? NAN
+			                : w3[(size_t)(j / 2) * (size_t)n3x + (size_t)(i / 2)];
+	free(w3);
+	char path[BSIM_PATH_MAX];
+	bsim_atomic_file o;
+	int rc = figs_data_open(f, file, &o, path, err);
+	if (!rc) {
+		fprintf(o.f,
+		        "# x y (m), E_total (J): the landscape F_prop (y0 - y) + sum 1/2 k "
+		        "th(x, y)^2,\n# then E_total as drawn on the map, cut at %.6g J, and in "
+		        "3-D: NaN above it and at the steps\n",
+		        cap);
+		for (int j = 0; j < ny; j++) {
+			for (int i = 0; i < nx; i++) {
+				const size_t k = (size_t)j * (size_t)nx + (size_t)i;
+				fprintf(o.f, "%.5g %.5g %.6g %.6g ", box[0] + 3.0 + i * dx,
+				        box[2] + j * dy, e[k], fmin(e[k], cap));
+				if (isnan(w[k]))
+					fputs("NaN\n", o.f);
+				else
+					fprintf(o.f, "%.6g\n", w[k]);
+			}
+			fputc('\n', o.f);
+		}
+		rc = figs_data_commit(&o, err);
+	}
+	free(e);
+	free(w);
+	return rc;
 }
 
 /* Where the surface is cut: a quarter above the highest energy the paths
@@ -369,7 +486,8 @@ static int paths_write(figs *f, const char *file, const bsim_scene *s, const fpa
 			int b = fpath_below(s, p[i].x[k], p[i].y[k], th);
 			double e = fpath_energy(s, p[i].y[k], th);
 			*below += b;
-			if (thin_keep(&t, p[i].x[k], p[i].y[k], e, b, k == p[i].n - 1))
+			if (thin_keep(&t, p[i].x[k], p[i].y[k], e, b, k == p[i].n - 1, OVER_STEP_M,
+			              OVER_STEP_J))
 				fprintf(o.f, "%.6g %.6g %.6g %d %d\n", p[i].x[k], p[i].y[k], e,
 				        p[i].cls, b);
 		}
@@ -403,13 +521,30 @@ static int paths_write(figs *f, const char *file, const bsim_scene *s, const fpa
 	return figs_data_commit(&o, err);
 }
 
+/* A class's colour over the landscape: the traversals in the landscapes'
+ * path colours (util/figure.h), the rest orange, none of them grey or
+ * blue-green like the map. */
+static const char *class_color_over(int c)
+{
+	switch (c) {
+	case FPATH_LEFT:
+		return BSIM_FIGURE_PATH_LEFT;
+	case FPATH_RIGHT:
+		return BSIM_FIGURE_PATH_RIGHT;
+	case FPATH_NONE:
+		return BSIM_FIGURE_PATH_NONE;
+	default:
+		return FIG_ORANGE;
+	}
+}
+
 int figs_over_landscape(figs *f, const char *name, const char *title, const bsim_scene *scene,
                         const fpath *p, int n, unsigned mask, bsim_error *err)
 {
 	char surf[200], file[200];
 	snprintf(surf, sizeof surf, "%s.surface.dat", name);
 	snprintf(file, sizeof file, "%s.dat", name);
-	double box[4], e_min, e_max = surface_cap(scene, p, n, mask);
+	double box[4], e_min = 0.0, e_max = surface_cap(scene, p, n, mask);
 	long below, total;
 	scene_box(scene, box);
 	int rc = surface_write(f, surf, scene, box, e_max, &e_min, err);
@@ -425,14 +560,17 @@ int figs_over_landscape(figs *f, const char *name, const char *title, const bsim
 	if ((rc = gp_text_open(&g, err)))
 		return rc;
 	FILE *s = g.f;
-	fputs("set multiplot layout 1,2 title ", s);
+	/* Two panels side by side, placed by hand: (a) as tall as the plane
+	 * at 1:1, its colour bar at its right, (b) from there to the right
+	 * edge, so that no strip of the figure stays empty. */
+	fputs("set multiplot title ", s);
 	gp_str(s, title);
 	fprintf(s,
-	        " noenhanced\n"
-	        "set palette defined (0 '#FFFFE5', 0.35 '#FEC44F', 0.7 '#CC4C02', 1 '#662506')\n"
-	        "set cbrange [%g:%g]\nset cblabel 'E_{total} (J)'\n"
+	        " noenhanced\n" BSIM_FIGURE_LANDSCAPE_PALETTE
+	        "set cbrange [%g:%g]\nset cblabel '" BSIM_FIGURE_LANDSCAPE_CBLABEL "'\n"
 	        "# (a) from above: the landscape, its contours every 50 J, the paths\n"
-	        "set title '(a) the landscape from above; paths, below the surface in black'\n"
+	        "set origin 0,0\nset size 0.42,0.9\nset colorbox\n"
+	        "set title '(a) from above; below the surface in black'\n"
 	        "set view map\nset size ratio -1\nset xrange [%g:%g]\nset yrange [%g:%g]\n"
 	        "set xlabel 'x (m)'\nset ylabel 'y (m)'\nunset key\n"
 	        "set contour base\nunset clabel\nset cntrparam levels incremental %g,50,%g\n",
@@ -441,44 +579,66 @@ int figs_over_landscape(figs *f, const char *name, const char *title, const bsim
 	scene_objects(s, scene);
 	fprintf(s,
 	        "splot '%s' using 1:2:4 with image, \\\n"
-	        "      '' using 1:2:4 with lines nosurface lw 0.5 lc rgb '#7F000000', \\\n",
+	        "      '' using 1:2:4 with lines nosurface lw 0.5 lc rgb '#80404040', \\\n",
 	        surf);
+	/* every class over a white outline first, then the class's colour */
+	for (int c = 0; c < FPATH_N; c++)
+		if (count[c])
+			fprintf(s,
+			        "      '%s' index 0 using 1:2:($4 == %d ? 0 : NaN) with lines "
+			        "nocontour lw %g lc rgb '" BSIM_FIGURE_PATH_OUTLINE "', \\\n",
+			        file, c, classes[c].width + 2.5);
 	for (int c = 0; c < FPATH_N; c++)
 		if (count[c])
 			fprintf(s,
 			        "      '%s' index 0 using 1:2:($4 == %d ? 0 : NaN) with lines "
 			        "nocontour lw %g lc rgb '%s', \\\n",
-			        file, c, classes[c].width, classes[c].color);
+			        file, c, classes[c].width, class_color_over(c));
 	fprintf(s,
 	        "      '%s' index 1 using 1:2:(0) with lines nocontour lw 2.5 lc rgb '%s'\n"
 	        "unset contour\nunset arrow\nunset object\n",
 	        file, FIG_BLACK);
+	/* (b): the surface, then the paths in a second plot over it with the
+	 * same view and ranges: pm3d draws its depth-sorted quadrangles after
+	 * every line of its plot, so that in one plot the paths would be
+	 * under a translucent surface. */
 	fprintf(s,
-	        "# (b) in 3-D: the surface and each path at its own energy\n"
+	        "# (b) in 3-D, seen as landscape_total of beamsim landscape: the surface cut\n"
+	        "# above the top of the colours and at its steps; then, over it, each path at\n"
+	        "# its own energy, a stretch below the surface in black\n"
+	        "set origin 0.36,0\nset size 0.64,0.9\nunset colorbox\n"
 	        "set title '(b) E along the paths over the surface E_{total}(x, y)'\n"
-	        "# seen from behind the start; no depth sorting, so that the paths are drawn\n"
-	        "# over the translucent surface and a stretch below it stays in sight\n"
-	        "set view 60,10\nset size noratio\nset xyplane at %g\n"
+	        "set view 55,300,1,1.05\nset size noratio\nset xyplane 0\n"
 	        "set zlabel 'E (J)' rotate parallel\nset zrange [%g:%g]\n"
-	        "set style fill transparent solid 0.55\nunset colorbox\n"
-	        "set key at screen 0.99, screen 0.83 right top\n"
-	        "splot '%s' every 2:2 using 1:2:4 with pm3d notitle, \\\n",
-	        e_min, e_min, e_max, surf);
+	        "set pm3d depthorder lighting primary 0.5 specular 0.1\n"
+	        "splot '%s' every 2:2 using 1:2:5 with pm3d notitle\n"
+	        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\n"
+	        "unset zlabel\nunset grid\n"
+	        "set key at screen 0.99, screen 0.84 right top opaque box\n"
+	        "splot ",
+	        e_min, e_max, surf);
+	int k = 0;
 	for (int c = 0; c < FPATH_N; c++)
 		if (count[c])
 			fprintf(s,
-			        "      '%s' index 0 using 1:2:($4 == %d ? $3 : NaN) with lines lw "
-			        "%g "
-			        "lc rgb '%s' title '%s (%d)', \\\n",
-			        file, c, classes[c].width, classes[c].color, classes[c].name,
-			        count[c]);
+			        "%s'%s' index 0 using 1:2:($4 == %d ? $3 : NaN) with lines lw %g "
+			        "lc rgb '" BSIM_FIGURE_PATH_OUTLINE "' notitle",
+			        k++ ? ", \\\n      " : "", file, c, classes[c].width + 2.0);
+	for (int c = 0; c < FPATH_N; c++)
+		if (count[c])
+			fprintf(s,
+			        "%s'%s' index 0 using 1:2:($4 == %d ? $3 : NaN) with lines lw %g "
+			        "lc rgb '%s' title '%s (%d)'",
+			        k++ ? ", \\\n      " : "", file, c, classes[c].width,
+			        class_color_over(c), classes[c].name, count[c]);
 	fprintf(s,
-	        "      '%s' index 1 using 1:2:3 with lines lw 2.5 lc rgb '%s' "
+	        "%s'%s' index 1 using 1:2:3 with lines lw 2.5 lc rgb '%s' "
 	        "title 'below the surface: %.0f%% of the states'\n"
 	        "unset multiplot\n",
-	        file, FIG_BLACK, total ? 100.0 * (double)below / (double)total : 0.0);
+	        k ? ", \\\n      " : "", file, FIG_BLACK,
+	        total ? 100.0 * (double)below / (double)total : 0.0);
 	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, name, 1400, 720, body, err)
+	rc = body ? figs_render(f, name, 1400, 760, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;

@@ -48,6 +48,13 @@ int figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *
 int figs_over_landscape(figs *f, const char *name, const char *title, const bsim_scene *scene,
                         const fpath *p, int n, unsigned mask, bsim_error *err);
 
+/* The backend and the parameters of a figure's scene that differ from
+ * its scene file's, for a title: "backend thesis, F_prop = 8 N, R_m = 30 N,
+ * k_1 = 300 N m/rad" (beamsim/key_names.h), a line break after every third
+ * item; backend may be NULL or "". */
+void fpath_params(char *buf, size_t size, const char *backend, const char *const *keys,
+                  const char *const *values, int n);
+
 /* The paths of a trajectory table (trajectories.csv, or one trajectory
  * with group = trial = 0 when the table has no group column): the rows of
  * each (group, trial) in order. Allocates *paths (free with fpaths_free);

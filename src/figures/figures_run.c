@@ -21,11 +21,15 @@
 #include "util/yaml_doc.h"
 #include "beamsim/limits.h"
 
+/* Most beams of a scene Fig. 2.7(c) is drawn for (a gate has two). */
+#define BSIM_MAX_BEAMS_FIG 16
+
 /* The scene of the run: inputs/scene.yaml with run.json's "set"
- * overrides; outcome and type of the trial into the buffers. *found is 0
- * if there is no record to load it from. */
-static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *type, int *found,
-                     bsim_error *err)
+ * overrides; outcome and type of the trial into the buffers (32 bytes
+ * each), the backend and the overrides for a title into params
+ * (fpath_params). *found is 0 if there is no record to load it from. */
+static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *type, char *params,
+                     size_t params_size, int *found, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX], scene_path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/run.json", dir);
@@ -40,9 +44,10 @@ static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *ty
 		return rc;
 	struct fy_node *root = fy_document_root(d.fyd);
 	struct fy_node *set = ydoc_lookup(root, "set");
-	const char *names[2] = {"outcome", "type"};
-	char *bufs[2] = {outcome, type};
-	for (int i = 0; i < 2; i++) {
+	char backend[32] = "";
+	const char *names[3] = {"outcome", "type", "backend"};
+	char *bufs[3] = {outcome, type, backend};
+	for (int i = 0; i < 3; i++) {
 		struct fy_node *n = ydoc_lookup(root, names[i]);
 		size_t len = 0;
 		const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : "";
@@ -70,6 +75,18 @@ static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *ty
 	}
 	if (!rc)
 		rc = bsim_scene_load(scene_path, ov, n, scene, err);
+	if (!rc) {
+		const char **kv = malloc(2 * (size_t)n * sizeof *kv + 1);
+		if (!kv)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		for (int i = 0; kv && i < n; i++) {
+			kv[i] = text[2 * i];
+			kv[n + i] = text[2 * i + 1];
+		}
+		if (kv)
+			fpath_params(params, params_size, backend, kv, kv + n, n);
+		free(kv);
+	}
 	for (int i = 0; text && i < 2 * n; i++)
 		free(text[i]);
 	free(text);
@@ -310,6 +327,53 @@ static int ledger(figs *f, const char *dir, bsim_error *err)
 	return rc;
 }
 
+/* Fig. 2.7(c): a trajectory that went below the surface (a beam left the
+ * body while it was still within the beam's reach) drawn over the
+ * landscape of the beam that carried it alone, the one of the largest peak
+ * angle: the scene's other beams get stiffness 0 for the drawing, so that
+ * their terms drop out of both the surface and the path's energy. Drawn
+ * only for a path with a state below the surface of a scene of two or
+ * more beams. */
+static int single_beam(figs *f, bsim_scene *scene, const fpath *p, const char *title,
+                       bsim_error *err)
+{
+	const int nb = scene->n_beams;
+	long below = 0;
+	int active = 0;
+	double peak[BSIM_MAX_BEAMS_FIG] = {0};
+	if (nb < 2 || nb > BSIM_MAX_BEAMS_FIG)
+		return BSIM_OK;
+	for (long k = 0; k < p->n; k++) {
+		const double *th = p->theta + (size_t)k * (size_t)nb;
+		below += fpath_below(scene, p->x[k], p->y[k], th);
+		for (int b = 0; b < nb; b++)
+			peak[b] = fmax(peak[b], fabs(th[b]));
+	}
+	if (below == 0) {
+		figs_note(f, "landscape_path: no state below the surface, so no "
+		             "landscape_path_single (Fig. 2.7c)");
+		return BSIM_OK;
+	}
+	for (int b = 1; b < nb; b++)
+		if (peak[b] > peak[active])
+			active = b;
+	double k_saved[BSIM_MAX_BEAMS_FIG];
+	for (int b = 0; b < nb; b++) {
+		k_saved[b] = scene->beams[b].stiffness;
+		if (b != active)
+			scene->beams[b].stiffness = 0.0;
+	}
+	char t[1400];
+	snprintf(t, sizeof t,
+	         "%s\nover beam %d's landscape alone: F_prop (y0 - y) + 1/2 k_%d th_%d^2, the "
+	         "other beam%s left out",
+	         title, active + 1, active + 1, active + 1, nb > 2 ? "s" : "");
+	int rc = figs_over_landscape(f, "landscape_path_single", t, scene, p, 1, ~0u, err);
+	for (int b = 0; b < nb; b++)
+		scene->beams[b].stiffness = k_saved[b];
+	return rc;
+}
+
 int figs_run(figs *f, const char *dir, bsim_error *err)
 {
 	if (f->def->n_select > 0)
@@ -319,9 +383,9 @@ int figs_run(figs *f, const char *dir, bsim_error *err)
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/trajectory.csv", dir);
 	bsim_scene scene;
-	char outcome[32] = "", type[32] = "";
+	char outcome[32] = "", type[32] = "", params[400] = "";
 	int found;
-	int rc = run_scene(dir, &scene, outcome, type, &found, err);
+	int rc = run_scene(dir, &scene, outcome, type, params, sizeof params, &found, err);
 	if (!rc && !found) {
 		figs_note(f,
 		          "%s: no run.json and inputs/scene.yaml, so no scene: only the ledger "
@@ -334,9 +398,8 @@ int figs_run(figs *f, const char *dir, bsim_error *err)
 	csv_table t;
 	rc = csv_table_read(path, &t, err);
 	if (!rc) {
-		char hdr[600], plain[600];
+		char hdr[600];
 		run_header(dir, 1, hdr, sizeof hdr);
-		run_header(dir, 0, plain, sizeof plain);
 		rc = random_force(f, hdr, &t, path, &scene, err);
 		if (!rc)
 			rc = ledger(f, dir, err);
@@ -353,9 +416,11 @@ int figs_run(figs *f, const char *dir, bsim_error *err)
 			snprintf(title, sizeof title,
 			         "%s: one trial, %s%s%s, over its landscape\n%s", scene.name,
 			         outcome, *type && strcmp(type, "none") ? ", type " : "",
-			         strcmp(type, "none") ? type : "", plain);
+			         strcmp(type, "none") ? type : "", params);
 			rc = figs_over_landscape(f, "landscape_path", title, &scene, ps.p, 1, ~0u,
 			                         err);
+			if (!rc)
+				rc = single_beam(f, &scene, &ps.p[0], title, err);
 		}
 		fpaths_free(&ps);
 		csv_table_free(&t);

@@ -596,17 +596,35 @@ static int group_figures(figs *f, traj_job *j, int g, bsim_error *err)
 	snprintf(name, sizeof name, "trajectories_g%03d", g);
 	rc = figs_bundle(f, name, title, &scene, p, n, err);
 	if (!rc && trav > 0) {
+		/* the landscape's title: backend, the experiment's set: and the
+		 * group's grid values, in the model's symbols and units */
+		const int nk = j->e->n_set + j->s->n_axes;
+		const char **kv = malloc(2 * (size_t)(nk > 0 ? nk : 1) * sizeof *kv);
+		if (!kv) {
+			bsim_scene_free(&scene);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		}
+		for (int i = 0; i < j->e->n_set; i++) {
+			kv[i] = j->e->set[i].key;
+			kv[nk + i] = j->e->set[i].value;
+		}
+		for (int a = 0; a < j->s->n_axes; a++) {
+			kv[j->e->n_set + a] = j->s->axes[a].key;
+			kv[nk + j->e->n_set + a] = j->s->axes[a].values[j->s->g[g].idx[a]];
+		}
+		fpath_params(label, sizeof label, j->s->backend, kv, kv + nk, nk);
+		free(kv);
 		if (det)
 			snprintf(title, sizeof title,
 			         "group %d: one deterministic trial (no random force), traversed, "
 			         "over "
-			         "the landscape\n%s%s%s",
-			         g, j->s->header, *label ? "\n" : "", label);
+			         "the landscape\n%s",
+			         g, label);
 		else
 			snprintf(title, sizeof title,
 			         "group %d, the %d traversed of the first %d trials over the "
-			         "landscape\n%s%s%s",
-			         g, trav, n, j->s->header, *label ? "\n" : "", label);
+			         "landscape\n%s",
+			         g, trav, n, label);
 		snprintf(name, sizeof name, "landscape_g%03d", g);
 		rc = figs_over_landscape(f, name, title, &scene, p, n,
 		                         1u << FPATH_LEFT | 1u << FPATH_RIGHT | 1u << FPATH_NONE,

@@ -59,9 +59,15 @@ static const struct {
                                 "body's position (essay Fig. 2.6b)"},
         {"landscape_top.png", "E_total from above with contours, the passes and the paths of "
                               "least resistance (essay Fig. 2.6c)"},
+        {"landscape_path_single.png", "the same trajectory over the landscape of the beam "
+                                      "that carried it alone, the other left out (essay "
+                                      "Fig. 2.7c)"},
         {"landscape*.png", "the potential energy landscape (%s)"},
+        {"prediction.png", "final-location probabilities the Markov chain predicts, drawn as "
+                           "the field, with the end / side / stuck totals"},
         {"validate_g*.png", "group %s: the Markov chain's predicted final locations against "
-                            "simulated ones"},
+                            "simulated ones (essay protocol, whole world) drawn as the field, "
+                            "with the differences and the end / side / stuck totals"},
         {"kramers.png", "ln k, the traversal rate, against dE / D (Kramers' law) with the "
                         "fit, and its residuals"},
         {"*.png", "figure %s"},

@@ -17,6 +17,21 @@
 
 #include "beamsim/error.h"
 
+/* The colour convention of every potential-energy landscape (beamsim
+ * landscape, the paths of beamsim plot, Fig. 2.7): a grey to dark
+ * blue-green map, light where the energy is low (where the paths run), and
+ * a colour bar with this label. Nothing drawn over it is grey or
+ * blue-green: the paths of the left and right types are blue and
+ * vermilion, those of neither type magenta, saturated colours the map never
+ * reaches, each drawn over a white outline. */
+#define BSIM_FIGURE_LANDSCAPE_PALETTE                                                              \
+	"set palette defined (0 '#E4EBE9', 0.35 '#BFCFCB', 0.7 '#7E9E99', 1 '#2E4A47')\n"
+#define BSIM_FIGURE_LANDSCAPE_CBLABEL "potential energy E_{total} (J)"
+#define BSIM_FIGURE_PATH_LEFT         "#0072B2"
+#define BSIM_FIGURE_PATH_RIGHT        "#D55E00"
+#define BSIM_FIGURE_PATH_NONE         "#B8008A"
+#define BSIM_FIGURE_PATH_OUTLINE      "#FFFFFF"
+
 typedef struct bsim_figure_def {
 	const char *dir;  /* output directory, existing */
 	const char *name; /* base name of NAME.gp, NAME.png, NAME.svg */
