@@ -29,7 +29,9 @@
 #include <gsl/gsl_fit.h>
 
 #include "beamsim/landscape_barriers.h"
+#include "beamsim/key_names.h"
 #include "beamsim/limits.h"
+#include "beamsim/run_record.h"
 #include "beamsim/sweep_dir.h"
 #include "store/session.h"
 #include "store/store.h"
@@ -179,6 +181,7 @@ static void json_num(FILE *f, const char *name, double v, const char *sep)
 
 typedef struct esc_job {
 	const bsim_experiment *e;
+	const char *backend; /* the sweep's backend label, from run.json */
 	esc_group *g;
 	esc_scene *sc;
 	const escape_summary *sum;
@@ -307,11 +310,24 @@ static int write_figure(const char *stage, const esc_job *j, int *drawn, bsim_er
 			lo = fmin(lo, j->g[k].x);
 			hi = fmax(hi, j->g[k].x);
 		}
-	char body[2048];
+	/* the title's second line: the backend and the experiment's fixed
+	 * values, in the model's symbols */
+	char fixed[600];
+	int used = snprintf(fixed, sizeof fixed, "%s backend", j->backend);
+	for (int i = 0; i < j->e->n_set && used > 0 && (size_t)used < sizeof fixed; i++) {
+		char kv[160];
+		bsim_key_value(j->e->set[i].key, j->e->set[i].value, 0, kv, sizeof kv);
+		used += snprintf(fixed + used, sizeof fixed - (size_t)used, "%s %s", i ? "," : ";",
+		                 kv);
+	}
+	for (char *c = fixed; *c; c++)
+		if (*c == '\'')
+			*c = ' ';
+	char body[2700];
 	snprintf(body, sizeof body,
 	         "set multiplot layout 1,2 title 'escape rate against barrier / noise power: "
 	         "ln k = ln k0 - dE / (c D), k0 = %.3g 1/s, c = %.3g +- %.2g m/(N s), n = %d, "
-	         "R^2 = %.2f' noenhanced\n"
+	         "R^2 = %.2f'.\"\\n\".'%s' noenhanced\n"
 	         "set grid\nset xlabel 'dE / D (J / (N^2 s))'\nset ylabel 'ln k (k in 1/s)'\n"
 	         "set key bottom left font ',9'\n"
 	         "set title 'traversal rate (95%% Poisson interval) and the fit'\n"
@@ -325,7 +341,7 @@ static int write_figure(const char *stage, const esc_job *j, int *drawn, bsim_er
 	         "plot 'kramers.dat' index 0 using 1:6 with points pt 7 lc rgb '#0072B2', "
 	         "0 with lines lc rgb '#5A5A5A'\n"
 	         "unset multiplot\n",
-	         f->k0, f->c, f->se_c, f->n, f->r2, lo, hi, f->a, f->b);
+	         f->k0, f->c, f->se_c, f->n, f->r2, fixed, lo, hi, f->a, f->b);
 	bsim_figure_def d = bsim_figure_def_default();
 	d.dir = stage;
 	d.name = "kramers";
@@ -450,7 +466,13 @@ int escape_run(const escape_def *def, escape_summary *sum, bsim_error *err)
 			g->residual = y[i] - g->fit;
 		}
 	}
-	esc_job j = {.e = e, .g = gs, .sc = scenes, .sum = sum};
+	bsim_run_record rec;
+	bsim_error ignore;
+	const char *backend =
+	        bsim_run_record_read(def->dir, &rec, &ignore) == BSIM_OK && rec.n_backends > 0
+	                ? rec.label[0]
+	                : "?";
+	esc_job j = {.e = e, .backend = backend, .g = gs, .sc = scenes, .sum = sum};
 	if (rc == BSIM_OK)
 		rc = write_csv(ss.stage, &j, err);
 	if (rc == BSIM_OK)
