@@ -103,6 +103,9 @@ int cmd_plot(int argc, char **argv)
 			}
 			for (int i = 0; i < res.n; i++)
 				printf("  %s.{png,svg,gp}\n", cli_path(res.paths[i]));
+			if (res.drawn > 0)
+				printf("  %s/index.html: every figure with a caption\n",
+				       cli_path(c.out ? c.out : dir));
 		}
 		bsim_figures_result_free(&res);
 	}
