@@ -12,8 +12,7 @@ mkdir -p "$o" "$d"
 # Fig. 2.2: the random force of one trial at Rm = 20 N (the gate's default)
 $b run configs/thesis/gate.yaml --out $o/fig2.2 >/dev/null
 # Fig. 2.7: a trial whose path runs below the landscape (H1 group 13, trial 15)
-$b run configs/thesis/gate.yaml --seed 1 --group 13 --trial 15 \
-  --set effects.propulsion.force=6 --set effects.random_force.magnitude=30 --out $o/fig2.7 >/dev/null
+$b run configs/thesis/h1_symmetric.yaml --group 13 --trial 15 --out $o/fig2.7 >/dev/null
 # Fig. 3.1: H1
 $b sweep configs/thesis/h1_symmetric.yaml --quiet --out $o/h1
 # Figs. 3.2, 3.3: the H2 groups the essay draws, every trajectory kept
