@@ -42,6 +42,11 @@ $b compare configs/lattice/c_track_1000.yaml --quiet --out $o/c-track-backends |
 for dir in c-track-20 c-track-protocols c-track-backends; do $b plot $o/$dir --quiet; done
 # the accuracy study of docs/accuracy.csv
 mkdir -p $o/accuracy && cp docs/accuracy.csv $o/accuracy/ && $b plot $o/accuracy --quiet
+# docs/first_passage.md: H1 at a 24 s horizon, the 9 N groups' survival
+$b sweep configs/thesis/h1_symmetric.yaml --set integration.duration=24 --quiet --out $o/h1-24
+$b plot $o/h1-24 --select effects.propulsion.force=9 --out $o/h1-24-9N --quiet
+# docs/essay.md: the essay's levels beside beamsim's (the table's run, without --sensitivity)
+$b essay --quiet --out $o/essay
 
 small() { # small DIR NAME COPY: DIR/NAME.gp drawn again at 0.75 as docs/figures/COPY.png
   (cd "$1" && gnuplot -e "scale=0.75; outbase=\"small-$2\"" "$2.gp" && rm -f "small-$2.svg")
@@ -61,6 +66,8 @@ small $o/c-track-protocols/world lattice_g000 fig3.5-c-track-200
 small $o/c-track-protocols final_locations_g000 c-track-protocols
 small $o/c-track-backends final_locations_g000 c-track-backends
 small $o/accuracy accuracy accuracy
+small $o/h1-24-9N survival survival_h1_9N
+small $o/essay essay essay
 small $o/landscape landscape_beam landscape_beam
 small $o/landscape landscape_total landscape_total
 small $o/landscape landscape_top landscape_top
