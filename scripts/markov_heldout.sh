@@ -4,14 +4,13 @@
 # maps as without --entries), with self-consistent entry states (self:1,
 # self:2: each pass's states drawn from the previous pass's exits of the
 # same map) and flow-weighted ones (flow:1, flow:2: from every map's exits,
-# weighted by the field's chain), at
-# 4,4,3 bins x 800 trials, each validated against 10,000 directly
-# simulated trials of configs/markov/heldout/field_{a,b,c}.yaml under the
-# essay's protocol and as a whole world. No map setting was chosen on these
+# weighted by the field's chain), at 4,4,3 bins x 800 trials, each
+# validated against 10,000 directly
+# simulated trials of configs/markov/heldout/field_{a,b,c,d}.yaml under the
+# essay's protocol and as a whole world. No map setting was tuned on these
 # fields. Prints one row per method, field and protocol; the runs stay in
 # OUT (default out/markov-heldout), the table in OUT/table.txt; FIELDS="d"
-# chooses the fields (default a b c). About 25
-# minutes on two cores.
+# chooses the fields (default a b c). About 30 minutes on two cores.
 #   scripts/markov_heldout.sh [OUT] [THREADS] [METHOD...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
