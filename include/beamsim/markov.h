@@ -99,6 +99,13 @@ typedef struct bsim_markov_def {
 	int threads;                        /* <= 0: all cores; the map is the same for any */
 	const bsim_markov_entries *entries; /* NULL: states uniform in each bin */
 	char entries_id[64];                /* the entries' id when read back from markov.json */
+	bsim_progress_fn progress;          /* may be NULL; counts single-gate trials */
+	void *progress_user;
+	/* May be NULL. When *stop becomes nonzero (a signal handler sets it),
+	 * no further single gate starts, the map under way is dropped, the
+	 * maps finished are kept in the map directory, and the build returns
+	 * BSIM_ESTOPPED. */
+	const volatile sig_atomic_t *stop;
 	/* Self-consistent entry states (entries NULL): 1 builds the map in
 	 * passes 0 .. self_passes. Pass 0 is the map of states uniform in each
 	 * bin; pass p draws each bin's states from the exit states the single
@@ -115,15 +122,8 @@ typedef struct bsim_markov_def {
 	 * lattice's chain of pass p - 1) of its entry bin in the gates whose
 	 * neighbour across that exit is a gate of pair B: maps for that
 	 * lattice's layout only (its hash is in the key). */
-	int self_entries;          /* 0 off, 1 self-consistent, 2 flow-weighted (above) */
-	int self_passes;           /* 0 to BSIM_MARKOV_SELF_PASSES_MAX */
-	bsim_progress_fn progress; /* may be NULL; counts single-gate trials */
-	void *progress_user;
-	/* May be NULL. When *stop becomes nonzero (a signal handler sets it),
-	 * no further single gate starts, the map under way is dropped, the
-	 * maps finished are kept in the map directory, and the build returns
-	 * BSIM_ESTOPPED. */
-	const volatile sig_atomic_t *stop;
+	int self_entries; /* 0 off, 1 self-consistent, 2 flow-weighted (above) */
+	int self_passes;  /* 0 to BSIM_MARKOV_SELF_PASSES_MAX */
 } bsim_markov_def;
 
 #define BSIM_MARKOV_SELF_GATES      16
