@@ -10,6 +10,9 @@
  *     independent trials within their sampling error;
  *   - the map is the same with 1 and 2 threads; its cache reuses a map only
  *     when nothing it depends on changed;
+ *   - self-consistent and flow-weighted entry states are exits of the
+ *     previous pass's single gates into the bin, as that pass's own record
+ *     says;
  *   - a bad input exits 2 naming what is wrong and writes nothing. */
 #define _POSIX_C_SOURCE 200809L
 
@@ -758,6 +761,168 @@ static void test_entries(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The rows of a map's exits file (map_HASH.exits.csv) of dir: each row's
+ * fields as text, 11 per row; returns the number of rows. */
+static int exits_rows(const char *dir, uint64_t key, char ***fields)
+{
+	char name[64];
+	snprintf(name, sizeof name, "map_%016llx.exits.csv", (unsigned long long)key);
+	char *text = bsim_test_read(bsim_test_join(dir, name));
+	assert_non_null(text);
+	int n = bsim_test_count_lines(text) - 1, r = 0;
+	char **f = calloc((size_t)n * 11, sizeof *f);
+	assert_non_null(f);
+	char *save = NULL, *line = strtok_r(text, "\n", &save);
+	assert_string_equal(line, "entry,trial,x,y,vx,vy,exit,exit_x,exit_y,exit_vx,exit_vy");
+	while ((line = strtok_r(NULL, "\n", &save)) && r < n) {
+		char *s2 = NULL, *c = strtok_r(line, ",", &s2);
+		for (int k = 0; k < 11; k++, c = strtok_r(NULL, ",", &s2)) {
+			assert_non_null(c);
+			f[r * 11 + k] = strdup(c);
+		}
+		r++;
+	}
+	assert_int_equal(r, n);
+	free(text);
+	*fields = f;
+	return n;
+}
+
+static void exits_free(char **f, int n)
+{
+	for (int i = 0; i < n * 11; i++)
+		free(f[i]);
+	free(f);
+}
+
+/* Self-consistent entries (--entries self:N): pass 0 is the uniform map
+ * (other key, same counts); pass 1's states of a bin are exits of pass 0's
+ * single gates into that bin, as pass 0's own file of exits records them
+ * and its counts agree; the map is the same with 1 and 2 threads and
+ * whether pass 0 is reused from the directory or simulated again; the
+ * passes are part of the key. */
+static void test_self_entries(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 1, 6, 30), BSIM_OK);
+	const char *dir = exe_dir("self");
+	char du[1100], d0[1100], d1[1100];
+	snprintf(du, sizeof du, "%s/uniform", dir);
+	snprintf(d0, sizeof d0, "%s/pass0", dir);
+	snprintf(d1, sizeof d1, "%s/pass1", dir);
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){2, 2, 2, 40.0};
+	def.trials = 30;
+	def.threads = 2;
+	bsim_error err;
+	bsim_markov_set uni, p0, p1a, p1b, again;
+	assert_int_equal(bsim_markov_build(&s, &def, du, &uni, &err), BSIM_OK);
+	def.self_entries = 1;
+	def.self_passes = 0;
+	assert_int_equal(bsim_markov_build(&s, &def, d0, &p0, &err), BSIM_OK);
+	const int nb = uni.maps[0].n_bins, T = def.trials;
+	assert_true(p0.maps[0].key != uni.maps[0].key);
+	assert_memory_equal(p0.maps[0].counts, uni.maps[0].counts, (size_t)nb * nb * sizeof(int));
+	/* pass 1 from scratch on one thread, and on two from d0's pass 0 */
+	def.self_passes = 1;
+	def.threads = 1;
+	assert_int_equal(bsim_markov_build(&s, &def, d1, &p1a, &err), BSIM_OK);
+	def.threads = 2;
+	assert_int_equal(bsim_markov_build(&s, &def, d0, &p1b, &err), BSIM_OK);
+	const uint64_t k0 = p0.maps[0].key, k1 = p1a.maps[0].key;
+	assert_true(k1 != k0 && k1 != uni.maps[0].key);
+	assert_int_equal(p1b.maps[0].key, k1);
+	char name[64];
+	for (int f = 0; f < 3; f++) {
+		static const char *const ext[] = {"key", "csv", "exits.csv"};
+		snprintf(name, sizeof name, "map_%016llx.%s", (unsigned long long)k1, ext[f]);
+		char *a = bsim_test_read(bsim_test_join(d1, name));
+		char *b = bsim_test_read(bsim_test_join(d0, name));
+		assert_non_null(a);
+		assert_non_null(b);
+		assert_string_equal(a, b);
+		free(a);
+		free(b);
+	}
+	/* the same passes again: reused; more passes: built */
+	assert_int_equal(bsim_markov_build(&s, &def, d1, &again, &err), BSIM_OK);
+	assert_int_equal(again.reused, 1);
+	bsim_markov_set_free(&again);
+	def.self_passes = 2;
+	assert_int_equal(bsim_markov_build(&s, &def, d1, &again, &err), BSIM_OK);
+	assert_int_equal(again.built, 1);
+	assert_true(again.maps[0].key != k1);
+	bsim_markov_set_free(&again);
+
+	/* pass 0's exits, against its map's counts */
+	char **e0, **e1;
+	const int n0 = exits_rows(d0, k0, &e0), n1 = exits_rows(d0, k1, &e1);
+	assert_int_equal(n0, nb * T);
+	assert_int_equal(n1, nb * T);
+	int *count = calloc((size_t)nb * nb, sizeof *count),
+	    *into = calloc((size_t)nb, sizeof *into);
+	assert_non_null(count);
+	assert_non_null(into);
+	for (int r = 0; r < n0; r++) {
+		int a = atoi(e0[r * 11]), x = atoi(e0[r * 11 + 6]);
+		count[a * nb + x]++;
+		into[x]++;
+	}
+	assert_memory_equal(count, p0.maps[0].counts, (size_t)nb * nb * sizeof(int));
+	/* each pass-1 state of bin b > 0 is the exit state of a pass-0 trial
+	 * that left into b; states drawn uniformly only in bins none left into */
+	int matched = 0;
+	for (int r = 0; r < n1; r++) {
+		const int b = atoi(e1[r * 11]);
+		if (b == 0 || into[b] == 0)
+			continue;
+		int found = 0;
+		for (int q = 0; q < n0 && !found; q++)
+			found = atoi(e0[q * 11 + 6]) == b &&
+			        strcmp(e0[q * 11 + 7], e1[r * 11 + 2]) == 0 &&
+			        strcmp(e0[q * 11 + 8], e1[r * 11 + 3]) == 0 &&
+			        strcmp(e0[q * 11 + 9], e1[r * 11 + 4]) == 0 &&
+			        strcmp(e0[q * 11 + 10], e1[r * 11 + 5]) == 0;
+		if (!found)
+			fail_msg("pass 1, bin %d, trial %s: state %s %s %s %s is no exit of pass 0 "
+			         "into it",
+			         b, e1[r * 11 + 1], e1[r * 11 + 2], e1[r * 11 + 3], e1[r * 11 + 4],
+			         e1[r * 11 + 5]);
+		matched++;
+	}
+	assert_true(matched > n1 / 4);
+	free(count);
+	free(into);
+	exits_free(e0, n0);
+	exits_free(e1, n1);
+	bsim_markov_set_free(&uni);
+	bsim_markov_set_free(&p0);
+	bsim_markov_set_free(&p1a);
+	bsim_markov_set_free(&p1b);
+
+	/* the command line: self:N beyond the passes, and self with observed
+	 * entries, refused */
+	const char *exp = bsim_test_src("configs/lattice/c_track_essay.yaml");
+	char target[1200];
+	snprintf(target, sizeof target, "%s/refused", dir);
+	const char *too_many[] = {"markov", "build", exp,    "--entries",
+	                          "self:9", "--out", target, NULL};
+	char *err_text = NULL;
+	assert_int_equal(bsim_test_cli(too_many, NULL, &err_text), 2);
+	assert_non_null(strstr(err_text, "--entries self:9: expected self, self:N"));
+	free(err_text);
+	const char *obs = bsim_test_write(dir, "gate_entries.csv",
+	                                  "group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy\n"
+	                                  "0,0,1,0,0,bottom,10,0.04,20,20,0.01,0,1\n");
+	const char *both[] = {"markov",    "build", exp,     "--entries", "self",
+	                      "--entries", obs,     "--out", target,      NULL};
+	const char *need2[] = {"self-consistent entries", NULL};
+	bsim_test_expect_input_error(both, need2);
+	assert_false(bsim_test_exists(target));
+	bsim_scene_free(&s);
+}
+
 /* The maps files of dir (key, counts; not the CPU times) concatenated. */
 static char *maps_of(const char *dir)
 {
@@ -771,6 +936,98 @@ static char *maps_of(const char *dir)
 	free(keys);
 	free(csv);
 	return both;
+}
+
+/* Flow-weighted entries (--entries flow:N) on a column of two gates of
+ * different stiffness pairs: the maps are the same with 1 and 2 threads;
+ * each pass-1 state of a bin is the exit state of a pass-0 single gate of
+ * either map into that bin; the lattice's layout is part of the key. */
+static void test_flow_entries(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 2, 6, 30), BSIM_OK);
+	for (int side = 0; side < 2; side++) /* gate (0, 1): 100, 400 */
+		s.beams[bsim_lattice_beam(&s.lattice, 0, 1, side)].stiffness = side ? 400 : 100;
+	const char *dir = exe_dir("flow");
+	char d1[1100], d2[1100], d3[1100];
+	snprintf(d1, sizeof d1, "%s/threads1", dir);
+	snprintf(d2, sizeof d2, "%s/threads2", dir);
+	snprintf(d3, sizeof d3, "%s/swapped", dir);
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){2, 2, 2, 40.0};
+	def.trials = 20;
+	def.self_entries = 2;
+	def.self_passes = 1;
+	def.threads = 1;
+	bsim_error err;
+	bsim_markov_set a, b, c;
+	assert_int_equal(bsim_markov_build(&s, &def, d1, &a, &err), BSIM_OK);
+	def.threads = 2;
+	assert_int_equal(bsim_markov_build(&s, &def, d2, &b, &err), BSIM_OK);
+	assert_int_equal(a.n, 2);
+	char *t1 = maps_of(d1), *t2 = maps_of(d2);
+	assert_string_equal(t1, t2);
+	free(t1);
+	free(t2);
+	const int nb = a.maps[0].n_bins, T = def.trials;
+	/* pass 0's exits of both maps (the self-consistent pass 0's keys) */
+	bsim_markov_def d0 = def;
+	d0.self_entries = 1;
+	d0.self_passes = 0;
+	bsim_markov_set p0;
+	assert_int_equal(bsim_markov_build(&s, &d0, d1, &p0, &err), BSIM_OK);
+	assert_int_equal(p0.reused, 2); /* written by the flow build */
+	char **e0[2], **e1[2];
+	int n0[2], n1[2];
+	for (int i = 0; i < 2; i++) {
+		n0[i] = exits_rows(d1, p0.maps[i].key, &e0[i]);
+		n1[i] = exits_rows(d1, a.maps[i].key, &e1[i]);
+		assert_int_equal(n0[i], nb * T);
+		assert_int_equal(n1[i], nb * T);
+	}
+	int matched = 0;
+	for (int i = 0; i < 2; i++)
+		for (int r = 0; r < n1[i]; r++) {
+			const int bin = atoi(e1[i][r * 11]);
+			int into = 0, found = 0;
+			for (int j = 0; j < 2; j++)
+				for (int q = 0; q < n0[j] && !found; q++) {
+					char **f = e0[j] + q * 11;
+					if (atoi(f[6]) != bin)
+						continue;
+					into++;
+					found = strcmp(f[7], e1[i][r * 11 + 2]) == 0 &&
+					        strcmp(f[8], e1[i][r * 11 + 3]) == 0 &&
+					        strcmp(f[9], e1[i][r * 11 + 4]) == 0 &&
+					        strcmp(f[10], e1[i][r * 11 + 5]) == 0;
+				}
+			if (bin == 0 || into == 0)
+				continue;
+			if (!found)
+				fail_msg("map %d, bin %d, trial %s: no exit of pass 0 into the bin",
+				         i, bin, e1[i][r * 11 + 1]);
+			matched++;
+		}
+	assert_true(matched > (n1[0] + n1[1]) / 4);
+	for (int i = 0; i < 2; i++) {
+		exits_free(e0[i], n0[i]);
+		exits_free(e1[i], n1[i]);
+	}
+	/* the layout swapped: other maps */
+	for (int iy = 0; iy < 2; iy++)
+		for (int side = 0; side < 2; side++)
+			s.beams[bsim_lattice_beam(&s.lattice, 0, iy, side)].stiffness =
+			        iy == side ? 400 : 100;
+	assert_int_equal(bsim_markov_build(&s, &def, d3, &c, &err), BSIM_OK);
+	for (int i = 0; i < c.n; i++)
+		for (int j = 0; j < a.n; j++)
+			assert_true(c.maps[i].key != a.maps[j].key);
+	bsim_markov_set_free(&a);
+	bsim_markov_set_free(&b);
+	bsim_markov_set_free(&c);
+	bsim_markov_set_free(&p0);
+	bsim_scene_free(&s);
 }
 
 /* A build stopped by SIGINT or SIGTERM once its first map is committed
@@ -837,6 +1094,8 @@ int main(void)
 	        cmocka_unit_test(test_threads_and_cache),
 	        cmocka_unit_test(test_interrupted_build),
 	        cmocka_unit_test(test_entries),
+	        cmocka_unit_test(test_self_entries),
+	        cmocka_unit_test(test_flow_entries),
 	        cmocka_unit_test(test_bad_inputs),
 	        cmocka_unit_test(test_bad_map_files),
 	        cmocka_unit_test(test_field_figures),

@@ -106,7 +106,28 @@ typedef struct bsim_markov_def {
 	 * maps finished are kept in the map directory, and the build returns
 	 * BSIM_ESTOPPED. */
 	const volatile sig_atomic_t *stop;
+	/* Self-consistent entry states (entries NULL): 1 builds the map in
+	 * passes 0 .. self_passes. Pass 0 is the map of states uniform in each
+	 * bin; pass p draws each bin's states from the exit states the single
+	 * gates of pass p - 1 left into that bin (a top exit is the next gate's
+	 * bottom entry), each exit weighted by the expected visits of the bin it
+	 * came from in a field of this gate alone (the first
+	 * BSIM_MARKOV_SELF_GATES gates from the start). Seeds of the states from
+	 * (seed, pass, bin, trial); the schedules are pass 0's. The map
+	 * directory keeps every pass's map and its single gates' entry and exit
+	 * states (map_HASH.exits.csv), and a later build with more passes starts
+	 * from the last pass there. Flow-weighted (self_entries 2): pass p draws
+	 * bin b's states of the map of pair B from the exits into b of every
+	 * map of the lattice, each weighted by the expected visits (in the
+	 * lattice's chain of pass p - 1) of its entry bin in the gates whose
+	 * neighbour across that exit is a gate of pair B: maps for that
+	 * lattice's layout only (its hash is in the key). */
+	int self_entries; /* 0 off, 1 self-consistent, 2 flow-weighted (above) */
+	int self_passes;  /* 0 to BSIM_MARKOV_SELF_PASSES_MAX */
 } bsim_markov_def;
+
+#define BSIM_MARKOV_SELF_GATES      16
+#define BSIM_MARKOV_SELF_PASSES_MAX 8
 
 /* bsim_markov_bins_default(), 200 trials per bin, seed 1, the default
  * backend, all cores. */

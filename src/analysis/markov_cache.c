@@ -36,6 +36,45 @@
  * old map. */
 #define MAP_FORMAT 1
 
+/* The hash of a lattice's layout: its size and every gate's stiffness
+ * pair, row 0 first. */
+static uint64_t layout_hash(const bsim_scene *lattice)
+{
+	const bsim_lattice_def *l = &lattice->lattice;
+	uint64_t h = HASH_FNV1A64_SEED;
+	int size[2] = {l->columns, l->rows};
+	h = hash_fnv1a64(size, sizeof size, h);
+	for (int iy = 0; iy < l->rows; iy++)
+		for (int ix = l->ix_min; ix <= l->ix_max; ix++)
+			for (int side = 0; side < 2; side++) {
+				double k = lattice->beams[bsim_lattice_beam(l, ix, iy, side)]
+				                   .stiffness;
+				h = hash_fnv1a64(&k, sizeof k, h);
+			}
+	return h;
+}
+
+const char *markov_entries_label(const bsim_markov_def *def, const bsim_scene *lattice, char *buf,
+                                 size_t size)
+{
+	if (def->entries)
+		return def->entries->id;
+	int passes = def->self_passes, flow = def->self_entries == 2;
+	if (!def->self_entries && strncmp(def->entries_id, "flow ", 5) == 0) {
+		/* read back from markov.json: the field is the one predicted */
+		flow = 1;
+		passes = atoi(def->entries_id + 5);
+	}
+	if (flow && lattice)
+		snprintf(buf, size, "flow %d field %016llx", passes,
+		         (unsigned long long)layout_hash(lattice));
+	else if (flow || def->self_entries)
+		snprintf(buf, size, "%s %d", flow ? "flow" : "self", passes);
+	else
+		return def->entries_id[0] ? def->entries_id : "none";
+	return buf;
+}
+
 /* Every input of a map, a line each, numbers to the last bit (%.17g). */
 char *markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
                       const bsim_options *opts, const double k[2])
@@ -70,10 +109,8 @@ char *markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, con
 	        s->effects.propulsion_force, s->effects.has_random_force,
 	        s->effects.random_magnitude, s->effects.random_frequency);
 	fprintf(f, "dt %.17g gate_steps %d max_steps %d\n", s->dt, s->gate_steps, s->max_steps);
-	fprintf(f, "entries %s\n",
-	        def->entries         ? def->entries->id
-	        : def->entries_id[0] ? def->entries_id
-	                             : "none");
+	char label[64];
+	fprintf(f, "entries %s\n", markov_entries_label(def, lattice, label, sizeof label));
 	fprintf(f, "bins %d %d %d %.17g\ntrials %d\nseed %llu\n", def->bins.n_pos,
 	        def->bins.n_speed, def->bins.n_dir, def->bins.v_max, def->trials,
 	        (unsigned long long)def->seed);
@@ -334,9 +371,8 @@ int markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_b
 		bsim_json_string(o.f, kv);
 	}
 	fputs("], \"entries\": ", o.f);
-	bsim_json_string(o.f, def->entries         ? def->entries->id
-	                      : def->entries_id[0] ? def->entries_id
-	                                           : "none");
+	char label[64];
+	bsim_json_string(o.f, markov_entries_label(def, NULL, label, sizeof label));
 	fputs("}\n", o.f);
 	return bsim_atomic_file_commit(&o, err);
 }

@@ -40,10 +40,17 @@ void markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice, con
 	g->s.body.start[1] -= l->depth * iy;
 }
 
+/* c clamped into [lo, hi). */
+static double clamp_in(double c, double lo, double hi)
+{
+	return c < lo ? lo : c >= hi ? nextafter(hi, lo) : c;
+}
+
 /* The exit of a step from p0 inside the gate to s->x outside it: the entry
- * bin of the gate it enters (the boundary crossed first). */
+ * bin of the gate it enters (the boundary crossed first), and in next the
+ * body's centre in that gate's frame (inside its rectangle). */
 static int exit_bin(const bsim_markov_bins *b, const bsim_lattice_def *l, const double p0[2],
-                    const bsim_state *s)
+                    const bsim_state *s, double next[2])
 {
 	const double *p1 = s->x, w2 = 0.5 * l->width, d = l->depth;
 	double fx = LATTICE_NO_CROSSING, fy = LATTICE_NO_CROSSING;
@@ -62,9 +69,49 @@ static int exit_bin(const bsim_markov_bins *b, const bsim_lattice_def *l, const 
 		fy = lattice_crossing(p0, p1, 1, d);
 		ey = BSIM_EDGE_BOTTOM;
 	}
-	if (ex && (!ey || fx <= fy))
+	if (ex && (!ey || fx <= fy)) {
+		next[0] = clamp_in(p1[0] + (ex == BSIM_EDGE_LEFT ? -l->width : l->width), -w2, w2);
+		next[1] = clamp_in(p1[1], 0.0, d);
 		return bsim_markov_bin_of(b, l, ex, p0[1] + fx * (p1[1] - p0[1]), s->v);
+	}
+	next[0] = clamp_in(p1[0], -w2, w2);
+	next[1] = clamp_in(p1[1] + (ey == BSIM_EDGE_BOTTOM ? -d : d), 0.0, d);
 	return bsim_markov_bin_of(b, l, ey, p0[0] + fy * (p1[0] - p0[0]), s->v);
+}
+
+/* Salt of the self-consistent passes' entry-state seeds. */
+#define SELF_SALT 0x73656c6670617373ULL
+
+/* A state of bin (> 0) from the pool's exits into it, each with its
+ * weight; uniformly in the bin where none arrived. */
+static void pool_sample(const markov_pool *p, const bsim_markov_bins *b, const bsim_lattice_def *l,
+                        double h, int bin, gsl_rng *rng, double x[2], double v[2])
+{
+	const int lo = p->first[bin], hi = p->first[bin + 1];
+	if (hi == lo) {
+		markov_bin_sample(b, l, h, bin, rng, x, v);
+		return;
+	}
+	int j;
+	const double total = p->cw[hi - 1];
+	if (total > 0.0) {
+		/* the first run whose cumulative weight exceeds r */
+		const double r = gsl_rng_uniform(rng) * total;
+		int a = lo, z = hi - 1;
+		while (a < z) {
+			int mid = a + (z - a) / 2;
+			if (p->cw[mid] > r)
+				z = mid;
+			else
+				a = mid + 1;
+		}
+		j = a;
+	} else {
+		j = lo + (int)gsl_rng_uniform_int(rng, (unsigned long)(hi - lo));
+	}
+	const markov_run *u = p->run[j];
+	memcpy(x, u->exit_x, sizeof u->exit_x);
+	memcpy(v, u->exit_v, sizeof u->exit_v);
 }
 
 /* What a thread keeps from one single-gate trial to the next. */
@@ -73,6 +120,8 @@ typedef struct gate_runner {
 	gsl_rng *rng;
 	markov_gate_scene g;
 	const markov_entry_index *ex; /* NULL: no observed entries */
+	const markov_pool *pool;      /* NULL: not a self-consistent pass */
+	markov_run *run;              /* NULL: not kept */
 } gate_runner;
 
 /* One single-gate trial from entry bin `bin` (0: the start) with trial index
@@ -83,7 +132,14 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 {
 	const bsim_lattice_def *l = &lattice->lattice;
 	bsim_scene *s = &r->g.s;
-	if (bin > 0) {
+	if (bin > 0 && r->pool) {
+		gsl_rng_set(r->rng, bsim_schedule_seed_mix(
+		                            bsim_schedule_seed_mix(def->seed ^ SELF_SALT,
+		                                                   (uint64_t)r->pool->pass, 0),
+		                            (uint64_t)bin, (uint64_t)t));
+		pool_sample(r->pool, &def->bins, l, s->dt, bin, r->rng, s->body.start,
+		            s->body.velocity);
+	} else if (bin > 0) {
 		gsl_rng_set(r->rng, bsim_schedule_seed_mix(def->seed ^ 0x6d61726b6f76ULL,
 		                                           (uint64_t)bin, (uint64_t)t));
 		const int lo = r->ex ? r->ex->first[bin] : 0,
@@ -111,6 +167,11 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	const long n_max = lattice->gate_steps > 0 ? lattice->gate_steps : lattice->max_steps;
 	const double w2 = 0.5 * l->width, d = l->depth;
 	be->get_state(w, &r->s0);
+	if (r->run) {
+		memcpy(r->run->x, s->body.start, sizeof r->run->x);
+		memcpy(r->run->v, s->body.velocity, sizeof r->run->v);
+	}
+	double next[2];
 	int out = 0;
 	for (long n = 0; n < n_max; n++) {
 		double f[2];
@@ -131,7 +192,7 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 		}
 		const double *p = r->s1.x;
 		if (p[0] < -w2 || p[0] >= w2 || p[1] < 0.0 || p[1] >= d) {
-			out = exit_bin(&def->bins, l, r->s0.x, &r->s1);
+			out = exit_bin(&def->bins, l, r->s0.x, &r->s1, next);
 			break;
 		}
 		bsim_state tmp = r->s0;
@@ -140,6 +201,13 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	}
 	if (out >= 0 && bsim_effects_status(&fx, err) != BSIM_OK)
 		out = -1;
+	if (r->run && out >= 0) {
+		/* stuck: the last state, in this gate's frame */
+		const bsim_state *last = out > 0 ? &r->s1 : &r->s0;
+		r->run->exit = out;
+		memcpy(r->run->exit_x, out > 0 ? next : last->x, sizeof r->run->exit_x);
+		memcpy(r->run->exit_v, last->v, sizeof r->run->exit_v);
+	}
 	bsim_effects_free(&fx);
 	be->destroy(w);
 	return out;
@@ -148,6 +216,14 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
                         long *done, long total, bsim_error *err)
+{
+	return markov_map_simulate_runs(lattice, def, be, opts, m, NULL, NULL, done, total, err);
+}
+
+int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
+                             const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
+                             const markov_pool *pool, markov_run *runs, long *done, long total,
+                             bsim_error *err)
 {
 	const int nb = m->n_bins, T = def->trials;
 	const long units = (long)nb * T;
@@ -173,6 +249,7 @@ int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		         bsim_state_init(&r.s1, 2) == BSIM_OK;
 		r.rng = gsl_rng_alloc(gsl_rng_mt19937);
 		r.ex = def->entries ? &ex : NULL;
+		r.pool = pool;
 		markov_gate_scene_init(&r.g, lattice, m->k);
 		const double start[2] = {r.g.s.body.start[0], r.g.s.body.start[1]};
 #pragma omp for schedule(dynamic, 16)
@@ -197,6 +274,7 @@ int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			r.g.s.body.start[1] = start[1];
 			r.g.s.body.velocity[0] = lattice->body.velocity[0];
 			r.g.s.body.velocity[1] = lattice->body.velocity[1];
+			r.run = runs ? &runs[u] : NULL;
 			exit[u] = gate_trial(&r, lattice, def, be, opts, (int)(u / T), (int)(u % T),
 			                     &e);
 			if (exit[u] < 0) {

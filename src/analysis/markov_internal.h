@@ -8,6 +8,7 @@
 #define BSIM_ANALYSIS_MARKOV_INTERNAL_H
 
 #include <gsl/gsl_rng.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "beamsim/lattice_outcome.h"
@@ -52,6 +53,26 @@ typedef struct markov_gate_scene {
 
 void markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice, const double k[2]);
 
+/* One single-gate trial of a map: the entry state it started from and the
+ * state it left with, in the frame of the gate it enters (the body at the
+ * end of the step that crossed, as a lattice records an entry), or its
+ * last state if stuck (exit 0). */
+typedef struct markov_run {
+	int exit;
+	double x[2], v[2];           /* entry: body centre (gate frame), m; velocity, m/s */
+	double exit_x[2], exit_v[2]; /* exit, in the next gate's frame */
+} markov_run;
+
+/* The exits of a previous pass by the bin they enter: bin b's runs are
+ * run[first[b] .. first[b + 1]) in (map, trial) order, cw their cumulative
+ * weights within the bin. */
+typedef struct markov_pool {
+	int pass;
+	const markov_run **run;
+	int *first;
+	double *cw;
+} markov_pool;
+
 /* Map m's counts (n_bins, k and counts allocated) from def->trials single
  * gates per entry bin, on def->threads threads; *done counts the trials
  * run of total, for def->progress. BSIM_EFAIL with the error of the first
@@ -60,6 +81,49 @@ void markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice, con
 int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
                         long *done, long total, bsim_error *err);
+
+/* The same with the self-consistent entries: the states of bin b > 0
+ * drawn from pool's exits into b (pool NULL: as markov_map_simulate), and
+ * every trial's entry and exit kept in runs[bin * trials + trial] (may be
+ * NULL). */
+int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
+                             const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
+                             const markov_pool *pool, markov_run *runs, long *done, long total,
+                             bsim_error *err);
+
+/* ---- self-consistent entries (markov_self.c) ---- */
+
+/* The entries line of a map's key and markov.json: the observed entries'
+ * id, "self N" (self-consistent, N passes), "flow N" (weighted by the
+ * field's flow; in a key followed by "field HASH", the hash of lattice's
+ * layout of stiffness pairs, lattice NULL for markov.json) or "none". */
+const char *markov_entries_label(const bsim_markov_def *def, const bsim_scene *lattice, char *buf,
+                                 size_t size);
+
+/* The passes of map m still to simulate (m's key for def->self_passes;
+ * the last pass whose map and exits are in dir is reused): how many. */
+int markov_self_todo(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                     const bsim_options *opts, const bsim_markov_map *m, const char *dir);
+
+/* The maps of set (maps[i] with key and counts allocated, have[i] those
+ * read from the cache) by def's flow-weighted passes (self_entries 2): pass
+ * p draws map B's states of bin b from the exits into b of every map's
+ * pass p - 1 single gates, each weighted by the expected visits, in
+ * lattice's chain of pass p - 1, of its entry bin in the gates of its map
+ * whose neighbour across that exit is a gate of map B. Pass 0 is the
+ * self-consistent pass 0 (read from dir where there); the passes simulated
+ * now and the last pass of maps not in the cache written into stage. */
+int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
+                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *maps,
+                         int n, const char *have, const char *dir, const char *stage, long *done,
+                         long total, bsim_error *err);
+
+/* Map m by def's self-consistent passes, starting from the last pass in
+ * dir; each pass simulated now written into stage (map and exits). */
+int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
+                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
+                         const char *dir, const char *stage, long *done, long total,
+                         bsim_error *err);
 
 /* ---- the map directory (markov_cache.c) ---- */
 

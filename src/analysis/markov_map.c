@@ -102,6 +102,13 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "bins: %d entry bins make a map of more than 2e7 cells",
 		                      bsim_markov_bins_count(b));
+	if (def->self_entries && (def->entries || def->self_entries > 2 || def->self_passes < 0 ||
+	                          def->self_passes > BSIM_MARKOV_SELF_PASSES_MAX))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "entries: self-consistent entries take 0 to %d passes and no "
+		                      "observed entries, got %d passes%s",
+		                      BSIM_MARKOV_SELF_PASSES_MAX, def->self_passes,
+		                      def->entries ? " and observed entries" : "");
 	if (def->trials < 1 || def->trials > 1000000)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "trials: expected 1 to 1000000 per bin, got %d", def->trials);
@@ -178,18 +185,32 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			        "writes it",
 			        dir, m->k[0], m->k[1], (unsigned long long)m->key);
 		else
-			total += (long)m->n_bins * def->trials;
+			total += (long)m->n_bins * def->trials *
+			         (def->self_entries == 1
+			                  ? markov_self_todo(lattice, def, be, opts, m, dir) + 1
+			          : def->self_entries == 2 ? def->self_passes + 1
+			                                   : 1);
 	}
 	int to_build = n - out->reused;
+	/* Flow-weighted entries: every map's passes at once, the lattice's
+	 * chain weighting each pass's states. */
+	const int flow = def->self_entries == 2 && to_build > 0 && stage && rc == BSIM_OK;
+	if (flow)
+		rc = markov_flow_simulate(lattice, def, be, opts, out->maps, n, have, dir, stage,
+		                          &done, total, err);
 	for (int i = 0; i < n && rc == BSIM_OK && stage; i++) {
 		bsim_markov_map *m = &out->maps[i];
 		if (have[i])
 			continue;
 		clock_t c0 = clock();
-		rc = def->stop && *def->stop
-		             ? BSIM_ESTOPPED
+		rc = flow                      ? BSIM_OK
+		     : def->stop && *def->stop ? BSIM_ESTOPPED
+		     : def->self_entries
+		             ? markov_self_simulate(lattice, def, be, opts, m, dir, stage, &done,
+		                                    total, err)
 		             : markov_map_simulate(lattice, def, be, opts, m, &done, total, err);
-		m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
+		if (!flow) /* else the CPU time of its passes */
+			m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 		m->cost = m->seconds;
 		out->seconds += m->seconds;
 		if (rc == BSIM_OK)

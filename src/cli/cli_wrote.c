@@ -70,6 +70,8 @@ const char *cli_wrote_what(const char *path)
 		return "the figure's gnuplot script";
 	if (ends_with(base, ".dat"))
 		return "the figure's data";
+	if (strncmp(base, "map_", 4) == 0 && ends_with(base, ".exits.csv"))
+		return "every single gate's entry and exit state (--entries self)";
 	if (strncmp(base, "map_", 4) == 0 && ends_with(base, ".csv"))
 		return "a single-gate map: entry bin, exit bin, count";
 	if (strncmp(base, "map_", 4) == 0 && ends_with(base, ".key"))

@@ -68,6 +68,24 @@ static int markov_option(void *args, int i, const char *value)
 			return cli_usage("markov", "--vmax %s: expected a speed > 0 in m/s", value);
 		return CLI_OK;
 	case OWN_ENTRIES:
+		/* self or self:N: the exits of the map's own single gates, N passes
+		 * (default 1); a file named self is ./self */
+		if (strcmp(value, "self") == 0 || strncmp(value, "self:", 5) == 0 ||
+		    strcmp(value, "flow") == 0 || strncmp(value, "flow:", 5) == 0) {
+			long n = 1;
+			if ((value[4] &&
+			     cli_parse_long(value + 5, 0, BSIM_MARKOV_SELF_PASSES_MAX, &n) != 0) ||
+			    a->def.self_entries)
+				return cli_usage(
+				        "markov",
+				        "--entries %s: expected self, self:N, flow or flow:N, N "
+				        "passes 0 to "
+				        "%d, once",
+				        value, BSIM_MARKOV_SELF_PASSES_MAX);
+			a->def.self_entries = value[0] == 's' ? 1 : 2;
+			a->def.self_passes = (int)n;
+			return CLI_OK;
+		}
 		if (a->n_entries == MAX_ENTRIES)
 			return cli_usage("markov", "--entries %s: at most %d", value, MAX_ENTRIES);
 		a->entries[a->n_entries++] = value;
@@ -98,7 +116,11 @@ static const cli_own build_own[] = {
         [OWN_ENTRIES] = {"entries", 1, "PATH",
                          "gate_entries.csv of a lattice sweep (or its directory),\n"
                          "repeatable: a bin's states are drawn from the entries\n"
-                         "that fall in it (default: uniformly in the bin)"},
+                         "that fall in it (default: uniformly in the bin); self or\n"
+                         "self:N: from the exits of the map's own single gates, N\n"
+                         "passes (default 1); flow or flow:N: from every map's exits\n"
+                         "weighted by the chain's flow on each lattice (maps for\n"
+                         "that lattice only; docs/markov.md)"},
 };
 
 static const char *const build_help[CLI_N_OPTS] = {
