@@ -427,8 +427,16 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 	 * every map file has the size and CRC-32 listed there (a map's CSV
 	 * put in another's place is refused here). */
 	int has_manifest = 0;
-	if (bsim_outdir_verify(dir, &has_manifest, err) != BSIM_OK)
+	if (bsim_outdir_verify(dir, &has_manifest, err) != BSIM_OK) {
+		/* A damaged map is not repaired here: its counts are gone. */
+		if (err) {
+			size_t len = strlen(err->msg);
+			snprintf(err->msg + len, sizeof err->msg - len,
+			         "; rebuild the maps with beamsim markov build EXPERIMENT --out %s",
+			         dir);
+		}
 		return BSIM_EINPUT;
+	}
 	snprintf(path, sizeof path, "%s/markov.json", dir);
 	/* Without blocking: a FIFO there is refused by ydoc_load. */
 	int probe = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);

@@ -15,6 +15,7 @@
 
 #include "store/outdir.h"
 #include "store/session.h"
+#include "beamsim/limits.h"
 
 bsim_markov_def bsim_markov_def_default(void)
 {
@@ -255,6 +256,39 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 	return rc;
 }
 
+/* With a manifest, every map file read must be one it lists (and so was
+ * checked against its size and CRC-32 by markov_def_read): a map copied
+ * in from elsewhere after the build is not used unchecked. */
+static int maps_listed(const char *dir, const bsim_markov_set *set, bsim_error *err)
+{
+	char **files = NULL;
+	size_t n = 0;
+	int rc = bsim_outdir_files(dir, &files, &n, err);
+	static const char *const ext[] = {"key", "csv", "cost"};
+	for (int i = 0; rc == BSIM_OK && n > 0 && i < set->n; i++)
+		for (int e = 0; rc == BSIM_OK && e < 3; e++) {
+			char name[64];
+			snprintf(name, sizeof name, "map_%016llx.%s",
+			         (unsigned long long)set->maps[i].key, ext[e]);
+			struct stat st;
+			char path[BSIM_PATH_MAX];
+			snprintf(path, sizeof path, "%s/%s", dir, name);
+			if (lstat(path, &st) != 0)
+				continue; /* a map without a .cost file: its cost unknown */
+			size_t j = 0;
+			while (j < n && strcmp(files[j], name) != 0)
+				j++;
+			if (j == n)
+				rc = bsim_error_set(err, BSIM_EINPUT,
+				                    "%s: not listed in %s/manifest.json, so not "
+				                    "checked against it: rebuild the maps with "
+				                    "beamsim markov build EXPERIMENT --out %s",
+				                    path, dir, dir);
+		}
+	bsim_outdir_files_free(files, n);
+	return rc;
+}
+
 int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *opts,
                      bsim_markov_set *out, bsim_error *err)
 {
@@ -266,5 +300,9 @@ int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *o
 	if ((rc = markov_def_read(dir, &def, opts, err)) != BSIM_OK ||
 	    (rc = def_check(&def, err)) != BSIM_OK)
 		return rc;
-	return set_fill(lattice, &def, dir, NULL, out, err);
+	if ((rc = set_fill(lattice, &def, dir, NULL, out, err)) != BSIM_OK)
+		return rc;
+	if ((rc = maps_listed(dir, out, err)) != BSIM_OK)
+		bsim_markov_set_free(out);
+	return rc;
 }
