@@ -230,6 +230,69 @@ static void test_tolerance(void **state)
 	bsim_scene_free(&s);
 }
 
+/* What a map cost, against what its single gates must have taken: a
+ * stuck trial runs gate_steps steps, any other at least one, so a map's
+ * steps lie between stuck * gate_steps + the others and trials *
+ * gate_steps; read back from the map's .cost file they are the same. With
+ * self entries each pass's cost holds the passes before it: pass 0 runs
+ * the uniform map's single gates again (the same steps), and a build with
+ * one more pass adds just that pass's steps to the cached passes'. */
+static void check_steps(const bsim_markov_map *m, long long steps, long gate_steps)
+{
+	long stuck = 0, total = (long)m->n_bins * m->trials;
+	for (int a = 0; a < m->n_bins; a++)
+		stuck += m->counts[(size_t)a * m->n_bins];
+	assert_true(steps >= (long long)stuck * gate_steps + (total - stuck));
+	assert_true(steps <= (long long)total * gate_steps);
+}
+
+static void test_map_cost(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_error err;
+	assert_int_equal(
+	        bsim_scene_load(bsim_test_src("configs/lattice/c_track.yaml"), NULL, 0, &s, &err),
+	        BSIM_OK);
+	const long gate_steps = s.gate_steps > 0 ? s.gate_steps : s.max_steps;
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
+	def.trials = 8;
+	def.threads = 1;
+	char uni[1024], self[1024];
+	snprintf(uni, sizeof uni, "%s", exe_dir("cost_uniform"));
+	snprintf(self, sizeof self, "%s", exe_dir("cost_self"));
+	bsim_markov_set u, back, s1, s2;
+	assert_int_equal(bsim_markov_build(&s, &def, uni, &u, &err), BSIM_OK);
+	bsim_options opts;
+	assert_int_equal(bsim_markov_load(&s, uni, &opts, &back, &err), BSIM_OK);
+	assert_int_equal(back.n, u.n);
+	for (int i = 0; i < u.n; i++) {
+		check_steps(&u.maps[i], u.maps[i].steps, gate_steps);
+		assert_true(u.maps[i].cost == u.maps[i].seconds && u.maps[i].cost > 0.0);
+		assert_true(back.maps[i].steps == u.maps[i].steps);
+		assert_true(fabs(back.maps[i].cost - u.maps[i].cost) <= 1e-5 * u.maps[i].cost);
+	}
+	def.self_entries = 1;
+	def.self_passes = 1;
+	assert_int_equal(bsim_markov_build(&s, &def, self, &s1, &err), BSIM_OK);
+	def.self_passes = 2;
+	assert_int_equal(bsim_markov_build(&s, &def, self, &s2, &err), BSIM_OK);
+	for (int i = 0; i < u.n; i++) {
+		/* the same stiffness pair in all three sets */
+		assert_true(s1.maps[i].k[0] == u.maps[i].k[0] && s2.maps[i].k[1] == u.maps[i].k[1]);
+		check_steps(&s1.maps[i], s1.maps[i].steps - u.maps[i].steps, gate_steps);
+		check_steps(&s2.maps[i], s2.maps[i].steps - s1.maps[i].steps, gate_steps);
+		/* pass 2 alone simulated now, passes 0 and 1 in its cost too */
+		assert_true(s2.maps[i].cost >= s1.maps[i].cost + s2.maps[i].seconds - 1e-5);
+	}
+	bsim_markov_set_free(&u);
+	bsim_markov_set_free(&back);
+	bsim_markov_set_free(&s1);
+	bsim_markov_set_free(&s2);
+	bsim_scene_free(&s);
+}
+
 /* One gate, where the essay's protocol is the whole world: the chain from a
  * map of 400 start trials against 400 independent trials of the lattice
  * run directly, each outcome within 4.5 standard errors of the difference
@@ -1138,6 +1201,7 @@ int main(void)
 	        cmocka_unit_test(test_bins),
 	        cmocka_unit_test(test_conservation),
 	        cmocka_unit_test(test_tolerance),
+	        cmocka_unit_test(test_map_cost),
 	        cmocka_unit_test(test_one_gate_against_simulation),
 	        cmocka_unit_test(test_threads_and_cache),
 	        cmocka_unit_test(test_interrupted_build),

@@ -136,15 +136,18 @@ BSIM_API bsim_markov_def bsim_markov_def_default(void);
 
 /* One single-gate map. */
 typedef struct bsim_markov_map {
-	double k[2];    /* N m/rad, the gate's left and right beam */
-	uint64_t key;   /* FNV-1a hash of key_text: the map's file name */
-	char *key_text; /* everything the map depends on, a line each */
-	int n_bins;     /* bsim_markov_bins_count */
-	int trials;     /* per entry bin */
-	int *counts;    /* n_bins x n_bins, [entry * n_bins + exit], exit 0 = stuck */
-	double seconds; /* CPU time of its simulation now, s (0 if read from the cache) */
-	double cost;    /* CPU time its simulation took when it was built, s */
-	int cached;     /* 1: read from the cache, 0: simulated now */
+	double k[2];     /* N m/rad, the gate's left and right beam */
+	uint64_t key;    /* FNV-1a hash of key_text: the map's file name */
+	char *key_text;  /* everything the map depends on, a line each */
+	int n_bins;      /* bsim_markov_bins_count */
+	int trials;      /* per entry bin */
+	int *counts;     /* n_bins x n_bins, [entry * n_bins + exit], exit 0 = stuck */
+	double seconds;  /* CPU time of its simulation now, s (0 if read from the cache) */
+	double cost;     /* CPU time its simulation took when it was built, s: with self or
+	                  * flow entries every pass's, those reused from the cache too */
+	long long steps; /* single-gate time steps that simulation took (as cost); 0 if
+	                  * the map's .cost file predates the count */
+	int cached;      /* 1: read from the cache, 0: simulated now */
 } bsim_markov_map;
 
 /* The maps of one lattice: one per stiffness pair it uses. */
@@ -278,7 +281,8 @@ typedef struct bsim_markov_check {
 typedef struct bsim_markov_validation {
 	int n;
 	bsim_markov_check *checks; /* group-major, essay then world */
-	double map_cost;           /* s of CPU the maps took to build */
+	double map_cost;           /* s of CPU the maps took to build (every pass) */
+	long long map_steps;       /* single-gate steps those builds took */
 	int bins, trials_per_bin;
 } bsim_markov_validation;
 

@@ -212,7 +212,9 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		             : markov_map_simulate(lattice, def, be, opts, m, &done, total, err);
 		if (!flow) /* else the CPU time of its passes */
 			m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
-		m->cost = m->seconds;
+		/* with self or flow entries, m->cost holds what the passes
+		 * reused from the cache cost */
+		m->cost = m->seconds + (def->self_entries ? m->cost : 0.0);
 		out->seconds += m->seconds;
 		if (rc == BSIM_OK)
 			rc = markov_map_write(stage, m, &def->bins, err);

@@ -493,19 +493,27 @@ static int markov_validate(int argc, char **argv)
 	rc = bsim_markov_validate(&def, &v, &err);
 	cli_progress_finish(&progress);
 	if (rc == BSIM_OK && !c.quiet) {
-		printf("maps        %s: %d entry bins x %d trials, %.1f s of CPU to build\n\n",
-		       a.map, v.bins, v.trials_per_bin, v.map_cost);
+		printf("maps        %s: %d entry bins x %d trials, %.1f s of CPU to build "
+		       "(%lld single-gate steps)\n\n",
+		       a.map, v.bins, v.trials_per_bin, v.map_cost, v.map_steps);
 		printf("group protocol trials    TV  sampling (95%%)   map   gates sim/chain  "
-		       "sim CPU s  predict s   speedup\n");
+		       "sim CPU s  predict s   speedup  pays off after\n");
 		for (int i = 0; i < v.n; i++) {
 			const bsim_markov_check *k = &v.checks[i];
+			/* the fields (predictions) after which the maps cost less
+			 * than simulating each field directly at these trials */
+			const double saved = k->sim_cpu - k->predict;
+			char pays[32] = "never";
+			if (saved > 0)
+				snprintf(pays, sizeof pays, "%.0f fields",
+				         ceil(v.map_cost / saved));
 			printf("%5d %-8s %6d %5.3f  %5.3f (%5.3f)  %5.3f   %5.2f / %5.2f  %9.3f  "
 			       "%9.2e  "
-			       "%8.3g\n",
+			       "%8.3g  %s\n",
 			       k->group, k->protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world",
 			       k->trials, k->tv, k->tv_sampling, k->tv_sampling95, k->tv_map,
 			       k->gates_sim, k->gates_chain, k->sim_cpu, k->predict,
-			       k->sim_cpu / k->predict);
+			       k->sim_cpu / k->predict, pays);
 		}
 		printf("\n");
 		cli_wrote(stdout, c.out);
