@@ -29,7 +29,8 @@
  *   p = s (I - Q)^-1 R,
  * solved exactly by LU decomposition (GSL) when the chain has at most
  * BSIM_MARKOV_LU_MAX states, else by the series s (I + Q + Q^2 + ...) R
- * summed until the probability still in the field is below 1e-12. The
+ * summed until the probability still in the field is below a tolerance
+ * (BSIM_MARKOV_TOL, far below the maps' sampling error). The
  * series' k-th term is the k-th gate entered, so it also gives the
  * distribution of the number of gates visited, the start gate counted.
  *
@@ -135,15 +136,18 @@ BSIM_API bsim_markov_def bsim_markov_def_default(void);
 
 /* One single-gate map. */
 typedef struct bsim_markov_map {
-	double k[2];    /* N m/rad, the gate's left and right beam */
-	uint64_t key;   /* FNV-1a hash of key_text: the map's file name */
-	char *key_text; /* everything the map depends on, a line each */
-	int n_bins;     /* bsim_markov_bins_count */
-	int trials;     /* per entry bin */
-	int *counts;    /* n_bins x n_bins, [entry * n_bins + exit], exit 0 = stuck */
-	double seconds; /* CPU time of its simulation now, s (0 if read from the cache) */
-	double cost;    /* CPU time its simulation took when it was built, s */
-	int cached;     /* 1: read from the cache, 0: simulated now */
+	double k[2];     /* N m/rad, the gate's left and right beam */
+	uint64_t key;    /* FNV-1a hash of key_text: the map's file name */
+	char *key_text;  /* everything the map depends on, a line each */
+	int n_bins;      /* bsim_markov_bins_count */
+	int trials;      /* per entry bin */
+	int *counts;     /* n_bins x n_bins, [entry * n_bins + exit], exit 0 = stuck */
+	double seconds;  /* CPU time of its simulation now, s (0 if read from the cache) */
+	double cost;     /* CPU time its simulation took when it was built, s: with self or
+	                  * flow entries every pass's, those reused from the cache too */
+	long long steps; /* single-gate time steps that simulation took (as cost); 0 if
+	                  * the map's .cost file predates the count */
+	int cached;      /* 1: read from the cache, 0: simulated now */
 } bsim_markov_map;
 
 /* The maps of one lattice: one per stiffness pair it uses. */
@@ -186,14 +190,25 @@ typedef struct bsim_markov_prediction {
 	int n_gates;        /* p_gates has n_gates + 1 entries */
 	double *p_gates;    /* p_gates[k]: k gates visited, the start counted */
 	double mean_gates;
-	double left_in_field; /* probability the series had not absorbed when it stopped */
+	double left_in_field; /* probability the series had not absorbed when it stopped:
+	                       * each location's p is short by at most this */
+	double tol;           /* the tolerance the series stopped at */
 	int n_states;         /* transient states (gate, entry bin) */
 	int exact;            /* 1: p by LU, 0: by the series */
 } bsim_markov_prediction;
 
-/* The chain of lattice composed from set's maps, solved. */
+/* The series stops when less than this is left in the field: far below
+ * the maps' own sampling error (a TV of 0.02 at 800 trials per bin). */
+#define BSIM_MARKOV_TOL 1e-6
+
+/* The chain of lattice composed from set's maps, solved; the series to
+ * BSIM_MARKOV_TOL. */
 BSIM_API int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
                                  bsim_markov_prediction *out, bsim_error *err);
+/* The same, the series summed until less than tol (in (0, 1)) is left in
+ * the field; BSIM_EINPUT for another tol. */
+BSIM_API int bsim_markov_predict_tol(const bsim_scene *lattice, const bsim_markov_set *set,
+                                     double tol, bsim_markov_prediction *out, bsim_error *err);
 BSIM_API void bsim_markov_prediction_free(bsim_markov_prediction *p);
 
 /* Writes p, the prediction of lattice by the chain of set's maps, into
@@ -266,7 +281,8 @@ typedef struct bsim_markov_check {
 typedef struct bsim_markov_validation {
 	int n;
 	bsim_markov_check *checks; /* group-major, essay then world */
-	double map_cost;           /* s of CPU the maps took to build */
+	double map_cost;           /* s of CPU the maps took to build (every pass) */
+	long long map_steps;       /* single-gate steps those builds took */
 	int bins, trials_per_bin;
 } bsim_markov_validation;
 

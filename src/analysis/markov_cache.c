@@ -295,13 +295,22 @@ int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 			m->cost = strtod(t.text + 12, &end);
 		int ok = end && end != t.text + 12 && (*end == '\n' || *end == '\0') &&
 		         isfinite(m->cost) && m->cost >= 0.0;
+		/* "steps N" on the second line; absent in maps built before it */
+		m->steps = 0;
+		if (ok && *end == '\n' && end[1]) {
+			char *s = end + 1, *e2 = NULL;
+			errno = 0;
+			if (strncmp(s, "steps ", 6) == 0 && s[6] >= '0' && s[6] <= '9')
+				m->steps = strtoll(s + 6, &e2, 10);
+			ok = e2 && !errno && (*e2 == '\0' || (*e2 == '\n' && !e2[1]));
+		}
 		file_text_free(&t);
 		if (!ok) {
 			snprintf(path, sizeof path, "%s/map_%016llx.cost", dir,
 			         (unsigned long long)m->key);
 			bsim_error_set(err, BSIM_EINPUT,
-			               "%s:1: cpu_seconds: expected \"cpu_seconds S\", S >= 0 the "
-			               "CPU time of the map's build",
+			               "%s: expected \"cpu_seconds S\" (S >= 0 the CPU time of "
+			               "the map's build) and \"steps N\", a line each",
 			               path);
 			return -1;
 		}
@@ -342,7 +351,7 @@ int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_mar
 	snprintf(path, sizeof path, "%s/map_%016llx.cost", stage, (unsigned long long)m->key);
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
-	fprintf(o.f, "cpu_seconds %.6g\n", m->seconds);
+	fprintf(o.f, "cpu_seconds %.6g\nsteps %lld\n", m->cost, m->steps);
 	return bsim_atomic_file_commit(&o, err);
 }
 
@@ -427,8 +436,16 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 	 * every map file has the size and CRC-32 listed there (a map's CSV
 	 * put in another's place is refused here). */
 	int has_manifest = 0;
-	if (bsim_outdir_verify(dir, &has_manifest, err) != BSIM_OK)
+	if (bsim_outdir_verify(dir, &has_manifest, err) != BSIM_OK) {
+		/* A damaged map is not repaired here: its counts are gone. */
+		if (err) {
+			size_t len = strlen(err->msg);
+			snprintf(err->msg + len, sizeof err->msg - len,
+			         "; rebuild the maps with beamsim markov build EXPERIMENT --out %s",
+			         dir);
+		}
 		return BSIM_EINPUT;
+	}
 	snprintf(path, sizeof path, "%s/markov.json", dir);
 	/* Without blocking: a FIFO there is refused by ydoc_load. */
 	int probe = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);

@@ -18,8 +18,13 @@
  * expected number of visits of each state and p = y R. Always, the series
  * s Q^(k-1) R, k = 1, 2, ..., whose k-th term is the probability of ending
  * after the k-th gate entered: the distribution of gates visited, and p
- * where the chain is too large for LU. It stops when less than 1e-12 is
- * left in the field (or after 1e6 terms, said in left_in_field). */
+ * where the chain is too large for LU. It stops when less than tol is
+ * left in the field, a tolerance (or after 1e6 terms), said in
+ * left_in_field: what is left would have ended somewhere, so each
+ * location's probability is short by at most left_in_field. The series
+ * walks each map's own rows (compressed sparse rows, contiguous exits and
+ * probabilities) through a table of where each gate's exits lead, built
+ * once; Q is composed only for the LU. */
 #include "beamsim/markov.h"
 #include "beamsim/lattice_outcome.h"
 
@@ -28,19 +33,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define SERIES_TOL 1e-12
 #define SERIES_MAX 1000000
 
-/* One nonzero transition of a map row. */
-typedef struct arc {
-	int exit;
-	double p;
-} arc;
-
-/* A map's rows as arcs: row a is arcs[first[a] .. first[a + 1]). */
+/* A map's rows in compressed sparse rows: row a's nonzero transitions are
+ * exit[first[a] .. first[a + 1]) with probabilities p[], contiguous. */
 typedef struct sparse_map {
-	int *first;
-	arc *arcs;
+	int *first, *exit;
+	double *p;
 } sparse_map;
 
 static int sparse_init(sparse_map *s, const bsim_markov_map *m)
@@ -50,8 +49,9 @@ static int sparse_init(sparse_map *s, const bsim_markov_map *m)
 	for (long i = 0; i < (long)nb * nb; i++)
 		nnz += m->counts[i] != 0;
 	s->first = malloc((size_t)(nb + 1) * sizeof *s->first);
-	s->arcs = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *s->arcs);
-	if (!s->first || !s->arcs)
+	s->exit = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *s->exit);
+	s->p = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *s->p);
+	if (!s->first || !s->exit || !s->p)
 		return -1;
 	int k = 0;
 	for (int a = 0; a < nb; a++) {
@@ -61,8 +61,10 @@ static int sparse_init(sparse_map *s, const bsim_markov_map *m)
 			total += m->counts[(size_t)a * nb + x];
 		for (int x = 0; x < nb; x++) {
 			int c = m->counts[(size_t)a * nb + x];
-			if (c)
-				s->arcs[k++] = (arc){x, (double)c / (double)total};
+			if (c) {
+				s->exit[k] = x;
+				s->p[k++] = (double)c / (double)total;
+			}
 		}
 	}
 	s->first[nb] = k;
@@ -78,8 +80,13 @@ typedef struct chain {
 	int per_edge;   /* bins per edge */
 	int *gate_map;  /* gate -> map index */
 	sparse_map *sm; /* per map */
-	/* The composed chain: state s's arcs are to[first[s] .. first[s + 1])
-	 * with probabilities p[]; to >= 0 a state, else -1 - location. */
+	/* Where exit x of gate g leads, tgt[g nb + x]: a state, or n_states +
+	 * location. The series walks the maps' own rows through this table
+	 * (both small enough to stay in cache) rather than a composed Q. */
+	int *tgt;
+	/* The composed chain, for the LU only (at most BSIM_MARKOV_LU_MAX
+	 * states): state s's arcs are to[first[s] .. first[s + 1]) with
+	 * probabilities p[]; to >= 0 a state, else -1 - location. */
 	int *first, *to;
 	double *p;
 } chain;
@@ -138,10 +145,12 @@ static void chain_free(chain *c, int n_maps)
 {
 	for (int i = 0; c->sm && i < n_maps; i++) {
 		free(c->sm[i].first);
-		free(c->sm[i].arcs);
+		free(c->sm[i].exit);
+		free(c->sm[i].p);
 	}
 	free(c->sm);
 	free(c->gate_map);
+	free(c->tgt);
 	free(c->first);
 	free(c->to);
 	free(c->p);
@@ -186,9 +195,22 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 				        k[0], k[1]);
 			c->gate_map[iy * c->cols + ix - l->ix_min] = j;
 		}
-	/* Compose: every state's arcs resolved once. */
+	/* Every exit of every gate resolved once. */
+	const int G = c->cols * c->rows;
+	c->tgt = malloc((size_t)G * c->nb * sizeof *c->tgt);
+	if (!c->tgt)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int g = 0; g < G; g++)
+		for (int x = 0; x < c->nb; x++) {
+			int state, loc;
+			target(c, g, x, &state, &loc);
+			c->tgt[(size_t)g * c->nb + x] = state >= 0 ? state : c->n_states + loc;
+		}
+	if (c->n_states > BSIM_MARKOV_LU_MAX)
+		return BSIM_OK;
+	/* Compose for the LU: every state's arcs. */
 	long nnz = 0;
-	for (int g = 0; g < c->cols * c->rows; g++) {
+	for (int g = 0; g < G; g++) {
 		const sparse_map *sm = &c->sm[c->gate_map[g]];
 		nnz += sm->first[c->nb];
 	}
@@ -203,24 +225,28 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 		int g = s / c->nb, a = s % c->nb;
 		const sparse_map *sm = &c->sm[c->gate_map[g]];
 		for (int j = sm->first[a]; j < sm->first[a + 1]; j++, k++) {
-			int state, loc;
-			target(c, g, sm->arcs[j].exit, &state, &loc);
-			c->to[k] = state >= 0 ? state : -1 - loc;
-			c->p[k] = sm->arcs[j].p;
+			int t = c->tgt[(size_t)g * c->nb + sm->exit[j]];
+			c->to[k] = t < c->n_states ? t : -1 - (t - c->n_states);
+			c->p[k] = sm->p[j];
 		}
 	}
 	c->first[c->n_states] = k;
 	return BSIM_OK;
 }
 
-/* The series from the start state: p_loc (n_loc), p_gates (grown as
- * needed), the probability left. */
-static int series(const chain *c, int start, double *p_loc, double **p_gates, int *n_gates,
-                  double *left)
+/* The series from the start state, until less than tol is left in the
+ * field: p_loc (n_loc), p_gates (grown as needed), the probability left.
+ * Every buffer is allocated before the loop. A term walks the gates that
+ * hold probability (a band of rows that moves up the field), each state's
+ * map row through the gate's target table; the absorbing locations are
+ * the last n_loc entries of next, emptied into p_loc after each term. */
+static int series(const chain *c, int start, double tol, double *p_loc, double **p_gates,
+                  int *n_gates, double *left)
 {
-	double *cur = calloc((size_t)c->n_states, sizeof *cur);
-	double *next = calloc((size_t)c->n_states, sizeof *next);
-	int cap = 64;
+	const int n = c->n_states, nb = c->nb, G = c->cols * c->rows;
+	double *cur = calloc((size_t)n + c->n_loc, sizeof *cur);
+	double *next = calloc((size_t)n + c->n_loc, sizeof *next);
+	int cap = 128;
 	double *pg = calloc((size_t)cap + 1, sizeof *pg);
 	if (!cur || !next || !pg) {
 		free(cur);
@@ -229,9 +255,11 @@ static int series(const chain *c, int start, double *p_loc, double **p_gates, in
 		return -1;
 	}
 	cur[start] = 1.0;
+	/* the gates that may hold probability: [glo, ghi) */
+	int glo = start / nb, ghi = glo + 1;
 	double in_field = 1.0;
 	int k = 0;
-	while (in_field > SERIES_TOL && k < SERIES_MAX) {
+	while (in_field > tol && k < SERIES_MAX) {
 		k++;
 		if (k > cap) {
 			double *np = realloc(pg, ((size_t)2 * cap + 1) * sizeof *pg);
@@ -245,26 +273,47 @@ static int series(const chain *c, int start, double *p_loc, double **p_gates, in
 			pg = np;
 			cap *= 2;
 		}
-		double absorbed = 0.0;
-		in_field = 0.0;
-		for (int s = 0; s < c->n_states; s++) {
-			double m = cur[s];
-			if (m == 0.0)
-				continue;
-			cur[s] = 0.0;
-			for (int j = c->first[s]; j < c->first[s + 1]; j++) {
-				int to = c->to[j];
-				double q = m * c->p[j];
-				if (to >= 0) {
-					next[to] += q;
-					in_field += q;
-				} else {
-					p_loc[-1 - to] += q;
-					absorbed += q;
-				}
+		for (int g = glo; g < ghi; g++) {
+			const sparse_map *sm = &c->sm[c->gate_map[g]];
+			const int *restrict first = sm->first, *restrict ex = sm->exit;
+			const double *restrict pr = sm->p;
+			const int *restrict tg = c->tgt + (size_t)g * nb;
+			double *restrict cg = cur + (size_t)g * nb;
+			for (int a = 0; a < nb; a++) {
+				const double m = cg[a];
+				if (m == 0.0)
+					continue;
+				cg[a] = 0.0;
+				const int j1 = first[a + 1];
+				for (int j = first[a]; j < j1; j++)
+					next[tg[ex[j]]] += m * pr[j];
 			}
 		}
+		double absorbed = 0.0;
+		for (int l = 0; l < c->n_loc; l++) {
+			absorbed += next[n + l];
+			p_loc[l] += next[n + l];
+			next[n + l] = 0.0;
+		}
 		pg[k] = absorbed;
+		/* a gate's exits reach its neighbours and, from row 0, row 0 */
+		glo = glo - c->cols > 0 ? glo - c->cols : 0;
+		ghi = ghi + c->cols < G ? ghi + c->cols : G;
+		in_field = 0.0;
+		int nlo = G, nhi = 0;
+		for (int g = glo; g < ghi; g++) {
+			double mg = 0.0;
+			const double *ng = next + (size_t)g * nb;
+			for (int a = 0; a < nb; a++)
+				mg += ng[a];
+			if (mg != 0.0) {
+				nlo = g < nlo ? g : nlo;
+				nhi = g + 1;
+			}
+			in_field += mg;
+		}
+		glo = nlo;
+		ghi = nhi;
 		double *t = cur;
 		cur = next;
 		next = t;
@@ -320,15 +369,27 @@ done:
 int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
                         bsim_markov_prediction *out, bsim_error *err)
 {
+	return bsim_markov_predict_tol(lattice, set, BSIM_MARKOV_TOL, out, err);
+}
+
+int bsim_markov_predict_tol(const bsim_scene *lattice, const bsim_markov_set *set, double tol,
+                            bsim_markov_prediction *out, bsim_error *err)
+{
 	memset(out, 0, sizeof *out);
 	if (!lattice->has_lattice)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: not a gate lattice", lattice->name);
+	if (!(tol > 0.0 && tol < 1.0))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "tolerance %g: expected the probability left in the field "
+		                      "at which the series stops, in (0, 1)",
+		                      tol);
 	chain c;
 	int rc = chain_init(&c, lattice, set, err);
 	const bsim_lattice_def *l = &lattice->lattice;
 	if (rc == BSIM_OK) {
 		out->n_locations = c.n_loc;
 		out->n_states = c.n_states;
+		out->tol = tol;
 		out->loc = malloc((size_t)c.n_loc * sizeof *out->loc);
 		out->p = calloc((size_t)c.n_loc, sizeof *out->p);
 		if (!out->loc || !out->p)
@@ -345,7 +406,8 @@ int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
 		int ix, iy;
 		bsim_lattice_gate_at(lattice, lattice->body.start, &ix, &iy);
 		int start = ((iy * c.cols) + ix - l->ix_min) * c.nb;
-		if (series(&c, start, out->p, &out->p_gates, &out->n_gates, &out->left_in_field))
+		if (series(&c, start, tol, out->p, &out->p_gates, &out->n_gates,
+		           &out->left_in_field))
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		if (rc == BSIM_OK && c.n_states <= BSIM_MARKOV_LU_MAX) {
 			/* Two solutions of one chain: they must agree to within what

@@ -122,6 +122,7 @@ typedef struct gate_runner {
 	const markov_entry_index *ex; /* NULL: no observed entries */
 	const markov_pool *pool;      /* NULL: not a self-consistent pass */
 	markov_run *run;              /* NULL: not kept */
+	long steps;                   /* of the last trial */
 } gate_runner;
 
 /* One single-gate trial from entry bin `bin` (0: the start) with trial index
@@ -173,6 +174,7 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	}
 	double next[2];
 	int out = 0;
+	r->steps = n_max;
 	for (long n = 0; n < n_max; n++) {
 		double f[2];
 		bsim_effects_force(&fx, n, s->dt, f);
@@ -193,6 +195,7 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 		const double *p = r->s1.x;
 		if (p[0] < -w2 || p[0] >= w2 || p[1] < 0.0 || p[1] >= d) {
 			out = exit_bin(&def->bins, l, r->s0.x, &r->s1, next);
+			r->steps = n + 1;
 			break;
 		}
 		bsim_state tmp = r->s0;
@@ -238,6 +241,7 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	int failed = 0, stopped = 0;
+	long long steps = 0;
 	bsim_error first = {0};
 	long first_unit = units;
 	int threads = def->threads > 0 ? def->threads : 0;
@@ -277,6 +281,8 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 			r.run = runs ? &runs[u] : NULL;
 			exit[u] = gate_trial(&r, lattice, def, be, opts, (int)(u / T), (int)(u % T),
 			                     &e);
+#pragma omp atomic
+			steps += r.steps;
 			if (exit[u] < 0) {
 #pragma omp critical(markov_fail)
 				if (u < first_unit) {
@@ -305,6 +311,7 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 	}
 	for (long u = 0; !failed && u < units; u++)
 		m->counts[(u / T) * nb + exit[u]]++;
+	m->steps += steps;
 	free(exit);
 	markov_entry_index_free(&ex);
 	return stopped ? BSIM_ESTOPPED : failed ? BSIM_EFAIL : BSIM_OK;

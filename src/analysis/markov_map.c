@@ -15,6 +15,7 @@
 
 #include "store/outdir.h"
 #include "store/session.h"
+#include "beamsim/limits.h"
 
 bsim_markov_def bsim_markov_def_default(void)
 {
@@ -211,7 +212,9 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		             : markov_map_simulate(lattice, def, be, opts, m, &done, total, err);
 		if (!flow) /* else the CPU time of its passes */
 			m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
-		m->cost = m->seconds;
+		/* with self or flow entries, m->cost holds what the passes
+		 * reused from the cache cost */
+		m->cost = m->seconds + (def->self_entries ? m->cost : 0.0);
 		out->seconds += m->seconds;
 		if (rc == BSIM_OK)
 			rc = markov_map_write(stage, m, &def->bins, err);
@@ -255,6 +258,39 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 	return rc;
 }
 
+/* With a manifest, every map file read must be one it lists (and so was
+ * checked against its size and CRC-32 by markov_def_read): a map copied
+ * in from elsewhere after the build is not used unchecked. */
+static int maps_listed(const char *dir, const bsim_markov_set *set, bsim_error *err)
+{
+	char **files = NULL;
+	size_t n = 0;
+	int rc = bsim_outdir_files(dir, &files, &n, err);
+	static const char *const ext[] = {"key", "csv", "cost"};
+	for (int i = 0; rc == BSIM_OK && n > 0 && i < set->n; i++)
+		for (int e = 0; rc == BSIM_OK && e < 3; e++) {
+			char name[64];
+			snprintf(name, sizeof name, "map_%016llx.%s",
+			         (unsigned long long)set->maps[i].key, ext[e]);
+			struct stat st;
+			char path[BSIM_PATH_MAX];
+			snprintf(path, sizeof path, "%s/%s", dir, name);
+			if (lstat(path, &st) != 0)
+				continue; /* a map without a .cost file: its cost unknown */
+			size_t j = 0;
+			while (j < n && strcmp(files[j], name) != 0)
+				j++;
+			if (j == n)
+				rc = bsim_error_set(err, BSIM_EINPUT,
+				                    "%s: not listed in %s/manifest.json, so not "
+				                    "checked against it: rebuild the maps with "
+				                    "beamsim markov build EXPERIMENT --out %s",
+				                    path, dir, dir);
+		}
+	bsim_outdir_files_free(files, n);
+	return rc;
+}
+
 int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *opts,
                      bsim_markov_set *out, bsim_error *err)
 {
@@ -266,5 +302,9 @@ int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *o
 	if ((rc = markov_def_read(dir, &def, opts, err)) != BSIM_OK ||
 	    (rc = def_check(&def, err)) != BSIM_OK)
 		return rc;
-	return set_fill(lattice, &def, dir, NULL, out, err);
+	if ((rc = set_fill(lattice, &def, dir, NULL, out, err)) != BSIM_OK)
+		return rc;
+	if ((rc = maps_listed(dir, out, err)) != BSIM_OK)
+		bsim_markov_set_free(out);
+	return rc;
 }

@@ -211,7 +211,7 @@ static void pass_map_free(bsim_markov_map *q)
  * exits are malformed. */
 static int last_cached(const bsim_scene *lattice, const bsim_markov_def *def,
                        const bsim_backend *be, const bsim_options *opts, const bsim_markov_map *m,
-                       const char *dir, markov_run *runs, bsim_error *err)
+                       const char *dir, markov_run *runs, bsim_markov_map *cost, bsim_error *err)
 {
 	for (int q = def->self_passes - 1; q >= 0 && dir; q--) {
 		bsim_markov_map mq;
@@ -223,6 +223,10 @@ static int last_cached(const bsim_scene *lattice, const bsim_markov_def *def,
 			                                 err)
 			                     : 1
 			              : 0;
+		}
+		if (got == 1 && cost) { /* what it and the passes before it cost */
+			cost->cost = mq.cost;
+			cost->steps = mq.steps;
 		}
 		pass_map_free(&mq);
 		if (got == 1)
@@ -236,7 +240,7 @@ static int last_cached(const bsim_scene *lattice, const bsim_markov_def *def,
 int markov_self_todo(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
                      const bsim_options *opts, const bsim_markov_map *m, const char *dir)
 {
-	int q = last_cached(lattice, def, be, opts, m, dir, NULL, NULL);
+	int q = last_cached(lattice, def, be, opts, m, dir, NULL, NULL, NULL);
 	return def->self_passes - (q < 0 ? -1 : q);
 }
 
@@ -255,7 +259,12 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	int rc = BSIM_OK;
-	int q0 = last_cached(lattice, def, be, opts, m, dir, prev, err) + 1;
+	m->cost = 0.0;
+	m->steps = 0;
+	int q0 = last_cached(lattice, def, be, opts, m, dir, prev, m, err) + 1;
+	/* each pass's .cost holds it and every pass before it */
+	double cum = m->cost;
+	long long cum_steps = m->steps;
 	if (q0 < 0)
 		rc = BSIM_EINPUT; /* a cached pass whose exits are malformed: err says which */
 	for (int q = q0; q <= def->self_passes && rc == BSIM_OK; q++) {
@@ -274,6 +283,10 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		                                                        have_pool ? &pool : NULL,
 		                                                        cur, done, total, err);
 		mq.seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
+		cum += mq.seconds;
+		cum_steps += mq.steps;
+		mq.cost = cum;
+		mq.steps = cum_steps;
 		if (have_pool)
 			pool_free(&pool);
 		if (rc == BSIM_OK && q < def->self_passes)
@@ -289,6 +302,8 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	}
 	free(prev);
 	free(cur);
+	/* the caller adds this build's CPU time */
+	m->steps = cum_steps;
 	return rc;
 }
 
@@ -401,14 +416,20 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	int sx, sy;
 	bsim_lattice_gate_at(lattice, lattice->body.start, &sx, &sy);
 	const int start_gate = sy * cols + sx - l->ix_min;
-	/* The last pass every map has in dir. */
+	/* The last pass every map has in dir; what that pass and those before
+	 * it cost, into the cost of each map to build (the caller adds this
+	 * build's CPU time). */
 	int q0 = 0;
+	bsim_markov_map *prior = calloc((size_t)n, sizeof *prior);
+	if (!prior)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (int q = def->self_passes - 1; q >= 0 && rc == BSIM_OK && !q0; q--) {
 		int all = 1;
 		for (int i = 0; i < n && all; i++) {
 			bsim_markov_def dq = *def;
 			dq.self_passes = q + 1;
-			int got = last_cached(lattice, &dq, be, opts, &maps[i], dir, prev[i], err);
+			int got = last_cached(lattice, &dq, be, opts, &maps[i], dir, prev[i],
+			                      &prior[i], err);
 			if (got == -2)
 				rc = BSIM_EINPUT;
 			all = got == q;
@@ -416,6 +437,12 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		if (all)
 			q0 = q + 1;
 	}
+	for (int i = 0; i < n && prior; i++)
+		if (!have[i]) {
+			maps[i].cost = q0 > 0 ? prior[i].cost : 0.0;
+			maps[i].steps = q0 > 0 ? prior[i].steps : 0;
+		}
+	free(prior);
 	for (int q = q0; q <= def->self_passes && rc == BSIM_OK; q++) {
 		if (q > 0) {
 			memset(visits, 0, (size_t)G * nb * sizeof *visits);
@@ -466,6 +493,10 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			                                        total, err);
 			mq.seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 			maps[b].seconds += mq.seconds;
+			maps[b].steps += mq.steps;
+			/* each pass's .cost: it and every pass before it */
+			mq.cost = maps[b].cost + maps[b].seconds;
+			mq.steps = maps[b].steps;
 			if (q > 0)
 				pool_free(&pool);
 			const int last = q == def->self_passes;

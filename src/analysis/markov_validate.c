@@ -228,6 +228,7 @@ static int write_json(const char *stage, const bsim_markov_validate_def *def,
 	fprintf(f, ", \"entry_bins\": %d, \"trials_per_bin\": %d, \"map_cpu_seconds\": ", v->bins,
 	        v->trials_per_bin);
 	bsim_json_number(f, v->map_cost);
+	fprintf(f, ", \"map_steps\": %lld", v->map_steps);
 	fputs(", \"checks\": [", f);
 	for (int i = 0; i < v->n; i++) {
 		const bsim_markov_check *c = &v->checks[i];
@@ -360,8 +361,10 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 		free(idx);
 		v->bins = set.n ? set.maps[0].n_bins : 0;
 		v->trials_per_bin = set.def.trials;
-		for (int i = 0; i < set.n; i++)
+		for (int i = 0; i < set.n; i++) {
 			v->map_cost += set.maps[i].cost;
+			v->map_steps += set.maps[i].steps;
+		}
 	}
 	const bsim_lattice_def *l = &scene.lattice;
 	const int nl = d->pred.n_locations;
@@ -461,8 +464,10 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++)
 		rc = group_validate(def, &e, g, res, cpu, rng, &gd[g], out, err);
-	if (rc == BSIM_OK)
+	if (rc == BSIM_OK) {
 		out->map_cost /= e.n_groups;
+		out->map_steps /= e.n_groups;
+	}
 	if (rc == BSIM_OK)
 		rc = write_csv(ss.stage, &e, out, gd, err);
 	if (rc == BSIM_OK)

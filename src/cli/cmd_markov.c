@@ -15,9 +15,10 @@
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
+#include "util/clock.h"
 #include "util/json.h"
 
-enum { OWN_BINS, OWN_VMAX, OWN_ENTRIES, OWN_MAP, OWN_BOOTSTRAP, OWN_LOCATIONS, OWN_JSON };
+enum { OWN_BINS, OWN_VMAX, OWN_ENTRIES, OWN_MAP, OWN_BOOTSTRAP, OWN_LOCATIONS, OWN_JSON, OWN_TOL };
 
 #define MAX_ENTRIES 16
 
@@ -26,6 +27,7 @@ typedef struct markov_args {
 	const char *map;
 	long bootstrap;
 	int locations, json; /* predict: --locations, --json */
+	double tol;          /* predict: --tol */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
 } markov_args;
@@ -104,6 +106,14 @@ static int markov_option(void *args, int i, const char *value)
 	case OWN_JSON:
 		a->json = 1;
 		return CLI_OK;
+	case OWN_TOL:
+		a->tol = strtod(value, &end);
+		if (end == value || *end || !(a->tol > 0.0 && a->tol < 1.0))
+			return cli_usage("markov predict",
+			                 "--tol %s: expected the probability left in the field at "
+			                 "which the series stops, in (0, 1), e.g. 1e-12",
+			                 value);
+		return CLI_OK;
 	}
 	return CLI_USAGE;
 }
@@ -155,7 +165,11 @@ static const cli_spec build_spec = {
 static const cli_own predict_own[] = {
         {"map", 1, "DIR", "the map directory of beamsim markov build (required)"},
         {"locations", 0, NULL, "also print every final location with its probability"},
-        {"json", 0, NULL, "print one JSON object (totals, every location) instead\nof text"},
+        {"json", 0, NULL,
+         "print one JSON object (totals, every location, predict_seconds)\ninstead of text"},
+        {"tol", 1, "T",
+         "stop the series when less than T is left in the field\n(default 1e-6; "
+         "each location's p is short by at most\nwhat is left)"},
 };
 
 /* predict's and validate's own options: --map, then predict's --locations
@@ -189,7 +203,7 @@ static const cli_spec predict_spec = {
         .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_QUIET),
         .help = predict_help,
         .own = predict_own,
-        .n_own = 3,
+        .n_own = 4,
         .option = predict_option,
 };
 
@@ -337,7 +351,7 @@ static void predict_print(const char *path, const bsim_scene *scene, const bsim_
 		printf("%-12s %7.4f\n", kinds[k], total[k]);
 	printf("%-12s %7.4f\n", "(sum)", total[0] + total[1] + total[2]);
 	printf("\ngates visited: mean %.2f (%d terms of the series)", p->mean_gates, p->n_gates);
-	if (p->left_in_field > 1e-12)
+	if (!p->exact || p->left_in_field > 1e-12)
 		printf(" (the series stopped with %.2g still in the field)", p->left_in_field);
 	printf("\nexpected time: none (the chain counts gates, not seconds)\n");
 	if (locations) {
@@ -358,7 +372,7 @@ static void predict_print(const char *path, const bsim_scene *scene, const bsim_
 
 /* --json: one object with the totals and every final location. */
 static void predict_json(const char *path, const bsim_scene *scene, const bsim_markov_set *set,
-                         const bsim_markov_prediction *p)
+                         const bsim_markov_prediction *p, double seconds)
 {
 	static const char *const kinds[] = {"end", "side", "stuck"};
 	double total[3];
@@ -381,6 +395,10 @@ static void predict_json(const char *path, const bsim_scene *scene, const bsim_m
 	bsim_json_number(f, p->mean_gates);
 	fputs(", \"left_in_field\": ", f);
 	bsim_json_number(f, p->left_in_field);
+	fputs(", \"tol\": ", f);
+	bsim_json_number(f, p->tol);
+	fputs(", \"predict_seconds\": ", f);
+	bsim_json_number(f, seconds);
 	fputs(", \"locations\": [", f);
 	for (int i = 0; i < p->n_locations; i++) {
 		char label[48];
@@ -401,7 +419,7 @@ static void predict_json(const char *path, const bsim_scene *scene, const bsim_m
 static int markov_predict(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	markov_args a = {.def = bsim_markov_def_default()};
+	markov_args a = {.def = bsim_markov_def_default(), .tol = BSIM_MARKOV_TOL};
 	const char *path = NULL;
 	int rc = cli_parse(&predict_spec, argc, argv, &c, &a, &path);
 	if (rc < 0 && !a.map)
@@ -420,13 +438,17 @@ static int markov_predict(int argc, char **argv)
 	bsim_markov_set set;
 	bsim_markov_prediction p = {0};
 	rc = bsim_markov_load(&scene, a.map, &opts, &set, &err);
+	/* The wall time of the prediction alone (the chain composed and
+	 * solved; the maps already read). */
+	double t0 = bsim_clock_seconds();
 	if (rc == BSIM_OK)
-		rc = bsim_markov_predict(&scene, &set, &p, &err);
+		rc = bsim_markov_predict_tol(&scene, &set, a.tol, &p, &err);
+	double seconds = bsim_clock_seconds() - t0;
 	if (rc == BSIM_OK && c.out)
 		rc = bsim_markov_prediction_store(c.out, &scene, &set, &p, &err);
 	/* --quiet wins over --json: nothing on stdout. */
 	if (rc == BSIM_OK && !c.quiet && a.json)
-		predict_json(path, &scene, &set, &p);
+		predict_json(path, &scene, &set, &p, seconds);
 	else if (rc == BSIM_OK && !c.quiet)
 		predict_print(path, &scene, &set, &p, c.out, a.locations);
 	bsim_markov_prediction_free(&p);
@@ -471,19 +493,27 @@ static int markov_validate(int argc, char **argv)
 	rc = bsim_markov_validate(&def, &v, &err);
 	cli_progress_finish(&progress);
 	if (rc == BSIM_OK && !c.quiet) {
-		printf("maps        %s: %d entry bins x %d trials, %.1f s of CPU to build\n\n",
-		       a.map, v.bins, v.trials_per_bin, v.map_cost);
+		printf("maps        %s: %d entry bins x %d trials, %.1f s of CPU to build "
+		       "(%lld single-gate steps)\n\n",
+		       a.map, v.bins, v.trials_per_bin, v.map_cost, v.map_steps);
 		printf("group protocol trials    TV  sampling (95%%)   map   gates sim/chain  "
-		       "sim CPU s  predict s   speedup\n");
+		       "sim CPU s  predict s   speedup  pays off after\n");
 		for (int i = 0; i < v.n; i++) {
 			const bsim_markov_check *k = &v.checks[i];
+			/* the fields (predictions) after which the maps cost less
+			 * than simulating each field directly at these trials */
+			const double saved = k->sim_cpu - k->predict;
+			char pays[32] = "never";
+			if (saved > 0)
+				snprintf(pays, sizeof pays, "%.0f fields",
+				         ceil(v.map_cost / saved));
 			printf("%5d %-8s %6d %5.3f  %5.3f (%5.3f)  %5.3f   %5.2f / %5.2f  %9.3f  "
 			       "%9.2e  "
-			       "%8.3g\n",
+			       "%8.3g  %s\n",
 			       k->group, k->protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world",
 			       k->trials, k->tv, k->tv_sampling, k->tv_sampling95, k->tv_map,
 			       k->gates_sim, k->gates_chain, k->sim_cpu, k->predict,
-			       k->sim_cpu / k->predict);
+			       k->sim_cpu / k->predict, pays);
 		}
 		printf("\n");
 		cli_wrote(stdout, c.out);
