@@ -47,6 +47,7 @@ static const struct {
         {"validate.csv", "per group: every location, simulated and chained"},
         {"gates.csv", "per group: gates visited, simulated and chained"},
         {"markov.json", "the settings the maps were built with"},
+        {"index.html", "every figure with a caption, for a browser"},
 };
 
 static int ends_with(const char *s, const char *tail)
