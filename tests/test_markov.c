@@ -230,6 +230,54 @@ static void test_tolerance(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The sweeps against the other path through the chain, the series to
+ * 1e-12, on the C-track (maps of 4 trials per bin, the default bins): at
+ * every location within the sweeps' bound (left_in_field, plus the
+ * series' own 1e-12), both short of the exact p, the probabilities plus
+ * the bound at least one and at most one; the sweeps' expected visits
+ * are the series' mean of gates visited. */
+static void test_sweeps_against_series(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_error err;
+	assert_int_equal(
+	        bsim_scene_load(bsim_test_src("configs/lattice/c_track.yaml"), NULL, 0, &s, &err),
+	        BSIM_OK);
+	bsim_markov_def def = bsim_markov_def_default();
+	def.trials = 4;
+	bsim_markov_set set;
+	assert_int_equal(bsim_markov_build(&s, &def, exe_dir("sweeps"), &set, &err), BSIM_OK);
+	bsim_markov_prediction ser, fast, gates;
+	assert_int_equal(bsim_markov_predict_with(&s, &set, 1e-12, BSIM_MARKOV_GATES, &ser, &err),
+	                 BSIM_OK);
+	assert_int_equal(bsim_markov_predict_with(&s, &set, BSIM_MARKOV_TOL, 0, &fast, &err),
+	                 BSIM_OK);
+	assert_int_equal(bsim_markov_predict_with(&s, &set, BSIM_MARKOV_TOL, BSIM_MARKOV_GATES,
+	                                          &gates, &err),
+	                 BSIM_OK);
+	assert_int_equal(ser.sweeps, 0);
+	assert_true(ser.left_in_field <= 1e-12);
+	assert_true(fast.sweeps > 0 && fast.left_in_field <= BSIM_MARKOV_TOL);
+	assert_int_equal(fast.n_gates, 0);
+	double sum = 0.0;
+	for (int i = 0; i < fast.n_locations; i++) {
+		/* both short of the exact p by at most what they left */
+		double d = ser.p[i] - fast.p[i];
+		assert_true(fabs(d) <= fast.left_in_field + ser.left_in_field);
+		assert_true(d >= -ser.left_in_field - 1e-15);
+		sum += fast.p[i];
+	}
+	assert_true(sum + fast.left_in_field >= 1.0 - 1e-12 && sum <= 1.0 + 1e-12);
+	assert_true(gates.sweeps == 0 && gates.n_gates > 0 && fast.p_gates[0] == 0.0);
+	assert_double_equal(fast.mean_gates, ser.mean_gates, 1e-3);
+	bsim_markov_prediction_free(&ser);
+	bsim_markov_prediction_free(&fast);
+	bsim_markov_prediction_free(&gates);
+	bsim_markov_set_free(&set);
+	bsim_scene_free(&s);
+}
+
 /* What a map cost, against what its single gates must have taken: a
  * stuck trial runs gate_steps steps, any other at least one, so a map's
  * steps lie between stuck * gate_steps + the others and trials *
@@ -382,6 +430,22 @@ static void check_predict_totals(const char *printed, const char *csv, const cha
 	assert_int_equal(bsim_test_cli(argv, &quiet, NULL), 0);
 	argv[n] = "--locations";
 	assert_int_equal(bsim_test_cli(argv, &list, NULL), 0);
+	/* --no-gates: the sweeps, the same totals to within what they and
+	 * the series left in the field, no distribution of gates visited */
+	char *fast = NULL;
+	argv[n] = "--json";
+	argv[n + 1] = "--no-gates";
+	argv[n + 2] = NULL;
+	assert_int_equal(bsim_test_cli(argv, &fast, NULL), 0);
+	assert_non_null(strstr(fast, "\"solve\": \"sweeps\""));
+	assert_non_null(strstr(fast, "\"p_gates\": [0]"));
+	assert_true(bsim_test_json_number(fast, "sweeps") > 0);
+	const char *fast_totals = strstr(fast, "\"totals\": {");
+	assert_non_null(fast_totals);
+	for (int k = 0; k < 3; k++)
+		near(bsim_test_json_number(fast_totals, kinds[k]), sum[k], 2 * BSIM_MARKOV_TOL,
+		     __LINE__);
+	free(fast);
 	const char *totals = strstr(json, "\"totals\": {");
 	assert_non_null(totals);
 	for (int k = 0; k < 3; k++) {
@@ -1201,6 +1265,7 @@ int main(void)
 	        cmocka_unit_test(test_bins),
 	        cmocka_unit_test(test_conservation),
 	        cmocka_unit_test(test_tolerance),
+	        cmocka_unit_test(test_sweeps_against_series),
 	        cmocka_unit_test(test_map_cost),
 	        cmocka_unit_test(test_one_gate_against_simulation),
 	        cmocka_unit_test(test_threads_and_cache),

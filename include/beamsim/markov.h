@@ -190,11 +190,12 @@ typedef struct bsim_markov_prediction {
 	int n_gates;        /* p_gates has n_gates + 1 entries */
 	double *p_gates;    /* p_gates[k]: k gates visited, the start counted */
 	double mean_gates;
-	double left_in_field; /* probability the series had not absorbed when it stopped:
+	double left_in_field; /* probability the series or sweeps had not absorbed:
 	                       * each location's p is short by at most this */
-	double tol;           /* the tolerance the series stopped at */
+	double tol;           /* the tolerance the sweeps and series stopped at */
 	int n_states;         /* transient states (gate, entry bin) */
-	int exact;            /* 1: p by LU, 0: by the series */
+	int exact;            /* 1: p by LU, 0: by the sweeps */
+	int sweeps;           /* Gauss-Seidel sweeps that gave p (0: the series) */
 } bsim_markov_prediction;
 
 /* The series stops when less than this is left in the field: far below
@@ -209,6 +210,16 @@ BSIM_API int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_se
  * the field; BSIM_EINPUT for another tol. */
 BSIM_API int bsim_markov_predict_tol(const bsim_scene *lattice, const bsim_markov_set *set,
                                      double tol, bsim_markov_prediction *out, bsim_error *err);
+/* bsim_markov_predict_with's flags: p by the series, which also gives
+ * the distribution of gates visited. Without it p is by Gauss-Seidel
+ * sweeps (faster), n_gates = 0, p_gates = {0}, and mean_gates is the
+ * expected number of gates entered. */
+#define BSIM_MARKOV_GATES 1
+/* The same as bsim_markov_predict_tol (which is flags =
+ * BSIM_MARKOV_GATES); flags 0 is the fastest. */
+BSIM_API int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *set,
+                                      double tol, int flags, bsim_markov_prediction *out,
+                                      bsim_error *err);
 BSIM_API void bsim_markov_prediction_free(bsim_markov_prediction *p);
 
 /* Writes p, the prediction of lattice by the chain of set's maps, into
