@@ -102,8 +102,9 @@ const char *markov_entries_label(const bsim_markov_def *def, const bsim_scene *l
 
 /* The passes of map m still to simulate (m's key for def->self_passes;
  * the last pass whose map and exits are in dir is reused): how many. */
-int markov_self_todo(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                     const bsim_options *opts, const bsim_markov_map *m, const char *dir);
+int markov_self_passes_left(const bsim_scene *lattice, const bsim_markov_def *def,
+                            const bsim_backend *be, const bsim_options *opts,
+                            const bsim_markov_map *m, const char *dir);
 
 /* The maps of set (maps[i] with key and counts allocated, have[i] those
  * read from the cache) by def's flow-weighted passes (self_entries 2): pass

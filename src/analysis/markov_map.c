@@ -187,8 +187,9 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			        dir, m->k[0], m->k[1], (unsigned long long)m->key);
 		else
 			total += (long)m->n_bins * def->trials *
-			         (def->self_entries == 1
-			                  ? markov_self_todo(lattice, def, be, opts, m, dir) + 1
+			         (def->self_entries == 1 ? markov_self_passes_left(lattice, def, be,
+			                                                           opts, m, dir) +
+			                                           1
 			          : def->self_entries == 2 ? def->self_passes + 1
 			                                   : 1);
 	}

@@ -237,8 +237,9 @@ static int last_cached(const bsim_scene *lattice, const bsim_markov_def *def,
 	return -1;
 }
 
-int markov_self_todo(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                     const bsim_options *opts, const bsim_markov_map *m, const char *dir)
+int markov_self_passes_left(const bsim_scene *lattice, const bsim_markov_def *def,
+                            const bsim_backend *be, const bsim_options *opts,
+                            const bsim_markov_map *m, const char *dir)
 {
 	int q = last_cached(lattice, def, be, opts, m, dir, NULL, NULL, NULL);
 	return def->self_passes - (q < 0 ? -1 : q);
