@@ -184,6 +184,19 @@ static void test_conservation(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The C-track and its maps of 4 trials per bin (the default bins), built
+ * into the test's folder name. */
+static void c_track_maps(const char *name, bsim_scene *s, bsim_markov_set *set)
+{
+	bsim_error err;
+	assert_int_equal(
+	        bsim_scene_load(bsim_test_src("configs/lattice/c_track.yaml"), NULL, 0, s, &err),
+	        BSIM_OK);
+	bsim_markov_def def = bsim_markov_def_default();
+	def.trials = 4;
+	assert_int_equal(bsim_markov_build(s, &def, exe_dir(name), set, &err), BSIM_OK);
+}
+
 /* The series' tolerance: on the C-track (maps of 4 trials per bin, the
  * default bins), the prediction stopped at the default tolerance differs
  * from the one summed to 1e-12 by no more than the probability it left in
@@ -193,14 +206,9 @@ static void test_tolerance(void **state)
 {
 	(void)state;
 	bsim_scene s;
-	bsim_error err;
-	assert_int_equal(
-	        bsim_scene_load(bsim_test_src("configs/lattice/c_track.yaml"), NULL, 0, &s, &err),
-	        BSIM_OK);
-	bsim_markov_def def = bsim_markov_def_default();
-	def.trials = 4;
 	bsim_markov_set set;
-	assert_int_equal(bsim_markov_build(&s, &def, exe_dir("tolerance"), &set, &err), BSIM_OK);
+	bsim_error err;
+	c_track_maps("tolerance", &s, &set);
 	bsim_markov_prediction fine, p;
 	assert_int_equal(bsim_markov_predict_tol(&s, &set, 1e-12, &fine, &err), BSIM_OK);
 	assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
@@ -240,14 +248,9 @@ static void test_sweeps_against_series(void **state)
 {
 	(void)state;
 	bsim_scene s;
-	bsim_error err;
-	assert_int_equal(
-	        bsim_scene_load(bsim_test_src("configs/lattice/c_track.yaml"), NULL, 0, &s, &err),
-	        BSIM_OK);
-	bsim_markov_def def = bsim_markov_def_default();
-	def.trials = 4;
 	bsim_markov_set set;
-	assert_int_equal(bsim_markov_build(&s, &def, exe_dir("sweeps"), &set, &err), BSIM_OK);
+	bsim_error err;
+	c_track_maps("sweeps", &s, &set);
 	bsim_markov_prediction ser, fast, gates;
 	assert_int_equal(bsim_markov_predict_with(&s, &set, 1e-12, BSIM_MARKOV_GATES, &ser, &err),
 	                 BSIM_OK);
