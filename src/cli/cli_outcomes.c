@@ -107,7 +107,8 @@ static void print_gate(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 			params_cell(f, e, idx, w, g, pw);
 			fputs("  ", f);
 		}
-		fraction(f, G->traversed, G->trials, G->deterministic, 2);
+		/* p_traverse and its interval as summary.json holds them */
+		fprintf(f, "%.2f [%.2f, %.2f]", G->p_traverse, G->ci95[0], G->ci95[1]);
 		fprintf(f, " %5d %5d  ", G->left, G->right);
 		if (G->left + G->right > 0)
 			fraction(f, G->left, G->left + G->right, G->deterministic, 2);
