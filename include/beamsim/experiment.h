@@ -56,6 +56,10 @@ BSIM_API int bsim_experiment_load_grid(const char *path, const bsim_override *ex
 
 BSIM_API void bsim_experiment_free(bsim_experiment *e);
 
+/* Frees what a grid axis holds (key, values, origins; origins may be NULL
+ * while the values are being made) and zeroes it. */
+BSIM_API void bsim_experiment_axis_free(bsim_grid_axis *ax);
+
 /* BSIM_EINPUT with "expected at most N trials in all, got G groups x T
  * trials = ..." if n_groups x trials exceeds the limit trials
  * (beamsim/limits.h); for a --trials that replaces the file's. */

@@ -191,19 +191,6 @@ int cli_sets_add(cli_sets *s, const char *cmd, const char *kv)
 	return CLI_OK;
 }
 
-static void grid_axis_free(bsim_grid_axis *a)
-{
-	for (int i = 0; i < a->n_values; i++) {
-		free(a->values[i]);
-		if (a->origins) /* NULL while the values are being made */
-			free(a->origins[i]);
-	}
-	free(a->key);
-	free(a->values);
-	free(a->origins);
-	memset(a, 0, sizeof *a);
-}
-
 void cli_sets_free(cli_sets *s)
 {
 	for (int i = 0; i < s->n; i++) {
@@ -213,7 +200,7 @@ void cli_sets_free(cli_sets *s)
 	}
 	free(s->ov);
 	for (int a = 0; a < s->n_grid; a++)
-		grid_axis_free(&s->grid[a]);
+		bsim_experiment_axis_free(&s->grid[a]);
 	free(s->grid);
 	memset(s, 0, sizeof *s);
 }
@@ -375,10 +362,10 @@ int cli_grid_add(cli_sets *s, const char *cmd, const char *text)
 	if (rc != CLI_OK) {
 		if (rc == CLI_FAIL)
 			cli_error("out of memory");
-		grid_axis_free(&a);
+		bsim_experiment_axis_free(&a);
 		return rc;
 	}
-	grid_axis_free(&s->grid[at]);
+	bsim_experiment_axis_free(&s->grid[at]);
 	s->grid[at] = a;
 	return CLI_OK;
 }

@@ -219,11 +219,12 @@ static int walk_experiment(const ydoc *d, bsim_experiment *e, bsim_error *err)
 	return BSIM_OK;
 }
 
-static void axis_free(bsim_grid_axis *ax)
+void bsim_experiment_axis_free(bsim_grid_axis *ax)
 {
 	for (int i = 0; i < ax->n_values; i++) {
 		free(ax->values[i]);
-		free(ax->origins[i]);
+		if (ax->origins)
+			free(ax->origins[i]);
 	}
 	free(ax->key);
 	free(ax->values);
@@ -285,7 +286,7 @@ static int apply_grid(bsim_experiment *e, const bsim_grid_axis *grid, int n_grid
 			memset(&e->axes[a], 0, sizeof e->axes[a]);
 			e->n_axes = a + 1;
 		}
-		axis_free(&e->axes[a]);
+		bsim_experiment_axis_free(&e->axes[a]);
 		if (axis_copy(&e->axes[a], g) != 0)
 			return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
 		int kept = 0;
@@ -562,7 +563,7 @@ void bsim_experiment_free(bsim_experiment *e)
 	}
 	free(e->set);
 	for (int a = 0; a < e->n_axes; a++)
-		axis_free(&e->axes[a]);
+		bsim_experiment_axis_free(&e->axes[a]);
 	free(e->axes);
 	memset(e, 0, sizeof *e);
 }
