@@ -7,6 +7,7 @@
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
 
+#include <stdio.h>
 #include <string.h>
 #include <time.h>
 
@@ -154,18 +155,34 @@ const bsim_backend *pyb_backend(const char *spec, PyObject *seq, bsim_options *o
 				return pyb_raise(err.code, &err), NULL;
 		}
 	}
-	bsim_compare_side side;
-	memset(&side, 0, sizeof side);
-	side.opts = *opts;
+	/* As beamsim run reads --backend: the name, the --backend-opt
+	 * options, then the spec's own (they win). */
 	if (!spec)
 		spec = bsim_backend_default()->name;
-	if (bsim_compare_side_parse(spec, &side, &err) != BSIM_OK)
-		return pyb_raise(err.code, &err), NULL;
-	if (bsim_options_check(&side.opts, side.backend->knobs, side.backend->n_knobs,
-	                       side.backend->name, &err) != BSIM_OK)
-		return pyb_raise(err.code, &err), NULL;
-	*opts = side.opts;
-	return side.backend;
+	size_t n = strcspn(spec, ":");
+	char name[32];
+	snprintf(name, sizeof name, "%.*s", (int)(n < sizeof name ? n : sizeof name - 1), spec);
+	const bsim_backend *b = bsim_backend_find(name, &err);
+	if (!b)
+		return pyb_raise(err.code ? err.code : BSIM_EINPUT, &err), NULL;
+	for (const char *p = spec + n; *p == ':';) {
+		size_t len = strcspn(p + 1, ":");
+		char kv[128];
+		snprintf(kv, sizeof kv, "%.*s", (int)(len < sizeof kv ? len : sizeof kv - 1),
+		         p + 1);
+		if (bsim_options_add(opts, kv, &err) != BSIM_OK)
+			return pyb_raise(err.code, &err), NULL;
+		p += len + 1;
+	}
+	if (bsim_options_check(opts, b->knobs, b->n_knobs, b->name, &err) != BSIM_OK) {
+		if (spec[n]) {
+			bsim_error e2;
+			bsim_error_set(&e2, BSIM_EINPUT, "--backend %s: %s", spec, err.msg);
+			return pyb_raise(BSIM_EINPUT, &e2), NULL;
+		}
+		return pyb_raise(BSIM_EINPUT, &err), NULL;
+	}
+	return b;
 }
 
 PyObject *pyb_column(const double *data, long n, long stride, int ints)

@@ -112,15 +112,15 @@ static PyObject *json_text(const bsim_run_info *info, const bsim_trial_result *r
 PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"path", "seed",         "group",      "trial",  "backend",
-	                         "sets", "backend_opts", "trajectory", "stride", NULL};
+	static char *kwlist[] = {"path",         "seed",       "group",  "trial", "backend", "sets",
+	                         "backend_opts", "trajectory", "stride", "grid",  NULL};
 	const char *path, *backend_spec = NULL;
-	PyObject *seed_o = Py_None, *sets_o = Py_None, *opts_o = Py_None;
+	PyObject *seed_o = Py_None, *sets_o = Py_None, *opts_o = Py_None, *grid_o = Py_None;
 	long group = 0, trial = 0, stride = 1;
 	int trajectory = 0;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "s|OllzOOpl", kwlist, &path, &seed_o, &group,
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "s|OllzOOplO", kwlist, &path, &seed_o, &group,
 	                                 &trial, &backend_spec, &sets_o, &opts_o, &trajectory,
-	                                 &stride))
+	                                 &stride, &grid_o))
 		return NULL;
 	if (stride < 1) {
 		PyErr_Format(PyExc_ValueError, "--stride %ld: expected an integer >= 1", stride);
@@ -150,10 +150,17 @@ PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw)
 		return NULL;
 	}
 	pyb_sets sets;
+	pyb_grid grid;
 	if (pyb_sets_from(sets_o, &sets))
 		return NULL;
+	if (pyb_grid_from(grid_o, &grid)) {
+		pyb_sets_free(&sets);
+		return NULL;
+	}
 	def.sets = sets.ov;
 	def.n_sets = sets.n;
+	def.grid = grid.axes;
+	def.n_grid = grid.n;
 
 	bsim_replay *rp = NULL;
 	bsim_trial_log *log = bsim_trial_log_alloc();
@@ -229,5 +236,6 @@ done:
 	bsim_trial_log_free(log);
 	bsim_replay_free(rp);
 	pyb_sets_free(&sets);
+	pyb_grid_free(&grid);
 	return out;
 }

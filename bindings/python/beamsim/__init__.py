@@ -178,7 +178,7 @@ def load(path):
 
 
 def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=None,
-        trajectory=False, stride=1):
+        trajectory=False, stride=1, grid=None):
     """One trial, as `beamsim run SCENE --json` runs it.
 
     scene: a scene file; an experiment file (trial `trial` of group `group`
@@ -187,7 +187,8 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     with its seed, backend and options; backend names a comparison's side).
     seed: None is the experiment's (a scene's: 1). backend: "thesis"
     (None, the default), "box2d", or "NAME:KEY=VALUE..." as a compare side.
-    set: {dotted key: value} scene overrides; backend_opt: {knob: value}.
+    set: {dotted key: value} scene overrides; backend_opt: {knob: value};
+    grid: an experiment's axes {key: [values]}, as sweep's.
 
     Returns run --json's object as a dict (outcome, type, steps, t_end,
     x_end, y_end, vx_end, max_theta, ledger, ...), with "row" (the trial's
@@ -200,7 +201,7 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     of (RuntimeWarning)."""
     r = _beamsim.run(os.fspath(scene), seed, _count("group", group, 0),
                      _count("trial", trial, 0), backend, _sets(set), _opts(backend_opt),
-                     bool(trajectory), _count("stride", stride, 1))
+                     bool(trajectory), _count("stride", stride, 1), _grid(grid))
     d = json.loads(r["json"])
     d["row"] = r["row"]
     if r["kind"] != "scene":
@@ -299,10 +300,13 @@ def landscape(scene, set=None, resolution=None, region=None):
     the trial's arena).
 
     Returns a dict: "x" (nx), "y" (ny), "e_total", "e_beam", "e_prop"
-    ((ny, nx) arrays, J, row j at y[j]), "theta" ((beams, ny, nx), rad),
-    "spacing", "region", and "barriers": "start", "start_e", "far_y",
-    "lowest" (the lowest pass over any beam) and "beams" (the lowest over
-    each), a pass being kind, beam, x, y, height, e_total, ..., path."""
+    ((ny, nx) arrays, J, row j at y[j]: landscape.csv's rows), "theta"
+    ((beams, ny, nx), rad), and what landscape.json holds: "grid", "start",
+    "far_y", "lowest_pass" (over any beam) and "barriers" (the lowest pass
+    over each beam: [{"beam": 1, "pass": {...}}, ...]), a pass being kind,
+    crossed (the beam, from 1), x, y, e_total, e_beam, e_prop, height,
+    above_start, floor, grid, refine_spacing, refine_change and path (an
+    (n, 2) array)."""
     if resolution is not None and not (resolution > 0 and math.isfinite(resolution)):
         raise ValueError(f"--resolution {resolution}: expected a grid spacing > 0 in m")
     if region is not None:
