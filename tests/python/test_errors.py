@@ -1,6 +1,7 @@
 """Bad input raises ValueError with the message `beamsim` prints for the
-same command (its first line, without "beamsim: "); the program's exit
-status for it is 2."""
+same command (its first line, without "beamsim: " and, for a bad option
+value, the command's name before it); the program's exit status for it is
+2."""
 
 import pytest
 
@@ -11,6 +12,9 @@ from conftest import cli_message
 def raises_as_cli(call, *args):
     message, status = cli_message(*args)
     assert status == 2
+    command = f"{args[0]}: "
+    if message.startswith(command):
+        message = message[len(command):]
     with pytest.raises(ValueError) as e:
         call()
     assert str(e.value) == message
@@ -65,3 +69,12 @@ def test_a_failed_call_leaves_no_directory(tmp_path, h1):
     with pytest.raises(ValueError):
         beamsim.sweep(h1, set={"body.radius": "x"}, out=tmp_path / "o")
     assert not (tmp_path / "o" / "summary.json").exists()
+
+
+def test_numbers_out_of_range(gate, h1, tmp_path):
+    raises_as_cli(lambda: beamsim.run(gate, seed=-1), "run", gate, "--seed", -1)
+    raises_as_cli(lambda: beamsim.run(gate, stride=0), "run", gate, "--stride", 0)
+    raises_as_cli(lambda: beamsim.sweep(h1, threads=0), "sweep", h1, "--threads", 0,
+                  "--out", tmp_path / "o")
+    raises_as_cli(lambda: beamsim.sweep(h1, trials=0), "sweep", h1, "--trials", 0,
+                  "--out", tmp_path / "o")

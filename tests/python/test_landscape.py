@@ -41,6 +41,10 @@ def test_landscape_is_the_cli_landscape(gate, tmp_path, args):
         for b in range(L["theta"].shape[0]):
             value[f"theta{b + 1}"] = L["theta"][b, j_, i]
         assert ",".join("%.10g" % value[n] for n in names) == rows[k + 1]
+    # load reads both files of the directory.
+    d = beamsim.load(tmp_path)
+    assert d["landscape.json"] == j
+    assert np.array_equal(np.unique(d["landscape"]["x"]), np.unique(np.round(L["x"], 9)))
 
 
 def test_bad_resolution(gate):

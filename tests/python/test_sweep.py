@@ -59,6 +59,13 @@ def test_grid_and_set(h1, tmp_path):
     assert set(s["trials"]["effects.propulsion.force"]) == {6, 7.5}
 
 
+def test_kept_trajectories(h1, tmp_path):
+    cli("sweep", h1, "--trials", 2, "--trajectories", 1, "--out", tmp_path / "cli")
+    beamsim.sweep(h1, trials=2, trajectories=1, out=tmp_path / "py")
+    assert filecmp.cmp(tmp_path / "cli" / "trajectories.csv",
+                       tmp_path / "py" / "trajectories.csv", shallow=False)
+
+
 def test_stored_sweep_replays(h1, tmp_path):
     s = beamsim.sweep(h1, trials=3, out=tmp_path / "s")
     tr = s["trials"]

@@ -106,12 +106,24 @@ def _opts(opts):
     return list(opts)
 
 
-def _count(name, value, least):
+_INT32_MAX = 2**31 - 1
+
+
+def _count(name, value, least, most=_INT32_MAX):
+    """An integer option as the command line checks it (0 for None: the
+    library's default)."""
     if value is None:
         return 0
-    if not isinstance(value, numbers.Integral) or value < least:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or \
+            not least <= value <= most:
         raise ValueError(f"--{name} {value}: expected an integer >= {least}")
     return int(value)
+
+
+def _seed(seed):
+    if seed is None:
+        return None
+    return _count("seed", seed, 0, 2**64 - 1)
 
 
 # ---- files of an output directory ------------------------------------------
@@ -147,7 +159,9 @@ def load(path):
     landscape, ...) into a dict: each CSV file a dict of NumPy arrays by
     column (trials.csv: load(d)["trials"]["x_end"]), each JSON file what
     json gives, each folder (a comparison's side) a dict of the same kind,
-    by name without the extension. A single file is read alone."""
+    by name without the extension (a JSON file beside a CSV file of the
+    same name by its whole name: "landscape" and "landscape.json"). A
+    single file is read alone."""
     path = os.fspath(path)
     if os.path.isfile(path):
         if path.endswith(".csv"):
@@ -158,19 +172,22 @@ def load(path):
         raise ValueError(f"{path}: expected an output directory of beamsim or a CSV or JSON "
                          "file, got nothing there")
     out = {}
-    for name in sorted(os.listdir(path)):
+    names = sorted(os.listdir(path))
+    for name in names:
         full = os.path.join(path, name)
+        stem, ext = os.path.splitext(name)
         if name.startswith(".") or name == "inputs":
             continue
         if os.path.isdir(full):
             sub = load(full)
             if sub:
                 out[name] = sub
-        elif name.endswith(".csv"):
-            out[name[:-4]] = read_csv(full)
-        elif name.endswith(".json"):
+        elif ext == ".csv":
+            out[stem] = read_csv(full)
+        elif ext == ".json":
+            # landscape.json beside landscape.csv: the CSV keeps the name.
             with open(full, encoding="utf-8") as f:
-                out[name[:-5]] = json.load(f)
+                out[name if stem + ".csv" in names else stem] = json.load(f)
     return out
 
 
@@ -199,7 +216,7 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     e_prop), a row every `stride` steps. An unstable trial (outcome
     "unstable") and a replay that differs from its stored row are warned
     of (RuntimeWarning)."""
-    r = _beamsim.run(os.fspath(scene), seed, _count("group", group, 0),
+    r = _beamsim.run(os.fspath(scene), _seed(seed), _count("group", group, 0),
                      _count("trial", trial, 0), backend, _sets(set), _opts(backend_opt),
                      bool(trajectory), _count("stride", stride, 1), _grid(grid))
     d = json.loads(r["json"])
@@ -238,7 +255,7 @@ class _Dir:
 
 
 def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=None, seed=None,
-          backend_opt=None, out=None, progress=None, keep=0, resume=False):
+          backend_opt=None, out=None, progress=None, trajectories=0, resume=False):
     """Every trial of every group of an experiment, as `beamsim sweep
     EXPERIMENT --out DIR` runs them (the same numbers, whatever threads).
 
@@ -246,9 +263,10 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
     backend, set, backend_opt as in run; grid: {key: [values]} axes that
     replace or join the file's. out: keep the output directory there (a
     replayable run: beamsim.run(out, group=g, trial=t)); None: a temporary
-    one. progress: callable(done, total), called with the GIL now and then.
-    keep: trajectories kept per group (trajectories.csv). resume: continue
-    the stopped sweep in out.
+    one. progress: callable(done, total), called with the GIL after each
+    finished trial. trajectories: the first trials of each group whose
+    trajectories are kept (trajectories.csv, as --trajectories). resume:
+    continue the stopped sweep in out.
 
     Returns a dict: "groups" (summary.json's groups: params, trials,
     traversed, side_exit, stuck, left, right, p_traverse, ci95, ...),
@@ -257,12 +275,15 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
     of (RuntimeWarning); Ctrl-C stops the sweep (KeyboardInterrupt)."""
     with _Dir(out, "sweep") as d:
         info = _beamsim.sweep(os.fspath(experiment), d, _count("trials", trials, 1),
-                              _count("threads", threads, 1), seed, backend, _sets(set),
-                              _grid(grid), _opts(backend_opt), progress,
-                              _count("keep", keep, 0), bool(resume))
+                              _count("threads", threads, 1, 4096), _seed(seed), backend,
+                              _sets(set), _grid(grid), _opts(backend_opt), progress,
+                              _count("trajectories", trajectories, 0), bool(resume))
         files = load(d)
     if info["unstable"]:
-        warnings.warn(info["unstable_text"], RuntimeWarning, stacklevel=2)
+        text = info["unstable_text"]
+        if out is None:
+            text = text.replace(f"{d}/trials.csv", "the trials' outcome")
+        warnings.warn(text, RuntimeWarning, stacklevel=2)
     summary = files["summary"]
     return {"groups": summary["groups"], "trials": files["trials"], "summary": summary,
             "threads": info["threads"], "out": out}
@@ -278,8 +299,8 @@ def compare(experiment, backends=("thesis", "box2d"), trials=None, threads=None,
     a, b = backends
     with _Dir(out, "compare") as d:
         info = _beamsim.compare(os.fspath(experiment), d, a, b, _count("trials", trials, 1),
-                                _count("threads", threads, 1), seed, _sets(set), _grid(grid),
-                                progress)
+                                _count("threads", threads, 1, 4096), _seed(seed), _sets(set),
+                                _grid(grid), progress)
         files = load(d)
     sides = {}
     for label, name in zip((a, b), info["dirs"]):
