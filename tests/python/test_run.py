@@ -2,6 +2,7 @@
 trial: a scene, an experiment's group, overrides, the other backend."""
 
 import numpy as np
+import pytest
 
 import beamsim
 from conftest import cli, cli_json, config
@@ -69,3 +70,18 @@ def test_trajectory_columns_are_trajectory_csv(gate, tmp_path):
 
 def test_no_trajectory_unless_asked(gate):
     assert "trajectory" not in beamsim.run(gate)
+
+
+def test_unstable_trial_is_said():
+    """The stiff beam on Box2D's explicit spring torque blows up: the
+    program exits 1 with a line; the module returns the trial, outcome
+    unstable, and warns with the same line."""
+    scene = config("hard", "stiff_beam.yaml")
+    args = ("run", scene, "--backend", "box2d", "--backend-opt", "spring=torque")
+    p = cli(*args, check=False)
+    assert p.returncode == 1
+    line = next(s for s in p.stderr.splitlines() if "unstable trial" in s)
+    with pytest.warns(RuntimeWarning) as w:
+        r = beamsim.run(scene, backend="box2d", backend_opt={"spring": "torque"})
+    assert r["outcome"] == "unstable" and r["instability"] is not None
+    assert [str(x.message) for x in w] == [line[len("beamsim: "):]]

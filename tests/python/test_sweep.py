@@ -87,6 +87,10 @@ def test_compare_is_the_cli_compare(h1, tmp_path):
     assert without_wall(c["report"]) == without_wall(report)
     assert set(c["sides"]) == {"thesis", "box2d"}
     assert c["sides"]["box2d"]["trials"]["outcome"].shape == (60,)
+    # A side's trial replayed from the comparison's directory.
+    for side in ("thesis", "box2d"):
+        r = beamsim.run(tmp_path / "py", group=29, trial=1, backend=side)
+        assert r["backend"] == side and r["stored_row"] == r["row"]
 
 
 def test_load_reads_run_out(gate, tmp_path):
