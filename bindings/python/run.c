@@ -11,13 +11,19 @@
 
 /* The trajectory's rows as they are recorded, trajectory.csv's columns:
  * t, x, y, vx, vy, theta_i, omega_i (each beam), f_rand, contact_i, e_kin,
- * e_beam, e_prop. Filled with the GIL released: no Python here. */
+ * e_beam, e_prop; and at the same times ledger.csv's (LEDGER). Filled with
+ * the GIL released: no Python here. */
 typedef struct rows {
 	int n_beams, width;
 	long n, cap;
-	double *v;
+	double *v, *ledger;
 	int oom;
 } rows;
+
+static const char *const LEDGER[] = {"t",        "e_kin",  "e_beam", "e_mech",  "w_prop",
+                                     "w_rand",   "damper", "impact", "contact", "correction",
+                                     "residual", "sleep",  "reset"};
+enum { LEDGER_WIDTH = sizeof LEDGER / sizeof LEDGER[0] };
 
 static void rows_record(void *user, const bsim_record_row *row)
 {
@@ -32,13 +38,25 @@ static void rows_record(void *user, const bsim_record_row *row)
 	if (r->n == r->cap) {
 		long cap = r->cap ? 2 * r->cap : 1024;
 		double *v = realloc(r->v, (size_t)cap * (size_t)r->width * sizeof *v);
-		if (!v) {
+		if (v)
+			r->v = v;
+		double *l = v ? realloc(r->ledger, (size_t)cap * LEDGER_WIDTH * sizeof *l) : NULL;
+		if (!l) {
 			r->oom = 1;
 			return;
 		}
-		r->v = v;
+		r->ledger = l;
 		r->cap = cap;
 	}
+	/* ledger.csv's row: the flows summed over [0, t] (beamsim/trial.h) */
+	const bsim_ledger *g = row->ledger;
+	double *q = r->ledger + r->n * LEDGER_WIDTH;
+	const double lrow[LEDGER_WIDTH] = {
+	        row->t,     row->e_kin,    row->e_beam, row->e_kin + row->e_beam,
+	        g->w_prop,  g->w_rand,     g->damper,   g->impact,
+	        g->contact, g->correction, g->residual, g->sleep,
+	        g->reset};
+	memcpy(q, lrow, sizeof lrow);
 	double *p = r->v + r->n++ * r->width;
 	*p++ = row->t;
 	*p++ = s->x[0];
@@ -92,6 +110,16 @@ static PyObject *rows_dict(const rows *r)
 fail:
 	Py_DECREF(d);
 	return NULL;
+}
+
+/* ledger.csv's columns by name. */
+static PyObject *ledger_dict(const rows *r)
+{
+	PyObject *d = PyDict_New();
+	for (int c = 0; d && c < LEDGER_WIDTH; c++)
+		if (pyb_set(d, LEDGER[c], pyb_column(r->ledger + c, r->n, LEDGER_WIDTH, 0)))
+			Py_CLEAR(d);
+	return d;
 }
 
 /* The JSON object of `beamsim run --json` (bsim_run_output_json). */
@@ -226,13 +254,15 @@ PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw)
 		if (pyb_set(out, "stored_row", PyUnicode_FromString(row)))
 			goto fail;
 	}
-	if (trajectory && pyb_set(out, "trajectory", rows_dict(&traj)))
+	if (trajectory && (pyb_set(out, "trajectory", rows_dict(&traj)) ||
+	                   pyb_set(out, "ledger_rows", ledger_dict(&traj))))
 		goto fail;
 	goto done;
 fail:
 	Py_CLEAR(out);
 done:
 	free(traj.v);
+	free(traj.ledger);
 	bsim_trial_log_free(log);
 	bsim_replay_free(rp);
 	pyb_sets_free(&sets);

@@ -213,7 +213,10 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     stored run, "stored_row" (its row in trials.csv). trajectory=True adds
     "trajectory": a dict of NumPy arrays by trajectory.csv column (t, x, y,
     vx, vy, theta1, omega1, ..., f_rand, contact1, ..., e_kin, e_beam,
-    e_prop), a row every `stride` steps. An unstable trial (outcome
+    e_prop), a row every `stride` steps, and "ledger_rows", the energy
+    ledger at the same times by ledger.csv column (t, e_kin, e_beam, e_mech,
+    w_prop, w_rand, damper, impact, contact, correction, residual, sleep,
+    reset: J, each flow summed from t = 0). An unstable trial (outcome
     "unstable") and a replay that differs from its stored row are warned
     of (RuntimeWarning)."""
     r = _beamsim.run(os.fspath(scene), _seed(seed), _count("group", group, 0),
@@ -234,6 +237,7 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
                       RuntimeWarning, stacklevel=2)
     if trajectory:
         d["trajectory"] = r["trajectory"]
+        d["ledger_rows"] = r["ledger_rows"]
     return d
 
 
