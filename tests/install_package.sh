@@ -94,4 +94,22 @@ grep -o '"p_traverse": *[0-9.e+-]*' "$work/cli/summary.json" | sed 's/.*: *//' |
 grep '^group' "$work/shared.txt" | awk '{print $4}' >"$work/lib_p.txt"
 test -s "$work/lib_p.txt"
 cmp "$work/lib_p.txt" "$work/cli_p.txt"
+
+# The Python module, when the build has it: imported from the prefix by
+# Debian's python3 with the prefix's dist-packages on PYTHONPATH (for the
+# prefix /usr/local python3 finds it without), finding libbeamsim.so by its
+# rpath, and its sweep the program's.
+if [ -d "$build/python/beamsim" ]; then
+    init=$(find "$prefix" -path '*/dist-packages/beamsim/__init__.py')
+    test -n "$init" || { echo "the Python module is not installed under dist-packages"; exit 1; }
+    site=$(dirname "$(dirname "$init")")
+    py=/usr/bin/python3
+    [ -x "$py" ] || py=python3
+    env -u LD_LIBRARY_PATH PYTHONPATH="$site" "$py" -c '
+import sys, beamsim
+assert beamsim.__file__.startswith(sys.argv[2]), beamsim.__file__
+for g in beamsim.sweep(sys.argv[1], trials=20)["groups"]:
+    print("%.3f" % g["p_traverse"])' "$exp" "$site" >"$work/py_p.txt"
+    cmp "$work/py_p.txt" "$work/cli_p.txt"
+fi
 echo "installed package: shared, static and pkg-config builds agree with beamsim sweep"

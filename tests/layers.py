@@ -70,6 +70,7 @@ PUBLIC = {
     "compare_dir": "store",
     "output": "store",
     "regress": "store",
+    "replay": "store",
     "report": "store",
     "run_output": "store",
     "run_record": "store",

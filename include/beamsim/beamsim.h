@@ -26,6 +26,7 @@
 #include "beamsim/output.h"
 #include "beamsim/override.h"
 #include "beamsim/progress.h"
+#include "beamsim/replay.h"
 #include "beamsim/regress.h"
 #include "beamsim/report.h"
 #include "beamsim/run_output.h"

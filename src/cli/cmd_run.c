@@ -146,17 +146,17 @@ static void print_lattice(FILE *out, const bsim_scene *s, const bsim_trial_resul
 		        r->reset_overlaps);
 }
 
-static void print_text(FILE *out, const run_args *a, const cli_replay *rp, uint64_t mixed,
+static void print_text(FILE *out, const run_args *a, const bsim_replay *rp, uint64_t mixed,
                        const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	const bsim_ledger *l = &r->ledger;
 	const bsim_scene *s = &rp->scene;
-	if (rp->kind == CLI_REPLAY_SCENE) {
+	if (rp->kind == BSIM_REPLAY_SCENE) {
 		fprintf(out, "scene       %s (%s), backend %s\n", cli_path(a->scene), s->name,
 		        a->backend);
 	} else {
 		fprintf(out, "%-11s %s, scene %s (%s), backend %s\n",
-		        rp->kind == CLI_REPLAY_STORED ? rp->command : "experiment",
+		        rp->kind == BSIM_REPLAY_STORED ? rp->command : "experiment",
 		        cli_path(rp->path), cli_path(rp->scene_path), s->name, a->backend);
 		fprintf(out, "grid        %s\n", rp->grid);
 	}
@@ -203,9 +203,9 @@ static void print_text(FILE *out, const run_args *a, const cli_replay *rp, uint6
 		bsim_trial_instability_text(r, s->dt, why, sizeof why);
 		fprintf(out, "unstable    %s\n", why);
 	}
-	if (rp->kind != CLI_REPLAY_SCENE) {
+	if (rp->kind != BSIM_REPLAY_SCENE) {
 		char row[256];
-		cli_replay_row(row, sizeof row, a->group, a->trial, r);
+		bsim_replay_row(row, sizeof row, a->group, a->trial, r);
 		fprintf(out,
 		        "row         %s (trials.csv: group,trial,outcome,type,steps,t_end,"
 		        "x_end,y_end)\n",
@@ -256,7 +256,7 @@ int cmd_run(int argc, char **argv)
 	run_args a = {.seed = defaults.seed, .stride = defaults.stride};
 	int rc = cli_parse(&run_spec, argc, argv, &c, &a, &a.scene);
 	/* A stored run's directory names its own backend (--backend: a side). */
-	int stored = rc < 0 && cli_replay_is_dir(a.scene);
+	int stored = rc < 0 && bsim_replay_is_dir(a.scene);
 	const bsim_backend *backend = NULL;
 	if (rc < 0 && !stored && !(backend = run_backend(&c, &a)))
 		rc = CLI_USAGE;
@@ -264,28 +264,28 @@ int cmd_run(int argc, char **argv)
 		cli_common_free(&c);
 		return rc;
 	}
-	cli_replay rp;
+	bsim_replay *rp;
 	rc = cli_replay_open("run", a.scene, &c, a.group, a.trial, a.has_group, defaults.seed, &rp);
 	if (rc != CLI_OK) {
 		cli_common_free(&c);
 		return rc;
 	}
 	if (stored) {
-		backend = rp.backend;
-		a.opts = rp.opts;
-		a.backend = rp.label;
+		backend = rp->backend;
+		a.opts = rp->opts;
+		a.backend = rp->label;
 	}
-	a.seed = rp.seed;
-	const bsim_scene *scene = &rp.scene;
+	a.seed = rp->seed;
+	const bsim_scene *scene = &rp->scene;
 	cli_estimate_line(backend->name, (double)scene->max_steps * scene->n_beams);
 	uint64_t mixed = bsim_schedule_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
 	bsim_trial_log *log = bsim_trial_log_alloc();
-	int of_scene = rp.kind == CLI_REPLAY_SCENE;
+	int of_scene = rp->kind == BSIM_REPLAY_SCENE;
 	bsim_run_info info = {
-	        .scene_path = rp.scene_path,
+	        .scene_path = rp->scene_path,
 	        .scene = scene,
-	        .sets = of_scene ? c.sets.ov : rp.ov,
-	        .n_sets = of_scene ? c.sets.n : rp.n_ov,
+	        .sets = rp->ov,
+	        .n_sets = rp->n_ov,
 	        .backend = backend,
 	        .opts = &a.opts,
 	        .seed = a.seed,
@@ -309,9 +309,9 @@ int cmd_run(int argc, char **argv)
 	if (rc == CLI_OK && a.json) {
 		bsim_run_output_json(out, &info, &res, 0);
 		if (!of_scene)
-			cli_error("%s", rp.grid);
+			cli_error("%s", rp->grid);
 	} else if (rc == CLI_OK) {
-		print_text(out, &a, &rp, mixed, &res, log);
+		print_text(out, &a, rp, mixed, &res, log);
 	}
 	if (rc == CLI_OK && !a.json && c.out)
 		cli_wrote(out, c.out);
@@ -326,9 +326,9 @@ int cmd_run(int argc, char **argv)
 	/* A stored run's row, against the replay (after an unstable trial's
 	 * line, which has its own exit status). */
 	if (rc == CLI_OK)
-		rc = cli_replay_check(&rp, &res, a.json ? stderr : out);
+		rc = cli_replay_check(rp, &res, a.json ? stderr : out);
 	bsim_trial_log_free(log);
-	cli_replay_free(&rp);
+	bsim_replay_free(rp);
 	cli_common_free(&c);
 	return rc;
 }

@@ -225,7 +225,7 @@ static void print_outcome(FILE *out, const char *name, const bsim_scene *s,
 
 /* Streams the video of the trial on every backend (bsim_video_stream_*:
  * its memory does not grow with the trial's steps) and reports it. */
-static int video_main(video_args *a, const bsim_backend *const *backends, const cli_replay *rp)
+static int video_main(video_args *a, const bsim_backend *const *backends, const bsim_replay *rp)
 {
 	const bsim_scene *scene = &rp->scene;
 	const char *labels[MAX_PANELS];
@@ -261,7 +261,7 @@ static int video_main(video_args *a, const bsim_backend *const *backends, const 
 	if (rc == BSIM_OK) {
 		fprintf(out, "scene       %s (%s), seed %" PRIu64 ", group %ld, trial %ld\n",
 		        cli_path(rp->scene_path), scene->name, a->seed, a->group, a->trial);
-		if (rp->kind != CLI_REPLAY_SCENE)
+		if (rp->kind != BSIM_REPLAY_SCENE)
 			fprintf(out, "grid        %s of %s\n", rp->grid, cli_path(rp->path));
 		for (int i = 0; i < a->n_backends; i++)
 			print_outcome(out, a->names[i], scene, &rep.results[i]);
@@ -299,7 +299,7 @@ int cmd_video(int argc, char **argv)
 	a->def = bsim_video_def_default();
 	cli_common c = cli_common_default();
 	int rc = cli_parse(&video_spec, argc, argv, &c, a, &a->scene);
-	int stored = rc < 0 && cli_replay_is_dir(a->scene);
+	int stored = rc < 0 && bsim_replay_is_dir(a->scene);
 	if (rc < 0 && (rc = video_resolve(&c, a, stored)) == CLI_OK)
 		rc = -1;
 	if (rc < 0) {
@@ -308,19 +308,19 @@ int cmd_video(int argc, char **argv)
 		for (int i = 0; !stored && i < a->n_backends && rc == CLI_OK; i++)
 			if (!(backends[i] = cli_backend(a->names[i], &a->opts[i])))
 				rc = CLI_USAGE;
-		cli_replay rp;
+		bsim_replay *rp;
 		if (rc == CLI_OK)
 			rc = cli_replay_open("video", a->scene, &c, a->group, a->trial,
 			                     a->has_group, a->seed, &rp);
 		if (rc == CLI_OK) {
 			if (stored) {
-				backends[0] = rp.backend;
-				a->opts[0] = rp.opts;
-				snprintf(a->names[0], sizeof a->names[0], "%.31s", rp.label);
+				backends[0] = rp->backend;
+				a->opts[0] = rp->opts;
+				snprintf(a->names[0], sizeof a->names[0], "%.31s", rp->label);
 			}
-			a->seed = rp.seed;
-			rc = video_main(a, backends, &rp);
-			cli_replay_free(&rp);
+			a->seed = rp->seed;
+			rc = video_main(a, backends, rp);
+			bsim_replay_free(rp);
 		}
 	}
 	cli_common_free(&c);

@@ -1,0 +1,343 @@
+"""beamsim: the beam-gate traversal simulator (libbeamsim) from Python.
+
+    import beamsim
+    r = beamsim.run("configs/thesis/h1_symmetric.yaml", group=3, trial=2, trajectory=True)
+    r["outcome"], r["t_end"], r["trajectory"]["y"]        # a NumPy array
+    s = beamsim.sweep("configs/thesis/h1_symmetric.yaml", trials=50)
+    [g["p_traverse"] for g in s["groups"]], s["trials"]["outcome"]
+
+Each call is the command line's: run is `beamsim run`, sweep is `beamsim
+sweep`, compare is `beamsim compare`, landscape is `beamsim landscape`, with
+the same numbers, and bad input raises ValueError with the one-line message
+`beamsim` prints. Groups and trials count from 0, as in trials.csv. Long
+calls release the GIL; Ctrl-C stops a sweep or a comparison
+(KeyboardInterrupt). See docs/bindings.md.
+"""
+
+import csv
+import json
+import math
+import numbers
+import os
+import tempfile
+import warnings
+
+import numpy as np
+
+from . import _beamsim
+
+__all__ = ["run", "sweep", "compare", "landscape", "load", "version"]
+
+
+def version():
+    """libbeamsim's version."""
+    return _beamsim.version()
+
+
+# ---- arguments as the command line gives them ------------------------------
+
+
+def _text(v):
+    """A value as the YAML text --set takes (7 -> "7", [0, 5] -> "[0, 5]")."""
+    if isinstance(v, np.generic):
+        v = v.item()
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, numbers.Integral):
+        return str(int(v))
+    if isinstance(v, numbers.Real):
+        x = float(v)
+        if not math.isfinite(x):
+            raise ValueError(f"{x!r}: expected a finite number")
+        return repr(x)
+    if isinstance(v, str):
+        return v
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(_text(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k}: {_text(x)}" for k, x in v.items()) + "}"
+    raise TypeError(f"{v!r}: expected a number, str, list or dict")
+
+
+def _sets(sets):
+    """--set KEY=VALUE overrides: a dict {key: value}, or "KEY=VALUE" strings."""
+    if sets is None:
+        return []
+    items = sets.items() if isinstance(sets, dict) else sets
+    if isinstance(items, str):
+        items = [items]
+    out = []
+    for item in items:
+        if isinstance(item, str):
+            key, eq, value = item.partition("=")
+            if not eq or not key:
+                raise ValueError(f"--set {item}: expected KEY=VALUE, e.g. "
+                                 "--set effects.propulsion.force=7")
+        else:
+            key, value = item
+            value = _text(value)
+        out.append((key, value, f"--set {key}={value}"))
+    return out
+
+
+def _grid(grid):
+    """--grid axes: a dict {key: [values]}."""
+    if grid is None:
+        return []
+    if not isinstance(grid, dict):
+        raise TypeError("grid: expected a dict {key: [values]}")
+    out = []
+    for key, values in grid.items():
+        if isinstance(values, (str, numbers.Number)):
+            values = [values]
+        texts = [_text(v) for v in values]
+        out.append((key, texts, f"--grid {key}={','.join(texts)}"))
+    return out
+
+
+def _opts(opts):
+    """--backend-opt KEY=VALUE options: a dict, or "KEY=VALUE" strings."""
+    if opts is None:
+        return []
+    if isinstance(opts, dict):
+        return [f"{k}={_text(v)}" for k, v in opts.items()]
+    if isinstance(opts, str):
+        return [opts]
+    return list(opts)
+
+
+_INT32_MAX = 2**31 - 1
+
+
+def _count(name, value, least, most=_INT32_MAX):
+    """An integer option as the command line checks it (0 for None: the
+    library's default)."""
+    if value is None:
+        return 0
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or \
+            not least <= value <= most:
+        raise ValueError(f"--{name} {value}: expected an integer >= {least}")
+    return int(value)
+
+
+def _seed(seed):
+    if seed is None:
+        return None
+    return _count("seed", seed, 0, 2**64 - 1)
+
+
+# ---- files of an output directory ------------------------------------------
+
+
+def _column(values):
+    """A CSV column as a NumPy array: int64 if every field is an integer,
+    float64 if every field is a number (an empty field is NaN, not
+    measured), else str."""
+    try:
+        return np.array([int(v) for v in values], dtype=np.int64)
+    except ValueError:
+        pass
+    try:
+        return np.array([float(v) if v != "" else math.nan for v in values], dtype=np.float64)
+    except ValueError:
+        return np.array(values, dtype=str)
+
+
+def read_csv(path):
+    """One CSV file of beamsim as a dict of NumPy arrays by column."""
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        return {}
+    header, body = rows[0], rows[1:]
+    cols = list(zip(*body)) if body else [() for _ in header]
+    return {name: _column(list(col)) for name, col in zip(header, cols)}
+
+
+def load(path):
+    """Reads an output directory of beamsim (sweep, compare, run --out,
+    landscape, ...) into a dict: each CSV file a dict of NumPy arrays by
+    column (trials.csv: load(d)["trials"]["x_end"]), each JSON file what
+    json gives, each folder (a comparison's side) a dict of the same kind,
+    by name without the extension (a JSON file beside a CSV file of the
+    same name by its whole name: "landscape" and "landscape.json"). A
+    single file is read alone."""
+    path = os.fspath(path)
+    if os.path.isfile(path):
+        if path.endswith(".csv"):
+            return read_csv(path)
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    if not os.path.isdir(path):
+        raise ValueError(f"{path}: expected an output directory of beamsim or a CSV or JSON "
+                         "file, got nothing there")
+    out = {}
+    names = sorted(os.listdir(path))
+    for name in names:
+        full = os.path.join(path, name)
+        stem, ext = os.path.splitext(name)
+        if name.startswith(".") or name == "inputs":
+            continue
+        if os.path.isdir(full):
+            sub = load(full)
+            if sub:
+                out[name] = sub
+        elif ext == ".csv":
+            out[stem] = read_csv(full)
+        elif ext == ".json":
+            # landscape.json beside landscape.csv: the CSV keeps the name.
+            with open(full, encoding="utf-8") as f:
+                out[name if stem + ".csv" in names else stem] = json.load(f)
+    return out
+
+
+# ---- the calls -------------------------------------------------------------
+
+
+def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=None,
+        trajectory=False, stride=1, grid=None):
+    """One trial, as `beamsim run SCENE --json` runs it.
+
+    scene: a scene file; an experiment file (trial `trial` of group `group`
+    as `beamsim sweep` runs it, the group's grid values applied); or the
+    output directory of a sweep or comparison (the trial as that run ran it,
+    with its seed, backend and options; backend names a comparison's side).
+    seed: None is the experiment's (a scene's: 1). backend: "thesis"
+    (None, the default), "box2d", or "NAME:KEY=VALUE..." as a compare side.
+    set: {dotted key: value} scene overrides; backend_opt: {knob: value};
+    grid: an experiment's axes {key: [values]}, as sweep's.
+
+    Returns run --json's object as a dict (outcome, type, steps, t_end,
+    x_end, y_end, vx_end, max_theta, ledger, ...), with "row" (the trial's
+    trials.csv fields), "grid" (an experiment's group values) and, for a
+    stored run, "stored_row" (its row in trials.csv). trajectory=True adds
+    "trajectory": a dict of NumPy arrays by trajectory.csv column (t, x, y,
+    vx, vy, theta1, omega1, ..., f_rand, contact1, ..., e_kin, e_beam,
+    e_prop), a row every `stride` steps, and "ledger_rows", the energy
+    ledger at the same times by ledger.csv column (t, e_kin, e_beam, e_mech,
+    w_prop, w_rand, damper, impact, contact, correction, residual, sleep,
+    reset: J, each flow summed from t = 0). An unstable trial (outcome
+    "unstable") and a replay that differs from its stored row are warned
+    of (RuntimeWarning)."""
+    r = _beamsim.run(os.fspath(scene), _seed(seed), _count("group", group, 0),
+                     _count("trial", trial, 0), backend, _sets(set), _opts(backend_opt),
+                     bool(trajectory), _count("stride", stride, 1), _grid(grid))
+    d = json.loads(r["json"])
+    d["row"] = r["row"]
+    if r["kind"] != "scene":
+        d["grid"] = r["grid"]
+    if "stored_row" in r:
+        d["stored_row"] = r["stored_row"]
+        if r["stored_row"] != r["row"]:
+            warnings.warn(f"the replay of group {d['group']}, trial {d['trial']} differs from "
+                          f"its row in trials.csv: {r['row']}, stored {r['stored_row']}",
+                          RuntimeWarning, stacklevel=2)
+    if d["outcome"] == "unstable":
+        warnings.warn(f"{d['backend']} backend: unstable trial: {r['instability_text']}",
+                      RuntimeWarning, stacklevel=2)
+    if trajectory:
+        d["trajectory"] = r["trajectory"]
+        d["ledger_rows"] = r["ledger_rows"]
+    return d
+
+
+class _Dir:
+    """out, or a temporary directory removed afterwards."""
+
+    def __init__(self, out, name):
+        self.out, self.name, self.tmp = out, name, None
+
+    def __enter__(self):
+        if self.out is not None:
+            return os.fspath(self.out)
+        self.tmp = tempfile.TemporaryDirectory(prefix="beamsim-")
+        return os.path.join(self.tmp.name, self.name)
+
+    def __exit__(self, *exc):
+        if self.tmp is not None:
+            self.tmp.cleanup()
+
+
+def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=None, seed=None,
+          backend_opt=None, out=None, progress=None, trajectories=0, resume=False):
+    """Every trial of every group of an experiment, as `beamsim sweep
+    EXPERIMENT --out DIR` runs them (the same numbers, whatever threads).
+
+    trials, seed: instead of the file's; threads: None is all cores;
+    backend, set, backend_opt as in run; grid: {key: [values]} axes that
+    replace or join the file's. out: keep the output directory there (a
+    replayable run: beamsim.run(out, group=g, trial=t)); None: a temporary
+    one. progress: callable(done, total), called with the GIL after each
+    finished trial. trajectories: the first trials of each group whose
+    trajectories are kept (trajectories.csv, as --trajectories). resume:
+    continue the stopped sweep in out.
+
+    Returns a dict: "groups" (summary.json's groups: params, trials,
+    traversed, side_exit, stuck, left, right, p_traverse, ci95, ...),
+    "trials" (trials.csv as a dict of NumPy arrays by column), "summary"
+    (all of summary.json), "threads" and "out". Unstable trials are warned
+    of (RuntimeWarning); Ctrl-C stops the sweep (KeyboardInterrupt)."""
+    with _Dir(out, "sweep") as d:
+        info = _beamsim.sweep(os.fspath(experiment), d, _count("trials", trials, 1),
+                              _count("threads", threads, 1, 4096), _seed(seed), backend,
+                              _sets(set), _grid(grid), _opts(backend_opt), progress,
+                              _count("trajectories", trajectories, 0), bool(resume))
+        files = load(d)
+    if info["unstable"]:
+        text = info["unstable_text"]
+        if out is None:
+            text = text.replace(f"{d}/trials.csv", "the trials' outcome")
+        warnings.warn(text, RuntimeWarning, stacklevel=2)
+    summary = files["summary"]
+    return {"groups": summary["groups"], "trials": files["trials"], "summary": summary,
+            "threads": info["threads"], "out": out}
+
+
+def compare(experiment, backends=("thesis", "box2d"), trials=None, threads=None, set=None,
+            grid=None, seed=None, out=None, progress=None):
+    """The experiment on two sides with the same random-force schedules, as
+    `beamsim compare EXPERIMENT --backends A,B --out DIR` runs it. A side is
+    "NAME[:KEY=VALUE]...". Returns a dict: "report" (report.json), "pairs"
+    (pairs.csv as arrays), "sides" (each side's summary.json and trials
+    arrays, by label), "n_disagree" and "out"."""
+    a, b = backends
+    with _Dir(out, "compare") as d:
+        info = _beamsim.compare(os.fspath(experiment), d, a, b, _count("trials", trials, 1),
+                                _count("threads", threads, 1, 4096), _seed(seed), _sets(set),
+                                _grid(grid), progress)
+        files = load(d)
+    sides = {}
+    for label, name in zip((a, b), info["dirs"]):
+        side = files.get(name, {})
+        sides[label] = {"groups": side.get("summary", {}).get("groups"),
+                        "trials": side.get("trials"), "summary": side.get("summary")}
+    for label, n in zip((a, b), info["unstable"]):
+        if n:
+            warnings.warn(f"{label}: {n} unstable trials", RuntimeWarning, stacklevel=2)
+    return {"report": files.get("report"), "pairs": files.get("pairs"), "sides": sides,
+            "n_disagree": info["n_disagree"], "out": out}
+
+
+def landscape(scene, set=None, resolution=None, region=None):
+    """The potential energy landscape of a scene and its passes, as `beamsim
+    landscape SCENE` computes them. resolution: the grid spacing in m (None:
+    the region's longer side / 260); region: (x0, x1, y0, y1) in m (None:
+    the trial's arena).
+
+    Returns a dict: "x" (nx), "y" (ny), "e_total", "e_beam", "e_prop"
+    ((ny, nx) arrays, J, row j at y[j]: landscape.csv's rows), "theta"
+    ((beams, ny, nx), rad), and what landscape.json holds: "grid", "start",
+    "far_y", "lowest_pass" (over any beam) and "barriers" (the lowest pass
+    over each beam: [{"beam": 1, "pass": {...}}, ...]), a pass being kind,
+    crossed (the beam, from 1), x, y, e_total, e_beam, e_prop, height,
+    above_start, floor, grid, refine_spacing, refine_change and path (an
+    (n, 2) array)."""
+    if resolution is not None and not (resolution > 0 and math.isfinite(resolution)):
+        raise ValueError(f"--resolution {resolution}: expected a grid spacing > 0 in m")
+    if region is not None:
+        region = tuple(float(v) for v in region)
+        if len(region) != 4 or not (region[0] < region[1] and region[2] < region[3]):
+            raise ValueError(f"--region {region}: expected X0,X1,Y0,Y1 in m with X0 < X1 "
+                             "and Y0 < Y1, e.g. --region -25,25,0,65")
+    return _beamsim.landscape(os.fspath(scene), _sets(set),
+                              float(resolution) if resolution is not None else 0.0, region)

@@ -1,0 +1,325 @@
+/* The module beamsim._beamsim: its table of functions, errors, argument
+ * conversion and NumPy arrays (the only file that uses NumPy's C API). */
+#define _POSIX_C_SOURCE 200809L
+
+#include "pyb.h"
+
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
+
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+PyObject *pyb_raise(int rc, const bsim_error *err)
+{
+	PyErr_SetString(rc == BSIM_EINPUT ? PyExc_ValueError : PyExc_RuntimeError, err->msg);
+	return NULL;
+}
+
+/* The UTF-8 text of item i of a tuple, or NULL with TypeError. */
+static const char *tuple_text(PyObject *t, Py_ssize_t i, const char *what)
+{
+	PyObject *o = PyTuple_GetItem(t, i);
+	if (!o || !PyUnicode_Check(o)) {
+		PyErr_Format(PyExc_TypeError, "%s: expected a str", what);
+		return NULL;
+	}
+	return PyUnicode_AsUTF8(o);
+}
+
+int pyb_sets_from(PyObject *seq, pyb_sets *s)
+{
+	memset(s, 0, sizeof *s);
+	if (!seq || seq == Py_None)
+		return 0;
+	if (!PyList_Check(seq)) {
+		PyErr_SetString(PyExc_TypeError, "set: expected a list of (key, value, origin)");
+		return -1;
+	}
+	Py_ssize_t n = PyList_Size(seq);
+	s->ov = calloc((size_t)(n ? n : 1), sizeof *s->ov);
+	if (!s->ov) {
+		PyErr_NoMemory();
+		return -1;
+	}
+	for (Py_ssize_t i = 0; i < n; i++) {
+		PyObject *t = PyList_GetItem(seq, i);
+		if (!PyTuple_Check(t) || PyTuple_Size(t) != 3) {
+			PyErr_SetString(PyExc_TypeError,
+			                "set: expected (key, value, origin) tuples");
+			pyb_sets_free(s);
+			return -1;
+		}
+		bsim_override *o = &s->ov[s->n];
+		if (!(o->key = tuple_text(t, 0, "set key")) ||
+		    !(o->value = tuple_text(t, 1, "set value")) ||
+		    !(o->origin = tuple_text(t, 2, "set origin"))) {
+			pyb_sets_free(s);
+			return -1;
+		}
+		s->n++;
+	}
+	return 0;
+}
+
+void pyb_sets_free(pyb_sets *s)
+{
+	free(s->ov);
+	memset(s, 0, sizeof *s);
+}
+
+int pyb_grid_from(PyObject *seq, pyb_grid *g)
+{
+	memset(g, 0, sizeof *g);
+	if (!seq || seq == Py_None)
+		return 0;
+	if (!PyList_Check(seq)) {
+		PyErr_SetString(PyExc_TypeError, "grid: expected a list of (key, values, origin)");
+		return -1;
+	}
+	Py_ssize_t n = PyList_Size(seq);
+	g->axes = calloc((size_t)(n ? n : 1), sizeof *g->axes);
+	if (!g->axes) {
+		PyErr_NoMemory();
+		return -1;
+	}
+	for (Py_ssize_t i = 0; i < n; i++) {
+		PyObject *t = PyList_GetItem(seq, i);
+		PyObject *values =
+		        PyTuple_Check(t) && PyTuple_Size(t) == 3 ? PyTuple_GetItem(t, 1) : NULL;
+		if (!values || !PyList_Check(values)) {
+			PyErr_SetString(PyExc_TypeError,
+			                "grid: expected (key, [values], origin) tuples");
+			pyb_grid_free(g);
+			return -1;
+		}
+		bsim_grid_axis *ax = &g->axes[g->n++];
+		Py_ssize_t m = PyList_Size(values);
+		ax->n_values = (int)m;
+		ax->values = calloc((size_t)(m ? m : 1), sizeof *ax->values);
+		ax->origins = calloc((size_t)(m ? m : 1), sizeof *ax->origins);
+		const char *key = tuple_text(t, 0, "grid key");
+		const char *origin = key ? tuple_text(t, 2, "grid origin") : NULL;
+		if (!ax->values || !ax->origins || !origin) {
+			if (!PyErr_Occurred())
+				PyErr_NoMemory();
+			pyb_grid_free(g);
+			return -1;
+		}
+		/* The library only reads an axis given to it (const). */
+		ax->key = (char *)key;
+		for (Py_ssize_t k = 0; k < m; k++) {
+			PyObject *v = PyList_GetItem(values, k);
+			const char *text = PyUnicode_Check(v) ? PyUnicode_AsUTF8(v) : NULL;
+			if (!text) {
+				PyErr_SetString(PyExc_TypeError, "grid value: expected a str");
+				pyb_grid_free(g);
+				return -1;
+			}
+			ax->values[k] = (char *)text;
+			ax->origins[k] = (char *)origin;
+		}
+	}
+	return 0;
+}
+
+void pyb_grid_free(pyb_grid *g)
+{
+	for (int i = 0; i < g->n; i++) {
+		free(g->axes[i].values);
+		free(g->axes[i].origins);
+	}
+	free(g->axes);
+	memset(g, 0, sizeof *g);
+}
+
+const bsim_backend *pyb_backend(const char *spec, PyObject *seq, bsim_options *opts)
+{
+	bsim_error err;
+	memset(opts, 0, sizeof *opts);
+	if (seq && seq != Py_None) {
+		if (!PyList_Check(seq)) {
+			PyErr_SetString(PyExc_TypeError,
+			                "backend_opt: expected a list of KEY=VALUE");
+			return NULL;
+		}
+		for (Py_ssize_t i = 0; i < PyList_Size(seq); i++) {
+			PyObject *o = PyList_GetItem(seq, i);
+			const char *kv = PyUnicode_Check(o) ? PyUnicode_AsUTF8(o) : NULL;
+			if (!kv) {
+				PyErr_SetString(PyExc_TypeError, "backend_opt: expected str items");
+				return NULL;
+			}
+			if (bsim_options_add(opts, kv, &err) != BSIM_OK)
+				return pyb_raise(err.code, &err), NULL;
+		}
+	}
+	/* As beamsim run reads --backend: the name, the --backend-opt
+	 * options, then the spec's own (they win). */
+	if (!spec)
+		spec = bsim_backend_default()->name;
+	size_t n = strcspn(spec, ":");
+	char name[32];
+	snprintf(name, sizeof name, "%.*s", (int)(n < sizeof name ? n : sizeof name - 1), spec);
+	const bsim_backend *b = bsim_backend_find(name, &err);
+	if (!b)
+		return pyb_raise(err.code ? err.code : BSIM_EINPUT, &err), NULL;
+	for (const char *p = spec + n; *p == ':';) {
+		size_t len = strcspn(p + 1, ":");
+		char kv[128];
+		snprintf(kv, sizeof kv, "%.*s", (int)(len < sizeof kv ? len : sizeof kv - 1),
+		         p + 1);
+		if (bsim_options_add(opts, kv, &err) != BSIM_OK)
+			return pyb_raise(err.code, &err), NULL;
+		p += len + 1;
+	}
+	if (bsim_options_check(opts, b->knobs, b->n_knobs, b->name, &err) != BSIM_OK) {
+		if (spec[n]) {
+			bsim_error e2;
+			bsim_error_set(&e2, BSIM_EINPUT, "--backend %s: %s", spec, err.msg);
+			return pyb_raise(BSIM_EINPUT, &e2), NULL;
+		}
+		return pyb_raise(BSIM_EINPUT, &err), NULL;
+	}
+	return b;
+}
+
+PyObject *pyb_column(const double *data, long n, long stride, int ints)
+{
+	npy_intp dims[1] = {n};
+	PyObject *a = PyArray_SimpleNew(1, dims, ints ? NPY_INT32 : NPY_DOUBLE);
+	if (!a)
+		return NULL;
+	if (ints) {
+		int32_t *p = PyArray_DATA((PyArrayObject *)a);
+		for (long i = 0; i < n; i++)
+			p[i] = (int32_t)data[i * stride];
+	} else {
+		double *p = PyArray_DATA((PyArrayObject *)a);
+		for (long i = 0; i < n; i++)
+			p[i] = data[i * stride];
+	}
+	return a;
+}
+
+PyObject *pyb_array(int nd, const long *dims, const double *data)
+{
+	npy_intp d[3];
+	size_t n = 1;
+	for (int i = 0; i < nd; i++) {
+		d[i] = dims[i];
+		n *= (size_t)dims[i];
+	}
+	PyObject *a = PyArray_SimpleNew(nd, d, NPY_DOUBLE);
+	if (a && n)
+		memcpy(PyArray_DATA((PyArrayObject *)a), data, n * sizeof *data);
+	return a;
+}
+
+int pyb_set(PyObject *d, const char *key, PyObject *value)
+{
+	if (!value)
+		return -1;
+	int rc = PyDict_SetItemString(d, key, value);
+	Py_DECREF(value);
+	return rc;
+}
+
+/* ---- progress and Ctrl-C ------------------------------------------------ */
+
+static double now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void pyb_progress_init(pyb_progress *p, PyObject *fn)
+{
+	memset(p, 0, sizeof *p);
+	p->fn = fn == Py_None ? NULL : fn;
+	p->last = now();
+}
+
+void pyb_progress_update(void *user, long done, long total)
+{
+	pyb_progress *p = user;
+	if (p->stop)
+		return;
+	/* Without a callable the GIL is taken about 10 times a second, to see
+	 * a Ctrl-C, not after every trial. */
+	double t = now();
+	if (!p->fn && t - p->last < 0.1 && done < total)
+		return;
+	p->last = t;
+	PyGILState_STATE g = PyGILState_Ensure();
+	int failed = PyErr_CheckSignals() != 0;
+	if (!failed && p->fn) {
+		PyObject *r = PyObject_CallFunction(p->fn, "ll", done, total);
+		failed = r == NULL;
+		Py_XDECREF(r);
+	}
+	if (failed) {
+		PyErr_Fetch(&p->type, &p->value, &p->trace);
+		p->stop = 1;
+	}
+	PyGILState_Release(g);
+}
+
+PyObject *pyb_progress_end(pyb_progress *p, int rc, const bsim_error *err)
+{
+	/* A signal that came after the last check. */
+	if (!p->type && PyErr_CheckSignals() != 0)
+		return NULL;
+	if (p->type) {
+		PyErr_Restore(p->type, p->value, p->trace);
+		p->type = p->value = p->trace = NULL;
+		return NULL;
+	}
+	if (rc != BSIM_OK)
+		return pyb_raise(rc, err);
+	return Py_None;
+}
+
+/* ---- the module ------------------------------------------------------------ */
+
+static PyObject *py_version(PyObject *self, PyObject *args)
+{
+	(void)self;
+	(void)args;
+	return PyUnicode_FromString(bsim_version());
+}
+
+static PyMethodDef methods[] = {
+        {"run", (PyCFunction)(void (*)(void))pyb_run, METH_VARARGS | METH_KEYWORDS,
+         "run(path, seed, group, trial, backend, sets, backend_opts, trajectory, stride)"},
+        {"sweep", (PyCFunction)(void (*)(void))pyb_sweep, METH_VARARGS | METH_KEYWORDS,
+         "sweep(experiment, out, trials, threads, seed, backend, sets, grid, backend_opts, "
+         "progress)"},
+        {"compare", (PyCFunction)(void (*)(void))pyb_compare, METH_VARARGS | METH_KEYWORDS,
+         "compare(experiment, out, backends, trials, threads, seed, sets, grid, progress)"},
+        {"landscape", (PyCFunction)(void (*)(void))pyb_landscape, METH_VARARGS | METH_KEYWORDS,
+         "landscape(scene, sets, spacing, region)"},
+        {"version", py_version, METH_NOARGS, "the library's version"},
+        {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+        PyModuleDef_HEAD_INIT,
+        "_beamsim",
+        "libbeamsim's calls (use the package beamsim).",
+        -1,
+        methods,
+        NULL,
+        NULL,
+        NULL,
+        NULL,
+};
+
+PyMODINIT_FUNC PyInit__beamsim(void);
+PyMODINIT_FUNC PyInit__beamsim(void)
+{
+	import_array();
+	return PyModule_Create(&module);
+}

@@ -1,0 +1,75 @@
+/* The CPython extension beamsim._beamsim over libbeamsim: what its files
+ * share. The functions are called by the package beamsim (__init__.py),
+ * which turns the user's arguments (dicts, numbers) into the strings the
+ * command line would give, so that every check and every message is the
+ * library's. */
+#ifndef BSIM_PYB_H
+#define BSIM_PYB_H
+
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include "beamsim/beamsim.h"
+
+/* Raises the exception of a failed call: ValueError for bad input
+ * (BSIM_EINPUT), RuntimeError otherwise, with err's one line. NULL. */
+PyObject *pyb_raise(int rc, const bsim_error *err);
+
+/* --set overrides from a sequence of (key, value, origin) str tuples. The
+ * strings are the tuples' own (valid while seq lives). -1 with an
+ * exception set. */
+typedef struct pyb_sets {
+	int n;
+	bsim_override *ov;
+} pyb_sets;
+int pyb_sets_from(PyObject *seq, pyb_sets *s);
+void pyb_sets_free(pyb_sets *s);
+
+/* --grid axes from a sequence of (key, [values], origin) tuples. */
+typedef struct pyb_grid {
+	int n;
+	bsim_grid_axis *axes;
+} pyb_grid;
+int pyb_grid_from(PyObject *seq, pyb_grid *g);
+void pyb_grid_free(pyb_grid *g);
+
+/* A backend "NAME[:KEY=VALUE]..." (NULL or None: the default backend) with
+ * the "KEY=VALUE" options of seq (applied first; the spec's win), checked.
+ * NULL with an exception set. */
+const bsim_backend *pyb_backend(const char *spec, PyObject *seq, bsim_options *opts);
+
+/* A NumPy array of n doubles (or int32 when ints), copied from data with
+ * the given stride (values between consecutive elements). New reference. */
+PyObject *pyb_column(const double *data, long n, long stride, int ints);
+/* A 1-, 2- or 3-D float64 array copied from data (C order). */
+PyObject *pyb_array(int nd, const long *dims, const double *data);
+
+/* Sets d[key] = value and drops the reference to value. -1 on failure
+ * (value NULL included). */
+int pyb_set(PyObject *d, const char *key, PyObject *value);
+
+/* The module's functions. */
+PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *pyb_landscape(PyObject *self, PyObject *args, PyObject *kw);
+
+/* A progress callback for long runs (bsim_progress_fn), called from the
+ * thread that started the run while the GIL is released: every so often
+ * it takes the GIL, calls the user's callable(done, total) if any and
+ * checks for signals (Ctrl-C); a Python exception sets stop, which ends
+ * the run (BSIM_ESTOPPED), and is kept to be raised once it has. */
+typedef struct pyb_progress {
+	PyObject *fn;                   /* None or NULL: no callable */
+	volatile sig_atomic_t stop;     /* the run's stop flag */
+	double last;                    /* s, monotonic clock of the last check */
+	PyObject *type, *value, *trace; /* the exception that stopped the run */
+} pyb_progress;
+void pyb_progress_init(pyb_progress *p, PyObject *fn);
+void pyb_progress_update(void *user, long done, long total);
+/* After the run, with the GIL: the kept exception raised (NULL) if there
+ * is one, else the error of rc (pyb_raise) if rc is not BSIM_OK, else
+ * Py_None (borrowed, a non-NULL marker). */
+PyObject *pyb_progress_end(pyb_progress *p, int rc, const bsim_error *err);
+
+#endif

@@ -1,0 +1,80 @@
+"""Bad input raises ValueError with the message `beamsim` prints for the
+same command (its first line, without "beamsim: " and, for a bad option
+value, the command's name before it); the program's exit status for it is
+2."""
+
+import pytest
+
+import beamsim
+from conftest import cli_message
+
+
+def raises_as_cli(call, *args):
+    message, status = cli_message(*args)
+    assert status == 2
+    command = f"{args[0]}: "
+    if message.startswith(command):
+        message = message[len(command):]
+    with pytest.raises(ValueError) as e:
+        call()
+    assert str(e.value) == message
+
+
+def test_group_out_of_range(h1):
+    raises_as_cli(lambda: beamsim.run(h1, group=30), "run", h1, "--group", 30)
+    raises_as_cli(lambda: beamsim.run(h1, trial=10**6), "run", h1, "--trial", 10**6)
+
+
+def test_unknown_scene_field(gate):
+    raises_as_cli(lambda: beamsim.run(gate, set={"body.mas": 2}), "run", gate, "--set",
+                  "body.mas=2")
+    raises_as_cli(lambda: beamsim.run(gate, set={"body.mass": -1}), "run", gate, "--set",
+                  "body.mass=-1")
+
+
+def test_missing_file(tmp_path):
+    missing = str(tmp_path / "nothing.yaml")
+    raises_as_cli(lambda: beamsim.run(missing), "run", missing)
+    raises_as_cli(lambda: beamsim.sweep(missing, out=tmp_path / "o"), "sweep", missing,
+                  "--out", tmp_path / "o")
+
+
+def test_bad_backend_and_option(gate, h1, tmp_path):
+    raises_as_cli(lambda: beamsim.run(gate, backend="box3d"), "run", gate, "--backend", "box3d")
+    raises_as_cli(lambda: beamsim.sweep(h1, backend_opt={"integrator": "rk9"}), "sweep", h1,
+                  "--backend-opt", "integrator=rk9", "--out", tmp_path / "o")
+
+
+def test_grid_on_a_scene(gate, tmp_path):
+    raises_as_cli(lambda: beamsim.run(gate, grid={"effects.propulsion.force": [6, 7]}), "run",
+                  gate, "--grid", "effects.propulsion.force=6,7")
+    raises_as_cli(lambda: beamsim.sweep(gate, out=tmp_path / "o"), "sweep", gate, "--out",
+                  tmp_path / "o")
+
+
+def test_stored_run_refuses_a_seed(h1, tmp_path):
+    beamsim.sweep(h1, trials=1, out=tmp_path / "s")
+    raises_as_cli(lambda: beamsim.run(tmp_path / "s", seed=3), "run", tmp_path / "s",
+                  "--seed", 3)
+    raises_as_cli(lambda: beamsim.run(tmp_path / "s", backend="box2d"), "run",
+                  tmp_path / "s", "--backend", "box2d")
+
+
+def test_trials_too_many(h1, tmp_path):
+    raises_as_cli(lambda: beamsim.sweep(h1, trials=10**9), "sweep", h1, "--trials", 10**9,
+                  "--out", tmp_path / "o")
+
+
+def test_a_failed_call_leaves_no_directory(tmp_path, h1):
+    with pytest.raises(ValueError):
+        beamsim.sweep(h1, set={"body.radius": "x"}, out=tmp_path / "o")
+    assert not (tmp_path / "o" / "summary.json").exists()
+
+
+def test_numbers_out_of_range(gate, h1, tmp_path):
+    raises_as_cli(lambda: beamsim.run(gate, seed=-1), "run", gate, "--seed", -1)
+    raises_as_cli(lambda: beamsim.run(gate, stride=0), "run", gate, "--stride", 0)
+    raises_as_cli(lambda: beamsim.sweep(h1, threads=0), "sweep", h1, "--threads", 0,
+                  "--out", tmp_path / "o")
+    raises_as_cli(lambda: beamsim.sweep(h1, trials=0), "sweep", h1, "--trials", 0,
+                  "--out", tmp_path / "o")

@@ -1,0 +1,71 @@
+"""A sweep releases the GIL while its trials run, and Ctrl-C (SIGINT) stops
+it with KeyboardInterrupt, leaving no output files, only the journal a
+resume continues from. Synchronised on events and on the sweep's own
+progress calls, never on sleeps or elapsed time."""
+
+import os
+import signal
+import sys
+import threading
+
+import pytest
+
+import beamsim
+
+
+@pytest.fixture
+def no_preemption():
+    """The GIL changes hands only when its holder releases it: Python's
+    switch interval made longer than any test."""
+    before = sys.getswitchinterval()
+    sys.setswitchinterval(1000.0)
+    yield
+    sys.setswitchinterval(before)
+
+
+def test_another_thread_runs_during_a_sweep(h1, no_preemption):
+    """The sweep calls progress(done, total) after each trial (one thread).
+    The first call wakes a Python thread; with no preemption it can run
+    only when the sweep releases the GIL, so the number of calls it sees
+    must be below the last one's. A sweep that held the GIL would let it run
+    only after returning, when every call has been made."""
+    calls, seen = [], []
+    woken = threading.Event()
+
+    def other():
+        woken.wait()
+        seen.append(len(calls))
+
+    def progress(done, total):
+        calls.append(done)
+        woken.set()
+
+    t = threading.Thread(target=other)
+    t.start()
+    beamsim.sweep(h1, trials=4, threads=1, progress=progress)
+    t.join()
+    assert calls[-1] == 30 * 4
+    assert seen and seen[0] < len(calls)
+
+
+def test_ctrl_c_stops_a_sweep(h1, tmp_path):
+    calls = []
+
+    def progress(done, total):
+        calls.append(done)
+        if len(calls) == 1:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    out = tmp_path / "s"
+    with pytest.raises(KeyboardInterrupt):
+        beamsim.sweep(h1, trials=4, threads=1, progress=progress, out=out)
+    # Stopped at once: no more progress after the signal, no files, the
+    # journal kept.
+    assert calls == [1]
+    assert not (out / "summary.json").exists() and not (out / "trials.csv").exists()
+    assert (out / ".beamsim" / "journal").exists()
+    # It continues where it stopped, to the uninterrupted sweep's numbers.
+    r = beamsim.sweep(h1, trials=4, threads=1, out=out, resume=True)
+    s = beamsim.sweep(h1, trials=4, threads=2)
+    for k in s["trials"]:
+        assert list(map(str, r["trials"][k])) == list(map(str, s["trials"][k])), k
