@@ -546,8 +546,9 @@ static void test_threads_and_cache(void **state)
 	        pdir,     NULL};
 	out = NULL;
 	assert_int_equal(bsim_test_cli(pred_out, &out, NULL), 0);
-	/* prediction*.csv and .mat, prediction.{png,svg,gp,dat} and index.html */
-	assert_int_equal(bsim_test_check_wrote(out, pdir), 9);
+	/* prediction*.csv and .mat, prediction.{png,svg,gp,dat}, index.html and
+	 * the time to the outcome: time.{csv,mat,png,svg,gp} */
+	assert_int_equal(bsim_test_check_wrote(out, pdir), 14);
 	free(out);
 	char csv[1200];
 	snprintf(csv, sizeof csv, "%s/prediction.csv", pdir);
@@ -647,7 +648,7 @@ static void test_field_figures(void **state)
 	if (rc != 0)
 		fail_msg("validate: exit %d: %s", rc, err ? err : "");
 	free(err);
-	assert_int_equal(bsim_test_check_figures(pdir), 1);
+	assert_int_equal(bsim_test_check_figures(pdir), 2); /* prediction and time */
 	assert_int_equal(bsim_test_check_figures(vdir), 1);
 
 	/* predict: prediction.dat against prediction.csv */

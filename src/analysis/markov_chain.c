@@ -27,7 +27,7 @@
  * walks each map's own rows (compressed sparse rows, contiguous exits and
  * probabilities) through a table of where each gate's exits lead, built
  * once; Q is composed only for the LU. */
-#include "beamsim/markov.h"
+#include "analysis/markov_internal.h"
 #include "beamsim/lattice_outcome.h"
 
 #include <gsl/gsl_linalg.h>
@@ -42,7 +42,26 @@
 typedef struct sparse_map {
 	int *first, *exit;
 	double *p;
+	double *hold; /* s, each row's mean holding time; NULL without holding times */
 } sparse_map;
+
+/* Row a's mean holding time, s: its single gates' steps times dt. */
+static int sparse_hold(sparse_map *s, const bsim_markov_map *m, double dt)
+{
+	const int nb = m->n_bins, T = m->trials;
+	if (!m->hold_steps)
+		return 0;
+	s->hold = malloc((size_t)nb * sizeof *s->hold);
+	if (!s->hold)
+		return -1;
+	for (int a = 0; a < nb; a++) {
+		long long sum = 0;
+		for (int t = 0; t < T; t++)
+			sum += m->hold_steps[(size_t)a * T + t];
+		s->hold[a] = (double)sum / T * dt;
+	}
+	return 0;
+}
 
 static int sparse_init(sparse_map *s, const bsim_markov_map *m)
 {
@@ -81,6 +100,7 @@ typedef struct chain {
 	int nb, cols, rows, n_loc, n_states;
 	int per_edge;   /* bins per edge */
 	int *gate_map;  /* gate -> map index */
+	int has_time;   /* every map has holding times */
 	sparse_map *sm; /* per map */
 	/* Where exit x of gate g leads, tgt[g nb + x]: a state, or n_states +
 	 * location. The series walks the maps' own rows through this table
@@ -93,20 +113,20 @@ typedef struct chain {
 	double *p;
 } chain;
 
-static void target(const chain *c, int g, int x, int *state, int *loc)
+void markov_exit_target(int cols, int rows, int nb, int g, int x, int *state, int *loc)
 {
-	const int ix = g % c->cols, iy = g / c->cols;
+	const int ix = g % cols, iy = g / cols, per_edge = (nb - 1) / 4;
 	*state = -1;
 	*loc = -1;
 	if (x == 0) {
-		*loc = c->cols + c->rows + g;
+		*loc = cols + rows + g;
 		return;
 	}
-	int edge = BSIM_EDGE_BOTTOM + (x - 1) / c->per_edge;
+	int edge = BSIM_EDGE_BOTTOM + (x - 1) / per_edge;
 	int jx = ix, jy = iy;
 	switch (edge) {
 	case BSIM_EDGE_BOTTOM: /* into the gate above */
-		if (++jy == c->rows) {
+		if (++jy == rows) {
 			*loc = ix;
 			return;
 		}
@@ -114,23 +134,28 @@ static void target(const chain *c, int g, int x, int *state, int *loc)
 	case BSIM_EDGE_TOP: /* into the gate below */
 		if (--jy < 0) {
 			jy = 0;
-			x -= (BSIM_EDGE_TOP - BSIM_EDGE_BOTTOM) * c->per_edge;
+			x -= (BSIM_EDGE_TOP - BSIM_EDGE_BOTTOM) * per_edge;
 		}
 		break;
 	case BSIM_EDGE_LEFT: /* into the gate on the right */
-		if (++jx == c->cols) {
-			*loc = c->cols + iy;
+		if (++jx == cols) {
+			*loc = cols + iy;
 			return;
 		}
 		break;
 	default: /* into the gate on the left */
 		if (--jx < 0) {
-			*loc = c->cols + iy;
+			*loc = cols + iy;
 			return;
 		}
 		break;
 	}
-	*state = (jy * c->cols + jx) * c->nb + x;
+	*state = (jy * cols + jx) * nb + x;
+}
+
+static void target(const chain *c, int g, int x, int *state, int *loc)
+{
+	markov_exit_target(c->cols, c->rows, c->nb, g, x, state, loc);
 }
 
 void bsim_markov_prediction_free(bsim_markov_prediction *p)
@@ -140,6 +165,8 @@ void bsim_markov_prediction_free(bsim_markov_prediction *p)
 	free(p->loc);
 	free(p->p);
 	free(p->p_gates);
+	free(p->p_time);
+	free(p->p_loc_time);
 	memset(p, 0, sizeof *p);
 }
 
@@ -149,6 +176,7 @@ static void chain_free(chain *c, int n_maps)
 		free(c->sm[i].first);
 		free(c->sm[i].exit);
 		free(c->sm[i].p);
+		free(c->sm[i].hold);
 	}
 	free(c->sm);
 	free(c->gate_map);
@@ -179,8 +207,10 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 		if (set->maps[i].n_bins != c->nb)
 			return bsim_error_set(err, BSIM_EINPUT, "map %d has %d bins, the set %d", i,
 			                      set->maps[i].n_bins, c->nb);
-		if (sparse_init(&c->sm[i], &set->maps[i]) != 0)
+		if (sparse_init(&c->sm[i], &set->maps[i]) != 0 ||
+		    sparse_hold(&c->sm[i], &set->maps[i], lattice->dt) != 0)
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		c->has_time = i == 0 ? c->sm[i].hold != NULL : c->has_time && c->sm[i].hold;
 	}
 	for (int iy = 0; iy < c->rows; iy++)
 		for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
@@ -245,8 +275,10 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 /* Out of line (as sweeps()): both inlined into their one caller, the
  * series took 2.2 times as long (perf stat, C-track, 800-trial maps). */
 __attribute__((noinline)) static int series(const chain *c, int start, double tol, double *p_loc,
-                                            double **p_gates, int *n_gates, double *left)
+                                            double **p_gates, int *n_gates, double *left,
+                                            double *time)
 {
+	double tm = 0.0; /* s, the sum of each state's mass times its mean holding time */
 	const int n = c->n_states, nb = c->nb, G = c->cols * c->rows;
 	double *cur = calloc((size_t)n + c->n_loc, sizeof *cur);
 	double *next = calloc((size_t)n + c->n_loc, sizeof *next);
@@ -283,11 +315,14 @@ __attribute__((noinline)) static int series(const chain *c, int start, double to
 			const double *restrict pr = sm->p;
 			const int *restrict tg = c->tgt + (size_t)g * nb;
 			double *restrict cg = cur + (size_t)g * nb;
+			const double *restrict hb = sm->hold;
 			for (int a = 0; a < nb; a++) {
 				const double m = cg[a];
 				if (m == 0.0)
 					continue;
 				cg[a] = 0.0;
+				if (hb)
+					tm += m * hb[a];
 				const int j1 = first[a + 1];
 				for (int j = first[a]; j < j1; j++)
 					next[tg[ex[j]]] += m * pr[j];
@@ -327,6 +362,7 @@ __attribute__((noinline)) static int series(const chain *c, int start, double to
 	*p_gates = pg;
 	*n_gates = k;
 	*left = in_field;
+	*time = tm;
 	return 0;
 }
 
@@ -356,8 +392,10 @@ __attribute__((noinline)) static int series(const chain *c, int start, double to
  * of gates entered, the start counted, short by what r has still to
  * visit. */
 __attribute__((noinline)) static int sweeps(const chain *c, int start, double tol, double *p_loc,
-                                            double *visits, double *left, int *n_sweeps)
+                                            double *visits, double *left, int *n_sweeps,
+                                            double *time)
 {
+	double tm = 0.0; /* s, as vis with each push weighted by its mean holding time */
 	const int n = c->n_states, nb = c->nb, G = c->cols * c->rows;
 	double *r = calloc((size_t)n + c->n_loc, sizeof *r);
 	if (!r)
@@ -375,6 +413,7 @@ __attribute__((noinline)) static int sweeps(const chain *c, int start, double to
 			const double *restrict pr = sm->p;
 			const int *restrict tg = c->tgt + (size_t)g * nb;
 			double *restrict rg = r + (size_t)g * nb;
+			const double *restrict hb = sm->hold;
 			for (int ai = 0; ai < nb; ai++) {
 				const int a = back ? nb - 1 - ai : ai;
 				const double m = rg[a];
@@ -382,6 +421,8 @@ __attribute__((noinline)) static int sweeps(const chain *c, int start, double to
 					continue;
 				rg[a] = 0.0;
 				vis += m;
+				if (hb)
+					tm += m * hb[a];
 				const int j1 = first[a + 1];
 				for (int j = first[a]; j < j1; j++)
 					r[tg[ex[j]]] += m * pr[j];
@@ -399,12 +440,15 @@ __attribute__((noinline)) static int sweeps(const chain *c, int start, double to
 	*visits = vis;
 	*left = in_field;
 	*n_sweeps = k;
+	*time = tm;
 	return 0;
 }
 
-/* p_loc by LU of (I - Q)^T y = e_start. */
-static int lu_solve(const chain *c, int start, double *p_loc)
+/* p_loc by LU of (I - Q)^T y = e_start; *time the sum of the visits y
+ * times each state's mean holding time (with holding times). */
+static int lu_solve(const chain *c, int start, double *p_loc, double *time)
 {
+	*time = 0.0;
 	const int n = c->n_states;
 	gsl_matrix *A = gsl_matrix_calloc((size_t)n, (size_t)n);
 	gsl_vector *e = gsl_vector_calloc((size_t)n);
@@ -429,6 +473,9 @@ static int lu_solve(const chain *c, int start, double *p_loc)
 		double visits = gsl_vector_get(y, (size_t)s);
 		if (visits == 0.0)
 			continue;
+		const sparse_map *sm = &c->sm[c->gate_map[s / c->nb]];
+		if (sm->hold)
+			*time += visits * sm->hold[s % c->nb];
 		for (int j = c->first[s]; j < c->first[s + 1]; j++)
 			if (c->to[j] < 0)
 				p_loc[-1 - c->to[j]] += visits * c->p[j];
@@ -491,14 +538,14 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 		if (flags & BSIM_MARKOV_GATES) {
 			/* The series: p and the distribution of gates visited. */
 			if (series(&c, start, tol, out->p, &out->p_gates, &out->n_gates,
-			           &out->left_in_field))
+			           &out->left_in_field, &out->mean_time))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 			for (int k = 1; rc == BSIM_OK && k <= out->n_gates; k++)
 				out->mean_gates += k * out->p_gates[k];
 		} else {
 			/* The sweeps: p and the expected visits alone. */
 			if (sweeps(&c, start, tol, out->p, &out->mean_gates, &out->left_in_field,
-			           &out->sweeps) ||
+			           &out->sweeps, &out->mean_time) ||
 			    !(out->p_gates = calloc(1, sizeof *out->p_gates)))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
@@ -511,7 +558,7 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 			else {
 				memcpy(by_series, out->p, (size_t)c.n_loc * sizeof *out->p);
 				memset(out->p, 0, (size_t)c.n_loc * sizeof *out->p);
-				if (lu_solve(&c, start, out->p))
+				if (lu_solve(&c, start, out->p, &out->mean_time))
 					rc = bsim_error_set(
 					        err, BSIM_EFAIL,
 					        "the chain's LU solve failed (out of memory or a "
@@ -529,6 +576,9 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 			}
 			out->exact = 1;
 		}
+		out->has_time = c.has_time;
+		if (!c.has_time)
+			out->mean_time = NAN;
 	}
 	chain_free(&c, set->n);
 	if (rc != BSIM_OK)

@@ -27,7 +27,8 @@ enum {
 	OWN_LOCATIONS,
 	OWN_JSON,
 	OWN_TOL,
-	OWN_NO_GATES
+	OWN_NO_GATES,
+	OWN_WALKS
 };
 
 #define MAX_ENTRIES 16
@@ -39,6 +40,7 @@ typedef struct markov_args {
 	int locations, json; /* predict: --locations, --json */
 	int no_gates;        /* predict: --no-gates */
 	double tol;          /* predict: --tol */
+	long walks;          /* predict: --walks */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
 } markov_args;
@@ -128,6 +130,11 @@ static int markov_option(void *args, int i, const char *value)
 	case OWN_NO_GATES:
 		a->no_gates = 1;
 		return CLI_OK;
+	case OWN_WALKS:
+		if (cli_parse_long(value, 0, 100000000L, &a->walks) != 0)
+			return cli_usage("markov predict",
+			                 "--walks %s: expected an integer 0 to 100000000", value);
+		return CLI_OK;
 	}
 	return CLI_USAGE;
 }
@@ -187,6 +194,9 @@ static const cli_own predict_own[] = {
         {"no-gates", 0, NULL,
          "skip the distribution of gates visited (its series):\nthe mean from the "
          "expected visits, faster"},
+        {"walks", 1, "N",
+         "walks of the semi-Markov chain for the distribution of\nthe time to the "
+         "outcome (default 100000; 0: none)"},
 };
 
 /* predict's and validate's own options: --map, then predict's --locations
@@ -202,8 +212,9 @@ static int predict_option(void *args, int i, const char *value)
 }
 
 static const char *const predict_help[CLI_N_OPTS] = {
-        [CLI_OPT_OUT] = "also write prediction.csv, prediction_gates.csv, their\n"
-                        ".mat twins and the figure prediction.png (the field) into DIR",
+        [CLI_OPT_OUT] = "also write prediction.csv, prediction_gates.csv, time.csv,\n"
+                        "their .mat twins and the figures prediction.png (the field)\n"
+                        "and time.png into DIR",
 };
 
 static const cli_spec predict_spec = {
@@ -214,13 +225,15 @@ static const cli_spec predict_spec = {
                  "a side and stuck in a gate, and the mean number of gates visited. The\n"
                  "distribution over every final location (the end through column ix, a side\n"
                  "at row iy, stuck in gate (ix, iy)) is --out DIR's prediction.csv, or\n"
-                 "printed with --locations or --json. The chain counts gates, not seconds:\n"
-                 "it has no expected time.\n",
+                 "printed with --locations or --json. With the maps' holding times it\n"
+                 "prints the expected time to the outcome (first-step analysis) and, by\n"
+                 "walks of the semi-Markov chain, the outcome at the trial's duration and\n"
+                 "the time of each kind (--out DIR's time.csv and time.png).\n",
         .positional = "LATTICE_SCENE",
         .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_QUIET),
         .help = predict_help,
         .own = predict_own,
-        .n_own = 5,
+        .n_own = 6,
         .option = predict_option,
 };
 
@@ -377,7 +390,22 @@ static void predict_print(const char *path, const bsim_scene *scene, const bsim_
 	if (!p->exact || p->left_in_field > 1e-12)
 		printf(" (the %s stopped with %.2g still in the field)",
 		       p->sweeps ? "sweeps" : "series", p->left_in_field);
-	printf("\nexpected time: none (the chain counts gates, not seconds)\n");
+	if (p->has_time)
+		printf("\nexpected time to the outcome: %.2f s (first-step analysis, without the "
+		       "trial's duration)\n",
+		       p->mean_time);
+	else
+		printf("\nexpected time: none (maps built before holding times were kept: "
+		       "beamsim markov build simulates them again)\n");
+	if (p->walks > 0) {
+		printf("\nat the trial's duration, %g s (%ld walks of the semi-Markov chain; "
+		       "their error on a p: at most %.4f):\n"
+		       "outcome      p        mean time s   sd s\n",
+		       p->duration, p->walks, 0.5 / sqrt((double)p->walks));
+		for (int k = 0; k < 3; k++)
+			printf("%-12s %7.4f  %10.2f  %8.2f\n", kinds[k], p->p_by[k], p->t_mean[k],
+			       p->t_sd[k]);
+	}
 	if (locations) {
 		printf("\nlocation       p\n");
 		for (int i = 0; i < p->n_locations; i++) {
@@ -424,6 +452,23 @@ static void predict_json(const char *path, const bsim_scene *scene, const bsim_m
 	fputs(", \"tol\": ", f);
 	bsim_json_number(f, p->tol);
 	fprintf(f, ", \"sweeps\": %d", p->sweeps);
+	fputs(", \"mean_time\": ", f);
+	bsim_json_number(f, p->mean_time);
+	if (p->walks > 0) {
+		fprintf(f, ", \"walks\": %ld, \"duration\": ", p->walks);
+		bsim_json_number(f, p->duration);
+		fputs(", \"at_duration\": {", f);
+		for (int k = 0; k < 3; k++) {
+			fprintf(f, "%s\"%s\": {\"p\": ", k ? ", " : "", kinds[k]);
+			bsim_json_number(f, p->p_by[k]);
+			fputs(", \"mean_time\": ", f);
+			bsim_json_number(f, p->t_mean[k]);
+			fputs(", \"sd_time\": ", f);
+			bsim_json_number(f, p->t_sd[k]);
+			fputc('}', f);
+		}
+		fputc('}', f);
+	}
 	fputs(", \"predict_seconds\": ", f);
 	bsim_json_number(f, seconds);
 	fputs(", \"locations\": [", f);
@@ -446,7 +491,9 @@ static void predict_json(const char *path, const bsim_scene *scene, const bsim_m
 static int markov_predict(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	markov_args a = {.def = bsim_markov_def_default(), .tol = BSIM_MARKOV_TOL};
+	markov_args a = {.def = bsim_markov_def_default(),
+	                 .tol = BSIM_MARKOV_TOL,
+	                 .walks = BSIM_MARKOV_WALKS};
 	const char *path = NULL;
 	int rc = cli_parse(&predict_spec, argc, argv, &c, &a, &path);
 	if (rc < 0 && !a.map)
@@ -472,6 +519,8 @@ static int markov_predict(int argc, char **argv)
 		rc = bsim_markov_predict_with(&scene, &set, a.tol,
 		                              a.no_gates ? 0 : BSIM_MARKOV_GATES, &p, &err);
 	double seconds = bsim_clock_seconds() - t0;
+	if (rc == BSIM_OK && p.has_time && a.walks > 0)
+		rc = bsim_markov_predict_time(&scene, &set, a.walks, set.def.seed, &p, &err);
 	if (rc == BSIM_OK && c.out)
 		rc = bsim_markov_prediction_store(c.out, &scene, &set, &p, &err);
 	/* --quiet wins over --json: nothing on stdout. */
@@ -542,6 +591,26 @@ static int markov_validate(int argc, char **argv)
 			       k->trials, k->tv, k->tv_sampling, k->tv_sampling95, k->tv_map,
 			       k->gates_sim, k->gates_chain, k->sim_cpu, k->predict,
 			       k->sim_cpu / k->predict, pays);
+		}
+		if (v.n > 0 && v.checks[0].has_time) {
+			printf("\ntime to the outcome, trials out (end or side) by the trial's "
+			       "duration (95%% intervals; the difference's without the maps' "
+			       "sampling error):\n"
+			       "group protocol  out sim [interval]      chain   mean t out sim s   "
+			       " "
+			       "chain s          difference s    sup|dP(out by t)| (sim's 95%%)\n");
+			for (int i = 0; i < v.n; i++) {
+				const bsim_markov_check *k = &v.checks[i];
+				printf("%5d %-8s %6.4f [%6.4f, %6.4f] %6.4f  %7.2f +- %5.2f  %7.2f "
+				       "+- "
+				       "%5.2f  %+7.2f +- %5.2f  %6.4f (%6.4f)\n",
+				       k->group,
+				       k->protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world",
+				       k->out_sim, k->out_sim_lo, k->out_sim_hi, k->out_chain,
+				       k->t_out_sim, k->t_out_sim_ci, k->t_out_chain,
+				       k->t_out_chain_ci, k->t_out_chain - k->t_out_sim,
+				       k->t_out_diff_ci, k->t_ks, k->t_ks95);
+			}
 		}
 		printf("\n");
 		cli_wrote(stdout, c.out);
