@@ -230,6 +230,16 @@ typedef struct bsim_markov_prediction {
  * the maps' own sampling error (a TV of 0.02 at 800 trials per bin). */
 #define BSIM_MARKOV_TOL 1e-6
 
+/* A tolerance tied to the maps' own sampling error: a transition
+ * probability estimated from T single gates has a standard error of at
+ * most 0.5 / sqrt(T); stopping with less than 1/16 of that in the field,
+ *   tol = 1 / (32 sqrt(T))     (1.1e-3 at 800 trials per bin),
+ * moves every location's p by at most tol and the total variation from the
+ * solution to 1e-12 by at most tol, against the maps' own 0.017 (mean TV of
+ * chains of resampled 800-trial maps on the C-track, docs/markov.md). T:
+ * the fewest trials per bin of set's maps. */
+BSIM_API double bsim_markov_tol_sampling(const bsim_markov_set *set);
+
 /* The chain of lattice composed from set's maps, solved; the series to
  * BSIM_MARKOV_TOL. */
 BSIM_API int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,

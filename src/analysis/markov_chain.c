@@ -489,6 +489,14 @@ done:
 	return rc;
 }
 
+double bsim_markov_tol_sampling(const bsim_markov_set *set)
+{
+	int T = set->n > 0 ? set->maps[0].trials : set->def.trials;
+	for (int i = 1; i < set->n; i++)
+		T = set->maps[i].trials < T ? set->maps[i].trials : T;
+	return 1.0 / (32.0 * sqrt(T > 1 ? (double)T : 1.0));
+}
+
 int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
                         bsim_markov_prediction *out, bsim_error *err)
 {

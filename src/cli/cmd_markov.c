@@ -120,11 +120,16 @@ static int markov_option(void *args, int i, const char *value)
 		a->json = 1;
 		return CLI_OK;
 	case OWN_TOL:
+		if (strcmp(value, "sampling") == 0) {
+			a->tol = -1.0; /* from the maps, once read */
+			return CLI_OK;
+		}
 		a->tol = strtod(value, &end);
 		if (end == value || *end || !(a->tol > 0.0 && a->tol < 1.0))
 			return cli_usage("markov predict",
 			                 "--tol %s: expected the probability left in the field at "
-			                 "which the solution stops, in (0, 1), e.g. 1e-12",
+			                 "which the solution stops, in (0, 1), e.g. 1e-12, or "
+			                 "sampling",
 			                 value);
 		return CLI_OK;
 	case OWN_NO_GATES:
@@ -190,7 +195,8 @@ static const cli_own predict_own[] = {
          "print one JSON object (totals, every location, predict_seconds)\ninstead of text"},
         {"tol", 1, "T",
          "stop when less than T is left in the field\n(default 1e-6; "
-         "each location's p is short by at most\nwhat is left)"},
+         "each location's p is short by at most\nwhat is left); sampling: 1 / (32 "
+         "sqrt(trials per bin)),\n1/16 of a map probability's standard error"},
         {"no-gates", 0, NULL,
          "skip the distribution of gates visited (its series):\nthe mean from the "
          "expected visits, faster"},
@@ -424,7 +430,7 @@ static void predict_print(const char *path, const bsim_scene *scene, const bsim_
 
 /* --json: one object with the totals and every final location. */
 static void predict_json(const char *path, const bsim_scene *scene, const bsim_markov_set *set,
-                         const bsim_markov_prediction *p, double seconds)
+                         const bsim_markov_prediction *p, double seconds, double cpu)
 {
 	static const char *const kinds[] = {"end", "side", "stuck"};
 	double total[3];
@@ -471,6 +477,9 @@ static void predict_json(const char *path, const bsim_scene *scene, const bsim_m
 	}
 	fputs(", \"predict_seconds\": ", f);
 	bsim_json_number(f, seconds);
+	/* the CPU time of the same: what it costs on a machine others share */
+	fputs(", \"predict_cpu_seconds\": ", f);
+	bsim_json_number(f, cpu);
 	fputs(", \"locations\": [", f);
 	for (int i = 0; i < p->n_locations; i++) {
 		char label[48];
@@ -514,18 +523,20 @@ static int markov_predict(int argc, char **argv)
 	rc = bsim_markov_load(&scene, a.map, &opts, &set, &err);
 	/* The wall time of the prediction alone (the chain composed and
 	 * solved; the maps already read). */
-	double t0 = bsim_clock_seconds();
+	if (rc == BSIM_OK && a.tol < 0)
+		a.tol = bsim_markov_tol_sampling(&set);
+	double t0 = bsim_clock_seconds(), c0 = bsim_clock_thread_cpu_seconds();
 	if (rc == BSIM_OK)
 		rc = bsim_markov_predict_with(&scene, &set, a.tol,
 		                              a.no_gates ? 0 : BSIM_MARKOV_GATES, &p, &err);
-	double seconds = bsim_clock_seconds() - t0;
+	double seconds = bsim_clock_seconds() - t0, cpu = bsim_clock_thread_cpu_seconds() - c0;
 	if (rc == BSIM_OK && p.has_time && a.walks > 0)
 		rc = bsim_markov_predict_time(&scene, &set, a.walks, set.def.seed, &p, &err);
 	if (rc == BSIM_OK && c.out)
 		rc = bsim_markov_prediction_store(c.out, &scene, &set, &p, &err);
 	/* --quiet wins over --json: nothing on stdout. */
 	if (rc == BSIM_OK && !c.quiet && a.json)
-		predict_json(path, &scene, &set, &p, seconds);
+		predict_json(path, &scene, &set, &p, seconds, cpu);
 	else if (rc == BSIM_OK && !c.quiet)
 		predict_print(path, &scene, &set, &p, c.out, a.locations);
 	bsim_markov_prediction_free(&p);
