@@ -391,16 +391,69 @@ __attribute__((noinline)) static int series(const chain *c, int start, double to
  * same at any thread count. y is summed into *visits: the expected number
  * of gates entered, the start counted, short by what r has still to
  * visit. */
-__attribute__((noinline)) static int sweeps(const chain *c, int start, double tol, double *p_loc,
-                                            double *visits, double *left, int *n_sweeps,
-                                            double *time)
+/* The sweeps' layout. The field is padded with a ring of ghost gates,
+ * W = cols + 2 to a row, and each gate holds S = nb + 1 doubles: its entry
+ * bins and, last, the probability stuck in it. Exit x of any gate then
+ * lands at a fixed offset from the gate's first bin:
+ *   x = 0 (stuck)                  nb
+ *   bottom-edge bins (gate above)  W S + x
+ *   left-edge bins (gate right)    S + x
+ *   right-edge bins (gate left)    -S + x
+ *   top-edge bins (gate below)     -W S + x
+ * so each map's row is a list of (offset, probability) and the inner loop
+ * is one load of each and one add, with no table per gate and no test for
+ * the field's edge. After each sweep the ghosts are emptied: those above
+ * the last row into the ends, those beside the outer columns into the
+ * sides, the stuck slots into the stuck gates, and those below row 0 back
+ * into row 0 through its bottom edge (same position, speed and direction
+ * bins) to be passed on in the next sweep. */
+static int exit_offset(int x, int nb, int W)
+{
+	const int S = nb + 1, per_edge = (nb - 1) / 4;
+	if (x == 0)
+		return nb;
+	switch (BSIM_EDGE_BOTTOM + (x - 1) / per_edge) {
+	case BSIM_EDGE_BOTTOM:
+		return W * S + x;
+	case BSIM_EDGE_LEFT:
+		return S + x;
+	case BSIM_EDGE_RIGHT:
+		return -S + x;
+	default:
+		return -W * S + x;
+	}
+}
+
+__attribute__((noinline)) static int sweeps(const chain *c, int n_maps, int start, double tol,
+                                            double *p_loc, double *visits, double *left,
+                                            int *n_sweeps, double *time)
 {
 	double tm = 0.0; /* s, as vis with each push weighted by its mean holding time */
-	const int n = c->n_states, nb = c->nb, G = c->cols * c->rows;
-	double *r = calloc((size_t)n + c->n_loc, sizeof *r);
-	if (!r)
+	const int nb = c->nb, cols = c->cols, rows = c->rows, G = cols * rows;
+	const int W = cols + 2, S = nb + 1, per_edge = (nb - 1) / 4;
+	double *r = calloc((size_t)W * (rows + 2) * S, sizeof *r);
+	int **off = calloc((size_t)n_maps, sizeof *off);
+	int *base = malloc((size_t)G * sizeof *base);
+	int ok = r && off && base;
+	for (int i = 0; ok && i < n_maps; i++) {
+		const sparse_map *sm = &c->sm[i];
+		const int nnz = sm->first[nb];
+		off[i] = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof **off);
+		ok = off[i] != NULL;
+		for (int j = 0; ok && j < nnz; j++)
+			off[i][j] = exit_offset(sm->exit[j], nb, W);
+	}
+	if (!ok) {
+		for (int i = 0; off && i < n_maps; i++)
+			free(off[i]);
+		free(off);
+		free(base);
+		free(r);
 		return -1;
-	r[start] = 1.0;
+	}
+	for (int g = 0; g < G; g++)
+		base[g] = ((g / cols + 1) * W + g % cols + 1) * S;
+	r[base[start / nb] + start % nb] = 1.0;
 	double in_field = 1.0, vis = 0.0;
 	int k = 0;
 	while (in_field > tol && k < SERIES_MAX) {
@@ -408,12 +461,11 @@ __attribute__((noinline)) static int sweeps(const chain *c, int start, double to
 		const int back = !(k & 1);
 		for (int gi = 0; gi < G; gi++) {
 			const int g = back ? G - 1 - gi : gi;
-			const sparse_map *sm = &c->sm[c->gate_map[g]];
-			const int *restrict first = sm->first, *restrict ex = sm->exit;
-			const double *restrict pr = sm->p;
-			const int *restrict tg = c->tgt + (size_t)g * nb;
-			double *restrict rg = r + (size_t)g * nb;
-			const double *restrict hb = sm->hold;
+			const int mi = c->gate_map[g];
+			const sparse_map *sm = &c->sm[mi];
+			const int *restrict first = sm->first, *restrict of = off[mi];
+			const double *restrict pr = sm->p, *restrict hb = sm->hold;
+			double *rg = r + base[g];
 			for (int ai = 0; ai < nb; ai++) {
 				const int a = back ? nb - 1 - ai : ai;
 				const double m = rg[a];
@@ -425,17 +477,43 @@ __attribute__((noinline)) static int sweeps(const chain *c, int start, double to
 					tm += m * hb[a];
 				const int j1 = first[a + 1];
 				for (int j = first[a]; j < j1; j++)
-					r[tg[ex[j]]] += m * pr[j];
+					rg[of[j]] += m * pr[j];
 			}
 		}
-		for (int l = 0; l < c->n_loc; l++) {
-			p_loc[l] += r[n + l];
-			r[n + l] = 0.0;
+		/* the ghosts and the stuck slots emptied */
+		for (int ix = 0; ix < cols; ix++) {
+			double *end = r + ((size_t)(rows + 1) * W + ix + 1) * S;
+			double *below = r + ((size_t)ix + 1) * S, *row0 = r + base[ix];
+			for (int x = 0; x < S; x++) {
+				p_loc[ix] += end[x];
+				end[x] = 0.0;
+			}
+			for (int x = 1 + 3 * per_edge; x < nb; x++) {
+				row0[x - 3 * per_edge] += below[x];
+				below[x] = 0.0;
+			}
 		}
+		for (int iy = 0; iy < rows; iy++)
+			for (int side = 0; side < 2; side++) {
+				double *gh = r + ((size_t)(iy + 1) * W + (side ? W - 1 : 0)) * S;
+				for (int x = 0; x < S; x++) {
+					p_loc[cols + iy] += gh[x];
+					gh[x] = 0.0;
+				}
+			}
 		in_field = 0.0;
-		for (int a = 0; a < n; a++)
-			in_field += r[a];
+		for (int g = 0; g < G; g++) {
+			double *rg = r + base[g];
+			p_loc[cols + rows + g] += rg[nb];
+			rg[nb] = 0.0;
+			for (int a = 0; a < nb; a++)
+				in_field += rg[a];
+		}
 	}
+	for (int i = 0; i < n_maps; i++)
+		free(off[i]);
+	free(off);
+	free(base);
 	free(r);
 	*visits = vis;
 	*left = in_field;
@@ -552,8 +630,8 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 				out->mean_gates += k * out->p_gates[k];
 		} else {
 			/* The sweeps: p and the expected visits alone. */
-			if (sweeps(&c, start, tol, out->p, &out->mean_gates, &out->left_in_field,
-			           &out->sweeps, &out->mean_time) ||
+			if (sweeps(&c, set->n, start, tol, out->p, &out->mean_gates,
+			           &out->left_in_field, &out->sweeps, &out->mean_time) ||
 			    !(out->p_gates = calloc(1, sizeof *out->p_gates)))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
