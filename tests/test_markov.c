@@ -581,7 +581,7 @@ static void check_predict_totals(const char *printed, const char *csv, const cha
 				sum[k] += atof(strrchr(line, ',') + 1);
 	}
 	free(text);
-	const char *argv[16];
+	const char *argv[20];
 	int n = 0;
 	while (pred[n] && n < 12) {
 		argv[n] = pred[n];
@@ -611,6 +611,24 @@ static void check_predict_totals(const char *printed, const char *csv, const cha
 		near(bsim_test_json_number(fast_totals, kinds[k]), sum[k], 2 * BSIM_MARKOV_TOL,
 		     __LINE__);
 	free(fast);
+	/* --tol sampling: stopped at 1 / (32 sqrt(trials)), each total short
+	 * of the series' (to 1e-6) by at most what was left, itself at most
+	 * the tolerance */
+	char *lean = NULL;
+	argv[n + 2] = "--tol";
+	argv[n + 3] = "sampling";
+	argv[n + 4] = NULL;
+	assert_int_equal(bsim_test_cli(argv, &lean, NULL), 0);
+	const double tol = bsim_test_json_number(lean, "tol"),
+	             left = bsim_test_json_number(lean, "left_in_field");
+	assert_true(tol > 1e-4 && tol < 0.1 && left <= tol);
+	const char *lean_totals = strstr(lean, "\"totals\": {");
+	assert_non_null(lean_totals);
+	for (int k = 0; k < 3; k++) {
+		const double d = sum[k] - bsim_test_json_number(lean_totals, kinds[k]);
+		assert_true(d >= -2 * BSIM_MARKOV_TOL && d <= left + 2 * BSIM_MARKOV_TOL);
+	}
+	free(lean);
 	const char *totals = strstr(json, "\"totals\": {");
 	assert_non_null(totals);
 	for (int k = 0; k < 3; k++) {
