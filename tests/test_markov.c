@@ -1033,6 +1033,34 @@ static void test_bad_map_files(void **state)
 	assert_non_null(strstr(err, name));
 	assert_non_null(strstr(err, ":2: exit: expected a bin 0 to 4"));
 	free(err);
+	bsim_test_write(dir, name, csv);
+	assert_int_equal(bsim_test_cli(pred, NULL, NULL), 0);
+
+	/* a map's holding times: a malformed row, then an exit that no
+	 * longer counts up to the map's counts */
+	snprintf(path, sizeof path, "%.*s.hold.csv", (int)(strlen(first) - 4), first);
+	char *hold = bsim_test_read(path);
+	assert_non_null(hold);
+	const char *hname = strrchr(path, '/') + 1;
+	char *h2 = strchr(hold, '\n') + 1; /* "0,0,EXIT,STEPS" */
+	char *c3 = strchr(strchr(strchr(h2, ',') + 1, ',') + 1, ',');
+	snprintf(text, sizeof text, "%.*s,x%s", (int)(c3 - hold), hold, c3);
+	bsim_test_write(dir, hname, text);
+	err = NULL;
+	assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
+	if (!strstr(err, ".hold.csv:2: expected a row entry,trial,exit,steps"))
+		print_error("%s\n", err);
+	assert_non_null(strstr(err, ".hold.csv:2: expected a row entry,trial,exit,steps"));
+	free(err);
+	char *c2 = strchr(strchr(h2, ',') + 1, ','); /* the exit */
+	const int ex = atoi(c2 + 1);
+	snprintf(text, sizeof text, "%.*s,%d%s", (int)(c2 - hold), hold, ex == 0 ? 1 : 0, c3);
+	bsim_test_write(dir, hname, text);
+	err = NULL;
+	assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
+	assert_non_null(strstr(err, "do not count up to the map's counts"));
+	free(err);
+	free(hold);
 	free(csv);
 	free(essay);
 	free(track);
