@@ -586,6 +586,12 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		rc = i == 2 ? bsim_matlab_from_json(src, mat, twins[i][1], err)
 		            : bsim_matlab_from_csv(src, mat, twins[i][1], err);
 	}
+	if (rc == BSIM_OK && e.n_groups > 0 && gd[0].pred.walks > 0) {
+		char src[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
+		snprintf(src, sizeof src, "%s/time_validate.csv", ss.stage);
+		snprintf(mat, sizeof mat, "%s/time_validate.mat", ss.stage);
+		rc = bsim_matlab_from_csv(src, mat, "time_validate", err);
+	}
 	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++)
 		rc = write_figure(ss.stage, g, &gd[g], out, NULL, err);
 	rc = bsim_session_close(&ss, rc, "markov validate", NULL, err);

@@ -260,8 +260,10 @@ static const cli_spec validate_spec = {
                  "--map, and writes into --out: validate.json (total variation distance of\n"
                  "the final-location distributions with the simulation's and the maps'\n"
                  "sampling errors, mean gates visited, CPU time of simulation and\n"
-                 "prediction, the lattices after which building the maps pays off),\n"
-                 "validate.csv, gates.csv, their .mat twins and validate_gNNN (.png .svg).\n",
+                 "prediction, the lattices after which building the maps pays off; with\n"
+                 "the maps' holding times the exit times against the chain's walks),\n"
+                 "validate.csv, gates.csv, time_validate.csv, their .mat twins and\n"
+                 "validate_gNNN (.png .svg).\n",
         .positional = "LATTICE_EXPERIMENT",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
                   CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
