@@ -38,7 +38,8 @@
  * gates behind and beside the body absent), and that the exit depends on
  * the entry only through its bin. A body leaving row 0 downwards re-enters
  * row 0 in the chain (the lattice keeps it in row 0's gate); a trial's
- * overall max_steps is not modelled. */
+ * overall max_steps is not in p, only in bsim_markov_predict_time's walks,
+ * which use the maps' holding times (the chain as a semi-Markov one). */
 #ifndef BSIM_MARKOV_H
 #define BSIM_MARKOV_H
 
