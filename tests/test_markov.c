@@ -13,6 +13,11 @@
  *   - self-consistent and flow-weighted entry states are exits of the
  *     previous pass's single gates into the bin, as that pass's own record
  *     says;
+ *   - the time to the outcome: on hand-made maps with fixed holding times
+ *     the first-step mean is the hand-solved one (two gates passed
+ *     straight through: the sum) and the walks agree with it; on one gate
+ *     the first-step mean is the map's own samples', and the walks' exit
+ *     time agrees with direct simulation within the sampling errors;
  *   - a bad input exits 2 naming what is wrong and writes nothing. */
 #define _POSIX_C_SOURCE 200809L
 
@@ -61,6 +66,29 @@ static bsim_markov_set hand_set(double k, const int rows[][NB], int n_rows, cons
 	for (int i = 0; i < n_rows; i++)
 		memcpy(s.maps[0].counts + which[i] * NB, rows[i], sizeof rows[i]);
 	return s;
+}
+
+/* Holding times for hand_set's map, its rows of 100 trials: each trial of
+ * row which[i] with exit x holds steps[i][x] steps (rows not given: stuck
+ * after 1 step, never visited). */
+static void hand_hold(bsim_markov_set *s, const int steps[][NB], int n_rows, const int *which)
+{
+	bsim_markov_map *m = &s->maps[0];
+	m->trials = 100;
+	m->hold_exit = calloc(NB * 100, sizeof(int));
+	m->hold_steps = malloc(NB * 100 * sizeof(int));
+	for (int u = 0; u < NB * 100; u++)
+		m->hold_steps[u] = 1;
+	for (int i = 0; i < n_rows; i++) {
+		const int a = which[i];
+		int t = 0;
+		for (int x = 0; x < NB; x++)
+			for (int c = 0; c < m->counts[a * NB + x]; c++, t++) {
+				m->hold_exit[a * 100 + t] = x;
+				m->hold_steps[a * 100 + t] = steps[i][x];
+			}
+		assert_int_equal(t, 100);
+	}
 }
 
 static double p_of(const bsim_markov_prediction *p, bsim_location_kind kind, int ix, int iy)
@@ -137,6 +165,99 @@ static void test_two_gates_geometric(void **state)
 	assert_double_equal(sum, 1.0, 1e-12);
 	bsim_markov_prediction_free(&p);
 	bsim_markov_set_free(&set);
+	bsim_scene_free(&s);
+}
+
+/* Time to the outcome on hand-made maps with fixed holding times (steps):
+ * - two gates passed straight through (the start up after 500 steps, the
+ *   gate above to the end after 700): the time is the sum, 1200 steps,
+ *   by first-step analysis and in every walk; with a duration of 1000
+ *   steps every walk is stuck in the second gate at 1000 steps;
+ * - the loop of test_two_gates_geometric with times: the expected steps
+ *   from first-step equations solved by hand,
+ *     E0 = 0.4 3000 + 0.6 (500 + E1),
+ *     E1 = 0.2 3000 + 0.5 700 + 0.3 (400 + E2),
+ *     E2 = 0.7 (300 + E1) + 0.3 200,
+ *   so E1 = (1070 + 0.3 270) / (1 - 0.3 0.7); the walks' mean within 4.5 of
+ *   their standard errors, and their totals the chain's p within 4.5. */
+static void test_time_by_hand(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 2, 6, 30), BSIM_OK);
+	const double dt = s.dt;
+	bsim_error err;
+	{
+		const int rows[][NB] = {{0, 100, 0, 0, 0}, {0, 100, 0, 0, 0}};
+		const int steps[][NB] = {{1, 500, 1, 1, 1}, {1, 700, 1, 1, 1}};
+		const int which[] = {START, BOTTOM};
+		bsim_markov_set set = hand_set(400, rows, 2, which);
+		hand_hold(&set, steps, 2, which);
+		bsim_markov_prediction p;
+		assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
+		assert_true(p.has_time);
+		assert_double_equal(p.mean_time, 1200 * dt, 1e-9);
+		assert_int_equal(bsim_markov_predict_time(&s, &set, 1000, 7, &p, &err), BSIM_OK);
+		assert_double_equal(p.p_by[0], 1.0, 0.0);
+		assert_double_equal(p.t_mean[0], 1200 * dt, 1e-9);
+		assert_double_equal(p.t_sd[0], 0.0, 1e-9);
+		double in_bin = 0.0; /* all of it in the bin of 1200 steps */
+		const int b = (int)floor(1200 * dt / p.time_bin + 1e-9);
+		in_bin = p.p_time[b * 3];
+		assert_double_equal(in_bin, 1.0, 1e-12);
+		bsim_scene short_s = s;
+		short_s.max_steps = 1000;
+		assert_int_equal(bsim_markov_predict_time(&short_s, &set, 1000, 7, &p, &err),
+		                 BSIM_OK);
+		assert_double_equal(p.p_by[2], 1.0, 0.0);
+		assert_double_equal(p.t_mean[2], 1000 * dt, 1e-9);
+		assert_double_equal(p.duration, 1000 * dt, 1e-12);
+		for (int i = 0; i < p.n_locations; i++)
+			assert_double_equal(
+			        p.p_loc_time[i],
+			        p.loc[i].kind == BSIM_LOCATION_STUCK && p.loc[i].iy == 1, 0.0);
+		bsim_markov_prediction_free(&p);
+		bsim_markov_set_free(&set);
+	}
+	{
+		const int rows[][NB] = {{40, 60, 0, 0, 0}, {20, 50, 0, 0, 30}, {0, 70, 30, 0, 0}};
+		const int steps[][NB] = {
+		        {3000, 500, 1, 1, 1}, {3000, 700, 1, 1, 400}, {1, 300, 200, 1, 1}};
+		const int which[] = {START, BOTTOM, TOP};
+		bsim_markov_set set = hand_set(400, rows, 3, which);
+		hand_hold(&set, steps, 3, which);
+		bsim_markov_prediction p;
+		assert_int_equal(bsim_markov_predict_tol(&s, &set, 1e-12, &p, &err), BSIM_OK);
+		const double e2_free = 0.7 * 300 + 0.3 * 200; /* E2 = 270 + 0.7 E1 */
+		const double e1 = (0.2 * 3000 + 0.5 * 700 + 0.3 * 400 + 0.3 * e2_free) /
+		                  (1 - 0.3 * 0.7),
+		             e0 = 0.4 * 3000 + 0.6 * (500 + e1);
+		assert_double_equal(p.mean_time, e0 * dt, 1e-9 * e0 * dt);
+		/* the sweeps' expected visits give the same */
+		bsim_markov_prediction q;
+		assert_int_equal(bsim_markov_predict_with(&s, &set, 1e-12, 0, &q, &err), BSIM_OK);
+		assert_double_equal(q.mean_time, e0 * dt, 1e-9 * e0 * dt);
+		bsim_markov_prediction_free(&q);
+		const long W = 40000;
+		assert_int_equal(bsim_markov_predict_time(&s, &set, W, 3, &p, &err), BSIM_OK);
+		double mean = 0.0, m2 = 0.0;
+		for (int k = 0; k < 3; k++) {
+			mean += p.p_by[k] * p.t_mean[k];
+			m2 += p.p_by[k] * (p.t_sd[k] * p.t_sd[k] + p.t_mean[k] * p.t_mean[k]);
+			double tot = 0.0;
+			for (int i = 0; i < p.n_locations; i++)
+				tot += (int)p.loc[i].kind == k ? p.p[i] : 0.0;
+			assert_double_equal(p.p_by[k], tot,
+			                    4.5 * sqrt(tot * (1 - tot) / W) + 1e-12);
+		}
+		const double se = sqrt((m2 - mean * mean) / W);
+		print_message("mean time: first step %.4f s, walks %.4f s (se %.4f)\n", p.mean_time,
+		              mean, se);
+		assert_true(se > 0);
+		assert_double_equal(mean, p.mean_time, 4.5 * se);
+		bsim_markov_prediction_free(&p);
+		bsim_markov_set_free(&set);
+	}
 	bsim_scene_free(&s);
 }
 
@@ -363,7 +484,8 @@ static void test_one_gate_against_simulation(void **state)
 	bsim_markov_prediction p;
 	assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
 	const int N = 400;
-	double sim[3] = {0, 0, 0};
+	double sim[3] = {0, 0, 0}, t_out = 0.0, t_out2 = 0.0;
+	int n_out = 0;
 	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	const bsim_options none = {0};
 	for (int t = 0; t < N; t++) {
@@ -372,7 +494,13 @@ static void test_one_gate_against_simulation(void **state)
 		                                bsim_schedule_seed_mix(99, 0, (uint64_t)t), NULL,
 		                                &res, &err),
 		                 BSIM_OK);
-		sim[bsim_lattice_location_of(&res).kind] += 1.0 / N;
+		const bsim_location_kind kind = bsim_lattice_location_of(&res).kind;
+		sim[kind] += 1.0 / N;
+		if (kind != BSIM_LOCATION_STUCK) {
+			n_out++;
+			t_out += res.t_end;
+			t_out2 += res.t_end * res.t_end;
+		}
 	}
 	bsim_trial_runner_free(r);
 	const double chain[3] = {p_of(&p, BSIM_LOCATION_END, 0, 0),
@@ -388,6 +516,40 @@ static void test_one_gate_against_simulation(void **state)
 		informative += q > 0.05 && q < 0.95;
 	}
 	assert_true(informative >= 2); /* the test can tell outcomes apart */
+
+	/* Time. First-step analysis by hand on the map's own samples: from the
+	 * start (bin 0) the body leaves after h0 on average; down (bin TOP,
+	 * through the top edge of the gate below) it enters row 0 again
+	 * through its bottom (bin BOTTOM), whose mean time is h1, returning with
+	 * probability back: E = h0 + P(0 -> TOP) h1 / (1 - back). */
+	const bsim_markov_map *m = &set.maps[0];
+	assert_non_null(m->hold_steps);
+	double h[2] = {0, 0};
+	for (int a = 0; a < 2; a++)
+		for (int t = 0; t < m->trials; t++)
+			h[a] += m->hold_steps[a * m->trials + t] * s.dt / m->trials;
+	const double down = (double)m->counts[START * NB + TOP] / m->trials,
+	             back = (double)m->counts[BOTTOM * NB + TOP] / m->trials;
+	const double e = h[0] + (down > 0 ? down * h[1] / (1 - back) : 0.0);
+	assert_true(p.has_time);
+	assert_double_equal(p.mean_time, e, 1e-9 * e);
+	/* The walks' time of the trials out (end or side) against the direct
+	 * trials' exit times: within 4.5 standard errors of the difference,
+	 * the simulation's, the map's (its samples out) and the walks'. */
+	const long W = 20000;
+	assert_int_equal(bsim_markov_predict_time(&s, &set, W, 5, &p, &err), BSIM_OK);
+	const double w_out = p.p_by[0] + p.p_by[1];
+	const double c_mean = (p.p_by[0] * p.t_mean[0] + p.p_by[1] * p.t_mean[1]) / w_out;
+	double c_var = 0.0;
+	for (int k = 0; k < 2; k++)
+		c_var += p.p_by[k] / w_out *
+		         (p.t_sd[k] * p.t_sd[k] + (p.t_mean[k] - c_mean) * (p.t_mean[k] - c_mean));
+	const double s_mean = t_out / n_out, s_var = t_out2 / n_out - s_mean * s_mean;
+	const double se = sqrt(s_var / n_out + c_var / (w_out * m->trials) + c_var / (w_out * W));
+	print_message("time out: chain %.3f s, simulation %.3f s (se %.3f); first step %.3f s\n",
+	              c_mean, s_mean, se, p.mean_time);
+	assert_true(n_out > 50 && se > 0);
+	assert_double_equal(c_mean, s_mean, 4.5 * se);
 	bsim_markov_prediction_free(&p);
 	bsim_markov_set_free(&set);
 	bsim_scene_free(&s);
@@ -419,7 +581,7 @@ static void check_predict_totals(const char *printed, const char *csv, const cha
 				sum[k] += atof(strrchr(line, ',') + 1);
 	}
 	free(text);
-	const char *argv[16];
+	const char *argv[20];
 	int n = 0;
 	while (pred[n] && n < 12) {
 		argv[n] = pred[n];
@@ -449,6 +611,24 @@ static void check_predict_totals(const char *printed, const char *csv, const cha
 		near(bsim_test_json_number(fast_totals, kinds[k]), sum[k], 2 * BSIM_MARKOV_TOL,
 		     __LINE__);
 	free(fast);
+	/* --tol sampling: stopped at 1 / (32 sqrt(trials)), each total short
+	 * of the series' (to 1e-6) by at most what was left, itself at most
+	 * the tolerance */
+	char *lean = NULL;
+	argv[n + 2] = "--tol";
+	argv[n + 3] = "sampling";
+	argv[n + 4] = NULL;
+	assert_int_equal(bsim_test_cli(argv, &lean, NULL), 0);
+	const double tol = bsim_test_json_number(lean, "tol"),
+	             left = bsim_test_json_number(lean, "left_in_field");
+	assert_true(tol > 1e-4 && tol < 0.1 && left <= tol);
+	const char *lean_totals = strstr(lean, "\"totals\": {");
+	assert_non_null(lean_totals);
+	for (int k = 0; k < 3; k++) {
+		const double d = sum[k] - bsim_test_json_number(lean_totals, kinds[k]);
+		assert_true(d >= -2 * BSIM_MARKOV_TOL && d <= left + 2 * BSIM_MARKOV_TOL);
+	}
+	free(lean);
 	const char *totals = strstr(json, "\"totals\": {");
 	assert_non_null(totals);
 	for (int k = 0; k < 3; k++) {
@@ -546,8 +726,9 @@ static void test_threads_and_cache(void **state)
 	        pdir,     NULL};
 	out = NULL;
 	assert_int_equal(bsim_test_cli(pred_out, &out, NULL), 0);
-	/* prediction*.csv and .mat, prediction.{png,svg,gp,dat} and index.html */
-	assert_int_equal(bsim_test_check_wrote(out, pdir), 9);
+	/* prediction*.csv and .mat, prediction.{png,svg,gp,dat}, index.html and
+	 * the time to the outcome: time.{csv,mat,png,svg,gp} */
+	assert_int_equal(bsim_test_check_wrote(out, pdir), 14);
 	free(out);
 	char csv[1200];
 	snprintf(csv, sizeof csv, "%s/prediction.csv", pdir);
@@ -647,7 +828,7 @@ static void test_field_figures(void **state)
 	if (rc != 0)
 		fail_msg("validate: exit %d: %s", rc, err ? err : "");
 	free(err);
-	assert_int_equal(bsim_test_check_figures(pdir), 1);
+	assert_int_equal(bsim_test_check_figures(pdir), 2); /* prediction and time */
 	assert_int_equal(bsim_test_check_figures(vdir), 1);
 
 	/* predict: prediction.dat against prediction.csv */
@@ -852,6 +1033,34 @@ static void test_bad_map_files(void **state)
 	assert_non_null(strstr(err, name));
 	assert_non_null(strstr(err, ":2: exit: expected a bin 0 to 4"));
 	free(err);
+	bsim_test_write(dir, name, csv);
+	assert_int_equal(bsim_test_cli(pred, NULL, NULL), 0);
+
+	/* a map's holding times: a malformed row, then an exit that no
+	 * longer counts up to the map's counts */
+	snprintf(path, sizeof path, "%.*s.hold.csv", (int)(strlen(first) - 4), first);
+	char *hold = bsim_test_read(path);
+	assert_non_null(hold);
+	const char *hname = strrchr(path, '/') + 1;
+	char *h2 = strchr(hold, '\n') + 1; /* "0,0,EXIT,STEPS" */
+	char *c3 = strchr(strchr(strchr(h2, ',') + 1, ',') + 1, ',');
+	snprintf(text, sizeof text, "%.*s,x%s", (int)(c3 - hold), hold, c3);
+	bsim_test_write(dir, hname, text);
+	err = NULL;
+	assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
+	if (!strstr(err, ".hold.csv:2: expected a row entry,trial,exit,steps"))
+		print_error("%s\n", err);
+	assert_non_null(strstr(err, ".hold.csv:2: expected a row entry,trial,exit,steps"));
+	free(err);
+	char *c2 = strchr(strchr(h2, ',') + 1, ','); /* the exit */
+	const int ex = atoi(c2 + 1);
+	snprintf(text, sizeof text, "%.*s,%d%s", (int)(c2 - hold), hold, ex == 0 ? 1 : 0, c3);
+	bsim_test_write(dir, hname, text);
+	err = NULL;
+	assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
+	assert_non_null(strstr(err, "do not count up to the map's counts"));
+	free(err);
+	free(hold);
 	free(csv);
 	free(essay);
 	free(track);
@@ -1265,6 +1474,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_one_gate_is_the_map),
 	        cmocka_unit_test(test_two_gates_geometric),
+	        cmocka_unit_test(test_time_by_hand),
 	        cmocka_unit_test(test_bins),
 	        cmocka_unit_test(test_conservation),
 	        cmocka_unit_test(test_tolerance),

@@ -38,7 +38,8 @@
  * gates behind and beside the body absent), and that the exit depends on
  * the entry only through its bin. A body leaving row 0 downwards re-enters
  * row 0 in the chain (the lattice keeps it in row 0's gate); a trial's
- * overall max_steps is not modelled. */
+ * overall max_steps is not in p, only in bsim_markov_predict_time's walks,
+ * which use the maps' holding times (the chain as a semi-Markov one). */
 #ifndef BSIM_MARKOV_H
 #define BSIM_MARKOV_H
 
@@ -148,6 +149,12 @@ typedef struct bsim_markov_map {
 	long long steps; /* single-gate time steps that simulation took (as cost); 0 if
 	                  * the map's .cost file predates the count */
 	int cached;      /* 1: read from the cache, 0: simulated now */
+	/* Holding times: each single gate's exit bin (0 stuck) and the time
+	 * steps it spent in the gate (to the step that left it, or gate_steps
+	 * if stuck), [entry * trials + trial] (map_HASH.hold.csv). NULL for a
+	 * map read without that file (built before holding times were kept):
+	 * the chain then has no times, and a build simulates it again. */
+	int *hold_exit, *hold_steps;
 } bsim_markov_map;
 
 /* The maps of one lattice: one per stiffness pair it uses. */
@@ -196,11 +203,43 @@ typedef struct bsim_markov_prediction {
 	int n_states;         /* transient states (gate, entry bin) */
 	int exact;            /* 1: p by LU, 0: by the sweeps */
 	int sweeps;           /* Gauss-Seidel sweeps that gave p (0: the series) */
+	/* Time to the outcome (the semi-Markov chain), when every map has
+	 * holding times (has_time 1; else 0 and the times NAN). mean_time: the
+	 * expected time of the outcome event, s (an exit, or the per-gate
+	 * limit), by first-step analysis: the sum over states of the expected
+	 * visits times the state's mean holding time, without the trial's
+	 * duration; short like p by what is left in the field. */
+	int has_time;
+	double mean_time;
+	/* Filled by bsim_markov_predict_time (walks 0 before): the outcome at
+	 * the trial's duration, as a lattice trial ends: stuck when a gate has
+	 * held the body gate_steps steps or when max_steps steps have passed
+	 * (duration = max_steps dt), else out at the end or a side. */
+	long walks;
+	double duration;    /* s */
+	double time_bin;    /* s, the width of p_time's bins */
+	int n_time_bins;    /* bins covering [0, duration] */
+	double *p_time;     /* [bin * 3 + kind] (end, side, stuck): probability the
+	                     * outcome happens in the bin (stuck: when it is declared) */
+	double p_by[3];     /* end, side, stuck at the duration */
+	double t_mean[3];   /* s, mean time of each kind's outcome (NAN if none) */
+	double t_sd[3];     /* s, its standard deviation over the walks */
+	double *p_loc_time; /* n_locations: the final locations at the duration */
 } bsim_markov_prediction;
 
 /* The series stops when less than this is left in the field: far below
  * the maps' own sampling error (a TV of 0.02 at 800 trials per bin). */
 #define BSIM_MARKOV_TOL 1e-6
+
+/* A tolerance tied to the maps' own sampling error: a transition
+ * probability estimated from T single gates has a standard error of at
+ * most 0.5 / sqrt(T); stopping with less than 1/16 of that in the field,
+ *   tol = 1 / (32 sqrt(T))     (1.1e-3 at 800 trials per bin),
+ * moves every location's p by at most tol and the total variation from the
+ * solution to 1e-12 by at most tol, against the maps' own 0.017 (mean TV of
+ * chains of resampled 800-trial maps on the C-track, docs/markov.md). T:
+ * the fewest trials per bin of set's maps. */
+BSIM_API double bsim_markov_tol_sampling(const bsim_markov_set *set);
 
 /* The chain of lattice composed from set's maps, solved; the series to
  * BSIM_MARKOV_TOL. */
@@ -221,6 +260,24 @@ BSIM_API int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_mark
                                       double tol, int flags, bsim_markov_prediction *out,
                                       bsim_error *err);
 BSIM_API void bsim_markov_prediction_free(bsim_markov_prediction *p);
+
+/* The distribution of the time to the outcome, by walks of the semi-Markov
+ * chain: each walk starts in the start state; in a gate of map m entered
+ * in bin a it takes one of the map's single gates of that bin (uniformly
+ * among its trials: the map's joint distribution of exit and holding
+ * time), adds its steps to the walk's and follows its exit, until the
+ * end, a side, a gate's limit (exit 0) or max_steps steps in all (then
+ * stuck in the gate it is in). Walks seeded from seed alone, one after the
+ * other: the same answer on any machine. The walks' own error on a
+ * probability p is sqrt(p (1 - p) / walks). Fills p's walks, duration,
+ * time_bin (the time step times an integer, about duration / 200),
+ * n_time_bins, p_time, p_by, t_mean, t_sd and p_loc_time; BSIM_EINPUT if a
+ * map has no holding times (naming the command that rebuilds it) or walks
+ * is not 1 to 1e8. */
+BSIM_API int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *set,
+                                      long walks, uint64_t seed, bsim_markov_prediction *p,
+                                      bsim_error *err);
+#define BSIM_MARKOV_WALKS 100000
 
 /* Writes p, the prediction of lattice by the chain of set's maps, into
  * the output directory dir: prediction.csv (location, kind, ix, iy, p:
@@ -287,6 +344,21 @@ typedef struct bsim_markov_check {
 	double sim_cpu;                /* s, the direct simulation */
 	double predict;                /* s, one prediction */
 	int n_states, exact;
+	/* Time to the outcome, when the maps have holding times (has_time; else
+	 * the times NAN): the trials out (the end or a side) by the trial's
+	 * duration, simulated (t_exit, trials.csv's) against the chain's
+	 * BSIM_MARKOV_WALKS walks (bsim_markov_predict_time). Intervals: 95%,
+	 * Wilson's for shares, 1.96 standard errors for means; the walks' and
+	 * the simulation's sampling errors in the difference's, the maps' not. */
+	int has_time;
+	double out_sim, out_sim_lo, out_sim_hi; /* share out by the duration */
+	double out_chain;                       /* the walks' */
+	double t_out_sim, t_out_sim_ci;         /* s, mean exit time of those out, +- */
+	double t_out_chain, t_out_chain_ci;     /* s, the walks' */
+	double t_out_diff_ci;                   /* s, +- of t_out_chain - t_out_sim */
+	double t_ks;   /* sup over the time grid of |P(out by t) simulated - chain| */
+	double t_ks95; /* the simulation's own 95% band on it (Dvoretzky-Kiefer-Wolfowitz,
+	                * sqrt(ln(2 / 0.05) / (2 trials))) */
 } bsim_markov_check;
 
 typedef struct bsim_markov_validation {
@@ -298,6 +370,8 @@ typedef struct bsim_markov_validation {
 } bsim_markov_validation;
 
 /* Runs the validation and writes out: validate.json (every check),
+ * time_validate.csv (group, protocol, t, P(out by t) simulated and by the
+ * chain, on the chain's time grid; with holding times),
  * validate.csv (group, protocol, location, simulated p with its Wilson 95%
  * interval, predicted p), gates.csv (the distribution of gates visited,
  * simulated and predicted), their .mat twins, and the figure

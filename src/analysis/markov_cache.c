@@ -4,6 +4,9 @@
  *   DIR/map_HASH.key   the key text
  *   DIR/map_HASH.csv   entry,exit,count,...: the nonzero counts
  *   DIR/map_HASH.cost  the CPU time the map took to build
+ *   DIR/map_HASH.hold.csv  entry,trial,exit,steps: each single gate's exit
+ *                      and the time steps it spent in the gate (a map
+ *                      without it has no holding times)
  *   DIR/markov.json    the def of the last build, for bsim_markov_load
  * A map is reused only if its .key file holds the whole key text, so a
  * hash collision never reuses a map either. */
@@ -204,6 +207,86 @@ static const char *map_row(char *line, const bsim_markov_map *m, long v[3], doub
 	return NULL;
 }
 
+static const char HOLD_HEADER[] = "entry,trial,exit,steps";
+
+/* map_HASH.hold.csv into m->hold_exit and m->hold_steps (m->counts read):
+ * 1 if there, 0 if absent, -1 with err naming the line if malformed or if
+ * its exits do not count up to the map's counts. */
+static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
+{
+	const int nb = m->n_bins, T = m->trials;
+	const long units = (long)nb * T;
+	file_text t;
+	int absent = 0;
+	/* a row is at most four integers of 11 characters */
+	if (map_file(dir, m, "hold.csv", ((double)units + 1.0) * 48.0, &t, &absent, err) != BSIM_OK)
+		return -1;
+	if (absent)
+		return 0;
+	int *ex = malloc((size_t)units * sizeof *ex), *st = malloc((size_t)units * sizeof *st);
+	int *count = calloc((size_t)nb * nb, sizeof *count);
+	char *line = t.text, *nl = strchr(line, '\n');
+	long u = 0, lineno = 1;
+	int bad = !ex || !st || !count || !nl || (*nl = '\0', strcmp(line, HOLD_HEADER) != 0);
+	while (!bad && u < units) {
+		line = nl + 1;
+		lineno++;
+		nl = strchr(line, '\n'); /* every line has one: csv_text_check */
+		if (!nl) {
+			bad = 1;
+			break;
+		}
+		*nl = '\0';
+		long v[4];
+		char *c = line, *end = line;
+		for (int k = 0; k < 4 && !bad; k++) {
+			errno = 0;
+			v[k] = strtol(c, &end, 10);
+			bad = end == c || errno || *end != (k < 3 ? ',' : '\0');
+			c = end + 1;
+		}
+		bad = bad || v[0] != u / T || v[1] != u % T || v[2] < 0 || v[2] >= nb || v[3] < 1 ||
+		      v[3] > INT_MAX;
+		if (!bad) {
+			ex[u] = (int)v[2];
+			st[u] = (int)v[3];
+			count[(u / T) * nb + ex[u]]++;
+			u++;
+		}
+	}
+	if (!bad && *(nl + 1))
+		bad = 1, lineno++;
+	/* the same single gates as the counts */
+	for (long i = 0; !bad && i < (long)nb * nb; i++)
+		if (count[i] != m->counts[i])
+			bad = 2;
+	file_text_free(&t);
+	free(count);
+	if (bad) {
+		free(ex);
+		free(st);
+		char path[BSIM_PATH_MAX];
+		snprintf(path, sizeof path, "%s/map_%016llx.hold.csv", dir,
+		         (unsigned long long)m->key);
+		if (bad == 2)
+			bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s: its exits do not count up to the map's counts (map_%016llx."
+			        "csv): rebuild the maps with beamsim markov build",
+			        path, (unsigned long long)m->key);
+		else
+			bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s:%ld: expected a row entry,trial,exit,steps (exit 0 to %d, "
+			        "steps >= 1) for each of the %d bins x %d trials in order",
+			        path, lineno, nb - 1, nb, T);
+		return -1;
+	}
+	m->hold_exit = ex;
+	m->hold_steps = st;
+	return 1;
+}
+
 int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
@@ -315,7 +398,10 @@ int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 			return -1;
 		}
 	}
-	return 1;
+	free(m->hold_exit);
+	free(m->hold_steps);
+	m->hold_exit = m->hold_steps = NULL;
+	return hold_read(dir, m, err) < 0 ? -1 : 1;
 }
 
 int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_markov_bins *b,
@@ -352,6 +438,19 @@ int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_mar
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	fprintf(o.f, "cpu_seconds %.6g\nsteps %lld\n", m->cost, m->steps);
+	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (!m->hold_exit)
+		return BSIM_OK;
+	/* Each single gate's exit and holding time, for the time to the
+	 * outcome. */
+	snprintf(path, sizeof path, "%s/map_%016llx.hold.csv", stage, (unsigned long long)m->key);
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fprintf(o.f, "%s\n", HOLD_HEADER);
+	for (long u = 0; u < (long)m->n_bins * m->trials; u++)
+		fprintf(o.f, "%ld,%ld,%d,%d\n", u / m->trials, u % m->trials, m->hold_exit[u],
+		        m->hold_steps[u]);
 	return bsim_atomic_file_commit(&o, err);
 }
 

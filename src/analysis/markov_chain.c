@@ -27,7 +27,7 @@
  * walks each map's own rows (compressed sparse rows, contiguous exits and
  * probabilities) through a table of where each gate's exits lead, built
  * once; Q is composed only for the LU. */
-#include "beamsim/markov.h"
+#include "analysis/markov_internal.h"
 #include "beamsim/lattice_outcome.h"
 
 #include <gsl/gsl_linalg.h>
@@ -42,7 +42,26 @@
 typedef struct sparse_map {
 	int *first, *exit;
 	double *p;
+	double *hold; /* s, each row's mean holding time; NULL without holding times */
 } sparse_map;
+
+/* Row a's mean holding time, s: its single gates' steps times dt. */
+static int sparse_hold(sparse_map *s, const bsim_markov_map *m, double dt)
+{
+	const int nb = m->n_bins, T = m->trials;
+	if (!m->hold_steps)
+		return 0;
+	s->hold = malloc((size_t)nb * sizeof *s->hold);
+	if (!s->hold)
+		return -1;
+	for (int a = 0; a < nb; a++) {
+		long long sum = 0;
+		for (int t = 0; t < T; t++)
+			sum += m->hold_steps[(size_t)a * T + t];
+		s->hold[a] = (double)sum / T * dt;
+	}
+	return 0;
+}
 
 static int sparse_init(sparse_map *s, const bsim_markov_map *m)
 {
@@ -81,6 +100,7 @@ typedef struct chain {
 	int nb, cols, rows, n_loc, n_states;
 	int per_edge;   /* bins per edge */
 	int *gate_map;  /* gate -> map index */
+	int has_time;   /* every map has holding times */
 	sparse_map *sm; /* per map */
 	/* Where exit x of gate g leads, tgt[g nb + x]: a state, or n_states +
 	 * location. The series walks the maps' own rows through this table
@@ -93,20 +113,20 @@ typedef struct chain {
 	double *p;
 } chain;
 
-static void target(const chain *c, int g, int x, int *state, int *loc)
+void markov_exit_target(int cols, int rows, int nb, int g, int x, int *state, int *loc)
 {
-	const int ix = g % c->cols, iy = g / c->cols;
+	const int ix = g % cols, iy = g / cols, per_edge = (nb - 1) / 4;
 	*state = -1;
 	*loc = -1;
 	if (x == 0) {
-		*loc = c->cols + c->rows + g;
+		*loc = cols + rows + g;
 		return;
 	}
-	int edge = BSIM_EDGE_BOTTOM + (x - 1) / c->per_edge;
+	int edge = BSIM_EDGE_BOTTOM + (x - 1) / per_edge;
 	int jx = ix, jy = iy;
 	switch (edge) {
 	case BSIM_EDGE_BOTTOM: /* into the gate above */
-		if (++jy == c->rows) {
+		if (++jy == rows) {
 			*loc = ix;
 			return;
 		}
@@ -114,23 +134,28 @@ static void target(const chain *c, int g, int x, int *state, int *loc)
 	case BSIM_EDGE_TOP: /* into the gate below */
 		if (--jy < 0) {
 			jy = 0;
-			x -= (BSIM_EDGE_TOP - BSIM_EDGE_BOTTOM) * c->per_edge;
+			x -= (BSIM_EDGE_TOP - BSIM_EDGE_BOTTOM) * per_edge;
 		}
 		break;
 	case BSIM_EDGE_LEFT: /* into the gate on the right */
-		if (++jx == c->cols) {
-			*loc = c->cols + iy;
+		if (++jx == cols) {
+			*loc = cols + iy;
 			return;
 		}
 		break;
 	default: /* into the gate on the left */
 		if (--jx < 0) {
-			*loc = c->cols + iy;
+			*loc = cols + iy;
 			return;
 		}
 		break;
 	}
-	*state = (jy * c->cols + jx) * c->nb + x;
+	*state = (jy * cols + jx) * nb + x;
+}
+
+static void target(const chain *c, int g, int x, int *state, int *loc)
+{
+	markov_exit_target(c->cols, c->rows, c->nb, g, x, state, loc);
 }
 
 void bsim_markov_prediction_free(bsim_markov_prediction *p)
@@ -140,6 +165,8 @@ void bsim_markov_prediction_free(bsim_markov_prediction *p)
 	free(p->loc);
 	free(p->p);
 	free(p->p_gates);
+	free(p->p_time);
+	free(p->p_loc_time);
 	memset(p, 0, sizeof *p);
 }
 
@@ -149,6 +176,7 @@ static void chain_free(chain *c, int n_maps)
 		free(c->sm[i].first);
 		free(c->sm[i].exit);
 		free(c->sm[i].p);
+		free(c->sm[i].hold);
 	}
 	free(c->sm);
 	free(c->gate_map);
@@ -179,8 +207,10 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 		if (set->maps[i].n_bins != c->nb)
 			return bsim_error_set(err, BSIM_EINPUT, "map %d has %d bins, the set %d", i,
 			                      set->maps[i].n_bins, c->nb);
-		if (sparse_init(&c->sm[i], &set->maps[i]) != 0)
+		if (sparse_init(&c->sm[i], &set->maps[i]) != 0 ||
+		    sparse_hold(&c->sm[i], &set->maps[i], lattice->dt) != 0)
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		c->has_time = i == 0 ? c->sm[i].hold != NULL : c->has_time && c->sm[i].hold;
 	}
 	for (int iy = 0; iy < c->rows; iy++)
 		for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
@@ -245,8 +275,10 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 /* Out of line (as sweeps()): both inlined into their one caller, the
  * series took 2.2 times as long (perf stat, C-track, 800-trial maps). */
 __attribute__((noinline)) static int series(const chain *c, int start, double tol, double *p_loc,
-                                            double **p_gates, int *n_gates, double *left)
+                                            double **p_gates, int *n_gates, double *left,
+                                            double *time)
 {
+	double tm = 0.0; /* s, the sum of each state's mass times its mean holding time */
 	const int n = c->n_states, nb = c->nb, G = c->cols * c->rows;
 	double *cur = calloc((size_t)n + c->n_loc, sizeof *cur);
 	double *next = calloc((size_t)n + c->n_loc, sizeof *next);
@@ -283,11 +315,14 @@ __attribute__((noinline)) static int series(const chain *c, int start, double to
 			const double *restrict pr = sm->p;
 			const int *restrict tg = c->tgt + (size_t)g * nb;
 			double *restrict cg = cur + (size_t)g * nb;
+			const double *restrict hb = sm->hold;
 			for (int a = 0; a < nb; a++) {
 				const double m = cg[a];
 				if (m == 0.0)
 					continue;
 				cg[a] = 0.0;
+				if (hb)
+					tm += m * hb[a];
 				const int j1 = first[a + 1];
 				for (int j = first[a]; j < j1; j++)
 					next[tg[ex[j]]] += m * pr[j];
@@ -327,6 +362,7 @@ __attribute__((noinline)) static int series(const chain *c, int start, double to
 	*p_gates = pg;
 	*n_gates = k;
 	*left = in_field;
+	*time = tm;
 	return 0;
 }
 
@@ -355,14 +391,69 @@ __attribute__((noinline)) static int series(const chain *c, int start, double to
  * same at any thread count. y is summed into *visits: the expected number
  * of gates entered, the start counted, short by what r has still to
  * visit. */
-__attribute__((noinline)) static int sweeps(const chain *c, int start, double tol, double *p_loc,
-                                            double *visits, double *left, int *n_sweeps)
+/* The sweeps' layout. The field is padded with a ring of ghost gates,
+ * W = cols + 2 to a row, and each gate holds S = nb + 1 doubles: its entry
+ * bins and, last, the probability stuck in it. Exit x of any gate then
+ * lands at a fixed offset from the gate's first bin:
+ *   x = 0 (stuck)                  nb
+ *   bottom-edge bins (gate above)  W S + x
+ *   left-edge bins (gate right)    S + x
+ *   right-edge bins (gate left)    -S + x
+ *   top-edge bins (gate below)     -W S + x
+ * so each map's row is a list of (offset, probability) and the inner loop
+ * is one load of each and one add, with no table per gate and no test for
+ * the field's edge. After each sweep the ghosts are emptied: those above
+ * the last row into the ends, those beside the outer columns into the
+ * sides, the stuck slots into the stuck gates, and those below row 0 back
+ * into row 0 through its bottom edge (same position, speed and direction
+ * bins) to be passed on in the next sweep. */
+static int exit_offset(int x, int nb, int W)
 {
-	const int n = c->n_states, nb = c->nb, G = c->cols * c->rows;
-	double *r = calloc((size_t)n + c->n_loc, sizeof *r);
-	if (!r)
+	const int S = nb + 1, per_edge = (nb - 1) / 4;
+	if (x == 0)
+		return nb;
+	switch (BSIM_EDGE_BOTTOM + (x - 1) / per_edge) {
+	case BSIM_EDGE_BOTTOM:
+		return W * S + x;
+	case BSIM_EDGE_LEFT:
+		return S + x;
+	case BSIM_EDGE_RIGHT:
+		return -S + x;
+	default:
+		return -W * S + x;
+	}
+}
+
+__attribute__((noinline)) static int sweeps(const chain *c, int n_maps, int start, double tol,
+                                            double *p_loc, double *visits, double *left,
+                                            int *n_sweeps, double *time)
+{
+	double tm = 0.0; /* s, as vis with each push weighted by its mean holding time */
+	const int nb = c->nb, cols = c->cols, rows = c->rows, G = cols * rows;
+	const int W = cols + 2, S = nb + 1, per_edge = (nb - 1) / 4;
+	double *r = calloc((size_t)W * (rows + 2) * S, sizeof *r);
+	int **off = calloc((size_t)n_maps, sizeof *off);
+	int *base = malloc((size_t)G * sizeof *base);
+	int ok = r && off && base;
+	for (int i = 0; ok && i < n_maps; i++) {
+		const sparse_map *sm = &c->sm[i];
+		const int nnz = sm->first[nb];
+		off[i] = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof **off);
+		ok = off[i] != NULL;
+		for (int j = 0; ok && j < nnz; j++)
+			off[i][j] = exit_offset(sm->exit[j], nb, W);
+	}
+	if (!ok) {
+		for (int i = 0; off && i < n_maps; i++)
+			free(off[i]);
+		free(off);
+		free(base);
+		free(r);
 		return -1;
-	r[start] = 1.0;
+	}
+	for (int g = 0; g < G; g++)
+		base[g] = ((g / cols + 1) * W + g % cols + 1) * S;
+	r[base[start / nb] + start % nb] = 1.0;
 	double in_field = 1.0, vis = 0.0;
 	int k = 0;
 	while (in_field > tol && k < SERIES_MAX) {
@@ -370,11 +461,11 @@ __attribute__((noinline)) static int sweeps(const chain *c, int start, double to
 		const int back = !(k & 1);
 		for (int gi = 0; gi < G; gi++) {
 			const int g = back ? G - 1 - gi : gi;
-			const sparse_map *sm = &c->sm[c->gate_map[g]];
-			const int *restrict first = sm->first, *restrict ex = sm->exit;
-			const double *restrict pr = sm->p;
-			const int *restrict tg = c->tgt + (size_t)g * nb;
-			double *restrict rg = r + (size_t)g * nb;
+			const int mi = c->gate_map[g];
+			const sparse_map *sm = &c->sm[mi];
+			const int *restrict first = sm->first, *restrict of = off[mi];
+			const double *restrict pr = sm->p, *restrict hb = sm->hold;
+			double *rg = r + base[g];
 			for (int ai = 0; ai < nb; ai++) {
 				const int a = back ? nb - 1 - ai : ai;
 				const double m = rg[a];
@@ -382,29 +473,60 @@ __attribute__((noinline)) static int sweeps(const chain *c, int start, double to
 					continue;
 				rg[a] = 0.0;
 				vis += m;
+				if (hb)
+					tm += m * hb[a];
 				const int j1 = first[a + 1];
 				for (int j = first[a]; j < j1; j++)
-					r[tg[ex[j]]] += m * pr[j];
+					rg[of[j]] += m * pr[j];
 			}
 		}
-		for (int l = 0; l < c->n_loc; l++) {
-			p_loc[l] += r[n + l];
-			r[n + l] = 0.0;
+		/* the ghosts and the stuck slots emptied */
+		for (int ix = 0; ix < cols; ix++) {
+			double *end = r + ((size_t)(rows + 1) * W + ix + 1) * S;
+			double *below = r + ((size_t)ix + 1) * S, *row0 = r + base[ix];
+			for (int x = 0; x < S; x++) {
+				p_loc[ix] += end[x];
+				end[x] = 0.0;
+			}
+			for (int x = 1 + 3 * per_edge; x < nb; x++) {
+				row0[x - 3 * per_edge] += below[x];
+				below[x] = 0.0;
+			}
 		}
+		for (int iy = 0; iy < rows; iy++)
+			for (int side = 0; side < 2; side++) {
+				double *gh = r + ((size_t)(iy + 1) * W + (side ? W - 1 : 0)) * S;
+				for (int x = 0; x < S; x++) {
+					p_loc[cols + iy] += gh[x];
+					gh[x] = 0.0;
+				}
+			}
 		in_field = 0.0;
-		for (int a = 0; a < n; a++)
-			in_field += r[a];
+		for (int g = 0; g < G; g++) {
+			double *rg = r + base[g];
+			p_loc[cols + rows + g] += rg[nb];
+			rg[nb] = 0.0;
+			for (int a = 0; a < nb; a++)
+				in_field += rg[a];
+		}
 	}
+	for (int i = 0; i < n_maps; i++)
+		free(off[i]);
+	free(off);
+	free(base);
 	free(r);
 	*visits = vis;
 	*left = in_field;
 	*n_sweeps = k;
+	*time = tm;
 	return 0;
 }
 
-/* p_loc by LU of (I - Q)^T y = e_start. */
-static int lu_solve(const chain *c, int start, double *p_loc)
+/* p_loc by LU of (I - Q)^T y = e_start; *time the sum of the visits y
+ * times each state's mean holding time (with holding times). */
+static int lu_solve(const chain *c, int start, double *p_loc, double *time)
 {
+	*time = 0.0;
 	const int n = c->n_states;
 	gsl_matrix *A = gsl_matrix_calloc((size_t)n, (size_t)n);
 	gsl_vector *e = gsl_vector_calloc((size_t)n);
@@ -429,6 +551,9 @@ static int lu_solve(const chain *c, int start, double *p_loc)
 		double visits = gsl_vector_get(y, (size_t)s);
 		if (visits == 0.0)
 			continue;
+		const sparse_map *sm = &c->sm[c->gate_map[s / c->nb]];
+		if (sm->hold)
+			*time += visits * sm->hold[s % c->nb];
 		for (int j = c->first[s]; j < c->first[s + 1]; j++)
 			if (c->to[j] < 0)
 				p_loc[-1 - c->to[j]] += visits * c->p[j];
@@ -440,6 +565,14 @@ done:
 	gsl_vector_free(y);
 	gsl_permutation_free(perm);
 	return rc;
+}
+
+double bsim_markov_tol_sampling(const bsim_markov_set *set)
+{
+	int T = set->n > 0 ? set->maps[0].trials : set->def.trials;
+	for (int i = 1; i < set->n; i++)
+		T = set->maps[i].trials < T ? set->maps[i].trials : T;
+	return 1.0 / (32.0 * sqrt(T > 1 ? (double)T : 1.0));
 }
 
 int bsim_markov_predict(const bsim_scene *lattice, const bsim_markov_set *set,
@@ -491,14 +624,14 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 		if (flags & BSIM_MARKOV_GATES) {
 			/* The series: p and the distribution of gates visited. */
 			if (series(&c, start, tol, out->p, &out->p_gates, &out->n_gates,
-			           &out->left_in_field))
+			           &out->left_in_field, &out->mean_time))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 			for (int k = 1; rc == BSIM_OK && k <= out->n_gates; k++)
 				out->mean_gates += k * out->p_gates[k];
 		} else {
 			/* The sweeps: p and the expected visits alone. */
-			if (sweeps(&c, start, tol, out->p, &out->mean_gates, &out->left_in_field,
-			           &out->sweeps) ||
+			if (sweeps(&c, set->n, start, tol, out->p, &out->mean_gates,
+			           &out->left_in_field, &out->sweeps, &out->mean_time) ||
 			    !(out->p_gates = calloc(1, sizeof *out->p_gates)))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
@@ -511,7 +644,7 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 			else {
 				memcpy(by_series, out->p, (size_t)c.n_loc * sizeof *out->p);
 				memset(out->p, 0, (size_t)c.n_loc * sizeof *out->p);
-				if (lu_solve(&c, start, out->p))
+				if (lu_solve(&c, start, out->p, &out->mean_time))
 					rc = bsim_error_set(
 					        err, BSIM_EFAIL,
 					        "the chain's LU solve failed (out of memory or a "
@@ -529,6 +662,9 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 			}
 			out->exact = 1;
 		}
+		out->has_time = c.has_time;
+		if (!c.has_time)
+			out->mean_time = NAN;
 	}
 	chain_free(&c, set->n);
 	if (rc != BSIM_OK)

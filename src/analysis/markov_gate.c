@@ -231,12 +231,17 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 	const int nb = m->n_bins, T = def->trials;
 	const long units = (long)nb * T;
 	int *exit = malloc((size_t)units * sizeof *exit);
-	if (!exit)
+	int *held = malloc((size_t)units * sizeof *held);
+	if (!exit || !held) {
+		free(exit);
+		free(held);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
 	markov_entry_index ex = {0};
 	if (def->entries &&
 	    markov_entry_index_init(&ex, def->entries, &def->bins, &lattice->lattice)) {
 		free(exit);
+		free(held);
 		markov_entry_index_free(&ex);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
@@ -281,6 +286,7 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 			r.run = runs ? &runs[u] : NULL;
 			exit[u] = gate_trial(&r, lattice, def, be, opts, (int)(u / T), (int)(u % T),
 			                     &e);
+			held[u] = (int)r.steps;
 #pragma omp atomic
 			steps += r.steps;
 			if (exit[u] < 0) {
@@ -312,7 +318,15 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 	for (long u = 0; !failed && u < units; u++)
 		m->counts[(u / T) * nb + exit[u]]++;
 	m->steps += steps;
+	if (!failed) { /* the holding times: the map keeps both arrays */
+		free(m->hold_exit);
+		free(m->hold_steps);
+		m->hold_exit = exit;
+		m->hold_steps = held;
+		exit = held = NULL;
+	}
 	free(exit);
+	free(held);
 	markov_entry_index_free(&ex);
 	return stopped ? BSIM_ESTOPPED : failed ? BSIM_EFAIL : BSIM_OK;
 }

@@ -119,12 +119,24 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                          int n, const char *have, const char *dir, const char *stage, long *done,
                          long total, bsim_error *err);
 
+/* Moves from's holding times into to (to's freed first). */
+void markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from);
+
 /* Map m by def's self-consistent passes, starting from the last pass in
  * dir; each pass simulated now written into stage (map and exits). */
 int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                          const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
                          const char *dir, const char *stage, long *done, long total,
                          bsim_error *err);
+
+/* ---- the chain's exits (markov_chain.c) ---- */
+
+/* Where exit x (0 stuck, else an entry bin of the gate entered) of gate g =
+ * iy cols + ix - ix_min of a cols x rows field leads: *state = g' nb + bin
+ * (>= 0), a transient state, or *state = -1 and *loc the final location,
+ * in bsim_markov_prediction's order (ends, sides, stuck gates). A body
+ * leaving row 0 downwards enters row 0's gate again through its bottom. */
+void markov_exit_target(int cols, int rows, int nb, int g, int x, int *state, int *loc);
 
 /* ---- the map directory (markov_cache.c) ---- */
 

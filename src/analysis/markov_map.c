@@ -123,6 +123,8 @@ void bsim_markov_set_free(bsim_markov_set *s)
 	for (int i = 0; i < s->n; i++) {
 		free(s->maps[i].key_text);
 		free(s->maps[i].counts);
+		free(s->maps[i].hold_exit);
+		free(s->maps[i].hold_steps);
 	}
 	free(s->maps);
 	memset(s, 0, sizeof *s);
@@ -174,6 +176,14 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		if (rc != BSIM_OK)
 			break;
 		int got = markov_map_read(dir, m, err);
+		if (got > 0 && stage && !m->hold_exit) {
+			/* built before holding times were kept: simulated again
+			 * (the same seeds: the same counts) with them */
+			memset(m->counts, 0, (size_t)m->n_bins * m->n_bins * sizeof *m->counts);
+			m->cost = 0.0;
+			m->steps = 0;
+			got = 0;
+		}
 		if (got < 0)
 			rc = BSIM_EINPUT;
 		else if (got)
@@ -267,9 +277,9 @@ static int maps_listed(const char *dir, const bsim_markov_set *set, bsim_error *
 	char **files = NULL;
 	size_t n = 0;
 	int rc = bsim_outdir_files(dir, &files, &n, err);
-	static const char *const ext[] = {"key", "csv", "cost"};
+	static const char *const ext[] = {"key", "csv", "cost", "hold.csv"};
 	for (int i = 0; rc == BSIM_OK && n > 0 && i < set->n; i++)
-		for (int e = 0; rc == BSIM_OK && e < 3; e++) {
+		for (int e = 0; rc == BSIM_OK && e < 4; e++) {
 			char name[64];
 			snprintf(name, sizeof name, "map_%016llx.%s",
 			         (unsigned long long)set->maps[i].key, ext[e]);

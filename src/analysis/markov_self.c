@@ -204,6 +204,8 @@ static void pass_map_free(bsim_markov_map *q)
 {
 	free(q->key_text);
 	free(q->counts);
+	free(q->hold_exit);
+	free(q->hold_steps);
 }
 
 /* The last pass below def->self_passes whose map and exits are in dir,
@@ -235,6 +237,15 @@ static int last_cached(const bsim_scene *lattice, const bsim_markov_def *def,
 			return -2;
 	}
 	return -1;
+}
+
+void markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from)
+{
+	free(to->hold_exit);
+	free(to->hold_steps);
+	to->hold_exit = from->hold_exit;
+	to->hold_steps = from->hold_steps;
+	from->hold_exit = from->hold_steps = NULL;
 }
 
 int markov_self_passes_left(const bsim_scene *lattice, const bsim_markov_def *def,
@@ -294,8 +305,10 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			rc = markov_map_write(stage, &mq, &def->bins, err);
 		if (rc == BSIM_OK)
 			rc = runs_write(stage, mq.key, cur, nb, T, err);
-		if (rc == BSIM_OK && q == def->self_passes)
+		if (rc == BSIM_OK && q == def->self_passes) {
 			memcpy(m->counts, mq.counts, (size_t)nb * nb * sizeof *m->counts);
+			markov_map_take_hold(m, &mq);
+		}
 		pass_map_free(&mq);
 		markov_run *tmp = prev;
 		prev = cur;
@@ -505,9 +518,11 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 				rc = markov_map_write(stage, &mq, &def->bins, err);
 			if (rc == BSIM_OK && (!last || !have[b]))
 				rc = runs_write(stage, mq.key, cur[b], nb, T, err);
-			if (rc == BSIM_OK && last)
+			if (rc == BSIM_OK && last) {
 				memcpy(maps[b].counts, mq.counts,
 				       (size_t)nb * nb * sizeof *mq.counts);
+				markov_map_take_hold(&maps[b], &mq);
+			}
 			pass_map_free(&mq);
 		}
 		markov_run **tmp = prev;

@@ -160,6 +160,67 @@ static int time_predict(const bsim_scene *scene, const bsim_markov_set *set, dou
 
 static const char *const protocol_names[] = {"essay", "world"};
 
+/* The time to the outcome of T simulated trials t against the chain's
+ * walks in pred: the checks' time fields, and *cdf (allocated) the
+ * simulated P(out by the end of each of pred's time bins). */
+static int time_check(const bsim_markov_prediction *pred, const bsim_trial_result *t, int T,
+                      double **cdf, bsim_markov_check *c, bsim_error *err)
+{
+	const int nb = pred->n_time_bins;
+	double *f = calloc((size_t)nb, sizeof *f);
+	if (!f)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	long out = 0;
+	double sum = 0.0, sum2 = 0.0;
+	for (int i = 0; i < T; i++) {
+		if (bsim_lattice_location_of(&t[i]).kind == BSIM_LOCATION_STUCK)
+			continue;
+		out++;
+		sum += t[i].t_end;
+		sum2 += t[i].t_end * t[i].t_end;
+		/* the walks' bin: [b bin, (b + 1) bin) */
+		long b = (long)floor(t[i].t_end / pred->time_bin + 1e-9);
+		b = b < 0 ? 0 : b >= nb ? nb - 1 : b;
+		f[b] += 1.0 / T;
+	}
+	for (int b = 1; b < nb; b++)
+		f[b] += f[b - 1];
+	c->has_time = 1;
+	c->out_sim = (double)out / T;
+	bsim_stats_wilson((int)out, T, BSIM_STATS_Z95, &c->out_sim_lo, &c->out_sim_hi);
+	c->out_chain = pred->p_by[0] + pred->p_by[1];
+	c->t_out_sim = out > 0 ? sum / out : NAN;
+	double var = out > 1 ? (sum2 - sum * sum / out) / (out - 1) : NAN;
+	c->t_out_sim_ci = out > 1 ? 1.96 * sqrt(fmax(var, 0.0) / out) : NAN;
+	/* the walks out: end and side pooled */
+	const double w = (double)pred->walks, n0 = pred->p_by[0] * w, n1 = pred->p_by[1] * w;
+	const double nw = n0 + n1;
+	double m = NAN, s2 = 0.0;
+	if (nw > 0) {
+		const double m0 = n0 > 0 ? pred->t_mean[0] : 0.0,
+		             m1 = n1 > 0 ? pred->t_mean[1] : 0.0;
+		m = (n0 * m0 + n1 * m1) / nw;
+		/* pooled variance: within kinds plus between */
+		const double v0 = n0 > 1 ? pred->t_sd[0] * pred->t_sd[0] : 0.0,
+		             v1 = n1 > 1 ? pred->t_sd[1] * pred->t_sd[1] : 0.0;
+		s2 = (fmax(n0 - 1, 0) * v0 + fmax(n1 - 1, 0) * v1 + n0 * (m0 - m) * (m0 - m) +
+		      n1 * (m1 - m) * (m1 - m)) /
+		     fmax(nw - 1, 1);
+	}
+	c->t_out_chain = m;
+	c->t_out_chain_ci = nw > 1 ? 1.96 * sqrt(s2 / nw) : NAN;
+	c->t_out_diff_ci = hypot(c->t_out_sim_ci, c->t_out_chain_ci);
+	double chain = 0.0, ks = 0.0;
+	for (int b = 0; b < nb; b++) {
+		chain += pred->p_time[b * 3] + pred->p_time[b * 3 + 1];
+		ks = fmax(ks, fabs(f[b] - chain));
+	}
+	c->t_ks = ks;
+	c->t_ks95 = sqrt(log(2.0 / 0.05) / (2.0 * T));
+	*cdf = f;
+	return BSIM_OK;
+}
+
 /* ---- files ------------------------------------------------------------------ */
 
 typedef struct group_data {
@@ -168,7 +229,8 @@ typedef struct group_data {
 	int trials[2];
 	double *gates_sim[2]; /* [k] for k = 0 .. n_gates_sim[i] */
 	int n_gates_sim[2];
-	char title[400]; /* backend and parameters, for the figure */
+	char title[400];        /* backend and parameters, for the figure */
+	double *cdf_out_sim[2]; /* P(out by the end of each time bin), simulated */
 } group_data;
 
 static int write_csv(const char *stage, const bsim_experiment *e, const bsim_markov_validation *v,
@@ -209,6 +271,25 @@ static int write_csv(const char *stage, const bsim_experiment *e, const bsim_mar
 				fprintf(o.f, "%d,chain,%d,%.9g\n", g, k, gd[g].pred.p_gates[k]);
 	}
 	(void)v;
+	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	if (!gd[0].pred.walks)
+		return BSIM_OK;
+	snprintf(path, sizeof path, "%s/time_validate.csv", stage);
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fputs("group,protocol,t,out_sim,out_chain\n", o.f);
+	for (int g = 0; g < e->n_groups; g++) {
+		const bsim_markov_prediction *p = &gd[g].pred;
+		for (int pr = 0; pr < 2 && gd[g].cdf_out_sim[pr]; pr++) {
+			double chain = 0.0;
+			for (int b = 0; b < p->n_time_bins; b++) {
+				chain += p->p_time[b * 3] + p->p_time[b * 3 + 1];
+				fprintf(o.f, "%d,%s,%.9g,%.9g,%.9g\n", g, protocol_names[pr],
+				        (b + 1) * p->time_bin, gd[g].cdf_out_sim[pr][b], chain);
+			}
+		}
+	}
 	return bsim_atomic_file_commit(&o, err);
 }
 
@@ -255,8 +336,25 @@ static int write_json(const char *stage, const bsim_markov_validate_def *def,
 		bsim_json_number(f, c->sim_cpu / c->predict);
 		fputs(", \"break_even_lattices\": ", f);
 		bsim_json_number(f, saved > 0 ? ceil(v->map_cost / saved) : NAN);
-		fprintf(f, ", \"states\": %d, \"exact\": %s}", c->n_states,
+		fprintf(f, ", \"states\": %d, \"exact\": %s", c->n_states,
 		        c->exact ? "true" : "false");
+		if (c->has_time) {
+			const char *const key[] = {"out_sim",     "out_sim_lo",     "out_sim_hi",
+			                           "out_chain",   "t_out_sim",      "t_out_sim_ci",
+			                           "t_out_chain", "t_out_chain_ci", "t_out_diff_ci",
+			                           "t_ks",        "t_ks95"};
+			const double val[] = {c->out_sim,     c->out_sim_lo,     c->out_sim_hi,
+			                      c->out_chain,   c->t_out_sim,      c->t_out_sim_ci,
+			                      c->t_out_chain, c->t_out_chain_ci, c->t_out_diff_ci,
+			                      c->t_ks,        c->t_ks95};
+			fputs(", \"time\": {", f);
+			for (int k = 0; k < 11; k++) {
+				fprintf(f, "%s\"%s\": ", k ? ", " : "", key[k]);
+				bsim_json_number(f, val[k]);
+			}
+			fputc('}', f);
+		}
+		fputc('}', f);
 	}
 	fputs("\n]}\n", f);
 	return bsim_atomic_file_commit(&o, err);
@@ -333,6 +431,9 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 	rc = bsim_markov_load(&scene, def->map_dir, &opts, &set, err);
 	if (rc == BSIM_OK)
 		rc = bsim_markov_predict(&scene, &set, &d->pred, err);
+	if (rc == BSIM_OK && d->pred.has_time)
+		rc = bsim_markov_predict_time(&scene, &set, BSIM_MARKOV_WALKS, set.def.seed,
+		                              &d->pred, err);
 	double predict = 0.0, tv_map = NAN;
 	if (rc == BSIM_OK)
 		rc = time_predict(&scene, &set, &predict, err);
@@ -402,6 +503,8 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 		c->predict = predict;
 		c->n_states = d->pred.n_states;
 		c->exact = d->pred.exact;
+		if (d->pred.walks > 0)
+			rc = time_check(&d->pred, t, T, &d->cdf_out_sim[pr], c, err);
 	}
 	bsim_markov_set_free(&set);
 	bsim_scene_free(&scene);
@@ -483,6 +586,12 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		rc = i == 2 ? bsim_matlab_from_json(src, mat, twins[i][1], err)
 		            : bsim_matlab_from_csv(src, mat, twins[i][1], err);
 	}
+	if (rc == BSIM_OK && e.n_groups > 0 && gd[0].pred.walks > 0) {
+		char src[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
+		snprintf(src, sizeof src, "%s/time_validate.csv", ss.stage);
+		snprintf(mat, sizeof mat, "%s/time_validate.mat", ss.stage);
+		rc = bsim_matlab_from_csv(src, mat, "time_validate", err);
+	}
 	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++)
 		rc = write_figure(ss.stage, g, &gd[g], out, NULL, err);
 	rc = bsim_session_close(&ss, rc, "markov validate", NULL, err);
@@ -491,6 +600,7 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		for (int pr = 0; pr < 2; pr++) {
 			free(gd[g].p_sim[pr]);
 			free(gd[g].gates_sim[pr]);
+			free(gd[g].cdf_out_sim[pr]);
 		}
 	}
 	free(gd);

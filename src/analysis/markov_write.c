@@ -12,6 +12,7 @@
 #include "store/matlab.h"
 #include "store/session.h"
 #include "beamsim/limits.h"
+#include "util/figure.h"
 
 static int write_tables(const char *stage, const bsim_markov_prediction *p, bsim_error *err)
 {
@@ -64,6 +65,47 @@ static int write_figure(const char *stage, const bsim_scene *lattice, const bsim
 	                           NULL, err);
 }
 
+/* time.csv: the walks' distribution of the time to the outcome, a row a
+ * bin, with each kind's cumulative probability; and the figure time. */
+static int write_time(const char *stage, const bsim_scene *lattice, const bsim_markov_prediction *p,
+                      bsim_error *err)
+{
+	char path[BSIM_PATH_MAX];
+	bsim_atomic_file o;
+	snprintf(path, sizeof path, "%s/time.csv", stage);
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fputs("t_lo,t_hi,p_end,p_side,p_stuck,cdf_end,cdf_side,cdf_stuck\n", o.f);
+	double cdf[3] = {0, 0, 0};
+	for (int b = 0; b < p->n_time_bins; b++) {
+		const double *q = p->p_time + (size_t)b * 3;
+		for (int k = 0; k < 3; k++)
+			cdf[k] += q[k];
+		fprintf(o.f, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", b * p->time_bin,
+		        (b + 1) * p->time_bin, q[0], q[1], q[2], cdf[0], cdf[1], cdf[2]);
+	}
+	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	char body[1600];
+	snprintf(body, sizeof body,
+	         "set datafile separator ','\n"
+	         "set title \"%s: time to the outcome by %ld walks of the semi-Markov chain\\n"
+	         "out by the duration %g s: end %.4f, side %.4f; stuck %.4f\" noenhanced\n"
+	         "set xlabel 'time t (s)'\nset ylabel 'probability of the outcome by t'\n"
+	         "set key left top\nset grid\n"
+	         "plot 'time.csv' every ::1 using 2:6 with steps lw 2 lc rgb '#0072B2' "
+	         "title 'end', \\\n"
+	         "     '' every ::1 using 2:7 with steps lw 2 lc rgb '#D55E00' title 'side', "
+	         "\\\n"
+	         "     '' every ::1 using 2:8 with steps lw 2 lc rgb '#777777' title \"stuck "
+	         "(a gate's limit or the duration)\"\n",
+	         lattice->name, p->walks, p->duration, p->p_by[0], p->p_by[1], p->p_by[2]);
+	bsim_figure_def fd = bsim_figure_def_default();
+	fd.dir = stage;
+	fd.name = "time";
+	return bsim_figure_render(&fd, body, NULL, err);
+}
+
 int bsim_markov_prediction_store(const char *dir, const bsim_scene *lattice,
                                  const bsim_markov_set *set, const bsim_markov_prediction *p,
                                  bsim_error *err)
@@ -82,5 +124,13 @@ int bsim_markov_prediction_store(const char *dir, const bsim_scene *lattice,
 	}
 	if (rc == BSIM_OK)
 		rc = write_figure(ss.stage, lattice, set, p, err);
+	if (rc == BSIM_OK && p->walks > 0)
+		rc = write_time(ss.stage, lattice, p, err);
+	if (rc == BSIM_OK && p->walks > 0) {
+		char csv[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
+		snprintf(csv, sizeof csv, "%s/time.csv", ss.stage);
+		snprintf(mat, sizeof mat, "%s/time.mat", ss.stage);
+		rc = bsim_matlab_from_csv(csv, mat, "time", err);
+	}
 	return bsim_session_close(&ss, rc, "markov predict", NULL, err);
 }

@@ -27,7 +27,8 @@ enum {
 	OWN_LOCATIONS,
 	OWN_JSON,
 	OWN_TOL,
-	OWN_NO_GATES
+	OWN_NO_GATES,
+	OWN_WALKS
 };
 
 #define MAX_ENTRIES 16
@@ -39,6 +40,7 @@ typedef struct markov_args {
 	int locations, json; /* predict: --locations, --json */
 	int no_gates;        /* predict: --no-gates */
 	double tol;          /* predict: --tol */
+	long walks;          /* predict: --walks */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
 } markov_args;
@@ -118,15 +120,25 @@ static int markov_option(void *args, int i, const char *value)
 		a->json = 1;
 		return CLI_OK;
 	case OWN_TOL:
+		if (strcmp(value, "sampling") == 0) {
+			a->tol = -1.0; /* from the maps, once read */
+			return CLI_OK;
+		}
 		a->tol = strtod(value, &end);
 		if (end == value || *end || !(a->tol > 0.0 && a->tol < 1.0))
 			return cli_usage("markov predict",
 			                 "--tol %s: expected the probability left in the field at "
-			                 "which the solution stops, in (0, 1), e.g. 1e-12",
+			                 "which the solution stops, in (0, 1), e.g. 1e-12, or "
+			                 "sampling",
 			                 value);
 		return CLI_OK;
 	case OWN_NO_GATES:
 		a->no_gates = 1;
+		return CLI_OK;
+	case OWN_WALKS:
+		if (cli_parse_long(value, 0, 100000000L, &a->walks) != 0)
+			return cli_usage("markov predict",
+			                 "--walks %s: expected an integer 0 to 100000000", value);
 		return CLI_OK;
 	}
 	return CLI_USAGE;
@@ -183,10 +195,14 @@ static const cli_own predict_own[] = {
          "print one JSON object (totals, every location, predict_seconds)\ninstead of text"},
         {"tol", 1, "T",
          "stop when less than T is left in the field\n(default 1e-6; "
-         "each location's p is short by at most\nwhat is left)"},
+         "each location's p is short by at most\nwhat is left); sampling: 1 / (32 "
+         "sqrt(trials per bin)),\n1/16 of a map probability's standard error"},
         {"no-gates", 0, NULL,
          "skip the distribution of gates visited (its series):\nthe mean from the "
          "expected visits, faster"},
+        {"walks", 1, "N",
+         "walks of the semi-Markov chain for the distribution of\nthe time to the "
+         "outcome (default 100000; 0: none)"},
 };
 
 /* predict's and validate's own options: --map, then predict's --locations
@@ -202,8 +218,9 @@ static int predict_option(void *args, int i, const char *value)
 }
 
 static const char *const predict_help[CLI_N_OPTS] = {
-        [CLI_OPT_OUT] = "also write prediction.csv, prediction_gates.csv, their\n"
-                        ".mat twins and the figure prediction.png (the field) into DIR",
+        [CLI_OPT_OUT] = "also write prediction.csv, prediction_gates.csv, time.csv,\n"
+                        "their .mat twins and the figures prediction.png (the field)\n"
+                        "and time.png into DIR",
 };
 
 static const cli_spec predict_spec = {
@@ -214,13 +231,15 @@ static const cli_spec predict_spec = {
                  "a side and stuck in a gate, and the mean number of gates visited. The\n"
                  "distribution over every final location (the end through column ix, a side\n"
                  "at row iy, stuck in gate (ix, iy)) is --out DIR's prediction.csv, or\n"
-                 "printed with --locations or --json. The chain counts gates, not seconds:\n"
-                 "it has no expected time.\n",
+                 "printed with --locations or --json. With the maps' holding times it\n"
+                 "prints the expected time to the outcome (first-step analysis) and, by\n"
+                 "walks of the semi-Markov chain, the outcome at the trial's duration and\n"
+                 "the time of each kind (--out DIR's time.csv and time.png).\n",
         .positional = "LATTICE_SCENE",
         .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_QUIET),
         .help = predict_help,
         .own = predict_own,
-        .n_own = 5,
+        .n_own = 6,
         .option = predict_option,
 };
 
@@ -241,8 +260,10 @@ static const cli_spec validate_spec = {
                  "--map, and writes into --out: validate.json (total variation distance of\n"
                  "the final-location distributions with the simulation's and the maps'\n"
                  "sampling errors, mean gates visited, CPU time of simulation and\n"
-                 "prediction, the lattices after which building the maps pays off),\n"
-                 "validate.csv, gates.csv, their .mat twins and validate_gNNN (.png .svg).\n",
+                 "prediction, the lattices after which building the maps pays off; with\n"
+                 "the maps' holding times the exit times against the chain's walks),\n"
+                 "validate.csv, gates.csv, time_validate.csv, their .mat twins and\n"
+                 "validate_gNNN (.png .svg).\n",
         .positional = "LATTICE_EXPERIMENT",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
                   CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
@@ -377,7 +398,22 @@ static void predict_print(const char *path, const bsim_scene *scene, const bsim_
 	if (!p->exact || p->left_in_field > 1e-12)
 		printf(" (the %s stopped with %.2g still in the field)",
 		       p->sweeps ? "sweeps" : "series", p->left_in_field);
-	printf("\nexpected time: none (the chain counts gates, not seconds)\n");
+	if (p->has_time)
+		printf("\nexpected time to the outcome: %.2f s (first-step analysis, without the "
+		       "trial's duration)\n",
+		       p->mean_time);
+	else
+		printf("\nexpected time: none (maps built before holding times were kept: "
+		       "beamsim markov build simulates them again)\n");
+	if (p->walks > 0) {
+		printf("\nat the trial's duration, %g s (%ld walks of the semi-Markov chain; "
+		       "their error on a p: at most %.4f):\n"
+		       "outcome      p        mean time s   sd s\n",
+		       p->duration, p->walks, 0.5 / sqrt((double)p->walks));
+		for (int k = 0; k < 3; k++)
+			printf("%-12s %7.4f  %10.2f  %8.2f\n", kinds[k], p->p_by[k], p->t_mean[k],
+			       p->t_sd[k]);
+	}
 	if (locations) {
 		printf("\nlocation       p\n");
 		for (int i = 0; i < p->n_locations; i++) {
@@ -396,7 +432,7 @@ static void predict_print(const char *path, const bsim_scene *scene, const bsim_
 
 /* --json: one object with the totals and every final location. */
 static void predict_json(const char *path, const bsim_scene *scene, const bsim_markov_set *set,
-                         const bsim_markov_prediction *p, double seconds)
+                         const bsim_markov_prediction *p, double seconds, double cpu)
 {
 	static const char *const kinds[] = {"end", "side", "stuck"};
 	double total[3];
@@ -424,8 +460,28 @@ static void predict_json(const char *path, const bsim_scene *scene, const bsim_m
 	fputs(", \"tol\": ", f);
 	bsim_json_number(f, p->tol);
 	fprintf(f, ", \"sweeps\": %d", p->sweeps);
+	fputs(", \"mean_time\": ", f);
+	bsim_json_number(f, p->mean_time);
+	if (p->walks > 0) {
+		fprintf(f, ", \"walks\": %ld, \"duration\": ", p->walks);
+		bsim_json_number(f, p->duration);
+		fputs(", \"at_duration\": {", f);
+		for (int k = 0; k < 3; k++) {
+			fprintf(f, "%s\"%s\": {\"p\": ", k ? ", " : "", kinds[k]);
+			bsim_json_number(f, p->p_by[k]);
+			fputs(", \"mean_time\": ", f);
+			bsim_json_number(f, p->t_mean[k]);
+			fputs(", \"sd_time\": ", f);
+			bsim_json_number(f, p->t_sd[k]);
+			fputc('}', f);
+		}
+		fputc('}', f);
+	}
 	fputs(", \"predict_seconds\": ", f);
 	bsim_json_number(f, seconds);
+	/* the CPU time of the same: what it costs on a machine others share */
+	fputs(", \"predict_cpu_seconds\": ", f);
+	bsim_json_number(f, cpu);
 	fputs(", \"locations\": [", f);
 	for (int i = 0; i < p->n_locations; i++) {
 		char label[48];
@@ -446,7 +502,9 @@ static void predict_json(const char *path, const bsim_scene *scene, const bsim_m
 static int markov_predict(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	markov_args a = {.def = bsim_markov_def_default(), .tol = BSIM_MARKOV_TOL};
+	markov_args a = {.def = bsim_markov_def_default(),
+	                 .tol = BSIM_MARKOV_TOL,
+	                 .walks = BSIM_MARKOV_WALKS};
 	const char *path = NULL;
 	int rc = cli_parse(&predict_spec, argc, argv, &c, &a, &path);
 	if (rc < 0 && !a.map)
@@ -467,16 +525,20 @@ static int markov_predict(int argc, char **argv)
 	rc = bsim_markov_load(&scene, a.map, &opts, &set, &err);
 	/* The wall time of the prediction alone (the chain composed and
 	 * solved; the maps already read). */
-	double t0 = bsim_clock_seconds();
+	if (rc == BSIM_OK && a.tol < 0)
+		a.tol = bsim_markov_tol_sampling(&set);
+	double t0 = bsim_clock_seconds(), c0 = bsim_clock_thread_cpu_seconds();
 	if (rc == BSIM_OK)
 		rc = bsim_markov_predict_with(&scene, &set, a.tol,
 		                              a.no_gates ? 0 : BSIM_MARKOV_GATES, &p, &err);
-	double seconds = bsim_clock_seconds() - t0;
+	double seconds = bsim_clock_seconds() - t0, cpu = bsim_clock_thread_cpu_seconds() - c0;
+	if (rc == BSIM_OK && p.has_time && a.walks > 0)
+		rc = bsim_markov_predict_time(&scene, &set, a.walks, set.def.seed, &p, &err);
 	if (rc == BSIM_OK && c.out)
 		rc = bsim_markov_prediction_store(c.out, &scene, &set, &p, &err);
 	/* --quiet wins over --json: nothing on stdout. */
 	if (rc == BSIM_OK && !c.quiet && a.json)
-		predict_json(path, &scene, &set, &p, seconds);
+		predict_json(path, &scene, &set, &p, seconds, cpu);
 	else if (rc == BSIM_OK && !c.quiet)
 		predict_print(path, &scene, &set, &p, c.out, a.locations);
 	bsim_markov_prediction_free(&p);
@@ -542,6 +604,26 @@ static int markov_validate(int argc, char **argv)
 			       k->trials, k->tv, k->tv_sampling, k->tv_sampling95, k->tv_map,
 			       k->gates_sim, k->gates_chain, k->sim_cpu, k->predict,
 			       k->sim_cpu / k->predict, pays);
+		}
+		if (v.n > 0 && v.checks[0].has_time) {
+			printf("\ntime to the outcome, trials out (end or side) by the trial's "
+			       "duration (95%% intervals; the difference's without the maps' "
+			       "sampling error):\n"
+			       "group protocol  out sim [interval]      chain   mean t out sim s   "
+			       " "
+			       "chain s          difference s    sup|dP(out by t)| (sim's 95%%)\n");
+			for (int i = 0; i < v.n; i++) {
+				const bsim_markov_check *k = &v.checks[i];
+				printf("%5d %-8s %6.4f [%6.4f, %6.4f] %6.4f  %7.2f +- %5.2f  %7.2f "
+				       "+- "
+				       "%5.2f  %+7.2f +- %5.2f  %6.4f (%6.4f)\n",
+				       k->group,
+				       k->protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world",
+				       k->out_sim, k->out_sim_lo, k->out_sim_hi, k->out_chain,
+				       k->t_out_sim, k->t_out_sim_ci, k->t_out_chain,
+				       k->t_out_chain_ci, k->t_out_chain - k->t_out_sim,
+				       k->t_out_diff_ci, k->t_ks, k->t_ks95);
+			}
 		}
 		printf("\n");
 		cli_wrote(stdout, c.out);

@@ -65,6 +65,8 @@ static const struct {
         {"landscape*.png", "the potential energy landscape (%s)"},
         {"prediction.png", "final-location probabilities the Markov chain predicts, drawn as "
                            "the field, with the end / side / stuck totals"},
+        {"time.png", "the time to the outcome (end, side, stuck) the Markov chain "
+                     "predicts, as cumulative probabilities"},
         {"validate_g*.png", "group %s: the Markov chain's predicted final locations against "
                             "simulated ones (essay protocol, whole world) drawn as the field, "
                             "with the differences and the end / side / stuck totals"},
@@ -107,8 +109,11 @@ static const struct {
         {"sensitivity.csv", "the sensitivity of each essay parameter"},
         {"prediction.csv", "every final location's probability"},
         {"prediction_gates.csv", "the distribution of gates visited"},
+        {"time.csv", "the Markov chain's distribution of the time to the outcome"},
+        {"time_validate.csv", "the time to the outcome, chain against simulation"},
         {"markov.json", "the settings the maps were built with"},
         {"map_*.exits.csv", "every single gate's entry and exit state (--entries self, flow)"},
+        {"map_*.hold.csv", "each single gate's exit bin and time steps in the gate"},
         {"map_*.csv", "a single-gate map: entry bin, exit bin, count"},
         {"map_*.key", "everything that map depends on"},
         {"map_*.cost", "the CPU time and steps that map took"},

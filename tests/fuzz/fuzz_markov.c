@@ -2,7 +2,7 @@
  * read. The first input byte chooses a file of a small valid map
  * directory (tests/fuzz/stored/markov, made by `beamsim markov build` for
  * the 3 x 3 lattice of tests/fuzz/stored/lattice: markov.json and each
- * map's .csv, .key and .cost) or a gate_entries.csv (what --entries
+ * map's .csv, .key, .cost and .hold.csv) or a gate_entries.csv (what --entries
  * reads); the rest of the input replaces it. The maps are then loaded for
  * the lattice and, if accepted, the chain is solved; an entries file is
  * read as --entries reads it. */
@@ -46,12 +46,13 @@ static void predict(void)
 	}
 	bsim_markov_prediction p;
 	rc = bsim_markov_predict(&lattice, &set, &p, &err);
-	if (rc != BSIM_OK) {
+	if (rc == BSIM_OK && p.has_time) /* the holding times, walked */
+		rc = bsim_markov_predict_time(&lattice, &set, 200, 1, &p, &err);
+	if (rc != BSIM_OK)
 		fuzz_check_error(rc, &err);
-	} else {
+	else
 		fuzz_accepted();
-		bsim_markov_prediction_free(&p);
-	}
+	bsim_markov_prediction_free(&p);
 	bsim_markov_set_free(&set);
 }
 
