@@ -80,7 +80,8 @@ static const cli_own bench_own[] = {
                            "free flight and the minimal loop (--trials per group,\n"
                            "default 4, 2, 2), and 1000-step trials on 5 x 5 and\n"
                            "33 x 33 lattices, setup included; each the difference\n"
-                           "of runs of T and 2T trials"},
+                           "of runs of T and 2T trials (--backend with its default\n"
+                           "options)"},
         [OWN_MEASURE] = {"measure", 1, "WHAT",
                          "run one measure of --callgrind and print its steps\n"
                          "(h1, free, minimal, lattice:N)"},
