@@ -240,6 +240,26 @@ static inline void thesis_beam_pushed(struct bsim_world *w, int i)
 	w->pushed_list[w->n_pushed++] = i;
 }
 
+/* The body's velocity at the step's end from its free velocity vf = v +
+ * h F / M (v0 = v at the start) and the contacts' impulse sum j, and its
+ * move by the mean velocity (persistent_contact.c); vm receives that
+ * velocity. Inline: the contact solve and a step in free flight (j = 0)
+ * share it, so both move the body by the same operations. */
+static inline void thesis_body_advance(struct bsim_world *w, const double v0[2], const double vf[2],
+                                       const double j[2], double h, double vm[2])
+{
+	w->v[0] = vf[0] + j[0] * w->inv_mass;
+	w->v[1] = vf[1] + j[1] * w->inv_mass;
+	vm[0] = 0.5 * (v0[0] + w->v[0]);
+	vm[1] = 0.5 * (v0[1] + w->v[1]);
+	if (w->integrator == THESIS_EULER) {
+		vm[0] = w->v[0];
+		vm[1] = w->v[1];
+	}
+	w->x[0] += h * vm[0];
+	w->x[1] += h * vm[1];
+}
+
 /* v_rel = v . n - omega c (contact_detect.c). */
 static inline void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c)
 {
