@@ -305,20 +305,15 @@ static int step_detect(bsim_world *w, const double force[2], double h, double *s
 	return n;
 }
 
-/* A step in free flight among beams at rest (none awake, none typed, none
- * in reach: thesis_broad_phase_clear) for the step size the beams are
- * prepared for: what thesis_step does then, without its general path. No
- * contact: no impact, no projection, nothing held; the contact solve's
- * body update with a zero impulse sum (thesis_body_advance, as
- * persistent_contact.c's with none); no beam to move, sleep or prune; the
- * last step's flags cleared. 1 if it was such a step. */
-static int flight_step(bsim_world *w, const double force[2], double h)
+/* A step in free flight among beams at rest (none awake or typed, none in
+ * reach: thesis_broad_phase_clear, which the caller asked) for the step
+ * size the beams are prepared for: what thesis_step does then, without its
+ * general path. No contact: no impact, no projection, nothing held; the
+ * contact solve's body update with a zero impulse sum (thesis_body_advance,
+ * as persistent_contact.c's with none); no beam to move, sleep or prune;
+ * the last step's flags cleared. */
+static void flight_step(bsim_world *w, const double force[2], double h)
 {
-	if (w->n_awake != 0 || w->n_typed != 0 || h != w->h_prepared ||
-	    w->contact_mode == THESIS_CONTACT_ESSAY || !thesis_broad_phase_clear(w, force, h))
-		return 0;
-	memset(&w->energy, 0, sizeof w->energy);
-	w->impacts = 0;
 	w->n_contacts = 0;
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
@@ -326,17 +321,22 @@ static int flight_step(bsim_world *w, const double force[2], double h)
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm);
 	thesis_contact_clear(w);
-	return 1;
 }
 
 /* Nothing in a step allocates: the world's memory is sized at creation. */
 static int thesis_step(bsim_world *w, const double force[2], double h, bsim_error *err)
 {
 	(void)err;
-	if (flight_step(w, force, h))
-		return BSIM_OK;
+	/* Free flight among beams at rest (none awake, none in reach): no
+	 * contact, no beam to move, no square root for the margin. */
+	int in_flight = w->n_awake == 0 && thesis_broad_phase_clear(w, force, h);
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
+	if (in_flight && w->n_typed == 0 && h == w->h_prepared &&
+	    w->contact_mode != THESIS_CONTACT_ESSAY) {
+		flight_step(w, force, h);
+		return BSIM_OK;
+	}
 	for (int k = 0; k < w->n_typed; k++)
 		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
 	w->n_typed = 0;
@@ -345,9 +345,6 @@ static int thesis_step(bsim_world *w, const double force[2], double h, bsim_erro
 			thesis_beam_prepare(&w->beams[i], h);
 		w->h_prepared = h;
 	}
-	/* Free flight among beams at rest (none awake, none in reach): no
-	 * contact, no beam to move, no square root for the margin. */
-	int in_flight = w->n_awake == 0 && thesis_broad_phase_clear(w, force, h);
 	double speed = 0.0;
 	int n = in_flight ? 0 : step_detect(w, force, h, &speed);
 	w->n_contacts = n;
