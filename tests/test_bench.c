@@ -7,7 +7,10 @@
  *   - taking that time out of Box2D's lowers the ratio, by its share;
  *   - free flight runs every trial to its last step (trials x max_steps);
  *   - --repeat N gives N one-thread runs and the median of them;
- *   - the paired ratios, by wall and by CPU time, are the medians of theirs. */
+ *   - the paired ratios, by wall and by CPU time, are the medians of theirs;
+ *   - --callgrind's measures (bench --measure) run the steps they count:
+ *     lattice trials of 1000 steps each, free flight and the minimal loop
+ *     trials x max_steps. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -128,11 +131,40 @@ static void thesis_reads_none(void **state)
 	free(j);
 }
 
+/* The steps bench --measure WHAT --trials T prints. */
+static long measure_steps(const char *what, const char *trials)
+{
+	char h1[1200];
+	snprintf(h1, sizeof h1, "%s", bsim_test_src("configs/thesis/h1_symmetric.yaml"));
+	const char *argv[] = {"bench", "--measure",    what, "--trials",
+	                      trials,  "--experiment", h1,   NULL};
+	char *out = NULL, *err = NULL;
+	int rc = bsim_test_cli(argv, &out, &err);
+	if (rc != 0)
+		fail_msg("bench --measure %s exited %d: %s", what, rc, err);
+	long steps = -1;
+	assert_int_equal(sscanf(out, "steps %ld", &steps), 1);
+	free(out);
+	free(err);
+	return steps;
+}
+
+static void measures_count_their_steps(void **state)
+{
+	(void)state;
+	assert_int_equal(measure_steps("lattice:5", "3"), 3000);
+	assert_int_equal(measure_steps("lattice:33", "2"), 2000);
+	long free_steps = measure_steps("free", "1");
+	assert_true(free_steps > 0 && free_steps % 3000 == 0);
+	assert_int_equal(measure_steps("minimal", "1"), free_steps);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(box2d_reads_its_clock),
 	        cmocka_unit_test(thesis_reads_none),
+	        cmocka_unit_test(measures_count_their_steps),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

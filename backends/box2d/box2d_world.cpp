@@ -959,4 +959,5 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         box2d_set_state,
         box2d_accuracy,
         (int)(sizeof box2d_accuracy / sizeof box2d_accuracy[0]),
+        nullptr, /* reset: the runner creates a world per trial */
 };

@@ -33,6 +33,7 @@ void thesis_beam_wake(struct bsim_world *w, int i)
 {
 	if (w->is_awake[i])
 		return;
+	thesis_beam_touch(w, i);
 	int k = w->n_awake;
 	while (k > 0 && w->awake[k - 1] > i) {
 		w->awake[k] = w->awake[k - 1];

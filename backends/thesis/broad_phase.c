@@ -155,53 +155,91 @@ int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], 
 	return 1;
 }
 
-/* Appends to out[n..] the beams at rest (not awake) whose pivot lies in a
- * grid cell within r of the body's centre and within L + R + margin of it;
- * returns the new count, *found set if any was. */
-static int grid_query(const struct bsim_world *w, double r, double margin, int *out, int n,
-                      int *found)
+/* The candidate cache. One grid query lists every beam (awake or not)
+ * whose pivot P lies within L + R + D of the body's centre C_c then (D =
+ * near_reach, a quarter cell plus the margin asked). While the body's
+ * centre C stays within D - margin of C_c, every beam the query for C
+ * would find, |C - P| <= L + R + margin, has
+ *   |C_c - P| <= |C_c - C| + |C - P| <= L + R + D,
+ * so it is in the list: filtering the list with the query's own test finds
+ * the same beams. The query's order (cells in ascending rows and columns,
+ * beams ascending within a cell) does not depend on where it is centred,
+ * so the list keeps it and the filtered beams come out in the order the
+ * query gives them. Cushions of 1e-9 of the lengths cover round-off (the
+ * list may hold more, never fewer). A step then tests the few beams of the
+ * list instead of the cells around the body. NaN fails every test: the
+ * list is refilled, from a query that finds nothing, as before. */
+void thesis_near_forget(struct bsim_world *w)
+{
+	w->n_near = 0;
+	w->near_reach = 0.0;
+}
+
+static void near_fill(struct bsim_world *w, double margin)
 {
 	const thesis_grid *g = &w->grid;
+	double d = 0.25 * g->cell + margin;
+	double r = g->cell + d;
 	double lo[2] = {w->x[0] - r, w->x[1] - r}, hi[2] = {w->x[0] + r, w->x[1] + r};
 	int c0x, c0y, c1x, c1y;
-	*found = 0;
-	/* Far outside the grid: no cell is near (and no int overflow). */
+	w->n_near = 0;
+	w->near_x[0] = w->x[0];
+	w->near_x[1] = w->x[1];
+	w->near_reach = d;
 	if (hi[0] < g->origin[0] || hi[1] < g->origin[1] ||
 	    lo[0] > g->origin[0] + g->cell * g->nx || lo[1] > g->origin[1] + g->cell * g->ny)
-		return n;
+		return;
 	grid_cell_of(g, lo, &c0x, &c0y);
 	grid_cell_of(g, hi, &c1x, &c1y);
 	c0x = c0x < 0 ? 0 : c0x;
 	c0y = c0y < 0 ? 0 : c0y;
 	c1x = c1x >= g->nx ? g->nx - 1 : c1x;
 	c1y = c1y >= g->ny ? g->ny - 1 : c1y;
-	/* A beam at rest is a candidate only if the body is within its reach
-	 * (the test contact_detect.c makes first, here without the call). */
 	for (int cy = c0y; cy <= c1y; cy++)
 		for (int cx = c0x; cx <= c1x; cx++) {
 			size_t c = (size_t)cy * g->nx + cx;
 			for (int k = g->start[c]; k < g->start[c + 1]; k++) {
 				int i = g->items[k];
-				if (w->is_awake[i])
-					continue;
 				const thesis_beam *b = &w->beams[i];
 				double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-				double reach = b->length + w->radius + margin;
+				double reach = (b->length + w->radius + d) * (1.0 + 1e-9);
 				if (dx * dx + dy * dy > reach * reach)
 					continue;
-				out[n++] = i;
-				*found = 1;
+				w->near[w->n_near++] = i;
 			}
 		}
+}
+
+/* Appends to out[n..] the beams at rest (not awake) whose pivot lies
+ * within L + R + margin of the body's centre, in the grid's order; returns
+ * the new count, *found set if any was. */
+static int near_query(struct bsim_world *w, double margin, int *out, int n, int *found)
+{
+	double ex = w->x[0] - w->near_x[0], ey = w->x[1] - w->near_x[1];
+	double lim = (w->near_reach - margin) * (1.0 - 1e-9);
+	if (!(lim > 0.0 && ex * ex + ey * ey < lim * lim))
+		near_fill(w, margin);
+	*found = 0;
+	for (int k = 0; k < w->n_near; k++) {
+		int i = w->near[k];
+		if (w->is_awake[i])
+			continue;
+		const thesis_beam *b = &w->beams[i];
+		double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+		double reach = b->length + w->radius + margin;
+		if (dx * dx + dy * dy > reach * reach)
+			continue;
+		out[n++] = i;
+		*found = 1;
+	}
 	return n;
 }
 
 /* Fills w->candidates with the awake beams and those at rest within reach
- * plus margin, searched in the square of half-side r (c + margin: the cell
- * side c >= L + R, so it holds every reach); returns how many, *sleeping_found set if any beam at
- * rest was added (then the list is no longer in ascending order). A world
- * of few beams, or broad_phase=0, lists them all, in order. */
-static int candidates_within(struct bsim_world *w, double r, double margin, int *sleeping_found)
+ * plus margin; returns how many, *sleeping_found set if any beam at rest
+ * was added (then the list is no longer in ascending order). A world of
+ * few beams, or broad_phase=0, lists them all, in order. */
+static int candidates_within(struct bsim_world *w, double margin, int *sleeping_found)
 {
 	int *out = w->candidates;
 	int n = 0;
@@ -213,7 +251,7 @@ static int candidates_within(struct bsim_world *w, double r, double margin, int 
 	}
 	for (int k = 0; k < w->n_awake; k++)
 		out[n++] = w->awake[k];
-	return grid_query(w, r, margin, out, n, sleeping_found);
+	return near_query(w, margin, out, n, sleeping_found);
 }
 
 /* Fills w->candidates with the beams the step must test, in ascending
@@ -221,8 +259,7 @@ static int candidates_within(struct bsim_world *w, double r, double margin, int 
 int thesis_broad_phase(struct bsim_world *w, double speed, double h)
 {
 	int sleeping_found;
-	int n = candidates_within(w, w->grid.cell + 2.0 * h * speed + w->slop,
-	                          2.0 * h * speed + w->slop, &sleeping_found);
+	int n = candidates_within(w, 2.0 * h * speed + w->slop, &sleeping_found);
 	if (sleeping_found)
 		sort_small(w->candidates, n);
 	return n;
@@ -232,5 +269,5 @@ int thesis_broad_phase(struct bsim_world *w, double speed, double h)
 int thesis_broad_phase_near(struct bsim_world *w, double margin)
 {
 	int found;
-	return candidates_within(w, w->grid.cell + margin, margin, &found);
+	return candidates_within(w, margin, &found);
 }

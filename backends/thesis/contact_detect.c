@@ -90,7 +90,7 @@ static int geometry_far(const thesis_beam *b, const double x[2], double radius, 
 	return slack > 0.0 && ex * ex + ey * ey < slack * slack; /* false for NaN */
 }
 
-int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out)
+int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out)
 {
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
@@ -103,6 +103,7 @@ int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thes
 	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta)) {
 		if (geometry_far(b, w->x, w->radius, margin))
 			return 0;
+		thesis_beam_touch(w, i);
 		geometry_compute(b, w->x);
 	}
 	if (g->type == BSIM_CONTACT_NONE)

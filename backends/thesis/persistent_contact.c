@@ -41,19 +41,15 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
 		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 	}
-	w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
-
-	double j[2];
-	thesis_impulse_sum(cs, n, j);
-	w->v[0] = vf[0] + j[0] * w->inv_mass;
-	w->v[1] = vf[1] + j[1] * w->inv_mass;
-	double vm[2] = {0.5 * (v0[0] + w->v[0]), 0.5 * (v0[1] + w->v[1])};
-	if (w->integrator == THESIS_EULER) {
-		vm[0] = w->v[0];
-		vm[1] = w->v[1];
+	/* No contact (free flight): no solve, and the impulse sum of none is
+	 * 0 (thesis_impulse_sum's start), added as it would be. */
+	double j[2] = {0.0, 0.0};
+	if (n) {
+		w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
+		thesis_impulse_sum(cs, n, j);
 	}
-	w->x[0] += h * vm[0];
-	w->x[1] += h * vm[1];
+	double vm[2];
+	thesis_body_advance(w, v0, vf, j, h, vm);
 
 	/* Beams in contact take their impulse; all others move freely. A beam
 	 * at rest and untouched stays at rest and costs nothing: only the awake

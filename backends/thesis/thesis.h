@@ -124,9 +124,35 @@ struct bsim_world {
 	int impacts;
 	bsim_solver_counts solver; /* since creation */
 	double h_prepared;         /* the step size the beams' constants are for, s */
+	/* What a reset (thesis_world.c) puts back: the beams whose angle,
+	 * contact or geometry a step or a state may have changed since the
+	 * world was made or last reset (woken or measured), every beam after
+	 * set_state; and the beams the scene starts awake. */
+	unsigned char *touched; /* per beam */
+	int *touched_list;
+	int n_touched;
+	int touched_all;
+	int *start_awake;
+	int n_start_awake;
+	/* The broad phase's candidate cache (broad_phase.c): every beam whose
+	 * pivot lies within L + R + near_reach of near_x, from one grid query. */
+	int *near;
+	int n_near;
+	double near_x[2];  /* m */
+	double near_reach; /* m; 0: no cache */
 };
 
+/* Beam i may differ from how the world was made: a reset restores it. */
+static inline void thesis_beam_touch(struct bsim_world *w, int i)
+{
+	if (w->touched[i])
+		return;
+	w->touched[i] = 1;
+	w->touched_list[w->n_touched++] = i;
+}
+
 /* broad_phase.c */
+void thesis_near_forget(struct bsim_world *w);
 int thesis_grid_build(thesis_grid *g, const struct bsim_world *w);
 void thesis_grid_free(thesis_grid *g);
 int thesis_broad_phase(struct bsim_world *w, double speed, double h);
@@ -144,7 +170,7 @@ void thesis_awake_prune(struct bsim_world *w);
 
 /* contact_detect.c */
 void thesis_beam_direction(thesis_beam *b, double u[2]);
-int thesis_contact_detect(const struct bsim_world *w, int i, double margin, thesis_contact *out);
+int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out);
 /* 0 if beam i certainly lies farther than R + margin from the body (its
  * reach, or the bound from its last geometry), 1 if it may not. */
 int thesis_contact_near(const struct bsim_world *w, int i, double margin);
@@ -212,6 +238,26 @@ static inline void thesis_beam_pushed(struct bsim_world *w, int i)
 		return;
 	w->pushed[i] = 1;
 	w->pushed_list[w->n_pushed++] = i;
+}
+
+/* The body's velocity at the step's end from its free velocity vf = v +
+ * h F / M (v0 = v at the start) and the contacts' impulse sum j, and its
+ * move by the mean velocity (persistent_contact.c); vm receives that
+ * velocity. Inline: the contact solve and a step in free flight (j = 0)
+ * share it, so both move the body by the same operations. */
+static inline void thesis_body_advance(struct bsim_world *w, const double v0[2], const double vf[2],
+                                       const double j[2], double h, double vm[2])
+{
+	w->v[0] = vf[0] + j[0] * w->inv_mass;
+	w->v[1] = vf[1] + j[1] * w->inv_mass;
+	vm[0] = 0.5 * (v0[0] + w->v[0]);
+	vm[1] = 0.5 * (v0[1] + w->v[1]);
+	if (w->integrator == THESIS_EULER) {
+		vm[0] = w->v[0];
+		vm[1] = w->v[1];
+	}
+	w->x[0] += h * vm[0];
+	w->x[1] += h * vm[1];
 }
 
 /* v_rel = v . n - omega c (contact_detect.c). */

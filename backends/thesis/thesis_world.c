@@ -101,6 +101,10 @@ static void thesis_destroy(bsim_world *w)
 	free(w->flagged);
 	free(w->pushed);
 	free(w->pushed_list);
+	free(w->touched);
+	free(w->touched_list);
+	free(w->start_awake);
+	free(w->near);
 	thesis_grid_free(&w->grid);
 	free(w->held);
 	free(w);
@@ -129,10 +133,15 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->flagged = malloc(nb * sizeof *w->flagged);
 		w->pushed = calloc(nb, sizeof *w->pushed);
 		w->pushed_list = malloc(nb * sizeof *w->pushed_list);
+		w->touched = calloc(nb, sizeof *w->touched);
+		w->touched_list = malloc(nb * sizeof *w->touched_list);
+		w->start_awake = malloc(nb * sizeof *w->start_awake);
+		w->near = malloc(nb * sizeof *w->near);
 	}
 	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type || !w->awake ||
 	    !w->is_awake || !w->candidates || !w->typed || !w->held || !w->flag || !w->flagged ||
-	    !w->pushed || !w->pushed_list) {
+	    !w->pushed || !w->pushed_list || !w->touched || !w->touched_list || !w->start_awake ||
+	    !w->near) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
@@ -192,14 +201,69 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->impact_inv_mass = 1.0 / m;
 	}
 	for (int i = 0; i < w->n_beams; i++)
-		if (w->beams[i].theta != 0.0 || w->beams[i].omega != 0.0)
+		if (w->beams[i].theta != 0.0 || w->beams[i].omega != 0.0) {
+			w->start_awake[w->n_start_awake++] = i;
 			thesis_beam_wake(w, i);
+		}
 	if (w->broad_phase && thesis_grid_build(&w->grid, w)) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
 	thesis_contact_report(w); /* a body that starts touching a beam */
 	*out = w;
+	return BSIM_OK;
+}
+
+/* A beam back to how thesis_create made it from its definition d. */
+static void beam_restore(bsim_world *w, int i, const bsim_beam_def *d)
+{
+	thesis_beam *b = &w->beams[i];
+	b->theta = d->initial_theta;
+	b->omega = d->initial_omega;
+	b->u_theta = 0.0;
+	b->u[0] = b->u0[0];
+	b->u[1] = b->u0[1];
+	memset(&b->geo, 0, sizeof b->geo);
+	b->geo.theta = NAN;
+	w->is_awake[i] = 0;
+	w->contact_type[i] = BSIM_CONTACT_NONE;
+	w->flag[i] = BSIM_CONTACT_NONE;
+	w->pushed[i] = 0;
+	w->held[i] = 0;
+	w->contact_of[i] = -1;
+	w->touched[i] = 0;
+}
+
+/* The world as thesis_create(scene) made it, at the cost of the beams the
+ * trials since touched: the grid, the rest directions and forward signs,
+ * and the constants for the last step size are kept (what the world holds
+ * of them depends on the beams' definitions only, which the runner
+ * guarantees unchanged: the same scene). The body and the beams' initial
+ * angles are read again. */
+static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
+{
+	if (scene->n_beams != w->n_beams)
+		return bsim_error_set(err, BSIM_EINPUT, "thesis: reset to %d beams, world has %d",
+		                      scene->n_beams, w->n_beams);
+	if (w->touched_all)
+		for (int i = 0; i < w->n_beams; i++)
+			beam_restore(w, i, &scene->beams[i]);
+	else
+		for (int k = 0; k < w->n_touched; k++)
+			beam_restore(w, w->touched_list[k], &scene->beams[w->touched_list[k]]);
+	w->touched_all = 0;
+	w->n_touched = 0;
+	memcpy(w->x, scene->body.start, sizeof w->x);
+	memcpy(w->v, scene->body.velocity, sizeof w->v);
+	w->n_awake = w->n_typed = w->n_flagged = w->n_pushed = w->n_contacts = 0;
+	w->any_held = 0;
+	memset(&w->energy, 0, sizeof w->energy);
+	w->impacts = 0;
+	memset(&w->solver, 0, sizeof w->solver);
+	thesis_near_forget(w);
+	for (int k = 0; k < w->n_start_awake; k++)
+		thesis_beam_wake(w, w->start_awake[k]);
+	thesis_contact_report(w); /* a body that starts touching a beam */
 	return BSIM_OK;
 }
 
@@ -241,12 +305,38 @@ static int step_detect(bsim_world *w, const double force[2], double h, double *s
 	return n;
 }
 
+/* A step in free flight among beams at rest (none awake or typed, none in
+ * reach: thesis_broad_phase_clear, which the caller asked) for the step
+ * size the beams are prepared for: what thesis_step does then, without its
+ * general path. No contact: no impact, no projection, nothing held; the
+ * contact solve's body update with a zero impulse sum (thesis_body_advance,
+ * as persistent_contact.c's with none); no beam to move, sleep or prune;
+ * the last step's flags cleared. */
+static void flight_step(bsim_world *w, const double force[2], double h)
+{
+	w->n_contacts = 0;
+	double v0[2] = {w->v[0], w->v[1]};
+	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
+	const double j[2] = {0.0, 0.0};
+	double vm[2];
+	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_contact_clear(w);
+}
+
 /* Nothing in a step allocates: the world's memory is sized at creation. */
 static int thesis_step(bsim_world *w, const double force[2], double h, bsim_error *err)
 {
 	(void)err;
+	/* Free flight among beams at rest (none awake, none in reach): no
+	 * contact, no beam to move, no square root for the margin. */
+	int in_flight = w->n_awake == 0 && thesis_broad_phase_clear(w, force, h);
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
+	if (in_flight && w->n_typed == 0 && h == w->h_prepared &&
+	    w->contact_mode != THESIS_CONTACT_ESSAY) {
+		flight_step(w, force, h);
+		return BSIM_OK;
+	}
 	for (int k = 0; k < w->n_typed; k++)
 		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
 	w->n_typed = 0;
@@ -255,9 +345,6 @@ static int thesis_step(bsim_world *w, const double force[2], double h, bsim_erro
 			thesis_beam_prepare(&w->beams[i], h);
 		w->h_prepared = h;
 	}
-	/* Free flight among beams at rest (none awake, none in reach): no
-	 * contact, no beam to move, no square root for the margin. */
-	int in_flight = w->n_awake == 0 && thesis_broad_phase_clear(w, force, h);
 	double speed = 0.0;
 	int n = in_flight ? 0 : step_detect(w, force, h, &speed);
 	w->n_contacts = n;
@@ -328,6 +415,8 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 		w->held[i] = 0; /* a state has no loop: contact_mode=essay starts afresh */
 	}
 	w->any_held = 0;
+	w->touched_all = 1; /* every beam's angle set */
+	thesis_near_forget(w);
 	return BSIM_OK;
 }
 
@@ -342,6 +431,7 @@ const bsim_backend bsim_backend_thesis = {
         .step = thesis_step,
         .get_state = thesis_get_state,
         .set_state = thesis_set_state,
+        .reset = thesis_reset,
         .accuracy = thesis_accuracy,
         .n_accuracy = (int)(sizeof thesis_accuracy / sizeof thesis_accuracy[0]),
 };

@@ -39,6 +39,13 @@ typedef struct bsim_backend {
 	 * at the finest step is the study's reference. */
 	const bsim_knob_setting *accuracy;
 	int n_accuracy;
+	/* Optional (NULL: not offered). Puts w back to the world create made
+	 * from scene, which must be the scene w was created from, unchanged:
+	 * the same steps then give the same bits. What the world derived from
+	 * the beams' definitions (its grid, their rest directions) is kept, so
+	 * a trial pays for the beams it touched, not for the field
+	 * (bsim_trial_runner_keep_worlds). */
+	int (*reset)(bsim_world *w, const bsim_scene *scene, bsim_error *err);
 } bsim_backend;
 
 /* The registry: all backends compiled in, NULL-terminated. */

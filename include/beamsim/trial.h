@@ -232,6 +232,16 @@ typedef struct bsim_trial_runner bsim_trial_runner;
 /* A runner holds the reusable per-thread memory (state buffers, schedule). */
 BSIM_API bsim_trial_runner *bsim_trial_runner_alloc(void);
 BSIM_API void bsim_trial_runner_free(bsim_trial_runner *r);
+/* on != 0: the runner keeps a trial's world for the next trial, which
+ * resets it (bsim_backend.reset, where the backend offers it) instead of
+ * building the world anew, when it runs the same scene (the same pointer),
+ * backend and options (the same pointers) under the whole-world protocol:
+ * a trial then costs what the beams it touches cost, not the field. The
+ * caller promises that while it is on a scene pointer it passes names one
+ * scene, unchanged, and likewise the options; results are the same bit for
+ * bit. 0 (the default): every trial builds its world; the kept one is
+ * freed. */
+BSIM_API void bsim_trial_runner_keep_worlds(bsim_trial_runner *r, int on);
 
 /* Runs one trial. seed: the mixed seed (bsim_schedule_seed_mix). rec may be NULL.
  * A lattice scene runs under its lattice.protocol: the whole world, or the

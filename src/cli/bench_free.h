@@ -10,6 +10,7 @@ typedef struct bench_free_args {
 	long trials;            /* per group, 0: the experiment's */
 	const bsim_backend *backend;
 	const bsim_options *opts;
+	int only; /* 0: both; 1: beamsim's sweep only; 2: the minimal loop only */
 } bench_free_args;
 
 typedef struct bench_free_result {

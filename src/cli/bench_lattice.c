@@ -112,6 +112,7 @@ static int bench_one(const bsim_backend *b, const bsim_options *opts, int n, lon
 		cli_error("out of memory for a trial runner");
 		return CLI_FAIL;
 	}
+	bsim_trial_runner_keep_worlds(runner, 1); /* as a sweep runs its trials */
 	int rc = BSIM_OK;
 	row->n = n;
 	row->beams = scene.n_beams;
@@ -149,6 +150,65 @@ static int bench_one(const bsim_backend *b, const bsim_options *opts, int n, lon
 		return cli_report(rc, &err);
 	row->active_mean = acc[1] > 0.0 ? acc[0] / acc[1] : 0.0;
 	row->ns_per_step = row->steps > 0 ? 1e9 * row->wall / (double)row->steps : 0.0;
+	return CLI_OK;
+}
+
+/* Trials of LONG_STEPS steps (max_steps; the field's own end and sides,
+ * which the body does not reach in that time at F_prop = 6 N), setup
+ * included: the world kept from trial to trial as a sweep keeps it. */
+#define LONG_STEPS 1000
+
+int bench_lattice_long(const bsim_backend *b, const bsim_options *opts, int n, long trials,
+                       long *steps, double *wall)
+{
+	bsim_scene scene;
+	bsim_error err;
+	*steps = 0;
+	*wall = 0.0;
+	if (bsim_lattice_scene_init(&scene, n, n, 6.0, 30.0) != BSIM_OK) {
+		bsim_scene_free(&scene);
+		cli_error("out of memory for a %d x %d lattice", n, n);
+		return CLI_FAIL;
+	}
+	scene.max_steps = LONG_STEPS;
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
+	if (!runner) {
+		bsim_scene_free(&scene);
+		cli_error("out of memory for a trial runner");
+		return CLI_FAIL;
+	}
+	bsim_trial_runner_keep_worlds(runner, 1);
+	int rc = BSIM_OK;
+	*wall = time_trials(runner, &scene, b, opts, trials, steps, &rc, &err);
+	bsim_trial_runner_free(runner);
+	bsim_scene_free(&scene);
+	return rc == BSIM_OK ? CLI_OK : cli_report(rc, &err);
+}
+
+/* The LONG_STEPS-step trials on every size, the fastest of ROUNDS rounds;
+ * the cost per step, setup included, against the 5 x 5 field's. */
+static int bench_long(FILE *out, const bsim_backend *b, const bsim_options *opts, long trials,
+                      double ns[N_SIZES])
+{
+	long steps[N_SIZES];
+	fprintf(out,
+	        "\n%d-step trials, setup included (the world kept from trial to trial, as a "
+	        "sweep keeps it)\n\n%-8s %11s %7s %11s %9s %9s %8s\n",
+	        LONG_STEPS, "backend", "gates", "trials", "steps", "wall s", "ns/step", "x 5x5");
+	for (int round = 0; round < ROUNDS; round++)
+		for (int i = 0; i < N_SIZES; i++) {
+			double wall;
+			int rc = bench_lattice_long(b, opts, sizes[i], trials, &steps[i], &wall);
+			if (rc != CLI_OK)
+				return rc;
+			double v = steps[i] > 0 ? 1e9 * wall / (double)steps[i] : 0.0;
+			if (round == 0 || v < ns[i])
+				ns[i] = v;
+		}
+	for (int i = 0; i < N_SIZES; i++)
+		fprintf(out, "%-8s %5d x %-3d %7ld %11ld %9.3f %9.1f %8.2f\n", b->name, sizes[i],
+		        sizes[i], trials, steps[i], 1e-9 * ns[i] * (double)steps[i], ns[i],
+		        ns[i] / ns[2]);
 	return CLI_OK;
 }
 
@@ -231,6 +291,14 @@ int bench_lattice(const bench_lattice_args *a)
 			fprintf(out, " %s %.2f x (same trials), %.2f x (own field);", b[k]->name,
 			        rows[0][k][N_SIZES - 1].ratio, rows[1][k][N_SIZES - 1].ratio);
 	fprintf(out, "\n");
+	double ns_long[N_SIZES];
+	int rc = bench_long(out, b[0], o[0], trials[0], ns_long);
+	if (rc != CLI_OK)
+		return rc;
+	fprintf(out,
+	        "\ncost per step, setup included, %d-step trials, 33 x 33 against 5 x 5: %s %.2f "
+	        "x\n",
+	        LONG_STEPS, b[0]->name, ns_long[N_SIZES - 1] / ns_long[2]);
 	if (!a->json)
 		return CLI_OK;
 	bsim_atomic_file jf;
@@ -245,6 +313,17 @@ int bench_lattice(const bench_lattice_args *a)
 				json_rows(jf.f, b[k]->name, mode_names[m], rows[m][k], first);
 				first = 0;
 			}
+	fputs("\n], \"long_trials\": [", jf.f);
+	for (int i = 0; i < N_SIZES; i++) {
+		fprintf(jf.f, "%s\n  {\"backend\": ", i ? "," : "");
+		bsim_json_string(jf.f, b[0]->name);
+		fprintf(jf.f, ", \"gates\": [%d, %d], \"steps_per_trial\": %d, \"ns_per_step\": ",
+		        sizes[i], sizes[i], LONG_STEPS);
+		bsim_json_number(jf.f, ns_long[i]);
+		fputs(", \"ratio_to_5x5\": ", jf.f);
+		bsim_json_number(jf.f, ns_long[i] / ns_long[2]);
+		fputc('}', jf.f);
+	}
 	fputs("\n]}\n", jf.f);
 	return cli_report(bsim_atomic_file_commit(&jf, &err), &err);
 }

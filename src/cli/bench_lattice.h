@@ -16,4 +16,10 @@ typedef struct bench_lattice_args {
 
 int bench_lattice(const bench_lattice_args *a);
 
+/* trials trials (seed 1, group 0) of 1000 steps on the n x n lattice, the
+ * world kept from trial to trial, setup included: their steps and wall
+ * time, s. 0, or the exit status of an error it printed. */
+int bench_lattice_long(const bsim_backend *b, const bsim_options *opts, int n, long trials,
+                       long *steps, double *wall);
+
 #endif

@@ -19,6 +19,7 @@
 #include "beamsim/output.h"
 #include "beamsim/sweep.h"
 #include "cli/bench_clock.h"
+#include "cli/bench_callgrind.h"
 #include "cli/bench_free.h"
 #include "cli/bench_lattice.h"
 #include "cli/bench_memory.h"
@@ -41,7 +42,9 @@ enum {
 	OWN_LATTICE,
 	OWN_REPEAT,
 	OWN_MEMORY,
-	OWN_PAIRS
+	OWN_PAIRS,
+	OWN_CALLGRIND,
+	OWN_MEASURE
 };
 
 static const cli_own bench_own[] = {
@@ -70,6 +73,18 @@ static const cli_own bench_own[] = {
                        "experiment, the two backends interleaved (default 5;\n"
                        "0: none): the median of the pairs' ratios per step, by\n"
                        "wall time and by CPU time"},
+        [OWN_CALLGRIND] = {"callgrind", 0, NULL,
+                           "instead: instructions per step, counted by valgrind's\n"
+                           "callgrind in child processes (perf stat's counters are\n"
+                           "not offered everywhere): the experiment's sweep, its\n"
+                           "free flight and the minimal loop (--trials per group,\n"
+                           "default 4, 2, 2), and 1000-step trials on 5 x 5 and\n"
+                           "33 x 33 lattices, setup included; each the difference\n"
+                           "of runs of T and 2T trials (--backend with its default\n"
+                           "options)"},
+        [OWN_MEASURE] = {"measure", 1, "WHAT",
+                         "run one measure of --callgrind and print its steps\n"
+                         "(h1, free, minimal, lattice:N)"},
 };
 
 static const char *const bench_help[CLI_N_OPTS] = {
@@ -90,6 +105,8 @@ typedef struct bench_args {
 	int memory;
 	int repeat; /* one-thread runs of the experiment */
 	int pairs;  /* interleaved runs of the two backends */
+	int callgrind;
+	const char *measure; /* NULL: none */
 } bench_args;
 
 typedef struct bench_run {
@@ -138,6 +155,12 @@ static int bench_option(void *args, int i, const char *value)
 	case OWN_MEMORY:
 		a->memory = 1;
 		return CLI_OK;
+	case OWN_CALLGRIND:
+		a->callgrind = 1;
+		return CLI_OK;
+	case OWN_MEASURE:
+		a->measure = value;
+		return CLI_OK;
 	case OWN_PAIRS: {
 		char *end;
 		long n = strtol(value, &end, 10);
@@ -182,7 +205,7 @@ static const cli_spec bench_spec = {
                   CLI_USES(CLI_OPT_TRIALS),
         .help = bench_help,
         .own = bench_own,
-        .n_own = 9,
+        .n_own = 11,
         .option = bench_option,
 };
 
@@ -611,6 +634,22 @@ int cmd_bench(int argc, char **argv)
 	if (a.memory) {
 		bench_memory_args ma = {.trials = a.trials, .json = a.json, .report = report};
 		return bench_memory(&ma);
+	}
+	if (a.measure) {
+		bench_measure_args ma = {.what = a.measure,
+		                         .experiment = a.experiment,
+		                         .trials = a.trials,
+		                         .backend = backend,
+		                         .opts = &a.opts};
+		return bench_measure(&ma);
+	}
+	if (a.callgrind) {
+		bench_callgrind_args ca = {.experiment = a.experiment,
+		                           .backend = a.backend,
+		                           .trials = a.trials,
+		                           .lattice_trials = 100,
+		                           .report = report};
+		return bench_callgrind(&ca);
 	}
 	if (a.lattice) {
 		bench_lattice_args la = {

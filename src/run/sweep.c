@@ -258,6 +258,9 @@ static void sweep_thread(sweep_shared *sh)
 	const bsim_sweep_config *cfg = sh->cfg;
 	int leader = omp_get_thread_num() == 0;
 	bsim_trial_runner *runner = bsim_trial_runner_alloc();
+	/* The scenes live, unchanged, as long as the sweep. */
+	if (runner)
+		bsim_trial_runner_keep_worlds(runner, 1);
 	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
 	bsim_trial_log *log[2] = {bsim_trial_log_alloc(), bsim_trial_log_alloc()};
 	bsim_error err;

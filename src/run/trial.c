@@ -40,7 +40,29 @@ struct bsim_trial_runner {
 	bsim_state whole;  /* the whole lattice's state, for recording (essay protocol) */
 	trial_peaks peaks;
 	trial_essay essay;
+	/* The world of the last trial, kept for the next trial of the same
+	 * scene, backend and options (bsim_trial_runner_keep_worlds). */
+	int keep;
+	bsim_world *kept;
+	const bsim_scene *kept_scene;
+	const bsim_backend *kept_backend;
+	const bsim_options *kept_opts;
 };
+
+static void runner_forget_world(bsim_trial_runner *r)
+{
+	if (r->kept)
+		r->kept_backend->destroy(r->kept);
+	r->kept = NULL;
+	r->kept_scene = NULL;
+}
+
+void bsim_trial_runner_keep_worlds(bsim_trial_runner *r, int on)
+{
+	r->keep = on != 0;
+	if (!r->keep)
+		runner_forget_world(r);
+}
 
 bsim_trial_runner *bsim_trial_runner_alloc(void)
 {
@@ -55,6 +77,7 @@ void bsim_trial_runner_free(bsim_trial_runner *r)
 	bsim_state_free(&r->s1);
 	bsim_state_free(&r->whole);
 	trial_peaks_free(&r->peaks);
+	runner_forget_world(r);
 	free(r->shape);
 	free(r);
 }
@@ -127,6 +150,18 @@ static int trial_world(trial_ctx *c, bsim_error *err)
 	c->ws = scene;
 	c->map = NULL;
 	trial_gate_start(&c->gate, scene);
+	if (!essay && r->kept && r->kept_scene == scene && r->kept_backend == c->backend &&
+	    r->kept_opts == c->opts) {
+		c->w = r->kept;
+		r->kept = NULL;
+		int rc = c->backend->reset(c->w, scene, err);
+		if (rc) {
+			c->backend->destroy(c->w);
+			c->w = NULL;
+		}
+		return rc;
+	}
+	runner_forget_world(r);
 	if (!essay)
 		return c->backend->create(scene, c->opts, &c->w, err);
 	int rc = trial_essay_start(&r->essay, scene, c->backend, c->opts, c->gate.ix, c->gate.iy,
@@ -328,7 +363,15 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, const bsim_state *s0,
 	if (rc == BSIM_OK && c->log && trial_log_peaks(c->log, c->r->peaks.peak, c->scene->n_beams))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the peaks");
 	bsim_effects_free(c->fx);
-	trial_essay_release(&c->r->essay, c->backend, &c->w);
+	bsim_trial_runner *r = c->r;
+	if (r->keep && c->backend->reset && c->map == NULL && c->w && rc == BSIM_OK) {
+		r->kept = c->w; /* the next trial of this scene resets it */
+		r->kept_scene = c->scene;
+		r->kept_backend = c->backend;
+		r->kept_opts = c->opts;
+		c->w = NULL;
+	}
+	trial_essay_release(&r->essay, c->backend, &c->w);
 	return rc;
 }
 

@@ -17,8 +17,16 @@ int trial_peaks_reserve(trial_peaks *p, int n_beams)
 	p->negative = malloc(n * sizeof *p->negative);
 	p->touching = calloc(n, sizeof *p->touching);
 	p->touch_list = malloc(n * sizeof *p->touch_list);
-	p->cap = p->peak && p->negative && p->touching && p->touch_list ? n_beams : 0;
-	return p->cap ? BSIM_OK : BSIM_EFAIL;
+	p->listed = calloc(n, sizeof *p->listed);
+	p->list = malloc(n * sizeof *p->list);
+	p->cap = p->peak && p->negative && p->touching && p->touch_list && p->listed && p->list
+	                 ? n_beams
+	                 : 0;
+	if (!p->cap)
+		return BSIM_EFAIL;
+	for (size_t i = 0; i < n; i++)
+		p->peak[i] = 0.0;
+	return BSIM_OK;
 }
 
 void trial_peaks_free(trial_peaks *p)
@@ -27,20 +35,37 @@ void trial_peaks_free(trial_peaks *p)
 	free(p->negative);
 	free(p->touching);
 	free(p->touch_list);
+	free(p->listed);
+	free(p->list);
 	p->peak = NULL;
-	p->negative = p->touching = p->touch_list = NULL;
-	p->cap = p->n_touch = p->n_negative = 0;
+	p->negative = p->touching = p->touch_list = p->list = NULL;
+	p->listed = NULL;
+	p->cap = p->n_touch = p->n_negative = p->n_list = 0;
 }
 
 void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
                        const bsim_state *s0)
 {
+	for (int k = 0; k < p->n_list; k++) {
+		p->peak[p->list[k]] = 0.0;
+		p->listed[p->list[k]] = 0;
+	}
+	p->n_list = 0;
 	p->n_negative = 0;
-	for (int i = 0; i < scene->n_beams; i++)
-		p->peak[i] = map ? 0.0 : s0->theta[i];
-	for (int i = 0; !map && i < scene->n_beams; i++)
+	/* Beams 0 and 1 (trials.csv's columns) are read every step. */
+	for (int i = 0; i < 2 && i < scene->n_beams; i++)
+		trial_peaks_list(p, i);
+	if (!map)
+		for (int k = 0; k < s0->n_active; k++) {
+			int i = s0->active[k];
+			trial_peaks_list(p, i);
+			p->peak[i] = s0->theta[i];
+		}
+	for (int k = 0; !map && k < p->n_list; k++) {
+		int i = p->list[k];
 		if (p->peak[i] < 0.0)
 			p->negative[p->n_negative++] = i;
+	}
 	p->touched = 0;
 	p->last_touch[0] = p->last_touch[1] = 0.0;
 	touching_clear(p);

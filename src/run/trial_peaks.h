@@ -18,6 +18,11 @@ typedef struct trial_peaks {
 	int *negative; /* beams whose peak is still below 0 */
 	int n_negative;
 	int cap; /* beams the arrays hold */
+	/* The beams whose peak may not be 0: the others' is 0 exactly, so a
+	 * trial's start clears these, not every beam of the scene. */
+	unsigned char *listed;
+	int *list;
+	int n_list;
 	/* The last touching step before success_y: where the body was, and per
 	 * beam of the scene its contacts then (all zero between trials:
 	 * trial_peaks_start clears what the last trial set). */
@@ -33,7 +38,9 @@ int trial_peaks_reserve(trial_peaks *p, int n_beams);
 void trial_peaks_free(trial_peaks *p);
 
 /* Peaks at the initial angles s0 (map: every beam of the scene starts at
- * rest), no contact yet. */
+ * rest), no contact yet. A beam s0 does not list active is at rest (its
+ * angle 0): its peak is 0, and the cost is that of the beams the last
+ * trial moved, not of the scene. */
 void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
                        const bsim_state *s0);
 
@@ -47,6 +54,15 @@ static inline int scene_beam(const int *map, int i)
 	return map ? map[i] : i;
 }
 
+/* Beam g's peak may leave 0. */
+static inline void trial_peaks_list(trial_peaks *p, int g)
+{
+	if (p->listed[g])
+		return;
+	p->listed[g] = 1;
+	p->list[p->n_list++] = g;
+}
+
 /* Every beam's peak theta over the steps so far, s the state after the
  * latest: the active beams, beams 0 and 1 (trials.csv's two columns), and
  * any beam whose peak is still below 0 (a beam at rest has theta 0). */
@@ -56,6 +72,7 @@ static inline void trial_peaks_update(trial_peaks *p, const bsim_scene *scene, c
 	double *peak = p->peak;
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k], g = scene_beam(map, i);
+		trial_peaks_list(p, g);
 		peak[g] = bsim_fmax(peak[g], s->theta[i]);
 	}
 	if (!map)
