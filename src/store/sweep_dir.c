@@ -24,6 +24,9 @@
 #include "store/survival_files.h"
 #include "store/trials_csv.h"
 #include "store/lattice_files.h"
+#include "store/part_dir.h"
+#include "util/journal.h"
+#include "util/clock.h"
 #include "util/atomic_file.h"
 #include "beamsim/limits.h"
 
@@ -154,8 +157,98 @@ static int session_end(bsim_session *ss, int rc, const char *command, char *jour
 	return rc;
 }
 
+/* A journal record marked in the done bits (bsim_journal_fn). */
+static int mark_done(void *user, uint64_t index, const void *payload)
+{
+	(void)payload;
+	unsigned char **bits = user;
+	(*bits)[index / 8] |= (unsigned char)(1u << (index % 8));
+	return 0;
+}
+
+/* This process's part of a spread sweep (def->spread not NONE): the trials
+ * of def->part not yet in the journal (ss NULL: none kept here), and for
+ * a shard the part directory's files staged. */
+static int sweep_part(const bsim_sweep_dir_def *def, const bsim_experiment *e, const char *inputs,
+                      bsim_sweep_config *cfg, bsim_session *ss, bsim_error *err)
+{
+	long total = (long)e->n_groups * e->trials;
+	size_t bytes = (size_t)total / 8 + 1;
+	unsigned char *done = calloc(bytes, 1);
+	if (!done)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	long kept = 0, cut = 0;
+	int rc = BSIM_OK;
+	if (ss && ss->journal) {
+		unsigned char *bits = done;
+		rc = bsim_journal_replay(ss->journal, mark_done, &bits, &kept, &cut, err);
+	}
+	if (rc == BSIM_OK && def->agree)
+		rc = def->agree(def->part.user, inputs, done, bytes, err);
+	bsim_sweep_part part = def->part;
+	part.done = done;
+	if (rc == BSIM_OK)
+		rc = bsim_sweep_run_part(e, cfg, &part, err);
+	if (rc == BSIM_OK && def->spread == BSIM_SPREAD_SHARD) {
+		long records = 0;
+		char run[17], path[BSIM_PATH_MAX];
+		part_dir_run_id(inputs, run);
+		ss->done = 1;
+		rc = bsim_journal_close(ss->journal, err);
+		ss->journal = NULL;
+		if (rc == BSIM_OK)
+			rc = bsim_session_path(path, sizeof path, ss->stage, "part.journal", err);
+		/* part.journal counts every trial it holds: count them again */
+		unsigned char *bits = done;
+		memset(done, 0, bytes);
+		if (rc == BSIM_OK)
+			rc = bsim_journal_read(ss->journal_path, inputs, bsim_sweep_record_size(0),
+			                       mark_done, &bits, &kept, &cut, err);
+		for (long i = 0; rc == BSIM_OK && i < total; i++)
+			records += (done[i / 8] >> (i % 8)) & 1;
+		if (rc == BSIM_OK && bsim_output_mkdir(ss->stage, err) != BSIM_OK)
+			rc = BSIM_EFAIL;
+		if (rc == BSIM_OK && rename(ss->journal_path, path) != 0)
+			rc = bsim_error_set(err, BSIM_EFAIL, "%s: cannot move to %s (%s)",
+			                    ss->journal_path, path, strerror(errno));
+		if (rc == BSIM_OK) {
+			ss->journal_path[0] = '\0';
+			rc = part_dir_write(ss->stage, "sweep", def->part.index + 1,
+			                    def->part.count, run, total, records, def->argc,
+			                    def->argv, err);
+		}
+	}
+	free(done);
+	return rc;
+}
+
+/* Whether e's groups are lattices (a lattice sweep is not split). */
+static int sweep_is_lattice(const bsim_sweep_dir_def *def, const bsim_experiment *e, int *lattice,
+                            bsim_error *err)
+{
+	bsim_scene scene;
+	int rc = bsim_experiment_group_scene(e, 0, def->sets, def->n_sets, &scene, err);
+	if (rc != BSIM_OK)
+		return rc;
+	*lattice = scene.has_lattice;
+	bsim_scene_free(&scene);
+	return BSIM_OK;
+}
+
+/* The journal, closed and opened again to be replayed by the whole sweep. */
+static int journal_reopen(bsim_session *ss, const char *inputs, bsim_error *err)
+{
+	int rc = bsim_journal_close(ss->journal, err);
+	ss->journal = NULL;
+	if (rc == BSIM_OK)
+		rc = bsim_journal_resume(&ss->journal, ss->journal_path, inputs,
+		                         bsim_sweep_record_size(0), err);
+	return rc;
+}
+
 int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err)
 {
+	double t0 = bsim_clock_seconds();
 	memset(res, 0, sizeof *res);
 	res->first_unstable = -1;
 	const bsim_backend *b = def->backend ? def->backend : &bsim_backend_thesis;
@@ -183,15 +276,17 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 		if (!inputs)
 			bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
-	bsim_session ss;
-	rc = inputs ? bsim_session_open(&ss, def->out, def->resume, inputs,
-	                                bsim_sweep_record_size(0), err)
-	            : err->code;
-	free(inputs);
-	if (rc != BSIM_OK) {
-		bsim_experiment_free(e);
-		return rc;
-	}
+	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread, lattice = 0;
+	rc = inputs ? BSIM_OK : err->code;
+	if (rc == BSIM_OK && (spread != BSIM_SPREAD_NONE || def->n_merge > 0))
+		rc = sweep_is_lattice(def, e, &lattice, err);
+	if (rc == BSIM_OK && lattice && (spread == BSIM_SPREAD_SHARD || def->n_merge > 0))
+		rc = bsim_error_set(err, BSIM_EINPUT,
+		                    "%s: a lattice sweep is not split into parts (its gate paths "
+		                    "are not journaled): run it in one process",
+		                    def->experiment);
+	if (rc == BSIM_OK && def->n_merge > 0 && def->resume)
+		rc = bsim_error_set(err, BSIM_EINPUT, "merge: --resume does not apply");
 	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
 	bsim_sweep_config cfg = {
 	        .backend = b,
@@ -204,17 +299,68 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	        .measure_overlap = def->overlap,
 	        .keep = def->keep,
 	        .keep_stride = def->keep_stride,
-	        .journal = ss.journal,
 	        .stop = def->stop,
 	};
+	if (rc == BSIM_OK && spread == BSIM_SPREAD_SEND) {
+		/* Another rank's: its records go to the gatherer; no directory.
+		 * Of a lattice sweep it runs nothing (the gatherer runs it all). */
+		rc = lattice ? (def->agree ? def->agree(def->part.user, inputs, NULL, 0, err)
+		                           : BSIM_OK)
+		             : sweep_part(def, e, inputs, &cfg, NULL, err);
+		free(inputs);
+		if (rc != BSIM_OK)
+			bsim_experiment_free(e);
+		return rc;
+	}
+	bsim_session ss;
+	if (rc == BSIM_OK)
+		rc = bsim_session_open(&ss, def->out, def->resume, inputs,
+		                       bsim_sweep_record_size(0), err);
+	if (rc != BSIM_OK) {
+		free(inputs);
+		bsim_experiment_free(e);
+		return rc;
+	}
+	cfg.journal = ss.journal;
+	if (def->n_merge > 0) {
+		char run[17];
+		part_dir_run_id(inputs, run);
+		long total = (long)e->n_groups * e->trials;
+		rc = part_dir_join(def->merge, def->n_merge, "sweep", run, inputs,
+		                   bsim_sweep_record_size(0), total, ss.journal, err);
+		if (rc == BSIM_OK)
+			rc = journal_reopen(&ss, inputs, err);
+		cfg.journal = ss.journal;
+	} else if (spread == BSIM_SPREAD_SHARD || (spread == BSIM_SPREAD_GATHER && !lattice)) {
+		rc = sweep_part(def, e, inputs, &cfg, &ss, err);
+		if (spread == BSIM_SPREAD_SHARD) {
+			free(inputs);
+			rc = session_end(&ss, rc, "sweep", res->journal, sizeof res->journal, err);
+			if (rc != BSIM_OK)
+				bsim_sweep_dir_result_free(res);
+			return rc;
+		}
+		if (rc == BSIM_OK)
+			rc = journal_reopen(&ss, inputs, err);
+		cfg.journal = ss.journal;
+	} else if (spread == BSIM_SPREAD_GATHER && def->agree) {
+		rc = def->agree(def->part.user, inputs, NULL, 0, err);
+	}
+	free(inputs);
 	/* The trials stream into their files as they finish. */
 	trials_sink sink = {0};
-	rc = sink_open(&sink, ss.stage, e, def->sets, def->n_sets, err);
+	int opened = rc == BSIM_OK;
+	if (opened)
+		rc = sink_open(&sink, ss.stage, e, def->sets, def->n_sets, err);
 	cfg.sink = trials_sink_take;
 	cfg.sink_user = &sink;
 	if (rc == BSIM_OK)
 		rc = bsim_sweep_run(e, &cfg, &res->r, err);
-	rc = sink_close(&sink, rc, ss.stage, err);
+	/* A gathered sweep's time is its parts' and the writing's. */
+	if (rc == BSIM_OK && spread == BSIM_SPREAD_GATHER)
+		res->r.wall_seconds = bsim_clock_seconds() - t0;
+	if (opened)
+		rc = sink_close(&sink, rc, ss.stage, err);
 	if (sink.failed)
 		ss.done = 1; /* the trials journaled before the disk filled are kept */
 	if (rc == BSIM_OK) {

@@ -1,0 +1,40 @@
+/* The processes of an MPI job (docs/cluster.md): the one file of the
+ * program that speaks MPI, built in when CMake finds MPI (BSIM_HAVE_MPI).
+ * The library knows nothing of MPI: a sweep is spread through its parts
+ * (beamsim/sweep.h bsim_sweep_part, beamsim/sweep_dir.h spread), and this
+ * file moves the parts' journal records to rank 0, which journals them and
+ * writes the output directory as one process writes it.
+ *
+ * Records go in batches: a rank's threads queue each finished trial's
+ * record, and its main thread sends the queue between its own trials (MPI
+ * called from one thread only: MPI_THREAD_FUNNELED). Rank 0 receives
+ * between its own trials and, once they are done, until every rank has
+ * sent its last batch. A rank that dies ends the job (mpirun kills the
+ * others); rank 0's journal then holds every record it received, and the
+ * same command with --resume continues. */
+#ifndef BSIM_CLI_CLI_MPI_H
+#define BSIM_CLI_CLI_MPI_H
+
+#include "beamsim/sweep_dir.h"
+
+/* Called first by main: starts MPI when the program runs under mpirun
+ * (and MPI is built in). CLI_OK, or CLI_USAGE (printed) when it runs as
+ * one of several processes of a job and MPI is not built in. */
+int cli_mpi_init(int *argc, char ***argv);
+
+/* Called last by main: ends MPI. */
+void cli_mpi_finish(void);
+
+/* This process's rank and the job's size (0 and 1 without MPI). */
+int cli_mpi_rank(void);
+int cli_mpi_size(void);
+
+/* In a job of several ranks, def's sweep spread over them: rank 0 gathers
+ * and writes, the others send (def->spread, part, agree). */
+void cli_mpi_spread(bsim_sweep_dir_def *def);
+
+/* Ends the whole job with status rc (after a rank's failure, printed):
+ * the other ranks would wait for it for ever. Returns if one process. */
+void cli_mpi_abort(int rc);
+
+#endif
