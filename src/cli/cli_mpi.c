@@ -96,10 +96,28 @@ int cli_mpi_init(int *argc, char ***argv)
 	return CLI_OK;
 }
 
+/* Waits for req, looking every millisecond: OpenMPI's own waits spin,
+ * which takes a core from the ranks still computing. */
+static void idle_wait(MPI_Request *req)
+{
+	const struct timespec ms = {0, 1000000};
+	int flag = 0;
+	MPI_Test(req, &flag, MPI_STATUS_IGNORE);
+	while (!flag) {
+		nanosleep(&ms, NULL);
+		MPI_Test(req, &flag, MPI_STATUS_IGNORE);
+	}
+}
+
 void cli_mpi_finish(void)
 {
-	if (mpi_on)
-		MPI_Finalize();
+	if (!mpi_on)
+		return;
+	/* a rank done early waits here idle, not in MPI_Finalize's spin */
+	MPI_Request req;
+	if (mpi_size > 1 && MPI_Ibarrier(MPI_COMM_WORLD, &req) == MPI_SUCCESS)
+		idle_wait(&req);
+	MPI_Finalize();
 	mpi_on = 0;
 }
 
@@ -155,9 +173,40 @@ static int mpi_record(void *user, long index, const void *payload, bsim_error *e
 	return BSIM_OK;
 }
 
+/* Batches on their way to rank 0 (sent without waiting: rank 0 takes
+ * them between its own trials), freed once sent. */
+#define PENDING_MAX 64
+static MPI_Request pending_req[PENDING_MAX];
+static unsigned char *pending_buf[PENDING_MAX];
+static int n_pending;
+
+/* Frees the batches sent; with all, waits for every one. */
+static void pending_reap(int all)
+{
+	for (int i = 0; i < n_pending;) {
+		int flag = 0;
+		if (all)
+			idle_wait(&pending_req[i]);
+		else
+			MPI_Test(&pending_req[i], &flag, MPI_STATUS_IGNORE);
+		if (all || flag) {
+			free(pending_buf[i]);
+			pending_req[i] = pending_req[--n_pending];
+			pending_buf[i] = pending_buf[n_pending];
+		} else {
+			i++;
+		}
+	}
+}
+
 /* The queue sent to rank 0 (main thread only). */
 static void send_queue(void)
 {
+	pending_reap(0);
+	if (n_pending == PENDING_MAX) {
+		idle_wait(&pending_req[0]);
+		pending_reap(0);
+	}
 	pthread_mutex_lock(&queue.lock);
 	size_t used = queue.used;
 	unsigned char *buf = NULL;
@@ -167,9 +216,11 @@ static void send_queue(void)
 		queue.used = queue.cap = 0;
 	}
 	pthread_mutex_unlock(&queue.lock);
-	if (buf)
-		MPI_Send(buf, (int)used, MPI_BYTE, 0, TAG_RECORDS, MPI_COMM_WORLD);
-	free(buf);
+	if (!buf)
+		return;
+	MPI_Isend(buf, (int)used, MPI_BYTE, 0, TAG_RECORDS, MPI_COMM_WORLD,
+	          &pending_req[n_pending]);
+	pending_buf[n_pending++] = buf;
 }
 
 /* Rank 0: every message waiting, records to accept; *ended counts the
@@ -222,8 +273,12 @@ static int mpi_collect(void *user, int wait, bsim_sweep_accept_fn accept, void *
 	mpi_part *p = user;
 	if (mpi_rank != 0) {
 		send_queue();
-		if (wait)
-			MPI_Send(NULL, 0, MPI_BYTE, 0, TAG_DONE, MPI_COMM_WORLD);
+		if (wait) {
+			pending_reap(1);
+			MPI_Request req;
+			MPI_Isend(NULL, 0, MPI_BYTE, 0, TAG_DONE, MPI_COMM_WORLD, &req);
+			idle_wait(&req);
+		}
 		return BSIM_OK;
 	}
 	int rc = receive(accept, ctx, &p->ended, err);
