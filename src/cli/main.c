@@ -138,6 +138,15 @@ static int dispatch(int argc, char **argv)
 		return CLI_OK;
 	}
 	const cli_command *c = find_command(name);
+	/* Only sweep spreads its trials over an MPI job's ranks (docs/cluster.md):
+	 * any other command would run whole in every rank, into one DIR. */
+	if (c && c->run != cmd_sweep && cli_mpi_size() > 1) {
+		cli_error("%s runs in one process: start it without mpirun (of the commands, "
+		          "sweep spreads over MPI ranks; docs/cluster.md)",
+		          name);
+		cli_mpi_abort(CLI_USAGE);
+		return CLI_USAGE;
+	}
 	return c ? c->run(argc - 1, argv + 1) : CLI_USAGE;
 }
 
