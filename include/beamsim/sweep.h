@@ -181,16 +181,21 @@ typedef struct bsim_sweep_part {
 	void *user;
 } bsim_sweep_part;
 
-/* Runs part's trials of the sweep of e (a plain sweep: cfg->sink, keep and
- * the second side are not used): each trial not marked in part->done runs
- * and its record goes to cfg->journal (if not NULL; already replayed) and
- * to part->record. A deterministic group's copies are not run (its trial
- * 0 stands for them). cfg->progress gets this part's trials done and its
- * total, or with collect the trials of every part (done bits and records
- * received included) and the sweep's total. BSIM_ESTOPPED when cfg->stop
- * stopped it. */
+/* Runs part's trials of the sweep of e (cfg->sink and keep are not used): each trial not marked in
+ * part->done runs and its record goes to cfg->journal (if not NULL; already replayed) and to
+ * part->record. A deterministic group's copies are not run (its trial 0 stands for them).
+ * cfg->progress gets this part's trials done and its total, or with collect the trials of every
+ * part (done bits and records received included) and the sweep's total. BSIM_ESTOPPED when
+ * cfg->stop stopped it. */
 BSIM_API int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                  const bsim_sweep_part *part, bsim_error *err);
+
+/* The same for a paired sweep (beamsim compare): each trial runs on both
+ * sides as bsim_sweep_run_paired runs it, its record both results and the
+ * separation time (bsim_sweep_record_size(1)). */
+BSIM_API int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                        const bsim_backend *backend_b, const bsim_options *opts_b,
+                                        const bsim_sweep_part *part, bsim_error *err);
 
 /* Aggregates one group's trials into counts and the Wilson interval. */
 BSIM_API void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n,

@@ -341,8 +341,15 @@ static void sweep_thread(sweep_shared *sh)
 		/* Only trials that ran are journaled: copies are filled in again. */
 		if (rc == BSIM_OK && ran && cfg->journal)
 			rc = journal_append(sh, i, &err);
-		if (rc == BSIM_OK && ran && sh->part && sh->part->record)
-			rc = sh->part->record(sh->part->user, i, &sh->results[k], &err);
+		if (rc == BSIM_OK && ran && sh->part && sh->part->record) {
+			pair_record p;
+			if (sh->backend_b)
+				p = (pair_record){sh->results[k], sh->results_b[k],
+				                  sh->t_separate[k]};
+			rc = sh->part->record(sh->part->user, i,
+			                      sh->backend_b ? (const void *)&p : &sh->results[k],
+			                      &err);
+		}
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
 		if (leader && sh->part && sh->part->collect &&
@@ -850,8 +857,9 @@ int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg
  * sweep's do, each thread passing over the other parts' trials; nothing is
  * kept but the records handed on, so memory does not grow with the sweep. */
 
-int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
-                        const bsim_sweep_part *part, bsim_error *err)
+static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                    const bsim_backend *backend_b, const bsim_options *opts_b,
+                    const bsim_sweep_part *part, bsim_error *err)
 {
 	int keep = 0, rc = sweep_check(e, cfg, &keep, err);
 	if (rc != BSIM_OK)
@@ -864,20 +872,38 @@ int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
 	bsim_trial_result *results = calloc(BSIM_SWEEP_BLOCK, sizeof *results);
 	bsim_trial_log *logs = calloc(BSIM_SWEEP_BLOCK, sizeof *logs);
-	if (!deterministic || !results || !logs)
+	/* a paired part's second side */
+	bsim_scene *scenes_b = NULL;
+	bsim_trial_result *results_b = NULL;
+	bsim_trial_log *logs_b = NULL;
+	double *t_separate = NULL;
+	if (backend_b) {
+		results_b = calloc(BSIM_SWEEP_BLOCK, sizeof *results_b);
+		logs_b = calloc(BSIM_SWEEP_BLOCK, sizeof *logs_b);
+		t_separate = calloc(BSIM_SWEEP_BLOCK, sizeof *t_separate);
+	}
+	if (!deterministic || !results || !logs ||
+	    (backend_b && (!results_b || !logs_b || !t_separate)))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
 	if (rc == BSIM_OK)
 		rc = scenes_build(e, cfg, 0, &scenes, err);
+	if (rc == BSIM_OK && backend_b && cfg->n_extra_b > 0)
+		rc = scenes_build(e, cfg, 1, &scenes_b, err);
 	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
 		deterministic[g] = !bsim_effects_random(&scenes[g]);
 	sweep_shared sh = {
 	        .e = e,
 	        .cfg = cfg,
 	        .scenes = scenes,
-	        .scenes_b = scenes,
+	        .scenes_b = scenes_b ? scenes_b : scenes,
 	        .deterministic = deterministic,
 	        .results = results,
 	        .logs = logs,
+	        .backend_b = backend_b,
+	        .opts_b = opts_b,
+	        .results_b = results_b,
+	        .logs_b = logs_b,
+	        .t_separate = t_separate,
 	        .keep_stride = 5,
 	        .total = total,
 	        .spill_fd = -1,
@@ -914,10 +940,30 @@ int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
 		cfg->progress(cfg->progress_user, sh.progress_total, sh.progress_total);
 	if (scenes)
 		scenes_free(scenes, e->n_groups);
+	if (scenes_b)
+		scenes_free(scenes_b, e->n_groups);
 	for (long k = 0; logs && k < BSIM_SWEEP_BLOCK; k++)
 		bsim_trial_log_clear(&logs[k]);
+	for (long k = 0; logs_b && k < BSIM_SWEEP_BLOCK; k++)
+		bsim_trial_log_clear(&logs_b[k]);
 	free(logs);
 	free(results);
+	free(logs_b);
+	free(results_b);
+	free(t_separate);
 	free(deterministic);
 	return rc;
+}
+
+int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                        const bsim_sweep_part *part, bsim_error *err)
+{
+	return run_part(e, cfg, NULL, NULL, part, err);
+}
+
+int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                               const bsim_backend *backend_b, const bsim_options *opts_b,
+                               const bsim_sweep_part *part, bsim_error *err)
+{
+	return run_part(e, cfg, backend_b, opts_b, part, err);
 }

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
+#include "beamsim/output.h"
 #include "beamsim/sweep_dir.h"
 #include "store/session.h"
 #include "util/hash.h"
@@ -245,5 +246,77 @@ int part_dir_join(const char *const *dirs, int n, const char *command, const cha
 	for (int k = 0; k < n; k++)
 		bsim_sweep_dir_part_free(&parts[k]);
 	free(parts);
+	return rc;
+}
+
+/* A journal record marked in the done bits (bsim_journal_fn). */
+static int mark_done(void *user, uint64_t index, const void *payload)
+{
+	(void)payload;
+	unsigned char **bits = user;
+	(*bits)[index / 8] |= (unsigned char)(1u << (index % 8));
+	return 0;
+}
+
+int part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_session *ss,
+                        part_dir_run_fn run, void *user, bsim_error *err)
+{
+	long total = sp->total;
+	size_t bytes = (size_t)total / 8 + 1;
+	unsigned char *done = calloc(bytes, 1);
+	if (!done)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	long kept = 0, cut = 0;
+	int rc = BSIM_OK;
+	if (ss && ss->journal) {
+		unsigned char *bits = done;
+		rc = bsim_journal_replay(ss->journal, mark_done, &bits, &kept, &cut, err);
+	}
+	if (rc == BSIM_OK && sp->agree)
+		rc = sp->agree(sp->part->user, inputs, done, bytes, err);
+	bsim_sweep_part part = *sp->part;
+	part.done = done;
+	if (rc == BSIM_OK)
+		rc = run(user, &part, err);
+	if (rc == BSIM_OK && sp->spread == BSIM_SPREAD_SHARD) {
+		long records = 0;
+		char id[17], path[BSIM_PATH_MAX];
+		part_dir_run_id(inputs, id);
+		ss->done = 1;
+		rc = bsim_journal_close(ss->journal, err);
+		ss->journal = NULL;
+		if (rc == BSIM_OK)
+			rc = bsim_session_path(path, sizeof path, ss->stage, "part.journal", err);
+		/* part.journal counts every trial it holds: count them again */
+		unsigned char *bits = done;
+		memset(done, 0, bytes);
+		if (rc == BSIM_OK)
+			rc = bsim_journal_read(ss->journal_path, inputs, sp->record_size, mark_done,
+			                       &bits, &kept, &cut, err);
+		for (long i = 0; rc == BSIM_OK && i < total; i++)
+			records += (done[i / 8] >> (i % 8)) & 1;
+		if (rc == BSIM_OK && bsim_output_mkdir(ss->stage, err) != BSIM_OK)
+			rc = BSIM_EFAIL;
+		if (rc == BSIM_OK && rename(ss->journal_path, path) != 0)
+			rc = bsim_error_set(err, BSIM_EFAIL, "%s: cannot move to %s (%s)",
+			                    ss->journal_path, path, strerror(errno));
+		if (rc == BSIM_OK) {
+			ss->journal_path[0] = '\0';
+			rc = part_dir_write(ss->stage, sp->command, sp->part->index + 1,
+			                    sp->part->count, id, total, records, sp->argc, sp->argv,
+			                    err);
+		}
+	}
+	free(done);
+	return rc;
+}
+
+int part_dir_journal_reopen(bsim_session *ss, const char *inputs, size_t record_size,
+                            bsim_error *err)
+{
+	int rc = bsim_journal_close(ss->journal, err);
+	ss->journal = NULL;
+	if (rc == BSIM_OK)
+		rc = bsim_journal_resume(&ss->journal, ss->journal_path, inputs, record_size, err);
 	return rc;
 }

@@ -8,6 +8,8 @@
 #include <stddef.h>
 
 #include "beamsim/error.h"
+#include "beamsim/sweep.h"
+#include "store/session.h"
 #include "util/journal.h"
 
 /* The run's name: 16 hex digits of the FNV-1a hash of its inputs
@@ -26,5 +28,32 @@ int part_dir_write(const char *stage, const char *command, int index, int count,
 int part_dir_join(const char *const *dirs, int n, const char *command, const char *run,
                   const char *inputs, size_t record_size, long total, bsim_journal *j,
                   bsim_error *err);
+
+/* How a run is spread (beamsim/sweep_dir.h): the mode, this process's
+ * part, the check that every process has the same inputs, and for a shard
+ * what part.json records. */
+typedef struct part_dir_spread {
+	int spread; /* BSIM_SPREAD_SHARD, _GATHER or _SEND */
+	const bsim_sweep_part *part;
+	int (*agree)(void *user, const char *inputs, unsigned char *done, size_t bytes,
+	             bsim_error *err);
+	const char *command; /* "sweep" or "compare" */
+	size_t record_size;
+	long total; /* trials of the whole run */
+	int argc;
+	char *const *argv;
+} part_dir_spread;
+
+/* Runs this process's part: run(user, part) with part->done the trials
+ * already in ss's journal (ss NULL: no journal here; the gatherer's done
+ * bits come through agree); for a shard, then, the journal moved to
+ * ss->stage/part.journal beside a part.json. */
+typedef int (*part_dir_run_fn)(void *user, const bsim_sweep_part *part, bsim_error *err);
+int part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_session *ss,
+                        part_dir_run_fn run, void *user, bsim_error *err);
+
+/* ss's journal closed and opened again, to be replayed by the whole run. */
+int part_dir_journal_reopen(bsim_session *ss, const char *inputs, size_t record_size,
+                            bsim_error *err);
 
 #endif

@@ -157,69 +157,31 @@ static int session_end(bsim_session *ss, int rc, const char *command, char *jour
 	return rc;
 }
 
-/* A journal record marked in the done bits (bsim_journal_fn). */
-static int mark_done(void *user, uint64_t index, const void *payload)
+/* This process's part of the sweep (part_dir_run_fn). */
+typedef struct sweep_part_ctx {
+	const bsim_experiment *e;
+	const bsim_sweep_config *cfg;
+} sweep_part_ctx;
+
+static int sweep_part_run(void *user, const bsim_sweep_part *part, bsim_error *err)
 {
-	(void)payload;
-	unsigned char **bits = user;
-	(*bits)[index / 8] |= (unsigned char)(1u << (index % 8));
-	return 0;
+	sweep_part_ctx *c = user;
+	return bsim_sweep_run_part(c->e, c->cfg, part, err);
 }
 
-/* This process's part of a spread sweep (def->spread not NONE): the trials
- * of def->part not yet in the journal (ss NULL: none kept here), and for
- * a shard the part directory's files staged. */
 static int sweep_part(const bsim_sweep_dir_def *def, const bsim_experiment *e, const char *inputs,
                       bsim_sweep_config *cfg, bsim_session *ss, bsim_error *err)
 {
-	long total = (long)e->n_groups * e->trials;
-	size_t bytes = (size_t)total / 8 + 1;
-	unsigned char *done = calloc(bytes, 1);
-	if (!done)
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	long kept = 0, cut = 0;
-	int rc = BSIM_OK;
-	if (ss && ss->journal) {
-		unsigned char *bits = done;
-		rc = bsim_journal_replay(ss->journal, mark_done, &bits, &kept, &cut, err);
-	}
-	if (rc == BSIM_OK && def->agree)
-		rc = def->agree(def->part.user, inputs, done, bytes, err);
-	bsim_sweep_part part = def->part;
-	part.done = done;
-	if (rc == BSIM_OK)
-		rc = bsim_sweep_run_part(e, cfg, &part, err);
-	if (rc == BSIM_OK && def->spread == BSIM_SPREAD_SHARD) {
-		long records = 0;
-		char run[17], path[BSIM_PATH_MAX];
-		part_dir_run_id(inputs, run);
-		ss->done = 1;
-		rc = bsim_journal_close(ss->journal, err);
-		ss->journal = NULL;
-		if (rc == BSIM_OK)
-			rc = bsim_session_path(path, sizeof path, ss->stage, "part.journal", err);
-		/* part.journal counts every trial it holds: count them again */
-		unsigned char *bits = done;
-		memset(done, 0, bytes);
-		if (rc == BSIM_OK)
-			rc = bsim_journal_read(ss->journal_path, inputs, bsim_sweep_record_size(0),
-			                       mark_done, &bits, &kept, &cut, err);
-		for (long i = 0; rc == BSIM_OK && i < total; i++)
-			records += (done[i / 8] >> (i % 8)) & 1;
-		if (rc == BSIM_OK && bsim_output_mkdir(ss->stage, err) != BSIM_OK)
-			rc = BSIM_EFAIL;
-		if (rc == BSIM_OK && rename(ss->journal_path, path) != 0)
-			rc = bsim_error_set(err, BSIM_EFAIL, "%s: cannot move to %s (%s)",
-			                    ss->journal_path, path, strerror(errno));
-		if (rc == BSIM_OK) {
-			ss->journal_path[0] = '\0';
-			rc = part_dir_write(ss->stage, "sweep", def->part.index + 1,
-			                    def->part.count, run, total, records, def->argc,
-			                    def->argv, err);
-		}
-	}
-	free(done);
-	return rc;
+	part_dir_spread sp = {def->spread,
+	                      &def->part,
+	                      def->agree,
+	                      "sweep",
+	                      bsim_sweep_record_size(0),
+	                      (long)e->n_groups * e->trials,
+	                      def->argc,
+	                      def->argv};
+	sweep_part_ctx c = {e, cfg};
+	return part_dir_spread_run(&sp, inputs, ss, sweep_part_run, &c, err);
 }
 
 /* Whether e's groups are lattices (a lattice sweep is not split). */
@@ -233,17 +195,6 @@ static int sweep_is_lattice(const bsim_sweep_dir_def *def, const bsim_experiment
 	*lattice = scene.has_lattice;
 	bsim_scene_free(&scene);
 	return BSIM_OK;
-}
-
-/* The journal, closed and opened again to be replayed by the whole sweep. */
-static int journal_reopen(bsim_session *ss, const char *inputs, bsim_error *err)
-{
-	int rc = bsim_journal_close(ss->journal, err);
-	ss->journal = NULL;
-	if (rc == BSIM_OK)
-		rc = bsim_journal_resume(&ss->journal, ss->journal_path, inputs,
-		                         bsim_sweep_record_size(0), err);
-	return rc;
 }
 
 int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err)
@@ -329,7 +280,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 		rc = part_dir_join(def->merge, def->n_merge, "sweep", run, inputs,
 		                   bsim_sweep_record_size(0), total, ss.journal, err);
 		if (rc == BSIM_OK)
-			rc = journal_reopen(&ss, inputs, err);
+			rc = part_dir_journal_reopen(&ss, inputs, bsim_sweep_record_size(0), err);
 		cfg.journal = ss.journal;
 	} else if (spread == BSIM_SPREAD_SHARD || (spread == BSIM_SPREAD_GATHER && !lattice)) {
 		rc = sweep_part(def, e, inputs, &cfg, &ss, err);
@@ -341,7 +292,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 			return rc;
 		}
 		if (rc == BSIM_OK)
-			rc = journal_reopen(&ss, inputs, err);
+			rc = part_dir_journal_reopen(&ss, inputs, bsim_sweep_record_size(0), err);
 		cfg.journal = ss.journal;
 	} else if (spread == BSIM_SPREAD_GATHER && def->agree) {
 		rc = def->agree(def->part.user, inputs, NULL, 0, err);
