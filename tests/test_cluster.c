@@ -87,14 +87,16 @@ static char *file_bytes(const char *path, long *n)
 	return b;
 }
 
-/* summary.json without its wall_seconds line. */
+/* A JSON text with every "wall_seconds" value cut out (summary.json,
+ * report.json). */
 static void drop_wall(char *text)
 {
-	char *w = strstr(text, "\"wall_seconds\"");
-	if (!w)
-		return;
-	char *end = strchr(w, '\n');
-	memmove(w, end ? end + 1 : w + strlen(w), strlen(end ? end + 1 : w) + 1);
+	const char *key = "\"wall_seconds\": ";
+	for (char *w = strstr(text, key); w; w = strstr(w + 1, key)) {
+		char *v = w + strlen(key);
+		size_t n = strcspn(v, ",}\n");
+		memmove(v, v + n, strlen(v + n) + 1);
+	}
 }
 
 static const char *ref_root, *other_root;
@@ -111,13 +113,14 @@ static int compare_one(const char *path, const struct stat *st, int type, struct
 		return 0;
 	const char *name = strrchr(rel, '/') ? strrchr(rel, '/') + 1 : rel;
 	/* the files that hold the wall time */
-	if (strcmp(name, "manifest.json") == 0 || strcmp(name, "summary.mat") == 0)
+	if (strcmp(name, "manifest.json") == 0 || strcmp(name, "summary.mat") == 0 ||
+	    strcmp(name, "report.mat") == 0)
 		return 0;
 	char other[2048];
 	snprintf(other, sizeof other, "%s/%s", other_root, rel);
 	long na = 0, nb = -1;
 	char *a = file_bytes(path, &na), *b = file_bytes(other, &nb);
-	if (a && b && strcmp(name, "summary.json") == 0) {
+	if (a && b && (strcmp(name, "summary.json") == 0 || strcmp(name, "report.json") == 0)) {
 		drop_wall(a);
 		drop_wall(b);
 		na = (long)strlen(a);
@@ -225,6 +228,31 @@ static void test_shards_merged(void **state)
 	assert_same_dir(one, out);
 }
 
+/* A comparison (thesis against box2d) in 3 parts, merged. */
+static void test_compare_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[3][1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("compare_parts"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	const char *argv1[] = {"compare", experiment, "--trials", "4",       "--threads",
+	                       "2",       "--out",    one,        "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv1, NULL, NULL), 0);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		const char *argv[] = {"compare",   experiment, "--trials", "4",
+		                      "--threads", "1",        "--shard",  shard_arg,
+		                      "--out",     part[i],    "--quiet",  NULL};
+		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	}
+	snprintf(out, sizeof out, "%s/merged", dir);
+	const char *argv[] = {"merge", part[1], part[2], part[0], "--out", out, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	assert_same_dir(one, out);
+}
+
 /* merge refuses: the status 2, one line naming the culprit, no DIR. */
 static void refused(const char *a, const char *b, const char *c, const char *const needles[])
 {
@@ -272,17 +300,17 @@ static int have_mpi(void)
 	return 0;
 }
 
-/* Starts mpirun -np ranks beamsim sweep ... in the background, its
- * stderr into err_path; returns mpirun's pid. */
-static pid_t mpirun(const char *ranks, const char *out, const char *trials, int resume,
-                    const char *err_path)
+/* Starts mpirun -np ranks beamsim cmd ... in the background, its stderr
+ * into err_path; returns mpirun's pid. */
+static pid_t mpirun_command(const char *cmd, const char *ranks, const char *out, const char *trials,
+                            int resume, const char *err_path)
 {
 	const char *argv[] = {BSIM_TEST_MPIEXEC,
 	                      "--oversubscribe",
 	                      "-np",
 	                      ranks,
 	                      BSIM_EXE,
-	                      "sweep",
+	                      cmd,
 	                      experiment,
 	                      "--trials",
 	                      trials,
@@ -323,6 +351,12 @@ static pid_t mpirun(const char *ranks, const char *out, const char *trials, int 
 	return pid;
 }
 
+static pid_t mpirun(const char *ranks, const char *out, const char *trials, int resume,
+                    const char *err_path)
+{
+	return mpirun_command("sweep", ranks, out, trials, resume, err_path);
+}
+
 static void print_stderr(const char *path)
 {
 	char *text = bsim_test_read(path);
@@ -336,6 +370,27 @@ static int wait_status(pid_t pid)
 	while (waitpid(pid, &st, 0) < 0)
 		;
 	return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
+/* mpirun -np 2 beamsim compare: the one-process comparison. */
+static void test_mpi_compare(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_compare"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/ranks2", dir);
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	const char *argv1[] = {"compare", experiment, "--trials", "6",       "--threads",
+	                       "2",       "--out",    one,        "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv1, NULL, NULL), 0);
+	int rc = wait_status(mpirun_command("compare", "2", out, "6", 0, err_path));
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
 }
 
 static void test_mpi_identical(void **state)
@@ -447,10 +502,12 @@ int main(int argc, char **argv)
 {
 	const struct CMUnitTest shards[] = {
 	        cmocka_unit_test(test_shards_merged),
+	        cmocka_unit_test(test_compare_shards_merged),
 	        cmocka_unit_test(test_merge_refuses),
 	};
 	const struct CMUnitTest mpi[] = {
 	        cmocka_unit_test(test_mpi_identical),
+	        cmocka_unit_test(test_mpi_compare),
 	        cmocka_unit_test(test_mpi_rank_killed_resumed),
 	};
 	if (argc < 2 || strcmp(argv[1], "mpi") != 0)

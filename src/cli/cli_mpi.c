@@ -1,5 +1,5 @@
 /* The processes of an MPI job; see cli_mpi.h. */
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700
 
 #include "cli/cli_mpi.h"
 
@@ -22,6 +22,40 @@ static long launcher_size(void)
 			return strtol(v, NULL, 10);
 	}
 	return getenv("PMIX_RANK") ? 1 : 0;
+}
+
+int cli_shard_parse(const char *cmd, const char *value, int *index, int *count)
+{
+	char *end = NULL, *end2 = NULL;
+	long k = strtol(value, &end, 10), n = 0;
+	if (end != value && *end == '/')
+		n = strtol(end + 1, &end2, 10);
+	if (end == value || *end != '/' || !end2 || end2 == end + 1 || *end2 || n < 1 ||
+	    n > 1000000 || k < 1 || k > n)
+		return cli_usage(cmd, "--shard %s: expected I/N with 1 <= I <= N <= 1000000",
+		                 value);
+	*index = (int)k;
+	*count = (int)n;
+	return CLI_OK;
+}
+
+char **cli_stored_argv(int argc, char **argv, const char *pos)
+{
+	char **copy = calloc((size_t)argc + 1, sizeof *copy);
+	char *abs = pos ? realpath(pos, NULL) : NULL;
+	for (int i = 0; copy && i < argc; i++)
+		copy[i] = argv[i] == pos && abs ? abs : argv[i];
+	if (!copy)
+		free(abs);
+	return copy;
+}
+
+void cli_stored_argv_free(char **stored, int argc, char **argv)
+{
+	for (int i = 0; stored && i < argc; i++)
+		if (stored[i] != argv[i])
+			free(stored[i]);
+	free(stored);
 }
 
 #ifndef BSIM_HAVE_MPI
@@ -56,9 +90,14 @@ int cli_mpi_size(void)
 	return 1;
 }
 
-void cli_mpi_spread(bsim_sweep_dir_def *def)
+void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
+                    const volatile sig_atomic_t *stop)
 {
-	(void)def;
+	(void)spread;
+	(void)part;
+	(void)agree;
+	(void)record_size;
+	(void)stop;
 }
 
 void cli_mpi_abort(int rc)
@@ -326,19 +365,20 @@ static int mpi_agree(void *user, const char *inputs, unsigned char *done, size_t
 	return BSIM_OK;
 }
 
-void cli_mpi_spread(bsim_sweep_dir_def *def)
+void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
+                    const volatile sig_atomic_t *stop)
 {
 	if (mpi_size < 2)
 		return;
-	queue.record_size = bsim_sweep_record_size(0);
-	part_state.stop = def->stop;
-	def->spread = mpi_rank == 0 ? BSIM_SPREAD_GATHER : BSIM_SPREAD_SEND;
-	def->part = (bsim_sweep_part){.index = mpi_rank,
-	                              .count = mpi_size,
-	                              .record = mpi_rank ? mpi_record : NULL,
-	                              .collect = mpi_collect,
-	                              .user = &part_state};
-	def->agree = mpi_agree;
+	queue.record_size = record_size;
+	part_state.stop = stop;
+	*spread = mpi_rank == 0 ? BSIM_SPREAD_GATHER : BSIM_SPREAD_SEND;
+	*part = (bsim_sweep_part){.index = mpi_rank,
+	                          .count = mpi_size,
+	                          .record = mpi_rank ? mpi_record : NULL,
+	                          .collect = mpi_collect,
+	                          .user = &part_state};
+	*agree = mpi_agree;
 }
 
 #endif

@@ -29,9 +29,39 @@ void cli_mpi_finish(void);
 int cli_mpi_rank(void);
 int cli_mpi_size(void);
 
-/* In a job of several ranks, def's sweep spread over them: rank 0 gathers
- * and writes, the others send (def->spread, part, agree). */
-void cli_mpi_spread(bsim_sweep_dir_def *def);
+/* The agreement of the ranks on a run's inputs (bsim_sweep_dir_def.agree). */
+typedef int (*cli_mpi_agree_fn)(void *user, const char *inputs, unsigned char *done, size_t bytes,
+                                bsim_error *err);
+
+/* In a job of several ranks, a run spread over them: rank 0 gathers and
+ * writes, the others send (*spread, *part, *agree of a sweep's or a
+ * comparison's def, whose journal records are record_size bytes). */
+void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
+                    const volatile sig_atomic_t *stop);
+
+/* --shard I/N of cmd: CLI_OK with *index (1-based) and *count, or a usage
+ * error (printed). */
+int cli_shard_parse(const char *cmd, const char *value, int *index, int *count);
+
+/* The command line a part's part.json keeps: argv with the positional
+ * argument pos made absolute (merge may run elsewhere); free with
+ * cli_stored_argv_free. NULL if out of memory. */
+char **cli_stored_argv(int argc, char **argv, const char *pos);
+
+/* What merge sets on the command line its parts recorded: the output
+ * directory, threads, quiet, the part directories. */
+typedef struct cli_merge {
+	const char *out;
+	long threads;
+	int quiet;
+	const char *const *parts;
+	int n_parts;
+} cli_merge;
+
+/* compare's command line (argv[0] "compare") run as the merge m of its
+ * parts (cmd_compare.c). */
+int cmd_compare_merge(int argc, char **argv, const cli_merge *m);
+void cli_stored_argv_free(char **stored, int argc, char **argv);
 
 /* Ends the whole job with status rc (after a rank's failure, printed):
  * the other ranks would wait for it for ever. Returns if one process. */

@@ -1,7 +1,7 @@
 /* beamsim sweep: every group and trial of an experiment, in parallel, into
  * DIR (beamsim/sweep_dir.h), with the p_traverse table and the groups'
  * splits (cli_outcomes.h) on stdout. */
-#define _XOPEN_SOURCE 700
+#define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
 #include <limits.h>
@@ -39,17 +39,7 @@ static int sweep_option(void *args, int i, const char *value)
 		a->overlap = 1;
 		return CLI_OK;
 	}
-	char *end = NULL, *end2 = NULL;
-	long k = strtol(value, &end, 10), n = 0;
-	if (end != value && *end == '/')
-		n = strtol(end + 1, &end2, 10);
-	if (end == value || *end != '/' || !end2 || end2 == end + 1 || *end2 || n < 1 ||
-	    n > 1000000 || k < 1 || k > n)
-		return cli_usage("sweep", "--shard %s: expected I/N with 1 <= I <= N <= 1000000",
-		                 value);
-	a->shard = (int)k;
-	a->shards = (int)n;
-	return CLI_OK;
+	return cli_shard_parse("sweep", value, &a->shard, &a->shards);
 }
 
 static const cli_spec sweep_spec = {
@@ -114,29 +104,7 @@ static void sweep_report(const char *out, const bsim_sweep_dir_result *res, cons
 	cli_wrote(stdout, out);
 }
 
-/* What merge sets on the stored command line of the parts. */
-typedef struct sweep_merge {
-	const char *out;
-	long threads;
-	int quiet;
-	const char *const *parts;
-	int n_parts;
-} sweep_merge;
-
-/* The command line kept in a part's part.json: argv with the experiment
- * made absolute (merge may run elsewhere), or NULL if out of memory. */
-static char **stored_argv(int argc, char **argv, const char *experiment)
-{
-	char **copy = calloc((size_t)argc + 1, sizeof *copy);
-	char *abs = realpath(experiment, NULL);
-	for (int i = 0; copy && i < argc; i++)
-		copy[i] = argv[i] == experiment && abs ? abs : argv[i];
-	if (!copy)
-		free(abs);
-	return copy;
-}
-
-static int sweep_main(int argc, char **argv, const sweep_merge *m)
+static int sweep_main(int argc, char **argv, const cli_merge *m)
 {
 	cli_common c = cli_common_default();
 	sweep_args a = {0};
@@ -192,11 +160,11 @@ static int sweep_main(int argc, char **argv, const sweep_merge *m)
 		def.spread = BSIM_SPREAD_SHARD;
 		def.part.index = a.shard - 1;
 		def.part.count = a.shards;
-		stored = stored_argv(argc, argv, experiment);
+		stored = cli_stored_argv(argc, argv, experiment);
 		def.argc = stored ? argc : 0;
 		def.argv = stored;
 	}
-	cli_mpi_spread(&def);
+	cli_mpi_spread(&def.spread, &def.part, &def.agree, bsim_sweep_record_size(0), def.stop);
 	if (rank == 0 && !m)
 		cli_estimate_line(def.backend->name,
 		                  cli_experiment_beam_steps(experiment, &c.sets, c.trials));
@@ -206,12 +174,7 @@ static int sweep_main(int argc, char **argv, const sweep_merge *m)
 	rc = bsim_sweep_dir_run(&def, &res, &err);
 	cli_signals_restore();
 	cli_progress_finish(&progress);
-	if (stored) {
-		for (int i = 0; i < argc; i++)
-			if (stored[i] != argv[i])
-				free(stored[i]);
-		free(stored);
-	}
+	cli_stored_argv_free(stored, argc, argv);
 	if (rc == BSIM_ESTOPPED && rank > 0) {
 		/* stopped by the job's signal: rank 0 says so, and how to resume */
 		cli_common_free(&c);
@@ -271,12 +234,11 @@ int cmd_sweep(int argc, char **argv)
 static const cli_spec merge_spec = {
         .name = "merge",
         .usage = "PART_DIR... --out DIR [--threads N] [--quiet]",
-        .about = "Joins the directories of the N parts of one sweep (beamsim sweep ... "
-                 "--shard I/N\n"
-                 "--out PART_DIR, I = 1..N) into DIR, the directory the sweep writes in "
-                 "one\n"
-                 "process: trials.csv, summary.json, figures, .mat twins and run.json, the\n"
-                 "same bytes but for timings (docs/cluster.md). Every part is needed once;\n"
+        .about = "Joins the directories of the N parts of one sweep or comparison (beamsim\n"
+                 "sweep|compare ... --shard I/N --out PART_DIR, I = 1..N) into DIR, the\n"
+                 "directory the command writes in one process (trials.csv, summary.json,\n"
+                 ".mat twins, run.json; a comparison's report and pairs too), the same bytes\n"
+                 "but for the wall time (docs/cluster.md). Every part is needed once;\n"
                  "parts of another run (other inputs), a missing or repeated part, or a\n"
                  "damaged part.journal are refused, naming the directory. The sweep's\n"
                  "command line is read from the parts' part.json (the experiment by its\n"
@@ -317,12 +279,16 @@ int cmd_merge(int argc, char **argv)
 	memset(&first, 0, sizeof first);
 	if (rc < 0 && bsim_sweep_dir_part_read(parts[0], &first, &err) != BSIM_OK)
 		rc = cli_report(BSIM_EINPUT, &err);
-	if (rc < 0 && strcmp(first.command, "sweep") != 0)
-		rc = cli_usage("merge", "%s: a part of a %s; merge joins the parts of a sweep",
+	int is_compare = rc < 0 && strcmp(first.command, "compare") == 0;
+	if (rc < 0 && !is_compare && strcmp(first.command, "sweep") != 0)
+		rc = cli_usage("merge",
+		               "%s: a part of a %s; merge joins the parts of a sweep or "
+		               "a comparison",
 		               parts[0], first.command);
 	if (rc < 0) {
-		sweep_merge m = {c.out, c.threads, c.quiet, parts, n_parts};
-		rc = sweep_main(first.argc, first.argv, &m);
+		cli_merge m = {c.out, c.threads, c.quiet, parts, n_parts};
+		rc = is_compare ? cmd_compare_merge(first.argc, first.argv, &m)
+		                : sweep_main(first.argc, first.argv, &m);
 	}
 	bsim_sweep_dir_part_free(&first);
 	cli_common_free(&c);
