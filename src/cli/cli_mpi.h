@@ -1,9 +1,11 @@
-/* The processes of an MPI job (docs/cluster.md): the one file of the
- * program that speaks MPI, built in when CMake finds MPI (BSIM_HAVE_MPI).
- * The library knows nothing of MPI: a sweep is spread through its parts
- * (beamsim/sweep.h bsim_sweep_part, beamsim/sweep_dir.h spread), and this
- * file moves the parts' journal records to rank 0, which journals them and
- * writes the output directory as one process writes it.
+/* A run spread over processes (docs/cluster.md): the processes of an MPI
+ * job, in the one file of the program that speaks MPI, built in when CMake
+ * finds MPI (BSIM_HAVE_MPI); and the job-array parts' --shard I/N and
+ * stored command line. The library knows nothing of MPI: a sweep or a
+ * comparison is spread through its parts (beamsim/sweep.h bsim_sweep_part,
+ * beamsim/sweep_dir.h spread), and this file moves the parts' journal
+ * records to rank 0, which journals them and writes the output directory
+ * as one process writes it.
  *
  * Records go in batches: a rank's threads queue each finished trial's
  * record, and its main thread sends the queue between its own trials (MPI
