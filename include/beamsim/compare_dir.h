@@ -18,6 +18,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "beamsim/sweep_dir.h"
+
 #include "beamsim/base.h"
 #include "beamsim/limits.h"
 #include "beamsim/backend.h"
@@ -69,6 +71,17 @@ typedef struct bsim_compare_dir_def {
 	bsim_progress_fn progress;
 	void *progress_user;
 	const volatile sig_atomic_t *stop;
+	/* Spreading the comparison over processes, as a sweep is spread
+	 * (beamsim/sweep_dir.h, docs/cluster.md): spread, part, agree, argc and
+	 * argv for a shard's part.json, the part directories to merge. */
+	int spread;
+	bsim_sweep_part part;
+	int (*agree)(void *user, const char *inputs, unsigned char *done, size_t bytes,
+	             bsim_error *err);
+	int argc;
+	char *const *argv;
+	const char *const *merge;
+	int n_merge;
 } bsim_compare_dir_def;
 
 /* thesis against box2d, no options, bsim_compare_rule_default(), 3

@@ -149,6 +149,54 @@ BSIM_API int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_co
                                    double **t_separate, bsim_error *err);
 BSIM_API void bsim_sweep_result_free(bsim_sweep_result *r);
 
+/* ---- a sweep spread over processes (MPI ranks, job-array tasks) ---------
+ *
+ * Trial i (= g * trials + t) belongs to part i mod count: parts take turns
+ * along the flat (group, trial) list, so each part holds about the same
+ * share of every group (groups differ in cost, so contiguous blocks would
+ * not). A part runs its trials and hands their journal records on (to
+ * cfg->journal, to record); the whole sweep is then the ordinary sweep
+ * resumed from a journal holding every part's records, so its results are
+ * one process's to the bit whatever the number of parts. */
+
+/* Hands one received record to the part runner (collect's accept). */
+typedef int (*bsim_sweep_accept_fn)(void *ctx, long index, const void *payload, bsim_error *err);
+
+typedef struct bsim_sweep_part {
+	int index, count; /* this part, 0 <= index < count */
+	/* NULL, or a bit per trial (bit i % 8 of byte i / 8) of the trials
+	 * already done (in a journal): not run again by any part. */
+	const unsigned char *done;
+	/* NULL, or called with each trial's journal record as it ends, from
+	 * any thread (the callee serialises); nonzero stops the part with err. */
+	int (*record)(void *user, long index, const void *payload, bsim_error *err);
+	/* NULL, or called on the calling thread (the one that called
+	 * bsim_sweep_run_part) between trials with wait 0, and once after this
+	 * part's own trials with wait 1, to hand the records other parts sent
+	 * to accept(ctx, ...) (appended to cfg->journal); with wait 1 it
+	 * returns once every other part has ended, with the first one's error
+	 * if one failed. */
+	int (*collect)(void *user, int wait, bsim_sweep_accept_fn accept, void *ctx,
+	               bsim_error *err);
+	void *user;
+} bsim_sweep_part;
+
+/* Runs part's trials of the sweep of e (cfg->sink and keep are not used): each trial not marked in
+ * part->done runs and its record goes to cfg->journal (if not NULL; already replayed) and to
+ * part->record. A deterministic group's copies are not run (its trial 0 stands for them).
+ * cfg->progress gets this part's trials done and its total, or with collect the trials of every
+ * part (done bits and records received included) and the sweep's total. BSIM_ESTOPPED when
+ * cfg->stop stopped it. */
+BSIM_API int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                 const bsim_sweep_part *part, bsim_error *err);
+
+/* The same for a paired sweep (beamsim compare): each trial runs on both
+ * sides as bsim_sweep_run_paired runs it, its record both results and the
+ * separation time (bsim_sweep_record_size(1)). */
+BSIM_API int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                        const bsim_backend *backend_b, const bsim_options *opts_b,
+                                        const bsim_sweep_part *part, bsim_error *err);
+
 /* Aggregates one group's trials into counts and the Wilson interval. */
 BSIM_API void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n,
                                          bsim_group_result *out);

@@ -60,7 +60,54 @@ typedef struct bsim_sweep_dir_def {
 	 * starts, those running finish and are journaled, and the run returns
 	 * BSIM_ESTOPPED with the journal kept for resume. */
 	const volatile sig_atomic_t *stop;
+	/* Spreading the sweep over processes (docs/cluster.md):
+	 *   BSIM_SPREAD_NONE    the whole sweep here (default);
+	 *   BSIM_SPREAD_SHARD   part.index of part.count (a job-array task): out
+	 *                       becomes a part directory (part.json and
+	 *                       part.journal, no results) for merge below;
+	 *   BSIM_SPREAD_GATHER  this process's part, the others' records taken
+	 *                       through part.collect and journaled; then out is
+	 *                       written as one process writes it (MPI rank 0);
+	 *   BSIM_SPREAD_SEND    this process's part, its records handed to
+	 *                       part.record; out is not touched (other ranks).
+	 * part.done is the run's own. A lattice sweep cannot be split (its
+	 * gate paths are not journaled): SHARD refuses it, GATHER runs it all
+	 * and SEND none of it. */
+	int spread;
+	bsim_sweep_part part;
+	/* GATHER and SEND: called in every process once the inputs are known,
+	 * before any trial: checks that every process has these inputs and
+	 * gives every process the gatherer's done bits (bytes of them). */
+	int (*agree)(void *user, const char *inputs, unsigned char *done, size_t bytes,
+	             bsim_error *err);
+	/* SHARD: the command line that ran the part, kept in part.json for
+	 * merge (argv[0] the command's name). */
+	int argc;
+	char *const *argv;
+	/* n_merge > 0: no trial runs; the part directories merge[0..n_merge)
+	 * (all the parts of this sweep, each once) are joined and out is
+	 * written as one process writes it. */
+	const char *const *merge;
+	int n_merge;
 } bsim_sweep_dir_def;
+
+enum { BSIM_SPREAD_NONE, BSIM_SPREAD_SHARD, BSIM_SPREAD_GATHER, BSIM_SPREAD_SEND };
+
+/* What a part directory's part.json says: the part (1-based, as given to
+ * --shard), of how many, the run (a hash of its inputs), the trials its
+ * journal holds and the command line that ran it. */
+typedef struct bsim_sweep_dir_part {
+	char command[16];
+	int index, count;
+	char run[17];
+	long records;
+	int argc;
+	char **argv;
+} bsim_sweep_dir_part;
+
+/* Reads DIR/part.json; BSIM_EINPUT naming the file and field. */
+BSIM_API int bsim_sweep_dir_part_read(const char *dir, bsim_sweep_dir_part *p, bsim_error *err);
+BSIM_API void bsim_sweep_dir_part_free(bsim_sweep_dir_part *p);
 
 /* The thesis backend, no options, all cores, nothing kept. */
 BSIM_API bsim_sweep_dir_def bsim_sweep_dir_def_default(void);

@@ -14,9 +14,10 @@
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
+#include "cli/cli_mpi.h"
 #include "beamsim/limits.h"
 
-enum { OWN_BACKENDS, OWN_PROTOCOLS, OWN_EXAMPLES };
+enum { OWN_BACKENDS, OWN_PROTOCOLS, OWN_EXAMPLES, OWN_SHARD };
 
 static const cli_own compare_own[] = {
         [OWN_BACKENDS] = {"backends", 1, "A,B",
@@ -31,6 +32,10 @@ static const cli_own compare_own[] = {
                            "directories are named by protocol"},
         [OWN_EXAMPLES] = {"examples", 1, "N",
                           "discordant trials shown per disagreeing group (default 3)"},
+        [OWN_SHARD] = {"shard", 1, "I/N",
+                       "run part I of N (I from 1 to N, as SLURM_ARRAY_TASK_ID of\n"
+                       "--array=1-N) into DIR, a part directory; beamsim merge\n"
+                       "joins the N parts' directories (docs/cluster.md)"},
 };
 
 static const char *const compare_help[CLI_N_OPTS] = {
@@ -46,6 +51,7 @@ typedef struct compare_args {
 	const char *backends; /* "A,B" as given, NULL: thesis,box2d */
 	char protocol[2][16]; /* --protocols, "" if not given */
 	long examples;
+	int shard, shards; /* --shard, 1-based; 0: the whole comparison */
 } compare_args;
 
 /* "world,essay" into a->protocol. */
@@ -80,6 +86,8 @@ static int compare_option(void *args, int i, const char *value)
 			return cli_usage("compare", "--examples %s: expected an integer 0..1000",
 			                 value);
 		return CLI_OK;
+	case OWN_SHARD:
+		return cli_shard_parse("compare", value, &a->shard, &a->shards);
 	}
 	return CLI_USAGE;
 }
@@ -123,7 +131,7 @@ static const cli_spec compare_spec = {
         .help = compare_help,
         .out_required = 1,
         .own = compare_own,
-        .n_own = 3,
+        .n_own = 4,
         .option = compare_option,
 };
 
@@ -211,7 +219,7 @@ static void compare_summary(const bsim_compare_dir_def *def, const char *out,
 	cli_wrote(stdout, out);
 }
 
-int cmd_compare(int argc, char **argv)
+static int compare_main(int argc, char **argv, const cli_merge *m)
 {
 	cli_common c = cli_common_default();
 	compare_args a = {.examples = 3};
@@ -220,12 +228,28 @@ int cmd_compare(int argc, char **argv)
 	int rc = cli_parse(&compare_spec, argc, argv, &c, &a, &experiment);
 	if (rc < 0 && (rc = sides_resolve(&c, &a, &def)) == CLI_OK)
 		rc = -1;
+	if (rc < 0 && a.shards > 0 && cli_mpi_size() > 1)
+		rc = cli_usage("compare",
+		               "--shard runs one part in one process: not under mpirun, "
+		               "which spreads the whole comparison over its %d ranks",
+		               cli_mpi_size());
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
 	}
+	if (m) {
+		c.out = m->out;
+		c.threads = m->threads;
+		c.quiet = m->quiet;
+		c.resume = 0;
+		a.shard = a.shards = 0;
+		def.merge = m->parts;
+		def.n_merge = m->n_parts;
+	}
+	int rank = cli_mpi_rank();
+	char **stored = NULL;
 	cli_progress progress;
-	cli_progress_init(&progress, !c.quiet, "trials");
+	cli_progress_init(&progress, !c.quiet && rank == 0, "trials");
 	def.experiment = experiment;
 	def.out = c.out;
 	def.sets = c.sets.ov;
@@ -244,24 +268,50 @@ int cmd_compare(int argc, char **argv)
 	def.keep = (int)c.keep;
 	def.keep_stride = (int)c.keep_stride;
 	def.resume = c.resume;
-	def.progress = cli_progress_update;
+	def.progress = rank == 0 ? cli_progress_update : NULL;
 	def.progress_user = &progress;
 	def.stop = &cli_stop;
+	if (a.shards > 0) {
+		def.spread = BSIM_SPREAD_SHARD;
+		def.part.index = a.shard - 1;
+		def.part.count = a.shards;
+		stored = cli_stored_argv(argc, argv, experiment);
+		def.argc = stored ? argc : 0;
+		def.argv = stored;
+	}
+	cli_mpi_spread(&def.spread, &def.part, &def.agree, bsim_sweep_record_size(1), def.stop);
 	/* Both sides run every trial; the costlier backend's constant bounds
 	 * the estimate. */
 	const char *costlier = def.side[0].backend ? def.side[0].backend->name : "thesis";
 	if (def.side[1].backend && strcmp(def.side[1].backend->name, "box2d") == 0)
 		costlier = "box2d";
-	cli_estimate_line(costlier, 2.0 * cli_experiment_beam_steps(experiment, &c.sets, c.trials));
+	if (rank == 0 && !m)
+		cli_estimate_line(costlier,
+		                  2.0 * cli_experiment_beam_steps(experiment, &c.sets, c.trials));
 	bsim_compare_dir_result res;
 	bsim_error err;
 	cli_signals_install();
 	rc = bsim_compare_dir_run(&def, &res, &err);
 	cli_signals_restore();
 	cli_progress_finish(&progress);
-	if (rc != BSIM_OK) {
-		cli_report(rc, &err);
-		rc = cli_run_end(rc, res.journal, argc, argv);
+	cli_stored_argv_free(stored, argc, argv);
+	if (rc == BSIM_ESTOPPED && rank > 0) {
+		/* stopped by the job's signal: rank 0 says so, and how to resume */
+	} else if (rc != BSIM_OK) {
+		if (rank > 0)
+			cli_error("rank %d of %d: %s", rank, cli_mpi_size(), err.msg);
+		else
+			cli_report(rc, &err);
+		rc = rank > 0 ? rc : cli_run_end(rc, res.journal, argc, argv);
+		cli_common_free(&c);
+		cli_mpi_abort(rc);
+		return rc;
+	} else if (def.spread == BSIM_SPREAD_SEND || a.shards > 0) {
+		if (a.shards > 0 && !c.quiet)
+			printf("part %d of %d of the comparison in %s; beamsim merge joins the %d "
+			       "parts' directories\n",
+			       a.shard, a.shards, c.out, a.shards);
+		bsim_compare_dir_result_free(&res);
 	} else {
 		if (!c.quiet)
 			compare_summary(&def, c.out, &res);
@@ -275,4 +325,14 @@ int cmd_compare(int argc, char **argv)
 	}
 	cli_common_free(&c);
 	return rc;
+}
+
+int cmd_compare(int argc, char **argv)
+{
+	return compare_main(argc, argv, NULL);
+}
+
+int cmd_compare_merge(int argc, char **argv, const cli_merge *m)
+{
+	return compare_main(argc, argv, m);
 }

@@ -4,6 +4,8 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
+#include <limits.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "beamsim/output.h"
@@ -14,22 +16,30 @@
 #include "cli/cli_options.h"
 #include "cli/cli_outcomes.h"
 #include "cli/cli_progress.h"
+#include "cli/cli_mpi.h"
 
 static const cli_own sweep_own[] = {
         {"overlap", 0, NULL,
          "measure each trial's deepest body-beam overlap\n(trials.csv overlap_max; costs time)"},
+        {"shard", 1, "I/N",
+         "run part I of N (I from 1 to N, as SLURM_ARRAY_TASK_ID of\n--array=1-N): trial "
+         "g*trials+t is part (g*trials+t) mod N + 1's;\nDIR gets part.json and part.journal, "
+         "beamsim merge joins\nthe N parts' directories into the sweep's (docs/cluster.md)"},
 };
 
 typedef struct sweep_args {
 	int overlap;
+	int shard, shards; /* 1-based part of shards; 0: the whole sweep */
 } sweep_args;
 
 static int sweep_option(void *args, int i, const char *value)
 {
-	(void)i;
-	(void)value;
-	((sweep_args *)args)->overlap = 1;
-	return CLI_OK;
+	sweep_args *a = args;
+	if (i == 0) {
+		a->overlap = 1;
+		return CLI_OK;
+	}
+	return cli_shard_parse("sweep", value, &a->shard, &a->shards);
 }
 
 static const cli_spec sweep_spec = {
@@ -58,7 +68,7 @@ static const cli_spec sweep_spec = {
                   CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_LIMIT),
         .out_required = 1,
         .own = sweep_own,
-        .n_own = 1,
+        .n_own = 2,
         .option = sweep_option,
         .after = "Under the p_traverse table: each group's left/right split of the traversals\n"
                  "(when some group has both types or the beams differ), or for a lattice its\n"
@@ -67,6 +77,14 @@ static const cli_spec sweep_spec = {
                  "transitions.csv, gate_entries.csv and beam_peaks.csv (docs/lattice.md).\n",
 };
 
+/* "3 ranks x " */
+static const char *cli_ranks_text(int ranks)
+{
+	static char text[32];
+	snprintf(text, sizeof text, "%d ranks x ", ranks);
+	return text;
+}
+
 static void sweep_report(const char *out, const bsim_sweep_dir_result *res, const cli_sets *sets)
 {
 	const bsim_sweep_result *r = &res->r;
@@ -74,9 +92,11 @@ static void sweep_report(const char *out, const bsim_sweep_dir_result *res, cons
 	bsim_output_table(stdout, &res->e, r);
 	cli_outcomes_print(stdout, &res->e, r,
 	                   !r->lattice && cli_outcomes_asymmetric(&res->e, sets));
-	printf("\n%ld trials, %ld steps in %.3f s on %d thread%s: %.0f trials/s, %.3g steps/s\n", n,
-	       r->total_steps, r->wall_seconds, res->threads, res->threads == 1 ? "" : "s",
-	       cli_per_second(n, r->wall_seconds), cli_per_second(r->total_steps, r->wall_seconds));
+	int ranks = cli_mpi_size();
+	printf("\n%ld trials, %ld steps in %.3f s on %s%d thread%s: %.0f trials/s, %.3g steps/s\n",
+	       n, r->total_steps, r->wall_seconds, ranks > 1 ? cli_ranks_text(ranks) : "",
+	       res->threads, res->threads == 1 ? "" : "s", cli_per_second(n, r->wall_seconds),
+	       cli_per_second(r->total_steps, r->wall_seconds));
 	if (n != rows)
 		printf("(%ld rows: the groups without random force ran one trial each)\n", rows);
 	/* A table over mat_rows has no twin (a note said so): the list
@@ -84,11 +104,12 @@ static void sweep_report(const char *out, const bsim_sweep_dir_result *res, cons
 	cli_wrote(stdout, out);
 }
 
-int cmd_sweep(int argc, char **argv)
+static int sweep_main(int argc, char **argv, const cli_merge *m)
 {
 	cli_common c = cli_common_default();
 	sweep_args a = {0};
 	const char *experiment = NULL;
+	char **stored = NULL;
 	int rc = cli_parse(&sweep_spec, argc, argv, &c, &a, &experiment);
 	bsim_sweep_dir_def def = bsim_sweep_dir_def_default();
 	if (rc < 0) {
@@ -97,12 +118,27 @@ int cmd_sweep(int argc, char **argv)
 		        &def.opts);
 		rc = def.backend ? -1 : CLI_USAGE;
 	}
+	if (rc < 0 && a.shards > 0 && cli_mpi_size() > 1)
+		rc = cli_usage("sweep",
+		               "--shard runs one part in one process: not under mpirun, "
+		               "which spreads the whole sweep over its %d ranks",
+		               cli_mpi_size());
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
 	}
+	if (m) {
+		c.out = m->out;
+		c.threads = m->threads;
+		c.quiet = m->quiet;
+		c.resume = 0;
+		a.shard = a.shards = 0;
+		def.merge = m->parts;
+		def.n_merge = m->n_parts;
+	}
+	int rank = cli_mpi_rank();
 	cli_progress progress;
-	cli_progress_init(&progress, !c.quiet, "trials");
+	cli_progress_init(&progress, !c.quiet && rank == 0, "trials");
 	def.experiment = experiment;
 	def.out = c.out;
 	def.sets = c.sets.ov;
@@ -117,22 +153,57 @@ int cmd_sweep(int argc, char **argv)
 	def.keep = (int)c.keep;
 	def.keep_stride = (int)c.keep_stride;
 	def.resume = c.resume;
-	def.progress = cli_progress_update;
+	def.progress = rank == 0 ? cli_progress_update : NULL;
 	def.progress_user = &progress;
 	def.stop = &cli_stop;
-	cli_estimate_line(def.backend->name,
-	                  cli_experiment_beam_steps(experiment, &c.sets, c.trials));
+	if (a.shards > 0) {
+		def.spread = BSIM_SPREAD_SHARD;
+		def.part.index = a.shard - 1;
+		def.part.count = a.shards;
+		stored = cli_stored_argv(argc, argv, experiment);
+		def.argc = stored ? argc : 0;
+		def.argv = stored;
+	}
+	cli_mpi_spread(&def.spread, &def.part, &def.agree, bsim_sweep_record_size(0), def.stop);
+	if (rank == 0 && !m)
+		cli_estimate_line(def.backend->name,
+		                  cli_experiment_beam_steps(experiment, &c.sets, c.trials));
 	bsim_sweep_dir_result res;
 	bsim_error err;
 	cli_signals_install();
 	rc = bsim_sweep_dir_run(&def, &res, &err);
 	cli_signals_restore();
 	cli_progress_finish(&progress);
-	if (rc != BSIM_OK) {
-		cli_report(rc, &err);
-		rc = cli_run_end(rc, res.journal, argc, argv);
+	cli_stored_argv_free(stored, argc, argv);
+	if (rc == BSIM_ESTOPPED && rank > 0) {
+		/* stopped by the job's signal: rank 0 says so, and how to resume */
 		cli_common_free(&c);
 		return rc;
+	}
+	if (rc != BSIM_OK) {
+		if (rank > 0)
+			cli_error("rank %d of %d: %s", rank, cli_mpi_size(), err.msg);
+		else
+			cli_report(rc, &err);
+		rc = rank > 0 ? rc : cli_run_end(rc, res.journal, argc, argv);
+		cli_common_free(&c);
+		cli_mpi_abort(rc);
+		return rc;
+	}
+	if (def.spread == BSIM_SPREAD_SEND) {
+		bsim_sweep_dir_result_free(&res);
+		cli_common_free(&c);
+		return CLI_OK;
+	}
+	if (a.shards > 0) {
+		if (!c.quiet)
+			printf("part %d of %d of the sweep in %s; beamsim merge joins the %d "
+			       "parts' "
+			       "directories\n",
+			       a.shard, a.shards, c.out, a.shards);
+		bsim_sweep_dir_result_free(&res);
+		cli_common_free(&c);
+		return CLI_OK;
 	}
 	if (!c.quiet)
 		sweep_report(c.out, &res, &c.sets);
@@ -150,5 +221,78 @@ int cmd_sweep(int argc, char **argv)
 	}
 	bsim_sweep_dir_result_free(&res);
 	cli_common_free(&c);
+	return rc;
+}
+
+int cmd_sweep(int argc, char **argv)
+{
+	return sweep_main(argc, argv, NULL);
+}
+
+/* ---- beamsim merge: the parts of a sweep run with --shard I/N ---------- */
+
+static const cli_spec merge_spec = {
+        .name = "merge",
+        .usage = "PART_DIR... --out DIR [--threads N] [--quiet]",
+        .about = "Joins the directories of the N parts of one sweep or comparison (beamsim\n"
+                 "sweep|compare ... --shard I/N --out PART_DIR, I = 1..N) into DIR, the\n"
+                 "directory the command writes in one process (trials.csv, summary.json,\n"
+                 ".mat twins, run.json; a comparison's report and pairs too), the same bytes\n"
+                 "but for the wall time (docs/cluster.md). Every part is needed once;\n"
+                 "parts of another run (other inputs), a missing or repeated part, or a\n"
+                 "damaged part.journal are refused, naming the directory. The sweep's\n"
+                 "command line is read from the parts' part.json (the experiment by its\n"
+                 "absolute path); kept trajectories (--trajectories) run again here.\n",
+        .positional = NULL,
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET),
+        .out_required = 1,
+};
+
+int cmd_merge(int argc, char **argv)
+{
+	/* The part directories are the arguments that are not options. */
+	cli_common c = cli_common_default();
+	const char **parts = calloc((size_t)argc + 1, sizeof *parts);
+	char **opts = calloc((size_t)argc + 1, sizeof *opts);
+	int n_parts = 0, n_opts = 0, rc = -1;
+	if (!parts || !opts) {
+		cli_error("out of memory");
+		rc = CLI_FAIL;
+	}
+	for (int i = 0; rc < 0 && i < argc; i++) {
+		int takes_value =
+		        strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "--threads") == 0;
+		if (i > 0 && argv[i][0] != '-') {
+			parts[n_parts++] = argv[i];
+			continue;
+		}
+		opts[n_opts++] = argv[i];
+		if (takes_value && i + 1 < argc)
+			opts[n_opts++] = argv[++i];
+	}
+	if (rc < 0)
+		rc = cli_parse(&merge_spec, n_opts, opts, &c, NULL, NULL);
+	if (rc < 0 && n_parts == 0)
+		rc = cli_usage("merge", "expected the directories of the parts, got none");
+	bsim_sweep_dir_part first;
+	bsim_error err;
+	memset(&first, 0, sizeof first);
+	if (rc < 0 && bsim_sweep_dir_part_read(parts[0], &first, &err) != BSIM_OK)
+		rc = cli_report(BSIM_EINPUT, &err);
+	int is_compare = rc < 0 && strcmp(first.command, "compare") == 0;
+	if (rc < 0 && !is_compare && strcmp(first.command, "sweep") != 0)
+		rc = cli_usage("merge",
+		               "%s: a part of a %s; merge joins the parts of a sweep or "
+		               "a comparison",
+		               parts[0], first.command);
+	if (rc < 0) {
+		cli_merge m = {c.out, c.threads, c.quiet, parts, n_parts};
+		rc = is_compare ? cmd_compare_merge(first.argc, first.argv, &m)
+		                : sweep_main(first.argc, first.argv, &m);
+	}
+	bsim_sweep_dir_part_free(&first);
+	cli_common_free(&c);
+	free(parts);
+	free(opts);
 	return rc;
 }

@@ -5,6 +5,7 @@
 
 #include "beamsim/version.h"
 #include "cli/cli_common.h"
+#include "cli/cli_mpi.h"
 
 typedef struct cli_command {
 	const char *name;
@@ -15,6 +16,7 @@ typedef struct cli_command {
 static const cli_command commands[] = {
         {"run", cmd_run, "run one trial of a scene, print its outcome, record a trajectory"},
         {"sweep", cmd_sweep, "run every group and trial of an experiment in parallel"},
+        {"merge", cmd_merge, "join the parts of a sweep run as a job array (sweep --shard I/N)"},
         {"compare", cmd_compare,
          "run an experiment on two backends, or two settings of one, pair by pair"},
         {"regress", cmd_regress, "rerun a stored sweep or comparison and report what changed"},
@@ -136,6 +138,15 @@ static int dispatch(int argc, char **argv)
 		return CLI_OK;
 	}
 	const cli_command *c = find_command(name);
+	/* Only sweep and compare spread their trials over an MPI job's ranks
+	 * (docs/cluster.md): any other command would run whole in every rank. */
+	if (c && c->run != cmd_sweep && c->run != cmd_compare && cli_mpi_size() > 1) {
+		cli_error("%s runs in one process: start it without mpirun (of the commands, "
+		          "sweep and compare spread over MPI ranks; docs/cluster.md)",
+		          name);
+		cli_mpi_abort(CLI_USAGE);
+		return CLI_USAGE;
+	}
 	return c ? c->run(argc - 1, argv + 1) : CLI_USAGE;
 }
 
@@ -143,5 +154,9 @@ int main(int argc, char **argv)
 {
 	if (argc > 0 && argv[0] && argv[0][0])
 		cli_program = argv[0];
-	return close_stdout(dispatch(argc, argv));
+	int rc = cli_mpi_init(&argc, &argv);
+	if (rc == CLI_OK)
+		rc = close_stdout(dispatch(argc, argv));
+	cli_mpi_finish();
+	return rc;
 }

@@ -184,9 +184,33 @@ typedef struct sweep_shared {
 	 * their own (-1: none), and which trials have one (a bit each). */
 	int spill_fd;
 	unsigned char *journaled;
-	int lattice; /* the scenes are lattices: every trial runs */
-	int stopped; /* a trial was not started because of cfg->stop */
+	int lattice;                 /* the scenes are lattices: every trial runs */
+	int stopped;                 /* a trial was not started because of cfg->stop */
+	const bsim_sweep_part *part; /* NULL: every trial is this process's */
+	long progress_total;         /* what progress counts up to */
 } sweep_shared;
+
+/* Trial i is another part's, or done before this part began. */
+static int part_skips(const bsim_sweep_part *p, long i)
+{
+	return p && (i % p->count != p->index || (p->done && (p->done[i / 8] & (1u << (i % 8)))));
+}
+
+/* A record another part sent (bsim_sweep_accept_fn): into the journal,
+ * counted as done. Called on the thread that called the part runner. */
+static int part_accept(void *ctx, long index, const void *payload, bsim_error *err)
+{
+	sweep_shared *sh = ctx;
+	if (index < 0 || index >= sh->total)
+		return bsim_error_set(err, BSIM_EFAIL, "a part sent trial %ld of a sweep of %ld",
+		                      index, sh->total);
+	if (sh->cfg->journal &&
+	    bsim_journal_append(sh->cfg->journal, (uint64_t)index, payload, err) != BSIM_OK)
+		return BSIM_EFAIL;
+#pragma omp atomic
+	sh->done++;
+	return BSIM_OK;
+}
 
 static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
 {
@@ -275,7 +299,8 @@ static void sweep_thread(sweep_shared *sh)
 		long stop, k = i - sh->first;
 #pragma omp atomic read
 		stop = sh->first_fail;
-		if (!runner || i > stop || (sh->from_journal && sh->from_journal[k]))
+		if (!runner || i > stop || (sh->from_journal && sh->from_journal[k]) ||
+		    part_skips(sh->part, i))
 			continue;
 		if (cfg->stop && *cfg->stop) {
 #pragma omp atomic write
@@ -319,13 +344,26 @@ static void sweep_thread(sweep_shared *sh)
 		/* Only trials that ran are journaled: copies are filled in again. */
 		if (rc == BSIM_OK && ran && cfg->journal)
 			rc = journal_append(sh, i, &err);
+		if (rc == BSIM_OK && ran && sh->part && sh->part->record) {
+			pair_record p;
+			if (sh->backend_b)
+				p = (pair_record){sh->results[k], sh->results_b[k],
+				                  sh->t_separate[k]};
+			rc = sh->part->record(sh->part->user, i,
+			                      sh->backend_b ? (const void *)&p : &sh->results[k],
+			                      &err);
+		}
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
+		if (leader && sh->part && sh->part->collect &&
+		    sh->part->collect(sh->part->user, 0, part_accept, sh, &err) != BSIM_OK)
+			shared_fail(sh, -1, err.code, err.msg);
 		long done;
 #pragma omp atomic capture
 		done = ++sh->done;
 		if (leader && cfg->progress)
-			cfg->progress(cfg->progress_user, done, sh->total);
+			cfg->progress(cfg->progress_user, done,
+			              sh->progress_total ? sh->progress_total : sh->total);
 	}
 	bsim_trial_runner_free(runner);
 	trial_pair_free(pair);
@@ -814,4 +852,121 @@ int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg
                           bsim_error *err)
 {
 	return sweep_common(e, cfg, backend_b, opts_b, out_a, out_b, t_separate, err);
+}
+
+/* ---- a part of a sweep (beamsim/sweep.h) ---------------------------------
+ *
+ * The trials run in blocks of BSIM_SWEEP_BLOCK indices as a streamed
+ * sweep's do, each thread passing over the other parts' trials; nothing is
+ * kept but the records handed on, so memory does not grow with the sweep. */
+
+static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                    const bsim_backend *backend_b, const bsim_options *opts_b,
+                    const bsim_sweep_part *part, bsim_error *err)
+{
+	int keep = 0, rc = sweep_check(e, cfg, &keep, err);
+	if (rc != BSIM_OK)
+		return rc;
+	if (part->count < 1 || part->index < 0 || part->index >= part->count)
+		return bsim_error_set(err, BSIM_EINPUT, "part %d of %d: expected 0 <= part < %d",
+		                      part->index, part->count, part->count);
+	long total = (long)e->n_groups * e->trials;
+	bsim_scene *scenes = NULL;
+	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
+	bsim_trial_result *results = calloc(BSIM_SWEEP_BLOCK, sizeof *results);
+	bsim_trial_log *logs = calloc(BSIM_SWEEP_BLOCK, sizeof *logs);
+	/* a paired part's second side */
+	bsim_scene *scenes_b = NULL;
+	bsim_trial_result *results_b = NULL;
+	bsim_trial_log *logs_b = NULL;
+	double *t_separate = NULL;
+	if (backend_b) {
+		results_b = calloc(BSIM_SWEEP_BLOCK, sizeof *results_b);
+		logs_b = calloc(BSIM_SWEEP_BLOCK, sizeof *logs_b);
+		t_separate = calloc(BSIM_SWEEP_BLOCK, sizeof *t_separate);
+	}
+	if (!deterministic || !results || !logs ||
+	    (backend_b && (!results_b || !logs_b || !t_separate)))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
+	if (rc == BSIM_OK)
+		rc = scenes_build(e, cfg, 0, &scenes, err);
+	if (rc == BSIM_OK && backend_b && cfg->n_extra_b > 0)
+		rc = scenes_build(e, cfg, 1, &scenes_b, err);
+	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
+		deterministic[g] = !bsim_effects_random(&scenes[g]);
+	sweep_shared sh = {
+	        .e = e,
+	        .cfg = cfg,
+	        .scenes = scenes,
+	        .scenes_b = scenes_b ? scenes_b : scenes,
+	        .deterministic = deterministic,
+	        .results = results,
+	        .logs = logs,
+	        .backend_b = backend_b,
+	        .opts_b = opts_b,
+	        .results_b = results_b,
+	        .logs_b = logs_b,
+	        .t_separate = t_separate,
+	        .keep_stride = 5,
+	        .total = total,
+	        .spill_fd = -1,
+	        .first_fail = total,
+	        .part = part,
+	};
+	/* Progress: this part's trials, or with collect every part's. */
+	for (long i = 0; i < total; i++) {
+		int done = part->done && (part->done[i / 8] & (1u << (i % 8)));
+		if (part->collect)
+			sh.done += done;
+		else
+			sh.progress_total += !part_skips(part, i);
+	}
+	if (part->collect)
+		sh.progress_total = total;
+	int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
+	for (long first = 0; rc == BSIM_OK && first < total; first += BSIM_SWEEP_BLOCK) {
+		sh.first = first;
+		sh.end = total - first < BSIM_SWEEP_BLOCK ? total : first + BSIM_SWEEP_BLOCK;
+		long n = sh.end - sh.first;
+		bsim_error_clear(&sh.fail);
+#pragma omp parallel num_threads(threads < n ? threads : (int)n)
+		sweep_thread(&sh);
+		if (sh.first_fail < total)
+			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
+		else if (sh.stopped)
+			rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped after %ld of %ld trials",
+			                    sh.done, sh.progress_total);
+	}
+	if (rc == BSIM_OK && part->collect)
+		rc = part->collect(part->user, 1, part_accept, &sh, err);
+	if (rc == BSIM_OK && cfg->progress)
+		cfg->progress(cfg->progress_user, sh.progress_total, sh.progress_total);
+	if (scenes)
+		scenes_free(scenes, e->n_groups);
+	if (scenes_b)
+		scenes_free(scenes_b, e->n_groups);
+	for (long k = 0; logs && k < BSIM_SWEEP_BLOCK; k++)
+		bsim_trial_log_clear(&logs[k]);
+	for (long k = 0; logs_b && k < BSIM_SWEEP_BLOCK; k++)
+		bsim_trial_log_clear(&logs_b[k]);
+	free(logs);
+	free(results);
+	free(logs_b);
+	free(results_b);
+	free(t_separate);
+	free(deterministic);
+	return rc;
+}
+
+int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                        const bsim_sweep_part *part, bsim_error *err)
+{
+	return run_part(e, cfg, NULL, NULL, part, err);
+}
+
+int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                               const bsim_backend *backend_b, const bsim_options *opts_b,
+                               const bsim_sweep_part *part, bsim_error *err)
+{
+	return run_part(e, cfg, backend_b, opts_b, part, err);
 }

@@ -17,6 +17,8 @@
 #include "store/rerun.h"
 #include "store/store.h"
 #include "beamsim/limits.h"
+#include "store/part_dir.h"
+#include "util/clock.h"
 
 bsim_compare_dir_def bsim_compare_dir_def_default(void)
 {
@@ -85,6 +87,7 @@ typedef struct compare_job {
 	bsim_journal *journal;    /* NULL: none */
 	int *done;                /* NULL, or set to 1 once every pair is journaled */
 	bsim_run_record rec;
+	double started; /* > 0: a gathered run's start (bsim_clock_seconds) */
 } compare_job;
 
 /* The report's heading: what was compared, how to reproduce it. */
@@ -214,6 +217,9 @@ static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, b
 		return rc;
 	if (job->done)
 		*job->done = 1;
+	/* A gathered comparison's time is its parts' and the writing's. */
+	if (job->started > 0)
+		r[0].wall_seconds = r[1].wall_seconds = bsim_clock_seconds() - job->started;
 	res->solver[0] = r[0].solver;
 	res->solver[1] = r[1].solver;
 	rc = bsim_compare_analyse(&r[0], &r[1], t_sep, &def->rule, &res->cmp, err);
@@ -287,9 +293,62 @@ static void record_fill(compare_job *job)
 		snprintf(job->rec.protocol[i], sizeof job->rec.protocol[i], "%s", def->protocol[i]);
 }
 
+/* This process's part of the pairs (part_dir_run_fn). */
+static int compare_part_run(void *user, const bsim_sweep_part *part, bsim_error *err)
+{
+	const compare_job *job = user;
+	const bsim_compare_dir_def *def = job->def;
+	int protocols = def->protocol[0] != NULL;
+	bsim_sweep_config cfg = {
+	        .backend = job->backend[0],
+	        .opts = job->opts[0],
+	        .threads = def->threads > 0 ? def->threads : omp_get_max_threads(),
+	        .extra = job->sets,
+	        .n_extra = job->n_sets,
+	        .progress = def->progress,
+	        .progress_user = def->progress_user,
+	        .extra_b = protocols ? &job->protocol_b : NULL,
+	        .n_extra_b = protocols,
+	        .journal = job->journal,
+	        .stop = def->stop,
+	};
+	return bsim_sweep_run_part_paired(job->e, &cfg, job->backend[1], job->opts[1], part, err);
+}
+
+/* A spread comparison's part (def->spread, def->n_merge; see
+ * beamsim/sweep_dir.h): *finished 1 when this process has nothing more to
+ * do (a shard written, another rank's part sent). */
+static int compare_spread(const bsim_compare_dir_def *def, compare_job *job, const char *inputs,
+                          bsim_session *ss, int lattice, int *finished, bsim_error *err)
+{
+	long total = (long)job->e->n_groups * job->e->trials;
+	size_t size = bsim_sweep_record_size(1);
+	part_dir_spread sp = {def->spread, &def->part, def->agree, "compare",
+	                      size,        total,      def->argc,  def->argv};
+	int rc;
+	*finished = 0;
+	if (def->n_merge > 0) {
+		char run[17];
+		part_dir_run_id(inputs, run);
+		rc = part_dir_join(def->merge, def->n_merge, "compare", run, inputs, size, total,
+		                   ss->journal, err);
+		return rc == BSIM_OK ? part_dir_journal_reopen(ss, inputs, size, err) : rc;
+	}
+	if (lattice) /* not split: the gatherer runs it all */
+		return def->agree ? def->agree(def->part.user, inputs, NULL, 0, err) : BSIM_OK;
+	job->journal = ss ? ss->journal : NULL;
+	rc = part_dir_spread_run(&sp, inputs, ss, compare_part_run, job, err);
+	if (rc != BSIM_OK || def->spread != BSIM_SPREAD_GATHER) {
+		*finished = 1;
+		return rc;
+	}
+	return part_dir_journal_reopen(ss, inputs, size, err);
+}
+
 int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_result *res,
                          bsim_error *err)
 {
+	double t0 = bsim_clock_seconds();
 	memset(res, 0, sizeof *res);
 	compare_job job = {.def = def, .sets = def->sets, .n_sets = def->n_sets};
 	int rc = sides_check(def, &job, res, err);
@@ -324,23 +383,56 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 	job.e = &res->e;
 	record_fill(&job);
 	char *inputs = bsim_run_record_inputs(&job.rec, &res->e, job.sets, job.n_sets, err);
+	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread, lattice = 0;
+	rc = inputs ? BSIM_OK : err->code;
+	if (rc == BSIM_OK && (spread != BSIM_SPREAD_NONE || def->n_merge > 0)) {
+		bsim_scene scene;
+		rc = bsim_experiment_group_scene(&res->e, 0, job.sets, job.n_sets, &scene, err);
+		if (rc == BSIM_OK) {
+			lattice = scene.has_lattice;
+			bsim_scene_free(&scene);
+		}
+	}
+	if (rc == BSIM_OK && lattice && (spread == BSIM_SPREAD_SHARD || def->n_merge > 0))
+		rc = bsim_error_set(err, BSIM_EINPUT,
+		                    "%s: a lattice comparison is not split into parts (its gate "
+		                    "paths are not journaled): run it in one process",
+		                    def->experiment);
+	if (rc == BSIM_OK && def->n_merge > 0 && def->resume)
+		rc = bsim_error_set(err, BSIM_EINPUT, "merge: --resume does not apply");
+	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
+	int finished = 0;
+	if (rc == BSIM_OK && spread == BSIM_SPREAD_SEND) {
+		rc = compare_spread(def, &job, inputs, NULL, lattice, &finished, err);
+		free(inputs);
+		free(sets);
+		if (rc != BSIM_OK)
+			bsim_compare_dir_result_free(res);
+		return rc;
+	}
 	bsim_session ss;
-	rc = inputs ? bsim_session_open(&ss, def->out, def->resume, inputs,
-	                                bsim_sweep_record_size(1), err)
-	            : err->code;
-	free(inputs);
+	if (rc == BSIM_OK)
+		rc = bsim_session_open(&ss, def->out, def->resume, inputs,
+		                       bsim_sweep_record_size(1), err);
 	if (rc == BSIM_OK) {
-		res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
+		if (spread != BSIM_SPREAD_NONE || def->n_merge > 0)
+			rc = compare_spread(def, &job, inputs, &ss, lattice, &finished, err);
+		if (spread == BSIM_SPREAD_GATHER)
+			job.started = t0;
 		job.out = ss.stage;
 		job.journal = ss.journal;
 		job.done = &ss.done;
-		rc = compare_pairs(&job, res, err);
+		if (rc == BSIM_OK && !finished)
+			rc = compare_pairs(&job, res, err);
 		int kept = 0;
 		rc = bsim_session_close(&ss, rc, "compare", &kept, err);
 		if (kept)
 			snprintf(res->journal, sizeof res->journal, "%s", ss.journal_path);
 	}
+	free(inputs);
 	free(sets);
+	if (rc == BSIM_OK && finished)
+		return BSIM_OK; /* a shard: res holds the experiment only */
 	if (rc != BSIM_OK) {
 		bsim_compare_dir_result_free(res);
 		return rc;

@@ -24,6 +24,9 @@
 #include "store/survival_files.h"
 #include "store/trials_csv.h"
 #include "store/lattice_files.h"
+#include "store/part_dir.h"
+#include "util/journal.h"
+#include "util/clock.h"
 #include "util/atomic_file.h"
 #include "beamsim/limits.h"
 
@@ -154,8 +157,49 @@ static int session_end(bsim_session *ss, int rc, const char *command, char *jour
 	return rc;
 }
 
+/* This process's part of the sweep (part_dir_run_fn). */
+typedef struct sweep_part_ctx {
+	const bsim_experiment *e;
+	const bsim_sweep_config *cfg;
+} sweep_part_ctx;
+
+static int sweep_part_run(void *user, const bsim_sweep_part *part, bsim_error *err)
+{
+	sweep_part_ctx *c = user;
+	return bsim_sweep_run_part(c->e, c->cfg, part, err);
+}
+
+static int sweep_part(const bsim_sweep_dir_def *def, const bsim_experiment *e, const char *inputs,
+                      bsim_sweep_config *cfg, bsim_session *ss, bsim_error *err)
+{
+	part_dir_spread sp = {def->spread,
+	                      &def->part,
+	                      def->agree,
+	                      "sweep",
+	                      bsim_sweep_record_size(0),
+	                      (long)e->n_groups * e->trials,
+	                      def->argc,
+	                      def->argv};
+	sweep_part_ctx c = {e, cfg};
+	return part_dir_spread_run(&sp, inputs, ss, sweep_part_run, &c, err);
+}
+
+/* Whether e's groups are lattices (a lattice sweep is not split). */
+static int sweep_is_lattice(const bsim_sweep_dir_def *def, const bsim_experiment *e, int *lattice,
+                            bsim_error *err)
+{
+	bsim_scene scene;
+	int rc = bsim_experiment_group_scene(e, 0, def->sets, def->n_sets, &scene, err);
+	if (rc != BSIM_OK)
+		return rc;
+	*lattice = scene.has_lattice;
+	bsim_scene_free(&scene);
+	return BSIM_OK;
+}
+
 int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err)
 {
+	double t0 = bsim_clock_seconds();
 	memset(res, 0, sizeof *res);
 	res->first_unstable = -1;
 	const bsim_backend *b = def->backend ? def->backend : &bsim_backend_thesis;
@@ -183,15 +227,17 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 		if (!inputs)
 			bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
-	bsim_session ss;
-	rc = inputs ? bsim_session_open(&ss, def->out, def->resume, inputs,
-	                                bsim_sweep_record_size(0), err)
-	            : err->code;
-	free(inputs);
-	if (rc != BSIM_OK) {
-		bsim_experiment_free(e);
-		return rc;
-	}
+	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread, lattice = 0;
+	rc = inputs ? BSIM_OK : err->code;
+	if (rc == BSIM_OK && (spread != BSIM_SPREAD_NONE || def->n_merge > 0))
+		rc = sweep_is_lattice(def, e, &lattice, err);
+	if (rc == BSIM_OK && lattice && (spread == BSIM_SPREAD_SHARD || def->n_merge > 0))
+		rc = bsim_error_set(err, BSIM_EINPUT,
+		                    "%s: a lattice sweep is not split into parts (its gate paths "
+		                    "are not journaled): run it in one process",
+		                    def->experiment);
+	if (rc == BSIM_OK && def->n_merge > 0 && def->resume)
+		rc = bsim_error_set(err, BSIM_EINPUT, "merge: --resume does not apply");
 	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
 	bsim_sweep_config cfg = {
 	        .backend = b,
@@ -204,17 +250,68 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	        .measure_overlap = def->overlap,
 	        .keep = def->keep,
 	        .keep_stride = def->keep_stride,
-	        .journal = ss.journal,
 	        .stop = def->stop,
 	};
+	if (rc == BSIM_OK && spread == BSIM_SPREAD_SEND) {
+		/* Another rank's: its records go to the gatherer; no directory.
+		 * Of a lattice sweep it runs nothing (the gatherer runs it all). */
+		rc = lattice ? (def->agree ? def->agree(def->part.user, inputs, NULL, 0, err)
+		                           : BSIM_OK)
+		             : sweep_part(def, e, inputs, &cfg, NULL, err);
+		free(inputs);
+		if (rc != BSIM_OK)
+			bsim_experiment_free(e);
+		return rc;
+	}
+	bsim_session ss;
+	if (rc == BSIM_OK)
+		rc = bsim_session_open(&ss, def->out, def->resume, inputs,
+		                       bsim_sweep_record_size(0), err);
+	if (rc != BSIM_OK) {
+		free(inputs);
+		bsim_experiment_free(e);
+		return rc;
+	}
+	cfg.journal = ss.journal;
+	if (def->n_merge > 0) {
+		char run[17];
+		part_dir_run_id(inputs, run);
+		long total = (long)e->n_groups * e->trials;
+		rc = part_dir_join(def->merge, def->n_merge, "sweep", run, inputs,
+		                   bsim_sweep_record_size(0), total, ss.journal, err);
+		if (rc == BSIM_OK)
+			rc = part_dir_journal_reopen(&ss, inputs, bsim_sweep_record_size(0), err);
+		cfg.journal = ss.journal;
+	} else if (spread == BSIM_SPREAD_SHARD || (spread == BSIM_SPREAD_GATHER && !lattice)) {
+		rc = sweep_part(def, e, inputs, &cfg, &ss, err);
+		if (spread == BSIM_SPREAD_SHARD) {
+			free(inputs);
+			rc = session_end(&ss, rc, "sweep", res->journal, sizeof res->journal, err);
+			if (rc != BSIM_OK)
+				bsim_sweep_dir_result_free(res);
+			return rc;
+		}
+		if (rc == BSIM_OK)
+			rc = part_dir_journal_reopen(&ss, inputs, bsim_sweep_record_size(0), err);
+		cfg.journal = ss.journal;
+	} else if (spread == BSIM_SPREAD_GATHER && def->agree) {
+		rc = def->agree(def->part.user, inputs, NULL, 0, err);
+	}
+	free(inputs);
 	/* The trials stream into their files as they finish. */
 	trials_sink sink = {0};
-	rc = sink_open(&sink, ss.stage, e, def->sets, def->n_sets, err);
+	int opened = rc == BSIM_OK;
+	if (opened)
+		rc = sink_open(&sink, ss.stage, e, def->sets, def->n_sets, err);
 	cfg.sink = trials_sink_take;
 	cfg.sink_user = &sink;
 	if (rc == BSIM_OK)
 		rc = bsim_sweep_run(e, &cfg, &res->r, err);
-	rc = sink_close(&sink, rc, ss.stage, err);
+	/* A gathered sweep's time is its parts' and the writing's. */
+	if (rc == BSIM_OK && spread == BSIM_SPREAD_GATHER)
+		res->r.wall_seconds = bsim_clock_seconds() - t0;
+	if (opened)
+		rc = sink_close(&sink, rc, ss.stage, err);
 	if (sink.failed)
 		ss.done = 1; /* the trials journaled before the disk filled are kept */
 	if (rc == BSIM_OK) {

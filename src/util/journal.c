@@ -279,6 +279,45 @@ int bsim_journal_replay(bsim_journal *j, bsim_journal_fn fn, void *user, long *n
 	return BSIM_OK;
 }
 
+int bsim_journal_read(const char *path, const char *inputs, size_t record_size, bsim_journal_fn fn,
+                      void *user, long *n_records, long *n_cut, bsim_error *err)
+{
+	*n_records = 0;
+	*n_cut = 0;
+	int fd = open(path, O_RDONLY | O_CLOEXEC);
+	if (fd < 0) {
+		int e = errno;
+		return bsim_error_set(err, e == ENOENT ? BSIM_EINPUT : BSIM_EFAIL,
+		                      "%s: cannot read the journal: %s", path, strerror(e));
+	}
+	int rc = header_check(fd, path, inputs, record_size, err);
+	size_t n = 4 + 8 + record_size + 4;
+	unsigned char *buf = rc ? NULL : malloc(n);
+	if (!rc && !buf)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	off_t good = rc ? 0 : lseek(fd, 0, SEEK_CUR);
+	while (!rc && buf && read_all(fd, buf, n) == (ssize_t)n) {
+		uint32_t m, crc;
+		uint64_t index;
+		memcpy(&m, buf, 4);
+		memcpy(&index, buf + 4, 8);
+		memcpy(&crc, buf + 12 + record_size, 4);
+		if (m != RECORD_MAGIC ||
+		    crc != (uint32_t)crc32(0L, buf + 4, (uInt)(8 + record_size)))
+			break;
+		if (fn && fn(user, index, buf + 12) != 0)
+			break;
+		++*n_records;
+		good += (off_t)n;
+	}
+	struct stat st;
+	if (!rc && fstat(fd, &st) == 0 && st.st_size > good)
+		*n_cut = (long)(st.st_size - good);
+	free(buf);
+	close(fd);
+	return rc;
+}
+
 int bsim_journal_append(bsim_journal *j, uint64_t index, const void *payload, bsim_error *err)
 {
 	uint32_t m = RECORD_MAGIC;

@@ -54,6 +54,13 @@ int bsim_journal_resume(bsim_journal **out, const char *path, const char *inputs
 int bsim_journal_replay(bsim_journal *j, bsim_journal_fn fn, void *user, long *n_records,
                         long *n_cut, bsim_error *err);
 
+/* Reads the journal at path without changing it: checks its header as
+ * bsim_journal_resume does, then passes every intact record to fn in file
+ * order; *n_cut gets the bytes after the last intact record (0 for a
+ * whole journal). */
+int bsim_journal_read(const char *path, const char *inputs, size_t record_size, bsim_journal_fn fn,
+                      void *user, long *n_records, long *n_cut, bsim_error *err);
+
 /* Appends one record; safe from several threads at once. BSIM_EFAIL naming
  * the file on a write error (a full disk): the run should stop, since what
  * it finishes from then on would not be kept. */

@@ -1,0 +1,384 @@
+/* The processes of an MPI job; see cli_mpi.h. */
+#define _XOPEN_SOURCE 700
+
+#include "cli/cli_mpi.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cli/cli_common.h"
+
+/* The job size the launcher gives, 0 if not launched as part of a job:
+ * OpenMPI's mpirun, and the PMI of SLURM's srun and MPICH. */
+static long launcher_size(void)
+{
+	const char *names[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"};
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+		const char *v = getenv(names[i]);
+		if (v && *v)
+			return strtol(v, NULL, 10);
+	}
+	return getenv("PMIX_RANK") ? 1 : 0;
+}
+
+int cli_shard_parse(const char *cmd, const char *value, int *index, int *count)
+{
+	char *end = NULL, *end2 = NULL;
+	long k = strtol(value, &end, 10), n = 0;
+	if (end != value && *end == '/')
+		n = strtol(end + 1, &end2, 10);
+	if (end == value || *end != '/' || !end2 || end2 == end + 1 || *end2 || n < 1 ||
+	    n > 1000000 || k < 1 || k > n)
+		return cli_usage(cmd, "--shard %s: expected I/N with 1 <= I <= N <= 1000000",
+		                 value);
+	*index = (int)k;
+	*count = (int)n;
+	return CLI_OK;
+}
+
+char **cli_stored_argv(int argc, char **argv, const char *pos)
+{
+	char **copy = calloc((size_t)argc + 1, sizeof *copy);
+	char *abs = pos ? realpath(pos, NULL) : NULL;
+	for (int i = 0; copy && i < argc; i++)
+		copy[i] = argv[i] == pos && abs ? abs : argv[i];
+	if (!copy)
+		free(abs);
+	return copy;
+}
+
+void cli_stored_argv_free(char **stored, int argc, char **argv)
+{
+	for (int i = 0; stored && i < argc; i++)
+		if (stored[i] != argv[i])
+			free(stored[i]);
+	free(stored);
+}
+
+#ifndef BSIM_HAVE_MPI
+
+int cli_mpi_init(int *argc, char ***argv)
+{
+	(void)argc;
+	(void)argv;
+	long n = launcher_size();
+	if (n > 1) {
+		cli_error("started as one of %ld processes of an MPI job, but this beamsim is "
+		          "built without MPI: each process would run the whole command; build "
+		          "it with MPI (libopenmpi-dev, docs/cluster.md) or split the work with "
+		          "--shard I/N",
+		          n);
+		return CLI_USAGE;
+	}
+	return CLI_OK;
+}
+
+void cli_mpi_finish(void)
+{
+}
+
+int cli_mpi_rank(void)
+{
+	return 0;
+}
+
+int cli_mpi_size(void)
+{
+	return 1;
+}
+
+void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
+                    const volatile sig_atomic_t *stop)
+{
+	(void)spread;
+	(void)part;
+	(void)agree;
+	(void)record_size;
+	(void)stop;
+}
+
+void cli_mpi_abort(int rc)
+{
+	(void)rc;
+}
+
+#else
+
+#include <mpi.h>
+#include <pthread.h>
+
+#include "beamsim/sweep.h"
+
+enum { TAG_RECORDS = 1, TAG_DONE = 2 };
+
+static int mpi_on, mpi_rank, mpi_size = 1;
+
+int cli_mpi_init(int *argc, char ***argv)
+{
+	if (launcher_size() < 1)
+		return CLI_OK; /* not under mpirun: one process, MPI not started */
+	int provided = 0;
+	if (MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
+		cli_error("MPI_Init_thread failed");
+		return CLI_FAIL;
+	}
+	mpi_on = 1;
+	MPI_Comm_rank(MPI_COMM_WORLD, &mpi_rank);
+	MPI_Comm_size(MPI_COMM_WORLD, &mpi_size);
+	if (provided < MPI_THREAD_FUNNELED) {
+		cli_error("the MPI library does not allow threads (MPI_THREAD_FUNNELED)");
+		cli_mpi_abort(CLI_FAIL);
+	}
+	return CLI_OK;
+}
+
+/* Waits for req, looking every millisecond: OpenMPI's own waits spin,
+ * which takes a core from the ranks still computing. */
+static void idle_wait(MPI_Request *req)
+{
+	const struct timespec ms = {0, 1000000};
+	int flag = 0;
+	MPI_Test(req, &flag, MPI_STATUS_IGNORE);
+	while (!flag) {
+		nanosleep(&ms, NULL);
+		MPI_Test(req, &flag, MPI_STATUS_IGNORE);
+	}
+}
+
+void cli_mpi_finish(void)
+{
+	if (!mpi_on)
+		return;
+	/* a rank done early waits here idle, not in MPI_Finalize's spin */
+	MPI_Request req;
+	if (mpi_size > 1 && MPI_Ibarrier(MPI_COMM_WORLD, &req) == MPI_SUCCESS)
+		idle_wait(&req);
+	MPI_Finalize();
+	mpi_on = 0;
+}
+
+int cli_mpi_rank(void)
+{
+	return mpi_rank;
+}
+
+int cli_mpi_size(void)
+{
+	return mpi_size;
+}
+
+void cli_mpi_abort(int rc)
+{
+	if (mpi_on && mpi_size > 1) {
+		fflush(stdout);
+		fflush(stderr);
+		MPI_Abort(MPI_COMM_WORLD, rc);
+	}
+}
+
+/* A rank's queue of records not yet sent: each an 8-byte index and the
+ * record; filled by any thread, sent by the main thread. */
+typedef struct mpi_queue {
+	pthread_mutex_t lock;
+	unsigned char *buf;
+	size_t used, cap, record_size;
+} mpi_queue;
+
+static mpi_queue queue = {PTHREAD_MUTEX_INITIALIZER, NULL, 0, 0, 0};
+
+static int mpi_record(void *user, long index, const void *payload, bsim_error *err)
+{
+	(void)user;
+	size_t n = 8 + queue.record_size;
+	int64_t i = index;
+	pthread_mutex_lock(&queue.lock);
+	if (queue.used + n > queue.cap) {
+		size_t cap = queue.cap ? 2 * queue.cap : 64 * n;
+		unsigned char *more = realloc(queue.buf, cap);
+		if (!more) {
+			pthread_mutex_unlock(&queue.lock);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory for records to send");
+		}
+		queue.buf = more;
+		queue.cap = cap;
+	}
+	memcpy(queue.buf + queue.used, &i, 8);
+	memcpy(queue.buf + queue.used + 8, payload, queue.record_size);
+	queue.used += n;
+	pthread_mutex_unlock(&queue.lock);
+	return BSIM_OK;
+}
+
+/* Batches on their way to rank 0 (sent without waiting: rank 0 takes
+ * them between its own trials), freed once sent. */
+#define PENDING_MAX 64
+static MPI_Request pending_req[PENDING_MAX];
+static unsigned char *pending_buf[PENDING_MAX];
+static int n_pending;
+
+/* Frees the batches sent; with all, waits for every one. */
+static void pending_reap(int all)
+{
+	for (int i = 0; i < n_pending;) {
+		int flag = 0;
+		if (all)
+			idle_wait(&pending_req[i]);
+		else
+			MPI_Test(&pending_req[i], &flag, MPI_STATUS_IGNORE);
+		if (all || flag) {
+			free(pending_buf[i]);
+			pending_req[i] = pending_req[--n_pending];
+			pending_buf[i] = pending_buf[n_pending];
+		} else {
+			i++;
+		}
+	}
+}
+
+/* The queue sent to rank 0 (main thread only). */
+static void send_queue(void)
+{
+	pending_reap(0);
+	if (n_pending == PENDING_MAX) {
+		idle_wait(&pending_req[0]);
+		pending_reap(0);
+	}
+	pthread_mutex_lock(&queue.lock);
+	size_t used = queue.used;
+	unsigned char *buf = NULL;
+	if (used > 0) {
+		buf = queue.buf;
+		queue.buf = NULL;
+		queue.used = queue.cap = 0;
+	}
+	pthread_mutex_unlock(&queue.lock);
+	if (!buf)
+		return;
+	MPI_Isend(buf, (int)used, MPI_BYTE, 0, TAG_RECORDS, MPI_COMM_WORLD,
+	          &pending_req[n_pending]);
+	pending_buf[n_pending++] = buf;
+}
+
+/* Rank 0: every message waiting, records to accept; *ended counts the
+ * ranks done. */
+static int receive(bsim_sweep_accept_fn accept, void *ctx, int *ended, bsim_error *err)
+{
+	for (;;) {
+		int flag = 0, bytes = 0;
+		MPI_Status st;
+		MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &st);
+		if (!flag)
+			return BSIM_OK;
+		MPI_Get_count(&st, MPI_BYTE, &bytes);
+		unsigned char *buf = malloc(bytes > 0 ? (size_t)bytes : 1);
+		if (!buf)
+			return bsim_error_set(err, BSIM_EFAIL,
+			                      "out of memory for %d bytes of records", bytes);
+		MPI_Recv(buf, bytes, MPI_BYTE, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD,
+		         MPI_STATUS_IGNORE);
+		int rc = BSIM_OK;
+		size_t n = 8 + queue.record_size;
+		if (st.MPI_TAG == TAG_DONE)
+			++*ended;
+		else if ((size_t)bytes % n != 0)
+			rc = bsim_error_set(err, BSIM_EFAIL,
+			                    "rank %d sent %d bytes, not records of %zu",
+			                    st.MPI_SOURCE, bytes, n);
+		for (size_t off = 0;
+		     rc == BSIM_OK && st.MPI_TAG == TAG_RECORDS && off < (size_t)bytes; off += n) {
+			int64_t index;
+			memcpy(&index, buf + off, 8);
+			rc = accept(ctx, (long)index, buf + off + 8, err);
+		}
+		free(buf);
+		if (rc != BSIM_OK)
+			return rc;
+	}
+}
+
+typedef struct mpi_part {
+	const volatile sig_atomic_t *stop;
+	int ended;
+} mpi_part;
+
+static mpi_part part_state;
+
+static int mpi_collect(void *user, int wait, bsim_sweep_accept_fn accept, void *ctx,
+                       bsim_error *err)
+{
+	mpi_part *p = user;
+	if (mpi_rank != 0) {
+		send_queue();
+		if (wait) {
+			pending_reap(1);
+			MPI_Request req;
+			MPI_Isend(NULL, 0, MPI_BYTE, 0, TAG_DONE, MPI_COMM_WORLD, &req);
+			idle_wait(&req);
+		}
+		return BSIM_OK;
+	}
+	int rc = receive(accept, ctx, &p->ended, err);
+	/* Waiting for the others: a millisecond's sleep between looks leaves
+	 * the cores to the ranks still running. */
+	while (rc == BSIM_OK && wait && p->ended < mpi_size - 1) {
+		if (p->stop && *p->stop)
+			return bsim_error_set(err, BSIM_ESTOPPED,
+			                      "stopped while %d of %d ranks were running",
+			                      mpi_size - 1 - p->ended, mpi_size);
+		struct timespec ms = {0, 1000000};
+		nanosleep(&ms, NULL);
+		rc = receive(accept, ctx, &p->ended, err);
+	}
+	return rc;
+}
+
+/* FNV-1a: the ranks compare their inputs by it. */
+static uint64_t text_hash(const char *s)
+{
+	uint64_t h = 0xcbf29ce484222325ULL;
+	for (; *s; s++)
+		h = (h ^ (unsigned char)*s) * 0x100000001b3ULL;
+	return h;
+}
+
+static int mpi_agree(void *user, const char *inputs, unsigned char *done, size_t bytes,
+                     bsim_error *err)
+{
+	(void)user;
+	uint64_t h = text_hash(inputs), lo = 0, hi = 0;
+	MPI_Allreduce(&h, &lo, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+	MPI_Allreduce(&h, &hi, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
+	if (lo != hi)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "the ranks read different inputs (an experiment, scene or "
+		                      "stiffness file differs between nodes, or another "
+		                      "beamsim build): rank %d's differ from another's",
+		                      mpi_rank);
+	/* in pieces: MPI counts are ints */
+	for (size_t off = 0; off < bytes; off += 1u << 30) {
+		size_t n = bytes - off < (1u << 30) ? bytes - off : (1u << 30);
+		MPI_Bcast(done + off, (int)n, MPI_BYTE, 0, MPI_COMM_WORLD);
+	}
+	return BSIM_OK;
+}
+
+void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
+                    const volatile sig_atomic_t *stop)
+{
+	if (mpi_size < 2)
+		return;
+	queue.record_size = record_size;
+	part_state.stop = stop;
+	*spread = mpi_rank == 0 ? BSIM_SPREAD_GATHER : BSIM_SPREAD_SEND;
+	*part = (bsim_sweep_part){.index = mpi_rank,
+	                          .count = mpi_size,
+	                          .record = mpi_rank ? mpi_record : NULL,
+	                          .collect = mpi_collect,
+	                          .user = &part_state};
+	*agree = mpi_agree;
+}
+
+#endif

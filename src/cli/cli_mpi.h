@@ -1,0 +1,72 @@
+/* A run spread over processes (docs/cluster.md): the processes of an MPI
+ * job, in the one file of the program that speaks MPI, built in when CMake
+ * finds MPI (BSIM_HAVE_MPI); and the job-array parts' --shard I/N and
+ * stored command line. The library knows nothing of MPI: a sweep or a
+ * comparison is spread through its parts (beamsim/sweep.h bsim_sweep_part,
+ * beamsim/sweep_dir.h spread), and this file moves the parts' journal
+ * records to rank 0, which journals them and writes the output directory
+ * as one process writes it.
+ *
+ * Records go in batches: a rank's threads queue each finished trial's
+ * record, and its main thread sends the queue between its own trials (MPI
+ * called from one thread only: MPI_THREAD_FUNNELED). Rank 0 receives
+ * between its own trials and, once they are done, until every rank has
+ * sent its last batch. A rank that dies ends the job (mpirun kills the
+ * others); rank 0's journal then holds every record it received, and the
+ * same command with --resume continues. */
+#ifndef BSIM_CLI_CLI_MPI_H
+#define BSIM_CLI_CLI_MPI_H
+
+#include "beamsim/sweep_dir.h"
+
+/* Called first by main: starts MPI when the program runs under mpirun
+ * (and MPI is built in). CLI_OK, or CLI_USAGE (printed) when it runs as
+ * one of several processes of a job and MPI is not built in. */
+int cli_mpi_init(int *argc, char ***argv);
+
+/* Called last by main: ends MPI. */
+void cli_mpi_finish(void);
+
+/* This process's rank and the job's size (0 and 1 without MPI). */
+int cli_mpi_rank(void);
+int cli_mpi_size(void);
+
+/* The agreement of the ranks on a run's inputs (bsim_sweep_dir_def.agree). */
+typedef int (*cli_mpi_agree_fn)(void *user, const char *inputs, unsigned char *done, size_t bytes,
+                                bsim_error *err);
+
+/* In a job of several ranks, a run spread over them: rank 0 gathers and
+ * writes, the others send (*spread, *part, *agree of a sweep's or a
+ * comparison's def, whose journal records are record_size bytes). */
+void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
+                    const volatile sig_atomic_t *stop);
+
+/* --shard I/N of cmd: CLI_OK with *index (1-based) and *count, or a usage
+ * error (printed). */
+int cli_shard_parse(const char *cmd, const char *value, int *index, int *count);
+
+/* The command line a part's part.json keeps: argv with the positional
+ * argument pos made absolute (merge may run elsewhere); free with
+ * cli_stored_argv_free. NULL if out of memory. */
+char **cli_stored_argv(int argc, char **argv, const char *pos);
+
+/* What merge sets on the command line its parts recorded: the output
+ * directory, threads, quiet, the part directories. */
+typedef struct cli_merge {
+	const char *out;
+	long threads;
+	int quiet;
+	const char *const *parts;
+	int n_parts;
+} cli_merge;
+
+/* compare's command line (argv[0] "compare") run as the merge m of its
+ * parts (cmd_compare.c). */
+int cmd_compare_merge(int argc, char **argv, const cli_merge *m);
+void cli_stored_argv_free(char **stored, int argc, char **argv);
+
+/* Ends the whole job with status rc (after a rank's failure, printed):
+ * the other ranks would wait for it for ever. Returns if one process. */
+void cli_mpi_abort(int rc);
+
+#endif

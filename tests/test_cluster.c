@@ -1,0 +1,520 @@
+/* A sweep spread over processes (docs/cluster.md) through the real program.
+ * The truth is the same sweep run by one process: trials are seeded from
+ * (seed, group, trial), so however the trials are split the directory must
+ * be that process's, byte for byte, but for the sweep's wall time
+ * (summary.json's wall_seconds, the summary.mat that holds it, and the
+ * manifest's sizes and CRCs of those two). Checked for three job-array
+ * parts (sweep --shard I/3) joined by merge, for mpirun -np 3, and for an
+ * MPI job one of whose ranks is killed (kill -9, once rank 0's journal holds
+ * some records: an event, never a time), resumed by a job of 2 ranks. merge
+ * refuses parts of another run, a missing or repeated part, a damaged part
+ * journal, naming them, with exit status 2 and nothing written.
+ *
+ * The MPI tests (ctest's test_cluster_mpi) need the program built with MPI
+ * (CMake found it): without it they are skipped, and ctest says so, unless
+ * BSIM_REQUIRE_MPI is set (scripts/test.sh sets it, since scripts/deps.sh
+ * installs OpenMPI), when they fail. */
+#define _XOPEN_SOURCE 700
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <ftw.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <fcntl.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "support.h"
+
+extern char **environ;
+
+static char experiment[1200];
+
+/* 12 groups of TRIALS trials of at most 1500 steps, the four without random
+ * force deterministic (run once, copied): a group count that 3 parts do not
+ * divide, so parts hold unequal shares of some groups. */
+static int setup(void **state)
+{
+	(void)state;
+	char text[2400];
+	snprintf(text, sizeof text,
+	         "scene: %s\n"
+	         "trials: 10\n"
+	         "seed: 3\n"
+	         "set:\n"
+	         "  integration.max_steps: 1500\n"
+	         "grid:\n"
+	         "  effects.propulsion.force: [6, 7, 8, 9]\n"
+	         "  effects.random_force.magnitude: [0, 10, 30]\n",
+	         bsim_test_src("configs/thesis/gate.yaml"));
+	snprintf(experiment, sizeof experiment, "%s",
+	         bsim_test_write(bsim_test_dir("exp"), "small.yaml", text));
+	/* mpirun refuses root without these (a CI container runs as root) */
+	setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+	setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+	return 0;
+}
+
+/* ---- comparing two output directories ---------------------------------- */
+
+static char *file_bytes(const char *path, long *n)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	fseek(f, 0, SEEK_END);
+	*n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	char *b = malloc((size_t)*n + 1);
+	if (b && fread(b, 1, (size_t)*n, f) != (size_t)*n) {
+		free(b);
+		b = NULL;
+	}
+	if (b)
+		b[*n] = '\0';
+	fclose(f);
+	return b;
+}
+
+/* A JSON text with every "wall_seconds" value cut out (summary.json,
+ * report.json). */
+static void drop_wall(char *text)
+{
+	const char *key = "\"wall_seconds\": ";
+	for (char *w = strstr(text, key); w; w = strstr(w + 1, key)) {
+		char *v = w + strlen(key);
+		size_t n = strcspn(v, ",}\n");
+		memmove(v, v + n, strlen(v + n) + 1);
+	}
+}
+
+static const char *ref_root, *other_root;
+static int n_compared, n_differ;
+
+static int compare_one(const char *path, const struct stat *st, int type, struct FTW *ftw)
+{
+	(void)st;
+	(void)ftw;
+	if (type != FTW_F)
+		return 0;
+	const char *rel = path + strlen(ref_root) + 1;
+	if (strncmp(rel, ".beamsim", 8) == 0)
+		return 0;
+	const char *name = strrchr(rel, '/') ? strrchr(rel, '/') + 1 : rel;
+	/* the files that hold the wall time */
+	if (strcmp(name, "manifest.json") == 0 || strcmp(name, "summary.mat") == 0 ||
+	    strcmp(name, "report.mat") == 0)
+		return 0;
+	char other[2048];
+	snprintf(other, sizeof other, "%s/%s", other_root, rel);
+	long na = 0, nb = -1;
+	char *a = file_bytes(path, &na), *b = file_bytes(other, &nb);
+	if (a && b && (strcmp(name, "summary.json") == 0 || strcmp(name, "report.json") == 0)) {
+		drop_wall(a);
+		drop_wall(b);
+		na = (long)strlen(a);
+		nb = (long)strlen(b);
+	}
+	int same = a && b && na == nb && memcmp(a, b, (size_t)na) == 0;
+	if (!same) {
+		print_error("%s differs from %s\n", other, path);
+		n_differ++;
+	}
+	n_compared++;
+	free(a);
+	free(b);
+	return 0;
+}
+
+static int count_files(const char *dir)
+{
+	char cmd[2200];
+	snprintf(cmd, sizeof cmd, "find '%s' -type f -not -path '*/.beamsim/*' | wc -l", dir);
+	FILE *p = popen(cmd, "r");
+	int n = -1;
+	if (p) {
+		if (fscanf(p, "%d", &n) != 1)
+			n = -1;
+		pclose(p);
+	}
+	return n;
+}
+
+/* Every file of ref is in dir with the same bytes (but the wall time),
+ * and dir has no other file. */
+static void assert_same_dir(const char *ref, const char *dir)
+{
+	ref_root = ref;
+	other_root = dir;
+	n_compared = n_differ = 0;
+	assert_int_equal(nftw(ref, compare_one, 16, FTW_PHYS), 0);
+	assert_true(n_compared >= 5); /* trials.csv, summary.json, run.json, inputs ... */
+	assert_int_equal(n_differ, 0);
+	assert_int_equal(count_files(dir), count_files(ref));
+}
+
+/* The one-process sweep of the experiment with trials per group. */
+static const char *reference(const char *name, const char *trials)
+{
+	static char out[1024];
+	snprintf(out, sizeof out, "%s", bsim_test_join(bsim_test_dir(name), "one"));
+	const char *argv[] = {"sweep", experiment, "--trials", trials,    "--threads",
+	                      "2",     "--out",    out,        "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	return out;
+}
+
+/* ---- job arrays: --shard I/N and merge --------------------------------- */
+
+static void shard(const char *out, const char *part, const char *seed, const char *threads)
+{
+	const char *argv[] = {"sweep", experiment, "--trials", "6",         "--seed",
+	                      seed,    "--shard",  part,       "--threads", threads,
+	                      "--out", out,        "--quiet",  NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	if (rc != 0)
+		print_error("%s", err ? err : "");
+	free(err);
+	assert_int_equal(rc, 0);
+	assert_true(bsim_test_exists(bsim_test_join(out, "part.json")));
+	assert_true(bsim_test_exists(bsim_test_join(out, "part.journal")));
+	assert_false(bsim_test_exists(bsim_test_join(out, "trials.csv")));
+}
+
+static char parts[6][1024];
+
+/* Parts 1..3 of the sweep (seed 3) with 1, 2, 1 threads, and part 2 of 3
+ * of seed 4 and part 2 of 4 of seed 3. */
+static void make_parts(const char *dir)
+{
+	const char *names[6] = {"p1", "p2", "p3", "other_seed", "of_four", "damaged"};
+	for (int i = 0; i < 6; i++)
+		snprintf(parts[i], sizeof parts[i], "%s/%s", dir, names[i]);
+	shard(parts[0], "1/3", "3", "1");
+	shard(parts[1], "2/3", "3", "2");
+	shard(parts[2], "3/3", "3", "1");
+	shard(parts[3], "2/3", "4", "1");
+	shard(parts[4], "2/4", "3", "1");
+	shard(parts[5], "3/3", "3", "2");
+	/* a torn last record, as a copy cut short would leave */
+	const char *journal = bsim_test_join(parts[5], "part.journal");
+	assert_int_equal(truncate(journal, bsim_test_size(journal) - 7), 0);
+}
+
+static void test_shards_merged(void **state)
+{
+	(void)state;
+	const char *one = reference("shards", "6");
+	char dir[1024];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("shards_parts"));
+	make_parts(dir);
+	/* the parts given in any order */
+	char out[1100];
+	snprintf(out, sizeof out, "%s/merged", dir);
+	const char *argv[] = {"merge", parts[2], parts[0], parts[1], "--out", out, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	assert_same_dir(one, out);
+}
+
+/* A comparison (thesis against box2d) in 3 parts, merged. */
+static void test_compare_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[3][1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("compare_parts"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	const char *argv1[] = {"compare", experiment, "--trials", "4",       "--threads",
+	                       "2",       "--out",    one,        "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv1, NULL, NULL), 0);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		const char *argv[] = {"compare",   experiment, "--trials", "4",
+		                      "--threads", "1",        "--shard",  shard_arg,
+		                      "--out",     part[i],    "--quiet",  NULL};
+		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	}
+	snprintf(out, sizeof out, "%s/merged", dir);
+	const char *argv[] = {"merge", part[1], part[2], part[0], "--out", out, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	assert_same_dir(one, out);
+}
+
+/* merge refuses: the status 2, one line naming the culprit, no DIR. */
+static void refused(const char *a, const char *b, const char *c, const char *const needles[])
+{
+	char out[1100];
+	snprintf(out, sizeof out, "%s/refused", bsim_test_dir("shards_refused"));
+	const char *argv[] = {"merge", a, b, c, "--out", out, NULL};
+	bsim_test_expect_input_error(argv, needles);
+	assert_false(bsim_test_exists(bsim_test_join(out, "trials.csv")));
+}
+
+static void test_merge_refuses(void **state)
+{
+	(void)state;
+	char dir[1024];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("refuse_parts"));
+	make_parts(dir);
+	refused(parts[0], parts[3], parts[2],
+	        (const char *const[]){parts[3], "parts of different runs", NULL});
+	refused(parts[0], parts[4], parts[2], (const char *const[]){parts[4], "2 of 4", NULL});
+	refused(parts[0], parts[1], parts[1],
+	        (const char *const[]){parts[1], "both part 2 of 3", NULL});
+	refused(parts[0], parts[1], parts[5],
+	        (const char *const[]){parts[5], "part.journal", "damaged", NULL});
+	/* a part missing: two of three given */
+	char out[1100];
+	snprintf(out, sizeof out, "%s/refused", bsim_test_dir("shards_missing"));
+	const char *argv[] = {"merge", parts[0], parts[2], "--out", out, NULL};
+	bsim_test_expect_input_error(argv, (const char *const[]){"part 2 of 3 is missing", NULL});
+	/* not a part's directory */
+	const char *one = reference("not_a_part", "2");
+	const char *argv2[] = {"merge", one, "--out", out, NULL};
+	bsim_test_expect_input_error(argv2, (const char *const[]){one, "part.json", NULL});
+}
+
+/* ---- MPI ----------------------------------------------------------------- */
+
+/* Fails the test when the program has no MPI though it is required
+ * (main skips the MPI tests otherwise). */
+static int have_mpi(void)
+{
+	if (BSIM_TEST_MPIEXEC[0])
+		return 1;
+	fail_msg("beamsim was built without MPI, but BSIM_REQUIRE_MPI is set (scripts/"
+	         "deps.sh installs libopenmpi-dev: CMake should have found it)");
+	return 0;
+}
+
+/* Starts mpirun -np ranks beamsim cmd ... in the background, its stderr
+ * into err_path; returns mpirun's pid. */
+static pid_t mpirun_command(const char *cmd, const char *ranks, const char *out, const char *trials,
+                            int resume, const char *err_path)
+{
+	const char *argv[] = {BSIM_TEST_MPIEXEC,
+	                      "--oversubscribe",
+	                      "-np",
+	                      ranks,
+	                      BSIM_EXE,
+	                      cmd,
+	                      experiment,
+	                      "--trials",
+	                      trials,
+	                      "--threads",
+	                      "1",
+	                      "--out",
+	                      out,
+	                      "--quiet",
+	                      resume ? "--resume" : NULL,
+	                      NULL};
+	posix_spawn_file_actions_t fa;
+	posix_spawn_file_actions_init(&fa);
+	posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+	posix_spawn_file_actions_addopen(&fa, 2, err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	/* OpenMPI's components leak at MPI_Finalize and are unloaded, so that
+	 * LeakSanitizer cannot even name them for a suppression: under ASan the
+	 * ranks run without leak detection (the same library code is leak-checked
+	 * by the shards and the one-process runs here). */
+	int n = 0;
+	while (environ[n])
+		n++;
+	char **env = calloc((size_t)n + 2, sizeof *env);
+	assert_non_null(env);
+	char asan[1024];
+	const char *was = getenv("ASAN_OPTIONS");
+	snprintf(asan, sizeof asan, "ASAN_OPTIONS=%s%sdetect_leaks=0", was ? was : "",
+	         was && *was ? ":" : "");
+	int k = 0;
+	for (int i = 0; i < n; i++)
+		if (strncmp(environ[i], "ASAN_OPTIONS=", 13) != 0)
+			env[k++] = environ[i];
+	env[k] = asan;
+	pid_t pid = -1;
+	int rc = posix_spawn(&pid, BSIM_TEST_MPIEXEC, &fa, NULL, (char *const *)argv, env);
+	posix_spawn_file_actions_destroy(&fa);
+	free(env);
+	assert_int_equal(rc, 0);
+	return pid;
+}
+
+static pid_t mpirun(const char *ranks, const char *out, const char *trials, int resume,
+                    const char *err_path)
+{
+	return mpirun_command("sweep", ranks, out, trials, resume, err_path);
+}
+
+static void print_stderr(const char *path)
+{
+	char *text = bsim_test_read(path);
+	print_error("%s", text ? text : "");
+	free(text);
+}
+
+static int wait_status(pid_t pid)
+{
+	int st = 0;
+	while (waitpid(pid, &st, 0) < 0)
+		;
+	return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
+/* mpirun -np 2 beamsim compare: the one-process comparison. */
+static void test_mpi_compare(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_compare"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/ranks2", dir);
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	const char *argv1[] = {"compare", experiment, "--trials", "6",       "--threads",
+	                       "2",       "--out",    one,        "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv1, NULL, NULL), 0);
+	int rc = wait_status(mpirun_command("compare", "2", out, "6", 0, err_path));
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
+}
+
+static void test_mpi_identical(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	const char *one = reference("mpi", "40");
+	char out[1100], err_path[1200];
+	snprintf(out, sizeof out, "%s/ranks3", bsim_test_dir("mpi_run"));
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	int rc = wait_status(mpirun("3", out, "40", 0, err_path));
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
+}
+
+/* The pid of the process of the given rank among mpirun's children: the
+ * one whose environment says OMPI_COMM_WORLD_RANK=rank; -1 if none. */
+static pid_t rank_pid(pid_t parent, int rank)
+{
+	char want[64];
+	snprintf(want, sizeof want, "OMPI_COMM_WORLD_RANK=%d", rank);
+	DIR *d = opendir("/proc");
+	pid_t found = -1;
+	struct dirent *e;
+	while (d && found < 0 && (e = readdir(d))) {
+		char path[300];
+		long pid = strtol(e->d_name, NULL, 10), ppid = -1;
+		if (pid <= 0)
+			continue;
+		snprintf(path, sizeof path, "/proc/%ld/stat", pid);
+		FILE *f = fopen(path, "r");
+		if (!f)
+			continue;
+		/* pid (comm) state ppid: comm may hold spaces, so from the last ')' */
+		char line[1024];
+		if (fgets(line, sizeof line, f) && strrchr(line, ')'))
+			sscanf(strrchr(line, ')') + 1, " %*c %ld", &ppid);
+		fclose(f);
+		if (ppid != parent)
+			continue;
+		snprintf(path, sizeof path, "/proc/%ld/environ", pid);
+		long n = 0;
+		char *env = NULL;
+		FILE *g = fopen(path, "rb");
+		if (g) {
+			env = malloc(1 << 20);
+			n = env ? (long)fread(env, 1, (1 << 20) - 1, g) : 0;
+			fclose(g);
+		}
+		for (long i = 0; env && i < n; i += (long)strlen(env + i) + 1)
+			if (strcmp(env + i, want) == 0)
+				found = (pid_t)pid;
+		free(env);
+	}
+	if (d)
+		closedir(d);
+	return found;
+}
+
+static void test_mpi_rank_killed_resumed(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	const char *one = reference("mpi_kill", "120");
+	char out[1100], err_path[1200], journal[1200];
+	snprintf(out, sizeof out, "%s/killed", bsim_test_dir("mpi_killed"));
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	snprintf(journal, sizeof journal, "%s/.beamsim/journal", out);
+	pid_t job = mpirun("3", out, "120", 0, err_path);
+	/* rank 0 journals the others' records as they come: once it holds 20
+	 * (of the 964 trials that run), rank 2 dies */
+	int status = 0;
+	if (!bsim_test_await_records(job, journal, 20, &status)) {
+		print_stderr(err_path);
+		fail_msg("the job ended (status %d) before its journal held 20 records", status);
+	}
+	pid_t victim = -1;
+	const struct timespec tick = {0, 1000000};
+	while ((victim = rank_pid(job, 2)) < 0) {
+		int st;
+		if (waitpid(job, &st, WNOHANG) == job)
+			fail_msg("the job ended before its rank 2 was found");
+		nanosleep(&tick, NULL);
+	}
+	kill(victim, SIGKILL);
+	int rc = wait_status(job);
+	assert_int_not_equal(rc, 0);
+	char *err = bsim_test_read(err_path);
+	assert_non_null(strstr(err, "rank 2"));
+	free(err);
+	long kept = bsim_test_journal_records(journal);
+	assert_true(kept >= 20);
+	assert_false(bsim_test_exists(bsim_test_join(out, "trials.csv")));
+	/* resumed by a job of 2 ranks */
+	rc = wait_status(mpirun("2", out, "120", 1, err_path));
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
+}
+
+/* test_cluster: the job arrays; test_cluster mpi: the MPI job, which ctest
+ * reports as skipped (status 77) when the program has no MPI. */
+int main(int argc, char **argv)
+{
+	const struct CMUnitTest shards[] = {
+	        cmocka_unit_test(test_shards_merged),
+	        cmocka_unit_test(test_compare_shards_merged),
+	        cmocka_unit_test(test_merge_refuses),
+	};
+	const struct CMUnitTest mpi[] = {
+	        cmocka_unit_test(test_mpi_identical),
+	        cmocka_unit_test(test_mpi_compare),
+	        cmocka_unit_test(test_mpi_rank_killed_resumed),
+	};
+	if (argc < 2 || strcmp(argv[1], "mpi") != 0)
+		return cmocka_run_group_tests(shards, setup, NULL);
+	if (!BSIM_TEST_MPIEXEC[0] && !(getenv("BSIM_REQUIRE_MPI") && *getenv("BSIM_REQUIRE_MPI"))) {
+		printf("skipped: beamsim is built without MPI (CMake did not find it)\n");
+		return 77;
+	}
+	return cmocka_run_group_tests(mpi, setup, NULL);
+}
