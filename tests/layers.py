@@ -40,6 +40,7 @@ RANK = {
     "video": 5,
     "analysis": 6,
     "cli": 7,
+    "bench": 8,
 }
 
 # Each public header's layer: the folder that implements it.

@@ -1,6 +1,6 @@
 /* beamsim bench --lattice (bench_lattice.c). */
-#ifndef BSIM_CLI_BENCH_LATTICE_H
-#define BSIM_CLI_BENCH_LATTICE_H
+#ifndef BSIM_BENCH_BENCH_LATTICE_H
+#define BSIM_BENCH_BENCH_LATTICE_H
 
 #include <stdio.h>
 

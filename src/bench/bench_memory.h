@@ -1,6 +1,6 @@
 /* beamsim bench --memory (bench_memory.c). */
-#ifndef BSIM_CLI_BENCH_MEMORY_H
-#define BSIM_CLI_BENCH_MEMORY_H
+#ifndef BSIM_BENCH_BENCH_MEMORY_H
+#define BSIM_BENCH_BENCH_MEMORY_H
 
 #include <stdio.h>
 

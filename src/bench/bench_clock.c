@@ -11,7 +11,7 @@
  * gettimeofday. */
 #define _GNU_SOURCE
 
-#include "cli/bench_clock.h"
+#include "bench/bench_clock.h"
 
 #include <dlfcn.h>
 #include <stdlib.h>

@@ -1,6 +1,6 @@
 /* The clock reads of Box2D's profiling timers, counted (bench_clock.c). */
-#ifndef BSIM_CLI_BENCH_CLOCK_H
-#define BSIM_CLI_BENCH_CLOCK_H
+#ifndef BSIM_BENCH_BENCH_CLOCK_H
+#define BSIM_BENCH_BENCH_CLOCK_H
 
 /* gettimeofday calls made in this process so far. */
 unsigned long bench_clock_reads(void);

@@ -16,7 +16,7 @@
  *             to trial as a sweep keeps it (bench_lattice_long). */
 #define _POSIX_C_SOURCE 200809L
 
-#include "cli/bench_callgrind.h"
+#include "bench/bench_callgrind.h"
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -28,8 +28,8 @@
 
 #include "beamsim/experiment.h"
 #include "beamsim/sweep.h"
-#include "cli/bench_free.h"
-#include "cli/bench_lattice.h"
+#include "bench/bench_free.h"
+#include "bench/bench_lattice.h"
 #include "cli/cli_common.h"
 
 extern char **environ;

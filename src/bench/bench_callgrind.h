@@ -1,6 +1,6 @@
 /* beamsim bench --callgrind and --measure (bench_callgrind.c). */
-#ifndef BSIM_CLI_BENCH_CALLGRIND_H
-#define BSIM_CLI_BENCH_CALLGRIND_H
+#ifndef BSIM_BENCH_BENCH_CALLGRIND_H
+#define BSIM_BENCH_BENCH_CALLGRIND_H
 
 #include <stdio.h>
 

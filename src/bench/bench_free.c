@@ -16,7 +16,7 @@
  * test. Nothing else: no runner, no ledger, no backend interface. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "cli/bench_free.h"
+#include "bench/bench_free.h"
 
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>

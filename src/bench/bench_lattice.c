@@ -25,7 +25,7 @@
  * step. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "cli/bench_lattice.h"
+#include "bench/bench_lattice.h"
 
 #include <stdio.h>
 #include <string.h>

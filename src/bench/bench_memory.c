@@ -24,7 +24,7 @@
  * from what the program holds whatever the size. */
 #define _DEFAULT_SOURCE
 
-#include "cli/bench_memory.h"
+#include "bench/bench_memory.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -1,6 +1,6 @@
 /* beamsim bench's free-flight figure (bench_free.c). */
-#ifndef BSIM_CLI_BENCH_FREE_H
-#define BSIM_CLI_BENCH_FREE_H
+#ifndef BSIM_BENCH_BENCH_FREE_H
+#define BSIM_BENCH_BENCH_FREE_H
 
 #include "beamsim/backend.h"
 #include "beamsim/options.h"
