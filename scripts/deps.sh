@@ -6,10 +6,12 @@ set -euo pipefail
 # libclang-rt-14-dev (libFuzzer, only recommended by clang) and libomp-dev
 # (clang's OpenMP): the fuzzing run of scripts/test.sh. python3: the test of
 # the layout's rules (tests/layers.py). chromium: test_index_html shows each
-# output directory's index.html in a headless browser.
+# output directory's index.html in a headless browser. octave and
+# liboctave-dev (mkoctfile): the MEX functions of bindings/matlab and their
+# test.
 pkgs=(build-essential cmake pkg-config libgsl-dev libcmocka-dev libfyaml-dev libbox2d-dev
       libmatio-dev gnuplot-nox fonts-dejavu-core libcairo2-dev ffmpeg zlib1g-dev
-      clang libclang-rt-14-dev libomp-dev python3 chromium)
+      clang libclang-rt-14-dev libomp-dev python3 chromium octave liboctave-dev)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
