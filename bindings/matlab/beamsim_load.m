@@ -79,79 +79,14 @@ function f = field_name(name)
   end
 end
 
+% A table by beamsim_read_csv (the MEX function beside this file), the
+% group and trial columns counted from 1.
 function t = read_csv(file)
-  text = fileread(file);
-  lines = regexp(text, '\r?\n', 'split');
-  if ~isempty(lines) && isempty(lines{end})
-    lines(end) = [];
-  end
-  if isempty(lines)
-    error('beamsim:input', 'beamsim_load: %s: expected a header line, got an empty file', file);
-  end
-  header = split_line(lines{1});
-  nc = numel(header);
-  body = lines(2:end);
-  n = numel(body);
-  if isempty(strfind(text, '"'))
-    parts = regexp(body, ',', 'split');
-  else
-    parts = cellfun(@split_line, body, 'UniformOutput', false);
-  end
-  counts = cellfun('numel', parts);
-  bad = find(counts ~= nc, 1);
-  if ~isempty(bad)
-    error('beamsim:input', 'beamsim_load: %s:%d: expected %d fields, got %d', file, ...
-          bad + 1, nc, counts(bad));
-  end
-  if n > 0
-    cells = vertcat(parts{:});
-  else
-    cells = cell(0, nc);
-  end
-  t = struct();
-  for j = 1:nc
-    col = cells(:, j);
-    v = str2double(col);
-    empty = cellfun('isempty', col);
-    name = field_name(header{j});
-    if all(~isnan(v) | empty | strcmpi(col, 'nan'))
-      v(empty) = NaN;
-      if any(strcmp(header{j}, {'group', 'trial'}))
-        v = v + 1;
-      end
-      t.(name) = v;
-    else
-      t.(name) = col;
+  t = beamsim_read_csv(file);
+  names = {'group', 'trial'};
+  for i = 1:numel(names)
+    if isfield(t, names{i}) && isnumeric(t.(names{i}))
+      t.(names{i}) = t.(names{i}) + 1;
     end
   end
-end
-
-% The fields of one CSV line, quoted fields ("a, b", "" for ") unquoted.
-function f = split_line(line)
-  f = {};
-  field = '';
-  quoted = false;
-  k = 1;
-  while k <= numel(line)
-    c = line(k);
-    if quoted
-      if c == '"' && k < numel(line) && line(k + 1) == '"'
-        field(end + 1) = '"';
-        k = k + 1;
-      elseif c == '"'
-        quoted = false;
-      else
-        field(end + 1) = c;
-      end
-    elseif c == '"'
-      quoted = true;
-    elseif c == ','
-      f{end + 1} = field;
-      field = '';
-    else
-      field(end + 1) = c;
-    end
-    k = k + 1;
-  end
-  f{end + 1} = field;
 end

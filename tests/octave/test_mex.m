@@ -227,6 +227,23 @@ check(numel(d.summary.groups) == numel(s.groups) && isfield(d, 'run') && isfield
 printf('beamsim_load: %d trials as the sweep returned them (to trials.csv''s 10 digits)\n', ...
        numel(d.trials.group));
 
+% A table with quoted fields, an empty field and nan; a short line refused.
+file = fullfile(tmp, 'quoted.csv');
+fid = fopen(file, 'w');
+fprintf(fid, 'group,"a,b",c\n0,"x, ""y""",1.5\n1,z,\n2,"",nan\n');
+fclose(fid);
+t = beamsim_load(tmp).quoted;
+check(isequal(t.group, [1; 2; 3]) && isequal(t.a_b, {'x, "y"'; 'z'; ''}) && ...
+      isequaln(t.c, [1.5; NaN; NaN]), 'quoted.csv read wrong');
+fid = fopen(file, 'a');
+fprintf(fid, '3,w\n');
+fclose(fid);
+[id, msg] = raised(@beamsim_load, tmp);
+check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, 'quoted.csv:5: expected 3 fields, got 2')), ...
+      'a short line: %s %s', id, msg);
+delete(file);
+printf('beamsim_load: quoted fields, empty fields and nan; a short line refused\n');
+
 % ---- the landscape ------------------------------------------------------
 landdir = fullfile(tmp, 'landscape');
 [out, err, status] = program(exe, tmp, sprintf('landscape %s --resolution 0.5 --json --out %s', ...
