@@ -268,6 +268,27 @@ check_column('landscape', 'theta2', reshape(l.theta(:, :, 2)', [], 1), ...
 printf('landscape: %d x %d points and the lowest pass (%.2f J) as the program''s\n', ...
        numel(l.x), numel(l.y), p.height);
 
+% ---- unstable trials: an ordinary result, said as the program says it ---
+stiff = fullfile(source, 'configs', 'hard', 'stiff_beam_sweep.yaml');
+[~, err, status] = program(exe, tmp, sprintf(['run %s --group 1 --backend box2d ' ...
+                                              '--backend-opt spring=torque'], stiff));
+lastwarn('', '');
+r = beamsim_run(stiff, 'group', 2, 'backend', 'box2d', 'backend_opt', {'spring', 'torque'});
+[wmsg, wid] = lastwarn();
+wmsg = regexprep(wmsg, '^beamsim_run: ', '');  % Octave's prefix
+lines = strsplit(err, "\n");
+check(status == 1 && strcmp(r.outcome, 'unstable') && strcmp(wid, 'beamsim:unstable') && ...
+      strcmp(['beamsim: ' wmsg], lines{end}) && ~isempty(strfind(wmsg, r.instability)), ...
+      'unstable trial: %s, warning %s; the program (exit %d) %s', r.outcome, wmsg, status, err);
+lastwarn('', '');
+s = beamsim_sweep(stiff, 'backend', 'box2d', 'backend_opt', {'spring', 'torque'});
+[wmsg, wid] = lastwarn();
+wmsg = regexprep(wmsg, '^beamsim_sweep: ', '');
+check(strcmp(wid, 'beamsim:unstable') && sum(strcmp(s.trials.outcome, 'unstable')) == 20 && ...
+      sum([s.groups.unstable]) == 20 && strncmp(wmsg, '20 of 20 trials unstable on the box2d', 37), ...
+      'unstable sweep: %s', wmsg);
+printf('unstable: a trial and a sweep on box2d with torque springs, said as the program says\n');
+
 % ---- errors: the program's messages -------------------------------------
 cases = {
   'run --set body.mass=-1', sprintf('run %s --set body.mass=-1', gate), ...
