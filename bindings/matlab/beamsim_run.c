@@ -253,9 +253,10 @@ static int stored_check(const bsim_replay *rp, const bsim_trial_result *x, bsim_
 		snprintf(where, sizeof where, "%s/trials.csv", rp->path);
 	}
 	return bsim_error_set(err, BSIM_EDISAGREE,
-	                      "the replay of group %ld, trial %ld differs from its row in %s: %s, "
-	                      "stored %s",
-	                      rp->group, rp->trial, where, mine, theirs);
+	                      "the replay of group %ld, trial %ld (from 1; trials.csv's %ld, %ld) "
+	                      "differs from its row in %s: %s, stored %s",
+	                      rp->group + 1, rp->trial + 1, rp->group, rp->trial, where, mine,
+	                      theirs);
 }
 
 /* The range of a group or trial out of range counted from 1, as the
