@@ -292,6 +292,26 @@ check(strcmp(wid, 'beamsim:unstable') && sum(strcmp(s.trials.outcome, 'unstable'
       'unstable sweep: %s', wmsg);
 printf('unstable: a trial and a sweep on box2d with torque springs, said as the program says\n');
 
+% ---- examples/fig3_1.m: the essay's Fig. 3.1 is the sweep's -------------
+figdir = fullfile(tmp, 'fig');
+[~, err, status] = program(exe, tmp, sprintf('sweep %s --trials 5 --quiet --out %s', h1, figdir));
+check(status == 0, 'beamsim sweep: exit %d: %s', status, err);
+summary = jsondecode(fileread(fullfile(figdir, 'summary.json')));
+addpath(fullfile(source, 'examples'));
+png = fullfile(tmp, 'fig3_1.png');
+[P, F, R] = fig3_1(png, 5);
+for g = 1:numel(summary.groups)
+  b = summary.groups(g);
+  i = find(F == b.params.effects_propulsion_force);
+  j = find(R == b.params.effects_random_force_magnitude);
+  check(json_same(P(j, i), b.p_traverse), 'fig3_1: F %g R %g: %g, summary.json %g', F(i), ...
+        R(j), P(j, i), b.p_traverse);
+end
+info = dir(png);
+check(numel(P) == numel(summary.groups) && numel(info) == 1 && info.bytes > 1000, ...
+      'fig3_1: %d cells, the figure %s', numel(P), png);
+printf('examples/fig3_1.m: %d cells as summary.json, the figure drawn\n', numel(P));
+
 % ---- errors: the program's messages -------------------------------------
 cases = {
   'run --set body.mass=-1', sprintf('run %s --set body.mass=-1', gate), ...
