@@ -160,11 +160,11 @@ printf('run of an experiment: group 11, trial 4 on box2d: the program''s numbers
 
 % ---- a sweep with --set and --grid: trials.csv and summary.json ---------
 sweepdir = fullfile(tmp, 'sweep');
-[out, err, status] = program(exe, tmp, sprintf(['sweep %s --trials 20 --threads 2 ' ...
+[out, err, status] = program(exe, tmp, sprintf(['sweep %s --trials 10 --threads 2 ' ...
     '--set contact.restitution=0.7 --grid effects.random_force.magnitude=10,30 --quiet --out %s'], ...
     h1, sweepdir));
 check(status == 0, 'beamsim sweep: exit %d: %s', status, err);
-opts = {'trials', 20, 'set', {'contact.restitution', 0.7}, ...
+opts = {'trials', 10, 'set', {'contact.restitution', 0.7}, ...
         'grid', {'effects.random_force.magnitude', [10 30]}};
 s = beamsim_sweep(h1, opts{:}, 'threads', 2);
 [names, cols] = csv_columns(fullfile(sweepdir, 'trials.csv'));
@@ -294,12 +294,12 @@ printf('unstable: a trial and a sweep on box2d with torque springs, said as the 
 
 % ---- examples/fig3_1.m: the essay's Fig. 3.1 is the sweep's -------------
 figdir = fullfile(tmp, 'fig');
-[~, err, status] = program(exe, tmp, sprintf('sweep %s --trials 5 --quiet --out %s', h1, figdir));
+[~, err, status] = program(exe, tmp, sprintf('sweep %s --trials 3 --quiet --out %s', h1, figdir));
 check(status == 0, 'beamsim sweep: exit %d: %s', status, err);
 summary = jsondecode(fileread(fullfile(figdir, 'summary.json')));
 addpath(fullfile(source, 'examples'));
 png = fullfile(tmp, 'fig3_1.png');
-[P, F, R] = fig3_1(png, 5);
+[P, F, R] = fig3_1(png, 3);
 for g = 1:numel(summary.groups)
   b = summary.groups(g);
   i = find(F == b.params.effects_propulsion_force);
