@@ -1,0 +1,386 @@
+/* beamsim_run: one trial, as `beamsim run` runs it.
+ *
+ *   r = beamsim_run(ARG, NAME, VALUE, ...)
+ *
+ * ARG is a scene file, an experiment file or the output directory of a
+ * sweep or a comparison (beamsim/replay.h says which trial each names).
+ * Names: 'seed', 'group' and 'trial' (from 1: trials.csv's group and trial
+ * plus 1), 'backend' (a stored comparison's side by its label),
+ * 'backend_opt' {KEY, VALUE, ...}, 'set' {KEY, VALUE, ...}, 'grid'
+ * {KEY, VALUES, ...}, 'trajectory' (true: the recorded rows), 'stride'.
+ * r holds what `beamsim run --json` prints; with 'trajectory' also
+ * r.trajectory, the columns of run --trajectory's CSV, and r.ledger_rows,
+ * those of run --out's ledger.csv, each a column vector. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bsim_mex.h"
+
+enum {
+	A_SEED,
+	A_GROUP,
+	A_TRIAL,
+	A_BACKEND,
+	A_BACKEND_OPT,
+	A_SET,
+	A_GRID,
+	A_TRAJECTORY,
+	A_STRIDE,
+	N_ARGS
+};
+static const char *const arg_names[N_ARGS] = {
+        "seed", "group", "trial", "backend", "backend_opt", "set", "grid", "trajectory", "stride"};
+
+/* The ledger.csv columns after t (bsim_trial_ledger_header). */
+#define LEDGER_COLUMNS 13
+
+/* The recorded rows, row by row: the trajectory's columns, then the
+ * ledger's. */
+typedef struct rows {
+	int n_beams, width;
+	long n, cap;
+	double *v;
+	int oom;
+} rows;
+
+static int traj_width(int n_beams)
+{
+	return 5 + 2 * n_beams + 1 + n_beams + 3;
+}
+
+static void rows_record(void *user, const bsim_record_row *row)
+{
+	rows *r = user;
+	const bsim_state *s = row->state;
+	if (r->oom)
+		return;
+	if (r->n == r->cap) {
+		long cap = r->cap ? 2 * r->cap : 1024;
+		double *more = realloc(r->v, (size_t)cap * (size_t)r->width * sizeof *more);
+		if (!more) {
+			r->oom = 1;
+			return;
+		}
+		r->v = more;
+		r->cap = cap;
+	}
+	double *d = r->v + (size_t)r->n * (size_t)r->width;
+	int k = 0;
+	d[k++] = row->t;
+	d[k++] = s->x[0];
+	d[k++] = s->x[1];
+	d[k++] = s->v[0];
+	d[k++] = s->v[1];
+	for (int i = 0; i < r->n_beams; i++) {
+		d[k++] = s->theta[i];
+		d[k++] = s->omega[i];
+	}
+	d[k++] = row->f_rand;
+	for (int i = 0; i < r->n_beams; i++)
+		d[k++] = s->contact[i];
+	d[k++] = row->e_kin;
+	d[k++] = row->e_beam;
+	d[k++] = row->e_prop;
+	const bsim_ledger *l = row->ledger;
+	const double ledger[LEDGER_COLUMNS] = {
+	        row->t,     row->e_kin,    row->e_beam, row->e_kin + row->e_beam,
+	        l->w_prop,  l->w_rand,     l->damper,   l->impact,
+	        l->contact, l->correction, l->residual, l->sleep,
+	        l->reset};
+	memcpy(d + k, ledger, sizeof ledger);
+	r->n++;
+}
+
+/* Column c of the rows as a field of s. */
+static void rows_field(mxArray *s, const rows *r, int c, const char *name)
+{
+	double *d;
+	mxArray *col = bmx_column((size_t)r->n, &d);
+	for (long i = 0; i < r->n; i++)
+		d[i] = r->v[(size_t)i * (size_t)r->width + (size_t)c];
+	bmx_set(s, 0, name, col);
+}
+
+/* r.trajectory and r.ledger_rows, named as the CSV headers name them. */
+static void rows_structs(mxArray *out, const rows *r)
+{
+	mxArray *t = mxCreateStructMatrix(1, 1, 0, NULL);
+	char name[32];
+	int c = 0;
+	static const char *const head[] = {"t", "x", "y", "vx", "vy"};
+	for (int i = 0; i < 5; i++)
+		rows_field(t, r, c++, head[i]);
+	for (int i = 1; i <= r->n_beams; i++) {
+		snprintf(name, sizeof name, "theta%d", i);
+		rows_field(t, r, c++, name);
+		snprintf(name, sizeof name, "omega%d", i);
+		rows_field(t, r, c++, name);
+	}
+	rows_field(t, r, c++, "f_rand");
+	for (int i = 1; i <= r->n_beams; i++) {
+		snprintf(name, sizeof name, "contact%d", i);
+		rows_field(t, r, c++, name);
+	}
+	static const char *const tail[] = {"e_kin", "e_beam", "e_prop"};
+	for (int i = 0; i < 3; i++)
+		rows_field(t, r, c++, tail[i]);
+	bmx_set(out, 0, "trajectory", t);
+	mxArray *l = mxCreateStructMatrix(1, 1, 0, NULL);
+	static const char *const ledger[LEDGER_COLUMNS] = {
+	        "t",      "e_kin",   "e_beam",     "e_mech",   "w_prop", "w_rand", "damper",
+	        "impact", "contact", "correction", "residual", "sleep",  "reset"};
+	for (int i = 0; i < LEDGER_COLUMNS; i++)
+		rows_field(l, r, c++, ledger[i]);
+	bmx_set(out, 0, "ledger_rows", l);
+}
+
+static mxArray *ledger_struct(const bsim_ledger *l)
+{
+	mxArray *s = mxCreateStructMatrix(1, 1, 0, NULL);
+	const char *names[] = {"e_start",  "e_end",        "w_prop",       "w_rand", "damper",
+	                       "impact",   "contact",      "correction",   "sleep",  "reset",
+	                       "residual", "residual_max", "residual_abs", "inflow"};
+	const double values[] = {l->e_start,      l->e_end,  l->w_prop,   l->w_rand,
+	                         l->damper,       l->impact, l->contact,  l->correction,
+	                         l->sleep,        l->reset,  l->residual, l->residual_max,
+	                         l->residual_abs, l->inflow};
+	for (size_t i = 0; i < sizeof values / sizeof values[0]; i++)
+		bmx_set(s, 0, names[i], bmx_scalar(values[i]));
+	return s;
+}
+
+/* The gates a lattice trial entered, one row each: ix, iy, t, pos, vx, vy
+ * (run --json's path), and each beam's peak angle. */
+static void path_fields(mxArray *out, const bsim_trial_log *log)
+{
+	mxArray *p = mxCreateDoubleMatrix((mwSize)log->n_entries, 6, mxREAL);
+	double *d = mxGetPr(p);
+	size_t n = (size_t)log->n_entries;
+	for (size_t k = 0; k < n; k++) {
+		const bsim_gate_entry *e = &log->entries[k];
+		const double row[6] = {e->ix, e->iy, e->t, e->pos, e->v[0], e->v[1]};
+		for (size_t j = 0; j < 6; j++)
+			d[j * n + k] = row[j];
+	}
+	bmx_set(out, 0, "path", p);
+	mxArray *edges = mxCreateCellMatrix((mwSize)log->n_entries, 1);
+	for (size_t k = 0; k < n; k++)
+		mxSetCell(edges, (mwIndex)k,
+		          bmx_string(bsim_trial_edge_name(log->entries[k].edge)));
+	bmx_set(out, 0, "path_edge", edges);
+	bmx_set(out, 0, "peak_theta", bmx_row(log->peak, log->n_beams));
+}
+
+static mxArray *result_struct(const bsim_replay *rp, const bsim_backend *b,
+                              const bsim_options *opts, const bsim_trial_result *r,
+                              const bsim_trial_log *log)
+{
+	mxArray *s = mxCreateStructMatrix(1, 1, 0, NULL);
+	bmx_set(s, 0, "scene", bmx_string(rp->scene_path ? rp->scene_path : ""));
+	bmx_set(s, 0, "name", bmx_string(rp->scene.name));
+	bmx_set(s, 0, "backend", bmx_string(b->name));
+	mxArray *o = mxCreateStructMatrix(1, 1, 0, NULL);
+	bsim_options eff;
+	bsim_options_effective(b->knobs, b->n_knobs, opts, &eff);
+	for (int i = 0; i < eff.n; i++) {
+		char field[64];
+		bmx_field_name(eff.key[i], field, sizeof field);
+		/* numbers as numbers, as run --json writes them */
+		char *end;
+		double x = strtod(eff.value[i], &end);
+		int number = end != eff.value[i] && *end == '\0';
+		bmx_set(o, 0, field, number ? bmx_scalar(x) : bmx_string(eff.value[i]));
+	}
+	bmx_set(s, 0, "backend_options", o);
+	bmx_set(s, 0, "seed", bmx_u64(rp->seed));
+	bmx_set(s, 0, "group", bmx_scalar((double)rp->group + 1));
+	bmx_set(s, 0, "trial", bmx_scalar((double)rp->trial + 1));
+	bmx_set(s, 0, "mixed_seed", bmx_u64(rp->mixed_seed));
+	/* The grid values applied, without the replay's "group G: " (G from 0). */
+	const char *grid = strncmp(rp->grid, "group ", 6) == 0 ? strchr(rp->grid, ':') : NULL;
+	grid = grid ? grid + 1 + (grid[1] == ' ') : rp->grid;
+	bmx_set(s, 0, "grid", bmx_string(grid));
+	bmx_set(s, 0, "outcome", bmx_string(bsim_trial_outcome_name(r->outcome)));
+	bmx_set(s, 0, "type", bmx_string(bsim_trial_type_name(r->type)));
+	bmx_set(s, 0, "landscape_beam", bmx_scalar(r->landscape_beam + 1));
+	bmx_set(s, 0, "in_contact_end", bmx_scalar(r->in_contact_end));
+	bmx_set(s, 0, "steps", bmx_scalar(r->steps));
+	bmx_set(s, 0, "steps_run", bmx_scalar(r->steps_run));
+	bmx_set(s, 0, "draws", bmx_scalar((double)r->draws));
+	bmx_set(s, 0, "t_end", bmx_scalar(r->t_end));
+	bmx_set(s, 0, "x_end", bmx_scalar(r->x_end));
+	bmx_set(s, 0, "y_end", bmx_scalar(r->y_end));
+	bmx_set(s, 0, "vx_end", bmx_scalar(r->vx_end));
+	bmx_set(s, 0, "max_theta", bmx_row(r->max_theta, 2));
+	bmx_set(s, 0, "overlap_max", bmx_scalar(r->overlap_max));
+	const double gate[2] = {r->final_ix, r->final_iy};
+	bmx_set(s, 0, "final_gate", bmx_row(gate, 2));
+	char label[48];
+	bsim_lattice_location_label(bsim_lattice_location_of(r), label, sizeof label);
+	bmx_set(s, 0, "location", bmx_string(label));
+	bmx_set(s, 0, "reset_overlaps", bmx_scalar(r->reset_overlaps));
+	path_fields(s, log);
+	bmx_set(s, 0, "ledger", ledger_struct(&r->ledger));
+	mxArray *solver = mxCreateStructMatrix(1, 1, 0, NULL);
+	bmx_set(solver, 0, "iteration_limit", bmx_scalar((double)r->solver.iteration_limit));
+	bmx_set(solver, 0, "clamped", bmx_scalar((double)r->solver.clamped));
+	bmx_set(s, 0, "solver", solver);
+	char why[256] = "";
+	if (r->instability)
+		bsim_trial_instability_text(r, rp->scene.dt, why, sizeof why);
+	bmx_set(s, 0, "instability", bmx_string(why));
+	return s;
+}
+
+/* A stored run's row against the replay, as `beamsim run DIR` checks it. */
+static int stored_check(const bsim_replay *rp, const bsim_trial_result *x, bsim_error *err)
+{
+	const bsim_trial_result *y = bsim_replay_stored_row(rp);
+	if (!y)
+		return BSIM_OK;
+	char mine[256], theirs[256], where[BSIM_PATH_MAX + 160];
+	bsim_replay_row(mine, sizeof mine, rp->group, rp->trial, x);
+	bsim_replay_row(theirs, sizeof theirs, rp->group, rp->trial, y);
+	if (strcmp(mine, theirs) == 0)
+		return BSIM_OK;
+	if (strcmp(rp->command, "compare") == 0) {
+		char name[128];
+		bsim_compare_dir_label(rp->label, name, sizeof name);
+		snprintf(where, sizeof where, "%s/%s/trials.csv", rp->path, name);
+	} else {
+		snprintf(where, sizeof where, "%s/trials.csv", rp->path);
+	}
+	return bsim_error_set(err, BSIM_EDISAGREE,
+	                      "the replay of group %ld, trial %ld (from 1; trials.csv's %ld, %ld) "
+	                      "differs from its row in %s: %s, stored %s",
+	                      rp->group + 1, rp->trial + 1, rp->group, rp->trial, where, mine,
+	                      theirs);
+}
+
+/* The range of a group or trial out of range counted from 1, as the
+ * arguments count: "--group 30: expected 0 to 29 (h1.yaml has 30 groups)"
+ * becomes "'group' 31: expected 1 to 30 (h1.yaml has 30 groups)". */
+static int from_one(bsim_error *err)
+{
+	static const char *const names[] = {"group", "trial"};
+	for (int i = 0; i < 2; i++) {
+		char head[64];
+		long given, last;
+		int used = 0;
+		snprintf(head, sizeof head, "--%s %%ld: expected 0 to %%ld%%n", names[i]);
+		if (sscanf(err->msg, head, &given, &last, &used) == 2 && used > 0) {
+			char rest[BSIM_ERROR_MSG_MAX];
+			snprintf(rest, sizeof rest, "%s", err->msg + used);
+			return bsim_error_set(err, err->code, "'%s' %ld: expected 1 to %ld%s",
+			                      names[i], given + 1, last + 1, rest);
+		}
+	}
+	return err->code ? err->code : BSIM_EINPUT;
+}
+
+typedef struct run_call {
+	bmx_pool pool;
+	bsim_grid_axis *grid;
+	int n_grid;
+	bsim_replay *rp;
+	bsim_trial_log *log;
+	rows traj;
+} run_call;
+
+static int run(run_call *c, int nrhs, const mxArray *prhs[], mxArray **out, char *warning,
+               size_t warning_size, bsim_error *err)
+{
+	const mxArray *v[N_ARGS];
+	if (nrhs < 1)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "expected a scene, an experiment or an output directory, "
+		                      "then name-value pairs");
+	if (bmx_pairs(nrhs, prhs, 1, arg_names, N_ARGS, v, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	bsim_replay_def def = bsim_replay_def_default();
+	long group = 1, trial = 1, stride = 1;
+	int trajectory = 0;
+	const char *backend = NULL;
+	bsim_override *kv = NULL;
+	int n_kv = 0;
+	if (bmx_text("path", prhs[0], &c->pool, &def.path, err) ||
+	    (v[A_GROUP] && bmx_long("group", v[A_GROUP], 1, INT32_MAX, &group, err)) ||
+	    (v[A_TRIAL] && bmx_long("trial", v[A_TRIAL], 1, INT32_MAX, &trial, err)) ||
+	    (v[A_STRIDE] && bmx_long("stride", v[A_STRIDE], 1, INT32_MAX, &stride, err)) ||
+	    (v[A_SEED] && bmx_seed("seed", v[A_SEED], &def.seed, err)) ||
+	    (v[A_TRAJECTORY] && bmx_flag("trajectory", v[A_TRAJECTORY], &trajectory, err)) ||
+	    (v[A_BACKEND] && bmx_text("backend", v[A_BACKEND], &c->pool, &backend, err)) ||
+	    bmx_overrides("backend_opt", v[A_BACKEND_OPT], &c->pool, &kv, &n_kv, err) ||
+	    bmx_overrides("set", v[A_SET], &c->pool, (bsim_override **)&def.sets, &def.n_sets,
+	                  err) ||
+	    bmx_grid("grid", v[A_GRID], &c->pool, &c->grid, &c->n_grid, err))
+		return err->code;
+	def.group = group - 1;
+	def.trial = trial - 1;
+	def.has_seed = v[A_SEED] != NULL;
+	def.grid = c->grid;
+	def.n_grid = c->n_grid;
+	int stored = bsim_replay_is_dir(def.path);
+	if (stored) {
+		def.side = backend;
+		def.has_backend_opts = n_kv > 0;
+	}
+	if (bsim_replay_open(&def, &c->rp, err) != BSIM_OK)
+		return from_one(err);
+	const bsim_replay *rp = c->rp;
+	const bsim_backend *b = rp->backend;
+	bsim_options opts = rp->opts;
+	if (!b && bmx_backend(backend, kv, n_kv, &b, &opts, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	if (!(c->log = bsim_trial_log_alloc()))
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	bsim_recorder rec = {.stride = (int)stride, .log = c->log, .overlap = 1};
+	if (trajectory) {
+		c->traj.n_beams = rp->scene.n_beams;
+		c->traj.width = traj_width(rp->scene.n_beams) + LEDGER_COLUMNS;
+		rec.record = rows_record;
+		rec.record_user = &c->traj;
+	}
+	bsim_trial_result res;
+	memset(&res, 0, sizeof res);
+	if (bsim_replay_run(rp, b, &opts, &rec, &res, err) != BSIM_OK)
+		return err->code ? err->code : BSIM_EFAIL;
+	if (c->traj.oom)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for the trajectory");
+	if (res.outcome == BSIM_UNSTABLE) {
+		char why[256];
+		bsim_trial_instability_text(&res, rp->scene.dt, why, sizeof why);
+		snprintf(warning, warning_size, "%s backend: unstable trial: %s", b->name, why);
+	}
+	if (stored_check(rp, &res, err) != BSIM_OK)
+		return err->code;
+	*out = result_struct(rp, b, &opts, &res, c->log);
+	if (trajectory)
+		rows_structs(*out, &c->traj);
+	return BSIM_OK;
+}
+
+void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
+{
+	(void)nlhs;
+	run_call c;
+	memset(&c, 0, sizeof c);
+	bsim_error err;
+	bsim_error_clear(&err);
+	char warning[512] = "";
+	mxArray *out = NULL;
+	int rc = run(&c, nrhs, prhs, &out, warning, sizeof warning, &err);
+	bsim_replay_free(c.rp);
+	bsim_trial_log_free(c.log);
+	free(c.traj.v);
+	bmx_grid_free(c.grid, c.n_grid);
+	bmx_pool_free(&c.pool);
+	if (rc != BSIM_OK)
+		bmx_fail(&err);
+	/* An unstable trial is said, as the program says it (and exits 1). */
+	if (warning[0])
+		mexWarnMsgIdAndTxt("beamsim:unstable", "%s", warning);
+	plhs[0] = out;
+}

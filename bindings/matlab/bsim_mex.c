@@ -1,0 +1,480 @@
+/* What the MEX functions share; see bsim_mex.h. */
+#include "bsim_mex.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+char *bmx_pool_take(bmx_pool *p, char *s)
+{
+	if (!s)
+		return NULL;
+	if (p->n == p->cap) {
+		int cap = p->cap ? 2 * p->cap : 16;
+		char **more = realloc(p->s, (size_t)cap * sizeof *more);
+		if (!more) {
+			free(s);
+			return NULL;
+		}
+		p->s = more;
+		p->cap = cap;
+	}
+	p->s[p->n++] = s;
+	return s;
+}
+
+void bmx_pool_free(bmx_pool *p)
+{
+	for (int i = 0; i < p->n; i++)
+		free(p->s[i]);
+	free(p->s);
+	memset(p, 0, sizeof *p);
+}
+
+static char *dup_text(const char *s)
+{
+	size_t n = strlen(s) + 1;
+	char *d = malloc(n);
+	if (d)
+		memcpy(d, s, n);
+	return d;
+}
+
+/* A character array's text in the pool, NULL if it is none. */
+static const char *char_text(const mxArray *a, bmx_pool *p)
+{
+	if (!mxIsChar(a) || mxGetM(a) > 1)
+		return NULL;
+	char *m = mxArrayToString(a);
+	if (!m)
+		return NULL;
+	char *s = bmx_pool_take(p, dup_text(m));
+	mxFree(m);
+	return s;
+}
+
+static int strcasesame(const char *a, const char *b)
+{
+	for (; *a && *b; a++, b++)
+		if (tolower((unsigned char)*a) != tolower((unsigned char)*b))
+			return 0;
+	return *a == *b;
+}
+
+int bmx_pairs(int nrhs, const mxArray *prhs[], int first, const char *const *names, int n_names,
+              const mxArray **values, bsim_error *err)
+{
+	char known[512] = "";
+	for (int i = 0; i < n_names; i++) {
+		values[i] = NULL;
+		size_t len = strlen(known);
+		snprintf(known + len, sizeof known - len, "%s'%s'", i ? ", " : "", names[i]);
+	}
+	if ((nrhs - first) % 2 != 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "expected name-value pairs after the first argument, got "
+		                      "an odd number of arguments (names: %s)",
+		                      known);
+	for (int k = first; k < nrhs; k += 2) {
+		char name[64] = "";
+		if (!mxIsChar(prhs[k]) || mxGetM(prhs[k]) > 1 ||
+		    mxGetString(prhs[k], name, sizeof name) != 0)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "argument %d: expected the name of an argument (%s)",
+			                      k + 1, known);
+		int i = 0;
+		while (i < n_names && !strcasesame(name, names[i]))
+			i++;
+		if (i == n_names)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "unknown argument '%s' (expected %s)", name, known);
+		values[i] = prhs[k + 1];
+	}
+	return BSIM_OK;
+}
+
+int bmx_text(const char *name, const mxArray *a, bmx_pool *p, const char **out, bsim_error *err)
+{
+	*out = char_text(a, p);
+	if (!*out)
+		return bsim_error_set(err, BSIM_EINPUT, "'%s': expected text (a character row)",
+		                      name);
+	return BSIM_OK;
+}
+
+/* The one real number of a numeric or logical scalar. */
+static int real_scalar(const mxArray *a, double *x)
+{
+	if (!(mxIsNumeric(a) || mxIsLogical(a)) || mxIsComplex(a) || mxGetNumberOfElements(a) != 1)
+		return -1;
+	*x = mxGetScalar(a);
+	return 0;
+}
+
+int bmx_long(const char *name, const mxArray *a, long lo, long hi, long *out, bsim_error *err)
+{
+	double x;
+	if (real_scalar(a, &x) != 0 || !(x >= (double)lo && x <= (double)hi) || x != floor(x))
+		return bsim_error_set(err, BSIM_EINPUT, "'%s': expected an integer from %ld to %ld",
+		                      name, lo, hi);
+	*out = (long)x;
+	return BSIM_OK;
+}
+
+int bmx_seed(const char *name, const mxArray *a, uint64_t *out, bsim_error *err)
+{
+	if (mxIsUint64(a) && mxGetNumberOfElements(a) == 1) {
+		*out = *(const uint64_t *)mxGetData(a);
+		return BSIM_OK;
+	}
+	double x;
+	if (real_scalar(a, &x) != 0 || !(x >= 0 && x <= 9007199254740992.0) || x != floor(x))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "'%s': expected an integer >= 0 (beyond 2^53 as uint64)",
+		                      name);
+	*out = (uint64_t)x;
+	return BSIM_OK;
+}
+
+int bmx_flag(const char *name, const mxArray *a, int *out, bsim_error *err)
+{
+	double x;
+	if (real_scalar(a, &x) != 0 || !(x == 0 || x == 1))
+		return bsim_error_set(err, BSIM_EINPUT, "'%s': expected true or false", name);
+	*out = x == 1;
+	return BSIM_OK;
+}
+
+int bmx_double(const char *name, const mxArray *a, double *out, bsim_error *err)
+{
+	if (real_scalar(a, out) != 0 || !isfinite(*out))
+		return bsim_error_set(err, BSIM_EINPUT, "'%s': expected a finite number", name);
+	return BSIM_OK;
+}
+
+/* The shortest text of x that reads back to x; integers without a point;
+ * YAML's words for the non-finite. */
+static void number_text(double x, char *buf, size_t size)
+{
+	if (isnan(x)) {
+		snprintf(buf, size, ".nan");
+	} else if (isinf(x)) {
+		snprintf(buf, size, x > 0 ? ".inf" : "-.inf");
+	} else if (x == floor(x) && fabs(x) <= 9007199254740992.0) {
+		snprintf(buf, size, "%.0f", x);
+	} else {
+		for (int digits = 1; digits <= 17; digits++) {
+			snprintf(buf, size, "%.*g", digits, x);
+			if (strtod(buf, NULL) == x)
+				break;
+		}
+	}
+}
+
+/* Element i of a numeric or logical array as text. */
+static void element_text(const mxArray *a, size_t i, char *buf, size_t size)
+{
+	if (mxIsLogical(a)) {
+		snprintf(buf, size, "%s", mxGetLogicals(a)[i] ? "true" : "false");
+		return;
+	}
+	double x;
+	switch (mxGetClassID(a)) {
+	case mxDOUBLE_CLASS:
+		x = ((const double *)mxGetData(a))[i];
+		break;
+	case mxSINGLE_CLASS:
+		x = ((const float *)mxGetData(a))[i];
+		break;
+	case mxINT8_CLASS:
+		x = ((const int8_T *)mxGetData(a))[i];
+		break;
+	case mxUINT8_CLASS:
+		x = ((const uint8_T *)mxGetData(a))[i];
+		break;
+	case mxINT16_CLASS:
+		x = ((const int16_T *)mxGetData(a))[i];
+		break;
+	case mxUINT16_CLASS:
+		x = ((const uint16_T *)mxGetData(a))[i];
+		break;
+	case mxINT32_CLASS:
+		x = ((const int32_T *)mxGetData(a))[i];
+		break;
+	case mxUINT32_CLASS:
+		x = ((const uint32_T *)mxGetData(a))[i];
+		break;
+	case mxINT64_CLASS:
+		x = (double)((const int64_T *)mxGetData(a))[i];
+		break;
+	case mxUINT64_CLASS:
+		x = (double)((const uint64_T *)mxGetData(a))[i];
+		break;
+	default:
+		x = NAN;
+		break;
+	}
+	number_text(x, buf, size);
+}
+
+int bmx_value_text(const char *name, const mxArray *a, bmx_pool *p, const char **out,
+                   bsim_error *err)
+{
+	if (mxIsChar(a)) {
+		if (!(*out = char_text(a, p)))
+			return bsim_error_set(err, BSIM_EINPUT, "'%s': expected one row of text",
+			                      name);
+		return BSIM_OK;
+	}
+	if (!(mxIsNumeric(a) || mxIsLogical(a)) || mxIsComplex(a))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "'%s': expected a value: a real number, a vector, true or "
+		                      "false, or text",
+		                      name);
+	size_t n = mxGetNumberOfElements(a);
+	char *s = malloc(32 * (n + 1) + 8);
+	if (!s)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	if (n == 1) {
+		element_text(a, 0, s, 32);
+	} else {
+		size_t len = 0;
+		s[len++] = '[';
+		for (size_t i = 0; i < n; i++) {
+			char one[32];
+			element_text(a, i, one, sizeof one);
+			len += (size_t)sprintf(s + len, "%s%s", i ? ", " : "", one);
+		}
+		s[len++] = ']';
+		s[len] = '\0';
+	}
+	if (!(*out = bmx_pool_take(p, s)))
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	return BSIM_OK;
+}
+
+/* A cell of an even number of elements, keys at odd places (1-based). */
+static int key_value_cell(const char *name, const mxArray *a, bsim_error *err)
+{
+	if (!mxIsCell(a) || mxGetNumberOfElements(a) % 2 != 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "'%s': expected a cell {KEY, VALUE, KEY, VALUE, ...}", name);
+	return BSIM_OK;
+}
+
+int bmx_overrides(const char *name, const mxArray *a, bmx_pool *p, bsim_override **ov, int *n,
+                  bsim_error *err)
+{
+	*ov = NULL;
+	*n = 0;
+	if (!a)
+		return BSIM_OK;
+	if (key_value_cell(name, a, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	int pairs = (int)(mxGetNumberOfElements(a) / 2);
+	/* The array is a string of the pool too: freed with it. */
+	*ov = (bsim_override *)bmx_pool_take(p, calloc((size_t)pairs + 1, sizeof **ov));
+	if (!*ov)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; i < pairs; i++) {
+		const mxArray *k = mxGetCell(a, (mwIndex)(2 * i));
+		const mxArray *v = mxGetCell(a, (mwIndex)(2 * i + 1));
+		const char *key = k ? char_text(k, p) : NULL;
+		if (!key)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "'%s': element %d: expected a key (text), e.g. "
+			                      "'body.mass'",
+			                      name, 2 * i + 1);
+		if (!v)
+			return bsim_error_set(err, BSIM_EINPUT, "'%s' %s: expected a value", name,
+			                      key);
+		const char *value;
+		if (bmx_value_text(key, v, p, &value, err) != BSIM_OK)
+			return err->code;
+		/* the origin the command line gives it, "--set KEY=VALUE", so
+		 * that its messages are the program's */
+		size_t size = strlen(key) + strlen(value) + sizeof "--set =";
+		char *origin = bmx_pool_take(p, malloc(size));
+		if (!origin)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		snprintf(origin, size, "--set %s=%s", key, value);
+		(*ov)[i] = (bsim_override){key, value, origin};
+	}
+	*n = pairs;
+	return BSIM_OK;
+}
+
+void bmx_grid_free(bsim_grid_axis *axes, int n)
+{
+	for (int i = 0; axes && i < n; i++) {
+		free(axes[i].values);
+		free(axes[i].origins);
+	}
+	free(axes);
+}
+
+/* The values of one axis: a numeric or logical vector, a cell of values,
+ * or one text. */
+static int axis_values(const char *key, const mxArray *v, bmx_pool *p, bsim_grid_axis *ax,
+                       bsim_error *err)
+{
+	size_t n = mxIsChar(v) ? 1 : mxGetNumberOfElements(v);
+	if (n == 0 || !(mxIsChar(v) || mxIsCell(v) || mxIsNumeric(v) || mxIsLogical(v)))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "'grid' %s: expected one or more values (a vector or a "
+		                      "cell)",
+		                      key);
+	ax->values = calloc(n, sizeof *ax->values);
+	ax->origins = calloc(n, sizeof *ax->origins);
+	if (!ax->values || !ax->origins)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (size_t i = 0; i < n; i++) {
+		const char *text = NULL;
+		if (mxIsChar(v)) {
+			if (bmx_value_text(key, v, p, &text, err) != BSIM_OK)
+				return err->code;
+		} else if (mxIsCell(v)) {
+			const mxArray *c = mxGetCell(v, (mwIndex)i);
+			if (!c || bmx_value_text(key, c, p, &text, err) != BSIM_OK)
+				return c ? err->code
+				         : bsim_error_set(err, BSIM_EINPUT,
+				                          "'grid' %s: empty value", key);
+		} else {
+			char one[32];
+			element_text(v, i, one, sizeof one);
+			if (!(text = bmx_pool_take(p, dup_text(one))))
+				return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		}
+		ax->values[i] = (char *)text;
+	}
+	ax->n_values = (int)n;
+	/* Every value's origin is the command line's "--grid KEY=V1,V2,...". */
+	size_t len = strlen(key) + sizeof "--grid =";
+	for (size_t i = 0; i < n; i++)
+		len += strlen(ax->values[i]) + 1;
+	char *origin = bmx_pool_take(p, malloc(len));
+	if (!origin)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	size_t at = (size_t)sprintf(origin, "--grid %s=", key);
+	for (size_t i = 0; i < n; i++)
+		at += (size_t)sprintf(origin + at, "%s%s", i ? "," : "", ax->values[i]);
+	for (size_t i = 0; i < n; i++)
+		ax->origins[i] = origin;
+	return BSIM_OK;
+}
+
+int bmx_grid(const char *name, const mxArray *a, bmx_pool *p, bsim_grid_axis **axes, int *n,
+             bsim_error *err)
+{
+	*axes = NULL;
+	*n = 0;
+	if (!a)
+		return BSIM_OK;
+	if (key_value_cell(name, a, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	int pairs = (int)(mxGetNumberOfElements(a) / 2);
+	*axes = calloc((size_t)pairs + 1, sizeof **axes);
+	if (!*axes)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	*n = pairs;
+	for (int i = 0; i < pairs; i++) {
+		const mxArray *k = mxGetCell(a, (mwIndex)(2 * i));
+		const mxArray *v = mxGetCell(a, (mwIndex)(2 * i + 1));
+		const char *key = k ? char_text(k, p) : NULL;
+		if (!key)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "'grid': element %d: expected a key (text), e.g. "
+			                      "'beams.0.stiffness'",
+			                      2 * i + 1);
+		(*axes)[i].key = (char *)key;
+		if (!v)
+			return bsim_error_set(err, BSIM_EINPUT, "'grid' %s: expected values", key);
+		if (axis_values(key, v, p, &(*axes)[i], err) != BSIM_OK)
+			return err->code;
+	}
+	return BSIM_OK;
+}
+
+int bmx_backend(const char *name, const bsim_override *kv, int n_kv, const bsim_backend **b,
+                bsim_options *opts, bsim_error *err)
+{
+	memset(opts, 0, sizeof *opts);
+	*b = name ? bsim_backend_find(name, err) : bsim_backend_default();
+	if (!*b)
+		return BSIM_EINPUT;
+	for (int i = 0; i < n_kv; i++) {
+		char text[128];
+		int len = snprintf(text, sizeof text, "%s=%s", kv[i].key, kv[i].value);
+		if (len < 0 || (size_t)len >= sizeof text)
+			return bsim_error_set(err, BSIM_EINPUT, "'backend_opt' %s: value too long",
+			                      kv[i].key);
+		if (bsim_options_add(opts, text, err) != BSIM_OK)
+			return BSIM_EINPUT;
+	}
+	return bsim_options_check(opts, (*b)->knobs, (*b)->n_knobs, (*b)->name, err);
+}
+
+/* ---- what the functions return ---------------------------------------- */
+
+void bmx_set(mxArray *s, mwIndex i, const char *field, mxArray *v)
+{
+	if (mxGetFieldNumber(s, field) < 0)
+		mxAddField(s, field);
+	mxSetField(s, i, field, v);
+}
+
+mxArray *bmx_scalar(double x)
+{
+	return mxCreateDoubleScalar(x);
+}
+
+mxArray *bmx_string(const char *text)
+{
+	return mxCreateString(text);
+}
+
+mxArray *bmx_u64(uint64_t x)
+{
+	mxArray *a = mxCreateNumericMatrix(1, 1, mxUINT64_CLASS, mxREAL);
+	*(uint64_t *)mxGetData(a) = x;
+	return a;
+}
+
+mxArray *bmx_row(const double *x, int n)
+{
+	mxArray *a = mxCreateDoubleMatrix(1, (mwSize)n, mxREAL);
+	double *d = mxGetPr(a);
+	for (int i = 0; i < n; i++)
+		d[i] = x[i];
+	return a;
+}
+
+mxArray *bmx_column(size_t n, double **data)
+{
+	mxArray *a = mxCreateDoubleMatrix((mwSize)n, 1, mxREAL);
+	*data = mxGetPr(a);
+	return a;
+}
+
+void bmx_field_name(const char *key, char *buf, size_t size)
+{
+	size_t j = 0;
+	if (size == 0)
+		return;
+	if (!isalpha((unsigned char)key[0]) && j + 1 < size)
+		buf[j++] = 'x';
+	for (const char *c = key; *c && j + 1 < size; c++)
+		buf[j++] = isalnum((unsigned char)*c) || *c == '_' ? *c : '_';
+	buf[j] = '\0';
+}
+
+void bmx_fail(const bsim_error *err)
+{
+	const char *id = err->code == BSIM_EINPUT      ? "beamsim:input"
+	                 : err->code == BSIM_EDISAGREE ? "beamsim:disagree"
+	                 : err->code == BSIM_ESTOPPED  ? "beamsim:stopped"
+	                                               : "beamsim:failed";
+	mexErrMsgIdAndTxt(id, "%s", err->msg[0] ? err->msg : "failed");
+}

@@ -1,0 +1,348 @@
+% The MEX functions (bindings/matlab) against the program's own numbers for
+% the same trial, sweep and landscape, and their errors against the
+% program's messages. One Octave process (its start-up is the slow part):
+%   octave --no-gui --no-window-system -q test_mex.m BUILD SOURCE BEAMSIM TMP
+% Exits 1 naming the first difference.
+1;
+
+function check(ok, varargin)
+  if ~ok
+    error('test_mex:failed', varargin{:});
+  end
+end
+
+% a equals the number b read from the program's JSON: Octave 7's jsondecode
+% (RapidJSON without its full-precision flag) reads a number to within an
+% ulp or two of the double the program wrote.
+function yes = json_same(a, b)
+  yes = isequal(size(a(:)), size(b(:))) && all(abs(a(:) - b(:)) <= 2 * eps(abs(b(:))));
+end
+
+% The program's run: its standard output, standard error and exit status.
+function [out, err, status] = program(exe, tmp, args)
+  errfile = fullfile(tmp, 'stderr.txt');
+  [status, out] = system(sprintf('%s %s 2>%s', exe, args, errfile));
+  err = strtrim(fileread(errfile));
+end
+
+% The error a MEX call raises: identifier and message.
+function [id, msg] = raised(fn, varargin)
+  id = '';
+  msg = '';
+  try
+    fn(varargin{:});
+  catch e
+    id = e.identifier;
+    msg = e.message;
+  end
+end
+
+% The program's one-line message ("beamsim: MSG") is the MEX error's,
+% which Octave prefixes with the function's name.
+function check_message(what, msg, program_err, fn)
+  lines = strsplit(program_err, "\n");
+  line = lines{end};
+  check(strncmp(line, 'beamsim: ', 9), '%s: the program said %s', what, program_err);
+  want = [fn ': ' line(10:end)];
+  check(strcmp(msg, want) || strcmp(msg, line(10:end)), ...
+        '%s: MEX error\n  %s\nprogram\n  %s', what, msg, line);
+end
+
+% The lines of a CSV file: header names and the fields of every row.
+function [names, cols] = csv_columns(file)
+  text = fileread(file);
+  lines = strsplit(strtrim(text), "\n");
+  names = strsplit(lines{1}, ',');
+  rows = regexp(lines(2:end), ',', 'split');
+  cells = vertcat(rows{:});
+  cols = cell(1, numel(names));
+  for j = 1:numel(names)
+    cols{j} = cells(:, j);
+  end
+end
+
+% Values v written as the program writes them (printf format fmt, NaN as an
+% empty field) are the file's fields, text for text.
+function check_column(what, name, v, fields, fmt)
+  if iscell(v)
+    same = isequal(v(:), fields(:));
+    bad = find(~strcmp(v(:), fields(:)), 1);
+    check(same, '%s: column %s row %d: %s, the file %s', what, name, bad, v{bad}, fields{bad});
+    return;
+  end
+  text = strsplit(sprintf([fmt "\n"], v), "\n");
+  text = text(1:end - 1)';
+  text(isnan(v)) = {''};
+  bad = find(~strcmp(text, fields(:)), 1);
+  check(isempty(bad), '%s: column %s row %d: %s, the file %s', what, name, bad, ...
+        text{min(bad, end)}, fields{min(bad, end)});
+end
+
+% The program runs as it is, whatever library Octave was started with
+% (a check of the MEX code under a preloaded sanitizer, docs/tests.md).
+unsetenv('LD_PRELOAD');
+args = argv();
+build = args{1};
+source = args{2};
+exe = args{3};
+tmp = args{4};
+if exist(tmp, 'dir')
+  confirm_recursive_rmdir(false, 'local');
+  rmdir(tmp, 's');
+end
+mkdir(tmp);
+addpath(fullfile(build, 'matlab'));
+gate = fullfile(source, 'configs', 'thesis', 'gate.yaml');
+h1 = fullfile(source, 'configs', 'thesis', 'h1_symmetric.yaml');
+h2 = fullfile(source, 'configs', 'thesis', 'h2_asymmetric.yaml');
+
+% ---- one trial of a scene: run --json and run --out's CSVs -------------
+rundir = fullfile(tmp, 'run');
+[out, err, status] = program(exe, tmp, sprintf('run %s --seed 3 --trial 2 --json --out %s', ...
+                                               gate, rundir));
+check(status == 0, 'beamsim run: exit %d: %s', status, err);
+cli = jsondecode(out);
+r = beamsim_run(gate, 'seed', 3, 'trial', 3, 'trajectory', true);
+check(r.group == 1 && r.trial == 3, 'group and trial from 1: %d, %d', r.group, r.trial);
+% (printf takes a uint64 beyond 2^63 as a double: in two halves)
+hi = idivide(r.mixed_seed, uint64(1e10));
+seed = sprintf('%d%010d', hi, r.mixed_seed - hi * uint64(1e10));
+seed = regexprep(seed, '^0+(?=.)', '');
+check(strcmp(seed, cli.mixed_seed), 'mixed seed %s, the program %s', seed, cli.mixed_seed);
+for f = {'outcome', 'type'}
+  check(strcmp(r.(f{1}), cli.(f{1})), '%s: %s, the program %s', f{1}, r.(f{1}), cli.(f{1}));
+end
+for f = {'steps', 'steps_run', 'draws', 't_end', 'x_end', 'y_end', 'vx_end', 'overlap_max', ...
+         'in_contact_end', 'reset_overlaps'}
+  check(json_same(r.(f{1}), cli.(f{1})), '%s: %.17g, the program %.17g', f{1}, r.(f{1}), ...
+        cli.(f{1}));
+end
+check(json_same(r.max_theta, cli.max_theta), 'max_theta differs');
+for f = fieldnames(cli.ledger)'
+  check(json_same(r.ledger.(f{1}), cli.ledger.(f{1})), 'ledger.%s: %.17g, the program %.17g', f{1}, ...
+        r.ledger.(f{1}), cli.ledger.(f{1}));
+end
+% The trajectory and the ledger over time, written as the program writes
+% them, are its files field for field.
+tables = {'trajectory', 'ledger_rows'; 'trajectory.csv', 'ledger.csv'};
+for k = 1:2
+  [names, cols] = csv_columns(fullfile(rundir, tables{2, k}));
+  mine = r.(tables{1, k});
+  check(isequal(fieldnames(mine)', names), '%s: columns %s, the file %s', tables{1, k}, ...
+        strjoin(fieldnames(mine)', ','), strjoin(names, ','));
+  for j = 1:numel(names)
+    fmt = '%.10g';
+    if strcmp(names{j}, 't')
+      fmt = '%.6f';
+    elseif strncmp(names{j}, 'contact', 7) && ~strcmp(names{j}, 'contact')
+      fmt = '%d';
+    end
+    check_column(tables{1, k}, names{j}, mine.(names{j}), cols{j}, fmt);
+  end
+end
+printf('run: %s, %d steps, %d trajectory rows: the program''s numbers\n', r.outcome, r.steps, ...
+       numel(r.trajectory.t));
+
+% ---- a trial of an experiment's group, with --set, on Box2D ------------
+[out, err, status] = program(exe, tmp, sprintf(['run %s --group 10 --trial 3 --backend box2d ' ...
+                                                '--set body.mass=1.5 --json'], h2));
+check(status == 0, 'beamsim run (experiment): exit %d: %s', status, err);
+cli = jsondecode(out);
+r = beamsim_run(h2, 'group', 11, 'trial', 4, 'backend', 'box2d', 'set', {'body.mass', 1.5});
+check(strcmp(r.outcome, cli.outcome) && r.steps == cli.steps && json_same(r.t_end, cli.t_end) && ...
+      json_same(r.x_end, cli.x_end) && json_same(r.y_end, cli.y_end) && ...
+      json_same(r.ledger.e_end, cli.ledger.e_end), ...
+      'experiment trial: %s %d %.17g, the program %s %d %.17g', r.outcome, r.steps, r.t_end, ...
+      cli.outcome, cli.steps, cli.t_end);
+check(strcmp(r.backend, 'box2d') && strcmp(r.grid, ['effects.propulsion.force=7, ' ...
+      'effects.random_force.magnitude=20, beams.0.stiffness=150']), 'grid line: %s', r.grid);
+printf('run of an experiment: group 11, trial 4 on box2d: the program''s numbers\n');
+
+% ---- a sweep with --set and --grid: trials.csv and summary.json ---------
+sweepdir = fullfile(tmp, 'sweep');
+[out, err, status] = program(exe, tmp, sprintf(['sweep %s --trials 10 --threads 2 ' ...
+    '--set contact.restitution=0.7 --grid effects.random_force.magnitude=10,30 --quiet --out %s'], ...
+    h1, sweepdir));
+check(status == 0, 'beamsim sweep: exit %d: %s', status, err);
+opts = {'trials', 10, 'set', {'contact.restitution', 0.7}, ...
+        'grid', {'effects.random_force.magnitude', [10 30]}};
+s = beamsim_sweep(h1, opts{:}, 'threads', 2);
+[names, cols] = csv_columns(fullfile(sweepdir, 'trials.csv'));
+fields = fieldnames(s.trials)';
+check(numel(fields) == numel(names), 'trials: %d columns, trials.csv %d', numel(fields), ...
+      numel(names));
+for j = 1:numel(names)
+  f = regexprep(names{j}, '[^A-Za-z0-9_]', '_');
+  check(strcmp(fields{j}, f), 'trials column %d: %s, trials.csv %s', j, fields{j}, names{j});
+  v = s.trials.(f);
+  fmt = '%.10g';
+  if any(strcmp(f, {'group', 'trial'}))
+    v = v - 1;  % trials.csv counts from 0
+    fmt = '%d';
+  end
+  check_column('sweep', names{j}, v, cols{j}, fmt);
+end
+summary = jsondecode(fileread(fullfile(sweepdir, 'summary.json')));
+check(numel(s.groups) == numel(summary.groups), 'groups: %d, summary.json %d', ...
+      numel(s.groups), numel(summary.groups));
+for g = 1:numel(s.groups)
+  a = s.groups(g);
+  b = summary.groups(g);
+  if iscell(summary.groups)
+    b = summary.groups{g};
+  end
+  for f = {'trials', 'traversed', 'side_exit', 'stuck', 'left', 'right', 'p_traverse', ...
+           'stuck_in_contact', 'landscape_left', 'landscape_right', 'steps', 'unstable'}
+    check(json_same(a.(f{1}), b.(f{1})), 'group %d %s: %g, summary.json %g', g, f{1}, a.(f{1}), b.(f{1}));
+  end
+  check(json_same(a.ci95, b.ci95) && isequal(a.params, b.params) && ...
+        a.deterministic == b.deterministic, 'group %d: interval or params differ', g);
+end
+one = beamsim_sweep(h1, opts{:}, 'threads', 1);
+check(isequaln(one.trials, s.trials) && isequaln(rmfield(one.groups, 'steps'), ...
+      rmfield(s.groups, 'steps')), 'the sweep on 1 and 2 threads differs');
+printf('sweep: %d groups x %d trials: trials.csv and summary.json, 1 and 2 threads the same\n', ...
+       numel(s.groups), s.trials_per_group);
+
+% ---- a trial of the stored sweep, and what a stored run refuses ---------
+k = find(strcmp(s.trials.outcome, 'traversed'), 1);
+if isempty(k)
+  k = numel(s.trials.group);
+end
+r = beamsim_run(sweepdir, 'group', s.trials.group(k), 'trial', s.trials.trial(k));
+check(strcmp(r.outcome, s.trials.outcome{k}) && r.t_end == s.trials.t_end(k) && ...
+      r.x_end == s.trials.x_end(k) && r.y_end == s.trials.y_end(k), ...
+      'the stored trial, group %d trial %d, replayed differs', s.trials.group(k), s.trials.trial(k));
+[~, err, status] = program(exe, tmp, sprintf('run %s --group 1 --trial 1 --seed 3', sweepdir));
+[id, msg] = raised(@beamsim_run, sweepdir, 'group', 2, 'trial', 2, 'seed', 3);
+check(status == 2 && strcmp(id, 'beamsim:input'), 'a seed for a stored run: %s, exit %d', id, status);
+check_message('a seed for a stored run', msg, err, 'beamsim_run');
+printf('stored run: group %d, trial %d replayed as stored\n', r.group, r.trial);
+
+% ---- beamsim_load of the sweep's directory ------------------------------
+d = beamsim_load(sweepdir);
+check(isequal(d.trials.group, s.trials.group) && isequal(d.trials.trial, s.trials.trial) && ...
+      isequal(d.trials.outcome, s.trials.outcome), 'beamsim_load: trials differ');
+rel = abs(d.trials.t_end - s.trials.t_end) ./ max(abs(s.trials.t_end), 1);
+check(max(rel) < 1e-9, 'beamsim_load: t_end off by %g', max(rel));
+check(numel(d.summary.groups) == numel(s.groups) && isfield(d, 'run') && isfield(d, 'manifest'), ...
+      'beamsim_load: summary.json, run.json or manifest.json missing');
+printf('beamsim_load: %d trials as the sweep returned them (to trials.csv''s 10 digits)\n', ...
+       numel(d.trials.group));
+
+% A table with quoted fields, an empty field and nan; a short line refused.
+file = fullfile(tmp, 'quoted.csv');
+fid = fopen(file, 'w');
+fprintf(fid, 'group,"a,b",c\n0,"x, ""y""",1.5\n1,z,\n2,"",nan\n');
+fclose(fid);
+t = beamsim_load(tmp).quoted;
+check(isequal(t.group, [1; 2; 3]) && isequal(t.a_b, {'x, "y"'; 'z'; ''}) && ...
+      isequaln(t.c, [1.5; NaN; NaN]), 'quoted.csv read wrong');
+fid = fopen(file, 'a');
+fprintf(fid, '3,w\n');
+fclose(fid);
+[id, msg] = raised(@beamsim_load, tmp);
+check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, 'quoted.csv:5: expected 3 fields, got 2')), ...
+      'a short line: %s %s', id, msg);
+delete(file);
+printf('beamsim_load: quoted fields, empty fields and nan; a short line refused\n');
+
+% ---- the landscape ------------------------------------------------------
+landdir = fullfile(tmp, 'landscape');
+[out, err, status] = program(exe, tmp, sprintf('landscape %s --resolution 0.5 --json --out %s', ...
+                                               gate, landdir));
+check(status == 0, 'beamsim landscape: exit %d: %s', status, err);
+cli = jsondecode(out);
+l = beamsim_landscape(gate, 'resolution', 0.5);
+p = l.barriers.lowest;
+q = cli.lowest_pass;
+check(strcmp(p.kind, q.kind) && p.beam == q.crossed && json_same(p.x, q.x) && ...
+      json_same(p.y, q.y) && json_same(p.height, q.height) && json_same(p.e_total, q.e_total), ...
+      'lowest pass: %s beam %d height %.17g, the program %s beam %d height %.17g', p.kind, ...
+      p.beam, p.height, q.kind, q.crossed, q.height);
+check(numel(l.x) == cli.grid.nx && numel(l.y) == cli.grid.ny, 'grid %d x %d, the program %d x %d', ...
+      numel(l.x), numel(l.y), cli.grid.nx, cli.grid.ny);
+[names, cols] = csv_columns(fullfile(landdir, 'landscape.csv'));
+% landscape.csv: a row per point, x fastest.
+check_column('landscape', 'e_total', reshape(l.e_total', [], 1), cols{strcmp(names, 'e_total')}, ...
+             '%.10g');
+check_column('landscape', 'theta2', reshape(l.theta(:, :, 2)', [], 1), ...
+             cols{strcmp(names, 'theta2')}, '%.10g');
+printf('landscape: %d x %d points and the lowest pass (%.2f J) as the program''s\n', ...
+       numel(l.x), numel(l.y), p.height);
+
+% ---- unstable trials: an ordinary result, said as the program says it ---
+stiff = fullfile(source, 'configs', 'hard', 'stiff_beam_sweep.yaml');
+[~, err, status] = program(exe, tmp, sprintf(['run %s --group 1 --backend box2d ' ...
+                                              '--backend-opt spring=torque'], stiff));
+lastwarn('', '');
+r = beamsim_run(stiff, 'group', 2, 'backend', 'box2d', 'backend_opt', {'spring', 'torque'});
+[wmsg, wid] = lastwarn();
+wmsg = regexprep(wmsg, '^beamsim_run: ', '');  % Octave's prefix
+lines = strsplit(err, "\n");
+check(status == 1 && strcmp(r.outcome, 'unstable') && strcmp(wid, 'beamsim:unstable') && ...
+      strcmp(['beamsim: ' wmsg], lines{end}) && ~isempty(strfind(wmsg, r.instability)), ...
+      'unstable trial: %s, warning %s; the program (exit %d) %s', r.outcome, wmsg, status, err);
+lastwarn('', '');
+s = beamsim_sweep(stiff, 'backend', 'box2d', 'backend_opt', {'spring', 'torque'});
+[wmsg, wid] = lastwarn();
+wmsg = regexprep(wmsg, '^beamsim_sweep: ', '');
+check(strcmp(wid, 'beamsim:unstable') && sum(strcmp(s.trials.outcome, 'unstable')) == 20 && ...
+      sum([s.groups.unstable]) == 20 && strncmp(wmsg, '20 of 20 trials unstable on the box2d', 37), ...
+      'unstable sweep: %s', wmsg);
+printf('unstable: a trial and a sweep on box2d with torque springs, said as the program says\n');
+
+% ---- examples/fig3_1.m: the essay's Fig. 3.1 is the sweep's -------------
+figdir = fullfile(tmp, 'fig');
+[~, err, status] = program(exe, tmp, sprintf('sweep %s --trials 3 --quiet --out %s', h1, figdir));
+check(status == 0, 'beamsim sweep: exit %d: %s', status, err);
+summary = jsondecode(fileread(fullfile(figdir, 'summary.json')));
+addpath(fullfile(source, 'examples'));
+png = fullfile(tmp, 'fig3_1.png');
+[P, F, R] = fig3_1(png, 3);
+for g = 1:numel(summary.groups)
+  b = summary.groups(g);
+  i = find(F == b.params.effects_propulsion_force);
+  j = find(R == b.params.effects_random_force_magnitude);
+  check(json_same(P(j, i), b.p_traverse), 'fig3_1: F %g R %g: %g, summary.json %g', F(i), ...
+        R(j), P(j, i), b.p_traverse);
+end
+info = dir(png);
+check(numel(P) == numel(summary.groups) && numel(info) == 1 && info.bytes > 1000, ...
+      'fig3_1: %d cells, the figure %s', numel(P), png);
+printf('examples/fig3_1.m: %d cells as summary.json, the figure drawn\n', numel(P));
+
+% ---- errors: the program's messages -------------------------------------
+cases = {
+  'run --set body.mass=-1', sprintf('run %s --set body.mass=-1', gate), ...
+      @() beamsim_run(gate, 'set', {'body.mass', -1}), 'beamsim_run';
+  'sweep --grid unknown key', sprintf('sweep %s --grid body.colour=1,2 --out %s', h1, ...
+      fullfile(tmp, 'never')), @() beamsim_sweep(h1, 'grid', {'body.colour', [1 2]}), ...
+      'beamsim_sweep';
+  'landscape of a missing file', sprintf('landscape %s --out %s', fullfile(tmp, 'none.yaml'), ...
+      fullfile(tmp, 'never')), @() beamsim_landscape(fullfile(tmp, 'none.yaml')), ...
+      'beamsim_landscape';
+};
+for c = 1:size(cases, 1)
+  [~, err, status] = program(exe, tmp, cases{c, 2});
+  [id, msg] = raised(cases{c, 3});
+  check(status == 2, '%s: the program exits %d', cases{c, 1}, status);
+  check(strcmp(id, 'beamsim:input'), '%s: identifier %s', cases{c, 1}, id);
+  check_message(cases{c, 1}, msg, err, cases{c, 4});
+end
+% A group or trial out of range: the program's message counted from 1.
+[~, err, status] = program(exe, tmp, sprintf('run %s --group 30', h1));
+[id, msg] = raised(@beamsim_run, h1, 'group', 31);
+want = regexprep(err, '^beamsim: --group 30: expected 0 to 29', ...
+                 '''group'' 31: expected 1 to 30');
+check(status == 2 && strcmp(id, 'beamsim:input') && ~strcmp(want, err) && ...
+      (strcmp(msg, want) || strcmp(msg, ['beamsim_run: ' want])), ...
+      'group 31 of 30: %s, the program %s', msg, err);
+[id, msg] = raised(@beamsim_run, gate, 'trial', 0);
+check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, '''trial''')), ...
+      'trial 0: %s %s', id, msg);
+[id, msg] = raised(@beamsim_sweep, h1, 'trails', 3);
+check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, 'unknown argument ''trails''')), ...
+      'a misspelt name: %s %s', id, msg);
+check(~exist(fullfile(tmp, 'never'), 'dir'), 'a failed command wrote its directory');
+printf('errors: %d of the program''s messages, and the arguments'' own\n', size(cases, 1));
