@@ -63,6 +63,8 @@ typedef struct cli_merge {
 /* compare's command line (argv[0] "compare") run as the merge m of its
  * parts (cmd_compare.c). */
 int cmd_compare_merge(int argc, char **argv, const cli_merge *m);
+/* sweep's, as the merge m of its parts (cmd_sweep.c). */
+int cmd_sweep_merge(int argc, char **argv, const cli_merge *m);
 void cli_stored_argv_free(char **stored, int argc, char **argv);
 
 /* Ends the whole job with status rc (after a rank's failure, printed):
