@@ -116,6 +116,9 @@ static int compare_one(const char *path, const struct stat *st, int type, struct
 	if (strcmp(name, "manifest.json") == 0 || strcmp(name, "summary.mat") == 0 ||
 	    strcmp(name, "report.mat") == 0)
 		return 0;
+	/* a Markov map's CPU time (map_HASH.cost) */
+	if (strlen(name) > 5 && strcmp(name + strlen(name) - 5, ".cost") == 0)
+		return 0;
 	char other[2048];
 	snprintf(other, sizeof other, "%s/%s", other_root, rel);
 	long na = 0, nb = -1;
@@ -285,6 +288,66 @@ static void test_merge_refuses(void **state)
 	const char *one = reference("not_a_part", "2");
 	const char *argv2[] = {"merge", one, "--out", out, NULL};
 	bsim_test_expect_input_error(argv2, (const char *const[]){one, "part.json", NULL});
+}
+
+/* ---- markov build: its maps spread over parts --------------------------- */
+
+static const char *markov_lattice(void)
+{
+	return bsim_test_src("configs/lattice/c_track_essay.yaml");
+}
+
+/* markov build of the lattice's maps (3 trials per bin) into out, with
+ * extra arguments a and b (NULL: none). */
+static void markov_build(const char *out, const char *threads, const char *a, const char *b)
+{
+	const char *argv[] = {
+	        "markov", "build", markov_lattice(), "--trials", "3", "--threads", threads,
+	        "--out",  out,     "--quiet",        a,          b,   NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	if (rc != 0)
+		print_error("%s", err ? err : "");
+	free(err);
+	assert_int_equal(rc, 0);
+}
+
+/* The lattice's two stiffness pairs in 3 parts (the third builds none),
+ * merged: the one-process map directory but for the maps' CPU times. */
+static void test_markov_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[4][1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("markov_parts"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	markov_build(one, "2", NULL, NULL);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		markov_build(part[i], i == 1 ? "2" : "1", "--shard", shard_arg);
+		assert_true(bsim_test_exists(bsim_test_join(part[i], "part.json")));
+	}
+	/* a part of another build: another seed */
+	snprintf(part[3], sizeof part[3], "%s/seed2", dir);
+	const char *argv_seed[] = {
+	        "markov",  "build", markov_lattice(), "--trials", "3",       "--seed", "2",
+	        "--shard", "2/3",   "--out",          part[3],    "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv_seed, NULL, NULL), 0);
+	snprintf(out, sizeof out, "%s/merged", dir);
+	const char *argv[] = {"merge", part[2], part[0], part[1], "--out", out, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	assert_same_dir(one, out);
+	/* refused: a part of another build, a part missing */
+	char bad[1100];
+	snprintf(bad, sizeof bad, "%s/refused", dir);
+	const char *other[] = {"merge", part[0], part[3], part[2], "--out", bad, NULL};
+	bsim_test_expect_input_error(
+	        other, (const char *const[]){part[3], "parts of different runs", NULL});
+	const char *missing[] = {"merge", part[0], part[2], "--out", bad, NULL};
+	bsim_test_expect_input_error(missing,
+	                             (const char *const[]){"part 2 of 3 is missing", NULL});
+	assert_false(bsim_test_exists(bsim_test_join(bad, "markov.json")));
 }
 
 /* ---- MPI ----------------------------------------------------------------- */
@@ -504,6 +567,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_shards_merged),
 	        cmocka_unit_test(test_compare_shards_merged),
 	        cmocka_unit_test(test_merge_refuses),
+	        cmocka_unit_test(test_markov_shards_merged),
 	};
 	const struct CMUnitTest mpi[] = {
 	        cmocka_unit_test(test_mpi_identical),

@@ -65,6 +65,9 @@ typedef struct cli_merge {
 int cmd_compare_merge(int argc, char **argv, const cli_merge *m);
 /* sweep's, as the merge m of its parts (cmd_sweep.c). */
 int cmd_sweep_merge(int argc, char **argv, const cli_merge *m);
+/* markov build's (argv[0] "build"): the maps copied from the parts
+ * (cmd_markov.c). */
+int cmd_markov_merge(int argc, char **argv, const cli_merge *m);
 void cli_stored_argv_free(char **stored, int argc, char **argv);
 
 /* Ends the whole job with status rc (after a rank's failure, printed):

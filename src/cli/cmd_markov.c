@@ -15,6 +15,8 @@
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
+#include "cli/cli_mpi.h"
+#include "beamsim/sweep_dir.h"
 #include "util/clock.h"
 #include "util/json.h"
 
@@ -28,7 +30,8 @@ enum {
 	OWN_JSON,
 	OWN_TOL,
 	OWN_NO_GATES,
-	OWN_WALKS
+	OWN_WALKS,
+	OWN_SHARD
 };
 
 #define MAX_ENTRIES 16
@@ -41,6 +44,7 @@ typedef struct markov_args {
 	int no_gates;        /* predict: --no-gates */
 	double tol;          /* predict: --tol */
 	long walks;          /* predict: --walks */
+	int shard, shards;   /* build: --shard, 1-based; 0: every map */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
 } markov_args;
@@ -135,6 +139,8 @@ static int markov_option(void *args, int i, const char *value)
 	case OWN_NO_GATES:
 		a->no_gates = 1;
 		return CLI_OK;
+	case OWN_SHARD:
+		return cli_shard_parse("markov build", value, &a->shard, &a->shards);
 	case OWN_WALKS:
 		if (cli_parse_long(value, 0, 100000000L, &a->walks) != 0)
 			return cli_usage("markov predict",
@@ -157,7 +163,18 @@ static const cli_own build_own[] = {
                          "passes (default 1); flow or flow:N: from every map's exits\n"
                          "weighted by the chain's flow on each lattice (maps for\n"
                          "that lattice only; docs/markov.md)"},
+        {"shard", 1, "I/N",
+         "build part I of N of the maps (I from 1 to N, as\n"
+         "SLURM_ARRAY_TASK_ID of --array=1-N): each lattice's\n"
+         "stiffness pair i is part i mod N + 1's; DIR gets those\n"
+         "maps and part.json, beamsim merge joins the N parts'\n"
+         "directories into the map directory (docs/cluster.md)"},
 };
+
+static int build_option(void *args, int i, const char *value)
+{
+	return markov_option(args, i == 3 ? OWN_SHARD : i, value);
+}
 
 static const char *const build_help[CLI_N_OPTS] = {
         [CLI_OPT_OUT] = "the map directory: maps already there with the same key are\n"
@@ -184,8 +201,8 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 3,
-        .option = markov_option,
+        .n_own = 4,
+        .option = build_option,
 };
 
 static const cli_own predict_own[] = {
@@ -275,15 +292,46 @@ static const cli_spec validate_spec = {
         .option = map_option,
 };
 
-static int markov_build(int argc, char **argv)
+/* Appends the keys of set's maps to *keys (the run's name, below). */
+static int keys_add(uint64_t **keys, int *n, const bsim_markov_set *set)
+{
+	uint64_t *k = realloc(*keys, (size_t)(*n + set->n + 1) * sizeof *k);
+	if (!k)
+		return -1;
+	for (int i = 0; i < set->n; i++)
+		k[(*n)++] = set->maps[i].key;
+	*keys = k;
+	return 0;
+}
+
+static int markov_build_main(int argc, char **argv, const cli_merge *m)
 {
 	cli_common c = cli_common_default();
 	markov_args a = {.def = bsim_markov_def_default()};
 	const char *path = NULL;
 	int rc = cli_parse(&build_spec, argc, argv, &c, &a, &path);
+	if (rc < 0 && a.shards > 0 && cli_mpi_size() > 1)
+		rc = cli_usage("markov build",
+		               "--shard builds one part in one process: not under mpirun (%d "
+		               "ranks)",
+		               cli_mpi_size());
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
+	}
+	bsim_sweep_dir_part first;
+	memset(&first, 0, sizeof first);
+	if (m) {
+		c.out = m->out;
+		c.threads = m->threads;
+		c.quiet = m->quiet;
+		a.shard = a.shards = 0;
+		a.def.from = m->parts;
+		a.def.n_from = m->n_parts;
+	}
+	if (a.shards > 0) {
+		a.def.part = a.shard - 1;
+		a.def.parts = a.shards;
 	}
 	bsim_options opts = {0};
 	const bsim_backend *be =
@@ -322,7 +370,9 @@ static int markov_build(int argc, char **argv)
 	a.def.progress_user = &progress;
 	a.def.stop = &cli_stop;
 	cli_signals_install();
-	int built = 0, reused = 0;
+	int built = 0, reused = 0, copied = 0, own = 0;
+	uint64_t *keys = NULL;
+	int n_keys = 0;
 	double cpu = 0.0;
 	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++) {
 		bsim_scene scene;
@@ -336,12 +386,19 @@ static int markov_build(int argc, char **argv)
 			break;
 		built += set.built;
 		reused += set.reused;
+		copied += set.copied;
+		own += set.built + set.reused;
 		cpu += set.seconds;
+		if (keys_add(&keys, &n_keys, &set) != 0)
+			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory");
 		for (int i = 0; i < set.n && !c.quiet; i++)
 			printf("group %d  k = %g, %g N m/rad  map_%016llx  %s\n", g,
 			       set.maps[i].k[0], set.maps[i].k[1],
 			       (unsigned long long)set.maps[i].key,
-			       set.maps[i].cached ? "reused" : "built");
+			       set.maps[i].elsewhere ? "another part's"
+			       : set.maps[i].copied  ? "from a part"
+			       : set.maps[i].cached  ? "reused"
+			                             : "built");
 		bsim_markov_set_free(&set);
 	}
 	cli_progress_finish(&progress);
@@ -354,17 +411,51 @@ static int markov_build(int argc, char **argv)
 		          sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
 		rc = 128 + sig;
 	}
+	/* A spread build's parts carry the name of the run, from the keys of
+	 * all its maps: merge checks they are one build's, and this one's. */
+	char run[17];
+	bsim_markov_run_id(keys, n_keys, run);
+	if (rc == BSIM_OK && m &&
+	    (rc = bsim_sweep_dir_part_read(m->parts[0], &first, &err)) == BSIM_OK &&
+	    strcmp(first.run, run) != 0)
+		rc = bsim_error_set(&err, BSIM_EINPUT,
+		                    "%s: part %d of %d of run %s, but the experiment read now "
+		                    "makes run %s: its file changed since the parts ran",
+		                    m->parts[0], first.index, first.count, first.run, run);
+	if (rc == BSIM_OK && a.shards > 0) {
+		char **stored = cli_stored_argv(argc, argv, path);
+		rc = stored ? bsim_markov_part_write(c.out, a.shard, a.shards, run, n_keys, own,
+		                                     argc, stored, &err)
+		            : bsim_error_set(&err, BSIM_EFAIL, "out of memory");
+		cli_stored_argv_free(stored, argc, argv);
+	}
+	if (rc == BSIM_OK && !c.quiet && a.shards > 0)
+		printf("part %d of %d of the maps in %s; beamsim merge joins the %d parts' "
+		       "directories\n",
+		       a.shard, a.shards, cli_path(c.out), a.shards);
 	if (rc == BSIM_OK && !c.quiet)
-		printf("%d maps built (%.1f s of CPU), %d reused; %d entry bins x %d trials each, "
-		       "in %s\n",
-		       built, cpu, reused, bsim_markov_bins_count(&a.def.bins), a.def.trials,
-		       cli_path(c.out));
+		printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials "
+		       "each, in %s\n",
+		       built, cpu, reused, copied ? ", the others from the parts" : "",
+		       bsim_markov_bins_count(&a.def.bins), a.def.trials, cli_path(c.out));
 	if (rc == BSIM_OK && !c.quiet)
 		cli_wrote(stdout, c.out);
 	bsim_experiment_free(&e);
 	bsim_markov_entries_free(&entries);
+	bsim_sweep_dir_part_free(&first);
+	free(keys);
 	cli_common_free(&c);
 	return rc > BSIM_ESTOPPED ? rc : cli_report(rc, &err);
+}
+
+static int markov_build(int argc, char **argv)
+{
+	return markov_build_main(argc, argv, NULL);
+}
+
+int cmd_markov_merge(int argc, char **argv, const cli_merge *m)
+{
+	return markov_build_main(argc, argv, m);
 }
 
 /* The probabilities of the end, a side and stuck: p summed by kind. */

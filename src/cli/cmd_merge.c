@@ -61,15 +61,17 @@ int cmd_merge(int argc, char **argv)
 	if (rc < 0 && bsim_sweep_dir_part_read(parts[0], &first, &err) != BSIM_OK)
 		rc = cli_report(BSIM_EINPUT, &err);
 	int is_compare = rc < 0 && strcmp(first.command, "compare") == 0;
-	if (rc < 0 && !is_compare && strcmp(first.command, "sweep") != 0)
+	int is_markov = rc < 0 && strcmp(first.command, "markov build") == 0;
+	if (rc < 0 && !is_compare && !is_markov && strcmp(first.command, "sweep") != 0)
 		rc = cli_usage("merge",
-		               "%s: a part of a %s; merge joins the parts of a sweep or "
-		               "a comparison",
+		               "%s: a part of a %s; merge joins the parts of a sweep, a "
+		               "comparison or a markov build",
 		               parts[0], first.command);
 	if (rc < 0) {
 		cli_merge m = {c.out, c.threads, c.quiet, parts, n_parts};
-		rc = is_compare ? cmd_compare_merge(first.argc, first.argv, &m)
-		                : cmd_sweep_merge(first.argc, first.argv, &m);
+		rc = is_compare  ? cmd_compare_merge(first.argc, first.argv, &m)
+		     : is_markov ? cmd_markov_merge(first.argc, first.argv, &m)
+		                 : cmd_sweep_merge(first.argc, first.argv, &m);
 	}
 	bsim_sweep_dir_part_free(&first);
 	cli_common_free(&c);
