@@ -30,6 +30,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <fcntl.h>
 #include <time.h>
@@ -365,6 +366,8 @@ static int have_mpi(void)
 
 /* Starts mpirun -np ranks beamsim cmd ... in the background, its stderr
  * into err_path; returns mpirun's pid. */
+static pid_t spawn_mpirun(const char *const *argv, const char *err_path);
+
 static pid_t mpirun_command(const char *cmd, const char *ranks, const char *out, const char *trials,
                             int resume, const char *err_path)
 {
@@ -384,6 +387,12 @@ static pid_t mpirun_command(const char *cmd, const char *ranks, const char *out,
 	                      "--quiet",
 	                      resume ? "--resume" : NULL,
 	                      NULL};
+	return spawn_mpirun(argv, err_path);
+}
+
+/* Starts argv (mpirun ...) in the background, its stderr into err_path. */
+static pid_t spawn_mpirun(const char *const *argv, const char *err_path)
+{
 	posix_spawn_file_actions_t fa;
 	posix_spawn_file_actions_init(&fa);
 	posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
@@ -454,6 +463,49 @@ static void test_mpi_compare(void **state)
 		print_stderr(err_path);
 	assert_int_equal(rc, 0);
 	assert_same_dir(one, out);
+}
+
+/* markov build over 3 ranks (two maps: the third rank builds none): the
+ * one-process map directory but for the maps' CPU times, and no
+ * temporary directory left behind. */
+static void test_mpi_markov_build(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200], tmp[1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_markov"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/ranks3", dir);
+	snprintf(tmp, sizeof tmp, "%s/tmp", dir);
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	assert_int_equal(mkdir(tmp, 0755), 0);
+	markov_build(one, "2", NULL, NULL);
+	const char *argv[] = {BSIM_TEST_MPIEXEC,
+	                      "--oversubscribe",
+	                      "-np",
+	                      "3",
+	                      BSIM_EXE,
+	                      "markov",
+	                      "build",
+	                      markov_lattice(),
+	                      "--trials",
+	                      "3",
+	                      "--threads",
+	                      "1",
+	                      "--out",
+	                      out,
+	                      "--quiet",
+	                      NULL};
+	setenv("TMPDIR", tmp, 1);
+	int rc = wait_status(spawn_mpirun(argv, err_path));
+	unsetenv("TMPDIR");
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
+	assert_int_equal(count_files(tmp), 0);
+	assert_int_equal(rmdir(tmp), 0); /* nor any directory */
 }
 
 static void test_mpi_identical(void **state)
@@ -572,6 +624,7 @@ int main(int argc, char **argv)
 	const struct CMUnitTest mpi[] = {
 	        cmocka_unit_test(test_mpi_identical),
 	        cmocka_unit_test(test_mpi_compare),
+	        cmocka_unit_test(test_mpi_markov_build),
 	        cmocka_unit_test(test_mpi_rank_killed_resumed),
 	};
 	if (argc < 2 || strcmp(argv[1], "mpi") != 0)

@@ -70,6 +70,13 @@ int cmd_sweep_merge(int argc, char **argv, const cli_merge *m);
 int cmd_markov_merge(int argc, char **argv, const cli_merge *m);
 void cli_stored_argv_free(char **stored, int argc, char **argv);
 
+/* Gathers every rank's directory on rank 0 (their files, not
+ * subdirectories): rank 0's dirs[0..size) (allocated, freed by the
+ * caller) are mine and rank r's copy in mine.rankR; the other ranks send
+ * theirs and set nothing. One process: dirs[0] is mine. CLI_OK, or
+ * CLI_FAIL printed. */
+int cli_mpi_gather_dir(const char *mine, char **dirs);
+
 /* Ends the whole job with status rc (after a rank's failure, printed):
  * the other ranks would wait for it for ever. Returns if one process. */
 void cli_mpi_abort(int rc);

@@ -1,12 +1,16 @@
 /* beamsim markov: the Markov chain that predicts a gate lattice from
  * single-gate maps (beamsim/markov.h). build, predict and validate parse
  * and print; the library simulates, composes, solves and writes. */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* asprintf, mkdtemp */
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+#include <ftw.h>
+#include <sys/stat.h>
 
 #include "beamsim/experiment.h"
 #include "beamsim/markov.h"
@@ -304,7 +308,78 @@ static int keys_add(uint64_t **keys, int *n, const bsim_markov_set *set)
 	return 0;
 }
 
-static int markov_build_main(int argc, char **argv, const cli_merge *m)
+/* A part of an MPI job's build: its rank's maps into a directory of
+ * its own (markov_build_ranks). */
+typedef struct markov_part {
+	const char *out;
+	int shard, shards; /* 1-based */
+} markov_part;
+
+static int markov_build_main(int argc, char **argv, const cli_merge *m, const markov_part *p);
+
+static int remove_one(const char *path, const struct stat *st, int type, struct FTW *ftw)
+{
+	(void)st;
+	(void)type;
+	(void)ftw;
+	remove(path);
+	return 0;
+}
+
+/* A part's temporary directory and all in it, gone. */
+static void remove_tree(const char *dir)
+{
+	nftw(dir, remove_one, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+/* The build spread over an MPI job's ranks: rank r builds part r + 1 of
+ * the maps into its own temporary directory, rank 0 gathers the parts'
+ * directories and merges them into out, as merge does. */
+static int markov_build_ranks(int argc, char **argv, const cli_common *c)
+{
+	const char *tmp = getenv("TMPDIR");
+	char mine[1024];
+	snprintf(mine, sizeof mine, "%s/beamsim-markov-XXXXXX", tmp && tmp[0] ? tmp : "/tmp");
+	int rank = cli_mpi_rank(), size = cli_mpi_size(), rc;
+	if (!mkdtemp(mine)) {
+		cli_error("%s: cannot create: %s", mine, strerror(errno));
+		cli_mpi_abort(CLI_FAIL);
+		return CLI_FAIL;
+	}
+	char *part = NULL;
+	/* the part's directory inside mine (mkdtemp's is private) */
+	if (asprintf(&part, "%s/part", mine) < 0) {
+		cli_mpi_abort(CLI_FAIL);
+		return CLI_FAIL;
+	}
+	markov_part p = {part, rank + 1, size};
+	rc = markov_build_main(argc, argv, NULL, &p);
+	if (rc != CLI_OK)
+		cli_mpi_abort(rc); /* printed; the others would wait for ever */
+	char **dirs = calloc((size_t)size, sizeof *dirs);
+	if (!dirs || (rc = cli_mpi_gather_dir(part, dirs)) != CLI_OK)
+		cli_mpi_abort(CLI_FAIL);
+	if (rank == 0) {
+		cli_merge merge = {c->out, c->threads, c->quiet, (const char *const *)dirs, size};
+		rc = markov_build_main(argc, argv, &merge, NULL);
+	}
+	/* the parts' files are in out now, or the build failed: either way
+	 * not kept */
+	for (int r = 0; r < size && dirs; r++)
+		if (dirs[r])
+			remove_tree(dirs[r]);
+	remove_tree(part);
+	rmdir(mine);
+	for (int r = 0; r < size && dirs; r++)
+		free(dirs[r]);
+	free(dirs);
+	free(part);
+	if (rc != CLI_OK)
+		cli_mpi_abort(rc);
+	return rc;
+}
+
+static int markov_build_main(int argc, char **argv, const cli_merge *m, const markov_part *p)
 {
 	cli_common c = cli_common_default();
 	markov_args a = {.def = bsim_markov_def_default()};
@@ -319,8 +394,21 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m)
 		cli_common_free(&c);
 		return rc;
 	}
+	if (!m && !p && cli_mpi_size() > 1) {
+		rc = markov_build_ranks(argc, argv, &c);
+		cli_common_free(&c);
+		return rc;
+	}
 	bsim_sweep_dir_part first;
 	memset(&first, 0, sizeof first);
+	/* an MPI job's progress: rank 0's part's */
+	const int show_progress = !c.quiet && (!p || cli_mpi_rank() == 0);
+	if (p) {
+		c.out = p->out;
+		c.quiet = 1;
+		a.shard = p->shard;
+		a.shards = p->shards;
+	}
 	if (m) {
 		c.out = m->out;
 		c.threads = m->threads;
@@ -365,7 +453,7 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m)
 		return rc;
 	}
 	cli_progress progress;
-	cli_progress_init(&progress, !c.quiet, "single gates");
+	cli_progress_init(&progress, show_progress, "single gates");
 	a.def.progress = cli_progress_update;
 	a.def.progress_user = &progress;
 	a.def.stop = &cli_stop;
@@ -450,12 +538,12 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m)
 
 static int markov_build(int argc, char **argv)
 {
-	return markov_build_main(argc, argv, NULL);
+	return markov_build_main(argc, argv, NULL, NULL);
 }
 
 int cmd_markov_merge(int argc, char **argv, const cli_merge *m)
 {
-	return markov_build_main(argc, argv, m);
+	return markov_build_main(argc, argv, m, NULL);
 }
 
 /* The probabilities of the end, a side and stuck: p summed by kind. */
