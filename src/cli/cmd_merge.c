@@ -15,15 +15,16 @@
 static const cli_spec merge_spec = {
         .name = "merge",
         .usage = "PART_DIR... --out DIR [--threads N] [--quiet]",
-        .about = "Joins the directories of the N parts of one sweep or comparison (beamsim\n"
-                 "sweep|compare ... --shard I/N --out PART_DIR, I = 1..N) into DIR, the\n"
-                 "directory the command writes in one process (trials.csv, summary.json,\n"
-                 ".mat twins, run.json; a comparison's report and pairs too), the same bytes\n"
-                 "but for the wall time (docs/cluster.md). Every part is needed once;\n"
-                 "parts of another run (other inputs), a missing or repeated part, or a\n"
-                 "damaged part.journal are refused, naming the directory. The sweep's\n"
-                 "command line is read from the parts' part.json (the experiment by its\n"
-                 "absolute path); kept trajectories (--trajectories) run again here.\n",
+        .about = "Joins the directories of the N parts of one sweep, comparison or markov\n"
+                 "build (beamsim sweep|compare|markov build ... --shard I/N --out PART_DIR,\n"
+                 "I = 1..N) into DIR, the directory the command writes in one process\n"
+                 "(trials.csv, summary.json, .mat twins, run.json; a comparison's report and\n"
+                 "pairs too; the maps of a markov build), the same bytes but for the wall and\n"
+                 "CPU times (docs/cluster.md). Every part is needed once; parts of another\n"
+                 "run (other inputs), a missing or repeated part, or a damaged part.journal\n"
+                 "are refused, naming the directory. The command line is read from the parts'\n"
+                 "part.json (the experiment by its absolute path); kept trajectories\n"
+                 "(--trajectories) run again here.\n",
         .positional = NULL,
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET),
         .out_required = 1,
