@@ -127,16 +127,18 @@ typedef struct bsim_markov_def {
 	int self_entries; /* 0 off, 1 self-consistent, 2 flow-weighted (above) */
 	int self_passes;  /* 0 to BSIM_MARKOV_SELF_PASSES_MAX */
 	/* A build spread over processes (docs/cluster.md). parts > 1: this
-	 * process builds only the maps of the lattice's stiffness pairs i
-	 * (in the order first met, row 0 first) with i mod parts == part,
-	 * 0 <= part < parts; the others are left out (their map's elsewhere
-	 * set, no counts). n_from > 0: no single gate runs; every map not in
-	 * dir is read from the first of the map directories from[0..n_from)
-	 * (each checked against its manifest) that has it and written into
-	 * dir, the same bytes; a map none has is BSIM_EINPUT naming it, and
-	 * nothing is written. Entries self or flow (maps built in passes)
-	 * are not spread: BSIM_EINPUT. */
-	int part, parts;
+	 * process builds only its maps: the lattice's stiffness pair i (in
+	 * the order first met, row 0 first) is the build's map part_first + i
+	 * (part_first: the maps of the groups before this lattice's), which
+	 * belongs to part (part_first + i) mod parts, 0 <= part < parts, so
+	 * that the parts take turns along all of a build's maps; the others
+	 * are left out (their map's elsewhere set, no counts). n_from > 0: no
+	 * single gate runs; every map not in dir is read from the first of the
+	 * map directories from[0..n_from) (each checked against its manifest)
+	 * that has it and written into dir, the same bytes; a map none has is
+	 * BSIM_EINPUT naming it, and nothing is written. Entries self or flow
+	 * (maps built in passes) are not spread: BSIM_EINPUT. */
+	int part, parts, part_first;
 	const char *const *from;
 	int n_from;
 } bsim_markov_def;

@@ -183,7 +183,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		rc = map_init(m, lattice, def, be, opts, pairs[i], err);
 		if (rc != BSIM_OK)
 			break;
-		if (def->parts > 1 && i % def->parts != def->part) {
+		if (def->parts > 1 && (def->part_first + i) % def->parts != def->part) {
 			m->elsewhere = 1; /* another part's */
 			continue;
 		}

@@ -169,8 +169,8 @@ static const cli_own build_own[] = {
                          "that lattice only; docs/markov.md)"},
         {"shard", 1, "I/N",
          "build part I of N of the maps (I from 1 to N, as\n"
-         "SLURM_ARRAY_TASK_ID of --array=1-N): each lattice's\n"
-         "stiffness pair i is part i mod N + 1's; DIR gets those\n"
+         "SLURM_ARRAY_TASK_ID of --array=1-N): the build's map j\n"
+         "(every group's pairs in turn) is part j mod N + 1's; DIR gets those\n"
          "maps and part.json, beamsim merge joins the N parts'\n"
          "directories into the map directory (docs/cluster.md)"},
 };
@@ -468,6 +468,7 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		if (rc != BSIM_OK)
 			break;
 		bsim_markov_set set;
+		a.def.part_first = n_keys; /* the parts take turns along every group's maps */
 		rc = bsim_markov_build(&scene, &a.def, c.out, &set, &err);
 		bsim_scene_free(&scene);
 		if (rc != BSIM_OK)
