@@ -298,13 +298,18 @@ static const char *markov_lattice(void)
 	return bsim_test_src("configs/lattice/c_track_essay.yaml");
 }
 
-/* markov build of the lattice's maps (3 trials per bin) into out, with
+/* markov build of the lattice's maps (3 trials per bin) at two propulsion
+ * forces (two groups of two stiffness pairs: four maps) into out, with
  * extra arguments a and b (NULL: none). */
+#define MARKOV_GRID "effects.propulsion.force=6,7"
+
 static void markov_build(const char *out, const char *threads, const char *a, const char *b)
 {
-	const char *argv[] = {
-	        "markov", "build", markov_lattice(), "--trials", "3", "--threads", threads,
-	        "--out",  out,     "--quiet",        a,          b,   NULL};
+	const char *argv[] = {"markov",    "build",     markov_lattice(),
+	                      "--trials",  "3",         "--grid",
+	                      MARKOV_GRID, "--threads", threads,
+	                      "--out",     out,         "--quiet",
+	                      a,           b,           NULL};
 	char *err = NULL;
 	int rc = bsim_test_cli(argv, NULL, &err);
 	if (rc != 0)
@@ -313,8 +318,24 @@ static void markov_build(const char *out, const char *threads, const char *a, co
 	assert_int_equal(rc, 0);
 }
 
-/* The lattice's two stiffness pairs in 3 parts (the third builds none),
- * merged: the one-process map directory but for the maps' CPU times. */
+/* How many maps dir holds (their .key files). */
+static int count_maps(const char *dir)
+{
+	char cmd[4600];
+	snprintf(cmd, sizeof cmd, "find '%s' -maxdepth 1 -name 'map_*.key' | wc -l", dir);
+	FILE *p = popen(cmd, "r");
+	int n = -1;
+	if (p) {
+		if (fscanf(p, "%d", &n) != 1)
+			n = -1;
+		pclose(p);
+	}
+	return n;
+}
+
+/* The four maps in 3 parts, merged: the one-process map directory but for
+ * the maps' CPU times. The parts take turns along both groups' maps: 2,
+ * 1 and 1 (each group's pairs from part 1 would leave part 3 none). */
 static void test_markov_shards_merged(void **state)
 {
 	(void)state;
@@ -322,18 +343,20 @@ static void test_markov_shards_merged(void **state)
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("markov_parts"));
 	snprintf(one, sizeof one, "%s/one", dir);
 	markov_build(one, "2", NULL, NULL);
+	assert_int_equal(count_maps(one), 4);
 	for (int i = 0; i < 3; i++) {
 		char shard_arg[16];
 		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
 		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
 		markov_build(part[i], i == 1 ? "2" : "1", "--shard", shard_arg);
 		assert_true(bsim_test_exists(bsim_test_join(part[i], "part.json")));
+		assert_int_equal(count_maps(part[i]), i == 0 ? 2 : 1);
 	}
 	/* a part of another build: another seed */
 	snprintf(part[3], sizeof part[3], "%s/seed2", dir);
-	const char *argv_seed[] = {
-	        "markov",  "build", markov_lattice(), "--trials", "3",       "--seed", "2",
-	        "--shard", "2/3",   "--out",          part[3],    "--quiet", NULL};
+	const char *argv_seed[] = {"markov", "build",     markov_lattice(), "--trials", "3",
+	                           "--grid", MARKOV_GRID, "--seed",         "2",        "--shard",
+	                           "2/3",    "--out",     part[3],          "--quiet",  NULL};
 	assert_int_equal(bsim_test_cli(argv_seed, NULL, NULL), 0);
 	snprintf(out, sizeof out, "%s/merged", dir);
 	const char *argv[] = {"merge", part[2], part[0], part[1], "--out", out, "--quiet", NULL};
@@ -465,7 +488,7 @@ static void test_mpi_compare(void **state)
 	assert_same_dir(one, out);
 }
 
-/* markov build over 3 ranks (two maps: the third rank builds none): the
+/* markov build over 3 ranks (four maps: 2, 1 and 1 a rank): the
  * one-process map directory but for the maps' CPU times, and no
  * temporary directory left behind. */
 static void test_mpi_markov_build(void **state)
@@ -491,6 +514,8 @@ static void test_mpi_markov_build(void **state)
 	                      markov_lattice(),
 	                      "--trials",
 	                      "3",
+	                      "--grid",
+	                      MARKOV_GRID,
 	                      "--threads",
 	                      "1",
 	                      "--out",
