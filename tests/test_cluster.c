@@ -30,6 +30,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <fcntl.h>
 #include <time.h>
@@ -115,6 +116,9 @@ static int compare_one(const char *path, const struct stat *st, int type, struct
 	/* the files that hold the wall time */
 	if (strcmp(name, "manifest.json") == 0 || strcmp(name, "summary.mat") == 0 ||
 	    strcmp(name, "report.mat") == 0)
+		return 0;
+	/* a Markov map's CPU time (map_HASH.cost) */
+	if (strlen(name) > 5 && strcmp(name + strlen(name) - 5, ".cost") == 0)
 		return 0;
 	char other[2048];
 	snprintf(other, sizeof other, "%s/%s", other_root, rel);
@@ -287,6 +291,89 @@ static void test_merge_refuses(void **state)
 	bsim_test_expect_input_error(argv2, (const char *const[]){one, "part.json", NULL});
 }
 
+/* ---- markov build: its maps spread over parts --------------------------- */
+
+static const char *markov_lattice(void)
+{
+	return bsim_test_src("configs/lattice/c_track_essay.yaml");
+}
+
+/* markov build of the lattice's maps (3 trials per bin) at two propulsion
+ * forces (two groups of two stiffness pairs: four maps) into out, with
+ * extra arguments a and b (NULL: none). */
+#define MARKOV_GRID "effects.propulsion.force=6,7"
+
+static void markov_build(const char *out, const char *threads, const char *a, const char *b)
+{
+	const char *argv[] = {"markov",    "build",     markov_lattice(),
+	                      "--trials",  "3",         "--grid",
+	                      MARKOV_GRID, "--threads", threads,
+	                      "--out",     out,         "--quiet",
+	                      a,           b,           NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	if (rc != 0)
+		print_error("%s", err ? err : "");
+	free(err);
+	assert_int_equal(rc, 0);
+}
+
+/* How many maps dir holds (their .key files). */
+static int count_maps(const char *dir)
+{
+	char cmd[4600];
+	snprintf(cmd, sizeof cmd, "find '%s' -maxdepth 1 -name 'map_*.key' | wc -l", dir);
+	FILE *p = popen(cmd, "r");
+	int n = -1;
+	if (p) {
+		if (fscanf(p, "%d", &n) != 1)
+			n = -1;
+		pclose(p);
+	}
+	return n;
+}
+
+/* The four maps in 3 parts, merged: the one-process map directory but for
+ * the maps' CPU times. The parts take turns along both groups' maps: 2,
+ * 1 and 1 (each group's pairs from part 1 would leave part 3 none). */
+static void test_markov_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[4][1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("markov_parts"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	markov_build(one, "2", NULL, NULL);
+	assert_int_equal(count_maps(one), 4);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		markov_build(part[i], i == 1 ? "2" : "1", "--shard", shard_arg);
+		assert_true(bsim_test_exists(bsim_test_join(part[i], "part.json")));
+		assert_int_equal(count_maps(part[i]), i == 0 ? 2 : 1);
+	}
+	/* a part of another build: another seed */
+	snprintf(part[3], sizeof part[3], "%s/seed2", dir);
+	const char *argv_seed[] = {"markov", "build",     markov_lattice(), "--trials", "3",
+	                           "--grid", MARKOV_GRID, "--seed",         "2",        "--shard",
+	                           "2/3",    "--out",     part[3],          "--quiet",  NULL};
+	assert_int_equal(bsim_test_cli(argv_seed, NULL, NULL), 0);
+	snprintf(out, sizeof out, "%s/merged", dir);
+	const char *argv[] = {"merge", part[2], part[0], part[1], "--out", out, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	assert_same_dir(one, out);
+	/* refused: a part of another build, a part missing */
+	char bad[1100];
+	snprintf(bad, sizeof bad, "%s/refused", dir);
+	const char *other[] = {"merge", part[0], part[3], part[2], "--out", bad, NULL};
+	bsim_test_expect_input_error(
+	        other, (const char *const[]){part[3], "parts of different runs", NULL});
+	const char *missing[] = {"merge", part[0], part[2], "--out", bad, NULL};
+	bsim_test_expect_input_error(missing,
+	                             (const char *const[]){"part 2 of 3 is missing", NULL});
+	assert_false(bsim_test_exists(bsim_test_join(bad, "markov.json")));
+}
+
 /* ---- MPI ----------------------------------------------------------------- */
 
 /* Fails the test when the program has no MPI though it is required
@@ -302,6 +389,8 @@ static int have_mpi(void)
 
 /* Starts mpirun -np ranks beamsim cmd ... in the background, its stderr
  * into err_path; returns mpirun's pid. */
+static pid_t spawn_mpirun(const char *const *argv, const char *err_path);
+
 static pid_t mpirun_command(const char *cmd, const char *ranks, const char *out, const char *trials,
                             int resume, const char *err_path)
 {
@@ -321,6 +410,12 @@ static pid_t mpirun_command(const char *cmd, const char *ranks, const char *out,
 	                      "--quiet",
 	                      resume ? "--resume" : NULL,
 	                      NULL};
+	return spawn_mpirun(argv, err_path);
+}
+
+/* Starts argv (mpirun ...) in the background, its stderr into err_path. */
+static pid_t spawn_mpirun(const char *const *argv, const char *err_path)
+{
 	posix_spawn_file_actions_t fa;
 	posix_spawn_file_actions_init(&fa);
 	posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
@@ -391,6 +486,51 @@ static void test_mpi_compare(void **state)
 		print_stderr(err_path);
 	assert_int_equal(rc, 0);
 	assert_same_dir(one, out);
+}
+
+/* markov build over 3 ranks (four maps: 2, 1 and 1 a rank): the
+ * one-process map directory but for the maps' CPU times, and no
+ * temporary directory left behind. */
+static void test_mpi_markov_build(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200], tmp[1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_markov"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/ranks3", dir);
+	snprintf(tmp, sizeof tmp, "%s/tmp", dir);
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	assert_int_equal(mkdir(tmp, 0755), 0);
+	markov_build(one, "2", NULL, NULL);
+	const char *argv[] = {BSIM_TEST_MPIEXEC,
+	                      "--oversubscribe",
+	                      "-np",
+	                      "3",
+	                      BSIM_EXE,
+	                      "markov",
+	                      "build",
+	                      markov_lattice(),
+	                      "--trials",
+	                      "3",
+	                      "--grid",
+	                      MARKOV_GRID,
+	                      "--threads",
+	                      "1",
+	                      "--out",
+	                      out,
+	                      "--quiet",
+	                      NULL};
+	setenv("TMPDIR", tmp, 1);
+	int rc = wait_status(spawn_mpirun(argv, err_path));
+	unsetenv("TMPDIR");
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
+	assert_int_equal(count_files(tmp), 0);
+	assert_int_equal(rmdir(tmp), 0); /* nor any directory */
 }
 
 static void test_mpi_identical(void **state)
@@ -504,10 +644,12 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_shards_merged),
 	        cmocka_unit_test(test_compare_shards_merged),
 	        cmocka_unit_test(test_merge_refuses),
+	        cmocka_unit_test(test_markov_shards_merged),
 	};
 	const struct CMUnitTest mpi[] = {
 	        cmocka_unit_test(test_mpi_identical),
 	        cmocka_unit_test(test_mpi_compare),
+	        cmocka_unit_test(test_mpi_markov_build),
 	        cmocka_unit_test(test_mpi_rank_killed_resumed),
 	};
 	if (argc < 2 || strcmp(argv[1], "mpi") != 0)

@@ -126,6 +126,21 @@ typedef struct bsim_markov_def {
 	 * lattice's layout only (its hash is in the key). */
 	int self_entries; /* 0 off, 1 self-consistent, 2 flow-weighted (above) */
 	int self_passes;  /* 0 to BSIM_MARKOV_SELF_PASSES_MAX */
+	/* A build spread over processes (docs/cluster.md). parts > 1: this
+	 * process builds only its maps: the lattice's stiffness pair i (in
+	 * the order first met, row 0 first) is the build's map part_first + i
+	 * (part_first: the maps of the groups before this lattice's), which
+	 * belongs to part (part_first + i) mod parts, 0 <= part < parts, so
+	 * that the parts take turns along all of a build's maps; the others
+	 * are left out (their map's elsewhere set, no counts). n_from > 0: no
+	 * single gate runs; every map not in dir is read from the first of the
+	 * map directories from[0..n_from) (each checked against its manifest)
+	 * that has it and written into dir, the same bytes; a map none has is
+	 * BSIM_EINPUT naming it, and nothing is written. Entries self or flow
+	 * (maps built in passes) are not spread: BSIM_EINPUT. */
+	int part, parts, part_first;
+	const char *const *from;
+	int n_from;
 } bsim_markov_def;
 
 #define BSIM_MARKOV_SELF_GATES      16
@@ -155,6 +170,8 @@ typedef struct bsim_markov_map {
 	 * map read without that file (built before holding times were kept):
 	 * the chain then has no times, and a build simulates it again. */
 	int *hold_exit, *hold_steps;
+	int elsewhere; /* 1: left to another part (def parts): no counts here */
+	int copied;    /* 1: read from a part's directory (def from) and written */
 } bsim_markov_map;
 
 /* The maps of one lattice: one per stiffness pair it uses. */
@@ -164,6 +181,7 @@ typedef struct bsim_markov_set {
 	bsim_markov_map *maps;
 	int built, reused; /* maps simulated now, maps read from the cache */
 	double seconds;    /* CPU time of the simulation of those built, s */
+	int copied;        /* maps read from the parts' directories (def from) */
 } bsim_markov_set;
 
 /* The maps lattice needs, from the cache directory dir: a map whose key is
@@ -186,6 +204,19 @@ BSIM_API int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_o
                               bsim_markov_set *out, bsim_error *err);
 
 BSIM_API void bsim_markov_set_free(bsim_markov_set *s);
+
+/* The name of a spread build's run (docs/cluster.md): 16 hex digits of
+ * the hash of the keys of every map it builds, in order (the maps of
+ * every part, elsewhere or not), so that the parts of one build carry one
+ * name and a part of another build (any other input) another. */
+BSIM_API void bsim_markov_run_id(const uint64_t *keys, int n, char out[17]);
+
+/* Writes dir/part.json of part index (1-based) of count of the build run
+ * (bsim_markov_run_id), of total maps, records of them built here, argv
+ * the command line (bsim_sweep_dir_part_read reads it). */
+BSIM_API int bsim_markov_part_write(const char *dir, int index, int count, const char *run,
+                                    long total, long records, int argc, char *const *argv,
+                                    bsim_error *err);
 
 /* The chains small enough for the exact LU solve. */
 #define BSIM_MARKOV_LU_MAX 1000

@@ -14,6 +14,7 @@
 #include <time.h>
 
 #include "store/outdir.h"
+#include "store/part_dir.h"
 #include "store/session.h"
 #include "beamsim/limits.h"
 
@@ -110,6 +111,13 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		                      "observed entries, got %d passes%s",
 		                      BSIM_MARKOV_SELF_PASSES_MAX, def->self_passes,
 		                      def->entries ? " and observed entries" : "");
+	if ((def->parts > 1 || def->n_from > 0) && def->self_entries)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "entries: maps built in passes (self or flow entries) are "
+		                      "built in one process, not spread over parts");
+	if (def->parts > 1 && (def->part < 0 || def->part >= def->parts))
+		return bsim_error_set(err, BSIM_EINPUT, "part %d of %d: expected 0 to %d",
+		                      def->part, def->parts, def->parts - 1);
 	if (def->trials < 1 || def->trials > 1000000)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "trials: expected 1 to 1000000 per bin, got %d", def->trials);
@@ -175,7 +183,28 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		rc = map_init(m, lattice, def, be, opts, pairs[i], err);
 		if (rc != BSIM_OK)
 			break;
+		if (def->parts > 1 && (def->part_first + i) % def->parts != def->part) {
+			m->elsewhere = 1; /* another part's */
+			continue;
+		}
 		int got = markov_map_read(dir, m, err);
+		/* A spread build's merge: the map from the part that built it. */
+		for (int j = 0; got == 0 && j < def->n_from; j++)
+			if ((got = markov_map_read(def->from[j], m, err)) > 0)
+				m->copied = 1;
+		if (got > 0 && m->copied && !m->hold_exit)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "%s: the map for k = %g, %g N m/rad has no holding "
+			                    "times: not a part of this build",
+			                    dir, m->k[0], m->k[1]);
+		else if (got == 0 && def->n_from > 0)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "no part holds the map for k = %g, %g N m/rad (key "
+			                    "%016llx): the parts are of another build, or one is "
+			                    "missing",
+			                    m->k[0], m->k[1], (unsigned long long)m->key);
+		if (rc != BSIM_OK)
+			break;
 		if (got > 0 && stage && !m->hold_exit) {
 			/* built before holding times were kept: simulated again
 			 * (the same seeds: the same counts) with them */
@@ -186,8 +215,10 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		}
 		if (got < 0)
 			rc = BSIM_EINPUT;
-		else if (got)
+		else if (got && !m->copied)
 			have[i] = m->cached = 1, out->reused++;
+		else if (got)
+			out->copied++;
 		else if (!stage)
 			rc = bsim_error_set(
 			        err, BSIM_EINPUT,
@@ -203,7 +234,9 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			          : def->self_entries == 2 ? def->self_passes + 1
 			                                   : 1);
 	}
-	int to_build = n - out->reused;
+	int to_build = n - out->reused - out->copied;
+	for (int i = 0; i < n; i++)
+		to_build -= out->maps[i].elsewhere;
 	/* Flow-weighted entries: every map's passes at once, the lattice's
 	 * chain weighting each pass's states. */
 	const int flow = def->self_entries == 2 && to_build > 0 && stage && rc == BSIM_OK;
@@ -212,8 +245,14 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		                          &done, total, err);
 	for (int i = 0; i < n && rc == BSIM_OK && stage; i++) {
 		bsim_markov_map *m = &out->maps[i];
-		if (have[i])
+		if (have[i] || m->elsewhere)
 			continue;
+		if (m->copied) {
+			/* read from a part: written again as it was */
+			if ((rc = markov_map_write(stage, m, &def->bins, err)) == BSIM_OK)
+				rc = map_commit(ss, err);
+			continue;
+		}
 		clock_t c0 = clock();
 		rc = flow                      ? BSIM_OK
 		     : def->stop && *def->stop ? BSIM_ESTOPPED
@@ -254,6 +293,29 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 		rc = def_check(def, err);
 	if (rc != BSIM_OK)
 		return rc;
+	if (def->n_from > 0) {
+		/* every part of one spread build, each once */
+		bsim_sweep_dir_part *parts = calloc((size_t)def->n_from, sizeof *parts);
+		if (!parts)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		rc = part_dir_check(def->from, def->n_from, "markov build", NULL, parts, err);
+		for (int j = 0; j < def->n_from; j++)
+			bsim_sweep_dir_part_free(&parts[j]);
+		free(parts);
+		if (rc != BSIM_OK)
+			return rc;
+	}
+	for (int j = 0; j < def->n_from; j++) {
+		int has_manifest = 0;
+		if (bsim_outdir_verify(def->from[j], &has_manifest, err) != BSIM_OK)
+			return BSIM_EINPUT;
+		if (!has_manifest)
+			return bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s: no manifest.json: not a part directory of beamsim "
+			        "markov build --shard",
+			        def->from[j]);
+	}
 	bsim_session ss;
 	if ((rc = bsim_session_open(&ss, dir, 0, NULL, 0, err)) != BSIM_OK)
 		return rc;
@@ -318,4 +380,26 @@ int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *o
 	if ((rc = maps_listed(dir, out, err)) != BSIM_OK)
 		bsim_markov_set_free(out);
 	return rc;
+}
+
+void bsim_markov_run_id(const uint64_t *keys, int n, char out[17])
+{
+	/* the keys as text, in order: the name part_dir_run_id gives it */
+	char *text = malloc((size_t)n * 17 + 16);
+	if (!text) {
+		snprintf(out, 17, "%016x", 0u);
+		return;
+	}
+	size_t len = (size_t)sprintf(text, "markov build\n");
+	for (int i = 0; i < n; i++)
+		len += (size_t)sprintf(text + len, "%016llx\n", (unsigned long long)keys[i]);
+	part_dir_run_id(text, out);
+	free(text);
+}
+
+int bsim_markov_part_write(const char *dir, int index, int count, const char *run, long total,
+                           long records, int argc, char *const *argv, bsim_error *err)
+{
+	return part_dir_write(dir, "markov build", index, count, run, total, records, argc, argv,
+	                      err);
 }

@@ -8,6 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <dirent.h>
+#include <errno.h>
+#include <sys/stat.h>
 
 #include "cli/cli_common.h"
 
@@ -103,6 +106,12 @@ void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree,
 void cli_mpi_abort(int rc)
 {
 	(void)rc;
+}
+
+int cli_mpi_gather_dir(const char *mine, char **dirs)
+{
+	dirs[0] = strdup(mine);
+	return dirs[0] ? CLI_OK : CLI_FAIL;
 }
 
 #else
@@ -379,6 +388,124 @@ void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree,
 	                          .collect = mpi_collect,
 	                          .user = &part_state};
 	*agree = mpi_agree;
+}
+
+#endif
+
+#ifdef BSIM_HAVE_MPI
+
+enum { TAG_FILE = 3 };
+
+/* Sends buf to rank 0, waiting idle (idle_wait) while rank 0 computes. */
+static void send_idle(const void *buf, int n, MPI_Datatype type)
+{
+	MPI_Request req;
+	MPI_Isend(buf, n, type, 0, TAG_FILE, MPI_COMM_WORLD, &req);
+	idle_wait(&req);
+}
+
+/* This rank's files of dir, each its name's length, name, size, bytes;
+ * an empty name ends them. */
+static int send_dir(const char *dir)
+{
+	DIR *d = opendir(dir);
+	if (!d) {
+		cli_error("%s: cannot read: %s", dir, strerror(errno));
+		return CLI_FAIL;
+	}
+	int rc = CLI_OK;
+	struct dirent *e;
+	while (rc == CLI_OK && (e = readdir(d)) != NULL) {
+		char path[4096];
+		struct stat st;
+		snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+		if (lstat(path, &st) != 0 || !S_ISREG(st.st_mode))
+			continue; /* ., .. and the session's .beamsim */
+		FILE *f = fopen(path, "rb");
+		long n = st.st_size;
+		char *b = f && n < INT32_MAX ? malloc((size_t)n + 1) : NULL;
+		if (!b || fread(b, 1, (size_t)n, f) != (size_t)n) {
+			cli_error("%s: cannot read: %s", path, strerror(errno));
+			rc = CLI_FAIL;
+		} else {
+			int len = (int)strlen(e->d_name);
+			int size = (int)n;
+			send_idle(&len, 1, MPI_INT);
+			send_idle(e->d_name, len, MPI_CHAR);
+			send_idle(&size, 1, MPI_INT);
+			send_idle(b, size, MPI_BYTE);
+		}
+		free(b);
+		if (f)
+			fclose(f);
+	}
+	closedir(d);
+	int end = 0;
+	if (rc == CLI_OK)
+		send_idle(&end, 1, MPI_INT);
+	return rc;
+}
+
+/* Rank from's files into the new directory dir. */
+static int receive_dir(int from, const char *dir)
+{
+	for (;;) {
+		int len = 0, size = 0;
+		char name[256];
+		MPI_Recv(&len, 1, MPI_INT, from, TAG_FILE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+		if (len <= 0)
+			return CLI_OK;
+		if (len >= (int)sizeof name) {
+			cli_error("rank %d: a file name of %d bytes", from, len);
+			return CLI_FAIL;
+		}
+		MPI_Recv(name, len, MPI_CHAR, from, TAG_FILE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+		name[len] = '\0';
+		MPI_Recv(&size, 1, MPI_INT, from, TAG_FILE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+		char *b = malloc((size_t)size + 1);
+		if (!b) {
+			cli_error("out of memory");
+			return CLI_FAIL;
+		}
+		MPI_Recv(b, size, MPI_BYTE, from, TAG_FILE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+		size_t n = strlen(dir) + (size_t)len + 2;
+		char *path = strchr(name, '/') ? NULL : malloc(n);
+		if (path)
+			snprintf(path, n, "%s/%s", dir, name);
+		FILE *f = path ? fopen(path, "wb") : NULL;
+		int ok = f && fwrite(b, 1, (size_t)size, f) == (size_t)size;
+		if (f && fclose(f) != 0)
+			ok = 0;
+		free(b);
+		if (!ok)
+			cli_error("%s/%s: cannot write: %s", dir, name, strerror(errno));
+		free(path);
+		if (!ok)
+			return CLI_FAIL;
+	}
+}
+
+int cli_mpi_gather_dir(const char *mine, char **dirs)
+{
+	if (!mpi_on || mpi_size < 2) {
+		dirs[0] = strdup(mine);
+		return dirs[0] ? CLI_OK : CLI_FAIL;
+	}
+	if (mpi_rank > 0)
+		return send_dir(mine);
+	int rc = (dirs[0] = strdup(mine)) ? CLI_OK : CLI_FAIL;
+	for (int r = 1; r < mpi_size && rc == CLI_OK; r++) {
+		char tmpl[4096];
+		snprintf(tmpl, sizeof tmpl, "%s.rank%d", mine, r);
+		if (mkdir(tmpl, 0700) != 0) {
+			cli_error("%s: cannot create: %s", tmpl, strerror(errno));
+			rc = CLI_FAIL;
+		} else if ((dirs[r] = strdup(tmpl)) == NULL)
+			rc = CLI_FAIL;
+		else
+			rc = receive_dir(r, tmpl);
+	}
+	return rc;
 }
 
 #endif

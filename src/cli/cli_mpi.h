@@ -63,7 +63,19 @@ typedef struct cli_merge {
 /* compare's command line (argv[0] "compare") run as the merge m of its
  * parts (cmd_compare.c). */
 int cmd_compare_merge(int argc, char **argv, const cli_merge *m);
+/* sweep's, as the merge m of its parts (cmd_sweep.c). */
+int cmd_sweep_merge(int argc, char **argv, const cli_merge *m);
+/* markov build's (argv[0] "build"): the maps copied from the parts
+ * (cmd_markov.c). */
+int cmd_markov_merge(int argc, char **argv, const cli_merge *m);
 void cli_stored_argv_free(char **stored, int argc, char **argv);
+
+/* Gathers every rank's directory on rank 0 (their files, not
+ * subdirectories): rank 0's dirs[0..size) (allocated, freed by the
+ * caller) are mine and rank r's copy in mine.rankR; the other ranks send
+ * theirs and set nothing. One process: dirs[0] is mine. CLI_OK, or
+ * CLI_FAIL printed. */
+int cli_mpi_gather_dir(const char *mine, char **dirs);
 
 /* Ends the whole job with status rc (after a rank's failure, printed):
  * the other ranks would wait for it for ever. Returns if one process. */

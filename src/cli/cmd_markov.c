@@ -1,12 +1,16 @@
 /* beamsim markov: the Markov chain that predicts a gate lattice from
  * single-gate maps (beamsim/markov.h). build, predict and validate parse
  * and print; the library simulates, composes, solves and writes. */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* asprintf, mkdtemp */
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+#include <ftw.h>
+#include <sys/stat.h>
 
 #include "beamsim/experiment.h"
 #include "beamsim/markov.h"
@@ -15,6 +19,8 @@
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
+#include "cli/cli_mpi.h"
+#include "beamsim/sweep_dir.h"
 #include "util/clock.h"
 #include "util/json.h"
 
@@ -28,7 +34,8 @@ enum {
 	OWN_JSON,
 	OWN_TOL,
 	OWN_NO_GATES,
-	OWN_WALKS
+	OWN_WALKS,
+	OWN_SHARD
 };
 
 #define MAX_ENTRIES 16
@@ -41,6 +48,7 @@ typedef struct markov_args {
 	int no_gates;        /* predict: --no-gates */
 	double tol;          /* predict: --tol */
 	long walks;          /* predict: --walks */
+	int shard, shards;   /* build: --shard, 1-based; 0: every map */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
 } markov_args;
@@ -135,6 +143,8 @@ static int markov_option(void *args, int i, const char *value)
 	case OWN_NO_GATES:
 		a->no_gates = 1;
 		return CLI_OK;
+	case OWN_SHARD:
+		return cli_shard_parse("markov build", value, &a->shard, &a->shards);
 	case OWN_WALKS:
 		if (cli_parse_long(value, 0, 100000000L, &a->walks) != 0)
 			return cli_usage("markov predict",
@@ -157,7 +167,18 @@ static const cli_own build_own[] = {
                          "passes (default 1); flow or flow:N: from every map's exits\n"
                          "weighted by the chain's flow on each lattice (maps for\n"
                          "that lattice only; docs/markov.md)"},
+        {"shard", 1, "I/N",
+         "build part I of N of the maps (I from 1 to N, as\n"
+         "SLURM_ARRAY_TASK_ID of --array=1-N): the build's map j\n"
+         "(every group's pairs in turn) is part j mod N + 1's; DIR gets those\n"
+         "maps and part.json, beamsim merge joins the N parts'\n"
+         "directories into the map directory (docs/cluster.md)"},
 };
+
+static int build_option(void *args, int i, const char *value)
+{
+	return markov_option(args, i == 3 ? OWN_SHARD : i, value);
+}
 
 static const char *const build_help[CLI_N_OPTS] = {
         [CLI_OPT_OUT] = "the map directory: maps already there with the same key are\n"
@@ -184,8 +205,8 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 3,
-        .option = markov_option,
+        .n_own = 4,
+        .option = build_option,
 };
 
 static const cli_own predict_own[] = {
@@ -275,15 +296,130 @@ static const cli_spec validate_spec = {
         .option = map_option,
 };
 
-static int markov_build(int argc, char **argv)
+/* Appends the keys of set's maps to *keys (the run's name, below). */
+static int keys_add(uint64_t **keys, int *n, const bsim_markov_set *set)
+{
+	uint64_t *k = realloc(*keys, (size_t)(*n + set->n + 1) * sizeof *k);
+	if (!k)
+		return -1;
+	for (int i = 0; i < set->n; i++)
+		k[(*n)++] = set->maps[i].key;
+	*keys = k;
+	return 0;
+}
+
+/* A part of an MPI job's build: its rank's maps into a directory of
+ * its own (markov_build_ranks). */
+typedef struct markov_part {
+	const char *out;
+	int shard, shards; /* 1-based */
+} markov_part;
+
+static int markov_build_main(int argc, char **argv, const cli_merge *m, const markov_part *p);
+
+static int remove_one(const char *path, const struct stat *st, int type, struct FTW *ftw)
+{
+	(void)st;
+	(void)type;
+	(void)ftw;
+	remove(path);
+	return 0;
+}
+
+/* A part's temporary directory and all in it, gone. */
+static void remove_tree(const char *dir)
+{
+	nftw(dir, remove_one, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+/* The build spread over an MPI job's ranks: rank r builds part r + 1 of
+ * the maps into its own temporary directory, rank 0 gathers the parts'
+ * directories and merges them into out, as merge does. */
+static int markov_build_ranks(int argc, char **argv, const cli_common *c)
+{
+	const char *tmp = getenv("TMPDIR");
+	char mine[1024];
+	snprintf(mine, sizeof mine, "%s/beamsim-markov-XXXXXX", tmp && tmp[0] ? tmp : "/tmp");
+	int rank = cli_mpi_rank(), size = cli_mpi_size(), rc;
+	if (!mkdtemp(mine)) {
+		cli_error("%s: cannot create: %s", mine, strerror(errno));
+		cli_mpi_abort(CLI_FAIL);
+		return CLI_FAIL;
+	}
+	char *part = NULL;
+	/* the part's directory inside mine (mkdtemp's is private) */
+	if (asprintf(&part, "%s/part", mine) < 0) {
+		cli_mpi_abort(CLI_FAIL);
+		return CLI_FAIL;
+	}
+	markov_part p = {part, rank + 1, size};
+	rc = markov_build_main(argc, argv, NULL, &p);
+	if (rc != CLI_OK)
+		cli_mpi_abort(rc); /* printed; the others would wait for ever */
+	char **dirs = calloc((size_t)size, sizeof *dirs);
+	if (!dirs || (rc = cli_mpi_gather_dir(part, dirs)) != CLI_OK)
+		cli_mpi_abort(CLI_FAIL);
+	if (rank == 0) {
+		cli_merge merge = {c->out, c->threads, c->quiet, (const char *const *)dirs, size};
+		rc = markov_build_main(argc, argv, &merge, NULL);
+	}
+	/* the parts' files are in out now, or the build failed: either way
+	 * not kept */
+	for (int r = 0; r < size && dirs; r++)
+		if (dirs[r])
+			remove_tree(dirs[r]);
+	remove_tree(part);
+	rmdir(mine);
+	for (int r = 0; r < size && dirs; r++)
+		free(dirs[r]);
+	free(dirs);
+	free(part);
+	if (rc != CLI_OK)
+		cli_mpi_abort(rc);
+	return rc;
+}
+
+static int markov_build_main(int argc, char **argv, const cli_merge *m, const markov_part *p)
 {
 	cli_common c = cli_common_default();
 	markov_args a = {.def = bsim_markov_def_default()};
 	const char *path = NULL;
 	int rc = cli_parse(&build_spec, argc, argv, &c, &a, &path);
+	if (rc < 0 && a.shards > 0 && cli_mpi_size() > 1)
+		rc = cli_usage("markov build",
+		               "--shard builds one part in one process: not under mpirun (%d "
+		               "ranks)",
+		               cli_mpi_size());
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
+	}
+	if (!m && !p && cli_mpi_size() > 1) {
+		rc = markov_build_ranks(argc, argv, &c);
+		cli_common_free(&c);
+		return rc;
+	}
+	bsim_sweep_dir_part first;
+	memset(&first, 0, sizeof first);
+	/* an MPI job's progress: rank 0's part's */
+	const int show_progress = !c.quiet && (!p || cli_mpi_rank() == 0);
+	if (p) {
+		c.out = p->out;
+		c.quiet = 1;
+		a.shard = p->shard;
+		a.shards = p->shards;
+	}
+	if (m) {
+		c.out = m->out;
+		c.threads = m->threads;
+		c.quiet = m->quiet;
+		a.shard = a.shards = 0;
+		a.def.from = m->parts;
+		a.def.n_from = m->n_parts;
+	}
+	if (a.shards > 0) {
+		a.def.part = a.shard - 1;
+		a.def.parts = a.shards;
 	}
 	bsim_options opts = {0};
 	const bsim_backend *be =
@@ -317,12 +453,14 @@ static int markov_build(int argc, char **argv)
 		return rc;
 	}
 	cli_progress progress;
-	cli_progress_init(&progress, !c.quiet, "single gates");
+	cli_progress_init(&progress, show_progress, "single gates");
 	a.def.progress = cli_progress_update;
 	a.def.progress_user = &progress;
 	a.def.stop = &cli_stop;
 	cli_signals_install();
-	int built = 0, reused = 0;
+	int built = 0, reused = 0, copied = 0, own = 0;
+	uint64_t *keys = NULL;
+	int n_keys = 0;
 	double cpu = 0.0;
 	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++) {
 		bsim_scene scene;
@@ -330,18 +468,26 @@ static int markov_build(int argc, char **argv)
 		if (rc != BSIM_OK)
 			break;
 		bsim_markov_set set;
+		a.def.part_first = n_keys; /* the parts take turns along every group's maps */
 		rc = bsim_markov_build(&scene, &a.def, c.out, &set, &err);
 		bsim_scene_free(&scene);
 		if (rc != BSIM_OK)
 			break;
 		built += set.built;
 		reused += set.reused;
+		copied += set.copied;
+		own += set.built + set.reused;
 		cpu += set.seconds;
+		if (keys_add(&keys, &n_keys, &set) != 0)
+			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory");
 		for (int i = 0; i < set.n && !c.quiet; i++)
 			printf("group %d  k = %g, %g N m/rad  map_%016llx  %s\n", g,
 			       set.maps[i].k[0], set.maps[i].k[1],
 			       (unsigned long long)set.maps[i].key,
-			       set.maps[i].cached ? "reused" : "built");
+			       set.maps[i].elsewhere ? "another part's"
+			       : set.maps[i].copied  ? "from a part"
+			       : set.maps[i].cached  ? "reused"
+			                             : "built");
 		bsim_markov_set_free(&set);
 	}
 	cli_progress_finish(&progress);
@@ -354,17 +500,51 @@ static int markov_build(int argc, char **argv)
 		          sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
 		rc = 128 + sig;
 	}
+	/* A spread build's parts carry the name of the run, from the keys of
+	 * all its maps: merge checks they are one build's, and this one's. */
+	char run[17];
+	bsim_markov_run_id(keys, n_keys, run);
+	if (rc == BSIM_OK && m &&
+	    (rc = bsim_sweep_dir_part_read(m->parts[0], &first, &err)) == BSIM_OK &&
+	    strcmp(first.run, run) != 0)
+		rc = bsim_error_set(&err, BSIM_EINPUT,
+		                    "%s: part %d of %d of run %s, but the experiment read now "
+		                    "makes run %s: its file changed since the parts ran",
+		                    m->parts[0], first.index, first.count, first.run, run);
+	if (rc == BSIM_OK && a.shards > 0) {
+		char **stored = cli_stored_argv(argc, argv, path);
+		rc = stored ? bsim_markov_part_write(c.out, a.shard, a.shards, run, n_keys, own,
+		                                     argc, stored, &err)
+		            : bsim_error_set(&err, BSIM_EFAIL, "out of memory");
+		cli_stored_argv_free(stored, argc, argv);
+	}
+	if (rc == BSIM_OK && !c.quiet && a.shards > 0)
+		printf("part %d of %d of the maps in %s; beamsim merge joins the %d parts' "
+		       "directories\n",
+		       a.shard, a.shards, cli_path(c.out), a.shards);
 	if (rc == BSIM_OK && !c.quiet)
-		printf("%d maps built (%.1f s of CPU), %d reused; %d entry bins x %d trials each, "
-		       "in %s\n",
-		       built, cpu, reused, bsim_markov_bins_count(&a.def.bins), a.def.trials,
-		       cli_path(c.out));
+		printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials "
+		       "each, in %s\n",
+		       built, cpu, reused, copied ? ", the others from the parts" : "",
+		       bsim_markov_bins_count(&a.def.bins), a.def.trials, cli_path(c.out));
 	if (rc == BSIM_OK && !c.quiet)
 		cli_wrote(stdout, c.out);
 	bsim_experiment_free(&e);
 	bsim_markov_entries_free(&entries);
+	bsim_sweep_dir_part_free(&first);
+	free(keys);
 	cli_common_free(&c);
 	return rc > BSIM_ESTOPPED ? rc : cli_report(rc, &err);
+}
+
+static int markov_build(int argc, char **argv)
+{
+	return markov_build_main(argc, argv, NULL, NULL);
+}
+
+int cmd_markov_merge(int argc, char **argv, const cli_merge *m)
+{
+	return markov_build_main(argc, argv, m, NULL);
 }
 
 /* The probabilities of the end, a side and stuck: p summed by kind. */

@@ -229,70 +229,9 @@ int cmd_sweep(int argc, char **argv)
 	return sweep_main(argc, argv, NULL);
 }
 
-/* ---- beamsim merge: the parts of a sweep run with --shard I/N ---------- */
-
-static const cli_spec merge_spec = {
-        .name = "merge",
-        .usage = "PART_DIR... --out DIR [--threads N] [--quiet]",
-        .about = "Joins the directories of the N parts of one sweep or comparison (beamsim\n"
-                 "sweep|compare ... --shard I/N --out PART_DIR, I = 1..N) into DIR, the\n"
-                 "directory the command writes in one process (trials.csv, summary.json,\n"
-                 ".mat twins, run.json; a comparison's report and pairs too), the same bytes\n"
-                 "but for the wall time (docs/cluster.md). Every part is needed once;\n"
-                 "parts of another run (other inputs), a missing or repeated part, or a\n"
-                 "damaged part.journal are refused, naming the directory. The sweep's\n"
-                 "command line is read from the parts' part.json (the experiment by its\n"
-                 "absolute path); kept trajectories (--trajectories) run again here.\n",
-        .positional = NULL,
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET),
-        .out_required = 1,
-};
-
-int cmd_merge(int argc, char **argv)
+/* sweep's command line (argv[0] "sweep") run as the merge m of its parts
+ * (cmd_merge.c). */
+int cmd_sweep_merge(int argc, char **argv, const cli_merge *m)
 {
-	/* The part directories are the arguments that are not options. */
-	cli_common c = cli_common_default();
-	const char **parts = calloc((size_t)argc + 1, sizeof *parts);
-	char **opts = calloc((size_t)argc + 1, sizeof *opts);
-	int n_parts = 0, n_opts = 0, rc = -1;
-	if (!parts || !opts) {
-		cli_error("out of memory");
-		rc = CLI_FAIL;
-	}
-	for (int i = 0; rc < 0 && i < argc; i++) {
-		int takes_value =
-		        strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "--threads") == 0;
-		if (i > 0 && argv[i][0] != '-') {
-			parts[n_parts++] = argv[i];
-			continue;
-		}
-		opts[n_opts++] = argv[i];
-		if (takes_value && i + 1 < argc)
-			opts[n_opts++] = argv[++i];
-	}
-	if (rc < 0)
-		rc = cli_parse(&merge_spec, n_opts, opts, &c, NULL, NULL);
-	if (rc < 0 && n_parts == 0)
-		rc = cli_usage("merge", "expected the directories of the parts, got none");
-	bsim_sweep_dir_part first;
-	bsim_error err;
-	memset(&first, 0, sizeof first);
-	if (rc < 0 && bsim_sweep_dir_part_read(parts[0], &first, &err) != BSIM_OK)
-		rc = cli_report(BSIM_EINPUT, &err);
-	int is_compare = rc < 0 && strcmp(first.command, "compare") == 0;
-	if (rc < 0 && !is_compare && strcmp(first.command, "sweep") != 0)
-		rc = cli_usage("merge",
-		               "%s: a part of a %s; merge joins the parts of a sweep or "
-		               "a comparison",
-		               parts[0], first.command);
-	if (rc < 0) {
-		cli_merge m = {c.out, c.threads, c.quiet, parts, n_parts};
-		rc = is_compare ? cmd_compare_merge(first.argc, first.argv, &m)
-		                : sweep_main(first.argc, first.argv, &m);
-	}
-	bsim_sweep_dir_part_free(&first);
-	cli_common_free(&c);
-	free(parts);
-	free(opts);
-	return rc;
+	return sweep_main(argc, argv, m);
 }

@@ -172,19 +172,17 @@ static int join_take(void *user, uint64_t index, const void *payload)
 	return 0;
 }
 
-int part_dir_join(const char *const *dirs, int n, const char *command, const char *run,
-                  const char *inputs, size_t record_size, long total, bsim_journal *j,
-                  bsim_error *err)
+int part_dir_check(const char *const *dirs, int n, const char *command, const char *run,
+                   bsim_sweep_dir_part *parts, bsim_error *err)
 {
-	bsim_sweep_dir_part *parts = calloc((size_t)n, sizeof *parts);
-	if (!parts)
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	int rc = BSIM_OK;
 	for (int k = 0; rc == BSIM_OK && k < n; k++) {
 		bsim_sweep_dir_part *p = &parts[k];
 		rc = bsim_sweep_dir_part_read(dirs[k], p, err);
 		if (rc != BSIM_OK)
 			break;
+		if (!run)
+			run = parts[0].run;
 		if (strcmp(p->command, command) != 0)
 			rc = bsim_error_set(err, BSIM_EINPUT, "%s: a part of a %s, not of a %s",
 			                    dirs[k], p->command, command);
@@ -221,6 +219,18 @@ int part_dir_join(const char *const *dirs, int n, const char *command, const cha
 		                    "missing; each part's directory is needed once)",
 		                    first, count, missing, count, run);
 	}
+	return rc;
+}
+
+int part_dir_join(const char *const *dirs, int n, const char *command, const char *run,
+                  const char *inputs, size_t record_size, long total, bsim_journal *j,
+                  bsim_error *err)
+{
+	bsim_sweep_dir_part *parts = calloc((size_t)n, sizeof *parts);
+	if (!parts)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	int rc = part_dir_check(dirs, n, command, run, parts, err);
+	int count = rc == BSIM_OK ? parts[0].count : 0;
 	unsigned char *seen = rc == BSIM_OK ? calloc((size_t)total / 8 + 1, 1) : NULL;
 	if (rc == BSIM_OK && !seen)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");

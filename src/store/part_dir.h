@@ -9,6 +9,7 @@
 
 #include "beamsim/error.h"
 #include "beamsim/sweep.h"
+#include "beamsim/sweep_dir.h"
 #include "store/session.h"
 #include "util/journal.h"
 
@@ -20,6 +21,14 @@ void part_dir_run_id(const char *inputs, char out[17]);
  * total trials, records trials in part.journal, argv the command line. */
 int part_dir_write(const char *stage, const char *command, int index, int count, const char *run,
                    long total, long records, int argc, char *const *argv, bsim_error *err);
+
+/* Reads the part.json of dirs[0..n) into parts[0..n) (freed by the
+ * caller, bsim_sweep_dir_part_free) and checks that they are every part
+ * of one run of command (run; NULL: the first's), each once. BSIM_EINPUT
+ * naming the directory at fault: a part of another command or run, of
+ * another count, given twice; the first part missing. */
+int part_dir_check(const char *const *dirs, int n, const char *command, const char *run,
+                   bsim_sweep_dir_part *parts, bsim_error *err);
 
 /* Checks that dirs[0..n) are every part of run (command, inputs), each
  * once, whole, and appends every part's records to j. BSIM_EINPUT naming

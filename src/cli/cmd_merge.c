@@ -1,0 +1,82 @@
+/* beamsim merge: joins the directories of the parts of one run made with
+ * --shard I/N into the directory one process writes (docs/cluster.md);
+ * the command the parts ran does the joining. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/sweep_dir.h"
+#include "cli/cli_common.h"
+#include "cli/cli_options.h"
+#include "cli/cli_mpi.h"
+
+static const cli_spec merge_spec = {
+        .name = "merge",
+        .usage = "PART_DIR... --out DIR [--threads N] [--quiet]",
+        .about = "Joins the directories of the N parts of one sweep, comparison or markov\n"
+                 "build (beamsim sweep|compare|markov build ... --shard I/N --out PART_DIR,\n"
+                 "I = 1..N) into DIR, the directory the command writes in one process\n"
+                 "(trials.csv, summary.json, .mat twins, run.json; a comparison's report and\n"
+                 "pairs too; the maps of a markov build), the same bytes but for the wall and\n"
+                 "CPU times (docs/cluster.md). Every part is needed once; parts of another\n"
+                 "run (other inputs), a missing or repeated part, or a damaged part.journal\n"
+                 "are refused, naming the directory. The command line is read from the parts'\n"
+                 "part.json (the experiment by its absolute path); kept trajectories\n"
+                 "(--trajectories) run again here.\n",
+        .positional = NULL,
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET),
+        .out_required = 1,
+};
+
+int cmd_merge(int argc, char **argv)
+{
+	/* The part directories are the arguments that are not options. */
+	cli_common c = cli_common_default();
+	const char **parts = calloc((size_t)argc + 1, sizeof *parts);
+	char **opts = calloc((size_t)argc + 1, sizeof *opts);
+	int n_parts = 0, n_opts = 0, rc = -1;
+	if (!parts || !opts) {
+		cli_error("out of memory");
+		rc = CLI_FAIL;
+	}
+	for (int i = 0; rc < 0 && i < argc; i++) {
+		int takes_value =
+		        strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "--threads") == 0;
+		if (i > 0 && argv[i][0] != '-') {
+			parts[n_parts++] = argv[i];
+			continue;
+		}
+		opts[n_opts++] = argv[i];
+		if (takes_value && i + 1 < argc)
+			opts[n_opts++] = argv[++i];
+	}
+	if (rc < 0)
+		rc = cli_parse(&merge_spec, n_opts, opts, &c, NULL, NULL);
+	if (rc < 0 && n_parts == 0)
+		rc = cli_usage("merge", "expected the directories of the parts, got none");
+	bsim_sweep_dir_part first;
+	bsim_error err;
+	memset(&first, 0, sizeof first);
+	if (rc < 0 && bsim_sweep_dir_part_read(parts[0], &first, &err) != BSIM_OK)
+		rc = cli_report(BSIM_EINPUT, &err);
+	int is_compare = rc < 0 && strcmp(first.command, "compare") == 0;
+	int is_markov = rc < 0 && strcmp(first.command, "markov build") == 0;
+	if (rc < 0 && !is_compare && !is_markov && strcmp(first.command, "sweep") != 0)
+		rc = cli_usage("merge",
+		               "%s: a part of a %s; merge joins the parts of a sweep, a "
+		               "comparison or a markov build",
+		               parts[0], first.command);
+	if (rc < 0) {
+		cli_merge m = {c.out, c.threads, c.quiet, parts, n_parts};
+		rc = is_compare  ? cmd_compare_merge(first.argc, first.argv, &m)
+		     : is_markov ? cmd_markov_merge(first.argc, first.argv, &m)
+		                 : cmd_sweep_merge(first.argc, first.argv, &m);
+	}
+	bsim_sweep_dir_part_free(&first);
+	cli_common_free(&c);
+	free(parts);
+	free(opts);
+	return rc;
+}
