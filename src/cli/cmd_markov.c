@@ -200,17 +200,17 @@ static const cli_own predict_own[] = {
          "print one JSON object (totals, every location, predict_seconds)\ninstead of text"},
         {"tol", 1, "T",
          "stop when less than T is left in the field (each\nlocation's p is short by "
-         "at most what is left); default\nsampling: 1 / (32 sqrt(trials per bin)), "
-         "1/16 of a map\nprobability's standard error (1.1e-3 at 800 trials)"},
+         "at most what is left);\ndefault sampling: 1 / (32 sqrt(trials per bin)),\n"
+         "1/16 of a map probability's standard error\n(1.1e-3 at 800 trials)"},
         {"no-gates", 0, NULL,
-         "no distribution of gates visited, even with --out (the\nsweeps; the mean "
+         "no distribution of gates visited, even with --out\n(the sweeps; the mean "
          "from the expected visits)"},
         {"walks", 1, "N",
          "walks of the semi-Markov chain for the distribution of\nthe time to the "
          "outcome (default 100000; 0: none)"},
         {"gates", 0, NULL,
          "also the distribution of gates visited (the series,\nslower; --out implies "
-         "it): p_gates, prediction_gates.csv"},
+         "it): p_gates,\nprediction_gates.csv"},
 };
 
 /* predict's and validate's own options: --map, then predict's --locations
