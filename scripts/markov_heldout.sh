@@ -10,7 +10,8 @@
 # essay's protocol and as a whole world. No map setting was tuned on these
 # fields. Prints one row per method, field and protocol; the runs stay in
 # OUT (default out/markov-heldout), the table in OUT/table.txt; FIELDS="d"
-# chooses the fields (default a b c). About 30 minutes on two cores.
+# chooses the fields (default a b c), TRIALS=N the trials per bin (default
+# 800). About 30 minutes on two cores at 800.
 #   scripts/markov_heldout.sh [OUT] [THREADS] [METHOD...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,6 +21,7 @@ shift 2 || shift $#
 methods=("$@")
 [ ${#methods[@]} -gt 0 ] || methods=(self:0 self:1 self:2 flow:1 flow:2)
 exe=build/beamsim
+trials=${TRIALS:-800}
 fields=(${FIELDS:-a b c})
 mkdir -p "$out"
 printf '%-7s %-6s %-6s %6s %9s %9s %7s %11s\n' entries field proto tv sampling s95 map gates
@@ -27,7 +29,7 @@ for m in "${methods[@]}"; do
     # one directory: a build with more passes starts from the last pass there
     maps=$out/maps
     for f in "${fields[@]}"; do
-        $exe markov build configs/markov/heldout/exp_$f.yaml --bins 4,4,3 --trials 800 \
+        $exe markov build configs/markov/heldout/exp_$f.yaml --bins 4,4,3 --trials "$trials" \
             --entries "$m" --threads "$threads" --quiet --out "$maps"
     done
     for f in "${fields[@]}"; do

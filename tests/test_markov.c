@@ -395,6 +395,23 @@ static void test_sweeps_against_series(void **state)
 	assert_true(sum + fast.left_in_field >= 1.0 - 1e-12 && sum <= 1.0 + 1e-12);
 	assert_true(gates.sweeps == 0 && gates.n_gates > 0 && fast.p_gates[0] == 0.0);
 	assert_double_equal(fast.mean_gates, ser.mean_gates, 1e-3);
+	/* markov predict's default: the sweeps to the maps' sampling tolerance.
+	 * Every location short of the exact p, in all by at most what was
+	 * left (the distance from the exact distribution), itself at most the
+	 * tolerance, 1 / (32 sqrt(trials)). */
+	bsim_markov_prediction lean;
+	const double tol = bsim_markov_tol_sampling(&set);
+	assert_double_equal(tol, 1.0 / (32.0 * sqrt((double)set.maps[0].trials)), 1e-15);
+	assert_int_equal(bsim_markov_predict_with(&s, &set, tol, 0, &lean, &err), BSIM_OK);
+	assert_true(lean.sweeps > 0 && lean.left_in_field <= tol);
+	double short_by = 0.0;
+	for (int i = 0; i < lean.n_locations; i++) {
+		const double d = ser.p[i] - lean.p[i];
+		assert_true(d >= -ser.left_in_field - 1e-15);
+		short_by += fabs(d);
+	}
+	assert_true(short_by <= lean.left_in_field + 1e-12);
+	bsim_markov_prediction_free(&lean);
 	bsim_markov_prediction_free(&ser);
 	bsim_markov_prediction_free(&fast);
 	bsim_markov_prediction_free(&gates);
@@ -563,9 +580,12 @@ static char *map_text(const char *dir)
 }
 
 /* markov predict's printed totals are prediction.csv's probabilities
- * summed by kind (to the 4 printed decimals), as are --json's; the
+ * summed by kind (to the 4 printed decimals), as are --json's, to within
+ * what the default solution states it left in the field; the
  * per-location list comes only with --locations or --json, and --quiet
- * prints nothing. pred: the predict command line without --out. */
+ * prints nothing. csv: written by the series to 1e-12 (--out --tol
+ * 1e-12), the exact p to within 1e-12. pred: the predict command line
+ * without --out or --tol. */
 static void check_predict_totals(const char *printed, const char *csv, const char *const *pred)
 {
 	static const char *const kinds[] = {"end", "side", "stuck"};
@@ -595,50 +615,58 @@ static void check_predict_totals(const char *printed, const char *csv, const cha
 	assert_int_equal(bsim_test_cli(argv, &quiet, NULL), 0);
 	argv[n] = "--locations";
 	assert_int_equal(bsim_test_cli(argv, &list, NULL), 0);
-	/* --no-gates: the sweeps, the same totals to within what they and
-	 * the series left in the field, no distribution of gates visited */
-	char *fast = NULL;
-	argv[n] = "--json";
-	argv[n + 1] = "--no-gates";
-	argv[n + 2] = NULL;
-	assert_int_equal(bsim_test_cli(argv, &fast, NULL), 0);
-	assert_non_null(strstr(fast, "\"solve\": \"sweeps\""));
-	assert_non_null(strstr(fast, "\"p_gates\": [0]"));
-	assert_true(bsim_test_json_number(fast, "sweeps") > 0);
-	const char *fast_totals = strstr(fast, "\"totals\": {");
-	assert_non_null(fast_totals);
-	for (int k = 0; k < 3; k++)
-		near(bsim_test_json_number(fast_totals, kinds[k]), sum[k], 2 * BSIM_MARKOV_TOL,
-		     __LINE__);
-	free(fast);
-	/* --tol sampling: stopped at 1 / (32 sqrt(trials)), each total short
-	 * of the series' (to 1e-6) by at most what was left, itself at most
-	 * the tolerance */
-	char *lean = NULL;
-	argv[n + 2] = "--tol";
-	argv[n + 3] = "sampling";
-	argv[n + 4] = NULL;
-	assert_int_equal(bsim_test_cli(argv, &lean, NULL), 0);
-	const double tol = bsim_test_json_number(lean, "tol"),
-	             left = bsim_test_json_number(lean, "left_in_field");
-	assert_true(tol > 1e-4 && tol < 0.1 && left <= tol);
-	const char *lean_totals = strstr(lean, "\"totals\": {");
-	assert_non_null(lean_totals);
-	for (int k = 0; k < 3; k++) {
-		const double d = sum[k] - bsim_test_json_number(lean_totals, kinds[k]);
-		assert_true(d >= -2 * BSIM_MARKOV_TOL && d <= left + 2 * BSIM_MARKOV_TOL);
-	}
-	free(lean);
+	/* The default: the sweeps to the maps' sampling tolerance, 1 / (32
+	 * sqrt(trials per bin)), no distribution of gates visited; each total
+	 * short of the exact one by at most what was left, itself at most the
+	 * tolerance. */
+	assert_non_null(strstr(json, "\"solve\": \"sweeps\""));
+	assert_non_null(strstr(json, "\"p_gates\": [0]"));
+	assert_true(bsim_test_json_number(json, "sweeps") > 0);
+	const double tol = bsim_test_json_number(json, "tol"),
+	             left = bsim_test_json_number(json, "left_in_field");
+	assert_true(tol > 1e-4 && tol < 0.1 && left <= tol && left > 0.0);
 	const char *totals = strstr(json, "\"totals\": {");
 	assert_non_null(totals);
+	for (int k = 0; k < 3; k++) {
+		const double d = sum[k] - bsim_test_json_number(totals, kinds[k]);
+		assert_true(d >= -1e-9 && d <= left + 1e-9);
+	}
+	/* --gates: the series to the same tolerance, with the distribution */
+	char *series = NULL;
+	argv[n] = "--json";
+	argv[n + 1] = "--gates";
+	argv[n + 2] = NULL;
+	assert_int_equal(bsim_test_cli(argv, &series, NULL), 0);
+	assert_non_null(strstr(series, "\"solve\": \"series\""));
+	assert_null(strstr(series, "\"p_gates\": [0]"));
+	const double series_left = bsim_test_json_number(series, "left_in_field");
+	assert_true(series_left <= tol);
+	const char *series_totals = strstr(series, "\"totals\": {");
+	assert_non_null(series_totals);
+	for (int k = 0; k < 3; k++) {
+		const double d = sum[k] - bsim_test_json_number(series_totals, kinds[k]);
+		assert_true(d >= -1e-9 && d <= series_left + 1e-9);
+	}
+	free(series);
+	/* --tol 1e-6: the sweeps to within 1e-6 */
+	char *tight = NULL;
+	argv[n + 1] = "--tol";
+	argv[n + 2] = "1e-6";
+	argv[n + 3] = NULL;
+	assert_int_equal(bsim_test_cli(argv, &tight, NULL), 0);
+	const char *tight_totals = strstr(tight, "\"totals\": {");
+	assert_non_null(tight_totals);
+	for (int k = 0; k < 3; k++)
+		near(bsim_test_json_number(tight_totals, kinds[k]), sum[k], 1e-6 + 1e-9, __LINE__);
+	free(tight);
 	for (int k = 0; k < 3; k++) {
 		char head[32];
 		snprintf(head, sizeof head, "\n%-12s ", kinds[k]);
 		const char *line = strstr(printed, head);
 		if (!line)
 			fail_msg("no '%s' total in:\n%s", kinds[k], printed);
-		near(atof(line + strlen(head)), sum[k], 5.1e-5, __LINE__);
-		near(bsim_test_json_number(totals, kinds[k]), sum[k], 1e-9, __LINE__);
+		const double d = sum[k] - atof(line + strlen(head));
+		assert_true(d >= -5.1e-5 && d <= left + 5.1e-5);
 	}
 	assert_null(strstr(printed, "\nstuck:"));
 	assert_non_null(strstr(printed, "--out DIR writes prediction.csv"));
@@ -723,7 +751,8 @@ static void test_threads_and_cache(void **state)
 	const char *pred_out[] = {
 	        "markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
 	        "--map",  d2,        "--out",
-	        pdir,     NULL};
+	        pdir,     "--tol",   "1e-12",
+	        NULL};
 	out = NULL;
 	assert_int_equal(bsim_test_cli(pred_out, &out, NULL), 0);
 	/* prediction*.csv and .mat, prediction.{png,svg,gp,dat}, index.html and
@@ -745,7 +774,7 @@ static void test_threads_and_cache(void **state)
 	free(text);
 	assert_int_equal(rows, 9 + 9 + 81);
 	/* short of 1 by what the series left in the field, at most its tolerance */
-	assert_true(sum <= 1.0 + 1e-9 && sum > 1.0 - BSIM_MARKOV_TOL - 1e-9);
+	assert_true(sum <= 1.0 + 1e-9 && sum > 1.0 - 1e-12 - 1e-9);
 	check_predict_totals(totals_text, csv, pred_ok);
 	free(totals_text);
 	snprintf(csv, sizeof csv, "%s/prediction.mat", pdir);

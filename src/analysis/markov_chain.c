@@ -186,7 +186,8 @@ static void chain_free(chain *c, int n_maps)
 	free(c->p);
 }
 
-static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set *set,
+/* targets: build tgt (the series and the LU walk it; the sweeps do not). */
+static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set *set, int targets,
                       bsim_error *err)
 {
 	memset(c, 0, sizeof *c);
@@ -227,6 +228,8 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 				        k[0], k[1]);
 			c->gate_map[iy * c->cols + ix - l->ix_min] = j;
 		}
+	if (!targets && c->n_states > BSIM_MARKOV_LU_MAX)
+		return BSIM_OK;
 	/* Every exit of every gate resolved once. */
 	const int G = c->cols * c->rows;
 	c->tgt = malloc((size_t)G * c->nb * sizeof *c->tgt);
@@ -599,7 +602,7 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 		                      "at which the series stops, in (0, 1)",
 		                      tol);
 	chain c;
-	int rc = chain_init(&c, lattice, set, err);
+	int rc = chain_init(&c, lattice, set, flags & BSIM_MARKOV_GATES, err);
 	const bsim_lattice_def *l = &lattice->lattice;
 	if (rc == BSIM_OK) {
 		out->n_locations = c.n_loc;
