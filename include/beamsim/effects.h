@@ -24,6 +24,13 @@ typedef struct bsim_effect {
 	double param;            /* force or magnitude, N */
 	bsim_schedule *schedule; /* random_force only */
 	double last;             /* last force value applied along its axis, N */
+	/* The ou and white random forces (their schedule draws z_n ~ N(0,1),
+	 * one per step): the step size h (s) the coefficients are for, the
+	 * coefficients, and the ou force's value at step `at` (N). */
+	double h;
+	double coef[2];
+	double value;
+	long at;
 } bsim_effect;
 
 typedef struct bsim_effects {

@@ -1,8 +1,9 @@
 /* The essay's body effects: constant propulsion along +y and the piecewise
- * constant lateral random force. Each is a pipeline entry only if the scene
- * lists it (beam spring, damping and restitution are the backend's). */
+ * constant lateral random force (held), with its ou and white variants. Each is a pipeline entry
+ * only if the scene lists it (beam spring, damping and restitution are the backend's). */
 #include "beamsim/effects.h"
 
+#include <math.h>
 #include <string.h>
 
 /* F_prop = (0, F): essay Eq. 2.1. */
@@ -20,6 +21,46 @@ static void random_force_apply(bsim_effect *e, long n, double h, double f[2])
 	double value = bsim_schedule_at_step(e->schedule, n, h);
 	f[0] += value;
 	e->last = value;
+}
+
+/* White: F_n = Rm / sqrt(f_R h) z_n, a new value each step; its spectrum
+ * below 1/(2h) is flat at the held force's low-frequency level 2 Rm^2 / f_R
+ * whatever h (docs/files.md "Forcing spectra"). */
+static void random_white_apply(bsim_effect *e, long n, double h, double f[2])
+{
+	if (h != e->h) {
+		e->h = h;
+		e->coef[0] = e->param / sqrt(e->coef[1] * h);
+	}
+	double value = e->coef[0] * bsim_schedule_value(e->schedule, n);
+	f[0] += value;
+	e->last = value;
+}
+
+/* Ornstein-Uhlenbeck, the exact update over a step h (no time-step error):
+ *   F_0 = sigma z_0,  F_n = a F_(n-1) + sigma sqrt(1 - a^2) z_n,  a = exp(-h/tau),
+ * so F_n ~ N(0, sigma^2) at every step and cov(F_n, F_(n+k)) = sigma^2 a^k =
+ * sigma^2 exp(-k h / tau). A step asked for out of order is reached from the
+ * nearest earlier one (from step 0 if it lies behind): F_n is a function of
+ * the seed and n alone. */
+static void random_ou_apply(bsim_effect *e, long n, double h, double f[2])
+{
+	if (h != e->h) {
+		e->h = h;
+		e->coef[0] = exp(-h / e->coef[1]);
+		e->at = -1; /* the values are for another h */
+	}
+	if (n < e->at || e->at < 0) {
+		e->value = e->param * bsim_schedule_value(e->schedule, 0);
+		e->at = 0;
+	}
+	const double a = e->coef[0], b = e->param * sqrt(1.0 - a * a);
+	while (e->at < n) {
+		e->at++;
+		e->value = a * e->value + b * bsim_schedule_value(e->schedule, e->at);
+	}
+	f[0] += e->value;
+	e->last = e->value;
 }
 
 static bsim_effect *effects_add(bsim_effects *fx, const char *name,
@@ -47,9 +88,25 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	if (d->has_propulsion)
 		effects_add(fx, "propulsion", propulsion_apply, 1, d->propulsion_force);
 	if (d->has_random_force) {
-		bsim_effect *e =
-		        effects_add(fx, "random_force", random_force_apply, 0, d->random_magnitude);
-		e->schedule = bsim_schedule_alloc(d->random_magnitude, d->random_frequency, seed);
+		bsim_effect *e;
+		if (d->random_model == BSIM_RANDOM_OU) {
+			e = effects_add(fx, "random_force", random_ou_apply, 0,
+			                d->random_magnitude);
+			e->coef[1] = d->random_correlation_time;
+			e->at = -1;
+		} else if (d->random_model == BSIM_RANDOM_WHITE) {
+			e = effects_add(fx, "random_force", random_white_apply, 0,
+			                d->random_magnitude);
+			e->coef[1] = d->random_frequency;
+		} else {
+			e = effects_add(fx, "random_force", random_force_apply, 0,
+			                d->random_magnitude);
+		}
+		/* ou and white scale z_n themselves: the schedule gives z_n, one per step */
+		e->schedule = d->random_model == BSIM_RANDOM_HELD
+		                      ? bsim_schedule_alloc(d->random_magnitude,
+		                                            d->random_frequency, seed)
+		                      : bsim_schedule_alloc(1.0, d->random_frequency, seed);
 		if (!e->schedule) {
 			fx->n--;
 			return BSIM_EFAIL;

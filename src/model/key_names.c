@@ -26,6 +26,8 @@ static const key_row scene_rows[] = {
         {"effects.propulsion.force", "propulsive force", "F_prop", "F_{prop}", "N"},
         {"effects.random_force.magnitude", "random force magnitude", "R_m", "R_{m}", "N"},
         {"effects.random_force.frequency", "random force frequency", "f_R", "f_{R}", "Hz"},
+        {"effects.random_force.correlation_time", "random force correlation time", "tau_R",
+         "{/Symbol t}_{R}", "s"},
         {"integration.dt", "time step", "dt", "{/Symbol D}t", "s"},
         {"integration.max_steps", "step limit", "N_steps", "N_{steps}", ""},
         {"integration.duration", "trial duration", "T", "T", "s"},

@@ -50,6 +50,9 @@ static const scene_table propulsion_table = TABLE(propulsion_fields);
 static const scene_field random_fields[] = {
         {"magnitude", SK_NUMBER, SR_NONNEG, 1, S(effects.random_magnitude), NULL},   /* N */
         {"frequency", SK_NUMBER, SR_POSITIVE, 0, S(effects.random_frequency), NULL}, /* Hz */
+        {"model", SK_LATER, SR_ANY, 0, 0, NULL}, /* held | ou | white (scene_load.c) */
+        {"correlation_time", SK_NUMBER, SR_POSITIVE, 0, S(effects.random_correlation_time),
+         NULL}, /* s */
 };
 static const scene_table random_table = TABLE(random_fields);
 
