@@ -54,6 +54,9 @@ typedef struct bsim_effects_def {
 	double random_frequency;        /* Hz, refresh rate of the draw, > 0; default 50 */
 	bsim_random_model random_model; /* default BSIM_RANDOM_HELD */
 	double random_correlation_time; /* s, tau of the OU model, > 0; default 0.01 */
+	int has_drag;
+	double drag_linear;  /* N s/m, c: F = -c v, >= 0 */
+	double drag_angular; /* N m s/rad; 0: the disk does not turn */
 } bsim_effects_def;
 
 /* A gate lattice (MODEL.md section 8, DESIGN.md "Scene file"): gates

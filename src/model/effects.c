@@ -7,17 +7,19 @@
 #include <string.h>
 
 /* F_prop = (0, F): essay Eq. 2.1. */
-static void propulsion_apply(bsim_effect *e, long n, double h, double f[2])
+static void propulsion_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
 {
 	(void)n;
 	(void)h;
+	(void)v;
 	f[1] += e->param;
 	e->last = e->param;
 }
 
 /* F_rand = (Rm z_j, 0), z_j held for 1/f seconds: essay Eq. 2.3. */
-static void random_force_apply(bsim_effect *e, long n, double h, double f[2])
+static void random_force_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
 {
+	(void)v;
 	double value = bsim_schedule_at_step(e->schedule, n, h);
 	f[0] += value;
 	e->last = value;
@@ -26,8 +28,9 @@ static void random_force_apply(bsim_effect *e, long n, double h, double f[2])
 /* White: F_n = Rm / sqrt(f_R h) z_n, a new value each step; its spectrum
  * below 1/(2h) is flat at the held force's low-frequency level 2 Rm^2 / f_R
  * whatever h (docs/files.md "Forcing spectra"). */
-static void random_white_apply(bsim_effect *e, long n, double h, double f[2])
+static void random_white_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
 {
+	(void)v;
 	if (h != e->h) {
 		e->h = h;
 		e->coef[0] = e->param / sqrt(e->coef[1] * h);
@@ -43,8 +46,9 @@ static void random_white_apply(bsim_effect *e, long n, double h, double f[2])
  * sigma^2 exp(-k h / tau). A step asked for out of order is reached from the
  * nearest earlier one (from step 0 if it lies behind): F_n is a function of
  * the seed and n alone. */
-static void random_ou_apply(bsim_effect *e, long n, double h, double f[2])
+static void random_ou_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
 {
+	(void)v;
 	if (h != e->h) {
 		e->h = h;
 		e->coef[0] = exp(-h / e->coef[1]);
@@ -63,9 +67,29 @@ static void random_ou_apply(bsim_effect *e, long n, double h, double f[2])
 	e->last = e->value;
 }
 
+/* Viscous drag F = -c v, the exact update over a step: on a free body
+ * (m dv/dt = -c v) v(t + h) = v(t) exp(-c h / m), so the force that takes v
+ * there in one step of the backends' v += h F / m is
+ *   F = m v (exp(-c h / m) - 1) / h,
+ * -c v to first order in h, never overshooting (v keeps its sign at any
+ * c h / m). The forces of the other effects and contacts add to it. */
+static void drag_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
+{
+	(void)n;
+	if (h != e->h) {
+		e->h = h;
+		e->coef[0] = e->mass * expm1(-e->param * h / e->mass) / h;
+	}
+	e->applied[0] = e->coef[0] * v[0];
+	e->applied[1] = e->coef[0] * v[1];
+	f[0] += e->applied[0];
+	f[1] += e->applied[1];
+}
+
 static bsim_effect *effects_add(bsim_effects *fx, const char *name,
-                                void (*apply)(bsim_effect *, long, double, double[2]), int axis,
-                                double param)
+                                void (*apply)(bsim_effect *, long, double, const double[2],
+                                              double[2]),
+                                int axis, double param)
 {
 	bsim_effect *e = &fx->e[fx->n++];
 	memset(e, 0, sizeof *e);
@@ -112,6 +136,12 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 			return BSIM_EFAIL;
 		}
 		fx->random = e;
+	}
+	fx->n_work = fx->n;
+	if (d->has_drag) { /* after the forces that do work: they book losses */
+		bsim_effect *e = effects_add(fx, "drag", drag_apply, 0, d->drag_linear);
+		e->mass = scene->body.mass;
+		fx->drag = e;
 	}
 	return BSIM_OK;
 }

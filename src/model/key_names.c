@@ -28,6 +28,8 @@ static const key_row scene_rows[] = {
         {"effects.random_force.frequency", "random force frequency", "f_R", "f_{R}", "Hz"},
         {"effects.random_force.correlation_time", "random force correlation time", "tau_R",
          "{/Symbol t}_{R}", "s"},
+        {"effects.drag.linear", "linear drag coefficient", "c", "c", "N s/m"},
+        {"effects.drag.angular", "angular drag coefficient", "c_rot", "c_{rot}", "N m s/rad"},
         {"integration.dt", "time step", "dt", "{/Symbol D}t", "s"},
         {"integration.max_steps", "step limit", "N_steps", "N_{steps}", ""},
         {"integration.duration", "trial duration", "T", "T", "s"},

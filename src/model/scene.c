@@ -333,6 +333,12 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		                      "%s: effects.random_force.model: expected held, ou or white, "
 		                      "got %d",
 		                      who, (int)s->effects.random_model);
+	if (s->effects.has_drag && s->effects.drag_angular != 0)
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "%s: effects.drag.angular: expected 0 (the body is a disk that "
+		        "does not turn, so no torque acts on it), got %g",
+		        who, s->effects.drag_angular);
 	if (s->classify_y < s->success_y)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: termination.classify_y: expected a number >= success_y "

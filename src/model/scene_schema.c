@@ -56,9 +56,16 @@ static const scene_field random_fields[] = {
 };
 static const scene_table random_table = TABLE(random_fields);
 
+static const scene_field drag_fields[] = {
+        {"linear", SK_NUMBER, SR_NONNEG, 1, S(effects.drag_linear), NULL},   /* N s/m */
+        {"angular", SK_NUMBER, SR_NONNEG, 0, S(effects.drag_angular), NULL}, /* N m s/rad */
+};
+static const scene_table drag_table = TABLE(drag_fields);
+
 static const scene_field effects_fields[] = {
         {"propulsion", SK_BLOCK, SR_ANY, 0, S(effects.has_propulsion), &propulsion_table},
         {"random_force", SK_BLOCK, SR_ANY, 0, S(effects.has_random_force), &random_table},
+        {"drag", SK_BLOCK, SR_ANY, 0, S(effects.has_drag), &drag_table},
 };
 static const scene_table effects_table = TABLE(effects_fields);
 
