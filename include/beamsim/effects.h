@@ -33,8 +33,9 @@ typedef struct bsim_effect {
 	double coef[2];
 	double value;
 	long at;
-	/* The effects that take energy out (drag): the body's mass (kg) and
-	 * the force applied in the step along x and y (N). */
+	/* The effects booked on their own ledger lines (oscillation, drag):
+	 * the body's mass (kg) and the force applied in the step along x and
+	 * y (N). */
 	double mass;
 	double applied[2];
 } bsim_effect;
@@ -43,10 +44,12 @@ typedef struct bsim_effects {
 	int n;
 	bsim_effect e[BSIM_EFFECTS_MAX];
 	bsim_effect *random; /* the random-force effect, or NULL */
-	/* e[0 .. n_work) do work along their axis (last); e[n_work .. n) take
-	 * energy out and book it as a loss (drag: applied). */
+	/* e[0 .. n_work) book their work along their axis (last) as w_prop or
+	 * w_rand; e[n_work .. n) their work (applied) on their own lines: the
+	 * oscillation's w_osc, the drag's loss. */
 	int n_work;
-	bsim_effect *drag; /* the drag effect, or NULL */
+	bsim_effect *drag;        /* the drag effect, or NULL */
+	bsim_effect *oscillation; /* the oscillation effect, or NULL */
 } bsim_effects;
 
 /* 1 if the scene's effects draw random numbers, so that a trial depends on

@@ -57,6 +57,10 @@ typedef struct bsim_effects_def {
 	int has_drag;
 	double drag_linear;  /* N s/m, c: F = -c v, >= 0 */
 	double drag_angular; /* N m s/rad; 0: the disk does not turn */
+	int has_oscillation;
+	double osc_amplitude; /* N, A: F_x = A sin(2 pi f t + phase) */
+	double osc_frequency; /* Hz, f, > 0 */
+	double osc_phase;     /* rad; default 0 */
 } bsim_effects_def;
 
 /* A gate lattice (MODEL.md section 8, DESIGN.md "Scene file"): gates

@@ -1,5 +1,6 @@
-/* The essay's body effects: constant propulsion along +y and the piecewise
- * constant lateral random force (held), with its ou and white variants. Each is a pipeline entry
+/* The body effects: the essay's constant propulsion along +y and piecewise
+ * constant lateral random force (held), with its ou and white variants; a
+ * periodic lateral force; viscous drag, which reads the body's velocity. Each is a pipeline entry
  * only if the scene lists it (beam spring, damping and restitution are the backend's). */
 #include "beamsim/effects.h"
 
@@ -65,6 +66,21 @@ static void random_ou_apply(bsim_effect *e, long n, double h, const double v[2],
 	}
 	f[0] += e->value;
 	e->last = e->value;
+}
+
+/* The lateral oscillation A sin(w t + phi), w = 2 pi f, as its mean over
+ * the step [t_n, t_n + h]:
+ *   F_n = A (cos(w t_n + phi) - cos(w t_n + w h + phi)) / (w h),
+ * so the impulse of each step, and a free body's velocity at every step,
+ * is the sine's exactly; F_n -> A sin(w t_n + phi) as h -> 0. */
+static void oscillation_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
+{
+	(void)v;
+	const double w = e->coef[0], phi = e->coef[1], t = (double)n * h;
+	double value = e->param * (cos(w * t + phi) - cos(w * (t + h) + phi)) / (w * h);
+	e->applied[0] = value;
+	e->last = value;
+	f[0] += value;
 }
 
 /* Viscous drag F = -c v, the exact update over a step: on a free body
@@ -138,6 +154,13 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 		fx->random = e;
 	}
 	fx->n_work = fx->n;
+	if (d->has_oscillation) {
+		bsim_effect *e =
+		        effects_add(fx, "oscillation", oscillation_apply, 0, d->osc_amplitude);
+		e->coef[0] = 2.0 * 3.14159265358979323846 * d->osc_frequency;
+		e->coef[1] = d->osc_phase;
+		fx->oscillation = e;
+	}
 	if (d->has_drag) { /* after the forces that do work: they book losses */
 		bsim_effect *e = effects_add(fx, "drag", drag_apply, 0, d->drag_linear);
 		e->mass = scene->body.mass;

@@ -341,6 +341,8 @@ static void effects_present(bsim_scene *s)
 		s->effects.has_random_force = 0;
 	if (s->effects.drag_linear == 0 && s->effects.drag_angular == 0)
 		s->effects.has_drag = 0;
+	if (s->effects.osc_amplitude == 0)
+		s->effects.has_oscillation = 0;
 }
 
 /* effects.random_force.model: held (the essay's, the default), ou or

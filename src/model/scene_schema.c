@@ -62,10 +62,18 @@ static const scene_field drag_fields[] = {
 };
 static const scene_table drag_table = TABLE(drag_fields);
 
+static const scene_field oscillation_fields[] = {
+        {"amplitude", SK_NUMBER, SR_ANY, 1, S(effects.osc_amplitude), NULL},      /* N */
+        {"frequency", SK_NUMBER, SR_POSITIVE, 1, S(effects.osc_frequency), NULL}, /* Hz */
+        {"phase", SK_NUMBER, SR_ANY, 0, S(effects.osc_phase), NULL},              /* rad */
+};
+static const scene_table oscillation_table = TABLE(oscillation_fields);
+
 static const scene_field effects_fields[] = {
         {"propulsion", SK_BLOCK, SR_ANY, 0, S(effects.has_propulsion), &propulsion_table},
         {"random_force", SK_BLOCK, SR_ANY, 0, S(effects.has_random_force), &random_table},
         {"drag", SK_BLOCK, SR_ANY, 0, S(effects.has_drag), &drag_table},
+        {"oscillation", SK_BLOCK, SR_ANY, 0, S(effects.has_oscillation), &oscillation_table},
 };
 static const scene_table effects_table = TABLE(effects_fields);
 

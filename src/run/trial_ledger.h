@@ -74,11 +74,18 @@ static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsi
 	const bsim_step_energy *se = &s1->energy;
 	double r = (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -
 	                        se->correction - se->sleep);
-	if (fx->n_work < fx->n) { /* effects that take energy out */
-		const bsim_effect *dr = fx->drag;
-		double loss = -(dr->applied[0] * d[0] + dr->applied[1] * d[1]);
-		l->drag += loss;
-		r += loss;
+	if (fx->n_work < fx->n) { /* the effects booked on their own lines */
+		for (int i = fx->n_work; i < fx->n; i++) {
+			const bsim_effect *e = &fx->e[i];
+			double work = e->applied[0] * d[0] + e->applied[1] * d[1];
+			r -= work;
+			if (e == fx->drag) {
+				l->drag -= work;
+			} else {
+				l->w_osc += work;
+				l->inflow += fabs(work);
+			}
+		}
 	}
 	l->w_prop += w_prop;
 	l->w_rand += w_rand;
