@@ -1,6 +1,7 @@
 /* The body effects beyond the essay's, on both backends, against the closed
  * forms of a free body (far from every beam): viscous drag's exponential
- * decay, the forced response to a periodic force, and their ledger lines. */
+ * decay, the forced response to a periodic force, Coulomb friction's
+ * stopping distance and stick, and their ledger lines. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -193,12 +194,143 @@ static void test_oscillation_free_body(void **state)
 	}
 }
 
+typedef struct stop_track {
+	double x0[2], h, decel; /* decel = mu g, m/s^2 */
+	double v0[2];
+	long stop_step; /* the first step at rest, or -1 */
+	double after;   /* max |v| and |x - x_stop| over the steps after it */
+	double x_stop[2];
+	double v_err;  /* max | |v| - (|v0| - mu g t) | while it slides */
+	double turned; /* max sin of the angle between v and v0 while it slides */
+} stop_track;
+
+static void track_stop(void *user, long step, const bsim_state *s)
+{
+	stop_track *t = user;
+	double speed = hypot(s->v[0], s->v[1]), speed0 = hypot(t->v0[0], t->v0[1]);
+	if (t->stop_step < 0 && speed < 1e-12) {
+		t->stop_step = step;
+		t->x_stop[0] = s->x[0];
+		t->x_stop[1] = s->x[1];
+	} else if (t->stop_step >= 0) {
+		t->after = fmax(t->after, speed);
+		t->after = fmax(t->after, hypot(s->x[0] - t->x_stop[0], s->x[1] - t->x_stop[1]));
+	} else if (speed > 0.1) { /* sliding (Box2D's floats blur slower ones' direction) */
+		t->v_err = fmax(t->v_err, fabs(speed - (speed0 - t->decel * step * t->h)));
+		double cross = s->v[0] * t->v0[1] - s->v[1] * t->v0[0];
+		t->turned = fmax(t->turned, fabs(cross) / (speed0 * speed));
+	}
+}
+
+/* A disk of 1 kg sliding at 5 m/s with mu = 0.5 on both backends: the
+ * speed falls by mu g per second along the line it started on, the body
+ * stops at v0^2 / (2 mu g) = 2.548 m from its start (within |v0| h, the
+ * backends' position updates) at t = |v0| / (mu g) (within a step; two on Box2D) and then
+ * stays at rest; the ledger books the kinetic energy as friction loss. */
+static void test_ground_friction_stopping_distance(void **state)
+{
+	(void)state;
+	for (int b = 0; b < 2; b++) {
+		bsim_scene s;
+		scene_one_beam(&s);
+		s.body.velocity[0] = 3.0;
+		s.body.velocity[1] = -4.0;
+		s.effects.has_ground_friction = 1;
+		s.effects.ground_mu = 0.5;
+		s.max_steps = 500; /* 2 s: stopped at 1.02 s */
+		s.side_x = 1000.0;
+		bsim_error err;
+		assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
+		const double mu_g = 0.5 * 9.81, v0 = 5.0;
+		stop_track t = {.x0 = {s.body.start[0], s.body.start[1]},
+		                .h = s.dt,
+		                .decel = mu_g,
+		                .v0 = {3.0, -4.0},
+		                .stop_step = -1};
+		bsim_recorder rec = {.trace = track_stop, .trace_user = &t};
+		bsim_trial_runner *r = bsim_trial_runner_alloc();
+		bsim_trial_result out;
+		assert_int_equal(bsim_trial_run(r, &s, backends[b], NULL, 1, &rec, &out, &err),
+		                 BSIM_OK);
+		assert_int_equal(out.instability, BSIM_STABLE);
+		assert_true(t.stop_step > 0);
+		/* Box2D's single-precision velocity reaches 0 a step later */
+		assert_true(fabs(t.stop_step * s.dt - v0 / mu_g) <= (b == 0 ? 1 : 2) * s.dt);
+		double dist = hypot(t.x_stop[0] - t.x0[0], t.x_stop[1] - t.x0[1]);
+		assert_true(fabs(dist - v0 * v0 / (2.0 * mu_g)) < v0 * s.dt);
+		/* along the initial direction */
+		assert_true(fabs((t.x_stop[0] - t.x0[0]) / dist - 0.6) < 1e-5);
+		assert_true(t.turned < (b == 0 ? 1e-12 : 1e-5));
+		assert_true(t.v_err < (b == 0 ? 1e-9 : 1e-5));
+		assert_true(t.after < 1e-12);
+		double e0 = 12.5;
+		assert_true(fabs(out.ledger.friction - e0) < (b == 0 ? 1e-9 : 0.02) * e0);
+		if (b == 0)
+			assert_true(fabs(out.ledger.residual) < 1e-9 * e0);
+		bsim_trial_runner_free(r);
+		bsim_scene_free(&s);
+	}
+}
+
+typedef struct push_track {
+	double h, accel;
+	double v_err, moved;
+} push_track;
+
+static void track_push(void *user, long step, const bsim_state *s)
+{
+	push_track *t = user;
+	t->v_err = fmax(t->v_err, fabs(s->v[1] - t->accel * step * t->h) + fabs(s->v[0]));
+	t->moved = fmax(t->moved, fabs(s->x[0]) + fabs(s->x[1] + 100.0));
+}
+
+/* A body at rest pushed along +y by the propulsion with mu m g = 4.905 N:
+ * at 4.9 N it stays at rest to the bit (stick, no chatter); at 6 N it
+ * accelerates at (F - mu m g) / m. Both backends. */
+static void test_ground_friction_stick(void **state)
+{
+	(void)state;
+	const double forces[2] = {4.9, 6.0};
+	for (int b = 0; b < 2; b++)
+		for (int k = 0; k < 2; k++) {
+			bsim_scene s;
+			scene_one_beam(&s);
+			s.effects.has_propulsion = 1;
+			s.effects.propulsion_force = forces[k];
+			s.effects.has_ground_friction = 1;
+			s.effects.ground_mu = 0.5;
+			s.max_steps = 750;
+			s.side_x = 1000.0;
+			bsim_error err;
+			assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
+			push_track t = {.h = s.dt, .accel = k ? forces[k] - 0.5 * 9.81 : 0.0};
+			bsim_recorder rec = {.trace = track_push, .trace_user = &t};
+			bsim_trial_runner *r = bsim_trial_runner_alloc();
+			bsim_trial_result out;
+			assert_int_equal(
+			        bsim_trial_run(r, &s, backends[b], NULL, 1, &rec, &out, &err),
+			        BSIM_OK);
+			if (k == 0) {
+				assert_true(t.v_err == 0.0);
+				assert_true(t.moved == 0.0);
+				assert_true(out.ledger.friction == 0.0);
+			} else {
+				assert_true(t.v_err < (b == 0 ? 1e-9 : 1e-4));
+				assert_true(t.moved > 1.0);
+			}
+			bsim_trial_runner_free(r);
+			bsim_scene_free(&s);
+		}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_drag_free_decay),
 	        cmocka_unit_test(test_drag_absent),
 	        cmocka_unit_test(test_oscillation_free_body),
+	        cmocka_unit_test(test_ground_friction_stopping_distance),
+	        cmocka_unit_test(test_ground_friction_stick),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

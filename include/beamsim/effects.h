@@ -50,6 +50,7 @@ typedef struct bsim_effects {
 	int n_work;
 	bsim_effect *drag;        /* the drag effect, or NULL */
 	bsim_effect *oscillation; /* the oscillation effect, or NULL */
+	bsim_effect *friction;    /* the ground friction effect (the last), or NULL */
 } bsim_effects;
 
 /* 1 if the scene's effects draw random numbers, so that a trial depends on

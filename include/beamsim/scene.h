@@ -61,6 +61,9 @@ typedef struct bsim_effects_def {
 	double osc_amplitude; /* N, A: F_x = A sin(2 pi f t + phase) */
 	double osc_frequency; /* Hz, f, > 0 */
 	double osc_phase;     /* rad; default 0 */
+	int has_ground_friction;
+	double ground_mu; /* Coulomb friction coefficient with the plane, >= 0 */
+	double ground_g;  /* m/s^2, > 0; default 9.81 */
 } bsim_effects_def;
 
 /* A gate lattice (MODEL.md section 8, DESIGN.md "Scene file"): gates

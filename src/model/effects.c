@@ -102,6 +102,33 @@ static void drag_apply(bsim_effect *e, long n, double h, const double v[2], doub
 	f[1] += e->applied[1];
 }
 
+/* Coulomb friction with the plane, exact stick/slip. Over a step h the
+ * friction impulse is at most mu m g h. Without friction the body would end
+ * the step at v* = v + h f / m (f: every other effect's force, which f
+ * holds since friction is the pipeline's last). If the impulse that stops it,
+ * m v*, is within the cone, |m v / h + f| <= mu m g, the body sticks:
+ *   F = -(m v / h + f)           (it ends the step at rest, exactly);
+ * else it slides:
+ *   F = -mu m g (m v / h + f) / |m v / h + f|.
+ * A body at rest under |f| <= mu m g gets F = -f and stays at rest to the
+ * bit: no chatter. Contact impulses in the step are not in f. */
+static void ground_friction_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
+{
+	(void)n;
+	const double m = e->mass, limit = e->coef[0];
+	double p[2] = {m * v[0] / h + f[0], m * v[1] / h + f[1]};
+	double size = sqrt(p[0] * p[0] + p[1] * p[1]);
+	if (size <= limit) {
+		e->applied[0] = -p[0];
+		e->applied[1] = -p[1];
+	} else {
+		e->applied[0] = -limit * p[0] / size;
+		e->applied[1] = -limit * p[1] / size;
+	}
+	f[0] += e->applied[0];
+	f[1] += e->applied[1];
+}
+
 static bsim_effect *effects_add(bsim_effects *fx, const char *name,
                                 void (*apply)(bsim_effect *, long, double, const double[2],
                                               double[2]),
@@ -165,6 +192,13 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 		bsim_effect *e = effects_add(fx, "drag", drag_apply, 0, d->drag_linear);
 		e->mass = scene->body.mass;
 		fx->drag = e;
+	}
+	if (d->has_ground_friction) { /* the last: it reads the others' forces */
+		bsim_effect *e =
+		        effects_add(fx, "ground_friction", ground_friction_apply, 0, d->ground_mu);
+		e->mass = scene->body.mass;
+		e->coef[0] = d->ground_mu * scene->body.mass * d->ground_g;
+		fx->friction = e;
 	}
 	return BSIM_OK;
 }

@@ -33,6 +33,8 @@ static const key_row scene_rows[] = {
         {"effects.oscillation.amplitude", "oscillation amplitude", "A", "A", "N"},
         {"effects.oscillation.frequency", "oscillation frequency", "f_osc", "f_{osc}", "Hz"},
         {"effects.oscillation.phase", "oscillation phase", "phi", "{/Symbol f}", "rad"},
+        {"effects.ground_friction.mu", "ground friction coefficient", "mu", "{/Symbol m}", ""},
+        {"effects.ground_friction.g", "gravity", "g", "g", "m/s^2"},
         {"integration.dt", "time step", "dt", "{/Symbol D}t", "s"},
         {"integration.max_steps", "step limit", "N_steps", "N_{steps}", ""},
         {"integration.duration", "trial duration", "T", "T", "s"},

@@ -60,6 +60,7 @@ bsim_effects_def bsim_effects_def_default(void)
 	/* s: 1 / (2 x 50 Hz), the OU force whose low-frequency power is the
 	 * held force's at the default frequency (docs/files.md "Forcing spectra") */
 	e.random_correlation_time = 0.01;
+	e.ground_g = 9.81; /* m/s^2 */
 	return e;
 }
 

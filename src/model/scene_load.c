@@ -343,6 +343,8 @@ static void effects_present(bsim_scene *s)
 		s->effects.has_drag = 0;
 	if (s->effects.osc_amplitude == 0)
 		s->effects.has_oscillation = 0;
+	if (s->effects.ground_mu == 0)
+		s->effects.has_ground_friction = 0;
 }
 
 /* effects.random_force.model: held (the essay's, the default), ou or

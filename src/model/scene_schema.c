@@ -69,11 +69,18 @@ static const scene_field oscillation_fields[] = {
 };
 static const scene_table oscillation_table = TABLE(oscillation_fields);
 
+static const scene_field ground_fields[] = {
+        {"mu", SK_NUMBER, SR_NONNEG, 1, S(effects.ground_mu), NULL}, /* 1 */
+        {"g", SK_NUMBER, SR_POSITIVE, 0, S(effects.ground_g), NULL}, /* m/s^2 */
+};
+static const scene_table ground_table = TABLE(ground_fields);
+
 static const scene_field effects_fields[] = {
         {"propulsion", SK_BLOCK, SR_ANY, 0, S(effects.has_propulsion), &propulsion_table},
         {"random_force", SK_BLOCK, SR_ANY, 0, S(effects.has_random_force), &random_table},
         {"drag", SK_BLOCK, SR_ANY, 0, S(effects.has_drag), &drag_table},
         {"oscillation", SK_BLOCK, SR_ANY, 0, S(effects.has_oscillation), &oscillation_table},
+        {"ground_friction", SK_BLOCK, SR_ANY, 0, S(effects.has_ground_friction), &ground_table},
 };
 static const scene_table effects_table = TABLE(effects_fields);
 

@@ -81,6 +81,8 @@ static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsi
 			r -= work;
 			if (e == fx->drag) {
 				l->drag -= work;
+			} else if (e == fx->friction) {
+				l->friction -= work;
 			} else {
 				l->w_osc += work;
 				l->inflow += fabs(work);
