@@ -34,7 +34,8 @@ static int walk(const scene_table *t, const char *prefix, char *missing, size_t 
 			continue;
 		}
 		if (f->kind == SK_NAME || strcmp(key, "lattice.stiffness_file") == 0 ||
-		    strcmp(key, "lattice.protocol") == 0)
+		    strcmp(key, "lattice.protocol") == 0 ||
+		    strcmp(key, "effects.random_force.model") == 0) /* words, not numbers */
 			continue;
 		bsim_key_name k;
 		if (!bsim_key_name_find(key, &k)) {

@@ -18,18 +18,39 @@ extern "C" {
 
 typedef struct bsim_effect {
 	const char *name;
-	/* Adds this effect's force on the body (N) at step n into f. */
-	void (*apply)(struct bsim_effect *e, long n, double h, double f[2]);
+	/* Adds this effect's force on the body (N) at step n of size h (s) into
+	 * f, given the body's velocity v (m/s) at the step's start; f holds the
+	 * forces of the effects before it in the pipeline. */
+	void (*apply)(struct bsim_effect *e, long n, double h, const double v[2], double f[2]);
 	int axis;                /* the body axis the force acts along: 0 = x, 1 = y */
 	double param;            /* force or magnitude, N */
 	bsim_schedule *schedule; /* random_force only */
 	double last;             /* last force value applied along its axis, N */
+	/* The ou and white random forces (their schedule draws z_n ~ N(0,1),
+	 * one per step): the step size h (s) the coefficients are for, the
+	 * coefficients, and the ou force's value at step `at` (N). */
+	double h;
+	double coef[2];
+	double value;
+	long at;
+	/* The effects booked on their own ledger lines (oscillation, drag):
+	 * the body's mass (kg) and the force applied in the step along x and
+	 * y (N). */
+	double mass;
+	double applied[2];
 } bsim_effect;
 
 typedef struct bsim_effects {
 	int n;
 	bsim_effect e[BSIM_EFFECTS_MAX];
 	bsim_effect *random; /* the random-force effect, or NULL */
+	/* e[0 .. n_work) book their work along their axis (last) as w_prop or
+	 * w_rand; e[n_work .. n) their work (applied) on their own lines: the
+	 * oscillation's w_osc, the drag's loss. */
+	int n_work;
+	bsim_effect *drag;        /* the drag effect, or NULL */
+	bsim_effect *oscillation; /* the oscillation effect, or NULL */
+	bsim_effect *friction;    /* the ground friction effect (the last), or NULL */
 } bsim_effects;
 
 /* 1 if the scene's effects draw random numbers, so that a trial depends on
@@ -45,13 +66,23 @@ BSIM_API void bsim_effects_free(bsim_effects *fx);
  * scene's, so the trial is not a result. */
 BSIM_API int bsim_effects_status(const bsim_effects *fx, bsim_error *err);
 
-/* Sum of all effects' forces on the body at step n. */
-static inline void bsim_effects_force(bsim_effects *fx, long n, double h, double f[2])
+/* Sum of all effects' forces on the body at step n of size h (s), the
+ * body's velocity v (m/s) at the step's start. */
+static inline void bsim_effects_force_at(bsim_effects *fx, long n, double h, const double v[2],
+                                         double f[2])
 {
 	f[0] = 0.0;
 	f[1] = 0.0;
 	for (int i = 0; i < fx->n; i++)
-		fx->e[i].apply(&fx->e[i], n, h, f);
+		fx->e[i].apply(&fx->e[i], n, h, v, f);
+}
+
+/* bsim_effects_force_at for a body at rest: the same forces for a scene
+ * whose effects do not read the state (propulsion, random force). */
+static inline void bsim_effects_force(bsim_effects *fx, long n, double h, double f[2])
+{
+	static const double rest[2] = {0.0, 0.0};
+	bsim_effects_force_at(fx, n, h, rest, f);
 }
 
 #ifdef __cplusplus

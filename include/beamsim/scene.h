@@ -37,13 +37,33 @@ typedef struct bsim_contact_def {
 	double rest_threshold;  /* m/s: slower approaches become persistent; default 0.05 */
 } bsim_contact_def;
 
+/* How the random force's values follow each other (docs/files.md "Forcing
+ * spectra" gives each one's power spectral density). */
+typedef enum bsim_random_model {
+	BSIM_RANDOM_HELD = 0,  /* the essay's: Rm z_j held for 1/frequency s */
+	BSIM_RANDOM_OU = 1,    /* Ornstein-Uhlenbeck: stationary std Rm, correlation time tau */
+	BSIM_RANDOM_WHITE = 2, /* a new value each step, std Rm / sqrt(frequency dt) */
+} bsim_random_model;
+
 /* Effects: only those present are simulated (has_* = 1). */
 typedef struct bsim_effects_def {
 	int has_propulsion;
 	double propulsion_force; /* N, along +y */
 	int has_random_force;
-	double random_magnitude; /* N, Rm: F_rand = Rm * N(0,1), >= 0 */
-	double random_frequency; /* Hz, refresh rate of the draw, > 0; default 50 */
+	double random_magnitude;        /* N, Rm: F_rand = Rm * N(0,1), >= 0 */
+	double random_frequency;        /* Hz, refresh rate of the draw, > 0; default 50 */
+	bsim_random_model random_model; /* default BSIM_RANDOM_HELD */
+	double random_correlation_time; /* s, tau of the OU model, > 0; default 0.01 */
+	int has_drag;
+	double drag_linear;  /* N s/m, c: F = -c v, >= 0 */
+	double drag_angular; /* N m s/rad; 0: the disk does not turn */
+	int has_oscillation;
+	double osc_amplitude; /* N, A: F_x = A sin(2 pi f t + phase) */
+	double osc_frequency; /* Hz, f, > 0 */
+	double osc_phase;     /* rad; default 0 */
+	int has_ground_friction;
+	double ground_mu; /* Coulomb friction coefficient with the plane, >= 0 */
+	double ground_g;  /* m/s^2, > 0; default 9.81 */
 } bsim_effects_def;
 
 /* A gate lattice (MODEL.md section 8, DESIGN.md "Scene file"): gates

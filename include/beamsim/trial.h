@@ -88,6 +88,9 @@ typedef struct bsim_ledger {
 	double residual_max; /* max |r| over steps */
 	double residual_abs; /* sum of |r| */
 	double inflow;       /* e_start + sum over steps of |w_prop| + |w_rand| */
+	double drag;         /* energy taken by effects.drag: minus its work */
+	double w_osc;        /* work of effects.oscillation (in inflow too) */
+	double friction;     /* energy taken by effects.ground_friction: minus its work */
 } bsim_ledger;
 
 /* Plain data, no pointers: a sweep's journal (util/journal.h) stores it

@@ -175,14 +175,16 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	double next[2];
 	int out = 0;
 	r->steps = n_max;
+	const double *v = r->s0.v; /* the body's velocity at the step's start */
 	for (long n = 0; n < n_max; n++) {
 		double f[2];
-		bsim_effects_force(&fx, n, s->dt, f);
+		bsim_effects_force_at(&fx, n, s->dt, v, f);
 		if (be->step(w, f, s->dt, err) != BSIM_OK) {
 			out = -1;
 			break;
 		}
 		be->get_state(w, &r->s1);
+		v = r->s1.v;
 		if (!isfinite(r->s1.x[0]) || !isfinite(r->s1.x[1]) || !isfinite(r->s1.v[0]) ||
 		    !isfinite(r->s1.v[1])) {
 			bsim_error_set(err, BSIM_EFAIL,

@@ -192,6 +192,12 @@ static void print_text(FILE *out, const run_args *a, const bsim_replay *rp, uint
 	fprintf(out,
 	        "  losses    damper %.6g J, impact %.6g J, contact %.6g J, correction %.6g J\n",
 	        l->damper, l->impact, l->contact, l->correction);
+	if (s->effects.has_oscillation)
+		fprintf(out, "  effects   oscillation work %.6g J\n", l->w_osc);
+	if (s->effects.has_drag)
+		fprintf(out, "  effects   drag loss %.6g J\n", l->drag);
+	if (s->effects.has_ground_friction)
+		fprintf(out, "  effects   ground friction loss %.6g J\n", l->friction);
 	if (l->sleep != 0.0 || l->reset != 0.0)
 		fprintf(out, "  at rest   sleeping %.6g J, essay resets %.6g J\n", l->sleep,
 		        l->reset);

@@ -1,30 +1,138 @@
-/* The essay's body effects: constant propulsion along +y and the piecewise
- * constant lateral random force. Each is a pipeline entry only if the scene
- * lists it (beam spring, damping and restitution are the backend's). */
+/* The body effects: the essay's constant propulsion along +y and piecewise
+ * constant lateral random force (held), with its ou and white variants; a
+ * periodic lateral force; viscous drag, which reads the body's velocity. Each is a pipeline entry
+ * only if the scene lists it (beam spring, damping and restitution are the backend's). */
 #include "beamsim/effects.h"
 
+#include <math.h>
 #include <string.h>
 
 /* F_prop = (0, F): essay Eq. 2.1. */
-static void propulsion_apply(bsim_effect *e, long n, double h, double f[2])
+static void propulsion_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
 {
 	(void)n;
 	(void)h;
+	(void)v;
 	f[1] += e->param;
 	e->last = e->param;
 }
 
 /* F_rand = (Rm z_j, 0), z_j held for 1/f seconds: essay Eq. 2.3. */
-static void random_force_apply(bsim_effect *e, long n, double h, double f[2])
+static void random_force_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
 {
+	(void)v;
 	double value = bsim_schedule_at_step(e->schedule, n, h);
 	f[0] += value;
 	e->last = value;
 }
 
+/* White: F_n = Rm / sqrt(f_R h) z_n, a new value each step; its spectrum
+ * below 1/(2h) is flat at the held force's low-frequency level 2 Rm^2 / f_R
+ * whatever h (docs/files.md "Forcing spectra"). */
+static void random_white_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
+{
+	(void)v;
+	if (h != e->h) {
+		e->h = h;
+		e->coef[0] = e->param / sqrt(e->coef[1] * h);
+	}
+	double value = e->coef[0] * bsim_schedule_value(e->schedule, n);
+	f[0] += value;
+	e->last = value;
+}
+
+/* Ornstein-Uhlenbeck, the exact update over a step h (no time-step error):
+ *   F_0 = sigma z_0,  F_n = a F_(n-1) + sigma sqrt(1 - a^2) z_n,  a = exp(-h/tau),
+ * so F_n ~ N(0, sigma^2) at every step and cov(F_n, F_(n+k)) = sigma^2 a^k =
+ * sigma^2 exp(-k h / tau). A step asked for out of order is reached from the
+ * nearest earlier one (from step 0 if it lies behind): F_n is a function of
+ * the seed and n alone. */
+static void random_ou_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
+{
+	(void)v;
+	if (h != e->h) {
+		e->h = h;
+		e->coef[0] = exp(-h / e->coef[1]);
+		e->at = -1; /* the values are for another h */
+	}
+	if (n < e->at || e->at < 0) {
+		e->value = e->param * bsim_schedule_value(e->schedule, 0);
+		e->at = 0;
+	}
+	const double a = e->coef[0], b = e->param * sqrt(1.0 - a * a);
+	while (e->at < n) {
+		e->at++;
+		e->value = a * e->value + b * bsim_schedule_value(e->schedule, e->at);
+	}
+	f[0] += e->value;
+	e->last = e->value;
+}
+
+/* The lateral oscillation A sin(w t + phi), w = 2 pi f, as its mean over
+ * the step [t_n, t_n + h]:
+ *   F_n = A (cos(w t_n + phi) - cos(w t_n + w h + phi)) / (w h),
+ * so the impulse of each step, and a free body's velocity at every step,
+ * is the sine's exactly; F_n -> A sin(w t_n + phi) as h -> 0. */
+static void oscillation_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
+{
+	(void)v;
+	const double w = e->coef[0], phi = e->coef[1], t = (double)n * h;
+	double value = e->param * (cos(w * t + phi) - cos(w * (t + h) + phi)) / (w * h);
+	e->applied[0] = value;
+	e->last = value;
+	f[0] += value;
+}
+
+/* Viscous drag F = -c v, the exact update over a step: on a free body
+ * (m dv/dt = -c v) v(t + h) = v(t) exp(-c h / m), so the force that takes v
+ * there in one step of the backends' v += h F / m is
+ *   F = m v (exp(-c h / m) - 1) / h,
+ * -c v to first order in h, never overshooting (v keeps its sign at any
+ * c h / m). The forces of the other effects and contacts add to it. */
+static void drag_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
+{
+	(void)n;
+	if (h != e->h) {
+		e->h = h;
+		e->coef[0] = e->mass * expm1(-e->param * h / e->mass) / h;
+	}
+	e->applied[0] = e->coef[0] * v[0];
+	e->applied[1] = e->coef[0] * v[1];
+	f[0] += e->applied[0];
+	f[1] += e->applied[1];
+}
+
+/* Coulomb friction with the plane, exact stick/slip. Over a step h the
+ * friction impulse is at most mu m g h. Without friction the body would end
+ * the step at v* = v + h f / m (f: every other effect's force, which f
+ * holds since friction is the pipeline's last). If the impulse that stops it,
+ * m v*, is within the cone, |m v / h + f| <= mu m g, the body sticks:
+ *   F = -(m v / h + f)           (it ends the step at rest, exactly);
+ * else it slides:
+ *   F = -mu m g (m v / h + f) / |m v / h + f|.
+ * A body at rest under |f| <= mu m g gets F = -f and stays at rest to the
+ * bit: no chatter. Contact impulses in the step are not in f. */
+static void ground_friction_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
+{
+	(void)n;
+	const double m = e->mass, limit = e->coef[0];
+	double p[2] = {m * v[0] / h + f[0], m * v[1] / h + f[1]};
+	double size = sqrt(p[0] * p[0] + p[1] * p[1]);
+	if (size <= limit) {
+		e->applied[0] = -p[0];
+		e->applied[1] = -p[1];
+	} else {
+		e->applied[0] = -limit * p[0] / size;
+		e->applied[1] = -limit * p[1] / size;
+	}
+	f[0] += e->applied[0];
+	f[1] += e->applied[1];
+}
+
 static bsim_effect *effects_add(bsim_effects *fx, const char *name,
-                                void (*apply)(bsim_effect *, long, double, double[2]), int axis,
-                                double param)
+                                void (*apply)(bsim_effect *, long, double, const double[2],
+                                              double[2]),
+                                int axis, double param)
 {
 	bsim_effect *e = &fx->e[fx->n++];
 	memset(e, 0, sizeof *e);
@@ -47,14 +155,50 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	if (d->has_propulsion)
 		effects_add(fx, "propulsion", propulsion_apply, 1, d->propulsion_force);
 	if (d->has_random_force) {
-		bsim_effect *e =
-		        effects_add(fx, "random_force", random_force_apply, 0, d->random_magnitude);
-		e->schedule = bsim_schedule_alloc(d->random_magnitude, d->random_frequency, seed);
+		bsim_effect *e;
+		if (d->random_model == BSIM_RANDOM_OU) {
+			e = effects_add(fx, "random_force", random_ou_apply, 0,
+			                d->random_magnitude);
+			e->coef[1] = d->random_correlation_time;
+			e->at = -1;
+		} else if (d->random_model == BSIM_RANDOM_WHITE) {
+			e = effects_add(fx, "random_force", random_white_apply, 0,
+			                d->random_magnitude);
+			e->coef[1] = d->random_frequency;
+		} else {
+			e = effects_add(fx, "random_force", random_force_apply, 0,
+			                d->random_magnitude);
+		}
+		/* ou and white scale z_n themselves: the schedule gives z_n, one per step */
+		e->schedule = d->random_model == BSIM_RANDOM_HELD
+		                      ? bsim_schedule_alloc(d->random_magnitude,
+		                                            d->random_frequency, seed)
+		                      : bsim_schedule_alloc(1.0, d->random_frequency, seed);
 		if (!e->schedule) {
 			fx->n--;
 			return BSIM_EFAIL;
 		}
 		fx->random = e;
+	}
+	fx->n_work = fx->n;
+	if (d->has_oscillation) {
+		bsim_effect *e =
+		        effects_add(fx, "oscillation", oscillation_apply, 0, d->osc_amplitude);
+		e->coef[0] = 2.0 * 3.14159265358979323846 * d->osc_frequency;
+		e->coef[1] = d->osc_phase;
+		fx->oscillation = e;
+	}
+	if (d->has_drag) { /* after the forces that do work: they book losses */
+		bsim_effect *e = effects_add(fx, "drag", drag_apply, 0, d->drag_linear);
+		e->mass = scene->body.mass;
+		fx->drag = e;
+	}
+	if (d->has_ground_friction) { /* the last: it reads the others' forces */
+		bsim_effect *e =
+		        effects_add(fx, "ground_friction", ground_friction_apply, 0, d->ground_mu);
+		e->mass = scene->body.mass;
+		e->coef[0] = d->ground_mu * scene->body.mass * d->ground_g;
+		fx->friction = e;
 	}
 	return BSIM_OK;
 }

@@ -57,6 +57,10 @@ bsim_effects_def bsim_effects_def_default(void)
 	bsim_effects_def e;
 	memset(&e, 0, sizeof e);
 	e.random_frequency = 50; /* Hz, the essay's refresh rate */
+	/* s: 1 / (2 x 50 Hz), the OU force whose low-frequency power is the
+	 * held force's at the default frequency (docs/files.md "Forcing spectra") */
+	e.random_correlation_time = 0.01;
+	e.ground_g = 9.81; /* m/s^2 */
 	return e;
 }
 
@@ -260,7 +264,10 @@ int scene_excess_find(const bsim_scene *s, scene_excess *x)
 {
 	const bsim_limits *l = bsim_limits_get();
 	/* In doubles: the products of valid fields can exceed any integer. */
-	double values = (double)s->max_steps * s->dt * s->effects.random_frequency;
+	/* held: one value per 1/frequency s; ou and white: one per step */
+	double values = s->effects.random_model == BSIM_RANDOM_HELD
+	                        ? (double)s->max_steps * s->dt * s->effects.random_frequency
+	                        : (double)s->max_steps;
 	/* Every beam of a lattice counts: the thesis backend's step costs the
 	 * beams near the body, but Box2D's visits every body and joint of its
 	 * world each step (0.21 s a step on a 333 x 300 field, 199,800 beams),
@@ -321,6 +328,18 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		if (rc)
 			return rc;
 	}
+	if (s->effects.has_random_force && (s->effects.random_model < BSIM_RANDOM_HELD ||
+	                                    s->effects.random_model > BSIM_RANDOM_WHITE))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: effects.random_force.model: expected held, ou or white, "
+		                      "got %d",
+		                      who, (int)s->effects.random_model);
+	if (s->effects.has_drag && s->effects.drag_angular != 0)
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "%s: effects.drag.angular: expected 0 (the body is a disk that "
+		        "does not turn, so no torque acts on it), got %g",
+		        who, s->effects.drag_angular);
 	if (s->classify_y < s->success_y)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: termination.classify_y: expected a number >= success_y "

@@ -339,6 +339,32 @@ static void effects_present(bsim_scene *s)
 		s->effects.has_propulsion = 0;
 	if (s->effects.random_magnitude == 0)
 		s->effects.has_random_force = 0;
+	if (s->effects.drag_linear == 0 && s->effects.drag_angular == 0)
+		s->effects.has_drag = 0;
+	if (s->effects.osc_amplitude == 0)
+		s->effects.has_oscillation = 0;
+	if (s->effects.ground_mu == 0)
+		s->effects.has_ground_friction = 0;
+}
+
+/* effects.random_force.model: held (the essay's, the default), ou or
+ * white. */
+static int random_model(walk *w, struct fy_node *root)
+{
+	struct fy_node *n = ydoc_lookup(root, "effects.random_force.model");
+	if (!n)
+		return BSIM_OK;
+	const char *t = ydoc_plain(n);
+	static const char *const names[] = {"held", "ou", "white"};
+	for (int i = 0; t && i < 3; i++)
+		if (!strcmp(t, names[i])) {
+			w->s->effects.random_model = (bsim_random_model)i;
+			return BSIM_OK;
+		}
+	return ydoc_expected(w->d, n, NULL, "effects.random_force.model",
+	                     "held (the essay's piecewise constant force), ou (Ornstein-Uhlenbeck, "
+	                     "correlation_time s) or white (a new value each step)",
+	                     w->err);
 }
 
 /* A scene has beams: or lattice:, not both, not neither. */
@@ -392,6 +418,8 @@ static int walk_scene(walk *w, const ydoc *file)
 		return expected(w, root, NULL, "scene",
 		                "a mapping of scene keys (body, beams, ...)");
 	int rc = walk_table(w, &scene_top_table, root, NULL, (char *)w->s, "");
+	if (!rc)
+		rc = random_model(w, root);
 	if (!rc)
 		rc = check_beams_or_lattice(w, root);
 	if (!rc)

@@ -50,12 +50,37 @@ static const scene_table propulsion_table = TABLE(propulsion_fields);
 static const scene_field random_fields[] = {
         {"magnitude", SK_NUMBER, SR_NONNEG, 1, S(effects.random_magnitude), NULL},   /* N */
         {"frequency", SK_NUMBER, SR_POSITIVE, 0, S(effects.random_frequency), NULL}, /* Hz */
+        {"model", SK_LATER, SR_ANY, 0, 0, NULL}, /* held | ou | white (scene_load.c) */
+        {"correlation_time", SK_NUMBER, SR_POSITIVE, 0, S(effects.random_correlation_time),
+         NULL}, /* s */
 };
 static const scene_table random_table = TABLE(random_fields);
+
+static const scene_field drag_fields[] = {
+        {"linear", SK_NUMBER, SR_NONNEG, 1, S(effects.drag_linear), NULL},   /* N s/m */
+        {"angular", SK_NUMBER, SR_NONNEG, 0, S(effects.drag_angular), NULL}, /* N m s/rad */
+};
+static const scene_table drag_table = TABLE(drag_fields);
+
+static const scene_field oscillation_fields[] = {
+        {"amplitude", SK_NUMBER, SR_ANY, 1, S(effects.osc_amplitude), NULL},      /* N */
+        {"frequency", SK_NUMBER, SR_POSITIVE, 1, S(effects.osc_frequency), NULL}, /* Hz */
+        {"phase", SK_NUMBER, SR_ANY, 0, S(effects.osc_phase), NULL},              /* rad */
+};
+static const scene_table oscillation_table = TABLE(oscillation_fields);
+
+static const scene_field ground_fields[] = {
+        {"mu", SK_NUMBER, SR_NONNEG, 1, S(effects.ground_mu), NULL}, /* 1 */
+        {"g", SK_NUMBER, SR_POSITIVE, 0, S(effects.ground_g), NULL}, /* m/s^2 */
+};
+static const scene_table ground_table = TABLE(ground_fields);
 
 static const scene_field effects_fields[] = {
         {"propulsion", SK_BLOCK, SR_ANY, 0, S(effects.has_propulsion), &propulsion_table},
         {"random_force", SK_BLOCK, SR_ANY, 0, S(effects.has_random_force), &random_table},
+        {"drag", SK_BLOCK, SR_ANY, 0, S(effects.has_drag), &drag_table},
+        {"oscillation", SK_BLOCK, SR_ANY, 0, S(effects.has_oscillation), &oscillation_table},
+        {"ground_friction", SK_BLOCK, SR_ANY, 0, S(effects.has_ground_friction), &ground_table},
 };
 static const scene_table effects_table = TABLE(effects_fields);
 

@@ -395,7 +395,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	rc = trial_begin(&c, &lp, s0, err);
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
 		double f[2];
-		bsim_effects_force(&fx, lp.n, lp.h, f);
+		bsim_effects_force_at(&fx, lp.n, lp.h, s0->v, f);
 		if (c.recording && lp.n % c.stride == 0)
 			trial_record(&c, s0, lp.n);
 		if ((rc = backend->step(c.w, f, lp.h, err)) != BSIM_OK)

@@ -64,7 +64,7 @@ static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsi
 {
 	const double d[2] = {s1->x[0] - s0->x[0], s1->x[1] - s0->x[1]};
 	double w_prop = 0.0, w_rand = 0.0;
-	for (int i = 0; i < fx->n; i++) {
+	for (int i = 0; i < fx->n_work; i++) {
 		double work = fx->e[i].last * d[fx->e[i].axis];
 		if (&fx->e[i] == fx->random)
 			w_rand += work;
@@ -74,6 +74,21 @@ static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsi
 	const bsim_step_energy *se = &s1->energy;
 	double r = (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -
 	                        se->correction - se->sleep);
+	if (fx->n_work < fx->n) { /* the effects booked on their own lines */
+		for (int i = fx->n_work; i < fx->n; i++) {
+			const bsim_effect *e = &fx->e[i];
+			double work = e->applied[0] * d[0] + e->applied[1] * d[1];
+			r -= work;
+			if (e == fx->drag) {
+				l->drag -= work;
+			} else if (e == fx->friction) {
+				l->friction -= work;
+			} else {
+				l->w_osc += work;
+				l->inflow += fabs(work);
+			}
+		}
+	}
 	l->w_prop += w_prop;
 	l->w_rand += w_rand;
 	l->damper += se->damper;

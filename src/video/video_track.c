@@ -136,7 +136,7 @@ void video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const b
 	}
 	f->e_prop = bsim_landscape_e_prop(sc, s->x[1]);
 	double force[2];
-	bsim_effects_force(fx, step, sc->dt, force);
+	bsim_effects_force_at(fx, step, sc->dt, s->v, force);
 	f->f_rand = fx->random ? fx->random->last : 0.0;
 }
 
