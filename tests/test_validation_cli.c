@@ -221,9 +221,10 @@ static void set_into_unknown_key(void **state)
 	char path[1100];
 	snprintf(path, sizeof path, "%s", bsim_test_src("configs/thesis/gate.yaml"));
 	const char *argv[] = {"run", path, "--set", "effects.random_force.magnitud=3", NULL};
-	const char *needles[] = {"--set effects.random_force.magnitud=3",
-	                         "effects.random_force.magnitud",
-	                         "unknown key (expected one of magnitude, frequency, model, correlation_time)", NULL};
+	const char *needles[] = {
+	        "--set effects.random_force.magnitud=3", "effects.random_force.magnitud",
+	        "unknown key (expected one of magnitude, frequency, model, correlation_time)",
+	        NULL};
 	bsim_test_expect_input_error(argv, needles);
 }
 
