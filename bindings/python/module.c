@@ -134,6 +134,26 @@ void pyb_grid_free(pyb_grid *g)
 	memset(g, 0, sizeof *g);
 }
 
+int pyb_sets_grid_from(PyObject *sets, PyObject *grid, pyb_sets *s, pyb_grid *g)
+{
+	if (pyb_sets_from(sets, s))
+		return -1;
+	if (pyb_grid_from(grid, g)) {
+		pyb_sets_free(s);
+		return -1;
+	}
+	return 0;
+}
+
+int pyb_seed_from(PyObject *o, int *has_seed, uint64_t *seed)
+{
+	if (o == Py_None)
+		return 0;
+	*has_seed = 1;
+	*seed = PyLong_AsUnsignedLongLong(o);
+	return PyErr_Occurred() ? -1 : 0;
+}
+
 const bsim_backend *pyb_backend(const char *spec, PyObject *seq, bsim_options *opts)
 {
 	bsim_error err;

@@ -33,6 +33,14 @@ typedef struct pyb_grid {
 int pyb_grid_from(PyObject *seq, pyb_grid *g);
 void pyb_grid_free(pyb_grid *g);
 
+/* A call's set= and grid=, both read or neither (-1 with an exception set,
+ * nothing to free). */
+int pyb_sets_grid_from(PyObject *sets, PyObject *grid, pyb_sets *s, pyb_grid *g);
+
+/* A call's seed=: None leaves *has_seed 0; else *has_seed 1 and *seed. -1
+ * with an exception set. */
+int pyb_seed_from(PyObject *o, int *has_seed, uint64_t *seed);
+
 /* A backend "NAME[:KEY=VALUE]..." (NULL or None: the default backend) with
  * the "KEY=VALUE" options of seq (applied first; the spec's win), checked.
  * NULL with an exception set. */

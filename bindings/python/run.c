@@ -158,12 +158,8 @@ PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw)
 	def.path = path;
 	def.group = group;
 	def.trial = trial;
-	if (seed_o != Py_None) {
-		def.has_seed = 1;
-		def.seed = PyLong_AsUnsignedLongLong(seed_o);
-		if (PyErr_Occurred())
-			return NULL;
-	}
+	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
+		return NULL;
 	/* A stored run's directory names its own backend: --backend is a
 	 * side's label there. */
 	int stored = bsim_replay_is_dir(path);
@@ -179,12 +175,8 @@ PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw)
 	}
 	pyb_sets sets;
 	pyb_grid grid;
-	if (pyb_sets_from(sets_o, &sets))
+	if (pyb_sets_grid_from(sets_o, grid_o, &sets, &grid))
 		return NULL;
-	if (pyb_grid_from(grid_o, &grid)) {
-		pyb_sets_free(&sets);
-		return NULL;
-	}
 	def.sets = sets.ov;
 	def.n_sets = sets.n;
 	def.grid = grid.axes;

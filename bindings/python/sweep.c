@@ -29,20 +29,12 @@ PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw)
 	bsim_sweep_dir_def def = bsim_sweep_dir_def_default();
 	if (!(def.backend = pyb_backend(backend_spec, opts_o, &def.opts)))
 		return NULL;
-	if (seed_o != Py_None) {
-		def.has_seed = 1;
-		def.seed = PyLong_AsUnsignedLongLong(seed_o);
-		if (PyErr_Occurred())
-			return NULL;
-	}
+	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
+		return NULL;
 	pyb_sets sets;
 	pyb_grid grid;
-	if (pyb_sets_from(sets_o, &sets))
+	if (pyb_sets_grid_from(sets_o, grid_o, &sets, &grid))
 		return NULL;
-	if (pyb_grid_from(grid_o, &grid)) {
-		pyb_sets_free(&sets);
-		return NULL;
-	}
 	pyb_progress progress;
 	pyb_progress_init(&progress, progress_o);
 	def.experiment = experiment;
