@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 
 #include "cli/cli_common.h"
+#include "cli/cli_options.h"
 
 /* The job size the launcher gives, 0 if not launched as part of a job:
  * OpenMPI's mpirun, and the PMI of SLURM's srun and MPICH. */
@@ -25,6 +26,14 @@ static long launcher_size(void)
 			return strtol(v, NULL, 10);
 	}
 	return getenv("PMIX_RANK") ? 1 : 0;
+}
+
+void cli_merge_apply(const cli_merge *m, struct cli_common *c)
+{
+	c->out = m->out;
+	c->threads = m->threads;
+	c->quiet = m->quiet;
+	c->resume = 0;
 }
 
 int cli_shard_parse(const char *cmd, const char *value, int *index, int *count)

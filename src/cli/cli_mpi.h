@@ -60,6 +60,11 @@ typedef struct cli_merge {
 	int n_parts;
 } cli_merge;
 
+struct cli_common;
+/* Sets merge m's output directory, threads and quiet on the parts' command
+ * line c, which is not resumed: the parts' journals are the run. */
+void cli_merge_apply(const cli_merge *m, struct cli_common *c);
+
 /* compare's command line (argv[0] "compare") run as the merge m of its
  * parts (cmd_compare.c). */
 int cmd_compare_merge(int argc, char **argv, const cli_merge *m);

@@ -238,10 +238,7 @@ static int compare_main(int argc, char **argv, const cli_merge *m)
 		return rc;
 	}
 	if (m) {
-		c.out = m->out;
-		c.threads = m->threads;
-		c.quiet = m->quiet;
-		c.resume = 0;
+		cli_merge_apply(m, &c);
 		a.shard = a.shards = 0;
 		def.merge = m->parts;
 		def.n_merge = m->n_parts;

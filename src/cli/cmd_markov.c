@@ -418,9 +418,7 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		a.shards = p->shards;
 	}
 	if (m) {
-		c.out = m->out;
-		c.threads = m->threads;
-		c.quiet = m->quiet;
+		cli_merge_apply(m, &c);
 		a.shard = a.shards = 0;
 		a.def.from = m->parts;
 		a.def.n_from = m->n_parts;
