@@ -186,6 +186,28 @@ static void chain_free(chain *c, int n_maps)
 	free(c->p);
 }
 
+int markov_gate_maps(const bsim_scene *lattice, const bsim_markov_set *set, int *gate_map,
+                     bsim_error *err)
+{
+	const bsim_lattice_def *l = &lattice->lattice;
+	for (int iy = 0; iy < l->rows; iy++)
+		for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
+			double k[2] = {lattice->beams[bsim_lattice_beam(l, ix, iy, 0)].stiffness,
+			               lattice->beams[bsim_lattice_beam(l, ix, iy, 1)].stiffness};
+			int j = 0;
+			while (j < set->n &&
+			       !(set->maps[j].k[0] == k[0] && set->maps[j].k[1] == k[1]))
+				j++;
+			if (j == set->n)
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "no map for gate (%d, %d), k = %g, %g N m/rad", ix, iy,
+				        k[0], k[1]);
+			gate_map[iy * l->columns + ix - l->ix_min] = j;
+		}
+	return BSIM_OK;
+}
+
 /* targets: build tgt (the series and the LU walk it; the sweeps do not). */
 static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set *set, int targets,
                       bsim_error *err)
@@ -213,21 +235,8 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		c->has_time = i == 0 ? c->sm[i].hold != NULL : c->has_time && c->sm[i].hold;
 	}
-	for (int iy = 0; iy < c->rows; iy++)
-		for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
-			double k[2] = {lattice->beams[bsim_lattice_beam(l, ix, iy, 0)].stiffness,
-			               lattice->beams[bsim_lattice_beam(l, ix, iy, 1)].stiffness};
-			int j = 0;
-			while (j < set->n &&
-			       !(set->maps[j].k[0] == k[0] && set->maps[j].k[1] == k[1]))
-				j++;
-			if (j == set->n)
-				return bsim_error_set(
-				        err, BSIM_EINPUT,
-				        "no map for gate (%d, %d), k = %g, %g N m/rad", ix, iy,
-				        k[0], k[1]);
-			c->gate_map[iy * c->cols + ix - l->ix_min] = j;
-		}
+	if (markov_gate_maps(lattice, set, c->gate_map, err) != BSIM_OK)
+		return err->code;
 	if (!targets && c->n_states > BSIM_MARKOV_LU_MAX)
 		return BSIM_OK;
 	/* Every exit of every gate resolved once. */

@@ -138,6 +138,12 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
  * leaving row 0 downwards enters row 0's gate again through its bottom. */
 void markov_exit_target(int cols, int rows, int nb, int g, int x, int *state, int *loc);
 
+/* gate_map[iy * columns + ix - ix_min]: the index in set of the map of
+ * gate (ix, iy) of lattice, by its pair of beam stiffnesses. BSIM_EINPUT
+ * naming the first gate no map has. */
+int markov_gate_maps(const bsim_scene *lattice, const bsim_markov_set *set, int *gate_map,
+                     bsim_error *err);
+
 /* ---- the map directory (markov_cache.c) ---- */
 
 /* Every input of the map of stiffness pair k, a line each (malloc'd; NULL

@@ -77,23 +77,10 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 	int *gate_map = malloc((size_t)G * sizeof *gate_map);
 	if (!gate_map)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (int iy = 0; iy < rows; iy++)
-		for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
-			double k[2] = {lattice->beams[bsim_lattice_beam(l, ix, iy, 0)].stiffness,
-			               lattice->beams[bsim_lattice_beam(l, ix, iy, 1)].stiffness};
-			int j = 0;
-			while (j < set->n &&
-			       !(set->maps[j].k[0] == k[0] && set->maps[j].k[1] == k[1]))
-				j++;
-			if (j == set->n) {
-				free(gate_map);
-				return bsim_error_set(
-				        err, BSIM_EINPUT,
-				        "no map for gate (%d, %d), k = %g, %g N m/rad", ix, iy,
-				        k[0], k[1]);
-			}
-			gate_map[iy * cols + ix - l->ix_min] = j;
-		}
+	if (markov_gate_maps(lattice, set, gate_map, err) != BSIM_OK) {
+		free(gate_map);
+		return err->code;
+	}
 	const double dt = lattice->dt;
 	const long max_steps = lattice->max_steps > 0 ? lattice->max_steps : 0;
 	/* the grid: whole steps, about 200 bins over the duration */
