@@ -66,7 +66,7 @@ static double check_tangent(double r, double e, double u, const bsim_options *o)
 	int impacts = 0, tangent = 0;
 	double impact_loss = 0.0;
 	for (int n = 0; n < 20; n++) {
-		assert_int_equal(b2->step(w, zero, 0.004, NULL), BSIM_OK);
+		assert_int_equal(b2->step(w, zero, 0.0, 0.004, NULL), BSIM_OK);
 		b2->get_state(w, &st);
 		impacts += st.impacts;
 		impact_loss += st.energy.impact;
@@ -144,7 +144,7 @@ static void run_tip(double e_tip, double out[4])
 	int impacts = 0, tip = 0;
 	double vrel_before = 0.0, vrel_after = 0.0;
 	for (int n_step = 0; n_step < 10; n_step++) {
-		assert_int_equal(b2->step(w, zero, 0.004, NULL), BSIM_OK);
+		assert_int_equal(b2->step(w, zero, 0.0, 0.004, NULL), BSIM_OK);
 		b2->get_state(w, &st);
 		tip |= st.contact[0] == BSIM_CONTACT_TIP;
 		assert_true(st.contact[0] != BSIM_CONTACT_TANGENT);
@@ -222,7 +222,7 @@ static double vibration_error(const char *spring, double h, double rest_deg)
 	double worst = 0.0, damper = 0.0;
 	long n_steps = lround(3.0 / h);
 	for (long n = 1; n <= n_steps; n++) {
-		assert_int_equal(b2->step(w, zero, h, NULL), BSIM_OK);
+		assert_int_equal(b2->step(w, zero, 0.0, h, NULL), BSIM_OK);
 		b2->get_state(w, &st);
 		double exact = oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
 		worst = fmax(worst, fabs(st.theta[0] - exact));
@@ -280,7 +280,7 @@ static void test_stiff_spring_stability(void **state)
 			const double zero[2] = {0.0, 0.0};
 			double e0 = 0.5 * k * 0.04, e_max = 0.0, e = e0;
 			for (int n = 0; n < 2000 && isfinite(e) && e < 1e6 * e0; n++) {
-				assert_int_equal(b2->step(w, zero, h, NULL), BSIM_OK);
+				assert_int_equal(b2->step(w, zero, 0.0, h, NULL), BSIM_OK);
 				b2->get_state(w, &st);
 				e = 0.5 * k * st.theta[0] * st.theta[0] +
 				    0.5 * inertia * st.omega[0] * st.omega[0];
@@ -421,8 +421,8 @@ static void test_mirror_deviation(void **state)
 	for (long n = 0; n < 3000; n++) {
 		double fr = bsim_schedule_value(sched, bsim_schedule_index(sched, n, a.dt));
 		const double fa[2] = {fr, 8.0}, fb[2] = {-fr, 8.0};
-		assert_int_equal(b2->step(wa, fa, a.dt, NULL), BSIM_OK);
-		assert_int_equal(b2->step(wb, fb, b.dt, NULL), BSIM_OK);
+		assert_int_equal(b2->step(wa, fa, 0.0, a.dt, NULL), BSIM_OK);
+		assert_int_equal(b2->step(wb, fb, 0.0, b.dt, NULL), BSIM_OK);
 		b2->get_state(wa, &sa);
 		b2->get_state(wb, &sb);
 		double dev = fmax(fmax(fabs(sa.x[0] + sb.x[0]), fabs(sa.x[1] - sb.x[1])),
@@ -516,7 +516,7 @@ static void test_set_state(void **state)
 	bsim_state_init(&st2, 2);
 	const double f[2] = {0.0, 7.0};
 	for (int n = 0; n < 700; n++) /* into contact with both beams */
-		assert_int_equal(b2->step(w, f, s.dt, NULL), BSIM_OK);
+		assert_int_equal(b2->step(w, f, 0.0, s.dt, NULL), BSIM_OK);
 	b2->get_state(w, &st);
 	assert_true(st.theta[0] > 0.05 && st.theta[1] > 0.05);
 	bsim_error err;
@@ -525,8 +525,8 @@ static void test_set_state(void **state)
 	assert_true(fabs(st2.x[1] - st.x[1]) <= 1e-5 && fabs(st2.theta[0] - st.theta[0]) <= 1e-6);
 	assert_true(fabs(st2.omega[1] - st.omega[1]) <= 1e-6);
 	for (int n = 0; n < 100; n++) {
-		assert_int_equal(b2->step(w, f, s.dt, NULL), BSIM_OK);
-		assert_int_equal(b2->step(w2, f, s.dt, NULL), BSIM_OK);
+		assert_int_equal(b2->step(w, f, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(b2->step(w2, f, 0.0, s.dt, NULL), BSIM_OK);
 	}
 	b2->get_state(w, &st);
 	b2->get_state(w2, &st2);
@@ -565,7 +565,7 @@ static void check_clamp(double speed, const char *scale, double moved, long clam
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	for (int n = 0; n < 5; n++)
-		assert_int_equal(b2->step(w, zero, 0.004, NULL), BSIM_OK);
+		assert_int_equal(b2->step(w, zero, 0.0, 0.004, NULL), BSIM_OK);
 	b2->get_state(w, &st);
 	assert_int_equal(st.solver.clamped, clamped);
 	assert_int_equal(st.solver.iteration_limit, 0);

@@ -44,7 +44,7 @@ static double vibration_error(double h, double t_end)
 	double worst = 0.0;
 	long n_steps = lround(t_end / h);
 	for (long n = 1; n <= n_steps; n++) {
-		assert_int_equal(bsim_backend_thesis.step(w, zero, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
 		bsim_backend_thesis.get_state(w, &st);
 		double exact = oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
 		worst = fmax(worst, fabs(st.theta[0] - exact));
@@ -90,7 +90,7 @@ static void test_stiff_spring_stable(void **state)
 			const double zero[2] = {0.0, 0.0};
 			double e0 = 0.5 * k * 0.04, e_prev = e0;
 			for (int n = 0; n < 5000; n++) {
-				assert_int_equal(bsim_backend_thesis.step(w, zero, h, NULL),
+				assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL),
 				                 BSIM_OK);
 				bsim_backend_thesis.get_state(w, &st);
 				double e = 0.5 * k * st.theta[0] * st.theta[0] +

@@ -117,7 +117,7 @@ static void zeno_one(const char *bname, double e)
 	double g_prev = 0.0, g_prev2 = 0.0, apex[64], apex_rise = 0.0;
 	int n_apex = 0, impacts = 0, max_per_step = 0, last_impact = 0, persistent_from = 0;
 	for (int n = 1; n <= steps; n++) {
-		assert_int_equal(b->step(w, force, s.dt, NULL), BSIM_OK);
+		assert_int_equal(b->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		double g = min_gap(&s, &st);
 		if (n >= 3 && g_prev > 1e-3 && g_prev > g_prev2 && g_prev >= g && n_apex < 64) {
@@ -185,7 +185,7 @@ static double_run double_one(const bsim_backend *b, double dx)
 	const double zero[2] = {0.0, 0.0};
 	double_run r = {0, 0, 0, 0};
 	for (int n = 0; n < s.max_steps; n++) {
-		assert_int_equal(b->step(w, zero, s.dt, NULL), BSIM_OK);
+		assert_int_equal(b->step(w, zero, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		r.vx_max = fmax(r.vx_max, fabs(st.v[0]));
 	}
@@ -361,7 +361,7 @@ static void wedge_one(const char *bname, double overlap)
 	double vmax = 0.0, y_half = 0.0, x_half = 0.0, pen_end = 0.0;
 	int n = 0;
 	for (n = 1; n <= s.max_steps; n++) {
-		assert_int_equal(b->step(w, force, s.dt, NULL), BSIM_OK);
+		assert_int_equal(b->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		vmax = fmax(vmax, hypot(st.v[0], st.v[1]));
 		if (n == s.max_steps / 2) {
@@ -411,7 +411,7 @@ static double phase_one(const bsim_backend *b, double u, double phase, int *impa
 	*impacts = 0;
 	int steps = (int)phase + 20;
 	for (int n = 0; n < steps; n++) {
-		assert_int_equal(b->step(w, zero, s.dt, NULL), BSIM_OK);
+		assert_int_equal(b->step(w, zero, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		*impacts += st.impacts;
 	}
@@ -444,7 +444,7 @@ static void graze_one(const bsim_backend *b, const char *bname, double eps)
 	int tangent = 0, tip = 0, impacts = 0;
 	double pen = -INFINITY;
 	for (int n = 0; n < 400; n++) {
-		assert_int_equal(b->step(w, zero, s.dt, NULL), BSIM_OK);
+		assert_int_equal(b->step(w, zero, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		tangent |= st.contact[0] == BSIM_CONTACT_TANGENT;
 		tip |= st.contact[0] == BSIM_CONTACT_TIP;

@@ -23,7 +23,7 @@ static void step_once(const bsim_scene *s, bsim_state *st)
 	bsim_error err;
 	assert_int_equal(bsim_backend_thesis.create(s, NULL, &w, &err), BSIM_OK);
 	const double zero[2] = {0.0, 0.0};
-	assert_int_equal(bsim_backend_thesis.step(w, zero, h, NULL), BSIM_OK);
+	assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
 	bsim_backend_thesis.get_state(w, st);
 	bsim_backend_thesis.destroy(w);
 }
@@ -135,7 +135,7 @@ static void run_midline(double offset, double e_tip, bsim_state *st)
 	const double zero[2] = {0.0, 0.0};
 	int impacts = 0;
 	for (int n = 0; n < 40; n++) {
-		assert_int_equal(bsim_backend_thesis.step(w, zero, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
 		bsim_backend_thesis.get_state(w, st);
 		impacts += st->impacts;
 	}
@@ -179,7 +179,7 @@ static void step_once_with(const bsim_scene *s, const bsim_options *opts, bsim_s
 	bsim_error err;
 	assert_int_equal(bsim_backend_thesis.create(s, opts, &w, &err), BSIM_OK);
 	const double zero[2] = {0.0, 0.0};
-	assert_int_equal(bsim_backend_thesis.step(w, zero, h, NULL), BSIM_OK);
+	assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
 	bsim_backend_thesis.get_state(w, st);
 	bsim_backend_thesis.destroy(w);
 }
@@ -263,8 +263,8 @@ static void test_impact_mass_identity(void **state)
 	const double force[2] = {1.5, 8.0};
 	int impacts = 0;
 	for (int n = 0; n < 3000; n++) {
-		assert_int_equal(bsim_backend_thesis.step(a, force, h, NULL), BSIM_OK);
-		assert_int_equal(bsim_backend_thesis.step(b, force, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_thesis.step(a, force, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_thesis.step(b, force, 0.0, h, NULL), BSIM_OK);
 		bsim_backend_thesis.get_state(a, &sa);
 		bsim_backend_thesis.get_state(b, &sb);
 		assert_memory_equal(sa.x, sb.x, sizeof sa.x);

@@ -70,7 +70,7 @@ static void push(const bsim_backend *be, push_result *r)
 	const double L = b->length, R = s.body.radius;
 	for (int n = 0; n < 45000 && st.x[1] < 40; n++) {
 		const double force[2] = {-200.0 * st.v[0], 200.0 * (0.25 - st.v[1])};
-		assert_int_equal(be->step(w, force, s.dt, NULL), BSIM_OK);
+		assert_int_equal(be->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
 		be->get_state(w, &st);
 		if (!st.contact[0])
 			continue;
@@ -159,7 +159,7 @@ static void rest_at_basin_floor(const bsim_backend *be, double tol)
 	assert_int_equal(bsim_state_init(&st, 2), BSIM_OK);
 	const double force[2] = {0.0, 8.0};
 	for (int n = 0; n < 10000; n++) { /* 40 s; d / k = 1.25 s */
-		assert_int_equal(be->step(w, force, s.dt, NULL), BSIM_OK);
+		assert_int_equal(be->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
 		be->get_state(w, &st);
 	}
 	const double *fl = br->lowest.floor;

@@ -40,8 +40,8 @@ static void test_mirror_bitwise_steps(void **state)
 	for (long n = 0; n < 3000; n++) {
 		double fr = bsim_schedule_value(sched, bsim_schedule_index(sched, n, a.dt));
 		const double fa[2] = {fr, 8.0}, fb[2] = {-fr, 8.0};
-		assert_int_equal(bsim_backend_thesis.step(wa, fa, a.dt, NULL), BSIM_OK);
-		assert_int_equal(bsim_backend_thesis.step(wb, fb, b.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_thesis.step(wa, fa, 0.0, a.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_thesis.step(wb, fb, 0.0, b.dt, NULL), BSIM_OK);
 		bsim_backend_thesis.get_state(wa, &sa);
 		bsim_backend_thesis.get_state(wb, &sb);
 		assert_true(sa.x[0] == -sb.x[0] && sa.x[1] == sb.x[1]);

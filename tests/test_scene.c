@@ -287,6 +287,111 @@ static void errors_name_file_line_field(void **state)
 	expect_error(p, NULL, 0, "mass.yaml:1:15: body.mass: expected a positive number, got -1");
 }
 
+/* The second moment and the area of a uniform body, by counting the
+ * centres of an n x n grid of cells over its bounding box that lie inside
+ * it: an independent truth of bsim_body_inertia's and bsim_body_area's
+ * closed forms (the grid's error is O(1/n) of the boundary). */
+static void grid_moments(const bsim_body_def *b, int n, double *area, double *second)
+{
+	double hx, hy;
+	if (b->shape == BSIM_SHAPE_ELLIPSE) {
+		hx = b->semi_axes[0];
+		hy = b->semi_axes[1];
+	} else {
+		hx = b->length / 2 + b->radius;
+		hy = b->radius;
+	}
+	double dx = 2 * hx / n, dy = 2 * hy / n, a = 0, j = 0;
+	for (int i = 0; i < n; i++)
+		for (int k = 0; k < n; k++) {
+			double x = -hx + (i + 0.5) * dx, y = -hy + (k + 0.5) * dy, inside;
+			if (b->shape == BSIM_SHAPE_ELLIPSE) {
+				double u = x / hx, v = y / hy;
+				inside = u * u + v * v <= 1;
+			} else {
+				double ax = fmin(fmax(x, -b->length / 2), b->length / 2);
+				inside = hypot(x - ax, y) <= b->radius;
+			}
+			if (inside) {
+				a += dx * dy;
+				j += dx * dy * (x * x + y * y);
+			}
+		}
+	*area = a;
+	*second = j;
+}
+
+static void body_shapes_load_and_have_their_inertia(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("shapes");
+	const char *beams =
+	        "beams:\n  - { pivot: [-25, 30], length: 25, mass: 0.1, stiffness: 1 }\n";
+	char text[512];
+	snprintf(text, sizeof text,
+	         "body: { mass: 2, radius: 4, shape: capsule, length: 12, heading_deg: 30 }\n%s",
+	         beams);
+	bsim_scene s;
+	load_ok(bsim_test_write(dir, "capsule.yaml", text), NULL, 0, &s);
+	assert_int_equal(s.body.shape, BSIM_SHAPE_CAPSULE);
+	assert_int_equal(s.body.rotates, 1); /* the default for a shape that is not a disk */
+	assert_near(bsim_body_heading(&s.body), 3.14159265358979323846 / 6, 1e-15);
+	double area, second;
+	grid_moments(&s.body, 2000, &area, &second);
+	assert_near(bsim_body_area(&s.body), area, 2e-3 * area);
+	assert_near(bsim_body_inertia(&s.body), 2 * second / area, 2e-3 * 2 * second / area);
+	bsim_scene_free(&s);
+
+	snprintf(text, sizeof text,
+	         "body: { mass: 3, shape: ellipse, semi_axes: [9, 4], rotates: false }\n%s", beams);
+	load_ok(bsim_test_write(dir, "ellipse.yaml", text), NULL, 0, &s);
+	assert_int_equal(s.body.shape, BSIM_SHAPE_ELLIPSE);
+	assert_int_equal(s.body.rotates, 0);
+	assert_near(bsim_body_heading(&s.body), 3.14159265358979323846 / 2, 1e-15);
+	grid_moments(&s.body, 2000, &area, &second);
+	assert_near(bsim_body_area(&s.body), area, 2e-3 * area);
+	assert_near(bsim_body_inertia(&s.body), 3 * second / area, 2e-3 * 3 * second / area);
+	bsim_scene_free(&s);
+
+	/* The essay's disk: M R^2 / 2, not turning; a given inertia wins. */
+	snprintf(text, sizeof text,
+	         "body: { mass: 2, radius: 5, inertia: 7 }\ncontact: { friction: 0.3 }\n"
+	         "effects: { propulsion: { force: 4, along: heading } }\n%s",
+	         beams);
+	load_ok(bsim_test_write(dir, "disk.yaml", text), NULL, 0, &s);
+	assert_int_equal(s.body.rotates, 0);
+	assert_near(bsim_body_inertia(&s.body), 7, 0);
+	s.body.inertia = 0;
+	assert_near(bsim_body_inertia(&s.body), 2 * 25 / 2.0, 1e-12);
+	assert_near(s.contact.friction, 0.3, 0);
+	assert_int_equal(s.effects.propulsion_along, BSIM_ALONG_HEADING);
+	bsim_scene_free(&s);
+
+	struct {
+		const char *body, *msg;
+	} bad[] = {
+	        {"{ mass: 1, shape: ellipse }", "b0.yaml:1:9: body.semi_axes: missing"},
+	        {"{ mass: 1, shape: capsule, radius: 3 }", "b1.yaml:1:9: body.length: missing"},
+	        {"{ mass: 1, shape: square, radius: 3 }",
+	         "b2.yaml:1:25: body.shape: expected disk, capsule"},
+	        {"{ mass: 1, radius: 3, rotates: maybe }",
+	         "b3.yaml:1:38: body.rotates: expected true or false, got maybe"},
+	        {"{ mass: 1, radius: 3, length: 4 }",
+	         "b4.yaml:1:37: body.length: expected none for a disk"},
+	        {"{ mass: 1, shape: ellipse, semi_axes: [3, 2], radius: 3 }",
+	         "b5.yaml:1:61: body.radius: expected none for an ellipse"},
+	        {"{ mass: 1, radius: 3, angular_velocity: 2 }",
+	         "body.angular_velocity: expected 0 for a body that does not turn"},
+	        {"{ mass: 1 }", "b7.yaml:1:9: body.radius: missing (expected a positive number"},
+	};
+	for (int i = 0; i < (int)(sizeof bad / sizeof bad[0]); i++) {
+		char name[16];
+		snprintf(name, sizeof name, "b%d.yaml", i);
+		snprintf(text, sizeof text, "body: %s\n%s", bad[i].body, beams);
+		expect_error(bsim_test_write(dir, name, text), NULL, 0, bad[i].msg);
+	}
+}
+
 static void override_errors_name_the_override(void **state)
 {
 	(void)state;
@@ -305,7 +410,7 @@ static void override_errors_name_the_override(void **state)
 	/* An unknown key inside an override's own mapping still names it. */
 	bsim_override inner[] = {{"effects.propulsion", "{forc: 3}", "p"}};
 	expect_error(gate, inner, 1,
-	             "p: effects.propulsion.forc: unknown key (expected one of force)");
+	             "p: effects.propulsion.forc: unknown key (expected one of force, along)");
 }
 
 /* A trial's length in seconds (docs/files.md "A trial's length"). The
@@ -668,6 +773,7 @@ int main(void)
 	        cmocka_unit_test(part_defaults_are_the_essays),
 	        cmocka_unit_test(zero_magnitude_means_no_random_force),
 	        cmocka_unit_test(errors_name_file_line_field),
+	        cmocka_unit_test(body_shapes_load_and_have_their_inertia),
 	        cmocka_unit_test(override_errors_name_the_override),
 	        cmocka_unit_test(duration_gives_the_steps),
 	        cmocka_unit_test(dt_override_keeps_the_duration),

@@ -129,8 +129,8 @@ static int step_against_fresh(const bsim_scene *sc, uint64_t seed, int n_steps)
 		bsim_world *b = NULL;
 		assert_int_equal(be->create(sc, NULL, &b, &err), BSIM_OK);
 		assert_int_equal(be->set_state(b, &sa, &err), BSIM_OK);
-		assert_int_equal(be->step(a, f, sc->dt, &err), BSIM_OK);
-		assert_int_equal(be->step(b, f, sc->dt, &err), BSIM_OK);
+		assert_int_equal(be->step(a, f, 0.0, sc->dt, &err), BSIM_OK);
+		assert_int_equal(be->step(b, f, 0.0, sc->dt, &err), BSIM_OK);
 		be->get_state(a, &sa);
 		be->get_state(b, &sb);
 		assert_same_step(&sa, &sb);

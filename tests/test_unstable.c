@@ -56,9 +56,10 @@ static void fake_destroy(bsim_world *w)
 	free(w);
 }
 
-static int fake_step(bsim_world *w, const double force[2], double h, bsim_error *err)
+static int fake_step(bsim_world *w, const double force[2], double torque, double h, bsim_error *err)
 {
 	(void)force; /* the scene below has no forces */
+	(void)torque;
 	w->step++;
 	if (w->kind == 3 && w->step == 7)
 		return bsim_error_set(err, BSIM_EFAIL, "fake: out of memory at step 7");

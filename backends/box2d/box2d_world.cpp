@@ -733,6 +733,12 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	if (!(s > 0.0) || !std::isfinite(s))
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "box2d: unit_scale=%g: expected a positive number", s);
+	if (scene->body.shape != BSIM_SHAPE_DISK || scene->body.rotates ||
+	    scene->contact.friction != 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "box2d: %s: expected a disk that does not rotate, without "
+		                      "contact.friction (the essay's body)",
+		                      scene->path[0] ? scene->path : scene->name);
 	if ((rc = scene_in_float_range(scene, s, err)) != BSIM_OK)
 		return rc;
 	if ((rc = body_motion_in_range(scene, s, scene->dt / (double)substeps, err)) != BSIM_OK)
@@ -867,8 +873,9 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 	}
 }
 
-int box2d_step(bsim_world *w, const double force[2], double h, bsim_error *err)
+int box2d_step(bsim_world *w, const double force[2], double torque, double h, bsim_error *err)
 {
+	(void)torque; /* the body does not rotate */
 	w->energy = bsim_step_energy{};
 	w->impacts = 0;
 	const double hs = h / w->substeps;
@@ -890,6 +897,8 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 	st->x[1] = p.y / s;
 	st->v[0] = v.x / s;
 	st->v[1] = v.y / s;
+	st->heading = bsim_body_heading(&w->scene.body);
+	st->angular_velocity = 0.0;
 	int n = st->n_beams < (int)w->beams.size() ? st->n_beams : (int)w->beams.size();
 	st->pivot_drift = 0.0;
 	if (w->track_live) {

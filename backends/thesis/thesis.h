@@ -78,6 +78,7 @@ enum { THESIS_CONTACT_PHYSICAL = 0, THESIS_CONTACT_ESSAY = 1 };
 
 struct bsim_world {
 	double x[2], v[2]; /* body centre and velocity */
+	double heading;    /* rad, the body's (fixed) heading */
 	double mass, inv_mass, radius;
 	/* 1/impact_mass, 1/kg: the body's inverse mass in the impact solve
 	 * only (impact_resolve.c); 1/M unless the knob is given. */

@@ -117,6 +117,12 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	int rc = bsim_options_check(opts, thesis_knobs, N_KNOBS, "thesis", err);
 	if (rc)
 		return rc;
+	if (scene->body.shape != BSIM_SHAPE_DISK || scene->body.rotates ||
+	    scene->contact.friction != 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "thesis: %s: expected a disk that does not rotate, without "
+		                      "contact.friction (the essay's body)",
+		                      scene->path[0] ? scene->path : scene->name);
 	bsim_world *w = calloc(1, sizeof *w);
 	size_t nb = scene->n_beams > 0 ? (size_t)scene->n_beams : 1;
 	if (w) {
@@ -147,6 +153,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	}
 	memcpy(w->x, scene->body.start, sizeof w->x);
 	memcpy(w->v, scene->body.velocity, sizeof w->v);
+	w->heading = bsim_body_heading(&scene->body);
 	w->h_prepared = NAN;
 	w->mass = scene->body.mass;
 	w->inv_mass = 1.0 / scene->body.mass;
@@ -255,6 +262,7 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	w->n_touched = 0;
 	memcpy(w->x, scene->body.start, sizeof w->x);
 	memcpy(w->v, scene->body.velocity, sizeof w->v);
+	w->heading = bsim_body_heading(&scene->body);
 	w->n_awake = w->n_typed = w->n_flagged = w->n_pushed = w->n_contacts = 0;
 	w->any_held = 0;
 	memset(&w->energy, 0, sizeof w->energy);
@@ -324,9 +332,11 @@ static void flight_step(bsim_world *w, const double force[2], double h)
 }
 
 /* Nothing in a step allocates: the world's memory is sized at creation. */
-static int thesis_step(bsim_world *w, const double force[2], double h, bsim_error *err)
+static int thesis_step(bsim_world *w, const double force[2], double torque, double h,
+                       bsim_error *err)
 {
 	(void)err;
+	(void)torque; /* the body does not rotate */
 	/* Free flight among beams at rest (none awake, none in reach): no
 	 * contact, no beam to move, no square root for the margin. */
 	int in_flight = w->n_awake == 0 && thesis_broad_phase_clear(w, force, h);
@@ -374,6 +384,8 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 {
 	memcpy(s->x, w->x, sizeof s->x);
 	memcpy(s->v, w->v, sizeof s->v);
+	s->heading = w->heading;
+	s->angular_velocity = 0.0;
 	s->pivot_drift = 0.0; /* a beam here is an angle about a fixed pivot */
 	bsim_state_set_active(s, w->awake, w->n_awake);
 	for (int k = 0; k < s->n_active; k++) {
@@ -394,6 +406,7 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 		                      s->n_beams, w->n_beams);
 	memcpy(w->x, s->x, sizeof w->x);
 	memcpy(w->v, s->v, sizeof w->v);
+	w->heading = s->heading;
 	w->n_awake = 0;
 	w->n_typed = 0;
 	w->n_flagged = 0;

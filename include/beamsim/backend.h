@@ -27,11 +27,12 @@ typedef struct bsim_backend {
 	int (*create)(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
 	              bsim_error *err);
 	void (*destroy)(bsim_world *w);
-	/* Advance one step of h seconds with force (N) on the body centre.
-	 * BSIM_OK, or BSIM_EFAIL with err saying why (out of memory): the world
-	 * cannot go on. What a solver gave up on without failing is counted
-	 * in the state's solver counts. */
-	int (*step)(bsim_world *w, const double force[2], double h, bsim_error *err);
+	/* Advance one step of h seconds with force (N) on the body centre and
+	 * torque (N m, counter-clockwise) about it; a body that does not rotate
+	 * (body.rotates 0) ignores the torque. BSIM_OK, or BSIM_EFAIL with err
+	 * saying why (out of memory): the world cannot go on. What a solver
+	 * gave up on without failing is counted in the state's solver counts. */
+	int (*step)(bsim_world *w, const double force[2], double torque, double h, bsim_error *err);
 	void (*get_state)(const bsim_world *w, bsim_state *out);
 	int (*set_state)(bsim_world *w, const bsim_state *s, bsim_error *err);
 	/* The knob settings the accuracy study compares (beamsim/accuracy.h),

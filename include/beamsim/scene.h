@@ -24,18 +24,48 @@ typedef struct bsim_beam_def {
 	double initial_omega;  /* rad/s; default 0 */
 } bsim_beam_def;
 
+/* The body's outline. A disk of radius R; a capsule: the points within R
+ * of a segment of length `length` along the heading (length + 2R long, 2R
+ * wide); an ellipse with semi-axes a along the heading and b across. */
+typedef enum bsim_body_shape {
+	BSIM_SHAPE_DISK = 0,
+	BSIM_SHAPE_CAPSULE = 1,
+	BSIM_SHAPE_ELLIPSE = 2,
+} bsim_body_shape;
+
 typedef struct bsim_body_def {
 	double mass;        /* kg, > 0 */
-	double radius;      /* m, > 0 */
+	double radius;      /* m, > 0: the disk's, the capsule's half-width; unused by an ellipse */
 	double start[2];    /* m; default (0, 0) */
 	double velocity[2]; /* m/s; default (0, 0) */
+	bsim_body_shape shape; /* default BSIM_SHAPE_DISK */
+	double length;         /* m, > 0: the capsule's segment */
+	double semi_axes[2];   /* m, > 0: the ellipse's a (along the heading) and b */
+	/* The heading: the direction of the body's long axis and of a thrust
+	 * along it, degrees from +x, counter-clockwise; default 90 (+y, the
+	 * direction of travel). The body's angle in the state is this in rad. */
+	double heading_deg;
+	double angular_velocity; /* rad/s, counter-clockwise; default 0 */
+	double inertia;          /* kg m^2 about the centre; 0: from shape and mass
+	                          * (bsim_body_inertia) */
+	/* 1: the body turns under torque; 0: its heading is fixed (the essay's
+	 * disk). A scene file's default is 0 for a disk, 1 otherwise. */
+	int rotates;
 } bsim_body_def;
 
 typedef struct bsim_contact_def {
 	double restitution;     /* tangent impacts, in [0, 1]; default 0.8 */
 	double tip_restitution; /* tip (point) impacts, in [0, 1]; default 1 */
 	double rest_threshold;  /* m/s: slower approaches become persistent; default 0.05 */
+	double friction;        /* body-beam Coulomb coefficient, >= 0; default 0 (the essay's
+	                         * frictionless contact) */
 } bsim_contact_def;
+
+/* What the propulsive force follows: +y (the essay's) or the heading. */
+typedef enum bsim_propulsion_along {
+	BSIM_ALONG_Y = 0,
+	BSIM_ALONG_HEADING = 1,
+} bsim_propulsion_along;
 
 /* How the random force's values follow each other (docs/files.md "Forcing
  * spectra" gives each one's power spectral density). */
@@ -48,7 +78,8 @@ typedef enum bsim_random_model {
 /* Effects: only those present are simulated (has_* = 1). */
 typedef struct bsim_effects_def {
 	int has_propulsion;
-	double propulsion_force; /* N, along +y */
+	double propulsion_force;                /* N, along +y or the heading */
+	bsim_propulsion_along propulsion_along; /* default BSIM_ALONG_Y */
 	int has_random_force;
 	double random_magnitude;        /* N, Rm: F_rand = Rm * N(0,1), >= 0 */
 	double random_frequency;        /* Hz, refresh rate of the draw, > 0; default 50 */
@@ -56,7 +87,7 @@ typedef struct bsim_effects_def {
 	double random_correlation_time; /* s, tau of the OU model, > 0; default 0.01 */
 	int has_drag;
 	double drag_linear;  /* N s/m, c: F = -c v, >= 0 */
-	double drag_angular; /* N m s/rad; 0: the disk does not turn */
+	double drag_angular; /* N m s/rad, torque -c_w w on a body that rotates */
 	int has_oscillation;
 	double osc_amplitude; /* N, A: F_x = A sin(2 pi f t + phase) */
 	double osc_frequency; /* Hz, f, > 0 */
@@ -137,8 +168,10 @@ BSIM_API bsim_scene bsim_scene_default(void);
  * 2.6), for a scene built in code:
  *   beam: pivot (0, 0), rest 0 deg, 25 m, 0.1 kg, inertia m L^2 / 3,
  *         400 N m/rad, 50 N m s/rad, at rest;
- *   body: 1 kg, radius 10 m, at (0, 0), at rest;
- *   contact: restitution 0.8, tip restitution 1, rest threshold 0.05 m/s;
+ *   body: a 1 kg disk of radius 10 m at (0, 0), at rest, heading 90 deg,
+ *         not rotating (length, semi_axes, inertia 0);
+ *   contact: restitution 0.8, tip restitution 1, rest threshold 0.05 m/s,
+ *            no friction;
  *   effects: none (the random force at 50 Hz once it is switched on);
  *   lattice: 9 x 9 gates (ix -4..4) of 50 m x 60 m, pivots 30 m up, the
  *            beam above, the whole-world protocol, no stiffness map. */
@@ -147,6 +180,19 @@ BSIM_API bsim_body_def bsim_body_def_default(void);
 BSIM_API bsim_contact_def bsim_contact_def_default(void);
 BSIM_API bsim_effects_def bsim_effects_def_default(void);
 BSIM_API bsim_lattice_def bsim_lattice_def_default(void);
+
+/* The body's moment of inertia about its centre, kg m^2: body->inertia if
+ * it is given (> 0), else the uniform body's of its shape and mass: disk
+ * M R^2 / 2; ellipse M (a^2 + b^2) / 4; capsule the rectangle's
+ * M_r (L^2 + 4 R^2) / 12 plus the two half-disks' M_d (R^2 / 2 + L^2 / 4 +
+ * 4 R L / (3 pi)), M_r and M_d the mass shared by area. */
+BSIM_API double bsim_body_inertia(const bsim_body_def *body);
+
+/* The body's heading at the start, rad (body.heading_deg converted). */
+BSIM_API double bsim_body_heading(const bsim_body_def *body);
+
+/* The body's area, m^2: pi R^2, 2 R L + pi R^2, pi a b. */
+BSIM_API double bsim_body_area(const bsim_body_def *body);
 
 /* Fills the essay's single-gate scene (MODEL.md section 1, Table 2.1) with
  * the given propulsion and random force magnitude (0 = effect absent). */

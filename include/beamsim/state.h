@@ -52,6 +52,11 @@ typedef struct bsim_solver_counts {
 typedef struct bsim_state {
 	double x[2]; /* body centre, m */
 	double v[2]; /* body velocity, m/s */
+	/* The body's heading, rad from +x counter-clockwise (the scene's
+	 * body.heading_deg at the start), and its angular velocity, rad/s:
+	 * constant for a body that does not rotate. */
+	double heading;
+	double angular_velocity;
 	int n_beams;
 	double *theta;             /* n_beams, rad, forward positive */
 	double *omega;             /* n_beams, rad/s */

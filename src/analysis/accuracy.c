@@ -143,7 +143,7 @@ static int consistency_piece(const bsim_accuracy_reference *ref, const bsim_scen
 	const double *v = ref->states[k].v; /* the body's velocity at the step's start */
 	for (long j = 0; j < m && rc == BSIM_OK; j++) {
 		bsim_effects_force_at(&fx, n0 + j, h, v, f);
-		rc = b->step(w, f, h, err);
+		rc = b->step(w, f, 0.0, h, err);
 		if (fx.n_work < fx.n) { /* effects that read the state */
 			b->get_state(w, s);
 			v = s->v;

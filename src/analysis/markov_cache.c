@@ -78,6 +78,36 @@ const char *markov_entries_label(const bsim_markov_def *def, const bsim_scene *l
 	return buf;
 }
 
+/* The inputs the essay's model does not have, a line each where a scene
+ * has them (so that the keys of the essay's maps stay what they were):
+ * the body's shape and turning, contact friction, the forcing's model and
+ * the effects that read the state. */
+static void markov_key_extra(FILE *f, const bsim_scene *s)
+{
+	const bsim_body_def *b = &s->body;
+	const bsim_effects_def *e = &s->effects;
+	if (b->shape != BSIM_SHAPE_DISK || b->rotates || b->heading_deg != 90)
+		fprintf(f,
+		        "body shape %d length %.17g semi_axes %.17g %.17g heading_deg %.17g "
+		        "angular_velocity %.17g inertia %.17g rotates %d\n",
+		        (int)b->shape, b->length, b->semi_axes[0], b->semi_axes[1], b->heading_deg,
+		        b->angular_velocity, b->inertia, b->rotates);
+	if (s->contact.friction != 0)
+		fprintf(f, "contact friction %.17g\n", s->contact.friction);
+	if (e->has_random_force && e->random_model != BSIM_RANDOM_HELD)
+		fprintf(f, "random model %d correlation_time %.17g\n", (int)e->random_model,
+		        e->random_correlation_time);
+	if (e->has_propulsion && e->propulsion_along != BSIM_ALONG_Y)
+		fprintf(f, "propulsion along %d\n", (int)e->propulsion_along);
+	if (e->has_drag)
+		fprintf(f, "drag %.17g %.17g\n", e->drag_linear, e->drag_angular);
+	if (e->has_oscillation)
+		fprintf(f, "oscillation %.17g %.17g %.17g\n", e->osc_amplitude, e->osc_frequency,
+		        e->osc_phase);
+	if (e->has_ground_friction)
+		fprintf(f, "ground_friction %.17g %.17g\n", e->ground_mu, e->ground_g);
+}
+
 /* Every input of a map, a line each, numbers to the last bit (%.17g). */
 char *markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
                       const bsim_options *opts, const double k[2])
@@ -111,6 +141,7 @@ char *markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, con
 	fprintf(f, "effects propulsion %d %.17g random %d %.17g %.17g\n", s->effects.has_propulsion,
 	        s->effects.propulsion_force, s->effects.has_random_force,
 	        s->effects.random_magnitude, s->effects.random_frequency);
+	markov_key_extra(f, s);
 	fprintf(f, "dt %.17g gate_steps %d max_steps %d\n", s->dt, s->gate_steps, s->max_steps);
 	char label[64];
 	fprintf(f, "entries %s\n", markov_entries_label(def, lattice, label, sizeof label));

@@ -179,7 +179,7 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	for (long n = 0; n < n_max; n++) {
 		double f[2];
 		bsim_effects_force_at(&fx, n, s->dt, v, f);
-		if (be->step(w, f, s->dt, err) != BSIM_OK) {
+		if (be->step(w, f, 0.0, s->dt, err) != BSIM_OK) {
 			out = -1;
 			break;
 		}

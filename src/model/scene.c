@@ -37,8 +37,9 @@ bsim_body_def bsim_body_def_default(void)
 {
 	bsim_body_def b;
 	memset(&b, 0, sizeof b);
-	b.mass = 1;    /* kg, essay Table 2.1 */
-	b.radius = 10; /* m */
+	b.mass = 1;         /* kg, essay Table 2.1 */
+	b.radius = 10;      /* m */
+	b.heading_deg = 90; /* +y, the direction of travel */
 	return b;
 }
 
@@ -82,6 +83,7 @@ bsim_lattice_def bsim_lattice_def_default(void)
 void scene_defaults(bsim_scene *s)
 {
 	memset(s, 0, sizeof *s);
+	s->body.heading_deg = 90; /* the only body key with a default other than 0 */
 	s->contact = bsim_contact_def_default();
 	s->effects = bsim_effects_def_default();
 	s->dt = 0.004;       /* s */
@@ -140,6 +142,102 @@ double bsim_scene_beam_forward_sign(const bsim_beam_def *b)
 	double u0[2];
 	bsim_scene_beam_rest_direction(b, u0);
 	return u0[0] >= 0.0 ? 1.0 : -1.0;
+}
+
+double bsim_body_inertia(const bsim_body_def *b)
+{
+	if (b->inertia > 0)
+		return b->inertia;
+	const double r = b->radius, l = b->length, a = b->semi_axes[0], c = b->semi_axes[1];
+	switch (b->shape) {
+	case BSIM_SHAPE_CAPSULE: {
+		double rect = 2 * r * l, disk = BSIM_PI * r * r,
+		       m_r = b->mass * rect / (rect + disk), m_d = b->mass - m_r;
+		return m_r * (l * l + 4 * r * r) / 12 +
+		       m_d * (r * r / 2 + l * l / 4 + 4 * r * l / (3 * BSIM_PI));
+	}
+	case BSIM_SHAPE_ELLIPSE:
+		return b->mass * (a * a + c * c) / 4;
+	default:
+		return b->mass * r * r / 2;
+	}
+}
+
+double bsim_body_heading(const bsim_body_def *b)
+{
+	return b->heading_deg * (BSIM_PI / 180);
+}
+
+double bsim_body_area(const bsim_body_def *b)
+{
+	switch (b->shape) {
+	case BSIM_SHAPE_CAPSULE:
+		return 2 * b->radius * b->length + BSIM_PI * b->radius * b->radius;
+	case BSIM_SHAPE_ELLIPSE:
+		return BSIM_PI * b->semi_axes[0] * b->semi_axes[1];
+	default:
+		return BSIM_PI * b->radius * b->radius;
+	}
+}
+
+/* The body's keys that depend on its shape, and the turning keys that need
+ * a body that turns. */
+static int body_validate(const bsim_scene *s, const char *who, bsim_error *err)
+{
+	const bsim_body_def *b = &s->body;
+	static const char *const shapes[] = {"disk", "capsule", "ellipse"};
+	if (b->shape < BSIM_SHAPE_DISK || b->shape > BSIM_SHAPE_ELLIPSE)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.shape: expected disk, capsule or ellipse, got %d",
+		                      who, (int)b->shape);
+	const char *shape = shapes[b->shape];
+	int ellipse = b->shape == BSIM_SHAPE_ELLIPSE;
+	if (!ellipse && !(b->radius > 0))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.radius: expected a positive number (the %s's %s), "
+		                      "got %g",
+		                      who, shape,
+		                      b->shape == BSIM_SHAPE_DISK ? "radius" : "half-width",
+		                      b->radius);
+	if (ellipse && b->radius != 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.radius: expected none for an ellipse (its size is "
+		                      "body.semi_axes), got %g",
+		                      who, b->radius);
+	if (b->shape == BSIM_SHAPE_CAPSULE && !(b->length > 0))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.length: expected a positive number (the capsule's "
+		                      "segment), got %g",
+		                      who, b->length);
+	if (b->shape != BSIM_SHAPE_CAPSULE && b->length != 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.length: expected none for a %s (only a capsule has "
+		                      "a length), got %g",
+		                      who, shape, b->length);
+	if (ellipse && !(b->semi_axes[0] > 0 && b->semi_axes[1] > 0))
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "%s: body.semi_axes: expected two positive numbers [a, b], got "
+		        "[%g, %g]",
+		        who, b->semi_axes[0], b->semi_axes[1]);
+	if (!ellipse && (b->semi_axes[0] != 0 || b->semi_axes[1] != 0))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.semi_axes: expected none for a %s (only an ellipse "
+		                      "has semi-axes)",
+		                      who, shape);
+	if (!b->rotates && b->angular_velocity != 0)
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "%s: body.angular_velocity: expected 0 for a body that does not "
+		        "turn (body.rotates: false), got %g",
+		        who, b->angular_velocity);
+	if (s->effects.has_drag && s->effects.drag_angular != 0 && !b->rotates)
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "%s: effects.drag.angular: expected 0 for a body that does not "
+		        "turn (body.rotates: false), got %g",
+		        who, s->effects.drag_angular);
+	return BSIM_OK;
 }
 
 int scene_overlap(const bsim_scene *s, double *dist)
@@ -334,12 +432,14 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		                      "%s: effects.random_force.model: expected held, ou or white, "
 		                      "got %d",
 		                      who, (int)s->effects.random_model);
-	if (s->effects.has_drag && s->effects.drag_angular != 0)
-		return bsim_error_set(
-		        err, BSIM_EINPUT,
-		        "%s: effects.drag.angular: expected 0 (the body is a disk that "
-		        "does not turn, so no torque acts on it), got %g",
-		        who, s->effects.drag_angular);
+	rc = body_validate(s, who, err);
+	if (rc)
+		return rc;
+	if (s->effects.propulsion_along != BSIM_ALONG_Y &&
+	    s->effects.propulsion_along != BSIM_ALONG_HEADING)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: effects.propulsion.along: expected y or heading, got %d",
+		                      who, (int)s->effects.propulsion_along);
 	if (s->classify_y < s->success_y)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: termination.classify_y: expected a number >= success_y "

@@ -367,6 +367,88 @@ static int random_model(walk *w, struct fy_node *root)
 	                     w->err);
 }
 
+/* One of names[0 .. n) at path, or nothing; what names the value is
+ * stored in *out. */
+static int scene_word(walk *w, struct fy_node *root, const char *path, const char *const *names,
+                      int n, const char *what, int *out, int *given)
+{
+	struct fy_node *node = ydoc_lookup(root, path);
+	*given = node != NULL;
+	if (!node)
+		return BSIM_OK;
+	const char *t = ydoc_plain(node);
+	for (int i = 0; t && i < n; i++)
+		if (!strcmp(t, names[i])) {
+			*out = i;
+			return BSIM_OK;
+		}
+	return ydoc_expected(w->d, node, NULL, path, what, w->err);
+}
+
+/* body.shape (disk, the default; capsule; ellipse), the size keys that go
+ * with it, body.rotates (default: false for a disk, true otherwise) and
+ * effects.propulsion.along (y, the default, or heading). */
+static int body_shape(walk *w, struct fy_node *root)
+{
+	static const char *const shapes[] = {"disk", "capsule", "ellipse"};
+	static const char *const flags[] = {"false", "true"};
+	static const char *const along[] = {"y", "heading"};
+	bsim_body_def *b = &w->s->body;
+	int shape = BSIM_SHAPE_DISK, rotates = 0, given = 0, rotates_given = 0, dir = BSIM_ALONG_Y;
+	int rc = scene_word(w, root, "body.shape", shapes, 3,
+	                    "disk, capsule (body.radius and body.length) or ellipse "
+	                    "(body.semi_axes)",
+	                    &shape, &given);
+	if (!rc)
+		rc = scene_word(w, root, "body.rotates", flags, 2, "true or false", &rotates,
+		                &rotates_given);
+	if (!rc)
+		rc = scene_word(
+		        w, root, "effects.propulsion.along", along, 2,
+		        "y (the essay's forward push) or heading (the thrust follows the body)",
+		        &dir, &given);
+	if (rc)
+		return rc;
+	b->shape = (bsim_body_shape)shape;
+	b->rotates = rotates_given ? rotates : shape != BSIM_SHAPE_DISK;
+	w->s->effects.propulsion_along = (bsim_propulsion_along)dir;
+	/* The sizes a shape must be given, positive, and none it does not
+	 * have; said at the key (or the override) that gives them. */
+	struct fy_node *body = ydoc_lookup(root, "body");
+	static const char *const names[] = {"a disk", "a capsule", "an ellipse"};
+	static const struct {
+		const char *key, *what;
+		int shape_mask; /* the shapes that need it, 1 << shape */
+	} sizes[] = {
+	        {"radius", "a positive number (the disk's radius or the capsule's half-width, m)",
+	         1 << BSIM_SHAPE_DISK | 1 << BSIM_SHAPE_CAPSULE},
+	        {"length", "a positive number (the capsule's segment, m)", 1 << BSIM_SHAPE_CAPSULE},
+	        {"semi_axes",
+	         "a list of 2 positive numbers [a, b] (the semi-axes along and across the "
+	         "heading, m)",
+	         1 << BSIM_SHAPE_ELLIPSE},
+	};
+	const double *value[] = {&b->radius, &b->length, b->semi_axes};
+	for (int i = 0; i < 3; i++) {
+		char field[32];
+		snprintf(field, sizeof field, "body.%s", sizes[i].key);
+		struct fy_node *n = ydoc_lookup(root, field);
+		int needed = sizes[i].shape_mask >> shape & 1;
+		if (!needed && n)
+			return ydoc_fail(w->d, n, body, field, w->err,
+			                 "expected none for %s (it is %s)", names[shape],
+			                 i == 0   ? "sized by body.semi_axes"
+			                 : i == 1 ? "only a capsule that has a length"
+			                          : "only an ellipse that has semi-axes");
+		if (needed && !n)
+			return ydoc_fail(w->d, body, root, field, w->err, "missing (expected %s)",
+			                 sizes[i].what);
+		if (needed && !(value[i][0] > 0 && (i < 2 || value[i][1] > 0)))
+			return ydoc_expected(w->d, n, body, field, sizes[i].what, w->err);
+	}
+	return BSIM_OK;
+}
+
 /* A scene has beams: or lattice:, not both, not neither. */
 static int check_beams_or_lattice(walk *w, struct fy_node *root)
 {
@@ -420,6 +502,8 @@ static int walk_scene(walk *w, const ydoc *file)
 	int rc = walk_table(w, &scene_top_table, root, NULL, (char *)w->s, "");
 	if (!rc)
 		rc = random_model(w, root);
+	if (!rc)
+		rc = body_shape(w, root);
 	if (!rc)
 		rc = check_beams_or_lattice(w, root);
 	if (!rc)

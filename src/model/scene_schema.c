@@ -15,10 +15,18 @@
 	}
 
 static const scene_field body_fields[] = {
-        {"mass", SK_NUMBER, SR_POSITIVE, 1, S(body.mass), NULL},     /* kg */
-        {"radius", SK_NUMBER, SR_POSITIVE, 1, S(body.radius), NULL}, /* m */
-        {"start", SK_VEC2, SR_ANY, 0, S(body.start), NULL},          /* m */
-        {"velocity", SK_VEC2, SR_ANY, 0, S(body.velocity), NULL},    /* m/s */
+        {"mass", SK_NUMBER, SR_POSITIVE, 1, S(body.mass), NULL}, /* kg */
+        /* > 0 for a disk and a capsule, absent for an ellipse (scene_load.c) */
+        {"radius", SK_NUMBER, SR_NONNEG, 0, S(body.radius), NULL}, /* m */
+        {"start", SK_VEC2, SR_ANY, 0, S(body.start), NULL},        /* m */
+        {"velocity", SK_VEC2, SR_ANY, 0, S(body.velocity), NULL},  /* m/s */
+        {"shape", SK_LATER, SR_ANY, 0, 0, NULL}, /* disk | capsule | ellipse (scene_load.c) */
+        {"length", SK_NUMBER, SR_NONNEG, 0, S(body.length), NULL},                  /* m, capsule */
+        {"semi_axes", SK_VEC2, SR_NONNEG, 0, S(body.semi_axes), NULL},              /* m, ellipse */
+        {"heading_deg", SK_NUMBER, SR_ANY, 0, S(body.heading_deg), NULL},           /* deg */
+        {"angular_velocity", SK_NUMBER, SR_ANY, 0, S(body.angular_velocity), NULL}, /* rad/s */
+        {"inertia", SK_NUMBER, SR_NONNEG, 0, S(body.inertia), NULL}, /* kg m^2, 0: from shape */
+        {"rotates", SK_LATER, SR_ANY, 0, 0, NULL},                   /* true | false */
 };
 static const scene_table body_table = TABLE(body_fields);
 
@@ -39,11 +47,13 @@ static const scene_field contact_fields[] = {
         {"restitution", SK_NUMBER, SR_UNIT, 0, S(contact.restitution), NULL},
         {"tip_restitution", SK_NUMBER, SR_UNIT, 0, S(contact.tip_restitution), NULL},
         {"rest_threshold", SK_NUMBER, SR_NONNEG, 0, S(contact.rest_threshold), NULL}, /* m/s */
+        {"friction", SK_NUMBER, SR_NONNEG, 0, S(contact.friction), NULL},             /* 1 */
 };
 static const scene_table contact_table = TABLE(contact_fields);
 
 static const scene_field propulsion_fields[] = {
         {"force", SK_NUMBER, SR_ANY, 1, S(effects.propulsion_force), NULL}, /* N */
+        {"along", SK_LATER, SR_ANY, 0, 0, NULL}, /* y | heading (scene_load.c) */
 };
 static const scene_table propulsion_table = TABLE(propulsion_fields);
 

@@ -398,7 +398,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 		bsim_effects_force_at(&fx, lp.n, lp.h, s0->v, f);
 		if (c.recording && lp.n % c.stride == 0)
 			trial_record(&c, s0, lp.n);
-		if ((rc = backend->step(c.w, f, lp.h, err)) != BSIM_OK)
+		if ((rc = backend->step(c.w, f, 0.0, lp.h, err)) != BSIM_OK)
 			break;
 		backend->get_state(c.w, s1);
 		double e1 = energy_mech(c.ws, s1);
