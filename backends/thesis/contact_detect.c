@@ -9,9 +9,24 @@
  *
  * Every expression is written so that mirroring the scene in x (x -> -x,
  * sgn -> -sgn) mirrors each intermediate value bit for bit (MODEL.md
- * oracle 4): products and sums keep the same operands in the same order. */
+ * oracle 4): products and sums keep the same operands in the same order.
+ *
+ * A body of another shape (extended path, thesis.h's head) meets the beam
+ * through its outline (model/body_shape.h): the outline's point K nearest
+ * the segment, the segment's point Q nearest the outline, the normal n from
+ * Q toward the body, gap = |K - Q| signed (< 0: overlap). Then
+ *   a = Q - P,  c = sgn (a x n),  ct = sgn (a . n),
+ *   r_b = K - C,  cb = r_b x n,  cbt = r_b . n,
+ * tip when Q is an end of the segment, tangent otherwise. The geometry
+ * keeps dist = gap + reach (w->radius is the shape's reach), so that every
+ * bound below, written for a disk of radius `reach`, holds: the outline
+ * lies within the reach of the centre. A turn of the body by dpsi moves no
+ * point of its outline farther than reach |dpsi|, which the bound on the
+ * distance adds. The disk keeps its own code (the bits of the essay's
+ * runs); on the extended path it has r_b = -R n: cb = 0, cbt = -R. */
 #include <math.h>
 
+#include "model/body_shape.h"
 #include "thesis/thesis.h"
 
 void thesis_beam_direction(thesis_beam *b, double u[2])
@@ -72,6 +87,41 @@ static void geometry_compute(thesis_beam *b, const double x[2])
 		g->type = BSIM_CONTACT_TIP;
 	}
 	g->c = b->sgn * (a[0] * g->n[1] - a[1] * g->n[0]);
+	g->a[0] = a[0];
+	g->a[1] = a[1];
+}
+
+/* A body of another shape against the beam: b->geo (thesis.h, the head of
+ * this file). */
+static void geometry_compute_shape(const struct bsim_world *w, thesis_beam *b)
+{
+	thesis_geometry *g = &b->geo;
+	double u[2];
+	thesis_beam_direction(b, u);
+	double tip[2] = {b->p[0] + b->length * u[0], b->p[1] + b->length * u[1]};
+	g->x[0] = w->x[0];
+	g->x[1] = w->x[1];
+	g->theta = b->theta;
+	g->psi = w->heading;
+	body_segment_contact sc;
+	if (body_shape_segment(&w->body, w->x, w->heading, b->p, tip, &sc) != BSIM_OK) {
+		/* The beam crosses the body's centre line: no normal. */
+		g->type = BSIM_CONTACT_NONE;
+		g->dist = 0.0;
+		return;
+	}
+	g->type = sc.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
+	g->dist = sc.dist + w->radius;
+	g->n[0] = sc.n[0];
+	g->n[1] = sc.n[1];
+	double a[2] = {sc.on_segment[0] - b->p[0], sc.on_segment[1] - b->p[1]};
+	double r[2] = {sc.on_body[0] - w->x[0], sc.on_body[1] - w->x[1]};
+	g->a[0] = a[0];
+	g->a[1] = a[1];
+	g->c = b->sgn * (a[0] * sc.n[1] - a[1] * sc.n[0]);
+	g->ct = b->sgn * (a[0] * sc.n[0] + a[1] * sc.n[1]);
+	g->cb = r[0] * sc.n[1] - r[1] * sc.n[0];
+	g->cbt = r[0] * sc.n[0] + r[1] * sc.n[1];
 }
 
 /* 1 if the body certainly lies farther than R + margin from the beam,
@@ -81,12 +131,15 @@ static void geometry_compute(thesis_beam *b, const double x[2])
  *   dist >= dist_g - |x - x_g| - L |theta - theta_g|.
  * A cushion of 1e-9 of the lengths involved covers the round-off of both
  * distances, so the bound never rejects what the exact test would keep. */
-static int geometry_far(const thesis_beam *b, const double x[2], double radius, double margin)
+static int geometry_far(const struct bsim_world *w, const thesis_beam *b, const double x[2],
+                        double radius, double margin)
 {
 	const thesis_geometry *g = &b->geo;
 	double ex = x[0] - g->x[0], ey = x[1] - g->x[1];
 	double cushion = 1e-9 * (g->dist + b->length + radius + margin);
 	double slack = g->dist - b->length * fabs(b->theta - g->theta) - radius - margin - cushion;
+	if (w->shaped)
+		slack -= radius * fabs(w->heading - g->psi);
 	return slack > 0.0 && ex * ex + ey * ey < slack * slack; /* false for NaN */
 }
 
@@ -100,11 +153,15 @@ int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_con
 	const thesis_geometry *g = &b->geo;
 	/* The same configuration gives the same bits: a step's detection
 	 * meets the geometry the last step's projection computed. */
-	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta)) {
-		if (geometry_far(b, w->x, w->radius, margin))
+	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta &&
+	      (!w->shaped || g->psi == w->heading))) {
+		if (geometry_far(w, b, w->x, w->radius, margin))
 			return 0;
 		thesis_beam_touch(w, i);
-		geometry_compute(b, w->x);
+		if (w->shaped)
+			geometry_compute_shape(w, b);
+		else
+			geometry_compute(b, w->x);
 	}
 	if (g->type == BSIM_CONTACT_NONE)
 		return 0;
@@ -118,6 +175,19 @@ int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_con
 	out->c = g->c;
 	out->e = g->type == BSIM_CONTACT_TIP ? w->e_tip : w->e_tangent;
 	out->impulse = 0.0;
+	if (w->extended) {
+		out->mu = w->friction;
+		out->impulse_t = 0.0;
+		if (w->shaped) {
+			out->cb = g->cb;
+			out->cbt = g->cbt;
+			out->ct = g->ct;
+		} else {
+			out->cb = 0.0;
+			out->cbt = -w->radius;
+			out->ct = b->sgn * (g->a[0] * g->n[0] + g->a[1] * g->n[1]);
+		}
+	}
 	return 1;
 }
 
@@ -128,5 +198,5 @@ int thesis_contact_near(const struct bsim_world *w, int i, double margin)
 	double reach = b->length + w->radius + margin;
 	if (dx * dx + dy * dy > reach * reach)
 		return 0;
-	return !geometry_far(b, w->x, w->radius, margin);
+	return !geometry_far(w, b, w->x, w->radius, margin);
 }

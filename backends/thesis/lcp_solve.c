@@ -37,19 +37,25 @@
 /* Projected Gauss-Seidel's sweeps at most. */
 #define LCP_ITERATIONS_MAX 100000
 
-static double k_entry(double inv_mass, const thesis_contact *a, const thesis_contact *b)
+/* inv_j: the body's 1/J on the extended path (thesis.h), whose rotation
+ * adds cb_i cb_j / J to K; 0 (the essay's body, which does not turn) adds
+ * nothing, not even a rounding. */
+static double k_entry(double inv_mass, double inv_j, const thesis_contact *a,
+                      const thesis_contact *b)
 {
 	double k = (a->n[0] * b->n[0] + a->n[1] * b->n[1]) * inv_mass;
 	if (a == b)
 		k += a->c * a->c * a->inv_i;
+	if (inv_j != 0.0)
+		k += a->cb * b->cb * inv_j;
 	return k;
 }
 
-static void lcp_two(double inv_mass, thesis_contact *c0, thesis_contact *c1)
+static void lcp_two(double inv_mass, double inv_j, thesis_contact *c0, thesis_contact *c1)
 {
 	double q0 = c0->vrel - c0->bound, q1 = c1->vrel - c1->bound;
-	double k00 = k_entry(inv_mass, c0, c0), k11 = k_entry(inv_mass, c1, c1);
-	double k01 = k_entry(inv_mass, c0, c1);
+	double k00 = k_entry(inv_mass, inv_j, c0, c0), k11 = k_entry(inv_mass, inv_j, c1, c1);
+	double k01 = k_entry(inv_mass, inv_j, c0, c1);
 	c0->impulse = c1->impulse = 0.0;
 	if (q0 >= 0.0 && q1 >= 0.0)
 		return;
@@ -75,7 +81,7 @@ static void lcp_two(double inv_mass, thesis_contact *c0, thesis_contact *c1)
 
 /* Sweeps until no impulse changes by more than 1e-14 N s; 1 if it stopped
  * at its iteration limit instead. */
-static int lcp_gauss_seidel(double inv_mass, thesis_contact *cs, int n)
+static int lcp_gauss_seidel(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	for (int i = 0; i < n; i++)
 		cs[i].impulse = 0.0;
@@ -84,9 +90,9 @@ static int lcp_gauss_seidel(double inv_mass, thesis_contact *cs, int n)
 		for (int i = 0; i < n; i++) {
 			double wi = cs[i].vrel - cs[i].bound;
 			for (int j = 0; j < n; j++)
-				wi += k_entry(inv_mass, &cs[i], &cs[j]) * cs[j].impulse;
-			double p =
-			        fmax(0.0, cs[i].impulse - wi / k_entry(inv_mass, &cs[i], &cs[i]));
+				wi += k_entry(inv_mass, inv_j, &cs[i], &cs[j]) * cs[j].impulse;
+			double p = fmax(0.0, cs[i].impulse -
+			                             wi / k_entry(inv_mass, inv_j, &cs[i], &cs[i]));
 			change = fmax(change, fabs(p - cs[i].impulse));
 			cs[i].impulse = p;
 		}
@@ -105,8 +111,8 @@ static int popcount(unsigned v)
 }
 
 /* Tries active set `mask`: 1 and the impulses in cs if it solves the LCP. */
-static int lcp_try_set(double inv_mass, thesis_contact *cs, int n, unsigned mask, const double *q,
-                       double tol)
+static int lcp_try_set(double inv_mass, double inv_j, thesis_contact *cs, int n, unsigned mask,
+                       const double *q, double tol)
 {
 	double kss[LCP_EXACT_MAX * LCP_EXACT_MAX], p[LCP_EXACT_MAX], rhs[LCP_EXACT_MAX];
 	int idx[LCP_EXACT_MAX], m = 0;
@@ -116,7 +122,7 @@ static int lcp_try_set(double inv_mass, thesis_contact *cs, int n, unsigned mask
 	for (int a = 0; a < m; a++) {
 		rhs[a] = -q[idx[a]];
 		for (int b = 0; b < m; b++)
-			kss[a * m + b] = k_entry(inv_mass, &cs[idx[a]], &cs[idx[b]]);
+			kss[a * m + b] = k_entry(inv_mass, inv_j, &cs[idx[a]], &cs[idx[b]]);
 	}
 	if (m > 0) {
 		/* LU with partial pivoting; a pivot below round-off of the
@@ -147,7 +153,7 @@ static int lcp_try_set(double inv_mass, thesis_contact *cs, int n, unsigned mask
 			continue;
 		double wj = q[j];
 		for (int a = 0; a < m; a++)
-			wj += k_entry(inv_mass, &cs[j], &cs[idx[a]]) * p[a];
+			wj += k_entry(inv_mass, inv_j, &cs[j], &cs[idx[a]]) * p[a];
 		if (wj < -tol)
 			return 0;
 	}
@@ -158,7 +164,7 @@ static int lcp_try_set(double inv_mass, thesis_contact *cs, int n, unsigned mask
 	return 1;
 }
 
-static int lcp_enumerate(double inv_mass, thesis_contact *cs, int n)
+static int lcp_enumerate(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	double q[LCP_EXACT_MAX], qmax = 0.0;
 	for (int i = 0; i < n; i++) {
@@ -169,7 +175,8 @@ static int lcp_enumerate(double inv_mass, thesis_contact *cs, int n)
 	unsigned sets = 1u << n;
 	for (int size = 0; size <= n; size++)
 		for (unsigned mask = 0; mask < sets; mask++)
-			if (popcount(mask) == size && lcp_try_set(inv_mass, cs, n, mask, q, tol))
+			if (popcount(mask) == size &&
+			    lcp_try_set(inv_mass, inv_j, cs, n, mask, q, tol))
 				return 1;
 	return 0;
 }
@@ -184,21 +191,26 @@ long thesis_lcp_fallbacks(void)
 	return n;
 }
 
-int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n)
+int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	if (n == 1) {
 		double q = cs[0].vrel - cs[0].bound;
-		cs[0].impulse = q < 0.0 ? -q / k_entry(inv_mass, &cs[0], &cs[0]) : 0.0;
+		cs[0].impulse = q < 0.0 ? -q / k_entry(inv_mass, inv_j, &cs[0], &cs[0]) : 0.0;
 	} else if (n == 2) {
-		lcp_two(inv_mass, &cs[0], &cs[1]);
+		lcp_two(inv_mass, inv_j, &cs[0], &cs[1]);
 	} else if (n > 2) {
-		if (n <= LCP_EXACT_MAX && lcp_enumerate(inv_mass, cs, n))
+		if (n <= LCP_EXACT_MAX && lcp_enumerate(inv_mass, inv_j, cs, n))
 			return 0;
 #pragma omp atomic update
 		lcp_fallbacks++;
-		return lcp_gauss_seidel(inv_mass, cs, n);
+		return lcp_gauss_seidel(inv_mass, inv_j, cs, n);
 	}
 	return 0;
+}
+
+int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n)
+{
+	return thesis_lcp_solve_j(inv_mass, 0.0, cs, n);
 }
 
 void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2])

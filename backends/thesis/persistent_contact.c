@@ -18,18 +18,34 @@
  * Ledger: with midpoint positions the body's kinetic energy changes by
  * exactly F . dx + sum P_i n_i . v_m, a beam's energy by -h d omega_m^2 -
  * P_i c_i omega_m; the contact forces' work sum P_i (n_i . v_m - c_i
- * omega_m,i) is reported, negated, as energy.contact. */
+ * omega_m,i) is reported, negated, as energy.contact.
+ *
+ * Extended path (thesis.h's head): the body's free angular velocity w* =
+ * w + h T / J under the torque T, v_rel and the bound with w cb in them,
+ * K with cb^2 / J, and with friction the tangent rows: v_t' = 0 while
+ * |P_t| <= mu P_n (stick), else P_t = -+mu P_n against v_t' (slide),
+ * friction_solve.c; then w' = w* + sum (P_n cb + P_t cbt) / J and the
+ * heading moves by h w_m (thesis_body_turn). The body's kinetic energy,
+ * rotation's included, changes by F . dx + T h w_m + sum P . (contact
+ * velocity at the means), so energy.contact is the contact impulses' work
+ *   -sum P_n (n . v_m + cb w_m - c omega_m) + P_t (t . v_m + cbt w_m - ct omega_m),
+ * friction's loss included; the runner credits T h w_m, the torque's work
+ * over the heading's change. */
 #include <math.h>
 
 #include "util/fminmax.h"
 #include "thesis/thesis.h"
 
-void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h)
+void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
+                                     double h)
 {
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
 	thesis_contact *cs = w->contacts;
 	int n = w->n_contacts;
+	double w0 = w->angular_velocity, wf = w0;
+	if (w->rotates)
+		wf = w0 + h * torque * w->inv_body_inertia;
 
 	for (int k = 0; k < n; k++) {
 		thesis_contact *c = &cs[k];
@@ -39,17 +55,30 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 		double gap = bsim_fmax(c->gap, 0.0);
 		c->inv_i = thesis_beam_response(b, h, w->integrator);
 		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
+		if (w->extended) {
+			vrel0 += w0 * c->cb;
+			c->vrel += wf * c->cb;
+			c->vrel_t = (vf[1] * c->n[0] - vf[0] * c->n[1]) + wf * c->cbt -
+			            c->omega_free * c->ct;
+		}
 		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 	}
 	/* No contact (free flight): no solve, and the impulse sum of none is
 	 * 0 (thesis_impulse_sum's start), added as it would be. */
-	double j[2] = {0.0, 0.0};
-	if (n) {
+	double j[2] = {0.0, 0.0}, jw = 0.0;
+	if (n && w->extended) {
+		w->solver.iteration_limit +=
+		        thesis_contact_solve(w->inv_mass, w->inv_body_inertia, cs, n);
+		thesis_impulse_sum_extended(cs, n, j, &jw);
+	} else if (n) {
 		w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
 		thesis_impulse_sum(cs, n, j);
 	}
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_turn(w, w0, torque, jw, h);
+	double wm = w->integrator == THESIS_EULER ? w->angular_velocity
+	                                          : 0.5 * (w0 + w->angular_velocity);
 
 	/* Beams in contact take their impulse; all others move freely. A beam
 	 * at rest and untouched stays at rest and costs nothing: only the awake
@@ -71,13 +100,21 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 		if (k < 0) {
 			omega_new = thesis_beam_free_omega(b, h, w->integrator);
 		} else {
-			omega_new = cs[k].omega_free - cs[k].impulse * cs[k].c * cs[k].inv_i;
+			const thesis_contact *c = &cs[k];
+			omega_new = c->omega_free - c->impulse * c->c * c->inv_i;
+			if (w->extended && c->impulse_t != 0.0)
+				omega_new = c->omega_free -
+				            (c->impulse * c->c + c->impulse_t * c->ct) * c->inv_i;
 			double omega_m = w->integrator == THESIS_EULER
 			                         ? omega_new
 			                         : 0.5 * (b->omega + omega_new);
 			w->energy.contact -=
-			        cs[k].impulse *
-			        ((cs[k].n[0] * vm[0] + cs[k].n[1] * vm[1]) - cs[k].c * omega_m);
+			        c->impulse * ((c->n[0] * vm[0] + c->n[1] * vm[1]) - c->c * omega_m);
+			if (w->extended)
+				w->energy.contact -=
+				        c->impulse * (c->cb * wm) +
+				        c->impulse_t * ((vm[1] * c->n[0] - vm[0] * c->n[1]) +
+				                        c->cbt * wm - c->ct * omega_m);
 		}
 		w->energy.damper += thesis_beam_advance(b, omega_new, h, w->integrator);
 	}

@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "model/body_shape.h"
 #include "thesis/thesis.h"
 
 static const bsim_knob thesis_knobs[] = {
@@ -110,6 +111,39 @@ static void thesis_destroy(bsim_world *w)
 	free(w);
 }
 
+/* A shape whose outline body_shape_segment cannot give (a far segment has
+ * a normal for every shape it supports) is refused. */
+static int shape_check(const bsim_scene *scene, bsim_error *err)
+{
+	const bsim_body_def *b = &scene->body;
+	if (b->shape == BSIM_SHAPE_DISK)
+		return BSIM_OK;
+	double r = body_shape_reach(b), x[2] = {0.0, 0.0};
+	double p0[2] = {2.0 * r + 1.0, -1.0}, p1[2] = {2.0 * r + 1.0, 1.0};
+	body_segment_contact c;
+	if (!(r > 0.0) || body_shape_segment(b, x, 0.0, p0, p1, &c) != BSIM_OK)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "thesis: %s: body.shape: the thesis backend has no contact "
+		                      "detection for this shape yet (disk and capsule have)",
+		                      scene->path[0] ? scene->path : scene->name);
+	return BSIM_OK;
+}
+
+/* The body's extended-path fields (thesis.h) from its definition. */
+static void body_setup(bsim_world *w, const bsim_scene *scene)
+{
+	const bsim_body_def *b = &scene->body;
+	w->body = *b;
+	w->shaped = b->shape != BSIM_SHAPE_DISK;
+	w->rotates = b->rotates != 0;
+	w->friction = scene->contact.friction;
+	w->extended = w->shaped || w->rotates || w->friction > 0.0;
+	w->radius = w->shaped ? body_shape_reach(b) : b->radius;
+	w->body_inertia = bsim_body_inertia(b);
+	w->inv_body_inertia = w->rotates ? 1.0 / w->body_inertia : 0.0;
+	w->angular_velocity = w->rotates ? b->angular_velocity : 0.0;
+}
+
 static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
                          bsim_error *err)
 {
@@ -117,12 +151,8 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	int rc = bsim_options_check(opts, thesis_knobs, N_KNOBS, "thesis", err);
 	if (rc)
 		return rc;
-	if (scene->body.shape != BSIM_SHAPE_DISK || scene->body.rotates ||
-	    scene->contact.friction != 0)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "thesis: %s: expected a disk that does not rotate, without "
-		                      "contact.friction (the essay's body)",
-		                      scene->path[0] ? scene->path : scene->name);
+	if ((rc = shape_check(scene, err)) != BSIM_OK)
+		return rc;
 	bsim_world *w = calloc(1, sizeof *w);
 	size_t nb = scene->n_beams > 0 ? (size_t)scene->n_beams : 1;
 	if (w) {
@@ -158,7 +188,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	w->mass = scene->body.mass;
 	w->inv_mass = 1.0 / scene->body.mass;
 	w->impact_inv_mass = w->inv_mass;
-	w->radius = scene->body.radius;
+	body_setup(w, scene);
 	w->n_beams = scene->n_beams;
 	for (int i = 0; i < scene->n_beams; i++) {
 		const bsim_beam_def *d = &scene->beams[i];
@@ -263,6 +293,8 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	memcpy(w->x, scene->body.start, sizeof w->x);
 	memcpy(w->v, scene->body.velocity, sizeof w->v);
 	w->heading = bsim_body_heading(&scene->body);
+	w->angular_velocity = w->rotates ? scene->body.angular_velocity : 0.0;
+	w->impacts_scaled = 0;
 	w->n_awake = w->n_typed = w->n_flagged = w->n_pushed = w->n_contacts = 0;
 	w->any_held = 0;
 	memset(&w->energy, 0, sizeof w->energy);
@@ -320,7 +352,7 @@ static int step_detect(bsim_world *w, const double force[2], double h, double *s
  * contact solve's body update with a zero impulse sum (thesis_body_advance,
  * as persistent_contact.c's with none); no beam to move, sleep or prune;
  * the last step's flags cleared. */
-static void flight_step(bsim_world *w, const double force[2], double h)
+static void flight_step(bsim_world *w, const double force[2], double torque, double h)
 {
 	w->n_contacts = 0;
 	double v0[2] = {w->v[0], w->v[1]};
@@ -328,6 +360,7 @@ static void flight_step(bsim_world *w, const double force[2], double h)
 	const double j[2] = {0.0, 0.0};
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_turn(w, w->angular_velocity, torque, 0.0, h);
 	thesis_contact_clear(w);
 }
 
@@ -336,7 +369,6 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
                        bsim_error *err)
 {
 	(void)err;
-	(void)torque; /* the body does not rotate */
 	/* Free flight among beams at rest (none awake, none in reach): no
 	 * contact, no beam to move, no square root for the margin. */
 	int in_flight = w->n_awake == 0 && thesis_broad_phase_clear(w, force, h);
@@ -344,7 +376,7 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 	w->impacts = 0;
 	if (in_flight && w->n_typed == 0 && h == w->h_prepared &&
 	    w->contact_mode != THESIS_CONTACT_ESSAY) {
-		flight_step(w, force, h);
+		flight_step(w, force, torque, h);
 		return BSIM_OK;
 	}
 	for (int k = 0; k < w->n_typed; k++)
@@ -360,11 +392,11 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 	w->n_contacts = n;
 	if (n)
 		thesis_impact_resolve(w, h);
-	thesis_persistent_contact_solve(w, force, h);
+	thesis_persistent_contact_solve(w, force, torque, h);
 	if (w->contact_mode == THESIS_CONTACT_ESSAY)
 		w->any_held = essay_hold(w);
 	if (n)
-		thesis_position_project(w, force);
+		thesis_position_project(w, force, torque);
 	for (int k = 0; k < w->n_contacts; k++)
 		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE)
 			w->typed[w->n_typed++] = w->contacts[k].beam;
@@ -385,7 +417,7 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 	memcpy(s->x, w->x, sizeof s->x);
 	memcpy(s->v, w->v, sizeof s->v);
 	s->heading = w->heading;
-	s->angular_velocity = 0.0;
+	s->angular_velocity = w->angular_velocity;
 	s->pivot_drift = 0.0; /* a beam here is an angle about a fixed pivot */
 	bsim_state_set_active(s, w->awake, w->n_awake);
 	for (int k = 0; k < s->n_active; k++) {
@@ -407,6 +439,7 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 	memcpy(w->x, s->x, sizeof w->x);
 	memcpy(w->v, s->v, sizeof w->v);
 	w->heading = s->heading;
+	w->angular_velocity = w->rotates ? s->angular_velocity : 0.0;
 	w->n_awake = 0;
 	w->n_typed = 0;
 	w->n_flagged = 0;
