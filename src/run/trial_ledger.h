@@ -18,10 +18,14 @@
 #include "beamsim/trial.h"
 #include "util/fminmax.h"
 
-/* Kinetic energy of body and beams, J. Beams at rest add nothing. */
+/* Kinetic energy of body and beams, J. Beams at rest add nothing; a body
+ * that turns adds J w^2 / 2 (bsim_body_inertia), one that does not nothing
+ * (not even a rounding). */
 static inline double energy_kinetic(const bsim_scene *sc, const bsim_state *s)
 {
 	double e = 0.5 * sc->body.mass * (s->v[0] * s->v[0] + s->v[1] * s->v[1]);
+	if (sc->body.rotates)
+		e += 0.5 * bsim_body_inertia(&sc->body) * s->angular_velocity * s->angular_velocity;
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k];
 		e += 0.5 * sc->beams[i].inertia * s->omega[i] * s->omega[i];
