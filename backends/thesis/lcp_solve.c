@@ -51,7 +51,7 @@ static double k_entry(double inv_mass, double inv_j, const thesis_contact *a,
 	return k;
 }
 
-static void lcp_two(double inv_mass, double inv_j, thesis_contact *c0, thesis_contact *c1)
+static inline void lcp_two(double inv_mass, double inv_j, thesis_contact *c0, thesis_contact *c1)
 {
 	double q0 = c0->vrel - c0->bound, q1 = c1->vrel - c1->bound;
 	double k00 = k_entry(inv_mass, inv_j, c0, c0), k11 = k_entry(inv_mass, inv_j, c1, c1);
@@ -191,7 +191,9 @@ long thesis_lcp_fallbacks(void)
 	return n;
 }
 
-int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n)
+/* The solve for both entry points below: inline, so that the essay's
+ * (inv_j = 0) is compiled with the rotation's terms gone. */
+static inline int lcp_solve(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	if (n == 1) {
 		double q = cs[0].vrel - cs[0].bound;
@@ -210,7 +212,12 @@ int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n)
 
 int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n)
 {
-	return thesis_lcp_solve_j(inv_mass, 0.0, cs, n);
+	return lcp_solve(inv_mass, 0.0, cs, n);
+}
+
+int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n)
+{
+	return lcp_solve(inv_mass, inv_j, cs, n);
 }
 
 void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2])

@@ -36,8 +36,10 @@
 #include "util/fminmax.h"
 #include "thesis/thesis.h"
 
-void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
-                                     double h)
+/* The extended path (this file's head); the essay's path below keeps its
+ * own loop, which this one's terms would slow. */
+static void persistent_solve_extended(struct bsim_world *w, const double force[2], double torque,
+                                      double h)
 {
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
@@ -55,24 +57,19 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 		double gap = bsim_fmax(c->gap, 0.0);
 		c->inv_i = thesis_beam_response(b, h, w->integrator);
 		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
-		if (w->extended) {
-			vrel0 += w0 * c->cb;
-			c->vrel += wf * c->cb;
-			c->vrel_t = (vf[1] * c->n[0] - vf[0] * c->n[1]) + wf * c->cbt -
-			            c->omega_free * c->ct;
-		}
+		vrel0 += w0 * c->cb;
+		c->vrel += wf * c->cb;
+		c->vrel_t =
+		        (vf[1] * c->n[0] - vf[0] * c->n[1]) + wf * c->cbt - c->omega_free * c->ct;
 		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 	}
 	/* No contact (free flight): no solve, and the impulse sum of none is
 	 * 0 (thesis_impulse_sum's start), added as it would be. */
 	double j[2] = {0.0, 0.0}, jw = 0.0;
-	if (n && w->extended) {
+	if (n) {
 		w->solver.iteration_limit +=
 		        thesis_contact_solve(w->inv_mass, w->inv_body_inertia, cs, n);
 		thesis_impulse_sum_extended(cs, n, j, &jw);
-	} else if (n) {
-		w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
-		thesis_impulse_sum(cs, n, j);
 	}
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm);
@@ -102,7 +99,7 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 		} else {
 			const thesis_contact *c = &cs[k];
 			omega_new = c->omega_free - c->impulse * c->c * c->inv_i;
-			if (w->extended && c->impulse_t != 0.0)
+			if (c->impulse_t != 0.0)
 				omega_new = c->omega_free -
 				            (c->impulse * c->c + c->impulse_t * c->ct) * c->inv_i;
 			double omega_m = w->integrator == THESIS_EULER
@@ -110,11 +107,73 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
 			                         : 0.5 * (b->omega + omega_new);
 			w->energy.contact -=
 			        c->impulse * ((c->n[0] * vm[0] + c->n[1] * vm[1]) - c->c * omega_m);
-			if (w->extended)
-				w->energy.contact -=
-				        c->impulse * (c->cb * wm) +
-				        c->impulse_t * ((vm[1] * c->n[0] - vm[0] * c->n[1]) +
-				                        c->cbt * wm - c->ct * omega_m);
+			w->energy.contact -= c->impulse * (c->cb * wm) +
+			                     c->impulse_t * ((vm[1] * c->n[0] - vm[0] * c->n[1]) +
+			                                     c->cbt * wm - c->ct * omega_m);
+		}
+		w->energy.damper += thesis_beam_advance(b, omega_new, h, w->integrator);
+	}
+}
+
+void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
+                                     double h)
+{
+	if (w->extended) {
+		persistent_solve_extended(w, force, torque, h);
+		return;
+	}
+	double v0[2] = {w->v[0], w->v[1]};
+	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
+	thesis_contact *cs = w->contacts;
+	int n = w->n_contacts;
+
+	for (int k = 0; k < n; k++) {
+		thesis_contact *c = &cs[k];
+		const thesis_beam *b = &w->beams[c->beam];
+		double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
+		c->omega_free = thesis_beam_free_omega(b, h, w->integrator);
+		double gap = bsim_fmax(c->gap, 0.0);
+		c->inv_i = thesis_beam_response(b, h, w->integrator);
+		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
+		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
+	}
+	/* No contact (free flight): no solve, and the impulse sum of none is
+	 * 0 (thesis_impulse_sum's start), added as it would be. */
+	double j[2] = {0.0, 0.0};
+	if (n) {
+		w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
+		thesis_impulse_sum(cs, n, j);
+	}
+	double vm[2];
+	thesis_body_advance(w, v0, vf, j, h, vm);
+
+	/* Beams in contact take their impulse; all others move freely. A beam
+	 * at rest and untouched stays at rest and costs nothing: only the awake
+	 * ones (every contact's beam among them) are visited, in ascending
+	 * order, so the ledger's sums are those over all beams. */
+	for (int k = 0; k < n; k++) {
+		w->contact_of[cs[k].beam] = k;
+		if (cs[k].impulse > 0.0)
+			thesis_beam_pushed(w, cs[k].beam);
+	}
+	for (int a = 0; a < w->n_awake; a++) {
+		int i = w->awake[a];
+		thesis_beam *b = &w->beams[i];
+		int k = w->contact_of[i];
+		w->contact_of[i] = -1;
+		if (k < 0 && b->theta == 0.0 && b->omega == 0.0)
+			continue;
+		double omega_new;
+		if (k < 0) {
+			omega_new = thesis_beam_free_omega(b, h, w->integrator);
+		} else {
+			omega_new = cs[k].omega_free - cs[k].impulse * cs[k].c * cs[k].inv_i;
+			double omega_m = w->integrator == THESIS_EULER
+			                         ? omega_new
+			                         : 0.5 * (b->omega + omega_new);
+			w->energy.contact -=
+			        cs[k].impulse *
+			        ((cs[k].n[0] * vm[0] + cs[k].n[1] * vm[1]) - cs[k].c * omega_m);
 		}
 		w->energy.damper += thesis_beam_advance(b, omega_new, h, w->integrator);
 	}

@@ -324,12 +324,17 @@ static int essay_hold(bsim_world *w)
 
 /* The contacts the step can reach into w->contacts; returns how many, and
  * the speed bound of the margins in *speed. */
-static int step_detect(bsim_world *w, const double force[2], double h, double *speed)
+static int step_detect(bsim_world *w, const double force[2], double torque, double h, double *speed)
 {
 	/* A bound for the margin only: speeds and forces are far from overflow,
 	 * so sqrt serves where hypot's scaling would cost a tenth of a step. */
 	double v = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
 	           h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
+	/* A shape that turns: its outline moves up to reach |w| faster than its
+	 * centre (the disk's does not move when it turns). */
+	if (w->shaped && w->rotates)
+		v += w->radius *
+		     (fabs(w->angular_velocity) + h * fabs(torque) * w->inv_body_inertia);
 	int holding = w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
 	int m = thesis_broad_phase(w, v, h);
 	int n = 0;
@@ -388,7 +393,7 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 		w->h_prepared = h;
 	}
 	double speed = 0.0;
-	int n = in_flight ? 0 : step_detect(w, force, h, &speed);
+	int n = in_flight ? 0 : step_detect(w, force, torque, h, &speed);
 	w->n_contacts = n;
 	if (n)
 		thesis_impact_resolve(w, h);
