@@ -12,6 +12,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <string.h>
 
 #include <cmocka.h>
 
@@ -353,6 +354,84 @@ static void test_no_energy_created(void **state)
 	assert_true(met > cases / 2);
 }
 
+/* thesis_contact_solve on random problems of 1 to 4 contacts (the body's
+ * mass and inertia, normals, body and beam levers, beams' inertias, free
+ * velocities and mu drawn at random; K built by the solver from them):
+ * every solution meets the conditions it solves, checked here from the
+ * impulses alone: P_n >= 0, u_n >= 0, P_n u_n = 0, |P_t| <= mu P_n, stick
+ * (u_t = 0) inside the cone, P_t = -mu P_n sign(u_t) on its edge; the
+ * solver reports each solve exact. 5 contacts: not exact, and said so. */
+static void test_solve_conditions(void **state)
+{
+	(void)state;
+	uint64_t seed = 11;
+	int solved = 0, sliding = 0, sticking = 0;
+	for (int k = 0; k < 4000; k++) {
+		int n = 1 + k % 4;
+		thesis_contact cs[5];
+		double inv_mass = 0.5 + uniform(&seed), inv_j = 0.05 * uniform(&seed);
+		for (int i = 0; i < n; i++) {
+			double a = 2.0 * 3.14159265358979 * uniform(&seed);
+			cs[i].n[0] = cos(a);
+			cs[i].n[1] = sin(a);
+			cs[i].cb = 10.0 * uniform(&seed) - 5.0;
+			cs[i].cbt = 10.0 * uniform(&seed) - 5.0;
+			cs[i].c = 30.0 * uniform(&seed) - 15.0;
+			cs[i].ct = 4.0 * uniform(&seed) - 2.0;
+			cs[i].inv_i = 0.05 * uniform(&seed);
+			cs[i].vrel = 4.0 * uniform(&seed) - 3.0;
+			cs[i].bound = uniform(&seed) < 0.5 ? 0.0 : 0.8 * fmax(-cs[i].vrel, 0.0);
+			cs[i].vrel_t = 4.0 * uniform(&seed) - 2.0;
+			cs[i].mu = uniform(&seed) < 0.1 ? 0.0 : 1.5 * uniform(&seed);
+		}
+		assert_int_equal(thesis_contact_solve(inv_mass, inv_j, cs, n), 0);
+		/* the contact velocities after, from the impulses: v, w and
+		 * each beam's omega (one beam per contact) */
+		double jv[2] = {0.0, 0.0}, jw = 0.0;
+		for (int i = 0; i < n; i++) {
+			jv[0] += cs[i].impulse * cs[i].n[0] - cs[i].impulse_t * cs[i].n[1];
+			jv[1] += cs[i].impulse * cs[i].n[1] + cs[i].impulse_t * cs[i].n[0];
+			jw += cs[i].impulse * cs[i].cb + cs[i].impulse_t * cs[i].cbt;
+		}
+		for (int i = 0; i < n; i++) {
+			const thesis_contact *c = &cs[i];
+			double jb = c->impulse * c->c + c->impulse_t * c->ct;
+			double un = c->vrel - c->bound +
+			            (jv[0] * c->n[0] + jv[1] * c->n[1]) * inv_mass +
+			            jw * c->cb * inv_j + jb * c->c * c->inv_i;
+			double ut = c->vrel_t + (jv[1] * c->n[0] - jv[0] * c->n[1]) * inv_mass +
+			            jw * c->cbt * inv_j + jb * c->ct * c->inv_i;
+			double tol = 1e-9;
+			assert_true(c->impulse >= 0.0);
+			assert_true(un >= -tol);
+			assert_true(c->impulse * un <= tol * (1.0 + c->impulse));
+			assert_true(fabs(c->impulse_t) <=
+			            c->mu * c->impulse * (1.0 + 1e-9) + 1e-15);
+			if (c->impulse > 1e-9 && c->mu > 0.0) {
+				if (fabs(c->impulse_t) < c->mu * c->impulse * (1.0 - 1e-9)) {
+					assert_true(fabs(ut) <= tol);
+					sticking++;
+				} else if (fabs(ut) > tol) {
+					assert_true(c->impulse_t * ut < 0.0);
+					sliding++;
+				}
+			}
+		}
+		solved++;
+	}
+	printf("%d problems of 1-4 contacts solved exactly: %d contacts sticking, %d sliding\n",
+	       solved, sticking, sliding);
+	assert_true(sticking > 100 && sliding > 100);
+	/* 5 contacts: beyond the enumeration, the approximation is reported */
+	thesis_contact cs[5];
+	for (int i = 0; i < 5; i++) {
+		memset(&cs[i], 0, sizeof cs[i]);
+		cs[i].n[0] = cos(i), cs[i].n[1] = sin(i);
+		cs[i].c = 1.0, cs[i].inv_i = 0.1, cs[i].vrel = -1.0, cs[i].mu = 0.5;
+	}
+	assert_int_equal(thesis_contact_solve(1.0, 0.1, cs, 5), 1);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -360,6 +439,7 @@ int main(void)
 	        cmocka_unit_test(test_capsule_stick_slide),
 	        cmocka_unit_test(test_persistent_hold_slide),
 	        cmocka_unit_test(test_no_energy_created),
+	        cmocka_unit_test(test_solve_conditions),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -126,6 +126,17 @@ static int try_cases(const double *k, const double *q, thesis_contact *cs, int n
 	}
 	if (!solve_dense(a, p, m))
 		return 0;
+	/* Elimination mixes the rows: a separated contact's impulses and a
+	 * sliding one's P_t + -mu P_n come out as round-off, not 0; they are
+	 * set exactly before the check. */
+	for (int i = 0; i < n; i++) {
+		if (mode[i] == CASE_SEPARATE)
+			p[2 * i] = p[2 * i + 1] = 0.0;
+		else if (mode[i] == CASE_SLIDE_FORWARD)
+			p[2 * i + 1] = -cs[i].mu * p[2 * i];
+		else if (mode[i] == CASE_SLIDE_BACKWARD)
+			p[2 * i + 1] = cs[i].mu * p[2 * i];
+	}
 	for (int i = 0; i < n; i++) {
 		double u[2];
 		for (int r = 0; r < 2; r++) {
