@@ -489,6 +489,39 @@ static void test_continuity(void **state)
 	}
 }
 
+/* Ends exactly on an axis or at the centre (the frame's special cases: a
+ * point on the major axis inside the evolute has two nearest points, one on
+ * the minor axis a far local maximum; the centre of a circle has every
+ * direction), in both namings of the axes, against brute force. */
+static void test_special_points(void **state)
+{
+	(void)state;
+	const double ends[][2] = {{0, 0},    {3, 0},    {-3, 0},   {8.5, 0},  {0, 1},
+	                          {0, -2.9}, {0, 2.99}, {9.05, 0}, {0, 3.02}, {-12, 0}};
+	const double others[][2] = {{20, 1}, {-4, 15}, {0, -14}, {13, 0}, {2, 0.5}};
+	const double shapes[][3] = {{9, 3, 0}, {3, 9, PI / 2}, {4, 4, 0}};
+	int n = 0;
+	for (size_t s = 0; s < sizeof shapes / sizeof *shapes; s++)
+		for (size_t i = 0; i < sizeof ends / sizeof *ends; i++)
+			for (size_t j = 0; j < sizeof others / sizeof *others; j++) {
+				config k = {shapes[s][0],
+				            shapes[s][1],
+				            {0, 0},
+				            shapes[s][2],
+				            {ends[i][0], ends[i][1]},
+				            {others[j][0], others[j][1]}};
+				if (shapes[s][2] !=
+				    0) /* the same points in the frame named (c, a) */
+					for (int m = 0; m < 2; m++) {
+						double *p = m ? k.p1 : k.p0, t = p[0];
+						p[0] = -p[1], p[1] = t;
+					}
+				check_brute(&k);
+				n++;
+			}
+	printf("special points: %d configurations\n", n);
+}
+
 static void test_degenerate(void **state)
 {
 	(void)state;
@@ -548,6 +581,7 @@ int main(void)
 	        cmocka_unit_test(test_brute_force),
 	        cmocka_unit_test(test_invariance),
 	        cmocka_unit_test(test_continuity),
+	        cmocka_unit_test(test_special_points),
 	        cmocka_unit_test(test_degenerate),
 	        cmocka_unit_test(test_cost),
 	};

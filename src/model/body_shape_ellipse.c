@@ -76,7 +76,7 @@ static double falling_root(double P, double Q, double s, double z, double zhi)
 			return z;
 	}
 	for (int i = 0; i < BISECT_MAX && zhi - z > 2.0 * DBL_EPSILON * z; i++) {
-		double mid = zhi > 4.0 * z ? sqrt(z * zhi) : 0.5 * (z + zhi);
+		double mid = zhi > 4.0 * z ? sqrt(z) * sqrt(zhi) : 0.5 * (z + zhi);
 		double A = P / mid, B = Q / (mid + s);
 		if (A * A + B * B - 1.0 > 0.0)
 			z = mid;
@@ -93,28 +93,33 @@ typedef struct ellipse {
 	int swap;      /* 1: the major axis is v */
 } ellipse;
 
+enum { NEAREST = 1, OTHER = 2 };
+
 /* The outward normals (body frame, not unit) at the outline points whose
- * normal passes through y (body frame): the nearest, and unless nearest_only
- * the other local maximum of g_k. Returns how many (0 only for the centre of
- * a circle, where every direction is one). */
-static int normals_through(const ellipse *E, const double y[2], int nearest_only, double N[3][2])
+ * normal passes through y (body frame): the nearest if want has NEAREST,
+ * g_k's other local maximum if it has OTHER. Returns how many (<= 3; none
+ * for the centre of a circle, where every direction is one). */
+static int normals_through(const ellipse *E, const double y[2], int want, double N[3][2])
 {
 	double y0 = fabs(E->swap ? y[1] : y[0]), y1 = fabs(E->swap ? y[0] : y[1]);
 	double e0 = E->e0, e1 = E->e1, dd = E->dd;
 	int k = 0;
 	if (y1 > 0.0) {
-		double P = e1 * y1, Q = e0 * y0, hi = hypot(P, Q);
-		/* One Newton step from hi (where F <= 0) lands below the root. */
-		double A = P / hi, B = Q / (hi + dd), f = A * A + B * B - 1.0;
-		double z = bsim_fmax(P, hi + f / (2.0 * (A * A / hi + B * B / (hi + dd))));
-		z = falling_root(P, Q, dd, z, hi);
-		N[k][0] = y0 / (z + dd);
-		N[k++][1] = y1 / z;
-		if (!nearest_only && y0 > 0.0 && dd > 0.0) {
+		double P = e1 * y1, Q = e0 * y0, z;
+		if (want & NEAREST) {
+			/* One Newton step from hi (where F <= 0) lands below the root. */
+			double hi = sqrt(P * P + Q * Q);
+			double A = P / hi, B = Q / (hi + dd), f = A * A + B * B - 1.0;
+			z = bsim_fmax(P, hi + f / (2.0 * (A * A / hi + B * B / (hi + dd))));
+			z = falling_root(P, Q, dd, z, hi);
+			N[k][0] = y0 / (z + dd);
+			N[k++][1] = y1 / z;
+		}
+		/* the evolute lies within |y0| < dd / e0, |y1| < dd / e1 */
+		if ((want & OTHER) && y0 > 0.0 && Q < dd && P < dd) {
 			double r = cbrt(Q / P), K = r * r;
 			double zl = dd * (K / (1.0 + K)), zr = dd / (1.0 + K);
-			A = Q / zl;
-			B = P / zr;
+			double A = Q / zl, B = P / zr;
 			if (A * A + B * B - 1.0 < 0.0) {
 				/* z = t + e0^2 from the pole -e0^2, and z = -(t + e1^2) from -e1^2
 				 */
@@ -125,10 +130,12 @@ static int normals_through(const ellipse *E, const double y[2], int nearest_only
 				N[k][0] = y0 / (dd - z);
 				N[k++][1] = -y1 / z;
 			}
-		} else if (!nearest_only && y0 == 0.0) {
+		} else if ((want & OTHER) && y0 == 0.0) {
 			N[k][0] = 0.0; /* the opposite end of the minor axis */
 			N[k++][1] = -1.0;
 		}
+	} else if (!(want & NEAREST)) {
+		/* on the major axis g_k has no other local maximum */
 	} else if (dd > 0.0 && e0 * y0 < dd) {
 		/* On the major axis inside the evolute: two nearest points */
 		double q0 = e0 * e0 * y0 / dd,
@@ -167,9 +174,9 @@ typedef struct best {
 static void consider(const ellipse *E, const double y0[2], const double dv[2], const double N[2],
                      int face, int end, best *b)
 {
-	double len = hypot(N[0], N[1]);
+	double len = sqrt(N[0] * N[0] + N[1] * N[1]);
 	double n0 = -N[0] / len, n1 = -N[1] / len;
-	double h = hypot(E->a * n0, E->c * n1);
+	double h = sqrt(E->a * E->a * n0 * n0 + E->c * E->c * n1 * n1);
 	double g = -(n0 * y0[0] + n1 * y0[1]) - h - bsim_fmax(0.0, n0 * dv[0] + n1 * dv[1]);
 	if (g > b->g) {
 		b->g = g;
@@ -217,21 +224,24 @@ int body_shape_ellipse_segment(double a, double c, const double x[2], double psi
 		int end = ts < 0.0 ? 0 : 1;
 		if (ln[0] * ln[0] + ln[1] * ln[1] > 1.0) {
 			/* The line misses E: is the foot of x + e(m) within the segment? */
-			double h = hypot(a * m[0], c * m[1]);
+			double h = sqrt(a * a * m[0] * m[0] + c * c * m[1] * m[1]);
 			double em[2] = {a * a * m[0] / h - y[0][0], c * c * m[1] / h - y[0][1]};
 			double t = (em[0] * dv[0] + em[1] * dv[1]) / dd2;
 			end = t < 0.0 ? 0 : 1;
 			if (t >= 0.0 && t <= 1.0)
 				consider(&E, y[0], dv, m, 1, 0, &b);
 		}
-		if (!b.face && normals_through(&E, y[end], 1, N) == 1)
+		if (!b.face && normals_through(&E, y[end], NEAREST, N) == 1)
 			consider(&E, y[0], dv, N[0], 0, end, &b);
 	} else {
 		double mm[2] = {-m[0], -m[1]};
 		consider(&E, y[0], dv, m, 1, 0, &b);
 		consider(&E, y[0], dv, mm, 1, 0, &b);
+		/* An end outside E is no maximum's tip: there g_k > 0 > max g. */
 		for (int k = 0; k < 2; k++) {
-			int nk = normals_through(&E, y[k], 0, N);
+			double o = s0[0] + k * sd[0], v = s0[1] + k * sd[1];
+			int want = o * o + v * v > 1.0 ? OTHER : NEAREST | OTHER;
+			int nk = normals_through(&E, y[k], want, N);
 			for (int i = 0; i < nk; i++)
 				consider(&E, y[0], dv, N[i], 0, k, &b);
 		}
@@ -240,7 +250,7 @@ int body_shape_ellipse_segment(double a, double c, const double x[2], double psi
 		return BSIM_EFAIL;
 
 	/* The body's point x - e(n), and the segment's highest along n */
-	double h = hypot(a * b.n[0], c * b.n[1]);
+	double h = sqrt(a * a * b.n[0] * b.n[0] + c * c * b.n[1] * b.n[1]);
 	double eb[2] = {-a * a * b.n[0] / h, -c * c * b.n[1] / h};
 	out->dist = b.g;
 	out->n[0] = cs * b.n[0] - sn * b.n[1];
