@@ -496,8 +496,9 @@ static void test_continuity(void **state)
 static void test_special_points(void **state)
 {
 	(void)state;
-	const double ends[][2] = {{0, 0},    {3, 0},    {-3, 0},   {8.5, 0},  {0, 1},
-	                          {0, -2.9}, {0, 2.99}, {9.05, 0}, {0, 3.02}, {-12, 0}};
+	const double ends[][2] = {{0, 0},      {3, 0},      {-3, 0},     {8.5, 0},  {0, 1},
+	                          {0, -2.9},   {0, 2.99},   {9.05, 0},   {0, 3.02}, {-12, 0},
+	                          {3, 1e-300}, {3, 1e-310}, {12, 1e-310}};
 	const double others[][2] = {{20, 1}, {-4, 15}, {0, -14}, {13, 0}, {2, 0.5}};
 	const double shapes[][3] = {{9, 3, 0}, {3, 9, PI / 2}, {4, 4, 0}};
 	int n = 0;

@@ -46,8 +46,8 @@
  * 0 then rises monotonically to it, a Newton step from a point with F <= 0
  * lands below it, and the iteration stops when its step is under 2 ulp of z:
  * the root to about 1 ulp (at most 14 steps for a million random points
- * about a 9 x 3 ellipse; after NEWTON_MAX steps, near a cusp of the
- * evolute, the bracket is bisected, which ends within ~70). A quartic
+ * about a 9 x 3 ellipse, 34 beside a cusp of its evolute; should
+ * NEWTON_MAX pass, the bracket is bisected, which ends within ~70). A quartic
  * solver (gsl_poly_complex_solve_quartic) gives the four at once but loses
  * precision at double roots and would need the same polishing.
  *
@@ -108,9 +108,15 @@ static int normals_through(const ellipse *E, const double y[2], int want, double
 {
 	double y0 = fabs(E->swap ? y[1] : y[0]), y1 = fabs(E->swap ? y[0] : y[1]);
 	double e0 = E->e0, e1 = E->e1, dd = E->dd;
+	/* Within rounding of an axis is on it (and no subnormal P or Q). */
+	if (y0 < DBL_EPSILON * e0)
+		y0 = 0.0;
+	if (y1 < DBL_EPSILON * e1)
+		y1 = 0.0;
 	int k = 0;
-	if (y1 > 0.0) {
-		double P = e1 * y1, Q = e0 * y0, z;
+	double P = e1 * y1, Q = e0 * y0;
+	if (P > 0.0) {
+		double z;
 		if (want & NEAREST) {
 			/* One Newton step from hi (where F <= 0) lands below the root. */
 			double hi = sqrt(P * P + Q * Q);
