@@ -250,6 +250,85 @@ static void offcentre_impact(const char *knob)
 	bsim_scene_free(&s);
 }
 
+/* Seeded random elastic (e = 1), frictionless impacts of a turning capsule
+ * and ellipse on the free beam (no spring): energy and the angular
+ * momentum about the pivot, M (C x v) + J w + I omega, are both conserved
+ * by the impulse whatever the contact point (MODEL.md section 4 with the
+ * body's rotation). */
+static void test_elastic_impacts_conserve(void **state)
+{
+	(void)state;
+	uint64_t seed = 3;
+	int met = 0;
+	double worst_e = 0.0, worst_l = 0.0;
+	for (int k = 0; k < 2000; k++) {
+		bsim_scene s;
+		scene_one_beam(&s);
+		if (k % 2) {
+			s.body.shape = BSIM_SHAPE_ELLIPSE;
+			s.body.radius = 0.0;
+			s.body.semi_axes[0] = 2.0 + 8.0 * uniform(&seed);
+			s.body.semi_axes[1] = 1.0 + 4.0 * uniform(&seed);
+		} else {
+			s.body.shape = BSIM_SHAPE_CAPSULE;
+			s.body.radius = 1.0 + 3.0 * uniform(&seed);
+			s.body.length = 2.0 + 10.0 * uniform(&seed);
+		}
+		s.body.heading_deg = 360.0 * uniform(&seed);
+		s.body.rotates = 1;
+		s.body.angular_velocity = 2.0 * uniform(&seed) - 1.0;
+		s.contact.restitution = s.contact.tip_restitution = 1.0;
+		s.contact.rest_threshold = 0.0; /* every approach elastic */
+		s.beams[0].initial_omega = 0.2 * uniform(&seed) - 0.1;
+		double x[2] = {-5.0 + 35.0 * uniform(&seed), 0.0};
+		x[1] = (uniform(&seed) < 0.5 ? -1.0 : 1.0) * (body_shape_reach(&s.body) + 0.5);
+		double psi = bsim_body_heading(&s.body), p0[2] = {0.0, 0.0}, p1[2] = {25.0, 0.0};
+		body_segment_contact bc;
+		assert_int_equal(body_shape_segment(&s.body, x, psi, p0, p1, &bc), BSIM_OK);
+		if (bc.dist > 20.0) {
+			bsim_scene_free(&s);
+			continue;
+		}
+		x[0] -= (bc.dist + 1e-9) * bc.n[0];
+		x[1] -= (bc.dist + 1e-9) * bc.n[1];
+		s.body.start[0] = x[0];
+		s.body.start[1] = x[1];
+		double speed = 0.2 + 3.0 * uniform(&seed);
+		s.body.velocity[0] = -speed * bc.n[0];
+		s.body.velocity[1] = -speed * bc.n[1];
+		double j = bsim_body_inertia(&s.body), ib = s.beams[0].inertia, m = s.body.mass;
+		double om0 = s.beams[0].initial_omega;
+		double e0 = 0.5 * m * speed * speed +
+		            0.5 * j * s.body.angular_velocity * s.body.angular_velocity +
+		            0.5 * ib * om0 * om0;
+		double l0 = m * (x[0] * s.body.velocity[1] - x[1] * s.body.velocity[0]) +
+		            j * s.body.angular_velocity + ib * om0;
+		bsim_world *w = make(&s);
+		bsim_state st;
+		bsim_state_init(&st, 1);
+		assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
+		bsim_backend_thesis.get_state(w, &st);
+		double e1 = 0.5 * m * (st.v[0] * st.v[0] + st.v[1] * st.v[1]) +
+		            0.5 * j * st.angular_velocity * st.angular_velocity +
+		            0.5 * ib * st.omega[0] * st.omega[0];
+		double l1 = m * (st.x[0] * st.v[1] - st.x[1] * st.v[0]) + j * st.angular_velocity +
+		            ib * st.omega[0];
+		met += st.impacts > 0;
+		worst_e = fmax(worst_e, fabs(e1 - e0) / e0);
+		double lscale = m * speed * (fabs(x[0]) + fabs(x[1])) + j + ib;
+		worst_l = fmax(worst_l, fabs(l1 - l0) / lscale);
+		bsim_backend_thesis.destroy(w);
+		bsim_state_free(&st);
+		bsim_scene_free(&s);
+	}
+	printf("elastic impacts of capsules and ellipses: %d met the beam; energy within %.3g, "
+	       "angular momentum within %.3g relative\n",
+	       met, worst_e, worst_l);
+	assert_true(met > 1000);
+	assert_true(worst_e < 1e-12);
+	assert_true(worst_l < 1e-12);
+}
+
 /* The same with the essay's impact order and with the Euler integrator: one
  * contact, the same impulse; the step's smooth part has no force. */
 static void test_offcentre_impact(void **state)
@@ -364,25 +443,32 @@ static void test_ledger_closes(void **state)
 	bsim_scene_free(&s);
 }
 
-/* A turning capsule driven through the gate by propulsion and a held
- * random lateral force, with and without friction: its outline never
+/* A turning capsule or ellipse driven through the gate by propulsion and a
+ * held random lateral force, with and without friction: its outline never
  * enters a beam deeper than the projection's slop (1e-6 m), measured with
  * the shape's own geometry from the state, and no solve gives up. */
 static void test_capsule_penetration(void **state)
 {
 	(void)state;
-	const double mus[] = {0.0, 0.3, 1.0, 2.0};
+	const double mus[] = {0.0, 0.0, 0.3, 0.3, 1.0, 1.0, 2.0, 2.0};
 	double deepest = 0.0;
 	uint64_t seed = 7;
 	for (int trial = 0; trial < 8; trial++) {
 		bsim_scene s;
 		bsim_scene_init_gate(&s, 8.0, 0.0);
-		s.body.shape = BSIM_SHAPE_CAPSULE;
-		s.body.radius = 5.0;
-		s.body.length = 12.0;
+		if (trial % 2 == 0) {
+			s.body.shape = BSIM_SHAPE_CAPSULE;
+			s.body.radius = 5.0;
+			s.body.length = 12.0;
+		} else {
+			s.body.shape = BSIM_SHAPE_ELLIPSE;
+			s.body.radius = 0.0;
+			s.body.semi_axes[0] = 11.0;
+			s.body.semi_axes[1] = 5.0;
+		}
 		s.body.heading_deg = 90.0 + 10.0 * sin(trial);
 		s.body.rotates = 1;
-		s.contact.friction = mus[trial % 4];
+		s.contact.friction = mus[trial];
 		bsim_world *w = make(&s);
 		bsim_state st;
 		bsim_state_init(&st, 2);
@@ -413,16 +499,21 @@ static void test_capsule_penetration(void **state)
 		bsim_state_free(&st);
 		bsim_scene_free(&s);
 	}
-	printf("capsule at the gate, 8 trials of 3000 steps: deepest overlap %.3g m\n", -deepest);
+	printf("capsule and ellipse at the gate, 8 trials of 3000 steps: deepest overlap %.3g m\n",
+	       -deepest);
 	assert_true(deepest > -1e-6 * (1.0 + 1e-6));
 }
 
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_capsule_outline),  cmocka_unit_test(test_free_capsule),
-	        cmocka_unit_test(test_offcentre_impact), cmocka_unit_test(test_turning_disk_bits),
-	        cmocka_unit_test(test_ledger_closes),    cmocka_unit_test(test_capsule_penetration),
+	        cmocka_unit_test(test_capsule_outline),
+	        cmocka_unit_test(test_free_capsule),
+	        cmocka_unit_test(test_offcentre_impact),
+	        cmocka_unit_test(test_turning_disk_bits),
+	        cmocka_unit_test(test_ledger_closes),
+	        cmocka_unit_test(test_elastic_impacts_conserve),
+	        cmocka_unit_test(test_capsule_penetration),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
