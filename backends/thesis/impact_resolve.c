@@ -130,25 +130,19 @@ static int impact_solve_friction(struct bsim_world *w, thesis_contact *cs, int n
 		p0n[i] = cs[i].impulse, p0t[i] = cs[i].impulse_t;
 		dn[i] = pn[i] - p0n[i], dt[i] = pt[i] - p0t[i];
 	}
-	/* E(s) - E = a s^2 + b s + c0 along P_0 + s D: c0 <= 0 at s = 0 and
-	 * > 0 at s = 1; the root between. */
+	/* E(s) - E = qa s^2 + qb s + c0 along P_0 + s D: <= 0 at s = 0 (the
+	 * plastic impulse) and > 0 at s = 1 (Newton's); the root between. */
 	double c0 = impact_energy_change(w, cs, n, p0n, p0t);
-	double e1 = impact_energy_change(w, cs, n, dn, dt); /* D . u + D K D / 2 */
-	double ehalf = 0.0;
-	{
-		double mn[IMPACT_CONTACTS_MAX], mt[IMPACT_CONTACTS_MAX];
-		for (int i = 0; i < n; i++)
-			mn[i] = p0n[i] + dn[i], mt[i] = p0t[i] + dt[i];
-		ehalf = impact_energy_change(w, cs, n, mn, mt);
-	}
+	double e1 = impact_energy_change(w, cs, n, dn, dt);       /* D . u + D K D / 2 */
+	double e_newton = impact_energy_change(w, cs, n, pn, pt); /* P_0 + D */
 	/* With f(P) = P . u + P K P / 2: f(P_0 + s D) = c0 + s (D . u + D K P_0)
-	 * + s^2 D K D / 2; from the three values f(0) = c0, f(D) = e1 and
-	 * f(P_0 + D) = ehalf: D K D / 2 = e1 - D . u, and the linear term is
-	 * ehalf - c0 - D K D / 2. */
+	 * + s^2 D K D / 2; from the three values f(P_0) = c0, f(D) = e1 and
+	 * f(P_0 + D) = e_newton: D K D / 2 = e1 - D . u, and the linear term
+	 * is e_newton - c0 - D K D / 2. */
 	double du = 0.0;
 	for (int i = 0; i < n; i++)
 		du += dn[i] * cs[i].vrel + dt[i] * cs[i].vrel_t;
-	double qa = e1 - du, qb = ehalf - c0 - qa;
+	double qa = e1 - du, qb = e_newton - c0 - qa;
 	double s = 0.0;
 	if (qa > 0.0) {
 		double disc = qb * qb - 4.0 * qa * c0;

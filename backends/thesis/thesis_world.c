@@ -123,8 +123,8 @@ static int shape_check(const bsim_scene *scene, bsim_error *err)
 	body_segment_contact c;
 	if (!(r > 0.0) || body_shape_segment(b, x, 0.0, p0, p1, &c) != BSIM_OK)
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "thesis: %s: body.shape: the thesis backend has no contact "
-		                      "detection for this shape yet (disk and capsule have)",
+		                      "thesis: %s: body.shape: no contact detection for this "
+		                      "shape (model/body_shape.h gives none)",
 		                      scene->path[0] ? scene->path : scene->name);
 	return BSIM_OK;
 }
