@@ -121,6 +121,28 @@ static void test_capsule_outline(void **state)
 	assert_int_equal(body_shape_segment(&b, x, 1.0, p0, p1, &bc), BSIM_EFAIL);
 }
 
+/* The start's overlap check by the outline: a capsule along x (r = 2, l =
+ * 8) whose centre is 4 m below the beam along +x overlaps it when its
+ * heading tilts an end up by more than 2 m (sin psi > 2 / 4: psi > 30 deg),
+ * not below; a disk's test (centre within r) would see neither. */
+static void test_start_overlap(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	scene_capsule(&s, 2.0, 8.0, 25.0);
+	s.body.start[0] = 12.0;
+	s.body.start[1] = -4.0;
+	bsim_error err;
+	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
+	s.body.heading_deg = 35.0;
+	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_EINPUT);
+	assert_non_null(strstr(err.msg, "overlaps beam 1"));
+	assert_non_null(strstr(err.msg, "capsule"));
+	s.body.heading_deg = -35.0; /* the other end up */
+	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_EINPUT);
+	bsim_scene_free(&s);
+}
+
 /* No force, no torque, nothing in reach: J w and M v constant, the heading
  * psi0 + w t and the energy constant, to round-off; with a constant torque
  * T, w = w0 + T t / J and psi = psi0 + w0 t + T t^2 / (2 J) (the midpoint
@@ -508,6 +530,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_capsule_outline),
+	        cmocka_unit_test(test_start_overlap),
 	        cmocka_unit_test(test_free_capsule),
 	        cmocka_unit_test(test_offcentre_impact),
 	        cmocka_unit_test(test_turning_disk_bits),
