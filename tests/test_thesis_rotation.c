@@ -209,6 +209,7 @@ static void test_free_capsule(void **state)
 	p_hand = p0 + 2.5 * n * h + torque * h * h * n * (n + 1.0) / (2.0 * inertia);
 	assert_true(fabs(st.heading - p_hand) < 1e-11 * fabs(p_hand));
 	assert_true(fabs(st.angular_velocity - (2.5 + torque * t / inertia)) < 1e-12 * 2.5);
+	bsim_backend_thesis.destroy(w);
 	bsim_state_free(&st);
 	bsim_scene_free(&s);
 }
