@@ -5,7 +5,7 @@
  * Rows r = 2i (normal) and 2i + 1 (tangent) of contact i have the Jacobian
  * (d_r on v, b_r on w, -l_r on the beam's omega): (n, cb, c) and (t, cbt,
  * ct). With P the 2n impulses, the solved relative velocities are
- *   u = q + K P,  K_rs = d_r . d_s / M + b_r b_s / J + [same contact] l_r l_s / I,
+ *   u = q + K P,  K_rs = d_r . d_s / M + b_r b_s / J + [same beam] l_r l_s / I,
  *   q_2i = v_n,i - bound_i,  q_2i+1 = v_t,i,
  * K = J M^-1 J^T symmetric positive semi-definite. Per contact:
  *   P_n >= 0, u_n >= 0, P_n u_n = 0                    (the normal LCP)
@@ -51,8 +51,9 @@ static double k_rows(double inv_mass, double inv_j, const thesis_contact *cs, in
 	row_of(&cs[r / 2], r, dr, &br, &lr);
 	row_of(&cs[s / 2], s, ds, &bs, &ls);
 	double k = (dr[0] * ds[0] + dr[1] * ds[1]) * inv_mass + br * bs * inv_j;
-	if (r / 2 == s / 2)
-		k += lr * ls * cs[r / 2].inv_i;
+	const thesis_contact *a = &cs[r / 2], *b = &cs[s / 2];
+	if (a == b || (a->two && b->two && a->beam == b->beam)) /* one beam */
+		k += lr * ls * a->inv_i;
 	return k;
 }
 

@@ -3,7 +3,8 @@
  *
  * Unknown impulses P_i >= 0 on contacts i. The solved normal velocity is
  *   w_i = q_i + sum_j K_ij P_j >= 0,   P_i w_i = 0,
- *   q_i = vrel_i - bound_i,   K_ij = (n_i . n_j) / M + [i = j] c_i^2 inv_i,
+ *   q_i = vrel_i - bound_i,   K_ij = (n_i . n_j) / M + [same beam] c_i c_j inv_i,
+ * (contacts on one beam: i = j, or a capsule's two, thesis_contact.two)
  * with 1/M from the caller (impacts pass 1/impact_mass, impact_resolve.c).
  * K = J M^-1 J^T is symmetric positive definite (1/M > 0 and the normals of
  * two contacts are not parallel), so the solution is unique.
@@ -46,6 +47,8 @@ static double k_entry(double inv_mass, double inv_j, const thesis_contact *a,
 	double k = (a->n[0] * b->n[0] + a->n[1] * b->n[1]) * inv_mass;
 	if (a == b)
 		k += a->c * a->c * a->inv_i;
+	else if (a->two && b->two && a->beam == b->beam) /* a capsule's two on one beam */
+		k += a->c * b->c * a->inv_i;
 	if (inv_j != 0.0)
 		k += a->cb * b->cb * inv_j;
 	return k;

@@ -97,19 +97,28 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 		if (k < 0) {
 			omega_new = thesis_beam_free_omega(b, h, w->integrator);
 		} else {
-			const thesis_contact *c = &cs[k];
-			omega_new = c->omega_free - c->impulse * c->c * c->inv_i;
-			if (c->impulse_t != 0.0)
-				omega_new = c->omega_free -
-				            (c->impulse * c->c + c->impulse_t * c->ct) * c->inv_i;
+			/* The beam's contacts: one, or a capsule's two. */
+			double moment = 0.0;
+			for (int q = 0; q < n; q++)
+				if (cs[q].beam == i)
+					moment += cs[q].impulse * cs[q].c +
+					          cs[q].impulse_t * cs[q].ct;
+			omega_new = cs[k].omega_free - moment * cs[k].inv_i;
 			double omega_m = w->integrator == THESIS_EULER
 			                         ? omega_new
 			                         : 0.5 * (b->omega + omega_new);
-			w->energy.contact -=
-			        c->impulse * ((c->n[0] * vm[0] + c->n[1] * vm[1]) - c->c * omega_m);
-			w->energy.contact -= c->impulse * (c->cb * wm) +
-			                     c->impulse_t * ((vm[1] * c->n[0] - vm[0] * c->n[1]) +
-			                                     c->cbt * wm - c->ct * omega_m);
+			for (int q = 0; q < n; q++) {
+				const thesis_contact *c = &cs[q];
+				if (c->beam != i)
+					continue;
+				w->energy.contact -=
+				        c->impulse *
+				        ((c->n[0] * vm[0] + c->n[1] * vm[1]) - c->c * omega_m);
+				w->energy.contact -=
+				        c->impulse * (c->cb * wm) +
+				        c->impulse_t * ((vm[1] * c->n[0] - vm[0] * c->n[1]) +
+				                        c->cbt * wm - c->ct * omega_m);
+			}
 		}
 		w->energy.damper += thesis_beam_advance(b, omega_new, h, w->integrator);
 	}

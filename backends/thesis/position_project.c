@@ -56,15 +56,33 @@ static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const 
 /* Projections per step at most. */
 #define PROJECT_PASSES_MAX 3
 
+/* The contacts of the beams of cs[0..n) detected again into cs, each beam
+ * once (a capsule may have two contacts with one beam, and may have one
+ * where it had two, or two where it had one): the beams are listed first
+ * (in w->candidates, free after the step's detection). */
+static int redetect(struct bsim_world *w, thesis_contact *cs, int n, double margin)
+{
+	int nb = 0;
+	for (int k = 0; k < n; k++) {
+		int seen = 0;
+		for (int q = 0; q < nb && !seen; q++)
+			seen = w->candidates[q] == cs[k].beam;
+		if (!seen)
+			w->candidates[nb++] = cs[k].beam;
+	}
+	int m = 0;
+	for (int q = 0; q < nb; q++)
+		m += thesis_contact_detect(w, w->candidates[q], margin, &cs[m]);
+	return m;
+}
+
 /* Re-detects the step's contacts at the new positions (they are the only
  * beams the step could have reached) and projects out penetration. */
 void thesis_position_project(struct bsim_world *w, const double force[2], double torque)
 {
 	double margin = w->contact_tol;
 	thesis_contact *cs = w->contacts;
-	int n = 0;
-	for (int k = 0; k < w->n_contacts; k++)
-		n += thesis_contact_detect(w, cs[k].beam, margin, &cs[n]);
+	int n = redetect(w, cs, w->n_contacts, margin);
 	for (int pass = 0; w->projection; pass++) {
 		int deep = 0;
 		for (int k = 0; k < n; k++)
@@ -76,10 +94,7 @@ void thesis_position_project(struct bsim_world *w, const double force[2], double
 			break;
 		}
 		project_once(w, cs, n, force, torque);
-		int m = 0;
-		for (int k = 0; k < n; k++)
-			m += thesis_contact_detect(w, cs[k].beam, margin, &cs[m]);
-		n = m;
+		n = redetect(w, cs, n, margin);
 	}
 	w->n_contacts = n;
 	for (int k = 0; k < n; k++)

@@ -44,6 +44,10 @@ typedef struct thesis_geometry {
 	/* The extended path's (a shape other than the disk): the heading the
 	 * geometry was computed at, rad, and the levers cb, cbt, ct, m. */
 	double psi, cb, cbt, ct;
+	/* A capsule resting along the beam touches it at both ends of its core:
+	 * the second end's contact (has2), in the same terms. */
+	int has2, type2;
+	double dist2, n2[2], c2, cb2, cbt2, ct2;
 } thesis_geometry;
 
 typedef struct thesis_beam {
@@ -87,6 +91,9 @@ typedef struct thesis_contact {
 	double cb, cbt, ct;
 	double vrel_t, impulse_t;
 	double mu;
+	/* 1: one of a capsule's two contacts with its beam (contact_detect.c),
+	 * whose impulses both turn the beam: K couples the pair. */
+	int two;
 } thesis_contact;
 
 /* The broad phase's uniform grid over the pivots (broad_phase.c). */
@@ -146,7 +153,8 @@ struct bsim_world {
 	int *typed;              /* beams whose contact_type is not NONE */
 	int n_typed;
 	/* per step */
-	thesis_contact *contacts; /* n_beams capacity */
+	thesis_contact *contacts; /* 2 n_beams capacity: a capsule has up to two
+	                           * contacts with one beam (contact_detect.c) */
 	int n_contacts;
 	int *contact_of;   /* per beam: its index in contacts, or -1 */
 	int *contact_type; /* per beam, at the end of the step, within contact_tol:
@@ -212,6 +220,8 @@ void thesis_awake_prune(struct bsim_world *w);
 
 /* contact_detect.c */
 void thesis_beam_direction(thesis_beam *b, double u[2]);
+/* The contacts of beam i within margin into out (room for 2); returns how
+ * many (0, 1, or 2 for a capsule along the beam). */
 int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out);
 /* 0 if beam i certainly lies farther than R + margin from the body (its
  * reach, or the bound from its last geometry), 1 if it may not. */

@@ -157,7 +157,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	size_t nb = scene->n_beams > 0 ? (size_t)scene->n_beams : 1;
 	if (w) {
 		w->beams = calloc(nb, sizeof *w->beams);
-		w->contacts = calloc(nb, sizeof *w->contacts);
+		w->contacts = calloc(2 * nb, sizeof *w->contacts);
 		w->contact_of = malloc(nb * sizeof *w->contact_of);
 		w->contact_type = calloc(nb, sizeof *w->contact_type);
 		w->awake = malloc(nb * sizeof *w->awake);
@@ -342,9 +342,11 @@ static int step_detect(bsim_world *w, const double force[2], double torque, doub
 		int i = w->candidates[k];
 		if (holding && !w->held[i])
 			continue; /* essay: the constraint loop tests only held beams */
-		if (thesis_contact_detect(w, i, thesis_step_margin(w, &w->beams[i], v, h),
-		                          &w->contacts[n]))
-			thesis_beam_wake(w, w->contacts[n++].beam);
+		int got = thesis_contact_detect(w, i, thesis_step_margin(w, &w->beams[i], v, h),
+		                                &w->contacts[n]);
+		if (got)
+			thesis_beam_wake(w, i);
+		n += got;
 	}
 	*speed = v;
 	return n;
@@ -402,8 +404,10 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 		w->any_held = essay_hold(w);
 	if (n)
 		thesis_position_project(w, force, torque);
+	/* A beam's two contacts (a capsule along it) are adjacent: listed once. */
 	for (int k = 0; k < w->n_contacts; k++)
-		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE)
+		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE &&
+		    (k == 0 || w->contacts[k - 1].beam != w->contacts[k].beam))
 			w->typed[w->n_typed++] = w->contacts[k].beam;
 	if (!in_flight) {
 		if (w->sleep)
