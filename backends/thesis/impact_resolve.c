@@ -209,14 +209,20 @@ int thesis_impact_resolve(struct bsim_world *w, double h)
 	thesis_contact *cs = w->contacts;
 	int n = 0, approaching = 0;
 	for (int i = 0; i < w->n_contacts; i++) {
-		thesis_contact c = cs[i];
-		thesis_contact_velocity(w, &c);
-		if (c.gap + h * bsim_fmin(c.vrel, 0.0) > w->slop)
+		/* In place: a contact left behind has its velocity and 1/I set
+		 * again by the contact solve. Swapped only when out of place. */
+		thesis_contact *c = &cs[i];
+		thesis_contact_velocity(w, c);
+		if (c->gap + h * bsim_fmin(c->vrel, 0.0) > w->slop)
 			continue;
-		c.inv_i = w->beams[c.beam].inv_inertia;
-		approaching |= c.vrel < 0.0;
-		cs[i] = cs[n];
-		cs[n++] = c;
+		c->inv_i = w->beams[c->beam].inv_inertia;
+		approaching |= c->vrel < 0.0;
+		if (i != n) {
+			thesis_contact t = cs[n];
+			cs[n] = *c;
+			*c = t;
+		}
+		n++;
 	}
 	if (!approaching)
 		return 0;

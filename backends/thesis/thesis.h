@@ -223,6 +223,12 @@ void thesis_beam_direction(thesis_beam *b, double u[2]);
 /* The contacts of beam i within margin into out (room for 2); returns how
  * many (0, 1, or 2 for a capsule along the beam). */
 int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out);
+/* shape_contact.c: a body of another shape than the disk against beam b of
+ * direction u (thesis_beam_direction), into b->geo; and a capsule's second contact with the beam of
+ * geometry g into out[1] (out[0] the first) if within margin: 1, else 0. */
+void thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const double u[2]);
+int thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
+                        thesis_contact *out);
 /* 0 if beam i certainly lies farther than R + margin from the body (its
  * reach, or the bound from its last geometry), 1 if it may not. */
 int thesis_contact_near(const struct bsim_world *w, int i, double margin);
