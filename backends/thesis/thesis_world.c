@@ -478,7 +478,8 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 const bsim_backend bsim_backend_thesis = {
         .name = "thesis",
         .description = "the essay's collision + constraint solver: impulses with restitution, "
-                       "persistent contact by complementarity, implicit beam springs",
+                       "persistent contact by complementarity, implicit beam springs; a body "
+                       "that turns, capsule and ellipse outlines, Coulomb contact friction",
         .knobs = thesis_knobs,
         .n_knobs = N_KNOBS,
         .create = thesis_create,
