@@ -306,7 +306,7 @@ static void test_no_energy_created(void **state)
 {
 	(void)state;
 	uint64_t seed = 26;
-	int cases = 0, met = 0;
+	int cases = 0, met = 0, two_point = 0;
 	long scaled = 0;
 	double worst = -INFINITY;
 	for (int k = 0; k < 3000; k++) {
@@ -315,7 +315,8 @@ static void test_no_energy_created(void **state)
 		s.body.shape = BSIM_SHAPE_CAPSULE;
 		s.body.radius = 1.0 + 2.0 * uniform(&seed);
 		s.body.length = 2.0 + 10.0 * uniform(&seed);
-		s.body.heading_deg = 360.0 * uniform(&seed);
+		/* every 4th lies along the beam: two contacts with it */
+		s.body.heading_deg = k % 4 == 0 ? 180.0 * (k % 8 == 0) : 360.0 * uniform(&seed);
 		s.body.rotates = 1;
 		s.body.angular_velocity = 2.0 * uniform(&seed) - 1.0;
 		s.contact.restitution = k % 7 == 0 ? 1.0 : uniform(&seed);
@@ -340,8 +341,11 @@ static void test_no_energy_created(void **state)
 		s.body.start[1] = x[1];
 		double speed = 0.2 + 3.0 * uniform(&seed), ang = 2.0 * M_PI_VALUE * uniform(&seed);
 		/* approaching: against the normal, plus a random part */
-		s.body.velocity[0] = -speed * bc.n[0] + 0.7 * speed * cos(ang);
-		s.body.velocity[1] = -speed * bc.n[1] + 0.7 * speed * sin(ang);
+		double side_part = k % 4 == 0 ? 0.0 : 0.7; /* flat: straight on, both ends */
+		s.body.velocity[0] = -speed * bc.n[0] + side_part * speed * cos(ang);
+		s.body.velocity[1] = -speed * bc.n[1] + side_part * speed * sin(ang);
+		if (k % 4 == 0)
+			s.body.angular_velocity = 0.0;
 		bsim_world *w = make(&s);
 		bsim_state st;
 		bsim_state_init(&st, 1);
@@ -357,6 +361,7 @@ static void test_no_energy_created(void **state)
 		            0.5 * ib * st.omega[0] * st.omega[0];
 		cases++;
 		met += st.impacts > 0;
+		two_point += st.impacts == 2; /* one beam, both ends of the core */
 		scaled += w->impacts_scaled;
 		worst = fmax(worst, (e1 - e0) / e0);
 		assert_true(e1 <= e0 * (1.0 + 1e-12));
@@ -365,10 +370,11 @@ static void test_no_energy_created(void **state)
 		bsim_state_free(&st);
 		bsim_scene_free(&s);
 	}
-	printf("%d impacts tried, %d met the beam, %ld scaled toward plastic; largest relative "
-	       "energy change %.3g\n",
-	       cases, met, scaled, worst);
+	printf("%d impacts tried, %d met the beam (%d on two points), %ld scaled toward plastic; "
+	       "largest relative energy change %.3g\n",
+	       cases, met, two_point, scaled, worst);
 	assert_true(met > cases / 2);
+	assert_true(two_point > 100);
 }
 
 /* thesis_contact_solve on random problems of 1 to 4 contacts (the body's

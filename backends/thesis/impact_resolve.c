@@ -95,6 +95,10 @@ static double impact_energy_change(const struct bsim_world *w, const thesis_cont
 		jw += pn[i] * cs[i].cb + pt[i] * cs[i].cbt;
 		double jb = pn[i] * cs[i].c + pt[i] * cs[i].ct;
 		e += 0.5 * jb * jb * cs[i].inv_i;
+		/* a capsule's two contacts turn one beam: (jb_i + jb_j)^2 / 2I */
+		for (int k = i + 1; k < n; k++)
+			if (cs[i].two && cs[k].two && cs[i].beam == cs[k].beam)
+				e += jb * (pn[k] * cs[k].c + pt[k] * cs[k].ct) * cs[i].inv_i;
 	}
 	e += 0.5 * (jv[0] * jv[0] + jv[1] * jv[1]) * w->impact_inv_mass +
 	     0.5 * jw * jw * w->inv_body_inertia;

@@ -8,75 +8,106 @@
 #include "model/body_shape.h"
 #include "thesis/thesis.h"
 
-/* One end E of a capsule's core (cap radius R) against the segment p-tip,
- * as a contact: Q the segment's point nearest E, n = (E - Q) / |E - Q|,
- * gap |E - Q| - R, K = E - R n. 0 if E lies on the segment. */
-static int cap_contact(const struct bsim_world *w, const thesis_beam *b, const double tip[2],
-                       const double e[2], double *dist, double n[2], double lev[4], int *type)
+/* A pair of points, K on the capsule's core and Q on the beam, as a contact
+ * of the outline: n = (K - Q) / |K - Q|, gap |K - Q| - R, the outline's
+ * point K - R n; s the place of Q along the beam (0 at the pivot, 1 at the
+ * tip). 0 if K lies on the beam. */
+typedef struct cap_pair {
+	double dist, n[2], lev[4], s; /* lev: c, ct, cb, cbt */
+	int type;
+} cap_pair;
+
+static int pair_contact(const struct bsim_world *w, const thesis_beam *b, const double k[2],
+                        const double q[2], double s, cap_pair *out)
 {
-	double d[2] = {tip[0] - b->p[0], tip[1] - b->p[1]};
-	double s =
-	        ((e[0] - b->p[0]) * d[0] + (e[1] - b->p[1]) * d[1]) / (d[0] * d[0] + d[1] * d[1]);
-	*type = s > 0.0 && s < 1.0 ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
-	s = fmin(fmax(s, 0.0), 1.0);
-	double q[2] = {b->p[0] + s * d[0], b->p[1] + s * d[1]};
-	double len = hypot(e[0] - q[0], e[1] - q[1]);
+	double len = hypot(k[0] - q[0], k[1] - q[1]);
 	if (!(len > 0.0))
 		return 0;
-	n[0] = (e[0] - q[0]) / len;
-	n[1] = (e[1] - q[1]) / len;
-	*dist = len - w->body.radius;
+	double *n = out->n;
+	n[0] = (k[0] - q[0]) / len;
+	n[1] = (k[1] - q[1]) / len;
+	out->dist = len - w->body.radius;
+	out->s = s;
+	out->type = s > 0.0 && s < 1.0 ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
 	double a[2] = {q[0] - b->p[0], q[1] - b->p[1]};
-	double r[2] = {e[0] - w->body.radius * n[0] - w->x[0],
-	               e[1] - w->body.radius * n[1] - w->x[1]};
-	lev[0] = b->sgn * (a[0] * n[1] - a[1] * n[0]); /* c */
-	lev[1] = b->sgn * (a[0] * n[0] + a[1] * n[1]); /* ct */
-	lev[2] = r[0] * n[1] - r[1] * n[0];            /* cb */
-	lev[3] = r[0] * n[0] + r[1] * n[1];            /* cbt */
+	double r[2] = {k[0] - w->body.radius * n[0] - w->x[0],
+	               k[1] - w->body.radius * n[1] - w->x[1]};
+	out->lev[0] = b->sgn * (a[0] * n[1] - a[1] * n[0]);
+	out->lev[1] = b->sgn * (a[0] * n[0] + a[1] * n[1]);
+	out->lev[2] = r[0] * n[1] - r[1] * n[0];
+	out->lev[3] = r[0] * n[0] + r[1] * n[1];
 	return 1;
 }
 
-/* A capsule's core ends A and B against the beam. Where the outline's
- * nearest point (body_shape_segment) lies on one end's cap (or on the
- * middle of a flat overlap), the capsule rests along the beam on both
- * ends: the geometry becomes the two ends' contacts, the nearer first (the
- * first in g, the other in g's second), so that a capsule pressed flat on a
- * beam stands on two points rather than rocking on one. Where the nearest
- * point is a beam's end against the capsule's flank, that one contact
- * stays. */
-static void capsule_ends(const struct bsim_world *w, const thesis_beam *b, const double tip[2],
-                         thesis_geometry *g)
+/* The parameter in [0, 1] of the point of segment p0-p1 nearest q, unclamped. */
+static double along(const double p0[2], const double p1[2], const double q[2])
+{
+	double d[2] = {p1[0] - p0[0], p1[1] - p0[1]};
+	return ((q[0] - p0[0]) * d[0] + (q[1] - p0[1]) * d[1]) / (d[0] * d[0] + d[1] * d[1]);
+}
+
+/* A capsule along the beam stands on the two ends of their overlap. The
+ * core A-B and the beam P-T, projected on each other, overlap between two
+ * extremes, each a core end over the beam (A or B against its nearest
+ * beam point) or a beam end beside the core (P or T against its nearest
+ * core point): the pairs with the parameter strictly inside the other
+ * segment. Where the nearest of them is the outline's nearest (the
+ * geometry computed from body_shape_segment), it is the first contact and
+ * the other extreme, if apart along the beam, the second (g's has2): a
+ * capsule pressed flat on a beam stands on two points rather than rocking
+ * on one, and where it crosses the beam the second lies far and is
+ * outside the step's margin. Otherwise (the nearest pair is end to end)
+ * the one contact stays. */
+static void capsule_pairs(const struct bsim_world *w, const thesis_beam *b, const double tip[2],
+                          thesis_geometry *g)
 {
 	double half = 0.5 * w->body.length;
 	double hu[2] = {half * cos(w->heading), half * sin(w->heading)};
-	double ends[2][2] = {{w->x[0] - hu[0], w->x[1] - hu[1]},
+	double core[2][2] = {{w->x[0] - hu[0], w->x[1] - hu[1]},
 	                     {w->x[0] + hu[0], w->x[1] + hu[1]}};
-	double dist[2], n[2][2], lev[2][4];
-	int type[2];
-	for (int e = 0; e < 2; e++)
-		if (!cap_contact(w, b, tip, ends[e], &dist[e], n[e], lev[e], &type[e]))
-			return;
-	int near = dist[1] < dist[0];
-	double gap = g->dist - w->radius; /* the outline's nearest */
-	/* The nearest point on an end's cap: that end's gap is the nearest. */
-	if (!(dist[near] <= gap + 1e-9 * (1.0 + fabs(gap))))
-		return;
-	for (int k = 0; k < 2; k++) {
-		int e = k == 0 ? near : 1 - near;
-		double *dst_n = k == 0 ? g->n : g->n2;
-		dst_n[0] = n[e][0];
-		dst_n[1] = n[e][1];
-		if (k == 0) {
-			g->dist = dist[e] + w->radius;
-			g->type = type[e];
-			g->c = lev[e][0], g->ct = lev[e][1], g->cb = lev[e][2], g->cbt = lev[e][3];
-		} else {
-			g->dist2 = dist[e] + w->radius;
-			g->type2 = type[e];
-			g->c2 = lev[e][0], g->ct2 = lev[e][1], g->cb2 = lev[e][2],
-			g->cbt2 = lev[e][3];
-		}
+	const double *beam[2] = {b->p, tip};
+	double d[2] = {tip[0] - b->p[0], tip[1] - b->p[1]}, c[2] = {2 * hu[0], 2 * hu[1]};
+	cap_pair cand[4];
+	int m = 0;
+	for (int e = 0; e < 2; e++) {
+		double t = along(b->p, tip, core[e]);
+		double q[2] = {b->p[0] + t * d[0], b->p[1] + t * d[1]};
+		if (t > 0.0 && t < 1.0 && pair_contact(w, b, core[e], q, t, &cand[m]))
+			m++;
 	}
+	for (int e = 0; e < 2; e++) {
+		double t = along(core[0], core[1], beam[e]);
+		double k[2] = {core[0][0] + t * c[0], core[0][1] + t * c[1]};
+		if (t > 0.0 && t < 1.0 && pair_contact(w, b, k, beam[e], (double)e, &cand[m]))
+			m++;
+	}
+	if (m < 2)
+		return;
+	int first = 0;
+	for (int k = 1; k < m; k++)
+		if (cand[k].dist < cand[first].dist)
+			first = k;
+	double gap = g->dist - w->radius; /* the outline's nearest */
+	if (!(cand[first].dist <= gap + 1e-9 * (1.0 + fabs(gap))))
+		return;
+	int second = -1;
+	double apart = 1e-9;
+	for (int k = 0; k < m; k++)
+		if (k != first && fabs(cand[k].s - cand[first].s) > apart) {
+			apart = fabs(cand[k].s - cand[first].s);
+			second = k;
+		}
+	if (second < 0)
+		return;
+	const cap_pair *f = &cand[first], *o = &cand[second];
+	g->dist = f->dist + w->radius;
+	g->type = f->type;
+	g->n[0] = f->n[0], g->n[1] = f->n[1];
+	g->c = f->lev[0], g->ct = f->lev[1], g->cb = f->lev[2], g->cbt = f->lev[3];
+	g->dist2 = o->dist + w->radius;
+	g->type2 = o->type;
+	g->n2[0] = o->n[0], g->n2[1] = o->n[1];
+	g->c2 = o->lev[0], g->ct2 = o->lev[1], g->cb2 = o->lev[2], g->cbt2 = o->lev[3];
 	g->has2 = 1;
 }
 
@@ -111,7 +142,7 @@ void thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const dou
 	g->cbt = r[0] * sc.n[0] + r[1] * sc.n[1];
 	g->has2 = 0;
 	if (w->body.shape == BSIM_SHAPE_CAPSULE)
-		capsule_ends(w, b, tip, g);
+		capsule_pairs(w, b, tip, g);
 }
 
 int thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
