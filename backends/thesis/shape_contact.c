@@ -122,6 +122,7 @@ void thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const dou
 	g->theta = b->theta;
 	g->psi = w->heading;
 	body_segment_contact sc;
+	g->has2 = 0;
 	if (body_shape_segment(&w->body, w->x, w->heading, b->p, tip, &sc) != BSIM_OK) {
 		/* The beam crosses the body's centre line: no normal. */
 		g->type = BSIM_CONTACT_NONE;
@@ -140,7 +141,6 @@ void thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const dou
 	g->ct = b->sgn * (a[0] * sc.n[0] + a[1] * sc.n[1]);
 	g->cb = r[0] * sc.n[1] - r[1] * sc.n[0];
 	g->cbt = r[0] * sc.n[0] + r[1] * sc.n[1];
-	g->has2 = 0;
 	if (w->body.shape == BSIM_SHAPE_CAPSULE)
 		capsule_pairs(w, b, tip, g);
 }
