@@ -113,6 +113,17 @@ typedef struct bsim_sweep_config {
 	 * (lattice_summaries). */
 	bsim_sweep_sink_fn sink;
 	void *sink_user;
+	/* One of several sweeps sharing one journal (beamsim markov validate,
+	 * essay; unstreamed sweeps and parts): trial i is the journal's record
+	 * journal_first + i, and the journal's records are indices 0 ..
+	 * journal_total - 1 (0: this sweep's alone). A part's trial i is part
+	 * (journal_first + i) mod count's, and its done bits, records and the
+	 * records collected from other parts are by journal index. */
+	long journal_first, journal_total;
+	/* 1: the caller uses the trials' results only, not their gate paths
+	 * (trials_out, not logs): a lattice's trials are taken from the
+	 * journal too, instead of running again. */
+	int results_only;
 } bsim_sweep_config;
 
 /* Trials per block of a streamed sweep: about 30 MB of results and gate

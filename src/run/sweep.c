@@ -190,10 +190,12 @@ typedef struct sweep_shared {
 	long progress_total;         /* what progress counts up to */
 } sweep_shared;
 
-/* Trial i is another part's, or done before this part began. */
-static int part_skips(const bsim_sweep_part *p, long i)
+/* Trial i is another part's, or done before this part began (by journal
+ * index j, bsim_sweep_config.journal_first). */
+static int part_skips(const bsim_sweep_part *p, long first, long i)
 {
-	return p && (i % p->count != p->index || (p->done && (p->done[i / 8] & (1u << (i % 8)))));
+	long j = first + i;
+	return p && (j % p->count != p->index || (p->done && (p->done[j / 8] & (1u << (j % 8)))));
 }
 
 /* A record another part sent (bsim_sweep_accept_fn): into the journal,
@@ -201,9 +203,10 @@ static int part_skips(const bsim_sweep_part *p, long i)
 static int part_accept(void *ctx, long index, const void *payload, bsim_error *err)
 {
 	sweep_shared *sh = ctx;
-	if (index < 0 || index >= sh->total)
+	long total = sh->cfg->journal_total > 0 ? sh->cfg->journal_total : sh->total;
+	if (index < 0 || index >= total)
 		return bsim_error_set(err, BSIM_EFAIL, "a part sent trial %ld of a sweep of %ld",
-		                      index, sh->total);
+		                      index, total);
 	if (sh->cfg->journal &&
 	    bsim_journal_append(sh->cfg->journal, (uint64_t)index, payload, err) != BSIM_OK)
 		return BSIM_EFAIL;
@@ -232,22 +235,35 @@ static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
 static int journal_append(sweep_shared *sh, long i, bsim_error *err)
 {
 	long k = i - sh->first;
+	uint64_t j = (uint64_t)(sh->cfg->journal_first + i);
 	if (!sh->backend_b)
-		return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &sh->results[k], err);
+		return bsim_journal_append(sh->cfg->journal, j, &sh->results[k], err);
 	pair_record p = {sh->results[k], sh->results_b[k], sh->t_separate[k]};
-	return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &p, err);
+	return bsim_journal_append(sh->cfg->journal, j, &p, err);
 }
 
 /* A journal record back into its slots (bsim_journal_fn). */
 static int journal_take(void *user, uint64_t index, const void *payload)
 {
 	sweep_shared *sh = user;
+	const bsim_sweep_config *cfg = sh->cfg;
+	/* A journal shared by several sweeps: the others' records are passed over. */
+	if (cfg->journal_total > 0) {
+		if (index >= (uint64_t)cfg->journal_total)
+			return 1;
+		if (index < (uint64_t)cfg->journal_first ||
+		    index - (uint64_t)cfg->journal_first >= (uint64_t)sh->total)
+			return 0;
+		index -= (uint64_t)cfg->journal_first;
+	}
 	if (index >= (uint64_t)sh->total)
 		return 1;
 	/* A trial whose trajectory is kept runs again (trajectories are not
 	 * journaled; the trial is the same): its record is passed over. So
-	 * does every trial of a lattice, whose gate path is not journaled. */
-	if ((long)(index % (uint64_t)sh->e->trials) < sh->keep || sh->lattice)
+	 * does every trial of a lattice, whose gate path is not journaled,
+	 * unless only the results are wanted. */
+	if ((long)(index % (uint64_t)sh->e->trials) < sh->keep ||
+	    (sh->lattice && !cfg->results_only))
 		return 0;
 	if (sh->journaled) {
 		/* Streamed: the record waits in the spill file for its block. */
@@ -300,7 +316,7 @@ static void sweep_thread(sweep_shared *sh)
 #pragma omp atomic read
 		stop = sh->first_fail;
 		if (!runner || i > stop || (sh->from_journal && sh->from_journal[k]) ||
-		    part_skips(sh->part, i))
+		    part_skips(sh->part, cfg->journal_first, i))
 			continue;
 		if (cfg->stop && *cfg->stop) {
 #pragma omp atomic write
@@ -349,7 +365,7 @@ static void sweep_thread(sweep_shared *sh)
 			if (sh->backend_b)
 				p = (pair_record){sh->results[k], sh->results_b[k],
 				                  sh->t_separate[k]};
-			rc = sh->part->record(sh->part->user, i,
+			rc = sh->part->record(sh->part->user, cfg->journal_first + i,
 			                      sh->backend_b ? (const void *)&p : &sh->results[k],
 			                      &err);
 		}
@@ -915,11 +931,12 @@ static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	};
 	/* Progress: this part's trials, or with collect every part's. */
 	for (long i = 0; i < total; i++) {
-		int done = part->done && (part->done[i / 8] & (1u << (i % 8)));
+		long j = cfg->journal_first + i;
+		int done = part->done && (part->done[j / 8] & (1u << (j % 8)));
 		if (part->collect)
 			sh.done += done;
 		else
-			sh.progress_total += !part_skips(part, i);
+			sh.progress_total += !part_skips(part, cfg->journal_first, i);
 	}
 	if (part->collect)
 		sh.progress_total = total;
