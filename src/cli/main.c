@@ -17,7 +17,8 @@ static const cli_command commands[] = {
         {"run", cmd_run, "run one trial of a scene, print its outcome, record a trajectory"},
         {"sweep", cmd_sweep, "run every group and trial of an experiment in parallel"},
         {"merge", cmd_merge,
-         "join the parts of a run as a job array (sweep|compare|markov build --shard I/N)"},
+         "join the parts of a run as a job array (sweep|compare|essay|markov build|markov "
+         "validate --shard I/N)"},
         {"compare", cmd_compare,
          "run an experiment on two backends, or two settings of one, pair by pair"},
         {"regress", cmd_regress, "rerun a stored sweep or comparison and report what changed"},
