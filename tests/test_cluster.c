@@ -408,6 +408,70 @@ static void test_markov_shards_merged(void **state)
 
 /* ---- MPI ----------------------------------------------------------------- */
 
+/* ---- a lattice sweep: its records hold the gate paths -------------------- */
+
+/* The C-track of the essay's lattice run (F 6 N) as a whole world, Rm 80 N,
+ * each gate held up to the whole duration: 30 trials, some of whose paths
+ * enter more gates (up to 46) than a journal record holds (32), so those
+ * trials run again where the files are written. argv filled, out and the
+ * extra arguments a, b (NULL: none) its last. */
+static void lattice_argv(const char **argv, char *exp, size_t size, const char *out,
+                         const char *threads, const char *a, const char *b)
+{
+	snprintf(exp, size, "%s", bsim_test_src("configs/lattice/c_track_essay.yaml"));
+	const char *v[] = {"sweep",     exp,
+	                   "--trials",  "30",
+	                   "--set",     "termination.gate_time=216",
+	                   "--set",     "lattice.protocol=world",
+	                   "--grid",    "effects.random_force.magnitude=80",
+	                   "--threads", threads,
+	                   "--out",     out,
+	                   "--quiet",   a,
+	                   b,           NULL};
+	memcpy(argv, v, sizeof v);
+}
+
+static void run_ok(const char *const *argv);
+
+/* The lattice sweep in 3 parts, merged: the one-process trials.csv,
+ * gate_entries.csv, beam_peaks.csv, final_locations.csv,
+ * transitions.csv, lattice_map.csv, summary.json (but its wall time) and
+ * twins, the trials whose paths did not fit their records included. */
+static void test_lattice_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[3][1100], exp[1200];
+	const char *argv[20];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("lattice_parts"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	lattice_argv(argv, exp, sizeof exp, one, "2", NULL, NULL);
+	run_ok(argv);
+	/* the case holds a path longer than a record's */
+	char *entries = bsim_test_read(bsim_test_join(one, "gate_entries.csv"));
+	assert_non_null(entries);
+	int longest = 0;
+	for (char *line = strchr(entries, '\n'); line && line[1]; line = strchr(line + 1, '\n')) {
+		int g, t, seq;
+		if (sscanf(line + 1, "%d,%d,%d", &g, &t, &seq) == 3 && seq + 1 > longest)
+			longest = seq + 1;
+	}
+	free(entries);
+	assert_true(longest > 32);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		lattice_argv(argv, exp, sizeof exp, part[i], i == 1 ? "2" : "1", "--shard",
+		             shard_arg);
+		run_ok(argv);
+	}
+	snprintf(out, sizeof out, "%s/merged", dir);
+	const char *m[] = {"merge", part[2], part[1], part[0], "--out", out, "--quiet", NULL};
+	run_ok(m);
+	assert_same_dir(one, out);
+	assert_true(bsim_test_exists(bsim_test_join(out, "transitions.csv")));
+}
+
 /* ---- markov validate and essay: several sweeps, one journal ------------- */
 
 /* The maps of the C-track (configs/markov/c_track.yaml, 10 trials a bin)
@@ -832,6 +896,33 @@ static void test_mpi_rank_killed_resumed(void **state)
 	assert_same_dir(one, out);
 }
 
+/* mpirun -np 3 beamsim sweep of the lattice: the one-process files. */
+static void test_mpi_lattice(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200], exp[1200];
+	const char *argv[20],
+	        *job[26] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_lattice"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/ranks3", dir);
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	lattice_argv(argv, exp, sizeof exp, one, "2", NULL, NULL);
+	run_ok(argv);
+	lattice_argv(argv, exp, sizeof exp, out, "1", NULL, NULL);
+	int n = 0;
+	while (argv[n])
+		n++;
+	memcpy(job + 5, argv, (size_t)(n + 1) * sizeof *argv);
+	int rc = wait_status(spawn_mpirun(job, err_path));
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
+}
+
 /* mpirun -np 3 beamsim markov validate and essay: the one-process
  * directories. */
 static void test_mpi_validate_essay(void **state)
@@ -936,6 +1027,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_compare_shards_merged),
 	        cmocka_unit_test(test_merge_refuses),
 	        cmocka_unit_test(test_markov_shards_merged),
+	        cmocka_unit_test(test_lattice_shards_merged),
 	        cmocka_unit_test(test_validate_shards_merged),
 	        cmocka_unit_test(test_essay_shards_merged),
 	        cmocka_unit_test(test_validate_killed_resumed),
@@ -945,6 +1037,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_mpi_compare),
 	        cmocka_unit_test(test_mpi_markov_build),
 	        cmocka_unit_test(test_mpi_rank_killed_resumed),
+	        cmocka_unit_test(test_mpi_lattice),
 	        cmocka_unit_test(test_mpi_validate_essay),
 	        cmocka_unit_test(test_mpi_essay_killed_resumed),
 	};

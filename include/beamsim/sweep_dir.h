@@ -70,9 +70,9 @@ typedef struct bsim_sweep_dir_def {
 	 *                       written as one process writes it (MPI rank 0);
 	 *   BSIM_SPREAD_SEND    this process's part, its records handed to
 	 *                       part.record; out is not touched (other ranks).
-	 * part.done is the run's own. A lattice sweep cannot be split (its
-	 * gate paths are not journaled): SHARD refuses it, GATHER runs it all
-	 * and SEND none of it. */
+	 * part.done is the run's own. A lattice sweep's records hold its
+	 * trials' gate paths and peaks (bsim_sweep_record_size_for), so it is
+	 * split as any other. */
 	int spread;
 	bsim_sweep_part part;
 	/* GATHER and SEND: called in every process once the inputs are known,

@@ -415,6 +415,14 @@ static int mpi_agree(void *user, const char *inputs, unsigned char *done, size_t
 	return BSIM_OK;
 }
 
+/* The records' size, once the run knows it (bsim_sweep_part.sized): a
+ * lattice sweep's hold its gate paths. */
+static void mpi_sized(void *user, size_t record_size)
+{
+	(void)user;
+	queue.record_size = record_size;
+}
+
 void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
                     const volatile sig_atomic_t *stop)
 {
@@ -427,7 +435,8 @@ void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree,
 	                          .count = mpi_size,
 	                          .record = mpi_rank ? mpi_record : NULL,
 	                          .collect = mpi_collect,
-	                          .user = &part_state};
+	                          .user = &part_state,
+	                          .sized = mpi_sized};
 	*agree = mpi_agree;
 }
 

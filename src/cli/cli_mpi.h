@@ -37,7 +37,8 @@ typedef int (*cli_mpi_agree_fn)(void *user, const char *inputs, unsigned char *d
 
 /* In a job of several ranks, a run spread over them: rank 0 gathers and
  * writes, the others send (*spread, *part, *agree of a sweep's or a
- * comparison's def, whose journal records are record_size bytes). */
+ * comparison's def, whose journal records are record_size bytes, or as
+ * many as the run says before it starts: bsim_sweep_part.sized). */
 void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
                     const volatile sig_atomic_t *stop);
 
