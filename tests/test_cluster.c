@@ -410,20 +410,20 @@ static void test_markov_shards_merged(void **state)
 
 /* ---- a lattice sweep: its records hold the gate paths -------------------- */
 
-/* The C-track of the essay's lattice run (F 6 N) as a whole world, Rm 80 N,
- * each gate held up to the whole duration: 30 trials, some of whose paths
- * enter more gates (up to 46) than a journal record holds (32), so those
- * trials run again where the files are written. argv filled, out and the
+/* The C-track of the essay's lattice run (F 6 N) as a whole world, Rm 100
+ * N, each gate held up to the whole duration: 12 trials, one of whose paths
+ * enters more gates (38) than a journal record holds (32), so that trial
+ * runs again where the files are written. argv filled, out and the
  * extra arguments a, b (NULL: none) its last. */
 static void lattice_argv(const char **argv, char *exp, size_t size, const char *out,
                          const char *threads, const char *a, const char *b)
 {
 	snprintf(exp, size, "%s", bsim_test_src("configs/lattice/c_track_essay.yaml"));
 	const char *v[] = {"sweep",     exp,
-	                   "--trials",  "30",
+	                   "--trials",  "12",
 	                   "--set",     "termination.gate_time=216",
 	                   "--set",     "lattice.protocol=world",
-	                   "--grid",    "effects.random_force.magnitude=80",
+	                   "--grid",    "effects.random_force.magnitude=100",
 	                   "--threads", threads,
 	                   "--out",     out,
 	                   "--quiet",   a,
@@ -474,8 +474,9 @@ static void test_lattice_shards_merged(void **state)
 
 /* ---- markov validate and essay: several sweeps, one journal ------------- */
 
-/* The maps of the C-track (configs/markov/c_track.yaml, 10 trials a bin)
- * that markov validate reads, built once. */
+/* The maps of the C-track (configs/markov/c_track.yaml, 2 x 2 x 2 entry
+ * bins of 5 trials: a chain quick to solve) that markov validate reads,
+ * built once. */
 static const char *validate_maps(void)
 {
 	static char maps[1024];
@@ -483,8 +484,8 @@ static const char *validate_maps(void)
 		snprintf(maps, sizeof maps, "%s", bsim_test_dir("validate_maps"));
 		char exp[1200];
 		snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
-		const char *argv[] = {"markov",  "build", exp,  "--trials", "10",
-		                      "--quiet", "--out", maps, NULL};
+		const char *argv[] = {"markov", "build",   exp,     "--trials", "5", "--bins",
+		                      "2,2,2",  "--quiet", "--out", maps,       NULL};
 		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	}
 	return maps;
@@ -592,13 +593,13 @@ static void test_essay_shards_merged(void **state)
 	const char *argv[20];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("essay_parts"));
 	named_out(one, sizeof one, dir, "one");
-	essay_argv(argv, configs, sizeof configs, one, "3", "2", NULL, NULL);
+	essay_argv(argv, configs, sizeof configs, one, "2", "2", NULL, NULL);
 	run_ok(argv);
 	for (int i = 0; i < 3; i++) {
 		char shard_arg[16];
 		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
 		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
-		essay_argv(argv, configs, sizeof configs, part[i], "3", i == 1 ? "2" : "1",
+		essay_argv(argv, configs, sizeof configs, part[i], "2", i == 1 ? "2" : "1",
 		           "--shard", shard_arg);
 		run_ok(argv);
 	}
@@ -943,12 +944,12 @@ static void test_mpi_validate_essay(void **state)
 		named_out(out, sizeof out, sub, "ranks3");
 		snprintf(err_path, sizeof err_path, "%s/%s.err", dir, name);
 		if (k)
-			essay_argv(argv, configs, sizeof configs, one, "3", "2", NULL, NULL);
+			essay_argv(argv, configs, sizeof configs, one, "2", "2", NULL, NULL);
 		else
 			validate_argv(argv, exp, sizeof exp, one, "8", "2", NULL, NULL, NULL);
 		run_ok(argv);
 		if (k)
-			essay_argv(argv, configs, sizeof configs, out, "3", "1", NULL, NULL);
+			essay_argv(argv, configs, sizeof configs, out, "2", "1", NULL, NULL);
 		else
 			validate_argv(argv, exp, sizeof exp, out, "8", "1", NULL, NULL, NULL);
 		int n = 0;
@@ -963,9 +964,9 @@ static void test_mpi_validate_essay(void **state)
 	}
 }
 
-/* An essay job of 3 ranks whose rank 2 is killed once rank 0's journal
- * holds 20 records (of the 979 trials that run), resumed by 2 ranks: the
- * one-process essay. */
+/* An essay job of 3 ranks (one mode, 8 trials a group: 344 trials run, the
+ * 6 groups without random force once) whose rank 2 is killed once rank 0's
+ * journal holds 20 records, resumed by 2 ranks: the one-process essay. */
 static void test_mpi_essay_killed_resumed(void **state)
 {
 	(void)state;
@@ -976,13 +977,13 @@ static void test_mpi_essay_killed_resumed(void **state)
 	        *job[26] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_essay_killed"));
 	named_out(one, sizeof one, dir, "one");
-	essay_argv(argv, configs, sizeof configs, one, "20", "2", NULL, NULL);
+	essay_argv(argv, configs, sizeof configs, one, "8", "2", NULL, NULL);
 	argv[9] = "--quiet"; /* no sensitivity study */
 	run_ok(argv);
 	named_out(out, sizeof out, dir, "killed");
 	snprintf(err_path, sizeof err_path, "%s/killed.err", dir);
 	snprintf(journal, sizeof journal, "%s/.beamsim/journal", out);
-	essay_argv(argv, configs, sizeof configs, out, "20", "1", NULL, NULL);
+	essay_argv(argv, configs, sizeof configs, out, "8", "1", NULL, NULL);
 	argv[9] = "--quiet";
 	int n = 0;
 	while (argv[n])
