@@ -474,6 +474,10 @@ static void test_lattice_shards_merged(void **state)
 
 /* ---- markov validate and essay: several sweeps, one journal ------------- */
 
+/* "mpi_" in test_cluster mpi: its directories apart from test_cluster's,
+ * which ctest may run at the same time. */
+static const char *group_prefix = "";
+
 /* The maps of the C-track (configs/markov/c_track.yaml, 2 x 2 x 2 entry
  * bins of 5 trials: a chain quick to solve) that markov validate reads,
  * built once. */
@@ -481,7 +485,9 @@ static const char *validate_maps(void)
 {
 	static char maps[1024];
 	if (!maps[0]) {
-		snprintf(maps, sizeof maps, "%s", bsim_test_dir("validate_maps"));
+		char name[64];
+		snprintf(name, sizeof name, "%svalidate_maps", group_prefix);
+		snprintf(maps, sizeof maps, "%s", bsim_test_dir(name));
 		char exp[1200];
 		snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
 		const char *argv[] = {"markov", "build",   exp,     "--trials", "5", "--bins",
@@ -1048,5 +1054,6 @@ int main(int argc, char **argv)
 		printf("skipped: beamsim is built without MPI (CMake did not find it)\n");
 		return 77;
 	}
+	group_prefix = "mpi_";
 	return cmocka_run_group_tests(mpi, setup, NULL);
 }

@@ -201,11 +201,14 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 		if (rc == BSIM_OK)
 			rc = part_dir_journal_reopen(&b->ss, inputs, size, err);
 	}
-	/* Every sweep from the journal, the trials it lacks run here. */
+	/* Every sweep from the journal, the trials it lacks run here. A new
+	 * journal holds no record of a sweep before it runs: it is read (from
+	 * its start, once per sweep) only when it held records before. */
+	const int read_back = b->resume || merge || spread != BSIM_SPREAD_NONE;
 	b->done_before = 0;
 	b->total = c.total;
 	for (int s = 0; s < n && rc == BSIM_OK; s++) {
-		if (s > 0 && b->open)
+		if (s > 0 && b->open && read_back)
 			rc = part_dir_journal_reopen(&b->ss, inputs, size, err);
 		bsim_sweep_config k = batch_cfg(&c, s, b->open ? b->ss.journal : NULL);
 		c.sweep_total = 0;
