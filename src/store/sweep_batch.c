@@ -3,10 +3,13 @@
 
 #include "store/sweep_batch.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "beamsim/run_record.h"
 #include "store/part_dir.h"
@@ -46,6 +49,84 @@ static char *batch_inputs(const char *command, const bsim_experiment *const *e,
 		return NULL;
 	}
 	return text;
+}
+
+/* ---- a complete journal read once ----------------------------------------
+ *
+ * After a merge or an MPI job's parts the journal holds every trial, in the
+ * order the parts sent them. Read once, its records go to a file at their
+ * index's place (unlinked at once: nothing is left behind); each sweep then
+ * gets a journal of its own records only, so the sweeps do not each read
+ * the whole journal. */
+typedef struct batch_spill {
+	int fd;
+	size_t size;
+	long total;
+	unsigned char *have; /* a bit per journal index */
+	int failed;          /* errno of a failed write */
+} batch_spill;
+
+static int spill_take(void *user, uint64_t index, const void *payload)
+{
+	batch_spill *sp = user;
+	if (index >= (uint64_t)sp->total)
+		return 1;
+	if (pwrite(sp->fd, payload, sp->size, (off_t)(index * sp->size)) != (ssize_t)sp->size) {
+		sp->failed = errno ? errno : EIO;
+		return 1;
+	}
+	sp->have[index / 8] |= (unsigned char)(1u << (index % 8));
+	return 0;
+}
+
+static int spill_fill(batch_spill *sp, const char *journal, const char *inputs, bsim_error *err)
+{
+	char path[BSIM_PATH_MAX + 16];
+	snprintf(path, sizeof path, "%s.byindex", journal);
+	sp->fd = open(path, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+	if (sp->fd < 0)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot create (%s)", path,
+		                      strerror(errno));
+	unlink(path);
+	sp->have = calloc((size_t)sp->total / 8 + 1, 1);
+	if (!sp->have)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	long n = 0, cut = 0;
+	int rc = bsim_journal_read(journal, inputs, sp->size, spill_take, sp, &n, &cut, err);
+	if (rc == BSIM_OK && sp->failed)
+		rc = bsim_error_set(err, BSIM_EFAIL, "%s: cannot write (%s)", path,
+		                    strerror(sp->failed));
+	return rc;
+}
+
+/* The records first .. end - 1 as a journal at path, opened to be replayed. */
+static int spill_journal(const batch_spill *sp, const char *path, const char *inputs, long first,
+                         long end, bsim_journal **out, bsim_error *err)
+{
+	bsim_journal *j = NULL;
+	*out = NULL;
+	unsigned char *buf = malloc(sp->size);
+	int rc = buf ? bsim_journal_create(&j, path, inputs, sp->size, err)
+	             : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (long i = first; rc == BSIM_OK && i < end; i++) {
+		if (!(sp->have[i / 8] & (1u << (i % 8))))
+			continue;
+		if (pread(sp->fd, buf, sp->size, (off_t)((size_t)i * sp->size)) !=
+		    (ssize_t)sp->size)
+			rc = bsim_error_set(err, BSIM_EFAIL,
+			                    "cannot read back the journal's trial %ld (%s)", i,
+			                    strerror(errno));
+		else
+			rc = bsim_journal_append(j, (uint64_t)i, buf, err);
+	}
+	free(buf);
+	bsim_error ignore;
+	int closed = bsim_journal_close(j, rc == BSIM_OK ? err : &ignore);
+	if (rc == BSIM_OK)
+		rc = closed;
+	if (rc == BSIM_OK)
+		rc = bsim_journal_resume(out, path, inputs, sp->size, err);
+	return rc;
 }
 
 /* Progress over every sweep: the sweeps before this one counted whole. */
@@ -202,23 +283,42 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 			rc = part_dir_journal_reopen(&b->ss, inputs, size, err);
 	}
 	/* Every sweep from the journal, the trials it lacks run here. A new
-	 * journal holds no record of a sweep before it runs: it is read (from
-	 * its start, once per sweep) only when it held records before. */
-	const int read_back = b->resume || merge || spread != BSIM_SPREAD_NONE;
+	 * journal holds no record of a sweep before it runs; a resumed one is
+	 * read from its start for each sweep; a complete one (a merge's, an
+	 * MPI job's) once, each sweep then reading its own records only. */
+	const int complete = b->open && (merge || spread == BSIM_SPREAD_GATHER);
+	batch_spill spill = {-1, size, c.total, NULL, 0};
+	char own_path[BSIM_PATH_MAX + 16] = "";
+	if (rc == BSIM_OK && complete) {
+		snprintf(own_path, sizeof own_path, "%s.sweep", b->ss.journal_path);
+		rc = spill_fill(&spill, b->ss.journal_path, inputs, err);
+	}
 	b->done_before = 0;
 	b->total = c.total;
 	for (int s = 0; s < n && rc == BSIM_OK; s++) {
-		if (s > 0 && b->open && read_back)
-			rc = part_dir_journal_reopen(&b->ss, inputs, size, err);
-		bsim_sweep_config k = batch_cfg(&c, s, b->open ? b->ss.journal : NULL);
-		c.sweep_total = 0;
+		bsim_journal *own = NULL;
 		clock_t c0 = clock();
+		if (complete)
+			rc = spill_journal(&spill, own_path, inputs, first[s], first[s + 1], &own,
+			                   err);
+		else if (s > 0 && b->open && b->resume)
+			rc = part_dir_journal_reopen(&b->ss, inputs, size, err);
+		bsim_sweep_config k = batch_cfg(&c, s, own ? own : b->open ? b->ss.journal : NULL);
+		c.sweep_total = 0;
 		if (rc == BSIM_OK)
 			rc = bsim_sweep_run(e[s], &k, &res[s], err);
+		if (own) {
+			bsim_error ignore;
+			bsim_journal_close(own, &ignore);
+			unlink(own_path);
+		}
 		if (cpu)
 			cpu[s] += (double)(clock() - c0) / CLOCKS_PER_SEC;
 		b->done_before += first[s + 1] - first[s];
 	}
+	if (spill.fd >= 0)
+		close(spill.fd);
+	free(spill.have);
 	if (rc == BSIM_OK) {
 		b->ss.done = 1;
 		b->writes = 1;
