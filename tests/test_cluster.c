@@ -572,7 +572,7 @@ static void test_validate_shards_merged(void **state)
 	bsim_test_expect_input_error(bad, (const char *const[]){other, "essay", NULL});
 }
 
-/* essay (one mode, the sensitivity study too: 29 sweeps) with extra
+/* essay (one mode, the sensitivity study too: 51 sweeps) with extra
  * arguments a, b (NULL: none) into out. */
 static void essay_argv(const char **argv, char *configs, size_t size, const char *out,
                        const char *trials, const char *threads, const char *a, const char *b)
