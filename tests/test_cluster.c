@@ -88,15 +88,42 @@ static char *file_bytes(const char *path, long *n)
 	return b;
 }
 
-/* A JSON text with every "wall_seconds" value cut out (summary.json,
- * report.json). */
-static void drop_wall(char *text)
+/* A JSON text with every value of "name" cut out. */
+static void drop_key(char *text, const char *name)
 {
-	const char *key = "\"wall_seconds\": ";
+	char key[64];
+	snprintf(key, sizeof key, "\"%s\": ", name);
 	for (char *w = strstr(text, key); w; w = strstr(w + 1, key)) {
 		char *v = w + strlen(key);
 		size_t n = strcspn(v, ",}\n");
 		memmove(v, v + n, strlen(v + n) + 1);
+	}
+}
+
+/* The wall time cut out of summary.json and report.json. */
+static void drop_wall(char *text)
+{
+	drop_key(text, "wall_seconds");
+}
+
+/* The CPU times and what is computed from them cut out of validate.json
+ * (the simulation's and one prediction's, as two runs of one process
+ * differ). */
+static void drop_cpu(char *text)
+{
+	static const char *const keys[] = {"sim_cpu_seconds", "predict_seconds", "speedup",
+	                                   "break_even_lattices"};
+	for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
+		drop_key(text, keys[i]);
+}
+
+/* essay.md's "568 trials in 1.4 s." without the time. */
+static void drop_essay_time(char *text)
+{
+	for (char *w = strstr(text, " trials in "); w; w = strstr(w + 1, " trials in ")) {
+		char *v = w + strlen(" trials in "), *end = strstr(v, " s.");
+		if (end)
+			memmove(v, end, strlen(end) + 1);
 	}
 }
 
@@ -115,7 +142,7 @@ static int compare_one(const char *path, const struct stat *st, int type, struct
 	const char *name = strrchr(rel, '/') ? strrchr(rel, '/') + 1 : rel;
 	/* the files that hold the wall time */
 	if (strcmp(name, "manifest.json") == 0 || strcmp(name, "summary.mat") == 0 ||
-	    strcmp(name, "report.mat") == 0)
+	    strcmp(name, "report.mat") == 0 || strcmp(name, "validate_summary.mat") == 0)
 		return 0;
 	/* a Markov map's CPU time (map_HASH.cost) */
 	if (strlen(name) > 5 && strcmp(name + strlen(name) - 5, ".cost") == 0)
@@ -124,9 +151,14 @@ static int compare_one(const char *path, const struct stat *st, int type, struct
 	snprintf(other, sizeof other, "%s/%s", other_root, rel);
 	long na = 0, nb = -1;
 	char *a = file_bytes(path, &na), *b = file_bytes(other, &nb);
-	if (a && b && (strcmp(name, "summary.json") == 0 || strcmp(name, "report.json") == 0)) {
-		drop_wall(a);
-		drop_wall(b);
+	void (*drop)(char *) = strcmp(name, "summary.json") == 0 || strcmp(name, "report.json") == 0
+	                               ? drop_wall
+	                       : strcmp(name, "validate.json") == 0 ? drop_cpu
+	                       : strcmp(name, "essay.md") == 0      ? drop_essay_time
+	                                                            : NULL;
+	if (a && b && drop) {
+		drop(a);
+		drop(b);
 		na = (long)strlen(a);
 		nb = (long)strlen(b);
 	}
@@ -375,6 +407,241 @@ static void test_markov_shards_merged(void **state)
 }
 
 /* ---- MPI ----------------------------------------------------------------- */
+
+/* ---- a lattice sweep: its records hold the gate paths -------------------- */
+
+/* The C-track of the essay's lattice run (F 6 N) as a whole world, Rm 100
+ * N, each gate held up to the whole duration: 12 trials, one of whose paths
+ * enters more gates (38) than a journal record holds (32), so that trial
+ * runs again where the files are written. argv filled, out and the
+ * extra arguments a, b (NULL: none) its last. */
+static void lattice_argv(const char **argv, char *exp, size_t size, const char *out,
+                         const char *threads, const char *a, const char *b)
+{
+	snprintf(exp, size, "%s", bsim_test_src("configs/lattice/c_track_essay.yaml"));
+	const char *v[] = {"sweep",     exp,
+	                   "--trials",  "12",
+	                   "--set",     "termination.gate_time=216",
+	                   "--set",     "lattice.protocol=world",
+	                   "--grid",    "effects.random_force.magnitude=100",
+	                   "--threads", threads,
+	                   "--out",     out,
+	                   "--quiet",   a,
+	                   b,           NULL};
+	memcpy(argv, v, sizeof v);
+}
+
+static void run_ok(const char *const *argv);
+
+/* The lattice sweep in 3 parts, merged: the one-process trials.csv,
+ * gate_entries.csv, beam_peaks.csv, final_locations.csv,
+ * transitions.csv, lattice_map.csv, summary.json (but its wall time) and
+ * twins, the trials whose paths did not fit their records included. */
+static void test_lattice_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[3][1100], exp[1200];
+	const char *argv[20];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("lattice_parts"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	lattice_argv(argv, exp, sizeof exp, one, "2", NULL, NULL);
+	run_ok(argv);
+	/* the case holds a path longer than a record's */
+	char *entries = bsim_test_read(bsim_test_join(one, "gate_entries.csv"));
+	assert_non_null(entries);
+	int longest = 0;
+	for (char *line = strchr(entries, '\n'); line && line[1]; line = strchr(line + 1, '\n')) {
+		int g, t, seq;
+		if (sscanf(line + 1, "%d,%d,%d", &g, &t, &seq) == 3 && seq + 1 > longest)
+			longest = seq + 1;
+	}
+	free(entries);
+	assert_true(longest > 32);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		lattice_argv(argv, exp, sizeof exp, part[i], i == 1 ? "2" : "1", "--shard",
+		             shard_arg);
+		run_ok(argv);
+	}
+	snprintf(out, sizeof out, "%s/merged", dir);
+	const char *m[] = {"merge", part[2], part[1], part[0], "--out", out, "--quiet", NULL};
+	run_ok(m);
+	assert_same_dir(one, out);
+	assert_true(bsim_test_exists(bsim_test_join(out, "transitions.csv")));
+}
+
+/* ---- markov validate and essay: several sweeps, one journal ------------- */
+
+/* "mpi_" in test_cluster mpi: its directories apart from test_cluster's,
+ * which ctest may run at the same time. */
+static const char *group_prefix = "";
+
+/* The maps of the C-track (configs/markov/c_track.yaml, 2 x 2 x 2 entry
+ * bins of 5 trials: a chain quick to solve) that markov validate reads,
+ * built once. */
+static const char *validate_maps(void)
+{
+	static char maps[1024];
+	if (!maps[0]) {
+		char name[64];
+		snprintf(name, sizeof name, "%svalidate_maps", group_prefix);
+		snprintf(maps, sizeof maps, "%s", bsim_test_dir(name));
+		char exp[1200];
+		snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
+		const char *argv[] = {"markov", "build",   exp,     "--trials", "5", "--bins",
+		                      "2,2,2",  "--quiet", "--out", maps,       NULL};
+		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	}
+	return maps;
+}
+
+/* markov validate of the C-track (its essay protocol's and whole world's
+ * sweeps of trials each) into out with extra arguments a, b, c (NULL:
+ * none): argv filled, pointing into exp. */
+static void validate_argv(const char **argv, char *exp, size_t size, const char *out,
+                          const char *trials, const char *threads, const char *a, const char *b,
+                          const char *c)
+{
+	snprintf(exp, size, "%s", bsim_test_src("configs/markov/c_track.yaml"));
+	const char *v[] = {"markov",   "validate", exp,           "--map",   validate_maps(),
+	                   "--trials", trials,     "--bootstrap", "20",      "--threads",
+	                   threads,    "--out",    out,           "--quiet", a,
+	                   b,          c,          NULL};
+	memcpy(argv, v, sizeof v);
+}
+
+static void run_ok(const char *const *argv)
+{
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	if (rc != 0)
+		print_error("%s: exit %d: %s", argv[0], rc, err ? err : "");
+	free(err);
+	assert_int_equal(rc, 0);
+}
+
+/* dir/name/out: the reference and each spread run in a directory of the
+ * same name (index.html titles the figures with it). */
+static void named_out(char *buf, size_t size, const char *dir, const char *name)
+{
+	int n = snprintf(buf, size, "%s/%s/out", dir, name);
+	assert_true(n > 0 && (size_t)n < size);
+	buf[n - 4] = '\0';
+	mkdir(buf, 0755);
+	buf[n - 4] = '/';
+}
+
+/* The validation in 3 parts (1, 2, 1 threads), merged: the one-process
+ * directory (validate.csv, gates.csv, time_validate.csv, the figures...)
+ * but for the CPU times. */
+static void test_validate_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[3][1100], exp[1200];
+	const char *argv[20];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("validate_parts"));
+	named_out(one, sizeof one, dir, "one");
+	validate_argv(argv, exp, sizeof exp, one, "8", "2", NULL, NULL, NULL);
+	run_ok(argv);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		validate_argv(argv, exp, sizeof exp, part[i], "8", i == 1 ? "2" : "1", "--shard",
+		              shard_arg, NULL);
+		run_ok(argv);
+		assert_true(bsim_test_exists(bsim_test_join(part[i], "part.journal")));
+		assert_false(bsim_test_exists(bsim_test_join(part[i], "validate.csv")));
+	}
+	named_out(out, sizeof out, dir, "merged");
+	const char *m[] = {"merge", part[2], part[0], part[1], "--out", out, "--quiet", NULL};
+	run_ok(m);
+	assert_same_dir(one, out);
+	/* an essay's part is not a validation's */
+	char other[1100];
+	snprintf(other, sizeof other, "%s/refused", dir);
+	const char *argv2[] = {"essay",    "--configs", bsim_test_src("configs"),
+	                       "--trials", "1",         "--mode",
+	                       "default",  "--shard",   "2/3",
+	                       "--out",    other,       "--quiet",
+	                       NULL};
+	run_ok(argv2);
+	const char *bad[] = {"merge", part[0], other, part[2], "--out", out, NULL};
+	bsim_test_expect_input_error(bad, (const char *const[]){other, "essay", NULL});
+}
+
+/* essay (one mode, the sensitivity study too: 51 sweeps) with extra
+ * arguments a, b (NULL: none) into out. */
+static void essay_argv(const char **argv, char *configs, size_t size, const char *out,
+                       const char *trials, const char *threads, const char *a, const char *b)
+{
+	snprintf(configs, size, "%s", bsim_test_src("configs"));
+	const char *v[] = {"essay",     "--configs",
+	                   configs,     "--trials",
+	                   trials,      "--lattice-trials",
+	                   "2",         "--mode",
+	                   "default",   "--sensitivity",
+	                   "--threads", threads,
+	                   "--out",     out,
+	                   "--quiet",   a,
+	                   b,           NULL};
+	memcpy(argv, v, sizeof v);
+}
+
+/* The essay in 3 parts, merged: the one-process essay.csv, essay.md (but
+ * its wall time), sensitivity.csv, their twins and the figure. */
+static void test_essay_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[3][1100], configs[1100];
+	const char *argv[20];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("essay_parts"));
+	named_out(one, sizeof one, dir, "one");
+	essay_argv(argv, configs, sizeof configs, one, "2", "2", NULL, NULL);
+	run_ok(argv);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		essay_argv(argv, configs, sizeof configs, part[i], "2", i == 1 ? "2" : "1",
+		           "--shard", shard_arg);
+		run_ok(argv);
+	}
+	named_out(out, sizeof out, dir, "merged");
+	const char *m[] = {"merge", part[1], part[2], part[0], "--out", out, "--quiet", NULL};
+	run_ok(m);
+	assert_same_dir(one, out);
+	assert_true(bsim_test_exists(bsim_test_join(out, "sensitivity.csv")));
+}
+
+/* A validation killed (SIGKILL) once its journal holds 5 of its 80
+ * simulated trials, resumed: the uninterrupted run's files. */
+static void test_validate_killed_resumed(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], exp[1200], journal[1200];
+	const char *argv[20];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("validate_killed"));
+	named_out(one, sizeof one, dir, "one");
+	validate_argv(argv, exp, sizeof exp, one, "40", "2", NULL, NULL, NULL);
+	run_ok(argv);
+	named_out(out, sizeof out, dir, "killed");
+	snprintf(journal, sizeof journal, "%s/.beamsim/journal", out);
+	validate_argv(argv, exp, sizeof exp, out, "40", "1", NULL, NULL, NULL);
+	int pid = bsim_test_spawn(argv), status = 0;
+	if (!bsim_test_await_records(pid, journal, 5, &status))
+		fail_msg("the validation ended (status %d) before its journal held 5 records",
+		         status);
+	kill(pid, SIGKILL);
+	bsim_test_wait(pid);
+	assert_true(bsim_test_journal_records(journal) >= 5);
+	assert_false(bsim_test_exists(bsim_test_join(out, "validate.csv")));
+	validate_argv(argv, exp, sizeof exp, out, "40", "2", "--resume", NULL, NULL);
+	run_ok(argv);
+	assert_same_dir(one, out);
+}
 
 /* Fails the test when the program has no MPI though it is required
  * (main skips the MPI tests otherwise). */
@@ -636,6 +903,128 @@ static void test_mpi_rank_killed_resumed(void **state)
 	assert_same_dir(one, out);
 }
 
+/* mpirun -np 3 beamsim sweep of the lattice: the one-process files. */
+static void test_mpi_lattice(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200], exp[1200];
+	const char *argv[20],
+	        *job[26] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_lattice"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/ranks3", dir);
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	lattice_argv(argv, exp, sizeof exp, one, "2", NULL, NULL);
+	run_ok(argv);
+	lattice_argv(argv, exp, sizeof exp, out, "1", NULL, NULL);
+	int n = 0;
+	while (argv[n])
+		n++;
+	memcpy(job + 5, argv, (size_t)(n + 1) * sizeof *argv);
+	int rc = wait_status(spawn_mpirun(job, err_path));
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
+}
+
+/* mpirun -np 3 beamsim markov validate and essay: the one-process
+ * directories. */
+static void test_mpi_validate_essay(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200], exp[1200], configs[1100];
+	const char *argv[20],
+	        *job[26] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_validate"));
+	for (int k = 0; k < 2; k++) {
+		const char *name = k ? "essay" : "validate";
+		char sub[1100];
+		snprintf(sub, sizeof sub, "%s/%s", dir, name);
+		mkdir(sub, 0755);
+		named_out(one, sizeof one, sub, "one");
+		named_out(out, sizeof out, sub, "ranks3");
+		snprintf(err_path, sizeof err_path, "%s/%s.err", dir, name);
+		if (k)
+			essay_argv(argv, configs, sizeof configs, one, "2", "2", NULL, NULL);
+		else
+			validate_argv(argv, exp, sizeof exp, one, "8", "2", NULL, NULL, NULL);
+		run_ok(argv);
+		if (k)
+			essay_argv(argv, configs, sizeof configs, out, "2", "1", NULL, NULL);
+		else
+			validate_argv(argv, exp, sizeof exp, out, "8", "1", NULL, NULL, NULL);
+		int n = 0;
+		while (argv[n])
+			n++;
+		memcpy(job + 5, argv, (size_t)(n + 1) * sizeof *argv);
+		int rc = wait_status(spawn_mpirun(job, err_path));
+		if (rc != 0)
+			print_stderr(err_path);
+		assert_int_equal(rc, 0);
+		assert_same_dir(one, out);
+	}
+}
+
+/* An essay job of 3 ranks (one mode, 8 trials a group: 344 trials run, the
+ * 6 groups without random force once) whose rank 2 is killed once rank 0's
+ * journal holds 20 records, resumed by 2 ranks: the one-process essay. */
+static void test_mpi_essay_killed_resumed(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200], journal[1200], configs[1100];
+	const char *argv[20],
+	        *job[26] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_essay_killed"));
+	named_out(one, sizeof one, dir, "one");
+	essay_argv(argv, configs, sizeof configs, one, "8", "2", NULL, NULL);
+	argv[9] = "--quiet"; /* no sensitivity study */
+	run_ok(argv);
+	named_out(out, sizeof out, dir, "killed");
+	snprintf(err_path, sizeof err_path, "%s/killed.err", dir);
+	snprintf(journal, sizeof journal, "%s/.beamsim/journal", out);
+	essay_argv(argv, configs, sizeof configs, out, "8", "1", NULL, NULL);
+	argv[9] = "--quiet";
+	int n = 0;
+	while (argv[n])
+		n++;
+	memcpy(job + 5, argv, (size_t)(n + 1) * sizeof *argv);
+	pid_t pid = spawn_mpirun(job, err_path);
+	int status = 0;
+	if (!bsim_test_await_records(pid, journal, 20, &status)) {
+		print_stderr(err_path);
+		fail_msg("the job ended (status %d) before its journal held 20 records", status);
+	}
+	pid_t victim = -1;
+	const struct timespec tick = {0, 1000000};
+	while ((victim = rank_pid(pid, 2)) < 0) {
+		int st;
+		if (waitpid(pid, &st, WNOHANG) == pid)
+			fail_msg("the job ended before its rank 2 was found");
+		nanosleep(&tick, NULL);
+	}
+	kill(victim, SIGKILL);
+	assert_int_not_equal(wait_status(pid), 0);
+	assert_true(bsim_test_journal_records(journal) >= 20);
+	assert_false(bsim_test_exists(bsim_test_join(out, "essay.csv")));
+	/* resumed by a job of 2 ranks */
+	argv[n] = "--resume";
+	argv[n + 1] = NULL;
+	memcpy(job + 5, argv, (size_t)(n + 2) * sizeof *argv);
+	job[3] = "2";
+	int rc = wait_status(spawn_mpirun(job, err_path));
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
+}
+
 /* test_cluster: the job arrays; test_cluster mpi: the MPI job, which ctest
  * reports as skipped (status 77) when the program has no MPI. */
 int main(int argc, char **argv)
@@ -645,12 +1034,19 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_compare_shards_merged),
 	        cmocka_unit_test(test_merge_refuses),
 	        cmocka_unit_test(test_markov_shards_merged),
+	        cmocka_unit_test(test_lattice_shards_merged),
+	        cmocka_unit_test(test_validate_shards_merged),
+	        cmocka_unit_test(test_essay_shards_merged),
+	        cmocka_unit_test(test_validate_killed_resumed),
 	};
 	const struct CMUnitTest mpi[] = {
 	        cmocka_unit_test(test_mpi_identical),
 	        cmocka_unit_test(test_mpi_compare),
 	        cmocka_unit_test(test_mpi_markov_build),
 	        cmocka_unit_test(test_mpi_rank_killed_resumed),
+	        cmocka_unit_test(test_mpi_lattice),
+	        cmocka_unit_test(test_mpi_validate_essay),
+	        cmocka_unit_test(test_mpi_essay_killed_resumed),
 	};
 	if (argc < 2 || strcmp(argv[1], "mpi") != 0)
 		return cmocka_run_group_tests(shards, setup, NULL);
@@ -658,5 +1054,6 @@ int main(int argc, char **argv)
 		printf("skipped: beamsim is built without MPI (CMake did not find it)\n");
 		return 77;
 	}
+	group_prefix = "mpi_";
 	return cmocka_run_group_tests(mpi, setup, NULL);
 }

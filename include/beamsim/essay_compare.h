@@ -18,6 +18,8 @@
 #include "beamsim/error.h"
 #include "beamsim/figures.h"
 #include "beamsim/progress.h"
+#include "beamsim/limits.h"
+#include "beamsim/sweep_dir.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -75,6 +77,15 @@ typedef struct bsim_essay_config {
 	bsim_progress_fn progress; /* may be NULL: trials done of all */
 	void *progress_user;
 	const volatile sig_atomic_t *stop; /* NULL, or a flag that stops the run (BSIM_ESTOPPED) */
+	/* bsim_essay_compare_store: every sweep's trials are journaled in out
+	 * as they end (one journal), so with resume a stopped or killed run
+	 * continues (same inputs), losing no finished trial. */
+	int resume;
+	/* bsim_essay_compare_store spread over processes (beamsim/sweep_dir.h,
+	 * docs/cluster.md): a shard writes a part directory into out, an MPI
+	 * rank other than 0 writes nothing; merge joins the parts. All zero:
+	 * one process. */
+	bsim_sweep_spread spread;
 } bsim_essay_config;
 
 /* configs "configs", the thesis backend in its default, with
@@ -90,6 +101,9 @@ typedef struct bsim_essay_result {
 	bsim_essay_sens_row *sens; /* by mode, parameter, value, group */
 	long trials_run;
 	double wall_seconds;
+	/* bsim_essay_compare_store stopped, or failed after finishing trials:
+	 * the journal that resume continues from ("" otherwise). */
+	char journal[BSIM_PATH_MAX];
 } bsim_essay_result;
 
 /* Runs every sweep and fills the rows. */
@@ -97,11 +111,14 @@ BSIM_API int bsim_essay_compare_run(const bsim_essay_config *cfg, bsim_essay_res
                                     bsim_error *err);
 BSIM_API void bsim_essay_result_free(bsim_essay_result *r);
 
-/* essay.csv (and sensitivity.csv when the study ran), with .mat twins,
- * essay.md (both tables and the definitions) and the figure essay (.png,
- * .svg, .gp, .dat), written into out as one set once every sweep is done:
- * an interrupted or failed run leaves none of them. fig gets the figure's
- * result; free it and res on BSIM_OK. */
+/* Runs every sweep, its trials journaled in out (cfg->resume continues a
+ * stopped run), and writes essay.csv (and sensitivity.csv when the study
+ * ran), with .mat twins, essay.md (both tables and the definitions) and
+ * the figure essay (.png, .svg, .gp, .dat) into out as one set once every
+ * sweep is done: an interrupted or failed run leaves none of them, and
+ * its journal (res->journal). A shard (cfg->spread) writes its part
+ * directory, an MPI rank other than 0 nothing; res then holds no rows.
+ * fig gets the figure's result; free it and res on BSIM_OK. */
 BSIM_API int bsim_essay_compare_store(const char *out, const bsim_essay_config *cfg,
                                       bsim_essay_result *res, bsim_figures_result *fig,
                                       bsim_error *err);

@@ -55,6 +55,8 @@
 #include "beamsim/progress.h"
 #include "beamsim/scene.h"
 #include "beamsim/lattice_outcome.h"
+#include "beamsim/limits.h"
+#include "beamsim/sweep_dir.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -358,6 +360,17 @@ typedef struct bsim_markov_validate_def {
 	int map_resamples;         /* resamples of the maps; default 40 */
 	bsim_progress_fn progress; /* may be NULL; counts trials simulated */
 	void *progress_user;
+	/* The simulated trials are journaled in out as they end (both
+	 * protocols' sweeps, one journal): with resume a stopped or killed
+	 * run continues (same inputs), losing no finished trial. */
+	int resume;
+	/* NULL, or a flag (a signal handler's): once nonzero no trial starts,
+	 * and the run returns BSIM_ESTOPPED with the journal kept. */
+	const volatile sig_atomic_t *stop;
+	/* Spread over processes (beamsim/sweep_dir.h, docs/cluster.md): a
+	 * shard writes a part directory into out, an MPI rank other than 0
+	 * writes nothing; merge joins the parts. All zero: one process. */
+	bsim_sweep_spread spread;
 } bsim_markov_validate_def;
 
 BSIM_API bsim_markov_validate_def bsim_markov_validate_def_default(void);
@@ -398,6 +411,9 @@ typedef struct bsim_markov_validation {
 	double map_cost;           /* s of CPU the maps took to build (every pass) */
 	long long map_steps;       /* single-gate steps those builds took */
 	int bins, trials_per_bin;
+	/* When the run stopped or failed after finishing trials: the journal
+	 * that resume continues from ("" otherwise). */
+	char journal[BSIM_PATH_MAX];
 } bsim_markov_validation;
 
 /* Runs the validation and writes out: validate.json (every check),

@@ -113,6 +113,17 @@ typedef struct bsim_sweep_config {
 	 * (lattice_summaries). */
 	bsim_sweep_sink_fn sink;
 	void *sink_user;
+	/* One of several sweeps sharing one journal (beamsim markov validate,
+	 * essay; unstreamed sweeps and parts): trial i is the journal's record
+	 * journal_first + i, and the journal's records are indices 0 ..
+	 * journal_total - 1 (0: this sweep's alone). A part's trial i is part
+	 * (journal_first + i) mod count's, and its done bits, records and the
+	 * records collected from other parts are by journal index. */
+	long journal_first, journal_total;
+	/* 1: the caller uses the trials' results only, not their gate paths
+	 * (trials_out, not logs): a lattice's trials are taken from the
+	 * journal too, instead of running again. */
+	int results_only;
 } bsim_sweep_config;
 
 /* Trials per block of a streamed sweep: about 30 MB of results and gate
@@ -130,6 +141,16 @@ BSIM_API bsim_sweep_config bsim_sweep_config_default(void);
  * bytes as they are in memory, so a resumed sweep's results are the
  * uninterrupted sweep's to the bit. */
 BSIM_API size_t bsim_sweep_record_size(int paired);
+
+/* The size of the journal records of the plain sweep of e with cfg (its
+ * --set in cfg->extra): bsim_sweep_record_size(0), or for a lattice (unless
+ * cfg->results_only) the result, then its gate path (a fixed number of
+ * entries; a longer path is marked, and the trial runs again where the
+ * records are read) and the peak of each of its scenes' beams, so that the
+ * lattice's files can be written from the journal. BSIM_EINPUT if a
+ * group's scene cannot be built. */
+BSIM_API int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                        size_t *size, bsim_error *err);
 
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller
  * applies --trials/--seed). BSIM_ESTOPPED (see cfg->stop) says how many
@@ -179,6 +200,10 @@ typedef struct bsim_sweep_part {
 	int (*collect)(void *user, int wait, bsim_sweep_accept_fn accept, void *ctx,
 	               bsim_error *err);
 	void *user;
+	/* NULL, or told the size of the records that record and collect carry
+	 * before the part runs (bsim_sweep_record_size_for: a lattice's are
+	 * larger); called by the spreading of bsim_sweep_dir_run. */
+	void (*sized)(void *user, size_t record_size);
 } bsim_sweep_part;
 
 /* Runs part's trials of the sweep of e (cfg->sink and keep are not used): each trial not marked in

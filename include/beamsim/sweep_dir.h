@@ -70,9 +70,9 @@ typedef struct bsim_sweep_dir_def {
 	 *                       written as one process writes it (MPI rank 0);
 	 *   BSIM_SPREAD_SEND    this process's part, its records handed to
 	 *                       part.record; out is not touched (other ranks).
-	 * part.done is the run's own. A lattice sweep cannot be split (its
-	 * gate paths are not journaled): SHARD refuses it, GATHER runs it all
-	 * and SEND none of it. */
+	 * part.done is the run's own. A lattice sweep's records hold its
+	 * trials' gate paths and peaks (bsim_sweep_record_size_for), so it is
+	 * split as any other. */
 	int spread;
 	bsim_sweep_part part;
 	/* GATHER and SEND: called in every process once the inputs are known,
@@ -92,6 +92,23 @@ typedef struct bsim_sweep_dir_def {
 } bsim_sweep_dir_def;
 
 enum { BSIM_SPREAD_NONE, BSIM_SPREAD_SHARD, BSIM_SPREAD_GATHER, BSIM_SPREAD_SEND };
+
+/* How a command that runs several sweeps with one journal (beamsim markov
+ * validate, beamsim essay) is spread over processes: the fields of
+ * bsim_sweep_dir_def of the same names, with the same meaning. Its trials
+ * are numbered along its sweeps in turn (the first sweep's g * trials + t,
+ * then the next's after them), and trial j belongs to part j mod count.
+ * All zero: one process. */
+typedef struct bsim_sweep_spread {
+	int spread;
+	bsim_sweep_part part;
+	int (*agree)(void *user, const char *inputs, unsigned char *done, size_t bytes,
+	             bsim_error *err);
+	int argc;
+	char *const *argv;
+	const char *const *merge;
+	int n_merge;
+} bsim_sweep_spread;
 
 /* What a part directory's part.json says: the part (1-based, as given to
  * --shard), of how many, the run (a hash of its inputs), the trials its

@@ -38,6 +38,7 @@
 #include "beamsim/stats.h"
 #include "beamsim/sweep.h"
 #include "util/clock.h"
+#include "analysis/essay_internal.h"
 
 #define ALPHA 0.05
 
@@ -224,46 +225,6 @@ static int exp_build(bsim_experiment *e, const char *configs, const char *scene,
 		rc = add_set(e, sets[i], err);
 	for (int i = 0; i < 2 && axes[i] && rc == BSIM_OK; i++)
 		rc = add_axis(e, axes[i], values[i], err);
-	return rc;
-}
-
-/* ---- running ---- */
-
-typedef struct run_ctx {
-	const bsim_essay_config *cfg;
-	const bsim_backend *backend;
-	long done, total; /* trials over every sweep */
-} run_ctx;
-
-static void progress_relay(void *user, long done, long total)
-{
-	run_ctx *x = user;
-	(void)total;
-	if (x->cfg->progress)
-		x->cfg->progress(x->cfg->progress_user, x->done + done, x->total);
-}
-
-static int run_sweep(run_ctx *x, const bsim_options *opts, bsim_experiment *e,
-                     bsim_group_result **groups, bsim_error *err)
-{
-	bsim_sweep_config sc = bsim_sweep_config_default();
-	sc.backend = x->backend;
-	sc.opts = opts;
-	sc.threads = x->cfg->threads;
-	sc.progress = progress_relay;
-	sc.progress_user = x;
-	sc.stop = x->cfg->stop;
-	bsim_sweep_result r;
-	int rc = bsim_sweep_run(e, &sc, &r, err);
-	if (rc == BSIM_OK) {
-		x->done += (long)e->n_groups * e->trials;
-		*groups = malloc((size_t)r.n_groups * sizeof **groups);
-		if (!*groups)
-			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-		else
-			memcpy(*groups, r.groups, (size_t)r.n_groups * sizeof **groups);
-		bsim_sweep_result_free(&r);
-	}
 	return rc;
 }
 
@@ -553,7 +514,109 @@ static long sens_values(const sens_def *d, const bsim_backend *b)
 	return k;
 }
 
-int bsim_essay_compare_run(const bsim_essay_config *cfg, bsim_essay_result *out, bsim_error *err)
+/* One sweep of the run: an experiment of a mode (EX_H1 .. EX_CTRACK), or
+ * a group of the sensitivity study (kind EX_N: parameter p, group q,
+ * value v). */
+typedef struct essay_job {
+	bsim_experiment e;
+	bsim_options opts;
+	int mode, kind, p, q, v;
+} essay_job;
+
+/* Every sweep of the run, in the order they ran one after another: by
+ * mode, its experiments, then its study by parameter, group and value. */
+static int jobs_build(const bsim_essay_config *cfg, const bsim_backend *b, const mode_def *md,
+                      essay_job **out, int *n_out, bsim_error *err)
+{
+	int cap = cfg->n_modes * (EX_N + N_SENS * N_SENS_GROUPS * 7), n = 0;
+	essay_job *jobs = calloc((size_t)cap, sizeof *jobs);
+	if (!jobs)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	int rc = BSIM_OK;
+	for (int m = 0; m < cfg->n_modes && rc == BSIM_OK; m++) {
+		for (int i = 0; i < EX_N && rc == BSIM_OK; i++) {
+			const ex_def *d = &experiments[i];
+			const char *sets[SETS_MAX];
+			int n_set = join_sets(d->set, 4, &md[m], sets);
+			essay_job *j = &jobs[n++];
+			j->mode = m;
+			j->kind = i;
+			j->opts = md[m].opts;
+			rc = exp_build(&j->e, cfg->configs, d->scene, sets, n_set, d->axis,
+			               d->values, d->lattice ? cfg->lattice_trials : cfg->trials,
+			               cfg->seed, err);
+		}
+		/* The sensitivity study: one sweep per parameter, value and
+		 * group, k1 = k2 = 500. Each is group 0 of its sweep, so every
+		 * value runs with the same random-force schedules (common random
+		 * numbers): the values differ by the parameter, not the draws. */
+		for (int p = 0; p < N_SENS && rc == BSIM_OK && cfg->sens_trials > 0; p++) {
+			const sens_def *d = &sens_params[p];
+			for (int q = 0; q < N_SENS_GROUPS && rc == BSIM_OK; q++)
+				for (long v = 0; v < sens_values(d, b) && rc == BSIM_OK; v++) {
+					char kv[96];
+					snprintf(kv, sizeof kv, "%s=%s", d->key, d->values[v]);
+					const char *base[5] = {
+					        "beams.0.stiffness=500", "beams.1.stiffness=500",
+					        sens_groups[q].set[0], sens_groups[q].set[1], NULL};
+					const char *sets[SETS_MAX];
+					int n_set = join_sets(base, 4, &md[m], sets);
+					essay_job *j = &jobs[n++];
+					j->mode = m;
+					j->kind = EX_N;
+					j->p = p;
+					j->q = q;
+					j->v = (int)v;
+					j->opts = md[m].opts;
+					if (strchr(d->key, '.'))
+						sets[n_set++] = kv; /* after the mode's */
+					else
+						rc = bsim_options_add(&j->opts, kv, err);
+					const char *none[2] = {NULL, NULL};
+					if (rc == BSIM_OK)
+						rc = exp_build(&j->e, cfg->configs,
+						               "thesis/gate.yaml", sets, n_set,
+						               none, none, cfg->sens_trials,
+						               cfg->seed, err);
+				}
+		}
+	}
+	*out = jobs;
+	*n_out = n;
+	return rc;
+}
+
+static void jobs_free(essay_job *jobs, int n)
+{
+	for (int i = 0; jobs && i < n; i++)
+		bsim_experiment_free(&jobs[i].e);
+	free(jobs);
+}
+
+/* A sensitivity row from its sweep's group. */
+static void sens_row(bsim_essay_sens_row *w, const essay_job *j, const char *mode,
+                     const bsim_group_result *gr)
+{
+	const sens_def *d = &sens_params[j->p];
+	snprintf(w->parameter, sizeof w->parameter, "%s", d->key);
+	snprintf(w->value, sizeof w->value, "%s", d->values[j->v]);
+	w->is_default = strcmp(d->values[j->v], d->shipped) == 0;
+	snprintf(w->condition, sizeof w->condition, "%s", sens_groups[j->q].condition);
+	snprintf(w->mode, sizeof w->mode, "%s", mode);
+	w->n = gr->trials;
+	w->traversed = gr->traversed;
+	w->left = gr->left;
+	w->right = gr->right;
+	w->side_exit = gr->side_exit;
+	w->stuck = gr->stuck;
+	w->p = pv(gr->traversed, gr->trials);
+	bsim_stats_wilson(gr->traversed, gr->trials, BSIM_STATS_Z95, &w->lo, &w->hi);
+	w->essay_value = sens_groups[j->q].essay;
+	w->reaches = w->hi >= w->essay_value;
+}
+
+int essay_compare_batch(const bsim_essay_config *cfg, sweep_batch *sb, bsim_essay_result *out,
+                        bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
 	if (cfg->trials < 1 || cfg->lattice_trials < 1 || cfg->sens_trials < 0 || cfg->n_modes < 1)
@@ -568,97 +631,57 @@ int bsim_essay_compare_run(const bsim_essay_config *cfg, bsim_essay_result *out,
 	int rc = BSIM_OK;
 	for (int m = 0; m < cfg->n_modes && rc == BSIM_OK; m++)
 		rc = mode_parse(cfg, b, cfg->modes[m], &md[m], err);
-	run_ctx x = {.cfg = cfg, .backend = b};
-	long per_mode = (long)cfg->trials * (30 + 9 + 3 + 6) + cfg->lattice_trials;
-	long sens = 0;
-	for (int p = 0; p < N_SENS; p++)
-		sens += sens_values(&sens_params[p], b) * N_SENS_GROUPS * cfg->sens_trials;
-	x.total = cfg->n_modes * (per_mode + sens);
 	double t0 = bsim_clock_seconds();
+	essay_job *jobs = NULL;
+	int n = 0;
+	if (rc == BSIM_OK)
+		rc = jobs_build(cfg, b, md, &jobs, &n, err);
+	const bsim_experiment **es = calloc((size_t)n + 1, sizeof *es);
+	bsim_sweep_config *sc = calloc((size_t)n + 1, sizeof *sc);
+	bsim_sweep_result *res = calloc((size_t)n + 1, sizeof *res);
+	if (rc == BSIM_OK && (!es || !sc || !res))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; rc == BSIM_OK && i < n; i++) {
+		es[i] = &jobs[i].e;
+		sc[i] = bsim_sweep_config_default();
+		sc[i].backend = b;
+		sc[i].opts = &jobs[i].opts;
+		sc[i].threads = cfg->threads;
+	}
+	if (rc == BSIM_OK)
+		rc = sweep_batch_run(sb, es, sc, n, res, err);
 	rows r = {0};
 	bsim_essay_sens_row *sv = NULL;
 	int n_sens = 0;
-	if (rc == BSIM_OK && cfg->sens_trials > 0) {
-		sv = calloc((size_t)(cfg->n_modes * N_SENS * 7 * N_SENS_GROUPS), sizeof *sv);
+	if (rc == BSIM_OK && sb->writes && cfg->sens_trials > 0) {
+		sv = calloc((size_t)n + 1, sizeof *sv);
 		if (!sv)
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
-	for (int m = 0; m < cfg->n_modes && rc == BSIM_OK; m++) {
-		r.mode = cfg->modes[m][0] ? cfg->modes[m] : "default";
-		bsim_group_result *g[EX_N] = {0};
-		for (int i = 0; i < EX_N && rc == BSIM_OK; i++) {
-			const ex_def *d = &experiments[i];
-			const char *sets[SETS_MAX];
-			int n_set = join_sets(d->set, 4, &md[m], sets);
-			bsim_experiment e;
-			rc = exp_build(&e, cfg->configs, d->scene, sets, n_set, d->axis, d->values,
-			               d->lattice ? cfg->lattice_trials : cfg->trials, cfg->seed,
-			               err);
-			if (rc == BSIM_OK)
-				rc = run_sweep(&x, &md[m].opts, &e, &g[i], err);
-			bsim_experiment_free(&e);
-		}
-		if (rc == BSIM_OK && claims(&r, g, cfg->trials, cfg->lattice_trials) != 0)
-			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-		for (int i = 0; i < EX_N; i++)
-			free(g[i]);
-		/* The sensitivity study: one sweep per parameter, value and
-		 * group, k1 = k2 = 500. Each is group 0 of its sweep, so every
-		 * value runs with the same random-force schedules (common random
-		 * numbers): the values differ by the parameter, not the draws. */
-		for (int p = 0; p < N_SENS && rc == BSIM_OK && sv; p++) {
-			const sens_def *d = &sens_params[p];
-			for (int q = 0; q < N_SENS_GROUPS && rc == BSIM_OK; q++)
-				for (long v = 0; v < sens_values(d, b) && rc == BSIM_OK; v++) {
-					char kv[96];
-					snprintf(kv, sizeof kv, "%s=%s", d->key, d->values[v]);
-					const char *base[5] = {
-					        "beams.0.stiffness=500", "beams.1.stiffness=500",
-					        sens_groups[q].set[0], sens_groups[q].set[1], NULL};
-					const char *sets[SETS_MAX];
-					int n_set = join_sets(base, 4, &md[m], sets);
-					bsim_options opts = md[m].opts;
-					if (strchr(d->key, '.'))
-						sets[n_set++] = kv; /* after the mode's */
-					else
-						rc = bsim_options_add(&opts, kv, err);
-					const char *none[2] = {NULL, NULL};
-					bsim_experiment e;
-					bsim_group_result *gr = NULL;
-					if (rc != BSIM_OK)
-						break;
-					rc = exp_build(&e, cfg->configs, "thesis/gate.yaml", sets,
-					               n_set, none, none, cfg->sens_trials,
-					               cfg->seed, err);
-					if (rc == BSIM_OK)
-						rc = run_sweep(&x, &opts, &e, &gr, err);
-					bsim_experiment_free(&e);
-					if (rc != BSIM_OK)
-						break;
-					bsim_essay_sens_row *w = &sv[n_sens++];
-					snprintf(w->parameter, sizeof w->parameter, "%s", d->key);
-					snprintf(w->value, sizeof w->value, "%s", d->values[v]);
-					w->is_default = strcmp(d->values[v], d->shipped) == 0;
-					snprintf(w->condition, sizeof w->condition, "%s",
-					         sens_groups[q].condition);
-					snprintf(w->mode, sizeof w->mode, "%s", r.mode);
-					w->n = gr->trials;
-					w->traversed = gr->traversed;
-					w->left = gr->left;
-					w->right = gr->right;
-					w->side_exit = gr->side_exit;
-					w->stuck = gr->stuck;
-					w->p = pv(gr->traversed, gr->trials);
-					bsim_stats_wilson(gr->traversed, gr->trials, BSIM_STATS_Z95,
-					                  &w->lo, &w->hi);
-					w->essay_value = sens_groups[q].essay;
-					w->reaches = w->hi >= w->essay_value;
-					free(gr);
-				}
+	long trials_run = 0;
+	for (int i = 0; rc == BSIM_OK && sb->writes && i < n; i++) {
+		const essay_job *j = &jobs[i];
+		r.mode = cfg->modes[j->mode][0] ? cfg->modes[j->mode] : "default";
+		trials_run += (long)j->e.n_groups * j->e.trials;
+		if (j->kind == EX_N) {
+			sens_row(&sv[n_sens++], j, r.mode, &res[i].groups[0]);
+		} else if (j->kind == EX_N - 1) {
+			/* the mode's experiments are jobs i - EX_N + 1 .. i */
+			bsim_group_result *g[EX_N];
+			for (int k = 0; k < EX_N; k++)
+				g[k] = res[i - EX_N + 1 + k].groups;
+			if (claims(&r, g, cfg->trials, cfg->lattice_trials) != 0)
+				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
 	}
+	for (int i = 0; res && i < n; i++)
+		bsim_sweep_result_free(&res[i]);
+	free(res);
+	free(sc);
+	free(es);
+	jobs_free(jobs, n);
 	free(md);
-	if (rc != BSIM_OK) {
+	if (rc != BSIM_OK || !sb->writes) {
 		free(r.v);
 		free(sv);
 		return rc;
@@ -667,7 +690,17 @@ int bsim_essay_compare_run(const bsim_essay_config *cfg, bsim_essay_result *out,
 	out->n = r.n;
 	out->sens = sv;
 	out->n_sens = n_sens;
-	out->trials_run = x.done;
+	out->trials_run = trials_run;
 	out->wall_seconds = bsim_clock_seconds() - t0;
 	return BSIM_OK;
+}
+
+int bsim_essay_compare_run(const bsim_essay_config *cfg, bsim_essay_result *out, bsim_error *err)
+{
+	/* in memory: no directory, no journal */
+	sweep_batch sb = {.command = "essay",
+	                  .progress = cfg->progress,
+	                  .progress_user = cfg->progress_user,
+	                  .stop = cfg->stop};
+	return essay_compare_batch(cfg, &sb, out, err);
 }

@@ -10,6 +10,7 @@
 #include "beamsim/limits.h"
 #include "store/matlab.h"
 #include "store/session.h"
+#include "analysis/essay_internal.h"
 #include "util/atomic_file.h"
 
 /* A number, or an empty field for NaN (a trend has no essay value). */
@@ -161,29 +162,35 @@ int bsim_essay_compare_store(const char *out, const bsim_essay_config *cfg, bsim
 {
 	memset(res, 0, sizeof *res);
 	memset(fig, 0, sizeof *fig);
-	bsim_session ss;
-	int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
-	if (rc != BSIM_OK)
-		return rc;
-	rc = bsim_essay_compare_run(cfg, res, err);
-	if (rc == BSIM_OK)
-		rc = write_table(ss.stage, "essay", write_csv, res, err);
-	if (rc == BSIM_OK && res->n_sens > 0)
-		rc = write_table(ss.stage, "sensitivity", write_sens_csv, res, err);
-	if (rc == BSIM_OK) {
+	const bsim_sweep_spread *sp = &cfg->spread;
+	sweep_batch sb = {.command = "essay",
+	                  .out = out,
+	                  .resume = cfg->resume,
+	                  .spread = sp->spread != BSIM_SPREAD_NONE || sp->n_merge > 0 ? sp : NULL,
+	                  .progress = cfg->progress,
+	                  .progress_user = cfg->progress_user,
+	                  .stop = cfg->stop};
+	int rc = essay_compare_batch(cfg, &sb, res, err);
+	const char *stage = sb.ss.stage;
+	if (rc == BSIM_OK && sb.writes)
+		rc = write_table(stage, "essay", write_csv, res, err);
+	if (rc == BSIM_OK && sb.writes && res->n_sens > 0)
+		rc = write_table(stage, "sensitivity", write_sens_csv, res, err);
+	if (rc == BSIM_OK && sb.writes) {
 		char path[BSIM_PATH_MAX];
-		snprintf(path, sizeof path, "%s/essay.md", ss.stage);
+		snprintf(path, sizeof path, "%s/essay.md", stage);
 		rc = write_md(path, res, cfg, err);
 	}
-	if (rc == BSIM_OK) {
+	if (rc == BSIM_OK && sb.writes) {
 		bsim_figures_def def = bsim_figures_def_default();
 		def.kind = BSIM_FIGURES_ESSAY;
-		rc = bsim_figures_draw(ss.stage, &def, fig, err);
+		rc = bsim_figures_draw(stage, &def, fig, err);
 	}
-	rc = bsim_session_close(&ss, rc, "essay", NULL, err);
+	rc = sweep_batch_end(&sb, rc, err);
 	if (rc != BSIM_OK) {
 		bsim_figures_result_free(fig);
 		bsim_essay_result_free(res);
 	}
+	snprintf(res->journal, sizeof res->journal, "%s", sb.journal);
 	return rc;
 }

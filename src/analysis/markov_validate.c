@@ -26,6 +26,7 @@
 #include "util/json.h"
 #include "store/matlab.h"
 #include "store/session.h"
+#include "store/sweep_batch.h"
 #include "beamsim/limits.h"
 
 bsim_markov_validate_def bsim_markov_validate_def_default(void)
@@ -392,30 +393,18 @@ static int write_figure(const char *stage, int g, const group_data *d,
 
 /* ---- the run ------------------------------------------------------------------ */
 
-static int simulate(const bsim_experiment *e, const bsim_markov_validate_def *def,
-                    const bsim_markov_set *set, int pr, bsim_sweep_result *res, double *cpu,
-                    bsim_error *err)
+/* The overrides of protocol pr's sweep: --set, then lattice.protocol
+ * (ov of n_sets + 1, malloc'd). */
+static bsim_override *protocol_sets(const bsim_markov_validate_def *def, int pr)
 {
-	int n = def->n_sets + 1;
-	bsim_override *ov = malloc((size_t)n * sizeof *ov);
+	bsim_override *ov = malloc((size_t)(def->n_sets + 1) * sizeof *ov);
 	if (!ov)
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		return NULL;
 	if (def->n_sets > 0) /* sets is NULL without --set */
 		memcpy(ov, def->sets, (size_t)def->n_sets * sizeof *ov);
 	ov[def->n_sets] =
 	        (bsim_override){"lattice.protocol", protocol_names[pr], "markov validate"};
-	bsim_sweep_config cfg = {.backend = set->def.backend,
-	                         .opts = set->def.opts,
-	                         .threads = def->threads,
-	                         .extra = ov,
-	                         .n_extra = n,
-	                         .progress = def->progress,
-	                         .progress_user = def->progress_user};
-	clock_t c0 = clock();
-	int rc = bsim_sweep_run(e, &cfg, res, err);
-	*cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
-	free(ov);
-	return rc;
+	return ov;
 }
 
 static int group_validate(const bsim_markov_validate_def *def, const bsim_experiment *e, int g,
@@ -542,19 +531,41 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		rc = bsim_markov_load(&scene, def->map_dir, &opts0, &set0, err);
 		bsim_scene_free(&scene);
 	}
-	bsim_session ss;
+	/* Both protocols' sweeps, journaled in out as one job. */
+	bsim_override *ov[2] = {protocol_sets(def, 0), protocol_sets(def, 1)};
+	bsim_sweep_config cfg[2];
+	const bsim_experiment *es[2] = {&e, &e};
+	for (int pr = 0; pr < 2; pr++)
+		cfg[pr] = (bsim_sweep_config){.backend = set0.def.backend,
+		                              .opts = set0.def.opts,
+		                              .threads = def->threads,
+		                              .extra = ov[pr],
+		                              .n_extra = def->n_sets + 1};
+	const bsim_sweep_spread *sp = &def->spread;
+	sweep_batch b = {.command = "markov validate",
+	                 .out = def->out,
+	                 .resume = def->resume,
+	                 .spread = sp->spread != BSIM_SPREAD_NONE || sp->n_merge > 0 ? sp : NULL,
+	                 .progress = def->progress,
+	                 .progress_user = def->progress_user,
+	                 .stop = def->stop};
+	bsim_sweep_result res[2];
+	memset(res, 0, sizeof res);
+	double cpu[2] = {0, 0};
+	if (rc == BSIM_OK && (!ov[0] || !ov[1]))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (rc == BSIM_OK)
-		rc = bsim_session_open(&ss, def->out, 0, NULL, 0, err);
-	if (rc != BSIM_OK) {
+		rc = sweep_batch_run_cpu(&b, es, cfg, 2, res, cpu, err);
+	if (!b.writes) {
+		/* a shard's part directory, or another rank's part: no results */
+		rc = sweep_batch_end(&b, rc, err);
+		snprintf(out->journal, sizeof out->journal, "%s", b.journal);
+		free(ov[0]);
+		free(ov[1]);
 		bsim_markov_set_free(&set0);
 		bsim_experiment_free(&e);
 		return rc;
 	}
-	bsim_sweep_result res[2];
-	memset(res, 0, sizeof res);
-	double cpu[2] = {0, 0};
-	for (int pr = 0; pr < 2 && rc == BSIM_OK; pr++)
-		rc = simulate(&e, def, &set0, pr, &res[pr], &cpu[pr], err);
 	group_data *gd = calloc((size_t)e.n_groups, sizeof *gd);
 	out->checks = calloc((size_t)2 * e.n_groups, sizeof *out->checks);
 	if (rc == BSIM_OK && (!gd || !out->checks))
@@ -572,29 +583,29 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		out->map_steps /= e.n_groups;
 	}
 	if (rc == BSIM_OK)
-		rc = write_csv(ss.stage, &e, out, gd, err);
+		rc = write_csv(b.ss.stage, &e, out, gd, err);
 	if (rc == BSIM_OK)
-		rc = write_json(ss.stage, def, &e, out, err);
+		rc = write_json(b.ss.stage, def, &e, out, err);
 	const char *const twins[][2] = {{"validate.csv", "validate"},
 	                                {"gates.csv", "gates"},
 	                                {"validate.json", "validate"}};
 	for (int i = 0; i < 3 && rc == BSIM_OK; i++) {
 		char src[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
-		snprintf(src, sizeof src, "%s/%s", ss.stage, twins[i][0]);
-		snprintf(mat, sizeof mat, "%s/%.*s%s", ss.stage, (int)strcspn(twins[i][0], "."),
+		snprintf(src, sizeof src, "%s/%s", b.ss.stage, twins[i][0]);
+		snprintf(mat, sizeof mat, "%s/%.*s%s", b.ss.stage, (int)strcspn(twins[i][0], "."),
 		         twins[i][0], i == 2 ? "_summary.mat" : ".mat");
 		rc = i == 2 ? bsim_matlab_from_json(src, mat, twins[i][1], err)
 		            : bsim_matlab_from_csv(src, mat, twins[i][1], err);
 	}
 	if (rc == BSIM_OK && e.n_groups > 0 && gd[0].pred.walks > 0) {
 		char src[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
-		snprintf(src, sizeof src, "%s/time_validate.csv", ss.stage);
-		snprintf(mat, sizeof mat, "%s/time_validate.mat", ss.stage);
+		snprintf(src, sizeof src, "%s/time_validate.csv", b.ss.stage);
+		snprintf(mat, sizeof mat, "%s/time_validate.mat", b.ss.stage);
 		rc = bsim_matlab_from_csv(src, mat, "time_validate", err);
 	}
 	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++)
-		rc = write_figure(ss.stage, g, &gd[g], out, NULL, err);
-	rc = bsim_session_close(&ss, rc, "markov validate", NULL, err);
+		rc = write_figure(b.ss.stage, g, &gd[g], out, NULL, err);
+	rc = sweep_batch_end(&b, rc, err);
 	for (int g = 0; gd && g < e.n_groups; g++) {
 		bsim_markov_prediction_free(&gd[g].pred);
 		for (int pr = 0; pr < 2; pr++) {
@@ -607,9 +618,12 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 	gsl_rng_free(rng);
 	for (int pr = 0; pr < 2; pr++)
 		bsim_sweep_result_free(&res[pr]);
+	free(ov[0]);
+	free(ov[1]);
 	bsim_markov_set_free(&set0);
 	bsim_experiment_free(&e);
 	if (rc != BSIM_OK)
 		bsim_markov_validation_free(out);
+	snprintf(out->journal, sizeof out->journal, "%s", b.journal);
 	return rc;
 }

@@ -53,12 +53,22 @@ int cli_shard_parse(const char *cmd, const char *value, int *index, int *count)
 
 char **cli_stored_argv(int argc, char **argv, const char *pos)
 {
+	return cli_stored_argv_paths(argc, argv, &pos, 1);
+}
+
+char **cli_stored_argv_paths(int argc, char **argv, const char *const *pos, int n_pos)
+{
 	char **copy = calloc((size_t)argc + 1, sizeof *copy);
-	char *abs = pos ? realpath(pos, NULL) : NULL;
-	for (int i = 0; copy && i < argc; i++)
-		copy[i] = argv[i] == pos && abs ? abs : argv[i];
-	if (!copy)
-		free(abs);
+	for (int i = 0; copy && i < argc; i++) {
+		copy[i] = argv[i];
+		for (int k = 0; k < n_pos; k++) {
+			char *abs = pos[k] && argv[i] == pos[k] ? realpath(pos[k], NULL) : NULL;
+			if (abs) {
+				copy[i] = abs;
+				break;
+			}
+		}
+	}
 	return copy;
 }
 
@@ -68,6 +78,28 @@ void cli_stored_argv_free(char **stored, int argc, char **argv)
 		if (stored[i] != argv[i])
 			free(stored[i]);
 	free(stored);
+}
+
+int cli_spread_end(const char *cmd, int rc, bsim_error *err, const char *journal, int argc,
+                   char **argv, int shard, int shards, const char *out, int quiet)
+{
+	int rank = cli_mpi_rank();
+	if (rc == BSIM_ESTOPPED && rank > 0)
+		return rc; /* stopped by the job's signal: rank 0 says so, and how to resume */
+	if (rc != BSIM_OK) {
+		if (rank > 0)
+			cli_error("rank %d of %d: %s", rank, cli_mpi_size(), err->msg);
+		else
+			cli_report(rc, err);
+		rc = rank > 0 ? rc : cli_run_end(rc, journal, argc, argv);
+		cli_mpi_abort(rc);
+		return rc;
+	}
+	if (shards > 0 && !quiet)
+		printf("part %d of %d of the %s in %s; beamsim merge joins the %d parts' "
+		       "directories\n",
+		       shard, shards, cmd, out, shards);
+	return CLI_OK;
 }
 
 #ifndef BSIM_HAVE_MPI
@@ -383,6 +415,14 @@ static int mpi_agree(void *user, const char *inputs, unsigned char *done, size_t
 	return BSIM_OK;
 }
 
+/* The records' size, once the run knows it (bsim_sweep_part.sized): a
+ * lattice sweep's hold its gate paths. */
+static void mpi_sized(void *user, size_t record_size)
+{
+	(void)user;
+	queue.record_size = record_size;
+}
+
 void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
                     const volatile sig_atomic_t *stop)
 {
@@ -395,7 +435,8 @@ void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree,
 	                          .count = mpi_size,
 	                          .record = mpi_rank ? mpi_record : NULL,
 	                          .collect = mpi_collect,
-	                          .user = &part_state};
+	                          .user = &part_state,
+	                          .sized = mpi_sized};
 	*agree = mpi_agree;
 }
 

@@ -37,7 +37,8 @@ typedef int (*cli_mpi_agree_fn)(void *user, const char *inputs, unsigned char *d
 
 /* In a job of several ranks, a run spread over them: rank 0 gathers and
  * writes, the others send (*spread, *part, *agree of a sweep's or a
- * comparison's def, whose journal records are record_size bytes). */
+ * comparison's def, whose journal records are record_size bytes, or as
+ * many as the run says before it starts: bsim_sweep_part.sized). */
 void cli_mpi_spread(int *spread, bsim_sweep_part *part, cli_mpi_agree_fn *agree, size_t record_size,
                     const volatile sig_atomic_t *stop);
 
@@ -49,6 +50,9 @@ int cli_shard_parse(const char *cmd, const char *value, int *index, int *count);
  * argument pos made absolute (merge may run elsewhere); free with
  * cli_stored_argv_free. NULL if out of memory. */
 char **cli_stored_argv(int argc, char **argv, const char *pos);
+/* The same with each of the arguments pos[0..n_pos) made absolute (a
+ * positional argument, an option's directory). */
+char **cli_stored_argv_paths(int argc, char **argv, const char *const *pos, int n_pos);
 
 /* What merge sets on the command line its parts recorded: the output
  * directory, threads, quiet, the part directories. */
@@ -74,6 +78,17 @@ int cmd_sweep_merge(int argc, char **argv, const cli_merge *m);
  * (cmd_markov.c). */
 int cmd_markov_merge(int argc, char **argv, const cli_merge *m);
 void cli_stored_argv_free(char **stored, int argc, char **argv);
+/* markov validate's (argv[0] "validate") and essay's, as the merge m of
+ * their parts (cmd_markov.c, cmd_essay.c). */
+int cmd_markov_validate_merge(int argc, char **argv, const cli_merge *m);
+int cmd_essay_merge(int argc, char **argv, const cli_merge *m);
+
+/* The end of a spread run that reports nothing here: a failure printed
+ * (by rank 0 with the resume line of journal, argv the command line; by
+ * another rank with its number) and the job ended; a shard's part said
+ * (unless quiet). Returns the exit status. */
+int cli_spread_end(const char *cmd, int rc, bsim_error *err, const char *journal, int argc,
+                   char **argv, int shard, int shards, const char *out, int quiet);
 
 /* Gathers every rank's directory on rank 0 (their files, not
  * subdirectories): rank 0's dirs[0..size) (allocated, freed by the

@@ -5,6 +5,7 @@
 
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "beamsim/essay_compare.h"
@@ -12,8 +13,9 @@
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
+#include "cli/cli_mpi.h"
 
-enum { OWN_MODE, OWN_LATTICE_TRIALS, OWN_SENSITIVITY, OWN_CONFIGS };
+enum { OWN_MODE, OWN_LATTICE_TRIALS, OWN_SENSITIVITY, OWN_CONFIGS, OWN_SHARD };
 
 #define ESSAY_MODES_MAX 5
 
@@ -34,6 +36,12 @@ static const cli_own essay_own[] = {
         [OWN_CONFIGS] = {"configs", 1, "DIR",
                          "the shipped configs (thesis/gate.yaml, lattice/c_track.yaml;\n"
                          "default configs)"},
+        [OWN_SHARD] = {"shard", 1, "I/N",
+                       "run part I of N (I from 1 to N, as SLURM_ARRAY_TASK_ID of\n"
+                       "--array=1-N): trial j of the sweeps, numbered along them in\n"
+                       "turn, is part j mod N + 1's; DIR gets part.json and\n"
+                       "part.journal, beamsim merge joins the N parts' directories\n"
+                       "into the essay's (docs/cluster.md)"},
 };
 
 static const char *const essay_help[CLI_N_OPTS] = {
@@ -50,6 +58,8 @@ typedef struct essay_args {
 	long lattice_trials;
 	int sensitivity;
 	const char *configs;
+	int configs_given;
+	int shard, shards; /* 1-based part of shards; 0: the whole run */
 } essay_args;
 
 static int essay_option(void *args, int i, const char *value)
@@ -71,7 +81,10 @@ static int essay_option(void *args, int i, const char *value)
 		return CLI_OK;
 	case OWN_CONFIGS:
 		a->configs = value;
+		a->configs_given = 1;
 		return CLI_OK;
+	case OWN_SHARD:
+		return cli_shard_parse("essay", value, &a->shard, &a->shards);
 	}
 	return CLI_USAGE;
 }
@@ -86,26 +99,72 @@ static const cli_spec essay_spec = {
                  "A level is tested against the essay's count (Fisher's exact test), a trend\n"
                  "by Cochran-Armitage or a Wald z test; `consistent` or `differs` at 0.05\n"
                  "(docs/essay.md). Writes DIR/essay.csv (+ .mat), DIR/essay.md, the figure\n"
-                 "DIR/essay.png and with --sensitivity DIR/sensitivity.csv (+ .mat).\n",
+                 "DIR/essay.png and with --sensitivity DIR/sensitivity.csv (+ .mat).\n"
+                 "Every sweep's trials are journaled as they end, so a stopped or killed run\n"
+                 "continues with --resume; under `mpirun -np N` they are spread over the\n"
+                 "ranks, with --shard I/N over N processes joined by beamsim merge, the\n"
+                 "files those of one process (docs/cluster.md).\n",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_TRIALS) |
-                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET),
+                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET) |
+                  CLI_USES(CLI_OPT_RESUME),
         .help = essay_help,
         .out_required = 1,
         .own = essay_own,
-        .n_own = 4,
+        .n_own = 5,
         .option = essay_option,
 };
 
-int cmd_essay(int argc, char **argv)
+/* The command line a shard keeps for merge: --configs made absolute, and
+ * given when it was not (merge may run in another directory). */
+static char **essay_stored_argv(int argc, char **argv, const essay_args *a, int *n,
+                                char ***extended)
+{
+	*extended = calloc((size_t)argc + 3, sizeof **extended);
+	if (!*extended)
+		return NULL;
+	memcpy(*extended, argv, (size_t)argc * sizeof *argv);
+	*n = argc;
+	const char *configs = a->configs;
+	if (!a->configs_given) {
+		(*extended)[(*n)++] = "--configs";
+		(*extended)[(*n)++] = (char *)a->configs;
+		configs = (*extended)[*n - 1];
+	}
+	return cli_stored_argv_paths(*n, *extended, &configs, 1);
+}
+
+static int essay_main(int argc, char **argv, const cli_merge *m)
 {
 	cli_common c = cli_common_default();
 	essay_args a = {.configs = "configs"};
 	int rc = cli_parse(&essay_spec, argc, argv, &c, &a, NULL);
+	if (rc < 0 && a.shards > 0 && cli_mpi_size() > 1)
+		rc = cli_usage("essay",
+		               "--shard runs one part in one process: not under mpirun, which "
+		               "spreads the whole run over its %d ranks",
+		               cli_mpi_size());
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
 	}
 	bsim_essay_config cfg = bsim_essay_config_default();
+	if (m) {
+		cli_merge_apply(m, &c);
+		a.shard = a.shards = 0;
+		cfg.spread.merge = m->parts;
+		cfg.spread.n_merge = m->n_parts;
+	}
+	char **stored = NULL, **extended = NULL;
+	int n_stored = 0;
+	if (a.shards > 0) {
+		cfg.spread.spread = BSIM_SPREAD_SHARD;
+		cfg.spread.part.index = a.shard - 1;
+		cfg.spread.part.count = a.shards;
+		stored = essay_stored_argv(argc, argv, &a, &n_stored, &extended);
+		cfg.spread.argc = stored ? n_stored : 0;
+		cfg.spread.argv = stored;
+	}
+	int rank = cli_mpi_rank();
 	cfg.configs = a.configs;
 	if (c.backend)
 		cfg.backend = c.backend;
@@ -120,11 +179,14 @@ int cmd_essay(int argc, char **argv)
 	if (c.has_seed)
 		cfg.seed = c.seed;
 	cfg.threads = (int)c.threads;
-	cli_progress progress;
-	cli_progress_init(&progress, !c.quiet, "trials");
-	cfg.progress = cli_progress_update;
-	cfg.progress_user = &progress;
+	cfg.resume = c.resume;
 	cfg.stop = &cli_stop;
+	cli_mpi_spread(&cfg.spread.spread, &cfg.spread.part, &cfg.spread.agree,
+	               bsim_sweep_record_size(0), cfg.stop);
+	cli_progress progress;
+	cli_progress_init(&progress, !c.quiet && rank == 0, "trials");
+	cfg.progress = rank == 0 ? cli_progress_update : NULL;
+	cfg.progress_user = &progress;
 	cli_signals_install();
 	bsim_essay_result r;
 	bsim_figures_result fig;
@@ -132,13 +194,17 @@ int cmd_essay(int argc, char **argv)
 	rc = bsim_essay_compare_store(c.out, &cfg, &r, &fig, &err);
 	cli_progress_finish(&progress);
 	cli_signals_restore();
-	if (rc == BSIM_ESTOPPED) {
-		/* Nothing is written before every sweep has run. */
-		int sig = cli_stop ? (int)cli_stop : SIGINT;
-		cli_error("%s: %s; nothing written", sig == SIGTERM ? "SIGTERM" : "SIGINT",
-		          err.msg);
+	cli_stored_argv_free(stored, n_stored, extended);
+	free(extended);
+	if (rc != BSIM_OK || cfg.spread.spread == BSIM_SPREAD_SEND || a.shards > 0) {
+		rc = cli_spread_end("essay", rc, &err, r.journal, argc, argv, a.shard, a.shards,
+		                    c.out, c.quiet);
+		if (rc == CLI_OK) {
+			bsim_figures_result_free(&fig);
+			bsim_essay_result_free(&r);
+		}
 		cli_common_free(&c);
-		return 128 + sig;
+		return rc;
 	}
 	rc = cli_report(rc, &err);
 	if (rc == BSIM_OK) {
@@ -157,4 +223,14 @@ int cmd_essay(int argc, char **argv)
 	}
 	cli_common_free(&c);
 	return rc;
+}
+
+int cmd_essay(int argc, char **argv)
+{
+	return essay_main(argc, argv, NULL);
+}
+
+int cmd_essay_merge(int argc, char **argv, const cli_merge *m)
+{
+	return essay_main(argc, argv, m);
 }

@@ -234,13 +234,8 @@ static const cli_own predict_own[] = {
          "it): p_gates,\nprediction_gates.csv"},
 };
 
-/* predict's and validate's own options: --map, then predict's --locations
- * and --json, or validate's --bootstrap. */
-static int map_option(void *args, int i, const char *value)
-{
-	return markov_option(args, OWN_MAP + i, value);
-}
-
+/* predict's own options: --map, then --locations, --json and the others
+ * (validate's: validate_option). */
 static int predict_option(void *args, int i, const char *value)
 {
 	return markov_option(args, i == 0 ? OWN_MAP : OWN_LOCATIONS + i - 1, value);
@@ -275,7 +270,21 @@ static const cli_spec predict_spec = {
 static const cli_own validate_own[] = {
         {"map", 1, "DIR", "the map directory of beamsim markov build (required)"},
         {"bootstrap", 1, "B", "resamples of the simulation (default 2000)"},
+        {"shard", 1, "I/N",
+         "simulate part I of N (I from 1 to N, as SLURM_ARRAY_TASK_ID\n"
+         "of --array=1-N): trial j of the two sweeps (the essay\n"
+         "protocol's g*trials+t, then the world's) is part j mod N + 1's;\n"
+         "DIR gets part.json and part.journal, beamsim merge joins the\n"
+         "N parts' directories into the validation's (docs/cluster.md)"},
 };
+
+static int validate_option(void *args, int i, const char *value)
+{
+	markov_args *a = args;
+	if (i == 2)
+		return cli_shard_parse("markov validate", value, &a->shard, &a->shards);
+	return markov_option(args, OWN_MAP + i, value); /* --map, --bootstrap */
+}
 
 static const char *const validate_help[CLI_N_OPTS] = {
         [CLI_OPT_OUT] = "output directory (required)",
@@ -292,16 +301,20 @@ static const cli_spec validate_spec = {
                  "prediction, the lattices after which building the maps pays off; with\n"
                  "the maps' holding times the exit times against the chain's walks),\n"
                  "validate.csv, gates.csv, time_validate.csv, their .mat twins and\n"
-                 "validate_gNNN (.png .svg).\n",
+                 "validate_gNNN (.png .svg). The simulated trials are journaled as they\n"
+                 "end, so a stopped or killed run continues with --resume; under\n"
+                 "`mpirun -np N` they are spread over the ranks, with --shard I/N over\n"
+                 "N processes joined by beamsim merge, the files those of one process\n"
+                 "but for the CPU times (docs/cluster.md).\n",
         .positional = "LATTICE_EXPERIMENT",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
                   CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
-                  CLI_USES(CLI_OPT_QUIET),
+                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_RESUME),
         .help = validate_help,
         .out_required = 1,
         .own = validate_own,
-        .n_own = 2,
-        .option = map_option,
+        .n_own = 3,
+        .option = validate_option,
 };
 
 /* Appends the keys of set's maps to *keys (the run's name, below). */
@@ -736,19 +749,45 @@ static int markov_predict(int argc, char **argv)
 	return cli_report(rc, &err);
 }
 
-static int markov_validate(int argc, char **argv)
+static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 {
 	cli_common c = cli_common_default();
 	markov_args a = {.def = bsim_markov_def_default(), .bootstrap = -1};
 	const char *path = NULL;
+	char **stored = NULL;
 	int rc = cli_parse(&validate_spec, argc, argv, &c, &a, &path);
 	if (rc < 0 && !a.map)
 		rc = cli_usage("markov validate", "--map DIR is required");
+	if (rc < 0 && a.shards > 0 && cli_mpi_size() > 1)
+		rc = cli_usage("markov validate",
+		               "--shard runs one part in one process: not under mpirun, "
+		               "which spreads the whole validation over its %d ranks",
+		               cli_mpi_size());
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
 	}
 	bsim_markov_validate_def def = bsim_markov_validate_def_default();
+	if (m) {
+		cli_merge_apply(m, &c);
+		a.shard = a.shards = 0;
+		def.spread.merge = m->parts;
+		def.spread.n_merge = m->n_parts;
+	}
+	if (a.shards > 0) {
+		const char *paths[2] = {path, a.map};
+		def.spread.spread = BSIM_SPREAD_SHARD;
+		def.spread.part.index = a.shard - 1;
+		def.spread.part.count = a.shards;
+		stored = cli_stored_argv_paths(argc, argv, paths, 2);
+		def.spread.argc = stored ? argc : 0;
+		def.spread.argv = stored;
+	}
+	int rank = cli_mpi_rank();
+	def.resume = c.resume;
+	def.stop = &cli_stop;
+	cli_mpi_spread(&def.spread.spread, &def.spread.part, &def.spread.agree,
+	               bsim_sweep_record_size(0), def.stop);
 	def.experiment = path;
 	def.map_dir = a.map;
 	def.out = c.out;
@@ -763,13 +802,25 @@ static int markov_validate(int argc, char **argv)
 	if (a.bootstrap >= 0)
 		def.bootstrap = (int)a.bootstrap;
 	cli_progress progress;
-	cli_progress_init(&progress, !c.quiet, "trials");
-	def.progress = cli_progress_update;
+	cli_progress_init(&progress, !c.quiet && rank == 0, "trials");
+	def.progress = rank == 0 ? cli_progress_update : NULL;
 	def.progress_user = &progress;
 	bsim_markov_validation v;
 	bsim_error err;
+	cli_signals_install();
 	rc = bsim_markov_validate(&def, &v, &err);
+	cli_signals_restore();
 	cli_progress_finish(&progress);
+	cli_stored_argv_free(stored, argc, argv);
+	if (rc != BSIM_OK || def.spread.spread == BSIM_SPREAD_SEND || a.shards > 0) {
+		/* the resume line: "markov validate ...", argv[-1] "markov" (a
+		 * merge's stored command line has no argv[-1]) */
+		rc = cli_spread_end("markov validate", rc, &err, v.journal, m ? argc : argc + 1,
+		                    m ? argv : argv - 1, a.shard, a.shards, c.out, c.quiet);
+		bsim_markov_validation_free(&v);
+		cli_common_free(&c);
+		return rc;
+	}
 	if (rc == BSIM_OK && !c.quiet) {
 		printf("maps        %s: %d entry bins x %d trials, %.1f s of CPU to build "
 		       "(%lld single-gate steps)\n\n",
@@ -819,6 +870,16 @@ static int markov_validate(int argc, char **argv)
 	bsim_markov_validation_free(&v);
 	cli_common_free(&c);
 	return cli_report(rc, &err);
+}
+
+static int markov_validate(int argc, char **argv)
+{
+	return markov_validate_main(argc, argv, NULL);
+}
+
+int cmd_markov_validate_merge(int argc, char **argv, const cli_merge *m)
+{
+	return markov_validate_main(argc, argv, m);
 }
 
 int cmd_markov(int argc, char **argv)

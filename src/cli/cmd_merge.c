@@ -15,12 +15,14 @@
 static const cli_spec merge_spec = {
         .name = "merge",
         .usage = "PART_DIR... --out DIR [--threads N] [--quiet]",
-        .about = "Joins the directories of the N parts of one sweep, comparison or markov\n"
-                 "build (beamsim sweep|compare|markov build ... --shard I/N --out PART_DIR,\n"
-                 "I = 1..N) into DIR, the directory the command writes in one process\n"
-                 "(trials.csv, summary.json, .mat twins, run.json; a comparison's report and\n"
-                 "pairs too; the maps of a markov build), the same bytes but for the wall and\n"
-                 "CPU times (docs/cluster.md). Every part is needed once; parts of another\n"
+        .about = "Joins the directories of the N parts of one sweep, comparison, markov build,\n"
+                 "markov validate or essay (beamsim sweep|compare|markov build|markov\n"
+                 "validate|essay ... --shard I/N --out PART_DIR, I = 1..N) into DIR, the\n"
+                 "directory the command writes in one process (trials.csv, summary.json, .mat\n"
+                 "twins, run.json; a comparison's report and pairs too; the maps of a markov\n"
+                 "build; a validation's or an essay's tables and figures), the same bytes but\n"
+                 "for the wall and CPU times (docs/cluster.md). Every part is needed once; parts "
+                 "of another\n"
                  "run (other inputs), a missing or repeated part, or a damaged part.journal\n"
                  "are refused, naming the directory. The command line is read from the parts'\n"
                  "part.json (the experiment by its absolute path); kept trajectories\n"
@@ -61,18 +63,26 @@ int cmd_merge(int argc, char **argv)
 	memset(&first, 0, sizeof first);
 	if (rc < 0 && bsim_sweep_dir_part_read(parts[0], &first, &err) != BSIM_OK)
 		rc = cli_report(BSIM_EINPUT, &err);
-	int is_compare = rc < 0 && strcmp(first.command, "compare") == 0;
-	int is_markov = rc < 0 && strcmp(first.command, "markov build") == 0;
-	if (rc < 0 && !is_compare && !is_markov && strcmp(first.command, "sweep") != 0)
+	static const struct {
+		const char *command;
+		int (*merge)(int argc, char **argv, const cli_merge *m);
+	} kinds[] = {{"sweep", cmd_sweep_merge},
+	             {"compare", cmd_compare_merge},
+	             {"markov build", cmd_markov_merge},
+	             {"markov validate", cmd_markov_validate_merge},
+	             {"essay", cmd_essay_merge}};
+	int kind = -1;
+	for (int k = 0; rc < 0 && k < (int)(sizeof kinds / sizeof kinds[0]); k++)
+		if (strcmp(first.command, kinds[k].command) == 0)
+			kind = k;
+	if (rc < 0 && kind < 0)
 		rc = cli_usage("merge",
 		               "%s: a part of a %s; merge joins the parts of a sweep, a "
-		               "comparison or a markov build",
+		               "comparison, a markov build, a markov validate or an essay",
 		               parts[0], first.command);
 	if (rc < 0) {
 		cli_merge m = {c.out, c.threads, c.quiet, parts, n_parts};
-		rc = is_compare  ? cmd_compare_merge(first.argc, first.argv, &m)
-		     : is_markov ? cmd_markov_merge(first.argc, first.argv, &m)
-		                 : cmd_sweep_merge(first.argc, first.argv, &m);
+		rc = kinds[kind].merge(first.argc, first.argv, &m);
 	}
 	bsim_sweep_dir_part_free(&first);
 	cli_common_free(&c);

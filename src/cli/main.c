@@ -17,7 +17,8 @@ static const cli_command commands[] = {
         {"run", cmd_run, "run one trial of a scene, print its outcome, record a trajectory"},
         {"sweep", cmd_sweep, "run every group and trial of an experiment in parallel"},
         {"merge", cmd_merge,
-         "join the parts of a run as a job array (sweep|compare|markov build --shard I/N)"},
+         "join the parts of a run as a job array (sweep|compare|essay|markov build|markov "
+         "validate --shard I/N)"},
         {"compare", cmd_compare,
          "run an experiment on two backends, or two settings of one, pair by pair"},
         {"regress", cmd_regress, "rerun a stored sweep or comparison and report what changed"},
@@ -139,14 +140,16 @@ static int dispatch(int argc, char **argv)
 		return CLI_OK;
 	}
 	const cli_command *c = find_command(name);
-	/* Only sweep, compare and markov build spread their work over an MPI
-	 * job's ranks (docs/cluster.md): any other command would run whole in
-	 * every rank. */
-	int spread = c && (c->run == cmd_sweep || c->run == cmd_compare ||
-	                   (c->run == cmd_markov && argc > 2 && strcmp(argv[2], "build") == 0));
+	/* Only sweep, compare, essay, markov build and markov validate spread
+	 * their work over an MPI job's ranks (docs/cluster.md): any other
+	 * command would run whole in every rank. */
+	int spread = c && (c->run == cmd_sweep || c->run == cmd_compare || c->run == cmd_essay ||
+	                   (c->run == cmd_markov && argc > 2 &&
+	                    (strcmp(argv[2], "build") == 0 || strcmp(argv[2], "validate") == 0)));
 	if (c && !spread && cli_mpi_size() > 1) {
 		cli_error("%s runs in one process: start it without mpirun (of the commands, "
-		          "sweep, compare and markov build spread over MPI ranks; docs/cluster.md)",
+		          "sweep, compare, essay, markov build and markov validate spread over MPI "
+		          "ranks; docs/cluster.md)",
 		          name);
 		cli_mpi_abort(CLI_USAGE);
 		return CLI_USAGE;

@@ -30,6 +30,7 @@
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"
+#include "run/sweep_record.h"
 #include "run/trial_pair.h"
 
 /* One trial into its group's counts (group_finish completes them). */
@@ -157,6 +158,17 @@ size_t bsim_sweep_record_size(int paired)
 	return paired ? sizeof(pair_record) : sizeof(bsim_trial_result);
 }
 
+/* The beams of a plain lattice sweep's records (run/sweep_record.h), 0 for
+ * records of the result alone. */
+static int record_beams(const bsim_scene *scenes, int n_groups, const bsim_sweep_config *cfg,
+                        int paired)
+{
+	if (paired || cfg->results_only || !scenes[0].has_lattice)
+		return 0;
+	int beams = sweep_record_beams(scenes, n_groups);
+	return beams > 0 ? beams : 1;
+}
+
 /* What the threads share. first_fail is the index of the lowest failed
  * trial so far (total if none, -1 if a thread could not start). */
 typedef struct sweep_shared {
@@ -188,12 +200,18 @@ typedef struct sweep_shared {
 	int stopped;                 /* a trial was not started because of cfg->stop */
 	const bsim_sweep_part *part; /* NULL: every trial is this process's */
 	long progress_total;         /* what progress counts up to */
+	/* > 0: a plain lattice sweep's records hold the gate path and the
+	 * peaks of this many beams (run/sweep_record.h), record_size bytes */
+	int record_beams;
+	size_t record_size;
 } sweep_shared;
 
-/* Trial i is another part's, or done before this part began. */
-static int part_skips(const bsim_sweep_part *p, long i)
+/* Trial i is another part's, or done before this part began (by journal
+ * index j, bsim_sweep_config.journal_first). */
+static int part_skips(const bsim_sweep_part *p, long first, long i)
 {
-	return p && (i % p->count != p->index || (p->done && (p->done[i / 8] & (1u << (i % 8)))));
+	long j = first + i;
+	return p && (j % p->count != p->index || (p->done && (p->done[j / 8] & (1u << (j % 8)))));
 }
 
 /* A record another part sent (bsim_sweep_accept_fn): into the journal,
@@ -201,9 +219,10 @@ static int part_skips(const bsim_sweep_part *p, long i)
 static int part_accept(void *ctx, long index, const void *payload, bsim_error *err)
 {
 	sweep_shared *sh = ctx;
-	if (index < 0 || index >= sh->total)
+	long total = sh->cfg->journal_total > 0 ? sh->cfg->journal_total : sh->total;
+	if (index < 0 || index >= total)
 		return bsim_error_set(err, BSIM_EFAIL, "a part sent trial %ld of a sweep of %ld",
-		                      index, sh->total);
+		                      index, total);
 	if (sh->cfg->journal &&
 	    bsim_journal_append(sh->cfg->journal, (uint64_t)index, payload, err) != BSIM_OK)
 		return BSIM_EFAIL;
@@ -228,37 +247,62 @@ static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
 	}
 }
 
-/* Trial i's record: its result, or both results and the separation time. */
-static int journal_append(sweep_shared *sh, long i, bsim_error *err)
+/* Trial i's record (its result; both results and the separation time; a
+ * lattice's result with its path and peaks) into buf, which holds
+ * sh->record_size bytes when a lattice's; returns it. */
+static const void *record_of(sweep_shared *sh, long i, void *buf, pair_record *pair)
 {
 	long k = i - sh->first;
-	if (!sh->backend_b)
-		return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &sh->results[k], err);
-	pair_record p = {sh->results[k], sh->results_b[k], sh->t_separate[k]};
-	return bsim_journal_append(sh->cfg->journal, (uint64_t)i, &p, err);
+	if (sh->backend_b) {
+		*pair = (pair_record){sh->results[k], sh->results_b[k], sh->t_separate[k]};
+		return pair;
+	}
+	if (sh->record_beams) {
+		sweep_record_pack(buf, sh->record_beams, &sh->results[k], &sh->logs[k]);
+		return buf;
+	}
+	return &sh->results[k];
 }
 
 /* A journal record back into its slots (bsim_journal_fn). */
 static int journal_take(void *user, uint64_t index, const void *payload)
 {
 	sweep_shared *sh = user;
+	const bsim_sweep_config *cfg = sh->cfg;
+	/* A journal shared by several sweeps: the others' records are passed over. */
+	if (cfg->journal_total > 0) {
+		if (index >= (uint64_t)cfg->journal_total)
+			return 1;
+		if (index < (uint64_t)cfg->journal_first ||
+		    index - (uint64_t)cfg->journal_first >= (uint64_t)sh->total)
+			return 0;
+		index -= (uint64_t)cfg->journal_first;
+	}
 	if (index >= (uint64_t)sh->total)
 		return 1;
 	/* A trial whose trajectory is kept runs again (trajectories are not
 	 * journaled; the trial is the same): its record is passed over. So
-	 * does every trial of a lattice, whose gate path is not journaled. */
-	if ((long)(index % (uint64_t)sh->e->trials) < sh->keep || sh->lattice)
+	 * does every trial of a lattice, whose gate path is not journaled,
+	 * unless only the results are wanted. */
+	if ((long)(index % (uint64_t)sh->e->trials) < sh->keep ||
+	    (sh->lattice && !cfg->results_only && !sh->record_beams))
 		return 0;
 	if (sh->journaled) {
 		/* Streamed: the record waits in the spill file for its block. */
-		size_t size = sizeof(bsim_trial_result);
+		size_t size = sh->record_beams ? sh->record_size : sizeof(bsim_trial_result);
 		if (pwrite(sh->spill_fd, payload, size, (off_t)(index * size)) != (ssize_t)size)
 			return -1;
 		sh->done += !(sh->journaled[index / 8] & (1u << (index % 8)));
 		sh->journaled[index / 8] |= (unsigned char)(1u << (index % 8));
 		return 0;
 	}
-	if (sh->backend_b) {
+	if (sh->record_beams) {
+		/* a path too long for its record: the trial runs again */
+		int got = sweep_record_unpack(payload, sh->record_beams, &sh->results[index],
+		                              &sh->logs[index]);
+		if (got <= 0)
+			return got;
+	} else if (sh->backend_b) {
 		pair_record p;
 		memcpy(&p, payload, sizeof p);
 		sh->results[index] = p.a;
@@ -287,9 +331,12 @@ static void sweep_thread(sweep_shared *sh)
 		bsim_trial_runner_keep_worlds(runner, 1);
 	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
 	bsim_trial_log *log[2] = {bsim_trial_log_alloc(), bsim_trial_log_alloc()};
+	void *record_buf = sh->record_beams ? malloc(sh->record_size) : NULL;
+	pair_record pr;
 	bsim_error err;
 
-	if (!runner || (sh->backend_b && !pair) || !log[0] || !log[1]) {
+	if (!runner || (sh->backend_b && !pair) || !log[0] || !log[1] ||
+	    (sh->record_beams && !record_buf)) {
 		bsim_trial_runner_free(runner);
 		runner = NULL;
 		shared_fail(sh, -1, BSIM_EFAIL, "out of memory for a trial runner");
@@ -300,7 +347,7 @@ static void sweep_thread(sweep_shared *sh)
 #pragma omp atomic read
 		stop = sh->first_fail;
 		if (!runner || i > stop || (sh->from_journal && sh->from_journal[k]) ||
-		    part_skips(sh->part, i))
+		    part_skips(sh->part, cfg->journal_first, i))
 			continue;
 		if (cfg->stop && *cfg->stop) {
 #pragma omp atomic write
@@ -342,17 +389,14 @@ static void sweep_thread(sweep_shared *sh)
 		    bsim_trial_log_copy(&sh->logs_b[k], log[1]) != BSIM_OK)
 			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
 		/* Only trials that ran are journaled: copies are filled in again. */
-		if (rc == BSIM_OK && ran && cfg->journal)
-			rc = journal_append(sh, i, &err);
-		if (rc == BSIM_OK && ran && sh->part && sh->part->record) {
-			pair_record p;
-			if (sh->backend_b)
-				p = (pair_record){sh->results[k], sh->results_b[k],
-				                  sh->t_separate[k]};
-			rc = sh->part->record(sh->part->user, i,
-			                      sh->backend_b ? (const void *)&p : &sh->results[k],
-			                      &err);
-		}
+		const void *record = ran && (cfg->journal || (sh->part && sh->part->record))
+		                             ? record_of(sh, i, record_buf, &pr)
+		                             : NULL;
+		if (rc == BSIM_OK && record && cfg->journal)
+			rc = bsim_journal_append(cfg->journal, (uint64_t)(cfg->journal_first + i),
+			                         record, &err);
+		if (rc == BSIM_OK && record && sh->part && sh->part->record)
+			rc = sh->part->record(sh->part->user, cfg->journal_first + i, record, &err);
 		if (rc != BSIM_OK)
 			shared_fail(sh, i, rc, err.msg);
 		if (leader && sh->part && sh->part->collect &&
@@ -369,6 +413,7 @@ static void sweep_thread(sweep_shared *sh)
 	trial_pair_free(pair);
 	bsim_trial_log_free(log[0]);
 	bsim_trial_log_free(log[1]);
+	free(record_buf);
 }
 
 /* The result's arrays; the per-trial ones (trials_out, logs) only if
@@ -548,6 +593,8 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	};
 	if (rc == BSIM_OK && cfg->journal) {
 		sh.lattice = scenes[0].has_lattice;
+		sh.record_beams = record_beams(scenes, e->n_groups, cfg, backend_b != NULL);
+		sh.record_size = sweep_record_size(sh.record_beams);
 		sh.from_journal = calloc(total ? (size_t)total : 1, 1);
 		long kept = 0, cut = 0;
 		rc = !sh.from_journal ? bsim_error_set(err, BSIM_EFAIL, "out of memory")
@@ -679,19 +726,32 @@ static int stream_replay(sweep_shared *sh, bsim_error *err)
 /* Block [sh->first, sh->end)'s journaled trials into their slots. */
 static int stream_load(sweep_shared *sh, bsim_error *err)
 {
-	size_t size = sizeof(bsim_trial_result);
-	for (long i = sh->first; sh->journaled && i < sh->end; i++) {
+	size_t size = sh->record_beams ? sh->record_size : sizeof(bsim_trial_result);
+	void *rec = sh->record_beams ? malloc(size) : NULL;
+	if (sh->record_beams && !rec)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	int rc = BSIM_OK;
+	for (long i = sh->first; rc == BSIM_OK && sh->journaled && i < sh->end; i++) {
 		if (!(sh->journaled[i / 8] & (1u << (i % 8))))
 			continue;
 		long k = i - sh->first;
-		if (pread(sh->spill_fd, &sh->results[k], size, (off_t)((size_t)i * size)) !=
-		    (ssize_t)size)
-			return bsim_error_set(err, BSIM_EFAIL,
-			                      "cannot read back the journal's trial %ld (%s)", i,
-			                      strerror(errno));
-		sh->from_journal[k] = 1;
+		if (pread(sh->spill_fd, rec ? rec : (void *)&sh->results[k], size,
+		          (off_t)((size_t)i * size)) != (ssize_t)size) {
+			rc = bsim_error_set(err, BSIM_EFAIL,
+			                    "cannot read back the journal's trial %ld (%s)", i,
+			                    strerror(errno));
+			break;
+		}
+		/* a lattice's path too long for its record: the trial runs again */
+		int got = rec ? sweep_record_unpack(rec, sh->record_beams, &sh->results[k],
+		                                    &sh->logs[k])
+		              : 1;
+		if (got < 0)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		sh->from_journal[k] = got > 0;
 	}
-	return BSIM_OK;
+	free(rec);
+	return rc;
 }
 
 /* A finished block: copies filled in, counted, handed to the sink. */
@@ -788,6 +848,10 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	        .first_fail = total,
 	        .lattice = out->lattice,
 	};
+	if (rc == BSIM_OK) {
+		sh.record_beams = record_beams(scenes, e->n_groups, cfg, 0);
+		sh.record_size = sweep_record_size(sh.record_beams);
+	}
 	if (rc == BSIM_OK && cfg->journal)
 		rc = stream_replay(&sh, err);
 	int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
@@ -854,6 +918,19 @@ int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg
 	return sweep_common(e, cfg, backend_b, opts_b, out_a, out_b, t_separate, err);
 }
 
+int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config *cfg, size_t *size,
+                               bsim_error *err)
+{
+	bsim_scene *scenes = NULL;
+	int rc = scenes_build(e, cfg, 0, &scenes, err);
+	if (rc != BSIM_OK)
+		return rc;
+	int beams = record_beams(scenes, e->n_groups, cfg, 0);
+	*size = beams ? sweep_record_size(beams) : bsim_sweep_record_size(0);
+	scenes_free(scenes, e->n_groups);
+	return BSIM_OK;
+}
+
 /* ---- a part of a sweep (beamsim/sweep.h) ---------------------------------
  *
  * The trials run in blocks of BSIM_SWEEP_BLOCK indices as a streamed
@@ -913,13 +990,18 @@ static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	        .first_fail = total,
 	        .part = part,
 	};
+	if (rc == BSIM_OK) {
+		sh.record_beams = record_beams(scenes, e->n_groups, cfg, backend_b != NULL);
+		sh.record_size = sweep_record_size(sh.record_beams);
+	}
 	/* Progress: this part's trials, or with collect every part's. */
 	for (long i = 0; i < total; i++) {
-		int done = part->done && (part->done[i / 8] & (1u << (i % 8)));
+		long j = cfg->journal_first + i;
+		int done = part->done && (part->done[j / 8] & (1u << (j % 8)));
 		if (part->collect)
 			sh.done += done;
 		else
-			sh.progress_total += !part_skips(part, i);
+			sh.progress_total += !part_skips(part, cfg->journal_first, i);
 	}
 	if (part->collect)
 		sh.progress_total = total;

@@ -286,6 +286,8 @@ int part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_sess
 		rc = sp->agree(sp->part->user, inputs, done, bytes, err);
 	bsim_sweep_part part = *sp->part;
 	part.done = done;
+	if (rc == BSIM_OK && part.sized)
+		part.sized(part.user, sp->record_size);
 	if (rc == BSIM_OK)
 		rc = run(user, &part, err);
 	if (rc == BSIM_OK && sp->spread == BSIM_SPREAD_SHARD) {

@@ -170,31 +170,13 @@ static int sweep_part_run(void *user, const bsim_sweep_part *part, bsim_error *e
 }
 
 static int sweep_part(const bsim_sweep_dir_def *def, const bsim_experiment *e, const char *inputs,
-                      bsim_sweep_config *cfg, bsim_session *ss, bsim_error *err)
+                      bsim_sweep_config *cfg, size_t record_size, bsim_session *ss, bsim_error *err)
 {
-	part_dir_spread sp = {def->spread,
-	                      &def->part,
-	                      def->agree,
-	                      "sweep",
-	                      bsim_sweep_record_size(0),
-	                      (long)e->n_groups * e->trials,
-	                      def->argc,
-	                      def->argv};
+	part_dir_spread sp = {def->spread, &def->part,  def->agree,
+	                      "sweep",     record_size, (long)e->n_groups * e->trials,
+	                      def->argc,   def->argv};
 	sweep_part_ctx c = {e, cfg};
 	return part_dir_spread_run(&sp, inputs, ss, sweep_part_run, &c, err);
-}
-
-/* Whether e's groups are lattices (a lattice sweep is not split). */
-static int sweep_is_lattice(const bsim_sweep_dir_def *def, const bsim_experiment *e, int *lattice,
-                            bsim_error *err)
-{
-	bsim_scene scene;
-	int rc = bsim_experiment_group_scene(e, 0, def->sets, def->n_sets, &scene, err);
-	if (rc != BSIM_OK)
-		return rc;
-	*lattice = scene.has_lattice;
-	bsim_scene_free(&scene);
-	return BSIM_OK;
 }
 
 int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err)
@@ -227,15 +209,8 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 		if (!inputs)
 			bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
-	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread, lattice = 0;
+	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread;
 	rc = inputs ? BSIM_OK : err->code;
-	if (rc == BSIM_OK && (spread != BSIM_SPREAD_NONE || def->n_merge > 0))
-		rc = sweep_is_lattice(def, e, &lattice, err);
-	if (rc == BSIM_OK && lattice && (spread == BSIM_SPREAD_SHARD || def->n_merge > 0))
-		rc = bsim_error_set(err, BSIM_EINPUT,
-		                    "%s: a lattice sweep is not split into parts (its gate paths "
-		                    "are not journaled): run it in one process",
-		                    def->experiment);
 	if (rc == BSIM_OK && def->n_merge > 0 && def->resume)
 		rc = bsim_error_set(err, BSIM_EINPUT, "merge: --resume does not apply");
 	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
@@ -252,12 +227,13 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	        .keep_stride = def->keep_stride,
 	        .stop = def->stop,
 	};
+	/* A lattice's records hold its trials' gate paths too. */
+	size_t size = bsim_sweep_record_size(0);
+	if (rc == BSIM_OK)
+		rc = bsim_sweep_record_size_for(e, &cfg, &size, err);
 	if (rc == BSIM_OK && spread == BSIM_SPREAD_SEND) {
-		/* Another rank's: its records go to the gatherer; no directory.
-		 * Of a lattice sweep it runs nothing (the gatherer runs it all). */
-		rc = lattice ? (def->agree ? def->agree(def->part.user, inputs, NULL, 0, err)
-		                           : BSIM_OK)
-		             : sweep_part(def, e, inputs, &cfg, NULL, err);
+		/* Another rank's: its records go to the gatherer; no directory. */
+		rc = sweep_part(def, e, inputs, &cfg, size, NULL, err);
 		free(inputs);
 		if (rc != BSIM_OK)
 			bsim_experiment_free(e);
@@ -265,8 +241,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	}
 	bsim_session ss;
 	if (rc == BSIM_OK)
-		rc = bsim_session_open(&ss, def->out, def->resume, inputs,
-		                       bsim_sweep_record_size(0), err);
+		rc = bsim_session_open(&ss, def->out, def->resume, inputs, size, err);
 	if (rc != BSIM_OK) {
 		free(inputs);
 		bsim_experiment_free(e);
@@ -277,13 +252,13 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 		char run[17];
 		part_dir_run_id(inputs, run);
 		long total = (long)e->n_groups * e->trials;
-		rc = part_dir_join(def->merge, def->n_merge, "sweep", run, inputs,
-		                   bsim_sweep_record_size(0), total, ss.journal, err);
+		rc = part_dir_join(def->merge, def->n_merge, "sweep", run, inputs, size, total,
+		                   ss.journal, err);
 		if (rc == BSIM_OK)
-			rc = part_dir_journal_reopen(&ss, inputs, bsim_sweep_record_size(0), err);
+			rc = part_dir_journal_reopen(&ss, inputs, size, err);
 		cfg.journal = ss.journal;
-	} else if (spread == BSIM_SPREAD_SHARD || (spread == BSIM_SPREAD_GATHER && !lattice)) {
-		rc = sweep_part(def, e, inputs, &cfg, &ss, err);
+	} else if (spread == BSIM_SPREAD_SHARD || spread == BSIM_SPREAD_GATHER) {
+		rc = sweep_part(def, e, inputs, &cfg, size, &ss, err);
 		if (spread == BSIM_SPREAD_SHARD) {
 			free(inputs);
 			rc = session_end(&ss, rc, "sweep", res->journal, sizeof res->journal, err);
@@ -292,10 +267,8 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 			return rc;
 		}
 		if (rc == BSIM_OK)
-			rc = part_dir_journal_reopen(&ss, inputs, bsim_sweep_record_size(0), err);
+			rc = part_dir_journal_reopen(&ss, inputs, size, err);
 		cfg.journal = ss.journal;
-	} else if (spread == BSIM_SPREAD_GATHER && def->agree) {
-		rc = def->agree(def->part.user, inputs, NULL, 0, err);
 	}
 	free(inputs);
 	/* The trials stream into their files as they finish. */
