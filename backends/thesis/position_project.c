@@ -60,8 +60,14 @@ static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const 
  * once (a capsule may have two contacts with one beam, and may have one
  * where it had two, or two where it had one): the beams are listed first
  * (in w->candidates, free after the step's detection). */
-static int redetect(struct bsim_world *w, thesis_contact *cs, int n, double margin)
+static inline int redetect(struct bsim_world *w, thesis_contact *cs, int n, double margin)
 {
+	if (!w->shaped) { /* one contact a beam: in place, in order */
+		int m = 0;
+		for (int k = 0; k < n; k++)
+			m += thesis_contact_detect(w, cs[k].beam, margin, &cs[m]);
+		return m;
+	}
 	int nb = 0;
 	for (int k = 0; k < n; k++) {
 		int seen = 0;
