@@ -145,6 +145,7 @@
 #include <vector>
 
 #include "beamsim/backend.h"
+#include "box2d/box2d_shape.h"
 #include "model/contact_flag.h"
 
 namespace
@@ -1355,6 +1356,66 @@ int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
 }
 
 } /* namespace */
+
+/* The Box2D outline of the ellipse, in m: its polygon (float32, as Box2D
+ * holds it) offset by delta = (2 b2_polygonRadius - b2_linearSlop) / s, the
+ * skins less the resting penetration. Its area is the polygon's plus
+ * perimeter delta plus pi delta^2 (a convex polygon's offset); the outline
+ * distance is the largest |signed distance| of the ellipse's points from
+ * it (n_samples points at equal steps of the eccentric anomaly) and of its
+ * vertices' offset points from the ellipse. */
+extern "C" int box2d_ellipse_error(double a, double b, double s, double *area_rel, double *max_dist)
+{
+	if (!(a > 0 && b > 0 && s > 0) || std::fmin(a, b) * s <= 2.0 * b2_polygonRadius)
+		return BSIM_EINPUT;
+	b2Vec2 ring[ELLIPSE_VERTICES];
+	ellipse_polygon(a, b, s, ring);
+	const double delta = (2.0 * b2_polygonRadius - b2_linearSlop) / s;
+	double px[ELLIPSE_VERTICES], py[ELLIPSE_VERTICES];
+	for (int i = 0; i < ELLIPSE_VERTICES; i++) {
+		px[i] = ring[i].x / s;
+		py[i] = ring[i].y / s;
+	}
+	double area = 0.0, perimeter = 0.0;
+	for (int i = 0; i < ELLIPSE_VERTICES; i++) {
+		int j = (i + 1) % ELLIPSE_VERTICES;
+		area += 0.5 * (px[i] * py[j] - px[j] * py[i]);
+		perimeter += std::hypot(px[j] - px[i], py[j] - py[i]);
+	}
+	area += perimeter * delta + BSIM_PI * delta * delta;
+	*area_rel = area / (BSIM_PI * a * b) - 1.0;
+	double worst = 0.0;
+	const int n_samples = 20000;
+	for (int k = 0; k < n_samples; k++) {
+		double t = 2.0 * BSIM_PI * k / n_samples;
+		double qx = a * std::cos(t), qy = b * std::sin(t);
+		/* signed distance from the convex polygon (counter-clockwise) */
+		double out = -INFINITY, near = INFINITY;
+		for (int i = 0; i < ELLIPSE_VERTICES; i++) {
+			int j = (i + 1) % ELLIPSE_VERTICES;
+			double ex = px[j] - px[i], ey = py[j] - py[i], len = std::hypot(ex, ey);
+			out = std::fmax(out, ((qx - px[i]) * ey - (qy - py[i]) * ex) / len);
+			double f = std::clamp(((qx - px[i]) * ex + (qy - py[i]) * ey) / (len * len),
+			                      0.0, 1.0);
+			near = std::fmin(near,
+			                 std::hypot(qx - px[i] - f * ex, qy - py[i] - f * ey));
+		}
+		double signed_dist = out > 0.0 ? near : out;
+		worst = std::fmax(worst, std::fabs(signed_dist - delta));
+	}
+	for (int i = 0; i < ELLIPSE_VERTICES; i++) {
+		int h = (i + ELLIPSE_VERTICES - 1) % ELLIPSE_VERTICES,
+		    j = (i + 1) % ELLIPSE_VERTICES;
+		/* the outward bisector of the vertex's two edge normals */
+		double n1x = py[i] - py[h], n1y = px[h] - px[i], l1 = std::hypot(n1x, n1y);
+		double n2x = py[j] - py[i], n2y = px[i] - px[j], l2 = std::hypot(n2x, n2y);
+		double nx = n1x / l1 + n2x / l2, ny = n1y / l1 + n2y / l2, ln = std::hypot(nx, ny);
+		double qx = px[i] + delta * nx / ln, qy = py[i] + delta * ny / ln;
+		worst = std::fmax(worst, ellipse_point_distance(a, b, qx, qy));
+	}
+	*max_dist = worst;
+	return BSIM_OK;
+}
 
 extern "C" const bsim_backend bsim_backend_box2d = {
         "box2d",
