@@ -13,6 +13,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -21,6 +22,7 @@
 #include "beamsim/trial.h"
 #include "box2d/box2d_shape.h"
 #include "scenes.h"
+#include "support.h"
 
 #define PI 3.14159265358979323846
 
@@ -546,6 +548,40 @@ static void test_trajectory_columns(void **state)
 	bsim_scene_free(&s);
 }
 
+/* What works with the disk's centre alone refuses another shape with an
+ * input error naming body.shape: the energy landscape and the video; a run
+ * and its trajectory work, the CSV ending with the body's columns. */
+static void test_disk_only_refused(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("disk_only");
+	char scene_path[1024];
+	snprintf(scene_path, sizeof scene_path, "%s",
+	         bsim_test_write(
+	                 dir, "capsule.yaml",
+	                 "name: capsule\n"
+	                 "body: { mass: 1.0, shape: capsule, radius: 6, length: 10, "
+	                 "rotates: true }\n"
+	                 "beams:\n"
+	                 "  - { pivot: [-25, 30], rest_angle_deg: 0, length: 25, mass: 0.1, "
+	                 "stiffness: 400, damping: 50 }\n"
+	                 "  - { pivot: [25, 30], rest_angle_deg: 180, length: 25, mass: 0.1, "
+	                 "stiffness: 400, damping: 50 }\n"
+	                 "effects: { propulsion: { force: 7, along: heading } }\n"
+	                 "integration: { dt: 0.004, duration: 1 }\n"));
+	const char *land[] = {"landscape", scene_path, "--out", bsim_test_join(dir, "land"), NULL};
+	const char *needles[] = {"body.shape", "capsule", NULL};
+	bsim_test_expect_input_error(land, needles);
+	char traj[1024];
+	snprintf(traj, sizeof traj, "%s", bsim_test_join(dir, "t.csv"));
+	const char *run[] = {"run", scene_path, "--backend", "box2d", "--trajectory", traj, NULL};
+	assert_int_equal(bsim_test_cli(run, NULL, NULL), 0);
+	char *text = bsim_test_read(traj);
+	assert_non_null(text);
+	assert_non_null(strstr(text, ",e_prop,heading,angular_velocity\n"));
+	free(text);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -559,6 +595,7 @@ int main(void)
 	        cmocka_unit_test(test_ellipse_outline),
 	        cmocka_unit_test(test_gate_shapes),
 	        cmocka_unit_test(test_trajectory_columns),
+	        cmocka_unit_test(test_disk_only_refused),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
