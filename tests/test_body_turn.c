@@ -422,6 +422,12 @@ static void test_ellipse_outline(void **state)
 	       area_rel, dist);
 	assert_true(fabs(area_rel) < 1e-3);
 	assert_true(dist < 0.02);
+	/* the gate's ellipse of the disk's area */
+	assert_int_equal(box2d_ellipse_error(12.5, 8.0, 1.0, &area_rel, &dist), BSIM_OK);
+	printf("box2d ellipse a = 12.5 m, b = 8 m: area error %+.3g, max outline distance %.3g m\n",
+	       area_rel, dist);
+	assert_true(fabs(area_rel) < 1e-3);
+	assert_true(dist < 0.02);
 	assert_int_equal(box2d_ellipse_error(0.005, 5.0, 1.0, &area_rel, &dist), BSIM_EINPUT);
 	const double gaps[] = {0.003, 0.009};
 	for (int turn = 0; turn < 2; turn++)
