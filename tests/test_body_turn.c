@@ -411,8 +411,9 @@ static void test_ledger_turning(void **state)
 /* Box2D's ellipse (a = 10 m, b = 5 m, unit_scale 1): area within 0.1% and
  * outline within 2 cm of the true ellipse's (the figures are printed for
  * docs/backends.md). The contact flag reads the true outline: a beam 3 mm
- * above the ellipse's top is flagged, one 9 mm above is not, whatever
- * Box2D's polygon; turned by 90 deg, the top is a away, not b. */
+ * above the ellipse's or the capsule's top (its support height at
+ * headings 0, 90 and 30 deg) is flagged, one 9 mm above is not, whatever
+ * Box2D's polygon. */
 static void test_ellipse_outline(void **state)
 {
 	(void)state;
@@ -429,29 +430,36 @@ static void test_ellipse_outline(void **state)
 	assert_true(fabs(area_rel) < 1e-3);
 	assert_true(dist < 0.02);
 	assert_int_equal(box2d_ellipse_error(0.005, 5.0, 1.0, &area_rel, &dist), BSIM_EINPUT);
-	const double gaps[] = {0.003, 0.009};
-	for (int turn = 0; turn < 2; turn++)
-		for (int g = 0; g < 2; g++) {
-			bsim_scene s;
-			scene_turning(&s, BSIM_SHAPE_ELLIPSE);
-			s.body.heading_deg = turn ? 90.0 : 0.0;
-			/* the beam from (-12.5, 0) along +x; the body's top just below */
-			s.beams[0].pivot[0] = -12.5;
-			s.body.start[0] = 0.0;
-			s.body.start[1] = -(turn ? 10.0 : 5.0) - gaps[g];
-			bsim_error err;
-			assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
-			bsim_world *w = NULL;
-			assert_int_equal(bsim_backend_box2d.create(&s, NULL, &w, &err), BSIM_OK);
-			bsim_state st;
-			assert_int_equal(bsim_state_init(&st, 1), BSIM_OK);
-			bsim_backend_box2d.get_state(w, &st);
-			assert_int_equal(st.contact[0],
-			                 g == 0 ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_NONE);
-			bsim_state_free(&st);
-			bsim_backend_box2d.destroy(w);
-			bsim_scene_free(&s);
-		}
+	/* The beam along y = 0 from x = -12.5 m to 12.5 m; the body's top at
+	 * heading psi is its support height: sqrt(a^2 sin^2 psi + b^2 cos^2 psi)
+	 * for the ellipse, R + (L/2) |sin psi| for the capsule. */
+	const double gaps[] = {0.003, 0.009}, headings[] = {0.0, 90.0, 30.0};
+	for (int k = 0; k < 2; k++)
+		for (int h = 0; h < 3; h++)
+			for (int g = 0; g < 2; g++) {
+				bsim_scene s;
+				scene_turning(&s, k ? BSIM_SHAPE_CAPSULE : BSIM_SHAPE_ELLIPSE);
+				s.body.heading_deg = headings[h];
+				s.beams[0].pivot[0] = -12.5;
+				double psi = headings[h] * PI / 180.0, sn = sin(psi), cs = cos(psi);
+				double top = k ? 4.0 + 6.0 * fabs(sn)
+				               : sqrt(100.0 * sn * sn + 25.0 * cs * cs);
+				s.body.start[0] = 0.0;
+				s.body.start[1] = -top - gaps[g];
+				bsim_error err;
+				assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
+				bsim_world *w = NULL;
+				assert_int_equal(bsim_backend_box2d.create(&s, NULL, &w, &err),
+				                 BSIM_OK);
+				bsim_state st;
+				assert_int_equal(bsim_state_init(&st, 1), BSIM_OK);
+				bsim_backend_box2d.get_state(w, &st);
+				assert_int_equal(st.contact[0],
+				                 g == 0 ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_NONE);
+				bsim_state_free(&st);
+				bsim_backend_box2d.destroy(w);
+				bsim_scene_free(&s);
+			}
 }
 
 typedef struct gate_track {
