@@ -1270,6 +1270,9 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 	 * exactly that far: a substep that ends there was clamped. */
 	const float hf = (float)h, near = 1.0f - 1e-5f;
 	bool clamped = hf * w->body->GetLinearVelocity().Length() >= near * b2_maxTranslation;
+	if (w->rotates)
+		clamped = clamped ||
+		          hf * std::fabs(w->body->GetAngularVelocity()) >= near * b2_maxRotation;
 	for (size_t k = 0; k < n_after && !clamped; k++) {
 		const beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
 		clamped = hf * std::fabs(b.body->GetAngularVelocity()) >= near * b2_maxRotation;
