@@ -563,37 +563,43 @@ static void test_trajectory_columns(void **state)
 }
 
 /* What works with the disk's centre alone refuses another shape with an
- * input error naming body.shape: the energy landscape and the video; a run
- * and its trajectory work, the CSV ending with the body's columns. */
+ * input error naming the key: the energy landscape (body.shape), and a
+ * gate scene that leaves the success line at the disk's default
+ * (termination.success_y); a run and its trajectory work, the CSV ending
+ * with the body's columns. */
 static void test_disk_only_refused(void **state)
 {
 	(void)state;
 	const char *dir = bsim_test_dir("disk_only");
-	char scene_path[1024];
-	snprintf(scene_path, sizeof scene_path, "%s",
-	         bsim_test_write(
-	                 dir, "capsule.yaml",
-	                 "name: capsule\n"
-	                 "body: { mass: 1.0, shape: capsule, radius: 6, length: 10, "
-	                 "rotates: true }\n"
-	                 "beams:\n"
-	                 "  - { pivot: [-25, 30], rest_angle_deg: 0, length: 25, mass: 0.1, "
-	                 "stiffness: 400, damping: 50 }\n"
-	                 "  - { pivot: [25, 30], rest_angle_deg: 180, length: 25, mass: 0.1, "
-	                 "stiffness: 400, damping: 50 }\n"
-	                 "effects: { propulsion: { force: 7, along: heading } }\n"
-	                 "integration: { dt: 0.004, duration: 1 }\n"));
+	static const char scene_text[] =
+	        "name: capsule\n"
+	        "body: { mass: 1.0, shape: capsule, radius: 6, length: 10, rotates: true }\n"
+	        "beams:\n"
+	        "  - { pivot: [-25, 30], rest_angle_deg: 0, length: 25, mass: 0.1, "
+	        "stiffness: 400, damping: 50 }\n"
+	        "  - { pivot: [25, 30], rest_angle_deg: 180, length: 25, mass: 0.1, "
+	        "stiffness: 400, damping: 50 }\n"
+	        "effects: { propulsion: { force: 7, along: heading } }\n"
+	        "integration: { dt: 0.004, duration: 1 }\n";
+	char text[2048], scene_path[1024], bare_path[1024];
+	snprintf(bare_path, sizeof bare_path, "%s", bsim_test_write(dir, "bare.yaml", scene_text));
+	snprintf(text, sizeof text, "%stermination: { success_y: 80, classify_y: 95 }\n",
+	         scene_text);
+	snprintf(scene_path, sizeof scene_path, "%s", bsim_test_write(dir, "capsule.yaml", text));
 	const char *land[] = {"landscape", scene_path, "--out", bsim_test_join(dir, "land"), NULL};
 	const char *needles[] = {"body.shape", "capsule", NULL};
 	bsim_test_expect_input_error(land, needles);
+	const char *bare[] = {"run", bare_path, "--backend", "box2d", NULL};
+	const char *bare_needles[] = {"bare.yaml:2:", "termination.success_y", NULL};
+	bsim_test_expect_input_error(bare, bare_needles);
 	char traj[1024];
 	snprintf(traj, sizeof traj, "%s", bsim_test_join(dir, "t.csv"));
 	const char *run[] = {"run", scene_path, "--backend", "box2d", "--trajectory", traj, NULL};
 	assert_int_equal(bsim_test_cli(run, NULL, NULL), 0);
-	char *text = bsim_test_read(traj);
-	assert_non_null(text);
-	assert_non_null(strstr(text, ",e_prop,heading,angular_velocity\n"));
-	free(text);
+	char *csv = bsim_test_read(traj);
+	assert_non_null(csv);
+	assert_non_null(strstr(csv, ",e_prop,heading,angular_velocity\n"));
+	free(csv);
 }
 
 int main(void)

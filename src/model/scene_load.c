@@ -254,6 +254,22 @@ static int check_termination(walk *w)
 	                 got);
 }
 
+/* The default success line, 65 m, is the essay's gate's for its disk of
+ * radius 10 m (pivot row 30 + beam 25 + R 10): a beam swung forward still
+ * reaches the tail of a longer body whose centre has crossed it. A gate
+ * scene whose body is not a disk must give it. */
+static int check_success_line(walk *w, struct fy_node *root)
+{
+	if (w->s->has_lattice || w->s->body.shape == BSIM_SHAPE_DISK ||
+	    ydoc_lookup(root, "termination.success_y"))
+		return BSIM_OK;
+	return ydoc_fail(w->d, ydoc_lookup(root, "body.shape"), root, "termination.success_y",
+	                 w->err,
+	                 "expected a value for a body that is not a disk (the default 65 m is "
+	                 "the essay's gate's end for a disk of radius 10 m: pivot row 30 + beam 25 "
+	                 "+ radius 10)");
+}
+
 /* The body must not start inside a beam (MODEL.md section 3). The message
  * points at body.start, or at the override that last moved the body or that
  * beam. */
@@ -512,6 +528,8 @@ static int walk_scene(walk *w, const ydoc *file)
 		lattice_defaults(w, root);
 	if (!rc)
 		rc = check_termination(w);
+	if (!rc)
+		rc = check_success_line(w, root);
 	if (!rc)
 		rc = check_overlap(w);
 	effects_present(w->s);
