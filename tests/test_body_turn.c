@@ -563,10 +563,9 @@ static void test_trajectory_columns(void **state)
 }
 
 /* What works with the disk's centre alone refuses another shape with an
- * input error naming the key: the energy landscape (body.shape), and a
- * gate scene that leaves the success line at the disk's default
- * (termination.success_y); a run and its trajectory work, the CSV ending
- * with the body's columns. */
+ * input error naming the key: the energy landscape (body.shape). A gate
+ * scene's default success line is the shape's; a run and its trajectory
+ * work, the CSV ending with the body's columns. */
 static void test_disk_only_refused(void **state)
 {
 	(void)state;
@@ -589,9 +588,16 @@ static void test_disk_only_refused(void **state)
 	const char *land[] = {"landscape", scene_path, "--out", bsim_test_join(dir, "land"), NULL};
 	const char *needles[] = {"body.shape", "capsule", NULL};
 	bsim_test_expect_input_error(land, needles);
-	const char *bare[] = {"run", bare_path, "--backend", "box2d", NULL};
-	const char *bare_needles[] = {"bare.yaml:2:", "termination.success_y", NULL};
-	bsim_test_expect_input_error(bare, bare_needles);
+	/* the success line's default: the beams' forward reach 55 m plus the
+	 * capsule's 5 + 6 m */
+	bsim_scene loaded;
+	bsim_error err;
+	assert_int_equal(bsim_scene_load(bare_path, NULL, 0, &loaded, &err), BSIM_OK);
+	assert_true(loaded.success_y == 66.0 && loaded.classify_y == 81.0);
+	bsim_scene_free(&loaded);
+	assert_int_equal(bsim_scene_load(scene_path, NULL, 0, &loaded, &err), BSIM_OK);
+	assert_true(loaded.success_y == 80.0 && loaded.classify_y == 95.0);
+	bsim_scene_free(&loaded);
 	char traj[1024];
 	snprintf(traj, sizeof traj, "%s", bsim_test_join(dir, "t.csv"));
 	const char *run[] = {"run", scene_path, "--backend", "box2d", "--trajectory", traj, NULL};

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
+#include "model/body_shape.h"
 #include "model/scene_internal.h"
 #include "util/yaml_override.h"
 
@@ -255,19 +256,20 @@ static int check_termination(walk *w)
 }
 
 /* The default success line, 65 m, is the essay's gate's for its disk of
- * radius 10 m (pivot row 30 + beam 25 + R 10): a beam swung forward still
- * reaches the tail of a longer body whose centre has crossed it. A gate
- * scene whose body is not a disk must give it. */
-static int check_success_line(walk *w, struct fy_node *root)
+ * radius 10 m: the beams' forward reach (pivot row 30 + beam 25) plus R.
+ * For another shape it is that reach plus the outline's farthest point
+ * from the centre (body_shape_reach), so that a beam swung forward no
+ * longer reaches the body; classify_y stays 15 m beyond it. What the file
+ * gives is kept. */
+static void success_line_default(walk *w, struct fy_node *root)
 {
-	if (w->s->has_lattice || w->s->body.shape == BSIM_SHAPE_DISK ||
+	bsim_scene *s = w->s;
+	if (s->has_lattice || s->body.shape == BSIM_SHAPE_DISK ||
 	    ydoc_lookup(root, "termination.success_y"))
-		return BSIM_OK;
-	return ydoc_fail(w->d, ydoc_lookup(root, "body.shape"), root, "termination.success_y",
-	                 w->err,
-	                 "expected a value for a body that is not a disk (the default 65 m is "
-	                 "the essay's gate's end for a disk of radius 10 m: pivot row 30 + beam 25 "
-	                 "+ radius 10)");
+		return;
+	s->success_y = 55.0 + body_shape_reach(&s->body);
+	if (!ydoc_lookup(root, "termination.classify_y"))
+		s->classify_y = s->success_y + 15.0;
 }
 
 /* The body must not start inside a beam (MODEL.md section 3). The message
@@ -527,9 +529,9 @@ static int walk_scene(walk *w, const ydoc *file)
 	if (!rc && w->s->has_lattice)
 		lattice_defaults(w, root);
 	if (!rc)
-		rc = check_termination(w);
+		success_line_default(w, root);
 	if (!rc)
-		rc = check_success_line(w, root);
+		rc = check_termination(w);
 	if (!rc)
 		rc = check_overlap(w);
 	effects_present(w->s);
