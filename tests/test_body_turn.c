@@ -462,6 +462,85 @@ static void test_ellipse_outline(void **state)
 			}
 }
 
+typedef struct slip_track {
+	long from, mid; /* the step the contact has settled by; halfway to the end */
+	double x_from, x_mid, x_last;
+	long last;
+	int touching;
+} slip_track;
+
+/* Positions only: the contact's velocity jitters by mm/s in Box2D, the
+ * mean velocities over the two halves do not. */
+static void track_slip(void *user, long step, const bsim_state *s)
+{
+	slip_track *t = user;
+	if (step == t->from)
+		t->x_from = s->x[0];
+	if (step == t->mid)
+		t->x_mid = s->x[0];
+	t->x_last = s->x[0];
+	t->last = step;
+	if (step >= t->from)
+		t->touching &= s->contact[0] != BSIM_CONTACT_NONE;
+}
+
+/* Contact friction on Box2D: a disk of 2 kg (heading fixed) under a thrust
+ * F = 10 N along psi pressed against a stiff horizontal beam above it
+ * (k = 1e6 N m/rad: it yields 1e-4 rad) with mu = 0.5. The friction along
+ * the beam passes through its pivot, so the beam holds the normal push
+ * F sin psi and the friction is at most mu F sin psi (the pair's
+ * coefficient is mu exactly): at psi = 70 deg (tan psi > 1/mu) the body
+ * sticks, x stays put; at 50 deg it slides with
+ * a = F (cos psi - mu sin psi) / M, 1.299 m/s^2. */
+static void test_contact_friction_stick_slip(void **state)
+{
+	(void)state;
+	const double psis[] = {70.0, 50.0};
+	for (int k = 0; k < 2; k++) {
+		bsim_scene s;
+		scene_one_beam(&s);
+		s.body.mass = 2.0;
+		s.body.radius = 2.0;
+		s.beams[0].pivot[0] = -20.0;
+		s.beams[0].length = 40.0;
+		s.beams[0].inertia = 0.1 * 1600.0 / 3.0;
+		s.beams[0].stiffness = 1e6;
+		s.beams[0].damping = 100.0;
+		s.body.start[0] = 0.0;
+		s.body.start[1] = -2.001;
+		s.body.heading_deg = psis[k];
+		s.contact.friction = 0.5;
+		s.effects.has_propulsion = 1;
+		s.effects.propulsion_force = 10.0;
+		s.effects.propulsion_along = BSIM_ALONG_HEADING;
+		s.max_steps = 500;
+		s.success_y = 1e6;
+		s.classify_y = 1e6;
+		bsim_error err;
+		assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
+		slip_track t = {.from = 100, .mid = 300, .touching = 1};
+		bsim_recorder rec = {.trace = track_slip, .trace_user = &t};
+		bsim_trial_runner *r = bsim_trial_runner_alloc();
+		bsim_trial_result out;
+		assert_int_equal(
+		        bsim_trial_run(r, &s, &bsim_backend_box2d, NULL, 1, &rec, &out, &err),
+		        BSIM_OK);
+		assert_int_equal(t.last, 500);
+		assert_true(t.touching);
+		double psi = psis[k] * PI / 180.0;
+		double a = fmax(10.0 * (cos(psi) - 0.5 * sin(psi)) / 2.0, 0.0);
+		double half = 200 * s.dt;
+		double a_meas = ((t.x_last - t.x_mid) - (t.x_mid - t.x_from)) / (half * half);
+		printf("contact friction psi %g deg: a_x %.5f m/s^2 (truth %.5f), moved %.3g m\n",
+		       psis[k], a_meas, a, t.x_last - t.x_from);
+		if (a == 0.0)
+			assert_true(fabs(t.x_last - t.x_from) < 1e-3);
+		assert_true(fabs(a_meas - a) < 0.003); /* 0.2% of the sliding case's */
+		bsim_trial_runner_free(r);
+		bsim_scene_free(&s);
+	}
+}
+
 typedef struct gate_track {
 	int flagged;
 	int finite;
@@ -619,6 +698,7 @@ int main(void)
 	        cmocka_unit_test(test_propulsion_along_heading),
 	        cmocka_unit_test(test_ledger_turning),
 	        cmocka_unit_test(test_ellipse_outline),
+	        cmocka_unit_test(test_contact_friction_stick_slip),
 	        cmocka_unit_test(test_gate_shapes),
 	        cmocka_unit_test(test_trajectory_columns),
 	        cmocka_unit_test(test_disk_only_refused),
