@@ -1066,7 +1066,7 @@ static int body_motion_in_range(const bsim_scene *sc, double s, double h, bsim_e
 			        "units a substep, got %.3g; usable up to %.3g m/s at this step)",
 			        k, sc->body.velocity[k], MOTION_MAX, motion, MOTION_MAX / (s * h));
 	}
-	/* The propulsion acts along y, the random force (up to ten standard
+	/* The propulsion acts along y or the heading, the random force (up to ten standard
 	 * deviations) along x. */
 	const double fp = std::fabs(sc->effects.propulsion_force);
 	const double fr = 10.0 * sc->effects.random_magnitude;
