@@ -1143,6 +1143,14 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 		                      "below Box2D's skin (%g units); use a larger unit_scale",
 		                      s, ellipse ? "smaller semi-axis (body.semi_axes)" : "radius",
 		                      half_width * s, (double)b2_polygonRadius);
+	/* The capsule's box must be wider than the distance at which Box2D
+	 * welds vertices (b2_linearSlop / 2). */
+	if (scene->body.shape == BSIM_SHAPE_CAPSULE && scene->body.length * s < b2_linearSlop)
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "box2d: body.length: %g m is %g units at unit_scale=%g, below "
+		        "Box2D's linear slop (%g units); use a disk or a longer capsule",
+		        scene->body.length, scene->body.length * s, s, (double)b2_linearSlop);
 	double extent = std::fabs(scene->body.start[0]) + std::fabs(scene->body.start[1]);
 	for (int i = 0; i < scene->n_beams; i++)
 		extent = std::fmax(extent, std::fabs(scene->beams[i].pivot[0]) +
