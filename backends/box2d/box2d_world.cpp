@@ -100,8 +100,7 @@
  * not the edge's face (e_faceA) is the tip's, the disk's rule too.
  * The contact flag of a body that is not a disk is its true outline's gap
  * (outline_gap: the capsule's segment-to-segment distance less R; the
- * ellipse's by the convex distance along the beam's segment), not the
- * polygon's.
+ * ellipse's from model/body_shape.h), not the polygon's.
  *
  * Energy of a step, for the runner's ledger (dE = W - damper - impact -
  * contact - correction):
@@ -147,6 +146,9 @@
 #include "beamsim/backend.h"
 #include "box2d/box2d_shape.h"
 #include "model/contact_flag.h"
+extern "C" {
+#include "model/body_shape.h"
+}
 
 namespace
 {
@@ -796,12 +798,11 @@ double ellipse_point_distance(double a, double b, double px, double py)
  *     heading) and the beam's, less R (closest points of two segments:
  *     C. Ericson, Real-Time Collision Detection, 5.1.9, the body's segment
  *     first so that parallel segments give the beam's inner point);
- *   ellipse: in its frame the distance of the beam's point p + t u from
- *     the ellipse is a convex function of t (the distance from a convex
- *     set along a line), 0 where the segment crosses it: its minimum by
- *     golden-section search, after two exact tests that decide most
- *     steps: the segment misses the circumscribed circle by the
- *     tolerance (no contact), or crosses the ellipse (overlap). */
+ *   ellipse: the model's geometry (model/body_shape.h, as the thesis
+ *     backend and the start's overlap check measure it), after a test
+ *     that decides most steps: the segment misses the circumscribed circle
+ *     by the tolerance (no contact); a segment through the ellipse's
+ *     centre line, which has no separating normal, overlaps it. */
 double outline_gap(const bsim_body_def &body, const double c[2], double psi, const double p[2],
                    const double u[2], double length, double tol, int *type)
 {
@@ -829,60 +830,21 @@ double outline_gap(const bsim_body_def &body, const double c[2], double psi, con
 		double dy = p1[1] + sp * d1[1] - p[1] - tp * d2[1];
 		return std::hypot(dx, dy) - body.radius;
 	}
-	const double a = body.semi_axes[0], b = body.semi_axes[1];
-	/* the beam in the ellipse's frame: q(t) = q0 + t v */
-	const double rel[2] = {p[0] - c[0], p[1] - c[1]};
-	const double q0[2] = {rel[0] * e[0] + rel[1] * e[1], -rel[0] * e[1] + rel[1] * e[0]};
-	const double v[2] = {u[0] * e[0] + u[1] * e[1], -u[0] * e[1] + u[1] * e[0]};
-	/* nearest point to the centre: the circle test */
-	double t_c = std::clamp(-(q0[0] * v[0] + q0[1] * v[1]), 0.0, length);
+	/* the ellipse: the circumscribed circle first, which decides most steps */
+	const double rel[2] = {c[0] - p[0], c[1] - p[1]};
+	double t_c = std::clamp(rel[0] * u[0] + rel[1] * u[1], 0.0, length);
+	double gap_circle = std::hypot(rel[0] - t_c * u[0], rel[1] - t_c * u[1]) -
+	                    std::fmax(body.semi_axes[0], body.semi_axes[1]);
 	*type = t_c > 0.0 && t_c < length ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
-	double gap_circle = std::hypot(q0[0] + t_c * v[0], q0[1] + t_c * v[1]) - std::fmax(a, b);
 	if (gap_circle >= tol)
 		return gap_circle;
-	/* the segment against the ellipse scaled to the unit circle */
-	const double g0[2] = {q0[0] / a, q0[1] / b}, gv[2] = {v[0] / a, v[1] / b};
-	double t_u = std::clamp(-(g0[0] * gv[0] + g0[1] * gv[1]) / (gv[0] * gv[0] + gv[1] * gv[1]),
-	                        0.0, length);
-	double gx = g0[0] + t_u * gv[0], gy = g0[1] + t_u * gv[1];
-	if (gx * gx + gy * gy <= 1.0) {
-		*type = t_u > 0.0 && t_u < length ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
-		return 0.0;
-	}
-	auto dist = [&](double t) {
-		return ellipse_point_distance(a, b, q0[0] + t * v[0], q0[1] + t * v[1]);
-	};
-	const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
-	double lo = 0.0, hi = length;
-	double m1 = hi - ratio * (hi - lo), m2 = lo + ratio * (hi - lo);
-	double f1 = dist(m1), f2 = dist(m2);
-	/* to 0.1 mm along the beam: near an inner minimum the distance is
-	 * flat (off by curvature x (0.1 mm)^2 / 2, below 1e-8 m for outlines
-	 * curved less than 1/m); an end is tested exactly below */
-	while (hi - lo > 1e-4) {
-		if (f1 <= f2) {
-			hi = m2;
-			m2 = m1;
-			f2 = f1;
-			m1 = hi - ratio * (hi - lo);
-			f1 = dist(m1);
-		} else {
-			lo = m1;
-			m1 = m2;
-			f1 = f2;
-			m2 = lo + ratio * (hi - lo);
-			f2 = dist(m2);
-		}
-	}
-	double t = 0.5 * (lo + hi), best = dist(t);
-	const double ends[2] = {dist(0.0), dist(length)};
-	*type = BSIM_CONTACT_TANGENT;
-	for (int k = 0; k < 2; k++)
-		if (ends[k] <= best) {
-			best = ends[k];
-			*type = BSIM_CONTACT_TIP;
-		}
-	return best;
+	const double p1[2] = {p[0] + length * u[0], p[1] + length * u[1]};
+	body_segment_contact bc;
+	if (body_shape_segment(&body, c, psi, p, p1, &bc) != BSIM_OK)
+		return -std::fmin(body.semi_axes[0],
+		                  body.semi_axes[1]); /* through its centre line */
+	*type = bc.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
+	return bc.dist;
 }
 
 /* The contact flag of beam i after a step (model/contact_flag.h), from the
