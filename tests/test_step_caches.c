@@ -123,7 +123,7 @@ static int step_against_fresh(const bsim_scene *sc, uint64_t seed, int n_steps)
 	assert_int_equal(bsim_state_init(&sb, sc->n_beams), BSIM_OK);
 	int touching = 0;
 	for (int n = 0; n < n_steps; n++) {
-		double f[2];
+		double f[BSIM_WRENCH];
 		bsim_effects_force(&fx, n, sc->dt, f);
 		be->get_state(a, &sa);
 		bsim_world *b = NULL;

@@ -139,14 +139,14 @@ static int consistency_piece(const bsim_accuracy_reference *ref, const bsim_scen
 	}
 	/* Step n of this h starts at t = n h: the piece starts at t_k. */
 	long n0 = lround(k * ref->grid / h);
-	double f[2];
-	const double *v = ref->states[k].v; /* the body's velocity at the step's start */
+	double f[BSIM_WRENCH];
+	const bsim_state *at = &ref->states[k]; /* the body's motion at the step's start */
 	for (long j = 0; j < m && rc == BSIM_OK; j++) {
-		bsim_effects_force_at(&fx, n0 + j, h, v, f);
-		rc = b->step(w, f, 0.0, h, err);
+		bsim_effects_force_at(&fx, n0 + j, h, at, f);
+		rc = b->step(w, f, f[2], h, err);
 		if (fx.n_work < fx.n) { /* effects that read the state */
 			b->get_state(w, s);
-			v = s->v;
+			at = s;
 		}
 	}
 	if (rc == BSIM_OK)

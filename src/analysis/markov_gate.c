@@ -175,16 +175,17 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	double next[2];
 	int out = 0;
 	r->steps = n_max;
-	const double *v = r->s0.v; /* the body's velocity at the step's start */
+	/* the body's motion at the step's start: s0, which the swap below
+	 * refills with the state each step ends in */
+	const bsim_state *at = &r->s0;
 	for (long n = 0; n < n_max; n++) {
-		double f[2];
-		bsim_effects_force_at(&fx, n, s->dt, v, f);
-		if (be->step(w, f, 0.0, s->dt, err) != BSIM_OK) {
+		double f[BSIM_WRENCH];
+		bsim_effects_force_at(&fx, n, s->dt, at, f);
+		if (be->step(w, f, f[2], s->dt, err) != BSIM_OK) {
 			out = -1;
 			break;
 		}
 		be->get_state(w, &r->s1);
-		v = r->s1.v;
 		if (!isfinite(r->s1.x[0]) || !isfinite(r->s1.x[1]) || !isfinite(r->s1.v[0]) ||
 		    !isfinite(r->s1.v[1])) {
 			bsim_error_set(err, BSIM_EFAIL,

@@ -19,6 +19,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,6 +33,15 @@
 #include "beamsim/stats.h"
 #include "run/sweep_record.h"
 #include "run/trial_pair.h"
+
+/* The length compare's separation is 1% of: the disk's radius, or the
+ * radius of the disk of the body's area for another shape. */
+static double body_size(const bsim_scene *scene)
+{
+	if (scene->body.shape == BSIM_SHAPE_DISK)
+		return scene->body.radius;
+	return sqrt(bsim_body_area(&scene->body) / 3.14159265358979323846);
+}
 
 /* One trial into its group's counts (group_finish completes them). */
 static void group_add(bsim_group_result *out, const bsim_trial_result *t)
@@ -374,7 +384,7 @@ static void sweep_thread(sweep_shared *sh)
 			pair->keep_stride = sh->keep_stride;
 			rc = trial_pair_run(pair, scene, &sh->scenes_b[g], cfg->backend, cfg->opts,
 			                    sh->backend_b, sh->opts_b, seed,
-			                    0.01 * scene->body.radius, &sh->results[k],
+			                    0.01 * body_size(scene), &sh->results[k],
 			                    &sh->results_b[k], log, &sh->t_separate[k], &err);
 		} else {
 			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, &rec,
