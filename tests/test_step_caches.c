@@ -96,6 +96,45 @@ static void test_schedule_held_value(void **state)
 	}
 }
 
+/* The pipeline's forces, the held random force read inline between its
+ * refreshes (bsim_effects_force_at), against the definition: 0 + F_prop
+ * along y, 0 + value(index(n)) along x, read in order, backwards and at
+ * random, at a step that divides the hold and one that does not. */
+static void test_effects_held_inline(void **state)
+{
+	(void)state;
+	const double hs[] = {0.004, 0.003};
+	for (int k = 0; k < 2; k++) {
+		bsim_scene s;
+		bsim_scene_init_gate(&s, 7.0, 20.0);
+		bsim_effects fx;
+		assert_int_equal(bsim_effects_init(&fx, &s, 11), BSIM_OK);
+		bsim_schedule *ref = bsim_schedule_alloc(20.0, s.effects.random_frequency, 11);
+		assert_non_null(ref);
+		double h = hs[k];
+		long order[3000];
+		for (long n = 0; n < 1000; n++) {
+			order[n] = n;
+			order[1000 + n] = 999 - n;
+			order[2000 + n] = (n * 7919) % 1000;
+		}
+		const double v[2] = {0.0, 0.0};
+		for (int m = 0; m < 3000; m++) {
+			long n = order[m];
+			double f[2];
+			bsim_effects_force_at(&fx, n, h, v, f);
+			double want[2] = {0.0, 0.0};
+			want[0] += bsim_schedule_value(ref, bsim_schedule_index(ref, n, h));
+			want[1] += 7.0;
+			assert_memory_equal(f, want, sizeof f);
+			assert_memory_equal(&fx.random->last, &want[0], sizeof want[0]);
+		}
+		bsim_schedule_free(ref);
+		bsim_effects_free(&fx);
+		bsim_scene_free(&s);
+	}
+}
+
 static void assert_same_step(const bsim_state *a, const bsim_state *b)
 {
 	assert_memory_equal(a->x, b->x, sizeof a->x);
@@ -254,6 +293,64 @@ static void test_free_flight_bound(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The free-flight room (broad_phase.c clear_fill): a body wandering in
+ * small random steps about a gate, in and out of the beams' reach, at
+ * speeds that make the margin matter, so that most steps are decided by
+ * the room kept from an earlier step. Whenever the step is called clear,
+ * the exact test finds every beam out of reach. */
+static void test_free_flight_room(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	bsim_world *w = NULL;
+	bsim_error err;
+	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+	const double h = s.dt;
+	/* about a point on beam 0's reach, on the side away from beam 1 */
+	const thesis_beam *b0 = &w->beams[0], *b1 = &w->beams[1];
+	double reach0 = b0->length + w->radius;
+	double ax = b0->p[0] - b1->p[0], ay = b0->p[1] - b1->p[1], a = sqrt(ax * ax + ay * ay);
+	const double home[2] = {b0->p[0] + reach0 * ax / a, b0->p[1] + reach0 * ay / a};
+	w->x[0] = home[0];
+	w->x[1] = home[1];
+	int clear = 0, by_room = 0;
+	for (int t = 0; t < 200000; t++) {
+		double f[2] = {gsl_ran_gaussian(rng, 30.0), 7.0};
+		w->v[0] = gsl_ran_gaussian(rng, 5.0);
+		w->v[1] = gsl_ran_gaussian(rng, 5.0);
+		w->x[0] += gsl_ran_gaussian(rng, 2e-3);
+		w->x[1] += gsl_ran_gaussian(rng, 2e-3);
+		/* kept within half a reach of home: in and out of reach */
+		double ex = w->x[0] - home[0], ey = w->x[1] - home[1];
+		if (ex * ex + ey * ey > 0.25 * reach0 * reach0) {
+			w->x[0] = home[0];
+			w->x[1] = home[1];
+		}
+		double room_before = w->clear_room, cx = w->clear_x[0], cy = w->clear_x[1];
+		if (!thesis_broad_phase_clear(w, f, h))
+			continue;
+		clear++;
+		by_room +=
+		        w->clear_room == room_before && w->clear_x[0] == cx && w->clear_x[1] == cy;
+		double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
+		               h * sqrt(f[0] * f[0] + f[1] * f[1]) * w->inv_mass;
+		for (int i = 0; i < w->n_beams; i++) {
+			const thesis_beam *c = &w->beams[i];
+			double dx = w->x[0] - c->p[0], dy = w->x[1] - c->p[1];
+			double ri = c->length + w->radius + thesis_step_margin(w, c, speed, h);
+			assert_true(dx * dx + dy * dy > ri * ri);
+		}
+	}
+
+	assert_true(clear > 20000);
+	assert_true(by_room > clear / 2);
+	gsl_rng_free(rng);
+	bsim_backend_thesis.destroy(w);
+	bsim_scene_free(&s);
+}
+
 /* Trials of one scene in a world kept and reset between them against each
  * in a world built for it: the same results and beam peaks to the bit. On
  * a 5 x 5 lattice (the body pushes, wakes and leaves many beams; whole
@@ -323,6 +420,8 @@ int main(void)
 	        cmocka_unit_test(test_free_flight_as_detection),
 	        cmocka_unit_test(test_kept_world_as_built),
 	        cmocka_unit_test(test_free_flight_bound),
+	        cmocka_unit_test(test_free_flight_room),
+	        cmocka_unit_test(test_effects_held_inline),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -140,6 +140,10 @@ struct bsim_world {
 	int n_near;
 	double near_x[2];  /* m */
 	double near_reach; /* m; 0: no cache */
+	/* The room of thesis_broad_phase_clear: every beam's pivot lies
+	 * farther than L + R + clear_room from clear_x (0: none known). */
+	double clear_x[2]; /* m */
+	double clear_room; /* m */
 };
 
 /* Beam i may differ from how the world was made: a reset restores it. */
@@ -161,7 +165,7 @@ int thesis_broad_phase(struct bsim_world *w, double speed, double h);
 int thesis_broad_phase_near(struct bsim_world *w, double margin);
 /* 1 if no beam, all at rest, can reach the body this step (a world the
  * broad phase tests whole only; never with broad_phase=0); 0 if one may. */
-int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], double h);
+int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h);
 
 /* beam_sleep.c */
 void thesis_beam_wake(struct bsim_world *w, int i);

@@ -320,7 +320,8 @@ static void flight_step(bsim_world *w, const double force[2], double h)
 	const double j[2] = {0.0, 0.0};
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm);
-	thesis_contact_clear(w);
+	if (w->n_flagged)
+		thesis_contact_clear(w);
 }
 
 /* Nothing in a step allocates: the world's memory is sized at creation. */
@@ -375,7 +376,9 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 	memcpy(s->x, w->x, sizeof s->x);
 	memcpy(s->v, w->v, sizeof s->v);
 	s->pivot_drift = 0.0; /* a beam here is an angle about a fixed pivot */
-	bsim_state_set_active(s, w->awake, w->n_awake);
+	/* Both lists empty (free flight): the same, nothing to set. */
+	if (w->n_awake || s->n_active)
+		bsim_state_set_active(s, w->awake, w->n_awake);
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k];
 		s->theta[i] = w->beams[i].theta;

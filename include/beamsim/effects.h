@@ -16,8 +16,19 @@ extern "C" {
 
 #define BSIM_EFFECTS_MAX 8
 
+/* How bsim_effects_force_at computes an effect's force: by its apply, or
+ * inline for the two that every trial of the essay's scenes calls each
+ * step (the same operations as their apply: the same bits). */
+enum {
+	BSIM_EFFECT_APPLY = 0,    /* apply */
+	BSIM_EFFECT_CONSTANT = 1, /* param along axis (propulsion) */
+	BSIM_EFFECT_HELD = 2      /* last along axis while step n is in [held[0], held[1]) at
+	                           * step size held_h (the held random force), else apply */
+};
+
 typedef struct bsim_effect {
 	const char *name;
+	int kind; /* BSIM_EFFECT_* */
 	/* Adds this effect's force on the body (N) at step n of size h (s) into
 	 * f, given the body's velocity v (m/s) at the step's start; f holds the
 	 * forces of the effects before it in the pipeline. */
@@ -38,6 +49,10 @@ typedef struct bsim_effect {
 	 * y (N). */
 	double mass;
 	double applied[2];
+	/* BSIM_EFFECT_HELD: the steps over which last holds at step size
+	 * held_h (s), as the schedule's bsim_schedule_at_step_held gives them. */
+	long held[2];
+	double held_h;
 } bsim_effect;
 
 typedef struct bsim_effects {
@@ -73,8 +88,18 @@ static inline void bsim_effects_force_at(bsim_effects *fx, long n, double h, con
 {
 	f[0] = 0.0;
 	f[1] = 0.0;
-	for (int i = 0; i < fx->n; i++)
-		fx->e[i].apply(&fx->e[i], n, h, v, f);
+	for (int i = 0; i < fx->n; i++) {
+		bsim_effect *e = &fx->e[i];
+		if (e->kind == BSIM_EFFECT_CONSTANT) {
+			f[e->axis] += e->param;
+			e->last = e->param;
+		} else if (e->kind == BSIM_EFFECT_HELD && n >= e->held[0] && n < e->held[1] &&
+		           h == e->held_h) {
+			f[e->axis] += e->last;
+		} else {
+			e->apply(e, n, h, v, f);
+		}
+	}
 }
 
 /* bsim_effects_force_at for a body at rest: the same forces for a scene

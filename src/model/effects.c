@@ -17,11 +17,14 @@ static void propulsion_apply(bsim_effect *e, long n, double h, const double v[2]
 	e->last = e->param;
 }
 
-/* F_rand = (Rm z_j, 0), z_j held for 1/f seconds: essay Eq. 2.3. */
+/* F_rand = (Rm z_j, 0), z_j held for 1/f seconds: essay Eq. 2.3. The
+ * steps it holds over are kept, so that bsim_effects_force_at reads it
+ * there without a call. */
 static void random_force_apply(bsim_effect *e, long n, double h, const double v[2], double f[2])
 {
 	(void)v;
-	double value = bsim_schedule_at_step(e->schedule, n, h);
+	double value = bsim_schedule_at_step_held(e->schedule, n, h, e->held);
+	e->held_h = h;
 	f[0] += value;
 	e->last = value;
 }
@@ -153,7 +156,8 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	memset(fx, 0, sizeof *fx);
 	const bsim_effects_def *d = &scene->effects;
 	if (d->has_propulsion)
-		effects_add(fx, "propulsion", propulsion_apply, 1, d->propulsion_force);
+		effects_add(fx, "propulsion", propulsion_apply, 1, d->propulsion_force)->kind =
+		        BSIM_EFFECT_CONSTANT;
 	if (d->has_random_force) {
 		bsim_effect *e;
 		if (d->random_model == BSIM_RANDOM_OU) {
@@ -168,6 +172,7 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 		} else {
 			e = effects_add(fx, "random_force", random_force_apply, 0,
 			                d->random_magnitude);
+			e->kind = BSIM_EFFECT_HELD;
 		}
 		/* ou and white scale z_n themselves: the schedule gives z_n, one per step */
 		e->schedule = d->random_model == BSIM_RANDOM_HELD

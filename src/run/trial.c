@@ -401,8 +401,8 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 		if ((rc = backend->step(c.w, f, lp.h, err)) != BSIM_OK)
 			break;
 		backend->get_state(c.w, s1);
-		double e1 = energy_mech(c.ws, s1);
-		if (!state_finite(s1) || !isfinite(e1)) {
+		double e1;
+		if (!state_energy_finite(c.ws, s1, &e1)) {
 			/* s0 stays the last finite state, the one reported. */
 			out->instability = BSIM_UNSTABLE_NONFINITE;
 			out->unstable_step = (int)(lp.n + 1);

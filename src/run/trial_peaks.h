@@ -75,9 +75,13 @@ static inline void trial_peaks_update(trial_peaks *p, const bsim_scene *scene, c
 		trial_peaks_list(p, g);
 		peak[g] = bsim_fmax(peak[g], s->theta[i]);
 	}
+	/* A peak at +0 or above stays: the beam is active (the loop above
+	 * took its angle) or at rest (angle +-0, below it or, as bsim_fmax
+	 * orders zeros, not above +0). */
 	if (!map)
 		for (int i = 0; i < 2 && i < scene->n_beams; i++)
-			peak[i] = bsim_fmax(peak[i], s->theta[i]);
+			if (!(peak[i] >= 0.0) || signbit(peak[i]))
+				peak[i] = bsim_fmax(peak[i], s->theta[i]);
 	int m = 0; /* only without a map: the essay's beams all start at rest */
 	for (int k = 0; k < p->n_negative; k++) {
 		int i = p->negative[k];
