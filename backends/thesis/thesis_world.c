@@ -330,7 +330,7 @@ static int thesis_step(bsim_world *w, const double force[2], double h, bsim_erro
 	(void)err;
 	/* Free flight among beams at rest (none awake, none in reach): no
 	 * contact, no beam to move, no square root for the margin. */
-	int in_flight = w->n_awake == 0 && thesis_broad_phase_clear(w, force, h);
+	int in_flight = w->n_awake == 0 && thesis_flight_clear(w, force, h);
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
 	if (in_flight && w->n_typed == 0 && h == w->h_prepared &&
