@@ -351,6 +351,78 @@ static void test_free_flight_room(void **state)
 	bsim_scene_free(&s);
 }
 
+/* Steps a and b side by side through n steps of sc's effects (seed): the
+ * same states to the bit. Returns the steps in which the body touched. */
+static int step_pair_same(bsim_world *a, bsim_world *b, const bsim_scene *sc, uint64_t seed, int n)
+{
+	const bsim_backend *be = &bsim_backend_thesis;
+	bsim_error err;
+	bsim_effects fx;
+	assert_int_equal(bsim_effects_init(&fx, sc, seed), BSIM_OK);
+	bsim_state sa, sb;
+	assert_int_equal(bsim_state_init(&sa, sc->n_beams), BSIM_OK);
+	assert_int_equal(bsim_state_init(&sb, sc->n_beams), BSIM_OK);
+	int touched = 0;
+	for (int k = 0; k < n; k++) {
+		double f[2];
+		be->get_state(a, &sa);
+		bsim_effects_force_at(&fx, k, sc->dt, sa.v, f);
+		assert_int_equal(be->step(a, f, sc->dt, &err), BSIM_OK);
+		assert_int_equal(be->step(b, f, sc->dt, &err), BSIM_OK);
+		be->get_state(a, &sa);
+		be->get_state(b, &sb);
+		assert_same_step(&sa, &sb);
+		touched += sa.contact[0] || sa.contact[1];
+	}
+	bsim_state_free(&sa);
+	bsim_state_free(&sb);
+	bsim_effects_free(&fx);
+	return touched;
+}
+
+/* A world reset to its scene with the body started elsewhere (markov's
+ * single-gate trials), and one reset and then set to a state (accuracy's
+ * restarted pieces), step as worlds created for them. */
+static void test_reset_as_created(void **state)
+{
+	(void)state;
+	const bsim_backend *be = &bsim_backend_thesis;
+	bsim_error err;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	bsim_world *kept = NULL, *fresh = NULL;
+	assert_int_equal(be->create(&s, NULL, &kept, &err), BSIM_OK);
+	int touched = 0;
+	for (int t = 0; t < 6; t++) {
+		/* the last trial's steps, then the body moved */
+		bsim_state st;
+		assert_int_equal(bsim_state_init(&st, s.n_beams), BSIM_OK);
+		for (int k = 0; k < 400; k++) {
+			double f[2] = {0.0, 7.0};
+			assert_int_equal(be->step(kept, f, s.dt, &err), BSIM_OK);
+		}
+		be->get_state(kept, &st);
+		s.body.start[0] = 0.01 * (t - 3);
+		s.body.velocity[0] = 0.2 * (t - 2);
+		s.body.velocity[1] = 0.5 + 0.1 * t;
+		assert_int_equal(be->reset(kept, &s, &err), BSIM_OK);
+		assert_int_equal(be->create(&s, NULL, &fresh, &err), BSIM_OK);
+		touched += step_pair_same(kept, fresh, &s, 100 + (uint64_t)t, 600);
+		be->destroy(fresh);
+		/* reset, then set to the state of a step that touched */
+		assert_int_equal(be->reset(kept, &s, &err), BSIM_OK);
+		assert_int_equal(be->create(&s, NULL, &fresh, &err), BSIM_OK);
+		assert_int_equal(be->set_state(kept, &st, &err), BSIM_OK);
+		assert_int_equal(be->set_state(fresh, &st, &err), BSIM_OK);
+		touched += step_pair_same(kept, fresh, &s, 200 + (uint64_t)t, 300);
+		be->destroy(fresh);
+		bsim_state_free(&st);
+	}
+	assert_true(touched > 0); /* the beams were met */
+	be->destroy(kept);
+	bsim_scene_free(&s);
+}
+
 /* Trials of one scene in a world kept and reset between them against each
  * in a world built for it: the same results and beam peaks to the bit. On
  * a 5 x 5 lattice (the body pushes, wakes and leaves many beams; whole
@@ -422,6 +494,7 @@ int main(void)
 	        cmocka_unit_test(test_free_flight_bound),
 	        cmocka_unit_test(test_free_flight_room),
 	        cmocka_unit_test(test_effects_held_inline),
+	        cmocka_unit_test(test_reset_as_created),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
