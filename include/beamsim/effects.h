@@ -88,6 +88,16 @@ static inline void bsim_effects_force_at(bsim_effects *fx, long n, double h, con
 {
 	f[0] = 0.0;
 	f[1] = 0.0;
+	/* The essay's pipeline, propulsion then the held random force, within
+	 * a hold: the loop below unrolled, the same operations. */
+	bsim_effect *e0 = &fx->e[0], *e1 = &fx->e[1];
+	if (fx->n == 2 && e0->kind == BSIM_EFFECT_CONSTANT && e1->kind == BSIM_EFFECT_HELD &&
+	    n >= e1->held[0] && n < e1->held[1] && h == e1->held_h) {
+		f[e0->axis] += e0->param;
+		e0->last = e0->param;
+		f[e1->axis] += e1->last;
+		return;
+	}
 	for (int i = 0; i < fx->n; i++) {
 		bsim_effect *e = &fx->e[i];
 		if (e->kind == BSIM_EFFECT_CONSTANT) {

@@ -83,13 +83,18 @@ static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsi
 {
 	const double d[2] = {s1->x[0] - s0->x[0], s1->x[1] - s0->x[1]};
 	double w_prop = 0.0, w_rand = 0.0;
-	for (int i = 0; i < fx->n_work; i++) {
-		double work = fx->e[i].last * d[fx->e[i].axis];
-		if (&fx->e[i] == fx->random)
-			w_rand += work;
-		else
-			w_prop += work;
-	}
+	if (fx->n_work == 2 && fx->random == &fx->e[1]) {
+		/* the essay's pipeline: the loop below unrolled */
+		w_prop += fx->e[0].last * d[fx->e[0].axis];
+		w_rand += fx->e[1].last * d[fx->e[1].axis];
+	} else
+		for (int i = 0; i < fx->n_work; i++) {
+			double work = fx->e[i].last * d[fx->e[i].axis];
+			if (&fx->e[i] == fx->random)
+				w_rand += work;
+			else
+				w_prop += work;
+		}
 	const bsim_step_energy *se = &s1->energy;
 	double r = (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -
 	                        se->correction - se->sleep);

@@ -31,6 +31,9 @@ typedef struct trial_peaks {
 	int *touching;
 	int *touch_list; /* the beams touching[] holds non-zero */
 	int n_touch;
+	/* Beams 0 and 1's peaks are at +0 or above: a peak never falls, so
+	 * they stay there, and a beam at rest cannot raise them. */
+	int settled01;
 } trial_peaks;
 
 /* Room for a scene of n_beams beams. */
@@ -78,10 +81,15 @@ static inline void trial_peaks_update(trial_peaks *p, const bsim_scene *scene, c
 	/* A peak at +0 or above stays: the beam is active (the loop above
 	 * took its angle) or at rest (angle +-0, below it or, as bsim_fmax
 	 * orders zeros, not above +0). */
-	if (!map)
-		for (int i = 0; i < 2 && i < scene->n_beams; i++)
+	if (!map && !p->settled01) {
+		int settled = 1;
+		for (int i = 0; i < 2 && i < scene->n_beams; i++) {
 			if (!(peak[i] >= 0.0) || signbit(peak[i]))
 				peak[i] = bsim_fmax(peak[i], s->theta[i]);
+			settled &= peak[i] >= 0.0 && !signbit(peak[i]);
+		}
+		p->settled01 = settled;
+	}
 	int m = 0; /* only without a map: the essay's beams all start at rest */
 	for (int k = 0; k < p->n_negative; k++) {
 		int i = p->negative[k];
