@@ -425,8 +425,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 			                                                   scene->body.radius, s0));
 		if (lp.done)
 			continue;
-		trial_peaks_update(&r->peaks, scene, c.map, s0);
-		trial_peaks_contacts(&r->peaks, c.map, s0);
+		trial_peaks_step(&r->peaks, scene, c.map, s0);
 		/* The gate first: a body that leaves the field ends in its gate. */
 		if (scene->has_lattice && (rc = gate_follow(&c, &lp, s0, p0, err)) != BSIM_OK)
 			break;

@@ -136,4 +136,16 @@ static inline void trial_peaks_contacts(trial_peaks *p, const int *map, const bs
 	}
 }
 
+/* Both of the above after a step, s the state after it: nothing to do, at
+ * the cost of a test, where no beam is active, no peak is below 0 and
+ * beams 0 and 1's have settled (or the essay's map, which has no such). */
+static inline void trial_peaks_step(trial_peaks *p, const bsim_scene *scene, const int *map,
+                                    const bsim_state *s)
+{
+	if (s->n_active == 0 && p->n_negative == 0 && (map || p->settled01))
+		return;
+	trial_peaks_update(p, scene, map, s);
+	trial_peaks_contacts(p, map, s);
+}
+
 #endif
