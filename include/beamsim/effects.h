@@ -21,8 +21,19 @@ extern "C" {
  * its centre (N), f[2] the torque about it (N m, counter-clockwise). */
 enum { BSIM_WRENCH = 3 };
 
+/* How bsim_effects_force_at computes an effect's force: by its apply, or
+ * inline for the two that every trial of the essay's scenes calls each
+ * step (the same operations as their apply: the same bits). */
+enum {
+	BSIM_EFFECT_APPLY = 0,    /* apply */
+	BSIM_EFFECT_CONSTANT = 1, /* param along axis (propulsion along y) */
+	BSIM_EFFECT_HELD = 2      /* last along axis while step n is in [held[0], held[1]) at
+	                           * step size held_h (the held random force), else apply */
+};
+
 typedef struct bsim_effect {
 	const char *name;
+	int kind; /* BSIM_EFFECT_* */
 	/* Adds this effect's force and torque on the body at step n of size h
 	 * (s) into f (BSIM_WRENCH), given the body's motion at the step's
 	 * start: s's position x, velocity v, heading and angular_velocity (the
@@ -53,6 +64,10 @@ typedef struct bsim_effect {
 	 * coefficient for h. */
 	double param_turn;
 	double coef_turn;
+	/* BSIM_EFFECT_HELD: the steps over which last holds at step size
+	 * held_h (s), as the schedule's bsim_schedule_at_step_held gives them. */
+	long held[2];
+	double held_h;
 } bsim_effect;
 
 typedef struct bsim_effects {
@@ -93,8 +108,28 @@ static inline void bsim_effects_force_at(bsim_effects *fx, long n, double h, con
 	f[0] = 0.0;
 	f[1] = 0.0;
 	f[2] = 0.0;
-	for (int i = 0; i < fx->n; i++)
-		fx->e[i].apply(&fx->e[i], n, h, s, f);
+	/* The essay's pipeline, propulsion then the held random force, within
+	 * a hold: the loop below unrolled, the same operations. */
+	bsim_effect *e0 = &fx->e[0], *e1 = &fx->e[1];
+	if (fx->n == 2 && e0->kind == BSIM_EFFECT_CONSTANT && e1->kind == BSIM_EFFECT_HELD &&
+	    n >= e1->held[0] && n < e1->held[1] && h == e1->held_h) {
+		f[e0->axis] += e0->param;
+		e0->last = e0->param;
+		f[e1->axis] += e1->last;
+		return;
+	}
+	for (int i = 0; i < fx->n; i++) {
+		bsim_effect *e = &fx->e[i];
+		if (e->kind == BSIM_EFFECT_CONSTANT) {
+			f[e->axis] += e->param;
+			e->last = e->param;
+		} else if (e->kind == BSIM_EFFECT_HELD && n >= e->held[0] && n < e->held[1] &&
+		           h == e->held_h) {
+			f[e->axis] += e->last;
+		} else {
+			e->apply(e, n, h, s, f);
+		}
+	}
 }
 
 /* bsim_effects_force_at for a body at rest at the origin, heading +x: the

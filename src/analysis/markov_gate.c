@@ -123,6 +123,9 @@ typedef struct gate_runner {
 	const markov_pool *pool;      /* NULL: not a self-consistent pass */
 	markov_run *run;              /* NULL: not kept */
 	long steps;                   /* of the last trial */
+	/* The last trial's world, reset for the next (the gate's scene stays
+	 * but for the body's start); NULL: none, or a backend without reset. */
+	bsim_world *w;
 } gate_runner;
 
 /* One single-gate trial from entry bin `bin` (0: the start) with trial index
@@ -155,9 +158,14 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 			                  s->body.velocity);
 		}
 	}
-	bsim_world *w = NULL;
-	if (be->create(s, opts, &w, err) != BSIM_OK)
+	bsim_world *w = r->w;
+	const int reused = w != NULL;
+	r->w = NULL;
+	if ((reused ? be->reset(w, s, err) : be->create(s, opts, &w, err)) != BSIM_OK) {
+		if (reused)
+			be->destroy(w);
 		return -1;
+	}
 	bsim_effects fx;
 	if (bsim_effects_init(&fx, s,
 	                      bsim_schedule_seed_mix(def->seed, (uint64_t)bin, (uint64_t)t))) {
@@ -215,7 +223,10 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 		memcpy(r->run->exit_v, last->v, sizeof r->run->exit_v);
 	}
 	bsim_effects_free(&fx);
-	be->destroy(w);
+	if (out >= 0 && be->reset)
+		r->w = w;
+	else
+		be->destroy(w);
 	return out;
 }
 
@@ -307,6 +318,8 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 				def->progress(def->progress_user, now, total);
 			}
 		}
+		if (r.w)
+			be->destroy(r.w);
 		gsl_rng_free(r.rng);
 		bsim_state_free(&r.s0);
 		bsim_state_free(&r.s1);

@@ -19,11 +19,14 @@ static void propulsion_apply(bsim_effect *e, long n, double h, const bsim_state 
 	e->last = e->param;
 }
 
-/* F_rand = (Rm z_j, 0), z_j held for 1/f seconds: essay Eq. 2.3. */
+/* F_rand = (Rm z_j, 0), z_j held for 1/f seconds: essay Eq. 2.3. The
+ * steps it holds over are kept, so that bsim_effects_force_at reads it
+ * there without a call. */
 static void random_force_apply(bsim_effect *e, long n, double h, const bsim_state *s, double f[3])
 {
 	(void)s;
-	double value = bsim_schedule_at_step(e->schedule, n, h);
+	double value = bsim_schedule_at_step_held(e->schedule, n, h, e->held);
+	e->held_h = h;
 	f[0] += value;
 	e->last = value;
 }
@@ -269,7 +272,8 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	const bsim_effects_def *d = &scene->effects;
 	const int turns = scene->body.rotates;
 	if (d->has_propulsion && d->propulsion_along == BSIM_ALONG_Y)
-		effects_add(fx, "propulsion", propulsion_apply, 1, d->propulsion_force);
+		effects_add(fx, "propulsion", propulsion_apply, 1, d->propulsion_force)->kind =
+		        BSIM_EFFECT_CONSTANT;
 	if (d->has_random_force) {
 		bsim_effect *e;
 		if (d->random_model == BSIM_RANDOM_OU) {
@@ -284,6 +288,7 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 		} else {
 			e = effects_add(fx, "random_force", random_force_apply, 0,
 			                d->random_magnitude);
+			e->kind = BSIM_EFFECT_HELD;
 		}
 		/* ou and white scale z_n themselves: the schedule gives z_n, one per step */
 		e->schedule = d->random_model == BSIM_RANDOM_HELD

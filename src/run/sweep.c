@@ -340,6 +340,8 @@ static void sweep_thread(sweep_shared *sh)
 	if (runner)
 		bsim_trial_runner_keep_worlds(runner, 1);
 	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
+	if (pair)
+		trial_pair_keep_worlds(pair, 1);
 	bsim_trial_log *log[2] = {bsim_trial_log_alloc(), bsim_trial_log_alloc()};
 	void *record_buf = sh->record_beams ? malloc(sh->record_size) : NULL;
 	pair_record pr;

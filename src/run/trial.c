@@ -403,8 +403,8 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 		if ((rc = backend->step(c.w, f, f[2], lp.h, err)) != BSIM_OK)
 			break;
 		backend->get_state(c.w, s1);
-		double e1 = energy_mech(c.ws, s1);
-		if (!state_finite(s1) || !isfinite(e1)) {
+		double e1;
+		if (!state_energy_finite(c.ws, s1, &e1)) {
 			/* s0 stays the last finite state, the one reported. */
 			out->instability = BSIM_UNSTABLE_NONFINITE;
 			out->unstable_step = (int)(lp.n + 1);
@@ -427,8 +427,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 			                                                   scene->body.radius, s0));
 		if (lp.done)
 			continue;
-		trial_peaks_update(&r->peaks, scene, c.map, s0);
-		trial_peaks_contacts(&r->peaks, c.map, s0);
+		trial_peaks_step(&r->peaks, scene, c.map, s0);
 		/* The gate first: a body that leaves the field ends in its gate. */
 		if (scene->has_lattice && (rc = gate_follow(&c, &lp, s0, p0, err)) != BSIM_OK)
 			break;

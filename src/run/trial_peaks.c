@@ -68,6 +68,7 @@ void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
 	}
 	p->touched = 0;
 	p->last_touch[0] = p->last_touch[1] = 0.0;
+	p->settled01 = 0;
 	touching_clear(p);
 }
 
