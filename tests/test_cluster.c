@@ -582,6 +582,43 @@ static void test_lattice_compare_shards_merged(void **state)
 	}
 }
 
+/* A lattice comparison of 60 pairs a group killed (SIGKILL once its
+ * journal holds 5 records) and resumed: the one-process directory, its
+ * lattice files written from the journal's and the resumed run's pairs. */
+static void test_lattice_compare_killed_resumed(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], journal[1200];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("lattice_compare_killed"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/killed", dir);
+	snprintf(journal, sizeof journal, "%s/.beamsim/journal", out);
+	const char *argv1[] = {"compare",   lattice_compare_experiment(),
+	                       "--trials",  "60",
+	                       "--threads", "2",
+	                       "--out",     one,
+	                       "--quiet",   NULL};
+	int want = run_status(argv1);
+	assert_true(want == 0 || want == 3);
+	const char *argv[] = {"compare",   lattice_compare_experiment(),
+	                      "--trials",  "60",
+	                      "--threads", "1",
+	                      "--out",     out,
+	                      "--quiet",   NULL,
+	                      NULL};
+	int pid = bsim_test_spawn(argv), status = 0;
+	if (!bsim_test_await_records(pid, journal, 5, &status))
+		fail_msg("the comparison ended (status %d) before its journal held 5 records",
+		         status);
+	kill(pid, SIGKILL);
+	bsim_test_wait(pid);
+	assert_true(bsim_test_journal_records(journal) >= 5);
+	assert_false(bsim_test_exists(bsim_test_join(out, "pairs.csv")));
+	argv[9] = "--resume";
+	assert_int_equal(run_status(argv), want);
+	assert_same_dir(one, out);
+}
+
 /* ---- markov validate and essay: several sweeps, one journal ------------- */
 
 /* "mpi_" in test_cluster mpi: its directories apart from test_cluster's,
@@ -1175,6 +1212,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_markov_shards_merged),
 	        cmocka_unit_test(test_lattice_shards_merged),
 	        cmocka_unit_test(test_lattice_compare_shards_merged),
+	        cmocka_unit_test(test_lattice_compare_killed_resumed),
 	        cmocka_unit_test(test_validate_shards_merged),
 	        cmocka_unit_test(test_essay_shards_merged),
 	        cmocka_unit_test(test_validate_killed_resumed),
