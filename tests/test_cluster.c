@@ -472,6 +472,153 @@ static void test_lattice_shards_merged(void **state)
 	assert_true(bsim_test_exists(bsim_test_join(out, "transitions.csv")));
 }
 
+/* ---- a lattice comparison: its records hold both sides' gate paths ------ */
+
+static const char *group_prefix; /* below */
+
+/* A 3 x 3 gate lattice (beams k 150 N/m, F 6 N, sides at |X| 150 m), 5
+ * pairs a group of Rm 0 (deterministic) and 30 N: paths of up to 8 gates,
+ * most trials traversed, some stuck. Written once; its path. */
+static const char *lattice_compare_experiment(void)
+{
+	static char path[1200];
+	if (!path[0]) {
+		char name[64];
+		snprintf(name, sizeof name, "%slattice_compare_exp", group_prefix);
+		const char *dir = bsim_test_dir(name);
+		bsim_test_write(
+		        dir, "scene.yaml",
+		        "name: lattice-3x3\n"
+		        "body: { mass: 1.0, radius: 10.0, start: [0, 0], velocity: [0, 0] }\n"
+		        "lattice:\n"
+		        "  columns: 3\n"
+		        "  rows: 3\n"
+		        "  gate: { width: 50, depth: 60, pivot_y: 30 }\n"
+		        "  beam: { length: 25, mass: 0.1, stiffness: 150, damping: 50 }\n"
+		        "contact: { restitution: 0.8, tip_restitution: 1.0, "
+		        "rest_threshold: 0.05 }\n"
+		        "effects:\n"
+		        "  propulsion: { force: 6.0 }\n"
+		        "  random_force: { magnitude: 30.0, frequency: 50.0 }\n"
+		        "integration: { dt: 0.004, duration: 40 }\n"
+		        "termination: { success_y: 180, side_x: 150, gate_time: 12 }\n");
+		snprintf(path, sizeof path, "%s",
+		         bsim_test_write(dir, "exp.yaml",
+		                         "scene: scene.yaml\n"
+		                         "trials: 5\n"
+		                         "seed: 5\n"
+		                         "grid:\n"
+		                         "  effects.random_force.magnitude: [0, 30]\n"));
+	}
+	return path;
+}
+
+/* compare of the lattice (protocols NULL: thesis against box2d; else
+ * --protocols protocols) into out, extra arguments a, b (NULL: none) last:
+ * argv filled. */
+static void lattice_compare_argv(const char **argv, const char *out, const char *threads,
+                                 const char *protocols, const char *a, const char *b)
+{
+	const char *v[] = {"compare",
+	                   lattice_compare_experiment(),
+	                   "--threads",
+	                   threads,
+	                   "--out",
+	                   out,
+	                   "--quiet",
+	                   protocols ? "--protocols" : a,
+	                   protocols ? protocols : b,
+	                   protocols ? a : NULL,
+	                   protocols ? b : NULL,
+	                   NULL};
+	memcpy(argv, v, sizeof v);
+}
+
+/* The status of the program run with argv (0, or 3 when a group
+ * disagrees), its error printed when it is neither. */
+static int run_status(const char *const *argv)
+{
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	if (rc != 0 && rc != 3)
+		print_error("%s: exit %d: %s", argv[0], rc, err ? err : "");
+	free(err);
+	return rc;
+}
+
+/* The lattice comparison in 3 parts, merged: the one-process directory
+ * (report, pairs, each side's trials.csv, summary.json and lattice files),
+ * of two backends and of two protocols (whose side b has scenes of its
+ * own). */
+static void test_lattice_compare_shards_merged(void **state)
+{
+	(void)state;
+	static const char *const protocols[] = {NULL, "world,essay"};
+	for (int k = 0; k < 2; k++) {
+		char dir[1024], one[1100], out[1100], part[3][1100];
+		const char *argv[16];
+		snprintf(dir, sizeof dir, "%s",
+		         bsim_test_dir(k ? "lattice_compare_protocols" : "lattice_compare"));
+		snprintf(one, sizeof one, "%s/one", dir);
+		lattice_compare_argv(argv, one, "2", protocols[k], NULL, NULL);
+		int want = run_status(argv);
+		assert_true(want == 0 || want == 3);
+		assert_true(bsim_test_exists(bsim_test_join(one, k ? "world/transitions.csv"
+		                                                   : "box2d/gate_entries.csv")));
+		for (int i = 0; i < 3; i++) {
+			char shard_arg[16];
+			snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+			snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+			lattice_compare_argv(argv, part[i], i == 1 ? "2" : "1", protocols[k],
+			                     "--shard", shard_arg);
+			run_ok(argv);
+			assert_false(bsim_test_exists(bsim_test_join(part[i], "pairs.csv")));
+		}
+		snprintf(out, sizeof out, "%s/merged", dir);
+		const char *m[] = {"merge", part[1], part[0],   part[2],
+		                   "--out", out,     "--quiet", NULL};
+		assert_int_equal(run_status(m), want);
+		assert_same_dir(one, out);
+	}
+}
+
+/* A lattice comparison of 60 pairs a group killed (SIGKILL once its
+ * journal holds 5 records) and resumed: the one-process directory, its
+ * lattice files written from the journal's and the resumed run's pairs. */
+static void test_lattice_compare_killed_resumed(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], journal[1200];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("lattice_compare_killed"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/killed", dir);
+	snprintf(journal, sizeof journal, "%s/.beamsim/journal", out);
+	const char *argv1[] = {"compare",   lattice_compare_experiment(),
+	                       "--trials",  "60",
+	                       "--threads", "2",
+	                       "--out",     one,
+	                       "--quiet",   NULL};
+	int want = run_status(argv1);
+	assert_true(want == 0 || want == 3);
+	const char *argv[] = {"compare",   lattice_compare_experiment(),
+	                      "--trials",  "60",
+	                      "--threads", "1",
+	                      "--out",     out,
+	                      "--quiet",   NULL,
+	                      NULL};
+	int pid = bsim_test_spawn(argv), status = 0;
+	if (!bsim_test_await_records(pid, journal, 5, &status))
+		fail_msg("the comparison ended (status %d) before its journal held 5 records",
+		         status);
+	kill(pid, SIGKILL);
+	bsim_test_wait(pid);
+	assert_true(bsim_test_journal_records(journal) >= 5);
+	assert_false(bsim_test_exists(bsim_test_join(out, "pairs.csv")));
+	argv[9] = "--resume";
+	assert_int_equal(run_status(argv), want);
+	assert_same_dir(one, out);
+}
+
 /* ---- markov validate and essay: several sweeps, one journal ------------- */
 
 /* "mpi_" in test_cluster mpi: its directories apart from test_cluster's,
@@ -930,6 +1077,35 @@ static void test_mpi_lattice(void **state)
 	assert_same_dir(one, out);
 }
 
+/* mpirun -np 3 beamsim compare of the lattice: the one-process
+ * directory. */
+static void test_mpi_lattice_compare(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200];
+	const char *argv[16],
+	        *job[24] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_lattice_compare"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/ranks3", dir);
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	lattice_compare_argv(argv, one, "2", NULL, NULL, NULL);
+	int want = run_status(argv);
+	assert_true(want == 0 || want == 3);
+	lattice_compare_argv(argv, out, "1", NULL, NULL, NULL);
+	int n = 0;
+	while (argv[n])
+		n++;
+	memcpy(job + 5, argv, (size_t)(n + 1) * sizeof *argv);
+	int rc = wait_status(spawn_mpirun(job, err_path));
+	if (rc != want)
+		print_stderr(err_path);
+	assert_int_equal(rc, want);
+	assert_same_dir(one, out);
+}
+
 /* mpirun -np 3 beamsim markov validate and essay: the one-process
  * directories. */
 static void test_mpi_validate_essay(void **state)
@@ -1035,6 +1211,8 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_merge_refuses),
 	        cmocka_unit_test(test_markov_shards_merged),
 	        cmocka_unit_test(test_lattice_shards_merged),
+	        cmocka_unit_test(test_lattice_compare_shards_merged),
+	        cmocka_unit_test(test_lattice_compare_killed_resumed),
 	        cmocka_unit_test(test_validate_shards_merged),
 	        cmocka_unit_test(test_essay_shards_merged),
 	        cmocka_unit_test(test_validate_killed_resumed),
@@ -1045,6 +1223,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_mpi_markov_build),
 	        cmocka_unit_test(test_mpi_rank_killed_resumed),
 	        cmocka_unit_test(test_mpi_lattice),
+	        cmocka_unit_test(test_mpi_lattice_compare),
 	        cmocka_unit_test(test_mpi_validate_essay),
 	        cmocka_unit_test(test_mpi_essay_killed_resumed),
 	};

@@ -58,7 +58,7 @@ static void test_empty_pipeline(void **state)
 	bsim_effects fx;
 	assert_int_equal(bsim_effects_init(&fx, &s, 1), BSIM_OK);
 	assert_int_equal(fx.n, 0);
-	double f[2] = {1, 1};
+	double f[BSIM_WRENCH] = {1, 1, 1};
 	bsim_effects_force(&fx, 0, s.dt, f);
 	assert_true(f[0] == 0.0 && f[1] == 0.0);
 	bsim_effects_free(&fx);
@@ -148,7 +148,7 @@ static void forcing_series(const bsim_scene *s, uint64_t seed, double h, double 
 	assert_int_equal(bsim_effects_init(&fx, s, seed), BSIM_OK);
 	assert_non_null(fx.random);
 	for (int i = 0; i < n; i++) {
-		double f[2];
+		double f[BSIM_WRENCH];
 		bsim_effects_force(&fx, i, h, f);
 		assert_true(f[0] == fx.random->last);
 		out[i] = f[0];
@@ -199,7 +199,7 @@ static void test_ou_variance_and_autocorrelation(void **state)
 	/* a step asked for again, or out of order, is the same value */
 	bsim_effects fx;
 	assert_int_equal(bsim_effects_init(&fx, &s, bsim_schedule_seed_mix(7, 0, 3)), BSIM_OK);
-	double f[2], at37;
+	double f[BSIM_WRENCH], at37;
 	bsim_effects_force(&fx, 37, h, f);
 	at37 = f[0];
 	bsim_effects_force(&fx, 5, h, f);

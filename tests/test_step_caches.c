@@ -96,6 +96,45 @@ static void test_schedule_held_value(void **state)
 	}
 }
 
+/* The pipeline's forces, the held random force read inline between its
+ * refreshes (bsim_effects_force_at), against the definition: 0 + F_prop
+ * along y, 0 + value(index(n)) along x, read in order, backwards and at
+ * random, at a step that divides the hold and one that does not. */
+static void test_effects_held_inline(void **state)
+{
+	(void)state;
+	const double hs[] = {0.004, 0.003};
+	for (int k = 0; k < 2; k++) {
+		bsim_scene s;
+		bsim_scene_init_gate(&s, 7.0, 20.0);
+		bsim_effects fx;
+		assert_int_equal(bsim_effects_init(&fx, &s, 11), BSIM_OK);
+		bsim_schedule *ref = bsim_schedule_alloc(20.0, s.effects.random_frequency, 11);
+		assert_non_null(ref);
+		double h = hs[k];
+		long order[3000];
+		for (long n = 0; n < 1000; n++) {
+			order[n] = n;
+			order[1000 + n] = 999 - n;
+			order[2000 + n] = (n * 7919) % 1000;
+		}
+		const bsim_state rest = {0};
+		for (int m = 0; m < 3000; m++) {
+			long n = order[m];
+			double f[BSIM_WRENCH];
+			bsim_effects_force_at(&fx, n, h, &rest, f);
+			double want[BSIM_WRENCH] = {0.0, 0.0, 0.0};
+			want[0] += bsim_schedule_value(ref, bsim_schedule_index(ref, n, h));
+			want[1] += 7.0;
+			assert_memory_equal(f, want, sizeof f);
+			assert_memory_equal(&fx.random->last, &want[0], sizeof want[0]);
+		}
+		bsim_schedule_free(ref);
+		bsim_effects_free(&fx);
+		bsim_scene_free(&s);
+	}
+}
+
 static void assert_same_step(const bsim_state *a, const bsim_state *b)
 {
 	assert_memory_equal(a->x, b->x, sizeof a->x);
@@ -123,7 +162,7 @@ static int step_against_fresh(const bsim_scene *sc, uint64_t seed, int n_steps)
 	assert_int_equal(bsim_state_init(&sb, sc->n_beams), BSIM_OK);
 	int touching = 0;
 	for (int n = 0; n < n_steps; n++) {
-		double f[2];
+		double f[BSIM_WRENCH];
 		bsim_effects_force(&fx, n, sc->dt, f);
 		be->get_state(a, &sa);
 		bsim_world *b = NULL;
@@ -254,6 +293,136 @@ static void test_free_flight_bound(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The free-flight room (broad_phase.c clear_fill): a body wandering in
+ * small random steps about a gate, in and out of the beams' reach, at
+ * speeds that make the margin matter, so that most steps are decided by
+ * the room kept from an earlier step. Whenever the step is called clear,
+ * the exact test finds every beam out of reach. */
+static void test_free_flight_room(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	bsim_world *w = NULL;
+	bsim_error err;
+	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+	const double h = s.dt;
+	/* about a point on beam 0's reach, on the side away from beam 1 */
+	const thesis_beam *b0 = &w->beams[0], *b1 = &w->beams[1];
+	double reach0 = b0->length + w->radius;
+	double ax = b0->p[0] - b1->p[0], ay = b0->p[1] - b1->p[1], a = sqrt(ax * ax + ay * ay);
+	const double home[2] = {b0->p[0] + reach0 * ax / a, b0->p[1] + reach0 * ay / a};
+	w->x[0] = home[0];
+	w->x[1] = home[1];
+	int clear = 0, by_room = 0;
+	for (int t = 0; t < 200000; t++) {
+		double f[2] = {gsl_ran_gaussian(rng, 30.0), 7.0};
+		w->v[0] = gsl_ran_gaussian(rng, 5.0);
+		w->v[1] = gsl_ran_gaussian(rng, 5.0);
+		w->x[0] += gsl_ran_gaussian(rng, 2e-3);
+		w->x[1] += gsl_ran_gaussian(rng, 2e-3);
+		/* kept within half a reach of home: in and out of reach */
+		double ex = w->x[0] - home[0], ey = w->x[1] - home[1];
+		if (ex * ex + ey * ey > 0.25 * reach0 * reach0) {
+			w->x[0] = home[0];
+			w->x[1] = home[1];
+		}
+		double room_before = w->clear_room, cx = w->clear_x[0], cy = w->clear_x[1];
+		if (!thesis_broad_phase_clear(w, f, h))
+			continue;
+		clear++;
+		by_room +=
+		        w->clear_room == room_before && w->clear_x[0] == cx && w->clear_x[1] == cy;
+		double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
+		               h * sqrt(f[0] * f[0] + f[1] * f[1]) * w->inv_mass;
+		for (int i = 0; i < w->n_beams; i++) {
+			const thesis_beam *c = &w->beams[i];
+			double dx = w->x[0] - c->p[0], dy = w->x[1] - c->p[1];
+			double ri = c->length + w->radius + thesis_step_margin(w, c, speed, h);
+			assert_true(dx * dx + dy * dy > ri * ri);
+		}
+	}
+
+	assert_true(clear > 20000);
+	assert_true(by_room > clear / 2);
+	gsl_rng_free(rng);
+	bsim_backend_thesis.destroy(w);
+	bsim_scene_free(&s);
+}
+
+/* Steps a and b side by side through n steps of sc's effects (seed): the
+ * same states to the bit. Returns the steps in which the body touched. */
+static int step_pair_same(bsim_world *a, bsim_world *b, const bsim_scene *sc, uint64_t seed, int n)
+{
+	const bsim_backend *be = &bsim_backend_thesis;
+	bsim_error err;
+	bsim_effects fx;
+	assert_int_equal(bsim_effects_init(&fx, sc, seed), BSIM_OK);
+	bsim_state sa, sb;
+	assert_int_equal(bsim_state_init(&sa, sc->n_beams), BSIM_OK);
+	assert_int_equal(bsim_state_init(&sb, sc->n_beams), BSIM_OK);
+	int touched = 0;
+	for (int k = 0; k < n; k++) {
+		double f[BSIM_WRENCH];
+		be->get_state(a, &sa);
+		bsim_effects_force_at(&fx, k, sc->dt, &sa, f);
+		assert_int_equal(be->step(a, f, f[2], sc->dt, &err), BSIM_OK);
+		assert_int_equal(be->step(b, f, f[2], sc->dt, &err), BSIM_OK);
+		be->get_state(a, &sa);
+		be->get_state(b, &sb);
+		assert_same_step(&sa, &sb);
+		touched += sa.contact[0] || sa.contact[1];
+	}
+	bsim_state_free(&sa);
+	bsim_state_free(&sb);
+	bsim_effects_free(&fx);
+	return touched;
+}
+
+/* A world reset to its scene with the body started elsewhere (markov's
+ * single-gate trials), and one reset and then set to a state (accuracy's
+ * restarted pieces), step as worlds created for them. */
+static void test_reset_as_created(void **state)
+{
+	(void)state;
+	const bsim_backend *be = &bsim_backend_thesis;
+	bsim_error err;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	bsim_world *kept = NULL, *fresh = NULL;
+	assert_int_equal(be->create(&s, NULL, &kept, &err), BSIM_OK);
+	int touched = 0;
+	for (int t = 0; t < 6; t++) {
+		/* the last trial's steps, then the body moved */
+		bsim_state st;
+		assert_int_equal(bsim_state_init(&st, s.n_beams), BSIM_OK);
+		for (int k = 0; k < 400; k++) {
+			double f[2] = {0.0, 7.0};
+			assert_int_equal(be->step(kept, f, 0.0, s.dt, &err), BSIM_OK);
+		}
+		be->get_state(kept, &st);
+		s.body.start[0] = 0.01 * (t - 3);
+		s.body.velocity[0] = 0.2 * (t - 2);
+		s.body.velocity[1] = 0.5 + 0.1 * t;
+		assert_int_equal(be->reset(kept, &s, &err), BSIM_OK);
+		assert_int_equal(be->create(&s, NULL, &fresh, &err), BSIM_OK);
+		touched += step_pair_same(kept, fresh, &s, 100 + (uint64_t)t, 600);
+		be->destroy(fresh);
+		/* reset, then set to the state of a step that touched */
+		assert_int_equal(be->reset(kept, &s, &err), BSIM_OK);
+		assert_int_equal(be->create(&s, NULL, &fresh, &err), BSIM_OK);
+		assert_int_equal(be->set_state(kept, &st, &err), BSIM_OK);
+		assert_int_equal(be->set_state(fresh, &st, &err), BSIM_OK);
+		touched += step_pair_same(kept, fresh, &s, 200 + (uint64_t)t, 300);
+		be->destroy(fresh);
+		bsim_state_free(&st);
+	}
+	assert_true(touched > 0); /* the beams were met */
+	be->destroy(kept);
+	bsim_scene_free(&s);
+}
+
 /* Trials of one scene in a world kept and reset between them against each
  * in a world built for it: the same results and beam peaks to the bit. On
  * a 5 x 5 lattice (the body pushes, wakes and leaves many beams; whole
@@ -323,6 +492,9 @@ int main(void)
 	        cmocka_unit_test(test_free_flight_as_detection),
 	        cmocka_unit_test(test_kept_world_as_built),
 	        cmocka_unit_test(test_free_flight_bound),
+	        cmocka_unit_test(test_free_flight_room),
+	        cmocka_unit_test(test_effects_held_inline),
+	        cmocka_unit_test(test_reset_as_created),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -19,8 +19,26 @@
  * 390 rad/s (the gate sees < 20 m/s and < 10 rad/s).
  *
  * Bodies.
- *   body:  dynamic disk, a bullet (continuous collision) unless
- *          continuous=off, fixed rotation, mass M at its centre.
+ *   body:  dynamic, a bullet (continuous collision) unless continuous=off,
+ *          mass M at its centre; fixed rotation unless body.rotates, then
+ *          b2MassData.I = bsim_body_inertia and the angle the heading. Its
+ *          shape (docs/backends.md "Shapes"):
+ *            disk: one circle;
+ *            capsule: exactly, as a box of half-extents (L/2, R') and two
+ *              circles of radius R_b at (+-L/2, 0), all of one body (Box2D
+ *              2.4.1 has no capsule); R' = R s - 2 b2_polygonRadius +
+ *              b2_linearSlop: the box's own skin b2_polygonRadius rounds it
+ *              to the circles' radius R_b (below), so the union is the
+ *              capsule of radius R_b, and the box's corners stay inside the
+ *              circles;
+ *            ellipse: the convex polygon of ELLIPSE_VERTICES vertices at
+ *              eccentric anomalies 2 pi k / K on the ellipse of semi-axes
+ *              a s - d, b s - d (d = 2 b2_polygonRadius - b2_linearSlop,
+ *              the skins less the resting penetration), scaled by
+ *              2 / (1 + cos(pi / K)) so that the chords' midpoints lie as
+ *              far inside as the vertices lie outside; cut into fans of 6
+ *              edges about the centre (b2_maxPolygonVertices = 8). Its
+ *              shape error is box2d_ellipse_error's.
  *   beam i: dynamic body whose origin is the pivot P, angle a_i = sgn theta_i
  *          (sgn = +1 if the rest direction u0 has x >= 0, else -1: theta > 0
  *          swings the tip forward, +y), one two-sided edge from (0, 0) to
@@ -49,7 +67,12 @@
  *           -h d omega', dissipates h d omega'^2. A beam with k = 0 keeps the
  *           revolute pin and torque damper (a weld with stiffness 0 is rigid).
  *
- * Contacts: one circle-edge manifold per beam. Box2D's edge carries a skin
+ * Friction: contact.friction mu on the body's and the beams' fixtures;
+ * b2MixFriction's sqrt(mu mu) is mu to the bit (a correctly rounded
+ * square root of a correctly rounded square), and PreSolve sets mu on the
+ * contact too.
+ *
+ * Contacts: one circle-edge manifold per beam (the disk). Box2D's edge carries a skin
  * b2_polygonRadius = 2 b2_linearSlop (units) and its position solver rests a
  * contact at a penetration of b2_linearSlop, so the disk's Box2D radius is
  *   R_b = R s - b2_polygonRadius + b2_linearSlop:
@@ -72,6 +95,12 @@
  * contact on a fixed point, like the thesis backend, reported as TIP.
  * restitutionThreshold = rest_threshold s: Box2D makes approaches slower than
  * it fully inelastic, the same rule as the thesis backend's switch.
+ * A capsule's or an ellipse's polygons meet a beam's tip as a face-B
+ * manifold (the polygon's face is the reference): every manifold that is
+ * not the edge's face (e_faceA) is the tip's, the disk's rule too.
+ * The contact flag of a body that is not a disk is its true outline's gap
+ * (outline_gap: the capsule's segment-to-segment distance less R; the
+ * ellipse's from model/body_shape.h), not the polygon's.
  *
  * Energy of a step, for the runner's ledger (dE = W - damper - impact -
  * contact - correction):
@@ -87,6 +116,12 @@
  *           -P (v- + v+)/2 is an impact if v- < -rest_threshold, else contact
  *           work. Continuous-collision (TOI) sub-solves are measured the same
  *           way from the velocities they start from.
+ *           A body that turns, has polygons or friction ("rich" contacts):
+ *           the same sum over every manifold point j of every fixture
+ *           pair, normal and tangent rows alike,
+ *             -(P_n (v_n- + v_n+) + P_t (v_t- + v_t+)) / 2,
+ *           the body's velocity at the point v + omega x r (omega as the
+ *           torque turned it before the solve).
  *   correction: 0. The position solver moves bodies without changing
  *           velocities; its energy, the float32 rounding, and the integrators'
  *           own errors are what the runner's residual shows. The largest are
@@ -109,10 +144,16 @@
 #include <vector>
 
 #include "beamsim/backend.h"
+#include "box2d/box2d_shape.h"
 #include "model/contact_flag.h"
+extern "C" {
+#include "model/body_shape.h"
+}
 
 namespace
 {
+
+constexpr double BSIM_PI = 3.14159265358979323846;
 
 /* The knobs. The spring default is chosen from these measurements
  * (tests/test_box2d_oracles.c prints them; h = 4 ms, substeps = 1):
@@ -196,6 +237,27 @@ enum { SPRING_TORQUE = 0, SPRING_WELD = 1 };
  * 20% in the measured impact loss). At 1000 M it is exact to float32. */
 constexpr double PIN_MASS_RATIO = 1000.0;
 
+/* The ellipse's polygon: K vertices in fans of 6 edges (8 vertices with the
+ * centre, b2_maxPolygonVertices). */
+constexpr int ELLIPSE_FAN_EDGES = b2_maxPolygonVertices - 2;
+constexpr int ELLIPSE_FANS = 12;
+constexpr int ELLIPSE_VERTICES = ELLIPSE_FAN_EDGES * ELLIPSE_FANS;
+
+/* One manifold of a rich contact (a body that turns, has polygons or
+ * friction), captured in PreSolve for PostSolve's energy. */
+struct contact_row {
+	b2Contact *contact = nullptr;
+	int beam = 0;
+	int count = 0;
+	double n[2] = {0, 0};      /* beam -> body */
+	double q[2][2] = {};       /* the manifold's points, m */
+	double v[2] = {0, 0};      /* body velocity the solve starts from, m/s */
+	double w = 0.0;            /* body angular velocity, rad/s */
+	double c[2] = {0, 0};      /* body centre, m */
+	double beam_w = 0.0;       /* beam angular velocity (Box2D sense) */
+	double beam_u[2] = {0, 0}; /* beam pivot velocity, m/s */
+};
+
 /* Collision categories: the body meets beams, nothing else meets anything. */
 constexpr uint16 CATEGORY_BODY = 0x0001, CATEGORY_BEAM = 0x0002;
 
@@ -255,8 +317,17 @@ struct bsim_world {
 	contact_ledger *listener = nullptr;
 	std::vector<beam_rec> beams;
 	/* the step in progress */
-	b2Vec2 body_start;        /* Box2D position before the step */
+	b2Vec2 body_start; /* Box2D position before the step */
+	float body_start_angle = 0;
 	double v_pre[2] = {0, 0}; /* body velocity the solve starts from, m/s */
+	double w_pre = 0.0;       /* body angular velocity the solve starts from, rad/s */
+	/* A body that turns, is not a disk or has friction: contacts measured
+	 * per manifold (contact_row), the flag from the outline. */
+	bool rich = false;
+	bool rotates = false;
+	double inertia = 0.0; /* kg m^2, the body's (bsim_body_inertia) */
+	double reach = 0.0;   /* m, the outline's farthest point from the centre */
+	std::vector<contact_row> rows;
 	/* results of the last step */
 	std::vector<int> contact_type; /* the contact flag (model/contact_flag.h) */
 	bsim_step_energy energy = {};
@@ -294,6 +365,10 @@ class contact_ledger : public b2ContactListener
 		if (!b)
 			return;
 		mark_live(w_, b->index);
+		if (w_->rich) {
+			pre_solve_rich(contact, b);
+			return;
+		}
 		const b2Manifold *m = contact->GetManifold();
 		const bsim_contact_def &law = w_->scene.contact;
 		/* vertex region of the edge: the tip (or the pivot end) */
@@ -344,6 +419,10 @@ class contact_ledger : public b2ContactListener
 			b->pushed = true;
 			w_->pushed.push_back(b->index);
 		}
+		if (w_->rich) {
+			post_solve_rich(contact, b, impulse);
+			return;
+		}
 		if (!b->row || impulse->count < 1)
 			return;
 		b->row = false;
@@ -365,6 +444,114 @@ class contact_ledger : public b2ContactListener
 	}
 
       private:
+	/* The rich contact's row: restitution and friction set, the manifold's
+	 * points and the velocities the solve starts from captured. */
+	void pre_solve_rich(b2Contact *contact, beam_rec *b)
+	{
+		const b2Manifold *m = contact->GetManifold();
+		const bsim_contact_def &law = w_->scene.contact;
+		contact->SetRestitution((float)(m->type == b2Manifold::e_faceA
+		                                        ? law.restitution
+		                                        : law.tip_restitution));
+		contact->SetFriction((float)law.friction);
+		b2WorldManifold wm;
+		contact->GetWorldManifold(&wm);
+		const double s = w_->s;
+		contact_row r;
+		r.contact = contact;
+		r.beam = b->index;
+		r.count = m->pointCount;
+		r.n[0] = wm.normal.x;
+		r.n[1] = wm.normal.y;
+		for (int j = 0; j < m->pointCount && j < 2; j++) {
+			r.q[j][0] = wm.points[j].x / s;
+			r.q[j][1] = wm.points[j].y / s;
+		}
+		const b2Body *body = w_->body;
+		bool regular = body->GetPosition() == w_->body_start &&
+		               body->GetAngle() == w_->body_start_angle &&
+		               b->body->GetPosition() == b->start_position &&
+		               b->body->GetAngle() == b->start_angle;
+		b2Vec2 u = b->body->GetLinearVelocity();
+		r.beam_u[0] = u.x / s;
+		r.beam_u[1] = u.y / s;
+		b2Vec2 c = body->GetPosition();
+		r.c[0] = c.x / s;
+		r.c[1] = c.y / s;
+		if (regular) {
+			r.v[0] = w_->v_pre[0];
+			r.v[1] = w_->v_pre[1];
+			r.w = w_->w_pre;
+			r.beam_w = b->w_pre;
+		} else {
+			b2Vec2 v = body->GetLinearVelocity();
+			r.v[0] = v.x / s;
+			r.v[1] = v.y / s;
+			r.w = body->GetAngularVelocity();
+			r.beam_w = b->body->GetAngularVelocity();
+			w_->toi_events++;
+		}
+		for (contact_row &old : w_->rows)
+			if (old.contact == contact) {
+				old = r;
+				return;
+			}
+		w_->rows.push_back(r);
+	}
+
+	/* The body's velocity relative to the beam's at point q, m/s. */
+	static void relative_velocity(const beam_rec *b, const contact_row &r, const double v[2],
+	                              double w, const double u[2], double beam_w, const double q[2],
+	                              double out[2])
+	{
+		double rx = q[0] - r.c[0], ry = q[1] - r.c[1];
+		double ax = q[0] - b->pivot[0], ay = q[1] - b->pivot[1];
+		out[0] = v[0] - w * ry - (u[0] - beam_w * ay);
+		out[1] = v[1] + w * rx - (u[1] + beam_w * ax);
+	}
+
+	void post_solve_rich(b2Contact *contact, beam_rec *b, const b2ContactImpulse *impulse)
+	{
+		contact_row *r = nullptr;
+		for (contact_row &row : w_->rows)
+			if (row.contact == contact)
+				r = &row;
+		if (!r || r->contact == nullptr)
+			return;
+		r->contact = nullptr; /* spent: a TOI sub-solve captures it anew */
+		const double s = w_->s;
+		b2Vec2 v = w_->body->GetLinearVelocity();
+		const double v_post[2] = {v.x / s, v.y / s};
+		const double w_post = w_->body->GetAngularVelocity();
+		b2Vec2 u = b->body->GetLinearVelocity();
+		const double u_post[2] = {u.x / s, u.y / s};
+		const double bw_post = b->body->GetAngularVelocity();
+		const double t[2] = {r->n[1], -r->n[0]}; /* b2Cross(n, 1) */
+		double loss = 0.0, v_first = 0.0;
+		bool hit = false;
+		for (int j = 0; j < impulse->count && j < r->count && j < 2; j++) {
+			double pre[2], post[2];
+			relative_velocity(b, *r, r->v, r->w, r->beam_u, r->beam_w, r->q[j], pre);
+			relative_velocity(b, *r, v_post, w_post, u_post, bw_post, r->q[j], post);
+			double pn = impulse->normalImpulses[j] / s,
+			       pt = impulse->tangentImpulses[j] / s;
+			double vn0 = pre[0] * r->n[0] + pre[1] * r->n[1];
+			double vn1 = post[0] * r->n[0] + post[1] * r->n[1];
+			double vt0 = pre[0] * t[0] + pre[1] * t[1];
+			double vt1 = post[0] * t[0] + post[1] * t[1];
+			loss -= 0.5 * (pn * (vn0 + vn1) + pt * (vt0 + vt1));
+			if (j == 0 || vn0 < v_first)
+				v_first = vn0;
+			hit = hit || pn > 0.0;
+		}
+		if (v_first < -w_->scene.contact.rest_threshold) {
+			w_->energy.impact += loss;
+			w_->impacts += hit;
+		} else {
+			w_->energy.contact += loss;
+		}
+	}
+
 	beam_rec *beam_of(b2Contact *c)
 	{
 		uintptr_t a = c->GetFixtureA()->GetBody()->GetUserData().pointer;
@@ -396,9 +583,65 @@ void world_free_box2d(bsim_world *w)
 		b.body = nullptr;
 }
 
-/* Builds the Box2D world with the body and beams at the given state. */
-void world_build(bsim_world *w, const double x[2], const double v[2], const double *theta,
-                 const double *omega)
+/* The ellipse's polygon in Box2D units, centred, its a axis along +x
+ * (the header's "Bodies"): K vertices. */
+void ellipse_polygon(double a, double b, double s, b2Vec2 *out)
+{
+	const double d = 2.0 * b2_polygonRadius - b2_linearSlop;
+	const double k = 2.0 / (1.0 + std::cos(BSIM_PI / ELLIPSE_VERTICES));
+	for (int i = 0; i < ELLIPSE_VERTICES; i++) {
+		double t = 2.0 * BSIM_PI * i / ELLIPSE_VERTICES;
+		out[i].Set((float)(k * (a * s - d) * std::cos(t)),
+		           (float)(k * (b * s - d) * std::sin(t)));
+	}
+}
+
+/* The body's fixtures for its shape (the header's "Bodies"), all with the
+ * fixture definition fd's material. */
+void body_fixtures(bsim_world *w, b2FixtureDef &fd)
+{
+	const double s = w->s;
+	const bsim_body_def &body = w->scene.body;
+	const float r_b = (float)(body.radius * s) - b2_polygonRadius + b2_linearSlop;
+	if (body.shape == BSIM_SHAPE_DISK) {
+		b2CircleShape disk;
+		disk.m_radius = r_b;
+		fd.shape = &disk;
+		w->body->CreateFixture(&fd);
+	} else if (body.shape == BSIM_SHAPE_CAPSULE) {
+		const float half = (float)(0.5 * body.length * s);
+		b2PolygonShape box;
+		box.SetAsBox(half,
+		             (float)(body.radius * s) - 2.0f * b2_polygonRadius + b2_linearSlop);
+		fd.shape = &box;
+		w->body->CreateFixture(&fd);
+		for (int end = -1; end <= 1; end += 2) {
+			b2CircleShape cap;
+			cap.m_radius = r_b;
+			cap.m_p.Set((float)end * half, 0.0f);
+			fd.shape = &cap;
+			w->body->CreateFixture(&fd);
+		}
+	} else {
+		b2Vec2 ring[ELLIPSE_VERTICES];
+		ellipse_polygon(body.semi_axes[0], body.semi_axes[1], s, ring);
+		for (int f = 0; f < ELLIPSE_FANS; f++) {
+			b2Vec2 fan[b2_maxPolygonVertices];
+			fan[0].SetZero();
+			for (int j = 0; j <= ELLIPSE_FAN_EDGES; j++)
+				fan[j + 1] = ring[(f * ELLIPSE_FAN_EDGES + j) % ELLIPSE_VERTICES];
+			b2PolygonShape piece;
+			piece.Set(fan, b2_maxPolygonVertices);
+			fd.shape = &piece;
+			w->body->CreateFixture(&fd);
+		}
+	}
+}
+
+/* Builds the Box2D world with the body (heading psi, angular velocity
+ * omega_body) and beams at the given state. */
+void world_build(bsim_world *w, const double x[2], const double v[2], double psi, double omega_body,
+                 const double *theta, const double *omega)
 {
 	const double s = w->s;
 	const bsim_scene &sc = w->scene;
@@ -416,26 +659,29 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 	bd.type = b2_dynamicBody;
 	bd.position.Set((float)(x[0] * s), (float)(x[1] * s));
 	bd.linearVelocity.Set((float)(v[0] * s), (float)(v[1] * s));
-	bd.fixedRotation = true; /* forces act at the centre; frictionless */
+	/* forces act at the centre; a body that does not turn keeps its heading */
+	bd.fixedRotation = !w->rotates;
+	if (w->rich) {
+		bd.angle = (float)psi;
+		bd.angularVelocity = w->rotates ? (float)omega_body : 0.0f;
+	}
 	bd.bullet = w->continuous;
 	bd.allowSleep = false; /* the body never sleeps; only beams do */
 	bd.userData.pointer = 0;
 	w->body = w->world->CreateBody(&bd);
-	b2CircleShape disk;
-	disk.m_radius = (float)(sc.body.radius * s) - b2_polygonRadius + b2_linearSlop;
 	b2FixtureDef fd;
-	fd.shape = &disk;
 	fd.density = 0.0f; /* mass set below */
-	fd.friction = 0.0f;
+	fd.friction = (float)sc.contact.friction;
 	fd.restitution = (float)sc.contact.restitution;
 	fd.restitutionThreshold = (float)(sc.contact.rest_threshold * s);
 	fd.filter.categoryBits = CATEGORY_BODY;
 	fd.filter.maskBits = CATEGORY_BEAM;
-	w->body->CreateFixture(&fd);
+	body_fixtures(w, fd);
 	b2MassData md;
 	md.mass = (float)sc.body.mass;
 	md.center.SetZero();
-	md.I = (float)(0.5 * sc.body.mass * sc.body.radius * sc.body.radius * s * s);
+	md.I = w->rich ? (float)(w->inertia * s * s)
+	               : (float)(0.5 * sc.body.mass * sc.body.radius * sc.body.radius * s * s);
 	w->body->SetMassData(&md);
 
 	for (size_t i = 0; i < w->beams.size(); i++) {
@@ -458,7 +704,7 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 		b2FixtureDef ef;
 		ef.shape = &edge;
 		ef.density = 0.0f;
-		ef.friction = 0.0f;
+		ef.friction = (float)sc.contact.friction;
 		ef.restitution = (float)sc.contact.restitution;
 		ef.restitutionThreshold = (float)(sc.contact.rest_threshold * s);
 		ef.filter.categoryBits = CATEGORY_BEAM;
@@ -502,8 +748,108 @@ void world_build(bsim_world *w, const double x[2], const double v[2], const doub
 		}
 }
 
+/* The body's heading as get_state reports it, rad: Box2D's angle for a
+ * body that turns, else the scene's. */
+double body_heading(const bsim_world *w)
+{
+	return w->rotates ? (double)w->body->GetAngle() : bsim_body_heading(&w->scene.body);
+}
+
+/* The distance of the point (px, py) of the ellipse's frame from the
+ * ellipse x^2/a^2 + y^2/b^2 = 1, m; 0 inside. The nearest point of the
+ * outline is X = (a^2 y0 / (t + a^2), b^2 y1 / (t + b^2)) (y the point
+ * mirrored into the first quadrant) for the root t > 0 of
+ *   F(t) = (a y0 / (t + a^2))^2 + (b y1 / (t + b^2))^2 - 1,
+ * which for a point outside falls from F(0) > 0, convex (D. Eberly,
+ * "Distance from a point to an ellipse", 2013). Newton's method from
+ * t = 0 then rises to the root without passing it (the tangent of a convex
+ * falling function lies below it) and ends when F no longer falls. */
+double ellipse_point_distance(double a, double b, double px, double py)
+{
+	const double y0 = std::fabs(px), y1 = std::fabs(py);
+	const double z0 = y0 / a, z1 = y1 / b;
+	if (z0 * z0 + z1 * z1 <= 1.0)
+		return 0.0;
+	if (y1 == 0.0)
+		return y0 - a;
+	if (y0 == 0.0)
+		return y1 - b;
+	const double a2 = a * a, b2 = b * b, p0 = a * y0, p1 = b * y1;
+	double t = 0.0;
+	for (int i = 0; i < 100; i++) {
+		const double u0 = 1.0 / (t + a2), u1 = 1.0 / (t + b2);
+		const double f0 = p0 * u0, f1 = p1 * u1;
+		const double f = f0 * f0 + f1 * f1 - 1.0;
+		if (!(f > 0.0))
+			break;
+		const double slope = -2.0 * (f0 * f0 * u0 + f1 * f1 * u1);
+		const double next = t - f / slope;
+		if (!(next > t))
+			break;
+		t = next;
+	}
+	return std::hypot(a2 * y0 / (t + a2) - y0, b2 * y1 / (t + b2) - y1);
+}
+
+/* The gap between the body's outline and a beam's segment p + t u,
+ * t in [0, length], m (<= 0: they overlap), and in *type whether the
+ * segment's nearest point is an end (TIP) or inside it (TANGENT).
+ *   capsule: the distance between its segment C +- (L/2) e (e the
+ *     heading) and the beam's, less R (closest points of two segments:
+ *     C. Ericson, Real-Time Collision Detection, 5.1.9, the body's segment
+ *     first so that parallel segments give the beam's inner point);
+ *   ellipse: the model's geometry (model/body_shape.h, as the thesis
+ *     backend and the start's overlap check measure it), after a test
+ *     that decides most steps: the segment misses the circumscribed circle
+ *     by the tolerance (no contact); a segment through the ellipse's
+ *     centre line, which has no separating normal, overlaps it. */
+double outline_gap(const bsim_body_def &body, const double c[2], double psi, const double p[2],
+                   const double u[2], double length, double tol, int *type)
+{
+	const double e[2] = {std::cos(psi), std::sin(psi)};
+	if (body.shape == BSIM_SHAPE_CAPSULE) {
+		const double l = 0.5 * body.length;
+		const double p1[2] = {c[0] - l * e[0], c[1] - l * e[1]};
+		const double d1[2] = {2.0 * l * e[0], 2.0 * l * e[1]};
+		const double d2[2] = {length * u[0], length * u[1]};
+		const double r[2] = {p1[0] - p[0], p1[1] - p[1]};
+		const double aa = d1[0] * d1[0] + d1[1] * d1[1], ee = d2[0] * d2[0] + d2[1] * d2[1];
+		const double f = d2[0] * r[0] + d2[1] * r[1], cc = d1[0] * r[0] + d1[1] * r[1];
+		const double bb = d1[0] * d2[0] + d1[1] * d2[1], den = aa * ee - bb * bb;
+		double sp = den > 0.0 ? std::clamp((bb * f - cc * ee) / den, 0.0, 1.0) : 0.0;
+		double tp = (bb * sp + f) / ee;
+		if (tp < 0.0) {
+			tp = 0.0;
+			sp = std::clamp(-cc / aa, 0.0, 1.0);
+		} else if (tp > 1.0) {
+			tp = 1.0;
+			sp = std::clamp((bb - cc) / aa, 0.0, 1.0);
+		}
+		*type = tp > 0.0 && tp < 1.0 ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
+		double dx = p1[0] + sp * d1[0] - p[0] - tp * d2[0];
+		double dy = p1[1] + sp * d1[1] - p[1] - tp * d2[1];
+		return std::hypot(dx, dy) - body.radius;
+	}
+	/* the ellipse: the circumscribed circle first, which decides most steps */
+	const double rel[2] = {c[0] - p[0], c[1] - p[1]};
+	double t_c = std::clamp(rel[0] * u[0] + rel[1] * u[1], 0.0, length);
+	double gap_circle = std::hypot(rel[0] - t_c * u[0], rel[1] - t_c * u[1]) -
+	                    std::fmax(body.semi_axes[0], body.semi_axes[1]);
+	*type = t_c > 0.0 && t_c < length ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
+	if (gap_circle >= tol)
+		return gap_circle;
+	const double p1[2] = {p[0] + length * u[0], p[1] + length * u[1]};
+	body_segment_contact bc;
+	if (body_shape_segment(&body, c, psi, p, p1, &bc) != BSIM_OK)
+		return -std::fmin(body.semi_axes[0],
+		                  body.semi_axes[1]); /* through its centre line */
+	*type = bc.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
+	return bc.dist;
+}
+
 /* The contact flag of beam i after a step (model/contact_flag.h), from the
- * state get_state reports: x = position / s, theta = sgn angle. */
+ * state get_state reports: x = position / s, theta = sgn angle; for a body
+ * that is not a disk, from its outline's gap at the reported heading. */
 int contact_flag_of(const bsim_world *w, const beam_rec &b)
 {
 	const double s = w->s;
@@ -512,8 +858,13 @@ int contact_flag_of(const bsim_world *w, const beam_rec &b)
 	double u[2];
 	int type;
 	bsim_beam_direction(b.u0, b.sgn, b.sgn * (double)b.body->GetAngle(), u);
-	double dist2 =
-	        bsim_beam_distance2(b.pivot, u, w->scene.beams[(size_t)b.index].length, x, &type);
+	const double length = w->scene.beams[(size_t)b.index].length;
+	if (w->scene.body.shape != BSIM_SHAPE_DISK) {
+		double gap = outline_gap(w->scene.body, x, body_heading(w), b.pivot, u, length,
+		                         BSIM_CONTACT_TOL, &type);
+		return b.pushed || gap < BSIM_CONTACT_TOL ? type : BSIM_CONTACT_NONE;
+	}
+	double dist2 = bsim_beam_distance2(b.pivot, u, length, x, &type);
 	return bsim_contact_flag(dist2, w->scene.body.radius, type, b.pushed);
 }
 
@@ -560,7 +911,7 @@ void update_contact_types(bsim_world *w)
 	} else {
 		const double s = w->s;
 		const b2Vec2 c = w->body->GetPosition();
-		const double reach_extra = w->scene.body.radius + 1.0; /* m, generous */
+		const double reach_extra = w->reach + 1.0; /* m, generous */
 		for (size_t i = 0; i < w->beams.size(); i++) {
 			const beam_rec &b = w->beams[i];
 			double dx = c.x / s - b.pivot[0], dy = c.y / s - b.pivot[1];
@@ -610,6 +961,11 @@ static int scene_in_float_range(const bsim_scene *sc, double s, bsim_error *err)
 	} body[] = {
 	        {"body.mass", sc->body.mass},
 	        {"body.radius", sc->body.radius * s},
+	        {"body.length", sc->body.length * s},
+	        {"body.semi_axes.0", sc->body.semi_axes[0] * s},
+	        {"body.semi_axes.1", sc->body.semi_axes[1] * s},
+	        {"body.inertia", bsim_body_inertia(&sc->body) * s * s},
+	        {"body.angular_velocity", sc->body.angular_velocity},
 	        {"body.start.0", sc->body.start[0] * s},
 	        {"body.start.1", sc->body.start[1] * s},
 	        {"body.velocity.0", sc->body.velocity[0] * s},
@@ -672,7 +1028,7 @@ static int body_motion_in_range(const bsim_scene *sc, double s, double h, bsim_e
 			        "units a substep, got %.3g; usable up to %.3g m/s at this step)",
 			        k, sc->body.velocity[k], MOTION_MAX, motion, MOTION_MAX / (s * h));
 	}
-	/* The propulsion acts along y, the random force (up to ten standard
+	/* The propulsion acts along y or the heading, the random force (up to ten standard
 	 * deviations) along x. */
 	const double fp = std::fabs(sc->effects.propulsion_force);
 	const double fr = 10.0 * sc->effects.random_magnitude;
@@ -733,23 +1089,30 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	if (!(s > 0.0) || !std::isfinite(s))
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "box2d: unit_scale=%g: expected a positive number", s);
-	if (scene->body.shape != BSIM_SHAPE_DISK || scene->body.rotates ||
-	    scene->contact.friction != 0)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "box2d: %s: expected a disk that does not rotate, without "
-		                      "contact.friction (the essay's body)",
-		                      scene->path[0] ? scene->path : scene->name);
 	if ((rc = scene_in_float_range(scene, s, err)) != BSIM_OK)
 		return rc;
 	if ((rc = body_motion_in_range(scene, s, scene->dt / (double)substeps, err)) != BSIM_OK)
 		return rc;
-	/* The disk must be larger than Box2D's skin, and its coordinates within
+	/* The body must be wider than Box2D's skin, and its coordinates within
 	 * float32's reach. */
-	if (scene->body.radius * s <= 2.0 * b2_polygonRadius)
+	const bool ellipse = scene->body.shape == BSIM_SHAPE_ELLIPSE;
+	const double half_width =
+	        ellipse ? std::fmin(scene->body.semi_axes[0], scene->body.semi_axes[1])
+	                : scene->body.radius;
+	if (half_width * s <= 2.0 * b2_polygonRadius)
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "box2d: unit_scale=%g makes the body radius %g units, "
+		                      "box2d: unit_scale=%g makes the body's %s %g units, "
 		                      "below Box2D's skin (%g units); use a larger unit_scale",
-		                      s, scene->body.radius * s, (double)b2_polygonRadius);
+		                      s, ellipse ? "smaller semi-axis (body.semi_axes)" : "radius",
+		                      half_width * s, (double)b2_polygonRadius);
+	/* The capsule's box must be wider than the distance at which Box2D
+	 * welds vertices (b2_linearSlop / 2). */
+	if (scene->body.shape == BSIM_SHAPE_CAPSULE && scene->body.length * s < b2_linearSlop)
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "box2d: body.length: %g m is %g units at unit_scale=%g, below "
+		        "Box2D's linear slop (%g units); use a disk or a longer capsule",
+		        scene->body.length, scene->body.length * s, s, (double)b2_linearSlop);
 	double extent = std::fabs(scene->body.start[0]) + std::fabs(scene->body.start[1]);
 	for (int i = 0; i < scene->n_beams; i++)
 		extent = std::fmax(extent, std::fabs(scene->beams[i].pivot[0]) +
@@ -779,6 +1142,14 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
 	w->continuous = bsim_options_choice(opts, &box2d_knobs[KNOB_CONTINUOUS]) == CONTINUOUS_ON;
 	w->track_live = scene->has_lattice != 0;
+	w->rotates = scene->body.rotates != 0;
+	w->rich =
+	        w->rotates || scene->body.shape != BSIM_SHAPE_DISK || scene->contact.friction != 0;
+	w->inertia = bsim_body_inertia(&scene->body);
+	w->reach = scene->body.shape == BSIM_SHAPE_CAPSULE
+	                   ? 0.5 * scene->body.length + scene->body.radius
+	           : ellipse ? std::fmax(scene->body.semi_axes[0], scene->body.semi_axes[1])
+	                     : scene->body.radius;
 	int n = scene->n_beams;
 	w->beams.resize((size_t)n);
 	w->contact_type.assign((size_t)n, BSIM_CONTACT_NONE);
@@ -797,7 +1168,8 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 		theta[(size_t)i] = d.initial_theta;
 		omega[(size_t)i] = d.initial_omega;
 	}
-	world_build(w, scene->body.start, scene->body.velocity, theta.data(), omega.data());
+	world_build(w, scene->body.start, scene->body.velocity, bsim_body_heading(&scene->body),
+	            scene->body.angular_velocity, theta.data(), omega.data());
 	update_contact_types(w);
 	*out = w;
 	return BSIM_OK;
@@ -814,8 +1186,9 @@ int box2d_create(const bsim_scene *scene, const bsim_options *opts, bsim_world *
 	}
 }
 
-/* One Box2D step of h seconds with force f (N) on the body. */
-void box2d_substep(bsim_world *w, const double f[2], double h)
+/* One Box2D step of h seconds with force f (N) and torque (N m) on the
+ * body. */
+void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 {
 	const double s = w->s;
 	const double mass = w->scene.body.mass;
@@ -825,6 +1198,15 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 	w->v_pre[0] = v0.x / s + h * f[0] / mass;
 	w->v_pre[1] = v0.y / s + h * f[1] / mass;
 	w->body->ApplyForceToCenter(b2Vec2((float)(f[0] * s), (float)(f[1] * s)), false);
+	if (w->rich) {
+		w->rows.clear();
+		w->body_start_angle = w->body->GetAngle();
+		w->w_pre = w->body->GetAngularVelocity();
+		if (w->rotates && torque != 0.0) {
+			w->w_pre += h * torque / w->inertia;
+			w->body->ApplyTorque((float)(torque * s * s), false);
+		}
+	}
 
 	const size_t n_live = w->track_live ? w->live.size() : w->beams.size();
 	for (size_t k = 0; k < n_live; k++) {
@@ -858,6 +1240,9 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 	 * exactly that far: a substep that ends there was clamped. */
 	const float hf = (float)h, near = 1.0f - 1e-5f;
 	bool clamped = hf * w->body->GetLinearVelocity().Length() >= near * b2_maxTranslation;
+	if (w->rotates)
+		clamped = clamped ||
+		          hf * std::fabs(w->body->GetAngularVelocity()) >= near * b2_maxRotation;
 	for (size_t k = 0; k < n_after && !clamped; k++) {
 		const beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
 		clamped = hf * std::fabs(b.body->GetAngularVelocity()) >= near * b2_maxRotation;
@@ -875,13 +1260,12 @@ void box2d_substep(bsim_world *w, const double f[2], double h)
 
 int box2d_step(bsim_world *w, const double force[2], double torque, double h, bsim_error *err)
 {
-	(void)torque; /* the body does not rotate */
 	w->energy = bsim_step_energy{};
 	w->impacts = 0;
 	const double hs = h / w->substeps;
 	try {
 		for (int k = 0; k < w->substeps; k++)
-			box2d_substep(w, force, hs);
+			box2d_substep(w, force, torque, hs);
 		update_contact_types(w);
 	} catch (const std::bad_alloc &) {
 		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory in a step");
@@ -897,8 +1281,8 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 	st->x[1] = p.y / s;
 	st->v[0] = v.x / s;
 	st->v[1] = v.y / s;
-	st->heading = bsim_body_heading(&w->scene.body);
-	st->angular_velocity = 0.0;
+	st->heading = body_heading(w);
+	st->angular_velocity = w->rotates ? (double)w->body->GetAngularVelocity() : 0.0;
 	int n = st->n_beams < (int)w->beams.size() ? st->n_beams : (int)w->beams.size();
 	st->pivot_drift = 0.0;
 	if (w->track_live) {
@@ -935,7 +1319,8 @@ int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
 		                      st->n_beams, (int)w->beams.size());
 	try {
 		world_free_box2d(w);
-		world_build(w, st->x, st->v, st->theta, st->omega);
+		world_build(w, st->x, st->v, st->heading, st->angular_velocity, st->theta,
+		            st->omega);
 		/* The contact flags are the state's, as they were reported. */
 		w->typed.clear();
 		for (int i = 0; i < st->n_beams; i++) {
@@ -954,6 +1339,66 @@ int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
 }
 
 } /* namespace */
+
+/* The Box2D outline of the ellipse, in m: its polygon (float32, as Box2D
+ * holds it) offset by delta = (2 b2_polygonRadius - b2_linearSlop) / s, the
+ * skins less the resting penetration. Its area is the polygon's plus
+ * perimeter delta plus pi delta^2 (a convex polygon's offset); the outline
+ * distance is the largest |signed distance| of the ellipse's points from
+ * it (n_samples points at equal steps of the eccentric anomaly) and of its
+ * vertices' offset points from the ellipse. */
+extern "C" int box2d_ellipse_error(double a, double b, double s, double *area_rel, double *max_dist)
+{
+	if (!(a > 0 && b > 0 && s > 0) || std::fmin(a, b) * s <= 2.0 * b2_polygonRadius)
+		return BSIM_EINPUT;
+	b2Vec2 ring[ELLIPSE_VERTICES];
+	ellipse_polygon(a, b, s, ring);
+	const double delta = (2.0 * b2_polygonRadius - b2_linearSlop) / s;
+	double px[ELLIPSE_VERTICES], py[ELLIPSE_VERTICES];
+	for (int i = 0; i < ELLIPSE_VERTICES; i++) {
+		px[i] = ring[i].x / s;
+		py[i] = ring[i].y / s;
+	}
+	double area = 0.0, perimeter = 0.0;
+	for (int i = 0; i < ELLIPSE_VERTICES; i++) {
+		int j = (i + 1) % ELLIPSE_VERTICES;
+		area += 0.5 * (px[i] * py[j] - px[j] * py[i]);
+		perimeter += std::hypot(px[j] - px[i], py[j] - py[i]);
+	}
+	area += perimeter * delta + BSIM_PI * delta * delta;
+	*area_rel = area / (BSIM_PI * a * b) - 1.0;
+	double worst = 0.0;
+	const int n_samples = 20000;
+	for (int k = 0; k < n_samples; k++) {
+		double t = 2.0 * BSIM_PI * k / n_samples;
+		double qx = a * std::cos(t), qy = b * std::sin(t);
+		/* signed distance from the convex polygon (counter-clockwise) */
+		double out = -INFINITY, near = INFINITY;
+		for (int i = 0; i < ELLIPSE_VERTICES; i++) {
+			int j = (i + 1) % ELLIPSE_VERTICES;
+			double ex = px[j] - px[i], ey = py[j] - py[i], len = std::hypot(ex, ey);
+			out = std::fmax(out, ((qx - px[i]) * ey - (qy - py[i]) * ex) / len);
+			double f = std::clamp(((qx - px[i]) * ex + (qy - py[i]) * ey) / (len * len),
+			                      0.0, 1.0);
+			near = std::fmin(near,
+			                 std::hypot(qx - px[i] - f * ex, qy - py[i] - f * ey));
+		}
+		double signed_dist = out > 0.0 ? near : out;
+		worst = std::fmax(worst, std::fabs(signed_dist - delta));
+	}
+	for (int i = 0; i < ELLIPSE_VERTICES; i++) {
+		int h = (i + ELLIPSE_VERTICES - 1) % ELLIPSE_VERTICES,
+		    j = (i + 1) % ELLIPSE_VERTICES;
+		/* the outward bisector of the vertex's two edge normals */
+		double n1x = py[i] - py[h], n1y = px[h] - px[i], l1 = std::hypot(n1x, n1y);
+		double n2x = py[j] - py[i], n2y = px[i] - px[j], l2 = std::hypot(n2x, n2y);
+		double nx = n1x / l1 + n2x / l2, ny = n1y / l1 + n2y / l2, ln = std::hypot(nx, ny);
+		double qx = px[i] + delta * nx / ln, qy = py[i] + delta * ny / ln;
+		worst = std::fmax(worst, ellipse_point_distance(a, b, qx, qy));
+	}
+	*max_dist = worst;
+	return BSIM_OK;
+}
 
 extern "C" const bsim_backend bsim_backend_box2d = {
         "box2d",

@@ -24,10 +24,7 @@
 
 #include "thesis/thesis.h"
 
-/* A world of this many beams or fewer tests them all: the grid's query
- * costs more than the few reach tests it would save (the essay's gate has
- * two beams), and the result is the same bit for bit. */
-#define BROAD_PHASE_MIN_BEAMS 8
+#define BROAD_PHASE_MIN_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
 
 void thesis_grid_free(thesis_grid *g)
 {
@@ -131,20 +128,42 @@ static void sort_small(int *v, int n)
 	}
 }
 
-/* With every beam at rest the step's margin is 2 h |v| + slop, |v| = |v| +
- * h |F| / M from two square roots. |a| + |b| >= sqrt(a^2 + b^2) bounds
- * both without them; the factor 1 + 1e-12 covers the square roots'
- * rounding, so a beam out of reach of the bound is out of reach of the
- * margin, and the test changes no result. The contact flag's tolerance is
- * added, so that a clear step also ends more than BSIM_CONTACT_TOL from
- * every beam (contact_report.c). NaN or overflow: not clear. */
-int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], double h)
+/* The room around a clear body. With its centre at C_c every beam has
+ *   |C_c - P_i| >= L_i + R + D        (D = clear_room),
+ * so with the centre at C, |C - P_i| >= L_i + R + D - |C - C_c|, and a
+ * step whose margin m has |C - C_c|_1 + m < D (|.|_1 >= |.|) finds every
+ * beam out of reach, as testing them would: the step's test is then two
+ * differences, not a square per beam. D is cut by 1e-9 of the lengths
+ * involved (the distances, the reaches, |C_c|), which covers the
+ * round-off of the test (1e-16 of the same lengths): the room may say
+ * "not clear" where the beams are, then tested, clear, never the reverse.
+ * The pivots never move, so the room holds for the world's life; it is
+ * refilled wherever the beams are found clear after it failed. */
+static void clear_fill(struct bsim_world *w)
+{
+	double room = INFINITY, reach_max = 0.0;
+	for (int i = 0; i < w->n_beams; i++) {
+		const thesis_beam *b = &w->beams[i];
+		double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+		double reach = b->length + w->radius;
+		room = fmin(room, sqrt(dx * dx + dy * dy) * (1.0 - 1e-9) - reach);
+		reach_max = fmax(reach_max, reach);
+	}
+	w->clear_x[0] = w->x[0];
+	w->clear_x[1] = w->x[1];
+	/* No beam: INFINITY - INFINITY, NaN, never clear by the room. */
+	w->clear_room = room - 1e-9 * (reach_max + fabs(room) + fabs(w->x[0]) + fabs(w->x[1]));
+}
+
+/* With every beam at rest the step's margin is 2 h |v| + slop
+ * (thesis_clear_margin bounds it). NaN or overflow: not clear. */
+int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h)
 {
 	if (!w->broad_phase || w->n_beams > BROAD_PHASE_MIN_BEAMS)
 		return 0; /* broad_phase=0: every beam tested, for checking */
-	double speed = (fabs(w->v[0]) + fabs(w->v[1])) +
-	               h * (fabs(force[0]) + fabs(force[1])) * w->inv_mass;
-	double margin = 2.0 * (h * (speed * (1.0 + 1e-12))) + w->slop + BSIM_CONTACT_TOL;
+	double margin = thesis_clear_margin(w, force, h);
+	if (fabs(w->x[0] - w->clear_x[0]) + fabs(w->x[1] - w->clear_x[1]) + margin < w->clear_room)
+		return 1; /* clear_fill below */
 	for (int i = 0; i < w->n_beams; i++) {
 		const thesis_beam *b = &w->beams[i];
 		double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
@@ -152,6 +171,7 @@ int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], 
 		if (!(dx * dx + dy * dy > reach * reach))
 			return 0;
 	}
+	clear_fill(w);
 	return 1;
 }
 

@@ -190,6 +190,10 @@ struct bsim_world {
 	int n_near;
 	double near_x[2];  /* m */
 	double near_reach; /* m; 0: no cache */
+	/* The room of thesis_broad_phase_clear: every beam's pivot lies
+	 * farther than L + R + clear_room from clear_x (0: none known). */
+	double clear_x[2]; /* m */
+	double clear_room; /* m */
 };
 
 /* Beam i may differ from how the world was made: a reset restores it. */
@@ -202,6 +206,10 @@ static inline void thesis_beam_touch(struct bsim_world *w, int i)
 }
 
 /* broad_phase.c */
+/* A world of this many beams or fewer tests them all: the grid's query
+ * costs more than the few reach tests it would save (the essay's gate has
+ * two beams), and the result is the same bit for bit. */
+#define THESIS_BROAD_PHASE_MIN_BEAMS 8
 void thesis_near_forget(struct bsim_world *w);
 int thesis_grid_build(thesis_grid *g, const struct bsim_world *w);
 void thesis_grid_free(thesis_grid *g);
@@ -211,7 +219,7 @@ int thesis_broad_phase(struct bsim_world *w, double speed, double h);
 int thesis_broad_phase_near(struct bsim_world *w, double margin);
 /* 1 if no beam, all at rest, can reach the body this step (a world the
  * broad phase tests whole only; never with broad_phase=0); 0 if one may. */
-int thesis_broad_phase_clear(const struct bsim_world *w, const double force[2], double h);
+int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h);
 
 /* beam_sleep.c */
 void thesis_beam_wake(struct bsim_world *w, int i);
@@ -299,6 +307,33 @@ static inline double thesis_step_margin(const struct bsim_world *w, const thesis
 	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
 	               b->inertia;
 	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
+}
+
+/* With every beam at rest the step's margin is 2 h |v| + slop, |v| = |v| +
+ * h |F| / M from two square roots. |a| + |b| >= sqrt(a^2 + b^2) bounds
+ * both without them; the factor 1 + 1e-12 covers the square roots'
+ * rounding, so a beam out of reach of the bound is out of reach of the
+ * margin, and the test changes no result. The contact flag's tolerance is
+ * added, so that a clear step also ends more than BSIM_CONTACT_TOL from
+ * every beam (contact_report.c). m. */
+static inline double thesis_clear_margin(const struct bsim_world *w, const double force[2],
+                                         double h)
+{
+	double speed = (fabs(w->v[0]) + fabs(w->v[1])) +
+	               h * (fabs(force[0]) + fabs(force[1])) * w->inv_mass;
+	return 2.0 * (h * (speed * (1.0 + 1e-12))) + w->slop + BSIM_CONTACT_TOL;
+}
+
+/* thesis_broad_phase_clear with its room's test inline, so that a step in
+ * free flight is decided without a call: the same answer. */
+static inline int thesis_flight_clear(struct bsim_world *w, const double force[2], double h)
+{
+	if (w->broad_phase && w->n_beams <= THESIS_BROAD_PHASE_MIN_BEAMS &&
+	    fabs(w->x[0] - w->clear_x[0]) + fabs(w->x[1] - w->clear_x[1]) +
+	                    thesis_clear_margin(w, force, h) <
+	            w->clear_room)
+		return 1;
+	return thesis_broad_phase_clear(w, force, h);
 }
 
 /* Beam i exchanged a nonzero impulse with the body in this step (the

@@ -368,7 +368,8 @@ static void flight_step(bsim_world *w, const double force[2], double torque, dou
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm);
 	thesis_body_turn(w, w->angular_velocity, torque, 0.0, h);
-	thesis_contact_clear(w);
+	if (w->n_flagged)
+		thesis_contact_clear(w);
 }
 
 /* Nothing in a step allocates: the world's memory is sized at creation. */
@@ -378,7 +379,7 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 	(void)err;
 	/* Free flight among beams at rest (none awake, none in reach): no
 	 * contact, no beam to move, no square root for the margin. */
-	int in_flight = w->n_awake == 0 && thesis_broad_phase_clear(w, force, h);
+	int in_flight = w->n_awake == 0 && thesis_flight_clear(w, force, h);
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
 	if (in_flight && w->n_typed == 0 && h == w->h_prepared &&
@@ -428,7 +429,9 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 	s->heading = w->heading;
 	s->angular_velocity = w->angular_velocity;
 	s->pivot_drift = 0.0; /* a beam here is an angle about a fixed pivot */
-	bsim_state_set_active(s, w->awake, w->n_awake);
+	/* Both lists empty (free flight): the same, nothing to set. */
+	if (w->n_awake || s->n_active)
+		bsim_state_set_active(s, w->awake, w->n_awake);
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k];
 		s->theta[i] = w->beams[i].theta;

@@ -40,14 +40,15 @@ static const char *const arg_names[N_ARGS] = {
  * ledger's. */
 typedef struct rows {
 	int n_beams, width;
+	int body; /* 1: heading, angular_velocity after e_prop (bsim_trial_body_columns) */
 	long n, cap;
 	double *v;
 	int oom;
 } rows;
 
-static int traj_width(int n_beams)
+static int traj_width(int n_beams, int body)
 {
-	return 5 + 2 * n_beams + 1 + n_beams + 3;
+	return 5 + 2 * n_beams + 1 + n_beams + 3 + 2 * body;
 }
 
 static void rows_record(void *user, const bsim_record_row *row)
@@ -83,6 +84,10 @@ static void rows_record(void *user, const bsim_record_row *row)
 	d[k++] = row->e_kin;
 	d[k++] = row->e_beam;
 	d[k++] = row->e_prop;
+	if (r->body) {
+		d[k++] = s->heading;
+		d[k++] = s->angular_velocity;
+	}
 	const bsim_ledger *l = row->ledger;
 	const double ledger[LEDGER_COLUMNS] = {
 	        row->t,     row->e_kin,    row->e_beam, row->e_kin + row->e_beam,
@@ -123,8 +128,9 @@ static void rows_structs(mxArray *out, const rows *r)
 		snprintf(name, sizeof name, "contact%d", i);
 		rows_field(t, r, c++, name);
 	}
-	static const char *const tail[] = {"e_kin", "e_beam", "e_prop"};
-	for (int i = 0; i < 3; i++)
+	static const char *const tail[] = {"e_kin", "e_beam", "e_prop", "heading",
+	                                   "angular_velocity"};
+	for (int i = 0; i < 3 + 2 * r->body; i++)
 		rows_field(t, r, c++, tail[i]);
 	bmx_set(out, 0, "trajectory", t);
 	mxArray *l = mxCreateStructMatrix(1, 1, 0, NULL);
@@ -339,7 +345,8 @@ static int run(run_call *c, int nrhs, const mxArray *prhs[], mxArray **out, char
 	bsim_recorder rec = {.stride = (int)stride, .log = c->log, .overlap = 1};
 	if (trajectory) {
 		c->traj.n_beams = rp->scene.n_beams;
-		c->traj.width = traj_width(rp->scene.n_beams) + LEDGER_COLUMNS;
+		c->traj.body = bsim_trial_body_columns(&rp->scene);
+		c->traj.width = traj_width(rp->scene.n_beams, c->traj.body) + LEDGER_COLUMNS;
 		rec.record = rows_record;
 		rec.record_user = &c->traj;
 	}

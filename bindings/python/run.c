@@ -11,10 +11,11 @@
 
 /* The trajectory's rows as they are recorded, trajectory.csv's columns:
  * t, x, y, vx, vy, theta_i, omega_i (each beam), f_rand, contact_i, e_kin,
- * e_beam, e_prop; and at the same times ledger.csv's (LEDGER). Filled with
- * the GIL released: no Python here. */
+ * e_beam, e_prop, and heading, angular_velocity for a body that turns or is
+ * not a disk (body); and at the same times ledger.csv's (LEDGER). Filled
+ * with the GIL released: no Python here. */
 typedef struct rows {
-	int n_beams, width;
+	int n_beams, width, body;
 	long n, cap;
 	double *v, *ledger;
 	int oom;
@@ -33,7 +34,8 @@ static void rows_record(void *user, const bsim_record_row *row)
 		return;
 	if (r->n == 0) {
 		r->n_beams = s->n_beams;
-		r->width = 9 + 3 * s->n_beams;
+		r->body = row->body_columns;
+		r->width = 9 + 3 * s->n_beams + 2 * r->body;
 	}
 	if (r->n == r->cap) {
 		long cap = r->cap ? 2 * r->cap : 1024;
@@ -73,6 +75,10 @@ static void rows_record(void *user, const bsim_record_row *row)
 	*p++ = row->e_kin;
 	*p++ = row->e_beam;
 	*p++ = row->e_prop;
+	if (r->body) {
+		*p++ = s->heading;
+		*p++ = s->angular_velocity;
+	}
 }
 
 /* The columns by name, each a NumPy array (contact_i int32). */
@@ -102,8 +108,9 @@ static PyObject *rows_dict(const rows *r)
 		if (pyb_set(d, name, pyb_column(r->v + c++, r->n, r->width, 1)))
 			goto fail;
 	}
-	static const char *const tail[] = {"e_kin", "e_beam", "e_prop"};
-	for (int k = 0; k < 3; k++, c++)
+	static const char *const tail[] = {"e_kin", "e_beam", "e_prop", "heading",
+	                                   "angular_velocity"};
+	for (int k = 0; k < 3 + 2 * r->body; k++, c++)
 		if (pyb_set(d, tail[k], pyb_column(r->v + c, r->n, r->width, 0)))
 			goto fail;
 	return d;

@@ -41,8 +41,9 @@ typedef struct bsim_backend {
 	const bsim_knob_setting *accuracy;
 	int n_accuracy;
 	/* Optional (NULL: not offered). Puts w back to the world create made
-	 * from scene, which must be the scene w was created from, unchanged:
-	 * the same steps then give the same bits. What the world derived from
+	 * from scene, which must be the scene w was created from, unchanged
+	 * but for the body's start and velocity, which it reads again: the
+	 * same steps then give the same bits. What the world derived from
 	 * the beams' definitions (its grid, their rest directions) is kept, so
 	 * a trial pays for the beams it touched, not for the field
 	 * (bsim_trial_runner_keep_worlds). */

@@ -9,6 +9,7 @@
 #include "beamsim/base.h"
 #include "beamsim/scene.h"
 #include "beamsim/schedule.h"
+#include "beamsim/state.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -16,12 +17,29 @@ extern "C" {
 
 #define BSIM_EFFECTS_MAX 8
 
+/* The force and torque on the body an effect adds: f[0], f[1] the force on
+ * its centre (N), f[2] the torque about it (N m, counter-clockwise). */
+enum { BSIM_WRENCH = 3 };
+
+/* How bsim_effects_force_at computes an effect's force: by its apply, or
+ * inline for the two that every trial of the essay's scenes calls each
+ * step (the same operations as their apply: the same bits). */
+enum {
+	BSIM_EFFECT_APPLY = 0,    /* apply */
+	BSIM_EFFECT_CONSTANT = 1, /* param along axis (propulsion along y) */
+	BSIM_EFFECT_HELD = 2      /* last along axis while step n is in [held[0], held[1]) at
+	                           * step size held_h (the held random force), else apply */
+};
+
 typedef struct bsim_effect {
 	const char *name;
-	/* Adds this effect's force on the body (N) at step n of size h (s) into
-	 * f, given the body's velocity v (m/s) at the step's start; f holds the
-	 * forces of the effects before it in the pipeline. */
-	void (*apply)(struct bsim_effect *e, long n, double h, const double v[2], double f[2]);
+	int kind; /* BSIM_EFFECT_* */
+	/* Adds this effect's force and torque on the body at step n of size h
+	 * (s) into f (BSIM_WRENCH), given the body's motion at the step's
+	 * start: s's position x, velocity v, heading and angular_velocity (the
+	 * other fields of s are not read); f holds what the effects before it
+	 * in the pipeline gave. */
+	void (*apply)(struct bsim_effect *e, long n, double h, const bsim_state *s, double f[3]);
 	int axis;                /* the body axis the force acts along: 0 = x, 1 = y */
 	double param;            /* force or magnitude, N */
 	bsim_schedule *schedule; /* random_force only */
@@ -33,11 +51,23 @@ typedef struct bsim_effect {
 	double coef[2];
 	double value;
 	long at;
-	/* The effects booked on their own ledger lines (oscillation, drag):
-	 * the body's mass (kg) and the force applied in the step along x and
-	 * y (N). */
+	/* The effects booked on their own ledger lines (propulsion along the
+	 * heading, oscillation, drag, ground friction): the body's mass (kg),
+	 * the force applied in the step along x and y (N) and the torque (N m);
+	 * the body's moment of inertia (kg m^2) for those that turn it. */
 	double mass;
 	double applied[2];
+	double applied_torque;
+	double inertia;
+	/* The turning part's coefficient (angular drag's c_w, N m s/rad;
+	 * ground friction's torque limit, N m) and the angular drag's step
+	 * coefficient for h. */
+	double param_turn;
+	double coef_turn;
+	/* BSIM_EFFECT_HELD: the steps over which last holds at step size
+	 * held_h (s), as the schedule's bsim_schedule_at_step_held gives them. */
+	long held[2];
+	double held_h;
 } bsim_effect;
 
 typedef struct bsim_effects {
@@ -45,9 +75,12 @@ typedef struct bsim_effects {
 	bsim_effect e[BSIM_EFFECTS_MAX];
 	bsim_effect *random; /* the random-force effect, or NULL */
 	/* e[0 .. n_work) book their work along their axis (last) as w_prop or
-	 * w_rand; e[n_work .. n) their work (applied) on their own lines: the
-	 * oscillation's w_osc, the drag's loss. */
+	 * w_rand; e[n_work .. n) their work (applied over the displacement,
+	 * applied_torque over the turn) on their own lines: the propulsion
+	 * along the heading's w_prop, the oscillation's w_osc, the drag's and
+	 * the ground friction's losses. */
 	int n_work;
+	bsim_effect *heading;     /* the propulsion along the heading, or NULL */
 	bsim_effect *drag;        /* the drag effect, or NULL */
 	bsim_effect *oscillation; /* the oscillation effect, or NULL */
 	bsim_effect *friction;    /* the ground friction effect (the last), or NULL */
@@ -66,24 +99,54 @@ BSIM_API void bsim_effects_free(bsim_effects *fx);
  * scene's, so the trial is not a result. */
 BSIM_API int bsim_effects_status(const bsim_effects *fx, bsim_error *err);
 
-/* Sum of all effects' forces on the body at step n of size h (s), the
- * body's velocity v (m/s) at the step's start. */
-static inline void bsim_effects_force_at(bsim_effects *fx, long n, double h, const double v[2],
-                                         double f[2])
+/* Sum of all effects' forces and torques on the body at step n of size h
+ * (s), in f (BSIM_WRENCH: force N, torque N m), the body's motion s at the
+ * step's start. */
+static inline void bsim_effects_force_at(bsim_effects *fx, long n, double h, const bsim_state *s,
+                                         double f[3])
 {
 	f[0] = 0.0;
 	f[1] = 0.0;
-	for (int i = 0; i < fx->n; i++)
-		fx->e[i].apply(&fx->e[i], n, h, v, f);
+	f[2] = 0.0;
+	/* The essay's pipeline, propulsion then the held random force, within
+	 * a hold: the loop below unrolled, the same operations. */
+	bsim_effect *e0 = &fx->e[0], *e1 = &fx->e[1];
+	if (fx->n == 2 && e0->kind == BSIM_EFFECT_CONSTANT && e1->kind == BSIM_EFFECT_HELD &&
+	    n >= e1->held[0] && n < e1->held[1] && h == e1->held_h) {
+		f[e0->axis] += e0->param;
+		e0->last = e0->param;
+		f[e1->axis] += e1->last;
+		return;
+	}
+	for (int i = 0; i < fx->n; i++) {
+		bsim_effect *e = &fx->e[i];
+		if (e->kind == BSIM_EFFECT_CONSTANT) {
+			f[e->axis] += e->param;
+			e->last = e->param;
+		} else if (e->kind == BSIM_EFFECT_HELD && n >= e->held[0] && n < e->held[1] &&
+		           h == e->held_h) {
+			f[e->axis] += e->last;
+		} else {
+			e->apply(e, n, h, s, f);
+		}
+	}
 }
 
-/* bsim_effects_force_at for a body at rest: the same forces for a scene
- * whose effects do not read the state (propulsion, random force). */
-static inline void bsim_effects_force(bsim_effects *fx, long n, double h, double f[2])
+/* bsim_effects_force_at for a body at rest at the origin, heading +x: the
+ * same forces for a scene whose effects do not read the state (propulsion
+ * along y, random force, oscillation). */
+static inline void bsim_effects_force(bsim_effects *fx, long n, double h, double f[3])
 {
-	static const double rest[2] = {0.0, 0.0};
-	bsim_effects_force_at(fx, n, h, rest, f);
+	static const bsim_state rest;
+	bsim_effects_force_at(fx, n, h, &rest, f);
 }
+
+/* The mean distance of the body's footprint from its centre, m: the
+ * integral of |r| over the uniform body's area divided by the area (disk
+ * 2R/3; capsule and ellipse by quadrature of the outline's radius rho(phi),
+ * (1/A) integral of rho^3 / 3 dphi). Ground friction's torque limit on a
+ * turning body is mu g M times this. */
+BSIM_API double bsim_effects_spin_arm(const bsim_body_def *body);
 
 #ifdef __cplusplus
 }

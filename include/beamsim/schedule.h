@@ -42,6 +42,12 @@ BSIM_API double bsim_schedule_value(bsim_schedule *s, long j);
  * kept so that the steps between two refreshes read it at no cost. */
 BSIM_API double bsim_schedule_at_step(bsim_schedule *s, long n, double h);
 
+/* bsim_schedule_at_step, and in held[0], held[1] the steps [held[0],
+ * held[1]) at this h over which the value returned holds (held[0] =
+ * held[1] = 0 when no such steps are known), so that a caller can read the
+ * value over them without calling again: the same bits. */
+BSIM_API double bsim_schedule_at_step_held(bsim_schedule *s, long n, double h, long held[2]);
+
 /* BSIM_OK, or BSIM_EFAIL saying which value could not be had and why,
  * since the last reset. */
 BSIM_API int bsim_schedule_status(const bsim_schedule *s, bsim_error *err);

@@ -152,6 +152,13 @@ BSIM_API size_t bsim_sweep_record_size(int paired);
 BSIM_API int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                         size_t *size, bsim_error *err);
 
+/* The same for the paired sweep of e with cfg (its second side's
+ * overrides in cfg->extra_b): bsim_sweep_record_size(1), or for a lattice
+ * both sides' results, gate paths and peaks and the separation time. */
+BSIM_API int bsim_sweep_record_size_paired_for(const bsim_experiment *e,
+                                               const bsim_sweep_config *cfg, size_t *size,
+                                               bsim_error *err);
+
 /* Runs the sweep. e->trials and e->seed are used as they are (the caller
  * applies --trials/--seed). BSIM_ESTOPPED (see cfg->stop) says how many
  * trials were finished. */
@@ -217,7 +224,8 @@ BSIM_API int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_conf
 
 /* The same for a paired sweep (beamsim compare): each trial runs on both
  * sides as bsim_sweep_run_paired runs it, its record both results and the
- * separation time (bsim_sweep_record_size(1)). */
+ * separation time (bsim_sweep_record_size_paired_for: a lattice's hold
+ * both sides' gate paths and peaks too). */
 BSIM_API int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                         const bsim_backend *backend_b, const bsim_options *opts_b,
                                         const bsim_sweep_part *part, bsim_error *err);

@@ -185,6 +185,9 @@ typedef struct bsim_record_row {
 	const bsim_ledger *ledger; /* summed over the steps before t */
 	double e_kin, e_beam;      /* J: body and beams' kinetic, springs' elastic */
 	double e_prop;             /* J: F_prop (y0 - y), MODEL.md section 7 */
+	/* 1: the trajectory CSV's rows end with heading,angular_velocity
+	 * (bsim_trial_body_columns) */
+	int body_columns;
 } bsim_record_row;
 
 /* Called at every recorded row (the rows of the CSV, whatever it is). */
@@ -215,6 +218,15 @@ typedef struct bsim_recorder {
 
 /* Writes the trajectory CSV header for a scene of n_beams beams. */
 BSIM_API void bsim_trial_trajectory_header(FILE *f, int n_beams);
+
+/* 1 if the scene's body turns or is not a disk: its trajectory CSV then
+ * ends with the columns heading (rad) and angular_velocity (rad/s); 0 for
+ * the essay's disk, whose CSV is as it always was. */
+BSIM_API int bsim_trial_body_columns(const bsim_scene *scene);
+
+/* The trajectory CSV header of a scene of n_beams beams, with the body's
+ * columns if body_columns (bsim_trial_body_columns). */
+BSIM_API void bsim_trial_trajectory_header_body(FILE *f, int n_beams, int body_columns);
 
 /* A bsim_record_fn writing the row to the trajectory CSV file (a FILE *):
  * what rec->csv receives, for a second file with the same rows. */

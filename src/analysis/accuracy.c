@@ -119,16 +119,23 @@ static double state_distance(const bsim_scene *sc, const bsim_state *a, const bs
 	return sqrt(e2);
 }
 
-/* One piece: restart from ref->states[k] and run m steps of h. */
+/* One piece: restart from ref->states[k] and run m steps of h. The world
+ * is *kept's, reset (the last piece's, of the same scene), or a new one;
+ * a backend that can reset leaves it in *kept for the next piece. */
 static int consistency_piece(const bsim_accuracy_reference *ref, const bsim_scene *scene,
                              const bsim_backend *b, const bsim_options *opts, uint64_t seed, int k,
-                             long m, bsim_state *s, bsim_error *err)
+                             long m, bsim_state *s, bsim_world **kept, bsim_error *err)
 {
 	const double h = scene->dt;
-	bsim_world *w = NULL;
-	int rc = b->create(scene, opts, &w, err);
-	if (rc)
+	bsim_world *w = *kept;
+	const int reused = w != NULL;
+	*kept = NULL;
+	int rc = reused ? b->reset(w, scene, err) : b->create(scene, opts, &w, err);
+	if (rc) {
+		if (reused)
+			b->destroy(w);
 		return rc;
+	}
 	rc = b->set_state(w, &ref->states[k], err);
 	bsim_effects fx;
 	if (rc == BSIM_OK && bsim_effects_init(&fx, scene, seed))
@@ -139,21 +146,24 @@ static int consistency_piece(const bsim_accuracy_reference *ref, const bsim_scen
 	}
 	/* Step n of this h starts at t = n h: the piece starts at t_k. */
 	long n0 = lround(k * ref->grid / h);
-	double f[2];
-	const double *v = ref->states[k].v; /* the body's velocity at the step's start */
+	double f[BSIM_WRENCH];
+	const bsim_state *at = &ref->states[k]; /* the body's motion at the step's start */
 	for (long j = 0; j < m && rc == BSIM_OK; j++) {
-		bsim_effects_force_at(&fx, n0 + j, h, v, f);
-		rc = b->step(w, f, 0.0, h, err);
+		bsim_effects_force_at(&fx, n0 + j, h, at, f);
+		rc = b->step(w, f, f[2], h, err);
 		if (fx.n_work < fx.n) { /* effects that read the state */
 			b->get_state(w, s);
-			v = s->v;
+			at = s;
 		}
 	}
 	if (rc == BSIM_OK)
 		rc = bsim_effects_status(&fx, err);
 	b->get_state(w, s);
 	bsim_effects_free(&fx);
-	b->destroy(w);
+	if (rc == BSIM_OK && b->reset)
+		*kept = w;
+	else
+		b->destroy(w);
 	return rc;
 }
 
@@ -179,10 +189,11 @@ int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_sce
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	double sum = 0.0, worst = 0.0;
 	int rc = BSIM_OK;
+	bsim_world *kept = NULL; /* the pieces' world, reset from one to the next */
 	for (int i = 0; i < n_pieces && rc == BSIM_OK; i++) {
 		/* Midpoints of n_pieces equal spans of [0, last_start]. */
 		int k = (int)lround((i + 0.5) * (double)last_start / n_pieces);
-		rc = consistency_piece(ref, scene, b, opts, seed, k, m, &s, err);
+		rc = consistency_piece(ref, scene, b, opts, seed, k, m, &s, &kept, err);
 		if (rc)
 			break;
 		double e = state_distance(scene, &s, &ref->states[k + piece_k]);
@@ -191,6 +202,8 @@ int bsim_accuracy_consistency(const bsim_accuracy_reference *ref, const bsim_sce
 		sum += e;
 		worst = fmax(worst, e);
 	}
+	if (kept)
+		b->destroy(kept);
 	bsim_state_free(&s);
 	*mean = sum / n_pieces;
 	*max = worst;
@@ -277,6 +290,10 @@ static int row_run(bsim_accuracy_row *row, const bsim_accuracy_reference *ref,
 	bsim_trial_runner *runner = rc ? NULL : bsim_trial_runner_alloc();
 	if (!rc && !runner)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	/* The batch's trials share a world, as a sweep's do (sc lives,
+	 * unchanged, until the runner is freed). */
+	if (!rc)
+		bsim_trial_runner_keep_worlds(runner, 1);
 	if (!rc)
 		rc = row_batch(row, runner, &sc, b, cfg, err);
 	bsim_trial_runner_free(runner);

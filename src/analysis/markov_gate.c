@@ -123,6 +123,9 @@ typedef struct gate_runner {
 	const markov_pool *pool;      /* NULL: not a self-consistent pass */
 	markov_run *run;              /* NULL: not kept */
 	long steps;                   /* of the last trial */
+	/* The last trial's world, reset for the next (the gate's scene stays
+	 * but for the body's start); NULL: none, or a backend without reset. */
+	bsim_world *w;
 } gate_runner;
 
 /* One single-gate trial from entry bin `bin` (0: the start) with trial index
@@ -155,9 +158,14 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 			                  s->body.velocity);
 		}
 	}
-	bsim_world *w = NULL;
-	if (be->create(s, opts, &w, err) != BSIM_OK)
+	bsim_world *w = r->w;
+	const int reused = w != NULL;
+	r->w = NULL;
+	if ((reused ? be->reset(w, s, err) : be->create(s, opts, &w, err)) != BSIM_OK) {
+		if (reused)
+			be->destroy(w);
 		return -1;
+	}
 	bsim_effects fx;
 	if (bsim_effects_init(&fx, s,
 	                      bsim_schedule_seed_mix(def->seed, (uint64_t)bin, (uint64_t)t))) {
@@ -175,16 +183,17 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	double next[2];
 	int out = 0;
 	r->steps = n_max;
-	const double *v = r->s0.v; /* the body's velocity at the step's start */
+	/* the body's motion at the step's start: s0, which the swap below
+	 * refills with the state each step ends in */
+	const bsim_state *at = &r->s0;
 	for (long n = 0; n < n_max; n++) {
-		double f[2];
-		bsim_effects_force_at(&fx, n, s->dt, v, f);
-		if (be->step(w, f, 0.0, s->dt, err) != BSIM_OK) {
+		double f[BSIM_WRENCH];
+		bsim_effects_force_at(&fx, n, s->dt, at, f);
+		if (be->step(w, f, f[2], s->dt, err) != BSIM_OK) {
 			out = -1;
 			break;
 		}
 		be->get_state(w, &r->s1);
-		v = r->s1.v;
 		if (!isfinite(r->s1.x[0]) || !isfinite(r->s1.x[1]) || !isfinite(r->s1.v[0]) ||
 		    !isfinite(r->s1.v[1])) {
 			bsim_error_set(err, BSIM_EFAIL,
@@ -214,7 +223,10 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 		memcpy(r->run->exit_v, last->v, sizeof r->run->exit_v);
 	}
 	bsim_effects_free(&fx);
-	be->destroy(w);
+	if (out >= 0 && be->reset)
+		r->w = w;
+	else
+		be->destroy(w);
 	return out;
 }
 
@@ -306,6 +318,8 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 				def->progress(def->progress_user, now, total);
 			}
 		}
+		if (r.w)
+			be->destroy(r.w);
 		gsl_rng_free(r.rng);
 		bsim_state_free(&r.s0);
 		bsim_state_free(&r.s1);

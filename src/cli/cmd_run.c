@@ -186,7 +186,10 @@ static void print_text(FILE *out, const run_args *a, const bsim_replay *rp, uint
 	else
 		fprintf(out, "peak theta  beam 1 %.6g rad, beam 2 %.6g rad\n", r->max_theta[0],
 		        r->max_theta[1]);
-	fprintf(out, "overlap     deepest %.3g m of body and beams\n", r->overlap_max);
+	if (isnan(r->overlap_max))
+		fputs("overlap     not measured (the body is not a disk)\n", out);
+	else
+		fprintf(out, "overlap     deepest %.3g m of body and beams\n", r->overlap_max);
 	fprintf(out, "energy      start %.6g J, end %.6g J\n", l->e_start, l->e_end);
 	fprintf(out, "  work      propulsion %.6g J, random force %.6g J\n", l->w_prop, l->w_rand);
 	fprintf(out,

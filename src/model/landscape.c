@@ -132,6 +132,15 @@ int bsim_landscape_grid_alloc(const bsim_scene *s, const bsim_landscape_grid_def
                               bsim_landscape_grid **out, bsim_error *err)
 {
 	*out = NULL;
+	/* The landscape is the disk's: each beam turned just clear of a disk
+	 * at c, a function of the centre alone. Another shape's clearance
+	 * depends on its heading too. */
+	if (s->body.shape != BSIM_SHAPE_DISK)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.shape: expected disk for the energy landscape (a "
+		                      "function of the disk's centre alone), got %s",
+		                      s->path[0] ? s->path : s->name,
+		                      s->body.shape == BSIM_SHAPE_CAPSULE ? "capsule" : "ellipse");
 	double r[4];
 	int rc = grid_region(s, def, r, err);
 	if (rc)

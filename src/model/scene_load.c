@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
+#include "model/body_shape.h"
 #include "model/scene_internal.h"
 #include "util/yaml_override.h"
 
@@ -252,6 +253,23 @@ static int check_termination(walk *w)
 	return ydoc_fail(w->d, n, NULL, paths[1], w->err,
 	                 "expected a number <= termination.classify_y (%g), got %s", s->classify_y,
 	                 got);
+}
+
+/* The default success line, 65 m, is the essay's gate's for its disk of
+ * radius 10 m: the beams' forward reach (pivot row 30 + beam 25) plus R.
+ * For another shape it is that reach plus the outline's farthest point
+ * from the centre (body_shape_reach), so that a beam swung forward no
+ * longer reaches the body; classify_y stays 15 m beyond it. What the file
+ * gives is kept. */
+static void success_line_default(walk *w, struct fy_node *root)
+{
+	bsim_scene *s = w->s;
+	if (s->has_lattice || s->body.shape == BSIM_SHAPE_DISK ||
+	    ydoc_lookup(root, "termination.success_y"))
+		return;
+	s->success_y = 55.0 + body_shape_reach(&s->body);
+	if (!ydoc_lookup(root, "termination.classify_y"))
+		s->classify_y = s->success_y + 15.0;
 }
 
 /* The body must not start inside a beam (MODEL.md section 3). The message
@@ -510,6 +528,8 @@ static int walk_scene(walk *w, const ydoc *file)
 		rc = scene_horizon(w, file);
 	if (!rc && w->s->has_lattice)
 		lattice_defaults(w, root);
+	if (!rc)
+		success_line_default(w, root);
 	if (!rc)
 		rc = check_termination(w);
 	if (!rc)

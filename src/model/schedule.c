@@ -139,6 +139,17 @@ double bsim_schedule_at_step(bsim_schedule *s, long n, double h)
 	return value;
 }
 
+double bsim_schedule_at_step_held(bsim_schedule *s, long n, double h, long held[2])
+{
+	double value = bsim_schedule_at_step(s, n, h);
+	/* Held now: either the hold read above or the one just set, whose
+	 * value is the one returned. */
+	int holds = n >= s->held_lo && n < s->held_hi && h == s->held_h;
+	held[0] = holds ? s->held_lo : 0;
+	held[1] = holds ? s->held_hi : 0;
+	return value;
+}
+
 double bsim_schedule_value(bsim_schedule *s, long j)
 {
 	/* A value that cannot be had is no value: 0, and the failure kept for

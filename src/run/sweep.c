@@ -19,6 +19,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,6 +33,15 @@
 #include "beamsim/stats.h"
 #include "run/sweep_record.h"
 #include "run/trial_pair.h"
+
+/* The length compare's separation is 1% of: the disk's radius, or the
+ * radius of the disk of the body's area for another shape. */
+static double body_size(const bsim_scene *scene)
+{
+	if (scene->body.shape == BSIM_SHAPE_DISK)
+		return scene->body.radius;
+	return sqrt(bsim_body_area(&scene->body) / 3.14159265358979323846);
+}
 
 /* One trial into its group's counts (group_finish completes them). */
 static void group_add(bsim_group_result *out, const bsim_trial_result *t)
@@ -158,15 +168,28 @@ size_t bsim_sweep_record_size(int paired)
 	return paired ? sizeof(pair_record) : sizeof(bsim_trial_result);
 }
 
-/* The beams of a plain lattice sweep's records (run/sweep_record.h), 0 for
- * records of the result alone. */
-static int record_beams(const bsim_scene *scenes, int n_groups, const bsim_sweep_config *cfg,
-                        int paired)
+/* The beams of a lattice sweep's records (run/sweep_record.h), 0 for
+ * records of the result alone; a paired sweep's are the most of both
+ * sides' scenes (scenes_b NULL: the sides share scenes). */
+static int record_beams(const bsim_scene *scenes, const bsim_scene *scenes_b, int n_groups,
+                        const bsim_sweep_config *cfg)
 {
-	if (paired || cfg->results_only || !scenes[0].has_lattice)
+	if (cfg->results_only || !scenes[0].has_lattice)
 		return 0;
 	int beams = sweep_record_beams(scenes, n_groups);
+	int beams_b = scenes_b ? sweep_record_beams(scenes_b, n_groups) : 0;
+	beams = beams_b > beams ? beams_b : beams;
 	return beams > 0 ? beams : 1;
+}
+
+/* The size of a record of beams beams (0: the result alone). A paired
+ * lattice sweep's record is side a's lattice record, then side b's, then
+ * the separation time (a double), both sides packed by run/sweep_record.c. */
+static size_t record_bytes(int beams, int paired)
+{
+	if (!beams)
+		return bsim_sweep_record_size(paired);
+	return paired ? 2 * sweep_record_size(beams) + sizeof(double) : sweep_record_size(beams);
 }
 
 /* What the threads share. first_fail is the index of the lowest failed
@@ -200,8 +223,9 @@ typedef struct sweep_shared {
 	int stopped;                 /* a trial was not started because of cfg->stop */
 	const bsim_sweep_part *part; /* NULL: every trial is this process's */
 	long progress_total;         /* what progress counts up to */
-	/* > 0: a plain lattice sweep's records hold the gate path and the
-	 * peaks of this many beams (run/sweep_record.h), record_size bytes */
+	/* > 0: a lattice sweep's records hold the gate path and the peaks of
+	 * this many beams (run/sweep_record.h; a paired sweep's, each side's:
+	 * record_bytes), record_size bytes */
 	int record_beams;
 	size_t record_size;
 } sweep_shared;
@@ -253,6 +277,14 @@ static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
 static const void *record_of(sweep_shared *sh, long i, void *buf, pair_record *pair)
 {
 	long k = i - sh->first;
+	if (sh->backend_b && sh->record_beams) {
+		size_t side = sweep_record_size(sh->record_beams);
+		unsigned char *p = buf;
+		sweep_record_pack(p, sh->record_beams, &sh->results[k], &sh->logs[k]);
+		sweep_record_pack(p + side, sh->record_beams, &sh->results_b[k], &sh->logs_b[k]);
+		memcpy(p + 2 * side, &sh->t_separate[k], sizeof sh->t_separate[k]);
+		return buf;
+	}
 	if (sh->backend_b) {
 		*pair = (pair_record){sh->results[k], sh->results_b[k], sh->t_separate[k]};
 		return pair;
@@ -296,7 +328,19 @@ static int journal_take(void *user, uint64_t index, const void *payload)
 		sh->journaled[index / 8] |= (unsigned char)(1u << (index % 8));
 		return 0;
 	}
-	if (sh->record_beams) {
+	if (sh->record_beams && sh->backend_b) {
+		/* either side's path too long for its record: the pair runs again */
+		size_t side = sweep_record_size(sh->record_beams);
+		const unsigned char *p = payload;
+		int got = sweep_record_unpack(p, sh->record_beams, &sh->results[index],
+		                              &sh->logs[index]);
+		if (got > 0)
+			got = sweep_record_unpack(p + side, sh->record_beams, &sh->results_b[index],
+			                          &sh->logs_b[index]);
+		if (got <= 0)
+			return got;
+		memcpy(&sh->t_separate[index], p + 2 * side, sizeof sh->t_separate[index]);
+	} else if (sh->record_beams) {
 		/* a path too long for its record: the trial runs again */
 		int got = sweep_record_unpack(payload, sh->record_beams, &sh->results[index],
 		                              &sh->logs[index]);
@@ -330,6 +374,8 @@ static void sweep_thread(sweep_shared *sh)
 	if (runner)
 		bsim_trial_runner_keep_worlds(runner, 1);
 	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
+	if (pair)
+		trial_pair_keep_worlds(pair, 1);
 	bsim_trial_log *log[2] = {bsim_trial_log_alloc(), bsim_trial_log_alloc()};
 	void *record_buf = sh->record_beams ? malloc(sh->record_size) : NULL;
 	pair_record pr;
@@ -374,7 +420,7 @@ static void sweep_thread(sweep_shared *sh)
 			pair->keep_stride = sh->keep_stride;
 			rc = trial_pair_run(pair, scene, &sh->scenes_b[g], cfg->backend, cfg->opts,
 			                    sh->backend_b, sh->opts_b, seed,
-			                    0.01 * scene->body.radius, &sh->results[k],
+			                    0.01 * body_size(scene), &sh->results[k],
 			                    &sh->results_b[k], log, &sh->t_separate[k], &err);
 		} else {
 			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, &rec,
@@ -593,8 +639,8 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	};
 	if (rc == BSIM_OK && cfg->journal) {
 		sh.lattice = scenes[0].has_lattice;
-		sh.record_beams = record_beams(scenes, e->n_groups, cfg, backend_b != NULL);
-		sh.record_size = sweep_record_size(sh.record_beams);
+		sh.record_beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
+		sh.record_size = record_bytes(sh.record_beams, backend_b != NULL);
 		sh.from_journal = calloc(total ? (size_t)total : 1, 1);
 		long kept = 0, cut = 0;
 		rc = !sh.from_journal ? bsim_error_set(err, BSIM_EFAIL, "out of memory")
@@ -849,8 +895,8 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	        .lattice = out->lattice,
 	};
 	if (rc == BSIM_OK) {
-		sh.record_beams = record_beams(scenes, e->n_groups, cfg, 0);
-		sh.record_size = sweep_record_size(sh.record_beams);
+		sh.record_beams = record_beams(scenes, NULL, e->n_groups, cfg);
+		sh.record_size = record_bytes(sh.record_beams, 0);
 	}
 	if (rc == BSIM_OK && cfg->journal)
 		rc = stream_replay(&sh, err);
@@ -925,9 +971,28 @@ int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config
 	int rc = scenes_build(e, cfg, 0, &scenes, err);
 	if (rc != BSIM_OK)
 		return rc;
-	int beams = record_beams(scenes, e->n_groups, cfg, 0);
-	*size = beams ? sweep_record_size(beams) : bsim_sweep_record_size(0);
+	int beams = record_beams(scenes, NULL, e->n_groups, cfg);
+	*size = record_bytes(beams, 0);
 	scenes_free(scenes, e->n_groups);
+	return BSIM_OK;
+}
+
+int bsim_sweep_record_size_paired_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                      size_t *size, bsim_error *err)
+{
+	bsim_scene *scenes = NULL, *scenes_b = NULL;
+	int rc = scenes_build(e, cfg, 0, &scenes, err);
+	if (rc != BSIM_OK)
+		return rc;
+	if (cfg->n_extra_b > 0 && (rc = scenes_build(e, cfg, 1, &scenes_b, err)) != BSIM_OK) {
+		scenes_free(scenes, e->n_groups);
+		return rc;
+	}
+	int beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
+	*size = record_bytes(beams, 1);
+	scenes_free(scenes, e->n_groups);
+	if (scenes_b)
+		scenes_free(scenes_b, e->n_groups);
 	return BSIM_OK;
 }
 
@@ -991,8 +1056,8 @@ static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	        .part = part,
 	};
 	if (rc == BSIM_OK) {
-		sh.record_beams = record_beams(scenes, e->n_groups, cfg, backend_b != NULL);
-		sh.record_size = sweep_record_size(sh.record_beams);
+		sh.record_beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
+		sh.record_size = record_bytes(sh.record_beams, backend_b != NULL);
 	}
 	/* Progress: this part's trials, or with collect every part's. */
 	for (long i = 0; i < total; i++) {

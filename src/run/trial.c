@@ -181,7 +181,9 @@ static int trial_open(trial_ctx *c, uint64_t seed, bsim_error *err)
 	c->log = rec ? rec->log : NULL;
 	if (c->log)
 		c->log->n_entries = 0;
-	c->overlap = rec && rec->overlap;
+	/* the overlap is the disk's (R less the centre's distance): not
+	 * measured for another shape (overlap_max NaN) */
+	c->overlap = rec && rec->overlap && c->scene->body.shape == BSIM_SHAPE_DISK;
 	c->recording = rec && (rec->csv || rec->ledger || rec->record);
 	c->stride = rec && rec->stride > 0 ? rec->stride : 1;
 	c->trace = rec ? rec->trace : NULL;
@@ -394,15 +396,15 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	trial_loop lp;
 	rc = trial_begin(&c, &lp, s0, err);
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
-		double f[2];
-		bsim_effects_force_at(&fx, lp.n, lp.h, s0->v, f);
+		double f[BSIM_WRENCH];
+		bsim_effects_force_at(&fx, lp.n, lp.h, s0, f);
 		if (c.recording && lp.n % c.stride == 0)
 			trial_record(&c, s0, lp.n);
-		if ((rc = backend->step(c.w, f, 0.0, lp.h, err)) != BSIM_OK)
+		if ((rc = backend->step(c.w, f, f[2], lp.h, err)) != BSIM_OK)
 			break;
 		backend->get_state(c.w, s1);
-		double e1 = energy_mech(c.ws, s1);
-		if (!state_finite(s1) || !isfinite(e1)) {
+		double e1;
+		if (!state_energy_finite(c.ws, s1, &e1)) {
 			/* s0 stays the last finite state, the one reported. */
 			out->instability = BSIM_UNSTABLE_NONFINITE;
 			out->unstable_step = (int)(lp.n + 1);
@@ -425,8 +427,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 			                                                   scene->body.radius, s0));
 		if (lp.done)
 			continue;
-		trial_peaks_update(&r->peaks, scene, c.map, s0);
-		trial_peaks_contacts(&r->peaks, c.map, s0);
+		trial_peaks_step(&r->peaks, scene, c.map, s0);
 		/* The gate first: a body that leaves the field ends in its gate. */
 		if (scene->has_lattice && (rc = gate_follow(&c, &lp, s0, p0, err)) != BSIM_OK)
 			break;

@@ -13,18 +13,27 @@
 trial_pair *trial_pair_alloc(void)
 {
 	trial_pair *p = calloc(1, sizeof *p);
-	if (p && !(p->runner = bsim_trial_runner_alloc())) {
+	if (p && (!(p->runner[0] = bsim_trial_runner_alloc()) ||
+	          !(p->runner[1] = bsim_trial_runner_alloc()))) {
+		bsim_trial_runner_free(p->runner[0]);
 		free(p);
 		p = NULL;
 	}
 	return p;
 }
 
+void trial_pair_keep_worlds(trial_pair *p, int on)
+{
+	bsim_trial_runner_keep_worlds(p->runner[0], on);
+	bsim_trial_runner_keep_worlds(p->runner[1], on);
+}
+
 void trial_pair_free(trial_pair *p)
 {
 	if (!p)
 		return;
-	bsim_trial_runner_free(p->runner);
+	bsim_trial_runner_free(p->runner[0]);
+	bsim_trial_runner_free(p->runner[1]);
 	free(p->trace[0].xy);
 	free(p->trace[1].xy);
 	free(p);
@@ -65,7 +74,7 @@ static int run_traced(trial_pair *p, int k, const bsim_scene *scene, const bsim_
 		rec.record = bsim_trajectory_record;
 		rec.record_user = p->keep[k];
 	}
-	int rc = bsim_trial_run(p->runner, scene, b, opts, seed, &rec, r, err);
+	int rc = bsim_trial_run(p->runner[k], scene, b, opts, seed, &rec, r, err);
 	if (rc == BSIM_OK && tr->oom)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for a %ld-step trace", tr->n);
 	if (rc == BSIM_OK && p->keep[k] && p->keep[k]->oom)

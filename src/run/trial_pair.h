@@ -16,9 +16,10 @@ typedef struct trial_trace {
 	int oom; /* a push failed: the trace is incomplete */
 } trial_trace;
 
-/* Per-thread memory: a runner and two traces, reused trial after trial. */
+/* Per-thread memory: a runner and a trace per backend, reused trial after
+ * trial. */
 typedef struct trial_pair {
-	bsim_trial_runner *runner;
+	bsim_trial_runner *runner[2];
 	trial_trace trace[2];
 	bsim_trajectory *keep[2]; /* NULL, or where each run's rows are kept */
 	int keep_stride;
@@ -26,6 +27,10 @@ typedef struct trial_pair {
 
 trial_pair *trial_pair_alloc(void);
 void trial_pair_free(trial_pair *p);
+/* bsim_trial_runner_keep_worlds on both runners: each backend's world kept
+ * from one trial to the next of the same scene (the scenes must live,
+ * unchanged, while it is on). */
+void trial_pair_keep_worlds(trial_pair *p, int on);
 
 /* Trial `seed` of scene on backend a then of scene_b (scene, or one that
  * differs only in what the comparison is about) on b; logs[0] and [1] (may

@@ -68,10 +68,15 @@ void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
 	}
 	p->touched = 0;
 	p->last_touch[0] = p->last_touch[1] = 0.0;
+	p->settled01 = 0;
 	touching_clear(p);
 }
 
 int trial_peaks_label(const trial_peaks *p, const bsim_scene *scene)
 {
+	/* the landscape's label is the disk's (bsim_landscape_label): none for
+	 * another shape */
+	if (scene->body.shape != BSIM_SHAPE_DISK)
+		return -1;
 	return p->touched ? bsim_landscape_label(scene, p->last_touch, p->touching) : -1;
 }

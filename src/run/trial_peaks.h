@@ -31,6 +31,9 @@ typedef struct trial_peaks {
 	int *touching;
 	int *touch_list; /* the beams touching[] holds non-zero */
 	int n_touch;
+	/* Beams 0 and 1's peaks are at +0 or above: a peak never falls, so
+	 * they stay there, and a beam at rest cannot raise them. */
+	int settled01;
 } trial_peaks;
 
 /* Room for a scene of n_beams beams. */
@@ -75,9 +78,18 @@ static inline void trial_peaks_update(trial_peaks *p, const bsim_scene *scene, c
 		trial_peaks_list(p, g);
 		peak[g] = bsim_fmax(peak[g], s->theta[i]);
 	}
-	if (!map)
-		for (int i = 0; i < 2 && i < scene->n_beams; i++)
-			peak[i] = bsim_fmax(peak[i], s->theta[i]);
+	/* A peak at +0 or above stays: the beam is active (the loop above
+	 * took its angle) or at rest (angle +-0, below it or, as bsim_fmax
+	 * orders zeros, not above +0). */
+	if (!map && !p->settled01) {
+		int settled = 1;
+		for (int i = 0; i < 2 && i < scene->n_beams; i++) {
+			if (!(peak[i] >= 0.0) || signbit(peak[i]))
+				peak[i] = bsim_fmax(peak[i], s->theta[i]);
+			settled &= peak[i] >= 0.0 && !signbit(peak[i]);
+		}
+		p->settled01 = settled;
+	}
 	int m = 0; /* only without a map: the essay's beams all start at rest */
 	for (int k = 0; k < p->n_negative; k++) {
 		int i = p->negative[k];
@@ -122,6 +134,18 @@ static inline void trial_peaks_contacts(trial_peaks *p, const int *map, const bs
 		p->touching[g] = s->contact[i];
 		p->touch_list[p->n_touch++] = g;
 	}
+}
+
+/* Both of the above after a step, s the state after it: nothing to do, at
+ * the cost of a test, where no beam is active, no peak is below 0 and
+ * beams 0 and 1's have settled (or the essay's map, which has no such). */
+static inline void trial_peaks_step(trial_peaks *p, const bsim_scene *scene, const int *map,
+                                    const bsim_state *s)
+{
+	if (s->n_active == 0 && p->n_negative == 0 && (map || p->settled01))
+		return;
+	trial_peaks_update(p, scene, map, s);
+	trial_peaks_contacts(p, map, s);
 }
 
 #endif

@@ -8,7 +8,12 @@
 #include "beamsim/landscape.h"
 #include "run/trial_ledger.h"
 
-void bsim_trial_trajectory_header(FILE *f, int n_beams)
+int bsim_trial_body_columns(const bsim_scene *scene)
+{
+	return scene->body.rotates || scene->body.shape != BSIM_SHAPE_DISK;
+}
+
+void bsim_trial_trajectory_header_body(FILE *f, int n_beams, int body_columns)
 {
 	fputs("t,x,y,vx,vy", f);
 	for (int i = 1; i <= n_beams; i++)
@@ -16,7 +21,14 @@ void bsim_trial_trajectory_header(FILE *f, int n_beams)
 	fputs(",f_rand", f);
 	for (int i = 1; i <= n_beams; i++)
 		fprintf(f, ",contact%d", i);
-	fputs(",e_kin,e_beam,e_prop\n", f);
+	fputs(body_columns ? ",e_kin,e_beam,e_prop,heading,angular_velocity\n"
+	                   : ",e_kin,e_beam,e_prop\n",
+	      f);
+}
+
+void bsim_trial_trajectory_header(FILE *f, int n_beams)
+{
+	bsim_trial_trajectory_header_body(f, n_beams, 0);
 }
 
 void bsim_trial_ledger_header(FILE *f)
@@ -36,7 +48,11 @@ void bsim_trial_trajectory_row(void *file, const bsim_record_row *row)
 	fprintf(f, ",%.10g", row->f_rand);
 	for (int i = 0; i < s->n_beams; i++)
 		fprintf(f, ",%d", s->contact[i]);
-	fprintf(f, ",%.10g,%.10g,%.10g\n", row->e_kin, row->e_beam, row->e_prop);
+	if (row->body_columns)
+		fprintf(f, ",%.10g,%.10g,%.10g,%.10g,%.10g\n", row->e_kin, row->e_beam, row->e_prop,
+		        s->heading, s->angular_velocity);
+	else
+		fprintf(f, ",%.10g,%.10g,%.10g\n", row->e_kin, row->e_beam, row->e_prop);
 }
 
 static void ledger_row(FILE *f, const bsim_record_row *row)
@@ -59,6 +75,7 @@ void trial_record_row(const bsim_recorder *rec, const bsim_scene *sc, const bsim
 	        .e_kin = energy_kinetic(sc, s),
 	        .e_beam = energy_springs(sc, s),
 	        .e_prop = bsim_landscape_e_prop(sc, s->x[1]),
+	        .body_columns = bsim_trial_body_columns(sc),
 	};
 	if (rec->csv)
 		bsim_trial_trajectory_row(rec->csv, &row);
@@ -80,6 +97,8 @@ const bsim_state *trial_record_state(bsim_state *whole, const int *map, const bs
 	bsim_state_set_active(whole, local, s->n_active < 2 ? s->n_active : 2);
 	memcpy(whole->x, s->x, sizeof whole->x);
 	memcpy(whole->v, s->v, sizeof whole->v);
+	whole->heading = s->heading;
+	whole->angular_velocity = s->angular_velocity;
 	for (int k = 0; k < s->n_active && k < 2; k++) {
 		int i = s->active[k];
 		whole->theta[map[i]] = s->theta[i];

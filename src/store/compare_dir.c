@@ -319,10 +319,9 @@ static int compare_part_run(void *user, const bsim_sweep_part *part, bsim_error 
  * beamsim/sweep_dir.h): *finished 1 when this process has nothing more to
  * do (a shard written, another rank's part sent). */
 static int compare_spread(const bsim_compare_dir_def *def, compare_job *job, const char *inputs,
-                          bsim_session *ss, int lattice, int *finished, bsim_error *err)
+                          bsim_session *ss, size_t size, int *finished, bsim_error *err)
 {
 	long total = (long)job->e->n_groups * job->e->trials;
-	size_t size = bsim_sweep_record_size(1);
 	part_dir_spread sp = {def->spread, &def->part, def->agree, "compare",
 	                      size,        total,      def->argc,  def->argv};
 	int rc;
@@ -334,8 +333,6 @@ static int compare_spread(const bsim_compare_dir_def *def, compare_job *job, con
 		                   ss->journal, err);
 		return rc == BSIM_OK ? part_dir_journal_reopen(ss, inputs, size, err) : rc;
 	}
-	if (lattice) /* not split: the gatherer runs it all */
-		return def->agree ? def->agree(def->part.user, inputs, NULL, 0, err) : BSIM_OK;
 	job->journal = ss ? ss->journal : NULL;
 	rc = part_dir_spread_run(&sp, inputs, ss, compare_part_run, job, err);
 	if (rc != BSIM_OK || def->spread != BSIM_SPREAD_GATHER) {
@@ -383,27 +380,25 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 	job.e = &res->e;
 	record_fill(&job);
 	char *inputs = bsim_run_record_inputs(&job.rec, &res->e, job.sets, job.n_sets, err);
-	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread, lattice = 0;
+	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread;
 	rc = inputs ? BSIM_OK : err->code;
-	if (rc == BSIM_OK && (spread != BSIM_SPREAD_NONE || def->n_merge > 0)) {
-		bsim_scene scene;
-		rc = bsim_experiment_group_scene(&res->e, 0, job.sets, job.n_sets, &scene, err);
-		if (rc == BSIM_OK) {
-			lattice = scene.has_lattice;
-			bsim_scene_free(&scene);
-		}
+	/* A lattice's records hold both sides' gate paths and peaks too. */
+	size_t size = bsim_sweep_record_size(1);
+	if (rc == BSIM_OK) {
+		bsim_sweep_config cfg = {
+		        .extra = job.sets,
+		        .n_extra = job.n_sets,
+		        .extra_b = def->protocol[0] ? &job.protocol_b : NULL,
+		        .n_extra_b = def->protocol[0] != NULL,
+		};
+		rc = bsim_sweep_record_size_paired_for(&res->e, &cfg, &size, err);
 	}
-	if (rc == BSIM_OK && lattice && (spread == BSIM_SPREAD_SHARD || def->n_merge > 0))
-		rc = bsim_error_set(err, BSIM_EINPUT,
-		                    "%s: a lattice comparison is not split into parts (its gate "
-		                    "paths are not journaled): run it in one process",
-		                    def->experiment);
 	if (rc == BSIM_OK && def->n_merge > 0 && def->resume)
 		rc = bsim_error_set(err, BSIM_EINPUT, "merge: --resume does not apply");
 	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
 	int finished = 0;
 	if (rc == BSIM_OK && spread == BSIM_SPREAD_SEND) {
-		rc = compare_spread(def, &job, inputs, NULL, lattice, &finished, err);
+		rc = compare_spread(def, &job, inputs, NULL, size, &finished, err);
 		free(inputs);
 		free(sets);
 		if (rc != BSIM_OK)
@@ -412,11 +407,10 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 	}
 	bsim_session ss;
 	if (rc == BSIM_OK)
-		rc = bsim_session_open(&ss, def->out, def->resume, inputs,
-		                       bsim_sweep_record_size(1), err);
+		rc = bsim_session_open(&ss, def->out, def->resume, inputs, size, err);
 	if (rc == BSIM_OK) {
 		if (spread != BSIM_SPREAD_NONE || def->n_merge > 0)
-			rc = compare_spread(def, &job, inputs, &ss, lattice, &finished, err);
+			rc = compare_spread(def, &job, inputs, &ss, size, &finished, err);
 		if (spread == BSIM_SPREAD_GATHER)
 			job.started = t0;
 		job.out = ss.stage;

@@ -166,8 +166,8 @@ typedef struct run_dir {
 	bsim_atomic_file traj, ledger;
 } run_dir;
 
-static int run_dir_open(run_dir *o, const char *dir, int n_beams, bsim_recorder *rec,
-                        bsim_error *err)
+static int run_dir_open(run_dir *o, const char *dir, int n_beams, int body_columns,
+                        bsim_recorder *rec, bsim_error *err)
 {
 	memset(o, 0, sizeof *o);
 	if (strlen(dir) >= sizeof o->dir - 32)
@@ -183,7 +183,7 @@ static int run_dir_open(run_dir *o, const char *dir, int n_beams, bsim_recorder 
 		bsim_atomic_file_abort(&o->traj);
 		return BSIM_EFAIL;
 	}
-	bsim_trial_trajectory_header(o->traj.f, n_beams);
+	bsim_trial_trajectory_header_body(o->traj.f, n_beams, body_columns);
 	bsim_trial_ledger_header(o->ledger.f);
 	rec->csv = o->traj.f;
 	rec->ledger = o->ledger.f;
@@ -277,7 +277,8 @@ int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, con
 		if (trajectory_parent(trajectory, err) != BSIM_OK ||
 		    bsim_atomic_file_open(&traj, trajectory, err) != BSIM_OK)
 			return BSIM_EFAIL;
-		bsim_trial_trajectory_header(traj.f, scene->n_beams);
+		bsim_trial_trajectory_header_body(traj.f, scene->n_beams,
+		                                  bsim_trial_body_columns(scene));
 		rec.csv = traj.f;
 	}
 	/* DIR is checked before the trial runs and its files appear together. */
@@ -288,7 +289,8 @@ int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, con
 			bsim_atomic_file_abort(&traj);
 			return rc;
 		}
-		if (run_dir_open(&dir, ss.stage, scene->n_beams, &rec, err)) {
+		if (run_dir_open(&dir, ss.stage, scene->n_beams, bsim_trial_body_columns(scene),
+		                 &rec, err)) {
 			bsim_atomic_file_abort(&traj);
 			return bsim_session_close(&ss, BSIM_EFAIL, "run", NULL, err);
 		}

@@ -149,11 +149,24 @@ void video_teardown(bsim_video *v)
 	free(v);
 }
 
+int video_scene_check(const bsim_scene *scene, bsim_error *err)
+{
+	if (scene->body.shape == BSIM_SHAPE_DISK)
+		return BSIM_OK;
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "%s: body.shape: expected disk (the video draws the body as a disk), "
+	                      "got %s",
+	                      scene->path[0] ? scene->path : scene->name,
+	                      scene->body.shape == BSIM_SHAPE_CAPSULE ? "capsule" : "ellipse");
+}
+
 int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
                      const bsim_video_track *const *tracks, const char *const *labels, int n_panels,
                      bsim_video **out, bsim_error *err)
 {
 	*out = NULL;
+	if (video_scene_check(scene, err) != BSIM_OK)
+		return BSIM_EINPUT;
 	bsim_video *v = calloc(1, sizeof *v);
 	if (!v)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");

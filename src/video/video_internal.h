@@ -188,4 +188,8 @@ int video_render_frame(bsim_video *v, long k, bsim_error *err);
 /* The stiffness colour scale, 0x00RRGGBB: u in [0, 1], 0 the softest. */
 uint32_t video_colormap(double u);
 
+/* BSIM_OK for a scene the video can draw (a disk), else BSIM_EINPUT with
+ * err naming body.shape (video.c). */
+int video_scene_check(const bsim_scene *scene, bsim_error *err);
+
 #endif

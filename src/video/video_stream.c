@@ -415,6 +415,8 @@ int bsim_video_stream_alloc(const bsim_video_def *def, const bsim_scene *scene,
 {
 	*out = NULL;
 	int rc = bsim_video_def_check(def, err);
+	if (rc == BSIM_OK)
+		rc = video_scene_check(scene, err);
 	if (rc != BSIM_OK)
 		return rc;
 	if (n_panels < 1 || n_panels > BSIM_VIDEO_PANELS_MAX)

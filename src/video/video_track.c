@@ -126,6 +126,9 @@ void video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const b
 	f->x[0] = s->x[0];
 	f->x[1] = s->x[1];
 	f->e_kin = 0.5 * sc->body.mass * (s->v[0] * s->v[0] + s->v[1] * s->v[1]);
+	if (sc->body.rotates)
+		f->e_kin += 0.5 * bsim_body_inertia(&sc->body) * s->angular_velocity *
+		            s->angular_velocity;
 	f->e_spring = 0.0;
 	for (int i = 0; i < sc->n_beams; i++) {
 		const bsim_beam_def *b = &sc->beams[i];
@@ -135,8 +138,8 @@ void video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const b
 		ct[i] = (unsigned char)s->contact[i];
 	}
 	f->e_prop = bsim_landscape_e_prop(sc, s->x[1]);
-	double force[2];
-	bsim_effects_force_at(fx, step, sc->dt, s->v, force);
+	double force[BSIM_WRENCH];
+	bsim_effects_force_at(fx, step, sc->dt, s, force);
 	f->f_rand = fx->random ? fx->random->last : 0.0;
 }
 

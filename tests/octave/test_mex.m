@@ -143,6 +143,34 @@ end
 printf('run: %s, %d steps, %d trajectory rows: the program''s numbers\n', r.outcome, r.steps, ...
        numel(r.trajectory.t));
 
+% A capsule that turns (Box2D): the trajectory ends with heading and
+% angular_velocity, in the MEX function as in the program's file.
+capsule = fullfile(tmp, 'capsule.yaml');
+text = strrep(fileread(gate), 'body:      { mass: 1.0, radius: 10.0,', ...
+              'body:      { mass: 1.0, radius: 6.0, shape: capsule, length: 10,');
+check(~isempty(strfind(text, 'capsule')), 'the capsule scene');
+fid = fopen(capsule, 'w');
+fputs(fid, text);
+fclose(fid);
+capdir = fullfile(tmp, 'run_capsule');
+[out, err, status] = program(exe, tmp, sprintf('run %s --backend box2d --out %s', capsule, ...
+                                               capdir));
+check(status == 0, 'beamsim run capsule: exit %d: %s', status, err);
+rc = beamsim_run(capsule, 'backend', 'box2d', 'trajectory', true);
+[names, cols] = csv_columns(fullfile(capdir, 'trajectory.csv'));
+check(isequal(fieldnames(rc.trajectory)', names) && strcmp(names{end}, 'angular_velocity'), ...
+      'capsule trajectory: columns %s, the file %s', strjoin(fieldnames(rc.trajectory)', ','), ...
+      strjoin(names, ','));
+for j = 1:numel(names)
+  fmt = '%.10g';
+  if strcmp(names{j}, 't')
+    fmt = '%.6f';
+  elseif strncmp(names{j}, 'contact', 7)
+    fmt = '%d';
+  end
+  check_column('capsule trajectory', names{j}, rc.trajectory.(names{j}), cols{j}, fmt);
+end
+
 % ---- a trial of an experiment's group, with --set, on Box2D ------------
 [out, err, status] = program(exe, tmp, sprintf(['run %s --group 10 --trial 3 --backend box2d ' ...
                                                 '--set body.mass=1.5 --json'], h2));

@@ -41,12 +41,13 @@ def test_overrides_and_backend_options(gate):
     assert beamsim.run(gate, seed=2, backend="box2d")["ledger"] != r["ledger"]
 
 
-def test_trajectory_columns_are_trajectory_csv(gate, tmp_path):
+def check_trajectory_csv(scene, tmp_path, *backend):
     """The arrays written as the CLI writes trajectory.csv (t as %.6f, the
     contact flags as integers, the rest as %.10g) are its bytes."""
     out = tmp_path / "traj.csv"
-    cli("run", gate, "--seed", 5, "--trajectory", out, "--stride", 7)
-    r = beamsim.run(gate, seed=5, trajectory=True, stride=7)
+    cli("run", scene, "--seed", 5, "--trajectory", out, "--stride", 7, *backend)
+    kw = {"backend": backend[1]} if backend else {}
+    r = beamsim.run(scene, seed=5, trajectory=True, stride=7, **kw)
     tr = r["trajectory"]
     lines = out.read_text().splitlines()
     header = lines[0].split(",")
@@ -66,6 +67,25 @@ def test_trajectory_columns_are_trajectory_csv(gate, tmp_path):
     # Rows at t = 0, after every stride-th step and after the last one.
     n = r["steps_run"]
     assert len(tr["t"]) == n // 7 + 1 + (n % 7 != 0)
+    return header
+
+
+def test_trajectory_columns_are_trajectory_csv(gate, tmp_path):
+    header = check_trajectory_csv(gate, tmp_path)
+    assert header[-1] == "e_prop"
+
+
+def test_turning_body_has_its_columns(tmp_path):
+    """A capsule that turns (Box2D): the trajectory ends with heading and
+    angular_velocity, in the module as in the CSV."""
+    scene = tmp_path / "capsule.yaml"
+    text = open(config("thesis", "gate.yaml")).read()
+    text = text.replace("body:      { mass: 1.0, radius: 10.0,",
+                        "body:      { mass: 1.0, radius: 6.0, shape: capsule, length: 10,")
+    assert "capsule" in text
+    scene.write_text(text)
+    header = check_trajectory_csv(scene, tmp_path, "--backend", "box2d")
+    assert header[-2:] == ["heading", "angular_velocity"]
 
 
 def test_no_trajectory_unless_asked(gate):
