@@ -9,7 +9,23 @@
  *
  * Every expression is written so that mirroring the scene in x (x -> -x,
  * sgn -> -sgn) mirrors each intermediate value bit for bit (MODEL.md
- * oracle 4): products and sums keep the same operands in the same order. */
+ * oracle 4): products and sums keep the same operands in the same order.
+ *
+ * A body of another shape (extended path, thesis.h's head) meets the beam
+ * through its outline (model/body_shape.h): the outline's point K nearest
+ * the segment, the segment's point Q nearest the outline, the normal n from
+ * Q toward the body, gap = |K - Q| signed (< 0: overlap). Then
+ *   a = Q - P,  c = sgn (a x n),  ct = sgn (a . n),
+ *   r_b = K - C,  cb = r_b x n,  cbt = r_b . n,
+ * tip when Q is an end of the segment, tangent otherwise. The geometry
+ * keeps dist = gap + reach (w->radius is the shape's reach), so that every
+ * bound below, written for a disk of radius `reach`, holds: the outline
+ * lies within the reach of the centre. A turn of the body by dpsi moves no
+ * point of its outline farther than reach |dpsi|, which the bound on the
+ * distance adds. That geometry, and a capsule's second contact when it
+ * lies along the beam, is shape_contact.c's. The disk keeps its own code
+ * (the bits of the essay's runs); on the extended path it has r_b = -R n:
+ * cb = 0, cbt = -R. */
 #include <math.h>
 
 #include "thesis/thesis.h"
@@ -72,6 +88,8 @@ static void geometry_compute(thesis_beam *b, const double x[2])
 		g->type = BSIM_CONTACT_TIP;
 	}
 	g->c = b->sgn * (a[0] * g->n[1] - a[1] * g->n[0]);
+	g->a[0] = a[0];
+	g->a[1] = a[1];
 }
 
 /* 1 if the body certainly lies farther than R + margin from the beam,
@@ -81,12 +99,15 @@ static void geometry_compute(thesis_beam *b, const double x[2])
  *   dist >= dist_g - |x - x_g| - L |theta - theta_g|.
  * A cushion of 1e-9 of the lengths involved covers the round-off of both
  * distances, so the bound never rejects what the exact test would keep. */
-static int geometry_far(const thesis_beam *b, const double x[2], double radius, double margin)
+static int geometry_far(const struct bsim_world *w, const thesis_beam *b, const double x[2],
+                        double radius, double margin)
 {
 	const thesis_geometry *g = &b->geo;
 	double ex = x[0] - g->x[0], ey = x[1] - g->x[1];
 	double cushion = 1e-9 * (g->dist + b->length + radius + margin);
 	double slack = g->dist - b->length * fabs(b->theta - g->theta) - radius - margin - cushion;
+	if (w->shaped)
+		slack -= radius * fabs(w->heading - g->psi);
 	return slack > 0.0 && ex * ex + ey * ey < slack * slack; /* false for NaN */
 }
 
@@ -100,11 +121,18 @@ int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_con
 	const thesis_geometry *g = &b->geo;
 	/* The same configuration gives the same bits: a step's detection
 	 * meets the geometry the last step's projection computed. */
-	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta)) {
-		if (geometry_far(b, w->x, w->radius, margin))
+	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta &&
+	      (!w->shaped || g->psi == w->heading))) {
+		if (geometry_far(w, b, w->x, w->radius, margin))
 			return 0;
 		thesis_beam_touch(w, i);
-		geometry_compute(b, w->x);
+		if (w->shaped) {
+			double u[2];
+			thesis_beam_direction(b, u);
+			thesis_shape_geometry(w, b, u);
+		} else {
+			geometry_compute(b, w->x);
+		}
 	}
 	if (g->type == BSIM_CONTACT_NONE)
 		return 0;
@@ -118,6 +146,22 @@ int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_con
 	out->c = g->c;
 	out->e = g->type == BSIM_CONTACT_TIP ? w->e_tip : w->e_tangent;
 	out->impulse = 0.0;
+	out->two = 0;
+	if (w->extended) {
+		out->mu = w->friction;
+		out->impulse_t = 0.0;
+		if (w->shaped) {
+			out->cb = g->cb;
+			out->cbt = g->cbt;
+			out->ct = g->ct;
+		} else {
+			out->cb = 0.0;
+			out->cbt = -w->radius;
+			out->ct = b->sgn * (g->a[0] * g->n[0] + g->a[1] * g->n[1]);
+		}
+	}
+	if (w->shaped && g->has2)
+		return 1 + thesis_shape_second(w, g, margin, out);
 	return 1;
 }
 
@@ -128,5 +172,5 @@ int thesis_contact_near(const struct bsim_world *w, int i, double margin)
 	double reach = b->length + w->radius + margin;
 	if (dx * dx + dy * dy > reach * reach)
 		return 0;
-	return !geometry_far(b, w->x, w->radius, margin);
+	return !geometry_far(w, b, w->x, w->radius, margin);
 }

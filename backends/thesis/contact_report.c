@@ -19,8 +19,24 @@
  * A step in free flight (thesis_broad_phase_clear, whose margin includes
  * BSIM_CONTACT_TOL) ends more than 6 mm from every beam and pushes none, so
  * it only clears the last step's flags (thesis_contact_clear). */
+#include "model/body_shape.h"
 #include "model/contact_flag.h"
 #include "thesis/thesis.h"
+
+/* A body of another shape: the same rule with the outline's gap
+ * (model/body_shape.h), TIP where the segment's nearest point is its end. A
+ * beam through the body's centre line is in contact. */
+static int shape_flag(const struct bsim_world *w, const thesis_beam *b, const double u[2],
+                      int pushed)
+{
+	double tip[2] = {b->p[0] + b->length * u[0], b->p[1] + b->length * u[1]};
+	body_segment_contact c;
+	if (body_shape_segment(&w->body, w->x, w->heading, b->p, tip, &c) != BSIM_OK)
+		return BSIM_CONTACT_TANGENT;
+	if (!pushed && !(c.dist < BSIM_CONTACT_TOL))
+		return BSIM_CONTACT_NONE;
+	return c.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
+}
 
 static void report_beam(struct bsim_world *w, int i)
 {
@@ -30,10 +46,14 @@ static void report_beam(struct bsim_world *w, int i)
 	    (!pushed && !thesis_contact_near(w, i, BSIM_CONTACT_TOL)))
 		return;
 	double u[2];
-	int type;
+	int type, flag;
 	thesis_beam_direction(b, u);
-	double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
-	int flag = bsim_contact_flag(dist2, w->radius, type, pushed);
+	if (w->shaped) {
+		flag = shape_flag(w, b, u, pushed);
+	} else {
+		double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
+		flag = bsim_contact_flag(dist2, w->radius, type, pushed);
+	}
 	if (flag == BSIM_CONTACT_NONE)
 		return;
 	w->flag[i] = flag;

@@ -22,7 +22,27 @@
  * body's M belongs (MODEL.md section 2). Such an impact conserves
  * m_i r v + I omega, not the angular momentum of body and beam, and in
  * general not energy either: the kinetic energy (with M) it removes, or
- * adds, is what energy.impact records (negative where it adds). */
+ * adds, is what energy.impact records (negative where it adds).
+ *
+ * Extended path (a body that turns or is not a disk, or friction; thesis.h's
+ * head): v_rel = v . n + w cb - omega c, and the effective mass has the
+ * body's rotation too,
+ *   1/m_eff = 1/M + cb^2 / J + c^2 / I,
+ * and with friction each contact's tangential impulse P_t with |P_t| <=
+ * mu P_n brings the tangential relative velocity v_t to 0 (stick) or acts
+ * at the cone's edge against it (slide): friction_solve.c, the bound on
+ * the normal velocity as above, none on the tangential one (no tangential
+ * restitution). Impulses in the kinetic energy: with u the contact
+ * velocities before, E' - E = P . u + P . K P / 2. Without friction that is
+ * sum P_n v_n (1 - e) / 2 <= 0. With friction and e > 0, Newton's
+ * restitution can make E' > E where the normal and tangential rows are
+ * coupled (K_nt != 0: Kane's paradox). The plastic impulse P_0 (every e =
+ * 0) never gains energy (P . u' <= 0 by complementarity and the cone, so
+ * E' - E <= -P . K P / 2); then P = P_0 + s (P_e - P_0) with the largest s
+ * in [0, 1] for which E' <= E is taken, a root of a quadratic in s. Both
+ * ends lie in the cone and separate (u_n' >= 0), so P does too. The
+ * impacts so scaled are counted in w->impacts_scaled. The loss, friction's
+ * included, is energy.impact. */
 #include <math.h>
 #include <stddef.h>
 
@@ -34,18 +54,124 @@ static void impact_bounds(const struct bsim_world *w, thesis_contact *c)
 	c->bound = c->vrel < -w->rest_threshold ? -c->e * c->vrel : 0.0;
 }
 
+/* Contacts whose friction impact's energy is checked (a body meets 4 at
+ * most in a lattice). */
+#define IMPACT_CONTACTS_MAX 16
+
 static void impact_apply(struct bsim_world *w, const thesis_contact *cs, int n)
 {
-	double j[2];
-	thesis_impulse_sum(cs, n, j);
+	double j[2], jw = 0.0;
+	if (w->extended)
+		thesis_impulse_sum_extended(cs, n, j, &jw);
+	else
+		thesis_impulse_sum(cs, n, j);
 	w->v[0] += j[0] * w->impact_inv_mass;
 	w->v[1] += j[1] * w->impact_inv_mass;
+	if (w->rotates)
+		w->angular_velocity += jw * w->inv_body_inertia;
 	for (int i = 0; i < n; i++) {
 		thesis_beam *b = &w->beams[cs[i].beam];
-		b->omega -= cs[i].impulse * cs[i].c / b->inertia;
+		if (w->extended && cs[i].impulse_t != 0.0)
+			b->omega -=
+			        (cs[i].impulse * cs[i].c + cs[i].impulse_t * cs[i].ct) / b->inertia;
+		else
+			b->omega -= cs[i].impulse * cs[i].c / b->inertia;
 		if (cs[i].impulse > 0.0)
 			thesis_beam_pushed(w, cs[i].beam);
 	}
+}
+
+/* The kinetic energy's change for impulses p (2 per contact: normal,
+ * tangent) from contact velocities u (q without the bounds), J:
+ * P . u + P . K P / 2, K from the rows as friction_solve.c builds it. */
+static double impact_energy_change(const struct bsim_world *w, const thesis_contact *cs, int n,
+                                   const double *pn, const double *pt)
+{
+	double jv[2] = {0.0, 0.0}, jw = 0.0, e = 0.0;
+	for (int i = 0; i < n; i++) {
+		e += pn[i] * cs[i].vrel + pt[i] * cs[i].vrel_t;
+		jv[0] += pn[i] * cs[i].n[0] - pt[i] * cs[i].n[1];
+		jv[1] += pn[i] * cs[i].n[1] + pt[i] * cs[i].n[0];
+		jw += pn[i] * cs[i].cb + pt[i] * cs[i].cbt;
+		double jb = pn[i] * cs[i].c + pt[i] * cs[i].ct;
+		e += 0.5 * jb * jb * cs[i].inv_i;
+		/* a capsule's two contacts turn one beam: (jb_i + jb_j)^2 / 2I */
+		for (int k = i + 1; k < n; k++)
+			if (cs[i].two && cs[k].two && cs[i].beam == cs[k].beam)
+				e += jb * (pn[k] * cs[k].c + pt[k] * cs[k].ct) * cs[i].inv_i;
+	}
+	e += 0.5 * (jv[0] * jv[0] + jv[1] * jv[1]) * w->impact_inv_mass +
+	     0.5 * jw * jw * w->inv_body_inertia;
+	return e;
+}
+
+/* The extended path's solve with friction: Newton's restitution, scaled
+ * toward the plastic impulse where it would gain energy (this file's head).
+ * 1 if a solve was not exact. */
+static int impact_solve_friction(struct bsim_world *w, thesis_contact *cs, int n)
+{
+	double inv_j = w->inv_body_inertia;
+	int inexact = thesis_contact_solve(w->impact_inv_mass, inv_j, cs, n);
+	double pn[IMPACT_CONTACTS_MAX], pt[IMPACT_CONTACTS_MAX];
+	if (n > IMPACT_CONTACTS_MAX)
+		return inexact;
+	for (int i = 0; i < n; i++)
+		pn[i] = cs[i].impulse, pt[i] = cs[i].impulse_t;
+	double de = impact_energy_change(w, cs, n, pn, pt);
+	double ke = thesis_kinetic_energy(w);
+	if (!(de > 1e-12 * ke))
+		return inexact;
+	double bound[IMPACT_CONTACTS_MAX];
+	for (int i = 0; i < n; i++) {
+		bound[i] = cs[i].bound;
+		cs[i].bound = 0.0;
+	}
+	inexact |= thesis_contact_solve(w->impact_inv_mass, inv_j, cs, n);
+	double p0n[IMPACT_CONTACTS_MAX], p0t[IMPACT_CONTACTS_MAX], dn[IMPACT_CONTACTS_MAX],
+	        dt[IMPACT_CONTACTS_MAX];
+	for (int i = 0; i < n; i++) {
+		cs[i].bound = bound[i];
+		p0n[i] = cs[i].impulse, p0t[i] = cs[i].impulse_t;
+		dn[i] = pn[i] - p0n[i], dt[i] = pt[i] - p0t[i];
+	}
+	/* E(s) - E = qa s^2 + qb s + c0 along P_0 + s D: <= 0 at s = 0 (the
+	 * plastic impulse) and > 0 at s = 1 (Newton's); the root between. */
+	double c0 = impact_energy_change(w, cs, n, p0n, p0t);
+	double e1 = impact_energy_change(w, cs, n, dn, dt);       /* D . u + D K D / 2 */
+	double e_newton = impact_energy_change(w, cs, n, pn, pt); /* P_0 + D */
+	/* With f(P) = P . u + P K P / 2: f(P_0 + s D) = c0 + s (D . u + D K P_0)
+	 * + s^2 D K D / 2; from the three values f(P_0) = c0, f(D) = e1 and
+	 * f(P_0 + D) = e_newton: D K D / 2 = e1 - D . u, and the linear term
+	 * is e_newton - c0 - D K D / 2. */
+	double du = 0.0;
+	for (int i = 0; i < n; i++)
+		du += dn[i] * cs[i].vrel + dt[i] * cs[i].vrel_t;
+	double qa = e1 - du, qb = e_newton - c0 - qa;
+	double s = 0.0;
+	if (qa > 0.0) {
+		double disc = qb * qb - 4.0 * qa * c0;
+		s = (-qb + sqrt(fmax(disc, 0.0))) / (2.0 * qa);
+	} else if (qb > 0.0) {
+		s = -c0 / qb;
+	}
+	s = fmin(fmax(s, 0.0), 1.0);
+	for (int i = 0; i < n; i++) {
+		cs[i].impulse = p0n[i] + s * dn[i];
+		cs[i].impulse_t = p0t[i] + s * dt[i];
+	}
+	w->impacts_scaled++;
+	return inexact;
+}
+
+/* The impulses of contacts cs (their bounds set) into cs; 1 if the solve
+ * was not exact. */
+static int impact_solve(struct bsim_world *w, thesis_contact *cs, int n)
+{
+	if (!w->extended)
+		return thesis_lcp_solve(w->impact_inv_mass, cs, n);
+	if (w->friction > 0.0)
+		return impact_solve_friction(w, cs, n);
+	return thesis_contact_solve(w->impact_inv_mass, w->inv_body_inertia, cs, n);
 }
 
 /* Passes of the nearest-first order at most, and the approach speed, m/s,
@@ -74,7 +200,7 @@ static void impact_nearest_first(struct bsim_world *w, thesis_contact *cs, int n
 			return;
 		}
 		impact_bounds(w, next);
-		thesis_lcp_solve(w->impact_inv_mass, next, 1);
+		impact_solve(w, next, 1);
 		impact_apply(w, next, 1);
 		if (next->impulse > 0.0 && next->vrel < -w->rest_threshold)
 			w->impacts++;
@@ -87,14 +213,20 @@ int thesis_impact_resolve(struct bsim_world *w, double h)
 	thesis_contact *cs = w->contacts;
 	int n = 0, approaching = 0;
 	for (int i = 0; i < w->n_contacts; i++) {
-		thesis_contact c = cs[i];
-		thesis_contact_velocity(w, &c);
-		if (c.gap + h * bsim_fmin(c.vrel, 0.0) > w->slop)
+		/* In place: a contact left behind has its velocity and 1/I set
+		 * again by the contact solve. Swapped only when out of place. */
+		thesis_contact *c = &cs[i];
+		thesis_contact_velocity(w, c);
+		if (c->gap + h * bsim_fmin(c->vrel, 0.0) > w->slop)
 			continue;
-		c.inv_i = w->beams[c.beam].inv_inertia;
-		approaching |= c.vrel < 0.0;
-		cs[i] = cs[n];
-		cs[n++] = c;
+		c->inv_i = w->beams[c->beam].inv_inertia;
+		approaching |= c->vrel < 0.0;
+		if (i != n) {
+			thesis_contact t = cs[n];
+			cs[n] = *c;
+			*c = t;
+		}
+		n++;
 	}
 	if (!approaching)
 		return 0;
@@ -105,7 +237,7 @@ int thesis_impact_resolve(struct bsim_world *w, double h)
 	} else {
 		for (int i = 0; i < n; i++)
 			impact_bounds(w, &cs[i]);
-		w->solver.iteration_limit += thesis_lcp_solve(w->impact_inv_mass, cs, n);
+		w->solver.iteration_limit += impact_solve(w, cs, n);
 		impact_apply(w, cs, n);
 		for (int i = 0; i < n; i++)
 			w->impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->rest_threshold;

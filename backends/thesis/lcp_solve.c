@@ -3,7 +3,8 @@
  *
  * Unknown impulses P_i >= 0 on contacts i. The solved normal velocity is
  *   w_i = q_i + sum_j K_ij P_j >= 0,   P_i w_i = 0,
- *   q_i = vrel_i - bound_i,   K_ij = (n_i . n_j) / M + [i = j] c_i^2 inv_i,
+ *   q_i = vrel_i - bound_i,   K_ij = (n_i . n_j) / M + [same beam] c_i c_j inv_i,
+ * (contacts on one beam: i = j, or a capsule's two, thesis_contact.two)
  * with 1/M from the caller (impacts pass 1/impact_mass, impact_resolve.c).
  * K = J M^-1 J^T is symmetric positive definite (1/M > 0 and the normals of
  * two contacts are not parallel), so the solution is unique.
@@ -37,19 +38,27 @@
 /* Projected Gauss-Seidel's sweeps at most. */
 #define LCP_ITERATIONS_MAX 100000
 
-static double k_entry(double inv_mass, const thesis_contact *a, const thesis_contact *b)
+/* inv_j: the body's 1/J on the extended path (thesis.h), whose rotation
+ * adds cb_i cb_j / J to K; 0 (the essay's body, which does not turn) adds
+ * nothing, not even a rounding. */
+static double k_entry(double inv_mass, double inv_j, const thesis_contact *a,
+                      const thesis_contact *b)
 {
 	double k = (a->n[0] * b->n[0] + a->n[1] * b->n[1]) * inv_mass;
 	if (a == b)
 		k += a->c * a->c * a->inv_i;
+	else if (a->two && b->two && a->beam == b->beam) /* a capsule's two on one beam */
+		k += a->c * b->c * a->inv_i;
+	if (inv_j != 0.0)
+		k += a->cb * b->cb * inv_j;
 	return k;
 }
 
-static void lcp_two(double inv_mass, thesis_contact *c0, thesis_contact *c1)
+static inline void lcp_two(double inv_mass, double inv_j, thesis_contact *c0, thesis_contact *c1)
 {
 	double q0 = c0->vrel - c0->bound, q1 = c1->vrel - c1->bound;
-	double k00 = k_entry(inv_mass, c0, c0), k11 = k_entry(inv_mass, c1, c1);
-	double k01 = k_entry(inv_mass, c0, c1);
+	double k00 = k_entry(inv_mass, inv_j, c0, c0), k11 = k_entry(inv_mass, inv_j, c1, c1);
+	double k01 = k_entry(inv_mass, inv_j, c0, c1);
 	c0->impulse = c1->impulse = 0.0;
 	if (q0 >= 0.0 && q1 >= 0.0)
 		return;
@@ -75,7 +84,7 @@ static void lcp_two(double inv_mass, thesis_contact *c0, thesis_contact *c1)
 
 /* Sweeps until no impulse changes by more than 1e-14 N s; 1 if it stopped
  * at its iteration limit instead. */
-static int lcp_gauss_seidel(double inv_mass, thesis_contact *cs, int n)
+static int lcp_gauss_seidel(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	for (int i = 0; i < n; i++)
 		cs[i].impulse = 0.0;
@@ -84,9 +93,9 @@ static int lcp_gauss_seidel(double inv_mass, thesis_contact *cs, int n)
 		for (int i = 0; i < n; i++) {
 			double wi = cs[i].vrel - cs[i].bound;
 			for (int j = 0; j < n; j++)
-				wi += k_entry(inv_mass, &cs[i], &cs[j]) * cs[j].impulse;
-			double p =
-			        fmax(0.0, cs[i].impulse - wi / k_entry(inv_mass, &cs[i], &cs[i]));
+				wi += k_entry(inv_mass, inv_j, &cs[i], &cs[j]) * cs[j].impulse;
+			double p = fmax(0.0, cs[i].impulse -
+			                             wi / k_entry(inv_mass, inv_j, &cs[i], &cs[i]));
 			change = fmax(change, fabs(p - cs[i].impulse));
 			cs[i].impulse = p;
 		}
@@ -105,8 +114,8 @@ static int popcount(unsigned v)
 }
 
 /* Tries active set `mask`: 1 and the impulses in cs if it solves the LCP. */
-static int lcp_try_set(double inv_mass, thesis_contact *cs, int n, unsigned mask, const double *q,
-                       double tol)
+static int lcp_try_set(double inv_mass, double inv_j, thesis_contact *cs, int n, unsigned mask,
+                       const double *q, double tol)
 {
 	double kss[LCP_EXACT_MAX * LCP_EXACT_MAX], p[LCP_EXACT_MAX], rhs[LCP_EXACT_MAX];
 	int idx[LCP_EXACT_MAX], m = 0;
@@ -116,7 +125,7 @@ static int lcp_try_set(double inv_mass, thesis_contact *cs, int n, unsigned mask
 	for (int a = 0; a < m; a++) {
 		rhs[a] = -q[idx[a]];
 		for (int b = 0; b < m; b++)
-			kss[a * m + b] = k_entry(inv_mass, &cs[idx[a]], &cs[idx[b]]);
+			kss[a * m + b] = k_entry(inv_mass, inv_j, &cs[idx[a]], &cs[idx[b]]);
 	}
 	if (m > 0) {
 		/* LU with partial pivoting; a pivot below round-off of the
@@ -147,7 +156,7 @@ static int lcp_try_set(double inv_mass, thesis_contact *cs, int n, unsigned mask
 			continue;
 		double wj = q[j];
 		for (int a = 0; a < m; a++)
-			wj += k_entry(inv_mass, &cs[j], &cs[idx[a]]) * p[a];
+			wj += k_entry(inv_mass, inv_j, &cs[j], &cs[idx[a]]) * p[a];
 		if (wj < -tol)
 			return 0;
 	}
@@ -158,7 +167,7 @@ static int lcp_try_set(double inv_mass, thesis_contact *cs, int n, unsigned mask
 	return 1;
 }
 
-static int lcp_enumerate(double inv_mass, thesis_contact *cs, int n)
+static int lcp_enumerate(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	double q[LCP_EXACT_MAX], qmax = 0.0;
 	for (int i = 0; i < n; i++) {
@@ -169,7 +178,8 @@ static int lcp_enumerate(double inv_mass, thesis_contact *cs, int n)
 	unsigned sets = 1u << n;
 	for (int size = 0; size <= n; size++)
 		for (unsigned mask = 0; mask < sets; mask++)
-			if (popcount(mask) == size && lcp_try_set(inv_mass, cs, n, mask, q, tol))
+			if (popcount(mask) == size &&
+			    lcp_try_set(inv_mass, inv_j, cs, n, mask, q, tol))
 				return 1;
 	return 0;
 }
@@ -184,21 +194,33 @@ long thesis_lcp_fallbacks(void)
 	return n;
 }
 
-int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n)
+/* The solve for both entry points below: inline, so that the essay's
+ * (inv_j = 0) is compiled with the rotation's terms gone. */
+static inline int lcp_solve(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	if (n == 1) {
 		double q = cs[0].vrel - cs[0].bound;
-		cs[0].impulse = q < 0.0 ? -q / k_entry(inv_mass, &cs[0], &cs[0]) : 0.0;
+		cs[0].impulse = q < 0.0 ? -q / k_entry(inv_mass, inv_j, &cs[0], &cs[0]) : 0.0;
 	} else if (n == 2) {
-		lcp_two(inv_mass, &cs[0], &cs[1]);
+		lcp_two(inv_mass, inv_j, &cs[0], &cs[1]);
 	} else if (n > 2) {
-		if (n <= LCP_EXACT_MAX && lcp_enumerate(inv_mass, cs, n))
+		if (n <= LCP_EXACT_MAX && lcp_enumerate(inv_mass, inv_j, cs, n))
 			return 0;
 #pragma omp atomic update
 		lcp_fallbacks++;
-		return lcp_gauss_seidel(inv_mass, cs, n);
+		return lcp_gauss_seidel(inv_mass, inv_j, cs, n);
 	}
 	return 0;
+}
+
+int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n)
+{
+	return lcp_solve(inv_mass, 0.0, cs, n);
+}
+
+int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n)
+{
+	return lcp_solve(inv_mass, inv_j, cs, n);
 }
 
 void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2])

@@ -18,14 +18,119 @@
  * Ledger: with midpoint positions the body's kinetic energy changes by
  * exactly F . dx + sum P_i n_i . v_m, a beam's energy by -h d omega_m^2 -
  * P_i c_i omega_m; the contact forces' work sum P_i (n_i . v_m - c_i
- * omega_m,i) is reported, negated, as energy.contact. */
+ * omega_m,i) is reported, negated, as energy.contact.
+ *
+ * Extended path (thesis.h's head): the body's free angular velocity w* =
+ * w + h T / J under the torque T, v_rel and the bound with w cb in them,
+ * K with cb^2 / J, and with friction the tangent rows: v_t' = 0 while
+ * |P_t| <= mu P_n (stick), else P_t = -+mu P_n against v_t' (slide),
+ * friction_solve.c; then w' = w* + sum (P_n cb + P_t cbt) / J and the
+ * heading moves by h w_m (thesis_body_turn). The body's kinetic energy,
+ * rotation's included, changes by F . dx + T h w_m + sum P . (contact
+ * velocity at the means), so energy.contact is the contact impulses' work
+ *   -sum P_n (n . v_m + cb w_m - c omega_m) + P_t (t . v_m + cbt w_m - ct omega_m),
+ * friction's loss included; the runner credits T h w_m, the torque's work
+ * over the heading's change. */
 #include <math.h>
 
 #include "util/fminmax.h"
 #include "thesis/thesis.h"
 
-void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h)
+/* The extended path (this file's head); the essay's path below keeps its
+ * own loop, which this one's terms would slow. */
+static void persistent_solve_extended(struct bsim_world *w, const double force[2], double torque,
+                                      double h)
 {
+	double v0[2] = {w->v[0], w->v[1]};
+	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
+	thesis_contact *cs = w->contacts;
+	int n = w->n_contacts;
+	double w0 = w->angular_velocity, wf = w0;
+	if (w->rotates)
+		wf = w0 + h * torque * w->inv_body_inertia;
+
+	for (int k = 0; k < n; k++) {
+		thesis_contact *c = &cs[k];
+		const thesis_beam *b = &w->beams[c->beam];
+		double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
+		c->omega_free = thesis_beam_free_omega(b, h, w->integrator);
+		double gap = bsim_fmax(c->gap, 0.0);
+		c->inv_i = thesis_beam_response(b, h, w->integrator);
+		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
+		vrel0 += w0 * c->cb;
+		c->vrel += wf * c->cb;
+		c->vrel_t =
+		        (vf[1] * c->n[0] - vf[0] * c->n[1]) + wf * c->cbt - c->omega_free * c->ct;
+		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
+	}
+	/* No contact (free flight): no solve, and the impulse sum of none is
+	 * 0 (thesis_impulse_sum's start), added as it would be. */
+	double j[2] = {0.0, 0.0}, jw = 0.0;
+	if (n) {
+		w->solver.iteration_limit +=
+		        thesis_contact_solve(w->inv_mass, w->inv_body_inertia, cs, n);
+		thesis_impulse_sum_extended(cs, n, j, &jw);
+	}
+	double vm[2];
+	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_turn(w, w0, torque, jw, h);
+	double wm = w->integrator == THESIS_EULER ? w->angular_velocity
+	                                          : 0.5 * (w0 + w->angular_velocity);
+
+	/* Beams in contact take their impulse; all others move freely. A beam
+	 * at rest and untouched stays at rest and costs nothing: only the awake
+	 * ones (every contact's beam among them) are visited, in ascending
+	 * order, so the ledger's sums are those over all beams. */
+	for (int k = 0; k < n; k++) {
+		w->contact_of[cs[k].beam] = k;
+		if (cs[k].impulse > 0.0)
+			thesis_beam_pushed(w, cs[k].beam);
+	}
+	for (int a = 0; a < w->n_awake; a++) {
+		int i = w->awake[a];
+		thesis_beam *b = &w->beams[i];
+		int k = w->contact_of[i];
+		w->contact_of[i] = -1;
+		if (k < 0 && b->theta == 0.0 && b->omega == 0.0)
+			continue;
+		double omega_new;
+		if (k < 0) {
+			omega_new = thesis_beam_free_omega(b, h, w->integrator);
+		} else {
+			/* The beam's contacts: one, or a capsule's two. */
+			double moment = 0.0;
+			for (int q = 0; q < n; q++)
+				if (cs[q].beam == i)
+					moment += cs[q].impulse * cs[q].c +
+					          cs[q].impulse_t * cs[q].ct;
+			omega_new = cs[k].omega_free - moment * cs[k].inv_i;
+			double omega_m = w->integrator == THESIS_EULER
+			                         ? omega_new
+			                         : 0.5 * (b->omega + omega_new);
+			for (int q = 0; q < n; q++) {
+				const thesis_contact *c = &cs[q];
+				if (c->beam != i)
+					continue;
+				w->energy.contact -=
+				        c->impulse *
+				        ((c->n[0] * vm[0] + c->n[1] * vm[1]) - c->c * omega_m);
+				w->energy.contact -=
+				        c->impulse * (c->cb * wm) +
+				        c->impulse_t * ((vm[1] * c->n[0] - vm[0] * c->n[1]) +
+				                        c->cbt * wm - c->ct * omega_m);
+			}
+		}
+		w->energy.damper += thesis_beam_advance(b, omega_new, h, w->integrator);
+	}
+}
+
+void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
+                                     double h)
+{
+	if (w->extended) {
+		persistent_solve_extended(w, force, torque, h);
+		return;
+	}
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
 	thesis_contact *cs = w->contacts;

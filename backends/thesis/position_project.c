@@ -9,17 +9,34 @@
  *   gap_i + sum_j K_ij mu_j >= 0,   dx = sum mu_i n_i / M,   dtheta_i = -mu_i c_i / I_i.
  * Velocities are untouched, so no energy is injected into the motion; the
  * springs' energy change, and the work the runner credits to the external
- * force over the shift dx, are reported as energy.correction. */
+ * force over the shift dx, are reported as energy.correction.
+ *
+ * Extended path (thesis.h's head): the body turns too, dpsi = sum mu_i cb_i
+ * / J, and K has cb_i cb_j / J (frictionless: a projection moves along the
+ * normals only); the torque's work over dpsi joins the correction. */
 #include "thesis/thesis.h"
 
-static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const double force[2])
+static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const double force[2],
+                         double torque)
 {
 	for (int k = 0; k < n; k++) {
 		cs[k].vrel = cs[k].gap;
 		cs[k].bound = 0.0;
 		cs[k].inv_i = w->beams[cs[k].beam].inv_inertia;
 	}
-	w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
+	if (w->extended)
+		w->solver.iteration_limit +=
+		        thesis_lcp_solve_j(w->inv_mass, w->inv_body_inertia, cs, n);
+	else
+		w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
+	if (w->rotates) {
+		double dpsi = 0.0;
+		for (int k = 0; k < n; k++)
+			dpsi += cs[k].impulse * cs[k].cb;
+		dpsi *= w->inv_body_inertia;
+		w->heading += dpsi;
+		w->energy.correction += torque * dpsi;
+	}
 	double dx = 0.0, dy = 0.0, de = 0.0;
 	for (int k = 0; k < n; k++) {
 		thesis_beam *b = &w->beams[cs[k].beam];
@@ -39,15 +56,39 @@ static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const 
 /* Projections per step at most. */
 #define PROJECT_PASSES_MAX 3
 
+/* The contacts of the beams of cs[0..n) detected again into cs, each beam
+ * once (a capsule may have two contacts with one beam, and may have one
+ * where it had two, or two where it had one): the beams are listed first
+ * (in w->candidates, free after the step's detection). */
+static inline int redetect(struct bsim_world *w, thesis_contact *cs, int n, double margin)
+{
+	if (!w->shaped) { /* one contact a beam: in place, in order */
+		int m = 0;
+		for (int k = 0; k < n; k++)
+			m += thesis_contact_detect(w, cs[k].beam, margin, &cs[m]);
+		return m;
+	}
+	int nb = 0;
+	for (int k = 0; k < n; k++) {
+		int seen = 0;
+		for (int q = 0; q < nb && !seen; q++)
+			seen = w->candidates[q] == cs[k].beam;
+		if (!seen)
+			w->candidates[nb++] = cs[k].beam;
+	}
+	int m = 0;
+	for (int q = 0; q < nb; q++)
+		m += thesis_contact_detect(w, w->candidates[q], margin, &cs[m]);
+	return m;
+}
+
 /* Re-detects the step's contacts at the new positions (they are the only
  * beams the step could have reached) and projects out penetration. */
-void thesis_position_project(struct bsim_world *w, const double force[2])
+void thesis_position_project(struct bsim_world *w, const double force[2], double torque)
 {
 	double margin = w->contact_tol;
 	thesis_contact *cs = w->contacts;
-	int n = 0;
-	for (int k = 0; k < w->n_contacts; k++)
-		n += thesis_contact_detect(w, cs[k].beam, margin, &cs[n]);
+	int n = redetect(w, cs, w->n_contacts, margin);
 	for (int pass = 0; w->projection; pass++) {
 		int deep = 0;
 		for (int k = 0; k < n; k++)
@@ -58,11 +99,8 @@ void thesis_position_project(struct bsim_world *w, const double force[2])
 			w->solver.iteration_limit++;
 			break;
 		}
-		project_once(w, cs, n, force);
-		int m = 0;
-		for (int k = 0; k < n; k++)
-			m += thesis_contact_detect(w, cs[k].beam, margin, &cs[m]);
-		n = m;
+		project_once(w, cs, n, force, torque);
+		n = redetect(w, cs, n, margin);
 	}
 	w->n_contacts = n;
 	for (int k = 0; k < n; k++)

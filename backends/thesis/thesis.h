@@ -7,7 +7,23 @@
  * pointing right, like the left beam) and -1 otherwise. For a contact with
  * unit normal n (beam -> body) at lever a = Q - P, the generalised lever is
  * c = sgn (a x n): the body's normal velocity gains P/M per impulse P and
- * the beam's omega loses P c / I, and v_rel = v . n - omega c. */
+ * the beam's omega loses P c / I, and v_rel = v . n - omega c.
+ *
+ * A body that turns (body.rotates) or is not a disk, or a scene with
+ * contact friction, takes the extended path (w->extended). The body has
+ * heading psi and angular velocity w (rad, rad/s, counter-clockwise) and
+ * inertia J; the contact point on its outline is r_b from its centre; the
+ * tangent is t = perp(n) = (-n_y, n_x). Each contact then has two rows, the
+ * normal and the tangent, each a velocity of the body's contact point
+ * relative to the beam's:
+ *   v_n = v . n + w cb  - omega c,    cb  = r_b x n,  c  = sgn (a x n)
+ *   v_t = v . t + w cbt - omega ct,   cbt = r_b x t = r_b . n,
+ *                                     ct  = sgn (a x t) = sgn (a . n)
+ * and impulses P_n along n and P_t along t change
+ *   v += (P_n n + P_t t) / M,  w += (P_n cb + P_t cbt) / J,
+ *   omega -= (P_n c + P_t ct) / I.
+ * A disk has r_b = -R n: cb = 0 and cbt = -R. A body that does not turn
+ * has 1/J = 0 in every solve (w->inv_body_inertia). */
 #ifndef BSIM_THESIS_THESIS_H
 #define BSIM_THESIS_THESIS_H
 
@@ -24,6 +40,14 @@ typedef struct thesis_geometry {
 	double dist;        /* centre to segment, m */
 	double n[2];        /* unit normal from the beam toward the body */
 	double c;           /* generalised lever sgn (a x n), m */
+	double a[2];        /* the beam's lever Q - P, m */
+	/* The extended path's (a shape other than the disk): the heading the
+	 * geometry was computed at, rad, and the levers cb, cbt, ct, m. */
+	double psi, cb, cbt, ct;
+	/* A capsule resting along the beam touches it at both ends of its core:
+	 * the second end's contact (has2), in the same terms. */
+	int has2, type2;
+	double dist2, n2[2], c2, cb2, cbt2, ct2;
 } thesis_geometry;
 
 typedef struct thesis_beam {
@@ -61,6 +85,15 @@ typedef struct thesis_contact {
 	double omega_free; /* the beam's omega at the step's end without contact, rad/s */
 	double bound;      /* lower bound on the solved velocity, m/s */
 	double impulse;    /* N s */
+	/* The extended path's (thesis.h's head): the body's levers cb, cbt and
+	 * the beam's tangent lever ct, m; the tangent row's relative velocity,
+	 * m/s, and impulse, N s; the Coulomb coefficient mu. */
+	double cb, cbt, ct;
+	double vrel_t, impulse_t;
+	double mu;
+	/* 1: one of a capsule's two contacts with its beam (contact_detect.c),
+	 * whose impulses both turn the beam: K couples the pair. */
+	int two;
 } thesis_contact;
 
 /* The broad phase's uniform grid over the pivots (broad_phase.c). */
@@ -78,8 +111,23 @@ enum { THESIS_CONTACT_PHYSICAL = 0, THESIS_CONTACT_ESSAY = 1 };
 
 struct bsim_world {
 	double x[2], v[2]; /* body centre and velocity */
-	double heading;    /* rad, the body's (fixed) heading */
-	double mass, inv_mass, radius;
+	double heading;    /* rad, psi */
+	double mass, inv_mass;
+	/* m: the disk's radius; for another shape its reach (body_shape_reach),
+	 * what every distance bound (broad phase, margins, sleep) needs. */
+	double radius;
+	/* The extended path (thesis.h's head): 1 if the body turns, is not a
+	 * disk, or contacts have friction; the body's shape, whether it turns,
+	 * its angular velocity w (rad/s), its inertia J and 1/J (0 if it does
+	 * not turn: no solve turns it), kg m^2, and the contacts' Coulomb mu. */
+	int extended, shaped, rotates;
+	bsim_body_def body;
+	double angular_velocity;
+	double body_inertia, inv_body_inertia;
+	double friction;
+	/* Friction impacts whose Newton impulse would have gained energy and
+	 * was scaled toward the plastic one (impact_resolve.c), since creation. */
+	long impacts_scaled;
 	/* 1/impact_mass, 1/kg: the body's inverse mass in the impact solve
 	 * only (impact_resolve.c); 1/M unless the knob is given. */
 	double impact_inv_mass;
@@ -105,7 +153,8 @@ struct bsim_world {
 	int *typed;              /* beams whose contact_type is not NONE */
 	int n_typed;
 	/* per step */
-	thesis_contact *contacts; /* n_beams capacity */
+	thesis_contact *contacts; /* 2 n_beams capacity: a capsule has up to two
+	                           * contacts with one beam (contact_detect.c) */
 	int n_contacts;
 	int *contact_of;   /* per beam: its index in contacts, or -1 */
 	int *contact_type; /* per beam, at the end of the step, within contact_tol:
@@ -179,7 +228,15 @@ void thesis_awake_prune(struct bsim_world *w);
 
 /* contact_detect.c */
 void thesis_beam_direction(thesis_beam *b, double u[2]);
+/* The contacts of beam i within margin into out (room for 2); returns how
+ * many (0, 1, or 2 for a capsule along the beam). */
 int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out);
+/* shape_contact.c: a body of another shape than the disk against beam b of
+ * direction u (thesis_beam_direction), into b->geo; and a capsule's second contact with the beam of
+ * geometry g into out[1] (out[0] the first) if within margin: 1, else 0. */
+void thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const double u[2]);
+int thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
+                        thesis_contact *out);
 /* 0 if beam i certainly lies farther than R + margin from the body (its
  * reach, or the bound from its last geometry), 1 if it may not. */
 int thesis_contact_near(const struct bsim_world *w, int i, double margin);
@@ -192,6 +249,16 @@ void thesis_contact_clear(struct bsim_world *w);
  * counts it in w->solver), else 0. inv_mass is the body's 1/M, 1/kg (for
  * impacts, 1/impact_mass). */
 int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n);
+/* thesis_lcp_solve with the body's rotation: 1/J (inv_j) in K. */
+int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n);
+/* The same problem on the extended path: 1/J (the body's rotation, inv_j =
+ * 0: none) in K, and with friction (any contact's mu > 0) the tangent rows
+ * too (friction_solve.c); 1 if the solve was not exact (counted by the
+ * caller in w->solver.iteration_limit). */
+int thesis_contact_solve(double inv_mass, double inv_j, thesis_contact *cs, int n);
+/* The impulses' sum on the body: sum P_n n + P_t t (N s) into j, and their
+ * moment sum P_n cb + P_t cbt (N m s) into *jw. */
+void thesis_impulse_sum_extended(const thesis_contact *cs, int n, double j[2], double *jw);
 /* Solves with more than 2 contacts that fell back to Gauss-Seidel, all
  * worlds, since the program started. */
 long thesis_lcp_fallbacks(void);
@@ -202,10 +269,11 @@ void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2]);
 int thesis_impact_resolve(struct bsim_world *w, double h);
 
 /* persistent_contact.c */
-void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double h);
+void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
+                                     double h);
 
 /* position_project.c */
-void thesis_position_project(struct bsim_world *w, const double force[2]);
+void thesis_position_project(struct bsim_world *w, const double force[2], double torque);
 
 /* The kinetic energy of body and beams, J; inline, so that the world
  * (thesis_world.c) and the impacts (impact_resolve.c) share it without
@@ -219,6 +287,8 @@ static inline double thesis_kinetic_energy(const struct bsim_world *w)
 		const thesis_beam *b = &w->beams[w->awake[k]];
 		e += 0.5 * b->inertia * b->omega * b->omega;
 	}
+	if (w->rotates)
+		e += 0.5 * w->body_inertia * w->angular_velocity * w->angular_velocity;
 	return e;
 }
 
@@ -296,10 +366,31 @@ static inline void thesis_body_advance(struct bsim_world *w, const double v0[2],
 	w->x[1] += h * vm[1];
 }
 
-/* v_rel = v . n - omega c (contact_detect.c). */
+/* The body's turn over a step from angular velocity w0 under torque
+ * (N m) and the contacts' moment sum jw (N m s): J w' = J w0 + h torque +
+ * jw, and the heading moves by the mean angular velocity (midpoint), or by
+ * w' (euler), as the centre does (thesis_body_advance). */
+static inline void thesis_body_turn(struct bsim_world *w, double w0, double torque, double jw,
+                                    double h)
+{
+	if (!w->rotates)
+		return;
+	w->angular_velocity = w0 + (h * torque + jw) * w->inv_body_inertia;
+	double wm = w->integrator == THESIS_EULER ? w->angular_velocity
+	                                          : 0.5 * (w0 + w->angular_velocity);
+	w->heading += h * wm;
+}
+
+/* v_rel = v . n - omega c (contact_detect.c); on the extended path plus
+ * w cb, and the tangent row's v_t. */
 static inline void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c)
 {
 	c->vrel = (w->v[0] * c->n[0] + w->v[1] * c->n[1]) - w->beams[c->beam].omega * c->c;
+	if (w->extended) {
+		c->vrel += w->angular_velocity * c->cb;
+		c->vrel_t = (w->v[1] * c->n[0] - w->v[0] * c->n[1]) + w->angular_velocity * c->cbt -
+		            w->beams[c->beam].omega * c->ct;
+	}
 }
 
 #endif

@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "model/body_shape.h"
 #include "thesis/thesis.h"
 
 static const bsim_knob thesis_knobs[] = {
@@ -110,6 +111,39 @@ static void thesis_destroy(bsim_world *w)
 	free(w);
 }
 
+/* A shape whose outline body_shape_segment cannot give (a far segment has
+ * a normal for every shape it supports) is refused. */
+static int shape_check(const bsim_scene *scene, bsim_error *err)
+{
+	const bsim_body_def *b = &scene->body;
+	if (b->shape == BSIM_SHAPE_DISK)
+		return BSIM_OK;
+	double r = body_shape_reach(b), x[2] = {0.0, 0.0};
+	double p0[2] = {2.0 * r + 1.0, -1.0}, p1[2] = {2.0 * r + 1.0, 1.0};
+	body_segment_contact c;
+	if (!(r > 0.0) || body_shape_segment(b, x, 0.0, p0, p1, &c) != BSIM_OK)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "thesis: %s: body.shape: no contact detection for this "
+		                      "shape (model/body_shape.h gives none)",
+		                      scene->path[0] ? scene->path : scene->name);
+	return BSIM_OK;
+}
+
+/* The body's extended-path fields (thesis.h) from its definition. */
+static void body_setup(bsim_world *w, const bsim_scene *scene)
+{
+	const bsim_body_def *b = &scene->body;
+	w->body = *b;
+	w->shaped = b->shape != BSIM_SHAPE_DISK;
+	w->rotates = b->rotates != 0;
+	w->friction = scene->contact.friction;
+	w->extended = w->shaped || w->rotates || w->friction > 0.0;
+	w->radius = w->shaped ? body_shape_reach(b) : b->radius;
+	w->body_inertia = bsim_body_inertia(b);
+	w->inv_body_inertia = w->rotates ? 1.0 / w->body_inertia : 0.0;
+	w->angular_velocity = w->rotates ? b->angular_velocity : 0.0;
+}
+
 static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
                          bsim_error *err)
 {
@@ -117,17 +151,13 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	int rc = bsim_options_check(opts, thesis_knobs, N_KNOBS, "thesis", err);
 	if (rc)
 		return rc;
-	if (scene->body.shape != BSIM_SHAPE_DISK || scene->body.rotates ||
-	    scene->contact.friction != 0)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "thesis: %s: expected a disk that does not rotate, without "
-		                      "contact.friction (the essay's body)",
-		                      scene->path[0] ? scene->path : scene->name);
+	if ((rc = shape_check(scene, err)) != BSIM_OK)
+		return rc;
 	bsim_world *w = calloc(1, sizeof *w);
 	size_t nb = scene->n_beams > 0 ? (size_t)scene->n_beams : 1;
 	if (w) {
 		w->beams = calloc(nb, sizeof *w->beams);
-		w->contacts = calloc(nb, sizeof *w->contacts);
+		w->contacts = calloc(2 * nb, sizeof *w->contacts);
 		w->contact_of = malloc(nb * sizeof *w->contact_of);
 		w->contact_type = calloc(nb, sizeof *w->contact_type);
 		w->awake = malloc(nb * sizeof *w->awake);
@@ -158,7 +188,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	w->mass = scene->body.mass;
 	w->inv_mass = 1.0 / scene->body.mass;
 	w->impact_inv_mass = w->inv_mass;
-	w->radius = scene->body.radius;
+	body_setup(w, scene);
 	w->n_beams = scene->n_beams;
 	for (int i = 0; i < scene->n_beams; i++) {
 		const bsim_beam_def *d = &scene->beams[i];
@@ -263,6 +293,8 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	memcpy(w->x, scene->body.start, sizeof w->x);
 	memcpy(w->v, scene->body.velocity, sizeof w->v);
 	w->heading = bsim_body_heading(&scene->body);
+	w->angular_velocity = w->rotates ? scene->body.angular_velocity : 0.0;
+	w->impacts_scaled = 0;
 	w->n_awake = w->n_typed = w->n_flagged = w->n_pushed = w->n_contacts = 0;
 	w->any_held = 0;
 	memset(&w->energy, 0, sizeof w->energy);
@@ -292,12 +324,17 @@ static int essay_hold(bsim_world *w)
 
 /* The contacts the step can reach into w->contacts; returns how many, and
  * the speed bound of the margins in *speed. */
-static int step_detect(bsim_world *w, const double force[2], double h, double *speed)
+static int step_detect(bsim_world *w, const double force[2], double torque, double h, double *speed)
 {
 	/* A bound for the margin only: speeds and forces are far from overflow,
 	 * so sqrt serves where hypot's scaling would cost a tenth of a step. */
 	double v = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
 	           h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
+	/* A shape that turns: its outline moves up to reach |w| faster than its
+	 * centre (the disk's does not move when it turns). */
+	if (w->shaped && w->rotates)
+		v += w->radius *
+		     (fabs(w->angular_velocity) + h * fabs(torque) * w->inv_body_inertia);
 	int holding = w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
 	int m = thesis_broad_phase(w, v, h);
 	int n = 0;
@@ -305,9 +342,11 @@ static int step_detect(bsim_world *w, const double force[2], double h, double *s
 		int i = w->candidates[k];
 		if (holding && !w->held[i])
 			continue; /* essay: the constraint loop tests only held beams */
-		if (thesis_contact_detect(w, i, thesis_step_margin(w, &w->beams[i], v, h),
-		                          &w->contacts[n]))
-			thesis_beam_wake(w, w->contacts[n++].beam);
+		int got = thesis_contact_detect(w, i, thesis_step_margin(w, &w->beams[i], v, h),
+		                                &w->contacts[n]);
+		if (got)
+			thesis_beam_wake(w, i);
+		n += got;
 	}
 	*speed = v;
 	return n;
@@ -320,7 +359,7 @@ static int step_detect(bsim_world *w, const double force[2], double h, double *s
  * contact solve's body update with a zero impulse sum (thesis_body_advance,
  * as persistent_contact.c's with none); no beam to move, sleep or prune;
  * the last step's flags cleared. */
-static void flight_step(bsim_world *w, const double force[2], double h)
+static void flight_step(bsim_world *w, const double force[2], double torque, double h)
 {
 	w->n_contacts = 0;
 	double v0[2] = {w->v[0], w->v[1]};
@@ -328,6 +367,7 @@ static void flight_step(bsim_world *w, const double force[2], double h)
 	const double j[2] = {0.0, 0.0};
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_turn(w, w->angular_velocity, torque, 0.0, h);
 	if (w->n_flagged)
 		thesis_contact_clear(w);
 }
@@ -337,7 +377,6 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
                        bsim_error *err)
 {
 	(void)err;
-	(void)torque; /* the body does not rotate */
 	/* Free flight among beams at rest (none awake, none in reach): no
 	 * contact, no beam to move, no square root for the margin. */
 	int in_flight = w->n_awake == 0 && thesis_flight_clear(w, force, h);
@@ -345,7 +384,7 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 	w->impacts = 0;
 	if (in_flight && w->n_typed == 0 && h == w->h_prepared &&
 	    w->contact_mode != THESIS_CONTACT_ESSAY) {
-		flight_step(w, force, h);
+		flight_step(w, force, torque, h);
 		return BSIM_OK;
 	}
 	for (int k = 0; k < w->n_typed; k++)
@@ -357,17 +396,19 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 		w->h_prepared = h;
 	}
 	double speed = 0.0;
-	int n = in_flight ? 0 : step_detect(w, force, h, &speed);
+	int n = in_flight ? 0 : step_detect(w, force, torque, h, &speed);
 	w->n_contacts = n;
 	if (n)
 		thesis_impact_resolve(w, h);
-	thesis_persistent_contact_solve(w, force, h);
+	thesis_persistent_contact_solve(w, force, torque, h);
 	if (w->contact_mode == THESIS_CONTACT_ESSAY)
 		w->any_held = essay_hold(w);
 	if (n)
-		thesis_position_project(w, force);
+		thesis_position_project(w, force, torque);
+	/* A beam's two contacts (a capsule along it) are adjacent: listed once. */
 	for (int k = 0; k < w->n_contacts; k++)
-		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE)
+		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE &&
+		    (k == 0 || w->contacts[k - 1].beam != w->contacts[k].beam))
 			w->typed[w->n_typed++] = w->contacts[k].beam;
 	if (!in_flight) {
 		if (w->sleep)
@@ -386,7 +427,7 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 	memcpy(s->x, w->x, sizeof s->x);
 	memcpy(s->v, w->v, sizeof s->v);
 	s->heading = w->heading;
-	s->angular_velocity = 0.0;
+	s->angular_velocity = w->angular_velocity;
 	s->pivot_drift = 0.0; /* a beam here is an angle about a fixed pivot */
 	/* Both lists empty (free flight): the same, nothing to set. */
 	if (w->n_awake || s->n_active)
@@ -410,6 +451,7 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 	memcpy(w->x, s->x, sizeof w->x);
 	memcpy(w->v, s->v, sizeof w->v);
 	w->heading = s->heading;
+	w->angular_velocity = w->rotates ? s->angular_velocity : 0.0;
 	w->n_awake = 0;
 	w->n_typed = 0;
 	w->n_flagged = 0;
@@ -439,7 +481,8 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 const bsim_backend bsim_backend_thesis = {
         .name = "thesis",
         .description = "the essay's collision + constraint solver: impulses with restitution, "
-                       "persistent contact by complementarity, implicit beam springs",
+                       "persistent contact by complementarity, implicit beam springs; a body "
+                       "that turns, capsule and ellipse outlines, Coulomb contact friction",
         .knobs = thesis_knobs,
         .n_knobs = N_KNOBS,
         .create = thesis_create,

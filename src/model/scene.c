@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
+#include "model/body_shape.h"
 #include "model/scene_internal.h"
 
 #define BSIM_PI 3.14159265358979323846
@@ -255,6 +256,26 @@ int scene_overlap(const bsim_scene *s, double *dist)
 		double dx = c[0] - b->pivot[0], dy = c[1] - b->pivot[1];
 		double along = fmin(fmax(dx * ux + dy * uy, 0), b->length);
 		double d = hypot(dx - along * ux, dy - along * uy);
+		if (s->body.shape != BSIM_SHAPE_DISK) {
+			/* The outline (model/body_shape.h), for a beam within the
+			 * body's reach; no normal: the beam crosses the body's
+			 * centre line. */
+			if (!(d < body_shape_reach(&s->body)))
+				continue;
+			double tip[2] = {b->pivot[0] + b->length * ux,
+			                 b->pivot[1] + b->length * uy};
+			body_segment_contact bc;
+			if (body_shape_segment(&s->body, c, bsim_body_heading(&s->body), b->pivot,
+			                       tip, &bc) != BSIM_OK) {
+				*dist = 0.0;
+				return i;
+			}
+			if (bc.dist < 0) {
+				*dist = bc.dist;
+				return i;
+			}
+			continue;
+		}
 		if (d < s->body.radius) {
 			*dist = d;
 			return i;
@@ -447,6 +468,13 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		                      who, s->success_y, s->classify_y);
 	double d = 0;
 	int beam = scene_overlap(s, &d);
+	if (beam >= 0 && s->body.shape != BSIM_SHAPE_DISK)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: body.start: the body (%s, heading %g deg) overlaps beam "
+		                      "%d (beams.%d) at the start (outline's gap %.3g m)",
+		                      who,
+		                      s->body.shape == BSIM_SHAPE_CAPSULE ? "capsule" : "ellipse",
+		                      s->body.heading_deg, beam + 1, beam, d);
 	if (beam >= 0)
 		return bsim_error_set(
 		        err, BSIM_EINPUT,

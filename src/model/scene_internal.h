@@ -64,8 +64,11 @@ void scene_keys(const scene_table *t, char *buf, size_t size);
 /* Everything that has a default gets it; the rest is zero. */
 void scene_defaults(bsim_scene *s);
 
-/* Index of the first beam the body overlaps at the start (distance from the
- * body centre to the beam segment < radius), or -1; *dist in m. */
+/* Index of the first beam the body overlaps at the start, or -1; *dist in
+ * m. A disk: the distance from its centre to the beam's segment < radius,
+ * *dist that distance. Another shape: its outline against the segment
+ * (model/body_shape.h) has a gap < 0, *dist the gap (0 where the segment
+ * crosses the body's centre line). */
 int scene_overlap(const bsim_scene *s, double *dist);
 
 /* A walk of a scene document into a scene (scene_load.c). */

@@ -34,6 +34,8 @@ void bsim_state_copy(bsim_state *dst, const bsim_state *src)
 	int n = src->n_beams < dst->n_beams ? src->n_beams : dst->n_beams;
 	memcpy(dst->x, src->x, sizeof dst->x);
 	memcpy(dst->v, src->v, sizeof dst->v);
+	dst->heading = src->heading;
+	dst->angular_velocity = src->angular_velocity;
 	memcpy(dst->theta, src->theta, (size_t)n * sizeof *dst->theta);
 	memcpy(dst->omega, src->omega, (size_t)n * sizeof *dst->omega);
 	memcpy(dst->contact, src->contact, (size_t)n * sizeof *dst->contact);
