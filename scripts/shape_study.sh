@@ -46,7 +46,7 @@ gp = [f"set terminal pngcairo size 1200,1300 font 'Sans,11'",
       f"set output '{out}/shape_study.png'",
       "set multiplot layout 3,2 title 'p_{traverse} of bodies of equal area (314 m^2), "
       f"{backend} backend, Wilson 95% intervals' font 'Sans,13'",
-      "set xrange [4.5:9.5]", "set yrange [0:1]", "set xtics (5, 7, 9)",
+      "set xrange [4.5:10.5]", "set yrange [0:1]", "set xtics 5, 1, 10",
       "set xlabel 'propulsion force F_{prop} (N)'", "set ylabel 'p_{traverse}'",
       "set key top left", "set grid"]
 names = {"held": "held (50 Hz)", "ou": "Ornstein-Uhlenbeck ({/Symbol t} 0.01 s)",
