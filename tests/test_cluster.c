@@ -1007,6 +1007,31 @@ static pid_t rank_pid(pid_t parent, int rank)
 	return found;
 }
 
+/* The pid of the job's rank once it is running (polled every millisecond:
+ * the event is the rank's process appearing); the test fails if the job
+ * ends first, or kills the job and fails after 300 s, as bsim_test_await_*
+ * do. */
+static pid_t await_rank(pid_t job, int rank)
+{
+	const struct timespec tick = {0, 1000000};
+	struct timespec t0, t;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	pid_t victim;
+	while ((victim = rank_pid(job, rank)) < 0) {
+		int st;
+		if (waitpid(job, &st, WNOHANG) == job)
+			fail_msg("the job ended before its rank %d was found", rank);
+		clock_gettime(CLOCK_MONOTONIC, &t);
+		if (t.tv_sec - t0.tv_sec > 300) {
+			kill(job, SIGKILL);
+			waitpid(job, &st, 0);
+			fail_msg("waited 300 s for rank %d of job %d: killed it", rank, (int)job);
+		}
+		nanosleep(&tick, NULL);
+	}
+	return victim;
+}
+
 static void test_mpi_rank_killed_resumed(void **state)
 {
 	(void)state;
@@ -1025,14 +1050,7 @@ static void test_mpi_rank_killed_resumed(void **state)
 		print_stderr(err_path);
 		fail_msg("the job ended (status %d) before its journal held 20 records", status);
 	}
-	pid_t victim = -1;
-	const struct timespec tick = {0, 1000000};
-	while ((victim = rank_pid(job, 2)) < 0) {
-		int st;
-		if (waitpid(job, &st, WNOHANG) == job)
-			fail_msg("the job ended before its rank 2 was found");
-		nanosleep(&tick, NULL);
-	}
+	pid_t victim = await_rank(job, 2);
 	kill(victim, SIGKILL);
 	int rc = wait_status(job);
 	assert_int_not_equal(rc, 0);
@@ -1177,14 +1195,7 @@ static void test_mpi_essay_killed_resumed(void **state)
 		print_stderr(err_path);
 		fail_msg("the job ended (status %d) before its journal held 20 records", status);
 	}
-	pid_t victim = -1;
-	const struct timespec tick = {0, 1000000};
-	while ((victim = rank_pid(pid, 2)) < 0) {
-		int st;
-		if (waitpid(pid, &st, WNOHANG) == pid)
-			fail_msg("the job ended before its rank 2 was found");
-		nanosleep(&tick, NULL);
-	}
+	pid_t victim = await_rank(pid, 2);
 	kill(victim, SIGKILL);
 	assert_int_not_equal(wait_status(pid), 0);
 	assert_true(bsim_test_journal_records(journal) >= 20);
