@@ -35,6 +35,11 @@ typedef struct bsim_step_energy {
 	double contact;    /* -(work of persistent contact forces), ~0 */
 	double correction; /* energy change from position correction */
 	double sleep;      /* of beams put exactly to rest by sleeping (>= 0) */
+	/* Taken by the drag and the ground friction of a backend that simulates
+	 * them itself (bsim_backend.takes): minus the work of their impulses
+	 * over the body's displacement and turn; 0 on a backend that does not. */
+	double drag;
+	double friction;
 } bsim_step_energy;
 
 /* What a backend's solvers had to give up on, counted since the world was
