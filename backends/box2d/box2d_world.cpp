@@ -88,7 +88,7 @@
  *     c_w and J), set for the (sub)step h: Box2D multiplies the velocity,
  *     after the force and before the constraints, by 1 / (1 + h d) =
  *     exp(-c h / M), the exact decay of a free body over the step.
- *   Their losses (bsim_step_energy drag, friction) are minus the work of
+ *   Their losses (bsim_state drag_loss, friction_loss) are minus the work of
  *   their impulses over the body's displacement and turn in each (sub)step,
  *   the impulse / h taken as the force (the joint's accumulated impulse;
  *   the damping's velocity change times M or J), as the runner books the
@@ -364,6 +364,7 @@ struct bsim_world {
 	/* results of the last step */
 	std::vector<int> contact_type; /* the contact flag (model/contact_flag.h) */
 	bsim_step_energy energy = {};
+	double drag_loss = 0.0, friction_loss = 0.0; /* J (bsim_state) */
 	int impacts = 0;
 	long toi_events = 0;         /* continuous-collision sub-solves, all steps */
 	bsim_solver_counts solver{}; /* clamped substeps, since creation */
@@ -1289,14 +1290,14 @@ void taken_losses(bsim_world *w, const double v_force[2], double w_force, double
 		double work = m * a * (v_force[0] * dx[0] + v_force[1] * dx[1]);
 		if (w->rotates)
 			work += w->inertia * a_turn * w_force * turn;
-		w->energy.drag -= work / h;
+		w->drag_loss -= work / h;
 	}
 	if (w->ground_friction) {
 		const b2Vec2 impulse = w->ground_friction->GetReactionForce(1.0f);
 		const double torque_impulse = w->ground_friction->GetReactionTorque(1.0f);
 		double work = ((double)impulse.x * dx[0] + (double)impulse.y * dx[1]) / s +
 		              torque_impulse * turn / (s * s);
-		w->energy.friction -= work / h;
+		w->friction_loss -= work / h;
 	}
 }
 
@@ -1388,6 +1389,8 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 int box2d_step(bsim_world *w, const double force[2], double torque, double h, bsim_error *err)
 {
 	w->energy = bsim_step_energy{};
+	w->drag_loss = 0.0;
+	w->friction_loss = 0.0;
 	w->impacts = 0;
 	const double hs = h / w->substeps;
 	try {
@@ -1433,6 +1436,8 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 		st->contact[i] = w->contact_type[(size_t)i];
 	}
 	st->energy = w->energy;
+	st->drag_loss = w->drag_loss;
+	st->friction_loss = w->friction_loss;
 	st->impacts = w->impacts;
 	st->solver = w->solver;
 }
@@ -1461,6 +1466,8 @@ int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
 		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory");
 	}
 	w->energy = bsim_step_energy{};
+	w->drag_loss = 0.0;
+	w->friction_loss = 0.0;
 	w->impacts = 0;
 	return BSIM_OK;
 }

@@ -51,7 +51,8 @@ typedef struct bsim_backend {
 	/* The effects the backend simulates itself (BSIM_TAKES_* of
 	 * beamsim/effects.h), 0: none. The runner builds its pipeline with
 	 * bsim_effects_init_taking(..., takes): such an effect gives the step no
-	 * force, and the backend reports its loss in the step's energy. */
+	 * force, and the backend reports its loss in the step's state
+	 * (bsim_state drag_loss, friction_loss). */
 	unsigned takes;
 } bsim_backend;
 

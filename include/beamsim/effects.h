@@ -70,7 +70,7 @@ typedef struct bsim_effect {
 	double held_h;
 	/* 1: the backend simulates this effect itself (bsim_effects_init_taking):
 	 * apply adds nothing, and the ledger books the loss the backend reports
-	 * in the step's energy (bsim_step_energy drag, friction). */
+	 * in the step's state (bsim_state drag_loss, friction_loss). */
 	int taken;
 } bsim_effect;
 

@@ -35,11 +35,6 @@ typedef struct bsim_step_energy {
 	double contact;    /* -(work of persistent contact forces), ~0 */
 	double correction; /* energy change from position correction */
 	double sleep;      /* of beams put exactly to rest by sleeping (>= 0) */
-	/* Taken by the drag and the ground friction of a backend that simulates
-	 * them itself (bsim_backend.takes): minus the work of their impulses
-	 * over the body's displacement and turn; 0 on a backend that does not. */
-	double drag;
-	double friction;
 } bsim_step_energy;
 
 /* What a backend's solvers had to give up on, counted since the world was
@@ -78,6 +73,12 @@ typedef struct bsim_state {
 	 * beams cost what the beams near the body cost. */
 	int n_active;
 	int *active; /* n_beams capacity */
+	/* J, of the last step: taken by the drag and by the ground friction of
+	 * a backend that simulates them itself (bsim_backend.takes), minus the
+	 * work of their impulses over the body's displacement and turn; 0 (never
+	 * written) on a backend that does not. */
+	double drag_loss;
+	double friction_loss;
 } bsim_state;
 
 /* Sizes s for n_beams beams, everything zero. BSIM_EFAIL out of memory
