@@ -275,6 +275,12 @@ static void test_ground_friction_stopping_distance(void **state)
 		/* Box2D's single-precision velocity reaches 0 a step later */
 		assert_true(fabs(t.stop_step * s.dt - v0 / mu_g) <= (b == 0 ? 1 : 2) * s.dt);
 		double dist = hypot(t.x_stop[0] - t.x0[0], t.x_stop[1] - t.x0[1]);
+		print_message(
+		        "ground friction %s: stops %.5f m away (v0^2/(2 mu g) %.5f, one step's "
+		        "travel %.3f) at %.3f s (v0/(mu g) %.4f); friction booked %.4f J of "
+		        "12.5 J, residual %.3g J\n",
+		        backends[b]->name, dist, v0 * v0 / (2.0 * mu_g), v0 * s.dt,
+		        t.stop_step * s.dt, v0 / mu_g, out.ledger.friction, out.ledger.residual);
 		assert_true(fabs(dist - v0 * v0 / (2.0 * mu_g)) < v0 * s.dt);
 		/* along the initial direction */
 		assert_true(fabs((t.x_stop[0] - t.x0[0]) / dist - 0.6) < 1e-5);
