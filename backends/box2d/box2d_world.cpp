@@ -361,6 +361,9 @@ struct bsim_world {
 	double drag_linear = 0.0, drag_angular = 0.0;
 	double damping_h = 0.0;
 	double damping_factor = 1.0, damping_factor_turn = 1.0;
+	bool taken = false;      /* drag or ground_friction */
+	bool turn_start = false; /* rich or taken: the step records the body's turn */
+	double v_force[2] = {0, 0}, w_force = 0.0; /* m/s, rad/s: after the force */
 	/* results of the last step */
 	std::vector<int> contact_type; /* the contact flag (model/contact_flag.h) */
 	bsim_step_energy energy = {};
@@ -1192,9 +1195,11 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	w->drag = scene->effects.has_drag != 0;
 	w->drag_linear = scene->effects.drag_linear;
 	w->drag_angular = scene->effects.drag_angular;
+	w->taken = w->drag || scene->effects.has_ground_friction;
 	w->rotates = scene->body.rotates != 0;
 	w->rich =
 	        w->rotates || scene->body.shape != BSIM_SHAPE_DISK || scene->contact.friction != 0;
+	w->turn_start = w->rich || w->taken;
 	w->inertia = bsim_body_inertia(&scene->body);
 	w->reach = scene->body.shape == BSIM_SHAPE_CAPSULE
 	                   ? 0.5 * scene->body.length + scene->body.radius
@@ -1269,6 +1274,23 @@ void body_damping_set(bsim_world *w, double h)
 	w->damping_h = h;
 }
 
+/* Before a (sub)step of h with drag or ground friction: the velocities
+ * after the force, before Box2D damps them (v_force, w_force), and the
+ * solve's start (v_pre, w_pre) after the damping. */
+void taken_start(bsim_world *w, double h)
+{
+	w->v_force[0] = w->v_pre[0];
+	w->v_force[1] = w->v_pre[1];
+	w->w_force = w->w_pre;
+	if (!w->drag)
+		return;
+	if (h != w->damping_h)
+		body_damping_set(w, h);
+	w->v_pre[0] *= w->damping_factor;
+	w->v_pre[1] *= w->damping_factor;
+	w->w_pre *= w->damping_factor_turn;
+}
+
 /* The drag's and the ground friction's losses in the (sub)step of h just
  * taken: minus the work of their impulses over the body's displacement dx
  * and turn dpsi, as the runner books a force's (work F . dx with F the
@@ -1276,8 +1298,9 @@ void body_damping_set(bsim_world *w, double h)
  * M (a - 1) v* and J (a_w - 1) w* (v*, w*: after the force, before the
  * damping); the friction joint's is its accumulated impulse, which Box2D
  * reports as the reaction force times inv_dt (1 here: the impulse). */
-void taken_losses(bsim_world *w, const double v_force[2], double w_force, double h)
+void taken_losses(bsim_world *w, double h)
 {
+	const double *v_force = w->v_force, w_force = w->w_force;
 	const double s = w->s;
 	const b2Vec2 p = w->body->GetPosition();
 	const double dx[2] = {(double)p.x / s - (double)w->body_start.x / s,
@@ -1313,8 +1336,7 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 	w->v_pre[0] = v0.x / s + h * f[0] / mass;
 	w->v_pre[1] = v0.y / s + h * f[1] / mass;
 	w->body->ApplyForceToCenter(b2Vec2((float)(f[0] * s), (float)(f[1] * s)), false);
-	const bool taken = w->drag || w->ground_friction;
-	if (w->rich || taken) {
+	if (w->turn_start) {
 		w->rows.clear();
 		w->body_start_angle = w->body->GetAngle();
 		w->w_pre = w->body->GetAngularVelocity();
@@ -1323,16 +1345,8 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 			w->body->ApplyTorque((float)(torque * s * s), false);
 		}
 	}
-	/* Drag: the velocities after the force, before Box2D damps them, and
-	 * the solve's start (v_pre, w_pre) after it. */
-	double v_force[2] = {w->v_pre[0], w->v_pre[1]}, w_force = w->w_pre;
-	if (w->drag) {
-		if (h != w->damping_h)
-			body_damping_set(w, h);
-		w->v_pre[0] *= w->damping_factor;
-		w->v_pre[1] *= w->damping_factor;
-		w->w_pre *= w->damping_factor_turn;
-	}
+	if (w->taken)
+		taken_start(w, h);
 
 	const size_t n_live = w->track_live ? w->live.size() : w->beams.size();
 	for (size_t k = 0; k < n_live; k++) {
@@ -1374,8 +1388,8 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 		clamped = hf * std::fabs(b.body->GetAngularVelocity()) >= near * b2_maxRotation;
 	}
 	w->solver.clamped += clamped;
-	if (taken)
-		taken_losses(w, v_force, w_force, h);
+	if (w->taken)
+		taken_losses(w, h);
 	for (size_t k = 0; k < n_after; k++) {
 		const beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
 		if (b.damping == 0.0)
