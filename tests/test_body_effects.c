@@ -129,6 +129,53 @@ static void test_drag_absent(void **state)
 	bsim_scene_free(&s);
 }
 
+/* A backend that takes drag and ground friction (Box2D's bsim_backend.takes)
+ * gets them in the pipeline marked taken, with no force or torque: the
+ * pipeline's sum is the propulsion alone, where without taking it has the
+ * drag's -c v and the friction's stop. The thesis backend takes neither. */
+static void test_taken_effects(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	scene_one_beam(&s);
+	s.body.mass = 2.0;
+	s.effects.has_propulsion = 1;
+	s.effects.propulsion_force = 3.0;
+	s.effects.has_drag = 1;
+	s.effects.drag_linear = 0.8;
+	s.effects.has_ground_friction = 1;
+	s.effects.ground_mu = 0.5;
+	bsim_error err;
+	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
+	assert_int_equal(bsim_backend_thesis.takes, 0u);
+	assert_int_equal(bsim_backend_box2d.takes, BSIM_TAKES_DRAG | BSIM_TAKES_GROUND_FRICTION);
+	bsim_state at;
+	assert_int_equal(bsim_state_init(&at, 1), BSIM_OK);
+	at.v[0] = 1.5;
+	for (int taking = 0; taking < 2; taking++) {
+		bsim_effects fx;
+		assert_int_equal(bsim_effects_init_taking(&fx, &s, 1,
+		                                          taking ? bsim_backend_box2d.takes : 0u),
+		                 BSIM_OK);
+		assert_non_null(fx.drag);
+		assert_non_null(fx.friction);
+		assert_int_equal(fx.drag->taken, taking);
+		assert_int_equal(fx.friction->taken, taking);
+		double f[BSIM_WRENCH];
+		bsim_effects_force_at(&fx, 0, s.dt, &at, f);
+		if (taking) {
+			assert_true(f[0] == 0.0 && f[1] == 3.0 && f[2] == 0.0);
+		} else {
+			/* drag 2 x 1.5 (exp(-0.4 h) - 1) / h = -1.2 N, then the sliding
+			 * friction mu m g = 9.81 N against m v / h + f = (748.8, 3) N */
+			assert_true(f[0] < -9.8 && f[1] < 3.0);
+		}
+		bsim_effects_free(&fx);
+	}
+	bsim_state_free(&at);
+	bsim_scene_free(&s);
+}
+
 typedef struct osc_track {
 	double x0, a_over_m, w, phi, h;
 	double v_err, x_err, x_scale;
@@ -590,6 +637,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_drag_free_decay),
 	        cmocka_unit_test(test_drag_absent),
+	        cmocka_unit_test(test_taken_effects),
 	        cmocka_unit_test(test_oscillation_free_body),
 	        cmocka_unit_test(test_ground_friction_stopping_distance),
 	        cmocka_unit_test(test_ground_friction_stick),
