@@ -72,6 +72,28 @@
  * square root of a correctly rounded square), and PreSolve sets mu on the
  * contact too.
  *
+ * Ground friction and drag (effects.ground_friction, effects.drag) are
+ * Box2D's own, not the runner's forces (bsim_backend.takes):
+ *   ground friction: a b2FrictionJoint from the ground to the body, anchored
+ *     at the body's centre, maxForce mu M g and, on a body that turns,
+ *     maxTorque mu M g r_s (r_s = bsim_effects_spin_arm: the pipeline's
+ *     spinning limit). Each velocity iteration it takes the angular impulse
+ *     -J w and clamps its total to h maxTorque, then the linear impulse
+ *     -M v, its total clamped in length to h maxForce: stick or slide, each
+ *     with its own full limit. Its lever r_B is 0 (the anchor is the centre),
+ *     so the two rows do not couple: the pipeline's model ("sliding and
+ *     spinning taken apart"). Unlike the pipeline it is solved with the
+ *     contacts, so a contact's push is in what it holds back.
+ *   drag: the body's linear damping d = (exp(c h / M) - 1) / h (angular:
+ *     c_w and J), set for the (sub)step h: Box2D multiplies the velocity,
+ *     after the force and before the constraints, by 1 / (1 + h d) =
+ *     exp(-c h / M), the exact decay of a free body over the step.
+ *   Their losses (bsim_state drag_loss, friction_loss) are minus the work of
+ *   their impulses over the body's displacement and turn in each (sub)step,
+ *   the impulse / h taken as the force (the joint's accumulated impulse;
+ *   the damping's velocity change times M or J), as the runner books the
+ *   pipeline's drag and friction.
+ *
  * Contacts: one circle-edge manifold per beam (the disk). Box2D's edge carries a skin
  * b2_polygonRadius = 2 b2_linearSlop (units) and its position solver rests a
  * contact at a penetration of b2_linearSlop, so the disk's Box2D radius is
@@ -144,6 +166,7 @@
 #include <vector>
 
 #include "beamsim/backend.h"
+#include "beamsim/effects.h"
 #include "box2d/box2d_shape.h"
 #include "model/contact_flag.h"
 extern "C" {
@@ -328,9 +351,23 @@ struct bsim_world {
 	double inertia = 0.0; /* kg m^2, the body's (bsim_body_inertia) */
 	double reach = 0.0;   /* m, the outline's farthest point from the centre */
 	std::vector<contact_row> rows;
+	/* Ground friction and drag, simulated by Box2D (bsim_backend.takes;
+	 * the header's "Ground friction and drag"): the friction joint between
+	 * the ground and the body, or NULL; the drag coefficients c (N s/m) and
+	 * c_w (N m s/rad), the (sub)step h the body's damping is set for and
+	 * Box2D's per-step factors 1 / (1 + h d) it gives. */
+	b2FrictionJoint *ground_friction = nullptr;
+	bool drag = false;
+	double drag_linear = 0.0, drag_angular = 0.0;
+	double damping_h = 0.0;
+	double damping_factor = 1.0, damping_factor_turn = 1.0;
+	bool taken = false;      /* drag or ground_friction */
+	bool turn_start = false; /* rich or taken: the step records the body's turn */
+	double v_force[2] = {0, 0}, w_force = 0.0; /* m/s, rad/s: after the force */
 	/* results of the last step */
 	std::vector<int> contact_type; /* the contact flag (model/contact_flag.h) */
 	bsim_step_energy energy = {};
+	double drag_loss = 0.0, friction_loss = 0.0; /* J (bsim_state) */
 	int impacts = 0;
 	long toi_events = 0;         /* continuous-collision sub-solves, all steps */
 	bsim_solver_counts solver{}; /* clamped substeps, since creation */
@@ -683,6 +720,19 @@ void world_build(bsim_world *w, const double x[2], const double v[2], double psi
 	md.I = w->rich ? (float)(w->inertia * s * s)
 	               : (float)(0.5 * sc.body.mass * sc.body.radius * sc.body.radius * s * s);
 	w->body->SetMassData(&md);
+	/* Ground friction: a friction joint from the ground to the body's
+	 * centre (its anchor, so the joint's lever r_B is 0). */
+	w->ground_friction = nullptr;
+	if (sc.effects.has_ground_friction) {
+		const double limit = sc.effects.ground_mu * sc.body.mass * sc.effects.ground_g;
+		b2FrictionJointDef jd;
+		jd.Initialize(ground, w->body, w->body->GetPosition());
+		jd.maxForce = (float)(limit * s);
+		jd.maxTorque = w->rotates ? (float)(limit * bsim_effects_spin_arm(&sc.body) * s * s)
+		                          : 0.0f;
+		w->ground_friction = static_cast<b2FrictionJoint *>(w->world->CreateJoint(&jd));
+	}
+	w->damping_h = 0.0; /* the body's damping is set by the first step */
 
 	for (size_t i = 0; i < w->beams.size(); i++) {
 		beam_rec &b = w->beams[i];
@@ -1142,9 +1192,14 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
 	w->continuous = bsim_options_choice(opts, &box2d_knobs[KNOB_CONTINUOUS]) == CONTINUOUS_ON;
 	w->track_live = scene->has_lattice != 0;
+	w->drag = scene->effects.has_drag != 0;
+	w->drag_linear = scene->effects.drag_linear;
+	w->drag_angular = scene->effects.drag_angular;
+	w->taken = w->drag || scene->effects.has_ground_friction;
 	w->rotates = scene->body.rotates != 0;
 	w->rich =
 	        w->rotates || scene->body.shape != BSIM_SHAPE_DISK || scene->contact.friction != 0;
+	w->turn_start = w->rich || w->taken;
 	w->inertia = bsim_body_inertia(&scene->body);
 	w->reach = scene->body.shape == BSIM_SHAPE_CAPSULE
 	                   ? 0.5 * scene->body.length + scene->body.radius
@@ -1186,6 +1241,89 @@ int box2d_create(const bsim_scene *scene, const bsim_options *opts, bsim_world *
 	}
 }
 
+/* Box2D's damping factor for the damping d over a step of hf, as its
+ * island computes it (b2_island.cpp: v *= 1 / (1 + h d), float32). */
+float damping_factor_of(float hf, float d)
+{
+	return 1.0f / (1.0f + hf * d);
+}
+
+/* The float32 damping d (1/s) whose Box2D factor over h is exp(-rate h):
+ * d = (exp(rate h) - 1) / h. 1 + h d is a float32 near 1, spaced 2^-23,
+ * so the factor is exp(-rate h) within 2^-24 and the division's rounding
+ * (2^-25), the same every step. */
+float damping_exact(double rate, double h)
+{
+	const double hf = (double)(float)h;
+	return (float)(std::expm1(rate * hf) / hf);
+}
+
+/* The body's damping for a (sub)step of h (the header's "Ground friction
+ * and drag"): d = (exp(c h / M) - 1) / h, so that Box2D's factor
+ * 1 / (1 + h d) is exp(-c h / M), the exact decay (damping_exact: to
+ * float32); the same with c_w and J for a body that turns. */
+void body_damping_set(bsim_world *w, double h)
+{
+	const float hf = (float)h;
+	const float d = damping_exact(w->drag_linear / w->scene.body.mass, h);
+	const float d_turn = w->rotates ? damping_exact(w->drag_angular / w->inertia, h) : 0.0f;
+	w->body->SetLinearDamping(d);
+	w->body->SetAngularDamping(d_turn);
+	w->damping_factor = damping_factor_of(hf, d);
+	w->damping_factor_turn = damping_factor_of(hf, d_turn);
+	w->damping_h = h;
+}
+
+/* Before a (sub)step of h with drag or ground friction: the velocities
+ * after the force, before Box2D damps them (v_force, w_force), and the
+ * solve's start (v_pre, w_pre) after the damping. */
+void taken_start(bsim_world *w, double h)
+{
+	w->v_force[0] = w->v_pre[0];
+	w->v_force[1] = w->v_pre[1];
+	w->w_force = w->w_pre;
+	if (!w->drag)
+		return;
+	if (h != w->damping_h)
+		body_damping_set(w, h);
+	w->v_pre[0] *= w->damping_factor;
+	w->v_pre[1] *= w->damping_factor;
+	w->w_pre *= w->damping_factor_turn;
+}
+
+/* The drag's and the ground friction's losses in the (sub)step of h just
+ * taken: minus the work of their impulses over the body's displacement dx
+ * and turn dpsi, as the runner books a force's (work F . dx with F the
+ * impulse / h). The drag's impulse is the velocity change of the damping,
+ * M (a - 1) v* and J (a_w - 1) w* (v*, w*: after the force, before the
+ * damping); the friction joint's is its accumulated impulse, which Box2D
+ * reports as the reaction force times inv_dt (1 here: the impulse). */
+void taken_losses(bsim_world *w, double h)
+{
+	const double *v_force = w->v_force, w_force = w->w_force;
+	const double s = w->s;
+	const b2Vec2 p = w->body->GetPosition();
+	const double dx[2] = {(double)p.x / s - (double)w->body_start.x / s,
+	                      (double)p.y / s - (double)w->body_start.y / s};
+	const double turn =
+	        w->rotates ? (double)w->body->GetAngle() - (double)w->body_start_angle : 0.0;
+	if (w->drag) {
+		const double m = w->scene.body.mass;
+		const double a = w->damping_factor - 1.0, a_turn = w->damping_factor_turn - 1.0;
+		double work = m * a * (v_force[0] * dx[0] + v_force[1] * dx[1]);
+		if (w->rotates)
+			work += w->inertia * a_turn * w_force * turn;
+		w->drag_loss -= work / h;
+	}
+	if (w->ground_friction) {
+		const b2Vec2 impulse = w->ground_friction->GetReactionForce(1.0f);
+		const double torque_impulse = w->ground_friction->GetReactionTorque(1.0f);
+		double work = ((double)impulse.x * dx[0] + (double)impulse.y * dx[1]) / s +
+		              torque_impulse * turn / (s * s);
+		w->friction_loss -= work / h;
+	}
+}
+
 /* One Box2D step of h seconds with force f (N) and torque (N m) on the
  * body. */
 void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
@@ -1198,7 +1336,7 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 	w->v_pre[0] = v0.x / s + h * f[0] / mass;
 	w->v_pre[1] = v0.y / s + h * f[1] / mass;
 	w->body->ApplyForceToCenter(b2Vec2((float)(f[0] * s), (float)(f[1] * s)), false);
-	if (w->rich) {
+	if (w->turn_start) {
 		w->rows.clear();
 		w->body_start_angle = w->body->GetAngle();
 		w->w_pre = w->body->GetAngularVelocity();
@@ -1207,6 +1345,8 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 			w->body->ApplyTorque((float)(torque * s * s), false);
 		}
 	}
+	if (w->taken)
+		taken_start(w, h);
 
 	const size_t n_live = w->track_live ? w->live.size() : w->beams.size();
 	for (size_t k = 0; k < n_live; k++) {
@@ -1248,6 +1388,8 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 		clamped = hf * std::fabs(b.body->GetAngularVelocity()) >= near * b2_maxRotation;
 	}
 	w->solver.clamped += clamped;
+	if (w->taken)
+		taken_losses(w, h);
 	for (size_t k = 0; k < n_after; k++) {
 		const beam_rec &b = w->beams[w->track_live ? (size_t)w->live[k] : k];
 		if (b.damping == 0.0)
@@ -1261,6 +1403,8 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 int box2d_step(bsim_world *w, const double force[2], double torque, double h, bsim_error *err)
 {
 	w->energy = bsim_step_energy{};
+	w->drag_loss = 0.0;
+	w->friction_loss = 0.0;
 	w->impacts = 0;
 	const double hs = h / w->substeps;
 	try {
@@ -1306,6 +1450,8 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 		st->contact[i] = w->contact_type[(size_t)i];
 	}
 	st->energy = w->energy;
+	st->drag_loss = w->drag_loss;
+	st->friction_loss = w->friction_loss;
 	st->impacts = w->impacts;
 	st->solver = w->solver;
 }
@@ -1334,6 +1480,8 @@ int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
 		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory");
 	}
 	w->energy = bsim_step_energy{};
+	w->drag_loss = 0.0;
+	w->friction_loss = 0.0;
 	w->impacts = 0;
 	return BSIM_OK;
 }
@@ -1414,4 +1562,5 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         box2d_accuracy,
         (int)(sizeof box2d_accuracy / sizeof box2d_accuracy[0]),
         nullptr, /* reset: the runner creates a world per trial */
+        BSIM_TAKES_DRAG | BSIM_TAKES_GROUND_FRICTION,
 };

@@ -48,6 +48,12 @@ typedef struct bsim_backend {
 	 * a trial pays for the beams it touched, not for the field
 	 * (bsim_trial_runner_keep_worlds). */
 	int (*reset)(bsim_world *w, const bsim_scene *scene, bsim_error *err);
+	/* The effects the backend simulates itself (BSIM_TAKES_* of
+	 * beamsim/effects.h), 0: none. The runner builds its pipeline with
+	 * bsim_effects_init_taking(..., takes): such an effect gives the step no
+	 * force, and the backend reports its loss in the step's state
+	 * (bsim_state drag_loss, friction_loss). */
+	unsigned takes;
 } bsim_backend;
 
 /* The registry: all backends compiled in, NULL-terminated. */

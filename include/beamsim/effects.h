@@ -68,6 +68,10 @@ typedef struct bsim_effect {
 	 * held_h (s), as the schedule's bsim_schedule_at_step_held gives them. */
 	long held[2];
 	double held_h;
+	/* 1: the backend simulates this effect itself (bsim_effects_init_taking):
+	 * apply adds nothing, and the ledger books the loss the backend reports
+	 * in the step's state (bsim_state drag_loss, friction_loss). */
+	int taken;
 } bsim_effect;
 
 typedef struct bsim_effects {
@@ -90,8 +94,18 @@ typedef struct bsim_effects {
  * its seed; 0 if every trial of the scene is the same trial. */
 BSIM_API int bsim_effects_random(const bsim_scene *scene);
 
+/* The effects a backend may simulate itself instead of taking their force
+ * from the pipeline (bsim_backend.takes): viscous drag, ground friction. */
+enum { BSIM_TAKES_DRAG = 1u, BSIM_TAKES_GROUND_FRICTION = 2u };
+
 /* Builds the pipeline from scene->effects; seed is the trial's mixed seed. */
 BSIM_API int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed);
+/* bsim_effects_init for a backend that simulates the effects in taken
+ * (BSIM_TAKES_*, its bsim_backend.takes) itself: those stay in the
+ * pipeline, marked taken, so that the ledger books their losses on their
+ * lines, but give no force or torque. taken 0 is bsim_effects_init. */
+BSIM_API int bsim_effects_init_taking(bsim_effects *fx, const bsim_scene *scene, uint64_t seed,
+                                      unsigned taken);
 BSIM_API void bsim_effects_free(bsim_effects *fx);
 
 /* BSIM_OK, or BSIM_EFAIL if an effect could not give its force (the random
@@ -137,7 +151,11 @@ static inline void bsim_effects_force_at(bsim_effects *fx, long n, double h, con
  * along y, random force, oscillation). */
 static inline void bsim_effects_force(bsim_effects *fx, long n, double h, double f[3])
 {
+#ifdef __cplusplus
+	static const bsim_state rest{};
+#else
 	static const bsim_state rest;
+#endif
 	bsim_effects_force_at(fx, n, h, &rest, f);
 }
 

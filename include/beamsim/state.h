@@ -73,6 +73,12 @@ typedef struct bsim_state {
 	 * beams cost what the beams near the body cost. */
 	int n_active;
 	int *active; /* n_beams capacity */
+	/* J, of the last step: taken by the drag and by the ground friction of
+	 * a backend that simulates them itself (bsim_backend.takes), minus the
+	 * work of their impulses over the body's displacement and turn; 0 (never
+	 * written) on a backend that does not. */
+	double drag_loss;
+	double friction_loss;
 } bsim_state;
 
 /* Sizes s for n_beams beams, everything zero. BSIM_EFAIL out of memory

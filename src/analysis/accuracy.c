@@ -138,7 +138,7 @@ static int consistency_piece(const bsim_accuracy_reference *ref, const bsim_scen
 	}
 	rc = b->set_state(w, &ref->states[k], err);
 	bsim_effects fx;
-	if (rc == BSIM_OK && bsim_effects_init(&fx, scene, seed))
+	if (rc == BSIM_OK && bsim_effects_init_taking(&fx, scene, seed, b->takes))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (rc) {
 		b->destroy(w);

@@ -167,8 +167,9 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 		return -1;
 	}
 	bsim_effects fx;
-	if (bsim_effects_init(&fx, s,
-	                      bsim_schedule_seed_mix(def->seed, (uint64_t)bin, (uint64_t)t))) {
+	if (bsim_effects_init_taking(&fx, s,
+	                             bsim_schedule_seed_mix(def->seed, (uint64_t)bin, (uint64_t)t),
+	                             be->takes)) {
 		be->destroy(w);
 		bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		return -1;

@@ -175,6 +175,18 @@ static void ground_friction_turn_apply(bsim_effect *e, long n, double h, const b
 	f[2] += e->applied_torque;
 }
 
+/* An effect the backend simulates itself (bsim_effects_init_taking): no
+ * force from the pipeline; its applied force and torque stay 0, and its
+ * loss is the backend's (bsim_step_energy). */
+static void taken_apply(bsim_effect *e, long n, double h, const bsim_state *s, double f[3])
+{
+	(void)e;
+	(void)n;
+	(void)h;
+	(void)s;
+	(void)f;
+}
+
 /* Propulsion along the heading psi at the step's start, F (cos psi,
  * sin psi): the hovercraft's thrust, which turns with the body. */
 static void propulsion_heading_apply(bsim_effect *e, long n, double h, const bsim_state *s,
@@ -268,6 +280,12 @@ int bsim_effects_random(const bsim_scene *scene)
 
 int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 {
+	return bsim_effects_init_taking(fx, scene, seed, 0u);
+}
+
+int bsim_effects_init_taking(bsim_effects *fx, const bsim_scene *scene, uint64_t seed,
+                             unsigned taken)
+{
 	memset(fx, 0, sizeof *fx);
 	const bsim_effects_def *d = &scene->effects;
 	const int turns = scene->body.rotates;
@@ -322,6 +340,10 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 		e->mass = scene->body.mass;
 		e->inertia = bsim_body_inertia(&scene->body);
 		e->param_turn = d->drag_angular;
+		if (taken & BSIM_TAKES_DRAG) {
+			e->apply = taken_apply;
+			e->taken = 1;
+		}
 		fx->drag = e;
 	}
 	if (d->has_ground_friction) { /* the last: it reads the others' forces */
@@ -334,6 +356,10 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 		if (turns) {
 			e->inertia = bsim_body_inertia(&scene->body);
 			e->param_turn = e->coef[0] * bsim_effects_spin_arm(&scene->body);
+		}
+		if (taken & BSIM_TAKES_GROUND_FRICTION) {
+			e->apply = taken_apply;
+			e->taken = 1;
 		}
 		fx->friction = e;
 	}

@@ -44,6 +44,8 @@ void bsim_state_copy(bsim_state *dst, const bsim_state *src)
 		if (src->active[k] < dst->n_beams)
 			dst->active[dst->n_active++] = src->active[k];
 	dst->energy = src->energy;
+	dst->drag_loss = src->drag_loss;
+	dst->friction_loss = src->friction_loss;
 	dst->impacts = src->impacts;
 	dst->solver = src->solver;
 }

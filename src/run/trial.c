@@ -193,7 +193,7 @@ static int trial_open(trial_ctx *c, uint64_t seed, bsim_error *err)
 		trial_essay_release(&c->r->essay, c->backend, &c->w);
 		return rc;
 	}
-	if (bsim_effects_init(c->fx, c->scene, seed)) {
+	if (bsim_effects_init_taking(c->fx, c->scene, seed, c->backend->takes)) {
 		c->backend->destroy(c->w);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}

@@ -85,7 +85,10 @@ static inline int state_energy_finite(const bsim_scene *sc, const bsim_state *s,
 
 /* One step's entry in the ledger, s0 -> s1 with energies e0 -> e1: the work
  * of each force over the body's displacement and of each torque over its
- * turn, the backend's losses, and what is left over. */
+ * turn, the backend's losses, and what is left over. The drag and ground
+ * friction of a backend that simulates them (bsim_effect.taken) are booked
+ * on their lines from the losses it reports (bsim_state drag_loss,
+ * friction_loss). */
 static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsim_state *s0,
                                const bsim_state *s1, double e0, double e1)
 {
@@ -110,8 +113,12 @@ static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsi
 		const double turn = s1->heading - s0->heading;
 		for (int i = fx->n_work; i < fx->n; i++) {
 			const bsim_effect *e = &fx->e[i];
-			double work = e->applied[0] * d[0] + e->applied[1] * d[1] +
-			              e->applied_torque * turn;
+			/* an effect the backend simulates: minus its work is the
+			 * backend's (drag and ground friction only) */
+			double work = e->taken
+			                      ? -(e == fx->drag ? s1->drag_loss : s1->friction_loss)
+			                      : e->applied[0] * d[0] + e->applied[1] * d[1] +
+			                                e->applied_torque * turn;
 			r -= work;
 			if (e == fx->heading) {
 				l->w_prop += work;
