@@ -120,8 +120,9 @@ enum { THESIS_SIMULTANEOUS = 0, THESIS_NEAREST_FIRST = 1 };
 enum { THESIS_CONTACT_PHYSICAL = 0, THESIS_CONTACT_ESSAY = 1 };
 
 struct bsim_world {
-	double x[2], v[2]; /* body centre and velocity */
-	double heading;    /* rad, psi */
+	double x[2], v[2];       /* body centre and velocity */
+	double heading;          /* rad, psi */
+	double angular_velocity; /* rad/s, w (next to the heading: get_state copies them) */
 	double mass, inv_mass;
 	/* m: the disk's radius; for another shape its reach (body_shape_reach),
 	 * what every distance bound (broad phase, margins, sleep) needs. */
@@ -132,7 +133,6 @@ struct bsim_world {
 	 * not turn: no solve turns it), kg m^2, and the contacts' Coulomb mu. */
 	int extended, shaped, rotates;
 	bsim_body_def body;
-	double angular_velocity;
 	double body_inertia, inv_body_inertia;
 	double friction;
 	/* Friction impacts whose Newton impulse would have gained energy and
@@ -147,6 +147,9 @@ struct bsim_world {
 	double rest_threshold;   /* m/s */
 	/* knobs */
 	int integrator, impact_order, projection, contact_mode;
+	/* 1: the essay's disk (extended 0) with contact_mode physical, whose
+	 * free flight thesis_step takes at once. */
+	int flight_disk;
 	double slop;         /* penetration tolerated before projection, m */
 	double contact_tol;  /* gap the solver counts as touching (held, awake), m */
 	int broad_phase;     /* 1: grid query for beams at rest; 0: test every beam */
