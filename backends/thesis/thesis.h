@@ -40,6 +40,13 @@
 #else
 #define THESIS_SPECIALISED static inline
 #endif
+/* A function kept apart from its caller (thesis_world.c's two copies of
+ * the step), so that the caller's short path saves no registers for it. */
+#if defined(__GNUC__)
+#define THESIS_APART static __attribute__((noinline))
+#else
+#define THESIS_APART static
+#endif
 
 /* The geometry of the body against one beam at one configuration: the
  * body's centre x and the beam's angle theta it was computed at, and the
@@ -303,9 +310,8 @@ void thesis_position_project_disk(struct bsim_world *w, const double force[2]);
  * (thesis_world.c) and the impacts (impact_resolve.c) share it without
  * calling into each other. Beams at rest have omega = 0 and add nothing:
  * the awake ones, in ascending order, give the sum over all beams to the
- * bit. */
-/* extended: a constant, 0 for the essay's disk (w->extended 0), whose
- * copy has no test of the body's rotation. */
+ * bit. extended: a constant, 0 for the essay's disk (w->extended 0),
+ * whose copy has no test of the body's rotation. */
 static inline double thesis_kinetic_energy(const struct bsim_world *w, const int extended)
 {
 	double e = 0.5 * w->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);

@@ -379,8 +379,8 @@ THESIS_SPECIALISED void flight_step(bsim_world *w, const double force[2], double
 
 /* A step of any body (extended 1) or of the essay's disk (extended 0,
  * w->extended 0): a constant, so that the disk's copy, and the _disk
- * functions it calls, are compiled without the extended path's tests (the
- * essay's disk costs the instructions it cost before the extended path). */
+ * functions it calls, are compiled without the extended path's tests
+ * (docs/backends.md, "Cost to the essay's disk"). */
 THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double torque, double h,
                                 int in_flight, const int extended)
 {
@@ -440,20 +440,13 @@ THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double tor
 
 /* The two copies, apart from thesis_step, whose free flight then needs
  * no more registers than it uses. */
-#if defined(__GNUC__)
-__attribute__((noinline))
-#endif
-static int
-step_extended(bsim_world *w, const double force[2], double torque, double h, int in_flight)
+THESIS_APART int step_extended(bsim_world *w, const double force[2], double torque, double h,
+                               int in_flight)
 {
 	return step_run(w, force, torque, h, in_flight, 1);
 }
 
-#if defined(__GNUC__)
-__attribute__((noinline))
-#endif
-static int
-step_disk(bsim_world *w, const double force[2], double h, int in_flight)
+THESIS_APART int step_disk(bsim_world *w, const double force[2], double h, int in_flight)
 {
 	return step_run(w, force, 0.0, h, in_flight, 0);
 }
