@@ -52,8 +52,9 @@ void thesis_beam_direction(thesis_beam *b, double u[2])
 	u[1] = b->u[1];
 }
 
-/* The body's centre x against the beam at its angle: b->geo. */
-static void geometry_compute(thesis_beam *b, const double x[2])
+/* The body's centre x against the beam at its angle: b->geo; the lever a
+ * kept for the extended path only (extended: constant, see below). */
+THESIS_SPECIALISED void geometry_compute(thesis_beam *b, const double x[2], const int extended)
 {
 	thesis_geometry *g = &b->geo;
 	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
@@ -88,8 +89,10 @@ static void geometry_compute(thesis_beam *b, const double x[2])
 		g->type = BSIM_CONTACT_TIP;
 	}
 	g->c = b->sgn * (a[0] * g->n[1] - a[1] * g->n[0]);
-	g->a[0] = a[0];
-	g->a[1] = a[1];
+	if (extended) {
+		g->a[0] = a[0];
+		g->a[1] = a[1];
+	}
 }
 
 /* 1 if the body certainly lies farther than R + margin from the beam,
@@ -99,19 +102,24 @@ static void geometry_compute(thesis_beam *b, const double x[2])
  *   dist >= dist_g - |x - x_g| - L |theta - theta_g|.
  * A cushion of 1e-9 of the lengths involved covers the round-off of both
  * distances, so the bound never rejects what the exact test would keep. */
-static int geometry_far(const struct bsim_world *w, const thesis_beam *b, const double x[2],
-                        double radius, double margin)
+THESIS_SPECIALISED int geometry_far(const struct bsim_world *w, const thesis_beam *b,
+                                    const double x[2], double radius, double margin,
+                                    const int extended)
 {
 	const thesis_geometry *g = &b->geo;
 	double ex = x[0] - g->x[0], ey = x[1] - g->x[1];
 	double cushion = 1e-9 * (g->dist + b->length + radius + margin);
 	double slack = g->dist - b->length * fabs(b->theta - g->theta) - radius - margin - cushion;
-	if (w->shaped)
+	if (extended && w->shaped)
 		slack -= radius * fabs(w->heading - g->psi);
 	return slack > 0.0 && ex * ex + ey * ey < slack * slack; /* false for NaN */
 }
 
-int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out)
+/* Detection for any body (extended 1: the world's flags decide) or for the
+ * essay's disk (extended 0, w->extended 0): a constant, so that the disk's
+ * copy is compiled without the extended path's tests and stores. */
+THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin,
+                                      thesis_contact *out, const int extended)
 {
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
@@ -122,16 +130,16 @@ int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_con
 	/* The same configuration gives the same bits: a step's detection
 	 * meets the geometry the last step's projection computed. */
 	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta &&
-	      (!w->shaped || g->psi == w->heading))) {
-		if (geometry_far(w, b, w->x, w->radius, margin))
+	      (!(extended && w->shaped) || g->psi == w->heading))) {
+		if (geometry_far(w, b, w->x, w->radius, margin, extended))
 			return 0;
 		thesis_beam_touch(w, i);
-		if (w->shaped) {
+		if (extended && w->shaped) {
 			double u[2];
 			thesis_beam_direction(b, u);
 			thesis_shape_geometry(w, b, u);
 		} else {
-			geometry_compute(b, w->x);
+			geometry_compute(b, w->x, extended);
 		}
 	}
 	if (g->type == BSIM_CONTACT_NONE)
@@ -146,7 +154,9 @@ int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_con
 	out->c = g->c;
 	out->e = g->type == BSIM_CONTACT_TIP ? w->e_tip : w->e_tangent;
 	out->impulse = 0.0;
-	out->two = 0;
+	if (!extended)
+		return 1;
+	out->two = 0; /* read by the extended path's solves only */
 	if (w->extended) {
 		out->mu = w->friction;
 		out->impulse_t = 0.0;
@@ -165,12 +175,33 @@ int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_con
 	return 1;
 }
 
-int thesis_contact_near(const struct bsim_world *w, int i, double margin)
+int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out)
+{
+	return contact_detect(w, i, margin, out, 1);
+}
+
+int thesis_contact_detect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out)
+{
+	return contact_detect(w, i, margin, out, 0);
+}
+
+THESIS_SPECIALISED int contact_near(const struct bsim_world *w, int i, double margin,
+                                    const int extended)
 {
 	const thesis_beam *b = &w->beams[i];
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
 	double reach = b->length + w->radius + margin;
 	if (dx * dx + dy * dy > reach * reach)
 		return 0;
-	return !geometry_far(w, b, w->x, w->radius, margin);
+	return !geometry_far(w, b, w->x, w->radius, margin, extended);
+}
+
+int thesis_contact_near(const struct bsim_world *w, int i, double margin)
+{
+	return contact_near(w, i, margin, 1);
+}
+
+int thesis_contact_near_disk(const struct bsim_world *w, int i, double margin)
+{
+	return contact_near(w, i, margin, 0);
 }

@@ -38,17 +38,20 @@ static int shape_flag(const struct bsim_world *w, const thesis_beam *b, const do
 	return c.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
 }
 
-static void report_beam(struct bsim_world *w, int i)
+/* extended: constant (contact_detect.c's contact_detect): 0 compiles the
+ * essay's disk's copy without the shape's test. */
+THESIS_SPECIALISED void report_beam(struct bsim_world *w, int i, const int extended)
 {
 	thesis_beam *b = &w->beams[i];
 	int pushed = w->pushed[i];
 	if (w->flag[i] != BSIM_CONTACT_NONE ||
-	    (!pushed && !thesis_contact_near(w, i, BSIM_CONTACT_TOL)))
+	    (!pushed && !(extended ? thesis_contact_near(w, i, BSIM_CONTACT_TOL)
+	                           : thesis_contact_near_disk(w, i, BSIM_CONTACT_TOL))))
 		return;
 	double u[2];
 	int type, flag;
 	thesis_beam_direction(b, u);
-	if (w->shaped) {
+	if (extended && w->shaped) {
 		flag = shape_flag(w, b, u, pushed);
 	} else {
 		double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
@@ -68,16 +71,26 @@ void thesis_contact_clear(struct bsim_world *w)
 	w->n_flagged = 0;
 }
 
-void thesis_contact_report(struct bsim_world *w)
+THESIS_SPECIALISED void contact_report(struct bsim_world *w, const int extended)
 {
 	thesis_contact_clear(w);
 	int n = thesis_broad_phase_near(w, BSIM_CONTACT_TOL);
 	for (int k = 0; k < n; k++)
-		report_beam(w, w->candidates[k]);
+		report_beam(w, w->candidates[k], extended);
 	for (int k = 0; k < w->n_pushed; k++) {
 		int i = w->pushed_list[k];
-		report_beam(w, i);
+		report_beam(w, i, extended);
 		w->pushed[i] = 0;
 	}
 	w->n_pushed = 0;
+}
+
+void thesis_contact_report(struct bsim_world *w)
+{
+	contact_report(w, 1);
+}
+
+void thesis_contact_report_disk(struct bsim_world *w)
+{
+	contact_report(w, 0);
 }

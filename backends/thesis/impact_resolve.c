@@ -58,20 +58,23 @@ static void impact_bounds(const struct bsim_world *w, thesis_contact *c)
  * most in a lattice). */
 #define IMPACT_CONTACTS_MAX 16
 
-static void impact_apply(struct bsim_world *w, const thesis_contact *cs, int n)
+/* extended: constant (contact_detect.c's contact_detect): 0 compiles the
+ * essay's disk's copy of this file's functions without the extended path. */
+THESIS_SPECIALISED void impact_apply(struct bsim_world *w, const thesis_contact *cs, int n,
+                                     const int extended)
 {
 	double j[2], jw = 0.0;
-	if (w->extended)
+	if (extended && w->extended)
 		thesis_impulse_sum_extended(cs, n, j, &jw);
 	else
 		thesis_impulse_sum(cs, n, j);
 	w->v[0] += j[0] * w->impact_inv_mass;
 	w->v[1] += j[1] * w->impact_inv_mass;
-	if (w->rotates)
+	if (extended && w->rotates)
 		w->angular_velocity += jw * w->inv_body_inertia;
 	for (int i = 0; i < n; i++) {
 		thesis_beam *b = &w->beams[cs[i].beam];
-		if (w->extended && cs[i].impulse_t != 0.0)
+		if (extended && w->extended && cs[i].impulse_t != 0.0)
 			b->omega -=
 			        (cs[i].impulse * cs[i].c + cs[i].impulse_t * cs[i].ct) / b->inertia;
 		else
@@ -118,7 +121,7 @@ static int impact_solve_friction(struct bsim_world *w, thesis_contact *cs, int n
 	for (int i = 0; i < n; i++)
 		pn[i] = cs[i].impulse, pt[i] = cs[i].impulse_t;
 	double de = impact_energy_change(w, cs, n, pn, pt);
-	double ke = thesis_kinetic_energy(w);
+	double ke = thesis_kinetic_energy(w, 1);
 	if (!(de > 1e-12 * ke))
 		return inexact;
 	double bound[IMPACT_CONTACTS_MAX];
@@ -165,9 +168,10 @@ static int impact_solve_friction(struct bsim_world *w, thesis_contact *cs, int n
 
 /* The impulses of contacts cs (their bounds set) into cs; 1 if the solve
  * was not exact. */
-static int impact_solve(struct bsim_world *w, thesis_contact *cs, int n)
+THESIS_SPECIALISED int impact_solve(struct bsim_world *w, thesis_contact *cs, int n,
+                                    const int extended)
 {
-	if (!w->extended)
+	if (!(extended && w->extended))
 		return thesis_lcp_solve(w->impact_inv_mass, cs, n);
 	if (w->friction > 0.0)
 		return impact_solve_friction(w, cs, n);
@@ -180,12 +184,13 @@ static int impact_solve(struct bsim_world *w, thesis_contact *cs, int n)
 #define IMPACT_APPROACH_TOL 1e-9
 
 /* The essay's order: one contact at a time, nearest first. */
-static void impact_nearest_first(struct bsim_world *w, thesis_contact *cs, int n)
+THESIS_SPECIALISED void impact_nearest_first(struct bsim_world *w, thesis_contact *cs, int n,
+                                             const int extended)
 {
 	for (int pass = 0; pass <= IMPACT_PASSES_MAX; pass++) {
 		thesis_contact *next = NULL;
 		for (int i = 0; i < n; i++) {
-			thesis_contact_velocity(w, &cs[i]);
+			thesis_contact_velocity(w, &cs[i], extended);
 			if (cs[i].vrel < 0.0 && (!next || cs[i].gap < next->gap))
 				next = &cs[i];
 		}
@@ -200,14 +205,14 @@ static void impact_nearest_first(struct bsim_world *w, thesis_contact *cs, int n
 			return;
 		}
 		impact_bounds(w, next);
-		impact_solve(w, next, 1);
-		impact_apply(w, next, 1);
+		impact_solve(w, next, 1, extended);
+		impact_apply(w, next, 1, extended);
 		if (next->impulse > 0.0 && next->vrel < -w->rest_threshold)
 			w->impacts++;
 	}
 }
 
-int thesis_impact_resolve(struct bsim_world *w, double h)
+THESIS_SPECIALISED int impact_resolve(struct bsim_world *w, double h, const int extended)
 {
 	/* The touching contacts go to the front of the list. */
 	thesis_contact *cs = w->contacts;
@@ -216,7 +221,7 @@ int thesis_impact_resolve(struct bsim_world *w, double h)
 		/* In place: a contact left behind has its velocity and 1/I set
 		 * again by the contact solve. Swapped only when out of place. */
 		thesis_contact *c = &cs[i];
-		thesis_contact_velocity(w, c);
+		thesis_contact_velocity(w, c, extended);
 		if (c->gap + h * bsim_fmin(c->vrel, 0.0) > w->slop)
 			continue;
 		c->inv_i = w->beams[c->beam].inv_inertia;
@@ -231,17 +236,27 @@ int thesis_impact_resolve(struct bsim_world *w, double h)
 	if (!approaching)
 		return 0;
 
-	double ke = thesis_kinetic_energy(w);
+	double ke = thesis_kinetic_energy(w, extended);
 	if (w->impact_order == THESIS_NEAREST_FIRST) {
-		impact_nearest_first(w, cs, n);
+		impact_nearest_first(w, cs, n, extended);
 	} else {
 		for (int i = 0; i < n; i++)
 			impact_bounds(w, &cs[i]);
-		w->solver.iteration_limit += impact_solve(w, cs, n);
-		impact_apply(w, cs, n);
+		w->solver.iteration_limit += impact_solve(w, cs, n, extended);
+		impact_apply(w, cs, n, extended);
 		for (int i = 0; i < n; i++)
 			w->impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->rest_threshold;
 	}
-	w->energy.impact += ke - thesis_kinetic_energy(w);
+	w->energy.impact += ke - thesis_kinetic_energy(w, extended);
 	return 1;
+}
+
+int thesis_impact_resolve(struct bsim_world *w, double h)
+{
+	return impact_resolve(w, h, 1);
+}
+
+int thesis_impact_resolve_disk(struct bsim_world *w, double h)
+{
+	return impact_resolve(w, h, 0);
 }

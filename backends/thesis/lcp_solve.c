@@ -41,24 +41,26 @@
 /* inv_j: the body's 1/J on the extended path (thesis.h), whose rotation
  * adds cb_i cb_j / J to K; 0 (the essay's body, which does not turn) adds
  * nothing, not even a rounding. */
-static double k_entry(double inv_mass, double inv_j, const thesis_contact *a,
-                      const thesis_contact *b)
+THESIS_SPECIALISED double k_entry(double inv_mass, double inv_j, const thesis_contact *a,
+                                  const thesis_contact *b, const int extended)
 {
 	double k = (a->n[0] * b->n[0] + a->n[1] * b->n[1]) * inv_mass;
 	if (a == b)
 		k += a->c * a->c * a->inv_i;
-	else if (a->two && b->two && a->beam == b->beam) /* a capsule's two on one beam */
+	else if (extended && a->two && b->two && a->beam == b->beam) /* a capsule's two */
 		k += a->c * b->c * a->inv_i;
-	if (inv_j != 0.0)
+	if (extended && inv_j != 0.0)
 		k += a->cb * b->cb * inv_j;
 	return k;
 }
 
-static inline void lcp_two(double inv_mass, double inv_j, thesis_contact *c0, thesis_contact *c1)
+THESIS_SPECIALISED void lcp_two(double inv_mass, double inv_j, thesis_contact *c0,
+                                thesis_contact *c1, const int extended)
 {
 	double q0 = c0->vrel - c0->bound, q1 = c1->vrel - c1->bound;
-	double k00 = k_entry(inv_mass, inv_j, c0, c0), k11 = k_entry(inv_mass, inv_j, c1, c1);
-	double k01 = k_entry(inv_mass, inv_j, c0, c1);
+	double k00 = k_entry(inv_mass, inv_j, c0, c0, extended),
+	       k11 = k_entry(inv_mass, inv_j, c1, c1, extended);
+	double k01 = k_entry(inv_mass, inv_j, c0, c1, extended);
 	c0->impulse = c1->impulse = 0.0;
 	if (q0 >= 0.0 && q1 >= 0.0)
 		return;
@@ -84,7 +86,8 @@ static inline void lcp_two(double inv_mass, double inv_j, thesis_contact *c0, th
 
 /* Sweeps until no impulse changes by more than 1e-14 N s; 1 if it stopped
  * at its iteration limit instead. */
-static int lcp_gauss_seidel(double inv_mass, double inv_j, thesis_contact *cs, int n)
+THESIS_SPECIALISED int lcp_gauss_seidel(double inv_mass, double inv_j, thesis_contact *cs, int n,
+                                        const int extended)
 {
 	for (int i = 0; i < n; i++)
 		cs[i].impulse = 0.0;
@@ -93,9 +96,10 @@ static int lcp_gauss_seidel(double inv_mass, double inv_j, thesis_contact *cs, i
 		for (int i = 0; i < n; i++) {
 			double wi = cs[i].vrel - cs[i].bound;
 			for (int j = 0; j < n; j++)
-				wi += k_entry(inv_mass, inv_j, &cs[i], &cs[j]) * cs[j].impulse;
-			double p = fmax(0.0, cs[i].impulse -
-			                             wi / k_entry(inv_mass, inv_j, &cs[i], &cs[i]));
+				wi += k_entry(inv_mass, inv_j, &cs[i], &cs[j], extended) *
+				      cs[j].impulse;
+			double p = fmax(0.0, cs[i].impulse - wi / k_entry(inv_mass, inv_j, &cs[i],
+			                                                  &cs[i], extended));
 			change = fmax(change, fabs(p - cs[i].impulse));
 			cs[i].impulse = p;
 		}
@@ -114,8 +118,8 @@ static int popcount(unsigned v)
 }
 
 /* Tries active set `mask`: 1 and the impulses in cs if it solves the LCP. */
-static int lcp_try_set(double inv_mass, double inv_j, thesis_contact *cs, int n, unsigned mask,
-                       const double *q, double tol)
+THESIS_SPECIALISED int lcp_try_set(double inv_mass, double inv_j, thesis_contact *cs, int n,
+                                   unsigned mask, const double *q, double tol, const int extended)
 {
 	double kss[LCP_EXACT_MAX * LCP_EXACT_MAX], p[LCP_EXACT_MAX], rhs[LCP_EXACT_MAX];
 	int idx[LCP_EXACT_MAX], m = 0;
@@ -125,7 +129,8 @@ static int lcp_try_set(double inv_mass, double inv_j, thesis_contact *cs, int n,
 	for (int a = 0; a < m; a++) {
 		rhs[a] = -q[idx[a]];
 		for (int b = 0; b < m; b++)
-			kss[a * m + b] = k_entry(inv_mass, inv_j, &cs[idx[a]], &cs[idx[b]]);
+			kss[a * m + b] =
+			        k_entry(inv_mass, inv_j, &cs[idx[a]], &cs[idx[b]], extended);
 	}
 	if (m > 0) {
 		/* LU with partial pivoting; a pivot below round-off of the
@@ -156,7 +161,7 @@ static int lcp_try_set(double inv_mass, double inv_j, thesis_contact *cs, int n,
 			continue;
 		double wj = q[j];
 		for (int a = 0; a < m; a++)
-			wj += k_entry(inv_mass, inv_j, &cs[j], &cs[idx[a]]) * p[a];
+			wj += k_entry(inv_mass, inv_j, &cs[j], &cs[idx[a]], extended) * p[a];
 		if (wj < -tol)
 			return 0;
 	}
@@ -167,7 +172,8 @@ static int lcp_try_set(double inv_mass, double inv_j, thesis_contact *cs, int n,
 	return 1;
 }
 
-static int lcp_enumerate(double inv_mass, double inv_j, thesis_contact *cs, int n)
+THESIS_SPECIALISED int lcp_enumerate(double inv_mass, double inv_j, thesis_contact *cs, int n,
+                                     const int extended)
 {
 	double q[LCP_EXACT_MAX], qmax = 0.0;
 	for (int i = 0; i < n; i++) {
@@ -179,7 +185,7 @@ static int lcp_enumerate(double inv_mass, double inv_j, thesis_contact *cs, int 
 	for (int size = 0; size <= n; size++)
 		for (unsigned mask = 0; mask < sets; mask++)
 			if (popcount(mask) == size &&
-			    lcp_try_set(inv_mass, inv_j, cs, n, mask, q, tol))
+			    lcp_try_set(inv_mass, inv_j, cs, n, mask, q, tol, extended))
 				return 1;
 	return 0;
 }
@@ -196,31 +202,33 @@ long thesis_lcp_fallbacks(void)
 
 /* The solve for both entry points below: inline, so that the essay's
  * (inv_j = 0) is compiled with the rotation's terms gone. */
-static inline int lcp_solve(double inv_mass, double inv_j, thesis_contact *cs, int n)
+THESIS_SPECIALISED int lcp_solve(double inv_mass, double inv_j, thesis_contact *cs, int n,
+                                 const int extended)
 {
 	if (n == 1) {
 		double q = cs[0].vrel - cs[0].bound;
-		cs[0].impulse = q < 0.0 ? -q / k_entry(inv_mass, inv_j, &cs[0], &cs[0]) : 0.0;
+		cs[0].impulse =
+		        q < 0.0 ? -q / k_entry(inv_mass, inv_j, &cs[0], &cs[0], extended) : 0.0;
 	} else if (n == 2) {
-		lcp_two(inv_mass, inv_j, &cs[0], &cs[1]);
+		lcp_two(inv_mass, inv_j, &cs[0], &cs[1], extended);
 	} else if (n > 2) {
-		if (n <= LCP_EXACT_MAX && lcp_enumerate(inv_mass, inv_j, cs, n))
+		if (n <= LCP_EXACT_MAX && lcp_enumerate(inv_mass, inv_j, cs, n, extended))
 			return 0;
 #pragma omp atomic update
 		lcp_fallbacks++;
-		return lcp_gauss_seidel(inv_mass, inv_j, cs, n);
+		return lcp_gauss_seidel(inv_mass, inv_j, cs, n, extended);
 	}
 	return 0;
 }
 
 int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n)
 {
-	return lcp_solve(inv_mass, 0.0, cs, n);
+	return lcp_solve(inv_mass, 0.0, cs, n, 0);
 }
 
 int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
-	return lcp_solve(inv_mass, inv_j, cs, n);
+	return lcp_solve(inv_mass, inv_j, cs, n, 1);
 }
 
 void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2])

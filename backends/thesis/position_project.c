@@ -16,20 +16,22 @@
  * normals only); the torque's work over dpsi joins the correction. */
 #include "thesis/thesis.h"
 
-static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const double force[2],
-                         double torque)
+/* extended: constant (contact_detect.c's contact_detect): 0 compiles the
+ * essay's disk's copy of this file's functions without the extended path. */
+THESIS_SPECIALISED void project_once(struct bsim_world *w, thesis_contact *cs, int n,
+                                     const double force[2], double torque, const int extended)
 {
 	for (int k = 0; k < n; k++) {
 		cs[k].vrel = cs[k].gap;
 		cs[k].bound = 0.0;
 		cs[k].inv_i = w->beams[cs[k].beam].inv_inertia;
 	}
-	if (w->extended)
+	if (extended && w->extended)
 		w->solver.iteration_limit +=
 		        thesis_lcp_solve_j(w->inv_mass, w->inv_body_inertia, cs, n);
 	else
 		w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
-	if (w->rotates) {
+	if (extended && w->rotates) {
 		double dpsi = 0.0;
 		for (int k = 0; k < n; k++)
 			dpsi += cs[k].impulse * cs[k].cb;
@@ -60,8 +62,15 @@ static void project_once(struct bsim_world *w, thesis_contact *cs, int n, const 
  * once (a capsule may have two contacts with one beam, and may have one
  * where it had two, or two where it had one): the beams are listed first
  * (in w->candidates, free after the step's detection). */
-static inline int redetect(struct bsim_world *w, thesis_contact *cs, int n, double margin)
+THESIS_SPECIALISED int redetect(struct bsim_world *w, thesis_contact *cs, int n, double margin,
+                                const int extended)
 {
+	if (!extended) { /* the essay's disk */
+		int m = 0;
+		for (int k = 0; k < n; k++)
+			m += thesis_contact_detect_disk(w, cs[k].beam, margin, &cs[m]);
+		return m;
+	}
 	if (!w->shaped) { /* one contact a beam: in place, in order */
 		int m = 0;
 		for (int k = 0; k < n; k++)
@@ -84,11 +93,12 @@ static inline int redetect(struct bsim_world *w, thesis_contact *cs, int n, doub
 
 /* Re-detects the step's contacts at the new positions (they are the only
  * beams the step could have reached) and projects out penetration. */
-void thesis_position_project(struct bsim_world *w, const double force[2], double torque)
+THESIS_SPECIALISED void position_project(struct bsim_world *w, const double force[2], double torque,
+                                         const int extended)
 {
 	double margin = w->contact_tol;
 	thesis_contact *cs = w->contacts;
-	int n = redetect(w, cs, w->n_contacts, margin);
+	int n = redetect(w, cs, w->n_contacts, margin, extended);
 	for (int pass = 0; w->projection; pass++) {
 		int deep = 0;
 		for (int k = 0; k < n; k++)
@@ -99,11 +109,21 @@ void thesis_position_project(struct bsim_world *w, const double force[2], double
 			w->solver.iteration_limit++;
 			break;
 		}
-		project_once(w, cs, n, force, torque);
-		n = redetect(w, cs, n, margin);
+		project_once(w, cs, n, force, torque, extended);
+		n = redetect(w, cs, n, margin, extended);
 	}
 	w->n_contacts = n;
 	for (int k = 0; k < n; k++)
 		if (cs[k].gap <= w->contact_tol)
 			w->contact_type[cs[k].beam] = cs[k].type;
+}
+
+void thesis_position_project(struct bsim_world *w, const double force[2], double torque)
+{
+	position_project(w, force, torque, 1);
+}
+
+void thesis_position_project_disk(struct bsim_world *w, const double force[2])
+{
+	position_project(w, force, 0.0, 0);
 }

@@ -31,6 +31,23 @@
 
 #include "beamsim/backend.h"
 
+/* A function written once for any body with a constant `extended` and
+ * called with 1 (any body) and 0 (the essay's disk, w->extended 0): always
+ * inlined, so that each copy is compiled for its constant and the disk's
+ * has none of the extended path's tests. */
+#if defined(__GNUC__)
+#define THESIS_SPECIALISED static inline __attribute__((always_inline))
+#else
+#define THESIS_SPECIALISED static inline
+#endif
+/* A function kept apart from its caller (thesis_world.c's two copies of
+ * the step), so that the caller's short path saves no registers for it. */
+#if defined(__GNUC__)
+#define THESIS_APART static __attribute__((noinline))
+#else
+#define THESIS_APART static
+#endif
+
 /* The geometry of the body against one beam at one configuration: the
  * body's centre x and the beam's angle theta it was computed at, and the
  * nearest point's distance, normal and lever (contact_detect.c). */
@@ -110,8 +127,9 @@ enum { THESIS_SIMULTANEOUS = 0, THESIS_NEAREST_FIRST = 1 };
 enum { THESIS_CONTACT_PHYSICAL = 0, THESIS_CONTACT_ESSAY = 1 };
 
 struct bsim_world {
-	double x[2], v[2]; /* body centre and velocity */
-	double heading;    /* rad, psi */
+	double x[2], v[2];       /* body centre and velocity */
+	double heading;          /* rad, psi */
+	double angular_velocity; /* rad/s, w (next to the heading: get_state copies them) */
 	double mass, inv_mass;
 	/* m: the disk's radius; for another shape its reach (body_shape_reach),
 	 * what every distance bound (broad phase, margins, sleep) needs. */
@@ -122,7 +140,6 @@ struct bsim_world {
 	 * not turn: no solve turns it), kg m^2, and the contacts' Coulomb mu. */
 	int extended, shaped, rotates;
 	bsim_body_def body;
-	double angular_velocity;
 	double body_inertia, inv_body_inertia;
 	double friction;
 	/* Friction impacts whose Newton impulse would have gained energy and
@@ -137,6 +154,9 @@ struct bsim_world {
 	double rest_threshold;   /* m/s */
 	/* knobs */
 	int integrator, impact_order, projection, contact_mode;
+	/* 1: the essay's disk (extended 0) with contact_mode physical, whose
+	 * free flight thesis_step takes at once. */
+	int flight_disk;
 	double slop;         /* penetration tolerated before projection, m */
 	double contact_tol;  /* gap the solver counts as touching (held, awake), m */
 	int broad_phase;     /* 1: grid query for beams at rest; 0: test every beam */
@@ -231,6 +251,10 @@ void thesis_beam_direction(thesis_beam *b, double u[2]);
 /* The contacts of beam i within margin into out (room for 2); returns how
  * many (0, 1, or 2 for a capsule along the beam). */
 int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out);
+/* Each _disk function below: the same for the essay's disk (w->extended 0)
+ * only, compiled without the extended path's tests and stores (a contact's
+ * extended fields are not set); thesis_step picks once a step. */
+int thesis_contact_detect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out);
 /* shape_contact.c: a body of another shape than the disk against beam b of
  * direction u (thesis_beam_direction), into b->geo; and a capsule's second contact with the beam of
  * geometry g into out[1] (out[0] the first) if within margin: 1, else 0. */
@@ -240,16 +264,20 @@ int thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, do
 /* 0 if beam i certainly lies farther than R + margin from the body (its
  * reach, or the bound from its last geometry), 1 if it may not. */
 int thesis_contact_near(const struct bsim_world *w, int i, double margin);
+int thesis_contact_near_disk(const struct bsim_world *w, int i, double margin);
 
 /* contact_report.c: the state's contact flag after a step (or at creation). */
 void thesis_contact_report(struct bsim_world *w);
+void thesis_contact_report_disk(struct bsim_world *w);
 void thesis_contact_clear(struct bsim_world *w);
 
 /* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
  * counts it in w->solver), else 0. inv_mass is the body's 1/M, 1/kg (for
  * impacts, 1/impact_mass). */
 int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n);
-/* thesis_lcp_solve with the body's rotation: 1/J (inv_j) in K. */
+/* thesis_lcp_solve with the body's rotation: 1/J (inv_j) in K, and a
+ * capsule's two contacts on one beam coupled; thesis_lcp_solve is the
+ * essay's disk's (neither). */
 int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n);
 /* The same problem on the extended path: 1/J (the body's rotation, inv_j =
  * 0: none) in K, and with friction (any contact's mu > 0) the tangent rows
@@ -267,27 +295,31 @@ void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2]);
 
 /* impact_resolve.c */
 int thesis_impact_resolve(struct bsim_world *w, double h);
+int thesis_impact_resolve_disk(struct bsim_world *w, double h);
 
 /* persistent_contact.c */
 void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
                                      double h);
+void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2], double h);
 
 /* position_project.c */
 void thesis_position_project(struct bsim_world *w, const double force[2], double torque);
+void thesis_position_project_disk(struct bsim_world *w, const double force[2]);
 
 /* The kinetic energy of body and beams, J; inline, so that the world
  * (thesis_world.c) and the impacts (impact_resolve.c) share it without
  * calling into each other. Beams at rest have omega = 0 and add nothing:
  * the awake ones, in ascending order, give the sum over all beams to the
- * bit. */
-static inline double thesis_kinetic_energy(const struct bsim_world *w)
+ * bit. extended: a constant, 0 for the essay's disk (w->extended 0),
+ * whose copy has no test of the body's rotation. */
+static inline double thesis_kinetic_energy(const struct bsim_world *w, const int extended)
 {
 	double e = 0.5 * w->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);
 	for (int k = 0; k < w->n_awake; k++) {
 		const thesis_beam *b = &w->beams[w->awake[k]];
 		e += 0.5 * b->inertia * b->omega * b->omega;
 	}
-	if (w->rotates)
+	if (extended && w->rotates)
 		e += 0.5 * w->body_inertia * w->angular_velocity * w->angular_velocity;
 	return e;
 }
@@ -382,11 +414,12 @@ static inline void thesis_body_turn(struct bsim_world *w, double w0, double torq
 }
 
 /* v_rel = v . n - omega c (contact_detect.c); on the extended path plus
- * w cb, and the tangent row's v_t. */
-static inline void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c)
+ * w cb, and the tangent row's v_t (extended: a constant, 0 for the essay's disk). */
+static inline void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c,
+                                           const int extended)
 {
 	c->vrel = (w->v[0] * c->n[0] + w->v[1] * c->n[1]) - w->beams[c->beam].omega * c->c;
-	if (w->extended) {
+	if (extended && w->extended) {
 		c->vrel += w->angular_velocity * c->cb;
 		c->vrel_t = (w->v[1] * c->n[0] - w->v[0] * c->n[1]) + w->angular_velocity * c->cbt -
 		            w->beams[c->beam].omega * c->ct;

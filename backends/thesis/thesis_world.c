@@ -219,6 +219,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	w->slop = bsim_options_double(opts, &thesis_knobs[KNOB_SLOP]);
 	w->contact_tol = fmax(bsim_options_double(opts, &thesis_knobs[KNOB_CONTACT_TOL]), w->slop);
 	w->contact_mode = bsim_options_choice(opts, &thesis_knobs[KNOB_CONTACT_MODE]);
+	w->flight_disk = !w->extended && w->contact_mode != THESIS_CONTACT_ESSAY;
 	w->broad_phase = bsim_options_int(opts, &thesis_knobs[KNOB_BROAD_PHASE]) != 0;
 	int sleep = bsim_options_choice(opts, &thesis_knobs[KNOB_SLEEP]);
 	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
@@ -324,7 +325,8 @@ static int essay_hold(bsim_world *w)
 
 /* The contacts the step can reach into w->contacts; returns how many, and
  * the speed bound of the margins in *speed. */
-static int step_detect(bsim_world *w, const double force[2], double torque, double h, double *speed)
+THESIS_SPECIALISED int step_detect(bsim_world *w, const double force[2], double torque, double h,
+                                   double *speed, const int extended)
 {
 	/* A bound for the margin only: speeds and forces are far from overflow,
 	 * so sqrt serves where hypot's scaling would cost a tenth of a step. */
@@ -332,7 +334,7 @@ static int step_detect(bsim_world *w, const double force[2], double torque, doub
 	           h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
 	/* A shape that turns: its outline moves up to reach |w| faster than its
 	 * centre (the disk's does not move when it turns). */
-	if (w->shaped && w->rotates)
+	if (extended && w->shaped && w->rotates)
 		v += w->radius *
 		     (fabs(w->angular_velocity) + h * fabs(torque) * w->inv_body_inertia);
 	int holding = w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
@@ -342,8 +344,9 @@ static int step_detect(bsim_world *w, const double force[2], double torque, doub
 		int i = w->candidates[k];
 		if (holding && !w->held[i])
 			continue; /* essay: the constraint loop tests only held beams */
-		int got = thesis_contact_detect(w, i, thesis_step_margin(w, &w->beams[i], v, h),
-		                                &w->contacts[n]);
+		double margin = thesis_step_margin(w, &w->beams[i], v, h);
+		int got = extended ? thesis_contact_detect(w, i, margin, &w->contacts[n])
+		                   : thesis_contact_detect_disk(w, i, margin, &w->contacts[n]);
 		if (got)
 			thesis_beam_wake(w, i);
 		n += got;
@@ -359,7 +362,8 @@ static int step_detect(bsim_world *w, const double force[2], double torque, doub
  * contact solve's body update with a zero impulse sum (thesis_body_advance,
  * as persistent_contact.c's with none); no beam to move, sleep or prune;
  * the last step's flags cleared. */
-static void flight_step(bsim_world *w, const double force[2], double torque, double h)
+THESIS_SPECIALISED void flight_step(bsim_world *w, const double force[2], double torque, double h,
+                                    const int extended)
 {
 	w->n_contacts = 0;
 	double v0[2] = {w->v[0], w->v[1]};
@@ -367,24 +371,23 @@ static void flight_step(bsim_world *w, const double force[2], double torque, dou
 	const double j[2] = {0.0, 0.0};
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm);
-	thesis_body_turn(w, w->angular_velocity, torque, 0.0, h);
+	if (extended)
+		thesis_body_turn(w, w->angular_velocity, torque, 0.0, h);
 	if (w->n_flagged)
 		thesis_contact_clear(w);
 }
 
-/* Nothing in a step allocates: the world's memory is sized at creation. */
-static int thesis_step(bsim_world *w, const double force[2], double torque, double h,
-                       bsim_error *err)
+/* A step of any body (extended 1) or of the essay's disk (extended 0,
+ * w->extended 0): a constant, so that the disk's copy, and the _disk
+ * functions it calls, are compiled without the extended path's tests
+ * (docs/backends.md, "Cost to the essay's disk"). */
+THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double torque, double h,
+                                int in_flight, const int extended)
 {
-	(void)err;
-	/* Free flight among beams at rest (none awake, none in reach): no
-	 * contact, no beam to move, no square root for the margin. */
-	int in_flight = w->n_awake == 0 && thesis_flight_clear(w, force, h);
-	memset(&w->energy, 0, sizeof w->energy);
-	w->impacts = 0;
-	if (in_flight && w->n_typed == 0 && h == w->h_prepared &&
+	/* The essay's disk's free flight was thesis_step's (w->flight_disk). */
+	if (extended && in_flight && w->n_typed == 0 && h == w->h_prepared &&
 	    w->contact_mode != THESIS_CONTACT_ESSAY) {
-		flight_step(w, force, torque, h);
+		flight_step(w, force, torque, h, extended);
 		return BSIM_OK;
 	}
 	for (int k = 0; k < w->n_typed; k++)
@@ -396,19 +399,30 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 		w->h_prepared = h;
 	}
 	double speed = 0.0;
-	int n = in_flight ? 0 : step_detect(w, force, torque, h, &speed);
+	int n = in_flight ? 0 : step_detect(w, force, torque, h, &speed, extended);
 	w->n_contacts = n;
-	if (n)
-		thesis_impact_resolve(w, h);
-	thesis_persistent_contact_solve(w, force, torque, h);
+	if (n) {
+		if (extended)
+			thesis_impact_resolve(w, h);
+		else
+			thesis_impact_resolve_disk(w, h);
+	}
+	if (extended)
+		thesis_persistent_contact_solve(w, force, torque, h);
+	else
+		thesis_persistent_contact_solve_disk(w, force, h);
 	if (w->contact_mode == THESIS_CONTACT_ESSAY)
 		w->any_held = essay_hold(w);
-	if (n)
-		thesis_position_project(w, force, torque);
+	if (n) {
+		if (extended)
+			thesis_position_project(w, force, torque);
+		else
+			thesis_position_project_disk(w, force);
+	}
 	/* A beam's two contacts (a capsule along it) are adjacent: listed once. */
 	for (int k = 0; k < w->n_contacts; k++)
 		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE &&
-		    (k == 0 || w->contacts[k - 1].beam != w->contacts[k].beam))
+		    (!extended || k == 0 || w->contacts[k - 1].beam != w->contacts[k].beam))
 			w->typed[w->n_typed++] = w->contacts[k].beam;
 	if (!in_flight) {
 		if (w->sleep)
@@ -417,15 +431,53 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 	}
 	if (in_flight)
 		thesis_contact_clear(w);
-	else
+	else if (extended)
 		thesis_contact_report(w);
+	else
+		thesis_contact_report_disk(w);
 	return BSIM_OK;
+}
+
+/* The two copies, apart from thesis_step, whose free flight then needs
+ * no more registers than it uses. */
+THESIS_APART int step_extended(bsim_world *w, const double force[2], double torque, double h,
+                               int in_flight)
+{
+	return step_run(w, force, torque, h, in_flight, 1);
+}
+
+THESIS_APART int step_disk(bsim_world *w, const double force[2], double h, int in_flight)
+{
+	return step_run(w, force, 0.0, h, in_flight, 0);
+}
+
+/* Nothing in a step allocates: the world's memory is sized at creation. */
+static int thesis_step(bsim_world *w, const double force[2], double torque, double h,
+                       bsim_error *err)
+{
+	(void)err;
+	/* Free flight among beams at rest (none awake, none in reach): no
+	 * contact, no beam to move, no square root for the margin; the essay's
+	 * disk's at once, as it was before the extended path. */
+	int in_flight = w->n_awake == 0 && thesis_flight_clear(w, force, h);
+	memset(&w->energy, 0, sizeof w->energy);
+	w->impacts = 0;
+	if (in_flight && w->n_typed == 0 && h == w->h_prepared && w->flight_disk) {
+		flight_step(w, force, torque, h, 0);
+		return BSIM_OK;
+	}
+	if (w->extended)
+		return step_extended(w, force, torque, h, in_flight);
+	return step_disk(w, force, h, in_flight);
 }
 
 static void thesis_get_state(const bsim_world *w, bsim_state *s)
 {
-	memcpy(s->x, w->x, sizeof s->x);
-	memcpy(s->v, w->v, sizeof s->v);
+	/* In the order of both structs: three 16-byte moves. */
+	s->x[0] = w->x[0];
+	s->x[1] = w->x[1];
+	s->v[0] = w->v[0];
+	s->v[1] = w->v[1];
 	s->heading = w->heading;
 	s->angular_velocity = w->angular_velocity;
 	s->pivot_drift = 0.0; /* a beam here is an angle about a fixed pivot */
