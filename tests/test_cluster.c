@@ -406,6 +406,90 @@ static void test_markov_shards_merged(void **state)
 	assert_false(bsim_test_exists(bsim_test_join(bad, "markov.json")));
 }
 
+/* ---- markov build: maps built in passes -------------------------------- */
+
+/* markov build of the four maps in passes (entries "self:1" or "flow:1":
+ * pass 0, then pass 1 from its exits) at 2 x 2 x 2 entry bins of 3 trials
+ * into out, with the extra arguments a and b (NULL: none). */
+static void markov_passes_build(const char *out, const char *entries, const char *threads,
+                                const char *a, const char *b)
+{
+	const char *argv[] = {"markov",   "build",     markov_lattice(),
+	                      "--trials", "3",         "--bins",
+	                      "2,2,2",    "--entries", entries,
+	                      "--grid",   MARKOV_GRID, "--threads",
+	                      threads,    "--out",     out,
+	                      "--quiet",  a,           b,
+	                      NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	if (rc != 0)
+		print_error("%s", err ? err : "");
+	free(err);
+	assert_int_equal(rc, 0);
+}
+
+/* How many files of dir end in suffix. */
+static int count_suffix(const char *dir, const char *suffix)
+{
+	char cmd[4600];
+	snprintf(cmd, sizeof cmd, "find '%s' -maxdepth 1 -name '*%s' | wc -l", dir, suffix);
+	FILE *p = popen(cmd, "r");
+	int n = -1;
+	if (p) {
+		if (fscanf(p, "%d", &n) != 1)
+			n = -1;
+		pclose(p);
+	}
+	return n;
+}
+
+/* Self-consistent maps (self:1) in 3 parts, merged: the one-process map
+ * directory, every pass's map and exits with it, but for the CPU times.
+ * Flow-weighted ones (flow:1) in a part are refused, naming what builds
+ * them. */
+static void test_markov_self_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[3][1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("markov_self_parts"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	markov_passes_build(one, "self:1", "2", NULL, NULL);
+	/* four maps of two passes each: 8 maps, 8 exits */
+	assert_int_equal(count_maps(one), 8);
+	assert_int_equal(count_suffix(one, ".exits.csv"), 8);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		markov_passes_build(part[i], "self:1", i == 1 ? "2" : "1", "--shard", shard_arg);
+		assert_int_equal(count_maps(part[i]), i == 0 ? 4 : 2);
+	}
+	snprintf(out, sizeof out, "%s/merged", dir);
+	const char *argv[] = {"merge", part[1], part[2], part[0], "--out", out, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	assert_same_dir(one, out);
+	/* a part without one of its passes' exits: refused, naming it */
+	char cut[1100], bad[1100], cmd[4000];
+	snprintf(cut, sizeof cut, "%s/cut", dir);
+	snprintf(bad, sizeof bad, "%s/refused", dir);
+	snprintf(cmd, sizeof cmd, "cp -r '%s' '%s' && rm \"$(ls '%s'/map_*.exits.csv | head -1)\"",
+	         part[2], cut, cut);
+	assert_int_equal(system(cmd), 0);
+	const char *argv_cut[] = {"merge", part[0], part[1], cut, "--out", bad, NULL};
+	bsim_test_expect_input_error(argv_cut, (const char *const[]){cut, NULL});
+	assert_false(bsim_test_exists(bsim_test_join(bad, "markov.json")));
+	/* flow entries: a pass needs every map's previous pass */
+	char flow[1100];
+	snprintf(flow, sizeof flow, "%s/flow_part", dir);
+	const char *argv_flow[] = {
+	        "markov",    "build",  markov_lattice(), "--trials", "3",     "--bins", "2,2,2",
+	        "--entries", "flow:1", "--shard",        "1/3",      "--out", flow,     NULL};
+	bsim_test_expect_input_error(
+	        argv_flow, (const char *const[]){"flow", "mpirun -np N", "one process", NULL});
+	assert_false(bsim_test_exists(bsim_test_join(flow, "part.json")));
+}
+
 /* ---- MPI ----------------------------------------------------------------- */
 
 /* ---- a lattice sweep: its records hold the gate paths -------------------- */
@@ -947,6 +1031,55 @@ static void test_mpi_markov_build(void **state)
 	assert_int_equal(rmdir(tmp), 0); /* nor any directory */
 }
 
+/* markov build of maps in passes over 3 ranks: self:1 (each map's passes
+ * on its rank) and flow:1 (the ranks meet after pass 0, each with every
+ * map's single gates): the one-process map directory, every pass's map
+ * and exits, but for the CPU times. */
+static void test_mpi_markov_passes(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	static const char *const entries[] = {"self:1", "flow:1"};
+	for (int k = 0; k < 2; k++) {
+		char dir[1024], one[1100], out[1100], err_path[1200];
+		snprintf(dir, sizeof dir, "%s",
+		         bsim_test_dir(k ? "mpi_markov_flow" : "mpi_markov_self"));
+		snprintf(one, sizeof one, "%s/one", dir);
+		snprintf(out, sizeof out, "%s/ranks3", dir);
+		snprintf(err_path, sizeof err_path, "%s.err", out);
+		markov_passes_build(one, entries[k], "2", NULL, NULL);
+		assert_int_equal(count_suffix(one, ".exits.csv"), 8);
+		const char *argv[] = {BSIM_TEST_MPIEXEC,
+		                      "--oversubscribe",
+		                      "-np",
+		                      "3",
+		                      BSIM_EXE,
+		                      "markov",
+		                      "build",
+		                      markov_lattice(),
+		                      "--trials",
+		                      "3",
+		                      "--bins",
+		                      "2,2,2",
+		                      "--entries",
+		                      entries[k],
+		                      "--grid",
+		                      MARKOV_GRID,
+		                      "--threads",
+		                      "1",
+		                      "--out",
+		                      out,
+		                      "--quiet",
+		                      NULL};
+		int rc = wait_status(spawn_mpirun(argv, err_path));
+		if (rc != 0)
+			print_stderr(err_path);
+		assert_int_equal(rc, 0);
+		assert_same_dir(one, out);
+	}
+}
+
 static void test_mpi_identical(void **state)
 {
 	(void)state;
@@ -1221,6 +1354,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_compare_shards_merged),
 	        cmocka_unit_test(test_merge_refuses),
 	        cmocka_unit_test(test_markov_shards_merged),
+	        cmocka_unit_test(test_markov_self_shards_merged),
 	        cmocka_unit_test(test_lattice_shards_merged),
 	        cmocka_unit_test(test_lattice_compare_shards_merged),
 	        cmocka_unit_test(test_lattice_compare_killed_resumed),
@@ -1232,6 +1366,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_mpi_identical),
 	        cmocka_unit_test(test_mpi_compare),
 	        cmocka_unit_test(test_mpi_markov_build),
+	        cmocka_unit_test(test_mpi_markov_passes),
 	        cmocka_unit_test(test_mpi_rank_killed_resumed),
 	        cmocka_unit_test(test_mpi_lattice),
 	        cmocka_unit_test(test_mpi_lattice_compare),

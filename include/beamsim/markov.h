@@ -44,6 +44,7 @@
 #define BSIM_MARKOV_H
 
 #include <signal.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "beamsim/base.h"
@@ -138,11 +139,22 @@ typedef struct bsim_markov_def {
 	 * single gate runs; every map not in dir is read from the first of the
 	 * map directories from[0..n_from) (each checked against its manifest)
 	 * that has it and written into dir, the same bytes; a map none has is
-	 * BSIM_EINPUT naming it, and nothing is written. Entries self or flow
-	 * (maps built in passes) are not spread: BSIM_EINPUT. */
+	 * BSIM_EINPUT naming it, and nothing is written. Self entries are
+	 * spread the same way, a map's passes with it (every pass's map and
+	 * exits copied from its part); flow entries need pass_exchange. */
 	int part, parts, part_first;
 	const char *const *from;
 	int n_from;
+	/* Flow entries spread over parts (parts > 1) that meet after each pass
+	 * (an MPI job's ranks; NULL: flow entries over parts are BSIM_EINPUT,
+	 * since pass p + 1 of every map needs pass p of all). Called by every
+	 * part after each pass but the last, with the same arguments but runs'
+	 * contents: runs[i] (bytes each) holds map i's single gates of that
+	 * pass on part owner[i] (i < n, the lattice's pairs as above), and on
+	 * return every part must hold every map's; BSIM_OK or an error (err). */
+	int (*pass_exchange)(void *user, void *const *runs, size_t bytes, const int *owner, int n,
+	                     bsim_error *err);
+	void *pass_exchange_user;
 } bsim_markov_def;
 
 #define BSIM_MARKOV_SELF_GATES      16

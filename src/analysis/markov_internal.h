@@ -129,6 +129,14 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                          const char *dir, const char *stage, long *done, long total,
                          bsim_error *err);
 
+/* Map m's passes (def's self or flow entries) copied from the part
+ * directory from into stage by the writers that wrote them: every pass's
+ * map but the last (m, the caller's) and every pass's exits, the same
+ * bytes. BSIM_EINPUT naming the file if one is missing or malformed. */
+int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                     const bsim_options *opts, const bsim_markov_map *m, const char *from,
+                     const char *stage, bsim_error *err);
+
 /* ---- the chain's exits (markov_chain.c) ---- */
 
 /* Where exit x (0 stuck, else an entry bin of the gate entered) of gate g =

@@ -111,10 +111,16 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		                      "observed entries, got %d passes%s",
 		                      BSIM_MARKOV_SELF_PASSES_MAX, def->self_passes,
 		                      def->entries ? " and observed entries" : "");
-	if ((def->parts > 1 || def->n_from > 0) && def->self_entries)
+	/* A self-consistent map's passes are its own: spread whole. A flow
+	 * map's pass p + 1 needs every map's pass p: its parts must meet after
+	 * each pass (pass_exchange). */
+	if (def->parts > 1 && def->self_entries == 2 && !def->pass_exchange)
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "entries: maps built in passes (self or flow entries) are "
-		                      "built in one process, not spread over parts");
+		                      "entries: flow-weighted maps (flow or flow:N) are not built "
+		                      "in parts of a job array: each pass needs every map's pass "
+		                      "before; build them under mpirun -np N (whose ranks meet "
+		                      "after each pass) or in one process; --shard spreads self "
+		                      "and observed entries");
 	if (def->parts > 1 && (def->part < 0 || def->part >= def->parts))
 		return bsim_error_set(err, BSIM_EINPUT, "part %d of %d: expected 0 to %d",
 		                      def->part, def->parts, def->parts - 1);
@@ -176,7 +182,8 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	int rc = BSIM_OK;
 	long total = 0, done = 0;
 	char *have = calloc((size_t)n, 1);
-	if (!have)
+	int *src = calloc((size_t)n, sizeof *src); /* a copied map's part: from[src[i]] */
+	if (!have || !src)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (int i = 0; i < n && rc == BSIM_OK; i++) {
 		bsim_markov_map *m = &out->maps[i];
@@ -191,7 +198,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		/* A spread build's merge: the map from the part that built it. */
 		for (int j = 0; got == 0 && j < def->n_from; j++)
 			if ((got = markov_map_read(def->from[j], m, err)) > 0)
-				m->copied = 1;
+				m->copied = 1, src[i] = j;
 		if (got > 0 && m->copied && !m->hold_exit)
 			rc = bsim_error_set(err, BSIM_EINPUT,
 			                    "%s: the map for k = %g, %g N m/rad has no holding "
@@ -238,8 +245,10 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	for (int i = 0; i < n; i++)
 		to_build -= out->maps[i].elsewhere;
 	/* Flow-weighted entries: every map's passes at once, the lattice's
-	 * chain weighting each pass's states. */
-	const int flow = def->self_entries == 2 && to_build > 0 && stage && rc == BSIM_OK;
+	 * chain weighting each pass's states. Parts that meet after each pass
+	 * all take part, those with no map of this lattice too. */
+	const int flow = def->self_entries == 2 && stage && rc == BSIM_OK &&
+	                 (to_build > 0 || (def->parts > 1 && def->pass_exchange));
 	if (flow)
 		rc = markov_flow_simulate(lattice, def, be, opts, out->maps, n, have, dir, stage,
 		                          &done, total, err);
@@ -248,8 +257,14 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		if (have[i] || m->elsewhere)
 			continue;
 		if (m->copied) {
-			/* read from a part: written again as it was */
-			if ((rc = markov_map_write(stage, m, &def->bins, err)) == BSIM_OK)
+			/* read from a part: written again as it was, with its
+			 * passes' maps and exits when built in passes */
+			if (def->self_entries)
+				rc = markov_self_copy(lattice, def, be, opts, m, def->from[src[i]],
+				                      stage, err);
+			if (rc == BSIM_OK)
+				rc = markov_map_write(stage, m, &def->bins, err);
+			if (rc == BSIM_OK)
 				rc = map_commit(ss, err);
 			continue;
 		}
@@ -278,6 +293,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		               "stopped after %d of the %d maps to build; those are kept in %s",
 		               out->built, to_build, dir);
 	free(have);
+	free(src);
 	free(pairs);
 	if (rc != BSIM_OK)
 		bsim_markov_set_free(out);

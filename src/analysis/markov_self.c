@@ -321,6 +321,43 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	return rc;
 }
 
+int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                     const bsim_options *opts, const bsim_markov_map *m, const char *from,
+                     const char *stage, bsim_error *err)
+{
+	const int nb = m->n_bins, T = m->trials;
+	markov_run *runs = calloc((size_t)nb * T, sizeof *runs);
+	int rc = runs ? BSIM_OK : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int q = 0; q <= def->self_passes && rc == BSIM_OK; q++) {
+		bsim_markov_map mq;
+		if (pass_map(&mq, lattice, def, be, opts, m, q) != 0) {
+			pass_map_free(&mq);
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+			break;
+		}
+		/* the passes' maps but the last (m itself, written by the caller),
+		 * every pass's exits */
+		int got = q < def->self_passes ? markov_map_read(from, &mq, err) : 1;
+		if (got == 1)
+			got = runs_read(from, mq.key, runs, nb, T, err);
+		if (got == 0)
+			rc = bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s: pass %d of the map for k = %g, %g N m/rad (map_%016llx, "
+			        "its map and exits) is missing: not a part of this build",
+			        from, q, m->k[0], m->k[1], (unsigned long long)mq.key);
+		else if (got < 0)
+			rc = BSIM_EINPUT; /* err names the file and line */
+		if (rc == BSIM_OK && q < def->self_passes)
+			rc = markov_map_write(stage, &mq, &def->bins, err);
+		if (rc == BSIM_OK)
+			rc = runs_write(stage, mq.key, runs, nb, T, err);
+		pass_map_free(&mq);
+	}
+	free(runs);
+	return rc;
+}
+
 /* ---- flow-weighted passes over a field ---- */
 
 /* Where exit bin x (> 0) of gate g leads in a cols x rows field: the gate
@@ -395,6 +432,22 @@ static void field_visits(const markov_run *const *runs, const int *gate_map, int
 	free(y1);
 }
 
+/* Every map's runs of a pass from the part that simulated it: map i of
+ * the lattice is the build's map part_first + i (bsim_markov_def). */
+static int runs_exchange(const bsim_markov_def *def, markov_run **runs, int n, long units,
+                         bsim_error *err)
+{
+	int *owner = malloc((size_t)n * sizeof *owner);
+	if (!owner)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; i < n; i++)
+		owner[i] = (def->part_first + i) % def->parts;
+	int rc = def->pass_exchange(def->pass_exchange_user, (void *const *)runs,
+	                            (size_t)units * sizeof **runs, owner, n, err);
+	free(owner);
+	return rc;
+}
+
 int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                          const bsim_backend *be, const bsim_options *opts, bsim_markov_map *maps,
                          int n, const char *have, const char *dir, const char *stage, long *done,
@@ -434,10 +487,13 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	 * it cost, into the cost of each map to build (the caller adds this
 	 * build's CPU time). */
 	int q0 = 0;
+	/* Parts that meet after each pass start together from pass 0: the
+	 * same passes on every part, whatever each part's directory holds. */
+	const int meet = def->parts > 1 && def->pass_exchange;
 	bsim_markov_map *prior = calloc((size_t)n, sizeof *prior);
 	if (!prior)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (int q = def->self_passes - 1; q >= 0 && rc == BSIM_OK && !q0; q--) {
+	for (int q = def->self_passes - 1; q >= 0 && rc == BSIM_OK && !q0 && !meet; q--) {
 		int all = 1;
 		for (int i = 0; i < n && all; i++) {
 			bsim_markov_def dq = *def;
@@ -467,6 +523,8 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			markov_pool pool;
 			if (q == def->self_passes && have[b])
 				continue; /* its map is in the cache */
+			if (maps[b].elsewhere)
+				continue; /* another part's: its runs come by pass_exchange */
 			if (q > 0) {
 				/* each exit's weight: its entry bin's visits in the
 				 * gates of its map whose neighbour across it is map b's */
@@ -525,6 +583,8 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			}
 			pass_map_free(&mq);
 		}
+		if (meet && q < def->self_passes && rc == BSIM_OK)
+			rc = runs_exchange(def, cur, n, units, err);
 		markov_run **tmp = prev;
 		prev = cur;
 		cur = tmp;

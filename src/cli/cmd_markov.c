@@ -440,6 +440,8 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		a.def.part = a.shard - 1;
 		a.def.parts = a.shards;
 	}
+	if (p && cli_mpi_size() > 1) /* flow entries: the ranks meet after each pass */
+		a.def.pass_exchange = cli_mpi_pass_exchange;
 	bsim_options opts = {0};
 	const bsim_backend *be =
 	        cli_backend_with_opts(&c, "markov build", c.backend ? c.backend : "thesis", &opts);
