@@ -410,9 +410,9 @@ static void test_markov_shards_merged(void **state)
 
 /* markov build of the four maps in passes (entries "self:1" or "flow:1":
  * pass 0, then pass 1 from its exits) at 2 x 2 x 2 entry bins of 3 trials
- * into out, with the extra arguments a and b (NULL: none). */
-static void markov_passes_build(const char *out, const char *entries, const char *threads,
-                                const char *a, const char *b)
+ * into out, with the extra arguments a, b, c and d (NULL: none). */
+static void markov_passes_build4(const char *out, const char *entries, const char *threads,
+                                 const char *a, const char *b, const char *c, const char *d)
 {
 	const char *argv[] = {"markov",   "build",     markov_lattice(),
 	                      "--trials", "3",         "--bins",
@@ -420,13 +420,19 @@ static void markov_passes_build(const char *out, const char *entries, const char
 	                      "--grid",   MARKOV_GRID, "--threads",
 	                      threads,    "--out",     out,
 	                      "--quiet",  a,           b,
-	                      NULL};
+	                      c,          d,           NULL};
 	char *err = NULL;
 	int rc = bsim_test_cli(argv, NULL, &err);
 	if (rc != 0)
 		print_error("%s", err ? err : "");
 	free(err);
 	assert_int_equal(rc, 0);
+}
+
+static void markov_passes_build(const char *out, const char *entries, const char *threads,
+                                const char *a, const char *b)
+{
+	markov_passes_build4(out, entries, threads, a, b, NULL, NULL);
 }
 
 /* How many files of dir end in suffix. */
@@ -445,9 +451,8 @@ static int count_suffix(const char *dir, const char *suffix)
 }
 
 /* Self-consistent maps (self:1) in 3 parts, merged: the one-process map
- * directory, every pass's map and exits with it, but for the CPU times.
- * Flow-weighted ones (flow:1) in a part are refused, naming what builds
- * them. */
+ * directory, every pass's map and exits with it, but for the CPU times. A
+ * part that lacks a pass's exits is refused, naming it. */
 static void test_markov_self_shards_merged(void **state)
 {
 	(void)state;
@@ -479,15 +484,52 @@ static void test_markov_self_shards_merged(void **state)
 	const char *argv_cut[] = {"merge", part[0], part[1], cut, "--out", bad, NULL};
 	bsim_test_expect_input_error(argv_cut, (const char *const[]){cut, NULL});
 	assert_false(bsim_test_exists(bsim_test_join(bad, "markov.json")));
-	/* flow entries: a pass needs every map's previous pass */
-	char flow[1100];
-	snprintf(flow, sizeof flow, "%s/flow_part", dir);
-	const char *argv_flow[] = {
-	        "markov",    "build",  markov_lattice(), "--trials", "3",     "--bins", "2,2,2",
-	        "--entries", "flow:1", "--shard",        "1/3",      "--out", flow,     NULL};
+}
+
+/* Flow-weighted maps (flow:1) as a job array, one round a pass: 3 parts
+ * of pass 0 merged, then 3 parts of pass 1 reading that merge (--passes),
+ * merged: the one-process map directory, every pass's map and exits, but
+ * for the CPU times. A merge of parts of different rounds is refused, as
+ * is --passes without a round. */
+static void test_markov_flow_rounds_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], merged[2][1100], part[2][3][1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("markov_flow_rounds"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	markov_passes_build(one, "flow:1", "2", NULL, NULL);
+	assert_int_equal(count_suffix(one, ".exits.csv"), 8);
+	for (int r = 0; r < 2; r++) {
+		for (int i = 0; i < 3; i++) {
+			char shard_arg[16];
+			snprintf(part[r][i], sizeof part[r][i], "%s/r%d_p%d", dir, r, i + 1);
+			snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+			/* pass 1 from the merge of pass 0 */
+			markov_passes_build4(part[r][i], "flow:1", i == 1 ? "2" : "1", "--shard",
+			                     shard_arg, r ? "--passes" : NULL,
+			                     r ? merged[0] : NULL);
+		}
+		snprintf(merged[r], sizeof merged[r], "%s/merged%d", dir, r);
+		const char *argv[] = {"merge", part[r][2], part[r][0], part[r][1],
+		                      "--out", merged[r],  "--quiet",  NULL};
+		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+		/* pass 0 of every map, no final map; then everything */
+		assert_int_equal(count_suffix(merged[r], ".exits.csv"), r == 0 ? 4 : 8);
+	}
+	assert_same_dir(one, merged[1]);
+	char bad[1100];
+	snprintf(bad, sizeof bad, "%s/refused", dir);
+	const char *mixed[] = {"merge", part[0][0], part[1][1], part[1][2], "--out", bad, NULL};
 	bsim_test_expect_input_error(
-	        argv_flow, (const char *const[]){"flow", "mpirun -np N", "one process", NULL});
-	assert_false(bsim_test_exists(bsim_test_join(flow, "part.json")));
+	        mixed, (const char *const[]){part[1][1], "parts of different runs", NULL});
+	assert_false(bsim_test_exists(bsim_test_join(bad, "markov.json")));
+	const char *no_round[] = {"markov",   "build",   markov_lattice(), "--entries", "self:1",
+	                          "--passes", merged[0], "--out",          bad,         NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(no_round, NULL, &err);
+	bsim_test_check_input_error(rc, err, (const char *const[]){"--passes", "--shard", NULL}, 0);
+	free(err);
+	assert_false(bsim_test_exists(bad));
 }
 
 /* ---- MPI ----------------------------------------------------------------- */
@@ -1355,6 +1397,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_merge_refuses),
 	        cmocka_unit_test(test_markov_shards_merged),
 	        cmocka_unit_test(test_markov_self_shards_merged),
+	        cmocka_unit_test(test_markov_flow_rounds_merged),
 	        cmocka_unit_test(test_lattice_shards_merged),
 	        cmocka_unit_test(test_lattice_compare_shards_merged),
 	        cmocka_unit_test(test_lattice_compare_killed_resumed),

@@ -155,6 +155,16 @@ typedef struct bsim_markov_def {
 	int (*pass_exchange)(void *user, void *const *runs, size_t bytes, const int *owner, int n,
 	                     bsim_error *err);
 	void *pass_exchange_user;
+	/* Flow entries in a job array (docs/cluster.md): one array of parts
+	 * and one merge per pass. one_pass 1: this build makes one pass, the
+	 * first that the map directory passes_from (the merge of the pass
+	 * before; NULL: none, pass 0) does not hold for every map of the
+	 * lattice, drawing its states from the exits there. A pass before the
+	 * last writes the passes' maps and exits but no final map (the set's
+	 * pass says which); a merge (from) of such parts writes every map's
+	 * passes up to it, the earlier ones read from passes_from. */
+	int one_pass;
+	const char *passes_from;
 } bsim_markov_def;
 
 #define BSIM_MARKOV_SELF_GATES      16
@@ -196,6 +206,8 @@ typedef struct bsim_markov_set {
 	int built, reused; /* maps simulated now, maps read from the cache */
 	double seconds;    /* CPU time of the simulation of those built, s */
 	int copied;        /* maps read from the parts' directories (def from) */
+	int pass; /* def one_pass: the pass made (or merged); below def self_passes, the set's
+	           * maps hold no counts */
 } bsim_markov_set;
 
 /* The maps lattice needs, from the cache directory dir: a map whose key is

@@ -322,30 +322,36 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 }
 
 int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                     const bsim_options *opts, const bsim_markov_map *m, const char *from,
-                     const char *stage, bsim_error *err)
+                     const bsim_options *opts, const bsim_markov_map *m, int last,
+                     const char *const *dirs, int n_dirs, const char *stage, bsim_error *err)
 {
 	const int nb = m->n_bins, T = m->trials;
 	markov_run *runs = calloc((size_t)nb * T, sizeof *runs);
 	int rc = runs ? BSIM_OK : bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (int q = 0; q <= def->self_passes && rc == BSIM_OK; q++) {
+	for (int q = 0; q <= last && rc == BSIM_OK; q++) {
 		bsim_markov_map mq;
 		if (pass_map(&mq, lattice, def, be, opts, m, q) != 0) {
 			pass_map_free(&mq);
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 			break;
 		}
-		/* the passes' maps but the last (m itself, written by the caller),
-		 * every pass's exits */
-		int got = q < def->self_passes ? markov_map_read(from, &mq, err) : 1;
-		if (got == 1)
-			got = runs_read(from, mq.key, runs, nb, T, err);
+		/* every pass's map but the final one (m, the caller's) and every
+		 * pass's exits, from the first directory that has both */
+		int got = 0;
+		for (int d = 0; d < n_dirs && got == 0; d++) {
+			if (!dirs[d])
+				continue;
+			got = q < def->self_passes ? markov_map_read(dirs[d], &mq, err) : 1;
+			if (got == 1)
+				got = runs_read(dirs[d], mq.key, runs, nb, T, err);
+		}
 		if (got == 0)
 			rc = bsim_error_set(
 			        err, BSIM_EINPUT,
-			        "%s: pass %d of the map for k = %g, %g N m/rad (map_%016llx, "
-			        "its map and exits) is missing: not a part of this build",
-			        from, q, m->k[0], m->k[1], (unsigned long long)mq.key);
+			        "%s: pass %d of the map for k = %g, %g N m/rad "
+			        "(map_%016llx: its map and exits) is missing: not a part "
+			        "of this build",
+			        dirs[0], q, m->k[0], m->k[1], (unsigned long long)mq.key);
 		else if (got < 0)
 			rc = BSIM_EINPUT; /* err names the file and line */
 		if (rc == BSIM_OK && q < def->self_passes)
@@ -356,6 +362,38 @@ int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, cons
 	}
 	free(runs);
 	return rc;
+}
+
+int markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                      const bsim_options *opts, const bsim_markov_map *maps, int n, const char *dir,
+                      bsim_error *err)
+{
+	const long units = (long)maps[0].n_bins * maps[0].trials;
+	markov_run *runs = dir ? calloc((size_t)units, sizeof *runs) : NULL;
+	if (dir && !runs) {
+		bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		return -1;
+	}
+	/* as markov_flow_simulate finds the passes it starts after */
+	int round = 0;
+	for (int q = def->self_passes - 1; q >= 0 && dir && !round; q--) {
+		int all = 1;
+		for (int i = 0; i < n && all; i++) {
+			bsim_markov_def dq = *def;
+			dq.self_passes = q + 1;
+			int got =
+			        last_cached(lattice, &dq, be, opts, &maps[i], dir, runs, NULL, err);
+			if (got == -2) {
+				free(runs);
+				return -1;
+			}
+			all = got == q;
+		}
+		if (all)
+			round = q + 1;
+	}
+	free(runs);
+	return round;
 }
 
 /* ---- flow-weighted passes over a field ---- */
@@ -513,7 +551,9 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			maps[i].steps = q0 > 0 ? prior[i].steps : 0;
 		}
 	free(prior);
-	for (int q = q0; q <= def->self_passes && rc == BSIM_OK; q++) {
+	/* one pass of a job array's round, or all those left */
+	const int q_end = def->one_pass ? q0 : def->self_passes;
+	for (int q = q0; q <= q_end && rc == BSIM_OK; q++) {
 		if (q > 0) {
 			memset(visits, 0, (size_t)G * nb * sizeof *visits);
 			field_visits((const markov_run *const *)prev, gate_map, cols, rows,
