@@ -141,7 +141,7 @@ typedef struct bsim_markov_def {
 	 * that has it and written into dir, the same bytes; a map none has is
 	 * BSIM_EINPUT naming it, and nothing is written. Self entries are
 	 * spread the same way, a map's passes with it (every pass's map and
-	 * exits copied from its part); flow entries need pass_exchange. */
+	 * exits copied from its part); flow entries need pass_exchange or one_pass. */
 	int part, parts, part_first;
 	const char *const *from;
 	int n_from;

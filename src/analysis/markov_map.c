@@ -113,14 +113,13 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		                      def->entries ? " and observed entries" : "");
 	/* A self-consistent map's passes are its own: spread whole. A flow
 	 * map's pass p + 1 needs every map's pass p: its parts must meet after
-	 * each pass (pass_exchange). */
+	 * each pass (pass_exchange), or make one pass a round (one_pass). */
 	if (def->parts > 1 && def->self_entries == 2 && !def->pass_exchange && !def->one_pass)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "entries: flow-weighted maps (flow or flow:N) are not built "
-		                      "in parts of a job array: each pass needs every map's pass "
-		                      "before; build them under mpirun -np N (whose ranks meet "
-		                      "after each pass) or in one process; --shard spreads self "
-		                      "and observed entries");
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "entries: flow-weighted maps (flow or flow:N) over parts need "
+		        "each pass's parts to meet (under mpirun) or one pass a "
+		        "round of parts (--shard with --passes)");
 	if (def->parts > 1 && (def->part < 0 || def->part >= def->parts))
 		return bsim_error_set(err, BSIM_EINPUT, "part %d of %d: expected 0 to %d",
 		                      def->part, def->parts, def->parts - 1);
