@@ -246,7 +246,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	const int made = round && rc == BSIM_OK && out->pass < def->self_passes;
 	if (made) {
 		rc = round_fill(lattice, def, be, opts, out, stage, err);
-		if (rc == BSIM_OK)
+		if (rc == BSIM_OK && (out->built || out->copied)) /* else nothing staged */
 			rc = map_commit(ss, err);
 	}
 	for (int i = 0; i < n && rc == BSIM_OK && !made; i++) {
