@@ -576,10 +576,14 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		printf("part %d of %d of the maps in %s; beamsim merge joins the %d parts' "
 		       "directories\n",
 		       a.shard, a.shards, cli_path(c.out), a.shards);
-	if (rc == BSIM_OK && !c.quiet && round && pass < a.def.self_passes)
+	if (rc == BSIM_OK && !c.quiet && round && pass < a.def.self_passes && !m)
 		printf("pass %d of passes 0 to %d (flow entries): once merged into DIR, the next "
 		       "round is the same command with --passes DIR\n",
 		       pass, a.def.self_passes);
+	else if (rc == BSIM_OK && !c.quiet && round && pass < a.def.self_passes)
+		printf("passes 0 to %d of the %d (flow entries) in %s: the next round is the "
+		       "parts' command with --passes %s\n",
+		       pass, a.def.self_passes + 1, cli_path(c.out), cli_path(c.out));
 	if (rc == BSIM_OK && !c.quiet)
 		printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials "
 		       "each, in %s\n",
