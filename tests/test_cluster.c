@@ -406,6 +406,132 @@ static void test_markov_shards_merged(void **state)
 	assert_false(bsim_test_exists(bsim_test_join(bad, "markov.json")));
 }
 
+/* ---- markov build: maps built in passes -------------------------------- */
+
+/* markov build of the four maps in passes (entries "self:1" or "flow:1":
+ * pass 0, then pass 1 from its exits) at 2 x 2 x 2 entry bins of 3 trials
+ * into out, with the extra arguments a, b, c and d (NULL: none). */
+static void markov_passes_build4(const char *out, const char *entries, const char *threads,
+                                 const char *a, const char *b, const char *c, const char *d)
+{
+	const char *argv[] = {"markov",   "build",     markov_lattice(),
+	                      "--trials", "3",         "--bins",
+	                      "2,2,2",    "--entries", entries,
+	                      "--grid",   MARKOV_GRID, "--threads",
+	                      threads,    "--out",     out,
+	                      "--quiet",  a,           b,
+	                      c,          d,           NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	if (rc != 0)
+		print_error("%s", err ? err : "");
+	free(err);
+	assert_int_equal(rc, 0);
+}
+
+static void markov_passes_build(const char *out, const char *entries, const char *threads,
+                                const char *a, const char *b)
+{
+	markov_passes_build4(out, entries, threads, a, b, NULL, NULL);
+}
+
+/* How many files of dir end in suffix. */
+static int count_suffix(const char *dir, const char *suffix)
+{
+	char cmd[4600];
+	snprintf(cmd, sizeof cmd, "find '%s' -maxdepth 1 -name '*%s' | wc -l", dir, suffix);
+	FILE *p = popen(cmd, "r");
+	int n = -1;
+	if (p) {
+		if (fscanf(p, "%d", &n) != 1)
+			n = -1;
+		pclose(p);
+	}
+	return n;
+}
+
+/* Self-consistent maps (self:1) in 3 parts, merged: the one-process map
+ * directory, every pass's map and exits with it, but for the CPU times. A
+ * part that lacks a pass's exits is refused, naming it. */
+static void test_markov_self_shards_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], out[1100], part[3][1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("markov_self_parts"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	markov_passes_build(one, "self:1", "2", NULL, NULL);
+	/* four maps of two passes each: 8 maps, 8 exits */
+	assert_int_equal(count_maps(one), 8);
+	assert_int_equal(count_suffix(one, ".exits.csv"), 8);
+	for (int i = 0; i < 3; i++) {
+		char shard_arg[16];
+		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
+		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+		markov_passes_build(part[i], "self:1", i == 1 ? "2" : "1", "--shard", shard_arg);
+		assert_int_equal(count_maps(part[i]), i == 0 ? 4 : 2);
+	}
+	snprintf(out, sizeof out, "%s/merged", dir);
+	const char *argv[] = {"merge", part[1], part[2], part[0], "--out", out, "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	assert_same_dir(one, out);
+	/* a part without one of its passes' exits: refused, naming it */
+	char cut[1100], bad[1100], cmd[4000];
+	snprintf(cut, sizeof cut, "%s/cut", dir);
+	snprintf(bad, sizeof bad, "%s/refused", dir);
+	snprintf(cmd, sizeof cmd, "cp -r '%s' '%s' && rm \"$(ls '%s'/map_*.exits.csv | head -1)\"",
+	         part[2], cut, cut);
+	assert_int_equal(system(cmd), 0);
+	const char *argv_cut[] = {"merge", part[0], part[1], cut, "--out", bad, NULL};
+	bsim_test_expect_input_error(argv_cut, (const char *const[]){cut, NULL});
+	assert_false(bsim_test_exists(bsim_test_join(bad, "markov.json")));
+}
+
+/* Flow-weighted maps (flow:1) as a job array, one round a pass: 3 parts
+ * of pass 0 merged, then 3 parts of pass 1 reading that merge (--passes),
+ * merged: the one-process map directory, every pass's map and exits, but
+ * for the CPU times. A merge of parts of different rounds is refused, as
+ * is --passes without a round. */
+static void test_markov_flow_rounds_merged(void **state)
+{
+	(void)state;
+	char dir[1024], one[1100], merged[2][1100], part[2][3][1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("markov_flow_rounds"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	markov_passes_build(one, "flow:1", "2", NULL, NULL);
+	assert_int_equal(count_suffix(one, ".exits.csv"), 8);
+	for (int r = 0; r < 2; r++) {
+		for (int i = 0; i < 3; i++) {
+			char shard_arg[16];
+			snprintf(part[r][i], sizeof part[r][i], "%s/r%d_p%d", dir, r, i + 1);
+			snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
+			/* pass 1 from the merge of pass 0 */
+			markov_passes_build4(part[r][i], "flow:1", i == 1 ? "2" : "1", "--shard",
+			                     shard_arg, r ? "--passes" : NULL,
+			                     r ? merged[0] : NULL);
+		}
+		snprintf(merged[r], sizeof merged[r], "%s/merged%d", dir, r);
+		const char *argv[] = {"merge", part[r][2], part[r][0], part[r][1],
+		                      "--out", merged[r],  "--quiet",  NULL};
+		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+		/* pass 0 of every map, no final map; then everything */
+		assert_int_equal(count_suffix(merged[r], ".exits.csv"), r == 0 ? 4 : 8);
+	}
+	assert_same_dir(one, merged[1]);
+	char bad[1100];
+	snprintf(bad, sizeof bad, "%s/refused", dir);
+	const char *mixed[] = {"merge", part[0][0], part[1][1], part[1][2], "--out", bad, NULL};
+	bsim_test_expect_input_error(
+	        mixed, (const char *const[]){part[1][1], "parts of different runs", NULL});
+	assert_false(bsim_test_exists(bsim_test_join(bad, "markov.json")));
+	const char *no_round[] = {"markov",   "build",   markov_lattice(), "--entries", "self:1",
+	                          "--passes", merged[0], "--out",          bad,         NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(no_round, NULL, &err);
+	bsim_test_check_input_error(rc, err, (const char *const[]){"--passes", "--shard", NULL}, 0);
+	free(err);
+	assert_false(bsim_test_exists(bad));
+}
+
 /* ---- MPI ----------------------------------------------------------------- */
 
 /* ---- a lattice sweep: its records hold the gate paths -------------------- */
@@ -947,6 +1073,55 @@ static void test_mpi_markov_build(void **state)
 	assert_int_equal(rmdir(tmp), 0); /* nor any directory */
 }
 
+/* markov build of maps in passes over 3 ranks: self:1 (each map's passes
+ * on its rank) and flow:1 (the ranks meet after pass 0, each with every
+ * map's single gates): the one-process map directory, every pass's map
+ * and exits, but for the CPU times. */
+static void test_mpi_markov_passes(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	static const char *const entries[] = {"self:1", "flow:1"};
+	for (int k = 0; k < 2; k++) {
+		char dir[1024], one[1100], out[1100], err_path[1200];
+		snprintf(dir, sizeof dir, "%s",
+		         bsim_test_dir(k ? "mpi_markov_flow" : "mpi_markov_self"));
+		snprintf(one, sizeof one, "%s/one", dir);
+		snprintf(out, sizeof out, "%s/ranks3", dir);
+		snprintf(err_path, sizeof err_path, "%s.err", out);
+		markov_passes_build(one, entries[k], "2", NULL, NULL);
+		assert_int_equal(count_suffix(one, ".exits.csv"), 8);
+		const char *argv[] = {BSIM_TEST_MPIEXEC,
+		                      "--oversubscribe",
+		                      "-np",
+		                      "3",
+		                      BSIM_EXE,
+		                      "markov",
+		                      "build",
+		                      markov_lattice(),
+		                      "--trials",
+		                      "3",
+		                      "--bins",
+		                      "2,2,2",
+		                      "--entries",
+		                      entries[k],
+		                      "--grid",
+		                      MARKOV_GRID,
+		                      "--threads",
+		                      "1",
+		                      "--out",
+		                      out,
+		                      "--quiet",
+		                      NULL};
+		int rc = wait_status(spawn_mpirun(argv, err_path));
+		if (rc != 0)
+			print_stderr(err_path);
+		assert_int_equal(rc, 0);
+		assert_same_dir(one, out);
+	}
+}
+
 static void test_mpi_identical(void **state)
 {
 	(void)state;
@@ -1221,6 +1396,8 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_compare_shards_merged),
 	        cmocka_unit_test(test_merge_refuses),
 	        cmocka_unit_test(test_markov_shards_merged),
+	        cmocka_unit_test(test_markov_self_shards_merged),
+	        cmocka_unit_test(test_markov_flow_rounds_merged),
 	        cmocka_unit_test(test_lattice_shards_merged),
 	        cmocka_unit_test(test_lattice_compare_shards_merged),
 	        cmocka_unit_test(test_lattice_compare_killed_resumed),
@@ -1232,6 +1409,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_mpi_identical),
 	        cmocka_unit_test(test_mpi_compare),
 	        cmocka_unit_test(test_mpi_markov_build),
+	        cmocka_unit_test(test_mpi_markov_passes),
 	        cmocka_unit_test(test_mpi_rank_killed_resumed),
 	        cmocka_unit_test(test_mpi_lattice),
 	        cmocka_unit_test(test_mpi_lattice_compare),

@@ -44,6 +44,7 @@
 #define BSIM_MARKOV_H
 
 #include <signal.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "beamsim/base.h"
@@ -138,11 +139,32 @@ typedef struct bsim_markov_def {
 	 * single gate runs; every map not in dir is read from the first of the
 	 * map directories from[0..n_from) (each checked against its manifest)
 	 * that has it and written into dir, the same bytes; a map none has is
-	 * BSIM_EINPUT naming it, and nothing is written. Entries self or flow
-	 * (maps built in passes) are not spread: BSIM_EINPUT. */
+	 * BSIM_EINPUT naming it, and nothing is written. Self entries are
+	 * spread the same way, a map's passes with it (every pass's map and
+	 * exits copied from its part); flow entries need pass_exchange or one_pass. */
 	int part, parts, part_first;
 	const char *const *from;
 	int n_from;
+	/* Flow entries spread over parts (parts > 1) that meet after each pass
+	 * (an MPI job's ranks; NULL: flow entries over parts are BSIM_EINPUT,
+	 * since pass p + 1 of every map needs pass p of all). Called by every
+	 * part after each pass but the last, with the same arguments but runs'
+	 * contents: runs[i] (bytes each) holds map i's single gates of that
+	 * pass on part owner[i] (i < n, the lattice's pairs as above), and on
+	 * return every part must hold every map's; BSIM_OK or an error (err). */
+	int (*pass_exchange)(void *user, void *const *runs, size_t bytes, const int *owner, int n,
+	                     bsim_error *err);
+	void *pass_exchange_user;
+	/* Flow entries in a job array (docs/cluster.md): one array of parts
+	 * and one merge per pass. one_pass 1: this build makes one pass, the
+	 * first that the map directory passes_from (the merge of the pass
+	 * before; NULL: none, pass 0) does not hold for every map of the
+	 * lattice, drawing its states from the exits there. A pass before the
+	 * last writes the passes' maps and exits but no final map (the set's
+	 * pass says which); a merge (from) of such parts writes every map's
+	 * passes up to it, the earlier ones read from passes_from. */
+	int one_pass;
+	const char *passes_from;
 } bsim_markov_def;
 
 #define BSIM_MARKOV_SELF_GATES      16
@@ -184,6 +206,8 @@ typedef struct bsim_markov_set {
 	int built, reused; /* maps simulated now, maps read from the cache */
 	double seconds;    /* CPU time of the simulation of those built, s */
 	int copied;        /* maps read from the parts' directories (def from) */
+	int pass; /* def one_pass: the pass made (or merged); below def self_passes, the set's
+	           * maps hold no counts */
 } bsim_markov_set;
 
 /* The maps lattice needs, from the cache directory dir: a map whose key is

@@ -129,6 +129,24 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                          const char *dir, const char *stage, long *done, long total,
                          bsim_error *err);
 
+/* Map m's passes 0 .. last (def's self or flow entries) copied into stage
+ * by the writers that wrote them, each pass from the first of dirs[0..
+ * n_dirs) (NULL ones skipped) that holds it: every pass's map but the
+ * final one (m, the caller's) and every pass's exits, the same bytes.
+ * BSIM_EINPUT naming dirs[0] if a pass is in none, or the file if one is
+ * malformed. */
+int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                     const bsim_options *opts, const bsim_markov_map *m, int last,
+                     const char *const *dirs, int n_dirs, const char *stage, bsim_error *err);
+
+/* The pass a job array's round of flow-weighted maps makes (def
+ * one_pass): the first pass that dir (NULL: none) does not hold, map and
+ * exits, for every one of maps[0..n) (keys set); -1 with err if a pass's
+ * exits there are malformed. */
+int markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                      const bsim_options *opts, const bsim_markov_map *maps, int n, const char *dir,
+                      bsim_error *err);
+
 /* ---- the chain's exits (markov_chain.c) ---- */
 
 /* Where exit x (0 stuck, else an entry bin of the gate entered) of gate g =

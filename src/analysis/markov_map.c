@@ -111,10 +111,15 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		                      "observed entries, got %d passes%s",
 		                      BSIM_MARKOV_SELF_PASSES_MAX, def->self_passes,
 		                      def->entries ? " and observed entries" : "");
-	if ((def->parts > 1 || def->n_from > 0) && def->self_entries)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "entries: maps built in passes (self or flow entries) are "
-		                      "built in one process, not spread over parts");
+	/* A self-consistent map's passes are its own: spread whole. A flow
+	 * map's pass p + 1 needs every map's pass p: its parts must meet after
+	 * each pass (pass_exchange), or make one pass a round (one_pass). */
+	if (def->parts > 1 && def->self_entries == 2 && !def->pass_exchange && !def->one_pass)
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "entries: flow-weighted maps (flow or flow:N) over parts need "
+		        "each pass's parts to meet (under mpirun) or one pass a "
+		        "round of parts (--shard with --passes)");
 	if (def->parts > 1 && (def->part < 0 || def->part >= def->parts))
 		return bsim_error_set(err, BSIM_EINPUT, "part %d of %d: expected 0 to %d",
 		                      def->part, def->parts, def->parts - 1);
@@ -151,6 +156,52 @@ static int map_commit(bsim_session *ss, bsim_error *err)
 	return BSIM_OK;
 }
 
+/* A job array's round of flow-weighted maps that makes pass out->pass,
+ * before the last: a part simulates its maps' pass into stage (the passes
+ * before read from def->passes_from); a merge copies every map's passes
+ * up to it, the earlier ones from def->passes_from, that one from the
+ * part that made it. No final map. */
+static int round_fill(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                      const bsim_options *opts, bsim_markov_set *out, const char *stage,
+                      bsim_error *err)
+{
+	const int n = out->n;
+	int rc = BSIM_OK;
+	if (def->n_from > 0) {
+		const char **dirs = malloc((size_t)(def->n_from + 1) * sizeof *dirs);
+		if (!dirs)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		memcpy(dirs, def->from, (size_t)def->n_from * sizeof *dirs);
+		dirs[def->n_from] = def->passes_from;
+		for (int i = 0; i < n && rc == BSIM_OK; i++) {
+			rc = markov_self_copy(lattice, def, be, opts, &out->maps[i], out->pass,
+			                      dirs, def->n_from + 1, stage, err);
+			out->maps[i].copied = 1;
+			out->copied++;
+		}
+		free(dirs);
+		return rc;
+	}
+	char *have = calloc((size_t)n, 1);
+	if (!have)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	long total = 0, done = 0;
+	int own = 0;
+	for (int i = 0; i < n; i++)
+		if (!out->maps[i].elsewhere) {
+			total += (long)out->maps[i].n_bins * def->trials;
+			own++;
+		}
+	clock_t c0 = clock();
+	rc = markov_flow_simulate(lattice, def, be, opts, out->maps, n, have, def->passes_from,
+	                          stage, &done, total, err);
+	out->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
+	if (rc == BSIM_OK)
+		out->built = own;
+	free(have);
+	return rc;
+}
+
 /* The maps of lattice's pairs: read from dir where there; with a session,
  * the others simulated into its stage and committed one by one (def->stop
  * is looked at between single gates); without, the first missing is an
@@ -176,22 +227,37 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	int rc = BSIM_OK;
 	long total = 0, done = 0;
 	char *have = calloc((size_t)n, 1);
-	if (!have)
+	int *src = calloc((size_t)n, sizeof *src); /* a copied map's part: from[src[i]] */
+	if (!have || !src)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (int i = 0; i < n && rc == BSIM_OK; i++) {
+		rc = map_init(&out->maps[i], lattice, def, be, opts, pairs[i], err);
+		if (def->parts > 1 && (def->part_first + i) % def->parts != def->part)
+			out->maps[i].elsewhere = 1; /* another part's */
+	}
+	/* A job array's round of flow-weighted maps: one pass; one before the
+	 * last makes no final map. */
+	const int round = def->self_entries == 2 && def->one_pass && stage;
+	out->pass = def->self_passes;
+	if (round && rc == BSIM_OK &&
+	    (out->pass = markov_flow_round(lattice, def, be, opts, out->maps, n, def->passes_from,
+	                                   err)) < 0)
+		rc = BSIM_EINPUT;
+	const int made = round && rc == BSIM_OK && out->pass < def->self_passes;
+	if (made) {
+		rc = round_fill(lattice, def, be, opts, out, stage, err);
+		if (rc == BSIM_OK && (out->built || out->copied)) /* else nothing staged */
+			rc = map_commit(ss, err);
+	}
+	for (int i = 0; i < n && rc == BSIM_OK && !made; i++) {
 		bsim_markov_map *m = &out->maps[i];
-		rc = map_init(m, lattice, def, be, opts, pairs[i], err);
-		if (rc != BSIM_OK)
-			break;
-		if (def->parts > 1 && (def->part_first + i) % def->parts != def->part) {
-			m->elsewhere = 1; /* another part's */
+		if (m->elsewhere)
 			continue;
-		}
 		int got = markov_map_read(dir, m, err);
 		/* A spread build's merge: the map from the part that built it. */
 		for (int j = 0; got == 0 && j < def->n_from; j++)
 			if ((got = markov_map_read(def->from[j], m, err)) > 0)
-				m->copied = 1;
+				m->copied = 1, src[i] = j;
 		if (got > 0 && m->copied && !m->hold_exit)
 			rc = bsim_error_set(err, BSIM_EINPUT,
 			                    "%s: the map for k = %g, %g N m/rad has no holding "
@@ -234,22 +300,31 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			          : def->self_entries == 2 ? def->self_passes + 1
 			                                   : 1);
 	}
-	int to_build = n - out->reused - out->copied;
-	for (int i = 0; i < n; i++)
+	int to_build = made ? 0 : n - out->reused - out->copied;
+	for (int i = 0; i < n && !made; i++)
 		to_build -= out->maps[i].elsewhere;
 	/* Flow-weighted entries: every map's passes at once, the lattice's
-	 * chain weighting each pass's states. */
-	const int flow = def->self_entries == 2 && to_build > 0 && stage && rc == BSIM_OK;
+	 * chain weighting each pass's states. Parts that meet after each pass
+	 * all take part, those with no map of this lattice too. */
+	const int flow = def->self_entries == 2 && stage && rc == BSIM_OK &&
+	                 (to_build > 0 || (def->parts > 1 && def->pass_exchange));
 	if (flow)
-		rc = markov_flow_simulate(lattice, def, be, opts, out->maps, n, have, dir, stage,
-		                          &done, total, err);
-	for (int i = 0; i < n && rc == BSIM_OK && stage; i++) {
+		rc = markov_flow_simulate(lattice, def, be, opts, out->maps, n, have,
+		                          round ? def->passes_from : dir, stage, &done, total, err);
+	for (int i = 0; i < n && rc == BSIM_OK && stage && !made; i++) {
 		bsim_markov_map *m = &out->maps[i];
 		if (have[i] || m->elsewhere)
 			continue;
 		if (m->copied) {
-			/* read from a part: written again as it was */
-			if ((rc = markov_map_write(stage, m, &def->bins, err)) == BSIM_OK)
+			/* read from a part: written again as it was, with its
+			 * passes' maps and exits when built in passes */
+			const char *dirs[2] = {def->from[src[i]], round ? def->passes_from : NULL};
+			if (def->self_entries)
+				rc = markov_self_copy(lattice, def, be, opts, m, def->self_passes,
+				                      dirs, 2, stage, err);
+			if (rc == BSIM_OK)
+				rc = markov_map_write(stage, m, &def->bins, err);
+			if (rc == BSIM_OK)
 				rc = map_commit(ss, err);
 			continue;
 		}
@@ -273,11 +348,15 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		if (rc == BSIM_OK)
 			out->built++;
 	}
-	if (rc == BSIM_ESTOPPED)
+	if (rc == BSIM_ESTOPPED && made)
+		bsim_error_set(err, BSIM_ESTOPPED, "stopped in pass %d; nothing of it is kept",
+		               out->pass);
+	else if (rc == BSIM_ESTOPPED)
 		bsim_error_set(err, BSIM_ESTOPPED,
 		               "stopped after %d of the %d maps to build; those are kept in %s",
 		               out->built, to_build, dir);
 	free(have);
+	free(src);
 	free(pairs);
 	if (rc != BSIM_OK)
 		bsim_markov_set_free(out);

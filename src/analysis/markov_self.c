@@ -321,6 +321,81 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	return rc;
 }
 
+int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                     const bsim_options *opts, const bsim_markov_map *m, int last,
+                     const char *const *dirs, int n_dirs, const char *stage, bsim_error *err)
+{
+	const int nb = m->n_bins, T = m->trials;
+	markov_run *runs = calloc((size_t)nb * T, sizeof *runs);
+	int rc = runs ? BSIM_OK : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int q = 0; q <= last && rc == BSIM_OK; q++) {
+		bsim_markov_map mq;
+		if (pass_map(&mq, lattice, def, be, opts, m, q) != 0) {
+			pass_map_free(&mq);
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+			break;
+		}
+		/* every pass's map but the final one (m, the caller's) and every
+		 * pass's exits, from the first directory that has both */
+		int got = 0;
+		for (int d = 0; d < n_dirs && got == 0; d++) {
+			if (!dirs[d])
+				continue;
+			got = q < def->self_passes ? markov_map_read(dirs[d], &mq, err) : 1;
+			if (got == 1)
+				got = runs_read(dirs[d], mq.key, runs, nb, T, err);
+		}
+		if (got == 0)
+			rc = bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s: pass %d of the map for k = %g, %g N m/rad "
+			        "(map_%016llx: its map and exits) is missing: not a part "
+			        "of this build",
+			        dirs[0], q, m->k[0], m->k[1], (unsigned long long)mq.key);
+		else if (got < 0)
+			rc = BSIM_EINPUT; /* err names the file and line */
+		if (rc == BSIM_OK && q < def->self_passes)
+			rc = markov_map_write(stage, &mq, &def->bins, err);
+		if (rc == BSIM_OK)
+			rc = runs_write(stage, mq.key, runs, nb, T, err);
+		pass_map_free(&mq);
+	}
+	free(runs);
+	return rc;
+}
+
+int markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                      const bsim_options *opts, const bsim_markov_map *maps, int n, const char *dir,
+                      bsim_error *err)
+{
+	const long units = (long)maps[0].n_bins * maps[0].trials;
+	markov_run *runs = dir ? calloc((size_t)units, sizeof *runs) : NULL;
+	if (dir && !runs) {
+		bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		return -1;
+	}
+	/* as markov_flow_simulate finds the passes it starts after */
+	int round = 0;
+	for (int q = def->self_passes - 1; q >= 0 && dir && !round; q--) {
+		int all = 1;
+		for (int i = 0; i < n && all; i++) {
+			bsim_markov_def dq = *def;
+			dq.self_passes = q + 1;
+			int got =
+			        last_cached(lattice, &dq, be, opts, &maps[i], dir, runs, NULL, err);
+			if (got == -2) {
+				free(runs);
+				return -1;
+			}
+			all = got == q;
+		}
+		if (all)
+			round = q + 1;
+	}
+	free(runs);
+	return round;
+}
+
 /* ---- flow-weighted passes over a field ---- */
 
 /* Where exit bin x (> 0) of gate g leads in a cols x rows field: the gate
@@ -395,6 +470,22 @@ static void field_visits(const markov_run *const *runs, const int *gate_map, int
 	free(y1);
 }
 
+/* Every map's runs of a pass from the part that simulated it: map i of
+ * the lattice is the build's map part_first + i (bsim_markov_def). */
+static int runs_exchange(const bsim_markov_def *def, markov_run **runs, int n, long units,
+                         bsim_error *err)
+{
+	int *owner = malloc((size_t)n * sizeof *owner);
+	if (!owner)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; i < n; i++)
+		owner[i] = (def->part_first + i) % def->parts;
+	int rc = def->pass_exchange(def->pass_exchange_user, (void *const *)runs,
+	                            (size_t)units * sizeof **runs, owner, n, err);
+	free(owner);
+	return rc;
+}
+
 int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                          const bsim_backend *be, const bsim_options *opts, bsim_markov_map *maps,
                          int n, const char *have, const char *dir, const char *stage, long *done,
@@ -434,10 +525,13 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	 * it cost, into the cost of each map to build (the caller adds this
 	 * build's CPU time). */
 	int q0 = 0;
+	/* Parts that meet after each pass start together from pass 0: the
+	 * same passes on every part, whatever each part's directory holds. */
+	const int meet = def->parts > 1 && def->pass_exchange;
 	bsim_markov_map *prior = calloc((size_t)n, sizeof *prior);
 	if (!prior)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (int q = def->self_passes - 1; q >= 0 && rc == BSIM_OK && !q0; q--) {
+	for (int q = def->self_passes - 1; q >= 0 && rc == BSIM_OK && !q0 && !meet; q--) {
 		int all = 1;
 		for (int i = 0; i < n && all; i++) {
 			bsim_markov_def dq = *def;
@@ -457,7 +551,9 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			maps[i].steps = q0 > 0 ? prior[i].steps : 0;
 		}
 	free(prior);
-	for (int q = q0; q <= def->self_passes && rc == BSIM_OK; q++) {
+	/* one pass of a job array's round, or all those left */
+	const int q_end = def->one_pass ? q0 : def->self_passes;
+	for (int q = q0; q <= q_end && rc == BSIM_OK; q++) {
 		if (q > 0) {
 			memset(visits, 0, (size_t)G * nb * sizeof *visits);
 			field_visits((const markov_run *const *)prev, gate_map, cols, rows,
@@ -467,6 +563,8 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			markov_pool pool;
 			if (q == def->self_passes && have[b])
 				continue; /* its map is in the cache */
+			if (maps[b].elsewhere)
+				continue; /* another part's: its runs come by pass_exchange */
 			if (q > 0) {
 				/* each exit's weight: its entry bin's visits in the
 				 * gates of its map whose neighbour across it is map b's */
@@ -525,6 +623,8 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			}
 			pass_map_free(&mq);
 		}
+		if (meet && q < def->self_passes && rc == BSIM_OK)
+			rc = runs_exchange(def, cur, n, units, err);
 		markov_run **tmp = prev;
 		prev = cur;
 		cur = tmp;

@@ -155,6 +155,18 @@ int cli_mpi_gather_dir(const char *mine, char **dirs)
 	return dirs[0] ? CLI_OK : CLI_FAIL;
 }
 
+int cli_mpi_pass_exchange(void *user, void *const *runs, size_t bytes, const int *owner, int n,
+                          bsim_error *err)
+{
+	(void)user;
+	(void)runs;
+	(void)bytes;
+	(void)owner;
+	(void)n;
+	(void)err;
+	return BSIM_OK;
+}
+
 #else
 
 #include <mpi.h>
@@ -533,6 +545,29 @@ static int receive_dir(int from, const char *dir)
 		if (!ok)
 			return CLI_FAIL;
 	}
+}
+
+int cli_mpi_pass_exchange(void *user, void *const *runs, size_t bytes, const int *owner, int n,
+                          bsim_error *err)
+{
+	(void)user;
+	if (!mpi_on || mpi_size < 2)
+		return BSIM_OK;
+	/* in pieces of at most 1 GiB: MPI counts in int */
+	const size_t piece = (size_t)1 << 30;
+	for (int i = 0; i < n; i++)
+		for (size_t at = 0; at < bytes; at += piece) {
+			int count = (int)(bytes - at < piece ? bytes - at : piece);
+			MPI_Request req;
+			if (MPI_Ibcast((char *)runs[i] + at, count, MPI_BYTE, owner[i],
+			               MPI_COMM_WORLD, &req) != MPI_SUCCESS)
+				return bsim_error_set(
+				        err, BSIM_EFAIL,
+				        "MPI_Ibcast of map %d's pass from rank %d failed", i,
+				        owner[i]);
+			idle_wait(&req);
+		}
+	return BSIM_OK;
 }
 
 int cli_mpi_gather_dir(const char *mine, char **dirs)

@@ -97,6 +97,12 @@ int cli_spread_end(const char *cmd, int rc, bsim_error *err, const char *journal
  * CLI_FAIL printed. */
 int cli_mpi_gather_dir(const char *mine, char **dirs);
 
+/* bsim_markov_def.pass_exchange of an MPI job's ranks: each map's runs
+ * broadcast from its owner's rank (MPI_Ibcast, waiting idle), so every
+ * rank holds every map's pass. One process: nothing to do. */
+int cli_mpi_pass_exchange(void *user, void *const *runs, size_t bytes, const int *owner, int n,
+                          bsim_error *err);
+
 /* Ends the whole job with status rc (after a rank's failure, printed):
  * the other ranks would wait for it for ever. Returns if one process. */
 void cli_mpi_abort(int rc);

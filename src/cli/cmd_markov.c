@@ -36,7 +36,8 @@ enum {
 	OWN_NO_GATES,
 	OWN_WALKS,
 	OWN_GATES, /* predict's options follow each other from OWN_LOCATIONS */
-	OWN_SHARD
+	OWN_SHARD,
+	OWN_PASSES
 };
 
 #define MAX_ENTRIES 16
@@ -51,6 +52,7 @@ typedef struct markov_args {
 	double tol;          /* predict: --tol */
 	long walks;          /* predict: --walks */
 	int shard, shards;   /* build: --shard, 1-based; 0: every map */
+	const char *passes;  /* build: --passes */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
 } markov_args;
@@ -147,6 +149,9 @@ static int markov_option(void *args, int i, const char *value)
 		return CLI_OK;
 	case OWN_SHARD:
 		return cli_shard_parse("markov build", value, &a->shard, &a->shards);
+	case OWN_PASSES:
+		a->passes = value;
+		return CLI_OK;
 	case OWN_GATES:
 		a->gates = 1;
 		return CLI_OK;
@@ -177,12 +182,17 @@ static const cli_own build_own[] = {
          "SLURM_ARRAY_TASK_ID of --array=1-N): the build's map j\n"
          "(every group's pairs in turn) is part j mod N + 1's; DIR gets those\n"
          "maps and part.json, beamsim merge joins the N parts'\n"
-         "directories into the map directory (docs/cluster.md)"},
+         "directories into the map directory (docs/cluster.md); with\n"
+         "--entries flow or flow:N one pass of the maps (a round)"},
+        {"passes", 1, "DIR",
+         "with --entries flow[:N] and --shard: the map directory\n"
+         "beamsim merge wrote of the round before, whose passes the\n"
+         "next round's states come from (none: the first round)"},
 };
 
 static int build_option(void *args, int i, const char *value)
 {
-	return markov_option(args, i == 3 ? OWN_SHARD : i, value);
+	return markov_option(args, i == 3 ? OWN_SHARD : i == 4 ? OWN_PASSES : i, value);
 }
 
 static const char *const build_help[CLI_N_OPTS] = {
@@ -210,7 +220,7 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 4,
+        .n_own = 5,
         .option = build_option,
 };
 
@@ -411,6 +421,13 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		               "--shard builds one part in one process: not under mpirun (%d "
 		               "ranks)",
 		               cli_mpi_size());
+	/* flow entries in a job array: a round, one pass of the maps */
+	const int round = a.def.self_entries == 2 && a.shards > 0;
+	if (rc < 0 && a.passes && !round)
+		rc = cli_usage("markov build",
+		               "--passes %s: the merged directory of the round before, for "
+		               "--entries flow or flow:N with --shard I/N",
+		               a.passes);
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
@@ -440,6 +457,10 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		a.def.part = a.shard - 1;
 		a.def.parts = a.shards;
 	}
+	if (p && cli_mpi_size() > 1) /* flow entries: the ranks meet after each pass */
+		a.def.pass_exchange = cli_mpi_pass_exchange;
+	a.def.one_pass = round;
+	a.def.passes_from = a.passes;
 	bsim_options opts = {0};
 	const bsim_backend *be =
 	        cli_backend_with_opts(&c, "markov build", c.backend ? c.backend : "thesis", &opts);
@@ -478,6 +499,7 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 	a.def.stop = &cli_stop;
 	cli_signals_install();
 	int built = 0, reused = 0, copied = 0, own = 0;
+	int pass = a.def.self_passes; /* a round's: the pass made (the first group's) */
 	uint64_t *keys = NULL;
 	int n_keys = 0;
 	double cpu = 0.0;
@@ -497,12 +519,22 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		copied += set.copied;
 		own += set.built + set.reused;
 		cpu += set.seconds;
+		if (g == 0)
+			pass = set.pass;
+		else if (round && set.pass != pass)
+			rc = bsim_error_set(&err, BSIM_EINPUT,
+			                    "%s: group 0's maps are at pass %d but group %d's at "
+			                    "pass %d: not the merge of one round",
+			                    a.passes ? a.passes : "--passes", pass, g, set.pass);
 		if (keys_add(&keys, &n_keys, &set) != 0)
 			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory");
+		char of_pass[32] = ""; /* a round before the last: one pass of the maps */
+		if (set.pass < a.def.self_passes)
+			snprintf(of_pass, sizeof of_pass, "pass %d ", set.pass);
 		for (int i = 0; i < set.n && !c.quiet; i++)
-			printf("group %d  k = %g, %g N m/rad  map_%016llx  %s\n", g,
+			printf("group %d  k = %g, %g N m/rad  map_%016llx  %s%s\n", g,
 			       set.maps[i].k[0], set.maps[i].k[1],
-			       (unsigned long long)set.maps[i].key,
+			       (unsigned long long)set.maps[i].key, of_pass,
 			       set.maps[i].elsewhere ? "another part's"
 			       : set.maps[i].copied  ? "from a part"
 			       : set.maps[i].cached  ? "reused"
@@ -522,7 +554,9 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 	/* A spread build's parts carry the name of the run, from the keys of
 	 * all its maps: merge checks they are one build's, and this one's. */
 	char run[17];
-	bsim_markov_run_id(keys, n_keys, run);
+	if (round && keys) /* a round's parts: one pass's (keys has room for it) */
+		keys[n_keys] = (uint64_t)pass;
+	bsim_markov_run_id(keys, n_keys + (round && keys), run);
 	if (rc == BSIM_OK && m &&
 	    (rc = bsim_sweep_dir_part_read(m->parts[0], &first, &err)) == BSIM_OK &&
 	    strcmp(first.run, run) != 0)
@@ -531,7 +565,8 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		                    "makes run %s: its file changed since the parts ran",
 		                    m->parts[0], first.index, first.count, first.run, run);
 	if (rc == BSIM_OK && a.shards > 0) {
-		char **stored = cli_stored_argv(argc, argv, path);
+		const char *paths[2] = {path, a.passes};
+		char **stored = cli_stored_argv_paths(argc, argv, paths, 2);
 		rc = stored ? bsim_markov_part_write(c.out, a.shard, a.shards, run, n_keys, own,
 		                                     argc, stored, &err)
 		            : bsim_error_set(&err, BSIM_EFAIL, "out of memory");
@@ -541,6 +576,14 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		printf("part %d of %d of the maps in %s; beamsim merge joins the %d parts' "
 		       "directories\n",
 		       a.shard, a.shards, cli_path(c.out), a.shards);
+	if (rc == BSIM_OK && !c.quiet && round && pass < a.def.self_passes && !m)
+		printf("pass %d of passes 0 to %d (flow entries): once merged into DIR, the next "
+		       "round is the same command with --passes DIR\n",
+		       pass, a.def.self_passes);
+	else if (rc == BSIM_OK && !c.quiet && round && pass < a.def.self_passes)
+		printf("passes 0 to %d of the %d (flow entries) in %s: the next round is the "
+		       "parts' command with --passes %s\n",
+		       pass, a.def.self_passes + 1, cli_path(c.out), cli_path(c.out));
 	if (rc == BSIM_OK && !c.quiet)
 		printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials "
 		       "each, in %s\n",
