@@ -62,7 +62,23 @@ char **cli_stored_argv_paths(int argc, char **argv, const char *const *pos, int 
 	for (int i = 0; copy && i < argc; i++) {
 		copy[i] = argv[i];
 		for (int k = 0; k < n_pos; k++) {
-			char *abs = pos[k] && argv[i] == pos[k] ? realpath(pos[k], NULL) : NULL;
+			/* the path as its own word (--map DIR) or after the option's
+			 * '=' (--map=DIR) */
+			const size_t len = strlen(argv[i]);
+			const int own = pos[k] && argv[i] == pos[k];
+			const int joined = pos[k] && pos[k] > argv[i] && pos[k] <= argv[i] + len &&
+			                   pos[k][-1] == '=';
+			char *abs = own || joined ? realpath(pos[k], NULL) : NULL;
+			if (abs && joined) {
+				const size_t head = (size_t)(pos[k] - argv[i]);
+				char *word = malloc(head + strlen(abs) + 1);
+				if (word) {
+					memcpy(word, argv[i], head);
+					strcpy(word + head, abs);
+				}
+				free(abs);
+				abs = word;
+			}
 			if (abs) {
 				copy[i] = abs;
 				break;
