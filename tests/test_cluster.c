@@ -25,6 +25,7 @@
 
 #include <dirent.h>
 #include <ftw.h>
+#include <glob.h>
 #include <signal.h>
 #include <spawn.h>
 #include <stdio.h>
@@ -1071,6 +1072,97 @@ static void test_mpi_markov_build(void **state)
 	assert_same_dir(one, out);
 	assert_int_equal(count_files(tmp), 0);
 	assert_int_equal(rmdir(tmp), 0); /* nor any directory */
+	/* the ranks' parts, merged, are gone */
+	assert_false(bsim_test_exists(bsim_test_join(out, ".beamsim")));
+}
+
+/* The bytes of file path (NULL if unreadable), for comparison. */
+static pid_t await_rank(pid_t job, int rank);
+
+static char *file_text(const char *path)
+{
+	long n = 0;
+	return file_bytes(path, &n);
+}
+
+/* markov build over 2 ranks, rank 1 killed once it has finished a map:
+ * the map stays in its part (out/.beamsim/parts/2-of-2), and the same
+ * command reuses it (its .cost, the CPU time of the run that built it,
+ * comes through to out unchanged), giving the one-process directory. */
+static void test_mpi_markov_killed_reused(void **state)
+{
+	(void)state;
+	if (!have_mpi())
+		return;
+	char dir[1024], one[1100], out[1100], err_path[1200], pattern[1300];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_markov_killed"));
+	snprintf(one, sizeof one, "%s/one", dir);
+	snprintf(out, sizeof out, "%s/killed", dir);
+	snprintf(err_path, sizeof err_path, "%s.err", out);
+	const char *one_argv[] = {"markov",    "build",     markov_lattice(),
+	                          "--trials",  "20",        "--grid",
+	                          MARKOV_GRID, "--threads", "2",
+	                          "--out",     one,         "--quiet",
+	                          NULL};
+	run_ok(one_argv);
+	const char *argv[] = {BSIM_TEST_MPIEXEC,
+	                      "--oversubscribe",
+	                      "-np",
+	                      "2",
+	                      BSIM_EXE,
+	                      "markov",
+	                      "build",
+	                      markov_lattice(),
+	                      "--trials",
+	                      "20",
+	                      "--grid",
+	                      MARKOV_GRID,
+	                      "--threads",
+	                      "1",
+	                      "--out",
+	                      out,
+	                      "--quiet",
+	                      NULL};
+	pid_t job = spawn_mpirun(argv, err_path);
+	snprintf(pattern, sizeof pattern, "%s/.beamsim/parts/2-of-2/map_*.key", out);
+	int status = 0;
+	if (!bsim_test_await_glob(job, pattern, 1, &status)) {
+		print_stderr(err_path);
+		fail_msg("the job ended (status %d) before rank 1 finished a map", status);
+	}
+	kill(await_rank(job, 1), SIGKILL);
+	assert_int_not_equal(wait_status(job), 0);
+	/* what rank 1 kept: its finished maps' CPU times */
+	glob_t g;
+	assert_int_equal(glob(pattern, 0, NULL, &g), 0);
+	const size_t kept = g.gl_pathc;
+	char **cost = calloc(kept, sizeof *cost), **name = calloc(kept, sizeof *name);
+	for (size_t i = 0; i < kept; i++) {
+		char *base = strrchr(g.gl_pathv[i], '/') + 1, path[1400];
+		name[i] = strndup(base, strlen(base) - strlen(".key"));
+		snprintf(path, sizeof path, "%s/.beamsim/parts/2-of-2/%s.cost", out, name[i]);
+		cost[i] = file_text(path);
+		assert_non_null(cost[i]);
+	}
+	globfree(&g);
+	int rc = wait_status(spawn_mpirun(argv, err_path));
+	if (rc != 0)
+		print_stderr(err_path);
+	assert_int_equal(rc, 0);
+	assert_same_dir(one, out);
+	for (size_t i = 0; i < kept; i++) {
+		char path[1400];
+		snprintf(path, sizeof path, "%s/%s.cost", out, name[i]);
+		char *now = file_text(path);
+		assert_non_null(now);
+		assert_string_equal(now, cost[i]); /* reused, not built again */
+		free(now);
+		free(cost[i]);
+		free(name[i]);
+	}
+	free(cost);
+	free(name);
+	assert_false(bsim_test_exists(bsim_test_join(out, ".beamsim")));
 }
 
 /* markov build of maps in passes over 3 ranks: self:1 (each map's passes
@@ -1409,6 +1501,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_mpi_identical),
 	        cmocka_unit_test(test_mpi_compare),
 	        cmocka_unit_test(test_mpi_markov_build),
+	        cmocka_unit_test(test_mpi_markov_killed_reused),
 	        cmocka_unit_test(test_mpi_markov_passes),
 	        cmocka_unit_test(test_mpi_rank_killed_resumed),
 	        cmocka_unit_test(test_mpi_lattice),

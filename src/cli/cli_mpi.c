@@ -597,8 +597,9 @@ int cli_mpi_gather_dir(const char *mine, char **dirs)
 	int rc = (dirs[0] = strdup(mine)) ? CLI_OK : CLI_FAIL;
 	for (int r = 1; r < mpi_size && rc == CLI_OK; r++) {
 		char tmpl[4096];
-		snprintf(tmpl, sizeof tmpl, "%s.rank%d", mine, r);
-		if (mkdir(tmpl, 0700) != 0) {
+		/* unique: one left by a killed job is not in the way */
+		snprintf(tmpl, sizeof tmpl, "%s.rank%d-XXXXXX", mine, r);
+		if (!mkdtemp(tmpl)) {
 			cli_error("%s: cannot create: %s", tmpl, strerror(errno));
 			rc = CLI_FAIL;
 		} else if ((dirs[r] = strdup(tmpl)) == NULL)

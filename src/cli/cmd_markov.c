@@ -357,29 +357,42 @@ static int remove_one(const char *path, const struct stat *st, int type, struct 
 	return 0;
 }
 
-/* A part's temporary directory and all in it, gone. */
+/* A directory and all in it, gone. */
 static void remove_tree(const char *dir)
 {
 	nftw(dir, remove_one, 16, FTW_DEPTH | FTW_PHYS);
 }
 
-/* The build spread over an MPI job's ranks: rank r builds part r + 1 of
- * the maps into its own temporary directory, rank 0 gathers the parts'
- * directories and merges them into out, as merge does. */
-static int markov_build_ranks(int argc, char **argv, const cli_common *c)
+/* mkdir that accepts a directory already there. */
+static int mkdir_have(const char *dir)
 {
-	const char *tmp = getenv("TMPDIR");
-	char mine[1024];
-	snprintf(mine, sizeof mine, "%s/beamsim-markov-XXXXXX", tmp && tmp[0] ? tmp : "/tmp");
-	int rank = cli_mpi_rank(), size = cli_mpi_size(), rc;
-	if (!mkdtemp(mine)) {
-		cli_error("%s: cannot create: %s", mine, strerror(errno));
-		cli_mpi_abort(CLI_FAIL);
+	if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+		cli_error("%s: cannot create: %s", dir, strerror(errno));
 		return CLI_FAIL;
 	}
-	char *part = NULL;
-	/* the part's directory inside mine (mkdtemp's is private) */
-	if (asprintf(&part, "%s/part", mine) < 0) {
+	return CLI_OK;
+}
+
+/* The build spread over an MPI job's ranks: rank r builds part r + 1 of
+ * the maps into out/.beamsim/parts/R-of-N, rank 0 gathers the parts'
+ * files and merges them into out, as merge does. A part's directory is
+ * its cache: a job killed before the merge leaves each rank's finished
+ * maps there, and the same command with as many ranks reuses them; a
+ * merged build removes the parts. */
+static int markov_build_ranks(int argc, char **argv, const cli_common *c)
+{
+	int rank = cli_mpi_rank(), size = cli_mpi_size(), rc = CLI_OK;
+	char *work = NULL, *parts = NULL, *part = NULL;
+	if (asprintf(&work, "%s/.beamsim", c->out) < 0 || asprintf(&parts, "%s/parts", work) < 0 ||
+	    asprintf(&part, "%s/%d-of-%d", parts, rank + 1, size) < 0)
+		rc = CLI_FAIL;
+	if (rc == CLI_OK)
+		rc = mkdir_have(c->out);
+	if (rc == CLI_OK)
+		rc = mkdir_have(work);
+	if (rc == CLI_OK)
+		rc = mkdir_have(parts);
+	if (rc != CLI_OK) {
 		cli_mpi_abort(CLI_FAIL);
 		return CLI_FAIL;
 	}
@@ -394,17 +407,22 @@ static int markov_build_ranks(int argc, char **argv, const cli_common *c)
 		cli_merge merge = {c->out, c->threads, c->quiet, (const char *const *)dirs, size};
 		rc = markov_build_main(argc, argv, &merge, NULL);
 	}
-	/* the parts' files are in out now, or the build failed: either way
-	 * not kept */
-	for (int r = 0; r < size && dirs; r++)
+	/* the other ranks' files as rank 0 received them: copies, not kept */
+	for (int r = 1; r < size && dirs && rank == 0; r++)
 		if (dirs[r])
 			remove_tree(dirs[r]);
-	remove_tree(part);
-	rmdir(mine);
+	if (rc == CLI_OK && rank == 0) {
+		/* merged into out: every part has served, those of a killed
+		 * job's with another count of ranks too */
+		remove_tree(parts);
+		rmdir(work);
+	}
 	for (int r = 0; r < size && dirs; r++)
 		free(dirs[r]);
 	free(dirs);
 	free(part);
+	free(parts);
+	free(work);
 	if (rc != CLI_OK)
 		cli_mpi_abort(rc);
 	return rc;
