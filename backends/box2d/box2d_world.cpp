@@ -1414,4 +1414,5 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         box2d_accuracy,
         (int)(sizeof box2d_accuracy / sizeof box2d_accuracy[0]),
         nullptr, /* reset: the runner creates a world per trial */
+        nullptr, /* flight: the runner steps every step */
 };

@@ -1,0 +1,66 @@
+/* Internal: free-flight runs (trial_flight.c). Where the body flies free
+ * among beams at rest, a backend that offers bsim_backend.flight makes
+ * several steps in one call, and the runner books them (energies,
+ * finiteness, ledger, peaks, outcome, termination) in one loop over the
+ * body states it returns, with the operations of its step loop (trial.c)
+ * in their order: the same bits, at a fraction of the cost of a call, a
+ * state copy and the bookkeeping's calls per step.
+ *
+ * Also the loop's state (trial_loop), which trial.c's step loop and the
+ * runs share. */
+#ifndef BSIM_RUN_TRIAL_FLIGHT_H
+#define BSIM_RUN_TRIAL_FLIGHT_H
+
+#include "beamsim/backend.h"
+#include "beamsim/effects.h"
+#include "beamsim/trial.h"
+#include "run/trial_peaks.h"
+
+/* What the step loop carries from step to step. Apart from the context,
+ * whose address the backend's calls see, so that the loop can hold it in
+ * registers. */
+typedef struct trial_loop {
+	double h;    /* s, the time step */
+	long n;      /* steps done */
+	double e0;   /* J, the energy after step n */
+	int done;    /* the outcome is known; running on to classify_y */
+	long run_on; /* steps since */
+} trial_loop;
+
+/* The most steps of one run. A run also ends where the held random force
+ * takes its next value (the force of a run is one force). */
+#define TRIAL_FLIGHT_MAX 64
+
+typedef struct trial_flight {
+	int on; /* the trial takes runs (trial_flight_start) */
+	int (*flight)(bsim_world *w, const double force[2], double h, int n, double (*xv)[4]);
+	bsim_world *w;
+	const bsim_scene *scene;
+	bsim_effects *fx;
+	bsim_trial_result *out;
+	trial_peaks *peaks;
+	long n_max, gate_max; /* steps in all, in one gate */
+	double centre;        /* m, the field's centre line */
+	double xv[TRIAL_FLIGHT_MAX][4];
+} trial_flight;
+
+/* Sets f for a trial in world w of scene (no lattice: the whole scene's
+ * world) and whether it takes runs (f->on): when the backend offers them,
+ * plain is set (nothing recorded, traced or measured per step: no
+ * trajectory, trace or overlap), the body does not turn, and every effect
+ * gives a force that holds between draws (propulsion along y, the held
+ * random force), at most one of each. */
+void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend, bsim_world *w,
+                        const bsim_scene *scene, bsim_effects *fx, bsim_trial_result *out,
+                        trial_peaks *peaks, long n_max, long gate_max, double centre);
+
+/* A run from s0, the state after lp->n steps (the run not over): -1 if
+ * none was made (the next step is not one of free flight, or the force
+ * does not hold: the step loop makes it); else the steps of the run are
+ * booked (lp, *dwell, f->out, f->peaks), s0 is the state after the last
+ * of them the trial keeps, and the return is 1 if the trial ends there
+ * (a side exit, a non-finite state: s0 then the last finite one), 0 if
+ * the step loop goes on (to its test whether the run is over). */
+int trial_flight_run(trial_flight *f, trial_loop *lp, long *dwell, bsim_state *s0);
+
+#endif
