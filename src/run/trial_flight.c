@@ -13,12 +13,16 @@
  *   - the energy and finiteness test (state_energy_finite): no active beam
  *     adds nothing, the spring sum stays 0.0 and is added;
  *   - the ledger (ledger_step): the work of each force over d as the
- *     loop sums it, from 0.0; the residual with the backend's losses, all
- *     +0, whose subtraction leaves any value as it is (x - (+0) = x, -0
- *     included) and so is left out; the losses' lines gain +0, which
- *     changes a -0 to +0 the first time and nothing after: added once per
- *     run;
- *   - the peaks (trial_peaks_step) with the beams as they are, at rest;
+ *     loop sums it, from 0.0, which is left out: 0.0 + w differs from w
+ *     only for w = -0, which then gives +0, and the ledger's sums of w
+ *     start at +0 (never -0 after), as does e1 - e0 (e1 = kin + 0.0 is
+ *     never -0), so -0 and +0 give the same sums and residual; the residual with the backend's
+ * losses, all +0, whose subtraction leaves any value as it is (x - (+0) = x, -0 included) and so is
+ * left out; the losses' lines gain +0, which leaves them as they are: a line starts at +0
+ * (trial_open clears the result) and a sum that starts at +0 is never -0 (rounding to nearest, x +
+ * y is -0 only for x = y = -0), so left out too;
+ *   - the peaks (trial_peaks_step) with the beams as they are, at rest,
+ *     once per run: the same beams again give the same peaks;
  *   - the outcome and the end of the run by the loop's tests (trial_over,
  *     outcome_at), in their order.
  * A run the trial does not use to its end (it ends in it) leaves the world
@@ -38,14 +42,17 @@ void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend,
 {
 	f->on = plain && backend->flight && !scene->has_lattice && !scene->body.rotates &&
 	        fx->n_work == fx->n;
-	int constant = 0, held = 0;
+	/* the pipeline: the propulsion along y, then the held random force,
+	 * either or both */
+	f->propulsion = f->random = NULL;
 	for (int i = 0; i < fx->n && f->on; i++) {
-		const bsim_effect *e = &fx->e[i];
-		if (e->kind == BSIM_EFFECT_CONSTANT && !constant++)
-			continue;
-		if (e->kind == BSIM_EFFECT_HELD && e == fx->random && !held++)
-			continue;
-		f->on = 0;
+		bsim_effect *e = &fx->e[i];
+		if (e->kind == BSIM_EFFECT_CONSTANT && !f->propulsion && !f->random)
+			f->propulsion = e;
+		else if (e->kind == BSIM_EFFECT_HELD && e == fx->random && !f->random)
+			f->random = e;
+		else
+			f->on = 0;
 	}
 	f->flight = backend->flight;
 	f->w = w;
@@ -56,6 +63,27 @@ void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend,
 	f->n_max = n_max;
 	f->gate_max = gate_max;
 	f->centre = centre;
+}
+
+/* bsim_effects_force_at for the runs' pipelines (trial_flight_start):
+ * the propulsion, then the random force, held or drawn by its apply. */
+static inline void flight_force(trial_flight *f, long n, double h, const bsim_state *s0,
+                                double force[BSIM_WRENCH])
+{
+	bsim_effect *ep = f->propulsion, *er = f->random;
+	force[0] = 0.0;
+	force[1] = 0.0;
+	force[2] = 0.0;
+	if (ep) {
+		force[ep->axis] += ep->param;
+		ep->last = ep->param;
+	}
+	if (er) {
+		if (n >= er->held[0] && n < er->held[1] && h == er->held_h)
+			force[er->axis] += er->last;
+		else
+			er->apply(er, n, h, s0, force);
+	}
 }
 
 /* What a run books, held in locals while it runs: the energy after the
@@ -82,17 +110,18 @@ static inline int flight_book(flight_books *b, const double *q, double half_mass
 		return 0;
 	/* ledger_step */
 	const double d0 = q[0] - b->x0, d1 = q[1] - b->x1;
-	double w_prop = 0.0, w_rand = 0.0;
-	if (has_p)
-		w_prop += cp * (ap ? d1 : d0);
-	if (has_r)
-		w_rand += cr * (ar ? d1 : d0);
+	const double w_prop = has_p ? cp * (ap ? d1 : d0) : 0.0;
+	const double w_rand = has_r ? cr * (ar ? d1 : d0) : 0.0;
 	double r = (e1 - b->e0) - (w_prop + w_rand);
 	b->w_prop += w_prop;
 	b->w_rand += w_rand;
 	b->residual += r;
 	b->residual_abs += fabs(r);
-	b->residual_max = bsim_fmax(b->residual_max, fabs(r));
+	/* bsim_fmax(residual_max, |r|): |r| is never -0 and residual_max,
+	 * which starts at +0 and only ever takes a value of |r|, neither -0
+	 * nor NaN, so it is the larger of the two, |r| NaN ignored */
+	const double r_abs = fabs(r);
+	b->residual_max = r_abs > b->residual_max ? r_abs : b->residual_max;
 	b->inflow += fabs(w_prop) + fabs(w_rand);
 	b->e0 = e1;
 	b->x0 = q[0];
@@ -110,125 +139,133 @@ static inline int flight_open(trial_flight *f, flight_books *b, int m, double ha
 {
 	const double centre = f->centre, side_x = f->scene->side_x;
 	const double success_y = f->scene->success_y;
+	flight_books books = *b; /* in registers */
 	int k = 0;
 	for (; k < m; k++) {
-		if (!flight_book(b, f->xv[k], half_mass, has_p, cp, ap, has_r, cr, ar)) {
+		if (!flight_book(&books, f->xv[k], half_mass, has_p, cp, ap, has_r, cr, ar)) {
 			*end = -1;
-			return k;
+			break;
 		}
 		/* outcome_at */
-		if (fabs(b->x0 - centre) >= side_x) {
+		if (fabs(books.x0 - centre) >= side_x) {
 			*end = 1;
-			return k + 1;
+			k++;
+			break;
 		}
-		if (b->x1 >= success_y) {
+		if (books.x1 >= success_y) {
 			*traversed = 1;
-			return k + 1;
+			k++;
+			break;
 		}
 	}
+	*b = books;
 	return k;
 }
 
 int trial_flight_run(trial_flight *f, trial_loop *lp, long *dwell, bsim_state *s0)
 {
-	bsim_effects *fx = f->fx;
 	const double h = lp->h;
-	double force[BSIM_WRENCH];
-	bsim_effects_force_at(fx, lp->n, h, s0, force);
-	/* The steps the run may take: to the end of the hold, of the trial. */
-	long room = lp->done ? f->n_max - lp->run_on : f->n_max - lp->n;
-	if (!lp->done && f->gate_max - *dwell < room)
-		room = f->gate_max - *dwell;
-	room = room < TRIAL_FLIGHT_MAX ? room : TRIAL_FLIGHT_MAX;
-	/* The work of each force over d: the propulsion's (cp along ap), the
-	 * random force's (cr along ar), if there is one. */
-	int has_p = 0, has_r = 0, ap = 0, ar = 0;
-	double cp = 0.0, cr = 0.0;
-	for (int i = 0; i < fx->n; i++) {
-		const bsim_effect *e = &fx->e[i];
-		if (e->kind == BSIM_EFFECT_HELD) {
-			if (!(lp->n >= e->held[0] && lp->n < e->held[1] && h == e->held_h))
-				return -1; /* not held: the force is not one for a run */
-			if (e->held[1] - lp->n < room)
-				room = e->held[1] - lp->n;
-			has_r = 1;
-			ar = e->axis;
-			cr = e->last;
-		} else {
-			has_p = 1;
-			ap = e->axis;
-			cp = e->last;
-		}
-	}
-	if (room < 1)
-		return -1;
-	const int m = f->flight(f->w, force, h, (int)room, f->xv);
-	if (m == 0)
-		return -1;
-
 	const bsim_scene *sc = f->scene;
 	bsim_trial_result *out = f->out;
 	bsim_ledger *l = &out->ledger;
 	const double half_mass = 0.5 * sc->body.mass;
+	/* The work of each force over d: the propulsion's (along ap), the
+	 * random force's (along ar), if there is one. */
+	const bsim_effect *ep = f->propulsion, *er = f->random;
+	const int has_p = ep != NULL, has_r = er != NULL;
+	const int ap = ep ? ep->axis : 0, ar = er ? er->axis : 0;
+	const int essay = has_p && has_r && ap == 1 && ar == 0;
 	flight_books b = {lp->e0,      s0->x[0],        s0->x[1],        l->w_prop, l->w_rand,
 	                  l->residual, l->residual_abs, l->residual_max, l->inflow};
-	int end = 0, k = 0; /* k: the steps the trial keeps */
-	int traversed = 0;
-	if (!lp->done) {
-		if (has_p && has_r && ap == 1 && ar == 0) /* the essay's pipeline */
-			k = flight_open(f, &b, m, half_mass, 1, cp, 1, 1, cr, 0, &end, &traversed);
-		else
-			k = flight_open(f, &b, m, half_mass, has_p, cp, ap, has_r, cr, ar, &end,
-			                &traversed);
-		/* The step loop updates the peaks after each step kept, before
-		 * the outcome. The beams of a run's steps are at rest, s0's:
-		 * their peaks again are the same peaks, so once is all. */
-		if (k > 0)
-			trial_peaks_step(f->peaks, sc, NULL, s0);
-		lp->n += k;
-		*dwell += k;
-		if (end == 1)
-			out->outcome = BSIM_SIDE_EXIT;
-		if (traversed) {
-			out->outcome = BSIM_TRAVERSED;
-			out->steps = (int)lp->n;
-			out->t_end = (double)lp->n * h;
-			lp->done = 1;
+	double last[4]; /* the body after the last step kept */
+	long kept = 0;
+	int end = 0, peaked = 0;
+	for (;;) {
+		/* A run: the force of step n, and the steps it holds for, to the
+		 * end of the trial at most. */
+		double force[BSIM_WRENCH];
+		flight_force(f, lp->n, h, s0, force);
+		long room = lp->done ? f->n_max - lp->run_on : f->n_max - lp->n;
+		if (!lp->done && f->gate_max - *dwell < room)
+			room = f->gate_max - *dwell;
+		if (er) {
+			if (!(lp->n >= er->held[0] && lp->n < er->held[1] && h == er->held_h))
+				break; /* not held: the force is not one for a run */
+			if (er->held[1] - lp->n < room)
+				room = er->held[1] - lp->n;
 		}
-	}
-	/* The outcome known: on to classify_y (trial_over after each step,
-	 * the step that crossed success_y included). */
-	if (lp->done && !end && !(traversed && (b.x1 >= sc->classify_y || lp->run_on >= f->n_max)))
-		while (k < m) {
-			if (!flight_book(&b, f->xv[k], half_mass, has_p, cp, ap, has_r, cr, ar)) {
-				end = -1;
-				break;
+		room = room < TRIAL_FLIGHT_MAX ? room : TRIAL_FLIGHT_MAX;
+		const int m = room < 1 ? 0 : f->flight(f->w, force, h, (int)room, f->xv);
+		if (m == 0)
+			break;
+		const double cp = ep ? ep->last : 0.0, cr = er ? er->last : 0.0;
+		int k = 0, traversed = 0; /* k: the steps the trial keeps */
+		if (!lp->done) {
+			if (essay)
+				k = flight_open(f, &b, m, half_mass, 1, cp, 1, 1, cr, 0, &end,
+				                &traversed);
+			else
+				k = flight_open(f, &b, m, half_mass, has_p, cp, ap, has_r, cr, ar,
+				                &end, &traversed);
+			/* The step loop updates the peaks after each step kept,
+			 * before the outcome. The beams of the runs' steps are at
+			 * rest, s0's: their peaks again are the same peaks, so
+			 * once is all. */
+			if (k > 0 && !peaked) {
+				trial_peaks_step(f->peaks, sc, NULL, s0);
+				peaked = 1;
 			}
-			k++;
-			lp->n++;
-			(*dwell)++;
-			lp->run_on++;
-			if (b.x1 >= sc->classify_y || lp->run_on >= f->n_max)
-				break;
+			lp->n += k;
+			*dwell += k;
+			if (end == 1)
+				out->outcome = BSIM_SIDE_EXIT;
+			if (traversed) {
+				out->outcome = BSIM_TRAVERSED;
+				out->steps = (int)lp->n;
+				out->t_end = (double)lp->n * h;
+				lp->done = 1;
+			}
 		}
+		/* The outcome known: on to classify_y (trial_over after each
+		 * step, the step that crossed success_y included). */
+		if (lp->done && !end &&
+		    !(traversed && (b.x1 >= sc->classify_y || lp->run_on >= f->n_max)))
+			while (k < m) {
+				if (!flight_book(&b, f->xv[k], half_mass, has_p, cp, ap, has_r, cr,
+				                 ar)) {
+					end = -1;
+					break;
+				}
+				k++;
+				lp->n++;
+				(*dwell)++;
+				lp->run_on++;
+				if (b.x1 >= sc->classify_y || lp->run_on >= f->n_max)
+					break;
+			}
+		if (k) {
+			memcpy(last, f->xv[k - 1], sizeof last);
+			kept += k;
+		}
+		/* The trial over (trial_over), or the backend stopped short (a
+		 * beam may be in reach): the step loop's turn. */
+		if (end || k < m || m < room ||
+		    (lp->done ? b.x1 >= sc->classify_y || lp->run_on >= f->n_max
+		              : lp->n >= f->n_max || *dwell >= f->gate_max))
+			break;
+	}
 	if (end == -1) {
 		/* s0 stays the last finite state, the one reported */
 		out->instability = BSIM_UNSTABLE_NONFINITE;
 		out->unstable_step = (int)(lp->n + 1);
 	}
-	if (k) {
-		const double *q = f->xv[k - 1];
-		s0->x[0] = q[0];
-		s0->x[1] = q[1];
-		s0->v[0] = q[2];
-		s0->v[1] = q[3];
+	if (kept) {
+		s0->x[0] = last[0];
+		s0->x[1] = last[1];
+		s0->v[0] = last[2];
+		s0->v[1] = last[3];
 		memset(&s0->energy, 0, sizeof s0->energy);
 		s0->impacts = 0;
-		l->damper += 0.0;
-		l->impact += 0.0;
-		l->contact += 0.0;
-		l->correction += 0.0;
-		l->sleep += 0.0;
 	}
 	l->w_prop = b.w_prop;
 	l->w_rand = b.w_rand;
@@ -237,5 +274,5 @@ int trial_flight_run(trial_flight *f, trial_loop *lp, long *dwell, bsim_state *s
 	l->residual_max = b.residual_max;
 	l->inflow = b.inflow;
 	lp->e0 = b.e0;
-	return end != 0;
+	return end ? 1 : kept ? 0 : -1;
 }

@@ -37,6 +37,7 @@ typedef struct trial_flight {
 	bsim_world *w;
 	const bsim_scene *scene;
 	bsim_effects *fx;
+	bsim_effect *propulsion, *random; /* fx's, or NULL */
 	bsim_trial_result *out;
 	trial_peaks *peaks;
 	long n_max, gate_max; /* steps in all, in one gate */
