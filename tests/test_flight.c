@@ -87,6 +87,26 @@ static void test_whole_trial_in_flight(void **state)
 	bsim_scene_free(&s);
 }
 
+/* Leaving the beams at 100 m/s from 100 m below them: the room the first
+ * test finds is used up within a run, and the beams are tested again
+ * (and found out of reach) there, as the step does. */
+static void test_room_refilled_in_flight(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	s.body.start[1] = -100.0;
+	s.body.velocity[1] = -100.0;
+	s.side_x = 1e9;
+	s.max_steps = 2000;
+	bsim_trial_result r, r_step;
+	long made = run_both(&s, 3, &r, &r_step);
+	assert_same(&r, &r_step);
+	assert_true(made >= 1999);
+	assert_true(r.y_end < -600.0); /* -100 - 100 t + 7 t^2 / 2 at t = 8 s: -676 m */
+	bsim_scene_free(&s);
+}
+
 static void test_flight_then_beams(void **state)
 {
 	(void)state;
@@ -230,6 +250,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_whole_trial_in_flight),
+	        cmocka_unit_test(test_room_refilled_in_flight),
 	        cmocka_unit_test(test_flight_then_beams),
 	        cmocka_unit_test(test_traversal_in_flight),
 	        cmocka_unit_test(test_side_exit_in_flight),

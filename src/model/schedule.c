@@ -165,6 +165,24 @@ double bsim_schedule_at_step(bsim_schedule *s, long n, double h)
 
 double bsim_schedule_at_step_held(bsim_schedule *s, long n, double h, long held[2])
 {
+	/* The hold after the one held, its value the next to draw (a trial's
+	 * steps in order): what bsim_schedule_at_step does then, in a few
+	 * operations, and the hold it sets (n / whole = held_j + 1, whole
+	 * the same for the same h; its value drawn, no failure before). */
+	const long whole = s->held_hi - s->held_lo, j = s->held_j + 1;
+	if (n == s->held_hi && h == s->held_h && whole > 0 && j == s->n_drawn && j < s->cap &&
+	    !s->failed && n < LONG_MAX - whole) {
+		s->z[s->n_drawn++] = gsl_ran_gaussian_ziggurat(s->rng, 1.0);
+		s->draws++;
+		const double value = s->magnitude * s->z[j];
+		s->held_lo = n;
+		s->held_hi = n + whole;
+		s->held_value = value;
+		s->held_j = j;
+		held[0] = s->held_lo;
+		held[1] = s->held_hi;
+		return value;
+	}
 	double value = bsim_schedule_at_step(s, n, h);
 	/* Held now: either the hold read above or the one just set, whose
 	 * value is the one returned. */

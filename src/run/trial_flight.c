@@ -162,6 +162,31 @@ static inline int flight_open(trial_flight *f, flight_books *b, int m, double ha
 	return k;
 }
 
+/* The steps of a run from step k of xv (m in all) after the outcome is
+ * known, on to classify_y: booked until one is not finite (*end) or the
+ * trial is over (trial_over). Returns the steps kept, k included. */
+static int flight_done(trial_flight *f, flight_books *b, trial_loop *lp, long *dwell, int k, int m,
+                       double half_mass, int has_p, double cp, int ap, int has_r, double cr, int ar,
+                       int *end)
+{
+	const double classify_y = f->scene->classify_y;
+	flight_books books = *b;
+	while (k < m) {
+		if (!flight_book(&books, f->xv[k], half_mass, has_p, cp, ap, has_r, cr, ar)) {
+			*end = -1;
+			break;
+		}
+		k++;
+		lp->n++;
+		(*dwell)++;
+		lp->run_on++;
+		if (books.x1 >= classify_y || lp->run_on >= f->n_max)
+			break;
+	}
+	*b = books;
+	return k;
+}
+
 int trial_flight_run(trial_flight *f, trial_loop *lp, long *dwell, bsim_state *s0)
 {
 	const double h = lp->h;
@@ -230,19 +255,8 @@ int trial_flight_run(trial_flight *f, trial_loop *lp, long *dwell, bsim_state *s
 		 * step, the step that crossed success_y included). */
 		if (lp->done && !end &&
 		    !(traversed && (b.x1 >= sc->classify_y || lp->run_on >= f->n_max)))
-			while (k < m) {
-				if (!flight_book(&b, f->xv[k], half_mass, has_p, cp, ap, has_r, cr,
-				                 ar)) {
-					end = -1;
-					break;
-				}
-				k++;
-				lp->n++;
-				(*dwell)++;
-				lp->run_on++;
-				if (b.x1 >= sc->classify_y || lp->run_on >= f->n_max)
-					break;
-			}
+			k = flight_done(f, &b, lp, dwell, k, m, half_mass, has_p, cp, ap, has_r, cr,
+			                ar, &end);
 		if (k) {
 			memcpy(last, f->xv[k - 1], sizeof last);
 			kept += k;
