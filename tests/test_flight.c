@@ -81,7 +81,9 @@ static void test_whole_trial_in_flight(void **state)
 		long made = run_both(&s, seed, &r, &r_step);
 		assert_same(&r, &r_step);
 		assert_int_equal(r.steps_run, 1003);
-		assert_true(made >= 1000); /* the first step prepares the beams */
+		/* all but two: the first step prepares the beams (the try
+		 * before it makes no run), the second waits after that try */
+		assert_true(made >= 1001);
 		assert_true(r.draws > 200);
 	}
 	bsim_scene_free(&s);
@@ -102,7 +104,7 @@ static void test_room_refilled_in_flight(void **state)
 	bsim_trial_result r, r_step;
 	long made = run_both(&s, 3, &r, &r_step);
 	assert_same(&r, &r_step);
-	assert_true(made >= 1999);
+	assert_true(made >= 1998);
 	assert_true(r.y_end < -600.0); /* -100 - 100 t + 7 t^2 / 2 at t = 8 s: -676 m */
 	bsim_scene_free(&s);
 }
@@ -138,7 +140,7 @@ static void test_traversal_in_flight(void **state)
 	assert_same(&r, &r_step);
 	assert_int_equal(r.outcome, BSIM_TRAVERSED);
 	assert_true(r.steps < r.steps_run);
-	assert_true(made >= r.steps_run - 1);
+	assert_true(made >= r.steps_run - 2);
 	bsim_scene_free(&s);
 }
 
@@ -153,14 +155,14 @@ static void test_side_exit_in_flight(void **state)
 	long made = run_both(&s, 2, &r, &r_step);
 	assert_same(&r, &r_step);
 	assert_int_equal(r.outcome, BSIM_SIDE_EXIT);
-	assert_true(made >= r.steps_run - 1);
+	assert_true(made >= r.steps_run - 2);
 	bsim_scene_free(&s);
 }
 
 /* A body of 1e300 kg at 1e4 m/s gaining 2e3 m/s a step (5e305 N): its
  * kinetic energy 0.5 M v^2 overflows at 2e4 m/s, in the fifth step; the
- * first is the step loop's (it prepares the beams), so the failing step
- * is inside a run. */
+ * first two are the step loop's (the first prepares the beams, the second
+ * waits after the try before it), so the failing step is inside a run. */
 static void test_nonfinite_in_flight(void **state)
 {
 	(void)state;
@@ -175,7 +177,7 @@ static void test_nonfinite_in_flight(void **state)
 	assert_same(&r, &r_step);
 	assert_int_equal(r.instability, BSIM_UNSTABLE_NONFINITE);
 	assert_int_equal(r.unstable_step, 5);
-	assert_true(made >= 3); /* made, not all kept: the world runs ahead */
+	assert_true(made >= 2); /* made, not all kept: the world runs ahead */
 	bsim_scene_free(&s);
 }
 
@@ -193,7 +195,7 @@ static void test_one_force(void **state)
 		bsim_trial_result r, r_step;
 		long made = run_both(&s, 4, &r, &r_step);
 		assert_same(&r, &r_step);
-		assert_true(made >= 499);
+		assert_true(made >= 498);
 		bsim_scene_free(&s);
 	}
 }

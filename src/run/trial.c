@@ -389,9 +389,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	trial_flight_start(&r->flight, !c.recording && !c.trace && !c.overlap && !c.map, backend,
 	                   c.w, scene, &fx, out, &r->peaks, c.n_max, c.gate_max, c.centre);
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
-		int run = r->flight.on && !s0->n_active
-		                  ? trial_flight_run(&r->flight, &lp, &c.gate.dwell, s0)
-		                  : -1;
+		int run = trial_flight_try(&r->flight, &lp, &c.gate.dwell, s0);
 		if (run == 1)
 			break;
 		if (run == 0)

@@ -1,40 +1,43 @@
 /* Free-flight runs (trial_flight.h): a backend's bsim_backend.flight steps,
  * booked as trial.c's step loop books each step.
  *
+ * A stretch of flight is a sequence of runs, one per value of the force:
+ * the force of step n (drawn there if a hold starts there, as the step
+ * loop draws it), then the backend's run of the steps it holds for, then
+ * their booking; on to the next run while the trial goes on and the
+ * backend made every step asked.
+ *
  * Why the bits are the same. The force: the step loop asks the pipeline
  * for it before each step; propulsion along y gives its constant, the held
  * random force its held value until the step its hold ends, and neither
- * reads the state, so the force asked once before the run, which ends
- * before that step, is the force of every step of it (and asking it again
- * there, after a run that was not made, gives the same: the held value is
- * drawn once). The state after a step: the backend's (xv), with no beam
- * active, no impact and zero energy flows (bsim_backend.flight). Then
- * each step books, as the step loop does with that state:
+ * reads the state, so the force asked before a run, which ends before
+ * that step, is the force of every step of it (and asking it again there,
+ * after a run that was not made, gives the same: the held value is drawn
+ * once). The state after a step: the backend's (xv), with no beam active,
+ * no impact and zero energy flows (bsim_backend.flight). Each step books,
+ * as the step loop does with that state:
  *   - the energy and finiteness test (state_energy_finite): no active beam
  *     adds nothing, the spring sum stays 0.0 and is added;
- *   - the ledger (ledger_step): the work of each force over d as the
- *     loop sums it, from 0.0, which is left out: 0.0 + w differs from w
- *     only for w = -0, which then gives +0, and the ledger's sums of w
- *     start at +0 (never -0 after), as does e1 - e0 (e1 = kin + 0.0 is
- *     never -0), so -0 and +0 give the same sums and residual; the residual with the backend's
- * losses, all +0, whose subtraction leaves any value as it is (x - (+0) = x, -0 included) and so is
- * left out; the losses' lines gain +0, which leaves them as they are: a line starts at +0
- * (trial_open clears the result) and a sum that starts at +0 is never -0 (rounding to nearest, x +
- * y is -0 only for x = y = -0), so left out too;
+ *   - the ledger (ledger_step): the work of each force over d as the loop
+ *     sums it from 0.0, the 0.0 left out: 0.0 + w differs from w only for
+ *     w = -0, which gives +0, and the sums of w start at +0 (so are never
+ *     -0: rounding to nearest, x + y is -0 only for x = y = -0), as e1 - e0
+ *     is never -0 (e1 = kin + 0.0 is not), so -0 and +0 give the same sums
+ *     and residual. The backend's losses are all +0: subtracting them
+ *     leaves any value as it is (x - (+0) = x, -0 included), and adding
+ *     them to their lines, which start at +0 and so are never -0, too: both
+ *     left out. The largest |r| as bsim_fmax keeps it (flight_book);
  *   - the peaks (trial_peaks_step) with the beams as they are, at rest,
- *     once per run: the same beams again give the same peaks;
- *   - the outcome and the end of the run by the loop's tests (trial_over,
+ *     once per stretch: the same beams again give the same peaks;
+ *   - the outcome and the end of the trial by the loop's tests (trial_over,
  *     outcome_at), in their order.
- * A run the trial does not use to its end (it ends in it) leaves the world
- * ahead of the trial; the runner steps it no further (a kept world is
- * reset). */
+ * A run the trial does not use to its end (the trial ends in it) leaves
+ * the world ahead of the trial; the runner steps it no further (a kept
+ * world is reset). */
 #include "run/trial_flight.h"
 
 #include <math.h>
 #include <string.h>
-
-#include "run/trial_ledger.h"
-#include "util/fminmax.h"
 
 void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend, bsim_world *w,
                         const bsim_scene *scene, bsim_effects *fx, bsim_trial_result *out,
@@ -54,6 +57,7 @@ void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend,
 		else
 			f->on = 0;
 	}
+	f->skip = f->wait = 0;
 	f->flight = backend->flight;
 	f->w = w;
 	f->scene = scene;

@@ -1,10 +1,10 @@
 /* Internal: free-flight runs (trial_flight.c). Where the body flies free
- * among beams at rest, a backend that offers bsim_backend.flight makes
- * several steps in one call, and the runner books them (energies,
- * finiteness, ledger, peaks, outcome, termination) in one loop over the
- * body states it returns, with the operations of its step loop (trial.c)
- * in their order: the same bits, at a fraction of the cost of a call, a
- * state copy and the bookkeeping's calls per step.
+ * among beams at rest, a backend that offers bsim_backend.flight makes the
+ * steps of each value of the force in one call, and the runner books them
+ * (energies, finiteness, ledger, peaks, outcome, termination) in a loop
+ * over the body states it returns, with the operations of its step loop
+ * (trial.c) in their order: the same bits, without a call, a state copy
+ * and the bookkeeping's calls per step.
  *
  * Also the loop's state (trial_loop), which trial.c's step loop and the
  * runs share. */
@@ -28,7 +28,7 @@ typedef struct trial_loop {
 } trial_loop;
 
 /* The most steps of one run. A run also ends where the held random force
- * takes its next value (the force of a run is one force). */
+ * takes its next value (a run has one force). */
 #define TRIAL_FLIGHT_MAX 64
 
 typedef struct trial_flight {
@@ -42,6 +42,11 @@ typedef struct trial_flight {
 	trial_peaks *peaks;
 	long n_max, gate_max; /* steps in all, in one gate */
 	double centre;        /* m, the field's centre line */
+	/* After a try that made no run (the body near a beam, say), the steps
+	 * left before the next try, and the wait after the last failure:
+	 * doubled by each, to TRIAL_FLIGHT_MAX, 0 after a run. Which steps are
+	 * tried changes no result, only what a stretch near the beams costs. */
+	int skip, wait;
 	double xv[TRIAL_FLIGHT_MAX][4];
 } trial_flight;
 
@@ -55,13 +60,33 @@ void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend,
                         const bsim_scene *scene, bsim_effects *fx, bsim_trial_result *out,
                         trial_peaks *peaks, long n_max, long gate_max, double centre);
 
-/* A run from s0, the state after lp->n steps (the run not over): -1 if
- * none was made (the next step is not one of free flight, or the force
- * does not hold: the step loop makes it); else the steps of the run are
+/* A stretch of runs from s0, the state after lp->n steps (the trial not
+ * over): -1 if none was made (the next step is not one of free flight, or
+ * the force does not hold: the step loop makes it); else their steps are
  * booked (lp, *dwell, f->out, f->peaks), s0 is the state after the last
- * of them the trial keeps, and the return is 1 if the trial ends there
- * (a side exit, a non-finite state: s0 then the last finite one), 0 if
- * the step loop goes on (to its test whether the run is over). */
+ * step the trial keeps, and the return is 1 if the trial ends there (a
+ * side exit, a non-finite state: s0 then the last finite one), 0 if the
+ * step loop goes on (to its test whether the trial is over). */
 int trial_flight_run(trial_flight *f, trial_loop *lp, long *dwell, bsim_state *s0);
+
+/* trial_flight_run where it may make a run: the trial takes runs, no beam
+ * is active (s0), and no try failed too recently (f->skip); -1 else. */
+static inline int trial_flight_try(trial_flight *f, trial_loop *lp, long *dwell, bsim_state *s0)
+{
+	if (!f->on || s0->n_active)
+		return -1;
+	if (f->skip > 0) {
+		f->skip--;
+		return -1;
+	}
+	int run = trial_flight_run(f, lp, dwell, s0);
+	if (run >= 0) {
+		f->wait = 0;
+		return run;
+	}
+	f->wait = f->wait ? (2 * f->wait < TRIAL_FLIGHT_MAX ? 2 * f->wait : TRIAL_FLIGHT_MAX) : 1;
+	f->skip = f->wait;
+	return -1;
+}
 
 #endif
