@@ -44,6 +44,7 @@ void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend,
                         trial_peaks *peaks, long n_max, long gate_max, double centre)
 {
 	f->on = plain && backend->flight && !scene->has_lattice && !scene->body.rotates &&
+	        !scene->effects.has_drag && !scene->effects.has_ground_friction &&
 	        fx->n_work == fx->n;
 	/* the pipeline: the propulsion along y, then the held random force,
 	 * either or both */

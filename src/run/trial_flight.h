@@ -55,7 +55,8 @@ typedef struct trial_flight {
  * plain is set (nothing recorded, traced or measured per step: no
  * trajectory, trace or overlap), the body does not turn, and every effect
  * gives a force that holds between draws (propulsion along y, the held
- * random force), at most one of each. */
+ * random force), at most one of each (no drag or ground friction, in the
+ * pipeline or simulated by the backend). */
 void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend, bsim_world *w,
                         const bsim_scene *scene, bsim_effects *fx, bsim_trial_result *out,
                         trial_peaks *peaks, long n_max, long gate_max, double centre);
