@@ -1563,4 +1563,5 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         (int)(sizeof box2d_accuracy / sizeof box2d_accuracy[0]),
         nullptr, /* reset: the runner creates a world per trial */
         BSIM_TAKES_DRAG | BSIM_TAKES_GROUND_FRICTION,
+        nullptr, /* flight: the runner steps every step */
 };

@@ -241,6 +241,9 @@ int thesis_broad_phase_near(struct bsim_world *w, double margin);
  * broad phase tests whole only; never with broad_phase=0); 0 if one may. */
 int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h);
 
+/* thesis_flight.c: bsim_backend.flight. */
+int thesis_flight(struct bsim_world *w, const double force[2], double h, int n, double (*xv)[4]);
+
 /* beam_sleep.c */
 void thesis_beam_wake(struct bsim_world *w, int i);
 void thesis_beams_sleep(struct bsim_world *w, double speed, double h);

@@ -543,6 +543,7 @@ const bsim_backend bsim_backend_thesis = {
         .get_state = thesis_get_state,
         .set_state = thesis_set_state,
         .reset = thesis_reset,
+        .flight = thesis_flight,
         .accuracy = thesis_accuracy,
         .n_accuracy = (int)(sizeof thesis_accuracy / sizeof thesis_accuracy[0]),
 };

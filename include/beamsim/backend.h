@@ -54,6 +54,19 @@ typedef struct bsim_backend {
 	 * force, and the backend reports its loss in the step's state
 	 * (bsim_state drag_loss, friction_loss). */
 	unsigned takes;
+	/* Optional (NULL: not offered; the runner calls step for every step).
+	 * Free flight: up to n steps of h seconds under force (N) and no
+	 * torque, each the step that step(w, force, 0, h) would make, for as
+	 * long as the body cannot reach a beam and every beam is at rest; the
+	 * body's centre and velocity after each into xv[k] = {x, y, vx, vy}
+	 * (m, m/s). Returns how many it made: 0 where the next step is not
+	 * such a step (or the backend does not tell, a body that turns, say),
+	 * and step makes it. After k > 0 of them get_state gives the state
+	 * before them with the body at xv[k - 1], no beam active, no impact
+	 * and zero energy flows. What the runner books per step (ledger,
+	 * energies, finiteness, outcome) it then books for the k from xv,
+	 * with one call instead of k (trial_flight.c). */
+	int (*flight)(bsim_world *w, const double force[2], double h, int n, double (*xv)[4]);
 } bsim_backend;
 
 /* The registry: all backends compiled in, NULL-terminated. */

@@ -21,6 +21,7 @@ struct bsim_schedule {
 	 * a step inside the hold reads it without computing its index. */
 	long held_lo, held_hi;
 	double held_h, held_value;
+	long held_j; /* the index of the value held */
 	long failed; /* 0, or the index that could not be given a value */
 	int oom;     /* 1: failed for want of memory; 0: beyond any schedule */
 };
@@ -123,24 +124,65 @@ long bsim_schedule_index(const bsim_schedule *s, long n, double h)
 	return j < SCHEDULE_MAX ? (long)j : SCHEDULE_MAX;
 }
 
+/* The value of index j, drawn if it is the next: bsim_schedule_value, its
+ * common case without a call. */
+static inline double schedule_value_at(bsim_schedule *s, long j)
+{
+	if (j >= 0 && j < s->n_drawn)
+		return s->magnitude * s->z[j];
+	if (j == s->n_drawn && j < s->cap) {
+		s->z[s->n_drawn++] = gsl_ran_gaussian_ziggurat(s->rng, 1.0);
+		s->draws++;
+		return s->magnitude * s->z[j];
+	}
+	return bsim_schedule_value(s, j);
+}
+
 double bsim_schedule_at_step(bsim_schedule *s, long n, double h)
 {
 	if (n >= s->held_lo && n < s->held_hi && h == s->held_h)
 		return s->held_value;
-	long whole = schedule_steps_per_value(s, h);
-	long j = whole ? n / whole : bsim_schedule_index(s, n, h);
-	double value = bsim_schedule_value(s, j);
+	long whole, j;
+	if (n == s->held_hi && h == s->held_h && s->held_hi > s->held_lo) {
+		/* The hold after the one held (steps in order): the same h, so
+		 * the same whole, and n / whole is the held index + 1. */
+		whole = s->held_hi - s->held_lo;
+		j = s->held_j + 1;
+	} else {
+		whole = schedule_steps_per_value(s, h);
+		j = whole ? n / whole : bsim_schedule_index(s, n, h);
+	}
+	double value = schedule_value_at(s, j);
 	if (whole && !s->failed && n >= 0 && n < LONG_MAX - whole) {
 		s->held_lo = j * whole;
 		s->held_hi = s->held_lo + whole;
 		s->held_h = h;
 		s->held_value = value;
+		s->held_j = j;
 	}
 	return value;
 }
 
 double bsim_schedule_at_step_held(bsim_schedule *s, long n, double h, long held[2])
 {
+	/* The hold after the one held, its value the next to draw (a trial's
+	 * steps in order): what bsim_schedule_at_step does then, in a few
+	 * operations, and the hold it sets (n / whole = held_j + 1, whole
+	 * the same for the same h; its value drawn, no failure before). */
+	const long whole = s->held_hi - s->held_lo, j = s->held_j + 1;
+	if (n == s->held_hi && h == s->held_h && whole > 0 && j == s->n_drawn && j < s->cap &&
+	    !s->failed && n < LONG_MAX - whole) {
+		s->z[s->n_drawn++] = gsl_ran_gaussian_ziggurat(s->rng, 1.0);
+		s->draws++;
+		const double value = s->magnitude * s->z[j];
+		s->held_lo = n;
+		s->held_hi = n + whole;
+		s->held_value = value;
+		s->held_j = j;
+		held[0] = s->held_lo;
+		held[1] = s->held_hi;
+		return value;
+	}
 	double value = bsim_schedule_at_step(s, n, h);
 	/* Held now: either the hold read above or the one just set, whose
 	 * value is the one returned. */

@@ -26,6 +26,7 @@
 #include "beamsim/effects.h"
 #include "beamsim/lattice.h"
 #include "run/trial_essay.h"
+#include "run/trial_flight.h"
 #include "run/trial_gates.h"
 #include "run/trial_ledger.h"
 #include "run/trial_log.h"
@@ -40,6 +41,7 @@ struct bsim_trial_runner {
 	bsim_state whole;  /* the whole lattice's state, for recording (essay protocol) */
 	trial_peaks peaks;
 	trial_essay essay;
+	trial_flight flight; /* free-flight runs */
 	/* The world of the last trial, kept for the next trial of the same
 	 * scene, backend and options (bsim_trial_runner_keep_worlds). */
 	int keep;
@@ -120,17 +122,6 @@ typedef struct trial_ctx {
 	int trace_whole; /* the trace sees the whole lattice (essay protocol) */
 	long recorded;   /* the last step recorded, -1: none */
 } trial_ctx;
-
-/* What the step loop carries from step to step. Apart from the context,
- * whose address the backend's calls see, so that the loop can hold it in
- * registers. */
-typedef struct trial_loop {
-	double h;    /* s, the time step */
-	long n;      /* steps done */
-	double e0;   /* J, the energy after step n */
-	int done;    /* the outcome is known; running on to classify_y */
-	long run_on; /* steps since */
-} trial_loop;
 
 /* The world the trial starts in (the whole scene, or the essay's start
  * gate) and the runner's memory for it. */
@@ -395,7 +386,14 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	bsim_state *s0 = &r->s0, *s1 = &r->s1;
 	trial_loop lp;
 	rc = trial_begin(&c, &lp, s0, err);
+	trial_flight_start(&r->flight, !c.recording && !c.trace && !c.overlap && !c.map, backend,
+	                   c.w, scene, &fx, out, &r->peaks, c.n_max, c.gate_max, c.centre);
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
+		int run = trial_flight_try(&r->flight, &lp, &c.gate.dwell, s0);
+		if (run == 1)
+			break;
+		if (run == 0)
+			continue;
 		double f[BSIM_WRENCH];
 		bsim_effects_force_at(&fx, lp.n, lp.h, s0, f);
 		if (c.recording && lp.n % c.stride == 0)

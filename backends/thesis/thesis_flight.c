@@ -1,0 +1,102 @@
+/* The thesis backend's free-flight runs (bsim_backend.flight): the steps
+ * thesis_step makes by its flight path (thesis_world.c's flight_step), one
+ * after another in one call, for as long as that path would be taken.
+ *
+ * thesis_step takes the flight path when no beam is awake or typed, the
+ * room test finds every beam out of reach (thesis_flight_clear), the beams
+ * are prepared for h and contact_mode is physical. A flight step changes
+ * none of these but the body's position and velocity, so all but the room
+ * test hold for the whole run and are asked once; the room test is asked
+ * before every step, as thesis_step asks it: its inline part here on the
+ * body held in locals (the same operations, the force's part of the
+ * margin computed once), and where that fails thesis_broad_phase_clear,
+ * which asks it again and then tests the beams, as thesis_flight_clear
+ * does. (A world that the room test cannot serve, broad_phase=0 or more
+ * than THESIS_BROAD_PHASE_MIN_BEAMS beams, is never clear: no run.)
+ *
+ * Each step then moves the body as thesis_body_advance does with a zero
+ * impulse sum (v = vf + 0 / M, which turns a -0 into +0, is kept), and
+ * clears what flight_step clears (the energy flows, the impacts, the
+ * contacts, the last step's flags), which after the first step stay
+ * cleared: cleared once, after the run. A body that turns is left to
+ * thesis_step (its heading moves too). */
+#include <string.h>
+
+#include "thesis/thesis.h"
+
+int thesis_flight(bsim_world *w, const double force[2], double h, int n, double (*xv)[4])
+{
+	if (w->n_awake || w->n_typed || h != w->h_prepared ||
+	    w->contact_mode == THESIS_CONTACT_ESSAY || w->rotates || !w->broad_phase ||
+	    w->n_beams > THESIS_BROAD_PHASE_MIN_BEAMS)
+		return 0;
+	const double inv_mass = w->inv_mass, f0 = force[0], f1 = force[1];
+	/* thesis_clear_margin's force term and the step's h F / M, 0 / M */
+	const double push = h * (fabs(f0) + fabs(f1)) * inv_mass;
+	const double dv0 = h * f0 * inv_mass, dv1 = h * f1 * inv_mass, zero = 0.0 * inv_mass;
+	const double slop = w->slop;
+	const int euler = w->integrator == THESIS_EULER;
+	double cx0 = w->clear_x[0], cx1 = w->clear_x[1], room = w->clear_room;
+	double x0 = w->x[0], x1 = w->x[1], v0 = w->v[0], v1 = w->v[1];
+	/* The room test of every step of the run at once. Step k starts at
+	 * speed |v_k|_1 <= s + k d (s = |v|_1 now, d = |h F / M|_1 a step)
+	 * and |x_k - C_c|_1 <= |x - C_c|_1 + h k (s + k d) (each step moves
+	 * by h times a speed of at most that), so the test's left side is at
+	 * most its value for those bounds at k = n - 1; a cushion of 1e-9 of
+	 * the lengths involved covers the round-off of the steps and of the
+	 * test (1e-16 of the same lengths a step). If that passes, every
+	 * step's test would: the same steps. */
+	const double s = fabs(v0) + fabs(v1), d = fabs(dv0) + fabs(dv1), kn = (double)(n - 1);
+	const double reach = fabs(x0 - cx0) + fabs(x1 - cx1) + h * kn * (s + kn * d) +
+	                     2.0 * (h * ((s + kn * d + push) * (1.0 + 1e-12))) + slop +
+	                     BSIM_CONTACT_TOL;
+	const int sure =
+	        reach + 1e-9 * (reach + fabs(x0) + fabs(x1) + fabs(cx0) + fabs(cx1)) < room;
+	int k = 0;
+	for (; k < n; k++) {
+		if (!sure) {
+			double speed = (fabs(v0) + fabs(v1)) + push;
+			double margin =
+			        2.0 * (h * (speed * (1.0 + 1e-12))) + slop + BSIM_CONTACT_TOL;
+			if (!(fabs(x0 - cx0) + fabs(x1 - cx1) + margin < room)) {
+				w->x[0] = x0;
+				w->x[1] = x1;
+				w->v[0] = v0;
+				w->v[1] = v1;
+				if (!thesis_broad_phase_clear(w, force, h))
+					break;
+				cx0 = w->clear_x[0];
+				cx1 = w->clear_x[1];
+				room = w->clear_room;
+			}
+		}
+		/* thesis_body_advance(w, v, v + h F / M, 0, h, vm) */
+		double vf0 = v0 + dv0, vf1 = v1 + dv1;
+		double u0 = vf0 + zero, u1 = vf1 + zero;
+		double vm0 = 0.5 * (v0 + u0), vm1 = 0.5 * (v1 + u1);
+		if (euler) {
+			vm0 = u0;
+			vm1 = u1;
+		}
+		x0 += h * vm0;
+		x1 += h * vm1;
+		v0 = u0;
+		v1 = u1;
+		xv[k][0] = x0;
+		xv[k][1] = x1;
+		xv[k][2] = v0;
+		xv[k][3] = v1;
+	}
+	w->x[0] = x0;
+	w->x[1] = x1;
+	w->v[0] = v0;
+	w->v[1] = v1;
+	if (k) {
+		memset(&w->energy, 0, sizeof w->energy);
+		w->impacts = 0;
+		w->n_contacts = 0;
+		if (w->n_flagged)
+			thesis_contact_clear(w);
+	}
+	return k;
+}

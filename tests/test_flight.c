@@ -1,0 +1,264 @@
+/* Free-flight runs (bsim_backend.flight, src/run/trial_flight.c) against
+ * the step loop they stand in for, which is the truth here: a trial the
+ * runner books in runs gives the same result to the bit as the same trial
+ * stepped one step at a time (a trace, which sees every step, keeps the
+ * runner on the step loop), and the thesis backend's runs leave the body
+ * where its steps leave it. Each case counts the steps made in runs, so
+ * that a case which never took one fails rather than passes unseen: whole
+ * trials in flight (ending at max_steps between two draws), flight then
+ * the beams (H1), a traversal and the run on to classify_y in flight, a
+ * side exit, a state that stops being finite, and the pipelines with one
+ * force only. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "beamsim/backend.h"
+#include "beamsim/scene.h"
+#include "beamsim/trial.h"
+#include "support.h"
+
+static long flown; /* steps made in runs */
+
+static int counted_flight(bsim_world *w, const double force[2], double h, int n, double (*xv)[4])
+{
+	int k = bsim_backend_thesis.flight(w, force, h, n, xv);
+	flown += k;
+	return k;
+}
+
+static void no_trace(void *user, long step, const bsim_state *s)
+{
+	(void)user;
+	(void)step;
+	(void)s;
+}
+
+/* The trial of seed through runs (r) and stepped (r_step); returns the
+ * steps the first made in runs. */
+static long run_both(const bsim_scene *s, uint64_t seed, bsim_trial_result *r,
+                     bsim_trial_result *r_step)
+{
+	bsim_backend counted = bsim_backend_thesis;
+	counted.flight = counted_flight;
+	bsim_options o = {0};
+	bsim_error err;
+	bsim_trial_runner *runner = bsim_trial_runner_alloc();
+	assert_non_null(runner);
+	flown = 0;
+	assert_int_equal(bsim_trial_run(runner, s, &counted, &o, seed, NULL, r, &err), BSIM_OK);
+	long made = flown;
+	bsim_recorder rec = {.stride = 1, .trace = no_trace};
+	assert_int_equal(bsim_trial_run(runner, s, &counted, &o, seed, &rec, r_step, &err),
+	                 BSIM_OK);
+	assert_int_equal(flown, made); /* the trace kept it on the step loop */
+	bsim_trial_runner_free(runner);
+	return made;
+}
+
+static void assert_same(const bsim_trial_result *a, const bsim_trial_result *b)
+{
+	assert_int_equal(a->outcome, b->outcome);
+	assert_int_equal(a->steps_run, b->steps_run);
+	assert_int_equal(a->instability, b->instability);
+	assert_memory_equal(a, b, sizeof *a);
+}
+
+static void test_whole_trial_in_flight(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	s.body.start[1] = -10000.0;
+	s.side_x = 1e9;
+	s.max_steps = 1003; /* ends two steps into a hold */
+	for (uint64_t seed = 1; seed <= 3; seed++) {
+		bsim_trial_result r, r_step;
+		long made = run_both(&s, seed, &r, &r_step);
+		assert_same(&r, &r_step);
+		assert_int_equal(r.steps_run, 1003);
+		/* all but two: the first step prepares the beams (the try
+		 * before it makes no run), the second waits after that try */
+		assert_true(made >= 1001);
+		assert_true(r.draws > 200);
+	}
+	bsim_scene_free(&s);
+}
+
+/* Leaving the beams at 100 m/s from 100 m below them: the room the first
+ * test finds is used up within a run, and the beams are tested again
+ * (and found out of reach) there, as the step does. */
+static void test_room_refilled_in_flight(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	s.body.start[1] = -100.0;
+	s.body.velocity[1] = -100.0;
+	s.side_x = 1e9;
+	s.max_steps = 2000;
+	bsim_trial_result r, r_step;
+	long made = run_both(&s, 3, &r, &r_step);
+	assert_same(&r, &r_step);
+	assert_true(made >= 1998);
+	assert_true(r.y_end < -600.0); /* -100 - 100 t + 7 t^2 / 2 at t = 8 s: -676 m */
+	bsim_scene_free(&s);
+}
+
+static void test_flight_then_beams(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	long made = 0;
+	for (uint64_t seed = 1; seed <= 8; seed++) {
+		bsim_trial_result r, r_step;
+		made += run_both(&s, seed, &r, &r_step);
+		assert_same(&r, &r_step);
+	}
+	assert_true(made > 100);
+	bsim_scene_free(&s);
+}
+
+/* Above the beams, rising: success_y is crossed in a run, which goes on
+ * to classify_y. */
+static void test_traversal_in_flight(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	s.body.start[1] = 70.0; /* its pivots farther than L + R */
+	s.body.velocity[1] = 3.0;
+	s.success_y = 75.0;
+	s.classify_y = 90.0;
+	bsim_trial_result r, r_step;
+	long made = run_both(&s, 5, &r, &r_step);
+	assert_same(&r, &r_step);
+	assert_int_equal(r.outcome, BSIM_TRAVERSED);
+	assert_true(r.steps < r.steps_run);
+	assert_true(made >= r.steps_run - 2);
+	bsim_scene_free(&s);
+}
+
+static void test_side_exit_in_flight(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	s.body.start[1] = -300.0;
+	s.body.velocity[0] = 20.0;
+	bsim_trial_result r, r_step;
+	long made = run_both(&s, 2, &r, &r_step);
+	assert_same(&r, &r_step);
+	assert_int_equal(r.outcome, BSIM_SIDE_EXIT);
+	assert_true(made >= r.steps_run - 2);
+	bsim_scene_free(&s);
+}
+
+/* A body of 1e300 kg at 1e4 m/s gaining 2e3 m/s a step (5e305 N): its
+ * kinetic energy 0.5 M v^2 overflows at 2e4 m/s, in the fifth step; the
+ * first two are the step loop's (the first prepares the beams, the second
+ * waits after the try before it), so the failing step is inside a run. */
+static void test_nonfinite_in_flight(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 5e305, 0.0);
+	s.body.mass = 1e300;
+	s.body.start[1] = -1e6;
+	s.body.velocity[1] = 1e4;
+	s.side_x = 1e9;
+	bsim_trial_result r, r_step;
+	long made = run_both(&s, 1, &r, &r_step);
+	assert_same(&r, &r_step);
+	assert_int_equal(r.instability, BSIM_UNSTABLE_NONFINITE);
+	assert_int_equal(r.unstable_step, 5);
+	assert_true(made >= 2); /* made, not all kept: the world runs ahead */
+	bsim_scene_free(&s);
+}
+
+/* Propulsion alone (no draws) and the random force alone. */
+static void test_one_force(void **state)
+{
+	(void)state;
+	const double forces[2][2] = {{7.0, 0.0}, {0.0, 20.0}};
+	for (int k = 0; k < 2; k++) {
+		bsim_scene s;
+		bsim_scene_init_gate(&s, forces[k][0], forces[k][1]);
+		s.body.start[1] = -10000.0;
+		s.side_x = 1e9;
+		s.max_steps = 500;
+		bsim_trial_result r, r_step;
+		long made = run_both(&s, 4, &r, &r_step);
+		assert_same(&r, &r_step);
+		assert_true(made >= 498);
+		bsim_scene_free(&s);
+	}
+}
+
+/* The backend alone: runs of 1 to 7 steps leave the body where as many
+ * steps leave it, and a state as after them. */
+static void test_thesis_runs(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 0.0);
+	s.body.start[1] = -1000.0;
+	bsim_options o = {0};
+	bsim_error err;
+	bsim_world *a, *b;
+	const bsim_backend *t = &bsim_backend_thesis;
+	assert_int_equal(t->create(&s, &o, &a, &err), BSIM_OK);
+	assert_int_equal(t->create(&s, &o, &b, &err), BSIM_OK);
+	bsim_state sa, sb;
+	assert_int_equal(bsim_state_init(&sa, s.n_beams), BSIM_OK);
+	assert_int_equal(bsim_state_init(&sb, s.n_beams), BSIM_OK);
+	const double f[2] = {1.5, 7.0}, h = 0.004;
+	double xv[8][4];
+	/* unprepared for h: no run, the step prepares */
+	assert_int_equal(t->flight(b, f, h, 4, xv), 0);
+	assert_int_equal(t->step(a, f, 0.0, h, &err), BSIM_OK);
+	assert_int_equal(t->step(b, f, 0.0, h, &err), BSIM_OK);
+	long steps = 0;
+	for (int n = 1; n <= 7; n++) {
+		assert_int_equal(t->flight(b, f, h, n, xv), n);
+		for (int k = 0; k < n; k++) {
+			assert_int_equal(t->step(a, f, 0.0, h, &err), BSIM_OK);
+			t->get_state(a, &sa);
+			assert_memory_equal(sa.x, xv[k], 2 * sizeof(double));
+			assert_memory_equal(sa.v, xv[k] + 2, 2 * sizeof(double));
+		}
+		steps += n;
+		t->get_state(b, &sb);
+		assert_memory_equal(sa.x, sb.x, sizeof sa.x);
+		assert_memory_equal(sa.v, sb.v, sizeof sa.v);
+		assert_memory_equal(&sa.energy, &sb.energy, sizeof sa.energy);
+		assert_int_equal(sb.n_active, 0);
+		assert_int_equal(sb.impacts, 0);
+	}
+	assert_int_equal(steps, 28);
+	bsim_state_free(&sa);
+	bsim_state_free(&sb);
+	t->destroy(a);
+	t->destroy(b);
+	bsim_scene_free(&s);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	        cmocka_unit_test(test_whole_trial_in_flight),
+	        cmocka_unit_test(test_room_refilled_in_flight),
+	        cmocka_unit_test(test_flight_then_beams),
+	        cmocka_unit_test(test_traversal_in_flight),
+	        cmocka_unit_test(test_side_exit_in_flight),
+	        cmocka_unit_test(test_nonfinite_in_flight),
+	        cmocka_unit_test(test_one_force),
+	        cmocka_unit_test(test_thesis_runs),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
