@@ -174,10 +174,9 @@ static int compare_one(const char *path, const struct stat *st, int type, struct
 	return 0;
 }
 
-static int count_files(const char *dir)
+/* The number a shell command prints (a count of wc -l), -1 if none. */
+static int command_count(const char *cmd)
 {
-	char cmd[2200];
-	snprintf(cmd, sizeof cmd, "find '%s' -type f -not -path '*/.beamsim/*' | wc -l", dir);
 	FILE *p = popen(cmd, "r");
 	int n = -1;
 	if (p) {
@@ -186,6 +185,13 @@ static int count_files(const char *dir)
 		pclose(p);
 	}
 	return n;
+}
+
+static int count_files(const char *dir)
+{
+	char cmd[2200];
+	snprintf(cmd, sizeof cmd, "find '%s' -type f -not -path '*/.beamsim/*' | wc -l", dir);
+	return command_count(cmd);
 }
 
 /* Every file of ref is in dir with the same bytes (but the wall time),
@@ -356,14 +362,7 @@ static int count_maps(const char *dir)
 {
 	char cmd[4600];
 	snprintf(cmd, sizeof cmd, "find '%s' -maxdepth 1 -name 'map_*.key' | wc -l", dir);
-	FILE *p = popen(cmd, "r");
-	int n = -1;
-	if (p) {
-		if (fscanf(p, "%d", &n) != 1)
-			n = -1;
-		pclose(p);
-	}
-	return n;
+	return command_count(cmd);
 }
 
 /* The four maps in 3 parts, merged: the one-process map directory but for
@@ -441,14 +440,7 @@ static int count_suffix(const char *dir, const char *suffix)
 {
 	char cmd[4600];
 	snprintf(cmd, sizeof cmd, "find '%s' -maxdepth 1 -name '*%s' | wc -l", dir, suffix);
-	FILE *p = popen(cmd, "r");
-	int n = -1;
-	if (p) {
-		if (fscanf(p, "%d", &n) != 1)
-			n = -1;
-		pclose(p);
-	}
-	return n;
+	return command_count(cmd);
 }
 
 /* Self-consistent maps (self:1) in 3 parts, merged: the one-process map
