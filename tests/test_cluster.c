@@ -1068,6 +1068,33 @@ static void test_mpi_markov_build(void **state)
 	assert_false(bsim_test_exists(bsim_test_join(out, ".beamsim")));
 }
 
+/* Waits until the file at path holds needle (polled every millisecond:
+ * the event is the text appearing); 0 with *status if the job ends first;
+ * kills the job and fails after 300 s, as bsim_test_await_* do. */
+static int await_listed(pid_t job, const char *path, const char *needle, int *status)
+{
+	const struct timespec tick = {0, 1000000};
+	struct timespec t0, t;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	for (;;) {
+		long n = 0;
+		char *text = file_bytes(path, &n);
+		int found = text && strstr(text, needle);
+		free(text);
+		if (found)
+			return 1;
+		if (waitpid(job, status, WNOHANG) == job)
+			return 0;
+		clock_gettime(CLOCK_MONOTONIC, &t);
+		if (t.tv_sec - t0.tv_sec > 300) {
+			kill(job, SIGKILL);
+			waitpid(job, status, 0);
+			fail_msg("waited 300 s for %s in %s: killed the job", needle, path);
+		}
+		nanosleep(&tick, NULL);
+	}
+}
+
 /* The bytes of file path (NULL if unreadable), for comparison. */
 static pid_t await_rank(pid_t job, int rank);
 
@@ -1116,27 +1143,41 @@ static void test_mpi_markov_killed_reused(void **state)
 	                      "--quiet",
 	                      NULL};
 	pid_t job = spawn_mpirun(argv, err_path);
+	char manifest[1400];
 	snprintf(pattern, sizeof pattern, "%s/.beamsim/parts/2-of-2/map_*.key", out);
+	snprintf(manifest, sizeof manifest, "%s/.beamsim/parts/2-of-2/manifest.json", out);
+	/* the event: a map committed in rank 1's part, its files listed in
+	 * the part's manifest (written after them) */
 	int status = 0;
-	if (!bsim_test_await_glob(job, pattern, 1, &status)) {
+	if (!await_listed(job, manifest, ".cost\"", &status)) {
 		print_stderr(err_path);
 		fail_msg("the job ended (status %d) before rank 1 finished a map", status);
 	}
 	kill(await_rank(job, 1), SIGKILL);
 	assert_int_not_equal(wait_status(job), 0);
-	/* what rank 1 kept: its finished maps' CPU times */
+	/* what rank 1 kept: its committed maps' CPU times */
+	char *listed = file_text(manifest);
+	assert_non_null(listed);
 	glob_t g;
 	assert_int_equal(glob(pattern, 0, NULL, &g), 0);
-	const size_t kept = g.gl_pathc;
-	char **cost = calloc(kept, sizeof *cost), **name = calloc(kept, sizeof *name);
-	for (size_t i = 0; i < kept; i++) {
-		char *base = strrchr(g.gl_pathv[i], '/') + 1, path[1400];
-		name[i] = strndup(base, strlen(base) - strlen(".key"));
-		snprintf(path, sizeof path, "%s/.beamsim/parts/2-of-2/%s.cost", out, name[i]);
-		cost[i] = file_text(path);
-		assert_non_null(cost[i]);
+	size_t kept = 0;
+	char **cost = calloc(g.gl_pathc, sizeof *cost), **name = calloc(g.gl_pathc, sizeof *name);
+	for (size_t i = 0; i < g.gl_pathc; i++) {
+		char *base = strrchr(g.gl_pathv[i], '/') + 1, path[1400], entry[300];
+		name[kept] = strndup(base, strlen(base) - strlen(".key"));
+		snprintf(entry, sizeof entry, "\"%s.cost\"", name[kept]);
+		if (!strstr(listed, entry)) {
+			free(name[kept]); /* caught before its commit ended */
+			continue;
+		}
+		snprintf(path, sizeof path, "%s/.beamsim/parts/2-of-2/%s.cost", out, name[kept]);
+		cost[kept] = file_text(path);
+		assert_non_null(cost[kept]);
+		kept++;
 	}
 	globfree(&g);
+	free(listed);
+	assert_true(kept >= 1);
 	int rc = wait_status(spawn_mpirun(argv, err_path));
 	if (rc != 0)
 		print_stderr(err_path);
