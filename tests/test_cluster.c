@@ -332,6 +332,8 @@ static void test_merge_refuses(void **state)
 
 /* ---- markov build: its maps spread over parts --------------------------- */
 
+static void run_ok(const char *const *argv);
+
 static const char *markov_lattice(void)
 {
 	return bsim_test_src("configs/lattice/c_track_essay.yaml");
@@ -349,12 +351,7 @@ static void markov_build(const char *out, const char *threads, const char *a, co
 	                      MARKOV_GRID, "--threads", threads,
 	                      "--out",     out,         "--quiet",
 	                      a,           b,           NULL};
-	char *err = NULL;
-	int rc = bsim_test_cli(argv, NULL, &err);
-	if (rc != 0)
-		print_error("%s", err ? err : "");
-	free(err);
-	assert_int_equal(rc, 0);
+	run_ok(argv);
 }
 
 /* How many maps dir holds (their .key files). */
@@ -421,12 +418,7 @@ static void markov_passes_build4(const char *out, const char *entries, const cha
 	                      threads,    "--out",     out,
 	                      "--quiet",  a,           b,
 	                      c,          d,           NULL};
-	char *err = NULL;
-	int rc = bsim_test_cli(argv, NULL, &err);
-	if (rc != 0)
-		print_error("%s", err ? err : "");
-	free(err);
-	assert_int_equal(rc, 0);
+	run_ok(argv);
 }
 
 static void markov_passes_build(const char *out, const char *entries, const char *threads,
@@ -549,8 +541,6 @@ static void lattice_argv(const char **argv, char *exp, size_t size, const char *
 	                   b,           NULL};
 	memcpy(argv, v, sizeof v);
 }
-
-static void run_ok(const char *const *argv);
 
 /* The lattice sweep in 3 parts, merged: the one-process trials.csv,
  * gate_entries.csv, beam_peaks.csv, final_locations.csv,
@@ -923,6 +913,7 @@ static int have_mpi(void)
 /* Starts mpirun -np ranks beamsim cmd ... in the background, its stderr
  * into err_path; returns mpirun's pid. */
 static pid_t spawn_mpirun(const char *const *argv, const char *err_path);
+static pid_t spawn_ranks(const char *ranks, const char *const *args, const char *err_path);
 
 static pid_t mpirun_command(const char *cmd, const char *ranks, const char *out, const char *trials,
                             int resume, const char *err_path)
@@ -944,6 +935,19 @@ static pid_t mpirun_command(const char *cmd, const char *ranks, const char *out,
 	                      resume ? "--resume" : NULL,
 	                      NULL};
 	return spawn_mpirun(argv, err_path);
+}
+
+/* Starts beamsim with args (a NULL-terminated list, at most 32) under
+ * mpirun --oversubscribe -np ranks, its stderr into err_path. */
+static pid_t spawn_ranks(const char *ranks, const char *const *args, const char *err_path)
+{
+	const char *job[40] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", ranks, BSIM_EXE};
+	int n = 0;
+	while (args[n])
+		n++;
+	assert_true(n <= 32);
+	memcpy(job + 5, args, (size_t)(n + 1) * sizeof *args);
+	return spawn_mpirun(job, err_path);
 }
 
 /* Starts argv (mpirun ...) in the background, its stderr into err_path. */
@@ -1375,8 +1379,7 @@ static void test_mpi_lattice(void **state)
 	if (!have_mpi())
 		return;
 	char dir[1024], one[1100], out[1100], err_path[1200], exp[1200];
-	const char *argv[20],
-	        *job[26] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
+	const char *argv[20];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_lattice"));
 	snprintf(one, sizeof one, "%s/one", dir);
 	snprintf(out, sizeof out, "%s/ranks3", dir);
@@ -1384,11 +1387,7 @@ static void test_mpi_lattice(void **state)
 	lattice_argv(argv, exp, sizeof exp, one, "2", NULL, NULL);
 	run_ok(argv);
 	lattice_argv(argv, exp, sizeof exp, out, "1", NULL, NULL);
-	int n = 0;
-	while (argv[n])
-		n++;
-	memcpy(job + 5, argv, (size_t)(n + 1) * sizeof *argv);
-	int rc = wait_status(spawn_mpirun(job, err_path));
+	int rc = wait_status(spawn_ranks("3", argv, err_path));
 	if (rc != 0)
 		print_stderr(err_path);
 	assert_int_equal(rc, 0);
@@ -1403,8 +1402,7 @@ static void test_mpi_lattice_compare(void **state)
 	if (!have_mpi())
 		return;
 	char dir[1024], one[1100], out[1100], err_path[1200];
-	const char *argv[16],
-	        *job[24] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
+	const char *argv[16];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_lattice_compare"));
 	snprintf(one, sizeof one, "%s/one", dir);
 	snprintf(out, sizeof out, "%s/ranks3", dir);
@@ -1413,11 +1411,7 @@ static void test_mpi_lattice_compare(void **state)
 	int want = run_status(argv);
 	assert_true(want == 0 || want == 3);
 	lattice_compare_argv(argv, out, "1", NULL, NULL, NULL);
-	int n = 0;
-	while (argv[n])
-		n++;
-	memcpy(job + 5, argv, (size_t)(n + 1) * sizeof *argv);
-	int rc = wait_status(spawn_mpirun(job, err_path));
+	int rc = wait_status(spawn_ranks("3", argv, err_path));
 	if (rc != want)
 		print_stderr(err_path);
 	assert_int_equal(rc, want);
@@ -1432,8 +1426,7 @@ static void test_mpi_validate_essay(void **state)
 	if (!have_mpi())
 		return;
 	char dir[1024], one[1100], out[1100], err_path[1200], exp[1200], configs[1100];
-	const char *argv[20],
-	        *job[26] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
+	const char *argv[20];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_validate"));
 	for (int k = 0; k < 2; k++) {
 		const char *name = k ? "essay" : "validate";
@@ -1452,11 +1445,7 @@ static void test_mpi_validate_essay(void **state)
 			essay_argv(argv, configs, sizeof configs, out, "2", "1", NULL, NULL);
 		else
 			validate_argv(argv, exp, sizeof exp, out, "8", "1", NULL, NULL, NULL);
-		int n = 0;
-		while (argv[n])
-			n++;
-		memcpy(job + 5, argv, (size_t)(n + 1) * sizeof *argv);
-		int rc = wait_status(spawn_mpirun(job, err_path));
+		int rc = wait_status(spawn_ranks("3", argv, err_path));
 		if (rc != 0)
 			print_stderr(err_path);
 		assert_int_equal(rc, 0);
@@ -1473,8 +1462,7 @@ static void test_mpi_essay_killed_resumed(void **state)
 	if (!have_mpi())
 		return;
 	char dir[1024], one[1100], out[1100], err_path[1200], journal[1200], configs[1100];
-	const char *argv[20],
-	        *job[26] = {BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "3", BSIM_EXE};
+	const char *argv[20];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("mpi_essay_killed"));
 	named_out(one, sizeof one, dir, "one");
 	essay_argv(argv, configs, sizeof configs, one, "8", "2", NULL, NULL);
@@ -1485,11 +1473,7 @@ static void test_mpi_essay_killed_resumed(void **state)
 	snprintf(journal, sizeof journal, "%s/.beamsim/journal", out);
 	essay_argv(argv, configs, sizeof configs, out, "8", "1", NULL, NULL);
 	argv[9] = "--quiet";
-	int n = 0;
-	while (argv[n])
-		n++;
-	memcpy(job + 5, argv, (size_t)(n + 1) * sizeof *argv);
-	pid_t pid = spawn_mpirun(job, err_path);
+	pid_t pid = spawn_ranks("3", argv, err_path);
 	int status = 0;
 	if (!bsim_test_await_records(pid, journal, 20, &status)) {
 		print_stderr(err_path);
@@ -1501,11 +1485,12 @@ static void test_mpi_essay_killed_resumed(void **state)
 	assert_true(bsim_test_journal_records(journal) >= 20);
 	assert_false(bsim_test_exists(bsim_test_join(out, "essay.csv")));
 	/* resumed by a job of 2 ranks */
+	int n = 0;
+	while (argv[n])
+		n++;
 	argv[n] = "--resume";
 	argv[n + 1] = NULL;
-	memcpy(job + 5, argv, (size_t)(n + 2) * sizeof *argv);
-	job[3] = "2";
-	int rc = wait_status(spawn_mpirun(job, err_path));
+	int rc = wait_status(spawn_ranks("2", argv, err_path));
 	if (rc != 0)
 		print_stderr(err_path);
 	assert_int_equal(rc, 0);
