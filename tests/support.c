@@ -401,18 +401,13 @@ static int has_entry(const char *dir, long n)
  * beyond any run the tests start, even on a loaded machine. */
 #define AWAIT_DEADLINE_S 300.0
 
-/* Looks every millisecond whether ready(path, n) holds, until it does (1)
- * or the program pid has ended (0, its status in *status): what ends the
- * wait is the program's doing. A program that does neither within
- * AWAIT_DEADLINE_S is killed and the test fails, naming what it waited
- * for. */
-static int await(int pid, int (*ready)(const char *, long), const char *path, long n, int *status)
+int bsim_test_await(int pid, int (*ready)(void *ctx), void *ctx, const char *what, int *status)
 {
 	const struct timespec tick = {0, 1000000};
 	struct timespec t0, t;
 	clock_gettime(CLOCK_MONOTONIC, &t0);
 	for (;;) {
-		if (ready(path, n))
+		if (ready(ctx))
 			return 1;
 		int st = 0;
 		pid_t w = waitpid((pid_t)pid, &st, WNOHANG);
@@ -424,12 +419,33 @@ static int await(int pid, int (*ready)(const char *, long), const char *path, lo
 		if ((double)(t.tv_sec - t0.tv_sec) > AWAIT_DEADLINE_S) {
 			kill((pid_t)pid, SIGKILL);
 			waitpid((pid_t)pid, &st, 0);
-			fail_msg("waited %g s for %s (%ld) while the program neither got there nor "
+			fail_msg("waited %g s for %s while the program neither got there nor "
 			         "ended: killed it",
-			         AWAIT_DEADLINE_S, path, n);
+			         AWAIT_DEADLINE_S, what);
 		}
 		nanosleep(&tick, NULL);
 	}
+}
+
+/* What a wait on a file or a directory looks at: ready(path, n). */
+typedef struct path_wait {
+	int (*ready)(const char *path, long n);
+	const char *path;
+	long n;
+} path_wait;
+
+static int path_ready(void *ctx)
+{
+	const path_wait *pw = ctx;
+	return pw->ready(pw->path, pw->n);
+}
+
+static int await(int pid, int (*ready)(const char *, long), const char *path, long n, int *status)
+{
+	path_wait pw = {ready, path, n};
+	char what[1200];
+	snprintf(what, sizeof what, "%s (%ld)", path, n);
+	return bsim_test_await(pid, path_ready, &pw, what, status);
 }
 
 int bsim_test_await_records(int pid, const char *path, long n, int *status)

@@ -53,7 +53,13 @@ long bsim_test_journal_records(const char *path);
  * (never a fixed time); a program that neither gets there nor ends within
  * a generous guard (300 s) is killed and the test fails.
  *
- * Waits until the journal at path holds at least n records while the
+ * Waits until ready(ctx) holds while the spawned pid runs: 1 if it does,
+ * or 0 with *status (as bsim_test_wait gives it) if the program ended
+ * first; what names the event in the guard's failure. The waits after it
+ * are this one on a journal, a directory or a glob. */
+int bsim_test_await(int pid, int (*ready)(void *ctx), void *ctx, const char *what, int *status);
+
+/* Waits until the journal at path holds at least n records while the
  * spawned pid runs: 1 if it does (the program still running), or 0 with
  * *status (as bsim_test_wait gives it) if the program ended first. The
  * journal is created whole (header and all) after the program installs its

@@ -1072,31 +1072,33 @@ static void test_mpi_markov_build(void **state)
 	assert_false(bsim_test_exists(bsim_test_join(out, ".beamsim")));
 }
 
-/* Waits until the file at path holds needle (polled every millisecond:
- * the event is the text appearing) and returns the text then; NULL with
- * *status if the job ends first; kills the job and fails after 300 s, as
- * bsim_test_await_* do. */
+/* A wait for a file's text: the text at path once it holds needle. */
+typedef struct text_wait {
+	const char *path, *needle;
+	char *text;
+} text_wait;
+
+static int text_ready(void *ctx)
+{
+	text_wait *tw = ctx;
+	long n = 0;
+	free(tw->text);
+	tw->text = file_bytes(tw->path, &n);
+	return tw->text && strstr(tw->text, tw->needle);
+}
+
+/* Waits until the file at path holds needle and returns the text then (a
+ * later look may find the file rewritten); NULL with *status if the job
+ * ends first (bsim_test_await). */
 static char *await_text(pid_t job, const char *path, const char *needle, int *status)
 {
-	const struct timespec tick = {0, 1000000};
-	struct timespec t0, t;
-	clock_gettime(CLOCK_MONOTONIC, &t0);
-	for (;;) {
-		long n = 0;
-		char *text = file_bytes(path, &n);
-		if (text && strstr(text, needle))
-			return text;
-		free(text);
-		if (waitpid(job, status, WNOHANG) == job)
-			return NULL;
-		clock_gettime(CLOCK_MONOTONIC, &t);
-		if (t.tv_sec - t0.tv_sec > 300) {
-			kill(job, SIGKILL);
-			waitpid(job, status, 0);
-			fail_msg("waited 300 s for %s in %s: killed the job", needle, path);
-		}
-		nanosleep(&tick, NULL);
-	}
+	text_wait tw = {path, needle, NULL};
+	char what[4200];
+	snprintf(what, sizeof what, "%s in %s", needle, path);
+	if (bsim_test_await((int)job, text_ready, &tw, what, status))
+		return tw.text;
+	free(tw.text);
+	return NULL;
 }
 
 /* The bytes of file path (NULL if unreadable), for comparison. */
@@ -1311,29 +1313,30 @@ static pid_t rank_pid(pid_t parent, int rank)
 	return found;
 }
 
-/* The pid of the job's rank once it is running (polled every millisecond:
- * the event is the rank's process appearing); the test fails if the job
- * ends first, or kills the job and fails after 300 s, as bsim_test_await_*
- * do. */
+/* A wait for an MPI rank's process: its pid once found. */
+typedef struct rank_wait {
+	pid_t job, pid;
+	int rank;
+} rank_wait;
+
+static int rank_ready(void *ctx)
+{
+	rank_wait *rw = ctx;
+	return (rw->pid = rank_pid(rw->job, rw->rank)) >= 0;
+}
+
+/* The pid of the job's rank once it is running (the event is the rank's
+ * process appearing, bsim_test_await); the test fails if the job ends
+ * first. */
 static pid_t await_rank(pid_t job, int rank)
 {
-	const struct timespec tick = {0, 1000000};
-	struct timespec t0, t;
-	clock_gettime(CLOCK_MONOTONIC, &t0);
-	pid_t victim;
-	while ((victim = rank_pid(job, rank)) < 0) {
-		int st;
-		if (waitpid(job, &st, WNOHANG) == job)
-			fail_msg("the job ended before its rank %d was found", rank);
-		clock_gettime(CLOCK_MONOTONIC, &t);
-		if (t.tv_sec - t0.tv_sec > 300) {
-			kill(job, SIGKILL);
-			waitpid(job, &st, 0);
-			fail_msg("waited 300 s for rank %d of job %d: killed it", rank, (int)job);
-		}
-		nanosleep(&tick, NULL);
-	}
-	return victim;
+	rank_wait rw = {job, -1, rank};
+	char what[64];
+	snprintf(what, sizeof what, "rank %d of job %d", rank, (int)job);
+	int status = 0;
+	if (!bsim_test_await((int)job, rank_ready, &rw, what, &status))
+		fail_msg("the job ended (status %d) before its rank %d was found", status, rank);
+	return rw.pid;
 }
 
 static void test_mpi_rank_killed_resumed(void **state)
