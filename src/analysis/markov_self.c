@@ -364,36 +364,50 @@ int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, cons
 	return rc;
 }
 
-int markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                      const bsim_options *opts, const bsim_markov_map *maps, int n, const char *dir,
-                      bsim_error *err)
+/* The passes every one of the n maps has in dir: the first pass some map
+ * lacks (0 if none, or dir NULL), each map's runs of the pass before it
+ * read into runs[i] (runs NULL: each read and checked, then dropped) and
+ * what that pass and those before it cost into prior[i] (prior NULL: not
+ * kept); -1 with err if a cached pass's exits are malformed. */
+static int passes_cached(const bsim_scene *lattice, const bsim_markov_def *def,
+                         const bsim_backend *be, const bsim_options *opts,
+                         const bsim_markov_map *maps, int n, const char *dir, markov_run **runs,
+                         bsim_markov_map *prior, bsim_error *err)
 {
 	const long units = (long)maps[0].n_bins * maps[0].trials;
-	markov_run *runs = dir ? calloc((size_t)units, sizeof *runs) : NULL;
-	if (dir && !runs) {
+	markov_run *scratch = dir && !runs ? calloc((size_t)units, sizeof *scratch) : NULL;
+	if (dir && !runs && !scratch) {
 		bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		return -1;
 	}
-	/* as markov_flow_simulate finds the passes it starts after */
-	int round = 0;
-	for (int q = def->self_passes - 1; q >= 0 && dir && !round; q--) {
+	int first = 0;
+	for (int q = def->self_passes - 1; q >= 0 && dir && !first; q--) {
 		int all = 1;
 		for (int i = 0; i < n && all; i++) {
 			bsim_markov_def dq = *def;
 			dq.self_passes = q + 1;
-			int got =
-			        last_cached(lattice, &dq, be, opts, &maps[i], dir, runs, NULL, err);
+			int got = last_cached(lattice, &dq, be, opts, &maps[i], dir,
+			                      runs ? runs[i] : scratch, prior ? &prior[i] : NULL,
+			                      err);
 			if (got == -2) {
-				free(runs);
+				free(scratch);
 				return -1;
 			}
 			all = got == q;
 		}
 		if (all)
-			round = q + 1;
+			first = q + 1;
 	}
-	free(runs);
-	return round;
+	free(scratch);
+	return first;
+}
+
+int markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                      const bsim_options *opts, const bsim_markov_map *maps, int n, const char *dir,
+                      bsim_error *err)
+{
+	/* as markov_flow_simulate finds the passes it starts after */
+	return passes_cached(lattice, def, be, opts, maps, n, dir, NULL, NULL, err);
 }
 
 /* ---- flow-weighted passes over a field ---- */
@@ -531,19 +545,10 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	bsim_markov_map *prior = calloc((size_t)n, sizeof *prior);
 	if (!prior)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (int q = def->self_passes - 1; q >= 0 && rc == BSIM_OK && !q0 && !meet; q--) {
-		int all = 1;
-		for (int i = 0; i < n && all; i++) {
-			bsim_markov_def dq = *def;
-			dq.self_passes = q + 1;
-			int got = last_cached(lattice, &dq, be, opts, &maps[i], dir, prev[i],
-			                      &prior[i], err);
-			if (got == -2)
-				rc = BSIM_EINPUT;
-			all = got == q;
-		}
-		if (all)
-			q0 = q + 1;
+	if (rc == BSIM_OK && !meet &&
+	    (q0 = passes_cached(lattice, def, be, opts, maps, n, dir, prev, prior, err)) < 0) {
+		rc = BSIM_EINPUT; /* a cached pass's exits malformed: err says which */
+		q0 = 0;
 	}
 	for (int i = 0; i < n && prior; i++)
 		if (!have[i]) {
