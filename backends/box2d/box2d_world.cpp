@@ -1564,4 +1564,5 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         nullptr, /* reset: the runner creates a world per trial */
         BSIM_TAKES_DRAG | BSIM_TAKES_GROUND_FRICTION,
         nullptr, /* flight: the runner steps every step */
+        nullptr, /* steps: likewise */
 };

@@ -6,7 +6,7 @@
  * (body and tip speeds, and what the force and the spring add, with a
  * factor 2 of safety; |v| already includes h |F| / M). A beam can touch the
  * body only if the body's centre C lies within L_i + R + m_i of its pivot
- * P_i; contact_detect.c makes that test exactly, beam by beam.
+ * P_i; contact_geometry.h makes that test exactly, beam by beam.
  *
  * A beam at rest (theta = omega = 0) has m_i = 2 h |v| + slop, the same for
  * every such beam. The pivots sit in a uniform grid of cells of side
@@ -22,6 +22,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "model/contact_flag.h"
 #include "thesis/thesis.h"
 
 #define BROAD_PHASE_MIN_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
@@ -128,26 +129,38 @@ static void sort_small(int *v, int n)
 	}
 }
 
-/* The room around a clear body. With its centre at C_c every beam has
- *   |C_c - P_i| >= L_i + R + D        (D = clear_room),
- * so with the centre at C, |C - P_i| >= L_i + R + D - |C - C_c|, and a
- * step whose margin m has |C - C_c|_1 + m < D (|.|_1 >= |.|) finds every
- * beam out of reach, as testing them would: the step's test is then two
- * differences, not a square per beam. D is cut by 1e-9 of the lengths
- * involved (the distances, the reaches, |C_c|), which covers the
- * round-off of the test (1e-16 of the same lengths): the room may say
- * "not clear" where the beams are, then tested, clear, never the reverse.
- * The pivots never move, so the room holds for the world's life; it is
- * refilled wherever the beams are found clear after it failed. */
+/* Free flight among beams at rest (thesis_broad_phase_clear). A beam at
+ * rest is its segment S_i from P_i along its rest direction u0_i, and the
+ * body can touch it within a step only if its centre comes within R + m of
+ * S_i (m: the step's margin). The room around a clear body: with its
+ * centre at C_c every beam has
+ *   dist(C_c, S_i) >= R + D        (D = clear_room),
+ * so with the centre at C, dist(C, S_i) >= R + D - |C - C_c| (the
+ * distance to a fixed set moves no faster than the point), and a step
+ * whose margin m has |C - C_c|_1 + m < D (|.|_1 >= |.|) finds every beam
+ * out of reach, as detecting them would (their gap exceeds the margin, so
+ * no contact; the body ends the step more than BSIM_CONTACT_TOL from each,
+ * so no flag): the step's test is then two differences, not a beam's
+ * distance each. D is cut by 1e-9 of the lengths involved (the distances,
+ * the reaches, |C_c|), which covers the round-off of the test and of the
+ * distances (1e-16 of the same lengths): the room may say "not clear"
+ * where the beams are, then tested, clear, never the reverse. The beams
+ * at rest never move, so the room holds while they stay at rest (the
+ * callers ask only then: no beam awake); it is refilled wherever the
+ * beams are found clear after it failed. */
+static double rest_distance2(const struct bsim_world *w, const thesis_beam *b)
+{
+	int type;
+	return bsim_beam_distance2(b->p, b->u0, b->length, w->x, &type);
+}
+
 static void clear_fill(struct bsim_world *w)
 {
 	double room = INFINITY, reach_max = 0.0;
 	for (int i = 0; i < w->n_beams; i++) {
 		const thesis_beam *b = &w->beams[i];
-		double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-		double reach = b->length + w->radius;
-		room = fmin(room, sqrt(dx * dx + dy * dy) * (1.0 - 1e-9) - reach);
-		reach_max = fmax(reach_max, reach);
+		room = fmin(room, sqrt(rest_distance2(w, b)) * (1.0 - 1e-9) - w->radius);
+		reach_max = fmax(reach_max, b->length + w->radius);
 	}
 	w->clear_x[0] = w->x[0];
 	w->clear_x[1] = w->x[1];
@@ -165,10 +178,8 @@ int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double
 	if (fabs(w->x[0] - w->clear_x[0]) + fabs(w->x[1] - w->clear_x[1]) + margin < w->clear_room)
 		return 1; /* clear_fill below */
 	for (int i = 0; i < w->n_beams; i++) {
-		const thesis_beam *b = &w->beams[i];
-		double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-		double reach = b->length + w->radius + margin;
-		if (!(dx * dx + dy * dy > reach * reach))
+		const double reach = (w->radius + margin) * (1.0 + 1e-9);
+		if (!(rest_distance2(w, &w->beams[i]) > reach * reach))
 			return 0;
 	}
 	clear_fill(w);

@@ -38,7 +38,7 @@ static int shape_flag(const struct bsim_world *w, const thesis_beam *b, const do
 	return c.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
 }
 
-/* extended: constant (contact_detect.c's contact_detect): 0 compiles the
+/* extended: constant (contact_geometry.h's contact_detect): 0 compiles the
  * essay's disk's copy without the shape's test. */
 THESIS_SPECIALISED void report_beam(struct bsim_world *w, int i, const int extended)
 {

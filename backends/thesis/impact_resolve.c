@@ -49,16 +49,11 @@
 #include "util/fminmax.h"
 #include "thesis/thesis.h"
 
-static void impact_bounds(const struct bsim_world *w, thesis_contact *c)
-{
-	c->bound = c->vrel < -w->rest_threshold ? -c->e * c->vrel : 0.0;
-}
-
 /* Contacts whose friction impact's energy is checked (a body meets 4 at
  * most in a lattice). */
 #define IMPACT_CONTACTS_MAX 16
 
-/* extended: constant (contact_detect.c's contact_detect): 0 compiles the
+/* extended: constant (contact_geometry.h's contact_detect): 0 compiles the
  * essay's disk's copy of this file's functions without the extended path. */
 THESIS_SPECIALISED void impact_apply(struct bsim_world *w, const thesis_contact *cs, int n,
                                      const int extended)
@@ -204,7 +199,7 @@ THESIS_SPECIALISED void impact_nearest_first(struct bsim_world *w, thesis_contac
 			w->solver.iteration_limit += next->vrel < -IMPACT_APPROACH_TOL;
 			return;
 		}
-		impact_bounds(w, next);
+		thesis_impact_bound(w, next);
 		impact_solve(w, next, 1, extended);
 		impact_apply(w, next, 1, extended);
 		if (next->impulse > 0.0 && next->vrel < -w->rest_threshold)
@@ -216,23 +211,8 @@ THESIS_SPECIALISED int impact_resolve(struct bsim_world *w, double h, const int 
 {
 	/* The touching contacts go to the front of the list. */
 	thesis_contact *cs = w->contacts;
-	int n = 0, approaching = 0;
-	for (int i = 0; i < w->n_contacts; i++) {
-		/* In place: a contact left behind has its velocity and 1/I set
-		 * again by the contact solve. Swapped only when out of place. */
-		thesis_contact *c = &cs[i];
-		thesis_contact_velocity(w, c, extended);
-		if (c->gap + h * bsim_fmin(c->vrel, 0.0) > w->slop)
-			continue;
-		c->inv_i = w->beams[c->beam].inv_inertia;
-		approaching |= c->vrel < 0.0;
-		if (i != n) {
-			thesis_contact t = cs[n];
-			cs[n] = *c;
-			*c = t;
-		}
-		n++;
-	}
+	int approaching;
+	int n = thesis_impacts_touching(w, w->n_contacts, h, &approaching, extended);
 	if (!approaching)
 		return 0;
 
@@ -241,7 +221,7 @@ THESIS_SPECIALISED int impact_resolve(struct bsim_world *w, double h, const int 
 		impact_nearest_first(w, cs, n, extended);
 	} else {
 		for (int i = 0; i < n; i++)
-			impact_bounds(w, &cs[i]);
+			thesis_impact_bound(w, &cs[i]);
 		w->solver.iteration_limit += impact_solve(w, cs, n, extended);
 		impact_apply(w, cs, n, extended);
 		for (int i = 0; i < n; i++)

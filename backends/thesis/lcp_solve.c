@@ -38,52 +38,6 @@
 /* Projected Gauss-Seidel's sweeps at most. */
 #define LCP_ITERATIONS_MAX 100000
 
-/* inv_j: the body's 1/J on the extended path (thesis.h), whose rotation
- * adds cb_i cb_j / J to K; 0 (the essay's body, which does not turn) adds
- * nothing, not even a rounding. */
-THESIS_SPECIALISED double k_entry(double inv_mass, double inv_j, const thesis_contact *a,
-                                  const thesis_contact *b, const int extended)
-{
-	double k = (a->n[0] * b->n[0] + a->n[1] * b->n[1]) * inv_mass;
-	if (a == b)
-		k += a->c * a->c * a->inv_i;
-	else if (extended && a->two && b->two && a->beam == b->beam) /* a capsule's two */
-		k += a->c * b->c * a->inv_i;
-	if (extended && inv_j != 0.0)
-		k += a->cb * b->cb * inv_j;
-	return k;
-}
-
-THESIS_SPECIALISED void lcp_two(double inv_mass, double inv_j, thesis_contact *c0,
-                                thesis_contact *c1, const int extended)
-{
-	double q0 = c0->vrel - c0->bound, q1 = c1->vrel - c1->bound;
-	double k00 = k_entry(inv_mass, inv_j, c0, c0, extended),
-	       k11 = k_entry(inv_mass, inv_j, c1, c1, extended);
-	double k01 = k_entry(inv_mass, inv_j, c0, c1, extended);
-	c0->impulse = c1->impulse = 0.0;
-	if (q0 >= 0.0 && q1 >= 0.0)
-		return;
-	double det = k00 * k11 - k01 * k01;
-	if (det > 0.0) {
-		double p0 = (k01 * q1 - k11 * q0) / det;
-		double p1 = (k01 * q0 - k00 * q1) / det;
-		if (p0 >= 0.0 && p1 >= 0.0) {
-			c0->impulse = p0;
-			c1->impulse = p1;
-			return;
-		}
-	}
-	double p0 = -q0 / k00;
-	if (p0 > 0.0 && q1 + k01 * p0 >= 0.0) {
-		c0->impulse = p0;
-		return;
-	}
-	double p1 = -q1 / k11;
-	if (p1 > 0.0 && q0 + k01 * p1 >= 0.0)
-		c1->impulse = p1;
-}
-
 /* Sweeps until no impulse changes by more than 1e-14 N s; 1 if it stopped
  * at its iteration limit instead. */
 THESIS_SPECIALISED int lcp_gauss_seidel(double inv_mass, double inv_j, thesis_contact *cs, int n,
@@ -205,13 +159,9 @@ long thesis_lcp_fallbacks(void)
 THESIS_SPECIALISED int lcp_solve(double inv_mass, double inv_j, thesis_contact *cs, int n,
                                  const int extended)
 {
-	if (n == 1) {
-		double q = cs[0].vrel - cs[0].bound;
-		cs[0].impulse =
-		        q < 0.0 ? -q / k_entry(inv_mass, inv_j, &cs[0], &cs[0], extended) : 0.0;
-	} else if (n == 2) {
-		lcp_two(inv_mass, inv_j, &cs[0], &cs[1], extended);
-	} else if (n > 2) {
+	if (n <= 2) {
+		thesis_lcp_small(inv_mass, inv_j, cs, n, extended);
+	} else {
 		if (n <= LCP_EXACT_MAX && lcp_enumerate(inv_mass, inv_j, cs, n, extended))
 			return 0;
 #pragma omp atomic update
@@ -229,18 +179,4 @@ int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n)
 int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	return lcp_solve(inv_mass, inv_j, cs, n, 1);
-}
-
-void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2])
-{
-	j[0] = j[1] = 0.0;
-	if (n == 2) { /* one expression for a pair: a mirrored pair sums alike */
-		j[0] = cs[0].impulse * cs[0].n[0] + cs[1].impulse * cs[1].n[0];
-		j[1] = cs[0].impulse * cs[0].n[1] + cs[1].impulse * cs[1].n[1];
-		return;
-	}
-	for (int k = 0; k < n; k++) {
-		j[0] += cs[k].impulse * cs[k].n[0];
-		j[1] += cs[k].impulse * cs[k].n[1];
-	}
 }

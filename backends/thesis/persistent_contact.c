@@ -140,16 +140,8 @@ void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double for
 	thesis_contact *cs = w->contacts;
 	int n = w->n_contacts;
 
-	for (int k = 0; k < n; k++) {
-		thesis_contact *c = &cs[k];
-		const thesis_beam *b = &w->beams[c->beam];
-		double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
-		c->omega_free = thesis_beam_free_omega(b, h, w->integrator);
-		double gap = bsim_fmax(c->gap, 0.0);
-		c->inv_i = thesis_beam_response(b, h, w->integrator);
-		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
-		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
-	}
+	for (int k = 0; k < n; k++)
+		thesis_smooth_row(&cs[k], &w->beams[cs[k].beam], v0, vf, h, w->integrator);
 	/* No contact (free flight): no solve, and the impulse sum of none is
 	 * 0 (thesis_impulse_sum's start), added as it would be. */
 	double j[2] = {0.0, 0.0};
@@ -171,23 +163,9 @@ void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double for
 	}
 	for (int a = 0; a < w->n_awake; a++) {
 		int i = w->awake[a];
-		thesis_beam *b = &w->beams[i];
 		int k = w->contact_of[i];
 		w->contact_of[i] = -1;
-		if (k < 0 && b->theta == 0.0 && b->omega == 0.0)
-			continue;
-		double omega_new;
-		if (k < 0) {
-			omega_new = thesis_beam_free_omega(b, h, w->integrator);
-		} else {
-			omega_new = cs[k].omega_free - cs[k].impulse * cs[k].c * cs[k].inv_i;
-			double omega_m = w->integrator == THESIS_EULER
-			                         ? omega_new
-			                         : 0.5 * (b->omega + omega_new);
-			w->energy.contact -=
-			        cs[k].impulse *
-			        ((cs[k].n[0] * vm[0] + cs[k].n[1] * vm[1]) - cs[k].c * omega_m);
-		}
-		w->energy.damper += thesis_beam_advance(b, omega_new, h, w->integrator);
+		thesis_smooth_beam(&w->beams[i], k < 0 ? NULL : &cs[k], vm, h, w->integrator,
+		                   &w->energy.damper, &w->energy.contact);
 	}
 }

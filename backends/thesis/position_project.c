@@ -16,7 +16,7 @@
  * normals only); the torque's work over dpsi joins the correction. */
 #include "thesis/thesis.h"
 
-/* extended: constant (contact_detect.c's contact_detect): 0 compiles the
+/* extended: constant (contact_geometry.h's contact_detect): 0 compiles the
  * essay's disk's copy of this file's functions without the extended path. */
 THESIS_SPECIALISED void project_once(struct bsim_world *w, thesis_contact *cs, int n,
                                      const double force[2], double torque, const int extended)
@@ -39,24 +39,8 @@ THESIS_SPECIALISED void project_once(struct bsim_world *w, thesis_contact *cs, i
 		w->heading += dpsi;
 		w->energy.correction += torque * dpsi;
 	}
-	double dx = 0.0, dy = 0.0, de = 0.0;
-	for (int k = 0; k < n; k++) {
-		thesis_beam *b = &w->beams[cs[k].beam];
-		double theta = b->theta - cs[k].impulse * cs[k].c * cs[k].inv_i;
-		de += 0.5 * b->stiffness * (theta * theta - b->theta * b->theta);
-		b->theta = theta;
-		dx += cs[k].impulse * cs[k].n[0];
-		dy += cs[k].impulse * cs[k].n[1];
-	}
-	dx *= w->inv_mass;
-	dy *= w->inv_mass;
-	w->x[0] += dx;
-	w->x[1] += dy;
-	w->energy.correction += (force[0] * dx + force[1] * dy) - de;
+	thesis_project_move(w, cs, n, force, &w->energy.correction);
 }
-
-/* Projections per step at most. */
-#define PROJECT_PASSES_MAX 3
 
 /* The contacts of the beams of cs[0..n) detected again into cs, each beam
  * once (a capsule may have two contacts with one beam, and may have one
@@ -105,7 +89,7 @@ THESIS_SPECIALISED void position_project(struct bsim_world *w, const double forc
 			deep |= cs[k].gap < -w->slop;
 		if (!deep)
 			break;
-		if (pass == PROJECT_PASSES_MAX) { /* still deeper than slop */
+		if (pass == THESIS_PROJECT_PASSES_MAX) { /* still deeper than slop */
 			w->solver.iteration_limit++;
 			break;
 		}

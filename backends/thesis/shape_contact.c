@@ -1,8 +1,8 @@
 /* The contact geometry of a body of another shape than the disk against a
- * beam (extended path, thesis.h's head; contact_detect.c's head gives the
+ * beam (extended path, thesis.h's head; contact_geometry.h's head gives the
  * levers): the outline's nearest point from model/body_shape.h, and a
  * capsule's second contact when it lies along the beam. Apart from
- * contact_detect.c, so that the disk's detection is compiled as it was. */
+ * contact_geometry.h, so that the disk's detection is compiled as it was. */
 #include <math.h>
 
 #include "model/body_shape.h"

@@ -30,6 +30,7 @@
 #include <math.h>
 
 #include "beamsim/backend.h"
+#include "util/fminmax.h"
 
 /* A function written once for any body with a constant `extended` and
  * called with 1 (any body) and 0 (the essay's disk, w->extended 0): always
@@ -50,7 +51,7 @@
 
 /* The geometry of the body against one beam at one configuration: the
  * body's centre x and the beam's angle theta it was computed at, and the
- * nearest point's distance, normal and lever (contact_detect.c). */
+ * nearest point's distance, normal and lever (contact_geometry.h). */
 typedef struct thesis_geometry {
 	double x[2], theta; /* m, rad; theta NaN: none computed yet */
 	int type;           /* BSIM_CONTACT_TANGENT or _TIP; NONE: centre on an end */
@@ -81,7 +82,7 @@ typedef struct thesis_beam {
 	double h_d, d, response;
 	double theta; /* rad */
 	double omega; /* rad/s */
-	/* The direction at angle u_theta (contact_detect.c): detection and the
+	/* The direction at angle u_theta (contact_geometry.h): detection and the
 	 * projection's re-detection of one step meet the same angle. */
 	double u_theta; /* rad */
 	double u[2];
@@ -108,7 +109,7 @@ typedef struct thesis_contact {
 	double cb, cbt, ct;
 	double vrel_t, impulse_t;
 	double mu;
-	/* 1: one of a capsule's two contacts with its beam (contact_detect.c),
+	/* 1: one of a capsule's two contacts with its beam (contact_geometry.h),
 	 * whose impulses both turn the beam: K couples the pair. */
 	int two;
 } thesis_contact;
@@ -174,7 +175,7 @@ struct bsim_world {
 	int n_typed;
 	/* per step */
 	thesis_contact *contacts; /* 2 n_beams capacity: a capsule has up to two
-	                           * contacts with one beam (contact_detect.c) */
+	                           * contacts with one beam (contact_geometry.h) */
 	int n_contacts;
 	int *contact_of;   /* per beam: its index in contacts, or -1 */
 	int *contact_type; /* per beam, at the end of the step, within contact_tol:
@@ -210,8 +211,8 @@ struct bsim_world {
 	int n_near;
 	double near_x[2];  /* m */
 	double near_reach; /* m; 0: no cache */
-	/* The room of thesis_broad_phase_clear: every beam's pivot lies
-	 * farther than L + R + clear_room from clear_x (0: none known). */
+	/* The room of thesis_broad_phase_clear: every beam at rest lies
+	 * farther than R + clear_room from clear_x (0: none known). */
 	double clear_x[2]; /* m */
 	double clear_room; /* m */
 };
@@ -244,13 +245,19 @@ int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double
 /* thesis_flight.c: bsim_backend.flight. */
 int thesis_flight(struct bsim_world *w, const double force[2], double h, int n, double (*xv)[4]);
 
+/* thesis_steps.c: bsim_backend.steps, for the worlds thesis_steps_takes
+ * (1: the essay's disk, physical contacts, simultaneous impacts, no
+ * sleeping, at most THESIS_STEPS_BEAMS beams). */
+#define THESIS_STEPS_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
+int thesis_steps_takes(const struct bsim_world *w);
+int thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out);
+
 /* beam_sleep.c */
 void thesis_beam_wake(struct bsim_world *w, int i);
 void thesis_beams_sleep(struct bsim_world *w, double speed, double h);
 void thesis_awake_prune(struct bsim_world *w);
 
 /* contact_detect.c */
-void thesis_beam_direction(thesis_beam *b, double u[2]);
 /* The contacts of beam i within margin into out (room for 2); returns how
  * many (0, 1, or 2 for a capsule along the beam). */
 int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out);
@@ -293,8 +300,6 @@ void thesis_impulse_sum_extended(const thesis_contact *cs, int n, double j[2], d
 /* Solves with more than 2 contacts that fell back to Gauss-Seidel, all
  * worlds, since the program started. */
 long thesis_lcp_fallbacks(void);
-/* The total impulse sum P_i n_i on the body, N s. */
-void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2]);
 
 /* impact_resolve.c */
 int thesis_impact_resolve(struct bsim_world *w, double h);
@@ -305,7 +310,8 @@ void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2]
                                      double h);
 void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2], double h);
 
-/* position_project.c */
+/* position_project.c; projections per step at most. */
+#define THESIS_PROJECT_PASSES_MAX 3
 void thesis_position_project(struct bsim_world *w, const double force[2], double torque);
 void thesis_position_project_disk(struct bsim_world *w, const double force[2]);
 
@@ -330,18 +336,25 @@ static inline double thesis_kinetic_energy(const struct bsim_world *w, const int
 /* The beam integrator, inline (beam_integrate.h). */
 #include "thesis/beam_integrate.h"
 
-/* How far beam i and the body can close within a step (broad_phase.c
- * derives it), m; inline: every step asks it of every beam in reach. */
-static inline double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b,
-                                        double speed, double h)
+/* How far beam b and a body whose speed is at most `speed` (m/s) can close
+ * within a step of h, plus slop (broad_phase.c derives it), m; inline:
+ * every step asks it of every beam in reach. thesis_step_margin is it for
+ * world w's body and slop. */
+static inline double thesis_beam_margin(const thesis_beam *b, double speed, double h, double slop)
 {
 	/* At rest the formula below is 2 h |v| + slop exactly (every other
 	 * term is +0), without its division. */
 	if (b->theta == 0.0 && b->omega == 0.0)
-		return 2.0 * (h * speed) + w->slop;
+		return 2.0 * (h * speed) + slop;
 	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
 	               b->inertia;
-	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
+	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + slop;
+}
+
+static inline double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b,
+                                        double speed, double h)
+{
+	return thesis_beam_margin(b, speed, h, w->slop);
 }
 
 /* With every beam at rest the step's margin is 2 h |v| + slop, |v| = |v| +
@@ -384,21 +397,29 @@ static inline void thesis_beam_pushed(struct bsim_world *w, int i)
 /* The body's velocity at the step's end from its free velocity vf = v +
  * h F / M (v0 = v at the start) and the contacts' impulse sum j, and its
  * move by the mean velocity (persistent_contact.c); vm receives that
- * velocity. Inline: the contact solve and a step in free flight (j = 0)
- * share it, so both move the body by the same operations. */
+ * velocity. Inline: the contact solve, a step in free flight (j = 0) and
+ * the runs of steps (thesis_steps.c: thesis_body_move, on the body's x and
+ * v held apart) share it, so all move the body by the same operations. */
+static inline void thesis_body_move(double x[2], double v[2], const double v0[2],
+                                    const double vf[2], const double j[2], double inv_mass,
+                                    double h, int integrator, double vm[2])
+{
+	v[0] = vf[0] + j[0] * inv_mass;
+	v[1] = vf[1] + j[1] * inv_mass;
+	vm[0] = 0.5 * (v0[0] + v[0]);
+	vm[1] = 0.5 * (v0[1] + v[1]);
+	if (integrator == THESIS_EULER) {
+		vm[0] = v[0];
+		vm[1] = v[1];
+	}
+	x[0] += h * vm[0];
+	x[1] += h * vm[1];
+}
+
 static inline void thesis_body_advance(struct bsim_world *w, const double v0[2], const double vf[2],
                                        const double j[2], double h, double vm[2])
 {
-	w->v[0] = vf[0] + j[0] * w->inv_mass;
-	w->v[1] = vf[1] + j[1] * w->inv_mass;
-	vm[0] = 0.5 * (v0[0] + w->v[0]);
-	vm[1] = 0.5 * (v0[1] + w->v[1]);
-	if (w->integrator == THESIS_EULER) {
-		vm[0] = w->v[0];
-		vm[1] = w->v[1];
-	}
-	w->x[0] += h * vm[0];
-	w->x[1] += h * vm[1];
+	thesis_body_move(w->x, w->v, v0, vf, j, w->inv_mass, h, w->integrator, vm);
 }
 
 /* The body's turn over a step from angular velocity w0 under torque
@@ -416,17 +437,141 @@ static inline void thesis_body_turn(struct bsim_world *w, double w0, double torq
 	w->heading += h * wm;
 }
 
-/* v_rel = v . n - omega c (contact_detect.c); on the extended path plus
- * w cb, and the tangent row's v_t (extended: a constant, 0 for the essay's disk). */
+/* v_rel = v . n - omega c of contact c (contact_geometry.h), the body's
+ * velocity v, its beam's omega. */
+static inline double thesis_contact_vrel(const double v[2], double omega, const thesis_contact *c)
+{
+	return (v[0] * c->n[0] + v[1] * c->n[1]) - omega * c->c;
+}
+
+/* c->vrel in world w; on the extended path plus w cb, and the tangent
+ * row's v_t (extended: a constant, 0 for the essay's disk). */
 static inline void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c,
                                            const int extended)
 {
-	c->vrel = (w->v[0] * c->n[0] + w->v[1] * c->n[1]) - w->beams[c->beam].omega * c->c;
+	c->vrel = thesis_contact_vrel(w->v, w->beams[c->beam].omega, c);
 	if (extended && w->extended) {
 		c->vrel += w->angular_velocity * c->cb;
 		c->vrel_t = (w->v[1] * c->n[0] - w->v[0] * c->n[1]) + w->angular_velocity * c->cbt -
 		            w->beams[c->beam].omega * c->ct;
 	}
 }
+
+/* The first pass of the impacts (impact_resolve.c) over the step's nc
+ * contacts: each one's v_rel, and the touching ones (gap + h min(v_rel, 0)
+ * <= slop) moved to the front in place, their 1/I set; *approaching set if
+ * one of them approaches (v_rel < 0). Returns how many touch. Inline: the
+ * runs of steps (thesis_steps.c) make it too. extended: a constant, 0 for
+ * the essay's disk. */
+THESIS_SPECIALISED int thesis_impacts_touching(struct bsim_world *w, int nc, double h,
+                                               int *approaching, const int extended)
+{
+	thesis_contact *cs = w->contacts;
+	int n = 0;
+	*approaching = 0;
+	for (int i = 0; i < nc; i++) {
+		/* In place: a contact left behind has its velocity and 1/I set
+		 * again by the contact solve. Swapped only when out of place. */
+		thesis_contact *c = &cs[i];
+		thesis_contact_velocity(w, c, extended);
+		if (c->gap + h * bsim_fmin(c->vrel, 0.0) > w->slop)
+			continue;
+		c->inv_i = w->beams[c->beam].inv_inertia;
+		*approaching |= c->vrel < 0.0;
+		if (i != n) {
+			thesis_contact t = cs[n];
+			cs[n] = *c;
+			*c = t;
+		}
+		n++;
+	}
+	return n;
+}
+
+/* An impact's bound on contact c's solved normal velocity (impact_resolve.c):
+ * -e v_rel, or 0 (plastic) below rest_threshold. */
+static inline void thesis_impact_bound(const struct bsim_world *w, thesis_contact *c)
+{
+	c->bound = c->vrel < -w->rest_threshold ? -c->e * c->vrel : 0.0;
+}
+
+/* A projection's move (position_project.c) by the position impulses of
+ * cs[0 .. n): each beam's angle and the body's centre, the springs' energy
+ * change and the force's work over the shift booked into *correction. */
+static inline void thesis_project_move(struct bsim_world *w, const thesis_contact *cs, int n,
+                                       const double force[2], double *correction)
+{
+	double dx = 0.0, dy = 0.0, de = 0.0;
+	for (int k = 0; k < n; k++) {
+		thesis_beam *b = &w->beams[cs[k].beam];
+		double theta = b->theta - cs[k].impulse * cs[k].c * cs[k].inv_i;
+		de += 0.5 * b->stiffness * (theta * theta - b->theta * b->theta);
+		b->theta = theta;
+		dx += cs[k].impulse * cs[k].n[0];
+		dy += cs[k].impulse * cs[k].n[1];
+	}
+	dx *= w->inv_mass;
+	dy *= w->inv_mass;
+	w->x[0] += dx;
+	w->x[1] += dy;
+	*correction += (force[0] * dx + force[1] * dy) - de;
+}
+
+/* The smooth solve (persistent_contact.c) for the essay's disk: contact
+ * c's row against beam b, from the body's velocity v0 at the step's start
+ * and its free velocity vf = v0 + h F / M: the beam's free omega, the
+ * response 1/(I D), v_rel at the free velocities and the bound that keeps
+ * the gap from closing. */
+static inline void thesis_smooth_row(thesis_contact *c, const thesis_beam *b, const double v0[2],
+                                     const double vf[2], double h, int integrator)
+{
+	double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
+	c->omega_free = thesis_beam_free_omega(b, h, integrator);
+	double gap = bsim_fmax(c->gap, 0.0);
+	c->inv_i = thesis_beam_response(b, h, integrator);
+	c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
+	c->bound = integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
+}
+
+/* The smooth solve's advance of awake beam b for the essay's disk, with its
+ * solved contact c (NULL: none) and the body's mean velocity vm: a beam at
+ * rest without contact stays at rest; the dampers' loss added to *damper,
+ * minus the contact impulse's work to *contact, J. */
+static inline void thesis_smooth_beam(thesis_beam *b, const thesis_contact *c, const double vm[2],
+                                      double h, int integrator, double *damper, double *contact)
+{
+	if (!c && b->theta == 0.0 && b->omega == 0.0)
+		return;
+	double omega_new;
+	if (!c) {
+		omega_new = thesis_beam_free_omega(b, h, integrator);
+	} else {
+		omega_new = c->omega_free - c->impulse * c->c * c->inv_i;
+		double omega_m = integrator == THESIS_EULER ? omega_new : 0.5 * (b->omega + omega_new);
+		*contact -= c->impulse * ((c->n[0] * vm[0] + c->n[1] * vm[1]) - c->c * omega_m);
+	}
+	*damper += thesis_beam_advance(b, omega_new, h, integrator);
+}
+
+/* get_state's body: its centre, velocity, heading and angular velocity;
+ * a beam here is an angle about a fixed pivot (no drift). */
+static inline void thesis_state_body(const struct bsim_world *w, bsim_state *s)
+{
+	/* In the order of both structs: three 16-byte moves. */
+	s->x[0] = w->x[0];
+	s->x[1] = w->x[1];
+	s->v[0] = w->v[0];
+	s->v[1] = w->v[1];
+	s->heading = w->heading;
+	s->angular_velocity = w->angular_velocity;
+	s->pivot_drift = 0.0;
+}
+
+/* Detection's geometry and tests, inline (contact_geometry.h). */
+#include "thesis/contact_geometry.h"
+
+/* The solve of one or two contacts and the impulse sum, inline
+ * (lcp_small.h). */
+#include "thesis/lcp_small.h"
 
 #endif

@@ -4,7 +4,9 @@
  *
  * thesis_step takes the flight path when no beam is awake or typed, the
  * room test finds every beam out of reach (thesis_flight_clear), the beams
- * are prepared for h and contact_mode is physical. A flight step changes
+ * are prepared for h and contact_mode is physical (a run prepares them for
+ * h first, as the step would before a flight step otherwise: the flight
+ * reads none of their constants). A flight step changes
  * none of these but the body's position and velocity, so all but the room
  * test hold for the whole run and are asked once; the room test is asked
  * before every step, as thesis_step asks it: its inline part here on the
@@ -26,10 +28,16 @@
 
 int thesis_flight(bsim_world *w, const double force[2], double h, int n, double (*xv)[4])
 {
-	if (w->n_awake || w->n_typed || h != w->h_prepared ||
-	    w->contact_mode == THESIS_CONTACT_ESSAY || w->rotates || !w->broad_phase ||
-	    w->n_beams > THESIS_BROAD_PHASE_MIN_BEAMS)
+	if (w->n_awake || w->n_typed || w->contact_mode == THESIS_CONTACT_ESSAY || w->rotates ||
+	    !w->broad_phase || w->n_beams > THESIS_BROAD_PHASE_MIN_BEAMS)
 		return 0;
+	/* The beams' constants for h, as the step would prepare them before
+	 * its flight (a step in flight reads none of them). */
+	if (h != w->h_prepared) {
+		for (int i = 0; i < w->n_beams; i++)
+			thesis_beam_prepare(&w->beams[i], h);
+		w->h_prepared = h;
+	}
 	const double inv_mass = w->inv_mass, f0 = force[0], f1 = force[1];
 	/* thesis_clear_margin's force term and the step's h F / M, 0 / M */
 	const double push = h * (fabs(f0) + fabs(f1)) * inv_mass;

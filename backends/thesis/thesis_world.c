@@ -473,14 +473,7 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 
 static void thesis_get_state(const bsim_world *w, bsim_state *s)
 {
-	/* In the order of both structs: three 16-byte moves. */
-	s->x[0] = w->x[0];
-	s->x[1] = w->x[1];
-	s->v[0] = w->v[0];
-	s->v[1] = w->v[1];
-	s->heading = w->heading;
-	s->angular_velocity = w->angular_velocity;
-	s->pivot_drift = 0.0; /* a beam here is an angle about a fixed pivot */
+	thesis_state_body(w, s);
 	/* Both lists empty (free flight): the same, nothing to set. */
 	if (w->n_awake || s->n_active)
 		bsim_state_set_active(s, w->awake, w->n_awake);
@@ -544,6 +537,7 @@ const bsim_backend bsim_backend_thesis = {
         .set_state = thesis_set_state,
         .reset = thesis_reset,
         .flight = thesis_flight,
+        .steps = thesis_steps,
         .accuracy = thesis_accuracy,
         .n_accuracy = (int)(sizeof thesis_accuracy / sizeof thesis_accuracy[0]),
 };

@@ -67,6 +67,16 @@ typedef struct bsim_backend {
 	 * energies, finiteness, outcome) it then books for the k from xv,
 	 * with one call instead of k (trial_flight.c). */
 	int (*flight)(bsim_world *w, const double force[2], double h, int n, double (*xv)[4]);
+	/* Optional (NULL: not offered). Up to n steps of h seconds under force
+	 * (N) and no torque, each the step that step(w, force, 0, h) would
+	 * make, the state after each into out[k] as get_state would write it
+	 * (each out[k] sized for the world's beams by bsim_state_init).
+	 * Returns how many it made: n, or 0 where the world is not one it
+	 * makes them for (a body that turns, a knob it does not take, too
+	 * many beams), and step makes them. The runner books a trial's steps
+	 * from these states as from get_state's, with one call for a run of
+	 * steps under one force instead of two calls a step (trial_steps.c). */
+	int (*steps)(bsim_world *w, const double force[2], double h, int n, bsim_state *out);
 } bsim_backend;
 
 /* The registry: all backends compiled in, NULL-terminated. */

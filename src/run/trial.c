@@ -33,6 +33,7 @@
 #include "run/trial_overlap.h"
 #include "run/trial_peaks.h"
 #include "run/trial_record.h"
+#include "run/trial_steps.h"
 
 struct bsim_trial_runner {
 	bsim_state s0, s1; /* before and after a step */
@@ -42,6 +43,7 @@ struct bsim_trial_runner {
 	trial_peaks peaks;
 	trial_essay essay;
 	trial_flight flight; /* free-flight runs */
+	trial_steps steps;   /* runs of steps */
 	/* The world of the last trial, kept for the next trial of the same
 	 * scene, backend and options (bsim_trial_runner_keep_worlds). */
 	int keep;
@@ -68,7 +70,10 @@ void bsim_trial_runner_keep_worlds(bsim_trial_runner *r, int on)
 
 bsim_trial_runner *bsim_trial_runner_alloc(void)
 {
-	return calloc(1, sizeof(bsim_trial_runner));
+	bsim_trial_runner *r = calloc(1, sizeof(bsim_trial_runner));
+	if (r)
+		trial_steps_init(&r->steps);
+	return r;
 }
 
 void bsim_trial_runner_free(bsim_trial_runner *r)
@@ -79,6 +84,7 @@ void bsim_trial_runner_free(bsim_trial_runner *r)
 	bsim_state_free(&r->s1);
 	bsim_state_free(&r->whole);
 	trial_peaks_free(&r->peaks);
+	trial_steps_free(&r->steps);
 	runner_forget_world(r);
 	free(r->shape);
 	free(r);
@@ -368,6 +374,56 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, const bsim_state *s0,
 	return rc;
 }
 
+/* Always inlined: a copy in the step loop and one, plain, in the runs. */
+#if defined(__GNUC__)
+#define TRIAL_BOOK static inline __attribute__((always_inline))
+#else
+#define TRIAL_BOOK static inline
+#endif
+
+/* What booking a state gives (trial_book). */
+enum { BOOK_ON = 0, BOOK_END = 1, BOOK_NONFINITE = 2 };
+
+/* Books s1, the state after step lp->n + 1, from s0, the state before it:
+ * its energy and finiteness, the step's count, the trace, the ledger, the
+ * overlap, and before the outcome is known the peaks, the gate and the
+ * outcome. BOOK_NONFINITE: s1 is not finite and not kept (s0 stays the
+ * last finite state, the one reported); else s1 is kept (the caller makes
+ * it the state s0), BOOK_END if the trial ends there (a side exit, or *rc
+ * failed). The step loop and the runs of steps book every state by it;
+ * plain (a constant): nothing traced or measured per step, no lattice, as
+ * in the runs (trial_steps_start), whose copy has none of their tests. */
+TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bsim_state *s1,
+                          int *rc, bsim_error *err, const int plain)
+{
+	bsim_trial_result *out = c->out;
+	double e1;
+	if (!state_energy_finite(c->ws, s1, &e1)) {
+		out->instability = BSIM_UNSTABLE_NONFINITE;
+		out->unstable_step = (int)(lp->n + 1);
+		return BOOK_NONFINITE;
+	}
+	lp->n++;
+	c->gate.dwell++;
+	lp->run_on += lp->done;
+	if (!plain && c->trace)
+		c->trace(c->rec->trace_user, lp->n, trial_trace_state(c, s1));
+	ledger_step(&out->ledger, c->fx, s0, s1, lp->e0, e1);
+	lp->e0 = e1;
+	if (!plain && c->overlap)
+		out->overlap_max = fmax(out->overlap_max,
+		                        trial_overlap_depth(c->r->shape, c->ws->n_beams,
+		                                            c->scene->body.radius, s1));
+	if (lp->done)
+		return BOOK_ON;
+	trial_peaks_step(&c->r->peaks, c->scene, c->map, s1);
+	/* The gate first: a body that leaves the field ends in its gate. */
+	if (!plain && c->scene->has_lattice &&
+	    (*rc = gate_follow(c, lp, s1, s0->x, err)) != BSIM_OK)
+		return BOOK_END;
+	return outcome_at(c, lp, s1) ? BOOK_END : BOOK_ON;
+}
+
 int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_backend *backend,
                    const bsim_options *opts, uint64_t seed, const bsim_recorder *rec,
                    bsim_trial_result *out, bsim_error *err)
@@ -386,8 +442,12 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	bsim_state *s0 = &r->s0, *s1 = &r->s1;
 	trial_loop lp;
 	rc = trial_begin(&c, &lp, s0, err);
-	trial_flight_start(&r->flight, !c.recording && !c.trace && !c.overlap && !c.map, backend,
-	                   c.w, scene, &fx, out, &r->peaks, c.n_max, c.gate_max, c.centre);
+	const int plain = !c.recording && !c.trace && !c.overlap && !c.map;
+	trial_flight_start(&r->flight, plain, backend, c.w, scene, &fx, out, &r->peaks, c.n_max,
+	                   c.gate_max, c.centre);
+	if (rc == BSIM_OK && trial_steps_start(&r->steps, plain, backend, scene, &fx, c.n_max,
+	                                       c.gate_max))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
 		int run = trial_flight_try(&r->flight, &lp, &c.gate.dwell, s0);
 		if (run == 1)
@@ -396,40 +456,36 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 			continue;
 		double f[BSIM_WRENCH];
 		bsim_effects_force_at(&fx, lp.n, lp.h, s0, f);
+		bsim_state *states;
+		int m = r->steps.on ? trial_steps_make(&r->steps, c.w, f, &lp, c.gate.dwell, s0,
+		                                       &states)
+		                    : 0;
+		if (m > 0) {
+			/* The run's states, booked until the trial ends. */
+			int b = BOOK_ON;
+			for (int k = 0; k < m && b == BOOK_ON && !trial_over(&c, &lp, s0); k++) {
+				b = trial_book(&c, &lp, s0, &states[k], &rc, err, 1);
+				if (b != BOOK_NONFINITE)
+					s0 = &states[k];
+			}
+			if (b != BOOK_ON)
+				break;
+			trial_flight_passed(&r->flight, m - 1);
+			continue;
+		}
 		if (c.recording && lp.n % c.stride == 0)
 			trial_record(&c, s0, lp.n);
 		if ((rc = backend->step(c.w, f, f[2], lp.h, err)) != BSIM_OK)
 			break;
 		backend->get_state(c.w, s1);
-		double e1;
-		if (!state_energy_finite(c.ws, s1, &e1)) {
-			/* s0 stays the last finite state, the one reported. */
-			out->instability = BSIM_UNSTABLE_NONFINITE;
-			out->unstable_step = (int)(lp.n + 1);
+		int b = trial_book(&c, &lp, s0, s1, &rc, err, 0);
+		if (b == BOOK_NONFINITE)
 			break;
-		}
-		lp.n++;
-		c.gate.dwell++;
-		lp.run_on += lp.done;
-		if (c.trace)
-			c.trace(rec->trace_user, lp.n, trial_trace_state(&c, s1));
-		ledger_step(&out->ledger, &fx, s0, s1, lp.e0, e1);
-		lp.e0 = e1;
-		double p0[2] = {s0->x[0], s0->x[1]};
-		bsim_state *t = s0;
+		/* s1 is always one of the runner's two states (a run's states
+		 * are its banks'): the next step's is the other one. */
 		s0 = s1;
-		s1 = t;
-		if (c.overlap)
-			out->overlap_max =
-			        fmax(out->overlap_max, trial_overlap_depth(r->shape, c.ws->n_beams,
-			                                                   scene->body.radius, s0));
-		if (lp.done)
-			continue;
-		trial_peaks_step(&r->peaks, scene, c.map, s0);
-		/* The gate first: a body that leaves the field ends in its gate. */
-		if (scene->has_lattice && (rc = gate_follow(&c, &lp, s0, p0, err)) != BSIM_OK)
-			break;
-		if (outcome_at(&c, &lp, s0))
+		s1 = s0 == &r->s0 ? &r->s1 : &r->s0;
+		if (b != BOOK_ON)
 			break;
 	}
 	return trial_close(&c, &lp, s0, rc, err);

@@ -39,25 +39,32 @@
 #include <math.h>
 #include <string.h>
 
+int trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
+                      bsim_effect **random)
+{
+	int holds = !scene->has_lattice && !scene->body.rotates && !scene->effects.has_drag &&
+	            !scene->effects.has_ground_friction && fx->n_work == fx->n;
+	/* the pipeline: the propulsion along y, then the held random force,
+	 * either or both */
+	*propulsion = *random = NULL;
+	for (int i = 0; i < fx->n && holds; i++) {
+		bsim_effect *e = &fx->e[i];
+		if (e->kind == BSIM_EFFECT_CONSTANT && !*propulsion && !*random)
+			*propulsion = e;
+		else if (e->kind == BSIM_EFFECT_HELD && e == fx->random && !*random)
+			*random = e;
+		else
+			holds = 0;
+	}
+	return holds;
+}
+
 void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend, bsim_world *w,
                         const bsim_scene *scene, bsim_effects *fx, bsim_trial_result *out,
                         trial_peaks *peaks, long n_max, long gate_max, double centre)
 {
-	f->on = plain && backend->flight && !scene->has_lattice && !scene->body.rotates &&
-	        !scene->effects.has_drag && !scene->effects.has_ground_friction &&
-	        fx->n_work == fx->n;
-	/* the pipeline: the propulsion along y, then the held random force,
-	 * either or both */
-	f->propulsion = f->random = NULL;
-	for (int i = 0; i < fx->n && f->on; i++) {
-		bsim_effect *e = &fx->e[i];
-		if (e->kind == BSIM_EFFECT_CONSTANT && !f->propulsion && !f->random)
-			f->propulsion = e;
-		else if (e->kind == BSIM_EFFECT_HELD && e == fx->random && !f->random)
-			f->random = e;
-		else
-			f->on = 0;
-	}
+	f->on = trial_force_holds(scene, fx, &f->propulsion, &f->random) && plain &&
+	        backend->flight;
 	f->skip = f->wait = 0;
 	f->flight = backend->flight;
 	f->w = w;

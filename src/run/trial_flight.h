@@ -50,13 +50,20 @@ typedef struct trial_flight {
 	double xv[TRIAL_FLIGHT_MAX][4];
 } trial_flight;
 
+/* 1 if the forces of the scene's pipeline fx hold between the random
+ * force's draws, so that the force asked before a step is the force of the
+ * steps after it up to the hold's end (0 if not): no lattice, a body that
+ * does not turn, and every effect one that holds (propulsion along y, the
+ * held random force), at most one of each (no drag or ground friction, in
+ * the pipeline or simulated by the backend). The two effects into
+ * *propulsion and *random (NULL: absent). */
+int trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
+                      bsim_effect **random);
+
 /* Sets f for a trial in world w of scene (no lattice: the whole scene's
  * world) and whether it takes runs (f->on): when the backend offers them,
  * plain is set (nothing recorded, traced or measured per step: no
- * trajectory, trace or overlap), the body does not turn, and every effect
- * gives a force that holds between draws (propulsion along y, the held
- * random force), at most one of each (no drag or ground friction, in the
- * pipeline or simulated by the backend). */
+ * trajectory, trace or overlap), and the forces hold (trial_force_holds). */
 void trial_flight_start(trial_flight *f, int plain, const bsim_backend *backend, bsim_world *w,
                         const bsim_scene *scene, bsim_effects *fx, bsim_trial_result *out,
                         trial_peaks *peaks, long n_max, long gate_max, double centre);
@@ -88,6 +95,14 @@ static inline int trial_flight_try(trial_flight *f, trial_loop *lp, long *dwell,
 	f->wait = f->wait ? (2 * f->wait < TRIAL_FLIGHT_MAX ? 2 * f->wait : TRIAL_FLIGHT_MAX) : 1;
 	f->skip = f->wait;
 	return -1;
+}
+
+/* Steps the trial made by other means (a run of steps, trial_steps.h)
+ * after a try: they pass the wait for the next try as many steps of the
+ * step loop would. */
+static inline void trial_flight_passed(trial_flight *f, long steps)
+{
+	f->skip = f->skip > steps ? f->skip - (int)steps : 0;
 }
 
 #endif

@@ -1,0 +1,249 @@
+/* Contact detection between the body (a disk of radius R about C) and a
+ * beam (the segment P .. P + L u). MODEL.md section 3.
+ *
+ *   s = clamp((C - P) . u, 0, L),  Q = P + s u,  gap = |C - Q| - R
+ *   tangent (0 < s < L):  n = +-perp(u) toward the body, lever a = s u
+ *   tip (s = L):          n = (C - Q) / |C - Q|,          lever a = L u
+ *   pivot end (s = 0):    n = (C - P) / |C - P|,          lever a = 0
+ *   c = sgn (a x n),  v_rel = v . n - omega c
+ *
+ * Every expression is written so that mirroring the scene in x (x -> -x,
+ * sgn -> -sgn) mirrors each intermediate value bit for bit (MODEL.md
+ * oracle 4): products and sums keep the same operands in the same order.
+ *
+ * A body of another shape (extended path, thesis.h's head) meets the beam
+ * through its outline (model/body_shape.h): the outline's point K nearest
+ * the segment, the segment's point Q nearest the outline, the normal n from
+ * Q toward the body, gap = |K - Q| signed (< 0: overlap). Then
+ *   a = Q - P,  c = sgn (a x n),  ct = sgn (a . n),
+ *   r_b = K - C,  cb = r_b x n,  cbt = r_b . n,
+ * tip when Q is an end of the segment, tangent otherwise. The geometry
+ * keeps dist = gap + reach (w->radius is the shape's reach), so that every
+ * bound below, written for a disk of radius `reach`, holds: the outline
+ * lies within the reach of the centre. A turn of the body by dpsi moves no
+ * point of its outline farther than reach |dpsi|, which the bound on the
+ * distance adds. That geometry, and a capsule's second contact when it
+ * lies along the beam, is shape_contact.c's. The disk keeps its own code
+ * (the bits of the essay's runs); on the extended path it has r_b = -R n:
+ * cb = 0, cbt = -R. */
+#ifndef BSIM_THESIS_CONTACT_GEOMETRY_H
+#define BSIM_THESIS_CONTACT_GEOMETRY_H
+
+#include <stddef.h>
+
+/* Inline, included by thesis.h: the step's detection (contact_detect.c's
+ * entry points) and the runs of steps of the essay's disk (thesis_steps.c)
+ * call these for every beam in reach, and share one copy. */
+
+/* The direction u of beam b at its angle. */
+static inline void thesis_beam_direction(thesis_beam *b, double u[2])
+{
+	/* At rest the rotation is the identity: u0 exactly, as the formula
+	 * below gives it (u0 - u0_perp * (+-0) = u0), without the sine and
+	 * cosine; a lattice has many beams at rest near the body. */
+	if (b->theta == 0.0) {
+		u[0] = b->u0[0];
+		u[1] = b->u0[1];
+		return;
+	}
+	/* The same angle gives the same bits: the sine and cosine once per
+	 * angle, however often a step asks (NaN never equals itself). */
+	if (b->theta != b->u_theta) {
+		double cs = cos(b->theta), sn = b->sgn * sin(b->theta);
+		b->u[0] = b->u0[0] * cs - b->u0[1] * sn;
+		b->u[1] = b->u0[1] * cs + b->u0[0] * sn;
+		b->u_theta = b->theta;
+	}
+	u[0] = b->u[0];
+	u[1] = b->u[1];
+}
+
+/* The body's centre x against the beam at its angle: b->geo; the lever a
+ * kept for the extended path only (extended: constant, see below). */
+THESIS_SPECIALISED void geometry_compute(thesis_beam *b, const double x[2], const int extended)
+{
+	thesis_geometry *g = &b->geo;
+	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
+	double u[2];
+	thesis_beam_direction(b, u);
+	double s = dx * u[0] + dy * u[1];
+	double a[2];
+	g->x[0] = x[0];
+	g->x[1] = x[1];
+	g->theta = b->theta;
+	if (s > 0.0 && s < b->length) {
+		double cross = u[0] * dy - u[1] * dx; /* u x (C - P) */
+		double side = cross >= 0.0 ? 1.0 : -1.0;
+		g->dist = fabs(cross);
+		g->n[0] = -side * u[1];
+		g->n[1] = side * u[0];
+		a[0] = s * u[0];
+		a[1] = s * u[1];
+		g->type = BSIM_CONTACT_TANGENT;
+	} else {
+		double l = s > 0.0 ? b->length : 0.0;
+		a[0] = l * u[0];
+		a[1] = l * u[1];
+		double qx = dx - a[0], qy = dy - a[1];
+		g->dist = sqrt(qx * qx + qy * qy);
+		if (g->dist == 0.0) {
+			g->type = BSIM_CONTACT_NONE; /* centre on the segment's end: no normal */
+			return;
+		}
+		g->n[0] = qx / g->dist;
+		g->n[1] = qy / g->dist;
+		g->type = BSIM_CONTACT_TIP;
+	}
+	g->c = b->sgn * (a[0] * g->n[1] - a[1] * g->n[0]);
+	if (extended) {
+		g->a[0] = a[0];
+		g->a[1] = a[1];
+	}
+}
+
+/* 1 if the body certainly lies farther than R + margin from the beam,
+ * judged from the last geometry without trigonometry. The distance from a
+ * point to the segment changes by at most how far the point moves, and
+ * turning the beam by dtheta moves no point of it farther than L |dtheta|:
+ *   dist >= dist_g - |x - x_g| - L |theta - theta_g|.
+ * A cushion of 1e-9 of the lengths involved covers the round-off of both
+ * distances, so the bound never rejects what the exact test would keep. */
+THESIS_SPECIALISED int geometry_far(const struct bsim_world *w, const thesis_beam *b,
+                                    const double x[2], double radius, double margin,
+                                    const int extended)
+{
+	const thesis_geometry *g = &b->geo;
+	double ex = x[0] - g->x[0], ey = x[1] - g->x[1];
+	double cushion = 1e-9 * (g->dist + b->length + radius + margin);
+	double slack = g->dist - b->length * fabs(b->theta - g->theta) - radius - margin - cushion;
+	if (extended && w->shaped)
+		slack -= radius * fabs(w->heading - g->psi);
+	return slack > 0.0 && ex * ex + ey * ey < slack * slack; /* false for NaN */
+}
+
+/* Beam i's contact from its geometry g, for a body of reach R (the disk's
+ * radius) within margin, into out: gap, normal, lever, restitution, no
+ * impulse yet (the disk's fields; the extended path's are contact_detect's).
+ * 1, or 0 if g has none within margin. */
+THESIS_SPECIALISED int contact_from_geometry(const thesis_geometry *g, int i, double radius,
+                                             double margin, double e_tip, double e_tangent,
+                                             thesis_contact *out)
+{
+	if (g->type == BSIM_CONTACT_NONE)
+		return 0;
+	out->gap = g->dist - radius;
+	if (out->gap > margin)
+		return 0;
+	out->beam = i;
+	out->type = g->type;
+	out->n[0] = g->n[0];
+	out->n[1] = g->n[1];
+	out->c = g->c;
+	out->e = g->type == BSIM_CONTACT_TIP ? e_tip : e_tangent;
+	out->impulse = 0.0;
+	return 1;
+}
+
+/* The essay's disk, radius R about x, against beam b (beam i of its
+ * world): its contact within margin into out, 1, or 0; the geometry kept in
+ * b. touch: the world of beam i, which marks it touched where its geometry
+ * is computed (NULL: none). The disk's detection (contact_detect) on any
+ * beam and body: the runs of steps (thesis_steps.c) hold theirs apart. */
+THESIS_SPECIALISED int disk_detect(thesis_beam *b, int i, const double x[2], double radius,
+                                   double margin, double e_tip, double e_tangent,
+                                   struct bsim_world *touch, thesis_contact *out)
+{
+	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
+	double reach = b->length + radius + margin;
+	if (dx * dx + dy * dy > reach * reach)
+		return 0; /* outside the beam's disc: no trigonometry needed */
+	const thesis_geometry *g = &b->geo;
+	/* The same configuration gives the same bits: a step's detection
+	 * meets the geometry the last step's projection computed. */
+	if (!(g->x[0] == x[0] && g->x[1] == x[1] && g->theta == b->theta)) {
+		if (geometry_far(NULL, b, x, radius, margin, 0))
+			return 0;
+		if (touch)
+			thesis_beam_touch(touch, i);
+		geometry_compute(b, x, 0);
+	}
+	return contact_from_geometry(g, i, radius, margin, e_tip, e_tangent, out);
+}
+
+/* 0 if the disk, radius R about x, certainly lies farther than R + margin
+ * from beam b (contact_near for the disk), 1 if it may not. */
+static inline int disk_near(const thesis_beam *b, const double x[2], double radius, double margin)
+{
+	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
+	double reach = b->length + radius + margin;
+	if (dx * dx + dy * dy > reach * reach)
+		return 0;
+	return !geometry_far(NULL, b, x, radius, margin, 0);
+}
+
+/* Detection for any body (extended 1: the world's flags decide) or for the
+ * essay's disk (extended 0, w->extended 0): a constant, so that the disk's
+ * copy is compiled without the extended path's tests and stores. */
+THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin,
+                                      thesis_contact *out, const int extended)
+{
+	thesis_beam *b = &w->beams[i]; /* its geometry kept */
+	if (!extended)
+		return disk_detect(b, i, w->x, w->radius, margin, w->e_tip, w->e_tangent, w, out);
+	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+	double reach = b->length + w->radius + margin;
+	if (dx * dx + dy * dy > reach * reach)
+		return 0; /* outside the beam's disc: no trigonometry needed */
+	const thesis_geometry *g = &b->geo;
+	/* The same configuration gives the same bits: a step's detection
+	 * meets the geometry the last step's projection computed. */
+	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta &&
+	      (!(extended && w->shaped) || g->psi == w->heading))) {
+		if (geometry_far(w, b, w->x, w->radius, margin, extended))
+			return 0;
+		thesis_beam_touch(w, i);
+		if (extended && w->shaped) {
+			double u[2];
+			thesis_beam_direction(b, u);
+			thesis_shape_geometry(w, b, u);
+		} else {
+			geometry_compute(b, w->x, extended);
+		}
+	}
+	if (!contact_from_geometry(g, i, w->radius, margin, w->e_tip, w->e_tangent, out))
+		return 0;
+	if (!extended)
+		return 1;
+	out->two = 0; /* read by the extended path's solves only */
+	if (w->extended) {
+		out->mu = w->friction;
+		out->impulse_t = 0.0;
+		if (w->shaped) {
+			out->cb = g->cb;
+			out->cbt = g->cbt;
+			out->ct = g->ct;
+		} else {
+			out->cb = 0.0;
+			out->cbt = -w->radius;
+			out->ct = b->sgn * (g->a[0] * g->n[0] + g->a[1] * g->n[1]);
+		}
+	}
+	if (w->shaped && g->has2)
+		return 1 + thesis_shape_second(w, g, margin, out);
+	return 1;
+}
+
+THESIS_SPECIALISED int contact_near(const struct bsim_world *w, int i, double margin,
+                                    const int extended)
+{
+	const thesis_beam *b = &w->beams[i];
+	if (!extended)
+		return disk_near(b, w->x, w->radius, margin);
+	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+	double reach = b->length + w->radius + margin;
+	if (dx * dx + dy * dy > reach * reach)
+		return 0;
+	return !geometry_far(w, b, w->x, w->radius, margin, extended);
+}
+
+#endif

@@ -1,0 +1,343 @@
+/* The thesis backend's runs of steps (bsim_backend.steps): the steps
+ * thesis_step makes for the essay's disk among a few beams, one after
+ * another in one call, each state written as get_state writes it.
+ *
+ * Which worlds. The essay's disk (w->extended 0) under contact_mode
+ * physical, simultaneous impacts and no sleeping, among at most
+ * THESIS_STEPS_BEAMS beams: the single gate of the essay and its variants
+ * (H1, H2). There every beam is a candidate of every step, in ascending
+ * order (broad_phase.c tests them all, with or without the grid), so the
+ * step needs none of the general path's lists: the awake, typed, flagged
+ * and pushed beams are bit masks here, and the lists are written back when
+ * the run ends, as the general path leaves them.
+ *
+ * Why the bits are the same. Each step is step_run's (thesis_world.c) for
+ * extended 0, its functions' operations in their order, written in one
+ * place from the inline pieces they share (thesis.h, contact_geometry.h,
+ * lcp_small.h, beam_integrate.h): detection (contact_detect, with each
+ * beam's step margin), impacts (impact_resolve.c), the smooth solve
+ * (persistent_contact.c), projection with re-detection
+ * (position_project.c), the typed beams, pruning (beam_sleep.c) and the
+ * contact flag (contact_report.c). What differs is only what the general
+ * path spends on its generality:
+ *   - no free-flight test: a step thesis_step would take as free flight
+ *     (no beam awake, every beam out of reach) is the general path's step
+ *     here, which detects nothing, solves nothing and moves the body by the
+ *     same operations (thesis_body_advance with a zero impulse sum), and
+ *     whose report finds no beam within BSIM_CONTACT_TOL (the room's margin
+ *     includes it): the same state;
+ *   - the kinetic energy of the impacts sums every beam in ascending order,
+ *     not the awake ones: a beam not awake has omega = +-0 and adds +0 to a
+ *     sum that is never -0 (it starts at 1/2 M |v|^2), which leaves it as
+ *     it is;
+ *   - the force's part of the margins' speed bound, h |F| / M, once a run
+ *     (its operations as the step makes them);
+ *   - every beam is marked touched once (thesis_beam_touch), so that a
+ *     reset restores it: a reset of a beam the run did not move puts back
+ *     what it holds.
+ * test_steps checks runs against thesis_step and get_state, state by
+ * state, bit for bit. */
+#include <math.h>
+#include <string.h>
+
+#include "model/contact_flag.h"
+#include "util/fminmax.h"
+#include "thesis/thesis.h"
+
+/* 1 if beam i is in mask m. */
+static inline int gate_in(unsigned m, int i)
+{
+	return (m >> i) & 1u;
+}
+
+int thesis_steps_takes(const struct bsim_world *w)
+{
+	return !w->extended && w->contact_mode == THESIS_CONTACT_PHYSICAL &&
+	       w->impact_order == THESIS_SIMULTANEOUS && !w->sleep &&
+	       w->n_beams <= THESIS_STEPS_BEAMS;
+}
+
+/* The kinetic energy of body and beams (thesis_kinetic_energy for the
+ * disk), every beam summed: the head says why that is the same. */
+static inline double gate_kinetic(const struct bsim_world *w, int nb)
+{
+	double e = 0.5 * w->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);
+	for (int i = 0; i < nb; i++) {
+		const thesis_beam *b = &w->beams[i];
+		e += 0.5 * b->inertia * b->omega * b->omega;
+	}
+	return e;
+}
+
+/* thesis_lcp_solve for the disk, one or two contacts inline. */
+static inline int gate_lcp(double inv_mass, thesis_contact *cs, int n)
+{
+	if (n > 2)
+		return thesis_lcp_solve(inv_mass, cs, n);
+	thesis_lcp_small(inv_mass, 0.0, cs, n, 0);
+	return 0;
+}
+
+/* The masks of a run: the beams awake, typed (contact_type not NONE),
+ * flagged (flag not NONE). Pushed beams live within a step. */
+typedef struct gate_masks {
+	unsigned awake, typed, flagged;
+} gate_masks;
+
+/* impact_resolve.c's impact_resolve for the disk, simultaneous: the
+ * touching contacts to the front, one solve, the impulses applied; the
+ * loss into *e_impact, the impacts counted into *impacts, the beams
+ * pushed into *pushed. */
+static inline void gate_impacts(struct bsim_world *w, double h, int nc, unsigned *pushed,
+                                double *e_impact, int *impacts, int nb)
+{
+	thesis_contact *cs = w->contacts;
+	int approaching;
+	int n = thesis_impacts_touching(w, nc, h, &approaching, 0);
+	if (!approaching)
+		return;
+	double ke = gate_kinetic(w, nb);
+	for (int i = 0; i < n; i++)
+		thesis_impact_bound(w, &cs[i]);
+	w->solver.iteration_limit += gate_lcp(w->impact_inv_mass, cs, n);
+	double j[2];
+	thesis_impulse_sum(cs, n, j);
+	w->v[0] += j[0] * w->impact_inv_mass;
+	w->v[1] += j[1] * w->impact_inv_mass;
+	for (int i = 0; i < n; i++) {
+		thesis_beam *b = &w->beams[cs[i].beam];
+		b->omega -= cs[i].impulse * cs[i].c / b->inertia;
+		if (cs[i].impulse > 0.0)
+			*pushed |= 1u << cs[i].beam;
+	}
+	for (int i = 0; i < n; i++)
+		*impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->rest_threshold;
+	*e_impact += ke - gate_kinetic(w, nb);
+}
+
+/* persistent_contact.c's thesis_persistent_contact_solve_disk: the
+ * contacts' solve, the body's advance, the awake beams' (mask) advance;
+ * the dampers' and contacts' energies into e_damper, e_contact.
+ * integrator: w->integrator, a constant where the caller gives one. */
+THESIS_SPECIALISED void gate_solve(struct bsim_world *w, const double dv[2], double h, int nc,
+                                   unsigned awake, unsigned *pushed, double *e_damper,
+                                   double *e_contact, const int integrator, const int nb)
+{
+	double v0[2] = {w->v[0], w->v[1]};
+	double vf[2] = {v0[0] + dv[0], v0[1] + dv[1]};
+	thesis_contact *cs = w->contacts;
+	int contact_of[THESIS_STEPS_BEAMS];
+	for (int i = 0; i < nb; i++)
+		contact_of[i] = -1;
+	for (int k = 0; k < nc; k++) {
+		thesis_smooth_row(&cs[k], &w->beams[cs[k].beam], v0, vf, h, integrator);
+		contact_of[cs[k].beam] = k;
+	}
+	double j[2] = {0.0, 0.0};
+	if (nc) {
+		w->solver.iteration_limit += gate_lcp(w->inv_mass, cs, nc);
+		thesis_impulse_sum(cs, nc, j);
+		for (int k = 0; k < nc; k++)
+			if (cs[k].impulse > 0.0)
+				*pushed |= 1u << cs[k].beam;
+	}
+	double vm[2];
+	thesis_body_advance(w, v0, vf, j, h, vm);
+	double damper = *e_damper, contact = *e_contact;
+	for (int i = 0; i < nb; i++)
+		if (gate_in(awake, i))
+			thesis_smooth_beam(&w->beams[i], contact_of[i] < 0 ? NULL : &cs[contact_of[i]],
+			                   vm, h, integrator, &damper, &contact);
+	*e_damper = damper;
+	*e_contact = contact;
+}
+
+/* The contacts of cs[0..n)'s beams within margin, again, in place
+ * (position_project.c's redetect for the disk). */
+static inline int gate_redetect(struct bsim_world *w, int n, double margin)
+{
+	thesis_contact *cs = w->contacts;
+	int m = 0;
+	for (int k = 0; k < n; k++)
+		m += contact_detect(w, cs[k].beam, margin, &cs[m], 0);
+	return m;
+}
+
+/* position_project.c's position_project for the disk: re-detection at the
+ * new positions and projection of penetration deeper than slop; the
+ * correction's energy into e_correction. Returns the contacts left. */
+static inline int gate_project(struct bsim_world *w, const double force[2], int nc,
+                               double *e_correction)
+{
+	const double margin = w->contact_tol;
+	thesis_contact *cs = w->contacts;
+	int n = gate_redetect(w, nc, margin);
+	for (int pass = 0; w->projection; pass++) {
+		int deep = 0;
+		for (int k = 0; k < n; k++)
+			deep |= cs[k].gap < -w->slop;
+		if (!deep)
+			break;
+		if (pass == THESIS_PROJECT_PASSES_MAX) { /* still deeper than slop */
+			w->solver.iteration_limit++;
+			break;
+		}
+		for (int k = 0; k < n; k++) {
+			cs[k].vrel = cs[k].gap;
+			cs[k].bound = 0.0;
+			cs[k].inv_i = w->beams[cs[k].beam].inv_inertia;
+		}
+		w->solver.iteration_limit += gate_lcp(w->inv_mass, cs, n);
+		thesis_project_move(w, cs, n, force, e_correction);
+		n = gate_redetect(w, n, margin);
+	}
+	return n;
+}
+
+/* contact_report.c's contact_report for the disk: the flag of every beam
+ * (the candidates of a world this small are all its beams, in order); a
+ * flagged beam is woken. */
+static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pushed, int nb)
+{
+	for (int i = 0; i < nb; i++)
+		if (gate_in(mk->flagged, i))
+			w->flag[i] = BSIM_CONTACT_NONE;
+	mk->flagged = 0;
+	for (int i = 0; i < nb; i++) {
+		int is_pushed = gate_in(pushed, i);
+		if (!is_pushed && !contact_near(w, i, BSIM_CONTACT_TOL, 0))
+			continue;
+		thesis_beam *b = &w->beams[i];
+		double u[2];
+		int type;
+		thesis_beam_direction(b, u);
+		double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
+		int flag = bsim_contact_flag(dist2, w->radius, type, is_pushed);
+		if (flag == BSIM_CONTACT_NONE)
+			continue;
+		w->flag[i] = flag;
+		mk->flagged |= 1u << i;
+		mk->awake |= 1u << i;
+	}
+}
+
+/* One step (step_run for extended 0, the head's differences) under the
+ * force, its state into s. hv: h |F| / M of the margins' speed bound; dv:
+ * h F / M of the free velocity. */
+THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], double h, double hv,
+                                  const double dv[2], gate_masks *mk, bsim_state *s,
+                                  const int integrator, const int nb)
+{
+	double e_damper = 0.0, e_impact = 0.0, e_contact = 0.0, e_correction = 0.0;
+	int impacts = 0;
+	unsigned pushed = 0;
+	for (int i = 0; i < nb; i++)
+		if (gate_in(mk->typed, i))
+			w->contact_type[i] = BSIM_CONTACT_NONE;
+	mk->typed = 0;
+	/* step_detect: every beam a candidate, in order */
+	double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) + hv;
+	int nc = 0;
+	for (int i = 0; i < nb; i++) {
+		double margin = thesis_step_margin(w, &w->beams[i], speed, h);
+		int got = contact_detect(w, i, margin, &w->contacts[nc], 0);
+		mk->awake |= (unsigned)got << i;
+		nc += got;
+	}
+	if (nc)
+		gate_impacts(w, h, nc, &pushed, &e_impact, &impacts, nb);
+	gate_solve(w, dv, h, nc, mk->awake, &pushed, &e_damper, &e_contact, integrator, nb);
+	int n = nc ? gate_project(w, force, nc, &e_correction) : 0;
+	w->n_contacts = n;
+	for (int k = 0; k < n; k++) {
+		const thesis_contact *c = &w->contacts[k];
+		if (c->gap <= w->contact_tol) {
+			w->contact_type[c->beam] = c->type;
+			mk->typed |= 1u << c->beam;
+		}
+	}
+	/* thesis_awake_prune */
+	for (int i = 0; i < nb; i++) {
+		const thesis_beam *b = &w->beams[i];
+		if (gate_in(mk->awake, i) && b->theta == 0.0 && b->omega == 0.0 &&
+		    !gate_in(mk->typed, i))
+			mk->awake &= ~(1u << i);
+	}
+	gate_report(w, mk, pushed, nb);
+	/* get_state */
+	thesis_state_body(w, s);
+	int na = 0;
+	for (int i = 0; i < nb; i++) {
+		if (gate_in(mk->awake, i)) {
+			s->active[na++] = i;
+			s->theta[i] = w->beams[i].theta;
+			s->omega[i] = w->beams[i].omega;
+			s->contact[i] = w->flag[i];
+		} else {
+			s->theta[i] = 0.0;
+			s->omega[i] = 0.0;
+			s->contact[i] = BSIM_CONTACT_NONE;
+		}
+	}
+	s->n_active = na;
+	s->energy.damper = e_damper;
+	s->energy.impact = e_impact;
+	s->energy.contact = e_contact;
+	s->energy.correction = e_correction;
+	s->energy.sleep = 0.0;
+	s->impacts = impacts;
+	s->solver = w->solver;
+}
+
+/* The run of n steps, nb beams and the integrator constants where the
+ * caller can give them. */
+THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], double h, int n,
+                                 bsim_state *out, const int integrator, const int nb)
+{
+	gate_masks mk = {0, 0, 0};
+	for (int k = 0; k < w->n_awake; k++)
+		mk.awake |= 1u << w->awake[k];
+	for (int k = 0; k < w->n_typed; k++)
+		mk.typed |= 1u << w->typed[k];
+	for (int k = 0; k < w->n_flagged; k++)
+		mk.flagged |= 1u << w->flagged[k];
+	/* step_detect's h |F| / M and the smooth solve's h F / M, as they
+	 * compute them */
+	const double hv = h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
+	const double dv[2] = {h * force[0] * w->inv_mass, h * force[1] * w->inv_mass};
+	for (int k = 0; k < n; k++)
+		gate_step(w, force, h, hv, dv, &mk, &out[k], integrator, nb);
+	/* The lists as the general path leaves them: ascending awake and
+	 * flagged beams, the typed ones (any order: only cleared), nothing
+	 * pushed; the last step's energy flows and impacts. */
+	w->n_awake = w->n_typed = w->n_flagged = 0;
+	for (int i = 0; i < nb; i++) {
+		w->is_awake[i] = (unsigned char)gate_in(mk.awake, i);
+		if (w->is_awake[i])
+			w->awake[w->n_awake++] = i;
+		if (gate_in(mk.typed, i))
+			w->typed[w->n_typed++] = i;
+		if (gate_in(mk.flagged, i))
+			w->flagged[w->n_flagged++] = i;
+	}
+	w->energy = out[n - 1].energy;
+	w->impacts = out[n - 1].impacts;
+}
+
+int thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out)
+{
+	if (n < 1 || !thesis_steps_takes(w) || out[0].n_beams != w->n_beams)
+		return 0;
+	for (int i = 0; i < w->n_beams; i++)
+		thesis_beam_touch(w, i);
+	if (h != w->h_prepared) {
+		for (int i = 0; i < w->n_beams; i++)
+			thesis_beam_prepare(&w->beams[i], h);
+		w->h_prepared = h;
+	}
+	if (w->n_beams == 2 && w->integrator == THESIS_MIDPOINT) /* the essay's gate */
+		gate_run(w, force, h, n, out, THESIS_MIDPOINT, 2);
+	else
+		gate_run(w, force, h, n, out, w->integrator, w->n_beams);
+	return n;
+}

@@ -1,0 +1,92 @@
+/* Runs of steps (trial_steps.h): a backend's bsim_backend.steps, for the
+ * steps over which the force holds.
+ *
+ * Why the force is the same. The step loop asks the pipeline for the
+ * force before each step; where it holds (trial_force_holds: propulsion
+ * along y gives its constant, the held random force its held value until
+ * the step its hold ends, and neither reads the state), the force asked
+ * before a run is the force of each step of it up to the hold's end, and
+ * asking it again after the run gives what the step loop would get there
+ * (the held value, or the next draw, drawn once, in order). So a run ends
+ * at the hold's end at the latest, and at the end of the trial (max_steps,
+ * gate_steps, or max_steps after the outcome), which the booking finds
+ * anyway: a run the trial does not use to its end leaves the world ahead
+ * of the trial, which then ends (a kept world is reset). */
+#include "run/trial_steps.h"
+
+#include <string.h>
+
+void trial_steps_init(trial_steps *t)
+{
+	t->on = 0;
+	t->cap = -1;
+}
+
+void trial_steps_free(trial_steps *t)
+{
+	if (t->cap < 0)
+		return;
+	for (int b = 0; b < 2; b++)
+		for (int k = 0; k < TRIAL_STEPS_MAX; k++)
+			bsim_state_free(&t->bank[b][k]);
+	t->cap = -1;
+}
+
+/* The banks sized for n_beams beams. */
+static int steps_reserve(trial_steps *t, int n_beams)
+{
+	if (t->cap == n_beams)
+		return BSIM_OK;
+	trial_steps_free(t);
+	/* empty states first: bsim_state_free of one is harmless */
+	memset(t->bank, 0, sizeof t->bank);
+	t->cap = n_beams;
+	for (int b = 0; b < 2; b++)
+		for (int k = 0; k < TRIAL_STEPS_MAX; k++)
+			if (bsim_state_init(&t->bank[b][k], n_beams)) {
+				trial_steps_free(t);
+				return BSIM_EFAIL;
+			}
+	return BSIM_OK;
+}
+
+int trial_steps_start(trial_steps *t, int plain, const bsim_backend *backend,
+                      const bsim_scene *scene, bsim_effects *fx, long n_max, long gate_max)
+{
+	t->on = plain && backend->steps && scene->n_beams <= TRIAL_STEPS_BEAMS &&
+	        trial_force_holds(scene, fx, &t->propulsion, &t->random);
+	t->steps = backend->steps;
+	t->n_max = n_max;
+	t->gate_max = gate_max;
+	if (t->on && steps_reserve(t, scene->n_beams)) {
+		t->on = 0;
+		return BSIM_EFAIL;
+	}
+	return BSIM_OK;
+}
+
+int trial_steps_make(trial_steps *t, bsim_world *w, const double force[2], const trial_loop *lp,
+                     long dwell, const bsim_state *s0, bsim_state **out)
+{
+	if (!t->on)
+		return 0;
+	long room = lp->done ? t->n_max - lp->run_on : t->n_max - lp->n;
+	if (!lp->done && t->gate_max - dwell < room)
+		room = t->gate_max - dwell;
+	const bsim_effect *er = t->random;
+	if (er) {
+		if (!(lp->n >= er->held[0] && lp->n < er->held[1] && lp->h == er->held_h))
+			return 0; /* not held: the step loop's step */
+		if (er->held[1] - lp->n < room)
+			room = er->held[1] - lp->n;
+	}
+	if (room < 1)
+		return 0;
+	room = room < TRIAL_STEPS_MAX ? room : TRIAL_STEPS_MAX;
+	bsim_state *bank = t->bank[s0 >= t->bank[0] && s0 < t->bank[0] + TRIAL_STEPS_MAX];
+	int m = t->steps(w, force, lp->h, (int)room, bank);
+	if (m == 0)
+		t->on = 0; /* the backend makes none for this world */
+	*out = bank;
+	return m;
+}
