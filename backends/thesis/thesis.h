@@ -336,25 +336,18 @@ static inline double thesis_kinetic_energy(const struct bsim_world *w, const int
 /* The beam integrator, inline (beam_integrate.h). */
 #include "thesis/beam_integrate.h"
 
-/* How far beam b and a body whose speed is at most `speed` (m/s) can close
- * within a step of h, plus slop (broad_phase.c derives it), m; inline:
- * every step asks it of every beam in reach. thesis_step_margin is it for
- * world w's body and slop. */
-static inline double thesis_beam_margin(const thesis_beam *b, double speed, double h, double slop)
+/* How far beam i and the body can close within a step (broad_phase.c
+ * derives it), m; inline: every step asks it of every beam in reach. */
+static inline double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b,
+                                        double speed, double h)
 {
 	/* At rest the formula below is 2 h |v| + slop exactly (every other
 	 * term is +0), without its division. */
 	if (b->theta == 0.0 && b->omega == 0.0)
-		return 2.0 * (h * speed) + slop;
+		return 2.0 * (h * speed) + w->slop;
 	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
 	               b->inertia;
-	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + slop;
-}
-
-static inline double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b,
-                                        double speed, double h)
-{
-	return thesis_beam_margin(b, speed, h, w->slop);
+	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
 }
 
 /* With every beam at rest the step's margin is 2 h |v| + slop, |v| = |v| +
@@ -398,28 +391,21 @@ static inline void thesis_beam_pushed(struct bsim_world *w, int i)
  * h F / M (v0 = v at the start) and the contacts' impulse sum j, and its
  * move by the mean velocity (persistent_contact.c); vm receives that
  * velocity. Inline: the contact solve, a step in free flight (j = 0) and
- * the runs of steps (thesis_steps.c: thesis_body_move, on the body's x and
- * v held apart) share it, so all move the body by the same operations. */
-static inline void thesis_body_move(double x[2], double v[2], const double v0[2],
-                                    const double vf[2], const double j[2], double inv_mass,
-                                    double h, int integrator, double vm[2])
-{
-	v[0] = vf[0] + j[0] * inv_mass;
-	v[1] = vf[1] + j[1] * inv_mass;
-	vm[0] = 0.5 * (v0[0] + v[0]);
-	vm[1] = 0.5 * (v0[1] + v[1]);
-	if (integrator == THESIS_EULER) {
-		vm[0] = v[0];
-		vm[1] = v[1];
-	}
-	x[0] += h * vm[0];
-	x[1] += h * vm[1];
-}
-
+ * the runs of steps (thesis_steps.c) share it, so all move the body by the
+ * same operations. */
 static inline void thesis_body_advance(struct bsim_world *w, const double v0[2], const double vf[2],
                                        const double j[2], double h, double vm[2])
 {
-	thesis_body_move(w->x, w->v, v0, vf, j, w->inv_mass, h, w->integrator, vm);
+	w->v[0] = vf[0] + j[0] * w->inv_mass;
+	w->v[1] = vf[1] + j[1] * w->inv_mass;
+	vm[0] = 0.5 * (v0[0] + w->v[0]);
+	vm[1] = 0.5 * (v0[1] + w->v[1]);
+	if (w->integrator == THESIS_EULER) {
+		vm[0] = w->v[0];
+		vm[1] = w->v[1];
+	}
+	w->x[0] += h * vm[0];
+	w->x[1] += h * vm[1];
 }
 
 /* The body's turn over a step from angular velocity w0 under torque
@@ -437,19 +423,12 @@ static inline void thesis_body_turn(struct bsim_world *w, double w0, double torq
 	w->heading += h * wm;
 }
 
-/* v_rel = v . n - omega c of contact c (contact_geometry.h), the body's
- * velocity v, its beam's omega. */
-static inline double thesis_contact_vrel(const double v[2], double omega, const thesis_contact *c)
-{
-	return (v[0] * c->n[0] + v[1] * c->n[1]) - omega * c->c;
-}
-
-/* c->vrel in world w; on the extended path plus w cb, and the tangent
- * row's v_t (extended: a constant, 0 for the essay's disk). */
+/* v_rel = v . n - omega c (contact_geometry.h); on the extended path plus
+ * w cb, and the tangent row's v_t (extended: a constant, 0 for the essay's disk). */
 static inline void thesis_contact_velocity(const struct bsim_world *w, thesis_contact *c,
                                            const int extended)
 {
-	c->vrel = thesis_contact_vrel(w->v, w->beams[c->beam].omega, c);
+	c->vrel = (w->v[0] * c->n[0] + w->v[1] * c->n[1]) - w->beams[c->beam].omega * c->c;
 	if (extended && w->extended) {
 		c->vrel += w->angular_velocity * c->cb;
 		c->vrel_t = (w->v[1] * c->n[0] - w->v[0] * c->n[1]) + w->angular_velocity * c->cbt -
