@@ -45,6 +45,36 @@ static inline void scene_gate_conservative(bsim_scene *s)
 	s->body.velocity[1] = 12.0;
 }
 
+/* A body of 1e300 kg at 1e4 m/s, 1e6 m below the gate, gaining 2e3 m/s a
+ * step (5e305 N along y): its kinetic energy 0.5 M v^2 overflows at 2e4
+ * m/s, in the fifth step. */
+static inline void scene_gate_overflow(bsim_scene *s)
+{
+	bsim_scene_init_gate(s, 5e305, 0.0);
+	s->body.mass = 1e300;
+	s->body.start[1] = -1e6;
+	s->body.velocity[1] = 1e4;
+	s->side_x = 1e9;
+}
+
+/* Six beams at forces f_prop, rm: the gate, a second gate 50 m above it
+ * and a pair of 12 m stubs between them (the left one soft), so that a
+ * body meets up to three at once. */
+static inline int scene_six_beams(bsim_scene *s, double f_prop, double rm)
+{
+	bsim_scene_init_gate(s, f_prop, rm);
+	int rc = bsim_scene_set_beams(s, 6);
+	if (rc)
+		return rc;
+	for (int i = 2; i < 6; i++)
+		s->beams[i] = s->beams[i % 2];
+	s->beams[2].pivot[1] = s->beams[3].pivot[1] = 80.0;
+	s->beams[4].pivot[1] = s->beams[5].pivot[1] = 55.0;
+	s->beams[4].length = s->beams[5].length = 12.0;
+	s->beams[4].stiffness = 50.0;
+	return 0;
+}
+
 /* The mirror image of a two-beam scene: x -> -x, so the beams change
  * places and sides (MODEL.md oracle 4). m is a new scene. */
 static inline void scene_mirror(const bsim_scene *s, bsim_scene *m)

@@ -83,16 +83,7 @@ THESIS_SPECIALISED void position_project(struct bsim_world *w, const double forc
 	double margin = w->contact_tol;
 	thesis_contact *cs = w->contacts;
 	int n = redetect(w, cs, w->n_contacts, margin, extended);
-	for (int pass = 0; w->projection; pass++) {
-		int deep = 0;
-		for (int k = 0; k < n; k++)
-			deep |= cs[k].gap < -w->slop;
-		if (!deep)
-			break;
-		if (pass == THESIS_PROJECT_PASSES_MAX) { /* still deeper than slop */
-			w->solver.iteration_limit++;
-			break;
-		}
+	for (int pass = 0; w->projection && thesis_project_more(w, cs, n, pass); pass++) {
 		project_once(w, cs, n, force, torque, extended);
 		n = redetect(w, cs, n, margin, extended);
 	}

@@ -474,6 +474,25 @@ static inline void thesis_impact_bound(const struct bsim_world *w, thesis_contac
 	c->bound = c->vrel < -w->rest_threshold ? -c->e * c->vrel : 0.0;
 }
 
+/* Whether pass `pass` of the projection (position_project.c) projects the
+ * n contacts cs: 1 if one is deeper than slop and the passes are not used
+ * up; at the limit, still too deep, the solver's iteration limit is
+ * counted and 0 returned. */
+static inline int thesis_project_more(struct bsim_world *w, const thesis_contact *cs, int n,
+                                      int pass)
+{
+	int deep = 0;
+	for (int k = 0; k < n; k++)
+		deep |= cs[k].gap < -w->slop;
+	if (!deep)
+		return 0;
+	if (pass == THESIS_PROJECT_PASSES_MAX) { /* still deeper than slop */
+		w->solver.iteration_limit++;
+		return 0;
+	}
+	return 1;
+}
+
 /* A projection's move (position_project.c) by the position impulses of
  * cs[0 .. n): each beam's angle and the body's centre, the springs' energy
  * change and the force's work over the shift booked into *correction. */

@@ -172,16 +172,7 @@ static inline int gate_project(struct bsim_world *w, const double force[2], int 
 	const double margin = w->contact_tol;
 	thesis_contact *cs = w->contacts;
 	int n = gate_redetect(w, nc, margin);
-	for (int pass = 0; w->projection; pass++) {
-		int deep = 0;
-		for (int k = 0; k < n; k++)
-			deep |= cs[k].gap < -w->slop;
-		if (!deep)
-			break;
-		if (pass == THESIS_PROJECT_PASSES_MAX) { /* still deeper than slop */
-			w->solver.iteration_limit++;
-			break;
-		}
+	for (int pass = 0; w->projection && thesis_project_more(w, cs, n, pass); pass++) {
 		for (int k = 0; k < n; k++) {
 			cs[k].vrel = cs[k].gap;
 			cs[k].bound = 0.0;
