@@ -9,7 +9,8 @@
  * order (broad_phase.c tests them all, with or without the grid), so the
  * step needs none of the general path's lists: the awake, typed, flagged
  * and pushed beams are bit masks here, and the lists are written back when
- * the run ends, as the general path leaves them.
+ * the run ends, as the general path leaves them. The essay's gate (two
+ * beams, the midpoint rule) has a copy compiled for it.
  *
  * Why the bits are the same. Each step is step_run's (thesis_world.c) for
  * extended 0, its functions' operations in their order, written in one
@@ -30,8 +31,8 @@
  *     not the awake ones: a beam not awake has omega = +-0 and adds +0 to a
  *     sum that is never -0 (it starts at 1/2 M |v|^2), which leaves it as
  *     it is;
- *   - the force's part of the margins' speed bound, h |F| / M, once a run
- *     (its operations as the step makes them);
+ *   - the force's parts of the margins' speed bound (h |F| / M) and of the
+ *     free velocity (h F / M) once a run, by the operations the step makes;
  *   - every beam is marked touched once (thesis_beam_touch), so that a
  *     reset restores it: a reset of a beam the run did not move puts back
  *     what it holds.
