@@ -6,9 +6,8 @@
  * where its steps leave it. Each case counts the steps made in runs, so
  * that a case which never took one fails rather than passes unseen: whole
  * trials in flight (ending at max_steps between two draws), flight then
- * the beams (H1), flight up to a beam's segment, a traversal and the run on to classify_y in flight, a
- * side exit, a state that stops being finite, and the pipelines with one
- * force only. */
+ * the beams (H1), flight up to a beam's segment, a traversal and the run on to classify_y in
+ * flight, a side exit, a state that stops being finite, and the pipelines with one force only. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>

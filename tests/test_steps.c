@@ -145,7 +145,8 @@ static void compare_worlds(const bsim_scene *s, const char *const *kv, double f_
 				b = &run[k];
 				t->in_runs++;
 				for (int q = 0; q < b->n_active; q++)
-					t->touching += b->contact[b->active[q]] != BSIM_CONTACT_NONE;
+					t->touching +=
+					        b->contact[b->active[q]] != BSIM_CONTACT_NONE;
 				t->impacts += b->impacts;
 			}
 			assert_same_state(&sa, b, n + 1);
@@ -243,9 +244,9 @@ static void test_knobs(void **state)
 {
 	(void)state;
 	static const char *const knobs[][3] = {
-	        {"integrator=euler", NULL},   {"projection=0", NULL},
-	        {"impact_mass=0.1", NULL},    {"slop=1e-3", "contact_tol=2e-3"},
-	        {"broad_phase=0", NULL},      {"sleep=off", NULL},
+	        {"integrator=euler", NULL}, {"projection=0", NULL},
+	        {"impact_mass=0.1", NULL},  {"slop=1e-3", "contact_tol=2e-3"},
+	        {"broad_phase=0", NULL},    {"sleep=off", NULL},
 	};
 	for (size_t k = 0; k < sizeof knobs / sizeof knobs[0]; k++) {
 		tally t = {0};
@@ -275,8 +276,9 @@ static void test_nonfinite(void **state)
 static void test_declined(void **state)
 {
 	(void)state;
-	static const char *const knobs[][2] = {
-	        {"contact_mode=essay", NULL}, {"impact_order=nearest_first", NULL}, {"sleep=on", NULL}};
+	static const char *const knobs[][2] = {{"contact_mode=essay", NULL},
+	                                       {"impact_order=nearest_first", NULL},
+	                                       {"sleep=on", NULL}};
 	bsim_state run[2];
 	bsim_error err;
 	const double force[2] = {0.0, 7.0};
@@ -320,8 +322,7 @@ static void no_trace(void *user, long step, const bsim_state *s)
  * from the trial before) into r, and stepped in a fresh runner into
  * r_step; returns the steps the first made in runs. */
 static long trial_both(const bsim_scene *s, const bsim_options *o, uint64_t seed,
-                       bsim_trial_runner *runner, bsim_trial_result *r,
-                       bsim_trial_result *r_step)
+                       bsim_trial_runner *runner, bsim_trial_result *r, bsim_trial_result *r_step)
 {
 	bsim_backend counted = bsim_backend_thesis;
 	counted.steps = counted_steps;
@@ -465,9 +466,12 @@ static void test_runner_declined(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_h1_forces),    cmocka_unit_test(test_asymmetric),
-	        cmocka_unit_test(test_impacts_and_starts), cmocka_unit_test(test_six_beams),
-	        cmocka_unit_test(test_knobs),        cmocka_unit_test(test_nonfinite),
+	        cmocka_unit_test(test_h1_forces),
+	        cmocka_unit_test(test_asymmetric),
+	        cmocka_unit_test(test_impacts_and_starts),
+	        cmocka_unit_test(test_six_beams),
+	        cmocka_unit_test(test_knobs),
+	        cmocka_unit_test(test_nonfinite),
 	        cmocka_unit_test(test_declined),
 	        cmocka_unit_test(test_runner_h1),
 	        cmocka_unit_test(test_runner_cut_runs),

@@ -545,7 +545,8 @@ static inline void thesis_smooth_beam(thesis_beam *b, const thesis_contact *c, c
 		omega_new = thesis_beam_free_omega(b, h, integrator);
 	} else {
 		omega_new = c->omega_free - c->impulse * c->c * c->inv_i;
-		double omega_m = integrator == THESIS_EULER ? omega_new : 0.5 * (b->omega + omega_new);
+		double omega_m =
+		        integrator == THESIS_EULER ? omega_new : 0.5 * (b->omega + omega_new);
 		*contact -= c->impulse * ((c->n[0] * vm[0] + c->n[1] * vm[1]) - c->c * omega_m);
 	}
 	*damper += thesis_beam_advance(b, omega_new, h, integrator);

@@ -147,8 +147,9 @@ THESIS_SPECIALISED void gate_solve(struct bsim_world *w, const double dv[2], dou
 	double damper = *e_damper, contact = *e_contact;
 	for (int i = 0; i < nb; i++)
 		if (gate_in(awake, i))
-			thesis_smooth_beam(&w->beams[i], contact_of[i] < 0 ? NULL : &cs[contact_of[i]],
-			                   vm, h, integrator, &damper, &contact);
+			thesis_smooth_beam(&w->beams[i],
+			                   contact_of[i] < 0 ? NULL : &cs[contact_of[i]], vm, h,
+			                   integrator, &damper, &contact);
 	*e_damper = damper;
 	*e_contact = contact;
 }

@@ -411,9 +411,9 @@ TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bs
 	ledger_step(&out->ledger, c->fx, s0, s1, lp->e0, e1);
 	lp->e0 = e1;
 	if (!plain && c->overlap)
-		out->overlap_max = fmax(out->overlap_max,
-		                        trial_overlap_depth(c->r->shape, c->ws->n_beams,
-		                                            c->scene->body.radius, s1));
+		out->overlap_max =
+		        fmax(out->overlap_max, trial_overlap_depth(c->r->shape, c->ws->n_beams,
+		                                                   c->scene->body.radius, s1));
 	if (lp->done)
 		return BOOK_ON;
 	trial_peaks_step(&c->r->peaks, c->scene, c->map, s1);
@@ -445,8 +445,8 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	const int plain = !c.recording && !c.trace && !c.overlap && !c.map;
 	trial_flight_start(&r->flight, plain, backend, c.w, scene, &fx, out, &r->peaks, c.n_max,
 	                   c.gate_max, c.centre);
-	if (rc == BSIM_OK && trial_steps_start(&r->steps, plain, backend, scene, &fx, c.n_max,
-	                                       c.gate_max))
+	if (rc == BSIM_OK &&
+	    trial_steps_start(&r->steps, plain, backend, scene, &fx, c.n_max, c.gate_max))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
 		int run = trial_flight_try(&r->flight, &lp, &c.gate.dwell, s0);
