@@ -336,6 +336,17 @@ static inline double thesis_kinetic_energy(const struct bsim_world *w, const int
 /* The beam integrator, inline (beam_integrate.h). */
 #include "thesis/beam_integrate.h"
 
+/* Every beam's constants for steps of h (thesis_beam_prepare), unless they
+ * are for h already. */
+static inline void thesis_beams_prepare(struct bsim_world *w, double h)
+{
+	if (h == w->h_prepared)
+		return;
+	for (int i = 0; i < w->n_beams; i++)
+		thesis_beam_prepare(&w->beams[i], h);
+	w->h_prepared = h;
+}
+
 /* How far beam i and the body can close within a step (broad_phase.c
  * derives it), m; inline: every step asks it of every beam in reach. */
 static inline double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b,

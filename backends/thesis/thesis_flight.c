@@ -33,11 +33,7 @@ int thesis_flight(bsim_world *w, const double force[2], double h, int n, double 
 		return 0;
 	/* The beams' constants for h, as the step would prepare them before
 	 * its flight (a step in flight reads none of them). */
-	if (h != w->h_prepared) {
-		for (int i = 0; i < w->n_beams; i++)
-			thesis_beam_prepare(&w->beams[i], h);
-		w->h_prepared = h;
-	}
+	thesis_beams_prepare(w, h);
 	const double inv_mass = w->inv_mass, f0 = force[0], f1 = force[1];
 	/* thesis_clear_margin's force term and the step's h F / M, 0 / M */
 	const double push = h * (fabs(f0) + fabs(f1)) * inv_mass;

@@ -323,11 +323,7 @@ int thesis_steps(struct bsim_world *w, const double force[2], double h, int n, b
 		return 0;
 	for (int i = 0; i < w->n_beams; i++)
 		thesis_beam_touch(w, i);
-	if (h != w->h_prepared) {
-		for (int i = 0; i < w->n_beams; i++)
-			thesis_beam_prepare(&w->beams[i], h);
-		w->h_prepared = h;
-	}
+	thesis_beams_prepare(w, h);
 	if (w->n_beams == 2 && w->integrator == THESIS_MIDPOINT) /* the essay's gate */
 		gate_run(w, force, h, n, out, THESIS_MIDPOINT, 2);
 	else

@@ -393,11 +393,7 @@ THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double tor
 	for (int k = 0; k < w->n_typed; k++)
 		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
 	w->n_typed = 0;
-	if (h != w->h_prepared) {
-		for (int i = 0; i < w->n_beams; i++)
-			thesis_beam_prepare(&w->beams[i], h);
-		w->h_prepared = h;
-	}
+	thesis_beams_prepare(w, h);
 	double speed = 0.0;
 	int n = in_flight ? 0 : step_detect(w, force, torque, h, &speed, extended);
 	w->n_contacts = n;

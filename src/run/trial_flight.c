@@ -222,16 +222,8 @@ int trial_flight_run(trial_flight *f, trial_loop *lp, long *dwell, bsim_state *s
 		 * end of the trial at most. */
 		double force[BSIM_WRENCH];
 		flight_force(f, lp->n, h, s0, force);
-		long room = lp->done ? f->n_max - lp->run_on : f->n_max - lp->n;
-		if (!lp->done && f->gate_max - *dwell < room)
-			room = f->gate_max - *dwell;
-		if (er) {
-			if (!(lp->n >= er->held[0] && lp->n < er->held[1] && h == er->held_h))
-				break; /* not held: the force is not one for a run */
-			if (er->held[1] - lp->n < room)
-				room = er->held[1] - lp->n;
-		}
-		room = room < TRIAL_FLIGHT_MAX ? room : TRIAL_FLIGHT_MAX;
+		const long room =
+		        trial_run_room(lp, *dwell, f->n_max, f->gate_max, er, TRIAL_FLIGHT_MAX);
 		const int m = room < 1 ? 0 : f->flight(f->w, force, h, (int)room, f->xv);
 		if (m == 0)
 			break;

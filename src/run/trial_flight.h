@@ -97,6 +97,26 @@ static inline int trial_flight_try(trial_flight *f, trial_loop *lp, long *dwell,
 	return -1;
 }
 
+/* The steps a run from step lp->n may make under the force just asked, the
+ * gate's dwell steps so far: to the end of the trial (max_steps n_max, or
+ * after the outcome max_steps more; gate_steps gate_max in one gate), to
+ * the end of the held random force's hold (er, NULL: none), max at most;
+ * 0 if er does not hold at lp->n (the force is not one for a run). */
+static inline long trial_run_room(const trial_loop *lp, long dwell, long n_max, long gate_max,
+                                  const bsim_effect *er, long max)
+{
+	long room = lp->done ? n_max - lp->run_on : n_max - lp->n;
+	if (!lp->done && gate_max - dwell < room)
+		room = gate_max - dwell;
+	if (er) {
+		if (!(lp->n >= er->held[0] && lp->n < er->held[1] && lp->h == er->held_h))
+			return 0;
+		if (er->held[1] - lp->n < room)
+			room = er->held[1] - lp->n;
+	}
+	return room < max ? room : max;
+}
+
 /* Steps the trial made by other means (a run of steps, trial_steps.h)
  * after a try: they pass the wait for the next try as many steps of the
  * step loop would. */

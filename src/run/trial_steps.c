@@ -53,8 +53,9 @@ static int steps_reserve(trial_steps *t, int n_beams)
 int trial_steps_start(trial_steps *t, int plain, const bsim_backend *backend,
                       const bsim_scene *scene, bsim_effects *fx, long n_max, long gate_max)
 {
+	bsim_effect *propulsion;
 	t->on = plain && backend->steps && scene->n_beams <= TRIAL_STEPS_BEAMS &&
-	        trial_force_holds(scene, fx, &t->propulsion, &t->random);
+	        trial_force_holds(scene, fx, &propulsion, &t->random);
 	t->steps = backend->steps;
 	t->n_max = n_max;
 	t->gate_max = gate_max;
@@ -68,21 +69,10 @@ int trial_steps_start(trial_steps *t, int plain, const bsim_backend *backend,
 int trial_steps_make(trial_steps *t, bsim_world *w, const double force[2], const trial_loop *lp,
                      long dwell, const bsim_state *s0, bsim_state **out)
 {
-	if (!t->on)
-		return 0;
-	long room = lp->done ? t->n_max - lp->run_on : t->n_max - lp->n;
-	if (!lp->done && t->gate_max - dwell < room)
-		room = t->gate_max - dwell;
-	const bsim_effect *er = t->random;
-	if (er) {
-		if (!(lp->n >= er->held[0] && lp->n < er->held[1] && lp->h == er->held_h))
-			return 0; /* not held: the step loop's step */
-		if (er->held[1] - lp->n < room)
-			room = er->held[1] - lp->n;
-	}
+	const long room =
+	        trial_run_room(lp, dwell, t->n_max, t->gate_max, t->random, TRIAL_STEPS_MAX);
 	if (room < 1)
-		return 0;
-	room = room < TRIAL_STEPS_MAX ? room : TRIAL_STEPS_MAX;
+		return 0; /* the step loop's step */
 	bsim_state *bank = t->bank[s0 >= t->bank[0] && s0 < t->bank[0] + TRIAL_STEPS_MAX];
 	int m = t->steps(w, force, lp->h, (int)room, bank);
 	if (m == 0)

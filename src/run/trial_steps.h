@@ -21,8 +21,8 @@
 typedef struct trial_steps {
 	int on; /* the trial takes runs (trial_steps_start) */
 	int (*steps)(bsim_world *w, const double force[2], double h, int n, bsim_state *out);
-	bsim_effect *propulsion, *random; /* the pipeline's, or NULL */
-	long n_max, gate_max;             /* steps in all, in one gate */
+	bsim_effect *random;  /* the pipeline's held random force, or NULL */
+	long n_max, gate_max; /* steps in all, in one gate */
 	/* Two banks of states, for the beams of `cap`: a run writes into the
 	 * bank that does not hold the state it starts from. */
 	bsim_state bank[2][TRIAL_STEPS_MAX];
@@ -39,7 +39,7 @@ void trial_steps_free(trial_steps *t);
 int trial_steps_start(trial_steps *t, int plain, const bsim_backend *backend,
                       const bsim_scene *scene, bsim_effects *fx, long n_max, long gate_max);
 
-/* A run from s0, the state after lp->n steps, under force (the
+/* For a trial t->on: a run from s0, the state after lp->n steps, under force (the
  * pipeline's for step lp->n, just asked), dwell steps in the gate: up to
  * the force's next change and the end of the trial. Returns the states
  * made, into *out (0: none, the step loop makes the step; a world the
