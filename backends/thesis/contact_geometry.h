@@ -29,8 +29,6 @@
 #ifndef BSIM_THESIS_CONTACT_GEOMETRY_H
 #define BSIM_THESIS_CONTACT_GEOMETRY_H
 
-#include <stddef.h>
-
 /* Inline, included by thesis.h: the step's detection (contact_detect.c's
  * entry points) and the runs of steps of the essay's disk (thesis_steps.c)
  * call these for every beam in reach, and share one copy. */
@@ -144,41 +142,38 @@ THESIS_SPECIALISED int contact_from_geometry(const thesis_geometry *g, int i, do
 	return 1;
 }
 
-/* The essay's disk, radius R about x, against beam b (beam i of its
- * world): its contact within margin into out, 1, or 0; the geometry kept in
- * b. touch: the world of beam i, which marks it touched where its geometry
- * is computed (NULL: none). The disk's detection (contact_detect) on any
- * beam and body: the runs of steps (thesis_steps.c) hold theirs apart. */
-THESIS_SPECIALISED int disk_detect(thesis_beam *b, int i, const double x[2], double radius,
-                                   double margin, double e_tip, double e_tangent,
-                                   struct bsim_world *touch, thesis_contact *out)
+/* The essay's disk (w->extended 0) against beam i: its contact within
+ * margin into out, 1, or 0; the geometry kept in the beam. contact_detect's
+ * path for the disk, apart from the extended path's, whose tests it has
+ * none of. */
+THESIS_SPECIALISED int disk_detect(struct bsim_world *w, int i, double margin, thesis_contact *out)
 {
-	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
-	double reach = b->length + radius + margin;
+	thesis_beam *b = &w->beams[i]; /* its geometry kept */
+	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+	double reach = b->length + w->radius + margin;
 	if (dx * dx + dy * dy > reach * reach)
 		return 0; /* outside the beam's disc: no trigonometry needed */
 	const thesis_geometry *g = &b->geo;
 	/* The same configuration gives the same bits: a step's detection
 	 * meets the geometry the last step's projection computed. */
-	if (!(g->x[0] == x[0] && g->x[1] == x[1] && g->theta == b->theta)) {
-		if (geometry_far(NULL, b, x, radius, margin, 0))
+	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta)) {
+		if (geometry_far(w, b, w->x, w->radius, margin, 0))
 			return 0;
-		if (touch)
-			thesis_beam_touch(touch, i);
-		geometry_compute(b, x, 0);
+		thesis_beam_touch(w, i);
+		geometry_compute(b, w->x, 0);
 	}
-	return contact_from_geometry(g, i, radius, margin, e_tip, e_tangent, out);
+	return contact_from_geometry(g, i, w->radius, margin, w->e_tip, w->e_tangent, out);
 }
 
-/* 0 if the disk, radius R about x, certainly lies farther than R + margin
- * from beam b (contact_near for the disk), 1 if it may not. */
-static inline int disk_near(const thesis_beam *b, const double x[2], double radius, double margin)
+/* contact_near for the essay's disk. */
+static inline int disk_near(const struct bsim_world *w, int i, double margin)
 {
-	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
-	double reach = b->length + radius + margin;
+	const thesis_beam *b = &w->beams[i];
+	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+	double reach = b->length + w->radius + margin;
 	if (dx * dx + dy * dy > reach * reach)
 		return 0;
-	return !geometry_far(NULL, b, x, radius, margin, 0);
+	return !geometry_far(w, b, w->x, w->radius, margin, 0);
 }
 
 /* Detection for any body (extended 1: the world's flags decide) or for the
@@ -187,9 +182,9 @@ static inline int disk_near(const thesis_beam *b, const double x[2], double radi
 THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin,
                                       thesis_contact *out, const int extended)
 {
-	thesis_beam *b = &w->beams[i]; /* its geometry kept */
 	if (!extended)
-		return disk_detect(b, i, w->x, w->radius, margin, w->e_tip, w->e_tangent, w, out);
+		return disk_detect(w, i, margin, out);
+	thesis_beam *b = &w->beams[i]; /* its geometry kept */
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
 	double reach = b->length + w->radius + margin;
 	if (dx * dx + dy * dy > reach * reach)
@@ -198,22 +193,20 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
 	/* The same configuration gives the same bits: a step's detection
 	 * meets the geometry the last step's projection computed. */
 	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta &&
-	      (!(extended && w->shaped) || g->psi == w->heading))) {
-		if (geometry_far(w, b, w->x, w->radius, margin, extended))
+	      (!w->shaped || g->psi == w->heading))) {
+		if (geometry_far(w, b, w->x, w->radius, margin, 1))
 			return 0;
 		thesis_beam_touch(w, i);
-		if (extended && w->shaped) {
+		if (w->shaped) {
 			double u[2];
 			thesis_beam_direction(b, u);
 			thesis_shape_geometry(w, b, u);
 		} else {
-			geometry_compute(b, w->x, extended);
+			geometry_compute(b, w->x, 1);
 		}
 	}
 	if (!contact_from_geometry(g, i, w->radius, margin, w->e_tip, w->e_tangent, out))
 		return 0;
-	if (!extended)
-		return 1;
 	out->two = 0; /* read by the extended path's solves only */
 	if (w->extended) {
 		out->mu = w->friction;
@@ -236,9 +229,9 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
 THESIS_SPECIALISED int contact_near(const struct bsim_world *w, int i, double margin,
                                     const int extended)
 {
-	const thesis_beam *b = &w->beams[i];
 	if (!extended)
-		return disk_near(b, w->x, w->radius, margin);
+		return disk_near(w, i, margin);
+	const thesis_beam *b = &w->beams[i];
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
 	double reach = b->length + w->radius + margin;
 	if (dx * dx + dy * dy > reach * reach)

@@ -32,6 +32,7 @@
  * friction's loss included; the runner credits T h w_m, the torque's work
  * over the heading's change. */
 #include <math.h>
+#include <stddef.h>
 
 #include "util/fminmax.h"
 #include "thesis/thesis.h"
