@@ -331,6 +331,77 @@ static void test_free_flight_bound(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The projection's re-detection (thesis_contact_redetect_disk) skips the
+ * distance bound geometry_far, which only saves the exact test: it finds
+ * the contact detection finds, bit for bit. The body is placed near a beam
+ * at a small angle, its last geometry computed at a configuration a little
+ * away (a random step of the body and of the angle), so that the bound is
+ * stale and often decides; each case is detected both ways from the same
+ * cached geometry: the same count, and a contact found the same to the
+ * bit. The bound rejects many of the cases, and the contacts found are
+ * many too. */
+static void test_redetect_as_detect(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 7.0, 20.0);
+	bsim_world *w = NULL;
+	bsim_error err;
+	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+	int far = 0, found = 0;
+	for (int t = 0; t < 100000; t++) {
+		int i = t % 2;
+		thesis_beam *b = &w->beams[i];
+		const double margin = gsl_ran_flat(rng, 1e-4, 5e-3);
+		/* the configuration of the cached geometry: the body's centre
+		 * off the segment's side or off an end, within a few margins of
+		 * R + margin */
+		b->theta = gsl_ran_flat(rng, -0.3, 0.3);
+		double u[2];
+		thesis_beam_direction(b, u);
+		double r = w->radius + margin * gsl_ran_flat(rng, 0.0, 4.0), dir[2], along;
+		if (t % 4 < 2) {
+			along = gsl_ran_flat(rng, 0.0, b->length);
+			double side = t % 4 ? 1.0 : -1.0;
+			dir[0] = -side * u[1];
+			dir[1] = side * u[0];
+		} else {
+			along = b->length;
+			double phi = gsl_ran_flat(rng, -1.5, 1.5);
+			dir[0] = u[0] * cos(phi) - u[1] * sin(phi);
+			dir[1] = u[1] * cos(phi) + u[0] * sin(phi);
+		}
+		w->x[0] = b->p[0] + along * u[0] + r * dir[0];
+		w->x[1] = b->p[1] + along * u[1] + r * dir[1];
+		thesis_contact c0, c1;
+		thesis_contact_detect_disk(w, i, margin, &c0); /* the geometry cached */
+		/* the configuration detected: a step away */
+		double step = margin * gsl_ran_flat(rng, 0.0, 2.0);
+		w->x[0] += gsl_ran_flat(rng, -step, step);
+		w->x[1] += gsl_ran_flat(rng, -step, step);
+		b->theta += gsl_ran_flat(rng, -1e-3, 1e-3);
+		far += geometry_far(w, b, w->x, w->radius, margin, 0);
+		const thesis_beam kept = *b;
+		memset(&c0, 0, sizeof c0);
+		memset(&c1, 0, sizeof c1);
+		int n0 = thesis_contact_detect_disk(w, i, margin, &c0);
+		*b = kept;
+		int n1 = thesis_contact_redetect_disk(w, i, margin, &c1);
+		assert_int_equal(n0, n1);
+		if (n1) /* without a contact out's fields say nothing */
+			assert_memory_equal(&c0, &c1, sizeof c0);
+		found += n1;
+	}
+	print_message("redetection: %d of 100000 cases rejected by the bound, %d contacts\n", far,
+	              found);
+	assert_true(far > 3000);
+	assert_true(found > 10000);
+	gsl_rng_free(rng);
+	bsim_backend_thesis.destroy(w);
+	bsim_scene_free(&s);
+}
+
 /* The free-flight room (broad_phase.c clear_fill): a body wandering in
  * small random steps under the middle of beam 0, in and out of its reach,
  * at speeds that make the margin matter, so that most steps are decided
@@ -523,6 +594,7 @@ int main(void)
 	        cmocka_unit_test(test_kept_world_as_built),
 	        cmocka_unit_test(test_free_flight_bound),
 	        cmocka_unit_test(test_free_flight_room),
+	        cmocka_unit_test(test_redetect_as_detect),
 	        cmocka_unit_test(test_effects_held_inline),
 	        cmocka_unit_test(test_reset_as_created),
 	};

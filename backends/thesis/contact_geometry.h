@@ -145,8 +145,12 @@ THESIS_SPECIALISED int contact_from_geometry(const thesis_geometry *g, int i, do
 /* The essay's disk (w->extended 0) against beam i: its contact within
  * margin into out, 1, or 0; the geometry kept in the beam. contact_detect's
  * path for the disk, apart from the extended path's, whose tests it has
- * none of. */
-THESIS_SPECIALISED int disk_detect(struct bsim_world *w, int i, double margin, thesis_contact *out)
+ * none of. near (a constant): beam i is one the step found in contact
+ * (the projection's re-detection), which geometry_far seldom rejects;
+ * that test only saves the exact one, so it is not asked there (the same
+ * result). */
+THESIS_SPECIALISED int disk_detect(struct bsim_world *w, int i, double margin, thesis_contact *out,
+                                   const int near)
 {
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
@@ -157,7 +161,7 @@ THESIS_SPECIALISED int disk_detect(struct bsim_world *w, int i, double margin, t
 	/* The same configuration gives the same bits: a step's detection
 	 * meets the geometry the last step's projection computed. */
 	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta)) {
-		if (geometry_far(w, b, w->x, w->radius, margin, 0))
+		if (!near && geometry_far(w, b, w->x, w->radius, margin, 0))
 			return 0;
 		thesis_beam_touch(w, i);
 		geometry_compute(b, w->x, 0);
@@ -183,7 +187,7 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
                                       thesis_contact *out, const int extended)
 {
 	if (!extended)
-		return disk_detect(w, i, margin, out);
+		return disk_detect(w, i, margin, out, 0);
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
 	double reach = b->length + w->radius + margin;

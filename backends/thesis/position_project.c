@@ -52,7 +52,7 @@ THESIS_SPECIALISED int redetect(struct bsim_world *w, thesis_contact *cs, int n,
 	if (!extended) { /* the essay's disk */
 		int m = 0;
 		for (int k = 0; k < n; k++)
-			m += thesis_contact_detect_disk(w, cs[k].beam, margin, &cs[m]);
+			m += thesis_contact_redetect_disk(w, cs[k].beam, margin, &cs[m]);
 		return m;
 	}
 	if (!w->shaped) { /* one contact a beam: in place, in order */

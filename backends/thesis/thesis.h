@@ -265,6 +265,9 @@ int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_con
  * only, compiled without the extended path's tests and stores (a contact's
  * extended fields are not set); thesis_step picks once a step. */
 int thesis_contact_detect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out);
+/* The same for a beam the step found in contact (the projection's
+ * re-detection): disk_detect's near, the same result. */
+int thesis_contact_redetect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out);
 /* shape_contact.c: a body of another shape than the disk against beam b of
  * direction u (thesis_beam_direction), into b->geo; and a capsule's second contact with the beam of
  * geometry g into out[1] (out[0] the first) if within margin: 1, else 0. */

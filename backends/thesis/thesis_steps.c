@@ -155,13 +155,13 @@ THESIS_SPECIALISED void gate_solve(struct bsim_world *w, const double dv[2], dou
 }
 
 /* The contacts of cs[0..n)'s beams within margin, again, in place
- * (position_project.c's redetect for the disk). */
+ * (position_project.c's redetect for the disk), beams in contact. */
 static inline int gate_redetect(struct bsim_world *w, int n, double margin)
 {
 	thesis_contact *cs = w->contacts;
 	int m = 0;
 	for (int k = 0; k < n; k++)
-		m += contact_detect(w, cs[k].beam, margin, &cs[m], 0);
+		m += disk_detect(w, cs[k].beam, margin, &cs[m], 1);
 	return m;
 }
 

@@ -397,8 +397,11 @@ TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bs
                           int *rc, bsim_error *err, const int plain)
 {
 	bsim_trial_result *out = c->out;
+	/* plain: the world holds the scene (no map) */
+	const bsim_scene *ws = plain ? c->scene : c->ws;
+	const int *map = plain ? NULL : c->map;
 	double e1;
-	if (!state_energy_finite(c->ws, s1, &e1)) {
+	if (!state_energy_finite(ws, s1, &e1)) {
 		out->instability = BSIM_UNSTABLE_NONFINITE;
 		out->unstable_step = (int)(lp->n + 1);
 		return BOOK_NONFINITE;
@@ -416,7 +419,7 @@ TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bs
 		                                                   c->scene->body.radius, s1));
 	if (lp->done)
 		return BOOK_ON;
-	trial_peaks_step(&c->r->peaks, c->scene, c->map, s1);
+	trial_peaks_step(&c->r->peaks, c->scene, map, s1);
 	/* The gate first: a body that leaves the field ends in its gate. */
 	if (!plain && c->scene->has_lattice &&
 	    (*rc = gate_follow(c, lp, s1, s0->x, err)) != BSIM_OK)

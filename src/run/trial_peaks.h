@@ -68,15 +68,19 @@ static inline void trial_peaks_list(trial_peaks *p, int g)
 
 /* Every beam's peak theta over the steps so far, s the state after the
  * latest: the active beams, beams 0 and 1 (trials.csv's two columns), and
- * any beam whose peak is still below 0 (a beam at rest has theta 0). */
-static inline void trial_peaks_update(trial_peaks *p, const bsim_scene *scene, const int *map,
-                                      const bsim_state *s)
+ * any beam whose peak is still below 0 (a beam at rest has theta 0).
+ * Returns whether an active beam touches the body in s (any_contact), from
+ * the same pass. */
+static inline int trial_peaks_update(trial_peaks *p, const bsim_scene *scene, const int *map,
+                                     const bsim_state *s)
 {
 	double *peak = p->peak;
+	int touches = 0;
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k], g = scene_beam(map, i);
 		trial_peaks_list(p, g);
 		peak[g] = bsim_fmax(peak[g], s->theta[i]);
+		touches |= s->contact[i];
 	}
 	/* A peak at +0 or above stays: the beam is active (the loop above
 	 * took its angle) or at rest (angle +-0, below it or, as bsim_fmax
@@ -98,6 +102,7 @@ static inline void trial_peaks_update(trial_peaks *p, const bsim_scene *scene, c
 			p->negative[m++] = i;
 	}
 	p->n_negative = m;
+	return touches != 0;
 }
 
 static inline int any_contact(const bsim_state *s)
@@ -115,13 +120,11 @@ static inline void touching_clear(trial_peaks *p)
 	p->n_touch = 0;
 }
 
-/* If the body touches a beam in s: where it is and the contacts of s in
+/* The body touches a beam in s: where it is and the contacts of s in
  * touching[], as a copy of the whole contact array would leave it, at the
  * cost of the beams listed. */
 static inline void trial_peaks_contacts(trial_peaks *p, const int *map, const bsim_state *s)
 {
-	if (!any_contact(s))
-		return;
 	p->touched = 1;
 	p->last_touch[0] = s->x[0];
 	p->last_touch[1] = s->x[1];
@@ -144,8 +147,8 @@ static inline void trial_peaks_step(trial_peaks *p, const bsim_scene *scene, con
 {
 	if (s->n_active == 0 && p->n_negative == 0 && (map || p->settled01))
 		return;
-	trial_peaks_update(p, scene, map, s);
-	trial_peaks_contacts(p, map, s);
+	if (trial_peaks_update(p, scene, map, s))
+		trial_peaks_contacts(p, map, s);
 }
 
 #endif
