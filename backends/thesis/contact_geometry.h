@@ -142,6 +142,28 @@ THESIS_SPECIALISED int contact_from_geometry(const thesis_geometry *g, int i, do
 	return 1;
 }
 
+/* 1 if the body's centre lies outside beam b's disc of radius L + R +
+ * margin about its pivot, where no point of the beam, at any angle, comes
+ * within R + margin: no trigonometry needed. */
+static inline int beam_beyond_reach(const struct bsim_world *w, const thesis_beam *b, double margin)
+{
+	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+	double reach = b->length + w->radius + margin;
+	return dx * dx + dy * dy > reach * reach;
+}
+
+/* 1 if beam b's geometry is the body's at its angle now (and, for a shaped
+ * body on the extended path, at its heading): the same configuration gives
+ * the same bits, so a step's detection meets the geometry the last step's
+ * projection computed. extended: a constant, as in contact_detect. */
+static inline int geometry_fresh(const struct bsim_world *w, const thesis_beam *b,
+                                 const int extended)
+{
+	const thesis_geometry *g = &b->geo;
+	return g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta &&
+	       (!extended || !w->shaped || g->psi == w->heading);
+}
+
 /* The essay's disk (w->extended 0) against beam i: its contact within
  * margin into out, 1, or 0; the geometry kept in the beam. contact_detect's
  * path for the disk, apart from the extended path's, whose tests it has
@@ -153,31 +175,16 @@ THESIS_SPECIALISED int disk_detect(struct bsim_world *w, int i, double margin, t
                                    const int near)
 {
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
-	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-	double reach = b->length + w->radius + margin;
-	if (dx * dx + dy * dy > reach * reach)
-		return 0; /* outside the beam's disc: no trigonometry needed */
+	if (beam_beyond_reach(w, b, margin))
+		return 0;
 	const thesis_geometry *g = &b->geo;
-	/* The same configuration gives the same bits: a step's detection
-	 * meets the geometry the last step's projection computed. */
-	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta)) {
+	if (!geometry_fresh(w, b, 0)) {
 		if (!near && geometry_far(w, b, w->x, w->radius, margin, 0))
 			return 0;
 		thesis_beam_touch(w, i);
 		geometry_compute(b, w->x, 0);
 	}
 	return contact_from_geometry(g, i, w->radius, margin, w->e_tip, w->e_tangent, out);
-}
-
-/* contact_near for the essay's disk. */
-static inline int disk_near(const struct bsim_world *w, int i, double margin)
-{
-	const thesis_beam *b = &w->beams[i];
-	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-	double reach = b->length + w->radius + margin;
-	if (dx * dx + dy * dy > reach * reach)
-		return 0;
-	return !geometry_far(w, b, w->x, w->radius, margin, 0);
 }
 
 /* Detection for any body (extended 1: the world's flags decide) or for the
@@ -189,15 +196,10 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
 	if (!extended)
 		return disk_detect(w, i, margin, out, 0);
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
-	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-	double reach = b->length + w->radius + margin;
-	if (dx * dx + dy * dy > reach * reach)
-		return 0; /* outside the beam's disc: no trigonometry needed */
+	if (beam_beyond_reach(w, b, margin))
+		return 0;
 	const thesis_geometry *g = &b->geo;
-	/* The same configuration gives the same bits: a step's detection
-	 * meets the geometry the last step's projection computed. */
-	if (!(g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta &&
-	      (!w->shaped || g->psi == w->heading))) {
+	if (!geometry_fresh(w, b, 1)) {
 		if (geometry_far(w, b, w->x, w->radius, margin, 1))
 			return 0;
 		thesis_beam_touch(w, i);
@@ -230,15 +232,15 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
 	return 1;
 }
 
+/* 0 if the body certainly lies farther than R + margin from beam i
+ * (beyond its reach, or far by the bound), 1 if it may not: the contact
+ * flag's test before it measures the distance. extended: a constant, as in
+ * contact_detect. */
 THESIS_SPECIALISED int contact_near(const struct bsim_world *w, int i, double margin,
                                     const int extended)
 {
-	if (!extended)
-		return disk_near(w, i, margin);
 	const thesis_beam *b = &w->beams[i];
-	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-	double reach = b->length + w->radius + margin;
-	if (dx * dx + dy * dy > reach * reach)
+	if (beam_beyond_reach(w, b, margin))
 		return 0;
 	return !geometry_far(w, b, w->x, w->radius, margin, extended);
 }
