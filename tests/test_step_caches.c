@@ -276,6 +276,32 @@ static void assert_clear_truly(const bsim_world *w, double speed, double h)
 	}
 }
 
+/* The body's centre x at distance r from the segment from p along u (unit)
+ * of the given length: off its side (t % 4 = 0 or 1, one side each, at a
+ * random point along it: the nearest point inside), or off one of its ends
+ * (2: the pivot's, 3: the tip's, at a random angle, away from the
+ * segment). */
+static void place_off_segment(gsl_rng *rng, int t, const double p[2], const double u[2],
+                              double length, double r, double x[2])
+{
+	double along, dir[2];
+	if (t % 4 < 2) {
+		along = gsl_ran_flat(rng, 0.0, length);
+		double side = t % 4 ? 1.0 : -1.0;
+		dir[0] = -side * u[1];
+		dir[1] = side * u[0];
+	} else {
+		int tip = t % 4 == 3;
+		along = tip ? length : 0.0;
+		double phi = gsl_ran_flat(rng, -1.5707963267948966, 1.5707963267948966);
+		double out = tip ? 1.0 : -1.0;
+		dir[0] = out * (u[0] * cos(phi) - u[1] * sin(phi));
+		dir[1] = out * (u[1] * cos(phi) + u[0] * sin(phi));
+	}
+	x[0] = p[0] + along * u[0] + r * dir[0];
+	x[1] = p[1] + along * u[1] + r * dir[1];
+}
+
 /* The free-flight test itself, at the edge of reach: the body's centre
  * placed at random within 1% of R + m of a point of a beam's segment (m
  * the test's own margin, thesis_clear_margin), at speeds that make the
@@ -302,24 +328,7 @@ static void test_free_flight_bound(void **state)
 		const thesis_beam *b = &w->beams[(t / 4) % 2];
 		double reach = w->radius + thesis_clear_margin(w, f, h);
 		double r = reach * (1.0 + gsl_ran_flat(rng, -1e-2, 1e-2));
-		/* r from the segment: off its side (the nearest point inside)
-		 * or off one of its ends, away from it */
-		double along, dir[2];
-		if (t % 4 < 2) {
-			along = gsl_ran_flat(rng, 0.0, b->length);
-			double side = t % 4 ? 1.0 : -1.0;
-			dir[0] = -side * b->u0[1];
-			dir[1] = side * b->u0[0];
-		} else {
-			int tip = t % 4 == 3;
-			along = tip ? b->length : 0.0;
-			double phi = gsl_ran_flat(rng, -1.5707963267948966, 1.5707963267948966);
-			double out = tip ? 1.0 : -1.0;
-			dir[0] = out * (b->u0[0] * cos(phi) - b->u0[1] * sin(phi));
-			dir[1] = out * (b->u0[1] * cos(phi) + b->u0[0] * sin(phi));
-		}
-		w->x[0] = b->p[0] + along * b->u0[0] + r * dir[0];
-		w->x[1] = b->p[1] + along * b->u0[1] + r * dir[1];
+		place_off_segment(rng, t, b->p, b->u0, b->length, r, w->x);
 		if (!thesis_broad_phase_clear(w, f, h))
 			continue;
 		clear++;
@@ -351,7 +360,7 @@ static void test_redetect_as_detect(void **state)
 	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
 	int far = 0, found = 0;
 	for (int t = 0; t < 100000; t++) {
-		int i = t % 2;
+		int i = (t / 4) % 2;
 		thesis_beam *b = &w->beams[i];
 		const double margin = gsl_ran_flat(rng, 1e-4, 5e-3);
 		/* the configuration of the cached geometry: the body's centre
@@ -360,20 +369,8 @@ static void test_redetect_as_detect(void **state)
 		b->theta = gsl_ran_flat(rng, -0.3, 0.3);
 		double u[2];
 		thesis_beam_direction(b, u);
-		double r = w->radius + margin * gsl_ran_flat(rng, 0.0, 4.0), dir[2], along;
-		if (t % 4 < 2) {
-			along = gsl_ran_flat(rng, 0.0, b->length);
-			double side = t % 4 ? 1.0 : -1.0;
-			dir[0] = -side * u[1];
-			dir[1] = side * u[0];
-		} else {
-			along = b->length;
-			double phi = gsl_ran_flat(rng, -1.5, 1.5);
-			dir[0] = u[0] * cos(phi) - u[1] * sin(phi);
-			dir[1] = u[1] * cos(phi) + u[0] * sin(phi);
-		}
-		w->x[0] = b->p[0] + along * u[0] + r * dir[0];
-		w->x[1] = b->p[1] + along * u[1] + r * dir[1];
+		double r = w->radius + margin * gsl_ran_flat(rng, 0.0, 4.0);
+		place_off_segment(rng, t, b->p, u, b->length, r, w->x);
 		thesis_contact c0, c1;
 		thesis_contact_detect_disk(w, i, margin, &c0); /* the geometry cached */
 		/* the configuration detected: a step away */
