@@ -2,7 +2,9 @@
 # The README's tour, timed: runs each of its commands in order (after
 # scripts/build.sh, which builds what is not built yet) and prints how long
 # each took on this machine, so that the README's times can be measured
-# again anywhere. Outputs go to out/tour/ instead of out/.
+# again anywhere. Outputs go to out/tour/ instead of out/, which the tour
+# removes first (its markov build would otherwise reuse the maps of an
+# earlier tour, and every other command refuse the finished results there).
 # Usage: scripts/tour.sh [--quick]   (--quick: the essay comparison at 100
 # trials a group instead of 1000)
 set -euo pipefail
@@ -11,6 +13,7 @@ essay_trials=1000
 [ "${1:-}" = "--quick" ] && essay_trials=100
 b=build/beamsim
 o=out/tour
+[ -e "$o" ] && echo "scripts/tour.sh: removing $o (an earlier tour's outputs)" >&2
 rm -rf "$o"
 mkdir -p "$o"
 printf '%-8s %s\n' "seconds" "command"

@@ -436,7 +436,7 @@ static void test_sweep(void **state)
 	assert_no_tmp(out);
 
 	/* --quiet prints nothing on success. */
-	const char *quiet[] = {"sweep", exp, "--out", out, "--quiet", NULL};
+	const char *quiet[] = {"sweep", exp, "--out", out, "--quiet", "--overwrite", NULL};
 	r = run_cli(quiet);
 	assert_int_equal(r.status, 0);
 	assert_string_equal(r.out, "");
@@ -536,8 +536,8 @@ static void test_sweep_split(void **state)
 	cli_run_free(&r);
 
 	/* The symmetric gate with no traversal: nothing to split. */
-	const char *none[] = {"sweep", small_experiment(dir),     "--out", out,
-	                      "--set", "integration.max_steps=5", NULL};
+	const char *none[] = {"sweep", small_experiment(dir),     "--out",       out,
+	                      "--set", "integration.max_steps=5", "--overwrite", NULL};
 	r = run_cli(none);
 	assert_int_equal(r.status, 0);
 	assert_null(strstr(r.out, "left/(left+right)"));

@@ -824,7 +824,7 @@ static void test_validate_shards_merged(void **state)
 	                       "--out",    other,       "--quiet",
 	                       NULL};
 	run_ok(argv2);
-	const char *bad[] = {"merge", part[0], other, part[2], "--out", out, NULL};
+	const char *bad[] = {"merge", part[0], other, part[2], "--out", out, "--overwrite", NULL};
 	bsim_test_expect_input_error(bad, (const char *const[]){other, "essay", NULL});
 }
 

@@ -403,7 +403,8 @@ static void test_select(void **state)
 	assert_true(bsim_test_check_figures(out_dir) >= 0);
 
 	char *err = NULL;
-	const char *bad[] = {"plot", dir, "--select", "beams.0.mass=1", "--out", out_dir, NULL};
+	const char *bad[] = {"plot",  dir,     "--select",    "beams.0.mass=1",
+	                     "--out", out_dir, "--overwrite", NULL};
 	assert_int_equal(run_cli(bad, NULL, &err), 2);
 	assert_non_null(strstr(err, "beams.0.mass is not a grid axis"));
 	free(err);

@@ -367,14 +367,14 @@ static void test_select_lists_every_axis(void **state)
 	free(o);
 	free(err);
 
-	const char *bad[] = {"plot", out, "--select", "k1=300", "--out", figs, NULL};
+	const char *bad[] = {"plot", out, "--select", "k1=300", "--out", figs, "--overwrite", NULL};
 	const char *needles[] = {"--select k1=300",
 	                         "effects.propulsion.force, effects.random_force.magnitude, "
 	                         "beams.0.stiffness",
 	                         NULL};
 	bsim_test_expect_input_error(bad, needles);
-	const char *none[] = {"plot",  out,  "--select", "beams.0.stiffness=200",
-	                      "--out", figs, NULL};
+	const char *none[] = {"plot",  out,  "--select",    "beams.0.stiffness=200",
+	                      "--out", figs, "--overwrite", NULL};
 	const char *values[] = {"beams.0.stiffness has no value 200", "its values: 100, 300", NULL};
 	bsim_test_expect_input_error(none, values);
 }

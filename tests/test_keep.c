@@ -170,7 +170,9 @@ static void same_as(const char *ref, const char *dir)
 	assert_false(bsim_test_exists(bsim_test_join(dir, ".beamsim")));
 }
 
-static void sweep_argv(const char **argv, const char *dir, int resume)
+/* The sweep into dir; then: 0 nothing, 1 --resume, 2 --overwrite. */
+enum { FRESH, RESUME, OVERWRITE };
+static void sweep_argv(const char **argv, const char *dir, int then)
 {
 	int n = 0;
 	argv[n++] = "sweep";
@@ -182,8 +184,10 @@ static void sweep_argv(const char **argv, const char *dir, int resume)
 	argv[n++] = "2";
 	argv[n++] = "--out";
 	argv[n++] = dir;
-	if (resume)
+	if (then == RESUME)
 		argv[n++] = "--resume";
+	if (then == OVERWRITE)
+		argv[n++] = "--overwrite";
 	argv[n] = NULL;
 }
 
@@ -195,7 +199,7 @@ static char *fail_then_resume(const char *ref, const char *dir, long fsize, long
                               const char *names)
 {
 	const char *argv[16];
-	sweep_argv(argv, dir, 0);
+	sweep_argv(argv, dir, FRESH);
 	bsim_test_opts limited = {.fsize = fsize};
 	char *err = NULL;
 	int rc = bsim_test_cli_with(argv, &limited, NULL, &err);
@@ -214,7 +218,7 @@ static char *fail_then_resume(const char *ref, const char *dir, long fsize, long
 		         min_records, records);
 	assert_false(bsim_test_exists(bsim_test_join(dir, ".beamsim/staging")));
 
-	sweep_argv(argv, dir, 1);
+	sweep_argv(argv, dir, RESUME);
 	char *err2 = NULL;
 	rc = bsim_test_cli(argv, NULL, &err2);
 	if (rc != 0)
@@ -230,7 +234,7 @@ static const char *reference(void)
 	static char ref[1400];
 	snprintf(ref, sizeof ref, "%s", bsim_test_dir("ref"));
 	const char *argv[16];
-	sweep_argv(argv, ref, 0);
+	sweep_argv(argv, ref, FRESH);
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	return ref;
 }
@@ -251,7 +255,7 @@ static void test_journal_full(void **state)
 	char *before = bsim_test_read(bsim_test_join(dir, "trials.csv"));
 	assert_non_null(before);
 	const char *argv[16];
-	sweep_argv(argv, dir, 0);
+	sweep_argv(argv, dir, OVERWRITE);
 	bsim_test_opts limited = {.fsize = 20000};
 	char *err = NULL;
 	assert_int_equal(bsim_test_cli_with(argv, &limited, NULL, &err), 1);
@@ -259,7 +263,7 @@ static void test_journal_full(void **state)
 	assert_non_null(during);
 	assert_string_equal(before, during);
 	assert_true(bsim_test_journal_records(bsim_test_join(dir, ".beamsim/journal")) > 0);
-	sweep_argv(argv, dir, 1);
+	sweep_argv(argv, dir, RESUME);
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	same_as(ref, dir);
 	free(before);

@@ -193,6 +193,7 @@ static void test_json_quiet(void **state)
 	                       "--quiet",
 	                       "--out",
 	                       d,
+	                       "--overwrite",
 	                       NULL};
 	out = NULL;
 	assert_int_equal(bsim_test_cli(quiet, &out, NULL), 0);

@@ -328,7 +328,8 @@ static void test_sweep_without_trajectories(void **state)
 	const char *argv[] = {"sweep",    bsim_test_src("configs/thesis/h1_symmetric.yaml"),
 	                      "--trials", "2",
 	                      "--quiet",  "--out",
-	                      dir,        NULL};
+	                      dir,        "--overwrite",
+	                      NULL};
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	assert_null(bsim_test_read(path));
 	snprintf(path, sizeof path, "%s/trajectories.mat", dir);

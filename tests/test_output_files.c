@@ -15,7 +15,9 @@
 
 #include <cmocka.h>
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,13 +29,14 @@
 #include "store/outdir.h"
 #include "support.h"
 
-static char gate[1200], h1[1200];
+static char gate[1200], h1[1200], h2[1200];
 
 static int setup(void **state)
 {
 	(void)state;
 	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
 	snprintf(h1, sizeof h1, "%s", bsim_test_src("configs/thesis/h1_symmetric.yaml"));
+	snprintf(h2, sizeof h2, "%s", bsim_test_src("configs/thesis/h2_asymmetric.yaml"));
 	return 0;
 }
 
@@ -183,6 +186,161 @@ static void test_lock(void **state)
 	free(err);
 }
 
+/* Every entry below path (path itself included), one line each with its
+ * kind, inode, size and modification time to the nanosecond, appended to
+ * buf: a directory whose entries change changes its time, so two equal
+ * listings mean nothing was created, removed or written in between. */
+static void tree_list(const char *path, char *buf, size_t size)
+{
+	struct stat st;
+	size_t len = strlen(buf);
+	if (lstat(path, &st) != 0) {
+		snprintf(buf + len, size - len, "%s missing\n", path);
+		return;
+	}
+	snprintf(buf + len, size - len, "%s %o %llu %lld %lld.%09ld\n", path,
+	         (unsigned)(st.st_mode & S_IFMT), (unsigned long long)st.st_ino,
+	         (long long)st.st_size, (long long)st.st_mtim.tv_sec, st.st_mtim.tv_nsec);
+	if (!S_ISDIR(st.st_mode))
+		return;
+	DIR *d = opendir(path);
+	assert_non_null(d);
+	struct dirent *e;
+	char names[64][256];
+	int n = 0;
+	while ((e = readdir(d)) && n < 64)
+		if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+			snprintf(names[n++], sizeof names[0], "%s", e->d_name);
+	closedir(d);
+	for (int i = 0; i < n; i++) /* readdir's order, the same for an unchanged directory */
+		tree_list(bsim_test_join(path, names[i]), buf, size);
+}
+
+/* A run refused on a directory another run is writing touches nothing in
+ * it: a sweep of H2 (two real processes) journals its first trial and is
+ * stopped (SIGSTOP, so that it is still running at every check below, on
+ * a machine however busy); then a second sweep, a plot, a markov build, a
+ * landscape, a run --out, a comparison and the same sweep with --resume and
+ * with --overwrite are each refused with exit 2 naming the directory and
+ * the run that holds it, and the directory, its staging area and journal
+ * included, is exactly as it was. Continued, the first sweep ends with all
+ * its 16,200 trials. */
+static void test_refused_run_touches_nothing(void **state)
+{
+	(void)state;
+	char dir[1400], journal[1500], pid_text[32];
+	snprintf(dir, sizeof dir, "%s", bsim_test_join(bsim_test_dir("held"), "D"));
+	snprintf(journal, sizeof journal, "%s/.beamsim/journal", dir);
+	const char *first[] = {"sweep", h2, "--threads", "1", "--quiet", "--out", dir, NULL};
+	int pid = bsim_test_spawn(first), status = 0;
+	if (!bsim_test_await_records(pid, journal, 1, &status))
+		fail_msg("the sweep of H2 ended (status %d) before journaling a trial", status);
+	assert_int_equal(kill(pid, SIGSTOP), 0);
+	assert_int_equal(waitpid(pid, &status, WUNTRACED), pid);
+	if (!WIFSTOPPED(status))
+		fail_msg("the sweep of H2 ended (status %d) before it could be stopped", status);
+	snprintf(pid_text, sizeof pid_text, "process %d", pid);
+
+	static char before[16384], after[16384];
+	before[0] = after[0] = '\0';
+	tree_list(dir, before, sizeof before);
+	assert_non_null(strstr(before, "/.beamsim/staging"));
+	char figs[1500];
+	snprintf(figs, sizeof figs, "%s", bsim_test_join(bsim_test_dir("held_figs"), "f"));
+	const char *markov_exp = bsim_test_src("configs/markov/c_track.yaml");
+	const char *refused[][12] = {
+	        {"sweep", h1, "--trials", "2", "--out", dir, NULL},
+	        {"sweep", h2, "--threads", "1", "--quiet", "--out", dir, "--resume", NULL},
+	        {"sweep", h2, "--threads", "1", "--quiet", "--out", dir, "--overwrite", NULL},
+	        {"plot", dir, NULL},
+	        {"markov", "build", markov_exp, "--trials", "2", "--out", dir, NULL},
+	        {"landscape", gate, "--resolution", "2", "--out", dir, NULL},
+	        {"run", gate, "--out", dir, "--overwrite", NULL},
+	        {"compare", h1, "--trials", "1", "--out", dir, NULL},
+	};
+	for (size_t i = 0; i < sizeof refused / sizeof refused[0]; i++) {
+		const char *needles[] = {dir, "another beamsim run (beamsim sweep, ", pid_text,
+		                         "is writing this directory", NULL};
+		bsim_test_expect_input_error(refused[i], needles);
+	}
+	tree_list(dir, after, sizeof after);
+	assert_string_equal(before, after);
+
+	assert_int_equal(kill(pid, SIGCONT), 0);
+	assert_int_equal(bsim_test_wait(pid), 0);
+	char *csv = bsim_test_read(bsim_test_join(dir, "trials.csv"));
+	assert_non_null(csv);
+	assert_int_equal(bsim_test_count_lines(csv), 16200 + 1);
+	int has = 0;
+	bsim_error e;
+	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_OK);
+	assert_int_equal(has, 1);
+	assert_false(bsim_test_exists(bsim_test_join(dir, ".beamsim")));
+	free(csv);
+}
+
+/* A directory holding a finished result is refused, naming it and what
+ * wrote it, and stays as it was; --overwrite replaces it; --resume with
+ * --overwrite is a usage error. A stopped run's journal is refused
+ * likewise, naming both ways on, and --overwrite starts over. */
+static void test_finished_result_needs_overwrite(void **state)
+{
+	(void)state;
+	char dir[1400];
+	snprintf(dir, sizeof dir, "%s", bsim_test_join(bsim_test_dir("finished"), "out"));
+	const char *sweep[] = {"sweep", h1, "--trials", "2", "--quiet", "--out", dir, NULL};
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	static char before[16384], after[16384];
+	before[0] = after[0] = '\0';
+	tree_list(dir, before, sizeof before);
+	const char *again[] = {"sweep", h1, "--trials", "3", "--quiet", "--out", dir, NULL};
+	const char *needles[] = {dir, "holds the finished result of beamsim sweep", "--overwrite",
+	                         NULL};
+	bsim_test_expect_input_error(again, needles);
+	const char *other[] = {"landscape", gate, "--resolution", "2", "--out", dir, NULL};
+	bsim_test_expect_input_error(other, needles);
+	tree_list(dir, after, sizeof after);
+	assert_string_equal(before, after);
+
+	const char *both[] = {"sweep", h1,         "--trials",    "3", "--out",
+	                      dir,     "--resume", "--overwrite", NULL};
+	char *err = NULL;
+	assert_int_equal(bsim_test_cli(both, NULL, &err), 2);
+	assert_non_null(strstr(err, "--resume and --overwrite: expected one of them"));
+	free(err);
+
+	const char *replace[] = {"sweep", h1,  "--trials",    "3", "--quiet",
+	                         "--out", dir, "--overwrite", NULL};
+	assert_int_equal(bsim_test_cli(replace, NULL, NULL), 0);
+	char *csv = bsim_test_read(bsim_test_join(dir, "trials.csv"));
+	assert_int_equal(bsim_test_count_lines(csv), 30 * 3 + 1);
+	free(csv);
+
+	/* a stopped run: its journal is refused without --resume or --overwrite */
+	char stopped[1400], journal[1500];
+	snprintf(stopped, sizeof stopped, "%s", bsim_test_join(bsim_test_dir("stopped"), "out"));
+	snprintf(journal, sizeof journal, "%s/.beamsim/journal", stopped);
+	const char *long_run[] = {"sweep", h2, "--threads", "1", "--quiet", "--out", stopped, NULL};
+	int pid = bsim_test_spawn(long_run), status = 0;
+	if (!bsim_test_await_records(pid, journal, 1, &status))
+		fail_msg("the sweep of H2 ended (status %d) before journaling a trial", status);
+	kill(pid, SIGKILL);
+	bsim_test_wait(pid);
+	long kept = bsim_test_journal_records(journal);
+	const char *fresh[] = {"sweep", h1, "--trials", "2", "--quiet", "--out", stopped, NULL};
+	const char *j_needles[] = {stopped, "journal of a stopped run", "--resume", "--overwrite",
+	                           NULL};
+	bsim_test_expect_input_error(fresh, j_needles);
+	assert_int_equal(bsim_test_journal_records(journal), kept);
+	const char *over[] = {"sweep", h1,      "--trials",    "2", "--quiet",
+	                      "--out", stopped, "--overwrite", NULL};
+	assert_int_equal(bsim_test_cli(over, NULL, NULL), 0);
+	assert_false(bsim_test_exists(journal));
+	csv = bsim_test_read(bsim_test_join(stopped, "trials.csv"));
+	assert_int_equal(bsim_test_count_lines(csv), 30 * 2 + 1);
+	free(csv);
+}
+
 /* A rerun into a directory on a disk that fills up (RLIMIT_FSIZE: no file
  * may pass 30 kB, trials.csv needs 51 kB) fails naming the user's path,
  * and the directory keeps the previous run's files, whole, with their
@@ -206,7 +364,7 @@ static void test_failed_rerun_keeps_previous_set(void **state)
 	char *before = bsim_test_read(bsim_test_join(out, "trials.csv"));
 	char *before_json = bsim_test_read(bsim_test_join(out, "regress.json"));
 
-	const char *r2[] = {"regress", b2, "--quiet", "--out", out, NULL};
+	const char *r2[] = {"regress", b2, "--quiet", "--out", out, "--overwrite", NULL};
 	bsim_test_opts small = {.fsize = 30000};
 	char *err = NULL;
 	assert_int_equal(bsim_test_cli_with(r2, &small, NULL, &err), 1);
@@ -247,7 +405,8 @@ static void test_replacing_a_set(void **state)
 	snprintf(elsewhere, sizeof elsewhere, "%s",
 	         bsim_test_join(bsim_test_dir("elsewhere"), "t.csv"));
 	assert_int_equal(symlink(elsewhere, bsim_test_join(dir, "trials.csv")), 0);
-	const char *sweep[] = {"sweep", h1, "--trials", "1", "--quiet", "--out", dir, NULL};
+	const char *sweep[] = {"sweep", h1,  "--trials",    "1", "--quiet",
+	                       "--out", dir, "--overwrite", NULL};
 	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
 	const char *gone[] = {"pairs.csv", "report.md", "report.json", "thesis/trials.csv",
 	                      "box2d/summary.json"};
@@ -306,14 +465,20 @@ static void test_figures_join_the_set(void **state)
 	const char *plot[] = {"plot", dir, "--quiet", NULL};
 	assert_int_equal(bsim_test_cli(plot, NULL, NULL), 0);
 	char *manifest = bsim_test_read(bsim_test_join(dir, "manifest.json"));
-	assert_non_null(strstr(manifest, "\"command\": \"plot\""));
+	/* still the sweep's result, with the figures added */
+	assert_non_null(strstr(manifest, "\"command\": \"sweep\""));
 	assert_non_null(strstr(manifest, "\"path\": \"p_traverse.gp\""));
 	assert_non_null(strstr(manifest, "\"path\": \"trials.csv\""));
 	int has = 0;
 	bsim_error e;
 	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_OK);
 	assert_int_equal(has, 1);
-	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
+	/* a rerun is refused as it stands, and replaces the set with --overwrite */
+	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 2);
+	assert_int_equal(access(bsim_test_join(dir, "p_traverse.gp"), F_OK), 0);
+	const char *again[] = {"sweep", h1,  "--trials",    "2", "--trajectories", "1", "--quiet",
+	                       "--out", dir, "--overwrite", NULL};
+	assert_int_equal(bsim_test_cli(again, NULL, NULL), 0);
 	assert_int_equal(access(bsim_test_join(dir, "p_traverse.gp"), F_OK), -1);
 	free(manifest);
 
@@ -336,6 +501,8 @@ int main(void)
 	        cmocka_unit_test(test_stdout_errors),
 	        cmocka_unit_test(test_unwritable_out),
 	        cmocka_unit_test(test_lock),
+	        cmocka_unit_test(test_refused_run_touches_nothing),
+	        cmocka_unit_test(test_finished_result_needs_overwrite),
 	        cmocka_unit_test(test_failed_rerun_keeps_previous_set),
 	        cmocka_unit_test(test_replacing_a_set),
 	        cmocka_unit_test(test_manifest_check),

@@ -5,10 +5,12 @@
  *
  * Names: 'set' {KEY, VALUE, ...}, 'region' [X0 X1 Y0 Y1] (m), 'resolution'
  * (the grid spacing, m), 'out' (a directory: also write the program's files
- * and figures there). l.x (1 x nx) and l.y (ny x 1) are the grid's
- * coordinates, l.e_total, l.e_beam and l.e_prop ny x nx matrices (rows y,
- * columns x, as meshgrid and surf take them), l.theta ny x nx x n_beams;
- * l.barriers the start, the far side and the passes (landscape.json's). */
+ * and figures there), 'overwrite' (true: replace the result 'out' holds;
+ * without it such a directory is refused, as by `beamsim landscape`).
+ * l.x (1 x nx) and l.y (ny x 1) are the grid's coordinates, l.e_total,
+ * l.e_beam and l.e_prop ny x nx matrices (rows y, columns x, as meshgrid
+ * and surf take them), l.theta ny x nx x n_beams; l.barriers the start,
+ * the far side and the passes (landscape.json's). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,8 +18,8 @@
 
 #include "bsim_mex.h"
 
-enum { A_SET, A_REGION, A_RESOLUTION, A_OUT, N_ARGS };
-static const char *const arg_names[N_ARGS] = {"set", "region", "resolution", "out"};
+enum { A_SET, A_REGION, A_RESOLUTION, A_OUT, A_OVERWRITE, N_ARGS };
+static const char *const arg_names[N_ARGS] = {"set", "region", "resolution", "out", "overwrite"};
 
 /* Grid values v (entry j nx + i at x_i, y_j) as an ny x nx matrix. */
 static mxArray *grid_matrix(const bsim_landscape_grid *g, const double *v)
@@ -156,13 +158,15 @@ static int landscape(landscape_call *c, int nrhs, const mxArray *prhs[], mxArray
 	if (bmx_pairs(nrhs, prhs, 1, arg_names, N_ARGS, v, err) != BSIM_OK)
 		return BSIM_EINPUT;
 	const char *path = NULL, *dir = NULL;
+	int overwrite = 0;
 	bsim_override *sets = NULL;
 	int n_sets = 0;
 	bsim_landscape_grid_def def = bsim_landscape_grid_def_default();
 	if (bmx_text("scene", prhs[0], &c->pool, &path, err) ||
 	    bmx_overrides("set", v[A_SET], &c->pool, &sets, &n_sets, err) ||
 	    (v[A_RESOLUTION] && bmx_double("resolution", v[A_RESOLUTION], &def.spacing, err)) ||
-	    (v[A_OUT] && bmx_text("out", v[A_OUT], &c->pool, &dir, err)))
+	    (v[A_OUT] && bmx_text("out", v[A_OUT], &c->pool, &dir, err)) ||
+	    (v[A_OVERWRITE] && bmx_flag("overwrite", v[A_OVERWRITE], &overwrite, err)))
 		return err->code;
 	if (v[A_RESOLUTION] && !(def.spacing > 0))
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -187,7 +191,8 @@ static int landscape(landscape_call *c, int nrhs, const mxArray *prhs[], mxArray
 	int rc;
 	if (dir) {
 		int drawn = 0;
-		rc = bsim_landscape_store(dir, &c->scene, &def, &c->g, &c->b, &drawn, err);
+		rc = bsim_landscape_store(dir, overwrite, &c->scene, &def, &c->g, &c->b, &drawn,
+		                          err);
 	} else {
 		rc = bsim_landscape_grid_alloc(&c->scene, &def, &c->g, err);
 		if (rc == BSIM_OK)

@@ -10,17 +10,18 @@
 PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"experiment",   "out",    "trials", "threads",      "seed",
-	                         "backend",      "sets",   "grid",   "backend_opts", "progress",
-	                         "trajectories", "resume", NULL};
+	static char *kwlist[] = {"experiment",   "out",      "trials",       "threads",
+	                         "seed",         "backend",  "sets",         "grid",
+	                         "backend_opts", "progress", "trajectories", "resume",
+	                         "overwrite",    NULL};
 	const char *experiment, *out, *backend_spec = NULL;
 	long trials = 0, keep = 0;
-	int threads = 0, resume = 0;
+	int threads = 0, resume = 0, overwrite = 0;
 	PyObject *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None, *opts_o = Py_None,
 	         *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|liOzOOOOlp", kwlist, &experiment, &out,
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|liOzOOOOlpp", kwlist, &experiment, &out,
 	                                 &trials, &threads, &seed_o, &backend_spec, &sets_o,
-	                                 &grid_o, &opts_o, &progress_o, &keep, &resume))
+	                                 &grid_o, &opts_o, &progress_o, &keep, &resume, &overwrite))
 		return NULL;
 	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
 		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
@@ -47,6 +48,7 @@ PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw)
 	def.threads = threads;
 	def.keep = (int)keep;
 	def.resume = resume;
+	def.overwrite = overwrite;
 	def.progress = pyb_progress_update;
 	def.progress_user = &progress;
 	def.stop = &progress.stop;

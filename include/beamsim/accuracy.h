@@ -156,14 +156,16 @@ BSIM_API int bsim_accuracy_write_md(const char *path, const bsim_accuracy_result
                                     bsim_error *err);
 
 /* The study written into the output directory out as one set (checked
- * before the study runs): accuracy.csv, accuracy.mat, equal_error.csv (at
+ * before the study runs; overwrite 1 replaces the result it holds, 0
+ * refuses it): accuracy.csv, accuracy.mat, equal_error.csv (at
  * cfg's targets), accuracy.md (naming the scene by scene_label, with the
  * equal-error table) and the figure accuracy (.png, .svg, .gp, .dat). fig gets the figure's result
  * (its notes say what gnuplot could not draw); free it and res on BSIM_OK. */
-BSIM_API int bsim_accuracy_store(const char *out, const bsim_scene *scene, const char *scene_label,
-                                 const bsim_backend *const *backends, int n_backends,
-                                 const bsim_accuracy_config *cfg, bsim_accuracy_result *res,
-                                 bsim_figures_result *fig, bsim_error *err);
+BSIM_API int bsim_accuracy_store(const char *out, int overwrite, const bsim_scene *scene,
+                                 const char *scene_label, const bsim_backend *const *backends,
+                                 int n_backends, const bsim_accuracy_config *cfg,
+                                 bsim_accuracy_result *res, bsim_figures_result *fig,
+                                 bsim_error *err);
 
 #ifdef __cplusplus
 }

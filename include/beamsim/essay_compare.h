@@ -81,6 +81,8 @@ typedef struct bsim_essay_config {
 	 * as they end (one journal), so with resume a stopped or killed run
 	 * continues (same inputs), losing no finished trial. */
 	int resume;
+	/* 1: replace the finished result or stopped run in out; 0: refuse it */
+	int overwrite;
 	/* bsim_essay_compare_store spread over processes (beamsim/sweep_dir.h,
 	 * docs/cluster.md): a shard writes a part directory into out, an MPI
 	 * rank other than 0 writes nothing; merge joins the parts. All zero:

@@ -58,6 +58,7 @@ BSIM_API const char *bsim_figures_kind_name(bsim_figures_kind k);
 typedef struct bsim_figures_def {
 	bsim_figures_kind kind;
 	const char *out; /* directory for the figures; NULL: the directory read */
+	int overwrite;   /* with out: 1 replaces the result out holds; 0 refuses it */
 	/* Only groups whose grid value of KEY equals VALUE (numerically if
 	 * both are numbers), for every KEY=VALUE given; the key must be a
 	 * grid axis. */

@@ -69,9 +69,10 @@ BSIM_API int bsim_landscape_write(const char *dir, const bsim_scene *s,
 
 /* The landscape of s on the grid def, its barriers and files, computed and
  * written into the output directory out as one set (out is checked before
- * anything is computed). *g and *b get the grid and the barriers (free them
+ * anything is computed; overwrite 1 replaces the result it holds, 0
+ * refuses it). *g and *b get the grid and the barriers (free them
  * on BSIM_OK); BSIM_EINPUT for an unusable out or a bad grid, naming it. */
-BSIM_API int bsim_landscape_store(const char *out, const bsim_scene *s,
+BSIM_API int bsim_landscape_store(const char *out, int overwrite, const bsim_scene *s,
                                   const bsim_landscape_grid_def *def, bsim_landscape_grid **g,
                                   bsim_landscape_barriers **b, int *drawn, bsim_error *err);
 

@@ -337,12 +337,13 @@ BSIM_API int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_mark
 #define BSIM_MARKOV_WALKS 100000
 
 /* Writes p, the prediction of lattice by the chain of set's maps, into
- * the output directory dir: prediction.csv (location, kind, ix, iy, p:
+ * the output directory dir (overwrite 1: replacing the result it holds;
+ * 0: refusing it, BSIM_EINPUT): prediction.csv (location, kind, ix, iy, p:
  * every final location of the field), prediction_gates.csv (gates, p),
  * their .mat twins and the figure prediction (.png .svg .gp .dat): the
  * final locations drawn as the field with the totals of end, side and
  * stuck. */
-BSIM_API int bsim_markov_prediction_store(const char *dir, const bsim_scene *lattice,
+BSIM_API int bsim_markov_prediction_store(const char *dir, int overwrite, const bsim_scene *lattice,
                                           const bsim_markov_set *set,
                                           const bsim_markov_prediction *p, bsim_error *err);
 
@@ -388,6 +389,8 @@ typedef struct bsim_markov_validate_def {
 	 * protocols' sweeps, one journal): with resume a stopped or killed
 	 * run continues (same inputs), losing no finished trial. */
 	int resume;
+	/* 1: replace the finished result or stopped run in out; 0: refuse it */
+	int overwrite;
 	/* NULL, or a flag (a signal handler's): once nonzero no trial starts,
 	 * and the run returns BSIM_ESTOPPED with the journal kept. */
 	const volatile sig_atomic_t *stop;

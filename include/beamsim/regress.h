@@ -22,6 +22,7 @@ extern "C" {
 typedef struct bsim_regress_def {
 	const char *baseline; /* the stored run's directory */
 	const char *out;      /* the rerun's; not the baseline */
+	int overwrite;        /* 1: replace the result out holds; 0: refuse it */
 	int threads;          /* <= 0: all cores */
 	double alpha, margin; /* < 0: the stored rule's */
 	int exact;            /* 1: any trial that differs in any trials.csv field counts */

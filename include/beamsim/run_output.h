@@ -68,12 +68,15 @@ BSIM_API void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsi
  *               and, when FILE is a regular file, its twin FILE.mat; "-" is
  *               standard output; NULL: none;
  *   out         the directory above, checked before the trial runs and
- *               written as one set (docs/files.md); NULL: none.
+ *               written as one set (docs/files.md); NULL: none. With
+ *               overwrite 1 it replaces the result out holds; with 0 such
+ *               an out is refused.
  * The files appear only if the trial ran (an unstable trial did run: its
  * outcome says so). res gets the result. BSIM_EINPUT if out cannot be
  * used or an option is bad; BSIM_EFAIL if the trial or a file fails. */
 BSIM_API int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory,
-                                   const char *out, bsim_trial_result *res, bsim_error *err);
+                                   const char *out, int overwrite, bsim_trial_result *res,
+                                   bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -54,6 +54,8 @@ typedef struct bsim_sweep_dir_def {
 	int keep;                    /* trajectories kept per group (trajectories.csv) */
 	int keep_stride;             /* a kept row every keep_stride steps (<= 0: 5) */
 	int resume;                  /* 1: continue the stopped run in out (same inputs) */
+	int overwrite; /* 1: replace the finished result, or a stopped run's journal, in
+	                * out; 0: such an out is refused (BSIM_EINPUT) */
 	bsim_progress_fn progress;   /* may be NULL */
 	void *progress_user;
 	/* NULL, or a flag (set by a signal handler, say): once nonzero no trial

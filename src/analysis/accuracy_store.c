@@ -35,15 +35,16 @@ bsim_accuracy_config bsim_accuracy_quick(void)
 	return c;
 }
 
-int bsim_accuracy_store(const char *out, const bsim_scene *scene, const char *scene_label,
-                        const bsim_backend *const *backends, int n_backends,
-                        const bsim_accuracy_config *cfg, bsim_accuracy_result *res,
+int bsim_accuracy_store(const char *out, int overwrite, const bsim_scene *scene,
+                        const char *scene_label, const bsim_backend *const *backends,
+                        int n_backends, const bsim_accuracy_config *cfg, bsim_accuracy_result *res,
                         bsim_figures_result *fig, bsim_error *err)
 {
 	memset(res, 0, sizeof *res);
 	memset(fig, 0, sizeof *fig);
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
+	int rc = bsim_session_open(&ss, out, bsim_session_mode(0, overwrite), "accuracy", NULL, 0,
+	                           err);
 	if (rc != BSIM_OK)
 		return rc;
 	char path[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];

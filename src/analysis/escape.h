@@ -46,6 +46,7 @@ double escape_contact_time(const bsim_scene *s);
 typedef struct escape_def {
 	const char *dir; /* a sweep's output directory */
 	const char *out; /* where kramers.csv, kramers.json and the figure go */
+	int overwrite;   /* 1: replace the result out holds; 0: refuse it */
 	bsim_landscape_grid_def grid;
 } escape_def;
 

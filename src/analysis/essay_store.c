@@ -166,6 +166,7 @@ int bsim_essay_compare_store(const char *out, const bsim_essay_config *cfg, bsim
 	sweep_batch sb = {.command = "essay",
 	                  .out = out,
 	                  .resume = cfg->resume,
+	                  .overwrite = cfg->overwrite,
 	                  .spread = sp->spread != BSIM_SPREAD_NONE || sp->n_merge > 0 ? sp : NULL,
 	                  .progress = cfg->progress,
 	                  .progress_user = cfg->progress_user,

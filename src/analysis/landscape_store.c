@@ -5,9 +5,9 @@
 
 #include "store/session.h"
 
-int bsim_landscape_store(const char *out, const bsim_scene *s, const bsim_landscape_grid_def *def,
-                         bsim_landscape_grid **g, bsim_landscape_barriers **b, int *drawn,
-                         bsim_error *err)
+int bsim_landscape_store(const char *out, int overwrite, const bsim_scene *s,
+                         const bsim_landscape_grid_def *def, bsim_landscape_grid **g,
+                         bsim_landscape_barriers **b, int *drawn, bsim_error *err)
 {
 	*g = NULL;
 	*b = NULL;
@@ -16,7 +16,8 @@ int bsim_landscape_store(const char *out, const bsim_scene *s, const bsim_landsc
 	/* DIR is checked before the grid is computed, and its files appear
 	 * together. */
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
+	int rc = bsim_session_open(&ss, out, bsim_session_mode(0, overwrite), "landscape", NULL, 0,
+	                           err);
 	if (rc != BSIM_OK)
 		return rc;
 	rc = bsim_landscape_grid_alloc(s, def, g, err);

@@ -396,9 +396,10 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 			        def->from[j]);
 	}
 	bsim_session ss;
-	if ((rc = bsim_session_open(&ss, dir, 0, NULL, 0, err)) != BSIM_OK)
+	/* the maps join those already cached */
+	if ((rc = bsim_session_open(&ss, dir, BSIM_OUTDIR_ADD, "markov build", NULL, 0, err)) !=
+	    BSIM_OK)
 		return rc;
-	ss.add = 1; /* the maps join those already cached */
 	rc = set_fill(lattice, def, dir, &ss, out, err);
 	if (rc == BSIM_OK)
 		rc = markov_def_write(ss.stage, def,

@@ -545,6 +545,7 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 	sweep_batch b = {.command = "markov validate",
 	                 .out = def->out,
 	                 .resume = def->resume,
+	                 .overwrite = def->overwrite,
 	                 .spread = sp->spread != BSIM_SPREAD_NONE || sp->n_merge > 0 ? sp : NULL,
 	                 .progress = def->progress,
 	                 .progress_user = def->progress_user,

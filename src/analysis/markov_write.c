@@ -106,12 +106,13 @@ static int write_time(const char *stage, const bsim_scene *lattice, const bsim_m
 	return bsim_figure_render(&fd, body, NULL, err);
 }
 
-int bsim_markov_prediction_store(const char *dir, const bsim_scene *lattice,
+int bsim_markov_prediction_store(const char *dir, int overwrite, const bsim_scene *lattice,
                                  const bsim_markov_set *set, const bsim_markov_prediction *p,
                                  bsim_error *err)
 {
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, dir, 0, NULL, 0, err);
+	int rc = bsim_session_open(&ss, dir, bsim_session_mode(0, overwrite), "markov predict",
+	                           NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
 	rc = write_tables(ss.stage, p, err);

@@ -34,6 +34,7 @@ void cli_merge_apply(const cli_merge *m, struct cli_common *c)
 	c->threads = m->threads;
 	c->quiet = m->quiet;
 	c->resume = 0;
+	c->overwrite = m->overwrite;
 }
 
 int cli_shard_parse(const char *cmd, const char *value, int *index, int *count)

@@ -62,11 +62,13 @@ typedef struct cli_merge {
 	int quiet;
 	const char *const *parts;
 	int n_parts;
+	int overwrite; /* merge --overwrite: the joined run may replace out's result */
 } cli_merge;
 
 struct cli_common;
-/* Sets merge m's output directory, threads and quiet on the parts' command
- * line c, which is not resumed: the parts' journals are the run. */
+/* Sets merge m's output directory, threads, quiet and overwrite on the
+ * parts' command line c, which is not resumed: the parts' journals are the
+ * run. */
 void cli_merge_apply(const cli_merge *m, struct cli_common *c);
 
 /* compare's command line (argv[0] "compare") run as the merge m of its

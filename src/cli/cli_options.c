@@ -39,6 +39,9 @@ static const shared_def shared[CLI_N_OPTS] = {
                            "groups, trials, schedule, beam_steps, mat_rows\n"
                            "(docs/robustness.md)"},
         [CLI_OPT_RESUME] = {"resume", 0, NULL, "continue the stopped run in DIR (same inputs)"},
+        [CLI_OPT_OVERWRITE] = {"overwrite", 0, NULL,
+                               "replace the finished result (or a stopped run's\n"
+                               "journal) in DIR; without it such a DIR is refused"},
         [CLI_OPT_TRAJECTORIES] = {"trajectories", 1, "N",
                                   "keep the trajectories of the first N trials of each\n"
                                   "group in DIR/trajectories.csv (and .mat), for\n"
@@ -139,6 +142,9 @@ static int shared_take(const cli_spec *spec, cli_common *c, int o, const char *v
 	case CLI_OPT_RESUME:
 		c->resume = 1;
 		return CLI_OK;
+	case CLI_OPT_OVERWRITE:
+		c->overwrite = 1;
+		return CLI_OK;
 	case CLI_OPT_TRAJECTORIES:
 		if (cli_parse_long(v, 0, INT32_MAX, &c->keep) != 0)
 			return cli_usage(cmd, "--trajectories %s: expected an integer >= 0", v);
@@ -218,6 +224,10 @@ int cli_parse(const cli_spec *spec, int argc, char **argv, cli_common *c, void *
 		if (rc != CLI_OK)
 			return rc;
 	}
+	if (c->resume && c->overwrite)
+		return cli_usage(spec->name,
+		                 "--resume and --overwrite: expected one of them (--resume "
+		                 "continues the stopped run in DIR, --overwrite replaces it)");
 	if (spec->out_required && !c->out)
 		return cli_usage(spec->name, "--out %s is required",
 		                 spec->out_arg ? spec->out_arg : "DIR");

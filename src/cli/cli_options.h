@@ -29,6 +29,7 @@ typedef enum cli_opt {
 	CLI_OPT_QUIET,
 	CLI_OPT_LIMIT,
 	CLI_OPT_RESUME,
+	CLI_OPT_OVERWRITE,
 	CLI_OPT_TRAJECTORIES,
 	CLI_OPT_TRAJECTORY_STRIDE,
 	CLI_OPT_ALPHA,
@@ -56,7 +57,7 @@ typedef struct cli_common {
 	int n_grid;
 	const char *grid[CLI_GRID_MAX];
 	const char *out;
-	int quiet, resume;
+	int quiet, resume, overwrite;
 	long keep, keep_stride;
 	int has_alpha, has_margin;
 	double alpha, margin;

@@ -113,8 +113,9 @@ static const cli_spec accuracy_spec = {
                  "and its cost over the first backend's: the speed ratio at equal error.\n"
                  "Writes DIR/accuracy.csv, DIR/equal_error.csv, DIR/accuracy.md and the\n"
                  "figure DIR/accuracy.png (error against speed, log-log).\n",
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_BACKEND_OPT) |
-                  CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) | CLI_USES(CLI_OPT_SET) |
+                  CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_TRIALS) |
+                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS),
         .help = accuracy_help,
         .out_required = 1,
         .own = accuracy_own,
@@ -230,7 +231,8 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 	         a->scene_given ? "" : " (propulsion 9 N, random force 20 N)");
 	bsim_accuracy_result r;
 	bsim_figures_result fig;
-	rc = bsim_accuracy_store(c->out, &scene, label, backends, n_b, &cfg, &r, &fig, &err);
+	rc = bsim_accuracy_store(c->out, c->overwrite, &scene, label, backends, n_b, &cfg, &r, &fig,
+	                         &err);
 	cli_progress_finish(&progress);
 	rc = cli_report(rc, &err);
 	if (rc == BSIM_OK) {

@@ -122,12 +122,13 @@ static const cli_spec compare_spec = {
                  "continues with --resume and gives the same files.\n"
                  "\n",
         .positional = "EXPERIMENT",
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND_OPT) |
-                  CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_TRIALS) |
-                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
-                  CLI_USES(CLI_OPT_ALPHA) | CLI_USES(CLI_OPT_MARGIN) |
-                  CLI_USES(CLI_OPT_TRAJECTORIES) | CLI_USES(CLI_OPT_TRAJECTORY_STRIDE) |
-                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_LIMIT),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) |
+                  CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_BACKEND) |
+                  CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
+                  CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) | CLI_USES(CLI_OPT_ALPHA) |
+                  CLI_USES(CLI_OPT_MARGIN) | CLI_USES(CLI_OPT_TRAJECTORIES) |
+                  CLI_USES(CLI_OPT_TRAJECTORY_STRIDE) | CLI_USES(CLI_OPT_QUIET) |
+                  CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_LIMIT),
         .help = compare_help,
         .out_required = 1,
         .own = compare_own,
@@ -265,6 +266,7 @@ static int compare_main(int argc, char **argv, const cli_merge *m)
 	def.keep = (int)c.keep;
 	def.keep_stride = (int)c.keep_stride;
 	def.resume = c.resume;
+	def.overwrite = c.overwrite;
 	def.progress = rank == 0 ? cli_progress_update : NULL;
 	def.progress_user = &progress;
 	def.stop = &cli_stop;

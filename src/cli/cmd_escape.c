@@ -59,7 +59,7 @@ static const cli_spec escape_spec = {
                  "  kramers        .png .svg .gp .dat: ln k against dE / D, and the "
                  "residuals\n",
         .positional = "SWEEP_DIR",
-        .common = CLI_USES(CLI_OPT_OUT),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE),
         .help = escape_help,
         .out_required = 1,
         .own = escape_own,
@@ -77,7 +77,7 @@ int cmd_escape(int argc, char **argv)
 		return rc;
 	}
 	bsim_error err;
-	escape_def def = {.dir = a.dir, .out = c.out, .grid = a.grid};
+	escape_def def = {.dir = a.dir, .out = c.out, .overwrite = c.overwrite, .grid = a.grid};
 	escape_summary s;
 	rc = cli_report(escape_run(&def, &s, &err), &err);
 	if (rc == BSIM_OK) {

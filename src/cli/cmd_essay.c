@@ -104,9 +104,9 @@ static const cli_spec essay_spec = {
                  "continues with --resume; under `mpirun -np N` they are spread over the\n"
                  "ranks, with --shard I/N over N processes joined by beamsim merge, the\n"
                  "files those of one process (docs/cluster.md).\n",
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_TRIALS) |
-                  CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET) |
-                  CLI_USES(CLI_OPT_RESUME),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) | CLI_USES(CLI_OPT_BACKEND) |
+                  CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS) |
+                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_RESUME),
         .help = essay_help,
         .out_required = 1,
         .own = essay_own,
@@ -180,6 +180,7 @@ static int essay_main(int argc, char **argv, const cli_merge *m)
 		cfg.seed = c.seed;
 	cfg.threads = (int)c.threads;
 	cfg.resume = c.resume;
+	cfg.overwrite = c.overwrite;
 	cfg.stop = &cli_stop;
 	cli_mpi_spread(&cfg.spread.spread, &cfg.spread.part, &cfg.spread.agree,
 	               bsim_sweep_record_size(0), cfg.stop);

@@ -105,8 +105,8 @@ static const cli_spec landscape_spec = {
                  "                   the top view and the surfaces without and with "
                  "propulsion\n",
         .positional = "SCENE",
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_LIMIT) |
-                  CLI_USES(CLI_OPT_QUIET),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) | CLI_USES(CLI_OPT_SET) |
+                  CLI_USES(CLI_OPT_LIMIT) | CLI_USES(CLI_OPT_QUIET),
         .help = landscape_help,
         .out_required = 1,
         .own = landscape_own,
@@ -197,7 +197,9 @@ int cmd_landscape(int argc, char **argv)
 		return err.code ? err.code : CLI_USAGE;
 	}
 	int drawn = 0;
-	rc = cli_report(bsim_landscape_store(c.out, &scene, &a.grid, &g, &b, &drawn, &err), &err);
+	rc = cli_report(
+	        bsim_landscape_store(c.out, c.overwrite, &scene, &a.grid, &g, &b, &drawn, &err),
+	        &err);
 	if (rc == BSIM_OK && !c.quiet && a.json)
 		rc = print_json(c.out);
 	else if (rc == BSIM_OK && !c.quiet) {

@@ -20,6 +20,7 @@
 #include "cli/cli_options.h"
 #include "cli/cli_progress.h"
 #include "cli/cli_mpi.h"
+#include "store/outdir.h"
 #include "beamsim/sweep_dir.h"
 #include "util/clock.h"
 #include "util/json.h"
@@ -270,7 +271,8 @@ static const cli_spec predict_spec = {
                  "walks of the semi-Markov chain, the outcome at the trial's duration and\n"
                  "the time of each kind (--out DIR's time.csv and time.png).\n",
         .positional = "LATTICE_SCENE",
-        .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_QUIET),
+        .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) |
+                  CLI_USES(CLI_OPT_QUIET),
         .help = predict_help,
         .own = predict_own,
         .n_own = 7,
@@ -319,7 +321,7 @@ static const cli_spec validate_spec = {
         .positional = "LATTICE_EXPERIMENT",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
                   CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
-                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_RESUME),
+                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_OVERWRITE),
         .help = validate_help,
         .out_required = 1,
         .own = validate_own,
@@ -386,6 +388,11 @@ static int markov_build_ranks(int argc, char **argv, const cli_common *c)
 	if (asprintf(&work, "%s/.beamsim", c->out) < 0 || asprintf(&parts, "%s/parts", work) < 0 ||
 	    asprintf(&part, "%s/%d-of-%d", parts, rank + 1, size) < 0)
 		rc = CLI_FAIL;
+	/* out is opened by rank 0's merge; until then the ranks make their
+	 * parts in it only if it could be opened (no other run holds it) */
+	bsim_error err;
+	if (rc == CLI_OK && bsim_outdir_probe(c->out, BSIM_OUTDIR_ADD, &err) != BSIM_OK)
+		rc = cli_report(err.code, &err);
 	if (rc == CLI_OK)
 		rc = mkdir_have(c->out);
 	if (rc == CLI_OK)
@@ -393,8 +400,8 @@ static int markov_build_ranks(int argc, char **argv, const cli_common *c)
 	if (rc == CLI_OK)
 		rc = mkdir_have(parts);
 	if (rc != CLI_OK) {
-		cli_mpi_abort(CLI_FAIL);
-		return CLI_FAIL;
+		cli_mpi_abort(rc);
+		return rc;
 	}
 	markov_part p = {part, rank + 1, size};
 	rc = markov_build_main(argc, argv, NULL, &p);
@@ -404,7 +411,8 @@ static int markov_build_ranks(int argc, char **argv, const cli_common *c)
 	if (!dirs || (rc = cli_mpi_gather_dir(part, dirs)) != CLI_OK)
 		cli_mpi_abort(CLI_FAIL);
 	if (rank == 0) {
-		cli_merge merge = {c->out, c->threads, c->quiet, (const char *const *)dirs, size};
+		cli_merge merge = {c->out, c->threads, c->quiet, (const char *const *)dirs,
+		                   size,   0};
 		rc = markov_build_main(argc, argv, &merge, NULL);
 	}
 	/* the other ranks' files as rank 0 received them: copies, not kept */
@@ -783,6 +791,15 @@ static int markov_predict(int argc, char **argv)
 	bsim_options opts;
 	bsim_markov_set set;
 	bsim_markov_prediction p = {0};
+	/* --out refused before the chain is solved, not after */
+	rc = c.out ? bsim_outdir_probe(c.out, c.overwrite ? BSIM_OUTDIR_OVERWRITE : BSIM_OUTDIR_NEW,
+	                               &err)
+	           : BSIM_OK;
+	if (rc != BSIM_OK) {
+		bsim_scene_free(&scene);
+		cli_common_free(&c);
+		return cli_report(rc, &err);
+	}
 	rc = bsim_markov_load(&scene, a.map, &opts, &set, &err);
 	/* The wall time of the prediction alone (the chain composed and
 	 * solved; the maps already read). */
@@ -797,7 +814,7 @@ static int markov_predict(int argc, char **argv)
 	if (rc == BSIM_OK && p.has_time && a.walks > 0)
 		rc = bsim_markov_predict_time(&scene, &set, a.walks, set.def.seed, &p, &err);
 	if (rc == BSIM_OK && c.out)
-		rc = bsim_markov_prediction_store(c.out, &scene, &set, &p, &err);
+		rc = bsim_markov_prediction_store(c.out, c.overwrite, &scene, &set, &p, &err);
 	/* --quiet wins over --json: nothing on stdout. */
 	if (rc == BSIM_OK && !c.quiet && a.json)
 		predict_json(path, &scene, &set, &p, seconds, cpu);
@@ -846,6 +863,7 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	}
 	int rank = cli_mpi_rank();
 	def.resume = c.resume;
+	def.overwrite = c.overwrite;
 	def.stop = &cli_stop;
 	cli_mpi_spread(&def.spread.spread, &def.spread.part, &def.spread.agree,
 	               bsim_sweep_record_size(0), def.stop);

@@ -28,7 +28,8 @@ static const cli_spec merge_spec = {
                  "part.json (the experiment by its absolute path); kept trajectories\n"
                  "(--trajectories) run again here.\n",
         .positional = NULL,
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) | CLI_USES(CLI_OPT_THREADS) |
+                  CLI_USES(CLI_OPT_QUIET),
         .out_required = 1,
 };
 
@@ -81,7 +82,7 @@ int cmd_merge(int argc, char **argv)
 		               "comparison, a markov build, a markov validate or an essay",
 		               parts[0], first.command);
 	if (rc < 0) {
-		cli_merge m = {c.out, c.threads, c.quiet, parts, n_parts};
+		cli_merge m = {c.out, c.threads, c.quiet, parts, n_parts, c.overwrite};
 		rc = kinds[kind].merge(first.argc, first.argv, &m);
 	}
 	bsim_sweep_dir_part_free(&first);

@@ -59,7 +59,8 @@ static const cli_spec plot_spec = {
                 "Without gnuplot (Debian package gnuplot-nox) the data and scripts are\n"
                 "written and the images are not.\n",
         .positional = "DIR",
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_QUIET),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) | CLI_USES(CLI_OPT_THREADS) |
+                  CLI_USES(CLI_OPT_QUIET),
         .help = plot_help,
         .out_arg = "ODIR",
         .own = plot_own,
@@ -80,6 +81,7 @@ int cmd_plot(int argc, char **argv)
 	}
 	bsim_figures_def def = bsim_figures_def_default();
 	def.out = c.out;
+	def.overwrite = c.overwrite;
 	def.select = select.ov;
 	def.n_select = select.n;
 	def.threads = (int)c.threads;

@@ -44,8 +44,9 @@ static const cli_spec regress_spec = {
                  "(defaults: the stored rule), or with --exact when any trial differs in any\n"
                  "trials.csv field. Exit status 3 if any group has.\n",
         .positional = "BASELINE_DIR",
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_ALPHA) |
-                  CLI_USES(CLI_OPT_MARGIN) | CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_LIMIT),
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) | CLI_USES(CLI_OPT_THREADS) |
+                  CLI_USES(CLI_OPT_ALPHA) | CLI_USES(CLI_OPT_MARGIN) | CLI_USES(CLI_OPT_QUIET) |
+                  CLI_USES(CLI_OPT_LIMIT),
         .help = regress_help,
         .out_required = 1,
         .own = regress_own,
@@ -68,6 +69,7 @@ int cmd_regress(int argc, char **argv)
 	bsim_regress_def def = bsim_regress_def_default();
 	def.baseline = baseline;
 	def.out = c.out;
+	def.overwrite = c.overwrite;
 	def.threads = (int)c.threads;
 	if (c.has_alpha)
 		def.alpha = c.alpha;

@@ -114,7 +114,7 @@ static const cli_spec run_spec = {
         .positional = "SCENE|EXPERIMENT|DIR",
         .common = CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_BACKEND_OPT) |
                   CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
-                  CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_LIMIT),
+                  CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) | CLI_USES(CLI_OPT_LIMIT),
         .help = run_help,
         .own = run_own,
         .n_own = 5,
@@ -310,8 +310,9 @@ int cmd_run(int argc, char **argv)
 	if (!log)
 		rc = cli_report(bsim_error_set(&err, BSIM_EFAIL, "out of memory"), &err);
 	else
-		rc = cli_report(bsim_run_output_trial(&info, a.trajectory, c.out, &res, &err),
-		                &err);
+		rc = cli_report(
+		        bsim_run_output_trial(&info, a.trajectory, c.out, c.overwrite, &res, &err),
+		        &err);
 	/* A trajectory on standard output keeps it to itself: the report
 	 * goes to standard error. */
 	FILE *out = a.trajectory && strcmp(a.trajectory, "-") == 0 ? stderr : stdout;

@@ -60,7 +60,7 @@ static const cli_spec sweep_spec = {
                  "so a\n"
                  "stopped or killed sweep continues with --resume and gives the same files.\n",
         .positional = "EXPERIMENT",
-        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_BACKEND) |
+        .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) | CLI_USES(CLI_OPT_BACKEND) |
                   CLI_USES(CLI_OPT_BACKEND_OPT) | CLI_USES(CLI_OPT_THREADS) |
                   CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_SET) |
                   CLI_USES(CLI_OPT_GRID) | CLI_USES(CLI_OPT_TRAJECTORIES) |
@@ -150,6 +150,7 @@ static int sweep_main(int argc, char **argv, const cli_merge *m)
 	def.keep = (int)c.keep;
 	def.keep_stride = (int)c.keep_stride;
 	def.resume = c.resume;
+	def.overwrite = c.overwrite;
 	def.progress = rank == 0 ? cli_progress_update : NULL;
 	def.progress_user = &progress;
 	def.stop = &cli_stop;

@@ -20,10 +20,12 @@ int bsim_figures_plot(const char *dir, const bsim_figures_def *def, bsim_figures
 		return BSIM_EINPUT;
 	const char *to = def->out ? def->out : dir;
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, to, 0, NULL, 0, err);
+	/* Into DIR the figures join its result; into another directory they
+	 * are a result of their own. */
+	bsim_outdir_mode mode = def->out ? bsim_session_mode(0, def->overwrite) : BSIM_OUTDIR_ADD;
+	int rc = bsim_session_open(&ss, to, mode, "plot", NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
-	ss.add = def->out == NULL;
 	bsim_figures_def d = *def;
 	d.out = ss.stage;
 	rc = bsim_figures_draw(dir, &d, out, err);

@@ -210,13 +210,137 @@ static int collect(const char *root, const char *rel, olist *l, char *bad, size_
 	return rc;
 }
 
+static int manifest_read(const char *dir, olist *l, int *has, char *command, size_t command_size,
+                         bsim_error *err);
+
 static int input_error(bsim_error *err, const char *dir, int e)
 {
 	return bsim_error_set(err, BSIM_EINPUT, "%s: cannot write to the output directory: %s", dir,
 	                      strerror(e));
 }
 
-int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_error *err)
+/* The owner file: "pid N\ncommand C\n", written by the run that holds the
+ * lock, read (never written) by a run refused, to say who is there. */
+#define OWNER_FILE "owner"
+
+static void owner_write(const bsim_outdir *od, const char *command)
+{
+	char path[BSIM_PATH_MAX];
+	if (join(path, sizeof path, od->work, OWNER_FILE))
+		return;
+	FILE *f = fopen(path, "w");
+	if (!f)
+		return;
+	fprintf(f, "pid %ld\ncommand %s\n", (long)getpid(), command ? command : "");
+	fclose(f); /* a hint for messages: its failure fails nothing */
+}
+
+/* " (beamsim sweep, process 1234)" from DIR/.beamsim/owner, or "". */
+static void owner_read(const char *work, char *buf, size_t size)
+{
+	char path[BSIM_PATH_MAX], text[256];
+	buf[0] = '\0';
+	struct stat st;
+	int fd = join(path, sizeof path, work, OWNER_FILE) ? -1 : file_open_checked(path, &st);
+	if (fd < 0)
+		return;
+	ssize_t n = S_ISREG(st.st_mode) ? read(fd, text, sizeof text - 1) : -1;
+	close(fd);
+	if (n <= 0)
+		return;
+	text[n] = '\0';
+	long pid = 0;
+	char command[64] = "";
+	if (sscanf(text, "pid %ld command %63[a-z ]", &pid, command) < 1 || pid <= 0)
+		return;
+	size_t len = strlen(command);
+	while (len > 0 && command[len - 1] == ' ')
+		command[--len] = '\0';
+	snprintf(buf, size, " (beamsim%s%s, process %ld)", len ? " " : "", command, pid);
+}
+
+/* The refusal of a DIR another run holds; who from owner_read. */
+static int refuse_running(const char *dir, const char *who, bsim_error *err)
+{
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "%s: another beamsim run%s is writing this directory: wait for it "
+	                      "to end, or choose another output directory",
+	                      dir, who);
+}
+
+/* The result DIR holds, for the refusal of a run that would replace it
+ * (mode NEW): a finished one (a manifest) or a stopped one (a journal). */
+static int refuse_held(const bsim_outdir *od, const char *dir, bsim_error *err)
+{
+	char path[BSIM_PATH_MAX];
+	struct stat st;
+	if (join(path, sizeof path, od->work, "journal") == 0 && lstat(path, &st) == 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s holds the journal of a stopped run (%s): add --resume to "
+		                      "continue it, or --overwrite to discard it and start over",
+		                      dir, path);
+	olist l = {0};
+	int has = 0;
+	bsim_error ignored;
+	char command[64] = "";
+	if (join(path, sizeof path, od->dir, BSIM_OUTDIR_MANIFEST) || lstat(path, &st) != 0)
+		return BSIM_OK;
+	char what[128];
+	if (manifest_read(od->dir, &l, &has, command, sizeof command, &ignored) == BSIM_OK &&
+	    command[0])
+		snprintf(what, sizeof what, "the finished result of beamsim %s (%zu files in %s)",
+		         command, l.n, BSIM_OUTDIR_MANIFEST);
+	else
+		snprintf(what, sizeof what, "a finished result (%s)", BSIM_OUTDIR_MANIFEST);
+	olist_free(&l);
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "%s holds %s: add --overwrite to replace it, or choose another "
+	                      "output directory",
+	                      dir, what);
+}
+
+/* lock_take's answer for a DIR that is there and not a directory. */
+#define NOT_A_DIRECTORY (-1)
+
+/* Takes DIR's lock: 0, NOT_A_DIRECTORY, or an errno (EWOULDBLOCK: another
+ * run holds it).
+ * The descriptor must be DIR's as named now: a run that ends removes the
+ * directory it created if it left it empty, and the lock on a directory
+ * removed is no lock, so the name is looked up again once the lock is
+ * held. */
+static int lock_take(bsim_outdir *od)
+{
+	for (int attempt = 0; attempt < 8; attempt++) {
+		struct stat held, named;
+		int rc = 0;
+		if (stat(od->dir, &named) != 0) {
+			od->created = 1;
+			rc = mkdir_p(od->dir);
+		} else if (!S_ISDIR(named.st_mode)) {
+			return NOT_A_DIRECTORY;
+		}
+		if (rc)
+			return rc;
+		od->lock_fd = open(od->dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+		if (od->lock_fd < 0)
+			return errno;
+		if (flock(od->lock_fd, LOCK_EX | LOCK_NB) != 0) {
+			rc = errno;
+			close(od->lock_fd);
+			od->lock_fd = -1;
+			return rc;
+		}
+		if (fstat(od->lock_fd, &held) == 0 && stat(od->dir, &named) == 0 &&
+		    held.st_dev == named.st_dev && held.st_ino == named.st_ino)
+			return 0;
+		close(od->lock_fd); /* removed or replaced while we waited: again */
+		od->lock_fd = -1;
+	}
+	return EAGAIN;
+}
+
+int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_outdir_mode mode, const char *command,
+                     bsim_error *err)
 {
 	*out = NULL;
 	bsim_outdir *od = calloc(1, sizeof *od);
@@ -237,36 +361,31 @@ int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_error *err)
 	join(od->work, sizeof od->work, od->dir, ".beamsim");
 	join(od->stage, sizeof od->stage, od->work, "staging");
 
-	struct stat st;
-	int rc = 0;
-	if (stat(od->dir, &st) == 0) {
-		if (!S_ISDIR(st.st_mode)) {
-			free(od);
+	/* Until the lock is held nothing in DIR is ours: a run refused here
+	 * leaves it exactly as it found it, the other run's staging area,
+	 * journal and the directory itself included. */
+	int rc = lock_take(od);
+	if (rc) {
+		char who[128];
+		owner_read(od->work, who, sizeof who);
+		free(od);
+		if (rc == NOT_A_DIRECTORY)
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      "%s: expected an output directory, got a file", dir);
-		}
-	} else {
-		od->created = 1;
-		rc = mkdir_p(od->dir);
+		if (rc == EWOULDBLOCK)
+			return refuse_running(dir, who, err);
+		return input_error(err, dir, rc);
 	}
-	if (!rc) {
-		od->lock_fd = open(od->dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-		rc = od->lock_fd < 0 ? errno : 0;
-	}
-	if (!rc && flock(od->lock_fd, LOCK_EX | LOCK_NB) != 0) {
-		int e = errno;
-		bsim_outdir_close(od);
-		if (e == EWOULDBLOCK)
-			return bsim_error_set(err, BSIM_EINPUT,
-			                      "%s: another beamsim run is writing this directory",
-			                      dir);
-		return input_error(err, dir, e);
+	if (mode == BSIM_OUTDIR_NEW && (rc = refuse_held(od, dir, err)) != BSIM_OK) {
+		close(od->lock_fd);
+		free(od);
+		return rc;
 	}
 	/* Creating the work area and the staging area is the test that DIR
 	 * can be written (access() says yes to root on a read-only disk). A
 	 * staging area left by a run that was killed is stale: the lock says
 	 * no run owns it. */
-	if (!rc && mkdir(od->work, 0777) != 0 && errno != EEXIST)
+	if (mkdir(od->work, 0777) != 0 && errno != EEXIST)
 		rc = errno;
 	if (!rc) {
 		rm_tree(od->stage);
@@ -277,8 +396,38 @@ int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_error *err)
 		bsim_outdir_close(od);
 		return input_error(err, dir, rc);
 	}
+	owner_write(od, command);
 	*out = od;
 	return BSIM_OK;
+}
+
+int bsim_outdir_probe(const char *dir, bsim_outdir_mode mode, bsim_error *err)
+{
+	bsim_outdir probe = {.lock_fd = -1};
+	struct stat st;
+	if (stat(dir, &st) != 0)
+		return BSIM_OK; /* created by the open */
+	if (!S_ISDIR(st.st_mode))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: expected an output directory, got a file", dir);
+	if (join(probe.dir, sizeof probe.dir, dir, "") ||
+	    join(probe.work, sizeof probe.work, dir, ".beamsim"))
+		return bsim_error_set(err, BSIM_EINPUT, "%.200s: path too long", dir);
+	int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+	if (fd < 0)
+		return input_error(err, dir, errno);
+	/* shared: probes of one job's processes do not refuse each other */
+	int rc = BSIM_OK;
+	if (flock(fd, LOCK_SH | LOCK_NB) != 0) {
+		char who[128];
+		owner_read(probe.work, who, sizeof who);
+		rc = errno == EWOULDBLOCK ? refuse_running(dir, who, err)
+		                          : input_error(err, dir, errno);
+	} else if (mode == BSIM_OUTDIR_NEW) {
+		rc = refuse_held(&probe, dir, err);
+	}
+	close(fd);
+	return rc;
 }
 
 const char *bsim_outdir_dir(const bsim_outdir *od)
@@ -346,8 +495,10 @@ static void fsync_dir(const char *dir)
 	}
 }
 
-/* The files a manifest lists (none if there is no manifest). */
-static int manifest_read(const char *dir, olist *l, int *has, bsim_error *err)
+/* The files a manifest lists (none if there is no manifest) and, if
+ * command is not NULL, the command that wrote it ("" if unknown). */
+static int manifest_read(const char *dir, olist *l, int *has, char *command, size_t command_size,
+                         bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	struct stat st;
@@ -361,6 +512,10 @@ static int manifest_read(const char *dir, olist *l, int *has, bsim_error *err)
 	struct fy_node *files = ydoc_lookup(fy_document_root(d.fyd), "files");
 	struct fy_node *format = ydoc_lookup(fy_document_root(d.fyd), "format");
 	const char *ft = format && fy_node_is_scalar(format) ? fy_node_get_scalar0(format) : NULL;
+	struct fy_node *cmd = ydoc_lookup(fy_document_root(d.fyd), "command");
+	if (command)
+		snprintf(command, command_size, "%s",
+		         cmd && fy_node_is_scalar(cmd) ? fy_node_get_scalar0(cmd) : "");
 	int rc = BSIM_OK;
 	/* The one format there has been; a manifest of a later one is not
 	 * read as if it were this. */
@@ -396,7 +551,7 @@ int bsim_outdir_files(const char *dir, char ***paths, size_t *n, bsim_error *err
 	int has;
 	*paths = NULL;
 	*n = 0;
-	int rc = manifest_read(dir, &l, &has, err);
+	int rc = manifest_read(dir, &l, &has, NULL, 0, err);
 	if (rc == BSIM_OK && l.n > 0) {
 		*paths = malloc(l.n * sizeof **paths);
 		if (!*paths) {
@@ -462,8 +617,13 @@ static int commit_set(bsim_outdir *od, const char *command, int add, bsim_error 
 	/* A damaged old manifest lists nothing to remove: only what a
 	 * manifest names is ever deleted. */
 	bsim_error ignored;
-	if (manifest_read(od->dir, &before, &has, &ignored) != BSIM_OK)
+	char was[64] = "";
+	if (manifest_read(od->dir, &before, &has, was, sizeof was, &ignored) != BSIM_OK)
 		olist_free(&before);
+	/* Files added to a result (plot's figures) leave it the result of the
+	 * command that made it. */
+	if (add && was[0])
+		command = was;
 	char path[BSIM_PATH_MAX], staged[BSIM_PATH_MAX];
 	if (join(path, sizeof path, od->dir, BSIM_OUTDIR_MANIFEST) == 0 && unlink(path) == 0)
 		fsync_dir(od->dir);
@@ -528,7 +688,10 @@ void bsim_outdir_close(bsim_outdir *od)
 {
 	if (!od)
 		return;
+	char owner[BSIM_PATH_MAX];
 	rm_tree(od->stage);
+	if (join(owner, sizeof owner, od->work, OWNER_FILE) == 0)
+		unlink(owner);
 	rmdir(od->work); /* kept while a journal is in it */
 	if (od->created && !od->committed)
 		rmdir(od->dir);
@@ -584,7 +747,7 @@ static int verify_one(const char *dir, const char *path, const ofile *want, bsim
 int bsim_outdir_verify(const char *dir, int *has_manifest, bsim_error *err)
 {
 	olist l = {0};
-	int rc = manifest_read(dir, &l, has_manifest, err);
+	int rc = manifest_read(dir, &l, has_manifest, NULL, 0, err);
 	for (size_t i = 0; !rc && i < l.n; i++) {
 		char path[BSIM_PATH_MAX];
 		if (join(path, sizeof path, dir, l.v[i].rel))

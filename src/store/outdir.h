@@ -3,7 +3,8 @@
  * some files of one run beside files of another.
  *
  *   bsim_outdir *od;
- *   if (bsim_outdir_open(&od, "out/h1", err) != BSIM_OK) return ...; // exit 2
+ *   if (bsim_outdir_open(&od, "out/h1", BSIM_OUTDIR_NEW, "sweep", err) != BSIM_OK)
+ *           return ...; // exit 2
  *   ... write files into bsim_outdir_stage(od) under their final names,
  *       subdirectories included (DIR/thesis/trials.csv) ...
  *   rc = bsim_outdir_commit(od, "sweep", err);
@@ -11,7 +12,10 @@
  *
  * Open checks before any work that DIR is a directory that can be written
  * (creating it and its parents if missing), takes a lock so that two runs
- * never write one DIR at once, and creates DIR/.beamsim/staging/.
+ * never write one DIR at once, refuses to replace a result the user did
+ * not ask to replace (bsim_outdir_mode), and creates DIR/.beamsim/staging/.
+ * Until the lock is held it changes nothing in DIR, and only the run that
+ * holds the lock ever removes what is in DIR/.beamsim.
  *
  * Commit moves every staged file into DIR (one rename each, or written
  * through if DIR already holds a symlink, FIFO or device under that name),
@@ -39,9 +43,30 @@ typedef struct bsim_outdir bsim_outdir;
 
 #define BSIM_OUTDIR_MANIFEST "manifest.json"
 
-/* Prepares dir as above. BSIM_EINPUT naming dir and the cause if it is not
- * a directory, cannot be created or written, or another run holds it. */
-int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_error *err);
+/* What a run may do to what DIR holds. Whatever the mode, a directory
+ * another run holds is refused, and a run refused touches nothing in it. */
+typedef enum bsim_outdir_mode {
+	BSIM_OUTDIR_NEW = 0,   /* refuse a finished result (a manifest) or a stopped
+	                        * run (a journal): the user did not ask to replace it */
+	BSIM_OUTDIR_OVERWRITE, /* the result there is replaced at the commit */
+	BSIM_OUTDIR_RESUME,    /* the stopped run there continues (session.h checks it) */
+	BSIM_OUTDIR_ADD,       /* the files join the result there (plot, a map cache) */
+} bsim_outdir_mode;
+
+/* Prepares dir as above; command ("sweep") names the run to a run refused
+ * while this one holds DIR (DIR/.beamsim/owner). BSIM_EINPUT naming dir and
+ * the cause if it is not a directory, cannot be created or written,
+ * another run holds it, or, with mode NEW, it holds a result. */
+int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_outdir_mode mode, const char *command,
+                     bsim_error *err);
+
+/* Whether bsim_outdir_open(dir, mode) would refuse dir, found without
+ * creating, locking for long or changing anything: for a run that must
+ * know before work that is not its own (the processes of a job, before
+ * they make their parts in dir). BSIM_OK, or the refusal open would give
+ * (a directory missing is no refusal). The answer may change before the
+ * open. */
+int bsim_outdir_probe(const char *dir, bsim_outdir_mode mode, bsim_error *err);
 
 /* The directory as the user named it. */
 const char *bsim_outdir_dir(const bsim_outdir *od);

@@ -264,7 +264,7 @@ static int trajectory_parent(const char *path, bsim_error *err)
 }
 
 int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, const char *out,
-                          bsim_trial_result *res, bsim_error *err)
+                          int overwrite, bsim_trial_result *res, bsim_error *err)
 {
 	bsim_atomic_file traj = {0};
 	run_dir dir;
@@ -284,7 +284,8 @@ int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, con
 	/* DIR is checked before the trial runs and its files appear together. */
 	bsim_session ss;
 	if (out) {
-		int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
+		int rc = bsim_session_open(&ss, out, bsim_session_mode(0, overwrite), "run", NULL,
+		                           0, err);
 		if (rc != BSIM_OK) {
 			bsim_atomic_file_abort(&traj);
 			return rc;

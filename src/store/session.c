@@ -18,13 +18,14 @@ int bsim_session_path(char *buf, size_t size, const char *dir, const char *name,
 	return BSIM_OK;
 }
 
-int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *inputs,
-                      size_t record_size, bsim_error *err)
+int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, const char *command,
+                      const char *inputs, size_t record_size, bsim_error *err)
 {
 	struct stat st;
 	memset(s, 0, sizeof *s);
 	s->dir = dir;
-	if (bsim_outdir_open(&s->od, dir, err) != BSIM_OK)
+	s->add = mode == BSIM_OUTDIR_ADD;
+	if (bsim_outdir_open(&s->od, dir, mode, command, err) != BSIM_OK)
 		return err->code;
 	s->stage = bsim_outdir_stage(s->od);
 	if (!inputs)
@@ -35,7 +36,8 @@ int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *
 		bsim_session_close(s, BSIM_EINPUT, NULL, NULL, err);
 		return BSIM_EINPUT;
 	}
-	int have = stat(s->journal_path, &st) == 0;
+	const int resume = mode == BSIM_OUTDIR_RESUME;
+	int have = lstat(s->journal_path, &st) == 0;
 	if (have && !S_ISREG(st.st_mode)) {
 		/* The journal is opened for reading and writing: a FIFO in its
 		 * place would block the first read for ever. */
@@ -47,14 +49,9 @@ int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *
 		bsim_error ignore;
 		bsim_outdir_verify(dir, &finished, &ignore);
 		rc = bsim_error_set(err, BSIM_EINPUT, "--resume: %s holds %s", dir,
-		                    finished ? "a finished run, nothing to resume (run without "
-		                               "--resume to replace it)"
+		                    finished ? "a finished run, nothing to resume (run with "
+		                               "--overwrite instead of --resume to replace it)"
 		                             : "no stopped run to resume (run without --resume)");
-	} else if (!resume && have) {
-		rc = bsim_error_set(err, BSIM_EINPUT,
-		                    "%s holds the journal of a stopped run (%s): add --resume to "
-		                    "continue it, or delete the journal to start over",
-		                    dir, s->journal_path);
 	} else if (resume) {
 		rc = bsim_journal_resume(&s->journal, s->journal_path, inputs, record_size, err);
 		if (rc != BSIM_OK) {
@@ -63,6 +60,8 @@ int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *
 			bsim_error_set(err, rc, "--resume: %s: %s", dir, msg);
 		}
 	} else {
+		/* a stopped run's journal is there only if the user asked to
+		 * replace it (bsim_outdir_open refuses it otherwise) */
 		rc = bsim_journal_create(&s->journal, s->journal_path, inputs, record_size, err);
 	}
 	if (rc != BSIM_OK) {

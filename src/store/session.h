@@ -19,16 +19,25 @@ typedef struct bsim_session {
 	bsim_outdir *od;
 	bsim_journal *journal;
 	char journal_path[BSIM_PATH_MAX];
-	int add;  /* set before closing: the files join DIR's set (bsim_outdir_add) */
+	int add;  /* the files join DIR's set (bsim_outdir_add): mode BSIM_OUTDIR_ADD */
 	int done; /* set once every trial is journaled: a later failure keeps the journal */
 } bsim_session;
 
-/* Opens dir (BSIM_EINPUT if it cannot be used) and, if inputs is not NULL,
- * the journal for records of record_size bytes: with resume the journal of
- * the stopped run in dir, which must have these inputs; without, a new
- * one, refusing a dir that holds a stopped run's journal. */
-int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *inputs,
-                      size_t record_size, bsim_error *err);
+/* Opens dir in mode (outdir.h; BSIM_EINPUT if it cannot be used, another
+ * run holds it, or it holds a result the mode may not replace), command
+ * naming the run, and, if inputs is not NULL, the journal for records of
+ * record_size bytes: with BSIM_OUTDIR_RESUME the journal of the stopped
+ * run in dir, which must have these inputs; otherwise a new one (with
+ * BSIM_OUTDIR_OVERWRITE, in the place of a stopped run's). With
+ * BSIM_OUTDIR_ADD the files join dir's set at the close. */
+int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, const char *command,
+                      const char *inputs, size_t record_size, bsim_error *err);
+
+/* The mode of a run with the user's resume and overwrite flags. */
+static inline bsim_outdir_mode bsim_session_mode(int resume, int overwrite)
+{
+	return resume ? BSIM_OUTDIR_RESUME : overwrite ? BSIM_OUTDIR_OVERWRITE : BSIM_OUTDIR_NEW;
+}
 
 /* Ends the session with the run's status rc (err holding its message if
  * rc is not BSIM_OK): if BSIM_OK, commits the files (and removes the

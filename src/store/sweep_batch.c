@@ -260,7 +260,8 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 		return rc;
 	}
 	if (rc == BSIM_OK && b->out) {
-		rc = bsim_session_open(&b->ss, b->out, b->resume, inputs, size, err);
+		rc = bsim_session_open(&b->ss, b->out, bsim_session_mode(b->resume, b->overwrite),
+		                       b->command, inputs, size, err);
 		b->open = rc == BSIM_OK;
 		c.journal = b->open ? b->ss.journal : NULL;
 	}

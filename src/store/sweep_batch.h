@@ -30,6 +30,7 @@ typedef struct sweep_batch {
 	const char *command; /* "markov validate", "essay": the journal's and part.json's */
 	const char *out;     /* the output directory; NULL: no directory, no journal */
 	int resume;
+	int overwrite;                   /* 1: replace what out holds (outdir.h) */
 	const bsim_sweep_spread *spread; /* NULL: one process */
 	bsim_progress_fn progress;       /* trials done of every sweep's; may be NULL */
 	void *progress_user;

@@ -298,6 +298,12 @@ check_column('landscape', 'theta2', reshape(l.theta(:, :, 2)', [], 1), ...
              cols{strcmp(names, 'theta2')}, '%.10g');
 printf('landscape: %d x %d points and the lowest pass (%.2f J) as the program''s\n', ...
        numel(l.x), numel(l.y), p.height);
+% Into the program's finished landscape: refused as the program refuses it
+% (below, with the errors), replaced with 'overwrite'.
+l2 = beamsim_landscape(gate, 'resolution', 2, 'out', landdir, 'overwrite', true);
+[names, cols] = csv_columns(fullfile(landdir, 'landscape.csv'));
+check(numel(cols{1}) == numel(l2.x) * numel(l2.y), 'overwrite: %d rows for %d x %d points', ...
+      numel(cols{1}), numel(l2.x), numel(l2.y));
 
 % ---- unstable trials: an ordinary result, said as the program says it ---
 stiff = fullfile(source, 'configs', 'hard', 'stiff_beam_sweep.yaml');
@@ -350,6 +356,9 @@ cases = {
   'landscape of a missing file', sprintf('landscape %s --out %s', fullfile(tmp, 'none.yaml'), ...
       fullfile(tmp, 'never')), @() beamsim_landscape(fullfile(tmp, 'none.yaml')), ...
       'beamsim_landscape';
+  'landscape into a finished result',
+	  sprintf('landscape %s --resolution 2 --out %s', gate, ... landdir),
+	  @() beamsim_landscape(gate, 'resolution', 2, 'out', landdir), ... 'beamsim_landscape';
 };
 for c = 1:size(cases, 1)
   [~, err, status] = program(exe, tmp, cases{c, 2});

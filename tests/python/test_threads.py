@@ -69,3 +69,49 @@ def test_ctrl_c_stops_a_sweep(h1, tmp_path):
     s = beamsim.sweep(h1, trials=4, threads=2)
     for k in s["trials"]:
         assert list(map(str, r["trials"][k])) == list(map(str, s["trials"][k])), k
+
+
+def test_two_threads_one_out(h1, tmp_path):
+    """Two sweeps into one directory from two threads of one process: the
+    first holds it, the second is refused (ValueError naming it) at the
+    first's first progress call, and the first still ends with all its
+    trials, its staging area untouched by the refusal."""
+    out = tmp_path / "d"
+    refused = []
+
+    def second():
+        try:
+            beamsim.sweep(h1, trials=2, threads=1, out=out)
+        except ValueError as e:
+            refused.append(str(e))
+
+    def progress(done, total):
+        if done == 1:
+            t = threading.Thread(target=second)
+            t.start()
+            t.join()
+
+    r = beamsim.sweep(h1, trials=4, threads=1, progress=progress, out=out)
+    assert len(refused) == 1, refused
+    assert str(out) in refused[0] and "another beamsim run" in refused[0]
+    assert len(r["trials"]["trial"]) == 30 * 4
+    assert (out / "manifest.json").exists() and not (out / ".beamsim").exists()
+
+
+def test_finished_out_needs_overwrite(h1, tmp_path):
+    """A finished sweep's directory is refused, naming it, and left as it
+    was; overwrite=True replaces it."""
+    out = tmp_path / "d"
+    beamsim.sweep(h1, trials=2, threads=1, out=out)
+    before = (out / "trials.csv").read_bytes()
+    with pytest.raises(ValueError, match="holds the finished result of beamsim sweep"):
+        beamsim.sweep(h1, trials=3, threads=1, out=out)
+    assert (out / "trials.csv").read_bytes() == before
+    r = beamsim.sweep(h1, trials=3, threads=1, out=out, overwrite=True)
+    assert len(r["trials"]["trial"]) == 30 * 3
+    c_out = tmp_path / "c"
+    beamsim.compare(h1, trials=1, threads=1, out=c_out)
+    with pytest.raises(ValueError, match="holds the finished result of beamsim compare"):
+        beamsim.compare(h1, trials=1, threads=1, out=c_out)
+    c = beamsim.compare(h1, trials=2, threads=1, out=c_out, overwrite=True)
+    assert len(c["pairs"]["trial"]) == 30 * 2

@@ -259,7 +259,8 @@ class _Dir:
 
 
 def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=None, seed=None,
-          backend_opt=None, out=None, progress=None, trajectories=0, resume=False):
+          backend_opt=None, out=None, progress=None, trajectories=0, resume=False,
+          overwrite=False):
     """Every trial of every group of an experiment, as `beamsim sweep
     EXPERIMENT --out DIR` runs them (the same numbers, whatever threads).
 
@@ -270,7 +271,9 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
     one. progress: callable(done, total), called with the GIL after each
     finished trial. trajectories: the first trials of each group whose
     trajectories are kept (trajectories.csv, as --trajectories). resume:
-    continue the stopped sweep in out.
+    continue the stopped sweep in out. overwrite: replace the finished
+    result (or a stopped sweep's journal) in out; without it such an out is
+    refused (ValueError), as it is by `beamsim sweep` without --overwrite.
 
     Returns a dict: "groups" (summary.json's groups: params, trials,
     traversed, side_exit, stuck, left, right, p_traverse, ci95, ...),
@@ -281,7 +284,8 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
         info = _beamsim.sweep(os.fspath(experiment), d, _count("trials", trials, 1),
                               _count("threads", threads, 1, 4096), _seed(seed), backend,
                               _sets(set), _grid(grid), _opts(backend_opt), progress,
-                              _count("trajectories", trajectories, 0), bool(resume))
+                              _count("trajectories", trajectories, 0), bool(resume),
+                              bool(overwrite))
         files = load(d)
     if info["unstable"]:
         text = info["unstable_text"]
@@ -294,17 +298,18 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
 
 
 def compare(experiment, backends=("thesis", "box2d"), trials=None, threads=None, set=None,
-            grid=None, seed=None, out=None, progress=None):
+            grid=None, seed=None, out=None, progress=None, overwrite=False):
     """The experiment on two sides with the same random-force schedules, as
     `beamsim compare EXPERIMENT --backends A,B --out DIR` runs it. A side is
-    "NAME[:KEY=VALUE]...". Returns a dict: "report" (report.json), "pairs"
+    "NAME[:KEY=VALUE]...". overwrite: replace the finished result in out
+    (without it such an out is refused). Returns a dict: "report" (report.json), "pairs"
     (pairs.csv as arrays), "sides" (each side's summary.json and trials
     arrays, by label), "n_disagree" and "out"."""
     a, b = backends
     with _Dir(out, "compare") as d:
         info = _beamsim.compare(os.fspath(experiment), d, a, b, _count("trials", trials, 1),
                                 _count("threads", threads, 1, 4096), _seed(seed), _sets(set),
-                                _grid(grid), progress)
+                                _grid(grid), progress, bool(overwrite))
         files = load(d)
     sides = {}
     for label, name in zip((a, b), info["dirs"]):
