@@ -12,6 +12,7 @@
 #include "support.h"
 
 #include "util/figure.h"
+#include "store/outdir.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -96,6 +97,60 @@ const char *bsim_test_write(const char *dir, const char *name, const char *text)
 		fclose(f);
 	}
 	return path;
+}
+
+char *bsim_test_fake_program(const char *dir, const char *name, const char *script)
+{
+	if (mkdir(dir, 0755) != 0 && errno != EEXIST)
+		fail_msg("%s: %s", dir, strerror(errno));
+	const char *path = bsim_test_write(dir, name, script);
+	if (chmod(path, 0755) != 0)
+		fail_msg("%s: %s", path, strerror(errno));
+	const char *now = getenv("PATH");
+	char *old = strdup(now ? now : "/usr/bin:/bin");
+	size_t n = strlen(dir) + strlen(old) + 2;
+	char *with = malloc(n);
+	if (!old || !with)
+		abort();
+	snprintf(with, n, "%s:%s", dir, old);
+	setenv("PATH", with, 1);
+	free(with);
+	return old;
+}
+
+void bsim_test_path_restore(char *old)
+{
+	setenv("PATH", old, 1);
+	free(old);
+}
+
+void bsim_test_check_committed(const char *dir, const char *const files[],
+                               const char *const absent[])
+{
+	int has = 0;
+	bsim_error err;
+	if (bsim_outdir_verify(dir, &has, &err) != BSIM_OK)
+		fail_msg("%s: %s", dir, err.msg);
+	if (!has)
+		fail_msg("%s: no manifest.json", dir);
+	char **paths = NULL;
+	size_t n = 0;
+	if (bsim_outdir_files(dir, &paths, &n, &err) != BSIM_OK)
+		fail_msg("%s: %s", dir, err.msg);
+	for (int k = 0; k < 2; k++) {
+		const char *const *names = k == 0 ? files : absent;
+		for (int i = 0; names && names[i]; i++) {
+			int found = 0;
+			for (size_t j = 0; j < n; j++)
+				found |= strcmp(paths[j], names[i]) == 0;
+			if (found != (k == 0))
+				fail_msg("%s/manifest.json %s %s", dir, k == 0 ? "lacks" : "lists",
+				         names[i]);
+		}
+	}
+	bsim_outdir_files_free(paths, n);
+	if (bsim_test_exists(bsim_test_join(dir, ".beamsim")))
+		fail_msg("%s/.beamsim is left", dir);
 }
 
 char *bsim_test_read(const char *path)

@@ -84,6 +84,23 @@ int bsim_test_remove(const char *path);
 /* Writes text to dir/name and returns the path (static buffer). */
 const char *bsim_test_write(const char *dir, const char *name, const char *text);
 
+/* A stand-in for a program the command starts (gnuplot, ffmpeg): writes
+ * the shell script text to dir/name (dir made if missing; keep it apart
+ * from the outputs), executable, and puts dir first on this
+ * process's PATH, so the programs it starts find the stand-in first.
+ * Returns the PATH before (malloc'd), for bsim_test_path_restore. A script
+ * reaches the real program with PATH="${PATH#*:}" (the PATH without dir). */
+char *bsim_test_fake_program(const char *dir, const char *name, const char *script);
+void bsim_test_path_restore(char *old);
+
+/* Asserts that dir holds a committed set of files (its manifest.json
+ * lists only files there with their size and CRC-32: bsim_outdir_verify),
+ * that the manifest lists each of files (NULL-terminated) and none of
+ * absent (NULL-terminated, may be NULL), and that no staging area is
+ * left (dir/.beamsim). */
+void bsim_test_check_committed(const char *dir, const char *const files[],
+                               const char *const absent[]);
+
 /* Reads a whole file into a malloc'd, NUL-terminated string (NULL on error). */
 char *bsim_test_read(const char *path);
 

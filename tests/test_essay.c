@@ -4,7 +4,9 @@
  * documentation, Newcombe 1998 Table II, Agresti 2002 Sec. 5.3.5); (b) the
  * command end to end with few trials: every column, one row per claim and
  * mode, each verdict what its p-value and sign say, the same file whatever
- * the threads, and bad options refused with exit status 2. */
+ * the threads, and bad options refused with exit status 2; (c) a gnuplot
+ * that fails on the figure: exit 1 naming it, and the tables committed
+ * with its script and data. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -186,6 +188,41 @@ static void test_command(void **state)
 	free(c2);
 }
 
+/* A gnuplot that fails: exit 1 naming the figure and quoting its line; the
+ * essay's tables, the figure's script and data are committed as a result
+ * (the journal of the trials with them gone). */
+static void test_gnuplot_fails(void **state)
+{
+	(void)state;
+	const char *base = bsim_test_dir("essay_gnuplot_fails");
+	char bin[1100], dir[1100];
+	snprintf(bin, sizeof bin, "%s/bin", base);
+	snprintf(dir, sizeof dir, "%s/out", base);
+	char cfg[1024];
+	snprintf(cfg, sizeof cfg, "%s", bsim_test_src("configs"));
+	char *old = bsim_test_fake_program(
+	        bin, "gnuplot",
+	        "#!/bin/sh\necho '\"essay.gp\" line 5: the stand-in fails here' >&2\nexit 1\n");
+	const char *argv[] = {"essay",  "--out",     dir, "--trials",  "20", "--lattice-trials",
+	                      "5",      "--configs", cfg, "--threads", "2",  "--quiet",
+	                      "--mode", "default",   NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	bsim_test_path_restore(old);
+	printf("# exit %d: %s", rc, err);
+	assert_int_equal(rc, 1);
+	char want[1400];
+	snprintf(want, sizeof want,
+	         "beamsim: figure essay: gnuplot exited with status 1: \"essay.gp\" line 5: the "
+	         "stand-in fails here; its script and data are in %s: essay.gp, essay.dat\n",
+	         dir);
+	assert_string_equal(err, want);
+	free(err);
+	const char *kept[] = {"essay.csv", "essay.mat", "essay.md", "essay.gp", "essay.dat", NULL};
+	const char *none[] = {"essay.png", "essay.svg", NULL};
+	bsim_test_check_committed(dir, kept, none);
+}
+
 static void test_bad_options(void **state)
 {
 	(void)state;
@@ -225,6 +262,7 @@ int main(void)
 	        cmocka_unit_test(test_newcombe_difference_published),
 	        cmocka_unit_test(test_cochran_armitage_published),
 	        cmocka_unit_test(test_command),
+	        cmocka_unit_test(test_gnuplot_fails),
 	        cmocka_unit_test(test_bad_options),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -4,7 +4,11 @@
  * written, exactly (doubles bit for bit, strings byte for byte, nested
  * structs by field name); a figure's PNG starts with the PNG signature and
  * its IHDR gives the requested size; its SVG is an <svg> document; without
- * gnuplot the script is still written and nothing claims to be drawn. */
+ * gnuplot the script is still written and nothing claims to be drawn. A
+ * gnuplot that fails (the real one on a missing data file; a stand-in that
+ * exits 1 with a message; one that exits 0 leaving images cut short, as a
+ * full disk does) is a failure naming the figure and quoting gnuplot's
+ * line, with the script and its data left in place and no image. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -172,15 +176,127 @@ static void test_figure_error_named(void **state)
 	d.dir = dir;
 	d.name = "bad";
 	bsim_error err;
-	int drawn = -1;
+	int drawn = 0;
 	/* A data file that does not exist: gnuplot fails, the error names the
-	 * script, and no image is left behind. */
+	 * figure and quotes gnuplot's last line, and no image is left behind. */
 	assert_int_equal(bsim_figure_render(&d, "plot 'missing.dat'\n", &drawn, &err), BSIM_EFAIL);
-	assert_int_equal(drawn, 0);
+	printf("# %s\n", err.msg);
+	assert_int_equal(drawn, BSIM_FIGURE_FAILED);
+	assert_non_null(strstr(err.msg, "figure bad: gnuplot exited with status 1: "));
+	assert_non_null(strstr(err.msg, "No data in plot"));
 	assert_non_null(strstr(err.msg, "bad.gp"));
 	char path[1024];
 	snprintf(path, sizeof path, "%s/bad.png", dir);
 	assert_int_not_equal(access(path, F_OK), 0);
+}
+
+/* The files in dir whose names hold ".tmp.": none may be left. */
+static int temporaries(const char *dir)
+{
+	char pattern[1100];
+	snprintf(pattern, sizeof pattern, "%s/*.tmp.*", dir);
+	char *all = bsim_test_read_glob(pattern);
+	int any = all != NULL;
+	free(all);
+	return any;
+}
+
+/* A figure of dir named "wave" reading wave.dat, drawn by the stand-in
+ * gnuplot script (in dir/bin): its status, drawn and message. */
+static int render_with(const char *dir, const char *fake, int *drawn, bsim_error *err)
+{
+	char bin[1100];
+	snprintf(bin, sizeof bin, "%s/bin", dir);
+	bsim_test_write(dir, "wave.dat", "0 0\n1 1\n");
+	char *old = bsim_test_fake_program(bin, "gnuplot", fake);
+	bsim_figure_def d = bsim_figure_def_default();
+	d.dir = dir;
+	d.name = "wave";
+	int rc = bsim_figure_render(
+	        &d, "set title 'wave'\nplot 'wave.dat' with lines title \"x\"\n", drawn, err);
+	bsim_test_path_restore(old);
+	printf("# %s\n", rc ? err->msg : "drawn");
+	return rc;
+}
+
+/* A gnuplot that says what went wrong and exits 1: its line is quoted, the
+ * script and the data it reads are named, they stay, no image does. */
+static void test_figure_gnuplot_message_quoted(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("figure_fails");
+	int drawn = 0;
+	bsim_error err;
+	assert_int_equal(render_with(dir,
+	                             "#!/bin/sh\necho 'plot it' >&2\n"
+	                             "echo '\"wave.gp\" line 9: the stand-in fails here' >&2\n"
+	                             "exit 1\n",
+	                             &drawn, &err),
+	                 BSIM_EFAIL);
+	assert_int_equal(drawn, BSIM_FIGURE_FAILED);
+	char want[1400];
+	snprintf(want, sizeof want,
+	         "figure wave: gnuplot exited with status 1: \"wave.gp\" line 9: the stand-in "
+	         "fails here; its script and data are in %s: wave.gp, wave.dat",
+	         dir);
+	assert_string_equal(err.msg, want);
+	assert_true(bsim_test_exists(bsim_test_join(dir, "wave.gp")));
+	assert_true(bsim_test_exists(bsim_test_join(dir, "wave.dat")));
+	assert_false(bsim_test_exists(bsim_test_join(dir, "wave.png")));
+	assert_false(temporaries(dir));
+}
+
+/* A gnuplot that exits 0 but leaves its images cut short (a full disk:
+ * gnuplot does not check its writes) fails all the same. */
+static void test_figure_cut_short(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("figure_cut");
+	int drawn = 0;
+	bsim_error err;
+	/* $2 is outbase="NAME.tmp.PID": the images' temporary base name. */
+	assert_int_equal(render_with(dir,
+	                             "#!/bin/sh\nb=${2#outbase=\\\"}; b=${b%\\\"}\n"
+	                             "printf '\\211PNG\\r\\n\\032\\nIHDR' > \"$b.png\"\n"
+	                             "printf '<svg>' > \"$b.svg\"\n",
+	                             &drawn, &err),
+	                 BSIM_EFAIL);
+	assert_int_equal(drawn, BSIM_FIGURE_FAILED);
+	assert_non_null(strstr(err.msg, "figure wave: gnuplot exited with status 0 but "));
+	assert_non_null(
+	        strstr(err.msg, "wave.png is cut short (12 bytes, no IEND chunk at its end)"));
+	assert_non_null(strstr(err.msg, "wave.gp, wave.dat"));
+	assert_false(bsim_test_exists(bsim_test_join(dir, "wave.png")));
+	assert_false(bsim_test_exists(bsim_test_join(dir, "wave.svg")));
+	assert_false(temporaries(dir));
+}
+
+static void take_note(void *user, const char *text)
+{
+	snprintf(user, 512, "%s", text);
+}
+
+/* What a gnuplot that succeeds says (a warning) is passed on as a note
+ * naming the figure; the figure is drawn. */
+static void test_figure_warning_noted(void **state)
+{
+	(void)state;
+	if (!bsim_figure_available())
+		skip();
+	const char *dir = bsim_test_dir("figure_warns");
+	char note[512] = "";
+	bsim_note_set_handler(take_note, note);
+	int drawn = 0;
+	bsim_error err;
+	int rc = render_with(dir,
+	                     "#!/bin/sh\necho 'a stand-in warning' >&2\n"
+	                     "PATH=\"${PATH#*:}\" exec gnuplot \"$@\"\n",
+	                     &drawn, &err);
+	bsim_note_set_handler(NULL, NULL);
+	assert_int_equal(rc, BSIM_OK);
+	assert_int_equal(drawn, BSIM_FIGURE_DRAWN);
+	assert_string_equal(note, "gnuplot on wave.gp: a stand-in warning");
+	assert_true(bsim_test_exists(bsim_test_join(dir, "wave.png")));
 }
 
 static void test_figure_without_gnuplot(void **state)
@@ -227,6 +343,9 @@ int main(void)
 	        cmocka_unit_test(test_mat_name),
 	        cmocka_unit_test(test_figure_drawn),
 	        cmocka_unit_test(test_figure_error_named),
+	        cmocka_unit_test(test_figure_gnuplot_message_quoted),
+	        cmocka_unit_test(test_figure_cut_short),
+	        cmocka_unit_test(test_figure_warning_noted),
 	        cmocka_unit_test(test_figure_without_gnuplot),
 	        cmocka_unit_test(test_figure_bad_name),
 	};

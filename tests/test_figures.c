@@ -690,6 +690,48 @@ static void test_without_gnuplot(void **state)
 	assert_null(bsim_test_read(path));
 }
 
+/* ---- gnuplot failing ------------------------------------------------------------------- */
+
+/* A gnuplot that fails on one figure of a run's directory (and draws the
+ * others): plot exits 1 naming it, quoting its line and naming its script
+ * and data; they join the directory's set with the figures drawn, beside
+ * the run's own files. */
+static void test_gnuplot_fails(void **state)
+{
+	(void)state;
+	const char *base = bsim_test_dir("gnuplot_fails");
+	char bin[1100], dir[1100];
+	snprintf(bin, sizeof bin, "%s/bin", base);
+	snprintf(dir, sizeof dir, "%s/run", base);
+	const char *run[] = {"run", bsim_test_src("configs/thesis/gate.yaml"), "--out", dir, NULL};
+	assert_int_equal(run_cli(run, NULL, NULL), 0);
+	char *old = bsim_test_fake_program(
+	        bin, "gnuplot",
+	        "#!/bin/sh\n"
+	        "if [ \"$3\" = ledger.gp ]; then\n"
+	        "  echo '\"ledger.gp\" line 7: the stand-in fails here' >&2; exit 1\n"
+	        "fi\n"
+	        "PATH=\"${PATH#*:}\" exec gnuplot \"$@\"\n");
+	char *err = NULL;
+	const char *argv[] = {"plot", dir, "--quiet", NULL};
+	int rc = bsim_test_cli(argv, NULL, &err);
+	bsim_test_path_restore(old);
+	printf("# exit %d: %s", rc, err);
+	assert_int_equal(rc, 1);
+	assert_int_equal(bsim_test_count_lines(err), 1);
+	char want[1400];
+	snprintf(want, sizeof want,
+	         "beamsim: figure ledger: gnuplot exited with status 1: \"ledger.gp\" line 7: the "
+	         "stand-in fails here; its script and data are in %s: ledger.gp, ledger.dat\n",
+	         dir);
+	assert_string_equal(err, want);
+	free(err);
+	const char *kept[] = {"trajectory.csv",  "ledger.csv",       "ledger.gp", "ledger.dat",
+	                      "random_force.gp", "random_force.png", NULL};
+	const char *none[] = {"ledger.png", "ledger.svg", NULL};
+	bsim_test_check_committed(dir, kept, none);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -705,6 +747,7 @@ int main(void)
 	        cmocka_unit_test(test_compare_figures),
 	        cmocka_unit_test(test_without_gnuplot),
 	        cmocka_unit_test(test_fig27),
+	        cmocka_unit_test(test_gnuplot_fails),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

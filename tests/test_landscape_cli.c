@@ -3,7 +3,10 @@
  * (the MATLAB file read back by libmatio's own reader, the JSON), the
  * figures are PNG and SVG under 1 MB, --resolution, --region and --set do
  * what they say, and every bad input exits 2 with a message naming it and
- * writes nothing. */
+ * writes nothing. A figure gnuplot fails on (a stand-in that fails on one
+ * figure; the real gnuplot on a region too wide to draw) exits 1 naming it
+ * and gnuplot's message, and the landscape's files, the failed figure's
+ * script and data among them, are committed all the same. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -22,6 +25,7 @@
 
 #include "beamsim/landscape.h"
 #include "support.h"
+#include "util/figure.h"
 
 static char out_dir[1024];
 
@@ -472,13 +476,102 @@ static void test_errors(void **state)
 	}
 }
 
+/* ---- gnuplot failing ------------------------------------------------------------ */
+
+/* beamsim landscape into dir with args; its status and one-line stderr
+ * (checked to be one line). */
+static int landscape_failing(const char *dir, const char *const extra[], char **err)
+{
+	const char *argv[16] = {"landscape", bsim_test_src("configs/thesis/gate.yaml")};
+	int n = 2;
+	for (int i = 0; extra[i]; i++)
+		argv[n++] = extra[i];
+	argv[n++] = "--out";
+	argv[n++] = dir;
+	argv[n] = NULL;
+	char *out = NULL;
+	int rc = bsim_test_cli(argv, &out, err);
+	print_message("exit %d: %s", rc, *err);
+	assert_int_equal(bsim_test_count_lines(*err), 1);
+	free(out);
+	return rc;
+}
+
+/* A gnuplot that fails on the top view (and draws the others): exit 1
+ * naming the figure, quoting its line, naming its script and data in DIR;
+ * DIR holds the landscape's files, the surfaces drawn, and the top view's
+ * script and data but no image. */
+static void test_gnuplot_fails(void **state)
+{
+	(void)state;
+	const char *base = bsim_test_dir("landscape_gnuplot_fails");
+	char bin[1100], dir[1100];
+	snprintf(bin, sizeof bin, "%s/bin", base);
+	snprintf(dir, sizeof dir, "%s/out", base);
+	char *old = bsim_test_fake_program(
+	        bin, "gnuplot",
+	        "#!/bin/sh\n"
+	        "if [ \"$3\" = landscape_top.gp ]; then\n"
+	        "  echo '\"landscape_top.gp\" line 3: the stand-in fails here' >&2; exit 1\n"
+	        "fi\n"
+	        "PATH=\"${PATH#*:}\" exec gnuplot \"$@\"\n");
+	char *err = NULL;
+	const char *extra[] = {"--resolution", "1", NULL};
+	int rc = landscape_failing(dir, extra, &err);
+	bsim_test_path_restore(old);
+	assert_int_equal(rc, 1);
+	char want[1400];
+	snprintf(want, sizeof want,
+	         "beamsim: figure landscape_top: gnuplot exited with status 1: "
+	         "\"landscape_top.gp\" line 3: the stand-in fails here; its script and data are "
+	         "in %s: landscape_top.gp, ",
+	         dir);
+	assert_non_null(strstr(err, want));
+	assert_non_null(strstr(err, "landscape_top.dat"));
+	free(err);
+	const char *kept[] = {"landscape.csv",       "landscape.json",
+	                      "landscape.mat",       "landscape_top.gp",
+	                      "landscape_top.dat",   "landscape_beam.png",
+	                      "landscape_total.svg", NULL};
+	const char *none[] = {"landscape_top.png", "landscape_top.svg", NULL};
+	bsim_test_check_committed(dir, kept, none);
+}
+
+/* The real gnuplot on a region too wide for it: every energy overflows,
+ * and gnuplot refuses the surfaces ("empty z range"). Exit 1 quoting it;
+ * the landscape's tables are committed with the scripts and data. */
+static void test_gnuplot_refuses_region(void **state)
+{
+	(void)state;
+	if (!bsim_figure_available())
+		skip();
+	char dir[1100];
+	snprintf(dir, sizeof dir, "%s/out", bsim_test_dir("landscape_region_too_wide"));
+	char *err = NULL;
+	const char *extra[] = {"--region=-1e300,1e300,-1e300,1e300", NULL};
+	assert_int_equal(landscape_failing(dir, extra, &err), 1);
+	assert_non_null(strstr(err, "figure landscape_beam: gnuplot exited with status 1: "));
+	assert_non_null(strstr(err, "empty z range"));
+	assert_non_null(strstr(err, "landscape_beam.gp, landscape_beam.dat"));
+	free(err);
+	const char *kept[] = {"landscape.csv", "landscape.json", "landscape_beam.gp",
+	                      "landscape_beam.dat", NULL};
+	const char *none[] = {"landscape_beam.png", NULL};
+	bsim_test_check_committed(dir, kept, none);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_csv),          cmocka_unit_test(test_mat),
-	        cmocka_unit_test(test_figures),      cmocka_unit_test(test_options),
-	        cmocka_unit_test(test_json_quiet),   cmocka_unit_test(test_errors),
+	        cmocka_unit_test(test_csv),
+	        cmocka_unit_test(test_mat),
+	        cmocka_unit_test(test_figures),
+	        cmocka_unit_test(test_options),
+	        cmocka_unit_test(test_json_quiet),
+	        cmocka_unit_test(test_errors),
 	        cmocka_unit_test(test_figure_style),
+	        cmocka_unit_test(test_gnuplot_fails),
+	        cmocka_unit_test(test_gnuplot_refuses_region),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -705,6 +705,99 @@ static void cli_missing_ffmpeg(void **state)
 	free(se);
 }
 
+/* ---- ffmpeg failing after it started ----------------------------------------------------- */
+
+/* beamsim video of a short gate trial into dir/x.mp4 with the ffmpeg
+ * stand-in script (in its own directory, first on the PATH): exit 1, one
+ * line on stderr naming the step and holding need, and dir empty (no video,
+ * no temporary file). */
+static void expect_encoder_failure(const char *name, const char *script, const char *need)
+{
+	const char *base = bsim_test_dir(name);
+	char bin[1100], dir[1100], out[1200], gate[1200];
+	snprintf(bin, sizeof bin, "%s/bin", base);
+	snprintf(dir, sizeof dir, "%s/out", base);
+	snprintf(out, sizeof out, "%s/x.mp4", dir);
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	assert_int_equal(mkdir(dir, 0755), 0);
+	char *old = bsim_test_fake_program(bin, "ffmpeg", script);
+	const char *argv[] = {"video", gate, "--set", "integration.max_steps=20", "--size", "64x64",
+	                      "--out", out,  NULL};
+	char *se = NULL;
+	int rc = bsim_test_cli(argv, NULL, &se);
+	bsim_test_path_restore(old);
+	printf("# exit %d: %s", rc, se);
+	assert_int_equal(rc, 1);
+	assert_int_equal(bsim_test_count_lines(se), 1);
+	char step[1400];
+	snprintf(step, sizeof step, "beamsim: %s: encoding the video: ", out);
+	assert_non_null(strstr(se, step));
+	assert_non_null(strstr(se, need));
+	assert_non_null(strstr(se, "; no video written\n"));
+	assert_true(dir_empty(dir));
+	free(se);
+}
+
+/* ffmpeg 5.1 on a full disk exits with status 0 after "Error writing
+ * trailer": an ffmpeg that writes half a file, says so and exits 0 is a
+ * failure quoting its message, and the half file is removed. */
+static void cli_ffmpeg_error_with_status_0(void **state)
+{
+	(void)state;
+	expect_encoder_failure(
+	        "error_status_0",
+	        "#!/bin/sh\nfor a; do out=${a#file:}; done\n"
+	        "head -c 1000 > \"$out\"; cat > /dev/null\n"
+	        "echo \"Error writing trailer of file:$out: No space left on device\" >&2\n"
+	        "echo \"Error closing file file:$out: No space left on device\" >&2\n"
+	        "exit 0\n",
+	        "ffmpeg exited with status 0 after an error: Error writing trailer of file:");
+}
+
+/* An ffmpeg that says nothing and exits 0 but leaves an MP4 cut short
+ * (its frames' box claims 1 MiB, 8 bytes follow): the file is checked. */
+static void cli_mp4_cut_short_with_status_0(void **state)
+{
+	(void)state;
+	expect_encoder_failure(
+	        "cut_status_0",
+	        "#!/bin/sh\nfor a; do out=${a#file:}; done\ncat > /dev/null\n"
+	        "printf '\\0\\0\\0\\10ftyp\\0\\20\\0\\0mdatframes..' > \"$out\"\n",
+	        "ffmpeg exited with status 0 but the MP4 is not whole: its box 'mdat' at byte 8 "
+	        "claims 1048576 bytes, of 16 left");
+}
+
+/* The real ffmpeg on a full disk, made without privilege by a file-size
+ * limit on beamsim, which ffmpeg inherits (SIGXFSZ ignored: a write beyond
+ * fails with EFBIG as one to a full disk with ENOSPC): the video of the
+ * same trial, unlimited, is S bytes; under a limit of S / 2 the command
+ * exits 1 quoting ffmpeg and leaves nothing at the path. */
+static void cli_full_disk_real_ffmpeg(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("full_disk");
+	char gate[1200], whole[1400], cut[1400];
+	snprintf(gate, sizeof gate, "%s", bsim_test_src("configs/thesis/gate.yaml"));
+	snprintf(whole, sizeof whole, "%s/whole.mp4", dir);
+	snprintf(cut, sizeof cut, "%s/cut.mp4", dir);
+	const char *a1[] = {"video", gate, "--size", "128x128", "--out", whole, NULL};
+	assert_int_equal(bsim_test_cli(a1, NULL, NULL), 0);
+	const long size = bsim_test_size(whole);
+	const bsim_test_opts half = {.fsize = size / 2};
+	const char *a2[] = {"video", gate, "--size", "128x128", "--out", cut, NULL};
+	char *se = NULL;
+	int rc = bsim_test_cli_with(a2, &half, NULL, &se);
+	printf("# %ld bytes whole; limited to %ld: exit %d: %s", size, size / 2, rc, se);
+	assert_int_equal(rc, 1);
+	assert_non_null(strstr(se, ": encoding the video: ffmpeg "));
+	assert_non_null(strstr(se, "File too large"));
+	assert_false(bsim_test_exists(cut));
+	char pattern[1500];
+	snprintf(pattern, sizeof pattern, "%s.tmp.*", cut);
+	assert_null(bsim_test_glob_first(pattern));
+	free(se);
+}
+
 static void cli_bad_arguments(void **state)
 {
 	(void)state;
@@ -843,15 +936,20 @@ static void cli_stopped_video_leaves_no_temporary(void **state)
 	assert_true(bsim_test_exists(alive));
 }
 
-/* An "ffmpeg" that writes the raw frames it reads into the output file
- * (its last argument, file:PATH), so a test reads back what was sent. */
+/* An "ffmpeg" that writes the raw frames it reads beside the output file
+ * (its last argument, file:OUT.tmp.PID) as OUT.frames, so a test reads back
+ * what was sent, and into the output the smallest MP4 whose boxes are
+ * whole (ftyp, moov, mdat, 8 bytes each), which the encoder's check of the
+ * file takes. */
 static const char *raw_encoder(const char *dir)
 {
 	static char path[1500];
 	snprintf(path, sizeof path, "%s",
-	         bsim_test_write(
-	                 dir, "raw-ffmpeg",
-	                 "#!/bin/sh\nfor a; do out=$a; done\nexec cat > \"${out#file:}\"\n"));
+	         bsim_test_write(dir, "raw-ffmpeg",
+	                         "#!/bin/sh\nfor a; do out=${a#file:}; done\n"
+	                         "cat > \"${out%.tmp.*}.frames\" || exit 1\n"
+	                         "printf '\\0\\0\\0\\10ftyp\\0\\0\\0\\10moov\\0\\0\\0\\10mdat' "
+	                         "> \"$out\"\n"));
 	assert_int_equal(chmod(path, 0755), 0);
 	return path;
 }
@@ -904,7 +1002,8 @@ static void lib_stream_memory_does_not_grow_with_steps(void **state)
 	       steps, rep.frames, rep.trail_points, rep.steps_held, per_frame, grown / 1024);
 	assert_int_equal(steps, 1000000);
 	assert_int_equal(rep.frames, 201);
-	assert_int_equal(bsim_test_size(out), 201L * 64 * 64 * 4);
+	assert_int_equal(bsim_test_size(bsim_test_join(dir, "long.raw.frames")),
+	                 201L * 64 * 64 * 4);
 	assert_true(rep.steps_held <= per_frame + 1);
 	assert_true(rep.trail_points <= 2); /* at rest: the start, a list a view scale */
 #if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
@@ -1023,9 +1122,11 @@ static void lib_stream_draws_the_recorded_frames(void **state)
 		assert_true(rep.t_part == t_part);
 		for (int p = 0; p < cases[c].n; p++)
 			assert_int_equal(rep.results[p].steps_run, steps[p]);
-		char *got = bsim_test_read(out);
+		char frames_path[1500];
+		snprintf(frames_path, sizeof frames_path, "%s.frames", out);
+		char *got = bsim_test_read(frames_path);
 		assert_non_null(got);
-		assert_int_equal(bsim_test_size(out), (long)(frames * frame_px * 4));
+		assert_int_equal(bsim_test_size(frames_path), (long)(frames * frame_px * 4));
 		long differ = 0;
 		for (long k = 0; k < frames; k++) {
 			const uint32_t *g =
@@ -1062,6 +1163,9 @@ int main(void)
 	        cmocka_unit_test(lib_essay_protocol_frames_are_the_runs_states),
 	        cmocka_unit_test(lib_failing_encoder_writes_nothing),
 	        cmocka_unit_test(cli_missing_ffmpeg),
+	        cmocka_unit_test(cli_ffmpeg_error_with_status_0),
+	        cmocka_unit_test(cli_mp4_cut_short_with_status_0),
+	        cmocka_unit_test(cli_full_disk_real_ffmpeg),
 	        cmocka_unit_test(cli_stopped_video_leaves_no_temporary),
 	        cmocka_unit_test(cli_bad_arguments),
 	};

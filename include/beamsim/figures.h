@@ -73,6 +73,7 @@ typedef struct bsim_figures_result {
 	bsim_figures_kind kind;
 	int n;        /* figures written (script and data) */
 	int drawn;    /* of which gnuplot drew the images */
+	int failed;   /* figures gnuplot failed on: their scripts and data are written */
 	char **paths; /* n "OUT/NAME", without extension, in the order written */
 	int n_notes;
 	char **notes; /* what was not drawn and why, one line each */
@@ -89,14 +90,19 @@ BSIM_API void bsim_figures_result_free(bsim_figures_result *r);
 /* Draws every figure of the directory. BSIM_EINPUT naming the directory
  * and the files looked for when it holds nothing known, or naming file,
  * line and field when a file is malformed; BSIM_EFAIL if a file cannot be
- * written or gnuplot fails on a script. */
+ * written, or if gnuplot fails on a script (out->failed figures): the other
+ * figures are still drawn, and the message names the failed figure first
+ * by name, gnuplot's message, and its script and data, which stay in the
+ * directory. */
 BSIM_API int bsim_figures_draw(const char *dir, const bsim_figures_def *def,
                                bsim_figures_result *out, bsim_error *err);
 
 /* beamsim plot DIR: checks DIR's files against its manifest (a mix of two
  * runs is refused, BSIM_EINPUT), draws its figures and commits them as
  * one set: into def->out, or, with def->out NULL, into DIR itself, where
- * they join the files already there (DIR/manifest.json lists both).
+ * they join the files already there (DIR/manifest.json lists both). A
+ * figure gnuplot fails on is a failure (BSIM_EFAIL) that keeps the rest:
+ * the set is committed, the failed figure's script and data with it.
  * out->paths name the figures where they are once this returns. */
 BSIM_API int bsim_figures_plot(const char *dir, const bsim_figures_def *def,
                                bsim_figures_result *out, bsim_error *err);

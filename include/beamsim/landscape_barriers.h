@@ -62,7 +62,9 @@ BSIM_API const char *bsim_landscape_pass_kind_name(bsim_pass_kind k);
  * landscape.json (grid, start, passes) and the figures landscape_top
  * (heat map, contours, beams), landscape_beam and landscape_total (3-D
  * surfaces without and with the propulsive term), each .gp + data + .png +
- * .svg. drawn (may be NULL) is 1 if gnuplot drew the figures. */
+ * .svg, the figures last. drawn (may be NULL) is 1 if gnuplot drew the
+ * figures, 0 if gnuplot is missing, -1 if it failed on one: BSIM_EFAIL
+ * naming it and quoting gnuplot, every other file written. */
 BSIM_API int bsim_landscape_write(const char *dir, const bsim_scene *s,
                                   const bsim_landscape_grid *g, const bsim_landscape_barriers *b,
                                   int *drawn, bsim_error *err);
@@ -71,7 +73,9 @@ BSIM_API int bsim_landscape_write(const char *dir, const bsim_scene *s,
  * written into the output directory out as one set (out is checked before
  * anything is computed; overwrite 1 replaces the result it holds, 0
  * refuses it). *g and *b get the grid and the barriers (free them
- * on BSIM_OK); BSIM_EINPUT for an unusable out or a bad grid, naming it. */
+ * on BSIM_OK); BSIM_EINPUT for an unusable out or a bad grid, naming it.
+ * A figure gnuplot fails on (drawn -1) is BSIM_EFAIL, and the files are
+ * committed all the same, its script and data among them. */
 BSIM_API int bsim_landscape_store(const char *out, int overwrite, const bsim_scene *s,
                                   const bsim_landscape_grid_def *def, bsim_landscape_grid **g,
                                   bsim_landscape_barriers **b, int *drawn, bsim_error *err);

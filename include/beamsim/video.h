@@ -170,9 +170,11 @@ BSIM_API int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, c
 
 /* Renders every frame and encodes them with ffmpeg into path: H.264,
  * yuv420p, fps frames per second. The file appears whole or not at all
- * (written under a temporary name, renamed when ffmpeg succeeded).
- * BSIM_EFAIL naming ffmpeg's package if it is missing, ffmpeg's exit
- * status and last message if it fails, or the path if it cannot be
+ * (written under a temporary name, renamed when ffmpeg succeeded, removed
+ * when it failed). BSIM_EFAIL naming ffmpeg's package if it is missing;
+ * "PATH: encoding the video: " and ffmpeg's exit status and first message
+ * if it fails, which it also does by writing a message at status 0 or
+ * leaving a file that is not a whole MP4; or the path if it cannot be
  * written. */
 BSIM_API int bsim_video_write(bsim_video *v, const char *path, bsim_error *err);
 
@@ -234,11 +236,14 @@ BSIM_API int bsim_video_encoder_open(const char *path, const char *program, int 
                                      double fps, int crf, bsim_video_encoder **out,
                                      bsim_error *err);
 /* Writes one frame. BSIM_EFAIL if ffmpeg has stopped reading (the
- * message then gives its exit status and last message). */
+ * message then gives its exit status and first message). */
 BSIM_API int bsim_video_encoder_write(bsim_video_encoder *e, const uint32_t *pixels,
                                       bsim_error *err);
 /* Ends the stream, waits for ffmpeg, and if it exited with status 0
- * renames the file into place; else removes it. Frees e either way. */
+ * without a message and the file is a whole MP4 (its boxes tile it, ftyp,
+ * moov and mdat among them; not checked for what is not a regular file),
+ * renames the file into place; else removes it and fails as
+ * bsim_video_write does. Frees e either way. */
 BSIM_API int bsim_video_encoder_close(bsim_video_encoder *e, bsim_error *err);
 /* Stops ffmpeg and removes the temporary file; frees e. NULL is a no-op. */
 BSIM_API void bsim_video_encoder_abort(bsim_video_encoder *e);

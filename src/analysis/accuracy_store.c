@@ -73,6 +73,8 @@ int bsim_accuracy_store(const char *out, int overwrite, const bsim_scene *scene,
 		bsim_figures_def def = bsim_figures_def_default();
 		def.kind = BSIM_FIGURES_ACCURACY;
 		rc = bsim_figures_draw(ss.stage, &def, fig, err);
+		/* the tables are kept beside a figure gnuplot failed on */
+		rc = bsim_session_defer(&ss, rc, fig->failed > 0, err);
 	}
 	rc = bsim_session_close(&ss, rc, "accuracy", NULL, err);
 	if (rc != BSIM_OK) {

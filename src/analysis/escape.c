@@ -480,8 +480,11 @@ int escape_run(const escape_def *def, escape_summary *sum, bsim_error *err)
 		rc = bsim_store_twin(ss.stage, "kramers.csv", "kramers", err);
 	if (rc == BSIM_OK)
 		rc = write_json(ss.stage, &j, err);
-	if (rc == BSIM_OK && sum->fitted)
+	if (rc == BSIM_OK && sum->fitted) {
+		/* the tables are kept beside a figure gnuplot failed on */
 		rc = write_figure(ss.stage, &j, &sum->drawn, err);
+		rc = bsim_session_defer(&ss, rc, sum->drawn == BSIM_FIGURE_FAILED, err);
+	}
 	rc = bsim_session_close(&ss, rc, "escape", NULL, err);
 	for (int i = 0; i < n_scenes; i++)
 		free(scenes[i].key);

@@ -54,7 +54,7 @@ typedef struct escape_summary {
 	int groups, used, scenes; /* groups, groups in the fit, landscapes searched */
 	escape_fit fit;
 	int fitted; /* 0: too few groups with a barrier, noise and a traversal */
-	int drawn;  /* 1: gnuplot drew the figure */
+	int drawn;  /* 1: gnuplot drew the figure, -1: it failed on it (util/figure.h) */
 } escape_summary;
 
 /* Reads the sweep in def->dir, searches each distinct scene's landscape,

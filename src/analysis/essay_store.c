@@ -186,6 +186,8 @@ int bsim_essay_compare_store(const char *out, const bsim_essay_config *cfg, bsim
 		bsim_figures_def def = bsim_figures_def_default();
 		def.kind = BSIM_FIGURES_ESSAY;
 		rc = bsim_figures_draw(stage, &def, fig, err);
+		/* the tables are kept beside a figure gnuplot failed on */
+		rc = bsim_session_defer(&sb.ss, rc, fig->failed > 0, err);
 	}
 	rc = sweep_batch_end(&sb, rc, err);
 	if (rc != BSIM_OK) {

@@ -4,6 +4,7 @@
 #include "beamsim/landscape_barriers.h"
 
 #include "store/session.h"
+#include "util/figure.h"
 
 int bsim_landscape_store(const char *out, int overwrite, const bsim_scene *s,
                          const bsim_landscape_grid_def *def, bsim_landscape_grid **g,
@@ -23,8 +24,14 @@ int bsim_landscape_store(const char *out, int overwrite, const bsim_scene *s,
 	rc = bsim_landscape_grid_alloc(s, def, g, err);
 	if (rc == BSIM_OK)
 		rc = bsim_landscape_barriers_alloc(s, *g, b, err);
+	int shown = BSIM_FIGURE_UNDRAWN;
 	if (rc == BSIM_OK)
-		rc = bsim_landscape_write(ss.stage, s, *g, *b, drawn, err);
+		rc = bsim_landscape_write(ss.stage, s, *g, *b, &shown, err);
+	/* A figure gnuplot failed on is written last: the tables are kept
+	 * with its script and data, and the run fails. */
+	rc = bsim_session_defer(&ss, rc, shown == BSIM_FIGURE_FAILED, err);
+	if (drawn)
+		*drawn = shown;
 	rc = bsim_session_close(&ss, rc, "landscape", NULL, err);
 	if (rc != BSIM_OK) {
 		bsim_landscape_barriers_free(*b);

@@ -604,8 +604,13 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		snprintf(mat, sizeof mat, "%s/time_validate.mat", b.ss.stage);
 		rc = bsim_matlab_from_csv(src, mat, "time_validate", err);
 	}
-	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++)
-		rc = write_figure(b.ss.stage, g, &gd[g], out, NULL, err);
+	/* A figure gnuplot fails on is reported at the end, the tables and the
+	 * other groups' figures kept beside its script and data. */
+	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++) {
+		int drawn = BSIM_FIGURE_UNDRAWN;
+		rc = write_figure(b.ss.stage, g, &gd[g], out, &drawn, err);
+		rc = bsim_session_defer(&b.ss, rc, drawn == BSIM_FIGURE_FAILED, err);
+	}
 	rc = sweep_batch_end(&b, rc, err);
 	for (int g = 0; gd && g < e.n_groups; g++) {
 		bsim_markov_prediction_free(&gd[g].pred);

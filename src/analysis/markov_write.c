@@ -44,7 +44,7 @@ static int write_tables(const char *stage, const bsim_markov_prediction *p, bsim
 /* prediction.png: the predicted final locations as the field, titled
  * with the lattice, the chain and what the maps were simulated with. */
 static int write_figure(const char *stage, const bsim_scene *lattice, const bsim_markov_set *set,
-                        const bsim_markov_prediction *p, bsim_error *err)
+                        const bsim_markov_prediction *p, int *drawn, bsim_error *err)
 {
 	char fp[32], rm[32], params[300], title[600];
 	snprintf(fp, sizeof fp, "%g",
@@ -62,13 +62,13 @@ static int write_figure(const char *stage, const bsim_scene *lattice, const bsim
 	         set ? set->def.trials : 0);
 	const markov_field_panel panel = {"probability of each final location", p->p, NULL};
 	return markov_field_figure(stage, "prediction", title, p->loc, p->n_locations, &panel, 1, 1,
-	                           NULL, err);
+	                           drawn, err);
 }
 
 /* time.csv: the walks' distribution of the time to the outcome, a row a
  * bin, with each kind's cumulative probability; and the figure time. */
 static int write_time(const char *stage, const bsim_scene *lattice, const bsim_markov_prediction *p,
-                      bsim_error *err)
+                      int *drawn, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
@@ -103,7 +103,7 @@ static int write_time(const char *stage, const bsim_scene *lattice, const bsim_m
 	bsim_figure_def fd = bsim_figure_def_default();
 	fd.dir = stage;
 	fd.name = "time";
-	return bsim_figure_render(&fd, body, NULL, err);
+	return bsim_figure_render(&fd, body, drawn, err);
 }
 
 int bsim_markov_prediction_store(const char *dir, int overwrite, const bsim_scene *lattice,
@@ -123,10 +123,18 @@ int bsim_markov_prediction_store(const char *dir, int overwrite, const bsim_scen
 		snprintf(mat, sizeof mat, "%s/%s.mat", ss.stage, names[i]);
 		rc = bsim_matlab_from_csv(csv, mat, names[i], err);
 	}
-	if (rc == BSIM_OK)
-		rc = write_figure(ss.stage, lattice, set, p, err);
-	if (rc == BSIM_OK && p->walks > 0)
-		rc = write_time(ss.stage, lattice, p, err);
+	/* A figure gnuplot fails on is reported at the end, the tables (those
+	 * after it too) kept beside its script and data. */
+	int drawn = BSIM_FIGURE_UNDRAWN;
+	if (rc == BSIM_OK) {
+		rc = write_figure(ss.stage, lattice, set, p, &drawn, err);
+		rc = bsim_session_defer(&ss, rc, drawn == BSIM_FIGURE_FAILED, err);
+	}
+	if (rc == BSIM_OK && p->walks > 0) {
+		drawn = BSIM_FIGURE_UNDRAWN;
+		rc = write_time(ss.stage, lattice, p, &drawn, err);
+		rc = bsim_session_defer(&ss, rc, drawn == BSIM_FIGURE_FAILED, err);
+	}
 	if (rc == BSIM_OK && p->walks > 0) {
 		char csv[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];
 		snprintf(csv, sizeof csv, "%s/time.csv", ss.stage);

@@ -80,11 +80,13 @@ int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures
 		        "trials.csv of a sweep, report.json and pairs.csv of compare, "
 		        "trajectory.csv and ledger.csv of run --out, accuracy.csv or essay.csv)",
 		        dir);
+	figs_failure failure = {.name = ""};
 	figs f = {
 	        .out = d.out ? d.out : dir,
 	        .def = &d,
 	        .res = out,
 	        .threads = d.threads > 0 ? d.threads : omp_get_max_threads(),
+	        .failure = &failure,
 	};
 	out->kind = kind;
 	int rc = bsim_output_mkdir(f.out, err);
@@ -111,6 +113,10 @@ int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures
 	default:
 		break;
 	}
+	if (rc == BSIM_OK && out->failed > 0)
+		return bsim_error_set(err, BSIM_EFAIL, "%s%s", failure.err.msg,
+		                      out->failed > 1 ? " (and more figures gnuplot failed on)"
+		                                      : "");
 	if (rc == BSIM_OK && out->n > 0 && out->drawn < out->n)
 		figs_note(&f, "%s", bsim_figure_missing_hint());
 	return rc;

@@ -29,6 +29,8 @@ int bsim_figures_plot(const char *dir, const bsim_figures_def *def, bsim_figures
 	bsim_figures_def d = *def;
 	d.out = ss.stage;
 	rc = bsim_figures_draw(dir, &d, out, err);
+	/* the figures drawn and those gnuplot failed on are committed */
+	rc = bsim_session_defer(&ss, rc, out->failed > 0, err);
 	/* Paths and notes name the figures where they will be. */
 	size_t stage_len = strlen(ss.stage), to_len = strlen(to);
 	for (int i = 0; rc == BSIM_OK && i < out->n; i++) {

@@ -46,9 +46,23 @@ int figs_render(figs *f, const char *name, int width, int height, const char *bo
 	d.width = width;
 	d.height = height;
 	int drawn = 0;
-	int rc = bsim_figure_render(&d, body, &drawn, err);
-	if (rc)
+	bsim_error e1;
+	int rc = bsim_figure_render(&d, body, &drawn, &e1);
+	if (rc && drawn == BSIM_FIGURE_FAILED) {
+#pragma omp critical(bsim_figures_list)
+		{
+			if (f->res->failed++ == 0 || strcmp(name, f->failure->name) < 0) {
+				f->failure->err = e1;
+				snprintf(f->failure->name, sizeof f->failure->name, "%s", name);
+			}
+		}
+		return BSIM_OK;
+	}
+	if (rc) {
+		if (err)
+			*err = e1;
 		return rc;
+	}
 	size_t len = strlen(f->out) + strlen(name) + 2;
 	char *path = malloc(len);
 	if (path)

@@ -29,11 +29,19 @@
 #define FIG_GREY   "#9A9A9A"
 #define FIG_DKGREY "#5A5A5A"
 
+/* Of the figures gnuplot failed on (res->failed), the first by name,
+ * whatever the order they were drawn in: bsim_figures_draw's error. */
+typedef struct figs_failure {
+	bsim_error err;
+	char name[128];
+} figs_failure;
+
 typedef struct figs {
 	const char *out; /* where the figures go */
 	const bsim_figures_def *def;
 	bsim_figures_result *res;
 	int threads;
+	figs_failure *failure; /* shared by the copies of f made for a subdirectory */
 } figs;
 
 /* Files. */
@@ -44,7 +52,10 @@ int figs_data_open(const figs *f, const char *file, bsim_atomic_file *o, char *p
 int figs_data_commit(bsim_atomic_file *o, bsim_error *err);
 
 /* Writes OUT/NAME.gp around body and draws it (width x height pixels);
- * records the figure. Safe to call from several threads. */
+ * records the figure. A figure gnuplot fails on is counted (res->failed,
+ * f->failure) and BSIM_OK returned, so the writers draw the others and
+ * bsim_figures_draw reports it at the end. Safe to call from several
+ * threads. */
 int figs_render(figs *f, const char *name, int width, int height, const char *body,
                 bsim_error *err);
 

@@ -72,6 +72,16 @@ int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, c
 	return rc;
 }
 
+int bsim_session_defer(bsim_session *s, int rc, int deferrable, const bsim_error *err)
+{
+	if (rc == BSIM_OK || !deferrable)
+		return rc;
+	if (s->n_deferred++ == 0 && err)
+		s->deferred = *err;
+	s->deferred.code = rc;
+	return BSIM_OK;
+}
+
 int bsim_session_close(bsim_session *s, int rc, const char *command, int *kept, bsim_error *err)
 {
 	bsim_error e;
@@ -86,6 +96,15 @@ int bsim_session_close(bsim_session *s, int rc, const char *command, int *kept, 
 			*err = e;
 			rc = BSIM_EFAIL;
 			keep = 1; /* the trials are done: a resumed run writes the files again */
+		} else if (s->n_deferred > 0) {
+			/* committed as a result; the run still failed */
+			*err = s->deferred;
+			rc = s->deferred.code;
+			if (s->n_deferred > 1) {
+				size_t used = strlen(err->msg);
+				snprintf(err->msg + used, sizeof err->msg - used,
+				         " (and %d more failures like it)", s->n_deferred - 1);
+			}
 		}
 	} else if (rc == BSIM_ESTOPPED || s->done ||
 	           (s->journal && bsim_journal_failed(s->journal))) {

@@ -21,6 +21,8 @@ typedef struct bsim_session {
 	char journal_path[BSIM_PATH_MAX];
 	int add;  /* the files join DIR's set (bsim_outdir_add): mode BSIM_OUTDIR_ADD */
 	int done; /* set once every trial is journaled: a later failure keeps the journal */
+	bsim_error deferred; /* the first failure deferred to close (bsim_session_defer) */
+	int n_deferred;
 } bsim_session;
 
 /* Opens dir in mode (outdir.h; BSIM_EINPUT if it cannot be used, another
@@ -42,7 +44,8 @@ static inline bsim_outdir_mode bsim_session_mode(int resume, int overwrite)
 /* Ends the session with the run's status rc (err holding its message if
  * rc is not BSIM_OK): if BSIM_OK, commits the files (and removes the
  * journal once they are in place; a failed commit keeps it, so a resumed
- * run writes the files again). Finished work is never thrown away: the
+ * run writes the files again), and then returns a failure deferred by
+ * bsim_session_defer if there is one. Finished work is never thrown away: the
  * journal is kept if the run was stopped (BSIM_ESTOPPED), if it failed
  * after its trials were done (s->done: writing the files, a full disk),
  * or if the journal itself could not be written (a full disk: what was
@@ -52,6 +55,16 @@ static inline bsim_outdir_mode bsim_session_mode(int resume, int overwrite)
  * not in the staging area; *kept (may be NULL) is 1 if the journal was
  * kept, its path in s->journal_path. */
 int bsim_session_close(bsim_session *s, int rc, const char *command, int *kept, bsim_error *err);
+
+/* Defers a failure that leaves what the run made sound to the session's
+ * end: a figure gnuplot failed on (drawn BSIM_FIGURE_FAILED, util/figure.h)
+ * has its script and data staged beside the tables computed before it.
+ * With rc a failure and deferrable set, records it (the first one; later
+ * ones are counted) and returns BSIM_OK, so the run goes on to write its
+ * other files; else returns rc. bsim_session_close then commits the staged
+ * files as on success and returns the deferred failure, its message naming
+ * files by their place in dir. */
+int bsim_session_defer(bsim_session *s, int rc, int deferrable, const bsim_error *err);
 
 /* "dir/name" into buf; BSIM_EFAIL naming both if it does not fit. */
 int bsim_session_path(char *buf, size_t size, const char *dir, const char *name, bsim_error *err);

@@ -13,7 +13,11 @@
  *
  * By hand it draws NAME.png and NAME.svg. beamsim passes
  * outbase = "NAME.tmp.PID" and renames the two images once gnuplot has
- * exited cleanly, so a reader never sees a half-drawn image. */
+ * exited with status 0 and both are whole (a PNG ends with its IEND chunk,
+ * an SVG with </svg>), so a reader never sees a half-drawn image. gnuplot's
+ * messages go to a temporary file: the last line of a failing gnuplot is
+ * its error, quoted in ours; those of one that succeeded are warnings,
+ * passed on as notes (bsim_note). */
 #define _POSIX_C_SOURCE 200809L
 #include "util/figure.h"
 
@@ -27,6 +31,7 @@
 #include <unistd.h>
 
 #include "util/atomic_file.h"
+#include "util/program_log.h"
 #include "beamsim/version.h"
 #include "beamsim/limits.h"
 
@@ -110,8 +115,8 @@ static int script_write(const bsim_figure_def *d, const char *body, bsim_error *
 }
 
 /* Starts `gnuplot -e 'outbase="TMP"' NAME.gp` in DIR, its standard output
- * to /dev/null and its messages to ours. The process id, or -1. */
-static pid_t gnuplot_start(const char *dir, const char *name, const char *tmpbase)
+ * to /dev/null and its messages to log. The process id, or -1. */
+static pid_t gnuplot_start(const char *dir, const char *name, const char *tmpbase, FILE *log)
 {
 	char script[BSIM_PATH_MAX], expr[BSIM_PATH_MAX];
 	snprintf(script, sizeof script, "%s.gp", name);
@@ -123,13 +128,16 @@ static pid_t gnuplot_start(const char *dir, const char *name, const char *tmpbas
 	int null = open("/dev/null", O_WRONLY);
 	if (null >= 0)
 		dup2(null, STDOUT_FILENO);
+	if (log)
+		dup2(fileno(log), STDERR_FILENO);
 	if (chdir(dir) != 0)
 		_exit(126);
 	execlp("gnuplot", "gnuplot", "-e", expr, script, (char *)NULL);
 	_exit(127);
 }
 
-/* The exit status of process pid, or -1. */
+/* The status of process pid as a shell gives it (128 + a signal's
+ * number), or -1. */
 static int gnuplot_wait(pid_t pid)
 {
 	if (pid < 0)
@@ -138,32 +146,131 @@ static int gnuplot_wait(pid_t pid)
 	while (waitpid(pid, &status, 0) < 0)
 		if (errno != EINTR)
 			return -1;
+	if (WIFSIGNALED(status))
+		return 128 + WTERMSIG(status);
 	return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-/* Moves the images of a finished gnuplot into place, or removes them if
- * it failed. */
-static int images_commit(const bsim_figure_def *d, const char *tmpbase, int status, bsim_error *err)
+/* Whether an image gnuplot wrote is whole: a PNG ends with its IEND chunk,
+ * an SVG with its closing tag. gnuplot exits with status 0 when a full disk
+ * cut an image short, so its status alone does not tell. 0, or -1 with why
+ * (of size n) saying what is wrong of the image NAME.EXT. */
+static int image_whole(const char *path, const char *name, const char *ext, char *why, size_t n)
+{
+	static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+	static const unsigned char png_end[12] = {0,   0,   0,    0,    'I',  'E',
+	                                          'N', 'D', 0xae, 0x42, 0x60, 0x82};
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		snprintf(why, n, "%s.%s was not written: %s", name, ext, strerror(errno));
+		return -1;
+	}
+	unsigned char head[8] = {0}, tail[64] = {0};
+	long size = -1;
+	size_t got_head = fread(head, 1, sizeof head, f), got_tail = 0;
+	if (fseek(f, 0, SEEK_END) == 0 && (size = ftell(f)) >= 0) {
+		long from = size > (long)sizeof tail ? size - (long)sizeof tail : 0;
+		if (fseek(f, from, SEEK_SET) == 0)
+			got_tail = fread(tail, 1, sizeof tail, f);
+	}
+	fclose(f);
+	int whole;
+	if (strcmp(ext, "png") == 0) {
+		whole = got_head == 8 && memcmp(head, png_sig, 8) == 0 && got_tail >= 12 &&
+		        memcmp(tail + got_tail - 12, png_end, 12) == 0;
+	} else {
+		while (got_tail > 0 && (tail[got_tail - 1] == '\n' || tail[got_tail - 1] == '\r' ||
+		                        tail[got_tail - 1] == ' '))
+			got_tail--;
+		whole = got_tail >= 6 && memcmp(tail + got_tail - 6, "</svg>", 6) == 0;
+	}
+	if (whole)
+		return 0;
+	snprintf(why, n, "%s.%s is cut short (%ld bytes, no %s at its end)", name, ext, size,
+	         strcmp(ext, "png") == 0 ? "IEND chunk" : "</svg>");
+	return -1;
+}
+
+/* 1 if name is one of the list ", A, B" in out. */
+static int listed(const char *out, const char *name)
+{
+	size_t len = strlen(name);
+	for (const char *q = out; (q = strstr(q, name)) != NULL; q++)
+		if (q - out >= 2 && q[-2] == ',' && q[-1] == ' ' && (q[len] == ',' || !q[len]))
+			return 1;
+	return 0;
+}
+
+/* Appends ", A.dat, B.csv" to out (of size n) for the files the script's
+ * body reads, named in it in quotes and present in dir (its titles and
+ * labels name no file there), each once. */
+static void data_names(const char *dir, const char *body, char *out, size_t n)
+{
+	size_t used = strlen(out);
+	for (const char *p = body; *p; p++) {
+		if (*p != '\'' && *p != '"')
+			continue;
+		const char *end = strchr(p + 1, *p);
+		if (!end)
+			break;
+		size_t len = (size_t)(end - p - 1);
+		char name[256], path[BSIM_PATH_MAX];
+		struct stat st;
+		if (len > 0 && len < sizeof name) {
+			memcpy(name, p + 1, len);
+			name[len] = '\0';
+			if (!strchr(name, '/') && !listed(out, name) && used + len + 3 < n &&
+			    snprintf(path, sizeof path, "%s/%s", dir, name) < (int)sizeof path &&
+			    stat(path, &st) == 0 && S_ISREG(st.st_mode))
+				used += (size_t)snprintf(out + used, n - used, ", %s", name);
+		}
+		p = end;
+	}
+}
+
+/* Moves the images of a finished gnuplot into place if it exited with
+ * status 0 and both are whole: 0. Else removes them and says why (of size
+ * n, gnuplot's own message quoted): -1. */
+static int images_commit(const bsim_figure_def *d, const char *tmpbase, int status, FILE *log,
+                         char *why, size_t n)
 {
 	static const char *const ext[] = {"png", "svg"};
-	char from[BSIM_PATH_MAX], to[BSIM_PATH_MAX];
-	if (status != 0) {
-		for (int i = 0; i < 2; i++) {
-			snprintf(from, sizeof from, "%s/%s.%s", d->dir, tmpbase, ext[i]);
-			unlink(from);
-		}
-		return bsim_error_set(err, BSIM_EFAIL,
-		                      "gnuplot failed on %s/%s.gp (exit status %d); its data and "
-		                      "script are left for a look",
-		                      d->dir, d->name, status);
+	char from[BSIM_PATH_MAX], to[BSIM_PATH_MAX], last[400];
+	/* gnuplot ends a failure with `"NAME.gp" line N: what went wrong`,
+	 * after the command and a caret under the place; what one that
+	 * succeeded says are warnings, passed on. */
+	program_log_line(log, 1, last, sizeof last);
+	if (status == 0) {
+		char prefix[200];
+		snprintf(prefix, sizeof prefix, "gnuplot on %s.gp", d->name);
+		program_log_notes(log, prefix);
 	}
-	for (int i = 0; i < 2; i++) {
+	why[0] = '\0';
+	if (status != 0) {
+		snprintf(why, n, "gnuplot %s %d%s%s",
+		         status > 128 ? "was killed by signal" : "exited with status",
+		         status > 128 ? status - 128 : status, last[0] ? ": " : "", last);
+	} else {
+		for (int i = 0; i < 2 && !why[0]; i++) {
+			char cut[360];
+			snprintf(from, sizeof from, "%s/%s.%s", d->dir, tmpbase, ext[i]);
+			if (image_whole(from, d->name, ext[i], cut, sizeof cut) != 0)
+				snprintf(why, n, "gnuplot exited with status 0 but %s", cut);
+		}
+	}
+	for (int i = 0; i < 2 && !why[0]; i++) {
 		snprintf(from, sizeof from, "%s/%s.%s", d->dir, tmpbase, ext[i]);
 		snprintf(to, sizeof to, "%s/%s.%s", d->dir, d->name, ext[i]);
 		if (rename(from, to) != 0)
-			return bsim_error_set(err, BSIM_EFAIL, "%s: %s", to, strerror(errno));
+			snprintf(why, n, "%s.%s: %s", d->name, ext[i], strerror(errno));
 	}
-	return BSIM_OK;
+	if (!why[0])
+		return 0;
+	for (int i = 0; i < 2; i++) {
+		snprintf(from, sizeof from, "%s/%s.%s", d->dir, tmpbase, ext[i]);
+		unlink(from);
+	}
+	return -1;
 }
 
 /* def with the defaults filled in. */
@@ -185,7 +292,7 @@ int bsim_figure_render_all(const bsim_figure_def *defs, const char *const *bodie
                            int *drawn, bsim_error *err)
 {
 	if (drawn)
-		*drawn = 0;
+		*drawn = BSIM_FIGURE_UNDRAWN;
 	for (int i = 0; i < n; i++) {
 		bsim_figure_def d = def_resolve(&defs[i]);
 		if (!d.dir || !name_ok(d.name))
@@ -198,29 +305,49 @@ int bsim_figure_render_all(const bsim_figure_def *defs, const char *const *bodie
 	if (!bsim_figure_available())
 		return BSIM_OK;
 	pid_t *pids = malloc((n > 0 ? (size_t)n : 1) * sizeof *pids);
-	if (!pids)
+	FILE **logs = calloc(n > 0 ? (size_t)n : 1, sizeof *logs);
+	if (!pids || !logs) {
+		free(pids);
+		free(logs);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
 	for (int i = 0; i < n; i++) {
 		char tmpbase[256];
 		snprintf(tmpbase, sizeof tmpbase, "%s.tmp.%ld", defs[i].name, (long)getpid());
-		pids[i] = gnuplot_start(defs[i].dir, defs[i].name, tmpbase);
+		logs[i] = program_log_open();
+		pids[i] = gnuplot_start(defs[i].dir, defs[i].name, tmpbase, logs[i]);
 	}
-	int rc = BSIM_OK;
+	/* Every figure that failed is named with gnuplot's message, then the
+	 * files that remain to look at and rerun it by hand. */
+	char fails[BSIM_ERROR_MSG_MAX] = "", files[BSIM_ERROR_MSG_MAX] = "";
+	const char *where = NULL;
+	int n_failed = 0;
 	for (int i = 0; i < n; i++) {
 		bsim_figure_def d = def_resolve(&defs[i]);
-		char tmpbase[256];
+		char tmpbase[256], why[480];
 		snprintf(tmpbase, sizeof tmpbase, "%s.tmp.%ld", d.name, (long)getpid());
-		bsim_error e1;
-		int r = images_commit(&d, tmpbase, gnuplot_wait(pids[i]), &e1);
-		if (r && rc == BSIM_OK) {
-			rc = r;
-			if (err)
-				*err = e1;
-		}
+		int r = images_commit(&d, tmpbase, gnuplot_wait(pids[i]), logs[i], why, sizeof why);
+		if (logs[i])
+			fclose(logs[i]);
+		if (r == 0)
+			continue;
+		size_t used = strlen(fails), f_used = strlen(files);
+		snprintf(fails + used, sizeof fails - used, "%sfigure %s: %s", n_failed ? "; " : "",
+		         d.name, why);
+		snprintf(files + f_used, sizeof files - f_used, ", %s.gp", d.name);
+		data_names(d.dir, bodies[i], files, sizeof files);
+		where = where ? where : d.dir;
+		n_failed++;
 	}
+	int rc = BSIM_OK;
+	if (n_failed)
+		rc = bsim_error_set(err, BSIM_EFAIL, "%s; %s and data are in %s: %s", fails,
+		                    n_failed == 1 ? "its script" : "their scripts", where,
+		                    files + 2);
 	free(pids);
+	free(logs);
 	if (drawn)
-		*drawn = rc == BSIM_OK;
+		*drawn = rc == BSIM_OK ? BSIM_FIGURE_DRAWN : BSIM_FIGURE_FAILED;
 	return rc;
 }
 

@@ -9,9 +9,13 @@
  * Data files are named in the body relative to DIR.
  *
  * gnuplot writes the images under temporary names, renamed into place when
- * it succeeds, so a figure appears whole or not at all. Without gnuplot on
- * the PATH the script and data are still written and the caller is told
- * (drawn = 0), with a message naming the package to install. */
+ * it exits with status 0 and both images are whole, so a figure appears
+ * whole or not at all. A figure gnuplot failed on keeps its script and data
+ * (drawn = BSIM_FIGURE_FAILED): what made them is sound, and the caller
+ * keeps it (store/session.h, bsim_session_defer). Without gnuplot on the
+ * PATH the script and data are still written and the caller is told
+ * (drawn = BSIM_FIGURE_UNDRAWN), with a message naming the package to
+ * install. */
 #ifndef BSIM_UTIL_FIGURE_H
 #define BSIM_UTIL_FIGURE_H
 
@@ -43,16 +47,27 @@ typedef struct bsim_figure_def {
 /* dir and name NULL, 900 x 600, "sans,11". */
 bsim_figure_def bsim_figure_def_default(void);
 
+/* What *drawn of the calls below says. */
+enum {
+	BSIM_FIGURE_FAILED = -1, /* gnuplot failed (BSIM_EFAIL): scripts and data written */
+	BSIM_FIGURE_UNDRAWN = 0, /* gnuplot is missing: scripts and data written */
+	BSIM_FIGURE_DRAWN = 1,   /* the images too */
+};
+
 /* Writes DIR/NAME.gp around body (gnuplot commands, newline-separated) and,
  * if gnuplot is on the PATH, runs it to draw NAME.png and NAME.svg. drawn
- * (may be NULL) is 1 if both images were drawn, 0 if gnuplot is missing.
- * BSIM_EFAIL naming the script if it cannot be written or gnuplot fails. */
+ * (may be NULL) as above. BSIM_EFAIL if the script cannot be written
+ * (drawn BSIM_FIGURE_UNDRAWN), or if gnuplot exits with another status than
+ * 0 or leaves an image cut short (BSIM_FIGURE_FAILED): the message names
+ * the figure, quotes gnuplot's last line, and names the script and the data
+ * it reads, which stay in DIR. */
 int bsim_figure_render(const bsim_figure_def *def, const char *body, int *drawn, bsim_error *err);
 
 /* Renders n figures as bsim_figure_render does, their gnuplot processes
  * running at the same time (a figure's wall time is mostly gnuplot's). All
- * scripts are written first; drawn (may be NULL) is 1 if every figure was
- * drawn. The first error is returned; the other figures are still drawn. */
+ * scripts are written first; drawn (may be NULL) is BSIM_FIGURE_DRAWN if
+ * every figure was drawn. A figure that fails does not stop the others; the
+ * message names every one that failed, in order. */
 int bsim_figure_render_all(const bsim_figure_def *defs, const char *const *bodies, int n,
                            int *drawn, bsim_error *err);
 

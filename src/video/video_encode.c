@@ -11,10 +11,12 @@
  * chroma layout every H.264 player decodes.
  *
  * ffmpeg is started with posix_spawnp (no shell, so no quoting of the
- * path), its standard error goes to an unnamed temporary file whose last
+ * path), its standard error goes to an unnamed temporary file whose first
  * line is quoted if it fails. The output is the temporary file of a
  * bsim_atomic_file: ffmpeg truncates and fills that same file, and commit
- * syncs it and renames it into place only if ffmpeg exited with status 0.
+ * syncs it and renames it into place only if ffmpeg exited with status 0,
+ * wrote no error (at -loglevel error it writes nothing else) and the file
+ * is a whole MP4 (video_mp4.c); else the temporary file is removed.
  * SIGPIPE (ffmpeg gone while frames are written) is blocked in the writing
  * thread only for the write, and a pending one it raised is taken back, so
  * the library leaves the process's signal handling as it found it. */
@@ -35,7 +37,9 @@
 #include <unistd.h>
 
 #include "util/atomic_file.h"
+#include "util/program_log.h"
 #include "beamsim/video.h"
+#include "video/video_internal.h"
 #include "beamsim/limits.h"
 
 extern char **environ;
@@ -57,25 +61,6 @@ static const char *raw_pixel_format(void)
 	unsigned char first;
 	memcpy(&first, &probe, 1);
 	return first == 0x03 ? "bgr0" : "0rgb";
-}
-
-/* The last non-empty line ffmpeg wrote to its standard error. */
-static void last_log_line(FILE *log, char *buf, size_t n)
-{
-	buf[0] = '\0';
-	if (!log || n == 0)
-		return;
-	char line[512];
-	rewind(log);
-	while (fgets(line, sizeof line, log)) {
-		size_t len = strcspn(line, "\r\n");
-		line[len] = '\0';
-		if (len > 0) {
-			size_t m = len < n - 1 ? len : n - 1;
-			memcpy(buf, line, m);
-			buf[m] = '\0';
-		}
-	}
 }
 
 /* Removes the temporary files PATH.tmp.PID that processes no longer alive
@@ -116,11 +101,11 @@ static void remove_stale(const char *path)
 		closedir(d);
 }
 
-/* "exited with status 1: <its last line>" or "was killed by signal 9". */
+/* "exited with status 1: <its first line>" or "was killed by signal 9". */
 static void describe_status(bsim_video_encoder *e, char *buf, size_t n)
 {
 	char last[320];
-	last_log_line(e->log, last, sizeof last);
+	program_log_line(e->log, 0, last, sizeof last);
 	int k;
 	if (WIFEXITED(e->status))
 		k = snprintf(buf, n, "%s exited with status %d", e->program,
@@ -262,10 +247,9 @@ int bsim_video_encoder_open(const char *path, const char *program, int width, in
 		free(e);
 		return rc;
 	}
-	e->log = tmpfile();
+	e->log = program_log_open();
 	int fds[2] = {-1, -1};
-	if (!e->log || set_cloexec(fileno(e->log)) || pipe(fds) != 0 || set_cloexec(fds[0]) ||
-	    set_cloexec(fds[1])) {
+	if (!e->log || pipe(fds) != 0 || set_cloexec(fds[0]) || set_cloexec(fds[1])) {
 		rc = bsim_error_set(err, BSIM_EFAIL, "cannot make a pipe to %s: %s", e->program,
 		                    strerror(errno));
 	} else {
@@ -333,17 +317,51 @@ int bsim_video_encoder_write(bsim_video_encoder *e, const uint32_t *pixels, bsim
 	                      strerror(saved));
 }
 
+/* Why the video ffmpeg ended is not whole (of size n, empty if it is):
+ * its exit status; a message at -loglevel error, which is an error
+ * although the status is 0 (ffmpeg 5.1 exits with 0 after "Error writing
+ * trailer": the index of the MP4 is missing); and, for a regular file, the
+ * file itself (video_mp4_whole). */
+static void encoder_verdict(bsim_video_encoder *e, char *why, size_t n)
+{
+	char first[320];
+	struct stat st;
+	why[0] = '\0';
+	/* At -loglevel error ffmpeg writes errors alone, the first the cause
+	 * ("Error writing trailer of ...: No space left on device"), those
+	 * after it what followed ("Error closing file ..."). */
+	program_log_line(e->log, 0, first, sizeof first);
+	if (e->status != 0) {
+		describe_status(e, why, n);
+		return;
+	}
+	if (first[0]) {
+		snprintf(why, n, "%s exited with status 0 after an error: %s", e->program, first);
+		return;
+	}
+	const char *file = e->out.mode == BSIM_ATOMIC_RENAME ? e->out.tmp : e->path;
+	char cut[400];
+	if (e->out.mode != BSIM_ATOMIC_STDOUT && stat(file, &st) == 0 && S_ISREG(st.st_mode) &&
+	    video_mp4_whole(file, cut, sizeof cut) != 0)
+		snprintf(why, n, "%s exited with status 0 but the MP4 is not whole: %s", e->program,
+		         cut);
+}
+
 int bsim_video_encoder_close(bsim_video_encoder *e, bsim_error *err)
 {
 	reap(e);
 	int rc;
-	if (e->status == 0) {
+	char why[768];
+	encoder_verdict(e, why, sizeof why);
+	if (!why[0]) {
 		rc = bsim_atomic_file_commit(&e->out, err);
 	} else {
-		char why[512];
-		describe_status(e, why, sizeof why);
+		/* Its temporary file is removed: nothing that looks like a
+		 * finished video is left at the path. */
+		int removed = e->out.mode == BSIM_ATOMIC_RENAME;
 		bsim_atomic_file_abort(&e->out);
-		rc = bsim_error_set(err, BSIM_EFAIL, "%s: %s", e->path, why);
+		rc = bsim_error_set(err, BSIM_EFAIL, "%s: encoding the video: %s%s", e->path, why,
+		                    removed ? "; no video written" : "");
 	}
 	encoder_free(e);
 	return rc;

@@ -188,6 +188,12 @@ int video_render_frame(bsim_video *v, long k, bsim_error *err);
 /* The stiffness colour scale, 0x00RRGGBB: u in [0, 1], 0 the softest. */
 uint32_t video_colormap(double u);
 
+/* 0 if the file at path is a whole MP4 (video_mp4.c): its boxes tile it
+ * exactly and ftyp (first), moov and mdat are among them; else -1 with why
+ * (of size n) saying what is wrong ("its box 'mdat' at byte 48 claims ...",
+ * "... has no moov box"). */
+int video_mp4_whole(const char *path, char *why, size_t n);
+
 /* BSIM_OK for a scene the video can draw (a disk), else BSIM_EINPUT with
  * err naming body.shape (video.c). */
 int video_scene_check(const bsim_scene *scene, bsim_error *err);
