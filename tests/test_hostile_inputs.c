@@ -224,7 +224,7 @@ static void test_set_values(void **state)
 	        {"body.mass=*x", "alias *x"},
 	        {"body.mass=[1,", "expected a YAML value"},
 	        {"body.ma ss=2", "expected a dotted key"},
-	        {"effects.random_force.frequency=1e9", "--limit schedule=N"},
+	        {"effects.random_force.frequency=1e9", "integration.dt: expected at most 1e-09 s"},
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
 		const char *argv[] = {"run", gate(), "--set", cases[i].set, NULL};
@@ -254,10 +254,14 @@ static void test_limits(void **state)
 	(void)state;
 	char *g = bsim_test_read(gate());
 	char *fast = malloc(strlen(g) + 64);
-	/* frequency 1e9 Hz in the file: 1.2e10 random-force values a trial */
+	/* frequency 1e9 Hz in the file, and the step of 1 ns its hold needs:
+	 * 2e6 random-force values in 2e6 steps */
 	char *f = strstr(g, "frequency: 50.0");
-	assert_non_null(f);
-	sprintf(fast, "%.*sfrequency: 1e9%s", (int)(f - g), g, f + strlen("frequency: 50.0"));
+	char *t = strstr(g, "{ dt: 0.004, duration: 12 }");
+	assert_true(f && t && f < t);
+	sprintf(fast, "%.*sfrequency: 1e9%.*s{ dt: 1e-9, max_steps: 2000000 }%s", (int)(f - g), g,
+	        (int)(t - f - strlen("frequency: 50.0")), f + strlen("frequency: 50.0"),
+	        t + strlen("{ dt: 0.004, duration: 12 }"));
 	const char *sched[] = {"frequency.yaml:", "effects.random_force.frequency",
 	                       "random-force values", "--limit schedule=N", NULL};
 	run_refused(write_bytes("frequency.yaml", fast, strlen(fast)), sched);

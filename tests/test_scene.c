@@ -619,6 +619,119 @@ static void validate_checks_code_built_scenes(void **state)
 	bsim_scene_free(&g);
 }
 
+/* ---- the time step (docs/model.md "The time step") ---------------------- */
+
+#define PI 3.14159265358979323846
+
+/* The scene at path with overrides ov[0..n) and then integration.dt = dt:
+ * its load's return code, err its message. */
+static int load_at_dt(const char *path, const bsim_override *ov, int n, double dt, bsim_error *err)
+{
+	bsim_override all[8];
+	char value[32];
+	snprintf(value, sizeof value, "%.17g", dt);
+	assert_true(n < 8);
+	for (int i = 0; i < n; i++)
+		all[i] = ov[i];
+	all[n] = (bsim_override){"integration.dt", value, NULL};
+	bsim_scene s;
+	int rc = bsim_scene_load(path, all, n + 1, &s, err);
+	bsim_scene_free(&s);
+	return rc;
+}
+
+/* The bound (s) computed by the test from the scene's numbers: a step a
+ * millionth longer is refused, the message naming integration.dt, what
+ * (the bound's name and where it comes from) and a bound of its own within
+ * 1e-3 below the test's; a step a millionth shorter loads. A bound that is
+ * not strict also loads at the number the message states; a strict one
+ * (the oscillation's Nyquist) is refused at the bound itself. */
+static void expect_dt_bound(const char *path, const bsim_override *ov, int n, double bound,
+                            int strict, const char *what)
+{
+	bsim_error err = {0};
+	assert_int_equal(load_at_dt(path, ov, n, bound * (1 + 1e-6), &err), BSIM_EINPUT);
+	const char *prefix = strict ? "integration.dt: expected less than "
+	                            : "integration.dt: expected at most ";
+	const char *at = strstr(err.msg, prefix);
+	if (!at || !strstr(err.msg, what))
+		fail_msg("\"%s\" lacks \"%s\" or \"%s\"", err.msg, prefix, what);
+	double stated = strtod(at + strlen(prefix), NULL);
+	if (!(stated <= bound && stated >= bound * (1 - 1e-3)))
+		fail_msg("%s: states %.17g, the bound is %.17g", err.msg, stated, bound);
+	assert_int_equal(load_at_dt(path, ov, n, bound * (1 - 1e-6), &err), BSIM_OK);
+	if (strict)
+		assert_int_equal(load_at_dt(path, ov, n, bound, &err), BSIM_EINPUT);
+	else
+		assert_int_equal(load_at_dt(path, ov, n, stated, &err), BSIM_OK);
+}
+
+/* Each bound on the essay's gate (configs/thesis/gate.yaml: a 1 kg disk of
+ * radius 10 m at rest at the origin, F_prop 7 N, the random force 20 N at
+ * 50 Hz, beams of 0.1 kg and 25 m, k 400 N m/rad, d 50 N m s/rad, pivots
+ * (-/+25, 30)), made the tightest by the overrides, at the value the
+ * model's formula gives. */
+static void time_step_bounds_refuse_and_accept(void **state)
+{
+	(void)state;
+	const char *gate = bsim_test_src("configs/thesis/gate.yaml");
+	const double inertia = 0.1 * 25.0 * 25.0 / 3.0; /* m L^2 / 3 */
+	/* the farthest point a beam reaches from the start: pivot + L */
+	const double reach = hypot(25.0, 30.0) + 25.0;
+	const double forces = sqrt(2.0 * 7.0 / 1.0 * reach); /* F_prop alone, from rest */
+	/* held: a value must hold for a step */
+	expect_dt_bound(gate, NULL, 0, 1.0 / 50.0, 0, "the random force's hold 1/f, f = 50 Hz");
+	bsim_override ou[] = {{"effects.random_force.model", "ou", NULL},
+	                      {"effects.random_force.correlation_time", "0.005", NULL}};
+	expect_dt_bound(gate, ou, 2, 0.005, 0, "correlation time tau = 0.005 s");
+	/* without the random force, each of the others in turn */
+	bsim_override osc[] = {{"effects.random_force.magnitude", "0", NULL},
+	                       {"effects.oscillation", "{amplitude: 1, frequency: 4}", NULL}};
+	expect_dt_bound(gate, osc, 2, 1.0 / (2.0 * 4.0), 1, "half the oscillation's period");
+	bsim_override spring[] = {{"effects.random_force.magnitude", "0", NULL},
+	                          {"beams.0.stiffness", "1e5", NULL}};
+	expect_dt_bound(gate, spring, 2, PI * sqrt(inertia / 1e5), 0,
+	                "half the natural period pi sqrt(I/k) of beam 1 (beams.0)");
+	bsim_override damper[] = {{"effects.random_force.magnitude", "0", NULL},
+	                          {"beams.1.damping", "5000", NULL}};
+	expect_dt_bound(gate, damper, 2, 2.0 * inertia / 5000.0, 0,
+	                "twice the damping time 2 I/d of beam 2 (beams.1)");
+	bsim_override calm[] = {{"effects.random_force.magnitude", "0", NULL}};
+	expect_dt_bound(gate, calm, 1, 10.0 / forces, 0,
+	                "the body's crossing: its half-width 10 m");
+	/* a start speed adds to the speed scale */
+	bsim_override fast[] = {{"effects.random_force.magnitude", "0", NULL},
+	                        {"body.velocity", "[0, 50]", NULL}};
+	expect_dt_bound(gate, fast, 2, 10.0 / (50.0 + forces), 0, "start 50 m/s");
+	/* an ellipse: its smaller semi-axis */
+	expect_dt_bound(bsim_test_src("configs/shape/gate_ellipse.yaml"), calm, 1, 7.071 / forces,
+	                0, "its half-width 7.071 m");
+	/* a capsule that spins: its half-width 6 m, its ends 6 + 16.755 / 2 m
+	 * from its centre turning at 3 rad/s */
+	const char *capsule = bsim_test_src("configs/shape/gate_capsule.yaml");
+	bsim_override spin[] = {{"effects.random_force.magnitude", "0", NULL},
+	                        {"body.angular_velocity", "3", NULL}};
+	expect_dt_bound(capsule, spin, 2, 6.0 / (forces + 3.0 * (6.0 + 16.755 / 2.0)), 0,
+	                "its half-width 6 m");
+}
+
+/* The same check on a scene built in code, as the bindings' programs may
+ * build one: the gate at dt 0.5 s is refused, at 1/f = 0.02 s it is not. */
+static void validate_checks_the_time_step(void **state)
+{
+	(void)state;
+	bsim_scene g;
+	bsim_error err = {0};
+	bsim_scene_init_gate(&g, 7, 20);
+	g.dt = 0.5;
+	assert_int_equal(bsim_scene_validate(&g, &err), BSIM_EINPUT);
+	assert_non_null(strstr(err.msg, "thesis-gate: integration.dt: expected at most 0.02 s "
+	                                "(the random force's hold 1/f, f = 50 Hz), got 0.5"));
+	g.dt = 1.0 / 50.0;
+	assert_int_equal(bsim_scene_validate(&g, &err), BSIM_OK);
+	bsim_scene_free(&g);
+}
+
 static void load_experiment(const char *rel, bsim_experiment *e)
 {
 	bsim_error err = {0};
@@ -781,6 +894,8 @@ int main(void)
 	        cmocka_unit_test(inconsistent_steps_and_time_are_refused),
 	        cmocka_unit_test(lattice_gate_time_gives_gate_steps),
 	        cmocka_unit_test(validate_checks_code_built_scenes),
+	        cmocka_unit_test(time_step_bounds_refuse_and_accept),
+	        cmocka_unit_test(validate_checks_the_time_step),
 	        cmocka_unit_test(h1_has_30_groups_first_axis_slowest),
 	        cmocka_unit_test(h2_has_162_groups_and_set_block),
 	        cmocka_unit_test(experiment_grid_value_is_validated_at_load),

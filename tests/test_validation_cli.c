@@ -161,6 +161,54 @@ static void non_positive_dt(void **state)
 	run_bad_scene("dt", BODY BEAMS "integration:\n  dt: 0\n", needles);
 }
 
+/* A step the model cannot resolve: exit 2 naming integration.dt, where it
+ * was set, the bound and its numbers. On the essay's gate the random force
+ * holds each value 1/f = 1/50 Hz = 0.02 s: 0.5 s and 12 s are refused at
+ * their --set, 0.02 s runs. */
+static void unresolvable_dt(void **state)
+{
+	(void)state;
+	const char *gate = bsim_test_src("configs/thesis/gate.yaml");
+	static const char *const steps[] = {"0.5", "12"};
+	for (int i = 0; i < 2; i++) {
+		char set[64], says[200];
+		snprintf(set, sizeof set, "integration.dt=%s", steps[i]);
+		snprintf(says, sizeof says,
+		         "--set %s: integration.dt: expected at most 0.02 s (the random force's "
+		         "hold "
+		         "1/f, f = 50 Hz), got %s",
+		         set, steps[i]);
+		const char *argv[] = {"run", gate, "--set", set, NULL};
+		const char *needles[] = {says, NULL};
+		bsim_test_expect_input_error(argv, needles);
+	}
+	const char *ok[] = {"run", gate, "--set", "integration.dt=0.02", NULL};
+	assert_int_equal(bsim_test_cli(ok, NULL, NULL), 0);
+	/* In a file: at the file's dt. */
+	const char *needles[] = {"dt_hold.yaml:9:7: integration.dt: expected at most 0.02 s",
+	                         "got 0.5", NULL};
+	run_bad_scene("dt_hold",
+	              BODY BEAMS "effects:\n  random_force: { magnitude: 20 }\n"
+	                         "integration:\n  dt: 0.5\n",
+	              needles);
+	/* A bound's field an override changed last is where the step broke it:
+	 * k = 2e7 N m/rad on I = 0.1 x 25^2 / 3 kg m^2 has half a period of
+	 * pi sqrt(I/k) = 3.2 ms, under the gate's 4 ms. */
+	const char *stiff[] = {"run", gate, "--set", "beams.0.stiffness=2e7", NULL};
+	const char *stiff_says[] = {"--set beams.0.stiffness=2e7: integration.dt: expected at most "
+	                            "0.003206 s (half the natural period pi sqrt(I/k) of beam 1 "
+	                            "(beams.0)",
+	                            "got 0.004", NULL};
+	bsim_test_expect_input_error(stiff, stiff_says);
+	/* The body's crossing: 10 km/s covers 40 m a step of 4 ms, four times
+	 * its radius. */
+	const char *fast[] = {"run", gate, "--backend", "box2d", "--set", "body.velocity.1=1e4",
+	                      NULL};
+	const char *fast_says[] = {"--set body.velocity.1=1e4: integration.dt: expected at most",
+	                           "the body's crossing: its half-width 10 m", "got 0.004", NULL};
+	bsim_test_expect_input_error(fast, fast_says);
+}
+
 static void missing_required_key(void **state)
 {
 	(void)state;
@@ -398,6 +446,7 @@ int main(void)
 	        cmocka_unit_test(non_positive_mass),
 	        cmocka_unit_test(non_positive_length),
 	        cmocka_unit_test(non_positive_dt),
+	        cmocka_unit_test(unresolvable_dt),
 	        cmocka_unit_test(missing_required_key),
 	        cmocka_unit_test(overlapping_start),
 	        cmocka_unit_test(yaml_syntax_error),

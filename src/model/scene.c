@@ -481,6 +481,12 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		        "%s: body.start: the body (radius %g) overlaps beam %d (beams.%d) at "
 		        "the start (distance %.3g m)",
 		        who, s->body.radius, beam + 1, beam, d);
+	scene_dt_bound bound;
+	if (scene_dt_find(s, &bound)) {
+		char msg[640];
+		scene_dt_message(s, &bound, msg, sizeof msg);
+		return bsim_error_set(err, BSIM_EINPUT, "%s: integration.dt: %s", who, msg);
+	}
 	scene_excess x;
 	if (scene_excess_find(s, &x)) {
 		char hint[160], detail[128];

@@ -123,6 +123,44 @@ void scene_excess_detail(const bsim_scene *s, const scene_excess *x, char *buf, 
 /* 1 and *x if the scene asks for more than a limit allows, else 0. */
 int scene_excess_find(const bsim_scene *s, scene_excess *x);
 
+/* A bound on integration.dt from one of the scene's time scales
+ * (scene_timestep.c, docs/model.md "The time step"). */
+#define SCENE_DT_BOUNDS 5 /* random force, oscillation, spring, damper, crossing */
+#define SCENE_DT_PATHS  12
+typedef struct scene_dt_bound {
+	double max;     /* s, the longest step it allows */
+	int strict;     /* 1: dt must stay below max */
+	char what[384]; /* "the random force's hold 1/f, f = 50 Hz" */
+	/* The fields it involves besides integration.dt, for the loader to
+	 * blame the one an override changed last. */
+	char paths[SCENE_DT_PATHS][48];
+	int n_paths;
+} scene_dt_bound;
+
+/* The body's speed scale for the crossing bound, m/s: its start speed, plus
+ * what its forces (propulsion, random force magnitude, oscillation
+ * amplitude) give it from rest over the distance to the farthest point a
+ * beam reaches (a lattice's gate depth or width), capped at the drag's
+ * terminal speed F/c, plus its spin times its reach, plus the fastest beam
+ * tip a beam's initial angle and speed give. */
+typedef struct scene_speed {
+	double start, accel, distance, forces, spin, tips, total;
+	int drag_capped;
+} scene_speed;
+void scene_speed_scale(const bsim_scene *s, scene_speed *v);
+
+/* Every bound the scene has (those of absent effects and of beams without
+ * spring or damper are none), the beams' the tightest beam's; returns
+ * their number. */
+int scene_dt_bounds(const bsim_scene *s, scene_dt_bound out[SCENE_DT_BOUNDS]);
+
+/* 1 and *broken the tightest bound the scene's dt breaks, else 0. */
+int scene_dt_find(const bsim_scene *s, scene_dt_bound *broken);
+
+/* "expected at most 0.02 s (the random force's hold ...), got 0.5": the
+ * bound stated rounded down to 4 digits, so that it is a step accepted. */
+void scene_dt_message(const bsim_scene *s, const scene_dt_bound *b, char *buf, size_t size);
+
 /* bsim_scene_load on a document already read (the experiment loader reads
  * the scene file once and builds every group from a clone of it). */
 int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,

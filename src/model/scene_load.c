@@ -334,6 +334,30 @@ static int check_limits(walk *w)
 	                 hint);
 }
 
+/* A step the scene cannot be resolved at (scene_timestep.c): always said
+ * of integration.dt, at the override that changed dt or a field of the
+ * bound last, else at dt in the file, else at the first of the bound's
+ * fields the file gives, else at the integration block or the root. */
+static int check_timestep(walk *w)
+{
+	scene_dt_bound b;
+	if (!scene_dt_find(w->s, &b))
+		return BSIM_OK;
+	const char *paths[1 + SCENE_DT_PATHS] = {"integration.dt"};
+	for (int i = 0; i < b.n_paths; i++)
+		paths[1 + i] = b.paths[i];
+	int n = 1 + b.n_paths;
+	struct fy_node *root = fy_document_root(w->d->fyd);
+	struct fy_node *node = latest_override(w->d, paths, n);
+	for (int i = 0; !node && i < n; i++)
+		node = ydoc_lookup(root, paths[i]);
+	if (!node)
+		node = ydoc_lookup(root, "integration");
+	char msg[640];
+	scene_dt_message(w->s, &b, msg, sizeof msg);
+	return ydoc_fail(w->d, node ? node : root, NULL, "integration.dt", w->err, "%s", msg);
+}
+
 /* The file's base name without its extension: "configs/gate.yaml" -> "gate". */
 static void default_name(bsim_scene *s, const char *path)
 {
@@ -535,6 +559,8 @@ static int walk_scene(walk *w, const ydoc *file)
 	if (!rc)
 		rc = check_overlap(w);
 	effects_present(w->s);
+	if (!rc)
+		rc = check_timestep(w);
 	if (!rc)
 		rc = check_limits(w);
 	return rc;

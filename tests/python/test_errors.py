@@ -78,3 +78,15 @@ def test_numbers_out_of_range(gate, h1, tmp_path):
                   "--out", tmp_path / "o")
     raises_as_cli(lambda: beamsim.sweep(h1, trials=0), "sweep", h1, "--trials", 0,
                   "--out", tmp_path / "o")
+
+
+def test_unresolvable_time_step(gate):
+    """A step the model cannot resolve is refused by the library's scene
+    check, as the program refuses it: on the gate, longer than the random
+    force's hold 1/f = 0.02 s; at 0.02 s the trial runs, 12 s in 600 steps."""
+    for dt in (0.5, 12):
+        raises_as_cli(lambda: beamsim.run(gate, set={"integration.dt": dt}), "run", gate,
+                      "--set", f"integration.dt={dt}")
+        with pytest.raises(ValueError, match=r"integration\.dt: expected at most 0\.02 s"):
+            beamsim.run(gate, set={"integration.dt": dt})
+    assert beamsim.run(gate, set={"integration.dt": 0.02})["steps"] == 600
