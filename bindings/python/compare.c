@@ -12,13 +12,14 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
 	static char *kwlist[] = {"experiment", "out",  "a",    "b",        "trials", "threads",
-	                         "seed",       "sets", "grid", "progress", NULL};
+	                         "seed",       "sets", "grid", "progress", "resume", NULL};
 	const char *experiment, *out, *a = "thesis", *b = "box2d";
 	long trials = 0;
-	int threads = 0;
+	int threads = 0, resume = 0;
 	PyObject *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|ssliOOOO", kwlist, &experiment, &out, &a, &b,
-	                                 &trials, &threads, &seed_o, &sets_o, &grid_o, &progress_o))
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|ssliOOOOp", kwlist, &experiment, &out, &a,
+	                                 &b, &trials, &threads, &seed_o, &sets_o, &grid_o,
+	                                 &progress_o, &resume))
 		return NULL;
 	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
 		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
@@ -48,6 +49,8 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	def.n_grid = grid.n;
 	def.trials = trials;
 	def.threads = threads;
+	def.resume = resume;
+	def.resume_option = "resume=True";
 	def.progress = pyb_progress_update;
 	def.progress_user = &progress;
 	def.stop = &progress.stop;

@@ -47,6 +47,7 @@ PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw)
 	def.threads = threads;
 	def.keep = (int)keep;
 	def.resume = resume;
+	def.resume_option = "resume=True";
 	def.progress = pyb_progress_update;
 	def.progress_user = &progress;
 	def.stop = &progress.stop;

@@ -54,7 +54,11 @@ typedef struct bsim_sweep_dir_def {
 	int keep;                    /* trajectories kept per group (trajectories.csv) */
 	int keep_stride;             /* a kept row every keep_stride steps (<= 0: 5) */
 	int resume;                  /* 1: continue the stopped run in out (same inputs) */
-	bsim_progress_fn progress;   /* may be NULL */
+	/* How the caller spells resume in messages about it ("add --resume
+	 * to continue it"): NULL the command line's "--resume"; a binding
+	 * names its own argument ("resume=True"). */
+	const char *resume_option;
+	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
 	/* NULL, or a flag (set by a signal handler, say): once nonzero no trial
 	 * starts, those running finish and are journaled, and the run returns

@@ -43,7 +43,7 @@ int bsim_accuracy_store(const char *out, const bsim_scene *scene, const char *sc
 	memset(res, 0, sizeof *res);
 	memset(fig, 0, sizeof *fig);
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
+	int rc = bsim_session_open(&ss, out, 0, NULL, NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
 	char path[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];

@@ -425,7 +425,7 @@ int escape_run(const escape_def *def, escape_summary *sum, bsim_error *err)
 		return rc;
 	const bsim_experiment *e = &res.e;
 	bsim_session ss;
-	if ((rc = bsim_session_open(&ss, def->out, 0, NULL, 0, err)) != BSIM_OK) {
+	if ((rc = bsim_session_open(&ss, def->out, 0, NULL, NULL, 0, err)) != BSIM_OK) {
 		bsim_sweep_dir_result_free(&res);
 		return rc;
 	}

@@ -16,7 +16,7 @@ int bsim_landscape_store(const char *out, const bsim_scene *s, const bsim_landsc
 	/* DIR is checked before the grid is computed, and its files appear
 	 * together. */
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
+	int rc = bsim_session_open(&ss, out, 0, NULL, NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
 	rc = bsim_landscape_grid_alloc(s, def, g, err);

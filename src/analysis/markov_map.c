@@ -396,7 +396,7 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 			        def->from[j]);
 	}
 	bsim_session ss;
-	if ((rc = bsim_session_open(&ss, dir, 0, NULL, 0, err)) != BSIM_OK)
+	if ((rc = bsim_session_open(&ss, dir, 0, NULL, NULL, 0, err)) != BSIM_OK)
 		return rc;
 	ss.add = 1; /* the maps join those already cached */
 	rc = set_fill(lattice, def, dir, &ss, out, err);

@@ -111,7 +111,7 @@ int bsim_markov_prediction_store(const char *dir, const bsim_scene *lattice,
                                  bsim_error *err)
 {
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, dir, 0, NULL, 0, err);
+	int rc = bsim_session_open(&ss, dir, 0, NULL, NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
 	rc = write_tables(ss.stage, p, err);

@@ -20,7 +20,7 @@ int bsim_figures_plot(const char *dir, const bsim_figures_def *def, bsim_figures
 		return BSIM_EINPUT;
 	const char *to = def->out ? def->out : dir;
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, to, 0, NULL, 0, err);
+	int rc = bsim_session_open(&ss, to, 0, NULL, NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
 	ss.add = def->out == NULL;

@@ -407,7 +407,8 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 	}
 	bsim_session ss;
 	if (rc == BSIM_OK)
-		rc = bsim_session_open(&ss, def->out, def->resume, inputs, size, err);
+		rc = bsim_session_open(&ss, def->out, def->resume, def->resume_option, inputs, size,
+		                       err);
 	if (rc == BSIM_OK) {
 		if (spread != BSIM_SPREAD_NONE || def->n_merge > 0)
 			rc = compare_spread(def, &job, inputs, &ss, size, &finished, err);

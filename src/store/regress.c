@@ -241,7 +241,7 @@ int bsim_regress_run(const bsim_regress_def *def, bsim_regress_result *res, bsim
 	int rc = regress_load(def, res, backend, err);
 	bsim_session ss;
 	if (rc == BSIM_OK)
-		rc = bsim_session_open(&ss, def->out, 0, NULL, 0, err);
+		rc = bsim_session_open(&ss, def->out, 0, NULL, NULL, 0, err);
 	if (rc != BSIM_OK) {
 		bsim_regress_result_free(res);
 		return rc;

@@ -284,7 +284,7 @@ int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, con
 	/* DIR is checked before the trial runs and its files appear together. */
 	bsim_session ss;
 	if (out) {
-		int rc = bsim_session_open(&ss, out, 0, NULL, 0, err);
+		int rc = bsim_session_open(&ss, out, 0, NULL, NULL, 0, err);
 		if (rc != BSIM_OK) {
 			bsim_atomic_file_abort(&traj);
 			return rc;

@@ -18,9 +18,10 @@ int bsim_session_path(char *buf, size_t size, const char *dir, const char *name,
 	return BSIM_OK;
 }
 
-int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *inputs,
-                      size_t record_size, bsim_error *err)
+int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *resume_option,
+                      const char *inputs, size_t record_size, bsim_error *err)
 {
+	const char *opt = resume_option ? resume_option : "--resume";
 	struct stat st;
 	memset(s, 0, sizeof *s);
 	s->dir = dir;
@@ -46,21 +47,27 @@ int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *
 		int finished = 0;
 		bsim_error ignore;
 		bsim_outdir_verify(dir, &finished, &ignore);
-		rc = bsim_error_set(err, BSIM_EINPUT, "--resume: %s holds %s", dir,
-		                    finished ? "a finished run, nothing to resume (run without "
-		                               "--resume to replace it)"
-		                             : "no stopped run to resume (run without --resume)");
+		if (finished)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "%s: %s holds a finished run, nothing to resume (run "
+			                    "without %s to replace it)",
+			                    opt, dir, opt);
+		else
+			rc = bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s: %s holds no stopped run to resume (run without %s)", opt, dir,
+			        opt);
 	} else if (!resume && have) {
 		rc = bsim_error_set(err, BSIM_EINPUT,
-		                    "%s holds the journal of a stopped run (%s): add --resume to "
+		                    "%s holds the journal of a stopped run (%s): add %s to "
 		                    "continue it, or delete the journal to start over",
-		                    dir, s->journal_path);
+		                    dir, s->journal_path, opt);
 	} else if (resume) {
 		rc = bsim_journal_resume(&s->journal, s->journal_path, inputs, record_size, err);
 		if (rc != BSIM_OK) {
 			char msg[sizeof err->msg];
 			snprintf(msg, sizeof msg, "%s", err->msg);
-			bsim_error_set(err, rc, "--resume: %s: %s", dir, msg);
+			bsim_error_set(err, rc, "%s: %s: %s", opt, dir, msg);
 		}
 	} else {
 		rc = bsim_journal_create(&s->journal, s->journal_path, inputs, record_size, err);

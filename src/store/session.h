@@ -26,9 +26,11 @@ typedef struct bsim_session {
 /* Opens dir (BSIM_EINPUT if it cannot be used) and, if inputs is not NULL,
  * the journal for records of record_size bytes: with resume the journal of
  * the stopped run in dir, which must have these inputs; without, a new
- * one, refusing a dir that holds a stopped run's journal. */
-int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *inputs,
-                      size_t record_size, bsim_error *err);
+ * one, refusing a dir that holds a stopped run's journal. resume_option
+ * is how the caller spells resume in those messages (NULL: the command
+ * line's "--resume"; "resume=True" from Python). */
+int bsim_session_open(bsim_session *s, const char *dir, int resume, const char *resume_option,
+                      const char *inputs, size_t record_size, bsim_error *err);
 
 /* Ends the session with the run's status rc (err holding its message if
  * rc is not BSIM_OK): if BSIM_OK, commits the files (and removes the

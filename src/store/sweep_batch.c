@@ -260,7 +260,7 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 		return rc;
 	}
 	if (rc == BSIM_OK && b->out) {
-		rc = bsim_session_open(&b->ss, b->out, b->resume, inputs, size, err);
+		rc = bsim_session_open(&b->ss, b->out, b->resume, NULL, inputs, size, err);
 		b->open = rc == BSIM_OK;
 		c.journal = b->open ? b->ss.journal : NULL;
 	}

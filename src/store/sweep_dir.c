@@ -241,7 +241,8 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	}
 	bsim_session ss;
 	if (rc == BSIM_OK)
-		rc = bsim_session_open(&ss, def->out, def->resume, inputs, size, err);
+		rc = bsim_session_open(&ss, def->out, def->resume, def->resume_option, inputs, size,
+		                       err);
 	if (rc != BSIM_OK) {
 		free(inputs);
 		bsim_experiment_free(e);

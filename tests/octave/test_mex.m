@@ -374,3 +374,27 @@ check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, 'unknown argument ''t
       'a misspelt name: %s %s', id, msg);
 check(~exist(fullfile(tmp, 'never'), 'dir'), 'a failed command wrote its directory');
 printf('errors: %d of the program''s messages, and the arguments'' own\n', size(cases, 1));
+
+% Regression: text holding a NUL was cut there (a 'set' value '2\0x' ran
+% as 2); every text argument is refused naming it, the NUL written \x00.
+nul = ['2' char(0) 'x'];
+cases = {
+  @() beamsim_run(gate, 'set', {'body.mass', nul}), '''body.mass'': the value "2\x00x": ';
+  @() beamsim_run(gate, 'set', {['body.mass' char(0) 'zz'], 2}), ...
+      '''set'': the key "body.mass\x00zz": ';
+  @() beamsim_run([gate char(0) 'x']), ['''path'' "' gate '\x00x": '];
+  @() beamsim_run(gate, 'backend', ['thesis' char(0)]), '''backend'' "thesis\x00": ';
+  @() beamsim_run(gate, ['set' char(0) 'x'], {'body.mass', 2}), 'argument 2 "set\x00x": ';
+  @() beamsim_run(gate, 'backend_opt', {'integrator', ['euler' char(0)]}), ...
+      '''integrator'': the value "euler\x00": ';
+  @() beamsim_sweep(h1, 'trials', 1, 'grid', {'body.mass', {nul, '3'}}), ...
+      '''body.mass'': the value "2\x00x": ';
+  @() beamsim_landscape([gate char(0)]), ['''scene'' "' gate '\x00": '];
+};
+for c = 1:size(cases, 1)
+  [id, msg] = raised(cases{c, 1});
+  check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, cases{c, 2})) && ...
+        ~isempty(strfind(msg, 'expected text without NUL bytes')), 'NUL case %d: %s %s', c, ...
+        id, msg);
+end
+printf('NUL in text: %d arguments refused, naming themselves\n', size(cases, 1));
