@@ -275,6 +275,57 @@ check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, 'quoted.csv:5: expect
 delete(file);
 printf('beamsim_load: quoted fields, empty fields and nan; a short line refused\n');
 
+% Regression: beamsim_read_csv kept the text before a NUL, one of two
+% columns that become one field name (a.b and a_b, or names alike in their
+% first 63 characters, MATLAB's longest), and read anything it was given
+% (a directory as a read error, /dev/zero until memory ran out). Each is
+% refused naming the file and what is wrong, as the library reads a table.
+csvdir = fullfile(tmp, 'csv');
+mkdir(csvdir);
+long = repmat('x', 1, 63);
+bad = {'nul.csv', ['a,b' "\n" '1,2' char(0) 'junk' "\n" '3,4' "\n"], ...
+       'nul.csv:2:4: expected text, got a NUL byte';
+       'dup.csv', ['a.b,c,a_b' "\n" '1,2,3' "\n"], ...
+       'dup.csv:1: columns 1 (a.b) and 3 (a_b) both become the field a_b ';
+       'long.csv', [long 'yy,' long 'zz' "\n" '1,2' "\n"], ...
+       ['long.csv:1: columns 1 (' long 'yy) and 2 (' long 'zz) both become the field ' long ' ']};
+for k = 1:size(bad, 1)
+  f = fullfile(csvdir, bad{k, 1});
+  fid = fopen(f, 'w');
+  fwrite(fid, bad{k, 2});
+  fclose(fid);
+  [id, msg] = raised(@beamsim_read_csv, f);
+  check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, bad{k, 3})), '%s: %s %s', ...
+        bad{k, 1}, id, msg);
+  delete(f);
+end
+% Names apart within 63 characters stay apart.
+f = fullfile(csvdir, 'longok.csv');
+fid = fopen(f, 'w');
+fprintf(fid, '%s,%s\n1,2\n', [long(1:62) 'a' 'tail'], [long(1:62) 'b' 'tail']);
+fclose(fid);
+t = beamsim_read_csv(f);
+names = fieldnames(t)';
+check(isequal(names, {[long(1:62) 'a'], [long(1:62) 'b']}) && t.(names{1}) == 1 && ...
+      t.(names{2}) == 2, 'long names: %s', strjoin(names, ','));
+delete(f);
+% Not a regular file, refused at once: a directory, a device; and a file
+% over the bound, 16 GiB (sparse: no byte of it is written or read).
+big = fullfile(csvdir, 'big.csv');
+check(system(sprintf('truncate -s 17179869185 %s', big)) == 0, 'truncate %s', big);
+refused = {csvdir, 'expected a CSV file, got a directory';
+           '/dev/zero', 'expected a CSV file, got a character device';
+           big, 'expected a file of at most 17179869184 bytes, got more'};
+for k = 1:size(refused, 1)
+  [id, msg] = raised(@beamsim_read_csv, refused{k, 1});
+  check(strcmp(id, 'beamsim:input') && ...
+        ~isempty(strfind(msg, [refused{k, 1} ': ' refused{k, 2}])), '%s: %s %s', ...
+        refused{k, 1}, id, msg);
+end
+delete(big);
+printf(['beamsim_read_csv: a NUL, columns of one field name, a directory, a device and ' ...
+        '16 GiB refused\n']);
+
 % ---- the landscape ------------------------------------------------------
 landdir = fullfile(tmp, 'landscape');
 [out, err, status] = program(exe, tmp, sprintf('landscape %s --resolution 0.5 --json --out %s', ...
