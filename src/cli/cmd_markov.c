@@ -86,6 +86,9 @@ static int markov_option(void *args, int i, const char *value)
 		a->def.bins.n_pos = (int)n[0];
 		a->def.bins.n_speed = (int)n[1];
 		a->def.bins.n_dir = (int)n[2];
+		bsim_error err;
+		if (bsim_markov_bins_check(&a->def.bins, &err) != BSIM_OK)
+			return cli_usage("markov", "--bins %s: %s", value, err.msg);
 		return CLI_OK;
 	}
 	case OWN_VMAX:
