@@ -6,6 +6,7 @@
 
 #include <stdint.h>
 
+#include "beamsim/backend.h"
 #include "beamsim/base.h"
 #include "beamsim/error.h"
 #include "beamsim/scene.h"
@@ -72,6 +73,15 @@ BSIM_API void bsim_experiment_group_index(const bsim_experiment *e, int g, int *
 BSIM_API int bsim_experiment_group_scene(const bsim_experiment *e, int g,
                                          const bsim_override *extra, int n_extra, bsim_scene *out,
                                          bsim_error *err);
+
+/* Checks scene, group g's (bsim_experiment_group_scene with the same
+ * extra), against backend b with opts (bsim_backend_check): what b refuses
+ * is said where the group's scene gave the field, the scene file's line,
+ * set:, extra or the grid value. */
+BSIM_API int bsim_experiment_group_check(const bsim_experiment *e, int g,
+                                         const bsim_override *extra, int n_extra,
+                                         const bsim_scene *scene, const bsim_backend *b,
+                                         const bsim_options *opts, bsim_error *err);
 
 #ifdef __cplusplus
 }

@@ -432,6 +432,26 @@ int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_over
 	return rc;
 }
 
+int bsim_experiment_group_check(const bsim_experiment *e, int g, const bsim_override *extra,
+                                int n_extra, const bsim_scene *scene, const bsim_backend *b,
+                                const bsim_options *opts, bsim_error *err)
+{
+	if (!b->check)
+		return BSIM_OK;
+	int n = 0, *idx = malloc((size_t)(e->n_axes ? e->n_axes : 1) * sizeof *idx);
+	bsim_override *ov = NULL;
+	if (idx) {
+		bsim_experiment_group_index(e, g, idx);
+		ov = group_overrides(e, idx, extra, n_extra, &n);
+	}
+	free(idx);
+	if (!ov)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
+	int rc = bsim_backend_check(b, opts, scene, e->scene_path, ov, n, err);
+	free(ov);
+	return rc;
+}
+
 /* A fixed override (set: or --set) of a field the grid varies would be
  * overwritten in every group without a word: refused. One of a block that
  * holds the axis (set body.start, grid body.start.1) keeps its other
