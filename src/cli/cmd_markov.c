@@ -508,7 +508,8 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		a.def.entries = &entries;
 	}
 	/* c.trials is the single gates' per bin, not the experiment's */
-	if ((rc = cli_experiment_load(path, &c.sets, 0, &e)) != CLI_OK) {
+	if ((rc = cli_experiment_load(path, &c.sets, c.has_seed ? &c.seed : NULL, 0, &e)) !=
+	    CLI_OK) {
 		bsim_markov_entries_free(&entries);
 		cli_common_free(&c);
 		return rc;

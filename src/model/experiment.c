@@ -192,11 +192,12 @@ static int walk_key(const ydoc *d, const char *name, struct fy_node *k, struct f
 	                 experiment_keys);
 }
 
-static int walk_experiment(const ydoc *d, bsim_experiment *e, bsim_error *err)
+/* has_seed: a seed given beside the file stands in for its seed:. */
+static int walk_experiment(const ydoc *d, int has_seed, bsim_experiment *e, bsim_error *err)
 {
 	static const char *const required[] = {"scene", "trials", "seed", "grid"};
 	static const char *const phrase[] = {"a scene file name", "a positive integer",
-	                                     "an integer >= 0",
+	                                     "an integer >= 0, or give one with --seed N",
 	                                     "a mapping of dotted keys to lists"};
 	struct fy_node *root = fy_document_root(d->fyd);
 	if (!root || !fy_node_is_mapping(root))
@@ -213,7 +214,8 @@ static int walk_experiment(const ydoc *d, bsim_experiment *e, bsim_error *err)
 			return rc;
 	}
 	for (int i = 0; i < 4; i++)
-		if (!ydoc_pair(root, required[i], strlen(required[i])))
+		if (!ydoc_pair(root, required[i], strlen(required[i])) &&
+		    !(has_seed && !strcmp(required[i], "seed")))
 			return ydoc_fail(d, root, NULL, required[i], err, "missing (expected %s)",
 			                 phrase[i]);
 	return BSIM_OK;
@@ -541,6 +543,13 @@ int bsim_experiment_load_grid(const char *path, const bsim_override *extra, int 
                               const bsim_grid_axis *grid, int n_grid, bsim_experiment *out,
                               bsim_error *err)
 {
+	return bsim_experiment_load_seeded(path, extra, n_extra, grid, n_grid, NULL, out, err);
+}
+
+int bsim_experiment_load_seeded(const char *path, const bsim_override *extra, int n_extra,
+                                const bsim_grid_axis *grid, int n_grid, const uint64_t *seed,
+                                bsim_experiment *out, bsim_error *err)
+{
 	memset(out, 0, sizeof *out);
 	if (strlen(path) >= sizeof out->path)
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -551,7 +560,9 @@ int bsim_experiment_load_grid(const char *path, const bsim_override *extra, int 
 	int rc = ydoc_load(&d, out->path, err);
 	if (rc)
 		return rc;
-	rc = walk_experiment(&d, out, err);
+	rc = walk_experiment(&d, seed != NULL, out, err);
+	if (!rc && seed)
+		out->seed = *seed;
 	if (!rc)
 		rc = apply_grid(out, grid, n_grid, err);
 	if (!rc)

@@ -47,7 +47,7 @@ static int regress_load(const bsim_regress_def *def, bsim_regress_result *res,
 	}
 	if (bsim_session_path(path, sizeof path, def->baseline, "inputs/experiment.yaml", err))
 		return BSIM_EINPUT;
-	int rc = bsim_store_experiment(path, NULL, 0, NULL, 0, res->rec.trials, &res->e, err);
+	int rc = bsim_store_experiment(path, NULL, 0, NULL, 0, res->rec.trials, NULL, &res->e, err);
 	if (rc != BSIM_OK)
 		return rc;
 	res->e.seed = res->rec.seed;

@@ -110,8 +110,9 @@ static int group_build(bsim_replay *r, const bsim_experiment *e, const bsim_over
 
 static int open_experiment(bsim_replay *r, const bsim_replay_def *def, bsim_error *err)
 {
-	int rc = bsim_experiment_load_grid(r->path, def->sets, def->n_sets, def->grid, def->n_grid,
-	                                   &r->e, err);
+	int rc =
+	        bsim_experiment_load_seeded(r->path, def->sets, def->n_sets, def->grid, def->n_grid,
+	                                    def->has_seed ? &def->seed : NULL, &r->e, err);
 	if (rc != BSIM_OK)
 		return rc ? rc : BSIM_EINPUT;
 	r->kind = BSIM_REPLAY_EXPERIMENT;
