@@ -328,6 +328,31 @@ static void test_merge_refuses(void **state)
 	const char *one = reference("not_a_part", "2");
 	const char *argv2[] = {"merge", one, "--out", out, NULL};
 	bsim_test_expect_input_error(argv2, (const char *const[]){one, "part.json", NULL});
+	/* Regression: the first part's part.json edited (its run) was said to
+	 * be of another run than its own ("p1 is part 1 of 3 of run R', not of
+	 * run R (p1's)"). It is said against the run its command line gives
+	 * the inputs, which the other parts share. */
+	char *json = bsim_test_read(bsim_test_join(parts[0], "part.json"));
+	assert_non_null(json);
+	char *run = strstr(json, "\"run\": \"");
+	assert_non_null(run);
+	run += strlen("\"run\": \"");
+	const char was = run[0];
+	run[0] = was == '0' ? '1' : '0';
+	bsim_test_write(parts[0], "part.json", json);
+	char says[1100], self[1100];
+	snprintf(says, sizeof says, "%s/part.json says part 1 of 3 of run ", parts[0]);
+	snprintf(self, sizeof self, "(%s's)", parts[0]);
+	const char *argv3[] = {"merge", parts[0], parts[1], parts[2], "--out", out, NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(argv3, NULL, &err);
+	bsim_test_check_input_error(
+	        rc, err, (const char *const[]){says, "but its command line gives run", NULL}, 1);
+	assert_null(strstr(err, self));
+	free(err);
+	run[0] = was;
+	bsim_test_write(parts[0], "part.json", json);
+	free(json);
 }
 
 /* ---- markov build: its maps spread over parts --------------------------- */

@@ -5,7 +5,8 @@
  *    code, and a mass of 1e-29 kg or a velocity of 1e25 m/s, is refused by
  *    the box2d backend naming the field, before float32 loses the body;
  *    the thesis backend, in double, runs it to its ordinary end (the body
- *    leaves the gate in one step, as x' = x + h^2 F / m says);
+ *    leaves the gate in one step, as x' = x + h^2 F / m says); a body
+ *    within Box2D's skin is refused naming where the scene gave it;
  *  - a trial whose energy vanishes (Box2D clamping a 2 km/s body to
  *    b2_maxTranslation = 2 units a step: 500 m/s at h = 4 ms) is unstable,
  *    "energy vanished", exit 1 - never an ordinary outcome;
@@ -75,18 +76,102 @@ static void test_box2d_force_refused(void **state)
 	bsim_test_expect_input_error(argv, needles);
 	bsim_scene s;
 	gate_with(&s, 1e25, 1.0, 0.0);
-	const char *force[] = {"effects.propulsion.force: 1e+25 N",
+	const char *force[] = {"effects.propulsion.force: box2d: 1e+25 N",
 	                       "beyond what Box2D's float32 can integrate", "usable up to", NULL};
 	expect_box2d_refusal(&s, force);
 	bsim_scene_free(&s);
 	gate_with(&s, 7.0, 1e-29, 0.0);
-	const char *mass[] = {"body.mass: 1e-29 kg", "usable down to", NULL};
+	const char *mass[] = {"body.mass: box2d: 1e-29 kg", "usable down to", NULL};
 	expect_box2d_refusal(&s, mass);
 	bsim_scene_free(&s);
 	gate_with(&s, 7.0, 1.0, 1e25);
-	const char *vel[] = {"body.velocity.1: 1e+25 m/s", NULL};
+	const char *vel[] = {"body.velocity.1: box2d: 1e+25 m/s", NULL};
 	expect_box2d_refusal(&s, vel);
 	bsim_scene_free(&s);
+}
+
+/* "FILE:LINE:" of the first line of text holding key, into buf. */
+static void line_of(const char *file, const char *text, const char *key, char *buf, size_t size)
+{
+	const char *at = strstr(text, key);
+	assert_non_null(at);
+	int line = 1;
+	for (const char *c = text; c < at; c++)
+		line += *c == '\n';
+	snprintf(buf, size, "%s:%d:", file, line);
+}
+
+/* Regression: a body within Box2D's skin (radius at most twice
+ * b2_polygonRadius, 0.02 units at unit_scale 1, in float32) was refused as "group 0,
+ * trial 0: box2d: ..." without saying where the radius came from. It is
+ * said as a scene error is: the --set, the grid value, the set: line or the
+ * scene file's line that gave the field, exit 2, before any trial (no
+ * output directory), and a radius just past the skin runs. */
+static void test_box2d_small_body_located(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("small_body");
+	/* A step short enough for such a body (its crossing), so that the
+	 * scene loads and Box2D is the one to refuse it. */
+	const char *fine = "integration.dt=1e-5";
+	const char *set[] = {"run",   gate(),           "--backend", "box2d", "--set",
+	                     "body.radius=0.019", "--set", fine,       NULL};
+	const char *set_needles[] = {"--set body.radius=0.019: body.radius: box2d: 0.019 m",
+	                             "expected more than 0.02 units", NULL};
+	bsim_test_expect_input_error(set, set_needles);
+	const char *past[] = {"run",       gate(),
+	                      "--backend", "box2d",
+	                      "--set",     "body.radius=0.0201",
+	                      "--set",     fine,
+	                      "--set",     "integration.max_steps=10",
+	                      NULL};
+	assert_int_equal(bsim_test_cli(past, NULL, NULL), 0);
+	/* the scene file's line */
+	char *text = bsim_test_read(gate());
+	assert_non_null(text);
+	char *small = malloc(strlen(text) + 16);
+	assert_non_null(small);
+	const char *r = strstr(text, "radius: 10.0");
+	assert_non_null(r);
+	snprintf(small, strlen(text) + 16, "%.*sradius: 0.001%s", (int)(r - text), text,
+	         r + strlen("radius: 10.0"));
+	char scene[1100], where[1200];
+	snprintf(scene, sizeof scene, "%s", bsim_test_write(dir, "small.yaml", small));
+	line_of(scene, small, "radius: 0.001", where, sizeof where);
+	const char *file[] = {"run", scene, "--backend", "box2d", "--set", fine, NULL};
+	const char *file_needles[] = {where, "body.radius: box2d: 0.001 m", NULL};
+	bsim_test_expect_input_error(file, file_needles);
+	/* an experiment's set: line, and a grid value of the command line */
+	char exp_text[1400], exp[1100];
+	snprintf(exp_text, sizeof exp_text,
+	         "scene: %s\ntrials: 2\nseed: 1\nset:\n  body.radius: 0.001\n"
+	         "  integration.dt: 1e-5\n  integration.duration: 0.01\n"
+	         "grid:\n  effects.propulsion.force: [7, 8]\n",
+	         gate());
+	snprintf(exp, sizeof exp, "%s", bsim_test_write(dir, "exp.yaml", exp_text));
+	line_of(exp, exp_text, "body.radius: 0.001", where, sizeof where);
+	const char *out = bsim_test_join(dir, "out");
+	const char *sweep[] = {"sweep", exp, "--backend", "box2d", "--out", out, NULL};
+	const char *sweep_needles[] = {where, "body.radius: box2d: 0.001 m", NULL};
+	bsim_test_expect_input_error(sweep, sweep_needles);
+	const char *grid[] = {"sweep",     bsim_test_src("configs/thesis/h1_symmetric.yaml"),
+	                      "--backend", "box2d",
+	                      "--grid",    "body.radius=10,0.001",
+	                      "--set",     fine,
+	                      "--set",     "integration.duration=0.01",
+	                      "--out",     out,
+	                      NULL};
+	const char *grid_needles[] = {"--grid body.radius=10,0.001: body.radius: box2d: 0.001 m",
+	                              NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(grid, NULL, &err);
+	bsim_test_check_input_error(rc, err, grid_needles, 1);
+	assert_null(strstr(err, "group 0, trial 0"));
+	free(err);
+	assert_false(bsim_test_exists(out));
+	free(small);
+	free(text);
+	bsim_test_remove(dir);
 }
 
 /* The thesis backend integrates in double: F = 1e25 N on 1 kg for one step
@@ -289,6 +374,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_box2d_force_refused),
+	        cmocka_unit_test(test_box2d_small_body_located),
 	        cmocka_unit_test(test_thesis_force_runs),
 	        cmocka_unit_test(test_box2d_clamp_unstable),
 	        cmocka_unit_test(test_solver_columns),

@@ -411,6 +411,51 @@ static void expect_bad(const char *const argv[], const char *dir, const char *co
 	free(err);
 }
 
+/* The points of a grid of spacing h over len m: x0 + i h up to x0 + len
+ * (landscape.h), counted here from that definition. */
+static double points(double len, double h)
+{
+	return floor(len / h + 1e-9) + 1.0;
+}
+
+/* Regression: --resolution 1e-300 said a 300-digit point count. It names
+ * --resolution, the count in short, the largest grid allowed and the
+ * finest spacing it allows over the region: a spacing that gives at most
+ * BSIM_LANDSCAPE_MAX_POINTS points, where 1% finer gives more. */
+static void test_resolution_too_fine(void **state)
+{
+	(void)state;
+	const char *base = bsim_test_dir("landscape_fine");
+	char gone[1100];
+	snprintf(gone, sizeof gone, "%s/never", base);
+	const char *argv[] = {"landscape",
+	                      bsim_test_src("configs/thesis/gate.yaml"),
+	                      "--resolution",
+	                      "1e-300",
+	                      "--out",
+	                      gone,
+	                      NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	char most[32];
+	snprintf(most, sizeof most, "more than the %d", BSIM_LANDSCAPE_MAX_POINTS);
+	const char *needles[] = {"--resolution 1e-300: 5e+301 x 6.5e+301 points", most, NULL};
+	bsim_test_check_input_error(rc, err, needles, 1);
+	assert_true(strlen(err) < 300);
+	double w = 0, h = 0, finest = 0;
+	const char *region = strstr(err, "over the "), *least = strstr(err, "at least ");
+	assert_non_null(region);
+	assert_non_null(least);
+	assert_int_equal(sscanf(region, "over the %lf x %lf m region", &w, &h), 2);
+	assert_int_equal(sscanf(least, "at least %lf m", &finest), 1);
+	print_message("the finest spacing over the %g x %g m region: %g m\n", w, h, finest);
+	assert_true(points(w, finest) * points(h, finest) <= BSIM_LANDSCAPE_MAX_POINTS);
+	assert_true(points(w, 0.99 * finest) * points(h, 0.99 * finest) >
+	            BSIM_LANDSCAPE_MAX_POINTS);
+	assert_true(bsim_test_size(gone) < 0);
+	free(err);
+}
+
 static void test_errors(void **state)
 {
 	(void)state;
@@ -444,7 +489,8 @@ static void test_errors(void **state)
 	{
 		const char *argv[] = {"landscape", gate, "--resolution", "0.001", "--out",
 		                      gone,        NULL};
-		const char *needles[] = {"resolution 0.001 m", "more than", NULL};
+		const char *needles[] = {"--resolution 0.001: 50001 x 65001 points", "more than",
+		                         NULL};
 		expect_bad(argv, gone, needles);
 	}
 	{
@@ -569,6 +615,7 @@ int main(void)
 	        cmocka_unit_test(test_options),
 	        cmocka_unit_test(test_json_quiet),
 	        cmocka_unit_test(test_errors),
+	        cmocka_unit_test(test_resolution_too_fine),
 	        cmocka_unit_test(test_figure_style),
 	        cmocka_unit_test(test_gnuplot_fails),
 	        cmocka_unit_test(test_gnuplot_refuses_region),

@@ -985,6 +985,34 @@ static void test_bad_inputs(void **state)
 		struct stat st;
 		assert_int_not_equal(stat(target, &st), 0);
 	}
+	/* Regression: bins within 1..64 whose map is too large were refused as
+	 * "bins: N entry bins make a map of more than 2e7 cells", naming
+	 * neither --bins nor what it takes. The largest P S D: the most k with
+	 * (1 + 4 k)^2 cells within BSIM_MARKOV_MAX_CELLS, counted here. */
+	long most = 0;
+	while ((double)(1 + 4 * (most + 1)) * (double)(1 + 4 * (most + 1)) <=
+	       (double)BSIM_MARKOV_MAX_CELLS)
+		most++;
+	char says[96];
+	snprintf(says, sizeof says, "expected P x S x D at most %ld", most);
+	const char *big[] = {"markov", "build", essay, "--bins", "64,64,64", "--out", target, NULL};
+	char *err = NULL;
+	int rc = bsim_test_cli(big, NULL, &err);
+	bsim_test_check_input_error(rc, err, (const char *const[]){"--bins 64,64,64: ", says, NULL},
+	                            0);
+	free(err);
+	/* the bound itself, on every P, S, D from 1 to 64: accepted exactly
+	 * when P S D is at most that */
+	long wrong = 0;
+	for (int p = 1; p <= 64; p++)
+		for (int q = 1; q <= 64; q++)
+			for (int d = 1; d <= 64; d++) {
+				bsim_markov_bins bins = {p, q, d, 40.0};
+				bsim_error e;
+				int fits = (long)p * q * d <= most;
+				wrong += (bsim_markov_bins_check(&bins, &e) == BSIM_OK) != fits;
+			}
+	assert_int_equal(wrong, 0);
 	free(h1);
 	free(essay);
 	free(track);

@@ -36,24 +36,30 @@
 
 static char experiment[1200];
 
-/* A small experiment: 12 groups of 24 trials of at most 1500 steps, the
- * four without random force deterministic (run once, copied). */
-static int setup(void **state)
+/* A small experiment, into dir/name: 12 groups of 24 trials of at most
+ * 1500 steps, the four without random force deterministic (run once,
+ * copied), with seed_line ("seed: 5\n", or none). */
+static void write_small(char *path, size_t size, const char *dir, const char *name,
+                        const char *seed_line)
 {
-	(void)state;
 	char text[2400];
 	snprintf(text, sizeof text,
 	         "scene: %s\n"
 	         "trials: 24\n"
-	         "seed: 5\n"
+	         "%s"
 	         "set:\n"
 	         "  integration.max_steps: 1500\n"
 	         "grid:\n"
 	         "  effects.propulsion.force: [6, 7, 8, 9]\n"
 	         "  effects.random_force.magnitude: [0, 10, 30]\n",
-	         bsim_test_src("configs/thesis/gate.yaml"));
-	snprintf(experiment, sizeof experiment, "%s",
-	         bsim_test_write(bsim_test_dir("exp"), "small.yaml", text));
+	         bsim_test_src("configs/thesis/gate.yaml"), seed_line);
+	snprintf(path, size, "%s", bsim_test_write(bsim_test_dir(dir), name, text));
+}
+
+static int setup(void **state)
+{
+	(void)state;
+	write_small(experiment, sizeof experiment, "exp", "small.yaml", "seed: 5\n");
 	return 0;
 }
 
@@ -300,13 +306,53 @@ static void test_refusals(void **state)
 	free(err);
 }
 
+/* Regression: an experiment without seed: run with --seed N said "seed:
+ * missing". The seed given stands in for it: the sweep is the one of the
+ * same experiment with seed: N in the file, trials.csv byte for byte,
+ * whether it runs through or is stopped (SIGINT once a trial is
+ * journaled) and resumed with the same --seed; the stored run records the
+ * seed, so a trial of it replays to its row; without --seed the file is
+ * refused, naming seed: and --seed. */
+static void test_seed_beside_file(void **state)
+{
+	(void)state;
+	char noseed[1200], ref[1200], dir[1200];
+	write_small(noseed, sizeof noseed, "noseed", "noseed.yaml", "");
+	snprintf(ref, sizeof ref, "%s", bsim_test_dir("noseed_ref"));
+	const char *one[] = {"sweep", experiment, "--quiet", "--out", ref, NULL};
+	assert_int_equal(bsim_test_cli(one, NULL, NULL), 0);
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("noseed_run"));
+	const char *given[] = {"sweep", noseed,  "--seed", "5",  "--quiet", "--threads",
+	                       "1",     "--out", dir,      NULL, NULL};
+	char *err = NULL;
+	int pid = bsim_test_spawn(given), rc = 0;
+	if (bsim_test_await_records(pid, bsim_test_join(dir, ".beamsim/journal"), 1, &rc)) {
+		kill(pid, SIGINT);
+		rc = bsim_test_wait(pid);
+	}
+	if (rc == 128 + SIGINT) {
+		given[9] = "--resume";
+		assert_int_equal(bsim_test_cli(given, NULL, NULL), 0);
+	} else {
+		assert_int_equal(rc, 0); /* finished before the signal */
+		print_message("the sweep finished before the signal\n");
+	}
+	same_files(ref, dir, (const char *const[]){"trials.csv", NULL});
+	const char *replay[] = {"run", dir, "--group", "7", "--trial", "3", NULL};
+	assert_int_equal(bsim_test_cli(replay, NULL, NULL), 0);
+	const char *none[] = {"sweep", noseed, "--quiet", "--out", bsim_test_join(dir, "x"), NULL};
+	rc = bsim_test_cli(none, NULL, &err);
+	bsim_test_check_input_error(rc, err, (const char *const[]){"seed: missing", "--seed", NULL},
+	                            1);
+	free(err);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_sweep_killed),
-	        cmocka_unit_test(test_compare_killed),
-	        cmocka_unit_test(test_signals),
-	        cmocka_unit_test(test_refusals),
+	        cmocka_unit_test(test_sweep_killed),     cmocka_unit_test(test_compare_killed),
+	        cmocka_unit_test(test_signals),          cmocka_unit_test(test_refusals),
+	        cmocka_unit_test(test_seed_beside_file),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -158,6 +158,7 @@
 #include <box2d/box2d.h>
 
 #include <algorithm>
+#include <cstdarg>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -989,18 +990,38 @@ void box2d_destroy(bsim_world *w)
  * on a value that is not finite. Every quantity it is given must be zero
  * or within 1e-30..1e30 in magnitude once scaled: float32 reaches 3e38,
  * and the margin keeps products and sums of a few such values finite. */
-static int float_range(const char *field, double v, bsim_error *err)
+/* A check's refusal: the scene key to blame into field (check in
+ * bsim_backend), the message into err. */
+struct blame {
+	char *field;
+	size_t size;
+};
+
+static int refuse(const blame &b, const char *key, bsim_error *err, const char *fmt, ...)
+        __attribute__((format(printf, 4, 5)));
+static int refuse(const blame &b, const char *key, bsim_error *err, const char *fmt, ...)
+{
+	std::snprintf(b.field, b.size, "%s", key);
+	char msg[BSIM_ERROR_MSG_MAX];
+	va_list ap;
+	va_start(ap, fmt);
+	std::vsnprintf(msg, sizeof msg, fmt, ap);
+	va_end(ap);
+	return bsim_error_set(err, BSIM_EINPUT, "box2d: %s", msg);
+}
+
+static int float_range(const blame &b, const char *field, double v, double s, bsim_error *err)
 {
 	double a = std::fabs(v);
 	if (a == 0.0 || (a >= 1e-30 && a <= 1e30))
 		return BSIM_OK;
-	return bsim_error_set(err, BSIM_EINPUT,
-	                      "box2d: %s: expected 0 or a magnitude from 1e-30 to 1e30 in Box2D's "
-	                      "units (float32), got %g",
-	                      field, v);
+	return refuse(b, field, err,
+	              "expected 0 or a magnitude from 1e-30 to 1e30 in Box2D's units (float32), "
+	              "got %g at unit_scale=%g",
+	              v, s);
 }
 
-static int scene_in_float_range(const bsim_scene *sc, double s, bsim_error *err)
+static int scene_in_float_range(const blame &bl, const bsim_scene *sc, double s, bsim_error *err)
 {
 	const double s2 = s * s;
 	int rc = BSIM_OK;
@@ -1026,7 +1047,7 @@ static int scene_in_float_range(const bsim_scene *sc, double s, bsim_error *err)
 	        {"contact.rest_threshold", sc->contact.rest_threshold * s},
 	};
 	for (const auto &q : body)
-		if ((rc = float_range(q.field, q.v, err)) != BSIM_OK)
+		if ((rc = float_range(bl, q.field, q.v, s, err)) != BSIM_OK)
 			return rc;
 	for (int i = 0; i < sc->n_beams; i++) {
 		const bsim_beam_def &b = sc->beams[i];
@@ -1043,7 +1064,7 @@ static int scene_in_float_range(const bsim_scene *sc, double s, bsim_error *err)
 		for (const auto &q : beam) {
 			char field[64];
 			std::snprintf(field, sizeof field, "beams.%d.%s", i, q.key);
-			if ((rc = float_range(field, q.v, err)) != BSIM_OK)
+			if ((rc = float_range(bl, field, q.v, s, err)) != BSIM_OK)
 				return rc;
 		}
 	}
@@ -1065,18 +1086,19 @@ static int scene_in_float_range(const bsim_scene *sc, double s, bsim_error *err)
 const double MOTION_MAX = 1e18; /* units per substep */
 const double ACCEL_MAX = 1e30;  /* units / s^2 */
 
-static int body_motion_in_range(const bsim_scene *sc, double s, double h, bsim_error *err)
+static int body_motion_in_range(const blame &bl, const bsim_scene *sc, double s, double h,
+                                bsim_error *err)
 {
 	const double m = sc->body.mass;
 	for (int k = 0; k < 2; k++) {
 		double motion = std::fabs(sc->body.velocity[k]) * s * h;
 		if (motion > MOTION_MAX)
-			return bsim_error_set(
-			        err, BSIM_EINPUT,
-			        "box2d: body.velocity.%d: %g m/s is beyond what Box2D's float32 "
-			        "can integrate (|v| dt / substeps x unit_scale must stay below %g "
-			        "units a substep, got %.3g; usable up to %.3g m/s at this step)",
-			        k, sc->body.velocity[k], MOTION_MAX, motion, MOTION_MAX / (s * h));
+			return refuse(
+			        bl, k ? "body.velocity.1" : "body.velocity.0", err,
+			        "%g m/s is beyond what Box2D's float32 can integrate (|v| dt / "
+			        "substeps x unit_scale must stay below %g units a substep, got "
+			        "%.3g; usable up to %.3g m/s at this step)",
+			        sc->body.velocity[k], MOTION_MAX, motion, MOTION_MAX / (s * h));
 	}
 	/* The propulsion acts along y or the heading, the random force (up to ten standard
 	 * deviations) along x. */
@@ -1101,32 +1123,49 @@ static int body_motion_in_range(const bsim_scene *sc, double s, double h, bsim_e
 	const double fv_max =
 	        std::sqrt(std::fmax(0.0, f_max * f_max - other * other)) / (fp >= fr ? 1.0 : 10.0);
 	if (std::fabs(std::log10(m)) > std::fabs(std::log10(f)))
-		return bsim_error_set(
-		        err, BSIM_EINPUT,
-		        "box2d: body.mass: %g kg is beyond what Box2D's float32 can integrate "
-		        "(|F| dt^2 / m must stay below %g units a substep and |F| / m below %g, "
-		        "got %.3g N x (%g s)^2 / %g kg = %.3g units at unit_scale %g, |F| the "
-		        "propulsion and ten standard deviations of the random force; usable down "
-		        "to %.3g kg at this force and step)",
-		        m, MOTION_MAX, ACCEL_MAX, f, h, m, motion, s, m_min);
-	return bsim_error_set(err, BSIM_EINPUT,
-	                      "box2d: %s: %g N is beyond what Box2D's float32 can integrate "
-	                      "(|F| dt^2 / m must stay below %g units a substep and |F| / m below "
-	                      "%g, got %.3g N x (%g s)^2 / %g kg = %.3g units at unit_scale %g; "
-	                      "usable up to %.3g N at this mass and step)",
-	                      field, fv, MOTION_MAX, ACCEL_MAX, f, h, m, motion, s, fv_max);
+		return refuse(bl, "body.mass", err,
+		              "%g kg is beyond what Box2D's float32 can integrate (|F| dt^2 / m "
+		              "must stay below %g units a substep and |F| / m below %g, got %.3g N "
+		              "x (%g s)^2 / %g kg = %.3g units at unit_scale %g, |F| the "
+		              "propulsion and ten standard deviations of the random force; usable "
+		              "down to %.3g kg at this force and step)",
+		              m, MOTION_MAX, ACCEL_MAX, f, h, m, motion, s, m_min);
+	return refuse(bl, field, err,
+	              "%g N is beyond what Box2D's float32 can integrate (|F| dt^2 / m must stay "
+	              "below %g units a substep and |F| / m below %g, got %.3g N x (%g s)^2 / %g "
+	              "kg = %.3g units at unit_scale %g; usable up to %.3g N at this mass and "
+	              "step)",
+	              fv, MOTION_MAX, ACCEL_MAX, f, h, m, motion, s, fv_max);
 }
 
-int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
-                      bsim_error *err)
+/* The knobs create reads, as numbers. */
+struct knob_values {
+	long vel_it, pos_it, substeps;
+	double s; /* unit_scale */
+};
+
+static knob_values knobs_of(const bsim_options *opts)
 {
+	return {bsim_options_int(opts, &box2d_knobs[KNOB_VEL_IT]),
+	        bsim_options_int(opts, &box2d_knobs[KNOB_POS_IT]),
+	        bsim_options_int(opts, &box2d_knobs[KNOB_SUBSTEPS]),
+	        bsim_options_double(opts, &box2d_knobs[KNOB_UNIT_SCALE])};
+}
+
+/* What create refuses (bsim_backend's check): the options, then the scene
+ * against what float32 holds and against Box2D's skin; field the scene key
+ * to blame ("" for an option). */
+static int box2d_check(const bsim_scene *scene, const bsim_options *opts, char *field, size_t size,
+                       bsim_error *err)
+{
+	const blame bl = {field, size};
+	std::snprintf(field, size, "%s", "");
 	int rc = bsim_options_check(opts, box2d_knobs, N_KNOBS, "box2d", err);
 	if (rc)
 		return rc;
-	long vel_it = bsim_options_int(opts, &box2d_knobs[KNOB_VEL_IT]);
-	long pos_it = bsim_options_int(opts, &box2d_knobs[KNOB_POS_IT]);
-	long substeps = bsim_options_int(opts, &box2d_knobs[KNOB_SUBSTEPS]);
-	double s = bsim_options_double(opts, &box2d_knobs[KNOB_UNIT_SCALE]);
+	const knob_values k = knobs_of(opts);
+	const long vel_it = k.vel_it, pos_it = k.pos_it, substeps = k.substeps;
+	const double s = k.s;
 	if (vel_it < 1 || vel_it > 1000)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "box2d: velocity_iterations=%ld: expected 1..1000", vel_it);
@@ -1139,41 +1178,67 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	if (!(s > 0.0) || !std::isfinite(s))
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "box2d: unit_scale=%g: expected a positive number", s);
-	if ((rc = scene_in_float_range(scene, s, err)) != BSIM_OK)
+	if ((rc = scene_in_float_range(bl, scene, s, err)) != BSIM_OK)
 		return rc;
-	if ((rc = body_motion_in_range(scene, s, scene->dt / (double)substeps, err)) != BSIM_OK)
+	if ((rc = body_motion_in_range(bl, scene, s, scene->dt / (double)substeps, err)) != BSIM_OK)
 		return rc;
-	/* The body must be wider than Box2D's skin, and its coordinates within
-	 * float32's reach. */
-	const bool ellipse = scene->body.shape == BSIM_SHAPE_ELLIPSE;
-	const double half_width =
-	        ellipse ? std::fmin(scene->body.semi_axes[0], scene->body.semi_axes[1])
-	                : scene->body.radius;
-	if (half_width * s <= 2.0 * b2_polygonRadius)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "box2d: unit_scale=%g makes the body's %s %g units, "
-		                      "below Box2D's skin (%g units); use a larger unit_scale",
-		                      s, ellipse ? "smaller semi-axis (body.semi_axes)" : "radius",
-		                      half_width * s, (double)b2_polygonRadius);
+	/* The body must be wider than Box2D's skin (a polygon's, rounding the
+	 * capsule's box and the ellipse's polygon, b2_polygonRadius) on either
+	 * side, and its coordinates within float32's reach. */
+	const bsim_body_def &body = scene->body;
+	const bool ellipse = body.shape == BSIM_SHAPE_ELLIPSE;
+	const int narrow = body.semi_axes[1] < body.semi_axes[0];
+	const double half_width = ellipse ? body.semi_axes[narrow] : body.radius;
+	const double skin = b2_polygonRadius;
+	if (half_width * s <= 2.0 * skin)
+		return refuse(bl,
+		              !ellipse ? "body.radius"
+		              : narrow ? "body.semi_axes.1"
+		                       : "body.semi_axes.0",
+		              err,
+		              "%g m is %g units at unit_scale=%g, expected more than %g units "
+		              "(twice Box2D's skin b2_polygonRadius, %g units); use a larger body "
+		              "or unit_scale",
+		              half_width, half_width * s, s, 2.0 * skin, skin);
 	/* The capsule's box must be wider than the distance at which Box2D
 	 * welds vertices (b2_linearSlop / 2). */
-	if (scene->body.shape == BSIM_SHAPE_CAPSULE && scene->body.length * s < b2_linearSlop)
-		return bsim_error_set(
-		        err, BSIM_EINPUT,
-		        "box2d: body.length: %g m is %g units at unit_scale=%g, below "
-		        "Box2D's linear slop (%g units); use a disk or a longer capsule",
-		        scene->body.length, scene->body.length * s, s, (double)b2_linearSlop);
-	double extent = std::fabs(scene->body.start[0]) + std::fabs(scene->body.start[1]);
-	for (int i = 0; i < scene->n_beams; i++)
-		extent = std::fmax(extent, std::fabs(scene->beams[i].pivot[0]) +
-		                                   std::fabs(scene->beams[i].pivot[1]) +
-		                                   scene->beams[i].length);
-	if (extent * s > 1e5)
-		return bsim_error_set(
-		        err, BSIM_EINPUT,
-		        "box2d: unit_scale=%g puts the scene %g units from the origin, "
-		        "too far for float32; use a smaller unit_scale",
-		        s, extent * s);
+	if (body.shape == BSIM_SHAPE_CAPSULE && body.length * s < b2_linearSlop)
+		return refuse(bl, "body.length", err,
+		              "%g m is %g units at unit_scale=%g, below Box2D's linear slop (%g "
+		              "units); use a disk or a longer capsule",
+		              body.length, body.length * s, s, (double)b2_linearSlop);
+	double extent = std::fabs(body.start[0]) + std::fabs(body.start[1]);
+	int far = -1; /* the beam that reaches furthest, -1: the body */
+	for (int i = 0; i < scene->n_beams; i++) {
+		const bsim_beam_def &b = scene->beams[i];
+		const double reach = std::fabs(b.pivot[0]) + std::fabs(b.pivot[1]) + b.length;
+		if (reach > extent) {
+			extent = reach;
+			far = i;
+		}
+	}
+	if (extent * s > 1e5) {
+		char key[64] = "body.start";
+		if (far >= 0)
+			std::snprintf(key, sizeof key, "beams.%d.pivot", far);
+		return refuse(bl, key, err,
+		              "unit_scale=%g puts the scene %g units from the origin, too far for "
+		              "float32; use a smaller unit_scale",
+		              s, extent * s);
+	}
+	return BSIM_OK;
+}
+
+int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
+                      bsim_error *err)
+{
+	/* Without where the scene came from: the field names itself. */
+	int rc = bsim_backend_check(&bsim_backend_box2d, opts, scene, NULL, NULL, 0, err);
+	if (rc)
+		return rc;
+	const knob_values k = knobs_of(opts);
+	const double s = k.s;
+	const bool ellipse = scene->body.shape == BSIM_SHAPE_ELLIPSE;
 
 	bsim_world *w = new (std::nothrow) bsim_world;
 	if (!w)
@@ -1183,9 +1248,9 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 		delete w;
 		return bsim_error_set(err, BSIM_EFAIL, "box2d: out of memory");
 	}
-	w->velocity_iterations = (int)vel_it;
-	w->position_iterations = (int)pos_it;
-	w->substeps = (int)substeps;
+	w->velocity_iterations = (int)k.vel_it;
+	w->position_iterations = (int)k.pos_it;
+	w->substeps = (int)k.substeps;
 	w->spring = bsim_options_choice(opts, &box2d_knobs[KNOB_SPRING]);
 	w->s = s;
 	int sleep = bsim_options_choice(opts, &box2d_knobs[KNOB_SLEEP]);
@@ -1565,4 +1630,5 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         BSIM_TAKES_DRAG | BSIM_TAKES_GROUND_FRICTION,
         nullptr, /* flight: the runner steps every step */
         nullptr, /* steps: likewise */
+        box2d_check,
 };

@@ -189,6 +189,10 @@ static int landscape(landscape_call *c, int nrhs, const mxArray *prhs[], mxArray
 	if (bsim_scene_load(path, sets, n_sets, &c->scene, err) != BSIM_OK)
 		return err->code ? err->code : BSIM_EINPUT;
 	int rc;
+	/* 'out' refused in the function's own words ('overwrite'), before the
+	 * grid is computed */
+	if (dir && bsim_output_dir_check(dir, overwrite, "'overwrite', true", err) != BSIM_OK)
+		return err->code;
 	if (dir) {
 		int drawn = 0;
 		rc = bsim_landscape_store(dir, overwrite, &c->scene, &def, &c->g, &c->b, &drawn,

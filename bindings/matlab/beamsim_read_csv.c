@@ -8,8 +8,14 @@
  * whose every field is a number, empty or nan is a double column (empty
  * and nan are NaN), any other a cell column of text. Fields may be quoted
  * ("a, b", "" for a quote). The file's numbers as they are: beamsim_load
- * adds 1 to the group and trial columns. */
-#include <errno.h>
+ * adds 1 to the group and trial columns.
+ *
+ * The file is read as the library reads its tables
+ * (bsim_output_table_text): a regular file of at most 16 GiB, without a
+ * NUL byte, ending in a line feed. Two columns whose names become one field
+ * name (a.b and a_b; names alike in their first 63 characters, Octave's
+ * namelengthmax and older MATLAB's, where the names are cut) are refused,
+ * naming both, rather than one kept silently. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -77,43 +83,10 @@ static size_t split_line(char **at, char **out, size_t room)
 	return n;
 }
 
-/* The file's text, NUL-terminated. */
-static char *read_all(const char *path, bsim_error *err)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		bsim_error_set(err, BSIM_EINPUT, "%s: %s", path, strerror(errno));
-		return NULL;
-	}
-	size_t cap = 1 << 16, len = 0;
-	char *s = malloc(cap);
-	while (s) {
-		len += fread(s + len, 1, cap - len - 1, f);
-		if (len < cap - 1)
-			break;
-		char *more = realloc(s, 2 * cap);
-		if (!more) {
-			free(s);
-			s = NULL;
-			break;
-		}
-		s = more;
-		cap *= 2;
-	}
-	int failed = ferror(f);
-	fclose(f);
-	if (!s || failed) {
-		free(s);
-		bsim_error_set(err, BSIM_EFAIL, "%s: %s", path, s ? "read error" : "out of memory");
-		return NULL;
-	}
-	s[len] = '\0';
-	return s;
-}
-
 static int read_table(const char *path, table *t, bsim_error *err)
 {
-	if (!(t->text = read_all(path, err)))
+	size_t bytes;
+	if (bsim_output_table_text(path, &t->text, &bytes, err) != BSIM_OK)
 		return err->code;
 	if (t->text[0] == '\0' || t->text[0] == '\n')
 		return bsim_error_set(err, BSIM_EINPUT, "%s:1: expected a header line", path);
@@ -161,7 +134,29 @@ static int field_number(const char *s, double *x)
 	return end != s && *end == '\0';
 }
 
-static mxArray *table_struct(const table *t)
+/* Each column's field name (bmx_field_name, cut to 63 characters, the
+ * namelengthmax of Octave and of older MATLAB) into names: BSIM_EINPUT
+ * naming both columns if two become one name, which would keep only the
+ * later column. */
+typedef char field_name[64];
+static int field_names(const char *path, const table *t, field_name *names, bsim_error *err)
+{
+	for (size_t c = 0; c < t->nc; c++) {
+		bmx_field_name(t->fields[c], names[c], sizeof names[c]);
+		for (size_t d = 0; d < c; d++)
+			if (strcmp(names[d], names[c]) == 0)
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s:1: columns %zu (%s) and %zu (%s) both become the field "
+				        "%s "
+				        "(letters, digits and underscores, at most 63 characters); "
+				        "expected names that differ there",
+				        path, d + 1, t->fields[d], c + 1, t->fields[c], names[c]);
+	}
+	return BSIM_OK;
+}
+
+static mxArray *table_struct(const table *t, const field_name *names)
 {
 	mxArray *s = mxCreateStructMatrix(1, 1, 0, NULL);
 	size_t n = t->rows > 0 ? t->rows - 1 : 0;
@@ -182,9 +177,7 @@ static mxArray *table_struct(const table *t)
 				mxSetCell(col, (mwIndex)r,
 				          bmx_string(t->fields[(r + 1) * t->nc + c]));
 		}
-		char name[64];
-		bmx_field_name(t->fields[c], name, sizeof name);
-		bmx_set(s, 0, name, col);
+		bmx_set(s, 0, names[c], col);
 	}
 	return s;
 }
@@ -202,10 +195,16 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
 	                   : bsim_error_set(&err, BSIM_EINPUT, "expected one file name");
 	if (rc == BSIM_OK)
 		rc = read_table(path, &t, &err);
+	field_name *names = rc == BSIM_OK ? calloc(t.nc + 1, sizeof *names) : NULL;
+	if (rc == BSIM_OK && !names)
+		rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory");
 	if (rc == BSIM_OK)
-		out = table_struct(&t);
+		rc = field_names(path, &t, names, &err);
+	if (rc == BSIM_OK)
+		out = table_struct(&t, names);
+	free(names);
 	free(t.fields);
-	free(t.text);
+	bsim_output_table_text_free(t.text);
 	bmx_pool_free(&pool);
 	if (rc != BSIM_OK)
 		bmx_fail(&err);

@@ -376,8 +376,8 @@ static int sweep(sweep_call *c, int nrhs, const mxArray *prhs[], mxArray **out, 
 		return BSIM_EINPUT;
 	/* The experiment as `beamsim sweep` loads it: --set, --grid, then
 	 * --trials and --seed. */
-	if (bsim_experiment_load_grid(path, sets, n_sets, c->grid, c->n_grid, &c->e, err) !=
-	    BSIM_OK)
+	if (bsim_experiment_load_seeded(path, sets, n_sets, c->grid, c->n_grid,
+	                                v[A_SEED] ? &seed : NULL, &c->e, err) != BSIM_OK)
 		return err->code ? err->code : BSIM_EINPUT;
 	if (trials > 0 && bsim_experiment_check_trials(&c->e, trials, err) != BSIM_OK) {
 		char msg[sizeof err->msg];

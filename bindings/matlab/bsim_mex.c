@@ -42,17 +42,62 @@ static char *dup_text(const char *s)
 	return d;
 }
 
-/* A character array's text in the pool, NULL if it is none. */
-static const char *char_text(const mxArray *a, bmx_pool *p)
+/* A character array's elements as UTF-8 with its NUL characters kept,
+ * for a message about them: Octave's mxChar is a byte of UTF-8 already,
+ * MATLAB's a UTF-16 unit (one of a surrogate pair shown as '?'). *len its
+ * bytes; malloc'd, NULL if out of memory. */
+static char *char_bytes(const mxArray *a, size_t *len)
 {
+	size_t n = mxGetNumberOfElements(a), j = 0;
+	const mxChar *c = mxGetChars(a);
+	char *s = malloc(3 * n + 1);
+	for (size_t i = 0; s && i < n; i++) {
+		unsigned u = sizeof *c == 1 ? (unsigned char)c[i] : (unsigned)c[i];
+		if (sizeof *c == 1 || u < 0x80) {
+			s[j++] = (char)u;
+		} else if (u < 0x800) {
+			s[j++] = (char)(0xC0 | u >> 6);
+			s[j++] = (char)(0x80 | (u & 0x3F));
+		} else if (u >= 0xD800 && u < 0xE000) {
+			s[j++] = '?';
+		} else {
+			s[j++] = (char)(0xE0 | u >> 12);
+			s[j++] = (char)(0x80 | ((u >> 6) & 0x3F));
+			s[j++] = (char)(0x80 | (u & 0x3F));
+		}
+	}
+	*len = j;
+	return s;
+}
+
+/* A character row's text in the pool: *out NULL if a is no character
+ * row; BSIM_EINPUT naming what if it holds a NUL character, at which
+ * mxArrayToString, and the library after it, would end the text. */
+static int char_text(const char *what, const mxArray *a, bmx_pool *p, const char **out,
+                     bsim_error *err)
+{
+	*out = NULL;
 	if (!mxIsChar(a) || mxGetM(a) > 1)
-		return NULL;
+		return BSIM_OK;
+	const mxChar *c = mxGetChars(a);
+	size_t n = mxGetNumberOfElements(a), i = 0;
+	while (i < n && c[i] != 0)
+		i++;
+	if (i < n) {
+		size_t len;
+		char *bytes = char_bytes(a, &len);
+		if (!bytes)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		bsim_error_nul_check(what, bytes, len, err);
+		free(bytes);
+		return BSIM_EINPUT;
+	}
 	char *m = mxArrayToString(a);
 	if (!m)
-		return NULL;
-	char *s = bmx_pool_take(p, dup_text(m));
+		return BSIM_OK;
+	*out = bmx_pool_take(p, dup_text(m));
 	mxFree(m);
-	return s;
+	return *out ? BSIM_OK : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 }
 
 static int strcasesame(const char *a, const char *b)
@@ -78,9 +123,16 @@ int bmx_pairs(int nrhs, const mxArray *prhs[], int first, const char *const *nam
 		                      "an odd number of arguments (names: %s)",
 		                      known);
 	for (int k = first; k < nrhs; k += 2) {
-		char name[64] = "";
-		if (!mxIsChar(prhs[k]) || mxGetM(prhs[k]) > 1 ||
-		    mxGetString(prhs[k], name, sizeof name) != 0)
+		char name[64] = "", what[48];
+		snprintf(what, sizeof what, "argument %d", k + 1);
+		bmx_pool none = {0};
+		const char *text;
+		/* (a name holding a NUL would match the name before it) */
+		int bad = char_text(what, prhs[k], &none, &text, err), is_text = text != NULL;
+		bmx_pool_free(&none);
+		if (bad)
+			return err->code;
+		if (!is_text || mxGetString(prhs[k], name, sizeof name) != 0)
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      "argument %d: expected the name of an argument (%s)",
 			                      k + 1, known);
@@ -97,7 +149,10 @@ int bmx_pairs(int nrhs, const mxArray *prhs[], int first, const char *const *nam
 
 int bmx_text(const char *name, const mxArray *a, bmx_pool *p, const char **out, bsim_error *err)
 {
-	*out = char_text(a, p);
+	char what[80];
+	snprintf(what, sizeof what, "'%s'", name);
+	if (char_text(what, a, p, out, err) != BSIM_OK)
+		return err->code;
 	if (!*out)
 		return bsim_error_set(err, BSIM_EINPUT, "'%s': expected text (a character row)",
 		                      name);
@@ -223,7 +278,11 @@ int bmx_value_text(const char *name, const mxArray *a, bmx_pool *p, const char *
                    bsim_error *err)
 {
 	if (mxIsChar(a)) {
-		if (!(*out = char_text(a, p)))
+		char what[160];
+		snprintf(what, sizeof what, "'%s': the value", name);
+		if (char_text(what, a, p, out, err) != BSIM_OK)
+			return err->code;
+		if (!*out)
 			return bsim_error_set(err, BSIM_EINPUT, "'%s': expected one row of text",
 			                      name);
 		return BSIM_OK;
@@ -281,7 +340,11 @@ int bmx_overrides(const char *name, const mxArray *a, bmx_pool *p, bsim_override
 	for (int i = 0; i < pairs; i++) {
 		const mxArray *k = mxGetCell(a, (mwIndex)(2 * i));
 		const mxArray *v = mxGetCell(a, (mwIndex)(2 * i + 1));
-		const char *key = k ? char_text(k, p) : NULL;
+		char what[80];
+		snprintf(what, sizeof what, "'%s': the key", name);
+		const char *key = NULL;
+		if (k && char_text(what, k, p, &key, err) != BSIM_OK)
+			return err->code;
 		if (!key)
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      "'%s': element %d: expected a key (text), e.g. "
@@ -382,7 +445,9 @@ int bmx_grid(const char *name, const mxArray *a, bmx_pool *p, bsim_grid_axis **a
 	for (int i = 0; i < pairs; i++) {
 		const mxArray *k = mxGetCell(a, (mwIndex)(2 * i));
 		const mxArray *v = mxGetCell(a, (mwIndex)(2 * i + 1));
-		const char *key = k ? char_text(k, p) : NULL;
+		const char *key = NULL;
+		if (k && char_text("'grid': the key", k, p, &key, err) != BSIM_OK)
+			return err->code;
 		if (!key)
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      "'grid': element %d: expected a key (text), e.g. "

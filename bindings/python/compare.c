@@ -11,15 +11,17 @@
 PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"experiment", "out",  "a",    "b",        "trials",    "threads",
-	                         "seed",       "sets", "grid", "progress", "overwrite", NULL};
+	static char *kwlist[] = {"experiment", "out",    "a",        "b",
+	                         "trials",     "threads", "seed",     "sets",
+	                         "grid",       "progress", "resume",  "overwrite",
+	                         NULL};
 	const char *experiment, *out, *a = "thesis", *b = "box2d";
 	long trials = 0;
-	int threads = 0, overwrite = 0;
+	int threads = 0, resume = 0, overwrite = 0;
 	PyObject *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|ssliOOOOp", kwlist, &experiment, &out, &a,
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|ssliOOOOpp", kwlist, &experiment, &out, &a,
 	                                 &b, &trials, &threads, &seed_o, &sets_o, &grid_o,
-	                                 &progress_o, &overwrite))
+	                                 &progress_o, &resume, &overwrite))
 		return NULL;
 	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
 		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
@@ -49,7 +51,10 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	def.n_grid = grid.n;
 	def.trials = trials;
 	def.threads = threads;
+	def.resume = resume;
 	def.overwrite = overwrite;
+	def.resume_option = "resume=True";
+	def.overwrite_option = "overwrite=True";
 	def.progress = pyb_progress_update;
 	def.progress_user = &progress;
 	def.stop = &progress.stop;

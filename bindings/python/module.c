@@ -17,15 +17,24 @@ PyObject *pyb_raise(int rc, const bsim_error *err)
 	return NULL;
 }
 
-/* The UTF-8 text of item i of a tuple, or NULL with TypeError. */
-static const char *tuple_text(PyObject *t, Py_ssize_t i, const char *what)
+const char *pyb_text(PyObject *o, const char *what)
 {
-	PyObject *o = PyTuple_GetItem(t, i);
 	if (!o || !PyUnicode_Check(o)) {
 		PyErr_Format(PyExc_TypeError, "%s: expected a str", what);
 		return NULL;
 	}
-	return PyUnicode_AsUTF8(o);
+	Py_ssize_t len;
+	const char *text = PyUnicode_AsUTF8AndSize(o, &len);
+	bsim_error err;
+	if (text && bsim_error_nul_check(what, text, (size_t)len, &err) != BSIM_OK)
+		return pyb_raise(err.code, &err), NULL;
+	return text;
+}
+
+/* The text of item i of a tuple (pyb_text). */
+static const char *tuple_text(PyObject *t, Py_ssize_t i, const char *what)
+{
+	return pyb_text(PyTuple_GetItem(t, i), what);
 }
 
 int pyb_sets_from(PyObject *seq, pyb_sets *s)
@@ -52,9 +61,11 @@ int pyb_sets_from(PyObject *seq, pyb_sets *s)
 			return -1;
 		}
 		bsim_override *o = &s->ov[s->n];
-		if (!(o->key = tuple_text(t, 0, "set key")) ||
-		    !(o->value = tuple_text(t, 1, "set value")) ||
-		    !(o->origin = tuple_text(t, 2, "set origin"))) {
+		char what[160];
+		if ((o->key = tuple_text(t, 0, "set: the key")))
+			snprintf(what, sizeof what, "set %s: the value", o->key);
+		if (!o->key || !(o->value = tuple_text(t, 1, what)) ||
+		    !(o->origin = tuple_text(t, 2, "set: the origin"))) {
 			pyb_sets_free(s);
 			return -1;
 		}
@@ -99,9 +110,8 @@ int pyb_grid_from(PyObject *seq, pyb_grid *g)
 		ax->n_values = (int)m;
 		ax->values = calloc((size_t)(m ? m : 1), sizeof *ax->values);
 		ax->origins = calloc((size_t)(m ? m : 1), sizeof *ax->origins);
-		const char *key = tuple_text(t, 0, "grid key");
-		const char *origin = key ? tuple_text(t, 2, "grid origin") : NULL;
-		if (!ax->values || !ax->origins || !origin) {
+		const char *key = tuple_text(t, 0, "grid: the key");
+		if (!ax->values || !ax->origins || !key) {
 			if (!PyErr_Occurred())
 				PyErr_NoMemory();
 			pyb_grid_free(g);
@@ -109,17 +119,24 @@ int pyb_grid_from(PyObject *seq, pyb_grid *g)
 		}
 		/* The library only reads an axis given to it (const). */
 		ax->key = (char *)key;
+		char what[160];
+		snprintf(what, sizeof what, "grid %s: the value", key);
 		for (Py_ssize_t k = 0; k < m; k++) {
-			PyObject *v = PyList_GetItem(values, k);
-			const char *text = PyUnicode_Check(v) ? PyUnicode_AsUTF8(v) : NULL;
+			const char *text = pyb_text(PyList_GetItem(values, k), what);
 			if (!text) {
-				PyErr_SetString(PyExc_TypeError, "grid value: expected a str");
 				pyb_grid_free(g);
 				return -1;
 			}
 			ax->values[k] = (char *)text;
-			ax->origins[k] = (char *)origin;
 		}
+		/* the origin, made of key and values, last: a message names those */
+		const char *origin = tuple_text(t, 2, "grid: the origin");
+		if (!origin) {
+			pyb_grid_free(g);
+			return -1;
+		}
+		for (Py_ssize_t k = 0; k < m; k++)
+			ax->origins[k] = (char *)origin;
 	}
 	return 0;
 }
@@ -165,12 +182,10 @@ const bsim_backend *pyb_backend(const char *spec, PyObject *seq, bsim_options *o
 			return NULL;
 		}
 		for (Py_ssize_t i = 0; i < PyList_Size(seq); i++) {
-			PyObject *o = PyList_GetItem(seq, i);
-			const char *kv = PyUnicode_Check(o) ? PyUnicode_AsUTF8(o) : NULL;
-			if (!kv) {
-				PyErr_SetString(PyExc_TypeError, "backend_opt: expected str items");
+			const char *kv =
+			        pyb_text(PyList_GetItem(seq, i), "backend_opt: the option");
+			if (!kv)
 				return NULL;
-			}
 			if (bsim_options_add(opts, kv, &err) != BSIM_OK)
 				return pyb_raise(err.code, &err), NULL;
 		}
@@ -311,6 +326,20 @@ static PyObject *py_version(PyObject *self, PyObject *args)
 	return PyUnicode_FromString(bsim_version());
 }
 
+/* text_check(what, text): None, or ValueError naming what if the str text
+ * holds a NUL (pyb_text): the package's check of the arguments the
+ * functions above take as C strings (paths, backends), whose own
+ * conversion would refuse one without naming the argument. */
+static PyObject *py_text_check(PyObject *self, PyObject *args)
+{
+	(void)self;
+	const char *what;
+	PyObject *text;
+	if (!PyArg_ParseTuple(args, "sO", &what, &text) || !pyb_text(text, what))
+		return NULL;
+	Py_RETURN_NONE;
+}
+
 static PyMethodDef methods[] = {
         {"run", (PyCFunction)(void (*)(void))pyb_run, METH_VARARGS | METH_KEYWORDS,
          "run(path, seed, group, trial, backend, sets, backend_opts, trajectory, stride)"},
@@ -318,10 +347,13 @@ static PyMethodDef methods[] = {
          "sweep(experiment, out, trials, threads, seed, backend, sets, grid, backend_opts, "
          "progress)"},
         {"compare", (PyCFunction)(void (*)(void))pyb_compare, METH_VARARGS | METH_KEYWORDS,
-         "compare(experiment, out, backends, trials, threads, seed, sets, grid, progress)"},
+         "compare(experiment, out, a, b, trials, threads, seed, sets, grid, progress, "
+         "resume)"},
         {"landscape", (PyCFunction)(void (*)(void))pyb_landscape, METH_VARARGS | METH_KEYWORDS,
          "landscape(scene, sets, spacing, region)"},
         {"version", py_version, METH_NOARGS, "the library's version"},
+        {"text_check", py_text_check, METH_VARARGS,
+         "text_check(what, text): ValueError naming what if text holds a NUL"},
         {NULL, NULL, 0, NULL},
 };
 

@@ -15,6 +15,12 @@
  * (BSIM_EINPUT), RuntimeError otherwise, with err's one line. NULL. */
 PyObject *pyb_raise(int rc, const bsim_error *err);
 
+/* The UTF-8 text of the str o, which the library reads as a C string: NULL
+ * with TypeError if o is no str, or ValueError naming what ("set: the
+ * key") if it holds a NUL, which would end the text there
+ * (bsim_error_nul_check). Valid while o lives. */
+const char *pyb_text(PyObject *o, const char *what);
+
 /* --set overrides from a sequence of (key, value, origin) str tuples. The
  * strings are the tuples' own (valid while seq lives). -1 with an
  * exception set. */

@@ -49,6 +49,8 @@ PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw)
 	def.keep = (int)keep;
 	def.resume = resume;
 	def.overwrite = overwrite;
+	def.resume_option = "resume=True";
+	def.overwrite_option = "overwrite=True";
 	def.progress = pyb_progress_update;
 	def.progress_user = &progress;
 	def.stop = &progress.stop;

@@ -7,6 +7,8 @@
 #ifndef BSIM_BACKEND_H
 #define BSIM_BACKEND_H
 
+#include <stddef.h>
+
 #include "beamsim/base.h"
 #include "beamsim/error.h"
 #include "beamsim/options.h"
@@ -77,7 +79,27 @@ typedef struct bsim_backend {
 	 * from these states as from get_state's, with one call for a run of
 	 * steps under one force instead of two calls a step (trial_steps.c). */
 	int (*steps)(bsim_world *w, const double force[2], double h, int n, bsim_state *out);
+	/* Optional (NULL: create refuses no valid scene for itself). What
+	 * create refuses of a scene valid on its own, for this backend's
+	 * limits (a body within Box2D's skin, a number beyond float32), and
+	 * of opts: BSIM_OK, or BSIM_EINPUT with err's message and, in
+	 * field[0..size), the dotted scene key to blame ("body.radius"; ""
+	 * for an option), so that a caller who knows where the scene came
+	 * from names the place (bsim_backend_check). */
+	int (*check)(const bsim_scene *scene, const bsim_options *opts, char *field, size_t size,
+	             bsim_error *err);
 } bsim_backend;
+
+/* Checks scene against b with opts (b->check) before a run, as a scene
+ * error is said: BSIM_EINPUT "WHERE: MESSAGE", WHERE the place that gave
+ * the field b refuses, as a scene loader names it: the --set, set: line or
+ * grid value (ov, the overrides the scene was built with from the file
+ * path, in order) that set it last, else the file's line
+ * ("gate.yaml:4:22"). Without path, or where b blames no field, b's
+ * message alone. BSIM_OK if b has no check. */
+BSIM_API int bsim_backend_check(const bsim_backend *b, const bsim_options *opts,
+                                const bsim_scene *scene, const char *path, const bsim_override *ov,
+                                int n_ov, bsim_error *err);
 
 /* The registry: all backends compiled in, NULL-terminated. */
 BSIM_API const bsim_backend *const *bsim_backend_list(void);

@@ -68,7 +68,9 @@ typedef struct bsim_compare_dir_def {
 	int examples;          /* discordant trials listed per disagreeing group */
 	int keep, keep_stride; /* trajectories kept per group, see bsim_sweep_config */
 	int resume;
-	int overwrite; /* as bsim_sweep_dir_def's */
+	int overwrite;                /* as bsim_sweep_dir_def's */
+	const char *resume_option;    /* as bsim_sweep_dir_def's */
+	const char *overwrite_option; /* as bsim_sweep_dir_def's */
 	bsim_progress_fn progress;
 	void *progress_user;
 	const volatile sig_atomic_t *stop;

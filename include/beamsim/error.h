@@ -3,6 +3,8 @@
 #ifndef BSIM_ERROR_H
 #define BSIM_ERROR_H
 
+#include <stddef.h>
+
 #include "beamsim/base.h"
 
 #ifdef __cplusplus
@@ -34,6 +36,14 @@ BSIM_API int bsim_error_set(bsim_error *err, int code, const char *fmt, ...)
 
 /* Clears err to BSIM_OK with an empty message. */
 BSIM_API void bsim_error_clear(bsim_error *err);
+
+/* The library takes text as C strings, which end at their first NUL byte:
+ * text that holds one (a Python str, an Octave char array, both of which
+ * may) would be cut there without a word. For callers that get text with
+ * its length: BSIM_OK if s[0..len) holds no NUL, else BSIM_EINPUT
+ * "WHAT "TEXT": expected text without NUL bytes (...)", TEXT escaped (the
+ * NUL as \x00) and cut to a few hundred bytes. */
+BSIM_API int bsim_error_nul_check(const char *what, const char *s, size_t len, bsim_error *err);
 
 /* A note: what a call that succeeded did not do as asked and the caller
  * should hear of (a table too large for its .mat twin), one line. Notes

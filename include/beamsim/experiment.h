@@ -6,6 +6,7 @@
 
 #include <stdint.h>
 
+#include "beamsim/backend.h"
 #include "beamsim/base.h"
 #include "beamsim/error.h"
 #include "beamsim/scene.h"
@@ -54,6 +55,15 @@ BSIM_API int bsim_experiment_load_grid(const char *path, const bsim_override *ex
                                        const bsim_grid_axis *grid, int n_grid, bsim_experiment *out,
                                        bsim_error *err);
 
+/* bsim_experiment_load_grid with a seed given beside the file (beamsim
+ * --seed N), or NULL: the seed replaces the file's seed:, and a file that
+ * gives none takes it (without one, a file must give seed:). The
+ * experiment then holds the seed that runs, so the record of a run
+ * (beamsim/run_record.h) repeats it. */
+BSIM_API int bsim_experiment_load_seeded(const char *path, const bsim_override *extra, int n_extra,
+                                         const bsim_grid_axis *grid, int n_grid,
+                                         const uint64_t *seed, bsim_experiment *out,
+                                         bsim_error *err);
 BSIM_API void bsim_experiment_free(bsim_experiment *e);
 
 /* Frees what a grid axis holds (key, values, origins; origins may be NULL
@@ -72,6 +82,15 @@ BSIM_API void bsim_experiment_group_index(const bsim_experiment *e, int g, int *
 BSIM_API int bsim_experiment_group_scene(const bsim_experiment *e, int g,
                                          const bsim_override *extra, int n_extra, bsim_scene *out,
                                          bsim_error *err);
+
+/* Checks scene, group g's (bsim_experiment_group_scene with the same
+ * extra), against backend b with opts (bsim_backend_check): what b refuses
+ * is said where the group's scene gave the field, the scene file's line,
+ * set:, extra or the grid value. */
+BSIM_API int bsim_experiment_group_check(const bsim_experiment *e, int g,
+                                         const bsim_override *extra, int n_extra,
+                                         const bsim_scene *scene, const bsim_backend *b,
+                                         const bsim_options *opts, bsim_error *err);
 
 #ifdef __cplusplus
 }

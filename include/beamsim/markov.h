@@ -75,6 +75,16 @@ BSIM_API bsim_markov_bins bsim_markov_bins_default(void);
 /* The number of entry bins, the start's included: 1 + 4 n_pos n_speed n_dir. */
 BSIM_API int bsim_markov_bins_count(const bsim_markov_bins *b);
 
+/* The most cells (entry bin x exit bin counts) a map may hold. */
+#define BSIM_MARKOV_MAX_CELLS 20000000L
+
+/* BSIM_OK if the bins make a map that may be built: 1 to 64 positions,
+ * speeds and directions, and at most BSIM_MARKOV_MAX_CELLS cells
+ * (bsim_markov_bins_count squared); else BSIM_EINPUT saying what is wrong
+ * and what is accepted (n_pos n_speed n_dir at most 1117). v_max is not
+ * checked. */
+BSIM_API int bsim_markov_bins_check(const bsim_markov_bins *b, bsim_error *err);
+
 /* Gate entries observed in simulation (gate_entries.csv of lattice sweeps,
  * the start rows left out): when a map is built with them, the states of
  * an entry bin are drawn from the entries that fall in it (uniformly in

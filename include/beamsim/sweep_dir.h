@@ -56,7 +56,12 @@ typedef struct bsim_sweep_dir_def {
 	int resume;                  /* 1: continue the stopped run in out (same inputs) */
 	int overwrite; /* 1: replace the finished result, or a stopped run's journal, in
 	                * out; 0: such an out is refused (BSIM_EINPUT) */
-	bsim_progress_fn progress;   /* may be NULL */
+	/* How the caller spells resume and overwrite in messages about them
+	 * ("add --resume to continue it"): NULL the command line's "--resume"
+	 * and "--overwrite"; a binding names its own arguments ("resume=True"). */
+	const char *resume_option;
+	const char *overwrite_option;
+	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
 	/* NULL, or a flag (set by a signal handler, say): once nonzero no trial
 	 * starts, those running finish and are journaled, and the run returns

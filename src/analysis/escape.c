@@ -426,7 +426,7 @@ int escape_run(const escape_def *def, escape_summary *sum, bsim_error *err)
 	const bsim_experiment *e = &res.e;
 	bsim_session ss;
 	if ((rc = bsim_session_open(&ss, def->out, bsim_session_mode(0, def->overwrite), "escape",
-	                            NULL, 0, err)) != BSIM_OK) {
+	                            NULL, NULL, 0, err)) != BSIM_OK) {
 		bsim_sweep_dir_result_free(&res);
 		return rc;
 	}

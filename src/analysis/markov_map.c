@@ -94,16 +94,12 @@ static int map_init(bsim_markov_map *m, const bsim_scene *lattice, const bsim_ma
 static int def_check(const bsim_markov_def *def, bsim_error *err)
 {
 	const bsim_markov_bins *b = &def->bins;
-	if (b->n_pos < 1 || b->n_speed < 1 || b->n_dir < 1 || b->n_pos > 64 || b->n_speed > 64 ||
-	    b->n_dir > 64 || !(b->v_max > 0) || !isfinite(b->v_max))
+	bsim_error why;
+	if (bsim_markov_bins_check(b, &why) != BSIM_OK)
+		return bsim_error_set(err, BSIM_EINPUT, "bins: %s", why.msg);
+	if (!(b->v_max > 0) || !isfinite(b->v_max))
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "bins: expected 1 to 64 positions, speeds and directions and "
-		                      "v_max > 0, got %d, %d, %d, %g",
-		                      b->n_pos, b->n_speed, b->n_dir, b->v_max);
-	if ((long)bsim_markov_bins_count(b) * bsim_markov_bins_count(b) > 20000000L)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "bins: %d entry bins make a map of more than 2e7 cells",
-		                      bsim_markov_bins_count(b));
+		                      "bins: v_max %g: expected a speed > 0 in m/s", b->v_max);
 	if (def->self_entries && (def->entries || def->self_entries > 2 || def->self_passes < 0 ||
 	                          def->self_passes > BSIM_MARKOV_SELF_PASSES_MAX))
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -397,7 +393,7 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 	}
 	bsim_session ss;
 	/* the maps join those already cached */
-	if ((rc = bsim_session_open(&ss, dir, BSIM_OUTDIR_ADD, "markov build", NULL, 0, err)) !=
+	if ((rc = bsim_session_open(&ss, dir, BSIM_OUTDIR_ADD, "markov build", NULL, NULL, 0, err)) !=
 	    BSIM_OK)
 		return rc;
 	rc = set_fill(lattice, def, dir, &ss, out, err);

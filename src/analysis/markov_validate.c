@@ -505,8 +505,9 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 {
 	memset(out, 0, sizeof *out);
 	bsim_experiment e;
-	int rc = bsim_experiment_load_grid(def->experiment, def->sets, def->n_sets, def->grid,
-	                                   def->n_grid, &e, err);
+	int rc = bsim_experiment_load_seeded(def->experiment, def->sets, def->n_sets, def->grid,
+	                                     def->n_grid, def->has_seed ? &def->seed : NULL, &e,
+	                                     err);
 	if (rc != BSIM_OK)
 		return rc;
 	if (def->trials > 0 &&

@@ -112,7 +112,7 @@ int bsim_markov_prediction_store(const char *dir, int overwrite, const bsim_scen
 {
 	bsim_session ss;
 	int rc = bsim_session_open(&ss, dir, bsim_session_mode(0, overwrite), "markov predict",
-	                           NULL, 0, err);
+	                           NULL, NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
 	rc = write_tables(ss.stage, p, err);

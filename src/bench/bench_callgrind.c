@@ -40,7 +40,7 @@ int bench_measure(const bench_measure_args *a)
 	int rc = CLI_OK;
 	if (strcmp(a->what, "h1") == 0) {
 		bsim_experiment e;
-		if ((rc = cli_experiment_load(a->experiment, NULL, a->trials, &e)) != CLI_OK)
+		if ((rc = cli_experiment_load(a->experiment, NULL, NULL, a->trials, &e)) != CLI_OK)
 			return rc;
 		bsim_sweep_config cfg = {.backend = a->backend, .opts = a->opts, .threads = 1};
 		bsim_sweep_result r;

@@ -93,7 +93,7 @@ int bench_free(const bench_free_args *a, bench_free_result *out)
 		rc = cli_sets_add(&sets, "bench", "termination.side_x=1e9");
 	bsim_experiment e;
 	if (rc == CLI_OK)
-		rc = cli_experiment_load(a->experiment, &sets, a->trials, &e);
+		rc = cli_experiment_load(a->experiment, &sets, NULL, a->trials, &e);
 	if (rc != CLI_OK) {
 		cli_sets_free(&sets);
 		return rc;

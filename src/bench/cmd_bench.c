@@ -563,10 +563,10 @@ static int bench_main(const bench_args *a, const bsim_backend *backend, const bs
 	if (rc == CLI_OK && a->h2)
 		rc = bench_find(BENCH_H2);
 	if (rc == CLI_OK)
-		rc = cli_experiment_load(a->experiment, NULL, a->trials, &h1);
+		rc = cli_experiment_load(a->experiment, NULL, NULL, a->trials, &h1);
 	if (rc != CLI_OK)
 		return rc;
-	if (a->h2 && (rc = cli_experiment_load(BENCH_H2, NULL, a->trials, &h2)) != CLI_OK) {
+	if (a->h2 && (rc = cli_experiment_load(BENCH_H2, NULL, NULL, a->trials, &h2)) != CLI_OK) {
 		bsim_experiment_free(&h1);
 		return rc;
 	}

@@ -405,12 +405,13 @@ int cli_report(int rc, const bsim_error *err)
 	return rc;
 }
 
-int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsim_experiment *e)
+int cli_experiment_load(const char *path, const cli_sets *sets, const uint64_t *seed, long trials,
+                        bsim_experiment *e)
 {
 	bsim_error err;
 	const bsim_override *ov = sets ? sets->ov : NULL;
-	if (bsim_experiment_load_grid(path, ov, sets ? sets->n : 0, sets ? sets->grid : NULL,
-	                              sets ? sets->n_grid : 0, e, &err) != BSIM_OK) {
+	if (bsim_experiment_load_seeded(path, ov, sets ? sets->n : 0, sets ? sets->grid : NULL,
+	                                sets ? sets->n_grid : 0, seed, e, &err) != BSIM_OK) {
 		cli_error("%s", err.msg);
 		return err.code ? err.code : CLI_USAGE;
 	}
@@ -528,14 +529,15 @@ void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const 
 		                  : "");
 }
 
-double cli_experiment_beam_steps(const char *path, const cli_sets *sets, long trials)
+double cli_experiment_beam_steps(const char *path, const cli_sets *sets, const uint64_t *seed,
+                                 long trials)
 {
 	bsim_experiment e;
 	bsim_error err;
 	const bsim_override *ov = sets ? sets->ov : NULL;
 	int n_ov = sets ? sets->n : 0;
-	if (bsim_experiment_load_grid(path, ov, n_ov, sets ? sets->grid : NULL,
-	                              sets ? sets->n_grid : 0, &e, &err) != BSIM_OK)
+	if (bsim_experiment_load_seeded(path, ov, n_ov, sets ? sets->grid : NULL,
+	                                sets ? sets->n_grid : 0, seed, &e, &err) != BSIM_OK)
 		return 0.0;
 	if (trials > 0 && bsim_experiment_check_trials(&e, trials, &err) != BSIM_OK) {
 		bsim_experiment_free(&e);

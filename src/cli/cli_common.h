@@ -98,10 +98,11 @@ const bsim_backend *cli_backend(const char *name, const bsim_options *opts);
 int cli_report(int rc, const bsim_error *err);
 
 /* Loads an experiment with the --set overrides and --grid axes (sets may
- * be NULL) and,
- * if trials > 0, that many trials per group. Prints any error; returns
- * the exit status (2 for a bad file). */
-int cli_experiment_load(const char *path, const cli_sets *sets, long trials, bsim_experiment *e);
+ * be NULL), the --seed (seed NULL: the file's) and, if trials > 0, that
+ * many trials per group. Prints any error; returns the exit status (2 for
+ * a bad file). */
+int cli_experiment_load(const char *path, const cli_sets *sets, const uint64_t *seed, long trials,
+                        bsim_experiment *e);
 
 /* bsim_sweep_run with a progress line on stderr if show_progress (cfg's
  * own progress fields are ignored). Prints any error; returns the exit
@@ -135,10 +136,11 @@ void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const 
 /* The beam-steps a run may take at most: trials x max_steps x beams
  * (every beam of a lattice), summed over the groups of the experiment at
  * path with the --set overrides and --grid axes (a group without random force runs one
- * trial); trials > 0 replaces the file's. 0 if the experiment does not
- * load or asks for more trials than the limit (the run itself then says
- * why). */
-double cli_experiment_beam_steps(const char *path, const cli_sets *sets, long trials);
+ * trial); seed, if not NULL, stands in for a missing seed:; trials > 0
+ * replaces the file's. 0 if the experiment does not load or asks for more
+ * trials than the limit (the run itself then says why). */
+double cli_experiment_beam_steps(const char *path, const cli_sets *sets, const uint64_t *seed,
+                                 long trials);
 
 /* One line on stderr before a run that may take more than an hour of one
  * core: the estimate, the beam-steps it is made of and the cost of a

@@ -285,8 +285,9 @@ static int compare_main(int argc, char **argv, const cli_merge *m)
 	if (def.side[1].backend && strcmp(def.side[1].backend->name, "box2d") == 0)
 		costlier = "box2d";
 	if (rank == 0 && !m)
-		cli_estimate_line(costlier,
-		                  2.0 * cli_experiment_beam_steps(experiment, &c.sets, c.trials));
+		cli_estimate_line(costlier, 2.0 * cli_experiment_beam_steps(
+		                                          experiment, &c.sets,
+		                                          c.has_seed ? &c.seed : NULL, c.trials));
 	bsim_compare_dir_result res;
 	bsim_error err;
 	cli_signals_install();

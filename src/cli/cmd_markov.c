@@ -87,6 +87,9 @@ static int markov_option(void *args, int i, const char *value)
 		a->def.bins.n_pos = (int)n[0];
 		a->def.bins.n_speed = (int)n[1];
 		a->def.bins.n_dir = (int)n[2];
+		bsim_error err;
+		if (bsim_markov_bins_check(&a->def.bins, &err) != BSIM_OK)
+			return cli_usage("markov", "--bins %s: %s", value, err.msg);
 		return CLI_OK;
 	}
 	case OWN_VMAX:
@@ -391,7 +394,7 @@ static int markov_build_ranks(int argc, char **argv, const cli_common *c)
 	/* out is opened by rank 0's merge; until then the ranks make their
 	 * parts in it only if it could be opened (no other run holds it) */
 	bsim_error err;
-	if (rc == CLI_OK && bsim_outdir_probe(c->out, BSIM_OUTDIR_ADD, &err) != BSIM_OK)
+	if (rc == CLI_OK && bsim_outdir_probe(c->out, BSIM_OUTDIR_ADD, NULL, &err) != BSIM_OK)
 		rc = cli_report(err.code, &err);
 	if (rc == CLI_OK)
 		rc = mkdir_have(c->out);
@@ -513,7 +516,8 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		a.def.entries = &entries;
 	}
 	/* c.trials is the single gates' per bin, not the experiment's */
-	if ((rc = cli_experiment_load(path, &c.sets, 0, &e)) != CLI_OK) {
+	if ((rc = cli_experiment_load(path, &c.sets, c.has_seed ? &c.seed : NULL, 0, &e)) !=
+	    CLI_OK) {
 		bsim_markov_entries_free(&entries);
 		cli_common_free(&c);
 		return rc;
@@ -793,7 +797,7 @@ static int markov_predict(int argc, char **argv)
 	bsim_markov_prediction p = {0};
 	/* --out refused before the chain is solved, not after */
 	rc = c.out ? bsim_outdir_probe(c.out, c.overwrite ? BSIM_OUTDIR_OVERWRITE : BSIM_OUTDIR_NEW,
-	                               &err)
+	                               NULL, &err)
 	           : BSIM_OK;
 	if (rc != BSIM_OK) {
 		bsim_scene_free(&scene);

@@ -23,7 +23,7 @@ int bsim_figures_plot(const char *dir, const bsim_figures_def *def, bsim_figures
 	/* Into DIR the figures join its result; into another directory they
 	 * are a result of their own. */
 	bsim_outdir_mode mode = def->out ? bsim_session_mode(0, def->overwrite) : BSIM_OUTDIR_ADD;
-	int rc = bsim_session_open(&ss, to, mode, "plot", NULL, 0, err);
+	int rc = bsim_session_open(&ss, to, mode, "plot", NULL, NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
 	bsim_figures_def d = *def;

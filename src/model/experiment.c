@@ -192,11 +192,12 @@ static int walk_key(const ydoc *d, const char *name, struct fy_node *k, struct f
 	                 experiment_keys);
 }
 
-static int walk_experiment(const ydoc *d, bsim_experiment *e, bsim_error *err)
+/* has_seed: a seed given beside the file stands in for its seed:. */
+static int walk_experiment(const ydoc *d, int has_seed, bsim_experiment *e, bsim_error *err)
 {
 	static const char *const required[] = {"scene", "trials", "seed", "grid"};
 	static const char *const phrase[] = {"a scene file name", "a positive integer",
-	                                     "an integer >= 0",
+	                                     "an integer >= 0, or give one with --seed N",
 	                                     "a mapping of dotted keys to lists"};
 	struct fy_node *root = fy_document_root(d->fyd);
 	if (!root || !fy_node_is_mapping(root))
@@ -213,7 +214,8 @@ static int walk_experiment(const ydoc *d, bsim_experiment *e, bsim_error *err)
 			return rc;
 	}
 	for (int i = 0; i < 4; i++)
-		if (!ydoc_pair(root, required[i], strlen(required[i])))
+		if (!ydoc_pair(root, required[i], strlen(required[i])) &&
+		    !(has_seed && !strcmp(required[i], "seed")))
 			return ydoc_fail(d, root, NULL, required[i], err, "missing (expected %s)",
 			                 phrase[i]);
 	return BSIM_OK;
@@ -432,6 +434,26 @@ int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_over
 	return rc;
 }
 
+int bsim_experiment_group_check(const bsim_experiment *e, int g, const bsim_override *extra,
+                                int n_extra, const bsim_scene *scene, const bsim_backend *b,
+                                const bsim_options *opts, bsim_error *err)
+{
+	if (!b->check)
+		return BSIM_OK;
+	int n = 0, *idx = malloc((size_t)(e->n_axes ? e->n_axes : 1) * sizeof *idx);
+	bsim_override *ov = NULL;
+	if (idx) {
+		bsim_experiment_group_index(e, g, idx);
+		ov = group_overrides(e, idx, extra, n_extra, &n);
+	}
+	free(idx);
+	if (!ov)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
+	int rc = bsim_backend_check(b, opts, scene, e->scene_path, ov, n, err);
+	free(ov);
+	return rc;
+}
+
 /* A fixed override (set: or --set) of a field the grid varies would be
  * overwritten in every group without a word: refused. One of a block that
  * holds the axis (set body.start, grid body.start.1) keeps its other
@@ -521,6 +543,13 @@ int bsim_experiment_load_grid(const char *path, const bsim_override *extra, int 
                               const bsim_grid_axis *grid, int n_grid, bsim_experiment *out,
                               bsim_error *err)
 {
+	return bsim_experiment_load_seeded(path, extra, n_extra, grid, n_grid, NULL, out, err);
+}
+
+int bsim_experiment_load_seeded(const char *path, const bsim_override *extra, int n_extra,
+                                const bsim_grid_axis *grid, int n_grid, const uint64_t *seed,
+                                bsim_experiment *out, bsim_error *err)
+{
 	memset(out, 0, sizeof *out);
 	if (strlen(path) >= sizeof out->path)
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -531,7 +560,9 @@ int bsim_experiment_load_grid(const char *path, const bsim_override *extra, int 
 	int rc = ydoc_load(&d, out->path, err);
 	if (rc)
 		return rc;
-	rc = walk_experiment(&d, out, err);
+	rc = walk_experiment(&d, seed != NULL, out, err);
+	if (!rc && seed)
+		out->seed = *seed;
 	if (!rc)
 		rc = apply_grid(out, grid, n_grid, err);
 	if (!rc)

@@ -7,6 +7,7 @@
 #include "beamsim/landscape.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 double bsim_landscape_theta(const bsim_beam_def *b, double radius, const double c[2])
@@ -128,6 +129,32 @@ static int grid_region(const bsim_scene *s, const bsim_landscape_grid_def *def, 
 	return BSIM_OK;
 }
 
+/* The points x0 + i h up to x0 + len (a hair of slack so that a region
+ * that is a whole number of spacings ends on its edge). */
+static double grid_points(double len, double h)
+{
+	return floor(len / h + 1e-9) + 1.0;
+}
+
+/* The finest spacing, to three digits as text (rounded up), whose grid
+ * over a w x hgt region has at most BSIM_LANDSCAPE_MAX_POINTS points: from
+ * (w / h + 1) (hgt / h + 1) = N, a quadratic in 1 / h, then checked on the
+ * value the text reads back as. */
+static void finest_spacing(double w, double hgt, char *text, size_t size)
+{
+	const double n = BSIM_LANDSCAPE_MAX_POINTS, b = w + hgt;
+	double h = 2.0 * w * hgt / (-b + sqrt(b * b + 4.0 * w * hgt * (n - 1.0)));
+	const double step = pow(10.0, floor(log10(h)) - 2.0);
+	h = ceil(h / step) * step;
+	for (;;) {
+		snprintf(text, size, "%.3g", h);
+		const double read = strtod(text, NULL);
+		if (grid_points(w, read) * grid_points(hgt, read) <= n)
+			return;
+		h += step;
+	}
+}
+
 int bsim_landscape_grid_alloc(const bsim_scene *s, const bsim_landscape_grid_def *def,
                               bsim_landscape_grid **out, bsim_error *err)
 {
@@ -150,20 +177,31 @@ int bsim_landscape_grid_alloc(const bsim_scene *s, const bsim_landscape_grid_def
 	if (h == 0.0)
 		h = fmax(w, hgt) / GRID_DEFAULT_INTERVALS;
 	if (!(h > 0.0) || !isfinite(h))
-		return bsim_error_set(err, BSIM_EINPUT, "resolution %g: expected a spacing > 0 m",
+		return bsim_error_set(err, BSIM_EINPUT, "--resolution %g: expected a spacing > 0 m",
 		                      def->spacing);
-	/* The points x0 + i h up to x1 (a hair of slack so that a region that
-	 * is a whole number of spacings ends on its edge). */
-	const double nxd = floor(w / h + 1e-9) + 1.0, nyd = floor(hgt / h + 1e-9) + 1.0;
+	const double nxd = grid_points(w, h), nyd = grid_points(hgt, h);
 	if (nxd < 3 || nyd < 3)
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "resolution %g m: under 3 points across the %g x %g m region",
+		                      "--resolution %g: under 3 points across the %g x %g m region",
 		                      h, w, hgt);
-	if (nxd * nyd > BSIM_LANDSCAPE_MAX_POINTS)
+	if (nxd * nyd > BSIM_LANDSCAPE_MAX_POINTS) {
+		/* The counts in full up to 10^15, so that a tiny spacing gives
+		 * "5e+301", not 300 digits. */
+		char finest[32];
+		finest_spacing(w, hgt, finest, sizeof finest);
+		if (strtod(finest, NULL) > fmin(w, hgt) / 2.0)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "--resolution %g: %.15g x %.15g points over the %g x "
+			                      "%g m region, more than the %d a landscape may have, "
+			                      "and no spacing gives fewer with 3 points a side; "
+			                      "expected a smaller --region",
+			                      h, nxd, nyd, w, hgt, BSIM_LANDSCAPE_MAX_POINTS);
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "resolution %g m: %.0f x %.0f points, more than %d; choose a "
-		                      "coarser spacing or a smaller region",
-		                      h, nxd, nyd, BSIM_LANDSCAPE_MAX_POINTS);
+		                      "--resolution %g: %.15g x %.15g points over the %g x %g m "
+		                      "region, more than the %d a landscape may have; expected a "
+		                      "spacing of at least %s m (or a smaller --region)",
+		                      h, nxd, nyd, w, hgt, BSIM_LANDSCAPE_MAX_POINTS, finest);
+	}
 	bsim_landscape_grid *g = calloc(1, sizeof *g);
 	if (!g)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");

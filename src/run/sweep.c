@@ -117,6 +117,17 @@ static void scenes_free(bsim_scene *scenes, int n)
 	free(scenes);
 }
 
+/* The overrides a side's scenes are built with after the experiment's:
+ * extra, then the second side's own of a paired sweep. malloc'd. */
+static bsim_override *side_overrides(const bsim_sweep_config *cfg, int side_b, int *n_ov)
+{
+	*n_ov = cfg->n_extra + (side_b ? cfg->n_extra_b : 0);
+	bsim_override *ov = calloc(*n_ov > 0 ? (size_t)*n_ov : 1, sizeof *ov);
+	for (int i = 0; ov && i < *n_ov; i++)
+		ov[i] = i < cfg->n_extra ? cfg->extra[i] : cfg->extra_b[i - cfg->n_extra];
+	return ov;
+}
+
 /* Every group's scene, built once: a trial only reads its scene. The
  * second side of a paired sweep adds its own overrides after extra. */
 static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, int side_b,
@@ -126,16 +137,12 @@ static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 	*out = NULL;
 	if (!scenes)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %d scenes", e->n_groups);
-	int n_ov = cfg->n_extra + (side_b ? cfg->n_extra_b : 0);
-	bsim_override *ov = calloc(n_ov > 0 ? (size_t)n_ov : 1, sizeof *ov);
+	int n_ov;
+	bsim_override *ov = side_overrides(cfg, side_b, &n_ov);
 	if (!ov) {
 		free(scenes);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %d scenes", e->n_groups);
 	}
-	for (int i = 0; i < cfg->n_extra; i++)
-		ov[i] = cfg->extra[i];
-	for (int i = 0; side_b && i < cfg->n_extra_b; i++)
-		ov[cfg->n_extra + i] = cfg->extra_b[i];
 	for (int g = 0; g < e->n_groups; g++) {
 		int rc = bsim_experiment_group_scene(e, g, ov, n_ov, &scenes[g], err);
 		if (rc != BSIM_OK) {
@@ -147,6 +154,46 @@ static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 	free(ov);
 	*out = scenes;
 	return BSIM_OK;
+}
+
+/* The scenes of every group for each side, each checked against the
+ * backend that runs it (bsim_experiment_group_check), so that a scene a
+ * backend refuses (a body within Box2D's skin) is said where the scene
+ * gave the field, before any trial runs: side b's scenes (scenes_b, NULL
+ * when not paired) are side a's unless it has overrides of its own. On
+ * failure nothing is left built. */
+static int scenes_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                      const bsim_backend *backend_b, const bsim_options *opts_b,
+                      bsim_scene **scenes, bsim_scene **scenes_b, bsim_error *err)
+{
+	const int own_b = backend_b && cfg->n_extra_b > 0;
+	if (scenes_b)
+		*scenes_b = NULL;
+	int rc = scenes_build(e, cfg, 0, scenes, err);
+	if (rc == BSIM_OK && own_b)
+		rc = scenes_build(e, cfg, 1, scenes_b, err);
+	for (int side = 0; rc == BSIM_OK && side < (backend_b ? 2 : 1); side++) {
+		const int of_b = side == 1 && own_b;
+		int n_ov;
+		bsim_override *ov = side_overrides(cfg, of_b, &n_ov);
+		if (!ov)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
+			rc = bsim_experiment_group_check(
+			        e, g, ov, n_ov, of_b ? &(*scenes_b)[g] : &(*scenes)[g],
+			        side ? backend_b : cfg->backend, side ? opts_b : cfg->opts, err);
+		free(ov);
+	}
+	if (rc != BSIM_OK) {
+		if (*scenes)
+			scenes_free(*scenes, e->n_groups);
+		if (scenes_b && *scenes_b)
+			scenes_free(*scenes_b, e->n_groups);
+		*scenes = NULL;
+		if (scenes_b)
+			*scenes_b = NULL;
+	}
+	return rc;
 }
 
 /* A paired sweep's journal record. */
@@ -603,10 +650,7 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 		}
 	}
 	bsim_scene *scenes, *scenes_b = NULL;
-	int rc = scenes_build(e, cfg, 0, &scenes, err);
-	if (rc == BSIM_OK && backend_b && cfg->n_extra_b > 0 &&
-	    (rc = scenes_build(e, cfg, 1, &scenes_b, err)) != BSIM_OK)
-		scenes_free(scenes, e->n_groups);
+	int rc = scenes_for(e, cfg, backend_b, opts_b, &scenes, &scenes_b, err);
 	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
 	if (rc == BSIM_OK && !deterministic) {
 		scenes_free(scenes, e->n_groups);
@@ -850,7 +894,7 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	bsim_scene *scenes = NULL;
 	stream_state st = {0};
 	int *deterministic = NULL;
-	int rc = scenes_build(e, cfg, 0, &scenes, err);
+	int rc = scenes_for(e, cfg, NULL, NULL, &scenes, NULL, err);
 	if (rc == BSIM_OK && scenes[0].has_lattice) {
 		out->lattice = 1;
 		out->lattice_def = scenes[0].lattice;
@@ -1031,9 +1075,7 @@ static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	    (backend_b && (!results_b || !logs_b || !t_separate)))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
 	if (rc == BSIM_OK)
-		rc = scenes_build(e, cfg, 0, &scenes, err);
-	if (rc == BSIM_OK && backend_b && cfg->n_extra_b > 0)
-		rc = scenes_build(e, cfg, 1, &scenes_b, err);
+		rc = scenes_for(e, cfg, backend_b, opts_b, &scenes, &scenes_b, err);
 	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
 		deterministic[g] = !bsim_effects_random(&scenes[g]);
 	sweep_shared sh = {

@@ -370,13 +370,11 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 		                                 "--protocols (side b)"};
 	}
 	rc = bsim_store_experiment(def->experiment, job.sets, job.n_sets, def->grid, def->n_grid,
-	                           def->trials, &res->e, err);
+	                           def->trials, def->has_seed ? &def->seed : NULL, &res->e, err);
 	if (rc != BSIM_OK) {
 		free(sets);
 		return rc;
 	}
-	if (def->has_seed)
-		res->e.seed = def->seed;
 	job.e = &res->e;
 	record_fill(&job);
 	char *inputs = bsim_run_record_inputs(&job.rec, &res->e, job.sets, job.n_sets, err);
@@ -409,6 +407,7 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 	if (rc == BSIM_OK)
 		rc = bsim_session_open(&ss, def->out,
 		                       bsim_session_mode(def->resume, def->overwrite), "compare",
+		                       &(bsim_outdir_spelling){def->resume_option, def->overwrite_option},
 		                       inputs, size, err);
 	if (rc == BSIM_OK) {
 		if (spread != BSIM_SPREAD_NONE || def->n_merge > 0)

@@ -28,6 +28,7 @@
 #include "util/yaml_doc.h"
 #include "beamsim/limits.h"
 #include "util/file_read.h"
+#include "beamsim/output.h"
 
 struct bsim_outdir {
 	char dir[1024];
@@ -270,15 +271,17 @@ static int refuse_running(const char *dir, const char *who, bsim_error *err)
 
 /* The result DIR holds, for the refusal of a run that would replace it
  * (mode NEW): a finished one (a manifest) or a stopped one (a journal). */
-static int refuse_held(const bsim_outdir *od, const char *dir, bsim_error *err)
+static int refuse_held(const bsim_outdir *od, const char *dir, const bsim_outdir_spelling *sp,
+                       bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	struct stat st;
 	if (join(path, sizeof path, od->work, "journal") == 0 && lstat(path, &st) == 0)
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s holds the journal of a stopped run (%s): add --resume to "
-		                      "continue it, or --overwrite to discard it and start over",
-		                      dir, path);
+		                      "%s holds the journal of a stopped run (%s): add %s to "
+		                      "continue it, or %s to discard it and start over",
+		                      dir, path, bsim_outdir_resume_option(sp),
+		                      bsim_outdir_overwrite_option(sp));
 	olist l = {0};
 	int has = 0;
 	bsim_error ignored;
@@ -294,9 +297,9 @@ static int refuse_held(const bsim_outdir *od, const char *dir, bsim_error *err)
 		snprintf(what, sizeof what, "a finished result (%s)", BSIM_OUTDIR_MANIFEST);
 	olist_free(&l);
 	return bsim_error_set(err, BSIM_EINPUT,
-	                      "%s holds %s: add --overwrite to replace it, or choose another "
-	                      "output directory",
-	                      dir, what);
+	                      "%s holds %s: add %s to replace it, or choose another output "
+	                      "directory",
+	                      dir, what, bsim_outdir_overwrite_option(sp));
 }
 
 /* lock_take's answer for a DIR that is there and not a directory. */
@@ -340,7 +343,7 @@ static int lock_take(bsim_outdir *od)
 }
 
 int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_outdir_mode mode, const char *command,
-                     bsim_error *err)
+                     const bsim_outdir_spelling *spelling, bsim_error *err)
 {
 	*out = NULL;
 	bsim_outdir *od = calloc(1, sizeof *od);
@@ -376,7 +379,7 @@ int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_outdir_mode mode, 
 			return refuse_running(dir, who, err);
 		return input_error(err, dir, rc);
 	}
-	if (mode == BSIM_OUTDIR_NEW && (rc = refuse_held(od, dir, err)) != BSIM_OK) {
+	if (mode == BSIM_OUTDIR_NEW && (rc = refuse_held(od, dir, spelling, err)) != BSIM_OK) {
 		close(od->lock_fd);
 		free(od);
 		return rc;
@@ -401,7 +404,8 @@ int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_outdir_mode mode, 
 	return BSIM_OK;
 }
 
-int bsim_outdir_probe(const char *dir, bsim_outdir_mode mode, bsim_error *err)
+int bsim_outdir_probe(const char *dir, bsim_outdir_mode mode, const bsim_outdir_spelling *spelling,
+                      bsim_error *err)
 {
 	bsim_outdir probe = {.lock_fd = -1};
 	struct stat st;
@@ -424,10 +428,17 @@ int bsim_outdir_probe(const char *dir, bsim_outdir_mode mode, bsim_error *err)
 		rc = errno == EWOULDBLOCK ? refuse_running(dir, who, err)
 		                          : input_error(err, dir, errno);
 	} else if (mode == BSIM_OUTDIR_NEW) {
-		rc = refuse_held(&probe, dir, err);
+		rc = refuse_held(&probe, dir, spelling, err);
 	}
 	close(fd);
 	return rc;
+}
+
+int bsim_output_dir_check(const char *dir, int overwrite, const char *overwrite_option,
+                          bsim_error *err)
+{
+	const bsim_outdir_spelling sp = {NULL, overwrite_option};
+	return bsim_outdir_probe(dir, overwrite ? BSIM_OUTDIR_OVERWRITE : BSIM_OUTDIR_NEW, &sp, err);
 }
 
 const char *bsim_outdir_dir(const bsim_outdir *od)

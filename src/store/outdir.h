@@ -3,7 +3,7 @@
  * some files of one run beside files of another.
  *
  *   bsim_outdir *od;
- *   if (bsim_outdir_open(&od, "out/h1", BSIM_OUTDIR_NEW, "sweep", err) != BSIM_OK)
+ *   if (bsim_outdir_open(&od, "out/h1", BSIM_OUTDIR_NEW, "sweep", NULL, err) != BSIM_OK)
  *           return ...; // exit 2
  *   ... write files into bsim_outdir_stage(od) under their final names,
  *       subdirectories included (DIR/thesis/trials.csv) ...
@@ -53,12 +53,30 @@ typedef enum bsim_outdir_mode {
 	BSIM_OUTDIR_ADD,       /* the files join the result there (plot, a map cache) */
 } bsim_outdir_mode;
 
+/* How the caller spells the options a refusal names: NULL (or a NULL
+ * field) is the command line's "--resume" and "--overwrite"; a binding
+ * names its own arguments ("resume=True", "'overwrite', true"). */
+typedef struct bsim_outdir_spelling {
+	const char *resume;
+	const char *overwrite;
+} bsim_outdir_spelling;
+
+static inline const char *bsim_outdir_resume_option(const bsim_outdir_spelling *s)
+{
+	return s && s->resume ? s->resume : "--resume";
+}
+
+static inline const char *bsim_outdir_overwrite_option(const bsim_outdir_spelling *s)
+{
+	return s && s->overwrite ? s->overwrite : "--overwrite";
+}
+
 /* Prepares dir as above; command ("sweep") names the run to a run refused
  * while this one holds DIR (DIR/.beamsim/owner). BSIM_EINPUT naming dir and
  * the cause if it is not a directory, cannot be created or written,
  * another run holds it, or, with mode NEW, it holds a result. */
 int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_outdir_mode mode, const char *command,
-                     bsim_error *err);
+                     const bsim_outdir_spelling *spelling, bsim_error *err);
 
 /* Whether bsim_outdir_open(dir, mode) would refuse dir, found without
  * creating, locking for long or changing anything: for a run that must
@@ -66,7 +84,8 @@ int bsim_outdir_open(bsim_outdir **out, const char *dir, bsim_outdir_mode mode, 
  * they make their parts in dir). BSIM_OK, or the refusal open would give
  * (a directory missing is no refusal). The answer may change before the
  * open. */
-int bsim_outdir_probe(const char *dir, bsim_outdir_mode mode, bsim_error *err);
+int bsim_outdir_probe(const char *dir, bsim_outdir_mode mode, const bsim_outdir_spelling *spelling,
+                      bsim_error *err);
 
 /* The directory as the user named it. */
 const char *bsim_outdir_dir(const bsim_outdir *od);

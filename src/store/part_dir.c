@@ -176,6 +176,10 @@ int part_dir_check(const char *const *dirs, int n, const char *command, const ch
                    bsim_sweep_dir_part *parts, bsim_error *err)
 {
 	int rc = BSIM_OK;
+	/* The run the caller gives is the one the first part's command line
+	 * makes of the inputs now; the first part is checked against it, the
+	 * others against the first. */
+	const char *given = run;
 	for (int k = 0; rc == BSIM_OK && k < n; k++) {
 		bsim_sweep_dir_part *p = &parts[k];
 		rc = bsim_sweep_dir_part_read(dirs[k], p, err);
@@ -186,6 +190,13 @@ int part_dir_check(const char *const *dirs, int n, const char *command, const ch
 		if (strcmp(p->command, command) != 0)
 			rc = bsim_error_set(err, BSIM_EINPUT, "%s: a part of a %s, not of a %s",
 			                    dirs[k], p->command, command);
+		else if (strcmp(p->run, run) != 0 && k == 0 && given)
+			rc = bsim_error_set(err, BSIM_EINPUT,
+			                    "%s/part.json says part %d of %d of run %s, but its "
+			                    "command line gives run %s of the inputs as they are "
+			                    "now: the file was edited, or the inputs (experiment, "
+			                    "scene) changed since the part ran",
+			                    dirs[k], p->index, p->count, p->run, run);
 		else if (strcmp(p->run, run) != 0)
 			rc = bsim_error_set(err, BSIM_EINPUT,
 			                    "%s is part %d of %d of run %s, not of run %s (%s's): "

@@ -47,7 +47,7 @@ static int regress_load(const bsim_regress_def *def, bsim_regress_result *res,
 	}
 	if (bsim_session_path(path, sizeof path, def->baseline, "inputs/experiment.yaml", err))
 		return BSIM_EINPUT;
-	int rc = bsim_store_experiment(path, NULL, 0, NULL, 0, res->rec.trials, &res->e, err);
+	int rc = bsim_store_experiment(path, NULL, 0, NULL, 0, res->rec.trials, NULL, &res->e, err);
 	if (rc != BSIM_OK)
 		return rc;
 	res->e.seed = res->rec.seed;
@@ -242,7 +242,7 @@ int bsim_regress_run(const bsim_regress_def *def, bsim_regress_result *res, bsim
 	bsim_session ss;
 	if (rc == BSIM_OK)
 		rc = bsim_session_open(&ss, def->out, bsim_session_mode(0, def->overwrite),
-		                       "regress", NULL, 0, err);
+		                       "regress", NULL, NULL, 0, err);
 	if (rc != BSIM_OK) {
 		bsim_regress_result_free(res);
 		return rc;

@@ -110,8 +110,9 @@ static int group_build(bsim_replay *r, const bsim_experiment *e, const bsim_over
 
 static int open_experiment(bsim_replay *r, const bsim_replay_def *def, bsim_error *err)
 {
-	int rc = bsim_experiment_load_grid(r->path, def->sets, def->n_sets, def->grid, def->n_grid,
-	                                   &r->e, err);
+	int rc =
+	        bsim_experiment_load_seeded(r->path, def->sets, def->n_sets, def->grid, def->n_grid,
+	                                    def->has_seed ? &def->seed : NULL, &r->e, err);
 	if (rc != BSIM_OK)
 		return rc ? rc : BSIM_EINPUT;
 	r->kind = BSIM_REPLAY_EXPERIMENT;
@@ -310,12 +311,17 @@ int bsim_replay_run(const bsim_replay *r, const bsim_backend *backend, const bsi
 		backend = r->backend ? r->backend : bsim_backend_default();
 		opts = r->backend ? &r->opts : opts;
 	}
+	memset(res, 0, sizeof *res);
+	/* What the backend refuses of the scene, said where the scene gave it. */
+	int rc = bsim_backend_check(backend, opts ? opts : &none, &r->scene, r->scene_path, r->ov,
+	                            r->n_ov, err);
+	if (rc != BSIM_OK)
+		return rc;
 	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	if (!runner)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	memset(res, 0, sizeof *res);
-	int rc = bsim_trial_run(runner, &r->scene, backend, opts ? opts : &none, r->mixed_seed, rec,
-	                        res, err);
+	rc = bsim_trial_run(runner, &r->scene, backend, opts ? opts : &none, r->mixed_seed, rec,
+	                    res, err);
 	bsim_trial_runner_free(runner);
 	return rc;
 }

@@ -273,6 +273,12 @@ int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, con
 	bsim_recorder rec = {.stride = stride, .log = log, .overlap = 1};
 	const bsim_scene *scene = info->scene;
 	memset(res, 0, sizeof *res);
+	/* What the backend refuses of the scene, said where the scene gave it,
+	 * before any file is opened. */
+	int rc0 = bsim_backend_check(info->backend, info->opts, scene, info->scene_path, info->sets,
+	                             info->n_sets, err);
+	if (rc0 != BSIM_OK)
+		return rc0;
 	if (trajectory) {
 		if (trajectory_parent(trajectory, err) != BSIM_OK ||
 		    bsim_atomic_file_open(&traj, trajectory, err) != BSIM_OK)
@@ -285,7 +291,7 @@ int bsim_run_output_trial(const bsim_run_info *info, const char *trajectory, con
 	bsim_session ss;
 	if (out) {
 		int rc = bsim_session_open(&ss, out, bsim_session_mode(0, overwrite), "run", NULL,
-		                           0, err);
+		                           NULL, 0, err);
 		if (rc != BSIM_OK) {
 			bsim_atomic_file_abort(&traj);
 			return rc;

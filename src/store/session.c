@@ -19,13 +19,15 @@ int bsim_session_path(char *buf, size_t size, const char *dir, const char *name,
 }
 
 int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, const char *command,
-                      const char *inputs, size_t record_size, bsim_error *err)
+                      const bsim_outdir_spelling *spelling, const char *inputs,
+                      size_t record_size, bsim_error *err)
 {
+	const char *opt = bsim_outdir_resume_option(spelling);
 	struct stat st;
 	memset(s, 0, sizeof *s);
 	s->dir = dir;
 	s->add = mode == BSIM_OUTDIR_ADD;
-	if (bsim_outdir_open(&s->od, dir, mode, command, err) != BSIM_OK)
+	if (bsim_outdir_open(&s->od, dir, mode, command, spelling, err) != BSIM_OK)
 		return err->code;
 	s->stage = bsim_outdir_stage(s->od);
 	if (!inputs)
@@ -48,16 +50,19 @@ int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, c
 		int finished = 0;
 		bsim_error ignore;
 		bsim_outdir_verify(dir, &finished, &ignore);
-		rc = bsim_error_set(err, BSIM_EINPUT, "--resume: %s holds %s", dir,
-		                    finished ? "a finished run, nothing to resume (run with "
-		                               "--overwrite instead of --resume to replace it)"
-		                             : "no stopped run to resume (run without --resume)");
+		rc = finished ? bsim_error_set(err, BSIM_EINPUT,
+		                               "%s: %s holds a finished run, nothing to resume (use "
+		                               "%s instead to replace it)",
+		                               opt, dir, bsim_outdir_overwrite_option(spelling))
+		              : bsim_error_set(err, BSIM_EINPUT,
+		                               "%s: %s holds no stopped run to resume (run without %s)",
+		                               opt, dir, opt);
 	} else if (resume) {
 		rc = bsim_journal_resume(&s->journal, s->journal_path, inputs, record_size, err);
 		if (rc != BSIM_OK) {
 			char msg[sizeof err->msg];
 			snprintf(msg, sizeof msg, "%s", err->msg);
-			bsim_error_set(err, rc, "--resume: %s: %s", dir, msg);
+			bsim_error_set(err, rc, "%s: %s: %s", opt, dir, msg);
 		}
 	} else {
 		/* a stopped run's journal is there only if the user asked to

@@ -31,9 +31,11 @@ typedef struct bsim_session {
  * record_size bytes: with BSIM_OUTDIR_RESUME the journal of the stopped
  * run in dir, which must have these inputs; otherwise a new one (with
  * BSIM_OUTDIR_OVERWRITE, in the place of a stopped run's). With
- * BSIM_OUTDIR_ADD the files join dir's set at the close. */
+ * BSIM_OUTDIR_ADD the files join dir's set at the close. spelling (may be
+ * NULL) is how the caller names --resume and --overwrite in the messages. */
 int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, const char *command,
-                      const char *inputs, size_t record_size, bsim_error *err);
+                      const bsim_outdir_spelling *spelling, const char *inputs,
+                      size_t record_size, bsim_error *err);
 
 /* The mode of a run with the user's resume and overwrite flags. */
 static inline bsim_outdir_mode bsim_session_mode(int resume, int overwrite)

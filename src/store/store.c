@@ -114,10 +114,10 @@ long bsim_store_unstable(const bsim_experiment *e, const bsim_override *extra, i
 }
 
 int bsim_store_experiment(const char *path, const bsim_override *sets, int n_sets,
-                          const bsim_grid_axis *grid, int n_grid, long trials, bsim_experiment *e,
-                          bsim_error *err)
+                          const bsim_grid_axis *grid, int n_grid, long trials, const uint64_t *seed,
+                          bsim_experiment *e, bsim_error *err)
 {
-	int rc = bsim_experiment_load_grid(path, sets, n_sets, grid, n_grid, e, err);
+	int rc = bsim_experiment_load_seeded(path, sets, n_sets, grid, n_grid, seed, e, err);
 	if (rc != BSIM_OK)
 		return rc ? rc : BSIM_EINPUT;
 	if (trials > 0 && bsim_experiment_check_trials(e, trials, err) != BSIM_OK) {

@@ -33,11 +33,12 @@ int bsim_store_text(const char *dir, const char *name, const char *head, bsim_st
 long bsim_store_unstable(const bsim_experiment *e, const bsim_override *extra, int n_extra,
                          const bsim_sweep_result *r, long *first, char *why, size_t size);
 
-/* Loads the experiment at path with the overrides and the grid axes
- * (bsim_experiment_load_grid) and, if trials > 0, that many trials per
- * group (BSIM_EINPUT "--trials N: ..." beyond the limit). */
+/* Loads the experiment at path with the overrides, the grid axes and the
+ * seed (NULL: the file's; bsim_experiment_load_seeded) and, if trials > 0,
+ * that many trials per group (BSIM_EINPUT "--trials N: ..." beyond the
+ * limit). */
 int bsim_store_experiment(const char *path, const bsim_override *sets, int n_sets,
-                          const bsim_grid_axis *grid, int n_grid, long trials, bsim_experiment *e,
-                          bsim_error *err);
+                          const bsim_grid_axis *grid, int n_grid, long trials, const uint64_t *seed,
+                          bsim_experiment *e, bsim_error *err);
 
 #endif

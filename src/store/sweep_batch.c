@@ -261,7 +261,7 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 	}
 	if (rc == BSIM_OK && b->out) {
 		rc = bsim_session_open(&b->ss, b->out, bsim_session_mode(b->resume, b->overwrite),
-		                       b->command, inputs, size, err);
+		                       b->command, NULL, inputs, size, err);
 		b->open = rc == BSIM_OK;
 		c.journal = b->open ? b->ss.journal : NULL;
 	}

@@ -189,11 +189,10 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 		return BSIM_EINPUT;
 	bsim_experiment *e = &res->e;
 	int rc = bsim_store_experiment(def->experiment, def->sets, def->n_sets, def->grid,
-	                               def->n_grid, def->trials, e, err);
+	                               def->n_grid, def->trials, def->has_seed ? &def->seed : NULL,
+	                               e, err);
 	if (rc != BSIM_OK)
 		return rc;
-	if (def->has_seed)
-		e->seed = def->seed;
 	bsim_run_record rec;
 	const bsim_options *opts = &def->opts;
 	bsim_run_record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL);
@@ -243,6 +242,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	if (rc == BSIM_OK)
 		rc = bsim_session_open(&ss, def->out,
 		                       bsim_session_mode(def->resume, def->overwrite), "sweep",
+		                       &(bsim_outdir_spelling){def->resume_option, def->overwrite_option},
 		                       inputs, size, err);
 	if (rc != BSIM_OK) {
 		free(inputs);
@@ -345,7 +345,7 @@ int bsim_sweep_dir_read(const char *dir, const char *side, bsim_sweep_dir_result
 		return BSIM_EINPUT;
 	if (bsim_session_path(path, sizeof path, dir, "inputs/experiment.yaml", err))
 		return BSIM_EINPUT;
-	int rc = bsim_store_experiment(path, NULL, 0, NULL, 0, rec.trials, &res->e, err);
+	int rc = bsim_store_experiment(path, NULL, 0, NULL, 0, rec.trials, NULL, &res->e, err);
 	if (rc != BSIM_OK)
 		return rc;
 	res->e.seed = rec.seed;

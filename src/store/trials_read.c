@@ -221,13 +221,9 @@ int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_swe
 	/* A regular file only (a link to /dev/zero or a FIFO is refused at
 	 * once), bounded, and whole: its last row ends in a line feed. */
 	file_text ft;
-	int rc = file_read(path, "a CSV file", CSV_TABLE_MAX_BYTES, NULL, &ft, err);
+	int rc = csv_text_read(path, &ft, err);
 	if (rc != BSIM_OK)
 		return rc;
-	if ((rc = csv_text_check(path, ft.text, ft.len, err)) != BSIM_OK) {
-		file_text_free(&ft);
-		return rc;
-	}
 	size_t total = (size_t)n_groups * (size_t)trials;
 	r->n_groups = n_groups;
 	r->trials = trials;

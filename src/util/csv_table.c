@@ -84,22 +84,26 @@ void csv_table_free(csv_table *t)
 	memset(t, 0, sizeof *t);
 }
 
-int csv_table_read(const char *path, csv_table *t, bsim_error *err)
+int csv_text_read(const char *path, file_text *out, bsim_error *err)
 {
-	memset(t, 0, sizeof *t);
 	/* Only a regular file, never waited on, and at most CSV_TABLE_MAX_BYTES
 	 * of it: a link to /dev/zero or a file that keeps growing must not
 	 * fill memory. */
+	int rc = file_read(path, "a CSV file", CSV_TABLE_MAX_BYTES, NULL, out, err);
+	if (rc == BSIM_OK && (rc = csv_text_check(path, out->text, out->len, err)) != BSIM_OK)
+		file_text_free(out);
+	return rc;
+}
+
+int csv_table_read(const char *path, csv_table *t, bsim_error *err)
+{
+	memset(t, 0, sizeof *t);
 	file_text f;
-	int rc = file_read(path, "a CSV file", CSV_TABLE_MAX_BYTES, NULL, &f, err);
+	int rc = csv_text_read(path, &f, err);
 	if (rc != BSIM_OK)
 		return rc;
 	t->text = f.text;
 	size_t len = f.len;
-	if ((rc = csv_text_check(path, f.text, len, err)) != BSIM_OK) {
-		csv_table_free(t);
-		return rc;
-	}
 	/* Lines, in place: strip \r\n, skip a last empty line. */
 	long n_lines = 0;
 	for (size_t i = 0; i < len; i++)

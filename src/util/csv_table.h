@@ -12,6 +12,7 @@
 #include <stdio.h>
 
 #include "beamsim/error.h"
+#include "util/file_read.h"
 
 typedef struct csv_table {
 	int n_cols;
@@ -34,6 +35,12 @@ void csv_field_write(FILE *f, const char *s);
  * writes, so a file without one was cut mid-row). BSIM_EINPUT
  * "FILE:LINE: expected ..." naming the line otherwise. */
 int csv_text_check(const char *path, const char *text, size_t len, bsim_error *err);
+
+/* The text of path as every reader of beamsim's tables takes it: a regular
+ * file (a FIFO, a device or a directory is refused at once, without
+ * waiting on it or reading it) of at most CSV_TABLE_MAX_BYTES (file_read)
+ * that passes csv_text_check. */
+int csv_text_read(const char *path, file_text *out, bsim_error *err);
 
 /* Reads path: a regular file (a FIFO, a device or a directory is refused
  * at once, without waiting on it) of at most CSV_TABLE_MAX_BYTES that

@@ -2,6 +2,7 @@
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "util/text_check.h"
 
@@ -24,6 +25,31 @@ void bsim_error_clear(bsim_error *err)
 		err->code = BSIM_OK;
 		err->msg[0] = '\0';
 	}
+}
+
+int bsim_error_nul_check(const char *what, const char *s, size_t len, bsim_error *err)
+{
+	if (!memchr(s, '\0', len))
+		return BSIM_OK;
+	/* The text as far as it fits, each NUL written \x00 here (the message
+	 * could not hold it), what else is not printable by bsim_error_set. */
+	char shown[256];
+	size_t j = 0, i = 0;
+	for (; i < len && j + 8 < sizeof shown; i++) {
+		if (s[i] == '\0') {
+			memcpy(shown + j, "\\x00", 4);
+			j += 4;
+		} else {
+			shown[j++] = s[i];
+		}
+	}
+	if (i < len)
+		j += (size_t)snprintf(shown + j, sizeof shown - j, "...");
+	shown[j] = '\0';
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "%s \"%s\": expected text without NUL bytes (the library would "
+	                      "read it only up to the first)",
+	                      what, shown);
 }
 
 static bsim_note_fn note_fn;

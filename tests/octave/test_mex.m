@@ -275,6 +275,57 @@ check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, 'quoted.csv:5: expect
 delete(file);
 printf('beamsim_load: quoted fields, empty fields and nan; a short line refused\n');
 
+% Regression: beamsim_read_csv kept the text before a NUL, one of two
+% columns that become one field name (a.b and a_b, or names alike in their
+% first 63 characters, MATLAB's longest), and read anything it was given
+% (a directory as a read error, /dev/zero until memory ran out). Each is
+% refused naming the file and what is wrong, as the library reads a table.
+csvdir = fullfile(tmp, 'csv');
+mkdir(csvdir);
+long = repmat('x', 1, 63);
+bad = {'nul.csv', ['a,b' "\n" '1,2' char(0) 'junk' "\n" '3,4' "\n"], ...
+       'nul.csv:2:4: expected text, got a NUL byte';
+       'dup.csv', ['a.b,c,a_b' "\n" '1,2,3' "\n"], ...
+       'dup.csv:1: columns 1 (a.b) and 3 (a_b) both become the field a_b ';
+       'long.csv', [long 'yy,' long 'zz' "\n" '1,2' "\n"], ...
+       ['long.csv:1: columns 1 (' long 'yy) and 2 (' long 'zz) both become the field ' long ' ']};
+for k = 1:size(bad, 1)
+  f = fullfile(csvdir, bad{k, 1});
+  fid = fopen(f, 'w');
+  fwrite(fid, bad{k, 2});
+  fclose(fid);
+  [id, msg] = raised(@beamsim_read_csv, f);
+  check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, bad{k, 3})), '%s: %s %s', ...
+        bad{k, 1}, id, msg);
+  delete(f);
+end
+% Names apart within 63 characters stay apart.
+f = fullfile(csvdir, 'longok.csv');
+fid = fopen(f, 'w');
+fprintf(fid, '%s,%s\n1,2\n', [long(1:62) 'a' 'tail'], [long(1:62) 'b' 'tail']);
+fclose(fid);
+t = beamsim_read_csv(f);
+names = fieldnames(t)';
+check(isequal(names, {[long(1:62) 'a'], [long(1:62) 'b']}) && t.(names{1}) == 1 && ...
+      t.(names{2}) == 2, 'long names: %s', strjoin(names, ','));
+delete(f);
+% Not a regular file, refused at once: a directory, a device; and a file
+% over the bound, 16 GiB (sparse: no byte of it is written or read).
+big = fullfile(csvdir, 'big.csv');
+check(system(sprintf('truncate -s 17179869185 %s', big)) == 0, 'truncate %s', big);
+refused = {csvdir, 'expected a CSV file, got a directory';
+           '/dev/zero', 'expected a CSV file, got a character device';
+           big, 'expected a file of at most 17179869184 bytes, got more'};
+for k = 1:size(refused, 1)
+  [id, msg] = raised(@beamsim_read_csv, refused{k, 1});
+  check(strcmp(id, 'beamsim:input') && ...
+        ~isempty(strfind(msg, [refused{k, 1} ': ' refused{k, 2}])), '%s: %s %s', ...
+        refused{k, 1}, id, msg);
+end
+delete(big);
+printf(['beamsim_read_csv: a NUL, columns of one field name, a directory, a device and ' ...
+        '16 GiB refused\n']);
+
 % ---- the landscape ------------------------------------------------------
 landdir = fullfile(tmp, 'landscape');
 [out, err, status] = program(exe, tmp, sprintf('landscape %s --resolution 0.5 --json --out %s', ...
@@ -358,9 +409,6 @@ cases = {
   'landscape of a missing file', sprintf('landscape %s --out %s', fullfile(tmp, 'none.yaml'), ...
       fullfile(tmp, 'never')), @() beamsim_landscape(fullfile(tmp, 'none.yaml')), ...
       'beamsim_landscape';
-  'landscape into a finished result', sprintf('landscape %s --resolution 2 --out %s', gate, ...
-      landdir), @() beamsim_landscape(gate, 'resolution', 2, 'out', landdir), ...
-      'beamsim_landscape';
 };
 for c = 1:size(cases, 1)
   [~, err, status] = program(exe, tmp, cases{c, 2});
@@ -369,6 +417,14 @@ for c = 1:size(cases, 1)
   check(strcmp(id, 'beamsim:input'), '%s: identifier %s', cases{c, 1}, id);
   check_message(cases{c, 1}, msg, err, cases{c, 4});
 end
+% Into a finished result: the program's refusal, naming the function's own
+% argument where the program names its option.
+[~, err, status] = program(exe, tmp, sprintf('landscape %s --resolution 2 --out %s', gate, landdir));
+[id, msg] = raised(@beamsim_landscape, gate, 'resolution', 2, 'out', landdir);
+want = strrep(regexprep(err, '^beamsim: ', ''), '--overwrite', '''overwrite'', true');
+check(status == 2 && strcmp(id, 'beamsim:input') && isempty(strfind(msg, '--overwrite')) && ...
+      (strcmp(msg, want) || strcmp(msg, ['beamsim_landscape: ' want])), ...
+      'landscape into a finished result: %s, the program %s', msg, err);
 % A group or trial out of range: the program's message counted from 1.
 [~, err, status] = program(exe, tmp, sprintf('run %s --group 30', h1));
 [id, msg] = raised(@beamsim_run, h1, 'group', 31);
@@ -385,3 +441,27 @@ check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, 'unknown argument ''t
       'a misspelt name: %s %s', id, msg);
 check(~exist(fullfile(tmp, 'never'), 'dir'), 'a failed command wrote its directory');
 printf('errors: %d of the program''s messages, and the arguments'' own\n', size(cases, 1));
+
+% Regression: text holding a NUL was cut there (a 'set' value '2\0x' ran
+% as 2); every text argument is refused naming it, the NUL written \x00.
+nul = ['2' char(0) 'x'];
+cases = {
+  @() beamsim_run(gate, 'set', {'body.mass', nul}), '''body.mass'': the value "2\x00x": ';
+  @() beamsim_run(gate, 'set', {['body.mass' char(0) 'zz'], 2}), ...
+      '''set'': the key "body.mass\x00zz": ';
+  @() beamsim_run([gate char(0) 'x']), ['''path'' "' gate '\x00x": '];
+  @() beamsim_run(gate, 'backend', ['thesis' char(0)]), '''backend'' "thesis\x00": ';
+  @() beamsim_run(gate, ['set' char(0) 'x'], {'body.mass', 2}), 'argument 2 "set\x00x": ';
+  @() beamsim_run(gate, 'backend_opt', {'integrator', ['euler' char(0)]}), ...
+      '''integrator'': the value "euler\x00": ';
+  @() beamsim_sweep(h1, 'trials', 1, 'grid', {'body.mass', {nul, '3'}}), ...
+      '''body.mass'': the value "2\x00x": ';
+  @() beamsim_landscape([gate char(0)]), ['''scene'' "' gate '\x00": '];
+};
+for c = 1:size(cases, 1)
+  [id, msg] = raised(cases{c, 1});
+  check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, cases{c, 2})) && ...
+        ~isempty(strfind(msg, 'expected text without NUL bytes')), 'NUL case %d: %s %s', c, ...
+        id, msg);
+end
+printf('NUL in text: %d arguments refused, naming themselves\n', size(cases, 1));

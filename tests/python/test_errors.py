@@ -90,3 +90,48 @@ def test_unresolvable_time_step(gate):
         with pytest.raises(ValueError, match=r"integration\.dt: expected at most 0\.02 s"):
             beamsim.run(gate, set={"integration.dt": dt})
     assert beamsim.run(gate, set={"integration.dt": 0.02})["steps"] == 600
+
+
+NUL = "expected text without NUL bytes"
+
+
+def test_nul_in_text_is_refused(gate, h1, tmp_path):
+    """Regression: a NUL inside a set value was cut there (body.mass "2\\0x"
+    ran as 2). Text the library takes as a C string is refused with the
+    argument named and the text escaped, wherever it holds a NUL."""
+    cases = [
+        (lambda: beamsim.run(gate, set={"body.mass": "2\0x"}),
+         'set body.mass: the value "2\\x00x": '),
+        (lambda: beamsim.run(gate, set={"body.mass\0zz": 2}),
+         'set: the key "body.mass\\x00zz": '),
+        (lambda: beamsim.run(gate, set=["body.mass=2\0"]), 'set body.mass: the value "2\\x00": '),
+        (lambda: beamsim.sweep(h1, trials=1, grid={"body.mass": ["2\0x", 3]}),
+         'grid body.mass: the value "2\\x00x": '),
+        (lambda: beamsim.sweep(h1, trials=1, grid={"body.mass\0": [2, 3]}),
+         'grid: the key "body.mass\\x00": '),
+        (lambda: beamsim.run(gate, backend_opt={"integrator": "euler\0x"}),
+         'backend_opt: the option "integrator=euler\\x00x": '),
+        (lambda: beamsim.run(gate + "\0x"), 'scene "' + gate + '\\x00x": '),
+        (lambda: beamsim.run(gate, backend="thesis\0"), 'backend "thesis\\x00": '),
+        (lambda: beamsim.sweep(h1, out=str(tmp_path / "o\0")), 'out "'),
+        (lambda: beamsim.compare(h1, backends=("thesis", "box2d\0")), 'backends "box2d\\x00": '),
+        (lambda: beamsim.landscape(gate + "\0"), 'scene "'),
+    ]
+    for call, says in cases:
+        with pytest.raises(ValueError) as e:
+            call()
+        assert str(e.value).startswith(says) and NUL in str(e.value), str(e.value)
+    assert not (tmp_path / "o").exists()
+
+
+def test_set_pair_of_the_wrong_shape(gate):
+    """Regression: set=[("body.mass",)] raised "not enough values to
+    unpack"; it says what set takes."""
+    for bad in ([("body.mass",)], [("body.mass", 2, 3)], [7]):
+        with pytest.raises(TypeError) as e:
+            beamsim.run(gate, set=bad)
+        assert "set: expected a dict {key: value}, \"KEY=VALUE\" strings or (key, value) " \
+               "pairs, got " in str(e.value)
+    # a pair as a list or tuple is one
+    assert beamsim.run(gate, set=[["body.mass", 2]])["row"] == \
+        beamsim.run(gate, set={"body.mass": 2})["row"]

@@ -48,14 +48,19 @@ def test_another_thread_runs_during_a_sweep(h1, no_preemption):
     assert seen and seen[0] < len(calls)
 
 
-def test_ctrl_c_stops_a_sweep(h1, tmp_path):
-    calls = []
-
+def interrupt_at_first(calls):
+    """A progress callable that notes each call in calls and sends this
+    process SIGINT (Ctrl-C) at the first."""
     def progress(done, total):
         calls.append(done)
         if len(calls) == 1:
             os.kill(os.getpid(), signal.SIGINT)
+    return progress
 
+
+def test_ctrl_c_stops_a_sweep(h1, tmp_path):
+    calls = []
+    progress = interrupt_at_first(calls)
     out = tmp_path / "s"
     with pytest.raises(KeyboardInterrupt):
         beamsim.sweep(h1, trials=4, threads=1, progress=progress, out=out)
@@ -115,3 +120,31 @@ def test_finished_out_needs_overwrite(h1, tmp_path):
         beamsim.compare(h1, trials=1, threads=1, out=c_out)
     c = beamsim.compare(h1, trials=2, threads=1, out=c_out, overwrite=True)
     assert len(c["pairs"]["trial"]) == 30 * 2
+
+
+def test_ctrl_c_stops_a_comparison_and_resume_continues(h1, tmp_path):
+    """compare takes resume= as sweep does (it had none). Stopped by
+    Ctrl-C, the comparison keeps its journal; resume=True continues it to
+    the uninterrupted comparison's pairs.csv, byte for byte. The messages
+    about resuming name resume=True, the argument, not the command line's
+    --resume."""
+    calls = []
+    progress = interrupt_at_first(calls)
+    out = tmp_path / "c"
+    with pytest.raises(KeyboardInterrupt):
+        beamsim.compare(h1, trials=2, threads=1, progress=progress, out=out)
+    assert calls == [1]
+    assert not (out / "pairs.csv").exists() and (out / ".beamsim" / "journal").exists()
+    with pytest.raises(ValueError) as e:
+        beamsim.compare(h1, trials=2, threads=1, out=out)
+    assert "add resume=True to continue it" in str(e.value) and "--resume" not in str(e.value)
+    beamsim.compare(h1, trials=2, threads=1, out=out, resume=True)
+    whole = tmp_path / "whole"
+    beamsim.compare(h1, trials=2, threads=2, out=whole)
+    assert (out / "pairs.csv").read_bytes() == (whole / "pairs.csv").read_bytes()
+    for call in (beamsim.compare, beamsim.sweep):
+        with pytest.raises(ValueError) as e:
+            call(h1, trials=2, out=out, resume=True)
+        assert str(e.value).startswith(f"resume=True: {out} holds a finished run, nothing to "
+                                       "resume (use overwrite=True instead") and \
+            "--resume" not in str(e.value), str(e.value)

@@ -73,9 +73,12 @@ def _sets(sets):
             if not eq or not key:
                 raise ValueError(f"--set {item}: expected KEY=VALUE, e.g. "
                                  "--set effects.propulsion.force=7")
-        else:
+        elif isinstance(item, (tuple, list)) and len(item) == 2:
             key, value = item
             value = _text(value)
+        else:
+            raise TypeError(f"set: expected a dict {{key: value}}, \"KEY=VALUE\" strings or "
+                            f"(key, value) pairs, got {item!r}")
         out.append((key, value, f"--set {key}={value}"))
     return out
 
@@ -104,6 +107,15 @@ def _opts(opts):
     if isinstance(opts, str):
         return [opts]
     return list(opts)
+
+
+def _no_nul(what, text):
+    """A path or name the library takes as a C string, which ends at a NUL:
+    one in it is refused naming the argument (ValueError); None passes."""
+    if text is not None:
+        text = os.fspath(text)
+        if isinstance(text, str):
+            _beamsim.text_check(what, text)
 
 
 _INT32_MAX = 2**31 - 1
@@ -219,6 +231,8 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     reset: J, each flow summed from t = 0). An unstable trial (outcome
     "unstable") and a replay that differs from its stored row are warned
     of (RuntimeWarning)."""
+    _no_nul("scene", scene)
+    _no_nul("backend", backend)
     r = _beamsim.run(os.fspath(scene), _seed(seed), _count("group", group, 0),
                      _count("trial", trial, 0), backend, _sets(set), _opts(backend_opt),
                      bool(trajectory), _count("stride", stride, 1), _grid(grid))
@@ -280,6 +294,9 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
     "trials" (trials.csv as a dict of NumPy arrays by column), "summary"
     (all of summary.json), "threads" and "out". Unstable trials are warned
     of (RuntimeWarning); Ctrl-C stops the sweep (KeyboardInterrupt)."""
+    _no_nul("experiment", experiment)
+    _no_nul("out", out)
+    _no_nul("backend", backend)
     with _Dir(out, "sweep") as d:
         info = _beamsim.sweep(os.fspath(experiment), d, _count("trials", trials, 1),
                               _count("threads", threads, 1, 4096), _seed(seed), backend,
@@ -298,18 +315,24 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
 
 
 def compare(experiment, backends=("thesis", "box2d"), trials=None, threads=None, set=None,
-            grid=None, seed=None, out=None, progress=None, overwrite=False):
+            grid=None, seed=None, out=None, progress=None, resume=False, overwrite=False):
     """The experiment on two sides with the same random-force schedules, as
     `beamsim compare EXPERIMENT --backends A,B --out DIR` runs it. A side is
-    "NAME[:KEY=VALUE]...". overwrite: replace the finished result in out
-    (without it such an out is refused). Returns a dict: "report" (report.json), "pairs"
-    (pairs.csv as arrays), "sides" (each side's summary.json and trials
-    arrays, by label), "n_disagree" and "out"."""
+    "NAME[:KEY=VALUE]...". resume: continue the stopped comparison in out,
+    as sweep's. overwrite: replace the finished result (or a stopped
+    comparison's journal) in out; without it such an out is refused.
+    Returns a dict: "report" (report.json), "pairs" (pairs.csv as arrays),
+    "sides" (each side's summary.json and trials arrays, by label),
+    "n_disagree" and "out"."""
     a, b = backends
+    _no_nul("experiment", experiment)
+    _no_nul("out", out)
+    _no_nul("backends", a)
+    _no_nul("backends", b)
     with _Dir(out, "compare") as d:
         info = _beamsim.compare(os.fspath(experiment), d, a, b, _count("trials", trials, 1),
                                 _count("threads", threads, 1, 4096), _seed(seed), _sets(set),
-                                _grid(grid), progress, bool(overwrite))
+                                _grid(grid), progress, bool(resume), bool(overwrite))
         files = load(d)
     sides = {}
     for label, name in zip((a, b), info["dirs"]):
@@ -344,5 +367,6 @@ def landscape(scene, set=None, resolution=None, region=None):
         if len(region) != 4 or not (region[0] < region[1] and region[2] < region[3]):
             raise ValueError(f"--region {region}: expected X0,X1,Y0,Y1 in m with X0 < X1 "
                              "and Y0 < Y1, e.g. --region -25,25,0,65")
+    _no_nul("scene", scene)
     return _beamsim.landscape(os.fspath(scene), _sets(set),
                               float(resolution) if resolution is not None else 0.0, region)
