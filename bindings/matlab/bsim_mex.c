@@ -308,10 +308,8 @@ int bmx_overrides(const char *name, const mxArray *a, bmx_pool *p, bsim_override
 
 void bmx_grid_free(bsim_grid_axis *axes, int n)
 {
-	for (int i = 0; axes && i < n; i++) {
+	for (int i = 0; axes && i < n; i++)
 		free(axes[i].values);
-		free(axes[i].origins);
-	}
 	free(axes);
 }
 
@@ -327,8 +325,7 @@ static int axis_values(const char *key, const mxArray *v, bmx_pool *p, bsim_grid
 		                      "cell)",
 		                      key);
 	ax->values = calloc(n, sizeof *ax->values);
-	ax->origins = calloc(n, sizeof *ax->origins);
-	if (!ax->values || !ax->origins)
+	if (!ax->values)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (size_t i = 0; i < n; i++) {
 		const char *text = NULL;
@@ -350,18 +347,14 @@ static int axis_values(const char *key, const mxArray *v, bmx_pool *p, bsim_grid
 		ax->values[i] = (char *)text;
 	}
 	ax->n_values = (int)n;
-	/* Every value's origin is the command line's "--grid KEY=V1,V2,...". */
-	size_t len = strlen(key) + sizeof "--grid =";
-	for (size_t i = 0; i < n; i++)
-		len += strlen(ax->values[i]) + 1;
+	/* The axis's origin is the command line's "--grid KEY", one for all its
+	 * values: the library names a value "--grid KEY=VALUE". */
+	size_t len = strlen(key) + sizeof "--grid ";
 	char *origin = bmx_pool_take(p, malloc(len));
 	if (!origin)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	size_t at = (size_t)sprintf(origin, "--grid %s=", key);
-	for (size_t i = 0; i < n; i++)
-		at += (size_t)sprintf(origin + at, "%s%s", i ? "," : "", ax->values[i]);
-	for (size_t i = 0; i < n; i++)
-		ax->origins[i] = origin;
+	snprintf(origin, len, "--grid %s", key);
+	ax->origin = origin;
 	return BSIM_OK;
 }
 

@@ -98,17 +98,18 @@ int pyb_grid_from(PyObject *seq, pyb_grid *g)
 		Py_ssize_t m = PyList_Size(values);
 		ax->n_values = (int)m;
 		ax->values = calloc((size_t)(m ? m : 1), sizeof *ax->values);
-		ax->origins = calloc((size_t)(m ? m : 1), sizeof *ax->origins);
 		const char *key = tuple_text(t, 0, "grid key");
 		const char *origin = key ? tuple_text(t, 2, "grid origin") : NULL;
-		if (!ax->values || !ax->origins || !origin) {
+		if (!ax->values || !origin) {
 			if (!PyErr_Occurred())
 				PyErr_NoMemory();
 			pyb_grid_free(g);
 			return -1;
 		}
-		/* The library only reads an axis given to it (const). */
+		/* The library only reads an axis given to it (const); the
+		 * origin ("--grid KEY") is the axis's, one for all its values. */
 		ax->key = (char *)key;
+		ax->origin = (char *)origin;
 		for (Py_ssize_t k = 0; k < m; k++) {
 			PyObject *v = PyList_GetItem(values, k);
 			const char *text = PyUnicode_Check(v) ? PyUnicode_AsUTF8(v) : NULL;
@@ -118,7 +119,6 @@ int pyb_grid_from(PyObject *seq, pyb_grid *g)
 				return -1;
 			}
 			ax->values[k] = (char *)text;
-			ax->origins[k] = (char *)origin;
 		}
 	}
 	return 0;
@@ -126,10 +126,8 @@ int pyb_grid_from(PyObject *seq, pyb_grid *g)
 
 void pyb_grid_free(pyb_grid *g)
 {
-	for (int i = 0; i < g->n; i++) {
+	for (int i = 0; i < g->n; i++)
 		free(g->axes[i].values);
-		free(g->axes[i].origins);
-	}
 	free(g->axes);
 	memset(g, 0, sizeof *g);
 }

@@ -90,8 +90,8 @@ def _grid(grid):
     for key, values in grid.items():
         if isinstance(values, (str, numbers.Number)):
             values = [values]
-        texts = [_text(v) for v in values]
-        out.append((key, texts, f"--grid {key}={','.join(texts)}"))
+        # one origin for the axis: the library names a value "--grid KEY=VALUE"
+        out.append((key, [_text(v) for v in values], f"--grid {key}"))
     return out
 
 
