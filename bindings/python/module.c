@@ -235,6 +235,69 @@ PyObject *pyb_array(int nd, const long *dims, const double *data)
 	return a;
 }
 
+static void free_capsule(PyObject *capsule)
+{
+	free(PyCapsule_GetPointer(capsule, "beamsim.column"));
+}
+
+PyObject *pyb_adopt(void *data, long n, int ints)
+{
+	npy_intp dims[1] = {n};
+	PyObject *a = PyArray_SimpleNewFromData(1, dims, ints ? NPY_INT64 : NPY_DOUBLE, data);
+	/* The capsule frees data once it is the array's base, not before:
+	 * on failure data stays the caller's. */
+	PyObject *owner = a ? PyCapsule_New(data, "beamsim.column", NULL) : NULL;
+	if (!owner) {
+		Py_XDECREF(a);
+		return NULL;
+	}
+	if (PyArray_SetBaseObject((PyArrayObject *)a, owner) != 0) { /* takes owner */
+		Py_DECREF(a);
+		return NULL;
+	}
+	PyCapsule_SetDestructor(owner, free_capsule);
+	return a;
+}
+
+PyObject *pyb_text_column(const uint32_t *codes, long n, PyObject *labels)
+{
+	Py_ssize_t n_labels = labels ? PyList_GET_SIZE(labels) : 0, width = 1;
+	for (Py_ssize_t i = 0; i < n_labels; i++) {
+		Py_ssize_t len = PyUnicode_GET_LENGTH(PyList_GET_ITEM(labels, i));
+		width = len > width ? len : width;
+	}
+	/* each label's code points once, copied into its rows */
+	Py_UCS4 **ucs = PyMem_Calloc((size_t)(n_labels ? n_labels : 1), sizeof *ucs);
+	PyObject *type = PyUnicode_FromFormat("<U%zd", width);
+	PyArray_Descr *descr = NULL;
+	PyObject *a = NULL;
+	int ok = ucs && type && PyArray_DescrConverter(type, &descr) == NPY_SUCCEED;
+	for (Py_ssize_t i = 0; ok && i < n_labels; i++)
+		ok = (ucs[i] = PyUnicode_AsUCS4Copy(PyList_GET_ITEM(labels, i))) != NULL;
+	if (ok) {
+		npy_intp dims[1] = {n};
+		a = PyArray_Zeros(1, dims, descr, 0); /* takes descr */
+		descr = NULL;
+	}
+	if (a) {
+		char *row = PyArray_DATA((PyArrayObject *)a);
+		size_t item = (size_t)width * sizeof(Py_UCS4);
+		for (long k = 0; k < n; k++, row += item) {
+			PyObject *s = PyList_GET_ITEM(labels, codes[k]);
+			memcpy(row, ucs[codes[k]],
+			       (size_t)PyUnicode_GET_LENGTH(s) * sizeof(Py_UCS4));
+		}
+	}
+	for (Py_ssize_t i = 0; ucs && i < n_labels; i++)
+		PyMem_Free(ucs[i]);
+	PyMem_Free(ucs);
+	Py_XDECREF(type);
+	Py_XDECREF(descr);
+	if (!a && !PyErr_Occurred())
+		PyErr_NoMemory();
+	return a;
+}
+
 int pyb_set(PyObject *d, const char *key, PyObject *value)
 {
 	if (!value)
@@ -314,11 +377,13 @@ static PyMethodDef methods[] = {
          "run(path, seed, group, trial, backend, sets, backend_opts, trajectory, stride)"},
         {"sweep", (PyCFunction)(void (*)(void))pyb_sweep, METH_VARARGS | METH_KEYWORDS,
          "sweep(experiment, out, trials, threads, seed, backend, sets, grid, backend_opts, "
-         "progress)"},
+         "progress, trajectories, resume, hold)"},
         {"compare", (PyCFunction)(void (*)(void))pyb_compare, METH_VARARGS | METH_KEYWORDS,
          "compare(experiment, out, backends, trials, threads, seed, sets, grid, progress)"},
         {"landscape", (PyCFunction)(void (*)(void))pyb_landscape, METH_VARARGS | METH_KEYWORDS,
          "landscape(scene, sets, spacing, region)"},
+        {"read_table", pyb_read_table, METH_VARARGS,
+         "read_table(path): a CSV table as a dict of NumPy arrays by column"},
         {"version", py_version, METH_NOARGS, "the library's version"},
         {NULL, NULL, 0, NULL},
 };

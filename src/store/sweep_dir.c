@@ -192,6 +192,11 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	                               def->n_grid, def->trials, e, err);
 	if (rc != BSIM_OK)
 		return rc;
+	if (def->hold_cell_bytes > 0 &&
+	    bsim_output_trials_fit(e, 0, def->hold_cell_bytes, err) != BSIM_OK) {
+		bsim_experiment_free(e);
+		return BSIM_EINPUT;
+	}
 	if (def->has_seed)
 		e->seed = def->seed;
 	bsim_run_record rec;
