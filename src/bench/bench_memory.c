@@ -211,22 +211,11 @@ static int python_peak(const char *tmp, const char *gate, const char *module, lo
 
 static int sweep_peak(const char *tmp, const char *gate, long trials, int twin, mem_run *out)
 {
-	char exp[BSIM_PATH_MAX], dir[BSIM_PATH_MAX];
-	snprintf(exp, sizeof exp, "%s/sweep_%ld.yaml", tmp, trials);
+	char exp[BSIM_PATH_MAX], dir[BSIM_PATH_MAX], name[32];
+	snprintf(name, sizeof name, "sweep_%ld", trials);
 	snprintf(dir, sizeof dir, "%s/sweep_%ld_%d", tmp, trials, twin);
-	FILE *f = fopen(exp, "w");
-	if (!f) {
-		cli_error("bench: %s: %s", exp, strerror(errno));
+	if (one_group(tmp, gate, name, trials, 50, exp, sizeof exp) != CLI_OK)
 		return CLI_FAIL;
-	}
-	fprintf(f,
-	        "scene: %s\ntrials: %ld\nseed: 1\nset:\n  integration.max_steps: 50\n"
-	        "grid:\n  effects.propulsion.force: [8]\n",
-	        gate, trials);
-	if (fclose(f) != 0) {
-		cli_error("bench: %s: cannot write", exp);
-		return CLI_FAIL;
-	}
 	char limit[64], rows[64];
 	snprintf(limit, sizeof limit, "trials=%ld", trials);
 	snprintf(rows, sizeof rows, "mat_rows=%ld", twin ? trials : 1);
