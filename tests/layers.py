@@ -76,6 +76,7 @@ PUBLIC = {
     "run_output": "store",
     "run_record": "store",
     "sweep_dir": "store",
+    "table": "store",
     "figures": "figures",
     "video": "video",
     "accuracy": "analysis",

@@ -282,6 +282,10 @@ static pid_t launch(const char *file, char *const args[], int search, const bsim
 		setrlimit(RLIMIT_FSIZE, &rl);
 		signal(SIGXFSZ, SIG_IGN); /* a write beyond fails with EFBIG */
 	}
+	if (o && o->as > 0) {
+		struct rlimit rl = {(rlim_t)o->as, (rlim_t)o->as};
+		setrlimit(RLIMIT_AS, &rl);
+	}
 	if (o && o->timeout > 0)
 		alarm((unsigned)ceil(o->timeout)); /* kept across exec */
 	if (search)

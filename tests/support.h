@@ -16,6 +16,8 @@ int bsim_test_cli(const char *const argv[], char **out, char **err);
 typedef struct bsim_test_opts {
 	double timeout;  /* s: ended by SIGALRM after this long, 0: never */
 	long fsize;      /* bytes: the child's RLIMIT_FSIZE (writes beyond fail), 0: none */
+	long as;         /* bytes: the child's RLIMIT_AS (its address space; an allocation
+	                  * beyond fails), 0: none */
 	const char *out; /* a file to be the child's stdout instead of a capture */
 	const char *err; /* a file to be the child's stderr (created) instead of a capture */
 	int tty;         /* 1: stderr a pseudo-terminal, which bsim_test_cli_with captures */

@@ -161,7 +161,7 @@ static void test_box2d_small_body_located(void **state)
 	                      "--set",     "integration.duration=0.01",
 	                      "--out",     out,
 	                      NULL};
-	const char *grid_needles[] = {"--grid body.radius=10,0.001: body.radius: box2d: 0.001 m",
+	const char *grid_needles[] = {"--grid body.radius=0.001: body.radius: box2d: 0.001 m",
 	                              NULL};
 	char *err = NULL;
 	int rc = bsim_test_cli(grid, NULL, &err);

@@ -20,6 +20,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "beamsim/limits.h"
 #include "store/matlab.h"
@@ -617,6 +620,119 @@ static void test_streamed_csv(void **state)
 	tcsv_free(&t);
 }
 
+/* Quoted fields, as csv_field_write writes a user's text (a grid value
+ * holding a comma, a quote or a line break), come back unquoted: the text
+ * written here, byte for byte; the rows after a line break inside quotes
+ * keep their columns; a quote not closed where its field ends is refused
+ * naming its line. */
+static void test_quoted_csv(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("quoted");
+	char csv[1100], mat[1100];
+	snprintf(csv, sizeof csv, "%s",
+	         bsim_test_write(dir, "q.csv",
+	                         "a,b,c\n1,\"x, y\",3\n2,\"say \"\"hi\"\"\",4\n"
+	                         "3,\"two\nlines\",5\n4,plain,6\n"));
+	snprintf(mat, sizeof mat, "%s/q.mat", dir);
+	bsim_error err;
+	assert_int_equal(bsim_matlab_from_csv(csv, mat, "q", &err), BSIM_OK);
+	mat_t *m;
+	matvar_t *st = mat_var(mat, "q", &m);
+	static const char *const b[] = {"x, y", "say \"hi\"", "two\nlines", "plain"};
+	const double a[] = {1, 2, 3, 4}, c[] = {3, 4, 5, 6};
+	assert_int_equal(field(st, "b")->dims[0], 4);
+	for (int r = 0; r < 4; r++) {
+		check_string(Mat_VarGetCell(field(st, "b"), r), b[r]);
+		assert_true(((double *)field(st, "a")->data)[r] == a[r]);
+		assert_true(((double *)field(st, "c")->data)[r] == c[r]);
+	}
+	Mat_VarFree(st);
+	Mat_Close(m);
+	snprintf(csv, sizeof csv, "%s",
+	         bsim_test_write(dir, "open.csv", "a,b\n1,2\n3,\"x\"y\n5,6\n"));
+	snprintf(mat, sizeof mat, "%s/open.mat", dir);
+	assert_int_equal(bsim_matlab_from_csv(csv, mat, "open", &err), BSIM_EINPUT);
+	assert_string_equal(strstr(err.msg, "open.csv:3"),
+	                    "open.csv:3: expected 2 fields, got a quoted field not closed where "
+	                    "its field ends");
+	assert_false(bsim_test_exists(mat));
+}
+
+/* The virtual memory of this process, bytes (/proc/self/statm). */
+static long vm_size(void)
+{
+	FILE *f = fopen("/proc/self/statm", "r");
+	long pages = 0;
+	assert_non_null(f);
+	assert_int_equal(fscanf(f, "%ld", &pages), 1);
+	fclose(f);
+	return pages * sysconf(_SC_PAGESIZE);
+}
+
+/* The twin of a JSON file holds what it needs, not a document of it: the
+ * summary.json of a 20,000-group sweep (8 MB, written here) converts in a
+ * child whose address space may grow by 150 MB (RLIMIT_AS) beyond this
+ * process's; libfyaml's document of it took 360 MB. The twin's groups are
+ * the rows written. Not under AddressSanitizer, whose shadow memory takes
+ * terabytes of address space. */
+static void test_json_twin_memory(void **state)
+{
+	(void)state;
+#if defined(__SANITIZE_ADDRESS__)
+	skip();
+#endif
+	enum { GROUPS = 20000 };
+	const char *dir = bsim_test_dir("json_memory");
+	char json[1100], mat[1100];
+	snprintf(json, sizeof json, "%s/summary.json", dir);
+	snprintf(mat, sizeof mat, "%s/summary.mat", dir);
+	FILE *f = fopen(json, "w");
+	assert_non_null(f);
+	fputs("{\n  \"backend\": \"thesis\",\n  \"groups\": [\n", f);
+	for (int g = 0; g < GROUPS; g++)
+		fprintf(f,
+		        "    {\"params\": {\"effects.propulsion.force\": 8, \"body.mass\": %d}, "
+		        "\"trials\": 1, \"traversed\": %d, \"side_exit\": 0, \"stuck\": %d, "
+		        "\"left\": 0, \"right\": 0, \"p_traverse\": %d, \"ci95\": [0, "
+		        "0.7934506856227626], \"stuck_in_contact\": 0, \"landscape_left\": 0, "
+		        "\"landscape_right\": 0, \"steps\": %d, \"unstable\": 0, "
+		        "\"deterministic\": false, \"solver\": {\"iteration_limit\": 0, "
+		        "\"clamped\": 0}, \"trials_iteration_limit\": 0, \"trials_clamped\": "
+		        "0}%s\n",
+		        g + 1, g % 2, 1 - g % 2, g % 2, 2 + g % 7, g + 1 < GROUPS ? "," : "");
+	fputs("  ]\n}\n", f);
+	assert_int_equal(fclose(f), 0);
+	long limit = vm_size() + (150L << 20);
+	fflush(NULL);
+	pid_t pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0) {
+		struct rlimit rl = {(rlim_t)limit, (rlim_t)limit};
+		setrlimit(RLIMIT_AS, &rl);
+		bsim_error err;
+		int rc = bsim_matlab_from_json(json, mat, "summary", &err);
+		if (rc != BSIM_OK)
+			fprintf(stderr, "%s\n", err.msg);
+		_exit(rc == BSIM_OK ? 0 : 1);
+	}
+	int status = 0;
+	assert_int_equal(waitpid(pid, &status, 0), pid);
+	assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+	mat_t *m;
+	matvar_t *st = mat_var(mat, "summary", &m);
+	matvar_t *groups = field(st, "groups");
+	matvar_t *mass = field(field(groups, "params"), "body_mass");
+	const double *p = field(groups, "p_traverse")->data, *steps = field(groups, "steps")->data;
+	assert_int_equal(mass->dims[0], GROUPS);
+	for (int g = 0; g < GROUPS; g++) {
+		assert_true(((double *)mass->data)[g] == g + 1);
+		assert_true(p[g] == g % 2 && steps[g] == 2 + g % 7);
+	}
+	Mat_VarFree(st);
+	Mat_Close(m);
+}
+
 /* What bsim_note passed to the handler the test set. */
 static char noted[BSIM_ERROR_MSG_MAX];
 static int notes;
@@ -710,6 +826,8 @@ int main(void)
 	        cmocka_unit_test(test_compare_twins),
 	        cmocka_unit_test(test_json_shapes),
 	        cmocka_unit_test(test_streamed_csv),
+	        cmocka_unit_test(test_quoted_csv),
+	        cmocka_unit_test(test_json_twin_memory),
 	        cmocka_unit_test(test_mat_rows_limit),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

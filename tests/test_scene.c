@@ -759,7 +759,9 @@ static void h1_has_30_groups_first_axis_slowest(void **state)
 	assert_string_equal(e.axes[0].key, "effects.propulsion.force");
 	assert_string_equal(e.axes[1].key, "effects.random_force.magnitude");
 	assert_non_null(strstr(e.scene_path, "configs/thesis/gate.yaml"));
-	assert_non_null(strstr(e.axes[1].origins[2], "h1_symmetric.yaml:7"));
+	char where[1400];
+	bsim_experiment_value_origin(&e.axes[1], 2, where, sizeof where);
+	assert_non_null(strstr(where, "h1_symmetric.yaml:7"));
 
 	int idx[2];
 	static const int want[][3] = {{0, 0, 0}, {1, 0, 1}, {5, 1, 0}, {29, 5, 4}};

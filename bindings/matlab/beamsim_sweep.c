@@ -1,5 +1,5 @@
 /* beamsim_sweep: every trial of every group of an experiment, as
- * `beamsim sweep` runs them, held in memory.
+ * `beamsim sweep` runs them, held in memory as columns.
  *
  *   s = beamsim_sweep(EXPERIMENT, NAME, VALUE, ...)
  *
@@ -8,9 +8,20 @@
  * 'backend_opt' {KEY, VALUE, ...}, 'set' {KEY, VALUE, ...}, 'grid'
  * {KEY, VALUES, ...}, 'overlap' (true: each trial's overlap_max).
  * s.groups is a struct array, one element per group with summary.json's
- * fields (its group field from 1); s.trials a struct of column vectors, one
- * per trials.csv column (group and trial from 1; text columns as cells;
- * an empty field of the file is NaN), at full precision. */
+ * fields (its group field from 1); s.trials a struct of n x 1 columns, one
+ * per trials.csv column, at full precision: numbers as doubles (group and
+ * trial from 1; an empty field of the file is NaN); each text column
+ * (outcome, type, location, path, a grid axis of text) as codes into its
+ * labels, s.labels.COLUMN (a cell column): categorical arrays where
+ * `categorical` exists (MATLAB), the codes themselves (uint8, uint16 or
+ * uint32, from 1) where it does not (Octave: s.labels.outcome(
+ * s.trials.outcome) is the text).
+ *
+ * The columns are made before the sweep, at their size, and filled as it
+ * streams its trials by (bsim_sweep_config.sink): what is held is the
+ * columns, about 185 bytes a trial, and the sweep's block of trials; a
+ * sweep whose columns would not fit in the memory available is refused
+ * before it runs (bsim_output_trials_fit). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -132,33 +143,8 @@ static const number_column after_path[] = {
         {"t_exit", c_t_exit},
 };
 
-static void number_field(mxArray *s, const bsim_sweep_result *r, const number_column *c)
-{
-	size_t n = (size_t)r->n_groups * (size_t)r->trials;
-	double *d;
-	mxArray *col = bmx_column(n, &d);
-	for (size_t k = 0; k < n; k++)
-		d[k] = c->fn(&r->trials_out[k]);
-	bmx_set(s, 0, c->name, col);
-}
-
-/* "ix:iy ix:iy ...", the gates entered in order, as trials.csv writes it. */
-static mxArray *path_text(const bsim_trial_result *x, const bsim_trial_log *tl)
-{
-	size_t n = tl ? (size_t)tl->n_entries : 0;
-	char *s = malloc(24 * (n + 1));
-	if (!s)
-		return bmx_string("");
-	size_t len = 0;
-	for (size_t j = 0; j < n; j++)
-		len += (size_t)sprintf(s + len, "%s%d:%d", j ? " " : "", tl->entries[j].ix,
-		                       tl->entries[j].iy);
-	if (n == 0)
-		sprintf(s, "%d:%d", x->final_ix, x->final_iy);
-	mxArray *a = bmx_string(s);
-	free(s);
-	return a;
-}
+enum { N_AFTER_TYPE = sizeof after_type / sizeof after_type[0] };
+enum { N_AFTER_PATH = sizeof after_path / sizeof after_path[0] };
 
 /* A grid value as a number, NaN if it is text. */
 static double value_number(const char *text)
@@ -168,64 +154,173 @@ static double value_number(const char *text)
 	return end != text && *end == '\0' ? x : NAN;
 }
 
-static mxArray *trials_struct(const bsim_experiment *e, const bsim_sweep_result *r)
+/* The trials as columns, made at their size before the sweep and filled
+ * block by block as it streams them (the sink, on the calling thread). A
+ * text column is codes from 1 into its labels: fixed lists for outcome and
+ * type, the distinct texts in order of first appearance for location and
+ * path (uint32 while the sweep runs, narrowed once their count is known). */
+typedef struct trial_columns {
+	const bsim_experiment *e;
+	size_t n;
+	int trials;
+	mxArray *group, *trial, *outcome, *type;
+	mxArray *number[N_AFTER_TYPE + N_AFTER_PATH];
+	mxArray **axis; /* n_axes: doubles, or codes into the axis's values */
+	uint32_t *location, *path;
+	bmx_labels location_labels, path_labels;
+	int *idx, *axis_text;
+	int oom;
+} trial_columns;
+
+/* "ix:iy ix:iy ...", the gates entered in order, as trials.csv writes it,
+ * into buf (grown as needed); NULL if out of memory. */
+static const char *path_text(const bsim_trial_result *x, const bsim_trial_log *tl, char **buf,
+                             size_t *size)
 {
-	mxArray *s = mxCreateStructMatrix(1, 1, 0, NULL);
-	size_t n = (size_t)r->n_groups * (size_t)r->trials;
-	double *g, *t;
-	mxArray *gc = bmx_column(n, &g), *tc = bmx_column(n, &t);
-	mxArray *outcome = mxCreateCellMatrix((mwSize)n, 1),
-	        *type = mxCreateCellMatrix((mwSize)n, 1);
-	mxArray *location = mxCreateCellMatrix((mwSize)n, 1),
-	        *path = mxCreateCellMatrix((mwSize)n, 1);
-	for (size_t k = 0; k < n; k++) {
-		const bsim_trial_result *x = &r->trials_out[k];
-		g[k] = (double)(k / (size_t)r->trials) + 1;
-		t[k] = (double)(k % (size_t)r->trials) + 1;
-		mxSetCell(outcome, (mwIndex)k, bmx_string(bsim_trial_outcome_name(x->outcome)));
-		mxSetCell(type, (mwIndex)k, bmx_string(bsim_trial_type_name(x->type)));
+	size_t n = tl ? (size_t)tl->n_entries : 0, need = 24 * (n + 1);
+	if (need > *size) {
+		char *b = realloc(*buf, need);
+		if (!b)
+			return NULL;
+		*buf = b;
+		*size = need;
+	}
+	size_t len = 0;
+	for (size_t j = 0; j < n; j++)
+		len += (size_t)sprintf(*buf + len, "%s%d:%d", j ? " " : "", tl->entries[j].ix,
+		                       tl->entries[j].iy);
+	if (n == 0)
+		sprintf(*buf, "%d:%d", x->final_ix, x->final_iy);
+	return *buf;
+}
+
+static int columns_block(void *user, const bsim_sweep_block *b, bsim_error *err)
+{
+	trial_columns *c = user;
+	char *buf = NULL;
+	size_t size = 0;
+	for (long k = 0; k < b->n && !c->oom; k++) {
+		size_t at = (size_t)(b->first + k);
+		const bsim_trial_result *x = &b->results[k];
+		mxGetPr(c->group)[at] = (double)(at / (size_t)c->trials) + 1;
+		mxGetPr(c->trial)[at] = (double)(at % (size_t)c->trials) + 1;
+		((uint8_t *)mxGetData(c->outcome))[at] = (uint8_t)(x->outcome + 1);
+		((uint8_t *)mxGetData(c->type))[at] = (uint8_t)(x->type + 1);
+		for (int i = 0; i < N_AFTER_TYPE; i++)
+			mxGetPr(c->number[i])[at] = after_type[i].fn(x);
+		for (int i = 0; i < N_AFTER_PATH; i++)
+			mxGetPr(c->number[N_AFTER_TYPE + i])[at] = after_path[i].fn(x);
 		char label[48];
 		bsim_lattice_location_label(bsim_lattice_location_of(x), label, sizeof label);
-		mxSetCell(location, (mwIndex)k, bmx_string(label));
-		mxSetCell(path, (mwIndex)k, path_text(x, r->logs ? &r->logs[k] : NULL));
-	}
-	bmx_set(s, 0, "group", gc);
-	bmx_set(s, 0, "trial", tc);
-	bmx_set(s, 0, "outcome", outcome);
-	bmx_set(s, 0, "type", type);
-	for (size_t c = 0; c < sizeof after_type / sizeof after_type[0]; c++)
-		number_field(s, r, &after_type[c]);
-	bmx_set(s, 0, "location", location);
-	bmx_set(s, 0, "path", path);
-	for (size_t c = 0; c < sizeof after_path / sizeof after_path[0]; c++)
-		number_field(s, r, &after_path[c]);
-	/* One column per grid axis: numbers if every value is one, else text. */
-	int *idx = calloc((size_t)(e->n_axes > 0 ? e->n_axes : 1), sizeof *idx);
-	for (int a = 0; idx && a < e->n_axes; a++) {
-		const bsim_grid_axis *ax = &e->axes[a];
-		int numeric = 1;
-		for (int i = 0; i < ax->n_values; i++)
-			numeric = numeric && !isnan(value_number(ax->values[i]));
-		mxArray *col;
-		double *d = NULL;
-		col = numeric ? bmx_column(n, &d) : mxCreateCellMatrix((mwSize)n, 1);
-		for (int grp = 0; grp < r->n_groups; grp++) {
-			bsim_experiment_group_index(e, grp, idx);
-			const char *text = ax->values[idx[a]];
-			for (int k = 0; k < r->trials; k++) {
-				size_t at = (size_t)grp * (size_t)r->trials + (size_t)k;
-				if (numeric)
-					d[at] = value_number(text);
-				else
-					mxSetCell(col, (mwIndex)at, bmx_string(text));
-			}
+		const char *path = path_text(x, b->logs ? &b->logs[k] : NULL, &buf, &size);
+		long lc = bmx_labels_code(&c->location_labels, label);
+		long pc = path ? bmx_labels_code(&c->path_labels, path) : -1;
+		c->oom = lc < 0 || pc < 0;
+		if (!c->oom) {
+			c->location[at] = (uint32_t)lc;
+			c->path[at] = (uint32_t)pc;
 		}
+		/* One column per grid axis: its value, or its code from 1. */
+		if (at % (size_t)c->trials == 0 || k == 0)
+			bsim_experiment_group_index(c->e, (int)(at / (size_t)c->trials), c->idx);
+		for (int a = 0; a < c->e->n_axes; a++) {
+			const char *text = c->e->axes[a].values[c->idx[a]];
+			if (c->axis_text[a])
+				((uint32_t *)mxGetData(c->axis[a]))[at] = (uint32_t)c->idx[a] + 1;
+			else
+				mxGetPr(c->axis[a])[at] = value_number(text);
+		}
+	}
+	free(buf);
+	if (c->oom)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for the trials' columns");
+	return BSIM_OK;
+}
+
+/* The columns of e's trials, zeroed, for columns_block. */
+static int columns_alloc(trial_columns *c, const bsim_experiment *e, bsim_error *err)
+{
+	memset(c, 0, sizeof *c);
+	c->e = e;
+	c->trials = e->trials;
+	c->n = (size_t)e->n_groups * (size_t)e->trials;
+	double *unused;
+	c->group = bmx_column(c->n, &unused);
+	c->trial = bmx_column(c->n, &unused);
+	c->outcome = mxCreateNumericMatrix((mwSize)c->n, 1, mxUINT8_CLASS, mxREAL);
+	c->type = mxCreateNumericMatrix((mwSize)c->n, 1, mxUINT8_CLASS, mxREAL);
+	for (int i = 0; i < N_AFTER_TYPE + N_AFTER_PATH; i++)
+		c->number[i] = bmx_column(c->n, &unused);
+	size_t axes = (size_t)(e->n_axes > 0 ? e->n_axes : 1);
+	c->axis = calloc(axes, sizeof *c->axis);
+	c->idx = calloc(axes, sizeof *c->idx);
+	c->axis_text = calloc(axes, sizeof *c->axis_text);
+	c->location = malloc((c->n ? c->n : 1) * sizeof *c->location);
+	c->path = malloc((c->n ? c->n : 1) * sizeof *c->path);
+	if (!c->axis || !c->idx || !c->axis_text || !c->location || !c->path)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for the trials' columns");
+	/* an axis is numbers if every value is one, else text (codes) */
+	for (int a = 0; a < e->n_axes; a++) {
+		const bsim_grid_axis *ax = &e->axes[a];
+		for (int i = 0; i < ax->n_values && !c->axis_text[a]; i++)
+			c->axis_text[a] = isnan(value_number(ax->values[i]));
+		c->axis[a] = c->axis_text[a] ? mxCreateNumericMatrix((mwSize)c->n, 1,
+		                                                     mxUINT32_CLASS, mxREAL)
+		                             : bmx_column(c->n, &unused);
+	}
+	return BSIM_OK;
+}
+
+static void columns_free(trial_columns *c)
+{
+	free(c->axis);
+	free(c->idx);
+	free(c->axis_text);
+	free(c->location);
+	free(c->path);
+	bmx_labels_free(&c->location_labels);
+	bmx_labels_free(&c->path_labels);
+	memset(c, 0, sizeof *c);
+}
+
+/* s.trials (and s.labels): the columns in trials.csv's order, each text
+ * column's codes with its labels, categorical where MATLAB has it. */
+static void trials_fields(mxArray *s, trial_columns *c)
+{
+	mxArray *t = mxCreateStructMatrix(1, 1, 0, NULL), *l = mxCreateStructMatrix(1, 1, 0, NULL);
+	static const char *const outcomes[] = {"traversed", "side_exit", "stuck", "unstable"};
+	static const char *const types[] = {"none", "left", "right"};
+	bmx_set(t, 0, "group", c->group);
+	bmx_set(t, 0, "trial", c->trial);
+	bmx_text_field(t, l, "outcome", c->outcome, bmx_cellstr(outcomes, 4));
+	bmx_text_field(t, l, "type", c->type, bmx_cellstr(types, 3));
+	for (int i = 0; i < N_AFTER_TYPE; i++)
+		bmx_set(t, 0, after_type[i].name, c->number[i]);
+	bmx_text_field(t, l, "location", bmx_codes(c->location, c->n, c->location_labels.n),
+	               bmx_labels_cell(&c->location_labels));
+	free(c->location);
+	c->location = NULL;
+	bmx_text_field(t, l, "path", bmx_codes(c->path, c->n, c->path_labels.n),
+	               bmx_labels_cell(&c->path_labels));
+	free(c->path);
+	c->path = NULL;
+	for (int i = 0; i < N_AFTER_PATH; i++)
+		bmx_set(t, 0, after_path[i].name, c->number[N_AFTER_TYPE + i]);
+	for (int a = 0; a < c->e->n_axes; a++) {
+		const bsim_grid_axis *ax = &c->e->axes[a];
 		char field[64];
 		bmx_field_name(ax->key, field, sizeof field);
-		bmx_set(s, 0, field, col);
+		if (!c->axis_text[a]) {
+			bmx_set(t, 0, field, c->axis[a]);
+			continue;
+		}
+		uint32_t *codes = mxGetData(c->axis[a]);
+		bmx_text_field(t, l, field, bmx_codes(codes, c->n, (size_t)ax->n_values),
+		               bmx_cellstr((const char *const *)ax->values, ax->n_values));
+		mxDestroyArray(c->axis[a]);
 	}
-	free(idx);
-	return s;
+	bmx_set(s, 0, "trials", t);
+	bmx_set(s, 0, "labels", l);
 }
 
 static mxArray *groups_struct(const bsim_experiment *e, const bsim_sweep_result *r)
@@ -292,7 +387,7 @@ static mxArray *groups_struct(const bsim_experiment *e, const bsim_sweep_result 
 }
 
 static mxArray *sweep_struct(const bsim_experiment *e, const bsim_backend *b,
-                             const bsim_sweep_result *r)
+                             const bsim_sweep_result *r, trial_columns *c)
 {
 	mxArray *s = mxCreateStructMatrix(1, 1, 0, NULL);
 	bmx_set(s, 0, "experiment", bmx_string(e->path));
@@ -308,20 +403,20 @@ static mxArray *sweep_struct(const bsim_experiment *e, const bsim_backend *b,
 	bmx_set(s, 0, "total_steps", bmx_scalar((double)r->total_steps));
 	bmx_set(s, 0, "trials_run", bmx_scalar((double)r->trials_run));
 	bmx_set(s, 0, "groups", groups_struct(e, r));
-	bmx_set(s, 0, "trials", trials_struct(e, r));
+	trials_fields(s, c);
 	return s;
 }
 
-/* Unstable trials, said as `beamsim sweep` says them (it exits 1). */
+/* Unstable trials, said as `beamsim sweep` says them (it exits 1): the
+ * groups' counts, and the first, which the streamed sweep keeps. */
 static void unstable_line(const bsim_experiment *e, const bsim_override *sets, int n_sets,
                           const bsim_backend *b, const bsim_sweep_result *r, char *buf, size_t size)
 {
 	size_t n = (size_t)r->n_groups * (size_t)r->trials;
-	long count = 0, first = -1;
-	for (size_t k = 0; k < n; k++)
-		if (r->trials_out[k].outcome == BSIM_UNSTABLE && count++ == 0)
-			first = (long)k;
-	if (count == 0)
+	long count = 0, first = r->first_unstable;
+	for (int g = 0; g < r->n_groups; g++)
+		count += r->groups[g].unstable;
+	if (count == 0 || first < 0)
 		return;
 	char why[256] = "";
 	bsim_scene scene;
@@ -329,7 +424,7 @@ static void unstable_line(const bsim_experiment *e, const bsim_override *sets, i
 	memset(&scene, 0, sizeof scene);
 	if (bsim_experiment_group_scene(e, (int)(first / r->trials), sets, n_sets, &scene, &err) ==
 	    BSIM_OK)
-		bsim_trial_instability_text(&r->trials_out[first], scene.dt, why, sizeof why);
+		bsim_trial_instability_text(&r->first_unstable_result, scene.dt, why, sizeof why);
 	bsim_scene_free(&scene);
 	snprintf(buf, size,
 	         "%ld of %zu trials unstable on the %s backend (outcome unstable in s.trials); the "
@@ -343,7 +438,11 @@ typedef struct sweep_call {
 	int n_grid;
 	bsim_experiment e;
 	bsim_sweep_result r;
+	trial_columns c;
 } sweep_call;
+
+/* A cell of the columns: 8 bytes a number, 1 to 4 a text column's code. */
+#define CELL_BYTES 8.0
 
 static int sweep(sweep_call *c, int nrhs, const mxArray *prhs[], mxArray **out, char *warning,
                  size_t warning_size, bsim_error *err)
@@ -388,15 +487,20 @@ static int sweep(sweep_call *c, int nrhs, const mxArray *prhs[], mxArray **out, 
 		c->e.trials = (int)trials;
 	if (v[A_SEED])
 		c->e.seed = seed;
+	if (bsim_output_trials_fit(&c->e, 0, CELL_BYTES, err) != BSIM_OK ||
+	    columns_alloc(&c->c, &c->e, err) != BSIM_OK)
+		return err->code;
 	cfg.opts = &opts;
 	cfg.threads = (int)threads;
 	cfg.extra = sets;
 	cfg.n_extra = n_sets;
 	cfg.measure_overlap = overlap;
+	cfg.sink = columns_block;
+	cfg.sink_user = &c->c;
 	if (bsim_sweep_run(&c->e, &cfg, &c->r, err) != BSIM_OK)
 		return err->code ? err->code : BSIM_EFAIL;
 	unstable_line(&c->e, sets, n_sets, cfg.backend, &c->r, warning, warning_size);
-	*out = sweep_struct(&c->e, cfg.backend, &c->r);
+	*out = sweep_struct(&c->e, cfg.backend, &c->r, &c->c);
 	return BSIM_OK;
 }
 
@@ -410,6 +514,7 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
 	char warning[512] = "";
 	mxArray *out = NULL;
 	int rc = sweep(&c, nrhs, prhs, &out, warning, sizeof warning, &err);
+	columns_free(&c.c);
 	bsim_sweep_result_free(&c.r);
 	bsim_experiment_free(&c.e);
 	bmx_grid_free(c.grid, c.n_grid);

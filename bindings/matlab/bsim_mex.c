@@ -371,10 +371,8 @@ int bmx_overrides(const char *name, const mxArray *a, bmx_pool *p, bsim_override
 
 void bmx_grid_free(bsim_grid_axis *axes, int n)
 {
-	for (int i = 0; axes && i < n; i++) {
+	for (int i = 0; axes && i < n; i++)
 		free(axes[i].values);
-		free(axes[i].origins);
-	}
 	free(axes);
 }
 
@@ -390,8 +388,7 @@ static int axis_values(const char *key, const mxArray *v, bmx_pool *p, bsim_grid
 		                      "cell)",
 		                      key);
 	ax->values = calloc(n, sizeof *ax->values);
-	ax->origins = calloc(n, sizeof *ax->origins);
-	if (!ax->values || !ax->origins)
+	if (!ax->values)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (size_t i = 0; i < n; i++) {
 		const char *text = NULL;
@@ -413,18 +410,14 @@ static int axis_values(const char *key, const mxArray *v, bmx_pool *p, bsim_grid
 		ax->values[i] = (char *)text;
 	}
 	ax->n_values = (int)n;
-	/* Every value's origin is the command line's "--grid KEY=V1,V2,...". */
-	size_t len = strlen(key) + sizeof "--grid =";
-	for (size_t i = 0; i < n; i++)
-		len += strlen(ax->values[i]) + 1;
+	/* The axis's origin is the command line's "--grid KEY", one for all its
+	 * values: the library names a value "--grid KEY=VALUE". */
+	size_t len = strlen(key) + sizeof "--grid ";
 	char *origin = bmx_pool_take(p, malloc(len));
 	if (!origin)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	size_t at = (size_t)sprintf(origin, "--grid %s=", key);
-	for (size_t i = 0; i < n; i++)
-		at += (size_t)sprintf(origin + at, "%s%s", i ? "," : "", ax->values[i]);
-	for (size_t i = 0; i < n; i++)
-		ax->origins[i] = origin;
+	snprintf(origin, len, "--grid %s", key);
+	ax->origin = origin;
 	return BSIM_OK;
 }
 
@@ -521,6 +514,129 @@ mxArray *bmx_column(size_t n, double **data)
 	mxArray *a = mxCreateDoubleMatrix((mwSize)n, 1, mxREAL);
 	*data = mxGetPr(a);
 	return a;
+}
+
+static size_t text_hash(const char *s)
+{
+	size_t h = 1469598103934665603u; /* FNV-1a */
+	for (; *s; s++)
+		h = (h ^ (unsigned char)*s) * 1099511628211u;
+	return h;
+}
+
+long bmx_labels_code(bmx_labels *l, const char *text)
+{
+	if (2 * (l->n + 1) > l->n_slots) {
+		size_t size = l->n_slots ? 2 * l->n_slots : 64;
+		size_t *slot = calloc(size, sizeof *slot);
+		if (!slot)
+			return -1;
+		for (size_t i = 0; i < l->n; i++) {
+			size_t k = text_hash(l->text[i]);
+			while (slot[k & (size - 1)])
+				k++;
+			slot[k & (size - 1)] = i + 1;
+		}
+		free(l->slot);
+		l->slot = slot;
+		l->n_slots = size;
+	}
+	for (size_t k = text_hash(text);; k++) {
+		size_t *at = &l->slot[k & (l->n_slots - 1)];
+		if (*at && strcmp(l->text[*at - 1], text) == 0)
+			return (long)*at;
+		if (*at)
+			continue;
+		if (l->n == l->cap) {
+			size_t cap = l->cap ? 2 * l->cap : 16;
+			char **t = realloc(l->text, cap * sizeof *t);
+			if (!t)
+				return -1;
+			l->text = t;
+			l->cap = cap;
+		}
+		if (!(l->text[l->n] = dup_text(text)))
+			return -1;
+		*at = ++l->n;
+		return (long)l->n;
+	}
+}
+
+mxArray *bmx_labels_cell(const bmx_labels *l)
+{
+	return bmx_cellstr((const char *const *)l->text, (int)l->n);
+}
+
+void bmx_labels_free(bmx_labels *l)
+{
+	for (size_t i = 0; i < l->n; i++)
+		free(l->text[i]);
+	free(l->text);
+	free(l->slot);
+	memset(l, 0, sizeof *l);
+}
+
+mxArray *bmx_cellstr(const char *const *texts, int n)
+{
+	mxArray *c = mxCreateCellMatrix((mwSize)n, 1);
+	for (int i = 0; i < n; i++)
+		mxSetCell(c, (mwIndex)i, bmx_string(texts[i]));
+	return c;
+}
+
+mxArray *bmx_codes(const uint32_t *codes, size_t n, size_t n_labels)
+{
+	mxClassID id = n_labels <= UINT8_MAX    ? mxUINT8_CLASS
+	               : n_labels <= UINT16_MAX ? mxUINT16_CLASS
+	                                        : mxUINT32_CLASS;
+	mxArray *a = mxCreateNumericMatrix((mwSize)n, 1, id, mxREAL);
+	void *d = mxGetData(a);
+	for (size_t k = 0; k < n; k++) {
+		if (id == mxUINT8_CLASS)
+			((uint8_t *)d)[k] = (uint8_t)codes[k];
+		else if (id == mxUINT16_CLASS)
+			((uint16_t *)d)[k] = (uint16_t)codes[k];
+		else
+			((uint32_t *)d)[k] = codes[k];
+	}
+	return a;
+}
+
+/* 1 if the function name exists here (MATLAB's exist). */
+static int exists(const char *name)
+{
+	mxArray *in = bmx_string(name), *out = NULL;
+	int yes = mexCallMATLAB(1, &out, 1, &in, "exist") == 0 && out && mxGetScalar(out) != 0;
+	mxDestroyArray(in);
+	if (out)
+		mxDestroyArray(out);
+	return yes;
+}
+
+void bmx_text_field(mxArray *t, mxArray *l, const char *name, mxArray *codes, mxArray *labels)
+{
+	bmx_set(l, 0, name, labels);
+	if (!exists("categorical")) {
+		bmx_set(t, 0, name, codes);
+		return;
+	}
+	/* categorical(codes, 1:n, labels): the value set of the codes' class */
+	size_t n = mxGetNumberOfElements(labels);
+	mxArray *set = mxCreateNumericMatrix(1, (mwSize)n, mxGetClassID(codes), mxREAL);
+	void *d = mxGetData(set);
+	for (size_t i = 0; i < n; i++) {
+		if (mxGetClassID(codes) == mxUINT8_CLASS)
+			((uint8_t *)d)[i] = (uint8_t)(i + 1);
+		else if (mxGetClassID(codes) == mxUINT16_CLASS)
+			((uint16_t *)d)[i] = (uint16_t)(i + 1);
+		else
+			((uint32_t *)d)[i] = (uint32_t)(i + 1);
+	}
+	mxArray *in[3] = {codes, set, labels}, *cat = NULL;
+	mexCallMATLAB(1, &cat, 3, in, "categorical");
+	mxDestroyArray(set);
+	mxDestroyArray(codes);
+	bmx_set(t, 0, name, cat);
 }
 
 void bmx_field_name(const char *key, char *buf, size_t size)

@@ -60,8 +60,9 @@ int bmx_overrides(const char *name, const mxArray *a, bmx_pool *p, bsim_override
                   bsim_error *err);
 
 /* 'grid': a cell {KEY, VALUES, ...}: VALUES a numeric or logical vector
- * (one value each) or a cell of values, as --grid KEY=V1,V2,... (each
- * value's origin that text). The axes and their arrays are malloc'd
+ * (one value each) or a cell of values, as --grid KEY=V1,V2,... (the
+ * axis's origin "--grid KEY", a value named "--grid KEY=VALUE" as the
+ * program names it). The axes and their arrays are malloc'd
  * (bmx_grid_free), the strings the pool's. */
 int bmx_grid(const char *name, const mxArray *a, bmx_pool *p, bsim_grid_axis **axes, int *n,
              bsim_error *err);
@@ -82,6 +83,31 @@ mxArray *bmx_u64(uint64_t x);
 mxArray *bmx_row(const double *x, int n);
 /* An n x 1 double column; *data its values. */
 mxArray *bmx_column(size_t n, double **data);
+
+/* Distinct texts, each kept once, in order of first appearance: the
+ * labels of a text column whose rows are codes from 1 into them, so that a
+ * column of a million trials holds a code a row, not a char array. */
+typedef struct bmx_labels {
+	char **text; /* n (malloc'd) */
+	size_t n, cap;
+	size_t *slot; /* n_slots (a power of 2): index + 1, 0 free */
+	size_t n_slots;
+} bmx_labels;
+/* The code (from 1) of text in l, added if new; -1 if out of memory. */
+long bmx_labels_code(bmx_labels *l, const char *text);
+/* l's texts as an n x 1 cell of char rows. */
+mxArray *bmx_labels_cell(const bmx_labels *l);
+void bmx_labels_free(bmx_labels *l);
+/* texts[0 .. n) as an n x 1 cell of char rows. */
+mxArray *bmx_cellstr(const char *const *texts, int n);
+/* n codes (from 1, of n_labels labels) as an n x 1 column of the narrowest
+ * class that holds them: uint8, uint16 or uint32. */
+mxArray *bmx_codes(const uint32_t *codes, size_t n, size_t n_labels);
+/* A text column: t.name = codes (a column of codes from 1 into labels, an
+ * n x 1 cell) and l.name = labels; where `categorical` exists (MATLAB),
+ * t.name = categorical(codes, 1:numel(labels), labels) instead, which
+ * holds as little (Octave has none). */
+void bmx_text_field(mxArray *t, mxArray *l, const char *name, mxArray *codes, mxArray *labels);
 
 /* A field name MATLAB accepts made of key, as MATLAB's and Octave's
  * jsondecode make one (matlab.lang.makeValidName): every character other

@@ -109,16 +109,18 @@ int pyb_grid_from(PyObject *seq, pyb_grid *g)
 		Py_ssize_t m = PyList_Size(values);
 		ax->n_values = (int)m;
 		ax->values = calloc((size_t)(m ? m : 1), sizeof *ax->values);
-		ax->origins = calloc((size_t)(m ? m : 1), sizeof *ax->origins);
 		const char *key = tuple_text(t, 0, "grid: the key");
-		if (!ax->values || !ax->origins || !key) {
+		const char *origin = key ? tuple_text(t, 2, "grid: the origin") : NULL;
+		if (!ax->values || !origin) {
 			if (!PyErr_Occurred())
 				PyErr_NoMemory();
 			pyb_grid_free(g);
 			return -1;
 		}
-		/* The library only reads an axis given to it (const). */
+		/* The library only reads an axis given to it (const); the
+		 * origin ("--grid KEY") is the axis's, one for all its values. */
 		ax->key = (char *)key;
+		ax->origin = (char *)origin;
 		char what[160];
 		snprintf(what, sizeof what, "grid %s: the value", key);
 		for (Py_ssize_t k = 0; k < m; k++) {
@@ -129,24 +131,14 @@ int pyb_grid_from(PyObject *seq, pyb_grid *g)
 			}
 			ax->values[k] = (char *)text;
 		}
-		/* the origin, made of key and values, last: a message names those */
-		const char *origin = tuple_text(t, 2, "grid: the origin");
-		if (!origin) {
-			pyb_grid_free(g);
-			return -1;
-		}
-		for (Py_ssize_t k = 0; k < m; k++)
-			ax->origins[k] = (char *)origin;
 	}
 	return 0;
 }
 
 void pyb_grid_free(pyb_grid *g)
 {
-	for (int i = 0; i < g->n; i++) {
+	for (int i = 0; i < g->n; i++)
 		free(g->axes[i].values);
-		free(g->axes[i].origins);
-	}
 	free(g->axes);
 	memset(g, 0, sizeof *g);
 }
@@ -252,6 +244,69 @@ PyObject *pyb_array(int nd, const long *dims, const double *data)
 	return a;
 }
 
+static void free_capsule(PyObject *capsule)
+{
+	free(PyCapsule_GetPointer(capsule, "beamsim.column"));
+}
+
+PyObject *pyb_adopt(void *data, long n, int ints)
+{
+	npy_intp dims[1] = {n};
+	PyObject *a = PyArray_SimpleNewFromData(1, dims, ints ? NPY_INT64 : NPY_DOUBLE, data);
+	/* The capsule frees data once it is the array's base, not before:
+	 * on failure data stays the caller's. */
+	PyObject *owner = a ? PyCapsule_New(data, "beamsim.column", NULL) : NULL;
+	if (!owner) {
+		Py_XDECREF(a);
+		return NULL;
+	}
+	if (PyArray_SetBaseObject((PyArrayObject *)a, owner) != 0) { /* takes owner */
+		Py_DECREF(a);
+		return NULL;
+	}
+	PyCapsule_SetDestructor(owner, free_capsule);
+	return a;
+}
+
+PyObject *pyb_text_column(const uint32_t *codes, long n, PyObject *labels)
+{
+	Py_ssize_t n_labels = labels ? PyList_GET_SIZE(labels) : 0, width = 1;
+	for (Py_ssize_t i = 0; i < n_labels; i++) {
+		Py_ssize_t len = PyUnicode_GET_LENGTH(PyList_GET_ITEM(labels, i));
+		width = len > width ? len : width;
+	}
+	/* each label's code points once, copied into its rows */
+	Py_UCS4 **ucs = PyMem_Calloc((size_t)(n_labels ? n_labels : 1), sizeof *ucs);
+	PyObject *type = PyUnicode_FromFormat("<U%zd", width);
+	PyArray_Descr *descr = NULL;
+	PyObject *a = NULL;
+	int ok = ucs && type && PyArray_DescrConverter(type, &descr) == NPY_SUCCEED;
+	for (Py_ssize_t i = 0; ok && i < n_labels; i++)
+		ok = (ucs[i] = PyUnicode_AsUCS4Copy(PyList_GET_ITEM(labels, i))) != NULL;
+	if (ok) {
+		npy_intp dims[1] = {n};
+		a = PyArray_Zeros(1, dims, descr, 0); /* takes descr */
+		descr = NULL;
+	}
+	if (a) {
+		char *row = PyArray_DATA((PyArrayObject *)a);
+		size_t item = (size_t)width * sizeof(Py_UCS4);
+		for (long k = 0; k < n; k++, row += item) {
+			PyObject *s = PyList_GET_ITEM(labels, codes[k]);
+			memcpy(row, ucs[codes[k]],
+			       (size_t)PyUnicode_GET_LENGTH(s) * sizeof(Py_UCS4));
+		}
+	}
+	for (Py_ssize_t i = 0; ucs && i < n_labels; i++)
+		PyMem_Free(ucs[i]);
+	PyMem_Free(ucs);
+	Py_XDECREF(type);
+	Py_XDECREF(descr);
+	if (!a && !PyErr_Occurred())
+		PyErr_NoMemory();
+	return a;
+}
+
 int pyb_set(PyObject *d, const char *key, PyObject *value)
 {
 	if (!value)
@@ -345,12 +400,14 @@ static PyMethodDef methods[] = {
          "run(path, seed, group, trial, backend, sets, backend_opts, trajectory, stride)"},
         {"sweep", (PyCFunction)(void (*)(void))pyb_sweep, METH_VARARGS | METH_KEYWORDS,
          "sweep(experiment, out, trials, threads, seed, backend, sets, grid, backend_opts, "
-         "progress)"},
+         "progress, trajectories, resume, hold)"},
         {"compare", (PyCFunction)(void (*)(void))pyb_compare, METH_VARARGS | METH_KEYWORDS,
          "compare(experiment, out, a, b, trials, threads, seed, sets, grid, progress, "
          "resume)"},
         {"landscape", (PyCFunction)(void (*)(void))pyb_landscape, METH_VARARGS | METH_KEYWORDS,
          "landscape(scene, sets, spacing, region)"},
+        {"read_table", pyb_read_table, METH_VARARGS,
+         "read_table(path): a CSV table as a dict of NumPy arrays by column"},
         {"version", py_version, METH_NOARGS, "the library's version"},
         {"text_check", py_text_check, METH_VARARGS,
          "text_check(what, text): ValueError naming what if text holds a NUL"},

@@ -9,6 +9,8 @@
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
+#include <stdint.h>
+
 #include "beamsim/beamsim.h"
 
 /* Raises the exception of a failed call: ValueError for bad input
@@ -58,6 +60,14 @@ PyObject *pyb_column(const double *data, long n, long stride, int ints);
 /* A 1-, 2- or 3-D float64 array copied from data (C order). */
 PyObject *pyb_array(int nd, const long *dims, const double *data);
 
+/* A NumPy array of n int64 (ints) or float64 values that takes over data
+ * (malloc'd, at least n values; freed with the array). New reference, or
+ * NULL with data still the caller's. */
+PyObject *pyb_adopt(void *data, long n, int ints);
+/* A NumPy str array of n rows, row k the string labels[codes[k]] (labels a
+ * list of str; NULL if n is 0), as wide as the longest. New reference. */
+PyObject *pyb_text_column(const uint32_t *codes, long n, PyObject *labels);
+
 /* Sets d[key] = value and drops the reference to value. -1 on failure
  * (value NULL included). */
 int pyb_set(PyObject *d, const char *key, PyObject *value);
@@ -67,6 +77,7 @@ PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_landscape(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *pyb_read_table(PyObject *self, PyObject *args);
 
 /* A progress callback for long runs (bsim_progress_fn), called from the
  * thread that started the run while the GIL is released: every so often

@@ -1,6 +1,8 @@
 /* _beamsim.sweep: an experiment's sweep as `beamsim sweep EXPERIMENT --out
  * DIR` runs it (bsim_sweep_dir_run), with the GIL released, a progress
- * callable and Ctrl-C; the package reads DIR's files back. */
+ * callable and Ctrl-C; the package reads DIR's files back. hold: the bytes
+ * a cell of trials.csv will take in the package's arrays, for the run to
+ * be refused at once if they would not fit in memory. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "pyb.h"
@@ -13,15 +15,17 @@ PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw)
 	static char *kwlist[] = {"experiment",   "out",      "trials",       "threads",
 	                         "seed",         "backend",  "sets",         "grid",
 	                         "backend_opts", "progress", "trajectories", "resume",
-	                         "overwrite",    NULL};
+	                         "overwrite",    "hold",         NULL};
 	const char *experiment, *out, *backend_spec = NULL;
 	long trials = 0, keep = 0;
 	int threads = 0, resume = 0, overwrite = 0;
+	double hold = 0;
 	PyObject *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None, *opts_o = Py_None,
 	         *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|liOzOOOOlpp", kwlist, &experiment, &out,
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|liOzOOOOlppd", kwlist, &experiment, &out,
 	                                 &trials, &threads, &seed_o, &backend_spec, &sets_o,
-	                                 &grid_o, &opts_o, &progress_o, &keep, &resume, &overwrite))
+	                                 &grid_o, &opts_o, &progress_o, &keep, &resume, &overwrite,
+	                                 &hold))
 		return NULL;
 	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
 		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
@@ -51,6 +55,7 @@ PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw)
 	def.overwrite = overwrite;
 	def.resume_option = "resume=True";
 	def.overwrite_option = "overwrite=True";
+	def.hold_cell_bytes = hold;
 	def.progress = pyb_progress_update;
 	def.progress_user = &progress;
 	def.stop = &progress.stop;

@@ -37,6 +37,7 @@
 #include "beamsim/stats.h"
 #include "beamsim/sweep.h"
 #include "beamsim/sweep_dir.h"
+#include "beamsim/table.h"
 #include "beamsim/trajectory.h"
 #include "beamsim/trial.h"
 #include "beamsim/version.h"

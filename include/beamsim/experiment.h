@@ -4,6 +4,7 @@
 #ifndef BSIM_EXPERIMENT_H
 #define BSIM_EXPERIMENT_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "beamsim/backend.h"
@@ -15,11 +16,19 @@
 extern "C" {
 #endif
 
+/* One axis of the grid. What it holds grows with its values' text alone:
+ * where it came from is said once for all its values (a --grid option of
+ * 20,000 values is not repeated 20,000 times), and a value's origin is
+ * made when a message needs it (bsim_experiment_value_origin). */
 typedef struct bsim_grid_axis {
 	char *key; /* dotted scene path */
 	int n_values;
-	char **values;  /* YAML scalar text of each value */
-	char **origins; /* "file:line" of each value, for error messages */
+	char **values; /* YAML scalar text of each value */
+	/* Where the axis was given, for error messages: an experiment file
+	 * (with lines), or an option such as "--grid body.mass"; NULL is
+	 * "--grid KEY". */
+	char *origin;
+	int *lines; /* NULL, or the line of each value in the file origin (from 1) */
 } bsim_grid_axis;
 
 typedef struct bsim_experiment {
@@ -47,8 +56,8 @@ BSIM_API int bsim_experiment_load(const char *path, const bsim_override *extra, 
  * of the same key where it stands, or, if the file has none, is appended
  * after the file's axes, in the order given; an entry of the file's set:
  * for the axis's field (or a field inside it) is dropped, the axis giving
- * that field its values. The axes are copied; each value's origin (NULL:
- * "--grid") names it in error messages. The experiment then holds the grid
+ * that field its values. The axes are copied; their origins name their
+ * values in error messages ("--grid body.mass=7"). The experiment then holds the grid
  * that runs, so the record of a run (beamsim/run_record.h) repeats it.
  * With n_grid 0, bsim_experiment_load. */
 BSIM_API int bsim_experiment_load_grid(const char *path, const bsim_override *extra, int n_extra,
@@ -66,9 +75,19 @@ BSIM_API int bsim_experiment_load_seeded(const char *path, const bsim_override *
                                          bsim_error *err);
 BSIM_API void bsim_experiment_free(bsim_experiment *e);
 
-/* Frees what a grid axis holds (key, values, origins; origins may be NULL
- * while the values are being made) and zeroes it. */
+/* Frees what a grid axis holds (key, values, origin, lines; each may be
+ * NULL while the axis is being made) and zeroes it. */
 BSIM_API void bsim_experiment_axis_free(bsim_grid_axis *ax);
+
+/* Where value i of ax came from, for a message: "FILE:LINE" when ax has
+ * lines, else "ORIGIN=VALUE" ("--grid body.mass=7", as a --set names
+ * itself). Written into buf as snprintf would; returns the length of the
+ * whole text (buf may be too small: size it with a first call). */
+BSIM_API int bsim_experiment_value_origin(const bsim_grid_axis *ax, int i, char *buf, size_t size);
+
+/* Where ax came from as a whole: "FILE:LINE" of its first value, or its
+ * origin ("--grid body.mass"), into buf (cut to size). */
+BSIM_API void bsim_experiment_axis_origin(const bsim_grid_axis *ax, char *buf, size_t size);
 
 /* BSIM_EINPUT with "expected at most N trials in all, got G groups x T
  * trials = ..." if n_groups x trials exceeds the limit trials
@@ -77,6 +96,15 @@ BSIM_API int bsim_experiment_check_trials(const bsim_experiment *e, long trials,
 
 /* The value index along each axis for group g (idx has n_axes entries). */
 BSIM_API void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx);
+
+/* The overrides that build group g's scene, in the order they apply: set,
+ * then extra, then the group's grid values, each value with its origin
+ * (bsim_experiment_value_origin). *n gets their count. One allocation,
+ * freed with free(); keys and values are borrowed from e and extra (valid
+ * while they are). NULL if out of memory, or if g is out of range. */
+BSIM_API bsim_override *bsim_experiment_group_overrides(const bsim_experiment *e, int g,
+                                                        const bsim_override *extra, int n_extra,
+                                                        int *n);
 
 /* Builds the scene of group g: scene file + set + extra + grid values. */
 BSIM_API int bsim_experiment_group_scene(const bsim_experiment *e, int g,

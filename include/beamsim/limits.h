@@ -57,6 +57,14 @@ BSIM_API void bsim_limits_set(const bsim_limits *l);
  * names if NAME is unknown, or if N is not a number >= 1. */
 BSIM_API int bsim_limits_parse(bsim_limits *l, const char *text, bsim_error *err);
 
+/* The memory the machine can still give a process, bytes: Linux's
+ * MemAvailable (/proc/meminfo: free memory and the caches it may drop),
+ * else the free physical pages; INFINITY if neither is known. For a
+ * caller about to hold something that grows with the work (the bindings'
+ * columns of a sweep's trials) to refuse it at once rather than be killed
+ * half-way. */
+BSIM_API double bsim_memory_available(void);
+
 /* "(limit NAME = N; raise it with --limit NAME=M)" for messages. */
 BSIM_API void bsim_limits_hint(char *buf, unsigned size, const char *name, double value);
 

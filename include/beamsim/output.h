@@ -66,6 +66,15 @@ BSIM_API void bsim_output_table_text_free(char *text);
 BSIM_API int bsim_output_dir_check(const char *dir, int overwrite, const char *overwrite_option,
                                    bsim_error *err);
 
+/* For a caller that holds a sweep's trials in memory as columns of
+ * trials.csv (the bindings), before any trial runs: BSIM_EINPUT "expected
+ * trials that fit in memory as columns: ..." with the sizes if e's
+ * n_groups x trials rows of trials.csv's columns (one more a grid axis),
+ * cell_bytes each, need more than the memory available
+ * (bsim_memory_available, beamsim/limits.h). trials > 0 replaces e's. */
+BSIM_API int bsim_output_trials_fit(const bsim_experiment *e, long trials, double cell_bytes,
+                                    bsim_error *err);
+
 /* A lattice sweep's own files in dir (docs/lattice.md "Files"):
  * lattice_map.csv, final_locations.csv, transitions.csv, gate_entries.csv
  * and beam_peaks.csv. Nothing

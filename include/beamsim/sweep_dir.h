@@ -96,6 +96,11 @@ typedef struct bsim_sweep_dir_def {
 	 * written as one process writes it. */
 	const char *const *merge;
 	int n_merge;
+	/* > 0: the caller will hold the trials in memory as columns of
+	 * trials.csv, this many bytes a cell (a binding's arrays): the run is
+	 * refused before any trial if they would need more than the memory
+	 * available (bsim_output_trials_fit, beamsim/output.h). */
+	double hold_cell_bytes;
 } bsim_sweep_dir_def;
 
 enum { BSIM_SPREAD_NONE, BSIM_SPREAD_SHARD, BSIM_SPREAD_GATHER, BSIM_SPREAD_SEND };

@@ -179,10 +179,12 @@ static int add_axis(bsim_experiment *e, const char *key, const char *values, bsi
 	int n = 1;
 	for (const char *c = values; *c; c++)
 		n += *c == ',';
+	char origin[160];
+	snprintf(origin, sizeof origin, "beamsim essay: %s", key);
 	a->key = dup_str(key);
+	a->origin = dup_str(origin);
 	a->values = calloc((size_t)n, sizeof *a->values);
-	a->origins = calloc((size_t)n, sizeof *a->origins);
-	if (!a->key || !a->values || !a->origins)
+	if (!a->key || !a->origin || !a->values)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	const char *s = values;
 	for (int i = 0; i < n; i++) {
@@ -190,9 +192,8 @@ static int add_axis(bsim_experiment *e, const char *key, const char *values, bsi
 		char v[32];
 		snprintf(v, sizeof v, "%.*s", (int)len, s);
 		a->values[i] = dup_str(v);
-		a->origins[i] = dup_str("beamsim essay");
 		a->n_values++;
-		if (!a->values[i] || !a->origins[i])
+		if (!a->values[i])
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		s += len + (s[len] == ',');
 	}

@@ -18,10 +18,19 @@
  *   trajectory  `run --trajectory` of the gate with no propulsion and no
  *               random force (the body stays where it is: nothing ends the
  *               trial before max_steps) for S and S / 10 steps (S =
- *               1,000,000), with the CSV's .mat twin.
- * The growth per trial (per step) is the difference of the two peaks over
- * the difference of the sizes: what memory costs per unit of work, apart
- * from what the program holds whatever the size. */
+ *               1,000,000), with the CSV's .mat twin;
+ *   grid axis   `sweep --grid body.mass=1,2,...,V` of a one-group
+ *               experiment of the gate (one trial of two steps a group),
+ *               V = 20,000 and 2,000 values, with every file and twin: an
+ *               axis costs its values, not its values times the option;
+ *   replay      `run DIR --group V-1 --trial 0` of the V = 20,000 sweep;
+ *   python      beamsim.sweep of the one-group sweep above from Python
+ *               (the python3 the module is built for, the module beside
+ *               this program), 200,000 and 20,000 trials: its trials as
+ *               NumPy columns; left out without the module.
+ * The growth per trial (per step, per value) is the difference of the two
+ * peaks over the difference of the sizes: what memory costs per unit of
+ * work, apart from what the program holds whatever the size. */
 #define _DEFAULT_SOURCE
 
 #include "bench/bench_memory.h"
@@ -45,9 +54,14 @@ extern char **environ;
 
 #define BENCH_GATE "configs/thesis/gate.yaml"
 
+/* The large grid axis's values and Python sweep's trials (the small: a
+ * tenth). */
+#define AXIS_VALUES   20000
+#define PYTHON_TRIALS 200000
+
 typedef struct mem_run {
-	const char *what; /* sweep, twin, trajectory */
-	long size;        /* trials or steps */
+	const char *what; /* sweep, twin, trajectory, grid axis, replay, python */
+	long size;        /* trials, steps or values */
 	double rss;       /* bytes */
 	double wall;
 } mem_run;
@@ -56,9 +70,10 @@ typedef struct mem_run {
  * in it, shown only if a run fails. */
 static const char *tmp_dir;
 
-/* argv run as a child with its output discarded; its peak resident set,
- * bytes, in *rss. */
-static int child_peak(const char *const argv[], double *rss, double *wall)
+/* argv run as a child with its output discarded (file: a program found on
+ * PATH or by its path, NULL: this program); its peak resident set, bytes,
+ * in *rss. */
+static int child_run(const char *file, const char *const argv[], double *rss, double *wall)
 {
 	char log[BSIM_PATH_MAX];
 	snprintf(log, sizeof log, "%s/stderr.txt", tmp_dir);
@@ -69,7 +84,8 @@ static int child_peak(const char *const argv[], double *rss, double *wall)
 	pid_t pid;
 	struct timeval t0, t1;
 	gettimeofday(&t0, NULL);
-	int e = posix_spawn(&pid, "/proc/self/exe", &fa, NULL, (char *const *)argv, environ);
+	int e = file ? posix_spawnp(&pid, file, &fa, NULL, (char *const *)argv, environ)
+	             : posix_spawn(&pid, "/proc/self/exe", &fa, NULL, (char *const *)argv, environ);
 	posix_spawn_file_actions_destroy(&fa);
 	if (e != 0) {
 		cli_error("bench: cannot start %s: %s", argv[0], strerror(e));
@@ -84,7 +100,7 @@ static int child_peak(const char *const argv[], double *rss, double *wall)
 		}
 	gettimeofday(&t1, NULL);
 	if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-		cli_error("bench: beamsim %s %s failed (status %d)", argv[1], argv[2],
+		cli_error("bench: %s %s %.60s failed (status %d)", argv[0], argv[1], argv[2],
 		          WIFEXITED(status) ? WEXITSTATUS(status) : -1);
 		FILE *f = fopen(log, "r");
 		char line[512];
@@ -99,24 +115,107 @@ static int child_peak(const char *const argv[], double *rss, double *wall)
 	return CLI_OK;
 }
 
-static int sweep_peak(const char *tmp, const char *gate, long trials, int twin, mem_run *out)
+static int child_peak(const char *const argv[], double *rss, double *wall)
 {
-	char exp[BSIM_PATH_MAX], dir[BSIM_PATH_MAX];
-	snprintf(exp, sizeof exp, "%s/sweep_%ld.yaml", tmp, trials);
-	snprintf(dir, sizeof dir, "%s/sweep_%ld_%d", tmp, trials, twin);
+	return child_run(NULL, argv, rss, wall);
+}
+
+/* The one-group experiment of the gate in tmp (trials a group, steps
+ * each), its path in exp. */
+static int one_group(const char *tmp, const char *gate, const char *name, long trials, long steps,
+                     char *exp, size_t size)
+{
+	snprintf(exp, size, "%s/%s.yaml", tmp, name);
 	FILE *f = fopen(exp, "w");
 	if (!f) {
 		cli_error("bench: %s: %s", exp, strerror(errno));
 		return CLI_FAIL;
 	}
 	fprintf(f,
-	        "scene: %s\ntrials: %ld\nseed: 1\nset:\n  integration.max_steps: 50\n"
+	        "scene: %s\ntrials: %ld\nseed: 1\nset:\n  integration.max_steps: %ld\n"
 	        "grid:\n  effects.propulsion.force: [8]\n",
-	        gate, trials);
+	        gate, trials, steps);
 	if (fclose(f) != 0) {
 		cli_error("bench: %s: cannot write", exp);
 		return CLI_FAIL;
 	}
+	return CLI_OK;
+}
+
+/* sweep --grid body.mass=1,...,values into tmp/axis_VALUES; then, with
+ * replay, run of that directory's last group. */
+static int axis_peak(const char *tmp, const char *gate, long values, mem_run *out, mem_run *replay)
+{
+	char exp[BSIM_PATH_MAX], dir[BSIM_PATH_MAX];
+	if (one_group(tmp, gate, "axis", 1, 2, exp, sizeof exp) != CLI_OK)
+		return CLI_FAIL;
+	snprintf(dir, sizeof dir, "%s/axis_%ld", tmp, values);
+	size_t size = (size_t)values * 12 + 32;
+	char *option = malloc(size);
+	if (!option) {
+		cli_error("out of memory");
+		return CLI_FAIL;
+	}
+	size_t at = (size_t)snprintf(option, size, "body.mass=");
+	for (long i = 1; i <= values; i++)
+		at += (size_t)snprintf(option + at, size - at, "%s%ld", i > 1 ? "," : "", i);
+	const char *argv[] = {"beamsim", "sweep",  exp,    "--out", dir,
+	                      "--quiet", "--grid", option, NULL};
+	*out = (mem_run){.what = "grid axis", .size = values};
+	int rc = child_peak(argv, &out->rss, &out->wall);
+	free(option);
+	if (rc != CLI_OK || !replay)
+		return rc;
+	char group[32];
+	snprintf(group, sizeof group, "%ld", values - 1);
+	const char *run[] = {"beamsim", "run", dir, "--group", group, "--trial", "0", NULL};
+	*replay = (mem_run){.what = "replay", .size = values};
+	return child_peak(run, &replay->rss, &replay->wall);
+}
+
+/* The Python module beside this program (build/python), or "" without it. */
+static void python_dir(char *dir, size_t size)
+{
+	char self[BSIM_PATH_MAX], test[BSIM_PATH_MAX + 32];
+	dir[0] = '\0';
+	ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+	self[n > 0 ? n : 0] = '\0';
+	char *slash = strrchr(self, '/');
+	int len = slash ? snprintf(dir, size, "%.*s/python", (int)(slash - self), self) : -1;
+	snprintf(test, sizeof test, "%s/beamsim/__init__.py", dir);
+	if (n <= 0 || len < 0 || (size_t)len >= size || access(test, R_OK) != 0)
+		dir[0] = '\0';
+}
+
+/* beamsim.sweep of the one-group experiment of trials trials, from Python. */
+static int python_peak(const char *tmp, const char *gate, const char *module, long trials,
+                       mem_run *out)
+{
+#ifdef BSIM_PYTHON_EXECUTABLE
+	char exp[BSIM_PATH_MAX], name[32], code[BSIM_PATH_MAX * 2];
+	snprintf(name, sizeof name, "python_%ld", trials);
+	if (one_group(tmp, gate, name, trials, 50, exp, sizeof exp) != CLI_OK)
+		return CLI_FAIL;
+	snprintf(code, sizeof code,
+	         "import sys; sys.path.insert(0, '%s'); import beamsim; "
+	         "s = beamsim.sweep('%s'); assert len(s['trials']['outcome']) == %ld",
+	         module, exp, trials);
+	const char *argv[] = {BSIM_PYTHON_EXECUTABLE, "-c", code, NULL};
+	*out = (mem_run){.what = "python", .size = trials};
+	return child_run(BSIM_PYTHON_EXECUTABLE, argv, &out->rss, &out->wall);
+#else
+	(void)tmp, (void)gate, (void)module, (void)trials, (void)out;
+	return CLI_FAIL;
+#endif
+}
+
+static int sweep_peak(const char *tmp, const char *gate, long trials, int twin, mem_run *out)
+{
+	char exp[BSIM_PATH_MAX], dir[BSIM_PATH_MAX], name[32];
+	snprintf(name, sizeof name, "sweep_%ld", trials);
+	snprintf(dir, sizeof dir, "%s/sweep_%ld_%d", tmp, trials, twin);
+	if (one_group(tmp, gate, name, trials, 50, exp, sizeof exp) != CLI_OK)
+		return CLI_FAIL;
 	char limit[64], rows[64];
 	snprintf(limit, sizeof limit, "trials=%ld", trials);
 	snprintf(rows, sizeof rows, "mat_rows=%ld", twin ? trials : 1);
@@ -171,7 +270,35 @@ static void json_run(FILE *f, const mem_run *m)
 	fputc('}', f);
 }
 
-static int write_json(const char *path, const mem_run run[5])
+/* The runs measured, in the order they run. */
+enum {
+	SWEEP_SMALL,
+	SWEEP_LARGE,
+	TRAJ_SHORT,
+	TRAJ_LONG,
+	TWIN,
+	AXIS_SMALL,
+	AXIS_LARGE,
+	REPLAY,
+	PY_SMALL,
+	PY_LARGE,
+	N_RUNS
+};
+
+/* "name": {"small": ..., "large": ..., "per": growth} */
+static void json_pair(FILE *f, const char *name, const mem_run *small, const mem_run *big,
+                      const char *per)
+{
+	fprintf(f, ", \"%s\": {\"small\": ", name);
+	json_run(f, small);
+	fputs(", \"large\": ", f);
+	json_run(f, big);
+	fprintf(f, ", \"%s\": ", per);
+	bsim_json_number(f, growth(small, big));
+	fputc('}', f);
+}
+
+static int write_json(const char *path, const mem_run run[N_RUNS], int python)
 {
 	bsim_atomic_file o;
 	bsim_error err;
@@ -179,22 +306,24 @@ static int write_json(const char *path, const mem_run run[5])
 		cli_error("bench: %s", err.msg);
 		return CLI_FAIL;
 	}
-	static const char *const names[2] = {"sweep", "trajectory"};
-	static const char *const per[2] = {"bytes_per_trial", "bytes_per_step"};
-	fputs("{\"memory\": {", o.f);
-	for (int k = 0; k < 2; k++) {
-		fprintf(o.f, "%s\"%s\": {\"small\": ", k ? ", " : "", names[k]);
-		json_run(o.f, &run[2 * k]);
-		fputs(", \"large\": ", o.f);
-		json_run(o.f, &run[2 * k + 1]);
-		fprintf(o.f, ", \"%s\": ", per[k]);
-		bsim_json_number(o.f, growth(&run[2 * k], &run[2 * k + 1]));
-		fputc('}', o.f);
-	}
+	fputs("{\"memory\": {\"sweep\": {\"small\": ", o.f);
+	json_run(o.f, &run[SWEEP_SMALL]);
+	fputs(", \"large\": ", o.f);
+	json_run(o.f, &run[SWEEP_LARGE]);
+	fputs(", \"bytes_per_trial\": ", o.f);
+	bsim_json_number(o.f, growth(&run[SWEEP_SMALL], &run[SWEEP_LARGE]));
+	fputc('}', o.f);
+	json_pair(o.f, "trajectory", &run[TRAJ_SHORT], &run[TRAJ_LONG], "bytes_per_step");
 	fputs(", \"twin\": ", o.f);
-	json_run(o.f, &run[4]);
+	json_run(o.f, &run[TWIN]);
 	fputs(", \"twin_bytes_per_row\": ", o.f);
-	bsim_json_number(o.f, (run[4].rss - run[1].rss) / (double)run[1].size);
+	bsim_json_number(o.f,
+	                 (run[TWIN].rss - run[SWEEP_LARGE].rss) / (double)run[SWEEP_LARGE].size);
+	json_pair(o.f, "grid_axis", &run[AXIS_SMALL], &run[AXIS_LARGE], "bytes_per_value");
+	fputs(", \"replay\": ", o.f);
+	json_run(o.f, &run[REPLAY]);
+	if (python)
+		json_pair(o.f, "python_sweep", &run[PY_SMALL], &run[PY_LARGE], "bytes_per_trial");
 	fputs("}}\n", o.f);
 	if (bsim_atomic_file_commit(&o, &err) != BSIM_OK) {
 		cli_error("bench: %s", err.msg);
@@ -230,36 +359,69 @@ int bench_memory(const bench_memory_args *a)
 	FILE *r = a->report;
 	fprintf(r, "Peak resident memory (ru_maxrss of each run as a child process)\n");
 	fprintf(r, "%-12s %18s %13s %11s\n", "run", "size", "peak", "wall");
-	mem_run run[5];
+	mem_run run[N_RUNS];
+	memset(run, 0, sizeof run);
 	long small = trials / 10 > 0 ? trials / 10 : 1;
-	int rc = sweep_peak(tmp, gate, small, 0, &run[0]);
+	int rc = sweep_peak(tmp, gate, small, 0, &run[SWEEP_SMALL]);
 	if (rc == CLI_OK) {
-		print_run(r, &run[0], "trials");
-		rc = sweep_peak(tmp, gate, trials, 0, &run[1]);
+		print_run(r, &run[SWEEP_SMALL], "trials");
+		rc = sweep_peak(tmp, gate, trials, 0, &run[SWEEP_LARGE]);
 	}
 	if (rc == CLI_OK) {
-		print_run(r, &run[1], "trials");
-		rc = trajectory_peak(tmp, gate, steps / 10 > 0 ? steps / 10 : 1, &run[2]);
+		print_run(r, &run[SWEEP_LARGE], "trials");
+		rc = trajectory_peak(tmp, gate, steps / 10 > 0 ? steps / 10 : 1, &run[TRAJ_SHORT]);
 	}
 	if (rc == CLI_OK) {
-		print_run(r, &run[2], "steps");
-		rc = trajectory_peak(tmp, gate, steps, &run[3]);
+		print_run(r, &run[TRAJ_SHORT], "steps");
+		rc = trajectory_peak(tmp, gate, steps, &run[TRAJ_LONG]);
 	}
 	if (rc == CLI_OK) {
-		print_run(r, &run[3], "steps");
-		rc = sweep_peak(tmp, gate, trials, 1, &run[4]);
+		print_run(r, &run[TRAJ_LONG], "steps");
+		rc = sweep_peak(tmp, gate, trials, 1, &run[TWIN]);
 	}
 	if (rc == CLI_OK) {
-		print_run(r, &run[4], "trials");
+		print_run(r, &run[TWIN], "trials");
+		rc = axis_peak(tmp, gate, AXIS_VALUES / 10, &run[AXIS_SMALL], NULL);
+	}
+	if (rc == CLI_OK) {
+		print_run(r, &run[AXIS_SMALL], "values");
+		rc = axis_peak(tmp, gate, AXIS_VALUES, &run[AXIS_LARGE], &run[REPLAY]);
+	}
+	char module[BSIM_PATH_MAX];
+	python_dir(module, sizeof module);
+#ifndef BSIM_PYTHON_EXECUTABLE
+	module[0] = '\0';
+#endif
+	if (rc == CLI_OK) {
+		print_run(r, &run[AXIS_LARGE], "values");
+		print_run(r, &run[REPLAY], "values");
+		if (module[0])
+			rc = python_peak(tmp, gate, module, PYTHON_TRIALS / 10, &run[PY_SMALL]);
+	}
+	if (rc == CLI_OK && module[0]) {
+		print_run(r, &run[PY_SMALL], "trials");
+		rc = python_peak(tmp, gate, module, PYTHON_TRIALS, &run[PY_LARGE]);
+		if (rc == CLI_OK)
+			print_run(r, &run[PY_LARGE], "trials");
+	}
+	if (rc == CLI_OK) {
 		fprintf(r,
 		        "\ngrowth: %.1f bytes per trial (the sweep), %.1f bytes per step (the "
 		        "trajectory and its twin);\nthe .mat twin of trials.csv: %.1f bytes per "
-		        "row\n",
-		        growth(&run[0], &run[1]), growth(&run[2], &run[3]),
-		        (run[4].rss - run[1].rss) / (double)run[1].size);
+		        "row; %.1f bytes per value of a grid axis",
+		        growth(&run[SWEEP_SMALL], &run[SWEEP_LARGE]),
+		        growth(&run[TRAJ_SHORT], &run[TRAJ_LONG]),
+		        (run[TWIN].rss - run[SWEEP_LARGE].rss) / (double)run[SWEEP_LARGE].size,
+		        growth(&run[AXIS_SMALL], &run[AXIS_LARGE]));
+		if (module[0])
+			fprintf(r, ";\n%.1f bytes per trial of a sweep from Python (NumPy columns)",
+			        growth(&run[PY_SMALL], &run[PY_LARGE]));
+		else
+			fputs(";\nno sweep from Python: no Python module beside this program", r);
+		fputc('\n', r);
 	}
 	tmp_remove(tmp);
 	if (rc == CLI_OK && a->json)
-		rc = write_json(a->json, run);
+		rc = write_json(a->json, run, module[0] != '\0');
 	return rc;
 }

@@ -65,9 +65,13 @@ static const cli_own bench_own[] = {
         [OWN_MEMORY] = {"memory", 0, NULL,
                         "instead: peak resident memory of a sweep of --trials\n"
                         "trials (default 2,000,000) and of a tenth of it (without\n"
-                        "and with the .mat twin of trials.csv), and of run\n"
-                        "--trajectory over 1,000,000 and 100,000 steps, each a\n"
-                        "child process; the growth per trial, per row and per step"},
+                        "and with the .mat twin of trials.csv), of run\n"
+                        "--trajectory over 1,000,000 and 100,000 steps, of sweep\n"
+                        "--grid with 20,000 and 2,000 values and the replay of\n"
+                        "its last group, and of a sweep from Python of 200,000\n"
+                        "and 20,000 trials (with the module built), each a child\n"
+                        "process; the growth per trial, per row, per step and\n"
+                        "per value"},
         [OWN_PAIRS] = {"pairs", 1, "N",
                        "after the --vs run, N pairs of one-thread runs of the\n"
                        "experiment, the two backends interleaved (default 5;\n"

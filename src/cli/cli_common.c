@@ -337,14 +337,12 @@ int cli_grid_add(cli_sets *s, const char *cmd, const char *text)
 	if (rc == CLI_OK)
 		rc = strchr(eq + 1, ':') ? grid_range(&a, cmd, text, eq + 1, buf)
 		                         : grid_list(&a, cmd, text, eq + 1, buf);
-	if (rc == CLI_OK && !(a.origins = calloc((size_t)a.n_values, sizeof *a.origins)))
-		rc = CLI_FAIL;
-	for (int i = 0; rc == CLI_OK && i < a.n_values; i++) {
-		a.origins[i] = malloc(n + sizeof "--grid ");
-		if (!a.origins[i])
+	/* One origin for the axis, "--grid KEY": a value's is made from it
+	 * when a message names it ("--grid KEY=VALUE"). */
+	if (rc == CLI_OK) {
+		snprintf(buf, n + 128, "--grid %s", a.key);
+		if (!(a.origin = strdup(buf)))
 			rc = CLI_FAIL;
-		else
-			snprintf(a.origins[i], n + sizeof "--grid ", "--grid %s", text);
 	}
 	free(buf);
 	int at = 0;

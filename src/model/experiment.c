@@ -104,10 +104,12 @@ static int walk_axis(const ydoc *d, struct fy_node *k, struct fy_node *v, bsim_g
 	int count = v && fy_node_is_sequence(v) ? fy_node_sequence_item_count(v) : 0;
 	if (count == 0)
 		return ydoc_expected(d, v, k, field, "a non-empty list of values", err);
+	/* The file is said once for the axis, each value by its line. */
 	a->key = dup_text(name);
+	a->origin = dup_text(d->path);
 	a->values = calloc((size_t)count, sizeof *a->values);
-	a->origins = calloc((size_t)count, sizeof *a->origins);
-	if (!a->key || !a->values || !a->origins)
+	a->lines = calloc((size_t)count, sizeof *a->lines);
+	if (!a->key || !a->origin || !a->values || !a->lines)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
 	for (int i = 0; i < count; i++) {
 		struct fy_node *item = fy_node_sequence_get_by_index(v, i);
@@ -118,9 +120,9 @@ static int walk_axis(const ydoc *d, struct fy_node *k, struct fy_node *v, bsim_g
 			return ydoc_expected(d, item, k, f, "a scalar value", err);
 		}
 		a->values[i] = ydoc_flow_text(item);
-		a->origins[i] = value_origin(d, item, k);
+		a->lines[i] = ydoc_line(item, k);
 		a->n_values = i + 1;
-		if (!a->values[i] || !a->origins[i])
+		if (!a->values[i])
 			return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
 	}
 	return BSIM_OK;
@@ -223,31 +225,61 @@ static int walk_experiment(const ydoc *d, int has_seed, bsim_experiment *e, bsim
 
 void bsim_experiment_axis_free(bsim_grid_axis *ax)
 {
-	for (int i = 0; i < ax->n_values; i++) {
+	for (int i = 0; ax->values && i < ax->n_values; i++)
 		free(ax->values[i]);
-		if (ax->origins)
-			free(ax->origins[i]);
-	}
 	free(ax->key);
 	free(ax->values);
-	free(ax->origins);
+	free(ax->origin);
+	free(ax->lines);
 	memset(ax, 0, sizeof *ax);
 }
 
-/* A copy of from into to (which holds nothing). */
+int bsim_experiment_value_origin(const bsim_grid_axis *ax, int i, char *buf, size_t size)
+{
+	if (ax->origin && ax->lines)
+		return snprintf(buf, size, "%s:%d", ax->origin, ax->lines[i]);
+	if (ax->origin)
+		return snprintf(buf, size, "%s=%s", ax->origin, ax->values[i]);
+	return snprintf(buf, size, "--grid %s=%s", ax->key, ax->values[i]);
+}
+
+void bsim_experiment_axis_origin(const bsim_grid_axis *ax, char *buf, size_t size)
+{
+	if (ax->origin && ax->lines && ax->n_values > 0)
+		snprintf(buf, size, "%s:%d", ax->origin, ax->lines[0]);
+	else if (ax->origin)
+		snprintf(buf, size, "%s", ax->origin);
+	else
+		snprintf(buf, size, "--grid %s", ax->key);
+}
+
+/* 1 if ax was given on the command line (or by a program as an option),
+ * not in the experiment file. */
+static int axis_from_option(const bsim_grid_axis *ax)
+{
+	return !ax->origin || strncmp(ax->origin, "--", 2) == 0;
+}
+
+/* A copy of from into to (which holds nothing): its values, and its origin
+ * once. */
 static int axis_copy(bsim_grid_axis *to, const bsim_grid_axis *from)
 {
 	size_t n = (size_t)(from->n_values > 0 ? from->n_values : 1);
 	to->key = dup_text(from->key);
 	to->values = calloc(n, sizeof *to->values);
-	to->origins = calloc(n, sizeof *to->origins);
-	if (!to->key || !to->values || !to->origins)
+	if (!to->key || !to->values)
 		return -1;
+	if (from->origin && !(to->origin = dup_text(from->origin)))
+		return -1;
+	if (from->lines) {
+		if (!(to->lines = malloc(n * sizeof *to->lines)))
+			return -1;
+		memcpy(to->lines, from->lines, (size_t)from->n_values * sizeof *to->lines);
+	}
 	for (int i = 0; i < from->n_values; i++) {
 		to->values[i] = dup_text(from->values[i]);
-		to->origins[i] = dup_text(from->origins[i] ? from->origins[i] : "--grid");
 		to->n_values = i + 1;
-		if (!to->values[i] || !to->origins[i])
+		if (!to->values[i])
 			return -1;
 	}
 	return 0;
@@ -269,13 +301,11 @@ static int apply_grid(bsim_experiment *e, const bsim_grid_axis *grid, int n_grid
 {
 	for (int k = 0; k < n_grid; k++) {
 		const bsim_grid_axis *g = &grid[k];
-		if (!g->key || !g->key[0] || g->n_values < 1)
+		if (!g->key || !g->key[0] || g->n_values < 1 || !g->values)
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      "%s: expected a dotted scene key with a non-empty "
 			                      "list of values",
-			                      g->n_values > 0 && g->origins && g->origins[0]
-			                              ? g->origins[0]
-			                              : "--grid");
+			                      g->origin ? g->origin : "--grid");
 		int a = 0;
 		while (a < e->n_axes && strcmp(e->axes[a].key, g->key) != 0)
 			a++;
@@ -321,14 +351,17 @@ static int check_counts(const ydoc *d, bsim_experiment *e, int n_grid, bsim_erro
 		char hint[160];
 		bsim_limits_hint(hint, sizeof hint, "groups", limit);
 		if (n_grid > 0) {
-			/* the options that made the grid this large, as given */
+			/* the options that made the grid this large, with their
+			 * counts */
 			char given[512] = "";
 			for (int k = 0; k < e->n_axes; k++) {
-				const char *o = e->axes[k].origins[0];
+				const bsim_grid_axis *ax = &e->axes[k];
+				char o[256];
 				size_t at = strlen(given);
-				if (o && strncmp(o, "--", 2) == 0)
-					snprintf(given + at, sizeof given - at, "%s%s",
-					         at ? ", " : "", o);
+				bsim_experiment_axis_origin(ax, o, sizeof o);
+				if (axis_from_option(ax) && at < sizeof given)
+					snprintf(given + at, sizeof given - at, "%s%s (%d values)",
+					         at ? ", " : "", o, ax->n_values);
 			}
 			return bsim_error_set(
 			        err, BSIM_EINPUT,
@@ -373,24 +406,47 @@ void bsim_experiment_group_index(const bsim_experiment *e, int g, int *idx)
 	}
 }
 
-/* set, then extra (the command line), then the group's grid values: later
- * overrides win. The strings are borrowed from e and extra. */
+/* set, then extra (the command line), then the grid values of index idx:
+ * later overrides win. The keys and values are borrowed from e and extra;
+ * the grid values' origins are made here, after the array in the same
+ * allocation, so that an axis holds one origin for all its values. */
 static bsim_override *group_overrides(const bsim_experiment *e, const int *idx,
                                       const bsim_override *extra, int n_extra, int *n)
 {
 	*n = e->n_set + n_extra + e->n_axes;
-	bsim_override *ov = malloc((size_t)(*n ? *n : 1) * sizeof *ov);
+	size_t head = (size_t)(*n ? *n : 1) * sizeof(bsim_override), text = 0;
+	for (int a = 0; a < e->n_axes; a++)
+		text += (size_t)bsim_experiment_value_origin(&e->axes[a], idx[a], NULL, 0) + 1;
+	bsim_override *ov = malloc(head + text);
 	if (!ov)
 		return NULL;
 	for (int i = 0; i < e->n_set; i++)
 		ov[i] = e->set[i];
 	for (int i = 0; i < n_extra; i++)
 		ov[e->n_set + i] = extra[i];
+	char *at = (char *)ov + head;
 	for (int a = 0; a < e->n_axes; a++) {
 		const bsim_grid_axis *ax = &e->axes[a];
-		ov[e->n_set + n_extra + a] =
-		        (bsim_override){ax->key, ax->values[idx[a]], ax->origins[idx[a]]};
+		size_t len = (size_t)bsim_experiment_value_origin(ax, idx[a], at, text) + 1;
+		ov[e->n_set + n_extra + a] = (bsim_override){ax->key, ax->values[idx[a]], at};
+		at += len;
+		text -= len;
 	}
+	return ov;
+}
+
+bsim_override *bsim_experiment_group_overrides(const bsim_experiment *e, int g,
+                                               const bsim_override *extra, int n_extra, int *n)
+{
+	*n = 0;
+	if (g < 0 || g >= e->n_groups)
+		return NULL;
+	int *idx = malloc((size_t)(e->n_axes ? e->n_axes : 1) * sizeof *idx);
+	if (!idx)
+		return NULL;
+	bsim_experiment_group_index(e, g, idx);
+	bsim_override *ov = group_overrides(e, idx, extra, n_extra, n);
+	free(idx);
 	return ov;
 }
 
@@ -463,6 +519,8 @@ static int check_conflicts(const bsim_experiment *e, const bsim_override *extra,
 {
 	for (int a = 0; a < e->n_axes; a++) {
 		const bsim_grid_axis *ax = &e->axes[a];
+		char where[256];
+		bsim_experiment_axis_origin(ax, where, sizeof where);
 		for (int i = 0; i < e->n_set; i++)
 			if (key_within(e->set[i].key, ax->key))
 				return bsim_error_set(
@@ -470,7 +528,7 @@ static int check_conflicts(const bsim_experiment *e, const bsim_override *extra,
 				        "%s: set.%s: the grid varies %s (%s), which would "
 				        "overwrite it in every group; expected a key the "
 				        "grid does not vary",
-				        e->set[i].origin, e->set[i].key, ax->key, ax->origins[0]);
+				        e->set[i].origin, e->set[i].key, ax->key, where);
 		for (int i = 0; i < n_extra; i++)
 			if (key_within(extra[i].key, ax->key))
 				return bsim_error_set(
@@ -480,7 +538,7 @@ static int check_conflicts(const bsim_experiment *e, const bsim_override *extra,
 				        "the grid does not vary (to run one value, give "
 				        "--grid %s=VALUE)",
 				        extra[i].origin ? extra[i].origin : extra[i].key, ax->key,
-				        ax->origins[0], ax->key);
+				        where, ax->key);
 	}
 	return BSIM_OK;
 }

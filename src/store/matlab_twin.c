@@ -4,8 +4,8 @@
  * in an arena or the table's columns, freed after the write. A CSV table
  * is read as a stream into the arrays written (a twin may be of a million
  * rows); JSON is read with libfyaml (JSON is YAML), the reader of every
- * other beamsim input; a number is a plain scalar that reads as one, so a
- * quoted "7" stays text. */
+ * other beamsim input, as events into a compact tree of its own; a number
+ * is a plain scalar that reads as one, so a quoted "7" stays text. */
 #define _POSIX_C_SOURCE 200809L
 #include "store/matlab.h"
 
@@ -22,32 +22,56 @@
 
 /* ---- an arena of allocations freed together -------------------------- */
 
+/* Small allocations are cut from blocks of ARENA_BLOCK bytes (a JSON
+ * file's tree is millions of them), larger ones are their own. */
+#define ARENA_BLOCK 65536
+
 typedef struct arena {
 	void **p;
 	int n, cap;
 	int oom;
+	char *block; /* the block being cut */
+	size_t used;
 } arena;
 
-static void *arena_alloc(arena *a, size_t size)
+/* m kept, to be freed with the arena; m or NULL. */
+static void *arena_keep(arena *a, void *m)
 {
-	if (a->oom)
+	if (!m || a->oom) {
+		free(m);
+		a->oom = 1;
 		return NULL;
+	}
 	if (a->n == a->cap) {
 		int cap = a->cap ? 2 * a->cap : 64;
 		void **p = realloc(a->p, (size_t)cap * sizeof *p);
 		if (!p) {
+			free(m);
 			a->oom = 1;
 			return NULL;
 		}
 		a->p = p;
 		a->cap = cap;
 	}
-	void *m = calloc(1, size ? size : 1);
-	if (!m) {
-		a->oom = 1;
-		return NULL;
-	}
 	a->p[a->n++] = m;
+	return m;
+}
+
+/* size zeroed bytes, aligned for any type. */
+static void *arena_alloc(arena *a, size_t size)
+{
+	if (a->oom)
+		return NULL;
+	size = (size + 15) & ~(size_t)15;
+	if (size == 0 || size > ARENA_BLOCK / 8)
+		return arena_keep(a, calloc(1, size ? size : 1));
+	if (!a->block || a->used + size > ARENA_BLOCK) {
+		if (!(a->block = arena_keep(a, calloc(1, ARENA_BLOCK))))
+			return NULL;
+		a->used = 0;
+	}
+	void *m = a->block + a->used;
+	a->used += size;
 	return m;
 }
 
@@ -443,69 +467,261 @@ int bsim_matlab_from_csv(const char *csv_path, const char *mat_path, const char 
 
 /* ---- JSON -------------------------------------------------------------- */
 
+/* A JSON file is read as libfyaml's events (ydoc_events_own) into a tree
+ * of its own, 40 bytes a value, with each distinct string (key or value)
+ * kept once: libfyaml's document of the same file costs about 44 bytes a
+ * byte of JSON (summary.json of a 20,000-group sweep, 8 MB, would take
+ * 360 MB), the tree about 4. The file's text is kept beside it, to give
+ * a list or object that lands in a text column its flow text. */
+
 enum { J_NUMBER, J_STRING, J_MAP, J_SEQ, J_ABSENT };
 
-/* What a node is; a number (true, false and null too) goes to *v. */
-static int json_kind(struct fy_node *n, double *v)
+typedef struct jnode {
+	int kind; /* J_NUMBER, J_STRING, J_MAP or J_SEQ */
+	int n;    /* a list's items, an object's pairs */
+	union {
+		double v;     /* a number's value (true 1, false 0, null NaN) */
+		size_t start; /* a collection's offset in the file's text */
+	} u;
+	union {
+		const char *text; /* a scalar's text (interned) */
+		size_t end;       /* a collection's end offset in the text */
+	} w;
+	struct jnode **kids; /* a list's items, an object's values */
+	const char **keys;   /* an object's keys (interned) */
+} jnode;
+
+/* An open list or object while the events come: its node and its
+ * children so far. */
+typedef struct jopen {
+	jnode *node;
+	jnode **kids;
+	const char **keys;
+	int n, cap;
+	const char *key; /* an object's key awaiting its value */
+} jopen;
+
+typedef struct jtree {
+	arena a;
+	intern in;
+	const char *text; /* the file's text, for the flow text of collections */
+	jnode *root;
+	jopen *open;
+	int depth, cap;
+} jtree;
+
+/* What a scalar is, as YAML reads JSON: a plain number, true, false and
+ * null are numbers; anything else (a quoted "7" too) is text. */
+static int scalar_kind(const char *t, int plain, double *v)
 {
-	if (!n)
-		return J_ABSENT;
-	if (fy_node_is_mapping(n))
-		return J_MAP;
-	if (fy_node_is_sequence(n))
-		return J_SEQ;
-	const char *p = ydoc_plain(n);
-	if (p && ydoc_number(n, v) == YDOC_NUM_OK)
+	if (!plain)
+		return J_STRING;
+	if (ydoc_number_text(t, v) == YDOC_NUM_OK)
 		return J_NUMBER;
-	if (p && (strcmp(p, "true") == 0 || strcmp(p, "false") == 0)) {
-		*v = p[0] == 't';
+	if (strcmp(t, "true") == 0 || strcmp(t, "false") == 0) {
+		*v = t[0] == 't';
 		return J_NUMBER;
 	}
-	if (p && strcmp(p, "null") == 0) {
+	if (strcmp(t, "null") == 0) {
 		*v = NAN;
 		return J_NUMBER;
 	}
 	return J_STRING;
 }
 
-static const char *json_text(arena *a, struct fy_node *n)
+static int jopen_add(jopen *o, jnode *kid, const char *key)
+{
+	if (o->n == o->cap) {
+		int cap = o->cap ? 2 * o->cap : 8;
+		jnode **k = realloc(o->kids, (size_t)cap * sizeof *k);
+		if (k)
+			o->kids = k;
+		const char **ks = k && o->node->kind == J_MAP
+		                          ? realloc(o->keys, (size_t)cap * sizeof *ks)
+		                          : o->keys;
+		if (!k || (o->node->kind == J_MAP && !ks))
+			return -1;
+		o->keys = ks;
+		o->cap = cap;
+	}
+	o->kids[o->n] = kid;
+	if (o->node->kind == J_MAP)
+		o->keys[o->n] = key;
+	o->n++;
+	return 0;
+}
+
+static const char *json_text(jtree *t, const jnode *n);
+
+/* A finished value into its list or object (or the root). In an object
+ * awaiting a key it is the key: its text, kept once (a list or object as
+ * a key, which beamsim never writes, by its flow text). */
+static int jtree_place(jtree *t, jnode *node)
+{
+	if (t->depth == 0) {
+		t->root = node;
+		return 0;
+	}
+	jopen *o = &t->open[t->depth - 1];
+	if (o->node->kind == J_SEQ)
+		return jopen_add(o, node, NULL);
+	if (!o->key) {
+		const char *text = json_text(t, node);
+		o->key = text ? intern_str(&t->a, &t->in, text) : NULL;
+		return o->key ? 0 : -1;
+	}
+	const char *key = o->key;
+	o->key = NULL;
+	return jopen_add(o, node, key);
+}
+
+/* One event into the tree; -1 if out of memory. */
+static int jtree_add(jtree *t, struct fy_event *ev)
+{
+	if (ev->type == FYET_SCALAR) {
+		size_t len = 0;
+		const char *s = fy_token_get_text(ev->scalar.value, &len);
+		char *z = malloc(len + 1);
+		if (!z)
+			return -1;
+		memcpy(z, s ? s : "", len);
+		z[len] = '\0';
+		const char *kept = intern_str(&t->a, &t->in, z);
+		int plain = fy_token_scalar_style(ev->scalar.value) == FYSS_PLAIN;
+		free(z);
+		if (!kept)
+			return -1;
+		jnode *n = arena_alloc(&t->a, sizeof *n);
+		if (!n)
+			return -1;
+		n->kind = scalar_kind(kept, plain, &n->u.v);
+		n->w.text = kept;
+		return jtree_place(t, n);
+	}
+	if (ev->type == FYET_SEQUENCE_START || ev->type == FYET_MAPPING_START) {
+		if (t->depth == t->cap) {
+			int cap = t->cap ? 2 * t->cap : 16;
+			jopen *o = realloc(t->open, (size_t)cap * sizeof *o);
+			if (!o)
+				return -1;
+			t->open = o;
+			t->cap = cap;
+		}
+		jnode *n = arena_alloc(&t->a, sizeof *n);
+		if (!n)
+			return -1;
+		int seq = ev->type == FYET_SEQUENCE_START;
+		struct fy_token *tok =
+		        seq ? ev->sequence_start.sequence_start : ev->mapping_start.mapping_start;
+		const struct fy_mark *m = tok ? fy_token_start_mark(tok) : NULL;
+		n->kind = seq ? J_SEQ : J_MAP;
+		n->u.start = m ? m->input_pos : 0;
+		t->open[t->depth++] = (jopen){.node = n};
+		return 0;
+	}
+	if (ev->type == FYET_SEQUENCE_END || ev->type == FYET_MAPPING_END) {
+		jopen *o = &t->open[--t->depth];
+		jnode *n = o->node;
+		struct fy_token *tok = ev->type == FYET_SEQUENCE_END ? ev->sequence_end.sequence_end
+		                                                     : ev->mapping_end.mapping_end;
+		const struct fy_mark *m = tok ? fy_token_end_mark(tok) : NULL;
+		n->w.end = m ? m->input_pos : n->u.start;
+		n->n = o->n;
+		size_t bytes = (size_t)(o->n ? o->n : 1) * sizeof(void *);
+		n->kids = arena_alloc(&t->a, bytes);
+		n->keys = n->kind == J_MAP ? arena_alloc(&t->a, bytes) : NULL;
+		int rc = !n->kids || (n->kind == J_MAP && !n->keys) ? -1 : 0;
+		if (!rc && o->n) {
+			memcpy(n->kids, o->kids, (size_t)o->n * sizeof *n->kids);
+			if (n->keys)
+				memcpy(n->keys, o->keys, (size_t)o->n * sizeof *n->keys);
+		}
+		free(o->kids);
+		free(o->keys);
+		return rc ? rc : jtree_place(t, n);
+	}
+	return 0;
+}
+
+static int jtree_event(void *user, struct fy_event *ev, const char *text, bsim_error *err)
+{
+	jtree *t = user;
+	t->text = text;
+	if (jtree_add(t, ev) != 0)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	return BSIM_OK;
+}
+
+static void jtree_free(jtree *t)
+{
+	for (int i = 0; i < t->depth; i++) {
+		free(t->open[i].kids);
+		free(t->open[i].keys);
+	}
+	free(t->open);
+	free(t->in.slot);
+	arena_free(&t->a);
+	memset(t, 0, sizeof *t);
+}
+
+static int json_kind(const jnode *n, double *v)
+{
+	if (!n)
+		return J_ABSENT;
+	if (n->kind == J_NUMBER)
+		*v = n->u.v;
+	return n->kind;
+}
+
+/* A node's text: a scalar's own; a list's or object's flow text on one
+ * line, as libfyaml writes the node read from the file's text. */
+static const char *json_text(jtree *t, const jnode *n)
 {
 	if (!n)
 		return "";
-	if (fy_node_is_scalar(n)) {
-		size_t len;
-		const char *s = fy_node_get_scalar(n, &len);
-		return s ? arena_strdup(a, s, len) : "";
-	}
-	char *flow = ydoc_flow_text(n);
-	const char *s = flow ? arena_strdup(a, flow, strlen(flow)) : NULL;
+	if (n->kind == J_NUMBER || n->kind == J_STRING)
+		return n->w.text;
+	struct fy_document *d =
+	        fy_document_build_from_string(NULL, t->text + n->u.start, n->w.end - n->u.start);
+	char *flow = d ? ydoc_flow_text(fy_document_root(d)) : NULL;
+	const char *s = flow ? arena_strdup(&t->a, flow, strlen(flow)) : NULL;
 	free(flow);
+	if (d)
+		fy_document_destroy(d);
 	return s;
 }
 
-static int json_value(arena *a, struct fy_node *n, const char *name, bsim_mat_field *out);
-static int json_column(arena *a, struct fy_node **nodes, size_t n, const char *name,
+/* The value of key in object n (keys are interned: one pointer each), NULL
+ * if n is no object or has none. */
+static const jnode *json_lookup(const jnode *n, const char *key)
+{
+	for (int i = 0; n && n->kind == J_MAP && i < n->n; i++)
+		if (n->keys[i] == key)
+			return n->kids[i];
+	return NULL;
+}
+
+static int json_value(jtree *t, const jnode *n, const char *name, bsim_mat_field *out);
+static int json_column(jtree *t, const jnode **nodes, size_t n, const char *name,
                        bsim_mat_field *out);
 
-/* Keys of the mappings among nodes, in order of first appearance. */
-static int map_keys(arena *a, struct fy_node **nodes, size_t n, const char ***keys)
+/* Keys of the objects among nodes, in order of first appearance. */
+static int map_keys(jtree *t, const jnode **nodes, size_t n, const char ***keys)
 {
 	int cap = 8, k = 0;
-	const char **out = arena_alloc(a, (size_t)cap * sizeof *out);
+	const char **out = arena_alloc(&t->a, (size_t)cap * sizeof *out);
 	for (size_t i = 0; out && i < n; i++) {
-		if (!nodes[i] || !fy_node_is_mapping(nodes[i]))
+		if (!nodes[i] || nodes[i]->kind != J_MAP)
 			continue;
-		void *it = NULL;
-		struct fy_node_pair *p;
-		while ((p = fy_node_mapping_iterate(nodes[i], &it)) != NULL) {
-			const char *key = json_text(a, fy_node_pair_key(p));
+		for (int p = 0; p < nodes[i]->n; p++) {
+			const char *key = nodes[i]->keys[p];
 			int seen = 0;
-			for (int j = 0; key && j < k && !seen; j++)
-				seen = strcmp(out[j], key) == 0;
-			if (!key || seen)
+			for (int j = 0; j < k && !seen; j++)
+				seen = out[j] == key;
+			if (seen)
 				continue;
 			if (k == cap) {
-				const char **o = arena_alloc(a, (size_t)cap * 2 * sizeof *o);
+				const char **o = arena_alloc(&t->a, (size_t)cap * 2 * sizeof *o);
 				if (!o)
 					return -1;
 				memcpy(o, out, (size_t)cap * sizeof *o);
@@ -519,24 +735,22 @@ static int map_keys(arena *a, struct fy_node **nodes, size_t n, const char ***ke
 	return out ? k : -1;
 }
 
-/* nodes[i] (mappings or absent) as a struct of n-row columns. */
-static int json_table(arena *a, struct fy_node **nodes, size_t n, const char *name,
+/* nodes[i] (objects or absent) as a struct of n-row columns. */
+static int json_table(jtree *t, const jnode **nodes, size_t n, const char *name,
                       bsim_mat_field *out)
 {
 	const char **keys;
-	int k = map_keys(a, nodes, n, &keys);
+	int k = map_keys(t, nodes, n, &keys);
 	if (k < 0)
 		return -1;
-	bsim_mat_field *f = arena_alloc(a, (size_t)k * sizeof *f);
-	struct fy_node **col = arena_alloc(a, n * sizeof *col);
+	bsim_mat_field *f = arena_alloc(&t->a, (size_t)k * sizeof *f);
+	const jnode **col = arena_alloc(&t->a, n * sizeof *col);
 	if (!f || !col)
 		return -1;
 	for (int j = 0; j < k; j++) {
 		for (size_t i = 0; i < n; i++)
-			col[i] = nodes[i] && fy_node_is_mapping(nodes[i])
-			                 ? fy_node_mapping_lookup_by_string(nodes[i], keys[j], -1)
-			                 : NULL;
-		if (json_column(a, col, n, mat_ident(a, keys[j]), &f[j]) != 0)
+			col[i] = json_lookup(nodes[i], keys[j]);
+		if (json_column(t, col, n, mat_ident(&t->a, keys[j]), &f[j]) != 0)
 			return -1;
 	}
 	*out = bsim_mat_struct(name, f, k);
@@ -544,21 +758,18 @@ static int json_table(arena *a, struct fy_node **nodes, size_t n, const char *na
 }
 
 /* Length of a list of numbers, -1 if n is anything else. */
-static int number_list(struct fy_node *n)
+static int number_list(const jnode *n)
 {
-	if (!n || !fy_node_is_sequence(n))
+	if (!n || n->kind != J_SEQ)
 		return -1;
-	int len = fy_node_sequence_item_count(n);
-	for (int i = 0; i < len; i++) {
-		double v;
-		if (json_kind(fy_node_sequence_get_by_index(n, i), &v) != J_NUMBER)
+	for (int i = 0; i < n->n; i++)
+		if (n->kids[i]->kind != J_NUMBER)
 			return -1;
-	}
-	return len;
+	return n->n;
 }
 
 /* One value per row: numbers, text, nested tables or rows of a matrix. */
-static int json_column(arena *a, struct fy_node **nodes, size_t n, const char *name,
+static int json_column(jtree *t, const jnode **nodes, size_t n, const char *name,
                        bsim_mat_field *out)
 {
 	int numbers = 1, maps = 1, width = -2;
@@ -575,7 +786,7 @@ static int json_column(arena *a, struct fy_node **nodes, size_t n, const char *n
 	if (!name)
 		return -1;
 	if (numbers) {
-		double *v = arena_alloc(a, n * sizeof *v);
+		double *v = arena_alloc(&t->a, n * sizeof *v);
 		if (!v)
 			return -1;
 		for (size_t i = 0; i < n; i++)
@@ -585,39 +796,36 @@ static int json_column(arena *a, struct fy_node **nodes, size_t n, const char *n
 		return 0;
 	}
 	if (maps)
-		return json_table(a, nodes, n, name, out);
+		return json_table(t, nodes, n, name, out);
 	if (width > 0) {
-		double *m = arena_alloc(a, n * (size_t)width * sizeof *m);
+		double *m = arena_alloc(&t->a, n * (size_t)width * sizeof *m);
 		if (!m)
 			return -1;
 		for (size_t i = 0; i < n; i++)
-			for (int j = 0; j < width; j++) {
-				double v = NAN;
-				if (nodes[i])
-					json_kind(fy_node_sequence_get_by_index(nodes[i], j), &v);
-				m[(size_t)j * n + i] = v; /* column-major */
-			}
+			for (int j = 0; j < width; j++)
+				m[(size_t)j * n + i] =
+				        nodes[i] ? nodes[i]->kids[j]->u.v : NAN; /* column-major */
 		*out = bsim_mat_matrix(name, m, n, (size_t)width);
 		return 0;
 	}
-	const char **s = arena_alloc(a, n * sizeof *s);
+	const char **s = arena_alloc(&t->a, n * sizeof *s);
 	if (!s)
 		return -1;
 	for (size_t i = 0; i < n; i++)
-		if (!(s[i] = json_text(a, nodes[i])))
+		if (!(s[i] = json_text(t, nodes[i])))
 			return -1;
 	*out = bsim_mat_strings(name, s, n);
 	return 0;
 }
 
-static int json_value(arena *a, struct fy_node *n, const char *name, bsim_mat_field *out)
+static int json_value(jtree *t, const jnode *n, const char *name, bsim_mat_field *out)
 {
 	double v;
 	if (!name)
 		return -1;
 	switch (json_kind(n, &v)) {
 	case J_NUMBER: {
-		double *d = arena_alloc(a, sizeof *d);
+		double *d = arena_alloc(&t->a, sizeof *d);
 		if (!d)
 			return -1;
 		*d = v;
@@ -625,43 +833,31 @@ static int json_value(arena *a, struct fy_node *n, const char *name, bsim_mat_fi
 		return 0;
 	}
 	case J_MAP: {
-		int k = fy_node_mapping_item_count(n);
-		bsim_mat_field *f = arena_alloc(a, (size_t)k * sizeof *f);
+		bsim_mat_field *f = arena_alloc(&t->a, (size_t)n->n * sizeof *f);
 		if (!f)
 			return -1;
-		void *it = NULL;
-		struct fy_node_pair *p;
-		int j = 0;
-		while ((p = fy_node_mapping_iterate(n, &it)) != NULL && j < k) {
-			const char *key = json_text(a, fy_node_pair_key(p));
-			if (!key || json_value(a, fy_node_pair_value(p), mat_ident(a, key), &f[j]))
+		for (int j = 0; j < n->n; j++)
+			if (json_value(t, n->kids[j], mat_ident(&t->a, n->keys[j]), &f[j]))
 				return -1;
-			j++;
-		}
-		*out = bsim_mat_struct(name, f, j);
+		*out = bsim_mat_struct(name, f, n->n);
 		return 0;
 	}
 	case J_SEQ: {
-		size_t len = (size_t)fy_node_sequence_item_count(n);
-		struct fy_node **items = arena_alloc(a, (len ? len : 1) * sizeof *items);
-		if (!items)
-			return -1;
-		for (size_t i = 0; i < len; i++)
-			items[i] = fy_node_sequence_get_by_index(n, (int)i);
+		size_t len = (size_t)n->n;
 		if (number_list(n) >= 0) { /* a row, as MATLAB writes [1 2 3] */
-			double *d = arena_alloc(a, (len ? len : 1) * sizeof *d);
+			double *d = arena_alloc(&t->a, (len ? len : 1) * sizeof *d);
 			if (!d)
 				return -1;
 			for (size_t i = 0; i < len; i++)
-				json_kind(items[i], &d[i]);
+				d[i] = n->kids[i]->u.v;
 			*out = bsim_mat_matrix(name, d, len ? 1 : 0, len);
 			return 0;
 		}
-		return json_column(a, items, len, name, out);
+		return json_column(t, (const jnode **)n->kids, len, name, out);
 	}
 	default: {
-		const char **s = arena_alloc(a, sizeof *s);
-		if (!s || !(s[0] = json_text(a, n)))
+		const char **s = arena_alloc(&t->a, sizeof *s);
+		if (!s || !(s[0] = json_text(t, n)))
 			return -1;
 		*out = bsim_mat_string(name, s);
 		return 0;
@@ -672,18 +868,19 @@ static int json_value(arena *a, struct fy_node *n, const char *name, bsim_mat_fi
 int bsim_matlab_from_json(const char *json_path, const char *mat_path, const char *var,
                           bsim_error *err)
 {
-	ydoc d;
-	int rc = ydoc_load_own(&d, json_path, err);
-	if (rc)
-		return rc;
-	arena a = {0};
+	jtree t;
+	memset(&t, 0, sizeof t);
+	char *text = NULL;
+	int rc = ydoc_events_own(json_path, jtree_event, &t, &text, err);
+	t.text = text;
 	bsim_mat_field f;
-	if (json_value(&a, fy_document_root(d.fyd), var, &f) != 0)
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %s", mat_path);
-	else
-		rc = bsim_mat_write(mat_path, &f, 1, err);
-	arena_free(&a);
-	ydoc_free(&d);
+	/* An empty file has no value: its twin holds an empty string. */
+	if (rc == BSIM_OK)
+		rc = json_value(&t, t.root, var, &f) != 0
+		             ? bsim_error_set(err, BSIM_EFAIL, "out of memory for %s", mat_path)
+		             : bsim_mat_write(mat_path, &f, 1, err);
+	jtree_free(&t);
+	free(text);
 	return rc;
 }
 

@@ -417,6 +417,21 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 	return trials_csv_commit(&w, err);
 }
 
+int bsim_output_trials_fit(const bsim_experiment *e, long trials, double cell_bytes,
+                           bsim_error *err)
+{
+	double rows = (double)e->n_groups * (double)(trials > 0 ? trials : e->trials);
+	int columns = TRIALS_N_COLUMNS + e->n_axes;
+	double need = rows * columns * cell_bytes, have = bsim_memory_available();
+	if (need <= have)
+		return BSIM_OK;
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "%s: expected trials that fit in memory as columns: %.15g trials "
+	                      "x %d columns x %.15g bytes = %.3g GB, and %.3g GB is available "
+	                      "(beamsim sweep writes trials.csv without holding it)",
+	                      e->path, rows, columns, cell_bytes, need / 1e9, have / 1e9);
+}
+
 /* ---- the p_traverse table ------------------------------------------------ */
 
 /* Where each group sits in the tables: cell[(rest * n1 + i1) * n0 + i0] is

@@ -80,24 +80,17 @@ static int group_build(bsim_replay *r, const bsim_experiment *e, const bsim_over
 	int rc = bsim_experiment_group_scene(e, (int)r->group, extra, n_extra, &r->scene, err);
 	if (rc != BSIM_OK)
 		return rc ? rc : BSIM_EINPUT;
-	int n = e->n_set + n_extra + e->n_axes;
 	int *idx = calloc((size_t)(e->n_axes ? e->n_axes : 1), sizeof *idx);
-	r->ov_owned = calloc((size_t)(n ? n : 1), sizeof *r->ov_owned);
+	r->ov_owned = bsim_experiment_group_overrides(e, (int)r->group, extra, n_extra, &r->n_ov);
 	if (!idx || !r->ov_owned) {
 		free(idx);
 		bsim_scene_free(&r->scene);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	bsim_experiment_group_index(e, (int)r->group, idx);
-	for (int i = 0; i < e->n_set; i++)
-		r->ov_owned[r->n_ov++] = e->set[i];
-	for (int i = 0; i < n_extra; i++)
-		r->ov_owned[r->n_ov++] = extra[i];
 	int len = snprintf(r->grid, sizeof r->grid, "group %ld:", r->group);
 	for (int a = 0; a < e->n_axes; a++) {
 		const bsim_grid_axis *ax = &e->axes[a];
-		r->ov_owned[r->n_ov++] =
-		        (bsim_override){ax->key, ax->values[idx[a]], ax->origins[idx[a]]};
 		if (len >= 0 && (size_t)len < sizeof r->grid)
 			len += snprintf(r->grid + len, sizeof r->grid - (size_t)len, "%s %s=%s",
 			                a ? "," : "", ax->key, ax->values[idx[a]]);

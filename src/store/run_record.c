@@ -66,11 +66,14 @@ static void experiment_body(FILE *f, const bsim_experiment *e, const bsim_overri
 		for (int i = 0; i < e->axes[a].n_values; i++)
 			fprintf(f, "%s%s", i ? ", " : "", e->axes[a].values[i]);
 		/* an axis of the command line says so, as a --set does */
-		const char *origin = e->axes[a].origins[0];
-		if (origin && strncmp(origin, "--", 2) == 0)
-			fprintf(f, "]  # %s\n", origin);
-		else
+		const char *origin = e->axes[a].origin;
+		if (!origin || strncmp(origin, "--", 2) == 0) {
+			char where[256];
+			bsim_experiment_axis_origin(&e->axes[a], where, sizeof where);
+			fprintf(f, "]  # %s\n", where);
+		} else {
 			fputs("]\n", f);
+		}
 	}
 }
 

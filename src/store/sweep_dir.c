@@ -193,6 +193,11 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	                               e, err);
 	if (rc != BSIM_OK)
 		return rc;
+	if (def->hold_cell_bytes > 0 &&
+	    bsim_output_trials_fit(e, 0, def->hold_cell_bytes, err) != BSIM_OK) {
+		bsim_experiment_free(e);
+		return BSIM_EINPUT;
+	}
 	bsim_run_record rec;
 	const bsim_options *opts = &def->opts;
 	bsim_run_record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL);

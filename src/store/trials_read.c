@@ -76,46 +76,6 @@ static int column_index(const char *s)
 	return -1;
 }
 
-/* Splits one CSV line in place into at most max fields (RFC 4180 quoting:
- * "a,""b""" is the field a,"b"). Returns the number of fields, -1 on a
- * malformed quote. */
-static int csv_split(char *line, char **field, int max)
-{
-	int n = 0;
-	char *r = line, *w = line;
-	while (n < max) {
-		field[n++] = w;
-		if (*r == '"') {
-			r++;
-			while (1) {
-				if (*r == '\0')
-					return -1;
-				if (*r == '"' && r[1] == '"') {
-					*w++ = '"';
-					r += 2;
-				} else if (*r == '"') {
-					r++;
-					break;
-				} else {
-					*w++ = *r++;
-				}
-			}
-			if (*r != ',' && *r != '\0')
-				return -1;
-		} else {
-			while (*r && *r != ',')
-				*w++ = *r++;
-		}
-		if (*r == '\0') {
-			*w = '\0';
-			return n;
-		}
-		*w++ = '\0';
-		r++;
-	}
-	return n;
-}
-
 static int parse_double(const char *s, double *out)
 {
 	char *end;

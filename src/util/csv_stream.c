@@ -56,20 +56,44 @@ static int fill(csv_stream *s, bsim_error *err)
 	}
 }
 
-/* The next line, its line feed (and a CR before it) cut off: 1 and *line,
+/* The line feed that ends the row at p (avail bytes, the first scanned
+ * of them already seen, with *quoted the quoting after them): one outside
+ * double quotes, as a quoted field may hold a line break
+ * (csv_field_write). NULL if the bytes hold none yet; *breaks counts the
+ * line feeds inside quotes. */
+static char *row_end(char *p, size_t avail, size_t *scanned, int *quoted, long *breaks)
+{
+	while (*scanned < avail) {
+		char *from = p + *scanned;
+		char *nl = memchr(from, '\n', avail - *scanned);
+		char *to = nl ? nl : p + avail;
+		for (char *q = memchr(from, '"', (size_t)(to - from)); q;
+		     q = q + 1 < to ? memchr(q + 1, '"', (size_t)(to - q - 1)) : NULL)
+			*quoted = !*quoted; /* a doubled quote turns it twice */
+		*scanned = nl ? (size_t)(nl - p) + 1 : avail;
+		if (nl && !*quoted)
+			return nl;
+		*breaks += nl != NULL;
+	}
+	return NULL;
+}
+
+/* The next row, its line feed (and a CR before it) cut off: 1 and *line,
  * 0 at the end of the file, -1 on a NUL byte or a last line cut short
  * (csv_text_check's messages) or a read error. */
 static int next_line(csv_stream *s, char **line, bsim_error *err)
 {
-	size_t scanned = 0; /* bytes after start known to hold no line feed */
+	size_t scanned = 0; /* bytes after start already seen */
+	int quoted = 0;
+	long breaks = 0;
 	for (;;) {
 		char *p = s->buf + s->start;
 		size_t avail = s->end - s->start;
-		char *nl = memchr(p + scanned, '\n', avail - scanned);
-		scanned = avail;
+		char *nl = row_end(p, avail, &scanned, &quoted, &breaks);
 		if (nl || (s->eof && avail > 0)) {
 			size_t len = nl ? (size_t)(nl - p) : avail;
-			s->line++;
+			s->line += 1 + s->breaks;
+			s->breaks = breaks;
 			char *z = memchr(p, '\0', len);
 			if (z) {
 				bsim_error_set(err, BSIM_EINPUT,
@@ -96,25 +120,6 @@ static int next_line(csv_stream *s, char **line, bsim_error *err)
 			return 0;
 		if (fill(s, err) != BSIM_OK)
 			return -1;
-	}
-}
-
-static int count_fields(const char *line)
-{
-	int n = 1;
-	for (; *line; line++)
-		n += *line == ',';
-	return n;
-}
-
-/* Splits line in place at commas into out (n fields, counted before). */
-static void split(char *line, char **out, int n)
-{
-	out[0] = line;
-	for (int i = 1; i < n; i++) {
-		line = strchr(line, ',');
-		*line++ = '\0';
-		out[i] = line;
 	}
 }
 
@@ -156,7 +161,7 @@ int csv_stream_open(const char *path, csv_stream *s, bsim_error *err)
 	else if (!rc && got < 0)
 		rc = err ? err->code : BSIM_EINPUT;
 	if (!rc) {
-		s->n_cols = count_fields(header);
+		s->n_cols = csv_count_fields(header);
 		s->names = calloc((size_t)s->n_cols, sizeof *s->names);
 		s->cells = calloc((size_t)s->n_cols, sizeof *s->cells);
 		char *copy = strdup(header);
@@ -164,7 +169,7 @@ int csv_stream_open(const char *path, csv_stream *s, bsim_error *err)
 			free(copy);
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 		} else {
-			split(copy, s->names, s->n_cols);
+			csv_split(copy, s->names, s->n_cols);
 		}
 	}
 	if (rc)
@@ -177,15 +182,20 @@ int csv_stream_next(csv_stream *s, bsim_error *err)
 	char *line;
 	int got;
 	while ((got = next_line(s, &line, err)) == 1) {
-		int n = count_fields(line);
-		if (n == s->n_cols && s->bad_line == 0) {
-			split(line, s->cells, n);
+		int n = csv_count_fields(line);
+		if (n == s->n_cols && s->bad_line == 0 && csv_split(line, s->cells, n) == n)
 			return 1;
-		}
 		if (s->bad_line == 0) {
 			s->bad_line = s->line;
-			s->bad_got = n;
+			s->bad_got = n == s->n_cols ? -1 : n; /* -1: a malformed quote */
 		}
+	}
+	if (got == 0 && s->bad_line > 0 && s->bad_got < 0) {
+		bsim_error_set(err, BSIM_EINPUT,
+		               "%s:%ld: expected %d fields, got a quoted field not closed where "
+		               "its field ends",
+		               s->path, s->bad_line, s->n_cols);
+		return -1;
 	}
 	if (got == 0 && s->bad_line > 0) {
 		bsim_error_set(err, BSIM_EINPUT, "%s:%ld: expected %d fields, got %d", s->path,

@@ -1,8 +1,9 @@
 /* Internal: a CSV table of beamsim's own making read row by row, for a
  * reader that must not hold the whole file (a .mat twin of a million-row
- * trajectory). The table is the plain CSV of util/csv_table.h and is
- * checked the same way, with the same messages: a regular file (refused at
- * once otherwise, never waited on) of at most CSV_TABLE_MAX_BYTES, no NUL
+ * trajectory). The table is the CSV of util/csv_table.h, a quoted field
+ * unquoted (csv_split; it may hold commas and line breaks), and is checked
+ * the same way, with the same messages: a regular file (refused at once
+ * otherwise, never waited on) of at most CSV_TABLE_MAX_BYTES, no NUL
  * byte, a last line ending in a line feed, every row as wide as the
  * header, a CR before a line feed dropped.
  *
@@ -26,7 +27,9 @@ typedef struct csv_stream {
 	size_t cap, start, end;
 	double bytes; /* read so far */
 	int eof;
-	long line; /* the line last returned: 1 the header, r + 2 row r */
+	long line;   /* the first line of the row last returned: 1 the header, r + 2
+	              * row r (later if a quoted field before held a line break) */
+	long breaks; /* line feeds inside quotes of the row last returned */
 	int n_cols;
 	char **names;  /* n_cols, the header's (owned) */
 	char **cells;  /* n_cols, the row last returned, into buf */

@@ -51,6 +51,55 @@ void csv_field_write(FILE *f, const char *s)
 	fputc('"', f);
 }
 
+int csv_split(char *line, char **field, int max)
+{
+	int n = 0;
+	char *r = line, *w = line;
+	while (n < max) {
+		field[n++] = w;
+		if (*r == '"') {
+			r++;
+			while (1) {
+				if (*r == '\0')
+					return -1;
+				if (*r == '"' && r[1] == '"') {
+					*w++ = '"';
+					r += 2;
+				} else if (*r == '"') {
+					r++;
+					break;
+				} else {
+					*w++ = *r++;
+				}
+			}
+			if (*r != ',' && *r != '\0')
+				return -1;
+		} else {
+			while (*r && *r != ',')
+				*w++ = *r++;
+		}
+		if (*r == '\0') {
+			*w = '\0';
+			return n;
+		}
+		*w++ = '\0';
+		r++;
+	}
+	return n;
+}
+
+int csv_count_fields(const char *line)
+{
+	int n = 1, quoted = 0;
+	for (; *line; line++) {
+		if (*line == '"')
+			quoted = !quoted; /* a doubled quote turns it twice */
+		else if (*line == ',' && !quoted)
+			n++;
+	}
+	return n;
+}
+
 int csv_text_check(const char *path, const char *text, size_t len, bsim_error *err)
 {
 	/* A NUL would end a line's text early, unseen: named where it is. */

@@ -2,9 +2,10 @@
  * by header name, so that a reader keeps working when columns are added.
  *
  * beamsim's CSV files are plain: a header line of names, then rows of the
- * same number of comma-separated fields, no quoting (no field it writes
- * holds a comma or a newline). Fields stay text; a reader asks for the
- * numbers it wants. */
+ * same number of comma-separated fields; only text a user gave (a grid key
+ * or value) may need quoting (csv_field_write), which csv_split and the
+ * streamed reader (csv_stream.h) undo. Fields stay text; a reader asks for
+ * the numbers it wants. */
 #ifndef BSIM_UTIL_CSV_TABLE_H
 #define BSIM_UTIL_CSV_TABLE_H
 
@@ -29,6 +30,15 @@ typedef struct csv_table {
  * doubled) if it holds a comma, a quote or a line break, so that text a
  * user gave (a grid key or value) cannot shift the columns. */
 void csv_field_write(FILE *f, const char *s);
+
+/* Splits one CSV line in place into at most max fields, with RFC 4180
+ * quoting (the field a,"b" is written "a,""b""", as csv_field_write writes
+ * it). Returns the number of fields, or -1 on a malformed quote. */
+int csv_split(char *line, char **field, int max);
+
+/* The fields of a CSV line, quoted commas not counted (a malformed quote
+ * counts as the end of its field). */
+int csv_count_fields(const char *line);
 
 /* The checks every stored CSV text passes before it is split: no NUL byte,
  * and a last line that ends in a line feed (beamsim ends every line it

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* The defaults of beamsim/limits.h. */
 #define LIMITS_DEFAULT                                                                             \
@@ -69,4 +70,24 @@ int bsim_limits_parse(bsim_limits *l, const char *text, bsim_error *err)
 void bsim_limits_hint(char *buf, unsigned size, const char *name, double value)
 {
 	snprintf(buf, size, "limit %s = %.15g; raise it with --limit %s=N", name, value, name);
+}
+
+double bsim_memory_available(void)
+{
+	FILE *f = fopen("/proc/meminfo", "r");
+	char line[256];
+	double kib = -1;
+	while (f && kib < 0 && fgets(line, sizeof line, f))
+		if (sscanf(line, "MemAvailable: %lf kB", &kib) != 1)
+			kib = -1;
+	if (f)
+		fclose(f);
+	if (kib >= 0)
+		return kib * 1024.0;
+#if defined(_SC_AVPHYS_PAGES) && defined(_SC_PAGESIZE)
+	long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+	if (pages > 0 && page > 0)
+		return (double)pages * (double)page;
+#endif
+	return INFINITY;
 }

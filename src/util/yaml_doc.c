@@ -251,6 +251,89 @@ int ydoc_load_own(ydoc *d, const char *path, bsim_error *err)
 	return load(d, path, INFINITY, NULL, err);
 }
 
+/* An alias event as parse_checked reports an alias node (its path is not
+ * known without a document). */
+static void alias_fault(struct fy_event *ev, parse_fault *pf)
+{
+	struct fy_token *t = ev->alias.anchor;
+	size_t len = 0;
+	const char *name = t ? fy_token_get_text(t, &len) : NULL;
+	const struct fy_mark *m = t ? fy_token_start_mark(t) : NULL;
+	pf->kind = PF_ALIAS;
+	snprintf(pf->alias, sizeof pf->alias, "%.*s", name ? (int)len : 0, name ? name : "");
+	pf->alias_line = m ? m->line + 1 : 0;
+	pf->alias_col = m ? m->column + 1 : 0;
+}
+
+int ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text, bsim_error *err)
+{
+	if (text)
+		*text = NULL;
+	file_text f;
+	int rc = file_read(path, "a YAML file", INFINITY, NULL, &f, err);
+	if (rc != BSIM_OK)
+		return rc;
+	parse_fault pf;
+	memset(&pf, 0, sizeof pf);
+	text_fault tf;
+	if (!text_check(f.text, f.len, &tf)) {
+		free(f.text);
+		pf.kind = PF_TEXT;
+		pf.line = tf.line;
+		pf.col = tf.col;
+		snprintf(pf.what, sizeof pf.what, "%s", tf.what);
+		return fault_error(path, &pf, err);
+	}
+	f.len = text_strip_cr(f.text, f.len);
+	f.text[f.len] = '\0';
+	struct fy_diag *diag = quiet_diag();
+	struct fy_parse_cfg cfg;
+	memset(&cfg, 0, sizeof cfg);
+	cfg.flags = FYPCF_QUIET | FYPCF_COLLECT_DIAG;
+	cfg.diag = diag;
+	struct fy_parser *fyp = diag ? fy_parser_create(&cfg) : NULL;
+	if (!fyp || fy_parser_set_string(fyp, f.text, f.len) != 0)
+		rc = bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
+	int docs = 0, ended = 0;
+	struct fy_event *ev;
+	while (rc == BSIM_OK && pf.kind == PF_OK && (ev = fy_parser_parse(fyp)) != NULL) {
+		ended = ev->type == FYET_STREAM_END;
+		if (ev->type == FYET_DOCUMENT_START && ++docs > 1)
+			pf.kind = PF_MORE;
+		else if (ev->type == FYET_ALIAS)
+			alias_fault(ev, &pf);
+		else if (ev->type != FYET_STREAM_START && ev->type != FYET_STREAM_END &&
+		         ev->type != FYET_DOCUMENT_START && ev->type != FYET_DOCUMENT_END)
+			rc = fn(user, ev, f.text, err);
+		fy_parser_event_free(fyp, ev);
+	}
+	void *it = NULL;
+	struct fy_diag_error *e = diag ? fy_diag_errors_iterate(diag, &it) : NULL;
+	if (rc == BSIM_OK && e) {
+		pf.kind = PF_SYNTAX;
+		pf.line = e->line;
+		pf.col = e->column;
+		snprintf(pf.what, sizeof pf.what, "%s", e->msg ? e->msg : "invalid YAML");
+	}
+	if (rc == BSIM_OK && pf.kind != PF_OK)
+		rc = fault_error(path, &pf, err);
+	/* The parser stops without a word when it cannot allocate: a stream
+	 * without its end is not taken for the whole file. */
+	if (rc == BSIM_OK && !ended)
+		rc = bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
+	if (diag)
+		fy_diag_set_collect_errors(diag, false);
+	if (fyp)
+		fy_parser_destroy(fyp);
+	if (diag)
+		fy_diag_unref(diag);
+	if (rc == BSIM_OK && text)
+		*text = f.text;
+	else
+		free(f.text);
+	return rc;
+}
+
 struct fy_document *ydoc_parse_text(const char *text, char *msg, size_t size)
 {
 	size_t len = strlen(text);
@@ -445,8 +528,12 @@ static int yaml_nonfinite(const char *t)
 
 int ydoc_number(struct fy_node *n, double *out)
 {
-	const char *t = ydoc_plain(n);
-	if (!t)
+	return ydoc_number_text(ydoc_plain(n), out);
+}
+
+int ydoc_number_text(const char *t, double *out)
+{
+	if (!t || !*t)
 		return YDOC_NUM_NONE;
 	if (yaml_nonfinite(t))
 		return YDOC_NUM_NONFINITE;

@@ -32,6 +32,19 @@ int ydoc_load(ydoc *d, const char *path, bsim_error *err);
  * not on what a large run writes. Bounded by memory only. */
 int ydoc_load_own(ydoc *d, const char *path, bsim_error *err);
 
+/* A file beamsim wrote itself read as ydoc_load_own reads it (the same
+ * checks and messages; an alias is refused without its field's path, and
+ * a key given twice is not looked for) but without a document: each event
+ * of its one document goes to fn as the parser makes it (not the stream's
+ * or document's own start and end), so that memory is what fn keeps, not
+ * libfyaml's nodes and tokens (about 44 bytes a byte of JSON). fn gets the
+ * file's text (the events' marks are offsets into it) and returns BSIM_OK
+ * or an error it set in err, which stops the parse. text: NULL, or gets
+ * that text (malloc'd, NUL-terminated; NULL on failure) for the caller to
+ * free. */
+typedef int (*ydoc_event_fn)(void *user, struct fy_event *ev, const char *text, bsim_error *err);
+int ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text, bsim_error *err);
+
 /* Parses YAML flow text (an override value) into a new document, checked
  * like a file. On failure returns NULL and puts in msg "expected ..., got
  * ..." saying why. */
@@ -80,6 +93,8 @@ const char *ydoc_plain(struct fy_node *n);
  * YDOC_NUM_NONFINITE (.nan, .inf, 1e999, "nan", ...). */
 enum { YDOC_NUM_OK = 0, YDOC_NUM_NONE = 1, YDOC_NUM_NONFINITE = 2 };
 int ydoc_number(struct fy_node *n, double *out);
+/* The same for the text of a plain scalar (NULL: YDOC_NUM_NONE). */
+int ydoc_number_text(const char *t, double *out);
 
 /* Plain decimal integers only ("3000", "+7", "-1"); 1 on success. */
 int ydoc_int64(struct fy_node *n, long long *out);

@@ -199,10 +199,22 @@ s = beamsim_sweep(h1, opts{:}, 'threads', 2);
 fields = fieldnames(s.trials)';
 check(numel(fields) == numel(names), 'trials: %d columns, trials.csv %d', numel(fields), ...
       numel(names));
+check(isequal(sort(fieldnames(s.labels)), sort({'outcome'; 'type'; 'location'; 'path'})) && ...
+      isequal(s.labels.outcome', {'traversed', 'side_exit', 'stuck', 'unstable'}) && ...
+      isequal(s.labels.type', {'none', 'left', 'right'}), 'labels: %s', ...
+      strjoin(fieldnames(s.labels)', ', '));
 for j = 1:numel(names)
   f = regexprep(names{j}, '[^A-Za-z0-9_]', '_');
   check(strcmp(fields{j}, f), 'trials column %d: %s, trials.csv %s', j, fields{j}, names{j});
   v = s.trials.(f);
+  if isfield(s.labels, f)
+    % a text column: a code a row (the narrowest unsigned class) into its labels
+    check(any(strcmp(class(v), {'uint8', 'uint16', 'uint32'})) && iscellstr(s.labels.(f)), ...
+          'trials column %s: codes of class %s', f, class(v));
+    v = s.labels.(f)(v);
+  else
+    check(isa(v, 'double'), 'trials column %s: class %s', f, class(v));
+  end
   fmt = '%.10g';
   if any(strcmp(f, {'group', 'trial'}))
     v = v - 1;  % trials.csv counts from 0
@@ -232,13 +244,30 @@ check(isequaln(one.trials, s.trials) && isequaln(rmfield(one.groups, 'steps'), .
 printf('sweep: %d groups x %d trials: trials.csv and summary.json, 1 and 2 threads the same\n', ...
        numel(s.groups), s.trials_per_group);
 
+% ---- a grid axis of text: codes into its values, trials.csv's column ----
+textexp = fullfile(tmp, 'text_axis.yaml');
+fid = fopen(textexp, 'w');
+fprintf(fid, ['scene: %s\ntrials: 2\nseed: 4\nset:\n  integration.max_steps: 30\n' ...
+              'grid:\n  name: [gate_b, gate_a]\n  effects.propulsion.force: [7, 9]\n'], gate);
+fclose(fid);
+textdir = fullfile(tmp, 'text_axis');
+[~, err, status] = program(exe, tmp, sprintf('sweep %s --quiet --out %s', textexp, textdir));
+check(status == 0, 'beamsim sweep (text axis): exit %d: %s', status, err);
+t = beamsim_sweep(textexp);
+[names, cols] = csv_columns(fullfile(textdir, 'trials.csv'));
+check(isa(t.trials.name, 'uint8') && isequal(t.labels.name', {'gate_b', 'gate_a'}), ...
+      'text axis: class %s', class(t.trials.name));
+check_column('text axis', 'name', t.labels.name(t.trials.name), cols{strcmp(names, 'name')}, '');
+printf('a text grid axis: %d codes into its 2 values, trials.csv''s column\n', numel(t.trials.name));
+
 % ---- a trial of the stored sweep, and what a stored run refuses ---------
-k = find(strcmp(s.trials.outcome, 'traversed'), 1);
+outcome = s.labels.outcome(s.trials.outcome);
+k = find(strcmp(outcome, 'traversed'), 1);
 if isempty(k)
   k = numel(s.trials.group);
 end
 r = beamsim_run(sweepdir, 'group', s.trials.group(k), 'trial', s.trials.trial(k));
-check(strcmp(r.outcome, s.trials.outcome{k}) && r.t_end == s.trials.t_end(k) && ...
+check(strcmp(r.outcome, outcome{k}) && r.t_end == s.trials.t_end(k) && ...
       r.x_end == s.trials.x_end(k) && r.y_end == s.trials.y_end(k), ...
       'the stored trial, group %d trial %d, replayed differs', s.trials.group(k), s.trials.trial(k));
 [~, err, status] = program(exe, tmp, sprintf('run %s --group 1 --trial 1 --seed 3', sweepdir));
@@ -250,7 +279,7 @@ printf('stored run: group %d, trial %d replayed as stored\n', r.group, r.trial);
 % ---- beamsim_load of the sweep's directory ------------------------------
 d = beamsim_load(sweepdir);
 check(isequal(d.trials.group, s.trials.group) && isequal(d.trials.trial, s.trials.trial) && ...
-      isequal(d.trials.outcome, s.trials.outcome), 'beamsim_load: trials differ');
+      isequal(d.trials.outcome, outcome), 'beamsim_load: trials differ');
 rel = abs(d.trials.t_end - s.trials.t_end) ./ max(abs(s.trials.t_end), 1);
 check(max(rel) < 1e-9, 'beamsim_load: t_end off by %g', max(rel));
 check(numel(d.summary.groups) == numel(s.groups) && isfield(d, 'run') && isfield(d, 'manifest'), ...
@@ -372,7 +401,8 @@ lastwarn('', '');
 s = beamsim_sweep(stiff, 'backend', 'box2d', 'backend_opt', {'spring', 'torque'});
 [wmsg, wid] = lastwarn();
 wmsg = regexprep(wmsg, '^beamsim_sweep: ', '');
-check(strcmp(wid, 'beamsim:unstable') && sum(strcmp(s.trials.outcome, 'unstable')) == 20 && ...
+check(strcmp(wid, 'beamsim:unstable') && ...
+      sum(s.trials.outcome == find(strcmp(s.labels.outcome, 'unstable'))) == 20 && ...
       sum([s.groups.unstable]) == 20 && strncmp(wmsg, '20 of 20 trials unstable on the box2d', 37), ...
       'unstable sweep: %s', wmsg);
 printf('unstable: a trial and a sweep on box2d with torque springs, said as the program says\n');

@@ -40,7 +40,7 @@ def test_another_thread_runs_during_a_sweep(h1, no_preemption):
         calls.append(done)
         woken.set()
 
-    t = threading.Thread(target=other)
+    t = threading.Thread(target=other, daemon=True)  # a sweep that raises leaves it waiting
     t.start()
     beamsim.sweep(h1, trials=4, threads=1, progress=progress)
     t.join()
@@ -109,8 +109,9 @@ def test_finished_out_needs_overwrite(h1, tmp_path):
     out = tmp_path / "d"
     beamsim.sweep(h1, trials=2, threads=1, out=out)
     before = (out / "trials.csv").read_bytes()
-    with pytest.raises(ValueError, match="holds the finished result of beamsim sweep"):
+    with pytest.raises(ValueError, match="holds the finished result of beamsim sweep") as e:
         beamsim.sweep(h1, trials=3, threads=1, out=out)
+    assert "add overwrite=True to replace it" in str(e.value) and "--" not in str(e.value)
     assert (out / "trials.csv").read_bytes() == before
     r = beamsim.sweep(h1, trials=3, threads=1, out=out, overwrite=True)
     assert len(r["trials"]["trial"]) == 30 * 3

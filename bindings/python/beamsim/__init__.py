@@ -14,7 +14,6 @@ calls release the GIL; Ctrl-C stops a sweep or a comparison
 (KeyboardInterrupt). See docs/bindings.md.
 """
 
-import csv
 import json
 import math
 import numbers
@@ -93,8 +92,8 @@ def _grid(grid):
     for key, values in grid.items():
         if isinstance(values, (str, numbers.Number)):
             values = [values]
-        texts = [_text(v) for v in values]
-        out.append((key, texts, f"--grid {key}={','.join(texts)}"))
+        # one origin for the axis: the library names a value "--grid KEY=VALUE"
+        out.append((key, [_text(v) for v in values], f"--grid {key}"))
     return out
 
 
@@ -141,29 +140,13 @@ def _seed(seed):
 # ---- files of an output directory ------------------------------------------
 
 
-def _column(values):
-    """A CSV column as a NumPy array: int64 if every field is an integer,
-    float64 if every field is a number (an empty field is NaN, not
-    measured), else str."""
-    try:
-        return np.array([int(v) for v in values], dtype=np.int64)
-    except ValueError:
-        pass
-    try:
-        return np.array([float(v) if v != "" else math.nan for v in values], dtype=np.float64)
-    except ValueError:
-        return np.array(values, dtype=str)
-
-
 def read_csv(path):
-    """One CSV file of beamsim as a dict of NumPy arrays by column."""
-    with open(path, newline="", encoding="utf-8") as f:
-        rows = list(csv.reader(f))
-    if not rows:
-        return {}
-    header, body = rows[0], rows[1:]
-    cols = list(zip(*body)) if body else [() for _ in header]
-    return {name: _column(list(col)) for name, col in zip(header, cols)}
+    """One CSV file of beamsim as a dict of NumPy arrays by column: int64 if
+    every field of the column is an integer, float64 if every field is a
+    number (an empty field is NaN, not measured), else str. The arrays are
+    made while the rows are read, so what is held is the arrays themselves
+    (trials.csv: about 330 bytes a row, docs/bindings.md), not the file."""
+    return _beamsim.read_table(os.fspath(path))
 
 
 def load(path):
@@ -255,6 +238,13 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     return d
 
 
+# The bytes a cell of trials.csv takes in read_csv's arrays, at most: 8 a
+# number; a text column (outcome, type, location, path) 4 a character of its
+# longest string, which for a gate's trials stays under this on average
+# (docs/bindings.md "Memory").
+_CELL_BYTES = 16.0
+
+
 class _Dir:
     """out, or a temporary directory removed afterwards."""
 
@@ -291,9 +281,11 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
 
     Returns a dict: "groups" (summary.json's groups: params, trials,
     traversed, side_exit, stuck, left, right, p_traverse, ci95, ...),
-    "trials" (trials.csv as a dict of NumPy arrays by column), "summary"
-    (all of summary.json), "threads" and "out". Unstable trials are warned
-    of (RuntimeWarning); Ctrl-C stops the sweep (KeyboardInterrupt)."""
+    "trials" (trials.csv as a dict of NumPy arrays by column, read_csv),
+    "summary" (all of summary.json), "threads" and "out". A sweep whose
+    arrays would not fit in the memory available is refused before it
+    runs (ValueError). Unstable trials are warned of (RuntimeWarning);
+    Ctrl-C stops the sweep (KeyboardInterrupt)."""
     _no_nul("experiment", experiment)
     _no_nul("out", out)
     _no_nul("backend", backend)
@@ -302,7 +294,7 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
                               _count("threads", threads, 1, 4096), _seed(seed), backend,
                               _sets(set), _grid(grid), _opts(backend_opt), progress,
                               _count("trajectories", trajectories, 0), bool(resume),
-                              bool(overwrite))
+                              bool(overwrite), _CELL_BYTES)
         files = load(d)
     if info["unstable"]:
         text = info["unstable_text"]
