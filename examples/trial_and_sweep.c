@@ -16,8 +16,8 @@ static int fail(const bsim_error *err)
 	return 1;
 }
 
-/* The gate of MODEL.md section 1 pushed with 8 N and shaken with Rm = 30 N:
- * group 0, trial 0 of seed 1, as `beamsim run` runs it. */
+/* The gate of docs/model.md section 1 pushed with 8 N and shaken with
+ * Rm = 30 N: group 0, trial 0 of seed 1, as `beamsim run` runs it. */
 static int one_trial(void)
 {
 	bsim_error err;

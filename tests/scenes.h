@@ -33,7 +33,7 @@ static inline void scene_one_beam(bsim_scene *s)
 
 /* The gate with elastic impacts (tangent and tip), springs but no dampers,
  * no effects, and the body launched at (3, 0) with (0.4, 12) m/s: energy
- * is conserved exactly by the model (MODEL.md oracle 3). */
+ * is conserved exactly by the model (docs/model.md check 3). */
 static inline void scene_gate_conservative(bsim_scene *s)
 {
 	scene_gate_quiet(s);
@@ -76,7 +76,7 @@ static inline int scene_six_beams(bsim_scene *s, double f_prop, double rm)
 }
 
 /* The mirror image of a two-beam scene: x -> -x, so the beams change
- * places and sides (MODEL.md oracle 4). m is a new scene. */
+ * places and sides (docs/model.md check 4). m is a new scene. */
 static inline void scene_mirror(const bsim_scene *s, bsim_scene *m)
 {
 	bsim_scene_copy(m, s);

@@ -1,7 +1,8 @@
-/* MODEL.md's oracles (section 10) on the Box2D backend, with tolerances that
- * fit float32 and Box2D's semi-implicit Euler. Where Box2D cannot meet an
- * oracle exactly, the test bounds the deviation measured (a little above
- * it) and says so; each measured value is printed so a change shows.
+/* The checks of docs/model.md section 10 on the Box2D backend, with
+ * tolerances that fit float32 and Box2D's semi-implicit Euler. Where Box2D
+ * cannot meet a check exactly, the test bounds the deviation measured (a
+ * little above it) and says so; each measured value is printed so a change
+ * shows.
  *   1 impact:          closed form, e = 1 and 0.8; tip vs tangent restitution
  *   2 free vibration:  analytic damped oscillator, both spring realisations
  *   3 energy ledger:   conservative drift; driven, damped, noisy residual
@@ -45,8 +46,8 @@ static bsim_world *create(const bsim_scene *s, const bsim_options *o)
 
 /* ---- 1. impacts ---------------------------------------------------------- */
 
-/* Body of speed u hits the beam at rest square-on at lever r (MODEL.md
- * oracle 1): mu = M r^2 / I, v' = u (mu - e) / (1 + mu),
+/* Body of speed u hits the beam at rest square-on at lever r (docs/model.md
+ * check 1): mu = M r^2 / I, v' = u (mu - e) / (1 + mu),
  * omega' = (1 + e) u mu / (r (1 + mu)). Box2D's contact starts b2_linearSlop
  * / s = 5 cm before touching, so the body starts 2 cm away and the run
  * goes until after the impact; the spring is absent (k = 0). */

@@ -1,4 +1,4 @@
-/* The left/right type of a traversal (MODEL.md section 6): the sign of v_x
+/* The left/right type of a traversal (docs/model.md section 6): the sign of v_x
  * at classify_y, with |v_x| below termination.classify_deadband typed
  * none. A body that never meets a beam keeps its starting lateral speed
  * exactly (no lateral force), so the type is known in advance. */

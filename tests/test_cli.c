@@ -1,5 +1,6 @@
-/* The beamsim program as a user meets it (DESIGN.md "Command line",
- * "Outputs"): help, version, exit statuses, run, sweep, backends. */
+/* The beamsim program as a user meets it (docs/files.md "Command line",
+ * "Outputs of `sweep --out DIR`"): help, version, exit statuses, run,
+ * sweep, backends. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <setjmp.h>

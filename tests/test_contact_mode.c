@@ -1,6 +1,6 @@
 /* The thesis backend's contact_mode knob. physical (the default) keeps
  * every beam out of the body: the body's overlap with any beam stays within
- * the projection's slop (MODEL.md section 5, penetration below a stated
+ * the projection's slop (docs/model.md section 5, penetration below a stated
  * tolerance). essay reads the essay's flowchart literally: while one beam
  * is held in persistent contact, the others are not tested, so a beam can
  * pass into the body, but only while another beam is held; with a single

@@ -1,7 +1,7 @@
-/* MODEL.md oracle 6 / DESIGN.md "Determinism": the same experiment and seed
- * give byte-identical trials.csv and the same summary.json (but for the
- * wall time) whatever the number of threads; another seed gives other
- * trials. Runs the real program. */
+/* docs/model.md check 6 / docs/files.md "Experiment file (YAML)": the same
+ * experiment and seed give byte-identical trials.csv and the same
+ * summary.json (but for the wall time) whatever the number of threads;
+ * another seed gives other trials. Runs the real program. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

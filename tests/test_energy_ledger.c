@@ -1,4 +1,4 @@
-/* MODEL.md oracle 3: the energy ledger.
+/* docs/model.md check 3: the energy ledger.
  *   E = KE_body + sum(1/2 I omega^2 + 1/2 k theta^2)
  * changes by exactly the work of F_prop and F_rand, less the dampers' and
  * the impacts' losses (and the contact and correction terms, which the

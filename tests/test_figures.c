@@ -5,7 +5,7 @@
  * closed form) from the outcomes in trials.csv, left / right fractions from
  * the types; E along a path is F_prop (y0 - y) + 1/2 k (theta1^2 +
  * theta2^2) of the recorded angles, and a state lies below the landscape
- * exactly when its beams' energy is short of MODEL.md section 7's
+ * exactly when its beams' energy is short of docs/model.md section 7's
  * th(x, y), implemented here again, by more than 1 J; the random-force
  * histogram holds every draw the runner made once and integrates to 1;
  * the Pareto front of a hand-made accuracy table is the one worked out by
@@ -45,7 +45,7 @@ static int run_cli(const char *const *argv, char **out, char **err)
 	return rc;
 }
 
-/* ---- the landscape of MODEL.md section 7, written again ---------------------------------- */
+/* ---- the landscape of docs/model.md section 7, written again ----------------------------- */
 
 /* th of a beam with pivot (px, 30) pointing at the midline: the left one
  * (px < 0) points +x, the right one -x; phi measured from it, forward

@@ -1,4 +1,4 @@
-/* MODEL.md oracle 2: a beam released from theta0 with no body follows the
+/* docs/model.md check 2: a beam released from theta0 with no body follows the
  * damped oscillator I th'' + d th' + k th = 0; the implicit midpoint update
  * converges at second order and stays stable and non-expansive for stiff
  * springs (omega_n h up to 4). */

@@ -4,7 +4,7 @@
  * refused before the work it asks for, with exit status 2 and one line
  * naming where, the field or cause and the limit, or (extreme but valid
  * numbers) runs without undefined behaviour: the sanitized build halts on
- * any. The truth is the contract (DESIGN.md "Command line"), and, for the
+ * any. The truth is the contract (docs/files.md "Command line"), and, for the
  * libfyaml cases, the crash and the hang that the same bytes cause without
  * the checks. "Before the work" is shown by what the work would have left
  * or said, never by a clock: the timeout only ends a hang. */

@@ -1,4 +1,4 @@
-/* MODEL.md oracle 1 and the impact laws of section 4, on the thesis
+/* docs/model.md check 1 and the impact laws of section 4, on the thesis
  * backend: square-on tangent impacts against the closed-form solution,
  * elastic tip impacts against the conservation laws, the simultaneous
  * double impact on the midline, and the knob impact_mass (essay Eq. 2.4 read

@@ -1,4 +1,4 @@
-/* The potential energy landscape (MODEL.md section 7).
+/* The potential energy landscape (docs/model.md section 7).
  *
  * Truths: the tangent and tip branches of th(x, y) meet at
  * rho^2 = L^2 + R^2 (the tangent point is then the tip); th vanishes from

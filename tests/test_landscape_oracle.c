@@ -1,4 +1,4 @@
-/* MODEL.md oracle 5 on both backends: a body pushed slowly against a
+/* docs/model.md check 5 on both backends: a body pushed slowly against a
  * heavily damped beam keeps the beam at the landscape's th(x, y) while they
  * touch, through the tangent branch, the tip branch and the release at
  * rho = L + R, and comes to rest where th(x, y) says; and a body pushed
@@ -7,7 +7,7 @@
  *
  * The truth is the contact geometry each backend enforces on its own
  * (the thesis solver's contact solve, Box2D's edge-circle manifold)
- * against the landscape's closed forms (MODEL.md section 7), which share
+ * against the landscape's closed forms (docs/model.md section 7), which share
  * no code with either. Box2D holds contacts to its linear slop (5 mm at
  * unit_scale 1) in float32, so its bound is wider; each run prints what it
  * measures. */

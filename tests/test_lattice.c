@@ -1,4 +1,4 @@
-/* The gate lattice (MODEL.md section 8) against independent truths:
+/* The gate lattice (docs/model.md section 8) against independent truths:
  *   - its geometry is the essay's (Eq. 2.17, Fig. 2.8), loaded from the
  *     shipped configs;
  *   - the broad phase changes no bit of any result (against testing every
@@ -56,7 +56,7 @@ static void geometry_is_the_essays(void **state)
 	assert_int_equal(s.n_beams, 2 * 9 * 9);
 	assert_int_equal(l->ix_min, -4);
 	assert_int_equal(l->ix_max, 4);
-	/* MODEL.md section 8: pivots at (50 ix -/+ 25, 60 iy + 30) */
+	/* docs/model.md section 8: pivots at (50 ix -/+ 25, 60 iy + 30) */
 	for (int iy = 0; iy < 9; iy++)
 		for (int ix = -4; ix <= 4; ix++) {
 			const bsim_beam_def *bl = &s.beams[bsim_lattice_beam(l, ix, iy, 0)];

@@ -433,7 +433,7 @@ static void test_run_out_twins(void **state)
 		Mat_Close(mat);
 		tcsv_free(&t);
 	}
-	/* The ledger closes at every row (MODEL.md oracle 3): the change of
+	/* The ledger closes at every row (docs/model.md check 3): the change of
 	 * the mechanical energy is the work in minus the losses, to round-off. */
 	char csv[1100];
 	snprintf(csv, sizeof csv, "%s/ledger.csv", dir);

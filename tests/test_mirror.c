@@ -1,4 +1,4 @@
-/* MODEL.md oracle 4: a scene mirrored in x, run with the random force
+/* docs/model.md check 4: a scene mirrored in x, run with the random force
  * negated, gives the mirrored trajectory bit for bit. The gate is made
  * asymmetric (k1 = 300, k2 = 500) so that the mirror is a different scene. */
 #include <math.h>

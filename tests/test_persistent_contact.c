@@ -1,4 +1,4 @@
-/* Impact chains settle into persistent contact (MODEL.md section 5): the
+/* Impact chains settle into persistent contact (docs/model.md section 5): the
  * body pushed into the symmetric gate bounces with shrinking speed, switches
  * to persistent contact with both beams, and comes to rest where the push
  * balances the springs, at the point the potential energy landscape

@@ -1,4 +1,4 @@
-/* MODEL.md oracle 4 (mirror symmetry) on the body that turns, has a shape
+/* docs/model.md check 4 (mirror symmetry) on the body that turns, has a shape
  * and feels contact friction. The essay's gate with equal beams is its own
  * mirror image in x = 0; a trial started at (x0, y0) with heading psi0 and
  * angular velocity w0 under the lateral force F_x(t), and its image started

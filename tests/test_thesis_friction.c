@@ -1,6 +1,7 @@
 /* Body-beam Coulomb friction in the thesis backend (contact.friction,
- * MODEL.md section 11): impacts that stick and impacts that slide against
- * the impulse analysis solved by hand (a turning disk, whose tangent row
+ * docs/backends.md "A body that turns, has a shape, and feels friction"):
+ * impacts that stick and impacts that slide against the impulse analysis
+ * solved by hand (a turning disk, whose tangent row
  * the beam does not feel, and a tilted capsule, whose normal and tangent
  * rows are coupled through its rotation); persistent contact holding a
  * capsule at rest under a force inside the cone and letting it slide,

@@ -1,12 +1,13 @@
-/* The thesis backend's body that turns and has a shape (MODEL.md section
- * 11): the capsule's outline against a segment against a sampled outline;
- * a free capsule's angular momentum and energy (constant), and its heading
- * under a constant torque (the closed form); an off-centre frictionless
- * impact of a capsule on a beam against the impulse equations with the
- * body's inertia solved by hand, and against the angular momentum about the
- * pivot; a turning disk without friction against the essay's disk bit for
- * bit (no contact can turn a frictionless disk); the energy ledger of a
- * turning capsule among beams with friction, closed. */
+/* The thesis backend's body that turns and has a shape (docs/backends.md,
+ * "A body that turns, has a shape, and feels friction"): the capsule's outline
+ * against a segment against a sampled outline; a free capsule's angular
+ * momentum and energy (constant), and its heading under a constant torque
+ * (the closed form); an off-centre frictionless impact of a capsule on a beam
+ * against the impulse equations with the body's inertia solved by hand, and
+ * against the angular momentum about the pivot; a turning disk without
+ * friction against the essay's disk bit for bit (no contact can turn a
+ * frictionless disk); the energy ledger of a turning capsule among beams with
+ * friction, closed. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -276,7 +277,7 @@ static void offcentre_impact(const char *knob)
 /* Seeded random elastic (e = 1), frictionless impacts of a turning capsule
  * and ellipse on the free beam (no spring): energy and the angular
  * momentum about the pivot, M (C x v) + J w + I omega, are both conserved
- * by the impulse whatever the contact point (MODEL.md section 4 with the
+ * by the impulse whatever the contact point (docs/model.md section 4 with the
  * body's rotation). */
 static void test_elastic_impacts_conserve(void **state)
 {
@@ -424,7 +425,7 @@ static double energy_of(const bsim_scene *s, const bsim_state *st)
 /* The ledger dE = F . dx + T dpsi - damper - impact - contact - correction
  * - sleep, step by step, for a capsule that turns under a torque, driven
  * through the gate with friction; it closes to round-off of the energies
- * involved (MODEL.md oracle 3's ledger). */
+ * involved (docs/model.md check 3's ledger). */
 static void test_ledger_closes(void **state)
 {
 	(void)state;

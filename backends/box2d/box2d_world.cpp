@@ -1,6 +1,6 @@
-/* The Box2D 2.4.1 backend ("box2d"): the model of MODEL.md sections 2-5 built
- * from Box2D's rigid bodies, joints and contacts, behind the C interface of
- * include/beamsim/backend.h. The only C++ in the project.
+/* The Box2D 2.4.1 backend ("box2d"): the model of docs/model.md sections
+ * 2-5 built from Box2D's rigid bodies, joints and contacts, behind the C
+ * interface of include/beamsim/backend.h. The only C++ in the project.
  *
  * Units. Box2D works in float32 and prefers moving bodies of 0.1-10 units;
  * our body is 10 m and the beams 25 m. Every quantity is scaled by s (knob
@@ -52,7 +52,7 @@
  *          mass is PIN_MASS_RATIO M, not the scene's m (see there).
  *   ground: static, no fixtures; the pivots hang on it.
  * Collision filtering: the body collides with beams only; beams collide
- * with nothing else (MODEL.md section 1: beams pass through each other).
+ * with nothing else (docs/model.md section 1: beams pass through each other).
  *
  * Spring and damper, I beta = tau_c - k theta - d omega (essay Eq. 2.2), two
  * realisations (knob spring):

@@ -1,5 +1,5 @@
 /* Contact detection between the body (a disk of radius R about C) and a
- * beam (the segment P .. P + L u). MODEL.md section 3.
+ * beam (the segment P .. P + L u). docs/model.md section 3.
  *
  *   s = clamp((C - P) . u, 0, L),  Q = P + s u,  gap = |C - Q| - R
  *   tangent (0 < s < L):  n = +-perp(u) toward the body, lever a = s u
@@ -8,8 +8,8 @@
  *   c = sgn (a x n),  v_rel = v . n - omega c
  *
  * Every expression is written so that mirroring the scene in x (x -> -x,
- * sgn -> -sgn) mirrors each intermediate value bit for bit (MODEL.md
- * oracle 4): products and sums keep the same operands in the same order.
+ * sgn -> -sgn) mirrors each intermediate value bit for bit (docs/model.md
+ * check 4): products and sums keep the same operands in the same order.
  *
  * A body of another shape (extended path, thesis.h's head) meets the beam
  * through its outline (model/body_shape.h): the outline's point K nearest

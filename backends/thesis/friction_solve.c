@@ -1,6 +1,7 @@
 /* The contact problem with friction (extended path, thesis.h's head): the
  * normal rows of lcp_solve.c plus each contact's tangent row, bounded by
- * Coulomb's cone (MODEL.md section 11, "Contact friction").
+ * Coulomb's cone (docs/backends.md, "A body that turns, has a shape, and
+ * feels friction").
  *
  * Rows r = 2i (normal) and 2i + 1 (tangent) of contact i have the Jacobian
  * (d_r on v, b_r on w, -l_r on the beam's omega): (n, cb, c) and (t, cbt,

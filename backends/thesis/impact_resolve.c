@@ -1,4 +1,4 @@
-/* Impacts: the essay's collision method (MODEL.md section 4).
+/* Impacts: the essay's collision method (docs/model.md section 4).
  *
  * A contact that touches, or will touch within this step (gap + h v_rel <=
  * slop), and approaches (v_rel < 0) takes an instantaneous frictionless
@@ -19,7 +19,7 @@
  * The knob impact_mass puts m_i in place of M in this solve only (1/m_eff
  * and v += J n / m_i): essay Eq. 2.4 read literally, m_i r v_ni + I omega_i
  * = m_i r v_nf + I omega_f, with m_i = 0.1 kg the beam's mass where the
- * body's M belongs (MODEL.md section 2). Such an impact conserves
+ * body's M belongs (docs/model.md section 2). Such an impact conserves
  * m_i r v + I omega, not the angular momentum of body and beam, and in
  * general not energy either: the kinetic energy (with M) it removes, or
  * adds, is what energy.impact records (negative where it adds).

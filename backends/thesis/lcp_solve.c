@@ -1,5 +1,5 @@
 /* The contact complementarity problem shared by impacts, persistent contact
- * and position projection (MODEL.md sections 4-5).
+ * and position projection (docs/model.md sections 4-5).
  *
  * Unknown impulses P_i >= 0 on contacts i. The solved normal velocity is
  *   w_i = q_i + sum_j K_ij P_j >= 0,   P_i w_i = 0,

@@ -1,5 +1,5 @@
 /* One step of smooth motion with persistent contacts: the essay's constraint
- * method (MODEL.md section 5) in velocity form.
+ * method (docs/model.md section 5) in velocity form.
  *
  * Free velocities over the step: v* = v + h F / M, omega*_i from the beam
  * integrator. Contact impulses P_i >= 0 then give

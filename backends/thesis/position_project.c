@@ -1,5 +1,5 @@
 /* Position projection: keeps the drift of persistent contacts bounded
- * (MODEL.md section 5).
+ * (docs/model.md section 5).
  *
  * The velocity-level contact holds v_rel = 0, but the contact geometry
  * turns within a step, so a gap drifts at second order (about h^2 v^2 / R

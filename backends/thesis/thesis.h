@@ -1,5 +1,5 @@
 /* The essay's collision + constraint solver ("thesis" backend): internal
- * types shared by its files. MODEL.md sections 2-5.
+ * types shared by its files. docs/model.md sections 2-5.
  *
  * Sign conventions. Beam i turns about its pivot P_i; theta_i > 0 swings the
  * tip forward (+y). Its direction is u = R(sgn * theta) u0, with u0 the rest

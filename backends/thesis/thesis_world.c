@@ -1,5 +1,5 @@
 /* The thesis backend: world creation, state access, knobs, and the order of
- * one step (MODEL.md sections 3-5):
+ * one step (docs/model.md sections 3-5):
  *   1. detect the contacts the step can reach (speculative margin);
  *   2. impacts of approaching contacts (restitution, or plastic below
  *      rest_threshold);

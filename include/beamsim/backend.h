@@ -1,4 +1,5 @@
-/* The physics backend interface (DESIGN.md "The backend interface").
+/* The physics backend interface (how to add one: docs/architecture.md,
+ * "Where a new thing goes").
  *
  * A backend owns bodies, beams, joints (spring + damper), contacts and
  * integration; nothing else. The runner owns time, the external force on the

@@ -1,7 +1,7 @@
-/* The whole API of libbeamsim in one include (DESIGN.md "The library"):
- * every public header of include/beamsim/. A program may include the few it
- * needs instead; what libbeamsim.so exports is exactly what these declare
- * (BSIM_API, beamsim/base.h). */
+/* The whole API of libbeamsim in one include (docs/architecture.md "The
+ * API and the ABI"): every public header of include/beamsim/. A program may
+ * include the few it needs instead; what libbeamsim.so exports is exactly
+ * what these declare (BSIM_API, beamsim/base.h). */
 #ifndef BSIM_BEAMSIM_H
 #define BSIM_BEAMSIM_H
 

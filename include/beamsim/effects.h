@@ -1,6 +1,7 @@
-/* The effect pipeline (DESIGN.md "Effects"): built once from the scene's
- * list; an effect that is not listed is not in the pipeline at all, so it
- * costs nothing per step and a scene without random force never draws. */
+/* The effect pipeline (docs/architecture.md "Where a new thing goes"):
+ * built once from the scene's list; an effect that is not listed is not in
+ * the pipeline at all, so it costs nothing per step and a scene without
+ * random force never draws. */
 #ifndef BSIM_EFFECTS_H
 #define BSIM_EFFECTS_H
 

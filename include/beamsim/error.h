@@ -11,7 +11,8 @@
 extern "C" {
 #endif
 
-/* The codes double as the program's exit status (DESIGN.md "Command line"). */
+/* The codes double as the program's exit status (docs/files.md "Command
+ * line"). */
 enum {
 	BSIM_OK = 0,
 	BSIM_EFAIL = 1,     /* a run failed (I/O, a non-finite state, ...) */

@@ -1,6 +1,6 @@
 /* An experiment: a scene, fixed overrides, a grid of parameter values whose
  * cartesian product is the groups, trials per group and a seed
- * (DESIGN.md "Experiment file"). */
+ * (docs/files.md "Experiment file (YAML)"). */
 #ifndef BSIM_EXPERIMENT_H
 #define BSIM_EXPERIMENT_H
 

@@ -1,4 +1,4 @@
-/* The potential energy landscape of a scene (MODEL.md section 7, essay
+/* The potential energy landscape of a scene (docs/model.md section 7, essay
  * Sec. 2.5, Eq. 2.16):
  *
  *   E_total(x, y) = E_prop(y) + E_beam(x, y)

@@ -1,4 +1,4 @@
-/* Gate lattices (MODEL.md section 8, essay Sec. 2.6): the gates' geometry
+/* Gate lattices (docs/model.md section 8, essay Sec. 2.6): the gates' geometry
  * and which gate a point lies in. Where a trial ended and a group's
  * summary: beamsim/lattice_outcome.h.
  *
@@ -42,7 +42,7 @@ BSIM_API double bsim_lattice_centre_x(const bsim_scene *s);
  * lattice.beam.stiffness). Sets has_lattice and columns from ix_min/max. */
 BSIM_API int bsim_lattice_build(bsim_scene *s, const double *k_left, const double *k_right);
 
-/* The essay's lattice (MODEL.md section 8) built in code: columns x rows
+/* The essay's lattice (docs/model.md section 8) built in code: columns x rows
  * gates (columns odd, centred on ix = 0) of the Table 2.1 gate, k = 400,
  * with the lattice's termination defaults and the given propulsion and
  * random force (0 = absent). The body starts at (0, 0). */

@@ -1,4 +1,4 @@
-/* Where the trials of a gate lattice ended (MODEL.md section 8): a trial's
+/* Where the trials of a gate lattice ended (docs/model.md section 8): a trial's
  * final location, and a group's locations, gate-to-gate transitions and
  * time per row, from the runner's results (beamsim/trial.h) over the
  * lattice's geometry (beamsim/lattice.h). */
@@ -15,7 +15,7 @@
 extern "C" {
 #endif
 
-/* Where a trial ended (MODEL.md section 8): through the end boundary in
+/* Where a trial ended (docs/model.md section 8): through the end boundary in
  * column ix, out through a side at row iy, or stuck in gate (ix, iy). */
 typedef enum bsim_location_kind {
 	BSIM_LOCATION_END = 0,

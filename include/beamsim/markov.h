@@ -21,7 +21,7 @@
  * stiffnesses (left, right) the lattice uses.
  *
  * The chain. The transient states are (gate, entry bin); the absorbing ones
- * the final locations of MODEL.md section 8: the end through column ix
+ * the final locations of docs/model.md section 8: the end through column ix
  * (the top edge of the last row), a side at row iy (the outer edge of the
  * outer columns, where side_x lies), stuck in gate (ix, iy). With Q the
  * transient-to-transient and R the transient-to-absorbing probabilities and

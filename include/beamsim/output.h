@@ -1,6 +1,6 @@
-/* The output files of a sweep (DESIGN.md "Outputs", a contract):
- * summary.json, trials.csv and the text table of p_traverse. Files are
- * written through util/atomic_file.h, so a reader never sees half a
+/* The output files of a sweep (docs/files.md "Outputs of `sweep --out DIR`",
+ * a contract): summary.json, trials.csv and the text table of p_traverse.
+ * Files are written through util/atomic_file.h, so a reader never sees half a
  * file and an interrupted run leaves none. */
 #ifndef BSIM_OUTPUT_H
 #define BSIM_OUTPUT_H
@@ -20,8 +20,9 @@ extern "C" {
 BSIM_API int bsim_output_summary_json(const char *path, const bsim_experiment *e,
                                       const char *backend, const bsim_options *opts,
                                       const bsim_sweep_result *r, bsim_error *err);
-/* trials.csv, one row per trial (DESIGN.md "Outputs", extended by
- * appending): group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,
+/* trials.csv, one row per trial (docs/files.md "Outputs of
+ * `sweep --out DIR`", extended by appending):
+ * group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,
  * max_theta1,max_theta2, then the energy ledger e_start,e_end,work_in
  * (propulsion + random force),losses (dampers + impacts + contact +
  * correction),residual (J), overlap_max (m; empty if not measured), then one

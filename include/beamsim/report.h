@@ -1,7 +1,7 @@
-/* The report of a paired comparison (DESIGN.md "Outputs": compare's
- * report.md for people, report.json for tools) and the per-pair table
- * pairs.csv. beamsim regress reuses the sections for a stored run against
- * its rerun. */
+/* The report of a paired comparison (docs/files.md "Outputs of
+ * `compare --out DIR`": report.md for people, report.json for tools) and
+ * the per-pair table pairs.csv. beamsim regress reuses the sections for a
+ * stored run against its rerun. */
 #ifndef BSIM_REPORT_H
 #define BSIM_REPORT_H
 

@@ -1,6 +1,6 @@
 /* A scene: one body, any number of beams, the contact law, the effects to
- * simulate, and the integration and termination settings (DESIGN.md "Scene
- * file", MODEL.md sections 1-6). All quantities SI. */
+ * simulate, and the integration and termination settings (docs/files.md
+ * "Scene file (YAML)", docs/model.md sections 1-6). All quantities SI. */
 #ifndef BSIM_SCENE_H
 #define BSIM_SCENE_H
 
@@ -97,7 +97,7 @@ typedef struct bsim_effects_def {
 	double ground_g;  /* m/s^2, > 0; default 9.81 */
 } bsim_effects_def;
 
-/* A gate lattice (MODEL.md section 8, DESIGN.md "Scene file"): gates
+/* A gate lattice (docs/model.md section 8, docs/lattice.md "Scenes"): gates
  * (ix, iy), ix_min <= ix <= ix_max, 0 <= iy < rows. Gate (ix, iy) spans
  * X in [width ix - width/2, width ix + width/2), Y in [depth iy, depth (iy + 1))
  * (essay Eq. 2.17); its left beam hangs at (width ix - width/2, depth iy +
@@ -194,8 +194,9 @@ BSIM_API double bsim_body_heading(const bsim_body_def *body);
 /* The body's area, m^2: pi R^2, 2 R L + pi R^2, pi a b. */
 BSIM_API double bsim_body_area(const bsim_body_def *body);
 
-/* Fills the essay's single-gate scene (MODEL.md section 1, Table 2.1) with
- * the given propulsion and random force magnitude (0 = effect absent). */
+/* Fills the essay's single-gate scene (docs/model.md section 1, Table 2.1)
+ * with the given propulsion and random force magnitude (0 = effect
+ * absent). */
 BSIM_API void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm);
 
 /* Range and geometry checks (positive masses, no initial overlap, ...) on a

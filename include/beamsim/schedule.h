@@ -1,4 +1,5 @@
-/* Random-force schedules (MODEL.md section 2, DESIGN.md "Determinism").
+/* Random-force schedules (docs/model.md section 2; the seed of a trial:
+ * docs/files.md "Experiment file (YAML)").
  *
  * F_rand(t) = Rm * z_j for t in [j/f, (j+1)/f), z_j ~ N(0,1) drawn from a GSL
  * generator seeded by bsim_schedule_seed_mix(experiment seed, group, trial). Values

@@ -1,4 +1,4 @@
-/* The trial runner (MODEL.md section 6): owns time, the effect pipeline,
+/* The trial runner (docs/model.md section 6): owns time, the effect pipeline,
  * termination, outcomes, the energy ledger and optional recording. */
 #ifndef BSIM_TRIAL_H
 #define BSIM_TRIAL_H
@@ -72,7 +72,7 @@ typedef enum {
  * no energy flows is not a failure. */
 #define BSIM_LEDGER_FLOOR 1e-6
 
-/* The energy ledger of a trial, J (MODEL.md section 10, oracle 3).
+/* The energy ledger of a trial, J (docs/model.md section 10, check 3).
  * E = body KE + sum(1/2 I omega^2 + 1/2 k theta^2). Each step:
  *   E' - E = w_prop + w_rand - damper - impact - contact - correction - sleep + r
  * with r the step's residual; |r| summed and at its largest are kept. The
@@ -184,7 +184,7 @@ typedef struct bsim_record_row {
 	double f_rand;             /* N, lateral, acting on [t, t + h) */
 	const bsim_ledger *ledger; /* summed over the steps before t */
 	double e_kin, e_beam;      /* J: body and beams' kinetic, springs' elastic */
-	double e_prop;             /* J: F_prop (y0 - y), MODEL.md section 7 */
+	double e_prop;             /* J: F_prop (y0 - y), docs/model.md section 7 */
 	/* 1: the trajectory CSV's rows end with heading,angular_velocity
 	 * (bsim_trial_body_columns) */
 	int body_columns;
@@ -193,7 +193,7 @@ typedef struct bsim_record_row {
 /* Called at every recorded row (the rows of the CSV, whatever it is). */
 typedef void (*bsim_record_fn)(void *user, const bsim_record_row *row);
 
-/* Trajectory recording (DESIGN.md "Outputs"). Rows are the state at
+/* Trajectory recording (docs/files.md "`run`"). Rows are the state at
  * t = 0, after every stride-th step, and after the last step. */
 typedef struct bsim_recorder {
 	FILE *csv;           /* NULL: no trajectory CSV */

@@ -34,7 +34,7 @@
  * and side boundaries, the body and its trail, the random force as an arrow
  * from the body centre (length R |F| / Rm: one body radius per Rm), and
  * overlaid: the backend, the time, the kinetic energy of body and beams,
- * the springs' energy, the propulsive potential F_prop (y0 - y) (MODEL.md
+ * the springs' energy, the propulsive potential F_prop (y0 - y) (docs/model.md
  * section 7), the random force, and the outcome from the moment it is
  * decided. Side by side, each panel also shows the other panels' trails in
  * grey and marks where the body trajectories part (first more than 1% of

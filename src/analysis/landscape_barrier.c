@@ -1,5 +1,5 @@
 /* The barriers of a potential energy landscape (beamsim/landscape.h,
- * MODEL.md section 7): the lowest pass from the start basin to the far
+ * docs/model.md section 7): the lowest pass from the start basin to the far
  * side, over any beam and over each beam, for any number of beams.
  *
  * Definitions. E = E_total. A path moves between 4-neighbouring grid
@@ -362,7 +362,7 @@ static int exit_label(const patch *p, int k)
 }
 
 /* Where the body cannot be: at or beyond the side boundary (a trial ends
- * there) or overlapping a pivot (a fixed point, MODEL.md section 3). */
+ * there) or overlapping a pivot (a fixed point, docs/model.md section 3). */
 static int blocked(const bsim_scene *s, const double c[2])
 {
 	if (fabs(c[0]) >= s->side_x)

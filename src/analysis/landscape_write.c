@@ -613,7 +613,7 @@ static int figure_top(const char *dir, const bsim_scene *s, const bsim_landscape
  * - where the body cannot be (overlapping a pivot) and above the clip level
  *   (near a pivot th(x, y) nears pi and E thousands of joules);
  * - at a cliff, the step of the landscape at the rim of a beam's reach
- *   (rho = L + R, MODEL.md section 7): between neighbours that differ by
+ *   (rho = L + R, docs/model.md section 7): between neighbours that differ by
  *   more than CLIFF_SHARE of the drawn range and by more than CLIFF_RATIO
  *   times the steps on either side, the higher one. Drawn, a step is one
  *   quadrangle standing upright, which no lighting makes legible. */

@@ -15,7 +15,8 @@
 #include "beamsim/scene.h"
 #include "beamsim/sweep.h"
 
-/* Exit statuses (DESIGN.md "Command line"); they equal the bsim_error codes. */
+/* Exit statuses (docs/files.md "Command line"); they equal the bsim_error
+ * codes. */
 enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2, CLI_DISAGREE = 3 };
 
 /* One subcommand: argv[0] is its name. Returns the exit status. */

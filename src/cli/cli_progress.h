@@ -1,4 +1,4 @@
-/* A progress line for long runs on a terminal (DESIGN.md "Command line":
+/* A progress line for long runs on a terminal (docs/files.md "Command line":
  * progress and an ETA on a terminal, quiet when not on one).
  *
  *   "\r  1234/3000 trials  41%  ETA 0:03" on stderr, redrawn in place. */

@@ -91,11 +91,9 @@ static const cli_spec landscape_spec = {
         .name = "landscape",
         .usage = "SCENE --out DIR [OPTIONS]",
         .about = "Samples the potential energy landscape of the scene file SCENE on a grid,\n"
-                 "E_total(x, y) = F_prop (y0 - y) + sum 1/2 k_i th_i(x, y)^2 (MODEL.md section "
-                 "7),\n"
-                 "finds the lowest pass from the start basin to the far side over any beam "
-                 "and\n"
-                 "over each beam, prints the barrier table and writes into DIR:\n"
+                 "E_total(x, y) = F_prop (y0 - y) + sum 1/2 k_i th_i(x, y)^2 (docs/model.md\n"
+                 "section 7), finds the lowest pass from the start basin to the far side over\n"
+                 "any beam and over each beam, prints the barrier table and writes into DIR:\n"
                  "  landscape.csv    x,y,e_beam,e_prop,e_total,theta1,...,thetaN per grid "
                  "point\n"
                  "  landscape.mat    the same columns, the grid's shape and the barrier "

@@ -4,7 +4,7 @@
  * Over the landscape a recorded state at (x, y) with beam angles theta_i
  * sits at its own energy
  *   E = F_prop (y0 - y) + sum_i 1/2 k_i theta_i^2,
- * the same E_total as the surface's (MODEL.md section 7) but with the
+ * the same E_total as the surface's (docs/model.md section 7) but with the
  * beams' actual angles instead of th_i(x, y), the angle of a beam resting
  * against the body. With every beam that the body can reach in contact the
  * two agree; a beam swung past the body (after an impact) lifts the path

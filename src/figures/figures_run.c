@@ -3,7 +3,7 @@
  * N(0, Rm^2) it is drawn from (essay Fig. 2.2), the energy ledger over
  * time, and the trajectory over the landscape (Fig. 2.7).
  *
- * The force is piecewise constant, a fresh draw every 1/f s (MODEL.md
+ * The force is piecewise constant, a fresh draw every 1/f s (docs/model.md
  * section 2): the histogram counts each draw once, the first recorded row
  * of each interval [j/f, (j+1)/f) (rows further apart than 1/f miss
  * some draws, which are then missing from it). */

@@ -5,7 +5,7 @@
  * Beam i is in contact during a step when, at the step's end,
  *   gap_i = |C - Q_i| - R < BSIM_CONTACT_TOL        (beamsim/state.h, 6 mm)
  * (C the body's centre, Q_i the nearest point of the beam's segment, R the
- * body's radius: MODEL.md section 3, from the state the backend reports),
+ * body's radius: docs/model.md section 3, from the state the backend reports),
  * or the beam exchanged a nonzero normal impulse with the body during the
  * step (an impact, a persistent-contact or a Box2D contact impulse). The
  * flag's value is the contact's type at the step's end: TANGENT when the

@@ -1,9 +1,9 @@
-/* Experiment files (DESIGN.md "Experiment file"): a scene, fixed overrides,
- * a grid whose cartesian product is the groups (first axis slowest), trials
- * per group and a seed. Every group's scene is built and validated at load,
- * so a bad grid value fails before any trial runs; each value is tried
- * first in one group of its own, so a bad one is named before the product
- * is counted or expanded. */
+/* Experiment files (docs/files.md "Experiment file (YAML)"): a scene, fixed
+ * overrides, a grid whose cartesian product is the groups (first axis
+ * slowest), trials per group and a seed. Every group's scene is built and
+ * validated at load, so a bad grid value fails before any trial runs; each
+ * value is tried first in one group of its own, so a bad one is named before
+ * the product is counted or expanded. */
 #include "beamsim/experiment.h"
 
 #include <errno.h>

@@ -1,4 +1,5 @@
-/* The potential energy landscape (beamsim/landscape.h, MODEL.md section 7).
+/* The potential energy landscape (beamsim/landscape.h, docs/model.md
+ * section 7).
  *
  * phi is computed from the centre's components along the rest direction u0
  * and along the forward normal sgn * perp(u0), so that a mirrored beam (u0

@@ -1,5 +1,5 @@
 /* Gate lattices: geometry, the lattice built in code, and final locations
- * (beamsim/lattice.h, MODEL.md section 8). */
+ * (beamsim/lattice.h, docs/model.md section 8). */
 #include "beamsim/lattice.h"
 
 #include <math.h>

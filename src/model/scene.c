@@ -1,7 +1,7 @@
 /* Scenes built in code: the essay's gate, defaults, validation, copies
- * (MODEL.md sections 1-6). A scene owns its beams array; every function that
- * fills a scene from scratch overwrites it without freeing, so free the old
- * contents first with bsim_scene_free. */
+ * (docs/model.md sections 1-6). A scene owns its beams array; every
+ * function that fills a scene from scratch overwrites it without freeing,
+ * so free the old contents first with bsim_scene_free. */
 #include "beamsim/scene.h"
 
 #include <math.h>
@@ -73,7 +73,7 @@ bsim_lattice_def bsim_lattice_def_default(void)
 	l.columns = l.rows = 9; /* essay Sec. 2.6 */
 	l.ix_min = -4;
 	l.ix_max = 4;
-	l.width = 50;   /* m, MODEL.md section 8 */
+	l.width = 50;   /* m, docs/model.md section 8 */
 	l.depth = 60;   /* m */
 	l.pivot_y = 30; /* m */
 	l.beam = bsim_beam_def_default();

@@ -1,9 +1,9 @@
-/* The lattice: block of a scene file (DESIGN.md "Scene file", MODEL.md
- * section 8): its keys by the schema table, then what needs the lattice's
- * shape first (the ix range, the stiffness maps, the map's CSV file, the
- * protocol), then the beams built from it. Every failure is one message
- * "WHERE: lattice.FIELD: expected WHAT, got GOT", WHERE a position in the
- * scene file or, for the CSV, in that file. */
+/* The lattice: block of a scene file (docs/files.md "Scene file (YAML)",
+ * docs/model.md section 8): its keys by the schema table, then what needs the
+ * lattice's shape first (the ix range, the stiffness maps, the map's CSV
+ * file, the protocol), then the beams built from it. Every failure is one
+ * message "WHERE: lattice.FIELD: expected WHAT, got GOT", WHERE a position in
+ * the scene file or, for the CSV, in that file. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>

@@ -272,7 +272,7 @@ static void success_line_default(walk *w, struct fy_node *root)
 		s->classify_y = s->success_y + 15.0;
 }
 
-/* The body must not start inside a beam (MODEL.md section 3). The message
+/* The body must not start inside a beam (docs/model.md section 3). The message
  * points at body.start, or at the override that last moved the body or that
  * beam. */
 static int check_overlap(walk *w)
@@ -373,7 +373,7 @@ static void default_name(bsim_scene *s, const char *path)
 }
 
 /* An effect block that asks for nothing simulates nothing: "Rm = 0 means no
- * random force at all (no draws)" (MODEL.md section 2), and likewise a
+ * random force at all (no draws)" (docs/model.md section 2), and likewise a
  * propulsion of 0 N. */
 static void effects_present(bsim_scene *s)
 {

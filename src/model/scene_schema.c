@@ -1,6 +1,7 @@
-/* The scene file's keys (DESIGN.md "Scene file"): one table per mapping.
- * Blocks are namespaces over the same struct, so every offset in the top
- * table's tree is into bsim_scene; the beam table's are into bsim_beam_def. */
+/* The scene file's keys (docs/files.md "Scene file (YAML)"): one table per
+ * mapping. Blocks are namespaces over the same struct, so every offset in
+ * the top table's tree is into bsim_scene; the beam table's are into
+ * bsim_beam_def. */
 #include "model/scene_internal.h"
 
 #include <math.h>

@@ -4,9 +4,9 @@
  * out dynamically to OpenMP threads (trials end at very different times, so
  * a static split would leave threads idle). A trial's seed depends only on
  * (experiment seed, g, t) and its result goes to its own slot, so the
- * result is the same whatever the thread count (DESIGN.md "Determinism").
- * A paired sweep runs each trial on a second backend too, in the same slot
- * of a second result (trial_pair.c).
+ * result is the same whatever the thread count (docs/files.md "Experiment
+ * file (YAML)"). A paired sweep runs each trial on a second backend too, in
+ * the same slot of a second result (trial_pair.c).
  *
  * A group whose scene draws no random numbers (bsim_effects_random) is
  * deterministic: every trial of it is the same trial. It runs once, as

@@ -1,17 +1,17 @@
-/* The trial runner (MODEL.md section 6, DESIGN.md "The flow of one
- * experiment"): time, forces from the effect pipeline, termination and
- * outcomes, around a backend's step. Everything here is the same code for
- * every backend. What the runner keeps besides the state has a file each:
- * the energy ledger and instability (trial_ledger), the beams' peaks and
- * last contacts (trial_peaks), the gate path (trial_gates, trial_log),
- * recording (trial_record) and the overlap measure (trial_overlap).
+/* The trial runner (docs/model.md section 6): time, forces from the effect
+ * pipeline, termination and outcomes, around a backend's step. Everything
+ * here is the same code for every backend. What the runner keeps besides the
+ * state has a file each: the energy ledger and instability (trial_ledger),
+ * the beams' peaks and last contacts (trial_peaks), the gate path
+ * (trial_gates, trial_log), recording (trial_record) and the overlap measure
+ * (trial_overlap).
  *
  * Cost. A step's bookkeeping visits only the beams the backend lists as
  * active (bsim_state.active: the others are exactly at rest), so in a
  * lattice it costs what the beams near the body cost, like the backend's
  * step; what it calls every step is inline.
  *
- * Lattices (MODEL.md section 8). The runner follows the gate the body is
+ * Lattices (docs/model.md section 8). The runner follows the gate the body is
  * in (lattice.h), records each entry (bsim_gate_entry), ends the trial as
  * stuck when the body has spent gate_steps steps in one gate, and measures
  * side exits from the field's centre line. Under the essay's protocol

@@ -1,4 +1,4 @@
-/* Internal: the gate of a lattice the body is in (MODEL.md section 8,
+/* Internal: the gate of a lattice the body is in (docs/model.md section 8,
  * lattice.h), followed step by step, and the path of gates it entered
  * (bsim_gate_entry, the trial log). A scene without a lattice is one gate,
  * (0, 0). */

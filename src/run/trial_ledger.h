@@ -1,4 +1,4 @@
-/* Internal: the energy ledger of a trial (trial.h bsim_ledger, MODEL.md
+/* Internal: the energy ledger of a trial (trial.h bsim_ledger, docs/model.md
  * section 10) and the two tests that find a trial's numbers untrustworthy
  * (bsim_instability). The runner calls the energies, the ledger's step and
  * the finiteness test every step: they are inline, so that its loop makes

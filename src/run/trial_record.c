@@ -1,4 +1,4 @@
-/* Recording a trial (DESIGN.md "Outputs"): the layout of the trajectory
+/* Recording a trial (docs/files.md "`run`"): the layout of the trajectory
  * and ledger CSVs (trial.h gives their columns), their rows, and the row
  * every sink of a recorder receives. */
 #include "run/trial_record.h"

@@ -1,6 +1,7 @@
-/* The output files of a sweep (DESIGN.md "Outputs"): summary.json,
- * trials.csv and the p_traverse table. Both files go through
- * bsim_atomic_file, so a reader never sees a torn one. */
+/* The output files of a sweep (docs/files.md "Outputs of
+ * `sweep --out DIR`"): summary.json, trials.csv and the p_traverse table.
+ * Both files go through bsim_atomic_file, so a reader never sees a torn
+ * one. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "beamsim/output.h"

@@ -1,7 +1,8 @@
-/* The columns of trials.csv, in the order they are written (docs/files.md:
- * the eleven of DESIGN.md "Outputs", then those appended since): the one
- * list the writer (output.c) and the reader (trials_read.c) share. After
- * them come the grid axes of the experiment, one column each. */
+/* The columns of trials.csv, in the order they are written (docs/files.md
+ * "Outputs of `sweep --out DIR`": the first eleven, group to max_theta2,
+ * then those appended since): the one list the writer (output.c) and the
+ * reader (trials_read.c) share. After them come the grid axes of the
+ * experiment, one column each. */
 #ifndef BSIM_STORE_TRIALS_CSV_H
 #define BSIM_STORE_TRIALS_CSV_H
 

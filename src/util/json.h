@@ -1,7 +1,7 @@
 /* JSON values for the files and records beamsim writes (summary.json,
  * run --json, bench --json). Only the two leaf values that need care live
  * here; callers write the braces, commas and keys themselves, so each
- * output keeps the exact layout its contract (DESIGN.md "Outputs") gives. */
+ * output keeps the exact layout its contract (docs/files.md) gives. */
 #ifndef BSIM_UTIL_JSON_H
 #define BSIM_UTIL_JSON_H
 

@@ -1,5 +1,5 @@
 /* Internal: applying "--set KEY=VALUE" overrides to a YAML document by
- * dotted path (DESIGN.md "Command line"). */
+ * dotted path (docs/files.md "Command line"). */
 #ifndef BSIM_UTIL_YAML_OVERRIDE_H
 #define BSIM_UTIL_YAML_OVERRIDE_H
 
