@@ -444,6 +444,19 @@ static void test_manifest_check(void **state)
 	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_EINPUT);
 	assert_non_null(strstr(e.msg, "summary.json"));
 	assert_non_null(strstr(e.msg, "mixes files of two runs"));
+	/* a file grown past its listed size is named with its whole size */
+	char grown[64];
+	size_t len = strlen(json);
+	json[len - 3] ^= 1;
+	char *longer = malloc(len + 3);
+	assert_non_null(longer);
+	snprintf(longer, len + 3, "%s  ", json);
+	bsim_test_write(dir, "summary.json", longer);
+	free(longer);
+	snprintf(grown, sizeof grown, "got %zu bytes: the directory mixes", len + 2);
+	assert_int_equal(bsim_outdir_verify(dir, &has, &e), BSIM_EINPUT);
+	if (!strstr(e.msg, grown))
+		fail_msg("\"%s\" lacks \"%s\"", e.msg, grown);
 	/* and regress refuses such a baseline */
 	const char *argv[] = {"regress", dir, "--quiet", "--out", bsim_test_dir("mixed_rerun"),
 	                      NULL};
