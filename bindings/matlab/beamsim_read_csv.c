@@ -10,12 +10,12 @@
  * ("a, b", "" for a quote). The file's numbers as they are: beamsim_load
  * adds 1 to the group and trial columns.
  *
- * The file is read as the library reads its tables
- * (bsim_output_table_text): a regular file of at most 16 GiB, without a
- * NUL byte, ending in a line feed. Two columns whose names become one field
- * name (a.b and a_b; names alike in their first 63 characters, Octave's
- * namelengthmax and older MATLAB's, where the names are cut) are refused,
- * naming both, rather than one kept silently. */
+ * The file is read as the library reads its tables (beamsim/table.h): a
+ * regular file of at most 16 GiB, without a NUL byte, ending in a line
+ * feed, every row as wide as the header. Two columns whose names become
+ * one field name (a.b and a_b; names alike in their first 63 characters,
+ * Octave's namelengthmax and older MATLAB's, where the names are cut) are
+ * refused, naming both, rather than one kept silently. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,103 +23,69 @@
 
 #include "bsim_mex.h"
 
+/* The table's fields, header first, row by row: their texts one after
+ * another in one block (each ending in a NUL), found by offset. */
 typedef struct table {
-	char *text;    /* the file, split in place */
-	char **fields; /* rows x nc, row by row; the header first */
+	char *text;
+	size_t len, room;
+	size_t *at; /* rows x nc offsets into text */
 	size_t nc, rows, cap;
 } table;
 
-/* Splits the line at *at (ending at a newline or the end) into fields in
- * place, unquoting them; *at moves past the line. Returns the number of
- * fields, each appended to out (NULL: counted only). */
-static size_t split_line(char **at, char **out, size_t room)
+static const char *field(const table *t, size_t r, size_t c)
 {
-	char *p = *at, *w = *at;
-	size_t n = 0;
-	char *start = w;
-	int quoted = 0;
-	for (;;) {
-		char c = *p;
-		if (quoted) {
-			if (c == '\0') {
-				quoted = 0;
-				continue;
-			}
-			p++;
-			if (c == '"' && *p == '"') {
-				*w++ = '"';
-				p++;
-			} else if (c == '"') {
-				quoted = 0;
-			} else {
-				*w++ = c;
-			}
-			continue;
-		}
-		if (c == '"') {
-			quoted = 1;
-			p++;
-			continue;
-		}
-		if (c == ',' || c == '\n' || c == '\0') {
-			if (n < room)
-				out[n] = start;
-			n++;
-			int end = c != ',';
-			if (c != '\0')
-				p++;
-			*w = '\0';
-			w = p;
-			start = p;
-			if (end)
-				break;
-			continue;
-		}
-		if (c != '\r')
-			*w++ = c;
-		p++;
+	return t->text + t->at[r * t->nc + c];
+}
+
+static int keep_row(table *t, const char *const *cells, bsim_error *err)
+{
+	if ((t->rows + 1) * t->nc > t->cap) {
+		size_t cap = (t->rows + 1) * t->nc * 2;
+		size_t *more = realloc(t->at, cap * sizeof *more);
+		if (!more)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		t->at = more;
+		t->cap = cap;
 	}
-	*at = p;
-	return n;
+	for (size_t c = 0; c < t->nc; c++) {
+		size_t n = strlen(cells[c]) + 1;
+		if (t->len + n > t->room) {
+			size_t room = 2 * (t->len + n) + 4096;
+			char *more = realloc(t->text, room);
+			if (!more)
+				return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+			t->text = more;
+			t->room = room;
+		}
+		memcpy(t->text + t->len, cells[c], n);
+		t->at[t->rows * t->nc + c] = t->len;
+		t->len += n;
+	}
+	t->rows++;
+	return BSIM_OK;
 }
 
 static int read_table(const char *path, table *t, bsim_error *err)
 {
-	size_t bytes;
-	if (bsim_output_table_text(path, &t->text, &bytes, err) != BSIM_OK)
+	bsim_table_reader *r;
+	if (bsim_table_open(path, &r, err) != BSIM_OK)
 		return err->code;
-	if (t->text[0] == '\0' || t->text[0] == '\n')
-		return bsim_error_set(err, BSIM_EINPUT, "%s:1: expected a header line", path);
-	/* The header's fields counted on a copy of its line (splitting
-	 * writes into the line). */
-	size_t len = strcspn(t->text, "\n");
-	char *copy = malloc(len + 1);
-	if (!copy)
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	memcpy(copy, t->text, len);
-	copy[len] = '\0';
-	char *probe = copy;
-	t->nc = split_line(&probe, NULL, 0);
-	free(copy);
-	/* Row 0 is the header. */
-	char *at = t->text;
-	for (long line = 1; *at; line++) {
-		if ((t->rows + 1) * t->nc > t->cap) {
-			size_t cap = (t->rows + 1) * t->nc * 2;
-			char **more = realloc(t->fields, cap * sizeof *more);
-			if (!more)
-				return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-			t->fields = more;
-			t->cap = cap;
-		}
-		size_t n = split_line(&at, t->fields + t->rows * t->nc, t->nc);
-		if (n != t->nc)
-			return bsim_error_set(err, BSIM_EINPUT,
-			                      "%s:%ld: expected %zu fields, got %zu", path, line,
-			                      t->nc, n);
-		t->rows++;
-	}
-	return BSIM_OK;
+	t->nc = (size_t)bsim_table_columns(r);
+	const char **names = malloc((t->nc + 1) * sizeof *names);
+	int rc = names ? BSIM_OK : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (size_t c = 0; rc == BSIM_OK && c < t->nc; c++)
+		names[c] = bsim_table_column(r, (int)c);
+	if (rc == BSIM_OK) /* row 0 is the header */
+		rc = keep_row(t, names, err);
+	free(names);
+	const char *const *cells;
+	int got = 1;
+	while (rc == BSIM_OK && (got = bsim_table_next(r, &cells, err)) == 1)
+		rc = keep_row(t, cells, err);
+	if (rc == BSIM_OK && got < 0)
+		rc = err->code;
+	bsim_table_close(r);
+	return rc;
 }
 
 /* A field as a number: 1 if it is one (empty and nan are NaN). */
@@ -142,7 +108,7 @@ typedef char field_name[64];
 static int field_names(const char *path, const table *t, field_name *names, bsim_error *err)
 {
 	for (size_t c = 0; c < t->nc; c++) {
-		bmx_field_name(t->fields[c], names[c], sizeof names[c]);
+		bmx_field_name(field(t, 0, c), names[c], sizeof names[c]);
 		for (size_t d = 0; d < c; d++)
 			if (strcmp(names[d], names[c]) == 0)
 				return bsim_error_set(
@@ -151,7 +117,7 @@ static int field_names(const char *path, const table *t, field_name *names, bsim
 				        "%s "
 				        "(letters, digits and underscores, at most 63 characters); "
 				        "expected names that differ there",
-				        path, d + 1, t->fields[d], c + 1, t->fields[c], names[c]);
+				        path, d + 1, field(t, 0, d), c + 1, field(t, 0, c), names[c]);
 	}
 	return BSIM_OK;
 }
@@ -164,18 +130,18 @@ static mxArray *table_struct(const table *t, const field_name *names)
 		int numeric = 1;
 		double x;
 		for (size_t r = 1; numeric && r < t->rows; r++)
-			numeric = field_number(t->fields[r * t->nc + c], &x);
+			numeric = field_number(field(t, r, c), &x);
 		mxArray *col;
 		if (numeric) {
 			double *d;
 			col = bmx_column(n, &d);
 			for (size_t r = 0; r < n; r++)
-				field_number(t->fields[(r + 1) * t->nc + c], &d[r]);
+				field_number(field(t, r + 1, c), &d[r]);
 		} else {
 			col = mxCreateCellMatrix((mwSize)n, 1);
 			for (size_t r = 0; r < n; r++)
 				mxSetCell(col, (mwIndex)r,
-				          bmx_string(t->fields[(r + 1) * t->nc + c]));
+				          bmx_string(field(t, r + 1, c)));
 		}
 		bmx_set(s, 0, names[c], col);
 	}
@@ -203,8 +169,8 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
 	if (rc == BSIM_OK)
 		out = table_struct(&t, names);
 	free(names);
-	free(t.fields);
-	bsim_output_table_text_free(t.text);
+	free(t.at);
+	free(t.text);
 	bmx_pool_free(&pool);
 	if (rc != BSIM_OK)
 		bmx_fail(&err);

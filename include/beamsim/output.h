@@ -45,17 +45,6 @@ BSIM_API int bsim_output_trajectories_csv(const char *path, const bsim_sweep_res
 BSIM_API int bsim_output_trials_read(const char *path, int n_groups, int trials,
                                      bsim_sweep_result *r, bsim_error *err);
 
-/* The text of a CSV table, read as beamsim reads its own tables, for a
- * program that splits it itself (the MEX function beamsim_read_csv): a
- * regular file (a directory, a FIFO or a device such as /dev/zero is
- * refused at once, never waited on or read) of at most 16 GiB (80 million
- * rows of trials.csv), without a NUL byte, its last line ending in a line
- * feed. *text is malloc'd, a NUL after its *len bytes; free it with
- * bsim_output_table_text_free. BSIM_EINPUT naming the file (and the line,
- * or the limit) otherwise. */
-BSIM_API int bsim_output_table_text(const char *path, char **text, size_t *len, bsim_error *err);
-BSIM_API void bsim_output_table_text_free(char *text);
-
 /* Whether a run could write the output directory dir now (docs/robustness.md,
  * "Directories"), found without changing anything: BSIM_OK (a directory
  * missing is fine: the run creates it), or BSIM_EINPUT naming why not: dir

@@ -565,20 +565,6 @@ void bsim_output_table(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 
 /* ---- directories ---------------------------------------------------------- */
 
-int bsim_output_table_text(const char *path, char **text, size_t *len, bsim_error *err)
-{
-	file_text t;
-	int rc = csv_text_read(path, &t, err);
-	*text = t.text;
-	*len = t.len;
-	return rc;
-}
-
-void bsim_output_table_text_free(char *text)
-{
-	free(text);
-}
-
 int bsim_output_mkdir(const char *dir, bsim_error *err)
 {
 	char path[1024];
