@@ -287,7 +287,7 @@ static void test_refusals(void **state)
 	}
 	assert_int_equal(rc, 128 + SIGINT);
 	assert_int_equal(bsim_test_cli(argv, NULL, &err), 2);
-	assert_non_null(strstr(err, "add --resume to continue it"));
+	assert_non_null(strstr(err, "that run's command with --resume continues it"));
 	free(err);
 	const char *other[] = {"sweep",    experiment, "--quiet", "--out", dir,
 	                       "--resume", "--seed",   "6",       NULL};

@@ -278,8 +278,9 @@ static int refuse_held(const bsim_outdir *od, const char *dir, const bsim_outdir
 	struct stat st;
 	if (join(path, sizeof path, od->work, "journal") == 0 && lstat(path, &st) == 0)
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s holds the journal of a stopped run (%s): add %s to "
-		                      "continue it, or %s to discard it and start over",
+		                      "%s holds the journal of a stopped run (%s): that run's "
+		                      "command with %s continues it, %s discards it and starts "
+		                      "over",
 		                      dir, path, bsim_outdir_resume_option(sp),
 		                      bsim_outdir_overwrite_option(sp));
 	olist l = {0};

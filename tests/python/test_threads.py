@@ -138,7 +138,8 @@ def test_ctrl_c_stops_a_comparison_and_resume_continues(h1, tmp_path):
     assert not (out / "pairs.csv").exists() and (out / ".beamsim" / "journal").exists()
     with pytest.raises(ValueError) as e:
         beamsim.compare(h1, trials=2, threads=1, out=out)
-    assert "add resume=True to continue it" in str(e.value) and "--resume" not in str(e.value)
+    assert "that run's command with resume=True continues it, overwrite=True discards it" \
+        in str(e.value) and "--" not in str(e.value)
     beamsim.compare(h1, trials=2, threads=1, out=out, resume=True)
     whole = tmp_path / "whole"
     beamsim.compare(h1, trials=2, threads=2, out=whole)
