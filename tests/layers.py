@@ -34,6 +34,7 @@ RANK = {
     "model": 1,
     "thesis": 2,
     "box2d": 2,
+    "chipmunk": 2,
     "run": 3,
     "store": 4,
     "figures": 5,

@@ -111,6 +111,7 @@ BSIM_API const bsim_backend *bsim_backend_find(const char *name, bsim_error *err
 
 BSIM_API extern const bsim_backend bsim_backend_thesis;
 BSIM_API extern const bsim_backend bsim_backend_box2d;
+BSIM_API extern const bsim_backend bsim_backend_chipmunk;
 
 #ifdef __cplusplus
 }

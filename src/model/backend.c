@@ -7,6 +7,7 @@
 static const bsim_backend *const registry[] = {
         &bsim_backend_thesis,
         &bsim_backend_box2d,
+        &bsim_backend_chipmunk,
         NULL,
 };
 

@@ -1,6 +1,7 @@
 /* What the library is and what built it; see beamsim/version.h. The Box2D
  * version is its CMake package's (BSIM_BOX2D_VERSION, set by CMakeLists.txt):
- * Debian's 2.4.1 still says 2.4.0 in its b2_version. */
+ * Debian's 2.4.1 still says 2.4.0 in its b2_version. Chipmunk's is its
+ * header's (BSIM_CHIPMUNK_VERSION, read by CMakeLists.txt). */
 #include "beamsim/version.h"
 
 #include "build_info.h"
@@ -18,6 +19,11 @@ const char *bsim_version_commit(void)
 const char *bsim_version_box2d(void)
 {
 	return BSIM_BOX2D_VERSION;
+}
+
+const char *bsim_version_chipmunk(void)
+{
+	return BSIM_CHIPMUNK_VERSION;
 }
 
 #define TEXT_OF(x) #x
