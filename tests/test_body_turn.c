@@ -46,7 +46,9 @@ static void scene_turning(bsim_scene *s, bsim_body_shape shape)
 	s->side_x = 1000.0;
 }
 
-static const bsim_backend *const backends[] = {&bsim_backend_box2d, &bsim_backend_thesis};
+static const bsim_backend *const backends[] = {&bsim_backend_box2d, &bsim_backend_thesis,
+                                               &bsim_backend_chipmunk};
+#define N_BACKENDS ((int)(sizeof backends / sizeof backends[0]))
 
 /* Runs trial 0 of s on be into out: 1, or 0 if be refuses the scene when
  * it creates the world (a backend that does not simulate a turning body;
@@ -174,7 +176,7 @@ static void test_spin_stop_angle(void **state)
 			arm = 2.0 * 10.0 / 3.0;
 		}
 		double alpha = 0.4 * 9.81 * 2.0 * arm / J;
-		for (int b = 0; b < 2; b++) {
+		for (int b = 0; b < N_BACKENDS; b++) {
 			spin_track t = {.h = s.dt,
 			                .psi0 = bsim_body_heading(&s.body),
 			                .w0 = 3.0,
@@ -290,7 +292,7 @@ static void test_angular_drag_decay(void **state)
 	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
 	double J = bsim_body_inertia(&s.body);
 	assert_true(fabs(J - 2.0 * (100.0 + 25.0) / 4.0) < 1e-12);
-	for (int b = 0; b < 2; b++) {
+	for (int b = 0; b < N_BACKENDS; b++) {
 		decay_track t = {.h = s.dt, .w0 = 4.0, .rate = 30.0 / J, .mass = 2.0, .J = J};
 		bsim_recorder rec = {.trace = track_decay, .trace_user = &t};
 		bsim_trial_result out;
@@ -323,7 +325,7 @@ static void test_free_capsule_conserves(void **state)
 	bsim_error err;
 	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
 	double J = bsim_body_inertia(&s.body);
-	for (int b = 0; b < 2; b++) {
+	for (int b = 0; b < N_BACKENDS; b++) {
 		decay_track t = {.h = s.dt, .w0 = 1.5, .rate = 0.0, .mass = 2.0, .J = J};
 		bsim_recorder rec = {.trace = track_decay, .trace_user = &t};
 		bsim_trial_result out;
@@ -419,7 +421,7 @@ static void test_ledger_turning(void **state)
 	s.classify_y = 1e6;
 	bsim_error err;
 	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
-	for (int b = 0; b < 2; b++) {
+	for (int b = 0; b < N_BACKENDS; b++) {
 		bsim_trial_result out;
 		if (!run_on(backends[b], &s, NULL, &out))
 			continue;

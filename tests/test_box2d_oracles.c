@@ -54,12 +54,7 @@ static bsim_world *create(const bsim_scene *s, const bsim_options *o)
 static double check_tangent(double r, double e, double u, const bsim_options *o)
 {
 	bsim_scene s;
-	scene_one_beam(&s);
-	s.contact.restitution = e;
-	s.contact.tip_restitution = 0.3; /* must not be used */
-	s.body.start[0] = r;
-	s.body.start[1] = -s.body.radius - 0.02;
-	s.body.velocity[1] = u;
+	scene_tangent_hit(&s, r, e, u, 0.02);
 	bsim_world *w = create(&s, o);
 	bsim_state st;
 	bsim_state_init(&st, 1);
@@ -128,16 +123,7 @@ static void test_tangent_impact_oracle(void **state)
 static void run_tip(double e_tip, double out[4])
 {
 	bsim_scene s;
-	scene_one_beam(&s);
-	s.contact.restitution = 0.2; /* must not be used */
-	s.contact.tip_restitution = e_tip;
-	double a = -40.0 * 3.141592653589793 / 180.0;
-	double n[2] = {cos(a), sin(a)}; /* tip -> body centre */
-	double d = 10.0 + 0.03;
-	s.body.start[0] = 25.0 + d * n[0];
-	s.body.start[1] = d * n[1];
-	s.body.velocity[0] = -0.6;
-	s.body.velocity[1] = 2.0;
+	scene_tip_hit(&s, e_tip, 0.03);
 	bsim_world *w = create(&s, NULL);
 	bsim_state st;
 	bsim_state_init(&st, 1);
@@ -149,17 +135,8 @@ static void run_tip(double e_tip, double out[4])
 		b2->get_state(w, &st);
 		tip |= st.contact[0] == BSIM_CONTACT_TIP;
 		assert_true(st.contact[0] != BSIM_CONTACT_TANGENT);
-		if (st.impacts && !impacts) {
-			/* the tip point moves with omega (-L sin, L cos) ~ (0, L omega) */
-			double c[2] = {st.x[0] - 25.0 * cos(st.theta[0]),
-			               st.x[1] - 25.0 * sin(st.theta[0])};
-			double len = hypot(c[0], c[1]);
-			double tipv[2] = {-25.0 * sin(st.theta[0]) * st.omega[0],
-			                  25.0 * cos(st.theta[0]) * st.omega[0]};
-			vrel_before = -0.6 * c[0] / len + 2.0 * c[1] / len;
-			vrel_after =
-			        ((st.v[0] - tipv[0]) * c[0] + (st.v[1] - tipv[1]) * c[1]) / len;
-		}
+		if (st.impacts && !impacts)
+			tip_hit_normal_velocities(&st, &vrel_before, &vrel_after);
 		impacts += st.impacts;
 	}
 	double mass = s.body.mass, inertia = s.beams[0].inertia;
@@ -199,13 +176,6 @@ static void test_tip_impact_restitution(void **state)
 
 /* ---- 2. free vibration ---------------------------------------------------- */
 
-static double oscillator(double k, double d, double inertia, double th0, double t)
-{
-	double wn = sqrt(k / inertia), zeta = d / (2.0 * sqrt(k * inertia));
-	double wd = wn * sqrt(1.0 - zeta * zeta);
-	return th0 * exp(-zeta * wn * t) * (cos(wd * t) + zeta * wn / wd * sin(wd * t));
-}
-
 /* Max |theta - exact| over 3 s for a Table 2.1 beam released from 0.1 rad. */
 static double vibration_error(const char *spring, double h, double rest_deg)
 {
@@ -225,7 +195,8 @@ static double vibration_error(const char *spring, double h, double rest_deg)
 	for (long n = 1; n <= n_steps; n++) {
 		assert_int_equal(b2->step(w, zero, 0.0, h, NULL), BSIM_OK);
 		b2->get_state(w, &st);
-		double exact = oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
+		double exact =
+		        damped_oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
 		worst = fmax(worst, fabs(st.theta[0] - exact));
 		/* torque mode: d omega h omega' is negative only when omega
 		 * changes sign within the step */

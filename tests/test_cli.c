@@ -15,6 +15,8 @@
 
 #include <cmocka.h>
 
+#include <chipmunk/chipmunk.h>
+
 #include "beamsim/version.h"
 #include "support.h"
 
@@ -164,17 +166,42 @@ static void test_version(void **state)
 	cli_run r = run_cli(argv);
 	assert_int_equal(r.status, 0);
 	/* The first line is the project's version; then what built it: the
-	 * Box2D of the CMake package the build found, and this compiler. */
+	 * Box2D of the CMake package the build found, the Chipmunk2D of the
+	 * header, and this compiler. */
 	assert_true(strncmp(r.out, "beamsim " BSIM_VERSION "\n",
 	                    strlen("beamsim " BSIM_VERSION "\n")) == 0);
 	assert_contains(r.out, "\ncommit ");
 	assert_contains(r.out, "\nBox2D " BSIM_TEST_BOX2D_VERSION "\n");
+	char chipmunk[64]; /* the version Chipmunk's header gives */
+	snprintf(chipmunk, sizeof chipmunk, "\nChipmunk2D %d.%d.%d\n", CP_VERSION_MAJOR,
+	         CP_VERSION_MINOR, CP_VERSION_RELEASE);
+	assert_contains(r.out, chipmunk);
 #if defined(__GNUC__) && !defined(__clang__)
 	char compiler[64];
 	snprintf(compiler, sizeof compiler, "\ncompiler gcc %d.%d.%d\n", __GNUC__, __GNUC_MINOR__,
 	         __GNUC_PATCHLEVEL__);
 	assert_contains(r.out, compiler);
 #endif
+	cli_run_free(&r);
+}
+
+/* Debian's Chipmunk prints a banner on stdout at its first space: the
+ * chipmunk backend sends it to /dev/null, so `run --json` on it prints
+ * the one JSON object and nothing else, and the banner is on neither
+ * stream. Without the redirect the banner's two lines come first. */
+static void test_chipmunk_stdout_clean(void **state)
+{
+	(void)state;
+	const char *argv[] = {"run", gate, "--backend", "chipmunk", "--json", NULL};
+	cli_run r = run_cli(argv);
+	assert_int_equal(r.status, 0);
+	assert_true(r.out[0] == '{');
+	assert_non_null(strstr(r.out, "\"backend\": \"chipmunk\""));
+	const char *end = strrchr(r.out, '}');
+	assert_non_null(end);
+	assert_string_equal(end, "}\n");
+	assert_null(strstr(r.out, "Chipmunk v"));
+	assert_null(strstr(r.err, "Chipmunk v"));
 	cli_run_free(&r);
 }
 
@@ -737,6 +764,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_help),
 	        cmocka_unit_test(test_version),
+	        cmocka_unit_test(test_chipmunk_stdout_clean),
 	        cmocka_unit_test(test_help_command),
 	        cmocka_unit_test(test_bad_usage),
 	        cmocka_unit_test(test_sweep_needs_out),

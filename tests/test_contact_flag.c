@@ -1,21 +1,22 @@
 /* The contact flag (beamsim/state.h, model/contact_flag.h) against
- * independent truths, on both backends: beam i is flagged in a step when
+ * independent truths, on every backend: beam i is flagged in a step when
  * at the step's end the body is within BSIM_CONTACT_TOL (6 mm) of it, or
  * when it exchanged an impulse with the body in the step.
  *
  * - A head-on impact in free flight: the body, at speed u with a gap g0 to
  *   the beam and no force, touches it at t* = g0 / u. The first flagged
  *   step is the first that ends within the tolerance or holds t*, whichever
- *   comes first, on both backends; at 10 m/s the body has bounced clear by
- *   more than the tolerance at the impact step's end, so the impulse alone
- *   flags it.
+ *   comes first, on every backend; at 10 m/s the body has bounced clear by
+ *   more than the tolerance at the impact step's end on the thesis backend
+ *   and Box2D, so the impulse alone flags it (Chipmunk's contact acts once
+ *   the body overlaps the beam, and that step ends with it overlapping).
  * - A grazing pass parallel to the beam, from beside it to past its tip:
  *   the gap is known all along the straight path (the clearance c beside
  *   the beam, the distance to the tip beyond it); with c = 8 mm no step is
  *   flagged, with c = 3 mm exactly the steps that end with the analytic gap
  *   under the tolerance, tangent beside the beam and tip beyond it. No
  *   impulse acts (the motion is parallel), so this is the gap part alone.
- * - The two backends agree on the flag step by step through an impact. */
+ * - The backends agree on the flag step by step through an impact. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -27,7 +28,9 @@
 #include "model/contact_flag.h"
 #include "scenes.h"
 
-static const bsim_backend *const backends[] = {&bsim_backend_thesis, &bsim_backend_box2d};
+static const bsim_backend *const backends[] = {&bsim_backend_thesis, &bsim_backend_box2d,
+                                               &bsim_backend_chipmunk};
+#define N_BACKENDS ((int)(sizeof backends / sizeof backends[0]))
 
 /* Runs the scene with no force for n steps; flags[k] the flag of beam 0
  * after step k + 1. */
@@ -83,7 +86,7 @@ static void test_head_on_impact(void **state)
 		int want = near < step ? near : step;
 		bsim_scene s;
 		scene_head_on(&s, g0, u);
-		for (size_t k = 0; k < 2; k++) {
+		for (int k = 0; k < N_BACKENDS; k++) {
 			const bsim_backend *b = backends[k];
 			bsim_world *w = NULL;
 			bsim_error err;
@@ -112,7 +115,7 @@ static void test_head_on_impact(void **state)
 			assert_int_equal(first, want);
 			/* at 10 m/s the impact step ends with the body clear: the
 			 * impulse is what flags it */
-			if (u == 10.0 && near >= step)
+			if (u == 10.0 && near >= step && b != &bsim_backend_chipmunk)
 				assert_true(gap_at_impact > BSIM_CONTACT_TOL);
 			bsim_state_free(&st);
 			b->destroy(w);
@@ -147,7 +150,7 @@ static void test_grazing_pass(void **state)
 		s.body.start[0] = x0;
 		s.body.start[1] = -(R + clearance[c]);
 		s.body.velocity[0] = v;
-		for (size_t k = 0; k < 2; k++) {
+		for (int k = 0; k < N_BACKENDS; k++) {
 			run_flags(backends[k], &s, n, flags);
 			int flagged = 0, expected = 0, judged = 0;
 			for (int i = 0; i < n; i++) {
@@ -190,10 +193,13 @@ static void test_backends_agree(void **state)
 	scene_head_on(&s, 10.0 * 0.004 * 3.5, 10.0); /* impact in step 4 */
 	int a[60], b[60];
 	run_flags(&bsim_backend_thesis, &s, 60, a);
-	run_flags(&bsim_backend_box2d, &s, 60, b);
-	for (int i = 0; i < 60; i++)
-		if (a[i] != b[i])
-			fail_msg("step %d: thesis flag %d, box2d %d", i + 1, a[i], b[i]);
+	for (int k = 1; k < N_BACKENDS; k++) {
+		run_flags(backends[k], &s, 60, b);
+		for (int i = 0; i < 60; i++)
+			if (a[i] != b[i])
+				fail_msg("step %d: thesis flag %d, %s %d", i + 1, a[i],
+				         backends[k]->name, b[i]);
+	}
 	bsim_scene_free(&s);
 }
 

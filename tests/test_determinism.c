@@ -1,7 +1,8 @@
 /* docs/model.md check 6 / docs/files.md "Experiment file (YAML)": the same
  * experiment and seed give byte-identical trials.csv and the same
- * summary.json (but for the wall time) whatever the number of threads;
- * another seed gives other trials. Runs the real program. */
+ * summary.json (but for the wall time) whatever the number of threads, on
+ * every backend of the registry; another seed gives other trials. Runs the
+ * real program. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -12,6 +13,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/backend.h"
 #include "support.h"
 
 static char dir[1024];
@@ -38,21 +40,29 @@ static int setup(void **state)
 	return 0;
 }
 
-/* Runs the sweep into dir/name; returns nothing, asserts success. */
-static void sweep(const char *name, const char *threads, const char *seed)
+/* Runs the sweep into dir/name on backend (NULL: the default); returns
+ * nothing, asserts success. */
+static void sweep_on(const char *name, const char *threads, const char *seed, const char *backend)
 {
 	char out[1200];
 	snprintf(out, sizeof out, "%s/%s", dir, name);
 	const char *with_seed[] = {"sweep", experiment, "--out",  out,  "--threads",
 	                           threads, "--quiet",  "--seed", seed, NULL};
-	const char *without[] = {"sweep",     experiment, "--out",   out,
-	                         "--threads", threads,    "--quiet", NULL};
+	const char *without[] = {"sweep", experiment, "--out",     out,     "--threads",
+	                         threads, "--quiet",  "--backend", backend, NULL};
+	if (!backend)
+		without[7] = NULL;
 	char *err = NULL;
 	int status = bsim_test_cli(seed ? with_seed : without, NULL, &err);
 	if (status != 0)
 		fail_msg("beamsim sweep --threads %s exited %d: %s", threads, status,
 		         err ? err : "");
 	free(err);
+}
+
+static void sweep(const char *name, const char *threads, const char *seed)
+{
+	sweep_on(name, threads, seed, NULL);
 }
 
 static char *read_out(const char *name, const char *file)
@@ -106,6 +116,25 @@ static void test_threads_do_not_matter(void **state)
 	free(sum2);
 }
 
+/* Every backend of the registry: one thread or two, the same trials.csv. */
+static void test_threads_do_not_matter_any_backend(void **state)
+{
+	(void)state;
+	const bsim_backend *const *list = bsim_backend_list();
+	for (int k = 0; list[k]; k++) {
+		char one[64], two[64];
+		snprintf(one, sizeof one, "%s_t1", list[k]->name);
+		snprintf(two, sizeof two, "%s_t2", list[k]->name);
+		sweep_on(one, "1", NULL, list[k]->name);
+		sweep_on(two, "2", NULL, list[k]->name);
+		char *a = read_out(one, "trials.csv"), *b = read_out(two, "trials.csv");
+		if (strcmp(a, b) != 0)
+			fail_msg("%s: trials.csv differs between 1 and 2 threads", list[k]->name);
+		free(a);
+		free(b);
+	}
+}
+
 static void test_same_seed_same_result(void **state)
 {
 	(void)state;
@@ -133,6 +162,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_threads_do_not_matter),
+	        cmocka_unit_test(test_threads_do_not_matter_any_backend),
 	        cmocka_unit_test(test_same_seed_same_result),
 	        cmocka_unit_test(test_seed_matters),
 	};

@@ -21,9 +21,20 @@
 #include "beamsim/trial.h"
 #include "support.h"
 
-static const char *const BACKENDS[2] = {"thesis", "box2d"};
+/* The backends, and the index of each in the bounds below. */
+static const char *const BACKENDS[3] = {"thesis", "box2d", "chipmunk"};
+enum { THESIS = 0, BOX2D = 1, CHIPMUNK = 2 };
 /* Box2D pivot drift in case 3: measured 9.7e-5 m (1:1000), bound 1e-3 m. */
 #define PIVOT_BOUND_BOX2D 1e-3
+
+static int backend_index(const char *name)
+{
+	for (int k = 0; k < 3; k++)
+		if (strcmp(name, BACKENDS[k]) == 0)
+			return k;
+	fail_msg("unknown backend %s", name);
+	return -1;
+}
 
 static const bsim_backend *backend(const char *name)
 {
@@ -148,7 +159,8 @@ static void zeno_one(const char *bname, double e)
 	assert_true(impacts >= 2);
 	assert_true(max_per_step <= 2); /* at most one per contact */
 	/* apexes never rise (Box2D: to its float32 positions, ulp 2e-6 m at 20 m) */
-	assert_true(apex_rise <= (b == &bsim_backend_thesis ? 1e-9 : 1e-5));
+	const double rise_bound[3] = {1e-9, 1e-5, 1e-9};
+	assert_true(apex_rise <= rise_bound[backend_index(bname)]);
 	/* clean hand-off: the contacts hold from (at the latest) the step after
 	 * the last impact to the end, and the chain ends early */
 	assert_true(persistent_from > 0 && persistent_from <= last_impact + 1);
@@ -201,7 +213,7 @@ static double_run double_one(const bsim_backend *b, double dx)
 static void test_double_impact(void **state)
 {
 	const double d = 1e-6;
-	int k = strcmp(*state, "thesis") != 0;
+	int k = backend_index(*state);
 	{
 		const bsim_backend *b = backend(BACKENDS[k]);
 		double_run m = double_one(b, -d), z = double_one(b, 0.0), p = double_one(b, d);
@@ -214,7 +226,8 @@ static void test_double_impact(void **state)
 		        BACKENDS[k], z.vx_max, z.x_end, p.vx_end, m.vx_end, gain, asym, p.x_end,
 		        m.x_end, fmax(fabs(p.y_end - z.y_end), fabs(m.y_end - z.y_end)));
 		/* centred: lateral velocity at round-off (float32 for Box2D) */
-		assert_true(z.vx_max <= (k == 0 ? 1e-12 : 1e-7));
+		const double vx_bound[3] = {1e-12, 1e-7, 1e-12};
+		assert_true(z.vx_max <= vx_bound[k]);
 		/* smooth: the outcome is linear in the offset (antisymmetric) and a
 		 * 1e-6 m offset moves it by O(1e-4): the centred motion is an
 		 * unstable balance (the tips splay apart), gain ~ 86 1/s by the
@@ -287,7 +300,7 @@ static void test_mass_ratio(void **state)
 {
 	const double beam_mass[2] = {0.001, 1000.0}; /* body 1 kg: 1000:1 and 1:1000 */
 	const double wnh[4] = {0.05, 0.5, 1.5, 4.0};
-	int k = strcmp(*state, "thesis") != 0;
+	int k = backend_index(*state);
 	{
 		const bsim_backend *b = backend(BACKENDS[k]);
 		for (int m = 0; m < 2; m++) {
@@ -314,23 +327,53 @@ static void test_mass_ratio(void **state)
 				        "mass ratio %s 1:%g wn*h %.2f: rc %d, %s after %d "
 				        "steps, max "
 				        "|theta| %.3g, penetration %.3e m, pivot drift %.3e m, "
-				        "E_end - (E_0 + W) = %.3e J (W throughput %.3g J)\n",
+				        "E_end - (E_0 + W) = %.3e J (W throughput %.3g J, "
+				        "correction %.3g J)\n",
 				        BACKENDS[k], beam_mass[m], wnh[j], rc,
 				        bsim_trial_outcome_name(res.outcome), res.steps,
 				        fmax(fabs(res.max_theta[0]), fabs(res.max_theta[1])),
-				        wt.pen_max, wt.pivot_max, excess, scale);
+				        wt.pen_max, wt.pivot_max, excess, scale, l->correction);
+				if (k == CHIPMUNK && wnh[j] >= 2.0) {
+					/* Chipmunk's spring is explicit: beyond its bound
+					 * (omega_n h < 2 undamped) create refuses the scene,
+					 * naming the beam's stiffness */
+					assert_int_equal(rc, BSIM_EINPUT);
+					bsim_scene_free(&s);
+					continue;
+				}
 				assert_int_equal(rc, BSIM_OK);
 				assert_int_equal(wt.nonfinite, 0);
 				assert_int_equal(wt.tunnels, 0);
 				/* penetration: thesis projects to its slop (1e-6 m); Box2D
 				 * rests contacts at b2_linearSlop = 5 mm and lets a hard
-				 * impact sink in further within a step */
-				assert_true(wt.pen_max <= (k == 0 ? 1e-5 : 0.1));
-				/* the pin: exact in thesis; Box2D's joint rows converge
-				 * iteratively, so a pivot can be pushed off it */
-				assert_true(wt.pivot_max <= (k == 0 ? 0.0 : PIVOT_BOUND_BOX2D));
-				/* energy never rises above what the forces put in */
-				assert_true(excess <= 1e-6 * scale + 1e-9);
+				 * impact sink in further within a step; Chipmunk makes a
+				 * contact only once the shapes overlap, so a body sinks in
+				 * as far as the two close in one step: 1.40 m where the
+				 * light beam (1:0.001, omega_n h 0.5) swings back at its tip
+				 * at up to 350 m/s, 5.9 cm where the body meets the tips at
+				 * 15 m/s */
+				const double pen_bound[3] = {1e-5, 0.1, 1.5};
+				assert_true(wt.pen_max <= pen_bound[k]);
+				/* the pin: exact in thesis; Box2D's and Chipmunk's joint
+				 * rows converge iteratively, so a pivot can be pushed off
+				 * it (Chipmunk: measured 1.5e-9 m, double precision) */
+				const double pivot_bound[3] = {0.0, PIVOT_BOUND_BOX2D, 1e-6};
+				assert_true(wt.pivot_max <= pivot_bound[k]);
+				if (k != CHIPMUNK) {
+					/* energy never rises above what the forces put in */
+					assert_true(excess <= 1e-6 * scale + 1e-9);
+				} else {
+					/* Chipmunk pushes a deep overlap out by moving
+					 * positions (its bias velocities): the light beam
+					 * is turned against its spring, and energy rises
+					 * (measured +4.6 J of 29.8 J at omega_n h 0.5, +1.9
+					 * J of 62.6 J at 1.5). The ledger books it as the
+					 * correction's (a negative loss): the rise is within
+					 * it and the residual. */
+					assert_true(excess <= 0.2 * scale);
+					assert_true(excess <=
+					            -l->correction + fabs(l->residual) + 1e-9);
+				}
 				bsim_scene_free(&s);
 			}
 		}
@@ -465,9 +508,14 @@ static void graze_one(const bsim_backend *b, const char *bname, double eps)
 	assert_true(st.omega[0] > 0.0 && st.v[0] > 0.0); /* pushed the tip forward, deflected */
 	/* elastic tip impact: energy and angular momentum about the pivot kept;
 	 * Box2D in float32 with its 5 mm skin: bounded as measured */
-	assert_true(fabs(de) <= (b == &bsim_backend_thesis ? 1e-9 : 2e-3));
-	assert_true(fabs(dl) <= (b == &bsim_backend_thesis ? 1e-9 : 3e-5)); /* float32 */
-	assert_true(pen <= (b == &bsim_backend_thesis ? 1e-5 : 1e-2));
+	const int k = backend_index(bname);
+	/* Chipmunk: energy exact, angular momentum to 4e-7 (the normal the
+	 * solve used is that of the overlapping positions), overlap 3.3 mm */
+	const double de_bound[3] = {1e-9, 2e-3, 1e-9}, dl_bound[3] = {1e-9, 3e-5, 1e-6};
+	const double pen_bound[3] = {1e-5, 1e-2, 5e-3};
+	assert_true(fabs(de) <= de_bound[k]);
+	assert_true(fabs(dl) <= dl_bound[k]); /* Box2D: float32 */
+	assert_true(pen <= pen_bound[k]);
 	bsim_state_free(&st);
 	b->destroy(w);
 	bsim_scene_free(&s);
@@ -476,7 +524,7 @@ static void graze_one(const bsim_backend *b, const char *bname, double eps)
 static void test_impact_phase(void **state)
 {
 	const double e = 0.8, thr = 0.05;
-	int k = strcmp(*state, "thesis") != 0;
+	int k = backend_index(*state);
 	{
 		const bsim_backend *b = backend(BACKENDS[k]);
 		double lo = INFINITY, hi = -INFINITY, worst = 0.0;
@@ -514,7 +562,7 @@ static void test_violent_noise(void **state)
 {
 	bsim_scene s;
 	load("configs/hard/violent_noise.yaml", &s);
-	int k = strcmp(*state, "thesis") != 0;
+	int k = backend_index(*state);
 	{
 		const bsim_backend *b = backend(BACKENDS[k]);
 		int tunnels = 0, nonfinite = 0, failed = 0, hit = 0;
@@ -539,7 +587,10 @@ static void test_violent_noise(void **state)
 		assert_int_equal(failed, 0);
 		assert_int_equal(nonfinite, 0);
 		assert_int_equal(tunnels, 0);
-		assert_true(pen <= (k == 0 ? 1e-5 : 0.5));
+		/* Chipmunk: no continuous collision, the body sinks in as far
+		 * as it moves in a step (measured 0.49 m) */
+		const double pen_bound[3] = {1e-5, 0.5, 0.6};
+		assert_true(pen <= pen_bound[k]);
 	}
 	bsim_scene_free(&s);
 }
@@ -550,7 +601,7 @@ static void test_conservative_long(void **state)
 {
 	bsim_scene s;
 	load("configs/hard/conservative_long.yaml", &s);
-	int k = strcmp(*state, "thesis") != 0;
+	int k = backend_index(*state);
 	{
 		const bsim_backend *b = backend(BACKENDS[k]);
 		watch wt;
@@ -568,7 +619,7 @@ static void test_conservative_long(void **state)
 		assert_int_equal(rc, BSIM_OK);
 		assert_int_equal(res.steps_run, 100000);
 		assert_int_equal(wt.nonfinite, 0);
-		if (k == 0) {
+		if (k == THESIS) {
 			/* The model conserves energy here; the thesis solver loses
 			 * 1.06% over 400 s, all of it as persistent-contact work (ledger
 			 * contact 0.132 J, with rest_threshold 0.05 or 0 alike): a
@@ -578,11 +629,18 @@ static void test_conservative_long(void **state)
 			 * the beam, plastically. Stated and bounded as measured. */
 			assert_true(drift <= 0.0 && fabs(drift) <= 0.011);
 			assert_int_equal(wt.tunnels, 0);
-		} else {
+		} else if (k == BOX2D) {
 			/* Box2D's weld spring is backward Euler (it damps, -7% over 12 s
 			 * in the gate) and the body leaves the cage (float32 drift off
 			 * the midline): bounded as measured, -0.88 */
 			assert_true(drift <= 0.0 && fabs(drift) <= 0.9);
+		} else {
+			/* Chipmunk's spring is symplectic Euler: the energy oscillates
+			 * about its value (measured +0.54% at the end, +1.7% at most)
+			 * and impacts lose nothing */
+			assert_true(fabs(drift) <= 0.01 && rise <= 0.02);
+			assert_true(fabs(l->impact) + fabs(l->contact) <= 1e-6 * l->e_start);
+			assert_int_equal(wt.tunnels, 0);
 		}
 	}
 	bsim_scene_free(&s);
@@ -593,18 +651,25 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test_prestate(test_zeno_settling, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_zeno_settling, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_zeno_settling, (void *)"chipmunk"),
 	        cmocka_unit_test_prestate(test_double_impact, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_double_impact, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_double_impact, (void *)"chipmunk"),
 	        cmocka_unit_test_prestate(test_mass_ratio, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_mass_ratio, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_mass_ratio, (void *)"chipmunk"),
 	        cmocka_unit_test_prestate(test_wedge, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_wedge, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_wedge, (void *)"chipmunk"),
 	        cmocka_unit_test_prestate(test_impact_phase, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_impact_phase, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_impact_phase, (void *)"chipmunk"),
 	        cmocka_unit_test_prestate(test_violent_noise, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_violent_noise, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_violent_noise, (void *)"chipmunk"),
 	        cmocka_unit_test_prestate(test_conservative_long, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_conservative_long, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_conservative_long, (void *)"chipmunk"),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,5 +1,5 @@
 /* Hard cases of the turning, shaped, frictional body (configs/hard/), each
- * run on both backends through the trial runner with explicit criteria;
+ * run on every backend through the trial runner with explicit criteria;
  * every measured value is printed.
  *   8  a capsule wedged between both beams (capsule_wedge.yaml)
  *   9  friction at a high normal force: stick inside the cone, slide
@@ -202,10 +202,13 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test_prestate(test_capsule_wedge, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_capsule_wedge, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_capsule_wedge, (void *)"chipmunk"),
 	        cmocka_unit_test_prestate(test_friction_press, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_friction_press, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_friction_press, (void *)"chipmunk"),
 	        cmocka_unit_test_prestate(test_spin_tip, (void *)"thesis"),
 	        cmocka_unit_test_prestate(test_spin_tip, (void *)"box2d"),
+	        cmocka_unit_test_prestate(test_spin_tip, (void *)"chipmunk"),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

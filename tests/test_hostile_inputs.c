@@ -344,9 +344,9 @@ static void test_extreme_numbers(void **state)
 	        {"effects.random_force.frequency=1e5", "integration.dt=1e-8"},
 	        {"body.mass=1e-300", "body.velocity=[1e300, -1e300]"},
 	};
-	const char *backends[] = {"thesis", "box2d"};
+	const char *backends[] = {"thesis", "box2d", "chipmunk"};
 	for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++) {
-		for (int b = 0; b < 2; b++) {
+		for (int b = 0; b < 3; b++) {
 			const char *argv[] = {"run",       gate(),     "--backend",
 			                      backends[b], "--set",    sets[i][0],
 			                      "--set",     sets[i][1], NULL};
