@@ -22,6 +22,7 @@
 #include "beamsim/trial.h"
 #include "chipmunk/chipmunk_world.h"
 #include "scenes.h"
+#include "vibration.h"
 
 static const bsim_backend *const cm = &bsim_backend_chipmunk;
 
@@ -170,73 +171,13 @@ static void test_tip_impact_restitution(void **state)
 
 /* ---- 2. free vibration ---------------------------------------------------- */
 
-/* A Table 2.1 beam released from 0.1 rad, 3 s: the largest |theta - exact|,
- * and from the peaks of |theta| (its local maxima) the decay rate
- * ln(A_first / A_last) / (t_last - t_first) and the period, each relative
- * to the oscillator's (zeta omega_n, 2 pi / omega_d). */
-typedef struct vibration {
-	double worst, rate_rel, period_rel;
-} vibration;
-
-static vibration vibration_of(const char *opt, double h, double rest_deg)
-{
-	bsim_scene s;
-	scene_one_beam(&s);
-	const double k = 400.0, d = 50.0;
-	s.beams[0].stiffness = k;
-	s.beams[0].damping = d;
-	s.beams[0].initial_theta = 0.1;
-	s.beams[0].rest_angle_deg = rest_deg;
-	if (rest_deg > 90.0)
-		s.beams[0].pivot[0] = 25.0;
-	bsim_options o = opts_of(opt, NULL);
-	bsim_world *w = create(&s, &o);
-	bsim_state st;
-	bsim_state_init(&st, 1);
-	const double zero[2] = {0.0, 0.0}, inertia = s.beams[0].inertia;
-	double worst = 0.0, damper = 0.0, prev = 0.1, prev2 = 0.1;
-	double t_first = -1.0, a_first = 0.0, t_last = 0.0, a_last = 0.0;
-	int peaks = 0;
-	long n_steps = lround(3.0 / h);
-	for (long n = 1; n <= n_steps; n++) {
-		assert_int_equal(cm->step(w, zero, 0.0, h, NULL), BSIM_OK);
-		cm->get_state(w, &st);
-		double t = (double)n * h;
-		worst = fmax(worst, fabs(st.theta[0] - damped_oscillator(k, d, inertia, 0.1, t)));
-		if (n >= 2 && fabs(prev) > fabs(prev2) && fabs(prev) >= fabs(st.theta[0])) {
-			if (t_first < 0.0) {
-				t_first = t - h;
-				a_first = fabs(prev);
-			}
-			t_last = t - h;
-			a_last = fabs(prev);
-			peaks++;
-		}
-		prev2 = prev;
-		prev = st.theta[0];
-		damper += st.energy.damper;
-	}
-	assert_true(peaks >= 3);
-	assert_true(damper > 0.0);
-	double wn = sqrt(k / inertia), zeta = d / (2.0 * sqrt(k * inertia));
-	double rate = log(a_first / a_last) / (t_last - t_first);
-	/* peaks of |theta| come every half period */
-	double period = 2.0 * (t_last - t_first) / (peaks - 1);
-	vibration v = {worst, rate / (zeta * wn) - 1.0,
-	               period / (2.0 * 3.14159265358979323846 / (wn * sqrt(1.0 - zeta * zeta))) -
-	                       1.0};
-	bsim_state_free(&st);
-	cm->destroy(w);
-	bsim_scene_free(&s);
-	return v;
-}
-
 static void test_free_vibration_oracle(void **state)
 {
 	(void)state;
-	vibration v4 = vibration_of(NULL, 0.004, 0.0), v2 = vibration_of(NULL, 0.002, 0.0);
-	vibration mirror = vibration_of(NULL, 0.004, 180.0);
-	vibration sub = vibration_of("substeps=4", 0.004, 0.0);
+	vibration v4 = beam_vibration(cm, NULL, 0.004, 0.0),
+	          v2 = beam_vibration(cm, NULL, 0.002, 0.0);
+	vibration mirror = beam_vibration(cm, NULL, 0.004, 180.0);
+	vibration sub = beam_vibration(cm, "substeps=4", 0.004, 0.0);
 	print_message("chipmunk free vibration: max error %.3g rad at h = 4 ms, %.3g at 2 ms "
 	              "(ratio %.2f), %.3g with substeps=4; decay rate %+.2f%%, period %+.2f%% "
 	              "at 4 ms (%+.2f%%, %+.2f%% at 2 ms); right-hand beam %.3g rad\n",
