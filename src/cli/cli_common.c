@@ -566,6 +566,11 @@ static double beam_step_ns(const char *backend, const char **basis)
 		*basis = "Box2D measured at 0.21 s a step of a 333 x 300 lattice's 199,800 beams";
 		return 1050.0;
 	}
+	if (strcmp(backend, "chipmunk") == 0) {
+		*basis =
+		        "Chipmunk2D measured at 2.1 s of one core for H1's 2.07e6 steps of 2 beams";
+		return 510.0;
+	}
 	*basis = "the thesis backend's 1e8 beam-steps in about 15 s of one core "
 	         "(docs/robustness.md, beam_steps)";
 	return 150.0;
