@@ -462,7 +462,8 @@ static void test_reset_and_set_state(void **state)
 }
 
 /* A motion beyond what Chipmunk steps (1e100 in magnitude) stops the world
- * where it is, instead of Chipmunk aborting the process at its next step. */
+ * where it is, instead of Chipmunk aborting the process at its next step;
+ * a scene Chipmunk would abort on is refused. */
 static void test_motion_out_of_range(void **state)
 {
 	(void)state;
@@ -490,11 +491,24 @@ static void test_motion_out_of_range(void **state)
 	bsim_state_free(&st2);
 	cm->destroy(w);
 
-	/* a scene that starts there is refused, naming the field */
+	/* a scene that starts there is refused, naming the field, and so are
+	 * masses whose inverse (or 1e6 times which, the beams') is not finite:
+	 * Chipmunk aborted on a body of 1e303 kg */
 	s.body.velocity[0] = 2e100;
 	char field[64];
 	assert_int_equal(cm->check(&s, NULL, field, sizeof field, &err), BSIM_EINPUT);
 	assert_string_equal(field, "body.velocity.0");
+	s.body.velocity[0] = 0.0;
+	const double masses[] = {1e303, 1e-310};
+	for (int k = 0; k < 2; k++) {
+		s.body.mass = masses[k];
+		assert_int_equal(cm->check(&s, NULL, field, sizeof field, &err), BSIM_EINPUT);
+		assert_string_equal(field, "body.mass");
+	}
+	s.body.mass = 1.0;
+	s.beams[1].inertia = 1e-200;
+	assert_int_equal(cm->check(&s, NULL, field, sizeof field, &err), BSIM_EINPUT);
+	assert_string_equal(field, "beams.1.inertia");
 	bsim_scene_free(&s);
 }
 

@@ -79,7 +79,6 @@
 #include <threads.h>
 #include <unistd.h>
 
-#include "beamsim/effects.h"
 #include "chipmunk/chipmunk_world.h"
 
 /* The knobs. Defaults: Chipmunk's iterations and collision bias; a slop of
@@ -286,14 +285,23 @@ static int refuse(char *field, size_t size, const char *key, bsim_error *err, co
 	return bsim_error_set(err, BSIM_EINPUT, "chipmunk: %s", msg);
 }
 
-/* A value at or beyond MOTION_MAX refused, naming key. */
-static int motion_refused(char *field, size_t size, const char *key, double v, bsim_error *err)
+/* A scene value and the least magnitude Chipmunk takes of it (0: any). */
+typedef struct range_value {
+	const char *key;
+	double v, lo;
+} range_value;
+
+/* v refused, naming key, unless its magnitude is below MOTION_MAX and at
+ * least lo. */
+static int in_range(char *field, size_t size, const char *key, double v, double lo, bsim_error *err)
 {
+	if (fabs(v) < MOTION_MAX && fabs(v) >= lo)
+		return BSIM_OK;
 	char msg[BSIM_ERROR_MSG_MAX];
 	snprintf(msg, sizeof msg,
-	         "%g is beyond what the chipmunk backend steps (magnitudes below %g: Chipmunk "
-	         "aborts the process on a position or velocity that is not finite)",
-	         v, MOTION_MAX);
+	         "%g is beyond what the chipmunk backend takes (magnitudes %s%g: Chipmunk aborts "
+	         "the process on a mass, moment, position or velocity that is not finite)",
+	         v, lo > 0.0 ? "from 1e-100 to " : "below ", MOTION_MAX);
 	return refuse(field, size, key, err, msg);
 }
 
@@ -334,32 +342,43 @@ static int chipmunk_check(const bsim_scene *scene, const bsim_options *opts, cha
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "chipmunk: collision_bias=%g: expected a number from 0 to 1",
 		                      bias);
-	/* Where the world starts must be where it may step (MOTION_MAX). */
+	/* What Chipmunk would abort on: a mass, moment, size, position or
+	 * velocity whose products or inverses are not finite. */
 	const bsim_body_def *bd = &scene->body;
-	const struct {
-		const char *key;
-		double v;
-	} start[] = {
-	        {"body.start.0", bd->start[0]},
-	        {"body.start.1", bd->start[1]},
-	        {"body.velocity.0", bd->velocity[0]},
-	        {"body.velocity.1", bd->velocity[1]},
-	        {"body.angular_velocity", bd->angular_velocity},
+	const range_value body[] = {
+	        {"body.start.0", bd->start[0], 0.0},
+	        {"body.start.1", bd->start[1], 0.0},
+	        {"body.velocity.0", bd->velocity[0], 0.0},
+	        {"body.velocity.1", bd->velocity[1], 0.0},
+	        {"body.angular_velocity", bd->angular_velocity, 0.0},
+	        {"body.mass", bd->mass, 1.0 / MOTION_MAX},
+	        {"body.inertia", bd->rotates ? bsim_body_inertia(bd) : 1.0, 1.0 / MOTION_MAX},
+	        {"body.radius", bd->radius, 0.0},
+	        {"body.length", bd->length, 0.0},
+	        {"body.semi_axes.0", bd->semi_axes[0], 0.0},
+	        {"body.semi_axes.1", bd->semi_axes[1], 0.0},
 	};
-	for (size_t k = 0; k < sizeof start / sizeof start[0]; k++)
-		if (!(fabs(start[k].v) < MOTION_MAX))
-			return motion_refused(field, size, start[k].key, start[k].v, err);
+	for (size_t k = 0; k < sizeof body / sizeof body[0]; k++)
+		if ((rc = in_range(field, size, body[k].key, body[k].v, body[k].lo, err)) !=
+		    BSIM_OK)
+			return rc;
 	for (int i = 0; i < scene->n_beams; i++) {
 		const bsim_beam_def *b = &scene->beams[i];
-		const double v[4] = {b->pivot[0], b->pivot[1], b->initial_theta, b->initial_omega};
-		static const char *const key[4] = {"pivot.0", "pivot.1", "initial_theta",
-		                                   "initial_omega"};
-		for (int k = 0; k < 4; k++)
-			if (!(fabs(v[k]) < MOTION_MAX)) {
-				char name[64];
-				snprintf(name, sizeof name, "beams.%d.%s", i, key[k]);
-				return motion_refused(field, size, name, v[k], err);
-			}
+		const range_value beam[] = {
+		        {"pivot.0", b->pivot[0], 0.0},
+		        {"pivot.1", b->pivot[1], 0.0},
+		        {"initial_theta", b->initial_theta, 0.0},
+		        {"initial_omega", b->initial_omega, 0.0},
+		        {"length", b->length, 0.0},
+		        {"inertia", b->inertia, 1.0 / MOTION_MAX},
+		};
+		for (size_t k = 0; k < sizeof beam / sizeof beam[0]; k++) {
+			char name[64];
+			snprintf(name, sizeof name, "beams.%d.%s", i, beam[k].key);
+			if ((rc = in_range(field, size, name, beam[k].v, beam[k].lo, err)) !=
+			    BSIM_OK)
+				return rc;
+		}
 	}
 	const double h = scene->dt / (double)substeps;
 	for (int i = 0; i < scene->n_beams; i++) {
