@@ -1,9 +1,10 @@
 /* beamsim compare and regress through the real program: each backend's
  * half of a comparison is exactly its own sweep (the pairs share
- * schedules), results do not depend on threads, the replay lines in a
- * report reproduce the trials they name, a rerun of a stored run with the
- * same code reproduces it exactly, and a baseline whose outcomes were
- * changed is caught (exit status 3) in the groups that were changed. */
+ * schedules), for every pair of the registry's backends, results do not
+ * depend on threads, the replay lines in a report reproduce the trials they
+ * name, a rerun of a stored run with the same code reproduces it exactly,
+ * and a baseline whose outcomes were changed is caught (exit status 3) in
+ * the groups that were changed. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <setjmp.h>
@@ -16,6 +17,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/backend.h"
 #include "support.h"
 
 static char experiment[1200];
@@ -84,6 +86,51 @@ static void test_halves_are_sweeps(void **state)
 		free(a);
 		free(b);
 	}
+}
+
+/* Every pair of the registry's backends compares (`--backends A,B`), and
+ * each side of the comparison is that backend's own sweep. */
+static void test_every_pair(void **state)
+{
+	(void)state;
+	const bsim_backend *const *list = bsim_backend_list();
+	enum { MAX = 16 };
+	char sweep[MAX][1200];
+	int n = 0;
+	for (; list[n] && n < MAX; n++) {
+		char name[64];
+		snprintf(name, sizeof name, "pair_sweep_%s", list[n]->name);
+		snprintf(sweep[n], sizeof sweep[n], "%s", bsim_test_dir(name));
+		const char *argv[] = {"sweep",   experiment, "--backend", list[n]->name,
+		                      "--quiet", "--out",    sweep[n],    NULL};
+		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	}
+	for (int i = 0; i < n; i++)
+		for (int j = i + 1; j < n; j++) {
+			char sides[200], name[200], dir[1200];
+			snprintf(sides, sizeof sides, "%s,%s", list[i]->name, list[j]->name);
+			snprintf(name, sizeof name, "pair_%s_%s", list[i]->name, list[j]->name);
+			snprintf(dir, sizeof dir, "%s", bsim_test_dir(name));
+			const char *argv[] = {"compare",   experiment, "--backends", sides,
+			                      "--threads", "2",        "--quiet",    "--out",
+			                      dir,         NULL};
+			int status = bsim_test_cli(argv, NULL, NULL);
+			if (status != 0 && status != 3)
+				fail_msg("compare --backends %s: exit %d", sides, status);
+			const int side[2] = {i, j};
+			for (int k = 0; k < 2; k++) {
+				char sub[1300];
+				snprintf(sub, sizeof sub, "%s/%s", dir, list[side[k]]->name);
+				char *a = read_in(sweep[side[k]], "trials.csv"),
+				     *b = read_in(sub, "trials.csv");
+				if (strcmp(a, b) != 0)
+					fail_msg("compare --backends %s: the %s side differs from "
+					         "its sweep",
+					         sides, list[side[k]]->name);
+				free(a);
+				free(b);
+			}
+		}
 }
 
 /* The exit status says what report.json says; threads change nothing. */
@@ -439,6 +486,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_halves_are_sweeps),
+	        cmocka_unit_test(test_every_pair),
 	        cmocka_unit_test(test_status_and_threads),
 	        cmocka_unit_test(test_compare_replays),
 	        cmocka_unit_test(test_regress_identical),
