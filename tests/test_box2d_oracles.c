@@ -17,32 +17,10 @@
 
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "backend_run.h"
 #include "scenes.h"
 
 static const bsim_backend *const b2 = &bsim_backend_box2d;
-
-static bsim_options opts_of(const char *kv1, const char *kv2)
-{
-	bsim_options o;
-	bsim_error err;
-	memset(&o, 0, sizeof o);
-	if (kv1)
-		assert_int_equal(bsim_options_add(&o, kv1, &err), BSIM_OK);
-	if (kv2)
-		assert_int_equal(bsim_options_add(&o, kv2, &err), BSIM_OK);
-	return o;
-}
-
-static bsim_world *create(const bsim_scene *s, const bsim_options *o)
-{
-	bsim_world *w = NULL;
-	bsim_error err;
-	int rc = b2->create(s, o, &w, &err);
-	if (rc)
-		print_message("create: %s\n", err.msg);
-	assert_int_equal(rc, BSIM_OK);
-	return w;
-}
 
 /* ---- 1. impacts ---------------------------------------------------------- */
 
@@ -55,7 +33,7 @@ static double check_tangent(double r, double e, double u, const bsim_options *o)
 {
 	bsim_scene s;
 	scene_tangent_hit(&s, r, e, u, 0.02);
-	bsim_world *w = create(&s, o);
+	bsim_world *w = test_world(b2, &s, o);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
@@ -101,7 +79,7 @@ static void test_tangent_impact_oracle(void **state)
 	(void)state;
 	/* continuous=off: the body moves far less than its radius a step, so
 	 * discrete steps find the same impact (the bench's cheaper setting). */
-	bsim_options off = opts_of("continuous=off", NULL);
+	bsim_options off = test_options("continuous=off", NULL);
 	const bsim_options *setting[2] = {NULL, &off};
 	for (int k = 0; k < 2; k++) {
 		double worst = 0.0;
@@ -124,7 +102,7 @@ static void run_tip(double e_tip, double out[4])
 {
 	bsim_scene s;
 	scene_tip_hit(&s, e_tip, 0.03);
-	bsim_world *w = create(&s, NULL);
+	bsim_world *w = test_world(b2, &s, NULL);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
@@ -185,8 +163,8 @@ static double vibration_error(const char *spring, double h, double rest_deg)
 	s.beams[0].damping = 50.0;
 	s.beams[0].initial_theta = 0.1;
 	s.beams[0].rest_angle_deg = rest_deg;
-	bsim_options o = opts_of(spring, NULL);
-	bsim_world *w = create(&s, &o);
+	bsim_options o = test_options(spring, NULL);
+	bsim_world *w = test_world(b2, &s, &o);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
@@ -245,8 +223,8 @@ static void test_stiff_spring_stability(void **state)
 			double k = inertia * (wh[c] / h) * (wh[c] / h);
 			s.beams[0].stiffness = k;
 			s.beams[0].initial_theta = 0.2;
-			bsim_options o = opts_of(weld ? "spring=weld" : "spring=torque", NULL);
-			bsim_world *w = create(&s, &o);
+			bsim_options o = test_options(weld ? "spring=weld" : "spring=torque", NULL);
+			bsim_world *w = test_world(b2, &s, &o);
 			bsim_state st;
 			bsim_state_init(&st, 1);
 			const double zero[2] = {0.0, 0.0};
@@ -282,19 +260,6 @@ static void test_stiff_spring_stability(void **state)
 
 /* ---- 3. energy ledger ----------------------------------------------------- */
 
-static bsim_trial_result run_trial(const bsim_scene *s, const bsim_options *o, uint64_t seed)
-{
-	bsim_trial_runner *r = bsim_trial_runner_alloc();
-	bsim_trial_result out;
-	bsim_error err;
-	int rc = bsim_trial_run(r, s, b2, o, seed, NULL, &out, &err);
-	if (rc)
-		print_message("trial: %s\n", err.msg);
-	assert_int_equal(rc, BSIM_OK);
-	bsim_trial_runner_free(r);
-	return out;
-}
-
 /* e = 1, tip e = 1, d = 0, no forces: E is conserved up to the integrators'
  * errors (the explicit spring's splitting at each impact, float32). */
 static void test_conservative_drift(void **state)
@@ -305,8 +270,8 @@ static void test_conservative_drift(void **state)
 	for (int k = 0; k < 2; k++) {
 		bsim_scene s;
 		scene_gate_conservative(&s);
-		bsim_options o = opts_of(springs[k], NULL);
-		bsim_trial_result out = run_trial(&s, &o, 1);
+		bsim_options o = test_options(springs[k], NULL);
+		bsim_trial_result out = test_trial(b2, &s, &o, 1);
 		const bsim_ledger *l = &out.ledger;
 		double drift = (l->e_end - l->e_start) / l->e_start;
 		print_message("box2d conservative, %s: E %.4f -> %.4f J (drift %.2e of E), impact "
@@ -335,9 +300,9 @@ static double ledger_ratio(const char *spring, const char *substeps, double *abs
 	for (int trial = 0; trial < 10; trial++) {
 		bsim_scene s;
 		bsim_scene_init_gate(&s, 7.0, 20.0);
-		bsim_options o = opts_of(spring, substeps);
+		bsim_options o = test_options(spring, substeps);
 		bsim_trial_result out =
-		        run_trial(&s, &o, bsim_schedule_seed_mix(3, 0, (uint64_t)trial));
+		        test_trial(b2, &s, &o, bsim_schedule_seed_mix(3, 0, (uint64_t)trial));
 		const bsim_ledger *l = &out.ledger;
 		double scale = fabs(l->w_prop) + fabs(l->w_rand) + l->damper + l->impact;
 		assert_true(l->damper > 0.0 && l->w_prop > 0.0);
@@ -383,7 +348,7 @@ static void test_mirror_deviation(void **state)
 	a.beams[1].stiffness = 500.0;
 	a.body.start[0] = 1.5;
 	scene_mirror(&a, &b);
-	bsim_world *wa = create(&a, NULL), *wb = create(&b, NULL);
+	bsim_world *wa = test_world(b2, &a, NULL), *wb = test_world(b2, &b, NULL);
 	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_schedule_seed_mix(5, 0, 0));
 	bsim_state sa, sb;
 	bsim_state_init(&sa, 2);
@@ -438,7 +403,7 @@ static void test_mirror_deviation(void **state)
 static void test_expert_setting(void **state)
 {
 	(void)state;
-	bsim_options expert = opts_of("continuous=off", "sleep=on");
+	bsim_options expert = test_options("continuous=off", "sleep=on");
 	bsim_error err;
 	assert_int_equal(bsim_options_add(&expert, "velocity_iterations=4", &err), BSIM_OK);
 	const double force[] = {8.0, 9.0};
@@ -446,7 +411,8 @@ static void test_expert_setting(void **state)
 	for (int k = 0; k < 2; k++) {
 		bsim_scene s;
 		bsim_scene_init_gate(&s, force[k], 0.0);
-		bsim_trial_result a = run_trial(&s, NULL, 1), b = run_trial(&s, &expert, 1);
+		bsim_trial_result a = test_trial(b2, &s, NULL, 1),
+		                  b = test_trial(b2, &s, &expert, 1);
 		print_message(
 		        "box2d gate, F = %g N: %s in %d steps (defaults), %s in %d (expert)\n",
 		        force[k], bsim_trial_outcome_name(a.outcome), a.steps,
@@ -465,7 +431,7 @@ static void test_bad_options(void **state)
 	const char *bad[] = {"substeps=0",        "velocity_iterations=0", "unit_scale=-1",
 	                     "unit_scale=0.0001", "spring=rubber",         "nonsense=1"};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-		bsim_options o = opts_of(bad[i], NULL);
+		bsim_options o = test_options(bad[i], NULL);
 		bsim_world *w = NULL;
 		bsim_error err;
 		assert_int_equal(b2->create(&s, &o, &w, &err), BSIM_EINPUT);
@@ -482,7 +448,7 @@ static void test_set_state(void **state)
 	(void)state;
 	bsim_scene s;
 	bsim_scene_init_gate(&s, 7.0, 0.0);
-	bsim_world *w = create(&s, NULL), *w2 = create(&s, NULL);
+	bsim_world *w = test_world(b2, &s, NULL), *w2 = test_world(b2, &s, NULL);
 	bsim_state st, st2;
 	bsim_state_init(&st, 2);
 	bsim_state_init(&st2, 2);
@@ -532,7 +498,7 @@ static void check_clamp(double speed, const char *scale, double moved, long clam
 	bsim_error err;
 	if (scale)
 		assert_int_equal(bsim_options_add(&o, scale, &err), BSIM_OK);
-	bsim_world *w = create(&s, &o);
+	bsim_world *w = test_world(b2, &s, &o);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};

@@ -21,33 +21,10 @@
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "chipmunk/chipmunk_world.h"
+#include "backend_run.h"
 #include "scenes.h"
-#include "vibration.h"
 
 static const bsim_backend *const cm = &bsim_backend_chipmunk;
-
-static bsim_options opts_of(const char *kv1, const char *kv2)
-{
-	bsim_options o;
-	bsim_error err;
-	memset(&o, 0, sizeof o);
-	if (kv1)
-		assert_int_equal(bsim_options_add(&o, kv1, &err), BSIM_OK);
-	if (kv2)
-		assert_int_equal(bsim_options_add(&o, kv2, &err), BSIM_OK);
-	return o;
-}
-
-static bsim_world *create(const bsim_scene *s, const bsim_options *o)
-{
-	bsim_world *w = NULL;
-	bsim_error err;
-	int rc = cm->create(s, o, &w, &err);
-	if (rc)
-		print_message("create: %s\n", err.msg);
-	assert_int_equal(rc, BSIM_OK);
-	return w;
-}
 
 /* ---- 1. impacts ---------------------------------------------------------- */
 
@@ -60,7 +37,7 @@ static double check_tangent(double r, double e, double u)
 {
 	bsim_scene s;
 	scene_tangent_hit(&s, r, e, u, 0.02);
-	bsim_world *w = create(&s, NULL);
+	bsim_world *w = test_world(cm, &s, NULL);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
@@ -120,7 +97,7 @@ static void run_tip(double e_tip, double out[4])
 {
 	bsim_scene s;
 	scene_tip_hit(&s, e_tip, 0.03);
-	bsim_world *w = create(&s, NULL);
+	bsim_world *w = test_world(cm, &s, NULL);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
@@ -207,8 +184,8 @@ static double stiff_energy_ratio(double wh, const char *opt)
 	const double inertia = s.beams[0].inertia, k = inertia * (wh / h) * (wh / h);
 	s.beams[0].stiffness = k;
 	s.beams[0].initial_theta = 0.2;
-	bsim_options o = opts_of(opt, NULL);
-	bsim_world *w = create(&s, &o);
+	bsim_options o = test_options(opt, NULL);
+	bsim_world *w = test_world(cm, &s, &o);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0}, e0 = 0.5 * k * 0.04;
@@ -259,19 +236,6 @@ static void test_stiff_spring(void **state)
 
 /* ---- 3. energy ledger ----------------------------------------------------- */
 
-static bsim_trial_result run_trial(const bsim_scene *s, const bsim_options *o, uint64_t seed)
-{
-	bsim_trial_runner *r = bsim_trial_runner_alloc();
-	bsim_trial_result out;
-	bsim_error err;
-	int rc = bsim_trial_run(r, s, cm, o, seed, NULL, &out, &err);
-	if (rc)
-		print_message("trial: %s\n", err.msg);
-	assert_int_equal(rc, BSIM_OK);
-	bsim_trial_runner_free(r);
-	return out;
-}
-
 /* e = 1, tip e = 1, d = 0, no forces: E is conserved up to the explicit
  * spring's splitting at each impact; impacts lose nothing. */
 static void test_conservative_drift(void **state)
@@ -282,8 +246,8 @@ static void test_conservative_drift(void **state)
 	for (int k = 0; k < 2; k++) {
 		bsim_scene s;
 		scene_gate_conservative(&s);
-		bsim_options o = opts_of(opt[k], NULL);
-		bsim_trial_result out = run_trial(&s, &o, 1);
+		bsim_options o = test_options(opt[k], NULL);
+		bsim_trial_result out = test_trial(cm, &s, &o, 1);
 		const bsim_ledger *l = &out.ledger;
 		drift[k] = (l->e_end - l->e_start) / l->e_start;
 		print_message("chipmunk conservative%s: E %.4f -> %.4f J (drift %.2e of E), impact "
@@ -313,9 +277,9 @@ static double ledger_ratio(const char *opt, double *abs_ratio)
 	for (int trial = 0; trial < 10; trial++) {
 		bsim_scene s;
 		bsim_scene_init_gate(&s, 7.0, 20.0);
-		bsim_options o = opts_of(opt, NULL);
+		bsim_options o = test_options(opt, NULL);
 		bsim_trial_result out =
-		        run_trial(&s, &o, bsim_schedule_seed_mix(3, 0, (uint64_t)trial));
+		        test_trial(cm, &s, &o, bsim_schedule_seed_mix(3, 0, (uint64_t)trial));
 		const bsim_ledger *l = &out.ledger;
 		double scale = fabs(l->w_prop) + fabs(l->w_rand) + l->damper + l->impact;
 		assert_true(l->damper > 0.0 && l->w_prop > 0.0);
@@ -356,7 +320,7 @@ static void test_mirror_bitwise(void **state)
 	a.beams[1].stiffness = 500.0;
 	a.body.start[0] = 1.5;
 	scene_mirror(&a, &b);
-	bsim_world *wa = create(&a, NULL), *wb = create(&b, NULL);
+	bsim_world *wa = test_world(cm, &a, NULL), *wb = test_world(cm, &b, NULL);
 	bsim_schedule *sched = bsim_schedule_alloc(30.0, 50.0, bsim_schedule_seed_mix(5, 0, 0));
 	bsim_state sa, sb;
 	bsim_state_init(&sa, 2);
@@ -402,7 +366,7 @@ static void test_reset_and_set_state(void **state)
 	(void)state;
 	bsim_scene s;
 	bsim_scene_init_gate(&s, 7.0, 0.0);
-	bsim_world *w = create(&s, NULL), *w2 = create(&s, NULL);
+	bsim_world *w = test_world(cm, &s, NULL), *w2 = test_world(cm, &s, NULL);
 	bsim_state st, st2;
 	bsim_state_init(&st, 2);
 	bsim_state_init(&st2, 2);
@@ -470,7 +434,7 @@ static void test_motion_out_of_range(void **state)
 	bsim_scene s;
 	scene_gate_quiet(&s);
 	s.body.start[1] = -200.0;
-	bsim_world *w = create(&s, NULL);
+	bsim_world *w = test_world(cm, &s, NULL);
 	bsim_state st, st2;
 	bsim_state_init(&st, 2);
 	bsim_state_init(&st2, 2);
@@ -521,7 +485,7 @@ static void test_bad_options(void **state)
 	                     "collision_slop=-1",  "collision_bias=1.5",   "collision_bias=-0.1",
 	                     "collision_slop=inf", "velocity_iterations=8"};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-		bsim_options o = opts_of(bad[i], NULL);
+		bsim_options o = test_options(bad[i], NULL);
 		bsim_world *w = NULL;
 		bsim_error err;
 		assert_int_equal(cm->create(&s, &o, &w, &err), BSIM_EINPUT);

@@ -11,8 +11,8 @@
 #include <cmocka.h>
 
 #include "beamsim/backend.h"
+#include "backend_run.h"
 #include "scenes.h"
-#include "vibration.h"
 
 /* A Table 2.1 beam alone (no body in reach), released from theta0 at rest. */
 static bsim_world *beam_released(bsim_scene *s, double k, double d, double theta0)

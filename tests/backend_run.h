@@ -1,14 +1,59 @@
-/* A beam released from rest against the damped oscillator, measured on any
- * backend (include after cmocka.h): the largest error, and the decay rate
- * and period read off the peaks. */
-#ifndef BSIM_TESTS_VIBRATION_H
-#define BSIM_TESTS_VIBRATION_H
+/* Running a backend in the tests (include after cmocka.h): options from
+ * "key=value" text, a world and a trial that must succeed, and a beam
+ * released from rest measured against the damped oscillator (the largest
+ * error, and the decay rate and period read off the peaks). */
+#ifndef BSIM_TESTS_BACKEND_RUN_H
+#define BSIM_TESTS_BACKEND_RUN_H
 
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "beamsim/backend.h"
+#include "beamsim/trial.h"
 #include "scenes.h"
+
+/* Options from up to two "key=value" (NULL: none). */
+static inline bsim_options test_options(const char *kv1, const char *kv2)
+{
+	bsim_options o;
+	bsim_error err;
+	memset(&o, 0, sizeof o);
+	if (kv1)
+		assert_int_equal(bsim_options_add(&o, kv1, &err), BSIM_OK);
+	if (kv2)
+		assert_int_equal(bsim_options_add(&o, kv2, &err), BSIM_OK);
+	return o;
+}
+
+/* b's world of s with o; the test fails, saying why, if b refuses it. */
+static inline bsim_world *test_world(const bsim_backend *b, const bsim_scene *s,
+                                     const bsim_options *o)
+{
+	bsim_world *w = NULL;
+	bsim_error err;
+	int rc = b->create(s, o, &w, &err);
+	if (rc)
+		print_message("create: %s\n", err.msg);
+	assert_int_equal(rc, BSIM_OK);
+	return w;
+}
+
+/* A trial of s on b with o and the (mixed) seed; the test fails, saying
+ * why, if it cannot run. */
+static inline bsim_trial_result test_trial(const bsim_backend *b, const bsim_scene *s,
+                                           const bsim_options *o, uint64_t seed)
+{
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
+	bsim_trial_result out;
+	bsim_error err;
+	int rc = bsim_trial_run(r, s, b, o, seed, NULL, &out, &err);
+	if (rc)
+		print_message("trial: %s\n", err.msg);
+	assert_int_equal(rc, BSIM_OK);
+	bsim_trial_runner_free(r);
+	return out;
+}
 
 /* Over 3 s from 0.1 rad: the largest |theta - exact|, and from the peaks of
  * |theta| (its local maxima, every half period) the decay rate
@@ -33,13 +78,8 @@ static inline vibration beam_vibration(const bsim_backend *b, const char *kv, do
 	s.beams[0].rest_angle_deg = rest_deg;
 	if (rest_deg > 90.0)
 		s.beams[0].pivot[0] = 25.0;
-	bsim_options o;
-	bsim_error err;
-	memset(&o, 0, sizeof o);
-	if (kv)
-		assert_int_equal(bsim_options_add(&o, kv, &err), BSIM_OK);
-	bsim_world *w = NULL;
-	assert_int_equal(b->create(&s, &o, &w, &err), BSIM_OK);
+	bsim_options o = test_options(kv, NULL);
+	bsim_world *w = test_world(b, &s, &o);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0}, inertia = s.beams[0].inertia;
