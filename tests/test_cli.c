@@ -163,12 +163,19 @@ static void test_version(void **state)
 	const char *argv[] = {"--version", NULL};
 	cli_run r = run_cli(argv);
 	assert_int_equal(r.status, 0);
-	/* The first line is the project's version; then what built it: the
-	 * Box2D of the CMake package the build found, and this compiler. */
+	/* The first line is the project's version; then what built it: what
+	 * each registered backend is built on (the Box2D backend's, the CMake
+	 * package the build found), and this compiler. */
 	assert_true(strncmp(r.out, "beamsim " BSIM_VERSION "\n",
 	                    strlen("beamsim " BSIM_VERSION "\n")) == 0);
 	assert_contains(r.out, "\ncommit ");
-	assert_contains(r.out, "\nBox2D " BSIM_TEST_BOX2D_VERSION "\n");
+	for (const bsim_backend *const *b = bsim_backend_list(); *b; b++) {
+		char line[256];
+		snprintf(line, sizeof line, "\nbackend %s: %s %s\n", (*b)->name, (*b)->engine,
+		         (*b)->version);
+		assert_contains(r.out, line);
+	}
+	assert_contains(r.out, ": Box2D " BSIM_TEST_BOX2D_VERSION "\n");
 #if defined(__GNUC__) && !defined(__clang__)
 	char compiler[64];
 	snprintf(compiler, sizeof compiler, "\ncompiler gcc %d.%d.%d\n", __GNUC__, __GNUC_MINOR__,

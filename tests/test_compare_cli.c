@@ -196,8 +196,14 @@ static void test_regress_identical(void **state)
 	/* The rerun is itself a baseline. */
 	char *a = read_in(dir, "run.json");
 	assert_non_null(strstr(a, "\"command\": \"compare\""));
-	/* What built it: the Box2D CMake found, a compiler named. */
+	/* What built it: each registered backend's version (NAME_version; the
+	 * Box2D backend's the Box2D CMake found), a compiler named. */
 	assert_non_null(strstr(a, "\"box2d_version\": \"" BSIM_TEST_BOX2D_VERSION "\""));
+	for (const bsim_backend *const *b = bsim_backend_list(); *b; b++) {
+		char key[128];
+		snprintf(key, sizeof key, "\"%s_version\": \"%s\"", (*b)->name, (*b)->version);
+		assert_non_null(strstr(a, key));
+	}
 	assert_non_null(strstr(a, "\"compiler\": \"gcc ") || strstr(a, "\"compiler\": \"clang "));
 	assert_non_null(strstr(a, "\"beamsim_commit\": \""));
 	free(a);

@@ -15,11 +15,12 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	                         "trials",     "threads", "seed",     "sets",
 	                         "grid",       "progress", "resume",  "overwrite",
 	                         NULL};
-	const char *experiment, *out, *a = "thesis", *b = "box2d";
+	/* a, b None: the registry's default sides (bsim_compare_dir_def_default) */
+	const char *experiment, *out, *a = NULL, *b = NULL;
 	long trials = 0;
 	int threads = 0, resume = 0, overwrite = 0;
 	PyObject *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|ssliOOOOpp", kwlist, &experiment, &out, &a,
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|zzliOOOOpp", kwlist, &experiment, &out, &a,
 	                                 &b, &trials, &threads, &seed_o, &sets_o, &grid_o,
 	                                 &progress_o, &resume, &overwrite))
 		return NULL;
@@ -31,6 +32,8 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	bsim_error err;
 	const char *spec[2] = {a, b};
 	for (int i = 0; i < 2; i++) {
+		if (!spec[i])
+			continue;
 		memset(&def.side[i], 0, sizeof def.side[i]);
 		if (bsim_compare_side_parse(spec[i], &def.side[i], &err) != BSIM_OK)
 			return pyb_raise(err.code, &err);
@@ -74,6 +77,7 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	if (!d || pyb_set(d, "threads", PyLong_FromLong(res.threads)) ||
 	    pyb_set(d, "n_disagree", PyLong_FromLong(res.cmp.n_disagree)) ||
 	    pyb_set(d, "dirs", Py_BuildValue("(ss)", res.dir[0], res.dir[1])) ||
+	    pyb_set(d, "labels", Py_BuildValue("(ss)", def.side[0].label, def.side[1].label)) ||
 	    pyb_set(d, "unstable", Py_BuildValue("(ll)", res.unstable[0], res.unstable[1])))
 		Py_CLEAR(d);
 	bsim_compare_dir_result_free(&res);

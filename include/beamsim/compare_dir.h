@@ -8,9 +8,10 @@
  * resume behave as for a sweep (beamsim/sweep_dir.h).
  *
  * A side is a backend with options, written NAME[:KEY=VALUE]... as on the
- * command line ("thesis", "box2d:spring=torque:substeps=4"); that text is
- * its label. Or, on a gate lattice, the two sides are one backend under two
- * lattice protocols (protocol), and the protocols label them. */
+ * command line (a name `beamsim backends` lists, alone or with options:
+ * "NAME:KEY=VALUE:KEY=VALUE"); that text is its label. Or, on a gate
+ * lattice, the two sides are one backend under two lattice protocols
+ * (protocol), and the protocols label them. */
 #ifndef BSIM_COMPARE_DIR_H
 #define BSIM_COMPARE_DIR_H
 
@@ -44,7 +45,7 @@ typedef struct bsim_compare_side {
 BSIM_API int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err);
 
 /* The directory of a side's files in DIR: the label with ':' and '/'
- * written '-' ("thesis:integrator=euler" -> "thesis-integrator=euler"). */
+ * written '-' ("NAME:KEY=VALUE" -> "NAME-KEY=VALUE"). */
 BSIM_API void bsim_compare_dir_label(const char *label, char *buf, size_t size);
 
 typedef struct bsim_compare_dir_def {
@@ -87,7 +88,8 @@ typedef struct bsim_compare_dir_def {
 	int n_merge;
 } bsim_compare_dir_def;
 
-/* thesis against box2d, no options, bsim_compare_rule_default(), 3
+/* The registry's default comparison, its first two backends
+ * (bsim_backend_compared), no options, bsim_compare_rule_default(), 3
  * examples, all cores. */
 BSIM_API bsim_compare_dir_def bsim_compare_dir_def_default(void);
 

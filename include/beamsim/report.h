@@ -19,7 +19,7 @@ extern "C" {
 
 /* One side of a comparison. */
 typedef struct bsim_report_side {
-	const char *label;           /* "thesis", "baseline", ... */
+	const char *label;           /* a backend's name, "baseline", ... */
 	const bsim_backend *backend; /* the backend that ran it */
 	const bsim_options *opts;    /* as given, for the replay lines */
 	const bsim_sweep_result *run;

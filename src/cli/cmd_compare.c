@@ -21,13 +21,13 @@ enum { OWN_BACKENDS, OWN_PROTOCOLS, OWN_EXAMPLES, OWN_SHARD };
 
 static const cli_own compare_own[] = {
         [OWN_BACKENDS] = {"backends", 1, "A,B",
-                          "the two sides (default thesis,box2d); each a backend\n"
+                          "the two sides (default {pair}); each a backend\n"
                           "with options inline, NAME[:K=V]..., e.g.\n"
-                          "thesis,thesis:integrator=euler; the side's label and\n"
+                          "{default},{default}:{knob}; the side's label and\n"
                           "directory are the text (':' written '-' in the name)"},
         [OWN_PROTOCOLS] = {"protocols", 1, "P,Q",
                            "a lattice experiment on one backend (--backend B,\n"
-                           "default thesis) under two lattice protocols (world,\n"
+                           "default {default}) under two lattice protocols (world,\n"
                            "essay) instead of two backends; the sides and their\n"
                            "directories are named by protocol"},
         [OWN_EXAMPLES] = {"examples", 1, "N",
@@ -48,7 +48,7 @@ static const char *const compare_help[CLI_N_OPTS] = {
 };
 
 typedef struct compare_args {
-	const char *backends; /* "A,B" as given, NULL: thesis,box2d */
+	const char *backends; /* "A,B" as given, NULL: the registry's first two */
 	char protocol[2][16]; /* --protocols, "" if not given */
 	long examples;
 	int shard, shards; /* --shard, 1-based; 0: the whole comparison */
@@ -164,7 +164,9 @@ static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compar
 	if (c->backend)
 		return cli_usage("compare", "--backend B goes with --protocols; two backends are "
 		                            "--backends A,B");
-	const char *text = a->backends ? a->backends : "thesis,box2d";
+	char pair[128];
+	cli_backend_names(pair, sizeof pair, 2);
+	const char *text = a->backends ? a->backends : pair;
 	const char *comma = strchr(text, ',');
 	size_t n0 = comma ? (size_t)(comma - text) : 0;
 	if (!comma || n0 == 0 || n0 >= sizeof spec[0] || strchr(comma + 1, ',') ||
@@ -281,9 +283,12 @@ static int compare_main(int argc, char **argv, const cli_merge *m)
 	cli_mpi_spread(&def.spread, &def.part, &def.agree, bsim_sweep_record_size(1), def.stop);
 	/* Both sides run every trial; the costlier backend's constant bounds
 	 * the estimate. */
-	const char *costlier = def.side[0].backend ? def.side[0].backend->name : "thesis";
-	if (def.side[1].backend && strcmp(def.side[1].backend->name, "box2d") == 0)
-		costlier = "box2d";
+	const bsim_backend *costlier = bsim_backend_default();
+	for (int i = 0; i < 2; i++) {
+		const bsim_backend *b = def.side[i].backend;
+		if (b && (i == 0 || b->cost_ns_per_beam_step > costlier->cost_ns_per_beam_step))
+			costlier = b;
+	}
 	if (rank == 0 && !m)
 		cli_estimate_line(costlier, 2.0 * cli_experiment_beam_steps(
 		                                          experiment, &c.sets,

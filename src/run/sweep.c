@@ -26,6 +26,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "beamsim/backend_registry.h"
 #include "util/clock.h"
 #include "util/journal.h"
 #include "beamsim/effects.h"

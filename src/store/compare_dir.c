@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/output.h"
 #include "beamsim/report.h"
 #include "beamsim/run_record.h"
@@ -24,10 +25,15 @@ bsim_compare_dir_def bsim_compare_dir_def_default(void)
 {
 	bsim_compare_dir_def d;
 	memset(&d, 0, sizeof d);
-	d.side[0].backend = &bsim_backend_thesis;
-	d.side[1].backend = &bsim_backend_box2d;
-	snprintf(d.side[0].label, sizeof d.side[0].label, "%s", bsim_backend_thesis.name);
-	snprintf(d.side[1].label, sizeof d.side[1].label, "%s", bsim_backend_box2d.name);
+	/* The registry's default comparison, its first two: with one backend
+	 * registered, it against itself (which the run refuses unless the
+	 * sides' options differ). */
+	const bsim_backend *b[2];
+	int n = bsim_backend_compared(b, 2);
+	for (int i = 0; i < 2; i++) {
+		d.side[i].backend = b[i < n ? i : 0];
+		snprintf(d.side[i].label, sizeof d.side[i].label, "%s", d.side[i].backend->name);
+	}
 	d.rule = bsim_compare_rule_default();
 	d.examples = 3;
 	return d;
@@ -238,7 +244,7 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 {
 	for (int i = 0; i < 2; i++) {
 		const bsim_compare_side *s = &def->side[i];
-		job->backend[i] = s->backend ? s->backend : &bsim_backend_thesis;
+		job->backend[i] = s->backend ? s->backend : bsim_backend_default();
 		job->opts[i] = &s->opts;
 		job->label[i] = def->protocol[0] ? def->protocol[i]
 		                : s->label[0]    ? s->label
@@ -274,8 +280,8 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 		return bsim_error_set(
 		        err, BSIM_EINPUT,
 		        "--backends %s,%s: expected two different sides (a backend against "
-		        "itself takes options inline, e.g. thesis,thesis:integrator=euler)",
-		        job->label[0], job->label[1]);
+		        "itself takes options inline, e.g. %s,%s:KEY=VALUE)",
+		        job->label[0], job->label[1], job->backend[0]->name, job->backend[0]->name);
 	if (strcmp(res->dir[0], res->dir[1]) == 0)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "--backends %s,%s: both sides would write to %s/%s",

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/compare_dir.h"
 #include "beamsim/effects.h"
 #include "beamsim/output.h"

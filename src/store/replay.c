@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/compare_dir.h"
 #include "beamsim/limits.h"
 #include "beamsim/run_output.h"

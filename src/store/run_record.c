@@ -19,6 +19,7 @@
 #include "util/atomic_file.h"
 #include "util/file_read.h"
 #include "util/json.h"
+#include "beamsim/backend_registry.h"
 #include "beamsim/limits.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
@@ -144,11 +145,15 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 	fputs(",\n  \"beamsim_version\": ", f);
 	bsim_json_string(f, BSIM_VERSION);
 	/* What made the record, beyond the version: the checkout's commit ("" if
-	 * not built from one), the Box2D of the box2d backend, the compiler. */
+	 * not built from one), the version of what each registered backend is
+	 * built on (NAME_version; the Box2D backend's was the first), the
+	 * compiler. */
 	fputs(",\n  \"beamsim_commit\": ", f);
 	bsim_json_string(f, bsim_version_commit());
-	fputs(",\n  \"box2d_version\": ", f);
-	bsim_json_string(f, bsim_version_box2d());
+	for (const bsim_backend *const *b = bsim_backend_list(); *b; b++) {
+		fprintf(f, ",\n  \"%s_version\": ", (*b)->name);
+		bsim_json_string(f, (*b)->version ? (*b)->version : "");
+	}
 	fputs(",\n  \"compiler\": ", f);
 	bsim_json_string(f, bsim_version_compiler());
 	fputs(",\n  \"source_experiment\": ", f);

@@ -25,12 +25,18 @@ import numpy as np
 
 from . import _beamsim
 
-__all__ = ["run", "sweep", "compare", "landscape", "load", "version"]
+__all__ = ["run", "sweep", "compare", "landscape", "load", "version", "backends"]
 
 
 def version():
     """libbeamsim's version."""
     return _beamsim.version()
+
+
+def backends():
+    """The backends compiled in, by name, as `beamsim backends` lists them;
+    the first is the default."""
+    return list(_beamsim.backends())
 
 
 # ---- arguments as the command line gives them ------------------------------
@@ -197,8 +203,9 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     as `beamsim sweep` runs it, the group's grid values applied); or the
     output directory of a sweep or comparison (the trial as that run ran it,
     with its seed, backend and options; backend names a comparison's side).
-    seed: None is the experiment's (a scene's: 1). backend: "thesis"
-    (None, the default), "box2d", or "NAME:KEY=VALUE..." as a compare side.
+    seed: None is the experiment's (a scene's: 1). backend: a name of
+    backends() (None: the first, the default), or "NAME:KEY=VALUE..." as a
+    compare side.
     set: {dotted key: value} scene overrides; backend_opt: {knob: value};
     grid: an experiment's axes {key: [values]}, as sweep's.
 
@@ -306,17 +313,18 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
             "threads": info["threads"], "out": out}
 
 
-def compare(experiment, backends=("thesis", "box2d"), trials=None, threads=None, set=None,
+def compare(experiment, backends=None, trials=None, threads=None, set=None,
             grid=None, seed=None, out=None, progress=None, resume=False, overwrite=False):
     """The experiment on two sides with the same random-force schedules, as
     `beamsim compare EXPERIMENT --backends A,B --out DIR` runs it. A side is
-    "NAME[:KEY=VALUE]...". resume: continue the stopped comparison in out,
+    "NAME[:KEY=VALUE]..."; backends None: the first two of backends(), as
+    compare's default. resume: continue the stopped comparison in out,
     as sweep's. overwrite: replace the finished result (or a stopped
     comparison's journal) in out; without it such an out is refused.
     Returns a dict: "report" (report.json), "pairs" (pairs.csv as arrays),
     "sides" (each side's summary.json and trials arrays, by label),
     "n_disagree" and "out"."""
-    a, b = backends
+    a, b = backends if backends is not None else (None, None)
     _no_nul("experiment", experiment)
     _no_nul("out", out)
     _no_nul("backends", a)
@@ -326,6 +334,7 @@ def compare(experiment, backends=("thesis", "box2d"), trials=None, threads=None,
                                 _count("threads", threads, 1, 4096), _seed(seed), _sets(set),
                                 _grid(grid), progress, bool(resume), bool(overwrite))
         files = load(d)
+    a, b = info["labels"]
     sides = {}
     for label, name in zip((a, b), info["dirs"]):
         side = files.get(name, {})
