@@ -24,7 +24,9 @@ static const cli_own accuracy_own[] = {
         [OWN_SCENE] = {"scene", 1, "FILE",
                        "scene (default " ACC_SCENE " with propulsion 9 N,\n"
                        "random force 20 N)"},
-        [OWN_BACKENDS] = {"backends", 1, "LIST", "comma-separated (default thesis,box2d)"},
+        [OWN_BACKENDS] = {"backends", 1, "LIST",
+                          "comma-separated (default every backend, as\n"
+                          "beamsim backends lists them)"},
         [OWN_PIECES] = {"pieces", 1, "N", "restarted pieces (default 16)"},
         [OWN_QUICK] = {"quick", 0, NULL, "h down to 0.0005 s, 4 pieces, 8 trials (for tests)"},
         [OWN_TARGETS] = {"targets", 1, "LIST",
@@ -180,8 +182,14 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 	bsim_options extra[ACC_BACKENDS_MAX] = {0};
 	bsim_options *extra_of[ACC_BACKENDS_MAX];
 	int n_b = 0;
-	char list[256];
-	snprintf(list, sizeof list, "%s", a->backends);
+	char list[256] = "";
+	if (a->backends)
+		snprintf(list, sizeof list, "%s", a->backends);
+	/* by default every backend compiled in, in the registry's order */
+	for (const bsim_backend *const *b = bsim_backend_list(); !a->backends && *b; b++) {
+		size_t len = strlen(list);
+		snprintf(list + len, sizeof list - len, "%s%s", len ? "," : "", (*b)->name);
+	}
 	char *save = NULL;
 	for (char *t = strtok_r(list, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
 		if (n_b == ACC_BACKENDS_MAX) {
@@ -251,7 +259,7 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 int cmd_accuracy(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	accuracy_args a = {.scene = ACC_SCENE, .backends = "thesis,box2d"};
+	accuracy_args a = {.scene = ACC_SCENE, .backends = NULL};
 	int rc = cli_parse(&accuracy_spec, argc, argv, &c, &a, NULL);
 	if (rc < 0)
 		rc = accuracy_main(&c, &a);
