@@ -196,23 +196,6 @@ static int scenes_for(const bsim_experiment *e, const bsim_sweep_config *cfg, in
 	return rc;
 }
 
-int bsim_sweep_pairs(int n_sides)
-{
-	return n_sides > 1 ? n_sides * (n_sides - 1) / 2 : 0;
-}
-
-void bsim_sweep_pair(int n_sides, int k, int side[2])
-{
-	side[0] = side[1] = 0;
-	for (int i = 0; i < n_sides; i++)
-		for (int j = i + 1; j < n_sides; j++)
-			if (k-- == 0) {
-				side[0] = i;
-				side[1] = j;
-				return;
-			}
-}
-
 /* A record of sides holds each result, then each pair's separation time:
  * for two sides the bytes of {result a, result b, double} as a struct. */
 _Static_assert(sizeof(bsim_trial_result) % _Alignof(double) == 0,
