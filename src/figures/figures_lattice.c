@@ -977,7 +977,7 @@ int figs_lattice_compare(figs *f, int n, const char *const *dirs, const char *co
 		}
 		if (rc)
 			break;
-		char label[1300], title[1900], who[600] = "", name[64];
+		char label[1300], title[8192], who[600] = "", name[64];
 		group_label(s, g, label, sizeof label);
 		if (n == 2)
 			snprintf(who, sizeof who, "%s against %s", labels[0], labels[1]);
