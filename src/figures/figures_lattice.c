@@ -742,7 +742,7 @@ static int locations_figure(figs *f, const char *name, const char *title, const 
 	if ((rc = gp_text_open(&g, err)))
 		return rc;
 	/* the note on intervals: a location never reached is drawn without one */
-	char full[2200];
+	char full[8400]; /* the title of many sides: a line per pair */
 	double zero[3];
 	fraction(runs[0], 0, zero);
 	snprintf(full, sizeof full,
