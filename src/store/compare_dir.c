@@ -259,9 +259,12 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 {
 	job->n = def->n_sides;
 	if (job->n < 2 || job->n > BSIM_COMPARE_SIDES_MAX || (def->protocol[0] && job->n != 2))
-		return bsim_error_set(err, BSIM_EINPUT, "--backends: %d sides; expected %s %d",
-		                      job->n, def->protocol[0] ? "with --protocols" : "2 to",
-		                      def->protocol[0] ? 2 : BSIM_COMPARE_SIDES_MAX);
+		return def->protocol[0]
+		               ? bsim_error_set(err, BSIM_EINPUT,
+		                                "--protocols: %d sides; expected 2", job->n)
+		               : bsim_error_set(err, BSIM_EINPUT,
+		                                "--backends: %d sides; expected 2 to %d", job->n,
+		                                BSIM_COMPARE_SIDES_MAX);
 	for (int i = 0; i < job->n; i++) {
 		const bsim_compare_side *s = &def->side[i];
 		job->backend[i] = s->backend ? s->backend : &bsim_backend_thesis;
