@@ -72,7 +72,8 @@ static int regress_rerun(const bsim_regress_def *def, bsim_regress_result *res,
 			d.side[i].backend = backend[i];
 			d.side[i].opts = rec->opts[i];
 			snprintf(d.side[i].label, sizeof d.side[i].label, "%s", rec->label[i]);
-			d.protocol[i] = rec->protocol[0][0] && i < 2 ? rec->protocol[i] : NULL;
+			if (i < 2) /* --protocols: two sides */
+				d.protocol[i] = rec->protocol[0][0] ? rec->protocol[i] : NULL;
 		}
 		d.threads = def->threads;
 		d.rule = rec->rule;
