@@ -39,6 +39,9 @@ def backends():
     return list(_beamsim.backends())
 
 
+backends_list = backends  # for functions whose argument is named backends
+
+
 # ---- arguments as the command line gives them ------------------------------
 
 
@@ -315,32 +318,41 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
 
 def compare(experiment, backends=None, trials=None, threads=None, set=None,
             grid=None, seed=None, out=None, progress=None, resume=False, overwrite=False):
-    """The experiment on two sides with the same random-force schedules, as
-    `beamsim compare EXPERIMENT --backends A,B --out DIR` runs it. A side is
-    "NAME[:KEY=VALUE]..."; backends None: the first two of backends(), as
-    compare's default. resume: continue the stopped comparison in out,
-    as sweep's. overwrite: replace the finished result (or a stopped
-    comparison's journal) in out; without it such an out is refused.
-    Returns a dict: "report" (report.json), "pairs" (pairs.csv as arrays),
-    "sides" (each side's summary.json and trials arrays, by label),
-    "n_disagree" and "out"."""
-    a, b = backends if backends is not None else (None, None)
+    """The experiment on two or more sides (at most 8) with the same
+    random-force schedules, as `beamsim compare EXPERIMENT --backends A,B,...
+    --out DIR` runs it. A side is "NAME[:KEY=VALUE]...". resume: continue
+    the stopped comparison in out, as sweep's. backends None: the first two
+    of backends(), as compare's default. overwrite: replace the
+    finished result (or a stopped comparison's journal) in out; without it
+    such an out is refused.
+    Returns a dict: "report" (report.json: with three sides or more, its
+    "sides", "pairwise" and "odd_one_out" too), "pairs" (pairs.csv as
+    arrays), "sides" (each side's summary.json and trials arrays, by label,
+    in the order given), "n_disagree" (groups in which some pair of sides
+    disagrees) and "out"."""
+    if backends is None:
+        backends = tuple(backends_list())[:2]
+    if isinstance(backends, (str, bytes)):
+        raise TypeError("backends: expected a sequence of sides NAME[:KEY=VALUE]..., e.g. "
+                        f"{tuple(backends_list()[:2])}")
+    labels = tuple(backends)
+    if not 2 <= len(labels) <= 8:
+        raise ValueError(f"backends: {len(labels)} sides; expected 2 to 8")
     _no_nul("experiment", experiment)
     _no_nul("out", out)
-    _no_nul("backends", a)
-    _no_nul("backends", b)
+    for label in labels:
+        _no_nul("backends", label)
     with _Dir(out, "compare") as d:
-        info = _beamsim.compare(os.fspath(experiment), d, a, b, _count("trials", trials, 1),
+        info = _beamsim.compare(os.fspath(experiment), d, labels, _count("trials", trials, 1),
                                 _count("threads", threads, 1, 4096), _seed(seed), _sets(set),
                                 _grid(grid), progress, bool(resume), bool(overwrite))
         files = load(d)
-    a, b = info["labels"]
     sides = {}
-    for label, name in zip((a, b), info["dirs"]):
+    for label, name in zip(labels, info["dirs"]):
         side = files.get(name, {})
         sides[label] = {"groups": side.get("summary", {}).get("groups"),
                         "trials": side.get("trials"), "summary": side.get("summary")}
-    for label, n in zip((a, b), info["unstable"]):
+    for label, n in zip(labels, info["unstable"]):
         if n:
             warnings.warn(f"{label}: {n} unstable trials", RuntimeWarning, stacklevel=2)
     return {"report": files.get("report"), "pairs": files.get("pairs"), "sides": sides,
