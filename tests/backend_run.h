@@ -1,5 +1,5 @@
-/* Running a backend in the tests (include after cmocka.h): options from
- * "key=value" text, a world and a trial that must succeed, and a beam
+/* Running a backend under its knobs in the tests (include after cmocka.h):
+ * options from "key=value" text, a trial that must succeed, and a beam
  * released from rest measured against the damped oscillator (the largest
  * error, and the decay rate and period read off the peaks). */
 #ifndef BSIM_TESTS_BACKEND_RUN_H
@@ -12,6 +12,7 @@
 #include "beamsim/backend.h"
 #include "beamsim/trial.h"
 #include "scenes.h"
+#include "support.h"
 
 /* Options from up to two "key=value" (NULL: none). */
 static inline bsim_options test_options(const char *kv1, const char *kv2)
@@ -24,19 +25,6 @@ static inline bsim_options test_options(const char *kv1, const char *kv2)
 	if (kv2)
 		assert_int_equal(bsim_options_add(&o, kv2, &err), BSIM_OK);
 	return o;
-}
-
-/* b's world of s with o; the test fails, saying why, if b refuses it. */
-static inline bsim_world *test_world(const bsim_backend *b, const bsim_scene *s,
-                                     const bsim_options *o)
-{
-	bsim_world *w = NULL;
-	bsim_error err;
-	int rc = b->create(s, o, &w, &err);
-	if (rc)
-		print_message("create: %s\n", err.msg);
-	assert_int_equal(rc, BSIM_OK);
-	return w;
 }
 
 /* A trial of s on b with o and the (mixed) seed; the test fails, saying
@@ -79,7 +67,7 @@ static inline vibration beam_vibration(const bsim_backend *b, const char *kv, do
 	if (rest_deg > 90.0)
 		s.beams[0].pivot[0] = 25.0;
 	bsim_options o = test_options(kv, NULL);
-	bsim_world *w = test_world(b, &s, &o);
+	bsim_world *w = bsim_test_world(b, &s, &o);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0}, inertia = s.beams[0].inertia;

@@ -17,7 +17,15 @@ compiled objects:
    layer, so that a header is one layer's API;
 6. beamsim/beamsim.h includes every public header;
 7. every definition struct of the public API (bsim_*_def, bsim_*_config)
-   has its default function, named bsim_<struct>_default.
+   has its default function, named bsim_<struct>_default;
+8. no file of src/, include/ or bindings/ but the registry's names a
+   backend: for every folder NAME of backends/, neither its table
+   bsim_backend_NAME nor NAME as a word (a backend's name in a string, a
+   default, an example in a help text or a comment) outside a path
+   ("configs/NAME/") or a longer name ("NAME-gate"); a comment may still
+   speak of "the NAME backend" to state a fact about that backend. The rest
+   of the program reaches a backend through the registry, by the name it
+   was given or in a loop over the list.
 
 Usage: layers.py SOURCE_DIR BUILD_DIR. Prints every breach and exits 1 if
 there is one."""
@@ -28,21 +36,26 @@ import subprocess
 import sys
 
 # The layers, lowest first; a layer may include from its own and lower ranks,
-# never from another folder of the same rank.
+# never from another folder of the same rank. Every folder of backends/ is
+# a layer of rank BACKEND_RANK (backend_ranks adds them), below the registry
+# that lists them.
+BACKEND_RANK = 2
 RANK = {
     "util": 0,
     "model": 1,
-    "thesis": 2,
-    "box2d": 2,
-    "chipmunk": 2,
-    "run": 3,
-    "store": 4,
-    "figures": 5,
-    "video": 5,
-    "analysis": 6,
-    "cli": 7,
-    "bench": 8,
+    "registry": 3,
+    "run": 4,
+    "store": 5,
+    "figures": 6,
+    "video": 6,
+    "analysis": 7,
+    "cli": 8,
+    "bench": 9,
 }
+
+# The registry's files: the only ones of src/, include/ and bindings/ that
+# name a backend (rule 8).
+REGISTRY = ("src/registry/", "include/beamsim/backend_registry.h")
 
 # Each public header's layer: the folder that implements it.
 PUBLIC = {
@@ -55,6 +68,7 @@ PUBLIC = {
     "stats": "util",
     "version": "util",
     "backend": "model",
+    "backend_registry": "registry",
     "effects": "model",
     "experiment": "model",
     "key_names": "model",
@@ -277,12 +291,62 @@ def check_defaults(src, breaches):
             breaches.append(f"{name} has no default function {name}_default(void)")
 
 
+def backend_names(src):
+    """The backends: the folders of backends/."""
+    return sorted(os.path.basename(d) for d in glob.glob(os.path.join(src, "backends", "*"))
+                  if os.path.isdir(d))
+
+
+def backend_ranks(src, breaches):
+    for name in backend_names(src):
+        if name in RANK:
+            breaches.append(f"backends/{name}: a backend named as a layer of src/")
+        RANK[name] = BACKEND_RANK
+
+
+# A C comment, a C string or character literal; the rest is code.
+C_TOKEN = re.compile(r"/\*.*?\*/|//[^\n]*|\"(?:\\.|[^\"\\\n])*\"|'(?:\\.|[^'\\\n])*'", re.S)
+
+
+def comment_spans(text, python):
+    """(start, end) of the comments of a C or Python source."""
+    if python:
+        return [m.span() for m in re.finditer(r"#[^\n]*", text)]
+    return [m.span() for m in C_TOKEN.finditer(text) if m.group(0)[0] == "/"]
+
+
+def check_backend_names(src, breaches):
+    names = backend_names(src)
+    files = []
+    for top in ("src", "include", "bindings"):
+        for f in glob.glob(os.path.join(src, top, "**", "*"), recursive=True):
+            if os.path.isfile(f) and re.search(r"\.(c|h|cpp|in|py|m|txt)$", f):
+                files.append(f)
+    for f in sorted(files):
+        rel = os.path.relpath(f, src)
+        if rel.startswith(REGISTRY):
+            continue
+        text = open(f, encoding="utf-8", errors="replace").read()
+        spans = comment_spans(text, f.endswith(".py"))
+        for name in names:
+            word = r"(?<![\w/.-])%s(?![\w/-])" % re.escape(name)
+            for m in re.finditer(r"\bbsim_backend_%s\b|%s" % (re.escape(name), word), text):
+                in_comment = any(a <= m.start() < b for a, b in spans)
+                if in_comment and text.startswith(" backend", m.end()):
+                    continue
+                line = text.count("\n", 0, m.start()) + 1
+                breaches.append(f"{rel}:{line}: names the backend {name} "
+                                f"({m.group(0)}): only the registry ({REGISTRY[0]}) does; "
+                                f"use bsim_backend_default(), bsim_backend_find or the list")
+
+
 def main():
     if len(sys.argv) != 3:
         print(__doc__.splitlines()[-2], file=sys.stderr)
         return 2
     src, build = sys.argv[1], sys.argv[2]
     breaches = []
+    backend_ranks(src, breaches)
     check_includes(src, breaches)
     objects = read_objects(build)
     check_calls(objects, breaches)
@@ -291,6 +355,7 @@ def main():
     check_guards(src, breaches)
     check_umbrella(src, breaches)
     check_defaults(src, breaches)
+    check_backend_names(src, breaches)
     for b in breaches:
         print(b)
     print(f"layers: {len(breaches)} breach(es)")

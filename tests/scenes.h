@@ -5,7 +5,6 @@
 #include <math.h>
 
 #include "beamsim/scene.h"
-#include "beamsim/state.h"
 
 /* The essay's gate with no effects at all, body at rest at (0, 0). */
 static inline void scene_gate_quiet(bsim_scene *s)
@@ -32,50 +31,6 @@ static inline void scene_one_beam(bsim_scene *s)
 	b->damping = 0.0;
 	s->body.start[0] = 0.0;
 	s->body.start[1] = -100.0;
-}
-
-/* scene_one_beam with the body below the beam at lever r, gap m from it,
- * moving up at u m/s into it square-on: a tangent impact with restitution
- * e (tip_restitution 0.3, which must not be used). */
-static inline void scene_tangent_hit(bsim_scene *s, double r, double e, double u, double gap)
-{
-	scene_one_beam(s);
-	s->contact.restitution = e;
-	s->contact.tip_restitution = 0.3;
-	s->body.start[0] = r;
-	s->body.start[1] = -s->body.radius - gap;
-	s->body.velocity[1] = u;
-}
-
-/* scene_one_beam with the body moving at (-0.6, 2) m/s onto the beam's tip
- * (25, 0) from 40 degrees below +x, its centre R + gap from the tip: a tip
- * impact with tip_restitution e_tip (restitution 0.2, which must not be
- * used). */
-static inline void scene_tip_hit(bsim_scene *s, double e_tip, double gap)
-{
-	scene_one_beam(s);
-	s->contact.restitution = 0.2;
-	s->contact.tip_restitution = e_tip;
-	const double a = -40.0 * 3.141592653589793 / 180.0, d = s->body.radius + gap;
-	s->body.start[0] = 25.0 + d * cos(a);
-	s->body.start[1] = d * sin(a);
-	s->body.velocity[0] = -0.6;
-	s->body.velocity[1] = 2.0;
-}
-
-/* For scene_tip_hit's state st after the impact: the relative normal
- * velocity of body and tip before the impact (the start's velocity) and
- * after it, along the line from the tip to the centre at st. */
-static inline void tip_hit_normal_velocities(const bsim_state *st, double *before, double *after)
-{
-	const double c[2] = {st->x[0] - 25.0 * cos(st->theta[0]),
-	                     st->x[1] - 25.0 * sin(st->theta[0])};
-	const double len = hypot(c[0], c[1]);
-	/* the tip moves with omega (-L sin, L cos) */
-	const double tipv[2] = {-25.0 * sin(st->theta[0]) * st->omega[0],
-	                        25.0 * cos(st->theta[0]) * st->omega[0]};
-	*before = (-0.6 * c[0] + 2.0 * c[1]) / len;
-	*after = ((st->v[0] - tipv[0]) * c[0] + (st->v[1] - tipv[1]) * c[1]) / len;
 }
 
 /* The damped oscillator I th'' + d th' + k th = 0 (underdamped) from

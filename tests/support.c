@@ -11,6 +11,8 @@
 
 #include "support.h"
 
+#include "beamsim/backend_registry.h"
+
 #include "util/figure.h"
 #include "store/outdir.h"
 
@@ -655,4 +657,69 @@ int bsim_test_check_wrote(const char *out, const char *dir)
 	}
 	free(m);
 	return n;
+}
+
+int bsim_test_run_per_backend(const char *group, const struct CMUnitTest *tests, size_t n)
+{
+	const bsim_backend *const *all = bsim_backend_list();
+	size_t nb = 0;
+	while (all[nb])
+		nb++;
+	struct CMUnitTest *t = calloc(n * nb, sizeof *t);
+	char(*names)[128] = calloc(n * nb, sizeof *names);
+	if (!t || !names) {
+		fprintf(stderr, "%s: out of memory\n", group);
+		return 1;
+	}
+	for (size_t i = 0, k = 0; i < n; i++)
+		for (size_t j = 0; j < nb; j++, k++) {
+			t[k] = tests[i];
+			snprintf(names[k], sizeof names[k], "%s (%s)", tests[i].name, all[j]->name);
+			t[k].name = names[k];
+			t[k].initial_state = (void *)all[j];
+		}
+	int rc = _cmocka_run_group_tests(group, t, n * nb, NULL, NULL);
+	free(t);
+	free(names);
+	return rc;
+}
+
+double bsim_test_bound(const bsim_backend *b, const char *check)
+{
+	double v;
+	if (!bsim_backend_bound_of(b, check, &v))
+		bsim_test_skip(b,
+		               "it states no bound for the check %s (bsim_backend.bounds, "
+		               "docs/tests.md)",
+		               check);
+	return v;
+}
+
+void bsim_test_skip(const bsim_backend *b, const char *fmt, ...)
+{
+	char why[512];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(why, sizeof why, fmt, ap);
+	va_end(ap);
+	print_message("SKIP %s: %s\n", b->name, why);
+	skip();
+}
+
+const bsim_backend *bsim_test_backend(const char *name)
+{
+	bsim_error err;
+	const bsim_backend *b = bsim_backend_find(name, &err);
+	if (!b)
+		fail_msg("%s", err.msg);
+	return b;
+}
+
+bsim_world *bsim_test_world(const bsim_backend *b, const bsim_scene *s, const bsim_options *opts)
+{
+	bsim_world *w = NULL;
+	bsim_error err;
+	if (b->create(s, opts, &w, &err) != BSIM_OK)
+		fail_msg("%s: %s", b->name, err.msg);
+	return w;
 }

@@ -5,6 +5,10 @@
 
 #include <stddef.h>
 
+#include "beamsim/backend_registry.h"
+
+struct CMUnitTest;
+
 /* Runs BSIM_EXE with argv (NULL-terminated, without the program name),
  * capturing stdout and stderr into malloc'd strings (caller frees; may pass
  * NULL to discard). Returns the exit status, 128 + the signal's number if a
@@ -141,6 +145,29 @@ double bsim_test_json_number(const char *text, const char *key);
  * followed by a line "  PATH ..." for every file DIR/manifest.json lists;
  * returns their number. */
 int bsim_test_check_wrote(const char *out, const char *dir);
+
+/* The tests that every backend passes (docs/tests.md, "Every backend"):
+ * each of the n tests once per backend of the registry
+ * (bsim_backend_list), named "TEST (BACKEND)" with the backend as its
+ * state, so that a backend added to the registry runs them with no edit
+ * here; cmocka's status of the whole group. */
+int bsim_test_run_per_backend(const char *group, const struct CMUnitTest *tests, size_t n);
+
+/* The bound b states for check (bsim_backend_bound); if it states none,
+ * the test (of that backend) is skipped, saying so. */
+double bsim_test_bound(const bsim_backend *b, const char *check);
+
+/* Skips the test of backend b, printing why it cannot apply (printf-style). */
+void bsim_test_skip(const bsim_backend *b, const char *fmt, ...)
+        __attribute__((format(printf, 2, 3)));
+
+/* b's world for s with opts (may be NULL); fails the test with b's message
+ * if b refuses. */
+bsim_world *bsim_test_world(const bsim_backend *b, const bsim_scene *s, const bsim_options *opts);
+
+/* A backend by name, for a test of that backend's own behaviour (its
+ * knobs, its internals); fails the test if none is compiled in. */
+const bsim_backend *bsim_test_backend(const char *name);
 
 /* Wilson's 95% score interval of k successes in n, in closed form. */
 void bsim_test_wilson(int k, int n, double *lo, double *hi);

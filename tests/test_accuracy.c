@@ -38,8 +38,8 @@ static double vibration_consistency(const char *integrator, double h,
 	assert_int_equal(bsim_options_add(&o, kv, NULL), BSIM_OK);
 	double mean, max;
 	bsim_error err;
-	int rc = bsim_accuracy_consistency(ref, &s, &bsim_backend_thesis, &o, 1, 0.064, 8, &mean,
-	                                   &max, &err);
+	int rc = bsim_accuracy_consistency(ref, &s, bsim_test_backend("thesis"), &o, 1, 0.064, 8,
+	                                   &mean, &max, &err);
 	if (rc)
 		print_error("%s\n", err.msg);
 	assert_int_equal(rc, BSIM_OK);
@@ -58,9 +58,9 @@ static void test_consistency_order(void **state)
 	s.max_steps = 16000; /* 2 s */
 	bsim_accuracy_reference ref;
 	bsim_error err;
-	assert_int_equal(
-	        bsim_accuracy_reference_run(&ref, &s, &bsim_backend_thesis, NULL, 1, 0.016, &err),
-	        BSIM_OK);
+	assert_int_equal(bsim_accuracy_reference_run(&ref, &s, bsim_test_backend("thesis"), NULL, 1,
+	                                             0.016, &err),
+	                 BSIM_OK);
 	assert_true(ref.n > 100);
 	double m2 = vibration_consistency("midpoint", 0.002, &ref);
 	double m1 = vibration_consistency("midpoint", 0.001, &ref);

@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include "beamsim/trial.h"
+#include "support.h"
 
 static bsim_trial_result coast(double vx, double deadband)
 {
@@ -23,8 +24,9 @@ static bsim_trial_result coast(double vx, double deadband)
 	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
 	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
-	assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL, 1, NULL, &out, &err),
-	                 BSIM_OK);
+	assert_int_equal(
+	        bsim_trial_run(r, &s, bsim_test_backend("thesis"), NULL, 1, NULL, &out, &err),
+	        BSIM_OK);
 	bsim_trial_runner_free(r);
 	bsim_scene_free(&s);
 	assert_int_equal(out.outcome, BSIM_TRAVERSED);

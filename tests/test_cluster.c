@@ -271,29 +271,43 @@ static void test_shards_merged(void **state)
 	assert_same_dir(one, out);
 }
 
-/* A comparison (thesis against box2d) in 3 parts, merged. */
-static void test_compare_shards_merged(void **state)
+/* A comparison of the sides backends in 3 parts, merged. */
+static void compare_shards_merged(const char *name, const char *backends)
 {
-	(void)state;
 	char dir[1024], one[1100], out[1100], part[3][1100];
-	snprintf(dir, sizeof dir, "%s", bsim_test_dir("compare_parts"));
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir(name));
 	snprintf(one, sizeof one, "%s/one", dir);
-	const char *argv1[] = {"compare", experiment, "--trials", "4",       "--threads",
-	                       "2",       "--out",    one,        "--quiet", NULL};
+	const char *argv1[] = {"compare", experiment, "--trials", "4",       "--threads",  "2",
+	                       "--out",   one,        "--quiet",  "--backends", backends, NULL};
 	assert_int_equal(bsim_test_cli(argv1, NULL, NULL), 0);
 	for (int i = 0; i < 3; i++) {
 		char shard_arg[16];
 		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
 		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
-		const char *argv[] = {"compare",   experiment, "--trials", "4",
-		                      "--threads", "1",        "--shard",  shard_arg,
-		                      "--out",     part[i],    "--quiet",  NULL};
+		const char *argv[] = {"compare", experiment, "--trials",   "4",      "--threads",
+		                      "1",       "--shard",  shard_arg,    "--out",  part[i],
+		                      "--quiet", "--backends", backends, NULL};
 		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	}
 	snprintf(out, sizeof out, "%s/merged", dir);
 	const char *argv[] = {"merge", part[1], part[2], part[0], "--out", out, "--quiet", NULL};
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	assert_same_dir(one, out);
+}
+
+/* thesis against box2d */
+static void test_compare_shards_merged(void **state)
+{
+	(void)state;
+	compare_shards_merged("compare_parts", "thesis,box2d");
+}
+
+/* three sides: each record every side's result and every pair's
+ * separation time */
+static void test_compare3_shards_merged(void **state)
+{
+	(void)state;
+	compare_shards_merged("compare3_parts", "thesis,thesis:integrator=euler,box2d");
 }
 
 /* merge refuses: the status 2, one line naming the culprit, no DIR. */
@@ -647,12 +661,17 @@ static const char *lattice_compare_experiment(void)
 	return path;
 }
 
-/* compare of the lattice (protocols NULL: thesis against box2d; else
- * --protocols protocols) into out, extra arguments a, b (NULL: none) last:
- * argv filled. */
+/* compare of the lattice (sides NULL: thesis against box2d; "P,Q" of
+ * protocols: --protocols sides; else --backends sides) into out, extra
+ * arguments a, b (NULL: none) last: argv filled. */
 static void lattice_compare_argv(const char **argv, const char *out, const char *threads,
-                                 const char *protocols, const char *a, const char *b)
+                                 const char *sides, const char *a, const char *b)
 {
+	const char *opt = !sides                             ? NULL
+	                  : strncmp(sides, "world", 5) == 0 ||
+	                                    strncmp(sides, "essay", 5) == 0
+	                          ? "--protocols"
+	                          : "--backends";
 	const char *v[] = {"compare",
 	                   lattice_compare_experiment(),
 	                   "--threads",
@@ -660,10 +679,10 @@ static void lattice_compare_argv(const char **argv, const char *out, const char 
 	                   "--out",
 	                   out,
 	                   "--quiet",
-	                   protocols ? "--protocols" : a,
-	                   protocols ? protocols : b,
-	                   protocols ? a : NULL,
-	                   protocols ? b : NULL,
+	                   sides ? opt : a,
+	                   sides ? sides : b,
+	                   sides ? a : NULL,
+	                   sides ? b : NULL,
 	                   NULL};
 	memcpy(argv, v, sizeof v);
 }
@@ -682,23 +701,27 @@ static int run_status(const char *const *argv)
 
 /* The lattice comparison in 3 parts, merged: the one-process directory
  * (report, pairs, each side's trials.csv, summary.json and lattice files),
- * of two backends and of two protocols (whose side b has scenes of its
- * own). */
+ * of two backends, of two protocols (whose side b has scenes of its own)
+ * and of three sides (records of three sides' gate paths and peaks). */
 static void test_lattice_compare_shards_merged(void **state)
 {
 	(void)state;
-	static const char *const protocols[] = {NULL, "world,essay"};
-	for (int k = 0; k < 2; k++) {
+	static const char *const protocols[] = {NULL, "world,essay",
+	                                        "thesis,box2d,thesis:integrator=euler"};
+	static const char *const names[] = {"lattice_compare", "lattice_compare_protocols",
+	                                    "lattice_compare3"};
+	static const char *const lattice_file[] = {"box2d/gate_entries.csv",
+	                                           "world/transitions.csv",
+	                                           "thesis-integrator=euler/gate_entries.csv"};
+	for (int k = 0; k < 3; k++) {
 		char dir[1024], one[1100], out[1100], part[3][1100];
 		const char *argv[16];
-		snprintf(dir, sizeof dir, "%s",
-		         bsim_test_dir(k ? "lattice_compare_protocols" : "lattice_compare"));
+		snprintf(dir, sizeof dir, "%s", bsim_test_dir(names[k]));
 		snprintf(one, sizeof one, "%s/one", dir);
 		lattice_compare_argv(argv, one, "2", protocols[k], NULL, NULL);
 		int want = run_status(argv);
 		assert_true(want == 0 || want == 3);
-		assert_true(bsim_test_exists(bsim_test_join(one, k ? "world/transitions.csv"
-		                                                   : "box2d/gate_entries.csv")));
+		assert_true(bsim_test_exists(bsim_test_join(one, lattice_file[k])));
 		for (int i = 0; i < 3; i++) {
 			char shard_arg[16];
 			snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
@@ -1532,6 +1555,7 @@ int main(int argc, char **argv)
 	const struct CMUnitTest shards[] = {
 	        cmocka_unit_test(test_shards_merged),
 	        cmocka_unit_test(test_compare_shards_merged),
+	        cmocka_unit_test(test_compare3_shards_merged),
 	        cmocka_unit_test(test_merge_refuses),
 	        cmocka_unit_test(test_markov_shards_merged),
 	        cmocka_unit_test(test_markov_self_shards_merged),

@@ -5,7 +5,10 @@
  * group is one pair (same or different) outside the Holm family, and the
  * margin and the exact rule act as documented; the Holm family by its
  * definition, groups at the floor uninformative, and the smaller family
- * flagging what the redundant one missed. */
+ * flagging what the redundant one missed. More than two sides: one Holm
+ * family over every pair's tests against Holm's and McNemar's definitions
+ * computed here, and the odd one out on constructed verdicts and outcomes
+ * (one side flipped, two sides flipped, all alike). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -333,13 +336,245 @@ static void test_shape_mismatch(void **state)
 	assert_non_null(strstr(err.msg, "cannot pair"));
 }
 
+/* ---- more than two sides ---------------------------------------------------- */
+
+/* Whether trial r shows event e, written out here from the events'
+ * definitions (beamsim/compare.h) rather than taken from the library. */
+static int shows(const bsim_trial_result *r, int e)
+{
+	switch (e) {
+	case BSIM_EVENT_TRAVERSED:
+		return r->outcome == BSIM_TRAVERSED;
+	case BSIM_EVENT_LEFT:
+		return r->outcome == BSIM_TRAVERSED && r->type == BSIM_TYPE_LEFT;
+	case BSIM_EVENT_RIGHT:
+		return r->outcome == BSIM_TRAVERSED && r->type == BSIM_TYPE_RIGHT;
+	case BSIM_EVENT_SIDE_EXIT:
+		return r->outcome == BSIM_SIDE_EXIT;
+	case BSIM_EVENT_STUCK:
+		return r->outcome == BSIM_STUCK;
+	default:
+		return r->outcome == BSIM_UNSTABLE;
+	}
+}
+
+/* The exact McNemar p-value from its definition: b ~ Binomial(b + c, 1/2),
+ * two-sided, min(1, 2 P(X <= min(b, c))). */
+static double mcnemar_by_hand(int b, int c)
+{
+	int m = b + c, k = b < c ? b : c;
+	double tail = 0.0;
+	for (int i = 0; i <= k; i++)
+		tail += exp(lgamma(m + 1.0) - lgamma(i + 1.0) - lgamma(m - i + 1.0) - m * log(2.0));
+	return m == 0 ? 1.0 : fmin(1.0, 2.0 * tail);
+}
+
+/* Holm's step-down adjustment from its definition: the i-th smallest of n
+ * p-values times (n - i), the running maximum, at most 1. Quadratic, and
+ * apart from bsim_stats_holm. */
+static void holm_by_hand(const double *p, int n, double *adj)
+{
+	for (int i = 0; i < n; i++) {
+		double worst = 0.0;
+		/* adj_i = max over the p_j <= p_i (ties by index) of (n - rank_j) p_j */
+		for (int j = 0; j < n; j++) {
+			int rank = 0;
+			for (int k = 0; k < n; k++)
+				rank += p[k] < p[j] || (p[k] == p[j] && k < j);
+			int before = p[j] < p[i] || (p[j] == p[i] && j <= i);
+			if (before)
+				worst = fmax(worst, fmin(1.0, (n - rank) * p[j]));
+		}
+		adj[i] = worst;
+	}
+}
+
+enum { S3 = 3, G3 = 4, N3 = 120 };
+static bsim_trial_result T3[S3][G3 * N3];
+
+/* Three sides of four groups. Side 1 is side 0; side 2 is side 0 but for
+ * group 1, where 60 of 120 pairs traverse on sides 0 and 1 and get stuck
+ * on side 2 (side 2 is flipped), and group 2, where 5 trials of 120 are
+ * flipped (too few to show). Group 3 flips sides 1 and 2 alike in 60
+ * trials: side 0 is the one apart. Group 0 is alike everywhere. */
+static void build_sides(void)
+{
+	for (int i = 0; i < G3 * N3; i++) {
+		if (i % 3 == 2)
+			stuck(&T3[0][i]);
+		else
+			traversed(&T3[0][i], i % 3 ? BSIM_TYPE_LEFT : BSIM_TYPE_RIGHT);
+		T3[1][i] = T3[2][i] = T3[0][i];
+	}
+	for (int t = 0; t < 60; t++) {
+		traversed(&T3[0][1 * N3 + 2 * t], BSIM_TYPE_LEFT);
+		T3[1][1 * N3 + 2 * t] = T3[0][1 * N3 + 2 * t];
+		stuck(&T3[2][1 * N3 + 2 * t]);
+		traversed(&T3[0][3 * N3 + 2 * t], BSIM_TYPE_RIGHT);
+		stuck(&T3[1][3 * N3 + 2 * t]);
+		stuck(&T3[2][3 * N3 + 2 * t]);
+	}
+	for (int t = 0; t < 5; t++)
+		stuck(&T3[2][2 * N3 + 3 * t]), traversed(&T3[0][2 * N3 + 3 * t], BSIM_TYPE_LEFT),
+		        T3[1][2 * N3 + 3 * t] = T3[0][2 * N3 + 3 * t];
+}
+
+/* One Holm family over every pair's tests: each pair's family events'
+ * McNemar p-values, computed here from the trials, adjusted together by
+ * Holm's definition, are the p_holm of every pair; the family's size is
+ * the sum of the pairs' family sizes, and every pair states it. */
+static void test_sides_one_family(void **state)
+{
+	(void)state;
+	build_sides();
+	bsim_sweep_result r[S3];
+	for (int s = 0; s < S3; s++)
+		r[s] = (bsim_sweep_result){.n_groups = G3, .trials = N3, .trials_out = T3[s]};
+	bsim_compare_sides c;
+	bsim_error err;
+	bsim_compare_rule rule = {0.05, 0.05, 0};
+	assert_int_equal(bsim_compare_analyse_sides(r, S3, NULL, &rule, &c, &err), BSIM_OK);
+	assert_int_equal(c.n_pairs, 3);
+	static const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+	double p[3 * G3 * BSIM_N_EVENTS], adj[3 * G3 * BSIM_N_EVENTS];
+	int at[3][G3][BSIM_N_EVENTS], n = 0;
+	for (int k = 0; k < 3; k++) {
+		assert_int_equal(c.pair[k][0], pairs[k][0]);
+		assert_int_equal(c.pair[k][1], pairs[k][1]);
+		const bsim_trial_result *a = T3[pairs[k][0]], *b = T3[pairs[k][1]];
+		for (int g = 0; g < G3; g++) {
+			unsigned cells = 0;
+			for (int t = 0; t < N3; t++)
+				for (int side = 0; side < 2; side++) {
+					const bsim_trial_result *x =
+					        side ? &b[g * N3 + t] : &a[g * N3 + t];
+					cells |= x->outcome == BSIM_STUCK    ? 16u
+					         : x->type == BSIM_TYPE_LEFT ? 1u
+					                                     : 2u;
+				}
+			unsigned family = bsim_compare_family(cells);
+			assert_int_equal(c.pairs[k].groups[g].family, family);
+			for (int e = 0; e < BSIM_N_EVENTS; e++) {
+				at[k][g][e] = -1;
+				if (!(family >> e & 1u))
+					continue;
+				int only_a = 0, only_b = 0;
+				for (int t = 0; t < N3; t++) {
+					int x = shows(&a[g * N3 + t], e),
+					    y = shows(&b[g * N3 + t], e);
+					only_a += x && !y;
+					only_b += !x && y;
+				}
+				at[k][g][e] = n;
+				p[n++] = mcnemar_by_hand(only_a, only_b);
+			}
+		}
+	}
+	assert_int_equal(c.n_tests, n);
+	holm_by_hand(p, n, adj);
+	for (int k = 0; k < 3; k++) {
+		assert_int_equal(c.pairs[k].n_tests, n);
+		for (int g = 0; g < G3; g++)
+			for (int e = 0; e < BSIM_N_EVENTS; e++)
+				if (at[k][g][e] >= 0)
+					assert_float_equal(c.pairs[k].groups[g].ev[e].p_holm,
+					                   adj[at[k][g][e]],
+					                   1e-12 * adj[at[k][g][e]]);
+				else
+					assert_true(isnan(c.pairs[k].groups[g].ev[e].p_holm));
+	}
+	bsim_compare_sides_free(&c);
+}
+
+/* The odd one out from constructed pairwise verdicts (pairs in the order
+ * (0,1), (0,2), (1,2) for three sides; (0,1), (0,2), (0,3), (1,2), (1,3),
+ * (2,3) for four). */
+static void test_odd_one_out_rule(void **state)
+{
+	(void)state;
+	/* all agree */
+	assert_int_equal(bsim_compare_odd_one_out(3, (int[]){0, 0, 0}), BSIM_ODD_NONE);
+	assert_int_equal(bsim_compare_odd_one_out(2, (int[]){0}), BSIM_ODD_NONE);
+	/* one side flipped: it differs from both others, which agree */
+	assert_int_equal(bsim_compare_odd_one_out(3, (int[]){1, 1, 0}), 0);
+	assert_int_equal(bsim_compare_odd_one_out(3, (int[]){1, 0, 1}), 1);
+	assert_int_equal(bsim_compare_odd_one_out(3, (int[]){0, 1, 1}), 2);
+	assert_int_equal(bsim_compare_odd_one_out(4, (int[]){0, 0, 1, 0, 1, 1}), 3);
+	/* two sides flipped alike among four: two against two, no single side */
+	assert_int_equal(bsim_compare_odd_one_out(4, (int[]){0, 1, 1, 1, 1, 0}),
+	                 BSIM_ODD_NO_SINGLE);
+	/* side 0 differs from every other, but sides 1 and 2 differ too: the
+	 * others do not agree among themselves */
+	assert_int_equal(bsim_compare_odd_one_out(4, (int[]){1, 1, 1, 1, 0, 0}),
+	                 BSIM_ODD_NO_SINGLE);
+	/* a side that differs from one other only, or everything differing */
+	assert_int_equal(bsim_compare_odd_one_out(3, (int[]){1, 0, 0}), BSIM_ODD_NO_SINGLE);
+	assert_int_equal(bsim_compare_odd_one_out(3, (int[]){1, 1, 1}), BSIM_ODD_NO_SINGLE);
+	/* two sides that differ: either could be the odd one */
+	assert_int_equal(bsim_compare_odd_one_out(2, (int[]){1}), BSIM_ODD_NO_SINGLE);
+}
+
+/* The odd one out of constructed outcomes (build_sides): group 1's
+ * flipped side 2, group 3's side 0 (sides 1 and 2 flipped alike agree),
+ * none in group 0 (all alike) and group 2 (too few flips to show). Four
+ * sides, the fourth a copy of side 0: in group 3 two sides against two, no
+ * single side; in group 1 side 2 still. A group's verdict is its least
+ * agreeing pair's. */
+static void test_odd_one_out_flipped(void **state)
+{
+	(void)state;
+	build_sides();
+	bsim_sweep_result r[4];
+	for (int s = 0; s < 4; s++)
+		r[s] = (bsim_sweep_result){
+		        .n_groups = G3, .trials = N3, .trials_out = T3[s < S3 ? s : 0]};
+	bsim_compare_sides c;
+	bsim_error err;
+	bsim_compare_rule rule = {0.05, 0.05, 0};
+	assert_int_equal(bsim_compare_analyse_sides(r, 3, NULL, &rule, &c, &err), BSIM_OK);
+	assert_int_equal(c.odd[0], BSIM_ODD_NONE);
+	assert_int_equal(c.odd[1], 2);
+	assert_int_equal(c.odd[2], BSIM_ODD_NONE);
+	assert_int_equal(c.odd[3], 0);
+	assert_int_equal(c.verdict[1], BSIM_VERDICT_DISAGREE);
+	assert_int_equal(c.pairs[0].groups[1].verdict, BSIM_VERDICT_EQUIVALENT);
+	assert_int_equal(c.n_disagree, 2);
+	for (int g = 0; g < G3; g++) {
+		bsim_verdict worst = BSIM_VERDICT_SAME;
+		for (int k = 0; k < c.n_pairs; k++)
+			if (c.pairs[k].groups[g].verdict > worst)
+				worst = c.pairs[k].groups[g].verdict;
+		assert_int_equal(c.verdict[g], worst);
+	}
+	bsim_compare_sides_free(&c);
+	assert_int_equal(bsim_compare_analyse_sides(r, 4, NULL, &rule, &c, &err), BSIM_OK);
+	assert_int_equal(c.n_pairs, 6);
+	assert_int_equal(c.odd[1], 2);
+	assert_int_equal(c.odd[3], BSIM_ODD_NO_SINGLE);
+	assert_int_equal(c.odd[0], BSIM_ODD_NONE);
+	bsim_compare_sides_free(&c);
+	/* two sides: the pair disagrees in groups 1 and 3, no single side */
+	assert_int_equal(bsim_compare_analyse_sides(r + 1, 2, NULL, &rule, &c, &err), BSIM_OK);
+	assert_int_equal(c.odd[1], BSIM_ODD_NO_SINGLE);
+	assert_int_equal(c.odd[0], BSIM_ODD_NONE);
+	bsim_compare_sides_free(&c);
+	assert_int_equal(bsim_compare_analyse_sides(r, 9, NULL, &rule, &c, &err), BSIM_EINPUT);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_verdicts),       cmocka_unit_test(test_rule_knobs),
-	        cmocka_unit_test(test_inconclusive),   cmocka_unit_test(test_separation_quantiles),
-	        cmocka_unit_test(test_shape_mismatch), cmocka_unit_test(test_family_by_hand),
-	        cmocka_unit_test(test_uninformative),  cmocka_unit_test(test_family_power),
+	        cmocka_unit_test(test_verdicts),
+	        cmocka_unit_test(test_rule_knobs),
+	        cmocka_unit_test(test_inconclusive),
+	        cmocka_unit_test(test_separation_quantiles),
+	        cmocka_unit_test(test_shape_mismatch),
+	        cmocka_unit_test(test_family_by_hand),
+	        cmocka_unit_test(test_uninformative),
+	        cmocka_unit_test(test_family_power),
+	        cmocka_unit_test(test_sides_one_family),
+	        cmocka_unit_test(test_odd_one_out_rule),
+	        cmocka_unit_test(test_odd_one_out_flipped),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,12 +1,14 @@
 /* beamsim compare and regress through the real program: each backend's
  * half of a comparison is exactly its own sweep (the pairs share
- * schedules), for every pair of the registry's backends, results do not
- * depend on threads, the replay lines in a report reproduce the trials they
- * name, a rerun of a stored run with the same code reproduces it exactly,
- * and a baseline whose outcomes were changed is caught (exit status 3) in
- * the groups that were changed. */
+ * schedules), results do not depend on threads, the replay lines in a
+ * report reproduce the trials they name, a rerun of a stored run with the
+ * same code reproduces it exactly, and a baseline whose outcomes were
+ * changed is caught (exit status 3) in the groups that were changed.
+ * Three sides: report.json's every pair against pairs.csv read on its own,
+ * and the odd one out by its rule. */
 #define _POSIX_C_SOURCE 200809L
 
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -17,8 +19,8 @@
 
 #include <cmocka.h>
 
-#include "beamsim/backend.h"
 #include "support.h"
+#include "util/yaml_doc.h"
 
 static char experiment[1200];
 static char cmp_dir[1200];
@@ -88,49 +90,39 @@ static void test_halves_are_sweeps(void **state)
 	}
 }
 
-/* Every pair of the registry's backends compares (`--backends A,B`), and
- * each side of the comparison is that backend's own sweep. */
-static void test_every_pair(void **state)
+/* Every backend of the registry is a side of one comparison (`--backends
+ * A,B,C,...`, the whole list), and each side is that backend's own sweep. */
+static void test_every_backend_a_side(void **state)
 {
 	(void)state;
 	const bsim_backend *const *list = bsim_backend_list();
-	enum { MAX = 16 };
-	char sweep[MAX][1200];
-	int n = 0;
-	for (; list[n] && n < MAX; n++) {
+	char sides[512] = "";
+	for (int n = 0; list[n]; n++)
+		snprintf(sides + strlen(sides), sizeof sides - strlen(sides), "%s%s", n ? "," : "",
+		         list[n]->name);
+	char dir[1200];
+	snprintf(dir, sizeof dir, "%s", out_dir("cmp_all"));
+	const char *argv[] = {"compare", experiment, "--backends", sides, "--threads",
+	                      "2",       "--quiet",  "--out",      dir,   NULL};
+	int status = bsim_test_cli(argv, NULL, NULL);
+	if (status != 0 && status != 3)
+		fail_msg("compare --backends %s: exit %d", sides, status);
+	for (int n = 0; list[n]; n++) {
 		char name[64];
-		snprintf(name, sizeof name, "pair_sweep_%s", list[n]->name);
-		snprintf(sweep[n], sizeof sweep[n], "%s", bsim_test_dir(name));
-		const char *argv[] = {"sweep",   experiment, "--backend", list[n]->name,
-		                      "--quiet", "--out",    sweep[n],    NULL};
-		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+		snprintf(name, sizeof name, "side_sweep_%s", list[n]->name);
+		const char *sweep = out_dir(name);
+		const char *sw[] = {"sweep",   experiment, "--backend", list[n]->name,
+		                    "--quiet", "--out",    sweep,       NULL};
+		assert_int_equal(bsim_test_cli(sw, NULL, NULL), 0);
+		char sub[1300];
+		snprintf(sub, sizeof sub, "%s/%s", dir, list[n]->name);
+		char *a = read_in(sweep, "trials.csv"), *b = read_in(sub, "trials.csv");
+		if (strcmp(a, b) != 0)
+			fail_msg("compare --backends %s: the %s side differs from its sweep", sides,
+			         list[n]->name);
+		free(a);
+		free(b);
 	}
-	for (int i = 0; i < n; i++)
-		for (int j = i + 1; j < n; j++) {
-			char sides[200], name[200], dir[1200];
-			snprintf(sides, sizeof sides, "%s,%s", list[i]->name, list[j]->name);
-			snprintf(name, sizeof name, "pair_%s_%s", list[i]->name, list[j]->name);
-			snprintf(dir, sizeof dir, "%s", bsim_test_dir(name));
-			const char *argv[] = {"compare",   experiment, "--backends", sides,
-			                      "--threads", "2",        "--quiet",    "--out",
-			                      dir,         NULL};
-			int status = bsim_test_cli(argv, NULL, NULL);
-			if (status != 0 && status != 3)
-				fail_msg("compare --backends %s: exit %d", sides, status);
-			const int side[2] = {i, j};
-			for (int k = 0; k < 2; k++) {
-				char sub[1300];
-				snprintf(sub, sizeof sub, "%s/%s", dir, list[side[k]]->name);
-				char *a = read_in(sweep[side[k]], "trials.csv"),
-				     *b = read_in(sub, "trials.csv");
-				if (strcmp(a, b) != 0)
-					fail_msg("compare --backends %s: the %s side differs from "
-					         "its sweep",
-					         sides, list[side[k]]->name);
-				free(a);
-				free(b);
-			}
-		}
 }
 
 /* The exit status says what report.json says; threads change nothing. */
@@ -243,8 +235,14 @@ static void test_regress_identical(void **state)
 	/* The rerun is itself a baseline. */
 	char *a = read_in(dir, "run.json");
 	assert_non_null(strstr(a, "\"command\": \"compare\""));
-	/* What built it: the Box2D CMake found, a compiler named. */
+	/* What built it: each registered backend's version (NAME_version; the
+	 * Box2D backend's the Box2D CMake found), a compiler named. */
 	assert_non_null(strstr(a, "\"box2d_version\": \"" BSIM_TEST_BOX2D_VERSION "\""));
+	for (const bsim_backend *const *b = bsim_backend_list(); *b; b++) {
+		char key[128];
+		snprintf(key, sizeof key, "\"%s_version\": \"%s\"", (*b)->name, (*b)->version);
+		assert_non_null(strstr(a, key));
+	}
 	assert_non_null(strstr(a, "\"compiler\": \"gcc ") || strstr(a, "\"compiler\": \"clang "));
 	assert_non_null(strstr(a, "\"beamsim_commit\": \""));
 	free(a);
@@ -482,11 +480,267 @@ static void test_bad_usage(void **state)
 	free(err);
 }
 
+/* ---- three sides ------------------------------------------------------------ */
+
+enum { N3 = 3, P3 = 3, MAX_ROWS = 64 };
+static const char *const sides3[N3] = {"thesis", "box2d", "thesis:impact_mass=0.1"};
+static const char *const dirs3[N3] = {"thesis", "box2d", "thesis-impact_mass=0.1"};
+static const int pair3[P3][2] = {{0, 1}, {0, 2}, {1, 2}};
+
+/* pairs.csv read on its own: per row, each side's outcome and type. */
+typedef struct pairs_rows {
+	int n;
+	int group[MAX_ROWS];
+	char outcome[MAX_ROWS][N3][16], type[MAX_ROWS][N3][16];
+} pairs_rows;
+
+static void pairs_read(const char *dir, pairs_rows *r)
+{
+	char *text = read_in(dir, "pairs.csv");
+	char *save = NULL, *line = strtok_r(text, "\n", &save);
+	assert_string_equal(line, "group,trial,outcome_a,type_a,outcome_b,type_b,outcome_c,type_c,"
+	                          "t_separate,t_separate_a_c,t_separate_b_c,location_a,"
+	                          "location_b,location_c");
+	r->n = 0;
+	while ((line = strtok_r(NULL, "\n", &save)) != NULL) {
+		assert_true(r->n < MAX_ROWS);
+		char *f[14];
+		int k = 0;
+		/* empty fields (a pair that never separated) kept: split by hand */
+		for (char *p = line; k < 14; k++) {
+			f[k] = p;
+			char *c = strchr(p, ',');
+			if (!c) {
+				k++;
+				break;
+			}
+			*c = '\0';
+			p = c + 1;
+		}
+		assert_int_equal(k, 14);
+		r->group[r->n] = atoi(f[0]);
+		for (int s = 0; s < N3; s++) {
+			snprintf(r->outcome[r->n][s], 16, "%s", f[2 + 2 * s]);
+			snprintf(r->type[r->n][s], 16, "%s", f[3 + 2 * s]);
+		}
+		r->n++;
+	}
+	free(text);
+}
+
+/* Event e of a row's side, from the outcome and type columns. */
+static int row_event(const pairs_rows *r, int i, int s, int e)
+{
+	static const char *const outcome[] = {"traversed", "traversed", "traversed",
+	                                      "side_exit", "stuck",     "unstable"};
+	if (strcmp(r->outcome[i][s], outcome[e]) != 0)
+		return 0;
+	return e == 1   ? strcmp(r->type[i][s], "left") == 0
+	       : e == 2 ? strcmp(r->type[i][s], "right") == 0
+	                : 1;
+}
+
+static double json_at(struct fy_node *root, const char *path)
+{
+	double v = NAN;
+	struct fy_node *n = ydoc_lookup(root, path);
+	if (!n || ydoc_number(n, &v) != YDOC_NUM_OK)
+		fail_msg("report.json: no number at %s", path);
+	return v;
+}
+
+static const char *json_text_at(struct fy_node *root, const char *path, char *buf, size_t size)
+{
+	struct fy_node *n = ydoc_lookup(root, path);
+	size_t len = 0;
+	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
+	if (!t)
+		fail_msg("report.json: no text at %s", path);
+	snprintf(buf, size, "%.*s", (int)len, t);
+	return buf;
+}
+
+static int verdict_rank(const char *v)
+{
+	static const char *const order[] = {"same",  "equivalent", "uninformative", "inconclusive",
+	                                    "small", "DISAGREE",   "DIFFERENT"};
+	for (int i = 0; i < 7; i++)
+		if (strcmp(v, order[i]) == 0)
+			return i;
+	fail_msg("unknown verdict %s", v);
+	return -1;
+}
+
+/* Three sides: thesis, box2d and the thesis backend reading the essay's
+ * impact equation literally (a side meant to differ). Checked against
+ * pairs.csv read on its own: every pair's 2x2 table of every event in
+ * report.json; each side's trials.csv is its columns of pairs.csv; a
+ * group's verdict is its least agreeing pair's, groups_disagreeing and the
+ * exit status follow; the odd one out is the side that the rule (docs/
+ * compare.md), applied here to report.json's pairwise verdicts, names; the
+ * replay lines of the disagreeing pairs reproduce their trials. */
+static void test_three_sides(void **state)
+{
+	(void)state;
+	const char *dir = out_dir("cmp3");
+	char backends[200];
+	snprintf(backends, sizeof backends, "%s,%s,%s", sides3[0], sides3[1], sides3[2]);
+	const char *argv[] = {"compare", experiment, "--backends", backends, "--threads",
+	                      "2",       "--quiet",  "--out",      dir,      NULL};
+	int status = bsim_test_cli(argv, NULL, NULL);
+	assert_true(status == 0 || status == 3);
+	pairs_rows rows;
+	pairs_read(dir, &rows);
+	/* each side's trials.csv: its own columns */
+	for (int s = 0; s < N3; s++) {
+		char sub[1300];
+		snprintf(sub, sizeof sub, "%s/%s", dir, dirs3[s]);
+		char *t = read_in(sub, "trials.csv"), *save = NULL;
+		strtok_r(t, "\n", &save);
+		for (int i = 0; i < rows.n; i++) {
+			char *line = strtok_r(NULL, "\n", &save), want[64];
+			assert_non_null(line);
+			snprintf(want, sizeof want, ",%s,%s,", rows.outcome[i][s], rows.type[i][s]);
+			assert_non_null(strstr(line, want));
+		}
+		free(t);
+	}
+	ydoc d;
+	bsim_error err;
+	char path[1400], p[200], buf[64];
+	snprintf(path, sizeof path, "%s/report.json", dir);
+	assert_int_equal(ydoc_load_own(&d, path, &err), BSIM_OK);
+	struct fy_node *root = fy_document_root(d.fyd);
+	assert_string_equal(json_text_at(root, "a.label", buf, sizeof buf), sides3[0]);
+	assert_string_equal(json_text_at(root, "b.label", buf, sizeof buf), sides3[1]);
+	for (int s = 0; s < N3; s++) {
+		snprintf(p, sizeof p, "sides.%d.label", s);
+		assert_string_equal(json_text_at(root, p, buf, sizeof buf), sides3[s]);
+	}
+	int groups = (int)json_at(root, "pairs_of_sides") == P3 ? 4 : -1, disagreeing = 0,
+	    odd_found = 0;
+	assert_int_equal(groups, 4);
+	for (int g = 0; g < groups; g++) {
+		snprintf(p, sizeof p, "groups.%d.deterministic", g);
+		int det = strcmp(json_text_at(root, p, buf, sizeof buf), "true") == 0;
+		int differ[P3], worst = 0;
+		for (int k = 0; k < P3; k++) {
+			char q[120];
+			snprintf(q, sizeof q, "groups.%d.pairwise.%d", g, k);
+			snprintf(p, sizeof p, "%s.a", q);
+			assert_string_equal(json_text_at(root, p, buf, sizeof buf),
+			                    sides3[pair3[k][0]]);
+			snprintf(p, sizeof p, "%s.b", q);
+			assert_string_equal(json_text_at(root, p, buf, sizeof buf),
+			                    sides3[pair3[k][1]]);
+			for (int e = 0; e < 6; e++) {
+				static const char *const ev[] = {"traversed", "left",  "right",
+				                                 "side_exit", "stuck", "unstable"};
+				int n[4] = {0, 0, 0, 0}, seen = 0;
+				for (int i = 0; i < rows.n; i++) {
+					if (rows.group[i] != g || (det && seen++))
+						continue;
+					int x = row_event(&rows, i, pair3[k][0], e),
+					    y = row_event(&rows, i, pair3[k][1], e);
+					n[x && y ? 0 : x ? 1 : y ? 2 : 3]++;
+				}
+				static const char *const cell[] = {"both", "only_a", "only_b",
+				                                   "neither"};
+				for (int c = 0; c < 4; c++) {
+					snprintf(p, sizeof p, "%s.events.%s.%s", q, ev[e], cell[c]);
+					assert_int_equal((int)json_at(root, p), n[c]);
+				}
+			}
+			snprintf(p, sizeof p, "%s.verdict", q);
+			int v = verdict_rank(json_text_at(root, p, buf, sizeof buf));
+			worst = v > worst ? v : worst;
+			differ[k] = v >= 5; /* DISAGREE or DIFFERENT */
+		}
+		snprintf(p, sizeof p, "groups.%d.verdict", g);
+		assert_int_equal(verdict_rank(json_text_at(root, p, buf, sizeof buf)), worst);
+		disagreeing += worst >= 5;
+		/* the odd one out by the rule: every pair with it differs, no
+		 * other pair does */
+		int odd = -1, candidates = 0, any = differ[0] || differ[1] || differ[2];
+		for (int s = 0; s < N3; s++) {
+			int ok = 1;
+			for (int k = 0; k < P3; k++) {
+				int with = pair3[k][0] == s || pair3[k][1] == s;
+				ok &= with ? differ[k] : !differ[k];
+			}
+			if (ok) {
+				odd = s;
+				candidates++;
+			}
+		}
+		snprintf(p, sizeof p, "groups.%d.odd_one_out.found", g);
+		const char *found = json_text_at(root, p, buf, sizeof buf);
+		if (!any) {
+			assert_string_equal(found, "none");
+		} else if (candidates == 1) {
+			assert_string_equal(found, "side");
+			snprintf(p, sizeof p, "groups.%d.odd_one_out.side", g);
+			assert_string_equal(json_text_at(root, p, buf, sizeof buf), sides3[odd]);
+			odd_found++;
+		} else {
+			assert_string_equal(found, "no single side");
+		}
+	}
+	assert_int_equal((int)json_at(root, "groups_disagreeing"), disagreeing);
+	assert_int_equal(status, disagreeing > 0 ? 3 : 0);
+	/* the side meant to differ is the odd one out somewhere: the rule is
+	 * exercised, not only "none" */
+	assert_true(odd_found > 0);
+	ydoc_free(&d);
+	char *json = read_in(dir, "report.json");
+	assert_true(check_replays(json, 0) > 0);
+	free(json);
+	/* report.md names the odd ones out; regress reruns all three sides */
+	char *md = read_in(dir, "report.md");
+	assert_non_null(strstr(md, "# beamsim compare: thesis vs box2d vs thesis:impact_mass=0.1"));
+	assert_non_null(strstr(md, "**Odd one out:**"));
+	free(md);
+	const char *rerun = out_dir("cmp3_rerun");
+	const char *r[] = {"regress", dir, "--exact", "--out", rerun, NULL};
+	char *out = NULL;
+	assert_int_equal(bsim_test_cli(r, &out, NULL), 0);
+	for (int s = 0; s < N3; s++) {
+		char want[200];
+		snprintf(want, sizeof want, "%s: 0 of 48 trials changed", sides3[s]);
+		assert_non_null(strstr(out, want));
+	}
+	free(out);
+}
+
+/* A side given twice, or more sides than the most, is refused. */
+static void test_three_sides_bad(void **state)
+{
+	(void)state;
+	char *err = NULL;
+	const char *twice[] = {"compare", experiment,       "--backends", "thesis,box2d,thesis",
+	                       "--out",   out_dir("bad3s"), NULL};
+	assert_int_equal(bsim_test_cli(twice, NULL, &err), 2);
+	assert_non_null(strstr(err, "side thesis is given twice"));
+	free(err);
+	const char *many[] = {"compare",
+	                      experiment,
+	                      "--backends",
+	                      "thesis,box2d,thesis:slop=1e-5,thesis:slop=2e-5,"
+	                      "thesis:slop=3e-5,thesis:slop=4e-5,thesis:slop=5e-5,"
+	                      "thesis:slop=6e-5,thesis:slop=7e-5",
+	                      "--out",
+	                      out_dir("bad9"),
+	                      NULL};
+	assert_int_equal(bsim_test_cli(many, NULL, &err), 2);
+	assert_non_null(strstr(err, "expected 2 to 8 sides"));
+	free(err);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_halves_are_sweeps),
-	        cmocka_unit_test(test_every_pair),
+	        cmocka_unit_test(test_every_backend_a_side),
 	        cmocka_unit_test(test_status_and_threads),
 	        cmocka_unit_test(test_compare_replays),
 	        cmocka_unit_test(test_regress_identical),
@@ -497,6 +751,8 @@ int main(void)
 	        cmocka_unit_test(test_unstable_event),
 	        cmocka_unit_test(test_regress_old_format),
 	        cmocka_unit_test(test_bad_usage),
+	        cmocka_unit_test(test_three_sides),
+	        cmocka_unit_test(test_three_sides_bad),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

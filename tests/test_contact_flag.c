@@ -1,5 +1,5 @@
 /* The contact flag (beamsim/state.h, model/contact_flag.h) against
- * independent truths, on every backend: beam i is flagged in a step when
+ * independent truths, on every backend of the registry: beam i is flagged in a step when
  * at the step's end the body is within BSIM_CONTACT_TOL (6 mm) of it, or
  * when it exchanged an impulse with the body in the step.
  *
@@ -7,16 +7,16 @@
  *   the beam and no force, touches it at t* = g0 / u. The first flagged
  *   step is the first that ends within the tolerance or holds t*, whichever
  *   comes first, on every backend; at 10 m/s the body has bounced clear by
- *   more than the tolerance at the impact step's end on the thesis backend
- *   and Box2D, so the impulse alone flags it (Chipmunk's contact acts once
- *   the body overlaps the beam, and that step ends with it overlapping).
+ *   more than the tolerance at the impact step's end, so the impulse alone
+ *   flags it, on a backend whose impact acts before the shapes overlap.
  * - A grazing pass parallel to the beam, from beside it to past its tip:
  *   the gap is known all along the straight path (the clearance c beside
  *   the beam, the distance to the tip beyond it); with c = 8 mm no step is
  *   flagged, with c = 3 mm exactly the steps that end with the analytic gap
  *   under the tolerance, tangent beside the beam and tip beyond it. No
  *   impulse acts (the motion is parallel), so this is the gap part alone.
- * - The backends agree on the flag step by step through an impact. */
+ * - Every backend agrees with the default one on the flag step by step
+ *   through an impact. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -27,10 +27,7 @@
 #include "beamsim/backend.h"
 #include "model/contact_flag.h"
 #include "scenes.h"
-
-static const bsim_backend *const backends[] = {&bsim_backend_thesis, &bsim_backend_box2d,
-                                               &bsim_backend_chipmunk};
-#define N_BACKENDS ((int)(sizeof backends / sizeof backends[0]))
+#include "support.h"
 
 /* Runs the scene with no force for n steps; flags[k] the flag of beam 0
  * after step k + 1. */
@@ -73,7 +70,7 @@ static double gap_of(const bsim_scene *s, double theta, const double x[2])
 
 static void test_head_on_impact(void **state)
 {
-	(void)state;
+	const bsim_backend *b = *state;
 	const double h = 0.004;
 	/* speed, and where in its step the impact falls (steps from 1) */
 	const struct {
@@ -86,8 +83,7 @@ static void test_head_on_impact(void **state)
 		int want = near < step ? near : step;
 		bsim_scene s;
 		scene_head_on(&s, g0, u);
-		for (int k = 0; k < N_BACKENDS; k++) {
-			const bsim_backend *b = backends[k];
+		{
 			bsim_world *w = NULL;
 			bsim_error err;
 			assert_int_equal(b->create(&s, NULL, &w, &err), BSIM_OK);
@@ -113,10 +109,21 @@ static void test_head_on_impact(void **state)
 			        b->name, u, t_star, step, BSIM_CONTACT_TOL, near, first,
 			        gap_at_impact);
 			assert_int_equal(first, want);
-			/* at 10 m/s the impact step ends with the body clear: the
-			 * impulse is what flags it */
-			if (u == 10.0 && near >= step && b != &bsim_backend_chipmunk)
-				assert_true(gap_at_impact > BSIM_CONTACT_TOL);
+			/* at 10 m/s a backend that resolves the impact before the
+			 * shapes meet (the thesis backend's speculative contact,
+			 * Box2D's skin) ends the impact step with the body clear: the
+			 * impulse is what flags it. One whose contact acts once the
+			 * shapes overlap (Chipmunk) ends it overlapping, flagged by
+			 * the gap too. */
+			if (u == 10.0 && near >= step) {
+				if (gap_at_impact >= 0.0)
+					assert_true(gap_at_impact > BSIM_CONTACT_TOL);
+				else
+					print_message(
+					        "%s: the impact step ends overlapping (%.4f m): "
+					        "the gap flags it too\n",
+					        b->name, gap_at_impact);
+			}
 			bsim_state_free(&st);
 			b->destroy(w);
 		}
@@ -135,7 +142,7 @@ static double gap_along(double x, double y, double L, double R, int *type)
 
 static void test_grazing_pass(void **state)
 {
-	(void)state;
+	const bsim_backend *b = *state;
 	/* From beside the beam: approaching its pivot end from x < 0 at a
 	 * clearance under 5 mm, Box2D's contact, which starts there, would push
 	 * the body (a real impulse, flagged as it should be), and the gap
@@ -150,8 +157,8 @@ static void test_grazing_pass(void **state)
 		s.body.start[0] = x0;
 		s.body.start[1] = -(R + clearance[c]);
 		s.body.velocity[0] = v;
-		for (int k = 0; k < N_BACKENDS; k++) {
-			run_flags(backends[k], &s, n, flags);
+		{
+			run_flags(b, &s, n, flags);
 			int flagged = 0, expected = 0, judged = 0;
 			for (int i = 0; i < n; i++) {
 				int type;
@@ -170,13 +177,12 @@ static void test_grazing_pass(void **state)
 					fail_msg("%s, clearance %g m: step %d (x = %.4f m, gap "
 					         "%.6f m): "
 					         "flag %d, expected %d",
-					         backends[k]->name, clearance[c], i + 1, x, gap,
-					         flags[i], want);
+					         b->name, clearance[c], i + 1, x, gap, flags[i],
+					         want);
 			}
 			print_message("%s, clearance %g m: %d of %d steps flagged (%d expected, %d "
 			              "judged)\n",
-			              backends[k]->name, clearance[c], flagged, n, expected,
-			              judged);
+			              b->name, clearance[c], flagged, n, expected, judged);
 			if (c == 0)
 				assert_int_equal(flagged, 0);
 			else
@@ -188,18 +194,18 @@ static void test_grazing_pass(void **state)
 
 static void test_backends_agree(void **state)
 {
-	(void)state;
+	const bsim_backend *b = *state, *ref = bsim_backend_default();
+	if (b == ref)
+		bsim_test_skip(b, "the default backend is the reference the others agree with");
 	bsim_scene s;
 	scene_head_on(&s, 10.0 * 0.004 * 3.5, 10.0); /* impact in step 4 */
-	int a[60], b[60];
-	run_flags(&bsim_backend_thesis, &s, 60, a);
-	for (int k = 1; k < N_BACKENDS; k++) {
-		run_flags(backends[k], &s, 60, b);
-		for (int i = 0; i < 60; i++)
-			if (a[i] != b[i])
-				fail_msg("step %d: thesis flag %d, %s %d", i + 1, a[i],
-				         backends[k]->name, b[i]);
-	}
+	int fa[60], fb[60];
+	run_flags(ref, &s, 60, fa);
+	run_flags(b, &s, 60, fb);
+	for (int i = 0; i < 60; i++)
+		if (fa[i] != fb[i])
+			fail_msg("step %d: %s flag %d, %s %d", i + 1, ref->name, fa[i], b->name,
+			         fb[i]);
 	bsim_scene_free(&s);
 }
 
@@ -210,5 +216,5 @@ int main(void)
 	        cmocka_unit_test(test_grazing_pass),
 	        cmocka_unit_test(test_backends_agree),
 	};
-	return cmocka_run_group_tests(tests, NULL, NULL);
+	return bsim_test_run_per_backend("contact_flag", tests, sizeof tests / sizeof tests[0]);
 }

@@ -16,6 +16,7 @@
 
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "support.h"
 
 /* What a trace watches: the deepest overlap, and whether any step had a
  * beam deeper than tol in the body while no other beam touched it. */
@@ -67,8 +68,9 @@ static bsim_trial_result run(const bsim_scene *s, const char *mode, uint64_t see
 	bsim_recorder rec = {.stride = 1, .trace = watch_fn, .trace_user = w, .overlap = 1};
 	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	bsim_trial_result out;
-	assert_int_equal(bsim_trial_run(r, s, &bsim_backend_thesis, &o, seed, &rec, &out, &err),
-	                 BSIM_OK);
+	assert_int_equal(
+	        bsim_trial_run(r, s, bsim_test_backend("thesis"), &o, seed, &rec, &out, &err),
+	        BSIM_OK);
 	bsim_trial_runner_free(r);
 	return out;
 }

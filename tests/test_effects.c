@@ -32,8 +32,9 @@ static void test_no_random_force_no_draws(void **state)
 	bsim_trial_result out;
 	bsim_error err;
 	unsigned long before = bsim_schedule_total_draws();
-	assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL, 1, NULL, &out, &err),
-	                 BSIM_OK);
+	assert_int_equal(
+	        bsim_trial_run(r, &s, bsim_test_backend("thesis"), NULL, 1, NULL, &out, &err),
+	        BSIM_OK);
 	assert_true(out.steps_run > 100);
 	assert_int_equal(out.draws, 0);
 	assert_int_equal(bsim_schedule_total_draws(), before);
@@ -42,8 +43,9 @@ static void test_no_random_force_no_draws(void **state)
 	bsim_scene_free(&s);
 	bsim_scene_init_gate(&s, 9.0, 20.0);
 	before = bsim_schedule_total_draws();
-	assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL, 1, NULL, &out, &err),
-	                 BSIM_OK);
+	assert_int_equal(
+	        bsim_trial_run(r, &s, bsim_test_backend("thesis"), NULL, 1, NULL, &out, &err),
+	        BSIM_OK);
 	assert_int_equal(out.draws, (unsigned long)((out.steps_run - 1) / 5 + 1));
 	assert_int_equal(bsim_schedule_total_draws() - before, out.draws);
 	bsim_trial_runner_free(r);

@@ -52,7 +52,7 @@ static void expect_box2d_refusal(const bsim_scene *s, const char *const needles[
 {
 	bsim_world *w = NULL;
 	bsim_error err;
-	assert_int_equal(bsim_backend_box2d.create(s, NULL, &w, &err), BSIM_EINPUT);
+	assert_int_equal(bsim_test_backend("box2d")->create(s, NULL, &w, &err), BSIM_EINPUT);
 	assert_null(w);
 	for (int i = 0; needles[i]; i++)
 		if (!strstr(err.msg, needles[i]))
@@ -186,7 +186,7 @@ static void test_thesis_force_runs(void **state)
 	assert_non_null(r);
 	bsim_trial_result res;
 	bsim_error err;
-	assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL,
+	assert_int_equal(bsim_trial_run(r, &s, bsim_test_backend("thesis"), NULL,
 	                                bsim_schedule_seed_mix(1, 0, 0), NULL, &res, &err),
 	                 BSIM_OK);
 	assert_int_equal(res.outcome, BSIM_TRAVERSED);

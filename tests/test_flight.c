@@ -26,7 +26,7 @@ static long flown; /* steps made in runs */
 
 static int counted_flight(bsim_world *w, const double force[2], double h, int n, double (*xv)[4])
 {
-	int k = bsim_backend_thesis.flight(w, force, h, n, xv);
+	int k = bsim_test_backend("thesis")->flight(w, force, h, n, xv);
 	flown += k;
 	return k;
 }
@@ -43,7 +43,7 @@ static void no_trace(void *user, long step, const bsim_state *s)
 static long run_both(const bsim_scene *s, uint64_t seed, bsim_trial_result *r,
                      bsim_trial_result *r_step)
 {
-	bsim_backend counted = bsim_backend_thesis;
+	bsim_backend counted = *bsim_test_backend("thesis");
 	counted.flight = counted_flight;
 	bsim_options o = {0};
 	bsim_error err;
@@ -233,7 +233,7 @@ static void test_thesis_runs(void **state)
 	bsim_options o = {0};
 	bsim_error err;
 	bsim_world *a, *b;
-	const bsim_backend *t = &bsim_backend_thesis;
+	const bsim_backend *t = bsim_test_backend("thesis");
 	assert_int_equal(t->create(&s, &o, &a, &err), BSIM_OK);
 	assert_int_equal(t->create(&s, &o, &b, &err), BSIM_OK);
 	bsim_state sa, sb;

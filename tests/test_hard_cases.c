@@ -1,5 +1,6 @@
-/* Numerically hard cases (the scenes in configs/hard/), each run on both backends
- * with explicit pass criteria; every measured value is printed.
+/* Numerically hard cases (the scenes in configs/hard/), each run on every
+ * backend of the registry with explicit pass criteria; every measured value
+ * is printed.
  *   1 Zeno settling against sprung beams, e = 0.9 and 0.5
  *   2 simultaneous double impact on the midline, and offset by +-1e-6 m
  *   3 mass-ratio extremes (1000:1, 1:1000) x omega_n h from 0.05 to 4
@@ -7,8 +8,9 @@
  *   5 impact phase (16 phases in a step), approach speed, tip grazing
  *   6 violent noise (Rm = 1000 N): no tunnelling, no NaN
  *   7 a long conservative run (100,000 steps): energy drift
- * Where Box2D misses a criterion by its design, the test bounds the measured
- * failure (a little above it) and the comment says why. */
+ * Where a backend misses a criterion by its design, it states the bound it
+ * meets (bsim_backend.bounds, "hard.*": its file says why, e.g. Box2D's
+ * float32 and its 5 mm skin), a little above what was measured. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -20,29 +22,6 @@
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "support.h"
-
-/* The backends, and the index of each in the bounds below. */
-static const char *const BACKENDS[3] = {"thesis", "box2d", "chipmunk"};
-enum { THESIS = 0, BOX2D = 1, CHIPMUNK = 2 };
-/* Box2D pivot drift in case 3: measured 9.7e-5 m (1:1000), bound 1e-3 m. */
-#define PIVOT_BOUND_BOX2D 1e-3
-
-static int backend_index(const char *name)
-{
-	for (int k = 0; k < 3; k++)
-		if (strcmp(name, BACKENDS[k]) == 0)
-			return k;
-	fail_msg("unknown backend %s", name);
-	return -1;
-}
-
-static const bsim_backend *backend(const char *name)
-{
-	bsim_error err;
-	const bsim_backend *b = bsim_backend_find(name, &err);
-	assert_non_null(b);
-	return b;
-}
 
 static void load(const char *rel, bsim_scene *s)
 {
@@ -112,9 +91,10 @@ static double energy_of(const bsim_scene *sc, const bsim_state *st)
 
 /* ---- 1. Zeno settling ---------------------------------------------------- */
 
-static void zeno_one(const char *bname, double e)
+static void zeno_one(const bsim_backend *b, double e)
 {
-	const bsim_backend *b = backend(bname);
+	const char *bname = b->name;
+	double apex_bound = bsim_test_bound(b, "hard.apex");
 	bsim_scene s;
 	load("configs/hard/zeno_settle.yaml", &s);
 	s.contact.restitution = s.contact.tip_restitution = e;
@@ -158,9 +138,9 @@ static void zeno_one(const char *bname, double e)
 	              n_apex ? apex[n_apex - 1] : 0.0, apex_rise, persistent_from, speed, st.x[0]);
 	assert_true(impacts >= 2);
 	assert_true(max_per_step <= 2); /* at most one per contact */
-	/* apexes never rise (Box2D: to its float32 positions, ulp 2e-6 m at 20 m) */
-	const double rise_bound[3] = {1e-9, 1e-5, 1e-9};
-	assert_true(apex_rise <= rise_bound[backend_index(bname)]);
+	/* apexes never rise (but by round-off of the positions: float32's ulp is
+	 * 2e-6 m at 20 m) */
+	assert_true(apex_rise <= apex_bound);
 	/* clean hand-off: the contacts hold from (at the latest) the step after
 	 * the last impact to the end, and the chain ends early */
 	assert_true(persistent_from > 0 && persistent_from <= last_impact + 1);
@@ -213,9 +193,9 @@ static double_run double_one(const bsim_backend *b, double dx)
 static void test_double_impact(void **state)
 {
 	const double d = 1e-6;
-	int k = backend_index(*state);
+	const bsim_backend *b = *state;
+	double centred = bsim_test_bound(b, "hard.centred");
 	{
-		const bsim_backend *b = backend(BACKENDS[k]);
 		double_run m = double_one(b, -d), z = double_one(b, 0.0), p = double_one(b, d);
 		double asym = fabs((p.vx_end - z.vx_end) + (m.vx_end - z.vx_end));
 		double gain = fmax(fabs(p.vx_end - z.vx_end), fabs(m.vx_end - z.vx_end)) / d;
@@ -223,11 +203,10 @@ static void test_double_impact(void **state)
 		        "double impact %s: centred max|vx| %.2e m/s, x_end %.2e; offset +-1e-6: "
 		        "vx_end %.3e / %.3e m/s (gain %.3g 1/s, antisymmetry defect %.2e), "
 		        "x_end %.3e / %.3e, y_end spread %.2e m\n",
-		        BACKENDS[k], z.vx_max, z.x_end, p.vx_end, m.vx_end, gain, asym, p.x_end,
+		        b->name, z.vx_max, z.x_end, p.vx_end, m.vx_end, gain, asym, p.x_end,
 		        m.x_end, fmax(fabs(p.y_end - z.y_end), fabs(m.y_end - z.y_end)));
-		/* centred: lateral velocity at round-off (float32 for Box2D) */
-		const double vx_bound[3] = {1e-12, 1e-7, 1e-12};
-		assert_true(z.vx_max <= vx_bound[k]);
+		/* centred: lateral velocity at round-off */
+		assert_true(z.vx_max <= centred);
 		/* smooth: the outcome is linear in the offset (antisymmetric) and a
 		 * 1e-6 m offset moves it by O(1e-4): the centred motion is an
 		 * unstable balance (the tips splay apart), gain ~ 86 1/s by the
@@ -300,9 +279,18 @@ static void test_mass_ratio(void **state)
 {
 	const double beam_mass[2] = {0.001, 1000.0}; /* body 1 kg: 1000:1 and 1:1000 */
 	const double wnh[4] = {0.05, 0.5, 1.5, 4.0};
-	int k = backend_index(*state);
+	const bsim_backend *b = *state;
+	double pen_bound = bsim_test_bound(b, "hard.penetration");
+	double pivot_bound = bsim_test_bound(b, "hard.pivot");
+	/* energy: a backend whose solver may add energy by design (one that
+	 * pushes overlaps out by moving positions) states no bound, and the
+	 * check is skipped for it, saying so */
+	double energy_bound;
+	int energy = bsim_backend_bound_of(b, "hard.energy", &energy_bound);
+	if (!energy)
+		print_message("%s: energy not checked: it states no bound hard.energy\n", b->name);
+	int ran = 0;
 	{
-		const bsim_backend *b = backend(BACKENDS[k]);
 		for (int m = 0; m < 2; m++) {
 			for (int j = 0; j < 4; j++) {
 				bsim_scene s;
@@ -315,6 +303,19 @@ static void test_mass_ratio(void **state)
 					d->stiffness = d->inertia * wn * wn;
 					d->damping = 0.1 * 2.0 * d->inertia * wn; /* zeta = 0.1 */
 				}
+				/* a scene beyond the backend's own limits (its check,
+				 * which create applies) is not run on it, saying why */
+				bsim_error err;
+				char field[64];
+				if (b->check &&
+				    b->check(&s, NULL, field, sizeof field, &err) != BSIM_OK) {
+					print_message(
+					        "mass ratio %s 1:%g wn*h %.2f: refused (%s: %s)\n",
+					        b->name, beam_mass[m], wnh[j], field, err.msg);
+					bsim_scene_free(&s);
+					continue;
+				}
+				ran++;
 				watch wt;
 				bsim_trial_result res;
 				int rc = run_trial(b, &s, bsim_schedule_seed_mix(1, 0, 0), &wt,
@@ -329,62 +330,35 @@ static void test_mass_ratio(void **state)
 				        "|theta| %.3g, penetration %.3e m, pivot drift %.3e m, "
 				        "E_end - (E_0 + W) = %.3e J (W throughput %.3g J, "
 				        "correction %.3g J)\n",
-				        BACKENDS[k], beam_mass[m], wnh[j], rc,
+				        b->name, beam_mass[m], wnh[j], rc,
 				        bsim_trial_outcome_name(res.outcome), res.steps,
 				        fmax(fabs(res.max_theta[0]), fabs(res.max_theta[1])),
 				        wt.pen_max, wt.pivot_max, excess, scale, l->correction);
-				if (k == CHIPMUNK && wnh[j] >= 2.0) {
-					/* Chipmunk's spring is explicit: beyond its bound
-					 * (omega_n h < 2 undamped) create refuses the scene,
-					 * naming the beam's stiffness */
-					assert_int_equal(rc, BSIM_EINPUT);
-					bsim_scene_free(&s);
-					continue;
-				}
 				assert_int_equal(rc, BSIM_OK);
 				assert_int_equal(wt.nonfinite, 0);
 				assert_int_equal(wt.tunnels, 0);
-				/* penetration: thesis projects to its slop (1e-6 m); Box2D
-				 * rests contacts at b2_linearSlop = 5 mm and lets a hard
-				 * impact sink in further within a step; Chipmunk makes a
-				 * contact only once the shapes overlap, so a body sinks in
-				 * as far as the two close in one step: 1.40 m where the
-				 * light beam (1:0.001, omega_n h 0.5) swings back at its tip
-				 * at up to 350 m/s, 5.9 cm where the body meets the tips at
-				 * 15 m/s */
-				const double pen_bound[3] = {1e-5, 0.1, 1.5};
-				assert_true(wt.pen_max <= pen_bound[k]);
-				/* the pin: exact in thesis; Box2D's and Chipmunk's joint
-				 * rows converge iteratively, so a pivot can be pushed off
-				 * it (Chipmunk: measured 1.5e-9 m, double precision) */
-				const double pivot_bound[3] = {0.0, PIVOT_BOUND_BOX2D, 1e-6};
-				assert_true(wt.pivot_max <= pivot_bound[k]);
-				if (k != CHIPMUNK) {
-					/* energy never rises above what the forces put in */
-					assert_true(excess <= 1e-6 * scale + 1e-9);
-				} else {
-					/* Chipmunk pushes a deep overlap out by moving
-					 * positions (its bias velocities): the light beam
-					 * is turned against its spring, and energy rises
-					 * (measured +4.6 J of 29.8 J at omega_n h 0.5, +1.9
-					 * J of 62.6 J at 1.5). The ledger books it as the
-					 * correction's (a negative loss): the rise is within
-					 * it and the residual. */
-					assert_true(excess <= 0.2 * scale);
-					assert_true(excess <=
-					            -l->correction + fabs(l->residual) + 1e-9);
-				}
+				/* penetration: how deep a body may sink (a solver that
+				 * projects to a slop, or rests contacts at a skin and lets
+				 * a hard impact sink in within a step) */
+				assert_true(wt.pen_max <= pen_bound);
+				/* the pin: exact, or a joint whose rows converge
+				 * iteratively and let a pivot be pushed off it */
+				assert_true(wt.pivot_max <= pivot_bound);
+				/* energy never rises above what the forces put in */
+				if (energy)
+					assert_true(excess <= energy_bound * scale + 1e-9);
 				bsim_scene_free(&s);
 			}
 		}
 	}
+	assert_true(ran >= 4); /* the check covers both mass ratios */
 }
 
 /* ---- 4. a wedged body ---------------------------------------------------- */
 
-static void wedge_one(const char *bname, double overlap)
+static void wedge_one(const bsim_backend *b, double overlap)
 {
-	const bsim_backend *b = backend(bname);
+	const char *bname = b->name;
 	bsim_scene s;
 	load("configs/hard/wedge.yaml", &s);
 	bsim_world *w = create(b, &s);
@@ -468,8 +442,12 @@ static double phase_one(const bsim_backend *b, double u, double phase, int *impa
 /* Grazing: the body passes the tip (25, 0) with its centre at x = 25 +
  * R (1 - eps); returns the relative change of energy and of the angular
  * momentum about the pivot, and whether only tip contacts were seen. */
-static void graze_one(const bsim_backend *b, const char *bname, double eps)
+static void graze_one(const bsim_backend *b, double eps)
 {
+	const char *bname = b->name;
+	double e_bound = bsim_test_bound(b, "hard.graze.energy");
+	double l_bound = bsim_test_bound(b, "hard.graze.momentum");
+	double pen_bound = bsim_test_bound(b, "hard.graze.penetration");
 	bsim_scene s;
 	load("configs/hard/impact_phase.yaml", &s);
 	const double u = 4.0;
@@ -506,16 +484,11 @@ static void graze_one(const bsim_backend *b, const char *bname, double eps)
 	assert_true(impacts >= 1 && !tangent);
 	(void)tip;
 	assert_true(st.omega[0] > 0.0 && st.v[0] > 0.0); /* pushed the tip forward, deflected */
-	/* elastic tip impact: energy and angular momentum about the pivot kept;
-	 * Box2D in float32 with its 5 mm skin: bounded as measured */
-	const int k = backend_index(bname);
-	/* Chipmunk: energy exact, angular momentum to 4e-7 (the normal the
-	 * solve used is that of the overlapping positions), overlap 3.3 mm */
-	const double de_bound[3] = {1e-9, 2e-3, 1e-9}, dl_bound[3] = {1e-9, 3e-5, 1e-6};
-	const double pen_bound[3] = {1e-5, 1e-2, 5e-3};
-	assert_true(fabs(de) <= de_bound[k]);
-	assert_true(fabs(dl) <= dl_bound[k]); /* Box2D: float32 */
-	assert_true(pen <= pen_bound[k]);
+	/* elastic tip impact: energy and angular momentum about the pivot kept,
+	 * to the backend's bounds */
+	assert_true(fabs(de) <= e_bound);
+	assert_true(fabs(dl) <= l_bound);
+	assert_true(pen <= pen_bound);
 	bsim_state_free(&st);
 	b->destroy(w);
 	bsim_scene_free(&s);
@@ -524,9 +497,8 @@ static void graze_one(const bsim_backend *b, const char *bname, double eps)
 static void test_impact_phase(void **state)
 {
 	const double e = 0.8, thr = 0.05;
-	int k = backend_index(*state);
+	const bsim_backend *b = *state;
 	{
-		const bsim_backend *b = backend(BACKENDS[k]);
 		double lo = INFINITY, hi = -INFINITY, worst = 0.0;
 		for (int p = 0; p < 16; p++) {
 			int imp;
@@ -537,7 +509,7 @@ static void test_impact_phase(void **state)
 		}
 		print_message("phase %s: 16 phases, e_eff in [%.5f, %.5f], max |e_eff - e| %.2e, "
 		              "spread %.2e\n",
-		              BACKENDS[k], lo, hi, worst, hi - lo);
+		              b->name, lo, hi, worst, hi - lo);
 		assert_true(worst <= 0.02);
 		assert_true(hi - lo <= 0.05);
 
@@ -548,11 +520,11 @@ static void test_impact_phase(void **state)
 			double ee = phase_one(b, u, 5.5, &imp);
 			print_message("speed %s: u = %.2f x threshold: e_eff %.5f (model %.1f), %d "
 			              "impacts\n",
-			              BACKENDS[k], mult[j], ee, expect, imp);
+			              b->name, mult[j], ee, expect, imp);
 			assert_true(fabs(ee - expect) <= 0.02);
 		}
 		for (int j = 0; j < 3; j++)
-			graze_one(b, BACKENDS[k], j == 0 ? 0.05 : j == 1 ? 0.01 : 0.002);
+			graze_one(b, j == 0 ? 0.05 : j == 1 ? 0.01 : 0.002);
 	}
 }
 
@@ -561,10 +533,10 @@ static void test_impact_phase(void **state)
 static void test_violent_noise(void **state)
 {
 	bsim_scene s;
+	const bsim_backend *b = *state;
+	double pen_bound = bsim_test_bound(b, "hard.noise.penetration");
 	load("configs/hard/violent_noise.yaml", &s);
-	int k = backend_index(*state);
 	{
-		const bsim_backend *b = backend(BACKENDS[k]);
 		int tunnels = 0, nonfinite = 0, failed = 0, hit = 0;
 		double pen = -INFINITY, vmax = 0.0;
 		for (int t = 0; t < 40; t++) {
@@ -582,15 +554,12 @@ static void test_violent_noise(void **state)
 		        "violent noise %s: 40 trials, %d touched a beam, %d failed, %d "
 		        "non-finite steps, %d tunnellings, max penetration %.3e m, max |vx_end| "
 		        "%.1f m/s\n",
-		        BACKENDS[k], hit, failed, nonfinite, tunnels, pen, vmax);
+		        b->name, hit, failed, nonfinite, tunnels, pen, vmax);
 		assert_true(hit >= 10);
 		assert_int_equal(failed, 0);
 		assert_int_equal(nonfinite, 0);
 		assert_int_equal(tunnels, 0);
-		/* Chipmunk: no continuous collision, the body sinks in as far
-		 * as it moves in a step (measured 0.49 m) */
-		const double pen_bound[3] = {1e-5, 0.5, 0.6};
-		assert_true(pen <= pen_bound[k]);
+		assert_true(pen <= pen_bound);
 	}
 	bsim_scene_free(&s);
 }
@@ -600,10 +569,12 @@ static void test_violent_noise(void **state)
 static void test_conservative_long(void **state)
 {
 	bsim_scene s;
+	const bsim_backend *b = *state;
+	double drift_bound = bsim_test_bound(b, "hard.conservative.drift");
+	double tunnel_bound;
+	int caged = bsim_backend_bound_of(b, "hard.conservative.tunnels", &tunnel_bound);
 	load("configs/hard/conservative_long.yaml", &s);
-	int k = backend_index(*state);
 	{
-		const bsim_backend *b = backend(BACKENDS[k]);
 		watch wt;
 		bsim_trial_result res;
 		int rc = run_trial(b, &s, 1, &wt, &res);
@@ -613,35 +584,23 @@ static void test_conservative_long(void **state)
 		print_message("conservative %s: %d steps, %s, end (%.3g, %.3g), energy drift %.3e "
 		              "(max rise %.2e), ledger impact %.3e contact %.3e correction %.3e "
 		              "residual %.3e J, penetration %.2e m, tunnels %d\n",
-		              BACKENDS[k], res.steps_run, bsim_trial_outcome_name(res.outcome),
+		              b->name, res.steps_run, bsim_trial_outcome_name(res.outcome),
 		              res.x_end, res.y_end, drift, rise, l->impact, l->contact,
 		              l->correction, l->residual, wt.pen_max, wt.tunnels);
 		assert_int_equal(rc, BSIM_OK);
 		assert_int_equal(res.steps_run, 100000);
 		assert_int_equal(wt.nonfinite, 0);
-		if (k == THESIS) {
-			/* The model conserves energy here; the thesis solver loses
-			 * 1.06% over 400 s, all of it as persistent-contact work (ledger
-			 * contact 0.132 J, with rest_threshold 0.05 or 0 alike): a
-			 * contact that a beam's spring closes within a step, which the
-			 * impact stage does not predict from the velocities at the
-			 * step's start, is stopped by the speculative smooth solve at
-			 * the beam, plastically. Stated and bounded as measured. */
-			assert_true(drift <= 0.0 && fabs(drift) <= 0.011);
-			assert_int_equal(wt.tunnels, 0);
-		} else if (k == BOX2D) {
-			/* Box2D's weld spring is backward Euler (it damps, -7% over 12 s
-			 * in the gate) and the body leaves the cage (float32 drift off
-			 * the midline): bounded as measured, -0.88 */
-			assert_true(drift <= 0.0 && fabs(drift) <= 0.9);
-		} else {
-			/* Chipmunk's spring is symplectic Euler: the energy oscillates
-			 * about its value (measured +0.54% at the end, +1.7% at most)
-			 * and impacts lose nothing */
-			assert_true(fabs(drift) <= 0.01 && rise <= 0.02);
-			assert_true(fabs(l->impact) + fabs(l->contact) <= 1e-6 * l->e_start);
-			assert_int_equal(wt.tunnels, 0);
-		}
+		/* The model conserves energy here; a solver may only lose it (the
+		 * backends' files say how much and why), never gain it. */
+		assert_true(drift <= 0.0 && fabs(drift) <= drift_bound);
+		/* a backend whose body stays in the cage states how often it may
+		 * cross a beam (0); one whose body leaves it states none */
+		if (caged)
+			assert_true(wt.tunnels <= tunnel_bound);
+		else
+			print_message("%s: tunnelling not checked: it states no bound "
+			              "hard.conservative.tunnels\n",
+			              b->name);
 	}
 	bsim_scene_free(&s);
 }
@@ -649,27 +608,10 @@ static void test_conservative_long(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test_prestate(test_zeno_settling, (void *)"thesis"),
-	        cmocka_unit_test_prestate(test_zeno_settling, (void *)"box2d"),
-	        cmocka_unit_test_prestate(test_zeno_settling, (void *)"chipmunk"),
-	        cmocka_unit_test_prestate(test_double_impact, (void *)"thesis"),
-	        cmocka_unit_test_prestate(test_double_impact, (void *)"box2d"),
-	        cmocka_unit_test_prestate(test_double_impact, (void *)"chipmunk"),
-	        cmocka_unit_test_prestate(test_mass_ratio, (void *)"thesis"),
-	        cmocka_unit_test_prestate(test_mass_ratio, (void *)"box2d"),
-	        cmocka_unit_test_prestate(test_mass_ratio, (void *)"chipmunk"),
-	        cmocka_unit_test_prestate(test_wedge, (void *)"thesis"),
-	        cmocka_unit_test_prestate(test_wedge, (void *)"box2d"),
-	        cmocka_unit_test_prestate(test_wedge, (void *)"chipmunk"),
-	        cmocka_unit_test_prestate(test_impact_phase, (void *)"thesis"),
-	        cmocka_unit_test_prestate(test_impact_phase, (void *)"box2d"),
-	        cmocka_unit_test_prestate(test_impact_phase, (void *)"chipmunk"),
-	        cmocka_unit_test_prestate(test_violent_noise, (void *)"thesis"),
-	        cmocka_unit_test_prestate(test_violent_noise, (void *)"box2d"),
-	        cmocka_unit_test_prestate(test_violent_noise, (void *)"chipmunk"),
-	        cmocka_unit_test_prestate(test_conservative_long, (void *)"thesis"),
-	        cmocka_unit_test_prestate(test_conservative_long, (void *)"box2d"),
-	        cmocka_unit_test_prestate(test_conservative_long, (void *)"chipmunk"),
+	        cmocka_unit_test(test_zeno_settling),     cmocka_unit_test(test_double_impact),
+	        cmocka_unit_test(test_mass_ratio),        cmocka_unit_test(test_wedge),
+	        cmocka_unit_test(test_impact_phase),      cmocka_unit_test(test_violent_noise),
+	        cmocka_unit_test(test_conservative_long),
 	};
-	return cmocka_run_group_tests(tests, NULL, NULL);
+	return bsim_test_run_per_backend("hard_cases", tests, sizeof tests / sizeof tests[0]);
 }

@@ -1,8 +1,13 @@
-/* docs/model.md check 1 and the impact laws of section 4, on the thesis
- * backend: square-on tangent impacts against the closed-form solution,
- * elastic tip impacts against the conservation laws, the simultaneous
- * double impact on the midline, and the knob impact_mass (essay Eq. 2.4 read
- * literally) against Eqs. 2.4-2.5 solved by hand. */
+/* docs/model.md check 1 and the impact laws of section 4, on every backend
+ * of the registry: square-on tangent impacts against the closed-form
+ * solution, an elastic tip impact against the conservation laws, and the
+ * tip's own restitution. Each backend is held to the bound it states,
+ * "impact" (bsim_backend.bounds: the relative error of one impact's
+ * velocities, angular momentum and energy); the worst measured is printed.
+ * The body starts 2 to 3 cm from the beam and the run goes on until after
+ * the impact: a backend may start its contact before touching (Box2D's
+ * skin, 5 cm at unit_scale 1), and one that applies the impulse early keeps
+ * the same lever (the body moves along the normal). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -11,68 +16,27 @@
 
 #include <cmocka.h>
 
-#include "beamsim/backend.h"
+#include "impact_oracle.h"
 #include "scenes.h"
+#include "support.h"
 
 static const double h = 0.004;
 
-/* Steps the world once with no force and returns the state after. */
-static void step_once(const bsim_scene *s, bsim_state *st)
-{
-	bsim_world *w = NULL;
-	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(s, NULL, &w, &err), BSIM_OK);
-	const double zero[2] = {0.0, 0.0};
-	assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
-	bsim_backend_thesis.get_state(w, st);
-	bsim_backend_thesis.destroy(w);
-}
-
-/* Body of speed u hits the beam at rest square-on at lever r:
- *   mu = M r^2 / I,  v' = u (mu - e) / (1 + mu) (forward),
- *   omega' = (1 + e) u mu / (r (1 + mu)),  v_rel' = -e v_rel. */
-static void check_tangent(double r, double e, double u)
-{
-	bsim_scene s;
-	scene_one_beam(&s);
-	s.contact.restitution = e;
-	s.body.start[0] = r;
-	s.body.start[1] = -s.body.radius - 1e-9; /* touching, below the beam */
-	s.body.velocity[1] = u;
-	bsim_state st;
-	bsim_state_init(&st, 1);
-	step_once(&s, &st);
-
-	double inertia = s.beams[0].inertia, mass = s.body.mass;
-	double mu = mass * r * r / inertia;
-	double v_expect = u * (mu - e) / (1.0 + mu);
-	double omega_expect = (1.0 + e) * u * mu / (r * (1.0 + mu));
-	double tol = 1e-12 * u;
-	assert_true(fabs(st.v[1] - v_expect) <= tol);
-	assert_true(fabs(st.v[0]) <= tol);
-	assert_true(fabs(st.omega[0] - omega_expect) <= tol / r);
-	/* relative normal velocity reversed and scaled by e */
-	double vrel_after = omega_expect * r - v_expect;
-	assert_true(fabs((st.omega[0] * r - st.v[1]) - e * u) <= 4 * tol);
-	assert_true(fabs(vrel_after - e * u) <= 4 * tol);
-	/* angular momentum about the pivot: M r v + I omega = M r u */
-	assert_true(fabs(mass * r * st.v[1] + inertia * st.omega[0] - mass * r * u) <=
-	            1e-12 * mass * r * u);
-	assert_true(st.energy.impact >= 0.0);
-	assert_int_equal(st.impacts, 1);
-	bsim_state_free(&st);
-	bsim_scene_free(&s);
-}
-
 static void test_tangent_impact_oracle(void **state)
 {
-	(void)state;
+	const bsim_backend *b = *state;
+	double bound = bsim_test_bound(b, "impact");
 	/* r = 25: mu = 30, the body keeps 0.942 u, the beam spins at 0.0697 u */
-	check_tangent(24.999, 0.8, 1.0);
-	check_tangent(10.0, 0.8, 3.0);
-	check_tangent(20.0, 0.5, 2.0);
-	check_tangent(15.0, 1.0, 0.7);
-	check_tangent(5.0, 0.0, 1.5);
+	double worst = 0.0;
+	worst = fmax(worst, impact_tangent(b, NULL, 24.9, 0.8, 1.0, bound));
+	worst = fmax(worst, impact_tangent(b, NULL, 10.0, 0.8, 3.0, bound));
+	worst = fmax(worst, impact_tangent(b, NULL, 20.0, 0.5, 2.0, bound));
+	worst = fmax(worst, impact_tangent(b, NULL, 20.0, 1.0, 2.0, bound));
+	worst = fmax(worst, impact_tangent(b, NULL, 15.0, 1.0, 0.7, bound));
+	worst = fmax(worst, impact_tangent(b, NULL, 5.0, 0.8, 1.5, bound));
+	print_message("%s tangent impact: worst relative error %.2e (v, omega, L, loss; bound "
+	              "%.0e)\n",
+	              b->name, worst, bound);
 
 	double mu = 1.0 * 625.0 / (0.1 * 625.0 / 3.0);
 	assert_true(fabs(mu - 30.0) < 1e-12);
@@ -80,226 +44,94 @@ static void test_tangent_impact_oracle(void **state)
 	assert_true(fabs(1.8 * mu / (25.0 * (1 + mu)) - 0.0697) < 5e-5);
 }
 
-/* An oblique elastic hit on the tip: kinetic energy and the angular momentum
- * of body and beam about the pivot are conserved (essay Eqs. 2.6-2.9). */
-static void test_tip_impact_conserves(void **state)
+/* An oblique hit on the tip (25, 0) from 40 deg below +x: tip_restitution
+ * applies, not restitution, and the contact is a TIP one. With e_tip = 1
+ * the kinetic energy and the angular momentum of body and beam about the
+ * pivot (essay Eqs. 2.6-2.9) are what they were; out: the relative
+ * changes of energy and momentum, the relative normal velocity at the tip
+ * just before and just after. */
+static void run_tip(const bsim_backend *b, double e_tip, double out[4])
 {
-	(void)state;
 	bsim_scene s;
 	scene_one_beam(&s);
-	s.contact.tip_restitution = 1.0;
-	/* centre 10 m from the tip (25, 0) along a direction 40 deg below +x */
+	s.contact.restitution = 0.2; /* must not be used */
+	s.contact.tip_restitution = e_tip;
 	double a = -40.0 * 3.141592653589793 / 180.0;
-	s.body.start[0] = 25.0 + (10.0 + 1e-9) * cos(a);
-	s.body.start[1] = (10.0 + 1e-9) * sin(a);
+	double n[2] = {cos(a), sin(a)}; /* tip -> body centre */
+	double d = 10.0 + 0.03;
+	s.body.start[0] = 25.0 + d * n[0];
+	s.body.start[1] = d * n[1];
 	s.body.velocity[0] = -0.6;
 	s.body.velocity[1] = 2.0;
+	bsim_world *w = bsim_test_world(b, &s, NULL);
 	bsim_state st;
 	bsim_state_init(&st, 1);
-	step_once(&s, &st);
-
-	double mass = s.body.mass, inertia = s.beams[0].inertia;
+	const double zero[2] = {0.0, 0.0};
+	const double mass = s.body.mass, inertia = s.beams[0].inertia;
+	/* the angular momentum about the pivot: x x v is constant in free
+	 * flight, so the start's serves for any step before the impact */
+	double l0 = mass * (s.body.start[0] * 2.0 - s.body.start[1] * -0.6);
+	int impacts = 0, tip = 0;
+	double vrel_before = 0.0, vrel_after = 0.0;
+	for (int k = 0; k < 10; k++) {
+		assert_int_equal(b->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		b->get_state(w, &st);
+		tip |= st.contact[0] == BSIM_CONTACT_TIP;
+		assert_true(st.contact[0] != BSIM_CONTACT_TANGENT);
+		if (st.impacts && !impacts) {
+			/* the tip point moves with omega (-L sin, L cos) */
+			double c[2] = {st.x[0] - 25.0 * cos(st.theta[0]),
+			               st.x[1] - 25.0 * sin(st.theta[0])};
+			double len = hypot(c[0], c[1]);
+			double tipv[2] = {-25.0 * sin(st.theta[0]) * st.omega[0],
+			                  25.0 * cos(st.theta[0]) * st.omega[0]};
+			vrel_before = -0.6 * c[0] / len + 2.0 * c[1] / len;
+			vrel_after =
+			        ((st.v[0] - tipv[0]) * c[0] + (st.v[1] - tipv[1]) * c[1]) / len;
+		}
+		impacts += st.impacts;
+	}
 	double ke0 = 0.5 * mass * (0.36 + 4.0);
 	double ke1 = 0.5 * mass * (st.v[0] * st.v[0] + st.v[1] * st.v[1]) +
 	             0.5 * inertia * st.omega[0] * st.omega[0];
-	assert_true(fabs(ke1 - ke0) <= 1e-12 * ke0);
-	assert_int_equal(st.impacts, 1);
-	assert_true(st.omega[0] > 0.0); /* the tip was pushed forward */
-	/* angular momentum about the pivot, at the impact position (the step's
-	 * free flight adds x(t) x v, which is constant for a free body) */
-	double l0 = mass * (s.body.start[0] * 2.0 - s.body.start[1] * -0.6);
 	double l1 = mass * (st.x[0] * st.v[1] - st.x[1] * st.v[0]) + inertia * st.omega[0];
-	assert_true(fabs(l1 - l0) <= 1e-11 * fabs(l0));
+	assert_int_equal(impacts, 1);
+	assert_true(tip);
+	assert_true(st.omega[0] > 0.0); /* the tip was pushed forward */
+	out[0] = (ke1 - ke0) / ke0;
+	out[1] = (l1 - l0) / fabs(l0);
+	out[2] = vrel_before;
+	out[3] = vrel_after;
 	bsim_state_free(&st);
+	b->destroy(w);
 	bsim_scene_free(&s);
 }
 
-/* The body on the midline meets both tips at once: both beams take the same
- * impulse and the lateral velocity stays exactly zero; offsets of +-1e-6 m
- * give mirrored results and a lateral velocity of the order of the offset.
- * Off the midline one beam is met just inside its tip (a tangent contact)
- * and the other just past it (a tip contact); the model gives these
- * different restitutions, so the results are continuous in the offset only
- * when tip_restitution = restitution. */
-static void run_midline(double offset, double e_tip, bsim_state *st)
+static void test_tip_impact(void **state)
 {
-	bsim_scene s;
-	scene_gate_quiet(&s);
-	s.contact.tip_restitution = e_tip;
-	s.body.start[0] = offset;
-	s.body.start[1] = 19.99;
-	s.body.velocity[1] = 5.0;
-	bsim_world *w = NULL;
-	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
-	const double zero[2] = {0.0, 0.0};
-	int impacts = 0;
-	for (int n = 0; n < 40; n++) {
-		assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
-		bsim_backend_thesis.get_state(w, st);
-		impacts += st->impacts;
-	}
-	assert_true(impacts >= 2);
-	bsim_backend_thesis.destroy(w);
-	bsim_scene_free(&s);
-}
-
-static void test_simultaneous_double_impact(void **state)
-{
-	(void)state;
-	bsim_state c, l, r;
-	bsim_state_init(&c, 2);
-	bsim_state_init(&l, 2);
-	bsim_state_init(&r, 2);
-	for (int same_e = 0; same_e < 2; same_e++) {
-		double e_tip = same_e ? 0.8 : 1.0;
-		run_midline(0.0, e_tip, &c);
-		run_midline(-1e-6, e_tip, &l);
-		run_midline(1e-6, e_tip, &r);
-		assert_true(c.v[0] == 0.0 && c.x[0] == 0.0);
-		assert_true(c.theta[0] == c.theta[1] && c.omega[0] == c.omega[1]);
-		assert_true(c.theta[0] > 0.0);
-		assert_true(l.v[0] == -r.v[0] && l.x[0] == -r.x[0]);
-		assert_true(l.theta[0] == r.theta[1] && l.theta[1] == r.theta[0]);
-		assert_true(fabs(r.v[0]) < 1e-6);
-		if (same_e) {
-			assert_true(fabs(r.theta[0] - c.theta[0]) < 1e-6);
-			assert_true(fabs(r.v[1] - c.v[1]) < 1e-6);
-		}
-	}
-	bsim_state_free(&c);
-	bsim_state_free(&l);
-	bsim_state_free(&r);
-}
-
-/* Steps the world once with no force under opts. */
-static void step_once_with(const bsim_scene *s, const bsim_options *opts, bsim_state *st)
-{
-	bsim_world *w = NULL;
-	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(s, opts, &w, &err), BSIM_OK);
-	const double zero[2] = {0.0, 0.0};
-	assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
-	bsim_backend_thesis.get_state(w, st);
-	bsim_backend_thesis.destroy(w);
-}
-
-/* impact_mass = m: a body of speed u meets the beam at rest square-on at
- * lever r. Essay Eq. 2.4 with the beam's mass m and Eq. 2.5 (omega_i = 0,
- * v_ni = u) are two linear equations in v_nf and omega_f:
- *   m r v_nf + I omega_f = m r u
- *   -v_nf + r omega_f   = e u
- * whose determinant is m r^2 + I, so (Cramer)
- *   v_nf = u (m r^2 - e I) / (m r^2 + I),  omega_f = (1 + e) m r u / (m r^2 + I). */
-static void check_eq24_literal(double m, double r, double e, double u)
-{
-	bsim_scene s;
-	scene_one_beam(&s);
-	s.contact.restitution = e;
-	s.body.start[0] = r;
-	s.body.start[1] = -s.body.radius - 1e-9;
-	s.body.velocity[1] = u;
-	bsim_options opts = {0};
-	char kv[64];
-	snprintf(kv, sizeof kv, "impact_mass=%.17g", m);
-	assert_int_equal(bsim_options_add(&opts, kv, NULL), BSIM_OK);
-	bsim_state st;
-	bsim_state_init(&st, 1);
-	step_once_with(&s, &opts, &st);
-
-	double inertia = s.beams[0].inertia, det = m * r * r + inertia;
-	double v_nf = u * (m * r * r - e * inertia) / det;
-	double omega_f = (1.0 + e) * m * r * u / det;
-	double tol = 1e-12 * u;
-	assert_true(fabs(st.v[1] - v_nf) <= tol);
-	assert_true(fabs(st.v[0]) <= tol);
-	assert_true(fabs(st.omega[0] - omega_f) <= tol / r);
-	assert_int_equal(st.impacts, 1);
-	/* the ledger's impact term is the kinetic energy (with the body's
-	 * mass M) the impact removed */
-	double ke0 = 0.5 * s.body.mass * u * u;
-	double ke1 = 0.5 * s.body.mass * v_nf * v_nf + 0.5 * inertia * omega_f * omega_f;
-	assert_true(fabs(st.energy.impact - (ke0 - ke1)) <= 1e-11 * ke0);
-	bsim_state_free(&st);
-	bsim_scene_free(&s);
-}
-
-static void test_impact_mass_eq24(void **state)
-{
-	(void)state;
-	/* r = 25, m = 0.1: m r^2 / I = 3, so v_nf = 0.55 u (M would keep
-	 * 0.942 u) and omega_f r = 1.35 u */
-	check_eq24_literal(0.1, 24.999, 0.8, 1.0);
-	check_eq24_literal(0.1, 10.0, 0.8, 3.0);
-	check_eq24_literal(0.1, 20.0, 1.0, 2.0);
-	check_eq24_literal(0.1, 5.0, 0.5, 1.5);
-	double det = 0.1 * 625.0 + 0.1 * 625.0 / 3.0;
-	assert_true(fabs((0.1 * 625.0 - 0.8 * 0.1 * 625.0 / 3.0) / det - 0.55) < 1e-12);
-	assert_true(fabs(1.8 * 0.1 * 625.0 / det - 1.35) < 1e-12);
-}
-
-/* impact_mass equal to the body's mass is the default, bit for bit: the
- * same states over a run through the gate with impacts on both beams and
- * persistent contact; 0 and negative masses are refused. */
-static void test_impact_mass_identity(void **state)
-{
-	(void)state;
-	bsim_scene s;
-	scene_gate_quiet(&s);
-	s.body.start[0] = 3.0;
-	s.body.start[1] = -40.0;
-	s.body.velocity[1] = 6.0;
-	bsim_options opts = {0};
-	char kv[64];
-	snprintf(kv, sizeof kv, "impact_mass=%.17g", s.body.mass);
-	assert_int_equal(bsim_options_add(&opts, kv, NULL), BSIM_OK);
-	bsim_world *a = NULL, *b = NULL;
-	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &a, &err), BSIM_OK);
-	assert_int_equal(bsim_backend_thesis.create(&s, &opts, &b, &err), BSIM_OK);
-	bsim_state sa, sb;
-	bsim_state_init(&sa, 2);
-	bsim_state_init(&sb, 2);
-	const double force[2] = {1.5, 8.0};
-	int impacts = 0;
-	for (int n = 0; n < 3000; n++) {
-		assert_int_equal(bsim_backend_thesis.step(a, force, 0.0, h, NULL), BSIM_OK);
-		assert_int_equal(bsim_backend_thesis.step(b, force, 0.0, h, NULL), BSIM_OK);
-		bsim_backend_thesis.get_state(a, &sa);
-		bsim_backend_thesis.get_state(b, &sb);
-		assert_memory_equal(sa.x, sb.x, sizeof sa.x);
-		assert_memory_equal(sa.v, sb.v, sizeof sa.v);
-		assert_memory_equal(sa.theta, sb.theta, 2 * sizeof *sa.theta);
-		assert_memory_equal(sa.omega, sb.omega, 2 * sizeof *sa.omega);
-		assert_memory_equal(&sa.energy, &sb.energy, sizeof sa.energy);
-		assert_int_equal(sa.impacts, sb.impacts);
-		impacts += sa.impacts;
-	}
-	assert_true(impacts >= 2);
-	bsim_backend_thesis.destroy(a);
-	bsim_backend_thesis.destroy(b);
-	bsim_state_free(&sa);
-	bsim_state_free(&sb);
-
-	static const char *const bad[] = {"impact_mass=0", "impact_mass=-0.1"};
-	for (int i = 0; i < 2; i++) {
-		bsim_options o = {0};
-		assert_int_equal(bsim_options_add(&o, bad[i], NULL), BSIM_OK);
-		bsim_world *w = NULL;
-		assert_int_equal(bsim_backend_thesis.create(&s, &o, &w, &err), BSIM_EINPUT);
-		assert_null(w);
-	}
-	bsim_scene_free(&s);
+	const bsim_backend *b = *state;
+	double bound = bsim_test_bound(b, "impact");
+	double el[4], half[4];
+	run_tip(b, 1.0, el);
+	run_tip(b, 0.5, half);
+	double ratio = -half[3] / half[2];
+	print_message("%s tip impact: e_tip = 1 changes the energy by %.2e, the angular momentum "
+	              "by %.2e (bound %.0e); e_tip = 0.5 gives v_rel ratio %.4f\n",
+	              b->name, el[0], el[1], bound, ratio);
+	assert_true(fabs(el[0]) <= bound);
+	assert_true(fabs(el[1]) <= bound);
+	assert_true(el[2] < 0.0 && half[2] < 0.0);
+	/* The ratio is measured with the normal at the end of the impact's
+	 * step, not at the impact: the body has turned a little about the tip
+	 * (measured 0.50 +- 0.01 on Box2D). */
+	assert_true(fabs(ratio - 0.5) <= 0.02);
 }
 
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_tangent_impact_oracle),
-	        cmocka_unit_test(test_tip_impact_conserves),
-	        cmocka_unit_test(test_simultaneous_double_impact),
-	        cmocka_unit_test(test_impact_mass_eq24),
-	        cmocka_unit_test(test_impact_mass_identity),
+	        cmocka_unit_test(test_tip_impact),
 	};
-	return cmocka_run_group_tests(tests, NULL, NULL);
+	return bsim_test_run_per_backend("impact", tests, sizeof tests / sizeof tests[0]);
 }

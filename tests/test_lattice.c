@@ -175,8 +175,8 @@ static void broad_phase_is_exact(void **state)
 	int contacts = 0;
 	for (uint64_t t = 0; t < 12; t++) {
 		run_out a, b;
-		run(&s, &bsim_backend_thesis, NULL, t, &a);
-		run(&s, &bsim_backend_thesis, "broad_phase=0", t, &b);
+		run(&s, bsim_test_backend("thesis"), NULL, t, &a);
+		run(&s, bsim_test_backend("thesis"), "broad_phase=0", t, &b);
 		assert_true(same_trial(&a, &b));
 		contacts += a.r.ledger.impact > 0.0;
 		run_free(&a);
@@ -202,8 +202,8 @@ static void far_gates_change_nothing(void **state)
 	}
 	for (uint64_t t = 0; t < 8; t++) {
 		run_out a, b;
-		run(&small, &bsim_backend_thesis, NULL, t, &a);
-		run(&big, &bsim_backend_thesis, NULL, t, &b);
+		run(&small, bsim_test_backend("thesis"), NULL, t, &a);
+		run(&big, bsim_test_backend("thesis"), NULL, t, &b);
 		assert_true(a.r.outcome == b.r.outcome && a.r.steps_run == b.r.steps_run);
 		assert_true(a.r.x_end == b.r.x_end && a.r.y_end == b.r.y_end);
 		assert_true(a.r.ledger.damper == b.r.ledger.damper);
@@ -257,7 +257,7 @@ static void sleeping_keeps_outcomes(const bsim_backend *b, const char *scene, in
 	assert_true(p_mcnemar > 0.01);
 	assert_true(changed < trials / 4);
 	/* thesis: each sleep removes less than sleep_energy (1e-6 J) */
-	if (b == &bsim_backend_thesis)
+	if (b == bsim_test_backend("thesis"))
 		assert_true(slept / trials < 1e-3);
 	free(on);
 	free(off);
@@ -267,7 +267,7 @@ static void sleeping_keeps_outcomes(const bsim_backend *b, const char *scene, in
 static void sleeping_thesis(void **state)
 {
 	(void)state;
-	sleeping_keeps_outcomes(&bsim_backend_thesis, "configs/lattice/c_track.yaml", 80);
+	sleeping_keeps_outcomes(bsim_test_backend("thesis"), "configs/lattice/c_track.yaml", 80);
 }
 
 /* Box2D and Chipmunk without sleeping integrate every beam of the field
@@ -296,33 +296,38 @@ static void sleeping_on_3x3(const bsim_backend *b)
 	sleeping_keeps_outcomes(b, abs_path, 16);
 }
 
-static void sleeping_box2d(void **state)
+/* Every other backend of the registry that has the knob sleep, on the
+ * 3 x 3 field. */
+static void sleeping_others(void **state)
 {
 	(void)state;
-	sleeping_on_3x3(&bsim_backend_box2d);
+	for (const bsim_backend *const *be = bsim_backend_list(); *be; be++) {
+		int sleeps = 0;
+		for (int i = 0; i < (*be)->n_knobs; i++)
+			sleeps |= strcmp((*be)->knobs[i].name, "sleep") == 0;
+		if (sleeps && *be != bsim_test_backend("thesis"))
+			sleeping_on_3x3(*be);
+	}
 }
 
-static void sleeping_chipmunk(void **state)
-{
-	(void)state;
-	sleeping_on_3x3(&bsim_backend_chipmunk);
-}
-
-/* The essay's protocol on one gate: its world is the whole world. */
+/* The essay's protocol on one gate: its world is the whole world, on
+ * every backend of the registry (with sleeping off where it has the knob). */
 static void essay_is_world_on_one_gate(void **state)
 {
 	(void)state;
-	const bsim_backend *backends[3] = {&bsim_backend_thesis, &bsim_backend_box2d,
-	                                   &bsim_backend_chipmunk};
-	for (int k = 0; k < 3; k++)
+	for (const bsim_backend *const *be = bsim_backend_list(); *be; be++) {
+		const char *opts = NULL;
+		for (int i = 0; i < (*be)->n_knobs; i++)
+			if (strcmp((*be)->knobs[i].name, "sleep") == 0)
+				opts = "sleep=off";
 		for (uint64_t t = 0; t < 4; t++) {
 			bsim_scene w, e;
 			bsim_lattice_scene_init(&w, 1, 1, 6.0, 30.0);
 			bsim_lattice_scene_init(&e, 1, 1, 6.0, 30.0);
 			e.lattice.protocol = BSIM_PROTOCOL_ESSAY;
 			run_out a, b;
-			run(&w, backends[k], "sleep=off", t, &a);
-			run(&e, backends[k], "sleep=off", t, &b);
+			run(&w, *be, opts, t, &a);
+			run(&e, *be, opts, t, &b);
 			assert_true(same_trial(&a, &b));
 			assert_true(b.r.ledger.reset == 0.0);
 			run_free(&a);
@@ -330,6 +335,7 @@ static void essay_is_world_on_one_gate(void **state)
 			bsim_scene_free(&w);
 			bsim_scene_free(&e);
 		}
+	}
 }
 
 /* Two rows, the body launched fast through row 0: entering row 1 the essay
@@ -371,7 +377,7 @@ static void essay_resets_the_gate_left(void **state)
 		s.lattice.protocol = protocol ? BSIM_PROTOCOL_ESSAY : BSIM_PROTOCOL_WORLD;
 		/* the step of the entry into row 1, from a first run */
 		run_out o;
-		run(&s, &bsim_backend_thesis, "sleep=off", 0, &o);
+		run(&s, bsim_test_backend("thesis"), "sleep=off", 0, &o);
 		assert_true(o.log->n_entries >= 2);
 		assert_int_equal(o.log->entries[1].iy, 1);
 		beam_watch w = {&s, o.log->entries[1].step, 0.0, 0.0};
@@ -379,7 +385,7 @@ static void essay_resets_the_gate_left(void **state)
 		bsim_recorder rec = {.stride = 1, .trace = watch, .trace_user = &w};
 		bsim_trial_result r;
 		bsim_error err;
-		assert_int_equal(bsim_trial_run(runner, &s, &bsim_backend_thesis, NULL,
+		assert_int_equal(bsim_trial_run(runner, &s, bsim_test_backend("thesis"), NULL,
 		                                bsim_schedule_seed_mix(1, 0, 0), &rec, &r, &err),
 		                 BSIM_OK);
 		bsim_trial_runner_free(runner);
@@ -522,10 +528,10 @@ static void three_beams_static_equilibrium(void **state)
 	s.side_x = 1e9;
 	bsim_world *w = NULL;
 	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	assert_int_equal(bsim_test_backend("thesis")->create(&s, NULL, &w, &err), BSIM_OK);
 	const double f[2] = {0.0, 40.0};
 	for (int n = 0; n < s.max_steps; n++)
-		assert_int_equal(bsim_backend_thesis.step(w, f, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, f, 0.0, s.dt, NULL), BSIM_OK);
 	/* contacts of the final state, and the spring torques */
 	double sum[2] = {0.0, 0.0};
 	int touching = 0;
@@ -551,7 +557,7 @@ static void three_beams_static_equilibrium(void **state)
 	assert_true(hypot(w->v[0], w->v[1]) < 1e-6);
 	assert_true(fabs(sum[0]) < 1e-6 && fabs(sum[1] + 40.0) < 1e-6);
 	assert_int_equal(thesis_lcp_fallbacks(), 0); /* solved by enumeration */
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 	bsim_scene_free(&s);
 }
 
@@ -654,8 +660,7 @@ int main(void)
 	        cmocka_unit_test(broad_phase_is_exact),
 	        cmocka_unit_test(far_gates_change_nothing),
 	        cmocka_unit_test(sleeping_thesis),
-	        cmocka_unit_test(sleeping_box2d),
-	        cmocka_unit_test(sleeping_chipmunk),
+	        cmocka_unit_test(sleeping_others),
 	        cmocka_unit_test(essay_is_world_on_one_gate),
 	        cmocka_unit_test(essay_resets_the_gate_left),
 	        cmocka_unit_test(lcp_many_contacts),

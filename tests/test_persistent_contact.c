@@ -14,6 +14,7 @@
 
 #include "beamsim/backend.h"
 #include "scenes.h"
+#include "support.h"
 
 static const double R = 10.0, L = 25.0, K = 400.0;
 
@@ -51,15 +52,16 @@ static void test_impact_chain_settles(void **state)
 	s.body.start[1] = 19.0; /* 1 m short of the tips: arrives at 2.8 m/s */
 	bsim_world *w = NULL;
 	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	assert_int_equal(bsim_test_backend("thesis")->create(&s, NULL, &w, &err), BSIM_OK);
 	bsim_state st;
 	bsim_state_init(&st, 2);
 	const double force[2] = {0.0, f_prop};
 	int impacts = 0, last_impact = -1;
 	double worst = 0.0;
 	for (int n = 1; n <= 30000; n++) { /* 120 s: the last creep decays as e^(-t / 11 s) */
-		assert_int_equal(bsim_backend_thesis.step(w, force, 0.0, s.dt, NULL), BSIM_OK);
-		bsim_backend_thesis.get_state(w, &st);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, force, 0.0, s.dt, NULL),
+		                 BSIM_OK);
+		bsim_test_backend("thesis")->get_state(w, &st);
 		if (st.impacts) {
 			impacts += st.impacts;
 			last_impact = n;
@@ -92,7 +94,7 @@ static void test_impact_chain_settles(void **state)
 	assert_true(fabs(st.theta[0] - landscape_theta(st.x[1])) < 1e-6);
 	assert_true(worst <= 1e-6 + 1e-9); /* the slop, 1e-6 m */
 	bsim_state_free(&st);
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 	bsim_scene_free(&s);
 }
 
@@ -113,24 +115,25 @@ static void test_projection_limit(void **state)
 		s.body.start[0] = 12.0;
 		bsim_world *w = NULL;
 		bsim_error err;
-		assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+		assert_int_equal(bsim_test_backend("thesis")->create(&s, NULL, &w, &err), BSIM_OK);
 		bsim_state st;
 		assert_int_equal(bsim_state_init(&st, 1), BSIM_OK);
-		bsim_backend_thesis.get_state(w, &st);
+		bsim_test_backend("thesis")->get_state(w, &st);
 		st.x[0] = 12.0;
 		st.x[1] = d;
 		st.v[0] = st.v[1] = 0.0;
-		assert_int_equal(bsim_backend_thesis.set_state(w, &st, &err), BSIM_OK);
+		assert_int_equal(bsim_test_backend("thesis")->set_state(w, &st, &err), BSIM_OK);
 		const double zero[2] = {0.0, 0.0};
-		assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, 0.004, NULL), BSIM_OK);
-		bsim_backend_thesis.get_state(w, &st);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, 0.004, NULL),
+		                 BSIM_OK);
+		bsim_test_backend("thesis")->get_state(w, &st);
 		const double pivot[2] = {0.0, 0.0};
 		double depth = R - segment_distance(st.x, pivot, st.theta[0]);
 		assert_int_equal(st.solver.iteration_limit, depth > 1e-6 ? 1 : 0);
 		resolved += depth <= 1e-6;
 		limited += depth > 1e-6;
 		bsim_state_free(&st);
-		bsim_backend_thesis.destroy(w);
+		bsim_test_backend("thesis")->destroy(w);
 		bsim_scene_free(&s);
 	}
 	assert_true(resolved > 0 && limited > 0);

@@ -63,15 +63,20 @@ static int setup(void **state)
 	return 0;
 }
 
-/* The command line of a run of cmd ("sweep" or "compare") into dir. A
- * comparison runs 8 of the 24 trials per group: Box2D is the slow side; a
- * sweep keeps the trajectories of two trials per group. */
+/* The command line of a run of cmd ("sweep", "compare", or "compare3":
+ * a comparison of three sides) into dir. A comparison runs 8 of the 24
+ * trials per group: Box2D is the slow side; a sweep keeps the trajectories
+ * of two trials per group. */
 static void command(const char **argv, const char *cmd, const char *dir, int resume)
 {
 	int n = 0;
-	argv[n++] = cmd;
+	argv[n++] = strcmp(cmd, "compare3") == 0 ? "compare" : cmd;
 	argv[n++] = experiment;
-	if (strcmp(cmd, "compare") == 0) {
+	if (strcmp(cmd, "compare3") == 0) {
+		argv[n++] = "--backends";
+		argv[n++] = "thesis,thesis:integrator=euler,box2d";
+	}
+	if (strncmp(cmd, "compare", 7) == 0) {
 		argv[n++] = "--trials";
 		argv[n++] = "8";
 	} else {
@@ -93,6 +98,9 @@ static void command(const char **argv, const char *cmd, const char *dir, int res
 static const char *const sweep_files[] = {"trials.csv", "trajectories.csv", NULL};
 static const char *const compare_files[] = {"thesis/trials.csv", "box2d/trials.csv", "pairs.csv",
                                             NULL};
+static const char *const compare3_files[] = {"thesis/trials.csv",
+                                             "thesis-integrator=euler/trials.csv",
+                                             "box2d/trials.csv", "pairs.csv", NULL};
 
 /* Whenever there is a manifest, it lists exactly the files beside it. */
 static void check_manifest(const char *dir)
@@ -214,6 +222,14 @@ static void test_compare_killed(void **state)
 {
 	(void)state;
 	kill_and_resume("compare", compare_files);
+}
+
+/* Three sides: each record holds three results and three pairs'
+ * separation times. */
+static void test_compare3_killed(void **state)
+{
+	(void)state;
+	kill_and_resume("compare3", compare3_files);
 }
 
 /* SIGINT and SIGTERM: a clean stop, the journal kept, the resume line. The
@@ -351,6 +367,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_sweep_killed),     cmocka_unit_test(test_compare_killed),
+	        cmocka_unit_test(test_compare3_killed),
 	        cmocka_unit_test(test_signals),          cmocka_unit_test(test_refusals),
 	        cmocka_unit_test(test_seed_beside_file),
 	};

@@ -151,7 +151,7 @@ static void assert_same_step(const bsim_state *a, const bsim_state *b)
  * equal A's to the bit. Returns the steps in which the body touched. */
 static int step_against_fresh(const bsim_scene *sc, uint64_t seed, int n_steps)
 {
-	const bsim_backend *be = &bsim_backend_thesis;
+	const bsim_backend *be = bsim_test_backend("thesis");
 	bsim_error err;
 	bsim_world *a = NULL;
 	assert_int_equal(be->create(sc, NULL, &a, &err), BSIM_OK);
@@ -231,10 +231,10 @@ static void test_free_flight_as_detection(void **state)
 		bsim_scene_init_gate(&s, 6.0 + k, k ? 10.0 : 0.0);
 		s.body.start[1] = -15.0 * k;
 		bsim_trial_result a, b;
-		assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, NULL, 5 + (uint64_t)k,
-		                                NULL, &a, &err),
+		assert_int_equal(bsim_trial_run(r, &s, bsim_test_backend("thesis"), NULL,
+		                                5 + (uint64_t)k, NULL, &a, &err),
 		                 BSIM_OK);
-		assert_int_equal(bsim_trial_run(r, &s, &bsim_backend_thesis, &every,
+		assert_int_equal(bsim_trial_run(r, &s, bsim_test_backend("thesis"), &every,
 		                                5 + (uint64_t)k, NULL, &b, &err),
 		                 BSIM_OK);
 		assert_true(a.max_theta[0] > 0.0 || a.max_theta[1] > 0.0); /* the beams were met */
@@ -315,7 +315,7 @@ static void test_free_flight_bound(void **state)
 	bsim_scene_init_gate(&s, 7.0, 20.0);
 	bsim_world *w = NULL;
 	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	assert_int_equal(bsim_test_backend("thesis")->create(&s, NULL, &w, &err), BSIM_OK);
 	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
 	const double h = s.dt;
 	int clear = 0;
@@ -336,7 +336,7 @@ static void test_free_flight_bound(void **state)
 	}
 	assert_true(clear > 20000);
 	gsl_rng_free(rng);
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 	bsim_scene_free(&s);
 }
 
@@ -356,7 +356,7 @@ static void test_redetect_as_detect(void **state)
 	bsim_scene_init_gate(&s, 7.0, 20.0);
 	bsim_world *w = NULL;
 	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	assert_int_equal(bsim_test_backend("thesis")->create(&s, NULL, &w, &err), BSIM_OK);
 	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
 	int far = 0, found = 0;
 	for (int t = 0; t < 100000; t++) {
@@ -395,7 +395,7 @@ static void test_redetect_as_detect(void **state)
 	assert_true(far > 3000);
 	assert_true(found > 10000);
 	gsl_rng_free(rng);
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 	bsim_scene_free(&s);
 }
 
@@ -411,7 +411,7 @@ static void test_free_flight_room(void **state)
 	bsim_scene_init_gate(&s, 7.0, 20.0);
 	bsim_world *w = NULL;
 	bsim_error err;
-	assert_int_equal(bsim_backend_thesis.create(&s, NULL, &w, &err), BSIM_OK);
+	assert_int_equal(bsim_test_backend("thesis")->create(&s, NULL, &w, &err), BSIM_OK);
 	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
 	const double h = s.dt;
 	/* R + 5 cm under the middle of beam 0 (it points along +x) */
@@ -445,7 +445,7 @@ static void test_free_flight_room(void **state)
 	assert_true(clear > 20000);
 	assert_true(by_room > clear / 2);
 	gsl_rng_free(rng);
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 	bsim_scene_free(&s);
 }
 
@@ -453,7 +453,7 @@ static void test_free_flight_room(void **state)
  * same states to the bit. Returns the steps in which the body touched. */
 static int step_pair_same(bsim_world *a, bsim_world *b, const bsim_scene *sc, uint64_t seed, int n)
 {
-	const bsim_backend *be = &bsim_backend_thesis;
+	const bsim_backend *be = bsim_test_backend("thesis");
 	bsim_error err;
 	bsim_effects fx;
 	assert_int_equal(bsim_effects_init(&fx, sc, seed), BSIM_OK);
@@ -484,7 +484,7 @@ static int step_pair_same(bsim_world *a, bsim_world *b, const bsim_scene *sc, ui
 static void test_reset_as_created(void **state)
 {
 	(void)state;
-	const bsim_backend *be = &bsim_backend_thesis;
+	const bsim_backend *be = bsim_test_backend("thesis");
 	bsim_error err;
 	bsim_scene s;
 	bsim_scene_init_gate(&s, 7.0, 20.0);
@@ -537,12 +537,12 @@ static void kept_against_built(const bsim_scene *s, int trials)
 	for (int t = 0; t < trials; t++) {
 		uint64_t seed = bsim_schedule_seed_mix(4, 0, (uint64_t)t);
 		bsim_trial_result a, b;
-		assert_int_equal(
-		        bsim_trial_run(kept, s, &bsim_backend_thesis, NULL, seed, &ra, &a, &err),
-		        BSIM_OK);
-		assert_int_equal(
-		        bsim_trial_run(built, s, &bsim_backend_thesis, NULL, seed, &rb, &b, &err),
-		        BSIM_OK);
+		assert_int_equal(bsim_trial_run(kept, s, bsim_test_backend("thesis"), NULL, seed,
+		                                &ra, &a, &err),
+		                 BSIM_OK);
+		assert_int_equal(bsim_trial_run(built, s, bsim_test_backend("thesis"), NULL, seed,
+		                                &rb, &b, &err),
+		                 BSIM_OK);
 		assert_memory_equal(&a.ledger, &b.ledger, sizeof a.ledger);
 		assert_memory_equal(&a.x_end, &b.x_end, sizeof a.x_end);
 		assert_memory_equal(&a.y_end, &b.y_end, sizeof a.y_end);

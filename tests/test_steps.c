@@ -41,6 +41,7 @@
 #include "beamsim/scene.h"
 #include "beamsim/trial.h"
 #include "scenes.h"
+#include "support.h"
 
 #define RUN_MAX 64
 
@@ -104,7 +105,7 @@ typedef struct tally {
 static void compare_worlds(const bsim_scene *s, const char *const *kv, double f_prop, double rm,
                            long steps, uint64_t seed, tally *t)
 {
-	const bsim_backend *be = &bsim_backend_thesis;
+	const bsim_backend *be = bsim_test_backend("thesis");
 	bsim_options o = {0};
 	bsim_error err;
 	for (int k = 0; kv && kv[k]; k++)
@@ -291,13 +292,13 @@ static void test_declined(void **state)
 		else
 			s.body.rotates = 1;
 		bsim_world *w;
-		assert_int_equal(bsim_backend_thesis.create(&s, &o, &w, &err), BSIM_OK);
+		assert_int_equal(bsim_test_backend("thesis")->create(&s, &o, &w, &err), BSIM_OK);
 		for (int q = 0; q < 2; q++)
 			assert_int_equal(bsim_state_init(&run[q], s.n_beams), BSIM_OK);
-		assert_int_equal(bsim_backend_thesis.steps(w, force, s.dt, 2, run), 0);
+		assert_int_equal(bsim_test_backend("thesis")->steps(w, force, s.dt, 2, run), 0);
 		for (int q = 0; q < 2; q++)
 			bsim_state_free(&run[q]);
-		bsim_backend_thesis.destroy(w);
+		bsim_test_backend("thesis")->destroy(w);
 		bsim_scene_free(&s);
 	}
 }
@@ -306,7 +307,7 @@ static long stepped; /* steps made in runs */
 
 static int counted_steps(bsim_world *w, const double force[2], double h, int n, bsim_state *out)
 {
-	int k = bsim_backend_thesis.steps(w, force, h, n, out);
+	int k = bsim_test_backend("thesis")->steps(w, force, h, n, out);
 	stepped += k;
 	return k;
 }
@@ -324,7 +325,7 @@ static void no_trace(void *user, long step, const bsim_state *s)
 static long trial_both(const bsim_scene *s, const bsim_options *o, uint64_t seed,
                        bsim_trial_runner *runner, bsim_trial_result *r, bsim_trial_result *r_step)
 {
-	bsim_backend counted = bsim_backend_thesis;
+	bsim_backend counted = *bsim_test_backend("thesis");
 	counted.steps = counted_steps;
 	bsim_error err;
 	stepped = 0;

@@ -21,6 +21,7 @@
 #include "model/body_shape.h"
 #include "scenes.h"
 #include "thesis/thesis.h"
+#include "support.h"
 
 static const double h = 0.004;
 static const double M_PI_VALUE = 3.14159265358979323846;
@@ -30,7 +31,7 @@ static bsim_world *make(const bsim_scene *s)
 {
 	bsim_world *w = NULL;
 	bsim_error err;
-	int rc = bsim_backend_thesis.create(s, NULL, &w, &err);
+	int rc = bsim_test_backend("thesis")->create(s, NULL, &w, &err);
 	if (rc)
 		fprintf(stderr, "%s\n", err.msg);
 	assert_int_equal(rc, BSIM_OK);
@@ -85,10 +86,10 @@ static hand_impact solve_by_hand(double mass, double inertia, double ib, double 
 static void step_once(const bsim_scene *s, bsim_state *st, long *scaled)
 {
 	bsim_world *w = make(s);
-	assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
-	bsim_backend_thesis.get_state(w, st);
+	assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+	bsim_test_backend("thesis")->get_state(w, st);
 	*scaled = w->impacts_scaled;
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 }
 
 static double worst_error; /* m/s, rad/s: the largest difference from the hand solution */
@@ -231,19 +232,19 @@ static void press_case(double ratio, int rotates, double *accel, double *drift)
 	/* settle under the normal force alone, then push along */
 	const double fn[2] = {0.0, fy};
 	for (int k = 0; k < 500; k++)
-		assert_int_equal(bsim_backend_thesis.step(w, fn, 0.0, h, NULL), BSIM_OK);
-	bsim_backend_thesis.get_state(w, &st);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, fn, 0.0, h, NULL), BSIM_OK);
+	bsim_test_backend("thesis")->get_state(w, &st);
 	double x0 = st.x[0];
 	int n = 250;
 	double v_mid = 0.0;
 	for (int k = 0; k < 2 * n; k++) {
-		assert_int_equal(bsim_backend_thesis.step(w, f, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, f, 0.0, h, NULL), BSIM_OK);
 		if (k == n - 1) {
-			bsim_backend_thesis.get_state(w, &st);
+			bsim_test_backend("thesis")->get_state(w, &st);
 			v_mid = st.v[0];
 		}
 	}
-	bsim_backend_thesis.get_state(w, &st);
+	bsim_test_backend("thesis")->get_state(w, &st);
 	*accel = (st.v[0] - v_mid) / (n * h);
 	*drift = st.x[0] - x0;
 	/* A capsule that turns stands on both ends of its core: held, it does
@@ -252,7 +253,7 @@ static void press_case(double ratio, int rotates, double *accel, double *drift)
 	assert_true(fabs(st.angular_velocity) < (fabs(ratio) <= 1.0 ? 1e-9 : 1e-4));
 	assert_true(st.solver.iteration_limit == 0);
 	assert_true(st.contact[0] != BSIM_CONTACT_NONE); /* still pressed on the beam */
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 	bsim_state_free(&st);
 	bsim_scene_free(&s);
 }
@@ -350,13 +351,13 @@ static void test_no_energy_created(void **state)
 		bsim_world *w = make(&s);
 		bsim_state st;
 		bsim_state_init(&st, 1);
-		bsim_backend_thesis.get_state(w, &st);
+		bsim_test_backend("thesis")->get_state(w, &st);
 		double j = bsim_body_inertia(&s.body), ib = s.beams[0].inertia;
 		double e0 = 0.5 * (st.v[0] * st.v[0] + st.v[1] * st.v[1]) +
 		            0.5 * j * st.angular_velocity * st.angular_velocity +
 		            0.5 * ib * s.beams[0].initial_omega * s.beams[0].initial_omega;
-		assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
-		bsim_backend_thesis.get_state(w, &st);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		bsim_test_backend("thesis")->get_state(w, &st);
 		double e1 = 0.5 * (st.v[0] * st.v[0] + st.v[1] * st.v[1]) +
 		            0.5 * j * st.angular_velocity * st.angular_velocity +
 		            0.5 * ib * st.omega[0] * st.omega[0];
@@ -367,7 +368,7 @@ static void test_no_energy_created(void **state)
 		worst = fmax(worst, (e1 - e0) / e0);
 		assert_true(e1 <= e0 * (1.0 + 1e-12));
 		assert_true(st.energy.impact >= -1e-12 * e0);
-		bsim_backend_thesis.destroy(w);
+		bsim_test_backend("thesis")->destroy(w);
 		bsim_state_free(&st);
 		bsim_scene_free(&s);
 	}

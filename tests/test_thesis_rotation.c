@@ -22,6 +22,7 @@
 #include "model/body_shape.h"
 #include "model/contact_flag.h"
 #include "scenes.h"
+#include "support.h"
 
 static const double h = 0.004;
 static const double M_PI_VALUE = 3.14159265358979323846;
@@ -34,7 +35,7 @@ static bsim_world *make_with(const bsim_scene *s, const char *knob)
 	bsim_options opts = {0};
 	if (knob)
 		assert_int_equal(bsim_options_add(&opts, knob, NULL), BSIM_OK);
-	int rc = bsim_backend_thesis.create(s, knob ? &opts : NULL, &w, &err);
+	int rc = bsim_test_backend("thesis")->create(s, knob ? &opts : NULL, &w, &err);
 	if (rc)
 		fprintf(stderr, "%s\n", err.msg);
 	assert_int_equal(rc, BSIM_OK);
@@ -168,12 +169,12 @@ static void test_free_capsule(void **state)
 	bsim_world *w = make(&s);
 	bsim_state st;
 	bsim_state_init(&st, 1);
-	bsim_backend_thesis.get_state(w, &st);
+	bsim_test_backend("thesis")->get_state(w, &st);
 	double psi0 = st.heading, e0 = 0.5 * (0.49 + 0.16) + 0.5 * inertia * 2.5 * 2.5;
 	int n = 2000;
 	for (int k = 0; k < n; k++)
-		assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
-	bsim_backend_thesis.get_state(w, &st);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+	bsim_test_backend("thesis")->get_state(w, &st);
 	assert_true(st.angular_velocity == 2.5); /* J w: nothing acts on it */
 	assert_true(st.v[0] == 0.7 && st.v[1] == -0.4);
 	double t = n * h;
@@ -191,26 +192,28 @@ static void test_free_capsule(void **state)
 	const double torque = -0.3;
 	double w0 = st.angular_velocity, p0 = st.heading;
 	for (int k = 0; k < n; k++)
-		assert_int_equal(bsim_backend_thesis.step(w, zero, torque, h, NULL), BSIM_OK);
-	bsim_backend_thesis.get_state(w, &st);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, torque, h, NULL),
+		                 BSIM_OK);
+	bsim_test_backend("thesis")->get_state(w, &st);
 	double w_hand = w0 + torque * t / inertia;
 	double p_hand = p0 + w0 * t + torque * t * t / (2.0 * inertia);
 	assert_true(fabs(st.angular_velocity - w_hand) < 1e-12 * fabs(w0));
 	assert_true(fabs(st.heading - p_hand) < 1e-11 * fabs(p_hand));
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 
 	/* integrator=euler: psi moves by h w' each step, psi_n = psi0 + w0 n h
 	 * + T h^2 n (n + 1) / (2 J) */
 	w = make_with(&s, "integrator=euler");
-	bsim_backend_thesis.get_state(w, &st);
+	bsim_test_backend("thesis")->get_state(w, &st);
 	p0 = st.heading;
 	for (int k = 0; k < n; k++)
-		assert_int_equal(bsim_backend_thesis.step(w, zero, torque, h, NULL), BSIM_OK);
-	bsim_backend_thesis.get_state(w, &st);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, torque, h, NULL),
+		                 BSIM_OK);
+	bsim_test_backend("thesis")->get_state(w, &st);
 	p_hand = p0 + 2.5 * n * h + torque * h * h * n * (n + 1.0) / (2.0 * inertia);
 	assert_true(fabs(st.heading - p_hand) < 1e-11 * fabs(p_hand));
 	assert_true(fabs(st.angular_velocity - (2.5 + torque * t / inertia)) < 1e-12 * 2.5);
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 	bsim_state_free(&st);
 	bsim_scene_free(&s);
 }
@@ -241,8 +244,8 @@ static void offcentre_impact(const char *knob)
 	bsim_world *w = make_with(&s, knob);
 	bsim_state st;
 	bsim_state_init(&st, 1);
-	assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
-	bsim_backend_thesis.get_state(w, &st);
+	assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+	bsim_test_backend("thesis")->get_state(w, &st);
 
 	double cb = -0.5 * l * cos(psi), c = -12.0;
 	double m_eff = 1.0 / (1.0 / mass + cb * cb / inertia + c * c / ib);
@@ -269,7 +272,7 @@ static void offcentre_impact(const char *knob)
 	/* the loss is the restitution's: (1 - e^2) m u^2 / 2 */
 	double loss = 0.5 * (1.0 - e * e) * m_eff * u * u;
 	assert_true(fabs(st.energy.impact - loss) < 1e-12 * loss);
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 	bsim_state_free(&st);
 	bsim_scene_free(&s);
 }
@@ -333,8 +336,8 @@ static void test_elastic_impacts_conserve(void **state)
 		bsim_world *w = make(&s);
 		bsim_state st;
 		bsim_state_init(&st, 1);
-		assert_int_equal(bsim_backend_thesis.step(w, zero, 0.0, h, NULL), BSIM_OK);
-		bsim_backend_thesis.get_state(w, &st);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		bsim_test_backend("thesis")->get_state(w, &st);
 		double e1 = 0.5 * m * (st.v[0] * st.v[0] + st.v[1] * st.v[1]) +
 		            0.5 * j * st.angular_velocity * st.angular_velocity +
 		            0.5 * ib * st.omega[0] * st.omega[0];
@@ -345,7 +348,7 @@ static void test_elastic_impacts_conserve(void **state)
 		worst_e = fmax(worst_e, fabs(e1 - e0) / e0);
 		double lscale = m * speed * (fabs(x[0]) + fabs(x[1])) + j + ib;
 		worst_l = fmax(worst_l, fabs(l1 - l0) / lscale);
-		bsim_backend_thesis.destroy(w);
+		bsim_test_backend("thesis")->destroy(w);
 		bsim_state_free(&st);
 		bsim_scene_free(&s);
 	}
@@ -389,10 +392,10 @@ static void test_turning_disk_bits(void **state)
 	long impacts = 0;
 	for (int k = 0; k < 6000; k++) {
 		double fk[2] = {k % 500 < 250 ? f[0] : -f[0], f[1]};
-		assert_int_equal(bsim_backend_thesis.step(wa, fk, 0.0, h, NULL), BSIM_OK);
-		assert_int_equal(bsim_backend_thesis.step(wb, fk, 0.0, h, NULL), BSIM_OK);
-		bsim_backend_thesis.get_state(wa, &sa);
-		bsim_backend_thesis.get_state(wb, &sb);
+		assert_int_equal(bsim_test_backend("thesis")->step(wa, fk, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_test_backend("thesis")->step(wb, fk, 0.0, h, NULL), BSIM_OK);
+		bsim_test_backend("thesis")->get_state(wa, &sa);
+		bsim_test_backend("thesis")->get_state(wb, &sb);
 		impacts += sa.impacts;
 		assert_memory_equal(sa.x, sb.x, sizeof sa.x);
 		assert_memory_equal(sa.v, sb.v, sizeof sa.v);
@@ -403,8 +406,8 @@ static void test_turning_disk_bits(void **state)
 		assert_true(sb.angular_velocity == 0.0);
 	}
 	assert_true(impacts > 0); /* the run met the beams */
-	bsim_backend_thesis.destroy(wa);
-	bsim_backend_thesis.destroy(wb);
+	bsim_test_backend("thesis")->destroy(wa);
+	bsim_test_backend("thesis")->destroy(wb);
 	bsim_state_free(&sa);
 	bsim_state_free(&sb);
 	bsim_scene_free(&a);
@@ -443,13 +446,14 @@ static void test_ledger_closes(void **state)
 	bsim_state s0, s1;
 	bsim_state_init(&s0, 2);
 	bsim_state_init(&s1, 2);
-	bsim_backend_thesis.get_state(w, &s0);
+	bsim_test_backend("thesis")->get_state(w, &s0);
 	double worst = 0.0, flow = 0.0, friction_loss = 0.0;
 	long impacts = 0;
 	for (int k = 0; k < 5000; k++) {
 		double force[2] = {1.5 * sin(0.01 * k), 6.0}, torque = 2.0 * cos(0.003 * k);
-		assert_int_equal(bsim_backend_thesis.step(w, force, torque, h, NULL), BSIM_OK);
-		bsim_backend_thesis.get_state(w, &s1);
+		assert_int_equal(bsim_test_backend("thesis")->step(w, force, torque, h, NULL),
+		                 BSIM_OK);
+		bsim_test_backend("thesis")->get_state(w, &s1);
 		double work = force[0] * (s1.x[0] - s0.x[0]) + force[1] * (s1.x[1] - s0.x[1]) +
 		              torque * (s1.heading - s0.heading);
 		const bsim_step_energy *se = &s1.energy;
@@ -466,7 +470,7 @@ static void test_ledger_closes(void **state)
 	       worst, flow, friction_loss, impacts);
 	assert_true(impacts > 0);
 	assert_true(worst < 1e-9 * flow);
-	bsim_backend_thesis.destroy(w);
+	bsim_test_backend("thesis")->destroy(w);
 	bsim_state_free(&s0);
 	bsim_state_free(&s1);
 	bsim_scene_free(&s);
@@ -506,8 +510,9 @@ static void test_capsule_penetration(void **state)
 			if (k % 5 == 0) /* held 5 steps, uniform in [-40, 40] N */
 				lateral = 80.0 * uniform(&seed) - 40.0;
 			double f[2] = {lateral, 8.0};
-			assert_int_equal(bsim_backend_thesis.step(w, f, 0.0, h, NULL), BSIM_OK);
-			bsim_backend_thesis.get_state(w, &st);
+			assert_int_equal(bsim_test_backend("thesis")->step(w, f, 0.0, h, NULL),
+			                 BSIM_OK);
+			bsim_test_backend("thesis")->get_state(w, &st);
 			for (int i = 0; i < 2; i++) {
 				double u0[2], u[2];
 				bsim_scene_beam_rest_direction(&s.beams[i], u0);
@@ -524,7 +529,7 @@ static void test_capsule_penetration(void **state)
 			}
 		}
 		assert_int_equal(st.solver.iteration_limit, 0);
-		bsim_backend_thesis.destroy(w);
+		bsim_test_backend("thesis")->destroy(w);
 		bsim_state_free(&st);
 		bsim_scene_free(&s);
 	}

@@ -265,7 +265,7 @@ static void lib_camera_follows_the_body(void **state)
 	bsim_error err;
 	bsim_options opts = {0};
 	bsim_video_track *t = NULL;
-	assert_int_equal(bsim_video_track_record(&scene, &bsim_backend_thesis, &opts,
+	assert_int_equal(bsim_video_track_record(&scene, bsim_test_backend("thesis"), &opts,
 	                                         bsim_schedule_seed_mix(1, 0, 0), 30.0, &t, &err),
 	                 BSIM_OK);
 	bsim_video_def def = bsim_video_def_default();
@@ -377,9 +377,9 @@ static void lib_beams_take_their_stiffness_color(void **state)
 	bsim_error err;
 	bsim_options opts = {0};
 	bsim_video_track *t = NULL;
-	assert_int_equal(
-	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
-	        BSIM_OK);
+	assert_int_equal(bsim_video_track_record(&scene, bsim_test_backend("thesis"), &opts, 1,
+	                                         30.0, &t, &err),
+	                 BSIM_OK);
 	bsim_video_def def = bsim_video_def_default();
 	bsim_video *v = NULL;
 	assert_int_equal(bsim_video_alloc(&def, &scene, (const bsim_video_track *const *)&t, NULL,
@@ -431,14 +431,14 @@ static void lib_lattice_overview_shows_the_gate_path(void **state)
 	bsim_trial_log *log = bsim_trial_log_alloc();
 	bsim_recorder rec = {.stride = 1, .log = log};
 	bsim_trial_result res;
-	assert_int_equal(
-	        bsim_trial_run(runner, &scene, &bsim_backend_thesis, &opts, seed, &rec, &res, &err),
-	        BSIM_OK);
+	assert_int_equal(bsim_trial_run(runner, &scene, bsim_test_backend("thesis"), &opts, seed,
+	                                &rec, &res, &err),
+	                 BSIM_OK);
 	assert_true(log->n_entries >= 10); /* it travels far */
 	bsim_video_track *t = NULL;
-	assert_int_equal(
-	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, seed, 30.0, &t, &err),
-	        BSIM_OK);
+	assert_int_equal(bsim_video_track_record(&scene, bsim_test_backend("thesis"), &opts, seed,
+	                                         30.0, &t, &err),
+	                 BSIM_OK);
 	bsim_video_def def = bsim_video_def_default();
 	def.width = def.height = 480;
 	bsim_video *v = NULL;
@@ -496,9 +496,9 @@ static void lib_lattice_overview_shows_the_gate_path(void **state)
 	bsim_scene gate;
 	bsim_scene_init_gate(&gate, 7.0, 0.0);
 	gate.max_steps = 10;
-	assert_int_equal(
-	        bsim_video_track_record(&gate, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
-	        BSIM_OK);
+	assert_int_equal(bsim_video_track_record(&gate, bsim_test_backend("thesis"), &opts, 1, 30.0,
+	                                         &t, &err),
+	                 BSIM_OK);
 	assert_int_equal(bsim_video_alloc(&def, &gate, (const bsim_video_track *const *)&t, NULL, 1,
 	                                  &v, &err),
 	                 BSIM_OK);
@@ -591,7 +591,7 @@ static void frames_match_run(const char *rel, const char *steps, const char *ext
 	assert_int_equal(bsim_scene_load(gate, ov, extra ? 2 : 1, &scene, &err), BSIM_OK);
 	bsim_options opts = {0};
 	bsim_video_track *t = NULL;
-	assert_int_equal(bsim_video_track_record(&scene, &bsim_backend_thesis, &opts,
+	assert_int_equal(bsim_video_track_record(&scene, bsim_test_backend("thesis"), &opts,
 	                                         bsim_schedule_seed_mix(3, 0, 5), 30.0, &t, &err),
 	                 BSIM_OK);
 	long frames = bsim_video_track_frames(t);
@@ -656,9 +656,9 @@ static void lib_failing_encoder_writes_nothing(void **state)
 	bsim_error err;
 	bsim_options opts = {0};
 	bsim_video_track *t = NULL;
-	assert_int_equal(
-	        bsim_video_track_record(&scene, &bsim_backend_thesis, &opts, 1, 30.0, &t, &err),
-	        BSIM_OK);
+	assert_int_equal(bsim_video_track_record(&scene, bsim_test_backend("thesis"), &opts, 1,
+	                                         30.0, &t, &err),
+	                 BSIM_OK);
 	bsim_video_def def = bsim_video_def_default();
 	def.ffmpeg = "false";
 	bsim_video *v = NULL;
@@ -982,7 +982,7 @@ static void lib_stream_memory_does_not_grow_with_steps(void **state)
 	def.width = def.height = 64;
 	def.hold = 0.0;
 	def.ffmpeg = raw_encoder(dir);
-	const bsim_backend *backend = &bsim_backend_thesis;
+	const bsim_backend *backend = bsim_test_backend("thesis");
 	bsim_video_report rep;
 	bsim_error err;
 	const long before = peak_rss();
@@ -1077,14 +1077,14 @@ static void lib_stream_draws_the_recorded_frames(void **state)
 		double view;
 	} cases[] = {
 	        {&gate,
-	         {&bsim_backend_thesis, &bsim_backend_box2d},
+	         {bsim_test_backend("thesis"), bsim_test_backend("box2d")},
 	         2,
 	         bsim_schedule_seed_mix(1, 13, 15),
 	         320,
 	         160,
 	         200.0},
 	        {&field,
-	         {&bsim_backend_thesis},
+	         {bsim_test_backend("thesis")},
 	         1,
 	         bsim_schedule_seed_mix(1, 0, 0),
 	         320,

@@ -81,6 +81,10 @@
 
 #include "chipmunk/chipmunk_world.h"
 
+/* This backend's table, defined at the end of the file; the registry
+ * (src/registry) lists it. */
+extern const bsim_backend bsim_backend_chipmunk;
+
 /* The knobs. Defaults: Chipmunk's iterations and collision bias; a slop of
  * 1 mm, 0.01% of the essay's body radius (Chipmunk's default 0.1 assumes
  * pixels). */
@@ -680,6 +684,95 @@ static int chipmunk_reset(bsim_world *w, const bsim_scene *scene, bsim_error *er
 	return world_start(w, err);
 }
 
+/* The bounds it holds itself to in the checks every backend runs
+ * (docs/tests.md, "Every backend"), a little above what they measure on it
+ * (each test prints its figures: `ctest --test-dir build -R NAME -V`). */
+static const bsim_backend_bound chipmunk_bounds[] = {
+        {"impact", 1e-6,
+         "closed-form impulses to round-off (3e-16); a tip impact's angular momentum about the "
+         "pivot 1.4e-7: the overlap is pushed out by moving positions"},
+        {"vibration", 1e-3, "the explicit spring, first order in h: 8.9e-4 rad"},
+        {"vibration.order", 1, "symplectic Euler is first order"},
+        {"vibration.mirror", 1e-12, "round-off (measured 0)"},
+        /* No "stiff": the explicit spring grows without bound from
+         * omega_n h = 2 (undamped), and check refuses such a beam
+         * (test_chipmunk_oracles); below it the energy oscillates about
+         * its value (x 1.33 at omega_n h = 0.5). */
+        {"ledger.drift", 2e-3,
+         "the explicit spring's splitting at each impact: +1.8e-3 over 12 s, O(h)"},
+        {"ledger.elastic", 1e-9, "elastic impulses in double (1.7e-11)"},
+        {"ledger.residual", 0.11,
+         "a force credited over a displacement made with the velocity before it, and the "
+         "explicit spring: 0.096 of what flowed, O(h)"},
+        {"ledger.numerical", 3e-3, "contact and position correction: 1.9e-3"},
+        {"mirror.free.disk", 0, "every operation mirrors to the bit"},
+        {"mirror.contact.disk", 0, "every operation mirrors to the bit"},
+        {"mirror.trial.disk", 1e-12, "round-off: 6 of 40 trials' ends depart, by 1.2e-13 at most"},
+        {"mirror.free.capsule", 0, "free flight and every effect mirror to the bit"},
+        {"mirror.free.ellipse", 0, "free flight and every effect mirror to the bit"},
+        {"mirror.contact.capsule", 1e-12,
+         "the body's frame from cos and sin of psi and pi - psi, which differ in the last bit "
+         "(7e-15)"},
+        {"mirror.contact.ellipse", 0.06,
+         "its polygon of 128 vertices: the images part from the first contact, 0.045 in the "
+         "first second"},
+        /* No "mirror.trial.SHAPE": a turning body's images part in contact
+         * (0.11 to 0.16 m by the end) and the test checks the outcome. */
+        {"hard.apex", 1e-9, "round-off of positions in double (measured 0)"},
+        {"hard.centred", 1e-12, "round-off (6e-18)"},
+        {"hard.penetration", 1.5,
+         "contacts start at overlap: a body sinks in as far as the two close in a step, 1.40 m "
+         "where a light beam swings back at its tip"},
+        {"hard.pivot", 1e-8, "pivot joint rows converge iteratively, in double: 1.5e-9 m"},
+        /* No "hard.energy": the overlap pushed out by moving positions
+         * turns a light beam against its spring, +4.6 J of 29.8 J at
+         * omega_n h 0.5, booked as the correction's (a negative loss). */
+        {"hard.graze.energy", 1e-9, "an elastic tip impulse in double (measured 0)"},
+        {"hard.graze.momentum", 1e-6,
+         "the overlap pushed out by moving positions: 4.0e-7 about the pivot"},
+        {"hard.graze.penetration", 5e-3, "contacts start at overlap: 3.3 mm"},
+        {"hard.noise.penetration", 0.6,
+         "no continuous collision: a 1000 N impact sinks in as far as the body moves in a step, "
+         "0.49 m"},
+        /* No "hard.conservative.*": the explicit spring's energy oscillates
+         * about its value and ends +0.54% after 400 s, where the check
+         * allows only a loss. */
+        {"effects.drag.velocity", 1e-12, "the runner's exact decay, in double"},
+        {"effects.drag.step", 1e-12, "the runner's exact decay, in double"},
+        {"effects.drag.energy", 1e-9, "in double"},
+        {"effects.drag.residual", 1e-3,
+         "its position moved with the velocity before the step's drag: 7.9e-4, first order in "
+         "c h / m"},
+        {"effects.oscillation.velocity", 1e-12, "in double"},
+        {"effects.oscillation.residual", 0.2,
+         "x += h v_n books h^2 F^2 / 2m less work a step (0.167 of the energy gained in 3.5 s)"},
+        {"effects.friction.stop", 1, "a step"},
+        {"effects.friction.direction", 1e-12, "in double"},
+        {"effects.friction.velocity", 1e-9, "in double"},
+        {"effects.friction.energy", 5e-3,
+         "booked over the distance moved with the velocity before each step's friction: "
+         "3.9e-3"},
+        {"effects.friction.residual", 5e-3, "the same: 3.9e-3"},
+        {"effects.friction.push", 1e-9, "in double"},
+        {"effects.ledger", 0.02, "the runner's forces credited over its position update, O(h)"},
+        {"landscape.theta", 5e-4, "contacts rest at an overlap of a few mm: 2.9e-4 rad"},
+        {"landscape.release", 1e-3, "that overlap near the release: 6.3e-4 rad"},
+        /* No "contact.stick": a disk pushed into a stiff beam at 70 deg,
+         * inside the friction cone, creeps along it (0.052 m in 1.6 s
+         * after the contact settled, test_body_turn) where it should
+         * stick. */
+};
+
+/* The version as Chipmunk writes its cpVersionString (chipmunk.c), from the
+ * header's numbers: a table's fields are constants, and cpVersionString is
+ * a variable of the library (test_chipmunk_oracles holds the two equal). */
+#define CHIPMUNK_TEXT_OF(x) #x
+#define CHIPMUNK_TEXT(x)    CHIPMUNK_TEXT_OF(x)
+#define CHIPMUNK_VERSION                                                                           \
+	CHIPMUNK_TEXT(CP_VERSION_MAJOR)                                                            \
+	"." CHIPMUNK_TEXT(CP_VERSION_MINOR) "." CHIPMUNK_TEXT(CP_VERSION_RELEASE)
+
+/* This backend's table; the registry (src/registry) lists it. */
 const bsim_backend bsim_backend_chipmunk = {
         .name = "chipmunk",
         .description = "Chipmunk2D 7: sequential impulses with restitution and split-impulse "
@@ -697,4 +790,13 @@ const bsim_backend bsim_backend_chipmunk = {
         .reset = chipmunk_reset,
         .takes = 0,
         .check = chipmunk_check,
+        .engine = "Chipmunk2D",
+        .version = CHIPMUNK_VERSION,
+        /* Every beam awake is stepped (sleep off): on a lattice with
+         * sleeping this bounds the cost from above. */
+        .cost_ns_per_beam_step = 510.0,
+        .cost_basis = "Chipmunk2D measured at 7.0-7.4 s of one core for H1's 6.98e6 steps of 2 "
+                      "beams",
+        .bounds = chipmunk_bounds,
+        .n_bounds = (int)(sizeof chipmunk_bounds / sizeof chipmunk_bounds[0]),
 };

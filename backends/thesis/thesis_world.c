@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/version.h"
 #include "model/body_shape.h"
 #include "thesis/thesis.h"
 
@@ -69,6 +70,66 @@ static const bsim_knob_setting thesis_accuracy[] = {
         {"midpoint nearest_first", "integrator=midpoint:impact_order=nearest_first"},
         {"euler simultaneous", "integrator=euler:impact_order=simultaneous"},
         {"euler nearest_first", "integrator=euler:impact_order=nearest_first"},
+};
+
+/* The bounds of the checks every backend runs (docs/tests.md, "Every
+ * backend"), with the default options; each a little above what the tests
+ * measured (they print it), most of them round-off of doubles. */
+static const bsim_backend_bound thesis_bounds[] = {
+        {"impact", 1e-12, "one closed-form impulse in double"},
+        {"vibration", 2e-5, "the midpoint rule, 0.02% of theta0 over 3 s"},
+        {"vibration.order", 2, "the midpoint rule is second order"},
+        {"vibration.mirror", 1e-12, "round-off"},
+        {"stiff", 1e-12, "the midpoint rule is A-stable and keeps the spring's energy"},
+        {"ledger.drift", 1e-9, "round-off of the midpoint rule's exact ledger"},
+        {"ledger.elastic", 1e-9, "elastic impulses in double"},
+        {"ledger.residual", 1e-9, "round-off"},
+        {"ledger.numerical", 0.02, "persistent contact and projection"},
+        {"mirror.free.disk", 0, "every operation mirrors to the bit"},
+        {"mirror.contact.disk", 0, "the simultaneous impact solve mirrors to the bit"},
+        {"mirror.trial.disk", 0, "every operation mirrors to the bit"},
+        {"mirror.free.capsule", 0, "free flight and every effect mirror to the bit"},
+        {"mirror.free.ellipse", 0, "free flight and every effect mirror to the bit"},
+        {"mirror.contact.capsule", 1e-9,
+         "the body's frame from cos and sin of psi and pi - psi, which differ in the last bit"},
+        {"mirror.contact.ellipse", 1e-9,
+         "the body's frame from cos and sin of psi and pi - psi, which differ in the last bit"},
+        {"mirror.trial.capsule", 1e-6, "that round-off, grown by a chaotic path over 12 s"},
+        {"mirror.trial.ellipse", 1e-6, "that round-off, grown by a chaotic path over 12 s"},
+        {"hard.apex", 1e-9, "round-off of positions in double"},
+        {"hard.centred", 1e-12, "the simultaneous impact solve is symmetric to round-off"},
+        {"hard.penetration", 1e-5, "projection to slop, 1e-6 m"},
+        {"hard.pivot", 0, "the pin is exact: beams only turn"},
+        {"hard.energy", 1e-6,
+         "round-off: the solver only loses energy here (3.3 to 51 J in the mass-ratio cases)"},
+        {"hard.graze.energy", 1e-9, "an elastic tip impulse in double"},
+        {"hard.graze.momentum", 1e-9, "an elastic tip impulse in double"},
+        {"hard.graze.penetration", 1e-5, "speculative contacts, projection to slop"},
+        {"hard.noise.penetration", 1e-5, "speculative contacts, projection to slop"},
+        {"hard.conservative.drift", 0.011,
+         "1.06% lost over 400 s as persistent-contact work: a contact a beam's spring closes "
+         "within a step, which the impact stage does not predict from the step's start, is "
+         "stopped plastically by the smooth solve"},
+        {"hard.conservative.tunnels", 0, "speculative contacts: no step passes a beam"},
+        {"effects.drag.velocity", 1e-12, "the runner's exact decay, in double"},
+        {"effects.drag.step", 1e-12, "the runner's exact decay, in double"},
+        {"effects.drag.energy", 1e-9, "in double"},
+        {"effects.drag.residual", 1e-9, "the trapezoid's position update: the ledger closes"},
+        {"effects.oscillation.velocity", 1e-12, "in double"},
+        {"effects.oscillation.residual", 1e-9, "the trapezoid's position update"},
+        {"effects.friction.stop", 1, "a step"},
+        {"effects.friction.direction", 1e-12, "in double"},
+        {"effects.friction.velocity", 1e-9, "in double"},
+        {"effects.friction.energy", 1e-9, "in double"},
+        {"effects.friction.residual", 1e-9, "in double"},
+        {"effects.friction.push", 1e-9, "in double"},
+        {"effects.ledger", 1e-9, "round-off"},
+        {"landscape.theta", 1e-4, "a held contact's gap over its lever"},
+        {"landscape.release", 2e-3, "the sprung beam lags th by a step near the release"},
+        /* No "contact.stick": a disk pushed into a stiff beam at 70 deg,
+         * inside the friction cone, creeps along it (0.049 m in 1.6 s
+         * after the contact settled, test_body_turn) where it should
+         * stick. */
 };
 
 enum {
@@ -519,6 +580,7 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 	return BSIM_OK;
 }
 
+/* This backend's table; the registry (src/registry) lists it. */
 const bsim_backend bsim_backend_thesis = {
         .name = "thesis",
         .description = "the essay's collision + constraint solver: impulses with restitution, "
@@ -536,4 +598,13 @@ const bsim_backend bsim_backend_thesis = {
         .steps = thesis_steps,
         .accuracy = thesis_accuracy,
         .n_accuracy = (int)(sizeof thesis_accuracy / sizeof thesis_accuracy[0]),
+        .engine = "beamsim",
+        .version = BSIM_VERSION,
+        /* A step costs the beams near the body, so on a lattice this
+         * bounds the cost from above. */
+        .cost_ns_per_beam_step = 150.0,
+        .cost_basis = "the thesis backend's 1e8 beam-steps in about 15 s of one core "
+                      "(docs/robustness.md, beam_steps)",
+        .bounds = thesis_bounds,
+        .n_bounds = (int)(sizeof thesis_bounds / sizeof thesis_bounds[0]),
 };

@@ -1,5 +1,5 @@
-/* _beamsim.compare: two sides of an experiment with the same schedules as
- * `beamsim compare EXPERIMENT --backends A,B --out DIR` runs them
+/* _beamsim.compare: two or more sides of an experiment with the same
+ * schedules as `beamsim compare EXPERIMENT --backends A,B,... --out DIR` runs them
  * (bsim_compare_dir_run), with the GIL released, a progress callable and
  * Ctrl-C; the package reads DIR's files back. */
 #define _POSIX_C_SOURCE 200809L
@@ -8,19 +8,34 @@
 
 #include <string.h>
 
+/* A tuple of each side's directory (what 0) or unstable trials (1); NULL
+ * with an exception on failure. */
+static PyObject *per_side(const bsim_compare_dir_result *res, int what)
+{
+	PyObject *t = PyTuple_New(res->n_sides);
+	for (int i = 0; t && i < res->n_sides; i++) {
+		PyObject *v = what ? PyLong_FromLong(res->unstable[i])
+		                   : PyUnicode_FromString(res->dir[i]);
+		if (!v)
+			Py_CLEAR(t);
+		else
+			PyTuple_SET_ITEM(t, i, v);
+	}
+	return t;
+}
+
 PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"experiment", "out",    "a",        "b",
-	                         "trials",     "threads", "seed",     "sets",
-	                         "grid",       "progress", "resume",  "overwrite",
-	                         NULL};
-	const char *experiment, *out, *a = "thesis", *b = "box2d";
+	static char *kwlist[] = {"experiment", "out",  "sides",    "trials", "threads",   "seed",
+	                         "sets",       "grid", "progress", "resume", "overwrite", NULL};
+	const char *experiment, *out;
 	long trials = 0;
 	int threads = 0, resume = 0, overwrite = 0;
-	PyObject *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|ssliOOOOpp", kwlist, &experiment, &out, &a,
-	                                 &b, &trials, &threads, &seed_o, &sets_o, &grid_o,
+	PyObject *sides_o = Py_None, *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None,
+	                   *progress_o = Py_None;
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|OliOOOOpp", kwlist, &experiment, &out,
+	                                 &sides_o, &trials, &threads, &seed_o, &sets_o, &grid_o,
 	                                 &progress_o, &resume, &overwrite))
 		return NULL;
 	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
@@ -29,12 +44,38 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	}
 	bsim_compare_dir_def def = bsim_compare_dir_def_default();
 	bsim_error err;
-	const char *spec[2] = {a, b};
-	for (int i = 0; i < 2; i++) {
-		memset(&def.side[i], 0, sizeof def.side[i]);
-		if (bsim_compare_side_parse(spec[i], &def.side[i], &err) != BSIM_OK)
-			return pyb_raise(err.code, &err);
+	/* sides None: the registry's default ones (bsim_compare_dir_def_default) */
+	PyObject *sides = sides_o == Py_None
+	                          ? NULL
+	                          : PySequence_Fast(sides_o, "backends: expected a sequence of sides");
+	if (!sides && sides_o != Py_None)
+		return NULL;
+	Py_ssize_t n = sides ? PySequence_Fast_GET_SIZE(sides) : def.n_sides;
+	if (n < 2 || n > BSIM_COMPARE_SIDES_MAX) {
+		Py_XDECREF(sides);
+		PyErr_Format(PyExc_ValueError, "backends: %zd sides; expected 2 to %d", n,
+		             BSIM_COMPARE_SIDES_MAX);
+		return NULL;
 	}
+	def.n_sides = (int)n;
+	for (Py_ssize_t i = 0; sides && i < n; i++) {
+		const char *spec = PyUnicode_Check(PySequence_Fast_GET_ITEM(sides, i))
+		                           ? PyUnicode_AsUTF8(PySequence_Fast_GET_ITEM(sides, i))
+		                           : NULL;
+		if (!spec) {
+			Py_DECREF(sides);
+			if (!PyErr_Occurred())
+				PyErr_SetString(PyExc_TypeError,
+				                "backends: expected strings NAME[:KEY=VALUE]...");
+			return NULL;
+		}
+		memset(&def.side[i], 0, sizeof def.side[i]);
+		if (bsim_compare_side_parse(spec, &def.side[i], &err) != BSIM_OK) {
+			Py_DECREF(sides);
+			return pyb_raise(err.code, &err);
+		}
+	}
+	Py_XDECREF(sides);
 	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
 		return NULL;
 	pyb_sets sets;
@@ -73,8 +114,7 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	PyObject *d = PyDict_New();
 	if (!d || pyb_set(d, "threads", PyLong_FromLong(res.threads)) ||
 	    pyb_set(d, "n_disagree", PyLong_FromLong(res.cmp.n_disagree)) ||
-	    pyb_set(d, "dirs", Py_BuildValue("(ss)", res.dir[0], res.dir[1])) ||
-	    pyb_set(d, "unstable", Py_BuildValue("(ll)", res.unstable[0], res.unstable[1])))
+	    pyb_set(d, "dirs", per_side(&res, 0)) || pyb_set(d, "unstable", per_side(&res, 1)))
 		Py_CLEAR(d);
 	bsim_compare_dir_result_free(&res);
 	return d;

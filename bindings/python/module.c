@@ -381,6 +381,22 @@ static PyObject *py_version(PyObject *self, PyObject *args)
 	return PyUnicode_FromString(bsim_version());
 }
 
+/* backends(): the names of the backends compiled in, the registry's order
+ * (the first is the default), as `beamsim backends` lists them. */
+static PyObject *py_backends(PyObject *self, PyObject *args)
+{
+	(void)self;
+	(void)args;
+	PyObject *list = PyList_New(0);
+	for (const bsim_backend *const *b = bsim_backend_list(); list && *b; b++) {
+		PyObject *name = PyUnicode_FromString((*b)->name);
+		if (!name || PyList_Append(list, name) != 0)
+			Py_CLEAR(list);
+		Py_XDECREF(name);
+	}
+	return list;
+}
+
 /* text_check(what, text): None, or ValueError naming what if the str text
  * holds a NUL (pyb_text): the package's check of the arguments the
  * functions above take as C strings (paths, backends), whose own
@@ -409,6 +425,8 @@ static PyMethodDef methods[] = {
         {"read_table", pyb_read_table, METH_VARARGS,
          "read_table(path): a CSV table as a dict of NumPy arrays by column"},
         {"version", py_version, METH_NOARGS, "the library's version"},
+        {"backends", py_backends, METH_NOARGS,
+         "the backends compiled in, by name; the first is the default"},
         {"text_check", py_text_check, METH_VARARGS,
          "text_check(what, text): ValueError naming what if text holds a NUL"},
         {NULL, NULL, 0, NULL},

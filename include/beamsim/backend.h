@@ -1,5 +1,6 @@
 /* The physics backend interface (how to add one: docs/architecture.md,
- * "Where a new thing goes").
+ * "Where a new thing goes"); the backends compiled in are reached through
+ * the registry, beamsim/backend_registry.h.
  *
  * A backend owns bodies, beams, joints (spring + damper), contacts and
  * integration; nothing else. The runner owns time, the external force on the
@@ -21,6 +22,18 @@ extern "C" {
 #endif
 
 typedef struct bsim_world bsim_world; /* opaque, one per backend */
+
+/* A bound a backend holds itself to in a check that the tests run on every
+ * registered backend (docs/tests.md, "Every backend"): the check's name,
+ * the largest departure from the check's truth it allows (0: none, to the
+ * bit) and what it rests on (what was measured, and why the backend does
+ * not do better). A check whose name the backend does not list is skipped
+ * for it, and the test says so. */
+typedef struct bsim_backend_bound {
+	const char *check; /* "impact", "mirror.contact.ellipse", ... */
+	double bound;      /* in the check's unit (docs/tests.md) */
+	const char *basis; /* "measured 3e-7 (float32)" */
+} bsim_backend_bound;
 
 typedef struct bsim_backend {
 	const char *name;
@@ -89,6 +102,22 @@ typedef struct bsim_backend {
 	 * from names the place (bsim_backend_check). */
 	int (*check)(const bsim_scene *scene, const bsim_options *opts, char *field, size_t size,
 	             bsim_error *err);
+	/* What the backend is built on, for the records that say what made a
+	 * run (run.json's NAME_version) and `beamsim --version`: the engine
+	 * ("Box2D") and its version ("2.4.1"). */
+	const char *engine;
+	const char *version;
+	/* The cost of one beam-step (a step of one beam) with the default
+	 * options, ns of one core, and the measurement it comes from: the
+	 * constant of the one-hour estimate a command prints before a long run
+	 * (0: not stated, no estimate). */
+	double cost_ns_per_beam_step;
+	const char *cost_basis;
+	/* The bounds it holds itself to in the checks every backend runs
+	 * (bsim_backend_bound); n_bounds 0: none stated, and those checks are
+	 * skipped for it, saying so. */
+	const bsim_backend_bound *bounds;
+	int n_bounds;
 } bsim_backend;
 
 /* Checks scene against b with opts (b->check) before a run, as a scene
@@ -102,16 +131,9 @@ BSIM_API int bsim_backend_check(const bsim_backend *b, const bsim_options *opts,
                                 const bsim_scene *scene, const char *path, const bsim_override *ov,
                                 int n_ov, bsim_error *err);
 
-/* The registry: all backends compiled in, NULL-terminated. */
-BSIM_API const bsim_backend *const *bsim_backend_list(void);
-/* The backend a run uses when none is named: the essay's solver, thesis. */
-BSIM_API const bsim_backend *bsim_backend_default(void);
-/* By name; NULL and BSIM_EINPUT naming the known ones if unknown. */
-BSIM_API const bsim_backend *bsim_backend_find(const char *name, bsim_error *err);
-
-BSIM_API extern const bsim_backend bsim_backend_thesis;
-BSIM_API extern const bsim_backend bsim_backend_box2d;
-BSIM_API extern const bsim_backend bsim_backend_chipmunk;
+/* The bound b states for check (bsim_backend_bound) into *bound: 1, or
+ * 0 if b states none. */
+BSIM_API int bsim_backend_bound_of(const bsim_backend *b, const char *check, double *bound);
 
 #ifdef __cplusplus
 }

@@ -1,7 +1,7 @@
-/* Comparing two sweeps trial by trial: two backends run with the same
- * schedules (beamsim compare) or a stored sweep and its rerun (beamsim
- * regress). Trial t of group g in one is the pair of trial t of group g in
- * the other, so every test here is a paired one. */
+/* Comparing sweeps trial by trial: two or more backends (or settings of
+ * one) run with the same schedules (beamsim compare) or a stored sweep and
+ * its rerun (beamsim regress). Trial t of group g in one is the pair of
+ * trial t of group g in another, so every test here is a paired one. */
 #ifndef BSIM_COMPARE_H
 #define BSIM_COMPARE_H
 
@@ -185,6 +185,57 @@ BSIM_API int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_r
                                   const double *t_separate, const bsim_compare_rule *rule,
                                   bsim_comparison *out, bsim_error *err);
 BSIM_API void bsim_compare_free(bsim_comparison *c);
+
+/* ---- more than two sides ----------------------------------------------------
+ *
+ * A comparison of n sides (2 to BSIM_COMPARE_SIDES_MAX) compares every pair
+ * of sides as above, with one Holm family: every pair's tests together, so
+ * that the chance that any agreeing pair of any group is called
+ * disagreeing stays below alpha however many sides there are. Each pair's
+ * n_tests is that family's size, and its mde80 and min_significant are at
+ * the family's level. A group's verdict is its least agreeing pair's (the
+ * largest in bsim_verdict's order); it disagrees when any pair does.
+ *
+ * The odd one out of a group says which side a disagreement is due to: the
+ * side s such that every pair of s with another side disagrees (DISAGREE
+ * or DIFFERENT) and no pair of the other sides does. With three sides or
+ * more at most one side can be it; with two, both sides would be, so two
+ * sides never have one. bsim_compare_odd_one_out returns it, or
+ * BSIM_ODD_NONE when no pair disagrees, or BSIM_ODD_NO_SINGLE when some
+ * pair disagrees but no single side is the odd one out (two sides
+ * disagreeing with the rest, a pair of the others disagreeing, or a side
+ * that disagrees with some but not all of the others). */
+
+#define BSIM_COMPARE_SIDES_MAX BSIM_SWEEP_SIDES_MAX
+#define BSIM_ODD_NONE          (-1)
+#define BSIM_ODD_NO_SINGLE     (-2)
+
+/* The odd one out of n_sides sides from differ[k], nonzero when pair k (in
+ * bsim_sweep_pair's order) disagrees. */
+BSIM_API int bsim_compare_odd_one_out(int n_sides, const int *differ);
+
+typedef struct bsim_compare_sides {
+	int n_sides, n_pairs;
+	int n_groups, trials;
+	int pair[BSIM_SWEEP_PAIRS_MAX][2];           /* pair k's sides (bsim_sweep_pair) */
+	bsim_comparison pairs[BSIM_SWEEP_PAIRS_MAX]; /* pair k: side pair[k][0] as A,
+	                                              * pair[k][1] as B */
+	int n_tests;                /* the one Holm family's size, over every pair */
+	bsim_verdict *verdict;      /* per group: its least agreeing pair's */
+	int *odd;                   /* per group: the odd one out, a side, or BSIM_ODD_* */
+	int n_disagree;             /* groups in which some pair disagrees */
+	int count[BSIM_N_VERDICTS]; /* groups by verdict */
+} bsim_compare_sides;
+
+/* Compares n_sides sweeps (same groups and trials) pair by pair.
+ * t_separate may be NULL, else the pairs' separation times as
+ * bsim_sweep_run_sides gives them. BSIM_EINPUT if the shapes differ or
+ * n_sides is out of range. bsim_compare_analyse is n_sides = 2, its
+ * result the one pair's. */
+BSIM_API int bsim_compare_analyse_sides(const bsim_sweep_result *side, int n_sides,
+                                        const double *t_separate, const bsim_compare_rule *rule,
+                                        bsim_compare_sides *out, bsim_error *err);
+BSIM_API void bsim_compare_sides_free(bsim_compare_sides *c);
 
 /* 1 if trials differ in outcome or traversal type. */
 BSIM_API int bsim_compare_discordant(const bsim_trial_result *a, const bsim_trial_result *b);

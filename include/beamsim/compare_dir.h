@@ -1,16 +1,18 @@
 /* A comparison stored in an output directory (beamsim compare EXPERIMENT
- * --out DIR): every trial of an experiment run on two sides with the same
- * random-force schedules, so that trial t of group g is a pair
- * (beamsim/sweep.h), the pairs analysed (beamsim/compare.h), and DIR
- * written as one set: report.md, report.json, pairs.csv, each side's sweep
- * files in DIR/<label>/ (beamsim/sweep_dir.h), their .mat twins, and
- * run.json with inputs/ (beamsim/run_record.h). DIR, the journal and
- * resume behave as for a sweep (beamsim/sweep_dir.h).
+ * --out DIR): every trial of an experiment run on two or more sides with
+ * the same random-force schedules, so that trial t of group g of any two
+ * sides is a pair (beamsim/sweep.h), every pair of sides analysed
+ * (beamsim/compare.h), and DIR written as one set: report.md, report.json,
+ * pairs.csv, each side's sweep files in DIR/<label>/
+ * (beamsim/sweep_dir.h), their .mat twins, and run.json with inputs/
+ * (beamsim/run_record.h). DIR, the journal and resume behave as for a
+ * sweep (beamsim/sweep_dir.h).
  *
  * A side is a backend with options, written NAME[:KEY=VALUE]... as on the
- * command line ("thesis", "box2d:spring=torque:substeps=4"); that text is
- * its label. Or, on a gate lattice, the two sides are one backend under two
- * lattice protocols (protocol), and the protocols label them. */
+ * command line (a name `beamsim backends` lists, alone or with options:
+ * "NAME:KEY=VALUE:KEY=VALUE"); that text is its label. Or, on a gate
+ * lattice, the two sides are one backend under two lattice protocols
+ * (protocol), and the protocols label them. */
 #ifndef BSIM_COMPARE_DIR_H
 #define BSIM_COMPARE_DIR_H
 
@@ -44,7 +46,7 @@ typedef struct bsim_compare_side {
 BSIM_API int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err);
 
 /* The directory of a side's files in DIR: the label with ':' and '/'
- * written '-' ("thesis:integrator=euler" -> "thesis-integrator=euler"). */
+ * written '-' ("NAME:KEY=VALUE" -> "NAME-KEY=VALUE"). */
 BSIM_API void bsim_compare_dir_label(const char *label, char *buf, size_t size);
 
 typedef struct bsim_compare_dir_def {
@@ -58,10 +60,12 @@ typedef struct bsim_compare_dir_def {
 	long trials; /* > 0: trials per group instead of the file's */
 	int has_seed;
 	uint64_t seed;
-	bsim_compare_side side[2];
+	/* The sides, 2 to BSIM_COMPARE_SIDES_MAX, each label different. */
+	int n_sides;
+	bsim_compare_side side[BSIM_COMPARE_SIDES_MAX];
 	/* "world" and "essay" (lattice.protocol), or both NULL: the sides
-	 * differ by backend and options. With protocols both sides must name
-	 * one backend. */
+	 * differ by backend and options. With protocols there are two sides,
+	 * and both must name one backend. */
 	const char *protocol[2];
 	int threads; /* <= 0: all cores */
 	bsim_compare_rule rule;
@@ -87,18 +91,20 @@ typedef struct bsim_compare_dir_def {
 	int n_merge;
 } bsim_compare_dir_def;
 
-/* thesis against box2d, no options, bsim_compare_rule_default(), 3
+/* The registry's default comparison, its first two backends
+ * (bsim_backend_compared), no options, bsim_compare_rule_default(), 3
  * examples, all cores. */
 BSIM_API bsim_compare_dir_def bsim_compare_dir_def_default(void);
 
 typedef struct bsim_compare_dir_result {
 	bsim_experiment e;
-	bsim_comparison cmp;
+	bsim_compare_sides cmp; /* every pair of sides; two sides: cmp.pairs[0] */
 	int threads;
-	char dir[2][128];             /* each side's directory in DIR */
-	long unstable[2];             /* unstable trials on each side */
-	bsim_solver_counts solver[2]; /* what each side's solvers gave up on */
-	char journal[BSIM_PATH_MAX];  /* as in bsim_sweep_dir_result */
+	int n_sides;
+	char dir[BSIM_COMPARE_SIDES_MAX][128];             /* each side's directory in DIR */
+	long unstable[BSIM_COMPARE_SIDES_MAX];             /* unstable trials on each side */
+	bsim_solver_counts solver[BSIM_COMPARE_SIDES_MAX]; /* what each side's solvers gave up on */
+	char journal[BSIM_PATH_MAX];                       /* as in bsim_sweep_dir_result */
 } bsim_compare_dir_result;
 
 /* Runs the comparison into def->out. BSIM_OK whatever the verdicts

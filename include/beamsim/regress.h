@@ -44,7 +44,7 @@ typedef struct bsim_regress_result {
 	bsim_run_record rec; /* the baseline's */
 	bsim_experiment e;
 	int n_sides;
-	bsim_regress_side side[2];
+	bsim_regress_side side[BSIM_COMPARE_SIDES_MAX];
 	int beyond; /* groups beyond the rule, over the sides */
 } bsim_regress_result;
 

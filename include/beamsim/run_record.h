@@ -20,10 +20,11 @@ extern "C" {
 typedef struct bsim_run_record {
 	char command[16]; /* "sweep" or "compare" */
 	char version[32]; /* of the beamsim that wrote it */
-	int n_backends;   /* 1 (sweep) or 2 (compare) */
-	char backend[2][32];
-	char label[2][128];   /* compare's side labels (NAME[:K=V]...); the name if none */
-	bsim_options opts[2]; /* every knob, effective value */
+	int n_backends;   /* 1 (sweep), or compare's sides (2 to BSIM_COMPARE_SIDES_MAX) */
+	char backend[BSIM_COMPARE_SIDES_MAX][32];
+	/* compare's side labels (NAME[:K=V]...); the name if none */
+	char label[BSIM_COMPARE_SIDES_MAX][128];
+	bsim_options opts[BSIM_COMPARE_SIDES_MAX]; /* every knob, effective value */
 	uint64_t seed;
 	int trials;
 	bsim_compare_rule rule; /* compare only */
@@ -31,7 +32,8 @@ typedef struct bsim_run_record {
 	char protocol[2][16];
 } bsim_run_record;
 
-/* The record of a sweep (n = 1 backend) or comparison (n = 2 sides):
+/* The record of a sweep (n = 1 backend) or comparison (n sides, 2 to
+ * BSIM_COMPARE_SIDES_MAX):
  * each side's backend, label (NULL: the backend's name) and every knob's
  * effective value, the experiment's seed and trials, and the rule (NULL:
  * bsim_compare_rule_default()). */

@@ -90,9 +90,9 @@ typedef struct bsim_sweep_config {
 	int measure_overlap; /* 1: each trial's overlap_max (plain sweeps only) */
 	int keep;            /* keep the trajectories of the first keep trials of each group */
 	int keep_stride;     /* of those, a row every keep_stride steps (<= 0: 5) */
-	/* A paired sweep only: overrides applied after extra to the second
-	 * side's scenes (e.g. lattice.protocol=essay), so the two sides can
-	 * differ in the scene while sharing every schedule. */
+	/* A sweep of sides only: overrides applied after extra to the second
+	 * side's scenes (e.g. lattice.protocol=essay), so that side can differ
+	 * from the others in the scene while sharing every schedule. */
 	const bsim_override *extra_b;
 	int n_extra_b;
 	/* NULL, or a journal of records of
@@ -136,11 +136,28 @@ typedef struct bsim_sweep_config {
  * flag. */
 BSIM_API bsim_sweep_config bsim_sweep_config_default(void);
 
-/* The size of one journal record: a bsim_trial_result, or for a paired
- * sweep both results and the separation time. The record is the result's
- * bytes as they are in memory, so a resumed sweep's results are the
- * uninterrupted sweep's to the bit. */
+/* A sweep of sides (beamsim compare) runs every trial on 2 to this many
+ * sides (backends, or settings of one) with the same schedule. */
+#define BSIM_SWEEP_SIDES_MAX 8
+/* Pairs of sides: BSIM_SWEEP_SIDES_MAX choose 2. */
+#define BSIM_SWEEP_PAIRS_MAX (BSIM_SWEEP_SIDES_MAX * (BSIM_SWEEP_SIDES_MAX - 1) / 2)
+
+/* The pairs of n sides, n (n - 1) / 2, and pair k's two sides (side[0] <
+ * side[1]): the pairs in the order (0, 1), (0, 2), ..., (0, n-1), (1, 2),
+ * ..., so that the pair of two sides is pair 0 and a side's pairs with the
+ * sides before it come first. */
+BSIM_API int bsim_sweep_pairs(int n_sides);
+BSIM_API void bsim_sweep_pair(int n_sides, int k, int side[2]);
+
+/* The size of one journal record: a bsim_trial_result, or for a sweep of
+ * paired = 1 two sides both results and the separation time. The record
+ * is the result's bytes as they are in memory, so a resumed sweep's
+ * results are the uninterrupted sweep's to the bit. */
 BSIM_API size_t bsim_sweep_record_size(int paired);
+/* The same for a sweep of n_sides >= 2 sides: each side's result in order,
+ * then each pair's separation time (a double) in bsim_sweep_pair's order;
+ * for two sides bsim_sweep_record_size(1). */
+BSIM_API size_t bsim_sweep_record_size_sides(int n_sides);
 
 /* The size of the journal records of the plain sweep of e with cfg (its
  * --set in cfg->extra): bsim_sweep_record_size(0), or for a lattice (unless
@@ -152,9 +169,13 @@ BSIM_API size_t bsim_sweep_record_size(int paired);
 BSIM_API int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                         size_t *size, bsim_error *err);
 
-/* The same for the paired sweep of e with cfg (its second side's
- * overrides in cfg->extra_b): bsim_sweep_record_size(1), or for a lattice
- * both sides' results, gate paths and peaks and the separation time. */
+/* The same for the sweep of e on n_sides sides with cfg (the second side's
+ * overrides in cfg->extra_b): bsim_sweep_record_size_sides(n_sides), or
+ * for a lattice each side's result, gate path and peaks, then the pairs'
+ * separation times. bsim_sweep_record_size_paired_for is n_sides = 2. */
+BSIM_API int bsim_sweep_record_size_sides_for(const bsim_experiment *e,
+                                              const bsim_sweep_config *cfg, int n_sides,
+                                              size_t *size, bsim_error *err);
 BSIM_API int bsim_sweep_record_size_paired_for(const bsim_experiment *e,
                                                const bsim_sweep_config *cfg, size_t *size,
                                                bsim_error *err);
@@ -165,12 +186,21 @@ BSIM_API int bsim_sweep_record_size_paired_for(const bsim_experiment *e,
 BSIM_API int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg,
                             bsim_sweep_result *out, bsim_error *err);
 
-/* The same sweep run as pairs (beamsim compare): every trial runs on
- * cfg->backend into out_a and, with the same schedule, on backend_b into
- * out_b. t_separate (malloc'd, n_groups * trials, index g*trials + t) gets
- * the time, s, at which the pair's body centres first lie more than 1% of
- * the body radius apart, -1 if never while both ran. out_a and out_b each
- * equal what bsim_sweep_run gives for its backend. */
+/* The same sweep run on n_sides sides (beamsim compare), 2 to
+ * BSIM_SWEEP_SIDES_MAX: every trial runs on backend[s] with opts[s] into
+ * out[s] for each side s, with the same schedule (cfg->backend and
+ * cfg->opts are not used). t_separate (malloc'd, pairs x n_groups x
+ * trials, index (k * n_groups + g) * trials + t for pair k in
+ * bsim_sweep_pair's order) gets the time, s, at which the two sides' body
+ * centres first lie more than 1% of the body radius apart, -1 if never
+ * while both ran. Each out[s] equals what bsim_sweep_run gives for its
+ * side. */
+BSIM_API int bsim_sweep_run_sides(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                  int n_sides, const bsim_backend *const *backend,
+                                  const bsim_options *const *opts, bsim_sweep_result *out,
+                                  double **t_separate, bsim_error *err);
+
+/* Two sides: cfg->backend into out_a, backend_b into out_b. */
 BSIM_API int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                    const bsim_backend *backend_b, const bsim_options *opts_b,
                                    bsim_sweep_result *out_a, bsim_sweep_result *out_b,
@@ -222,10 +252,15 @@ typedef struct bsim_sweep_part {
 BSIM_API int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                  const bsim_sweep_part *part, bsim_error *err);
 
-/* The same for a paired sweep (beamsim compare): each trial runs on both
- * sides as bsim_sweep_run_paired runs it, its record both results and the
- * separation time (bsim_sweep_record_size_paired_for: a lattice's hold
- * both sides' gate paths and peaks too). */
+/* The same for a sweep of sides (beamsim compare): each trial runs on
+ * every side as bsim_sweep_run_sides runs it, its record every side's
+ * result and the pairs' separation times (bsim_sweep_record_size_sides_for:
+ * a lattice's hold every side's gate path and peaks too). The paired part
+ * is two sides, cfg->backend's and backend_b's. */
+BSIM_API int bsim_sweep_run_part_sides(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                       int n_sides, const bsim_backend *const *backend,
+                                       const bsim_options *const *opts, const bsim_sweep_part *part,
+                                       bsim_error *err);
 BSIM_API int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                         const bsim_backend *backend_b, const bsim_options *opts_b,
                                         const bsim_sweep_part *part, bsim_error *err);

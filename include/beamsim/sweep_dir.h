@@ -47,7 +47,7 @@ typedef struct bsim_sweep_dir_def {
 	long trials;  /* > 0: trials per group instead of the file's */
 	int has_seed; /* 1: seed instead of the file's */
 	uint64_t seed;
-	const bsim_backend *backend; /* default: thesis */
+	const bsim_backend *backend; /* default: bsim_backend_default() */
 	bsim_options opts;           /* the backend's options (beamsim/options.h) */
 	int threads;                 /* <= 0: all cores */
 	int overlap;                 /* 1: each trial's deepest body-beam overlap */

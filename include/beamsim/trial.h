@@ -53,8 +53,8 @@ typedef enum {
 } bsim_instability;
 
 /* The bound of the energy test above. Measured (H1 and H2, 19,200 trials
- * each): residual / inflow at most 3e-14 on thesis midpoint, 0.04 on
- * thesis euler and Box2D weld, 0.07 on Box2D torque; 0.47 with Box2D
+ * each): residual / inflow at most 3e-14 on the essay's solver (its midpoint
+ * integrator), 0.04 on its euler and on Box2D weld, 0.07 on Box2D torque; 0.47 with Box2D
  * torque springs of 3e6 N m/rad (omega_n h = 1.5, inaccurate but bounded);
  * 1.9 and above once an explicit spring passes its stability limit
  * (omega_n h > 2), where the energy grows without bound. */
@@ -64,8 +64,8 @@ typedef enum {
  * inflow (the end energy and the booked losses are not negative), which it
  * reaches when everything vanished. Measured on the stored reference runs
  * (docs/robustness.md), residual / (start energy + net work) at its most
- * negative: -3e-14 on thesis midpoint, -0.43 on thesis euler (H2), -0.34
- * on Box2D weld (H1); the inflow, which counts the work of every step in
+ * negative: -3e-14 on the essay's solver (midpoint), -0.43 on its euler
+ * (H2), -0.34 on Box2D weld (H1); the inflow, which counts the work of every step in
  * absolute value, is at least that denominator. */
 #define BSIM_LEDGER_LOST_BOUND 0.75
 /* A floor under the bound, J, so that round-off in a scene through which
@@ -212,7 +212,8 @@ typedef struct bsim_recorder {
 	/* 1: measure overlap_max, the deepest overlap of the body with any beam
 	 * after each step (R minus the distance from the centre to the beam's
 	 * segment). A solver that keeps contacts apart holds it near 0; it
-	 * costs about a fifth of a thesis step, so sweeps ask only when told. */
+	 * costs about a fifth of a step of the essay's solver, so sweeps ask only
+	 * when told. */
 	int overlap;
 } bsim_recorder;
 

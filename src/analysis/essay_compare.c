@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "beamsim/backend.h"
+#include "beamsim/backend_registry.h"
 #include "beamsim/experiment.h"
 #include "beamsim/options.h"
 #include "beamsim/stats.h"
@@ -129,7 +130,7 @@ bsim_essay_config bsim_essay_config_default(void)
 	                                    "contact_mode=essay:contact.tip_restitution=0.8"};
 	return (bsim_essay_config){
 	        .configs = "configs",
-	        .backend = "thesis",
+	        .backend = bsim_backend_default()->name,
 	        .n_modes = 3,
 	        .modes = modes,
 	        .trials = 1000,
@@ -499,7 +500,7 @@ static int join_sets(const char *const *base, int n_base, const mode_def *md, co
 }
 
 /* The values of d the study runs on backend b: none for a backend option
- * b does not have (impact_mass on box2d). */
+ * b does not have (impact_mass on a backend without it). */
 static long sens_values(const sens_def *d, const bsim_backend *b)
 {
 	if (!strchr(d->key, '.')) {

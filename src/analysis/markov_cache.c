@@ -24,6 +24,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
 #include "store/outdir.h"

@@ -203,7 +203,7 @@ typedef struct markov_field_panel {
 /* Sums of p over the ends, the sides and the stuck gates. */
 void markov_field_totals(const bsim_location *loc, const double *p, int n, double tot[3]);
 
-/* "backend thesis, F_prop = 6 N, k_1 = 100 N m/rad": the backend (may be
+/* "backend NAME, F_prop = 6 N, k_1 = 100 N m/rad": the backend (may be
  * NULL) and overrides in the model's symbols (beamsim/key_names.h). */
 void markov_title_params(char *buf, size_t size, const char *backend, const bsim_override *ov,
                          int n);

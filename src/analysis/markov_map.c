@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "beamsim/backend_registry.h"
 #include "store/outdir.h"
 #include "store/part_dir.h"
 #include "store/session.h"

@@ -13,6 +13,7 @@
 #include <time.h>
 
 #include "analysis/markov_internal.h"
+#include "beamsim/backend_registry.h"
 #include "util/atomic_file.h"
 #include "beamsim/backend.h"
 #include "beamsim/experiment.h"

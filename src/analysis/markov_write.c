@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "analysis/markov_internal.h"
+#include "beamsim/backend_registry.h"
 #include "util/atomic_file.h"
 #include "beamsim/backend.h"
 #include "beamsim/markov.h"

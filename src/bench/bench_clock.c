@@ -5,9 +5,9 @@
  * island (b2_island.cpp). No setting turns them off, and a clock read costs
  * tens of nanoseconds in a virtual machine, so part of what bench measures
  * for Box2D is its own timing. To state that part, the program (not the
- * library) defines gettimeofday: the dynamic linker binds libbox2d's calls
- * to this definition, which counts each call and passes it on to the C
- * library's. Only beamsim itself reads the count; nothing in beamsim calls
+ * library) defines gettimeofday: the dynamic linker binds the Box2D
+ * library's calls to this definition, which counts each call and passes it
+ * on to the C library's. Only beamsim itself reads the count; nothing in beamsim calls
  * gettimeofday. */
 #define _GNU_SOURCE
 

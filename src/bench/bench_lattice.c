@@ -10,8 +10,8 @@
  *     the body does the same thing in every field and only the number of
  *     gates around it changes (and, from 3 x 3 on, the neighbours' beams
  *     at the shared pivots, which it can touch): the cost of the field's
- *     size. The target, thesis within 1.2 x from 1 x 1 to 33 x 33, is on
- *     this table.
+ *     size. The target, the essay's solver within 1.2 x from 1 x 1 to
+ *     33 x 33, is on this table.
  *   own field: each field's own termination; the body goes as far as it
  *     gets, with the beams it pushed still swinging behind it, so the cost
  *     also follows how many beams are awake near its path.

@@ -51,7 +51,8 @@ static const cli_own bench_own[] = {
         [OWN_EXPERIMENT] = {"experiment", 1, "FILE",
                             "benchmark this experiment instead of H1 (no H2 step)"},
         [OWN_NO_H2] = {"no-h2", 0, NULL, "skip the H1 + H2 step"},
-        [OWN_VS] = {"vs", 1, "B", "the backend to compare speed with (default box2d;\nnone: skip)"},
+        [OWN_VS] = {"vs", 1, "B",
+                    "the backend to compare speed with (default {second};\nnone: skip)"},
         [OWN_VS_OPT] = {"vs-opt", 1, "K=V", "an option of the --vs backend, repeatable"},
         [OWN_JSON] = {"json", 1, "FILE", "also write the results as JSON to FILE"},
         [OWN_LATTICE] = {"lattice", 0, NULL,
@@ -200,7 +201,7 @@ static const cli_spec bench_spec = {
                  "all threads and reports the wall time of H1 + H2. Then the experiment as\n"
                  "free flight (the body far below every beam) on one thread against a\n"
                  "minimal loop of the same steps' physics. Then the experiment on one thread\n"
-                 "with a second backend (--vs, default box2d) at the same time step: how\n"
+                 "with a second backend (--vs, default {second}) at the same time step: how\n"
                  "many times faster the first is, per step and per trial, and what share of\n"
                  "the second's time went to reading the clock for its own profiling. The\n"
                  "default experiment paths are relative to the current directory (run it\n"
@@ -618,7 +619,13 @@ static int bench_main(const bench_args *a, const bsim_backend *backend, const bs
 int cmd_bench(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	bench_args a = {.experiment = BENCH_H1, .h2 = 1, .vs = "box2d", .repeat = 1, .pairs = 5};
+	/* --vs: the registry's second backend, none if it has one. */
+	const bsim_backend *pair[2];
+	bench_args a = {.experiment = BENCH_H1,
+	                .h2 = 1,
+	                .vs = bsim_backend_compared(pair, 2) == 2 ? pair[1]->name : NULL,
+	                .repeat = 1,
+	                .pairs = 5};
 	int rc = cli_parse(&bench_spec, argc, argv, &c, &a, NULL);
 	a.backend = c.backend ? c.backend : bsim_backend_default()->name;
 	a.trials = c.trials;

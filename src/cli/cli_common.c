@@ -557,36 +557,27 @@ double cli_experiment_beam_steps(const char *path, const cli_sets *sets, const u
 	return total;
 }
 
-/* The cost of a beam-step, ns of one core, with its basis: what the
- * estimate line says it assumed. The thesis backend's step costs the
- * beams near the body, so on a lattice the estimate is an upper bound. */
-static double beam_step_ns(const char *backend, const char **basis)
+void cli_estimate_line(const bsim_backend *b, double beam_steps)
 {
-	if (strcmp(backend, "box2d") == 0) {
-		*basis = "Box2D measured at 0.21 s a step of a 333 x 300 lattice's 199,800 beams";
-		return 1050.0;
-	}
-	if (strcmp(backend, "chipmunk") == 0) {
-		*basis =
-		        "Chipmunk2D measured at 2.1 s of one core for H1's 2.07e6 steps of 2 beams";
-		return 510.0;
-	}
-	*basis = "the thesis backend's 1e8 beam-steps in about 15 s of one core "
-	         "(docs/robustness.md, beam_steps)";
-	return 150.0;
-}
-
-void cli_estimate_line(const char *backend, double beam_steps)
-{
-	const char *basis;
-	double ns = beam_step_ns(backend, &basis);
+	double ns = b->cost_ns_per_beam_step;
 	double hours = beam_steps * ns * 1e-9 / 3600.0;
 	if (hours > 1.0)
 		cli_error(
 		        "note: this run may take up to about %.3g hours of one core: at most %.3g "
 		        "beam-steps (trials x max_steps x beams) at a stated constant of ~%g ns a "
 		        "beam-step on %s (%s)",
-		        hours, beam_steps, ns, backend, basis);
+		        hours, beam_steps, ns, b->name, b->cost_basis ? b->cost_basis : "");
+}
+
+void cli_backend_names(char *buf, size_t size, int max)
+{
+	const bsim_backend *b[16];
+	int n = bsim_backend_compared(b, max < 16 ? max : 16);
+	size_t k = 0;
+	if (size > 0)
+		buf[0] = '\0';
+	for (int i = 0; i < n && k < size; i++)
+		k += (size_t)snprintf(buf + k, size - k, "%s%s", i ? "," : "", b[i]->name);
 }
 
 const char *cli_path(const char *path)

@@ -11,6 +11,7 @@
 #include <signal.h>
 
 #include "beamsim/backend.h"
+#include "beamsim/backend_registry.h"
 #include "beamsim/experiment.h"
 #include "beamsim/scene.h"
 #include "beamsim/sweep.h"
@@ -145,8 +146,14 @@ double cli_experiment_beam_steps(const char *path, const cli_sets *sets, const u
 
 /* One line on stderr before a run that may take more than an hour of one
  * core: the estimate, the beam-steps it is made of and the cost of a
- * beam-step it assumes for the backend, with that cost's basis. */
-void cli_estimate_line(const char *backend, double beam_steps);
+ * beam-step it assumes for backend b (its table's, with that cost's
+ * basis); none for a backend that states no cost. */
+void cli_estimate_line(const bsim_backend *b, double beam_steps);
+
+/* The names of the first max backends of the registry's default
+ * comparison (bsim_backend_compared), joined by ',' into buf ("" if
+ * none); for a command's default list of backends and its help. */
+void cli_backend_names(char *buf, size_t size, int max);
 
 /* path as the terminal may show it: control characters and bytes that are
  * not UTF-8 as \xNN (a newline in a file name must not start a line of

@@ -17,7 +17,7 @@ typedef struct shared_def {
 
 static const shared_def shared[CLI_N_OPTS] = {
         [CLI_OPT_BACKEND] = {"backend", 1, "B",
-                             "physics backend (default thesis; see beamsim backends)"},
+                             "physics backend (default {default}; see beamsim backends)"},
         [CLI_OPT_BACKEND_OPT] = {"backend-opt", 1, "K=V",
                                  "a backend option, repeatable; B:K=V sets it on\n"
                                  "backend B (see beamsim backends --help)"},
@@ -64,12 +64,82 @@ void cli_common_free(cli_common *c)
 	cli_sets_free(&c->sets);
 }
 
+/* The default backend's first choice knob set to a choice other than its
+ * default, "integrator=euler": an example of an option; KEY=VALUE if it
+ * has none. */
+static void knob_example(char *buf, size_t size)
+{
+	const bsim_backend *b = bsim_backend_default();
+	for (int i = 0; i < b->n_knobs; i++) {
+		const bsim_knob *k = &b->knobs[i];
+		if (k->type != BSIM_KNOB_CHOICE || !k->choices)
+			continue;
+		for (const char *c = k->choices; *c;) {
+			size_t n = strcspn(c, "|");
+			if (!k->default_value || strlen(k->default_value) != n ||
+			    strncmp(c, k->default_value, n) != 0) {
+				snprintf(buf, size, "%s=%.*s", k->name, (int)n, c);
+				return;
+			}
+			c += n + (c[n] == '|');
+		}
+	}
+	snprintf(buf, size, "KEY=VALUE");
+}
+
+/* Help text with the registry's names in place of its placeholders, so
+ * that the help names the backends compiled in: {default} the default
+ * backend, {pair} the first two of the default comparison ("A,B"),
+ * {backends} every registered backend, {second} the second ("none" if
+ * there is one backend), {knob} an option of the default backend. */
+static void help_expand(const char *text, char *out, size_t size)
+{
+	static const char *const names[] = {"{default}", "{pair}", "{backends}", "{second}",
+	                                    "{knob}"};
+	size_t k = 0;
+	out[0] = '\0';
+	while (*text && k + 1 < size) {
+		int which = -1;
+		for (int i = 0; *text == '{' && i < 5 && which < 0; i++)
+			if (strncmp(text, names[i], strlen(names[i])) == 0)
+				which = i;
+		if (which < 0) {
+			out[k++] = *text++;
+			out[k] = '\0';
+			continue;
+		}
+		char value[256];
+		const bsim_backend *b[2];
+		switch (which) {
+		case 0:
+			snprintf(value, sizeof value, "%s", bsim_backend_default()->name);
+			break;
+		case 1:
+			cli_backend_names(value, sizeof value, 2);
+			break;
+		case 2:
+			cli_backend_names(value, sizeof value, 16);
+			break;
+		case 3:
+			snprintf(value, sizeof value, "%s",
+			         bsim_backend_compared(b, 2) == 2 ? b[1]->name : "none");
+			break;
+		default:
+			knob_example(value, sizeof value);
+		}
+		snprintf(out + k, size - k, "%s", value);
+		k += strlen(out + k);
+		text += strlen(names[which]);
+	}
+}
+
 /* "  --name ARG" padded to the help column, then the help, continuation
  * lines indented to it. */
-static void help_line(FILE *f, const char *name, const char *arg, const char *help)
+static void help_line(FILE *f, const char *name, const char *arg, const char *text)
 {
-	char head[64];
+	char head[64], help[2048];
 	snprintf(head, sizeof head, "--%s%s%s", name, arg ? " " : "", arg ? arg : "");
+	help_expand(text, help, sizeof help);
 	fprintf(f, "  %-22s ", head);
 	for (const char *p = help; *p; p++) {
 		fputc(*p, f);
@@ -82,7 +152,9 @@ static void help_line(FILE *f, const char *name, const char *arg, const char *he
 static void help_print(const cli_spec *spec)
 {
 	FILE *f = stdout;
-	fprintf(f, "Usage: beamsim %s %s\n\n%s\nOptions:\n", spec->name, spec->usage, spec->about);
+	char text[8192];
+	help_expand(spec->about, text, sizeof text);
+	fprintf(f, "Usage: beamsim %s %s\n\n%s\nOptions:\n", spec->name, spec->usage, text);
 	for (int o = 0; o < CLI_N_OPTS; o++) {
 		if (!(spec->common & CLI_USES(o)))
 			continue;
@@ -93,8 +165,10 @@ static void help_print(const cli_spec *spec)
 	for (int i = 0; i < spec->n_own; i++)
 		help_line(f, spec->own[i].name, spec->own[i].arg, spec->own[i].help);
 	fputs("  -h, --help             show this help\n", f);
-	if (spec->after)
-		fprintf(f, "\n%s", spec->after);
+	if (spec->after) {
+		help_expand(spec->after, text, sizeof text);
+		fprintf(f, "\n%s", text);
+	}
 }
 
 /* One shared option's value into c. */

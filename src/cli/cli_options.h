@@ -102,7 +102,7 @@ int cli_parse(const cli_spec *spec, int argc, char **argv, cli_common *c, void *
 
 /* The --backend-opt values, in the order given, into opts[i] for each of
  * the n backends a command runs (names[i]; a name may repeat, as for the
- * two sides of compare thesis,thesis:integrator=euler). B:K=V sets K on
+ * two sides of compare A,A:KEY=VALUE). B:K=V sets K on
  * backend B; K=V is short for it when the command runs one backend.
  * CLI_OK, or a usage error (a B that is not one of the backends, K=V with
  * several backends, bad syntax). */

@@ -24,7 +24,9 @@ static const cli_own accuracy_own[] = {
         [OWN_SCENE] = {"scene", 1, "FILE",
                        "scene (default " ACC_SCENE " with propulsion 9 N,\n"
                        "random force 20 N)"},
-        [OWN_BACKENDS] = {"backends", 1, "LIST", "comma-separated (default thesis,box2d)"},
+        [OWN_BACKENDS] = {"backends", 1, "LIST",
+                          "comma-separated (default: of {backends}, those\n"
+                          "with accuracy settings)"},
         [OWN_PIECES] = {"pieces", 1, "N", "restarted pieces (default 16)"},
         [OWN_QUICK] = {"quick", 0, NULL, "h down to 0.0005 s, 4 pieces, 8 trials (for tests)"},
         [OWN_TARGETS] = {"targets", 1, "LIST",
@@ -39,7 +41,7 @@ static const char *const accuracy_help[CLI_N_OPTS] = {
                             "not depend on it",
         [CLI_OPT_OUT] = "output directory (required; created if missing)",
         [CLI_OPT_BACKEND_OPT] = "B:K=V adds option K=V to every setting of backend B\n"
-                                "(e.g. box2d:continuous=off), repeatable",
+                                "(e.g. {default}:{knob}), repeatable",
 };
 
 typedef struct accuracy_args {
@@ -251,7 +253,15 @@ static int accuracy_main(const cli_common *c, accuracy_args *a)
 int cmd_accuracy(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
-	accuracy_args a = {.scene = ACC_SCENE, .backends = "thesis,box2d"};
+	/* Every registered backend that has accuracy settings to compare. */
+	char all[256] = "";
+	const bsim_backend *b[ACC_BACKENDS_MAX];
+	int n = bsim_backend_compared(b, ACC_BACKENDS_MAX);
+	for (int i = 0; i < n; i++)
+		if (b[i]->n_accuracy > 0)
+			snprintf(all + strlen(all), sizeof all - strlen(all), "%s%s",
+			         all[0] ? "," : "", b[i]->name);
+	accuracy_args a = {.scene = ACC_SCENE, .backends = all};
 	int rc = cli_parse(&accuracy_spec, argc, argv, &c, &a, NULL);
 	if (rc < 0)
 		rc = accuracy_main(&c, &a);

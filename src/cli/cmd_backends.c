@@ -1,4 +1,5 @@
-/* beamsim backends: each backend with its description and knobs. */
+/* beamsim backends: each backend of the registry with its description, what
+ * it is built on, its knobs and the bounds it holds itself to. */
 #include <stdio.h>
 #include <string.h>
 
@@ -9,8 +10,10 @@
 static const cli_spec backends_spec = {
         .name = "backends",
         .usage = "[OPTIONS]",
-        .about = "Lists the physics backends compiled in, with their options: name, type,\n"
-                 "default, choices and what each does.\n"
+        .about = "Lists the physics backends compiled in, the default first: what each is\n"
+                 "built on, its options (name, type, default, choices and what each does)\n"
+                 "and the bounds it holds itself to in the checks every backend runs\n"
+                 "(docs/tests.md, \"Every backend\").\n"
                  "\n"
                  "An option is set the same way on every command that runs backends (run,\n"
                  "sweep, compare, video, bench):\n"
@@ -18,7 +21,7 @@ static const cli_spec backends_spec = {
                  "                              not run is an error\n"
                  "  --backend-opt KEY=VALUE     the same, when the command runs one backend\n"
                  "and compare's sides also take options inline, NAME:KEY=VALUE[:KEY=VALUE]...\n"
-                 "(--backends thesis,thesis:integrator=euler), which win over --backend-opt.\n"
+                 "(--backends {default},{default}:{knob}), which win over --backend-opt.\n"
                  "(bench's --vs backend takes --vs-opt KEY=VALUE.)\n"
                  "Values are checked against the backend's knob: its type, range or choices.\n",
 };
@@ -52,11 +55,30 @@ static int width_of(const bsim_backend *b, int col)
 	return w;
 }
 
+/* The bounds b states (bsim_backend.bounds), a line each. */
+static void bounds_print(const bsim_backend *b)
+{
+	if (b->n_bounds == 0) {
+		puts("\n  states no bounds: the checks that need one skip it");
+		return;
+	}
+	int w = 0;
+	for (int i = 0; i < b->n_bounds; i++)
+		w = (int)strlen(b->bounds[i].check) > w ? (int)strlen(b->bounds[i].check) : w;
+	printf("\n  bounds in the checks every backend runs (%d):\n", b->n_bounds);
+	for (int i = 0; i < b->n_bounds; i++)
+		printf("    %-*s  %-7g  %s\n", w, b->bounds[i].check, b->bounds[i].bound,
+		       b->bounds[i].basis ? b->bounds[i].basis : "");
+}
+
 static void backend_print(const bsim_backend *b)
 {
 	printf("%s\n  %s\n", b->name, b->description ? b->description : "");
+	if (b->engine)
+		printf("  built on %s %s\n", b->engine, b->version ? b->version : "");
 	if (b->n_knobs == 0) {
 		puts("  (no options)");
+		bounds_print(b);
 		return;
 	}
 	int w[4];
@@ -75,6 +97,7 @@ static void backend_print(const bsim_backend *b)
 		       b->n_accuracy);
 	for (int i = 0; i < b->n_accuracy; i++)
 		printf("    %-24s %s\n", b->accuracy[i].name, b->accuracy[i].options);
+	bounds_print(b);
 }
 
 int cmd_backends(int argc, char **argv)

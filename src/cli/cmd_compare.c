@@ -1,8 +1,9 @@
-/* beamsim compare: an experiment on two backends with the same schedules,
- * trial by trial, into DIR (beamsim/compare_dir.h), and a summary of where
- * their traversal statistics agree and where they do not. Exit status 3
- * when a group disagrees beyond the rule (see beamsim/compare.h), so the
- * command can guard CI. */
+/* beamsim compare: an experiment on two or more backends (or settings of
+ * one) with the same schedules, trial by trial, into DIR
+ * (beamsim/compare_dir.h), and a summary of where their traversal
+ * statistics agree and where they do not, and which side a disagreement
+ * is due to. Exit status 3 when a group disagrees beyond the rule (see
+ * beamsim/compare.h), so the command can guard CI. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
@@ -20,14 +21,14 @@
 enum { OWN_BACKENDS, OWN_PROTOCOLS, OWN_EXAMPLES, OWN_SHARD };
 
 static const cli_own compare_own[] = {
-        [OWN_BACKENDS] = {"backends", 1, "A,B",
-                          "the two sides (default thesis,box2d); each a backend\n"
-                          "with options inline, NAME[:K=V]..., e.g.\n"
-                          "thesis,thesis:integrator=euler; the side's label and\n"
+        [OWN_BACKENDS] = {"backends", 1, "A,B[,C...]",
+                          "the sides, 2 to 8 (default {pair}); each a\n"
+                          "backend with options inline, NAME[:K=V]..., e.g.\n"
+                          "{default},{default}:{knob}; the side's label and\n"
                           "directory are the text (':' written '-' in the name)"},
         [OWN_PROTOCOLS] = {"protocols", 1, "P,Q",
                            "a lattice experiment on one backend (--backend B,\n"
-                           "default thesis) under two lattice protocols (world,\n"
+                           "default {default}) under two lattice protocols (world,\n"
                            "essay) instead of two backends; the sides and their\n"
                            "directories are named by protocol"},
         [OWN_EXAMPLES] = {"examples", 1, "N",
@@ -48,7 +49,7 @@ static const char *const compare_help[CLI_N_OPTS] = {
 };
 
 typedef struct compare_args {
-	const char *backends; /* "A,B" as given, NULL: thesis,box2d */
+	const char *backends; /* "A,B" as given, NULL: the registry's first two */
 	char protocol[2][16]; /* --protocols, "" if not given */
 	long examples;
 	int shard, shards; /* --shard, 1-based; 0: the whole comparison */
@@ -95,12 +96,14 @@ static int compare_option(void *args, int i, const char *value)
 static const cli_spec compare_spec = {
         .name = "compare",
         .usage = "EXPERIMENT --out DIR [OPTIONS]",
-        .about = "Runs every trial of the experiment on two backends, or two settings of one,\n"
-                 "with the same random-force schedule, so trial t of group g is a pair, and\n"
-                 "reports per group: both sides' probabilities of traversed, left, right,\n"
+        .about = "Runs every trial of the experiment on two or more backends, or settings of\n"
+                 "one, with the same random-force schedule, so trial t of group g is a pair, and\n"
+                 "reports per group and pair of sides: both sides' probabilities of traversed,\n"
+                 "left, right,\n"
                  "side_exit, stuck and unstable with Wilson 95% intervals, their paired\n"
                  "difference (Tango's 95% score interval), the exact McNemar test on the\n"
-                 "discordant pairs, Holm-corrected over all groups with random force and events,\n"
+                 "discordant pairs, Holm-corrected over all groups with random force, events\n"
+                 "and pairs of sides,\n"
                  "Tango's equivalence test against +-margin, the smallest difference the test\n"
                  "could detect, a verdict, and the times at which paired trajectories first\n"
                  "separate by more than 1% of the body radius. A group without random force is\n"
@@ -110,7 +113,10 @@ static const cli_spec compare_spec = {
                  "\n"
                  "A group disagrees when an event's Holm-adjusted p-value is below --alpha and\n"
                  "its probabilities differ by at least --margin, or, if deterministic, when its\n"
-                 "pair differs. Exit status 3 if any does. On a gate lattice the report adds\n"
+                 "pair differs, in any pair of sides. Exit status 3 if any does. With three\n"
+                 "sides or more each group names its odd one out: the side whose every pair\n"
+                 "with another side disagrees while the others agree among themselves\n"
+                 "(docs/compare.md). On a gate lattice the report adds\n"
                  "both sides' final-location distributions and a paired permutation test of\n"
                  "their difference, which joins the rule.\n"
                  "\n"
@@ -136,20 +142,23 @@ static const cli_spec compare_spec = {
         .option = compare_option,
 };
 
-/* The two sides: --backends A,B with options inline, or one backend under
+/* The sides: --backends A,B,... with options inline, or one backend under
  * --protocols; --backend-opt first, inline options after (they win). */
 static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compare_dir_def *def)
 {
 	bsim_error err;
-	const char *names[2];
-	bsim_options *opts[2] = {&def->side[0].opts, &def->side[1].opts};
-	char spec[2][128];
+	const char *names[BSIM_COMPARE_SIDES_MAX];
+	bsim_options *opts[BSIM_COMPARE_SIDES_MAX];
+	char spec[BSIM_COMPARE_SIDES_MAX][128];
+	for (int i = 0; i < BSIM_COMPARE_SIDES_MAX; i++)
+		opts[i] = &def->side[i].opts;
 	if (a->protocol[0][0]) {
 		if (a->backends)
 			return cli_usage("compare",
 			                 "--protocols runs one backend (--backend B), not "
 			                 "--backends");
 		const char *b = c->backend ? c->backend : bsim_backend_default()->name;
+		def->n_sides = 2;
 		for (int i = 0; i < 2; i++) {
 			bsim_compare_side *s = &def->side[i];
 			memset(s, 0, sizeof *s);
@@ -164,59 +173,95 @@ static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compar
 	if (c->backend)
 		return cli_usage("compare", "--backend B goes with --protocols; two backends are "
 		                            "--backends A,B");
-	const char *text = a->backends ? a->backends : "thesis,box2d";
-	const char *comma = strchr(text, ',');
-	size_t n0 = comma ? (size_t)(comma - text) : 0;
-	if (!comma || n0 == 0 || n0 >= sizeof spec[0] || strchr(comma + 1, ',') ||
-	    comma[1] == '\0' || strlen(comma + 1) >= sizeof spec[1])
-		return cli_usage("compare", "--backends %s: expected two sides A,B", text);
-	snprintf(spec[0], sizeof spec[0], "%.*s", (int)n0, text);
-	snprintf(spec[1], sizeof spec[1], "%s", comma + 1);
+	char pair[128];
+	cli_backend_names(pair, sizeof pair, 2);
+	const char *text = a->backends ? a->backends : pair;
+	int n = 0;
+	for (const char *p = text;; n++) {
+		size_t len = strcspn(p, ",");
+		if (len == 0 || len >= sizeof spec[0] || n == BSIM_COMPARE_SIDES_MAX)
+			return cli_usage("compare",
+			                 "--backends %s: expected 2 to %d sides A,B,... (each "
+			                 "NAME[:KEY=VALUE]..., none empty)",
+			                 text, BSIM_COMPARE_SIDES_MAX);
+		snprintf(spec[n], sizeof spec[n], "%.*s", (int)len, p);
+		if (p[len] == '\0') {
+			n++;
+			break;
+		}
+		p += len + 1;
+	}
+	if (n < 2)
+		return cli_usage("compare", "--backends %s: expected two sides A,B or more", text);
+	def->n_sides = n;
 	/* The backends first (--backend-opt needs them), then the options in
 	 * order: --backend-opt, then inline. */
-	for (int i = 0; i < 2; i++) {
+	for (int i = 0; i < n; i++) {
 		memset(&def->side[i], 0, sizeof def->side[i]);
 		if (bsim_compare_side_parse(spec[i], &def->side[i], &err) != BSIM_OK)
 			return cli_usage("compare", "%s", err.msg);
 		names[i] = def->side[i].backend->name;
 		memset(opts[i], 0, sizeof *opts[i]);
 	}
-	int rc = cli_backend_opts(c, "compare", 2, names, opts);
-	for (int i = 0; rc == CLI_OK && i < 2; i++)
+	int rc = cli_backend_opts(c, "compare", n, names, opts);
+	for (int i = 0; rc == CLI_OK && i < n; i++)
 		if (bsim_compare_side_parse(spec[i], &def->side[i], &err) != BSIM_OK)
 			rc = cli_usage("compare", "%s", err.msg);
 	return rc;
 }
 
+/* The label of side i. */
+static const char *side_label(const bsim_compare_dir_def *def, int i)
+{
+	return i < 2 && def->protocol[i] ? def->protocol[i] : def->side[i].label;
+}
+
 static void compare_summary(const bsim_compare_dir_def *def, const char *out,
                             const bsim_compare_dir_result *res)
 {
-	const bsim_comparison *cmp = &res->cmp;
-	const int *k = cmp->count;
-	const char *la = def->protocol[0] ? def->protocol[0] : def->side[0].label;
-	const char *lb = def->protocol[1] ? def->protocol[1] : def->side[1].label;
-	printf("%s vs %s on %s: %d of %d groups disagree (alpha %g, margin %g), %d x %d trials\n",
-	       la, lb, res->e.path, cmp->n_disagree, cmp->n_groups, cmp->rule.alpha,
-	       cmp->rule.margin, res->e.n_groups, res->e.trials);
+	const bsim_compare_sides *all = &res->cmp;
+	const bsim_comparison *cmp = &all->pairs[0];
+	const int *k = all->count;
+	for (int i = 0; i < res->n_sides; i++)
+		printf("%s%s", i ? " vs " : "", side_label(def, i));
+	printf(" on %s: %d of %d groups disagree (alpha %g, margin %g), %d x %d trials\n",
+	       res->e.path, all->n_disagree, all->n_groups, cmp->rule.alpha, cmp->rule.margin,
+	       res->e.n_groups, res->e.trials);
 	printf("  deterministic: %d same, %d different; random: %d equivalent within +-%g, %d "
 	       "uninformative (at the floor or ceiling), %d inconclusive, %d small, %d disagree "
 	       "(Holm over %d tests)\n",
 	       k[BSIM_VERDICT_SAME], k[BSIM_VERDICT_DIFFERENT], k[BSIM_VERDICT_EQUIVALENT],
 	       cmp->rule.margin, k[BSIM_VERDICT_UNINFORMATIVE], k[BSIM_VERDICT_INCONCLUSIVE],
-	       k[BSIM_VERDICT_SMALL], k[BSIM_VERDICT_DISAGREE], cmp->n_tests);
-	for (int g = 0; g < cmp->n_groups; g++) {
-		const bsim_compare_group *cg = &cmp->groups[g];
-		const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];
-		if (cg->verdict == BSIM_VERDICT_DISAGREE)
-			printf("  group %d: p_traverse %.2f vs %.2f, %d discordant pairs\n", g,
-			       t->p_a, t->p_b, cg->discordant);
-		else if (cg->verdict == BSIM_VERDICT_DIFFERENT)
-			printf("  group %d (deterministic): the one pair differs\n", g);
+	       k[BSIM_VERDICT_SMALL], k[BSIM_VERDICT_DISAGREE], all->n_tests);
+	for (int g = 0; g < all->n_groups; g++) {
+		if (all->verdict[g] != BSIM_VERDICT_DISAGREE &&
+		    all->verdict[g] != BSIM_VERDICT_DIFFERENT)
+			continue;
+		for (int p = 0; p < all->n_pairs; p++) {
+			const bsim_compare_group *cg = &all->pairs[p].groups[g];
+			const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];
+			char who[300] = "";
+			if (all->n_sides > 2)
+				snprintf(who, sizeof who, ", %s vs %s",
+				         side_label(def, all->pair[p][0]),
+				         side_label(def, all->pair[p][1]));
+			if (cg->verdict == BSIM_VERDICT_DISAGREE)
+				printf("  group %d%s: p_traverse %.2f vs %.2f, %d discordant "
+				       "pairs\n",
+				       g, who, t->p_a, t->p_b, cg->discordant);
+			else if (cg->verdict == BSIM_VERDICT_DIFFERENT)
+				printf("  group %d (deterministic)%s: the one pair differs\n", g,
+				       who);
+		}
+		int odd = all->odd[g];
+		if (all->n_sides > 2)
+			printf("  group %d: odd one out %s\n", g,
+			       odd >= 0 ? side_label(def, odd) : "no single side");
 	}
-	for (int i = 0; i < 2; i++)
+	for (int i = 0; i < res->n_sides; i++)
 		if (res->unstable[i] > 0)
-			printf("  %s: %ld unstable trials (see %s/%s/trials.csv)\n", i ? lb : la,
-			       res->unstable[i], cli_path(out), res->dir[i]);
+			printf("  %s: %ld unstable trials (see %s/%s/trials.csv)\n",
+			       side_label(def, i), res->unstable[i], cli_path(out), res->dir[i]);
 	cli_wrote(stdout, out);
 }
 
@@ -278,16 +323,21 @@ static int compare_main(int argc, char **argv, const cli_merge *m)
 		def.argc = stored ? argc : 0;
 		def.argv = stored;
 	}
-	cli_mpi_spread(&def.spread, &def.part, &def.agree, bsim_sweep_record_size(1), def.stop);
-	/* Both sides run every trial; the costlier backend's constant bounds
+	cli_mpi_spread(&def.spread, &def.part, &def.agree,
+	               bsim_sweep_record_size_sides(def.n_sides), def.stop);
+	/* Every side runs every trial; the costlier backend's constant bounds
 	 * the estimate. */
-	const char *costlier = def.side[0].backend ? def.side[0].backend->name : "thesis";
-	if (def.side[1].backend && strcmp(def.side[1].backend->name, "box2d") == 0)
-		costlier = "box2d";
+	const bsim_backend *costlier = bsim_backend_default();
+	for (int i = 0; i < def.n_sides; i++) {
+		const bsim_backend *b = def.side[i].backend;
+		if (b && (i == 0 || b->cost_ns_per_beam_step > costlier->cost_ns_per_beam_step))
+			costlier = b;
+	}
 	if (rank == 0 && !m)
-		cli_estimate_line(costlier, 2.0 * cli_experiment_beam_steps(
-		                                          experiment, &c.sets,
-		                                          c.has_seed ? &c.seed : NULL, c.trials));
+		cli_estimate_line(costlier,
+		                  def.n_sides * cli_experiment_beam_steps(
+		                                        experiment, &c.sets,
+		                                        c.has_seed ? &c.seed : NULL, c.trials));
 	bsim_compare_dir_result res;
 	bsim_error err;
 	cli_signals_install();
@@ -315,7 +365,7 @@ static int compare_main(int argc, char **argv, const cli_merge *m)
 	} else {
 		if (!c.quiet)
 			compare_summary(&def, c.out, &res);
-		for (int i = 0; i < 2; i++) {
+		for (int i = 0; i < res.n_sides; i++) {
 			char where[BSIM_PATH_MAX];
 			snprintf(where, sizeof where, "%s/%s/summary.json", c.out, res.dir[i]);
 			cli_solver_warning(def.side[i].backend->name, &res.solver[i], where);

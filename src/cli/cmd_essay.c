@@ -31,7 +31,8 @@ static const cli_own essay_own[] = {
         [OWN_SENSITIVITY] = {"sensitivity", 0, NULL,
                              "also vary what the essay leaves unstated (rest threshold,\n"
                              "restitution, tip restitution, duration, side boundary, the\n"
-                             "thesis backend's impact_mass) at the symmetric groups:\n"
+                             "backend option impact_mass where the backend has it) at\n"
+                             "the symmetric groups:\n"
                              "sensitivity.csv"},
         [OWN_CONFIGS] = {"configs", 1, "DIR",
                          "the shipped configs (thesis/gate.yaml, lattice/c_track.yaml;\n"
@@ -45,7 +46,7 @@ static const cli_own essay_own[] = {
 };
 
 static const char *const essay_help[CLI_N_OPTS] = {
-        [CLI_OPT_BACKEND] = "backend (default thesis)",
+        [CLI_OPT_BACKEND] = "backend (default {default})",
         [CLI_OPT_TRIALS] = "trials per group (default 1000; the essay's 100)",
         [CLI_OPT_SEED] = "seed of the schedules (default 1)",
         [CLI_OPT_THREADS] = "threads (default all); results do not depend on it",

@@ -491,8 +491,8 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 	a.def.one_pass = round;
 	a.def.passes_from = a.passes;
 	bsim_options opts = {0};
-	const bsim_backend *be =
-	        cli_backend_with_opts(&c, "markov build", c.backend ? c.backend : "thesis", &opts);
+	const bsim_backend *be = cli_backend_with_opts(
+	        &c, "markov build", c.backend ? c.backend : bsim_backend_default()->name, &opts);
 	if (!be) {
 		cli_common_free(&c);
 		return CLI_USAGE;

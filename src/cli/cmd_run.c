@@ -286,7 +286,7 @@ int cmd_run(int argc, char **argv)
 	}
 	a.seed = rp->seed;
 	const bsim_scene *scene = &rp->scene;
-	cli_estimate_line(backend->name, (double)scene->max_steps * scene->n_beams);
+	cli_estimate_line(backend, (double)scene->max_steps * scene->n_beams);
 	uint64_t mixed = bsim_schedule_seed_mix(a.seed, (uint64_t)a.group, (uint64_t)a.trial);
 	bsim_trial_log *log = bsim_trial_log_alloc();
 	int of_scene = rp->kind == BSIM_REPLAY_SCENE;

@@ -23,7 +23,7 @@ enum { OWN_BACKENDS, OWN_GROUP, OWN_TRIAL, OWN_FPS, OWN_SIZE, OWN_HOLD, OWN_VIEW
 static const cli_own video_own[] = {
         [OWN_BACKENDS] = {"backends", 1, "A,B",
                           "backends side by side, a panel each, each named once\n"
-                          "(1 to 4 names of `beamsim backends`: thesis,box2d)"},
+                          "(1 to 4 names of `beamsim backends`: {backends})"},
         [OWN_GROUP] = {"group", 1, "G",
                        "group, from 0: an experiment's grid values and the\n"
                        "seed (default 0)"},

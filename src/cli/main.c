@@ -135,9 +135,11 @@ static int dispatch(int argc, char **argv)
 	if (strcmp(name, "--version") == 0 || strcmp(name, "-V") == 0) {
 		const char *commit = bsim_version_commit();
 		printf("beamsim %s\n", bsim_version());
-		printf("commit %s\nBox2D %s\nChipmunk2D %s\ncompiler %s\n",
-		       commit[0] ? commit : "unknown", bsim_version_box2d(),
-		       bsim_version_chipmunk(), bsim_version_compiler());
+		printf("commit %s\n", commit[0] ? commit : "unknown");
+		for (const bsim_backend *const *b = bsim_backend_list(); *b; b++)
+			printf("backend %s: %s %s\n", (*b)->name, (*b)->engine ? (*b)->engine : "",
+			       (*b)->version ? (*b)->version : "");
+		printf("compiler %s\n", bsim_version_compiler());
 		return CLI_OK;
 	}
 	const cli_command *c = find_command(name);

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/backend_registry.h"
 #include "figures/figures_kinds.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
@@ -17,6 +18,20 @@
 
 static const char *const palette[] = {FIG_BLUE, FIG_RED,    FIG_GREEN, FIG_ORANGE,
                                       FIG_SKY,  FIG_PURPLE, FIG_BLACK, "#8C6D31"};
+
+/* A series' point type by its backend's place in the registry (filled
+ * circle, triangle, square, ...): the colours tell a backend's settings
+ * apart, the points the backends. A name the registry does not hold (a
+ * directory stored by another build) gets an open circle. */
+static int backend_mark(const char *name)
+{
+	static const int mark[] = {7, 9, 5, 11, 13, 15};
+	const bsim_backend *const *all = bsim_backend_list();
+	for (int i = 0; all[i]; i++)
+		if (strcmp(all[i]->name, name) == 0)
+			return mark[i % 6];
+	return 6;
+}
 
 typedef struct acc_point {
 	double speed, err, h;
@@ -142,12 +157,12 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 		      g.f);
 		for (int s = 0; s < drawn_series; s++) {
 			int r = first_row[s];
-			int thesis = strcmp(csv_table_cell(&t, r, col[0]), "thesis") == 0;
 			fprintf(g.f,
 			        "'accuracy.dat' index %d using 1:2 with linespoints lw 1.5 dt %d "
 			        "pt %d "
 			        "ps 0.9 lc rgb '%s' title ",
-			        s, s / 8 % 2 ? 2 : 1, thesis ? 7 : 9, palette[s % 8]);
+			        s, s / 8 % 2 ? 2 : 1, backend_mark(csv_table_cell(&t, r, col[0])),
+			        palette[s % 8]);
 			char label[200];
 			snprintf(label, sizeof label, "%s %s", csv_table_cell(&t, r, col[0]),
 			         csv_table_cell(&t, r, col[1]));

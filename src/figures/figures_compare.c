@@ -1,15 +1,18 @@
-/* Figures of a comparison (figures.h): both backends' p_traverse per group
+/* Figures of a comparison (figures.h): every side's p_traverse per group
  * side by side with their Wilson intervals, and the paired differences
  * p_A - p_B with the report's paired intervals (Tango's score interval) for
  * traversal, the left and right types, side exits, getting stuck and
  * instability, against the rule's margin; a difference beyond the rule is
  * marked; the title counts the verdicts, uninformative groups (every event
- * at the floor or the ceiling) apart from equivalent ones. The numbers are
- * report.json's. Each side's own sweep figures go to OUT/<label>/. */
+ * at the floor or the ceiling) apart from equivalent ones. With more than
+ * two sides the difference panels hold every pair of sides, and the sides
+ * and pairs take their colours from a palette by their index. The numbers
+ * are report.json's. Each side's own sweep figures go to OUT/<label>/. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/compare_dir.h"
 #include "beamsim/key_names.h"
 #include "beamsim/output.h"
 #include "figures/figures_kinds.h"
@@ -66,6 +69,12 @@ static const char *const events[] = {"traversed", "left",  "right",
                                      "side_exit", "stuck", "unstable"};
 enum { N_EV = 6 };
 
+/* The colours of sides (and of pairs of sides) by index: the first two are
+ * those of two sides, red is kept for "beyond the rule". */
+static const char *const palette[] = {FIG_BLUE, FIG_ORANGE, FIG_GREEN,  FIG_PURPLE,
+                                      FIG_SKY,  FIG_BLACK,  FIG_DKGREY, FIG_YELLOW};
+enum { N_PALETTE = 8 };
+
 /* The data: one row per selected group. Columns: 1 position, 2 group,
  * 3-8 p and Wilson interval of traversal on A then B, then per event
  * (traversed, left, right, side_exit, stuck, unstable) 4 columns from
@@ -117,7 +126,105 @@ static void fast_label(const fsum *s, int g, char *buf, size_t size)
 		snprintf(buf, size, "group %d", g);
 }
 
-static int compare_data(figs *f, const ydoc *d, const fsum *s, cmp_layout *lay, bsim_error *err)
+/* Group g's row of two sides after its position and number: traversal on
+ * A and B, then each event's difference, interval and beyond. *bad on a
+ * missing field. */
+static void two_row(FILE *o, struct fy_node *root, int g, cmp_layout *lay, int *bad)
+{
+	char p[200], verdict[32];
+	snprintf(p, sizeof p, "groups.%d.verdict", g);
+	text(root, p, verdict, sizeof verdict);
+	double v[6];
+	static const char *const fields[] = {"p_a", "ci95_a.0", "ci95_a.1",
+	                                     "p_b", "ci95_b.0", "ci95_b.1"};
+	for (int i = 0; i < 6; i++) {
+		snprintf(p, sizeof p, "groups.%d.events.traversed.%s", g, fields[i]);
+		v[i] = num_or(root, p, i < 3 ? "p_a" : "p_b", g, "traversed", bad);
+	}
+	for (int i = 0; i < 6; i++)
+		fprintf(o, " %.6g", v[i]);
+	for (int e = 0; e < N_EV; e++) {
+		static const char *const df[] = {"difference", "difference_ci95.0",
+		                                 "difference_ci95.1"};
+		for (int i = 0; i < 3; i++) {
+			snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e], df[i]);
+			double dv = num_or(root, p, "difference", g, events[e], bad);
+			fprintf(o, " %.6g", dv);
+		}
+		char b[16];
+		snprintf(p, sizeof p, "groups.%d.events.%s.beyond", g, events[e]);
+		text(root, p, b, sizeof b);
+		snprintf(p, sizeof p, "groups.%d.events.%s.difference", g, events[e]);
+		int beyond = strcmp(b, "true") == 0 ||
+		             (strcmp(verdict, "DIFFERENT") == 0 && num(root, p, bad) != 0);
+		fprintf(o, " %d", beyond);
+		lay->any[e] |= beyond;
+		/* an event that happened on either side gets its panel */
+		for (int side = 0; side < 2; side++) {
+			int absent = 0;
+			snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e],
+			         side ? "p_b" : "p_a");
+			double pv = num(root, p, &absent);
+			lay->any[e] |= absent || pv != 0;
+		}
+		lay->beyond[e] |= beyond;
+	}
+}
+
+/* Group g's row of more than two sides (report.json's groups.G.sides and
+ * .pairwise): each side's p_traverse and interval, then each pair's
+ * difference, interval and beyond for each event. */
+static void sides_row(FILE *o, struct fy_node *root, int g, int n_sides, cmp_layout *lay, int *bad)
+{
+	char p[200];
+	for (int side = 0; side < n_sides; side++) {
+		static const char *const fields[] = {"p_traverse", "ci95.0", "ci95.1"};
+		for (int i = 0; i < 3; i++) {
+			snprintf(p, sizeof p, "groups.%d.sides.%d.%s", g, side, fields[i]);
+			fprintf(o, " %.6g", num(root, p, bad));
+		}
+	}
+	for (int k = 0; k < n_sides * (n_sides - 1) / 2; k++) {
+		char q[160], verdict[32];
+		snprintf(q, sizeof q, "groups.%d.pairwise.%d", g, k);
+		snprintf(p, sizeof p, "%s.verdict", q);
+		text(root, p, verdict, sizeof verdict);
+		for (int e = 0; e < N_EV; e++) {
+			static const char *const df[] = {"difference", "difference_ci95.0",
+			                                 "difference_ci95.1"};
+			double dv[3];
+			for (int i = 0; i < 3; i++) {
+				int absent = 0;
+				snprintf(p, sizeof p, "%s.events.%s.%s", q, events[e], df[i]);
+				dv[i] = num(root, p, &absent);
+				/* a deterministic pair has no interval: its point */
+				if (absent && i > 0)
+					dv[i] = dv[0];
+				else if (absent)
+					*bad = 1;
+				fprintf(o, " %.6g", dv[i]);
+			}
+			char b[16];
+			snprintf(p, sizeof p, "%s.events.%s.beyond", q, events[e]);
+			text(root, p, b, sizeof b);
+			int beyond = strcmp(b, "true") == 0 ||
+			             (strcmp(verdict, "DIFFERENT") == 0 && dv[0] != 0);
+			fprintf(o, " %d", beyond);
+			lay->beyond[e] |= beyond;
+			lay->any[e] |= beyond;
+			for (int side = 0; side < 2; side++) {
+				int absent = 0;
+				snprintf(p, sizeof p, "%s.events.%s.%s", q, events[e],
+				         side ? "p_b" : "p_a");
+				double pv = num(root, p, &absent);
+				lay->any[e] |= absent || pv != 0;
+			}
+		}
+	}
+}
+
+static int compare_data(figs *f, const ydoc *d, const fsum *s, int n_sides, cmp_layout *lay,
+                        bsim_error *err)
 {
 	struct fy_node *root = fy_document_root(d->fyd);
 	char path[BSIM_PATH_MAX];
@@ -125,10 +232,18 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, cmp_layout *lay, 
 	int rc = figs_data_open(f, "compare.dat", &o, path, err);
 	if (rc)
 		return rc;
-	fputs("# position group p_a lo hi p_b lo hi (traversed, Wilson 95%), then for traversed, "
-	      "left, right, side_exit, stuck, unstable: p_a - p_b lo hi (the report's paired 95% "
-	      "interval) beyond (1: beyond the rule), label\n",
-	      o.f);
+	if (n_sides == 2)
+		fputs("# position group p_a lo hi p_b lo hi (traversed, Wilson 95%), then for "
+		      "traversed, left, right, side_exit, stuck, unstable: p_a - p_b lo hi (the "
+		      "report's paired 95% interval) beyond (1: beyond the rule), label\n",
+		      o.f);
+	else
+		fprintf(o.f,
+		        "# position group, then for each of the %d sides p_traverse lo hi (Wilson "
+		        "95%%), then for each pair of sides (report.json pairwise) and each of "
+		        "traversed, left, right, side_exit, stuck, unstable: p_a - p_b lo hi (the "
+		        "report's paired 95%% interval) beyond (1: beyond the rule), label\n",
+		        n_sides);
 	int k = 0, prev_block = -1, block_start = 0;
 	double x = -1.0;
 	/* blocks of the first axis when there are two or more, a gap between */
@@ -153,54 +268,22 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, cmp_layout *lay, 
 			block_start = (int)(x + 1.0);
 		prev_block = block;
 		x += 1.0;
-		char p[200], verdict[32];
 		int bad = 0;
-		snprintf(p, sizeof p, "groups.%d.verdict", g);
-		text(root, p, verdict, sizeof verdict);
-		double v[6];
-		static const char *const fields[] = {"p_a", "ci95_a.0", "ci95_a.1",
-		                                     "p_b", "ci95_b.0", "ci95_b.1"};
-		for (int i = 0; i < 6; i++) {
-			snprintf(p, sizeof p, "groups.%d.events.traversed.%s", g, fields[i]);
-			v[i] = num_or(root, p, i < 3 ? "p_a" : "p_b", g, "traversed", &bad);
-		}
 		fprintf(o.f, "%g %d", x, g);
 		k++;
-		for (int i = 0; i < 6; i++)
-			fprintf(o.f, " %.6g", v[i]);
-		for (int e = 0; e < N_EV; e++) {
-			static const char *const df[] = {"difference", "difference_ci95.0",
-			                                 "difference_ci95.1"};
-			for (int i = 0; i < 3; i++) {
-				snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e],
-				         df[i]);
-				double dv = num_or(root, p, "difference", g, events[e], &bad);
-				fprintf(o.f, " %.6g", dv);
-			}
-			char b[16];
-			snprintf(p, sizeof p, "groups.%d.events.%s.beyond", g, events[e]);
-			text(root, p, b, sizeof b);
-			snprintf(p, sizeof p, "groups.%d.events.%s.difference", g, events[e]);
-			int beyond = strcmp(b, "true") == 0 ||
-			             (strcmp(verdict, "DIFFERENT") == 0 && num(root, p, &bad) != 0);
-			fprintf(o.f, " %d", beyond);
-			lay->any[e] |= beyond;
-			/* an event that happened on either side gets its panel */
-			for (int side = 0; side < 2; side++) {
-				int absent = 0;
-				snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e],
-				         side ? "p_b" : "p_a");
-				double pv = num(root, p, &absent);
-				lay->any[e] |= absent || pv != 0;
-			}
-			lay->beyond[e] |= beyond;
-		}
+		if (n_sides == 2)
+			two_row(o.f, root, g, lay, &bad);
+		else
+			sides_row(o.f, root, g, n_sides, lay, &bad);
 		if (bad) {
 			bsim_atomic_file_abort(&o);
 			return bsim_error_set(
 			        err, BSIM_EINPUT,
-			        "%s: groups.%d.events: expected p_a, p_b and difference "
-			        "of traversed, left, right, side_exit, stuck and unstable",
+			        n_sides == 2
+			                ? "%s: groups.%d.events: expected p_a, p_b and difference "
+			                  "of traversed, left, right, side_exit, stuck and unstable"
+			                : "%s: groups.%d: expected sides with p_traverse and ci95, "
+			                  "and pairwise with the events' differences",
 			        d->path, g);
 		}
 		char label[256];
@@ -268,7 +351,36 @@ static void verdict_counts(struct fy_node *root, char *buf, size_t size)
 	}
 }
 
-static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, bsim_error *err)
+/* One event's differences of every pair of n sides (columns from sides_row),
+ * each pair offset along x and in its palette colour; those beyond the
+ * rule in red. */
+static void diff_series_sides(FILE *o, int e, int n, char (*label)[128], int pt, int beyond)
+{
+	const int n_pairs = n * (n - 1) / 2;
+	for (int k = 0, i = 0; i < n; i++)
+		for (int j = i + 1; j < n; j++, k++) {
+			int c = 3 + 3 * n + 4 * (k * N_EV + e);
+			double dx = 0.5 * ((k + 0.5) / n_pairs - 0.5);
+			char title[300];
+			snprintf(title, sizeof title, "%s - %s", label[i], label[j]);
+			fprintf(o,
+			        ", \\\n     'compare.dat' using ($1 + %.4f):($%d > 0 ? NaN : "
+			        "$%d):%d:%d "
+			        "with yerrorbars pt %d ps 0.6 lc rgb '%s' title ",
+			        dx, c + 3, c, c + 1, c + 2, pt, palette[k % N_PALETTE]);
+			gp_str(o, title);
+			fprintf(o,
+			        " noenhanced, \\\n     '' using ($1 + %.4f):($%d > 0 ? $%d : "
+			        "NaN):%d:%d "
+			        "with yerrorbars pt %d ps 0.9 lc rgb '" FIG_RED "' %s",
+			        dx, c + 3, c, c + 1, c + 2, pt,
+			        beyond && k == 0 ? "title 'beyond the rule'" : "notitle");
+		}
+	fputc('\n', o);
+}
+
+static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, int n_sides,
+                          char (*label)[128], bsim_error *err)
 {
 	cmp_layout lay;
 	memset(&lay, 0, sizeof lay);
@@ -278,7 +390,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	if (!rc)
 		rc = gp_text_open(&lay.blocks, err);
 	if (!rc)
-		rc = compare_data(f, d, s, &lay, err);
+		rc = compare_data(f, d, s, n_sides, &lay, err);
 	char *tics = gp_text_take(&lay.tics), *blank = gp_text_take(&lay.blank),
 	     *blocks = gp_text_take(&lay.blocks);
 	if (!rc && (!tics || !blank || !blocks))
@@ -290,10 +402,15 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 		return rc;
 	}
 	struct fy_node *root = fy_document_root(d->fyd);
-	char la[64], lb[64], who[200];
+	char la[64], lb[64], who[600];
 	text(root, "a.label", la, sizeof la);
 	text(root, "b.label", lb, sizeof lb);
 	snprintf(who, sizeof who, "A: %s backend, B: %s backend", la, lb);
+	for (int i = 0, len = 0; n_sides > 2 && i < n_sides && len < (int)sizeof who; i++) {
+		int w = snprintf(who + len, sizeof who - (size_t)len, "%s%s", i ? ", " : "sides ",
+		                 label[i]);
+		len += w > 0 ? w : 0;
+	}
 	fsum_header(s, inputs, who);
 	int bad = 0;
 	double margin = num(root, "rule.margin", &bad);
@@ -341,7 +458,8 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	         "intervals, paired differences p_A - p_B with the report's paired 95%% "
 	         "intervals; red: beyond the rule",
 	         s->header, s->trials_per_group, verdicts + (verdicts[0] == '\n'),
-	         NL ? (verdicts[0] ? "; " : "") : "", NL ? "on neither side: " : "", none);
+	         NL ? (verdicts[0] ? "; " : "") : "",
+	         NL ? (n_sides > 2 ? "on no side: " : "on neither side: ") : "", none);
 	/* the panels placed by hand, all the same height: the last one also
 	 * holds the tick labels and the x label below it */
 	int title_lines = 1;
@@ -350,14 +468,21 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	const int ph = 210, top = 18 * title_lines + 20, bottom = 7 * lay.longest + 50;
 	const int blocks_px = block_axis(s) >= 0 ? 24 : 0; /* (a)'s block names */
 	const int h = top + rows * ph + bottom + blocks_px;
+	/* the key's room: 26 characters, or the longest pair's "A - B" */
+	int key = 26;
+	for (int i = 0; n_sides > 2 && i < n_sides; i++)
+		for (int j = i + 1; j < n_sides; j++) {
+			int len = 3 * (int)(strlen(label[i]) + strlen(label[j]) + 3) / 4 + 6;
+			key = len > key ? len : key;
+		}
 	fputs("set multiplot title ", o);
 	gp_str(o, title);
 	fprintf(o,
 	        " noenhanced\nset xrange [-0.7:%g]\nset grid ytics\nset key outside right top "
-	        "font ',9'\nset lmargin 10\nset rmargin 26\nmargin = %.17g\n"
+	        "font ',9'\nset lmargin 10\nset rmargin %d\nmargin = %.17g\n"
 	        "set style fill transparent solid 0.15 noborder\nset tics nomirror\n"
 	        "unset xlabel\n",
-	        lay.x_max + 0.7, margin);
+	        lay.x_max + 0.7, key, margin);
 	/* (a): the blocks of the first axis named above */
 	if (block_axis(s) >= 0)
 		fprintf(o, "set x2range [-0.7:%g]\n%sset x2tics scale 0 font ',10'\n",
@@ -368,17 +493,34 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	fputs("set title '(a) p_{traverse}'\nset yrange [0:1]\n"
 	      "set ylabel 'p_{traverse}'\n",
 	      o);
-	fputs("plot 'compare.dat' using ($1 - 0.12):3:4:5 with yerrorbars pt 7 ps 0.6 lc rgb "
-	      "'" FIG_BLUE "' title ",
-	      o);
-	gp_str(o, la);
-	fputs(" noenhanced, \\\n     '' using ($1 + 0.12):6:7:8 with yerrorbars pt 9 ps 0.7 "
-	      "lc rgb '" FIG_ORANGE "' title ",
-	      o);
-	gp_str(o, lb);
-	fputs(" noenhanced\nunset x2tics\nset yrange [*:*]\n"
-	      "set ylabel 'p_A - p_B'\n",
-	      o);
+	if (n_sides == 2) {
+		fputs("plot 'compare.dat' using ($1 - 0.12):3:4:5 with yerrorbars pt 7 ps 0.6 lc "
+		      "rgb "
+		      "'" FIG_BLUE "' title ",
+		      o);
+		gp_str(o, la);
+		fputs(" noenhanced, \\\n     '' using ($1 + 0.12):6:7:8 with yerrorbars pt 9 ps "
+		      "0.7 "
+		      "lc rgb '" FIG_ORANGE "' title ",
+		      o);
+		gp_str(o, lb);
+		fputs(" noenhanced\n", o);
+	} else {
+		/* every side, offset along x, in its palette colour */
+		for (int i = 0; i < n_sides; i++) {
+			fprintf(o,
+			        "%s'compare.dat' using ($1 + %.4f):%d:%d:%d with yerrorbars pt %d "
+			        "ps "
+			        "0.6 lc rgb '%s' title ",
+			        i ? ", \\\n     " : "plot ", 0.5 * ((i + 0.5) / n_sides - 0.5),
+			        3 + 3 * i, 4 + 3 * i, 5 + 3 * i, i % 2 ? 9 : 7,
+			        palette[i % N_PALETTE]);
+			gp_str(o, label[i]);
+			fputs(" noenhanced", o);
+		}
+		fputc('\n', o);
+	}
+	fputs("unset x2tics\nset yrange [*:*]\nset ylabel 'p_A - p_B'\n", o);
 	char panel = 'b';
 	int drawn = 1;
 	for (int e = 0; e < N_EV; e++) {
@@ -398,6 +540,14 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 		}
 		fprintf(o, "set title '(%c) %s%s: p_A - p_B'\n", panel++,
 		        e == 1 || e == 2 ? "traversed, " : "", names[e]);
+		if (n_sides > 2) {
+			fputs("plot '+' using 1:(-margin):(margin) with filledcurves lc rgb "
+			      "'#808080' "
+			      "title '+- margin'",
+			      o);
+			diff_series_sides(o, e, n_sides, label, points[e], lay.beyond[e]);
+			continue;
+		}
 		fputs("plot '+' using 1:(-margin):(margin) with filledcurves lc rgb '#808080' "
 		      "title '+- margin', \\\n",
 		      o);
@@ -408,7 +558,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, b
 	free(blank);
 	free(blocks);
 	char *body = gp_text_take(&g);
-	int w = 360 + 24 * (int)(lay.x_max + 1);
+	int w = 360 + 24 * (int)(lay.x_max + 1) + 8 * (key - 26);
 	if (w < text_px(title))
 		w = text_px(title);
 	rc = body ? figs_render(f, "compare",
@@ -447,28 +597,60 @@ static void lattice_test_line(struct fy_node *root, int g, char *buf, size_t siz
 	         strcmp(beyond, "true") == 0 ? ": beyond the rule" : "");
 }
 
-/* A lattice comparison's final-location figures, one per selected group. */
-static int lattice_figures(figs *f, const ydoc *d, const fsum *s, const char *dir,
-                           char backend[2][128], bsim_error *err)
+/* The final-location test lines of group g of more than two sides, each
+ * pair's (report.json groups.G.pairwise.K.final_locations), one a line. */
+static void lattice_test_lines(struct fy_node *root, int g, int n_sides, char (*label)[128],
+                               char *buf, size_t size)
+{
+	size_t len = 0;
+	buf[0] = '\0';
+	for (int k = 0, i = 0; i < n_sides; i++)
+		for (int j = i + 1; j < n_sides && len < size; j++, k++) {
+			char p[200], v[4][32];
+			static const char *const fields[] = {"p", "p_holm", "total_variation",
+			                                     "beyond"};
+			for (int x = 0; x < 4; x++) {
+				snprintf(p, sizeof p, "groups.%d.pairwise.%d.final_locations.%s", g,
+				         k, fields[x]);
+				text(root, p, v[x], sizeof v[x]);
+			}
+			int w = snprintf(buf + len, size - len,
+			                 "%s%s vs %s: total variation %s, p = %s (Holm %s)%s",
+			                 len ? "\n" : "", label[i], label[j], v[2], v[0], v[1],
+			                 strcmp(v[3], "true") == 0 ? ": beyond the rule" : "");
+			len += w > 0 ? (size_t)w : 0;
+		}
+}
+
+/* A lattice comparison's final-location figures, one per selected group:
+ * every side's distribution on the same scales. */
+static int lattice_figures(figs *f, const ydoc *d, const fsum *s, const char *dir, int n_sides,
+                           char (*backend)[128], char (*labels)[128], bsim_error *err)
 {
 	struct fy_node *root = fy_document_root(d->fyd);
-	char(*lines)[400] = calloc((size_t)s->n_groups + 1, sizeof *lines);
+	const size_t line = n_sides > 2 ? 160 * (size_t)(n_sides * (n_sides - 1) / 2) : 400;
+	char *lines = calloc(((size_t)s->n_groups + 1) * line, 1);
 	const char **tests = calloc((size_t)s->n_groups + 1, sizeof *tests);
-	char dirs[2][BSIM_PATH_MAX], labels[2][128];
+	char dirs[BSIM_COMPARE_SIDES_MAX][BSIM_PATH_MAX];
+	const char *dv[BSIM_COMPARE_SIDES_MAX], *lv[BSIM_COMPARE_SIDES_MAX];
 	int rc = BSIM_OK;
 	if (!lines || !tests)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (int g = 0; !rc && g < s->n_groups; g++) {
-		lattice_test_line(root, g, lines[g], sizeof lines[g]);
-		tests[g] = lines[g];
+		char *l = lines + (size_t)g * line;
+		if (n_sides > 2)
+			lattice_test_lines(root, g, n_sides, labels, l, line);
+		else
+			lattice_test_line(root, g, l, line);
+		tests[g] = l;
 	}
-	text(root, "a.label", labels[0], sizeof labels[0]);
-	text(root, "b.label", labels[1], sizeof labels[1]);
-	for (int i = 0; i < 2; i++)
+	for (int i = 0; i < n_sides; i++) {
 		snprintf(dirs[i], sizeof dirs[i], "%s/%s", dir, backend[i]);
-	const char *const dv[2] = {dirs[0], dirs[1]}, *const lv[2] = {labels[0], labels[1]};
+		dv[i] = dirs[i];
+		lv[i] = labels[i];
+	}
 	if (!rc)
-		rc = figs_lattice_compare(f, dv, lv, s, tests, err);
+		rc = figs_lattice_compare(f, n_sides, dv, lv, s, tests, err);
 	free(lines);
 	free(tests);
 	return rc;
@@ -483,21 +665,36 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 	if (rc)
 		return rc;
 	struct fy_node *root = fy_document_root(d.fyd);
-	/* Each side's sweep is in DIR/<label>, ':' and '/' of the label
-	 * written '-' (beamsim compare's directories). */
-	char backend[2][128];
-	text(root, "a.label", backend[0], sizeof backend[0]);
-	text(root, "b.label", backend[1], sizeof backend[1]);
-	if (!*backend[0] || !*backend[1]) {
+	/* The sides: report.json's sides (more than two), else a and b. Each
+	 * side's sweep is in DIR/<label>, ':' and '/' of the label written '-'
+	 * (beamsim compare's directories). */
+	char label[BSIM_COMPARE_SIDES_MAX][128], backend[BSIM_COMPARE_SIDES_MAX][128];
+	struct fy_node *sides = ydoc_lookup(root, "sides");
+	int n_sides = sides && fy_node_is_sequence(sides) ? fy_node_sequence_item_count(sides) : 2;
+	if (n_sides < 2 || n_sides > BSIM_COMPARE_SIDES_MAX) {
 		ydoc_free(&d);
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s: a.label, b.label: expected the two sides' labels", path);
+		return bsim_error_set(err, BSIM_EINPUT, "%s: sides: expected 2 to %d sides", path,
+		                      BSIM_COMPARE_SIDES_MAX);
 	}
-	for (int i = 0; i < 2; i++)
-		for (char *c = backend[i]; *c; c++)
-			if (*c == ':' || *c == '/')
-				*c = '-';
-	/* Groups, labels and the selection from the first backend's summary. */
+	for (int i = 0; i < n_sides; i++) {
+		char p[64];
+		if (n_sides > 2)
+			snprintf(p, sizeof p, "sides.%d.label", i);
+		else
+			snprintf(p, sizeof p, "%s.label", i ? "b" : "a");
+		text(root, p, label[i], sizeof label[i]);
+		if (!*label[i]) {
+			ydoc_free(&d);
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      n_sides > 2
+			                              ? "%s: %s: expected the side's label"
+			                              : "%s: a.label, b.label: expected the two "
+			                                "sides' labels",
+			                      path, p);
+		}
+		bsim_compare_dir_label(label[i], backend[i], sizeof backend[i]);
+	}
+	/* Groups, labels and the selection from the first side's summary. */
 	snprintf(sub, sizeof sub, "%s/%s/summary.json", dir, backend[0]);
 	fsum s;
 	rc = fsum_read(sub, &s, err);
@@ -508,14 +705,14 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 	rc = fsum_select(f, &s, err);
 	snprintf(inputs, sizeof inputs, "%s/inputs", dir);
 	if (!rc)
-		rc = compare_figure(f, &d, &s, inputs, err);
+		rc = compare_figure(f, &d, &s, inputs, n_sides, label, err);
 	snprintf(sub, sizeof sub, "%s/%s", dir, backend[0]);
 	if (!rc && figs_is_lattice(sub))
-		rc = lattice_figures(f, &d, &s, dir, backend, err);
+		rc = lattice_figures(f, &d, &s, dir, n_sides, backend, label, err);
 	fsum_free(&s);
 	ydoc_free(&d);
 	snprintf(inputs, sizeof inputs, "%s/inputs", dir);
-	for (int i = 0; !rc && i < 2; i++) {
+	for (int i = 0; !rc && i < n_sides; i++) {
 		snprintf(sub, sizeof sub, "%s/%s", dir, backend[i]);
 		snprintf(out, sizeof out, "%s/%s", f->out, backend[i]);
 		figs one = *f;

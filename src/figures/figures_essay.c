@@ -15,7 +15,7 @@ static const char *const palette[] = {FIG_BLUE, FIG_RED, FIG_GREEN, FIG_ORANGE, 
 
 #define ESSAY_MODES_MAX 5
 
-/* The backend essay.md names ("Backend thesis, seed 1, ..."), "" if none. */
+/* The backend essay.md names ("Backend NAME, seed 1, ..."), "" if none. */
 static void essay_backend(const char *dir, char *buf, size_t size)
 {
 	char path[BSIM_PATH_MAX];

@@ -36,6 +36,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "beamsim/compare.h"
 #include "beamsim/experiment.h"
 #include "beamsim/lattice.h"
 #include "beamsim/stats.h"
@@ -741,7 +742,7 @@ static int locations_figure(figs *f, const char *name, const char *title, const 
 	if ((rc = gp_text_open(&g, err)))
 		return rc;
 	/* the note on intervals: a location never reached is drawn without one */
-	char full[2200];
+	char full[8400]; /* the title of many sides: a line per pair */
 	double zero[3];
 	fraction(runs[0], 0, zero);
 	snprintf(full, sizeof full,
@@ -953,40 +954,48 @@ int figs_is_lattice(const char *dir)
 
 /* ---- a comparison of two lattice runs -------------------------------------------------- */
 
-int figs_lattice_compare(figs *f, const char *const dirs[2], const char *const labels[2],
+int figs_lattice_compare(figs *f, int n, const char *const *dirs, const char *const *labels,
                          const fsum *s, const char *const *tests, bsim_error *err)
 {
-	flats l[2];
-	int rc = flats_read(dirs[0], s, &l[0], err);
-	if (rc)
-		return rc;
-	if ((rc = flats_read(dirs[1], s, &l[1], err))) {
-		flats_free(&l[0]);
-		return rc;
-	}
+	flats l[BSIM_COMPARE_SIDES_MAX];
+	int rc = BSIM_OK, read = 0;
+	for (; !rc && read < n; read++)
+		if ((rc = flats_read(dirs[read], s, &l[read], err)))
+			break;
 	for (int g = 0; !rc && g < s->n_groups; g++) {
 		if (!s->g[g].selected)
 			continue;
-		const flat *runs[2] = {&l[0].g[g], &l[1].g[g]};
-		if (runs[0]->cols != runs[1]->cols || runs[0]->rows != runs[1]->rows ||
-		    runs[0]->ix_min != runs[1]->ix_min) {
-			rc = bsim_error_set(
-			        err, BSIM_EINPUT,
-			        "%s and %s: group %d: the two sides' lattice_map.csv are "
-			        "not the same lattice",
-			        dirs[0], dirs[1], g);
-			break;
+		const flat *runs[BSIM_COMPARE_SIDES_MAX];
+		for (int i = 0; !rc && i < n; i++) {
+			runs[i] = &l[i].g[g];
+			if (runs[i]->cols != runs[0]->cols || runs[i]->rows != runs[0]->rows ||
+			    runs[i]->ix_min != runs[0]->ix_min)
+				rc = bsim_error_set(err, BSIM_EINPUT,
+				                    "%s and %s: group %d: the two sides' "
+				                    "lattice_map.csv are not the same lattice",
+				                    dirs[0], dirs[i], g);
 		}
-		char label[1300], title[1900], name[64];
+		if (rc)
+			break;
+		char label[1300], title[8192], who[600] = "", name[64];
 		group_label(s, g, label, sizeof label);
+		if (n == 2)
+			snprintf(who, sizeof who, "%s against %s", labels[0], labels[1]);
+		for (int i = 0, len = 0; n > 2 && i < n && len < (int)sizeof who; i++) {
+			int w = snprintf(who + len, sizeof who - (size_t)len, "%s%s",
+			                 i == 0      ? ""
+			                 : i + 1 < n ? ", "
+			                             : " and ",
+			                 labels[i]);
+			len += w > 0 ? w : 0;
+		}
 		snprintf(title, sizeof title,
-		         "where the trials of group %d ended, %s against %s on the same schedules\n"
-		         "%s\n%s",
-		         g, labels[0], labels[1], label, tests[g]);
+		         "where the trials of group %d ended, %s on the same schedules\n%s\n%s", g,
+		         who, label, tests[g]);
 		snprintf(name, sizeof name, "final_locations_g%03d", g);
-		rc = locations_figure(f, name, title, runs, labels, 2, err);
+		rc = locations_figure(f, name, title, runs, labels, n, err);
 	}
-	flats_free(&l[0]);
-	flats_free(&l[1]);
+	for (int i = 0; i < read; i++)
+		flats_free(&l[i]);
 	return rc;
 }

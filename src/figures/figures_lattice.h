@@ -21,10 +21,11 @@ int figs_lattice_load(figs *f, const char *dir, const char *inputs, const fsum *
 int figs_lattice_draw(figs *f, lat_job *j, bsim_error *err);
 void figs_lattice_free(lat_job *j);
 
-/* final_locations_gNNN of a comparison: both sides' final locations side
- * by side on the same scales; dirs are the sides' sweep directories, s the
- * groups (with the selection), tests[g] a line on the group's test. */
-int figs_lattice_compare(figs *f, const char *const dirs[2], const char *const labels[2],
+/* final_locations_gNNN of a comparison: every side's final locations side
+ * by side on the same scales; dirs are the n sides' sweep directories, s
+ * the groups (with the selection), tests[g] a line (or lines) on the
+ * group's tests. */
+int figs_lattice_compare(figs *f, int n, const char *const *dirs, const char *const *labels,
                          const fsum *s, const char *const *tests, bsim_error *err);
 
 #endif

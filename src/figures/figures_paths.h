@@ -49,7 +49,7 @@ int figs_over_landscape(figs *f, const char *name, const char *title, const bsim
                         const fpath *p, int n, unsigned mask, bsim_error *err);
 
 /* The backend and the parameters of a figure's scene that differ from
- * its scene file's, for a title: "backend thesis, F_prop = 8 N, R_m = 30 N,
+ * its scene file's, for a title: "backend NAME, F_prop = 8 N, R_m = 30 N,
  * k_1 = 300 N m/rad" (beamsim/key_names.h), a line break after every third
  * item; backend may be NULL or "". */
 void fpath_params(char *buf, size_t size, const char *backend, const char *const *keys,

@@ -1,6 +1,6 @@
 /* A backend's check of a scene, said where the scene gave the field it
- * refuses (beamsim/backend.h); apart from the registry, which the backends
- * call back into no file of. */
+ * refuses (beamsim/backend.h); in the model, below the backends, which
+ * call it (the registry is above them). */
 #include "beamsim/backend.h"
 
 #include <stdio.h>

@@ -1,7 +1,7 @@
 /* The time step a scene can be resolved at (docs/model.md "The time
  * step"): bounds on integration.dt from the scene's own time scales, the
- * same for every backend. A longer step does not fail loudly: the thesis
- * backend books its energy exactly whatever dt, so a step of 12 s runs and
+ * same for every backend. A longer step does not fail loudly: the essay's
+ * solver books its energy exactly whatever dt, so a step of 12 s runs and
  * reports a side exit 1.5 km away. Each bound is where the model stops
  * being represented at all, generous for accuracy (docs/accuracy.md
  * measures that):

@@ -453,9 +453,13 @@ static void group_verdict(bsim_compare_group *g, const bsim_compare_rule *rule, 
 		g->verdict = equivalent ? BSIM_VERDICT_EQUIVALENT : BSIM_VERDICT_INCONCLUSIVE;
 }
 
-int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
-                         const double *t_separate, const bsim_compare_rule *rule,
-                         bsim_comparison *out, bsim_error *err)
+/* One pair's tables and tests, before Holm's correction: its family's
+ * p-values appended to p at *n_p (in group order, events in enum order,
+ * then the final-location test), its separation times' quantiles from
+ * buf (n_groups x trials doubles). */
+static int pair_tables(const bsim_sweep_result *a, const bsim_sweep_result *b,
+                       const double *t_separate, const bsim_compare_rule *rule,
+                       bsim_comparison *out, double *p, int *n_p, double *buf, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
 	if (a->n_groups != b->n_groups || a->trials != b->trials)
@@ -464,24 +468,14 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 		        "cannot pair %d groups x %d trials with %d groups x %d trials", a->n_groups,
 		        a->trials, b->n_groups, b->trials);
 	int G = a->n_groups, n = a->trials;
-	long total = (long)G * n;
 	int ledger = a->has_ledger && b->has_ledger;
 	out->n_groups = G;
 	out->trials = n;
 	out->rule = *rule;
 	out->lattice = a->lattice && b->lattice;
 	out->groups = calloc(G > 0 ? (size_t)G : 1, sizeof *out->groups);
-	double *p = calloc((size_t)(G > 0 ? G : 1) * (BSIM_N_EVENTS + 1), sizeof *p);
-	double *buf = malloc((size_t)(total > 0 ? total : 1) * sizeof *buf);
-	int *splits = malloc(((size_t)(n > 0 ? n : 0) + 1) * sizeof *splits);
-	if (!out->groups || !p || !buf || !splits) {
-		free(p);
-		free(buf);
-		free(splits);
-		bsim_compare_free(out);
+	if (!out->groups)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory comparing %d groups", G);
-	}
-	int n_sep = 0;
 	for (int g = 0; g < G; g++) {
 		const bsim_trial_result *ra = &a->trials_out[(size_t)g * n];
 		const bsim_trial_result *rb = &b->trials_out[(size_t)g * n];
@@ -502,12 +496,12 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 			t->in_family = (cg->family >> e & 1u) != 0;
 			t->p_holm = NAN;
 			if (t->in_family)
-				p[out->n_tests++] = t->p_value;
+				p[(*n_p)++] = t->p_value;
 		}
 		if (out->lattice && !cg->deterministic) {
 			bsim_compare_location_test(ra, rb, cg->pairs, 0x5eed0000u + (uint64_t)g,
 			                           &cg->loc);
-			p[out->n_tests++] = cg->loc.p_value;
+			p[(*n_p)++] = cg->loc.p_value;
 		}
 		for (int i = 0; i < cg->pairs; i++)
 			cg->discordant += bsim_compare_discordant(&ra[i], &rb[i]);
@@ -522,38 +516,169 @@ int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
 			quantiles(buf, cg->separated, cg->t_sep);
 		}
 	}
-	bsim_stats_holm(p, out->n_tests, p);
-	double level = out->n_tests > 0 ? rule->alpha / out->n_tests : rule->alpha;
-	bsim_stats_mcnemar_splits(n, level, splits);
-	for (int g = 0, k = 0; g < G; g++) {
-		bsim_compare_group *cg = &out->groups[g];
-		for (int e = 0; !cg->deterministic && e < BSIM_N_EVENTS; e++) {
-			bsim_event_test *t = &cg->ev[e];
-			if (t->in_family)
-				t->p_holm = p[k++];
-			double psi =
-			        cg->pairs > 0 ? (double)(t->pairs.b + t->pairs.c) / cg->pairs : 0.0;
-			t->mde80 = bsim_stats_mcnemar_mde(cg->pairs, splits, psi, 0.8);
-			t->min_significant = event_min_significant(t, cg->pairs, splits);
-		}
-		if (out->lattice && !cg->deterministic)
-			cg->loc.p_holm = p[k++];
-		group_verdict(cg, rule, out->lattice && !cg->deterministic);
-		out->count[cg->verdict]++;
-		out->n_disagree += cg->verdict == BSIM_VERDICT_DISAGREE ||
-		                   cg->verdict == BSIM_VERDICT_DIFFERENT;
-	}
 	out->t_sep[0] = out->t_sep[1] = out->t_sep[2] = -1.0;
 	if (t_separate) {
+		int n_sep = 0;
 		for (int g = 0; g < G; g++)
 			n_sep += separated_times(&t_separate[(size_t)g * n], out->groups[g].pairs,
 			                         buf + n_sep);
 		out->separated = n_sep;
 		quantiles(buf, n_sep, out->t_sep);
 	}
+	return BSIM_OK;
+}
+
+/* One pair's tests after Holm's correction over the whole family of
+ * n_tests tests: p_holm its adjusted p-values in pair_tables' order,
+ * splits the exact McNemar test's at the family's level; the verdicts. */
+static void pair_finish(bsim_comparison *out, const double *p_holm, int n_tests, const int *splits)
+{
+	const bsim_compare_rule *rule = &out->rule;
+	out->n_tests = n_tests;
+	for (int g = 0, k = 0; g < out->n_groups; g++) {
+		bsim_compare_group *cg = &out->groups[g];
+		for (int e = 0; !cg->deterministic && e < BSIM_N_EVENTS; e++) {
+			bsim_event_test *t = &cg->ev[e];
+			if (t->in_family)
+				t->p_holm = p_holm[k++];
+			double psi =
+			        cg->pairs > 0 ? (double)(t->pairs.b + t->pairs.c) / cg->pairs : 0.0;
+			t->mde80 = bsim_stats_mcnemar_mde(cg->pairs, splits, psi, 0.8);
+			t->min_significant = event_min_significant(t, cg->pairs, splits);
+		}
+		if (out->lattice && !cg->deterministic)
+			cg->loc.p_holm = p_holm[k++];
+		group_verdict(cg, rule, out->lattice && !cg->deterministic);
+		out->count[cg->verdict]++;
+		out->n_disagree += cg->verdict == BSIM_VERDICT_DISAGREE ||
+		                   cg->verdict == BSIM_VERDICT_DIFFERENT;
+	}
+}
+
+int bsim_compare_odd_one_out(int n_sides, const int *differ)
+{
+	int any = 0, odd = -1, n_odd = 0;
+	const int n_pairs = bsim_sweep_pairs(n_sides);
+	for (int k = 0; k < n_pairs; k++)
+		any |= differ[k] != 0;
+	if (!any)
+		return BSIM_ODD_NONE;
+	for (int s = 0; s < n_sides; s++) {
+		int ok = 1;
+		for (int k = 0; ok && k < n_pairs; k++) {
+			int side[2];
+			bsim_sweep_pair(n_sides, k, side);
+			int with_s = side[0] == s || side[1] == s;
+			/* every pair with s differs, no pair of the others does */
+			ok = with_s ? differ[k] != 0 : differ[k] == 0;
+		}
+		if (ok) {
+			odd = s;
+			n_odd++;
+		}
+	}
+	return n_odd == 1 ? odd : BSIM_ODD_NO_SINGLE;
+}
+
+static int disagrees(bsim_verdict v)
+{
+	return v == BSIM_VERDICT_DISAGREE || v == BSIM_VERDICT_DIFFERENT;
+}
+
+int bsim_compare_analyse_sides(const bsim_sweep_result *side, int n_sides, const double *t_separate,
+                               const bsim_compare_rule *rule, bsim_compare_sides *out,
+                               bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	if (n_sides < 2 || n_sides > BSIM_COMPARE_SIDES_MAX)
+		return bsim_error_set(err, BSIM_EINPUT, "%d sides: expected 2 to %d", n_sides,
+		                      BSIM_COMPARE_SIDES_MAX);
+	int G = side[0].n_groups, n = side[0].trials;
+	for (int s = 1; s < n_sides; s++)
+		if (side[s].n_groups != G || side[s].trials != n)
+			return bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "cannot pair %d groups x %d trials with %d groups x %d "
+			        "trials",
+			        G, n, side[s].n_groups, side[s].trials);
+	long total = (long)G * n;
+	out->n_sides = n_sides;
+	out->n_pairs = bsim_sweep_pairs(n_sides);
+	out->n_groups = G;
+	out->trials = n;
+	const size_t per_pair = (size_t)(G > 0 ? G : 1) * (BSIM_N_EVENTS + 1);
+	double *p = calloc((size_t)out->n_pairs * per_pair, sizeof *p);
+	double *buf = malloc((size_t)(total > 0 ? total : 1) * sizeof *buf);
+	int *splits = malloc(((size_t)(n > 0 ? n : 0) + 1) * sizeof *splits);
+	int *first = calloc((size_t)out->n_pairs + 1, sizeof *first);
+	out->verdict = calloc(G > 0 ? (size_t)G : 1, sizeof *out->verdict);
+	out->odd = calloc(G > 0 ? (size_t)G : 1, sizeof *out->odd);
+	int rc = !p || !buf || !splits || !first || !out->verdict || !out->odd
+	                 ? bsim_error_set(err, BSIM_EFAIL, "out of memory comparing %d groups", G)
+	                 : BSIM_OK;
+	/* Every pair's tests, then Holm over all of them: one family. */
+	for (int k = 0; rc == BSIM_OK && k < out->n_pairs; k++) {
+		bsim_sweep_pair(n_sides, k, out->pair[k]);
+		first[k] = out->n_tests;
+		rc = pair_tables(&side[out->pair[k][0]], &side[out->pair[k][1]],
+		                 t_separate ? t_separate + (size_t)k * (size_t)total : NULL, rule,
+		                 &out->pairs[k], p, &out->n_tests, buf, err);
+	}
+	if (rc == BSIM_OK) {
+		bsim_stats_holm(p, out->n_tests, p);
+		double level = out->n_tests > 0 ? rule->alpha / out->n_tests : rule->alpha;
+		bsim_stats_mcnemar_splits(n, level, splits);
+		for (int k = 0; k < out->n_pairs; k++)
+			pair_finish(&out->pairs[k], p + first[k], out->n_tests, splits);
+	}
+	/* Each group's verdict is its least agreeing pair's. */
+	for (int g = 0; rc == BSIM_OK && g < G; g++) {
+		int differ[BSIM_SWEEP_PAIRS_MAX];
+		bsim_verdict v = BSIM_VERDICT_SAME;
+		for (int k = 0; k < out->n_pairs; k++) {
+			bsim_verdict w = out->pairs[k].groups[g].verdict;
+			v = w > v ? w : v;
+			differ[k] = disagrees(w);
+		}
+		out->verdict[g] = v;
+		out->count[v]++;
+		out->n_disagree += disagrees(v);
+		out->odd[g] = bsim_compare_odd_one_out(n_sides, differ);
+	}
 	free(p);
 	free(buf);
 	free(splits);
+	free(first);
+	if (rc != BSIM_OK)
+		bsim_compare_sides_free(out);
+	return rc;
+}
+
+void bsim_compare_sides_free(bsim_compare_sides *c)
+{
+	if (!c)
+		return;
+	for (int k = 0; k < c->n_pairs; k++)
+		bsim_compare_free(&c->pairs[k]);
+	free(c->verdict);
+	free(c->odd);
+	memset(c, 0, sizeof *c);
+}
+
+int bsim_compare_analyse(const bsim_sweep_result *a, const bsim_sweep_result *b,
+                         const double *t_separate, const bsim_compare_rule *rule,
+                         bsim_comparison *out, bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	bsim_sweep_result side[2] = {*a, *b};
+	bsim_compare_sides s;
+	int rc = bsim_compare_analyse_sides(side, 2, t_separate, rule, &s, err);
+	if (rc != BSIM_OK)
+		return rc;
+	/* The one pair's comparison is the result: taken from s. */
+	*out = s.pairs[0];
+	memset(&s.pairs[0], 0, sizeof s.pairs[0]);
+	bsim_compare_sides_free(&s);
 	return BSIM_OK;
 }
 

@@ -5,8 +5,8 @@
  * a static split would leave threads idle). A trial's seed depends only on
  * (experiment seed, g, t) and its result goes to its own slot, so the
  * result is the same whatever the thread count (docs/files.md "Experiment
- * file (YAML)"). A paired sweep runs each trial on a second backend too, in
- * the same slot of a second result (trial_pair.c).
+ * file (YAML)"). A sweep of sides runs each trial on every side (a backend
+ * with options), in the same slot of each side's result (trial_sides.c).
  *
  * A group whose scene draws no random numbers (bsim_effects_random) is
  * deterministic: every trial of it is the same trial. It runs once, as
@@ -26,13 +26,14 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "beamsim/backend_registry.h"
 #include "util/clock.h"
 #include "util/journal.h"
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/stats.h"
 #include "run/sweep_record.h"
-#include "run/trial_pair.h"
+#include "run/trial_sides.h"
 
 /* The length compare's separation is 1% of: the disk's radius, or the
  * radius of the disk of the body's area for another shape. */
@@ -156,32 +157,32 @@ static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 	return BSIM_OK;
 }
 
-/* The scenes of every group for each side, each checked against the
+/* The scenes of every group for each of n sides, each checked against the
  * backend that runs it (bsim_experiment_group_check), so that a scene a
  * backend refuses (a body within Box2D's skin) is said where the scene
- * gave the field, before any trial runs: side b's scenes (scenes_b, NULL
- * when not paired) are side a's unless it has overrides of its own. On
- * failure nothing is left built. */
-static int scenes_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
-                      const bsim_backend *backend_b, const bsim_options *opts_b,
+ * gave the field, before any trial runs. scenes_b (NULL for a plain sweep)
+ * gets side 1's scenes when it has overrides of its own (cfg->extra_b),
+ * else NULL: it shares side 0's. On failure nothing is left built. */
+static int scenes_for(const bsim_experiment *e, const bsim_sweep_config *cfg, int n,
+                      const bsim_backend *const *backend, const bsim_options *const *opts,
                       bsim_scene **scenes, bsim_scene **scenes_b, bsim_error *err)
 {
-	const int own_b = backend_b && cfg->n_extra_b > 0;
+	const int own_b = n > 1 && cfg->n_extra_b > 0;
 	if (scenes_b)
 		*scenes_b = NULL;
 	int rc = scenes_build(e, cfg, 0, scenes, err);
 	if (rc == BSIM_OK && own_b)
 		rc = scenes_build(e, cfg, 1, scenes_b, err);
-	for (int side = 0; rc == BSIM_OK && side < (backend_b ? 2 : 1); side++) {
+	for (int side = 0; rc == BSIM_OK && side < n; side++) {
 		const int of_b = side == 1 && own_b;
 		int n_ov;
 		bsim_override *ov = side_overrides(cfg, of_b, &n_ov);
 		if (!ov)
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
-			rc = bsim_experiment_group_check(
-			        e, g, ov, n_ov, of_b ? &(*scenes_b)[g] : &(*scenes)[g],
-			        side ? backend_b : cfg->backend, side ? opts_b : cfg->opts, err);
+			rc = bsim_experiment_group_check(e, g, ov, n_ov,
+			                                 of_b ? &(*scenes_b)[g] : &(*scenes)[g],
+			                                 backend[side], opts[side], err);
 		free(ov);
 	}
 	if (rc != BSIM_OK) {
@@ -196,11 +197,10 @@ static int scenes_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	return rc;
 }
 
-/* A paired sweep's journal record. */
-typedef struct pair_record {
-	bsim_trial_result a, b;
-	double t_separate;
-} pair_record;
+/* A record of sides holds each result, then each pair's separation time:
+ * for two sides the bytes of {result a, result b, double} as a struct. */
+_Static_assert(sizeof(bsim_trial_result) % _Alignof(double) == 0,
+               "a record of sides packs results and doubles without padding");
 
 bsim_sweep_config bsim_sweep_config_default(void)
 {
@@ -212,11 +212,17 @@ bsim_sweep_config bsim_sweep_config_default(void)
 
 size_t bsim_sweep_record_size(int paired)
 {
-	return paired ? sizeof(pair_record) : sizeof(bsim_trial_result);
+	return paired ? bsim_sweep_record_size_sides(2) : sizeof(bsim_trial_result);
+}
+
+size_t bsim_sweep_record_size_sides(int n_sides)
+{
+	return (size_t)n_sides * sizeof(bsim_trial_result) +
+	       (size_t)bsim_sweep_pairs(n_sides) * sizeof(double);
 }
 
 /* The beams of a lattice sweep's records (run/sweep_record.h), 0 for
- * records of the result alone; a paired sweep's are the most of both
+ * records of the result alone; a sweep of sides' are the most of the
  * sides' scenes (scenes_b NULL: the sides share scenes). */
 static int record_beams(const bsim_scene *scenes, const bsim_scene *scenes_b, int n_groups,
                         const bsim_sweep_config *cfg)
@@ -229,14 +235,15 @@ static int record_beams(const bsim_scene *scenes, const bsim_scene *scenes_b, in
 	return beams > 0 ? beams : 1;
 }
 
-/* The size of a record of beams beams (0: the result alone). A paired
- * lattice sweep's record is side a's lattice record, then side b's, then
- * the separation time (a double), both sides packed by run/sweep_record.c. */
-static size_t record_bytes(int beams, int paired)
+/* The size of a record of beams beams (0: the result alone) of n sides (1:
+ * a plain sweep). A lattice sweep of sides' record is each side's lattice
+ * record in order, packed by run/sweep_record.c, then each pair's
+ * separation time (a double). */
+static size_t record_bytes(int beams, int n)
 {
 	if (!beams)
-		return bsim_sweep_record_size(paired);
-	return paired ? 2 * sweep_record_size(beams) + sizeof(double) : sweep_record_size(beams);
+		return n > 1 ? bsim_sweep_record_size_sides(n) : sizeof(bsim_trial_result);
+	return (size_t)n * sweep_record_size(beams) + (size_t)bsim_sweep_pairs(n) * sizeof(double);
 }
 
 /* What the threads share. first_fail is the index of the lowest failed
@@ -244,18 +251,17 @@ static size_t record_bytes(int beams, int paired)
 typedef struct sweep_shared {
 	const bsim_experiment *e;
 	const bsim_sweep_config *cfg;
-	const bsim_scene *scenes;
-	const bsim_scene *scenes_b; /* the second side's (may be scenes) */
-	const int *deterministic;   /* per group */
-	bsim_trial_result *results;
-	bsim_trial_log *logs;
-	const bsim_backend *backend_b; /* NULL: not paired */
-	const bsim_options *opts_b;
-	bsim_trial_result *results_b;
-	bsim_trial_log *logs_b;
-	bsim_trajectory *kept, *kept_b; /* NULL: none kept */
+	int n_sides; /* 1: a plain sweep (cfg->backend); 2 or more: a sweep of sides */
+	const bsim_scene *scenes[BSIM_SWEEP_SIDES_MAX]; /* each side's (may be side 0's) */
+	const bsim_backend *backend[BSIM_SWEEP_SIDES_MAX];
+	const bsim_options *opts[BSIM_SWEEP_SIDES_MAX];
+	const int *deterministic; /* per group */
+	bsim_trial_result *results[BSIM_SWEEP_SIDES_MAX];
+	bsim_trial_log *logs[BSIM_SWEEP_SIDES_MAX];
+	bsim_trajectory *kept[BSIM_SWEEP_SIDES_MAX]; /* NULL: none kept */
 	int keep, keep_stride;
-	double *t_separate;
+	/* Each pair's separation times by slot (a sweep of sides). */
+	double *t_separate[BSIM_SWEEP_PAIRS_MAX];
 	long total;
 	long first, end; /* the trials of this block; slot k holds trial first + k */
 	long done;
@@ -271,8 +277,8 @@ typedef struct sweep_shared {
 	const bsim_sweep_part *part; /* NULL: every trial is this process's */
 	long progress_total;         /* what progress counts up to */
 	/* > 0: a lattice sweep's records hold the gate path and the peaks of
-	 * this many beams (run/sweep_record.h; a paired sweep's, each side's:
-	 * record_bytes), record_size bytes */
+	 * this many beams (run/sweep_record.h; a sweep of sides', each side's:
+	 * record_bytes); record_size bytes, every record's */
 	int record_beams;
 	size_t record_size;
 } sweep_shared;
@@ -318,29 +324,26 @@ static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
 	}
 }
 
-/* Trial i's record (its result; both results and the separation time; a
- * lattice's result with its path and peaks) into buf, which holds
- * sh->record_size bytes when a lattice's; returns it. */
-static const void *record_of(sweep_shared *sh, long i, void *buf, pair_record *pair)
+/* Trial i's record into buf (sh->record_size bytes, when record_of needs
+ * it: a lattice's or a sweep of sides'); returns it. A plain sweep's is
+ * its result, or a lattice's result with its path and peaks; a sweep of
+ * sides' each side's, then each pair's separation time. */
+static const void *record_of(sweep_shared *sh, long i, void *buf)
 {
 	long k = i - sh->first;
-	if (sh->backend_b && sh->record_beams) {
-		size_t side = sweep_record_size(sh->record_beams);
-		unsigned char *p = buf;
-		sweep_record_pack(p, sh->record_beams, &sh->results[k], &sh->logs[k]);
-		sweep_record_pack(p + side, sh->record_beams, &sh->results_b[k], &sh->logs_b[k]);
-		memcpy(p + 2 * side, &sh->t_separate[k], sizeof sh->t_separate[k]);
-		return buf;
-	}
-	if (sh->backend_b) {
-		*pair = (pair_record){sh->results[k], sh->results_b[k], sh->t_separate[k]};
-		return pair;
-	}
-	if (sh->record_beams) {
-		sweep_record_pack(buf, sh->record_beams, &sh->results[k], &sh->logs[k]);
-		return buf;
-	}
-	return &sh->results[k];
+	if (sh->n_sides == 1 && !sh->record_beams)
+		return &sh->results[0][k];
+	unsigned char *p = buf;
+	size_t side =
+	        sh->record_beams ? sweep_record_size(sh->record_beams) : sizeof(bsim_trial_result);
+	for (int s = 0; s < sh->n_sides; s++, p += side)
+		if (sh->record_beams)
+			sweep_record_pack(p, sh->record_beams, &sh->results[s][k], &sh->logs[s][k]);
+		else
+			memcpy(p, &sh->results[s][k], side);
+	for (int q = 0; q < bsim_sweep_pairs(sh->n_sides); q++, p += sizeof(double))
+		memcpy(p, &sh->t_separate[q][k], sizeof(double));
+	return buf;
 }
 
 /* A journal record back into its slots (bsim_journal_fn). */
@@ -368,40 +371,29 @@ static int journal_take(void *user, uint64_t index, const void *payload)
 		return 0;
 	if (sh->journaled) {
 		/* Streamed: the record waits in the spill file for its block. */
-		size_t size = sh->record_beams ? sh->record_size : sizeof(bsim_trial_result);
+		size_t size = sh->record_size;
 		if (pwrite(sh->spill_fd, payload, size, (off_t)(index * size)) != (ssize_t)size)
 			return -1;
 		sh->done += !(sh->journaled[index / 8] & (1u << (index % 8)));
 		sh->journaled[index / 8] |= (unsigned char)(1u << (index % 8));
 		return 0;
 	}
-	if (sh->record_beams && sh->backend_b) {
-		/* either side's path too long for its record: the pair runs again */
-		size_t side = sweep_record_size(sh->record_beams);
-		const unsigned char *p = payload;
-		int got = sweep_record_unpack(p, sh->record_beams, &sh->results[index],
-		                              &sh->logs[index]);
-		if (got > 0)
-			got = sweep_record_unpack(p + side, sh->record_beams, &sh->results_b[index],
-			                          &sh->logs_b[index]);
+	const unsigned char *p = payload;
+	size_t side =
+	        sh->record_beams ? sweep_record_size(sh->record_beams) : sizeof(bsim_trial_result);
+	for (int s = 0; s < sh->n_sides; s++, p += side) {
+		if (!sh->record_beams) {
+			memcpy(&sh->results[s][index], p, side);
+			continue;
+		}
+		/* a path too long for its record: the trial (every side) runs again */
+		int got = sweep_record_unpack(p, sh->record_beams, &sh->results[s][index],
+		                              &sh->logs[s][index]);
 		if (got <= 0)
 			return got;
-		memcpy(&sh->t_separate[index], p + 2 * side, sizeof sh->t_separate[index]);
-	} else if (sh->record_beams) {
-		/* a path too long for its record: the trial runs again */
-		int got = sweep_record_unpack(payload, sh->record_beams, &sh->results[index],
-		                              &sh->logs[index]);
-		if (got <= 0)
-			return got;
-	} else if (sh->backend_b) {
-		pair_record p;
-		memcpy(&p, payload, sizeof p);
-		sh->results[index] = p.a;
-		sh->results_b[index] = p.b;
-		sh->t_separate[index] = p.t_separate;
-	} else {
-		memcpy(&sh->results[index], payload, sizeof sh->results[index]);
 	}
+	for (int q = 0; q < bsim_sweep_pairs(sh->n_sides); q++, p += sizeof(double))
+		memcpy(&sh->t_separate[q][index], p, sizeof(double));
 	sh->done += !sh->from_journal[index];
 	sh->from_journal[index] = 1;
 	return 0;
@@ -415,21 +407,24 @@ static void sweep_thread(sweep_shared *sh)
 {
 	const bsim_experiment *e = sh->e;
 	const bsim_sweep_config *cfg = sh->cfg;
+	const int n_sides = sh->n_sides, n_pairs = bsim_sweep_pairs(n_sides);
 	int leader = omp_get_thread_num() == 0;
 	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	/* The scenes live, unchanged, as long as the sweep. */
 	if (runner)
 		bsim_trial_runner_keep_worlds(runner, 1);
-	trial_pair *pair = sh->backend_b ? trial_pair_alloc() : NULL;
-	if (pair)
-		trial_pair_keep_worlds(pair, 1);
-	bsim_trial_log *log[2] = {bsim_trial_log_alloc(), bsim_trial_log_alloc()};
-	void *record_buf = sh->record_beams ? malloc(sh->record_size) : NULL;
-	pair_record pr;
+	trial_sides *sides = n_sides > 1 ? trial_sides_alloc(n_sides) : NULL;
+	if (sides)
+		trial_sides_keep_worlds(sides, 1);
+	bsim_trial_log *log[BSIM_SWEEP_SIDES_MAX] = {NULL};
+	int logs_ok = 1;
+	for (int s = 0; s < n_sides; s++)
+		logs_ok &= (log[s] = bsim_trial_log_alloc()) != NULL;
+	void *record_buf = n_sides > 1 || sh->record_beams ? malloc(sh->record_size) : NULL;
 	bsim_error err;
 
-	if (!runner || (sh->backend_b && !pair) || !log[0] || !log[1] ||
-	    (sh->record_beams && !record_buf)) {
+	if (!runner || (n_sides > 1 && !sides) || !logs_ok ||
+	    ((n_sides > 1 || sh->record_beams) && !record_buf)) {
 		bsim_trial_runner_free(runner);
 		runner = NULL;
 		shared_fail(sh, -1, BSIM_EFAIL, "out of memory for a trial runner");
@@ -450,8 +445,8 @@ static void sweep_thread(sweep_shared *sh)
 		long g = i / e->trials, t = i % e->trials;
 		uint64_t seed = bsim_schedule_seed_mix(e->seed, (uint64_t)g, (uint64_t)t);
 		bsim_error_clear(&err);
-		const bsim_scene *scene = &sh->scenes[g];
-		bsim_trajectory *keep = t < sh->keep ? &sh->kept[g * sh->keep + t] : NULL;
+		const bsim_scene *scene = &sh->scenes[0][g];
+		bsim_trajectory *keep = t < sh->keep ? &sh->kept[0][g * sh->keep + t] : NULL;
 		bsim_recorder rec = {.stride = keep ? sh->keep_stride : 1,
 		                     .record = keep ? bsim_trajectory_record : NULL,
 		                     .record_user = keep,
@@ -461,29 +456,34 @@ static void sweep_thread(sweep_shared *sh)
 		if (t > 0 && sh->deterministic[g]) {
 			ran = 0; /* a copy of trial 0, filled in after the run (and its trajectory)
 			          */
-		} else if (pair) {
-			pair->keep[0] = keep;
-			pair->keep[1] = keep ? &sh->kept_b[g * sh->keep + t] : NULL;
-			pair->keep_stride = sh->keep_stride;
-			rc = trial_pair_run(pair, scene, &sh->scenes_b[g], cfg->backend, cfg->opts,
-			                    sh->backend_b, sh->opts_b, seed,
-			                    0.01 * body_size(scene), &sh->results[k],
-			                    &sh->results_b[k], log, &sh->t_separate[k], &err);
+		} else if (sides) {
+			const bsim_scene *scenes[BSIM_SWEEP_SIDES_MAX];
+			bsim_trial_result *results[BSIM_SWEEP_SIDES_MAX];
+			double t_sep[BSIM_SWEEP_PAIRS_MAX];
+			for (int s = 0; s < n_sides; s++) {
+				scenes[s] = &sh->scenes[s][g];
+				results[s] = &sh->results[s][k];
+				sides->keep[s] = keep ? &sh->kept[s][g * sh->keep + t] : NULL;
+			}
+			sides->keep_stride = sh->keep_stride;
+			rc = trial_sides_run(sides, scenes, sh->backend, sh->opts, seed,
+			                     0.01 * body_size(scene), results, log, t_sep, &err);
+			for (int q = 0; rc == BSIM_OK && q < n_pairs; q++)
+				sh->t_separate[q][k] = t_sep[q];
 		} else {
 			rc = bsim_trial_run(runner, scene, cfg->backend, cfg->opts, seed, &rec,
-			                    &sh->results[k], &err);
+			                    &sh->results[0][k], &err);
 			if (rc == BSIM_OK && keep && keep->oom)
 				rc = bsim_error_set(&err, BSIM_EFAIL,
 				                    "out of memory for a kept trajectory");
 		}
-		if (rc == BSIM_OK && ran && bsim_trial_log_copy(&sh->logs[k], log[0]) != BSIM_OK)
-			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
-		if (rc == BSIM_OK && ran && pair &&
-		    bsim_trial_log_copy(&sh->logs_b[k], log[1]) != BSIM_OK)
-			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory for the gate path");
+		for (int s = 0; rc == BSIM_OK && ran && s < n_sides; s++)
+			if (bsim_trial_log_copy(&sh->logs[s][k], log[s]) != BSIM_OK)
+				rc = bsim_error_set(&err, BSIM_EFAIL,
+				                    "out of memory for the gate path");
 		/* Only trials that ran are journaled: copies are filled in again. */
 		const void *record = ran && (cfg->journal || (sh->part && sh->part->record))
-		                             ? record_of(sh, i, record_buf, &pr)
+		                             ? record_of(sh, i, record_buf)
 		                             : NULL;
 		if (rc == BSIM_OK && record && cfg->journal)
 			rc = bsim_journal_append(cfg->journal, (uint64_t)(cfg->journal_first + i),
@@ -503,9 +503,9 @@ static void sweep_thread(sweep_shared *sh)
 			              sh->progress_total ? sh->progress_total : sh->total);
 	}
 	bsim_trial_runner_free(runner);
-	trial_pair_free(pair);
-	bsim_trial_log_free(log[0]);
-	bsim_trial_log_free(log[1]);
+	trial_sides_free(sides);
+	for (int s = 0; s < n_sides; s++)
+		bsim_trial_log_free(log[s]);
 	free(record_buf);
 }
 
@@ -537,7 +537,7 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, int keep
 }
 
 /* The copies of a deterministic group's trial 0, its log included. */
-static int deterministic_fill(bsim_trial_result *res, bsim_trial_log *logs, double *t_separate,
+static int deterministic_fill(bsim_trial_result *res, bsim_trial_log *logs,
                               const int *deterministic, int n_groups, int trials)
 {
 	for (int g = 0; g < n_groups; g++) {
@@ -546,13 +546,19 @@ static int deterministic_fill(bsim_trial_result *res, bsim_trial_log *logs, doub
 		size_t first = (size_t)g * trials;
 		for (int t = 1; t < trials; t++) {
 			res[first + t] = res[first];
-			if (t_separate)
-				t_separate[first + t] = t_separate[first];
 			if (bsim_trial_log_copy(&logs[first + t], &logs[first]) != BSIM_OK)
 				return BSIM_EFAIL;
 		}
 	}
 	return BSIM_OK;
+}
+
+/* A pair's separation times of a deterministic group's copies: trial 0's. */
+static void separation_fill(double *t_separate, const int *deterministic, int n_groups, int trials)
+{
+	for (int g = 0; g < n_groups; g++)
+		for (int t = 1; deterministic[g] && t < trials; t++)
+			t_separate[(size_t)g * trials + t] = t_separate[(size_t)g * trials];
 }
 
 /* The kept trajectories of a deterministic group's copies: trial 0's. */
@@ -625,32 +631,37 @@ static int sweep_check(const bsim_experiment *e, const bsim_sweep_config *cfg, i
 	return BSIM_OK;
 }
 
-/* A plain sweep (backend_b NULL) or a paired one. */
-static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
-                        const bsim_backend *backend_b, const bsim_options *opts_b,
-                        bsim_sweep_result *out, bsim_sweep_result *out_b, double **t_separate,
-                        bsim_error *err)
+/* A plain sweep (n_sides = 1, cfg->backend into out[0]) or a sweep of
+ * sides (backend[s] into out[s], the pairs' separation times into
+ * *t_separate). */
+static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg, int n_sides,
+                        const bsim_backend *const *backend, const bsim_options *const *opts,
+                        bsim_sweep_result *out, double **t_separate, bsim_error *err)
 {
 	double t0 = bsim_clock_seconds();
 	int keep = 0, rc0 = sweep_check(e, cfg, &keep, err);
 	if (rc0 != BSIM_OK)
 		return rc0;
+	const int n_pairs = bsim_sweep_pairs(n_sides);
 	long total = (long)e->n_groups * e->trials;
-	if (result_alloc(out, e->n_groups, e->trials, keep, 1, err) != BSIM_OK)
-		return BSIM_EFAIL;
-	if (backend_b) {
-		*t_separate = calloc(total ? (size_t)total : 1, sizeof **t_separate);
-		if (!*t_separate ||
-		    result_alloc(out_b, e->n_groups, e->trials, keep, 1, err) != BSIM_OK) {
-			free(*t_separate);
-			*t_separate = NULL;
-			bsim_sweep_result_free(out);
+	for (int s = 0; s < n_sides; s++)
+		if (result_alloc(&out[s], e->n_groups, e->trials, keep, 1, err) != BSIM_OK) {
+			while (s-- > 0)
+				bsim_sweep_result_free(&out[s]);
+			return BSIM_EFAIL;
+		}
+	if (n_pairs > 0) {
+		*t_separate =
+		        calloc(total ? (size_t)n_pairs * (size_t)total : 1, sizeof **t_separate);
+		if (!*t_separate) {
+			for (int s = 0; s < n_sides; s++)
+				bsim_sweep_result_free(&out[s]);
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory for %ld pairs",
 			                      total);
 		}
 	}
 	bsim_scene *scenes, *scenes_b = NULL;
-	int rc = scenes_for(e, cfg, backend_b, opts_b, &scenes, &scenes_b, err);
+	int rc = scenes_for(e, cfg, n_sides, backend, opts, &scenes, &scenes_b, err);
 	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
 	if (rc == BSIM_OK && !deterministic) {
 		scenes_free(scenes, e->n_groups);
@@ -663,28 +674,30 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	sweep_shared sh = {
 	        .e = e,
 	        .cfg = cfg,
-	        .scenes = scenes,
-	        .scenes_b = scenes_b ? scenes_b : scenes,
+	        .n_sides = n_sides,
 	        .deterministic = deterministic,
-	        .results = out->trials_out,
-	        .logs = out->logs,
-	        .backend_b = backend_b,
-	        .opts_b = opts_b,
-	        .results_b = backend_b ? out_b->trials_out : NULL,
-	        .logs_b = backend_b ? out_b->logs : NULL,
-	        .kept = out->kept,
-	        .kept_b = backend_b ? out_b->kept : NULL,
 	        .keep = keep,
 	        .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
-	        .t_separate = backend_b ? *t_separate : NULL,
 	        .total = total,
 	        .end = total,
 	        .spill_fd = -1,
 	};
+	for (int s = 0; s < n_sides; s++) {
+		sh.scenes[s] = s == 1 && scenes_b ? scenes_b : scenes;
+		sh.backend[s] = backend[s];
+		sh.opts[s] = opts[s];
+		sh.results[s] = out[s].trials_out;
+		sh.logs[s] = out[s].logs;
+		sh.kept[s] = out[s].kept;
+	}
+	for (int q = 0; q < n_pairs; q++)
+		sh.t_separate[q] = *t_separate + (size_t)q * (size_t)total;
+	if (rc == BSIM_OK) {
+		sh.record_beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
+		sh.record_size = record_bytes(sh.record_beams, n_sides);
+	}
 	if (rc == BSIM_OK && cfg->journal) {
 		sh.lattice = scenes[0].has_lattice;
-		sh.record_beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
-		sh.record_size = record_bytes(sh.record_beams, backend_b != NULL);
 		sh.from_journal = calloc(total ? (size_t)total : 1, 1);
 		long kept = 0, cut = 0;
 		rc = !sh.from_journal ? bsim_error_set(err, BSIM_EFAIL, "out of memory")
@@ -704,11 +717,9 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 			threads = sh.total > 0 ? (int)sh.total : 1;
 #pragma omp parallel num_threads(threads)
 		sweep_thread(&sh);
-		out->lattice = scenes[0].has_lattice;
-		out->lattice_def = scenes[0].lattice;
-		if (backend_b) {
-			out_b->lattice = sh.scenes_b[0].has_lattice;
-			out_b->lattice_def = sh.scenes_b[0].lattice;
+		for (int s = 0; s < n_sides; s++) {
+			out[s].lattice = sh.scenes[s][0].has_lattice;
+			out[s].lattice_def = sh.scenes[s][0].lattice;
 		}
 		scenes_free(scenes, e->n_groups);
 		if (scenes_b)
@@ -720,11 +731,20 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 			                    sh.done, sh.total);
 	}
 	free(sh.from_journal);
+	/* The copies of deterministic groups, then the totals. */
+	for (int s = 0; rc == BSIM_OK && s < n_sides; s++)
+		if (deterministic_fill(out[s].trials_out, out[s].logs, deterministic, e->n_groups,
+		                       e->trials))
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate paths");
+	for (int q = 0; rc == BSIM_OK && q < n_pairs; q++)
+		separation_fill(sh.t_separate[q], deterministic, e->n_groups, e->trials);
+	for (int s = 0; rc == BSIM_OK && s < n_sides; s++)
+		rc = kept_fill(&out[s], deterministic, err);
 	if (rc != BSIM_OK) {
 		free(deterministic);
-		bsim_sweep_result_free(out);
-		if (backend_b) {
-			bsim_sweep_result_free(out_b);
+		for (int s = 0; s < n_sides; s++)
+			bsim_sweep_result_free(&out[s]);
+		if (n_pairs > 0) {
 			free(*t_separate);
 			*t_separate = NULL;
 		}
@@ -733,30 +753,9 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	/* The final count may have been reached on another thread. */
 	if (cfg->progress)
 		cfg->progress(cfg->progress_user, sh.total, sh.total);
-	rc = BSIM_OK;
-	if (deterministic_fill(out->trials_out, out->logs, backend_b ? *t_separate : NULL,
-	                       deterministic, e->n_groups, e->trials) ||
-	    (backend_b && deterministic_fill(out_b->trials_out, out_b->logs, NULL, deterministic,
-	                                     e->n_groups, e->trials)))
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate paths");
-	if (rc == BSIM_OK)
-		rc = kept_fill(out, deterministic, err);
-	if (rc == BSIM_OK && backend_b)
-		rc = kept_fill(out_b, deterministic, err);
-	if (rc != BSIM_OK) {
-		free(deterministic);
-		bsim_sweep_result_free(out);
-		if (backend_b) {
-			bsim_sweep_result_free(out_b);
-			free(*t_separate);
-			*t_separate = NULL;
-		}
-		return rc;
-	}
 	double wall = bsim_clock_seconds() - t0;
-	result_finish(out, deterministic, e->n_groups, e->trials, wall);
-	if (backend_b)
-		result_finish(out_b, deterministic, e->n_groups, e->trials, wall);
+	for (int s = 0; s < n_sides; s++)
+		result_finish(&out[s], deterministic, e->n_groups, e->trials, wall);
 	free(deterministic);
 	return BSIM_OK;
 }
@@ -825,7 +824,7 @@ static int stream_load(sweep_shared *sh, bsim_error *err)
 		if (!(sh->journaled[i / 8] & (1u << (i % 8))))
 			continue;
 		long k = i - sh->first;
-		if (pread(sh->spill_fd, rec ? rec : (void *)&sh->results[k], size,
+		if (pread(sh->spill_fd, rec ? rec : (void *)&sh->results[0][k], size,
 		          (off_t)((size_t)i * size)) != (ssize_t)size) {
 			rc = bsim_error_set(err, BSIM_EFAIL,
 			                    "cannot read back the journal's trial %ld (%s)", i,
@@ -833,8 +832,8 @@ static int stream_load(sweep_shared *sh, bsim_error *err)
 			break;
 		}
 		/* a lattice's path too long for its record: the trial runs again */
-		int got = rec ? sweep_record_unpack(rec, sh->record_beams, &sh->results[k],
-		                                    &sh->logs[k])
+		int got = rec ? sweep_record_unpack(rec, sh->record_beams, &sh->results[0][k],
+		                                    &sh->logs[0][k])
 		              : 1;
 		if (got < 0)
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
@@ -894,7 +893,7 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	bsim_scene *scenes = NULL;
 	stream_state st = {0};
 	int *deterministic = NULL;
-	int rc = scenes_for(e, cfg, NULL, NULL, &scenes, NULL, err);
+	int rc = scenes_for(e, cfg, 1, &cfg->backend, &cfg->opts, &scenes, NULL, err);
 	if (rc == BSIM_OK && scenes[0].has_lattice) {
 		out->lattice = 1;
 		out->lattice_def = scenes[0].lattice;
@@ -924,12 +923,14 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	sweep_shared sh = {
 	        .e = e,
 	        .cfg = cfg,
-	        .scenes = scenes,
-	        .scenes_b = scenes,
+	        .n_sides = 1,
+	        .scenes = {scenes},
+	        .backend = {cfg->backend},
+	        .opts = {cfg->opts},
 	        .deterministic = deterministic,
-	        .results = st.results,
-	        .logs = st.logs,
-	        .kept = out->kept,
+	        .results = {st.results},
+	        .logs = {st.logs},
+	        .kept = {out->kept},
 	        .keep = keep,
 	        .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
 	        .total = total,
@@ -940,7 +941,7 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	};
 	if (rc == BSIM_OK) {
 		sh.record_beams = record_beams(scenes, NULL, e->n_groups, cfg);
-		sh.record_size = record_bytes(sh.record_beams, 0);
+		sh.record_size = record_bytes(sh.record_beams, 1);
 	}
 	if (rc == BSIM_OK && cfg->journal)
 		rc = stream_replay(&sh, err);
@@ -997,7 +998,24 @@ int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_
 {
 	if (cfg->sink)
 		return sweep_streamed(e, cfg, out, err);
-	return sweep_common(e, cfg, NULL, NULL, out, NULL, NULL, err);
+	return sweep_common(e, cfg, 1, &cfg->backend, &cfg->opts, out, NULL, err);
+}
+
+static int sides_check(int n_sides, bsim_error *err)
+{
+	if (n_sides < 2 || n_sides > BSIM_SWEEP_SIDES_MAX)
+		return bsim_error_set(err, BSIM_EINPUT, "%d sides: expected 2 to %d", n_sides,
+		                      BSIM_SWEEP_SIDES_MAX);
+	return BSIM_OK;
+}
+
+int bsim_sweep_run_sides(const bsim_experiment *e, const bsim_sweep_config *cfg, int n_sides,
+                         const bsim_backend *const *backend, const bsim_options *const *opts,
+                         bsim_sweep_result *out, double **t_separate, bsim_error *err)
+{
+	int rc = sides_check(n_sides, err);
+	return rc != BSIM_OK ? rc
+	                     : sweep_common(e, cfg, n_sides, backend, opts, out, t_separate, err);
 }
 
 int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
@@ -1005,7 +1023,15 @@ int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg
                           bsim_sweep_result *out_a, bsim_sweep_result *out_b, double **t_separate,
                           bsim_error *err)
 {
-	return sweep_common(e, cfg, backend_b, opts_b, out_a, out_b, t_separate, err);
+	const bsim_backend *backend[2] = {cfg->backend, backend_b};
+	const bsim_options *opts[2] = {cfg->opts, opts_b};
+	bsim_sweep_result out[2];
+	int rc = sweep_common(e, cfg, 2, backend, opts, out, t_separate, err);
+	if (rc == BSIM_OK) {
+		*out_a = out[0];
+		*out_b = out[1];
+	}
+	return rc;
 }
 
 int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config *cfg, size_t *size,
@@ -1016,16 +1042,19 @@ int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config
 	if (rc != BSIM_OK)
 		return rc;
 	int beams = record_beams(scenes, NULL, e->n_groups, cfg);
-	*size = record_bytes(beams, 0);
+	*size = record_bytes(beams, 1);
 	scenes_free(scenes, e->n_groups);
 	return BSIM_OK;
 }
 
-int bsim_sweep_record_size_paired_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
-                                      size_t *size, bsim_error *err)
+int bsim_sweep_record_size_sides_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                     int n_sides, size_t *size, bsim_error *err)
 {
+	int rc = sides_check(n_sides, err);
+	if (rc != BSIM_OK)
+		return rc;
 	bsim_scene *scenes = NULL, *scenes_b = NULL;
-	int rc = scenes_build(e, cfg, 0, &scenes, err);
+	rc = scenes_build(e, cfg, 0, &scenes, err);
 	if (rc != BSIM_OK)
 		return rc;
 	if (cfg->n_extra_b > 0 && (rc = scenes_build(e, cfg, 1, &scenes_b, err)) != BSIM_OK) {
@@ -1033,11 +1062,17 @@ int bsim_sweep_record_size_paired_for(const bsim_experiment *e, const bsim_sweep
 		return rc;
 	}
 	int beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
-	*size = record_bytes(beams, 1);
+	*size = record_bytes(beams, n_sides);
 	scenes_free(scenes, e->n_groups);
 	if (scenes_b)
 		scenes_free(scenes_b, e->n_groups);
 	return BSIM_OK;
+}
+
+int bsim_sweep_record_size_paired_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                      size_t *size, bsim_error *err)
+{
+	return bsim_sweep_record_size_sides_for(e, cfg, 2, size, err);
 }
 
 /* ---- a part of a sweep (beamsim/sweep.h) ---------------------------------
@@ -1046,8 +1081,8 @@ int bsim_sweep_record_size_paired_for(const bsim_experiment *e, const bsim_sweep
  * sweep's do, each thread passing over the other parts' trials; nothing is
  * kept but the records handed on, so memory does not grow with the sweep. */
 
-static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
-                    const bsim_backend *backend_b, const bsim_options *opts_b,
+static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg, int n_sides,
+                    const bsim_backend *const *backend, const bsim_options *const *opts,
                     const bsim_sweep_part *part, bsim_error *err)
 {
 	int keep = 0, rc = sweep_check(e, cfg, &keep, err);
@@ -1056,50 +1091,44 @@ static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
 	if (part->count < 1 || part->index < 0 || part->index >= part->count)
 		return bsim_error_set(err, BSIM_EINPUT, "part %d of %d: expected 0 <= part < %d",
 		                      part->index, part->count, part->count);
+	const int n_pairs = bsim_sweep_pairs(n_sides);
 	long total = (long)e->n_groups * e->trials;
-	bsim_scene *scenes = NULL;
+	bsim_scene *scenes = NULL, *scenes_b = NULL;
 	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
-	bsim_trial_result *results = calloc(BSIM_SWEEP_BLOCK, sizeof *results);
-	bsim_trial_log *logs = calloc(BSIM_SWEEP_BLOCK, sizeof *logs);
-	/* a paired part's second side */
-	bsim_scene *scenes_b = NULL;
-	bsim_trial_result *results_b = NULL;
-	bsim_trial_log *logs_b = NULL;
-	double *t_separate = NULL;
-	if (backend_b) {
-		results_b = calloc(BSIM_SWEEP_BLOCK, sizeof *results_b);
-		logs_b = calloc(BSIM_SWEEP_BLOCK, sizeof *logs_b);
-		t_separate = calloc(BSIM_SWEEP_BLOCK, sizeof *t_separate);
-	}
-	if (!deterministic || !results || !logs ||
-	    (backend_b && (!results_b || !logs_b || !t_separate)))
+	/* each side's slots, and each pair's separation times */
+	bsim_trial_result *results = calloc((size_t)n_sides * BSIM_SWEEP_BLOCK, sizeof *results);
+	bsim_trial_log *logs = calloc((size_t)n_sides * BSIM_SWEEP_BLOCK, sizeof *logs);
+	double *t_separate =
+	        n_pairs > 0 ? calloc((size_t)n_pairs * BSIM_SWEEP_BLOCK, sizeof *t_separate) : NULL;
+	if (!deterministic || !results || !logs || (n_pairs > 0 && !t_separate))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
 	if (rc == BSIM_OK)
-		rc = scenes_for(e, cfg, backend_b, opts_b, &scenes, &scenes_b, err);
+		rc = scenes_for(e, cfg, n_sides, backend, opts, &scenes, &scenes_b, err);
 	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
 		deterministic[g] = !bsim_effects_random(&scenes[g]);
 	sweep_shared sh = {
 	        .e = e,
 	        .cfg = cfg,
-	        .scenes = scenes,
-	        .scenes_b = scenes_b ? scenes_b : scenes,
+	        .n_sides = n_sides,
 	        .deterministic = deterministic,
-	        .results = results,
-	        .logs = logs,
-	        .backend_b = backend_b,
-	        .opts_b = opts_b,
-	        .results_b = results_b,
-	        .logs_b = logs_b,
-	        .t_separate = t_separate,
 	        .keep_stride = 5,
 	        .total = total,
 	        .spill_fd = -1,
 	        .first_fail = total,
 	        .part = part,
 	};
+	for (int s = 0; rc == BSIM_OK && s < n_sides; s++) {
+		sh.scenes[s] = s == 1 && scenes_b ? scenes_b : scenes;
+		sh.backend[s] = backend[s];
+		sh.opts[s] = opts[s];
+		sh.results[s] = results + (size_t)s * BSIM_SWEEP_BLOCK;
+		sh.logs[s] = logs + (size_t)s * BSIM_SWEEP_BLOCK;
+	}
+	for (int q = 0; rc == BSIM_OK && q < n_pairs; q++)
+		sh.t_separate[q] = t_separate + (size_t)q * BSIM_SWEEP_BLOCK;
 	if (rc == BSIM_OK) {
 		sh.record_beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
-		sh.record_size = record_bytes(sh.record_beams, backend_b != NULL);
+		sh.record_size = record_bytes(sh.record_beams, n_sides);
 	}
 	/* Progress: this part's trials, or with collect every part's. */
 	for (long i = 0; i < total; i++) {
@@ -1134,14 +1163,10 @@ static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
 		scenes_free(scenes, e->n_groups);
 	if (scenes_b)
 		scenes_free(scenes_b, e->n_groups);
-	for (long k = 0; logs && k < BSIM_SWEEP_BLOCK; k++)
+	for (size_t k = 0; logs && k < (size_t)n_sides * BSIM_SWEEP_BLOCK; k++)
 		bsim_trial_log_clear(&logs[k]);
-	for (long k = 0; logs_b && k < BSIM_SWEEP_BLOCK; k++)
-		bsim_trial_log_clear(&logs_b[k]);
 	free(logs);
 	free(results);
-	free(logs_b);
-	free(results_b);
 	free(t_separate);
 	free(deterministic);
 	return rc;
@@ -1150,12 +1175,22 @@ static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
 int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
                         const bsim_sweep_part *part, bsim_error *err)
 {
-	return run_part(e, cfg, NULL, NULL, part, err);
+	return run_part(e, cfg, 1, &cfg->backend, &cfg->opts, part, err);
+}
+
+int bsim_sweep_run_part_sides(const bsim_experiment *e, const bsim_sweep_config *cfg, int n_sides,
+                              const bsim_backend *const *backend, const bsim_options *const *opts,
+                              const bsim_sweep_part *part, bsim_error *err)
+{
+	int rc = sides_check(n_sides, err);
+	return rc != BSIM_OK ? rc : run_part(e, cfg, n_sides, backend, opts, part, err);
 }
 
 int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                const bsim_backend *backend_b, const bsim_options *opts_b,
                                const bsim_sweep_part *part, bsim_error *err)
 {
-	return run_part(e, cfg, backend_b, opts_b, part, err);
+	const bsim_backend *backend[2] = {cfg->backend, backend_b};
+	const bsim_options *opts[2] = {cfg->opts, opts_b};
+	return run_part(e, cfg, 2, backend, opts, part, err);
 }

@@ -1,6 +1,7 @@
 /* The overlap of body and beams (trial_overlap.h). A solver that keeps
  * contacts apart holds it near 0; measuring it costs about a fifth of a
- * thesis step, which is why the recorder asks for it only when told. */
+ * step of the essay's solver, which is why the recorder asks for it only
+ * when told. */
 #include "run/trial_overlap.h"
 
 #include <math.h>

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/output.h"
 #include "beamsim/report.h"
 #include "beamsim/run_record.h"
@@ -24,10 +25,16 @@ bsim_compare_dir_def bsim_compare_dir_def_default(void)
 {
 	bsim_compare_dir_def d;
 	memset(&d, 0, sizeof d);
-	d.side[0].backend = &bsim_backend_thesis;
-	d.side[1].backend = &bsim_backend_box2d;
-	snprintf(d.side[0].label, sizeof d.side[0].label, "%s", bsim_backend_thesis.name);
-	snprintf(d.side[1].label, sizeof d.side[1].label, "%s", bsim_backend_box2d.name);
+	/* The registry's default comparison, its first two: with one backend
+	 * registered, it against itself (which the run refuses unless the
+	 * sides' options differ). */
+	d.n_sides = 2;
+	const bsim_backend *b[2];
+	int n = bsim_backend_compared(b, 2);
+	for (int i = 0; i < 2; i++) {
+		d.side[i].backend = b[i < n ? i : 0];
+		snprintf(d.side[i].label, sizeof d.side[i].label, "%s", d.side[i].backend->name);
+	}
 	d.rule = bsim_compare_rule_default();
 	d.examples = 3;
 	return d;
@@ -69,17 +76,18 @@ int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_erro
 
 void bsim_compare_dir_result_free(bsim_compare_dir_result *res)
 {
-	bsim_compare_free(&res->cmp);
+	bsim_compare_sides_free(&res->cmp);
 	bsim_experiment_free(&res->e);
 }
 
 typedef struct compare_job {
 	const bsim_compare_dir_def *def;
 	const bsim_experiment *e;
-	const bsim_backend *backend[2];
-	const bsim_options *opts[2];
-	const char *label[2];
-	const char *dir[2];
+	int n; /* sides */
+	const bsim_backend *backend[BSIM_COMPARE_SIDES_MAX];
+	const bsim_options *opts[BSIM_COMPARE_SIDES_MAX];
+	const char *label[BSIM_COMPARE_SIDES_MAX];
+	const char *dir[BSIM_COMPARE_SIDES_MAX];
 	const bsim_override *sets; /* every group's, side a's protocol included */
 	int n_sets;
 	bsim_override protocol_b; /* side b's protocol, after the sets */
@@ -99,19 +107,22 @@ static char *compare_title(const compare_job *job)
 	if (!f)
 		return NULL;
 	const char *const *protocol = job->def->protocol;
-	fprintf(f, "# beamsim compare: %s vs %s\n\n", job->label[0], job->label[1]);
+	fputs("# beamsim compare: ", f);
+	for (int i = 0; i < job->n; i++)
+		fprintf(f, "%s%s", i ? " vs " : "", job->label[i]);
+	fputs("\n\n", f);
 	if (protocol[0])
 		fprintf(f,
 		        "The lattice protocols %s and %s on backend %s: `lattice.protocol=%s` for "
 		        "one side, `=%s` for the other.\n\n",
 		        protocol[0], protocol[1], job->backend[0]->name, protocol[0], protocol[1]);
 	fprintf(f,
-	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; both sides "
+	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; %s "
 	        "ran every trial with the same random-force schedule, so trial t of group g is "
 	        "a pair.\n\n",
 	        job->e->path, job->e->scene_path, (unsigned long long)job->e->seed,
-	        job->e->n_groups, job->e->trials);
-	for (int i = 0; i < 2; i++) {
+	        job->e->n_groups, job->e->trials, job->n == 2 ? "both sides" : "every side");
+	for (int i = 0; i < job->n; i++) {
 		fprintf(f, "- %s: backend %s, options ", job->label[i], job->backend[i]->name);
 		bsim_output_backend_options(f, job->backend[i], job->opts[i]);
 		fputc('\n', f);
@@ -136,11 +147,12 @@ static void write_md(FILE *f, const void *r)
 	bsim_report_md(f, r);
 }
 
-static int compare_write(const compare_job *job, const bsim_sweep_result r[2], const double *t_sep,
-                         const bsim_comparison *cmp, bsim_error *err)
+static int compare_write(const compare_job *job, const bsim_sweep_result *r, const double *t_sep,
+                         const bsim_compare_sides *cmp, bsim_error *err)
 {
 	const bsim_compare_dir_def *def = job->def;
 	int protocols = def->protocol[0] != NULL;
+	bsim_report_side sides[BSIM_COMPARE_SIDES_MAX];
 	bsim_report rep = {
 	        .e = job->e,
 	        .extra = job->sets,
@@ -148,13 +160,17 @@ static int compare_write(const compare_job *job, const bsim_sweep_result r[2], c
 	        .extra_b = protocols ? &job->protocol_b : NULL,
 	        .n_extra_b = protocols,
 	        .t_separate = t_sep,
-	        .cmp = cmp,
+	        .cmp = &cmp->pairs[0],
 	        .examples = def->examples,
+	        .n_sides = job->n,
+	        .sides = sides,
+	        .all = cmp,
 	};
-	for (int i = 0; i < 2; i++) {
+	for (int i = 0; i < job->n; i++) {
 		char dir[BSIM_PATH_MAX];
-		rep.side[i] =
-		        (bsim_report_side){job->label[i], job->backend[i], job->opts[i], &r[i]};
+		sides[i] = (bsim_report_side){job->label[i], job->backend[i], job->opts[i], &r[i]};
+		if (i < 2)
+			rep.side[i] = sides[i];
 		if (bsim_session_path(dir, sizeof dir, job->out, job->dir[i], err) ||
 		    bsim_store_sweep_files(dir, job->e, job->backend[i], job->opts[i], job->sets,
 		                           job->n_sets, &r[i], err))
@@ -178,27 +194,23 @@ static int compare_write(const compare_job *job, const bsim_sweep_result r[2], c
 	return rc;
 }
 
-/* Unstable trials on each side, over the whole comparison. */
-static void unstable_counts(const bsim_comparison *cmp, long n[2])
+/* Unstable trials on a side, over the whole comparison (copies of a
+ * deterministic group's trial included). */
+static long unstable_count(const bsim_sweep_result *r)
 {
-	n[0] = n[1] = 0;
-	for (int g = 0; g < cmp->n_groups; g++) {
-		const bsim_event_test *t = &cmp->groups[g].ev[BSIM_EVENT_UNSTABLE];
-		int w = cmp->groups[g].deterministic ? cmp->trials : 1;
-		n[0] += w * (t->pairs.a + t->pairs.b);
-		n[1] += w * (t->pairs.a + t->pairs.c);
-	}
+	long n = 0;
+	for (int g = 0; g < r->n_groups; g++)
+		n += r->groups[g].unstable;
+	return n;
 }
 
 static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, bsim_error *err)
 {
 	const bsim_compare_dir_def *def = job->def;
 	int protocols = def->protocol[0] != NULL;
-	bsim_sweep_result r[2];
+	bsim_sweep_result r[BSIM_COMPARE_SIDES_MAX];
 	double *t_sep = NULL;
 	bsim_sweep_config cfg = {
-	        .backend = job->backend[0],
-	        .opts = job->opts[0],
 	        .threads = res->threads,
 	        .extra = job->sets,
 	        .n_extra = job->n_sets,
@@ -211,24 +223,39 @@ static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, b
 	        .journal = job->journal,
 	        .stop = def->stop,
 	};
-	int rc = bsim_sweep_run_paired(job->e, &cfg, job->backend[1], job->opts[1], &r[0], &r[1],
-	                               &t_sep, err);
+	int rc =
+	        bsim_sweep_run_sides(job->e, &cfg, job->n, job->backend, job->opts, r, &t_sep, err);
 	if (rc != BSIM_OK)
 		return rc;
 	if (job->done)
 		*job->done = 1;
+	res->n_sides = job->n;
 	/* A gathered comparison's time is its parts' and the writing's. */
-	if (job->started > 0)
-		r[0].wall_seconds = r[1].wall_seconds = bsim_clock_seconds() - job->started;
-	res->solver[0] = r[0].solver;
-	res->solver[1] = r[1].solver;
-	rc = bsim_compare_analyse(&r[0], &r[1], t_sep, &def->rule, &res->cmp, err);
+	double wall = job->started > 0 ? bsim_clock_seconds() - job->started : 0.0;
+	for (int i = 0; i < job->n; i++) {
+		if (job->started > 0)
+			r[i].wall_seconds = wall;
+		res->solver[i] = r[i].solver;
+		res->unstable[i] = unstable_count(&r[i]);
+	}
+	rc = bsim_compare_analyse_sides(r, job->n, t_sep, &def->rule, &res->cmp, err);
 	if (rc == BSIM_OK)
 		rc = compare_write(job, r, t_sep, &res->cmp, err);
-	bsim_sweep_result_free(&r[0]);
-	bsim_sweep_result_free(&r[1]);
+	for (int i = 0; i < job->n; i++)
+		bsim_sweep_result_free(&r[i]);
 	free(t_sep);
 	return rc;
+}
+
+/* "--backends A,B,C" as given, for messages. */
+static void sides_text(const compare_job *job, char *buf, size_t size)
+{
+	size_t len = 0;
+	buf[0] = '\0';
+	for (int i = 0; i < job->n && len < size; i++) {
+		int w = snprintf(buf + len, size - len, "%s%s", i ? "," : "", job->label[i]);
+		len += w > 0 ? (size_t)w : 0;
+	}
 }
 
 /* The sides' backends, options, labels and directories; BSIM_EINPUT if
@@ -236,9 +263,17 @@ static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, b
 static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
                        bsim_compare_dir_result *res, bsim_error *err)
 {
-	for (int i = 0; i < 2; i++) {
+	job->n = def->n_sides;
+	if (job->n < 2 || job->n > BSIM_COMPARE_SIDES_MAX || (def->protocol[0] && job->n != 2))
+		return def->protocol[0]
+		               ? bsim_error_set(err, BSIM_EINPUT,
+		                                "--protocols: %d sides; expected 2", job->n)
+		               : bsim_error_set(err, BSIM_EINPUT,
+		                                "--backends: %d sides; expected 2 to %d", job->n,
+		                                BSIM_COMPARE_SIDES_MAX);
+	for (int i = 0; i < job->n; i++) {
 		const bsim_compare_side *s = &def->side[i];
-		job->backend[i] = s->backend ? s->backend : &bsim_backend_thesis;
+		job->backend[i] = s->backend ? s->backend : bsim_backend_default();
 		job->opts[i] = &s->opts;
 		job->label[i] = def->protocol[0] ? def->protocol[i]
 		                : s->label[0]    ? s->label
@@ -270,16 +305,30 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 			                      job->backend[0]->name, job->backend[1]->name);
 		return BSIM_OK;
 	}
-	if (strcmp(job->label[0], job->label[1]) == 0)
-		return bsim_error_set(
-		        err, BSIM_EINPUT,
-		        "--backends %s,%s: expected two different sides (a backend against "
-		        "itself takes options inline, e.g. thesis,thesis:integrator=euler)",
-		        job->label[0], job->label[1]);
-	if (strcmp(res->dir[0], res->dir[1]) == 0)
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "--backends %s,%s: both sides would write to %s/%s",
-		                      job->label[0], job->label[1], def->out, res->dir[0]);
+	char given[BSIM_ERROR_MSG_MAX / 2];
+	sides_text(job, given, sizeof given);
+	for (int i = 0; i < job->n; i++)
+		for (int j = i + 1; j < job->n; j++) {
+			if (strcmp(job->label[i], job->label[j]) == 0 && job->n == 2)
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "--backends %s: expected two different sides (a backend "
+				        "against itself takes options inline, e.g. %s,%s:KEY=VALUE)",
+				        given, job->backend[i]->name, job->backend[i]->name);
+			if (strcmp(job->label[i], job->label[j]) == 0)
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "--backends %s: side %s is given twice; expected different "
+				        "sides (a backend against itself takes options inline, "
+				        "e.g. %s,%s:KEY=VALUE)",
+				        given, job->label[i], job->backend[i]->name,
+				        job->backend[i]->name);
+			if (strcmp(res->dir[i], res->dir[j]) == 0)
+				return bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "--backends %s: sides %s and %s would write to %s/%s",
+				        given, job->label[i], job->label[j], def->out, res->dir[i]);
+		}
 	return BSIM_OK;
 }
 
@@ -287,8 +336,8 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 static void record_fill(compare_job *job)
 {
 	const bsim_compare_dir_def *def = job->def;
-	bsim_run_record_fill(&job->rec, "compare", job->e, 2, job->backend, job->opts, job->label,
-	                     &def->rule);
+	bsim_run_record_fill(&job->rec, "compare", job->e, job->n, job->backend, job->opts,
+	                     job->label, &def->rule);
 	for (int i = 0; def->protocol[0] && i < 2; i++)
 		snprintf(job->rec.protocol[i], sizeof job->rec.protocol[i], "%s", def->protocol[i]);
 }
@@ -300,8 +349,6 @@ static int compare_part_run(void *user, const bsim_sweep_part *part, bsim_error 
 	const bsim_compare_dir_def *def = job->def;
 	int protocols = def->protocol[0] != NULL;
 	bsim_sweep_config cfg = {
-	        .backend = job->backend[0],
-	        .opts = job->opts[0],
 	        .threads = def->threads > 0 ? def->threads : omp_get_max_threads(),
 	        .extra = job->sets,
 	        .n_extra = job->n_sets,
@@ -312,7 +359,7 @@ static int compare_part_run(void *user, const bsim_sweep_part *part, bsim_error 
 	        .journal = job->journal,
 	        .stop = def->stop,
 	};
-	return bsim_sweep_run_part_paired(job->e, &cfg, job->backend[1], job->opts[1], part, err);
+	return bsim_sweep_run_part_sides(job->e, &cfg, job->n, job->backend, job->opts, part, err);
 }
 
 /* A spread comparison's part (def->spread, def->n_merge; see
@@ -381,7 +428,7 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread;
 	rc = inputs ? BSIM_OK : err->code;
 	/* A lattice's records hold both sides' gate paths and peaks too. */
-	size_t size = bsim_sweep_record_size(1);
+	size_t size = bsim_sweep_record_size_sides(job.n);
 	if (rc == BSIM_OK) {
 		bsim_sweep_config cfg = {
 		        .extra = job.sets,
@@ -389,7 +436,7 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 		        .extra_b = def->protocol[0] ? &job.protocol_b : NULL,
 		        .n_extra_b = def->protocol[0] != NULL,
 		};
-		rc = bsim_sweep_record_size_paired_for(&res->e, &cfg, &size, err);
+		rc = bsim_sweep_record_size_sides_for(&res->e, &cfg, job.n, &size, err);
 	}
 	if (rc == BSIM_OK && def->n_merge > 0 && def->resume)
 		rc = bsim_error_set(err, BSIM_EINPUT, "merge: --resume does not apply");
@@ -432,7 +479,6 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 		bsim_compare_dir_result_free(res);
 		return rc;
 	}
-	unstable_counts(&res->cmp, res->unstable);
 	return BSIM_OK;
 }
 
@@ -451,9 +497,7 @@ int bsim_store_compare_rerun(const bsim_compare_dir_def *def, const bsim_experim
 	record_fill(&job);
 	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
 	rc = compare_pairs(&job, res, err);
-	if (rc == BSIM_OK)
-		unstable_counts(&res->cmp, res->unstable);
-	else
-		bsim_compare_free(&res->cmp);
+	if (rc != BSIM_OK)
+		bsim_compare_sides_free(&res->cmp);
 	return rc;
 }

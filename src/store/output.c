@@ -14,6 +14,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "beamsim/backend_registry.h"
 #include "util/atomic_file.h"
 #include "store/survival_files.h"
 #include "store/trials_csv.h"

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/compare_dir.h"
 #include "beamsim/effects.h"
 #include "beamsim/output.h"
@@ -31,7 +32,7 @@ bsim_regress_def bsim_regress_def_default(void)
 
 /* The stored record, its backends and its experiment. */
 static int regress_load(const bsim_regress_def *def, bsim_regress_result *res,
-                        const bsim_backend *backend[2], bsim_error *err)
+                        const bsim_backend **backend, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	int has_manifest = 0;
@@ -55,17 +56,25 @@ static int regress_load(const bsim_regress_def *def, bsim_regress_result *res,
 }
 
 /* The rerun into stage, written as the original command writes it. */
+/* A stored comparison's record (else a sweep's). */
+static int is_comparison(const bsim_run_record *rec)
+{
+	return strcmp(rec->command, "compare") == 0;
+}
+
 static int regress_rerun(const bsim_regress_def *def, bsim_regress_result *res,
-                         const bsim_backend *const backend[2], const char *stage, bsim_error *err)
+                         const bsim_backend *const *backend, const char *stage, bsim_error *err)
 {
 	const bsim_run_record *rec = &res->rec;
-	if (rec->n_backends == 2) {
+	if (is_comparison(rec)) {
 		bsim_compare_dir_def d = bsim_compare_dir_def_default();
-		for (int i = 0; i < 2; i++) {
+		d.n_sides = rec->n_backends;
+		for (int i = 0; i < rec->n_backends; i++) {
 			d.side[i].backend = backend[i];
 			d.side[i].opts = rec->opts[i];
 			snprintf(d.side[i].label, sizeof d.side[i].label, "%s", rec->label[i]);
-			d.protocol[i] = rec->protocol[0][0] ? rec->protocol[i] : NULL;
+			if (i < 2) /* --protocols: two sides */
+				d.protocol[i] = rec->protocol[0][0] ? rec->protocol[i] : NULL;
 		}
 		d.threads = def->threads;
 		d.rule = rec->rule;
@@ -74,7 +83,7 @@ static int regress_rerun(const bsim_regress_def *def, bsim_regress_result *res,
 		bsim_compare_dir_result r;
 		int rc = bsim_store_compare_rerun(&d, &res->e, stage, &r, err);
 		if (rc == BSIM_OK)
-			bsim_compare_free(&r.cmp);
+			bsim_compare_sides_free(&r.cmp);
 		return rc;
 	}
 	bsim_sweep_dir_def d = bsim_sweep_dir_def_default();
@@ -97,7 +106,7 @@ static int side_read(const bsim_regress_result *res, const char *dir, int i, bsi
                      bsim_error *err)
 {
 	char path[BSIM_PATH_MAX], sub[BSIM_PATH_MAX];
-	if (res->rec.n_backends == 2) {
+	if (is_comparison(&res->rec)) {
 		char name[128];
 		bsim_compare_dir_label(res->rec.label[i], name, sizeof name);
 		if (bsim_session_path(sub, sizeof sub, dir, name, err))
@@ -133,7 +142,7 @@ static int trials_changed(const bsim_sweep_result r[2])
 typedef struct regress_files {
 	const bsim_regress_def *def;
 	const bsim_regress_result *res;
-	bsim_report rep[2];
+	bsim_report rep[BSIM_COMPARE_SIDES_MAX];
 } regress_files;
 
 static void regress_md(FILE *f, const void *arg)
@@ -169,9 +178,9 @@ static void regress_json(FILE *f, const void *arg)
 
 /* Each side's stored and rerun trials compared, and the two files. */
 static int regress_compare(const bsim_regress_def *def, bsim_regress_result *res,
-                           const bsim_backend *const backend[2], const char *stage, bsim_error *err)
+                           const bsim_backend *const *backend, const char *stage, bsim_error *err)
 {
-	bsim_sweep_result r[2][2];
+	bsim_sweep_result r[BSIM_COMPARE_SIDES_MAX][2];
 	regress_files w = {.def = def, .res = res};
 	bsim_override protocol_b = {"lattice.protocol", res->rec.protocol[1],
 	                            "--protocols (side b)"};
@@ -222,7 +231,7 @@ static int regress_compare(const bsim_regress_def *def, bsim_regress_result *res
 
 void bsim_regress_result_free(bsim_regress_result *res)
 {
-	for (int i = 0; i < 2; i++)
+	for (int i = 0; i < BSIM_COMPARE_SIDES_MAX; i++)
 		bsim_compare_free(&res->side[i].cmp);
 	bsim_experiment_free(&res->e);
 	memset(res, 0, sizeof *res);
@@ -237,7 +246,7 @@ int bsim_regress_run(const bsim_regress_def *def, bsim_regress_result *res, bsim
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "--out %s: expected a directory other than the baseline",
 		                      def->out);
-	const bsim_backend *backend[2] = {NULL, NULL};
+	const bsim_backend *backend[BSIM_COMPARE_SIDES_MAX] = {NULL};
 	int rc = regress_load(def, res, backend, err);
 	bsim_session ss;
 	if (rc == BSIM_OK)

@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/compare_dir.h"
 #include "beamsim/limits.h"
 #include "beamsim/run_output.h"
@@ -137,22 +138,36 @@ static int stored_side(const char *dir, const bsim_run_record *rec, const char *
 		               want, d, rec->label[0], d);
 		return -1;
 	}
-	for (int i = 0; want && i < 2; i++) {
+	for (int i = 0; want && i < rec->n_backends; i++) {
 		char name[128];
 		bsim_compare_dir_label(rec->label[i], name, sizeof name);
 		if (strcmp(want, rec->label[i]) == 0 || strcmp(want, name) == 0)
 			return i;
 	}
+	char want_text[BSIM_ERROR_MSG_MAX / 4] = "";
 	if (want)
+		snprintf(want_text, sizeof want_text, "--backend %s: ", want);
+	if (rec->n_backends == 2) {
 		bsim_error_set(err, BSIM_EINPUT,
-		               "--backend %s: %s is a comparison of two sides, %s and %s: choose "
-		               "one with --backend %s or --backend %s",
-		               want, d, rec->label[0], rec->label[1], rec->label[0], rec->label[1]);
-	else
-		bsim_error_set(err, BSIM_EINPUT,
-		               "%s is a comparison of two sides, %s and %s: choose one with "
+		               "%s%s is a comparison of two sides, %s and %s: choose one with "
 		               "--backend %s or --backend %s",
-		               d, rec->label[0], rec->label[1], rec->label[0], rec->label[1]);
+		               want_text, d, rec->label[0], rec->label[1], rec->label[0],
+		               rec->label[1]);
+		return -1;
+	}
+	char sides[BSIM_ERROR_MSG_MAX / 2] = "";
+	size_t len = 0;
+	for (int i = 0; i < rec->n_backends && len < sizeof sides; i++) {
+		int w = snprintf(sides + len, sizeof sides - len, "%s%s",
+		                 i == 0                    ? ""
+		                 : i + 1 < rec->n_backends ? ", "
+		                                           : " and ",
+		                 rec->label[i]);
+		len += w > 0 ? (size_t)w : 0;
+	}
+	bsim_error_set(err, BSIM_EINPUT,
+	               "%s%s is a comparison of %d sides, %s: choose one with --backend LABEL",
+	               want_text, d, rec->n_backends, sides);
 	return -1;
 }
 
@@ -204,7 +219,7 @@ static int open_stored(bsim_replay *r, const bsim_replay_def *def, bsim_error *e
 	r->opts = rec.opts[side];
 	snprintf(r->label, sizeof r->label, "%s", rec.label[side]);
 	snprintf(r->command, sizeof r->command, "%s", rec.command);
-	int rc = bsim_sweep_dir_read(dir, rec.n_backends == 2 ? rec.label[side] : NULL, &r->stored,
+	int rc = bsim_sweep_dir_read(dir, rec.n_backends >= 2 ? rec.label[side] : NULL, &r->stored,
 	                             err);
 	if (rc != BSIM_OK)
 		return rc ? rc : BSIM_EINPUT;

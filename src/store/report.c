@@ -317,17 +317,17 @@ static const char *location_test_name(const bsim_location_test *t)
 
 /* Both sides' final-location distributions (lattices), group by group, and
  * the paired permutation test of their difference. */
-static void md_locations(FILE *f, const bsim_report *r)
+static void md_locations(FILE *f, const bsim_report *r, const char *pair)
 {
 	const bsim_comparison *c = r->cmp;
 	fprintf(f,
-	        "## Final locations\n\nWhere each trial ended: `end:ix` reached the end through "
+	        "## Final locations%s\n\nWhere each trial ended: `end:ix` reached the end through "
 	        "column ix, `side:iy` left the field through a side at row iy, `stuck:ix:iy` "
 	        "stuck in gate (ix, iy). Test of the difference: a paired permutation test on "
 	        "the final locations (the two locations of a discordant pair swapped with "
 	        "probability 1/2; statistic: the total variation distance), exact when at "
 	        "most %d pairs are discordant, else Monte Carlo; in the Holm family above.\n\n",
-	        BSIM_LOCATION_EXACT_MAX);
+	        pair, BSIM_LOCATION_EXACT_MAX);
 	for (int g = 0; g < c->n_groups; g++) {
 		const bsim_location_test *t = &c->groups[g].loc;
 		bsim_lattice_summary ls[2];
@@ -392,9 +392,10 @@ static void md_locations(FILE *f, const bsim_report *r)
  * and those it clamped. */
 static void solver_trials(const bsim_report *r, int side, int g, int *limited, int *clamped)
 {
+	const bsim_sweep_result *run = r->n_sides > 2 ? r->sides[side].run : r->side[side].run;
 	*limited = *clamped = 0;
-	for (int t = 0; t < r->side[side].run->trials; t++) {
-		const bsim_trial_result *x = trial_of(r, side, g, t);
+	for (int t = 0; t < run->trials; t++) {
+		const bsim_trial_result *x = &run->trials_out[(size_t)g * run->trials + t];
 		*limited += x->solver.iteration_limit > 0;
 		*clamped += x->solver.clamped > 0;
 	}
@@ -406,11 +407,14 @@ static void solver_trials(const bsim_report *r, int side, int g, int *limited, i
 static void md_solver(FILE *f, const bsim_report *r)
 {
 	int any = 0;
+	const int sides = r->n_sides > 2 ? r->n_sides : 2;
 	for (int g = 0; g < r->cmp->n_groups; g++) {
-		int n[2][2];
-		for (int s = 0; s < 2; s++)
+		int n[BSIM_COMPARE_SIDES_MAX][2], some = 0;
+		for (int s = 0; s < sides; s++) {
 			solver_trials(r, s, g, &n[s][0], &n[s][1]);
-		if (!n[0][0] && !n[0][1] && !n[1][0] && !n[1][1])
+			some |= n[s][0] || n[s][1];
+		}
+		if (!some)
 			continue;
 		if (!any)
 			fputs("**Solver limits.** Groups with trials whose motion was partly a "
@@ -419,9 +423,10 @@ static void md_solver(FILE *f, const bsim_report *r)
 			      f);
 		any = 1;
 		fprintf(f, "- group %d: ", g);
-		for (int s = 0; s < 2; s++)
+		for (int s = 0; s < sides; s++)
 			fprintf(f, "%s%s %d hit an iteration limit, %d clamped", s ? "; " : "",
-			        r->side[s].label, n[s][0], n[s][1]);
+			        r->n_sides > 2 ? r->sides[s].label : r->side[s].label, n[s][0],
+			        n[s][1]);
 		fputs("\n", f);
 	}
 	if (any)
@@ -439,23 +444,31 @@ static int equivalent_untraversed(const bsim_comparison *c)
 	return k;
 }
 
-void bsim_report_md(FILE *f, const bsim_report *r)
+/* The summary sentence: groups by verdict (k), n_disagree of them
+ * disagreeing, untraversed the equivalent ones with traversal at the
+ * floor or the ceiling on `every` side. */
+static void md_counts(FILE *f, const bsim_comparison *c, int n_disagree, const int *k,
+                      int untraversed, const char *every)
 {
-	const bsim_comparison *c = r->cmp;
-	const int *k = c->count;
 	int det = k[BSIM_VERDICT_SAME] + k[BSIM_VERDICT_DIFFERENT];
 	fprintf(f,
 	        "**%d of %d groups disagree.** %d deterministic (no random force: one trial each, "
 	        "compared as one pair): %d same, %d different. %d with random force, %d trials "
 	        "each: %d equivalent within +-%g (%d of them with p_traverse at the floor or the "
-	        "ceiling on both sides: equivalent in their other events, not in traversal), %d "
+	        "ceiling on %s: equivalent in their other events, not in traversal), %d "
 	        "uninformative (every event at the floor or the ceiling), %d inconclusive (no "
 	        "difference detected, none excluded), %d significantly different but within the "
 	        "margin, %d disagree.\n\n",
-	        c->n_disagree, c->n_groups, det, k[BSIM_VERDICT_SAME], k[BSIM_VERDICT_DIFFERENT],
+	        n_disagree, c->n_groups, det, k[BSIM_VERDICT_SAME], k[BSIM_VERDICT_DIFFERENT],
 	        c->n_groups - det, c->trials, k[BSIM_VERDICT_EQUIVALENT], c->rule.margin,
-	        equivalent_untraversed(c), k[BSIM_VERDICT_UNINFORMATIVE],
-	        k[BSIM_VERDICT_INCONCLUSIVE], k[BSIM_VERDICT_SMALL], k[BSIM_VERDICT_DISAGREE]);
+	        untraversed, every, k[BSIM_VERDICT_UNINFORMATIVE], k[BSIM_VERDICT_INCONCLUSIVE],
+	        k[BSIM_VERDICT_SMALL], k[BSIM_VERDICT_DISAGREE]);
+}
+
+/* The rule, as it applies to each pair of sides; c->n_tests is the Holm
+ * family's size. */
+static void md_rule(FILE *f, const bsim_comparison *c)
+{
 	fprintf(f,
 	        "Rule: a group with random force disagrees when, for one of its events in the "
 	        "family, the exact McNemar test on the paired trials gives a p-value below %g "
@@ -488,12 +501,25 @@ void bsim_report_md(FILE *f, const bsim_report *r)
 		      "variation distance between the two distributions is at least the margin "
 		      "(section Final locations).\n\n",
 		      f);
+}
+
+static void md_sides(FILE *f, const bsim_report *r);
+
+void bsim_report_md(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	if (r->n_sides > 2) {
+		md_sides(f, r);
+		return;
+	}
+	md_counts(f, c, c->n_disagree, c->count, equivalent_untraversed(c), "both sides");
+	md_rule(f, c);
 	md_separation(f, r);
 	md_pooled(f, r);
 	md_table(f, r);
 	md_solver(f, r);
 	if (c->lattice)
-		md_locations(f, r);
+		md_locations(f, r, "");
 	for (int g = 0; g < c->n_groups; g++) {
 		const bsim_compare_group *cg = &c->groups[g];
 		if (!shows_detail(cg))
@@ -505,6 +531,211 @@ void bsim_report_md(FILE *f, const bsim_report *r)
 		if (!cg->deterministic)
 			md_events(f, r, cg);
 		md_examples(f, r, g);
+	}
+}
+
+/* ---- more than two sides ------------------------------------------------ */
+
+/* Pair k of a comparison of more than two sides as a report of two sides:
+ * its sides, its comparison and its separation times. */
+static bsim_report pair_view(const bsim_report *r, int k)
+{
+	const bsim_compare_sides *all = r->all;
+	bsim_report v = *r;
+	v.n_sides = 0;
+	v.sides = NULL;
+	v.all = NULL;
+	v.extra_b = NULL; /* --protocols has two sides */
+	v.n_extra_b = 0;
+	v.side[0] = r->sides[all->pair[k][0]];
+	v.side[1] = r->sides[all->pair[k][1]];
+	v.cmp = &all->pairs[k];
+	v.t_separate = r->t_separate ? r->t_separate + (size_t)k * (size_t)all->n_groups *
+	                                                       (size_t)all->trials
+	                             : NULL;
+	return v;
+}
+
+/* A side's label, "none" or "no single side": a group's odd one out. */
+static const char *odd_text(const bsim_report *r, int odd)
+{
+	return odd >= 0 ? r->sides[odd].label : odd == BSIM_ODD_NONE ? "none" : "no single side";
+}
+
+/* Equivalent groups (every pair equivalent) whose traversal is at the
+ * floor or the ceiling in every pair. */
+static int equivalent_untraversed_all(const bsim_compare_sides *all)
+{
+	int k = 0;
+	for (int g = 0; g < all->n_groups; g++) {
+		int untraversed = all->verdict[g] == BSIM_VERDICT_EQUIVALENT;
+		for (int p = 0; untraversed && p < all->n_pairs; p++)
+			untraversed = !all->pairs[p].groups[g].ev[BSIM_EVENT_TRAVERSED].informative;
+		k += untraversed;
+	}
+	return k;
+}
+
+static void md_sides_table(FILE *f, const bsim_report *r)
+{
+	const bsim_experiment *e = r->e;
+	const bsim_compare_sides *all = r->all;
+	fputs("## Sides\n\nEach side's p_traverse (Wilson 95%; a deterministic group's one "
+	      "trial), the group's verdict (its least agreeing pair's) and its odd one out.\n\n"
+	      "| group |",
+	      f);
+	for (int a = 0; a < e->n_axes; a++)
+		fprintf(f, " %s |", e->axes[a].key);
+	for (int s = 0; s < r->n_sides; s++)
+		fprintf(f, " p_traverse %s [95%%] |", r->sides[s].label);
+	fputs(" verdict | odd one out |\n|---|", f);
+	for (int a = 0; a < e->n_axes + r->n_sides + 2; a++)
+		fputs("---|", f);
+	fputc('\n', f);
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	for (int g = 0; g < all->n_groups; g++) {
+		if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
+			bsim_experiment_group_index(e, g, idx);
+		fprintf(f, "| %d |", g);
+		for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
+			fprintf(f, " %s |", e->axes[a].values[idx[a]]);
+		for (int s = 0; s < r->n_sides; s++) {
+			const bsim_group_result *gr = &r->sides[s].run->groups[g];
+			fprintf(f, " %.2f [%.2f, %.2f] |", gr->p_traverse, gr->ci95[0],
+			        gr->ci95[1]);
+		}
+		fprintf(f, " %s | %s |\n", bsim_compare_verdict_name(all->verdict[g]),
+		        odd_text(r, all->odd[g]));
+	}
+	fputc('\n', f);
+}
+
+static void md_pairs_table(FILE *f, const bsim_report *r)
+{
+	const bsim_experiment *e = r->e;
+	const bsim_compare_sides *all = r->all;
+	fputs("## Pairs\n\nEvery pair of sides, group by group, as a comparison of two sides: "
+	      "p_A - p_B of traversal (Tango's 95%), the discordant pairs of trials, the "
+	      "family's smallest Holm p and its event, the equivalence p, the traversal's "
+	      "mde80, the median separation time and the pair's verdict.\n\n| group |",
+	      f);
+	for (int a = 0; a < e->n_axes; a++)
+		fprintf(f, " %s |", e->axes[a].key);
+	fputs(" A | B | difference [95%] | discordant | min p (Holm), event | equivalence p | "
+	      "mde80 traversed | t_sep median (s) | verdict |\n|---|",
+	      f);
+	for (int a = 0; a < e->n_axes + 9; a++)
+		fputs("---|", f);
+	fputc('\n', f);
+	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	for (int g = 0; g < all->n_groups; g++) {
+		if (e->n_axes <= BSIM_OUTPUT_AXES_MAX)
+			bsim_experiment_group_index(e, g, idx);
+		for (int k = 0; k < all->n_pairs; k++) {
+			const bsim_compare_group *cg = &all->pairs[k].groups[g];
+			const bsim_event_test *t = &cg->ev[BSIM_EVENT_TRAVERSED];
+			fprintf(f, "| %d |", g);
+			for (int a = 0; a < e->n_axes && a < BSIM_OUTPUT_AXES_MAX; a++)
+				fprintf(f, " %s |", e->axes[a].values[idx[a]]);
+			fprintf(f, " %s | %s | %+.2f [%+.2f, %+.2f] | %d of %d |",
+			        r->sides[all->pair[k][0]].label, r->sides[all->pair[k][1]].label,
+			        t->diff, t->diff_ci[0], t->diff_ci[1], cg->discordant, cg->pairs);
+			int ev = key_event(cg);
+			if (cg->deterministic)
+				fputs(" deterministic | - | - |", f);
+			else if (ev >= 0)
+				fprintf(f, " %.2g, %s | %.2g |", cg->ev[ev].p_holm,
+				        bsim_compare_event_name((bsim_event)ev),
+				        group_equivalence(cg));
+			else
+				fprintf(f, " - (no event varies) | %.2g |", group_equivalence(cg));
+			if (!cg->deterministic)
+				md_number(f, " %.2f |", t->mde80);
+			if (cg->t_sep[1] >= 0.0)
+				fprintf(f, " %.3f |", cg->t_sep[1]);
+			else
+				fputs(" - |", f);
+			fprintf(f, " %s |\n", bsim_compare_verdict_name(cg->verdict));
+		}
+	}
+	fputc('\n', f);
+}
+
+static void md_sides(FILE *f, const bsim_report *r)
+{
+	const bsim_compare_sides *all = r->all;
+	const bsim_comparison *c = &all->pairs[0];
+	md_counts(f, c, all->n_disagree, all->count, equivalent_untraversed_all(all), "every side");
+	md_rule(f, c);
+	fprintf(f,
+	        "With %d sides every pair of sides (%d pairs) is compared so, and the Holm family "
+	        "holds every pair's tests: %d tests. A group disagrees when any of its pairs "
+	        "does; its verdict is its least agreeing pair's (in the order same, equivalent, "
+	        "uninformative, inconclusive, small, DISAGREE, DIFFERENT). The odd one out of a "
+	        "group is the side whose every pair with another side disagrees while no pair "
+	        "of the other sides does: the disagreement is that side's. `none`: no pair "
+	        "disagrees; `no single side`: pairs disagree, but not so (two sides against the "
+	        "rest, or others that disagree among themselves).\n\n",
+	        all->n_sides, all->n_pairs, all->n_tests);
+	int none = 0, unattributed = 0;
+	for (int g = 0; g < all->n_groups; g++) {
+		none += all->odd[g] == BSIM_ODD_NONE;
+		unattributed += all->odd[g] == BSIM_ODD_NO_SINGLE;
+	}
+	fputs("**Odd one out:**", f);
+	for (int s = 0; s < all->n_sides; s++) {
+		int n = 0;
+		for (int g = 0; g < all->n_groups; g++)
+			n += all->odd[g] == s;
+		fprintf(f, " %s in %d group%s;", r->sides[s].label, n, n == 1 ? "" : "s");
+	}
+	fprintf(f, " no single side in %d; none in %d.\n\n", unattributed, none);
+	for (int k = 0; k < all->n_pairs; k++) {
+		bsim_report v = pair_view(r, k);
+		if (!v.t_separate)
+			break;
+		fprintf(f, "%s vs %s: ", v.side[0].label, v.side[1].label);
+		md_separation(f, &v);
+	}
+	md_sides_table(f, r);
+	md_pairs_table(f, r);
+	for (int k = 0; k < all->n_pairs; k++) {
+		bsim_report v = pair_view(r, k);
+		bsim_pairs t;
+		double ci[2], p;
+		if (pooled(v.cmp, 0, &t, ci, &p) == 0)
+			break; /* no group with random force */
+		fprintf(f, "### Pooled: %s vs %s\n\n", v.side[0].label, v.side[1].label);
+		md_pooled(f, &v);
+	}
+	md_solver(f, r);
+	for (int k = 0; c->lattice && k < all->n_pairs; k++) {
+		bsim_report v = pair_view(r, k);
+		char title[300];
+		snprintf(title, sizeof title, ": %s vs %s", v.side[0].label, v.side[1].label);
+		md_locations(f, &v, title);
+	}
+	for (int g = 0; g < all->n_groups; g++) {
+		if (all->verdict[g] != BSIM_VERDICT_DISAGREE &&
+		    all->verdict[g] != BSIM_VERDICT_DIFFERENT)
+			continue;
+		fprintf(f, "### Group %d: ", g);
+		params_text(f, r->e, g);
+		fprintf(f, "\n\nOdd one out: %s.\n\n", odd_text(r, all->odd[g]));
+		for (int k = 0; k < all->n_pairs; k++) {
+			bsim_report v = pair_view(r, k);
+			const bsim_compare_group *cg = &v.cmp->groups[g];
+			if (!shows_detail(cg))
+				continue;
+			fprintf(f,
+			        "#### %s vs %s\n\n%d of %d pairs discordant, %d changed in any "
+			        "field.\n\n",
+			        v.side[0].label, v.side[1].label, cg->discordant, cg->pairs,
+			        cg->changed);
+			if (!cg->deterministic)
+				md_events(f, &v, cg);
+			md_examples(f, &v, g);
+		}
 	}
 }
 
@@ -712,9 +943,153 @@ static void json_side(FILE *f, const bsim_report_side *s)
 	fputc('}', f);
 }
 
+/* The verdicts' counts as a JSON object. */
+static void json_verdicts(FILE *f, const int *count)
+{
+	fputc('{', f);
+	for (int v = 0; v < BSIM_N_VERDICTS; v++) {
+		fputs(v ? ", " : "", f);
+		bsim_json_string(f, bsim_compare_verdict_name((bsim_verdict)v));
+		fprintf(f, ": %d", count[v]);
+	}
+	fputc('}', f);
+}
+
+static void json_separation(FILE *f, const bsim_report *r)
+{
+	const bsim_comparison *c = r->cmp;
+	if (r->t_separate) {
+		fprintf(f,
+		        "{\"distance\": \"0.01 body radius\", \"separated\": %d, \"pairs\": %ld, "
+		        "\"quantiles_10_50_90_s\": ",
+		        c->separated, (long)c->pairs);
+		json_quantiles(f, c->t_sep);
+		fputc('}', f);
+	} else {
+		fputs("null", f);
+	}
+}
+
+/* A group's pair as in the groups of two sides: verdict, counts, events
+ * (the fields after "params"). */
+static void json_group_pair(FILE *f, const bsim_report *r, int g, bsim_verdict verdict)
+{
+	const bsim_comparison *c = r->cmp;
+	const bsim_compare_group *cg = &c->groups[g];
+	fputs(", \"verdict\": ", f);
+	bsim_json_string(f, bsim_compare_verdict_name(verdict));
+	fprintf(f,
+	        ", \"deterministic\": %s, \"pairs\": %d, \"discordant\": %d, \"changed\": "
+	        "%d, "
+	        "\"separated\": %d, ",
+	        cg->deterministic ? "true" : "false", cg->pairs, cg->discordant, cg->changed,
+	        cg->separated);
+	fputs("\"t_separate_quantiles_s\": ", f);
+	json_quantiles(f, cg->t_sep);
+	fputs(",\n     \"events\": {", f);
+	for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
+		fputs(ev ? ",\n       " : "\n       ", f);
+		bsim_json_string(f, bsim_compare_event_name((bsim_event)ev));
+		fputs(": ", f);
+		json_event(f, &cg->ev[ev], cg->deterministic);
+	}
+	fputc('}', f);
+	if (c->lattice && !cg->deterministic)
+		json_locations(f, r, g);
+	if (shows_detail(cg))
+		json_examples(f, r, g);
+}
+
+static void json_odd(FILE *f, const bsim_report *r, int odd)
+{
+	fputs("{\"side\": ", f);
+	if (odd >= 0)
+		bsim_json_string(f, r->sides[odd].label);
+	else
+		fputs("null", f);
+	fputs(", \"found\": ", f);
+	bsim_json_string(f, odd >= 0 ? "side" : odd == BSIM_ODD_NONE ? "none" : "no single side");
+	fputc('}', f);
+}
+
+/* More than two sides, at the top: every side, every pair's summary, the
+ * odd ones out. */
+static void json_sides_top(FILE *f, const bsim_report *r)
+{
+	const bsim_compare_sides *all = r->all;
+	fputs(",\n  \"sides\": [", f);
+	for (int s = 0; s < r->n_sides; s++) {
+		fputs(s ? ",\n    " : "\n    ", f);
+		json_side(f, &r->sides[s]);
+	}
+	fprintf(f, "],\n  \"pairs_of_sides\": %d,\n  \"pairwise\": [", all->n_pairs);
+	for (int k = 0; k < all->n_pairs; k++) {
+		bsim_report v = pair_view(r, k);
+		fputs(k ? ",\n    {\"a\": " : "\n    {\"a\": ", f);
+		bsim_json_string(f, v.side[0].label);
+		fputs(", \"b\": ", f);
+		bsim_json_string(f, v.side[1].label);
+		fprintf(f, ", \"groups_disagreeing\": %d, \"verdicts\": ", v.cmp->n_disagree);
+		json_verdicts(f, v.cmp->count);
+		fputs(", \"separation\": ", f);
+		json_separation(f, &v);
+		json_pooled(f, v.cmp);
+		fputc('}', f);
+	}
+	fputs("],\n  \"odd_one_out\": {\"rule\": ", f);
+	bsim_json_string(f, "the side whose every pair with another side disagrees (DISAGREE or "
+	                    "DIFFERENT) while no pair of the other sides does");
+	fputs(", \"groups\": {", f);
+	for (int s = -2; s < r->n_sides; s++) {
+		int n = 0;
+		for (int g = 0; g < all->n_groups; g++)
+			n += all->odd[g] == s;
+		fputs(s > -2 ? ", " : "", f);
+		bsim_json_string(f, s >= 0               ? r->sides[s].label
+		                    : s == BSIM_ODD_NONE ? "none"
+		                                         : "no single side");
+		fprintf(f, ": %d", n);
+	}
+	fputs("}}", f);
+}
+
+/* More than two sides, in group g: each side's p_traverse, every pair,
+ * the odd one out. */
+static void json_sides_group(FILE *f, const bsim_report *r, int g)
+{
+	const bsim_compare_sides *all = r->all;
+	fputs(",\n     \"sides\": [", f);
+	for (int s = 0; s < r->n_sides; s++) {
+		const bsim_group_result *gr = &r->sides[s].run->groups[g];
+		fputs(s ? ", " : "", f);
+		fputs("{\"label\": ", f);
+		bsim_json_string(f, r->sides[s].label);
+		fputs(", \"p_traverse\": ", f);
+		bsim_json_number(f, gr->p_traverse);
+		fputs(", \"ci95\": ", f);
+		json_pair_of_numbers(f, gr->ci95);
+		fputc('}', f);
+	}
+	fputs("],\n     \"pairwise\": [", f);
+	for (int k = 0; k < all->n_pairs; k++) {
+		bsim_report v = pair_view(r, k);
+		fputs(k ? ",\n     {\"a\": " : "\n     {\"a\": ", f);
+		bsim_json_string(f, v.side[0].label);
+		fputs(", \"b\": ", f);
+		bsim_json_string(f, v.side[1].label);
+		json_group_pair(f, &v, g, v.cmp->groups[g].verdict);
+		fputc('}', f);
+	}
+	fputs("],\n     \"odd_one_out\": ", f);
+	json_odd(f, r, all->odd[g]);
+}
+
 void bsim_report_json(FILE *f, const bsim_report *r)
 {
 	const bsim_comparison *c = r->cmp;
+	/* More than two sides: the fields of two sides are the first pair's,
+	 * but for the verdicts, which are over every pair. */
+	const bsim_compare_sides *all = r->n_sides > 2 ? r->all : NULL;
 	fputs("{\n  \"experiment\": ", f);
 	bsim_json_string(f, r->e->path);
 	fputs(",\n  \"seed\": ", f);
@@ -735,51 +1110,21 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	if (c->lattice)
 		fputs(", \"final_location_test\": \"paired_permutation\"", f);
 	fputc('}', f);
-	fprintf(f, ",\n  \"groups_disagreeing\": %d,\n  \"verdicts\": {", c->n_disagree);
-	for (int v = 0; v < BSIM_N_VERDICTS; v++) {
-		fputs(v ? ", " : "", f);
-		bsim_json_string(f, bsim_compare_verdict_name((bsim_verdict)v));
-		fprintf(f, ": %d", c->count[v]);
-	}
-	fputs("},\n  \"separation\": ", f);
-	if (r->t_separate) {
-		fprintf(f,
-		        "{\"distance\": \"0.01 body radius\", \"separated\": %d, \"pairs\": %ld, "
-		        "\"quantiles_10_50_90_s\": ",
-		        c->separated, (long)c->pairs);
-		json_quantiles(f, c->t_sep);
-		fputc('}', f);
-	} else {
-		fputs("null", f);
-	}
+	fprintf(f, ",\n  \"groups_disagreeing\": %d,\n  \"verdicts\": ",
+	        all ? all->n_disagree : c->n_disagree);
+	json_verdicts(f, all ? all->count : c->count);
+	fputs(",\n  \"separation\": ", f);
+	json_separation(f, r);
 	json_pooled(f, c);
+	if (all)
+		json_sides_top(f, r);
 	fputs(",\n  \"groups\": [", f);
 	for (int g = 0; g < c->n_groups; g++) {
-		const bsim_compare_group *cg = &c->groups[g];
 		fprintf(f, "%s\n    {\"group\": %d, \"params\": ", g ? "," : "", g);
 		bsim_output_group_params(f, r->e, g);
-		fputs(", \"verdict\": ", f);
-		bsim_json_string(f, bsim_compare_verdict_name(cg->verdict));
-		fprintf(f,
-		        ", \"deterministic\": %s, \"pairs\": %d, \"discordant\": %d, \"changed\": "
-		        "%d, "
-		        "\"separated\": %d, ",
-		        cg->deterministic ? "true" : "false", cg->pairs, cg->discordant,
-		        cg->changed, cg->separated);
-		fputs("\"t_separate_quantiles_s\": ", f);
-		json_quantiles(f, cg->t_sep);
-		fputs(",\n     \"events\": {", f);
-		for (int ev = 0; ev < BSIM_N_EVENTS; ev++) {
-			fputs(ev ? ",\n       " : "\n       ", f);
-			bsim_json_string(f, bsim_compare_event_name((bsim_event)ev));
-			fputs(": ", f);
-			json_event(f, &cg->ev[ev], cg->deterministic);
-		}
-		fputc('}', f);
-		if (c->lattice && !cg->deterministic)
-			json_locations(f, r, g);
-		if (shows_detail(cg))
-			json_examples(f, r, g);
+		json_group_pair(f, r, g, all ? all->verdict[g] : c->groups[g].verdict);
+		if (all)
+			json_sides_group(f, r, g);
 		fputc('}', f);
 	}
 	fputs("\n  ]\n}\n", f);
@@ -788,21 +1133,44 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 void bsim_report_pairs_csv(FILE *f, const bsim_report *r)
 {
 	const bsim_comparison *c = r->cmp;
-	fputs("group,trial,outcome_a,type_a,outcome_b,type_b,t_separate,location_a,location_b\n",
-	      f);
+	const int n = r->n_sides > 2 ? r->n_sides : 2, n_pairs = bsim_sweep_pairs(n);
+	const bsim_report_side *sides = r->n_sides > 2 ? r->sides : r->side;
+	const size_t total = (size_t)c->n_groups * (size_t)c->trials;
+	fputs("group,trial", f);
+	for (int s = 0; s < n; s++)
+		fprintf(f, ",outcome_%c,type_%c", 'a' + s, 'a' + s);
+	fputs(",t_separate", f);
+	for (int k = 1; k < n_pairs; k++) {
+		int p[2];
+		bsim_sweep_pair(n, k, p);
+		fprintf(f, ",t_separate_%c_%c", 'a' + p[0], 'a' + p[1]);
+	}
+	for (int s = 0; s < n; s++)
+		fprintf(f, ",location_%c", 'a' + s);
+	fputc('\n', f);
 	for (int g = 0; g < c->n_groups; g++)
 		for (int t = 0; t < c->trials; t++) {
-			const bsim_trial_result *a = trial_of(r, 0, g, t),
-			                        *b = trial_of(r, 1, g, t);
-			fprintf(f, "%d,%d,%s,%s,%s,%s,", g, t, bsim_trial_outcome_name(a->outcome),
-			        bsim_trial_type_name(a->type), bsim_trial_outcome_name(b->outcome),
-			        bsim_trial_type_name(b->type));
-			double ts = r->t_separate ? r->t_separate[(size_t)g * c->trials + t] : -1.0;
-			if (ts >= 0.0)
-				fprintf(f, "%.10g", ts);
-			char la[48], lb[48];
-			bsim_lattice_location_label(bsim_lattice_location_of(a), la, sizeof la);
-			bsim_lattice_location_label(bsim_lattice_location_of(b), lb, sizeof lb);
-			fprintf(f, ",%s,%s\n", la, lb);
+			size_t i = (size_t)g * c->trials + t;
+			fprintf(f, "%d,%d", g, t);
+			for (int s = 0; s < n; s++) {
+				const bsim_trial_result *x = &sides[s].run->trials_out[i];
+				fprintf(f, ",%s,%s", bsim_trial_outcome_name(x->outcome),
+				        bsim_trial_type_name(x->type));
+			}
+			for (int k = 0; k < n_pairs; k++) {
+				double ts =
+				        r->t_separate ? r->t_separate[(size_t)k * total + i] : -1.0;
+				fputc(',', f);
+				if (ts >= 0.0)
+					fprintf(f, "%.10g", ts);
+			}
+			for (int s = 0; s < n; s++) {
+				char label[48];
+				bsim_lattice_location_label(
+				        bsim_lattice_location_of(&sides[s].run->trials_out[i]),
+				        label, sizeof label);
+				fprintf(f, ",%s", label);
+			}
+			fputc('\n', f);
 		}
 }

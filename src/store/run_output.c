@@ -6,6 +6,7 @@
 #include <inttypes.h>
 #include <string.h>
 
+#include "beamsim/backend_registry.h"
 #include "util/atomic_file.h"
 #include "util/json.h"
 #include "beamsim/lattice.h"

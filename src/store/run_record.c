@@ -19,6 +19,7 @@
 #include "util/atomic_file.h"
 #include "util/file_read.h"
 #include "util/json.h"
+#include "beamsim/backend_registry.h"
 #include "beamsim/limits.h"
 #include "beamsim/output.h"
 #include "beamsim/version.h"
@@ -144,11 +145,15 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 	fputs(",\n  \"beamsim_version\": ", f);
 	bsim_json_string(f, BSIM_VERSION);
 	/* What made the record, beyond the version: the checkout's commit ("" if
-	 * not built from one), the Box2D of the box2d backend, the compiler. */
+	 * not built from one), the version of what each registered backend is
+	 * built on (NAME_version; the Box2D backend's was the first), the
+	 * compiler. */
 	fputs(",\n  \"beamsim_commit\": ", f);
 	bsim_json_string(f, bsim_version_commit());
-	fputs(",\n  \"box2d_version\": ", f);
-	bsim_json_string(f, bsim_version_box2d());
+	for (const bsim_backend *const *b = bsim_backend_list(); *b; b++) {
+		fprintf(f, ",\n  \"%s_version\": ", (*b)->name);
+		bsim_json_string(f, (*b)->version ? (*b)->version : "");
+	}
 	fputs(",\n  \"compiler\": ", f);
 	bsim_json_string(f, bsim_version_compiler());
 	fputs(",\n  \"source_experiment\": ", f);
@@ -316,12 +321,17 @@ int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 		rc = need_text(&d, root, "beamsim_version", rec->version, sizeof rec->version, err);
 	struct fy_node *b = ydoc_lookup(root, "backends");
 	if (!rc && (!b || !fy_node_is_sequence(b) || fy_node_sequence_item_count(b) < 1 ||
-	            fy_node_sequence_item_count(b) > 2))
-		rc = ydoc_expected(&d, b, NULL, "backends", "a list of 1 or 2 backends", err);
+	            fy_node_sequence_item_count(b) > BSIM_COMPARE_SIDES_MAX)) {
+		char want[64];
+		snprintf(want, sizeof want, "a list of 1 to %d backends", BSIM_COMPARE_SIDES_MAX);
+		rc = ydoc_expected(&d, b, NULL, "backends", want, err);
+	}
 	if (!rc)
 		rec->n_backends = fy_node_sequence_item_count(b);
 	for (int i = 0; !rc && i < rec->n_backends; i++)
 		rc = read_backend(&d, root, i, rec, err);
+	if (!rc && strcmp(rec->command, "compare") == 0 && rec->n_backends < 2)
+		rc = ydoc_expected(&d, b, NULL, "backends", "a comparison's 2 or more sides", err);
 	struct fy_node *pn = ydoc_lookup(root, "protocols");
 	if (!rc && pn &&
 	    (!fy_node_is_sequence(pn) || fy_node_sequence_item_count(pn) != 2 ||

@@ -11,6 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/run_record.h"
 #include "store/part_dir.h"
 #include "util/journal.h"

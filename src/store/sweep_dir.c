@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/compare_dir.h"
 #include "beamsim/effects.h"
 #include "beamsim/output.h"
@@ -34,7 +35,7 @@ bsim_sweep_dir_def bsim_sweep_dir_def_default(void)
 {
 	bsim_sweep_dir_def d;
 	memset(&d, 0, sizeof d);
-	d.backend = &bsim_backend_thesis;
+	d.backend = bsim_backend_default();
 	return d;
 }
 
@@ -184,7 +185,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	double t0 = bsim_clock_seconds();
 	memset(res, 0, sizeof *res);
 	res->first_unstable = -1;
-	const bsim_backend *b = def->backend ? def->backend : &bsim_backend_thesis;
+	const bsim_backend *b = def->backend ? def->backend : bsim_backend_default();
 	if (bsim_options_check(&def->opts, b->knobs, b->n_knobs, b->name, err) != BSIM_OK)
 		return BSIM_EINPUT;
 	bsim_experiment *e = &res->e;
@@ -315,7 +316,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 int bsim_store_sweep_rerun(const bsim_sweep_dir_def *def, const bsim_experiment *e,
                            const char *stage, bsim_sweep_result *r, bsim_error *err)
 {
-	const bsim_backend *b = def->backend ? def->backend : &bsim_backend_thesis;
+	const bsim_backend *b = def->backend ? def->backend : bsim_backend_default();
 	bsim_sweep_config cfg = {
 	        .backend = b,
 	        .opts = &def->opts,

@@ -1,7 +1,6 @@
-/* What the library is and what built it; see beamsim/version.h. The Box2D
- * version is its CMake package's (BSIM_BOX2D_VERSION, set by CMakeLists.txt):
- * Debian's 2.4.1 still says 2.4.0 in its b2_version. Chipmunk's is its
- * header's (BSIM_CHIPMUNK_VERSION, read by CMakeLists.txt). */
+/* What the library is and what built it; see beamsim/version.h. (What
+ * each backend is built on is in its table, bsim_backend.engine and
+ * version.) */
 #include "beamsim/version.h"
 
 #include "build_info.h"
@@ -14,16 +13,6 @@ const char *bsim_version(void)
 const char *bsim_version_commit(void)
 {
 	return BSIM_BUILD_COMMIT;
-}
-
-const char *bsim_version_box2d(void)
-{
-	return BSIM_BOX2D_VERSION;
-}
-
-const char *bsim_version_chipmunk(void)
-{
-	return BSIM_CHIPMUNK_VERSION;
 }
 
 #define TEXT_OF(x) #x

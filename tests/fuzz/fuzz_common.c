@@ -13,6 +13,7 @@
 #include <zlib.h>
 
 #include "beamsim/backend.h"
+#include "beamsim/backend_registry.h"
 #include "beamsim/trial.h"
 
 /* The essay's gate (Table 2.1), for experiments' `scene: gate.yaml`. */
@@ -241,7 +242,6 @@ void fuzz_check_error(int rc, const bsim_error *err)
 
 void fuzz_run_scene(const bsim_scene *scene)
 {
-	static const char *const names[] = {"thesis", "box2d"};
 	bsim_scene s;
 	if (bsim_scene_copy(&s, scene) != BSIM_OK)
 		return;
@@ -249,12 +249,12 @@ void fuzz_run_scene(const bsim_scene *scene)
 	if (s.max_steps > 200)
 		s.max_steps = 200;
 	bsim_trial_runner *r = bsim_trial_runner_alloc();
-	for (int i = 0; r && i < 2; i++) {
-		const bsim_backend *b = bsim_backend_find(names[i], NULL);
+	/* Every backend compiled in. */
+	for (const bsim_backend *const *b = bsim_backend_list(); r && *b; b++) {
 		bsim_trial_result res;
 		bsim_error err;
 		bsim_error_clear(&err);
-		int rc = b ? bsim_trial_run(r, &s, b, NULL, 1, NULL, &res, &err) : BSIM_OK;
+		int rc = bsim_trial_run(r, &s, *b, NULL, 1, NULL, &res, &err);
 		if (rc != BSIM_OK)
 			fuzz_check_error(rc, &err);
 	}

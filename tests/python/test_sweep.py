@@ -6,6 +6,7 @@ import filecmp
 import json
 
 import numpy as np
+import pytest
 
 import beamsim
 from conftest import cli
@@ -91,6 +92,29 @@ def test_compare_is_the_cli_compare(h1, tmp_path):
     for side in ("thesis", "box2d"):
         r = beamsim.run(tmp_path / "py", group=29, trial=1, backend=side)
         assert r["backend"] == side and r["stored_row"] == r["row"]
+
+
+def test_compare_three_sides_is_the_cli_compare(h1, tmp_path):
+    """compare(backends=...) of three sides: the program's files, the sides by
+    label in the order given, report.json's sides, pairwise and odd ones out."""
+    sides = ("thesis", "thesis:integrator=euler", "box2d")
+    cli("compare", h1, "--trials", 2, "--threads", 2, "--backends", ",".join(sides),
+        "--out", tmp_path / "cli")
+    c = beamsim.compare(h1, backends=sides, trials=2, out=tmp_path / "py")
+    for name in ("pairs.csv", "thesis/trials.csv", "thesis-integrator=euler/trials.csv",
+                 "box2d/trials.csv"):
+        assert filecmp.cmp(tmp_path / "cli" / name, tmp_path / "py" / name, shallow=False)
+    with open(tmp_path / "cli" / "report.json") as f:
+        report = json.load(f)
+    assert without_wall(c["report"]) == without_wall(report)
+    assert tuple(c["sides"]) == sides
+    assert [s["label"] for s in c["report"]["sides"]] == list(sides)
+    assert len(c["report"]["groups"][0]["pairwise"]) == 3
+    assert c["n_disagree"] == c["report"]["groups_disagreeing"]
+    assert list(c["pairs"])[:8] == ["group", "trial", "outcome_a", "type_a", "outcome_b",
+                                    "type_b", "outcome_c", "type_c"]
+    with pytest.raises(ValueError, match="expected 2 to 8"):
+        beamsim.compare(h1, backends=("thesis",), trials=1)
 
 
 def test_load_reads_run_out(gate, tmp_path):

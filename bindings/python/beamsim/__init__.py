@@ -25,12 +25,21 @@ import numpy as np
 
 from . import _beamsim
 
-__all__ = ["run", "sweep", "compare", "landscape", "load", "version"]
+__all__ = ["run", "sweep", "compare", "landscape", "load", "version", "backends"]
 
 
 def version():
     """libbeamsim's version."""
     return _beamsim.version()
+
+
+def backends():
+    """The backends compiled in, by name, as `beamsim backends` lists them;
+    the first is the default."""
+    return list(_beamsim.backends())
+
+
+backends_list = backends  # for functions whose argument is named backends
 
 
 # ---- arguments as the command line gives them ------------------------------
@@ -197,8 +206,9 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     as `beamsim sweep` runs it, the group's grid values applied); or the
     output directory of a sweep or comparison (the trial as that run ran it,
     with its seed, backend and options; backend names a comparison's side).
-    seed: None is the experiment's (a scene's: 1). backend: "thesis"
-    (None, the default), "box2d", or "NAME:KEY=VALUE..." as a compare side.
+    seed: None is the experiment's (a scene's: 1). backend: a name of
+    backends() (None: the first, the default), or "NAME:KEY=VALUE..." as a
+    compare side.
     set: {dotted key: value} scene overrides; backend_opt: {knob: value};
     grid: an experiment's axes {key: [values]}, as sweep's.
 
@@ -306,32 +316,43 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
             "threads": info["threads"], "out": out}
 
 
-def compare(experiment, backends=("thesis", "box2d"), trials=None, threads=None, set=None,
+def compare(experiment, backends=None, trials=None, threads=None, set=None,
             grid=None, seed=None, out=None, progress=None, resume=False, overwrite=False):
-    """The experiment on two sides with the same random-force schedules, as
-    `beamsim compare EXPERIMENT --backends A,B --out DIR` runs it. A side is
-    "NAME[:KEY=VALUE]...". resume: continue the stopped comparison in out,
-    as sweep's. overwrite: replace the finished result (or a stopped
-    comparison's journal) in out; without it such an out is refused.
-    Returns a dict: "report" (report.json), "pairs" (pairs.csv as arrays),
-    "sides" (each side's summary.json and trials arrays, by label),
-    "n_disagree" and "out"."""
-    a, b = backends
+    """The experiment on two or more sides (at most 8) with the same
+    random-force schedules, as `beamsim compare EXPERIMENT --backends A,B,...
+    --out DIR` runs it. A side is "NAME[:KEY=VALUE]...". resume: continue
+    the stopped comparison in out, as sweep's. backends None: the first two
+    of backends(), as compare's default. overwrite: replace the
+    finished result (or a stopped comparison's journal) in out; without it
+    such an out is refused.
+    Returns a dict: "report" (report.json: with three sides or more, its
+    "sides", "pairwise" and "odd_one_out" too), "pairs" (pairs.csv as
+    arrays), "sides" (each side's summary.json and trials arrays, by label,
+    in the order given), "n_disagree" (groups in which some pair of sides
+    disagrees) and "out"."""
+    if backends is None:
+        backends = tuple(backends_list())[:2]
+    if isinstance(backends, (str, bytes)):
+        raise TypeError("backends: expected a sequence of sides NAME[:KEY=VALUE]..., e.g. "
+                        f"{tuple(backends_list()[:2])}")
+    labels = tuple(backends)
+    if not 2 <= len(labels) <= 8:
+        raise ValueError(f"backends: {len(labels)} sides; expected 2 to 8")
     _no_nul("experiment", experiment)
     _no_nul("out", out)
-    _no_nul("backends", a)
-    _no_nul("backends", b)
+    for label in labels:
+        _no_nul("backends", label)
     with _Dir(out, "compare") as d:
-        info = _beamsim.compare(os.fspath(experiment), d, a, b, _count("trials", trials, 1),
+        info = _beamsim.compare(os.fspath(experiment), d, labels, _count("trials", trials, 1),
                                 _count("threads", threads, 1, 4096), _seed(seed), _sets(set),
                                 _grid(grid), progress, bool(resume), bool(overwrite))
         files = load(d)
     sides = {}
-    for label, name in zip((a, b), info["dirs"]):
+    for label, name in zip(labels, info["dirs"]):
         side = files.get(name, {})
         sides[label] = {"groups": side.get("summary", {}).get("groups"),
                         "trials": side.get("trials"), "summary": side.get("summary")}
-    for label, n in zip((a, b), info["unstable"]):
+    for label, n in zip(labels, info["unstable"]):
         if n:
             warnings.warn(f"{label}: {n} unstable trials", RuntimeWarning, stacklevel=2)
     return {"report": files.get("report"), "pairs": files.get("pairs"), "sides": sides,
