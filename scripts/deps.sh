@@ -10,9 +10,10 @@ set -euo pipefail
 # python3-pytest: the Python module (bindings/python) and its tests.
 # libopenmpi-dev and openmpi-bin: the program's MPI build and its test under
 # mpirun (docs/cluster.md). octave and liboctave-dev (mkoctfile): the MEX
-# functions of bindings/matlab and their test.
+# functions of bindings/matlab and their test. libchipmunk-dev: the chipmunk backend
+# (backends/chipmunk, Chipmunk2D 7).
 pkgs=(build-essential cmake pkg-config libgsl-dev libcmocka-dev libfyaml-dev libbox2d-dev
-      libmatio-dev gnuplot-nox fonts-dejavu-core libcairo2-dev ffmpeg zlib1g-dev
+      libmatio-dev libchipmunk-dev gnuplot-nox fonts-dejavu-core libcairo2-dev ffmpeg zlib1g-dev
       clang libclang-rt-14-dev libomp-dev python3 chromium python3-dev python3-numpy
       python3-pytest libopenmpi-dev openmpi-bin octave liboctave-dev)
 missing=()

@@ -2,6 +2,8 @@
 #ifndef BSIM_TESTS_SCENES_H
 #define BSIM_TESTS_SCENES_H
 
+#include <math.h>
+
 #include "beamsim/scene.h"
 
 /* The essay's gate with no effects at all, body at rest at (0, 0). */
@@ -29,6 +31,15 @@ static inline void scene_one_beam(bsim_scene *s)
 	b->damping = 0.0;
 	s->body.start[0] = 0.0;
 	s->body.start[1] = -100.0;
+}
+
+/* The damped oscillator I th'' + d th' + k th = 0 (underdamped) from
+ * theta(0) = th0 at rest: theta(t). */
+static inline double damped_oscillator(double k, double d, double inertia, double th0, double t)
+{
+	double wn = sqrt(k / inertia), zeta = d / (2.0 * sqrt(k * inertia));
+	double wd = wn * sqrt(1.0 - zeta * zeta);
+	return th0 * exp(-zeta * wn * t) * (cos(wd * t) + zeta * wn / wd * sin(wd * t));
 }
 
 /* The gate with elastic impacts (tangent and tip), springs but no dampers,

@@ -3,10 +3,11 @@
  * every backend runs with the default options do not reach
  * (test_impact, test_free_vibration, test_energy_ledger, test_mirror: its
  * bounds there are in its table, backends/box2d/box2d_world.cpp), and what
- * only it has: its expert setting, its options' checks, set_state's
- * float32 restart and b2_maxTranslation's clamp. Where Box2D cannot meet a
- * check exactly, the test bounds the deviation measured (a little above
- * it) and says so; each measured value is printed so a change shows.
+ * only it has: its expert setting, its options' checks and
+ * b2_maxTranslation's clamp (its restart from a state is test_set_state's,
+ * every backend's). Where Box2D cannot meet a check exactly, the test
+ * bounds the deviation measured (a little above it) and says so; each
+ * measured value is printed so a change shows.
  *   1 impact:          closed form with continuous=off
  *   2 free vibration:  the torque spring against the analytic oscillator;
  *                      its stability limit, against the weld's
@@ -21,6 +22,7 @@
 
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "backend_run.h"
 #include "impact_oracle.h"
 #include "scenes.h"
 #include "support.h"
@@ -34,29 +36,6 @@ static int setup(void **state)
 	return 0;
 }
 
-static bsim_options opts_of(const char *kv1, const char *kv2)
-{
-	bsim_options o;
-	bsim_error err;
-	memset(&o, 0, sizeof o);
-	if (kv1)
-		assert_int_equal(bsim_options_add(&o, kv1, &err), BSIM_OK);
-	if (kv2)
-		assert_int_equal(bsim_options_add(&o, kv2, &err), BSIM_OK);
-	return o;
-}
-
-static bsim_world *create(const bsim_scene *s, const bsim_options *o)
-{
-	bsim_world *w = NULL;
-	bsim_error err;
-	int rc = b2->create(s, o, &w, &err);
-	if (rc)
-		print_message("create: %s\n", err.msg);
-	assert_int_equal(rc, BSIM_OK);
-	return w;
-}
-
 /* ---- 1. impacts ---------------------------------------------------------- */
 
 static void test_tangent_impact_oracle(void **state)
@@ -65,7 +44,7 @@ static void test_tangent_impact_oracle(void **state)
 	/* continuous=off: the body moves far less than its radius a step, so
 	 * discrete steps find the same impact (the bench's cheaper setting);
 	 * the default options are test_impact's. */
-	bsim_options off = opts_of("continuous=off", NULL);
+	bsim_options off = test_options("continuous=off", NULL);
 	/* float32: measured <= 3e-7 relative; bound 1e-5 */
 	double worst = 0.0;
 	worst = fmax(worst, impact_tangent(b2, &off, 24.9, 0.8, 1.0, 1e-5));
@@ -80,13 +59,6 @@ static void test_tangent_impact_oracle(void **state)
 
 /* ---- 2. free vibration ---------------------------------------------------- */
 
-static double oscillator(double k, double d, double inertia, double th0, double t)
-{
-	double wn = sqrt(k / inertia), zeta = d / (2.0 * sqrt(k * inertia));
-	double wd = wn * sqrt(1.0 - zeta * zeta);
-	return th0 * exp(-zeta * wn * t) * (cos(wd * t) + zeta * wn / wd * sin(wd * t));
-}
-
 /* Max |theta - exact| over 3 s for a Table 2.1 beam released from 0.1 rad. */
 static double vibration_error(const char *spring, double h, double rest_deg)
 {
@@ -96,8 +68,8 @@ static double vibration_error(const char *spring, double h, double rest_deg)
 	s.beams[0].damping = 50.0;
 	s.beams[0].initial_theta = 0.1;
 	s.beams[0].rest_angle_deg = rest_deg;
-	bsim_options o = opts_of(spring, NULL);
-	bsim_world *w = create(&s, &o);
+	bsim_options o = test_options(spring, NULL);
+	bsim_world *w = bsim_test_world(b2, &s, &o);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
@@ -106,7 +78,8 @@ static double vibration_error(const char *spring, double h, double rest_deg)
 	for (long n = 1; n <= n_steps; n++) {
 		assert_int_equal(b2->step(w, zero, 0.0, h, NULL), BSIM_OK);
 		b2->get_state(w, &st);
-		double exact = oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
+		double exact =
+		        damped_oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
 		worst = fmax(worst, fabs(st.theta[0] - exact));
 		/* torque mode: d omega h omega' is negative only when omega
 		 * changes sign within the step */
@@ -158,8 +131,8 @@ static void test_stiff_spring_stability(void **state)
 			double k = inertia * (wh[c] / h) * (wh[c] / h);
 			s.beams[0].stiffness = k;
 			s.beams[0].initial_theta = 0.2;
-			bsim_options o = opts_of(weld ? "spring=weld" : "spring=torque", NULL);
-			bsim_world *w = create(&s, &o);
+			bsim_options o = test_options(weld ? "spring=weld" : "spring=torque", NULL);
+			bsim_world *w = bsim_test_world(b2, &s, &o);
 			bsim_state st;
 			bsim_state_init(&st, 1);
 			const double zero[2] = {0.0, 0.0};
@@ -195,19 +168,6 @@ static void test_stiff_spring_stability(void **state)
 
 /* ---- 3. energy ledger ----------------------------------------------------- */
 
-static bsim_trial_result run_trial(const bsim_scene *s, const bsim_options *o, uint64_t seed)
-{
-	bsim_trial_runner *r = bsim_trial_runner_alloc();
-	bsim_trial_result out;
-	bsim_error err;
-	int rc = bsim_trial_run(r, s, b2, o, seed, NULL, &out, &err);
-	if (rc)
-		print_message("trial: %s\n", err.msg);
-	assert_int_equal(rc, BSIM_OK);
-	bsim_trial_runner_free(r);
-	return out;
-}
-
 /* e = 1, tip e = 1, d = 0, no forces: E is conserved up to the integrators'
  * errors (the explicit spring's splitting at each impact, float32), the
  * weld's (the default's, whose bound test_energy_ledger checks) a loss. */
@@ -219,8 +179,8 @@ static void test_conservative_drift(void **state)
 	for (int k = 0; k < 2; k++) {
 		bsim_scene s;
 		scene_gate_conservative(&s);
-		bsim_options o = opts_of(springs[k], NULL);
-		bsim_trial_result out = run_trial(&s, &o, 1);
+		bsim_options o = test_options(springs[k], NULL);
+		bsim_trial_result out = test_trial(b2, &s, &o, 1);
 		const bsim_ledger *l = &out.ledger;
 		double drift = (l->e_end - l->e_start) / l->e_start;
 		print_message("box2d conservative, %s: E %.4f -> %.4f J (drift %.2e of E), impact "
@@ -249,9 +209,9 @@ static double ledger_ratio(const char *spring, const char *substeps, double *abs
 	for (int trial = 0; trial < 10; trial++) {
 		bsim_scene s;
 		bsim_scene_init_gate(&s, 7.0, 20.0);
-		bsim_options o = opts_of(spring, substeps);
+		bsim_options o = test_options(spring, substeps);
 		bsim_trial_result out =
-		        run_trial(&s, &o, bsim_schedule_seed_mix(3, 0, (uint64_t)trial));
+		        test_trial(b2, &s, &o, bsim_schedule_seed_mix(3, 0, (uint64_t)trial));
 		const bsim_ledger *l = &out.ledger;
 		double scale = fabs(l->w_prop) + fabs(l->w_rand) + l->damper + l->impact;
 		assert_true(l->damper > 0.0 && l->w_prop > 0.0);
@@ -289,7 +249,7 @@ static void test_driven_damped_noisy(void **state)
 static void test_expert_setting(void **state)
 {
 	(void)state;
-	bsim_options expert = opts_of("continuous=off", "sleep=on");
+	bsim_options expert = test_options("continuous=off", "sleep=on");
 	bsim_error err;
 	assert_int_equal(bsim_options_add(&expert, "velocity_iterations=4", &err), BSIM_OK);
 	const double force[] = {8.0, 9.0};
@@ -297,7 +257,8 @@ static void test_expert_setting(void **state)
 	for (int k = 0; k < 2; k++) {
 		bsim_scene s;
 		bsim_scene_init_gate(&s, force[k], 0.0);
-		bsim_trial_result a = run_trial(&s, NULL, 1), b = run_trial(&s, &expert, 1);
+		bsim_trial_result a = test_trial(b2, &s, NULL, 1),
+		                  b = test_trial(b2, &s, &expert, 1);
 		print_message(
 		        "box2d gate, F = %g N: %s in %d steps (defaults), %s in %d (expert)\n",
 		        force[k], bsim_trial_outcome_name(a.outcome), a.steps,
@@ -316,54 +277,13 @@ static void test_bad_options(void **state)
 	const char *bad[] = {"substeps=0",        "velocity_iterations=0", "unit_scale=-1",
 	                     "unit_scale=0.0001", "spring=rubber",         "nonsense=1"};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-		bsim_options o = opts_of(bad[i], NULL);
+		bsim_options o = test_options(bad[i], NULL);
 		bsim_world *w = NULL;
 		bsim_error err;
 		assert_int_equal(b2->create(&s, &o, &w, &err), BSIM_EINPUT);
 		assert_null(w);
 		assert_true(strlen(err.msg) > 0);
 	}
-	bsim_scene_free(&s);
-}
-
-/* set_state puts the bodies where asked (to float32) and a restarted world
- * follows the original closely. */
-static void test_set_state(void **state)
-{
-	(void)state;
-	bsim_scene s;
-	bsim_scene_init_gate(&s, 7.0, 0.0);
-	bsim_world *w = create(&s, NULL), *w2 = create(&s, NULL);
-	bsim_state st, st2;
-	bsim_state_init(&st, 2);
-	bsim_state_init(&st2, 2);
-	const double f[2] = {0.0, 7.0};
-	for (int n = 0; n < 700; n++) /* into contact with both beams */
-		assert_int_equal(b2->step(w, f, 0.0, s.dt, NULL), BSIM_OK);
-	b2->get_state(w, &st);
-	assert_true(st.theta[0] > 0.05 && st.theta[1] > 0.05);
-	bsim_error err;
-	assert_int_equal(b2->set_state(w2, &st, &err), BSIM_OK);
-	b2->get_state(w2, &st2);
-	assert_true(fabs(st2.x[1] - st.x[1]) <= 1e-5 && fabs(st2.theta[0] - st.theta[0]) <= 1e-6);
-	assert_true(fabs(st2.omega[1] - st.omega[1]) <= 1e-6);
-	for (int n = 0; n < 100; n++) {
-		assert_int_equal(b2->step(w, f, 0.0, s.dt, NULL), BSIM_OK);
-		assert_int_equal(b2->step(w2, f, 0.0, s.dt, NULL), BSIM_OK);
-	}
-	b2->get_state(w, &st);
-	b2->get_state(w2, &st2);
-	print_message("box2d set_state: restarted run differs by %.2e m after 0.4 s\n",
-	              fabs(st2.x[1] - st.x[1]));
-	assert_true(fabs(st2.x[1] - st.x[1]) <= 1e-3);
-	bsim_state bad;
-	bsim_state_init(&bad, 3);
-	assert_int_equal(b2->set_state(w2, &bad, &err), BSIM_EINPUT);
-	bsim_state_free(&bad);
-	bsim_state_free(&st);
-	bsim_state_free(&st2);
-	b2->destroy(w);
-	b2->destroy(w2);
 	bsim_scene_free(&s);
 }
 
@@ -383,7 +303,7 @@ static void check_clamp(double speed, const char *scale, double moved, long clam
 	bsim_error err;
 	if (scale)
 		assert_int_equal(bsim_options_add(&o, scale, &err), BSIM_OK);
-	bsim_world *w = create(&s, &o);
+	bsim_world *w = bsim_test_world(b2, &s, &o);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
@@ -416,7 +336,6 @@ int main(void)
 	        cmocka_unit_test(test_driven_damped_noisy),
 	        cmocka_unit_test(test_expert_setting),
 	        cmocka_unit_test(test_bad_options),
-	        cmocka_unit_test(test_set_state),
 	        cmocka_unit_test(test_clamped_motion),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);

@@ -185,6 +185,30 @@ static void test_version(void **state)
 	cli_run_free(&r);
 }
 
+/* `run --json` prints the one JSON object and nothing else, on every
+ * backend of the registry: an engine that writes to stdout itself
+ * (Debian's Chipmunk prints a banner at its first space; the chipmunk
+ * backend sends it to /dev/null) would put its lines first. */
+static void test_run_json_alone(void **state)
+{
+	(void)state;
+	for (const bsim_backend *const *b = bsim_backend_list(); *b; b++) {
+		const char *argv[] = {"run", gate, "--backend", (*b)->name, "--json", NULL};
+		cli_run r = run_cli(argv);
+		assert_int_equal(r.status, 0);
+		assert_true(r.out[0] == '{');
+		char backend[128];
+		snprintf(backend, sizeof backend, "\"backend\": \"%s\"", (*b)->name);
+		assert_non_null(strstr(r.out, backend));
+		const char *end = strrchr(r.out, '}');
+		assert_non_null(end);
+		assert_string_equal(end, "}\n");
+		assert_null(strstr(r.out, "Chipmunk v"));
+		assert_null(strstr(r.err, "Chipmunk v"));
+		cli_run_free(&r);
+	}
+}
+
 static void test_bad_usage(void **state)
 {
 	(void)state;
@@ -744,6 +768,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_help),
 	        cmocka_unit_test(test_version),
+	        cmocka_unit_test(test_run_json_alone),
 	        cmocka_unit_test(test_help_command),
 	        cmocka_unit_test(test_bad_usage),
 	        cmocka_unit_test(test_sweep_needs_out),

@@ -90,6 +90,41 @@ static void test_halves_are_sweeps(void **state)
 	}
 }
 
+/* Every backend of the registry is a side of one comparison (`--backends
+ * A,B,C,...`, the whole list), and each side is that backend's own sweep. */
+static void test_every_backend_a_side(void **state)
+{
+	(void)state;
+	const bsim_backend *const *list = bsim_backend_list();
+	char sides[512] = "";
+	for (int n = 0; list[n]; n++)
+		snprintf(sides + strlen(sides), sizeof sides - strlen(sides), "%s%s", n ? "," : "",
+		         list[n]->name);
+	char dir[1200];
+	snprintf(dir, sizeof dir, "%s", out_dir("cmp_all"));
+	const char *argv[] = {"compare", experiment, "--backends", sides, "--threads",
+	                      "2",       "--quiet",  "--out",      dir,   NULL};
+	int status = bsim_test_cli(argv, NULL, NULL);
+	if (status != 0 && status != 3)
+		fail_msg("compare --backends %s: exit %d", sides, status);
+	for (int n = 0; list[n]; n++) {
+		char name[64];
+		snprintf(name, sizeof name, "side_sweep_%s", list[n]->name);
+		const char *sweep = out_dir(name);
+		const char *sw[] = {"sweep",   experiment, "--backend", list[n]->name,
+		                    "--quiet", "--out",    sweep,       NULL};
+		assert_int_equal(bsim_test_cli(sw, NULL, NULL), 0);
+		char sub[1300];
+		snprintf(sub, sizeof sub, "%s/%s", dir, list[n]->name);
+		char *a = read_in(sweep, "trials.csv"), *b = read_in(sub, "trials.csv");
+		if (strcmp(a, b) != 0)
+			fail_msg("compare --backends %s: the %s side differs from its sweep", sides,
+			         list[n]->name);
+		free(a);
+		free(b);
+	}
+}
+
 /* The exit status says what report.json says; threads change nothing. */
 static void test_status_and_threads(void **state)
 {
@@ -705,6 +740,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_halves_are_sweeps),
+	        cmocka_unit_test(test_every_backend_a_side),
 	        cmocka_unit_test(test_status_and_threads),
 	        cmocka_unit_test(test_compare_replays),
 	        cmocka_unit_test(test_regress_identical),

@@ -8,7 +8,7 @@
  *   step is the first that ends within the tolerance or holds t*, whichever
  *   comes first, on every backend; at 10 m/s the body has bounced clear by
  *   more than the tolerance at the impact step's end, so the impulse alone
- *   flags it.
+ *   flags it, on a backend whose impact acts before the shapes overlap.
  * - A grazing pass parallel to the beam, from beside it to past its tip:
  *   the gap is known all along the straight path (the clearance c beside
  *   the beam, the distance to the tip beyond it); with c = 8 mm no step is
@@ -109,10 +109,21 @@ static void test_head_on_impact(void **state)
 			        b->name, u, t_star, step, BSIM_CONTACT_TOL, near, first,
 			        gap_at_impact);
 			assert_int_equal(first, want);
-			/* at 10 m/s the impact step ends with the body clear: the
-			 * impulse is what flags it */
-			if (u == 10.0 && near >= step)
-				assert_true(gap_at_impact > BSIM_CONTACT_TOL);
+			/* at 10 m/s a backend that resolves the impact before the
+			 * shapes meet (the thesis backend's speculative contact,
+			 * Box2D's skin) ends the impact step with the body clear: the
+			 * impulse is what flags it. One whose contact acts once the
+			 * shapes overlap (Chipmunk) ends it overlapping, flagged by
+			 * the gap too. */
+			if (u == 10.0 && near >= step) {
+				if (gap_at_impact >= 0.0)
+					assert_true(gap_at_impact > BSIM_CONTACT_TOL);
+				else
+					print_message(
+					        "%s: the impact step ends overlapping (%.4f m): "
+					        "the gap flags it too\n",
+					        b->name, gap_at_impact);
+			}
 			bsim_state_free(&st);
 			b->destroy(w);
 		}

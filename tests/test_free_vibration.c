@@ -18,14 +18,6 @@
 #include "scenes.h"
 #include "support.h"
 
-/* Closed-form underdamped response with theta(0) = th0, omega(0) = 0. */
-static double oscillator(double k, double d, double inertia, double th0, double t)
-{
-	double wn = sqrt(k / inertia), zeta = d / (2.0 * sqrt(k * inertia));
-	double wd = wn * sqrt(1.0 - zeta * zeta);
-	return th0 * exp(-zeta * wn * t) * (cos(wd * t) + zeta * wn / wd * sin(wd * t));
-}
-
 /* A Table 2.1 beam alone (no body in reach), released from theta0 at rest,
  * at rest angle rest_deg. */
 static bsim_world *beam_released(const bsim_backend *b, bsim_scene *s, double k, double d,
@@ -52,7 +44,8 @@ static double vibration_error(const bsim_backend *b, double h, double t_end, dou
 	for (long n = 1; n <= n_steps; n++) {
 		assert_int_equal(b->step(w, zero, 0.0, h, NULL), BSIM_OK);
 		b->get_state(w, &st);
-		double exact = oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
+		double exact =
+		        damped_oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
 		worst = fmax(worst, fabs(st.theta[0] - exact));
 	}
 	bsim_state_free(&st);

@@ -329,9 +329,10 @@ static void test_limits(void **state)
 	free(g);
 }
 
-/* Extreme but valid numbers: every double-to-integer conversion they reach
- * is defined (the sanitized build halts on one that is not: UBSan's
- * float-cast-overflow). Each run ends with a result or a stated failure. */
+/* Extreme but valid numbers, on every backend of the registry: every
+ * double-to-integer conversion they reach is defined (the sanitized build
+ * halts on one that is not: UBSan's float-cast-overflow). Each run ends with a result or a stated
+ * failure. */
 static void test_extreme_numbers(void **state)
 {
 	(void)state;
@@ -344,18 +345,18 @@ static void test_extreme_numbers(void **state)
 	        {"effects.random_force.frequency=1e5", "integration.dt=1e-8"},
 	        {"body.mass=1e-300", "body.velocity=[1e300, -1e300]"},
 	};
-	const char *backends[] = {"thesis", "box2d"};
+	const bsim_backend *const *backends = bsim_backend_list();
 	for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++) {
-		for (int b = 0; b < 2; b++) {
-			const char *argv[] = {"run",       gate(),     "--backend",
-			                      backends[b], "--set",    sets[i][0],
-			                      "--set",     sets[i][1], NULL};
+		for (int b = 0; backends[b]; b++) {
+			const char *argv[] = {"run",   gate(),     "--backend", backends[b]->name,
+			                      "--set", sets[i][0], "--set",     sets[i][1],
+			                      NULL};
 			char *err = NULL;
 			bsim_test_opts o = {.timeout = TIMEOUT};
 			int rc = bsim_test_cli_with(argv, &o, NULL, &err);
 			if ((rc != 0 && rc != 1 && rc != 2) || strstr(err, "runtime error"))
-				fail_msg("%s --set %s --set %s: exit %d, stderr %s", backends[b],
-				         sets[i][0], sets[i][1], rc, err);
+				fail_msg("%s --set %s --set %s: exit %d, stderr %s",
+				         backends[b]->name, sets[i][0], sets[i][1], rc, err);
 			free(err);
 		}
 	}

@@ -20,10 +20,11 @@ enum { BSIM_CONTACT_NONE = 0, BSIM_CONTACT_TANGENT = 1, BSIM_CONTACT_TIP = 2 };
  * beam exchanged a nonzero impulse with the body during the step (an impact
  * is flagged on the step it happens in). contact[i] is then the contact's
  * type at the step's end: TANGENT when the nearest point of the segment lies
- * inside it, TIP at either end. 6 mm: above the gaps at which both solvers
+ * inside it, TIP at either end. 6 mm: above the gaps at which the solvers
  * hold a resting contact, the thesis backend's within 1e-6 m, Box2D's
  * anywhere below b2_linearSlop / unit_scale = 5 mm (float32 adds 2e-6 m),
- * and 0.06% of the body's radius (docs/backends.md, "The contact flag"). */
+ * Chipmunk's at an overlap, and 0.06% of the body's radius (docs/backends.md,
+ * "The contact flag"). */
 #define BSIM_CONTACT_TOL 6e-3 /* m */
 
 /* Energy flows of the last step, J, as measured by the backend. With the

@@ -9,7 +9,8 @@
  * new backend adds its line here and nothing else outside its folder. */
 #define BSIM_BACKENDS(X)                                                                           \
 	X(thesis)                                                                                  \
-	X(box2d)
+	X(box2d)                                                                                   \
+	X(chipmunk)
 
 #define BSIM_BACKEND_DECLARE(name) extern const bsim_backend bsim_backend_##name;
 #define BSIM_BACKEND_ENTRY(name)   &bsim_backend_##name,
