@@ -77,6 +77,13 @@ static const bsim_knob_setting thesis_accuracy[] = {
  * measured (they print it), most of them round-off of doubles. */
 static const bsim_backend_bound thesis_bounds[] = {
         {"impact", 1e-12, "one closed-form impulse in double"},
+        {"impact.shape", 1e-12,
+         "a capsule's end or an ellipse's tip: the outline's normal through the centre, one "
+         "closed-form impulse in double (3.5e-16)"},
+        {"impact.shape.flat", 1e-12,
+         "a capsule's flat side: its two points in one simultaneous solve, in double (8.3e-16)"},
+        {"impact.shape.restitution", 1e-12,
+         "the true ellipse's contact point: Newton's law there, in double (8.9e-16)"},
         {"vibration", 2e-5, "the midpoint rule, 0.02% of theta0 over 3 s"},
         {"vibration.order", 2, "the midpoint rule is second order"},
         {"vibration.mirror", 1e-12, "round-off"},
