@@ -110,6 +110,73 @@ static void test_selection(void **state)
 	free(eq);
 }
 
+/* The Pareto front of accuracy.md, worked out by hand on a table of its
+ * own: the rows at the reference step (a backend against itself: error 0,
+ * or another setting's round-off) neither join the front nor push a row
+ * off it, as in the figure; of the others a row joins when no other is at
+ * least as fast and as accurate and better in one. */
+static void test_front(void **state)
+{
+	(void)state;
+	/* backend, reference, h (s), err_mean (m), speed (x real time) */
+	static const struct {
+		const char *backend;
+		int reference;
+		double h, err, speed;
+		int front;
+	} t[] = {
+	        {"thesis", 0, 0.004, 2e-3, 4e4, 1},     /* fastest */
+	        {"thesis", 0, 0.001, 7e-4, 7e3, 1},     /* */
+	        {"thesis", 1, 0.000125, 0.0, 300, 0},   /* the reference */
+	        {"thesis", 0, 0.000125, 1e-15, 330, 0}, /* another setting at h_ref */
+	        {"box2d", 0, 0.004, 5e-3, 1e3, 0},      /* slower and worse than row 0 */
+	        {"box2d", 0, 0.00025, 1.2e-4, 50, 1},   /* off the front only by rows 2, 3 */
+	        {"box2d", 0, 0.0005, 2.2e-4, 40, 0},    /* slower and worse than row 5 */
+	};
+	enum { N = sizeof t / sizeof t[0] };
+	bsim_accuracy_row rows[N];
+	memset(rows, 0, sizeof rows);
+	for (int i = 0; i < N; i++) {
+		rows[i].backend = t[i].backend;
+		snprintf(rows[i].setting, sizeof rows[i].setting, "row%d", i);
+		rows[i].reference = t[i].reference;
+		rows[i].h = t[i].h;
+		rows[i].err_mean = t[i].err;
+		rows[i].speed = t[i].speed;
+		rows[i].cpu_cost = 1.0 / t[i].speed;
+	}
+	bsim_accuracy_result r = {.n = N, .rows = rows};
+	bsim_accuracy_config cfg = bsim_accuracy_config_default();
+	cfg.n_targets = 0;
+	assert_true(cfg.h_ref == 0.000125);
+	const char *dir = bsim_test_dir("accuracy_front");
+	char path[1100];
+	snprintf(path, sizeof path, "%s/accuracy.md", dir);
+	bsim_error err;
+	assert_int_equal(bsim_accuracy_write_md(path, &r, &cfg, "hand-made", &err), BSIM_OK);
+	char *md = bsim_test_read(path);
+	assert_non_null(md);
+	const char *front = strstr(md, "## Pareto front");
+	assert_non_null(front);
+	for (int i = 0; i < N; i++) {
+		/* the row in the table, ending in its mark; and in the front's list */
+		char line[128];
+		snprintf(line, sizeof line, "| %s | row%d%s |", t[i].backend, i,
+		         t[i].reference ? " (ref)" : "");
+		const char *row = strstr(md, line);
+		assert_non_null(row);
+		const char *eol = strchr(row, '\n');
+		assert_non_null(eol);
+		int marked = eol[-3] == '*';
+		snprintf(line, sizeof line, "| %s | row%d |", t[i].backend, i);
+		int listed = strstr(front, line) != NULL;
+		if (marked != t[i].front || listed != t[i].front)
+			fail_msg("row %d: marked %d, listed %d, by hand %d", i, marked, listed,
+			         t[i].front);
+	}
+	free(md);
+}
+
 static void test_bad_targets(void **state)
 {
 	(void)state;
@@ -138,6 +205,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_selection),
 	        cmocka_unit_test(test_bad_targets),
+	        cmocka_unit_test(test_front),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
