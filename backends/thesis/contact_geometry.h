@@ -148,7 +148,7 @@ THESIS_SPECIALISED int contact_from_geometry(const thesis_geometry *g, int i, do
 static inline int beam_beyond_reach(const struct bsim_world *w, const thesis_beam *b, double margin)
 {
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-	double reach = b->length + w->radius + margin;
+	double reach = b->reach + margin; /* L + R + margin */
 	return dx * dx + dy * dy > reach * reach;
 }
 

@@ -56,7 +56,7 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 		double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
 		c->omega_free = thesis_beam_free_omega(b, h, w->integrator);
 		double gap = bsim_fmax(c->gap, 0.0);
-		c->inv_i = thesis_beam_response(b, h, w->integrator);
+		c->inv_i = thesis_beam_response(b, w->integrator);
 		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
 		vrel0 += w0 * c->cb;
 		c->vrel += wf * c->cb;

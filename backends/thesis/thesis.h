@@ -73,6 +73,7 @@ typedef struct thesis_beam {
 	double u0[2];       /* rest direction, exact for multiples of 90 degrees */
 	double sgn;         /* +1: forward swing is counter-clockwise */
 	double length;      /* m */
+	double reach;       /* L + R, m: the reach tests' L + R + margin, summed once */
 	double inertia;     /* kg m^2 about the pivot */
 	double stiffness;   /* N m/rad */
 	double damping;     /* N m s/rad */
@@ -540,7 +541,7 @@ static inline void thesis_smooth_row(thesis_contact *c, const thesis_beam *b, co
 	double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
 	c->omega_free = thesis_beam_free_omega(b, h, integrator);
 	double gap = bsim_fmax(c->gap, 0.0);
-	c->inv_i = thesis_beam_response(b, h, integrator);
+	c->inv_i = thesis_beam_response(b, integrator);
 	c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
 	c->bound = integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 }

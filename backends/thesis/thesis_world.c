@@ -256,6 +256,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		bsim_scene_beam_rest_direction(d, b->u0);
 		b->sgn = bsim_scene_beam_forward_sign(d); /* forward = toward +y */
 		b->length = d->length;
+		b->reach = b->length + w->radius; /* w->radius: body_setup's, above */
 		b->inertia = d->inertia;
 		b->inv_inertia = 1.0 / d->inertia;
 		b->h_d = NAN; /* thesis_beam_prepare at the first step */
