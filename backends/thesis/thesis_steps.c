@@ -79,8 +79,9 @@ static inline int gate_lcp(double inv_mass, thesis_contact *cs, int n)
 	return 0;
 }
 
-/* The masks of a run: the beams awake, typed (contact_type not NONE),
- * flagged (flag not NONE). Pushed beams live within a step. */
+/* The masks of a run: the beams awake, typed (the step's: contact_type
+ * not NONE, written when the run ends), flagged (flag not NONE). Pushed
+ * beams live within a step. */
 typedef struct gate_masks {
 	unsigned awake, typed, flagged;
 } gate_masks;
@@ -224,9 +225,6 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 	double e_damper = 0.0, e_impact = 0.0, e_contact = 0.0, e_correction = 0.0;
 	int impacts = 0;
 	unsigned pushed = 0;
-	for (int i = 0; i < nb; i++)
-		if (gate_in(mk->typed, i))
-			w->contact_type[i] = BSIM_CONTACT_NONE;
 	mk->typed = 0;
 	/* step_detect: every beam a candidate, in order */
 	double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) + hv;
@@ -242,13 +240,9 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 	gate_solve(w, dv, h, nc, mk->awake, &pushed, &e_damper, &e_contact, integrator, nb);
 	int n = nc ? gate_project(w, force, nc, &e_correction) : 0;
 	w->n_contacts = n;
-	for (int k = 0; k < n; k++) {
-		const thesis_contact *c = &w->contacts[k];
-		if (c->gap <= w->contact_tol) {
-			w->contact_type[c->beam] = c->type;
-			mk->typed |= 1u << c->beam;
-		}
-	}
+	for (int k = 0; k < n; k++)
+		if (w->contacts[k].gap <= w->contact_tol)
+			mk->typed |= 1u << w->contacts[k].beam;
 	/* thesis_awake_prune */
 	for (int i = 0; i < nb; i++) {
 		const thesis_beam *b = &w->beams[i];
@@ -290,8 +284,11 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 	gate_masks mk = {0, 0, 0};
 	for (int k = 0; k < w->n_awake; k++)
 		mk.awake |= 1u << w->awake[k];
+	/* No step of the run reads contact_type (the typed mask, each step's,
+	 * stands for it): it is cleared here and set from the last step's
+	 * contacts at the end, as the steps one after another leave it. */
 	for (int k = 0; k < w->n_typed; k++)
-		mk.typed |= 1u << w->typed[k];
+		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
 	for (int k = 0; k < w->n_flagged; k++)
 		mk.flagged |= 1u << w->flagged[k];
 	/* step_detect's h |F| / M and the smooth solve's h F / M, as they
@@ -303,6 +300,11 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 	/* The lists as the general path leaves them: ascending awake and
 	 * flagged beams, the typed ones (any order: only cleared), nothing
 	 * pushed; the last step's energy flows and impacts. */
+	for (int k = 0; k < w->n_contacts; k++) {
+		const thesis_contact *c = &w->contacts[k];
+		if (c->gap <= w->contact_tol)
+			w->contact_type[c->beam] = c->type;
+	}
 	w->n_awake = w->n_typed = w->n_flagged = 0;
 	for (int i = 0; i < nb; i++) {
 		w->is_awake[i] = (unsigned char)gate_in(mk.awake, i);
