@@ -57,8 +57,12 @@ static inline void thesis_beam_direction(thesis_beam *b, double u[2])
 }
 
 /* The body's centre x against the beam at its angle: b->geo; the lever a
- * kept for the extended path only (extended: constant, see below). */
-THESIS_SPECIALISED void geometry_compute(thesis_beam *b, const double x[2], const int extended)
+ * kept for the extended path only (extended: a constant, see below, which
+ * the compiler gives each copy). Kept apart from its callers (it may call
+ * the sine and cosine): inline, the detection and the runs of steps around
+ * it compiled to 30 instructions a step more on H1 (bench --callgrind),
+ * most of their calls reusing a geometry or bounding it far instead. */
+THESIS_APART void geometry_compute(thesis_beam *b, const double x[2], const int extended)
 {
 	thesis_geometry *g = &b->geo;
 	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
