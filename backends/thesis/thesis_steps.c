@@ -190,8 +190,10 @@ static inline int gate_project(struct bsim_world *w, const double force[2], int 
 
 /* contact_report.c's contact_report for the disk: the flag of every beam
  * (the candidates of a world this small are all its beams, in order); a
- * flagged beam is woken. */
-static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pushed, int nb)
+ * flagged beam is woken. d2: each beam's beam_pivot_distance2 at the
+ * step's end, which the next step's detection meets again. */
+static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pushed, double *d2,
+                               int nb)
 {
 	for (int i = 0; i < nb; i++)
 		if (gate_in(mk->flagged, i))
@@ -199,7 +201,8 @@ static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pu
 	mk->flagged = 0;
 	for (int i = 0; i < nb; i++) {
 		int is_pushed = gate_in(pushed, i);
-		if (!is_pushed && !contact_near(w, i, BSIM_CONTACT_TOL, 0))
+		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
+		if (!is_pushed && !contact_near_at(w, i, d2[i], BSIM_CONTACT_TOL, 0))
 			continue;
 		thesis_beam *b = &w->beams[i];
 		double u[2];
@@ -217,9 +220,10 @@ static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pu
 
 /* One step (step_run for extended 0, the head's differences) under the
  * force, its state into s. hv: h |F| / M of the margins' speed bound; dv:
- * h F / M of the free velocity. */
+ * h F / M of the free velocity; d2: each beam's beam_pivot_distance2 where
+ * the body is, for the next step at its end (nothing moves in between). */
 THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], double h, double hv,
-                                  const double dv[2], gate_masks *mk, bsim_state *s,
+                                  const double dv[2], gate_masks *mk, double *d2, bsim_state *s,
                                   const int integrator, const int nb)
 {
 	double e_damper = 0.0, e_impact = 0.0, e_contact = 0.0, e_correction = 0.0;
@@ -231,7 +235,7 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 	int nc = 0;
 	for (int i = 0; i < nb; i++) {
 		double margin = thesis_step_margin(w, &w->beams[i], speed, h);
-		int got = contact_detect(w, i, margin, &w->contacts[nc], 0);
+		int got = disk_detect_at(w, i, d2[i], margin, &w->contacts[nc], 0);
 		mk->awake |= (unsigned)got << i;
 		nc += got;
 	}
@@ -250,7 +254,7 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 		    !gate_in(mk->typed, i))
 			mk->awake &= ~(1u << i);
 	}
-	gate_report(w, mk, pushed, nb);
+	gate_report(w, mk, pushed, d2, nb);
 	/* get_state */
 	thesis_state_body(w, s);
 	int na = 0;
@@ -295,8 +299,11 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 	 * compute them */
 	const double hv = h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
 	const double dv[2] = {h * force[0] * w->inv_mass, h * force[1] * w->inv_mass};
+	double d2[THESIS_STEPS_BEAMS];
+	for (int i = 0; i < nb; i++)
+		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
 	for (int k = 0; k < n; k++)
-		gate_step(w, force, h, hv, dv, &mk, &out[k], integrator, nb);
+		gate_step(w, force, h, hv, dv, &mk, d2, &out[k], integrator, nb);
 	/* The lists as the general path leaves them: ascending awake and
 	 * flagged beams, the typed ones (any order: only cleared), nothing
 	 * pushed; the last step's energy flows and impacts. */
