@@ -42,8 +42,9 @@ struct bsim_trial_runner {
 	bsim_state whole;  /* the whole lattice's state, for recording (essay protocol) */
 	trial_peaks peaks;
 	trial_essay essay;
-	trial_flight flight; /* free-flight runs */
-	trial_steps steps;   /* runs of steps */
+	trial_flight flight;  /* free-flight runs */
+	trial_steps steps;    /* runs of steps */
+	bsim_schedule *spare; /* the last trial's random-force schedule, for the next */
 	/* The world of the last trial, kept for the next trial of the same
 	 * scene, backend and options (bsim_trial_runner_keep_worlds). */
 	int keep;
@@ -85,6 +86,7 @@ void bsim_trial_runner_free(bsim_trial_runner *r)
 	bsim_state_free(&r->whole);
 	trial_peaks_free(&r->peaks);
 	trial_steps_free(&r->steps);
+	bsim_schedule_free(r->spare);
 	runner_forget_world(r);
 	free(r->shape);
 	free(r);
@@ -194,7 +196,7 @@ static int trial_open(trial_ctx *c, uint64_t seed, bsim_error *err)
 		trial_essay_release(&c->r->essay, c->backend, &c->w);
 		return rc;
 	}
-	if (bsim_effects_init_taking(c->fx, c->scene, seed, c->backend->takes)) {
+	if (bsim_effects_init_spare(c->fx, c->scene, seed, c->backend->takes, &c->r->spare)) {
 		c->backend->destroy(c->w);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
@@ -365,8 +367,8 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, const bsim_state *s0,
 		rc = bsim_effects_status(c->fx, err);
 	if (rc == BSIM_OK && c->log && trial_log_peaks(c->log, c->r->peaks.peak, c->scene->n_beams))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the peaks");
-	bsim_effects_free(c->fx);
 	bsim_trial_runner *r = c->r;
+	bsim_effects_free_spare(c->fx, &r->spare);
 	if (r->keep && c->backend->reset && c->map == NULL && c->w && rc == BSIM_OK) {
 		r->kept = c->w; /* the next trial of this scene resets it */
 		r->kept_scene = c->scene;
