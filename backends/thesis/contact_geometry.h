@@ -188,9 +188,11 @@ static inline int geometry_fresh(const struct bsim_world *w, const thesis_beam *
  * (the projection's re-detection), which geometry_far seldom rejects;
  * that test only saves the exact one, so it is not asked there (the same
  * result). d2: the body's |C - P|^2 from the beam's pivot where it is
- * (beam_pivot_distance2), which a caller may hold from before. */
+ * (beam_pivot_distance2), which a caller may hold from before. touched (a
+ * constant): every beam is touched already (thesis_beam_touch; a run of
+ * steps touches them all first). */
 THESIS_SPECIALISED int disk_detect_at(struct bsim_world *w, int i, double d2, double margin,
-                                      thesis_contact *out, const int near)
+                                      thesis_contact *out, const int near, const int touched)
 {
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
 	if (beam_beyond(b, d2, margin))
@@ -199,7 +201,8 @@ THESIS_SPECIALISED int disk_detect_at(struct bsim_world *w, int i, double d2, do
 	if (!geometry_fresh(w, b, 0)) {
 		if (!near && geometry_far(w, b, w->x, w->radius, margin, 0))
 			return 0;
-		thesis_beam_touch(w, i);
+		if (!touched)
+			thesis_beam_touch(w, i);
 		geometry_compute(b, w->x, 0);
 	}
 	return contact_from_geometry(g, i, w->radius, margin, w->e_tip, w->e_tangent, out);
@@ -207,9 +210,10 @@ THESIS_SPECIALISED int disk_detect_at(struct bsim_world *w, int i, double d2, do
 
 /* disk_detect_at for the body where it is. */
 THESIS_SPECIALISED int disk_detect(struct bsim_world *w, int i, double margin, thesis_contact *out,
-                                   const int near)
+                                   const int near, const int touched)
 {
-	return disk_detect_at(w, i, beam_pivot_distance2(w, &w->beams[i]), margin, out, near);
+	return disk_detect_at(w, i, beam_pivot_distance2(w, &w->beams[i]), margin, out, near,
+	                      touched);
 }
 
 /* Detection for any body (extended 1: the world's flags decide) or for the
@@ -219,7 +223,7 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
                                       thesis_contact *out, const int extended)
 {
 	if (!extended)
-		return disk_detect(w, i, margin, out, 0);
+		return disk_detect(w, i, margin, out, 0, 0);
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
 	if (beam_beyond_reach(w, b, margin))
 		return 0;

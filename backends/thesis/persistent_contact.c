@@ -73,7 +73,7 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 		thesis_impulse_sum_extended(cs, n, j, &jw);
 	}
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
 	thesis_body_turn(w, w0, torque, jw, h);
 	double wm = w->integrator == THESIS_EULER ? w->angular_velocity
 	                                          : 0.5 * (w0 + w->angular_velocity);
@@ -151,7 +151,7 @@ void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double for
 		thesis_impulse_sum(cs, n, j);
 	}
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
 
 	/* Beams in contact take their impulse; all others move freely. A beam
 	 * at rest and untouched stays at rest and costs nothing: only the awake

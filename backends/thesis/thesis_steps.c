@@ -144,7 +144,7 @@ THESIS_SPECIALISED void gate_solve(struct bsim_world *w, const double dv[2], dou
 				*pushed |= 1u << cs[k].beam;
 	}
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_advance(w, v0, vf, j, h, vm, integrator);
 	double damper = *e_damper, contact = *e_contact;
 	for (int i = 0; i < nb; i++)
 		if (gate_in(awake, i))
@@ -162,7 +162,7 @@ static inline int gate_redetect(struct bsim_world *w, int n, double margin)
 	thesis_contact *cs = w->contacts;
 	int m = 0;
 	for (int k = 0; k < n; k++)
-		m += disk_detect(w, cs[k].beam, margin, &cs[m], 1);
+		m += disk_detect(w, cs[k].beam, margin, &cs[m], 1, 1);
 	return m;
 }
 
@@ -195,26 +195,25 @@ static inline int gate_project(struct bsim_world *w, const double force[2], int 
 static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pushed, double *d2,
                                int nb)
 {
-	for (int i = 0; i < nb; i++)
-		if (gate_in(mk->flagged, i))
-			w->flag[i] = BSIM_CONTACT_NONE;
+	/* every flag written: a beam not flagged before holds NONE already */
 	mk->flagged = 0;
 	for (int i = 0; i < nb; i++) {
 		int is_pushed = gate_in(pushed, i);
+		int flag = BSIM_CONTACT_NONE;
 		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
-		if (!is_pushed && !contact_near_at(w, i, d2[i], BSIM_CONTACT_TOL, 0))
-			continue;
-		thesis_beam *b = &w->beams[i];
-		double u[2];
-		int type;
-		thesis_beam_direction(b, u);
-		double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
-		int flag = bsim_contact_flag(dist2, w->radius, type, is_pushed);
-		if (flag == BSIM_CONTACT_NONE)
-			continue;
+		if (is_pushed || contact_near_at(w, i, d2[i], BSIM_CONTACT_TOL, 0)) {
+			thesis_beam *b = &w->beams[i];
+			double u[2];
+			int type;
+			thesis_beam_direction(b, u);
+			double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
+			flag = bsim_contact_flag(dist2, w->radius, type, is_pushed);
+		}
 		w->flag[i] = flag;
-		mk->flagged |= 1u << i;
-		mk->awake |= 1u << i;
+		if (flag != BSIM_CONTACT_NONE) {
+			mk->flagged |= 1u << i;
+			mk->awake |= 1u << i;
+		}
 	}
 }
 
@@ -235,7 +234,7 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 	int nc = 0;
 	for (int i = 0; i < nb; i++) {
 		double margin = thesis_step_margin(w, &w->beams[i], speed, h);
-		int got = disk_detect_at(w, i, d2[i], margin, &w->contacts[nc], 0);
+		int got = disk_detect_at(w, i, d2[i], margin, &w->contacts[nc], 0, 1);
 		mk->awake |= (unsigned)got << i;
 		nc += got;
 	}
@@ -285,16 +284,19 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], double h, int n,
                                  bsim_state *out, const int integrator, const int nb)
 {
+	/* The awake and flagged lists as masks (is_awake and flag say which
+	 * beams the lists hold). */
 	gate_masks mk = {0, 0, 0};
-	for (int k = 0; k < w->n_awake; k++)
-		mk.awake |= 1u << w->awake[k];
+	for (int i = 0; i < nb; i++)
+		mk.awake |= (unsigned)w->is_awake[i] << i;
 	/* No step of the run reads contact_type (the typed mask, each step's,
 	 * stands for it): it is cleared here and set from the last step's
 	 * contacts at the end, as the steps one after another leave it. */
 	for (int k = 0; k < w->n_typed; k++)
 		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
-	for (int k = 0; k < w->n_flagged; k++)
-		mk.flagged |= 1u << w->flagged[k];
+	for (int i = 0; i < nb; i++)
+		mk.flagged |= (unsigned)(w->flag[i] != BSIM_CONTACT_NONE) << i;
+	const gate_masks mk0 = mk;
 	/* step_detect's h |F| / M and the smooth solve's h F / M, as they
 	 * compute them */
 	const double hv = h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
@@ -305,22 +307,31 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 	for (int k = 0; k < n; k++)
 		gate_step(w, force, h, hv, dv, &mk, d2, &out[k], integrator, nb);
 	/* The lists as the general path leaves them: ascending awake and
-	 * flagged beams, the typed ones (any order: only cleared), nothing
-	 * pushed; the last step's energy flows and impacts. */
+	 * flagged beams (those of the run's start where the masks are theirs),
+	 * the typed ones (any order: only cleared), nothing pushed; the last
+	 * step's energy flows and impacts. */
 	for (int k = 0; k < w->n_contacts; k++) {
 		const thesis_contact *c = &w->contacts[k];
 		if (c->gap <= w->contact_tol)
 			w->contact_type[c->beam] = c->type;
 	}
-	w->n_awake = w->n_typed = w->n_flagged = 0;
-	for (int i = 0; i < nb; i++) {
-		w->is_awake[i] = (unsigned char)gate_in(mk.awake, i);
-		if (w->is_awake[i])
-			w->awake[w->n_awake++] = i;
+	if (mk.awake != mk0.awake) {
+		w->n_awake = 0;
+		for (int i = 0; i < nb; i++) {
+			w->is_awake[i] = (unsigned char)gate_in(mk.awake, i);
+			if (w->is_awake[i])
+				w->awake[w->n_awake++] = i;
+		}
+	}
+	w->n_typed = 0;
+	for (int i = 0; i < nb; i++)
 		if (gate_in(mk.typed, i))
 			w->typed[w->n_typed++] = i;
-		if (gate_in(mk.flagged, i))
-			w->flagged[w->n_flagged++] = i;
+	if (mk.flagged != mk0.flagged) {
+		w->n_flagged = 0;
+		for (int i = 0; i < nb; i++)
+			if (gate_in(mk.flagged, i))
+				w->flagged[w->n_flagged++] = i;
 	}
 	w->energy = out[n - 1].energy;
 	w->impacts = out[n - 1].impacts;
@@ -328,10 +339,11 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 
 int thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out)
 {
-	if (n < 1 || !thesis_steps_takes(w) || out[0].n_beams != w->n_beams)
+	if (n < 1 || !w->steps_disk || out[0].n_beams != w->n_beams)
 		return 0;
-	for (int i = 0; i < w->n_beams; i++)
-		thesis_beam_touch(w, i);
+	if (w->n_touched < w->n_beams) /* else every beam is */
+		for (int i = 0; i < w->n_beams; i++)
+			thesis_beam_touch(w, i);
 	thesis_beams_prepare(w, h);
 	if (w->n_beams == 2 && w->integrator == THESIS_MIDPOINT) /* the essay's gate */
 		gate_run(w, force, h, n, out, THESIS_MIDPOINT, 2);
