@@ -14,6 +14,7 @@
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "model/schedule_spare.h"
 #include "scenes.h"
 #include "support.h"
 

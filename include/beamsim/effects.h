@@ -108,15 +108,6 @@ BSIM_API int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64
 BSIM_API int bsim_effects_init_taking(bsim_effects *fx, const bsim_scene *scene, uint64_t seed,
                                       unsigned taken);
 BSIM_API void bsim_effects_free(bsim_effects *fx);
-/* bsim_effects_init_taking with the random force's schedule taken from
- * *spare when it holds one (*spare is then NULL), restarted for this trial
- * (bsim_schedule_restart: the same draws as a new one); and
- * bsim_effects_free leaving the schedule in *spare (one already there is
- * freed). A runner of many trials then allocates and seeds one generator,
- * not one a trial. bsim_schedule_free(*spare) at the end. */
-BSIM_API int bsim_effects_init_spare(bsim_effects *fx, const bsim_scene *scene, uint64_t seed,
-                                     unsigned taken, bsim_schedule **spare);
-BSIM_API void bsim_effects_free_spare(bsim_effects *fx, bsim_schedule **spare);
 
 /* BSIM_OK, or BSIM_EFAIL if an effect could not give its force (the random
  * force's schedule, bsim_schedule_status): the forces applied are not the

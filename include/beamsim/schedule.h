@@ -29,11 +29,6 @@ BSIM_API void bsim_schedule_free(bsim_schedule *s);
 
 /* Restarts the schedule with a new seed (no allocation: reuse across trials). */
 BSIM_API void bsim_schedule_reset(bsim_schedule *s, double magnitude, uint64_t seed);
-/* bsim_schedule_reset at frequency f (Hz, > 0) too: the schedule
- * bsim_schedule_alloc(magnitude, frequency, seed) would give, the same
- * draws, without its allocation and first seeding. */
-BSIM_API void bsim_schedule_restart(bsim_schedule *s, double magnitude, double frequency,
-                                    uint64_t seed);
 
 /* Index j of the value that applies at step n of size h. */
 BSIM_API long bsim_schedule_index(const bsim_schedule *s, long n, double h);
@@ -63,11 +58,9 @@ BSIM_API unsigned long bsim_schedule_draws(const bsim_schedule *s);
 
 /* Total draws made by all schedules of this process that have since been
  * reset, freed or kept (for tests that prove a scene without random force
- * makes none; a trial frees or keeps its schedule when it ends). */
+ * makes none; a trial frees its schedule when it ends, or keeps it for the
+ * next: model/schedule_spare.h). */
 BSIM_API unsigned long bsim_schedule_total_draws(void);
-/* Counts the draws of s in that total, as freeing it would: for a schedule
- * kept for another trial (bsim_effects_free_spare). */
-BSIM_API void bsim_schedule_keep(bsim_schedule *s);
 
 #ifdef __cplusplus
 }

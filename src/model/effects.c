@@ -5,6 +5,7 @@
  * body that turns, a torque. Each is a pipeline entry only if the scene
  * lists it (beam spring, damping and restitution are the backend's). */
 #include "beamsim/effects.h"
+#include "model/schedule_spare.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,6 +1,7 @@
 /* Random-force schedules: Rm * z_j, z_j ~ N(0,1), drawn lazily in order from
  * a GSL Mersenne Twister seeded per (experiment seed, group, trial). */
 #include "beamsim/schedule.h"
+#include "model/schedule_spare.h"
 
 #include <limits.h>
 #include <math.h>

@@ -25,6 +25,7 @@
 
 #include "beamsim/effects.h"
 #include "beamsim/lattice.h"
+#include "model/schedule_spare.h"
 #include "run/trial_essay.h"
 #include "run/trial_flight.h"
 #include "run/trial_gates.h"
