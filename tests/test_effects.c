@@ -1,6 +1,7 @@
 /* The effect pipeline and the random-force schedule: only listed effects
  * run, a scene without random force makes no draws at all, values refresh
- * at the scene's frequency, and seeds depend on (seed, group, trial) only. */
+ * at the scene's frequency, seeds depend on (seed, group, trial) only, and
+ * a schedule kept for another trial draws as a new one. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -13,6 +14,7 @@
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "model/schedule_spare.h"
 #include "scenes.h"
 #include "support.h"
 
@@ -284,6 +286,57 @@ static void test_model_key(void **state)
 	bsim_test_remove(dir);
 }
 
+/* A schedule restarted for another trial (a runner keeps one: bsim_effects_
+ * init_spare) gives what a new one of the same magnitude, frequency and
+ * seed gives, whatever it drew and held before at another frequency; and a
+ * runner's trials give the same results as trials on runners of their own. */
+static void test_schedule_restart_is_new(void **state)
+{
+	(void)state;
+	const uint64_t seed = bsim_schedule_seed_mix(3, 1, 4);
+	bsim_schedule *fresh = bsim_schedule_alloc(20.0, 50.0, seed);
+	bsim_schedule *kept = bsim_schedule_alloc(7.0, 25.0, bsim_schedule_seed_mix(3, 2, 9));
+	long held[2];
+	for (long n = 0; n < 400; n++)
+		bsim_schedule_at_step_held(kept, n, 0.004, held);
+	bsim_schedule_restart(kept, 20.0, 50.0, seed);
+	assert_int_equal(bsim_schedule_draws(kept), 0);
+	for (long n = 0; n < 400; n++) {
+		long hf[2], hk[2];
+		double f = bsim_schedule_at_step_held(fresh, n, 0.004, hf);
+		double k = bsim_schedule_at_step_held(kept, n, 0.004, hk);
+		assert_memory_equal(&f, &k, sizeof f);
+		assert_int_equal(hf[0], hk[0]);
+		assert_int_equal(hf[1], hk[1]);
+	}
+	bsim_schedule_free(fresh);
+	bsim_schedule_free(kept);
+
+	bsim_scene a, b;
+	bsim_scene_init_gate(&a, 9.0, 20.0);
+	bsim_scene_init_gate(&b, 6.0, 40.0);
+	b.effects.random_frequency = 25.0;
+	const bsim_backend *thesis = bsim_test_backend("thesis");
+	bsim_trial_runner *shared = bsim_trial_runner_alloc();
+	bsim_trial_result first, second, alone;
+	bsim_error err;
+	assert_int_equal(bsim_trial_run(shared, &b, thesis, NULL, 11, NULL, &first, &err), BSIM_OK);
+	assert_int_equal(bsim_trial_run(shared, &a, thesis, NULL, 12, NULL, &second, &err),
+	                 BSIM_OK);
+	assert_true(first.draws > 0 && second.draws > 0);
+	bsim_trial_runner *own = bsim_trial_runner_alloc();
+	assert_int_equal(bsim_trial_run(own, &a, thesis, NULL, 12, NULL, &alone, &err), BSIM_OK);
+	assert_int_equal(second.draws, alone.draws);
+	assert_int_equal(second.steps_run, alone.steps_run);
+	assert_memory_equal(&second.x_end, &alone.x_end, sizeof alone.x_end);
+	assert_memory_equal(&second.y_end, &alone.y_end, sizeof alone.y_end);
+	assert_memory_equal(&second.vx_end, &alone.vx_end, sizeof alone.vx_end);
+	bsim_trial_runner_free(own);
+	bsim_trial_runner_free(shared);
+	bsim_scene_free(&a);
+	bsim_scene_free(&b);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -291,6 +344,7 @@ int main(void)
 	        cmocka_unit_test(test_empty_pipeline),
 	        cmocka_unit_test(test_schedule_hold_and_scale),
 	        cmocka_unit_test(test_seed_mixing),
+	        cmocka_unit_test(test_schedule_restart_is_new),
 	        cmocka_unit_test(test_ou_variance_and_autocorrelation),
 	        cmocka_unit_test(test_white_scales_with_dt),
 	        cmocka_unit_test(test_model_key),

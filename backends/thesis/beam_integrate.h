@@ -35,11 +35,14 @@ static inline void thesis_beam_prepare(thesis_beam *b, double h)
 	b->response = 1.0 / (b->inertia * b->d);
 }
 
-static inline double thesis_beam_response(const thesis_beam *b, double h, int integrator)
+/* The two below are asked within a step only, after every beam was
+ * prepared for its h (thesis_beams_prepare, at the start of thesis_step
+ * and of a run of steps): D and 1/(I D) are read as prepared. */
+static inline double thesis_beam_response(const thesis_beam *b, int integrator)
 {
 	if (integrator == THESIS_EULER)
 		return 1.0 / b->inertia;
-	return h == b->h_d ? b->response : 1.0 / (b->inertia * thesis_beam_midpoint_d(b, h));
+	return b->response;
 }
 
 static inline double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator)
@@ -47,7 +50,7 @@ static inline double thesis_beam_free_omega(const thesis_beam *b, double h, int 
 	if (integrator == THESIS_EULER)
 		return b->omega -
 		       h * (b->stiffness * b->theta + b->damping * b->omega) / b->inertia;
-	double d = h == b->h_d ? b->d : thesis_beam_midpoint_d(b, h);
+	const double d = b->d;
 	return (b->omega * (2.0 - d) - h * b->stiffness * b->theta / b->inertia) / d;
 }
 

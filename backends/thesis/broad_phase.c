@@ -255,10 +255,7 @@ static int near_query(struct bsim_world *w, double margin, int *out, int n, int 
 		int i = w->near[k];
 		if (w->is_awake[i])
 			continue;
-		const thesis_beam *b = &w->beams[i];
-		double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-		double reach = b->length + w->radius + margin;
-		if (dx * dx + dy * dy > reach * reach)
+		if (beam_beyond_reach(w, &w->beams[i], margin))
 			continue;
 		out[n++] = i;
 		*found = 1;

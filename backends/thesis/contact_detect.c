@@ -15,7 +15,7 @@ int thesis_contact_detect_disk(struct bsim_world *w, int i, double margin, thesi
 
 int thesis_contact_redetect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out)
 {
-	return disk_detect(w, i, margin, out, 1);
+	return disk_detect(w, i, margin, out, 1, 0);
 }
 
 int thesis_contact_near(const struct bsim_world *w, int i, double margin)

@@ -57,8 +57,12 @@ static inline void thesis_beam_direction(thesis_beam *b, double u[2])
 }
 
 /* The body's centre x against the beam at its angle: b->geo; the lever a
- * kept for the extended path only (extended: constant, see below). */
-THESIS_SPECIALISED void geometry_compute(thesis_beam *b, const double x[2], const int extended)
+ * kept for the extended path only (extended: a constant, see below, which
+ * the compiler gives each copy). Kept apart from its callers (it may call
+ * the sine and cosine): inline, the detection and the runs of steps around
+ * it compiled to 30 instructions a step more on H1 (bench --callgrind),
+ * most of their calls reusing a geometry or bounding it far instead. */
+THESIS_APART void geometry_compute(thesis_beam *b, const double x[2], const int extended)
 {
 	thesis_geometry *g = &b->geo;
 	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
@@ -142,14 +146,27 @@ THESIS_SPECIALISED int contact_from_geometry(const thesis_geometry *g, int i, do
 	return 1;
 }
 
-/* 1 if the body's centre lies outside beam b's disc of radius L + R +
- * margin about its pivot, where no point of the beam, at any angle, comes
- * within R + margin: no trigonometry needed. */
-static inline int beam_beyond_reach(const struct bsim_world *w, const thesis_beam *b, double margin)
+/* |C - P|^2, m^2: the body's centre from beam b's pivot. */
+static inline double beam_pivot_distance2(const struct bsim_world *w, const thesis_beam *b)
 {
 	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-	double reach = b->length + w->radius + margin;
-	return dx * dx + dy * dy > reach * reach;
+	return dx * dx + dy * dy;
+}
+
+/* 1 if the body's centre, at d2 = |C - P|^2 from beam b's pivot
+ * (beam_pivot_distance2), lies outside the beam's disc of radius L + R +
+ * margin about the pivot, where no point of the beam, at any angle, comes
+ * within R + margin: no trigonometry needed. */
+static inline int beam_beyond(const thesis_beam *b, double d2, double margin)
+{
+	double reach = b->reach + margin; /* L + R + margin */
+	return d2 > reach * reach;
+}
+
+/* beam_beyond for the body where it is. */
+static inline int beam_beyond_reach(const struct bsim_world *w, const thesis_beam *b, double margin)
+{
+	return beam_beyond(b, beam_pivot_distance2(w, b), margin);
 }
 
 /* 1 if beam b's geometry is the body's at its angle now (and, for a shaped
@@ -170,21 +187,33 @@ static inline int geometry_fresh(const struct bsim_world *w, const thesis_beam *
  * none of. near (a constant): beam i is one the step found in contact
  * (the projection's re-detection), which geometry_far seldom rejects;
  * that test only saves the exact one, so it is not asked there (the same
- * result). */
-THESIS_SPECIALISED int disk_detect(struct bsim_world *w, int i, double margin, thesis_contact *out,
-                                   const int near)
+ * result). d2: the body's |C - P|^2 from the beam's pivot where it is
+ * (beam_pivot_distance2), which a caller may hold from before. touched (a
+ * constant): every beam is touched already (thesis_beam_touch; a run of
+ * steps touches them all first). */
+THESIS_SPECIALISED int disk_detect_at(struct bsim_world *w, int i, double d2, double margin,
+                                      thesis_contact *out, const int near, const int touched)
 {
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
-	if (beam_beyond_reach(w, b, margin))
+	if (beam_beyond(b, d2, margin))
 		return 0;
 	const thesis_geometry *g = &b->geo;
 	if (!geometry_fresh(w, b, 0)) {
 		if (!near && geometry_far(w, b, w->x, w->radius, margin, 0))
 			return 0;
-		thesis_beam_touch(w, i);
+		if (!touched)
+			thesis_beam_touch(w, i);
 		geometry_compute(b, w->x, 0);
 	}
 	return contact_from_geometry(g, i, w->radius, margin, w->e_tip, w->e_tangent, out);
+}
+
+/* disk_detect_at for the body where it is. */
+THESIS_SPECIALISED int disk_detect(struct bsim_world *w, int i, double margin, thesis_contact *out,
+                                   const int near, const int touched)
+{
+	return disk_detect_at(w, i, beam_pivot_distance2(w, &w->beams[i]), margin, out, near,
+	                      touched);
 }
 
 /* Detection for any body (extended 1: the world's flags decide) or for the
@@ -194,7 +223,7 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
                                       thesis_contact *out, const int extended)
 {
 	if (!extended)
-		return disk_detect(w, i, margin, out, 0);
+		return disk_detect(w, i, margin, out, 0, 0);
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
 	if (beam_beyond_reach(w, b, margin))
 		return 0;
@@ -234,15 +263,22 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
 
 /* 0 if the body certainly lies farther than R + margin from beam i
  * (beyond its reach, or far by the bound), 1 if it may not: the contact
- * flag's test before it measures the distance. extended: a constant, as in
- * contact_detect. */
+ * flag's test before it measures the distance. d2: as disk_detect_at's;
+ * extended: a constant, as in contact_detect. */
+THESIS_SPECIALISED int contact_near_at(const struct bsim_world *w, int i, double d2, double margin,
+                                       const int extended)
+{
+	const thesis_beam *b = &w->beams[i];
+	if (beam_beyond(b, d2, margin))
+		return 0;
+	return !geometry_far(w, b, w->x, w->radius, margin, extended);
+}
+
+/* contact_near_at for the body where it is. */
 THESIS_SPECIALISED int contact_near(const struct bsim_world *w, int i, double margin,
                                     const int extended)
 {
-	const thesis_beam *b = &w->beams[i];
-	if (beam_beyond_reach(w, b, margin))
-		return 0;
-	return !geometry_far(w, b, w->x, w->radius, margin, extended);
+	return contact_near_at(w, i, beam_pivot_distance2(w, &w->beams[i]), margin, extended);
 }
 
 #endif

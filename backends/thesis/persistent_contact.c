@@ -56,7 +56,7 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 		double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
 		c->omega_free = thesis_beam_free_omega(b, h, w->integrator);
 		double gap = bsim_fmax(c->gap, 0.0);
-		c->inv_i = thesis_beam_response(b, h, w->integrator);
+		c->inv_i = thesis_beam_response(b, w->integrator);
 		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
 		vrel0 += w0 * c->cb;
 		c->vrel += wf * c->cb;
@@ -73,7 +73,7 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 		thesis_impulse_sum_extended(cs, n, j, &jw);
 	}
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
 	thesis_body_turn(w, w0, torque, jw, h);
 	double wm = w->integrator == THESIS_EULER ? w->angular_velocity
 	                                          : 0.5 * (w0 + w->angular_velocity);
@@ -151,7 +151,7 @@ void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double for
 		thesis_impulse_sum(cs, n, j);
 	}
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
 
 	/* Beams in contact take their impulse; all others move freely. A beam
 	 * at rest and untouched stays at rest and costs nothing: only the awake

@@ -73,6 +73,7 @@ typedef struct thesis_beam {
 	double u0[2];       /* rest direction, exact for multiples of 90 degrees */
 	double sgn;         /* +1: forward swing is counter-clockwise */
 	double length;      /* m */
+	double reach;       /* L + R, m: the reach tests' L + R + margin, summed once */
 	double inertia;     /* kg m^2 about the pivot */
 	double stiffness;   /* N m/rad */
 	double damping;     /* N m s/rad */
@@ -158,6 +159,8 @@ struct bsim_world {
 	/* 1: the essay's disk (extended 0) with contact_mode physical, whose
 	 * free flight thesis_step takes at once. */
 	int flight_disk;
+	/* 1: a world the runs of steps take (thesis_steps_takes), once made. */
+	int steps_disk;
 	double slop;         /* penetration tolerated before projection, m */
 	double contact_tol;  /* gap the solver counts as touching (held, awake), m */
 	int broad_phase;     /* 1: grid query for beams at rest; 0: test every beam */
@@ -406,15 +409,16 @@ static inline void thesis_beam_pushed(struct bsim_world *w, int i)
  * move by the mean velocity (persistent_contact.c); vm receives that
  * velocity. Inline: the contact solve, a step in free flight (j = 0) and
  * the runs of steps (thesis_steps.c) share it, so all move the body by the
- * same operations. */
+ * same operations. integrator: w->integrator, a constant where the caller
+ * gives one. */
 static inline void thesis_body_advance(struct bsim_world *w, const double v0[2], const double vf[2],
-                                       const double j[2], double h, double vm[2])
+                                       const double j[2], double h, double vm[2], int integrator)
 {
 	w->v[0] = vf[0] + j[0] * w->inv_mass;
 	w->v[1] = vf[1] + j[1] * w->inv_mass;
 	vm[0] = 0.5 * (v0[0] + w->v[0]);
 	vm[1] = 0.5 * (v0[1] + w->v[1]);
-	if (w->integrator == THESIS_EULER) {
+	if (integrator == THESIS_EULER) {
 		vm[0] = w->v[0];
 		vm[1] = w->v[1];
 	}
@@ -540,7 +544,7 @@ static inline void thesis_smooth_row(thesis_contact *c, const thesis_beam *b, co
 	double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
 	c->omega_free = thesis_beam_free_omega(b, h, integrator);
 	double gap = bsim_fmax(c->gap, 0.0);
-	c->inv_i = thesis_beam_response(b, h, integrator);
+	c->inv_i = thesis_beam_response(b, integrator);
 	c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
 	c->bound = integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 }

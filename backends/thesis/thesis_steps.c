@@ -79,8 +79,9 @@ static inline int gate_lcp(double inv_mass, thesis_contact *cs, int n)
 	return 0;
 }
 
-/* The masks of a run: the beams awake, typed (contact_type not NONE),
- * flagged (flag not NONE). Pushed beams live within a step. */
+/* The masks of a run: the beams awake, typed (the step's: contact_type
+ * not NONE, written when the run ends), flagged (flag not NONE). Pushed
+ * beams live within a step. */
 typedef struct gate_masks {
 	unsigned awake, typed, flagged;
 } gate_masks;
@@ -143,7 +144,7 @@ THESIS_SPECIALISED void gate_solve(struct bsim_world *w, const double dv[2], dou
 				*pushed |= 1u << cs[k].beam;
 	}
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_advance(w, v0, vf, j, h, vm, integrator);
 	double damper = *e_damper, contact = *e_contact;
 	for (int i = 0; i < nb; i++)
 		if (gate_in(awake, i))
@@ -161,7 +162,7 @@ static inline int gate_redetect(struct bsim_world *w, int n, double margin)
 	thesis_contact *cs = w->contacts;
 	int m = 0;
 	for (int k = 0; k < n; k++)
-		m += disk_detect(w, cs[k].beam, margin, &cs[m], 1);
+		m += disk_detect(w, cs[k].beam, margin, &cs[m], 1, 1);
 	return m;
 }
 
@@ -189,51 +190,51 @@ static inline int gate_project(struct bsim_world *w, const double force[2], int 
 
 /* contact_report.c's contact_report for the disk: the flag of every beam
  * (the candidates of a world this small are all its beams, in order); a
- * flagged beam is woken. */
-static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pushed, int nb)
+ * flagged beam is woken. d2: each beam's beam_pivot_distance2 at the
+ * step's end, which the next step's detection meets again. */
+static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pushed, double *d2,
+                               int nb)
 {
-	for (int i = 0; i < nb; i++)
-		if (gate_in(mk->flagged, i))
-			w->flag[i] = BSIM_CONTACT_NONE;
+	/* every flag written: a beam not flagged before holds NONE already */
 	mk->flagged = 0;
 	for (int i = 0; i < nb; i++) {
 		int is_pushed = gate_in(pushed, i);
-		if (!is_pushed && !contact_near(w, i, BSIM_CONTACT_TOL, 0))
-			continue;
-		thesis_beam *b = &w->beams[i];
-		double u[2];
-		int type;
-		thesis_beam_direction(b, u);
-		double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
-		int flag = bsim_contact_flag(dist2, w->radius, type, is_pushed);
-		if (flag == BSIM_CONTACT_NONE)
-			continue;
+		int flag = BSIM_CONTACT_NONE;
+		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
+		if (is_pushed || contact_near_at(w, i, d2[i], BSIM_CONTACT_TOL, 0)) {
+			thesis_beam *b = &w->beams[i];
+			double u[2];
+			int type;
+			thesis_beam_direction(b, u);
+			double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
+			flag = bsim_contact_flag(dist2, w->radius, type, is_pushed);
+		}
 		w->flag[i] = flag;
-		mk->flagged |= 1u << i;
-		mk->awake |= 1u << i;
+		if (flag != BSIM_CONTACT_NONE) {
+			mk->flagged |= 1u << i;
+			mk->awake |= 1u << i;
+		}
 	}
 }
 
 /* One step (step_run for extended 0, the head's differences) under the
  * force, its state into s. hv: h |F| / M of the margins' speed bound; dv:
- * h F / M of the free velocity. */
+ * h F / M of the free velocity; d2: each beam's beam_pivot_distance2 where
+ * the body is, for the next step at its end (nothing moves in between). */
 THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], double h, double hv,
-                                  const double dv[2], gate_masks *mk, bsim_state *s,
+                                  const double dv[2], gate_masks *mk, double *d2, bsim_state *s,
                                   const int integrator, const int nb)
 {
 	double e_damper = 0.0, e_impact = 0.0, e_contact = 0.0, e_correction = 0.0;
 	int impacts = 0;
 	unsigned pushed = 0;
-	for (int i = 0; i < nb; i++)
-		if (gate_in(mk->typed, i))
-			w->contact_type[i] = BSIM_CONTACT_NONE;
 	mk->typed = 0;
 	/* step_detect: every beam a candidate, in order */
 	double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) + hv;
 	int nc = 0;
 	for (int i = 0; i < nb; i++) {
 		double margin = thesis_step_margin(w, &w->beams[i], speed, h);
-		int got = contact_detect(w, i, margin, &w->contacts[nc], 0);
+		int got = disk_detect_at(w, i, d2[i], margin, &w->contacts[nc], 0, 1);
 		mk->awake |= (unsigned)got << i;
 		nc += got;
 	}
@@ -242,13 +243,9 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 	gate_solve(w, dv, h, nc, mk->awake, &pushed, &e_damper, &e_contact, integrator, nb);
 	int n = nc ? gate_project(w, force, nc, &e_correction) : 0;
 	w->n_contacts = n;
-	for (int k = 0; k < n; k++) {
-		const thesis_contact *c = &w->contacts[k];
-		if (c->gap <= w->contact_tol) {
-			w->contact_type[c->beam] = c->type;
-			mk->typed |= 1u << c->beam;
-		}
-	}
+	for (int k = 0; k < n; k++)
+		if (w->contacts[k].gap <= w->contact_tol)
+			mk->typed |= 1u << w->contacts[k].beam;
 	/* thesis_awake_prune */
 	for (int i = 0; i < nb; i++) {
 		const thesis_beam *b = &w->beams[i];
@@ -256,7 +253,7 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 		    !gate_in(mk->typed, i))
 			mk->awake &= ~(1u << i);
 	}
-	gate_report(w, mk, pushed, nb);
+	gate_report(w, mk, pushed, d2, nb);
 	/* get_state */
 	thesis_state_body(w, s);
 	int na = 0;
@@ -287,31 +284,54 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], double h, int n,
                                  bsim_state *out, const int integrator, const int nb)
 {
+	/* The awake and flagged lists as masks (is_awake and flag say which
+	 * beams the lists hold). */
 	gate_masks mk = {0, 0, 0};
-	for (int k = 0; k < w->n_awake; k++)
-		mk.awake |= 1u << w->awake[k];
+	for (int i = 0; i < nb; i++)
+		mk.awake |= (unsigned)w->is_awake[i] << i;
+	/* No step of the run reads contact_type (the typed mask, each step's,
+	 * stands for it): it is cleared here and set from the last step's
+	 * contacts at the end, as the steps one after another leave it. */
 	for (int k = 0; k < w->n_typed; k++)
-		mk.typed |= 1u << w->typed[k];
-	for (int k = 0; k < w->n_flagged; k++)
-		mk.flagged |= 1u << w->flagged[k];
+		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
+	for (int i = 0; i < nb; i++)
+		mk.flagged |= (unsigned)(w->flag[i] != BSIM_CONTACT_NONE) << i;
+	const gate_masks mk0 = mk;
 	/* step_detect's h |F| / M and the smooth solve's h F / M, as they
 	 * compute them */
 	const double hv = h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
 	const double dv[2] = {h * force[0] * w->inv_mass, h * force[1] * w->inv_mass};
+	double d2[THESIS_STEPS_BEAMS];
+	for (int i = 0; i < nb; i++)
+		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
 	for (int k = 0; k < n; k++)
-		gate_step(w, force, h, hv, dv, &mk, &out[k], integrator, nb);
+		gate_step(w, force, h, hv, dv, &mk, d2, &out[k], integrator, nb);
 	/* The lists as the general path leaves them: ascending awake and
-	 * flagged beams, the typed ones (any order: only cleared), nothing
-	 * pushed; the last step's energy flows and impacts. */
-	w->n_awake = w->n_typed = w->n_flagged = 0;
-	for (int i = 0; i < nb; i++) {
-		w->is_awake[i] = (unsigned char)gate_in(mk.awake, i);
-		if (w->is_awake[i])
-			w->awake[w->n_awake++] = i;
+	 * flagged beams (those of the run's start where the masks are theirs),
+	 * the typed ones (any order: only cleared), nothing pushed; the last
+	 * step's energy flows and impacts. */
+	for (int k = 0; k < w->n_contacts; k++) {
+		const thesis_contact *c = &w->contacts[k];
+		if (c->gap <= w->contact_tol)
+			w->contact_type[c->beam] = c->type;
+	}
+	if (mk.awake != mk0.awake) {
+		w->n_awake = 0;
+		for (int i = 0; i < nb; i++) {
+			w->is_awake[i] = (unsigned char)gate_in(mk.awake, i);
+			if (w->is_awake[i])
+				w->awake[w->n_awake++] = i;
+		}
+	}
+	w->n_typed = 0;
+	for (int i = 0; i < nb; i++)
 		if (gate_in(mk.typed, i))
 			w->typed[w->n_typed++] = i;
-		if (gate_in(mk.flagged, i))
-			w->flagged[w->n_flagged++] = i;
+	if (mk.flagged != mk0.flagged) {
+		w->n_flagged = 0;
+		for (int i = 0; i < nb; i++)
+			if (gate_in(mk.flagged, i))
+				w->flagged[w->n_flagged++] = i;
 	}
 	w->energy = out[n - 1].energy;
 	w->impacts = out[n - 1].impacts;
@@ -319,10 +339,11 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 
 int thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out)
 {
-	if (n < 1 || !thesis_steps_takes(w) || out[0].n_beams != w->n_beams)
+	if (n < 1 || !w->steps_disk || out[0].n_beams != w->n_beams)
 		return 0;
-	for (int i = 0; i < w->n_beams; i++)
-		thesis_beam_touch(w, i);
+	if (w->n_touched < w->n_beams) /* else every beam is */
+		for (int i = 0; i < w->n_beams; i++)
+			thesis_beam_touch(w, i);
 	thesis_beams_prepare(w, h);
 	if (w->n_beams == 2 && w->integrator == THESIS_MIDPOINT) /* the essay's gate */
 		gate_run(w, force, h, n, out, THESIS_MIDPOINT, 2);

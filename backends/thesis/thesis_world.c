@@ -265,6 +265,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		bsim_scene_beam_rest_direction(d, b->u0);
 		b->sgn = bsim_scene_beam_forward_sign(d); /* forward = toward +y */
 		b->length = d->length;
+		b->reach = b->length + w->radius; /* w->radius: body_setup's, above */
 		b->inertia = d->inertia;
 		b->inv_inertia = 1.0 / d->inertia;
 		b->h_d = NAN; /* thesis_beam_prepare at the first step */
@@ -292,6 +293,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	int sleep = bsim_options_choice(opts, &thesis_knobs[KNOB_SLEEP]);
 	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
 	w->sleep_energy = bsim_options_double(opts, &thesis_knobs[KNOB_SLEEP_ENERGY]);
+	w->steps_disk = thesis_steps_takes(w);
 	if (!(w->sleep_energy >= 0.0) || !isfinite(w->sleep_energy)) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -438,7 +440,7 @@ THESIS_SPECIALISED void flight_step(bsim_world *w, const double force[2], double
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
 	const double j[2] = {0.0, 0.0};
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm);
+	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
 	if (extended)
 		thesis_body_turn(w, w->angular_velocity, torque, 0.0, h);
 	if (w->n_flagged)

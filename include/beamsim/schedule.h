@@ -57,8 +57,9 @@ BSIM_API int bsim_schedule_status(const bsim_schedule *s, bsim_error *err);
 BSIM_API unsigned long bsim_schedule_draws(const bsim_schedule *s);
 
 /* Total draws made by all schedules of this process that have since been
- * reset or freed (for tests that prove a scene without random force makes
- * none; a trial frees its schedule when it ends). */
+ * reset, freed or kept (for tests that prove a scene without random force
+ * makes none; a trial frees its schedule when it ends, or keeps it for the
+ * next: model/schedule_spare.h). */
 BSIM_API unsigned long bsim_schedule_total_draws(void);
 
 #ifdef __cplusplus

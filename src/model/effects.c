@@ -5,6 +5,7 @@
  * body that turns, a torque. Each is a pipeline entry only if the scene
  * lists it (beam spring, damping and restitution are the backend's). */
 #include "beamsim/effects.h"
+#include "model/schedule_spare.h"
 
 #include <math.h>
 #include <string.h>
@@ -283,8 +284,27 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	return bsim_effects_init_taking(fx, scene, seed, 0u);
 }
 
+/* A schedule of magnitude and frequency for seed: *spare's, restarted, if
+ * it holds one (spare NULL: none), else a new one. */
+static bsim_schedule *schedule_for(double magnitude, double frequency, uint64_t seed,
+                                   bsim_schedule **spare)
+{
+	if (!spare || !*spare)
+		return bsim_schedule_alloc(magnitude, frequency, seed);
+	bsim_schedule *s = *spare;
+	*spare = NULL;
+	bsim_schedule_restart(s, magnitude, frequency, seed);
+	return s;
+}
+
 int bsim_effects_init_taking(bsim_effects *fx, const bsim_scene *scene, uint64_t seed,
                              unsigned taken)
+{
+	return bsim_effects_init_spare(fx, scene, seed, taken, NULL);
+}
+
+int bsim_effects_init_spare(bsim_effects *fx, const bsim_scene *scene, uint64_t seed,
+                            unsigned taken, bsim_schedule **spare)
 {
 	memset(fx, 0, sizeof *fx);
 	const bsim_effects_def *d = &scene->effects;
@@ -310,9 +330,9 @@ int bsim_effects_init_taking(bsim_effects *fx, const bsim_scene *scene, uint64_t
 		}
 		/* ou and white scale z_n themselves: the schedule gives z_n, one per step */
 		e->schedule = d->random_model == BSIM_RANDOM_HELD
-		                      ? bsim_schedule_alloc(d->random_magnitude,
-		                                            d->random_frequency, seed)
-		                      : bsim_schedule_alloc(1.0, d->random_frequency, seed);
+		                      ? schedule_for(d->random_magnitude, d->random_frequency, seed,
+		                                     spare)
+		                      : schedule_for(1.0, d->random_frequency, seed, spare);
 		if (!e->schedule) {
 			fx->n--;
 			return BSIM_EFAIL;
@@ -373,7 +393,19 @@ int bsim_effects_status(const bsim_effects *fx, bsim_error *err)
 
 void bsim_effects_free(bsim_effects *fx)
 {
-	for (int i = 0; i < fx->n; i++)
-		bsim_schedule_free(fx->e[i].schedule);
+	bsim_effects_free_spare(fx, NULL);
+}
+
+void bsim_effects_free_spare(bsim_effects *fx, bsim_schedule **spare)
+{
+	for (int i = 0; i < fx->n; i++) {
+		if (spare && fx->e[i].schedule) {
+			bsim_schedule_free(*spare);
+			*spare = fx->e[i].schedule;
+			bsim_schedule_keep(*spare);
+		} else {
+			bsim_schedule_free(fx->e[i].schedule);
+		}
+	}
 	memset(fx, 0, sizeof *fx);
 }

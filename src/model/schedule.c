@@ -1,6 +1,7 @@
 /* Random-force schedules: Rm * z_j, z_j ~ N(0,1), drawn lazily in order from
  * a GSL Mersenne Twister seeded per (experiment seed, group, trial). */
 #include "beamsim/schedule.h"
+#include "model/schedule_spare.h"
 
 #include <limits.h>
 #include <math.h>
@@ -60,9 +61,14 @@ bsim_schedule *bsim_schedule_alloc(double magnitude, double frequency, uint64_t 
 		free(s);
 		return NULL;
 	}
+	bsim_schedule_restart(s, magnitude, frequency, seed);
+	return s;
+}
+
+void bsim_schedule_restart(bsim_schedule *s, double magnitude, double frequency, uint64_t seed)
+{
 	s->frequency = frequency;
 	bsim_schedule_reset(s, magnitude, seed);
-	return s;
 }
 
 /* The draws of s not yet in total_draws go there: once per trial, not per
@@ -71,6 +77,11 @@ static void schedule_count(bsim_schedule *s)
 {
 	__atomic_fetch_add(&total_draws, s->draws - s->counted, __ATOMIC_RELAXED);
 	s->counted = s->draws;
+}
+
+void bsim_schedule_keep(bsim_schedule *s)
+{
+	schedule_count(s);
 }
 
 void bsim_schedule_free(bsim_schedule *s)

@@ -25,6 +25,7 @@
 
 #include "beamsim/effects.h"
 #include "beamsim/lattice.h"
+#include "model/schedule_spare.h"
 #include "run/trial_essay.h"
 #include "run/trial_flight.h"
 #include "run/trial_gates.h"
@@ -42,8 +43,9 @@ struct bsim_trial_runner {
 	bsim_state whole;  /* the whole lattice's state, for recording (essay protocol) */
 	trial_peaks peaks;
 	trial_essay essay;
-	trial_flight flight; /* free-flight runs */
-	trial_steps steps;   /* runs of steps */
+	trial_flight flight;  /* free-flight runs */
+	trial_steps steps;    /* runs of steps */
+	bsim_schedule *spare; /* the last trial's random-force schedule, for the next */
 	/* The world of the last trial, kept for the next trial of the same
 	 * scene, backend and options (bsim_trial_runner_keep_worlds). */
 	int keep;
@@ -85,6 +87,7 @@ void bsim_trial_runner_free(bsim_trial_runner *r)
 	bsim_state_free(&r->whole);
 	trial_peaks_free(&r->peaks);
 	trial_steps_free(&r->steps);
+	bsim_schedule_free(r->spare);
 	runner_forget_world(r);
 	free(r->shape);
 	free(r);
@@ -127,6 +130,10 @@ typedef struct trial_ctx {
 	bsim_trace_fn trace;
 	int trace_whole; /* the trace sees the whole lattice (essay protocol) */
 	long recorded;   /* the last step recorded, -1: none */
+	/* In a run of steps: its last state booked in which the body touched a
+	 * beam (NULL: none yet), whose contacts the peaks take when the run's
+	 * booking ends (trial_book). */
+	const bsim_state *touch;
 } trial_ctx;
 
 /* The world the trial starts in (the whole scene, or the essay's start
@@ -190,7 +197,7 @@ static int trial_open(trial_ctx *c, uint64_t seed, bsim_error *err)
 		trial_essay_release(&c->r->essay, c->backend, &c->w);
 		return rc;
 	}
-	if (bsim_effects_init_taking(c->fx, c->scene, seed, c->backend->takes)) {
+	if (bsim_effects_init_spare(c->fx, c->scene, seed, c->backend->takes, &c->r->spare)) {
 		c->backend->destroy(c->w);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
@@ -361,8 +368,8 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, const bsim_state *s0,
 		rc = bsim_effects_status(c->fx, err);
 	if (rc == BSIM_OK && c->log && trial_log_peaks(c->log, c->r->peaks.peak, c->scene->n_beams))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the peaks");
-	bsim_effects_free(c->fx);
 	bsim_trial_runner *r = c->r;
+	bsim_effects_free_spare(c->fx, &r->spare);
 	if (r->keep && c->backend->reset && c->map == NULL && c->w && rc == BSIM_OK) {
 		r->kept = c->w; /* the next trial of this scene resets it */
 		r->kept_scene = c->scene;
@@ -392,7 +399,8 @@ enum { BOOK_ON = 0, BOOK_END = 1, BOOK_NONFINITE = 2 };
  * it the state s0), BOOK_END if the trial ends there (a side exit, or *rc
  * failed). The step loop and the runs of steps book every state by it;
  * plain (a constant): nothing traced or measured per step, no lattice, as
- * in the runs (trial_steps_start), whose copy has none of their tests. */
+ * in the runs (trial_steps_start), whose copy has none of their tests and
+ * leaves the last touching contacts to the run's end (c->touch). */
 TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bsim_state *s1,
                           int *rc, bsim_error *err, const int plain)
 {
@@ -419,7 +427,15 @@ TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bs
 		                                                   c->scene->body.radius, s1));
 	if (lp->done)
 		return BOOK_ON;
-	trial_peaks_step(&c->r->peaks, c->scene, map, s1);
+	/* The last touching contacts: a run's states stay where they are until
+	 * its booking ends, so that only the last touching one is copied
+	 * (trial_peaks_contacts), and by then, as the step loop leaves them. */
+	if (plain) {
+		if (trial_peaks_touch(&c->r->peaks, c->scene, NULL, s1))
+			c->touch = s1;
+	} else {
+		trial_peaks_step(&c->r->peaks, c->scene, map, s1);
+	}
 	/* The gate first: a body that leaves the field ends in its gate. */
 	if (!plain && c->scene->has_lattice &&
 	    (*rc = gate_follow(c, lp, s1, s0->x, err)) != BSIM_OK)
@@ -464,13 +480,19 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 		                                       &states)
 		                    : 0;
 		if (m > 0) {
-			/* The run's states, booked until the trial ends. */
+			/* The run's states, booked until the trial ends. The run's
+			 * room (trial_run_room) keeps max_steps and gate_steps:
+			 * before the outcome is known, only a booking ends it. */
 			int b = BOOK_ON;
-			for (int k = 0; k < m && b == BOOK_ON && !trial_over(&c, &lp, s0); k++) {
+			c.touch = NULL;
+			for (int k = 0;
+			     k < m && b == BOOK_ON && !(lp.done && trial_over(&c, &lp, s0)); k++) {
 				b = trial_book(&c, &lp, s0, &states[k], &rc, err, 1);
 				if (b != BOOK_NONFINITE)
 					s0 = &states[k];
 			}
+			if (c.touch)
+				trial_peaks_contacts(&r->peaks, NULL, c.touch);
 			if (b != BOOK_ON)
 				break;
 			trial_flight_passed(&r->flight, m - 1);

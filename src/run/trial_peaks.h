@@ -139,15 +139,23 @@ static inline void trial_peaks_contacts(trial_peaks *p, const int *map, const bs
 	}
 }
 
-/* Both of the above after a step, s the state after it: nothing to do, at
- * the cost of a test, where no beam is active, no peak is below 0 and
- * beams 0 and 1's have settled (or the essay's map, which has no such). */
-static inline void trial_peaks_step(trial_peaks *p, const bsim_scene *scene, const int *map,
+/* The peaks after a step, s the state after it (trial_peaks_update), and
+ * whether an active beam touches the body in s: nothing to do, at the cost
+ * of a test, where no beam is active, no peak is below 0 and beams 0 and
+ * 1's have settled (or the essay's map, which has no such). */
+static inline int trial_peaks_touch(trial_peaks *p, const bsim_scene *scene, const int *map,
                                     const bsim_state *s)
 {
 	if (s->n_active == 0 && p->n_negative == 0 && (map || p->settled01))
-		return;
-	if (trial_peaks_update(p, scene, map, s))
+		return 0;
+	return trial_peaks_update(p, scene, map, s);
+}
+
+/* Both of the above after a step, s the state after it. */
+static inline void trial_peaks_step(trial_peaks *p, const bsim_scene *scene, const int *map,
+                                    const bsim_state *s)
+{
+	if (trial_peaks_touch(p, scene, map, s))
 		trial_peaks_contacts(p, map, s);
 }
 

@@ -65,18 +65,3 @@ int trial_steps_start(trial_steps *t, int plain, const bsim_backend *backend,
 	}
 	return BSIM_OK;
 }
-
-int trial_steps_make(trial_steps *t, bsim_world *w, const double force[2], const trial_loop *lp,
-                     long dwell, const bsim_state *s0, bsim_state **out)
-{
-	const long room =
-	        trial_run_room(lp, dwell, t->n_max, t->gate_max, t->random, TRIAL_STEPS_MAX);
-	if (room < 1)
-		return 0; /* the step loop's step */
-	bsim_state *bank = t->bank[s0 >= t->bank[0] && s0 < t->bank[0] + TRIAL_STEPS_MAX];
-	int m = t->steps(w, force, lp->h, (int)room, bank);
-	if (m == 0)
-		t->on = 0; /* the backend makes none for this world */
-	*out = bank;
-	return m;
-}

@@ -43,8 +43,22 @@ int trial_steps_start(trial_steps *t, int plain, const bsim_backend *backend,
  * pipeline's for step lp->n, just asked), dwell steps in the gate: up to
  * the force's next change and the end of the trial. Returns the states
  * made, into *out (0: none, the step loop makes the step; a world the
- * backend makes none for ends the trial's runs). */
-int trial_steps_make(trial_steps *t, bsim_world *w, const double force[2], const trial_loop *lp,
-                     long dwell, const bsim_state *s0, bsim_state **out);
+ * backend makes none for ends the trial's runs). Inline: the runner asks
+ * it once a run, about every fifth step of H1. */
+static inline int trial_steps_make(trial_steps *t, bsim_world *w, const double force[2],
+                                   const trial_loop *lp, long dwell, const bsim_state *s0,
+                                   bsim_state **out)
+{
+	const long room =
+	        trial_run_room(lp, dwell, t->n_max, t->gate_max, t->random, TRIAL_STEPS_MAX);
+	if (room < 1)
+		return 0; /* the step loop's step */
+	bsim_state *bank = t->bank[s0 >= t->bank[0] && s0 < t->bank[0] + TRIAL_STEPS_MAX];
+	int m = t->steps(w, force, lp->h, (int)room, bank);
+	if (m == 0)
+		t->on = 0; /* the backend makes none for this world */
+	*out = bank;
+	return m;
+}
 
 #endif
