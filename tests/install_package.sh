@@ -8,7 +8,12 @@
 # runs giving the installed program's own answer: the sweep's p_traverse
 # per group equals that of `beamsim sweep` on the same experiment, trials
 # and seed. The shared library exports exactly the functions and objects
-# the installed headers declare BSIM_API.
+# the installed headers declare BSIM_API. A backend's helpers are usable
+# from outside the tree: examples/backend_helpers.c, built by CMake and by
+# pkg-config alone, computes a beam's contact flag and an ellipse's gap
+# with the installed beamsim/contact_flag.h and beamsim/body_shape.h and
+# agrees with their closed forms, and the two headers compile as C++ (a
+# backend may be written in it).
 #   install_package.sh BUILD_DIR SOURCE_DIR WORK_DIR
 set -eu
 build=$1 src=$2 work=$3
@@ -27,6 +32,11 @@ pcdir=$(dirname "$(find "$prefix" -name beamsim.pc)")
 libdir=$(dirname "$pcdir")
 PKG_CONFIG_PATH=$pcdir cc -std=c17 -Wall -Werror -o "$work/pc_example" \
     "$src/examples/trial_and_sweep.c" $(PKG_CONFIG_PATH=$pcdir pkg-config --cflags --libs beamsim)
+cc -std=c17 -Wall -Wextra -Werror -o "$work/pc_backend_helpers" \
+    "$src/examples/backend_helpers.c" $(PKG_CONFIG_PATH=$pcdir pkg-config --cflags --libs beamsim) -lm
+printf '#include <beamsim/contact_flag.h>\n#include <beamsim/body_shape.h>\n' |
+    c++ -x c++ -std=c++17 -fsyntax-only -Wall -Wextra -Werror \
+        $(PKG_CONFIG_PATH=$pcdir pkg-config --cflags beamsim) -
 
 # README's compile line exactly, with its prefix $HOME/beamsim this one,
 # run from the source tree's parent of examples/ into a.out in WORK: the
@@ -48,6 +58,10 @@ esac
 "$work/examples/trial_and_sweep_static" "$exp" 20 >"$work/static.txt"
 env -u LD_LIBRARY_PATH "$work/pc_example" "$exp" 20 >"$work/pc.txt"
 env -u LD_LIBRARY_PATH "$work/readme/a.out" "$exp" 20 >"$work/readme.txt"
+"$work/examples/backend_helpers" >"$work/backend_helpers.txt" ||
+    { cat "$work/backend_helpers.txt"; echo "backend_helpers (CMake) differs from its closed forms"; exit 1; }
+env -u LD_LIBRARY_PATH "$work/pc_backend_helpers" >"$work/pc_backend_helpers.txt" ||
+    { cat "$work/pc_backend_helpers.txt"; echo "backend_helpers (pkg-config) differs from its closed forms"; exit 1; }
 
 # The shared library brings only the bsim_ functions.
 if nm -D --defined-only "$libdir/libbeamsim.so" | awk '{print $3}' | grep -v '^bsim_' | grep .; then
@@ -112,4 +126,4 @@ for g in beamsim.sweep(sys.argv[1], trials=20)["groups"]:
     print("%.3f" % g["p_traverse"])' "$exp" "$site" >"$work/py_p.txt"
     cmp "$work/py_p.txt" "$work/cli_p.txt"
 fi
-echo "installed package: shared, static and pkg-config builds agree with beamsim sweep"
+echo "installed package: shared, static and pkg-config builds agree with beamsim sweep; a backend's helpers agree with their closed forms"

@@ -68,6 +68,8 @@ PUBLIC = {
     "stats": "util",
     "version": "util",
     "backend": "model",
+    "body_shape": "model",
+    "contact_flag": "model",
     "backend_registry": "registry",
     "effects": "model",
     "experiment": "model",

@@ -1,4 +1,4 @@
-/* The contact flag (beamsim/state.h, model/contact_flag.h) against
+/* The contact flag (beamsim/state.h, beamsim/contact_flag.h) against
  * independent truths, on every backend of the registry: beam i is flagged in a step when
  * at the step's end the body is within BSIM_CONTACT_TOL (6 mm) of it, or
  * when it exchanged an impulse with the body in the step.
@@ -25,7 +25,7 @@
 #include <cmocka.h>
 
 #include "beamsim/backend.h"
-#include "model/contact_flag.h"
+#include "beamsim/contact_flag.h"
 #include "scenes.h"
 #include "support.h"
 

@@ -1,5 +1,5 @@
-/* The ellipse against a beam's segment (body_shape_ellipse_segment,
- * model/body_shape.h) against independent truths:
+/* The ellipse against a beam's segment (bsim_body_shape_ellipse_segment,
+ * beamsim/body_shape.h) against independent truths:
  *
  * - a circle (a = c) against the disk's closed form: dist = |x - S| - r
  *   (apart and overlapping), n from the segment's nearest point to x;
@@ -30,7 +30,7 @@
 
 #include <cmocka.h>
 
-#include "model/body_shape.h"
+#include "beamsim/body_shape.h"
 
 #define PI 3.14159265358979323846
 
@@ -49,9 +49,9 @@ static double uniform(double lo, double hi)
 	return lo + (hi - lo) * ((double)(z >> 11) / 9007199254740992.0);
 }
 
-static int contact(const config *k, body_segment_contact *o)
+static int contact(const config *k, bsim_body_segment_contact *o)
 {
-	return body_shape_ellipse_segment(k->a, k->c, k->x, k->psi, k->p0, k->p1, o);
+	return bsim_body_shape_ellipse_segment(k->a, k->c, k->x, k->psi, k->p0, k->p1, o);
 }
 
 /* The outline's point at angle parameter th. */
@@ -165,7 +165,7 @@ static double scale(const config *k)
 /* What every answer satisfies: n a unit vector, on_body on the outline,
  * on_segment on the segment (an end when at_end), on_body = on_segment +
  * dist n. */
-static void check_consistent(const config *k, const body_segment_contact *o)
+static void check_consistent(const config *k, const bsim_body_segment_contact *o)
 {
 	double S = scale(k);
 	assert_true(fabs(hypot(o->n[0], o->n[1]) - 1.0) < 1e-14);
@@ -185,7 +185,7 @@ static double max_err_apart, max_err_overlap, max_err_moved;
 /* The answer against brute force; returns dist. */
 static double check_brute(const config *k)
 {
-	body_segment_contact o;
+	bsim_body_segment_contact o;
 	assert_int_equal(contact(k, &o), BSIM_OK);
 	check_consistent(k, &o);
 	double S = scale(k);
@@ -288,7 +288,7 @@ static void test_circle_closed_form(void **state)
 		config k;
 		random_config(&k, trial % 3, uniform(-0.3, 3.0));
 		k.c = k.a;
-		body_segment_contact o;
+		bsim_body_segment_contact o;
 		assert_int_equal(contact(&k, &o), BSIM_OK);
 		check_consistent(&k, &o);
 		double t, dx = segment_distance(&k, k.x, &t);
@@ -328,7 +328,7 @@ static void test_axis_parallel_closed_form(void **state)
 					k.p0[m] = x[m] + off * across[m] - l0 * along[m];
 					k.p1[m] = x[m] + off * across[m] + l1 * along[m];
 				}
-				body_segment_contact o;
+				bsim_body_segment_contact o;
 				assert_int_equal(contact(&k, &o), BSIM_OK);
 				check_consistent(&k, &o);
 				assert_true(fabs(o.dist - g) < 1e-13 * scale(&k));
@@ -371,7 +371,7 @@ static void test_brute_force(void **state)
 		double s = trial % 6 < 3 ? uniform(-0.01, 0.0) : uniform(0.0, 4.0);
 		random_config(&k, kind, s);
 		double d = check_brute(&k);
-		body_segment_contact o;
+		bsim_body_segment_contact o;
 		contact(&k, &o);
 		n_apart += d > 0;
 		n_overlap += d <= 0;
@@ -399,7 +399,7 @@ static void test_invariance(void **state)
 	for (int trial = 0; trial < 300; trial++) {
 		config k;
 		random_config(&k, trial % 3, uniform(-0.01, 2.0));
-		body_segment_contact o;
+		bsim_body_segment_contact o;
 		assert_int_equal(contact(&k, &o), BSIM_OK);
 		double S = scale(&k);
 		for (int form = 0; form < 4; form++) {
@@ -417,7 +417,7 @@ static void test_invariance(void **state)
 				t.p0[0] = t.p1[0], t.p0[1] = t.p1[1], t.p1[0] = p[0],
 				t.p1[1] = p[1];
 			}
-			body_segment_contact r;
+			bsim_body_segment_contact r;
 			assert_int_equal(contact(&t, &r), BSIM_OK);
 			assert_true(fabs(r.dist - o.dist) < 1e-12 * S);
 			double n[2], b[2], q[2];
@@ -460,7 +460,7 @@ static void test_continuity(void **state)
 				k.p0[m] = mid - 0.5 * L * (m ? N[0] : -N[1]);
 				k.p1[m] = mid + 0.5 * L * (m ? N[0] : -N[1]);
 			}
-			body_segment_contact o;
+			bsim_body_segment_contact o;
 			assert_int_equal(contact(&k, &o), BSIM_OK);
 			if (i > 0) {
 				double moved = fmax(hypot(k.p0[0] - p0[0], k.p0[1] - p0[1]),
@@ -478,7 +478,7 @@ static void test_continuity(void **state)
 		double ang = -PI / 2 + 1.2 * (i / 20000.0 - 0.5);
 		k.p1[0] = k.p0[0] + 7.3 * cos(ang);
 		k.p1[1] = k.p0[1] + 7.3 * sin(ang);
-		body_segment_contact o;
+		bsim_body_segment_contact o;
 		assert_int_equal(contact(&k, &o), BSIM_OK);
 		if (i > 0) {
 			double moved = hypot(k.p1[0] - p1[0], k.p1[1] - p1[1]);
@@ -527,7 +527,7 @@ static void test_degenerate(void **state)
 {
 	(void)state;
 	config k = {5.0, 2.0, {0, 0}, 0.3, {10, 0}, {10, 5}};
-	body_segment_contact o;
+	bsim_body_segment_contact o;
 	assert_int_equal(contact(&k, &o), BSIM_OK);
 	config bad[] = {k, k, k, k, k, k};
 	bad[0].a = 0.0;
@@ -550,7 +550,7 @@ static void test_degenerate(void **state)
  * N configurations, apart (offsets 1% to 200% of the minor semi-axis) or
  * overlapping (by up to 1% of it), beside the outline or tips, each called
  * REPEAT times. Instructions a call: valgrind --tool=callgrind
- * --toggle-collect=body_shape_ellipse_segment on this program with the
+ * --toggle-collect=bsim_body_shape_ellipse_segment on this program with the
  * test's name as its argument, the total over N * REPEAT. */
 enum { COST_N = 1000, COST_REPEAT = 100 };
 static void cost(int overlapping_kind)
@@ -564,7 +564,7 @@ static void cost(int overlapping_kind)
 	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
 	for (int r = 0; r < COST_REPEAT; r++)
 		for (int j = 0; j < COST_N; j++) {
-			body_segment_contact o;
+			bsim_body_segment_contact o;
 			assert_int_equal(contact(&ks[j], &o), BSIM_OK);
 			sum += o.dist;
 		}

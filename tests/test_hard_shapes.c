@@ -6,7 +6,7 @@
  *   9  friction at a high normal force: stick inside the cone, slide
  *      outside it (friction_press.yaml)
  *   10 a spinning capsule at a beam's tip (spin_tip.yaml)
- * The gap is the true outline's (model/body_shape.h), not the disk's. */
+ * The gap is the true outline's (beamsim/body_shape.h), not the disk's. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -17,7 +17,7 @@
 #include <cmocka.h>
 
 #include "beamsim/trial.h"
-#include "model/body_shape.h"
+#include "beamsim/body_shape.h"
 #include "support.h"
 
 static void load(const char *rel, const bsim_override *ov, int n, bsim_scene *s)
@@ -67,8 +67,8 @@ static void watch_fn(void *user, long step, const bsim_state *st)
 		double c = cos(st->theta[i]), sn = sg * sin(st->theta[i]);
 		double u[2] = {u0[0] * c - u0[1] * sn, u0[1] * c + u0[0] * sn};
 		double p1[2] = {d->pivot[0] + d->length * u[0], d->pivot[1] + d->length * u[1]};
-		body_segment_contact bc;
-		if (body_shape_segment(&wt->s->body, st->x, st->heading, d->pivot, p1, &bc) ==
+		bsim_body_segment_contact bc;
+		if (bsim_body_shape_segment(&wt->s->body, st->x, st->heading, d->pivot, p1, &bc) ==
 		    BSIM_OK)
 			wt->pen_max = fmax(wt->pen_max, -bc.dist);
 		double dx = st->x[0] - d->pivot[0], dy = st->x[1] - d->pivot[1];

@@ -18,7 +18,7 @@
 #include <cmocka.h>
 
 #include "beamsim/backend.h"
-#include "model/body_shape.h"
+#include "beamsim/body_shape.h"
 #include "scenes.h"
 #include "thesis/thesis.h"
 #include "support.h"
@@ -329,10 +329,11 @@ static void test_no_energy_created(void **state)
 		 * until the outline touches */
 		double x[2] = {-5.0 + 35.0 * uniform(&seed), 0.0};
 		double side = uniform(&seed) < 0.5 ? -1.0 : 1.0;
-		x[1] = side * (body_shape_reach(&s.body) + 0.5);
+		x[1] = side * (bsim_body_shape_reach(&s.body) + 0.5);
 		double psi = bsim_body_heading(&s.body), p0[2] = {0.0, 0.0}, p1[2] = {25.0, 0.0};
-		body_segment_contact bc;
-		if (body_shape_segment(&s.body, x, psi, p0, p1, &bc) != BSIM_OK || bc.dist > 20.0) {
+		bsim_body_segment_contact bc;
+		if (bsim_body_shape_segment(&s.body, x, psi, p0, p1, &bc) != BSIM_OK ||
+		    bc.dist > 20.0) {
 			bsim_scene_free(&s);
 			continue;
 		}

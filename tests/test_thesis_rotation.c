@@ -19,8 +19,8 @@
 #include <cmocka.h>
 
 #include "beamsim/backend.h"
-#include "model/body_shape.h"
-#include "model/contact_flag.h"
+#include "beamsim/body_shape.h"
+#include "beamsim/contact_flag.h"
 #include "scenes.h"
 #include "support.h"
 
@@ -69,7 +69,7 @@ static double uniform(uint64_t *s)
 /* The nearest distance from the capsule's outline to the segment by
  * sampling the outline (the circle of radius r about every point of the
  * core; the outline of the union is the nearest of them): an independent
- * truth for the capsule's case of body_shape_segment. */
+ * truth for the capsule's case of bsim_body_shape_segment. */
 static double sampled_gap(double r, double l, const double x[2], double psi, const double p0[2],
                           const double p1[2])
 {
@@ -101,8 +101,8 @@ static void test_capsule_outline(void **state)
 	};
 	for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
 		double x[2] = {cases[c][0], cases[c][1]}, psi = cases[c][2] * M_PI_VALUE / 180.0;
-		body_segment_contact bc;
-		assert_int_equal(body_shape_segment(&b, x, psi, p0, p1, &bc), BSIM_OK);
+		bsim_body_segment_contact bc;
+		assert_int_equal(bsim_body_shape_segment(&b, x, psi, p0, p1, &bc), BSIM_OK);
 		double truth = sampled_gap(b.radius, b.length, x, psi, p0, p1);
 		/* sampling the core at l/2000 and the beam at 25/400 m */
 		assert_true(fabs(bc.dist - truth) < 2e-3);
@@ -116,11 +116,11 @@ static void test_capsule_outline(void **state)
 		assert_true(fabs(bc.on_segment[1]) < 1e-12);
 	}
 	/* the reach: the half-length plus the half-width */
-	assert_true(body_shape_reach(&b) == 6.0);
+	assert_true(bsim_body_shape_reach(&b) == 6.0);
 	/* a beam through the core: no normal */
 	double x[2] = {12.0, 0.0};
-	body_segment_contact bc;
-	assert_int_equal(body_shape_segment(&b, x, 1.0, p0, p1, &bc), BSIM_EFAIL);
+	bsim_body_segment_contact bc;
+	assert_int_equal(bsim_body_shape_segment(&b, x, 1.0, p0, p1, &bc), BSIM_EFAIL);
 }
 
 /* The start's overlap check by the outline: a capsule along x (r = 2, l =
@@ -311,10 +311,10 @@ static void test_elastic_impacts_conserve(void **state)
 		s.contact.rest_threshold = 0.0; /* every approach elastic */
 		s.beams[0].initial_omega = 0.2 * uniform(&seed) - 0.1;
 		double x[2] = {-5.0 + 35.0 * uniform(&seed), 0.0};
-		x[1] = (uniform(&seed) < 0.5 ? -1.0 : 1.0) * (body_shape_reach(&s.body) + 0.5);
+		x[1] = (uniform(&seed) < 0.5 ? -1.0 : 1.0) * (bsim_body_shape_reach(&s.body) + 0.5);
 		double psi = bsim_body_heading(&s.body), p0[2] = {0.0, 0.0}, p1[2] = {25.0, 0.0};
-		body_segment_contact bc;
-		assert_int_equal(body_shape_segment(&s.body, x, psi, p0, p1, &bc), BSIM_OK);
+		bsim_body_segment_contact bc;
+		assert_int_equal(bsim_body_shape_segment(&s.body, x, psi, p0, p1, &bc), BSIM_OK);
 		if (bc.dist > 20.0) {
 			bsim_scene_free(&s);
 			continue;
@@ -521,10 +521,10 @@ static void test_capsule_penetration(void **state)
 				const double *p = s.beams[i].pivot;
 				double tip[2] = {p[0] + s.beams[i].length * u[0],
 				                 p[1] + s.beams[i].length * u[1]};
-				body_segment_contact c;
-				assert_int_equal(
-				        body_shape_segment(&s.body, st.x, st.heading, p, tip, &c),
-				        BSIM_OK);
+				bsim_body_segment_contact c;
+				assert_int_equal(bsim_body_shape_segment(&s.body, st.x, st.heading,
+				                                         p, tip, &c),
+				                 BSIM_OK);
 				deepest = fmin(deepest, c.dist);
 			}
 		}

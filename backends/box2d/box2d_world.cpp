@@ -106,7 +106,7 @@
  * started, so a resting contact sits at a gap anywhere from 0 to that
  * (4-5 mm on a stuck H2 trial, docs/backends.md).
  * The contact flag the state reports is not Box2D's manifold but the one
- * every backend reports (model/contact_flag.h): at the step's end the gap,
+ * every backend reports (beamsim/contact_flag.h): at the step's end the gap,
  * measured from the reported state (x, theta) with the shared geometry, is
  * below BSIM_CONTACT_TOL (6 mm, above that band at s = 1), or the beam's
  * contact had a nonzero normal impulse in the step (PostSolve, any substep
@@ -122,7 +122,7 @@
  * not the edge's face (e_faceA) is the tip's, the disk's rule too.
  * The contact flag of a body that is not a disk is its true outline's gap
  * (outline_gap: the capsule's segment-to-segment distance less R; the
- * ellipse's from model/body_shape.h), not the polygon's.
+ * ellipse's from beamsim/body_shape.h), not the polygon's.
  *
  * Energy of a step, for the runner's ledger (dE = W - damper - impact -
  * contact - correction):
@@ -167,12 +167,10 @@
 #include <vector>
 
 #include "beamsim/backend.h"
+#include "beamsim/body_shape.h"
+#include "beamsim/contact_flag.h"
 #include "beamsim/effects.h"
 #include "box2d/box2d_shape.h"
-#include "model/contact_flag.h"
-extern "C" {
-#include "model/body_shape.h"
-}
 
 /* This backend's table, defined at the end of the file; the registry
  * (src/registry) lists it. */
@@ -370,7 +368,7 @@ struct bsim_world {
 	bool turn_start = false; /* rich or taken: the step records the body's turn */
 	double v_force[2] = {0, 0}, w_force = 0.0; /* m/s, rad/s: after the force */
 	/* results of the last step */
-	std::vector<int> contact_type; /* the contact flag (model/contact_flag.h) */
+	std::vector<int> contact_type; /* the contact flag (beamsim/contact_flag.h) */
 	bsim_step_energy energy = {};
 	double drag_loss = 0.0, friction_loss = 0.0; /* J (bsim_state) */
 	int impacts = 0;
@@ -853,7 +851,7 @@ double ellipse_point_distance(double a, double b, double px, double py)
  *     heading) and the beam's, less R (closest points of two segments:
  *     C. Ericson, Real-Time Collision Detection, 5.1.9, the body's segment
  *     first so that parallel segments give the beam's inner point);
- *   ellipse: the model's geometry (model/body_shape.h, as the thesis
+ *   ellipse: the model's geometry (beamsim/body_shape.h, as the thesis
  *     backend and the start's overlap check measure it), after a test
  *     that decides most steps: the segment misses the circumscribed circle
  *     by the tolerance (no contact); a segment through the ellipse's
@@ -894,15 +892,15 @@ double outline_gap(const bsim_body_def &body, const double c[2], double psi, con
 	if (gap_circle >= tol)
 		return gap_circle;
 	const double p1[2] = {p[0] + length * u[0], p[1] + length * u[1]};
-	body_segment_contact bc;
-	if (body_shape_segment(&body, c, psi, p, p1, &bc) != BSIM_OK)
+	bsim_body_segment_contact bc;
+	if (bsim_body_shape_segment(&body, c, psi, p, p1, &bc) != BSIM_OK)
 		return -std::fmin(body.semi_axes[0],
 		                  body.semi_axes[1]); /* through its centre line */
 	*type = bc.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
 	return bc.dist;
 }
 
-/* The contact flag of beam i after a step (model/contact_flag.h), from the
+/* The contact flag of beam i after a step (beamsim/contact_flag.h), from the
  * state get_state reports: x = position / s, theta = sgn angle; for a body
  * that is not a disk, from its outline's gap at the reported heading. */
 int contact_flag_of(const bsim_world *w, const beam_rec &b)

@@ -44,15 +44,15 @@
  * correction (F . dx + T dpsi minus that change), as the thesis backend
  * books its projection.
  *
- * The contact flag is the one every backend reports (model/contact_flag.h):
+ * The contact flag is the one every backend reports (beamsim/contact_flag.h):
  * from the reported state (x, theta) by the shared geometry, the outline's
- * gap (model/body_shape.h) for a body that is not a disk, or a nonzero
+ * gap (beamsim/body_shape.h) for a body that is not a disk, or a nonzero
  * normal impulse in any substep of the step. */
 #include <math.h>
 
 #include "chipmunk/chipmunk_world.h"
-#include "model/body_shape.h"
-#include "model/contact_flag.h"
+#include "beamsim/body_shape.h"
+#include "beamsim/contact_flag.h"
 
 /* The energy flows of the substep of h just taken, into w->energy. */
 static void measure_energy(struct bsim_world *w, double h)
@@ -105,7 +105,7 @@ static double body_heading(const struct bsim_world *w)
 	return w->rotates ? cpBodyGetAngle(w->body) : bsim_body_heading(&w->scene.body);
 }
 
-/* The contact flag of beam i at the step's end (model/contact_flag.h). */
+/* The contact flag of beam i at the step's end (beamsim/contact_flag.h). */
 static int flag_of(const struct bsim_world *w, int i, const double x[2], double psi)
 {
 	const chip_beam *b = &w->beams[i];
@@ -121,8 +121,8 @@ static int flag_of(const struct bsim_world *w, int i, const double x[2], double 
 	if (d2 >= far * far && !b->pushed)
 		return BSIM_CONTACT_NONE;
 	const double p1[2] = {b->pivot[0] + b->length * u[0], b->pivot[1] + b->length * u[1]};
-	body_segment_contact bc;
-	if (body_shape_segment(body, x, psi, b->pivot, p1, &bc) != BSIM_OK)
+	bsim_body_segment_contact bc;
+	if (bsim_body_shape_segment(body, x, psi, b->pivot, p1, &bc) != BSIM_OK)
 		return type; /* through its centre line: overlapping */
 	type = bc.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
 	return b->pushed || bc.dist < BSIM_CONTACT_TOL ? type : BSIM_CONTACT_NONE;

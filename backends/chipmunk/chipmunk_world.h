@@ -66,7 +66,7 @@ struct bsim_world {
 	int n_live;
 	int *live;
 	char *is_live;
-	/* the contact flag (model/contact_flag.h) and the beams it set */
+	/* the contact flag (beamsim/contact_flag.h) and the beams it set */
 	int *contact_type;
 	int n_typed;
 	int *typed;

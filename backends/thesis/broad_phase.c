@@ -22,7 +22,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "model/contact_flag.h"
+#include "beamsim/contact_flag.h"
 #include "thesis/thesis.h"
 
 #define BROAD_PHASE_MIN_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS

@@ -12,7 +12,7 @@
  * check 4): products and sums keep the same operands in the same order.
  *
  * A body of another shape (extended path, thesis.h's head) meets the beam
- * through its outline (model/body_shape.h): the outline's point K nearest
+ * through its outline (beamsim/body_shape.h): the outline's point K nearest
  * the segment, the segment's point Q nearest the outline, the normal n from
  * Q toward the body, gap = |K - Q| signed (< 0: overlap). Then
  *   a = Q - P,  c = sgn (a x n),  ct = sgn (a . n),

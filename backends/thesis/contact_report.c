@@ -1,5 +1,5 @@
 /* The contact flag the thesis backend reports in its state, the one every
- * backend reports (model/contact_flag.h, beamsim/state.h): beam i is in
+ * backend reports (beamsim/contact_flag.h, beamsim/state.h): beam i is in
  * contact during a step when at the step's end its gap to the body is below
  * BSIM_CONTACT_TOL (6 mm), or when it took a nonzero impact or
  * persistent-contact impulse in the step (w->pushed, impact_resolve.c and
@@ -19,19 +19,19 @@
  * A step in free flight (thesis_broad_phase_clear, whose margin includes
  * BSIM_CONTACT_TOL) ends more than 6 mm from every beam and pushes none, so
  * it only clears the last step's flags (thesis_contact_clear). */
-#include "model/body_shape.h"
-#include "model/contact_flag.h"
+#include "beamsim/body_shape.h"
+#include "beamsim/contact_flag.h"
 #include "thesis/thesis.h"
 
 /* A body of another shape: the same rule with the outline's gap
- * (model/body_shape.h), TIP where the segment's nearest point is its end. A
+ * (beamsim/body_shape.h), TIP where the segment's nearest point is its end. A
  * beam through the body's centre line is in contact. */
 static int shape_flag(const struct bsim_world *w, const thesis_beam *b, const double u[2],
                       int pushed)
 {
 	double tip[2] = {b->p[0] + b->length * u[0], b->p[1] + b->length * u[1]};
-	body_segment_contact c;
-	if (body_shape_segment(&w->body, w->x, w->heading, b->p, tip, &c) != BSIM_OK)
+	bsim_body_segment_contact c;
+	if (bsim_body_shape_segment(&w->body, w->x, w->heading, b->p, tip, &c) != BSIM_OK)
 		return BSIM_CONTACT_TANGENT;
 	if (!pushed && !(c.dist < BSIM_CONTACT_TOL))
 		return BSIM_CONTACT_NONE;

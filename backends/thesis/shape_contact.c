@@ -1,11 +1,11 @@
 /* The contact geometry of a body of another shape than the disk against a
  * beam (extended path, thesis.h's head; contact_geometry.h's head gives the
- * levers): the outline's nearest point from model/body_shape.h, and a
+ * levers): the outline's nearest point from beamsim/body_shape.h, and a
  * capsule's second contact when it lies along the beam. Apart from
  * contact_geometry.h, so that the disk's detection is compiled as it was. */
 #include <math.h>
 
-#include "model/body_shape.h"
+#include "beamsim/body_shape.h"
 #include "thesis/thesis.h"
 
 /* A pair of points, K on the capsule's core and Q on the beam, as a contact
@@ -52,7 +52,7 @@ static double along(const double p0[2], const double p1[2], const double q[2])
  * beam point) or a beam end beside the core (P or T against its nearest
  * core point): the pairs with the parameter strictly inside the other
  * segment. Where the nearest of them is the outline's nearest (the
- * geometry computed from body_shape_segment), it is the first contact and
+ * geometry computed from bsim_body_shape_segment), it is the first contact and
  * the other extreme, if apart along the beam, the second (g's has2): a
  * capsule pressed flat on a beam stands on two points rather than rocking
  * on one, and where it crosses the beam the second lies far and is
@@ -121,9 +121,9 @@ void thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const dou
 	g->x[1] = w->x[1];
 	g->theta = b->theta;
 	g->psi = w->heading;
-	body_segment_contact sc;
+	bsim_body_segment_contact sc;
 	g->has2 = 0;
-	if (body_shape_segment(&w->body, w->x, w->heading, b->p, tip, &sc) != BSIM_OK) {
+	if (bsim_body_shape_segment(&w->body, w->x, w->heading, b->p, tip, &sc) != BSIM_OK) {
 		/* The beam crosses the body's centre line: no normal. */
 		g->type = BSIM_CONTACT_NONE;
 		g->dist = 0.0;

@@ -133,7 +133,7 @@ struct bsim_world {
 	double heading;          /* rad, psi */
 	double angular_velocity; /* rad/s, w (next to the heading: get_state copies them) */
 	double mass, inv_mass;
-	/* m: the disk's radius; for another shape its reach (body_shape_reach),
+	/* m: the disk's radius; for another shape its reach (bsim_body_shape_reach),
 	 * what every distance bound (broad phase, margins, sleep) needs. */
 	double radius;
 	/* The extended path (thesis.h's head): 1 if the body turns, is not a

@@ -41,7 +41,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "model/contact_flag.h"
+#include "beamsim/contact_flag.h"
 #include "util/fminmax.h"
 #include "thesis/thesis.h"
 

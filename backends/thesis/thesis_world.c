@@ -27,7 +27,7 @@
 #include <string.h>
 
 #include "beamsim/version.h"
-#include "model/body_shape.h"
+#include "beamsim/body_shape.h"
 #include "thesis/thesis.h"
 
 static const bsim_knob thesis_knobs[] = {
@@ -179,20 +179,20 @@ static void thesis_destroy(bsim_world *w)
 	free(w);
 }
 
-/* A shape whose outline body_shape_segment cannot give (a far segment has
+/* A shape whose outline bsim_body_shape_segment cannot give (a far segment has
  * a normal for every shape it supports) is refused. */
 static int shape_check(const bsim_scene *scene, bsim_error *err)
 {
 	const bsim_body_def *b = &scene->body;
 	if (b->shape == BSIM_SHAPE_DISK)
 		return BSIM_OK;
-	double r = body_shape_reach(b), x[2] = {0.0, 0.0};
+	double r = bsim_body_shape_reach(b), x[2] = {0.0, 0.0};
 	double p0[2] = {2.0 * r + 1.0, -1.0}, p1[2] = {2.0 * r + 1.0, 1.0};
-	body_segment_contact c;
-	if (!(r > 0.0) || body_shape_segment(b, x, 0.0, p0, p1, &c) != BSIM_OK)
+	bsim_body_segment_contact c;
+	if (!(r > 0.0) || bsim_body_shape_segment(b, x, 0.0, p0, p1, &c) != BSIM_OK)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "thesis: %s: body.shape: no contact detection for this "
-		                      "shape (model/body_shape.h gives none)",
+		                      "shape (beamsim/body_shape.h gives none)",
 		                      scene->path[0] ? scene->path : scene->name);
 	return BSIM_OK;
 }
@@ -206,7 +206,7 @@ static void body_setup(bsim_world *w, const bsim_scene *scene)
 	w->rotates = b->rotates != 0;
 	w->friction = scene->contact.friction;
 	w->extended = w->shaped || w->rotates || w->friction > 0.0;
-	w->radius = w->shaped ? body_shape_reach(b) : b->radius;
+	w->radius = w->shaped ? bsim_body_shape_reach(b) : b->radius;
 	w->body_inertia = bsim_body_inertia(b);
 	w->inv_body_inertia = w->rotates ? 1.0 / w->body_inertia : 0.0;
 	w->angular_velocity = w->rotates ? b->angular_velocity : 0.0;

@@ -1,5 +1,5 @@
-/* The body's outline against a segment (model/body_shape.h). */
-#include "model/body_shape.h"
+/* The body's outline against a segment (beamsim/body_shape.h). */
+#include "beamsim/body_shape.h"
 
 #include <math.h>
 
@@ -17,7 +17,7 @@ static void segment_nearest(const double p0[2], const double p1[2], const double
 
 /* A disk of radius r about x. */
 static int disk_segment(double r, const double x[2], const double p0[2], const double p1[2],
-                        body_segment_contact *out)
+                        bsim_body_segment_contact *out)
 {
 	segment_nearest(p0, p1, x, out->on_segment, &out->at_end);
 	double dx = x[0] - out->on_segment[0], dy = x[1] - out->on_segment[1];
@@ -56,7 +56,7 @@ static int segments_cross(const double a0[2], const double a1[2], const double b
  * overlap's middle is taken, so that a capsule lying on a beam is pressed
  * at the middle of its flat, not at one end. */
 static int capsule_segment(double r, double l, const double x[2], double psi, const double p0[2],
-                           const double p1[2], body_segment_contact *out)
+                           const double p1[2], bsim_body_segment_contact *out)
 {
 	double h[2] = {0.5 * l * cos(psi), 0.5 * l * sin(psi)};
 	double ca[2] = {x[0] - h[0], x[1] - h[1]}, cb[2] = {x[0] + h[0], x[1] + h[1]};
@@ -119,13 +119,13 @@ static int capsule_segment(double r, double l, const double x[2], double psi, co
 	return BSIM_OK;
 }
 
-int body_shape_segment(const bsim_body_def *b, const double x[2], double psi, const double p0[2],
-                       const double p1[2], body_segment_contact *out)
+int bsim_body_shape_segment(const bsim_body_def *b, const double x[2], double psi,
+                            const double p0[2], const double p1[2], bsim_body_segment_contact *out)
 {
 	switch (b->shape) {
 	case BSIM_SHAPE_ELLIPSE:
-		return body_shape_ellipse_segment(b->semi_axes[0], b->semi_axes[1], x, psi, p0, p1,
-		                                  out);
+		return bsim_body_shape_ellipse_segment(b->semi_axes[0], b->semi_axes[1], x, psi, p0,
+		                                       p1, out);
 	case BSIM_SHAPE_CAPSULE:
 		return capsule_segment(b->radius, b->length, x, psi, p0, p1, out);
 	default:
@@ -133,7 +133,7 @@ int body_shape_segment(const bsim_body_def *b, const double x[2], double psi, co
 	}
 }
 
-double body_shape_reach(const bsim_body_def *b)
+double bsim_body_shape_reach(const bsim_body_def *b)
 {
 	switch (b->shape) {
 	case BSIM_SHAPE_CAPSULE:

@@ -1,5 +1,5 @@
-/* An ellipse against a segment (model/body_shape.h). */
-#include "model/body_shape.h"
+/* An ellipse against a segment (beamsim/body_shape.h). */
+#include "beamsim/body_shape.h"
 
 #include <float.h>
 #include <math.h>
@@ -198,8 +198,9 @@ static void consider(const ellipse *E, const double y0[2], const double dv[2], c
 	}
 }
 
-int body_shape_ellipse_segment(double a, double c, const double x[2], double psi,
-                               const double p0[2], const double p1[2], body_segment_contact *out)
+int bsim_body_shape_ellipse_segment(double a, double c, const double x[2], double psi,
+                                    const double p0[2], const double p1[2],
+                                    bsim_body_segment_contact *out)
 {
 	if (!(a > 0.0 && c > 0.0 && isfinite(a) && isfinite(c) && isfinite(psi)))
 		return BSIM_EFAIL;

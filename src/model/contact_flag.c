@@ -1,9 +1,9 @@
-/* The geometry of the contact flag (model/contact_flag.h): a beam's gap to
+/* The geometry of the contact flag (beamsim/contact_flag.h): a beam's gap to
  * the body, computed the same way for every backend and for the runner's
  * overlap measure (docs/model.md section 3):
  *   s = clamp((C - P) . u, 0, L),  Q = P + s u,  gap = |C - Q| - R,
  *   tangent if 0 < (C - P) . u < L, tip otherwise. */
-#include "model/contact_flag.h"
+#include "beamsim/contact_flag.h"
 
 #include <math.h>
 

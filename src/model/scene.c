@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
-#include "model/body_shape.h"
+#include "beamsim/body_shape.h"
 #include "model/scene_internal.h"
 
 #define BSIM_PI 3.14159265358979323846
@@ -257,16 +257,16 @@ int scene_overlap(const bsim_scene *s, double *dist)
 		double along = fmin(fmax(dx * ux + dy * uy, 0), b->length);
 		double d = hypot(dx - along * ux, dy - along * uy);
 		if (s->body.shape != BSIM_SHAPE_DISK) {
-			/* The outline (model/body_shape.h), for a beam within the
+			/* The outline (beamsim/body_shape.h), for a beam within the
 			 * body's reach; no normal: the beam crosses the body's
 			 * centre line. */
-			if (!(d < body_shape_reach(&s->body)))
+			if (!(d < bsim_body_shape_reach(&s->body)))
 				continue;
 			double tip[2] = {b->pivot[0] + b->length * ux,
 			                 b->pivot[1] + b->length * uy};
-			body_segment_contact bc;
-			if (body_shape_segment(&s->body, c, bsim_body_heading(&s->body), b->pivot,
-			                       tip, &bc) != BSIM_OK) {
+			bsim_body_segment_contact bc;
+			if (bsim_body_shape_segment(&s->body, c, bsim_body_heading(&s->body),
+			                            b->pivot, tip, &bc) != BSIM_OK) {
 				*dist = 0.0;
 				return i;
 			}

@@ -67,7 +67,7 @@ void scene_defaults(bsim_scene *s);
 /* Index of the first beam the body overlaps at the start, or -1; *dist in
  * m. A disk: the distance from its centre to the beam's segment < radius,
  * *dist that distance. Another shape: its outline against the segment
- * (model/body_shape.h) has a gap < 0, *dist the gap (0 where the segment
+ * (beamsim/body_shape.h) has a gap < 0, *dist the gap (0 where the segment
  * crosses the body's centre line). */
 int scene_overlap(const bsim_scene *s, double *dist);
 

@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "beamsim/limits.h"
-#include "model/body_shape.h"
+#include "beamsim/body_shape.h"
 #include "model/scene_internal.h"
 #include "util/yaml_override.h"
 
@@ -258,7 +258,7 @@ static int check_termination(walk *w)
 /* The default success line, 65 m, is the essay's gate's for its disk of
  * radius 10 m: the beams' forward reach (pivot row 30 + beam 25) plus R.
  * For another shape it is that reach plus the outline's farthest point
- * from the centre (body_shape_reach), so that a beam swung forward no
+ * from the centre (bsim_body_shape_reach), so that a beam swung forward no
  * longer reaches the body; classify_y stays 15 m beyond it. What the file
  * gives is kept. */
 static void success_line_default(walk *w, struct fy_node *root)
@@ -267,7 +267,7 @@ static void success_line_default(walk *w, struct fy_node *root)
 	if (s->has_lattice || s->body.shape == BSIM_SHAPE_DISK ||
 	    ydoc_lookup(root, "termination.success_y"))
 		return;
-	s->success_y = 55.0 + body_shape_reach(&s->body);
+	s->success_y = 55.0 + bsim_body_shape_reach(&s->body);
 	if (!ydoc_lookup(root, "termination.classify_y"))
 		s->classify_y = s->success_y + 15.0;
 }

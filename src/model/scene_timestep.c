@@ -33,7 +33,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "model/body_shape.h"
+#include "beamsim/body_shape.h"
 #include "model/scene_internal.h"
 
 #define BSIM_PI 3.14159265358979323846
@@ -183,7 +183,7 @@ void scene_speed_scale(const bsim_scene *s, scene_speed *v)
 		v->forces = f / e->drag_linear;
 		v->drag_capped = 1;
 	}
-	v->spin = body->rotates ? fabs(body->angular_velocity) * body_shape_reach(body) : 0;
+	v->spin = body->rotates ? fabs(body->angular_velocity) * bsim_body_shape_reach(body) : 0;
 	for (int i = 0; i < s->n_beams; i++) {
 		const bsim_beam_def *d = &s->beams[i];
 		double w2 = d->initial_omega * d->initial_omega +

@@ -6,7 +6,7 @@
 
 #include <math.h>
 
-#include "model/contact_flag.h"
+#include "beamsim/contact_flag.h"
 
 void trial_overlap_shapes(beam_shape *shape, const bsim_scene *sc)
 {
@@ -24,7 +24,7 @@ void trial_overlap_shapes(beam_shape *shape, const bsim_scene *sc)
 
 /* R - min_i |C - Q_i|, Q_i the point of beam i's segment nearest the
  * centre C (docs/model.md section 3), measured as the contact flag measures
- * it (model/contact_flag.h). A beam whose reach L + R does not hold the
+ * it (beamsim/contact_flag.h). A beam whose reach L + R does not hold the
  * centre costs one distance test. */
 double trial_overlap_depth(const beam_shape *shape, int n, double radius, const bsim_state *s)
 {

@@ -1,18 +1,29 @@
-/* Internal: the one contact flag every backend reports (bsim_state.contact,
+/* The contact flag a backend reports (bsim_state.contact, beamsim/state.h;
  * the trajectory's contact columns), and the geometry of a beam's gap
- * behind it, shared so that the backends and the runner cannot drift apart.
+ * behind it. The runner defines the flag; a backend computes it with these
+ * helpers from the state it reports, so that every backend and the runner's
+ * own overlap measure agree to the bit.
  *
  * Beam i is in contact during a step when, at the step's end,
  *   gap_i = |C - Q_i| - R < BSIM_CONTACT_TOL        (beamsim/state.h, 6 mm)
  * (C the body's centre, Q_i the nearest point of the beam's segment, R the
- * body's radius: docs/model.md section 3, from the state the backend reports),
- * or the beam exchanged a nonzero normal impulse with the body during the
- * step (an impact, a persistent-contact or a Box2D contact impulse). The
- * flag's value is the contact's type at the step's end: TANGENT when the
- * nearest point lies inside the segment, TIP at either end. */
-#ifndef BSIM_MODEL_CONTACT_FLAG_H
-#define BSIM_MODEL_CONTACT_FLAG_H
+ * body's radius: docs/model.md section 3), or the beam exchanged a nonzero
+ * normal impulse with the body during the step (an impact or a resting
+ * contact's impulse, however the backend's solver names it). The flag's
+ * value is the contact's type at the step's end: TANGENT when the nearest
+ * point lies inside the segment, TIP at either end. For a body that is not
+ * a disk the gap is the outline's (bsim_body_shape_segment,
+ * beamsim/body_shape.h).
+ *
+ * A backend's step, for beam i with pivot p, rest direction u0, forward
+ * sign sgn and length L (beamsim/scene.h) at its reported angle theta:
+ *   bsim_beam_direction(u0, sgn, theta, u);
+ *   d2 = bsim_beam_distance2(p, u, L, x, &type);
+ *   contact[i] = bsim_contact_flag(d2, R, type, pushed_i); */
+#ifndef BSIM_CONTACT_FLAG_H
+#define BSIM_CONTACT_FLAG_H
 
+#include "beamsim/base.h"
 #include "beamsim/state.h"
 
 #ifdef __cplusplus
@@ -22,7 +33,7 @@ extern "C" {
 /* The direction of a beam at angle theta, rest direction u0 and forward
  * sign sgn (bsim_scene_beam_rest_direction, bsim_scene_beam_forward_sign):
  * u = R(sgn theta) u0. */
-void bsim_beam_direction(const double u0[2], double sgn, double theta, double u[2]);
+BSIM_API void bsim_beam_direction(const double u0[2], double sgn, double theta, double u[2]);
 
 /* C - Q for a body's centre x against the segment from the pivot p along
  * u of the given length, in d; *type the contact's type there
@@ -49,8 +60,8 @@ static inline double bsim_beam_distance2(const double p[2], const double u[2], d
 
 /* |C - Q|, m, the same distance (hypot: no overflow, for the runner's
  * overlap measure). */
-double bsim_beam_distance(const double p[2], const double u[2], double length, const double x[2],
-                          int *type);
+BSIM_API double bsim_beam_distance(const double p[2], const double u[2], double length,
+                                   const double x[2], int *type);
 
 /* The flag of a beam at squared distance dist2 (bsim_beam_distance2) from
  * the centre of a body of radius R at the step's end: type if the gap
