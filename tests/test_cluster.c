@@ -277,16 +277,16 @@ static void compare_shards_merged(const char *name, const char *backends)
 	char dir[1024], one[1100], out[1100], part[3][1100];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir(name));
 	snprintf(one, sizeof one, "%s/one", dir);
-	const char *argv1[] = {"compare", experiment, "--trials", "4",       "--threads",  "2",
-	                       "--out",   one,        "--quiet",  "--backends", backends, NULL};
+	const char *argv1[] = {"compare", experiment, "--trials", "4",          "--threads", "2",
+	                       "--out",   one,        "--quiet",  "--backends", backends,    NULL};
 	assert_int_equal(bsim_test_cli(argv1, NULL, NULL), 0);
 	for (int i = 0; i < 3; i++) {
 		char shard_arg[16];
 		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
 		snprintf(shard_arg, sizeof shard_arg, "%d/3", i + 1);
-		const char *argv[] = {"compare", experiment, "--trials",   "4",      "--threads",
-		                      "1",       "--shard",  shard_arg,    "--out",  part[i],
-		                      "--quiet", "--backends", backends, NULL};
+		const char *argv[] = {"compare", experiment,   "--trials", "4",     "--threads",
+		                      "1",       "--shard",    shard_arg,  "--out", part[i],
+		                      "--quiet", "--backends", backends,   NULL};
 		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	}
 	snprintf(out, sizeof out, "%s/merged", dir);
@@ -667,23 +667,16 @@ static const char *lattice_compare_experiment(void)
 static void lattice_compare_argv(const char **argv, const char *out, const char *threads,
                                  const char *sides, const char *a, const char *b)
 {
-	const char *opt = !sides                             ? NULL
-	                  : strncmp(sides, "world", 5) == 0 ||
-	                                    strncmp(sides, "essay", 5) == 0
+	const char *opt = !sides ? NULL
+	                  : strncmp(sides, "world", 5) == 0 || strncmp(sides, "essay", 5) == 0
 	                          ? "--protocols"
 	                          : "--backends";
-	const char *v[] = {"compare",
-	                   lattice_compare_experiment(),
-	                   "--threads",
-	                   threads,
-	                   "--out",
-	                   out,
-	                   "--quiet",
-	                   sides ? opt : a,
-	                   sides ? sides : b,
-	                   sides ? a : NULL,
-	                   sides ? b : NULL,
-	                   NULL};
+	const char *v[] = {"compare",         lattice_compare_experiment(),
+	                   "--threads",       threads,
+	                   "--out",           out,
+	                   "--quiet",         sides ? opt : a,
+	                   sides ? sides : b, sides ? a : NULL,
+	                   sides ? b : NULL,  NULL};
 	memcpy(argv, v, sizeof v);
 }
 

@@ -114,8 +114,8 @@ static void test_box2d_small_body_located(void **state)
 	/* A step short enough for such a body (its crossing), so that the
 	 * scene loads and Box2D is the one to refuse it. */
 	const char *fine = "integration.dt=1e-5";
-	const char *set[] = {"run",   gate(),           "--backend", "box2d", "--set",
-	                     "body.radius=0.019", "--set", fine,       NULL};
+	const char *set[] = {"run",   gate(), "--backend", "box2d", "--set", "body.radius=0.019",
+	                     "--set", fine,   NULL};
 	const char *set_needles[] = {"--set body.radius=0.019: body.radius: box2d: 0.019 m",
 	                             "expected more than 0.02 units", NULL};
 	bsim_test_expect_input_error(set, set_needles);

@@ -366,10 +366,9 @@ static void test_seed_beside_file(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	        cmocka_unit_test(test_sweep_killed),     cmocka_unit_test(test_compare_killed),
-	        cmocka_unit_test(test_compare3_killed),
-	        cmocka_unit_test(test_signals),          cmocka_unit_test(test_refusals),
-	        cmocka_unit_test(test_seed_beside_file),
+	        cmocka_unit_test(test_sweep_killed),    cmocka_unit_test(test_compare_killed),
+	        cmocka_unit_test(test_compare3_killed), cmocka_unit_test(test_signals),
+	        cmocka_unit_test(test_refusals),        cmocka_unit_test(test_seed_beside_file),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

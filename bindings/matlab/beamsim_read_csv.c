@@ -117,7 +117,8 @@ static int field_names(const char *path, const table *t, field_name *names, bsim
 				        "%s "
 				        "(letters, digits and underscores, at most 63 characters); "
 				        "expected names that differ there",
-				        path, d + 1, field(t, 0, d), c + 1, field(t, 0, c), names[c]);
+				        path, d + 1, field(t, 0, d), c + 1, field(t, 0, c),
+				        names[c]);
 	}
 	return BSIM_OK;
 }
@@ -140,8 +141,7 @@ static mxArray *table_struct(const table *t, const field_name *names)
 		} else {
 			col = mxCreateCellMatrix((mwSize)n, 1);
 			for (size_t r = 0; r < n; r++)
-				mxSetCell(col, (mwIndex)r,
-				          bmx_string(field(t, r + 1, c)));
+				mxSetCell(col, (mwIndex)r, bmx_string(field(t, r + 1, c)));
 		}
 		bmx_set(s, 0, names[c], col);
 	}

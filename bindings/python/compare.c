@@ -33,7 +33,7 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	long trials = 0;
 	int threads = 0, resume = 0, overwrite = 0;
 	PyObject *sides_o = Py_None, *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None,
-	                   *progress_o = Py_None;
+	         *progress_o = Py_None;
 	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|OliOOOOpp", kwlist, &experiment, &out,
 	                                 &sides_o, &trials, &threads, &seed_o, &sets_o, &grid_o,
 	                                 &progress_o, &resume, &overwrite))
@@ -45,9 +45,10 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	bsim_compare_dir_def def = bsim_compare_dir_def_default();
 	bsim_error err;
 	/* sides None: the registry's default ones (bsim_compare_dir_def_default) */
-	PyObject *sides = sides_o == Py_None
-	                          ? NULL
-	                          : PySequence_Fast(sides_o, "backends: expected a sequence of sides");
+	PyObject *sides =
+	        sides_o == Py_None
+	                ? NULL
+	                : PySequence_Fast(sides_o, "backends: expected a sequence of sides");
 	if (!sides && sides_o != Py_None)
 		return NULL;
 	Py_ssize_t n = sides ? PySequence_Fast_GET_SIZE(sides) : def.n_sides;

@@ -12,10 +12,9 @@
 PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"experiment",   "out",      "trials",       "threads",
-	                         "seed",         "backend",  "sets",         "grid",
-	                         "backend_opts", "progress", "trajectories", "resume",
-	                         "overwrite",    "hold",         NULL};
+	static char *kwlist[] = {"experiment",   "out",    "trials",    "threads",      "seed",
+	                         "backend",      "sets",   "grid",      "backend_opts", "progress",
+	                         "trajectories", "resume", "overwrite", "hold",         NULL};
 	const char *experiment, *out, *backend_spec = NULL;
 	long trials = 0, keep = 0;
 	int threads = 0, resume = 0, overwrite = 0;

@@ -43,8 +43,8 @@ int bsim_accuracy_store(const char *out, int overwrite, const bsim_scene *scene,
 	memset(res, 0, sizeof *res);
 	memset(fig, 0, sizeof *fig);
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, out, bsim_session_mode(0, overwrite), "accuracy", NULL, NULL, 0,
-	                           err);
+	int rc = bsim_session_open(&ss, out, bsim_session_mode(0, overwrite), "accuracy", NULL,
+	                           NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
 	char path[BSIM_PATH_MAX], mat[BSIM_PATH_MAX];

@@ -17,8 +17,8 @@ int bsim_landscape_store(const char *out, int overwrite, const bsim_scene *s,
 	/* DIR is checked before the grid is computed, and its files appear
 	 * together. */
 	bsim_session ss;
-	int rc = bsim_session_open(&ss, out, bsim_session_mode(0, overwrite), "landscape", NULL, NULL, 0,
-	                           err);
+	int rc = bsim_session_open(&ss, out, bsim_session_mode(0, overwrite), "landscape", NULL,
+	                           NULL, 0, err);
 	if (rc != BSIM_OK)
 		return rc;
 	rc = bsim_landscape_grid_alloc(s, def, g, err);

@@ -394,8 +394,8 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 	}
 	bsim_session ss;
 	/* the maps join those already cached */
-	if ((rc = bsim_session_open(&ss, dir, BSIM_OUTDIR_ADD, "markov build", NULL, NULL, 0, err)) !=
-	    BSIM_OK)
+	if ((rc = bsim_session_open(&ss, dir, BSIM_OUTDIR_ADD, "markov build", NULL, NULL, 0,
+	                            err)) != BSIM_OK)
 		return rc;
 	rc = set_fill(lattice, def, dir, &ss, out, err);
 	if (rc == BSIM_OK)

@@ -313,7 +313,8 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 				return bsim_error_set(
 				        err, BSIM_EINPUT,
 				        "--backends %s: expected two different sides (a backend "
-				        "against itself takes options inline, e.g. %s,%s:KEY=VALUE)",
+				        "against itself takes options inline, e.g. "
+				        "%s,%s:KEY=VALUE)",
 				        given, job->backend[i]->name, job->backend[i]->name);
 			if (strcmp(job->label[i], job->label[j]) == 0)
 				return bsim_error_set(
@@ -452,10 +453,10 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 	}
 	bsim_session ss;
 	if (rc == BSIM_OK)
-		rc = bsim_session_open(&ss, def->out,
-		                       bsim_session_mode(def->resume, def->overwrite), "compare",
-		                       &(bsim_outdir_spelling){def->resume_option, def->overwrite_option},
-		                       inputs, size, err);
+		rc = bsim_session_open(
+		        &ss, def->out, bsim_session_mode(def->resume, def->overwrite), "compare",
+		        &(bsim_outdir_spelling){def->resume_option, def->overwrite_option}, inputs,
+		        size, err);
 	if (rc == BSIM_OK) {
 		if (spread != BSIM_SPREAD_NONE || def->n_merge > 0)
 			rc = compare_spread(def, &job, inputs, &ss, size, &finished, err);

@@ -439,7 +439,8 @@ int bsim_output_dir_check(const char *dir, int overwrite, const char *overwrite_
                           bsim_error *err)
 {
 	const bsim_outdir_spelling sp = {NULL, overwrite_option};
-	return bsim_outdir_probe(dir, overwrite ? BSIM_OUTDIR_OVERWRITE : BSIM_OUTDIR_NEW, &sp, err);
+	return bsim_outdir_probe(dir, overwrite ? BSIM_OUTDIR_OVERWRITE : BSIM_OUTDIR_NEW, &sp,
+	                         err);
 }
 
 const char *bsim_outdir_dir(const bsim_outdir *od)
@@ -760,7 +761,8 @@ static int verify_one(const char *dir, const char *path, const ofile *want, bsim
 		                      "%s: expected the file %s/%s lists (%lld bytes, CRC-32 "
 		                      "%08lx), got %lld bytes, CRC-32 %08lx: the directory "
 		                      "mixes files of two runs, or the file was changed",
-		                      path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, want->crc, n, c);
+		                      path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, want->crc, n,
+		                      c);
 	return BSIM_OK;
 }
 

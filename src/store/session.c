@@ -19,8 +19,8 @@ int bsim_session_path(char *buf, size_t size, const char *dir, const char *name,
 }
 
 int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, const char *command,
-                      const bsim_outdir_spelling *spelling, const char *inputs,
-                      size_t record_size, bsim_error *err)
+                      const bsim_outdir_spelling *spelling, const char *inputs, size_t record_size,
+                      bsim_error *err)
 {
 	const char *opt = bsim_outdir_resume_option(spelling);
 	struct stat st;
@@ -50,13 +50,15 @@ int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, c
 		int finished = 0;
 		bsim_error ignore;
 		bsim_outdir_verify(dir, &finished, &ignore);
-		rc = finished ? bsim_error_set(err, BSIM_EINPUT,
-		                               "%s: %s holds a finished run, nothing to resume (use "
-		                               "%s instead to replace it)",
-		                               opt, dir, bsim_outdir_overwrite_option(spelling))
-		              : bsim_error_set(err, BSIM_EINPUT,
-		                               "%s: %s holds no stopped run to resume (run without %s)",
-		                               opt, dir, opt);
+		rc = finished
+		             ? bsim_error_set(err, BSIM_EINPUT,
+		                              "%s: %s holds a finished run, nothing to resume (use "
+		                              "%s instead to replace it)",
+		                              opt, dir, bsim_outdir_overwrite_option(spelling))
+		             : bsim_error_set(
+		                       err, BSIM_EINPUT,
+		                       "%s: %s holds no stopped run to resume (run without %s)",
+		                       opt, dir, opt);
 	} else if (resume) {
 		rc = bsim_journal_resume(&s->journal, s->journal_path, inputs, record_size, err);
 		if (rc != BSIM_OK) {

@@ -34,8 +34,8 @@ typedef struct bsim_session {
  * BSIM_OUTDIR_ADD the files join dir's set at the close. spelling (may be
  * NULL) is how the caller names --resume and --overwrite in the messages. */
 int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, const char *command,
-                      const bsim_outdir_spelling *spelling, const char *inputs,
-                      size_t record_size, bsim_error *err);
+                      const bsim_outdir_spelling *spelling, const char *inputs, size_t record_size,
+                      bsim_error *err);
 
 /* The mode of a run with the user's resume and overwrite flags. */
 static inline bsim_outdir_mode bsim_session_mode(int resume, int overwrite)

@@ -246,10 +246,10 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	}
 	bsim_session ss;
 	if (rc == BSIM_OK)
-		rc = bsim_session_open(&ss, def->out,
-		                       bsim_session_mode(def->resume, def->overwrite), "sweep",
-		                       &(bsim_outdir_spelling){def->resume_option, def->overwrite_option},
-		                       inputs, size, err);
+		rc = bsim_session_open(
+		        &ss, def->out, bsim_session_mode(def->resume, def->overwrite), "sweep",
+		        &(bsim_outdir_spelling){def->resume_option, def->overwrite_option}, inputs,
+		        size, err);
 	if (rc != BSIM_OK) {
 		free(inputs);
 		bsim_experiment_free(e);
