@@ -208,6 +208,17 @@ static void md_row_deterministic(FILE *f, const bsim_report *r, int g, const bsi
 	fprintf(f, " | deterministic | %d of 1 | - | - | - |", cg->discordant);
 }
 
+/* A group row's last two cells: the median separation time (or -) and the
+ * verdict, in the two-side and the many-side tables alike. */
+static void md_row_end(FILE *f, const bsim_compare_group *cg)
+{
+	if (cg->t_sep[1] >= 0.0)
+		fprintf(f, " %.3f |", cg->t_sep[1]);
+	else
+		fputs(" - |", f);
+	fprintf(f, " %s |\n", bsim_compare_verdict_name(cg->verdict));
+}
+
 static void md_table(FILE *f, const bsim_report *r)
 {
 	const bsim_experiment *e = r->e;
@@ -235,11 +246,7 @@ static void md_table(FILE *f, const bsim_report *r)
 			md_row_deterministic(f, r, g, cg);
 		else
 			md_row_random(f, cg);
-		if (cg->t_sep[1] >= 0.0)
-			fprintf(f, " %.3f |", cg->t_sep[1]);
-		else
-			fputs(" - |", f);
-		fprintf(f, " %s |\n", bsim_compare_verdict_name(cg->verdict));
+		md_row_end(f, cg);
 	}
 	fputc('\n', f);
 }
@@ -651,11 +658,7 @@ static void md_pairs_table(FILE *f, const bsim_report *r)
 				fprintf(f, " - (no event varies) | %.2g |", group_equivalence(cg));
 			if (!cg->deterministic)
 				md_number(f, " %.2f |", t->mde80);
-			if (cg->t_sep[1] >= 0.0)
-				fprintf(f, " %.3f |", cg->t_sep[1]);
-			else
-				fputs(" - |", f);
-			fprintf(f, " %s |\n", bsim_compare_verdict_name(cg->verdict));
+			md_row_end(f, cg);
 		}
 	}
 	fputc('\n', f);
