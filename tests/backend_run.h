@@ -43,6 +43,20 @@ static inline bsim_trial_result test_trial(const bsim_backend *b, const bsim_sce
 	return out;
 }
 
+/* A Table 2.1 beam alone (no body in reach) with stiffness k and damping d,
+ * released from theta0 at rest at rest angle rest_deg (its pivot kept), on
+ * backend b with its defaults. */
+static inline bsim_world *test_beam_released(const bsim_backend *b, bsim_scene *s, double k,
+                                             double d, double theta0, double rest_deg)
+{
+	scene_one_beam(s);
+	s->beams[0].stiffness = k;
+	s->beams[0].damping = d;
+	s->beams[0].initial_theta = theta0;
+	s->beams[0].rest_angle_deg = rest_deg;
+	return bsim_test_world(b, s, NULL);
+}
+
 /* Over 3 s from 0.1 rad: the largest |theta - exact|, and from the peaks of
  * |theta| (its local maxima, every half period) the decay rate
  * ln(A_first / A_last) / (t_last - t_first) and the period, each relative to

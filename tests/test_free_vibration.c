@@ -15,27 +15,15 @@
 
 #include <cmocka.h>
 
+#include "backend_run.h"
 #include "scenes.h"
 #include "support.h"
-
-/* A Table 2.1 beam alone (no body in reach), released from theta0 at rest,
- * at rest angle rest_deg. */
-static bsim_world *beam_released(const bsim_backend *b, bsim_scene *s, double k, double d,
-                                 double theta0, double rest_deg)
-{
-	scene_one_beam(s);
-	s->beams[0].stiffness = k;
-	s->beams[0].damping = d;
-	s->beams[0].initial_theta = theta0;
-	s->beams[0].rest_angle_deg = rest_deg;
-	return bsim_test_world(b, s, NULL);
-}
 
 /* Max |theta - exact| over t in [0, t_end] for a Table 2.1 beam. */
 static double vibration_error(const bsim_backend *b, double h, double t_end, double rest_deg)
 {
 	bsim_scene s;
-	bsim_world *w = beam_released(b, &s, 400.0, 50.0, 0.1, rest_deg);
+	bsim_world *w = test_beam_released(b, &s, 400.0, 50.0, 0.1, rest_deg);
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
@@ -91,7 +79,7 @@ static void test_stiff_spring_stable(void **state)
 			const double inertia = 0.1 * 625.0 / 3.0; /* scene_one_beam's beam */
 			double k = inertia * (wh[c] / h) * (wh[c] / h);
 			bsim_scene s;
-			bsim_world *w = beam_released(
+			bsim_world *w = test_beam_released(
 			        b, &s, k, damped ? 2.0 * 0.05 * sqrt(k * inertia) : 0.0, 0.2, 0.0);
 			assert_true(s.beams[0].inertia == inertia);
 			bsim_state st;

@@ -16,6 +16,7 @@
 
 #include <cmocka.h>
 
+#include "backend_run.h"
 #include "scenes.h"
 #include "support.h"
 
@@ -207,19 +208,6 @@ static void test_impact_mass_identity(void **state)
 	bsim_scene_free(&s);
 }
 
-/* A Table 2.1 beam alone (no body in reach), released from theta0 at rest. */
-static bsim_world *beam_released(bsim_scene *s, double k, double d, double theta0)
-{
-	scene_one_beam(s);
-	s->beams[0].stiffness = k;
-	s->beams[0].damping = d;
-	s->beams[0].initial_theta = theta0;
-	bsim_world *w = NULL;
-	bsim_error err;
-	assert_int_equal(thesis->create(s, NULL, &w, &err), BSIM_OK);
-	return w;
-}
-
 /* omega_n h from 0.05 to 4: no growth of the beam's energy, with and without
  * the damper; the undamped energy is kept to round-off. */
 static void test_stiff_spring_stable(void **state)
@@ -231,8 +219,9 @@ static void test_stiff_spring_stable(void **state)
 			const double inertia = 0.1 * 625.0 / 3.0; /* scene_one_beam's beam */
 			double k = inertia * (wh[c] / h) * (wh[c] / h);
 			bsim_scene s;
-			bsim_world *w = beam_released(
-			        &s, k, damped ? 2.0 * 0.05 * sqrt(k * inertia) : 0.0, 0.2);
+			bsim_world *w = test_beam_released(
+			        thesis, &s, k, damped ? 2.0 * 0.05 * sqrt(k * inertia) : 0.0, 0.2,
+			        0.0);
 			assert_true(s.beams[0].inertia == inertia);
 			bsim_state st;
 			bsim_state_init(&st, 1);
