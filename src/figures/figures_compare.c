@@ -126,6 +126,29 @@ static void fast_label(const fsum *s, int g, char *buf, size_t size)
 		snprintf(buf, size, "group %d", g);
 }
 
+/* Event e's last cell under ev (report.json's "...events.E"): beyond, as
+ * report.json says or by a DIFFERENT verdict with a nonzero difference;
+ * and in lay whether the event is beyond somewhere and gets its panel (it
+ * happened on either side, or beyond). */
+static void event_beyond(FILE *o, struct fy_node *root, const char *ev, int e, const char *verdict,
+                         double difference, cmp_layout *lay)
+{
+	char p[240], b[16];
+	snprintf(p, sizeof p, "%s.beyond", ev);
+	text(root, p, b, sizeof b);
+	int beyond =
+	        strcmp(b, "true") == 0 || (strcmp(verdict, "DIFFERENT") == 0 && difference != 0);
+	fprintf(o, " %d", beyond);
+	lay->beyond[e] |= beyond;
+	lay->any[e] |= beyond;
+	for (int side = 0; side < 2; side++) {
+		int absent = 0;
+		snprintf(p, sizeof p, "%s.%s", ev, side ? "p_b" : "p_a");
+		double pv = num(root, p, &absent);
+		lay->any[e] |= absent || pv != 0;
+	}
+}
+
 /* Group g's row of two sides after its position and number: traversal on
  * A and B, then each event's difference, interval and beyond. *bad on a
  * missing field. */
@@ -146,28 +169,14 @@ static void two_row(FILE *o, struct fy_node *root, int g, cmp_layout *lay, int *
 	for (int e = 0; e < N_EV; e++) {
 		static const char *const df[] = {"difference", "difference_ci95.0",
 		                                 "difference_ci95.1"};
+		double dv[3];
 		for (int i = 0; i < 3; i++) {
 			snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e], df[i]);
-			double dv = num_or(root, p, "difference", g, events[e], bad);
-			fprintf(o, " %.6g", dv);
+			dv[i] = num_or(root, p, "difference", g, events[e], bad);
+			fprintf(o, " %.6g", dv[i]);
 		}
-		char b[16];
-		snprintf(p, sizeof p, "groups.%d.events.%s.beyond", g, events[e]);
-		text(root, p, b, sizeof b);
-		snprintf(p, sizeof p, "groups.%d.events.%s.difference", g, events[e]);
-		int beyond = strcmp(b, "true") == 0 ||
-		             (strcmp(verdict, "DIFFERENT") == 0 && num(root, p, bad) != 0);
-		fprintf(o, " %d", beyond);
-		lay->any[e] |= beyond;
-		/* an event that happened on either side gets its panel */
-		for (int side = 0; side < 2; side++) {
-			int absent = 0;
-			snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, events[e],
-			         side ? "p_b" : "p_a");
-			double pv = num(root, p, &absent);
-			lay->any[e] |= absent || pv != 0;
-		}
-		lay->beyond[e] |= beyond;
+		snprintf(p, sizeof p, "groups.%d.events.%s", g, events[e]);
+		event_beyond(o, root, p, e, verdict, dv[0], lay);
 	}
 }
 
@@ -204,21 +213,8 @@ static void sides_row(FILE *o, struct fy_node *root, int g, int n_sides, cmp_lay
 					*bad = 1;
 				fprintf(o, " %.6g", dv[i]);
 			}
-			char b[16];
-			snprintf(p, sizeof p, "%s.events.%s.beyond", q, events[e]);
-			text(root, p, b, sizeof b);
-			int beyond = strcmp(b, "true") == 0 ||
-			             (strcmp(verdict, "DIFFERENT") == 0 && dv[0] != 0);
-			fprintf(o, " %d", beyond);
-			lay->beyond[e] |= beyond;
-			lay->any[e] |= beyond;
-			for (int side = 0; side < 2; side++) {
-				int absent = 0;
-				snprintf(p, sizeof p, "%s.events.%s.%s", q, events[e],
-				         side ? "p_b" : "p_a");
-				double pv = num(root, p, &absent);
-				lay->any[e] |= absent || pv != 0;
-			}
+			snprintf(p, sizeof p, "%s.events.%s", q, events[e]);
+			event_beyond(o, root, p, e, verdict, dv[0], lay);
 		}
 	}
 }
