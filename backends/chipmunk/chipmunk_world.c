@@ -522,19 +522,16 @@ static int chipmunk_create(const bsim_scene *scene, const bsim_options *opts, bs
  * within MOTION_MAX (not NaN). */
 static int motion_in_range(const struct bsim_world *w)
 {
-	double worst = 0.0;
-	const cpBody *bodies[2] = {w->body, NULL};
 	for (int k = -1; k < w->n_live; k++) {
-		bodies[1] = k < 0 ? w->body : w->beams[w->live[k]].body;
-		const cpVect p = cpBodyGetPosition(bodies[1]), v = cpBodyGetVelocity(bodies[1]);
-		worst = fmax(worst, fmax(fmax(fabs(p.x), fabs(p.y)), fmax(fabs(v.x), fabs(v.y))));
-		worst = fmax(worst, fmax(fabs(cpBodyGetAngle(bodies[1])),
-		                         fabs(cpBodyGetAngularVelocity(bodies[1]))));
-		if (isnan(p.x + p.y + v.x + v.y + cpBodyGetAngle(bodies[1]) +
-		          cpBodyGetAngularVelocity(bodies[1])))
-			return 0;
+		const cpBody *b = k < 0 ? w->body : w->beams[w->live[k]].body;
+		const cpVect p = cpBodyGetPosition(b), v = cpBodyGetVelocity(b);
+		const double q[6] = {
+		        p.x, p.y, v.x, v.y, cpBodyGetAngle(b), cpBodyGetAngularVelocity(b)};
+		for (int j = 0; j < 6; j++)
+			if (!(fabs(q[j]) < MOTION_MAX))
+				return 0;
 	}
-	return worst < MOTION_MAX;
+	return 1;
 }
 
 /* The body and the live beams before a substep (chipmunk_measure's "-"). */
