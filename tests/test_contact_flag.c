@@ -16,7 +16,13 @@
  *   under the tolerance, tangent beside the beam and tip beyond it. No
  *   impulse acts (the motion is parallel), so this is the gap part alone.
  * - Every backend agrees with the default one on the flag step by step
- *   through an impact. */
+ *   through an impact.
+ * - The rule for a body that is not a disk (bsim_contact_flag_of, which
+ *   every backend calls) against the gap measured by sampling: the
+ *   capsule's and the ellipse's outlines and the beam's segment at many
+ *   points, the gap the smallest distance between them, over random
+ *   placements whose sampled gap is not within 2 mm of the tolerance; a
+ *   segment through the body's centre line is in contact. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -209,12 +215,142 @@ static void test_backends_agree(void **state)
 	bsim_scene_free(&s);
 }
 
+/* A deterministic uniform deviate in [0, 1). */
+static double unit_draw(unsigned long long *st)
+{
+	*st = *st * 6364136223846793005ull + 1442695040888963407ull;
+	return (double)(*st >> 11) * 0x1.0p-53;
+}
+
+/* The outline's point at parameter t in [0, 1), m: the capsule (segment
+ * 2 l along the heading e, radius r) walked as two sides and two half
+ * circles; the ellipse (semi-axes a along e, c) by its angle. */
+static void outline_point(const bsim_body_def *b, const double x[2], double psi, double t,
+                          double q[2])
+{
+	const double e[2] = {cos(psi), sin(psi)}, n[2] = {-e[1], e[0]};
+	double lx, ly;
+	if (b->shape == BSIM_SHAPE_ELLIPSE) {
+		const double phi = 2.0 * 3.14159265358979323846 * t;
+		lx = b->semi_axes[0] * cos(phi);
+		ly = b->semi_axes[1] * sin(phi);
+	} else {
+		const double l = b->length / 2, r = b->radius;
+		const double side = 2.0 * l, arc = 3.14159265358979323846 * r,
+		             total = 2.0 * (side + arc);
+		double d = t * total;
+		if (d < side) {
+			lx = -l + d;
+			ly = -r;
+		} else if ((d -= side) < arc) {
+			lx = l + r * sin(d / r);
+			ly = -r * cos(d / r);
+		} else if ((d -= arc) < side) {
+			lx = l - d;
+			ly = r;
+		} else {
+			d -= side;
+			lx = -l - r * sin(d / r);
+			ly = r * cos(d / r);
+		}
+	}
+	q[0] = x[0] + lx * e[0] + ly * n[0];
+	q[1] = x[1] + lx * e[1] + ly * n[1];
+}
+
+enum { OUTLINE = 1440, SEGMENT = 600 };
+
+/* The smallest distance between the outline's and the segment's sampled
+ * points (the segment from p along u, len long), m, and in near the vector
+ * from the segment's nearest point to the outline's. */
+static double sampled_gap(const bsim_body_def *b, const double x[2], double psi, const double p[2],
+                          const double u[2], double len, double near[2])
+{
+	double gap = INFINITY;
+	for (int i = 0; i < OUTLINE; i++) {
+		double q[2];
+		outline_point(b, x, psi, (double)i / OUTLINE, q);
+		for (int j = 0; j <= SEGMENT; j++) {
+			const double t = len * j / SEGMENT;
+			const double d[2] = {q[0] - p[0] - t * u[0], q[1] - p[1] - t * u[1]};
+			const double g = hypot(d[0], d[1]);
+			if (g < gap) {
+				gap = g;
+				near[0] = d[0];
+				near[1] = d[1];
+			}
+		}
+	}
+	return gap;
+}
+
+static void test_outline_rule(void **state)
+{
+	const bsim_backend *b = *state;
+	if (b != bsim_backend_default())
+		bsim_test_skip(b, "the rule is the library's, the same for every backend");
+	bsim_body_def bodies[2] = {bsim_body_def_default(), bsim_body_def_default()};
+	bodies[0].shape = BSIM_SHAPE_CAPSULE;
+	bodies[0].radius = 1.0;
+	bodies[0].length = 3.0;
+	bodies[1].shape = BSIM_SHAPE_ELLIPSE;
+	bodies[1].semi_axes[0] = 3.0;
+	bodies[1].semi_axes[1] = 1.0;
+	enum { PLACEMENTS = 100 };
+	unsigned long long st = 12345;
+	int checked = 0, touching = 0;
+	for (int k = 0; k < 2; k++)
+		for (int m = 0; m < PLACEMENTS; m++) {
+			const double psi = 2.0 * 3.14159265358979323846 * unit_draw(&st);
+			const double x[2] = {0.0, 0.0};
+			double p[2] = {-6.0 + 12.0 * unit_draw(&st), -4.0 + 1.0 * unit_draw(&st)};
+			const double a = 3.14159265358979323846 * (0.1 + 0.8 * unit_draw(&st)),
+			             len = 8.0;
+			const double u[2] = {cos(a), sin(a)};
+			/* moved toward the body along the nearest points' line, which
+			 * takes the gap down by the move: to 1-4 mm either side of the
+			 * tolerance */
+			double near[2] = {0.0, 0.0};
+			double g0 = sampled_gap(&bodies[k], x, psi, p, u, len, near);
+			if (g0 < 0.05)
+				continue; /* an overlap, which sampling does not measure */
+			const double side = unit_draw(&st) < 0.5 ? -1.0 : 1.0;
+			const double target =
+			        BSIM_CONTACT_TOL + side * (1e-3 + 3e-3 * unit_draw(&st));
+			p[0] += (g0 - target) * near[0] / g0;
+			p[1] += (g0 - target) * near[1] / g0;
+			const double gap = sampled_gap(&bodies[k], x, psi, p, u, len, near);
+			if (fabs(gap - BSIM_CONTACT_TOL) < 1e-3)
+				continue; /* within sampling's error of the tolerance */
+			const int flag = bsim_contact_flag_of(&bodies[k], x, psi, p, u, len, 0);
+			if ((flag != BSIM_CONTACT_NONE) != (gap < BSIM_CONTACT_TOL))
+				fail_msg("body %d placement %d: sampled gap %.6f m, flag %d", k, m,
+				         gap, flag);
+			assert_int_equal(bsim_contact_flag_of(&bodies[k], x, psi, p, u, len, 1) ==
+			                         BSIM_CONTACT_NONE,
+			                 0); /* pushed: in contact whatever the gap */
+			checked++;
+			touching += gap < BSIM_CONTACT_TOL;
+		}
+	assert_true(checked > PLACEMENTS && touching > PLACEMENTS / 4 &&
+	            checked - touching > PLACEMENTS / 4); /* both sides, most placements */
+	/* a segment through the centre line: in contact */
+	for (int k = 0; k < 2; k++) {
+		const double x[2] = {0.0, 0.0}, p[2] = {0.0, -5.0}, u[2] = {0.0, 1.0};
+		assert_int_not_equal(bsim_contact_flag_of(&bodies[k], x, 0.3, p, u, 10.0, 0),
+		                     BSIM_CONTACT_NONE);
+	}
+	print_message("%d placements checked, %d of them within the tolerance\n", checked,
+	              touching);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_head_on_impact),
 	        cmocka_unit_test(test_grazing_pass),
 	        cmocka_unit_test(test_backends_agree),
+	        cmocka_unit_test(test_outline_rule),
 	};
 	return bsim_test_run_per_backend("contact_flag", tests, sizeof tests / sizeof tests[0]);
 }

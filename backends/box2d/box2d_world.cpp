@@ -121,8 +121,7 @@
  * manifold (the polygon's face is the reference): every manifold that is
  * not the edge's face (e_faceA) is the tip's, the disk's rule too.
  * The contact flag of a body that is not a disk is its true outline's gap
- * (outline_gap: the capsule's segment-to-segment distance less R; the
- * ellipse's from beamsim/body_shape.h), not the polygon's.
+ * (bsim_contact_flag_of), not the polygon's.
  *
  * Energy of a step, for the runner's ledger (dE = W - damper - impact -
  * contact - correction):
@@ -844,62 +843,6 @@ double ellipse_point_distance(double a, double b, double px, double py)
 	return std::hypot(a2 * y0 / (t + a2) - y0, b2 * y1 / (t + b2) - y1);
 }
 
-/* The gap between the body's outline and a beam's segment p + t u,
- * t in [0, length], m (<= 0: they overlap), and in *type whether the
- * segment's nearest point is an end (TIP) or inside it (TANGENT).
- *   capsule: the distance between its segment C +- (L/2) e (e the
- *     heading) and the beam's, less R (closest points of two segments:
- *     C. Ericson, Real-Time Collision Detection, 5.1.9, the body's segment
- *     first so that parallel segments give the beam's inner point);
- *   ellipse: the model's geometry (beamsim/body_shape.h, as the thesis
- *     backend and the start's overlap check measure it), after a test
- *     that decides most steps: the segment misses the circumscribed circle
- *     by the tolerance (no contact); a segment through the ellipse's
- *     centre line, which has no separating normal, overlaps it. */
-double outline_gap(const bsim_body_def &body, const double c[2], double psi, const double p[2],
-                   const double u[2], double length, double tol, int *type)
-{
-	const double e[2] = {std::cos(psi), std::sin(psi)};
-	if (body.shape == BSIM_SHAPE_CAPSULE) {
-		const double l = 0.5 * body.length;
-		const double p1[2] = {c[0] - l * e[0], c[1] - l * e[1]};
-		const double d1[2] = {2.0 * l * e[0], 2.0 * l * e[1]};
-		const double d2[2] = {length * u[0], length * u[1]};
-		const double r[2] = {p1[0] - p[0], p1[1] - p[1]};
-		const double aa = d1[0] * d1[0] + d1[1] * d1[1], ee = d2[0] * d2[0] + d2[1] * d2[1];
-		const double f = d2[0] * r[0] + d2[1] * r[1], cc = d1[0] * r[0] + d1[1] * r[1];
-		const double bb = d1[0] * d2[0] + d1[1] * d2[1], den = aa * ee - bb * bb;
-		double sp = den > 0.0 ? std::clamp((bb * f - cc * ee) / den, 0.0, 1.0) : 0.0;
-		double tp = (bb * sp + f) / ee;
-		if (tp < 0.0) {
-			tp = 0.0;
-			sp = std::clamp(-cc / aa, 0.0, 1.0);
-		} else if (tp > 1.0) {
-			tp = 1.0;
-			sp = std::clamp((bb - cc) / aa, 0.0, 1.0);
-		}
-		*type = tp > 0.0 && tp < 1.0 ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
-		double dx = p1[0] + sp * d1[0] - p[0] - tp * d2[0];
-		double dy = p1[1] + sp * d1[1] - p[1] - tp * d2[1];
-		return std::hypot(dx, dy) - body.radius;
-	}
-	/* the ellipse: the circumscribed circle first, which decides most steps */
-	const double rel[2] = {c[0] - p[0], c[1] - p[1]};
-	double t_c = std::clamp(rel[0] * u[0] + rel[1] * u[1], 0.0, length);
-	double gap_circle = std::hypot(rel[0] - t_c * u[0], rel[1] - t_c * u[1]) -
-	                    std::fmax(body.semi_axes[0], body.semi_axes[1]);
-	*type = t_c > 0.0 && t_c < length ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
-	if (gap_circle >= tol)
-		return gap_circle;
-	const double p1[2] = {p[0] + length * u[0], p[1] + length * u[1]};
-	bsim_body_segment_contact bc;
-	if (bsim_body_shape_segment(&body, c, psi, p, p1, &bc) != BSIM_OK)
-		return -std::fmin(body.semi_axes[0],
-		                  body.semi_axes[1]); /* through its centre line */
-	*type = bc.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
-	return bc.dist;
-}
-
 /* The contact flag of beam i after a step (beamsim/contact_flag.h), from the
  * state get_state reports: x = position / s, theta = sgn angle; for a body
  * that is not a disk, from its outline's gap at the reported heading. */
@@ -909,16 +852,10 @@ int contact_flag_of(const bsim_world *w, const beam_rec &b)
 	const b2Vec2 p = w->body->GetPosition();
 	const double x[2] = {p.x / s, p.y / s};
 	double u[2];
-	int type;
 	bsim_beam_direction(b.u0, b.sgn, b.sgn * (double)b.body->GetAngle(), u);
 	const double length = w->scene.beams[(size_t)b.index].length;
-	if (w->scene.body.shape != BSIM_SHAPE_DISK) {
-		double gap = outline_gap(w->scene.body, x, body_heading(w), b.pivot, u, length,
-		                         BSIM_CONTACT_TOL, &type);
-		return b.pushed || gap < BSIM_CONTACT_TOL ? type : BSIM_CONTACT_NONE;
-	}
-	double dist2 = bsim_beam_distance2(b.pivot, u, length, x, &type);
-	return bsim_contact_flag(dist2, w->scene.body.radius, type, b.pushed);
+	return bsim_contact_flag_of(&w->scene.body, x, body_heading(w), b.pivot, u, length,
+	                            b.pushed);
 }
 
 /* Beam i's flag is set: listed, and live. */

@@ -110,22 +110,8 @@ static int flag_of(const struct bsim_world *w, int i, const double x[2], double 
 {
 	const chip_beam *b = &w->beams[i];
 	double u[2];
-	int type;
 	bsim_beam_direction(b->u0, b->sgn, b->sgn * cpBodyGetAngle(b->body), u);
-	const bsim_body_def *body = &w->scene.body;
-	const double d2 = bsim_beam_distance2(b->pivot, u, b->length, x, &type);
-	if (body->shape == BSIM_SHAPE_DISK)
-		return bsim_contact_flag(d2, body->radius, type, b->pushed);
-	/* the outline: the circle about it decides most steps */
-	const double far = w->reach + BSIM_CONTACT_TOL;
-	if (d2 >= far * far && !b->pushed)
-		return BSIM_CONTACT_NONE;
-	const double p1[2] = {b->pivot[0] + b->length * u[0], b->pivot[1] + b->length * u[1]};
-	bsim_body_segment_contact bc;
-	if (bsim_body_shape_segment(body, x, psi, b->pivot, p1, &bc) != BSIM_OK)
-		return type; /* through its centre line: overlapping */
-	type = bc.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
-	return b->pushed || bc.dist < BSIM_CONTACT_TOL ? type : BSIM_CONTACT_NONE;
+	return bsim_contact_flag_of(&w->scene.body, x, psi, b->pivot, u, b->length, b->pushed);
 }
 
 /* Beam i flagged: listed, and live. */

@@ -19,24 +19,8 @@
  * A step in free flight (thesis_broad_phase_clear, whose margin includes
  * BSIM_CONTACT_TOL) ends more than 6 mm from every beam and pushes none, so
  * it only clears the last step's flags (thesis_contact_clear). */
-#include "beamsim/body_shape.h"
 #include "beamsim/contact_flag.h"
 #include "thesis/thesis.h"
-
-/* A body of another shape: the same rule with the outline's gap
- * (beamsim/body_shape.h), TIP where the segment's nearest point is its end. A
- * beam through the body's centre line is in contact. */
-static int shape_flag(const struct bsim_world *w, const thesis_beam *b, const double u[2],
-                      int pushed)
-{
-	double tip[2] = {b->p[0] + b->length * u[0], b->p[1] + b->length * u[1]};
-	bsim_body_segment_contact c;
-	if (bsim_body_shape_segment(&w->body, w->x, w->heading, b->p, tip, &c) != BSIM_OK)
-		return BSIM_CONTACT_TANGENT;
-	if (!pushed && !(c.dist < BSIM_CONTACT_TOL))
-		return BSIM_CONTACT_NONE;
-	return c.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
-}
 
 /* extended: constant (contact_geometry.h's contact_detect): 0 compiles the
  * essay's disk's copy without the shape's test. */
@@ -52,7 +36,7 @@ THESIS_SPECIALISED void report_beam(struct bsim_world *w, int i, const int exten
 	int type, flag;
 	thesis_beam_direction(b, u);
 	if (extended && w->shaped) {
-		flag = shape_flag(w, b, u, pushed);
+		flag = bsim_contact_flag_of(&w->body, w->x, w->heading, b->p, u, b->length, pushed);
 	} else {
 		double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
 		flag = bsim_contact_flag(dist2, w->radius, type, pushed);

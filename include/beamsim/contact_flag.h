@@ -13,7 +13,10 @@
  * value is the contact's type at the step's end: TANGENT when the nearest
  * point lies inside the segment, TIP at either end. For a body that is not
  * a disk the gap is the outline's (bsim_body_shape_segment,
- * beamsim/body_shape.h).
+ * beamsim/body_shape.h), the type where the outline's nearest point of the
+ * segment lies, and a segment through the body's centre line (no
+ * separating normal) is in contact with the type the centre's nearest
+ * point gives: bsim_contact_flag_of, the one rule every backend calls.
  *
  * A backend's step, for beam i with pivot p, rest direction u0, forward
  * sign sgn and length L (beamsim/scene.h) at its reported angle theta:
@@ -24,6 +27,7 @@
 #define BSIM_CONTACT_FLAG_H
 
 #include "beamsim/base.h"
+#include "beamsim/scene.h"
 #include "beamsim/state.h"
 
 #ifdef __cplusplus
@@ -73,6 +77,14 @@ static inline int bsim_contact_flag(double dist2, double radius, int type, int p
 	const double reach = radius + BSIM_CONTACT_TOL;
 	return pushed || dist2 < reach * reach ? type : BSIM_CONTACT_NONE;
 }
+
+/* The flag of a beam (pivot p, unit direction u, length) against a body of
+ * any shape at centre x with heading psi (rad), pushed in the step or not:
+ * the rule above, bsim_contact_flag's for a disk, the outline's gap for
+ * another shape (the circle about the outline first, which decides most
+ * steps without the outline's geometry). */
+BSIM_API int bsim_contact_flag_of(const bsim_body_def *body, const double x[2], double psi,
+                                  const double p[2], const double u[2], double length, int pushed);
 
 #ifdef __cplusplus
 }

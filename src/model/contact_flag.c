@@ -7,6 +7,8 @@
 
 #include <math.h>
 
+#include "beamsim/body_shape.h"
+
 void bsim_beam_direction(const double u0[2], double sgn, double theta, double u[2])
 {
 	double cs = cos(theta), sn = sgn * sin(theta);
@@ -20,4 +22,23 @@ double bsim_beam_distance(const double p[2], const double u[2], double length, c
 	double d[2];
 	bsim_beam_offset(p, u, length, x, type, d);
 	return hypot(d[0], d[1]);
+}
+
+int bsim_contact_flag_of(const bsim_body_def *body, const double x[2], double psi,
+                         const double p[2], const double u[2], double length, int pushed)
+{
+	int type;
+	const double d2 = bsim_beam_distance2(p, u, length, x, &type);
+	if (body->shape == BSIM_SHAPE_DISK)
+		return bsim_contact_flag(d2, body->radius, type, pushed);
+	/* the outline lies within the circle of its reach about the centre */
+	const double far = bsim_body_shape_reach(body) + BSIM_CONTACT_TOL;
+	if (d2 >= far * far && !pushed)
+		return BSIM_CONTACT_NONE;
+	const double tip[2] = {p[0] + length * u[0], p[1] + length * u[1]};
+	bsim_body_segment_contact c;
+	if (bsim_body_shape_segment(body, x, psi, p, tip, &c) != BSIM_OK)
+		return type; /* through its centre line: overlapping */
+	type = c.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
+	return pushed || c.dist < BSIM_CONTACT_TOL ? type : BSIM_CONTACT_NONE;
 }
