@@ -6,6 +6,7 @@
 
 #include <math.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/backend.h"
 #include "scenes.h"
 #include "support.h"
@@ -86,6 +87,7 @@ static inline double impact_square_on(const bsim_backend *b, const bsim_options 
 	for (int n = 0; n < 20; n++) {
 		assert_int_equal(b->step(w, zero, 0.0, 0.004, NULL), BSIM_OK);
 		b->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		impacts += st.impacts;
 		impact_loss += st.energy.impact;
 		tangent |= st.contact[0] == BSIM_CONTACT_TANGENT;

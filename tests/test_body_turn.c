@@ -20,6 +20,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/effects.h"
 #include "beamsim/trial.h"
 #include "box2d/box2d_shape.h"
@@ -485,6 +486,7 @@ static void test_outline_flag(void **state)
 				bsim_state st;
 				assert_int_equal(bsim_state_init(&st, 1), BSIM_OK);
 				be->get_state(w, &st);
+				bsim_contact_flags(&s, &st);
 				assert_int_equal(st.contact[0],
 				                 g == 0 ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_NONE);
 				bsim_state_free(&st);

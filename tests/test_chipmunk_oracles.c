@@ -22,6 +22,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "chipmunk/chipmunk_world.h"
@@ -267,9 +268,11 @@ static void test_reset_and_set_state(void **state)
 	for (int n = 0; n < 700; n++) /* into contact with both beams */
 		assert_int_equal(cm->step(w, g, 0.0, s.dt, NULL), BSIM_OK);
 	cm->get_state(w, &st);
+	bsim_contact_flags(&s, &st);
 	assert_true(st.theta[0] > 0.05 && st.theta[1] > 0.05);
 	assert_int_equal(cm->set_state(w2, &st, &err), BSIM_OK);
 	cm->get_state(w2, &st2);
+	bsim_contact_flags(&s, &st2);
 	assert_memory_equal(st.x, st2.x, sizeof st.x);
 	assert_memory_equal(st.theta, st2.theta, 2 * sizeof *st.theta);
 	assert_memory_equal(st.omega, st2.omega, 2 * sizeof *st.omega);

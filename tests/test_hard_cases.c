@@ -19,6 +19,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "support.h"
@@ -110,6 +111,7 @@ static void zeno_one(const bsim_backend *b, double e)
 	for (int n = 1; n <= steps; n++) {
 		assert_int_equal(b->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		double g = min_gap(&s, &st);
 		if (n >= 3 && g_prev > 1e-3 && g_prev > g_prev2 && g_prev >= g && n_apex < 64) {
 			if (n_apex > 0)
@@ -221,6 +223,7 @@ static void test_double_impact(void **state)
 /* ---- trial-runner helpers (cases 3, 6, 7) --------------------------------- */
 
 typedef struct {
+	const bsim_backend *b;
 	const bsim_scene *s;
 	double pen_max;   /* max (R - distance), m */
 	int tunnels;      /* side flips while inside the beam's span */
@@ -243,7 +246,7 @@ static void watch_fn(void *user, long step, const bsim_state *st)
 		return;
 	}
 	wt->e_max = fmax(wt->e_max, energy_of(wt->s, st));
-	wt->pivot_max = fmax(wt->pivot_max, st->pivot_drift);
+	wt->pivot_max = fmax(wt->pivot_max, bsim_backend_pivot_drift(wt->b, wt->s, st));
 	for (int i = 0; i < st->n_beams && i < 8; i++) {
 		const bsim_beam_def *d = &wt->s->beams[i];
 		double s, side;
@@ -260,6 +263,7 @@ static int run_trial(const bsim_backend *b, const bsim_scene *s, uint64_t seed, 
                      bsim_trial_result *res)
 {
 	memset(wt, 0, sizeof *wt);
+	wt->b = b;
 	wt->s = s;
 	wt->pen_max = -INFINITY;
 	bsim_recorder rec = {.stride = 1, .trace = watch_fn, .trace_user = wt};
@@ -368,6 +372,7 @@ static void wedge_one(const bsim_backend *b, double overlap)
 		/* both beams touch a centred body at y0 = 2 (20 sin 60 - R):
 		 * distance 20 sin 60 - y/2; y0 + 2 overlap sinks it by overlap */
 		b->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		st.x[1] = 2.0 * (20.0 * sin(60.0 * 0.017453292519943295) - s.body.radius) +
 		          2.0 * overlap;
 		st.v[1] = 0.0;
@@ -380,6 +385,7 @@ static void wedge_one(const bsim_backend *b, double overlap)
 	for (n = 1; n <= s.max_steps; n++) {
 		assert_int_equal(b->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		vmax = fmax(vmax, hypot(st.v[0], st.v[1]));
 		if (n == s.max_steps / 2) {
 			x_half = st.x[0];
@@ -458,6 +464,7 @@ static void graze_one(const bsim_backend *b, double eps)
 	bsim_state st;
 	bsim_state_init(&st, 1);
 	b->get_state(w, &st);
+	bsim_contact_flags(&s, &st);
 	double e0 = energy_of(&s, &st);
 	double l0 = s.body.mass * (st.x[0] * st.v[1] - st.x[1] * st.v[0]) +
 	            s.beams[0].inertia * st.omega[0];
@@ -467,6 +474,7 @@ static void graze_one(const bsim_backend *b, double eps)
 	for (int n = 0; n < 400; n++) {
 		assert_int_equal(b->step(w, zero, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		tangent |= st.contact[0] == BSIM_CONTACT_TANGENT;
 		tip |= st.contact[0] == BSIM_CONTACT_TIP;
 		impacts += st.impacts;

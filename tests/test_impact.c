@@ -226,6 +226,7 @@ static void run_tip(const bsim_backend *b, double e_tip, double out[4])
 	for (int k = 0; k < 10; k++) {
 		assert_int_equal(b->step(w, zero, 0.0, h, NULL), BSIM_OK);
 		b->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		tip |= st.contact[0] == BSIM_CONTACT_TIP;
 		assert_true(st.contact[0] != BSIM_CONTACT_TANGENT);
 		if (st.impacts && !impacts) {

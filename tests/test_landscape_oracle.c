@@ -20,6 +20,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/backend.h"
 #include "beamsim/landscape.h"
 #include "beamsim/landscape_barriers.h"
@@ -68,12 +69,14 @@ static void push(const bsim_backend *be, push_result *r)
 	bsim_state st;
 	assert_int_equal(bsim_state_init(&st, 1), BSIM_OK);
 	be->get_state(w, &st);
+	bsim_contact_flags(&s, &st);
 	memset(r, 0, sizeof *r);
 	const double L = b->length, R = s.body.radius;
 	for (int n = 0; n < 45000 && st.x[1] < 40; n++) {
 		const double force[2] = {-200.0 * st.v[0], 200.0 * (0.25 - st.v[1])};
 		assert_int_equal(be->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
 		be->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		if (!st.contact[0])
 			continue;
 		const double rho2 = st.x[0] * st.x[0] + st.x[1] * st.x[1];
@@ -157,6 +160,7 @@ static void rest_at_basin_floor(const bsim_backend *be, double tol)
 	for (int n = 0; n < 10000; n++) { /* 40 s; d / k = 1.25 s */
 		assert_int_equal(be->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
 		be->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 	}
 	const double *fl = br->lowest.floor;
 	print_message("%s: at rest at (%.5f, %.5f) m, speed %.2g m/s; the basin floor (%.5f, "

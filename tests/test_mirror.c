@@ -18,6 +18,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
 #include "scenes.h"
@@ -59,7 +60,9 @@ static void test_mirror_steps(void **state)
 		assert_int_equal(be->step(wa, fa, 0.0, a.dt, NULL), BSIM_OK);
 		assert_int_equal(be->step(wb, fb, 0.0, b.dt, NULL), BSIM_OK);
 		be->get_state(wa, &sa);
+		bsim_contact_flags(&a, &sa);
 		be->get_state(wb, &sb);
+		bsim_contact_flags(&b, &sb);
 		double dev = fmax(fmax(fabs(sa.x[0] + sb.x[0]), fabs(sa.x[1] - sb.x[1])),
 		                  fmax(fabs(sa.theta[0] - sb.theta[1]) * 25.0,
 		                       fabs(sa.theta[1] - sb.theta[0]) * 25.0));

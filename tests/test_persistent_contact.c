@@ -12,6 +12,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/backend.h"
 #include "scenes.h"
 #include "support.h"
@@ -62,6 +63,7 @@ static void test_impact_chain_settles(void **state)
 		assert_int_equal(bsim_test_backend("thesis")->step(w, force, 0.0, s.dt, NULL),
 		                 BSIM_OK);
 		bsim_test_backend("thesis")->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		if (st.impacts) {
 			impacts += st.impacts;
 			last_impact = n;
@@ -119,6 +121,7 @@ static void test_projection_limit(void **state)
 		bsim_state st;
 		assert_int_equal(bsim_state_init(&st, 1), BSIM_OK);
 		bsim_test_backend("thesis")->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		st.x[0] = 12.0;
 		st.x[1] = d;
 		st.v[0] = st.v[1] = 0.0;
@@ -127,6 +130,7 @@ static void test_projection_limit(void **state)
 		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, 0.004, NULL),
 		                 BSIM_OK);
 		bsim_test_backend("thesis")->get_state(w, &st);
+		bsim_contact_flags(&s, &st);
 		const double pivot[2] = {0.0, 0.0};
 		double depth = R - segment_distance(st.x, pivot, st.theta[0]);
 		assert_int_equal(st.solver.iteration_limit, depth > 1e-6 ? 1 : 0);

@@ -18,6 +18,7 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/backend.h"
 #include "beamsim/effects.h"
 #include "beamsim/lattice.h"
@@ -165,13 +166,16 @@ static int step_against_fresh(const bsim_scene *sc, uint64_t seed, int n_steps)
 		double f[BSIM_WRENCH];
 		bsim_effects_force(&fx, n, sc->dt, f);
 		be->get_state(a, &sa);
+		bsim_contact_flags(sc, &sa);
 		bsim_world *b = NULL;
 		assert_int_equal(be->create(sc, NULL, &b, &err), BSIM_OK);
 		assert_int_equal(be->set_state(b, &sa, &err), BSIM_OK);
 		assert_int_equal(be->step(a, f, 0.0, sc->dt, &err), BSIM_OK);
 		assert_int_equal(be->step(b, f, 0.0, sc->dt, &err), BSIM_OK);
 		be->get_state(a, &sa);
+		bsim_contact_flags(sc, &sa);
 		be->get_state(b, &sb);
+		bsim_contact_flags(sc, &sb);
 		assert_same_step(&sa, &sb);
 		be->destroy(b);
 		for (int k = 0; k < sa.n_active; k++)
@@ -464,11 +468,14 @@ static int step_pair_same(bsim_world *a, bsim_world *b, const bsim_scene *sc, ui
 	for (int k = 0; k < n; k++) {
 		double f[BSIM_WRENCH];
 		be->get_state(a, &sa);
+		bsim_contact_flags(sc, &sa);
 		bsim_effects_force_at(&fx, k, sc->dt, &sa, f);
 		assert_int_equal(be->step(a, f, f[2], sc->dt, &err), BSIM_OK);
 		assert_int_equal(be->step(b, f, f[2], sc->dt, &err), BSIM_OK);
 		be->get_state(a, &sa);
+		bsim_contact_flags(sc, &sa);
 		be->get_state(b, &sb);
+		bsim_contact_flags(sc, &sb);
 		assert_same_step(&sa, &sb);
 		touched += sa.contact[0] || sa.contact[1];
 	}

@@ -17,6 +17,7 @@
 
 #include <cmocka.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/backend.h"
 #include "beamsim/body_shape.h"
 #include "scenes.h"
@@ -234,6 +235,7 @@ static void press_case(double ratio, int rotates, double *accel, double *drift)
 	for (int k = 0; k < 500; k++)
 		assert_int_equal(bsim_test_backend("thesis")->step(w, fn, 0.0, h, NULL), BSIM_OK);
 	bsim_test_backend("thesis")->get_state(w, &st);
+	bsim_contact_flags(&s, &st);
 	double x0 = st.x[0];
 	int n = 250;
 	double v_mid = 0.0;
@@ -241,10 +243,12 @@ static void press_case(double ratio, int rotates, double *accel, double *drift)
 		assert_int_equal(bsim_test_backend("thesis")->step(w, f, 0.0, h, NULL), BSIM_OK);
 		if (k == n - 1) {
 			bsim_test_backend("thesis")->get_state(w, &st);
+			bsim_contact_flags(&s, &st);
 			v_mid = st.v[0];
 		}
 	}
 	bsim_test_backend("thesis")->get_state(w, &st);
+	bsim_contact_flags(&s, &st);
 	*accel = (st.v[0] - v_mid) / (n * h);
 	*drift = st.x[0] - x0;
 	/* A capsule that turns stands on both ends of its core: held, it does

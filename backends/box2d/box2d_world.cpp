@@ -105,12 +105,13 @@
  * s = 0.1. The velocity solver stops an approach wherever the contact has
  * started, so a resting contact sits at a gap anywhere from 0 to that
  * (4-5 mm on a stuck H2 trial, docs/backends.md).
- * The contact flag the state reports is not Box2D's manifold but the one
- * every backend reports (beamsim/contact_flag.h): at the step's end the gap,
+ * The contact flag is not Box2D's manifold but the runner's, the same for
+ * every backend (beamsim/contact_flag.h): at the step's end the gap,
  * measured from the reported state (x, theta) with the shared geometry, is
  * below BSIM_CONTACT_TOL (6 mm, above that band at s = 1), or the beam's
- * contact had a nonzero normal impulse in the step (PostSolve, any substep
- * or TOI sub-solve).
+ * contact had a nonzero normal impulse in the step (touched: PostSolve, any
+ * substep or TOI sub-solve). The world lists the beams the flag may mark
+ * by the same rule (contact_flag_of).
  * Restitution: e = contact.restitution on the fixtures, and in PreSolve the
  * vertex manifolds (b2CollideEdgeAndCircle's e_circles: the tip, feature 1,
  * or the pivot end, feature 0) get tip_restitution; the pivot end is a point
@@ -121,7 +122,7 @@
  * manifold (the polygon's face is the reference): every manifold that is
  * not the edge's face (e_faceA) is the tip's, the disk's rule too.
  * The contact flag of a body that is not a disk is its true outline's gap
- * (bsim_contact_flag_of), not the polygon's.
+ * (beamsim/body_shape.h), not the polygon's.
  *
  * Energy of a step, for the runner's ledger (dE = W - damper - impact -
  * contact - correction):
@@ -309,8 +310,10 @@ struct beam_rec {
 	double row_v[2] = {0, 0};            /* body velocity, m/s */
 	double row_w = 0.0;                  /* beam angular velocity, rad/s (Box2D sense) */
 	double row_u[2] = {0, 0};            /* beam pivot velocity, m/s (0 if pinned) */
-	/* a nonzero normal impulse with the body in this step (the flag) */
+	/* a nonzero normal impulse with the body in this step (the flag), and
+	 * in the last step, as the state reports it (touched) */
 	bool pushed = false;
+	bool touched = false;
 };
 
 class contact_ledger;
@@ -335,7 +338,8 @@ struct bsim_world {
 	std::vector<int> live;
 	std::vector<char> is_live;
 	std::vector<int> typed;  /* beams whose contact_type is not NONE */
-	std::vector<int> pushed; /* beams whose pushed is set */
+	std::vector<int> pushed;  /* beams whose pushed is set */
+	std::vector<int> touched; /* beams whose touched is set */
 	/* Box2D */
 	b2World *world = nullptr;
 	b2Body *body = nullptr;
@@ -789,8 +793,10 @@ void world_build(bsim_world *w, const double x[2], const double v[2], double psi
 		b.w_pre = b.body->GetAngularVelocity();
 		b.row = false;
 		b.pushed = false;
+		b.touched = false;
 	}
 	w->pushed.clear();
+	w->touched.clear();
 	w->live.clear();
 	w->is_live.assign(w->beams.size(), 0);
 	for (size_t i = 0; i < w->beams.size(); i++)
@@ -843,16 +849,23 @@ double ellipse_point_distance(double a, double b, double px, double py)
 	return std::hypot(a2 * y0 / (t + a2) - y0, b2 * y1 / (t + b2) - y1);
 }
 
-/* The contact flag of beam i after a step (beamsim/contact_flag.h), from the
- * state get_state reports: x = position / s, theta = sgn angle; for a body
- * that is not a disk, from its outline's gap at the reported heading. */
+/* The direction of beam b as get_state reports it (theta = sgn angle). */
+void beam_direction(const beam_rec &b, double u[2])
+{
+	bsim_beam_direction(b.u0, b.sgn, b.sgn * (double)b.body->GetAngle(), u);
+}
+
+/* Whether beam i is to be listed after a step (or at a new state): the
+ * contact flag (beamsim/contact_flag.h) of the state get_state reports
+ * (x = position / s, theta = sgn angle), which the runner then computes
+ * from that state; a beam it flags must be listed. */
 int contact_flag_of(const bsim_world *w, const beam_rec &b)
 {
 	const double s = w->s;
 	const b2Vec2 p = w->body->GetPosition();
 	const double x[2] = {p.x / s, p.y / s};
 	double u[2];
-	bsim_beam_direction(b.u0, b.sgn, b.sgn * (double)b.body->GetAngle(), u);
+	beam_direction(b, u);
 	const double length = w->scene.beams[(size_t)b.index].length;
 	return bsim_contact_flag_of(&w->scene.body, x, body_heading(w), b.pivot, u, length,
 	                            b.pushed);
@@ -911,8 +924,16 @@ void update_contact_types(bsim_world *w)
 			                             : contact_flag_of(w, b);
 		}
 	}
-	for (int i : w->pushed)
+	/* The pushes spent: the state reports them as touched until the next
+	 * step's. */
+	for (int i : w->touched)
+		w->beams[(size_t)i].touched = false;
+	w->touched.clear();
+	for (int i : w->pushed) {
 		w->beams[(size_t)i].pushed = false;
+		w->beams[(size_t)i].touched = true;
+		w->touched.push_back(i);
+	}
 	w->pushed.clear();
 }
 
@@ -1432,7 +1453,6 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 	st->heading = body_heading(w);
 	st->angular_velocity = w->rotates ? (double)w->body->GetAngularVelocity() : 0.0;
 	int n = st->n_beams < (int)w->beams.size() ? st->n_beams : (int)w->beams.size();
-	st->pivot_drift = 0.0;
 	if (w->track_live) {
 		bsim_state_set_active(st, w->live.data(), (int)w->live.size());
 	} else {
@@ -1445,13 +1465,13 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 		const beam_rec &b = w->beams[(size_t)i];
 		/* The beam body's origin is its pivot; the pin joint holds it there
 		 * only as well as Box2D's iterative solver converges. */
-		const double *pivot = w->scene.beams[i].pivot;
 		b2Vec2 o = b.body->GetPosition();
-		st->pivot_drift = std::fmax(st->pivot_drift,
-		                            std::hypot(o.x / s - pivot[0], o.y / s - pivot[1]));
+		st->pin[2 * i] = o.x / s;
+		st->pin[2 * i + 1] = o.y / s;
 		st->theta[i] = b.sgn * (double)b.body->GetAngle();
 		st->omega[i] = b.sgn * (double)b.body->GetAngularVelocity();
-		st->contact[i] = w->contact_type[(size_t)i];
+		st->touched[i] = b.touched;
+		beam_direction(b, &st->direction[2 * i]);
 	}
 	st->energy = w->energy;
 	st->drag_loss = w->drag_loss;
@@ -1650,4 +1670,5 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         "Box2D measured at 0.21 s a step of a 333 x 300 lattice's 199,800 beams",
         box2d_bounds,
         (int)(sizeof box2d_bounds / sizeof box2d_bounds[0]),
+        0, /* exact_pins: the pin joint holds a beam as well as the solver converges */
 };

@@ -105,7 +105,9 @@ static double body_heading(const struct bsim_world *w)
 	return w->rotates ? cpBodyGetAngle(w->body) : bsim_body_heading(&w->scene.body);
 }
 
-/* The contact flag of beam i at the step's end (beamsim/contact_flag.h). */
+/* Whether beam i is to be listed at the step's end: the contact flag
+ * (beamsim/contact_flag.h) of the state get_state reports, which the
+ * runner then computes from that state; a beam it flags must be listed. */
 static int flag_of(const struct bsim_world *w, int i, const double x[2], double psi)
 {
 	const chip_beam *b = &w->beams[i];
@@ -168,21 +170,18 @@ static void measure_flags(struct bsim_world *w)
 				flag_set(w, i, flag);
 		}
 	}
-	for (int k = 0; k < w->n_pushed; k++)
-		w->beams[w->pushed[k]].pushed = 0;
-	w->n_pushed = 0;
-}
-
-/* The largest distance of a live beam's pinned centre from its pivot, m. */
-static double measure_pivot_drift(const struct bsim_world *w)
-{
-	double drift = 0.0;
-	for (int k = 0; k < w->n_live; k++) {
-		const chip_beam *b = &w->beams[w->live[k]];
-		const cpVect p = cpBodyGetPosition(b->body);
-		drift = fmax(drift, hypot(p.x - b->pivot[0], p.y - b->pivot[1]));
+	/* The pushes spent: the state reports them as touched until the next
+	 * step's. */
+	for (int k = 0; k < w->n_reported; k++)
+		w->beams[w->reported[k]].reported = 0;
+	w->n_reported = 0;
+	for (int k = 0; k < w->n_pushed; k++) {
+		chip_beam *b = &w->beams[w->pushed[k]];
+		b->pushed = 0;
+		b->reported = 1;
+		w->reported[w->n_reported++] = w->pushed[k];
 	}
-	return drift;
+	w->n_pushed = 0;
 }
 
 void chipmunk_measure(struct bsim_world *w, double h, int last)
@@ -192,5 +191,4 @@ void chipmunk_measure(struct bsim_world *w, double h, int last)
 	if (!last)
 		return;
 	measure_flags(w);
-	w->pivot_drift = measure_pivot_drift(w);
 }

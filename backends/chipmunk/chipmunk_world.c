@@ -80,6 +80,7 @@
 #include <unistd.h>
 
 #include "chipmunk/chipmunk_world.h"
+#include "beamsim/contact_flag.h"
 
 /* This backend's table, defined at the end of the file; the registry
  * (src/registry) lists it. */
@@ -240,11 +241,13 @@ static void world_build(struct bsim_world *w, const double x[2], const double v[
 			cpBodySleep(b->body);
 		b->touched = 0;
 		b->pushed = 0;
+		b->reported = 0;
 	}
 	chipmunk_contact_install(w);
 
 	w->n_live = 0;
 	w->n_pushed = 0;
+	w->n_reported = 0;
 	memset(w->is_live, 0, (size_t)w->n_beams);
 	for (int i = 0; i < w->n_beams; i++)
 		if (!w->track_live || theta[i] != 0.0 || omega[i] != 0.0)
@@ -424,6 +427,7 @@ static void chipmunk_destroy(bsim_world *w)
 	free(w->contact_type);
 	free(w->typed);
 	free(w->pushed);
+	free(w->reported);
 	bsim_scene_free(&w->scene);
 	free(w);
 }
@@ -480,8 +484,9 @@ static int chipmunk_create(const bsim_scene *scene, const bsim_options *opts, bs
 	w->contact_type = calloc(n, sizeof *w->contact_type);
 	w->typed = calloc(n, sizeof *w->typed);
 	w->pushed = calloc(n, sizeof *w->pushed);
+	w->reported = calloc(n, sizeof *w->reported);
 	if (!w->beams || !w->live || !w->is_live || !w->contact_type || !w->typed || !w->pushed ||
-	    bsim_scene_copy(&w->scene, scene) != BSIM_OK) {
+	    !w->reported || bsim_scene_copy(&w->scene, scene) != BSIM_OK) {
 		chipmunk_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "chipmunk: out of memory");
 	}
@@ -611,14 +616,18 @@ static void chipmunk_get_state(const bsim_world *w, bsim_state *st)
 	for (int k = 0; k < st->n_active; k++) {
 		const int i = st->active[k];
 		const chip_beam *b = &w->beams[i];
-		st->theta[i] = b->sgn * cpBodyGetAngle(b->body);
+		const double angle = cpBodyGetAngle(b->body);
+		const cpVect pin = cpBodyGetPosition(b->body);
+		st->theta[i] = b->sgn * angle;
 		st->omega[i] = b->sgn * cpBodyGetAngularVelocity(b->body);
-		st->contact[i] = w->contact_type[i];
+		st->touched[i] = b->reported;
+		bsim_beam_direction(b->u0, b->sgn, b->sgn * angle, &st->direction[2 * i]);
+		st->pin[2 * i] = pin.x;
+		st->pin[2 * i + 1] = pin.y;
 	}
 	st->energy = w->energy;
 	st->impacts = w->impacts;
 	st->solver = w->solver;
-	st->pivot_drift = w->pivot_drift;
 }
 
 #define STATE_EXPECTED                                                                             \
@@ -661,7 +670,6 @@ static int chipmunk_set_state(bsim_world *w, const bsim_state *st, bsim_error *e
 			w->typed[w->n_typed++] = i;
 		}
 	}
-	w->pivot_drift = 0.0;
 	return BSIM_OK;
 }
 
@@ -807,4 +815,5 @@ const bsim_backend bsim_backend_chipmunk = {
                       "beams",
         .bounds = chipmunk_bounds,
         .n_bounds = (int)(sizeof chipmunk_bounds / sizeof chipmunk_bounds[0]),
+        .exact_pins = 0, /* a pivot joint, solved iteratively */
 };

@@ -42,7 +42,8 @@ typedef struct chip_beam {
 	cpVect impulse;
 	double normal_impulse;
 	cpVect offset;
-	int pushed; /* a nonzero normal impulse with the body in the step (the flag) */
+	int pushed;   /* a nonzero normal impulse with the body in the step (the flag) */
+	int reported; /* pushed in the last step, as the state reports it (touched) */
 } chip_beam;
 
 struct bsim_world {
@@ -66,12 +67,15 @@ struct bsim_world {
 	int n_live;
 	int *live;
 	char *is_live;
-	/* the contact flag (beamsim/contact_flag.h) and the beams it set */
+	/* the contact flag (beamsim/contact_flag.h), which decides the beams
+	 * listed, and the beams it set */
 	int *contact_type;
 	int n_typed;
 	int *typed;
 	int n_pushed;
 	int *pushed; /* beams whose pushed is set */
+	int n_reported;
+	int *reported; /* beams whose reported is set */
 	/* the substep in progress: the force (N) and torque (N m), the body
 	 * before it (m, m/s, rad, rad/s) */
 	double force[2], torque;
@@ -83,7 +87,6 @@ struct bsim_world {
 	/* results of the last step */
 	bsim_step_energy energy;
 	int impacts;
-	double pivot_drift;        /* m, of the last step's end */
 	bsim_solver_counts solver; /* Chipmunk reports none: stays 0 */
 	int diverged;              /* the motion left the range Chipmunk can step */
 };

@@ -56,6 +56,44 @@ static inline void thesis_beam_direction(thesis_beam *b, double u[2])
 	u[1] = b->u[1];
 }
 
+/* thesis_beam_direction without keeping what it computes, for a world it
+ * may not change (get_state): the kept direction where it is the angle's. */
+static inline void thesis_beam_direction_of(const thesis_beam *b, double u[2])
+{
+	if (b->theta == 0.0) {
+		u[0] = b->u0[0];
+		u[1] = b->u0[1];
+	} else if (b->theta == b->u_theta) {
+		u[0] = b->u[0];
+		u[1] = b->u[1];
+	} else {
+		double cs = cos(b->theta), sn = b->sgn * sin(b->theta);
+		u[0] = b->u0[0] * cs - b->u0[1] * sn;
+		u[1] = b->u0[1] * cs + b->u0[0] * sn;
+	}
+}
+
+/* The state's raw facts of beam i (beamsim/state.h): its angle, angular
+ * velocity, whether it was pushed in the step, its direction, NaN where
+ * it is neither pushed nor near (thesis_contact_near: the broad phase and
+ * the last geometry bound it farther than BSIM_CONTACT_TOL, so no sine and
+ * cosine); no pin (exact by construction: bsim_backend.exact_pins). A
+ * near beam's direction is the next step's detection's too: kept (b->u). */
+static inline void thesis_state_beam(struct bsim_world *w, int i, int pushed, int near,
+                                     bsim_state *s)
+{
+	thesis_beam *b = &w->beams[i];
+	s->theta[i] = b->theta;
+	s->omega[i] = b->omega;
+	s->touched[i] = pushed;
+	if (pushed || near) {
+		thesis_beam_direction(b, &s->direction[2 * i]);
+	} else {
+		s->direction[2 * i] = NAN;
+		s->direction[2 * i + 1] = NAN;
+	}
+}
+
 /* The body's centre x against the beam at its angle: b->geo; the lever a
  * kept for the extended path only (extended: a constant, see below, which
  * the compiler gives each copy). Kept apart from its callers (it may call

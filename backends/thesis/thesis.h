@@ -30,6 +30,7 @@
 #include <math.h>
 
 #include "beamsim/backend.h"
+#include "beamsim/contact_flag.h"
 #include "util/fminmax.h"
 
 /* A function written once for any body with a constant `extended` and
@@ -185,12 +186,9 @@ struct bsim_world {
 	                    * what keeps a beam awake and from sleeping */
 	int *held;         /* per beam: in persistent contact (contact_mode=essay) */
 	int any_held;
-	/* The contact flag reported in the state (contact_report.c), and the
-	 * beams pushed in this step (a nonzero impact or persistent-contact
-	 * impulse), which it counts. */
-	int *flag;    /* per beam, BSIM_CONTACT_* */
-	int *flagged; /* beams whose flag is not NONE */
-	int n_flagged;
+	/* The beams pushed in the last step (a nonzero impact or
+	 * persistent-contact impulse: the state's touched), which decide with
+	 * the gap the beams listed (contact_report.c). */
 	unsigned char *pushed; /* per beam */
 	int *pushed_list;      /* beams whose pushed is set */
 	int n_pushed;
@@ -282,9 +280,11 @@ int thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, do
 int thesis_contact_near(const struct bsim_world *w, int i, double margin);
 int thesis_contact_near_disk(const struct bsim_world *w, int i, double margin);
 
-/* contact_report.c: the state's contact flag after a step (or at creation). */
+/* contact_report.c: the beams listed for the contact flag after a step (or
+ * at creation). */
 void thesis_contact_report(struct bsim_world *w);
 void thesis_contact_report_disk(struct bsim_world *w);
+
 void thesis_contact_clear(struct bsim_world *w);
 
 /* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
@@ -402,6 +402,15 @@ static inline void thesis_beam_pushed(struct bsim_world *w, int i)
 		return;
 	w->pushed[i] = 1;
 	w->pushed_list[w->n_pushed++] = i;
+}
+
+/* The last step's pushes spent (the state reports them as touched until
+ * the next step): at the start of a step. */
+static inline void thesis_contact_spent(struct bsim_world *w)
+{
+	for (int k = 0; k < w->n_pushed; k++)
+		w->pushed[w->pushed_list[k]] = 0;
+	w->n_pushed = 0;
 }
 
 /* The body's velocity at the step's end from its free velocity vf = v +
@@ -581,7 +590,6 @@ static inline void thesis_state_body(const struct bsim_world *w, bsim_state *s)
 	s->v[1] = w->v[1];
 	s->heading = w->heading;
 	s->angular_velocity = w->angular_velocity;
-	s->pivot_drift = 0.0;
 }
 
 /* Detection's geometry and tests, inline (contact_geometry.h). */

@@ -19,8 +19,8 @@
  * Each step then moves the body as thesis_body_advance does with a zero
  * impulse sum (v = vf + 0 / M, which turns a -0 into +0, is kept), and
  * clears what flight_step clears (the energy flows, the impacts, the
- * contacts, the last step's flags), which after the first step stay
- * cleared: cleared once, after the run. A body that turns is left to
+ * contacts), which after the first step stay cleared: cleared once,
+ * after the run. A body that turns is left to
  * thesis_step (its heading moves too). */
 #include <string.h>
 
@@ -99,8 +99,6 @@ int thesis_flight(bsim_world *w, const double force[2], double h, int n, double 
 		memset(&w->energy, 0, sizeof w->energy);
 		w->impacts = 0;
 		w->n_contacts = 0;
-		if (w->n_flagged)
-			thesis_contact_clear(w);
 	}
 	return k;
 }

@@ -7,8 +7,8 @@
  * THESIS_STEPS_BEAMS beams: the single gate of the essay and its variants
  * (H1, H2). There every beam is a candidate of every step, in ascending
  * order (broad_phase.c tests them all, with or without the grid), so the
- * step needs none of the general path's lists: the awake, typed, flagged
- * and pushed beams are bit masks here, and the lists are written back when
+ * step needs none of the general path's lists: the awake, typed and
+ * pushed beams are bit masks here, and the lists are written back when
  * the run ends, as the general path leaves them. The essay's gate (two
  * beams, the midpoint rule) has a copy compiled for it.
  *
@@ -19,7 +19,7 @@
  * beam's step margin), impacts (impact_resolve.c), the smooth solve
  * (persistent_contact.c), projection with re-detection
  * (position_project.c), the typed beams, pruning (beam_sleep.c) and the
- * contact flag (contact_report.c). What differs is only what the general
+ * beams listed for the contact flag (contact_report.c). What differs is only what the general
  * path spends on its generality:
  *   - no free-flight test: a step thesis_step would take as free flight
  *     (no beam awake, every beam out of reach) is the general path's step
@@ -79,11 +79,12 @@ static inline int gate_lcp(double inv_mass, thesis_contact *cs, int n)
 	return 0;
 }
 
-/* The masks of a run: the beams awake, typed (the step's: contact_type
- * not NONE, written when the run ends), flagged (flag not NONE). Pushed
- * beams live within a step. */
+/* The masks of a run: the beams awake and typed (the step's:
+ * contact_type not NONE, written when the run ends), and those pushed in
+ * the last step. */
 typedef struct gate_masks {
-	unsigned awake, typed, flagged;
+	unsigned awake, typed, pushed;
+	unsigned near; /* pushed, or not certainly beyond BSIM_CONTACT_TOL */
 } gate_masks;
 
 /* impact_resolve.c's impact_resolve for the disk, simultaneous: the
@@ -188,33 +189,22 @@ static inline int gate_project(struct bsim_world *w, const double force[2], int 
 	return n;
 }
 
-/* contact_report.c's contact_report for the disk: the flag of every beam
- * (the candidates of a world this small are all its beams, in order); a
- * flagged beam is woken. d2: each beam's beam_pivot_distance2 at the
- * step's end, which the next step's detection meets again. */
+/* contact_report.c's contact_list for the disk: every beam pushed or not
+ * certainly farther than R + BSIM_CONTACT_TOL woken (the candidates of a
+ * world this small are all its beams, in order). d2: each beam's
+ * beam_pivot_distance2 at the step's end, which the next step's detection
+ * meets again. */
 static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pushed, double *d2,
                                int nb)
 {
-	/* every flag written: a beam not flagged before holds NONE already */
-	mk->flagged = 0;
+	mk->near = 0; /* the pushed among them */
 	for (int i = 0; i < nb; i++) {
-		int is_pushed = gate_in(pushed, i);
-		int flag = BSIM_CONTACT_NONE;
 		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
-		if (is_pushed || contact_near_at(w, i, d2[i], BSIM_CONTACT_TOL, 0)) {
-			thesis_beam *b = &w->beams[i];
-			double u[2];
-			int type;
-			thesis_beam_direction(b, u);
-			double dist2 = bsim_beam_distance2(b->p, u, b->length, w->x, &type);
-			flag = bsim_contact_flag(dist2, w->radius, type, is_pushed);
-		}
-		w->flag[i] = flag;
-		if (flag != BSIM_CONTACT_NONE) {
-			mk->flagged |= 1u << i;
-			mk->awake |= 1u << i;
-		}
+		if (gate_in(pushed, i) || contact_near_at(w, i, d2[i], BSIM_CONTACT_TOL, 0))
+			mk->near |= 1u << i;
 	}
+	mk->awake |= mk->near;
+	mk->pushed = pushed;
 }
 
 /* One step (step_run for extended 0, the head's differences) under the
@@ -260,13 +250,12 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 	for (int i = 0; i < nb; i++) {
 		if (gate_in(mk->awake, i)) {
 			s->active[na++] = i;
-			s->theta[i] = w->beams[i].theta;
-			s->omega[i] = w->beams[i].omega;
-			s->contact[i] = w->flag[i];
+			thesis_state_beam(w, i, gate_in(pushed, i), gate_in(mk->near, i), s);
 		} else {
 			s->theta[i] = 0.0;
 			s->omega[i] = 0.0;
 			s->contact[i] = BSIM_CONTACT_NONE;
+			s->touched[i] = 0;
 		}
 	}
 	s->n_active = na;
@@ -284,9 +273,8 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], double h, int n,
                                  bsim_state *out, const int integrator, const int nb)
 {
-	/* The awake and flagged lists as masks (is_awake and flag say which
-	 * beams the lists hold). */
-	gate_masks mk = {0, 0, 0};
+	/* The awake list as a mask (is_awake says which beams it holds). */
+	gate_masks mk = {0, 0, 0, 0};
 	for (int i = 0; i < nb; i++)
 		mk.awake |= (unsigned)w->is_awake[i] << i;
 	/* No step of the run reads contact_type (the typed mask, each step's,
@@ -294,8 +282,6 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 	 * contacts at the end, as the steps one after another leave it. */
 	for (int k = 0; k < w->n_typed; k++)
 		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
-	for (int i = 0; i < nb; i++)
-		mk.flagged |= (unsigned)(w->flag[i] != BSIM_CONTACT_NONE) << i;
 	const gate_masks mk0 = mk;
 	/* step_detect's h |F| / M and the smooth solve's h F / M, as they
 	 * compute them */
@@ -306,10 +292,10 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
 	for (int k = 0; k < n; k++)
 		gate_step(w, force, h, hv, dv, &mk, d2, &out[k], integrator, nb);
-	/* The lists as the general path leaves them: ascending awake and
-	 * flagged beams (those of the run's start where the masks are theirs),
-	 * the typed ones (any order: only cleared), nothing pushed; the last
-	 * step's energy flows and impacts. */
+	/* The lists as the general path leaves them: ascending awake beams
+	 * (those of the run's start where the mask is theirs), the typed ones
+	 * (any order: only cleared), the last step's pushes; the last step's
+	 * energy flows and impacts. */
 	for (int k = 0; k < w->n_contacts; k++) {
 		const thesis_contact *c = &w->contacts[k];
 		if (c->gap <= w->contact_tol)
@@ -327,12 +313,10 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 	for (int i = 0; i < nb; i++)
 		if (gate_in(mk.typed, i))
 			w->typed[w->n_typed++] = i;
-	if (mk.flagged != mk0.flagged) {
-		w->n_flagged = 0;
-		for (int i = 0; i < nb; i++)
-			if (gate_in(mk.flagged, i))
-				w->flagged[w->n_flagged++] = i;
-	}
+	/* the last step's pushes, which get_state reports as touched */
+	for (int i = 0; i < nb; i++)
+		if (gate_in(mk.pushed, i))
+			thesis_beam_pushed(w, i);
 	w->energy = out[n - 1].energy;
 	w->impacts = out[n - 1].impacts;
 }
@@ -341,6 +325,7 @@ int thesis_steps(struct bsim_world *w, const double force[2], double h, int n, b
 {
 	if (n < 1 || !w->steps_disk || out[0].n_beams != w->n_beams)
 		return 0;
+	thesis_contact_spent(w);
 	if (w->n_touched < w->n_beams) /* else every beam is */
 		for (int i = 0; i < w->n_beams; i++)
 			thesis_beam_touch(w, i);

@@ -166,8 +166,6 @@ static void thesis_destroy(bsim_world *w)
 	free(w->is_awake);
 	free(w->candidates);
 	free(w->typed);
-	free(w->flag);
-	free(w->flagged);
 	free(w->pushed);
 	free(w->pushed_list);
 	free(w->touched);
@@ -233,8 +231,6 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->candidates = malloc(nb * sizeof *w->candidates);
 		w->typed = malloc(nb * sizeof *w->typed);
 		w->held = calloc(nb, sizeof *w->held);
-		w->flag = calloc(nb, sizeof *w->flag);
-		w->flagged = malloc(nb * sizeof *w->flagged);
 		w->pushed = calloc(nb, sizeof *w->pushed);
 		w->pushed_list = malloc(nb * sizeof *w->pushed_list);
 		w->touched = calloc(nb, sizeof *w->touched);
@@ -243,9 +239,8 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->near = malloc(nb * sizeof *w->near);
 	}
 	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type || !w->awake ||
-	    !w->is_awake || !w->candidates || !w->typed || !w->held || !w->flag || !w->flagged ||
-	    !w->pushed || !w->pushed_list || !w->touched || !w->touched_list || !w->start_awake ||
-	    !w->near) {
+	    !w->is_awake || !w->candidates || !w->typed || !w->held || !w->pushed ||
+	    !w->pushed_list || !w->touched || !w->touched_list || !w->start_awake || !w->near) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
@@ -335,7 +330,6 @@ static void beam_restore(bsim_world *w, int i, const bsim_beam_def *d)
 	b->geo.theta = NAN;
 	w->is_awake[i] = 0;
 	w->contact_type[i] = BSIM_CONTACT_NONE;
-	w->flag[i] = BSIM_CONTACT_NONE;
 	w->pushed[i] = 0;
 	w->held[i] = 0;
 	w->contact_of[i] = -1;
@@ -366,7 +360,7 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	w->heading = bsim_body_heading(&scene->body);
 	w->angular_velocity = w->rotates ? scene->body.angular_velocity : 0.0;
 	w->impacts_scaled = 0;
-	w->n_awake = w->n_typed = w->n_flagged = w->n_pushed = w->n_contacts = 0;
+	w->n_awake = w->n_typed = w->n_pushed = w->n_contacts = 0;
 	w->any_held = 0;
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
@@ -431,7 +425,7 @@ THESIS_SPECIALISED int step_detect(bsim_world *w, const double force[2], double 
  * general path. No contact: no impact, no projection, nothing held; the
  * contact solve's body update with a zero impulse sum (thesis_body_advance,
  * as persistent_contact.c's with none); no beam to move, sleep or prune;
- * the last step's flags cleared. */
+ * nothing to list. */
 THESIS_SPECIALISED void flight_step(bsim_world *w, const double force[2], double torque, double h,
                                     const int extended)
 {
@@ -443,8 +437,6 @@ THESIS_SPECIALISED void flight_step(bsim_world *w, const double force[2], double
 	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
 	if (extended)
 		thesis_body_turn(w, w->angular_velocity, torque, 0.0, h);
-	if (w->n_flagged)
-		thesis_contact_clear(w);
 }
 
 /* A step of any body (extended 1) or of the essay's disk (extended 0,
@@ -495,11 +487,10 @@ THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double tor
 			thesis_beams_sleep(w, speed, h);
 		thesis_awake_prune(w);
 	}
-	if (in_flight)
-		thesis_contact_clear(w);
-	else if (extended)
+	/* in flight nothing is in reach: nothing to list */
+	if (!in_flight && extended)
 		thesis_contact_report(w);
-	else
+	else if (!in_flight)
 		thesis_contact_report_disk(w);
 	return BSIM_OK;
 }
@@ -525,6 +516,7 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 	/* Free flight among beams at rest (none awake, none in reach): no
 	 * contact, no beam to move, no square root for the margin; the essay's
 	 * disk's at once, as it was before the extended path. */
+	thesis_contact_spent(w);
 	int in_flight = w->n_awake == 0 && thesis_flight_clear(w, force, h);
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
@@ -543,11 +535,13 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 	/* Both lists empty (free flight): the same, nothing to set. */
 	if (w->n_awake || s->n_active)
 		bsim_state_set_active(s, w->awake, w->n_awake);
+	/* The beams' directions are kept for the next step's detection
+	 * (b->u): a cache, not the world's state, which stays as it is. */
+	bsim_world *cache = (bsim_world *)w;
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k];
-		s->theta[i] = w->beams[i].theta;
-		s->omega[i] = w->beams[i].omega;
-		s->contact[i] = w->flag[i];
+		thesis_state_beam(cache, i, w->pushed[i],
+		                  thesis_contact_near(w, i, BSIM_CONTACT_TOL), s);
 	}
 	s->energy = w->energy;
 	s->impacts = w->impacts;
@@ -565,7 +559,6 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 	w->angular_velocity = w->rotates ? s->angular_velocity : 0.0;
 	w->n_awake = 0;
 	w->n_typed = 0;
-	w->n_flagged = 0;
 	for (int k = 0; k < w->n_pushed; k++)
 		w->pushed[w->pushed_list[k]] = 0;
 	w->n_pushed = 0;
@@ -574,11 +567,8 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 		w->beams[i].theta = s->theta[i];
 		w->beams[i].omega = s->omega[i];
 		w->contact_type[i] = s->contact[i];
-		w->flag[i] = s->contact[i];
-		if (s->contact[i] != BSIM_CONTACT_NONE) {
+		if (s->contact[i] != BSIM_CONTACT_NONE)
 			w->typed[w->n_typed++] = i;
-			w->flagged[w->n_flagged++] = i;
-		}
 		if (s->theta[i] != 0.0 || s->omega[i] != 0.0 || s->contact[i] != BSIM_CONTACT_NONE)
 			thesis_beam_wake(w, i);
 		w->held[i] = 0; /* a state has no loop: contact_mode=essay starts afresh */
@@ -616,4 +606,5 @@ const bsim_backend bsim_backend_thesis = {
                       "(docs/robustness.md, beam_steps)",
         .bounds = thesis_bounds,
         .n_bounds = (int)(sizeof thesis_bounds / sizeof thesis_bounds[0]),
+        .exact_pins = 1,
 };

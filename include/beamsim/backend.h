@@ -118,6 +118,10 @@ typedef struct bsim_backend {
 	 * skipped for it, saying so. */
 	const bsim_backend_bound *bounds;
 	int n_bounds;
+	/* 1: the backend's joints hold every beam at its pivot exactly, by
+	 * construction, and its states leave bsim_state.pin unwritten; 0: its
+	 * states report where the joints hold the beams (bsim_state.pin). */
+	int exact_pins;
 } bsim_backend;
 
 /* Checks scene against b with opts (b->check) before a run, as a scene
@@ -130,6 +134,12 @@ typedef struct bsim_backend {
 BSIM_API int bsim_backend_check(const bsim_backend *b, const bsim_options *opts,
                                 const bsim_scene *scene, const char *path, const bsim_override *ov,
                                 int n_ov, bsim_error *err);
+
+/* The largest distance of an active beam's pinned point from its pivot in
+ * scene, m, in a state s of a world of b: how far b's joints let the beams
+ * drift (s->pin), 0 where b's pins are exact (exact_pins). */
+BSIM_API double bsim_backend_pivot_drift(const bsim_backend *b, const bsim_scene *scene,
+                                         const bsim_state *s);
 
 /* The bound b states for check (bsim_backend_bound) into *bound: 1, or
  * 0 if b states none. */

@@ -1,28 +1,28 @@
-/* The contact flag a backend reports (bsim_state.contact, beamsim/state.h;
- * the trajectory's contact columns), and the geometry of a beam's gap
- * behind it. The runner defines the flag; a backend computes it with these
- * helpers from the state it reports, so that every backend and the runner's
- * own overlap measure agree to the bit.
+/* The contact flag (bsim_state.contact, beamsim/state.h; the trajectory's
+ * contact columns) and the geometry of a beam's gap behind it. The runner
+ * defines the flag and computes it, from the raw facts a backend reports
+ * (bsim_contact_flags): no backend computes it, and every backend gets the
+ * same rule. A backend may use the same functions for what it decides
+ * itself (which beams to list as active, or to keep awake).
  *
  * Beam i is in contact during a step when, at the step's end,
  *   gap_i = |C - Q_i| - R < BSIM_CONTACT_TOL        (beamsim/state.h, 6 mm)
  * (C the body's centre, Q_i the nearest point of the beam's segment, R the
  * body's radius: docs/model.md section 3), or the beam exchanged a nonzero
- * normal impulse with the body during the step (an impact or a resting
- * contact's impulse, however the backend's solver names it). The flag's
+ * normal impulse with the body during the step (touched_i). The flag's
  * value is the contact's type at the step's end: TANGENT when the nearest
  * point lies inside the segment, TIP at either end. For a body that is not
  * a disk the gap is the outline's (bsim_body_shape_segment,
  * beamsim/body_shape.h), the type where the outline's nearest point of the
  * segment lies, and a segment through the body's centre line (no
  * separating normal) is in contact with the type the centre's nearest
- * point gives: bsim_contact_flag_of, the one rule every backend calls.
+ * point gives.
  *
- * A backend's step, for beam i with pivot p, rest direction u0, forward
- * sign sgn and length L (beamsim/scene.h) at its reported angle theta:
- *   bsim_beam_direction(u0, sgn, theta, u);
+ * For beam i with pivot p and length L at the step's end, direction u
+ * (bsim_beam_direction of its rest direction u0, forward sign sgn and
+ * angle theta; the state's direction):
  *   d2 = bsim_beam_distance2(p, u, L, x, &type);
- *   contact[i] = bsim_contact_flag(d2, R, type, pushed_i); */
+ *   contact[i] = bsim_contact_flag(d2, R, type, touched_i);      (a disk) */
 #ifndef BSIM_CONTACT_FLAG_H
 #define BSIM_CONTACT_FLAG_H
 
@@ -78,13 +78,37 @@ static inline int bsim_contact_flag(double dist2, double radius, int type, int p
 	return pushed || dist2 < reach * reach ? type : BSIM_CONTACT_NONE;
 }
 
-/* The flag of a beam (pivot p, unit direction u, length) against a body of
- * any shape at centre x with heading psi (rad), pushed in the step or not:
- * the rule above, bsim_contact_flag's for a disk, the outline's gap for
- * another shape (the circle about the outline first, which decides most
- * steps without the outline's geometry). */
+/* The flag of a beam (pivot p, direction u, length) against a body of
+ * any shape at centre x with heading psi (rad), touched in the step or
+ * not: the rule above, the outline's gap for a shape that is not a disk. */
 BSIM_API int bsim_contact_flag_of(const bsim_body_def *body, const double x[2], double psi,
-                                  const double p[2], const double u[2], double length, int pushed);
+                                  const double p[2], const double u[2], double length, int touched);
+
+/* The contact flag of every beam s lists as active, into s->contact, from
+ * s's raw facts (x, heading, touched, direction) and the beams of scene, the
+ * scene of the world that reported s (a beam whose direction is NaN is in
+ * contact only if touched). The runner calls it on the states it books; a
+ * caller stepping a world itself calls it for the flags. */
+BSIM_API void bsim_contact_flags(const bsim_scene *scene, bsim_state *s);
+
+/* bsim_contact_flags for a disk (scene->body.shape BSIM_SHAPE_DISK),
+ * inline: the runner's every step. */
+static inline void bsim_contact_flags_disk(const bsim_scene *scene, bsim_state *s)
+{
+	const double radius = scene->body.radius;
+	for (int k = 0; k < s->n_active; k++) {
+		const int i = s->active[k];
+		const bsim_beam_def *b = &scene->beams[i];
+		const double *u = &s->direction[2 * i];
+		if (u[0] != u[0] && !s->touched[i]) {
+			s->contact[i] = BSIM_CONTACT_NONE; /* apart, the backend says */
+			continue;
+		}
+		int type;
+		const double d2 = bsim_beam_distance2(b->pivot, u, b->length, s->x, &type);
+		s->contact[i] = bsim_contact_flag(d2, radius, type, s->touched[i]);
+	}
+}
 
 #ifdef __cplusplus
 }

@@ -14,17 +14,19 @@ extern "C" {
 
 enum { BSIM_CONTACT_NONE = 0, BSIM_CONTACT_TANGENT = 1, BSIM_CONTACT_TIP = 2 };
 
-/* The contact flag, the same on every backend: beam i is in contact in a
- * step (contact[i] not NONE) when at the step's end the gap between the
- * body's disk and the beam's segment is below BSIM_CONTACT_TOL, or when the
- * beam exchanged a nonzero impulse with the body during the step (an impact
- * is flagged on the step it happens in). contact[i] is then the contact's
- * type at the step's end: TANGENT when the nearest point of the segment lies
- * inside it, TIP at either end. 6 mm: above the gaps at which the solvers
- * hold a resting contact, the thesis backend's within 1e-6 m, Box2D's
- * anywhere below b2_linearSlop / unit_scale = 5 mm (float32 adds 2e-6 m),
- * Chipmunk's at an overlap, and 0.06% of the body's radius (docs/backends.md,
- * "The contact flag"). */
+/* The contact flag, the same on every backend because the runner computes
+ * it from the state's raw facts (bsim_contact_flags, beamsim/contact_flag.h):
+ * beam i is in contact in a step (contact[i] not NONE) when at the step's
+ * end the gap between the body's outline and the beam's segment is below
+ * BSIM_CONTACT_TOL, or when the beam exchanged a nonzero impulse with the
+ * body during the step (touched[i]: an impact is flagged on the step it
+ * happens in). contact[i] is then the contact's type at the step's end:
+ * TANGENT when the nearest point of the segment lies inside it, TIP at
+ * either end. 6 mm: above the gaps at which the solvers hold a resting
+ * contact, the thesis backend's within 1e-6 m, Box2D's anywhere below
+ * b2_linearSlop / unit_scale = 5 mm (float32 adds 2e-6 m), Chipmunk's at an
+ * overlap, and 0.06% of the body's radius (docs/backends.md, "The contact
+ * flag"). */
 #define BSIM_CONTACT_TOL 6e-3 /* m */
 
 /* Energy flows of the last step, J, as measured by the backend. With the
@@ -61,12 +63,29 @@ typedef struct bsim_state {
 	int n_beams;
 	double *theta;             /* n_beams, rad, forward positive */
 	double *omega;             /* n_beams, rad/s */
-	int *contact;              /* n_beams, the contact flag of the step (above) */
 	bsim_step_energy energy;   /* of the last step */
 	int impacts;               /* impacts resolved in the last step */
 	bsim_solver_counts solver; /* since the world was created */
-	double pivot_drift;        /* m, largest distance of a beam's pinned point from
-	                            * its pivot (0 where the pin is exact by construction) */
+	/* Raw facts of the active beams (below), from which the runner
+	 * derives what it defines (the contact flag, the pivot drift):
+	 *   touched[i]      1 if beam i exchanged a nonzero normal impulse
+	 *                   with the body during the last step (an impact or
+	 *                   a resting contact's impulse), else 0;
+	 *   direction[2i..] the unit vector from beam i's pivot to its tip at
+	 *                   the step's end (bsim_beam_direction of its angle),
+	 *                   or NaN (both) for a beam not touched that the
+	 *                   backend knows lies farther than BSIM_CONTACT_TOL
+	 *                   from the body (its broad phase: no sine and cosine
+	 *                   needed), which is then not in contact;
+	 *   pin[2i..]       m, where beam i's joint holds it, the point that
+	 *                   should be its pivot (not written by a backend
+	 *                   whose pins are exact, bsim_backend.exact_pins). */
+	int *touched;      /* n_beams */
+	double *direction; /* 2 n_beams */
+	double *pin;       /* 2 n_beams */
+	/* The contact flag of each active beam (above), written by the runner
+	 * from the raw facts (bsim_contact_flags), not by a backend. */
+	int *contact; /* n_beams */
 	/* The beams that may be away from rest, ascending: every beam not
 	 * listed has theta = omega = 0 and no contact, and so have its entries
 	 * in theta, omega and contact. A backend may list more than it must

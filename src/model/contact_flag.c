@@ -25,20 +25,39 @@ double bsim_beam_distance(const double p[2], const double u[2], double length, c
 }
 
 int bsim_contact_flag_of(const bsim_body_def *body, const double x[2], double psi,
-                         const double p[2], const double u[2], double length, int pushed)
+                         const double p[2], const double u[2], double length, int touched)
 {
 	int type;
 	const double d2 = bsim_beam_distance2(p, u, length, x, &type);
 	if (body->shape == BSIM_SHAPE_DISK)
-		return bsim_contact_flag(d2, body->radius, type, pushed);
-	/* the outline lies within the circle of its reach about the centre */
+		return bsim_contact_flag(d2, body->radius, type, touched);
+	/* the outline: the circle about it decides most steps */
 	const double far = bsim_body_shape_reach(body) + BSIM_CONTACT_TOL;
-	if (d2 >= far * far && !pushed)
+	if (d2 >= far * far && !touched)
 		return BSIM_CONTACT_NONE;
 	const double tip[2] = {p[0] + length * u[0], p[1] + length * u[1]};
 	bsim_body_segment_contact c;
 	if (bsim_body_shape_segment(body, x, psi, p, tip, &c) != BSIM_OK)
 		return type; /* through its centre line: overlapping */
 	type = c.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
-	return pushed || c.dist < BSIM_CONTACT_TOL ? type : BSIM_CONTACT_NONE;
+	return touched || c.dist < BSIM_CONTACT_TOL ? type : BSIM_CONTACT_NONE;
+}
+
+void bsim_contact_flags(const bsim_scene *scene, bsim_state *s)
+{
+	if (scene->body.shape == BSIM_SHAPE_DISK) {
+		bsim_contact_flags_disk(scene, s);
+		return;
+	}
+	for (int k = 0; k < s->n_active; k++) {
+		const int i = s->active[k];
+		const bsim_beam_def *b = &scene->beams[i];
+		const double *u = &s->direction[2 * i];
+		if (isnan(u[0]) && !s->touched[i]) {
+			s->contact[i] = BSIM_CONTACT_NONE; /* apart, the backend says */
+			continue;
+		}
+		s->contact[i] = bsim_contact_flag_of(&scene->body, s->x, s->heading, b->pivot, u,
+		                                     b->length, s->touched[i]);
+	}
 }

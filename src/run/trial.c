@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/contact_flag.h"
 #include "beamsim/effects.h"
 #include "beamsim/lattice.h"
 #include "model/schedule_spare.h"
@@ -126,14 +127,11 @@ typedef struct trial_ctx {
 	long n_max, gate_max;      /* steps in all, steps in one gate */
 	double centre;             /* m, the field's centre line */
 	int overlap;               /* the recorder asked for overlap_max */
+	int disk;                  /* the body is a disk (the flags' inline rule) */
 	int recording, stride;     /* rows to the recorder's sinks, every stride-th step */
 	bsim_trace_fn trace;
 	int trace_whole; /* the trace sees the whole lattice (essay protocol) */
 	long recorded;   /* the last step recorded, -1: none */
-	/* In a run of steps: its last state booked in which the body touched a
-	 * beam (NULL: none yet), whose contacts the peaks take when the run's
-	 * booking ends (trial_book). */
-	const bsim_state *touch;
 } trial_ctx;
 
 /* The world the trial starts in (the whole scene, or the essay's start
@@ -211,6 +209,41 @@ static const bsim_state *trial_trace_state(trial_ctx *c, const bsim_state *s)
 	return c->trace_whole ? trial_record_state(&c->r->whole, c->map, s) : s;
 }
 
+/* The contact flags of s, a state of the world of scene ws
+ * (bsim_contact_flags): the runner's, from the backend's raw facts. */
+static inline void trial_flags(const trial_ctx *c, const bsim_scene *ws, bsim_state *s)
+{
+	if (c->disk)
+		bsim_contact_flags_disk(ws, s);
+	else
+		bsim_contact_flags(ws, s);
+}
+
+/* Whether a beam s lists is in contact (bsim_contact_flags' rule), its
+ * flags not written: the first one found ends the test. */
+static inline int trial_touches(const trial_ctx *c, const bsim_scene *ws, bsim_state *s)
+{
+	if (!c->disk) {
+		bsim_contact_flags(ws, s);
+		return any_contact(s);
+	}
+	const double radius = ws->body.radius;
+	for (int k = 0; k < s->n_active; k++) {
+		const int i = s->active[k];
+		const double *u = &s->direction[2 * i];
+		if (s->touched[i])
+			return 1;
+		if (u[0] != u[0])
+			continue; /* apart, the backend says (a NaN direction) */
+		const bsim_beam_def *b = &ws->beams[i];
+		int type;
+		const double d2 = bsim_beam_distance2(b->pivot, u, b->length, s->x, &type);
+		if (bsim_contact_flag(d2, radius, type, 0) != BSIM_CONTACT_NONE)
+			return 1;
+	}
+	return 0;
+}
+
 /* The state at t = 0 in s0, and all that starts from it: the ledger, the
  * peaks, the gate path. */
 static int trial_begin(trial_ctx *c, trial_loop *lp, bsim_state *s0, bsim_error *err)
@@ -219,6 +252,8 @@ static int trial_begin(trial_ctx *c, trial_loop *lp, bsim_state *s0, bsim_error 
 	bsim_trial_result *out = c->out;
 	int rc = BSIM_OK;
 	c->backend->get_state(c->w, s0);
+	c->disk = scene->body.shape == BSIM_SHAPE_DISK;
+	trial_flags(c, c->ws, s0);
 	if (c->overlap)
 		trial_overlap_shapes(c->r->shape, c->ws);
 	c->n_max = scene->max_steps;
@@ -276,6 +311,7 @@ static int gate_enter(trial_ctx *c, trial_loop *lp, bsim_state *s, const double 
 	if (rc)
 		return rc;
 	c->backend->get_state(c->w, s);
+	trial_flags(c, c->ws, s);
 	if (c->overlap) /* the new world's two beams */
 		trial_overlap_shapes(c->r->shape, c->ws);
 	lp->e0 = energy_mech(c->ws, s);
@@ -316,7 +352,7 @@ static inline int outcome_at(trial_ctx *c, trial_loop *lp, const bsim_state *s)
 
 /* The result from the last state s0 (the last finite one), the ledger
  * closed. */
-static void trial_result(trial_ctx *c, const trial_loop *lp, const bsim_state *s0)
+static void trial_result(trial_ctx *c, const trial_loop *lp, bsim_state *s0)
 {
 	const bsim_scene *scene = c->scene;
 	bsim_trial_result *out = c->out;
@@ -325,8 +361,10 @@ static void trial_result(trial_ctx *c, const trial_loop *lp, const bsim_state *s
 		out->steps = (int)lp->n;
 		out->t_end = (double)lp->n * lp->h;
 	}
-	if (out->outcome == BSIM_STUCK)
+	if (out->outcome == BSIM_STUCK) {
+		trial_flags(c, c->ws, s0); /* a plain run's last state has none yet */
 		out->in_contact_end = any_contact(s0);
+	}
 	for (int i = 0; i < 2 && i < scene->n_beams; i++)
 		out->max_theta[i] = p->peak[i];
 	if (out->outcome == BSIM_TRAVERSED) {
@@ -358,8 +396,7 @@ static void trial_result(trial_ctx *c, const trial_loop *lp, const bsim_state *s
 
 /* After the last step (rc: how the run ended): the final row, the result,
  * the log's peaks; the world and effects released. */
-static int trial_close(trial_ctx *c, const trial_loop *lp, const bsim_state *s0, int rc,
-                       bsim_error *err)
+static int trial_close(trial_ctx *c, const trial_loop *lp, bsim_state *s0, int rc, bsim_error *err)
 {
 	if (c->recording && c->recorded != lp->n && rc == BSIM_OK) /* whatever the stride */
 		trial_record(c, s0, lp->n);
@@ -400,7 +437,8 @@ enum { BOOK_ON = 0, BOOK_END = 1, BOOK_NONFINITE = 2 };
  * failed). The step loop and the runs of steps book every state by it;
  * plain (a constant): nothing traced or measured per step, no lattice, as
  * in the runs (trial_steps_start), whose copy has none of their tests and
- * leaves the last touching contacts to the run's end (c->touch). */
+ * leaves the contact flags and the last touching contacts to the run's
+ * end (bsim_trial_run). */
 TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bsim_state *s1,
                           int *rc, bsim_error *err, const int plain)
 {
@@ -417,6 +455,11 @@ TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bs
 	lp->n++;
 	c->gate.dwell++;
 	lp->run_on += lp->done;
+	/* The flags of every state the trace, the recording, the overlap and
+	 * the peaks see; a run computes them for its last touching state and
+	 * the trial's last state only (bsim_trial_run, trial_result). */
+	if (!plain)
+		trial_flags(c, ws, s1);
 	if (!plain && c->trace)
 		c->trace(c->rec->trace_user, lp->n, trial_trace_state(c, s1));
 	ledger_step(&out->ledger, c->fx, s0, s1, lp->e0, e1);
@@ -427,15 +470,12 @@ TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bs
 		                                                   c->scene->body.radius, s1));
 	if (lp->done)
 		return BOOK_ON;
-	/* The last touching contacts: a run's states stay where they are until
-	 * its booking ends, so that only the last touching one is copied
-	 * (trial_peaks_contacts), and by then, as the step loop leaves them. */
-	if (plain) {
-		if (trial_peaks_touch(&c->r->peaks, c->scene, NULL, s1))
-			c->touch = s1;
-	} else {
+	/* The peaks; a run's states stay where they are until its booking
+	 * ends, so that the last touching contacts are found then. */
+	if (plain)
+		trial_peaks_note(&c->r->peaks, c->scene, NULL, s1);
+	else
 		trial_peaks_step(&c->r->peaks, c->scene, map, s1);
-	}
 	/* The gate first: a body that leaves the field ends in its gate. */
 	if (!plain && c->scene->has_lattice &&
 	    (*rc = gate_follow(c, lp, s1, s0->x, err)) != BSIM_OK)
@@ -484,15 +524,26 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 			 * room (trial_run_room) keeps max_steps and gate_steps:
 			 * before the outcome is known, only a booking ends it. */
 			int b = BOOK_ON;
-			c.touch = NULL;
+			const long n0 = lp.n;
+			const int open_at_start = !lp.done;
 			for (int k = 0;
 			     k < m && b == BOOK_ON && !(lp.done && trial_over(&c, &lp, s0)); k++) {
 				b = trial_book(&c, &lp, s0, &states[k], &rc, err, 1);
 				if (b != BOOK_NONFINITE)
 					s0 = &states[k];
 			}
-			if (c.touch)
-				trial_peaks_contacts(&r->peaks, NULL, c.touch);
+			/* The states kept before the outcome was known: to the
+			 * traversal's step, or all kept. */
+			const long open = !open_at_start ? 0 : (lp.done ? out->steps : lp.n) - n0;
+			/* The last of them in which the body touches a beam gives
+			 * the peaks' contacts, as the step loop would have left
+			 * them: found from the end, most often at once. */
+			for (long k = open - 1; k >= 0; k--)
+				if (trial_touches(&c, scene, &states[k])) {
+					trial_flags(&c, scene, &states[k]);
+					trial_peaks_contacts(&r->peaks, NULL, &states[k]);
+					break;
+				}
 			if (b != BOOK_ON)
 				break;
 			trial_flight_passed(&r->flight, m - 1);

@@ -68,19 +68,15 @@ static inline void trial_peaks_list(trial_peaks *p, int g)
 
 /* Every beam's peak theta over the steps so far, s the state after the
  * latest: the active beams, beams 0 and 1 (trials.csv's two columns), and
- * any beam whose peak is still below 0 (a beam at rest has theta 0).
- * Returns whether an active beam touches the body in s (any_contact), from
- * the same pass. */
-static inline int trial_peaks_update(trial_peaks *p, const bsim_scene *scene, const int *map,
-                                     const bsim_state *s)
+ * any beam whose peak is still below 0 (a beam at rest has theta 0). */
+static inline void trial_peaks_update(trial_peaks *p, const bsim_scene *scene, const int *map,
+                                      const bsim_state *s)
 {
 	double *peak = p->peak;
-	int touches = 0;
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k], g = scene_beam(map, i);
 		trial_peaks_list(p, g);
 		peak[g] = bsim_fmax(peak[g], s->theta[i]);
-		touches |= s->contact[i];
 	}
 	/* A peak at +0 or above stays: the beam is active (the loop above
 	 * took its angle) or at rest (angle +-0, below it or, as bsim_fmax
@@ -102,7 +98,6 @@ static inline int trial_peaks_update(trial_peaks *p, const bsim_scene *scene, co
 			p->negative[m++] = i;
 	}
 	p->n_negative = m;
-	return touches != 0;
 }
 
 static inline int any_contact(const bsim_state *s)
@@ -139,23 +134,25 @@ static inline void trial_peaks_contacts(trial_peaks *p, const int *map, const bs
 	}
 }
 
-/* The peaks after a step, s the state after it (trial_peaks_update), and
- * whether an active beam touches the body in s: nothing to do, at the cost
- * of a test, where no beam is active, no peak is below 0 and beams 0 and
- * 1's have settled (or the essay's map, which has no such). */
-static inline int trial_peaks_touch(trial_peaks *p, const bsim_scene *scene, const int *map,
+/* The peaks after a step, s the state after it (trial_peaks_update):
+ * nothing to do, at the cost of a test, where no beam is active, no peak is
+ * below 0 and beams 0 and 1's have settled (or the essay's map, which has
+ * no such). */
+static inline void trial_peaks_note(trial_peaks *p, const bsim_scene *scene, const int *map,
                                     const bsim_state *s)
 {
 	if (s->n_active == 0 && p->n_negative == 0 && (map || p->settled01))
-		return 0;
-	return trial_peaks_update(p, scene, map, s);
+		return;
+	trial_peaks_update(p, scene, map, s);
 }
 
-/* Both of the above after a step, s the state after it. */
+/* Both of the above after a step, s the state after it, its contact flags
+ * computed. */
 static inline void trial_peaks_step(trial_peaks *p, const bsim_scene *scene, const int *map,
                                     const bsim_state *s)
 {
-	if (trial_peaks_touch(p, scene, map, s))
+	trial_peaks_note(p, scene, map, s);
+	if (any_contact(s))
 		trial_peaks_contacts(p, map, s);
 }
 
