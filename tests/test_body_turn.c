@@ -584,6 +584,10 @@ typedef struct momentum_track {
 	double L0, E0, L_err, E_last, L_last;
 	double spun; /* max |omega| of the body, rad/s */
 	int touched;
+	/* The turn as the states say it, step by step: the trapezoid sum of
+	 * omega over time (h the step, s), omega's total variation, and the
+	 * heading's start, end and largest departure from the start. */
+	double h, turned, w_var, w_last, psi0, psi_last, psi_far;
 } momentum_track;
 
 /* Angular momentum about the beam's pivot (the origin) and kinetic energy
@@ -606,6 +610,15 @@ static void track_momentum(void *user, long step, const bsim_state *s)
 	t->E_last = E;
 	t->touched |= s->contact[0] != BSIM_CONTACT_NONE;
 	t->spun = fmax(t->spun, fabs(s->angular_velocity));
+	if (step == 0) {
+		t->psi0 = s->heading;
+	} else {
+		t->turned += 0.5 * t->h * (t->w_last + s->angular_velocity);
+		t->w_var += fabs(s->angular_velocity - t->w_last);
+	}
+	t->w_last = s->angular_velocity;
+	t->psi_last = s->heading;
+	t->psi_far = fmax(t->psi_far, fabs(s->heading - t->psi0));
 }
 
 /* A turning capsule (R = 2 m, L = 6 m, 2 kg, heading 30 deg) thrown at
@@ -615,7 +628,19 @@ static void track_momentum(void *user, long step, const bsim_state *s)
  * is conserved through the impact, with friction or without. Elastic and
  * frictionless (e = 1, mu = 0), the kinetic energy is conserved too; with
  * mu = 0.5 and e = 0.8 it falls, and the ledger books the loss as impact
- * and contact (to 0.1%) and closes. The hit spins the capsule. */
+ * and contact (to 0.1%) and closes. The hit spins the capsule.
+ *
+ * The trial's turn (bsim_trial_result turn_end, turn_max, heading_end,
+ * angular_velocity_end) against the states the trace saw: the end state's
+ * heading and angular velocity to the bit, the largest |psi - psi0| to the
+ * bit (at least |turn_end|), and turn_end = the integral of omega over the
+ * trial, the trapezoid sum over the steps, within h/2 times omega's total
+ * variation (a step's integrator may take omega anywhere between its
+ * values at the step's ends, which differ by |d omega|: the symplectic
+ * Euler of all three takes the end, and meets the bound) and a float32
+ * heading's rounding, 2^-24 |psi| a step (Box2D's), that bound under 2% of
+ * a turn of more than 0.5 rad. The same trial run with nothing recorded
+ * (as a sweep runs it) gives the same four numbers. */
 static void test_capsule_impact_conserves(void **state)
 {
 	const bsim_backend *be = *state;
@@ -641,11 +666,14 @@ static void test_capsule_impact_conserves(void **state)
 		s.classify_y = 1e6;
 		bsim_error err;
 		assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
-		momentum_track t = {
-		        .mass = 2.0, .J = bsim_body_inertia(&s.body), .beam_I = s.beams[0].inertia};
+		momentum_track t = {.mass = 2.0,
+		                    .J = bsim_body_inertia(&s.body),
+		                    .beam_I = s.beams[0].inertia,
+		                    .h = s.dt};
 		bsim_recorder rec = {.trace = track_momentum, .trace_user = &t};
-		bsim_trial_result out;
+		bsim_trial_result out, plain;
 		run_on(be, &s, &rec, &out);
+		run_on(be, &s, NULL, &plain);
 		printf("%s capsule impact e = %g, mu = %g: max |L - L0| / |L0| %.3g, E_end / E0 "
 		       "%.5f, ledger loss %.4g J of %.4g J lost, residual %.3g J, spin %.3g "
 		       "rad/s\n",
@@ -664,6 +692,27 @@ static void test_capsule_impact_conserves(void **state)
 			assert_true(fabs(booked - lost) < 1e-3 * lost);
 			assert_true(fabs(out.ledger.residual) < 1e-4 * t.E0);
 		}
+		/* the step sums' spread, and a float32 heading's rounding each
+		 * step (Box2D's: 2^-24 |psi| at most) */
+		double bound = 0.5 * s.dt * t.w_var +
+		               (double)out.steps_run * ldexp(1.0, -24) * (fabs(t.psi0) + t.psi_far);
+		printf("%s capsule impact e = %g, mu = %g: turn_end %.9g rad, trapezoid of omega "
+		       "%.9g rad (bound %.6g), turn_max %.6g rad\n",
+		       be->name, s.contact.restitution, s.contact.friction, out.turn_end, t.turned,
+		       bound, out.turn_max);
+		assert_true(out.heading_end == t.psi_last);
+		assert_true(out.angular_velocity_end == t.w_last);
+		assert_true(out.turn_end == t.psi_last - t.psi0);
+		assert_true(fabs(out.turn_end) > 0.5);
+		assert_true(fabs(out.turn_end - t.turned) <= bound);
+		assert_true(bound < 0.02 * fabs(out.turn_end));
+		assert_true(out.turn_max == t.psi_far);
+		assert_true(out.turn_max >= fabs(out.turn_end));
+		assert_memory_equal(&plain.heading_end, &out.heading_end, sizeof out.heading_end);
+		assert_memory_equal(&plain.angular_velocity_end, &out.angular_velocity_end,
+		                    sizeof out.angular_velocity_end);
+		assert_memory_equal(&plain.turn_end, &out.turn_end, sizeof out.turn_end);
+		assert_memory_equal(&plain.turn_max, &out.turn_max, sizeof out.turn_max);
 		bsim_scene_free(&s);
 	}
 }

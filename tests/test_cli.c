@@ -20,11 +20,13 @@
 
 /* trials.csv: the contract's first eleven columns, then the appended ones
  * (the ledger, the overlap, the lattice's final gate, location and path,
- * the group's grid values by key). */
+ * the solver's counts, the exit time, the body's turn, the group's grid
+ * values by key). */
 #define TRIALS_HEADER                                                                              \
 	"group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"           \
 	"e_start,e_end,work_in,losses,residual,overlap_max,final_ix,final_iy,location,path,"       \
-	"iteration_limits,clamps,t_exit,effects.propulsion.force,effects.random_force.magnitude\n"
+	"iteration_limits,clamps,t_exit,heading_end,angular_velocity_end,turn_end,turn_max,"       \
+	"effects.propulsion.force,effects.random_force.magnitude\n"
 #define TRAJ_HEADER                                                                                \
 	"t,x,y,vx,vy,theta1,omega1,theta2,omega2,f_rand,contact1,contact2,e_kin,e_beam,e_prop\n"
 

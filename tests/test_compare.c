@@ -8,7 +8,8 @@
  * flagging what the redundant one missed. More than two sides: one Holm
  * family over every pair's tests against Holm's and McNemar's definitions
  * computed here, and the odd one out on constructed verdicts and outcomes
- * (one side flipped, two sides flipped, all alike). */
+ * (one side flipped, two sides flipped, all alike). Trials identical but
+ * for the turn, compared only where both sides know it. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -336,6 +337,30 @@ static void test_shape_mismatch(void **state)
 	assert_non_null(strstr(err.msg, "cannot pair"));
 }
 
+/* Two trials that differ only in how far the body turned (a field of
+ * trials.csv that files written before it lack) are identical unless both
+ * sides know the turn: bsim_compare_known says so only when both results
+ * have it. */
+static void test_identical_turn(void **state)
+{
+	(void)state;
+	bsim_trial_result a, b;
+	traversed(&a, BSIM_TYPE_LEFT);
+	b = a;
+	assert_true(bsim_compare_identical(&a, &b, BSIM_COMPARE_LEDGER | BSIM_COMPARE_TURN));
+	double *field[4] = {&b.heading_end, &b.angular_velocity_end, &b.turn_end, &b.turn_max};
+	for (int k = 0; k < 4; k++) {
+		b = a;
+		*field[k] = 0.25; /* a field of b */
+		assert_true(bsim_compare_identical(&a, &b, BSIM_COMPARE_LEDGER));
+		assert_false(bsim_compare_identical(&a, &b, BSIM_COMPARE_TURN));
+	}
+	bsim_sweep_result x = {.has_ledger = 1, .has_turn = 1}, y = {.has_ledger = 1};
+	assert_int_equal(bsim_compare_known(&x, &x), BSIM_COMPARE_LEDGER | BSIM_COMPARE_TURN);
+	assert_int_equal(bsim_compare_known(&x, &y), BSIM_COMPARE_LEDGER);
+	assert_int_equal(bsim_compare_known(&y, &x), BSIM_COMPARE_LEDGER);
+}
+
 /* ---- more than two sides ---------------------------------------------------- */
 
 /* Whether trial r shows event e, written out here from the events'
@@ -569,6 +594,7 @@ int main(void)
 	        cmocka_unit_test(test_inconclusive),
 	        cmocka_unit_test(test_separation_quantiles),
 	        cmocka_unit_test(test_shape_mismatch),
+	        cmocka_unit_test(test_identical_turn),
 	        cmocka_unit_test(test_family_by_hand),
 	        cmocka_unit_test(test_uninformative),
 	        cmocka_unit_test(test_family_power),

@@ -215,13 +215,13 @@ static void test_box2d_clamp_unstable(void **state)
 	free(err);
 }
 
-/* The last four fields of a trials.csv row of a one-axis grid:
- * iteration_limits, clamps, t_exit, the axis's value. */
+/* The last eight fields of a trials.csv row of a one-axis grid:
+ * iteration_limits, clamps, t_exit, the turn's four, the axis's value. */
 static void row_tail(const char *row, long *limits, long *clamps)
 {
 	const char *end = strchr(row, '\n'), *p = end;
 	assert_non_null(end);
-	for (int commas = 0; commas < 4; commas++) {
+	for (int commas = 0; commas < 8; commas++) {
 		p--;
 		while (p > row && *p != ',')
 			p--;
@@ -251,7 +251,9 @@ static void test_solver_columns(void **state)
 	free(err);
 	char *csv = bsim_test_read(bsim_test_join(out_dir, "trials.csv"));
 	assert_non_null(csv);
-	const char *header = ",path,iteration_limits,clamps,t_exit,effects.propulsion.force\n";
+	const char *header =
+	        ",path,iteration_limits,clamps,t_exit,heading_end,angular_velocity_end,"
+	        "turn_end,turn_max,effects.propulsion.force\n";
 	const char *row = strstr(csv, header);
 	assert_non_null(row);
 	row += strlen(header);
@@ -283,7 +285,11 @@ static void test_solver_columns(void **state)
 	bsim_test_remove(dir);
 }
 
-/* A trials.csv written before the solver's columns reads, its counts 0. */
+/* A trials.csv written before the solver's columns reads, its counts 0;
+ * one written before the turn's reads, its turn 0 and unknown (has_turn
+ * 0, so that a comparison leaves it out); the turn's columns are read
+ * back, and a file with some of them but not all is refused, naming the
+ * file and the columns expected. */
 static void test_old_trials_csv(void **state)
 {
 	(void)state;
@@ -312,7 +318,36 @@ static void test_old_trials_csv(void **state)
 	assert_int_equal(bsim_output_trials_read(path, 1, 1, &r, &err), BSIM_OK);
 	assert_int_equal(r.trials_out[0].solver.iteration_limit, 7);
 	assert_int_equal(r.trials_out[0].solver.clamped, 2);
+	assert_int_equal(r.has_turn, 0);
+	assert_true(r.trials_out[0].heading_end == 0.0 && r.trials_out[0].turn_max == 0.0);
 	bsim_sweep_result_free(&r);
+	const char *turn_header =
+	        "group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,max_theta1,max_theta2,"
+	        "e_start,e_end,work_in,losses,residual,overlap_max,final_ix,final_iy,location,"
+	        "path,iteration_limits,clamps,t_exit,heading_end,angular_velocity_end,turn_end,"
+	        "turn_max\n";
+	char text[1024];
+	snprintf(text, sizeof text, "%s%s", turn_header,
+	         "0,0,stuck,none,3000,12,0,28.3,0,0.5,0.5,0,53.7,113.3,59.6,1e-12,,0,0,stuck:0:0,"
+	         "0:0,0,0,,2.25,-0.125,0.6792036732,1.5\n");
+	path = bsim_test_write(dir, "turn.csv", text);
+	assert_int_equal(bsim_output_trials_read(path, 1, 1, &r, &err), BSIM_OK);
+	assert_int_equal(r.has_turn, 1);
+	assert_true(r.trials_out[0].heading_end == 2.25);
+	assert_true(r.trials_out[0].angular_velocity_end == -0.125);
+	assert_true(r.trials_out[0].turn_end == 0.6792036732);
+	assert_true(r.trials_out[0].turn_max == 1.5);
+	bsim_sweep_result_free(&r);
+	/* turn_max dropped from the header and the row */
+	snprintf(text, sizeof text, "%.*s\n%s", (int)(strlen(turn_header) - strlen(",turn_max\n")),
+	         turn_header,
+	         "0,0,stuck,none,3000,12,0,28.3,0,0.5,0.5,0,53.7,113.3,59.6,1e-12,,0,0,stuck:0:0,"
+	         "0:0,0,0,,2.25,-0.125,0.6792036732\n");
+	path = bsim_test_write(dir, "part.csv", text);
+	assert_int_equal(bsim_output_trials_read(path, 1, 1, &r, &err), BSIM_EINPUT);
+	assert_non_null(strstr(err.msg, path));
+	assert_non_null(strstr(err.msg, "heading_end, angular_velocity_end, turn_end, turn_max all "
+	                                "or none"));
 	bsim_test_remove(dir);
 }
 

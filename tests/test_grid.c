@@ -1,6 +1,7 @@
-/* Grid axes from the command line (sweep --grid KEY=V1,V2 or KEY=A:B:STEP)
- * against the same axes written into the experiment file: the file edited
- * by hand is the independent truth, byte for byte; the stored run repeats
+/* Grid axes from the command line (sweep --grid KEY=V1,V2 or KEY=A:B:STEP,
+ * numbers or a key's words) against the same axes written into the
+ * experiment file: the file edited by hand is the independent truth, byte
+ * for byte; the stored run repeats
  * under beamsim regress; bad --grid values are input errors naming the
  * option; and plot --select lists every axis of a 3-axis sweep. Runs the
  * real program. */
@@ -156,6 +157,54 @@ static void test_grid_equals_edited_file(void **state)
 	free(err);
 }
 
+/* A key whose values are words takes them from --grid as from the file:
+ * --grid effects.random_force.model=held,ou gives the trials and summary
+ * of the file whose grid: lists [held, ou], byte for byte, and the record
+ * holds those words. */
+static void test_grid_words(void **state)
+{
+	(void)state;
+	char text[4096], exp_path[1200], out_cli[1200], out_file[1200];
+	snprintf(exp_path, sizeof exp_path, "%s",
+	         bsim_test_write(dir, "words.yaml",
+	                         experiment_text(text, sizeof text, "", base_grid)));
+	snprintf(out_cli, sizeof out_cli, "%s", bsim_test_join(dir, "words_cli"));
+	snprintf(out_file, sizeof out_file, "%s", bsim_test_join(dir, "words_file"));
+	const char *by_cli[] = {"sweep",
+	                        exp_path,
+	                        "--out",
+	                        out_cli,
+	                        "--quiet",
+	                        "--grid",
+	                        "effects.random_force.model=held, ou",
+	                        NULL};
+	run_ok(by_cli);
+	bsim_test_write(dir, "words.yaml",
+	                experiment_text(text, sizeof text, "",
+	                                "  effects.propulsion.force: [7, 9]\n"
+	                                "  effects.random_force.magnitude: [10, 40]\n"
+	                                "  effects.random_force.model: [held, ou]\n"));
+	const char *by_file[] = {"sweep", exp_path, "--out", out_file, "--quiet", NULL};
+	run_ok(by_file);
+	char *a = read_in(out_cli, "trials.csv"), *b = read_in(out_file, "trials.csv");
+	assert_string_equal(a, b);
+	assert_int_equal(bsim_test_count_lines(a), 1 + 2 * 2 * 2 * 4);
+	/* both values' groups ran, each named by its word */
+	assert_non_null(strstr(a, ",held\n"));
+	assert_non_null(strstr(a, ",ou\n"));
+	free(a);
+	free(b);
+	a = summary_without_wall(out_cli);
+	b = summary_without_wall(out_file);
+	assert_string_equal(a, b);
+	assert_non_null(strstr(a, "\"effects.random_force.model\": \"ou\""));
+	free(a);
+	free(b);
+	char *stored = read_in(out_cli, "inputs/experiment.yaml");
+	assert_non_null(strstr(stored, "effects.random_force.model: [held, ou]"));
+	free(stored);
+}
+
 /* compare takes --grid too: its pairs and each side's trials equal those
  * of the file edited to the same grid; a --grid given twice for one KEY
  * runs the later values. */
@@ -297,10 +346,24 @@ static void test_errors(void **state)
 	expect_grid_error_naming("beams.0.stifness=100,200",
 	                         "--grid beams.0.stifness=100: ", "unknown key", NULL);
 	expect_grid_error("nosuchblock.k=1", "unknown key", NULL);
-	expect_grid_error("beams.0.stiffness=", "non-empty list", NULL);
+	expect_grid_error("beams.0.stiffness=", "non-empty list of values", NULL);
 	expect_grid_error("beams.0.stiffness=100,,200", "non-empty list", NULL);
-	expect_grid_error("beams.0.stiffness=100,abc", "expected decimal numbers", NULL);
-	expect_grid_error("beams.0.stiffness=0x64", "expected decimal numbers", NULL);
+	/* a value is judged by the key's scene field, as the file's grid
+	 * values are: a word where a number goes, a word the key does not
+	 * take (named with the words it takes) */
+	expect_grid_error_naming("beams.0.stiffness=100,abc",
+	                         "--grid beams.0.stiffness=abc: beams.0.stiffness: ",
+	                         "expected a number >= 0, got abc", NULL);
+	expect_grid_error_naming("beams.0.stiffness=0x64",
+	                         "--grid beams.0.stiffness=0x64: beams.0.stiffness: ",
+	                         "expected a number >= 0, got 0x64", NULL);
+	expect_grid_error_naming("effects.random_force.model=held,ou,hold",
+	                         "--grid effects.random_force.model=hold: "
+	                         "effects.random_force.model: expected held",
+	                         "ou (Ornstein-Uhlenbeck", NULL);
+	expect_grid_error_naming("effects.random_force.model=held,ou,hold",
+	                         "--grid effects.random_force.model=hold: ",
+	                         "or white (a new value each step), got hold", NULL);
 	expect_grid_error("beams.0.stiffness=1:x:1", "three decimal numbers", NULL);
 	expect_grid_error("beams.0.stiffness=1:5", "A:B:STEP", NULL);
 	expect_grid_error("beams.0.stiffness=100:200:0", "STEP other than 0", NULL);
@@ -448,6 +511,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_grid_equals_edited_file),
+	        cmocka_unit_test(test_grid_words),
 	        cmocka_unit_test(test_compare_grid),
 	        cmocka_unit_test(test_range_expansion),
 	        cmocka_unit_test(test_errors),

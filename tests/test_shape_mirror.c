@@ -13,7 +13,10 @@
  * the registry, for a capsule and an ellipse with contact friction 0.3 and
  * for a capsule that also meets ground friction and angular drag, each
  * under a lateral oscillation and the held random force (negated for the
- * image).
+ * image). The trials' results say how far the bodies turned (heading_end,
+ * angular_velocity_end, turn_end, turn_max): to the bit what the states
+ * the trace saw say, and mirrored in the image within the whole-trial
+ * bound.
  *
  * Tolerances: the backend's bounds (bsim_backend.bounds; m, rad, rad/s),
  * 0 meaning bit for bit, per shape: "mirror.free.SHAPE" before the first
@@ -213,6 +216,34 @@ static void check_outcome(const bsim_trial_result *a, const bsim_trial_result *b
 		assert_true(a->x_end * b->x_end < 0);
 }
 
+/* The trial's turn (bsim_trial_result heading_end, angular_velocity_end,
+ * turn_end, turn_max) is that of the states the trace saw, to the bit: the
+ * last one's heading and angular velocity, its heading less the first's,
+ * and the largest |psi - psi0| over them. */
+static void check_turn(const bsim_trial_result *r, const path *p)
+{
+	const double *first = p->row[0], *last = p->row[p->n - 1];
+	double far = 0.0;
+	for (long k = 0; k < p->n; k++)
+		far = fmax(far, fabs(p->row[k][2] - first[2]));
+	assert_true(r->heading_end == last[2]);
+	assert_true(r->angular_velocity_end == last[3]);
+	assert_true(r->turn_end == last[2] - first[2]);
+	assert_true(r->turn_max == far);
+	assert_true(r->turn_max >= fabs(r->turn_end));
+}
+
+/* The image's turn is the trial's mirrored: heading pi - psi, angular
+ * velocity and turn negated, the same largest turn; within bound. */
+static void check_turn_mirrored(const bsim_trial_result *a, const bsim_trial_result *b,
+                                double bound)
+{
+	assert_true(fabs(a->heading_end + b->heading_end - PI) <= bound);
+	assert_true(fabs(a->angular_velocity_end + b->angular_velocity_end) <= bound);
+	assert_true(fabs(a->turn_end + b->turn_end) <= bound);
+	assert_true(fabs(a->turn_max - b->turn_max) <= bound);
+}
+
 /* Runs case c and its image on be: the departures before the first
  * contact, over the first second of contact and over the whole trial. */
 static void mirror_case(const bsim_backend *be, case_id c, departure d[3], long *exact,
@@ -245,6 +276,8 @@ static void mirror_case(const bsim_backend *be, case_id c, departure d[3], long 
 	d[0] = compare(&pa, &pb, *contact);
 	d[1] = compare(&pa, &pb, *contact + (long)(1.0 / a.dt));
 	d[2] = compare(&pa, &pb, pa.n > pb.n ? pa.n : pb.n);
+	check_turn(&res[0], &pa);
+	check_turn(&res[1], &pb);
 	print_message("%s, %s: %s%s / %s%s, %ld and %ld steps, %ld in contact from step %ld; "
 	              "mirrored bit for bit %s %ld\n",
 	              be->name, case_name[c], bsim_trial_outcome_name(res[0].outcome),
@@ -289,6 +322,11 @@ static void test_mirror(void **state)
 			assert_int_equal(d[2].flags_differ, 0);
 			assert_int_equal(res[0].steps_run, res[1].steps_run);
 			assert_true(fabs(res[0].x_end + res[1].x_end) <= bound[2]);
+			check_turn_mirrored(&res[0], &res[1], bound[2]);
+			print_message("%s, %s: turned %.6g and %.6g rad, at most %.6g rad\n",
+			              be->name, case_name[c], res[0].turn_end, res[1].turn_end,
+			              res[0].turn_max);
+			assert_true(res[0].turn_max > 0.1); /* the check covers a turn */
 		} else {
 			print_message(
 			        "%s, %s: the whole trial checked by its outcome alone: it states "

@@ -80,7 +80,8 @@ static int take(void *user, const bsim_sweep_block *b, bsim_error *err)
 	for (long k = 0; k < b->n; k++) {
 		const bsim_trial_result *x = &whole.trials_out[b->first + k];
 		const bsim_trial_log *lx = &whole.logs[b->first + k];
-		s->differ += !bsim_compare_identical(&b->results[k], x, 1) ||
+		s->differ += !bsim_compare_identical(&b->results[k], x,
+		                                     BSIM_COMPARE_LEDGER | BSIM_COMPARE_TURN) ||
 		             b->results[k].steps_run != x->steps_run ||
 		             b->results[k].draws != x->draws;
 		s->paths += b->logs[k].n_entries != lx->n_entries;

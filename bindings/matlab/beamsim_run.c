@@ -219,6 +219,10 @@ static mxArray *result_struct(const bsim_replay *rp, const bsim_backend *b,
 	bmx_set(s, 0, "x_end", bmx_scalar(r->x_end));
 	bmx_set(s, 0, "y_end", bmx_scalar(r->y_end));
 	bmx_set(s, 0, "vx_end", bmx_scalar(r->vx_end));
+	bmx_set(s, 0, "heading_end", bmx_scalar(r->heading_end));
+	bmx_set(s, 0, "angular_velocity_end", bmx_scalar(r->angular_velocity_end));
+	bmx_set(s, 0, "turn_end", bmx_scalar(r->turn_end));
+	bmx_set(s, 0, "turn_max", bmx_scalar(r->turn_max));
 	bmx_set(s, 0, "max_theta", bmx_row(r->max_theta, 2));
 	bmx_set(s, 0, "overlap_max", bmx_scalar(r->overlap_max));
 	const double gate[2] = {r->final_ix, r->final_iy};

@@ -19,7 +19,8 @@
  *
  * The columns are made before the sweep, at their size, and filled as it
  * streams its trials by (bsim_sweep_config.sink): what is held is the
- * columns, about 185 bytes a trial, and the sweep's block of trials; a
+ * columns, 212 bytes a trial of H1's sweep (docs/bindings.md), and the
+ * sweep's block of trials; a
  * sweep whose columns would not fit in the memory available is refused
  * before it runs (bsim_output_trials_fit). */
 #include <math.h>
@@ -112,6 +113,22 @@ static double c_t_exit(const bsim_trial_result *x)
 {
 	return x->outcome == BSIM_TRAVERSED || x->outcome == BSIM_SIDE_EXIT ? x->t_end : NAN;
 }
+static double c_heading_end(const bsim_trial_result *x)
+{
+	return x->heading_end;
+}
+static double c_angular_velocity_end(const bsim_trial_result *x)
+{
+	return x->angular_velocity_end;
+}
+static double c_turn_end(const bsim_trial_result *x)
+{
+	return x->turn_end;
+}
+static double c_turn_max(const bsim_trial_result *x)
+{
+	return x->turn_max;
+}
 
 typedef struct number_column {
 	const char *name;
@@ -141,6 +158,10 @@ static const number_column after_path[] = {
         {"iteration_limits", c_iteration_limits},
         {"clamps", c_clamps},
         {"t_exit", c_t_exit},
+        {"heading_end", c_heading_end},
+        {"angular_velocity_end", c_angular_velocity_end},
+        {"turn_end", c_turn_end},
+        {"turn_max", c_turn_max},
 };
 
 enum { N_AFTER_TYPE = sizeof after_type / sizeof after_type[0] };
@@ -376,6 +397,12 @@ static mxArray *groups_struct(const bsim_experiment *e, const bsim_sweep_result 
 				bmx_set(s, i, "ci95", bmx_row(g->ci95, 2));
 		}
 		bmx_set(s, i, "deterministic", mxCreateLogicalScalar(g->deterministic != 0));
+		if (g->rotates) { /* summary.json's turn, where the body rotates */
+			bmx_set(s, i, "turn_end_mean", bmx_scalar(g->turn_end_mean));
+			bmx_set(s, i, "turn_end_mean_abs", bmx_scalar(g->turn_end_mean_abs));
+			bmx_set(s, i, "turn_end_max_abs", bmx_scalar(g->turn_end_max_abs));
+			bmx_set(s, i, "turn_max", bmx_scalar(g->turn_max));
+		}
 		mxArray *solver = mxCreateStructMatrix(1, 1, 0, NULL);
 		bmx_set(solver, 0, "iteration_limit",
 		        bmx_scalar((double)g->solver.iteration_limit));

@@ -239,10 +239,18 @@ BSIM_API void bsim_compare_sides_free(bsim_compare_sides *c);
 
 /* 1 if trials differ in outcome or traversal type. */
 BSIM_API int bsim_compare_discordant(const bsim_trial_result *a, const bsim_trial_result *b);
+/* The fields of trials.csv that a file may lack (one written before them),
+ * compared only where both sides have them: a bit set. */
+enum { BSIM_COMPARE_LEDGER = 1, BSIM_COMPARE_TURN = 2 };
+
+/* The fields both results know (BSIM_COMPARE_LEDGER if both have_ledger,
+ * BSIM_COMPARE_TURN if both has_turn). */
+BSIM_API int bsim_compare_known(const bsim_sweep_result *a, const bsim_sweep_result *b);
+
 /* 1 if trials are identical in every field trials.csv records (the
- * ledger's only if ledger is 1). */
+ * ledger's and the turn's only where known has their bit). */
 BSIM_API int bsim_compare_identical(const bsim_trial_result *a, const bsim_trial_result *b,
-                                    int ledger);
+                                    int known);
 
 #ifdef __cplusplus
 }

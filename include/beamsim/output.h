@@ -25,9 +25,11 @@ BSIM_API int bsim_output_summary_json(const char *path, const bsim_experiment *e
  * group,trial,outcome,type,steps,t_end,x_end,y_end,vx_end,
  * max_theta1,max_theta2, then the energy ledger e_start,e_end,work_in
  * (propulsion + random force),losses (dampers + impacts + contact +
- * correction),residual (J), overlap_max (m; empty if not measured), then one
- * column per grid axis of e (may be NULL), named by its dotted key, holding
- * the group's value. */
+ * correction),residual (J), overlap_max (m; empty if not measured), the
+ * final gate, location and path, the solver's counts, t_exit, the body's
+ * turn heading_end,angular_velocity_end,turn_end,turn_max (rad, rad/s; the
+ * columns trials_csv.h lists), then one column per grid axis of e (may be
+ * NULL), named by its dotted key, holding the group's value. */
 BSIM_API int bsim_output_trials_csv(const char *path, const bsim_experiment *e,
                                     const bsim_sweep_result *r, bsim_error *err);
 /* trajectories.csv: the kept trajectories of r (r->keep per group), rows of
@@ -39,7 +41,8 @@ BSIM_API int bsim_output_trajectories_csv(const char *path, const bsim_sweep_res
  * an earlier one, back into r (which it allocates: n_groups x trials rows,
  * each exactly once) and aggregates the groups. Columns are found by their
  * header name; the first eleven are required, the ledger columns are read
- * when present (r->has_ledger), others are ignored. The fields not in the
+ * when present (r->has_ledger), and so are the final gate, the solver's
+ * counts and the turn (r->has_turn); others are ignored. The fields not in the
  * file are zero. BSIM_EINPUT with file and line on a malformed, missing or
  * extra row. */
 BSIM_API int bsim_output_trials_read(const char *path, int n_groups, int trials,

@@ -54,10 +54,10 @@ BSIM_API bsim_run_info bsim_run_info_default(void);
  * backend, backend_options, seed, group, trial, mixed_seed, outcome, type,
  * landscape_left, landscape_beam (the barrier crossed, 1-based, or null),
  * in_contact_end, steps, steps_run, draws, t_end, x_end, y_end, vx_end,
- * max_theta, overlap_max, final_gate, location, reset_overlaps, path and
- * peak_theta (with a log), ledger, instability (null or why the trial was
- * unstable). record adds command, beamsim_version,
- * stride, set and scene_copy, for run.json. */
+ * heading_end, angular_velocity_end, turn_end, turn_max, max_theta, overlap_max, final_gate,
+ * location, reset_overlaps, path and peak_theta (with a log), ledger, instability (null or why the
+ * trial was unstable). record adds command, beamsim_version, stride, set and scene_copy, for
+ * run.json. */
 BSIM_API void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_result *r,
                                    int record);
 

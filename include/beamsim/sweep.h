@@ -37,6 +37,14 @@ typedef struct bsim_group_result {
 	/* Trials (copies too) that hit an iteration limit, and a clamp: the
 	 * trials whose motion is partly the solver's, not the model's. */
 	int trials_iteration_limit, trials_clamped;
+	/* The body's turn over the group's trials (copies too), rad: the mean
+	 * of turn_end (a bias to one side), of |turn_end| (how far the bodies
+	 * ended turned), the largest |turn_end| and the largest turn_max
+	 * (beamsim/trial.h). rotates: the group's body rotates (body.rotates),
+	 * so that summary.json gives them; set by the sweep from its scenes (0
+	 * for groups read back from trials.csv). */
+	int rotates;
+	double turn_end_mean, turn_end_mean_abs, turn_end_max_abs, turn_max;
 } bsim_group_result;
 
 /* Consecutive trials of a sweep, handed to a sink (bsim_sweep_config.sink)
@@ -62,6 +70,8 @@ typedef struct bsim_sweep_result {
 	bsim_solver_counts solver; /* over the trials integrated */
 	int has_ledger;            /* 1: the trials' ledgers are known (a run, or a trials.csv
 	                            * with the energy columns) */
+	int has_turn;              /* 1: the trials' turns are known (a run, or a trials.csv
+	                            * with heading_end, ...) */
 	int keep;                  /* trajectories kept per group (its first trials) */
 	bsim_trajectory *kept;     /* n_groups * keep, index g*keep + t; NULL if keep = 0 */
 	/* Each trial's gate path with entry states and the peaks of every
@@ -265,7 +275,8 @@ BSIM_API int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_swe
                                         const bsim_backend *backend_b, const bsim_options *opts_b,
                                         const bsim_sweep_part *part, bsim_error *err);
 
-/* Aggregates one group's trials into counts and the Wilson interval. */
+/* Aggregates one group's trials into counts, the Wilson interval and the
+ * turn's statistics (rotates, which the trials do not say, left 0). */
 BSIM_API void bsim_sweep_group_aggregate(const bsim_trial_result *trials, int n,
                                          bsim_group_result *out);
 

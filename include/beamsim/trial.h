@@ -121,6 +121,14 @@ typedef struct bsim_trial_result {
 	/* What the backend's solvers gave up on over the trial (beamsim/
 	 * state.h), summed over the worlds it ran in. */
 	bsim_solver_counts solver;
+	/* The body's turn. At the end of the run, as x_end: its heading, rad
+	 * from +x counter-clockwise (bsim_state.heading, not wrapped), and
+	 * angular velocity, rad/s; turn_end, rad, the heading's change since
+	 * the start (counter-clockwise positive). turn_max, rad: the largest
+	 * |heading - heading at the start| over the run's steps (>= |turn_end|).
+	 * A body that does not rotate (body.rotates 0) keeps its heading:
+	 * angular_velocity_end, turn_end and turn_max are 0. */
+	double heading_end, angular_velocity_end, turn_end, turn_max;
 } bsim_trial_result;
 
 /* Which edge of a gate the body crossed to enter it. */

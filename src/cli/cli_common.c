@@ -229,7 +229,11 @@ static int grid_number(const char *t, double *x)
 
 #define GRID_EXPECTED "KEY=V1,V2,... or KEY=A:B:STEP"
 
-/* The values of "V1,V2,..." into a (values only). */
+/* The values of "V1,V2,..." into a (values only), as written: numbers, or
+ * words for a key whose values are words (effects.random_force.model=
+ * held,ou). Each is judged where an experiment file's grid values are, by
+ * the scene loader for its key (bsim_experiment_load_grid), which names
+ * the value "--grid KEY=VALUE" and what the key takes. */
 static int grid_list(bsim_grid_axis *a, const char *cmd, const char *text, const char *list,
                      char *buf)
 {
@@ -248,18 +252,12 @@ static int grid_list(bsim_grid_axis *a, const char *cmd, const char *text, const
 		return CLI_FAIL;
 	for (const char *p = list;; p++) {
 		size_t len = strcspn(p, ",");
-		double x;
 		trimmed(p, len, buf);
 		if (!buf[0])
 			return cli_usage(cmd,
-			                 "--grid %s: expected a non-empty list of numbers "
+			                 "--grid %s: expected a non-empty list of values "
 			                 "(" GRID_EXPECTED "), got an empty value",
 			                 text);
-		if (!grid_number(buf, &x))
-			return cli_usage(cmd,
-			                 "--grid %s: expected decimal numbers (" GRID_EXPECTED
-			                 "), got \"%s\"",
-			                 text, buf);
 		if (!(a->values[a->n_values++] = strdup(buf)))
 			return CLI_FAIL;
 		p += len;

@@ -74,13 +74,15 @@ typedef struct cli_sets {
 
 /* Adds "KEY=VALUE" with origin "--set KEY=VALUE". 0, or a usage error. */
 int cli_sets_add(cli_sets *s, const char *cmd, const char *kv);
-/* Adds a --grid axis: "KEY=V1,V2,..." (decimal numbers, kept as written)
- * or "KEY=A:B:STEP" (A, A + STEP, ... up to B, B included when reached
- * within 1e-9 of STEP, each written in the fewest decimals that hold it,
- * util/decimal.h), the axis's origin "--grid KEY" (a value is named "--grid
- * KEY=VALUE"). A KEY given again replaces its earlier values. At most the
- * limit groups values (beamsim/limits.h). 0, or a usage error naming
- * --grid, the text and what was expected. */
+/* Adds a --grid axis: "KEY=V1,V2,..." (kept as written: numbers, or words
+ * for a key whose values are words, each judged by the scene loader as an
+ * experiment file's grid values are) or "KEY=A:B:STEP" (A, A + STEP, ...
+ * up to B, B included when reached within 1e-9 of STEP, each written in
+ * the fewest decimals that hold it, util/decimal.h), the axis's origin
+ * "--grid KEY" (a value is named "--grid KEY=VALUE"). A KEY given again
+ * replaces its earlier values. At most the limit groups values
+ * (beamsim/limits.h). 0, or a usage error naming --grid, the text and what
+ * was expected. */
 int cli_grid_add(cli_sets *s, const char *cmd, const char *text);
 void cli_sets_free(cli_sets *s);
 

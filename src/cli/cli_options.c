@@ -29,9 +29,11 @@ static const shared_def shared[CLI_N_OPTS] = {
                          "(e.g. --set beams.0.stiffness=250: beams.0 is beam 1)"},
         [CLI_OPT_GRID] = {"grid", 1, "KEY=VALUES",
                           "vary a scene field over VALUES, repeatable: V1,V2,...\n"
-                          "or A:B:STEP (B included); replaces the experiment's\n"
-                          "grid axis of KEY, or adds one after its axes\n"
-                          "(e.g. --grid beams.0.stiffness=100:500:100)"},
+                          "(numbers, or the field's words) or A:B:STEP (B\n"
+                          "included); replaces the experiment's grid axis of\n"
+                          "KEY, or adds one after its axes (e.g. --grid\n"
+                          "beams.0.stiffness=100:500:100, --grid\n"
+                          "effects.random_force.model=held,ou)"},
         [CLI_OPT_OUT] = {"out", 1, "DIR", "output directory, created if missing (required)"},
         [CLI_OPT_QUIET] = {"quiet", 0, NULL, "no progress line, nothing on stdout"},
         [CLI_OPT_LIMIT] = {"limit", 1, "NAME=N",

@@ -92,8 +92,9 @@ static int run_option(void *args, int i, const char *value)
 static const cli_spec run_spec = {
         .name = "run",
         .usage = "SCENE|EXPERIMENT|DIR [OPTIONS]",
-        .about = "Runs one trial and prints its outcome, end state, peak beam angles, the\n"
-                 "deepest overlap of body and beams, and the energy ledger. The trial is\n"
+        .about = "Runs one trial and prints its outcome, end state, how far a body that\n"
+                 "rotates turned, peak beam angles, the deepest overlap of body and beams,\n"
+                 "and the energy ledger. The trial is\n"
                  "  of a scene file SCENE: the random-force schedule of trial I of group G\n"
                  "    of a sweep with seed N; a scene has no grid, so no grid values apply;\n"
                  "  of an experiment file EXPERIMENT: trial I of group G as `beamsim sweep\n"
@@ -181,6 +182,11 @@ static void print_text(FILE *out, const run_args *a, const bsim_replay *rp, uint
 	        r->steps_run);
 	fprintf(out, "end state   x = %.6g m, y = %.6g m, vx = %.6g m/s\n", r->x_end, r->y_end,
 	        r->vx_end);
+	if (s->body.rotates)
+		fprintf(out,
+		        "turn        heading %.6g rad, angular velocity %.6g rad/s at the end; "
+		        "turned %.6g rad, at most %.6g rad\n",
+		        r->heading_end, r->angular_velocity_end, r->turn_end, r->turn_max);
 	if (s->has_lattice)
 		print_lattice(out, s, r, log);
 	else

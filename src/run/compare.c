@@ -110,19 +110,29 @@ int bsim_compare_discordant(const bsim_trial_result *a, const bsim_trial_result 
 	                                    bsim_lattice_location_of(b));
 }
 
-int bsim_compare_identical(const bsim_trial_result *a, const bsim_trial_result *b, int ledger)
+int bsim_compare_known(const bsim_sweep_result *a, const bsim_sweep_result *b)
+{
+	return (a->has_ledger && b->has_ledger ? BSIM_COMPARE_LEDGER : 0) |
+	       (a->has_turn && b->has_turn ? BSIM_COMPARE_TURN : 0);
+}
+
+int bsim_compare_identical(const bsim_trial_result *a, const bsim_trial_result *b, int known)
 {
 	const bsim_ledger *la = &a->ledger, *lb = &b->ledger;
 	int same = !bsim_compare_discordant(a, b) && a->steps == b->steps && a->t_end == b->t_end &&
 	           a->x_end == b->x_end && a->y_end == b->y_end && a->vx_end == b->vx_end &&
 	           a->max_theta[0] == b->max_theta[0] && a->max_theta[1] == b->max_theta[1] &&
 	           a->final_ix == b->final_ix && a->final_iy == b->final_iy;
-	if (same && ledger)
+	if (same && (known & BSIM_COMPARE_LEDGER))
 		same = la->e_start == lb->e_start && la->e_end == lb->e_end &&
 		       la->w_prop + la->w_rand == lb->w_prop + lb->w_rand &&
 		       la->damper + la->impact + la->contact + la->correction ==
 		               lb->damper + lb->impact + lb->contact + lb->correction &&
 		       la->residual == lb->residual;
+	if (same && (known & BSIM_COMPARE_TURN))
+		same = a->heading_end == b->heading_end &&
+		       a->angular_velocity_end == b->angular_velocity_end &&
+		       a->turn_end == b->turn_end && a->turn_max == b->turn_max;
 	return same;
 }
 
@@ -468,7 +478,7 @@ static int pair_tables(const bsim_sweep_result *a, const bsim_sweep_result *b,
 		        "cannot pair %d groups x %d trials with %d groups x %d trials", a->n_groups,
 		        a->trials, b->n_groups, b->trials);
 	int G = a->n_groups, n = a->trials;
-	int ledger = a->has_ledger && b->has_ledger;
+	int known = bsim_compare_known(a, b);
 	out->n_groups = G;
 	out->trials = n;
 	out->rule = *rule;
@@ -508,7 +518,7 @@ static int pair_tables(const bsim_sweep_result *a, const bsim_sweep_result *b,
 		/* Over every trial, copies included: a stored file edited in
 		 * any row is a change. */
 		for (int i = 0; i < n; i++)
-			cg->changed += !bsim_compare_identical(&ra[i], &rb[i], ledger);
+			cg->changed += !bsim_compare_identical(&ra[i], &rb[i], known);
 		out->pairs += cg->pairs;
 		cg->t_sep[0] = cg->t_sep[1] = cg->t_sep[2] = -1.0;
 		if (t_separate) {

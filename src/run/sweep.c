@@ -53,6 +53,10 @@ static void group_add(bsim_group_result *out, const bsim_trial_result *t)
 	out->solver.clamped += t->solver.clamped;
 	out->trials_iteration_limit += t->solver.iteration_limit > 0;
 	out->trials_clamped += t->solver.clamped > 0;
+	out->turn_end_mean += t->turn_end; /* sums until group_finish */
+	out->turn_end_mean_abs += fabs(t->turn_end);
+	out->turn_end_max_abs = fmax(out->turn_end_max_abs, fabs(t->turn_end));
+	out->turn_max = fmax(out->turn_max, t->turn_max);
 	switch (t->outcome) {
 	case BSIM_TRAVERSED:
 		out->traversed++;
@@ -81,6 +85,8 @@ static void group_finish(bsim_group_result *out)
 {
 	int n = out->trials;
 	out->p_traverse = n > 0 ? (double)out->traversed / n : 0.0;
+	out->turn_end_mean = n > 0 ? out->turn_end_mean / n : 0.0;
+	out->turn_end_mean_abs = n > 0 ? out->turn_end_mean_abs / n : 0.0;
 	bsim_stats_wilson(out->traversed, n, BSIM_STATS_Z95, &out->ci95[0], &out->ci95[1]);
 }
 
@@ -519,6 +525,7 @@ static int result_alloc(bsim_sweep_result *r, int n_groups, int trials, int keep
 	r->n_groups = n_groups;
 	r->trials = trials;
 	r->has_ledger = 1;
+	r->has_turn = 1;
 	r->first_unstable = -1;
 	if (per_trial) {
 		r->trials_out = calloc(n ? n : 1, sizeof *r->trials_out);
@@ -605,12 +612,23 @@ static void result_totals(bsim_sweep_result *r, const int *deterministic, int tr
 	r->wall_seconds = wall;
 }
 
+/* Which groups' bodies rotate, from their scenes: before the groups are
+ * counted, which keeps it. */
+static void groups_rotate(bsim_sweep_result *r, const bsim_scene *scenes)
+{
+	for (int g = 0; g < r->n_groups; g++)
+		r->groups[g].rotates = scenes[g].body.rotates;
+}
+
 static void result_finish(bsim_sweep_result *r, const int *deterministic, int n_groups, int trials,
                           double wall)
 {
-	for (int g = 0; g < n_groups; g++)
+	for (int g = 0; g < n_groups; g++) {
+		int rotates = r->groups[g].rotates; /* groups_rotate's */
 		bsim_sweep_group_aggregate(&r->trials_out[(size_t)g * trials], trials,
 		                           &r->groups[g]);
+		r->groups[g].rotates = rotates;
+	}
 	result_totals(r, deterministic, trials, r->trials_out, (size_t)trials, wall);
 }
 
@@ -720,6 +738,7 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 		for (int s = 0; s < n_sides; s++) {
 			out[s].lattice = sh.scenes[s][0].has_lattice;
 			out[s].lattice_def = sh.scenes[s][0].lattice;
+			groups_rotate(&out[s], sh.scenes[s]);
 		}
 		scenes_free(scenes, e->n_groups);
 		if (scenes_b)
@@ -920,6 +939,8 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	}
 	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
 		deterministic[g] = !bsim_effects_random(&scenes[g]);
+	if (rc == BSIM_OK)
+		groups_rotate(out, scenes);
 	sweep_shared sh = {
 	        .e = e,
 	        .cfg = cfg,

@@ -128,6 +128,7 @@ typedef struct trial_ctx {
 	double centre;             /* m, the field's centre line */
 	int overlap;               /* the recorder asked for overlap_max */
 	int disk;                  /* the body is a disk (the flags' inline rule) */
+	int measure;               /* overlap, or a body that rotates: measured every step */
 	int recording, stride;     /* rows to the recorder's sinks, every stride-th step */
 	bsim_trace_fn trace;
 	int trace_whole; /* the trace sees the whole lattice (essay protocol) */
@@ -186,6 +187,7 @@ static int trial_open(trial_ctx *c, uint64_t seed, bsim_error *err)
 	/* the overlap is the disk's (R less the centre's distance): not
 	 * measured for another shape (overlap_max NaN) */
 	c->overlap = rec && rec->overlap && c->scene->body.shape == BSIM_SHAPE_DISK;
+	c->measure = c->overlap || c->scene->body.rotates;
 	c->recording = rec && (rec->csv || rec->ledger || rec->record);
 	c->stride = rec && rec->stride > 0 ? rec->stride : 1;
 	c->trace = rec ? rec->trace : NULL;
@@ -377,6 +379,7 @@ static void trial_result(trial_ctx *c, const trial_loop *lp, bsim_state *s0)
 	out->x_end = s0->x[0];
 	out->y_end = s0->x[1];
 	out->vx_end = s0->v[0];
+	trial_peaks_turn_end(p, s0, out);
 	out->steps_run = (int)lp->n;
 	trial_ledger_close(out, lp->e0, lp->n);
 	if (out->instability) {
@@ -416,6 +419,19 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, bsim_state *s0, int r
 	}
 	trial_essay_release(&r->essay, c->backend, &c->w);
 	return rc;
+}
+
+/* What a step measures beyond the essay's needs, s1 the state after it:
+ * the overlap (when asked for) and the turn of a body that rotates. Out of
+ * the step loop, which tests one flag for both (c->measure): a step that
+ * measures neither runs the loop's code as it was (bench --callgrind). */
+__attribute__((noinline)) static void trial_measure(trial_ctx *c, const bsim_state *s1)
+{
+	if (c->overlap)
+		c->out->overlap_max =
+		        fmax(c->out->overlap_max, trial_overlap_depth(c->r->shape, c->ws->n_beams,
+		                                                      c->scene->body.radius, s1));
+	trial_peaks_turn(&c->r->peaks, s1);
 }
 
 /* Always inlined: a copy in the step loop and one, plain, in the runs. */
@@ -464,10 +480,8 @@ TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bs
 		c->trace(c->rec->trace_user, lp->n, trial_trace_state(c, s1));
 	ledger_step(&out->ledger, c->fx, s0, s1, lp->e0, e1);
 	lp->e0 = e1;
-	if (!plain && c->overlap)
-		out->overlap_max =
-		        fmax(out->overlap_max, trial_overlap_depth(c->r->shape, c->ws->n_beams,
-		                                                   c->scene->body.radius, s1));
+	if (!plain && c->measure)
+		trial_measure(c, s1);
 	if (lp->done)
 		return BOOK_ON;
 	/* The peaks; a run's states stay where they are until its booking
@@ -501,7 +515,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	bsim_state *s0 = &r->s0, *s1 = &r->s1;
 	trial_loop lp;
 	rc = trial_begin(&c, &lp, s0, err);
-	const int plain = !c.recording && !c.trace && !c.overlap && !c.map;
+	const int plain = !c.recording && !c.trace && !c.measure && !c.map;
 	trial_flight_start(&r->flight, plain, backend, c.w, scene, &fx, out, &r->peaks, c.n_max,
 	                   c.gate_max, c.centre);
 	if (rc == BSIM_OK &&

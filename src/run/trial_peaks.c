@@ -70,6 +70,9 @@ void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
 	p->last_touch[0] = p->last_touch[1] = 0.0;
 	p->settled01 = 0;
 	touching_clear(p);
+	p->turns = scene->body.rotates;
+	p->heading0 = s0->heading;
+	p->turn_max = 0.0;
 }
 
 int trial_peaks_label(const trial_peaks *p, const bsim_scene *scene)
@@ -79,4 +82,12 @@ int trial_peaks_label(const trial_peaks *p, const bsim_scene *scene)
 	if (scene->body.shape != BSIM_SHAPE_DISK)
 		return -1;
 	return p->touched ? bsim_landscape_label(scene, p->last_touch, p->touching) : -1;
+}
+
+void trial_peaks_turn_end(const trial_peaks *p, const bsim_state *s, bsim_trial_result *out)
+{
+	out->heading_end = s->heading;
+	out->angular_velocity_end = s->angular_velocity;
+	out->turn_end = s->heading - p->heading0;
+	out->turn_max = p->turn_max;
 }

@@ -1,8 +1,9 @@
 /* Internal: what a trial remembers of the beams beyond their state (trial.c
  * keeps one per runner): every beam's peak angle (trials.csv's max_theta,
  * the log's peaks) and the beams touching the body at the last step before
- * success_y at which any did (for the landscape label of a traversal).
- * The runner updates both every step: those updates are inline.
+ * success_y at which any did (for the landscape label of a traversal); and
+ * of a body that rotates, its largest turn (trials.csv's turn_max).
+ * The runner updates them every step: those updates are inline.
  *
  * Beams are the scene's: under the essay's protocol the world's beam i is
  * the scene's map[i] (map NULL: the same). */
@@ -11,6 +12,7 @@
 
 #include "beamsim/scene.h"
 #include "beamsim/state.h"
+#include "beamsim/trial.h"
 #include "util/fminmax.h"
 
 typedef struct trial_peaks {
@@ -34,6 +36,11 @@ typedef struct trial_peaks {
 	/* Beams 0 and 1's peaks are at +0 or above: a peak never falls, so
 	 * they stay there, and a beam at rest cannot raise them. */
 	int settled01;
+	/* The body's heading at the start, rad, and the largest |heading -
+	 * heading0| since, over every step of the run (trial_peaks_turn);
+	 * turns: the body rotates (else turn_max stays 0). */
+	int turns;
+	double heading0, turn_max;
 } trial_peaks;
 
 /* Room for a scene of n_beams beams. */
@@ -41,8 +48,8 @@ int trial_peaks_reserve(trial_peaks *p, int n_beams);
 void trial_peaks_free(trial_peaks *p);
 
 /* Peaks at the initial angles s0 (map: every beam of the scene starts at
- * rest), no contact yet. A beam s0 does not list active is at rest (its
- * angle 0): its peak is 0, and the cost is that of the beams the last
+ * rest), no contact yet, no turn. A beam s0 does not list active is at rest
+ * (its angle 0): its peak is 0, and the cost is that of the beams the last
  * trial moved, not of the scene. */
 void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
                        const bsim_state *s0);
@@ -51,6 +58,11 @@ void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
  * crossed (bsim_landscape_label at the last touching step), -1 if it
  * touched none. */
 int trial_peaks_label(const trial_peaks *p, const bsim_scene *scene);
+
+/* The body's turn into out (heading_end, angular_velocity_end, turn_end,
+ * turn_max), s the run's last state. Not inline: the runner's step loop is
+ * compiled as it was without it. */
+void trial_peaks_turn_end(const trial_peaks *p, const bsim_state *s, bsim_trial_result *out);
 
 static inline int scene_beam(const int *map, int i)
 {
@@ -154,6 +166,17 @@ static inline void trial_peaks_step(trial_peaks *p, const bsim_scene *scene, con
 	trial_peaks_note(p, scene, map, s);
 	if (any_contact(s))
 		trial_peaks_contacts(p, map, s);
+}
+
+/* The largest turn with s, the state after a step (any step of the run,
+ * after the outcome too: the run's end state is turn_end's). Only a body
+ * that rotates turns: the runner calls this for it alone, so that a step
+ * of the essay's disk costs nothing more. A heading that is not a number
+ * is not taken (the state's test of finiteness judges the trial). */
+static inline void trial_peaks_turn(trial_peaks *p, const bsim_state *s)
+{
+	if (p->turns)
+		p->turn_max = bsim_fmax(p->turn_max, fabs(s->heading - p->heading0));
 }
 
 #endif

@@ -219,6 +219,21 @@ static void json_solver_trials(FILE *f, const bsim_group_result *g)
 	        g->trials_iteration_limit, g->trials_clamped);
 }
 
+/* How far a group's bodies turned (a body that rotates): the mean final
+ * turn (a bias to one side), the mean and largest of its size, and the
+ * largest turn during a trial, rad. */
+static void json_turn(FILE *f, const bsim_group_result *g)
+{
+	const char *names[] = {"turn_end_mean", "turn_end_mean_abs", "turn_end_max_abs",
+	                       "turn_max"};
+	const double values[] = {g->turn_end_mean, g->turn_end_mean_abs, g->turn_end_max_abs,
+	                         g->turn_max};
+	for (int i = 0; i < 4; i++) {
+		fprintf(f, ", \"%s\": ", names[i]);
+		bsim_json_number(f, values[i]);
+	}
+}
+
 static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int group,
                        int *idx)
 {
@@ -241,6 +256,8 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 	        g->deterministic ? "true" : "false");
 	json_solver(f, &g->solver);
 	json_solver_trials(f, g);
+	if (g->rotates)
+		json_turn(f, g);
 	if (r->lattice)
 		json_lattice(f, r, group);
 	fputc('}', f);
@@ -329,6 +346,8 @@ const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
         "final_iy",    "location",
         "path",        "iteration_limits",
         "clamps",      "t_exit",
+        "heading_end", "angular_velocity_end",
+        "turn_end",    "turn_max",
 };
 
 int trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
@@ -388,6 +407,10 @@ void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 		fprintf(f, ",%ld,%ld,", x->solver.iteration_limit, x->solver.clamped);
 		/* when it left the gate (the field), empty if censored */
 		number_field(f, survival_exit_time(x));
+		/* the body's turn: every body's, 0 for one that does not
+		 * rotate, so that every file has the same columns */
+		fprintf(f, ",%.10g,%.10g,%.10g,%.10g", x->heading_end, x->angular_velocity_end,
+		        x->turn_end, x->turn_max);
 		for (int a = 0; a < w->axes; a++) {
 			fputc(',', f);
 			csv_field_write(f, w->e->axes[a].values[w->idx[a]]);

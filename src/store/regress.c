@@ -132,10 +132,9 @@ static int side_read(const bsim_regress_result *res, const char *dir, int i, bsi
 
 static int trials_changed(const bsim_sweep_result r[2])
 {
-	int changed = 0, ledger = r[0].has_ledger && r[1].has_ledger;
+	int changed = 0, known = bsim_compare_known(&r[0], &r[1]);
 	for (long i = 0; i < (long)r[0].n_groups * r[0].trials; i++)
-		changed +=
-		        !bsim_compare_identical(&r[0].trials_out[i], &r[1].trials_out[i], ledger);
+		changed += !bsim_compare_identical(&r[0].trials_out[i], &r[1].trials_out[i], known);
 	return changed;
 }
 

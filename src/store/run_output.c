@@ -130,9 +130,13 @@ void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_r
 	fprintf(f, ", \"in_contact_end\": %d", r->in_contact_end);
 	fprintf(f, ", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
 	        r->draws);
-	const char *names[] = {"t_end", "x_end", "y_end", "vx_end"};
-	const double values[] = {r->t_end, r->x_end, r->y_end, r->vx_end};
-	for (int i = 0; i < 4; i++) {
+	const char *names[] = {"t_end",    "x_end",       "y_end",
+	                       "vx_end",   "heading_end", "angular_velocity_end",
+	                       "turn_end", "turn_max"};
+	const double values[] = {r->t_end,    r->x_end,       r->y_end,
+	                         r->vx_end,   r->heading_end, r->angular_velocity_end,
+	                         r->turn_end, r->turn_max};
+	for (int i = 0; i < 8; i++) {
 		fprintf(f, ", \"%s\": ", names[i]);
 		bsim_json_number(f, values[i]);
 	}

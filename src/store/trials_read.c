@@ -3,9 +3,11 @@
  * precision). Columns are found by their header name, so a file with more
  * columns than this version writes, or one written before the energy
  * columns, the lattice's final gate (final_ix, final_iy; 0 when absent,
- * what a gate scene writes) or the solver's counts (iteration_limits,
- * clamps; 0 when absent) existed, reads the same. t_exit is not read: it
- * is t_end for an exit and empty otherwise, so outcome and t_end give it. */
+ * what a gate scene writes), the solver's counts (iteration_limits,
+ * clamps; 0 when absent) or the body's turn (heading_end, ...; all four or
+ * none, 0 when absent, r->has_turn 0, so that a comparison leaves them out)
+ * existed, reads the same. t_exit is not read: it is t_end for an exit and
+ * empty otherwise, so outcome and t_end give it. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
@@ -40,6 +42,10 @@ enum {
 	COL_FINAL_IY,
 	COL_ITERATION_LIMITS,
 	COL_CLAMPS,
+	COL_HEADING_END,
+	COL_ANGULAR_VELOCITY_END,
+	COL_TURN_END,
+	COL_TURN_MAX,
 	N_COLUMNS
 };
 
@@ -65,6 +71,10 @@ static const int column_of[N_COLUMNS] = {
         TRIALS_FINAL_IY,
         TRIALS_ITERATION_LIMITS,
         TRIALS_CLAMPS,
+        TRIALS_HEADING_END,
+        TRIALS_ANGULAR_VELOCITY_END,
+        TRIALS_TURN_END,
+        TRIALS_TURN_MAX,
 };
 
 /* The column k of this reader whose name s is, or -1. */
@@ -143,12 +153,26 @@ static int parse_row(char **f, int n, const int *col, const bsim_sweep_result *r
 		if (*end || *solver[i] < 0)
 			return -1;
 	}
+	double *turn[4] = {&x->heading_end, &x->angular_velocity_end, &x->turn_end, &x->turn_max};
+	for (int i = 0; i < 4 && col[COL_HEADING_END] >= 0; i++)
+		if (parse_double(f[col[COL_HEADING_END + i]], turn[i]))
+			return -1;
 	x->steps_run = 1; /* marks the row as read; not in the file */
 	return 0;
 }
 
-/* The header: every required column once; the ledger columns all or
- * none. */
+/* The columns first .. end - 1 of this reader the header has: all or
+ * none (-1). */
+static int all_or_none(const int *col, int first, int end)
+{
+	int have = 0;
+	for (int k = first; k < end; k++)
+		have += col[k] >= 0;
+	return have == 0 || have == end - first ? 0 : -1;
+}
+
+/* The header: every required column once; the ledger's columns, and the
+ * turn's, all or none. */
 static int read_header(char *line, int *col, int *n_fields)
 {
 	char *f[256];
@@ -165,10 +189,8 @@ static int read_header(char *line, int *col, int *n_fields)
 	for (int k = 0; k < N_REQUIRED; k++)
 		if (col[k] < 0)
 			return -1;
-	int ledger = 0;
-	for (int k = N_REQUIRED; k < LEDGER_END; k++)
-		ledger += col[k] >= 0;
-	if (ledger != 0 && ledger != LEDGER_END - N_REQUIRED)
+	if (all_or_none(col, N_REQUIRED, LEDGER_END) ||
+	    all_or_none(col, COL_HEADING_END, N_COLUMNS))
 		return -1;
 	*n_fields = n;
 	return n > 0 ? 0 : -1;
@@ -210,9 +232,12 @@ int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_swe
 				        err, BSIM_EINPUT,
 				        "%s:1: expected a header naming each of group, trial, "
 				        "outcome, type, steps, t_end, x_end, y_end, vx_end, "
-				        "max_theta1, max_theta2 once",
+				        "max_theta1, max_theta2 once (e_start, e_end, work_in, "
+				        "losses, residual all or none; heading_end, "
+				        "angular_velocity_end, turn_end, turn_max all or none)",
 				        path);
 			r->has_ledger = col[COL_E_START] >= 0;
+			r->has_turn = col[COL_HEADING_END] >= 0;
 			continue;
 		}
 		int n = csv_split(line, field, 256);

@@ -112,8 +112,9 @@ check(strcmp(seed, cli.mixed_seed), 'mixed seed %s, the program %s', seed, cli.m
 for f = {'outcome', 'type'}
   check(strcmp(r.(f{1}), cli.(f{1})), '%s: %s, the program %s', f{1}, r.(f{1}), cli.(f{1}));
 end
-for f = {'steps', 'steps_run', 'draws', 't_end', 'x_end', 'y_end', 'vx_end', 'overlap_max', ...
-         'in_contact_end', 'reset_overlaps'}
+for f = {'steps', 'steps_run', 'draws', 't_end', 'x_end', 'y_end', 'vx_end', 'heading_end', ...
+         'angular_velocity_end', 'turn_end', 'turn_max', 'overlap_max', 'in_contact_end', ...
+         'reset_overlaps'}
   check(json_same(r.(f{1}), cli.(f{1})), '%s: %.17g, the program %.17g', f{1}, r.(f{1}), ...
         cli.(f{1}));
 end
@@ -170,6 +171,46 @@ for j = 1:numel(names)
   end
   check_column('capsule trajectory', names{j}, rc.trajectory.(names{j}), cols{j}, fmt);
 end
+% How far it turned: the program's numbers (run --json), and a turn.
+[out, err, status] = program(exe, tmp, sprintf('run %s --backend box2d --json', capsule));
+check(status == 0, 'beamsim run capsule --json: exit %d: %s', status, err);
+cli = jsondecode(out);
+turn = {'heading_end', 'angular_velocity_end', 'turn_end', 'turn_max'};
+for f = turn
+  check(json_same(rc.(f{1}), cli.(f{1})), 'capsule %s: %.17g, the program %.17g', f{1}, ...
+        rc.(f{1}), cli.(f{1}));
+end
+check(rc.turn_max > 0.01 && rc.turn_max >= abs(rc.turn_end), 'capsule: turned %g, at most %g', ...
+      rc.turn_end, rc.turn_max);
+% A sweep of it, its body turning in group 1 and not in group 2: the
+% groups' turn as summary.json's, which has none for group 2.
+capexp = fullfile(tmp, 'capsule_exp.yaml');
+fid = fopen(capexp, 'w');
+fprintf(fid, ['scene: %s\ntrials: 3\nseed: 2\nset:\n  integration.max_steps: 1500\n' ...
+              'grid:\n  body.rotates: [true, false]\n'], capsule);
+fclose(fid);
+capsweep = fullfile(tmp, 'capsule_sweep');
+[~, err, status] = program(exe, tmp, sprintf('sweep %s --backend box2d --quiet --out %s', ...
+                                             capexp, capsweep));
+check(status == 0, 'beamsim sweep capsule: exit %d: %s', status, err);
+cs = beamsim_sweep(capexp, 'backend', 'box2d');
+summary = jsondecode(fileread(fullfile(capsweep, 'summary.json')));
+groups = summary.groups;
+if ~iscell(groups)
+  groups = num2cell(groups);
+end
+for f = {'turn_end_mean', 'turn_end_mean_abs', 'turn_end_max_abs', 'turn_max'}
+  check(json_same(cs.groups(1).(f{1}), groups{1}.(f{1})), ...
+        'capsule group 1 %s: %.17g, summary.json %.17g', f{1}, cs.groups(1).(f{1}), ...
+        groups{1}.(f{1}));
+  check(isempty(cs.groups(2).(f{1})) && ~isfield(groups{2}, f{1}), ...
+        'capsule group 2 (not turning) has %s', f{1});
+end
+check(cs.groups(1).turn_max > 0 && ...
+      isequal(cs.groups(1).turn_max, max(cs.trials.turn_max(cs.trials.group == 1))), ...
+      'capsule group 1: largest turn %g', cs.groups(1).turn_max);
+printf('capsule: turned %.4g rad (at most %.4g), its sweep''s groups as summary.json''s\n', ...
+       rc.turn_end, rc.turn_max);
 
 % ---- a trial of an experiment's group, with --set, on Box2D ------------
 [out, err, status] = program(exe, tmp, sprintf(['run %s --group 10 --trial 3 --backend box2d ' ...

@@ -77,7 +77,8 @@ def test_trajectory_columns_are_trajectory_csv(gate, tmp_path):
 
 def test_turning_body_has_its_columns(tmp_path):
     """A capsule that turns (Box2D): the trajectory ends with heading and
-    angular_velocity, in the module as in the CSV."""
+    angular_velocity, in the module as in the CSV; the result's turn
+    (heading_end, angular_velocity_end, turn_end, turn_max) is run --json's."""
     scene = tmp_path / "capsule.yaml"
     text = open(config("thesis", "gate.yaml")).read()
     text = text.replace("body:      { mass: 1.0, radius: 10.0,",
@@ -86,6 +87,10 @@ def test_turning_body_has_its_columns(tmp_path):
     scene.write_text(text)
     header = check_trajectory_csv(scene, tmp_path, "--backend", "box2d")
     assert header[-2:] == ["heading", "angular_velocity"]
+    # How far it turned: run --json's numbers, and a turn.
+    r = beamsim.run(scene, backend="box2d")
+    same_as_cli(r, cli_json("run", scene, "--backend", "box2d"))
+    assert r["turn_max"] > 0.01 and r["turn_max"] >= abs(r["turn_end"])
 
 
 def test_no_trajectory_unless_asked(gate):

@@ -75,7 +75,8 @@ def test_stored_sweep_replays(h1, tmp_path):
         r = beamsim.run(tmp_path / "s", group=g, trial=t)
         assert r["stored_row"] == r["row"]
         assert r["outcome"] == tr["outcome"][k] and r["steps"] == tr["steps"][k]
-        assert "%.10g" % r["x_end"] == "%.10g" % tr["x_end"][k]
+        for f in ("x_end", "heading_end", "angular_velocity_end", "turn_end", "turn_max"):
+            assert "%.10g" % r[f] == "%.10g" % tr[f][k]
 
 
 def test_compare_is_the_cli_compare(h1, tmp_path):

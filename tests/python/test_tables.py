@@ -102,7 +102,7 @@ def test_sweep_beyond_memory_is_refused(h1, tmp_path, monkeypatch):
     written."""
     monkeypatch.setattr(beamsim, "_CELL_BYTES", 1e15)
     with pytest.raises(ValueError, match="expected trials that fit in memory as columns: "
-                                         "90 trials x 26 columns x 1e"):
+                                         "90 trials x 30 columns x 1e"):
         beamsim.sweep(h1, trials=3, out=tmp_path / "never")
     assert not os.path.exists(tmp_path / "never")
 
