@@ -115,6 +115,61 @@ static void test_drag_free_decay(void **state)
 }
 
 /* No drag block: no drag effect in the pipeline, nothing booked. */
+/* The trace's last body speed along y. */
+static void last_vy(void *user, long step, const bsim_state *st)
+{
+	(void)step;
+	*(double *)user = st->v[1];
+}
+
+/* Drag with a constant force, on every backend: the terminal speed. The
+ * exact motion of m dv/dt = F - c v reaches F/c; a step of the runner's
+ * drag (the force m v (exp(-a) - 1) / h read at the step's start, a =
+ * c h / m) with F added takes v to v exp(-a) + h F / m, whose fixed point
+ * is
+ *   v* = (F/c) a / (1 - exp(-a)) = (F/c) (1 + a/2 + a^2/12 + ...),
+ * and a backend that simulates the drag itself as damping after the force
+ * (bsim_backend.takes BSIM_TAKES_DRAG: Box2D's factor 1 / (1 + h d) =
+ * exp(-a)) takes v to (v + h F / m) exp(-a), whose fixed point is
+ *   v* = (F/c) a / (exp(a) - 1) = (F/c) (1 - a/2 + a^2/12 - ...):
+ * a bias of +-c h / (2 m), first order in h. F = 2 N, c = 0.5 N s/m, m = 2
+ * kg at h = 4 ms (a = 1e-3): F/c = 4 m/s, the bias 2.0e-3 m/s; after 15
+ * time constants m/c the speed is the fixed point within the backend's
+ * bound (effects.drag.terminal: exp(-15) in double; Box2D's float32 damping
+ * factor), and F/c is farther than a/5. */
+static void test_drag_terminal_speed(void **state)
+{
+	const bsim_backend *be = *state;
+	const double bound = bsim_test_bound(be, "effects.drag.terminal");
+	bsim_scene s;
+	bsim_scene_init_gate(&s, 2.0, 0.0);
+	s.body.mass = 2.0;
+	s.body.start[0] = 500.0; /* far from the beams */
+	s.side_x = 1e4;
+	s.success_y = s.classify_y = 1e6;
+	s.effects.has_drag = 1;
+	s.effects.drag_linear = 0.5;
+	s.max_steps = 15000; /* 60 s, 15 m/c */
+	bsim_error err;
+	assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
+	double vy = NAN;
+	bsim_recorder rec = {.trace = last_vy, .trace_user = &vy};
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
+	bsim_trial_result out;
+	assert_int_equal(bsim_trial_run(r, &s, be, NULL, 1, &rec, &out, &err), BSIM_OK);
+	bsim_trial_runner_free(r);
+	assert_int_equal(out.steps_run, 15000);
+	const double a = 0.5 * s.dt / 2.0, terminal = 2.0 / 0.5;
+	const double fixed =
+	        be->takes & BSIM_TAKES_DRAG ? terminal * a / expm1(a) : terminal * a / -expm1(-a);
+	print_message("%s: terminal speed %.9f m/s, the fixed point %.9f (F/c %.1f, bias %+.3g "
+	              "relative)\n",
+	              be->name, vy, fixed, terminal, fixed / terminal - 1.0);
+	assert_true(fabs(vy - fixed) < bound * terminal);
+	assert_true(fabs(vy - terminal) > 0.2 * a * terminal); /* the bias is there */
+	bsim_scene_free(&s);
+}
+
 static void test_drag_absent(void **state)
 {
 	(void)state;
@@ -688,6 +743,7 @@ int main(void)
 	/* what every backend does */
 	const struct CMUnitTest every[] = {
 	        cmocka_unit_test(test_drag_free_decay),
+	        cmocka_unit_test(test_drag_terminal_speed),
 	        cmocka_unit_test(test_oscillation_free_body),
 	        cmocka_unit_test(test_ground_friction_stopping_distance),
 	        cmocka_unit_test(test_ground_friction_stick),

@@ -1625,6 +1625,9 @@ static const bsim_backend_bound box2d_bounds[] = {
         {"hard.conservative.drift", 0.9,
          "the weld damps and the body leaves the cage, drifting off the midline in float32"},
         {"hard.conservative.tunnels", 0, "it leaves the cage below, through no beam"},
+        {"effects.drag.terminal", 1e-4,
+         "5.3e-5 of F/c: float32's damping factor exp(-c h / m), within 6e-8, moves the fixed "
+         "point by that over c h / m (1e-3)"},
         {"effects.drag.velocity", 2.7e-4,
          "its damping's factor rounds by 1.5 x 2^-23 a step: 1500 steps"},
         {"effects.drag.step", 1.8e-7, "its damping's factor, 1.5 x 2^-23"},

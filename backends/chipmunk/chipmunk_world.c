@@ -753,6 +753,8 @@ static const bsim_backend_bound chipmunk_bounds[] = {
         /* No "hard.conservative.*": the explicit spring's energy oscillates
          * about its value and ends +0.54% after 400 s, where the check
          * allows only a loss. */
+        {"effects.drag.terminal", 1e-6,
+         "3.1e-7 of F/c after 15 time constants: the approach's own exp(-15)"},
         {"effects.drag.velocity", 1e-12, "the runner's exact decay, in double"},
         {"effects.drag.step", 1e-12, "the runner's exact decay, in double"},
         {"effects.drag.energy", 1e-9, "in double"},

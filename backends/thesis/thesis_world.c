@@ -118,6 +118,8 @@ static const bsim_backend_bound thesis_bounds[] = {
          "within a step, which the impact stage does not predict from the step's start, is "
          "stopped plastically by the smooth solve"},
         {"hard.conservative.tunnels", 0, "speculative contacts: no step passes a beam"},
+        {"effects.drag.terminal", 1e-6,
+         "3.1e-7 of F/c after 15 time constants: the approach's own exp(-15)"},
         {"effects.drag.velocity", 1e-12, "the runner's exact decay, in double"},
         {"effects.drag.step", 1e-12, "the runner's exact decay, in double"},
         {"effects.drag.energy", 1e-9, "in double"},
