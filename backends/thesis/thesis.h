@@ -188,7 +188,7 @@ struct bsim_world {
 	int any_held;
 	/* The beams pushed in the last step (a nonzero impact or
 	 * persistent-contact impulse: the state's touched), which decide with
-	 * the gap the beams listed (contact_report.c). */
+	 * the gap the beams listed (contact_list.c). */
 	unsigned char *pushed; /* per beam */
 	int *pushed_list;      /* beams whose pushed is set */
 	int n_pushed;
@@ -280,12 +280,10 @@ int thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, do
 int thesis_contact_near(const struct bsim_world *w, int i, double margin);
 int thesis_contact_near_disk(const struct bsim_world *w, int i, double margin);
 
-/* contact_report.c: the beams listed for the contact flag after a step (or
+/* contact_list.c: the beams listed for the contact flag after a step (or
  * at creation). */
-void thesis_contact_report(struct bsim_world *w);
-void thesis_contact_report_disk(struct bsim_world *w);
-
-void thesis_contact_clear(struct bsim_world *w);
+void thesis_contact_list(struct bsim_world *w);
+void thesis_contact_list_disk(struct bsim_world *w);
 
 /* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
  * counts it in w->solver), else 0. inv_mass is the body's 1/M, 1/kg (for
@@ -373,7 +371,7 @@ static inline double thesis_step_margin(const struct bsim_world *w, const thesis
  * rounding, so a beam out of reach of the bound is out of reach of the
  * margin, and the test changes no result. The contact flag's tolerance is
  * added, so that a clear step also ends more than BSIM_CONTACT_TOL from
- * every beam (contact_report.c). m. */
+ * every beam (contact_list.c). m. */
 static inline double thesis_clear_margin(const struct bsim_world *w, const double force[2],
                                          double h)
 {
@@ -395,7 +393,7 @@ static inline int thesis_flight_clear(struct bsim_world *w, const double force[2
 }
 
 /* Beam i exchanged a nonzero impulse with the body in this step (the
- * contact flag counts it, contact_report.c). */
+ * state reports it as touched; contact_list.c lists the beam). */
 static inline void thesis_beam_pushed(struct bsim_world *w, int i)
 {
 	if (w->pushed[i])

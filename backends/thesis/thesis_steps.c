@@ -19,7 +19,7 @@
  * beam's step margin), impacts (impact_resolve.c), the smooth solve
  * (persistent_contact.c), projection with re-detection
  * (position_project.c), the typed beams, pruning (beam_sleep.c) and the
- * beams listed for the contact flag (contact_report.c). What differs is only what the general
+ * beams listed for the contact flag (contact_list.c). What differs is only what the general
  * path spends on its generality:
  *   - no free-flight test: a step thesis_step would take as free flight
  *     (no beam awake, every beam out of reach) is the general path's step
@@ -189,7 +189,7 @@ static inline int gate_project(struct bsim_world *w, const double force[2], int 
 	return n;
 }
 
-/* contact_report.c's contact_list for the disk: every beam pushed or not
+/* contact_list.c's contact_list_beams for the disk: every beam pushed or not
  * certainly farther than R + BSIM_CONTACT_TOL woken (the candidates of a
  * world this small are all its beams, in order). d2: each beam's
  * beam_pivot_distance2 at the step's end, which the next step's detection

@@ -8,8 +8,8 @@
  *   4. projection of any penetration left by the contacts' curvature;
  *   5. sleeping: beams the body has left and whose energy has decayed are
  *      put exactly to rest (beam_sleep.c);
- *   6. the contact flag the state reports (contact_report.c), which moves
- *      nothing.
+ *   6. the beams listed for the contact flag the runner computes from the
+ *      state (contact_list.c), which moves nothing.
  * Only the beams near the body (broad_phase.c) and the awake ones are
  * touched, so a step costs the same in a field of one gate or a thousand.
  *
@@ -314,7 +314,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
-	thesis_contact_report(w); /* a body that starts touching a beam */
+	thesis_contact_list(w); /* a body that starts touching a beam */
 	*out = w;
 	return BSIM_OK;
 }
@@ -370,7 +370,7 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	thesis_near_forget(w);
 	for (int k = 0; k < w->n_start_awake; k++)
 		thesis_beam_wake(w, w->start_awake[k]);
-	thesis_contact_report(w); /* a body that starts touching a beam */
+	thesis_contact_list(w); /* a body that starts touching a beam */
 	return BSIM_OK;
 }
 
@@ -491,9 +491,9 @@ THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double tor
 	}
 	/* in flight nothing is in reach: nothing to list */
 	if (!in_flight && extended)
-		thesis_contact_report(w);
+		thesis_contact_list(w);
 	else if (!in_flight)
-		thesis_contact_report_disk(w);
+		thesis_contact_list_disk(w);
 	return BSIM_OK;
 }
 

@@ -19,7 +19,7 @@
 
 /* extended: constant (contact_geometry.h's contact_detect): 0 compiles the
  * essay's disk's copy without the shape's test. */
-THESIS_SPECIALISED void contact_list(struct bsim_world *w, const int extended)
+THESIS_SPECIALISED void contact_list_beams(struct bsim_world *w, const int extended)
 {
 	int n = thesis_broad_phase_near(w, BSIM_CONTACT_TOL);
 	for (int k = 0; k < n; k++) {
@@ -33,12 +33,12 @@ THESIS_SPECIALISED void contact_list(struct bsim_world *w, const int extended)
 		thesis_beam_wake(w, w->pushed_list[k]);
 }
 
-void thesis_contact_report(struct bsim_world *w)
+void thesis_contact_list(struct bsim_world *w)
 {
-	contact_list(w, 1);
+	contact_list_beams(w, 1);
 }
 
-void thesis_contact_report_disk(struct bsim_world *w)
+void thesis_contact_list_disk(struct bsim_world *w)
 {
-	contact_list(w, 0);
+	contact_list_beams(w, 0);
 }
