@@ -70,7 +70,7 @@ typedef struct bsim_effect {
 	long held[2];
 	double held_h;
 	/* Ground friction on a body that turns, the coupled model: the
-	 * footprint it sums over (model/footprint_friction.h), else NULL. */
+	 * footprint and its limits (model/footprint_friction.h), else NULL. */
 	struct bsim_footprint_friction *footprint;
 	/* 1: the backend simulates this effect itself (bsim_effects_init_taking):
 	 * apply adds nothing, and the ledger books the loss the backend reports

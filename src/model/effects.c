@@ -296,15 +296,15 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	return bsim_effects_init_taking(fx, scene, seed, 0u);
 }
 
-/* A schedule of magnitude and frequency for seed: *spare's, restarted, if
+/* A schedule of magnitude and frequency for seed: spare's, restarted, if
  * it holds one (spare NULL: none), else a new one. */
 static bsim_schedule *schedule_for(double magnitude, double frequency, uint64_t seed,
-                                   bsim_schedule **spare)
+                                   bsim_effects_spare *spare)
 {
-	if (!spare || !*spare)
+	if (!spare || !spare->schedule)
 		return bsim_schedule_alloc(magnitude, frequency, seed);
-	bsim_schedule *s = *spare;
-	*spare = NULL;
+	bsim_schedule *s = spare->schedule;
+	spare->schedule = NULL;
 	bsim_schedule_restart(s, magnitude, frequency, seed);
 	return s;
 }
@@ -316,7 +316,7 @@ int bsim_effects_init_taking(bsim_effects *fx, const bsim_scene *scene, uint64_t
 }
 
 int bsim_effects_init_spare(bsim_effects *fx, const bsim_scene *scene, uint64_t seed,
-                            unsigned taken, bsim_schedule **spare)
+                            unsigned taken, bsim_effects_spare *spare)
 {
 	memset(fx, 0, sizeof *fx);
 	const bsim_effects_def *d = &scene->effects;
@@ -392,8 +392,11 @@ int bsim_effects_init_spare(bsim_effects *fx, const bsim_scene *scene, uint64_t 
 			e->param_turn = e->coef[0] * bsim_effects_spin_arm(&scene->body);
 		}
 		if (coupled) {
+			bsim_footprint_friction *kept = spare ? spare->footprint : NULL;
+			if (spare)
+				spare->footprint = NULL;
 			e->footprint = bsim_footprint_friction_alloc(&scene->body, d->ground_mu,
-			                                             d->ground_g);
+			                                             d->ground_g, kept);
 			if (!e->footprint) {
 				bsim_effects_free_spare(fx, spare);
 				return BSIM_EFAIL;
@@ -418,17 +421,30 @@ void bsim_effects_free(bsim_effects *fx)
 	bsim_effects_free_spare(fx, NULL);
 }
 
-void bsim_effects_free_spare(bsim_effects *fx, bsim_schedule **spare)
+void bsim_effects_free_spare(bsim_effects *fx, bsim_effects_spare *spare)
 {
 	for (int i = 0; i < fx->n; i++) {
-		bsim_footprint_friction_free(fx->e[i].footprint);
+		if (spare && fx->e[i].footprint) {
+			bsim_footprint_friction_free(spare->footprint);
+			spare->footprint = fx->e[i].footprint;
+		} else {
+			bsim_footprint_friction_free(fx->e[i].footprint);
+		}
 		if (spare && fx->e[i].schedule) {
-			bsim_schedule_free(*spare);
-			*spare = fx->e[i].schedule;
-			bsim_schedule_keep(*spare);
+			bsim_schedule_free(spare->schedule);
+			spare->schedule = fx->e[i].schedule;
+			bsim_schedule_keep(spare->schedule);
 		} else {
 			bsim_schedule_free(fx->e[i].schedule);
 		}
 	}
 	memset(fx, 0, sizeof *fx);
+}
+
+void bsim_effects_spare_free(bsim_effects_spare *spare)
+{
+	bsim_schedule_free(spare->schedule);
+	bsim_footprint_friction_free(spare->footprint);
+	spare->schedule = NULL;
+	spare->footprint = NULL;
 }
