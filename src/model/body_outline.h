@@ -1,6 +1,6 @@
 /* The outline's distance from a body's centre along a direction of its
  * frame (the heading along +x), for the sums over its footprint in polar
- * coordinates (effects.c, footprint_friction.c). Internal to the library. */
+ * coordinates (effects.c). Internal to the library. */
 #ifndef BSIM_MODEL_BODY_OUTLINE_H
 #define BSIM_MODEL_BODY_OUTLINE_H
 
