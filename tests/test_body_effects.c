@@ -194,7 +194,8 @@ static void test_drag_absent(void **state)
  * Box2D does) gets them in the pipeline marked taken, with no force or
  * torque: the pipeline's sum is the propulsion alone, where without taking
  * it has the drag's -c v and the friction's stop. Every registered
- * backend's pipeline marks taken exactly what it takes. */
+ * backend's pipeline marks taken exactly what it takes; a body that turns
+ * has its ground friction taken only under the decoupled model. */
 static void test_taken_effects(void **state)
 {
 	(void)state;
@@ -238,6 +239,21 @@ static void test_taken_effects(void **state)
 			 * friction mu m g = 9.81 N against m v / h + f = (748.8, 3) N */
 			assert_true(f[0] < -9.8 && f[1] < 3.0);
 		}
+		bsim_effects_free(&fx);
+	}
+	/* A body that turns: its ground friction is taken only under the
+	 * decoupled model, which is what a taking backend simulates; the
+	 * coupled one is the pipeline's on every backend. */
+	s.body.rotates = 1;
+	for (int model = 0; model < 2; model++) {
+		s.effects.ground_model = model ? BSIM_FRICTION_DECOUPLED : BSIM_FRICTION_COUPLED;
+		assert_int_equal(bsim_effects_friction_takeable(&s), model);
+		bsim_effects fx;
+		assert_int_equal(bsim_effects_init_taking(&fx, &s, 1, both), BSIM_OK);
+		assert_int_equal(fx.drag->taken, 1);
+		assert_int_equal(fx.friction->taken, model);
+		assert_true(model ? fx.friction->footprint == NULL
+		                  : fx.friction->footprint != NULL);
 		bsim_effects_free(&fx);
 	}
 	bsim_state_free(&at);
@@ -622,11 +638,14 @@ static void track_both(void *user, long step, const bsim_state *s)
 }
 
 /* A capsule (R = 4 m, L = 12 m, 2 kg) sliding at 5 m/s and spinning at
- * 3 rad/s at once, mu = 0.4. Box2D's friction joint clamps its linear
- * impulse to h mu M g and its angular one to h mu M g r_s apart, and the
- * thesis backend's pipeline does the same ("sliding and spinning taken
- * apart"): each motion stops at its own closed-form time, v0 / (mu g) and
- * omega0 J / (mu M g r_s), within two steps, on every backend. */
+ * 3 rad/s at once, mu = 0.4, under the decoupled model
+ * (effects.ground_friction.model: decoupled). Box2D's friction joint
+ * clamps its linear impulse to h mu M g and its angular one to
+ * h mu M g r_s apart, and the pipeline does the same on the other backends
+ * ("sliding and spinning taken apart"): each motion stops at its own
+ * closed-form time, v0 / (mu g) and omega0 J / (mu M g r_s), within two
+ * steps, on every backend. (The coupled model, the default, is
+ * test_footprint_friction's.) */
 static void test_slide_and_spin(void **state)
 {
 	const bsim_backend *be = *state;
@@ -642,6 +661,7 @@ static void test_slide_and_spin(void **state)
 		s.body.angular_velocity = 3.0;
 		s.effects.has_ground_friction = 1;
 		s.effects.ground_mu = 0.4;
+		s.effects.ground_model = BSIM_FRICTION_DECOUPLED;
 		s.max_steps = 2000;
 		s.side_x = 1000.0;
 		bsim_error err;

@@ -74,16 +74,18 @@
  *
  * Ground friction and drag (effects.ground_friction, effects.drag) are
  * Box2D's own, not the runner's forces (bsim_backend.takes):
- *   ground friction: a b2FrictionJoint from the ground to the body, anchored
- *     at the body's centre, maxForce mu M g and, on a body that turns,
- *     maxTorque mu M g r_s (r_s = bsim_effects_spin_arm: the pipeline's
- *     spinning limit). Each velocity iteration it takes the angular impulse
- *     -J w and clamps its total to h maxTorque, then the linear impulse
- *     -M v, its total clamped in length to h maxForce: stick or slide, each
- *     with its own full limit. Its lever r_B is 0 (the anchor is the centre),
- *     so the two rows do not couple: the pipeline's model ("sliding and
- *     spinning taken apart"). Unlike the pipeline it is solved with the
- *     contacts, so a contact's push is in what it holds back.
+ *   ground friction, where bsim_effects_friction_takeable (a body that does
+ *     not turn, or model: decoupled; the coupled friction of a body that
+ *     turns is the pipeline's): a b2FrictionJoint from the ground to the
+ *     body, anchored at the body's centre, maxForce mu M g and, on a body
+ *     that turns, maxTorque mu M g r_s (r_s = bsim_effects_spin_arm: the
+ *     decoupled model's spinning limit). Each velocity iteration it takes
+ *     the angular impulse -J w and clamps its total to h maxTorque, then the
+ *     linear impulse -M v, its total clamped in length to h maxForce: stick
+ *     or slide, each with its own full limit. Its lever r_B is 0 (the anchor
+ *     is the centre), so the two rows do not couple: the decoupled model.
+ *     Unlike the pipeline it is solved with the contacts, so a contact's
+ *     push is in what it holds back.
  *   drag: the body's linear damping d = (exp(c h / M) - 1) / h (angular:
  *     c_w and J), set for the (sub)step h: Box2D multiplies the velocity,
  *     after the force and before the constraints, by 1 / (1 + h d) =
@@ -729,7 +731,7 @@ void world_build(bsim_world *w, const double x[2], const double v[2], double psi
 	/* Ground friction: a friction joint from the ground to the body's
 	 * centre (its anchor, so the joint's lever r_B is 0). */
 	w->ground_friction = nullptr;
-	if (sc.effects.has_ground_friction) {
+	if (sc.effects.has_ground_friction && bsim_effects_friction_takeable(&sc)) {
 		const double limit = sc.effects.ground_mu * sc.body.mass * sc.effects.ground_g;
 		b2FrictionJointDef jd;
 		jd.Initialize(ground, w->body, w->body->GetPosition());
@@ -1220,7 +1222,8 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	w->drag = scene->effects.has_drag != 0;
 	w->drag_linear = scene->effects.drag_linear;
 	w->drag_angular = scene->effects.drag_angular;
-	w->taken = w->drag || scene->effects.has_ground_friction;
+	w->taken = w->drag ||
+	           (scene->effects.has_ground_friction && bsim_effects_friction_takeable(scene));
 	w->rotates = scene->body.rotates != 0;
 	w->rich =
 	        w->rotates || scene->body.shape != BSIM_SHAPE_DISK || scene->contact.friction != 0;

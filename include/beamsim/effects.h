@@ -69,6 +69,9 @@ typedef struct bsim_effect {
 	 * held_h (s), as the schedule's bsim_schedule_at_step_held gives them. */
 	long held[2];
 	double held_h;
+	/* Ground friction on a body that turns, the coupled model: the
+	 * footprint and its limits (model/footprint_friction.h), else NULL. */
+	struct bsim_footprint_friction *footprint;
 	/* 1: the backend simulates this effect itself (bsim_effects_init_taking):
 	 * apply adds nothing, and the ledger books the loss the backend reports
 	 * in the step's state (bsim_state drag_loss, friction_loss). */
@@ -96,8 +99,17 @@ typedef struct bsim_effects {
 BSIM_API int bsim_effects_random(const bsim_scene *scene);
 
 /* The effects a backend may simulate itself instead of taking their force
- * from the pipeline (bsim_backend.takes): viscous drag, ground friction. */
+ * from the pipeline (bsim_backend.takes): viscous drag, ground friction
+ * (where bsim_effects_friction_takeable). */
 enum { BSIM_TAKES_DRAG = 1u, BSIM_TAKES_GROUND_FRICTION = 2u };
+
+/* 1 if a backend that takes ground friction (BSIM_TAKES_GROUND_FRICTION)
+ * takes this scene's: such a backend's friction is the decoupled model,
+ * the sliding and the spinning each within its own limit, which is
+ * Coulomb's for a body that does not turn; a body that turns gets it
+ * only if the scene asks for it (effects.ground_friction.model:
+ * decoupled). Else the pipeline gives ground friction on every backend. */
+BSIM_API int bsim_effects_friction_takeable(const bsim_scene *scene);
 
 /* Builds the pipeline from scene->effects; seed is the trial's mixed seed. */
 BSIM_API int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed);

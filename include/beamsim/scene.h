@@ -75,6 +75,15 @@ typedef enum bsim_random_model {
 	BSIM_RANDOM_WHITE = 2, /* a new value each step, std Rm / sqrt(frequency dt) */
 } bsim_random_model;
 
+/* How ground friction acts on a body that turns (docs/files.md "A body
+ * that turns"); a body that does not turn only slides, where both agree. */
+typedef enum bsim_friction_model {
+	BSIM_FRICTION_COUPLED = 0,   /* Coulomb over the footprint: each patch against its own
+	                              * velocity v + omega x r */
+	BSIM_FRICTION_DECOUPLED = 1, /* the sliding and the spinning each within its own limit
+	                              * (the earlier model; Box2D's friction joint's) */
+} bsim_friction_model;
+
 /* Effects: only those present are simulated (has_* = 1). */
 typedef struct bsim_effects_def {
 	int has_propulsion;
@@ -93,8 +102,9 @@ typedef struct bsim_effects_def {
 	double osc_frequency; /* Hz, f, > 0 */
 	double osc_phase;     /* rad; default 0 */
 	int has_ground_friction;
-	double ground_mu; /* Coulomb friction coefficient with the plane, >= 0 */
-	double ground_g;  /* m/s^2, > 0; default 9.81 */
+	double ground_mu;                 /* Coulomb friction coefficient with the plane, >= 0 */
+	double ground_g;                  /* m/s^2, > 0; default 9.81 */
+	bsim_friction_model ground_model; /* default BSIM_FRICTION_COUPLED */
 } bsim_effects_def;
 
 /* A gate lattice (docs/model.md section 8, docs/lattice.md "Scenes"): gates

@@ -105,8 +105,11 @@ static void markov_key_extra(FILE *f, const bsim_scene *s)
 	if (e->has_oscillation)
 		fprintf(f, "oscillation %.17g %.17g %.17g\n", e->osc_amplitude, e->osc_frequency,
 		        e->osc_phase);
-	if (e->has_ground_friction)
-		fprintf(f, "ground_friction %.17g %.17g\n", e->ground_mu, e->ground_g);
+	if (e->has_ground_friction) /* the model tells a body that turns apart */
+		fprintf(f, "ground_friction %.17g %.17g%s\n", e->ground_mu, e->ground_g,
+		        !b->rotates                                ? ""
+		        : e->ground_model == BSIM_FRICTION_COUPLED ? " coupled"
+		                                                   : " decoupled");
 }
 
 /* Every input of a map, a line each, numbers to the last bit (%.17g). */

@@ -5,6 +5,8 @@
  * body that turns, a torque. Each is a pipeline entry only if the scene
  * lists it (beam spring, damping and restitution are the backend's). */
 #include "beamsim/effects.h"
+#include "model/body_outline.h"
+#include "model/footprint_friction.h"
 #include "model/schedule_spare.h"
 
 #include <math.h>
@@ -152,10 +154,11 @@ static void ground_friction_apply(bsim_effect *e, long n, double h, const bsim_s
 	f[1] += e->applied[1];
 }
 
-/* Ground friction on a body that turns: the sliding friction as
- * ground_friction_apply, and spinning friction with the same exact
- * stick/slip. Under uniform pressure M g / A over the footprint, a body
- * spinning in place meets the friction torque
+/* Ground friction on a body that turns, the decoupled model
+ * (effects.ground_friction.model: decoupled; Box2D's friction joint's):
+ * the sliding friction as ground_friction_apply, and spinning friction
+ * with the same exact stick/slip. Under uniform pressure M g / A over the
+ * footprint, a body spinning in place meets the friction torque
  *   T = mu (M g / A) integral |r| dA = mu M g r_s
  * (r_s = bsim_effects_spin_arm: 2R/3 for a disk). Over a step the torque
  * that stops the spin is J omega / h + tau (tau: the other effects'); if
@@ -165,7 +168,8 @@ static void ground_friction_apply(bsim_effect *e, long n, double h, const bsim_s
  * are centrally symmetric: no torque) or only spins (no net force); when
  * it does both, the true friction of each point opposes that point's
  * velocity v + omega x r and both the force and the torque are smaller
- * than their limits, so here both motions stop sooner than they would. */
+ * than their limits, so here both motions stop sooner than they would
+ * (ground_friction_coupled_apply is that friction). */
 static void ground_friction_turn_apply(bsim_effect *e, long n, double h, const bsim_state *s,
                                        double f[3])
 {
@@ -174,6 +178,28 @@ static void ground_friction_turn_apply(bsim_effect *e, long n, double h, const b
 	double p = e->inertia * s->angular_velocity / h + f[2];
 	e->applied_torque = fabs(p) <= limit ? -p : (p > 0 ? -limit : limit);
 	f[2] += e->applied_torque;
+}
+
+/* Ground friction on a body that turns, the sliding and the spinning
+ * coupled (footprint_friction.c): each patch of the footprint rubs against
+ * its own velocity v + omega x r. The same exact stick/slip: the body ends
+ * the step at rest when friction can hold the wrench that stops it,
+ * (m v / h + f, J omega / h + tau), else it gets the friction of the twist
+ * it ends the step with. */
+static void ground_friction_coupled_apply(bsim_effect *e, long n, double h, const bsim_state *s,
+                                          double f[3])
+{
+	(void)n;
+	const double p[2] = {e->mass * s->v[0] / h + f[0], e->mass * s->v[1] / h + f[1]};
+	const double q = e->inertia * s->angular_velocity / h + f[2];
+	double w[3];
+	bsim_footprint_friction_wrench(e->footprint, s->heading, p, q, w);
+	e->applied[0] = w[0];
+	e->applied[1] = w[1];
+	e->applied_torque = w[2];
+	f[0] += w[0];
+	f[1] += w[1];
+	f[2] += w[2];
 }
 
 /* An effect the backend simulates itself (bsim_effects_init_taking): no
@@ -202,23 +228,6 @@ static void propulsion_heading_apply(bsim_effect *e, long n, double h, const bsi
 	f[1] += e->applied[1];
 }
 
-/* The outline's distance from the centre along the direction phi of the
- * body's frame (the heading along +x): a capsule of half-segment l and
- * radius r meets the ray on its side y = r (at r / sin phi) if that point
- * lies within the segment's span, else on its end cap. */
-static double capsule_rho(double l, double r, double phi)
-{
-	double c = fabs(cos(phi)), sn = fabs(sin(phi));
-	if (r * c <= l * sn)
-		return r / sn;
-	return l * c + sqrt(r * r - l * l * sn * sn);
-}
-
-static double ellipse_rho(double a, double b, double phi)
-{
-	return a * b / hypot(b * cos(phi), a * sin(phi));
-}
-
 /* integral over [p0, p1] of rho(phi)^3 / 3 dphi by Simpson's rule on n
  * (even) intervals: rho is smooth on each piece it is asked for. */
 static double rho3_integral(const bsim_body_def *b, double p0, double p1, int n)
@@ -227,9 +236,7 @@ static double rho3_integral(const bsim_body_def *b, double p0, double p1, int n)
 	double sum = 0.0;
 	for (int i = 0; i <= n; i++) {
 		double phi = p0 + i * step;
-		double rho = b->shape == BSIM_SHAPE_CAPSULE
-		                     ? capsule_rho(b->length / 2, b->radius, phi)
-		                     : ellipse_rho(b->semi_axes[0], b->semi_axes[1], phi);
+		double rho = bsim_body_rho(b, phi);
 		double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
 		sum += w * rho * rho * rho / 3.0;
 	}
@@ -274,6 +281,11 @@ static bsim_effect *effects_add(bsim_effects *fx, const char *name,
 	return e;
 }
 
+int bsim_effects_friction_takeable(const bsim_scene *scene)
+{
+	return !scene->body.rotates || scene->effects.ground_model == BSIM_FRICTION_DECOUPLED;
+}
+
 int bsim_effects_random(const bsim_scene *scene)
 {
 	return scene->effects.has_random_force;
@@ -284,15 +296,15 @@ int bsim_effects_init(bsim_effects *fx, const bsim_scene *scene, uint64_t seed)
 	return bsim_effects_init_taking(fx, scene, seed, 0u);
 }
 
-/* A schedule of magnitude and frequency for seed: *spare's, restarted, if
+/* A schedule of magnitude and frequency for seed: spare's, restarted, if
  * it holds one (spare NULL: none), else a new one. */
 static bsim_schedule *schedule_for(double magnitude, double frequency, uint64_t seed,
-                                   bsim_schedule **spare)
+                                   bsim_effects_spare *spare)
 {
-	if (!spare || !*spare)
+	if (!spare || !spare->schedule)
 		return bsim_schedule_alloc(magnitude, frequency, seed);
-	bsim_schedule *s = *spare;
-	*spare = NULL;
+	bsim_schedule *s = spare->schedule;
+	spare->schedule = NULL;
 	bsim_schedule_restart(s, magnitude, frequency, seed);
 	return s;
 }
@@ -304,7 +316,7 @@ int bsim_effects_init_taking(bsim_effects *fx, const bsim_scene *scene, uint64_t
 }
 
 int bsim_effects_init_spare(bsim_effects *fx, const bsim_scene *scene, uint64_t seed,
-                            unsigned taken, bsim_schedule **spare)
+                            unsigned taken, bsim_effects_spare *spare)
 {
 	memset(fx, 0, sizeof *fx);
 	const bsim_effects_def *d = &scene->effects;
@@ -367,17 +379,30 @@ int bsim_effects_init_spare(bsim_effects *fx, const bsim_scene *scene, uint64_t 
 		fx->drag = e;
 	}
 	if (d->has_ground_friction) { /* the last: it reads the others' forces */
-		bsim_effect *e =
-		        effects_add(fx, "ground_friction",
-		                    turns ? ground_friction_turn_apply : ground_friction_apply, 0,
-		                    d->ground_mu);
+		const int coupled = turns && d->ground_model == BSIM_FRICTION_COUPLED;
+		bsim_effect *e = effects_add(fx, "ground_friction",
+		                             coupled ? ground_friction_coupled_apply
+		                             : turns ? ground_friction_turn_apply
+		                                     : ground_friction_apply,
+		                             0, d->ground_mu);
 		e->mass = scene->body.mass;
 		e->coef[0] = d->ground_mu * scene->body.mass * d->ground_g;
 		if (turns) {
 			e->inertia = bsim_body_inertia(&scene->body);
 			e->param_turn = e->coef[0] * bsim_effects_spin_arm(&scene->body);
 		}
-		if (taken & BSIM_TAKES_GROUND_FRICTION) {
+		if (coupled) {
+			bsim_footprint_friction *kept = spare ? spare->footprint : NULL;
+			if (spare)
+				spare->footprint = NULL;
+			e->footprint = bsim_footprint_friction_alloc(&scene->body, d->ground_mu,
+			                                             d->ground_g, kept);
+			if (!e->footprint) {
+				bsim_effects_free_spare(fx, spare);
+				return BSIM_EFAIL;
+			}
+		}
+		if ((taken & BSIM_TAKES_GROUND_FRICTION) && bsim_effects_friction_takeable(scene)) {
 			e->apply = taken_apply;
 			e->taken = 1;
 		}
@@ -396,16 +421,30 @@ void bsim_effects_free(bsim_effects *fx)
 	bsim_effects_free_spare(fx, NULL);
 }
 
-void bsim_effects_free_spare(bsim_effects *fx, bsim_schedule **spare)
+void bsim_effects_free_spare(bsim_effects *fx, bsim_effects_spare *spare)
 {
 	for (int i = 0; i < fx->n; i++) {
+		if (spare && fx->e[i].footprint) {
+			bsim_footprint_friction_free(spare->footprint);
+			spare->footprint = fx->e[i].footprint;
+		} else {
+			bsim_footprint_friction_free(fx->e[i].footprint);
+		}
 		if (spare && fx->e[i].schedule) {
-			bsim_schedule_free(*spare);
-			*spare = fx->e[i].schedule;
-			bsim_schedule_keep(*spare);
+			bsim_schedule_free(spare->schedule);
+			spare->schedule = fx->e[i].schedule;
+			bsim_schedule_keep(spare->schedule);
 		} else {
 			bsim_schedule_free(fx->e[i].schedule);
 		}
 	}
 	memset(fx, 0, sizeof *fx);
+}
+
+void bsim_effects_spare_free(bsim_effects_spare *spare)
+{
+	bsim_schedule_free(spare->schedule);
+	bsim_footprint_friction_free(spare->footprint);
+	spare->schedule = NULL;
+	spare->footprint = NULL;
 }

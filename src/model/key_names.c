@@ -44,6 +44,7 @@ static const key_row scene_rows[] = {
         {"effects.oscillation.phase", "oscillation phase", "phi", "{/Symbol f}", "rad"},
         {"effects.ground_friction.mu", "ground friction coefficient", "mu", "{/Symbol m}", ""},
         {"effects.ground_friction.g", "gravity", "g", "g", "m/s^2"},
+        {"effects.ground_friction.model", "ground friction model", "model", "model", ""},
         {"integration.dt", "time step", "dt", "{/Symbol D}t", "s"},
         {"integration.max_steps", "step limit", "N_steps", "N_{steps}", ""},
         {"integration.duration", "trial duration", "T", "T", "s"},

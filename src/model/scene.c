@@ -453,6 +453,12 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		                      "%s: effects.random_force.model: expected held, ou or white, "
 		                      "got %d",
 		                      who, (int)s->effects.random_model);
+	if (s->effects.has_ground_friction && s->effects.ground_model != BSIM_FRICTION_COUPLED &&
+	    s->effects.ground_model != BSIM_FRICTION_DECOUPLED)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: effects.ground_friction.model: expected coupled or "
+		                      "decoupled, got %d",
+		                      who, (int)s->effects.ground_model);
 	rc = body_validate(s, who, err);
 	if (rc)
 		return rc;

@@ -427,6 +427,19 @@ static int scene_word(walk *w, struct fy_node *root, const char *path, const cha
 	return ydoc_expected(w->d, node, NULL, path, what, w->err);
 }
 
+/* effects.ground_friction.model: coupled (the default) or decoupled. */
+static int ground_model(walk *w, struct fy_node *root)
+{
+	static const char *const names[] = {"coupled", "decoupled"};
+	int model = BSIM_FRICTION_COUPLED, given = 0;
+	int rc = scene_word(w, root, "effects.ground_friction.model", names, 2,
+	                    "coupled (each patch of the footprint against its own velocity) or "
+	                    "decoupled (the sliding and the spinning each within its own limit)",
+	                    &model, &given);
+	w->s->effects.ground_model = (bsim_friction_model)model;
+	return rc;
+}
+
 /* body.shape (disk, the default; capsule; ellipse), the size keys that go
  * with it, body.rotates (default: false for a disk, true otherwise) and
  * effects.propulsion.along (y, the default, or heading). */
@@ -546,6 +559,8 @@ static int walk_scene(walk *w, const ydoc *file)
 		rc = random_model(w, root);
 	if (!rc)
 		rc = body_shape(w, root);
+	if (!rc)
+		rc = ground_model(w, root);
 	if (!rc)
 		rc = check_beams_or_lattice(w, root);
 	if (!rc)

@@ -83,6 +83,7 @@ static const scene_table oscillation_table = TABLE(oscillation_fields);
 static const scene_field ground_fields[] = {
         {"mu", SK_NUMBER, SR_NONNEG, 1, S(effects.ground_mu), NULL}, /* 1 */
         {"g", SK_NUMBER, SR_POSITIVE, 0, S(effects.ground_g), NULL}, /* m/s^2 */
+        {"model", SK_LATER, SR_ANY, 0, 0, NULL}, /* coupled | decoupled (scene_load.c) */
 };
 static const scene_table ground_table = TABLE(ground_fields);
 

@@ -1,7 +1,9 @@
 /* A random force's schedule kept from one trial for the next (internal to
  * the library: the runner's). A runner of many trials then allocates and
  * seeds one generator, not one a trial; the draws are those of a new
- * schedule (test_effects). */
+ * schedule (test_effects). The coupled ground friction's footprint is kept
+ * the same way: its table (model/footprint_table.h) grows over the trials
+ * of the same outline and gives what a new one would. */
 #ifndef BSIM_MODEL_SCHEDULE_SPARE_H
 #define BSIM_MODEL_SCHEDULE_SPARE_H
 
@@ -19,12 +21,20 @@ void bsim_schedule_restart(bsim_schedule *s, double magnitude, double frequency,
  * for a schedule kept for another trial. */
 void bsim_schedule_keep(bsim_schedule *s);
 
-/* bsim_effects_init_taking with the random force's schedule taken from
- * *spare when it holds one (*spare is then NULL), restarted for this trial;
- * and bsim_effects_free leaving the schedule in *spare (one already there
- * is freed). bsim_schedule_free(*spare) at the end. */
+/* What a runner keeps from one trial's effects for the next. */
+typedef struct bsim_effects_spare {
+	bsim_schedule *schedule;
+	struct bsim_footprint_friction *footprint;
+} bsim_effects_spare;
+
+/* bsim_effects_init_taking with the random force's schedule and the
+ * footprint taken from *spare when it holds them (they are then NULL
+ * there), the schedule restarted for this trial; and bsim_effects_free
+ * leaving them in *spare (those already there are freed).
+ * bsim_effects_spare_free(spare) at the end. */
 int bsim_effects_init_spare(bsim_effects *fx, const bsim_scene *scene, uint64_t seed,
-                            unsigned taken, bsim_schedule **spare);
-void bsim_effects_free_spare(bsim_effects *fx, bsim_schedule **spare);
+                            unsigned taken, bsim_effects_spare *spare);
+void bsim_effects_free_spare(bsim_effects *fx, bsim_effects_spare *spare);
+void bsim_effects_spare_free(bsim_effects_spare *spare);
 
 #endif

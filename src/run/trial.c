@@ -44,9 +44,9 @@ struct bsim_trial_runner {
 	bsim_state whole;  /* the whole lattice's state, for recording (essay protocol) */
 	trial_peaks peaks;
 	trial_essay essay;
-	trial_flight flight;  /* free-flight runs */
-	trial_steps steps;    /* runs of steps */
-	bsim_schedule *spare; /* the last trial's random-force schedule, for the next */
+	trial_flight flight;      /* free-flight runs */
+	trial_steps steps;        /* runs of steps */
+	bsim_effects_spare spare; /* the last trial's schedule and footprint, for the next */
 	/* The world of the last trial, kept for the next trial of the same
 	 * scene, backend and options (bsim_trial_runner_keep_worlds). */
 	int keep;
@@ -88,7 +88,7 @@ void bsim_trial_runner_free(bsim_trial_runner *r)
 	bsim_state_free(&r->whole);
 	trial_peaks_free(&r->peaks);
 	trial_steps_free(&r->steps);
-	bsim_schedule_free(r->spare);
+	bsim_effects_spare_free(&r->spare);
 	runner_forget_world(r);
 	free(r->shape);
 	free(r);
