@@ -147,12 +147,17 @@ static void test_plot_and_escape(void **state)
 	const char *esc[] = {"escape", d24, "--out", out, NULL};
 	assert_int_equal(bsim_test_cli(esc, &o, NULL), 0);
 	assert_non_null(strstr(o, "2 groups"));
+	/* two groups: too few for a fit, so no verdict, and null in the file */
+	assert_null(strstr(o, "verdict"));
 	free(o);
 	char *csv = bsim_test_read(bsim_test_join(out, "kramers.csv"));
 	assert_int_equal(bsim_test_count_lines(csv), 3);
 	assert_non_null(strstr(csv, "group,barrier,above_start,kind,noise"));
 	free(csv);
 	assert_true(bsim_test_exists(bsim_test_join(out, "kramers.json")));
+	char *js = bsim_test_read(bsim_test_join(out, "kramers.json"));
+	assert_non_null(strstr(js, "\"verdict\": null"));
+	free(js);
 	const char *bad[] = {"escape", exp_path, "--out", out, NULL};
 	const char *needles[] = {"exp.yaml", NULL};
 	bsim_test_expect_input_error(bad, needles);

@@ -218,6 +218,24 @@ static void test_kramers_fit(void **state)
 	assert_true(fabs(f.b + 1.0 / c) < 3.0 * f.se_b);
 	assert_true(fabs(f.c - c) < 3.0 * f.se_c);
 	assert_true(f.p_poisson > 0.001);
+	/* the verdict: Poisson rates on the line are consistent with it when
+	 * the line explains them (R^2 >= 0.5); rates scattered by a factor
+	 * e^N(0, 1) about a constant, with 10^4 events each, are rejected and
+	 * explained by no line */
+	print_message("on the line: R^2 %.3f, p %.3g: %s\n", f.r2, f.p_poisson,
+	              escape_fit_verdict(&f));
+	assert_true(f.r2 >= ESCAPE_R2_LITTLE && f.p_poisson >= ESCAPE_P_REJECT);
+	assert_non_null(strstr(escape_fit_verdict(&f), "consistent"));
+	for (int i = 0; i < N; i++) {
+		y[i] = log(k0) + gsl_ran_ugaussian(rng);
+		w[i] = 1e4;
+	}
+	assert_int_equal(escape_fit_line(x, y, w, N, &f, &err), BSIM_OK);
+	print_message("scatter: R^2 %.3f, p %.3g: %s\n", f.r2, f.p_poisson, escape_fit_verdict(&f));
+	assert_true(f.p_poisson < ESCAPE_P_REJECT);
+	assert_non_null(strstr(escape_fit_verdict(&f), f.r2 < ESCAPE_R2_LITTLE
+	                                                       ? "do not describe these groups"
+	                                                       : "are not their law"));
 	/* under three points: no fit */
 	assert_int_equal(escape_fit_line(x, y, w, 2, &f, &err), BSIM_EINPUT);
 	gsl_rng_free(rng);

@@ -75,6 +75,22 @@ int escape_fit_line(const double *x, const double *y, const double *events, int 
 	return BSIM_OK;
 }
 
+const char *escape_fit_verdict(const escape_fit *f)
+{
+	const int rejected = f->p_poisson < ESCAPE_P_REJECT, little = f->r2 < ESCAPE_R2_LITTLE;
+	if (rejected && little)
+		return "the line explains little of ln k (R^2 < 0.5) and its residuals exceed "
+		       "their "
+		       "Poisson sampling error (p < 0.01): k0 and c do not describe these groups";
+	if (rejected)
+		return "the residuals exceed their Poisson sampling error (p < 0.01): the line "
+		       "summarises these groups, k0 and c are not their law";
+	if (little)
+		return "the line explains little of ln k (R^2 < 0.5): k0 and c are weakly "
+		       "determined";
+	return "consistent with the line (R^2 >= 0.5, Poisson p >= 0.01)";
+}
+
 /* The distance from c to the segment of beam b at rest, m. */
 static double beam_distance(const bsim_beam_def *b, const double c[2])
 {
@@ -267,7 +283,12 @@ static int write_json(const char *stage, const esc_job *j, bsim_error *err)
 	json_num(o.f, "r2", s->fitted ? f->r2 : NAN, ",");
 	json_num(o.f, "chisq_poisson", s->fitted ? f->chisq_poisson : NAN, ",");
 	json_num(o.f, "dof", s->fitted ? f->n - 2 : NAN, ",");
-	json_num(o.f, "p_poisson", s->fitted ? f->p_poisson : NAN, "");
+	json_num(o.f, "p_poisson", s->fitted ? f->p_poisson : NAN, ",");
+	fprintf(o.f, "  \"verdict\": ");
+	if (s->fitted)
+		fprintf(o.f, "\"%s\"\n", escape_fit_verdict(f));
+	else
+		fprintf(o.f, "null\n");
 	fputs("}\n", o.f);
 	return bsim_atomic_file_commit(&o, err);
 }

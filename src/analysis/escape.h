@@ -36,6 +36,14 @@ typedef struct escape_fit {
 int escape_fit_line(const double *x, const double *y, const double *events, int n, escape_fit *out,
                     bsim_error *err);
 
+/* What the fit f says of the data, in a sentence (a constant string): the
+ * Arrhenius line is rejected when the residuals exceed their Poisson
+ * sampling error (p_poisson < ESCAPE_P_REJECT), and explains little when
+ * R^2 < ESCAPE_R2_LITTLE; k0 and c then do not describe the groups. */
+#define ESCAPE_P_REJECT  0.01
+#define ESCAPE_R2_LITTLE 0.5
+const char *escape_fit_verdict(const escape_fit *f);
+
 /* s, the time the body of scene s, pushed by its propulsion from its start
  * velocity, first touches a beam at rest (the lateral random force does not
  * move it forward): 0 if it starts touching or is never pushed forward. */

@@ -92,6 +92,8 @@ int cmd_escape(int argc, char **argv)
 			       s.fit.a, s.fit.se_a, s.fit.b, s.fit.se_b, s.fit.k0, s.fit.c,
 			       s.fit.se_c, s.fit.rms, s.fit.r2, s.fit.chisq_poisson, s.fit.n - 2,
 			       s.fit.p_poisson);
+		if (s.fitted)
+			printf("verdict     %s\n", escape_fit_verdict(&s.fit));
 		else
 			printf("fit         none: fewer than 3 groups with a barrier, noise and a "
 			       "traversal\n");
