@@ -339,7 +339,7 @@ struct bsim_world {
 	bool track_live = false;
 	std::vector<int> live;
 	std::vector<char> is_live;
-	std::vector<int> typed;  /* beams whose contact_type is not NONE */
+	std::vector<int> typed;   /* beams whose contact_type is not NONE */
 	std::vector<int> pushed;  /* beams whose pushed is set */
 	std::vector<int> touched; /* beams whose touched is set */
 	/* Box2D */
@@ -1655,26 +1655,15 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         "box2d",
         "Box2D 2.4.1: sequential-impulse contacts with restitution, revolute pins with "
         "spring torques or soft weld joints, float32, scaled units",
-        box2d_knobs,
-        N_KNOBS,
-        box2d_create,
-        box2d_destroy,
-        box2d_step,
-        box2d_get_state,
-        box2d_set_state,
-        box2d_accuracy,
-        (int)(sizeof box2d_accuracy / sizeof box2d_accuracy[0]),
+        box2d_knobs, N_KNOBS, box2d_create, box2d_destroy, box2d_step, box2d_get_state,
+        box2d_set_state, box2d_accuracy, (int)(sizeof box2d_accuracy / sizeof box2d_accuracy[0]),
         nullptr, /* reset: the runner creates a world per trial */
         BSIM_TAKES_DRAG | BSIM_TAKES_GROUND_FRICTION,
         nullptr, /* flight: the runner steps every step */
         nullptr, /* steps: likewise */
-        box2d_check,
-        "Box2D",
-        BSIM_BOX2D_VERSION,
+        box2d_check, "Box2D", BSIM_BOX2D_VERSION,
         /* beam-step cost, ns of one core, and its basis */
-        1050.0,
-        "Box2D measured at 0.21 s a step of a 333 x 300 lattice's 199,800 beams",
-        box2d_bounds,
-        (int)(sizeof box2d_bounds / sizeof box2d_bounds[0]),
+        1050.0, "Box2D measured at 0.21 s a step of a 333 x 300 lattice's 199,800 beams",
+        box2d_bounds, (int)(sizeof box2d_bounds / sizeof box2d_bounds[0]),
         0, /* exact_pins: the pin joint holds a beam as well as the solver converges */
 };
