@@ -84,30 +84,32 @@ static inline int bsim_contact_flag(double dist2, double radius, int type, int p
 BSIM_API int bsim_contact_flag_of(const bsim_body_def *body, const double x[2], double psi,
                                   const double p[2], const double u[2], double length, int touched);
 
-/* The contact flag of every beam s lists as active, into s->contact, from
- * s's raw facts (x, heading, touched, direction) and the beams of scene, the
- * scene of the world that reported s (a beam whose direction is NaN is in
- * contact only if touched). The runner calls it on the states it books; a
- * caller stepping a world itself calls it for the flags. */
-BSIM_API void bsim_contact_flags(const bsim_scene *scene, bsim_state *s);
-
-/* bsim_contact_flags for a disk (scene->body.shape BSIM_SHAPE_DISK),
- * inline: the runner's every step. */
-static inline void bsim_contact_flags_disk(const bsim_scene *scene, bsim_state *s)
+/* The contact flag of beam i, one that state s lists as active, from s's
+ * raw facts (x, heading, touched, direction) and the beams of scene, the
+ * scene of the world that reported s: a beam whose direction is NaN (apart,
+ * the backend says) is in contact only if touched. Inline: the runner asks
+ * it of the beams of the states it books. */
+static inline int bsim_contact_flag_in(const bsim_scene *scene, const bsim_state *s, int i)
 {
-	const double radius = scene->body.radius;
-	for (int k = 0; k < s->n_active; k++) {
-		const int i = s->active[k];
-		const bsim_beam_def *b = &scene->beams[i];
-		const double *u = &s->direction[2 * i];
-		if (u[0] != u[0] && !s->touched[i]) {
-			s->contact[i] = BSIM_CONTACT_NONE; /* apart, the backend says */
-			continue;
-		}
-		int type;
-		const double d2 = bsim_beam_distance2(b->pivot, u, b->length, s->x, &type);
-		s->contact[i] = bsim_contact_flag(d2, radius, type, s->touched[i]);
-	}
+	const double *u = &s->direction[2 * i];
+	if (u[0] != u[0] && !s->touched[i])
+		return BSIM_CONTACT_NONE;
+	const bsim_beam_def *b = &scene->beams[i];
+	if (scene->body.shape != BSIM_SHAPE_DISK)
+		return bsim_contact_flag_of(&scene->body, s->x, s->heading, b->pivot, u, b->length,
+		                            s->touched[i]);
+	int type;
+	const double d2 = bsim_beam_distance2(b->pivot, u, b->length, s->x, &type);
+	return bsim_contact_flag(d2, scene->body.radius, type, s->touched[i]);
+}
+
+/* bsim_contact_flag_in of every beam s lists as active, into s->contact.
+ * The runner calls it on the states whose flags it reports; a caller
+ * stepping a world itself calls it for the flags. Inline, as the rule. */
+static inline void bsim_contact_flags(const bsim_scene *scene, bsim_state *s)
+{
+	for (int k = 0; k < s->n_active; k++)
+		s->contact[s->active[k]] = bsim_contact_flag_in(scene, s, s->active[k]);
 }
 
 #ifdef __cplusplus

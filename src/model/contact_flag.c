@@ -42,22 +42,3 @@ int bsim_contact_flag_of(const bsim_body_def *body, const double x[2], double ps
 	type = c.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
 	return touched || c.dist < BSIM_CONTACT_TOL ? type : BSIM_CONTACT_NONE;
 }
-
-void bsim_contact_flags(const bsim_scene *scene, bsim_state *s)
-{
-	if (scene->body.shape == BSIM_SHAPE_DISK) {
-		bsim_contact_flags_disk(scene, s);
-		return;
-	}
-	for (int k = 0; k < s->n_active; k++) {
-		const int i = s->active[k];
-		const bsim_beam_def *b = &scene->beams[i];
-		const double *u = &s->direction[2 * i];
-		if (isnan(u[0]) && !s->touched[i]) {
-			s->contact[i] = BSIM_CONTACT_NONE; /* apart, the backend says */
-			continue;
-		}
-		s->contact[i] = bsim_contact_flag_of(&scene->body, s->x, s->heading, b->pivot, u,
-		                                     b->length, s->touched[i]);
-	}
-}

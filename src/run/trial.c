@@ -127,7 +127,6 @@ typedef struct trial_ctx {
 	long n_max, gate_max;      /* steps in all, steps in one gate */
 	double centre;             /* m, the field's centre line */
 	int overlap;               /* the recorder asked for overlap_max */
-	int disk;                  /* the body is a disk (the flags' inline rule) */
 	int measure;               /* overlap, or a body that rotates: measured every step */
 	int recording, stride;     /* rows to the recorder's sinks, every stride-th step */
 	bsim_trace_fn trace;
@@ -211,38 +210,13 @@ static const bsim_state *trial_trace_state(trial_ctx *c, const bsim_state *s)
 	return c->trace_whole ? trial_record_state(&c->r->whole, c->map, s) : s;
 }
 
-/* The contact flags of s, a state of the world of scene ws
- * (bsim_contact_flags): the runner's, from the backend's raw facts. */
-static inline void trial_flags(const trial_ctx *c, const bsim_scene *ws, bsim_state *s)
+/* Whether a beam s lists is in contact (bsim_contact_flag_in), its flags
+ * not written: the first one found ends the test. */
+static inline int trial_touches(const bsim_scene *ws, const bsim_state *s)
 {
-	if (c->disk)
-		bsim_contact_flags_disk(ws, s);
-	else
-		bsim_contact_flags(ws, s);
-}
-
-/* Whether a beam s lists is in contact (bsim_contact_flags' rule), its
- * flags not written: the first one found ends the test. */
-static inline int trial_touches(const trial_ctx *c, const bsim_scene *ws, bsim_state *s)
-{
-	if (!c->disk) {
-		bsim_contact_flags(ws, s);
-		return any_contact(s);
-	}
-	const double radius = ws->body.radius;
-	for (int k = 0; k < s->n_active; k++) {
-		const int i = s->active[k];
-		const double *u = &s->direction[2 * i];
-		if (s->touched[i])
+	for (int k = 0; k < s->n_active; k++)
+		if (bsim_contact_flag_in(ws, s, s->active[k]) != BSIM_CONTACT_NONE)
 			return 1;
-		if (u[0] != u[0])
-			continue; /* apart, the backend says (a NaN direction) */
-		const bsim_beam_def *b = &ws->beams[i];
-		int type;
-		const double d2 = bsim_beam_distance2(b->pivot, u, b->length, s->x, &type);
-		if (bsim_contact_flag(d2, radius, type, 0) != BSIM_CONTACT_NONE)
-			return 1;
-	}
 	return 0;
 }
 
@@ -254,8 +228,7 @@ static int trial_begin(trial_ctx *c, trial_loop *lp, bsim_state *s0, bsim_error 
 	bsim_trial_result *out = c->out;
 	int rc = BSIM_OK;
 	c->backend->get_state(c->w, s0);
-	c->disk = scene->body.shape == BSIM_SHAPE_DISK;
-	trial_flags(c, c->ws, s0);
+	bsim_contact_flags(c->ws, s0);
 	if (c->overlap)
 		trial_overlap_shapes(c->r->shape, c->ws);
 	c->n_max = scene->max_steps;
@@ -313,7 +286,7 @@ static int gate_enter(trial_ctx *c, trial_loop *lp, bsim_state *s, const double 
 	if (rc)
 		return rc;
 	c->backend->get_state(c->w, s);
-	trial_flags(c, c->ws, s);
+	bsim_contact_flags(c->ws, s);
 	if (c->overlap) /* the new world's two beams */
 		trial_overlap_shapes(c->r->shape, c->ws);
 	lp->e0 = energy_mech(c->ws, s);
@@ -364,7 +337,7 @@ static void trial_result(trial_ctx *c, const trial_loop *lp, bsim_state *s0)
 		out->t_end = (double)lp->n * lp->h;
 	}
 	if (out->outcome == BSIM_STUCK) {
-		trial_flags(c, c->ws, s0); /* a plain run's last state has none yet */
+		bsim_contact_flags(c->ws, s0); /* a plain run's last state has none yet */
 		out->in_contact_end = any_contact(s0);
 	}
 	for (int i = 0; i < 2 && i < scene->n_beams; i++)
@@ -475,7 +448,7 @@ TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bs
 	 * the peaks see; a run computes them for its last touching state and
 	 * the trial's last state only (bsim_trial_run, trial_result). */
 	if (!plain)
-		trial_flags(c, ws, s1);
+		bsim_contact_flags(ws, s1);
 	if (!plain && c->trace)
 		c->trace(c->rec->trace_user, lp->n, trial_trace_state(c, s1));
 	ledger_step(&out->ledger, c->fx, s0, s1, lp->e0, e1);
@@ -553,8 +526,8 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 			 * the peaks' contacts, as the step loop would have left
 			 * them: found from the end, most often at once. */
 			for (long k = open - 1; k >= 0; k--)
-				if (trial_touches(&c, scene, &states[k])) {
-					trial_flags(&c, scene, &states[k]);
+				if (trial_touches(scene, &states[k])) {
+					bsim_contact_flags(scene, &states[k]);
 					trial_peaks_contacts(&r->peaks, NULL, &states[k]);
 					break;
 				}
