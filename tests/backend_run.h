@@ -90,7 +90,7 @@ static inline vibration beam_vibration(const bsim_backend *b, const char *kv, do
 	int peaks = 0;
 	long n_steps = lround(3.0 / h);
 	for (long n = 1; n <= n_steps; n++) {
-		assert_int_equal(b->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, zero, 0.0, h, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		double t = (double)n * h;
 		worst = fmax(worst, fabs(st.theta[0] - damped_oscillator(k, d, inertia, 0.1, t)));

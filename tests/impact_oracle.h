@@ -85,7 +85,7 @@ static inline double impact_square_on(const bsim_backend *b, const bsim_options 
 	int impacts = 0, tangent = 0;
 	double impact_loss = 0.0;
 	for (int n = 0; n < 20; n++) {
-		assert_int_equal(b->step(w, zero, 0.0, 0.004, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, zero, 0.0, 0.004, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 		impacts += st.impacts;

@@ -715,6 +715,32 @@ const bsim_backend *bsim_test_backend(const char *name)
 	return b;
 }
 
+long bsim_test_run_steps, bsim_test_run_free;
+
+int bsim_test_counted_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+                              bsim_state *out, int *made, bsim_error *err)
+{
+	const bsim_backend *be = bsim_test_backend("thesis");
+	if (n == 1 && out) {
+		int rc = be->advance(w, force, torque, h, 1, NULL, made, err);
+		be->get_state(w, out);
+		return rc;
+	}
+	int rc = be->advance(w, force, torque, h, n, out, made, err);
+	bsim_test_run_steps += *made;
+	for (int k = 0; out && k < *made; k++)
+		bsim_test_run_free += out[k].n_active == 0;
+	return rc;
+}
+
+double bsim_test_uniform(uint64_t *s)
+{
+	*s ^= *s >> 12;
+	*s ^= *s << 25;
+	*s ^= *s >> 27;
+	return (double)((*s * 2685821657736338717ull) >> 11) * 0x1.0p-53;
+}
+
 bsim_world *bsim_test_world(const bsim_backend *b, const bsim_scene *s, const bsim_options *opts)
 {
 	bsim_world *w = NULL;

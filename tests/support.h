@@ -4,6 +4,7 @@
 #define BSIM_TESTS_SUPPORT_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "beamsim/backend_registry.h"
 
@@ -168,6 +169,20 @@ bsim_world *bsim_test_world(const bsim_backend *b, const bsim_scene *s, const bs
 /* A backend by name, for a test of that backend's own behaviour (its
  * knobs, its internals); fails the test if none is compiled in. */
 const bsim_backend *bsim_test_backend(const char *name);
+
+/* The thesis backend's advance, for the tests that hold its runs to its
+ * single step (test_steps, test_flight): one step asked is made by the step
+ * itself (advance without a state, then get_state), the truth; more are
+ * made by advance, their count added to bsim_test_run_steps and the count
+ * of those whose state lists no beam (free flight's) to bsim_test_run_free.
+ * A bsim_backend.advance, for a copy of the thesis backend's table. */
+extern long bsim_test_run_steps, bsim_test_run_free;
+int bsim_test_counted_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+                              bsim_state *out, int *made, bsim_error *err);
+
+/* A test's own random numbers, reproducible: xorshift64* from the state
+ * *s (seed it nonzero), uniform on [0, 1). */
+double bsim_test_uniform(uint64_t *s);
 
 /* Wilson's 95% score interval of k successes in n, in closed form. */
 void bsim_test_wilson(int k, int n, double *lo, double *hi);

@@ -76,7 +76,7 @@ static double vibration_error(const char *spring, double h, double rest_deg)
 	double worst = 0.0, damper = 0.0;
 	long n_steps = lround(3.0 / h);
 	for (long n = 1; n <= n_steps; n++) {
-		assert_int_equal(b2->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b2, w, zero, 0.0, h, NULL), BSIM_OK);
 		b2->get_state(w, &st);
 		double exact =
 		        damped_oscillator(400.0, 50.0, s.beams[0].inertia, 0.1, (double)n * h);
@@ -138,7 +138,8 @@ static void test_stiff_spring_stability(void **state)
 			const double zero[2] = {0.0, 0.0};
 			double e0 = 0.5 * k * 0.04, e_max = 0.0, e = e0;
 			for (int n = 0; n < 2000 && isfinite(e) && e < 1e6 * e0; n++) {
-				assert_int_equal(b2->step(w, zero, 0.0, h, NULL), BSIM_OK);
+				assert_int_equal(bsim_backend_step(b2, w, zero, 0.0, h, NULL),
+				                 BSIM_OK);
 				b2->get_state(w, &st);
 				e = 0.5 * k * st.theta[0] * st.theta[0] +
 				    0.5 * inertia * st.omega[0] * st.omega[0];
@@ -308,7 +309,7 @@ static void check_clamp(double speed, const char *scale, double moved, long clam
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	for (int n = 0; n < 5; n++)
-		assert_int_equal(b2->step(w, zero, 0.0, 0.004, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b2, w, zero, 0.0, 0.004, NULL), BSIM_OK);
 	b2->get_state(w, &st);
 	assert_int_equal(st.solver.clamped, clamped);
 	assert_int_equal(st.solver.iteration_limit, 0);

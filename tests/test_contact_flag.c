@@ -53,7 +53,7 @@ static void run_flags(const bsim_backend *b, const bsim_scene *s, int n, int *fl
 	assert_int_equal(bsim_state_init(&st, s->n_beams), BSIM_OK);
 	const double force[2] = {0.0, 0.0};
 	for (int k = 0; k < n; k++) {
-		assert_int_equal(b->step(w, force, 0.0, s->dt, &err), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, force, 0.0, s->dt, &err), BSIM_OK);
 		b->get_state(w, &st);
 		bsim_contact_flags(s, &st);
 		flags[k] = st.contact[0];
@@ -107,7 +107,8 @@ static void test_head_on_impact(void **state)
 			int first = 0;
 			double gap_at_impact = 0.0;
 			for (int n = 1; n <= step; n++) {
-				assert_int_equal(b->step(w, force, 0.0, s.dt, &err), BSIM_OK);
+				assert_int_equal(bsim_backend_step(b, w, force, 0.0, s.dt, &err),
+				                 BSIM_OK);
 				b->get_state(w, &st);
 				bsim_contact_flags(&s, &st);
 				if (st.contact[0] != BSIM_CONTACT_NONE && !first)

@@ -1,10 +1,13 @@
-/* Free-flight runs (bsim_backend.flight, src/run/trial_flight.c) against
- * the step loop they stand in for, which is the truth here: a trial the
- * runner books in runs gives the same result to the bit as the same trial
- * stepped one step at a time (a trace, which sees every step, keeps the
- * runner on the step loop), and the thesis backend's runs leave the body
- * where its steps leave it. Each case counts the steps made in runs, so
- * that a case which never took one fails rather than passes unseen: whole
+/* Free-flight runs (the thesis backend's advance in flight,
+ * backends/thesis/thesis_flight.c, booked by the runner's runs of steps)
+ * against the step loop they stand in for, which is the truth here: a
+ * trial the runner books in runs gives the same result to the bit as the
+ * same trial stepped one step at a time (a trace, which sees every step,
+ * keeps the runner on the step loop; each of its steps is the step itself,
+ * no state written, then get_state), and the thesis backend's runs leave
+ * the body where its steps leave it. Each case counts the steps made in
+ * runs with no beam listed (free flight's states), so that a case which
+ * never took one fails rather than passes unseen: whole
  * trials in flight (ending at max_steps between two draws), flight then
  * the beams (H1), flight up to a beam's segment, a traversal and the run on to classify_y in
  * flight, a side exit, a state that stops being finite, and the pipelines with one force only. */
@@ -22,15 +25,6 @@
 #include "scenes.h"
 #include "support.h"
 
-static long flown; /* steps made in runs */
-
-static int counted_flight(bsim_world *w, const double force[2], double h, int n, double (*xv)[4])
-{
-	int k = bsim_test_backend("thesis")->flight(w, force, h, n, xv);
-	flown += k;
-	return k;
-}
-
 static void no_trace(void *user, long step, const bsim_state *s)
 {
 	(void)user;
@@ -44,18 +38,18 @@ static long run_both(const bsim_scene *s, uint64_t seed, bsim_trial_result *r,
                      bsim_trial_result *r_step)
 {
 	bsim_backend counted = *bsim_test_backend("thesis");
-	counted.flight = counted_flight;
+	counted.advance = bsim_test_counted_advance;
 	bsim_options o = {0};
 	bsim_error err;
 	bsim_trial_runner *runner = bsim_trial_runner_alloc();
 	assert_non_null(runner);
-	flown = 0;
+	bsim_test_run_free = 0;
 	assert_int_equal(bsim_trial_run(runner, s, &counted, &o, seed, NULL, r, &err), BSIM_OK);
-	long made = flown;
+	long made = bsim_test_run_free;
 	bsim_recorder rec = {.stride = 1, .trace = no_trace};
 	assert_int_equal(bsim_trial_run(runner, s, &counted, &o, seed, &rec, r_step, &err),
 	                 BSIM_OK);
-	assert_int_equal(flown, made); /* the trace kept it on the step loop */
+	assert_int_equal(bsim_test_run_free, made); /* the trace kept it on the step loop */
 	bsim_trial_runner_free(runner);
 	return made;
 }
@@ -240,16 +234,25 @@ static void test_thesis_runs(void **state)
 	assert_int_equal(bsim_state_init(&sa, s.n_beams), BSIM_OK);
 	assert_int_equal(bsim_state_init(&sb, s.n_beams), BSIM_OK);
 	const double f[2] = {1.5, 7.0}, h = 0.004;
-	double xv[8][4];
+	bsim_state run[7];
+	for (int k = 0; k < 7; k++)
+		assert_int_equal(bsim_state_init(&run[k], s.n_beams), BSIM_OK);
 	/* unprepared for h: the run prepares the beams, as the step would */
 	long steps = 0;
 	for (int n = 1; n <= 7; n++) {
-		assert_int_equal(t->flight(b, f, h, n, xv), n);
+		int m;
+		assert_int_equal(t->advance(b, f, 0.0, h, n, run, &m, &err), BSIM_OK);
+		assert_int_equal(m, n);
 		for (int k = 0; k < n; k++) {
-			assert_int_equal(t->step(a, f, 0.0, h, &err), BSIM_OK);
+			assert_int_equal(bsim_backend_step(t, a, f, 0.0, h, &err), BSIM_OK);
 			t->get_state(a, &sa);
-			assert_memory_equal(sa.x, xv[k], 2 * sizeof(double));
-			assert_memory_equal(sa.v, xv[k] + 2, 2 * sizeof(double));
+			assert_memory_equal(sa.x, run[k].x, sizeof sa.x);
+			assert_memory_equal(sa.v, run[k].v, sizeof sa.v);
+			assert_memory_equal(&sa.heading, &run[k].heading, sizeof sa.heading);
+			assert_memory_equal(&sa.energy, &run[k].energy, sizeof sa.energy);
+			assert_memory_equal(&sa.solver, &run[k].solver, sizeof sa.solver);
+			assert_int_equal(run[k].n_active, 0);
+			assert_int_equal(run[k].impacts, 0);
 		}
 		steps += n;
 		t->get_state(b, &sb);
@@ -260,6 +263,8 @@ static void test_thesis_runs(void **state)
 		assert_int_equal(sb.impacts, 0);
 	}
 	assert_int_equal(steps, 28);
+	for (int k = 0; k < 7; k++)
+		bsim_state_free(&run[k]);
 	bsim_state_free(&sa);
 	bsim_state_free(&sb);
 	t->destroy(a);

@@ -109,7 +109,7 @@ static void zeno_one(const bsim_backend *b, double e)
 	double g_prev = 0.0, g_prev2 = 0.0, apex[64], apex_rise = 0.0;
 	int n_apex = 0, impacts = 0, max_per_step = 0, last_impact = 0, persistent_from = 0;
 	for (int n = 1; n <= steps; n++) {
-		assert_int_equal(b->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, force, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 		double g = min_gap(&s, &st);
@@ -179,7 +179,7 @@ static double_run double_one(const bsim_backend *b, double dx)
 	const double zero[2] = {0.0, 0.0};
 	double_run r = {0, 0, 0, 0};
 	for (int n = 0; n < s.max_steps; n++) {
-		assert_int_equal(b->step(w, zero, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, zero, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		r.vx_max = fmax(r.vx_max, fabs(st.v[0]));
 	}
@@ -383,7 +383,7 @@ static void wedge_one(const bsim_backend *b, double overlap)
 	double vmax = 0.0, y_half = 0.0, x_half = 0.0, pen_end = 0.0;
 	int n = 0;
 	for (n = 1; n <= s.max_steps; n++) {
-		assert_int_equal(b->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, force, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 		vmax = fmax(vmax, hypot(st.v[0], st.v[1]));
@@ -434,7 +434,7 @@ static double phase_one(const bsim_backend *b, double u, double phase, int *impa
 	*impacts = 0;
 	int steps = (int)phase + 20;
 	for (int n = 0; n < steps; n++) {
-		assert_int_equal(b->step(w, zero, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, zero, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		*impacts += st.impacts;
 	}
@@ -472,7 +472,7 @@ static void graze_one(const bsim_backend *b, double eps)
 	int tangent = 0, tip = 0, impacts = 0;
 	double pen = -INFINITY;
 	for (int n = 0; n < 400; n++) {
-		assert_int_equal(b->step(w, zero, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, zero, 0.0, s.dt, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 		tangent |= st.contact[0] == BSIM_CONTACT_TANGENT;

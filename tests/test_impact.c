@@ -163,7 +163,8 @@ static void test_shape_impact_restitution(void **state)
 			const double zero[2] = {0.0, 0.0};
 			int impacts = 0;
 			for (int n = 0; n < 20 && !impacts; n++) {
-				assert_int_equal(b->step(w, zero, 0.0, 0.004, NULL), BSIM_OK);
+				assert_int_equal(bsim_backend_step(b, w, zero, 0.0, 0.004, NULL),
+				                 BSIM_OK);
 				b->get_state(w, &st);
 				impacts += st.impacts;
 			}
@@ -224,7 +225,7 @@ static void run_tip(const bsim_backend *b, double e_tip, double out[4])
 	int impacts = 0, tip = 0;
 	double vrel_before = 0.0, vrel_after = 0.0;
 	for (int k = 0; k < 10; k++) {
-		assert_int_equal(b->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, zero, 0.0, h, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 		tip |= st.contact[0] == BSIM_CONTACT_TIP;

@@ -74,7 +74,7 @@ static void push(const bsim_backend *be, push_result *r)
 	const double L = b->length, R = s.body.radius;
 	for (int n = 0; n < 45000 && st.x[1] < 40; n++) {
 		const double force[2] = {-200.0 * st.v[0], 200.0 * (0.25 - st.v[1])};
-		assert_int_equal(be->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(be, w, force, 0.0, s.dt, NULL), BSIM_OK);
 		be->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 		if (!st.contact[0])
@@ -158,7 +158,7 @@ static void rest_at_basin_floor(const bsim_backend *be, double tol)
 	assert_int_equal(bsim_state_init(&st, 2), BSIM_OK);
 	const double force[2] = {0.0, 8.0};
 	for (int n = 0; n < 10000; n++) { /* 40 s; d / k = 1.25 s */
-		assert_int_equal(be->step(w, force, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(be, w, force, 0.0, s.dt, NULL), BSIM_OK);
 		be->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 	}

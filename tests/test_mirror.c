@@ -57,8 +57,8 @@ static void test_mirror_steps(void **state)
 	for (long n = 0; n < 3000; n++) {
 		double fr = bsim_schedule_value(sched, bsim_schedule_index(sched, n, a.dt));
 		const double fa[2] = {fr, 8.0}, fb[2] = {-fr, 8.0};
-		assert_int_equal(be->step(wa, fa, 0.0, a.dt, NULL), BSIM_OK);
-		assert_int_equal(be->step(wb, fb, 0.0, b.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(be, wa, fa, 0.0, a.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(be, wb, fb, 0.0, b.dt, NULL), BSIM_OK);
 		be->get_state(wa, &sa);
 		bsim_contact_flags(&a, &sa);
 		be->get_state(wb, &sb);

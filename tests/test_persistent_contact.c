@@ -60,8 +60,9 @@ static void test_impact_chain_settles(void **state)
 	int impacts = 0, last_impact = -1;
 	double worst = 0.0;
 	for (int n = 1; n <= 30000; n++) { /* 120 s: the last creep decays as e^(-t / 11 s) */
-		assert_int_equal(bsim_test_backend("thesis")->step(w, force, 0.0, s.dt, NULL),
-		                 BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), w, force, 0.0, s.dt, NULL),
+		        BSIM_OK);
 		bsim_test_backend("thesis")->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 		if (st.impacts) {
@@ -127,8 +128,9 @@ static void test_projection_limit(void **state)
 		st.v[0] = st.v[1] = 0.0;
 		assert_int_equal(bsim_test_backend("thesis")->set_state(w, &st, &err), BSIM_OK);
 		const double zero[2] = {0.0, 0.0};
-		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, 0.004, NULL),
-		                 BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), w, zero, 0.0, 0.004, NULL),
+		        BSIM_OK);
 		bsim_test_backend("thesis")->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 		const double pivot[2] = {0.0, 0.0};

@@ -26,7 +26,7 @@ static void test_restart_from_state(void **state)
 	bsim_state_init(&st2, 2);
 	const double f[2] = {0.0, 7.0};
 	for (int n = 0; n < 700; n++) /* into contact with both beams */
-		assert_int_equal(b->step(w, f, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, f, 0.0, s.dt, NULL), BSIM_OK);
 	b->get_state(w, &st);
 	assert_true(st.theta[0] > 0.05 && st.theta[1] > 0.05);
 	bsim_error err;
@@ -38,8 +38,8 @@ static void test_restart_from_state(void **state)
 		assert_true(fabs(st2.omega[k] - st.omega[k]) <= 1e-6);
 	}
 	for (int n = 0; n < 100; n++) {
-		assert_int_equal(b->step(w, f, 0.0, s.dt, NULL), BSIM_OK);
-		assert_int_equal(b->step(w2, f, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w, f, 0.0, s.dt, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(b, w2, f, 0.0, s.dt, NULL), BSIM_OK);
 	}
 	b->get_state(w, &st);
 	b->get_state(w2, &st2);

@@ -170,8 +170,8 @@ static int step_against_fresh(const bsim_scene *sc, uint64_t seed, int n_steps)
 		bsim_world *b = NULL;
 		assert_int_equal(be->create(sc, NULL, &b, &err), BSIM_OK);
 		assert_int_equal(be->set_state(b, &sa, &err), BSIM_OK);
-		assert_int_equal(be->step(a, f, 0.0, sc->dt, &err), BSIM_OK);
-		assert_int_equal(be->step(b, f, 0.0, sc->dt, &err), BSIM_OK);
+		assert_int_equal(bsim_backend_step(be, a, f, 0.0, sc->dt, &err), BSIM_OK);
+		assert_int_equal(bsim_backend_step(be, b, f, 0.0, sc->dt, &err), BSIM_OK);
 		be->get_state(a, &sa);
 		bsim_contact_flags(sc, &sa);
 		be->get_state(b, &sb);
@@ -470,8 +470,8 @@ static int step_pair_same(bsim_world *a, bsim_world *b, const bsim_scene *sc, ui
 		be->get_state(a, &sa);
 		bsim_contact_flags(sc, &sa);
 		bsim_effects_force_at(&fx, k, sc->dt, &sa, f);
-		assert_int_equal(be->step(a, f, f[2], sc->dt, &err), BSIM_OK);
-		assert_int_equal(be->step(b, f, f[2], sc->dt, &err), BSIM_OK);
+		assert_int_equal(bsim_backend_step(be, a, f, f[2], sc->dt, &err), BSIM_OK);
+		assert_int_equal(bsim_backend_step(be, b, f, f[2], sc->dt, &err), BSIM_OK);
 		be->get_state(a, &sa);
 		bsim_contact_flags(sc, &sa);
 		be->get_state(b, &sb);
@@ -504,7 +504,7 @@ static void test_reset_as_created(void **state)
 		assert_int_equal(bsim_state_init(&st, s.n_beams), BSIM_OK);
 		for (int k = 0; k < 400; k++) {
 			double f[2] = {0.0, 7.0};
-			assert_int_equal(be->step(kept, f, 0.0, s.dt, &err), BSIM_OK);
+			assert_int_equal(bsim_backend_step(be, kept, f, 0.0, s.dt, &err), BSIM_OK);
 		}
 		be->get_state(kept, &st);
 		s.body.start[0] = 0.01 * (t - 3);

@@ -87,7 +87,8 @@ static hand_impact solve_by_hand(double mass, double inertia, double ib, double 
 static void step_once(const bsim_scene *s, bsim_state *st, long *scaled)
 {
 	bsim_world *w = make(s);
-	assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+	assert_int_equal(bsim_backend_step(bsim_test_backend("thesis"), w, zero, 0.0, h, NULL),
+	                 BSIM_OK);
 	bsim_test_backend("thesis")->get_state(w, st);
 	*scaled = w->impacts_scaled;
 	bsim_test_backend("thesis")->destroy(w);
@@ -233,14 +234,17 @@ static void press_case(double ratio, int rotates, double *accel, double *drift)
 	/* settle under the normal force alone, then push along */
 	const double fn[2] = {0.0, fy};
 	for (int k = 0; k < 500; k++)
-		assert_int_equal(bsim_test_backend("thesis")->step(w, fn, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), w, fn, 0.0, h, NULL),
+		        BSIM_OK);
 	bsim_test_backend("thesis")->get_state(w, &st);
 	bsim_contact_flags(&s, &st);
 	double x0 = st.x[0];
 	int n = 250;
 	double v_mid = 0.0;
 	for (int k = 0; k < 2 * n; k++) {
-		assert_int_equal(bsim_test_backend("thesis")->step(w, f, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(bsim_test_backend("thesis"), w, f, 0.0, h, NULL),
+		                 BSIM_OK);
 		if (k == n - 1) {
 			bsim_test_backend("thesis")->get_state(w, &st);
 			bsim_contact_flags(&s, &st);
@@ -361,7 +365,9 @@ static void test_no_energy_created(void **state)
 		double e0 = 0.5 * (st.v[0] * st.v[0] + st.v[1] * st.v[1]) +
 		            0.5 * j * st.angular_velocity * st.angular_velocity +
 		            0.5 * ib * s.beams[0].initial_omega * s.beams[0].initial_omega;
-		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), w, zero, 0.0, h, NULL),
+		        BSIM_OK);
 		bsim_test_backend("thesis")->get_state(w, &st);
 		double e1 = 0.5 * (st.v[0] * st.v[0] + st.v[1] * st.v[1]) +
 		            0.5 * j * st.angular_velocity * st.angular_velocity +

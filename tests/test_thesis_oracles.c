@@ -51,7 +51,7 @@ static void run_midline(double offset, double e_tip, bsim_state *st)
 	const double zero[2] = {0.0, 0.0};
 	int impacts = 0;
 	for (int n = 0; n < 40; n++) {
-		assert_int_equal(thesis->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(thesis, w, zero, 0.0, h, NULL), BSIM_OK);
 		thesis->get_state(w, st);
 		impacts += st->impacts;
 	}
@@ -95,7 +95,7 @@ static void step_once_with(const bsim_scene *s, const bsim_options *opts, bsim_s
 	bsim_error err;
 	assert_int_equal(thesis->create(s, opts, &w, &err), BSIM_OK);
 	const double zero[2] = {0.0, 0.0};
-	assert_int_equal(thesis->step(w, zero, 0.0, h, NULL), BSIM_OK);
+	assert_int_equal(bsim_backend_step(thesis, w, zero, 0.0, h, NULL), BSIM_OK);
 	thesis->get_state(w, st);
 	thesis->destroy(w);
 }
@@ -179,8 +179,8 @@ static void test_impact_mass_identity(void **state)
 	const double force[2] = {1.5, 8.0};
 	int impacts = 0;
 	for (int n = 0; n < 3000; n++) {
-		assert_int_equal(thesis->step(a, force, 0.0, h, NULL), BSIM_OK);
-		assert_int_equal(thesis->step(b, force, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(thesis, a, force, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(bsim_backend_step(thesis, b, force, 0.0, h, NULL), BSIM_OK);
 		thesis->get_state(a, &sa);
 		thesis->get_state(b, &sb);
 		assert_memory_equal(sa.x, sb.x, sizeof sa.x);
@@ -228,7 +228,8 @@ static void test_stiff_spring_stable(void **state)
 			const double zero[2] = {0.0, 0.0};
 			double e0 = 0.5 * k * 0.04, e_prev = e0;
 			for (int n = 0; n < 5000; n++) {
-				assert_int_equal(thesis->step(w, zero, 0.0, h, NULL), BSIM_OK);
+				assert_int_equal(bsim_backend_step(thesis, w, zero, 0.0, h, NULL),
+				                 BSIM_OK);
 				thesis->get_state(w, &st);
 				double e = 0.5 * k * st.theta[0] * st.theta[0] +
 				           0.5 * inertia * st.omega[0] * st.omega[0];

@@ -173,7 +173,9 @@ static void test_free_capsule(void **state)
 	double psi0 = st.heading, e0 = 0.5 * (0.49 + 0.16) + 0.5 * inertia * 2.5 * 2.5;
 	int n = 2000;
 	for (int k = 0; k < n; k++)
-		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), w, zero, 0.0, h, NULL),
+		        BSIM_OK);
 	bsim_test_backend("thesis")->get_state(w, &st);
 	assert_true(st.angular_velocity == 2.5); /* J w: nothing acts on it */
 	assert_true(st.v[0] == 0.7 && st.v[1] == -0.4);
@@ -192,8 +194,9 @@ static void test_free_capsule(void **state)
 	const double torque = -0.3;
 	double w0 = st.angular_velocity, p0 = st.heading;
 	for (int k = 0; k < n; k++)
-		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, torque, h, NULL),
-		                 BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), w, zero, torque, h, NULL),
+		        BSIM_OK);
 	bsim_test_backend("thesis")->get_state(w, &st);
 	double w_hand = w0 + torque * t / inertia;
 	double p_hand = p0 + w0 * t + torque * t * t / (2.0 * inertia);
@@ -207,8 +210,9 @@ static void test_free_capsule(void **state)
 	bsim_test_backend("thesis")->get_state(w, &st);
 	p0 = st.heading;
 	for (int k = 0; k < n; k++)
-		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, torque, h, NULL),
-		                 BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), w, zero, torque, h, NULL),
+		        BSIM_OK);
 	bsim_test_backend("thesis")->get_state(w, &st);
 	p_hand = p0 + 2.5 * n * h + torque * h * h * n * (n + 1.0) / (2.0 * inertia);
 	assert_true(fabs(st.heading - p_hand) < 1e-11 * fabs(p_hand));
@@ -244,7 +248,8 @@ static void offcentre_impact(const char *knob)
 	bsim_world *w = make_with(&s, knob);
 	bsim_state st;
 	bsim_state_init(&st, 1);
-	assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+	assert_int_equal(bsim_backend_step(bsim_test_backend("thesis"), w, zero, 0.0, h, NULL),
+	                 BSIM_OK);
 	bsim_test_backend("thesis")->get_state(w, &st);
 
 	double cb = -0.5 * l * cos(psi), c = -12.0;
@@ -336,7 +341,9 @@ static void test_elastic_impacts_conserve(void **state)
 		bsim_world *w = make(&s);
 		bsim_state st;
 		bsim_state_init(&st, 1);
-		assert_int_equal(bsim_test_backend("thesis")->step(w, zero, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), w, zero, 0.0, h, NULL),
+		        BSIM_OK);
 		bsim_test_backend("thesis")->get_state(w, &st);
 		double e1 = 0.5 * m * (st.v[0] * st.v[0] + st.v[1] * st.v[1]) +
 		            0.5 * j * st.angular_velocity * st.angular_velocity +
@@ -392,8 +399,12 @@ static void test_turning_disk_bits(void **state)
 	long impacts = 0;
 	for (int k = 0; k < 6000; k++) {
 		double fk[2] = {k % 500 < 250 ? f[0] : -f[0], f[1]};
-		assert_int_equal(bsim_test_backend("thesis")->step(wa, fk, 0.0, h, NULL), BSIM_OK);
-		assert_int_equal(bsim_test_backend("thesis")->step(wb, fk, 0.0, h, NULL), BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), wa, fk, 0.0, h, NULL),
+		        BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), wb, fk, 0.0, h, NULL),
+		        BSIM_OK);
 		bsim_test_backend("thesis")->get_state(wa, &sa);
 		bsim_test_backend("thesis")->get_state(wb, &sb);
 		impacts += sa.impacts;
@@ -451,8 +462,9 @@ static void test_ledger_closes(void **state)
 	long impacts = 0;
 	for (int k = 0; k < 5000; k++) {
 		double force[2] = {1.5 * sin(0.01 * k), 6.0}, torque = 2.0 * cos(0.003 * k);
-		assert_int_equal(bsim_test_backend("thesis")->step(w, force, torque, h, NULL),
-		                 BSIM_OK);
+		assert_int_equal(
+		        bsim_backend_step(bsim_test_backend("thesis"), w, force, torque, h, NULL),
+		        BSIM_OK);
 		bsim_test_backend("thesis")->get_state(w, &s1);
 		double work = force[0] * (s1.x[0] - s0.x[0]) + force[1] * (s1.x[1] - s0.x[1]) +
 		              torque * (s1.heading - s0.heading);
@@ -510,8 +522,9 @@ static void test_capsule_penetration(void **state)
 			if (k % 5 == 0) /* held 5 steps, uniform in [-40, 40] N */
 				lateral = 80.0 * uniform(&seed) - 40.0;
 			double f[2] = {lateral, 8.0};
-			assert_int_equal(bsim_test_backend("thesis")->step(w, f, 0.0, h, NULL),
-			                 BSIM_OK);
+			assert_int_equal(
+			        bsim_backend_step(bsim_test_backend("thesis"), w, f, 0.0, h, NULL),
+			        BSIM_OK);
 			bsim_test_backend("thesis")->get_state(w, &st);
 			for (int i = 0; i < 2; i++) {
 				double u0[2], u[2];

@@ -87,6 +87,14 @@ static void fake_get_state(const bsim_world *w, bsim_state *s)
 	s->solver = w->solver;
 }
 
+/* advance: the steps one by one, each state read after its step */
+static int fake_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+                        bsim_state *out, int *made, bsim_error *err)
+{
+	return bsim_backend_advance_each(w, fake_step, fake_get_state, force, torque, h, n, out,
+	                                 made, err);
+}
+
 static const bsim_knob fake_knobs[] = {{"kind", BSIM_KNOB_INT, "0", NULL, "how it fails"}};
 
 static const bsim_backend fake = {
@@ -95,7 +103,7 @@ static const bsim_backend fake = {
         .n_knobs = 1,
         .create = fake_create,
         .destroy = fake_destroy,
-        .step = fake_step,
+        .advance = fake_advance,
         .get_state = fake_get_state,
 };
 

@@ -1428,7 +1428,8 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 	}
 }
 
-int box2d_step(bsim_world *w, const double force[2], double torque, double h, bsim_error *err)
+static int box2d_step(bsim_world *w, const double force[2], double torque, double h,
+                      bsim_error *err)
 {
 	w->energy = bsim_step_energy{};
 	w->drag_loss = 0.0;
@@ -1481,6 +1482,15 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 	st->friction_loss = w->friction_loss;
 	st->impacts = w->impacts;
 	st->solver = w->solver;
+}
+
+/* bsim_backend.advance: Box2D's steps one by one, each state read after
+ * its step. */
+static int box2d_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+                         bsim_state *out, int *made, bsim_error *err)
+{
+	return bsim_backend_advance_each(w, box2d_step, box2d_get_state, force, torque, h, n, out,
+	                                 made, err);
 }
 
 /* Rebuilds the world at the state: no contact or joint impulses carried
@@ -1655,13 +1665,10 @@ extern "C" const bsim_backend bsim_backend_box2d = {
         "box2d",
         "Box2D 2.4.1: sequential-impulse contacts with restitution, revolute pins with "
         "spring torques or soft weld joints, float32, scaled units",
-        box2d_knobs, N_KNOBS, box2d_create, box2d_destroy, box2d_step, box2d_get_state,
+        box2d_knobs, N_KNOBS, box2d_create, box2d_destroy, box2d_advance, box2d_get_state,
         box2d_set_state, box2d_accuracy, (int)(sizeof box2d_accuracy / sizeof box2d_accuracy[0]),
         nullptr, /* reset: the runner creates a world per trial */
-        BSIM_TAKES_DRAG | BSIM_TAKES_GROUND_FRICTION,
-        nullptr, /* flight: the runner steps every step */
-        nullptr, /* steps: likewise */
-        box2d_check, "Box2D", BSIM_BOX2D_VERSION,
+        BSIM_TAKES_DRAG | BSIM_TAKES_GROUND_FRICTION, box2d_check, "Box2D", BSIM_BOX2D_VERSION,
         /* beam-step cost, ns of one core, and its basis */
         1050.0, "Box2D measured at 0.21 s a step of a 333 x 300 lattice's 199,800 beams",
         box2d_bounds, (int)(sizeof box2d_bounds / sizeof box2d_bounds[0]),

@@ -630,6 +630,15 @@ static void chipmunk_get_state(const bsim_world *w, bsim_state *st)
 	st->solver = w->solver;
 }
 
+/* bsim_backend.advance: the steps one by one, each state read after its
+ * step. */
+static int chipmunk_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+                            bsim_state *out, int *made, bsim_error *err)
+{
+	return bsim_backend_advance_each(w, chipmunk_step, chipmunk_get_state, force, torque, h, n,
+	                                 out, made, err);
+}
+
 #define STATE_EXPECTED                                                                             \
 	"expected a finite value below 1e100 in magnitude (Chipmunk aborts the process on one "    \
 	"that is not finite)"
@@ -800,7 +809,7 @@ const bsim_backend bsim_backend_chipmunk = {
         .n_knobs = N_KNOBS,
         .create = chipmunk_create,
         .destroy = chipmunk_destroy,
-        .step = chipmunk_step,
+        .advance = chipmunk_advance,
         .get_state = chipmunk_get_state,
         .set_state = chipmunk_set_state,
         .accuracy = chipmunk_accuracy,

@@ -162,6 +162,12 @@ struct bsim_world {
 	int flight_disk;
 	/* 1: a world the runs of steps take (thesis_steps_takes), once made. */
 	int steps_disk;
+	/* After a try at free flight that made no step (the body near a beam,
+	 * say), the steps left before the next try, and the wait after the last
+	 * failure: doubled by each, to THESIS_FLIGHT_WAIT_MAX, 0 after a run
+	 * (thesis_advance). Which steps are tried changes no result, only what
+	 * a stretch near the beams costs. */
+	int flight_skip, flight_wait;
 	double slop;         /* penetration tolerated before projection, m */
 	double contact_tol;  /* gap the solver counts as touching (held, awake), m */
 	int broad_phase;     /* 1: grid query for beams at rest; 0: test every beam */
@@ -243,12 +249,15 @@ int thesis_broad_phase_near(struct bsim_world *w, double margin);
  * broad phase tests whole only; never with broad_phase=0); 0 if one may. */
 int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h);
 
-/* thesis_flight.c: bsim_backend.flight. */
-int thesis_flight(struct bsim_world *w, const double force[2], double h, int n, double (*xv)[4]);
+/* thesis_flight.c: up to n steps of free flight under force, each state
+ * into out[k]; returns how many (0: the next step is not one). */
+int thesis_flight(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out);
+#define THESIS_FLIGHT_WAIT_MAX 64
 
-/* thesis_steps.c: bsim_backend.steps, for the worlds thesis_steps_takes
+/* thesis_steps.c: runs of steps of advance, for the worlds thesis_steps_takes
  * (1: the essay's disk, physical contacts, simultaneous impacts, no
- * sleeping, at most THESIS_STEPS_BEAMS beams). */
+ * sleeping, at most THESIS_STEPS_BEAMS beams): n steps, each state into
+ * out[k] (sized for the world's beams); returns n, 0 for another world. */
 #define THESIS_STEPS_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
 int thesis_steps_takes(const struct bsim_world *w);
 int thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out);

@@ -1,6 +1,8 @@
-/* The thesis backend's free-flight runs (bsim_backend.flight): the steps
- * thesis_step makes by its flight path (thesis_world.c's flight_step), one
- * after another in one call, for as long as that path would be taken.
+/* The thesis backend's free-flight runs (a path of its advance,
+ * thesis_world.c): the steps thesis_step makes by its flight path
+ * (thesis_world.c's flight_step), one after another in one call, for as
+ * long as that path would be taken, each state written as get_state
+ * writes it after such a step.
  *
  * thesis_step takes the flight path when no beam is awake or typed, the
  * room test finds every beam out of reach (thesis_flight_clear), the beams
@@ -20,13 +22,14 @@
  * impulse sum (v = vf + 0 / M, which turns a -0 into +0, is kept), and
  * clears what flight_step clears (the energy flows, the impacts, the
  * contacts), which after the first step stay cleared: cleared once,
- * after the run. A body that turns is left to
- * thesis_step (its heading moves too). */
+ * after the run. Its state is get_state's with no beam awake: the body,
+ * no beam listed, zero energy flows and impacts. A body that turns is left
+ * to thesis_step (its heading moves too). */
 #include <string.h>
 
 #include "thesis/thesis.h"
 
-int thesis_flight(bsim_world *w, const double force[2], double h, int n, double (*xv)[4])
+int thesis_flight(bsim_world *w, const double force[2], double h, int n, bsim_state *out)
 {
 	if (w->n_awake || w->n_typed || w->contact_mode == THESIS_CONTACT_ESSAY || w->rotates ||
 	    !w->broad_phase || w->n_beams > THESIS_BROAD_PHASE_MIN_BEAMS)
@@ -42,6 +45,9 @@ int thesis_flight(bsim_world *w, const double force[2], double h, int n, double 
 	const int euler = w->integrator == THESIS_EULER;
 	double cx0 = w->clear_x[0], cx1 = w->clear_x[1], room = w->clear_room;
 	double x0 = w->x[0], x1 = w->x[1], v0 = w->v[0], v1 = w->v[1];
+	/* what a flight step leaves as it is, for the states */
+	const double heading = w->heading, angular_velocity = w->angular_velocity;
+	const bsim_solver_counts solver = w->solver;
 	/* The room test of every step of the run at once. Step k starts at
 	 * speed |v_k|_1 <= s + k d (s = |v|_1 now, d = |h F / M|_1 a step)
 	 * and |x_k - C_c|_1 <= |x - C_c|_1 + h k (s + k d) (each step moves
@@ -86,10 +92,18 @@ int thesis_flight(bsim_world *w, const double force[2], double h, int n, double 
 		x1 += h * vm1;
 		v0 = u0;
 		v1 = u1;
-		xv[k][0] = x0;
-		xv[k][1] = x1;
-		xv[k][2] = v0;
-		xv[k][3] = v1;
+		bsim_state *st = &out[k];
+		st->x[0] = x0;
+		st->x[1] = x1;
+		st->v[0] = v0;
+		st->v[1] = v1;
+		st->heading = heading;
+		st->angular_velocity = angular_velocity;
+		if (st->n_active)
+			bsim_state_set_active(st, NULL, 0);
+		memset(&st->energy, 0, sizeof st->energy);
+		st->impacts = 0;
+		st->solver = solver;
 	}
 	w->x[0] = x0;
 	w->x[1] = x1;

@@ -1,4 +1,4 @@
-/* The thesis backend's runs of steps (bsim_backend.steps): the steps
+/* The thesis backend's runs of steps (a path of its advance, thesis_world.c): the steps
  * thesis_step makes for the essay's disk among a few beams, one after
  * another in one call, each state written as get_state writes it.
  *

@@ -364,6 +364,7 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	w->impacts_scaled = 0;
 	w->n_awake = w->n_typed = w->n_pushed = w->n_contacts = 0;
 	w->any_held = 0;
+	w->flight_skip = w->flight_wait = 0;
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
 	memset(&w->solver, 0, sizeof w->solver);
@@ -511,8 +512,8 @@ THESIS_APART int step_disk(bsim_world *w, const double force[2], double h, int i
 }
 
 /* Nothing in a step allocates: the world's memory is sized at creation. */
-static int thesis_step(bsim_world *w, const double force[2], double torque, double h,
-                       bsim_error *err)
+static inline int thesis_step(bsim_world *w, const double force[2], double torque, double h,
+                              bsim_error *err)
 {
 	(void)err;
 	/* Free flight among beams at rest (none awake, none in reach): no
@@ -531,7 +532,7 @@ static int thesis_step(bsim_world *w, const double force[2], double torque, doub
 	return step_disk(w, force, h, in_flight);
 }
 
-static void thesis_get_state(const bsim_world *w, bsim_state *s)
+THESIS_APART void thesis_get_state(const bsim_world *w, bsim_state *s)
 {
 	thesis_state_body(w, s);
 	/* Both lists empty (free flight): the same, nothing to set. */
@@ -548,6 +549,65 @@ static void thesis_get_state(const bsim_world *w, bsim_state *s)
 	s->energy = w->energy;
 	s->impacts = w->impacts;
 	s->solver = w->solver;
+}
+
+/* advance's steps one after another, thesis_step and get_state each;
+ * into *made those made. Apart: the runs' dispatch stays short. */
+THESIS_APART int advance_each(bsim_world *w, const double force[2], double torque, double h, int n,
+                              bsim_state *out, int *made, bsim_error *err)
+{
+	for (int m = 0; m < n; m++) {
+		int rc = thesis_step(w, force, torque, h, err);
+		if (rc) {
+			*made = m;
+			return rc;
+		}
+		if (out)
+			thesis_get_state(w, &out[m]);
+	}
+	*made = n;
+	return BSIM_OK;
+}
+
+/* bsim_backend.advance: one step by thesis_step and get_state; more, a
+ * run of free flight (thesis_flight.c) where the body flies among beams at
+ * rest, else the essay's disk's runs of steps (thesis_steps.c) where the
+ * world is one they take, else advance_each. Each path's steps are
+ * thesis_step's, to the bit (test_steps, test_flight). A try at flight
+ * that makes no step costs its room test; after one, the next waits
+ * (flight_skip), doubling the wait after each such try. */
+static int thesis_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+                          bsim_state *out, int *made, bsim_error *err)
+{
+	if (n == 1 && (w->flight_skip || w->n_awake || !out)) {
+		/* one step, not of free flight: the step loop's usual call */
+		if (w->flight_skip)
+			w->flight_skip--;
+		*made = 1;
+		int rc = thesis_step(w, force, torque, h, err);
+		if (out)
+			thesis_get_state(w, out);
+		return rc;
+	}
+	if (out && w->flight_skip == 0 && w->n_awake == 0) {
+		int m = thesis_flight(w, force, h, n, out);
+		if (m > 0) {
+			w->flight_wait = 0;
+			*made = m;
+			return BSIM_OK;
+		}
+		w->flight_wait = w->flight_wait ? 2 * w->flight_wait : 1;
+		if (w->flight_wait > THESIS_FLIGHT_WAIT_MAX)
+			w->flight_wait = THESIS_FLIGHT_WAIT_MAX;
+		w->flight_skip = w->flight_wait;
+	}
+	int rc = BSIM_OK;
+	if (out && n > 1 && w->steps_disk && out[0].n_beams == w->n_beams)
+		*made = thesis_steps(w, force, h, n, out);
+	else
+		rc = advance_each(w, force, torque, h, n, out, made, err);
+	w->flight_skip = w->flight_skip > *made ? w->flight_skip - *made : 0;
+	return rc;
 }
 
 static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
@@ -576,6 +636,7 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 		w->held[i] = 0; /* a state has no loop: contact_mode=essay starts afresh */
 	}
 	w->any_held = 0;
+	w->flight_skip = w->flight_wait = 0;
 	w->touched_all = 1; /* every beam's angle set */
 	thesis_near_forget(w);
 	return BSIM_OK;
@@ -591,12 +652,10 @@ const bsim_backend bsim_backend_thesis = {
         .n_knobs = N_KNOBS,
         .create = thesis_create,
         .destroy = thesis_destroy,
-        .step = thesis_step,
+        .advance = thesis_advance,
         .get_state = thesis_get_state,
         .set_state = thesis_set_state,
         .reset = thesis_reset,
-        .flight = thesis_flight,
-        .steps = thesis_steps,
         .accuracy = thesis_accuracy,
         .n_accuracy = (int)(sizeof thesis_accuracy / sizeof thesis_accuracy[0]),
         .engine = "beamsim",

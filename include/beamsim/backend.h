@@ -43,12 +43,21 @@ typedef struct bsim_backend {
 	int (*create)(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
 	              bsim_error *err);
 	void (*destroy)(bsim_world *w);
-	/* Advance one step of h seconds with force (N) on the body centre and
-	 * torque (N m, counter-clockwise) about it; a body that does not rotate
-	 * (body.rotates 0) ignores the torque. BSIM_OK, or BSIM_EFAIL with err
-	 * saying why (out of memory): the world cannot go on. What a solver
-	 * gave up on without failing is counted in the state's solver counts. */
-	int (*step)(bsim_world *w, const double force[2], double torque, double h, bsim_error *err);
+	/* The one call that moves a world: n >= 1 steps of h seconds each
+	 * under one wrench, force (N) on the body centre and torque (N m,
+	 * counter-clockwise) about it, held over them (a body that does not
+	 * rotate, body.rotates 0, ignores the torque); the state after each
+	 * into out[k] as get_state writes it (each sized for the world's beams
+	 * by bsim_state_init), or, out NULL, no state written. The steps made
+	 * into *made: n, or fewer (at least 1) where the backend's own paths
+	 * part (free flight ending near a beam, say); the caller asks again for
+	 * the rest. Whatever path makes them, each step is the step that a
+	 * call for one step would make, to the bit. BSIM_OK, or BSIM_EFAIL with
+	 * err saying why (out of memory): the world cannot go on. What a
+	 * solver gave up on without failing is counted in the state's solver
+	 * counts. */
+	int (*advance)(bsim_world *w, const double force[2], double torque, double h, int n,
+	               bsim_state *out, int *made, bsim_error *err);
 	void (*get_state)(const bsim_world *w, bsim_state *out);
 	int (*set_state)(bsim_world *w, const bsim_state *s, bsim_error *err);
 	/* The knob settings the accuracy study compares (beamsim/accuracy.h),
@@ -70,29 +79,6 @@ typedef struct bsim_backend {
 	 * force, and the backend reports its loss in the step's state
 	 * (bsim_state drag_loss, friction_loss). */
 	unsigned takes;
-	/* Optional (NULL: not offered; the runner calls step for every step).
-	 * Free flight: up to n steps of h seconds under force (N) and no
-	 * torque, each the step that step(w, force, 0, h) would make, for as
-	 * long as the body cannot reach a beam and every beam is at rest; the
-	 * body's centre and velocity after each into xv[k] = {x, y, vx, vy}
-	 * (m, m/s). Returns how many it made: 0 where the next step is not
-	 * such a step (or the backend does not tell, a body that turns, say),
-	 * and step makes it. After k > 0 of them get_state gives the state
-	 * before them with the body at xv[k - 1], no beam active, no impact
-	 * and zero energy flows. What the runner books per step (ledger,
-	 * energies, finiteness, outcome) it then books for the k from xv,
-	 * with one call instead of k (trial_flight.c). */
-	int (*flight)(bsim_world *w, const double force[2], double h, int n, double (*xv)[4]);
-	/* Optional (NULL: not offered). Up to n steps of h seconds under force
-	 * (N) and no torque, each the step that step(w, force, 0, h) would
-	 * make, the state after each into out[k] as get_state would write it
-	 * (each out[k] sized for the world's beams by bsim_state_init).
-	 * Returns how many it made: n, or 0 where the world is not one it
-	 * makes them for (a body that turns, a knob it does not take, too
-	 * many beams), and step makes them. The runner books a trial's steps
-	 * from these states as from get_state's, with one call for a run of
-	 * steps under one force instead of two calls a step (trial_steps.c). */
-	int (*steps)(bsim_world *w, const double force[2], double h, int n, bsim_state *out);
 	/* Optional (NULL: create refuses no valid scene for itself). What
 	 * create refuses of a scene valid on its own, for this backend's
 	 * limits (a body within Box2D's skin, a number beyond float32), and
@@ -144,6 +130,26 @@ BSIM_API double bsim_backend_pivot_drift(const bsim_backend *b, const bsim_scene
 /* The bound b states for check (bsim_backend_bound) into *bound: 1, or
  * 0 if b states none. */
 BSIM_API int bsim_backend_bound_of(const bsim_backend *b, const char *check, double *bound);
+
+/* A backend's single step (force N, torque N m, h s), and its get_state. */
+typedef int (*bsim_step_fn)(bsim_world *w, const double force[2], double torque, double h,
+                            bsim_error *err);
+typedef void (*bsim_get_state_fn)(const bsim_world *w, bsim_state *out);
+
+/* bsim_backend.advance for a backend that makes its steps one by one: n
+ * steps of step, each followed, where out is given, by get_state into
+ * out[k]; into *made the steps made. The first failing step's status, else
+ * BSIM_OK. */
+BSIM_API int bsim_backend_advance_each(bsim_world *w, bsim_step_fn step,
+                                       bsim_get_state_fn get_state, const double force[2],
+                                       double torque, double h, int n, bsim_state *out, int *made,
+                                       bsim_error *err);
+
+/* One step of world w of b (b->advance for one step, no state written):
+ * BSIM_OK, or BSIM_EFAIL with err. get_state then gives the state after
+ * it. */
+BSIM_API int bsim_backend_step(const bsim_backend *b, bsim_world *w, const double force[2],
+                               double torque, double h, bsim_error *err);
 
 #ifdef __cplusplus
 }

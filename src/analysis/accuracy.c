@@ -150,7 +150,7 @@ static int consistency_piece(const bsim_accuracy_reference *ref, const bsim_scen
 	const bsim_state *at = &ref->states[k]; /* the body's motion at the step's start */
 	for (long j = 0; j < m && rc == BSIM_OK; j++) {
 		bsim_effects_force_at(&fx, n0 + j, h, at, f);
-		rc = b->step(w, f, f[2], h, err);
+		rc = bsim_backend_step(b, w, f, f[2], h, err);
 		if (fx.n_work < fx.n) { /* effects that read the state */
 			b->get_state(w, s);
 			at = s;

@@ -190,11 +190,11 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	for (long n = 0; n < n_max; n++) {
 		double f[BSIM_WRENCH];
 		bsim_effects_force_at(&fx, n, s->dt, at, f);
-		if (be->step(w, f, f[2], s->dt, err) != BSIM_OK) {
+		int made;
+		if (be->advance(w, f, f[2], s->dt, 1, &r->s1, &made, err) != BSIM_OK) {
 			out = -1;
 			break;
 		}
-		be->get_state(w, &r->s1);
 		if (!isfinite(r->s1.x[0]) || !isfinite(r->s1.x[1]) || !isfinite(r->s1.v[0]) ||
 		    !isfinite(r->s1.v[1])) {
 			bsim_error_set(err, BSIM_EFAIL,

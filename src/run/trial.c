@@ -6,6 +6,13 @@
  * (trial_gates, trial_log), recording (trial_record) and the overlap measure
  * (trial_overlap).
  *
+ * One call moves the world (bsim_backend.advance): one step at a time in
+ * the step loop, which books each state with all the runner defines; or,
+ * in a plain trial (nothing recorded, traced or measured per step, no
+ * lattice) whose forces hold between the random force's draws, the steps
+ * up to the force's next change in one call, booked by run_book, which
+ * gives the same bits as the step loop (test_steps, test_flight).
+ *
  * Cost. A step's bookkeeping visits only the beams the backend lists as
  * active (bsim_state.active: the others are exactly at rest), so in a
  * lattice it costs what the beams near the body cost, like the backend's
@@ -28,7 +35,6 @@
 #include "beamsim/lattice.h"
 #include "model/schedule_spare.h"
 #include "run/trial_essay.h"
-#include "run/trial_flight.h"
 #include "run/trial_gates.h"
 #include "run/trial_ledger.h"
 #include "run/trial_log.h"
@@ -44,7 +50,6 @@ struct bsim_trial_runner {
 	bsim_state whole;  /* the whole lattice's state, for recording (essay protocol) */
 	trial_peaks peaks;
 	trial_essay essay;
-	trial_flight flight;      /* free-flight runs */
 	trial_steps steps;        /* runs of steps */
 	bsim_effects_spare spare; /* the last trial's schedule and footprint, for the next */
 	/* The world of the last trial, kept for the next trial of the same
@@ -407,34 +412,22 @@ __attribute__((noinline)) static void trial_measure(trial_ctx *c, const bsim_sta
 	trial_peaks_turn(&c->r->peaks, s1);
 }
 
-/* Always inlined: a copy in the step loop and one, plain, in the runs. */
-#if defined(__GNUC__)
-#define TRIAL_BOOK static inline __attribute__((always_inline))
-#else
-#define TRIAL_BOOK static inline
-#endif
-
-/* What booking a state gives (trial_book). */
+/* What booking a state gives (trial_book, run_book). */
 enum { BOOK_ON = 0, BOOK_END = 1, BOOK_NONFINITE = 2 };
 
-/* Books s1, the state after step lp->n + 1, from s0, the state before it:
- * its energy and finiteness, the step's count, the trace, the ledger, the
- * overlap, and before the outcome is known the peaks, the gate and the
- * outcome. BOOK_NONFINITE: s1 is not finite and not kept (s0 stays the
- * last finite state, the one reported); else s1 is kept (the caller makes
- * it the state s0), BOOK_END if the trial ends there (a side exit, or *rc
- * failed). The step loop and the runs of steps book every state by it;
- * plain (a constant): nothing traced or measured per step, no lattice, as
- * in the runs (trial_steps_start), whose copy has none of their tests and
- * leaves the contact flags and the last touching contacts to the run's
- * end (bsim_trial_run). */
-TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bsim_state *s1,
-                          int *rc, bsim_error *err, const int plain)
+/* Books s1, the state after step lp->n + 1 of the step loop, from s0, the
+ * state before it: its energy and finiteness, the step's count, its
+ * contact flags, the trace, the ledger, the overlap, and before the
+ * outcome is known the peaks, the gate and the outcome. BOOK_NONFINITE: s1
+ * is not finite and not kept (s0 stays the last finite state, the one
+ * reported); else s1 is kept (the caller makes it the state s0), BOOK_END
+ * if the trial ends there (a side exit, or *rc failed). Inline: the step
+ * loop makes no call for it. */
+static inline int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bsim_state *s1,
+                             int *rc, bsim_error *err)
 {
 	bsim_trial_result *out = c->out;
-	/* plain: the world holds the scene (no map) */
-	const bsim_scene *ws = plain ? c->scene : c->ws;
-	const int *map = plain ? NULL : c->map;
+	const bsim_scene *ws = c->ws;
 	double e1;
 	if (!state_energy_finite(ws, s1, &e1)) {
 		out->instability = BSIM_UNSTABLE_NONFINITE;
@@ -445,29 +438,148 @@ TRIAL_BOOK int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0, bs
 	c->gate.dwell++;
 	lp->run_on += lp->done;
 	/* The flags of every state the trace, the recording, the overlap and
-	 * the peaks see; a run computes them for its last touching state and
-	 * the trial's last state only (bsim_trial_run, trial_result). */
-	if (!plain)
-		bsim_contact_flags(ws, s1);
-	if (!plain && c->trace)
+	 * the peaks see (a run computes them for its last touching state and
+	 * the trial's last state only: bsim_trial_run, trial_result). */
+	bsim_contact_flags(ws, s1);
+	if (c->trace)
 		c->trace(c->rec->trace_user, lp->n, trial_trace_state(c, s1));
 	ledger_step(&out->ledger, c->fx, s0, s1, lp->e0, e1);
 	lp->e0 = e1;
-	if (!plain && c->measure)
+	if (c->measure)
 		trial_measure(c, s1);
 	if (lp->done)
 		return BOOK_ON;
-	/* The peaks; a run's states stay where they are until its booking
-	 * ends, so that the last touching contacts are found then. */
-	if (plain)
-		trial_peaks_note(&c->r->peaks, c->scene, NULL, s1);
-	else
-		trial_peaks_step(&c->r->peaks, c->scene, map, s1);
+	trial_peaks_step(&c->r->peaks, c->scene, c->map, s1);
 	/* The gate first: a body that leaves the field ends in its gate. */
-	if (!plain && c->scene->has_lattice &&
-	    (*rc = gate_follow(c, lp, s1, s0->x, err)) != BSIM_OK)
+	if (c->scene->has_lattice && (*rc = gate_follow(c, lp, s1, s0->x, err)) != BSIM_OK)
 		return BOOK_END;
 	return outcome_at(c, lp, s1) ? BOOK_END : BOOK_ON;
+}
+
+/* Always inlined: a copy for the essay's pipeline, its axes constants,
+ * and one for any pipeline that holds. */
+#if defined(__GNUC__)
+#define TRIAL_BOOK static inline __attribute__((always_inline))
+#else
+#define TRIAL_BOOK static inline
+#endif
+
+/* The pipeline of a run (trial_force_holds): the propulsion's force (N)
+ * and the held random force's, each over the whole run. */
+typedef struct run_forces {
+	double cp, cr;
+} run_forces;
+
+/* The ledger's lines a step adds to (LEDGER_LINES_ADD), held in locals
+ * while a run is booked. */
+typedef struct run_lines {
+	double w_prop, w_rand, damper, impact, contact, correction, sleep;
+	double residual, residual_abs, residual_max, inflow;
+} run_lines;
+
+/* Books a run's states[0..m) after *s0p (the state after lp->n steps) as
+ * the step loop books a state of a plain trial (nothing recorded, traced
+ * or measured, no lattice: trial_book without the flags, the trace, the
+ * measures and the gate), the operations in their order, with what the run
+ * does not change held in locals: the ledger's lines, the loop's counters,
+ * the scene's lines and the pipeline's forces, propulsion rf->cp along
+ * axis ap (has_p) and the held random force rf->cr along ar (has_r),
+ * constants where the caller gives them; each force's work is summed from
+ * 0.0, as ledger_step's loop sums it. Before each state, the step loop's
+ * test whether the trial is over, once the outcome is known. The peaks
+ * take no contacts here (the caller gives them the run's last touching
+ * state), and the test of a state that lists no beam (trial_peaks_note) is
+ * asked again only after a booking that updated them. Returns what the
+ * last booking gave (BOOK_ON: every state booked, or the trial over); *s0p
+ * the last state kept, *listed 0 if no state booked lists a beam. */
+TRIAL_BOOK int run_book(trial_ctx *c, trial_loop *lp, bsim_state **s0p, bsim_state *states, int m,
+                        int *listed, const run_forces *rf, const int has_p, const int ap,
+                        const int has_r, const int ar)
+{
+	const bsim_scene *sc = c->scene;
+	bsim_trial_result *out = c->out;
+	bsim_ledger *l = &out->ledger;
+	trial_peaks *peaks = &c->r->peaks;
+	const double cp = rf->cp, cr = rf->cr;
+	const double centre = c->centre, side_x = sc->side_x, success_y = sc->success_y;
+	const double classify_y = sc->classify_y;
+	const long n_max = c->n_max;
+	bsim_state *s0 = *s0p;
+	double e0 = lp->e0;
+	long n = lp->n, run_on = lp->run_on, dwell = c->gate.dwell;
+	int done = lp->done;
+	run_lines lines = {l->w_prop,       l->w_rand,       l->damper, l->impact,
+	                   l->contact,      l->correction,   l->sleep,  l->residual,
+	                   l->residual_abs, l->residual_max, l->inflow};
+	int quiet = peaks->n_negative == 0 && peaks->settled01;
+	int any = 0;
+	int b = BOOK_ON;
+	for (int k = 0; k < m; k++) {
+		/* trial_over, the outcome known */
+		if (done && (s0->x[1] >= classify_y || run_on >= n_max))
+			break;
+		bsim_state *s1 = &states[k];
+		double e1;
+		if (!state_energy_finite(sc, s1, &e1)) {
+			out->instability = BSIM_UNSTABLE_NONFINITE;
+			out->unstable_step = (int)(n + 1);
+			b = BOOK_NONFINITE;
+			break;
+		}
+		n++;
+		dwell++;
+		run_on += done;
+		any |= s1->n_active;
+		/* ledger_step, the pipeline's forces held */
+		const double d[2] = {s1->x[0] - s0->x[0], s1->x[1] - s0->x[1]};
+		double w_prop = 0.0, w_rand = 0.0;
+		if (has_p)
+			w_prop += cp * d[ap];
+		if (has_r)
+			w_rand += cr * d[ar];
+		const bsim_step_energy *se = &s1->energy;
+		const double r = ledger_residual(e0, e1, w_prop, w_rand, se);
+		LEDGER_LINES_ADD(lines, w_prop, w_rand, se, r);
+		e0 = e1;
+		s0 = s1;
+		if (done)
+			continue;
+		if (s1->n_active || !quiet) {
+			trial_peaks_note(peaks, sc, NULL, s1);
+			quiet = peaks->n_negative == 0 && peaks->settled01;
+		}
+		/* outcome_at */
+		if (fabs(s1->x[0] - centre) >= side_x) {
+			out->outcome = BSIM_SIDE_EXIT;
+			b = BOOK_END;
+			break;
+		}
+		if (s1->x[1] >= success_y) {
+			out->outcome = BSIM_TRAVERSED;
+			out->steps = (int)n;
+			out->t_end = (double)n * lp->h;
+			done = 1;
+		}
+	}
+	l->w_prop = lines.w_prop;
+	l->w_rand = lines.w_rand;
+	l->damper = lines.damper;
+	l->impact = lines.impact;
+	l->contact = lines.contact;
+	l->correction = lines.correction;
+	l->sleep = lines.sleep;
+	l->residual = lines.residual;
+	l->residual_abs = lines.residual_abs;
+	l->residual_max = lines.residual_max;
+	l->inflow = lines.inflow;
+	lp->e0 = e0;
+	lp->n = n;
+	lp->run_on = run_on;
+	lp->done = done;
+	c->gate.dwell = dwell;
+	*s0p = s0;
+	*listed = any;
+	return b;
 }
 
 int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_backend *backend,
@@ -489,59 +601,61 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	trial_loop lp;
 	rc = trial_begin(&c, &lp, s0, err);
 	const int plain = !c.recording && !c.trace && !c.measure && !c.map;
-	trial_flight_start(&r->flight, plain, backend, c.w, scene, &fx, out, &r->peaks, c.n_max,
-	                   c.gate_max, c.centre);
-	if (rc == BSIM_OK &&
-	    trial_steps_start(&r->steps, plain, backend, scene, &fx, c.n_max, c.gate_max))
+	if (rc == BSIM_OK && trial_steps_start(&r->steps, plain, scene, &fx, c.n_max, c.gate_max))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
-		int run = trial_flight_try(&r->flight, &lp, &c.gate.dwell, s0);
-		if (run == 1)
-			break;
-		if (run == 0)
-			continue;
 		double f[BSIM_WRENCH];
 		bsim_effects_force_at(&fx, lp.n, lp.h, s0, f);
 		bsim_state *states;
-		int m = r->steps.on ? trial_steps_make(&r->steps, c.w, f, &lp, c.gate.dwell, s0,
-		                                       &states)
+		int m = 0;
+		const long room =
+		        r->steps.on ? trial_steps_room(&r->steps, &lp, c.gate.dwell, s0, &states)
 		                    : 0;
-		if (m > 0) {
+		if (room > 0) {
+			/* a world that fails part-way: the steps made before are
+			 * booked, then the trial ends */
+			rc = backend->advance(c.w, f, f[2], lp.h, (int)room, states, &m, err);
 			/* The run's states, booked until the trial ends. The run's
-			 * room (trial_run_room) keeps max_steps and gate_steps:
-			 * before the outcome is known, only a booking ends it. */
-			int b = BOOK_ON;
+			 * room keeps max_steps and gate_steps: before the outcome
+			 * is known, only a booking ends it. */
 			const long n0 = lp.n;
 			const int open_at_start = !lp.done;
-			for (int k = 0;
-			     k < m && b == BOOK_ON && !(lp.done && trial_over(&c, &lp, s0)); k++) {
-				b = trial_book(&c, &lp, s0, &states[k], &rc, err, 1);
-				if (b != BOOK_NONFINITE)
-					s0 = &states[k];
-			}
+			bsim_state *kept = s0;
+			run_forces rf = {r->steps.propulsion ? r->steps.propulsion->last : 0.0,
+			                 r->steps.random ? r->steps.random->last : 0.0};
+			int b, listed;
+			if (r->steps.propulsion && r->steps.random &&
+			    r->steps.propulsion->axis == 1 &&
+			    r->steps.random->axis == 0) /* the essay's */
+				b = run_book(&c, &lp, &kept, states, m, &listed, &rf, 1, 1, 1, 0);
+			else
+				b = run_book(&c, &lp, &kept, states, m, &listed, &rf,
+				             r->steps.propulsion != NULL,
+				             r->steps.propulsion ? r->steps.propulsion->axis : 0,
+				             r->steps.random != NULL,
+				             r->steps.random ? r->steps.random->axis : 0);
+			s0 = kept;
 			/* The states kept before the outcome was known: to the
 			 * traversal's step, or all kept. */
 			const long open = !open_at_start ? 0 : (lp.done ? out->steps : lp.n) - n0;
 			/* The last of them in which the body touches a beam gives
 			 * the peaks' contacts, as the step loop would have left
 			 * them: found from the end, most often at once. */
-			for (long k = open - 1; k >= 0; k--)
+			for (long k = listed ? open - 1 : -1; k >= 0; k--)
 				if (trial_touches(scene, &states[k])) {
 					bsim_contact_flags(scene, &states[k]);
 					trial_peaks_contacts(&r->peaks, NULL, &states[k]);
 					break;
 				}
-			if (b != BOOK_ON)
+			if (b != BOOK_ON || rc != BSIM_OK)
 				break;
-			trial_flight_passed(&r->flight, m - 1);
 			continue;
 		}
 		if (c.recording && lp.n % c.stride == 0)
 			trial_record(&c, s0, lp.n);
-		if ((rc = backend->step(c.w, f, f[2], lp.h, err)) != BSIM_OK)
+		if ((rc = backend->advance(c.w, f, f[2], lp.h, 1, s1, &m, err)) != BSIM_OK)
 			break;
-		backend->get_state(c.w, s1);
-		int b = trial_book(&c, &lp, s0, s1, &rc, err, 0);
+		int b = trial_book(&c, &lp, s0, s1, &rc, err);
 		if (b == BOOK_NONFINITE)
 			break;
 		/* s1 is always one of the runner's two states (a run's states

@@ -16,7 +16,6 @@
 
 #include "beamsim/effects.h"
 #include "beamsim/trial.h"
-#include "util/fminmax.h"
 
 /* Kinetic energy of body and beams, J: the body's translation, and its
  * rotation 1/2 J omega^2 if it turns. Beams at rest add nothing. */
@@ -83,6 +82,37 @@ static inline int state_energy_finite(const bsim_scene *sc, const bsim_state *s,
 	return isfinite(sum) && isfinite(*e);
 }
 
+/* What is left of a step's energy change e0 -> e1 when the work of the
+ * forces (w_prop, w_rand) and the backend's losses se are booked, J. */
+static inline double ledger_residual(double e0, double e1, double w_prop, double w_rand,
+                                     const bsim_step_energy *se)
+{
+	return (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -
+	                    se->correction - se->sleep);
+}
+
+/* The lines every step adds to, in L (an lvalue with bsim_ledger's names
+ * for them: the ledger itself, or a run's copy of them held in locals,
+ * trial.c's run_book), from the step's work w_prop, w_rand, losses se and
+ * residual r. The largest |r| as bsim_fmax keeps it: |r| is never -0, and
+ * residual_max, which starts at +0 and only ever takes a value of |r|,
+ * neither -0 nor NaN, so it is the larger of the two, |r| NaN not taken. */
+#define LEDGER_LINES_ADD(L, w_prop_, w_rand_, se_, r_)                                             \
+	do {                                                                                       \
+		const double r_abs_ = fabs(r_);                                                    \
+		(L).w_prop += (w_prop_);                                                           \
+		(L).w_rand += (w_rand_);                                                           \
+		(L).damper += (se_)->damper;                                                       \
+		(L).impact += (se_)->impact;                                                       \
+		(L).contact += (se_)->contact;                                                     \
+		(L).correction += (se_)->correction;                                               \
+		(L).sleep += (se_)->sleep;                                                         \
+		(L).residual += (r_);                                                              \
+		(L).residual_abs += r_abs_;                                                        \
+		(L).residual_max = r_abs_ > (L).residual_max ? r_abs_ : (L).residual_max;          \
+		(L).inflow += fabs(w_prop_) + fabs(w_rand_);                                       \
+	} while (0)
+
 /* One step's entry in the ledger, s0 -> s1 with energies e0 -> e1: the work
  * of each force over the body's displacement and of each torque over its
  * turn, the backend's losses, and what is left over. The drag and ground
@@ -107,8 +137,7 @@ static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsi
 				w_prop += work;
 		}
 	const bsim_step_energy *se = &s1->energy;
-	double r = (e1 - e0) - (w_prop + w_rand - se->damper - se->impact - se->contact -
-	                        se->correction - se->sleep);
+	double r = ledger_residual(e0, e1, w_prop, w_rand, se);
 	if (fx->n_work < fx->n) { /* the effects booked on their own lines */
 		const double turn = s1->heading - s0->heading;
 		for (int i = fx->n_work; i < fx->n; i++) {
@@ -133,17 +162,7 @@ static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsi
 			}
 		}
 	}
-	l->w_prop += w_prop;
-	l->w_rand += w_rand;
-	l->damper += se->damper;
-	l->impact += se->impact;
-	l->contact += se->contact;
-	l->correction += se->correction;
-	l->sleep += se->sleep;
-	l->residual += r;
-	l->residual_abs += fabs(r);
-	l->residual_max = bsim_fmax(l->residual_max, fabs(r));
-	l->inflow += fabs(w_prop) + fabs(w_rand);
+	LEDGER_LINES_ADD(*l, w_prop, w_rand, se, r);
 }
 
 /* The ledger's close after step n, the energy e_end: an ordinary result

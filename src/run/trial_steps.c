@@ -1,9 +1,9 @@
-/* Runs of steps (trial_steps.h): a backend's bsim_backend.steps, for the
- * steps over which the force holds.
+/* Runs of steps (trial_steps.h): the steps over which the force holds,
+ * made by one call of the backend's advance.
  *
  * Why the force is the same. The step loop asks the pipeline for the
  * force before each step; where it holds (trial_force_holds: propulsion
- * along y gives its constant, the held random force its held value until
+ * gives its constant, the held random force its held value until
  * the step its hold ends, and neither reads the state), the force asked
  * before a run is the force of each step of it up to the hold's end, and
  * asking it again after the run gives what the step loop would get there
@@ -50,13 +50,31 @@ static int steps_reserve(trial_steps *t, int n_beams)
 	return BSIM_OK;
 }
 
-int trial_steps_start(trial_steps *t, int plain, const bsim_backend *backend,
-                      const bsim_scene *scene, bsim_effects *fx, long n_max, long gate_max)
+int trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
+                      bsim_effect **random)
 {
-	bsim_effect *propulsion;
-	t->on = plain && backend->steps && scene->n_beams <= TRIAL_STEPS_BEAMS &&
-	        trial_force_holds(scene, fx, &propulsion, &t->random);
-	t->steps = backend->steps;
+	int holds = !scene->has_lattice && !scene->body.rotates && !scene->effects.has_drag &&
+	            !scene->effects.has_ground_friction && fx->n_work == fx->n;
+	/* the pipeline: the propulsion, then the held random force, either
+	 * or both */
+	*propulsion = *random = NULL;
+	for (int i = 0; i < fx->n && holds; i++) {
+		bsim_effect *e = &fx->e[i];
+		if (e->kind == BSIM_EFFECT_CONSTANT && !*propulsion && !*random)
+			*propulsion = e;
+		else if (e->kind == BSIM_EFFECT_HELD && e == fx->random && !*random)
+			*random = e;
+		else
+			holds = 0;
+	}
+	return holds;
+}
+
+int trial_steps_start(trial_steps *t, int plain, const bsim_scene *scene, bsim_effects *fx,
+                      long n_max, long gate_max)
+{
+	t->on = plain && scene->n_beams <= TRIAL_STEPS_BEAMS &&
+	        trial_force_holds(scene, fx, &t->propulsion, &t->random);
 	t->n_max = n_max;
 	t->gate_max = gate_max;
 	if (t->on && steps_reserve(t, scene->n_beams)) {

@@ -1,16 +1,29 @@
 /* Internal: runs of steps (trial_steps.c). Where the forces hold between
  * the random force's draws (trial_force_holds) and nothing is recorded per
- * step, a backend that offers bsim_backend.steps makes the steps up to the
- * force's next change in one call, writing each state into the runner's
- * storage here, and the runner (trial.c) books each as it books the state
- * get_state gives after a step, with the same function: the same bits,
- * without two calls a step and the pipeline asked each step. */
+ * step, the runner asks the backend for the steps up to the force's next
+ * change in one call (bsim_backend.advance), each state written into the
+ * runner's storage here, and books them in one pass (trial.c's run_book,
+ * the step loop's operations for such a trial): the same bits, without a
+ * call and the pipeline asked each step.
+ *
+ * Also the loop's state (trial_loop), which trial.c's step loop and the
+ * runs share. */
 #ifndef BSIM_RUN_TRIAL_STEPS_H
 #define BSIM_RUN_TRIAL_STEPS_H
 
 #include "beamsim/backend.h"
 #include "beamsim/effects.h"
-#include "run/trial_flight.h"
+
+/* What the step loop carries from step to step. Apart from the context,
+ * whose address the backend's calls see, so that the loop can hold it in
+ * registers. */
+typedef struct trial_loop {
+	double h;    /* s, the time step */
+	long n;      /* steps done */
+	double e0;   /* J, the energy after step n */
+	int done;    /* the outcome is known; running on to classify_y */
+	long run_on; /* steps since */
+} trial_loop;
 
 /* The most steps of one run (a run also ends where the held random force
  * takes its next value), and the most beams of a scene whose trials take
@@ -19,10 +32,10 @@
 #define TRIAL_STEPS_BEAMS 64
 
 typedef struct trial_steps {
-	int on; /* the trial takes runs (trial_steps_start) */
-	int (*steps)(bsim_world *w, const double force[2], double h, int n, bsim_state *out);
-	bsim_effect *random;  /* the pipeline's held random force, or NULL */
-	long n_max, gate_max; /* steps in all, in one gate */
+	int on;                  /* the trial takes runs (trial_steps_start) */
+	bsim_effect *propulsion; /* the pipeline's propulsion, or NULL */
+	bsim_effect *random;     /* the pipeline's held random force, or NULL */
+	long n_max, gate_max;    /* steps in all, in one gate */
 	/* Two banks of states, for the beams of `cap`: a run writes into the
 	 * bank that does not hold the state it starts from. */
 	bsim_state bank[2][TRIAL_STEPS_MAX];
@@ -32,33 +45,52 @@ typedef struct trial_steps {
 void trial_steps_init(trial_steps *t);
 void trial_steps_free(trial_steps *t);
 
-/* Sets t for a trial of scene in pipeline fx: runs when plain (nothing
- * recorded, traced or measured per step), the backend offers them, the
- * forces hold and the scene has at most TRIAL_STEPS_BEAMS beams. BSIM_EFAIL
- * out of memory for the states (t->on 0 then). */
-int trial_steps_start(trial_steps *t, int plain, const bsim_backend *backend,
-                      const bsim_scene *scene, bsim_effects *fx, long n_max, long gate_max);
+/* 1 if the forces of the scene's pipeline fx hold between the random
+ * force's draws, so that the force asked before a step is the force of the
+ * steps after it up to the hold's end (0 if not): no lattice, a body that
+ * does not turn, and every effect one that holds (a constant force, the
+ * propulsion, then the held random force), at most one of each (no drag or ground friction, in
+ * the pipeline or simulated by the backend). The two effects into
+ * *propulsion and *random (NULL: absent). */
+int trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
+                      bsim_effect **random);
 
-/* For a trial t->on: a run from s0, the state after lp->n steps, under force (the
- * pipeline's for step lp->n, just asked), dwell steps in the gate: up to
- * the force's next change and the end of the trial. Returns the states
- * made, into *out (0: none, the step loop makes the step; a world the
- * backend makes none for ends the trial's runs). Inline: the runner asks
- * it once a run, about every fifth step of H1. */
-static inline int trial_steps_make(trial_steps *t, bsim_world *w, const double force[2],
-                                   const trial_loop *lp, long dwell, const bsim_state *s0,
-                                   bsim_state **out)
+/* Sets t for a trial of scene in pipeline fx: runs when plain (nothing
+ * recorded, traced or measured per step), the forces hold and the scene
+ * has at most TRIAL_STEPS_BEAMS beams. BSIM_EFAIL out of memory for the
+ * states (t->on 0 then). */
+int trial_steps_start(trial_steps *t, int plain, const bsim_scene *scene, bsim_effects *fx,
+                      long n_max, long gate_max);
+
+/* The steps a run from step lp->n may make under the force just asked, the
+ * gate's dwell steps so far: to the end of the trial (max_steps n_max, or
+ * after the outcome max_steps more; gate_steps gate_max in one gate), to
+ * the end of the held random force's hold (er, NULL: none), max at most;
+ * 0 if er does not hold at lp->n (the force is not one for a run). */
+static inline long trial_run_room(const trial_loop *lp, long dwell, long n_max, long gate_max,
+                                  const bsim_effect *er, long max)
 {
-	const long room =
-	        trial_run_room(lp, dwell, t->n_max, t->gate_max, t->random, TRIAL_STEPS_MAX);
-	if (room < 1)
-		return 0; /* the step loop's step */
-	bsim_state *bank = t->bank[s0 >= t->bank[0] && s0 < t->bank[0] + TRIAL_STEPS_MAX];
-	int m = t->steps(w, force, lp->h, (int)room, bank);
-	if (m == 0)
-		t->on = 0; /* the backend makes none for this world */
-	*out = bank;
-	return m;
+	long room = lp->done ? n_max - lp->run_on : n_max - lp->n;
+	if (!lp->done && gate_max - dwell < room)
+		room = gate_max - dwell;
+	if (er) {
+		if (!(lp->n >= er->held[0] && lp->n < er->held[1] && lp->h == er->held_h))
+			return 0;
+		if (er->held[1] - lp->n < room)
+			room = er->held[1] - lp->n;
+	}
+	return room < max ? room : max;
+}
+
+/* For a trial t->on: the steps a run from s0, the state after lp->n steps,
+ * may make (trial_run_room; 0: none, the step loop makes one) and the
+ * bank its states go into, the one that does not hold s0. Inline: the
+ * runner asks it once a run, about every fifth step of H1. */
+static inline long trial_steps_room(trial_steps *t, const trial_loop *lp, long dwell,
+                                    const bsim_state *s0, bsim_state **bank)
+{
+	*bank = t->bank[s0 >= t->bank[0] && s0 < t->bank[0] + TRIAL_STEPS_MAX];
+	return trial_run_room(lp, dwell, t->n_max, t->gate_max, t->random, TRIAL_STEPS_MAX);
 }
 
 #endif
