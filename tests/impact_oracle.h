@@ -37,8 +37,11 @@ typedef struct impact_figures {
  * with
  *   mu = M r^2 / I,  v' = u (mu - e) / (1 + mu) (forward),
  *   omega' = (1 + e) u mu / (r (1 + mu)),  v_rel' = e u,
- * the angular momentum about the pivot M x v + J w + I omega = M r u, and
- * the loss 1/2 m_eff (1 - e^2) u^2 with m_eff = M / (1 + mu). Fills f
+ * the angular momentum about the pivot M x v + J w + I omega = M r u, the
+ * loss 1/2 m_eff (1 - e^2) u^2 with m_eff = M / (1 + mu), and the normal
+ * impulse the beam reports (bsim_state.impulse, summed over the steps)
+ * M (u - v): the body's momentum change, which it alone changes, and the
+ * closed form's M u (1 + e) / (1 + mu). Fills f
  * (may be NULL) and returns the largest relative error; every error within
  * bound. The body starts 2 cm from the beam (a backend may start its
  * contact before touching: Box2D's skin, 5 cm at unit_scale 1) and the run
@@ -83,13 +86,16 @@ static inline double impact_square_on(const bsim_backend *b, const bsim_options 
 	bsim_state_init(&st, 1);
 	const double zero[2] = {0.0, 0.0};
 	int impacts = 0, tangent = 0;
-	double impact_loss = 0.0;
+	double impact_loss = 0.0, impulse = 0.0;
 	for (int n = 0; n < 20; n++) {
 		assert_int_equal(bsim_backend_step(b, w, zero, 0.0, 0.004, NULL), BSIM_OK);
 		b->get_state(w, &st);
 		bsim_contact_flags(&s, &st);
 		impacts += st.impacts;
 		impact_loss += st.energy.impact;
+		/* the impulse reported where, and only where, the beam was touched */
+		assert_true(st.touched[0] ? st.impulse[0] > 0.0 : st.impulse[0] == 0.0);
+		impulse += st.impulse[0];
 		tangent |= st.contact[0] == BSIM_CONTACT_TANGENT;
 		assert_true(st.contact[0] != BSIM_CONTACT_TIP);
 	}
@@ -111,6 +117,11 @@ static inline double impact_square_on(const bsim_backend *b, const bsim_options 
 	double err_loss = fabs(impact_loss - loss) / (0.5 * mass * u * u);
 	double l1 =
 	        mass * (st.x[0] * st.v[1] - st.x[1] * st.v[0]) + j * spin + inertia * st.omega[0];
+	/* The normal impulses the beam reported: the body's momentum change
+	 * along the normal (-y: no other force acts), and the closed form's
+	 * P = M (u - v'). */
+	double err_p = fabs(impulse - mass * (u - st.v[1])) / (mass * u);
+	double err_p_closed = fabs(impulse - mass * (u - v_expect)) / (mass * u);
 	double err_l = fabs(l1 - mass * r * u) / (mass * r * u);
 	if (f) {
 		f->restitution = (st.omega[0] * r - st.v[1]) / u;
@@ -127,13 +138,16 @@ static inline double impact_square_on(const bsim_backend *b, const bsim_options 
 	assert_true(err_w <= bound);
 	assert_true(err_rel <= 2.0 * bound); /* the difference of the two above */
 	assert_true(err_l <= bound);
+	assert_true(err_p <= bound);
+	assert_true(err_p_closed <= bound);
 	assert_true(err_loss <= bound);
 	assert_true(err_spin <= bound);
 	assert_true(impact_loss >= -bound * 0.5 * mass * u * u);
 	bsim_state_free(&st);
 	b->destroy(w);
 	bsim_scene_free(&s);
-	double worst = fmax(fmax(fmax(err_v, err_w), fmax(err_l, err_loss)), err_spin);
+	double worst = fmax(fmax(fmax(err_v, err_w), fmax(err_l, err_loss)),
+	                    fmax(err_spin, fmax(err_p, err_p_closed)));
 	if (f)
 		f->worst = worst;
 	return worst;

@@ -55,6 +55,7 @@ static void assert_same(const bsim_backend *be, const bsim_state *a, const bsim_
 			         be->name, step, i, b->theta[i], b->omega[i], a->theta[i],
 			         a->omega[i]);
 		assert_int_equal(a->touched[i], b->touched[i]);
+		assert_memory_equal(&a->impulse[i], &b->impulse[i], sizeof a->impulse[i]);
 		assert_int_equal(a->contact[i], b->contact[i]);
 		if (a->contact[i] != BSIM_CONTACT_NONE)
 			assert_memory_equal(&a->direction[2 * i], &b->direction[2 * i],

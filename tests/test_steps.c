@@ -86,6 +86,9 @@ static void assert_same_state(const bsim_state *a, const bsim_state *b, long ste
 	assert_memory_equal(a->contact, b->contact, nb * sizeof *a->contact);
 	for (int k = 0; k < a->n_active; k++) {
 		const int i = a->active[k];
+		if (memcmp(&a->impulse[i], &b->impulse[i], sizeof a->impulse[i]))
+			fail_msg("step %ld beam %d: impulse %.17g against %.17g", step, i,
+			         b->impulse[i], a->impulse[i]);
 		if (a->touched[i] != b->touched[i])
 			fail_msg("step %ld beam %d: touched %d against %d", step, i, b->touched[i],
 			         a->touched[i]);

@@ -316,6 +316,11 @@ struct beam_rec {
 	 * in the last step, as the state reports it (touched) */
 	bool pushed = false;
 	bool touched = false;
+	/* the normal impulses of this step's pushes (PostSolve, every solve of
+	 * every substep), and those of the last step as the state reports them,
+	 * N s */
+	double impulse_step = 0.0;
+	double impulse = 0.0;
 };
 
 class contact_ledger;
@@ -460,9 +465,13 @@ class contact_ledger : public b2ContactListener
 		float sum = 0.0f;
 		for (int j = 0; j < impulse->count; j++)
 			sum += impulse->normalImpulses[j];
-		if (sum > 0.0f && !b->pushed) {
-			b->pushed = true;
-			w_->pushed.push_back(b->index);
+		if (sum > 0.0f) {
+			const double p = (double)sum / w_->s; /* N s */
+			b->impulse_step = b->pushed ? b->impulse_step + p : p;
+			if (!b->pushed) {
+				b->pushed = true;
+				w_->pushed.push_back(b->index);
+			}
 		}
 		if (w_->rich) {
 			post_solve_rich(contact, b, impulse);
@@ -796,6 +805,7 @@ void world_build(bsim_world *w, const double x[2], const double v[2], double psi
 		b.row = false;
 		b.pushed = false;
 		b.touched = false;
+		b.impulse_step = b.impulse = 0.0;
 	}
 	w->pushed.clear();
 	w->touched.clear();
@@ -928,12 +938,16 @@ void update_contact_types(bsim_world *w)
 	}
 	/* The pushes spent: the state reports them as touched until the next
 	 * step's. */
-	for (int i : w->touched)
+	for (int i : w->touched) {
 		w->beams[(size_t)i].touched = false;
+		w->beams[(size_t)i].impulse = 0.0;
+	}
 	w->touched.clear();
 	for (int i : w->pushed) {
-		w->beams[(size_t)i].pushed = false;
-		w->beams[(size_t)i].touched = true;
+		beam_rec &b = w->beams[(size_t)i];
+		b.pushed = false;
+		b.touched = true;
+		b.impulse = b.impulse_step;
 		w->touched.push_back(i);
 	}
 	w->pushed.clear();
@@ -1475,6 +1489,7 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 		st->theta[i] = b.sgn * (double)b.body->GetAngle();
 		st->omega[i] = b.sgn * (double)b.body->GetAngularVelocity();
 		st->touched[i] = b.touched;
+		st->impulse[i] = b.impulse;
 		beam_direction(b, &st->direction[2 * i]);
 	}
 	st->energy = w->energy;

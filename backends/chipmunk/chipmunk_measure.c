@@ -88,9 +88,13 @@ static void measure_energy(struct bsim_world *w, double h)
 		} else {
 			w->energy.contact -= work;
 		}
-		if (b->normal_impulse > 0.0 && !b->pushed) {
-			b->pushed = 1;
-			w->pushed[w->n_pushed++] = w->live[k];
+		if (b->normal_impulse > 0.0) {
+			b->impulse_step =
+			        b->pushed ? b->impulse_step + b->normal_impulse : b->normal_impulse;
+			if (!b->pushed) {
+				b->pushed = 1;
+				w->pushed[w->n_pushed++] = w->live[k];
+			}
 		}
 	}
 	const cpVect dx = cpvsub(cpvsub(x1, w->x0), cpvmult(w->v0, h));
@@ -172,13 +176,16 @@ static void measure_flags(struct bsim_world *w)
 	}
 	/* The pushes spent: the state reports them as touched until the next
 	 * step's. */
-	for (int k = 0; k < w->n_reported; k++)
+	for (int k = 0; k < w->n_reported; k++) {
 		w->beams[w->reported[k]].reported = 0;
+		w->beams[w->reported[k]].impulse_reported = 0.0;
+	}
 	w->n_reported = 0;
 	for (int k = 0; k < w->n_pushed; k++) {
 		chip_beam *b = &w->beams[w->pushed[k]];
 		b->pushed = 0;
 		b->reported = 1;
+		b->impulse_reported = b->impulse_step;
 		w->reported[w->n_reported++] = w->pushed[k];
 	}
 	w->n_pushed = 0;

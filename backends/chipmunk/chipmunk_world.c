@@ -242,6 +242,7 @@ static void world_build(struct bsim_world *w, const double x[2], const double v[
 		b->touched = 0;
 		b->pushed = 0;
 		b->reported = 0;
+		b->impulse_step = b->impulse_reported = 0.0;
 	}
 	chipmunk_contact_install(w);
 
@@ -621,6 +622,7 @@ static void chipmunk_get_state(const bsim_world *w, bsim_state *st)
 		st->theta[i] = b->sgn * angle;
 		st->omega[i] = b->sgn * cpBodyGetAngularVelocity(b->body);
 		st->touched[i] = b->reported;
+		st->impulse[i] = b->impulse_reported;
 		bsim_beam_direction(b->u0, b->sgn, b->sgn * angle, &st->direction[2 * i]);
 		st->pin[2 * i] = pin.x;
 		st->pin[2 * i + 1] = pin.y;

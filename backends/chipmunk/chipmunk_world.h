@@ -44,6 +44,9 @@ typedef struct chip_beam {
 	cpVect offset;
 	int pushed;   /* a nonzero normal impulse with the body in the step (the flag) */
 	int reported; /* pushed in the last step, as the state reports it (touched) */
+	/* the normal impulses of this step's pushes (every substep's), and
+	 * those of the last step as the state reports them, N s */
+	double impulse_step, impulse_reported;
 } chip_beam;
 
 struct bsim_world {

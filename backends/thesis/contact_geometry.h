@@ -74,18 +74,20 @@ static inline void thesis_beam_direction_of(const thesis_beam *b, double u[2])
 }
 
 /* The state's raw facts of beam i (beamsim/state.h): its angle, angular
- * velocity, whether it was pushed in the step, its direction, NaN where
+ * velocity, whether it was pushed in the step and the normal impulse it
+ * took then (impulse, read where pushed), its direction, NaN where
  * it is neither pushed nor near (thesis_contact_near: the broad phase and
  * the last geometry bound it farther than BSIM_CONTACT_TOL, so no sine and
  * cosine); no pin (exact by construction: bsim_backend.exact_pins). A
  * near beam's direction is the next step's detection's too: kept (b->u). */
-static inline void thesis_state_beam(struct bsim_world *w, int i, int pushed, int near,
-                                     bsim_state *s)
+static inline void thesis_state_beam(struct bsim_world *w, int i, int pushed, double impulse,
+                                     int near, bsim_state *s)
 {
 	thesis_beam *b = &w->beams[i];
 	s->theta[i] = b->theta;
 	s->omega[i] = b->omega;
 	s->touched[i] = pushed;
+	s->impulse[i] = pushed ? impulse : 0.0;
 	if (pushed || near) {
 		thesis_beam_direction(b, &s->direction[2 * i]);
 	} else {

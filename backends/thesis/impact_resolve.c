@@ -75,7 +75,7 @@ THESIS_SPECIALISED void impact_apply(struct bsim_world *w, const thesis_contact 
 		else
 			b->omega -= cs[i].impulse * cs[i].c / b->inertia;
 		if (cs[i].impulse > 0.0)
-			thesis_beam_pushed(w, cs[i].beam);
+			thesis_beam_pushed(w, cs[i].beam, cs[i].impulse);
 	}
 }
 

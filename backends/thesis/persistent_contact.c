@@ -85,7 +85,7 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 	for (int k = 0; k < n; k++) {
 		w->contact_of[cs[k].beam] = k;
 		if (cs[k].impulse > 0.0)
-			thesis_beam_pushed(w, cs[k].beam);
+			thesis_beam_pushed(w, cs[k].beam, cs[k].impulse);
 	}
 	for (int a = 0; a < w->n_awake; a++) {
 		int i = w->awake[a];
@@ -160,7 +160,7 @@ void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double for
 	for (int k = 0; k < n; k++) {
 		w->contact_of[cs[k].beam] = k;
 		if (cs[k].impulse > 0.0)
-			thesis_beam_pushed(w, cs[k].beam);
+			thesis_beam_pushed(w, cs[k].beam, cs[k].impulse);
 	}
 	for (int a = 0; a < w->n_awake; a++) {
 		int i = w->awake[a];

@@ -197,6 +197,7 @@ struct bsim_world {
 	 * the gap the beams listed (contact_list.c). */
 	unsigned char *pushed; /* per beam */
 	int *pushed_list;      /* beams whose pushed is set */
+	double *impulse;       /* per beam, where pushed: its pushes' normal impulses, N s */
 	int n_pushed;
 	bsim_step_energy energy;
 	int impacts;
@@ -401,13 +402,17 @@ static inline int thesis_flight_clear(struct bsim_world *w, const double force[2
 	return thesis_broad_phase_clear(w, force, h);
 }
 
-/* Beam i exchanged a nonzero impulse with the body in this step (the
- * state reports it as touched; contact_list.c lists the beam). */
-static inline void thesis_beam_pushed(struct bsim_world *w, int i)
+/* Beam i exchanged a nonzero normal impulse (N s) with the body in this
+ * step (the state reports it as touched, and the impulses' sum in the
+ * order they came; contact_list.c lists the beam). */
+static inline void thesis_beam_pushed(struct bsim_world *w, int i, double impulse)
 {
-	if (w->pushed[i])
+	if (w->pushed[i]) {
+		w->impulse[i] += impulse;
 		return;
+	}
 	w->pushed[i] = 1;
+	w->impulse[i] = impulse;
 	w->pushed_list[w->n_pushed++] = i;
 }
 

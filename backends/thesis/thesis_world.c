@@ -169,6 +169,7 @@ static void thesis_destroy(bsim_world *w)
 	free(w->candidates);
 	free(w->typed);
 	free(w->pushed);
+	free(w->impulse);
 	free(w->pushed_list);
 	free(w->touched);
 	free(w->touched_list);
@@ -234,6 +235,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->typed = malloc(nb * sizeof *w->typed);
 		w->held = calloc(nb, sizeof *w->held);
 		w->pushed = calloc(nb, sizeof *w->pushed);
+		w->impulse = calloc(nb, sizeof *w->impulse);
 		w->pushed_list = malloc(nb * sizeof *w->pushed_list);
 		w->touched = calloc(nb, sizeof *w->touched);
 		w->touched_list = malloc(nb * sizeof *w->touched_list);
@@ -241,7 +243,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		w->near = malloc(nb * sizeof *w->near);
 	}
 	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type || !w->awake ||
-	    !w->is_awake || !w->candidates || !w->typed || !w->held || !w->pushed ||
+	    !w->is_awake || !w->candidates || !w->typed || !w->held || !w->pushed || !w->impulse ||
 	    !w->pushed_list || !w->touched || !w->touched_list || !w->start_awake || !w->near) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
@@ -543,7 +545,7 @@ THESIS_APART void thesis_get_state(const bsim_world *w, bsim_state *s)
 	bsim_world *cache = (bsim_world *)w;
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k];
-		thesis_state_beam(cache, i, w->pushed[i],
+		thesis_state_beam(cache, i, w->pushed[i], w->impulse[i],
 		                  thesis_contact_near(w, i, BSIM_CONTACT_TOL), s);
 	}
 	s->energy = w->energy;

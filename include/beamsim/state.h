@@ -71,6 +71,11 @@ typedef struct bsim_state {
 	 *   touched[i]      1 if beam i exchanged a nonzero normal impulse
 	 *                   with the body during the last step (an impact or
 	 *                   a resting contact's impulse), else 0;
+	 *   impulse[i]      N s, the normal impulse beam i exchanged with the
+	 *                   body during the last step, summed over its
+	 *                   contacts, impacts and resting contact alike (>= 0;
+	 *                   > 0 exactly where touched; position corrections,
+	 *                   which move no momentum, and friction not in it);
 	 *   direction[2i..] the unit vector from beam i's pivot to its tip at
 	 *                   the step's end (bsim_beam_direction of its angle),
 	 *                   or NaN (both) for a beam not touched that the
@@ -81,6 +86,7 @@ typedef struct bsim_state {
 	 *                   should be its pivot (not written by a backend
 	 *                   whose pins are exact, bsim_backend.exact_pins). */
 	int *touched;      /* n_beams */
+	double *impulse;   /* n_beams */
 	double *direction; /* 2 n_beams */
 	double *pin;       /* 2 n_beams */
 	/* The contact flag of each active beam (above), written by the runner

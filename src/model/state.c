@@ -14,10 +14,11 @@ int bsim_state_init(bsim_state *s, int n_beams)
 	s->contact = calloc(n, sizeof *s->contact);
 	s->active = calloc(n, sizeof *s->active);
 	s->touched = calloc(n, sizeof *s->touched);
+	s->impulse = calloc(n, sizeof *s->impulse);
 	s->direction = calloc(2 * n, sizeof *s->direction);
 	s->pin = calloc(2 * n, sizeof *s->pin);
-	if (!s->theta || !s->omega || !s->contact || !s->active || !s->touched || !s->direction ||
-	    !s->pin) {
+	if (!s->theta || !s->omega || !s->contact || !s->active || !s->touched || !s->impulse ||
+	    !s->direction || !s->pin) {
 		bsim_state_free(s);
 		return BSIM_EFAIL;
 	}
@@ -31,6 +32,7 @@ void bsim_state_free(bsim_state *s)
 	free(s->contact);
 	free(s->active);
 	free(s->touched);
+	free(s->impulse);
 	free(s->direction);
 	free(s->pin);
 	memset(s, 0, sizeof *s);
@@ -47,6 +49,7 @@ void bsim_state_copy(bsim_state *dst, const bsim_state *src)
 	memcpy(dst->omega, src->omega, (size_t)n * sizeof *dst->omega);
 	memcpy(dst->contact, src->contact, (size_t)n * sizeof *dst->contact);
 	memcpy(dst->touched, src->touched, (size_t)n * sizeof *dst->touched);
+	memcpy(dst->impulse, src->impulse, (size_t)n * sizeof *dst->impulse);
 	memcpy(dst->direction, src->direction, 2 * (size_t)n * sizeof *dst->direction);
 	memcpy(dst->pin, src->pin, 2 * (size_t)n * sizeof *dst->pin);
 	dst->n_active = 0;
@@ -77,6 +80,7 @@ void bsim_state_set_active(bsim_state *s, const int *active, int n)
 		s->omega[i] = 0.0;
 		s->contact[i] = BSIM_CONTACT_NONE;
 		s->touched[i] = 0;
+		s->impulse[i] = 0.0;
 	}
 	s->n_active = 0;
 	for (int k = 0; k < n; k++)
