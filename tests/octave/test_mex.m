@@ -536,3 +536,18 @@ for c = 1:size(cases, 1)
         id, msg);
 end
 printf('NUL in text: %d arguments refused, naming themselves\n', size(cases, 1));
+
+% Each MEX function's help (its .m file of comments beside it) says how it
+% is called, and a call still runs the MEX function.
+fns = {'beamsim_run', 'R = BEAMSIM_RUN(ARG, NAME, VALUE, ...)';
+       'beamsim_sweep', 'S = BEAMSIM_SWEEP(EXPERIMENT, NAME, VALUE, ...)';
+       'beamsim_landscape', 'L = BEAMSIM_LANDSCAPE(SCENE, NAME, VALUE, ...)';
+       'beamsim_read_csv', 'T = BEAMSIM_READ_CSV(FILE)'};
+for k = 1:size(fns, 1)
+  text = get_help_text(fns{k, 1});
+  check(~isempty(strfind(text, fns{k, 2})), 'help %s: no usage "%s" in "%s"', fns{k, 1}, ...
+        fns{k, 2}, text);
+  check(~isempty(regexp(which(fns{k, 1}), '\.mex$', 'once')), '%s is not the MEX function: %s', ...
+        fns{k, 1}, which(fns{k, 1}));
+end
+printf('help: %d MEX functions say how they are called\n', size(fns, 1));
