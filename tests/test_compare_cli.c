@@ -125,20 +125,44 @@ static void test_every_backend_a_side(void **state)
 	}
 }
 
-/* The exit status says what report.json says; threads change nothing. */
+/* The exit status says what report.json says; threads change nothing; the
+ * headline counts every group: those that disagree, agree and are left
+ * undecided (the inconclusive and uninformative of the line after it). */
 static void test_status_and_threads(void **state)
 {
 	(void)state;
 	const char *dir = out_dir("cmp1");
-	const char *argv[] = {"compare", experiment, "--threads", "1",
-	                      "--quiet", "--out",    dir,         NULL};
-	int status = bsim_test_cli(argv, NULL, NULL);
+	const char *argv[] = {"compare", experiment, "--threads", "1", "--out", dir, NULL};
+	char *out = NULL;
+	int status = bsim_test_cli(argv, &out, NULL);
 	char *json = read_in(dir, "report.json");
 	int disagreeing = -1;
 	const char *p = strstr(json, "\"groups_disagreeing\": ");
 	assert_non_null(p);
 	sscanf(p, "\"groups_disagreeing\": %d", &disagreeing);
 	assert_int_equal(status, disagreeing > 0 ? 3 : 0);
+	int head[4] = {-1, -1, -1, -1}, uninformative = -1, inconclusive = -1;
+	const char *h = strstr(out, " groups disagree, ");
+	assert_non_null(h);
+	while (h > out && h[-1] != ':')
+		h--;
+	assert_int_equal(sscanf(h, " %d of %d groups disagree, %d agree, %d undecided", &head[0],
+	                        &head[1], &head[2], &head[3]),
+	                 4);
+	const char *u = strstr(out, " uninformative"), *i = strstr(out, " inconclusive");
+	assert_true(u && i);
+	while (u > out && u[-1] != ' ')
+		u--;
+	while (i > out && i[-1] != ' ')
+		i--;
+	uninformative = atoi(u);
+	inconclusive = atoi(i);
+	print_message("headline: %d of %d disagree, %d agree, %d undecided\n", head[0], head[1],
+	              head[2], head[3]);
+	assert_int_equal(head[0], disagreeing);
+	assert_int_equal(head[0] + head[2] + head[3], head[1]);
+	assert_int_equal(head[3], uninformative + inconclusive);
+	free(out);
 	char *pairs1 = read_in(dir, "pairs.csv"), *pairs2 = read_in(cmp_dir, "pairs.csv");
 	assert_string_equal(pairs1, pairs2);
 	free(json);

@@ -224,9 +224,16 @@ static void compare_summary(const bsim_compare_dir_def *def, const char *out,
 	const int *k = all->count;
 	for (int i = 0; i < res->n_sides; i++)
 		printf("%s%s", i ? " vs " : "", side_label(def, i));
-	printf(" on %s: %d of %d groups disagree (alpha %g, margin %g), %d x %d trials\n",
-	       res->e.path, all->n_disagree, all->n_groups, cmp->rule.alpha, cmp->rule.margin,
-	       res->e.n_groups, res->e.trials);
+	/* The headline counts every group: those that disagree, those shown
+	 * alike (the same, equivalent, or a difference within the margin) and
+	 * those left undecided (inconclusive, or every event at the floor or
+	 * the ceiling), which more trials would decide. */
+	const int undecided = k[BSIM_VERDICT_INCONCLUSIVE] + k[BSIM_VERDICT_UNINFORMATIVE];
+	printf(" on %s: %d of %d groups disagree, %d agree, %d undecided (alpha %g, margin %g), "
+	       "%d x %d trials\n",
+	       res->e.path, all->n_disagree, all->n_groups,
+	       all->n_groups - all->n_disagree - undecided, undecided, cmp->rule.alpha,
+	       cmp->rule.margin, res->e.n_groups, res->e.trials);
 	printf("  deterministic: %d same, %d different; random: %d equivalent within +-%g, %d "
 	       "uninformative (at the floor or ceiling), %d inconclusive, %d small, %d disagree "
 	       "(Holm over %d tests)\n",
