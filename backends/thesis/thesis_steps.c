@@ -88,11 +88,11 @@ typedef struct gate_masks {
 } gate_masks;
 
 /* thesis_beam_pushed for the masks: beam i pushed by impulse p (> 0),
- * N s; impulse[i] the sum of its pushes in the step where pushed, in the
- * order thesis_beam_pushed sums them. */
-static inline void gate_push(unsigned *pushed, double *impulse, int i, double p)
+ * N s; w->impulse[i] the sum of its pushes in the step where pushed, in
+ * the order thesis_beam_pushed sums them. */
+static inline void gate_push(struct bsim_world *w, unsigned *pushed, int i, double p)
 {
-	impulse[i] = gate_in(*pushed, i) ? impulse[i] + p : p;
+	w->impulse[i] = gate_in(*pushed, i) ? w->impulse[i] + p : p;
 	*pushed |= 1u << i;
 }
 
@@ -101,7 +101,7 @@ static inline void gate_push(unsigned *pushed, double *impulse, int i, double p)
  * loss into *e_impact, the impacts counted into *impacts, the beams
  * pushed into *pushed. */
 static inline void gate_impacts(struct bsim_world *w, double h, int nc, unsigned *pushed,
-                                double *impulse, double *e_impact, int *impacts, int nb)
+                                double *e_impact, int *impacts, int nb)
 {
 	thesis_contact *cs = w->contacts;
 	int approaching;
@@ -120,7 +120,7 @@ static inline void gate_impacts(struct bsim_world *w, double h, int nc, unsigned
 		thesis_beam *b = &w->beams[cs[i].beam];
 		b->omega -= cs[i].impulse * cs[i].c / b->inertia;
 		if (cs[i].impulse > 0.0)
-			gate_push(pushed, impulse, cs[i].beam, cs[i].impulse);
+			gate_push(w, pushed, cs[i].beam, cs[i].impulse);
 	}
 	for (int i = 0; i < n; i++)
 		*impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->rest_threshold;
@@ -132,9 +132,8 @@ static inline void gate_impacts(struct bsim_world *w, double h, int nc, unsigned
  * the dampers' and contacts' energies into e_damper, e_contact.
  * integrator: w->integrator, a constant where the caller gives one. */
 THESIS_SPECIALISED void gate_solve(struct bsim_world *w, const double dv[2], double h, int nc,
-                                   unsigned awake, unsigned *pushed, double *impulse,
-                                   double *e_damper, double *e_contact, const int integrator,
-                                   const int nb)
+                                   unsigned awake, unsigned *pushed, double *e_damper,
+                                   double *e_contact, const int integrator, const int nb)
 {
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + dv[0], v0[1] + dv[1]};
@@ -152,7 +151,7 @@ THESIS_SPECIALISED void gate_solve(struct bsim_world *w, const double dv[2], dou
 		thesis_impulse_sum(cs, nc, j);
 		for (int k = 0; k < nc; k++)
 			if (cs[k].impulse > 0.0)
-				gate_push(pushed, impulse, cs[k].beam, cs[k].impulse);
+				gate_push(w, pushed, cs[k].beam, cs[k].impulse);
 	}
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm, integrator);
@@ -222,8 +221,8 @@ static inline void gate_report(struct bsim_world *w, gate_masks *mk, unsigned pu
  * h F / M of the free velocity; d2: each beam's beam_pivot_distance2 where
  * the body is, for the next step at its end (nothing moves in between). */
 THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], double h, double hv,
-                                  const double dv[2], gate_masks *mk, double *impulse, double *d2,
-                                  bsim_state *s, const int integrator, const int nb)
+                                  const double dv[2], gate_masks *mk, double *d2, bsim_state *s,
+                                  const int integrator, const int nb)
 {
 	double e_damper = 0.0, e_impact = 0.0, e_contact = 0.0, e_correction = 0.0;
 	int impacts = 0;
@@ -239,9 +238,8 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 		nc += got;
 	}
 	if (nc)
-		gate_impacts(w, h, nc, &pushed, impulse, &e_impact, &impacts, nb);
-	gate_solve(w, dv, h, nc, mk->awake, &pushed, impulse, &e_damper, &e_contact, integrator,
-	           nb);
+		gate_impacts(w, h, nc, &pushed, &e_impact, &impacts, nb);
+	gate_solve(w, dv, h, nc, mk->awake, &pushed, &e_damper, &e_contact, integrator, nb);
 	int n = nc ? gate_project(w, force, nc, &e_correction) : 0;
 	w->n_contacts = n;
 	for (int k = 0; k < n; k++)
@@ -261,7 +259,7 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 	for (int i = 0; i < nb; i++) {
 		if (gate_in(mk->awake, i)) {
 			s->active[na++] = i;
-			thesis_state_beam(w, i, gate_in(pushed, i), impulse[i],
+			thesis_state_beam(w, i, gate_in(pushed, i), w->impulse[i],
 			                  gate_in(mk->near, i), s);
 		} else {
 			s->theta[i] = 0.0;
@@ -288,7 +286,6 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 {
 	/* The awake list as a mask (is_awake says which beams it holds). */
 	gate_masks mk = {0, 0, 0, 0};
-	double impulse[THESIS_STEPS_BEAMS]; /* read where pushed only */
 	for (int i = 0; i < nb; i++)
 		mk.awake |= (unsigned)w->is_awake[i] << i;
 	/* No step of the run reads contact_type (the typed mask, each step's,
@@ -305,7 +302,7 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 	for (int i = 0; i < nb; i++)
 		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
 	for (int k = 0; k < n; k++)
-		gate_step(w, force, h, hv, dv, &mk, impulse, d2, &out[k], integrator, nb);
+		gate_step(w, force, h, hv, dv, &mk, d2, &out[k], integrator, nb);
 	/* The lists as the general path leaves them: ascending awake beams
 	 * (those of the run's start where the mask is theirs), the typed ones
 	 * (any order: only cleared), the last step's pushes; the last step's
@@ -330,7 +327,7 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 	/* the last step's pushes, which get_state reports as touched */
 	for (int i = 0; i < nb; i++)
 		if (gate_in(mk.pushed, i))
-			thesis_beam_pushed(w, i, impulse[i]);
+			thesis_beam_pushed(w, i, w->impulse[i]);
 	w->energy = out[n - 1].energy;
 	w->impacts = out[n - 1].impacts;
 }
