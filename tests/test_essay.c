@@ -106,10 +106,17 @@ static const char *const columns[] = {
         "diff_high", "test",          "p_value",   "verdict"};
 #define N_COLUMNS 19
 
+/* Per mode (0: default, 1: the other), of levels [0] and trends [1]: the
+ * rows and the consistent ones. */
+typedef struct mode_counts {
+	int n[2][2], ok[2][2];
+} mode_counts;
+
 /* Checks essay.csv: the header, rows per mode, and every verdict against
  * its p-value (a level: consistent iff p >= 0.05; a trend: iff p < 0.05
- * and the estimate has the stated sign). Returns the number of rows. */
-static int check_csv(const char *path, int trials)
+ * and the estimate has the stated sign); counts them into *mc (may be
+ * NULL). Returns the number of rows. */
+static int check_csv(const char *path, int trials, mode_counts *mc)
 {
 	char *text = bsim_test_read(path);
 	assert_non_null(text);
@@ -130,6 +137,11 @@ static int check_csv(const char *path, int trials)
 		assert_true(lo <= v + 1e-12 && v <= hi + 1e-12);
 		int consistent = strcmp(f[18], "consistent") == 0;
 		assert_true(consistent || strcmp(f[18], "differs") == 0);
+		if (mc) {
+			const int m = strcmp(f[3], "default") != 0, t = strcmp(f[4], "trend") == 0;
+			mc->n[m][t]++;
+			mc->ok[m][t] += consistent;
+		}
 		if (strcmp(f[4], "level") == 0) {
 			assert_true(f[6][0] != '\0');
 			assert_int_equal(atoi(f[7]), strstr(f[2], "C-track") ? 20 : 100);
@@ -169,23 +181,40 @@ static void test_command(void **state)
 		print_error("%s\n", err);
 	assert_int_equal(rc, 0);
 	free(err);
-	assert_int_equal(check_csv(bsim_test_join(out1, "essay.csv"), 20), 80);
+	assert_int_equal(check_csv(bsim_test_join(out1, "essay.csv"), 20, NULL), 80);
 	assert_true(bsim_test_exists(bsim_test_join(out1, "essay.mat")));
 	assert_true(bsim_test_exists(bsim_test_join(out1, "essay.md")));
 	assert_true(bsim_test_exists(bsim_test_join(out1, "essay.gp")));
 	assert_true(bsim_test_exists(bsim_test_join(out1, "manifest.json")));
 	assert_true(bsim_test_check_figures(out1) >= 1);
-	/* Same seed, same answer, whatever the threads. */
-	const char *a2[] = {
-	        "essay",  "--out",     out2,     "--trials",           "20", "--lattice-trials",
-	        "5",      "--configs", cfg,      "--threads",          "1",  "--quiet",
-	        "--mode", "default",   "--mode", "contact_mode=essay", NULL};
-	assert_int_equal(bsim_test_cli(a2, NULL, NULL), 0);
+	/* Same seed, same answer, whatever the threads; the command says each
+	 * mode's verdicts, levels and trends apart, as essay.csv counts them. */
+	const char *a2[] = {"essay",     "--out",     out2,
+	                    "--trials",  "20",        "--lattice-trials",
+	                    "5",         "--configs", cfg,
+	                    "--threads", "1",         "--mode",
+	                    "default",   "--mode",    "contact_mode=essay",
+	                    NULL};
+	char *printed = NULL;
+	assert_int_equal(bsim_test_cli(a2, &printed, NULL), 0);
 	char *c1 = bsim_test_read(bsim_test_join(out1, "essay.csv"));
 	char *c2 = bsim_test_read(bsim_test_join(out2, "essay.csv"));
 	assert_string_equal(c1, c2);
 	free(c1);
 	free(c2);
+	mode_counts mc = {{{0}}, {{0}}};
+	check_csv(bsim_test_join(out2, "essay.csv"), 20, &mc);
+	static const char *const names[2] = {"default", "contact_mode=essay"};
+	for (int m = 0; m < 2; m++) {
+		char want[160];
+		snprintf(want, sizeof want,
+		         "  %s: consistent with %d of the essay's %d levels and %d of its %d "
+		         "trends\n",
+		         names[m], mc.ok[m][0], mc.n[m][0], mc.ok[m][1], mc.n[m][1]);
+		if (!strstr(printed, want))
+			fail_msg("no line \"%s\" in:\n%s", want, printed);
+	}
+	free(printed);
 }
 
 /* A gnuplot that fails: exit 1 naming the figure and quoting its line; the

@@ -134,6 +134,32 @@ static char **essay_stored_argv(int argc, char **argv, const essay_args *a, int 
 	return cli_stored_argv_paths(*n, *extended, &configs, 1);
 }
 
+/* Each mode's verdicts, as the README states the default physics': of its
+ * levels and of its trends, how many are consistent with the essay's. The
+ * modes in the order of their first row. */
+static void essay_modes_print(const bsim_essay_result *r)
+{
+	for (int i = 0; i < r->n; i++) {
+		const char *mode = r->rows[i].mode;
+		int seen = 0;
+		for (int j = 0; j < i && !seen; j++)
+			seen = strcmp(r->rows[j].mode, mode) == 0;
+		if (seen)
+			continue;
+		int n[2] = {0, 0}, ok[2] = {0, 0};
+		for (int j = i; j < r->n; j++) {
+			if (strcmp(r->rows[j].mode, mode) != 0)
+				continue;
+			const int t = r->rows[j].kind == BSIM_ESSAY_TREND;
+			n[t]++;
+			ok[t] += r->rows[j].consistent != 0;
+		}
+		printf("  %s: consistent with %d of the essay's %d levels and %d of its %d "
+		       "trends\n",
+		       mode, ok[0], n[0], ok[1], n[1]);
+	}
+}
+
 static int essay_main(int argc, char **argv, const cli_merge *m)
 {
 	cli_common c = cli_common_default();
@@ -210,12 +236,10 @@ static int essay_main(int argc, char **argv, const cli_merge *m)
 	}
 	rc = cli_report(rc, &err);
 	if (rc == BSIM_OK) {
-		int differ = 0;
-		for (int i = 0; i < r.n; i++)
-			differ += !r.rows[i].consistent;
 		if (!c.quiet) {
-			printf("essay: %d rows (%d consistent, %d differ), %ld trials in %.1f s\n",
-			       r.n, r.n - differ, differ, r.trials_run, r.wall_seconds);
+			printf("essay: %d rows, %ld trials in %.1f s\n", r.n, r.trials_run,
+			       r.wall_seconds);
+			essay_modes_print(&r);
 			cli_wrote(stdout, c.out);
 		}
 		for (int i = 0; i < fig.n_notes; i++)
