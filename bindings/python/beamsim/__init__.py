@@ -18,12 +18,30 @@ import json
 import math
 import numbers
 import os
+import sys
 import tempfile
 import warnings
 
-import numpy as np
+from ._built import python as _BUILT_PYTHON, version as _BUILT_VERSION
 
-from . import _beamsim
+try:
+    import numpy as np
+except ImportError as _e:
+    raise ImportError(
+        f"beamsim needs NumPy, which this Python ({sys.executable}) does not have: run "
+        f"{_BUILT_PYTHON}, the Python beamsim was built for (Debian's python3 with "
+        f"python3-numpy, which scripts/deps.sh installs), or install NumPy into this one"
+    ) from _e
+
+try:
+    from . import _beamsim
+except ImportError as _e:
+    _here = "%d.%d" % sys.version_info[:2]
+    raise ImportError(
+        f"beamsim's extension was built for Python {_BUILT_VERSION} ({_BUILT_PYTHON}) and "
+        f"the NumPy it has; this is Python {_here} ({sys.executable}): run {_BUILT_PYTHON}, "
+        f"or build beamsim for this one (cmake -DPython3_EXECUTABLE={sys.executable}): {_e}"
+    ) from _e
 
 __all__ = ["run", "sweep", "compare", "landscape", "load", "version", "backends"]
 
