@@ -350,8 +350,9 @@ static int single_beam(figs *f, bsim_scene *scene, const fpath *p, const char *t
 			peak[b] = fmax(peak[b], fabs(th[b]));
 	}
 	if (below == 0) {
-		figs_note(f, "landscape_path: no state below the surface, so no "
-		             "landscape_path_single (Fig. 2.7c)");
+		figs_note(f, "landscape_path_single (Fig. 2.7c) not drawn: it shows a run in which "
+		             "a beam left the body while the body was still within its reach, and "
+		             "this run has none");
 		return BSIM_OK;
 	}
 	for (int b = 1; b < nb; b++)
