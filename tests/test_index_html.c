@@ -168,6 +168,7 @@ static void test_sweep_page(void **state)
 	char *page = bsim_test_read(bsim_test_join(dir, "index.html"));
 	assert_non_null(strstr(page, "href=\"summary.json\""));
 	assert_non_null(strstr(page, "href=\"p_traverse.dat\""));
+	assert_null(strstr(page, "<h2>Verdict</h2>")); /* a sweep has no report */
 	free(page);
 }
 
@@ -185,6 +186,23 @@ static void test_compare_page(void **state)
 	/* the sides' figures in their folders are on the top page */
 	assert_true(bsim_test_exists(bsim_test_join(dir, "thesis/p_traverse.png")));
 	check_page(dir);
+	/* the verdict: report.md's headline, its bold kept, and the link */
+	char *page = bsim_test_read(bsim_test_join(dir, "index.html"));
+	char *report = bsim_test_read(bsim_test_join(dir, "report.md"));
+	assert_non_null(page);
+	assert_non_null(report);
+	const char *head = strstr(report, "\n**");
+	assert_non_null(head);
+	char want[160];
+	const char *end = strstr(head + 3, "**");
+	assert_non_null(end);
+	snprintf(want, sizeof want, "<h2>Verdict</h2>\n<p><b>%.*s</b>", (int)(end - head - 3),
+	         head + 3);
+	if (!strstr(page, want))
+		fail_msg("index.html has no \"%s\"", want);
+	assert_non_null(strstr(page, "<a href=\"report.md\">report.md</a>"));
+	free(report);
+	free(page);
 }
 
 int main(void)

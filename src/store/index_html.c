@@ -326,7 +326,61 @@ static const char *base_of(const char *rel)
 	return s ? s + 1 : rel;
 }
 
-static void page(FILE *f, const flist *l, const char *dir, const char *command, char *used)
+/* The first line of report.md or regress.md (found in stage, else in dir)
+ * that opens in bold: the verdict's headline ("**0 of 30 groups
+ * disagree.** 6 deterministic ..."), as a paragraph with its bold kept,
+ * and a link to the whole report. Nothing if there is no such file. */
+static void page_verdict(FILE *f, const flist *l, const char *stage, const char *dir)
+{
+	static const char *const reports[] = {"report.md", "regress.md"};
+	for (size_t r = 0; r < sizeof reports / sizeof reports[0]; r++) {
+		int listed = 0;
+		for (int i = 0; i < l->n && !listed; i++)
+			listed = strcmp(l->rel[i], reports[r]) == 0;
+		if (!listed)
+			continue;
+		char path[BSIM_PATH_MAX];
+		snprintf(path, sizeof path, "%s/%s", stage, reports[r]);
+		FILE *in = fopen(path, "r");
+		if (!in && dir) {
+			snprintf(path, sizeof path, "%s/%s", dir, reports[r]);
+			in = fopen(path, "r");
+		}
+		if (!in)
+			continue;
+		char line[8192];
+		int found = 0;
+		while (!found && fgets(line, sizeof line, in))
+			found = strncmp(line, "**", 2) == 0;
+		fclose(in);
+		if (!found)
+			continue;
+		line[strcspn(line, "\n")] = '\0';
+		fputs("<h2>Verdict</h2>\n<p>", f);
+		/* **...** as bold, the rest as text */
+		int bold = 0;
+		for (char *p = line; *p;) {
+			char *q = strstr(p, "**");
+			if (q)
+				*q = '\0';
+			html_text(f, p);
+			if (!q)
+				break;
+			fputs(bold ? "</b>" : "<b>", f);
+			bold = !bold;
+			p = q + 2;
+		}
+		if (bold)
+			fputs("</b>", f);
+		fputs("</p>\n<p>The whole report, each group's verdict and the statistics: ", f);
+		html_link(f, reports[r], reports[r]);
+		fputs(".</p>\n", f);
+		return;
+	}
+}
+
+static void page(FILE *f, const flist *l, const char *stage, const char *dir, int add,
+                 const char *command, char *used)
 {
 	const char *title = base_of(dir);
 	fputs("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>", f);
@@ -344,8 +398,10 @@ static void page(FILE *f, const flist *l, const char *dir, const char *command, 
 	fputs("</code> (beamsim " BSIM_VERSION "). Each figure is its PNG; beside it its SVG, "
 	      "its gnuplot script (rerun with <code>gnuplot NAME.gp</code> in the figure's "
 	      "folder) and the data it draws. <code>manifest.json</code> lists every file with "
-	      "its size and CRC-32.</p>\n<h2>Figures</h2>\n",
+	      "its size and CRC-32.</p>\n",
 	      f);
+	page_verdict(f, l, stage, add ? dir : NULL);
+	fputs("<h2>Figures</h2>\n", f);
 	char caption[512];
 	for (int i = 0; i < l->n; i++) {
 		const char *r = l->rel[i];
@@ -436,7 +492,7 @@ int bsim_index_html_write(const char *stage, const char *dir, int add, const cha
 	if (!rc)
 		rc = bsim_atomic_file_open(&o, path, err);
 	if (!rc) {
-		page(o.f, &l, dir, command, used);
+		page(o.f, &l, stage, dir, add, command, used);
 		rc = bsim_atomic_file_commit(&o, err);
 	}
 	free(used);
