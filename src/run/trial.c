@@ -481,12 +481,13 @@ typedef struct run_lines {
  * the step loop books a state of a plain trial (nothing recorded, traced
  * or measured, no lattice: trial_book without the flags, the trace, the
  * measures and the gate), the operations in their order, with what the run
- * does not change held in locals: the ledger's lines, the loop's counters,
- * the scene's lines and the pipeline's forces, propulsion rf->cp along
+ * does not change held in locals: the ledger's lines, the loop's counters
+ * and the pipeline's forces, propulsion rf->cp along
  * axis ap (has_p) and the held random force rf->cr along ar (has_r),
  * constants where the caller gives them; each force's work is summed from
  * 0.0, as ledger_step's loop sums it. Before each state, the step loop's
- * test whether the trial is over, once the outcome is known. The peaks
+ * test whether the trial is over (trial_over), once the outcome is known;
+ * after it, the step loop's outcome (outcome_at). The peaks
  * take no contacts here (the caller gives them the run's last touching
  * state), and the test of a state that lists no beam (trial_peaks_note) is
  * asked again only after a booking that updated them. Returns what the
@@ -501,13 +502,9 @@ TRIAL_BOOK int run_book(trial_ctx *c, trial_loop *lp, bsim_state **s0p, bsim_sta
 	bsim_ledger *l = &out->ledger;
 	trial_peaks *peaks = &c->r->peaks;
 	const double cp = rf->cp, cr = rf->cr;
-	const double centre = c->centre, side_x = sc->side_x, success_y = sc->success_y;
-	const double classify_y = sc->classify_y;
-	const long n_max = c->n_max;
 	bsim_state *s0 = *s0p;
-	double e0 = lp->e0;
-	long n = lp->n, run_on = lp->run_on, dwell = c->gate.dwell;
-	int done = lp->done;
+	trial_loop L = *lp; /* the loop's counters, in locals */
+	long dwell = c->gate.dwell;
 	run_lines lines = {l->w_prop,       l->w_rand,       l->damper, l->impact,
 	                   l->contact,      l->correction,   l->sleep,  l->residual,
 	                   l->residual_abs, l->residual_max, l->inflow};
@@ -515,20 +512,19 @@ TRIAL_BOOK int run_book(trial_ctx *c, trial_loop *lp, bsim_state **s0p, bsim_sta
 	int any = 0;
 	int b = BOOK_ON;
 	for (int k = 0; k < m; k++) {
-		/* trial_over, the outcome known */
-		if (done && (s0->x[1] >= classify_y || run_on >= n_max))
+		if (L.done && trial_over(c, &L, s0))
 			break;
 		bsim_state *s1 = &states[k];
 		double e1;
 		if (!state_energy_finite(sc, s1, &e1)) {
 			out->instability = BSIM_UNSTABLE_NONFINITE;
-			out->unstable_step = (int)(n + 1);
+			out->unstable_step = (int)(L.n + 1);
 			b = BOOK_NONFINITE;
 			break;
 		}
-		n++;
+		L.n++;
 		dwell++;
-		run_on += done;
+		L.run_on += L.done;
 		any |= s1->n_active;
 		/* ledger_step, the pipeline's forces held */
 		const double d[2] = {s1->x[0] - s0->x[0], s1->x[1] - s0->x[1]};
@@ -538,27 +534,19 @@ TRIAL_BOOK int run_book(trial_ctx *c, trial_loop *lp, bsim_state **s0p, bsim_sta
 		if (has_r)
 			w_rand += cr * d[ar];
 		const bsim_step_energy *se = &s1->energy;
-		const double r = ledger_residual(e0, e1, w_prop, w_rand, se);
+		const double r = ledger_residual(L.e0, e1, w_prop, w_rand, se);
 		LEDGER_LINES_ADD(lines, w_prop, w_rand, se, r);
-		e0 = e1;
+		L.e0 = e1;
 		s0 = s1;
-		if (done)
+		if (L.done)
 			continue;
 		if (s1->n_active || !quiet) {
 			trial_peaks_note(peaks, sc, NULL, s1);
 			quiet = peaks->n_negative == 0 && peaks->settled01;
 		}
-		/* outcome_at */
-		if (fabs(s1->x[0] - centre) >= side_x) {
-			out->outcome = BSIM_SIDE_EXIT;
+		if (outcome_at(c, &L, s1)) {
 			b = BOOK_END;
 			break;
-		}
-		if (s1->x[1] >= success_y) {
-			out->outcome = BSIM_TRAVERSED;
-			out->steps = (int)n;
-			out->t_end = (double)n * lp->h;
-			done = 1;
 		}
 	}
 	l->w_prop = lines.w_prop;
@@ -572,10 +560,7 @@ TRIAL_BOOK int run_book(trial_ctx *c, trial_loop *lp, bsim_state **s0p, bsim_sta
 	l->residual_abs = lines.residual_abs;
 	l->residual_max = lines.residual_max;
 	l->inflow = lines.inflow;
-	lp->e0 = e0;
-	lp->n = n;
-	lp->run_on = run_on;
-	lp->done = done;
+	*lp = L;
 	c->gate.dwell = dwell;
 	*s0p = s0;
 	*listed = any;
