@@ -13,7 +13,8 @@
 # pkg-config alone, computes a beam's contact flag and an ellipse's gap
 # with the installed beamsim/contact_flag.h and beamsim/body_shape.h and
 # agrees with their closed forms, and the two headers compile as C++ (a
-# backend may be written in it).
+# backend may be written in it). The example plug-in, built against the
+# package, is loaded and run by the installed program.
 #   install_package.sh BUILD_DIR SOURCE_DIR WORK_DIR
 set -eu
 build=$1 src=$2 work=$3
@@ -63,6 +64,18 @@ env -u LD_LIBRARY_PATH "$work/readme/a.out" "$exp" 20 >"$work/readme.txt"
 env -u LD_LIBRARY_PATH "$work/pc_backend_helpers" >"$work/pc_backend_helpers.txt" ||
     { cat "$work/pc_backend_helpers.txt"; echo "backend_helpers (pkg-config) differs from its closed forms"; exit 1; }
 
+# A backend of one's own, outside the tree: the example plug-in built by
+# CMake against the package and by pkg-config alone, loaded by the installed
+# program (--backend plugin:PATH, BEAMSIM_PLUGINS) and run.
+cc -std=c17 -Wall -Wextra -Werror -shared -fPIC -o "$work/pc_gate_euler.so" \
+    "$src/examples/plugin_gate_euler.c" $(PKG_CONFIG_PATH=$pcdir pkg-config --cflags --libs beamsim) -lm
+"$prefix/bin/beamsim" sweep "$exp" --backend "plugin:$work/examples/libgate_euler.so" \
+    --trials 2 --quiet --out "$work/plugin_sweep"
+grep -q '"name": "gate_euler"' "$work/plugin_sweep/run.json" ||
+    { echo "the plug-in's sweep does not record gate_euler"; exit 1; }
+BEAMSIM_PLUGINS="$work/pc_gate_euler.so" "$prefix/bin/beamsim" backends >"$work/plugin_backends.txt"
+grep -q '^gate_euler$' "$work/plugin_backends.txt" ||
+    { echo "beamsim backends does not list the plug-in of BEAMSIM_PLUGINS"; exit 1; }
 # The shared library brings only the bsim_ functions.
 if nm -D --defined-only "$libdir/libbeamsim.so" | awk '{print $3}' | grep -v '^bsim_' | grep .; then
     echo "libbeamsim.so exports symbols outside bsim_"; exit 1
@@ -126,4 +139,4 @@ for g in beamsim.sweep(sys.argv[1], trials=20)["groups"]:
     print("%.3f" % g["p_traverse"])' "$exp" "$site" >"$work/py_p.txt"
     cmp "$work/py_p.txt" "$work/cli_p.txt"
 fi
-echo "installed package: shared, static and pkg-config builds agree with beamsim sweep; a backend's helpers agree with their closed forms"
+echo "installed package: shared, static and pkg-config builds agree with beamsim sweep; a backend's helpers agree with their closed forms; the example plug-in runs"

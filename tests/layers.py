@@ -71,6 +71,7 @@ PUBLIC = {
     "body_shape": "model",
     "contact_flag": "model",
     "backend_registry": "registry",
+    "backend_plugin": "registry",
     "effects": "model",
     "experiment": "model",
     "key_names": "model",

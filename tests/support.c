@@ -11,6 +11,7 @@
 
 #include "support.h"
 
+#include "beamsim/backend_plugin.h"
 #include "beamsim/backend_registry.h"
 
 #include "util/figure.h"
@@ -661,6 +662,15 @@ int bsim_test_check_wrote(const char *out, const char *dir)
 
 int bsim_test_run_per_backend(const char *group, const struct CMUnitTest *tests, size_t n)
 {
+	/* The example plug-in, registered as a user's is, by BEAMSIM_PLUGINS
+	 * (which the commands a test runs inherit): its tests are the built-in
+	 * backends' */
+	bsim_error err;
+	setenv(BSIM_PLUGINS_ENV, BSIM_TEST_PLUGIN, 1);
+	if (!bsim_backend_load(BSIM_TEST_PLUGIN, &err)) {
+		fprintf(stderr, "%s: %s\n", group, err.msg);
+		return 1;
+	}
 	const bsim_backend *const *all = bsim_backend_list();
 	size_t nb = 0;
 	while (all[nb])
@@ -739,6 +749,16 @@ double bsim_test_uniform(uint64_t *s)
 	*s ^= *s << 25;
 	*s ^= *s >> 27;
 	return (double)((*s * 2685821657736338717ull) >> 11) * 0x1.0p-53;
+}
+
+void bsim_test_skip_refused(const bsim_backend *b, bsim_scene *s)
+{
+	char field[64];
+	bsim_error err;
+	if (b->check && b->check(s, NULL, field, sizeof field, &err) != BSIM_OK) {
+		bsim_scene_free(s);
+		bsim_test_skip(b, "it refuses the scene: %s", err.msg);
+	}
 }
 
 bsim_world *bsim_test_world(const bsim_backend *b, const bsim_scene *s, const bsim_options *opts)

@@ -149,7 +149,8 @@ int bsim_test_check_wrote(const char *out, const char *dir);
 
 /* The tests that every backend passes (docs/tests.md, "Every backend"):
  * each of the n tests once per backend of the registry
- * (bsim_backend_list), named "TEST (BACKEND)" with the backend as its
+ * (bsim_backend_list), the example plug-in (examples/plugin_gate_euler.c)
+ * loaded into it first, named "TEST (BACKEND)" with the backend as its
  * state, so that a backend added to the registry runs them with no edit
  * here; cmocka's status of the whole group. */
 int bsim_test_run_per_backend(const char *group, const struct CMUnitTest *tests, size_t n);
@@ -161,6 +162,11 @@ double bsim_test_bound(const bsim_backend *b, const char *check);
 /* Skips the test of backend b, printing why it cannot apply (printf-style). */
 void bsim_test_skip(const bsim_backend *b, const char *fmt, ...)
         __attribute__((format(printf, 2, 3)));
+
+/* Skips the test of backend b if b's check refuses scene s (a backend that
+ * simulates only some scenes, the example plug-in's disk), saying why;
+ * frees s first then. */
+void bsim_test_skip_refused(const bsim_backend *b, bsim_scene *s);
 
 /* b's world for s with opts (may be NULL); fails the test with b's message
  * if b refuses. */

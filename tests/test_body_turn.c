@@ -373,6 +373,7 @@ static void test_propulsion_along_heading(void **state)
 		s.classify_y = 1e6;
 		bsim_error err;
 		assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
+		bsim_test_skip_refused(be, &s); /* the last, k = 2, the capsule */
 		thrust_track t = {.h = s.dt,
 		                  .accel = 3.0,
 		                  .psi = 210.0 * PI / 180.0,
@@ -846,6 +847,9 @@ static void test_disk_only_refused(void **state)
 	bsim_scene_free(&loaded);
 	assert_int_equal(bsim_scene_load(scene_path, NULL, 0, &loaded, &err), BSIM_OK);
 	assert_true(loaded.success_y == 80.0 && loaded.classify_y == 95.0);
+	bsim_scene_free(&loaded);
+	assert_int_equal(bsim_scene_load(scene_path, NULL, 0, &loaded, &err), BSIM_OK);
+	bsim_test_skip_refused(be, &loaded);
 	bsim_scene_free(&loaded);
 	char traj[1024];
 	snprintf(traj, sizeof traj, "%s", bsim_test_join(dir, "t.csv"));

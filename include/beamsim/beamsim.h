@@ -7,6 +7,7 @@
 
 #include "beamsim/accuracy.h"
 #include "beamsim/backend.h"
+#include "beamsim/backend_plugin.h"
 #include "beamsim/backend_registry.h"
 #include "beamsim/base.h"
 #include "beamsim/body_shape.h"

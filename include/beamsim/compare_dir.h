@@ -10,7 +10,9 @@
  *
  * A side is a backend with options, written NAME[:KEY=VALUE]... as on the
  * command line (a name `beamsim backends` lists, alone or with options:
- * "NAME:KEY=VALUE:KEY=VALUE"); that text is its label. Or, on a gate
+ * "NAME:KEY=VALUE:KEY=VALUE", or a plug-in's plugin:PATH in place of
+ * NAME); that text, with the backend's own name for plugin:PATH, is its
+ * label. Or, on a gate
  * lattice, the two sides are one backend under two lattice protocols
  * (protocol), and the protocols label them. */
 #ifndef BSIM_COMPARE_DIR_H
@@ -39,8 +41,9 @@ typedef struct bsim_compare_side {
 	char label[128]; /* NAME[:K=V]..., or the protocol */
 } bsim_compare_side;
 
-/* Parses a side "NAME[:KEY=VALUE]..." into side (label = spec, backend
- * found by name, options in order, later ones win), after the options
+/* Parses a side "NAME[:KEY=VALUE]..." into side (label = spec with the
+ * backend's name for NAME, backend found by name or loaded from
+ * plugin:PATH, options in order, later ones win), after the options
  * already in side->opts, which the spec's override. BSIM_EINPUT naming the
  * spec and what was expected. */
 BSIM_API int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err);

@@ -24,6 +24,9 @@ typedef struct bsim_run_record {
 	char backend[BSIM_COMPARE_SIDES_MAX][32];
 	/* compare's side labels (NAME[:K=V]...); the name if none */
 	char label[BSIM_COMPARE_SIDES_MAX][128];
+	/* the library of a plug-in backend (bsim_backend_plugin_path), "" for
+	 * one compiled in */
+	char plugin[BSIM_COMPARE_SIDES_MAX][1024];
 	bsim_options opts[BSIM_COMPARE_SIDES_MAX]; /* every knob, effective value */
 	uint64_t seed;
 	int trials;
@@ -41,6 +44,12 @@ BSIM_API void bsim_run_record_fill(bsim_run_record *rec, const char *command,
                                    const bsim_experiment *e, int n, const bsim_backend *const *b,
                                    const bsim_options *const *opts, const char *const *label,
                                    const bsim_compare_rule *rule);
+
+/* Side i's backend: the one registered under its name, else, for a
+ * plug-in's, the one its recorded library (plugin[i]) registers when
+ * loaded; NULL and BSIM_EINPUT saying which if neither. */
+BSIM_API const bsim_backend *bsim_run_record_backend(const bsim_run_record *rec, int i,
+                                                     bsim_error *err);
 
 /* Writes DIR/inputs/scene.yaml, DIR/inputs/experiment.yaml and, last,
  * DIR/run.json, each atomically: a directory with run.json is complete. */

@@ -355,11 +355,44 @@ int cli_backend_opts(const cli_common *c, const char *cmd, int n, const char *co
 	return CLI_OK;
 }
 
-const bsim_backend *cli_backend_with_opts(const cli_common *c, const char *cmd, const char *name,
+const bsim_backend *cli_backend_with_opts(const cli_common *c, const char *cmd, const char *spec,
                                           bsim_options *opts)
 {
 	memset(opts, 0, sizeof *opts);
-	if (cli_backend_opts(c, cmd, 1, &name, &opts) != CLI_OK)
+	size_t n = bsim_backend_spec_name(spec);
+	char name[1024];
+	if (n >= sizeof name) {
+		cli_usage(cmd, "--backend %s: a name longer than %zu characters", spec,
+		          sizeof name - 1);
 		return NULL;
-	return cli_backend(name, opts);
+	}
+	snprintf(name, sizeof name, "%.*s", (int)n, spec);
+	bsim_error err;
+	const bsim_backend *b = bsim_backend_find(name, &err);
+	if (!b) {
+		cli_error("%s", err.msg);
+		return NULL;
+	}
+	/* --backend-opt B:K=V names the backend by its own name (a plug-in's,
+	 * not its path) */
+	const char *own = b->name;
+	if (cli_backend_opts(c, cmd, 1, &own, &opts) != CLI_OK)
+		return NULL;
+	for (const char *p = spec + n; *p == ':';) {
+		size_t len = strcspn(p + 1, ":");
+		char kv[128];
+		snprintf(kv, sizeof kv, "%.*s", (int)(len < sizeof kv ? len : sizeof kv - 1),
+		         p + 1);
+		if (cli_options_add(opts, cmd, kv) != CLI_OK)
+			return NULL;
+		p += len + 1;
+	}
+	if (bsim_options_check(opts, b->knobs, b->n_knobs, b->name, &err) != BSIM_OK) {
+		if (spec[n]) /* the spec's own options */
+			cli_error("--backend %s: %s", spec, err.msg);
+		else
+			cli_error("%s", err.msg);
+		return NULL;
+	}
+	return b;
 }

@@ -109,10 +109,12 @@ int cli_parse(const cli_spec *spec, int argc, char **argv, cli_common *c, void *
 int cli_backend_opts(const cli_common *c, const char *cmd, int n, const char *const *names,
                      bsim_options *const *opts);
 
-/* The backend by name with the --backend-opt values for it (opts
- * cleared first) checked; prints the error and returns NULL (exit status
- * 2) if unknown or an option is bad. */
-const bsim_backend *cli_backend_with_opts(const cli_common *c, const char *cmd, const char *name,
+/* The backend of a spec NAME[:KEY=VALUE]... (or plugin:PATH[:KEY=VALUE]...,
+ * bsim_backend_spec_name) with the --backend-opt values for it, then the
+ * spec's own options (they win, as in compare's sides), into opts (cleared
+ * first), checked; prints the error and returns NULL (exit status 2) if
+ * unknown or an option is bad. */
+const bsim_backend *cli_backend_with_opts(const cli_common *c, const char *cmd, const char *spec,
                                           bsim_options *opts);
 
 #endif

@@ -4,16 +4,24 @@
 #include <string.h>
 
 #include "beamsim/backend.h"
+#include "beamsim/backend_plugin.h"
 #include "cli/cli_common.h"
 #include "cli/cli_options.h"
 
 static const cli_spec backends_spec = {
         .name = "backends",
         .usage = "[OPTIONS]",
-        .about = "Lists the physics backends compiled in, the default first: what each is\n"
-                 "built on, its options (name, type, default, choices and what each does)\n"
-                 "and the bounds it holds itself to in the checks every backend runs\n"
-                 "(docs/tests.md, \"Every backend\").\n"
+        .about = "Lists the physics backends compiled in, the default first, then the\n"
+                 "plug-ins loaded from BEAMSIM_PLUGINS: what each is built on (and a\n"
+                 "plug-in's library), its options (name, type, default, choices and what\n"
+                 "each does) and the bounds it holds itself to in the checks every backend\n"
+                 "runs (docs/tests.md, \"Every backend\").\n"
+                 "\n"
+                 "A backend of one's own (docs/backends.md, \"Your own solver\"): a shared\n"
+                 "library exporting a backend table (beamsim/backend_plugin.h), run by any\n"
+                 "command as --backend plugin:PATH[:KEY=VALUE]... (a compare side\n"
+                 "likewise), or by its name when BEAMSIM_PLUGINS lists PATH (several\n"
+                 "separated by ':').\n"
                  "\n"
                  "An option is set the same way on every command that runs backends (run,\n"
                  "sweep, compare, video, bench):\n"
@@ -76,6 +84,9 @@ static void backend_print(const bsim_backend *b)
 	printf("%s\n  %s\n", b->name, b->description ? b->description : "");
 	if (b->engine)
 		printf("  built on %s %s\n", b->engine, b->version ? b->version : "");
+	const char *lib = bsim_backend_plugin_path(b);
+	if (lib)
+		printf("  plug-in %s\n", lib);
 	if (b->n_knobs == 0) {
 		puts("  (no options)");
 		bounds_print(b);

@@ -241,25 +241,7 @@ static const bsim_backend *run_backend(const cli_common *c, run_args *a)
 		          spec, spec);
 		return NULL;
 	}
-	size_t n = strcspn(spec, ":");
-	char name[32];
-	snprintf(name, sizeof name, "%.*s", (int)(n < sizeof name ? n : sizeof name - 1), spec);
-	const bsim_backend *b = cli_backend_with_opts(c, "run", name, &a->opts);
-	for (const char *p = spec + n; b && *p == ':';) {
-		size_t len = strcspn(p + 1, ":");
-		char kv[128];
-		snprintf(kv, sizeof kv, "%.*s", (int)(len < sizeof kv ? len : sizeof kv - 1),
-		         p + 1);
-		if (cli_options_add(&a->opts, "run", kv) != CLI_OK)
-			return NULL;
-		p += len + 1;
-	}
-	bsim_error err;
-	if (b && spec[n] &&
-	    bsim_options_check(&a->opts, b->knobs, b->n_knobs, b->name, &err) != BSIM_OK) {
-		cli_error("--backend %s: %s", spec, err.msg);
-		return NULL;
-	}
+	const bsim_backend *b = cli_backend_with_opts(c, "run", spec, &a->opts);
 	a->backend = spec;
 	return b;
 }

@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "beamsim/backend_plugin.h"
 #include "beamsim/version.h"
 #include "cli/cli_common.h"
 #include "cli/cli_mpi.h"
@@ -141,6 +142,13 @@ static int dispatch(int argc, char **argv)
 			       (*b)->version ? (*b)->version : "");
 		printf("compiler %s\n", bsim_version_compiler());
 		return CLI_OK;
+	}
+	/* A plug-in BEAMSIM_PLUGINS names and that fails to load stops every
+	 * command: what it would run is not there. */
+	bsim_error err;
+	if (bsim_backend_plugins_status(&err) != BSIM_OK) {
+		cli_error("%s", err.msg);
+		return CLI_USAGE;
 	}
 	const cli_command *c = find_command(name);
 	/* Only sweep, compare, essay, markov build and markov validate spread

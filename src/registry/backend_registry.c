@@ -1,7 +1,13 @@
-/* The backend registry; see beamsim/backend_registry.h. */
+/* The backend registry; see beamsim/backend_registry.h and, for the
+ * plug-ins it adds at run time, beamsim/backend_plugin.h. */
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "beamsim/backend_registry.h"
 
+#include <pthread.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "registry/plugin_open.h"
 
 /* The backends compiled in, one line each, X(NAME) for the table
  * bsim_backend_NAME that backends/NAME/ defines; `beamsim backends` lists
@@ -17,10 +23,132 @@
 
 BSIM_BACKENDS(BSIM_BACKEND_DECLARE)
 
-static const bsim_backend *const registry[] = {BSIM_BACKENDS(BSIM_BACKEND_ENTRY) NULL};
+/* Room for the plug-ins a process loads. */
+#define REGISTRY_MAX 64
+
+/* The built-in backends, then the plug-ins in the order they loaded; NULL
+ * after the last. A plug-in is added under the lock and only ever appended
+ * (the NULL after it is there already), so a reader that walks the list
+ * without the lock sees it whole or not at all. */
+static const bsim_backend *registry[REGISTRY_MAX + 1] = {BSIM_BACKENDS(BSIM_BACKEND_ENTRY) NULL};
+/* The absolute path of each entry's library (NULL: compiled in). */
+static char *registry_path[REGISTRY_MAX];
+static pthread_mutex_t registry_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* BEAMSIM_PLUGINS, loaded once: the first refusal, if any. */
+static pthread_once_t env_once = PTHREAD_ONCE_INIT;
+static bsim_error env_error;
+static int env_rc = BSIM_OK;
+
+static int registry_count(void)
+{
+	int n = 0;
+	while (registry[n])
+		n++;
+	return n;
+}
+
+/* The table registered under name, or NULL. */
+static const bsim_backend *registry_named(const char *name)
+{
+	for (int i = 0; registry[i]; i++)
+		if (strcmp(registry[i]->name, name) == 0)
+			return registry[i];
+	return NULL;
+}
+
+/* Loads path's plug-in and registers it (bsim_backend_load), the caller
+ * holding the lock. */
+static const bsim_backend *load_locked(const char *path, bsim_error *err)
+{
+	const bsim_backend *b = registry_plugin_open(path, err);
+	if (!b)
+		return NULL;
+	const bsim_backend *same = registry_named(b->name);
+	if (same == b)
+		return b; /* loaded before */
+	if (same) {
+		bsim_error_set(err, BSIM_EINPUT,
+		               "plug-in %s: a backend named %s is registered already (each "
+		               "backend's name is its own)",
+		               path, b->name);
+		return NULL;
+	}
+	int n = registry_count();
+	if (n == REGISTRY_MAX) {
+		bsim_error_set(err, BSIM_EFAIL, "plug-in %s: more than %d backends", path,
+		               REGISTRY_MAX);
+		return NULL;
+	}
+	registry_path[n] = realpath(path, NULL);
+	__atomic_store_n(&registry[n], b, __ATOMIC_RELEASE);
+	return b;
+}
+
+static void env_load(void)
+{
+	const char *list = getenv(BSIM_PLUGINS_ENV);
+	if (!list)
+		return;
+	pthread_mutex_lock(&registry_lock);
+	for (const char *p = list; *p;) {
+		size_t len = strcspn(p, ":");
+		if (len > 0) {
+			char path[4096];
+			if (len >= sizeof path) {
+				env_rc = bsim_error_set(&env_error, BSIM_EINPUT,
+				                        "%s: a path longer than %zu characters",
+				                        BSIM_PLUGINS_ENV, sizeof path - 1);
+				break;
+			}
+			memcpy(path, p, len);
+			path[len] = '\0';
+			bsim_error e;
+			if (!load_locked(path, &e)) {
+				env_rc = bsim_error_set(&env_error, BSIM_EINPUT, "%s: %s",
+				                        BSIM_PLUGINS_ENV, e.msg);
+				break;
+			}
+		}
+		p += len + (p[len] == ':');
+	}
+	pthread_mutex_unlock(&registry_lock);
+}
+
+static void env_ensure(void)
+{
+	pthread_once(&env_once, env_load);
+}
+
+int bsim_backend_plugins_status(bsim_error *err)
+{
+	env_ensure();
+	if (env_rc != BSIM_OK && err)
+		*err = env_error;
+	return env_rc;
+}
+
+const bsim_backend *bsim_backend_load(const char *path, bsim_error *err)
+{
+	env_ensure();
+	pthread_mutex_lock(&registry_lock);
+	const bsim_backend *b = load_locked(path, err);
+	pthread_mutex_unlock(&registry_lock);
+	return b;
+}
+
+const char *bsim_backend_plugin_path(const bsim_backend *b)
+{
+	env_ensure();
+	for (int i = 0; registry[i]; i++)
+		if (registry[i] == b)
+			return registry_path[i];
+	return NULL;
+}
 
 const bsim_backend *const *bsim_backend_list(void)
 {
+	env_ensure();
 	return registry;
 }
 
@@ -29,18 +157,44 @@ const bsim_backend *bsim_backend_default(void)
 	return registry[0];
 }
 
+size_t bsim_backend_spec_name(const char *spec)
+{
+	static const char plugin[] = BSIM_PLUGIN_PREFIX;
+	size_t n = strlen(plugin);
+	if (strncmp(spec, plugin, n) == 0)
+		return n + strcspn(spec + n, ":");
+	return strcspn(spec, ":");
+}
+
 const bsim_backend *bsim_backend_find(const char *name, bsim_error *err)
 {
-	char known[256] = "";
+	bsim_error e;
+	if (bsim_backend_plugins_status(&e) != BSIM_OK) {
+		if (err)
+			*err = e;
+		return NULL;
+	}
+	static const char plugin[] = BSIM_PLUGIN_PREFIX;
+	if (strncmp(name, plugin, strlen(plugin)) == 0) {
+		const bsim_backend *b = bsim_backend_load(name + strlen(plugin), &e);
+		if (!b && err)
+			bsim_error_set(err, e.code, "--backend %s: %s", name, e.msg);
+		return b;
+	}
+	const bsim_backend *b = registry_named(name);
+	if (b)
+		return b;
+	char known[512] = "";
 	for (int i = 0; registry[i]; i++) {
-		if (strcmp(registry[i]->name, name) == 0)
-			return registry[i];
 		if (i)
 			strncat(known, ", ", sizeof known - strlen(known) - 1);
 		strncat(known, registry[i]->name, sizeof known - strlen(known) - 1);
 	}
-	bsim_error_set(err, BSIM_EINPUT, "--backend %s: unknown backend (expected one of %s)", name,
-	               known);
+	bsim_error_set(err, BSIM_EINPUT,
+	               "--backend %s: unknown backend (expected one of %s, or " BSIM_PLUGIN_PREFIX
+	               "PATH of a plug-in; a plug-in's backend is found by its name when %s "
+	               "lists its library)",
+	               name, known, BSIM_PLUGINS_ENV);
 	return NULL;
 }
 
@@ -48,6 +202,7 @@ int bsim_backend_compared(const bsim_backend **out, int max)
 {
 	/* The default is the registry's first, so the registry's order is
 	 * already the default followed by every other backend. */
+	env_ensure();
 	int n = 0;
 	for (; n < max && registry[n]; n++)
 		out[n] = registry[n];

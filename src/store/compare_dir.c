@@ -51,9 +51,9 @@ void bsim_compare_dir_label(const char *label, char *buf, size_t size)
 
 int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err)
 {
-	size_t n = strcspn(spec, ":");
-	char name[32];
-	if (n == 0 || n >= sizeof name || strlen(spec) >= sizeof side->label)
+	size_t n = bsim_backend_spec_name(spec);
+	char name[1024];
+	if (n == 0 || n >= sizeof name)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "--backends: side %s: expected NAME[:KEY=VALUE]...", spec);
 	snprintf(name, sizeof name, "%.*s", (int)n, spec);
@@ -61,6 +61,13 @@ int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_erro
 	side->backend = bsim_backend_find(name, &e);
 	if (!side->backend)
 		return bsim_error_set(err, BSIM_EINPUT, "--backends: side %s: %s", spec, e.msg);
+	/* The label: the backend's name (a plug-in's, not its path) and the
+	 * options as given. */
+	if (strlen(side->backend->name) + strlen(spec + n) >= sizeof side->label)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "--backends: side %s: its options are longer than %zu "
+		                      "characters",
+		                      spec, sizeof side->label - 1);
 	for (const char *p = spec + n; *p == ':';) {
 		const char *q = p + 1;
 		size_t len = strcspn(q, ":");
@@ -70,7 +77,7 @@ int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_erro
 			return BSIM_EINPUT;
 		p = q + len;
 	}
-	snprintf(side->label, sizeof side->label, "%s", spec);
+	snprintf(side->label, sizeof side->label, "%s%s", side->backend->name, spec + n);
 	return BSIM_OK;
 }
 

@@ -40,7 +40,7 @@ static int regress_load(const bsim_regress_def *def, bsim_regress_result *res,
 	    bsim_run_record_read(def->baseline, &res->rec, err) != BSIM_OK)
 		return BSIM_EINPUT;
 	for (int i = 0; i < res->rec.n_backends; i++) {
-		backend[i] = bsim_backend_find(res->rec.backend[i], err);
+		backend[i] = bsim_run_record_backend(&res->rec, i, err);
 		if (!backend[i] ||
 		    bsim_options_check(&res->rec.opts[i], backend[i]->knobs, backend[i]->n_knobs,
 		                       backend[i]->name, err) != BSIM_OK)

@@ -209,7 +209,7 @@ static int open_stored(bsim_replay *r, const bsim_replay_def *def, bsim_error *e
 	int side = stored_side(dir, &rec, def->side, err);
 	if (side < 0)
 		return BSIM_EINPUT;
-	const bsim_backend *b = bsim_backend_find(rec.backend[side], err);
+	const bsim_backend *b = bsim_run_record_backend(&rec, side, err);
 	if (!b || bsim_options_check(&rec.opts[side], b->knobs, b->n_knobs, b->name, err)) {
 		char msg[BSIM_ERROR_MSG_MAX];
 		snprintf(msg, sizeof msg, "%s", err->msg);

@@ -19,6 +19,7 @@
 #include "util/atomic_file.h"
 #include "util/file_read.h"
 #include "util/json.h"
+#include "beamsim/backend_plugin.h"
 #include "beamsim/backend_registry.h"
 #include "beamsim/limits.h"
 #include "beamsim/output.h"
@@ -35,6 +36,8 @@ void bsim_run_record_fill(bsim_run_record *rec, const char *command, const bsim_
 	for (int i = 0; i < n; i++) {
 		snprintf(rec->backend[i], sizeof rec->backend[i], "%s", b[i]->name);
 		snprintf(rec->label[i], sizeof rec->label[i], "%s", label ? label[i] : b[i]->name);
+		const char *lib = bsim_backend_plugin_path(b[i]);
+		snprintf(rec->plugin[i], sizeof rec->plugin[i], "%s", lib ? lib : "");
 		bsim_options_effective(b[i]->knobs, b[i]->n_knobs, opts[i], &rec->opts[i]);
 	}
 	rec->seed = e->seed;
@@ -168,6 +171,10 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 		fputs(", \"options\": ", f);
 		bsim_output_backend_options(f, bsim_backend_find(rec->backend[i], NULL),
 		                            &rec->opts[i]);
+		if (rec->plugin[i][0]) {
+			fputs(", \"plugin\": ", f);
+			bsim_json_string(f, rec->plugin[i]);
+		}
 		fputc('}', f);
 	}
 	fputc(']', f);
@@ -278,6 +285,10 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 		snprintf(rec->label[i], sizeof rec->label[i], "%s", rec->backend[i]);
 	else if (need_text(d, root, field, rec->label[i], sizeof rec->label[i], err))
 		return BSIM_EINPUT;
+	snprintf(field, sizeof field, "backends.%d.plugin", i);
+	if (ydoc_lookup(root, field) &&
+	    need_text(d, root, field, rec->plugin[i], sizeof rec->plugin[i], err))
+		return BSIM_EINPUT;
 	snprintf(field, sizeof field, "backends.%d.options", i);
 	struct fy_node *opts = ydoc_lookup(root, field);
 	if (!opts || !fy_node_is_mapping(opts) ||
@@ -298,6 +309,25 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 		o->n++;
 	}
 	return BSIM_OK;
+}
+
+const bsim_backend *bsim_run_record_backend(const bsim_run_record *rec, int i, bsim_error *err)
+{
+	const bsim_backend *b = bsim_backend_find(rec->backend[i], err);
+	if (b || !rec->plugin[i][0])
+		return b;
+	bsim_error e;
+	if (!(b = bsim_backend_load(rec->plugin[i], &e)))
+		bsim_error_set(err, BSIM_EINPUT,
+		               "backend %s: not registered, and its plug-in cannot be loaded "
+		               "again: %s",
+		               rec->backend[i], e.msg);
+	else if (strcmp(b->name, rec->backend[i]) != 0)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "backend %s: its plug-in %s now defines backend %s",
+		                      rec->backend[i], rec->plugin[i], b->name),
+		       NULL;
+	return b;
 }
 
 int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
