@@ -72,6 +72,7 @@ PUBLIC = {
     "contact_flag": "model",
     "backend_registry": "registry",
     "backend_plugin": "registry",
+    "stepper": "run",
     "effects": "model",
     "experiment": "model",
     "key_names": "model",

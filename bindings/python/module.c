@@ -186,8 +186,8 @@ const bsim_backend *pyb_backend(const char *spec, PyObject *seq, bsim_options *o
 	 * options, then the spec's own (they win). */
 	if (!spec)
 		spec = bsim_backend_default()->name;
-	size_t n = strcspn(spec, ":");
-	char name[32];
+	size_t n = bsim_backend_spec_name(spec);
+	char name[1024];
 	snprintf(name, sizeof name, "%.*s", (int)(n < sizeof name ? n : sizeof name - 1), spec);
 	const bsim_backend *b = bsim_backend_find(name, &err);
 	if (!b)
@@ -241,6 +241,15 @@ PyObject *pyb_array(int nd, const long *dims, const double *data)
 	PyObject *a = PyArray_SimpleNew(nd, d, NPY_DOUBLE);
 	if (a && n)
 		memcpy(PyArray_DATA((PyArrayObject *)a), data, n * sizeof *data);
+	return a;
+}
+
+PyObject *pyb_int_array(const int *v, long n)
+{
+	npy_intp d[1] = {n};
+	PyObject *a = PyArray_SimpleNew(1, d, NPY_INT32);
+	if (a && n)
+		memcpy(PyArray_DATA((PyArrayObject *)a), v, (size_t)n * sizeof *v);
 	return a;
 }
 
@@ -448,5 +457,8 @@ PyMODINIT_FUNC PyInit__beamsim(void);
 PyMODINIT_FUNC PyInit__beamsim(void)
 {
 	import_array();
-	return PyModule_Create(&module);
+	PyObject *m = PyModule_Create(&module);
+	if (m && pyb_world_add(m) < 0)
+		Py_CLEAR(m);
+	return m;
 }

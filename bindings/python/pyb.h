@@ -59,6 +59,8 @@ const bsim_backend *pyb_backend(const char *spec, PyObject *seq, bsim_options *o
 PyObject *pyb_column(const double *data, long n, long stride, int ints);
 /* A 1-, 2- or 3-D float64 array copied from data (C order). */
 PyObject *pyb_array(int nd, const long *dims, const double *data);
+/* A NumPy int32 array of the n ints v. */
+PyObject *pyb_int_array(const int *v, long n);
 
 /* A NumPy array of n int64 (ints) or float64 values that takes over data
  * (malloc'd, at least n values; freed with the array). New reference, or
@@ -73,11 +75,33 @@ PyObject *pyb_text_column(const uint32_t *codes, long n, PyObject *labels);
 int pyb_set(PyObject *d, const char *key, PyObject *value);
 
 /* The module's functions. */
+/* A trial named as beamsim.run names it (run.c): a scene, an experiment's
+ * (group, trial) or a stored run's, with the seed, the backend (for a
+ * stored run: a side's label) and its options, the overrides and the grid
+ * axes; the replay's definition (def) borrows them. 0, or -1 with a Python
+ * exception; pyb_trial_free releases it either way. */
+typedef struct pyb_trial {
+	bsim_replay_def def;
+	int stored;                  /* a stored run's directory */
+	const bsim_backend *backend; /* NULL for a stored run: its own */
+	bsim_options opts;
+	pyb_sets sets;
+	pyb_grid grid;
+} pyb_trial;
+int pyb_trial_from(const char *path, PyObject *seed_o, long group, long trial,
+                   const char *backend_spec, PyObject *sets_o, PyObject *opts_o, PyObject *grid_o,
+                   pyb_trial *t);
+void pyb_trial_free(pyb_trial *t);
+
 PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_landscape(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_read_table(PyObject *self, PyObject *args);
+
+/* Adds the type World (world.c) to the module: 0, or -1 with an
+ * exception. */
+int pyb_world_add(PyObject *module);
 
 /* A progress callback for long runs (bsim_progress_fn), called from the
  * thread that started the run while the GIL is released: every so often

@@ -144,6 +144,42 @@ static PyObject *json_text(const bsim_run_info *info, const bsim_trial_result *r
 	return s;
 }
 
+int pyb_trial_from(const char *path, PyObject *seed_o, long group, long trial,
+                   const char *backend_spec, PyObject *sets_o, PyObject *opts_o, PyObject *grid_o,
+                   pyb_trial *t)
+{
+	memset(t, 0, sizeof *t);
+	t->def = bsim_replay_def_default();
+	t->def.path = path;
+	t->def.group = group;
+	t->def.trial = trial;
+	if (pyb_seed_from(seed_o, &t->def.has_seed, &t->def.seed))
+		return -1;
+	/* A stored run's directory names its own backend: backend is a
+	 * side's label there. */
+	t->stored = bsim_replay_is_dir(path);
+	if (t->stored) {
+		t->def.side = backend_spec;
+		t->def.has_backend_opts =
+		        opts_o != Py_None && PyList_Check(opts_o) && PyList_Size(opts_o) > 0;
+	} else if (!(t->backend = pyb_backend(backend_spec, opts_o, &t->opts))) {
+		return -1;
+	}
+	if (pyb_sets_grid_from(sets_o, grid_o, &t->sets, &t->grid))
+		return -1;
+	t->def.sets = t->sets.ov;
+	t->def.n_sets = t->sets.n;
+	t->def.grid = t->grid.axes;
+	t->def.n_grid = t->grid.n;
+	return 0;
+}
+
+void pyb_trial_free(pyb_trial *t)
+{
+	pyb_sets_free(&t->sets);
+	pyb_grid_free(&t->grid);
+}
+
 PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
@@ -161,33 +197,12 @@ PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw)
 		PyErr_Format(PyExc_ValueError, "--stride %ld: expected an integer >= 1", stride);
 		return NULL;
 	}
-	bsim_replay_def def = bsim_replay_def_default();
-	def.path = path;
-	def.group = group;
-	def.trial = trial;
-	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
+	pyb_trial t;
+	if (pyb_trial_from(path, seed_o, group, trial, backend_spec, sets_o, opts_o, grid_o, &t))
 		return NULL;
-	/* A stored run's directory names its own backend: --backend is a
-	 * side's label there. */
-	int stored = bsim_replay_is_dir(path);
-	bsim_options opts;
-	memset(&opts, 0, sizeof opts);
-	const bsim_backend *backend = NULL;
-	if (stored) {
-		def.side = backend_spec;
-		def.has_backend_opts =
-		        opts_o != Py_None && PyList_Check(opts_o) && PyList_Size(opts_o) > 0;
-	} else if (!(backend = pyb_backend(backend_spec, opts_o, &opts))) {
-		return NULL;
-	}
-	pyb_sets sets;
-	pyb_grid grid;
-	if (pyb_sets_grid_from(sets_o, grid_o, &sets, &grid))
-		return NULL;
-	def.sets = sets.ov;
-	def.n_sets = sets.n;
-	def.grid = grid.axes;
-	def.n_grid = grid.n;
+	int stored = t.stored;
+	const bsim_backend *backend = t.backend;
+	bsim_options opts = t.opts;
 
 	bsim_replay *rp = NULL;
 	bsim_trial_log *log = bsim_trial_log_alloc();
@@ -201,7 +216,7 @@ PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw)
 	bsim_error err;
 	int rc;
 	Py_BEGIN_ALLOW_THREADS;
-	rc = log ? bsim_replay_open(&def, &rp, &err)
+	rc = log ? bsim_replay_open(&t.def, &rp, &err)
 	         : bsim_error_set(&err, BSIM_EFAIL, "out of memory");
 	if (rc == BSIM_OK) {
 		if (stored) {
@@ -264,7 +279,6 @@ done:
 	free(traj.ledger);
 	bsim_trial_log_free(log);
 	bsim_replay_free(rp);
-	pyb_sets_free(&sets);
-	pyb_grid_free(&grid);
+	pyb_trial_free(&t);
 	return out;
 }

@@ -39,6 +39,7 @@
 #include "beamsim/schedule.h"
 #include "beamsim/state.h"
 #include "beamsim/stats.h"
+#include "beamsim/stepper.h"
 #include "beamsim/sweep.h"
 #include "beamsim/sweep_dir.h"
 #include "beamsim/table.h"

@@ -43,7 +43,7 @@ except ImportError as _e:
         f"or build beamsim for this one (cmake -DPython3_EXECUTABLE={sys.executable}): {_e}"
     ) from _e
 
-__all__ = ["run", "sweep", "compare", "landscape", "load", "version", "backends"]
+__all__ = ["run", "sweep", "compare", "landscape", "load", "version", "backends", "World"]
 
 
 def version():
@@ -401,3 +401,70 @@ def landscape(scene, set=None, resolution=None, region=None):
     _no_nul("scene", scene)
     return _beamsim.landscape(os.fspath(scene), _sets(set),
                               float(resolution) if resolution is not None else 0.0, region)
+
+
+class World:
+    """A world stepped by hand, on any backend: the scene's bodies and beams
+    in a backend's world, advanced by the caller a step at a time
+    (libbeamsim's stepper, beamsim/stepper.h).
+
+    scene, seed, group, trial, backend, set, backend_opt and grid name the
+    trial as run() names it: a scene file, an experiment file (trial `trial`
+    of group `group`, the group's grid values applied) or the output
+    directory of a sweep or comparison (its seed, backend and options;
+    backend names a comparison's side). The world starts as that trial
+    starts.
+
+    step(force=None, n=1, torque=0.0): n steps of the scene's dt. With force
+    None, under the scene's own effects (propulsion, the random force of the
+    trial's schedule, drag, ...), each step's force from the state it starts
+    at: n steps are the trial's first n steps as run() and sweep() make
+    them, to the bit. With force (F_x, F_y) in N (and torque in N m), that
+    force held over the n steps instead. A step that fails (the backend's
+    error, a state no longer finite) raises RuntimeError naming it.
+
+    state: the state after the last step, a dict: step, t (s), x, v (body
+    centre and velocity, arrays of 2), heading, angular_velocity, theta,
+    omega (arrays by beam), contact (int32: 0 none, 1 tangent, 2 tip, the
+    contact flag every backend reports), touched (int32) and impulse (N s,
+    what each beam exchanged with the body in the last step), force (the
+    last step's F_x, F_y, torque), e_kin and e_elastic (J), energy (the last
+    step's flows: damper, impact, contact, correction, sleep), impacts and
+    solver (the backend's counts).
+
+    reset(): back to step 0. dt: the time step (s); backend: its name."""
+
+    def __init__(self, scene, backend=None, seed=None, group=0, trial=0, set=None,
+                 backend_opt=None, grid=None):
+        _no_nul("scene", scene)
+        _no_nul("backend", backend)
+        self._w = _beamsim.World(os.fspath(scene), _seed(seed), _count("group", group, 0),
+                                 _count("trial", trial, 0), backend, _sets(set),
+                                 _opts(backend_opt), _grid(grid))
+
+    def step(self, force=None, n=1, torque=0.0):
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
+            raise ValueError(f"n {n!r}: expected an integer >= 1")
+        if force is not None:
+            force = tuple(float(f) for f in force)
+            if len(force) != 2:
+                raise ValueError(f"force {force!r}: expected (F_x, F_y) in N")
+        self._w.step(force, int(n), float(torque))
+
+    def reset(self):
+        self._w.reset()
+
+    @property
+    def state(self):
+        return self._w.state
+
+    @property
+    def dt(self):
+        return self._w.dt
+
+    @property
+    def backend(self):
+        return self._w.backend
+
+    def __repr__(self):
+        return f"beamsim.World(backend={self.backend!r}, step={self.state['step']})"
