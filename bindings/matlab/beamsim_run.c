@@ -18,20 +18,9 @@
 
 #include "bsim_mex.h"
 
-enum {
-	A_SEED,
-	A_GROUP,
-	A_TRIAL,
-	A_BACKEND,
-	A_BACKEND_OPT,
-	A_SET,
-	A_GRID,
-	A_TRAJECTORY,
-	A_STRIDE,
-	N_ARGS
-};
-static const char *const arg_names[N_ARGS] = {
-        "seed", "group", "trial", "backend", "backend_opt", "set", "grid", "trajectory", "stride"};
+/* The trial's names (bsim_mex.h), then the run's. */
+enum { A_TRAJECTORY = BMX_TRIAL_NAMES, A_STRIDE, N_ARGS };
+static const char *const arg_names[N_ARGS] = {BMX_TRIAL_NAME_LIST, "trajectory", "stride"};
 
 /* The ledger.csv columns after t (bsim_trial_ledger_header). */
 #define LEDGER_COLUMNS 13
@@ -269,32 +258,9 @@ static int stored_check(const bsim_replay *rp, const bsim_trial_result *x, bsim_
 	                      theirs);
 }
 
-/* The range of a group or trial out of range counted from 1, as the
- * arguments count: "--group 30: expected 0 to 29 (h1.yaml has 30 groups)"
- * becomes "'group' 31: expected 1 to 30 (h1.yaml has 30 groups)". */
-static int from_one(bsim_error *err)
-{
-	static const char *const names[] = {"group", "trial"};
-	for (int i = 0; i < 2; i++) {
-		char head[64];
-		long given, last;
-		int used = 0;
-		snprintf(head, sizeof head, "--%s %%ld: expected 0 to %%ld%%n", names[i]);
-		if (sscanf(err->msg, head, &given, &last, &used) == 2 && used > 0) {
-			char rest[BSIM_ERROR_MSG_MAX];
-			snprintf(rest, sizeof rest, "%s", err->msg + used);
-			return bsim_error_set(err, err->code, "'%s' %ld: expected 1 to %ld%s",
-			                      names[i], given + 1, last + 1, rest);
-		}
-	}
-	return err->code ? err->code : BSIM_EINPUT;
-}
-
 typedef struct run_call {
 	bmx_pool pool;
-	bsim_grid_axis *grid;
-	int n_grid;
-	bsim_replay *rp;
+	bmx_trial trial;
 	bsim_trial_log *log;
 	rows traj;
 } run_call;
@@ -309,41 +275,15 @@ static int run(run_call *c, int nrhs, const mxArray *prhs[], mxArray **out, char
 		                      "then name-value pairs");
 	if (bmx_pairs(nrhs, prhs, 1, arg_names, N_ARGS, v, err) != BSIM_OK)
 		return BSIM_EINPUT;
-	bsim_replay_def def = bsim_replay_def_default();
-	long group = 1, trial = 1, stride = 1;
+	long stride = 1;
 	int trajectory = 0;
-	const char *backend = NULL;
-	bsim_override *kv = NULL;
-	int n_kv = 0;
-	if (bmx_text("path", prhs[0], &c->pool, &def.path, err) ||
-	    (v[A_GROUP] && bmx_long("group", v[A_GROUP], 1, INT32_MAX, &group, err)) ||
-	    (v[A_TRIAL] && bmx_long("trial", v[A_TRIAL], 1, INT32_MAX, &trial, err)) ||
-	    (v[A_STRIDE] && bmx_long("stride", v[A_STRIDE], 1, INT32_MAX, &stride, err)) ||
-	    (v[A_SEED] && bmx_seed("seed", v[A_SEED], &def.seed, err)) ||
+	if ((v[A_STRIDE] && bmx_long("stride", v[A_STRIDE], 1, INT32_MAX, &stride, err)) ||
 	    (v[A_TRAJECTORY] && bmx_flag("trajectory", v[A_TRAJECTORY], &trajectory, err)) ||
-	    (v[A_BACKEND] && bmx_text("backend", v[A_BACKEND], &c->pool, &backend, err)) ||
-	    bmx_overrides("backend_opt", v[A_BACKEND_OPT], &c->pool, &kv, &n_kv, err) ||
-	    bmx_overrides("set", v[A_SET], &c->pool, (bsim_override **)&def.sets, &def.n_sets,
-	                  err) ||
-	    bmx_grid("grid", v[A_GRID], &c->pool, &c->grid, &c->n_grid, err))
+	    bmx_trial_open(prhs[0], v, &c->pool, &c->trial, err))
 		return err->code;
-	def.group = group - 1;
-	def.trial = trial - 1;
-	def.has_seed = v[A_SEED] != NULL;
-	def.grid = c->grid;
-	def.n_grid = c->n_grid;
-	int stored = bsim_replay_is_dir(def.path);
-	if (stored) {
-		def.side = backend;
-		def.has_backend_opts = n_kv > 0;
-	}
-	if (bsim_replay_open(&def, &c->rp, err) != BSIM_OK)
-		return from_one(err);
-	const bsim_replay *rp = c->rp;
-	const bsim_backend *b = rp->backend;
-	bsim_options opts = rp->opts;
-	if (!b && bmx_backend(backend, kv, n_kv, &b, &opts, err) != BSIM_OK)
-		return BSIM_EINPUT;
+	const bsim_replay *rp = c->trial.rp;
+	const bsim_backend *b = c->trial.backend;
+	bsim_options opts = c->trial.opts;
 	if (!(c->log = bsim_trial_log_alloc()))
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	bsim_recorder rec = {.stride = (int)stride, .log = c->log, .overlap = 1};
@@ -383,10 +323,9 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
 	char warning[512] = "";
 	mxArray *out = NULL;
 	int rc = run(&c, nrhs, prhs, &out, warning, sizeof warning, &err);
-	bsim_replay_free(c.rp);
+	bmx_trial_free(&c.trial);
 	bsim_trial_log_free(c.log);
 	free(c.traj.v);
-	bmx_grid_free(c.grid, c.n_grid);
 	bmx_pool_free(&c.pool);
 	if (rc != BSIM_OK)
 		bmx_fail(&err);

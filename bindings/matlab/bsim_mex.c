@@ -474,6 +474,72 @@ int bmx_backend(const char *name, const bsim_override *kv, int n_kv, const bsim_
 	return bsim_options_check(opts, (*b)->knobs, (*b)->n_knobs, (*b)->name, err);
 }
 
+int bmx_from_one(bsim_error *err)
+{
+	static const char *const names[] = {"group", "trial"};
+	for (int i = 0; i < 2; i++) {
+		char head[64];
+		long given, last;
+		int used = 0;
+		snprintf(head, sizeof head, "--%s %%ld: expected 0 to %%ld%%n", names[i]);
+		if (sscanf(err->msg, head, &given, &last, &used) == 2 && used > 0) {
+			char rest[BSIM_ERROR_MSG_MAX];
+			snprintf(rest, sizeof rest, "%s", err->msg + used);
+			return bsim_error_set(err, err->code, "'%s' %ld: expected 1 to %ld%s",
+			                      names[i], given + 1, last + 1, rest);
+		}
+	}
+	return err->code ? err->code : BSIM_EINPUT;
+}
+
+int bmx_trial_open(const mxArray *path, const mxArray *const *v, bmx_pool *pool, bmx_trial *t,
+                   bsim_error *err)
+{
+	memset(t, 0, sizeof *t);
+	bsim_replay_def def = bsim_replay_def_default();
+	long group = 1, trial = 1;
+	const char *backend = NULL;
+	bsim_override *kv = NULL;
+	int n_kv = 0;
+	if (bmx_text("path", path, pool, &def.path, err) ||
+	    (v[BMX_TRIAL_GROUP] &&
+	     bmx_long("group", v[BMX_TRIAL_GROUP], 1, INT32_MAX, &group, err)) ||
+	    (v[BMX_TRIAL_TRIAL] &&
+	     bmx_long("trial", v[BMX_TRIAL_TRIAL], 1, INT32_MAX, &trial, err)) ||
+	    (v[BMX_TRIAL_SEED] && bmx_seed("seed", v[BMX_TRIAL_SEED], &def.seed, err)) ||
+	    (v[BMX_TRIAL_BACKEND] &&
+	     bmx_text("backend", v[BMX_TRIAL_BACKEND], pool, &backend, err)) ||
+	    bmx_overrides("backend_opt", v[BMX_TRIAL_BACKEND_OPT], pool, &kv, &n_kv, err) ||
+	    bmx_overrides("set", v[BMX_TRIAL_SET], pool, (bsim_override **)&def.sets, &def.n_sets,
+	                  err) ||
+	    bmx_grid("grid", v[BMX_TRIAL_GRID], pool, &t->grid, &t->n_grid, err))
+		return err->code;
+	def.group = group - 1;
+	def.trial = trial - 1;
+	def.has_seed = v[BMX_TRIAL_SEED] != NULL;
+	def.grid = t->grid;
+	def.n_grid = t->n_grid;
+	if (bsim_replay_is_dir(def.path)) {
+		/* a stored run names its own backend: 'backend' is a side's label */
+		def.side = backend;
+		def.has_backend_opts = n_kv > 0;
+	}
+	if (bsim_replay_open(&def, &t->rp, err) != BSIM_OK)
+		return bmx_from_one(err);
+	t->backend = t->rp->backend;
+	t->opts = t->rp->opts;
+	if (!t->backend && bmx_backend(backend, kv, n_kv, &t->backend, &t->opts, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	return BSIM_OK;
+}
+
+void bmx_trial_free(bmx_trial *t)
+{
+	bsim_replay_free(t->rp);
+	bmx_grid_free(t->grid, t->n_grid);
+	memset(t, 0, sizeof *t);
+}
+
 /* ---- what the functions return ---------------------------------------- */
 
 void bmx_set(mxArray *s, mwIndex i, const char *field, mxArray *v)

@@ -115,6 +115,43 @@ void bmx_text_field(mxArray *t, mxArray *l, const char *name, mxArray *codes, mx
  * does not start with a letter gets an x in front. */
 void bmx_field_name(const char *key, char *buf, size_t size);
 
+/* The names that pick a trial, first of beamsim_run's and beamsim_world
+ * 'open''s, in this order. */
+enum {
+	BMX_TRIAL_SEED,
+	BMX_TRIAL_GROUP,
+	BMX_TRIAL_TRIAL,
+	BMX_TRIAL_BACKEND,
+	BMX_TRIAL_BACKEND_OPT,
+	BMX_TRIAL_SET,
+	BMX_TRIAL_GRID,
+	BMX_TRIAL_NAMES
+};
+#define BMX_TRIAL_NAME_LIST "seed", "group", "trial", "backend", "backend_opt", "set", "grid"
+
+/* A trial as beamsim_run names it, opened (beamsim/replay.h): the replay,
+ * its backend (a stored run's own, else 'backend' with 'backend_opt') and
+ * options. */
+typedef struct bmx_trial {
+	bsim_grid_axis *grid;
+	int n_grid;
+	bsim_replay *rp;
+	const bsim_backend *backend;
+	bsim_options opts;
+} bmx_trial;
+/* path and v[0 .. BMX_TRIAL_NAMES) (bmx_pairs's values of those names,
+ * NULL where not given) into t; BSIM_OK or err's code. bmx_trial_free
+ * releases t either way. */
+int bmx_trial_open(const mxArray *path, const mxArray *const *v, bmx_pool *pool, bmx_trial *t,
+                   bsim_error *err);
+void bmx_trial_free(bmx_trial *t);
+
+/* err's message for a group or trial out of range, counted from 1 as the
+ * arguments count: "--group 30: expected 0 to 29 (h1.yaml has 30 groups)"
+ * becomes "'group' 31: expected 1 to 30 (h1.yaml has 30 groups)"; its
+ * code (BSIM_EINPUT if none). */
+int bmx_from_one(bsim_error *err);
+
 /* The error of err as a MATLAB error: identifier beamsim:input (bad
  * arguments or files, the program's exit status 2), beamsim:failed (1),
  * beamsim:disagree (3) or beamsim:stopped; the message is the line the

@@ -537,12 +537,50 @@ for c = 1:size(cases, 1)
 end
 printf('NUL in text: %d arguments refused, naming themselves\n', size(cases, 1));
 
+% ---- a world stepped by hand -------------------------------------------
+% Stepped under the trial's own forces, a step at a time, it passes through
+% beamsim_run's recorded rows to the bit; after a reset, all the steps in
+% one call end where the trial ends; a held force on a free body gives the
+% impulse's velocity; a closed world's handle is refused.
+for b = {'thesis', 'box2d', 'chipmunk'}
+  r = beamsim_run(h1, 'group', 21, 'trial', 4, 'backend', b{1}, 'trajectory', true);
+  w = beamsim_world('open', h1, 'group', 21, 'trial', 4, 'backend', b{1});
+  n = numel(r.trajectory.t) - 1;
+  for k = 1:n
+    beamsim_world('step', w);
+    s = beamsim_world('state', w);
+    check(isequal(s.x, [r.trajectory.x(k + 1), r.trajectory.y(k + 1)]) && ...
+          isequal(s.v, [r.trajectory.vx(k + 1), r.trajectory.vy(k + 1)]) && ...
+          s.theta(1) == r.trajectory.theta1(k + 1) && ...
+          s.contact(2) == r.trajectory.contact2(k + 1) && s.step == k, ...
+          'world (%s): step %d is not the trial''s', b{1}, k);
+  end
+  beamsim_world('reset', w);
+  beamsim_world('step', w, 'n', n);
+  s = beamsim_world('state', w);
+  check(isequal(s.x, [r.x_end, r.y_end]) && strcmp(s.backend, b{1}), ...
+        'world (%s): the steps in one call end at [%.17g %.17g], the trial at [%.17g %.17g]', ...
+        b{1}, s.x(1), s.x(2), r.x_end, r.y_end);
+  beamsim_world('close', w);
+end
+w = beamsim_world('open', gate, 'set', {'body.start', '[500, 0]', 'effects.propulsion.force', 0});
+beamsim_world('step', w, 'force', [-3 7], 'n', 250);
+s = beamsim_world('state', w);
+check(max(abs(s.v - [-3 7] * 250 * 0.004)) < 1e-12 && isequal(s.force, [-3 7 0]), ...
+      'world: a held force gives v [%.17g %.17g]', s.v(1), s.v(2));
+beamsim_world('close', w);
+[id, msg] = raised(@() beamsim_world('state', w));
+check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, 'names no open world')), ...
+      'a closed world: %s %s', id, msg);
+printf('world: %d steps of an H1 trial on 3 backends, each the trial''s\n', n);
+
 % Each MEX function's help (its .m file of comments beside it) says how it
 % is called, and a call still runs the MEX function.
 fns = {'beamsim_run', 'R = BEAMSIM_RUN(ARG, NAME, VALUE, ...)';
        'beamsim_sweep', 'S = BEAMSIM_SWEEP(EXPERIMENT, NAME, VALUE, ...)';
        'beamsim_landscape', 'L = BEAMSIM_LANDSCAPE(SCENE, NAME, VALUE, ...)';
-       'beamsim_read_csv', 'T = BEAMSIM_READ_CSV(FILE)'};
+       'beamsim_read_csv', 'T = BEAMSIM_READ_CSV(FILE)';
+       'beamsim_world', 'W = BEAMSIM_WORLD(''open'', ARG, NAME, VALUE, ...)'};
 for k = 1:size(fns, 1)
   text = get_help_text(fns{k, 1});
   check(~isempty(strfind(text, fns{k, 2})), 'help %s: no usage "%s" in "%s"', fns{k, 1}, ...
