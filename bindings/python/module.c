@@ -436,6 +436,8 @@ static PyMethodDef methods[] = {
         {"version", py_version, METH_NOARGS, "the library's version"},
         {"backends", py_backends, METH_NOARGS,
          "the backends compiled in, by name; the first is the default"},
+        {"register_backend", pyb_register_backend, METH_VARARGS,
+         "register_backend(cls, name, description): a backend written in Python, its name"},
         {"text_check", py_text_check, METH_VARARGS,
          "text_check(what, text): ValueError naming what if text holds a NUL"},
         {NULL, NULL, 0, NULL},

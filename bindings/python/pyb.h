@@ -94,6 +94,8 @@ int pyb_trial_from(const char *path, PyObject *seed_o, long group, long trial,
 void pyb_trial_free(pyb_trial *t);
 
 PyObject *pyb_run(PyObject *self, PyObject *args, PyObject *kw);
+/* register_backend(cls, name, description) (pybackend.c). */
+PyObject *pyb_register_backend(PyObject *self, PyObject *args);
 PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_landscape(PyObject *self, PyObject *args, PyObject *kw);

@@ -68,6 +68,12 @@ typedef struct bsim_backend_plugin {
  * another backend has; BSIM_EFAIL if the registry is full. */
 BSIM_API const bsim_backend *bsim_backend_load(const char *path, bsim_error *err);
 
+/* Adds a table the program made itself (a binding's backend written in
+ * Python, docs/bindings.md) to the registry, checked as a plug-in's is
+ * (its name, the required fields); b must outlive its use. b again gives
+ * b; NULL and BSIM_EINPUT if it fails a check or its name is taken. */
+BSIM_API const bsim_backend *bsim_backend_register(const bsim_backend *b, bsim_error *err);
+
 /* The absolute path of the library plug-in b was loaded from, for the
  * records of a run (run.json's backends.N.plugin, which beamsim regress
  * loads again); NULL for a backend compiled in. */

@@ -4,6 +4,7 @@
 #include "beamsim/backend_registry.h"
 
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -57,6 +58,31 @@ static const bsim_backend *registry_named(const char *name)
 	return NULL;
 }
 
+/* Adds b, checked, to the registry (once: b again is b), the caller
+ * holding the lock; what names it in errors, path its library (NULL: none). */
+static const bsim_backend *add_locked(const bsim_backend *b, const char *what, const char *path,
+                                      bsim_error *err)
+{
+	const bsim_backend *same = registry_named(b->name);
+	if (same == b)
+		return b; /* added before */
+	if (same) {
+		bsim_error_set(err, BSIM_EINPUT,
+		               "%s: a backend named %s is registered already (each backend's name "
+		               "is its own)",
+		               what, b->name);
+		return NULL;
+	}
+	int n = registry_count();
+	if (n == REGISTRY_MAX) {
+		bsim_error_set(err, BSIM_EFAIL, "%s: more than %d backends", what, REGISTRY_MAX);
+		return NULL;
+	}
+	registry_path[n] = path ? realpath(path, NULL) : NULL;
+	__atomic_store_n(&registry[n], b, __ATOMIC_RELEASE);
+	return b;
+}
+
 /* Loads path's plug-in and registers it (bsim_backend_load), the caller
  * holding the lock. */
 static const bsim_backend *load_locked(const char *path, bsim_error *err)
@@ -64,25 +90,9 @@ static const bsim_backend *load_locked(const char *path, bsim_error *err)
 	const bsim_backend *b = registry_plugin_open(path, err);
 	if (!b)
 		return NULL;
-	const bsim_backend *same = registry_named(b->name);
-	if (same == b)
-		return b; /* loaded before */
-	if (same) {
-		bsim_error_set(err, BSIM_EINPUT,
-		               "plug-in %s: a backend named %s is registered already (each "
-		               "backend's name is its own)",
-		               path, b->name);
-		return NULL;
-	}
-	int n = registry_count();
-	if (n == REGISTRY_MAX) {
-		bsim_error_set(err, BSIM_EFAIL, "plug-in %s: more than %d backends", path,
-		               REGISTRY_MAX);
-		return NULL;
-	}
-	registry_path[n] = realpath(path, NULL);
-	__atomic_store_n(&registry[n], b, __ATOMIC_RELEASE);
-	return b;
+	char what[4200];
+	snprintf(what, sizeof what, "plug-in %s", path);
+	return add_locked(b, what, path, err);
 }
 
 static void env_load(void)
@@ -135,6 +145,19 @@ const bsim_backend *bsim_backend_load(const char *path, bsim_error *err)
 	const bsim_backend *b = load_locked(path, err);
 	pthread_mutex_unlock(&registry_lock);
 	return b;
+}
+
+const bsim_backend *bsim_backend_register(const bsim_backend *b, bsim_error *err)
+{
+	env_ensure();
+	char what[64];
+	snprintf(what, sizeof what, "backend %.40s", b->name ? b->name : "");
+	if (registry_table_check(b, what, err) != BSIM_OK)
+		return NULL;
+	pthread_mutex_lock(&registry_lock);
+	const bsim_backend *r = add_locked(b, what, NULL, err);
+	pthread_mutex_unlock(&registry_lock);
+	return r;
 }
 
 const char *bsim_backend_plugin_path(const bsim_backend *b)

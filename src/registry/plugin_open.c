@@ -3,6 +3,7 @@
 
 #include <ctype.h>
 #include <dlfcn.h>
+#include <stdio.h>
 #include <string.h>
 
 /* Why table's name cannot be a backend's, or NULL. */
@@ -85,19 +86,22 @@ const bsim_backend *registry_plugin_open(const char *path, bsim_error *err)
 		               BSIM_PLUGIN_SYMBOL);
 		return NULL;
 	}
+	char what[1100];
+	snprintf(what, sizeof what, "plug-in %s", path);
+	return registry_table_check(b, what, err) == BSIM_OK ? b : NULL;
+}
+
+int registry_table_check(const bsim_backend *b, const char *what, bsim_error *err)
+{
 	const char *fault = name_fault(b->name);
-	if (fault) {
-		bsim_error_set(err, BSIM_EINPUT, "plug-in %s: the backend's name \"%s\" %s", path,
-		               b->name ? b->name : "", fault);
-		return NULL;
-	}
-	if ((fault = field_fault(b))) {
-		bsim_error_set(err, BSIM_EINPUT,
-		               "plug-in %s: backend %s: field %s is empty (every backend fills "
-		               "name, create, destroy, advance, get_state and set_state, "
-		               "beamsim/backend.h)",
-		               path, b->name, fault);
-		return NULL;
-	}
-	return b;
+	if (fault)
+		return bsim_error_set(err, BSIM_EINPUT, "%s: the backend's name \"%s\" %s", what,
+		                      b->name ? b->name : "", fault);
+	if ((fault = field_fault(b)))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s: backend %s: field %s is empty (every backend fills "
+		                      "name, create, destroy, advance, get_state and set_state, "
+		                      "beamsim/backend.h)",
+		                      what, b->name, fault);
+	return BSIM_OK;
 }

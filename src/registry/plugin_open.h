@@ -16,4 +16,9 @@
  * the reason. The library stays open. */
 const bsim_backend *registry_plugin_open(const char *path, bsim_error *err);
 
+/* The checks of a table a process adds at run time (a plug-in's or a
+ * binding's): its name and the fields every backend fills. BSIM_OK, or
+ * BSIM_EINPUT "WHAT: ..." saying what is wrong. */
+int registry_table_check(const bsim_backend *b, const char *what, bsim_error *err);
+
 #endif

@@ -158,6 +158,29 @@ def _count(name, value, least, most=_INT32_MAX):
     return int(value)
 
 
+def _backend(backend, what="backend"):
+    """A backend argument: None (the default), a name or compare side
+    "NAME[:KEY=VALUE]..." (str), or a class written in Python (a backend in
+    Python: registered once, then named by its `name`)."""
+    if backend is None:
+        return None
+    if isinstance(backend, type):
+        for method in ("advance", "state"):
+            if not callable(getattr(backend, method, None)):
+                raise TypeError(f"{what} {backend.__name__}: a backend in Python needs the "
+                                f"methods advance(force, torque, h) and state() "
+                                f"(docs/bindings.md, \"A backend in Python\")")
+        name = getattr(backend, "name", backend.__name__)
+        if not isinstance(name, str):
+            raise TypeError(f"{what} {backend.__name__}: its name must be a str")
+        doc = (backend.__doc__ or "").strip().splitlines()
+        about = doc[0] if doc else f"a backend in Python, {backend.__module__}.{backend.__qualname__}"
+        _no_nul(what, name)
+        return _beamsim.register_backend(backend, name, about)
+    _no_nul(what, backend)
+    return backend
+
+
 def _seed(seed):
     if seed is None:
         return None
@@ -243,7 +266,7 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     "unstable") and a replay that differs from its stored row are warned
     of (RuntimeWarning)."""
     _no_nul("scene", scene)
-    _no_nul("backend", backend)
+    backend = _backend(backend)
     r = _beamsim.run(os.fspath(scene), _seed(seed), _count("group", group, 0),
                      _count("trial", trial, 0), backend, _sets(set), _opts(backend_opt),
                      bool(trajectory), _count("stride", stride, 1), _grid(grid))
@@ -316,7 +339,7 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
     Ctrl-C stops the sweep (KeyboardInterrupt)."""
     _no_nul("experiment", experiment)
     _no_nul("out", out)
-    _no_nul("backend", backend)
+    backend = _backend(backend)
     with _Dir(out, "sweep") as d:
         info = _beamsim.sweep(os.fspath(experiment), d, _count("trials", trials, 1),
                               _count("threads", threads, 1, 4096), _seed(seed), backend,
@@ -353,13 +376,11 @@ def compare(experiment, backends=None, trials=None, threads=None, set=None,
     if isinstance(backends, (str, bytes)):
         raise TypeError("backends: expected a sequence of sides NAME[:KEY=VALUE]..., e.g. "
                         f"{tuple(backends_list()[:2])}")
-    labels = tuple(backends)
+    labels = tuple(_backend(b, "backends") for b in backends)
     if not 2 <= len(labels) <= 8:
         raise ValueError(f"backends: {len(labels)} sides; expected 2 to 8")
     _no_nul("experiment", experiment)
     _no_nul("out", out)
-    for label in labels:
-        _no_nul("backends", label)
     with _Dir(out, "compare") as d:
         info = _beamsim.compare(os.fspath(experiment), d, labels, _count("trials", trials, 1),
                                 _count("threads", threads, 1, 4096), _seed(seed), _sets(set),
@@ -437,7 +458,7 @@ class World:
     def __init__(self, scene, backend=None, seed=None, group=0, trial=0, set=None,
                  backend_opt=None, grid=None):
         _no_nul("scene", scene)
-        _no_nul("backend", backend)
+        backend = _backend(backend)
         self._w = _beamsim.World(os.fspath(scene), _seed(seed), _count("group", group, 0),
                                  _count("trial", trial, 0), backend, _sets(set),
                                  _opts(backend_opt), _grid(grid))
