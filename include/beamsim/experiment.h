@@ -41,6 +41,12 @@ typedef struct bsim_experiment {
 	int n_axes;
 	bsim_grid_axis *axes; /* the first axis varies slowest */
 	int n_groups;         /* product of the axes' sizes, >= 1 */
+	/* The scene file's text as it was read once at load (owned; NULL: read
+	 * the file each time), from which every group's scene is made: a run
+	 * reads its scene file once, and every group sees the same text. */
+	char *scene_text;
+	size_t scene_len;
+	void *scene_doc; /* that text parsed once (internal: a libfyaml document) */
 } bsim_experiment;
 
 /* Loads an experiment file. Errors (unknown keys, an empty grid, ...) are

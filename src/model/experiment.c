@@ -7,6 +7,8 @@
 #include "beamsim/experiment.h"
 
 #include <errno.h>
+#include <libfyaml.h>
+#include <pthread.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +16,7 @@
 
 #include "beamsim/limits.h"
 #include "model/scene_internal.h"
+#include "util/file_read.h"
 
 static const char experiment_keys[] = "name, scene, trials, seed, set, grid";
 
@@ -51,14 +54,24 @@ static int walk_scene_path(const ydoc *d, struct fy_node *n, struct fy_node *key
 	int len = snprintf(e->scene_path, sizeof e->scene_path, "%.*s%s", dir, d->path, t);
 	if (len < 0 || (size_t)len >= sizeof e->scene_path)
 		return ydoc_expected(d, n, key, "scene", "a shorter path", err);
-	FILE *f = fopen(e->scene_path, "rb");
-	if (!f) {
+	/* Read here, once: every group's scene is made from this text
+	 * (bsim_experiment.scene_text). */
+	file_text f;
+	bsim_error fe;
+	int rc = file_read(e->scene_path, "a YAML file", bsim_limits_get()->input_bytes,
+	                   "input_bytes", &f, &fe);
+	if (rc == BSIM_EFAIL) {
+		*err = fe;
+		return rc;
+	}
+	if (rc != BSIM_OK) {
 		char what[BSIM_PATH_MAX];
-		snprintf(what, sizeof what, "a readable scene file (%s: %s)", e->scene_path,
-		         strerror(errno));
+		snprintf(what, sizeof what, "a readable scene file (%s)", fe.msg);
 		return ydoc_expected(d, n, key, "scene", what, err);
 	}
-	fclose(f);
+	free(e->scene_text);
+	e->scene_text = f.text;
+	e->scene_len = f.len;
 	return BSIM_OK;
 }
 
@@ -475,6 +488,28 @@ static int load_group(const ydoc *scene, const bsim_experiment *e, int g,
 	return rc;
 }
 
+/* Guards the clone of an experiment's parsed scene, which threads making
+ * their groups' scenes share. */
+static pthread_mutex_t scene_doc_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* The scene file parsed: a copy of the document parsed at load, else the
+ * text read at load parsed, else the file. */
+static int scene_parse(const bsim_experiment *e, ydoc *scene, bsim_error *err)
+{
+	if (e->scene_doc) {
+		memset(scene, 0, sizeof *scene);
+		scene->path = e->scene_path;
+		pthread_mutex_lock(&scene_doc_lock);
+		scene->fyd = fy_document_clone(e->scene_doc);
+		pthread_mutex_unlock(&scene_doc_lock);
+		return scene->fyd ? BSIM_OK
+		                  : bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
+	}
+	if (e->scene_text)
+		return ydoc_load_text(scene, e->scene_path, e->scene_text, e->scene_len, err);
+	return ydoc_load(scene, e->scene_path, err);
+}
+
 int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_override *extra,
                                 int n_extra, bsim_scene *out, bsim_error *err)
 {
@@ -482,7 +517,7 @@ int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_over
 		return bsim_error_set(err, BSIM_EINPUT, "%s: group %d: expected 0 to %d", e->path,
 		                      g, e->n_groups - 1);
 	ydoc scene;
-	int rc = ydoc_load(&scene, e->scene_path, err);
+	int rc = scene_parse(e, &scene, err);
 	if (rc)
 		return rc;
 	rc = load_group(&scene, e, g, extra, n_extra, out, err);
@@ -624,7 +659,12 @@ int bsim_experiment_load_seeded(const char *path, const bsim_override *extra, in
 	if (!rc)
 		rc = apply_grid(out, grid, n_grid, err);
 	if (!rc)
-		rc = ydoc_load(&scene, out->scene_path, err);
+		rc = scene_parse(out, &scene, err);
+	if (!rc) { /* kept: every group's scene is made from it */
+		out->scene_doc = fy_document_clone(scene.fyd);
+		if (!out->scene_doc)
+			rc = bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", out->path);
+	}
 	if (!rc)
 		rc = check_values(&scene, out, extra, n_extra, err);
 	if (!rc)
@@ -654,5 +694,8 @@ void bsim_experiment_free(bsim_experiment *e)
 	for (int a = 0; a < e->n_axes; a++)
 		bsim_experiment_axis_free(&e->axes[a]);
 	free(e->axes);
+	free(e->scene_text);
+	if (e->scene_doc)
+		fy_document_destroy(e->scene_doc);
 	memset(e, 0, sizeof *e);
 }

@@ -93,17 +93,35 @@ static int write_experiment(const char *path, const bsim_experiment *e, const bs
 	return bsim_atomic_file_commit(&o, err);
 }
 
-/* The scene file's text into f, at most the input limit. */
-static int scene_text(FILE *f, const char *path, bsim_error *err)
+/* The scene file's text into f, at most the input limit: the text the
+ * experiment read at load where it holds it (what the run's groups are
+ * made of), else the file's. */
+static int scene_text(FILE *f, const bsim_experiment *e, bsim_error *err)
 {
+	if (e->scene_text) {
+		fwrite(e->scene_text, 1, e->scene_len, f);
+		return BSIM_OK;
+	}
 	file_text t;
-	int rc = file_read(path, "a scene file", bsim_limits_get()->input_bytes, "input_bytes", &t,
-	                   err);
+	int rc = file_read(e->scene_path, "a scene file", bsim_limits_get()->input_bytes,
+	                   "input_bytes", &t, err);
 	if (rc != BSIM_OK)
 		return rc;
 	fwrite(t.text, 1, t.len, f);
 	file_text_free(&t);
 	return BSIM_OK;
+}
+
+/* inputs/scene.yaml at path: the scene's text as scene_text gives it. */
+static int scene_copy(const char *path, const bsim_experiment *e, bsim_error *err)
+{
+	if (!e->scene_text)
+		return bsim_atomic_file_copy(e->scene_path, path, err);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	scene_text(o.f, e, err);
+	return bsim_atomic_file_commit(&o, err);
 }
 
 char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *e,
@@ -126,7 +144,7 @@ char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *
 	fprintf(f, "groups %d\n--- experiment\n", e->n_groups);
 	experiment_body(f, e, extra, n_extra);
 	fputs("--- scene\n", f);
-	int rc = scene_text(f, e->scene_path, err);
+	int rc = scene_text(f, e, err);
 	if (fclose(f) != 0 && rc == BSIM_OK)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (rc != BSIM_OK) {
@@ -237,7 +255,7 @@ int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsi
 	    bsim_output_mkdir(inputs, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (path_join(path, sizeof path, inputs, "scene.yaml", err) ||
-	    bsim_atomic_file_copy(e->scene_path, path, err) != BSIM_OK)
+	    scene_copy(path, e, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	if (copy_stiffness_files(inputs, e, extra, n_extra, err) != BSIM_OK)
 		return BSIM_EFAIL;

@@ -220,17 +220,11 @@ static int fault_error(const char *name, const parse_fault *pf, bsim_error *err)
 }
 
 /* Reads path, at most max_bytes (the limit limit_name, or INFINITY). */
-static int load(ydoc *d, const char *path, double max_bytes, const char *limit_name,
-                bsim_error *err)
+/* text (len bytes, a copy parse_checked takes) parsed as the file path. */
+static int load_parsed(ydoc *d, const char *path, char *text, size_t len, bsim_error *err)
 {
-	memset(d, 0, sizeof *d);
-	d->path = path;
-	file_text f;
-	int rc = file_read(path, "a YAML file", max_bytes, limit_name, &f, err);
-	if (rc != BSIM_OK)
-		return rc;
 	parse_fault pf;
-	if (parse_checked(d, f.text, f.len, &pf) != PF_OK)
+	if (parse_checked(d, text, len, &pf) != PF_OK)
 		return fault_error(path, &pf, err);
 	/* An empty file (or only comments) has no document at all: treat it as
 	 * a document with no root, which the loaders report as "got nothing". */
@@ -241,9 +235,33 @@ static int load(ydoc *d, const char *path, double max_bytes, const char *limit_n
 	return BSIM_OK;
 }
 
+static int load(ydoc *d, const char *path, double max_bytes, const char *limit_name,
+                bsim_error *err)
+{
+	memset(d, 0, sizeof *d);
+	d->path = path;
+	file_text f;
+	int rc = file_read(path, "a YAML file", max_bytes, limit_name, &f, err);
+	if (rc != BSIM_OK)
+		return rc;
+	return load_parsed(d, path, f.text, f.len, err);
+}
+
 int ydoc_load(ydoc *d, const char *path, bsim_error *err)
 {
 	return load(d, path, bsim_limits_get()->input_bytes, "input_bytes", err);
+}
+
+int ydoc_load_text(ydoc *d, const char *path, const char *text, size_t len, bsim_error *err)
+{
+	memset(d, 0, sizeof *d);
+	d->path = path;
+	char *copy = malloc(len + 1);
+	if (!copy)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
+	memcpy(copy, text, len);
+	copy[len] = '\0';
+	return load_parsed(d, path, copy, len, err);
 }
 
 int ydoc_load_own(ydoc *d, const char *path, bsim_error *err)

@@ -26,6 +26,10 @@ typedef struct ydoc {
  * (or the alias's field); libfyaml prints nothing itself. */
 int ydoc_load(ydoc *d, const char *path, bsim_error *err);
 
+/* ydoc_load of a file's text already read (len bytes; copied), named path
+ * in messages: the same checks but the size limit, which the read applied. */
+int ydoc_load_text(ydoc *d, const char *path, const char *text, size_t len, bsim_error *err);
+
 /* ydoc_load of a file beamsim wrote itself (summary.json, report.json,
  * run.json, manifest.json, ...): checked the same way but without the
  * input_bytes limit, which is a bound on what a user's file may ask for,
