@@ -711,6 +711,20 @@ static void test_spelling(void **state)
 	const char *missing[] = {"/nothing: expected a trials.csv or a directory holding one",
 	                         NULL};
 	refused_as(sides, NULL, missing, 1);
+	/* labelled by its folder: one named as another side is refused, one
+	 * that is not a label is labelled trials */
+	lines l;
+	lines_read(made_csv, &l);
+	snprintf(sides, sizeof sides, "thesis,trials:%s",
+	         write_variant("thesis", &l, -1, -1, NULL, NULL));
+	const char *clash[] = {"are both labelled thesis", "move the file to a folder", NULL};
+	refused(sides, NULL, clash);
+	snprintf(sides, sizeof sides, "thesis,trials:%s/trials.csv",
+	         write_variant("made.v2", &l, -1, -1, NULL, NULL));
+	const char *out = bsim_test_dir_held("label_cmp");
+	assert_int_equal(compare(sides, out, NULL, NULL), 0);
+	assert_true(bsim_test_exists(bsim_test_join(out, "trials/trials.csv")));
+	free(l.text);
 	const char *argv[] = {"run", experiment, "--backend", "trials:x", NULL};
 	const char *not_run[] = {"--backend trials:x: a side of beamsim compare read from", NULL};
 	bsim_test_expect_input_error(argv, not_run);

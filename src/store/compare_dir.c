@@ -391,6 +391,24 @@ static void sides_text(const compare_job *job, char *buf, size_t size)
 	}
 }
 
+/* BSIM_EINPUT: sides i and j, one of them read from a file, have one
+ * label. */
+static int read_label_clash(const bsim_compare_dir_def *def, const compare_job *job, int i, int j,
+                            const char *given, bsim_error *err)
+{
+	char side[2][BSIM_PATH_MAX + 16];
+	for (int k = 0; k < 2; k++) {
+		int s = k ? j : i;
+		snprintf(side[k], sizeof side[k], "%s%s", job->is_read[s] ? BSIM_TRIALS_PREFIX : "",
+		         job->is_read[s] ? def->side[s].trials : job->label[s]);
+	}
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "--backends %s: sides %s and %s are both labelled %s (a side read "
+	                      "from a file is labelled by the name of its folder); expected "
+	                      "different labels: move the file to a folder of another name",
+	                      given, side[0], side[1], job->label[i]);
+}
+
 /* The sides' backends, options, labels and directories; BSIM_EINPUT if
  * they cannot be told apart. */
 static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
@@ -456,18 +474,7 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 		for (int j = i + 1; j < job->n; j++) {
 			if (strcmp(job->label[i], job->label[j]) == 0 &&
 			    (job->is_read[i] || job->is_read[j]))
-				return bsim_error_set(
-				        err, BSIM_EINPUT,
-				        "--backends %s: sides %s%s and %s%s are both labelled %s "
-				        "(a "
-				        "side read from a file is labelled by the name of its "
-				        "folder); expected different labels: move the file to a "
-				        "folder of another name",
-				        given, job->is_read[i] ? BSIM_TRIALS_PREFIX : "",
-				        job->is_read[i] ? def->side[i].trials : job->label[i],
-				        job->is_read[j] ? BSIM_TRIALS_PREFIX : "",
-				        job->is_read[j] ? def->side[j].trials : job->label[j],
-				        job->label[i]);
+				return read_label_clash(def, job, i, j, given, err);
 			if (strcmp(job->label[i], job->label[j]) == 0 && job->n == 2)
 				return bsim_error_set(
 				        err, BSIM_EINPUT,
