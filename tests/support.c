@@ -16,6 +16,7 @@
 
 #include "util/figure.h"
 #include "store/outdir.h"
+#include "util/yaml_doc.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -88,6 +89,15 @@ const char *bsim_test_dir(const char *name)
 		return path;
 	mkdirs(path);
 	return path;
+}
+
+const char *bsim_test_dir_held(const char *name)
+{
+	static char buf[4][1200];
+	static int k;
+	k = (k + 1) % 4;
+	snprintf(buf[k], sizeof buf[k], "%s", bsim_test_dir(name));
+	return buf[k];
 }
 
 const char *bsim_test_write(const char *dir, const char *name, const char *text)
@@ -629,6 +639,26 @@ double bsim_test_json_number(const char *text, const char *key)
 		abort();
 	}
 	return strtod(p + strlen(pat), NULL);
+}
+
+double bsim_test_json_at(struct fy_node *root, const char *path)
+{
+	double v = NAN;
+	struct fy_node *n = ydoc_lookup(root, path);
+	if (!n || ydoc_number(n, &v) != YDOC_NUM_OK)
+		fail_msg("JSON: no number at %s", path);
+	return v;
+}
+
+const char *bsim_test_json_text_at(struct fy_node *root, const char *path, char *buf, size_t size)
+{
+	struct fy_node *n = ydoc_lookup(root, path);
+	size_t len = 0;
+	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
+	if (!t)
+		fail_msg("JSON: no text at %s", path);
+	snprintf(buf, size, "%.*s", (int)len, t);
+	return buf;
 }
 
 int bsim_test_check_wrote(const char *out, const char *dir)

@@ -85,6 +85,10 @@ int bsim_test_await_glob(int pid, const char *pattern, long n, int *status);
  * in a static buffer (valid until the next call). */
 const char *bsim_test_dir(const char *name);
 
+/* The same in one of four static buffers used in turn, so that a few
+ * may be held at once. */
+const char *bsim_test_dir_held(const char *name);
+
 /* Removes path and all below it (rm -rf): 0, or -1 on failure. */
 int bsim_test_remove(const char *path);
 
@@ -141,6 +145,13 @@ int bsim_test_check_figures(const char *dir);
 /* The number after "key": in JSON text (the first such key from text on);
  * aborts the test if there is none. */
 double bsim_test_json_number(const char *text, const char *key);
+
+/* A JSON (or YAML) document's node at a dotted path ("groups.3.verdict",
+ * util/yaml_doc.h's ydoc_lookup) as a number, or its scalar's text into
+ * buf; fails the test, naming the path, if there is none. */
+struct fy_node;
+double bsim_test_json_at(struct fy_node *root, const char *path);
+const char *bsim_test_json_text_at(struct fy_node *root, const char *path, char *buf, size_t size);
 
 /* Asserts that out (a command's stdout) has the line "wrote DIR/ ..."
  * followed by a line "  PATH ..." for every file DIR/manifest.json lists;

@@ -25,15 +25,6 @@
 static char experiment[1200];
 static char cmp_dir[1200];
 
-static const char *out_dir(const char *name)
-{
-	static char buf[4][1200];
-	static int k;
-	k = (k + 1) % 4;
-	snprintf(buf[k], sizeof buf[k], "%s", bsim_test_dir(name));
-	return buf[k];
-}
-
 /* A baseline edited by hand is no longer the set of files its manifest
  * lists (regress refuses such a mix): the edit removes the manifest too. */
 static void edit_in(const char *dir, const char *name, const char *text)
@@ -64,7 +55,7 @@ static int setup(void **state)
 	         "  effects.random_force.magnitude: [0, 30]\n",
 	         bsim_test_src("configs/thesis/gate.yaml"));
 	snprintf(experiment, sizeof experiment, "%s", bsim_test_write(dir, "small.yaml", text));
-	snprintf(cmp_dir, sizeof cmp_dir, "%s", out_dir("cmp"));
+	snprintf(cmp_dir, sizeof cmp_dir, "%s", bsim_test_dir_held("cmp"));
 	const char *argv[] = {"compare", experiment, "--threads", "2",
 	                      "--quiet", "--out",    cmp_dir,     NULL};
 	int status = bsim_test_cli(argv, NULL, NULL);
@@ -77,7 +68,7 @@ static void test_halves_are_sweeps(void **state)
 	(void)state;
 	const char *backends[] = {"thesis", "box2d"};
 	for (int i = 0; i < 2; i++) {
-		const char *dir = out_dir(backends[i]);
+		const char *dir = bsim_test_dir_held(backends[i]);
 		const char *argv[] = {"sweep",   experiment, "--backend", backends[i],
 		                      "--quiet", "--out",    dir,         NULL};
 		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
@@ -101,7 +92,7 @@ static void test_every_backend_a_side(void **state)
 		snprintf(sides + strlen(sides), sizeof sides - strlen(sides), "%s%s", n ? "," : "",
 		         list[n]->name);
 	char dir[1200];
-	snprintf(dir, sizeof dir, "%s", out_dir("cmp_all"));
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir_held("cmp_all"));
 	const char *argv[] = {"compare", experiment, "--backends", sides, "--threads",
 	                      "2",       "--quiet",  "--out",      dir,   NULL};
 	int status = bsim_test_cli(argv, NULL, NULL);
@@ -110,7 +101,7 @@ static void test_every_backend_a_side(void **state)
 	for (int n = 0; list[n]; n++) {
 		char name[64];
 		snprintf(name, sizeof name, "side_sweep_%s", list[n]->name);
-		const char *sweep = out_dir(name);
+		const char *sweep = bsim_test_dir_held(name);
 		const char *sw[] = {"sweep",   experiment, "--backend", list[n]->name,
 		                    "--quiet", "--out",    sweep,       NULL};
 		assert_int_equal(bsim_test_cli(sw, NULL, NULL), 0);
@@ -131,7 +122,7 @@ static void test_every_backend_a_side(void **state)
 static void test_status_and_threads(void **state)
 {
 	(void)state;
-	const char *dir = out_dir("cmp1");
+	const char *dir = bsim_test_dir_held("cmp1");
 	const char *argv[] = {"compare", experiment, "--threads", "1", "--out", dir, NULL};
 	char *out = NULL;
 	int status = bsim_test_cli(argv, &out, NULL);
@@ -249,7 +240,7 @@ static void test_compare_replays(void **state)
 static void test_regress_identical(void **state)
 {
 	(void)state;
-	const char *dir = out_dir("rerun");
+	const char *dir = bsim_test_dir_held("rerun");
 	const char *argv[] = {"regress", cmp_dir, "--exact", "--out", dir, NULL};
 	char *out = NULL;
 	assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
@@ -279,7 +270,7 @@ static void test_regress_identical(void **state)
 static void test_regress_catches_changes(void **state)
 {
 	(void)state;
-	const char *base = out_dir("base");
+	const char *base = bsim_test_dir_held("base");
 	const char *sweep[] = {"sweep", experiment, "--quiet", "--out", base, NULL};
 	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
 	char *csv = read_in(base, "trials.csv");
@@ -299,7 +290,7 @@ static void test_regress_catches_changes(void **state)
 	assert_true(changed >= 10); /* force 9 without noise traverses */
 	edit_in(base, "trials.csv", edited);
 
-	const char *dir = out_dir("caught");
+	const char *dir = bsim_test_dir_held("caught");
 	const char *argv[] = {"regress", base, "--quiet", "--out", dir, NULL};
 	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 3);
 	char *json = read_in(dir, "regress.json");
@@ -321,7 +312,7 @@ static void test_regress_catches_changes(void **state)
 static void test_regress_exact(void **state)
 {
 	(void)state;
-	const char *base = out_dir("exact");
+	const char *base = bsim_test_dir_held("exact");
 	const char *sweep[] = {"sweep", experiment, "--quiet", "--out", base, NULL};
 	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
 	char *csv = read_in(base, "trials.csv");
@@ -332,10 +323,11 @@ static void test_regress_exact(void **state)
 		field = strchr(field, ',') + 1;
 	*field = *field == '1' ? '2' : '1';
 	edit_in(base, "trials.csv", csv);
-	const char *loose[] = {"regress", base, "--quiet", "--out", out_dir("loose"), NULL};
+	const char *loose[] = {"regress", base, "--quiet", "--out", bsim_test_dir_held("loose"),
+	                       NULL};
 	assert_int_equal(bsim_test_cli(loose, NULL, NULL), 0);
-	const char *exact[] = {"regress",        base, "--quiet", "--exact", "--out",
-	                       out_dir("tight"), NULL};
+	const char *exact[] = {
+	        "regress", base, "--quiet", "--exact", "--out", bsim_test_dir_held("tight"), NULL};
 	assert_int_equal(bsim_test_cli(exact, NULL, NULL), 3);
 	free(csv);
 }
@@ -346,7 +338,7 @@ static void test_regress_exact(void **state)
 static void test_one_backend_two_settings(void **state)
 {
 	(void)state;
-	const char *dir = out_dir("euler");
+	const char *dir = bsim_test_dir_held("euler");
 	const char *argv[] = {"compare",
 	                      experiment,
 	                      "--backends",
@@ -374,7 +366,8 @@ static void test_one_backend_two_settings(void **state)
 	                            "\"projection\": 1, \"slop\": 2e-6,"));
 	char *md = read_in(dir, "report.md");
 	assert_non_null(strstr(md, "# beamsim compare: thesis vs thesis:integrator=euler"));
-	const char *again[] = {"regress", dir, "--exact", "--out", out_dir("euler_rerun"), NULL};
+	const char *again[] = {
+	        "regress", dir, "--exact", "--out", bsim_test_dir_held("euler_rerun"), NULL};
 	char *out = NULL;
 	assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
 	assert_non_null(strstr(out, "thesis:integrator=euler: 0 of 48 trials changed"));
@@ -423,7 +416,7 @@ static void test_report_deterministic(void **state)
 static void test_unstable_event(void **state)
 {
 	(void)state;
-	const char *dir = out_dir("stiff");
+	const char *dir = bsim_test_dir_held("stiff");
 	const char *argv[] = {"compare",    bsim_test_src("configs/hard/stiff_beam_sweep.yaml"),
 	                      "--backends", "thesis,box2d:spring=torque",
 	                      "--out",      dir,
@@ -452,7 +445,7 @@ static void test_unstable_event(void **state)
 static void test_regress_old_format(void **state)
 {
 	(void)state;
-	const char *base = out_dir("oldfmt");
+	const char *base = bsim_test_dir_held("oldfmt");
 	const char *sweep[] = {"sweep", experiment, "--quiet", "--out", base, NULL};
 	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
 	char *csv = read_in(base, "trials.csv");
@@ -464,7 +457,8 @@ static void test_regress_old_format(void **state)
 		w += sprintf(w, "%.*s\n", (int)(p - line), line);
 	}
 	edit_in(base, "trials.csv", old); /* an old baseline has no manifest */
-	const char *argv[] = {"regress", base, "--exact", "--out", out_dir("oldfmt_rerun"), NULL};
+	const char *argv[] = {
+	        "regress", base, "--exact", "--out", bsim_test_dir_held("oldfmt_rerun"), NULL};
 	char *out = NULL;
 	assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
 	assert_non_null(strstr(out, "thesis: 0 of 48 trials changed"));
@@ -477,28 +471,37 @@ static void test_bad_usage(void **state)
 {
 	(void)state;
 	char *err = NULL;
-	const char *same[] = {"compare", experiment,      "--backends", "thesis,thesis",
-	                      "--out",   out_dir("bad1"), NULL};
+	const char *same[] = {"compare",    experiment,
+	                      "--backends", "thesis,thesis",
+	                      "--out",      bsim_test_dir_held("bad1"),
+	                      NULL};
 	assert_int_equal(bsim_test_cli(same, NULL, &err), 2);
 	assert_non_null(strstr(err, "two different sides"));
 	free(err);
-	const char *knob[] = {"compare",       experiment, "--backend-opt", "box2d:nope=1", "--out",
-	                      out_dir("bad2"), NULL};
+	const char *knob[] = {"compare",
+	                      experiment,
+	                      "--backend-opt",
+	                      "box2d:nope=1",
+	                      "--out",
+	                      bsim_test_dir_held("bad2"),
+	                      NULL};
 	assert_int_equal(bsim_test_cli(knob, NULL, &err), 2);
 	assert_non_null(strstr(err, "nope"));
 	free(err);
-	const char *plain[] = {"compare",        experiment, "--backend-opt", "substeps=2", "--out",
-	                       out_dir("bad3b"), NULL};
+	const char *plain[] = {"compare",    experiment, "--backend-opt",
+	                       "substeps=2", "--out",    bsim_test_dir_held("bad3b"),
+	                       NULL};
 	assert_int_equal(bsim_test_cli(plain, NULL, &err), 2);
 	assert_non_null(strstr(err, "expected B:KEY=VALUE with several backends"));
 	free(err);
-	const char *who[] = {"compare",       experiment, "--backend-opt", "ode:x=1", "--out",
-	                     out_dir("bad3"), NULL};
+	const char *who[] = {"compare", experiment, "--backend-opt",
+	                     "ode:x=1", "--out",    bsim_test_dir_held("bad3"),
+	                     NULL};
 	assert_int_equal(bsim_test_cli(who, NULL, &err), 2);
 	assert_non_null(strstr(err, "B:KEY=VALUE"));
 	free(err);
-	const char *empty = out_dir("empty");
-	const char *none[] = {"regress", empty, "--out", out_dir("bad4"), NULL};
+	const char *empty = bsim_test_dir_held("empty");
+	const char *none[] = {"regress", empty, "--out", bsim_test_dir_held("bad4"), NULL};
 	assert_int_equal(bsim_test_cli(none, NULL, &err), 2);
 	assert_non_null(strstr(err, "run.json"));
 	free(err);
@@ -564,26 +567,6 @@ static int row_event(const pairs_rows *r, int i, int s, int e)
 	                : 1;
 }
 
-static double json_at(struct fy_node *root, const char *path)
-{
-	double v = NAN;
-	struct fy_node *n = ydoc_lookup(root, path);
-	if (!n || ydoc_number(n, &v) != YDOC_NUM_OK)
-		fail_msg("report.json: no number at %s", path);
-	return v;
-}
-
-static const char *json_text_at(struct fy_node *root, const char *path, char *buf, size_t size)
-{
-	struct fy_node *n = ydoc_lookup(root, path);
-	size_t len = 0;
-	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
-	if (!t)
-		fail_msg("report.json: no text at %s", path);
-	snprintf(buf, size, "%.*s", (int)len, t);
-	return buf;
-}
-
 static int verdict_rank(const char *v)
 {
 	static const char *const order[] = {"same",  "equivalent", "uninformative", "inconclusive",
@@ -606,7 +589,7 @@ static int verdict_rank(const char *v)
 static void test_three_sides(void **state)
 {
 	(void)state;
-	const char *dir = out_dir("cmp3");
+	const char *dir = bsim_test_dir_held("cmp3");
 	char backends[200];
 	snprintf(backends, sizeof backends, "%s,%s,%s", sides3[0], sides3[1], sides3[2]);
 	const char *argv[] = {"compare", experiment, "--backends", backends, "--threads",
@@ -635,27 +618,27 @@ static void test_three_sides(void **state)
 	snprintf(path, sizeof path, "%s/report.json", dir);
 	assert_int_equal(ydoc_load_own(&d, path, &err), BSIM_OK);
 	struct fy_node *root = fy_document_root(d.fyd);
-	assert_string_equal(json_text_at(root, "a.label", buf, sizeof buf), sides3[0]);
-	assert_string_equal(json_text_at(root, "b.label", buf, sizeof buf), sides3[1]);
+	assert_string_equal(bsim_test_json_text_at(root, "a.label", buf, sizeof buf), sides3[0]);
+	assert_string_equal(bsim_test_json_text_at(root, "b.label", buf, sizeof buf), sides3[1]);
 	for (int s = 0; s < N3; s++) {
 		snprintf(p, sizeof p, "sides.%d.label", s);
-		assert_string_equal(json_text_at(root, p, buf, sizeof buf), sides3[s]);
+		assert_string_equal(bsim_test_json_text_at(root, p, buf, sizeof buf), sides3[s]);
 	}
-	int groups = (int)json_at(root, "pairs_of_sides") == P3 ? 4 : -1, disagreeing = 0,
+	int groups = (int)bsim_test_json_at(root, "pairs_of_sides") == P3 ? 4 : -1, disagreeing = 0,
 	    odd_found = 0;
 	assert_int_equal(groups, 4);
 	for (int g = 0; g < groups; g++) {
 		snprintf(p, sizeof p, "groups.%d.deterministic", g);
-		int det = strcmp(json_text_at(root, p, buf, sizeof buf), "true") == 0;
+		int det = strcmp(bsim_test_json_text_at(root, p, buf, sizeof buf), "true") == 0;
 		int differ[P3], worst = 0;
 		for (int k = 0; k < P3; k++) {
 			char q[120];
 			snprintf(q, sizeof q, "groups.%d.pairwise.%d", g, k);
 			snprintf(p, sizeof p, "%s.a", q);
-			assert_string_equal(json_text_at(root, p, buf, sizeof buf),
+			assert_string_equal(bsim_test_json_text_at(root, p, buf, sizeof buf),
 			                    sides3[pair3[k][0]]);
 			snprintf(p, sizeof p, "%s.b", q);
-			assert_string_equal(json_text_at(root, p, buf, sizeof buf),
+			assert_string_equal(bsim_test_json_text_at(root, p, buf, sizeof buf),
 			                    sides3[pair3[k][1]]);
 			for (int e = 0; e < 6; e++) {
 				static const char *const ev[] = {"traversed", "left",  "right",
@@ -672,16 +655,17 @@ static void test_three_sides(void **state)
 				                                   "neither"};
 				for (int c = 0; c < 4; c++) {
 					snprintf(p, sizeof p, "%s.events.%s.%s", q, ev[e], cell[c]);
-					assert_int_equal((int)json_at(root, p), n[c]);
+					assert_int_equal((int)bsim_test_json_at(root, p), n[c]);
 				}
 			}
 			snprintf(p, sizeof p, "%s.verdict", q);
-			int v = verdict_rank(json_text_at(root, p, buf, sizeof buf));
+			int v = verdict_rank(bsim_test_json_text_at(root, p, buf, sizeof buf));
 			worst = v > worst ? v : worst;
 			differ[k] = v >= 5; /* DISAGREE or DIFFERENT */
 		}
 		snprintf(p, sizeof p, "groups.%d.verdict", g);
-		assert_int_equal(verdict_rank(json_text_at(root, p, buf, sizeof buf)), worst);
+		assert_int_equal(verdict_rank(bsim_test_json_text_at(root, p, buf, sizeof buf)),
+		                 worst);
 		disagreeing += worst >= 5;
 		/* the odd one out by the rule: every pair with it differs, no
 		 * other pair does */
@@ -698,19 +682,20 @@ static void test_three_sides(void **state)
 			}
 		}
 		snprintf(p, sizeof p, "groups.%d.odd_one_out.found", g);
-		const char *found = json_text_at(root, p, buf, sizeof buf);
+		const char *found = bsim_test_json_text_at(root, p, buf, sizeof buf);
 		if (!any) {
 			assert_string_equal(found, "none");
 		} else if (candidates == 1) {
 			assert_string_equal(found, "side");
 			snprintf(p, sizeof p, "groups.%d.odd_one_out.side", g);
-			assert_string_equal(json_text_at(root, p, buf, sizeof buf), sides3[odd]);
+			assert_string_equal(bsim_test_json_text_at(root, p, buf, sizeof buf),
+			                    sides3[odd]);
 			odd_found++;
 		} else {
 			assert_string_equal(found, "no single side");
 		}
 	}
-	assert_int_equal((int)json_at(root, "groups_disagreeing"), disagreeing);
+	assert_int_equal((int)bsim_test_json_at(root, "groups_disagreeing"), disagreeing);
 	assert_int_equal(status, disagreeing > 0 ? 3 : 0);
 	/* the side meant to differ is the odd one out somewhere: the rule is
 	 * exercised, not only "none" */
@@ -724,7 +709,7 @@ static void test_three_sides(void **state)
 	assert_non_null(strstr(md, "# beamsim compare: thesis vs box2d vs thesis:impact_mass=0.1"));
 	assert_non_null(strstr(md, "**Odd one out:**"));
 	free(md);
-	const char *rerun = out_dir("cmp3_rerun");
+	const char *rerun = bsim_test_dir_held("cmp3_rerun");
 	const char *r[] = {"regress", dir, "--exact", "--out", rerun, NULL};
 	char *out = NULL;
 	assert_int_equal(bsim_test_cli(r, &out, NULL), 0);
@@ -741,8 +726,10 @@ static void test_three_sides_bad(void **state)
 {
 	(void)state;
 	char *err = NULL;
-	const char *twice[] = {"compare", experiment,       "--backends", "thesis,box2d,thesis",
-	                       "--out",   out_dir("bad3s"), NULL};
+	const char *twice[] = {"compare",    experiment,
+	                       "--backends", "thesis,box2d,thesis",
+	                       "--out",      bsim_test_dir_held("bad3s"),
+	                       NULL};
 	assert_int_equal(bsim_test_cli(twice, NULL, &err), 2);
 	assert_non_null(strstr(err, "side thesis is given twice"));
 	free(err);
@@ -753,7 +740,7 @@ static void test_three_sides_bad(void **state)
 	                      "thesis:slop=3e-5,thesis:slop=4e-5,thesis:slop=5e-5,"
 	                      "thesis:slop=6e-5,thesis:slop=7e-5",
 	                      "--out",
-	                      out_dir("bad9"),
+	                      bsim_test_dir_held("bad9"),
 	                      NULL};
 	assert_int_equal(bsim_test_cli(many, NULL, &err), 2);
 	assert_non_null(strstr(err, "expected 2 to 8 sides"));

@@ -18,6 +18,11 @@ extern "C" {
  * "plugin:PATH" (bsim_backend_find). */
 #define BSIM_PLUGIN_PREFIX "plugin:"
 
+/* A comparison's side that is read, not run: "trials:PATH", the trials.csv
+ * of the same experiment made elsewhere (beamsim/compare_dir.h). No backend
+ * has this name; bsim_backend_find refuses it saying so. */
+#define BSIM_TRIALS_PREFIX "trials:"
+
 /* All backends, in the registry's order, NULL-terminated: those compiled
  * in, then the plug-ins loaded so far (those of BEAMSIM_PLUGINS first). */
 BSIM_API const bsim_backend *const *bsim_backend_list(void);
@@ -33,8 +38,8 @@ BSIM_API const bsim_backend *bsim_backend_find(const char *name, bsim_error *err
 
 /* The length of the backend's name at the start of a backend spec
  * "NAME[:KEY=VALUE]..." (compare's sides, run's --backend): up to the
- * first ':', or for "plugin:PATH[:KEY=VALUE]..." up to the ':' after PATH
- * (a path has no ':'). */
+ * first ':', or for "plugin:PATH[:KEY=VALUE]..." and "trials:PATH..." up
+ * to the ':' after PATH (a path has no ':'). */
 BSIM_API size_t bsim_backend_spec_name(const char *spec);
 
 /* The backends a comparison runs when none are named (compare's sides,

@@ -14,7 +14,15 @@
  * NAME); that text, with the backend's own name for plugin:PATH, is its
  * label. Or, on a gate
  * lattice, the two sides are one backend under two lattice protocols
- * (protocol), and the protocols label them. */
+ * (protocol), and the protocols label them.
+ *
+ * A side may also be read rather than run: "trials:PATH", the trials.csv
+ * (or a directory holding one) of the same experiment run elsewhere on the
+ * same schedules (`beamsim run EXPERIMENT --group G --trial T` gives trial
+ * T of group G). It is checked against the experiment as loaded before
+ * anything runs, and its trials enter the comparison as a run side's do;
+ * it is labelled by its folder's name (docs/compare.md, "Results made
+ * elsewhere"). */
 #ifndef BSIM_COMPARE_DIR_H
 #define BSIM_COMPARE_DIR_H
 
@@ -38,14 +46,23 @@ extern "C" {
 typedef struct bsim_compare_side {
 	const bsim_backend *backend;
 	bsim_options opts;
-	char label[128]; /* NAME[:K=V]..., or the protocol */
+	char label[128]; /* NAME[:K=V]..., the protocol, or a read side's folder */
+	/* A side read, not run: PATH of trials:PATH as given (a trials.csv or
+	 * a directory holding one); "" for a side that runs. Its backend is
+	 * then a stand-in named "trials" that runs nothing. */
+	char trials[BSIM_PATH_MAX];
+	/* "", or the FNV-1a 64 hash (16 hex digits) the file's bytes must
+	 * have: a stored comparison rerun (beamsim regress) reads the file it
+	 * read, and refuses one that changed. */
+	char trials_hash[17];
 } bsim_compare_side;
 
 /* Parses a side "NAME[:KEY=VALUE]..." into side (label = spec with the
  * backend's name for NAME, backend found by name or loaded from
  * plugin:PATH, options in order, later ones win), after the options
- * already in side->opts, which the spec's override. BSIM_EINPUT naming the
- * spec and what was expected. */
+ * already in side->opts, which the spec's override; or a side read from
+ * "trials:PATH" (side->trials; no options). BSIM_EINPUT naming the spec
+ * and what was expected. */
 BSIM_API int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err);
 
 /* The directory of a side's files in DIR: the label with ':' and '/'
@@ -105,6 +122,7 @@ typedef struct bsim_compare_dir_result {
 	int threads;
 	int n_sides;
 	char dir[BSIM_COMPARE_SIDES_MAX][128];             /* each side's directory in DIR */
+	int read[BSIM_COMPARE_SIDES_MAX];                  /* 1: the side was read, not run */
 	long unstable[BSIM_COMPARE_SIDES_MAX];             /* unstable trials on each side */
 	bsim_solver_counts solver[BSIM_COMPARE_SIDES_MAX]; /* what each side's solvers gave up on */
 	char journal[BSIM_PATH_MAX];                       /* as in bsim_sweep_dir_result */

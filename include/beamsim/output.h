@@ -43,8 +43,8 @@ BSIM_API int bsim_output_trajectories_csv(const char *path, const bsim_sweep_res
  * header name; the first eleven are required, the ledger columns are read
  * when present (r->has_ledger), and so are the final gate, the solver's
  * counts and the turn (r->has_turn); others are ignored. The fields not in the
- * file are zero. BSIM_EINPUT with file and line on a malformed, missing or
- * extra row. */
+ * file are zero. BSIM_EINPUT naming file, line and field, and what was
+ * expected there, on a malformed, missing or repeated row. */
 BSIM_API int bsim_output_trials_read(const char *path, int n_groups, int trials,
                                      bsim_sweep_result *r, bsim_error *err);
 

@@ -23,6 +23,7 @@ typedef struct bsim_report_side {
 	const bsim_backend *backend; /* the backend that ran it */
 	const bsim_options *opts;    /* as given, for the replay lines */
 	const bsim_sweep_result *run;
+	const char *read_from; /* NULL: run; else the trials.csv it was read from */
 } bsim_report_side;
 
 typedef struct bsim_report {

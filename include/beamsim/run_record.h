@@ -12,6 +12,7 @@
 #include "beamsim/backend.h"
 #include "beamsim/compare.h"
 #include "beamsim/experiment.h"
+#include "beamsim/limits.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -28,6 +29,11 @@ typedef struct bsim_run_record {
 	 * one compiled in */
 	char plugin[BSIM_COMPARE_SIDES_MAX][1024];
 	bsim_options opts[BSIM_COMPARE_SIDES_MAX]; /* every knob, effective value */
+	/* compare's sides read, not run (trials:PATH): the file's absolute
+	 * path and the FNV-1a 64 hash of its bytes (16 hex digits); "" for a
+	 * side that ran */
+	char read_from[BSIM_COMPARE_SIDES_MAX][BSIM_PATH_MAX];
+	char read_hash[BSIM_COMPARE_SIDES_MAX][17];
 	uint64_t seed;
 	int trials;
 	bsim_compare_rule rule; /* compare only */
@@ -47,7 +53,8 @@ BSIM_API void bsim_run_record_fill(bsim_run_record *rec, const char *command,
 
 /* Side i's backend: the one registered under its name, else, for a
  * plug-in's, the one its recorded library (plugin[i]) registers when
- * loaded; NULL and BSIM_EINPUT saying which if neither. */
+ * loaded, or for a side read from a file (read_from[i]) the stand-in that
+ * runs nothing; NULL and BSIM_EINPUT saying which if neither. */
 BSIM_API const bsim_backend *bsim_run_record_backend(const bsim_run_record *rec, int i,
                                                      bsim_error *err);
 

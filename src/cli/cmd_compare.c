@@ -25,7 +25,10 @@ static const cli_own compare_own[] = {
                           "the sides, 2 to 8 (default {pair}); each a\n"
                           "backend with options inline, NAME[:K=V]..., e.g.\n"
                           "{default},{default}:{knob}; the side's label and\n"
-                          "directory are the text (':' written '-' in the name)"},
+                          "directory are the text (':' written '-' in the name);\n"
+                          "or trials:PATH, read not run: the trials.csv of this\n"
+                          "experiment made elsewhere (or a directory holding one),\n"
+                          "labelled by its folder's name"},
         [OWN_PROTOCOLS] = {"protocols", 1, "P,Q",
                            "a lattice experiment on one backend (--backend B,\n"
                            "default {default}) under two lattice protocols (world,\n"
@@ -149,7 +152,8 @@ static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compar
 	bsim_error err;
 	const char *names[BSIM_COMPARE_SIDES_MAX];
 	bsim_options *opts[BSIM_COMPARE_SIDES_MAX];
-	char spec[BSIM_COMPARE_SIDES_MAX][128];
+	/* room for a side trials:PATH */
+	char spec[BSIM_COMPARE_SIDES_MAX][BSIM_PATH_MAX + 16];
 	for (int i = 0; i < BSIM_COMPARE_SIDES_MAX; i++)
 		opts[i] = &def->side[i].opts;
 	if (a->protocol[0][0]) {
@@ -182,7 +186,7 @@ static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compar
 		if (len == 0 || len >= sizeof spec[0] || n == BSIM_COMPARE_SIDES_MAX)
 			return cli_usage("compare",
 			                 "--backends %s: expected 2 to %d sides A,B,... (each "
-			                 "NAME[:KEY=VALUE]..., none empty)",
+			                 "NAME[:KEY=VALUE]... or trials:PATH, none empty)",
 			                 text, BSIM_COMPARE_SIDES_MAX);
 		snprintf(spec[n], sizeof spec[n], "%.*s", (int)len, p);
 		if (p[len] == '\0') {
@@ -195,15 +199,19 @@ static int sides_resolve(const cli_common *c, const compare_args *a, bsim_compar
 		return cli_usage("compare", "--backends %s: expected two sides A,B or more", text);
 	def->n_sides = n;
 	/* The backends first (--backend-opt needs them), then the options in
-	 * order: --backend-opt, then inline. */
+	 * order: --backend-opt, then inline. A side read from a file runs
+	 * nothing and takes none. */
+	int n_run = 0;
 	for (int i = 0; i < n; i++) {
 		memset(&def->side[i], 0, sizeof def->side[i]);
 		if (bsim_compare_side_parse(spec[i], &def->side[i], &err) != BSIM_OK)
 			return cli_usage("compare", "%s", err.msg);
-		names[i] = def->side[i].backend->name;
-		memset(opts[i], 0, sizeof *opts[i]);
+		if (def->side[i].trials[0])
+			continue;
+		names[n_run] = def->side[i].backend->name;
+		opts[n_run++] = &def->side[i].opts;
 	}
-	int rc = cli_backend_opts(c, "compare", n, names, opts);
+	int rc = n_run > 0 ? cli_backend_opts(c, "compare", n_run, names, opts) : CLI_OK;
 	for (int i = 0; rc == CLI_OK && i < n; i++)
 		if (bsim_compare_side_parse(spec[i], &def->side[i], &err) != BSIM_OK)
 			rc = cli_usage("compare", "%s", err.msg);
@@ -332,19 +340,24 @@ static int compare_main(int argc, char **argv, const cli_merge *m)
 	}
 	cli_mpi_spread(&def.spread, &def.part, &def.agree,
 	               bsim_sweep_record_size_sides(def.n_sides), def.stop);
-	/* Every side runs every trial; the costlier backend's constant bounds
-	 * the estimate. */
-	const bsim_backend *costlier = bsim_backend_default();
+	/* Every side that runs runs every trial; the costlier backend's
+	 * constant bounds the estimate. */
+	const bsim_backend *costlier = NULL;
+	int n_run = 0;
 	for (int i = 0; i < def.n_sides; i++) {
 		const bsim_backend *b = def.side[i].backend;
-		if (b && (i == 0 || b->cost_ns_per_beam_step > costlier->cost_ns_per_beam_step))
+		if (def.side[i].trials[0])
+			continue;
+		if (!b)
+			b = bsim_backend_default();
+		if (!costlier || b->cost_ns_per_beam_step > costlier->cost_ns_per_beam_step)
 			costlier = b;
+		n_run++;
 	}
-	if (rank == 0 && !m)
-		cli_estimate_line(costlier,
-		                  def.n_sides * cli_experiment_beam_steps(
-		                                        experiment, &c.sets,
-		                                        c.has_seed ? &c.seed : NULL, c.trials));
+	if (rank == 0 && !m && costlier)
+		cli_estimate_line(costlier, n_run * cli_experiment_beam_steps(
+		                                            experiment, &c.sets,
+		                                            c.has_seed ? &c.seed : NULL, c.trials));
 	bsim_compare_dir_result res;
 	bsim_error err;
 	cli_signals_install();

@@ -182,10 +182,13 @@ const bsim_backend *bsim_backend_default(void)
 
 size_t bsim_backend_spec_name(const char *spec)
 {
-	static const char plugin[] = BSIM_PLUGIN_PREFIX;
-	size_t n = strlen(plugin);
-	if (strncmp(spec, plugin, n) == 0)
-		return n + strcspn(spec + n, ":");
+	/* A path follows these: the name runs to the ':' after it. */
+	static const char *const prefixed[] = {BSIM_PLUGIN_PREFIX, BSIM_TRIALS_PREFIX};
+	for (int i = 0; i < 2; i++) {
+		size_t n = strlen(prefixed[i]);
+		if (strncmp(spec, prefixed[i], n) == 0)
+			return n + strcspn(spec + n, ":");
+	}
 	return strcspn(spec, ":");
 }
 
@@ -203,6 +206,14 @@ const bsim_backend *bsim_backend_find(const char *name, bsim_error *err)
 		if (!b && err)
 			bsim_error_set(err, e.code, "--backend %s: %s", name, e.msg);
 		return b;
+	}
+	if (strncmp(name, BSIM_TRIALS_PREFIX, strlen(BSIM_TRIALS_PREFIX)) == 0) {
+		bsim_error_set(err, BSIM_EINPUT,
+		               "--backend %s: a side of beamsim compare read from trials made "
+		               "elsewhere (--backends A," BSIM_TRIALS_PREFIX "PATH), not a backend "
+		               "that runs",
+		               name);
+		return NULL;
 	}
 	const bsim_backend *b = registry_named(name);
 	if (b)

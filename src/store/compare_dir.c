@@ -14,6 +14,7 @@
 #include "beamsim/output.h"
 #include "beamsim/report.h"
 #include "beamsim/run_record.h"
+#include "store/compare_read.h"
 #include "store/session.h"
 #include "store/rerun.h"
 #include "store/store.h"
@@ -51,6 +52,9 @@ void bsim_compare_dir_label(const char *label, char *buf, size_t size)
 
 int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err)
 {
+	if (strncmp(spec, BSIM_TRIALS_PREFIX, strlen(BSIM_TRIALS_PREFIX)) == 0)
+		return compare_read_side(spec, side, err);
+	side->trials[0] = '\0';
 	size_t n = bsim_backend_spec_name(spec);
 	char name[1024];
 	if (n == 0 || n >= sizeof name)
@@ -103,7 +107,22 @@ typedef struct compare_job {
 	int *done;                /* NULL, or set to 1 once every pair is journaled */
 	bsim_run_record rec;
 	double started; /* > 0: a gathered run's start (bsim_clock_seconds) */
+	/* The sides read, not run (def->side[i].trials): read[i] holds the
+	 * file and its trials; 0 for a side that runs. */
+	int is_read[BSIM_COMPARE_SIDES_MAX];
+	int n_read;
+	compare_read read[BSIM_COMPARE_SIDES_MAX];
 } compare_job;
+
+/* The sides that run: their indices into idx, in order; how many. */
+static int run_sides(const compare_job *job, int *idx)
+{
+	int n = 0;
+	for (int i = 0; i < job->n; i++)
+		if (!job->is_read[i])
+			idx[n++] = i;
+	return n;
+}
 
 /* The report's heading: what was compared, how to reproduce it. */
 static char *compare_title(const compare_job *job)
@@ -124,17 +143,35 @@ static char *compare_title(const compare_job *job)
 		        "one side, `=%s` for the other.\n\n",
 		        protocol[0], protocol[1], job->backend[0]->name, protocol[0], protocol[1]);
 	fprintf(f,
-	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; %s "
+	        "Experiment `%s` (scene `%s`), seed %llu, %d groups x %d trials; %s%s "
 	        "ran every trial with the same random-force schedule, so trial t of group g is "
 	        "a pair.\n\n",
 	        job->e->path, job->e->scene_path, (unsigned long long)job->e->seed,
-	        job->e->n_groups, job->e->trials, job->n == 2 ? "both sides" : "every side");
+	        job->e->n_groups, job->e->trials, job->n == 2 ? "both sides" : "every side",
+	        job->n_read == 0   ? ""
+	        : job->n_read == 1 ? " (the one read from a file elsewhere)"
+	                           : " (those read from files elsewhere)");
 	for (int i = 0; i < job->n; i++) {
+		if (job->is_read[i]) {
+			fprintf(f,
+			        "- %s: read from `%s` (FNV-1a 64 %s), made elsewhere: not run by "
+			        "beamsim\n",
+			        job->label[i], job->read[i].path, job->read[i].hash);
+			continue;
+		}
 		fprintf(f, "- %s: backend %s, options ", job->label[i], job->backend[i]->name);
 		bsim_output_backend_options(f, job->backend[i], job->opts[i]);
 		fputc('\n', f);
 	}
 	fputc('\n', f);
+	if (job->n_read > 0)
+		fprintf(f,
+		        "%s read rather than run: %s trials are taken as this experiment's on "
+		        "the same schedules, checked to be every group and trial of it once in "
+		        "beamsim's words. Separation times need both trajectories of a pair, and "
+		        "are not measured.\n\n",
+		        job->n_read == 1 ? "One side was" : "Sides were",
+		        job->n_read == 1 ? "its" : "their");
 	fclose(f);
 	return buf;
 }
@@ -152,6 +189,51 @@ static void write_json(FILE *f, const void *r)
 static void write_md(FILE *f, const void *r)
 {
 	bsim_report_md(f, r);
+}
+
+/* Each side's files in its directory: a sweep's, or a side read's. */
+static int sides_write(const compare_job *job, const bsim_sweep_result *r, bsim_error *err)
+{
+	for (int i = 0; i < job->n; i++) {
+		char dir[BSIM_PATH_MAX];
+		const compare_read *rd = job->is_read[i] ? &job->read[i] : NULL;
+		if (bsim_session_path(dir, sizeof dir, job->out, job->dir[i], err))
+			return BSIM_EFAIL;
+		if (rd ? bsim_store_read_files(dir, job->e, job->backend[i], job->sets, job->n_sets,
+		                               &r[i], rd->bytes, rd->len, err)
+		       : bsim_store_sweep_files(dir, job->e, job->backend[i], job->opts[i],
+		                                job->sets, job->n_sets, &r[i], err))
+			return BSIM_EFAIL;
+	}
+	return BSIM_OK;
+}
+
+/* With a side read from a file, the sides that ran are compared as their
+ * trials.csv just written reads back (into out; the others lent from r):
+ * every side then has the file's precision, so that the same trial is the
+ * same in every field (a group's `changed`), as regress compares. */
+static int sides_at_file_precision(const compare_job *job, const bsim_sweep_result *r,
+                                   bsim_sweep_result *out, bsim_error *err)
+{
+	for (int i = 0; i < job->n; i++) {
+		char dir[BSIM_PATH_MAX], path[BSIM_PATH_MAX];
+		out[i] = r[i];
+		if (job->is_read[i])
+			continue;
+		if (bsim_session_path(dir, sizeof dir, job->out, job->dir[i], err) ||
+		    bsim_session_path(path, sizeof path, dir, "trials.csv", err) ||
+		    bsim_output_trials_read(path, r[i].n_groups, r[i].trials, &out[i], err)) {
+			while (i-- > 0)
+				if (!job->is_read[i])
+					bsim_sweep_result_free(&out[i]);
+			return BSIM_EFAIL;
+		}
+		for (int g = 0; g < r[i].n_groups; g++)
+			out[i].groups[g].deterministic = r[i].groups[g].deterministic;
+		out[i].lattice = r[i].lattice;
+		out[i].lattice_def = r[i].lattice_def;
+	}
+	return BSIM_OK;
 }
 
 static int compare_write(const compare_job *job, const bsim_sweep_result *r, const double *t_sep,
@@ -174,14 +256,10 @@ static int compare_write(const compare_job *job, const bsim_sweep_result *r, con
 	        .all = cmp,
 	};
 	for (int i = 0; i < job->n; i++) {
-		char dir[BSIM_PATH_MAX];
-		sides[i] = (bsim_report_side){job->label[i], job->backend[i], job->opts[i], &r[i]};
+		sides[i] = (bsim_report_side){job->label[i], job->backend[i], job->opts[i], &r[i],
+		                              job->is_read[i] ? job->read[i].path : NULL};
 		if (i < 2)
 			rep.side[i] = sides[i];
-		if (bsim_session_path(dir, sizeof dir, job->out, job->dir[i], err) ||
-		    bsim_store_sweep_files(dir, job->e, job->backend[i], job->opts[i], job->sets,
-		                           job->n_sets, &r[i], err))
-			return BSIM_EFAIL;
 	}
 	char *title = compare_title(job);
 	int rc = bsim_store_text(job->out, "pairs.csv", NULL, write_pairs, &rep, err);
@@ -211,6 +289,42 @@ static long unstable_count(const bsim_sweep_result *r)
 	return n;
 }
 
+/* The sweep of the sides that run into r (their slots; a read side's slot
+ * is left for its file's trials), their pairs' separation times into
+ * *t_sep when every side runs. */
+static int sides_sweep(const compare_job *job, const bsim_sweep_config *cfg, bsim_sweep_result *r,
+                       double **t_sep, bsim_error *err)
+{
+	int idx[BSIM_COMPARE_SIDES_MAX], n_run = run_sides(job, idx);
+	const bsim_backend *b[BSIM_COMPARE_SIDES_MAX];
+	const bsim_options *o[BSIM_COMPARE_SIDES_MAX];
+	bsim_sweep_result run[BSIM_COMPARE_SIDES_MAX];
+	for (int k = 0; k < n_run; k++) {
+		b[k] = job->backend[idx[k]];
+		o[k] = job->opts[idx[k]];
+	}
+	*t_sep = NULL;
+	int rc = BSIM_OK;
+	if (n_run >= 2) {
+		rc = bsim_sweep_run_sides(job->e, cfg, n_run, b, o, run, t_sep, err);
+	} else if (n_run == 1) {
+		bsim_sweep_config one = *cfg;
+		one.backend = b[0];
+		one.opts = o[0];
+		rc = bsim_sweep_run(job->e, &one, &run[0], err);
+	}
+	if (rc != BSIM_OK)
+		return rc;
+	for (int k = 0; k < n_run; k++)
+		r[idx[k]] = run[k];
+	if (n_run < job->n) {
+		/* The separation of a pair needs both its trajectories. */
+		free(*t_sep);
+		*t_sep = NULL;
+	}
+	return BSIM_OK;
+}
+
 static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, bsim_error *err)
 {
 	const bsim_compare_dir_def *def = job->def;
@@ -230,8 +344,7 @@ static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, b
 	        .journal = job->journal,
 	        .stop = def->stop,
 	};
-	int rc =
-	        bsim_sweep_run_sides(job->e, &cfg, job->n, job->backend, job->opts, r, &t_sep, err);
+	int rc = sides_sweep(job, &cfg, r, &t_sep, err);
 	if (rc != BSIM_OK)
 		return rc;
 	if (job->done)
@@ -240,16 +353,29 @@ static int compare_pairs(const compare_job *job, bsim_compare_dir_result *res, b
 	/* A gathered comparison's time is its parts' and the writing's. */
 	double wall = job->started > 0 ? bsim_clock_seconds() - job->started : 0.0;
 	for (int i = 0; i < job->n; i++) {
-		if (job->started > 0)
+		if (job->is_read[i])
+			r[i] = job->read[i].r; /* lent: freed with job->read */
+		else if (job->started > 0)
 			r[i].wall_seconds = wall;
 		res->solver[i] = r[i].solver;
 		res->unstable[i] = unstable_count(&r[i]);
 	}
-	rc = bsim_compare_analyse_sides(r, job->n, t_sep, &def->rule, &res->cmp, err);
+	rc = sides_write(job, r, err);
+	bsim_sweep_result at[BSIM_COMPARE_SIDES_MAX];
+	if (rc == BSIM_OK && job->n_read > 0)
+		rc = sides_at_file_precision(job, r, at, err);
+	if (rc == BSIM_OK) {
+		rc = bsim_compare_analyse_sides(job->n_read > 0 ? at : r, job->n, t_sep, &def->rule,
+		                                &res->cmp, err);
+		for (int i = 0; job->n_read > 0 && i < job->n; i++)
+			if (!job->is_read[i])
+				bsim_sweep_result_free(&at[i]);
+	}
 	if (rc == BSIM_OK)
 		rc = compare_write(job, r, t_sep, &res->cmp, err);
 	for (int i = 0; i < job->n; i++)
-		bsim_sweep_result_free(&r[i]);
+		if (!job->is_read[i])
+			bsim_sweep_result_free(&r[i]);
 	free(t_sep);
 	return rc;
 }
@@ -263,6 +389,24 @@ static void sides_text(const compare_job *job, char *buf, size_t size)
 		int w = snprintf(buf + len, size - len, "%s%s", i ? "," : "", job->label[i]);
 		len += w > 0 ? (size_t)w : 0;
 	}
+}
+
+/* BSIM_EINPUT: sides i and j, one of them read from a file, have one
+ * label. */
+static int read_label_clash(const bsim_compare_dir_def *def, const compare_job *job, int i, int j,
+                            const char *given, bsim_error *err)
+{
+	char side[2][BSIM_PATH_MAX + 16];
+	for (int k = 0; k < 2; k++) {
+		int s = k ? j : i;
+		snprintf(side[k], sizeof side[k], "%s%s", job->is_read[s] ? BSIM_TRIALS_PREFIX : "",
+		         job->is_read[s] ? def->side[s].trials : job->label[s]);
+	}
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "--backends %s: sides %s and %s are both labelled %s (a side read "
+	                      "from a file is labelled by the name of its folder); expected "
+	                      "different labels: move the file to a folder of another name",
+	                      given, side[0], side[1], job->label[i]);
 }
 
 /* The sides' backends, options, labels and directories; BSIM_EINPUT if
@@ -280,7 +424,19 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 		                                BSIM_COMPARE_SIDES_MAX);
 	for (int i = 0; i < job->n; i++) {
 		const bsim_compare_side *s = &def->side[i];
-		job->backend[i] = s->backend ? s->backend : bsim_backend_default();
+		job->is_read[i] = res->read[i] = s->trials[0] != '\0';
+		job->n_read += job->is_read[i];
+		if (job->is_read[i] && (def->protocol[0] || s->opts.n > 0))
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "--backends: side " BSIM_TRIALS_PREFIX
+			                      "%s: expected a side read as it was made, %s",
+			                      s->trials,
+			                      def->protocol[0]
+			                              ? "not a --protocols side"
+			                              : "without options (it runs nothing)");
+		job->backend[i] = job->is_read[i] ? &compare_read_backend
+		                  : s->backend    ? s->backend
+		                                  : bsim_backend_default();
 		job->opts[i] = &s->opts;
 		job->label[i] = def->protocol[0] ? def->protocol[i]
 		                : s->label[0]    ? s->label
@@ -316,6 +472,9 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 	sides_text(job, given, sizeof given);
 	for (int i = 0; i < job->n; i++)
 		for (int j = i + 1; j < job->n; j++) {
+			if (strcmp(job->label[i], job->label[j]) == 0 &&
+			    (job->is_read[i] || job->is_read[j]))
+				return read_label_clash(def, job, i, j, given, err);
 			if (strcmp(job->label[i], job->label[j]) == 0 && job->n == 2)
 				return bsim_error_set(
 				        err, BSIM_EINPUT,
@@ -346,6 +505,13 @@ static void record_fill(compare_job *job)
 	const bsim_compare_dir_def *def = job->def;
 	bsim_run_record_fill(&job->rec, "compare", job->e, job->n, job->backend, job->opts,
 	                     job->label, &def->rule);
+	for (int i = 0; i < job->n; i++)
+		if (job->is_read[i]) {
+			snprintf(job->rec.read_from[i], sizeof job->rec.read_from[i], "%s",
+			         job->read[i].path);
+			snprintf(job->rec.read_hash[i], sizeof job->rec.read_hash[i], "%s",
+			         job->read[i].hash);
+		}
 	for (int i = 0; def->protocol[0] && i < 2; i++)
 		snprintf(job->rec.protocol[i], sizeof job->rec.protocol[i], "%s", def->protocol[i]);
 }
@@ -397,6 +563,38 @@ static int compare_spread(const bsim_compare_dir_def *def, compare_job *job, con
 	return part_dir_journal_reopen(ss, inputs, size, err);
 }
 
+/* Reads the files of the sides read, against job->e as it runs. */
+static int reads_load(compare_job *job, bsim_error *err)
+{
+	for (int i = 0; i < job->n; i++)
+		if (job->is_read[i] &&
+		    compare_read_load(&job->def->side[i], job->e, job->sets, job->n_sets,
+		                      &job->read[i], err) != BSIM_OK)
+			return BSIM_EINPUT;
+	return BSIM_OK;
+}
+
+static void reads_free(compare_job *job)
+{
+	for (int i = 0; i < job->n; i++)
+		if (job->is_read[i])
+			compare_read_free(&job->read[i]);
+}
+
+/* The size of the journal's records: those of the sweep of the sides
+ * that run (none, one, or several), with cfg's overrides. */
+static int journal_record_size(const compare_job *job, const bsim_sweep_config *cfg, size_t *size,
+                               bsim_error *err)
+{
+	int idx[BSIM_COMPARE_SIDES_MAX], n_run = run_sides(job, idx);
+	*size = bsim_sweep_record_size(0);
+	if (n_run == 1)
+		return bsim_sweep_record_size_for(job->e, cfg, size, err);
+	if (n_run >= 2)
+		return bsim_sweep_record_size_sides_for(job->e, cfg, n_run, size, err);
+	return BSIM_OK;
+}
+
 int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_result *res,
                          bsim_error *err)
 {
@@ -406,6 +604,11 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 	int rc = sides_check(def, &job, res, err);
 	if (rc != BSIM_OK)
 		return rc;
+	if (job.n_read > 0 && (def->spread != BSIM_SPREAD_NONE || def->n_merge > 0))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "--backends: a comparison with a side read from a file "
+		                      "(" BSIM_TRIALS_PREFIX "PATH) runs in one process: expected "
+		                      "no --shard, merge or mpirun");
 	/* --protocols: side a's protocol joins the overrides of every group,
 	 * written as the --set it amounts to; side b's is its own override
 	 * after them. */
@@ -431,6 +634,13 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 		return rc;
 	}
 	job.e = &res->e;
+	/* The files read are checked before anything runs or is written. */
+	if ((rc = reads_load(&job, err)) != BSIM_OK) {
+		reads_free(&job);
+		free(sets);
+		bsim_compare_dir_result_free(res);
+		return rc;
+	}
 	record_fill(&job);
 	char *inputs = bsim_run_record_inputs(&job.rec, &res->e, job.sets, job.n_sets, err);
 	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread;
@@ -444,7 +654,7 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 		        .extra_b = def->protocol[0] ? &job.protocol_b : NULL,
 		        .n_extra_b = def->protocol[0] != NULL,
 		};
-		rc = bsim_sweep_record_size_sides_for(&res->e, &cfg, job.n, &size, err);
+		rc = journal_record_size(&job, &cfg, &size, err);
 	}
 	if (rc == BSIM_OK && def->n_merge > 0 && def->resume)
 		rc = bsim_error_set(err, BSIM_EINPUT, "merge: --resume does not apply");
@@ -454,6 +664,7 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 		rc = compare_spread(def, &job, inputs, NULL, size, &finished, err);
 		free(inputs);
 		free(sets);
+		reads_free(&job);
 		if (rc != BSIM_OK)
 			bsim_compare_dir_result_free(res);
 		return rc;
@@ -481,6 +692,7 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 	}
 	free(inputs);
 	free(sets);
+	reads_free(&job);
 	if (rc == BSIM_OK && finished)
 		return BSIM_OK; /* a shard: res holds the experiment only */
 	if (rc != BSIM_OK) {
@@ -502,9 +714,14 @@ int bsim_store_compare_rerun(const bsim_compare_dir_def *def, const bsim_experim
 	if (def->protocol[0])
 		job.protocol_b = (bsim_override){"lattice.protocol", def->protocol[1],
 		                                 "--protocols (side b)"};
-	record_fill(&job);
-	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
-	rc = compare_pairs(&job, res, err);
+	/* A side read is read again, and must be the file it was. */
+	rc = reads_load(&job, err);
+	if (rc == BSIM_OK) {
+		record_fill(&job);
+		res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
+		rc = compare_pairs(&job, res, err);
+	}
+	reads_free(&job);
 	if (rc != BSIM_OK)
 		bsim_compare_sides_free(&res->cmp);
 	return rc;

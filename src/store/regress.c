@@ -73,6 +73,11 @@ static int regress_rerun(const bsim_regress_def *def, bsim_regress_result *res,
 			d.side[i].backend = backend[i];
 			d.side[i].opts = rec->opts[i];
 			snprintf(d.side[i].label, sizeof d.side[i].label, "%s", rec->label[i]);
+			/* a side read from a file: the same file, its hash checked */
+			snprintf(d.side[i].trials, sizeof d.side[i].trials, "%s",
+			         rec->read_from[i]);
+			snprintf(d.side[i].trials_hash, sizeof d.side[i].trials_hash, "%s",
+			         rec->read_hash[i]);
 			if (i < 2) /* --protocols: two sides */
 				d.protocol[i] = rec->protocol[0][0] ? rec->protocol[i] : NULL;
 		}
@@ -154,8 +159,15 @@ static void regress_md(FILE *f, const void *arg)
 	        w->def->baseline, res->rec.command, res->rec.version, w->def->out, bsim_version(),
 	        res->e.path, (unsigned long long)res->e.seed, res->e.n_groups, res->e.trials);
 	for (int i = 0; i < res->n_sides; i++) {
-		fprintf(f, "## %s\n\n%d of %d trials changed in some trials.csv field.\n\n",
-		        res->side[i].label, res->side[i].changed, res->side[i].trials);
+		fprintf(f, "## %s\n\n", res->side[i].label);
+		if (res->rec.read_from[i][0])
+			fprintf(f,
+			        "Read, not run: `%s` again, the bytes the comparison read (FNV-1a "
+			        "64 "
+			        "%s).\n\n",
+			        res->rec.read_from[i], res->rec.read_hash[i]);
+		fprintf(f, "%d of %d trials changed in some trials.csv field.\n\n",
+		        res->side[i].changed, res->side[i].trials);
 		bsim_report_md(f, &w->rep[i]);
 	}
 }

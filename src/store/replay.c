@@ -209,6 +209,15 @@ static int open_stored(bsim_replay *r, const bsim_replay_def *def, bsim_error *e
 	int side = stored_side(dir, &rec, def->side, err);
 	if (side < 0)
 		return BSIM_EINPUT;
+	if (rec.read_from[side][0])
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "--backend %s: side %s of %s was read from %s, made "
+		        "elsewhere, not run by beamsim; expected a side that ran (the "
+		        "trial's scene and schedule are those of beamsim run "
+		        "%s/inputs/experiment.yaml --group G --trial T)",
+		        def->side ? def->side : rec.label[side], rec.label[side], d,
+		        rec.read_from[side], d);
 	const bsim_backend *b = bsim_run_record_backend(&rec, side, err);
 	if (!b || bsim_options_check(&rec.opts[side], b->knobs, b->n_knobs, b->name, err)) {
 		char msg[BSIM_ERROR_MSG_MAX];

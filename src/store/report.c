@@ -33,9 +33,17 @@ static void replay_line(FILE *f, const bsim_report *r, int side, int g, int t)
 	const bsim_experiment *e = r->e;
 	const bsim_report_side *s = &r->side[side];
 	int idx[BSIM_OUTPUT_AXES_MAX] = {0};
+	/* A side read from a file ran elsewhere: the line gives the trial's
+	 * scene and schedule, as a comment, with no backend of beamsim's. */
+	if (s->read_from) {
+		fprintf(f, "# %s: row group %d, trial %d of ", s->label, g, t);
+		text_shell_word(f, s->read_from);
+		fputs(", made elsewhere on the scene and schedule of: ", f);
+	}
 	fputs("beamsim run ", f);
 	text_shell_word(f, e->scene_path);
-	fprintf(f, " --backend %s", s->backend->name);
+	if (!s->read_from)
+		fprintf(f, " --backend %s", s->backend->name);
 	for (int i = 0; s->opts && i < s->opts->n; i++) {
 		char buf[128];
 		snprintf(buf, sizeof buf, "%s=%s", s->opts->key[i], s->opts->value[i]);
@@ -941,6 +949,10 @@ static void json_side(FILE *f, const bsim_report_side *s)
 	bsim_json_string(f, s->backend->name);
 	fputs(", \"backend_options\": ", f);
 	bsim_output_backend_options(f, s->backend, s->opts);
+	if (s->read_from) {
+		fputs(", \"read_from\": ", f);
+		bsim_json_string(f, s->read_from);
+	}
 	fputs(", \"wall_seconds\": ", f);
 	bsim_json_number(f, s->run->wall_seconds);
 	fputc('}', f);

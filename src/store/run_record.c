@@ -25,6 +25,7 @@
 #include "beamsim/output.h"
 #include "beamsim/version.h"
 #include "util/yaml_doc.h"
+#include "store/compare_read.h"
 
 void bsim_run_record_fill(bsim_run_record *rec, const char *command, const bsim_experiment *e,
                           int n, const bsim_backend *const *b, const bsim_options *const *opts,
@@ -139,6 +140,9 @@ char *bsim_run_record_inputs(const bsim_run_record *rec, const bsim_experiment *
 		fprintf(f, "backend %s", rec->backend[i]);
 		for (int k = 0; k < rec->opts[i].n; k++)
 			fprintf(f, " %s=%s", rec->opts[i].key[k], rec->opts[i].value[k]);
+		/* a side read: its file's bytes are what its trials depend on */
+		if (rec->read_from[i][0])
+			fprintf(f, " read %s fnv1a64 %s", rec->read_from[i], rec->read_hash[i]);
 		fputc('\n', f);
 	}
 	fprintf(f, "groups %d\n--- experiment\n", e->n_groups);
@@ -192,6 +196,12 @@ static int write_json(const char *path, const bsim_run_record *rec, const bsim_e
 		if (rec->plugin[i][0]) {
 			fputs(", \"plugin\": ", f);
 			bsim_json_string(f, rec->plugin[i]);
+		}
+		if (rec->read_from[i][0]) {
+			fputs(", \"read_from\": ", f);
+			bsim_json_string(f, rec->read_from[i]);
+			fputs(", \"read_fnv1a64\": ", f);
+			bsim_json_string(f, rec->read_hash[i]);
 		}
 		fputc('}', f);
 	}
@@ -307,6 +317,17 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 	if (ydoc_lookup(root, field) &&
 	    need_text(d, root, field, rec->plugin[i], sizeof rec->plugin[i], err))
 		return BSIM_EINPUT;
+	snprintf(field, sizeof field, "backends.%d.read_from", i);
+	if (ydoc_lookup(root, field) &&
+	    need_text(d, root, field, rec->read_from[i], sizeof rec->read_from[i], err))
+		return BSIM_EINPUT;
+	snprintf(field, sizeof field, "backends.%d.read_fnv1a64", i);
+	if (rec->read_from[i][0] &&
+	    (need_text(d, root, field, rec->read_hash[i], sizeof rec->read_hash[i], err) ||
+	     strlen(rec->read_hash[i]) != 16 ||
+	     strspn(rec->read_hash[i], "0123456789abcdef") != 16))
+		return ydoc_expected(d, ydoc_lookup(root, field), NULL, field,
+		                     "16 hex digits (the FNV-1a 64 hash of the file read)", err);
 	snprintf(field, sizeof field, "backends.%d.options", i);
 	struct fy_node *opts = ydoc_lookup(root, field);
 	if (!opts || !fy_node_is_mapping(opts) ||
@@ -331,6 +352,8 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 
 const bsim_backend *bsim_run_record_backend(const bsim_run_record *rec, int i, bsim_error *err)
 {
+	if (rec->read_from[i][0])
+		return &compare_read_backend;
 	const bsim_backend *b = bsim_backend_find(rec->backend[i], err);
 	if (b || !rec->plugin[i][0])
 		return b;

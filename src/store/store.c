@@ -13,6 +13,16 @@
 #include "store/survival_files.h"
 #include "beamsim/limits.h"
 
+/* path holding the len bytes at text, atomically. */
+static int bytes_write(const char *path, const char *text, size_t len, bsim_error *err)
+{
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fwrite(text, 1, len, o.f);
+	return bsim_atomic_file_commit(&o, err);
+}
+
 /* survival.csv and horizon.csv of a sweep held in memory (a streamed
  * sweep's come from its sink, sweep_dir.c). */
 static int survival_files(const char *dir, const bsim_experiment *e, const bsim_override *extra,
@@ -28,9 +38,11 @@ static int survival_files(const char *dir, const bsim_experiment *e, const bsim_
 	return rc == BSIM_OK ? BSIM_OK : BSIM_EFAIL;
 }
 
-int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
-                           const bsim_options *opts, const bsim_override *extra, int n_extra,
-                           const bsim_sweep_result *r, bsim_error *err)
+/* A sweep's files; trials.csv from r, or, text not NULL, those len bytes
+ * (a side read from a file made elsewhere). */
+static int sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
+                       const bsim_options *opts, const bsim_override *extra, int n_extra,
+                       const bsim_sweep_result *r, const char *text, size_t len, bsim_error *err)
 {
 	char summary[BSIM_PATH_MAX], trials[BSIM_PATH_MAX], traj[BSIM_PATH_MAX],
 	        traj_mat[BSIM_PATH_MAX];
@@ -45,13 +57,29 @@ int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim
 	}
 	if (bsim_output_mkdir(dir, err) != BSIM_OK ||
 	    bsim_output_summary_json(summary, e, b->name, opts, r, err) != BSIM_OK ||
-	    (r->trials_out && bsim_output_trials_csv(trials, e, r, err) != BSIM_OK) ||
+	    (r->trials_out && !text && bsim_output_trials_csv(trials, e, r, err) != BSIM_OK) ||
+	    (text && bytes_write(trials, text, len, err) != BSIM_OK) ||
 	    (r->trials_out && survival_files(dir, e, extra, n_extra, r, err) != BSIM_OK) ||
 	    bsim_output_lattice(dir, e, extra, n_extra, r, err) != BSIM_OK ||
 	    bsim_output_trajectories_csv(traj, r, err) != BSIM_OK ||
 	    bsim_matlab_sweep(dir, e, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	return BSIM_OK;
+}
+
+int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
+                           const bsim_options *opts, const bsim_override *extra, int n_extra,
+                           const bsim_sweep_result *r, bsim_error *err)
+{
+	return sweep_files(dir, e, b, opts, extra, n_extra, r, NULL, 0, err);
+}
+
+int bsim_store_read_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
+                          const bsim_override *extra, int n_extra, const bsim_sweep_result *r,
+                          const char *text, size_t len, bsim_error *err)
+{
+	bsim_options none = {0};
+	return sweep_files(dir, e, b, &none, extra, n_extra, r, text, len, err);
 }
 
 int bsim_store_twin(const char *dir, const char *file, const char *var, bsim_error *err)

@@ -20,6 +20,15 @@ int bsim_store_sweep_files(const char *dir, const bsim_experiment *e, const bsim
                            const bsim_options *opts, const bsim_override *extra, int n_extra,
                            const bsim_sweep_result *r, bsim_error *err);
 
+/* The same for a comparison's side read from a trials.csv made elsewhere
+ * (store/compare_read.h; b its stand-in): trials.csv the len bytes at text,
+ * the file as read, and what else r's trials give (summary.json, the
+ * survival files, a lattice's summary in summary.json, the .mat twins);
+ * none of what needs the trials' paths (a lattice's other files). */
+int bsim_store_read_files(const char *dir, const bsim_experiment *e, const bsim_backend *b,
+                          const bsim_override *extra, int n_extra, const bsim_sweep_result *r,
+                          const char *text, size_t len, bsim_error *err);
+
 /* dir/file (a .csv or .json) as dir/NAME.mat, variable var. */
 int bsim_store_twin(const char *dir, const char *file, const char *var, bsim_error *err);
 

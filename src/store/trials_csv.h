@@ -65,4 +65,28 @@ void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 int trials_csv_commit(trials_csv_writer *w, bsim_error *err);
 void trials_csv_abort(trials_csv_writer *w);
 
+/* The shape a trials.csv read back must have: every (group, trial) of
+ * n_groups x trials once (bsim_output_trials_read asks no more), and what
+ * a file made elsewhere is held to besides (compare's trials:PATH side). */
+typedef struct trials_csv_shape {
+	int n_groups, trials;
+	/* NULL, or per group 1 if its trial 0 stands for every trial of it (a
+	 * group that draws no random force, beamsim/sweep.h): the other rows
+	 * are its copies, as a sweep writes them, and each must agree with
+	 * trial 0 in outcome, type and final gate. Such a group is marked
+	 * deterministic in the result. */
+	const int *one_trial;
+	int need_final_gate; /* 1: final_ix and final_iy required (a gate lattice) */
+	int type_rule;       /* 1: type none unless the outcome is traversed, as beamsim
+	                      * writes it */
+} trials_csv_shape;
+
+/* The text of the trials.csv at path (whole and checked: csv_text_read;
+ * split in place) into r, its groups aggregated. BSIM_EINPUT "PATH:LINE:
+ * FIELD: expected ..., got ..." at the first field that does not fit the
+ * shape, a (group, trial) read twice (naming the line of the first) or
+ * missing (named, at the end of the file). */
+int trials_csv_parse(const char *path, char *text, const trials_csv_shape *shape,
+                     bsim_sweep_result *r, bsim_error *err);
+
 #endif
