@@ -119,10 +119,11 @@ static void test_environment(void **state)
 	unsetenv(BSIM_PLUGINS_ENV);
 }
 
-/* --backend plugin:PATH[:K=V] on sweep and a compare side: run.json
- * records the plug-in's name, its options and its library, and regress runs
- * the comparison again from that record alone (no BEAMSIM_PLUGINS), every
- * trial the same; a bad option is refused before anything runs. */
+/* --backend plugin:PATH[:K=V] on sweep and a side of a three-way compare:
+ * run.json records the plug-in's name, its options and its library, and
+ * regress runs the comparison again from that record alone (no
+ * BEAMSIM_PLUGINS), every trial the same; a bad option is refused before
+ * anything runs. */
 static void test_command_line(void **state)
 {
 	(void)state;
@@ -148,12 +149,12 @@ static void test_command_line(void **state)
 	assert_non_null(strstr(run, "libgate_euler.so\""));
 	free(run);
 
-	snprintf(side, sizeof side, "thesis,plugin:%s", BSIM_TEST_PLUGIN);
+	snprintf(side, sizeof side, "thesis,chipmunk,plugin:%s", BSIM_TEST_PLUGIN);
 	const char *compare[] = {"compare", exp,     "--backends", side, "--trials",
 	                         "3",       "--out", cmp_dir,      NULL};
 	char *out = NULL;
 	assert_int_equal(bsim_test_cli(compare, &out, NULL), 0);
-	assert_non_null(strstr(out, "thesis vs gate_euler on "));
+	assert_non_null(strstr(out, "thesis vs chipmunk vs gate_euler on "));
 	free(out);
 	assert_true(bsim_test_exists(bsim_test_join(cmp_dir, "gate_euler/trials.csv")));
 	const char *regress[] = {"regress", cmp_dir, "--exact", "--out", again_dir, NULL};
