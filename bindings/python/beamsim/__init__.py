@@ -40,7 +40,8 @@ except ImportError as _e:
     raise ImportError(
         f"beamsim's extension was built for Python {_BUILT_VERSION} ({_BUILT_PYTHON}) and "
         f"the NumPy it has; this is Python {_here} ({sys.executable}): run {_BUILT_PYTHON}, "
-        f"or build beamsim for this one (cmake -DPython3_EXECUTABLE={sys.executable}): {_e}"
+        f"or build beamsim for this one (cmake -DPython3_EXECUTABLE={sys.executable}, or "
+        f"pip install --no-build-isolation . into it): {_e}"
     ) from _e
 
 __all__ = ["run", "sweep", "compare", "landscape", "load", "version", "backends", "World"]
