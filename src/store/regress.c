@@ -222,8 +222,8 @@ static int regress_compare(const bsim_regress_def *def, bsim_regress_result *res
 		        .e = &res->e,
 		        .extra = side_b ? &protocol_b : NULL,
 		        .n_extra = side_b,
-		        .side = {{"baseline", backend[n], &res->rec.opts[n], &r[n][0]},
-		                 {"rerun", backend[n], &res->rec.opts[n], &r[n][1]}},
+		        .side = {{"baseline", backend[n], &res->rec.opts[n], &r[n][0], NULL},
+		                 {"rerun", backend[n], &res->rec.opts[n], &r[n][1], NULL}},
 		        .cmp = &p->cmp,
 		        .examples = 3,
 		};
