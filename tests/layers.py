@@ -25,7 +25,13 @@ compiled objects:
    ("configs/NAME/") or a longer name ("NAME-gate"); a comment may still
    speak of "the NAME backend" to state a fact about that backend. The rest
    of the program reaches a backend through the registry, by the name it
-   was given or in a loop over the list.
+   was given or in a loop over the list;
+9. every global symbol the library's objects define carries the prefix
+   bsim_, internal ones too (a program linking libbeamsim.a meets no name
+   of ours but bsim_...): a function used in one file only is static. What
+   the C++ compiler makes of Box2D's classes and the standard library
+   (mangled names, _Z...) is not ours to name; an OpenMP critical section's
+   lock is named after the section, critical(bsim_...).
 
 Usage: layers.py SOURCE_DIR BUILD_DIR. Prints every breach and exits 1 if
 there is one."""
@@ -196,6 +202,15 @@ def check_homes(src, objects, breaches):
                 breaches.append(f"{rel} ({layer}) declares {name}, defined in {home} ({got})")
 
 
+def check_prefix(objects, breaches):
+    for name, (defined, _) in sorted(objects.items()):
+        for sym in sorted(defined):
+            # .gomp_critical_user_NAME: OpenMP's lock of a critical(NAME)
+            if not sym.startswith(("bsim_", "_Z", "_", "DW.", ".gomp_critical_user_bsim_")):
+                breaches.append(f"{name}: defines the global symbol {sym} without the prefix "
+                                "bsim_ (make it static, or name it bsim_...)")
+
+
 def check_calls(objects, breaches):
     if not objects:
         breaches.append("no object files of the library found")
@@ -354,6 +369,7 @@ def main():
     check_includes(src, breaches)
     objects = read_objects(build)
     check_calls(objects, breaches)
+    check_prefix(objects, breaches)
     check_homes(src, objects, breaches)
     check_sizes(src, breaches)
     check_guards(src, breaches)

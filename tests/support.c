@@ -644,15 +644,15 @@ double bsim_test_json_number(const char *text, const char *key)
 double bsim_test_json_at(struct fy_node *root, const char *path)
 {
 	double v = NAN;
-	struct fy_node *n = ydoc_lookup(root, path);
-	if (!n || ydoc_number(n, &v) != YDOC_NUM_OK)
+	struct fy_node *n = bsim_ydoc_lookup(root, path);
+	if (!n || bsim_ydoc_number(n, &v) != YDOC_NUM_OK)
 		fail_msg("JSON: no number at %s", path);
 	return v;
 }
 
 const char *bsim_test_json_text_at(struct fy_node *root, const char *path, char *buf, size_t size)
 {
-	struct fy_node *n = ydoc_lookup(root, path);
+	struct fy_node *n = bsim_ydoc_lookup(root, path);
 	size_t len = 0;
 	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
 	if (!t)

@@ -147,7 +147,7 @@ int bsim_test_check_figures(const char *dir);
 double bsim_test_json_number(const char *text, const char *key);
 
 /* A JSON (or YAML) document's node at a dotted path ("groups.3.verdict",
- * util/yaml_doc.h's ydoc_lookup) as a number, or its scalar's text into
+ * util/yaml_doc.h's bsim_ydoc_lookup) as a number, or its scalar's text into
  * buf; fails the test, naming the path, if there is none. */
 struct fy_node;
 double bsim_test_json_at(struct fy_node *root, const char *path);

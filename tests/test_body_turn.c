@@ -437,18 +437,18 @@ static void test_ellipse_outline(void **state)
 {
 	(void)state;
 	double area_rel, dist;
-	assert_int_equal(box2d_ellipse_error(10.0, 5.0, 1.0, &area_rel, &dist), BSIM_OK);
+	assert_int_equal(bsim_box2d_ellipse_error(10.0, 5.0, 1.0, &area_rel, &dist), BSIM_OK);
 	printf("box2d ellipse a = 10 m, b = 5 m: area error %+.3g, max outline distance %.3g m\n",
 	       area_rel, dist);
 	assert_true(fabs(area_rel) < 1e-3);
 	assert_true(dist < 0.02);
 	/* the gate's ellipse of the disk's area */
-	assert_int_equal(box2d_ellipse_error(12.5, 8.0, 1.0, &area_rel, &dist), BSIM_OK);
+	assert_int_equal(bsim_box2d_ellipse_error(12.5, 8.0, 1.0, &area_rel, &dist), BSIM_OK);
 	printf("box2d ellipse a = 12.5 m, b = 8 m: area error %+.3g, max outline distance %.3g m\n",
 	       area_rel, dist);
 	assert_true(fabs(area_rel) < 1e-3);
 	assert_true(dist < 0.02);
-	assert_int_equal(box2d_ellipse_error(0.005, 5.0, 1.0, &area_rel, &dist), BSIM_EINPUT);
+	assert_int_equal(bsim_box2d_ellipse_error(0.005, 5.0, 1.0, &area_rel, &dist), BSIM_EINPUT);
 }
 
 /* The contact flag reads the true outline, whatever polygon a backend

@@ -374,7 +374,7 @@ static void test_ellipse_polygon(void **state)
 	const double a = 12.5, b = 8.0;
 	enum { K = 128 };
 	cpVect v[K];
-	chipmunk_ellipse_polygon(a, b, K, v);
+	bsim_chipmunk_ellipse_polygon(a, b, K, v);
 	double worst = 0.0, area = 0.0;
 	for (int k = 0; k < K; k++) {
 		const cpVect p = v[k], q = v[(k + 1) % K];

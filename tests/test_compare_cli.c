@@ -616,7 +616,7 @@ static void test_three_sides(void **state)
 	bsim_error err;
 	char path[1400], p[200], buf[64];
 	snprintf(path, sizeof path, "%s/report.json", dir);
-	assert_int_equal(ydoc_load_own(&d, path, &err), BSIM_OK);
+	assert_int_equal(bsim_ydoc_load_own(&d, path, &err), BSIM_OK);
 	struct fy_node *root = fy_document_root(d.fyd);
 	assert_string_equal(bsim_test_json_text_at(root, "a.label", buf, sizeof buf), sides3[0]);
 	assert_string_equal(bsim_test_json_text_at(root, "b.label", buf, sizeof buf), sides3[1]);
@@ -700,7 +700,7 @@ static void test_three_sides(void **state)
 	/* the side meant to differ is the odd one out somewhere: the rule is
 	 * exercised, not only "none" */
 	assert_true(odd_found > 0);
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	char *json = read_in(dir, "report.json");
 	assert_true(check_replays(json, 0) > 0);
 	free(json);

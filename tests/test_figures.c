@@ -166,19 +166,19 @@ static void test_below_surface(void **state)
 		double x = pts[i][0], y = pts[i][1];
 		double th[2] = {th_model(-25, x, y), th_model(25, x, y)};
 		/* on the surface: both beams resting against the body */
-		assert_false(fpath_below(&s, x, y, th));
+		assert_false(bsim_fpath_below(&s, x, y, th));
 		double e = 7.0 * (60 - y) + 200 * (th[0] * th[0] + th[1] * th[1]);
-		assert_true(fabs(fpath_energy(&s, y, th) - e) < 1e-9);
+		assert_true(fabs(bsim_fpath_energy(&s, y, th) - e) < 1e-9);
 		/* a beam left behind (detached) where it would be deflected */
 		for (int b = 0; b < 2; b++) {
 			double d[2] = {th[0], th[1]};
 			d[b] = 0.0;
 			int deep = 200 * th[b] * th[b] > FPATH_BELOW_J;
-			assert_int_equal(fpath_below(&s, x, y, d), deep);
+			assert_int_equal(bsim_fpath_below(&s, x, y, d), deep);
 		}
 		/* a beam swung past the body lies above, never below */
 		double up[2] = {th[0] + 0.2, th[1] + 0.2};
-		assert_false(fpath_below(&s, x, y, up));
+		assert_false(bsim_fpath_below(&s, x, y, up));
 	}
 	bsim_scene_free(&s);
 }

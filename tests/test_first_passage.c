@@ -48,7 +48,7 @@ static int setup(void **state)
 static void read_table(const char *dir, const char *name, csv_table *t)
 {
 	bsim_error err;
-	if (csv_table_read(bsim_test_join(dir, name), t, &err) != 0)
+	if (bsim_csv_table_read(bsim_test_join(dir, name), t, &err) != 0)
 		fail_msg("%s", err.msg);
 }
 
@@ -58,22 +58,22 @@ static void outcome_counts(const char *dir, long counts[2][3])
 	csv_table t;
 	read_table(dir, "trials.csv", &t);
 	memset(counts, 0, 2 * sizeof counts[0]);
-	int cg = csv_table_col(&t, "group"), co = csv_table_col(&t, "outcome"),
-	    ct = csv_table_col(&t, "t_end"), cx = csv_table_col(&t, "t_exit");
+	int cg = bsim_csv_table_col(&t, "group"), co = bsim_csv_table_col(&t, "outcome"),
+	    ct = bsim_csv_table_col(&t, "t_end"), cx = bsim_csv_table_col(&t, "t_exit");
 	assert_true(cg >= 0 && co >= 0 && ct >= 0 && cx >= 0);
 	for (long r = 0; r < t.n_rows; r++) {
 		double g;
-		csv_table_number(&t, r, cg, &g);
-		const char *o = csv_table_cell(&t, r, co);
+		bsim_csv_table_number(&t, r, cg, &g);
+		const char *o = bsim_csv_table_cell(&t, r, co);
 		int k = strcmp(o, "traversed") == 0 ? 0 : strcmp(o, "side_exit") == 0 ? 1 : 2;
 		counts[(int)g][k]++;
 		/* t_exit: t_end, as written, for an exit; empty otherwise */
 		if (k < 2)
-			assert_string_equal(csv_table_cell(&t, r, cx), csv_table_cell(&t, r, ct));
+			assert_string_equal(bsim_csv_table_cell(&t, r, cx), bsim_csv_table_cell(&t, r, ct));
 		else
-			assert_string_equal(csv_table_cell(&t, r, cx), "");
+			assert_string_equal(bsim_csv_table_cell(&t, r, cx), "");
 	}
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 }
 
 /* horizon.csv of dir at h, group g: traversed, side_exit, stuck. */
@@ -85,18 +85,18 @@ static void horizon_at(const char *dir, int g, double h, long out[3])
 	int found = 0;
 	for (long r = 0; r < t.n_rows; r++) {
 		double gg, hh;
-		csv_table_number(&t, r, csv_table_col(&t, "group"), &gg);
-		csv_table_number(&t, r, csv_table_col(&t, "h"), &hh);
+		bsim_csv_table_number(&t, r, bsim_csv_table_col(&t, "group"), &gg);
+		bsim_csv_table_number(&t, r, bsim_csv_table_col(&t, "h"), &hh);
 		if ((int)gg != g || fabs(hh - h) > 1e-9)
 			continue;
 		for (int k = 0; k < 3; k++) {
 			double v;
-			csv_table_number(&t, r, csv_table_col(&t, cols[k]), &v);
+			bsim_csv_table_number(&t, r, bsim_csv_table_col(&t, cols[k]), &v);
 			out[k] = (long)v;
 		}
 		found = 1;
 	}
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	assert_true(found);
 }
 
@@ -124,13 +124,13 @@ static void test_horizon_identity(void **state)
 	double last_s = -1, last_t = -1;
 	for (long r = 0; r < t.n_rows; r++) {
 		double g;
-		csv_table_number(&t, r, csv_table_col(&t, "group"), &g);
+		bsim_csv_table_number(&t, r, bsim_csv_table_col(&t, "group"), &g);
 		if ((int)g == 1) {
-			csv_table_number(&t, r, csv_table_col(&t, "survival"), &last_s);
-			csv_table_number(&t, r, csv_table_col(&t, "t"), &last_t);
+			bsim_csv_table_number(&t, r, bsim_csv_table_col(&t, "survival"), &last_s);
+			bsim_csv_table_number(&t, r, bsim_csv_table_col(&t, "t"), &last_t);
 		}
 	}
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	if (c12[1][2] > 0)
 		assert_true(fabs(last_t - 12.0) < 1e-9);
 	assert_true(fabs(last_s - c12[1][2] / 60.0) < 1e-9);

@@ -51,7 +51,7 @@ static void every_numeric_key_has_a_name(void **state)
 {
 	(void)state;
 	char missing[2000] = "";
-	int n = walk(&scene_top_table, "", missing, sizeof missing);
+	int n = walk(&bsim_scene_top_table, "", missing, sizeof missing);
 	if (n)
 		fail_msg("%d keys without a display name:%s", n, missing);
 }

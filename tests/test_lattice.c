@@ -443,7 +443,7 @@ static void lcp_many_contacts(void **state)
 			cs[0].c = cs[1].c = 0.0;
 		}
 		memcpy(gs, cs, sizeof cs);
-		assert_int_equal(thesis_lcp_solve(w.inv_mass, cs, n), 0); /* converged */
+		assert_int_equal(bsim_thesis_lcp_solve(w.inv_mass, cs, n), 0); /* converged */
 		double scale = 0.0;
 		for (int i = 0; i < n; i++) {
 			double wi = cs[i].vrel - cs[i].bound;
@@ -491,7 +491,7 @@ static void lcp_many_contacts(void **state)
 		assert_true(fabs(j[0] - jg[0]) < 1e-7 && fabs(j[1] - jg[1]) < 1e-7);
 	}
 	assert_true(solved_with_impulse > 150);
-	assert_int_equal(thesis_lcp_fallbacks(), 0);
+	assert_int_equal(bsim_thesis_lcp_fallbacks(), 0);
 }
 
 /* A body pushed up by F into three overlapping beams (a "ceiling" of three
@@ -539,7 +539,7 @@ static void three_beams_static_equilibrium(void **state)
 	int touching = 0;
 	for (int i = 0; i < 3; i++) {
 		thesis_contact c;
-		if (!thesis_contact_detect(w, i, 1e-3, &c))
+		if (!bsim_thesis_contact_detect(w, i, 1e-3, &c))
 			continue;
 		touching++;
 		thesis_beam *b = &w->beams[i];
@@ -558,7 +558,7 @@ static void three_beams_static_equilibrium(void **state)
 	assert_int_equal(touching, 3);
 	assert_true(hypot(w->v[0], w->v[1]) < 1e-6);
 	assert_true(fabs(sum[0]) < 1e-6 && fabs(sum[1] + 40.0) < 1e-6);
-	assert_int_equal(thesis_lcp_fallbacks(), 0); /* solved by enumeration */
+	assert_int_equal(bsim_thesis_lcp_fallbacks(), 0); /* solved by enumeration */
 	bsim_test_backend("thesis")->destroy(w);
 	bsim_scene_free(&s);
 }

@@ -620,7 +620,7 @@ static void test_streamed_csv(void **state)
 	tcsv_free(&t);
 }
 
-/* Quoted fields, as csv_field_write writes a user's text (a grid value
+/* Quoted fields, as bsim_csv_field_write writes a user's text (a grid value
  * holding a comma, a quote or a line break), come back unquoted: the text
  * written here, byte for byte; the rows after a line break inside quotes
  * keep their columns; a quote not closed where its field ends is refused

@@ -197,7 +197,7 @@ static struct fy_node *json_open(const char *dir, const char *name, ydoc *d)
 	char path[1400];
 	bsim_error err;
 	snprintf(path, sizeof path, "%s/%s", dir, name);
-	if (ydoc_load_own(d, path, &err) != BSIM_OK)
+	if (bsim_ydoc_load_own(d, path, &err) != BSIM_OK)
 		fail_msg("%s: %s", path, err.msg);
 	return fy_document_root(d->fyd);
 }
@@ -243,7 +243,7 @@ static void test_same_trials(void **state)
 			assert_string_equal(buf, "same");
 		assert_false(disagrees(buf));
 	}
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	free(l.text);
 	/* pairs.csv: every pair's outcome and type the same */
 	char path[1400];
@@ -286,8 +286,8 @@ static void test_same_trials(void **state)
 	bsim_test_json_text_at(root, "backends.1.read_from", buf, sizeof buf);
 	assert_non_null(strstr(buf, "/made/trials.csv"));
 	assert_int_equal(buf[0], '/');
-	assert_null(ydoc_lookup(root, "backends.0.read_from"));
-	ydoc_free(&d);
+	assert_null(bsim_ydoc_lookup(root, "backends.0.read_from"));
+	bsim_ydoc_free(&d);
 	/* report.md says which side was read */
 	snprintf(path, sizeof path, "%s/report.md", same_dir);
 	char *md = bsim_test_read(path);
@@ -367,7 +367,7 @@ static void test_one_group_flipped(void **state)
 			assert_int_equal((int)bsim_test_json_at(root, p), 0);
 		}
 	}
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	for (int t = 0; t < TRIALS; t++)
 		free(owned[t]);
 	free(l.text);
@@ -515,8 +515,8 @@ static void test_three_sides(void **state)
 	struct fy_node *root = json_open(out, "report.json", &d);
 	char p[160], a[64], b[64];
 	assert_string_equal(bsim_test_json_text_at(root, "sides.1.label", a, sizeof a), "made");
-	assert_non_null(ydoc_lookup(root, "sides.1.read_from"));
-	assert_null(ydoc_lookup(root, "sides.2.read_from"));
+	assert_non_null(bsim_ydoc_lookup(root, "sides.1.read_from"));
+	assert_null(bsim_ydoc_lookup(root, "sides.2.read_from"));
 	static const char *const ev[] = {"traversed", "left", "right", "side_exit", "stuck"};
 	static const char *const cell[] = {"both", "only_a", "only_b", "neither"};
 	for (int g = 0; g < GROUPS; g++) {
@@ -540,7 +540,7 @@ static void test_three_sides(void **state)
 		}
 	}
 	assert_int_equal(rc, (int)bsim_test_json_at(root, "groups_disagreeing") > 0 ? 3 : 0);
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 }
 
 /* The comparison of a backend's own sweep read from its file is the
@@ -589,7 +589,7 @@ static void test_read_is_run(void **state)
 		for (int e = 0; e < 6; e++) {
 			/* a deterministic group's events have no p-value */
 			snprintf(p, sizeof p, "groups.%d.events.%s.p_mcnemar", g, ev[e]);
-			struct fy_node *n0 = ydoc_lookup(root[0], p), *n1 = ydoc_lookup(root[1], p);
+			struct fy_node *n0 = bsim_ydoc_lookup(root[0], p), *n1 = bsim_ydoc_lookup(root[1], p);
 			assert_true((n0 == NULL) == (n1 == NULL));
 			if (n0)
 				assert_string_equal(
@@ -597,8 +597,8 @@ static void test_read_is_run(void **state)
 				        bsim_test_json_text_at(root[1], p, b, sizeof b));
 		}
 	}
-	ydoc_free(&d[0]);
-	ydoc_free(&d[1]);
+	bsim_ydoc_free(&d[0]);
+	bsim_ydoc_free(&d[1]);
 }
 
 /* regress reads the recorded file again and reruns the other side; a file
@@ -683,7 +683,7 @@ static void test_lattice(void **state)
 		assert_int_equal((int)bsim_test_json_at(root, "groups.0.discordant"), m);
 		assert_int_equal(
 		        (int)bsim_test_json_at(root, "groups.0.final_locations.discordant"), m);
-		ydoc_free(&d);
+		bsim_ydoc_free(&d);
 	}
 	snprintf(sides, sizeof sides, "thesis,trials:%s", cut);
 	const char *gone = bsim_test_join(bsim_test_dir_held("lat_refused"), "out");

@@ -333,7 +333,7 @@ static void test_free_flight_bound(void **state)
 		double reach = w->radius + thesis_clear_margin(w, f, h);
 		double r = reach * (1.0 + gsl_ran_flat(rng, -1e-2, 1e-2));
 		place_off_segment(rng, t, b->p, b->u0, b->length, r, w->x);
-		if (!thesis_broad_phase_clear(w, f, h))
+		if (!bsim_thesis_broad_phase_clear(w, f, h))
 			continue;
 		clear++;
 		assert_clear_truly(w, speed, h);
@@ -344,7 +344,7 @@ static void test_free_flight_bound(void **state)
 	bsim_scene_free(&s);
 }
 
-/* The projection's re-detection (thesis_contact_redetect_disk) skips the
+/* The projection's re-detection (bsim_thesis_contact_redetect_disk) skips the
  * distance bound geometry_far, which only saves the exact test: it finds
  * the contact detection finds, bit for bit. The body is placed near a beam
  * at a small angle, its last geometry computed at a configuration a little
@@ -376,7 +376,7 @@ static void test_redetect_as_detect(void **state)
 		double r = w->radius + margin * gsl_ran_flat(rng, 0.0, 4.0);
 		place_off_segment(rng, t, b->p, u, b->length, r, w->x);
 		thesis_contact c0, c1;
-		thesis_contact_detect_disk(w, i, margin, &c0); /* the geometry cached */
+		bsim_thesis_contact_detect_disk(w, i, margin, &c0); /* the geometry cached */
 		/* the configuration detected: a step away */
 		double step = margin * gsl_ran_flat(rng, 0.0, 2.0);
 		w->x[0] += gsl_ran_flat(rng, -step, step);
@@ -386,9 +386,9 @@ static void test_redetect_as_detect(void **state)
 		const thesis_beam kept = *b;
 		memset(&c0, 0, sizeof c0);
 		memset(&c1, 0, sizeof c1);
-		int n0 = thesis_contact_detect_disk(w, i, margin, &c0);
+		int n0 = bsim_thesis_contact_detect_disk(w, i, margin, &c0);
 		*b = kept;
-		int n1 = thesis_contact_redetect_disk(w, i, margin, &c1);
+		int n1 = bsim_thesis_contact_redetect_disk(w, i, margin, &c1);
 		assert_int_equal(n0, n1);
 		if (n1) /* without a contact out's fields say nothing */
 			assert_memory_equal(&c0, &c1, sizeof c0);
@@ -437,7 +437,7 @@ static void test_free_flight_room(void **state)
 			w->x[1] = home[1];
 		}
 		double room_before = w->clear_room, cx = w->clear_x[0], cy = w->clear_x[1];
-		if (!thesis_broad_phase_clear(w, f, h))
+		if (!bsim_thesis_broad_phase_clear(w, f, h))
 			continue;
 		clear++;
 		by_room +=

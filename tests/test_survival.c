@@ -37,31 +37,31 @@ static void test_km_by_hand(void **state)
 {
 	(void)state;
 	survival_km k;
-	survival_km_start(&k, 6);
-	survival_km_step(&k, 1, 0);
+	bsim_survival_km_start(&k, 6);
+	bsim_survival_km_step(&k, 1, 0);
 	assert_true(fabs(k.s - 5.0 / 6.0) < 1e-15);
 	assert_int_equal(k.at_risk, 5);
-	survival_km_step(&k, 1, 1);
+	bsim_survival_km_step(&k, 1, 1);
 	assert_true(fabs(k.s - 2.0 / 3.0) < 1e-15);
 	assert_int_equal(k.at_risk, 3);
-	survival_km_step(&k, 2, 0);
+	bsim_survival_km_step(&k, 2, 0);
 	assert_true(fabs(k.s - 2.0 / 9.0) < 1e-15);
 	assert_true(fabs(k.greenwood - 0.75) < 1e-15);
 	/* the log-log interval: S^exp(-+z sqrt(G) / |ln S|) */
 	double lo, hi, sig = sqrt(0.75) / fabs(log(2.0 / 9.0));
-	survival_km_interval(&k, 1.959963984540054, &lo, &hi);
+	bsim_survival_km_interval(&k, 1.959963984540054, &lo, &hi);
 	assert_true(fabs(lo - pow(2.0 / 9.0, exp(1.959963984540054 * sig))) < 1e-14);
 	assert_true(fabs(hi - pow(2.0 / 9.0, exp(-1.959963984540054 * sig))) < 1e-14);
 	assert_true(lo < 2.0 / 9.0 && 2.0 / 9.0 < hi);
-	survival_km_step(&k, 0, 1);
+	bsim_survival_km_step(&k, 0, 1);
 	assert_true(fabs(k.s - 2.0 / 9.0) < 1e-15);
 	assert_int_equal(k.at_risk, 0);
 	/* S = 1 and S = 0 are points */
-	survival_km_start(&k, 3);
-	survival_km_interval(&k, 1.96, &lo, &hi);
+	bsim_survival_km_start(&k, 3);
+	bsim_survival_km_interval(&k, 1.96, &lo, &hi);
 	assert_true(lo == 1.0 && hi == 1.0);
-	survival_km_step(&k, 3, 0);
-	survival_km_interval(&k, 1.96, &lo, &hi);
+	bsim_survival_km_step(&k, 3, 0);
+	bsim_survival_km_interval(&k, 1.96, &lo, &hi);
 	assert_true(k.s == 0.0 && lo == 0.0 && hi == 0.0);
 }
 
@@ -86,16 +86,16 @@ static void test_km_file(void **state)
 		r[i].steps = trials[i].steps;
 		r[i].t_end = trials[i].steps * 0.5;
 	}
-	assert_true(survival_exit_time(&r[0]) == 1.0);
-	assert_true(isnan(survival_exit_time(&r[2])) && isnan(survival_exit_time(&r[5])));
-	survival_acc_add(&a, 0, 6, 6, r);
+	assert_true(bsim_survival_exit_time(&r[0]) == 1.0);
+	assert_true(isnan(bsim_survival_exit_time(&r[2])) && isnan(bsim_survival_exit_time(&r[5])));
+	bsim_survival_acc_add(&a, 0, 6, 6, r);
 	const char *dir = bsim_test_dir("survival_file");
 	bsim_error err;
-	if (survival_acc_write(&a, dir, &err) != BSIM_OK)
+	if (bsim_survival_acc_write(&a, dir, &err) != BSIM_OK)
 		fail_msg("%s", err.msg);
 	free(g.count);
 	csv_table t;
-	if (csv_table_read(bsim_test_join(dir, "survival.csv"), &t, &err) != BSIM_OK)
+	if (bsim_csv_table_read(bsim_test_join(dir, "survival.csv"), &t, &err) != BSIM_OK)
 		fail_msg("%s", err.msg);
 	/* t = 0, 1, 2, 3, 5 */
 	assert_int_equal(t.n_rows, 5);
@@ -108,24 +108,24 @@ static void test_km_file(void **state)
 	for (int row = 0; row < 5; row++)
 		for (int c = 0; c < 4; c++) {
 			double v;
-			assert_int_equal(csv_table_number(&t, row, csv_table_col(&t, cols[c]), &v),
+			assert_int_equal(bsim_csv_table_number(&t, row, bsim_csv_table_col(&t, cols[c]), &v),
 			                 0);
 			assert_true(fabs(v - want[row][c]) < 1e-9);
 		}
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	/* horizon.csv at 5 s: 2 traversed, 2 side exits, 1 stuck (the
 	 * unstable one is neither); at 2 s: 1 traversed, 1 side exit, 3 stuck */
-	if (csv_table_read(bsim_test_join(dir, "horizon.csv"), &t, &err) != BSIM_OK)
+	if (bsim_csv_table_read(bsim_test_join(dir, "horizon.csv"), &t, &err) != BSIM_OK)
 		fail_msg("%s", err.msg);
 	assert_int_equal(t.n_rows, 10);
-	int ch = csv_table_col(&t, "h"), ct = csv_table_col(&t, "traversed"),
-	    cs = csv_table_col(&t, "side_exit"), ck = csv_table_col(&t, "stuck");
+	int ch = bsim_csv_table_col(&t, "h"), ct = bsim_csv_table_col(&t, "traversed"),
+	    cs = bsim_csv_table_col(&t, "side_exit"), ck = bsim_csv_table_col(&t, "stuck");
 	for (long row = 0; row < t.n_rows; row++) {
 		double h, tr, se, st;
-		csv_table_number(&t, row, ch, &h);
-		csv_table_number(&t, row, ct, &tr);
-		csv_table_number(&t, row, cs, &se);
-		csv_table_number(&t, row, ck, &st);
+		bsim_csv_table_number(&t, row, ch, &h);
+		bsim_csv_table_number(&t, row, ct, &tr);
+		bsim_csv_table_number(&t, row, cs, &se);
+		bsim_csv_table_number(&t, row, ck, &st);
 		if (fabs(h - 5.0) < 1e-12)
 			assert_true(tr == 2 && se == 2 && st == 1);
 		if (fabs(h - 2.0) < 1e-12)
@@ -133,7 +133,7 @@ static void test_km_file(void **state)
 		if (fabs(h - 0.5) < 1e-12)
 			assert_true(tr == 0 && se == 0 && st == 6);
 	}
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 }
 
 /* 20,000 exponential times of rate k = 0.5 /s, censored at 4 s: the
@@ -164,10 +164,10 @@ static void test_km_exponential(void **state)
 		}
 	}
 	survival_km km;
-	survival_km_start(&km, n);
+	bsim_survival_km_start(&km, n);
 	double worst = 0.0;
 	for (int b = 0; b < bins; b++) {
-		survival_km_step(&km, d[b], c[b]);
+		bsim_survival_km_step(&km, d[b], c[b]);
 		if (d[b] == 0 || km.s <= 0.0)
 			continue;
 		double se = km.s * sqrt(km.greenwood);
@@ -176,10 +176,10 @@ static void test_km_exponential(void **state)
 	}
 	assert_true(worst < 4.0);
 	double rate, lo, hi;
-	survival_rate(events, exposure, &rate, &lo, &hi);
+	bsim_survival_rate(events, exposure, &rate, &lo, &hi);
 	assert_true(lo < k && k < hi);
 	assert_true(fabs(rate - k) < 0.02);
-	survival_rate(0, 10.0, &rate, &lo, &hi);
+	bsim_survival_rate(0, 10.0, &rate, &lo, &hi);
 	/* no event in 10 s: [0, -ln(0.025) / 10] */
 	assert_true(rate == 0.0 && lo == 0.0 && fabs(hi + log(0.025) / 10.0) < 1e-9);
 	free(d);
@@ -203,7 +203,7 @@ static void test_kramers_fit(void **state)
 	}
 	escape_fit f;
 	bsim_error err;
-	assert_int_equal(escape_fit_line(x, y, w, N, &f, &err), BSIM_OK);
+	assert_int_equal(bsim_escape_fit_line(x, y, w, N, &f, &err), BSIM_OK);
 	assert_true(fabs(f.k0 - k0) < 1e-9 && fabs(f.c - c) < 1e-9 && f.rms < 1e-12);
 	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
 	gsl_rng_set(rng, 11);
@@ -213,7 +213,7 @@ static void test_kramers_fit(void **state)
 		y[i] = log(d / T);
 		w[i] = d;
 	}
-	assert_int_equal(escape_fit_line(x, y, w, N, &f, &err), BSIM_OK);
+	assert_int_equal(bsim_escape_fit_line(x, y, w, N, &f, &err), BSIM_OK);
 	assert_true(fabs(f.a - log(k0)) < 3.0 * f.se_a);
 	assert_true(fabs(f.b + 1.0 / c) < 3.0 * f.se_b);
 	assert_true(fabs(f.c - c) < 3.0 * f.se_c);
@@ -223,21 +223,21 @@ static void test_kramers_fit(void **state)
 	 * e^N(0, 1) about a constant, with 10^4 events each, are rejected and
 	 * explained by no line */
 	print_message("on the line: R^2 %.3f, p %.3g: %s\n", f.r2, f.p_poisson,
-	              escape_fit_verdict(&f));
+	              bsim_escape_fit_verdict(&f));
 	assert_true(f.r2 >= ESCAPE_R2_LITTLE && f.p_poisson >= ESCAPE_P_REJECT);
-	assert_non_null(strstr(escape_fit_verdict(&f), "consistent"));
+	assert_non_null(strstr(bsim_escape_fit_verdict(&f), "consistent"));
 	for (int i = 0; i < N; i++) {
 		y[i] = log(k0) + gsl_ran_ugaussian(rng);
 		w[i] = 1e4;
 	}
-	assert_int_equal(escape_fit_line(x, y, w, N, &f, &err), BSIM_OK);
-	print_message("scatter: R^2 %.3f, p %.3g: %s\n", f.r2, f.p_poisson, escape_fit_verdict(&f));
+	assert_int_equal(bsim_escape_fit_line(x, y, w, N, &f, &err), BSIM_OK);
+	print_message("scatter: R^2 %.3f, p %.3g: %s\n", f.r2, f.p_poisson, bsim_escape_fit_verdict(&f));
 	assert_true(f.p_poisson < ESCAPE_P_REJECT);
-	assert_non_null(strstr(escape_fit_verdict(&f), f.r2 < ESCAPE_R2_LITTLE
+	assert_non_null(strstr(bsim_escape_fit_verdict(&f), f.r2 < ESCAPE_R2_LITTLE
 	                                                       ? "do not describe these groups"
 	                                                       : "are not their law"));
 	/* under three points: no fit */
-	assert_int_equal(escape_fit_line(x, y, w, 2, &f, &err), BSIM_EINPUT);
+	assert_int_equal(bsim_escape_fit_line(x, y, w, 2, &f, &err), BSIM_EINPUT);
 	gsl_rng_free(rng);
 }
 
@@ -251,7 +251,7 @@ static void test_contact_time(void **state)
 	bsim_override o = {"effects.propulsion.force", "8", NULL};
 	if (bsim_scene_load(bsim_test_src("configs/thesis/gate.yaml"), &o, 1, &s, &err))
 		fail_msg("%s", err.msg);
-	assert_true(fabs(escape_contact_time(&s) - sqrt(5.0)) < 1e-3);
+	assert_true(fabs(bsim_escape_contact_time(&s) - sqrt(5.0)) < 1e-3);
 	bsim_scene_free(&s);
 }
 

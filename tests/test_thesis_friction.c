@@ -390,7 +390,7 @@ static void test_no_energy_created(void **state)
 	assert_true(two_point > 100);
 }
 
-/* thesis_contact_solve on random problems of 1 to 4 contacts (the body's
+/* bsim_thesis_contact_solve on random problems of 1 to 4 contacts (the body's
  * mass and inertia, normals, body and beam levers, beams' inertias, free
  * velocities and mu drawn at random; K built by the solver from them):
  * every solution meets the conditions it solves, checked here from the
@@ -422,7 +422,7 @@ static void test_solve_conditions(void **state)
 			cs[i].vrel_t = 4.0 * uniform(&seed) - 2.0;
 			cs[i].mu = uniform(&seed) < 0.1 ? 0.0 : 1.5 * uniform(&seed);
 		}
-		assert_int_equal(thesis_contact_solve(inv_mass, inv_j, cs, n), 0);
+		assert_int_equal(bsim_thesis_contact_solve(inv_mass, inv_j, cs, n), 0);
 		/* the contact velocities after, from the impulses: v, w and
 		 * each beam's omega (one beam per contact) */
 		double jv[2] = {0.0, 0.0}, jw = 0.0;
@@ -467,7 +467,7 @@ static void test_solve_conditions(void **state)
 		cs[i].n[0] = cos(i), cs[i].n[1] = sin(i);
 		cs[i].c = 1.0, cs[i].inv_i = 0.1, cs[i].vrel = -1.0, cs[i].mu = 0.5;
 	}
-	assert_int_equal(thesis_contact_solve(1.0, 0.1, cs, 5), 1);
+	assert_int_equal(bsim_thesis_contact_solve(1.0, 0.1, cs, 5), 1);
 }
 
 int main(void)

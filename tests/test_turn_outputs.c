@@ -72,9 +72,9 @@ static char *read_in(const char *out, const char *file)
 static double cell(const csv_table *t, long r, const char *name)
 {
 	double x;
-	int c = csv_table_col(t, name);
+	int c = bsim_csv_table_col(t, name);
 	assert_true(c >= 0);
-	assert_int_equal(csv_table_number(t, r, c, &x), 0);
+	assert_int_equal(bsim_csv_table_number(t, r, c, &x), 0);
 	return x;
 }
 
@@ -112,7 +112,7 @@ static void test_columns_and_summary(void **state)
 	free(csv);
 	csv_table t;
 	bsim_error err;
-	if (csv_table_read(bsim_test_join(one, "trials.csv"), &t, &err) != 0)
+	if (bsim_csv_table_read(bsim_test_join(one, "trials.csv"), &t, &err) != 0)
 		fail_msg("%s", err.msg);
 	double mean = 0.0, mean_abs = 0.0, max_abs = 0.0, turn_max = 0.0;
 	int n = 0, turned = 0;
@@ -135,7 +135,7 @@ static void test_columns_and_summary(void **state)
 		turn_max = fmax(turn_max, far);
 		n++;
 	}
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	assert_int_equal(n, atoi(TRIALS));
 	assert_true(turned >= n / 2); /* the check covers bodies that turned */
 	char *summary = read_in(one, "summary.json");
@@ -160,7 +160,7 @@ static void test_run_json(void **state)
 	(void)state;
 	csv_table t;
 	bsim_error err;
-	if (csv_table_read(bsim_test_join(one, "trials.csv"), &t, &err) != 0)
+	if (bsim_csv_table_read(bsim_test_join(one, "trials.csv"), &t, &err) != 0)
 		fail_msg("%s", err.msg);
 	static const char *const names[] = {"heading_end", "angular_velocity_end", "turn_end",
 	                                    "turn_max"};
@@ -174,11 +174,11 @@ static void test_run_json(void **state)
 		for (int k = 0; k < 4; k++) {
 			char a[64];
 			snprintf(a, sizeof a, "%.10g", bsim_test_json_number(out, names[k]));
-			assert_string_equal(a, csv_table_cell(&t, r, csv_table_col(&t, names[k])));
+			assert_string_equal(a, bsim_csv_table_cell(&t, r, bsim_csv_table_col(&t, names[k])));
 		}
 		free(out);
 	}
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 }
 
 static void same_trials(const char *ref, const char *out)

@@ -12,7 +12,7 @@ extern "C" {
  * outline (*area_rel, Box2D's less the ellipse's over the ellipse's) and
  * the largest distance between the two outlines (*max_dist, m).
  * BSIM_EINPUT if the ellipse is too small for Box2D's skin at s. */
-int box2d_ellipse_error(double a, double b, double s, double *area_rel, double *max_dist);
+int bsim_box2d_ellipse_error(double a, double b, double s, double *area_rel, double *max_dist);
 
 #ifdef __cplusplus
 }

@@ -38,7 +38,7 @@
  *              2 / (1 + cos(pi / K)) so that the chords' midpoints lie as
  *              far inside as the vertices lie outside; cut into fans of 6
  *              edges about the centre (b2_maxPolygonVertices = 8). Its
- *              shape error is box2d_ellipse_error's.
+ *              shape error is bsim_box2d_ellipse_error's.
  *   beam i: dynamic body whose origin is the pivot P, angle a_i = sgn theta_i
  *          (sgn = +1 if the rest direction u0 has x >= 0, else -1: theta > 0
  *          swings the tip forward, +y), one two-sided edge from (0, 0) to
@@ -1547,7 +1547,7 @@ int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
  * distance is the largest |signed distance| of the ellipse's points from
  * it (n_samples points at equal steps of the eccentric anomaly) and of its
  * vertices' offset points from the ellipse. */
-extern "C" int box2d_ellipse_error(double a, double b, double s, double *area_rel, double *max_dist)
+extern "C" int bsim_box2d_ellipse_error(double a, double b, double s, double *area_rel, double *max_dist)
 {
 	if (!(a > 0 && b > 0 && s > 0) || std::fmin(a, b) * s <= 2.0 * b2_polygonRadius)
 		return BSIM_EINPUT;

@@ -21,7 +21,7 @@
  * backend gives each point its own).
  *
  * postSolve reads what the solve did: the arbiter's total impulse on the
- * body (friction included) and its normal part; chipmunk_measure turns them
+ * body (friction included) and its normal part; bsim_chipmunk_measure turns them
  * into energy. */
 #include <math.h>
 
@@ -101,7 +101,7 @@ static void contact_post_solve(cpArbiter *arb, cpSpace *space, cpDataPointer dat
 		b->offset = cpvmult(b->offset, 1.0 / set.count);
 }
 
-void chipmunk_contact_install(struct bsim_world *w)
+void bsim_chipmunk_contact_install(struct bsim_world *w)
 {
 	cpCollisionHandler *h =
 	        cpSpaceAddCollisionHandler(w->space, CHIP_TYPE_BODY, CHIP_TYPE_BEAM);

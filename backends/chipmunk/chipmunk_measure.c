@@ -1,7 +1,7 @@
 /* What the runner defines and the chipmunk backend reports (beamsim/state.h):
  * the energy flows of each substep, and at a step's end the contact flag and
  * the pivot drift. Kept here, apart from the world, in one function
- * (chipmunk_measure) and its helpers.
+ * (bsim_chipmunk_measure) and its helpers.
  *
  * Energy. A Chipmunk substep of h first moves every body with the velocity
  * it ends the last substep with (plus the position correction's bias
@@ -191,7 +191,7 @@ static void measure_flags(struct bsim_world *w)
 	w->n_pushed = 0;
 }
 
-void chipmunk_measure(struct bsim_world *w, double h, int last)
+void bsim_chipmunk_measure(struct bsim_world *w, double h, int last)
 {
 	if (h > 0.0)
 		measure_energy(w, h);

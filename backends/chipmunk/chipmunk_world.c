@@ -16,7 +16,7 @@
  *                      semi-axes a, b, scaled by 2 / (1 + cos(pi / K)) so
  *                      that its chords' midpoints lie as far inside the
  *                      ellipse as its vertices lie outside
- *                      (chipmunk_ellipse_polygon).
+ *                      (bsim_chipmunk_ellipse_polygon).
  *   beam i: dynamic, its origin and centre of gravity at the pivot P, angle
  *           a_i = sgn theta_i (sgn = +1 if the rest direction u0 has x >= 0:
  *           theta > 0 swings the tip forward, +y), one segment of radius 0
@@ -163,7 +163,7 @@ static void banner_swallow(void)
 
 /* ---- building ------------------------------------------------------------- */
 
-void chipmunk_ellipse_polygon(double a, double b, int n, cpVect *out)
+void bsim_chipmunk_ellipse_polygon(double a, double b, int n, cpVect *out)
 {
 	const double pi = 3.14159265358979323846;
 	const double s = 2.0 / (1.0 + cos(pi / n));
@@ -182,7 +182,7 @@ static cpShape *body_shape_new(const bsim_body_def *body, cpBody *b)
 		return cpSegmentShapeNew(b, cpv(-0.5 * body->length, 0.0),
 		                         cpv(0.5 * body->length, 0.0), body->radius);
 	cpVect ring[ELLIPSE_VERTICES];
-	chipmunk_ellipse_polygon(body->semi_axes[0], body->semi_axes[1], ELLIPSE_VERTICES, ring);
+	bsim_chipmunk_ellipse_polygon(body->semi_axes[0], body->semi_axes[1], ELLIPSE_VERTICES, ring);
 	return cpPolyShapeNew(b, ELLIPSE_VERTICES, ring, cpTransformIdentity, 0.0);
 }
 
@@ -244,7 +244,7 @@ static void world_build(struct bsim_world *w, const double x[2], const double v[
 		b->reported = 0;
 		b->impulse_step = b->impulse_reported = 0.0;
 	}
-	chipmunk_contact_install(w);
+	bsim_chipmunk_contact_install(w);
 
 	w->n_live = 0;
 	w->n_pushed = 0;
@@ -462,7 +462,7 @@ static int world_start(struct bsim_world *w, bsim_error *err)
 	w->n_typed = 0;
 	for (int i = 0; i < w->n_beams; i++)
 		w->contact_type[i] = BSIM_CONTACT_NONE;
-	chipmunk_measure(w, 0.0, 1);
+	bsim_chipmunk_measure(w, 0.0, 1);
 	return BSIM_OK;
 }
 
@@ -540,7 +540,7 @@ static int motion_in_range(const struct bsim_world *w)
 	return 1;
 }
 
-/* The body and the live beams before a substep (chipmunk_measure's "-"). */
+/* The body and the live beams before a substep (bsim_chipmunk_measure's "-"). */
 static void substep_start(struct bsim_world *w)
 {
 	w->x0 = cpBodyGetPosition(w->body);
@@ -592,7 +592,7 @@ static int chipmunk_step(bsim_world *w, const double force[2], double torque, do
 			w->diverged = 1;
 			return BSIM_OK;
 		}
-		chipmunk_measure(w, hs, k == w->substeps - 1);
+		bsim_chipmunk_measure(w, hs, k == w->substeps - 1);
 	}
 	return BSIM_OK;
 }

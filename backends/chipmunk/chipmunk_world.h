@@ -121,17 +121,17 @@ static inline void chipmunk_mark_live(struct bsim_world *w, int i)
 
 /* The ellipse of semi-axes a (along +x) and b as the body's polygon of n
  * vertices (chipmunk_world.c's head), into out[0 .. n). */
-void chipmunk_ellipse_polygon(double a, double b, int n, cpVect *out);
+void bsim_chipmunk_ellipse_polygon(double a, double b, int n, cpVect *out);
 
 /* The collision types of the body's shape and the beams' (set as the shapes
  * are made: setting one wakes a sleeping body), and their collision handler
  * (chipmunk_contact.c). */
 enum { CHIP_TYPE_BODY = 1, CHIP_TYPE_BEAM = 2 };
-void chipmunk_contact_install(struct bsim_world *w);
+void bsim_chipmunk_contact_install(struct bsim_world *w);
 
 /* What the runner defines, measured after a substep of h (chipmunk_measure.c):
  * the energy flows into w->energy; after the step's last substep (last),
  * the contact flag of every beam and the pivot drift. */
-void chipmunk_measure(struct bsim_world *w, double h, int last);
+void bsim_chipmunk_measure(struct bsim_world *w, double h, int last);
 
 #endif

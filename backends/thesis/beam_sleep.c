@@ -29,7 +29,7 @@
 #include "thesis/thesis.h"
 
 /* Inserts beam i into the ascending awake list. */
-void thesis_beam_wake(struct bsim_world *w, int i)
+void bsim_thesis_beam_wake(struct bsim_world *w, int i)
 {
 	if (w->is_awake[i])
 		return;
@@ -45,7 +45,7 @@ void thesis_beam_wake(struct bsim_world *w, int i)
 }
 
 /* Drops the beams that are exactly at rest and untouched from the list. */
-void thesis_awake_prune(struct bsim_world *w)
+void bsim_thesis_awake_prune(struct bsim_world *w)
 {
 	int m = 0;
 	for (int k = 0; k < w->n_awake; k++) {
@@ -60,7 +60,7 @@ void thesis_awake_prune(struct bsim_world *w)
 	w->n_awake = m;
 }
 
-void thesis_beams_sleep(struct bsim_world *w, double speed, double h)
+void bsim_thesis_beams_sleep(struct bsim_world *w, double speed, double h)
 {
 	for (int k = 0; k < w->n_awake; k++) {
 		int i = w->awake[k];

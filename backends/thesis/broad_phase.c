@@ -27,7 +27,7 @@
 
 #define BROAD_PHASE_MIN_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
 
-void thesis_grid_free(thesis_grid *g)
+void bsim_thesis_grid_free(thesis_grid *g)
 {
 	free(g->start);
 	free(g->items);
@@ -52,9 +52,9 @@ static void grid_cell_of(const thesis_grid *g, const double p[2], int *cx, int *
 	*cy = grid_index((p[1] - g->origin[1]) / g->cell, g->ny);
 }
 
-int thesis_grid_build(thesis_grid *g, const struct bsim_world *w)
+int bsim_thesis_grid_build(thesis_grid *g, const struct bsim_world *w)
 {
-	thesis_grid_free(g);
+	bsim_thesis_grid_free(g);
 	double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, reach = 0.0;
 	for (int i = 0; i < w->n_beams; i++) {
 		const thesis_beam *b = &w->beams[i];
@@ -80,7 +80,7 @@ int thesis_grid_build(thesis_grid *g, const struct bsim_world *w)
 	g->start = calloc(cells + 1, sizeof *g->start);
 	g->items = malloc((w->n_beams > 0 ? (size_t)w->n_beams : 1) * sizeof *g->items);
 	if (!g->start || !g->items) {
-		thesis_grid_free(g);
+		bsim_thesis_grid_free(g);
 		return -1;
 	}
 	/* Counting sort by cell keeps the beams of a cell in ascending order. */
@@ -93,7 +93,7 @@ int thesis_grid_build(thesis_grid *g, const struct bsim_world *w)
 		g->start[c + 1] += g->start[c];
 	int *fill = malloc((cells ? cells : 1) * sizeof *fill);
 	if (!fill) {
-		thesis_grid_free(g);
+		bsim_thesis_grid_free(g);
 		return -1;
 	}
 	for (size_t c = 0; c < cells; c++)
@@ -129,7 +129,7 @@ static void sort_small(int *v, int n)
 	}
 }
 
-/* Free flight among beams at rest (thesis_broad_phase_clear). A beam at
+/* Free flight among beams at rest (bsim_thesis_broad_phase_clear). A beam at
  * rest is its segment S_i from P_i along its rest direction u0_i, and the
  * body can touch it within a step only if its centre comes within R + m of
  * S_i (m: the step's margin). The room around a clear body: with its
@@ -170,7 +170,7 @@ static void clear_fill(struct bsim_world *w)
 
 /* With every beam at rest the step's margin is 2 h |v| + slop
  * (thesis_clear_margin bounds it). NaN or overflow: not clear. */
-int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h)
+int bsim_thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h)
 {
 	if (!w->broad_phase || w->n_beams > BROAD_PHASE_MIN_BEAMS)
 		return 0; /* broad_phase=0: every beam tested, for checking */
@@ -200,7 +200,7 @@ int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double
  * list may hold more, never fewer). A step then tests the few beams of the
  * list instead of the cells around the body. NaN fails every test: the
  * list is refilled, from a query that finds nothing, as before. */
-void thesis_near_forget(struct bsim_world *w)
+void bsim_thesis_near_forget(struct bsim_world *w)
 {
 	w->n_near = 0;
 	w->near_reach = 0.0;
@@ -284,7 +284,7 @@ static int candidates_within(struct bsim_world *w, double margin, int *sleeping_
 
 /* Fills w->candidates with the beams the step must test, in ascending
  * order; returns how many. */
-int thesis_broad_phase(struct bsim_world *w, double speed, double h)
+int bsim_thesis_broad_phase(struct bsim_world *w, double speed, double h)
 {
 	int sleeping_found;
 	int n = candidates_within(w, 2.0 * h * speed + w->slop, &sleeping_found);
@@ -294,7 +294,7 @@ int thesis_broad_phase(struct bsim_world *w, double speed, double h)
 }
 
 /* The same query with a margin of its own. Unsorted. */
-int thesis_broad_phase_near(struct bsim_world *w, double margin)
+int bsim_thesis_broad_phase_near(struct bsim_world *w, double margin)
 {
 	int found;
 	return candidates_within(w, margin, &found);

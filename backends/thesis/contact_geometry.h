@@ -76,7 +76,7 @@ static inline void thesis_beam_direction_of(const thesis_beam *b, double u[2])
 /* The state's raw facts of beam i (beamsim/state.h): its angle, angular
  * velocity, whether it was pushed in the step and the normal impulse it
  * took then (impulse, read where pushed), its direction, NaN where
- * it is neither pushed nor near (thesis_contact_near: the broad phase and
+ * it is neither pushed nor near (bsim_thesis_contact_near: the broad phase and
  * the last geometry bound it farther than BSIM_CONTACT_TOL, so no sine and
  * cosine); no pin (exact by construction: bsim_backend.exact_pins). A
  * near beam's direction is the next step's detection's too: kept (b->u). */
@@ -275,7 +275,7 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
 		if (w->shaped) {
 			double u[2];
 			thesis_beam_direction(b, u);
-			thesis_shape_geometry(w, b, u);
+			bsim_thesis_shape_geometry(w, b, u);
 		} else {
 			geometry_compute(b, w->x, 1);
 		}
@@ -297,7 +297,7 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
 		}
 	}
 	if (w->shaped && g->has2)
-		return 1 + thesis_shape_second(w, g, margin, out);
+		return 1 + bsim_thesis_shape_second(w, g, margin, out);
 	return 1;
 }
 

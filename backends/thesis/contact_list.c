@@ -7,11 +7,11 @@
  * the state reports as touched). So after each step the world wakes, and
  * its state lists, the pushed beams and those the broad phase finds within
  * L + R + 6 mm of the body, minus those whose last geometry bounds them
- * farther (thesis_contact_near: no trigonometry). A beam woken at rest
+ * farther (bsim_thesis_contact_near: no trigonometry). A beam woken at rest
  * stays at rest (nothing acts on it) and is pruned again once it is
  * neither near nor touching: waking moves nothing.
  *
- * A step in free flight (thesis_broad_phase_clear, whose margin includes
+ * A step in free flight (bsim_thesis_broad_phase_clear, whose margin includes
  * BSIM_CONTACT_TOL) ends more than 6 mm from every beam and pushes none,
  * so it lists nothing. */
 #include "beamsim/contact_flag.h"
@@ -21,24 +21,24 @@
  * essay's disk's copy without the shape's test. */
 THESIS_SPECIALISED void contact_list_beams(struct bsim_world *w, const int extended)
 {
-	int n = thesis_broad_phase_near(w, BSIM_CONTACT_TOL);
+	int n = bsim_thesis_broad_phase_near(w, BSIM_CONTACT_TOL);
 	for (int k = 0; k < n; k++) {
 		int i = w->candidates[k];
 		if (!w->is_awake[i] &&
-		    (extended ? thesis_contact_near(w, i, BSIM_CONTACT_TOL)
-		              : thesis_contact_near_disk(w, i, BSIM_CONTACT_TOL)))
-			thesis_beam_wake(w, i);
+		    (extended ? bsim_thesis_contact_near(w, i, BSIM_CONTACT_TOL)
+		              : bsim_thesis_contact_near_disk(w, i, BSIM_CONTACT_TOL)))
+			bsim_thesis_beam_wake(w, i);
 	}
 	for (int k = 0; k < w->n_pushed; k++)
-		thesis_beam_wake(w, w->pushed_list[k]);
+		bsim_thesis_beam_wake(w, w->pushed_list[k]);
 }
 
-void thesis_contact_list(struct bsim_world *w)
+void bsim_thesis_contact_list(struct bsim_world *w)
 {
 	contact_list_beams(w, 1);
 }
 
-void thesis_contact_list_disk(struct bsim_world *w)
+void bsim_thesis_contact_list_disk(struct bsim_world *w)
 {
 	contact_list_beams(w, 0);
 }

@@ -243,7 +243,7 @@ static void gauss_seidel(double inv_mass, double inv_j, thesis_contact *cs, int 
 	}
 }
 
-int thesis_contact_solve(double inv_mass, double inv_j, thesis_contact *cs, int n)
+int bsim_thesis_contact_solve(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	int friction = 0;
 	for (int i = 0; i < n; i++) {
@@ -251,7 +251,7 @@ int thesis_contact_solve(double inv_mass, double inv_j, thesis_contact *cs, int 
 		friction |= cs[i].mu > 0.0;
 	}
 	if (!friction)
-		return thesis_lcp_solve_j(inv_mass, inv_j, cs, n);
+		return bsim_thesis_lcp_solve_j(inv_mass, inv_j, cs, n);
 	if (n <= FRICTION_EXACT_MAX) {
 		int m = 2 * n;
 		double k[FRICTION_ROWS * FRICTION_ROWS], q[FRICTION_ROWS], qmax = 0.0;
@@ -268,7 +268,7 @@ int thesis_contact_solve(double inv_mass, double inv_j, thesis_contact *cs, int 
 	return 1;
 }
 
-void thesis_impulse_sum_extended(const thesis_contact *cs, int n, double j[2], double *jw)
+void bsim_thesis_impulse_sum_extended(const thesis_contact *cs, int n, double j[2], double *jw)
 {
 	thesis_impulse_sum(cs, n, j);
 	*jw = 0.0;

@@ -60,7 +60,7 @@ THESIS_SPECIALISED void impact_apply(struct bsim_world *w, const thesis_contact 
 {
 	double j[2], jw = 0.0;
 	if (extended && w->extended)
-		thesis_impulse_sum_extended(cs, n, j, &jw);
+		bsim_thesis_impulse_sum_extended(cs, n, j, &jw);
 	else
 		thesis_impulse_sum(cs, n, j);
 	w->v[0] += j[0] * w->impact_inv_mass;
@@ -109,7 +109,7 @@ static double impact_energy_change(const struct bsim_world *w, const thesis_cont
 static int impact_solve_friction(struct bsim_world *w, thesis_contact *cs, int n)
 {
 	double inv_j = w->inv_body_inertia;
-	int inexact = thesis_contact_solve(w->impact_inv_mass, inv_j, cs, n);
+	int inexact = bsim_thesis_contact_solve(w->impact_inv_mass, inv_j, cs, n);
 	double pn[IMPACT_CONTACTS_MAX], pt[IMPACT_CONTACTS_MAX];
 	if (n > IMPACT_CONTACTS_MAX)
 		return inexact;
@@ -124,7 +124,7 @@ static int impact_solve_friction(struct bsim_world *w, thesis_contact *cs, int n
 		bound[i] = cs[i].bound;
 		cs[i].bound = 0.0;
 	}
-	inexact |= thesis_contact_solve(w->impact_inv_mass, inv_j, cs, n);
+	inexact |= bsim_thesis_contact_solve(w->impact_inv_mass, inv_j, cs, n);
 	double p0n[IMPACT_CONTACTS_MAX], p0t[IMPACT_CONTACTS_MAX], dn[IMPACT_CONTACTS_MAX],
 	        dt[IMPACT_CONTACTS_MAX];
 	for (int i = 0; i < n; i++) {
@@ -167,10 +167,10 @@ THESIS_SPECIALISED int impact_solve(struct bsim_world *w, thesis_contact *cs, in
                                     const int extended)
 {
 	if (!(extended && w->extended))
-		return thesis_lcp_solve(w->impact_inv_mass, cs, n);
+		return bsim_thesis_lcp_solve(w->impact_inv_mass, cs, n);
 	if (w->friction > 0.0)
 		return impact_solve_friction(w, cs, n);
-	return thesis_contact_solve(w->impact_inv_mass, w->inv_body_inertia, cs, n);
+	return bsim_thesis_contact_solve(w->impact_inv_mass, w->inv_body_inertia, cs, n);
 }
 
 /* Passes of the nearest-first order at most, and the approach speed, m/s,
@@ -231,12 +231,12 @@ THESIS_SPECIALISED int impact_resolve(struct bsim_world *w, double h, const int 
 	return 1;
 }
 
-int thesis_impact_resolve(struct bsim_world *w, double h)
+int bsim_thesis_impact_resolve(struct bsim_world *w, double h)
 {
 	return impact_resolve(w, h, 1);
 }
 
-int thesis_impact_resolve_disk(struct bsim_world *w, double h)
+int bsim_thesis_impact_resolve_disk(struct bsim_world *w, double h)
 {
 	return impact_resolve(w, h, 0);
 }

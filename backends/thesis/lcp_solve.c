@@ -22,7 +22,7 @@
  * pivot, an S with K_SS singular is skipped and the solution with linearly
  * independent rows is found). Beyond that, or if round-off leaves no set
  * within tolerance, projected Gauss-Seidel iterates to convergence; each
- * such solve is counted (thesis_lcp_fallbacks), and one that reaches its
+ * such solve is counted (bsim_thesis_lcp_fallbacks), and one that reaches its
  * iteration limit first is reported to the caller, which counts it in the
  * world's solver counts. test_lattice checks both paths against the
  * complementarity conditions. */
@@ -146,7 +146,7 @@ THESIS_SPECIALISED int lcp_enumerate(double inv_mass, double inv_j, thesis_conta
 
 static long lcp_fallbacks;
 
-long thesis_lcp_fallbacks(void)
+long bsim_thesis_lcp_fallbacks(void)
 {
 	long n;
 #pragma omp atomic read
@@ -171,12 +171,12 @@ THESIS_SPECIALISED int lcp_solve(double inv_mass, double inv_j, thesis_contact *
 	return 0;
 }
 
-int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n)
+int bsim_thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n)
 {
 	return lcp_solve(inv_mass, 0.0, cs, n, 0);
 }
 
-int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n)
+int bsim_thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n)
 {
 	return lcp_solve(inv_mass, inv_j, cs, n, 1);
 }

@@ -69,8 +69,8 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 	double j[2] = {0.0, 0.0}, jw = 0.0;
 	if (n) {
 		w->solver.iteration_limit +=
-		        thesis_contact_solve(w->inv_mass, w->inv_body_inertia, cs, n);
-		thesis_impulse_sum_extended(cs, n, j, &jw);
+		        bsim_thesis_contact_solve(w->inv_mass, w->inv_body_inertia, cs, n);
+		bsim_thesis_impulse_sum_extended(cs, n, j, &jw);
 	}
 	double vm[2];
 	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
@@ -125,16 +125,16 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 	}
 }
 
-void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
+void bsim_thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
                                      double h)
 {
 	if (w->extended)
 		persistent_solve_extended(w, force, torque, h);
 	else
-		thesis_persistent_contact_solve_disk(w, force, h);
+		bsim_thesis_persistent_contact_solve_disk(w, force, h);
 }
 
-void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2], double h)
+void bsim_thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2], double h)
 {
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
@@ -147,7 +147,7 @@ void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double for
 	 * 0 (thesis_impulse_sum's start), added as it would be. */
 	double j[2] = {0.0, 0.0};
 	if (n) {
-		w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
+		w->solver.iteration_limit += bsim_thesis_lcp_solve(w->inv_mass, cs, n);
 		thesis_impulse_sum(cs, n, j);
 	}
 	double vm[2];

@@ -28,9 +28,9 @@ THESIS_SPECIALISED void project_once(struct bsim_world *w, thesis_contact *cs, i
 	}
 	if (extended && w->extended)
 		w->solver.iteration_limit +=
-		        thesis_lcp_solve_j(w->inv_mass, w->inv_body_inertia, cs, n);
+		        bsim_thesis_lcp_solve_j(w->inv_mass, w->inv_body_inertia, cs, n);
 	else
-		w->solver.iteration_limit += thesis_lcp_solve(w->inv_mass, cs, n);
+		w->solver.iteration_limit += bsim_thesis_lcp_solve(w->inv_mass, cs, n);
 	if (extended && w->rotates) {
 		double dpsi = 0.0;
 		for (int k = 0; k < n; k++)
@@ -52,13 +52,13 @@ THESIS_SPECIALISED int redetect(struct bsim_world *w, thesis_contact *cs, int n,
 	if (!extended) { /* the essay's disk */
 		int m = 0;
 		for (int k = 0; k < n; k++)
-			m += thesis_contact_redetect_disk(w, cs[k].beam, margin, &cs[m]);
+			m += bsim_thesis_contact_redetect_disk(w, cs[k].beam, margin, &cs[m]);
 		return m;
 	}
 	if (!w->shaped) { /* one contact a beam: in place, in order */
 		int m = 0;
 		for (int k = 0; k < n; k++)
-			m += thesis_contact_detect(w, cs[k].beam, margin, &cs[m]);
+			m += bsim_thesis_contact_detect(w, cs[k].beam, margin, &cs[m]);
 		return m;
 	}
 	int nb = 0;
@@ -71,7 +71,7 @@ THESIS_SPECIALISED int redetect(struct bsim_world *w, thesis_contact *cs, int n,
 	}
 	int m = 0;
 	for (int q = 0; q < nb; q++)
-		m += thesis_contact_detect(w, w->candidates[q], margin, &cs[m]);
+		m += bsim_thesis_contact_detect(w, w->candidates[q], margin, &cs[m]);
 	return m;
 }
 
@@ -93,12 +93,12 @@ THESIS_SPECIALISED void position_project(struct bsim_world *w, const double forc
 			w->contact_type[cs[k].beam] = cs[k].type;
 }
 
-void thesis_position_project(struct bsim_world *w, const double force[2], double torque)
+void bsim_thesis_position_project(struct bsim_world *w, const double force[2], double torque)
 {
 	position_project(w, force, torque, 1);
 }
 
-void thesis_position_project_disk(struct bsim_world *w, const double force[2])
+void bsim_thesis_position_project_disk(struct bsim_world *w, const double force[2])
 {
 	position_project(w, force, 0.0, 0);
 }

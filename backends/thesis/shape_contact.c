@@ -113,7 +113,7 @@ static void capsule_pairs(const struct bsim_world *w, const thesis_beam *b, cons
 
 /* A body of another shape against the beam: b->geo (thesis.h, the head of
  * this file). */
-void thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const double u[2])
+void bsim_thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const double u[2])
 {
 	thesis_geometry *g = &b->geo;
 	double tip[2] = {b->p[0] + b->length * u[0], b->p[1] + b->length * u[1]};
@@ -145,7 +145,7 @@ void thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const dou
 		capsule_pairs(w, b, tip, g);
 }
 
-int thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
+int bsim_thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
                         thesis_contact *out)
 {
 	if (!(g->dist2 - w->radius <= margin))

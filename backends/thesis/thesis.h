@@ -160,7 +160,7 @@ struct bsim_world {
 	/* 1: the essay's disk (extended 0) with contact_mode physical, whose
 	 * free flight thesis_step takes at once. */
 	int flight_disk;
-	/* 1: a world the runs of steps take (thesis_steps_takes), once made. */
+	/* 1: a world the runs of steps take (bsim_thesis_steps_takes), once made. */
 	int steps_disk;
 	/* After a try at free flight that made no step (the body near a beam,
 	 * say), the steps left before the next try, and the wait after the last
@@ -219,7 +219,7 @@ struct bsim_world {
 	int n_near;
 	double near_x[2];  /* m */
 	double near_reach; /* m; 0: no cache */
-	/* The room of thesis_broad_phase_clear: every beam at rest lies
+	/* The room of bsim_thesis_broad_phase_clear: every beam at rest lies
 	 * farther than R + clear_room from clear_x (0: none known). */
 	double clear_x[2]; /* m */
 	double clear_room; /* m */
@@ -239,95 +239,95 @@ static inline void thesis_beam_touch(struct bsim_world *w, int i)
  * costs more than the few reach tests it would save (the essay's gate has
  * two beams), and the result is the same bit for bit. */
 #define THESIS_BROAD_PHASE_MIN_BEAMS 8
-void thesis_near_forget(struct bsim_world *w);
-int thesis_grid_build(thesis_grid *g, const struct bsim_world *w);
-void thesis_grid_free(thesis_grid *g);
-int thesis_broad_phase(struct bsim_world *w, double speed, double h);
+void bsim_thesis_near_forget(struct bsim_world *w);
+int bsim_thesis_grid_build(thesis_grid *g, const struct bsim_world *w);
+void bsim_thesis_grid_free(thesis_grid *g);
+int bsim_thesis_broad_phase(struct bsim_world *w, double speed, double h);
 /* Fills w->candidates with every beam whose pivot may be within L + R +
  * margin of the body's centre now (awake or not); returns how many. */
-int thesis_broad_phase_near(struct bsim_world *w, double margin);
+int bsim_thesis_broad_phase_near(struct bsim_world *w, double margin);
 /* 1 if no beam, all at rest, can reach the body this step (a world the
  * broad phase tests whole only; never with broad_phase=0); 0 if one may. */
-int thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h);
+int bsim_thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h);
 
 /* thesis_flight.c: up to n steps of free flight under force, each state
  * into out[k]; returns how many (0: the next step is not one). */
-int thesis_flight(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out);
+int bsim_thesis_flight(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out);
 #define THESIS_FLIGHT_WAIT_MAX 64
 
-/* thesis_steps.c: runs of steps of advance, for the worlds thesis_steps_takes
+/* thesis_steps.c: runs of steps of advance, for the worlds bsim_thesis_steps_takes
  * (1: the essay's disk, physical contacts, simultaneous impacts, no
  * sleeping, at most THESIS_STEPS_BEAMS beams): n steps, each state into
  * out[k] (sized for the world's beams); returns n, 0 for another world. */
 #define THESIS_STEPS_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
-int thesis_steps_takes(const struct bsim_world *w);
-int thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out);
+int bsim_thesis_steps_takes(const struct bsim_world *w);
+int bsim_thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out);
 
 /* beam_sleep.c */
-void thesis_beam_wake(struct bsim_world *w, int i);
-void thesis_beams_sleep(struct bsim_world *w, double speed, double h);
-void thesis_awake_prune(struct bsim_world *w);
+void bsim_thesis_beam_wake(struct bsim_world *w, int i);
+void bsim_thesis_beams_sleep(struct bsim_world *w, double speed, double h);
+void bsim_thesis_awake_prune(struct bsim_world *w);
 
 /* contact_detect.c */
 /* The contacts of beam i within margin into out (room for 2); returns how
  * many (0, 1, or 2 for a capsule along the beam). */
-int thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out);
+int bsim_thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out);
 /* Each _disk function below: the same for the essay's disk (w->extended 0)
  * only, compiled without the extended path's tests and stores (a contact's
  * extended fields are not set); thesis_step picks once a step. */
-int thesis_contact_detect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out);
+int bsim_thesis_contact_detect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out);
 /* The same for a beam the step found in contact (the projection's
  * re-detection): disk_detect's near, the same result. */
-int thesis_contact_redetect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out);
+int bsim_thesis_contact_redetect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out);
 /* shape_contact.c: a body of another shape than the disk against beam b of
  * direction u (thesis_beam_direction), into b->geo; and a capsule's second contact with the beam of
  * geometry g into out[1] (out[0] the first) if within margin: 1, else 0. */
-void thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const double u[2]);
-int thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
+void bsim_thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const double u[2]);
+int bsim_thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
                         thesis_contact *out);
 /* 0 if beam i certainly lies farther than R + margin from the body (its
  * reach, or the bound from its last geometry), 1 if it may not. */
-int thesis_contact_near(const struct bsim_world *w, int i, double margin);
-int thesis_contact_near_disk(const struct bsim_world *w, int i, double margin);
+int bsim_thesis_contact_near(const struct bsim_world *w, int i, double margin);
+int bsim_thesis_contact_near_disk(const struct bsim_world *w, int i, double margin);
 
 /* contact_list.c: the beams listed for the contact flag after a step (or
  * at creation). */
-void thesis_contact_list(struct bsim_world *w);
-void thesis_contact_list_disk(struct bsim_world *w);
+void bsim_thesis_contact_list(struct bsim_world *w);
+void bsim_thesis_contact_list_disk(struct bsim_world *w);
 
 /* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
  * counts it in w->solver), else 0. inv_mass is the body's 1/M, 1/kg (for
  * impacts, 1/impact_mass). */
-int thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n);
-/* thesis_lcp_solve with the body's rotation: 1/J (inv_j) in K, and a
- * capsule's two contacts on one beam coupled; thesis_lcp_solve is the
+int bsim_thesis_lcp_solve(double inv_mass, thesis_contact *cs, int n);
+/* bsim_thesis_lcp_solve with the body's rotation: 1/J (inv_j) in K, and a
+ * capsule's two contacts on one beam coupled; bsim_thesis_lcp_solve is the
  * essay's disk's (neither). */
-int thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n);
+int bsim_thesis_lcp_solve_j(double inv_mass, double inv_j, thesis_contact *cs, int n);
 /* The same problem on the extended path: 1/J (the body's rotation, inv_j =
  * 0: none) in K, and with friction (any contact's mu > 0) the tangent rows
  * too (friction_solve.c); 1 if the solve was not exact (counted by the
  * caller in w->solver.iteration_limit). */
-int thesis_contact_solve(double inv_mass, double inv_j, thesis_contact *cs, int n);
+int bsim_thesis_contact_solve(double inv_mass, double inv_j, thesis_contact *cs, int n);
 /* The impulses' sum on the body: sum P_n n + P_t t (N s) into j, and their
  * moment sum P_n cb + P_t cbt (N m s) into *jw. */
-void thesis_impulse_sum_extended(const thesis_contact *cs, int n, double j[2], double *jw);
+void bsim_thesis_impulse_sum_extended(const thesis_contact *cs, int n, double j[2], double *jw);
 /* Solves with more than 2 contacts that fell back to Gauss-Seidel, all
  * worlds, since the program started. */
-long thesis_lcp_fallbacks(void);
+long bsim_thesis_lcp_fallbacks(void);
 
 /* impact_resolve.c */
-int thesis_impact_resolve(struct bsim_world *w, double h);
-int thesis_impact_resolve_disk(struct bsim_world *w, double h);
+int bsim_thesis_impact_resolve(struct bsim_world *w, double h);
+int bsim_thesis_impact_resolve_disk(struct bsim_world *w, double h);
 
 /* persistent_contact.c */
-void thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
+void bsim_thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
                                      double h);
-void thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2], double h);
+void bsim_thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2], double h);
 
 /* position_project.c; projections per step at most. */
 #define THESIS_PROJECT_PASSES_MAX 3
-void thesis_position_project(struct bsim_world *w, const double force[2], double torque);
-void thesis_position_project_disk(struct bsim_world *w, const double force[2]);
+void bsim_thesis_position_project(struct bsim_world *w, const double force[2], double torque);
+void bsim_thesis_position_project_disk(struct bsim_world *w, const double force[2]);
 
 /* The kinetic energy of body and beams, J; inline, so that the world
  * (thesis_world.c) and the impacts (impact_resolve.c) share it without
@@ -390,7 +390,7 @@ static inline double thesis_clear_margin(const struct bsim_world *w, const doubl
 	return 2.0 * (h * (speed * (1.0 + 1e-12))) + w->slop + BSIM_CONTACT_TOL;
 }
 
-/* thesis_broad_phase_clear with its room's test inline, so that a step in
+/* bsim_thesis_broad_phase_clear with its room's test inline, so that a step in
  * free flight is decided without a call: the same answer. */
 static inline int thesis_flight_clear(struct bsim_world *w, const double force[2], double h)
 {
@@ -399,7 +399,7 @@ static inline int thesis_flight_clear(struct bsim_world *w, const double force[2
 	                    thesis_clear_margin(w, force, h) <
 	            w->clear_room)
 		return 1;
-	return thesis_broad_phase_clear(w, force, h);
+	return bsim_thesis_broad_phase_clear(w, force, h);
 }
 
 /* Beam i exchanged a nonzero normal impulse (N s) with the body in this

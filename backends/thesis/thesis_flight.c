@@ -13,7 +13,7 @@
  * test hold for the whole run and are asked once; the room test is asked
  * before every step, as thesis_step asks it: its inline part here on the
  * body held in locals (the same operations, the force's part of the
- * margin computed once), and where that fails thesis_broad_phase_clear,
+ * margin computed once), and where that fails bsim_thesis_broad_phase_clear,
  * which asks it again and then tests the beams, as thesis_flight_clear
  * does. (A world that the room test cannot serve, broad_phase=0 or more
  * than THESIS_BROAD_PHASE_MIN_BEAMS beams, is never clear: no run.)
@@ -29,7 +29,7 @@
 
 #include "thesis/thesis.h"
 
-int thesis_flight(bsim_world *w, const double force[2], double h, int n, bsim_state *out)
+int bsim_thesis_flight(bsim_world *w, const double force[2], double h, int n, bsim_state *out)
 {
 	if (w->n_awake || w->n_typed || w->contact_mode == THESIS_CONTACT_ESSAY || w->rotates ||
 	    !w->broad_phase || w->n_beams > THESIS_BROAD_PHASE_MIN_BEAMS)
@@ -73,7 +73,7 @@ int thesis_flight(bsim_world *w, const double force[2], double h, int n, bsim_st
 				w->x[1] = x1;
 				w->v[0] = v0;
 				w->v[1] = v1;
-				if (!thesis_broad_phase_clear(w, force, h))
+				if (!bsim_thesis_broad_phase_clear(w, force, h))
 					break;
 				cx0 = w->clear_x[0];
 				cx1 = w->clear_x[1];

@@ -51,7 +51,7 @@ static inline int gate_in(unsigned m, int i)
 	return (m >> i) & 1u;
 }
 
-int thesis_steps_takes(const struct bsim_world *w)
+int bsim_thesis_steps_takes(const struct bsim_world *w)
 {
 	return !w->extended && w->contact_mode == THESIS_CONTACT_PHYSICAL &&
 	       w->impact_order == THESIS_SIMULTANEOUS && !w->sleep &&
@@ -70,11 +70,11 @@ static inline double gate_kinetic(const struct bsim_world *w, int nb)
 	return e;
 }
 
-/* thesis_lcp_solve for the disk, one or two contacts inline. */
+/* bsim_thesis_lcp_solve for the disk, one or two contacts inline. */
 static inline int gate_lcp(double inv_mass, thesis_contact *cs, int n)
 {
 	if (n > 2)
-		return thesis_lcp_solve(inv_mass, cs, n);
+		return bsim_thesis_lcp_solve(inv_mass, cs, n);
 	thesis_lcp_small(inv_mass, 0.0, cs, n, 0);
 	return 0;
 }
@@ -127,7 +127,7 @@ static inline void gate_impacts(struct bsim_world *w, double h, int nc, unsigned
 	*e_impact += ke - gate_kinetic(w, nb);
 }
 
-/* persistent_contact.c's thesis_persistent_contact_solve_disk: the
+/* persistent_contact.c's bsim_thesis_persistent_contact_solve_disk: the
  * contacts' solve, the body's advance, the awake beams' (mask) advance;
  * the dampers' and contacts' energies into e_damper, e_contact.
  * integrator: w->integrator, a constant where the caller gives one. */
@@ -245,7 +245,7 @@ THESIS_SPECIALISED void gate_step(struct bsim_world *w, const double force[2], d
 	for (int k = 0; k < n; k++)
 		if (w->contacts[k].gap <= w->contact_tol)
 			mk->typed |= 1u << w->contacts[k].beam;
-	/* thesis_awake_prune */
+	/* bsim_thesis_awake_prune */
 	for (int i = 0; i < nb; i++) {
 		const thesis_beam *b = &w->beams[i];
 		if (gate_in(mk->awake, i) && b->theta == 0.0 && b->omega == 0.0 &&
@@ -332,7 +332,7 @@ THESIS_SPECIALISED void gate_run(struct bsim_world *w, const double force[2], do
 	w->impacts = out[n - 1].impacts;
 }
 
-int thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out)
+int bsim_thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out)
 {
 	if (n < 1 || !w->steps_disk || out[0].n_beams != w->n_beams)
 		return 0;

@@ -175,7 +175,7 @@ static void thesis_destroy(bsim_world *w)
 	free(w->touched_list);
 	free(w->start_awake);
 	free(w->near);
-	thesis_grid_free(&w->grid);
+	bsim_thesis_grid_free(&w->grid);
 	free(w->held);
 	free(w);
 }
@@ -292,7 +292,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	int sleep = bsim_options_choice(opts, &thesis_knobs[KNOB_SLEEP]);
 	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
 	w->sleep_energy = bsim_options_double(opts, &thesis_knobs[KNOB_SLEEP_ENERGY]);
-	w->steps_disk = thesis_steps_takes(w);
+	w->steps_disk = bsim_thesis_steps_takes(w);
 	if (!(w->sleep_energy >= 0.0) || !isfinite(w->sleep_energy)) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -310,13 +310,13 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 	for (int i = 0; i < w->n_beams; i++)
 		if (w->beams[i].theta != 0.0 || w->beams[i].omega != 0.0) {
 			w->start_awake[w->n_start_awake++] = i;
-			thesis_beam_wake(w, i);
+			bsim_thesis_beam_wake(w, i);
 		}
-	if (w->broad_phase && thesis_grid_build(&w->grid, w)) {
+	if (w->broad_phase && bsim_thesis_grid_build(&w->grid, w)) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
-	thesis_contact_list(w); /* a body that starts touching a beam */
+	bsim_thesis_contact_list(w); /* a body that starts touching a beam */
 	*out = w;
 	return BSIM_OK;
 }
@@ -370,10 +370,10 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
 	memset(&w->solver, 0, sizeof w->solver);
-	thesis_near_forget(w);
+	bsim_thesis_near_forget(w);
 	for (int k = 0; k < w->n_start_awake; k++)
-		thesis_beam_wake(w, w->start_awake[k]);
-	thesis_contact_list(w); /* a body that starts touching a beam */
+		bsim_thesis_beam_wake(w, w->start_awake[k]);
+	bsim_thesis_contact_list(w); /* a body that starts touching a beam */
 	return BSIM_OK;
 }
 
@@ -407,17 +407,17 @@ THESIS_SPECIALISED int step_detect(bsim_world *w, const double force[2], double 
 		v += w->radius *
 		     (fabs(w->angular_velocity) + h * fabs(torque) * w->inv_body_inertia);
 	int holding = w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
-	int m = thesis_broad_phase(w, v, h);
+	int m = bsim_thesis_broad_phase(w, v, h);
 	int n = 0;
 	for (int k = 0; k < m; k++) {
 		int i = w->candidates[k];
 		if (holding && !w->held[i])
 			continue; /* essay: the constraint loop tests only held beams */
 		double margin = thesis_step_margin(w, &w->beams[i], v, h);
-		int got = extended ? thesis_contact_detect(w, i, margin, &w->contacts[n])
-		                   : thesis_contact_detect_disk(w, i, margin, &w->contacts[n]);
+		int got = extended ? bsim_thesis_contact_detect(w, i, margin, &w->contacts[n])
+		                   : bsim_thesis_contact_detect_disk(w, i, margin, &w->contacts[n]);
 		if (got)
-			thesis_beam_wake(w, i);
+			bsim_thesis_beam_wake(w, i);
 		n += got;
 	}
 	*speed = v;
@@ -425,7 +425,7 @@ THESIS_SPECIALISED int step_detect(bsim_world *w, const double force[2], double 
 }
 
 /* A step in free flight among beams at rest (none awake or typed, none in
- * reach: thesis_broad_phase_clear, which the caller asked) for the step
+ * reach: bsim_thesis_broad_phase_clear, which the caller asked) for the step
  * size the beams are prepared for: what thesis_step does then, without its
  * general path. No contact: no impact, no projection, nothing held; the
  * contact solve's body update with a zero impulse sum (thesis_body_advance,
@@ -466,21 +466,21 @@ THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double tor
 	w->n_contacts = n;
 	if (n) {
 		if (extended)
-			thesis_impact_resolve(w, h);
+			bsim_thesis_impact_resolve(w, h);
 		else
-			thesis_impact_resolve_disk(w, h);
+			bsim_thesis_impact_resolve_disk(w, h);
 	}
 	if (extended)
-		thesis_persistent_contact_solve(w, force, torque, h);
+		bsim_thesis_persistent_contact_solve(w, force, torque, h);
 	else
-		thesis_persistent_contact_solve_disk(w, force, h);
+		bsim_thesis_persistent_contact_solve_disk(w, force, h);
 	if (w->contact_mode == THESIS_CONTACT_ESSAY)
 		w->any_held = essay_hold(w);
 	if (n) {
 		if (extended)
-			thesis_position_project(w, force, torque);
+			bsim_thesis_position_project(w, force, torque);
 		else
-			thesis_position_project_disk(w, force);
+			bsim_thesis_position_project_disk(w, force);
 	}
 	/* A beam's two contacts (a capsule along it) are adjacent: listed once. */
 	for (int k = 0; k < w->n_contacts; k++)
@@ -489,14 +489,14 @@ THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double tor
 			w->typed[w->n_typed++] = w->contacts[k].beam;
 	if (!in_flight) {
 		if (w->sleep)
-			thesis_beams_sleep(w, speed, h);
-		thesis_awake_prune(w);
+			bsim_thesis_beams_sleep(w, speed, h);
+		bsim_thesis_awake_prune(w);
 	}
 	/* in flight nothing is in reach: nothing to list */
 	if (!in_flight && extended)
-		thesis_contact_list(w);
+		bsim_thesis_contact_list(w);
 	else if (!in_flight)
-		thesis_contact_list_disk(w);
+		bsim_thesis_contact_list_disk(w);
 	return BSIM_OK;
 }
 
@@ -546,7 +546,7 @@ THESIS_APART void thesis_get_state(const bsim_world *w, bsim_state *s)
 	for (int k = 0; k < s->n_active; k++) {
 		int i = s->active[k];
 		thesis_state_beam(cache, i, w->pushed[i], w->impulse[i],
-		                  thesis_contact_near(w, i, BSIM_CONTACT_TOL), s);
+		                  bsim_thesis_contact_near(w, i, BSIM_CONTACT_TOL), s);
 	}
 	s->energy = w->energy;
 	s->impacts = w->impacts;
@@ -592,7 +592,7 @@ static int thesis_advance(bsim_world *w, const double force[2], double torque, d
 		return rc;
 	}
 	if (out && w->flight_skip == 0 && w->n_awake == 0) {
-		int m = thesis_flight(w, force, h, n, out);
+		int m = bsim_thesis_flight(w, force, h, n, out);
 		if (m > 0) {
 			w->flight_wait = 0;
 			*made = m;
@@ -605,7 +605,7 @@ static int thesis_advance(bsim_world *w, const double force[2], double torque, d
 	}
 	int rc = BSIM_OK;
 	if (out && n > 1 && w->steps_disk && out[0].n_beams == w->n_beams)
-		*made = thesis_steps(w, force, h, n, out);
+		*made = bsim_thesis_steps(w, force, h, n, out);
 	else
 		rc = advance_each(w, force, torque, h, n, out, made, err);
 	w->flight_skip = w->flight_skip > *made ? w->flight_skip - *made : 0;
@@ -634,13 +634,13 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 		if (s->contact[i] != BSIM_CONTACT_NONE)
 			w->typed[w->n_typed++] = i;
 		if (s->theta[i] != 0.0 || s->omega[i] != 0.0 || s->contact[i] != BSIM_CONTACT_NONE)
-			thesis_beam_wake(w, i);
+			bsim_thesis_beam_wake(w, i);
 		w->held[i] = 0; /* a state has no loop: contact_mode=essay starts afresh */
 	}
 	w->any_held = 0;
 	w->flight_skip = w->flight_wait = 0;
 	w->touched_all = 1; /* every beam's angle set */
-	thesis_near_forget(w);
+	bsim_thesis_near_forget(w);
 	return BSIM_OK;
 }
 

@@ -406,7 +406,7 @@ static PyObject *py_backends(PyObject *self, PyObject *args)
 	return list;
 }
 
-/* text_check(what, text): None, or ValueError naming what if the str text
+/* bsim_text_check(what, text): None, or ValueError naming what if the str text
  * holds a NUL (pyb_text): the package's check of the arguments the
  * functions above take as C strings (paths, backends), whose own
  * conversion would refuse one without naming the argument. */
@@ -438,8 +438,8 @@ static PyMethodDef methods[] = {
          "the backends compiled in, by name; the first is the default"},
         {"register_backend", pyb_register_backend, METH_VARARGS,
          "register_backend(cls, name, description): a backend written in Python, its name"},
-        {"text_check", py_text_check, METH_VARARGS,
-         "text_check(what, text): ValueError naming what if text holds a NUL"},
+        {"bsim_text_check", py_text_check, METH_VARARGS,
+         "bsim_text_check(what, text): ValueError naming what if text holds a NUL"},
         {NULL, NULL, 0, NULL},
 };
 

@@ -40,7 +40,7 @@
 #include "util/figure.h"
 #include "util/survival.h"
 
-int escape_fit_line(const double *x, const double *y, const double *events, int n, escape_fit *out,
+int bsim_escape_fit_line(const double *x, const double *y, const double *events, int n, escape_fit *out,
                     bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
@@ -75,7 +75,7 @@ int escape_fit_line(const double *x, const double *y, const double *events, int 
 	return BSIM_OK;
 }
 
-const char *escape_fit_verdict(const escape_fit *f)
+const char *bsim_escape_fit_verdict(const escape_fit *f)
 {
 	const int rejected = f->p_poisson < ESCAPE_P_REJECT, little = f->r2 < ESCAPE_R2_LITTLE;
 	if (rejected && little)
@@ -102,7 +102,7 @@ static double beam_distance(const bsim_beam_def *b, const double c[2])
 	return hypot(d[0] - s * u[0], d[1] - s * u[1]);
 }
 
-double escape_contact_time(const bsim_scene *s)
+double bsim_escape_contact_time(const bsim_scene *s)
 {
 	const double a =
 	        s->effects.has_propulsion ? s->effects.propulsion_force / s->body.mass : 0.0;
@@ -217,7 +217,7 @@ static int write_csv(const char *stage, const esc_job *j, bsim_error *err)
 	      o.f);
 	for (int a = 0; a < e->n_axes; a++) {
 		fputc(',', o.f);
-		csv_field_write(o.f, e->axes[a].key);
+		bsim_csv_field_write(o.f, e->axes[a].key);
 	}
 	fputc('\n', o.f);
 	int idx[64];
@@ -247,7 +247,7 @@ static int write_csv(const char *stage, const esc_job *j, bsim_error *err)
 			bsim_experiment_group_index(e, k, idx);
 		for (int a = 0; a < e->n_axes && a < 64; a++) {
 			fputc(',', o.f);
-			csv_field_write(o.f, e->axes[a].values[idx[a]]);
+			bsim_csv_field_write(o.f, e->axes[a].values[idx[a]]);
 		}
 		fputc('\n', o.f);
 	}
@@ -286,7 +286,7 @@ static int write_json(const char *stage, const esc_job *j, bsim_error *err)
 	json_num(o.f, "p_poisson", s->fitted ? f->p_poisson : NAN, ",");
 	fprintf(o.f, "  \"verdict\": ");
 	if (s->fitted)
-		fprintf(o.f, "\"%s\"\n", escape_fit_verdict(f));
+		fprintf(o.f, "\"%s\"\n", bsim_escape_fit_verdict(f));
 	else
 		fprintf(o.f, "null\n");
 	fputs("}\n", o.f);
@@ -419,7 +419,7 @@ static int measure(const escape_def *def, const bsim_sweep_dir_result *res, esc_
 		                   ? s.effects.random_magnitude * s.effects.random_magnitude /
 		                             s.effects.random_frequency
 		                   : 0.0;
-		g->t0 = escape_contact_time(&s);
+		g->t0 = bsim_escape_contact_time(&s);
 		bsim_scene_free(&s);
 		for (int t = 0; t < e->trials; t++) {
 			const bsim_trial_result *r = &res->r.trials_out[(size_t)k * e->trials + t];
@@ -429,7 +429,7 @@ static int measure(const escape_def *def, const bsim_sweep_dir_result *res, esc_
 			g->early += r->outcome == BSIM_SIDE_EXIT && r->t_end < g->t0;
 			g->exposure += fmax(0.0, r->t_end - g->t0);
 		}
-		survival_rate(g->traversed, g->exposure, &g->rate, &g->lo, &g->hi);
+		bsim_survival_rate(g->traversed, g->exposure, &g->rate, &g->lo, &g->hi);
 		g->exit_rate = g->exposure > 0.0
 		                       ? (double)(g->traversed + g->side_exit) / g->exposure
 		                       : NAN;
@@ -437,7 +437,7 @@ static int measure(const escape_def *def, const bsim_sweep_dir_result *res, esc_
 	return rc;
 }
 
-int escape_run(const escape_def *def, escape_summary *sum, bsim_error *err)
+int bsim_escape_run(const escape_def *def, escape_summary *sum, bsim_error *err)
 {
 	memset(sum, 0, sizeof *sum);
 	bsim_sweep_dir_result res;
@@ -481,7 +481,7 @@ int escape_run(const escape_def *def, escape_summary *sum, bsim_error *err)
 	sum->used = n;
 	if (rc == BSIM_OK) {
 		bsim_error fe;
-		sum->fitted = escape_fit_line(x, y, w, n, &sum->fit, &fe) == BSIM_OK;
+		sum->fitted = bsim_escape_fit_line(x, y, w, n, &sum->fit, &fe) == BSIM_OK;
 		for (int i = 0; sum->fitted && i < n; i++) {
 			esc_group *g = &gs[at[i]];
 			g->fit = sum->fit.a + sum->fit.b * g->x;

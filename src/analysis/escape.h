@@ -33,7 +33,7 @@ typedef struct escape_fit {
 /* Fits y = a + b x over n points (events[i] the Poisson weight of point i
  * for chisq_poisson; may be NULL). BSIM_EINPUT under 3 points or without
  * spread in x. */
-int escape_fit_line(const double *x, const double *y, const double *events, int n, escape_fit *out,
+int bsim_escape_fit_line(const double *x, const double *y, const double *events, int n, escape_fit *out,
                     bsim_error *err);
 
 /* What the fit f says of the data, in a sentence (a constant string): the
@@ -42,12 +42,12 @@ int escape_fit_line(const double *x, const double *y, const double *events, int 
  * R^2 < ESCAPE_R2_LITTLE; k0 and c then do not describe the groups. */
 #define ESCAPE_P_REJECT  0.01
 #define ESCAPE_R2_LITTLE 0.5
-const char *escape_fit_verdict(const escape_fit *f);
+const char *bsim_escape_fit_verdict(const escape_fit *f);
 
 /* s, the time the body of scene s, pushed by its propulsion from its start
  * velocity, first touches a beam at rest (the lateral random force does not
  * move it forward): 0 if it starts touching or is never pushed forward. */
-double escape_contact_time(const bsim_scene *s);
+double bsim_escape_contact_time(const bsim_scene *s);
 
 /* The options of bsim escape: the landscape grid the barriers are searched
  * on. */
@@ -68,6 +68,6 @@ typedef struct escape_summary {
 /* Reads the sweep in def->dir, searches each distinct scene's landscape,
  * fits and writes def->out as a set. BSIM_EINPUT for a directory that is
  * no sweep or a lattice sweep. */
-int escape_run(const escape_def *def, escape_summary *sum, bsim_error *err);
+int bsim_escape_run(const escape_def *def, escape_summary *sum, bsim_error *err);
 
 #endif

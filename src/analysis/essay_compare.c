@@ -617,7 +617,7 @@ static void sens_row(bsim_essay_sens_row *w, const essay_job *j, const char *mod
 	w->reaches = w->hi >= w->essay_value;
 }
 
-int essay_compare_batch(const bsim_essay_config *cfg, sweep_batch *sb, bsim_essay_result *out,
+int bsim_essay_compare_batch(const bsim_essay_config *cfg, sweep_batch *sb, bsim_essay_result *out,
                         bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
@@ -651,7 +651,7 @@ int essay_compare_batch(const bsim_essay_config *cfg, sweep_batch *sb, bsim_essa
 		sc[i].threads = cfg->threads;
 	}
 	if (rc == BSIM_OK)
-		rc = sweep_batch_run(sb, es, sc, n, res, err);
+		rc = bsim_sweep_batch_run(sb, es, sc, n, res, err);
 	rows r = {0};
 	bsim_essay_sens_row *sv = NULL;
 	int n_sens = 0;
@@ -704,5 +704,5 @@ int bsim_essay_compare_run(const bsim_essay_config *cfg, bsim_essay_result *out,
 	                  .progress = cfg->progress,
 	                  .progress_user = cfg->progress_user,
 	                  .stop = cfg->stop};
-	return essay_compare_batch(cfg, &sb, out, err);
+	return bsim_essay_compare_batch(cfg, &sb, out, err);
 }

@@ -7,10 +7,10 @@
 #include "beamsim/essay_compare.h"
 #include "store/sweep_batch.h"
 
-/* Runs every sweep of cfg through sb (sweep_batch_run) and, when sb->writes,
+/* Runs every sweep of cfg through sb (bsim_sweep_batch_run) and, when sb->writes,
  * fills out's rows; otherwise (a shard, another rank) out holds nothing.
- * The caller ends sb (sweep_batch_end). */
-int essay_compare_batch(const bsim_essay_config *cfg, sweep_batch *sb, bsim_essay_result *out,
+ * The caller ends sb (bsim_sweep_batch_end). */
+int bsim_essay_compare_batch(const bsim_essay_config *cfg, sweep_batch *sb, bsim_essay_result *out,
                         bsim_error *err);
 
 #endif

@@ -171,7 +171,7 @@ int bsim_essay_compare_store(const char *out, const bsim_essay_config *cfg, bsim
 	                  .progress = cfg->progress,
 	                  .progress_user = cfg->progress_user,
 	                  .stop = cfg->stop};
-	int rc = essay_compare_batch(cfg, &sb, res, err);
+	int rc = bsim_essay_compare_batch(cfg, &sb, res, err);
 	const char *stage = sb.ss.stage;
 	if (rc == BSIM_OK && sb.writes)
 		rc = write_table(stage, "essay", write_csv, res, err);
@@ -189,7 +189,7 @@ int bsim_essay_compare_store(const char *out, const bsim_essay_config *cfg, bsim
 		/* the tables are kept beside a figure gnuplot failed on */
 		rc = bsim_session_defer(&sb.ss, rc, fig->failed > 0, err);
 	}
-	rc = sweep_batch_end(&sb, rc, err);
+	rc = bsim_sweep_batch_end(&sb, rc, err);
 	if (rc != BSIM_OK) {
 		bsim_figures_result_free(fig);
 		bsim_essay_result_free(res);

@@ -95,7 +95,7 @@ int bsim_markov_bin_of(const bsim_markov_bins *b, const bsim_lattice_def *l, int
 /* A state drawn uniformly in entry bin (> 0): position on the edge, moved
  * inside by half a step's normal travel (the lattice sees an entry at the
  * end of the step that crossed). */
-void markov_bin_sample(const bsim_markov_bins *b, const bsim_lattice_def *l, double h, int bin,
+void bsim_markov_bin_sample(const bsim_markov_bins *b, const bsim_lattice_def *l, double h, int bin,
                        gsl_rng *rng, double x[2], double v[2])
 {
 	int k = bin - 1;
@@ -137,12 +137,12 @@ void markov_bin_sample(const bsim_markov_bins *b, const bsim_lattice_def *l, dou
 
 static const char *const edge_names[] = {"start", "bottom", "left", "right", "top"};
 
-const char *markov_edge_name(int edge)
+const char *bsim_markov_edge_name(int edge)
 {
 	return edge_names[edge];
 }
 
-const char *markov_bin_edge(const bsim_markov_bins *b, int bin)
+const char *bsim_markov_bin_edge(const bsim_markov_bins *b, int bin)
 {
 	if (bin == 0)
 		return edge_names[BSIM_EDGE_START];

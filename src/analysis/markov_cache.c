@@ -47,18 +47,18 @@ static uint64_t layout_hash(const bsim_scene *lattice)
 	const bsim_lattice_def *l = &lattice->lattice;
 	uint64_t h = HASH_FNV1A64_SEED;
 	int size[2] = {l->columns, l->rows};
-	h = hash_fnv1a64(size, sizeof size, h);
+	h = bsim_hash_fnv1a64(size, sizeof size, h);
 	for (int iy = 0; iy < l->rows; iy++)
 		for (int ix = l->ix_min; ix <= l->ix_max; ix++)
 			for (int side = 0; side < 2; side++) {
 				double k = lattice->beams[bsim_lattice_beam(l, ix, iy, side)]
 				                   .stiffness;
-				h = hash_fnv1a64(&k, sizeof k, h);
+				h = bsim_hash_fnv1a64(&k, sizeof k, h);
 			}
 	return h;
 }
 
-const char *markov_entries_label(const bsim_markov_def *def, const bsim_scene *lattice, char *buf,
+const char *bsim_markov_entries_label(const bsim_markov_def *def, const bsim_scene *lattice, char *buf,
                                  size_t size)
 {
 	if (def->entries)
@@ -113,11 +113,11 @@ static void markov_key_extra(FILE *f, const bsim_scene *s)
 }
 
 /* Every input of a map, a line each, numbers to the last bit (%.17g). */
-char *markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+char *bsim_markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
                       const bsim_options *opts, const double k[2])
 {
 	markov_gate_scene g;
-	markov_gate_scene_init(&g, lattice, k);
+	bsim_markov_gate_scene_init(&g, lattice, k);
 	const bsim_scene *s = &g.s;
 	char *text = NULL;
 	size_t size = 0;
@@ -148,7 +148,7 @@ char *markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, con
 	markov_key_extra(f, s);
 	fprintf(f, "dt %.17g gate_steps %d max_steps %d\n", s->dt, s->gate_steps, s->max_steps);
 	char label[64];
-	fprintf(f, "entries %s\n", markov_entries_label(def, lattice, label, sizeof label));
+	fprintf(f, "entries %s\n", bsim_markov_entries_label(def, lattice, label, sizeof label));
 	fprintf(f, "bins %d %d %d %.17g\ntrials %d\nseed %llu\n", def->bins.n_pos,
 	        def->bins.n_speed, def->bins.n_dir, def->bins.v_max, def->trials,
 	        (unsigned long long)def->seed);
@@ -159,9 +159,9 @@ char *markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, con
 	return text;
 }
 
-uint64_t markov_key(const char *key_text)
+uint64_t bsim_markov_key(const char *key_text)
 {
-	return hash_fnv1a64(key_text, strlen(key_text), HASH_FNV1A64_SEED);
+	return bsim_hash_fnv1a64(key_text, strlen(key_text), HASH_FNV1A64_SEED);
 }
 
 /* Whether path, a map's .key file, holds exactly key_text: a file that
@@ -172,10 +172,10 @@ static int key_same(const char *path, const char *key_text)
 	size_t len = strlen(key_text);
 	file_text t;
 	bsim_error ignored;
-	if (file_read(path, "a map key", (double)len, NULL, &t, &ignored) != BSIM_OK)
+	if (bsim_file_read(path, "a map key", (double)len, NULL, &t, &ignored) != BSIM_OK)
 		return 0;
 	int same = t.len == len && memcmp(t.text, key_text, len) == 0;
-	file_text_free(&t);
+	bsim_file_text_free(&t);
 	return same;
 }
 
@@ -189,10 +189,10 @@ static int map_file(const char *dir, const bsim_markov_map *m, const char *ext, 
 	*absent = lstat(path, &st) != 0 && errno == ENOENT;
 	if (*absent)
 		return BSIM_OK;
-	int rc = file_read(path, "a map file", max_bytes, NULL, t, err);
+	int rc = bsim_file_read(path, "a map file", max_bytes, NULL, t, err);
 	if (rc == BSIM_OK && strcmp(ext, "csv") == 0 &&
-	    (rc = csv_text_check(path, t->text, t->len, err)) != BSIM_OK)
-		file_text_free(t);
+	    (rc = bsim_csv_text_check(path, t->text, t->len, err)) != BSIM_OK)
+		bsim_file_text_free(t);
 	return rc;
 }
 
@@ -266,7 +266,7 @@ static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	while (!bad && u < units) {
 		line = nl + 1;
 		lineno++;
-		nl = strchr(line, '\n'); /* every line has one: csv_text_check */
+		nl = strchr(line, '\n'); /* every line has one: bsim_csv_text_check */
 		if (!nl) {
 			bad = 1;
 			break;
@@ -295,7 +295,7 @@ static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	for (long i = 0; !bad && i < (long)nb * nb; i++)
 		if (count[i] != m->counts[i])
 			bad = 2;
-	file_text_free(&t);
+	bsim_file_text_free(&t);
 	free(count);
 	if (bad) {
 		free(ex);
@@ -322,7 +322,7 @@ static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	return 1;
 }
 
-int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
+int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/map_%016llx.key", dir, (unsigned long long)m->key);
@@ -347,7 +347,7 @@ int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	if (!sum || !last) {
 		free(sum);
 		free(last);
-		file_text_free(&t);
+		bsim_file_text_free(&t);
 		bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
 		return -1;
 	}
@@ -357,7 +357,7 @@ int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	}
 	while (!bad && *(line = nl + 1)) {
 		lineno++;
-		nl = strchr(line, '\n'); /* every line has one: csv_text_check */
+		nl = strchr(line, '\n'); /* every line has one: bsim_csv_text_check */
 		*nl = '\0';
 		long v[3];
 		double p;
@@ -396,7 +396,7 @@ int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 		}
 	free(sum);
 	free(last);
-	file_text_free(&t);
+	bsim_file_text_free(&t);
 	if (bad) {
 		memset(m->counts, 0, (size_t)nb * nb * sizeof *m->counts);
 		bsim_error_set(err, BSIM_EINPUT, "%s:%d: %s: expected %s", path, lineno, bad, what);
@@ -422,7 +422,7 @@ int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 				m->steps = strtoll(s + 6, &e2, 10);
 			ok = e2 && !errno && (*e2 == '\0' || (*e2 == '\n' && !e2[1]));
 		}
-		file_text_free(&t);
+		bsim_file_text_free(&t);
 		if (!ok) {
 			snprintf(path, sizeof path, "%s/map_%016llx.cost", dir,
 			         (unsigned long long)m->key);
@@ -439,7 +439,7 @@ int markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	return hold_read(dir, m, err) < 0 ? -1 : 1;
 }
 
-int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_markov_bins *b,
+int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_markov_bins *b,
                      bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
@@ -462,8 +462,8 @@ int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_mar
 			int c = m->counts[(size_t)a * m->n_bins + x];
 			if (c == 0)
 				continue;
-			fprintf(o.f, "%d,%d,%d,%s,%s,%.9g\n", a, x, c, markov_bin_edge(b, a),
-			        x == 0 ? "stuck" : markov_bin_edge(b, x), (double)c / total);
+			fprintf(o.f, "%d,%d,%d,%s,%s,%.9g\n", a, x, c, bsim_markov_bin_edge(b, a),
+			        x == 0 ? "stuck" : bsim_markov_bin_edge(b, x), (double)c / total);
 		}
 	}
 	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
@@ -489,7 +489,7 @@ int markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_mar
 	return bsim_atomic_file_commit(&o, err);
 }
 
-int markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
+int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
                      const bsim_options *opts, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
@@ -515,7 +515,7 @@ int markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_b
 	}
 	fputs("], \"entries\": ", o.f);
 	char label[64];
-	bsim_json_string(o.f, markov_entries_label(def, NULL, label, sizeof label));
+	bsim_json_string(o.f, bsim_markov_entries_label(def, NULL, label, sizeof label));
 	fputs("}\n", o.f);
 	return bsim_atomic_file_commit(&o, err);
 }
@@ -526,8 +526,8 @@ static struct fy_node *def_field(const ydoc *d, const char *path, const char *wh
 {
 	struct fy_node *root = fy_document_root(d->fyd);
 	struct fy_node *n = root ? fy_node_by_path(root, path, -1, FYNWF_DONT_FOLLOW) : NULL;
-	if (!n || ydoc_is_null(n)) {
-		ydoc_expected(d, n, root, path + 1, what, err);
+	if (!n || bsim_ydoc_is_null(n)) {
+		bsim_ydoc_expected(d, n, root, path + 1, what, err);
 		return NULL;
 	}
 	return n;
@@ -541,8 +541,8 @@ static int def_int(const ydoc *d, const char *path, int lo, int hi, int *out, bs
 	long long v;
 	if (!n)
 		return BSIM_EINPUT;
-	if (!ydoc_int64(n, &v) || v < lo || v > hi)
-		return ydoc_expected(d, n, NULL, path + 1, what, err);
+	if (!bsim_ydoc_int64(n, &v) || v < lo || v > hi)
+		return bsim_ydoc_expected(d, n, NULL, path + 1, what, err);
 	*out = (int)v;
 	return BSIM_OK;
 }
@@ -555,15 +555,15 @@ static int def_string(const ydoc *d, const char *path, char *buf, size_t size, b
 		return BSIM_EINPUT;
 	const char *t = fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
 	if (!t || strlen(t) >= size)
-		return ydoc_expected(d, n, NULL, path + 1, "a short string", err);
+		return bsim_ydoc_expected(d, n, NULL, path + 1, "a short string", err);
 	snprintf(buf, size, "%s", t);
 	return BSIM_OK;
 }
 
 /* markov.json's def, read as JSON (a YAML flow document) with libfyaml:
- * every field markov_def_write writes, each fault naming its file position
+ * every field bsim_markov_def_write writes, each fault naming its file position
  * and field. */
-int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err)
+int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	/* The directory as its last build committed it: with a manifest,
@@ -581,7 +581,7 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 		return BSIM_EINPUT;
 	}
 	snprintf(path, sizeof path, "%s/markov.json", dir);
-	/* Without blocking: a FIFO there is refused by ydoc_load. */
+	/* Without blocking: a FIFO there is refused by bsim_ydoc_load. */
 	int probe = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
 	if (probe < 0)
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -591,7 +591,7 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 	close(probe);
 	memset(opts, 0, sizeof *opts);
 	ydoc d;
-	int rc = ydoc_load(&d, path, err);
+	int rc = bsim_ydoc_load(&d, path, err);
 	if (rc != BSIM_OK)
 		return rc;
 	int format = 0;
@@ -603,7 +603,7 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 	if (rc == BSIM_OK)
 		rc = def_string(&d, "/beamsim_version", version, sizeof version, err);
 	if (rc == BSIM_OK && strcmp(version, BSIM_VERSION) != 0)
-		rc = ydoc_fail(&d, def_field(&d, "/beamsim_version", "a string", err), NULL,
+		rc = bsim_ydoc_fail(&d, def_field(&d, "/beamsim_version", "a string", err), NULL,
 		               "beamsim_version", err,
 		               "expected maps of this beamsim, %s, got maps built by beamsim %s "
 		               "(build them again with beamsim markov build)",
@@ -617,8 +617,8 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 	if (rc == BSIM_OK) {
 		struct fy_node *n = def_field(&d, "/bins/v_max", "a speed > 0, m/s", err);
 		rc = !n ? BSIM_EINPUT
-		     : ydoc_number(n, &def->bins.v_max) != YDOC_NUM_OK || !(def->bins.v_max > 0)
-		             ? ydoc_expected(&d, n, NULL, "bins/v_max", "a speed > 0, m/s", err)
+		     : bsim_ydoc_number(n, &def->bins.v_max) != YDOC_NUM_OK || !(def->bins.v_max > 0)
+		             ? bsim_ydoc_expected(&d, n, NULL, "bins/v_max", "a speed > 0, m/s", err)
 		             : BSIM_OK;
 	}
 	if (rc == BSIM_OK)
@@ -632,7 +632,7 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 		seed = t && *t >= '0' && *t <= '9' ? strtoull(t, &end, 10) : 0;
 		rc = !n ? BSIM_EINPUT
 		     : !end || *end || errno
-		             ? ydoc_expected(&d, n, NULL, "seed", "a seed, an integer >= 0", err)
+		             ? bsim_ydoc_expected(&d, n, NULL, "seed", "a seed, an integer >= 0", err)
 		             : BSIM_OK;
 	}
 	if (rc == BSIM_OK)
@@ -642,18 +642,18 @@ int markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, b
 		if (!n)
 			rc = BSIM_EINPUT;
 		else if (!fy_node_is_sequence(n))
-			rc = ydoc_expected(&d, n, NULL, "options", "a list of \"KEY=VALUE\"", err);
+			rc = bsim_ydoc_expected(&d, n, NULL, "options", "a list of \"KEY=VALUE\"", err);
 		void *it = NULL;
 		struct fy_node *kv;
 		while (rc == BSIM_OK && (kv = fy_node_sequence_iterate(n, &it))) {
 			const char *t = fy_node_is_scalar(kv) ? fy_node_get_scalar0(kv) : NULL;
 			rc = t ? bsim_options_add(opts, t, err)
-			       : ydoc_expected(&d, kv, n, "options", "\"KEY=VALUE\"", err);
+			       : bsim_ydoc_expected(&d, kv, n, "options", "\"KEY=VALUE\"", err);
 		}
 	}
 	if (rc == BSIM_OK)
 		rc = def_string(&d, "/entries", id, sizeof id, err);
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	if (rc != BSIM_OK)
 		return rc;
 	if (strcmp(id, "none") != 0)

@@ -113,7 +113,7 @@ typedef struct chain {
 	double *p;
 } chain;
 
-void markov_exit_target(int cols, int rows, int nb, int g, int x, int *state, int *loc)
+void bsim_markov_exit_target(int cols, int rows, int nb, int g, int x, int *state, int *loc)
 {
 	const int ix = g % cols, iy = g / cols, per_edge = (nb - 1) / 4;
 	*state = -1;
@@ -155,7 +155,7 @@ void markov_exit_target(int cols, int rows, int nb, int g, int x, int *state, in
 
 static void target(const chain *c, int g, int x, int *state, int *loc)
 {
-	markov_exit_target(c->cols, c->rows, c->nb, g, x, state, loc);
+	bsim_markov_exit_target(c->cols, c->rows, c->nb, g, x, state, loc);
 }
 
 void bsim_markov_prediction_free(bsim_markov_prediction *p)
@@ -186,7 +186,7 @@ static void chain_free(chain *c, int n_maps)
 	free(c->p);
 }
 
-int markov_gate_maps(const bsim_scene *lattice, const bsim_markov_set *set, int *gate_map,
+int bsim_markov_gate_maps(const bsim_scene *lattice, const bsim_markov_set *set, int *gate_map,
                      bsim_error *err)
 {
 	const bsim_lattice_def *l = &lattice->lattice;
@@ -235,7 +235,7 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		c->has_time = i == 0 ? c->sm[i].hold != NULL : c->has_time && c->sm[i].hold;
 	}
-	if (markov_gate_maps(lattice, set, c->gate_map, err) != BSIM_OK)
+	if (bsim_markov_gate_maps(lattice, set, c->gate_map, err) != BSIM_OK)
 		return err->code;
 	if (!targets && c->n_states > BSIM_MARKOV_LU_MAX)
 		return BSIM_OK;

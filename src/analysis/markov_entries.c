@@ -79,19 +79,19 @@ int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entrie
 			break;
 		csv_table t;
 		int col[6];
-		if ((rc = csv_table_read(path, &t, err)) != BSIM_OK)
+		if ((rc = bsim_csv_table_read(path, &t, err)) != BSIM_OK)
 			break;
-		rc = csv_table_require(&t, path, want, 6, col, err);
+		rc = bsim_csv_table_require(&t, path, want, 6, col, err);
 		for (long r = 0; rc == BSIM_OK && r < t.n_rows; r++) {
-			const char *edge = csv_table_cell(&t, r, col[0]);
+			const char *edge = bsim_csv_table_cell(&t, r, col[0]);
 			int e = -1;
 			for (int k = 0; k < 5; k++)
-				if (strcmp(edge, markov_edge_name(k)) == 0)
+				if (strcmp(edge, bsim_markov_edge_name(k)) == 0)
 					e = k;
 			double val[6];
 			int bad = e < 0;
 			for (int k = 1; k < 6 && !bad; k++)
-				bad = csv_table_number(&t, r, col[k], &val[k]) != 0 ||
+				bad = bsim_csv_table_number(&t, r, col[k], &val[k]) != 0 ||
 				      !isfinite(val[k]);
 			if (bad) {
 				rc = bsim_error_set(
@@ -103,13 +103,13 @@ int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entrie
 			}
 			if (e == BSIM_EDGE_START)
 				continue;
-			h = hash_fnv1a64(&e, sizeof e, h);
-			h = hash_fnv1a64(val + 1, 5 * sizeof val[0], h);
+			h = bsim_hash_fnv1a64(&e, sizeof e, h);
+			h = bsim_hash_fnv1a64(val + 1, 5 * sizeof val[0], h);
 			const double x[2] = {val[2], val[3]}, v[2] = {val[4], val[5]};
 			if (entries_push(out, &cap, e, val[1], x, v))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
-		csv_table_free(&t);
+		bsim_csv_table_free(&t);
 	}
 	if (rc != BSIM_OK) {
 		bsim_markov_entries_free(out);
@@ -119,7 +119,7 @@ int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entrie
 	return BSIM_OK;
 }
 
-int markov_entry_index_init(markov_entry_index *x, const bsim_markov_entries *e,
+int bsim_markov_entry_index_init(markov_entry_index *x, const bsim_markov_entries *e,
                             const bsim_markov_bins *b, const bsim_lattice_def *l)
 {
 	const int nb = bsim_markov_bins_count(b);
@@ -148,7 +148,7 @@ int markov_entry_index_init(markov_entry_index *x, const bsim_markov_entries *e,
 	return 0;
 }
 
-void markov_entry_index_free(markov_entry_index *x)
+void bsim_markov_entry_index_free(markov_entry_index *x)
 {
 	free(x->first);
 	free(x->idx);

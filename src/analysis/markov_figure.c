@@ -28,7 +28,7 @@
 /* A cell's value is written in it from this probability (0.5%) on. */
 #define LABEL_FROM 0.005
 
-void markov_title_params(char *buf, size_t size, const char *backend, const bsim_override *ov,
+void bsim_markov_title_params(char *buf, size_t size, const char *backend, const bsim_override *ov,
                          int n)
 {
 	size_t k = 0;
@@ -68,7 +68,7 @@ static void extent(const bsim_location *loc, int n, int *ix_min, int *ix_max, in
 	}
 }
 
-void markov_field_totals(const bsim_location *loc, const double *p, int n, double tot[3])
+void bsim_markov_field_totals(const bsim_location *loc, const double *p, int n, double tot[3])
 {
 	tot[0] = tot[1] = tot[2] = 0.0;
 	for (int i = 0; i < n; i++)
@@ -77,7 +77,7 @@ void markov_field_totals(const bsim_location *loc, const double *p, int n, doubl
 		                                        : 2] += p[i];
 }
 
-int markov_field_figure(const char *stage, const char *name, const char *title,
+int bsim_markov_field_figure(const char *stage, const char *name, const char *title,
                         const bsim_location *loc, int n, const markov_field_panel *panel,
                         int n_panels, int per_row, int *drawn, bsim_error *err)
 {
@@ -159,10 +159,10 @@ int markov_field_figure(const char *stage, const char *name, const char *title,
 			continue;
 		}
 		double tot[3];
-		markov_field_totals(loc, panel[k].p, n, tot);
+		bsim_markov_field_totals(loc, panel[k].p, n, tot);
 		if (panel[k].minus) {
 			double t2[3];
-			markov_field_totals(loc, panel[k].minus, n, t2);
+			bsim_markov_field_totals(loc, panel[k].minus, n, t2);
 			for (int j = 0; j < 3; j++)
 				tot[j] -= t2[j];
 			fprintf(f,

@@ -19,7 +19,7 @@
 #include "beamsim/state.h"
 #include "model/lattice_crossing.h"
 
-void markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice, const double k[2])
+void bsim_markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice, const double k[2])
 {
 	const bsim_lattice_def *l = &lattice->lattice;
 	int ix, iy;
@@ -89,7 +89,7 @@ static void pool_sample(const markov_pool *p, const bsim_markov_bins *b, const b
 {
 	const int lo = p->first[bin], hi = p->first[bin + 1];
 	if (hi == lo) {
-		markov_bin_sample(b, l, h, bin, rng, x, v);
+		bsim_markov_bin_sample(b, l, h, bin, rng, x, v);
 		return;
 	}
 	int j;
@@ -154,7 +154,7 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 			memcpy(s->body.start, def->entries->x[i], sizeof s->body.start);
 			memcpy(s->body.velocity, def->entries->v[i], sizeof s->body.velocity);
 		} else {
-			markov_bin_sample(&def->bins, l, s->dt, bin, r->rng, s->body.start,
+			bsim_markov_bin_sample(&def->bins, l, s->dt, bin, r->rng, s->body.start,
 			                  s->body.velocity);
 		}
 	}
@@ -231,14 +231,14 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	return out;
 }
 
-int markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
+int bsim_markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
                         long *done, long total, bsim_error *err)
 {
-	return markov_map_simulate_runs(lattice, def, be, opts, m, NULL, NULL, done, total, err);
+	return bsim_markov_map_simulate_runs(lattice, def, be, opts, m, NULL, NULL, done, total, err);
 }
 
-int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
+int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
                              const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
                              const markov_pool *pool, markov_run *runs, long *done, long total,
                              bsim_error *err)
@@ -254,10 +254,10 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 	}
 	markov_entry_index ex = {0};
 	if (def->entries &&
-	    markov_entry_index_init(&ex, def->entries, &def->bins, &lattice->lattice)) {
+	    bsim_markov_entry_index_init(&ex, def->entries, &def->bins, &lattice->lattice)) {
 		free(exit);
 		free(held);
-		markov_entry_index_free(&ex);
+		bsim_markov_entry_index_free(&ex);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	int failed = 0, stopped = 0;
@@ -274,13 +274,13 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 		r.rng = gsl_rng_alloc(gsl_rng_mt19937);
 		r.ex = def->entries ? &ex : NULL;
 		r.pool = pool;
-		markov_gate_scene_init(&r.g, lattice, m->k);
+		bsim_markov_gate_scene_init(&r.g, lattice, m->k);
 		const double start[2] = {r.g.s.body.start[0], r.g.s.body.start[1]};
 #pragma omp for schedule(dynamic, 16)
 		for (long u = 0; u < units; u++) {
 			if (!ok || !r.rng) {
 				exit[u] = -1;
-#pragma omp critical(markov_fail)
+#pragma omp critical(bsim_markov_fail)
 				if (u < first_unit) {
 					first_unit = u;
 					bsim_error_set(&first, BSIM_EFAIL, "out of memory");
@@ -305,7 +305,7 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 #pragma omp atomic
 			steps += r.steps;
 			if (exit[u] < 0) {
-#pragma omp critical(markov_fail)
+#pragma omp critical(bsim_markov_fail)
 				if (u < first_unit) {
 					first_unit = u;
 					first = e;
@@ -315,7 +315,7 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 #pragma omp atomic capture
 			now = ++*done;
 			if (def->progress && (now % 256 == 0 || now == total)) {
-#pragma omp critical(markov_progress)
+#pragma omp critical(bsim_markov_progress)
 				def->progress(def->progress_user, now, total);
 			}
 		}
@@ -344,6 +344,6 @@ int markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *d
 	}
 	free(exit);
 	free(held);
-	markov_entry_index_free(&ex);
+	bsim_markov_entry_index_free(&ex);
 	return stopped ? BSIM_ESTOPPED : failed ? BSIM_EFAIL : BSIM_OK;
 }

@@ -84,11 +84,11 @@ static int map_init(bsim_markov_map *m, const bsim_scene *lattice, const bsim_ma
 	m->k[1] = k[1];
 	m->n_bins = bsim_markov_bins_count(&def->bins);
 	m->trials = def->trials;
-	m->key_text = markov_key_text(lattice, def, be, opts, k);
+	m->key_text = bsim_markov_key_text(lattice, def, be, opts, k);
 	m->counts = calloc((size_t)m->n_bins * m->n_bins, sizeof *m->counts);
 	if (!m->key_text || !m->counts)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	m->key = markov_key(m->key_text);
+	m->key = bsim_markov_key(m->key_text);
 	return BSIM_OK;
 }
 
@@ -171,7 +171,7 @@ static int round_fill(const bsim_scene *lattice, const bsim_markov_def *def, con
 		memcpy(dirs, def->from, (size_t)def->n_from * sizeof *dirs);
 		dirs[def->n_from] = def->passes_from;
 		for (int i = 0; i < n && rc == BSIM_OK; i++) {
-			rc = markov_self_copy(lattice, def, be, opts, &out->maps[i], out->pass,
+			rc = bsim_markov_self_copy(lattice, def, be, opts, &out->maps[i], out->pass,
 			                      dirs, def->n_from + 1, stage, err);
 			out->maps[i].copied = 1;
 			out->copied++;
@@ -190,7 +190,7 @@ static int round_fill(const bsim_scene *lattice, const bsim_markov_def *def, con
 			own++;
 		}
 	clock_t c0 = clock();
-	rc = markov_flow_simulate(lattice, def, be, opts, out->maps, n, have, def->passes_from,
+	rc = bsim_markov_flow_simulate(lattice, def, be, opts, out->maps, n, have, def->passes_from,
 	                          stage, &done, total, err);
 	out->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 	if (rc == BSIM_OK)
@@ -237,7 +237,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	const int round = def->self_entries == 2 && def->one_pass && stage;
 	out->pass = def->self_passes;
 	if (round && rc == BSIM_OK &&
-	    (out->pass = markov_flow_round(lattice, def, be, opts, out->maps, n, def->passes_from,
+	    (out->pass = bsim_markov_flow_round(lattice, def, be, opts, out->maps, n, def->passes_from,
 	                                   err)) < 0)
 		rc = BSIM_EINPUT;
 	const int made = round && rc == BSIM_OK && out->pass < def->self_passes;
@@ -250,10 +250,10 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		bsim_markov_map *m = &out->maps[i];
 		if (m->elsewhere)
 			continue;
-		int got = markov_map_read(dir, m, err);
+		int got = bsim_markov_map_read(dir, m, err);
 		/* A spread build's merge: the map from the part that built it. */
 		for (int j = 0; got == 0 && j < def->n_from; j++)
-			if ((got = markov_map_read(def->from[j], m, err)) > 0)
+			if ((got = bsim_markov_map_read(def->from[j], m, err)) > 0)
 				m->copied = 1, src[i] = j;
 		if (got > 0 && m->copied && !m->hold_exit)
 			rc = bsim_error_set(err, BSIM_EINPUT,
@@ -291,7 +291,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			        dir, m->k[0], m->k[1], (unsigned long long)m->key);
 		else
 			total += (long)m->n_bins * def->trials *
-			         (def->self_entries == 1 ? markov_self_passes_left(lattice, def, be,
+			         (def->self_entries == 1 ? bsim_markov_self_passes_left(lattice, def, be,
 			                                                           opts, m, dir) +
 			                                           1
 			          : def->self_entries == 2 ? def->self_passes + 1
@@ -306,7 +306,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	const int flow = def->self_entries == 2 && stage && rc == BSIM_OK &&
 	                 (to_build > 0 || (def->parts > 1 && def->pass_exchange));
 	if (flow)
-		rc = markov_flow_simulate(lattice, def, be, opts, out->maps, n, have,
+		rc = bsim_markov_flow_simulate(lattice, def, be, opts, out->maps, n, have,
 		                          round ? def->passes_from : dir, stage, &done, total, err);
 	for (int i = 0; i < n && rc == BSIM_OK && stage && !made; i++) {
 		bsim_markov_map *m = &out->maps[i];
@@ -317,10 +317,10 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			 * passes' maps and exits when built in passes */
 			const char *dirs[2] = {def->from[src[i]], round ? def->passes_from : NULL};
 			if (def->self_entries)
-				rc = markov_self_copy(lattice, def, be, opts, m, def->self_passes,
+				rc = bsim_markov_self_copy(lattice, def, be, opts, m, def->self_passes,
 				                      dirs, 2, stage, err);
 			if (rc == BSIM_OK)
-				rc = markov_map_write(stage, m, &def->bins, err);
+				rc = bsim_markov_map_write(stage, m, &def->bins, err);
 			if (rc == BSIM_OK)
 				rc = map_commit(ss, err);
 			continue;
@@ -329,9 +329,9 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		rc = flow                      ? BSIM_OK
 		     : def->stop && *def->stop ? BSIM_ESTOPPED
 		     : def->self_entries
-		             ? markov_self_simulate(lattice, def, be, opts, m, dir, stage, &done,
+		             ? bsim_markov_self_simulate(lattice, def, be, opts, m, dir, stage, &done,
 		                                    total, err)
-		             : markov_map_simulate(lattice, def, be, opts, m, &done, total, err);
+		             : bsim_markov_map_simulate(lattice, def, be, opts, m, &done, total, err);
 		if (!flow) /* else the CPU time of its passes */
 			m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 		/* with self or flow entries, m->cost holds what the passes
@@ -339,7 +339,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		m->cost = m->seconds + (def->self_entries ? m->cost : 0.0);
 		out->seconds += m->seconds;
 		if (rc == BSIM_OK)
-			rc = markov_map_write(stage, m, &def->bins, err);
+			rc = bsim_markov_map_write(stage, m, &def->bins, err);
 		if (rc == BSIM_OK)
 			rc = map_commit(ss, err);
 		if (rc == BSIM_OK)
@@ -374,7 +374,7 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 		bsim_sweep_dir_part *parts = calloc((size_t)def->n_from, sizeof *parts);
 		if (!parts)
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-		rc = part_dir_check(def->from, def->n_from, "markov build", NULL, parts, err);
+		rc = bsim_part_dir_check(def->from, def->n_from, "markov build", NULL, parts, err);
 		for (int j = 0; j < def->n_from; j++)
 			bsim_sweep_dir_part_free(&parts[j]);
 		free(parts);
@@ -399,7 +399,7 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 		return rc;
 	rc = set_fill(lattice, def, dir, &ss, out, err);
 	if (rc == BSIM_OK)
-		rc = markov_def_write(ss.stage, def,
+		rc = bsim_markov_def_write(ss.stage, def,
 		                      def->backend ? def->backend : bsim_backend_default(),
 		                      def->opts, err);
 	rc = bsim_session_close(&ss, rc, "markov build", NULL, err);
@@ -409,7 +409,7 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 }
 
 /* With a manifest, every map file read must be one it lists (and so was
- * checked against its size and CRC-32 by markov_def_read): a map copied
+ * checked against its size and CRC-32 by bsim_markov_def_read): a map copied
  * in from elsewhere after the build is not used unchecked. */
 static int maps_listed(const char *dir, const bsim_markov_set *set, bsim_error *err)
 {
@@ -449,7 +449,7 @@ int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *o
 	if (rc != BSIM_OK)
 		return rc;
 	bsim_markov_def def = bsim_markov_def_default();
-	if ((rc = markov_def_read(dir, &def, opts, err)) != BSIM_OK ||
+	if ((rc = bsim_markov_def_read(dir, &def, opts, err)) != BSIM_OK ||
 	    (rc = def_check(&def, err)) != BSIM_OK)
 		return rc;
 	if ((rc = set_fill(lattice, &def, dir, NULL, out, err)) != BSIM_OK)
@@ -461,7 +461,7 @@ int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *o
 
 void bsim_markov_run_id(const uint64_t *keys, int n, char out[17])
 {
-	/* the keys as text, in order: the name part_dir_run_id gives it */
+	/* the keys as text, in order: the name bsim_part_dir_run_id gives it */
 	char *text = malloc((size_t)n * 17 + 16);
 	if (!text) {
 		snprintf(out, 17, "%016x", 0u);
@@ -470,13 +470,13 @@ void bsim_markov_run_id(const uint64_t *keys, int n, char out[17])
 	size_t len = (size_t)sprintf(text, "markov build\n");
 	for (int i = 0; i < n; i++)
 		len += (size_t)sprintf(text + len, "%016llx\n", (unsigned long long)keys[i]);
-	part_dir_run_id(text, out);
+	bsim_part_dir_run_id(text, out);
 	free(text);
 }
 
 int bsim_markov_part_write(const char *dir, int index, int count, const char *run, long total,
                            long records, int argc, char *const *argv, bsim_error *err)
 {
-	return part_dir_write(dir, "markov build", index, count, run, total, records, argc, argv,
+	return bsim_part_dir_write(dir, "markov build", index, count, run, total, records, argc, argv,
 	                      err);
 }

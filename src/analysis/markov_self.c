@@ -55,7 +55,7 @@ static int runs_read(const char *dir, uint64_t key, markov_run *runs, int nb, in
 	fclose(probe);
 	file_text t;
 	/* a row is at most 11 numbers of 25 characters */
-	if (file_read(path, "a map's exits", ((double)nb * T + 1.0) * 320.0, NULL, &t, err) !=
+	if (bsim_file_read(path, "a map's exits", ((double)nb * T + 1.0) * 320.0, NULL, &t, err) !=
 	    BSIM_OK)
 		return -1;
 	char *line = t.text, *nl = strchr(line, '\n');
@@ -91,7 +91,7 @@ static int runs_read(const char *dir, uint64_t key, markov_run *runs, int nb, in
 	}
 	if (!bad && *(nl + 1))
 		bad = 1, lineno++;
-	file_text_free(&t);
+	bsim_file_text_free(&t);
 	if (bad) {
 		bsim_error_set(err, BSIM_EINPUT,
 		               "%s:%ld: expected a row entry,trial,x,y,vx,vy,exit,exit_x,exit_y,"
@@ -192,11 +192,11 @@ static int pass_map(bsim_markov_map *q_map, const bsim_scene *lattice, const bsi
 	q_map->k[1] = m->k[1];
 	q_map->n_bins = m->n_bins;
 	q_map->trials = m->trials;
-	q_map->key_text = markov_key_text(lattice, &dq, be, opts, m->k);
+	q_map->key_text = bsim_markov_key_text(lattice, &dq, be, opts, m->k);
 	q_map->counts = calloc((size_t)m->n_bins * m->n_bins, sizeof *q_map->counts);
 	if (!q_map->key_text || !q_map->counts)
 		return -1;
-	q_map->key = markov_key(q_map->key_text);
+	q_map->key = bsim_markov_key(q_map->key_text);
 	return 0;
 }
 
@@ -220,7 +220,7 @@ static int last_cached(const bsim_scene *lattice, const bsim_markov_def *def,
 		int got = -1;
 		if (pass_map(&mq, lattice, def, be, opts, m, q) == 0) {
 			bsim_error ignored;
-			got = markov_map_read(dir, &mq, &ignored) == 1
+			got = bsim_markov_map_read(dir, &mq, &ignored) == 1
 			              ? runs ? runs_read(dir, mq.key, runs, m->n_bins, m->trials,
 			                                 err)
 			                     : 1
@@ -239,7 +239,7 @@ static int last_cached(const bsim_scene *lattice, const bsim_markov_def *def,
 	return -1;
 }
 
-void markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from)
+void bsim_markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from)
 {
 	free(to->hold_exit);
 	free(to->hold_steps);
@@ -248,7 +248,7 @@ void markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from)
 	from->hold_exit = from->hold_steps = NULL;
 }
 
-int markov_self_passes_left(const bsim_scene *lattice, const bsim_markov_def *def,
+int bsim_markov_self_passes_left(const bsim_scene *lattice, const bsim_markov_def *def,
                             const bsim_backend *be, const bsim_options *opts,
                             const bsim_markov_map *m, const char *dir)
 {
@@ -256,7 +256,7 @@ int markov_self_passes_left(const bsim_scene *lattice, const bsim_markov_def *de
 	return def->self_passes - (q < 0 ? -1 : q);
 }
 
-int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
+int bsim_markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                          const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
                          const char *dir, const char *stage, long *done, long total,
                          bsim_error *err)
@@ -291,7 +291,7 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		}
 		clock_t c0 = clock();
 		rc = def->stop && *def->stop ? BSIM_ESTOPPED
-		                             : markov_map_simulate_runs(lattice, def, be, opts, &mq,
+		                             : bsim_markov_map_simulate_runs(lattice, def, be, opts, &mq,
 		                                                        have_pool ? &pool : NULL,
 		                                                        cur, done, total, err);
 		mq.seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
@@ -302,12 +302,12 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 		if (have_pool)
 			pool_free(&pool);
 		if (rc == BSIM_OK && q < def->self_passes)
-			rc = markov_map_write(stage, &mq, &def->bins, err);
+			rc = bsim_markov_map_write(stage, &mq, &def->bins, err);
 		if (rc == BSIM_OK)
 			rc = runs_write(stage, mq.key, cur, nb, T, err);
 		if (rc == BSIM_OK && q == def->self_passes) {
 			memcpy(m->counts, mq.counts, (size_t)nb * nb * sizeof *m->counts);
-			markov_map_take_hold(m, &mq);
+			bsim_markov_map_take_hold(m, &mq);
 		}
 		pass_map_free(&mq);
 		markov_run *tmp = prev;
@@ -321,7 +321,7 @@ int markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 	return rc;
 }
 
-int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+int bsim_markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
                      const bsim_options *opts, const bsim_markov_map *m, int last,
                      const char *const *dirs, int n_dirs, const char *stage, bsim_error *err)
 {
@@ -341,7 +341,7 @@ int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, cons
 		for (int d = 0; d < n_dirs && got == 0; d++) {
 			if (!dirs[d])
 				continue;
-			got = q < def->self_passes ? markov_map_read(dirs[d], &mq, err) : 1;
+			got = q < def->self_passes ? bsim_markov_map_read(dirs[d], &mq, err) : 1;
 			if (got == 1)
 				got = runs_read(dirs[d], mq.key, runs, nb, T, err);
 		}
@@ -355,7 +355,7 @@ int markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, cons
 		else if (got < 0)
 			rc = BSIM_EINPUT; /* err names the file and line */
 		if (rc == BSIM_OK && q < def->self_passes)
-			rc = markov_map_write(stage, &mq, &def->bins, err);
+			rc = bsim_markov_map_write(stage, &mq, &def->bins, err);
 		if (rc == BSIM_OK)
 			rc = runs_write(stage, mq.key, runs, nb, T, err);
 		pass_map_free(&mq);
@@ -402,11 +402,11 @@ static int passes_cached(const bsim_scene *lattice, const bsim_markov_def *def,
 	return first;
 }
 
-int markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+int bsim_markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
                       const bsim_options *opts, const bsim_markov_map *maps, int n, const char *dir,
                       bsim_error *err)
 {
-	/* as markov_flow_simulate finds the passes it starts after */
+	/* as bsim_markov_flow_simulate finds the passes it starts after */
 	return passes_cached(lattice, def, be, opts, maps, n, dir, NULL, NULL, err);
 }
 
@@ -500,7 +500,7 @@ static int runs_exchange(const bsim_markov_def *def, markov_run **runs, int n, l
 	return rc;
 }
 
-int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
+int bsim_markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                          const bsim_backend *be, const bsim_options *opts, bsim_markov_map *maps,
                          int n, const char *have, const char *dir, const char *stage, long *done,
                          long total, bsim_error *err)
@@ -605,7 +605,7 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 			clock_t c0 = clock();
 			rc = def->stop && *def->stop
 			             ? BSIM_ESTOPPED
-			             : markov_map_simulate_runs(lattice, def, be, opts, &mq,
+			             : bsim_markov_map_simulate_runs(lattice, def, be, opts, &mq,
 			                                        q > 0 ? &pool : NULL, cur[b], done,
 			                                        total, err);
 			mq.seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
@@ -618,13 +618,13 @@ int markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
 				pool_free(&pool);
 			const int last = q == def->self_passes;
 			if (rc == BSIM_OK && !last)
-				rc = markov_map_write(stage, &mq, &def->bins, err);
+				rc = bsim_markov_map_write(stage, &mq, &def->bins, err);
 			if (rc == BSIM_OK && (!last || !have[b]))
 				rc = runs_write(stage, mq.key, cur[b], nb, T, err);
 			if (rc == BSIM_OK && last) {
 				memcpy(maps[b].counts, mq.counts,
 				       (size_t)nb * nb * sizeof *mq.counts);
-				markov_map_take_hold(&maps[b], &mq);
+				bsim_markov_map_take_hold(&maps[b], &mq);
 			}
 			pass_map_free(&mq);
 		}

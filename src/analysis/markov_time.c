@@ -77,7 +77,7 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 	int *gate_map = malloc((size_t)G * sizeof *gate_map);
 	if (!gate_map)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	if (markov_gate_maps(lattice, set, gate_map, err) != BSIM_OK) {
+	if (bsim_markov_gate_maps(lattice, set, gate_map, err) != BSIM_OK) {
 		free(gate_map);
 		return err->code;
 	}
@@ -125,7 +125,7 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 				loc = cols + rows + g; /* the gate's limit */
 			} else {
 				int state;
-				markov_exit_target(cols, rows, nb, g, x, &state, &loc);
+				bsim_markov_exit_target(cols, rows, nb, g, x, &state, &loc);
 				if (state >= 0) {
 					g = state / nb;
 					a = state % nb;

@@ -388,7 +388,7 @@ static int write_figure(const char *stage, int g, const group_data *d,
 	        {"(d) chain - essay protocol", p->p, d->p_sim[0]},
 	        {"(e) chain - whole world", p->p, d->p_sim[1]},
 	};
-	return markov_field_figure(stage, name, title, p->loc, p->n_locations, panel, 6, 3, drawn,
+	return bsim_markov_field_figure(stage, name, title, p->loc, p->n_locations, panel, 6, 3, drawn,
 	                           err);
 }
 
@@ -446,7 +446,7 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 				        e->axes[a].key, e->axes[a].values[idx[a]], NULL};
 			const bsim_backend *b =
 			        set.def.backend ? set.def.backend : bsim_backend_default();
-			markov_title_params(d->title, sizeof d->title, b ? b->name : NULL, ov, n);
+			bsim_markov_title_params(d->title, sizeof d->title, b ? b->name : NULL, ov, n);
 		}
 		free(ov);
 		free(idx);
@@ -558,10 +558,10 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 	if (rc == BSIM_OK && (!ov[0] || !ov[1]))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (rc == BSIM_OK)
-		rc = sweep_batch_run_cpu(&b, es, cfg, 2, res, cpu, err);
+		rc = bsim_sweep_batch_run_cpu(&b, es, cfg, 2, res, cpu, err);
 	if (!b.writes) {
 		/* a shard's part directory, or another rank's part: no results */
-		rc = sweep_batch_end(&b, rc, err);
+		rc = bsim_sweep_batch_end(&b, rc, err);
 		snprintf(out->journal, sizeof out->journal, "%s", b.journal);
 		free(ov[0]);
 		free(ov[1]);
@@ -613,7 +613,7 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		rc = write_figure(b.ss.stage, g, &gd[g], out, &drawn, err);
 		rc = bsim_session_defer(&b.ss, rc, drawn == BSIM_FIGURE_FAILED, err);
 	}
-	rc = sweep_batch_end(&b, rc, err);
+	rc = bsim_sweep_batch_end(&b, rc, err);
 	for (int g = 0; gd && g < e.n_groups; g++) {
 		bsim_markov_prediction_free(&gd[g].pred);
 		for (int pr = 0; pr < 2; pr++) {

@@ -55,14 +55,14 @@ static int write_figure(const char *stage, const bsim_scene *lattice, const bsim
 	const bsim_override ov[2] = {{"effects.propulsion.force", fp, NULL},
 	                             {"effects.random_force.magnitude", rm, NULL}};
 	const bsim_backend *b = set && set->def.backend ? set->def.backend : bsim_backend_default();
-	markov_title_params(params, sizeof params, b ? b->name : NULL, ov, 2);
+	bsim_markov_title_params(params, sizeof params, b ? b->name : NULL, ov, 2);
 	snprintf(title, sizeof title,
 	         "%s: final locations predicted by the Markov chain (%d states, %s)\n%s, "
 	         "%d trials per entry bin",
 	         lattice->name, p->n_states, p->exact ? "LU" : "series", params,
 	         set ? set->def.trials : 0);
 	const markov_field_panel panel = {"probability of each final location", p->p, NULL};
-	return markov_field_figure(stage, "prediction", title, p->loc, p->n_locations, &panel, 1, 1,
+	return bsim_markov_field_figure(stage, "prediction", title, p->loc, p->n_locations, &panel, 1, 1,
 	                           drawn, err);
 }
 

@@ -221,7 +221,7 @@ static const char *trimmed(const char *t, size_t len, char *buf)
 static int grid_number(const char *t, double *x)
 {
 	char *end;
-	if (!*t || decimal_other_base(t) || isspace((unsigned char)*t))
+	if (!*t || bsim_decimal_other_base(t) || isspace((unsigned char)*t))
 		return 0;
 	*x = strtod(t, &end);
 	return *end == '\0' && isfinite(*x);
@@ -305,7 +305,7 @@ static int grid_range(bsim_grid_axis *a, const char *cmd, const char *text, cons
 	if (!a->values)
 		return CLI_FAIL;
 	for (long i = 0; i < (long)n; i++) {
-		if (decimal_step(part[0], part[2], i, buf, 128) != 0)
+		if (bsim_decimal_step(part[0], part[2], i, buf, 128) != 0)
 			snprintf(buf, 128, "%.17g", x[0] + (double)i * x[2]);
 		if (!(a->values[a->n_values++] = strdup(buf)))
 			return CLI_FAIL;
@@ -475,10 +475,10 @@ void cli_signals_restore(void)
 static void resume_line(FILE *f, int argc, char **argv)
 {
 	int has = 0;
-	text_shell_word(f, cli_program);
+	bsim_text_shell_word(f, cli_program);
 	for (int i = 0; i < argc; i++) {
 		fputc(' ', f);
-		text_shell_word(f, argv[i]);
+		bsim_text_shell_word(f, argv[i]);
 		has |= strcmp(argv[i], "--resume") == 0;
 	}
 	if (!has)
@@ -585,7 +585,7 @@ const char *cli_path(const char *path)
 	static int next;
 	char *b = ring[next++ % 4];
 	snprintf(b, sizeof ring[0], "%s", path);
-	text_escape(b, sizeof ring[0]);
+	bsim_text_escape(b, sizeof ring[0]);
 	return b;
 }
 

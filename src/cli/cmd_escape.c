@@ -79,7 +79,7 @@ int cmd_escape(int argc, char **argv)
 	bsim_error err;
 	escape_def def = {.dir = a.dir, .out = c.out, .overwrite = c.overwrite, .grid = a.grid};
 	escape_summary s;
-	rc = cli_report(escape_run(&def, &s, &err), &err);
+	rc = cli_report(bsim_escape_run(&def, &s, &err), &err);
 	if (rc == BSIM_OK) {
 		printf("escape      %s: %d groups, %d landscapes, %d groups in the fit\n",
 		       cli_path(a.dir), s.groups, s.scenes, s.used);
@@ -93,7 +93,7 @@ int cmd_escape(int argc, char **argv)
 			       s.fit.se_c, s.fit.rms, s.fit.r2, s.fit.chisq_poisson, s.fit.n - 2,
 			       s.fit.p_poisson);
 		if (s.fitted)
-			printf("verdict     %s\n", escape_fit_verdict(&s.fit));
+			printf("verdict     %s\n", bsim_escape_fit_verdict(&s.fit));
 		else
 			printf("fit         none: fewer than 3 groups with a barrier, noise and a "
 			       "traversal\n");

@@ -169,10 +169,10 @@ static int print_json(const char *dir)
 	file_text t;
 	bsim_error err;
 	snprintf(path, sizeof path, "%s/landscape.json", dir);
-	if (file_read(path, "landscape.json", INFINITY, NULL, &t, &err) != BSIM_OK)
+	if (bsim_file_read(path, "landscape.json", INFINITY, NULL, &t, &err) != BSIM_OK)
 		return cli_report(err.code, &err);
 	fwrite(t.text, 1, t.len, stdout);
-	file_text_free(&t);
+	bsim_file_text_free(&t);
 	return CLI_OK;
 }
 

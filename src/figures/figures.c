@@ -96,19 +96,19 @@ int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures
 	snprintf(inputs, sizeof inputs, "%s/inputs", dir);
 	switch (kind) {
 	case BSIM_FIGURES_SWEEP:
-		rc = figs_sweep(&f, dir, inputs, err);
+		rc = bsim_figs_sweep(&f, dir, inputs, err);
 		break;
 	case BSIM_FIGURES_COMPARE:
-		rc = figs_compare(&f, dir, err);
+		rc = bsim_figs_compare(&f, dir, err);
 		break;
 	case BSIM_FIGURES_RUN:
-		rc = figs_run(&f, dir, err);
+		rc = bsim_figs_run(&f, dir, err);
 		break;
 	case BSIM_FIGURES_ACCURACY:
-		rc = figs_accuracy(&f, dir, err);
+		rc = bsim_figs_accuracy(&f, dir, err);
 		break;
 	case BSIM_FIGURES_ESSAY:
-		rc = figs_essay(&f, dir, err);
+		rc = bsim_figs_essay(&f, dir, err);
 		break;
 	default:
 		break;
@@ -118,6 +118,6 @@ int bsim_figures_draw(const char *dir, const bsim_figures_def *def, bsim_figures
 		                      out->failed > 1 ? " (and more figures gnuplot failed on)"
 		                                      : "");
 	if (rc == BSIM_OK && out->n > 0 && out->drawn < out->n)
-		figs_note(&f, "%s", bsim_figure_missing_hint());
+		bsim_figs_note(&f, "%s", bsim_figure_missing_hint());
 	return rc;
 }

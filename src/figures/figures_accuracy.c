@@ -47,7 +47,7 @@ static int cmp_speed(const void *a, const void *b)
 	return (x->err > y->err) - (x->err < y->err);
 }
 
-int figs_accuracy(figs *f, const char *dir, bsim_error *err)
+int bsim_figs_accuracy(figs *f, const char *dir, bsim_error *err)
 {
 	if (f->def->n_select > 0)
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -57,13 +57,13 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 	char path[BSIM_PATH_MAX], file[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/accuracy.csv", dir);
 	csv_table t;
-	int rc = csv_table_read(path, &t, err);
+	int rc = bsim_csv_table_read(path, &t, err);
 	if (rc)
 		return rc;
 	static const char *const need[] = {"backend", "setting", "h_s", "err_mean_m",
 	                                   "speed_x_realtime"};
 	int col[5];
-	rc = csv_table_require(&t, path, need, 5, col, err);
+	rc = bsim_csv_table_require(&t, path, need, 5, col, err);
 	const size_t n = (size_t)t.n_rows;
 	double *v = malloc((3 * n + 1) * sizeof *v);
 	acc_point *pt = malloc((n + 1) * sizeof *pt);
@@ -71,7 +71,7 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 	if (!rc && (!v || !pt || !series))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (int c = 0; !rc && c < 3; c++)
-		rc = csv_table_numbers(&t, path, col[2 + c], 0, 0.0, v + (size_t)c * n, err);
+		rc = bsim_csv_table_numbers(&t, path, col[2 + c], 0, 0.0, v + (size_t)c * n, err);
 	double h_ref = INFINITY;
 	for (size_t r = 0; !rc && r < n; r++)
 		h_ref = fmin(h_ref, v[r]);
@@ -79,10 +79,10 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 	int n_series = 0;
 	for (size_t r = 0; !rc && r < n; r++) {
 		int same = r > 0 &&
-		           strcmp(csv_table_cell(&t, r, col[0]),
-		                  csv_table_cell(&t, r - 1, col[0])) == 0 &&
-		           strcmp(csv_table_cell(&t, r, col[1]),
-		                  csv_table_cell(&t, r - 1, col[1])) == 0;
+		           strcmp(bsim_csv_table_cell(&t, r, col[0]),
+		                  bsim_csv_table_cell(&t, r - 1, col[0])) == 0 &&
+		           strcmp(bsim_csv_table_cell(&t, r, col[1]),
+		                  bsim_csv_table_cell(&t, r - 1, col[1])) == 0;
 		series[r] = same ? series[r - 1] : n_series++;
 	}
 	size_t n_pt = 0;
@@ -94,12 +94,12 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 	}
 	bsim_atomic_file o;
 	if (!rc)
-		rc = figs_data_open(f, "accuracy.dat", &o, file, err);
+		rc = bsim_figs_data_open(f, "accuracy.dat", &o, file, err);
 	if (rc) {
 		free(v);
 		free(pt);
 		free(series);
-		csv_table_free(&t);
+		bsim_csv_table_free(&t);
 		return rc;
 	}
 	fputs("# speed (simulated s per wall s), consistency error (m), h (s): one block per "
@@ -113,8 +113,8 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 			if (series[r] == s)
 				first_row[s] = (int)r;
 		fprintf(o.f, "%s# %s %s\n", s ? "\n\n" : "",
-		        csv_table_cell(&t, first_row[s], col[0]),
-		        csv_table_cell(&t, first_row[s], col[1]));
+		        bsim_csv_table_cell(&t, first_row[s], col[0]),
+		        bsim_csv_table_cell(&t, first_row[s], col[1]));
 		int any = 0;
 		for (size_t i = 0; i < n_pt; i++)
 			if (pt[i].series == s) {
@@ -135,16 +135,16 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 			best = pt[i].err;
 			int r = first_row[pt[i].series];
 			fprintf(o.f, "%.6g %.6g %.6g %s \"%s\"\n", pt[i].speed, pt[i].err, pt[i].h,
-			        csv_table_cell(&t, r, col[0]), csv_table_cell(&t, r, col[1]));
+			        bsim_csv_table_cell(&t, r, col[0]), bsim_csv_table_cell(&t, r, col[1]));
 			on_front++;
 		}
 	}
 	if (!on_front)
 		fputs("NaN NaN NaN\n", o.f);
-	rc = figs_data_commit(&o, err);
+	rc = bsim_figs_data_commit(&o, err);
 	gp_text g;
 	if (!rc)
-		rc = gp_text_open(&g, err);
+		rc = bsim_gp_text_open(&g, err);
 	if (!rc) {
 		fputs("set title 'consistency error against speed, h from 0.016 s halved down to "
 		      "the "
@@ -161,12 +161,12 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 			        "'accuracy.dat' index %d using 1:2 with linespoints lw 1.5 dt %d "
 			        "pt %d "
 			        "ps 0.9 lc rgb '%s' title ",
-			        s, s / 8 % 2 ? 2 : 1, backend_mark(csv_table_cell(&t, r, col[0])),
+			        s, s / 8 % 2 ? 2 : 1, backend_mark(bsim_csv_table_cell(&t, r, col[0])),
 			        palette[s % 8]);
 			char label[200];
-			snprintf(label, sizeof label, "%s %s", csv_table_cell(&t, r, col[0]),
-			         csv_table_cell(&t, r, col[1]));
-			gp_str(g.f, label);
+			snprintf(label, sizeof label, "%s %s", bsim_csv_table_cell(&t, r, col[0]),
+			         bsim_csv_table_cell(&t, r, col[1]));
+			bsim_gp_str(g.f, label);
 			fputs(", \\\n     ", g.f);
 		}
 		fprintf(g.f,
@@ -174,14 +174,14 @@ int figs_accuracy(figs *f, const char *dir, bsim_error *err)
 		        "'#55000000' "
 		        "pt 6 ps 2.2 title 'Pareto front'\n",
 		        drawn_series);
-		char *body = gp_text_take(&g);
-		rc = body ? figs_render(f, "accuracy", 1200, 700, body, err)
+		char *body = bsim_gp_text_take(&g);
+		rc = body ? bsim_figs_render(f, "accuracy", 1200, 700, body, err)
 		          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		free(body);
 	}
 	free(v);
 	free(pt);
 	free(series);
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	return rc;
 }

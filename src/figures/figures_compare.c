@@ -25,8 +25,8 @@
 static double num(struct fy_node *root, const char *path, int *bad)
 {
 	double v = 0.0;
-	struct fy_node *n = ydoc_lookup(root, path);
-	if (!n || ydoc_number(n, &v) != YDOC_NUM_OK)
+	struct fy_node *n = bsim_ydoc_lookup(root, path);
+	if (!n || bsim_ydoc_number(n, &v) != YDOC_NUM_OK)
 		*bad = 1;
 	return v;
 }
@@ -37,8 +37,8 @@ static double num_or(struct fy_node *root, const char *path, const char *point, 
                      const char *event, int *bad)
 {
 	double v = 0.0;
-	struct fy_node *n = ydoc_lookup(root, path);
-	if (n && ydoc_number(n, &v) == YDOC_NUM_OK)
+	struct fy_node *n = bsim_ydoc_lookup(root, path);
+	if (n && bsim_ydoc_number(n, &v) == YDOC_NUM_OK)
 		return v;
 	char p[200];
 	snprintf(p, sizeof p, "groups.%d.events.%s.%s", g, event, point);
@@ -47,7 +47,7 @@ static double num_or(struct fy_node *root, const char *path, const char *point, 
 
 static void text(struct fy_node *root, const char *path, char *buf, size_t size)
 {
-	struct fy_node *n = ydoc_lookup(root, path);
+	struct fy_node *n = bsim_ydoc_lookup(root, path);
 	size_t len = 0;
 	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
 	snprintf(buf, size, "%.*s", t ? (int)len : 0, t ? t : "");
@@ -225,7 +225,7 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int n_sides, cmp_
 	struct fy_node *root = fy_document_root(d->fyd);
 	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
-	int rc = figs_data_open(f, "compare.dat", &o, path, err);
+	int rc = bsim_figs_data_open(f, "compare.dat", &o, path, err);
 	if (rc)
 		return rc;
 	if (n_sides == 2)
@@ -253,10 +253,10 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int n_sides, cmp_
 		const int block = blocked ? s->g[g].idx[bx] : 0;
 		if (block != prev_block && prev_block >= 0) {
 			char kv[200];
-			figs_key_value(s->axes[bx].key, s->axes[bx].values[prev_block], kv,
+			bsim_figs_key_value(s->axes[bx].key, s->axes[bx].values[prev_block], kv,
 			               sizeof kv);
 			fputs(block_start ? ", " : "", lay->blocks.f);
-			gp_str(lay->blocks.f, kv);
+			bsim_gp_str(lay->blocks.f, kv);
 			fprintf(lay->blocks.f, " %g", 0.5 * (block_start + x));
 			x += 1.0;
 		}
@@ -286,7 +286,7 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int n_sides, cmp_
 		fast_label(s, g, label, sizeof label);
 		fprintf(o.f, " \"%s\"\n", label);
 		fputs(k > 1 ? ", " : "", lay->tics.f);
-		gp_str(lay->tics.f, label);
+		bsim_gp_str(lay->tics.f, label);
 		fprintf(lay->tics.f, " %g", x);
 		fprintf(lay->blank.f, "%s'' %g", k > 1 ? ", " : "", x);
 		int len = (int)strlen(label);
@@ -294,9 +294,9 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int n_sides, cmp_
 	}
 	if (blocked && prev_block >= 0) {
 		char kv[200];
-		figs_key_value(s->axes[bx].key, s->axes[bx].values[prev_block], kv, sizeof kv);
+		bsim_figs_key_value(s->axes[bx].key, s->axes[bx].values[prev_block], kv, sizeof kv);
 		fputs(block_start ? ", " : "", lay->blocks.f);
-		gp_str(lay->blocks.f, kv);
+		bsim_gp_str(lay->blocks.f, kv);
 		fprintf(lay->blocks.f, " %g", 0.5 * (block_start + x));
 	}
 	fputs(") noenhanced\n", lay->tics.f);
@@ -304,7 +304,7 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int n_sides, cmp_
 	fputs(") noenhanced\n", lay->blocks.f);
 	lay->x_max = x;
 	lay->n = k;
-	return figs_data_commit(&o, err);
+	return bsim_figs_data_commit(&o, err);
 }
 
 /* One event's differences: points within the rule in colour, beyond in
@@ -364,7 +364,7 @@ static void diff_series_sides(FILE *o, int e, int n, char (*label)[128], int pt,
 			        "$%d):%d:%d "
 			        "with yerrorbars pt %d ps 0.6 lc rgb '%s' title ",
 			        dx, c + 3, c, c + 1, c + 2, pt, palette[k % N_PALETTE]);
-			gp_str(o, title);
+			bsim_gp_str(o, title);
 			fprintf(o,
 			        " noenhanced, \\\n     '' using ($1 + %.4f):($%d > 0 ? $%d : "
 			        "NaN):%d:%d "
@@ -380,15 +380,15 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, i
 {
 	cmp_layout lay;
 	memset(&lay, 0, sizeof lay);
-	int rc = gp_text_open(&lay.tics, err);
+	int rc = bsim_gp_text_open(&lay.tics, err);
 	if (!rc)
-		rc = gp_text_open(&lay.blank, err);
+		rc = bsim_gp_text_open(&lay.blank, err);
 	if (!rc)
-		rc = gp_text_open(&lay.blocks, err);
+		rc = bsim_gp_text_open(&lay.blocks, err);
 	if (!rc)
 		rc = compare_data(f, d, s, n_sides, &lay, err);
-	char *tics = gp_text_take(&lay.tics), *blank = gp_text_take(&lay.blank),
-	     *blocks = gp_text_take(&lay.blocks);
+	char *tics = bsim_gp_text_take(&lay.tics), *blank = bsim_gp_text_take(&lay.blank),
+	     *blocks = bsim_gp_text_take(&lay.blocks);
 	if (!rc && (!tics || !blank || !blocks))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (rc) {
@@ -407,7 +407,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, i
 		                 label[i]);
 		len += w > 0 ? w : 0;
 	}
-	fsum_header(s, inputs, who);
+	bsim_fsum_header(s, inputs, who);
 	int bad = 0;
 	double margin = num(root, "rule.margin", &bad);
 	if (bad)
@@ -440,7 +440,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, i
 		XL += w > 0 ? (size_t)w : 0;
 	}
 	gp_text g;
-	if ((rc = gp_text_open(&g, err))) {
+	if ((rc = bsim_gp_text_open(&g, err))) {
 		free(tics);
 		free(blank);
 		free(blocks);
@@ -472,7 +472,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, i
 			key = len > key ? len : key;
 		}
 	fputs("set multiplot title ", o);
-	gp_str(o, title);
+	bsim_gp_str(o, title);
 	fprintf(o,
 	        " noenhanced\nset xrange [-0.7:%g]\nset grid ytics\nset key outside right top "
 	        "font ',9'\nset lmargin 10\nset rmargin %d\nmargin = %.17g\n"
@@ -494,12 +494,12 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, i
 		      "rgb "
 		      "'" FIG_BLUE "' title ",
 		      o);
-		gp_str(o, la);
+		bsim_gp_str(o, la);
 		fputs(" noenhanced, \\\n     '' using ($1 + 0.12):6:7:8 with yerrorbars pt 9 ps "
 		      "0.7 "
 		      "lc rgb '" FIG_ORANGE "' title ",
 		      o);
-		gp_str(o, lb);
+		bsim_gp_str(o, lb);
 		fputs(" noenhanced\n", o);
 	} else {
 		/* every side, offset along x, in its palette colour */
@@ -511,7 +511,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, i
 			        i ? ", \\\n     " : "plot ", 0.5 * ((i + 0.5) / n_sides - 0.5),
 			        3 + 3 * i, 4 + 3 * i, 5 + 3 * i, i % 2 ? 9 : 7,
 			        palette[i % N_PALETTE]);
-			gp_str(o, label[i]);
+			bsim_gp_str(o, label[i]);
 			fputs(" noenhanced", o);
 		}
 		fputc('\n', o);
@@ -531,7 +531,7 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, i
 		if (drawn == rows) {
 			fputs(tics, o);
 			fputs("set xtics rotate by 90 right font ',9'\nset xlabel ", o);
-			gp_str(o, xlabel);
+			bsim_gp_str(o, xlabel);
 			fputs(" enhanced\n", o);
 		}
 		fprintf(o, "set title '(%c) %s%s: p_A - p_B'\n", panel++,
@@ -553,11 +553,11 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, i
 	free(tics);
 	free(blank);
 	free(blocks);
-	char *body = gp_text_take(&g);
+	char *body = bsim_gp_text_take(&g);
 	int w = 360 + 24 * (int)(lay.x_max + 1) + 8 * (key - 26);
 	if (w < text_px(title))
 		w = text_px(title);
-	rc = body ? figs_render(f, "compare",
+	rc = body ? bsim_figs_render(f, "compare",
 	                        w < 1000   ? 1000
 	                        : w > 2600 ? 2600
 	                                   : w,
@@ -646,18 +646,18 @@ static int lattice_figures(figs *f, const ydoc *d, const fsum *s, const char *di
 		lv[i] = labels[i];
 	}
 	if (!rc)
-		rc = figs_lattice_compare(f, n_sides, dv, lv, s, tests, err);
+		rc = bsim_figs_lattice_compare(f, n_sides, dv, lv, s, tests, err);
 	free(lines);
 	free(tests);
 	return rc;
 }
 
-int figs_compare(figs *f, const char *dir, bsim_error *err)
+int bsim_figs_compare(figs *f, const char *dir, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX], sub[BSIM_PATH_MAX], out[BSIM_PATH_MAX], inputs[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/report.json", dir);
 	ydoc d;
-	int rc = ydoc_load_own(&d, path, err);
+	int rc = bsim_ydoc_load_own(&d, path, err);
 	if (rc)
 		return rc;
 	struct fy_node *root = fy_document_root(d.fyd);
@@ -665,10 +665,10 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 	 * side's sweep is in DIR/<label>, ':' and '/' of the label written '-'
 	 * (beamsim compare's directories). */
 	char label[BSIM_COMPARE_SIDES_MAX][128], backend[BSIM_COMPARE_SIDES_MAX][128];
-	struct fy_node *sides = ydoc_lookup(root, "sides");
+	struct fy_node *sides = bsim_ydoc_lookup(root, "sides");
 	int n_sides = sides && fy_node_is_sequence(sides) ? fy_node_sequence_item_count(sides) : 2;
 	if (n_sides < 2 || n_sides > BSIM_COMPARE_SIDES_MAX) {
-		ydoc_free(&d);
+		bsim_ydoc_free(&d);
 		return bsim_error_set(err, BSIM_EINPUT, "%s: sides: expected 2 to %d sides", path,
 		                      BSIM_COMPARE_SIDES_MAX);
 	}
@@ -680,7 +680,7 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 			snprintf(p, sizeof p, "%s.label", i ? "b" : "a");
 		text(root, p, label[i], sizeof label[i]);
 		if (!*label[i]) {
-			ydoc_free(&d);
+			bsim_ydoc_free(&d);
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      n_sides > 2
 			                              ? "%s: %s: expected the side's label"
@@ -693,20 +693,20 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 	/* Groups, labels and the selection from the first side's summary. */
 	snprintf(sub, sizeof sub, "%s/%s/summary.json", dir, backend[0]);
 	fsum s;
-	rc = fsum_read(sub, &s, err);
+	rc = bsim_fsum_read(sub, &s, err);
 	if (rc) {
-		ydoc_free(&d);
+		bsim_ydoc_free(&d);
 		return rc;
 	}
-	rc = fsum_select(f, &s, err);
+	rc = bsim_fsum_select(f, &s, err);
 	snprintf(inputs, sizeof inputs, "%s/inputs", dir);
 	if (!rc)
 		rc = compare_figure(f, &d, &s, inputs, n_sides, label, err);
 	snprintf(sub, sizeof sub, "%s/%s", dir, backend[0]);
-	if (!rc && figs_is_lattice(sub))
+	if (!rc && bsim_figs_is_lattice(sub))
 		rc = lattice_figures(f, &d, &s, dir, n_sides, backend, label, err);
-	fsum_free(&s);
-	ydoc_free(&d);
+	bsim_fsum_free(&s);
+	bsim_ydoc_free(&d);
 	snprintf(inputs, sizeof inputs, "%s/inputs", dir);
 	for (int i = 0; !rc && i < n_sides; i++) {
 		snprintf(sub, sizeof sub, "%s/%s", dir, backend[i]);
@@ -715,7 +715,7 @@ int figs_compare(figs *f, const char *dir, bsim_error *err)
 		one.out = out;
 		rc = bsim_output_mkdir(out, err);
 		if (!rc)
-			rc = figs_sweep(&one, sub, inputs, err);
+			rc = bsim_figs_sweep(&one, sub, inputs, err);
 	}
 	return rc;
 }

@@ -34,7 +34,7 @@ static void essay_backend(const char *dir, char *buf, size_t size)
 	fclose(in);
 }
 
-int figs_essay(figs *f, const char *dir, bsim_error *err)
+int bsim_figs_essay(figs *f, const char *dir, bsim_error *err)
 {
 	if (f->def->n_select > 0)
 		return bsim_error_set(
@@ -45,18 +45,18 @@ int figs_essay(figs *f, const char *dir, bsim_error *err)
 	char path[BSIM_PATH_MAX], file[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/essay.csv", dir);
 	csv_table t;
-	int rc = csv_table_read(path, &t, err);
+	int rc = bsim_csv_table_read(path, &t, err);
 	if (rc)
 		return rc;
 	static const char *const need[] = {"figure",      "quantity",      "mode",   "kind",
 	                                   "essay_value", "beamsim_value", "ci_low", "ci_high"};
 	int col[8];
-	rc = csv_table_require(&t, path, need, 8, col, err);
+	rc = bsim_csv_table_require(&t, path, need, 8, col, err);
 	/* The modes in order of appearance. */
 	const char *modes[ESSAY_MODES_MAX];
 	int n_modes = 0;
 	for (int r = 0; !rc && r < t.n_rows; r++) {
-		const char *m = csv_table_cell(&t, r, col[2]);
+		const char *m = bsim_csv_table_cell(&t, r, col[2]);
 		int seen = 0;
 		for (int k = 0; k < n_modes; k++)
 			seen |= strcmp(modes[k], m) == 0;
@@ -65,9 +65,9 @@ int figs_essay(figs *f, const char *dir, bsim_error *err)
 	}
 	bsim_atomic_file o;
 	if (!rc)
-		rc = figs_data_open(f, "essay.dat", &o, file, err);
+		rc = bsim_figs_data_open(f, "essay.dat", &o, file, err);
 	if (rc) {
-		csv_table_free(&t);
+		bsim_csv_table_free(&t);
 		return rc;
 	}
 	fputs("# x, beamsim p, 95% low, 95% high, essay p: one block per mode, levels only\n", o.f);
@@ -76,12 +76,12 @@ int figs_essay(figs *f, const char *dir, bsim_error *err)
 		fprintf(o.f, "%s# %s\n", k ? "\n\n" : "", modes[k]);
 		int x = 0, any = 0;
 		for (int r = 0; r < t.n_rows; r++) {
-			if (strcmp(csv_table_cell(&t, r, col[3]), "level") != 0 ||
-			    strcmp(csv_table_cell(&t, r, col[2]), modes[k]) != 0)
+			if (strcmp(bsim_csv_table_cell(&t, r, col[3]), "level") != 0 ||
+			    strcmp(bsim_csv_table_cell(&t, r, col[2]), modes[k]) != 0)
 				continue;
 			fprintf(o.f, "%.3f %s %s %s %s\n", x + 0.15 * (k - 0.5 * (n_modes - 1)),
-			        csv_table_cell(&t, r, col[5]), csv_table_cell(&t, r, col[6]),
-			        csv_table_cell(&t, r, col[7]), csv_table_cell(&t, r, col[4]));
+			        bsim_csv_table_cell(&t, r, col[5]), bsim_csv_table_cell(&t, r, col[6]),
+			        bsim_csv_table_cell(&t, r, col[7]), bsim_csv_table_cell(&t, r, col[4]));
 			x++;
 			any = 1;
 		}
@@ -90,12 +90,12 @@ int figs_essay(figs *f, const char *dir, bsim_error *err)
 		if (x > n_levels)
 			n_levels = x;
 	}
-	rc = figs_data_commit(&o, err);
+	rc = bsim_figs_data_commit(&o, err);
 	gp_text g;
 	if (!rc)
-		rc = gp_text_open(&g, err);
+		rc = bsim_gp_text_open(&g, err);
 	if (rc) {
-		csv_table_free(&t);
+		bsim_csv_table_free(&t);
 		return rc;
 	}
 	char backend[64];
@@ -112,14 +112,14 @@ int figs_essay(figs *f, const char *dir, bsim_error *err)
 	      g.f);
 	int x = 0;
 	for (int r = 0; r < t.n_rows && n_modes > 0; r++) {
-		if (strcmp(csv_table_cell(&t, r, col[3]), "level") != 0 ||
-		    strcmp(csv_table_cell(&t, r, col[2]), modes[0]) != 0)
+		if (strcmp(bsim_csv_table_cell(&t, r, col[3]), "level") != 0 ||
+		    strcmp(bsim_csv_table_cell(&t, r, col[2]), modes[0]) != 0)
 			continue;
 		char label[160];
-		snprintf(label, sizeof label, "%s %s", csv_table_cell(&t, r, col[0]),
-		         csv_table_cell(&t, r, col[1]));
+		snprintf(label, sizeof label, "%s %s", bsim_csv_table_cell(&t, r, col[0]),
+		         bsim_csv_table_cell(&t, r, col[1]));
 		fputs(x ? ", " : "", g.f);
-		gp_str(g.f, label);
+		bsim_gp_str(g.f, label);
 		fprintf(g.f, " %d", x++);
 	}
 	fprintf(g.f, ")\nset xrange [-0.7:%g]\nplot ", n_levels - 0.3);
@@ -131,16 +131,16 @@ int figs_essay(figs *f, const char *dir, bsim_error *err)
 		        k, palette[k % 5]);
 		char label[120];
 		snprintf(label, sizeof label, "beamsim, %s", modes[k]);
-		gp_str(g.f, label);
+		bsim_gp_str(g.f, label);
 		fputs(", \\\n     ", g.f);
 	}
 	fputs("'essay.dat' index 0 using (floor($1 + 0.5)):5 with points pt 6 ps 1.6 lw 2 lc rgb "
 	      "'#000000' title 'the essay'\n",
 	      g.f);
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, "essay", 1400, 700, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, "essay", 1400, 700, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	return rc;
 }

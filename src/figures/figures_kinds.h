@@ -8,10 +8,10 @@
 
 /* inputs: the directory holding experiment.yaml and scene.yaml of the run
  * (DIR/inputs, or the comparison's for one of its backends). */
-int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err);
-int figs_compare(figs *f, const char *dir, bsim_error *err);
-int figs_run(figs *f, const char *dir, bsim_error *err);
-int figs_accuracy(figs *f, const char *dir, bsim_error *err);
-int figs_essay(figs *f, const char *dir, bsim_error *err);
+int bsim_figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err);
+int bsim_figs_compare(figs *f, const char *dir, bsim_error *err);
+int bsim_figs_run(figs *f, const char *dir, bsim_error *err);
+int bsim_figs_accuracy(figs *f, const char *dir, bsim_error *err);
+int bsim_figs_essay(figs *f, const char *dir, bsim_error *err);
 
 #endif

@@ -103,18 +103,18 @@ static int map_read(const char *dir, flats *l, bsim_error *err)
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/lattice_map.csv", dir);
 	csv_table t;
-	int rc = csv_table_read(path, &t, err);
+	int rc = bsim_csv_table_read(path, &t, err);
 	if (rc)
 		return rc;
 	static const char *const need[] = {"group", "ix",    "iy",      "x_min",  "x_max",
 	                                   "y_min", "y_max", "pivot_y", "k_left", "k_right"};
 	int col[10];
 	double *v = NULL;
-	rc = csv_table_require(&t, path, need, 10, col, err);
+	rc = bsim_csv_table_require(&t, path, need, 10, col, err);
 	if (!rc && !(v = malloc(((size_t)t.n_rows + 1) * 10 * sizeof *v)))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 	for (int c = 0; !rc && c < 10; c++)
-		rc = csv_table_numbers(&t, path, col[c], 0, 0.0, v + (size_t)c * (size_t)t.n_rows,
+		rc = bsim_csv_table_numbers(&t, path, col[c], 0, 0.0, v + (size_t)c * (size_t)t.n_rows,
 		                       err);
 	const size_t n = (size_t)t.n_rows;
 #define MAP(c, r) v[(size_t)(c)*n + (size_t)(r)]
@@ -185,7 +185,7 @@ static int map_read(const char *dir, flats *l, bsim_error *err)
 			a->centre_x = 0.5 * (a->gate[0].x_min + a->gate[a->cols - 1].x_max);
 	}
 	free(v);
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	return rc;
 }
 
@@ -211,12 +211,12 @@ static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/trials.csv", dir);
 	csv_table t;
-	int rc = csv_table_read(path, &t, err);
+	int rc = bsim_csv_table_read(path, &t, err);
 	if (rc)
 		return rc;
 	static const char *const need[] = {"group", "trial", "outcome", "x_end", "location"};
 	int col[5];
-	rc = csv_table_require(&t, path, need, 5, col, err);
+	rc = bsim_csv_table_require(&t, path, need, 5, col, err);
 	const int per = s->trials_per_group;
 	for (int g = 0; !rc && g < l->n_groups; g++) {
 		flat *a = &l->g[g];
@@ -230,7 +230,7 @@ static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *
 	}
 	for (long r = 0; !rc && r < t.n_rows; r++) {
 		double g, tr, x_end;
-		if (csv_table_number(&t, r, col[0], &g) || csv_table_number(&t, r, col[1], &tr) ||
+		if (bsim_csv_table_number(&t, r, col[0], &g) || bsim_csv_table_number(&t, r, col[1], &tr) ||
 		    g != floor(g) || g < 0 || g >= l->n_groups || tr != floor(tr) || tr < 0 ||
 		    tr >= per) {
 			rc = bsim_error_set(err, BSIM_EINPUT,
@@ -240,7 +240,7 @@ static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *
 			break;
 		}
 		flat *a = &l->g[(int)g];
-		const char *loc = csv_table_cell(&t, r, col[4]);
+		const char *loc = bsim_csv_table_cell(&t, r, col[4]);
 		int ix = 0, iy = 0, ok = 0;
 		const char *p;
 		if (!strncmp(loc, "end:", 4) && !loc_int(loc + 4, '\0', &p, &ix)) {
@@ -250,7 +250,7 @@ static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *
 				a->where[(int)tr] = FLAT_END;
 			}
 		} else if (!strncmp(loc, "side:", 5) && !loc_int(loc + 5, '\0', &p, &iy)) {
-			ok = iy >= 0 && iy < a->rows && !csv_table_number(&t, r, col[3], &x_end);
+			ok = iy >= 0 && iy < a->rows && !bsim_csv_table_number(&t, r, col[3], &x_end);
 			if (ok) {
 				a->side[(x_end < a->centre_x ? 0 : a->rows) + iy]++;
 				a->where[(int)tr] = FLAT_SIDE;
@@ -272,9 +272,9 @@ static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *
 			break;
 		}
 		a->trials++;
-		a->unstable += strcmp(csv_table_cell(&t, r, col[2]), "unstable") == 0;
+		a->unstable += strcmp(bsim_csv_table_cell(&t, r, col[2]), "unstable") == 0;
 	}
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	return rc;
 }
 
@@ -452,7 +452,7 @@ static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
 	snprintf(name, sizeof name, "lattice_g%03d", gi);
 	snprintf(file, sizeof file, "%s.dat", name);
 	bsim_atomic_file o;
-	int rc = figs_data_open(f, file, &o, path, err);
+	int rc = bsim_figs_data_open(f, file, &o, path, err);
 	if (rc)
 		return rc;
 	double k_min = INFINITY, k_max = -INFINITY;
@@ -498,11 +498,11 @@ static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
 	thinned(p, n, d, o.f, 1);
 	fputs("\n\n# block 3: x y (m) of the other kept trajectories\n", o.f);
 	thinned(p, n, d, o.f, 0);
-	if ((rc = figs_data_commit(&o, err)))
+	if ((rc = bsim_figs_data_commit(&o, err)))
 		return rc;
 
 	gp_text g;
-	if ((rc = gp_text_open(&g, err)))
+	if ((rc = bsim_gp_text_open(&g, err)))
 		return rc;
 	FILE *s = g.f;
 	double box[4];
@@ -519,7 +519,7 @@ static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
 	         "sweeps it; gate columns i_x on top, rows i_y on the right",
 	         gi, ends, a->trials, a->trials ? 100.0 * ends / a->trials : 0.0, label);
 	fprintf(s, "set multiplot layout 1,%d title ", n > 0 ? 2 : 1);
-	gp_str(s, title);
+	bsim_gp_str(s, title);
 	fprintf(s,
 	        " noenhanced\nset size ratio -1\nset xrange [%g:%g]\nset yrange [%g:%g]\n"
 	        "set cbrange [%.10g:%.10g]\nset cblabel 'k (N m/rad)'\nset style fill solid 1.0 "
@@ -553,8 +553,8 @@ static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
 		        file, FIG_GREY, FIG_RED, n - n_end, FIG_BLUE, n_end);
 	}
 	fputs("unset multiplot\n", s);
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, name, n > 0 ? 1400 : 760, 860, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, name, n > 0 ? 1400 : 760, 860, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -677,7 +677,7 @@ static void locations_region(FILE *g, const char *file, int b0, const flat *a, d
 	fputs("set title ", g);
 	char title[700];
 	snprintf(title, sizeof title, "%s\n%s", label, line);
-	gp_str(g, title);
+	bsim_gp_str(g, title);
 	fprintf(g,
 	        " noenhanced\nset xrange [%g:%g]\nset yrange [0:%g]\nset xtics 1 format ''\n"
 	        "set ytics auto format '%%g'\nunset xlabel\nset ylabel 'end (%%)'\n"
@@ -728,7 +728,7 @@ static int locations_figure(figs *f, const char *name, const char *title, const 
 	char file[200], path[BSIM_PATH_MAX];
 	snprintf(file, sizeof file, "%s.dat", name);
 	bsim_atomic_file o;
-	int rc = figs_data_open(f, file, &o, path, err);
+	int rc = bsim_figs_data_open(f, file, &o, path, err);
 	if (rc)
 		return rc;
 	double top[3] = {0.0, 0.0, 0.0};
@@ -736,10 +736,10 @@ static int locations_figure(figs *f, const char *name, const char *title, const 
 		locations_blocks(o.f, runs[i], labels[i], i == 0);
 		locations_top(runs[i], top);
 	}
-	if ((rc = figs_data_commit(&o, err)))
+	if ((rc = bsim_figs_data_commit(&o, err)))
 		return rc;
 	gp_text g;
-	if ((rc = gp_text_open(&g, err)))
+	if ((rc = bsim_gp_text_open(&g, err)))
 		return rc;
 	/* the note on intervals: a location never reached is drawn without one */
 	char full[8400]; /* the title of many sides: a line per pair */
@@ -750,7 +750,7 @@ static int locations_figure(figs *f, const char *name, const char *title, const 
 	         "up to %.2g%%)",
 	         title, runs[0]->trials, 100.0 * zero[2]);
 	fputs("set multiplot title ", g.f);
-	gp_str(g.f, full);
+	bsim_gp_str(g.f, full);
 	fputs(" noenhanced\n", g.f);
 	int lines = 1;
 	for (const char *c = full; *c; c++)
@@ -763,8 +763,8 @@ static int locations_figure(figs *f, const char *name, const char *title, const 
 		                 top, labels[i], line);
 	}
 	fputs("unset multiplot\n", g.f);
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, name, 980 * n_runs, 820, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, name, 980 * n_runs, 820, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -791,7 +791,7 @@ static void lat_free(lat_job *j)
 	if (j->have_e)
 		bsim_experiment_free(&j->e);
 	if (j->have_table)
-		csv_table_free(&j->table);
+		bsim_csv_table_free(&j->table);
 	free(j->cols);
 	free(j->paths);
 	free(j->first);
@@ -803,13 +803,13 @@ static int paths_read(const char *dir, lat_job *j, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/trajectories.csv", dir);
-	int rc = csv_table_read(path, &j->table, err);
+	int rc = bsim_csv_table_read(path, &j->table, err);
 	if (rc)
 		return rc;
 	j->have_table = 1;
 	static const char *const need[] = {"group", "trial", "x", "y"};
 	int col[4];
-	if ((rc = csv_table_require(&j->table, path, need, 4, col, err)))
+	if ((rc = bsim_csv_table_require(&j->table, path, need, 4, col, err)))
 		return rc;
 	const size_t n = (size_t)j->table.n_rows;
 	j->cols = malloc((4 * n + 1) * sizeof *j->cols);
@@ -819,7 +819,7 @@ static int paths_read(const char *dir, lat_job *j, bsim_error *err)
 	if (!j->cols || !j->paths || !j->first || !j->count)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 	for (int c = 0; !rc && c < 4; c++)
-		rc = csv_table_numbers(&j->table, path, col[c], 0, 0.0, j->cols + (size_t)c * n,
+		rc = bsim_csv_table_numbers(&j->table, path, col[c], 0, 0.0, j->cols + (size_t)c * n,
 		                       err);
 	const double *gg = j->cols, *tt = gg + n, *xx = tt + n, *yy = xx + n;
 	for (size_t r = 0; !rc && r < n;) {
@@ -859,7 +859,7 @@ static int paths_read(const char *dir, lat_job *j, bsim_error *err)
 static void group_label(const fsum *s, int g, char *buf, size_t size)
 {
 	char l[512];
-	fsum_label(s, g, l, sizeof l);
+	bsim_fsum_label(s, g, l, sizeof l);
 	for (char *c = l; *c; c++)
 		*c = *c == '\n' ? ' ' : *c;
 	snprintf(buf, size, "%s%s%s", s->header, *l ? "; " : "", l);
@@ -896,7 +896,7 @@ static int lat_group(figs *f, lat_job *j, int g, bsim_error *err)
 	return rc;
 }
 
-int figs_lattice_load(figs *f, const char *dir, const char *inputs, const fsum *s, lat_job **out,
+int bsim_figs_lattice_load(figs *f, const char *dir, const char *inputs, const fsum *s, lat_job **out,
                       bsim_error *err)
 {
 	lat_job *j = calloc(1, sizeof *j);
@@ -916,19 +916,19 @@ int figs_lattice_load(figs *f, const char *dir, const char *inputs, const fsum *
 			                    "%s: %d groups, but %s/summary.json has %d", exp_path,
 			                    j->e.n_groups, dir, s->n_groups);
 	} else if (!rc) {
-		figs_note(f, "%s: no %s, so no scene to draw the stiffness map's beams on", dir,
+		bsim_figs_note(f, "%s: no %s, so no scene to draw the stiffness map's beams on", dir,
 		          exp_path);
 	}
 	if (!rc && j->have_e && file_exists(dir, "trajectories.csv"))
 		rc = paths_read(dir, j, err);
 	if (rc)
-		figs_lattice_free(j);
+		bsim_figs_lattice_free(j);
 	else
 		*out = j;
 	return rc;
 }
 
-void figs_lattice_free(lat_job *j)
+void bsim_figs_lattice_free(lat_job *j)
 {
 	if (!j)
 		return;
@@ -942,19 +942,19 @@ static int lat_group_fn(figs *f, void *job, int g, bsim_error *err)
 	return j->s->g[g].selected ? lat_group(f, j, g, err) : BSIM_OK;
 }
 
-int figs_lattice_draw(figs *f, lat_job *j, bsim_error *err)
+int bsim_figs_lattice_draw(figs *f, lat_job *j, bsim_error *err)
 {
-	return figs_each_group(f, j->s->n_groups, lat_group_fn, j, err);
+	return bsim_figs_each_group(f, j->s->n_groups, lat_group_fn, j, err);
 }
 
-int figs_is_lattice(const char *dir)
+int bsim_figs_is_lattice(const char *dir)
 {
 	return file_exists(dir, "lattice_map.csv");
 }
 
 /* ---- a comparison of two lattice runs -------------------------------------------------- */
 
-int figs_lattice_compare(figs *f, int n, const char *const *dirs, const char *const *labels,
+int bsim_figs_lattice_compare(figs *f, int n, const char *const *dirs, const char *const *labels,
                          const fsum *s, const char *const *tests, bsim_error *err)
 {
 	flats l[BSIM_COMPARE_SIDES_MAX];

@@ -37,7 +37,7 @@ static const struct {
         [FPATH_LEFT] = {"traversed, left type", BSIM_FIGURE_PATH_LEFT, 1.5},
 };
 
-int fpath_class(const char *outcome, const char *type)
+int bsim_fpath_class(const char *outcome, const char *type)
 {
 	if (strcmp(outcome, "traversed") == 0)
 		return strcmp(type, "left") == 0    ? FPATH_LEFT
@@ -50,7 +50,7 @@ int fpath_class(const char *outcome, const char *type)
 	return FPATH_OTHER;
 }
 
-double fpath_energy(const bsim_scene *s, double y, const double *theta)
+double bsim_fpath_energy(const bsim_scene *s, double y, const double *theta)
 {
 	double e = bsim_landscape_e_prop(s, y);
 	for (int i = 0; i < s->n_beams; i++)
@@ -58,16 +58,16 @@ double fpath_energy(const bsim_scene *s, double y, const double *theta)
 	return e;
 }
 
-int fpath_below(const bsim_scene *s, double x, double y, const double *theta)
+int bsim_fpath_below(const bsim_scene *s, double x, double y, const double *theta)
 {
 	const double c[2] = {x, y};
 	double e_land;
 	bsim_landscape_energy(s, c, NULL, &e_land, NULL);
-	double e_beam = fpath_energy(s, y, theta) - bsim_landscape_e_prop(s, y);
+	double e_beam = bsim_fpath_energy(s, y, theta) - bsim_landscape_e_prop(s, y);
 	return e_land - e_beam > FPATH_BELOW_J;
 }
 
-void fpath_params(char *buf, size_t size, const char *backend, const char *const *keys,
+void bsim_fpath_params(char *buf, size_t size, const char *backend, const char *const *keys,
                   const char *const *values, int n)
 {
 	size_t k = 0;
@@ -93,27 +93,27 @@ void fpath_params(char *buf, size_t size, const char *backend, const char *const
 
 /* ---- reading --------------------------------------------------------------------- */
 
-void fpaths_free(fpaths *p)
+void bsim_fpaths_free(fpaths *p)
 {
 	free(p->p);
 	free(p->cols);
 	memset(p, 0, sizeof *p);
 }
 
-int fpaths_read(const csv_table *t, const char *path, fpaths *out, bsim_error *err)
+int bsim_fpaths_read(const csv_table *t, const char *path, fpaths *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
 	static const char *const need[] = {"t", "x", "y"};
 	int col[3];
-	int rc = csv_table_require(t, path, need, 3, col, err);
+	int rc = bsim_csv_table_require(t, path, need, 3, col, err);
 	if (rc)
 		return rc;
-	int gc = csv_table_col(t, "group"), tc = csv_table_col(t, "trial");
+	int gc = bsim_csv_table_col(t, "group"), tc = bsim_csv_table_col(t, "trial");
 	int nb = 0;
 	char name[32];
 	for (;; nb++) {
 		snprintf(name, sizeof name, "theta%d", nb + 1);
-		if (csv_table_col(t, name) < 0)
+		if (bsim_csv_table_col(t, name) < 0)
 			break;
 	}
 	const size_t n = (size_t)t->n_rows;
@@ -125,11 +125,11 @@ int fpaths_read(const csv_table *t, const char *path, fpaths *out, bsim_error *e
 	double *tt = out->cols, *xx = tt + n, *yy = xx + n, *gg = yy + n, *rr = gg + n,
 	       *th = rr + n;
 	for (int k = 0; !rc && k < 3; k++)
-		rc = csv_table_numbers(t, path, col[k], 0, 0.0, out->cols + (size_t)k * n, err);
+		rc = bsim_csv_table_numbers(t, path, col[k], 0, 0.0, out->cols + (size_t)k * n, err);
 	if (!rc && gc >= 0)
-		rc = csv_table_numbers(t, path, gc, 0, 0.0, gg, err);
+		rc = bsim_csv_table_numbers(t, path, gc, 0, 0.0, gg, err);
 	if (!rc && tc >= 0)
-		rc = csv_table_numbers(t, path, tc, 0, 0.0, rr, err);
+		rc = bsim_csv_table_numbers(t, path, tc, 0, 0.0, rr, err);
 	if (gc < 0)
 		memset(gg, 0, n * sizeof *gg);
 	if (tc < 0)
@@ -139,7 +139,7 @@ int fpaths_read(const csv_table *t, const char *path, fpaths *out, bsim_error *e
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 	for (int b = 0; !rc && b < nb; b++) {
 		snprintf(name, sizeof name, "theta%d", b + 1);
-		rc = csv_table_numbers(t, path, csv_table_col(t, name), 0, 0.0, col_buf, err);
+		rc = bsim_csv_table_numbers(t, path, bsim_csv_table_col(t, name), 0, 0.0, col_buf, err);
 		for (size_t r = 0; !rc && r < n; r++)
 			th[r * (size_t)nb + (size_t)b] = col_buf[r];
 	}
@@ -173,7 +173,7 @@ int fpaths_read(const csv_table *t, const char *path, fpaths *out, bsim_error *e
 		r = e;
 	}
 	if (rc)
-		fpaths_free(out);
+		bsim_fpaths_free(out);
 	return rc;
 }
 
@@ -248,13 +248,13 @@ static int thin_keep(thin *t, double x, double y, double e, int below, int last,
 
 /* ---- Fig. 3.2: the bundle ------------------------------------------------------------ */
 
-int figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *scene,
+int bsim_figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *scene,
                 const fpath *p, int n, bsim_error *err)
 {
 	char file[200], path[BSIM_PATH_MAX];
 	snprintf(file, sizeof file, "%s.dat", name);
 	bsim_atomic_file o;
-	int rc = figs_data_open(f, file, &o, path, err);
+	int rc = bsim_figs_data_open(f, file, &o, path, err);
 	if (rc)
 		return rc;
 	int count[FPATH_N] = {0}, block[FPATH_N], n_blocks = 0;
@@ -283,16 +283,16 @@ int figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *
 					fprintf(o.f, "%.6g %.6g\n", p[i].x[k], p[i].y[k]);
 		}
 	}
-	if ((rc = figs_data_commit(&o, err)))
+	if ((rc = bsim_figs_data_commit(&o, err)))
 		return rc;
 
 	gp_text g;
-	if ((rc = gp_text_open(&g, err)))
+	if ((rc = bsim_gp_text_open(&g, err)))
 		return rc;
 	double box[4];
 	scene_box(scene, box);
 	fputs("set title ", g.f);
-	gp_str(g.f, title);
+	bsim_gp_str(g.f, title);
 	fprintf(g.f,
 	        " noenhanced\nset size ratio -1\nset xrange [%g:%g]\nset yrange [%g:%g]\n"
 	        "set xlabel 'x (m)'\nset ylabel 'y (m)'\nset key below maxrows 3\n",
@@ -311,8 +311,8 @@ int figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *
 	if (!k)
 		fputs("NaN notitle", g.f);
 	fputc('\n', g.f);
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, name, 720, 900, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, name, 720, 900, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -412,7 +412,7 @@ static int surface_write(figs *f, const char *file, const bsim_scene *s, const d
 	free(w3);
 	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
-	int rc = figs_data_open(f, file, &o, path, err);
+	int rc = bsim_figs_data_open(f, file, &o, path, err);
 	if (!rc) {
 		fprintf(o.f,
 		        "# x y (m), E_total (J): the landscape F_prop (y0 - y) + sum 1/2 k "
@@ -431,7 +431,7 @@ static int surface_write(figs *f, const char *file, const bsim_scene *s, const d
 			}
 			fputc('\n', o.f);
 		}
-		rc = figs_data_commit(&o, err);
+		rc = bsim_figs_data_commit(&o, err);
 	}
 	free(e);
 	free(w);
@@ -451,7 +451,7 @@ static double surface_cap(const bsim_scene *s, const fpath *p, int n, unsigned m
 			const double c[2] = {p[i].x[k], p[i].y[k]};
 			const double *th = p[i].theta + (size_t)k * (size_t)s->n_beams;
 			top = fmax(top, bsim_landscape_energy(s, c, NULL, NULL, NULL));
-			top = fmax(top, fpath_energy(s, c[1], th));
+			top = fmax(top, bsim_fpath_energy(s, c[1], th));
 		}
 	}
 	return 1.25 * top;
@@ -466,7 +466,7 @@ static int paths_write(figs *f, const char *file, const bsim_scene *s, const fpa
 {
 	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
-	int rc = figs_data_open(f, file, &o, path, err);
+	int rc = bsim_figs_data_open(f, file, &o, path, err);
 	if (rc)
 		return rc;
 	const int nb = s->n_beams;
@@ -483,8 +483,8 @@ static int paths_write(figs *f, const char *file, const bsim_scene *s, const fpa
 		thin t = {0};
 		for (long k = 0; k < p[i].n; k++) {
 			const double *th = p[i].theta + (size_t)k * (size_t)nb;
-			int b = fpath_below(s, p[i].x[k], p[i].y[k], th);
-			double e = fpath_energy(s, p[i].y[k], th);
+			int b = bsim_fpath_below(s, p[i].x[k], p[i].y[k], th);
+			double e = bsim_fpath_energy(s, p[i].y[k], th);
 			*below += b;
 			if (thin_keep(&t, p[i].x[k], p[i].y[k], e, b, k == p[i].n - 1, OVER_STEP_M,
 			              OVER_STEP_J))
@@ -501,24 +501,24 @@ static int paths_write(figs *f, const char *file, const bsim_scene *s, const fpa
 		int in = 0;
 		for (long k = 0; k < p[i].n; k++) {
 			const double *th = p[i].theta + (size_t)k * (size_t)nb;
-			int b = fpath_below(s, p[i].x[k], p[i].y[k], th);
+			int b = bsim_fpath_below(s, p[i].x[k], p[i].y[k], th);
 			long from = k > 0 ? k - 1 : k;
 			if (b && !in) { /* a stretch starts: from the state before */
 				fputs(any ? "\n" : "", o.f);
 				const double *t0 = p[i].theta + (size_t)from * (size_t)nb;
 				fprintf(o.f, "%.6g %.6g %.6g\n", p[i].x[from], p[i].y[from],
-				        fpath_energy(s, p[i].y[from], t0));
+				        bsim_fpath_energy(s, p[i].y[from], t0));
 				any = 1;
 			}
 			if (b || in)
 				fprintf(o.f, "%.6g %.6g %.6g\n", p[i].x[k], p[i].y[k],
-				        fpath_energy(s, p[i].y[k], th));
+				        bsim_fpath_energy(s, p[i].y[k], th));
 			in = b;
 		}
 	}
 	if (!any) /* gnuplot needs a point in every block it plots */
 		fputs("NaN NaN NaN\n", o.f);
-	return figs_data_commit(&o, err);
+	return bsim_figs_data_commit(&o, err);
 }
 
 /* A class's colour over the landscape: the traversals in the landscapes'
@@ -538,7 +538,7 @@ static const char *class_color_over(int c)
 	}
 }
 
-int figs_over_landscape(figs *f, const char *name, const char *title, const bsim_scene *scene,
+int bsim_figs_over_landscape(figs *f, const char *name, const char *title, const bsim_scene *scene,
                         const fpath *p, int n, unsigned mask, bsim_error *err)
 {
 	char surf[200], file[200];
@@ -557,14 +557,14 @@ int figs_over_landscape(figs *f, const char *name, const char *title, const bsim
 		count[p[i].cls] += (mask & 1u << p[i].cls) != 0;
 
 	gp_text g;
-	if ((rc = gp_text_open(&g, err)))
+	if ((rc = bsim_gp_text_open(&g, err)))
 		return rc;
 	FILE *s = g.f;
 	/* Two panels side by side, placed by hand: (a) as tall as the plane
 	 * at 1:1, its colour bar at its right, (b) from there to the right
 	 * edge, so that no strip of the figure stays empty. */
 	fputs("set multiplot title ", s);
-	gp_str(s, title);
+	bsim_gp_str(s, title);
 	fprintf(s,
 	        " noenhanced\n" BSIM_FIGURE_LANDSCAPE_PALETTE
 	        "set cbrange [%g:%g]\nset cblabel '" BSIM_FIGURE_LANDSCAPE_CBLABEL "'\n"
@@ -637,8 +637,8 @@ int figs_over_landscape(figs *f, const char *name, const char *title, const bsim
 	        "unset multiplot\n",
 	        k ? ", \\\n      " : "", file, FIG_BLACK,
 	        total ? 100.0 * (double)below / (double)total : 0.0);
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, name, 1400, 760, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, name, 1400, 760, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;

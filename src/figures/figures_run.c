@@ -27,7 +27,7 @@
 /* The scene of the run: inputs/scene.yaml with run.json's "set"
  * overrides; outcome and type of the trial into the buffers (32 bytes
  * each), the backend and the overrides for a title into params
- * (fpath_params). *found is 0 if there is no record to load it from. */
+ * (bsim_fpath_params). *found is 0 if there is no record to load it from. */
 static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *type, char *params,
                      size_t params_size, int *found, bsim_error *err)
 {
@@ -39,16 +39,16 @@ static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *ty
 	if (!*found)
 		return BSIM_OK;
 	ydoc d;
-	int rc = ydoc_load_own(&d, path, err);
+	int rc = bsim_ydoc_load_own(&d, path, err);
 	if (rc)
 		return rc;
 	struct fy_node *root = fy_document_root(d.fyd);
-	struct fy_node *set = ydoc_lookup(root, "set");
+	struct fy_node *set = bsim_ydoc_lookup(root, "set");
 	char backend[32] = "";
 	const char *names[3] = {"outcome", "type", "backend"};
 	char *bufs[3] = {outcome, type, backend};
 	for (int i = 0; i < 3; i++) {
-		struct fy_node *n = ydoc_lookup(root, names[i]);
+		struct fy_node *n = bsim_ydoc_lookup(root, names[i]);
 		size_t len = 0;
 		const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : "";
 		snprintf(bufs[i], 32, "%.*s", (int)(len < 31 ? len : 31), t ? t : "");
@@ -69,7 +69,7 @@ static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *ty
 			text[2 * i + k] = t ? strndup(t, len) : NULL;
 		}
 		if (!text[2 * i] || !text[2 * i + 1])
-			rc = ydoc_expected(&d, fy_node_pair_value(p), set, "set",
+			rc = bsim_ydoc_expected(&d, fy_node_pair_value(p), set, "set",
 			                   "a mapping of KEY: VALUE strings", err);
 		ov[i] = (bsim_override){text[2 * i], text[2 * i + 1], path};
 	}
@@ -84,14 +84,14 @@ static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *ty
 			kv[n + i] = text[2 * i + 1];
 		}
 		if (kv)
-			fpath_params(params, params_size, backend, kv, kv + n, n);
+			bsim_fpath_params(params, params_size, backend, kv, kv + n, n);
 		free(kv);
 	}
 	for (int i = 0; text && i < 2 * n; i++)
 		free(text[i]);
 	free(text);
 	free(ov);
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	return rc;
 }
 
@@ -105,10 +105,10 @@ static void run_header(const char *dir, int gp, char *buf, size_t size)
 	buf[0] = '\0';
 	ydoc d;
 	bsim_error ignore;
-	if (ydoc_load_own(&d, path, &ignore) != BSIM_OK)
+	if (bsim_ydoc_load_own(&d, path, &ignore) != BSIM_OK)
 		return;
 	struct fy_node *root = fy_document_root(d.fyd);
-	struct fy_node *b = ydoc_lookup(root, "backend"), *set = ydoc_lookup(root, "set");
+	struct fy_node *b = bsim_ydoc_lookup(root, "backend"), *set = bsim_ydoc_lookup(root, "set");
 	size_t len = 0;
 	const char *bt = b && fy_node_is_scalar(b) ? fy_node_get_scalar(b, &len) : NULL;
 	int n = snprintf(buf, size, "%.*s backend", bt ? (int)len : 0, bt ? bt : "?");
@@ -122,7 +122,7 @@ static void run_header(const char *dir, int gp, char *buf, size_t size)
 		size_t kl = 0;
 		const char *kt = kn && fy_node_is_scalar(kn) ? fy_node_get_scalar(kn, &kl) : NULL;
 		char *key = kt ? strndup(kt, kl) : NULL;
-		char *val = ydoc_flow_text(fy_node_pair_value(p));
+		char *val = bsim_ydoc_flow_text(fy_node_pair_value(p));
 		if (key && val) {
 			char v[64], kv[300];
 			size_t j = 0;
@@ -138,14 +138,14 @@ static void run_header(const char *dir, int gp, char *buf, size_t size)
 			if (gp)
 				bsim_key_value(key, v, 1, kv, sizeof kv);
 			else
-				figs_key_value(key, v, kv, sizeof kv);
+				bsim_figs_key_value(key, v, kv, sizeof kv);
 			n = snprintf(buf + k, size - k, "%s%s", i++ ? ", " : "; ", kv);
 			k += n > 0 ? (size_t)n : 0;
 		}
 		free(key);
 		free(val);
 	}
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 }
 
 /* ---- Fig. 2.2 -------------------------------------------------------------------- */
@@ -155,20 +155,20 @@ static int random_force(figs *f, const char *hdr, const csv_table *t, const char
 {
 	const double rm = s->effects.random_magnitude, freq = s->effects.random_frequency;
 	if (!s->effects.has_random_force || rm <= 0.0) {
-		figs_note(f, "the scene has no random force: no random-force figure");
+		bsim_figs_note(f, "the scene has no random force: no random-force figure");
 		return BSIM_OK;
 	}
 	static const char *const need[] = {"t", "f_rand"};
 	int col[2];
-	int rc = csv_table_require(t, path, need, 2, col, err);
+	int rc = bsim_csv_table_require(t, path, need, 2, col, err);
 	const size_t n = (size_t)t->n_rows;
 	double *tt = malloc((2 * n + 1) * sizeof *tt), *ff = tt ? tt + n : NULL;
 	if (!rc && !tt)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (!rc)
-		rc = csv_table_numbers(t, path, col[0], 0, 0.0, tt, err);
+		rc = bsim_csv_table_numbers(t, path, col[0], 0, 0.0, tt, err);
 	if (!rc)
-		rc = csv_table_numbers(t, path, col[1], 0, 0.0, ff, err);
+		rc = bsim_csv_table_numbers(t, path, col[1], 0, 0.0, ff, err);
 	/* One sample per draw; the last row is the state after the last step,
 	 * where no force acts any more. */
 	long draws = 0, last = -1;
@@ -190,7 +190,7 @@ static int random_force(figs *f, const char *hdr, const csv_table *t, const char
 	char file[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	if (!rc)
-		rc = figs_data_open(f, "random_force.dat", &o, file, err);
+		rc = bsim_figs_data_open(f, "random_force.dat", &o, file, err);
 	if (rc) {
 		free(tt);
 		return rc;
@@ -204,12 +204,12 @@ static int random_force(figs *f, const char *hdr, const csv_table *t, const char
 	for (size_t r = 0; r < n; r++)
 		fprintf(o.f, "%.6g %.10g\n", tt[r], ff[r]);
 	free(tt);
-	if ((rc = figs_data_commit(&o, err)))
+	if ((rc = bsim_figs_data_commit(&o, err)))
 		return rc;
 	double mean = draws ? sum / draws : 0.0;
 	double sd = draws > 1 ? sqrt((sum2 - draws * mean * mean) / (draws - 1)) : 0.0;
 	gp_text g;
-	if ((rc = gp_text_open(&g, err)))
+	if ((rc = bsim_gp_text_open(&g, err)))
 		return rc;
 	fprintf(g.f,
 	        "set multiplot layout 2,1 title 'random force, R_m = %g N, a draw every %g s: "
@@ -230,8 +230,8 @@ static int random_force(figs *f, const char *hdr, const csv_table *t, const char
 	        "unset multiplot\n",
 	        rm, 1.0 / freq, draws, mean, sd, hdr, rm, lo, -lo, FIG_SKY, width, FIG_SKY, FIG_RED,
 	        -3.5 * rm, 3.5 * rm, FIG_BLUE);
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, "random_force", 900, 800, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, "random_force", 900, 800, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -246,7 +246,7 @@ static int ledger(figs *f, const char *dir, bsim_error *err)
 	char path[BSIM_PATH_MAX], file[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/ledger.csv", dir);
 	csv_table t;
-	int rc = csv_table_read(path, &t, err);
+	int rc = bsim_csv_table_read(path, &t, err);
 	if (rc)
 		return rc;
 	static const char *const need[] = {"t",       "e_kin",      "e_beam",  "e_mech",
@@ -254,19 +254,19 @@ static int ledger(figs *f, const char *dir, bsim_error *err)
 	                                   "contact", "correction", "residual"};
 	enum { NC = sizeof need / sizeof need[0] };
 	int col[NC];
-	rc = csv_table_require(&t, path, need, NC, col, err);
+	rc = bsim_csv_table_require(&t, path, need, NC, col, err);
 	const size_t n = (size_t)t.n_rows;
 	double *v = malloc((NC * n + 1) * sizeof *v);
 	if (!rc && !v)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (int c = 0; !rc && c < NC; c++)
-		rc = csv_table_numbers(&t, path, col[c], 0, 0.0, v + (size_t)c * n, err);
-	csv_table_free(&t);
+		rc = bsim_csv_table_numbers(&t, path, col[c], 0, 0.0, v + (size_t)c * n, err);
+	bsim_csv_table_free(&t);
 	bsim_atomic_file o;
 	if (!rc && n == 0)
 		rc = bsim_error_set(err, BSIM_EINPUT, "%s: expected at least one row", path);
 	if (!rc)
-		rc = figs_data_open(f, "ledger.dat", &o, file, err);
+		rc = bsim_figs_data_open(f, "ledger.dat", &o, file, err);
 	if (rc) {
 		free(v);
 		return rc;
@@ -290,10 +290,10 @@ static int ledger(figs *f, const char *dir, bsim_error *err)
 	}
 	const double t_end = v[n - 1];
 	free(v);
-	if ((rc = figs_data_commit(&o, err)))
+	if ((rc = bsim_figs_data_commit(&o, err)))
 		return rc;
 	gp_text g;
-	if ((rc = gp_text_open(&g, err)))
+	if ((rc = bsim_gp_text_open(&g, err)))
 		return rc;
 	fprintf(g.f,
 	        "set multiplot layout 3,1 title 'energy ledger: dE = W_{prop} + W_{rand} - "
@@ -320,8 +320,8 @@ static int ledger(figs *f, const char *dir, bsim_error *err)
 	        "unset multiplot\n",
 	        hdr, t_end > 0 ? t_end : 1.0, FIG_ORANGE, FIG_GREEN, FIG_BLACK, FIG_BLUE, FIG_SKY,
 	        FIG_RED, FIG_PURPLE, FIG_YELLOW, FIG_DKGREY, FIG_BLACK, FIG_ORANGE, worst, FIG_RED);
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, "ledger", 1000, 900, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, "ledger", 1000, 900, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -345,12 +345,12 @@ static int single_beam(figs *f, bsim_scene *scene, const fpath *p, const char *t
 		return BSIM_OK;
 	for (long k = 0; k < p->n; k++) {
 		const double *th = p->theta + (size_t)k * (size_t)nb;
-		below += fpath_below(scene, p->x[k], p->y[k], th);
+		below += bsim_fpath_below(scene, p->x[k], p->y[k], th);
 		for (int b = 0; b < nb; b++)
 			peak[b] = fmax(peak[b], fabs(th[b]));
 	}
 	if (below == 0) {
-		figs_note(f, "landscape_path_single (Fig. 2.7c) not drawn: it shows a run in which "
+		bsim_figs_note(f, "landscape_path_single (Fig. 2.7c) not drawn: it shows a run in which "
 		             "a beam left the body while the body was still within its reach, and "
 		             "this run has none");
 		return BSIM_OK;
@@ -369,13 +369,13 @@ static int single_beam(figs *f, bsim_scene *scene, const fpath *p, const char *t
 	         "%s\nover beam %d's landscape alone: F_prop (y0 - y) + 1/2 k_%d th_%d^2, the "
 	         "other beam%s left out",
 	         title, active + 1, active + 1, active + 1, nb > 2 ? "s" : "");
-	int rc = figs_over_landscape(f, "landscape_path_single", t, scene, p, 1, ~0u, err);
+	int rc = bsim_figs_over_landscape(f, "landscape_path_single", t, scene, p, 1, ~0u, err);
 	for (int b = 0; b < nb; b++)
 		scene->beams[b].stiffness = k_saved[b];
 	return rc;
 }
 
-int figs_run(figs *f, const char *dir, bsim_error *err)
+int bsim_figs_run(figs *f, const char *dir, bsim_error *err)
 {
 	if (f->def->n_select > 0)
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -388,7 +388,7 @@ int figs_run(figs *f, const char *dir, bsim_error *err)
 	int found;
 	int rc = run_scene(dir, &scene, outcome, type, params, sizeof params, &found, err);
 	if (!rc && !found) {
-		figs_note(f,
+		bsim_figs_note(f,
 		          "%s: no run.json and inputs/scene.yaml, so no scene: only the ledger "
 		          "is drawn",
 		          dir);
@@ -397,7 +397,7 @@ int figs_run(figs *f, const char *dir, bsim_error *err)
 	if (rc)
 		return rc;
 	csv_table t;
-	rc = csv_table_read(path, &t, err);
+	rc = bsim_csv_table_read(path, &t, err);
 	if (!rc) {
 		char hdr[600];
 		run_header(dir, 1, hdr, sizeof hdr);
@@ -406,25 +406,25 @@ int figs_run(figs *f, const char *dir, bsim_error *err)
 			rc = ledger(f, dir, err);
 		fpaths ps = {0};
 		if (!rc)
-			rc = fpaths_read(&t, path, &ps, err);
+			rc = bsim_fpaths_read(&t, path, &ps, err);
 		if (!rc && ps.n_beams != scene.n_beams)
 			rc = bsim_error_set(err, BSIM_EINPUT,
 			                    "%s: %d theta columns for a scene of %d beams", path,
 			                    ps.n_beams, scene.n_beams);
 		if (!rc && ps.n > 0) {
-			ps.p[0].cls = fpath_class(outcome, type);
+			ps.p[0].cls = bsim_fpath_class(outcome, type);
 			char title[1100];
 			snprintf(title, sizeof title,
 			         "%s: one trial, %s%s%s, over its landscape\n%s", scene.name,
 			         outcome, *type && strcmp(type, "none") ? ", type " : "",
 			         strcmp(type, "none") ? type : "", params);
-			rc = figs_over_landscape(f, "landscape_path", title, &scene, ps.p, 1, ~0u,
+			rc = bsim_figs_over_landscape(f, "landscape_path", title, &scene, ps.p, 1, ~0u,
 			                         err);
 			if (!rc)
 				rc = single_beam(f, &scene, &ps.p[0], title, err);
 		}
-		fpaths_free(&ps);
-		csv_table_free(&t);
+		bsim_fpaths_free(&ps);
+		bsim_csv_table_free(&t);
 	}
 	bsim_scene_free(&scene);
 	return rc;

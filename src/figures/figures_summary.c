@@ -20,7 +20,7 @@ static int text_number(const char *s, double *x)
 	return *end == '\0' && isfinite(*x);
 }
 
-int fsum_same_value(const char *a, const char *b)
+int bsim_fsum_same_value(const char *a, const char *b)
 {
 	double x, y;
 	if (text_number(a, &x) && text_number(b, &y))
@@ -28,7 +28,7 @@ int fsum_same_value(const char *a, const char *b)
 	return strcmp(a, b) == 0;
 }
 
-void fsum_free(fsum *s)
+void bsim_fsum_free(fsum *s)
 {
 	for (int a = 0; a < s->n_axes; a++) {
 		free(s->axes[a].key);
@@ -77,11 +77,11 @@ static int group_count(const ydoc *d, struct fy_node *gn, const char *field, int
                        bsim_error *err)
 {
 	long long v;
-	struct fy_node *n = ydoc_lookup(gn, field);
+	struct fy_node *n = bsim_ydoc_lookup(gn, field);
 	char where[64];
 	snprintf(where, sizeof where, "groups.%d.%s", g, field);
-	if (!n || !ydoc_int64(n, &v) || v < 0 || v > 2147483647)
-		return ydoc_expected(d, n, gn, where, "an integer >= 0", err);
+	if (!n || !bsim_ydoc_int64(n, &v) || v < 0 || v > 2147483647)
+		return bsim_ydoc_expected(d, n, gn, where, "an integer >= 0", err);
 	*out = (int)v;
 	return BSIM_OK;
 }
@@ -91,10 +91,10 @@ static int read_group(const ydoc *d, struct fy_node *gn, int g, fsum *s, bsim_er
 	fsum_group *G = &s->g[g];
 	char where[64];
 	snprintf(where, sizeof where, "groups.%d.params", g);
-	struct fy_node *params = ydoc_lookup(gn, "params");
+	struct fy_node *params = bsim_ydoc_lookup(gn, "params");
 	if (!params || !fy_node_is_mapping(params) ||
 	    (g > 0 && fy_node_mapping_item_count(params) != s->n_axes))
-		return ydoc_expected(d, params, gn, where, "a mapping of the grid's keys", err);
+		return bsim_ydoc_expected(d, params, gn, where, "a mapping of the grid's keys", err);
 	if (g == 0) {
 		s->n_axes = fy_node_mapping_item_count(params);
 		s->axes = calloc((size_t)(s->n_axes ? s->n_axes : 1), sizeof *s->axes);
@@ -119,7 +119,7 @@ static int read_group(const ydoc *d, struct fy_node *gn, int g, fsum *s, bsim_er
 		free(key);
 		free(val);
 		if (bad)
-			return ydoc_expected(d, fy_node_pair_key(p), params, where,
+			return bsim_ydoc_expected(d, fy_node_pair_key(p), params, where,
 			                     "the grid's keys in the order of group 0", err);
 	}
 	int rc = BSIM_OK;
@@ -138,41 +138,41 @@ static int read_group(const ydoc *d, struct fy_node *gn, int g, fsum *s, bsim_er
 	};
 	for (size_t i = 0; !rc && i < sizeof counts / sizeof counts[0]; i++)
 		rc = group_count(d, gn, counts[i].field, g, counts[i].out, err);
-	struct fy_node *pn = ydoc_lookup(gn, "p_traverse"), *lo = ydoc_lookup(gn, "ci95.0"),
-	               *hi = ydoc_lookup(gn, "ci95.1");
+	struct fy_node *pn = bsim_ydoc_lookup(gn, "p_traverse"), *lo = bsim_ydoc_lookup(gn, "ci95.0"),
+	               *hi = bsim_ydoc_lookup(gn, "ci95.1");
 	snprintf(where, sizeof where, "groups.%d.p_traverse", g);
-	if (!rc && (!pn || ydoc_number(pn, &G->p)))
-		rc = ydoc_expected(d, pn, gn, where, "a number", err);
+	if (!rc && (!pn || bsim_ydoc_number(pn, &G->p)))
+		rc = bsim_ydoc_expected(d, pn, gn, where, "a number", err);
 	snprintf(where, sizeof where, "groups.%d.ci95", g);
-	if (!rc && (!lo || !hi || ydoc_number(lo, &G->lo) || ydoc_number(hi, &G->hi)))
-		rc = ydoc_expected(d, ydoc_lookup(gn, "ci95"), gn, where, "[lo, hi]", err);
+	if (!rc && (!lo || !hi || bsim_ydoc_number(lo, &G->lo) || bsim_ydoc_number(hi, &G->hi)))
+		rc = bsim_ydoc_expected(d, bsim_ydoc_lookup(gn, "ci95"), gn, where, "[lo, hi]", err);
 	G->selected = 1;
-	struct fy_node *det = ydoc_lookup(gn, "deterministic");
-	const char *dt = det ? ydoc_plain(det) : NULL;
+	struct fy_node *det = bsim_ydoc_lookup(gn, "deterministic");
+	const char *dt = det ? bsim_ydoc_plain(det) : NULL;
 	G->deterministic = dt && strcmp(dt, "true") == 0;
 	return rc;
 }
 
-int fsum_read(const char *path, fsum *s, bsim_error *err)
+int bsim_fsum_read(const char *path, fsum *s, bsim_error *err)
 {
 	memset(s, 0, sizeof *s);
 	ydoc d;
-	int rc = ydoc_load_own(&d, path, err);
+	int rc = bsim_ydoc_load_own(&d, path, err);
 	if (rc)
 		return rc;
 	struct fy_node *root = fy_document_root(d.fyd);
-	struct fy_node *groups = ydoc_lookup(root, "groups");
-	struct fy_node *b = ydoc_lookup(root, "backend");
-	struct fy_node *tpg = ydoc_lookup(root, "trials_per_group");
+	struct fy_node *groups = bsim_ydoc_lookup(root, "groups");
+	struct fy_node *b = bsim_ydoc_lookup(root, "backend");
+	struct fy_node *tpg = bsim_ydoc_lookup(root, "trials_per_group");
 	long long trials = 0;
-	const char *bt = b ? ydoc_plain(b) : NULL;
+	const char *bt = b ? bsim_ydoc_plain(b) : NULL;
 	size_t blen = 0;
 	if (b && fy_node_is_scalar(b))
 		bt = fy_node_get_scalar(b, &blen);
 	if (!groups || !fy_node_is_sequence(groups) || fy_node_sequence_item_count(groups) < 1)
-		rc = ydoc_expected(&d, groups, root, "groups", "a list of groups", err);
-	else if (!tpg || !ydoc_int64(tpg, &trials) || trials < 0)
-		rc = ydoc_expected(&d, tpg, root, "trials_per_group", "an integer >= 0", err);
+		rc = bsim_ydoc_expected(&d, groups, root, "groups", "a list of groups", err);
+	else if (!tpg || !bsim_ydoc_int64(tpg, &trials) || trials < 0)
+		rc = bsim_ydoc_expected(&d, tpg, root, "trials_per_group", "an integer >= 0", err);
 	if (!rc) {
 		snprintf(s->backend, sizeof s->backend, "%.*s", bt ? (int)blen : 0, bt ? bt : "");
 		s->trials_per_group = (int)trials;
@@ -194,9 +194,9 @@ int fsum_read(const char *path, fsum *s, bsim_error *err)
 		for (int i = 0; i < ax->n_values; i++)
 			ax->numeric &= text_number(ax->values[i], &ax->x[i]);
 	}
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	if (rc)
-		fsum_free(s);
+		bsim_fsum_free(s);
 	return rc;
 }
 
@@ -288,7 +288,7 @@ static void count_selected(fsum *s)
 	}
 }
 
-int fsum_select(const figs *f, fsum *s, bsim_error *err)
+int bsim_fsum_select(const figs *f, fsum *s, bsim_error *err)
 {
 	count_selected(s);
 	for (int i = 0; i < f->def->n_select; i++) {
@@ -311,7 +311,7 @@ int fsum_select(const figs *f, fsum *s, bsim_error *err)
 		}
 		int any = 0;
 		for (int g = 0; a < s->n_axes && g < s->n_groups; g++) {
-			int match = fsum_same_value(s->axes[a].values[s->g[g].idx[a]], o->value);
+			int match = bsim_fsum_same_value(s->axes[a].values[s->g[g].idx[a]], o->value);
 			s->g[g].selected &= match;
 			any |= match;
 		}
@@ -353,7 +353,7 @@ static void fixed_add(fsum *s, const char *key, const char *value)
 		s->n_fixed++;
 }
 
-int fsum_fixed_number(const fsum *s, const char *key, double *x)
+int bsim_fsum_fixed_number(const fsum *s, const char *key, double *x)
 {
 	for (int i = 0; i < s->n_fixed; i++)
 		if (strcmp(s->fixed_key[i], key) == 0)
@@ -361,27 +361,27 @@ int fsum_fixed_number(const fsum *s, const char *key, double *x)
 	return 0;
 }
 
-void fsum_header(fsum *s, const char *inputs, const char *who)
+void bsim_fsum_header(fsum *s, const char *inputs, const char *who)
 {
 	s->n_fixed = 0;
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/experiment.yaml", inputs ? inputs : "");
 	ydoc d;
 	bsim_error ignore;
-	if (inputs && ydoc_load_own(&d, path, &ignore) == BSIM_OK) {
-		struct fy_node *set = ydoc_lookup(fy_document_root(d.fyd), "set");
+	if (inputs && bsim_ydoc_load_own(&d, path, &ignore) == BSIM_OK) {
+		struct fy_node *set = bsim_ydoc_lookup(fy_document_root(d.fyd), "set");
 		void *it = NULL;
 		struct fy_node_pair *p;
 		while (set && fy_node_is_mapping(set) &&
 		       (p = fy_node_mapping_iterate(set, &it)) != NULL) {
 			char *key = scalar_dup(fy_node_pair_key(p));
-			char *val = ydoc_flow_text(fy_node_pair_value(p));
+			char *val = bsim_ydoc_flow_text(fy_node_pair_value(p));
 			if (key && val)
 				fixed_add(s, key, val);
 			free(key);
 			free(val);
 		}
-		ydoc_free(&d);
+		bsim_ydoc_free(&d);
 	}
 	for (int a = 0; a < s->n_axes; a++) {
 		if (s->axes[a].n_selected != 1)
@@ -396,13 +396,13 @@ void fsum_header(fsum *s, const char *inputs, const char *who)
 	size_t k = n > 0 ? (size_t)n : 0;
 	for (int i = 0; i < s->n_fixed && k < sizeof s->header; i++) {
 		char kv[200];
-		figs_key_value(s->fixed_key[i], s->fixed_value[i], kv, sizeof kv);
+		bsim_figs_key_value(s->fixed_key[i], s->fixed_value[i], kv, sizeof kv);
 		n = snprintf(s->header + k, sizeof s->header - k, "%s%s", i ? ", " : "; ", kv);
 		k += n > 0 ? (size_t)n : 0;
 	}
 }
 
-void fsum_label(const fsum *s, int g, char *buf, size_t size)
+void bsim_fsum_label(const fsum *s, int g, char *buf, size_t size)
 {
 	size_t k = 0;
 	int shown = 0;
@@ -411,7 +411,7 @@ void fsum_label(const fsum *s, int g, char *buf, size_t size)
 		if (s->axes[a].n_selected == 1)
 			continue;
 		char kv[200];
-		figs_key_value(s->axes[a].key, s->axes[a].values[s->g[g].idx[a]], kv, sizeof kv);
+		bsim_figs_key_value(s->axes[a].key, s->axes[a].values[s->g[g].idx[a]], kv, sizeof kv);
 		/* a line of its own from the third on, to fit a figure's width */
 		int n = snprintf(buf + k, size - k, "%s%s",
 		                 shown == 0  ? ""

@@ -21,11 +21,11 @@ static int table(const char *dir, const char *name, const char *const *need, int
                  int *col, char *path, bsim_error *err)
 {
 	snprintf(path, BSIM_PATH_MAX, "%s/%s", dir, name);
-	int rc = csv_table_read(path, t, err);
+	int rc = bsim_csv_table_read(path, t, err);
 	if (rc)
 		return rc;
-	if ((rc = csv_table_require(t, path, need, n, col, err)))
-		csv_table_free(t);
+	if ((rc = bsim_csv_table_require(t, path, need, n, col, err)))
+		bsim_csv_table_free(t);
 	return rc;
 }
 
@@ -36,13 +36,13 @@ static int block(FILE *o, const csv_table *t, const char *path, const int *col, 
 {
 	for (long r = 0; r < t->n_rows; r++) {
 		double v, gr;
-		if (csv_table_number(t, r, col[0], &gr))
+		if (bsim_csv_table_number(t, r, col[0], &gr))
 			return bsim_error_set(err, BSIM_EINPUT, "%s:%ld: group: expected a number",
 			                      path, r + 2);
 		if ((int)gr != g)
 			continue;
 		for (int k = 1; k < n; k++) {
-			if (csv_table_number(t, r, col[k], &v))
+			if (bsim_csv_table_number(t, r, col[k], &v))
 				return bsim_error_set(err, BSIM_EINPUT,
 				                      "%s:%ld: expected a number in column %d",
 				                      path, r + 2, col[k] + 1);
@@ -53,7 +53,7 @@ static int block(FILE *o, const csv_table *t, const char *path, const int *col, 
 	return BSIM_OK;
 }
 
-int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
+int bsim_figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX], spath[BSIM_PATH_MAX], hpath[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/survival.csv", dir);
@@ -70,7 +70,7 @@ int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 	if (rc)
 		return rc;
 	if ((rc = table(dir, "horizon.csv", hneed, 8, &ht, hcol, hpath, err))) {
-		csv_table_free(&st);
+		bsim_csv_table_free(&st);
 		return rc;
 	}
 	/* the groups shown: the selected ones with the most exits by the horizon */
@@ -101,12 +101,12 @@ int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 			shown[k - 1] = x;
 		}
 	if (n_sel > n_shown)
-		figs_note(f,
+		bsim_figs_note(f,
 		          "survival: %d of the %d selected groups drawn (those with the most "
 		          "exits); --select KEY=VALUE draws others",
 		          n_shown, n_sel);
 	bsim_atomic_file o;
-	rc = figs_data_open(f, "survival.dat", &o, path, err);
+	rc = bsim_figs_data_open(f, "survival.dat", &o, path, err);
 	if (!rc) {
 		fputs("# t S lo hi (Kaplan-Meier, Greenwood 95%), one block per group shown; then "
 		      "h p_traverse lo hi p_stuck lo hi (Wilson 95%), one block per group\n",
@@ -122,27 +122,27 @@ int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 		if (rc)
 			bsim_atomic_file_abort(&o);
 		else
-			rc = figs_data_commit(&o, err);
+			rc = bsim_figs_data_commit(&o, err);
 	}
 	/* the horizon each group ran to: the last h of its block */
 	double horizon = 0.0;
 	for (long r = 0; !rc && r < ht.n_rows; r++) {
 		double h;
-		if (csv_table_number(&ht, r, hcol[1], &h) == 0 && h > horizon)
+		if (bsim_csv_table_number(&ht, r, hcol[1], &h) == 0 && h > horizon)
 			horizon = h;
 	}
-	csv_table_free(&st);
-	csv_table_free(&ht);
+	bsim_csv_table_free(&st);
+	bsim_csv_table_free(&ht);
 	if (rc || n_shown == 0)
 		return rc;
 	gp_text g;
-	if ((rc = gp_text_open(&g, err)))
+	if ((rc = bsim_gp_text_open(&g, err)))
 		return rc;
 	char title[900];
 	snprintf(title, sizeof title, "time to leave the gate, %d trials per group\n%s",
 	         s->trials_per_group, s->header);
 	fputs("set multiplot layout 1,2 title ", g.f);
-	gp_str(g.f, title);
+	bsim_gp_str(g.f, title);
 	fprintf(g.f,
 	        " noenhanced\n"
 	        "set grid\nset style fill transparent solid 0.12 noborder\n"
@@ -156,7 +156,7 @@ int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 		/* the key's one line: every axis, ", " where the label breaks */
 		char text[300], label[450];
 		size_t k = 0;
-		fsum_label(s, shown[i], text, sizeof text);
+		bsim_fsum_label(s, shown[i], text, sizeof text);
 		for (const char *c = text; *c && k + 3 < sizeof label; c++) {
 			if (*c == '\n') {
 				label[k++] = ',';
@@ -171,7 +171,7 @@ int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 		        "notitle, "
 		        "\\\n     '' index %d using 1:2 with steps lw 2 lc rgb '%s' title ",
 		        i ? ", \\\n     " : "", i, colour[i], i, colour[i]);
-		gp_str(g.f, label);
+		bsim_gp_str(g.f, label);
 	}
 	fprintf(g.f,
 	        "\nset title 'had the trials stopped at h: traversed (solid), stuck (dashed); "
@@ -186,8 +186,8 @@ int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 		        i ? ", \\\n     " : "", n_shown + i, colour[i], n_shown + i, colour[i],
 		        n_shown + i, colour[i], n_shown + i, colour[i]);
 	fputs("\nunset multiplot\n", g.f);
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, "survival", 1300, 560, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, "survival", 1300, 560, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;

@@ -13,6 +13,6 @@
 /* Draws survival.png from dir's survival.csv and horizon.csv, if dir has
  * them (an older sweep has not: nothing drawn, BSIM_OK); BSIM_EINPUT if
  * either is malformed. */
-int figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err);
+int bsim_figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err);
 
 #endif

@@ -92,7 +92,7 @@ static void panel_label(const fsum *s, const active *a, int g, int skip0, int sk
 		if (ax == skip0 || ax == skip1 || a->n[ax] < 2)
 			continue;
 		char kv[200];
-		figs_key_value(s->axes[ax].key, s->axes[ax].values[s->g[g].idx[ax]], kv, sizeof kv);
+		bsim_figs_key_value(s->axes[ax].key, s->axes[ax].values[s->g[g].idx[ax]], kv, sizeof kv);
 		int n = snprintf(buf + k, size - k, "%s%s", k ? ", " : "", kv);
 		k += n > 0 ? (size_t)n : 0;
 	}
@@ -116,7 +116,7 @@ static int tics(FILE *f, const char *which, const fsum_axis *ax, const int *pos)
 	for (int i = 0; i < ax->n_values; i++)
 		if (pos[i] >= 0) {
 			fputs(k++ ? ", " : "", f);
-			gp_str(f, ax->values[i]);
+			bsim_gp_str(f, ax->values[i]);
 			fprintf(f, " %d", pos[i]);
 			int n = (int)strlen(ax->values[i]);
 			longest = n > longest ? n : longest;
@@ -166,7 +166,7 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	const int np = panels(s, a, ax0, ax1);
 	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
-	int rc = figs_data_open(f, "p_traverse.dat", &o, path, err);
+	int rc = bsim_figs_data_open(f, "p_traverse.dat", &o, path, err);
 	if (rc)
 		return rc;
 	fputs("# column row p_traverse ci95_lo ci95_hi traversed trials group: one block per "
@@ -192,12 +192,12 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 			        G->traversed, G->trials, g);
 		}
 	}
-	if ((rc = figs_data_commit(&o, err))) {
+	if ((rc = bsim_figs_data_commit(&o, err))) {
 		free(first);
 		return rc;
 	}
 	gp_text g;
-	if ((rc = gp_text_open(&g, err))) {
+	if ((rc = bsim_gp_text_open(&g, err))) {
 		free(first);
 		return rc;
 	}
@@ -210,7 +210,7 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	         lattice ? " (reached the end of the lattice)" : "", s->trials_per_group,
 	         s->header);
 	fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
-	gp_str(g.f, title);
+	bsim_gp_str(g.f, title);
 	fputs(" noenhanced\n"
 	      "set palette defined (0 '#F7FBFF', 0.5 '#6BAED6', 1 '#08306B')\n"
 	      "set cbrange [0:1]\nset cblabel 'p_{traverse}'\nset cbtics 0.2\n",
@@ -223,7 +223,7 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	if (ax0 >= 0) {
 		xtic = tics(g.f, "x", &s->axes[ax0], a->pos[ax0]);
 		fputs("set xlabel ", g.f);
-		gp_key_label(g.f, s->axes[ax0].key);
+		bsim_gp_key_label(g.f, s->axes[ax0].key);
 		fputs("\n", g.f);
 		xlab = bsim_key_label(s->axes[ax0].key, 0, label, sizeof label);
 	} else {
@@ -232,7 +232,7 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	if (ax1 >= 0) {
 		ytic = tics(g.f, "y", &s->axes[ax1], a->pos[ax1]);
 		fputs("set ylabel ", g.f);
-		gp_key_label(g.f, s->axes[ax1].key);
+		bsim_gp_key_label(g.f, s->axes[ax1].key);
 		fputs("\n", g.f);
 		ylab = 1;
 	} else {
@@ -255,7 +255,7 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 		if (pw < TEXT_PX(widest_line(label)) + 150)
 			pw = TEXT_PX(widest_line(label)) + 150;
 		fputs("set title ", g.f);
-		gp_str(g.f, label);
+		bsim_gp_str(g.f, label);
 		fprintf(g.f,
 		        " noenhanced\n"
 		        "plot 'p_traverse.dat' index %d using 1:2:(0.5):(0.5):3 with boxxyerror "
@@ -270,8 +270,8 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	int W = pw * cols, H = ph * rows + 60;
 	if (W < TEXT_PX(widest_line(title)))
 		W = TEXT_PX(widest_line(title));
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, "p_traverse", W, H, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, "p_traverse", W, H, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -291,7 +291,7 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 	snprintf(name, sizeof name, "traversal_vs_%s", ident);
 	snprintf(file, sizeof file, "%s.dat", name);
 	bsim_atomic_file o;
-	int rc = figs_data_open(f, file, &o, path, err);
+	int rc = bsim_figs_data_open(f, file, &o, path, err);
 	if (rc)
 		return rc;
 	fprintf(o.f,
@@ -354,12 +354,12 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 				        G->land_left / n, G->land_right / n);
 			}
 	}
-	if ((rc = figs_data_commit(&o, err))) {
+	if ((rc = bsim_figs_data_commit(&o, err))) {
 		free(first);
 		return rc;
 	}
 	gp_text g;
-	if ((rc = gp_text_open(&g, err))) {
+	if ((rc = bsim_gp_text_open(&g, err))) {
 		free(first);
 		return rc;
 	}
@@ -399,9 +399,9 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 		fputs("set multiplot title ", g.f);
 	else
 		fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
-	gp_str(g.f, title);
+	bsim_gp_str(g.f, title);
 	fputs(" noenhanced\nset yrange [0:1]\nset ylabel 'fraction of trials'\nset xlabel ", g.f);
-	gp_key_label(g.f, A->key);
+	bsim_gp_key_label(g.f, A->key);
 	fputs("\nset grid\nset style fill transparent solid 0.15 noborder\n"
 	      "unset key\n",
 	      g.f);
@@ -410,11 +410,11 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 	double other;
 	int ratio = 0;
 	if (A->numeric && strcmp(A->key, "beams.0.stiffness") == 0 &&
-	    fsum_fixed_number(s, "beams.1.stiffness", &other) && other > 0) {
+	    bsim_fsum_fixed_number(s, "beams.1.stiffness", &other) && other > 0) {
 		fprintf(g.f, "set link x2 via x/%.17g inverse x*%.17g\n", other, other);
 		ratio = 1;
 	} else if (A->numeric && strcmp(A->key, "beams.1.stiffness") == 0 &&
-	           fsum_fixed_number(s, "beams.0.stiffness", &other) && other > 0) {
+	           bsim_fsum_fixed_number(s, "beams.0.stiffness", &other) && other > 0) {
 		fprintf(g.f, "set link x2 via %.17g/x inverse %.17g/x\n", other, other);
 		ratio = 1;
 	}
@@ -432,7 +432,7 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 		for (int oa = 0; oa < s->n_axes && k < sizeof label; oa++)
 			if (oa != ax && a->n[oa] > 1) {
 				char kv[200];
-				figs_key_value(s->axes[oa].key,
+				bsim_figs_key_value(s->axes[oa].key,
 				               s->axes[oa].values[s->g[first[p]].idx[oa]], kv,
 				               sizeof kv);
 				int w = snprintf(label + k, sizeof label - k, "%s%s", k ? ", " : "",
@@ -440,7 +440,7 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 				k += w > 0 ? (size_t)w : 0;
 			}
 		fputs("set title ", g.f);
-		gp_str(g.f, label);
+		bsim_gp_str(g.f, label);
 		if (lattice) {
 			fprintf(g.f,
 			        " noenhanced\n"
@@ -506,8 +506,8 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 		        FIG_BLACK, FIG_BLUE, FIG_RED, FIG_BLUE, FIG_RED, FIG_GREY);
 	fputs("unset multiplot\n", g.f);
 	free(first);
-	char *body = gp_text_take(&g);
-	rc = body ? figs_render(f, name, W, H, body, err)
+	char *body = bsim_gp_text_take(&g);
+	rc = body ? bsim_figs_render(f, name, W, H, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
@@ -543,17 +543,17 @@ static int classes_read(const char *dir, const fsum *s, fpaths *ps, bsim_error *
 			which[(long)p->group * per + p->trial] = i;
 	}
 	csv_table t;
-	int rc = csv_table_read(path, &t, err);
+	int rc = bsim_csv_table_read(path, &t, err);
 	if (rc) {
 		free(which);
 		return rc;
 	}
 	static const char *const need[] = {"group", "trial", "outcome", "type"};
 	int col[4];
-	rc = csv_table_require(&t, path, need, 4, col, err);
+	rc = bsim_csv_table_require(&t, path, need, 4, col, err);
 	for (long r = 0; !rc && r < t.n_rows; r++) {
 		double g, tr;
-		if (csv_table_number(&t, r, col[0], &g) || csv_table_number(&t, r, col[1], &tr) ||
+		if (bsim_csv_table_number(&t, r, col[0], &g) || bsim_csv_table_number(&t, r, col[1], &tr) ||
 		    g < 0 || g >= s->n_groups || tr < 0 || tr >= per) {
 			rc = bsim_error_set(err, BSIM_EINPUT,
 			                    "%s:%ld: group, trial: expected integers within the "
@@ -563,11 +563,11 @@ static int classes_read(const char *dir, const fsum *s, fpaths *ps, bsim_error *
 		}
 		int i = which[(long)g * per + (long)tr];
 		if (i >= 0)
-			ps->p[i].cls = fpath_class(csv_table_cell(&t, r, col[2]),
-			                           csv_table_cell(&t, r, col[3]));
+			ps->p[i].cls = bsim_fpath_class(bsim_csv_table_cell(&t, r, col[2]),
+			                           bsim_csv_table_cell(&t, r, col[3]));
 	}
 	free(which);
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	return rc;
 }
 
@@ -578,7 +578,7 @@ static int group_figures(figs *f, traj_job *j, int g, bsim_error *err)
 	if (rc)
 		return rc;
 	char label[512], title[1400], name[64];
-	fsum_label(j->s, g, label, sizeof label);
+	bsim_fsum_label(j->s, g, label, sizeof label);
 	const fpath *p = j->paths.p + j->first[g];
 	/* a group without random force ran one trial, whose rows fill the
 	 * group: one path, not the first n of many */
@@ -594,7 +594,7 @@ static int group_figures(figs *f, traj_job *j, int g, bsim_error *err)
 		snprintf(title, sizeof title, "group %d, the first %d of %d trials\n%s%s%s", g, n,
 		         j->s->g[g].trials, j->s->header, *label ? "\n" : "", label);
 	snprintf(name, sizeof name, "trajectories_g%03d", g);
-	rc = figs_bundle(f, name, title, &scene, p, n, err);
+	rc = bsim_figs_bundle(f, name, title, &scene, p, n, err);
 	if (!rc && trav > 0) {
 		/* the landscape's title: backend, the experiment's set: and the
 		 * group's grid values, in the model's symbols and units */
@@ -612,7 +612,7 @@ static int group_figures(figs *f, traj_job *j, int g, bsim_error *err)
 			kv[j->e->n_set + a] = j->s->axes[a].key;
 			kv[nk + j->e->n_set + a] = j->s->axes[a].values[j->s->g[g].idx[a]];
 		}
-		fpath_params(label, sizeof label, j->s->backend, kv, kv + nk, nk);
+		bsim_fpath_params(label, sizeof label, j->s->backend, kv, kv + nk, nk);
 		free(kv);
 		if (det)
 			snprintf(title, sizeof title,
@@ -626,7 +626,7 @@ static int group_figures(figs *f, traj_job *j, int g, bsim_error *err)
 			         "landscape\n%s",
 			         g, trav, n, label);
 		snprintf(name, sizeof name, "landscape_g%03d", g);
-		rc = figs_over_landscape(f, name, title, &scene, p, n,
+		rc = bsim_figs_over_landscape(f, name, title, &scene, p, n,
 		                         1u << FPATH_LEFT | 1u << FPATH_RIGHT | 1u << FPATH_NONE,
 		                         err);
 	}
@@ -651,7 +651,7 @@ static void untraversed_note(figs *f, const char *dir, const char *flag, int n)
 		}
 	}
 	if (count)
-		figs_note(f,
+		bsim_figs_note(f,
 		          "%s: no landscape figure for %d group%s without a traversed trial "
 		          "among the kept ones: %s%s",
 		          dir, count, count == 1 ? "" : "s", buf,
@@ -672,7 +672,7 @@ static int traj_load(figs *f, const char *dir, const char *inputs, const fsum *s
 	if (stat(path, &st) != 0)
 		return BSIM_OK;
 	if (stat(exp_path, &st) != 0) {
-		figs_note(f, "%s: no %s, so no scene to draw the trajectories on", dir, exp_path);
+		bsim_figs_note(f, "%s: no %s, so no scene to draw the trajectories on", dir, exp_path);
 		return BSIM_OK;
 	}
 	int rc = bsim_experiment_load(exp_path, NULL, 0, &j->e_own, err);
@@ -683,11 +683,11 @@ static int traj_load(figs *f, const char *dir, const char *inputs, const fsum *s
 	if (j->e->n_groups != s->n_groups)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: %d groups, but %s/summary.json has %d",
 		                      exp_path, j->e->n_groups, dir, s->n_groups);
-	rc = csv_table_read(path, &j->table, err);
+	rc = bsim_csv_table_read(path, &j->table, err);
 	if (rc)
 		return rc;
 	j->have_table = 1;
-	rc = fpaths_read(&j->table, path, &j->paths, err);
+	rc = bsim_fpaths_read(&j->table, path, &j->paths, err);
 	if (!rc)
 		rc = classes_read(dir, s, &j->paths, err);
 	j->first = calloc((size_t)s->n_groups, sizeof *j->first);
@@ -713,9 +713,9 @@ static void traj_free(traj_job *j, int have)
 	free(j->untraversed);
 	free(j->first);
 	free(j->count);
-	fpaths_free(&j->paths);
+	bsim_fpaths_free(&j->paths);
 	if (j->have_table)
-		csv_table_free(&j->table);
+		bsim_csv_table_free(&j->table);
 	bsim_experiment_free(&j->e_own);
 }
 
@@ -729,13 +729,13 @@ static int traj_group(figs *f, void *job, int g, bsim_error *err)
 
 static int traj_draw(figs *f, const char *dir, traj_job *j, bsim_error *err)
 {
-	int rc = figs_each_group(f, j->s->n_groups, traj_group, j, err);
+	int rc = bsim_figs_each_group(f, j->s->n_groups, traj_group, j, err);
 	if (rc == BSIM_OK)
 		untraversed_note(f, dir, j->untraversed, j->s->n_groups);
 	return rc;
 }
 
-/* trials.csv whole and of this summary: every row complete (csv_table_read
+/* trials.csv whole and of this summary: every row complete (bsim_csv_table_read
  * refuses a file cut mid-row), and each trial of the groups x trials
  * summary.json counts once. The figures come from summary.json; a
  * trials.csv that does not add up to it means the directory is damaged,
@@ -746,18 +746,18 @@ static int trials_check(const char *dir, const fsum *s, bsim_error *err)
 	snprintf(path, sizeof path, "%s/trials.csv", dir);
 	const long per = s->trials_per_group, total = (long)s->n_groups * per;
 	csv_table t;
-	int rc = csv_table_read(path, &t, err);
+	int rc = bsim_csv_table_read(path, &t, err);
 	if (rc)
 		return rc;
 	static const char *const need[] = {"group", "trial"};
 	int col[2];
 	char *seen = calloc((size_t)total + 1, 1);
-	rc = csv_table_require(&t, path, need, 2, col, err);
+	rc = bsim_csv_table_require(&t, path, need, 2, col, err);
 	if (!rc && !seen)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (long r = 0; !rc && r < t.n_rows; r++) {
 		double g, tr;
-		if (csv_table_number(&t, r, col[0], &g) || csv_table_number(&t, r, col[1], &tr) ||
+		if (bsim_csv_table_number(&t, r, col[0], &g) || bsim_csv_table_number(&t, r, col[1], &tr) ||
 		    g < 0 || g >= s->n_groups || tr < 0 || tr >= per || g != (long)g ||
 		    tr != (long)tr || seen[(long)g * per + (long)tr]++)
 			rc = bsim_error_set(err, BSIM_EINPUT,
@@ -771,16 +771,16 @@ static int trials_check(const char *dir, const fsum *s, bsim_error *err)
 		                    "summary.json), got %ld by the end of the file",
 		                    path, t.n_rows + 1, total, s->n_groups, per, t.n_rows);
 	free(seen);
-	csv_table_free(&t);
+	bsim_csv_table_free(&t);
 	return rc;
 }
 
-int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
+int bsim_figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/summary.json", dir);
 	fsum s;
-	int rc = fsum_read(path, &s, err);
+	int rc = bsim_fsum_read(path, &s, err);
 	if (rc)
 		return rc;
 	active a = {{NULL}, {0}};
@@ -789,23 +789,23 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 	/* every input read and checked first: a bad one leaves no figure */
 	rc = trials_check(dir, &s, err);
 	if (!rc)
-		rc = fsum_select(f, &s, err);
+		rc = bsim_fsum_select(f, &s, err);
 	if (!rc)
 		rc = active_build(&s, &a, err);
 	if (!rc) {
 		char who[128];
 		snprintf(who, sizeof who, "%s backend", s.backend);
-		fsum_header(&s, inputs, who);
+		bsim_fsum_header(&s, inputs, who);
 	}
 	/* a lattice gets its own trajectory figures (figures_lattice.c) */
 	lat_job *lat = NULL;
-	if (!rc && figs_is_lattice(dir))
-		rc = figs_lattice_load(f, dir, inputs, &s, &lat, err);
+	if (!rc && bsim_figs_is_lattice(dir))
+		rc = bsim_figs_lattice_load(f, dir, inputs, &s, &lat, err);
 	else if (!rc)
 		rc = traj_load(f, dir, inputs, &s, &j, &have, err);
 	/* survival.csv and horizon.csv are read whole before it draws */
 	if (!rc)
-		rc = figs_survival(f, dir, &s, err);
+		rc = bsim_figs_survival(f, dir, &s, err);
 	if (!rc)
 		rc = heat_map(f, &s, &a, lat != NULL, err);
 	for (int ax = 0; !rc && ax < s.n_axes; ax++)
@@ -814,10 +814,10 @@ int figs_sweep(figs *f, const char *dir, const char *inputs, bsim_error *err)
 	if (!rc && have)
 		rc = traj_draw(f, dir, &j, err);
 	if (!rc && lat)
-		rc = figs_lattice_draw(f, lat, err);
-	figs_lattice_free(lat);
+		rc = bsim_figs_lattice_draw(f, lat, err);
+	bsim_figs_lattice_free(lat);
 	traj_free(&j, have);
 	active_free(&a, s.n_axes);
-	fsum_free(&s);
+	bsim_fsum_free(&s);
 	return rc;
 }

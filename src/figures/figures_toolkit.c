@@ -11,7 +11,7 @@
 #include "util/figure.h"
 #include "beamsim/limits.h"
 
-int figs_data_open(const figs *f, const char *file, bsim_atomic_file *o, char *path,
+int bsim_figs_data_open(const figs *f, const char *file, bsim_atomic_file *o, char *path,
                    bsim_error *err)
 {
 	if (snprintf(path, BSIM_PATH_MAX, "%s/%s", f->out, file) >= BSIM_PATH_MAX)
@@ -19,7 +19,7 @@ int figs_data_open(const figs *f, const char *file, bsim_atomic_file *o, char *p
 	return bsim_atomic_file_open(o, path, err);
 }
 
-int figs_data_commit(bsim_atomic_file *o, bsim_error *err)
+int bsim_figs_data_commit(bsim_atomic_file *o, bsim_error *err)
 {
 	return bsim_atomic_file_commit(o, err);
 }
@@ -38,7 +38,7 @@ static void list_add(char ***list, int *n, char *s)
 	*list = l;
 }
 
-int figs_render(figs *f, const char *name, int width, int height, const char *body, bsim_error *err)
+int bsim_figs_render(figs *f, const char *name, int width, int height, const char *body, bsim_error *err)
 {
 	bsim_figure_def d = bsim_figure_def_default();
 	d.dir = f->out;
@@ -75,7 +75,7 @@ int figs_render(figs *f, const char *name, int width, int height, const char *bo
 	return BSIM_OK;
 }
 
-void figs_note(figs *f, const char *fmt, ...)
+void bsim_figs_note(figs *f, const char *fmt, ...)
 {
 	char buf[512];
 	va_list ap;
@@ -86,7 +86,7 @@ void figs_note(figs *f, const char *fmt, ...)
 	list_add(&f->res->notes, &f->res->n_notes, strdup(buf));
 }
 
-int figs_each_group(figs *f, int n_groups, figs_group_fn draw, void *job, bsim_error *err)
+int bsim_figs_each_group(figs *f, int n_groups, figs_group_fn draw, void *job, bsim_error *err)
 {
 	int failed = n_groups;
 	bsim_error first_err;
@@ -107,7 +107,7 @@ int figs_each_group(figs *f, int n_groups, figs_group_fn draw, void *job, bsim_e
 	return BSIM_OK;
 }
 
-int gp_text_open(gp_text *t, bsim_error *err)
+int bsim_gp_text_open(gp_text *t, bsim_error *err)
 {
 	t->buf = NULL;
 	t->len = 0;
@@ -115,7 +115,7 @@ int gp_text_open(gp_text *t, bsim_error *err)
 	return t->f ? BSIM_OK : bsim_error_set(err, BSIM_EFAIL, "out of memory for a script");
 }
 
-char *gp_text_take(gp_text *t)
+char *bsim_gp_text_take(gp_text *t)
 {
 	if (t->f)
 		fclose(t->f);
@@ -123,7 +123,7 @@ char *gp_text_take(gp_text *t)
 	return t->buf;
 }
 
-void gp_str(FILE *f, const char *s)
+void bsim_gp_str(FILE *f, const char *s)
 {
 	fputc('\'', f);
 	for (; *s; s++) {
@@ -137,15 +137,15 @@ void gp_str(FILE *f, const char *s)
 	fputc('\'', f);
 }
 
-void gp_key_label(FILE *f, const char *key)
+void bsim_gp_key_label(FILE *f, const char *key)
 {
 	char buf[400];
 	bsim_key_label(key, 1, buf, sizeof buf);
-	gp_str(f, buf);
+	bsim_gp_str(f, buf);
 	fputs(" enhanced", f);
 }
 
-void figs_key_value(const char *key, const char *value, char *buf, size_t size)
+void bsim_figs_key_value(const char *key, const char *value, char *buf, size_t size)
 {
 	bsim_key_value(key, value, 0, buf, size);
 }

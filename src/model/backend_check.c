@@ -24,23 +24,23 @@ int bsim_backend_check(const bsim_backend *b, const bsim_options *opts, const bs
 	 * (a field at its default, a beam of a lattice), says where. */
 	ydoc d;
 	bsim_error ignore;
-	if (!path || !path[0] || ydoc_load(&d, path, &ignore) != BSIM_OK)
+	if (!path || !path[0] || bsim_ydoc_load(&d, path, &ignore) != BSIM_OK)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: %s", field, msg);
 	struct fy_node *n = NULL;
-	if (yov_apply(&d, ov, n_ov, &ignore) == BSIM_OK) {
+	if (bsim_yov_apply(&d, ov, n_ov, &ignore) == BSIM_OK) {
 		struct fy_node *root = fy_document_root(d.fyd);
 		char key[sizeof field];
 		snprintf(key, sizeof key, "%s", field);
-		n = ydoc_lookup(root, key);
+		n = bsim_ydoc_lookup(root, key);
 		for (char *dot; !n && (dot = strrchr(key, '.'));) {
 			*dot = '\0';
-			n = ydoc_lookup(root, key);
+			n = bsim_ydoc_lookup(root, key);
 		}
 		if (!n)
 			n = root;
 	}
-	int rc = n ? ydoc_fail(&d, n, NULL, field, err, "%s", msg)
+	int rc = n ? bsim_ydoc_fail(&d, n, NULL, field, err, "%s", msg)
 	           : bsim_error_set(err, BSIM_EINPUT, "%s: %s", field, msg);
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	return rc;
 }

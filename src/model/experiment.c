@@ -32,7 +32,7 @@ static char *dup_text(const char *t)
 static char *value_origin(const ydoc *d, struct fy_node *n, struct fy_node *key)
 {
 	char buf[BSIM_PATH_MAX];
-	snprintf(buf, sizeof buf, "%s:%d", d->path, ydoc_line(n, key));
+	snprintf(buf, sizeof buf, "%s:%d", d->path, bsim_ydoc_line(n, key));
 	return dup_text(buf);
 }
 
@@ -46,19 +46,19 @@ static const char *key_text(struct fy_node *k)
 static int walk_scene_path(const ydoc *d, struct fy_node *n, struct fy_node *key,
                            bsim_experiment *e, bsim_error *err)
 {
-	const char *t = ydoc_is_null(n) || !fy_node_is_scalar(n) ? NULL : fy_node_get_scalar0(n);
+	const char *t = bsim_ydoc_is_null(n) || !fy_node_is_scalar(n) ? NULL : fy_node_get_scalar0(n);
 	if (!t)
-		return ydoc_expected(d, n, key, "scene", "a scene file name", err);
+		return bsim_ydoc_expected(d, n, key, "scene", "a scene file name", err);
 	const char *slash = strrchr(d->path, '/');
 	int dir = t[0] == '/' || !slash ? 0 : (int)(slash - d->path + 1);
 	int len = snprintf(e->scene_path, sizeof e->scene_path, "%.*s%s", dir, d->path, t);
 	if (len < 0 || (size_t)len >= sizeof e->scene_path)
-		return ydoc_expected(d, n, key, "scene", "a shorter path", err);
+		return bsim_ydoc_expected(d, n, key, "scene", "a shorter path", err);
 	/* Read here, once: every group's scene is made from this text
 	 * (bsim_experiment.scene_text). */
 	file_text f;
 	bsim_error fe;
-	int rc = file_read(e->scene_path, "a YAML file", bsim_limits_get()->input_bytes,
+	int rc = bsim_file_read(e->scene_path, "a YAML file", bsim_limits_get()->input_bytes,
 	                   "input_bytes", &f, &fe);
 	if (rc == BSIM_EFAIL) {
 		*err = fe;
@@ -67,7 +67,7 @@ static int walk_scene_path(const ydoc *d, struct fy_node *n, struct fy_node *key
 	if (rc != BSIM_OK) {
 		char what[BSIM_PATH_MAX];
 		snprintf(what, sizeof what, "a readable scene file (%s)", fe.msg);
-		return ydoc_expected(d, n, key, "scene", what, err);
+		return bsim_ydoc_expected(d, n, key, "scene", what, err);
 	}
 	free(e->scene_text);
 	e->scene_text = f.text;
@@ -78,10 +78,10 @@ static int walk_scene_path(const ydoc *d, struct fy_node *n, struct fy_node *key
 static int walk_set(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim_experiment *e,
                     bsim_error *err)
 {
-	if (ydoc_is_null(n))
+	if (bsim_ydoc_is_null(n))
 		return BSIM_OK;
 	if (!fy_node_is_mapping(n))
-		return ydoc_expected(d, n, key, "set", "a mapping of dotted keys to values", err);
+		return bsim_ydoc_expected(d, n, key, "set", "a mapping of dotted keys to values", err);
 	int count = fy_node_mapping_item_count(n);
 	e->set = calloc((size_t)count, sizeof *e->set);
 	if (!e->set)
@@ -91,14 +91,14 @@ static int walk_set(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim_
 		struct fy_node *k = fy_node_pair_key(p), *v = fy_node_pair_value(p);
 		const char *name = key_text(k);
 		char field[512];
-		ydoc_join(field, sizeof field, "set.", name ? name : "?");
+		bsim_ydoc_join(field, sizeof field, "set.", name ? name : "?");
 		if (!name)
-			return ydoc_expected(d, k, n, "set", "a dotted scene key", err);
-		if (ydoc_is_null(v))
-			return ydoc_expected(d, v, k, field, "a value", err);
+			return bsim_ydoc_expected(d, k, n, "set", "a dotted scene key", err);
+		if (bsim_ydoc_is_null(v))
+			return bsim_ydoc_expected(d, v, k, field, "a value", err);
 		bsim_override *o = &e->set[e->n_set++];
 		o->key = dup_text(name);
-		o->value = ydoc_flow_text(v);
+		o->value = bsim_ydoc_flow_text(v);
 		o->origin = value_origin(d, v, k);
 		if (!o->key || !o->value || !o->origin)
 			return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
@@ -111,12 +111,12 @@ static int walk_axis(const ydoc *d, struct fy_node *k, struct fy_node *v, bsim_g
 {
 	const char *name = key_text(k);
 	char field[512];
-	ydoc_join(field, sizeof field, "grid.", name ? name : "?");
+	bsim_ydoc_join(field, sizeof field, "grid.", name ? name : "?");
 	if (!name)
-		return ydoc_expected(d, k, NULL, "grid", "a dotted scene key", err);
+		return bsim_ydoc_expected(d, k, NULL, "grid", "a dotted scene key", err);
 	int count = v && fy_node_is_sequence(v) ? fy_node_sequence_item_count(v) : 0;
 	if (count == 0)
-		return ydoc_expected(d, v, k, field, "a non-empty list of values", err);
+		return bsim_ydoc_expected(d, v, k, field, "a non-empty list of values", err);
 	/* The file is said once for the axis, each value by its line. */
 	a->key = dup_text(name);
 	a->origin = dup_text(d->path);
@@ -126,14 +126,14 @@ static int walk_axis(const ydoc *d, struct fy_node *k, struct fy_node *v, bsim_g
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
 	for (int i = 0; i < count; i++) {
 		struct fy_node *item = fy_node_sequence_get_by_index(v, i);
-		if (!item || !fy_node_is_scalar(item) || ydoc_is_null(item)) {
+		if (!item || !fy_node_is_scalar(item) || bsim_ydoc_is_null(item)) {
 			char f[540], idx[16];
 			snprintf(idx, sizeof idx, ".%d", i);
-			ydoc_join(f, sizeof f, field, idx);
-			return ydoc_expected(d, item, k, f, "a scalar value", err);
+			bsim_ydoc_join(f, sizeof f, field, idx);
+			return bsim_ydoc_expected(d, item, k, f, "a scalar value", err);
 		}
-		a->values[i] = ydoc_flow_text(item);
-		a->lines[i] = ydoc_line(item, k);
+		a->values[i] = bsim_ydoc_flow_text(item);
+		a->lines[i] = bsim_ydoc_line(item, k);
 		a->n_values = i + 1;
 		if (!a->values[i])
 			return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
@@ -149,7 +149,7 @@ static int walk_grid(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim
 {
 	int count = n && fy_node_is_mapping(n) ? fy_node_mapping_item_count(n) : 0;
 	if (count == 0)
-		return ydoc_expected(d, n, key, "grid",
+		return bsim_ydoc_expected(d, n, key, "grid",
 		                     "at least one axis (a dotted scene key with a list of values)",
 		                     err);
 	e->axes = calloc((size_t)count, sizeof *e->axes);
@@ -169,8 +169,8 @@ static int walk_trials(const ydoc *d, struct fy_node *n, struct fy_node *key, bs
                        bsim_error *err)
 {
 	long long v = 0;
-	if (!ydoc_int64(n, &v) || v <= 0 || v > INT_MAX)
-		return ydoc_expected(d, n, key, "trials", "a positive integer", err);
+	if (!bsim_ydoc_int64(n, &v) || v <= 0 || v > INT_MAX)
+		return bsim_ydoc_expected(d, n, key, "trials", "a positive integer", err);
 	e->trials = (int)v;
 	return BSIM_OK;
 }
@@ -179,31 +179,31 @@ static int walk_key(const ydoc *d, const char *name, struct fy_node *k, struct f
                     bsim_experiment *e, bsim_error *err)
 {
 	if (!strcmp(name, "name"))
-		return v && fy_node_is_scalar(v) && !ydoc_is_null(v)
+		return v && fy_node_is_scalar(v) && !bsim_ydoc_is_null(v)
 		               ? BSIM_OK
-		               : ydoc_expected(d, v, k, "name", "a non-empty string", err);
+		               : bsim_ydoc_expected(d, v, k, "name", "a non-empty string", err);
 	if (!strcmp(name, "scene"))
 		return walk_scene_path(d, v, k, e, err);
 	if (!strcmp(name, "trials"))
 		return walk_trials(d, v, k, e, err);
 	if (!strcmp(name, "seed"))
-		return ydoc_uint64(v, &e->seed)
+		return bsim_ydoc_uint64(v, &e->seed)
 		               ? BSIM_OK
-		               : ydoc_expected(d, v, k, "seed", "an integer >= 0", err);
+		               : bsim_ydoc_expected(d, v, k, "seed", "an integer >= 0", err);
 	if (!strcmp(name, "set"))
 		return walk_set(d, v, k, e, err);
 	if (!strcmp(name, "grid"))
 		return walk_grid(d, v, k, e, err);
 	/* A scene given where an experiment belongs (beamsim sweep SCENE). */
 	struct fy_node *root = fy_document_root(d->fyd);
-	if (ydoc_pair(root, "body", 4) &&
-	    (ydoc_pair(root, "beams", 5) || ydoc_pair(root, "lattice", 7)))
-		return ydoc_fail(
+	if (bsim_ydoc_pair(root, "body", 4) &&
+	    (bsim_ydoc_pair(root, "beams", 5) || bsim_ydoc_pair(root, "lattice", 7)))
+		return bsim_ydoc_fail(
 		        d, k, NULL, name, err,
 		        "this is a scene file (body: and beams: or lattice:), not an "
 		        "experiment: run it with beamsim run, or name it in an experiment's "
 		        "scene: with a grid:");
-	return ydoc_fail(d, k, NULL, name, err, "unknown key (expected one of %s)",
+	return bsim_ydoc_fail(d, k, NULL, name, err, "unknown key (expected one of %s)",
 	                 experiment_keys);
 }
 
@@ -216,7 +216,7 @@ static int walk_experiment(const ydoc *d, int has_seed, bsim_experiment *e, bsim
 	                                     "a mapping of dotted keys to lists"};
 	struct fy_node *root = fy_document_root(d->fyd);
 	if (!root || !fy_node_is_mapping(root))
-		return ydoc_expected(d, root, NULL, "experiment",
+		return bsim_ydoc_expected(d, root, NULL, "experiment",
 		                     "a mapping of experiment keys (scene, trials, seed, grid)",
 		                     err);
 	void *it = NULL;
@@ -229,9 +229,9 @@ static int walk_experiment(const ydoc *d, int has_seed, bsim_experiment *e, bsim
 			return rc;
 	}
 	for (int i = 0; i < 4; i++)
-		if (!ydoc_pair(root, required[i], strlen(required[i])) &&
+		if (!bsim_ydoc_pair(root, required[i], strlen(required[i])) &&
 		    !(has_seed && !strcmp(required[i], "seed")))
-			return ydoc_fail(d, root, NULL, required[i], err, "missing (expected %s)",
+			return bsim_ydoc_fail(d, root, NULL, required[i], err, "missing (expected %s)",
 			                 phrase[i]);
 	return BSIM_OK;
 }
@@ -360,7 +360,7 @@ static int check_counts(const ydoc *d, bsim_experiment *e, int n_grid, bsim_erro
 	for (int a = 0; a < e->n_axes; a++)
 		groups *= e->axes[a].n_values;
 	if (groups > limit || groups > INT_MAX) {
-		struct fy_node_pair *gp = ydoc_pair(root, "grid", 4);
+		struct fy_node_pair *gp = bsim_ydoc_pair(root, "grid", 4);
 		char hint[160];
 		bsim_limits_hint(hint, sizeof hint, "groups", limit);
 		if (n_grid > 0) {
@@ -382,7 +382,7 @@ static int check_counts(const ydoc *d, bsim_experiment *e, int n_grid, bsim_erro
 			        "lengths, with %s's grid), got %.15g (%s)",
 			        given, limit < INT_MAX ? limit : INT_MAX, d->path, groups, hint);
 		}
-		return ydoc_fail(
+		return bsim_ydoc_fail(
 		        d, fy_node_pair_value(gp), fy_node_pair_key(gp), "grid", err,
 		        "expected at most %.15g groups (the product of the lists' lengths), "
 		        "got %.15g (%s)",
@@ -391,8 +391,8 @@ static int check_counts(const ydoc *d, bsim_experiment *e, int n_grid, bsim_erro
 	e->n_groups = (int)groups;
 	bsim_error why;
 	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK) {
-		struct fy_node_pair *tp = ydoc_pair(root, "trials", 6);
-		return ydoc_fail(d, fy_node_pair_value(tp), fy_node_pair_key(tp), "trials", err,
+		struct fy_node_pair *tp = bsim_ydoc_pair(root, "trials", 6);
+		return bsim_ydoc_fail(d, fy_node_pair_value(tp), fy_node_pair_key(tp), "trials", err,
 		                 "%s", why.msg);
 	}
 	return BSIM_OK;
@@ -471,7 +471,7 @@ static int load_at(const ydoc *scene, const bsim_experiment *e, const int *idx,
 	bsim_override *ov = group_overrides(e, idx, extra, n_extra, &n);
 	if (!ov)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
-	int rc = scene_load_parsed(scene, ov, n, out, err);
+	int rc = bsim_scene_load_parsed(scene, ov, n, out, err);
 	free(ov);
 	return rc;
 }
@@ -506,8 +506,8 @@ static int scene_parse(const bsim_experiment *e, ydoc *scene, bsim_error *err)
 		                  : bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
 	}
 	if (e->scene_text)
-		return ydoc_load_text(scene, e->scene_path, e->scene_text, e->scene_len, err);
-	return ydoc_load(scene, e->scene_path, err);
+		return bsim_ydoc_load_text(scene, e->scene_path, e->scene_text, e->scene_len, err);
+	return bsim_ydoc_load(scene, e->scene_path, err);
 }
 
 int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_override *extra,
@@ -521,7 +521,7 @@ int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_over
 	if (rc)
 		return rc;
 	rc = load_group(&scene, e, g, extra, n_extra, out, err);
-	ydoc_free(&scene);
+	bsim_ydoc_free(&scene);
 	return rc;
 }
 
@@ -650,7 +650,7 @@ int bsim_experiment_load_seeded(const char *path, const bsim_override *extra, in
 		                      sizeof out->path);
 	snprintf(out->path, sizeof out->path, "%s", path);
 	ydoc d, scene = {0};
-	int rc = ydoc_load(&d, out->path, err);
+	int rc = bsim_ydoc_load(&d, out->path, err);
 	if (rc)
 		return rc;
 	rc = walk_experiment(&d, seed != NULL, out, err);
@@ -669,13 +669,13 @@ int bsim_experiment_load_seeded(const char *path, const bsim_override *extra, in
 		rc = check_values(&scene, out, extra, n_extra, err);
 	if (!rc)
 		rc = check_counts(&d, out, n_grid, err);
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	if (!rc)
 		rc = check_conflicts(out, extra, n_extra, err);
 	if (!rc)
 		rc = check_groups(&scene, out, extra, n_extra, err);
 	if (scene.fyd)
-		ydoc_free(&scene);
+		bsim_ydoc_free(&scene);
 	if (rc)
 		bsim_experiment_free(out);
 	return rc;

@@ -82,7 +82,7 @@ int bsim_lattice_build(bsim_scene *s, const double *k_left, const double *k_righ
 
 /* The termination defaults of a lattice: the end boundary, the sides, the
  * zero of the propulsive potential at the end, no run-on past the end. */
-void scene_lattice_defaults(bsim_scene *s)
+void bsim_scene_lattice_defaults(bsim_scene *s)
 {
 	const bsim_lattice_def *l = &s->lattice;
 	s->success_y = l->depth * l->rows;
@@ -108,6 +108,6 @@ int bsim_lattice_scene_init(bsim_scene *s, int columns, int rows, double f_prop,
 	l->pivot_y = 30; /* m */
 	int rc = bsim_lattice_build(s, NULL, NULL);
 	if (rc == BSIM_OK)
-		scene_lattice_defaults(s);
+		bsim_scene_lattice_defaults(s);
 	return rc;
 }

@@ -18,7 +18,7 @@
 bsim_scene bsim_scene_default(void)
 {
 	bsim_scene d;
-	scene_defaults(&d);
+	bsim_scene_defaults(&d);
 	return d;
 }
 
@@ -81,7 +81,7 @@ bsim_lattice_def bsim_lattice_def_default(void)
 	return l;
 }
 
-void scene_defaults(bsim_scene *s)
+void bsim_scene_defaults(bsim_scene *s)
 {
 	memset(s, 0, sizeof *s);
 	s->body.heading_deg = 90; /* the only body key with a default other than 0 */
@@ -109,7 +109,7 @@ static void gate_beam(bsim_beam_def *b, double px, double rest_deg)
 
 void bsim_scene_init_gate(bsim_scene *s, double f_prop, double rm)
 {
-	scene_defaults(s);
+	bsim_scene_defaults(s);
 	snprintf(s->name, sizeof s->name, "thesis-gate");
 	s->body = bsim_body_def_default();
 	/* On allocation failure the scene has no beams and fails validation. */
@@ -241,7 +241,7 @@ static int body_validate(const bsim_scene *s, const char *who, bsim_error *err)
 	return BSIM_OK;
 }
 
-int scene_overlap(const bsim_scene *s, double *dist)
+int bsim_scene_overlap(const bsim_scene *s, double *dist)
 {
 	const double *c = s->body.start;
 	for (int i = 0; i < s->n_beams; i++) {
@@ -302,7 +302,7 @@ static int check_value(const bsim_scene *s, const scene_field *f, const char *ba
 		int k = *(const int *)p;
 		if (k < (f->range == SR_NONNEG ? 0 : 1))
 			return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s, got %d", who,
-			                      field, scene_phrase(f), k);
+			                      field, bsim_scene_phrase(f), k);
 		return BSIM_OK;
 	}
 	if (f->kind == SK_NAME)
@@ -317,9 +317,9 @@ static int check_value(const bsim_scene *s, const scene_field *f, const char *ba
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      "%s: %s: expected a finite number, got %g", who,
 			                      field, v[i]);
-		if (!scene_in_range(f->range, v[i]))
+		if (!bsim_scene_in_range(f->range, v[i]))
 			return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s, got %g", who,
-			                      field, scene_phrase(f), v[i]);
+			                      field, bsim_scene_phrase(f), v[i]);
 	}
 	return BSIM_OK;
 }
@@ -332,13 +332,13 @@ static int check_table(const bsim_scene *s, const scene_table *t, const char *ba
 	for (int i = 0; i < t->n_fields; i++) {
 		const scene_field *f = &t->fields[i];
 		char field[256];
-		ydoc_join(field, sizeof field, prefix, f->key);
+		bsim_ydoc_join(field, sizeof field, prefix, f->key);
 		int rc = BSIM_OK;
 		if (f->kind == SK_BLOCK) {
 			if (f->offset != SCENE_NO_FLAG && !*(const int *)(base + f->offset))
 				continue;
 			char sub[260];
-			ydoc_join(sub, sizeof sub, field, ".");
+			bsim_ydoc_join(sub, sizeof sub, field, ".");
 			rc = check_table(s, f->sub, base, sub, err);
 		} else if (f->kind == SK_NUMBER || f->kind == SK_INT || f->kind == SK_VEC2 ||
 		           f->kind == SK_NAME) {
@@ -379,7 +379,7 @@ static int lattice_validate(const bsim_scene *s, const char *who, bsim_error *er
 	return BSIM_OK;
 }
 
-int scene_excess_find(const bsim_scene *s, scene_excess *x)
+int bsim_scene_excess_find(const bsim_scene *s, scene_excess *x)
 {
 	const bsim_limits *l = bsim_limits_get();
 	/* In doubles: the products of valid fields can exceed any integer. */
@@ -413,7 +413,7 @@ int scene_excess_find(const bsim_scene *s, scene_excess *x)
 	return 0;
 }
 
-void scene_excess_detail(const bsim_scene *s, const scene_excess *x, char *buf, size_t size)
+void bsim_scene_excess_detail(const bsim_scene *s, const scene_excess *x, char *buf, size_t size)
 {
 	if (strcmp(x->limit, "beam_steps") != 0) {
 		snprintf(buf, size, "%s", "");
@@ -429,7 +429,7 @@ void scene_excess_detail(const bsim_scene *s, const scene_excess *x, char *buf, 
 int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 {
 	const char *who = scene_who(s);
-	int rc = check_table(s, &scene_top_table, (const char *)s, "", err);
+	int rc = check_table(s, &bsim_scene_top_table, (const char *)s, "", err);
 	if (rc)
 		return rc;
 	if (s->n_beams < 1 || !s->beams)
@@ -438,7 +438,7 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 	for (int i = 0; i < s->n_beams; i++) {
 		char prefix[64];
 		snprintf(prefix, sizeof prefix, "beams.%d.", i);
-		rc = check_table(s, &scene_beam_table, (const char *)&s->beams[i], prefix, err);
+		rc = check_table(s, &bsim_scene_beam_table, (const char *)&s->beams[i], prefix, err);
 		if (rc)
 			return rc;
 	}
@@ -473,7 +473,7 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		                      "(%g), got %g",
 		                      who, s->success_y, s->classify_y);
 	double d = 0;
-	int beam = scene_overlap(s, &d);
+	int beam = bsim_scene_overlap(s, &d);
 	if (beam >= 0 && s->body.shape != BSIM_SHAPE_DISK)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: body.start: the body (%s, heading %g deg) overlaps beam "
@@ -488,16 +488,16 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 		        "the start (distance %.3g m)",
 		        who, s->body.radius, beam + 1, beam, d);
 	scene_dt_bound bound;
-	if (scene_dt_find(s, &bound)) {
+	if (bsim_scene_dt_find(s, &bound)) {
 		char msg[640];
-		scene_dt_message(s, &bound, msg, sizeof msg);
+		bsim_scene_dt_message(s, &bound, msg, sizeof msg);
 		return bsim_error_set(err, BSIM_EINPUT, "%s: integration.dt: %s", who, msg);
 	}
 	scene_excess x;
-	if (scene_excess_find(s, &x)) {
+	if (bsim_scene_excess_find(s, &x)) {
 		char hint[160], detail[128];
 		bsim_limits_hint(hint, sizeof hint, x.limit, x.max);
-		scene_excess_detail(s, &x, detail, sizeof detail);
+		bsim_scene_excess_detail(s, &x, detail, sizeof detail);
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: %s: expected at most %.15g %s, got %.3g%s (%s)", who,
 		                      x.field, x.max, x.what, x.got, detail, hint);

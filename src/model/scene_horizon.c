@@ -19,7 +19,7 @@
 /* n = t / dt steps, rounded to the nearest integer when t / dt is within
  * 1e-9 relative of it (16.1 / 0.004 is 4025.0000000000005 in doubles, and
  * means 4025), else rounded up, so that the steps cover at least t. */
-double scene_steps_for(double t, double dt)
+double bsim_scene_steps_for(double t, double dt)
 {
 	double r = t / dt;
 	double n = round(r);
@@ -38,9 +38,9 @@ typedef struct horizon_pair {
 static struct fy_node *lookup(struct fy_node *root, const char *block, const char *key,
                               struct fy_node **key_node)
 {
-	struct fy_node *map = ydoc_lookup(root, block);
+	struct fy_node *map = bsim_ydoc_lookup(root, block);
 	struct fy_node_pair *p =
-	        map && fy_node_is_mapping(map) ? ydoc_pair(map, key, strlen(key)) : NULL;
+	        map && fy_node_is_mapping(map) ? bsim_ydoc_pair(map, key, strlen(key)) : NULL;
 	if (key_node)
 		*key_node = p ? fy_node_pair_key(p) : NULL;
 	return p ? fy_node_pair_value(p) : NULL;
@@ -66,7 +66,7 @@ static double file_dt(const ydoc *file, const bsim_scene *s)
 		bsim_scene d = bsim_scene_default();
 		return d.dt;
 	}
-	if (ydoc_number(n, &dt) != YDOC_NUM_OK || !scene_in_range(SR_POSITIVE, dt))
+	if (bsim_ydoc_number(n, &dt) != YDOC_NUM_OK || !bsim_scene_in_range(SR_POSITIVE, dt))
 		return s->dt;
 	return dt;
 }
@@ -82,24 +82,24 @@ static int resolve(scene_walk *w, const ydoc *file, const horizon_pair *p)
 	snprintf(tfield, sizeof tfield, "%s.%s", p->block, p->time_key);
 	snprintf(sfield, sizeof sfield, "%s.%s", p->block, p->steps_key);
 	double t = 0;
-	int rc = ydoc_number(nt, &t);
+	int rc = bsim_ydoc_number(nt, &t);
 	if (rc == YDOC_NUM_NONFINITE)
-		return ydoc_expected(w->d, nt, kt, tfield, "a finite number (s)", w->err);
-	if (rc != YDOC_NUM_OK || !scene_in_range(p->time_range, t))
-		return ydoc_expected(w->d, nt, kt, tfield,
+		return bsim_ydoc_expected(w->d, nt, kt, tfield, "a finite number (s)", w->err);
+	if (rc != YDOC_NUM_OK || !bsim_scene_in_range(p->time_range, t))
+		return bsim_ydoc_expected(w->d, nt, kt, tfield,
 		                     p->time_range == SR_POSITIVE ? "a positive number (s)"
 		                                                  : "a number >= 0 (s)",
 		                     w->err);
 	if (ns) {
-		const bsim_override *os = ydoc_origin(ns), *ot = ydoc_origin(nt);
+		const bsim_override *os = bsim_ydoc_origin(ns), *ot = bsim_ydoc_origin(nt);
 		if (later(os, ot))
 			return BSIM_OK; /* the steps, as walked */
 		if (os == ot) {
 			double dt = os ? w->s->dt : file_dt(file, w->s);
-			double want = scene_steps_for(t, dt);
+			double want = bsim_scene_steps_for(t, dt);
 			if ((double)*p->steps != want) {
-				ydoc_describe(nt, got, sizeof got);
-				return ydoc_fail(
+				bsim_ydoc_describe(nt, got, sizeof got);
+				return bsim_ydoc_fail(
 				        w->d, ns, ks, sfield, w->err,
 				        "expected %.15g (%s %s s at integration.dt %.15g s; "
 				        "give one of the two), got %d",
@@ -107,10 +107,10 @@ static int resolve(scene_walk *w, const ydoc *file, const horizon_pair *p)
 			}
 		}
 	}
-	double n = scene_steps_for(t, w->s->dt);
+	double n = bsim_scene_steps_for(t, w->s->dt);
 	if (!(n <= INT_MAX)) {
-		ydoc_describe(nt, got, sizeof got);
-		return ydoc_fail(w->d, nt, kt, tfield, w->err,
+		bsim_ydoc_describe(nt, got, sizeof got);
+		return bsim_ydoc_fail(w->d, nt, kt, tfield, w->err,
 		                 "expected at most %d steps of integration.dt %.15g s, got %s s "
 		                 "(%.3g steps)",
 		                 INT_MAX, w->s->dt, got, n);
@@ -119,7 +119,7 @@ static int resolve(scene_walk *w, const ydoc *file, const horizon_pair *p)
 	return BSIM_OK;
 }
 
-int scene_horizon(scene_walk *w, const ydoc *file)
+int bsim_scene_horizon(scene_walk *w, const ydoc *file)
 {
 	const horizon_pair pairs[2] = {
 	        {"integration", "max_steps", "duration", SR_POSITIVE, &w->s->max_steps},

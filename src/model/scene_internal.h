@@ -50,26 +50,26 @@ struct scene_table {
 	int n_fields;
 };
 
-extern const scene_table scene_top_table;  /* offsets into bsim_scene */
-extern const scene_table scene_beam_table; /* offsets into bsim_beam_def */
+extern const scene_table bsim_scene_top_table;  /* offsets into bsim_scene */
+extern const scene_table bsim_scene_beam_table; /* offsets into bsim_beam_def */
 
 /* What a field expects, for messages: "a positive number", "a mapping". */
-const char *scene_phrase(const scene_field *f);
+const char *bsim_scene_phrase(const scene_field *f);
 
-int scene_in_range(scene_range r, double v);
+int bsim_scene_in_range(scene_range r, double v);
 
 /* "pivot, rest_angle_deg, ..." for unknown-key messages. */
-void scene_keys(const scene_table *t, char *buf, size_t size);
+void bsim_scene_keys(const scene_table *t, char *buf, size_t size);
 
 /* Everything that has a default gets it; the rest is zero. */
-void scene_defaults(bsim_scene *s);
+void bsim_scene_defaults(bsim_scene *s);
 
 /* Index of the first beam the body overlaps at the start, or -1; *dist in
  * m. A disk: the distance from its centre to the beam's segment < radius,
  * *dist that distance. Another shape: its outline against the segment
  * (beamsim/body_shape.h) has a gap < 0, *dist the gap (0 where the segment
  * crosses the body's centre line). */
-int scene_overlap(const bsim_scene *s, double *dist);
+int bsim_scene_overlap(const bsim_scene *s, double *dist);
 
 /* A walk of a scene document into a scene (scene_load.c). */
 typedef struct scene_walk {
@@ -80,31 +80,31 @@ typedef struct scene_walk {
 
 /* Walks one mapping (NULL: an empty one) against table t into base: unknown
  * keys are errors, known ones are stored, missing required ones reported. */
-int scene_walk_table(scene_walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
+int bsim_scene_walk_table(scene_walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
                      char *base, const char *prefix);
 
 /* The lattice: block (scene_lattice.c). The loader walks its keys
- * (scene_lattice_table) between the two calls: begin sets the gate's
+ * (bsim_scene_lattice_table) between the two calls: begin sets the gate's
  * defaults, finish checks the ranges, reads the stiffness maps and CSV file
  * and builds the beams. */
-void scene_lattice_begin(bsim_scene *s);
-int scene_lattice_finish(scene_walk *w, struct fy_node *n, struct fy_node *key);
-extern const scene_table scene_lattice_table;
+void bsim_scene_lattice_begin(bsim_scene *s);
+int bsim_scene_lattice_finish(scene_walk *w, struct fy_node *n, struct fy_node *key);
+extern const scene_table bsim_scene_lattice_table;
 
 /* The termination defaults of a lattice (lattice.c): success_y = depth
  * rows, side_x = width columns / 2, classify_y = success_y, landscape y0 =
  * success_y, gate_steps = 3000, max_steps = gate_steps (rows + columns). */
-void scene_lattice_defaults(bsim_scene *s);
+void bsim_scene_lattice_defaults(bsim_scene *s);
 
 /* The steps of dt that make up t seconds: round(t / dt) when t / dt is
  * within 1e-9 relative of an integer, else ceil(t / dt) (scene_horizon.c). */
-double scene_steps_for(double t, double dt);
+double bsim_scene_steps_for(double t, double dt);
 
 /* After the walk of a scene document (w->d, overrides applied; file the
  * document before them): integration.duration and termination.gate_time
  * into max_steps and gate_steps at the scene's dt, or refused where the
  * file (or one override) gives a time and steps that disagree. */
-int scene_horizon(scene_walk *w, const ydoc *file);
+int bsim_scene_horizon(scene_walk *w, const ydoc *file);
 
 /* A limit of beamsim/limits.h that a scene exceeds: the field to blame,
  * what it asks for and the limit's name and value. */
@@ -118,10 +118,10 @@ typedef struct scene_excess {
 
 /* What x's count is made of, for its message: " = 3000 steps x 199800
  * beams" for beam_steps, "" for the others. */
-void scene_excess_detail(const bsim_scene *s, const scene_excess *x, char *buf, size_t size);
+void bsim_scene_excess_detail(const bsim_scene *s, const scene_excess *x, char *buf, size_t size);
 
 /* 1 and *x if the scene asks for more than a limit allows, else 0. */
-int scene_excess_find(const bsim_scene *s, scene_excess *x);
+int bsim_scene_excess_find(const bsim_scene *s, scene_excess *x);
 
 /* A bound on integration.dt from one of the scene's time scales
  * (scene_timestep.c, docs/model.md "The time step"). */
@@ -147,23 +147,23 @@ typedef struct scene_speed {
 	double start, accel, distance, forces, spin, tips, total;
 	int drag_capped;
 } scene_speed;
-void scene_speed_scale(const bsim_scene *s, scene_speed *v);
+void bsim_scene_speed_scale(const bsim_scene *s, scene_speed *v);
 
 /* Every bound the scene has (those of absent effects and of beams without
  * spring or damper are none), the beams' the tightest beam's; returns
  * their number. */
-int scene_dt_bounds(const bsim_scene *s, scene_dt_bound out[SCENE_DT_BOUNDS]);
+int bsim_scene_dt_bounds(const bsim_scene *s, scene_dt_bound out[SCENE_DT_BOUNDS]);
 
 /* 1 and *broken the tightest bound the scene's dt breaks, else 0. */
-int scene_dt_find(const bsim_scene *s, scene_dt_bound *broken);
+int bsim_scene_dt_find(const bsim_scene *s, scene_dt_bound *broken);
 
 /* "expected at most 0.02 s (the random force's hold ...), got 0.5": the
  * bound stated rounded down to 4 digits, so that it is a step accepted. */
-void scene_dt_message(const bsim_scene *s, const scene_dt_bound *b, char *buf, size_t size);
+void bsim_scene_dt_message(const bsim_scene *s, const scene_dt_bound *b, char *buf, size_t size);
 
 /* bsim_scene_load on a document already read (the experiment loader reads
  * the scene file once and builds every group from a clone of it). */
-int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,
+int bsim_scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,
                       bsim_error *err);
 
 #endif

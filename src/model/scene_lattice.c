@@ -37,7 +37,7 @@ static void maps_free(lattice_maps *m)
 
 static struct fy_node *child(struct fy_node *map, const char *key, struct fy_node **key_node)
 {
-	struct fy_node_pair *p = map ? ydoc_pair(map, key, strlen(key)) : NULL;
+	struct fy_node_pair *p = map ? bsim_ydoc_pair(map, key, strlen(key)) : NULL;
 	if (key_node)
 		*key_node = p ? fy_node_pair_key(p) : NULL;
 	return p ? fy_node_pair_value(p) : NULL;
@@ -53,28 +53,28 @@ static int lattice_range(scene_walk *w, struct fy_node *map, struct fy_node *key
 	struct fy_node *ix_max = child(map, "ix_max", &kmax);
 	if ((ix_min != NULL) != (ix_max != NULL)) {
 		struct fy_node *given = ix_min ? ix_min : ix_max;
-		return ydoc_fail(w->d, given, ix_min ? kmin : kmax,
+		return bsim_ydoc_fail(w->d, given, ix_min ? kmin : kmax,
 		                 ix_min ? "lattice.ix_max" : "lattice.ix_min", w->err,
 		                 "missing (expected both ix_min and ix_max, or columns)");
 	}
 	if (ix_min) {
 		if (l->ix_max < l->ix_min)
-			return ydoc_fail(w->d, ix_max, kmax, "lattice.ix_max", w->err,
+			return bsim_ydoc_fail(w->d, ix_max, kmax, "lattice.ix_max", w->err,
 			                 "expected an integer >= lattice.ix_min (%d), got %d",
 			                 l->ix_min, l->ix_max);
 		int span = l->ix_max - l->ix_min + 1;
 		if (columns && l->columns != span)
-			return ydoc_fail(w->d, columns, kc, "lattice.columns", w->err,
+			return bsim_ydoc_fail(w->d, columns, kc, "lattice.columns", w->err,
 			                 "expected %d (ix_min %d .. ix_max %d), got %d", span,
 			                 l->ix_min, l->ix_max, l->columns);
 		l->columns = span;
 		return BSIM_OK;
 	}
 	if (!columns)
-		return ydoc_fail(w->d, map, key, "lattice.columns", w->err,
+		return bsim_ydoc_fail(w->d, map, key, "lattice.columns", w->err,
 		                 "missing (expected a positive odd integer, or ix_min and ix_max)");
 	if (l->columns % 2 == 0)
-		return ydoc_fail(w->d, columns, kc, "lattice.columns", w->err,
+		return bsim_ydoc_fail(w->d, columns, kc, "lattice.columns", w->err,
 		                 "expected an odd number (gates ix = -(columns-1)/2 .. "
 		                 "(columns-1)/2; give ix_min and ix_max otherwise), got %d",
 		                 l->columns);
@@ -87,11 +87,11 @@ static int lattice_range(scene_walk *w, struct fy_node *map, struct fy_node *key
 static int map_number(scene_walk *w, struct fy_node *n, struct fy_node *alt, const char *field,
                       double *out)
 {
-	int rc = ydoc_number(n, out);
+	int rc = bsim_ydoc_number(n, out);
 	if (rc == YDOC_NUM_NONFINITE)
-		return ydoc_expected(w->d, n, alt, field, "a finite number >= 0", w->err);
+		return bsim_ydoc_expected(w->d, n, alt, field, "a finite number >= 0", w->err);
 	if (rc != YDOC_NUM_OK || !(*out >= 0.0))
-		return ydoc_expected(w->d, n, alt, field, "a number >= 0 (N m/rad)", w->err);
+		return bsim_ydoc_expected(w->d, n, alt, field, "a number >= 0 (N m/rad)", w->err);
 	return BSIM_OK;
 }
 
@@ -106,7 +106,7 @@ static int map_walk(scene_walk *w, struct fy_node *n, struct fy_node *key, const
 	         "a list of %d rows (row iy = 0 first) of %d numbers (ix = %d .. %d)", l->rows,
 	         l->columns, l->ix_min, l->ix_max);
 	if (!n || !fy_node_is_sequence(n) || fy_node_sequence_item_count(n) != l->rows)
-		return ydoc_expected(w->d, n, key, field, what, w->err);
+		return bsim_ydoc_expected(w->d, n, key, field, what, w->err);
 	for (int iy = 0; iy < l->rows; iy++) {
 		struct fy_node *row = fy_node_sequence_get_by_index(n, iy);
 		char rfield[80];
@@ -115,7 +115,7 @@ static int map_walk(scene_walk *w, struct fy_node *n, struct fy_node *key, const
 		         l->ix_min, l->ix_max);
 		if (!row || !fy_node_is_sequence(row) ||
 		    fy_node_sequence_item_count(row) != l->columns)
-			return ydoc_expected(w->d, row, n, rfield, what, w->err);
+			return bsim_ydoc_expected(w->d, row, n, rfield, what, w->err);
 		for (int c = 0; c < l->columns; c++) {
 			char vfield[96];
 			snprintf(vfield, sizeof vfield, "%s.%d", rfield, c);
@@ -205,30 +205,30 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 {
 	const bsim_lattice_def *l = &w->s->lattice;
 	const char *rel =
-	        n && fy_node_is_scalar(n) && !ydoc_is_null(n) ? fy_node_get_scalar0(n) : NULL;
+	        n && fy_node_is_scalar(n) && !bsim_ydoc_is_null(n) ? fy_node_get_scalar0(n) : NULL;
 	if (!rel || !name_beside(rel))
-		return ydoc_expected(w->d, n, key, "lattice.stiffness_file",
+		return bsim_ydoc_expected(w->d, n, key, "lattice.stiffness_file",
 		                     "a CSV file name relative to the scene's directory (no '..')",
 		                     w->err);
 	if (strlen(rel) >= sizeof w->s->lattice.stiffness_file)
-		return ydoc_expected(w->d, n, key, "lattice.stiffness_file", "a shorter file name",
+		return bsim_ydoc_expected(w->d, n, key, "lattice.stiffness_file", "a shorter file name",
 		                     w->err);
 	char path[1300];
 	if (csv_path(w->d->path, rel, path, sizeof path))
-		return ydoc_expected(w->d, n, key, "lattice.stiffness_file", "a shorter path",
+		return bsim_ydoc_expected(w->d, n, key, "lattice.stiffness_file", "a shorter path",
 		                     w->err);
 	/* Without blocking, and checked before the first read: a FIFO would
 	 * wait for a writer for ever, a directory fails only at the read. */
 	struct stat st;
-	int fd = file_open_checked(path, &st);
+	int fd = bsim_file_open_checked(path, &st);
 	if (fd < 0)
-		return ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
+		return bsim_ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
 		                 "expected a readable CSV file, got %s (%s)", path,
 		                 strerror(errno));
 	if (!S_ISREG(st.st_mode)) {
 		close(fd);
-		return ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
-		                 "expected a regular CSV file, got %s (%s)", path, file_kind(&st));
+		return bsim_ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
+		                 "expected a regular CSV file, got %s (%s)", path, bsim_file_kind(&st));
 	}
 	FILE *f = fdopen(fd, "r");
 	if (!f) {
@@ -293,7 +293,7 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 			errno = 0;
 			double v = strtod(fields[c], &end);
 			if (end == fields[c] || *end != '\0' || errno == ERANGE || !isfinite(v) ||
-			    v < 0.0 || decimal_other_base(fields[c]))
+			    v < 0.0 || bsim_decimal_other_base(fields[c]))
 				rc = bsim_error_set(w->err, BSIM_EINPUT,
 				                    "%s:%d:%d: lattice.stiffness_file: expected a "
 				                    "number >= 0 (N m/rad), got %.40s",
@@ -324,13 +324,13 @@ static int lattice_protocol(scene_walk *w, struct fy_node *map)
 	struct fy_node *n = child(map, "protocol", &k);
 	if (!n)
 		return BSIM_OK;
-	const char *t = ydoc_plain(n);
+	const char *t = bsim_ydoc_plain(n);
 	if (t && !strcmp(t, "world"))
 		w->s->lattice.protocol = BSIM_PROTOCOL_WORLD;
 	else if (t && !strcmp(t, "essay"))
 		w->s->lattice.protocol = BSIM_PROTOCOL_ESSAY;
 	else
-		return ydoc_expected(w->d, n, k, "lattice.protocol",
+		return bsim_ydoc_expected(w->d, n, k, "lattice.protocol",
 		                     "world (one world, every beam kept) or essay (only the "
 		                     "active gate, reset on entry)",
 		                     w->err);
@@ -347,7 +347,7 @@ static int lattice_maps_read(scene_walk *w, struct fy_node *map, lattice_maps *m
 	struct fy_node *file = child(map, "stiffness_file", &kfile);
 	struct fy_node *gate_map = child(map, "stiffness", &kmap);
 	if (file && gate_map)
-		return ydoc_fail(w->d, file, kfile, "lattice.stiffness_file", w->err,
+		return bsim_ydoc_fail(w->d, file, kfile, "lattice.stiffness_file", w->err,
 		                 "expected either stiffness or stiffness_file, not both");
 	/* A per-gate map and a per-beam one give every beam twice: which one a
 	 * reader of the scene meant is not for beamsim to guess. */
@@ -355,7 +355,7 @@ static int lattice_maps_read(scene_walk *w, struct fy_node *map, lattice_maps *m
 		struct fy_node *k;
 		struct fy_node *n = child(map, names[i], &k);
 		if (n)
-			return ydoc_fail(w->d, n, k,
+			return bsim_ydoc_fail(w->d, n, k,
 			                 i == 1 ? "lattice.stiffness_left"
 			                        : "lattice.stiffness_right",
 			                 w->err, "expected either %s or %s, not both",
@@ -377,7 +377,7 @@ static int lattice_maps_read(scene_walk *w, struct fy_node *map, lattice_maps *m
 	return BSIM_OK;
 }
 
-void scene_lattice_begin(bsim_scene *s)
+void bsim_scene_lattice_begin(bsim_scene *s)
 {
 	/* The gate's geometry at its defaults; what a file must give (columns,
 	 * rows, the beam) starts at zero, the beam's inertia unset. */
@@ -390,7 +390,7 @@ void scene_lattice_begin(bsim_scene *s)
 	l->beam.inertia = NAN;
 }
 
-int scene_lattice_finish(scene_walk *w, struct fy_node *n, struct fy_node *key)
+int bsim_scene_lattice_finish(scene_walk *w, struct fy_node *n, struct fy_node *key)
 {
 	bsim_scene *s = w->s;
 	bsim_lattice_def *l = &s->lattice;
@@ -402,7 +402,7 @@ int scene_lattice_finish(scene_walk *w, struct fy_node *n, struct fy_node *key)
 	if ((long)l->columns * l->rows > LATTICE_GATES_MAX) {
 		struct fy_node *k;
 		struct fy_node *rows = child(n, "rows", &k);
-		return ydoc_fail(w->d, rows, k, "lattice.rows", w->err,
+		return bsim_ydoc_fail(w->d, rows, k, "lattice.rows", w->err,
 		                 "expected at most %d gates (columns x rows), got %d x %d",
 		                 LATTICE_GATES_MAX, l->columns, l->rows);
 	}

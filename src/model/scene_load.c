@@ -16,23 +16,23 @@
 
 typedef scene_walk walk;
 
-#define walk_table scene_walk_table
+#define walk_table bsim_scene_walk_table
 
 /* "expected WHAT, got <the node>" at node n (or its key). */
 static int expected(walk *w, struct fy_node *n, struct fy_node *key, const char *field,
                     const char *what)
 {
-	return ydoc_expected(w->d, n, key, field, what, w->err);
+	return bsim_ydoc_expected(w->d, n, key, field, what, w->err);
 }
 
 static int walk_number(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
                        const char *field, double *out)
 {
-	int rc = ydoc_number(n, out);
+	int rc = bsim_ydoc_number(n, out);
 	if (rc == YDOC_NUM_NONFINITE)
 		return expected(w, n, key, field, "a finite number");
-	if (rc != YDOC_NUM_OK || !scene_in_range(f->range, *out))
-		return expected(w, n, key, field, scene_phrase(f));
+	if (rc != YDOC_NUM_OK || !bsim_scene_in_range(f->range, *out))
+		return expected(w, n, key, field, bsim_scene_phrase(f));
 	return BSIM_OK;
 }
 
@@ -42,8 +42,8 @@ static int walk_int(walk *w, const scene_field *f, struct fy_node *n, struct fy_
 	long long v = 0;
 	long long lo = f->kind == SK_INDEX ? -1000000 : f->range == SR_NONNEG ? 0 : 1;
 	long long hi = f->kind == SK_INDEX ? 1000000 : INT_MAX;
-	if (!ydoc_int64(n, &v) || v < lo || v > hi)
-		return expected(w, n, key, field, scene_phrase(f));
+	if (!bsim_ydoc_int64(n, &v) || v < lo || v > hi)
+		return expected(w, n, key, field, bsim_scene_phrase(f));
 	*out = (int)v;
 	return BSIM_OK;
 }
@@ -52,12 +52,12 @@ static int walk_vec2(walk *w, const scene_field *f, struct fy_node *n, struct fy
                      const char *field, double *out)
 {
 	if (!n || !fy_node_is_sequence(n) || fy_node_sequence_item_count(n) != 2)
-		return expected(w, n, key, field, scene_phrase(f));
+		return expected(w, n, key, field, bsim_scene_phrase(f));
 	static const scene_field coord = {"", SK_NUMBER, SR_ANY, 0, 0, NULL};
 	for (int i = 0; i < 2; i++) {
 		char item[300], idx[16];
 		snprintf(idx, sizeof idx, ".%d", i);
-		ydoc_join(item, sizeof item, field, idx);
+		bsim_ydoc_join(item, sizeof item, field, idx);
 		int rc = walk_number(w, &coord, fy_node_sequence_get_by_index(n, i), n, item,
 		                     &out[i]);
 		if (rc)
@@ -71,8 +71,8 @@ static int walk_name(walk *w, const scene_field *f, struct fy_node *n, struct fy
 {
 	size_t len = 0;
 	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
-	if (!t || len == 0 || ydoc_is_null(n))
-		return expected(w, n, key, field, scene_phrase(f));
+	if (!t || len == 0 || bsim_ydoc_is_null(n))
+		return expected(w, n, key, field, bsim_scene_phrase(f));
 	if (len >= sizeof w->s->name)
 		return expected(w, n, key, field, "a name of at most 127 characters");
 	memcpy(out, t, len);
@@ -87,7 +87,7 @@ static int walk_beams(walk *w, const scene_field *f, struct fy_node *n, struct f
 {
 	int count = n && fy_node_is_sequence(n) ? fy_node_sequence_item_count(n) : 0;
 	if (count == 0)
-		return expected(w, n, key, f->key, scene_phrase(f));
+		return expected(w, n, key, f->key, bsim_scene_phrase(f));
 	if (bsim_scene_set_beams(w->s, count) != BSIM_OK)
 		return bsim_error_set(w->err, BSIM_EFAIL, "%s: out of memory", w->d->path);
 	for (int i = 0; i < count; i++) {
@@ -113,13 +113,13 @@ static int walk_block(walk *w, const scene_field *f, struct fy_node *n, struct f
                       char *base, const char *field)
 {
 	/* "effects:" with nothing under it is an empty block. */
-	if (!ydoc_is_null(n) && !fy_node_is_mapping(n))
-		return expected(w, n, key, field, scene_phrase(f));
+	if (!bsim_ydoc_is_null(n) && !fy_node_is_mapping(n))
+		return expected(w, n, key, field, bsim_scene_phrase(f));
 	if (f->offset != SCENE_NO_FLAG)
 		*(int *)(base + f->offset) = 1;
 	char prefix[300];
-	ydoc_join(prefix, sizeof prefix, field, ".");
-	return walk_table(w, f->sub, ydoc_is_null(n) ? NULL : n, key, base, prefix);
+	bsim_ydoc_join(prefix, sizeof prefix, field, ".");
+	return walk_table(w, f->sub, bsim_ydoc_is_null(n) ? NULL : n, key, base, prefix);
 }
 
 /* The lattice: block: its keys as a table, between the lattice module's
@@ -127,12 +127,12 @@ static int walk_block(walk *w, const scene_field *f, struct fy_node *n, struct f
 static int walk_lattice(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key)
 {
 	if (!n || !fy_node_is_mapping(n))
-		return ydoc_expected(w->d, n, key, "lattice",
+		return bsim_ydoc_expected(w->d, n, key, "lattice",
 		                     "a mapping (columns, rows, gate, beam, stiffness, ...)",
 		                     w->err);
-	scene_lattice_begin(w->s);
+	bsim_scene_lattice_begin(w->s);
 	int rc = walk_table(w, f->sub, n, key, (char *)w->s, "lattice.");
-	return rc ? rc : scene_lattice_finish(w, n, key);
+	return rc ? rc : bsim_scene_lattice_finish(w, n, key);
 }
 
 static int walk_field(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
@@ -172,7 +172,7 @@ static int find_field(const scene_table *t, const char *key)
 /* Walks one mapping (NULL: an empty one) against table t: unknown keys are
  * errors, known ones are stored, missing required ones are reported at the
  * mapping (or at alt, the key naming it, when it is empty). */
-int scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
+int bsim_scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
                      char *base, const char *prefix)
 {
 	unsigned seen = 0;
@@ -182,17 +182,17 @@ int scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, struct 
 		struct fy_node *k = fy_node_pair_key(p);
 		const char *name = k && fy_node_is_scalar(k) ? fy_node_get_scalar0(k) : NULL;
 		char field[300], keys[512];
-		ydoc_join(field, sizeof field, prefix, name ? name : "?");
+		bsim_ydoc_join(field, sizeof field, prefix, name ? name : "?");
 		int i = find_field(t, name);
 		/* An experiment given where a scene belongs (beamsim run EXP). */
-		if (i < 0 && !prefix[0] && ydoc_pair(map, "scene", 5) && ydoc_pair(map, "grid", 4))
-			return ydoc_fail(
+		if (i < 0 && !prefix[0] && bsim_ydoc_pair(map, "scene", 5) && bsim_ydoc_pair(map, "grid", 4))
+			return bsim_ydoc_fail(
 			        w->d, k, map, field, w->err,
 			        "this is an experiment file (scene: and grid:), not a scene: "
 			        "run it with beamsim sweep or compare, or run its scene");
 		if (i < 0) {
-			scene_keys(t, keys, sizeof keys);
-			return ydoc_fail(w->d, k, map, field, w->err,
+			bsim_scene_keys(t, keys, sizeof keys);
+			return bsim_ydoc_fail(w->d, k, map, field, w->err,
 			                 "unknown key (expected one of %s)", keys);
 		}
 		seen |= 1u << i;
@@ -204,9 +204,9 @@ int scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, struct 
 		const scene_field *f = &t->fields[i];
 		if (f->required && !(seen & (1u << i))) {
 			char field[300];
-			ydoc_join(field, sizeof field, prefix, f->key);
-			return ydoc_fail(w->d, map, alt, field, w->err, "missing (expected %s)",
-			                 scene_phrase(f));
+			bsim_ydoc_join(field, sizeof field, prefix, f->key);
+			return bsim_ydoc_fail(w->d, map, alt, field, w->err, "missing (expected %s)",
+			                 bsim_scene_phrase(f));
 		}
 	}
 	return BSIM_OK;
@@ -221,8 +221,8 @@ static struct fy_node *latest_override(const ydoc *d, const char *const *paths, 
 	struct fy_node *root = fy_document_root(d->fyd), *best = NULL;
 	const bsim_override *best_o = NULL;
 	for (int i = 0; i < n; i++) {
-		struct fy_node *node = ydoc_lookup(root, paths[i]);
-		const bsim_override *o = node ? ydoc_origin(node) : NULL;
+		struct fy_node *node = bsim_ydoc_lookup(root, paths[i]);
+		const bsim_override *o = node ? bsim_ydoc_origin(node) : NULL;
 		if (o && (!best_o || o > best_o)) {
 			best = node;
 			best_o = o;
@@ -240,17 +240,17 @@ static int check_termination(walk *w)
 		return BSIM_OK;
 	const char *paths[] = {"termination.classify_y", "termination.success_y"};
 	struct fy_node *root = fy_document_root(w->d->fyd);
-	struct fy_node *classify = ydoc_lookup(root, paths[0]);
+	struct fy_node *classify = bsim_ydoc_lookup(root, paths[0]);
 	struct fy_node *n = latest_override(w->d, paths, 2);
 	if (!n)
-		n = classify ? classify : ydoc_lookup(root, paths[1]);
+		n = classify ? classify : bsim_ydoc_lookup(root, paths[1]);
 	char got[128];
-	ydoc_describe(n, got, sizeof got);
+	bsim_ydoc_describe(n, got, sizeof got);
 	if (n == classify)
-		return ydoc_fail(w->d, n, NULL, paths[0], w->err,
+		return bsim_ydoc_fail(w->d, n, NULL, paths[0], w->err,
 		                 "expected a number >= termination.success_y (%g), got %s",
 		                 s->success_y, got);
-	return ydoc_fail(w->d, n, NULL, paths[1], w->err,
+	return bsim_ydoc_fail(w->d, n, NULL, paths[1], w->err,
 	                 "expected a number <= termination.classify_y (%g), got %s", s->classify_y,
 	                 got);
 }
@@ -265,10 +265,10 @@ static void success_line_default(walk *w, struct fy_node *root)
 {
 	bsim_scene *s = w->s;
 	if (s->has_lattice || s->body.shape == BSIM_SHAPE_DISK ||
-	    ydoc_lookup(root, "termination.success_y"))
+	    bsim_ydoc_lookup(root, "termination.success_y"))
 		return;
 	s->success_y = 55.0 + bsim_body_shape_reach(&s->body);
-	if (!ydoc_lookup(root, "termination.classify_y"))
+	if (!bsim_ydoc_lookup(root, "termination.classify_y"))
 		s->classify_y = s->success_y + 15.0;
 }
 
@@ -278,7 +278,7 @@ static void success_line_default(walk *w, struct fy_node *root)
 static int check_overlap(walk *w)
 {
 	double dist = 0;
-	int beam = scene_overlap(w->s, &dist);
+	int beam = bsim_scene_overlap(w->s, &dist);
 	if (beam < 0)
 		return BSIM_OK;
 	char p[4][64];
@@ -289,10 +289,10 @@ static int check_overlap(walk *w)
 	struct fy_node *root = fy_document_root(w->d->fyd);
 	struct fy_node *n = latest_override(w->d, paths, 6);
 	if (!n)
-		n = ydoc_lookup(root, "body.start");
+		n = bsim_ydoc_lookup(root, "body.start");
 	if (!n)
-		n = ydoc_lookup(root, "body");
-	return ydoc_fail(
+		n = bsim_ydoc_lookup(root, "body");
+	return bsim_ydoc_fail(
 	        w->d, n, NULL, "body.start", w->err,
 	        "the body (radius %g) overlaps beam %d (beams.%d) at the start (distance %.3g m)",
 	        w->s->body.radius, beam + 1, beam, dist);
@@ -304,7 +304,7 @@ static int check_overlap(walk *w)
 static int check_limits(walk *w)
 {
 	scene_excess x;
-	if (!scene_excess_find(w->s, &x))
+	if (!bsim_scene_excess_find(w->s, &x))
 		return BSIM_OK;
 	static const char *const schedule[] = {"effects.random_force.frequency", "integration.dt",
 	                                       "integration.max_steps", "integration.duration"};
@@ -317,7 +317,7 @@ static int check_limits(walk *w)
 	struct fy_node *node = latest_override(w->d, paths, n);
 	const char *field = paths[0];
 	for (int i = 0; i < n; i++) {
-		struct fy_node *at = ydoc_lookup(root, paths[i]);
+		struct fy_node *at = bsim_ydoc_lookup(root, paths[i]);
 		if (node ? at == node : at != NULL) {
 			node = at;
 			field = paths[i];
@@ -325,11 +325,11 @@ static int check_limits(walk *w)
 		}
 	}
 	if (!node) /* all defaults: the block the first field would be in */
-		node = ydoc_lookup(root, is_schedule ? "effects.random_force" : "integration");
+		node = bsim_ydoc_lookup(root, is_schedule ? "effects.random_force" : "integration");
 	char hint[160], detail[128];
 	bsim_limits_hint(hint, sizeof hint, x.limit, x.max);
-	scene_excess_detail(w->s, &x, detail, sizeof detail);
-	return ydoc_fail(w->d, node ? node : root, NULL, field, w->err,
+	bsim_scene_excess_detail(w->s, &x, detail, sizeof detail);
+	return bsim_ydoc_fail(w->d, node ? node : root, NULL, field, w->err,
 	                 "expected at most %.15g %s, got %.3g%s (%s)", x.max, x.what, x.got, detail,
 	                 hint);
 }
@@ -341,7 +341,7 @@ static int check_limits(walk *w)
 static int check_timestep(walk *w)
 {
 	scene_dt_bound b;
-	if (!scene_dt_find(w->s, &b))
+	if (!bsim_scene_dt_find(w->s, &b))
 		return BSIM_OK;
 	const char *paths[1 + SCENE_DT_PATHS] = {"integration.dt"};
 	for (int i = 0; i < b.n_paths; i++)
@@ -350,12 +350,12 @@ static int check_timestep(walk *w)
 	struct fy_node *root = fy_document_root(w->d->fyd);
 	struct fy_node *node = latest_override(w->d, paths, n);
 	for (int i = 0; !node && i < n; i++)
-		node = ydoc_lookup(root, paths[i]);
+		node = bsim_ydoc_lookup(root, paths[i]);
 	if (!node)
-		node = ydoc_lookup(root, "integration");
+		node = bsim_ydoc_lookup(root, "integration");
 	char msg[640];
-	scene_dt_message(w->s, &b, msg, sizeof msg);
-	return ydoc_fail(w->d, node ? node : root, NULL, "integration.dt", w->err, "%s", msg);
+	bsim_scene_dt_message(w->s, &b, msg, sizeof msg);
+	return bsim_ydoc_fail(w->d, node ? node : root, NULL, "integration.dt", w->err, "%s", msg);
 }
 
 /* The file's base name without its extension: "configs/gate.yaml" -> "gate". */
@@ -393,17 +393,17 @@ static void effects_present(bsim_scene *s)
  * white. */
 static int random_model(walk *w, struct fy_node *root)
 {
-	struct fy_node *n = ydoc_lookup(root, "effects.random_force.model");
+	struct fy_node *n = bsim_ydoc_lookup(root, "effects.random_force.model");
 	if (!n)
 		return BSIM_OK;
-	const char *t = ydoc_plain(n);
+	const char *t = bsim_ydoc_plain(n);
 	static const char *const names[] = {"held", "ou", "white"};
 	for (int i = 0; t && i < 3; i++)
 		if (!strcmp(t, names[i])) {
 			w->s->effects.random_model = (bsim_random_model)i;
 			return BSIM_OK;
 		}
-	return ydoc_expected(w->d, n, NULL, "effects.random_force.model",
+	return bsim_ydoc_expected(w->d, n, NULL, "effects.random_force.model",
 	                     "held (the essay's piecewise constant force), ou (Ornstein-Uhlenbeck, "
 	                     "correlation_time s) or white (a new value each step)",
 	                     w->err);
@@ -414,17 +414,17 @@ static int random_model(walk *w, struct fy_node *root)
 static int scene_word(walk *w, struct fy_node *root, const char *path, const char *const *names,
                       int n, const char *what, int *out, int *given)
 {
-	struct fy_node *node = ydoc_lookup(root, path);
+	struct fy_node *node = bsim_ydoc_lookup(root, path);
 	*given = node != NULL;
 	if (!node)
 		return BSIM_OK;
-	const char *t = ydoc_plain(node);
+	const char *t = bsim_ydoc_plain(node);
 	for (int i = 0; t && i < n; i++)
 		if (!strcmp(t, names[i])) {
 			*out = i;
 			return BSIM_OK;
 		}
-	return ydoc_expected(w->d, node, NULL, path, what, w->err);
+	return bsim_ydoc_expected(w->d, node, NULL, path, what, w->err);
 }
 
 /* effects.ground_friction.model: coupled (the default) or decoupled. */
@@ -469,7 +469,7 @@ static int body_shape(walk *w, struct fy_node *root)
 	w->s->effects.propulsion_along = (bsim_propulsion_along)dir;
 	/* The sizes a shape must be given, positive, and none it does not
 	 * have; said at the key (or the override) that gives them. */
-	struct fy_node *body = ydoc_lookup(root, "body");
+	struct fy_node *body = bsim_ydoc_lookup(root, "body");
 	static const char *const names[] = {"a disk", "a capsule", "an ellipse"};
 	static const struct {
 		const char *key, *what;
@@ -487,19 +487,19 @@ static int body_shape(walk *w, struct fy_node *root)
 	for (int i = 0; i < 3; i++) {
 		char field[32];
 		snprintf(field, sizeof field, "body.%s", sizes[i].key);
-		struct fy_node *n = ydoc_lookup(root, field);
+		struct fy_node *n = bsim_ydoc_lookup(root, field);
 		int needed = sizes[i].shape_mask >> shape & 1;
 		if (!needed && n)
-			return ydoc_fail(w->d, n, body, field, w->err,
+			return bsim_ydoc_fail(w->d, n, body, field, w->err,
 			                 "expected none for %s (it is %s)", names[shape],
 			                 i == 0   ? "sized by body.semi_axes"
 			                 : i == 1 ? "only a capsule that has a length"
 			                          : "only an ellipse that has semi-axes");
 		if (needed && !n)
-			return ydoc_fail(w->d, body, root, field, w->err, "missing (expected %s)",
+			return bsim_ydoc_fail(w->d, body, root, field, w->err, "missing (expected %s)",
 			                 sizes[i].what);
 		if (needed && !(value[i][0] > 0 && (i < 2 || value[i][1] > 0)))
-			return ydoc_expected(w->d, n, body, field, sizes[i].what, w->err);
+			return bsim_ydoc_expected(w->d, n, body, field, sizes[i].what, w->err);
 	}
 	return BSIM_OK;
 }
@@ -507,42 +507,42 @@ static int body_shape(walk *w, struct fy_node *root)
 /* A scene has beams: or lattice:, not both, not neither. */
 static int check_beams_or_lattice(walk *w, struct fy_node *root)
 {
-	struct fy_node_pair *beams = ydoc_pair(root, "beams", 5);
-	struct fy_node_pair *lattice = ydoc_pair(root, "lattice", 7);
+	struct fy_node_pair *beams = bsim_ydoc_pair(root, "beams", 5);
+	struct fy_node_pair *lattice = bsim_ydoc_pair(root, "lattice", 7);
 	if (beams && lattice)
-		return ydoc_fail(w->d, fy_node_pair_key(lattice), root, "lattice", w->err,
+		return bsim_ydoc_fail(w->d, fy_node_pair_key(lattice), root, "lattice", w->err,
 		                 "expected either beams: or lattice:, not both");
 	if (!beams && !lattice)
-		return ydoc_fail(w->d, root, NULL, "beams", w->err,
+		return bsim_ydoc_fail(w->d, root, NULL, "beams", w->err,
 		                 "missing (expected a non-empty list of beams, or a lattice: "
 		                 "block)");
 	return BSIM_OK;
 }
 
 /* The lattice's termination defaults where the file and overrides leave a
- * key out (scene_lattice_defaults); a length given in seconds counts as
- * given (scene_horizon has made it steps). */
+ * key out (bsim_scene_lattice_defaults); a length given in seconds counts as
+ * given (bsim_scene_horizon has made it steps). */
 static void lattice_defaults(walk *w, struct fy_node *root)
 {
 	bsim_scene *s = w->s, given = *s;
-	scene_lattice_defaults(s);
+	bsim_scene_lattice_defaults(s);
 	static const char *const keys[] = {"termination.success_y",  "termination.side_x",
 	                                   "termination.classify_y", "landscape.y0",
 	                                   "termination.gate_steps", "integration.max_steps",
 	                                   "termination.gate_time",  "integration.duration"};
-	if (ydoc_lookup(root, keys[0]))
+	if (bsim_ydoc_lookup(root, keys[0]))
 		s->success_y = given.success_y;
-	if (ydoc_lookup(root, keys[1]))
+	if (bsim_ydoc_lookup(root, keys[1]))
 		s->side_x = given.side_x;
-	if (ydoc_lookup(root, keys[2]))
+	if (bsim_ydoc_lookup(root, keys[2]))
 		s->classify_y = given.classify_y;
 	else
 		s->classify_y = s->success_y;
-	if (ydoc_lookup(root, keys[3]))
+	if (bsim_ydoc_lookup(root, keys[3]))
 		s->landscape_y0 = given.landscape_y0;
-	if (ydoc_lookup(root, keys[4]) || ydoc_lookup(root, keys[6]))
+	if (bsim_ydoc_lookup(root, keys[4]) || bsim_ydoc_lookup(root, keys[6]))
 		s->gate_steps = given.gate_steps;
-	if (ydoc_lookup(root, keys[5]) || ydoc_lookup(root, keys[7]))
+	if (bsim_ydoc_lookup(root, keys[5]) || bsim_ydoc_lookup(root, keys[7]))
 		s->max_steps = given.max_steps;
 	else
 		s->max_steps = s->gate_steps * (s->lattice.rows + s->lattice.columns);
@@ -554,7 +554,7 @@ static int walk_scene(walk *w, const ydoc *file)
 	if (!root || !fy_node_is_mapping(root))
 		return expected(w, root, NULL, "scene",
 		                "a mapping of scene keys (body, beams, ...)");
-	int rc = walk_table(w, &scene_top_table, root, NULL, (char *)w->s, "");
+	int rc = walk_table(w, &bsim_scene_top_table, root, NULL, (char *)w->s, "");
 	if (!rc)
 		rc = random_model(w, root);
 	if (!rc)
@@ -564,7 +564,7 @@ static int walk_scene(walk *w, const ydoc *file)
 	if (!rc)
 		rc = check_beams_or_lattice(w, root);
 	if (!rc)
-		rc = scene_horizon(w, file);
+		rc = bsim_scene_horizon(w, file);
 	if (!rc && w->s->has_lattice)
 		lattice_defaults(w, root);
 	if (!rc)
@@ -581,10 +581,10 @@ static int walk_scene(walk *w, const ydoc *file)
 	return rc;
 }
 
-int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,
+int bsim_scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,
                       bsim_error *err)
 {
-	scene_defaults(out);
+	bsim_scene_defaults(out);
 	if (strlen(file->path) >= sizeof out->path)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: expected a path shorter than %zu characters", file->path,
@@ -594,10 +594,10 @@ int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_sce
 	if (!d.fyd)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", file->path);
 	walk w = {&d, out, err};
-	int rc = yov_apply(&d, ov, n, err);
+	int rc = bsim_yov_apply(&d, ov, n, err);
 	if (!rc)
 		rc = walk_scene(&w, file);
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	if (!rc) {
 		snprintf(out->path, sizeof out->path, "%s", file->path);
 		if (!out->name[0])
@@ -606,7 +606,7 @@ int scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_sce
 	}
 	if (rc) {
 		bsim_scene_free(out);
-		scene_defaults(out);
+		bsim_scene_defaults(out);
 	}
 	return rc;
 }
@@ -615,11 +615,11 @@ int bsim_scene_load(const char *path, const bsim_override *overrides, int n_over
                     bsim_scene *out, bsim_error *err)
 {
 	ydoc d;
-	scene_defaults(out);
-	int rc = ydoc_load(&d, path, err);
+	bsim_scene_defaults(out);
+	int rc = bsim_ydoc_load(&d, path, err);
 	if (rc)
 		return rc;
-	rc = scene_load_parsed(&d, overrides, n_overrides, out, err);
-	ydoc_free(&d);
+	rc = bsim_scene_load_parsed(&d, overrides, n_overrides, out, err);
+	bsim_ydoc_free(&d);
 	return rc;
 }

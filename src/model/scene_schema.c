@@ -42,7 +42,7 @@ static const scene_field beam_fields[] = {
         {"initial_theta", SK_NUMBER, SR_ANY, 0, B(initial_theta), NULL},   /* rad */
         {"initial_omega", SK_NUMBER, SR_ANY, 0, B(initial_omega), NULL},   /* rad/s */
 };
-const scene_table scene_beam_table = TABLE(beam_fields);
+const scene_table bsim_scene_beam_table = TABLE(beam_fields);
 
 static const scene_field contact_fields[] = {
         {"restitution", SK_NUMBER, SR_UNIT, 0, S(contact.restitution), NULL},
@@ -121,15 +121,15 @@ static const scene_table landscape_table = TABLE(landscape_fields);
 static const scene_field top_fields[] = {
         {"name", SK_NAME, SR_ANY, 0, S(name), NULL},
         {"body", SK_BLOCK, SR_ANY, 1, SCENE_NO_FLAG, &body_table},
-        {"beams", SK_BEAMS, SR_ANY, 0, S(beams), &scene_beam_table},
-        {"lattice", SK_LATTICE, SR_ANY, 0, S(has_lattice), &scene_lattice_table},
+        {"beams", SK_BEAMS, SR_ANY, 0, S(beams), &bsim_scene_beam_table},
+        {"lattice", SK_LATTICE, SR_ANY, 0, S(has_lattice), &bsim_scene_lattice_table},
         {"contact", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &contact_table},
         {"effects", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &effects_table},
         {"integration", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &integration_table},
         {"termination", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &termination_table},
         {"landscape", SK_BLOCK, SR_ANY, 0, SCENE_NO_FLAG, &landscape_table},
 };
-const scene_table scene_top_table = TABLE(top_fields);
+const scene_table bsim_scene_top_table = TABLE(top_fields);
 
 /* The lattice block (scene_lattice.c reads the SK_LATER keys itself). */
 static const scene_field lattice_gate_fields[] = {
@@ -161,9 +161,9 @@ static const scene_field lattice_fields[] = {
         {"stiffness_file", SK_LATER, SR_ANY, 0, 0, NULL},
         {"protocol", SK_LATER, SR_ANY, 0, 0, NULL},
 };
-const scene_table scene_lattice_table = TABLE(lattice_fields);
+const scene_table bsim_scene_lattice_table = TABLE(lattice_fields);
 
-const char *scene_phrase(const scene_field *f)
+const char *bsim_scene_phrase(const scene_field *f)
 {
 	switch (f->kind) {
 	case SK_NUMBER:
@@ -197,7 +197,7 @@ const char *scene_phrase(const scene_field *f)
 	return "a value";
 }
 
-int scene_in_range(scene_range r, double v)
+int bsim_scene_in_range(scene_range r, double v)
 {
 	if (!isfinite(v))
 		return 0;
@@ -213,7 +213,7 @@ int scene_in_range(scene_range r, double v)
 	}
 }
 
-void scene_keys(const scene_table *t, char *buf, size_t size)
+void bsim_scene_keys(const scene_table *t, char *buf, size_t size)
 {
 	size_t used = 0;
 	buf[0] = '\0';

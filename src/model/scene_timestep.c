@@ -153,7 +153,7 @@ static double body_half_width(const bsim_body_def *b)
 	return b->radius;
 }
 
-void scene_speed_scale(const bsim_scene *s, scene_speed *v)
+void bsim_scene_speed_scale(const bsim_scene *s, scene_speed *v)
 {
 	const bsim_effects_def *e = &s->effects;
 	const bsim_body_def *body = &s->body;
@@ -196,7 +196,7 @@ void scene_speed_scale(const bsim_scene *s, scene_speed *v)
 static int crossing_bound(const bsim_scene *s, scene_dt_bound *b)
 {
 	scene_speed v;
-	scene_speed_scale(s, &v);
+	bsim_scene_speed_scale(s, &v);
 	if (!(v.total > 0))
 		return 0;
 	double size = body_half_width(&s->body);
@@ -236,7 +236,7 @@ static int crossing_bound(const bsim_scene *s, scene_dt_bound *b)
 	return 1;
 }
 
-int scene_dt_bounds(const bsim_scene *s, scene_dt_bound out[SCENE_DT_BOUNDS])
+int bsim_scene_dt_bounds(const bsim_scene *s, scene_dt_bound out[SCENE_DT_BOUNDS])
 {
 	int n = forcing_bounds(s, out);
 	n += beam_bounds(s, out + n);
@@ -250,10 +250,10 @@ static int dt_breaks(double dt, const scene_dt_bound *b)
 	return b->strict ? !(dt < b->max * (1 - DT_ROUNDING)) : !(dt <= max);
 }
 
-int scene_dt_find(const bsim_scene *s, scene_dt_bound *broken)
+int bsim_scene_dt_find(const bsim_scene *s, scene_dt_bound *broken)
 {
 	scene_dt_bound all[SCENE_DT_BOUNDS];
-	int n = scene_dt_bounds(s, all), found = 0;
+	int n = bsim_scene_dt_bounds(s, all), found = 0;
 	for (int i = 0; i < n; i++)
 		if (dt_breaks(s->dt, &all[i]) && (!found || all[i].max < broken->max)) {
 			*broken = all[i];
@@ -274,7 +274,7 @@ static double floor_4(double x)
 	return fabs(r + p - x) <= DT_ROUNDING * x ? r + p : r;
 }
 
-void scene_dt_message(const bsim_scene *s, const scene_dt_bound *b, char *buf, size_t size)
+void bsim_scene_dt_message(const bsim_scene *s, const scene_dt_bound *b, char *buf, size_t size)
 {
 	snprintf(buf, size, "expected %s %.4g s (%s), got %g", b->strict ? "less than" : "at most",
 	         floor_4(b->max), b->what, s->dt);

@@ -87,7 +87,7 @@ static const bsim_backend *add_locked(const bsim_backend *b, const char *what, c
  * holding the lock. */
 static const bsim_backend *load_locked(const char *path, bsim_error *err)
 {
-	const bsim_backend *b = registry_plugin_open(path, err);
+	const bsim_backend *b = bsim_registry_plugin_open(path, err);
 	if (!b)
 		return NULL;
 	char what[4200];
@@ -152,7 +152,7 @@ const bsim_backend *bsim_backend_register(const bsim_backend *b, bsim_error *err
 	env_ensure();
 	char what[64];
 	snprintf(what, sizeof what, "backend %.40s", b->name ? b->name : "");
-	if (registry_table_check(b, what, err) != BSIM_OK)
+	if (bsim_registry_table_check(b, what, err) != BSIM_OK)
 		return NULL;
 	pthread_mutex_lock(&registry_lock);
 	const bsim_backend *r = add_locked(b, what, NULL, err);

@@ -50,7 +50,7 @@ static const char *field_fault(const bsim_backend *b)
 	return NULL;
 }
 
-const bsim_backend *registry_plugin_open(const char *path, bsim_error *err)
+const bsim_backend *bsim_registry_plugin_open(const char *path, bsim_error *err)
 {
 	/* Bound now (RTLD_NOW): a symbol the plug-in needs and this process
 	 * lacks is said here, not at its first step. */
@@ -88,10 +88,10 @@ const bsim_backend *registry_plugin_open(const char *path, bsim_error *err)
 	}
 	char what[1100];
 	snprintf(what, sizeof what, "plug-in %s", path);
-	return registry_table_check(b, what, err) == BSIM_OK ? b : NULL;
+	return bsim_registry_table_check(b, what, err) == BSIM_OK ? b : NULL;
 }
 
-int registry_table_check(const bsim_backend *b, const char *what, bsim_error *err)
+int bsim_registry_table_check(const bsim_backend *b, const char *what, bsim_error *err)
 {
 	const char *fault = name_fault(b->name);
 	if (fault)

@@ -14,11 +14,11 @@
  * most of letters, digits, '_' and '-', a letter first) and the fields
  * every backend fills. The table, or NULL with BSIM_EINPUT naming path and
  * the reason. The library stays open. */
-const bsim_backend *registry_plugin_open(const char *path, bsim_error *err);
+const bsim_backend *bsim_registry_plugin_open(const char *path, bsim_error *err);
 
 /* The checks of a table a process adds at run time (a plug-in's or a
  * binding's): its name and the fields every backend fills. BSIM_OK, or
  * BSIM_EINPUT "WHAT: ..." saying what is wrong. */
-int registry_table_check(const bsim_backend *b, const char *what, bsim_error *err);
+int bsim_registry_table_check(const bsim_backend *b, const char *what, bsim_error *err);
 
 #endif

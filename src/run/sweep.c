@@ -235,8 +235,8 @@ static int record_beams(const bsim_scene *scenes, const bsim_scene *scenes_b, in
 {
 	if (cfg->results_only || !scenes[0].has_lattice)
 		return 0;
-	int beams = sweep_record_beams(scenes, n_groups);
-	int beams_b = scenes_b ? sweep_record_beams(scenes_b, n_groups) : 0;
+	int beams = bsim_sweep_record_beams(scenes, n_groups);
+	int beams_b = scenes_b ? bsim_sweep_record_beams(scenes_b, n_groups) : 0;
 	beams = beams_b > beams ? beams_b : beams;
 	return beams > 0 ? beams : 1;
 }
@@ -249,7 +249,7 @@ static size_t record_bytes(int beams, int n)
 {
 	if (!beams)
 		return n > 1 ? bsim_sweep_record_size_sides(n) : sizeof(bsim_trial_result);
-	return (size_t)n * sweep_record_size(beams) + (size_t)bsim_sweep_pairs(n) * sizeof(double);
+	return (size_t)n * bsim_sweep_record_bytes(beams) + (size_t)bsim_sweep_pairs(n) * sizeof(double);
 }
 
 /* What the threads share. first_fail is the index of the lowest failed
@@ -341,10 +341,10 @@ static const void *record_of(sweep_shared *sh, long i, void *buf)
 		return &sh->results[0][k];
 	unsigned char *p = buf;
 	size_t side =
-	        sh->record_beams ? sweep_record_size(sh->record_beams) : sizeof(bsim_trial_result);
+	        sh->record_beams ? bsim_sweep_record_bytes(sh->record_beams) : sizeof(bsim_trial_result);
 	for (int s = 0; s < sh->n_sides; s++, p += side)
 		if (sh->record_beams)
-			sweep_record_pack(p, sh->record_beams, &sh->results[s][k], &sh->logs[s][k]);
+			bsim_sweep_record_pack(p, sh->record_beams, &sh->results[s][k], &sh->logs[s][k]);
 		else
 			memcpy(p, &sh->results[s][k], side);
 	for (int q = 0; q < bsim_sweep_pairs(sh->n_sides); q++, p += sizeof(double))
@@ -386,14 +386,14 @@ static int journal_take(void *user, uint64_t index, const void *payload)
 	}
 	const unsigned char *p = payload;
 	size_t side =
-	        sh->record_beams ? sweep_record_size(sh->record_beams) : sizeof(bsim_trial_result);
+	        sh->record_beams ? bsim_sweep_record_bytes(sh->record_beams) : sizeof(bsim_trial_result);
 	for (int s = 0; s < sh->n_sides; s++, p += side) {
 		if (!sh->record_beams) {
 			memcpy(&sh->results[s][index], p, side);
 			continue;
 		}
 		/* a path too long for its record: the trial (every side) runs again */
-		int got = sweep_record_unpack(p, sh->record_beams, &sh->results[s][index],
+		int got = bsim_sweep_record_unpack(p, sh->record_beams, &sh->results[s][index],
 		                              &sh->logs[s][index]);
 		if (got <= 0)
 			return got;
@@ -419,9 +419,9 @@ static void sweep_thread(sweep_shared *sh)
 	/* The scenes live, unchanged, as long as the sweep. */
 	if (runner)
 		bsim_trial_runner_keep_worlds(runner, 1);
-	trial_sides *sides = n_sides > 1 ? trial_sides_alloc(n_sides) : NULL;
+	trial_sides *sides = n_sides > 1 ? bsim_trial_sides_alloc(n_sides) : NULL;
 	if (sides)
-		trial_sides_keep_worlds(sides, 1);
+		bsim_trial_sides_keep_worlds(sides, 1);
 	bsim_trial_log *log[BSIM_SWEEP_SIDES_MAX] = {NULL};
 	int logs_ok = 1;
 	for (int s = 0; s < n_sides; s++)
@@ -472,7 +472,7 @@ static void sweep_thread(sweep_shared *sh)
 				sides->keep[s] = keep ? &sh->kept[s][g * sh->keep + t] : NULL;
 			}
 			sides->keep_stride = sh->keep_stride;
-			rc = trial_sides_run(sides, scenes, sh->backend, sh->opts, seed,
+			rc = bsim_trial_sides_run(sides, scenes, sh->backend, sh->opts, seed,
 			                     0.01 * body_size(scene), results, log, t_sep, &err);
 			for (int q = 0; rc == BSIM_OK && q < n_pairs; q++)
 				sh->t_separate[q][k] = t_sep[q];
@@ -509,7 +509,7 @@ static void sweep_thread(sweep_shared *sh)
 			              sh->progress_total ? sh->progress_total : sh->total);
 	}
 	bsim_trial_runner_free(runner);
-	trial_sides_free(sides);
+	bsim_trial_sides_free(sides);
 	for (int s = 0; s < n_sides; s++)
 		bsim_trial_log_free(log[s]);
 	free(record_buf);
@@ -851,7 +851,7 @@ static int stream_load(sweep_shared *sh, bsim_error *err)
 			break;
 		}
 		/* a lattice's path too long for its record: the trial runs again */
-		int got = rec ? sweep_record_unpack(rec, sh->record_beams, &sh->results[0][k],
+		int got = rec ? bsim_sweep_record_unpack(rec, sh->record_beams, &sh->results[0][k],
 		                                    &sh->logs[0][k])
 		              : 1;
 		if (got < 0)

@@ -5,13 +5,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-size_t sweep_record_size(int beams_max)
+size_t bsim_sweep_record_bytes(int beams_max)
 {
 	return sizeof(bsim_trial_result) + 2 * sizeof(int32_t) +
 	       SWEEP_RECORD_ENTRIES * sizeof(bsim_gate_entry) + (size_t)beams_max * sizeof(double);
 }
 
-int sweep_record_beams(const bsim_scene *scenes, int n)
+int bsim_sweep_record_beams(const bsim_scene *scenes, int n)
 {
 	int most = 0;
 	for (int g = 0; g < n; g++)
@@ -19,11 +19,11 @@ int sweep_record_beams(const bsim_scene *scenes, int n)
 	return most;
 }
 
-void sweep_record_pack(void *rec, int beams_max, const bsim_trial_result *r,
+void bsim_sweep_record_pack(void *rec, int beams_max, const bsim_trial_result *r,
                        const bsim_trial_log *log)
 {
 	unsigned char *p = rec;
-	memset(p, 0, sweep_record_size(beams_max));
+	memset(p, 0, bsim_sweep_record_bytes(beams_max));
 	memcpy(p, r, sizeof *r);
 	p += sizeof *r;
 	int32_t n_entries = log->n_entries, n_beams = log->n_beams;
@@ -41,7 +41,7 @@ void sweep_record_pack(void *rec, int beams_max, const bsim_trial_result *r,
 		memcpy(p, log->peak, (size_t)n_beams * sizeof *log->peak);
 }
 
-int sweep_record_unpack(const void *rec, int beams_max, bsim_trial_result *r, bsim_trial_log *log)
+int bsim_sweep_record_unpack(const void *rec, int beams_max, bsim_trial_result *r, bsim_trial_log *log)
 {
 	const unsigned char *p = rec;
 	int32_t n_entries, n_beams;

@@ -26,17 +26,17 @@
 #define SWEEP_RECORD_ENTRIES 32
 
 /* The record's size for scenes of at most beams_max beams. */
-size_t sweep_record_size(int beams_max);
+size_t bsim_sweep_record_bytes(int beams_max);
 
 /* The most beams of the n scenes: the record's peaks. */
-int sweep_record_beams(const bsim_scene *scenes, int n);
+int bsim_sweep_record_beams(const bsim_scene *scenes, int n);
 
-/* r and log packed into rec (sweep_record_size(beams_max) bytes). */
-void sweep_record_pack(void *rec, int beams_max, const bsim_trial_result *r,
+/* r and log packed into rec (bsim_sweep_record_bytes(beams_max) bytes). */
+void bsim_sweep_record_pack(void *rec, int beams_max, const bsim_trial_result *r,
                        const bsim_trial_log *log);
 
 /* rec into r and log (grown as needed): 1; 0 if the record's path did not
  * fit (nothing filled: the trial runs again); -1 out of memory. */
-int sweep_record_unpack(const void *rec, int beams_max, bsim_trial_result *r, bsim_trial_log *log);
+int bsim_sweep_record_unpack(const void *rec, int beams_max, bsim_trial_result *r, bsim_trial_log *log);
 
 #endif

@@ -80,7 +80,7 @@ bsim_trial_runner *bsim_trial_runner_alloc(void)
 {
 	bsim_trial_runner *r = calloc(1, sizeof(bsim_trial_runner));
 	if (r)
-		trial_steps_init(&r->steps);
+		bsim_trial_steps_init(&r->steps);
 	return r;
 }
 
@@ -91,8 +91,8 @@ void bsim_trial_runner_free(bsim_trial_runner *r)
 	bsim_state_free(&r->s0);
 	bsim_state_free(&r->s1);
 	bsim_state_free(&r->whole);
-	trial_peaks_free(&r->peaks);
-	trial_steps_free(&r->steps);
+	bsim_trial_peaks_free(&r->peaks);
+	bsim_trial_steps_free(&r->steps);
 	bsim_effects_spare_free(&r->spare);
 	runner_forget_world(r);
 	free(r->shape);
@@ -147,7 +147,7 @@ static int trial_world(trial_ctx *c, bsim_error *err)
 	bsim_trial_runner *r = c->r;
 	int essay = scene->has_lattice && scene->lattice.protocol == BSIM_PROTOCOL_ESSAY;
 	int world_beams = essay ? 2 : scene->n_beams;
-	if (runner_reserve(r, world_beams) || trial_peaks_reserve(&r->peaks, scene->n_beams))
+	if (runner_reserve(r, world_beams) || bsim_trial_peaks_reserve(&r->peaks, scene->n_beams))
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (essay && (c->recording || c->trace_whole) && r->whole.n_beams != scene->n_beams) {
 		bsim_state_free(&r->whole);
@@ -156,7 +156,7 @@ static int trial_world(trial_ctx *c, bsim_error *err)
 	}
 	c->ws = scene;
 	c->map = NULL;
-	trial_gate_start(&c->gate, scene);
+	bsim_trial_gate_start(&c->gate, scene);
 	if (!essay && r->kept && r->kept_scene == scene && r->kept_backend == c->backend &&
 	    r->kept_opts == c->opts) {
 		c->w = r->kept;
@@ -171,7 +171,7 @@ static int trial_world(trial_ctx *c, bsim_error *err)
 	runner_forget_world(r);
 	if (!essay)
 		return c->backend->create(scene, c->opts, &c->w, err);
-	int rc = trial_essay_start(&r->essay, scene, c->backend, c->opts, c->gate.ix, c->gate.iy,
+	int rc = bsim_trial_essay_start(&r->essay, scene, c->backend, c->opts, c->gate.ix, c->gate.iy,
 	                           &c->w, &c->out->reset_overlaps, err);
 	c->ws = &r->essay.scene;
 	c->map = r->essay.map;
@@ -198,7 +198,7 @@ static int trial_open(trial_ctx *c, uint64_t seed, bsim_error *err)
 	c->trace_whole = c->trace && rec->trace_whole;
 	int rc = trial_world(c, err);
 	if (rc) {
-		trial_essay_release(&c->r->essay, c->backend, &c->w);
+		bsim_trial_essay_release(&c->r->essay, c->backend, &c->w);
 		return rc;
 	}
 	if (bsim_effects_init_spare(c->fx, c->scene, seed, c->backend->takes, &c->r->spare)) {
@@ -212,7 +212,7 @@ static int trial_open(trial_ctx *c, uint64_t seed, bsim_error *err)
  * lattice's (trace_whole under the essay's protocol). */
 static const bsim_state *trial_trace_state(trial_ctx *c, const bsim_state *s)
 {
-	return c->trace_whole ? trial_record_state(&c->r->whole, c->map, s) : s;
+	return c->trace_whole ? bsim_trial_record_state(&c->r->whole, c->map, s) : s;
 }
 
 /* Whether a beam s lists is in contact (bsim_contact_flag_in), its flags
@@ -235,7 +235,7 @@ static int trial_begin(trial_ctx *c, trial_loop *lp, bsim_state *s0, bsim_error 
 	c->backend->get_state(c->w, s0);
 	bsim_contact_flags(c->ws, s0);
 	if (c->overlap)
-		trial_overlap_shapes(c->r->shape, c->ws);
+		bsim_trial_overlap_shapes(c->r->shape, c->ws);
 	c->n_max = scene->max_steps;
 	c->gate_max = scene->gate_steps > 0 ? scene->gate_steps : c->n_max;
 	c->centre = bsim_lattice_centre_x(scene);
@@ -244,9 +244,9 @@ static int trial_begin(trial_ctx *c, trial_loop *lp, bsim_state *s0, bsim_error 
 	out->ledger.inflow = lp->e0;
 	/* Peaks start at the initial angles: every beam of the scene (the
 	 * essay's world holds one gate; the others start at rest). */
-	trial_peaks_start(&c->r->peaks, scene, c->map, s0);
+	bsim_trial_peaks_start(&c->r->peaks, scene, c->map, s0);
 	if (c->log)
-		rc = trial_gate_log_start(c->log, &c->gate, scene, c->map, s0, err);
+		rc = bsim_trial_gate_log_start(c->log, &c->gate, scene, c->map, s0, err);
 	out->overlap_max = c->overlap ? 0.0 : NAN;
 	if (c->trace)
 		c->trace(c->rec->trace_user, 0, trial_trace_state(c, s0));
@@ -259,7 +259,7 @@ static int trial_begin(trial_ctx *c, trial_loop *lp, bsim_state *s0, bsim_error 
 static void trial_record(trial_ctx *c, const bsim_state *s, long n)
 {
 	double f_rand = c->fx->random ? c->fx->random->last : 0.0;
-	trial_record_row(c->rec, c->scene, trial_record_state(&c->r->whole, c->map, s), n, f_rand,
+	bsim_trial_record_row(c->rec, c->scene, bsim_trial_record_state(&c->r->whole, c->map, s), n, f_rand,
 	                 &c->out->ledger);
 	c->recorded = n;
 }
@@ -279,21 +279,21 @@ static inline int trial_over(const trial_ctx *c, const trial_loop *lp, const bsi
 static int gate_enter(trial_ctx *c, trial_loop *lp, bsim_state *s, const double p0[2], int ix,
                       int iy, bsim_error *err)
 {
-	int rc = trial_gate_cross(&c->gate, c->log, c->scene, c->map, p0, s, ix, iy, lp->n, err);
+	int rc = bsim_trial_gate_cross(&c->gate, c->log, c->scene, c->map, p0, s, ix, iy, lp->n, err);
 	if (rc || c->scene->lattice.protocol != BSIM_PROTOCOL_ESSAY)
 		return rc;
 	double e_before = lp->e0;
 	/* The world is replaced: what its solvers gave up on stays counted. */
 	c->solver.iteration_limit += s->solver.iteration_limit;
 	c->solver.clamped += s->solver.clamped;
-	rc = trial_essay_enter(&c->r->essay, c->scene, c->backend, c->opts, ix, iy, s, &c->w,
+	rc = bsim_trial_essay_enter(&c->r->essay, c->scene, c->backend, c->opts, ix, iy, s, &c->w,
 	                       &c->out->reset_overlaps, err);
 	if (rc)
 		return rc;
 	c->backend->get_state(c->w, s);
 	bsim_contact_flags(c->ws, s);
 	if (c->overlap) /* the new world's two beams */
-		trial_overlap_shapes(c->r->shape, c->ws);
+		bsim_trial_overlap_shapes(c->r->shape, c->ws);
 	lp->e0 = energy_mech(c->ws, s);
 	c->out->ledger.reset += e_before - lp->e0;
 	return BSIM_OK;
@@ -352,14 +352,14 @@ static void trial_result(trial_ctx *c, const trial_loop *lp, bsim_state *s0)
 		out->type = s0->v[0] > band    ? BSIM_TYPE_LEFT
 		            : s0->v[0] < -band ? BSIM_TYPE_RIGHT
 		                               : BSIM_TYPE_NONE;
-		out->landscape_beam = trial_peaks_label(p, scene);
+		out->landscape_beam = bsim_trial_peaks_label(p, scene);
 	}
 	out->x_end = s0->x[0];
 	out->y_end = s0->x[1];
 	out->vx_end = s0->v[0];
-	trial_peaks_turn_end(p, s0, out);
+	bsim_trial_peaks_turn_end(p, s0, out);
 	out->steps_run = (int)lp->n;
-	trial_ledger_close(out, lp->e0, lp->n);
+	bsim_trial_ledger_close(out, lp->e0, lp->n);
 	if (out->instability) {
 		out->outcome = BSIM_UNSTABLE;
 		out->type = BSIM_TYPE_NONE;
@@ -384,7 +384,7 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, bsim_state *s0, int r
 	trial_result(c, lp, s0);
 	if (rc == BSIM_OK)
 		rc = bsim_effects_status(c->fx, err);
-	if (rc == BSIM_OK && c->log && trial_log_peaks(c->log, c->r->peaks.peak, c->scene->n_beams))
+	if (rc == BSIM_OK && c->log && bsim_trial_log_peaks(c->log, c->r->peaks.peak, c->scene->n_beams))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the peaks");
 	bsim_trial_runner *r = c->r;
 	bsim_effects_free_spare(c->fx, &r->spare);
@@ -395,7 +395,7 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, bsim_state *s0, int r
 		r->kept_opts = c->opts;
 		c->w = NULL;
 	}
-	trial_essay_release(&r->essay, c->backend, &c->w);
+	bsim_trial_essay_release(&r->essay, c->backend, &c->w);
 	return rc;
 }
 
@@ -407,7 +407,7 @@ __attribute__((noinline)) static void trial_measure(trial_ctx *c, const bsim_sta
 {
 	if (c->overlap)
 		c->out->overlap_max =
-		        fmax(c->out->overlap_max, trial_overlap_depth(c->r->shape, c->ws->n_beams,
+		        fmax(c->out->overlap_max, bsim_trial_overlap_depth(c->r->shape, c->ws->n_beams,
 		                                                      c->scene->body.radius, s1));
 	trial_peaks_turn(&c->r->peaks, s1);
 }
@@ -464,7 +464,7 @@ static inline int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0,
 #define TRIAL_BOOK static inline
 #endif
 
-/* The pipeline of a run (trial_force_holds): the propulsion's force (N)
+/* The pipeline of a run (bsim_trial_force_holds): the propulsion's force (N)
  * and the held random force's, each over the whole run. */
 typedef struct run_forces {
 	double cp, cr;
@@ -586,7 +586,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	trial_loop lp;
 	rc = trial_begin(&c, &lp, s0, err);
 	const int plain = !c.recording && !c.trace && !c.measure && !c.map;
-	if (rc == BSIM_OK && trial_steps_start(&r->steps, plain, scene, &fx, c.n_max, c.gate_max))
+	if (rc == BSIM_OK && bsim_trial_steps_start(&r->steps, plain, scene, &fx, c.n_max, c.gate_max))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
 		double f[BSIM_WRENCH];

@@ -49,12 +49,12 @@ static int essay_create(trial_essay *te, const bsim_backend *b, const bsim_optio
                         bsim_world **w, int *overlaps, bsim_error *err)
 {
 	double dist;
-	if (scene_overlap(&te->scene, &dist) >= 0)
+	if (bsim_scene_overlap(&te->scene, &dist) >= 0)
 		(*overlaps)++;
 	return b->create(&te->scene, opts, w, err);
 }
 
-int trial_essay_start(trial_essay *te, const bsim_scene *lattice, const bsim_backend *b,
+int bsim_trial_essay_start(trial_essay *te, const bsim_scene *lattice, const bsim_backend *b,
                       const bsim_options *opts, int ix, int iy, bsim_world **w, int *overlaps,
                       bsim_error *err)
 {
@@ -63,16 +63,16 @@ int trial_essay_start(trial_essay *te, const bsim_scene *lattice, const bsim_bac
 	return essay_create(te, b, opts, w, overlaps, err);
 }
 
-int trial_essay_enter(trial_essay *te, const bsim_scene *lattice, const bsim_backend *b,
+int bsim_trial_essay_enter(trial_essay *te, const bsim_scene *lattice, const bsim_backend *b,
                       const bsim_options *opts, int ix, int iy, const bsim_state *s, bsim_world **w,
                       int *overlaps, bsim_error *err)
 {
-	trial_essay_release(te, b, w);
+	bsim_trial_essay_release(te, b, w);
 	essay_scene(te, lattice, ix, iy, s->x, s->v);
 	return essay_create(te, b, opts, w, overlaps, err);
 }
 
-void trial_essay_release(trial_essay *te, const bsim_backend *b, bsim_world **w)
+void bsim_trial_essay_release(trial_essay *te, const bsim_backend *b, bsim_world **w)
 {
 	(void)te;
 	if (*w)

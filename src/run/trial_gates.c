@@ -11,7 +11,7 @@
 #include "model/lattice_crossing.h"
 #include "run/trial_log.h"
 
-void trial_gate_start(gate_track *g, const bsim_scene *scene)
+void bsim_trial_gate_start(gate_track *g, const bsim_scene *scene)
 {
 	double p[2] = {scene->body.start[0], scene->body.start[1]};
 	bsim_lattice_gate_at(scene, p, &g->ix, &g->iy);
@@ -54,14 +54,14 @@ static void entry_fill(bsim_gate_entry *e, const bsim_scene *scene, const int *m
 	}
 }
 
-int trial_gate_log_start(bsim_trial_log *log, const gate_track *g, const bsim_scene *scene,
+int bsim_trial_gate_log_start(bsim_trial_log *log, const gate_track *g, const bsim_scene *scene,
                          const int *map, const bsim_state *s0, bsim_error *err)
 {
 	bsim_gate_entry e;
 	entry_fill(&e, scene, map, s0, g->ix, g->iy, BSIM_EDGE_START,
 	           s0->x[0] - (scene->has_lattice ? scene->lattice.width * g->ix : 0.0), 0,
 	           scene->dt);
-	if (trial_log_push(log, &e))
+	if (bsim_trial_log_push(log, &e))
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate path");
 	return BSIM_OK;
 }
@@ -107,14 +107,14 @@ static int entries_of_step(const bsim_scene *scene, const int *map, const gate_t
 	return 2;
 }
 
-int trial_gate_cross(gate_track *g, bsim_trial_log *log, const bsim_scene *scene, const int *map,
+int bsim_trial_gate_cross(gate_track *g, bsim_trial_log *log, const bsim_scene *scene, const int *map,
                      const double p0[2], const bsim_state *s, int ix, int iy, long n,
                      bsim_error *err)
 {
 	bsim_gate_entry e[2];
 	int k = entries_of_step(scene, map, g, p0, s, ix, iy, n, scene->dt, e);
 	for (int i = 0; i < k; i++)
-		if (log && trial_log_push(log, &e[i]))
+		if (log && bsim_trial_log_push(log, &e[i]))
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate path");
 	g->ix = ix;
 	g->iy = iy;

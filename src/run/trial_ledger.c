@@ -6,7 +6,7 @@
 
 #include <stdio.h>
 
-void trial_ledger_close(bsim_trial_result *out, double e_end, long n)
+void bsim_trial_ledger_close(bsim_trial_result *out, double e_end, long n)
 {
 	out->ledger.e_end = e_end;
 	const bsim_ledger *l = &out->ledger;

@@ -169,6 +169,6 @@ static inline void ledger_step(bsim_ledger *l, const bsim_effects *fx, const bsi
  * whose residual exceeds the bound becomes unstable (energy created), and
  * so does one whose residual is below minus the lost bound (energy
  * vanished). */
-void trial_ledger_close(bsim_trial_result *out, double e_end, long n);
+void bsim_trial_ledger_close(bsim_trial_result *out, double e_end, long n);
 
 #endif

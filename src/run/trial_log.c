@@ -53,7 +53,7 @@ int bsim_trial_log_copy(bsim_trial_log *dst, const bsim_trial_log *src)
 	return BSIM_OK;
 }
 
-int trial_log_push(bsim_trial_log *l, const bsim_gate_entry *e)
+int bsim_trial_log_push(bsim_trial_log *l, const bsim_gate_entry *e)
 {
 	if (l->n_entries == l->cap_entries) {
 		int cap = l->cap_entries ? 2 * l->cap_entries : 16;
@@ -67,7 +67,7 @@ int trial_log_push(bsim_trial_log *l, const bsim_gate_entry *e)
 	return BSIM_OK;
 }
 
-int trial_log_peaks(bsim_trial_log *l, const double *peak, int n)
+int bsim_trial_log_peaks(bsim_trial_log *l, const double *peak, int n)
 {
 	if (l->cap_beams < n) {
 		double *p = realloc(l->peak, (size_t)n * sizeof *p);

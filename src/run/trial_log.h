@@ -5,9 +5,9 @@
 #include "beamsim/trial.h"
 
 /* Appends gate entry e to the path. */
-int trial_log_push(bsim_trial_log *l, const bsim_gate_entry *e);
+int bsim_trial_log_push(bsim_trial_log *l, const bsim_gate_entry *e);
 
 /* The n beams' peak angles, rad. */
-int trial_log_peaks(bsim_trial_log *l, const double *peak, int n);
+int bsim_trial_log_peaks(bsim_trial_log *l, const double *peak, int n);
 
 #endif

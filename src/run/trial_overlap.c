@@ -8,7 +8,7 @@
 
 #include "beamsim/contact_flag.h"
 
-void trial_overlap_shapes(beam_shape *shape, const bsim_scene *sc)
+void bsim_trial_overlap_shapes(beam_shape *shape, const bsim_scene *sc)
 {
 	for (int i = 0; i < sc->n_beams; i++) {
 		const bsim_beam_def *b = &sc->beams[i];
@@ -26,7 +26,7 @@ void trial_overlap_shapes(beam_shape *shape, const bsim_scene *sc)
  * centre C (docs/model.md section 3), measured as the contact flag measures
  * it (beamsim/contact_flag.h). A beam whose reach L + R does not hold the
  * centre costs one distance test. */
-double trial_overlap_depth(const beam_shape *shape, int n, double radius, const bsim_state *s)
+double bsim_trial_overlap_depth(const beam_shape *shape, int n, double radius, const bsim_state *s)
 {
 	double depth = 0.0;
 	for (int i = 0; i < n; i++) {

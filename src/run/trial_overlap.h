@@ -14,10 +14,10 @@ typedef struct beam_shape {
 } beam_shape;
 
 /* The shapes of sc's beams, shape[sc->n_beams]. */
-void trial_overlap_shapes(beam_shape *shape, const bsim_scene *sc);
+void bsim_trial_overlap_shapes(beam_shape *shape, const bsim_scene *sc);
 
 /* How deep the body of radius R overlaps the n beams at s, m (0 if it
  * does not). */
-double trial_overlap_depth(const beam_shape *shape, int n, double radius, const bsim_state *s);
+double bsim_trial_overlap_depth(const beam_shape *shape, int n, double radius, const bsim_state *s);
 
 #endif

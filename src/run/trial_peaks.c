@@ -7,11 +7,11 @@
 #include "beamsim/error.h"
 #include "beamsim/landscape.h"
 
-int trial_peaks_reserve(trial_peaks *p, int n_beams)
+int bsim_trial_peaks_reserve(trial_peaks *p, int n_beams)
 {
 	if (p->cap >= n_beams && p->peak)
 		return BSIM_OK;
-	trial_peaks_free(p);
+	bsim_trial_peaks_free(p);
 	size_t n = n_beams > 0 ? (size_t)n_beams : 1;
 	p->peak = malloc(n * sizeof *p->peak);
 	p->negative = malloc(n * sizeof *p->negative);
@@ -29,7 +29,7 @@ int trial_peaks_reserve(trial_peaks *p, int n_beams)
 	return BSIM_OK;
 }
 
-void trial_peaks_free(trial_peaks *p)
+void bsim_trial_peaks_free(trial_peaks *p)
 {
 	free(p->peak);
 	free(p->negative);
@@ -43,7 +43,7 @@ void trial_peaks_free(trial_peaks *p)
 	p->cap = p->n_touch = p->n_negative = p->n_list = 0;
 }
 
-void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
+void bsim_trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
                        const bsim_state *s0)
 {
 	for (int k = 0; k < p->n_list; k++) {
@@ -75,7 +75,7 @@ void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
 	p->turn_max = 0.0;
 }
 
-int trial_peaks_label(const trial_peaks *p, const bsim_scene *scene)
+int bsim_trial_peaks_label(const trial_peaks *p, const bsim_scene *scene)
 {
 	/* the landscape's label is the disk's (bsim_landscape_label): none for
 	 * another shape */
@@ -84,7 +84,7 @@ int trial_peaks_label(const trial_peaks *p, const bsim_scene *scene)
 	return p->touched ? bsim_landscape_label(scene, p->last_touch, p->touching) : -1;
 }
 
-void trial_peaks_turn_end(const trial_peaks *p, const bsim_state *s, bsim_trial_result *out)
+void bsim_trial_peaks_turn_end(const trial_peaks *p, const bsim_state *s, bsim_trial_result *out)
 {
 	out->heading_end = s->heading;
 	out->angular_velocity_end = s->angular_velocity;

@@ -27,7 +27,7 @@ typedef struct trial_peaks {
 	int n_list;
 	/* The last touching step before success_y: where the body was, and per
 	 * beam of the scene its contacts then (all zero between trials:
-	 * trial_peaks_start clears what the last trial set). */
+	 * bsim_trial_peaks_start clears what the last trial set). */
 	int touched; /* the body touched a beam at all */
 	double last_touch[2];
 	int *touching;
@@ -44,25 +44,25 @@ typedef struct trial_peaks {
 } trial_peaks;
 
 /* Room for a scene of n_beams beams. */
-int trial_peaks_reserve(trial_peaks *p, int n_beams);
-void trial_peaks_free(trial_peaks *p);
+int bsim_trial_peaks_reserve(trial_peaks *p, int n_beams);
+void bsim_trial_peaks_free(trial_peaks *p);
 
 /* Peaks at the initial angles s0 (map: every beam of the scene starts at
  * rest), no contact yet, no turn. A beam s0 does not list active is at rest
  * (its angle 0): its peak is 0, and the cost is that of the beams the last
  * trial moved, not of the scene. */
-void trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
+void bsim_trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
                        const bsim_state *s0);
 
 /* The landscape label of a traversal: the beam whose barrier the body
  * crossed (bsim_landscape_label at the last touching step), -1 if it
  * touched none. */
-int trial_peaks_label(const trial_peaks *p, const bsim_scene *scene);
+int bsim_trial_peaks_label(const trial_peaks *p, const bsim_scene *scene);
 
 /* The body's turn into out (heading_end, angular_velocity_end, turn_end,
  * turn_max), s the run's last state. Not inline: the runner's step loop is
  * compiled as it was without it. */
-void trial_peaks_turn_end(const trial_peaks *p, const bsim_state *s, bsim_trial_result *out);
+void bsim_trial_peaks_turn_end(const trial_peaks *p, const bsim_state *s, bsim_trial_result *out);
 
 static inline int scene_beam(const int *map, int i)
 {

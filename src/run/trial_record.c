@@ -63,7 +63,7 @@ static void ledger_row(FILE *f, const bsim_record_row *row)
 	        l->damper, l->impact, l->contact, l->correction, l->residual, l->sleep, l->reset);
 }
 
-void trial_record_row(const bsim_recorder *rec, const bsim_scene *sc, const bsim_state *s,
+void bsim_trial_record_row(const bsim_recorder *rec, const bsim_scene *sc, const bsim_state *s,
                       long step, double f_rand, const bsim_ledger *ledger)
 {
 	bsim_record_row row = {
@@ -87,7 +87,7 @@ void trial_record_row(const bsim_recorder *rec, const bsim_scene *sc, const bsim
 
 /* The essay's world holds two beams: the whole state takes those listed
  * active, where the map puts them. */
-const bsim_state *trial_record_state(bsim_state *whole, const int *map, const bsim_state *s)
+const bsim_state *bsim_trial_record_state(bsim_state *whole, const int *map, const bsim_state *s)
 {
 	if (!map)
 		return s;

@@ -6,12 +6,12 @@
 #include "beamsim/trial.h"
 
 /* One recorded row, the state s at step `step`, to every sink of rec. */
-void trial_record_row(const bsim_recorder *rec, const bsim_scene *sc, const bsim_state *s,
+void bsim_trial_record_row(const bsim_recorder *rec, const bsim_scene *sc, const bsim_state *s,
                       long step, double f_rand, const bsim_ledger *ledger);
 
 /* The whole lattice's state for the recorder, in whole (a state of the
  * scene's beams), from the state s of the essay's world, whose beam i is
  * the scene's map[i]; s itself if map is NULL. */
-const bsim_state *trial_record_state(bsim_state *whole, const int *map, const bsim_state *s);
+const bsim_state *bsim_trial_record_state(bsim_state *whole, const int *map, const bsim_state *s);
 
 #endif

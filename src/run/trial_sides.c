@@ -10,7 +10,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-trial_sides *trial_sides_alloc(int n)
+trial_sides *bsim_trial_sides_alloc(int n)
 {
 	if (n < 2 || n > BSIM_SWEEP_SIDES_MAX)
 		return NULL;
@@ -20,19 +20,19 @@ trial_sides *trial_sides_alloc(int n)
 	p->n = n;
 	for (int s = 0; s < n; s++)
 		if (!(p->runner[s] = bsim_trial_runner_alloc())) {
-			trial_sides_free(p);
+			bsim_trial_sides_free(p);
 			return NULL;
 		}
 	return p;
 }
 
-void trial_sides_keep_worlds(trial_sides *p, int on)
+void bsim_trial_sides_keep_worlds(trial_sides *p, int on)
 {
 	for (int s = 0; s < p->n; s++)
 		bsim_trial_runner_keep_worlds(p->runner[s], on);
 }
 
-void trial_sides_free(trial_sides *p)
+void bsim_trial_sides_free(trial_sides *p)
 {
 	if (!p)
 		return;
@@ -97,7 +97,7 @@ static double separation(const trial_sides *p, int a, int b, double d, double dt
 	return -1.0;
 }
 
-int trial_sides_run(trial_sides *p, const bsim_scene *const *scene,
+int bsim_trial_sides_run(trial_sides *p, const bsim_scene *const *scene,
                     const bsim_backend *const *backend, const bsim_options *const *opts,
                     uint64_t seed, double sep_distance, bsim_trial_result *const *result,
                     bsim_trial_log *const *log, double *t_separate, bsim_error *err)

@@ -28,12 +28,12 @@ typedef struct trial_sides {
 	int keep_stride;
 } trial_sides;
 
-trial_sides *trial_sides_alloc(int n);
-void trial_sides_free(trial_sides *p);
+trial_sides *bsim_trial_sides_alloc(int n);
+void bsim_trial_sides_free(trial_sides *p);
 /* bsim_trial_runner_keep_worlds on every runner: each backend's world kept
  * from one trial to the next of the same scene (the scenes must live,
  * unchanged, while it is on). */
-void trial_sides_keep_worlds(trial_sides *p, int on);
+void bsim_trial_sides_keep_worlds(trial_sides *p, int on);
 
 /* Trial `seed` of scene[s] (one scene, or ones that differ only in what the
  * comparison is about) on backend[s] with opts[s], for each side s in
@@ -41,7 +41,7 @@ void trial_sides_keep_worlds(trial_sides *p, int on);
  * t_separate[k], for each pair k of sides in bsim_sweep_pair's order: the
  * first time, s, at which the two body centres are more than sep_distance
  * apart (m), compared while both runs go on; -1 if they never are. */
-int trial_sides_run(trial_sides *p, const bsim_scene *const *scene,
+int bsim_trial_sides_run(trial_sides *p, const bsim_scene *const *scene,
                     const bsim_backend *const *backend, const bsim_options *const *opts,
                     uint64_t seed, double sep_distance, bsim_trial_result *const *result,
                     bsim_trial_log *const *log, double *t_separate, bsim_error *err);

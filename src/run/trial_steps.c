@@ -2,7 +2,7 @@
  * made by one call of the backend's advance.
  *
  * Why the force is the same. The step loop asks the pipeline for the
- * force before each step; where it holds (trial_force_holds: propulsion
+ * force before each step; where it holds (bsim_trial_force_holds: propulsion
  * gives its constant, the held random force its held value until
  * the step its hold ends, and neither reads the state), the force asked
  * before a run is the force of each step of it up to the hold's end, and
@@ -16,13 +16,13 @@
 
 #include <string.h>
 
-void trial_steps_init(trial_steps *t)
+void bsim_trial_steps_init(trial_steps *t)
 {
 	t->on = 0;
 	t->cap = -1;
 }
 
-void trial_steps_free(trial_steps *t)
+void bsim_trial_steps_free(trial_steps *t)
 {
 	if (t->cap < 0)
 		return;
@@ -37,20 +37,20 @@ static int steps_reserve(trial_steps *t, int n_beams)
 {
 	if (t->cap == n_beams)
 		return BSIM_OK;
-	trial_steps_free(t);
+	bsim_trial_steps_free(t);
 	/* empty states first: bsim_state_free of one is harmless */
 	memset(t->bank, 0, sizeof t->bank);
 	t->cap = n_beams;
 	for (int b = 0; b < 2; b++)
 		for (int k = 0; k < TRIAL_STEPS_MAX; k++)
 			if (bsim_state_init(&t->bank[b][k], n_beams)) {
-				trial_steps_free(t);
+				bsim_trial_steps_free(t);
 				return BSIM_EFAIL;
 			}
 	return BSIM_OK;
 }
 
-int trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
+int bsim_trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
                       bsim_effect **random)
 {
 	int holds = !scene->has_lattice && !scene->body.rotates && !scene->effects.has_drag &&
@@ -70,11 +70,11 @@ int trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **p
 	return holds;
 }
 
-int trial_steps_start(trial_steps *t, int plain, const bsim_scene *scene, bsim_effects *fx,
+int bsim_trial_steps_start(trial_steps *t, int plain, const bsim_scene *scene, bsim_effects *fx,
                       long n_max, long gate_max)
 {
 	t->on = plain && scene->n_beams <= TRIAL_STEPS_BEAMS &&
-	        trial_force_holds(scene, fx, &t->propulsion, &t->random);
+	        bsim_trial_force_holds(scene, fx, &t->propulsion, &t->random);
 	t->n_max = n_max;
 	t->gate_max = gate_max;
 	if (t->on && steps_reserve(t, scene->n_beams)) {

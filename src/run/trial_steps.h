@@ -1,5 +1,5 @@
 /* Internal: runs of steps (trial_steps.c). Where the forces hold between
- * the random force's draws (trial_force_holds) and nothing is recorded per
+ * the random force's draws (bsim_trial_force_holds) and nothing is recorded per
  * step, the runner asks the backend for the steps up to the force's next
  * change in one call (bsim_backend.advance), each state written into the
  * runner's storage here, and books them in one pass (trial.c's run_book,
@@ -32,7 +32,7 @@ typedef struct trial_loop {
 #define TRIAL_STEPS_BEAMS 64
 
 typedef struct trial_steps {
-	int on;                  /* the trial takes runs (trial_steps_start) */
+	int on;                  /* the trial takes runs (bsim_trial_steps_start) */
 	bsim_effect *propulsion; /* the pipeline's propulsion, or NULL */
 	bsim_effect *random;     /* the pipeline's held random force, or NULL */
 	long n_max, gate_max;    /* steps in all, in one gate */
@@ -42,8 +42,8 @@ typedef struct trial_steps {
 	int cap; /* -1: none allocated */
 } trial_steps;
 
-void trial_steps_init(trial_steps *t);
-void trial_steps_free(trial_steps *t);
+void bsim_trial_steps_init(trial_steps *t);
+void bsim_trial_steps_free(trial_steps *t);
 
 /* 1 if the forces of the scene's pipeline fx hold between the random
  * force's draws, so that the force asked before a step is the force of the
@@ -52,14 +52,14 @@ void trial_steps_free(trial_steps *t);
  * propulsion, then the held random force), at most one of each (no drag or ground friction, in
  * the pipeline or simulated by the backend). The two effects into
  * *propulsion and *random (NULL: absent). */
-int trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
+int bsim_trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
                       bsim_effect **random);
 
 /* Sets t for a trial of scene in pipeline fx: runs when plain (nothing
  * recorded, traced or measured per step), the forces hold and the scene
  * has at most TRIAL_STEPS_BEAMS beams. BSIM_EFAIL out of memory for the
  * states (t->on 0 then). */
-int trial_steps_start(trial_steps *t, int plain, const bsim_scene *scene, bsim_effects *fx,
+int bsim_trial_steps_start(trial_steps *t, int plain, const bsim_scene *scene, bsim_effects *fx,
                       long n_max, long gate_max);
 
 /* The steps a run from step lp->n may make under the force just asked, the

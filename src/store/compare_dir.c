@@ -53,7 +53,7 @@ void bsim_compare_dir_label(const char *label, char *buf, size_t size)
 int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err)
 {
 	if (strncmp(spec, BSIM_TRIALS_PREFIX, strlen(BSIM_TRIALS_PREFIX)) == 0)
-		return compare_read_side(spec, side, err);
+		return bsim_compare_read_side(spec, side, err);
 	side->trials[0] = '\0';
 	size_t n = bsim_backend_spec_name(spec);
 	char name[1024];
@@ -434,7 +434,7 @@ static int sides_check(const bsim_compare_dir_def *def, compare_job *job,
 			                      def->protocol[0]
 			                              ? "not a --protocols side"
 			                              : "without options (it runs nothing)");
-		job->backend[i] = job->is_read[i] ? &compare_read_backend
+		job->backend[i] = job->is_read[i] ? &bsim_compare_read_backend
 		                  : s->backend    ? s->backend
 		                                  : bsim_backend_default();
 		job->opts[i] = &s->opts;
@@ -549,18 +549,18 @@ static int compare_spread(const bsim_compare_dir_def *def, compare_job *job, con
 	*finished = 0;
 	if (def->n_merge > 0) {
 		char run[17];
-		part_dir_run_id(inputs, run);
-		rc = part_dir_join(def->merge, def->n_merge, "compare", run, inputs, size, total,
+		bsim_part_dir_run_id(inputs, run);
+		rc = bsim_part_dir_join(def->merge, def->n_merge, "compare", run, inputs, size, total,
 		                   ss->journal, err);
-		return rc == BSIM_OK ? part_dir_journal_reopen(ss, inputs, size, err) : rc;
+		return rc == BSIM_OK ? bsim_part_dir_journal_reopen(ss, inputs, size, err) : rc;
 	}
 	job->journal = ss ? ss->journal : NULL;
-	rc = part_dir_spread_run(&sp, inputs, ss, compare_part_run, job, err);
+	rc = bsim_part_dir_spread_run(&sp, inputs, ss, compare_part_run, job, err);
 	if (rc != BSIM_OK || def->spread != BSIM_SPREAD_GATHER) {
 		*finished = 1;
 		return rc;
 	}
-	return part_dir_journal_reopen(ss, inputs, size, err);
+	return bsim_part_dir_journal_reopen(ss, inputs, size, err);
 }
 
 /* Reads the files of the sides read, against job->e as it runs. */
@@ -568,7 +568,7 @@ static int reads_load(compare_job *job, bsim_error *err)
 {
 	for (int i = 0; i < job->n; i++)
 		if (job->is_read[i] &&
-		    compare_read_load(&job->def->side[i], job->e, job->sets, job->n_sets,
+		    bsim_compare_read_load(&job->def->side[i], job->e, job->sets, job->n_sets,
 		                      &job->read[i], err) != BSIM_OK)
 			return BSIM_EINPUT;
 	return BSIM_OK;
@@ -578,7 +578,7 @@ static void reads_free(compare_job *job)
 {
 	for (int i = 0; i < job->n; i++)
 		if (job->is_read[i])
-			compare_read_free(&job->read[i]);
+			bsim_compare_read_free(&job->read[i]);
 }
 
 /* The size of the journal's records: those of the sweep of the sides

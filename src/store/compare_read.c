@@ -29,7 +29,7 @@ static int read_create(const bsim_scene *scene, const bsim_options *opts, bsim_w
 	                      "PATH) runs no trial in beamsim");
 }
 
-const bsim_backend compare_read_backend = {
+const bsim_backend bsim_compare_read_backend = {
         .name = "trials",
         .description = "trials read from a trials.csv made elsewhere (compare's " BSIM_TRIALS_PREFIX
                        "PATH), not run",
@@ -73,7 +73,7 @@ static int side_file(const char *spec, const char *path, char *file, size_t size
 	return BSIM_OK;
 }
 
-int compare_read_side(const char *spec, bsim_compare_side *side, bsim_error *err)
+int bsim_compare_read_side(const char *spec, bsim_compare_side *side, bsim_error *err)
 {
 	const size_t skip = strlen(BSIM_TRIALS_PREFIX);
 	size_t n = bsim_backend_spec_name(spec) - skip;
@@ -93,7 +93,7 @@ int compare_read_side(const char *spec, bsim_compare_side *side, bsim_error *err
 	char file[BSIM_PATH_MAX], folder[BSIM_PATH_MAX];
 	if (side_file(spec, side->trials, file, sizeof file, folder, err) != BSIM_OK)
 		return BSIM_EINPUT;
-	side->backend = &compare_read_backend;
+	side->backend = &bsim_compare_read_backend;
 	const char *name = strrchr(folder, '/') ? strrchr(folder, '/') + 1 : folder;
 	if (!label_ok(name)) /* at most 63 characters when it is */
 		name = "trials";
@@ -101,7 +101,7 @@ int compare_read_side(const char *spec, bsim_compare_side *side, bsim_error *err
 	return BSIM_OK;
 }
 
-void compare_read_free(compare_read *rd)
+void bsim_compare_read_free(compare_read *rd)
 {
 	free(rd->bytes);
 	bsim_sweep_result_free(&rd->r);
@@ -156,7 +156,7 @@ static int groups_one_trial(const bsim_experiment *e, const bsim_override *extra
 	return BSIM_OK;
 }
 
-int compare_read_load(const bsim_compare_side *side, const bsim_experiment *e,
+int bsim_compare_read_load(const bsim_compare_side *side, const bsim_experiment *e,
                       const bsim_override *extra, int n_extra, compare_read *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
@@ -168,20 +168,20 @@ int compare_read_load(const bsim_compare_side *side, const bsim_experiment *e,
 	snprintf(out->path, sizeof out->path, "%s", real ? real : out->given);
 	free(real);
 	file_text ft;
-	int rc = csv_text_read(out->given, &ft, err);
+	int rc = bsim_csv_text_read(out->given, &ft, err);
 	if (rc != BSIM_OK)
 		return rc;
 	/* The bytes as read, before the parse splits them: what is hashed
 	 * is what the comparison copies. */
 	out->bytes = malloc(ft.len ? ft.len : 1);
 	if (!out->bytes) {
-		file_text_free(&ft);
+		bsim_file_text_free(&ft);
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", out->given);
 	}
 	memcpy(out->bytes, ft.text, ft.len);
 	out->len = ft.len;
 	snprintf(out->hash, sizeof out->hash, "%016" PRIx64,
-	         hash_fnv1a64(ft.text, ft.len, HASH_FNV1A64_SEED));
+	         bsim_hash_fnv1a64(ft.text, ft.len, HASH_FNV1A64_SEED));
 	if (side->trials_hash[0] && strcmp(side->trials_hash, out->hash) != 0)
 		rc = bsim_error_set(err, BSIM_EINPUT,
 		                    "%s: expected the bytes the comparison read (FNV-1a 64 %s, as "
@@ -200,13 +200,13 @@ int compare_read_load(const bsim_compare_side *side, const bsim_experiment *e,
 		                          .one_trial = one,
 		                          .need_final_gate = scene0.has_lattice,
 		                          .type_rule = 1};
-		rc = trials_csv_parse(out->given, ft.text, &shape, &out->r, err);
+		rc = bsim_trials_csv_parse(out->given, ft.text, &shape, &out->r, err);
 		if (rc == BSIM_OK)
 			result_complete(&out->r, &scene0);
 		bsim_scene_free(&scene0);
 	}
 	free(one);
-	file_text_free(&ft);
+	bsim_file_text_free(&ft);
 	if (rc != BSIM_OK) {
 		free(out->bytes);
 		out->bytes = NULL;

@@ -15,7 +15,7 @@
 /* What stands for a read side where a backend is expected (labels,
  * run.json, reports): named "trials", no knobs, in no registry; it makes
  * no world (create refuses, saying why). */
-extern const bsim_backend compare_read_backend;
+extern const bsim_backend bsim_compare_read_backend;
 
 /* The side of spec "trials:PATH" (BSIM_TRIALS_PREFIX): side->trials =
  * PATH, side->backend the table above, and its label, the name of the
@@ -24,7 +24,7 @@ extern const bsim_backend compare_read_backend;
  * '='; not "inputs", which the comparison's directory has). BSIM_EINPUT
  * naming the spec if PATH is empty, followed by options, too long or
  * cannot be found. */
-int compare_read_side(const char *spec, bsim_compare_side *side, bsim_error *err);
+int bsim_compare_read_side(const char *spec, bsim_compare_side *side, bsim_error *err);
 
 typedef struct compare_read {
 	char given[BSIM_PATH_MAX]; /* the file as named (PATH, or PATH/trials.csv) */
@@ -45,8 +45,8 @@ typedef struct compare_read {
  * marked, the lattice's definition set. BSIM_EINPUT "FILE:LINE: FIELD:
  * expected ..." on a file that does not fit, or if side->trials_hash is
  * given and the bytes' hash is another. */
-int compare_read_load(const bsim_compare_side *side, const bsim_experiment *e,
+int bsim_compare_read_load(const bsim_compare_side *side, const bsim_experiment *e,
                       const bsim_override *extra, int n_extra, compare_read *out, bsim_error *err);
-void compare_read_free(compare_read *rd);
+void bsim_compare_read_free(compare_read *rd);
 
 #endif

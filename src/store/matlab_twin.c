@@ -143,7 +143,7 @@ typedef struct intern {
 	size_t used, size;
 } intern;
 
-/* The group column of a sweep's table, checked as csv_table_numbers and
+/* The group column of a sweep's table, checked as bsim_csv_table_numbers and
  * the group range check did: the first cell that is no number, else the
  * first out of range, reported once the file is known to be sound. */
 typedef struct group_check {
@@ -233,7 +233,7 @@ static void group_check_row(group_check *g, const csv_stream *s, int n_groups)
 {
 	const char *cell = s->cells[g->col];
 	double v;
-	if (csv_number(cell, &v) != 0) {
+	if (bsim_csv_number(cell, &v) != 0) {
 		if (!g->bad_line) {
 			g->bad_line = s->line;
 			g->bad = strdup(cell);
@@ -269,7 +269,7 @@ static int twin_cell(twin_table *t, int c, long r, size_t cap, const char *cell)
 	int keep = !t->over && !t->lost;
 	if (!col->text) {
 		double x;
-		int num = csv_number(cell, &x) == 0;
+		int num = bsim_csv_number(cell, &x) == 0;
 		if (num || !*cell) {
 			if (keep)
 				col->v[r] = num ? x : NAN;
@@ -303,7 +303,7 @@ static int twin_pass(const char *path, twin_table *t, const unsigned char *text,
 {
 	memset(t, 0, sizeof *t);
 	csv_stream s;
-	int rc = csv_stream_open(path, &s, err);
+	int rc = bsim_csv_stream_open(path, &s, err);
 	if (rc)
 		return rc;
 	t->n_cols = s.n_cols;
@@ -323,8 +323,8 @@ static int twin_pass(const char *path, twin_table *t, const unsigned char *text,
 	for (int c = 0; !oom && c < t->n_cols; c++)
 		t->cols[c].text = text ? text[c] : 0;
 	/* A table over the limit keeps nothing: it is only checked. */
-	t->over = csv_count_lines(path) - 1 > limit;
-	while (!oom && (got = csv_stream_next(&s, err)) == 1) {
+	t->over = bsim_csv_count_lines(path) - 1 > limit;
+	while (!oom && (got = bsim_csv_stream_next(&s, err)) == 1) {
 		long r = t->n_rows++;
 		if (g && g->col >= 0)
 			group_check_row(g, &s, n_groups);
@@ -340,7 +340,7 @@ static int twin_pass(const char *path, twin_table *t, const unsigned char *text,
 			oom = twin_cell(t, c, r, cap, s.cells[c]) < 0;
 		}
 	}
-	csv_stream_close(&s);
+	bsim_csv_stream_close(&s);
 	if (oom)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 	return got < 0 ? (err ? err->code : BSIM_EINPUT) : BSIM_OK;
@@ -467,7 +467,7 @@ int bsim_matlab_from_csv(const char *csv_path, const char *mat_path, const char 
 
 /* ---- JSON -------------------------------------------------------------- */
 
-/* A JSON file is read as libfyaml's events (ydoc_events_own) into a tree
+/* A JSON file is read as libfyaml's events (bsim_ydoc_events_own) into a tree
  * of its own, 40 bytes a value, with each distinct string (key or value)
  * kept once: libfyaml's document of the same file costs about 44 bytes a
  * byte of JSON (summary.json of a 20,000-group sweep, 8 MB, would take
@@ -516,7 +516,7 @@ static int scalar_kind(const char *t, int plain, double *v)
 {
 	if (!plain)
 		return J_STRING;
-	if (ydoc_number_text(t, v) == YDOC_NUM_OK)
+	if (bsim_ydoc_number_text(t, v) == YDOC_NUM_OK)
 		return J_NUMBER;
 	if (strcmp(t, "true") == 0 || strcmp(t, "false") == 0) {
 		*v = t[0] == 't';
@@ -683,7 +683,7 @@ static const char *json_text(jtree *t, const jnode *n)
 		return n->w.text;
 	struct fy_document *d =
 	        fy_document_build_from_string(NULL, t->text + n->u.start, n->w.end - n->u.start);
-	char *flow = d ? ydoc_flow_text(fy_document_root(d)) : NULL;
+	char *flow = d ? bsim_ydoc_flow_text(fy_document_root(d)) : NULL;
 	const char *s = flow ? arena_strdup(&t->a, flow, strlen(flow)) : NULL;
 	free(flow);
 	if (d)
@@ -871,7 +871,7 @@ int bsim_matlab_from_json(const char *json_path, const char *mat_path, const cha
 	jtree t;
 	memset(&t, 0, sizeof t);
 	char *text = NULL;
-	int rc = ydoc_events_own(json_path, jtree_event, &t, &text, err);
+	int rc = bsim_ydoc_events_own(json_path, jtree_event, &t, &text, err);
 	t.text = text;
 	bsim_mat_field f;
 	/* An empty file has no value: its twin holds an empty string. */

@@ -242,7 +242,7 @@ static void owner_read(const char *work, char *buf, size_t size)
 	char path[BSIM_PATH_MAX], text[256];
 	buf[0] = '\0';
 	struct stat st;
-	int fd = join(path, sizeof path, work, OWNER_FILE) ? -1 : file_open_checked(path, &st);
+	int fd = join(path, sizeof path, work, OWNER_FILE) ? -1 : bsim_file_open_checked(path, &st);
 	if (fd < 0)
 		return;
 	ssize_t n = S_ISREG(st.st_mode) ? read(fd, text, sizeof text - 1) : -1;
@@ -519,13 +519,13 @@ static int manifest_read(const char *dir, olist *l, int *has, char *command, siz
 	if (join(path, sizeof path, dir, BSIM_OUTDIR_MANIFEST) || stat(path, &st) != 0)
 		return BSIM_OK;
 	ydoc d;
-	if (ydoc_load_own(&d, path, err) != BSIM_OK)
+	if (bsim_ydoc_load_own(&d, path, err) != BSIM_OK)
 		return BSIM_EINPUT;
 	*has = 1;
-	struct fy_node *files = ydoc_lookup(fy_document_root(d.fyd), "files");
-	struct fy_node *format = ydoc_lookup(fy_document_root(d.fyd), "format");
+	struct fy_node *files = bsim_ydoc_lookup(fy_document_root(d.fyd), "files");
+	struct fy_node *format = bsim_ydoc_lookup(fy_document_root(d.fyd), "format");
 	const char *ft = format && fy_node_is_scalar(format) ? fy_node_get_scalar0(format) : NULL;
-	struct fy_node *cmd = ydoc_lookup(fy_document_root(d.fyd), "command");
+	struct fy_node *cmd = bsim_ydoc_lookup(fy_document_root(d.fyd), "command");
 	if (command)
 		snprintf(command, command_size, "%s",
 		         cmd && fy_node_is_scalar(cmd) ? fy_node_get_scalar0(cmd) : "");
@@ -533,28 +533,28 @@ static int manifest_read(const char *dir, olist *l, int *has, char *command, siz
 	/* The one format there has been; a manifest of a later one is not
 	 * read as if it were this. */
 	if (format && (!ft || strcmp(ft, "beamsim-manifest-1") != 0))
-		rc = ydoc_expected(&d, format, NULL, "format",
+		rc = bsim_ydoc_expected(&d, format, NULL, "format",
 		                   "\"beamsim-manifest-1\" (a manifest this beamsim reads)", err);
 	if (!rc && (!files || !fy_node_is_sequence(files)))
-		rc = ydoc_expected(&d, files, NULL, "files", "a list of files", err);
+		rc = bsim_ydoc_expected(&d, files, NULL, "files", "a list of files", err);
 	int n = rc ? 0 : fy_node_sequence_item_count(files);
 	for (int i = 0; !rc && i < n; i++) {
 		struct fy_node *f = fy_node_sequence_get_by_index(files, i);
-		struct fy_node *pn = ydoc_lookup(f, "path"), *cn = ydoc_lookup(f, "crc32");
+		struct fy_node *pn = bsim_ydoc_lookup(f, "path"), *cn = bsim_ydoc_lookup(f, "crc32");
 		const char *rel = pn && fy_node_is_scalar(pn) ? fy_node_get_scalar0(pn) : NULL;
 		const char *crc = cn && fy_node_is_scalar(cn) ? fy_node_get_scalar0(cn) : NULL;
 		long long bytes = -1;
 		char *end = NULL;
 		unsigned long c = crc ? strtoul(crc, &end, 16) : 0;
 		if (!rel || !*rel || strstr(rel, "..") || rel[0] == '/' ||
-		    !ydoc_int64(ydoc_lookup(f, "bytes"), &bytes) || bytes < 0 || !crc || *end ||
+		    !bsim_ydoc_int64(bsim_ydoc_lookup(f, "bytes"), &bytes) || bytes < 0 || !crc || *end ||
 		    strlen(crc) != 8)
-			rc = ydoc_expected(&d, f, files, "files", "{path, bytes, crc32} of a file",
+			rc = bsim_ydoc_expected(&d, f, files, "files", "{path, bytes, crc32} of a file",
 			                   err);
 		else if (olist_add(l, rel, bytes, c) != 0)
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	return rc;
 }
 
@@ -720,7 +720,7 @@ void bsim_outdir_close(bsim_outdir *od)
 static int verify_one(const char *dir, const char *path, const ofile *want, bsim_error *err)
 {
 	struct stat st;
-	int fd = file_open_checked(path, &st);
+	int fd = bsim_file_open_checked(path, &st);
 	if (fd < 0)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: listed in %s/%s but unreadable: %s",
 		                      path, dir, BSIM_OUTDIR_MANIFEST, strerror(errno));
@@ -728,7 +728,7 @@ static int verify_one(const char *dir, const char *path, const ofile *want, bsim
 		close(fd);
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: expected the file %s/%s lists (%lld bytes), got %s",
-		                      path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, file_kind(&st));
+		                      path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, bsim_file_kind(&st));
 	}
 	unsigned char buf[65536];
 	uLong c = crc32(0L, Z_NULL, 0);

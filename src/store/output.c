@@ -153,7 +153,7 @@ void bsim_output_group_params(FILE *f, const bsim_experiment *e, int g)
 static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 {
 	bsim_lattice_summary own, *s = &own;
-	if (lattice_group_summary(r, group, &s) != BSIM_OK) {
+	if (bsim_lattice_group_summary(r, group, &s) != BSIM_OK) {
 		fputs(", \"lattice\": null", f);
 		return;
 	}
@@ -350,7 +350,7 @@ const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
         "turn_end",    "turn_max",
 };
 
-int trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
+int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
                     bsim_error *err)
 {
 	memset(w, 0, sizeof *w);
@@ -363,13 +363,13 @@ int trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experimen
 		fprintf(w->o.f, "%s%s", c ? "," : "", bsim_trials_csv_columns[c]);
 	for (int a = 0; a < w->axes; a++) {
 		fputc(',', w->o.f);
-		csv_field_write(w->o.f, e->axes[a].key);
+		bsim_csv_field_write(w->o.f, e->axes[a].key);
 	}
 	fputc('\n', w->o.f);
 	return BSIM_OK;
 }
 
-void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
+void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
                      const bsim_trial_result *results, const bsim_trial_log *logs)
 {
 	FILE *f = w->o.f;
@@ -406,25 +406,25 @@ void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 		/* what the backend's solvers gave up on in this trial */
 		fprintf(f, ",%ld,%ld,", x->solver.iteration_limit, x->solver.clamped);
 		/* when it left the gate (the field), empty if censored */
-		number_field(f, survival_exit_time(x));
+		number_field(f, bsim_survival_exit_time(x));
 		/* the body's turn: every body's, 0 for one that does not
 		 * rotate, so that every file has the same columns */
 		fprintf(f, ",%.10g,%.10g,%.10g,%.10g", x->heading_end, x->angular_velocity_end,
 		        x->turn_end, x->turn_max);
 		for (int a = 0; a < w->axes; a++) {
 			fputc(',', f);
-			csv_field_write(f, w->e->axes[a].values[w->idx[a]]);
+			bsim_csv_field_write(f, w->e->axes[a].values[w->idx[a]]);
 		}
 		fputc('\n', f);
 	}
 }
 
-int trials_csv_commit(trials_csv_writer *w, bsim_error *err)
+int bsim_trials_csv_commit(trials_csv_writer *w, bsim_error *err)
 {
 	return bsim_atomic_file_commit(&w->o, err);
 }
 
-void trials_csv_abort(trials_csv_writer *w)
+void bsim_trials_csv_abort(trials_csv_writer *w)
 {
 	bsim_atomic_file_abort(&w->o);
 }
@@ -433,13 +433,13 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
                            bsim_error *err)
 {
 	trials_csv_writer w;
-	if (trials_csv_open(&w, path, e, err) != BSIM_OK)
+	if (bsim_trials_csv_open(&w, path, e, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	for (int g = 0; g < r->n_groups; g++)
-		trials_csv_rows(&w, (long)g * r->trials, r->trials, r->trials,
+		bsim_trials_csv_rows(&w, (long)g * r->trials, r->trials, r->trials,
 		                &r->trials_out[(size_t)g * r->trials],
 		                r->logs ? &r->logs[(size_t)g * r->trials] : NULL);
-	return trials_csv_commit(&w, err);
+	return bsim_trials_csv_commit(&w, err);
 }
 
 int bsim_output_trials_fit(const bsim_experiment *e, long trials, double cell_bytes,

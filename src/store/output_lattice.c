@@ -63,7 +63,7 @@ static int write_summaries(FILE *f, const bsim_sweep_result *r, int transitions,
 	static const char *const kinds[] = {"end", "side", "stuck"};
 	for (int g = 0; g < r->n_groups; g++) {
 		bsim_lattice_summary own, *ls = &own;
-		if (lattice_group_summary(r, g, &ls) != BSIM_OK)
+		if (bsim_lattice_group_summary(r, g, &ls) != BSIM_OK)
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		for (int k = 0; transitions && k < ls->n_transitions; k++) {
 			const bsim_transition *x = &ls->transitions[k];
@@ -107,7 +107,7 @@ static int write_transitions(FILE *f, const bsim_experiment *e, const bsim_overr
 	return write_summaries(f, r, 1, err);
 }
 
-int lattice_group_summary(const bsim_sweep_result *r, int g, bsim_lattice_summary **ls)
+int bsim_lattice_group_summary(const bsim_sweep_result *r, int g, bsim_lattice_summary **ls)
 {
 	if (r->lattice_summaries) {
 		*ls = &r->lattice_summaries[g];
@@ -118,14 +118,14 @@ int lattice_group_summary(const bsim_sweep_result *r, int g, bsim_lattice_summar
 	                              r->lattice_def.rows, *ls);
 }
 
-void lattice_entries_header(FILE *f)
+void bsim_lattice_entries_header(FILE *f)
 {
 	fputs("group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy,theta_left,omega_left,theta_right,"
 	      "omega_right\n",
 	      f);
 }
 
-void lattice_entries_rows(FILE *f, long first, long n, int trials, const bsim_trial_log *logs)
+void bsim_lattice_entries_rows(FILE *f, long first, long n, int trials, const bsim_trial_log *logs)
 {
 	for (long i = 0; i < n; i++) {
 		int g = (int)((first + i) / trials), t = (int)((first + i) % trials);
@@ -143,12 +143,12 @@ void lattice_entries_rows(FILE *f, long first, long n, int trials, const bsim_tr
 	}
 }
 
-void lattice_peaks_header(FILE *f)
+void bsim_lattice_peaks_header(FILE *f)
 {
 	fputs("group,trial,beam,ix,iy,side,max_theta\n", f);
 }
 
-void lattice_peaks_rows(FILE *f, const bsim_lattice_def *def, long first, long n, int trials,
+void bsim_lattice_peaks_rows(FILE *f, const bsim_lattice_def *def, long first, long n, int trials,
                         const bsim_trial_log *logs)
 {
 	for (long i = 0; i < n; i++) {
@@ -172,8 +172,8 @@ static int write_entries(FILE *f, const bsim_experiment *e, const bsim_override 
 	(void)extra;
 	(void)n_extra;
 	(void)err;
-	lattice_entries_header(f);
-	lattice_entries_rows(f, 0, (long)r->n_groups * r->trials, r->trials, r->logs);
+	bsim_lattice_entries_header(f);
+	bsim_lattice_entries_rows(f, 0, (long)r->n_groups * r->trials, r->trials, r->logs);
 	return BSIM_OK;
 }
 
@@ -184,8 +184,8 @@ static int write_peaks(FILE *f, const bsim_experiment *e, const bsim_override *e
 	(void)extra;
 	(void)n_extra;
 	(void)err;
-	lattice_peaks_header(f);
-	lattice_peaks_rows(f, &r->lattice_def, 0, (long)r->n_groups * r->trials, r->trials,
+	bsim_lattice_peaks_header(f);
+	bsim_lattice_peaks_rows(f, &r->lattice_def, 0, (long)r->n_groups * r->trials, r->trials,
 	                   r->logs);
 	return BSIM_OK;
 }

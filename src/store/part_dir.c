@@ -17,12 +17,12 @@
 #include "util/json.h"
 #include "util/yaml_doc.h"
 
-void part_dir_run_id(const char *inputs, char out[17])
+void bsim_part_dir_run_id(const char *inputs, char out[17])
 {
-	snprintf(out, 17, "%016" PRIx64, hash_fnv1a64(inputs, strlen(inputs), HASH_FNV1A64_SEED));
+	snprintf(out, 17, "%016" PRIx64, bsim_hash_fnv1a64(inputs, strlen(inputs), HASH_FNV1A64_SEED));
 }
 
-int part_dir_write(const char *stage, const char *command, int index, int count, const char *run,
+int bsim_part_dir_write(const char *stage, const char *command, int index, int count, const char *run,
                    long total, long records, int argc, char *const *argv, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
@@ -59,11 +59,11 @@ void bsim_sweep_dir_part_free(bsim_sweep_dir_part *p)
 static int part_text(const ydoc *d, struct fy_node *root, const char *field, char *buf, size_t size,
                      bsim_error *err)
 {
-	struct fy_node *n = ydoc_lookup(root, field);
+	struct fy_node *n = bsim_ydoc_lookup(root, field);
 	size_t len;
 	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
 	if (!t || len == 0 || len >= size)
-		return ydoc_expected(d, n, NULL, field, "a string", err);
+		return bsim_ydoc_expected(d, n, NULL, field, "a string", err);
 	memcpy(buf, t, len);
 	buf[len] = '\0';
 	return BSIM_OK;
@@ -72,10 +72,10 @@ static int part_text(const ydoc *d, struct fy_node *root, const char *field, cha
 static int part_long(const ydoc *d, struct fy_node *root, const char *field, long lo, long *out,
                      bsim_error *err)
 {
-	struct fy_node *n = ydoc_lookup(root, field);
+	struct fy_node *n = bsim_ydoc_lookup(root, field);
 	double x;
-	if (!n || ydoc_number(n, &x) != YDOC_NUM_OK || x < lo || x > 1e15 || x != (long)x)
-		return ydoc_expected(d, n, NULL, field, lo ? "a whole number >= 1" : "a count",
+	if (!n || bsim_ydoc_number(n, &x) != YDOC_NUM_OK || x < lo || x > 1e15 || x != (long)x)
+		return bsim_ydoc_expected(d, n, NULL, field, lo ? "a whole number >= 1" : "a count",
 		                     err);
 	*out = (long)x;
 	return BSIM_OK;
@@ -88,7 +88,7 @@ int bsim_sweep_dir_part_read(const char *dir, bsim_sweep_dir_part *p, bsim_error
 	memset(p, 0, sizeof *p);
 	if (bsim_session_path(path, sizeof path, dir, "part.json", err))
 		return BSIM_EINPUT;
-	if (ydoc_load_own(&d, path, err) != BSIM_OK) {
+	if (bsim_ydoc_load_own(&d, path, err) != BSIM_OK) {
 		char msg[sizeof err->msg];
 		snprintf(msg, sizeof msg, "%s", err->msg);
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -103,15 +103,15 @@ int bsim_sweep_dir_part_read(const char *dir, bsim_sweep_dir_part *p, bsim_error
 	if (!rc)
 		rc = part_long(&d, root, "parts", 1, &count, err);
 	if (!rc && (index > count || count > 1000000))
-		rc = ydoc_expected(&d, ydoc_lookup(root, "part"), NULL, "part",
+		rc = bsim_ydoc_expected(&d, bsim_ydoc_lookup(root, "part"), NULL, "part",
 		                   "a part from 1 to parts", err);
 	if (!rc)
 		rc = part_text(&d, root, "run", p->run, sizeof p->run, err);
 	if (!rc)
 		rc = part_long(&d, root, "records", 0, &p->records, err);
-	struct fy_node *av = ydoc_lookup(root, "argv");
+	struct fy_node *av = bsim_ydoc_lookup(root, "argv");
 	if (!rc && (!av || !fy_node_is_sequence(av) || fy_node_sequence_item_count(av) < 1))
-		rc = ydoc_expected(&d, av, NULL, "argv", "the command line, a list of strings",
+		rc = bsim_ydoc_expected(&d, av, NULL, "argv", "the command line, a list of strings",
 		                   err);
 	if (!rc) {
 		int n = fy_node_sequence_item_count(av);
@@ -124,7 +124,7 @@ int bsim_sweep_dir_part_read(const char *dir, bsim_sweep_dir_part *p, bsim_error
 			const char *t =
 			        a && fy_node_is_scalar(a) ? fy_node_get_scalar(a, &len) : NULL;
 			if (!t) {
-				rc = ydoc_expected(&d, a, NULL, "argv", "a list of strings", err);
+				rc = bsim_ydoc_expected(&d, a, NULL, "argv", "a list of strings", err);
 				break;
 			}
 			p->argv[i] = strndup(t, len);
@@ -133,7 +133,7 @@ int bsim_sweep_dir_part_read(const char *dir, bsim_sweep_dir_part *p, bsim_error
 			p->argc = i + 1;
 		}
 	}
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	p->index = (int)index;
 	p->count = (int)count;
 	if (rc != BSIM_OK)
@@ -172,7 +172,7 @@ static int join_take(void *user, uint64_t index, const void *payload)
 	return 0;
 }
 
-int part_dir_check(const char *const *dirs, int n, const char *command, const char *run,
+int bsim_part_dir_check(const char *const *dirs, int n, const char *command, const char *run,
                    bsim_sweep_dir_part *parts, bsim_error *err)
 {
 	int rc = BSIM_OK;
@@ -233,14 +233,14 @@ int part_dir_check(const char *const *dirs, int n, const char *command, const ch
 	return rc;
 }
 
-int part_dir_join(const char *const *dirs, int n, const char *command, const char *run,
+int bsim_part_dir_join(const char *const *dirs, int n, const char *command, const char *run,
                   const char *inputs, size_t record_size, long total, bsim_journal *j,
                   bsim_error *err)
 {
 	bsim_sweep_dir_part *parts = calloc((size_t)n, sizeof *parts);
 	if (!parts)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	int rc = part_dir_check(dirs, n, command, run, parts, err);
+	int rc = bsim_part_dir_check(dirs, n, command, run, parts, err);
 	int count = rc == BSIM_OK ? parts[0].count : 0;
 	unsigned char *seen = rc == BSIM_OK ? calloc((size_t)total / 8 + 1, 1) : NULL;
 	if (rc == BSIM_OK && !seen)
@@ -279,7 +279,7 @@ static int mark_done(void *user, uint64_t index, const void *payload)
 	return 0;
 }
 
-int part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_session *ss,
+int bsim_part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_session *ss,
                         part_dir_run_fn run, void *user, bsim_error *err)
 {
 	long total = sp->total;
@@ -304,7 +304,7 @@ int part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_sess
 	if (rc == BSIM_OK && sp->spread == BSIM_SPREAD_SHARD) {
 		long records = 0;
 		char id[17], path[BSIM_PATH_MAX];
-		part_dir_run_id(inputs, id);
+		bsim_part_dir_run_id(inputs, id);
 		ss->done = 1;
 		rc = bsim_journal_close(ss->journal, err);
 		ss->journal = NULL;
@@ -325,7 +325,7 @@ int part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_sess
 			                    ss->journal_path, path, strerror(errno));
 		if (rc == BSIM_OK) {
 			ss->journal_path[0] = '\0';
-			rc = part_dir_write(ss->stage, sp->command, sp->part->index + 1,
+			rc = bsim_part_dir_write(ss->stage, sp->command, sp->part->index + 1,
 			                    sp->part->count, id, total, records, sp->argc, sp->argv,
 			                    err);
 		}
@@ -334,7 +334,7 @@ int part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_sess
 	return rc;
 }
 
-int part_dir_journal_reopen(bsim_session *ss, const char *inputs, size_t record_size,
+int bsim_part_dir_journal_reopen(bsim_session *ss, const char *inputs, size_t record_size,
                             bsim_error *err)
 {
 	int rc = bsim_journal_close(ss->journal, err);

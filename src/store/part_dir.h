@@ -15,11 +15,11 @@
 
 /* The run's name: 16 hex digits of the FNV-1a hash of its inputs
  * (bsim_run_record_inputs), so that parts of one run carry one name. */
-void part_dir_run_id(const char *inputs, char out[17]);
+void bsim_part_dir_run_id(const char *inputs, char out[17]);
 
 /* Writes stage/part.json: part index (1-based) of count of run, over
  * total trials, records trials in part.journal, argv the command line. */
-int part_dir_write(const char *stage, const char *command, int index, int count, const char *run,
+int bsim_part_dir_write(const char *stage, const char *command, int index, int count, const char *run,
                    long total, long records, int argc, char *const *argv, bsim_error *err);
 
 /* Reads the part.json of dirs[0..n) into parts[0..n) (freed by the
@@ -27,14 +27,14 @@ int part_dir_write(const char *stage, const char *command, int index, int count,
  * of one run of command (run; NULL: the first's), each once. BSIM_EINPUT
  * naming the directory at fault: a part of another command or run, of
  * another count, given twice; the first part missing. */
-int part_dir_check(const char *const *dirs, int n, const char *command, const char *run,
+int bsim_part_dir_check(const char *const *dirs, int n, const char *command, const char *run,
                    bsim_sweep_dir_part *parts, bsim_error *err);
 
 /* Checks that dirs[0..n) are every part of run (command, inputs), each
  * once, whole, and appends every part's records to j. BSIM_EINPUT naming
  * the directory at fault: a part of another run, one missing or given
  * twice, a damaged journal. */
-int part_dir_join(const char *const *dirs, int n, const char *command, const char *run,
+int bsim_part_dir_join(const char *const *dirs, int n, const char *command, const char *run,
                   const char *inputs, size_t record_size, long total, bsim_journal *j,
                   bsim_error *err);
 
@@ -58,11 +58,11 @@ typedef struct part_dir_spread {
  * bits come through agree); for a shard, then, the journal moved to
  * ss->stage/part.journal beside a part.json. */
 typedef int (*part_dir_run_fn)(void *user, const bsim_sweep_part *part, bsim_error *err);
-int part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_session *ss,
+int bsim_part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_session *ss,
                         part_dir_run_fn run, void *user, bsim_error *err);
 
 /* ss's journal closed and opened again, to be replayed by the whole run. */
-int part_dir_journal_reopen(bsim_session *ss, const char *inputs, size_t record_size,
+int bsim_part_dir_journal_reopen(bsim_session *ss, const char *inputs, size_t record_size,
                             bsim_error *err);
 
 #endif

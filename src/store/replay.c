@@ -37,7 +37,7 @@ int bsim_replay_is_dir(const char *path)
 static const char *esc(const char *path, char *buf, size_t size)
 {
 	snprintf(buf, size, "%s", path);
-	text_escape(buf, size);
+	bsim_text_escape(buf, size);
 	return buf;
 }
 
@@ -47,12 +47,12 @@ static int is_experiment(const char *path)
 {
 	ydoc d;
 	bsim_error err;
-	if (ydoc_load(&d, path, &err) != BSIM_OK)
+	if (bsim_ydoc_load(&d, path, &err) != BSIM_OK)
 		return 0;
 	struct fy_node *root = fy_document_root(d.fyd);
-	int yes = root && fy_node_is_mapping(root) && ydoc_pair(root, "scene", 5) &&
-	          ydoc_pair(root, "grid", 4);
-	ydoc_free(&d);
+	int yes = root && fy_node_is_mapping(root) && bsim_ydoc_pair(root, "scene", 5) &&
+	          bsim_ydoc_pair(root, "grid", 4);
+	bsim_ydoc_free(&d);
 	return yes;
 }
 

@@ -25,7 +25,7 @@ static void set_word(FILE *f, const char *key, const char *value)
 	char buf[1200];
 	snprintf(buf, sizeof buf, "%s=%s", key, value);
 	fputs(" --set ", f);
-	text_shell_word(f, buf);
+	bsim_text_shell_word(f, buf);
 }
 
 static void replay_line(FILE *f, const bsim_report *r, int side, int g, int t)
@@ -37,18 +37,18 @@ static void replay_line(FILE *f, const bsim_report *r, int side, int g, int t)
 	 * scene and schedule, as a comment, with no backend of beamsim's. */
 	if (s->read_from) {
 		fprintf(f, "# %s: row group %d, trial %d of ", s->label, g, t);
-		text_shell_word(f, s->read_from);
+		bsim_text_shell_word(f, s->read_from);
 		fputs(", made elsewhere on the scene and schedule of: ", f);
 	}
 	fputs("beamsim run ", f);
-	text_shell_word(f, e->scene_path);
+	bsim_text_shell_word(f, e->scene_path);
 	if (!s->read_from)
 		fprintf(f, " --backend %s", s->backend->name);
 	for (int i = 0; s->opts && i < s->opts->n; i++) {
 		char buf[128];
 		snprintf(buf, sizeof buf, "%s=%s", s->opts->key[i], s->opts->value[i]);
 		fputs(" --backend-opt ", f);
-		text_shell_word(f, buf);
+		bsim_text_shell_word(f, buf);
 	}
 	fprintf(f, " --seed %" PRIu64 " --group %d --trial %d", e->seed, g, t);
 	for (int i = 0; i < e->n_set; i++)

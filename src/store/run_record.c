@@ -104,12 +104,12 @@ static int scene_text(FILE *f, const bsim_experiment *e, bsim_error *err)
 		return BSIM_OK;
 	}
 	file_text t;
-	int rc = file_read(e->scene_path, "a scene file", bsim_limits_get()->input_bytes,
+	int rc = bsim_file_read(e->scene_path, "a scene file", bsim_limits_get()->input_bytes,
 	                   "input_bytes", &t, err);
 	if (rc != BSIM_OK)
 		return rc;
 	fwrite(t.text, 1, t.len, f);
-	file_text_free(&t);
+	bsim_file_text_free(&t);
 	return BSIM_OK;
 }
 
@@ -282,11 +282,11 @@ int bsim_run_record_write(const char *dir, const bsim_run_record *rec, const bsi
 static int need_text(const ydoc *d, struct fy_node *root, const char *field, char *buf, size_t size,
                      bsim_error *err)
 {
-	struct fy_node *n = ydoc_lookup(root, field);
+	struct fy_node *n = bsim_ydoc_lookup(root, field);
 	size_t len;
 	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
 	if (!t || len == 0 || len >= size)
-		return ydoc_expected(d, n, NULL, field, "a string", err);
+		return bsim_ydoc_expected(d, n, NULL, field, "a string", err);
 	memcpy(buf, t, len);
 	buf[len] = '\0';
 	return BSIM_OK;
@@ -295,9 +295,9 @@ static int need_text(const ydoc *d, struct fy_node *root, const char *field, cha
 static int need_number(const ydoc *d, struct fy_node *root, const char *field, double *out,
                        bsim_error *err)
 {
-	struct fy_node *n = ydoc_lookup(root, field);
-	if (!n || ydoc_number(n, out) != YDOC_NUM_OK)
-		return ydoc_expected(d, n, NULL, field, "a number", err);
+	struct fy_node *n = bsim_ydoc_lookup(root, field);
+	if (!n || bsim_ydoc_number(n, out) != YDOC_NUM_OK)
+		return bsim_ydoc_expected(d, n, NULL, field, "a number", err);
 	return BSIM_OK;
 }
 
@@ -309,16 +309,16 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 	if (need_text(d, root, field, rec->backend[i], sizeof rec->backend[i], err))
 		return BSIM_EINPUT;
 	snprintf(field, sizeof field, "backends.%d.label", i);
-	if (!ydoc_lookup(root, field)) /* written before labels existed */
+	if (!bsim_ydoc_lookup(root, field)) /* written before labels existed */
 		snprintf(rec->label[i], sizeof rec->label[i], "%s", rec->backend[i]);
 	else if (need_text(d, root, field, rec->label[i], sizeof rec->label[i], err))
 		return BSIM_EINPUT;
 	snprintf(field, sizeof field, "backends.%d.plugin", i);
-	if (ydoc_lookup(root, field) &&
+	if (bsim_ydoc_lookup(root, field) &&
 	    need_text(d, root, field, rec->plugin[i], sizeof rec->plugin[i], err))
 		return BSIM_EINPUT;
 	snprintf(field, sizeof field, "backends.%d.read_from", i);
-	if (ydoc_lookup(root, field) &&
+	if (bsim_ydoc_lookup(root, field) &&
 	    need_text(d, root, field, rec->read_from[i], sizeof rec->read_from[i], err))
 		return BSIM_EINPUT;
 	snprintf(field, sizeof field, "backends.%d.read_fnv1a64", i);
@@ -326,13 +326,13 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 	    (need_text(d, root, field, rec->read_hash[i], sizeof rec->read_hash[i], err) ||
 	     strlen(rec->read_hash[i]) != 16 ||
 	     strspn(rec->read_hash[i], "0123456789abcdef") != 16))
-		return ydoc_expected(d, ydoc_lookup(root, field), NULL, field,
+		return bsim_ydoc_expected(d, bsim_ydoc_lookup(root, field), NULL, field,
 		                     "16 hex digits (the FNV-1a 64 hash of the file read)", err);
 	snprintf(field, sizeof field, "backends.%d.options", i);
-	struct fy_node *opts = ydoc_lookup(root, field);
+	struct fy_node *opts = bsim_ydoc_lookup(root, field);
 	if (!opts || !fy_node_is_mapping(opts) ||
 	    fy_node_mapping_item_count(opts) > BSIM_OPTIONS_MAX)
-		return ydoc_expected(d, opts, NULL, field, "a mapping of knobs", err);
+		return bsim_ydoc_expected(d, opts, NULL, field, "a mapping of knobs", err);
 	void *it = NULL;
 	struct fy_node_pair *p;
 	while ((p = fy_node_mapping_iterate(opts, &it)) != NULL) {
@@ -341,7 +341,7 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 		const char *v = fy_node_get_scalar(fy_node_pair_value(p), &vl);
 		bsim_options *o = &rec->opts[i];
 		if (!k || !v || kl >= sizeof o->key[0] || vl >= sizeof o->value[0])
-			return ydoc_expected(d, fy_node_pair_value(p), NULL, field,
+			return bsim_ydoc_expected(d, fy_node_pair_value(p), NULL, field,
 			                     "knob: value strings", err);
 		snprintf(o->key[o->n], sizeof o->key[0], "%.*s", (int)kl, k);
 		snprintf(o->value[o->n], sizeof o->value[0], "%.*s", (int)vl, v);
@@ -353,7 +353,7 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 const bsim_backend *bsim_run_record_backend(const bsim_run_record *rec, int i, bsim_error *err)
 {
 	if (rec->read_from[i][0])
-		return &compare_read_backend;
+		return &bsim_compare_read_backend;
 	const bsim_backend *b = bsim_backend_find(rec->backend[i], err);
 	if (b || !rec->plugin[i][0])
 		return b;
@@ -378,7 +378,7 @@ int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 	memset(rec, 0, sizeof *rec);
 	if (path_join(path, sizeof path, dir, "run.json", err))
 		return BSIM_EINPUT;
-	if (ydoc_load_own(&d, path, err) != BSIM_OK) {
+	if (bsim_ydoc_load_own(&d, path, err) != BSIM_OK) {
 		char msg[sizeof err->msg];
 		snprintf(msg, sizeof msg, "%s", err->msg);
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -390,50 +390,50 @@ int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 	int rc = need_text(&d, root, "command", rec->command, sizeof rec->command, err);
 	if (!rc)
 		rc = need_text(&d, root, "beamsim_version", rec->version, sizeof rec->version, err);
-	struct fy_node *b = ydoc_lookup(root, "backends");
+	struct fy_node *b = bsim_ydoc_lookup(root, "backends");
 	if (!rc && (!b || !fy_node_is_sequence(b) || fy_node_sequence_item_count(b) < 1 ||
 	            fy_node_sequence_item_count(b) > BSIM_COMPARE_SIDES_MAX)) {
 		char want[64];
 		snprintf(want, sizeof want, "a list of 1 to %d backends", BSIM_COMPARE_SIDES_MAX);
-		rc = ydoc_expected(&d, b, NULL, "backends", want, err);
+		rc = bsim_ydoc_expected(&d, b, NULL, "backends", want, err);
 	}
 	if (!rc)
 		rec->n_backends = fy_node_sequence_item_count(b);
 	for (int i = 0; !rc && i < rec->n_backends; i++)
 		rc = read_backend(&d, root, i, rec, err);
 	if (!rc && strcmp(rec->command, "compare") == 0 && rec->n_backends < 2)
-		rc = ydoc_expected(&d, b, NULL, "backends", "a comparison's 2 or more sides", err);
-	struct fy_node *pn = ydoc_lookup(root, "protocols");
+		rc = bsim_ydoc_expected(&d, b, NULL, "backends", "a comparison's 2 or more sides", err);
+	struct fy_node *pn = bsim_ydoc_lookup(root, "protocols");
 	if (!rc && pn &&
 	    (!fy_node_is_sequence(pn) || fy_node_sequence_item_count(pn) != 2 ||
 	     rec->n_backends != 2))
-		rc = ydoc_expected(&d, pn, NULL, "protocols", "a list of 2 lattice protocols", err);
+		rc = bsim_ydoc_expected(&d, pn, NULL, "protocols", "a list of 2 lattice protocols", err);
 	for (int i = 0; !rc && pn && i < 2; i++) {
 		char field[32];
 		snprintf(field, sizeof field, "protocols.%d", i);
 		rc = need_text(&d, root, field, rec->protocol[i], sizeof rec->protocol[i], err);
 	}
-	struct fy_node *sn = ydoc_lookup(root, "seed"), *tn = ydoc_lookup(root, "trials");
+	struct fy_node *sn = bsim_ydoc_lookup(root, "seed"), *tn = bsim_ydoc_lookup(root, "trials");
 	long long trials = 0;
-	if (!rc && (!sn || !ydoc_uint64_text(sn, &rec->seed)))
-		rc = ydoc_expected(&d, sn, NULL, "seed", "an integer >= 0", err);
-	if (!rc && (!tn || !ydoc_int64(tn, &trials) || trials < 1 || trials > INT32_MAX))
-		rc = ydoc_expected(&d, tn, NULL, "trials", "an integer >= 1", err);
+	if (!rc && (!sn || !bsim_ydoc_uint64_text(sn, &rec->seed)))
+		rc = bsim_ydoc_expected(&d, sn, NULL, "seed", "an integer >= 0", err);
+	if (!rc && (!tn || !bsim_ydoc_int64(tn, &trials) || trials < 1 || trials > INT32_MAX))
+		rc = bsim_ydoc_expected(&d, tn, NULL, "trials", "an integer >= 1", err);
 	if (!rc)
 		rc = need_number(&d, root, "rule.alpha", &alpha, err);
 	if (!rc)
 		rc = need_number(&d, root, "rule.margin", &margin, err);
 	if (!rc) {
-		struct fy_node *ex = ydoc_lookup(root, "rule.exact");
-		const char *t = ex ? ydoc_plain(ex) : NULL;
+		struct fy_node *ex = bsim_ydoc_lookup(root, "rule.exact");
+		const char *t = ex ? bsim_ydoc_plain(ex) : NULL;
 		rec->rule.exact = t && strcmp(t, "true") == 0;
 		rec->trials = (int)trials;
 		rec->rule.alpha = alpha;
 		rec->rule.margin = margin;
 		if (strcmp(rec->command, "sweep") != 0 && strcmp(rec->command, "compare") != 0)
-			rc = ydoc_expected(&d, ydoc_lookup(root, "command"), NULL, "command",
+			rc = bsim_ydoc_expected(&d, bsim_ydoc_lookup(root, "command"), NULL, "command",
 			                   "\"sweep\" or \"compare\"", err);
 	}
-	ydoc_free(&d);
+	bsim_ydoc_free(&d);
 	return rc;
 }

@@ -45,7 +45,7 @@ int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, c
 		 * place would block the first read for ever. */
 		rc = bsim_error_set(err, BSIM_EINPUT,
 		                    "%s: expected the journal of a stopped run, got %s",
-		                    s->journal_path, file_kind(&st));
+		                    s->journal_path, bsim_file_kind(&st));
 	} else if (resume && !have) {
 		int finished = 0;
 		bsim_error ignore;

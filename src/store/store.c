@@ -29,12 +29,12 @@ static int survival_files(const char *dir, const bsim_experiment *e, const bsim_
                           int n_extra, const bsim_sweep_result *r, bsim_error *err)
 {
 	survival_acc a;
-	int rc = survival_acc_init(&a, e, extra, n_extra, err);
+	int rc = bsim_survival_acc_init(&a, e, extra, n_extra, err);
 	if (rc == BSIM_OK)
-		survival_acc_add(&a, 0, (long)r->n_groups * r->trials, r->trials, r->trials_out);
+		bsim_survival_acc_add(&a, 0, (long)r->n_groups * r->trials, r->trials, r->trials_out);
 	if (rc == BSIM_OK)
-		rc = survival_acc_write(&a, dir, err);
-	survival_acc_free(&a);
+		rc = bsim_survival_acc_write(&a, dir, err);
+	bsim_survival_acc_free(&a);
 	return rc == BSIM_OK ? BSIM_OK : BSIM_EFAIL;
 }
 

@@ -25,12 +25,12 @@
 /* Points of the horizon grid of each group: h = H j / HORIZON_POINTS. */
 #define HORIZON_POINTS 48
 
-double survival_exit_time(const bsim_trial_result *r)
+double bsim_survival_exit_time(const bsim_trial_result *r)
 {
 	return r->outcome == BSIM_TRAVERSED || r->outcome == BSIM_SIDE_EXIT ? r->t_end : NAN;
 }
 
-int survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_override *sets,
+int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_override *sets,
                       int n_sets, bsim_error *err)
 {
 	memset(a, 0, sizeof *a);
@@ -61,7 +61,7 @@ int survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_over
 	return BSIM_OK;
 }
 
-void survival_acc_free(survival_acc *a)
+void bsim_survival_acc_free(survival_acc *a)
 {
 	for (int k = 0; a->g && k < a->n_groups; k++)
 		free(a->g[k].count);
@@ -83,7 +83,7 @@ static int kind_of(bsim_outcome o)
 	}
 }
 
-void survival_acc_add(survival_acc *a, long first, long n, int trials,
+void bsim_survival_acc_add(survival_acc *a, long first, long n, int trials,
                       const bsim_trial_result *results)
 {
 	for (long k = 0; k < n; k++) {
@@ -109,7 +109,7 @@ static long bin_steps(const survival_group *g, int b)
 static void survival_rows(FILE *f, int k, const survival_group *g)
 {
 	survival_km km;
-	survival_km_start(&km, g->n);
+	bsim_survival_km_start(&km, g->n);
 	fprintf(f, "%d,0,%ld,0,1,1,1,0\n", k, g->n);
 	for (int b = 0; b < g->n_bins; b++) {
 		const uint32_t *c = &g->count[(size_t)b * SURV_KINDS];
@@ -118,9 +118,9 @@ static void survival_rows(FILE *f, int k, const survival_group *g)
 		if (d == 0 && cens == 0)
 			continue;
 		long at_risk = km.at_risk;
-		survival_km_step(&km, d, cens);
+		bsim_survival_km_step(&km, d, cens);
 		double lo, hi;
-		survival_km_interval(&km, BSIM_STATS_Z95, &lo, &hi);
+		bsim_survival_km_interval(&km, BSIM_STATS_Z95, &lo, &hi);
 		fprintf(f, "%d,%.10g,%ld,%ld,%.10g,%.10g,%.10g,%ld\n", k, bin_steps(g, b) * g->dt,
 		        at_risk, d, km.s, lo, hi, cens);
 	}
@@ -169,7 +169,7 @@ static int write_table(const survival_acc *a, const char *dir, const char *name,
 	return bsim_atomic_file_commit(&o, err);
 }
 
-int survival_acc_write(const survival_acc *a, const char *dir, bsim_error *err)
+int bsim_survival_acc_write(const survival_acc *a, const char *dir, bsim_error *err)
 {
 	if (write_table(a, dir, "survival.csv",
 	                "group,t,at_risk,events,survival,ci_low,ci_high,censored\n", survival_rows,

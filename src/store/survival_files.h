@@ -46,21 +46,21 @@ typedef struct survival_acc {
 
 /* Sets up the bins of every group of e (each group's scene with sets for
  * its dt and max_steps). BSIM_EFAIL out of memory; free with
- * survival_acc_free either way. */
-int survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_override *sets,
+ * bsim_survival_acc_free either way. */
+int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_override *sets,
                       int n_sets, bsim_error *err);
-void survival_acc_free(survival_acc *a);
+void bsim_survival_acc_free(survival_acc *a);
 
 /* Counts trials first .. first + n - 1 of a sweep of `trials` per group. */
-void survival_acc_add(survival_acc *a, long first, long n, int trials,
+void bsim_survival_acc_add(survival_acc *a, long first, long n, int trials,
                       const bsim_trial_result *results);
 
 /* Writes dir/survival.csv and dir/horizon.csv (their twins come with the
  * sweep's, bsim_matlab_sweep). */
-int survival_acc_write(const survival_acc *a, const char *dir, bsim_error *err);
+int bsim_survival_acc_write(const survival_acc *a, const char *dir, bsim_error *err);
 
 /* The trial's exit time t_exit, s, or NaN when it is censored (stuck,
  * unstable): what trials.csv's t_exit column holds. */
-double survival_exit_time(const bsim_trial_result *r);
+double bsim_survival_exit_time(const bsim_trial_result *r);
 
 #endif

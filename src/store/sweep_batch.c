@@ -217,13 +217,13 @@ static int batch_parts(void *user, const bsim_sweep_part *part, bsim_error *err)
 	return rc;
 }
 
-int sweep_batch_run(sweep_batch *b, const bsim_experiment *const *e, const bsim_sweep_config *cfg,
+int bsim_sweep_batch_run(sweep_batch *b, const bsim_experiment *const *e, const bsim_sweep_config *cfg,
                     int n, bsim_sweep_result *res, bsim_error *err)
 {
-	return sweep_batch_run_cpu(b, e, cfg, n, res, NULL, err);
+	return bsim_sweep_batch_run_cpu(b, e, cfg, n, res, NULL, err);
 }
 
-int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
+int bsim_sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
                         const bsim_sweep_config *cfg, int n, bsim_sweep_result *res, double *cpu,
                         bsim_error *err)
 {
@@ -255,7 +255,7 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 	        c.total, sp ? sp->argc : 0,     sp ? sp->argv : NULL};
 	if (rc == BSIM_OK && spread == BSIM_SPREAD_SEND) {
 		/* another rank's part: its records go to rank 0, no directory */
-		rc = part_dir_spread_run(&pds, inputs, NULL, batch_parts, &c, err);
+		rc = bsim_part_dir_spread_run(&pds, inputs, NULL, batch_parts, &c, err);
 		free(inputs);
 		free(first);
 		return rc;
@@ -268,13 +268,13 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 	}
 	if (rc == BSIM_OK && merge) {
 		char run[17];
-		part_dir_run_id(inputs, run);
-		rc = part_dir_join(sp->merge, sp->n_merge, b->command, run, inputs, size, c.total,
+		bsim_part_dir_run_id(inputs, run);
+		rc = bsim_part_dir_join(sp->merge, sp->n_merge, b->command, run, inputs, size, c.total,
 		                   b->ss.journal, err);
 		if (rc == BSIM_OK)
-			rc = part_dir_journal_reopen(&b->ss, inputs, size, err);
+			rc = bsim_part_dir_journal_reopen(&b->ss, inputs, size, err);
 	} else if (rc == BSIM_OK && spread != BSIM_SPREAD_NONE) {
-		rc = part_dir_spread_run(&pds, inputs, &b->ss, batch_parts, &c, err);
+		rc = bsim_part_dir_spread_run(&pds, inputs, &b->ss, batch_parts, &c, err);
 		if (spread == BSIM_SPREAD_SHARD) {
 			/* the part directory is written: the caller commits it */
 			free(inputs);
@@ -282,7 +282,7 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 			return rc;
 		}
 		if (rc == BSIM_OK)
-			rc = part_dir_journal_reopen(&b->ss, inputs, size, err);
+			rc = bsim_part_dir_journal_reopen(&b->ss, inputs, size, err);
 	}
 	/* Every sweep from the journal, the trials it lacks run here. A new
 	 * journal holds no record of a sweep before it runs; a resumed one is
@@ -304,7 +304,7 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 			rc = spill_journal(&spill, own_path, inputs, first[s], first[s + 1], &own,
 			                   err);
 		else if (s > 0 && b->open && b->resume)
-			rc = part_dir_journal_reopen(&b->ss, inputs, size, err);
+			rc = bsim_part_dir_journal_reopen(&b->ss, inputs, size, err);
 		bsim_sweep_config k = batch_cfg(&c, s, own ? own : b->open ? b->ss.journal : NULL);
 		c.sweep_total = 0;
 		if (rc == BSIM_OK)
@@ -333,7 +333,7 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 	return rc;
 }
 
-int sweep_batch_end(sweep_batch *b, int rc, bsim_error *err)
+int bsim_sweep_batch_end(sweep_batch *b, int rc, bsim_error *err)
 {
 	if (!b->open)
 		return rc;

@@ -35,13 +35,13 @@ typedef struct sweep_batch {
 	bsim_progress_fn progress;       /* trials done of every sweep's; may be NULL */
 	void *progress_user;
 	const volatile sig_atomic_t *stop;
-	/* Set by sweep_batch_run: */
+	/* Set by bsim_sweep_batch_run: */
 	bsim_session ss; /* out's session, when open: the caller writes into ss.stage */
 	int open;
 	/* 1: this process has the results and writes out's files (not a
 	 * shard, not an MPI rank other than 0) */
 	int writes;
-	/* the journal kept by sweep_batch_end ("" if none): resume continues it */
+	/* the journal kept by bsim_sweep_batch_end ("" if none): resume continues it */
 	char journal[BSIM_PATH_MAX];
 	/* progress over the sweeps */
 	long done_before, total;
@@ -51,13 +51,13 @@ typedef struct sweep_batch {
  * fields are the batch's) into res[0..n) (bsim_sweep_run's results,
  * trials_out without logs), with out opened first (b->ss). With b->writes
  * 0 (a shard, another rank) res holds nothing. On error res holds nothing;
- * call sweep_batch_end in every case where b->open. */
-int sweep_batch_run(sweep_batch *b, const bsim_experiment *const *e, const bsim_sweep_config *cfg,
+ * call bsim_sweep_batch_end in every case where b->open. */
+int bsim_sweep_batch_run(sweep_batch *b, const bsim_experiment *const *e, const bsim_sweep_config *cfg,
                     int n, bsim_sweep_result *res, bsim_error *err);
 
 /* With cpu not NULL, cpu[0..n) gets the CPU time, s, this process spent
  * on each sweep (clock(): its part and the final run from the journal). */
-int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
+int bsim_sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
                         const bsim_sweep_config *cfg, int n, bsim_sweep_result *res, double *cpu,
                         bsim_error *err);
 
@@ -65,6 +65,6 @@ int sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
  * caller wrote into b->ss.stage (a shard's part.json and part.journal)
  * committed when rc is BSIM_OK, the journal kept when the run stopped or
  * failed after finishing trials (its path in b->journal). */
-int sweep_batch_end(sweep_batch *b, int rc, bsim_error *err);
+int bsim_sweep_batch_end(sweep_batch *b, int rc, bsim_error *err);
 
 #endif

@@ -72,12 +72,12 @@ static FILE *sink_file(trials_sink *s, int k)
 static int trials_sink_take(void *user, const bsim_sweep_block *b, bsim_error *err)
 {
 	trials_sink *s = user;
-	trials_csv_rows(&s->w, b->first, b->n, s->trials, b->results, b->logs);
-	survival_acc_add(&s->surv, b->first, b->n, s->trials, b->results);
+	bsim_trials_csv_rows(&s->w, b->first, b->n, s->trials, b->results, b->logs);
+	bsim_survival_acc_add(&s->surv, b->first, b->n, s->trials, b->results);
 	if (s->n_files > 1) {
-		lattice_entries_rows(s->lattice[SINK_ENTRIES].f, b->first, b->n, s->trials,
+		bsim_lattice_entries_rows(s->lattice[SINK_ENTRIES].f, b->first, b->n, s->trials,
 		                     b->logs);
-		lattice_peaks_rows(s->lattice[SINK_PEAKS].f, &s->def, b->first, b->n, s->trials,
+		bsim_lattice_peaks_rows(s->lattice[SINK_PEAKS].f, &s->def, b->first, b->n, s->trials,
 		                   b->logs);
 	}
 	for (int k = 0; k < s->n_files; k++) {
@@ -103,21 +103,21 @@ static int sink_open(trials_sink *s, const char *stage, const bsim_experiment *e
 	s->def = scene.lattice;
 	s->trials = e->trials;
 	bsim_scene_free(&scene);
-	if ((rc = survival_acc_init(&s->surv, e, sets, n_sets, err)) != BSIM_OK)
+	if ((rc = bsim_survival_acc_init(&s->surv, e, sets, n_sets, err)) != BSIM_OK)
 		return rc;
 	if (bsim_output_mkdir(stage, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	for (int k = 0; k < s->n_files; k++)
 		if (bsim_session_path(s->path[k], sizeof s->path[k], stage, sink_names[k], err))
 			return BSIM_EFAIL;
-	if (trials_csv_open(&s->w, s->path[SINK_TRIALS], e, err) != BSIM_OK)
+	if (bsim_trials_csv_open(&s->w, s->path[SINK_TRIALS], e, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	for (int k = 1; k < s->n_files; k++)
 		if (bsim_atomic_file_open(&s->lattice[k], s->path[k], err) != BSIM_OK)
 			return BSIM_EFAIL;
 	if (s->n_files > 1) {
-		lattice_entries_header(s->lattice[SINK_ENTRIES].f);
-		lattice_peaks_header(s->lattice[SINK_PEAKS].f);
+		bsim_lattice_entries_header(s->lattice[SINK_ENTRIES].f);
+		bsim_lattice_peaks_header(s->lattice[SINK_PEAKS].f);
 	}
 	return BSIM_OK;
 }
@@ -127,12 +127,12 @@ static int sink_open(trials_sink *s, const char *stage, const bsim_experiment *e
 static int sink_close(trials_sink *s, int rc, const char *stage, bsim_error *err)
 {
 	if (rc == BSIM_OK)
-		rc = trials_csv_commit(&s->w, err);
+		rc = bsim_trials_csv_commit(&s->w, err);
 	if (rc == BSIM_OK)
-		rc = survival_acc_write(&s->surv, stage, err);
-	survival_acc_free(&s->surv);
+		rc = bsim_survival_acc_write(&s->surv, stage, err);
+	bsim_survival_acc_free(&s->surv);
 	if (rc != BSIM_OK)
-		trials_csv_abort(&s->w);
+		bsim_trials_csv_abort(&s->w);
 	for (int k = 1; k < SINK_FILES; k++) {
 		if (rc == BSIM_OK && s->lattice[k].f)
 			rc = bsim_atomic_file_commit(&s->lattice[k], err);
@@ -177,7 +177,7 @@ static int sweep_part(const bsim_sweep_dir_def *def, const bsim_experiment *e, c
 	                      "sweep",     record_size, (long)e->n_groups * e->trials,
 	                      def->argc,   def->argv};
 	sweep_part_ctx c = {e, cfg};
-	return part_dir_spread_run(&sp, inputs, ss, sweep_part_run, &c, err);
+	return bsim_part_dir_spread_run(&sp, inputs, ss, sweep_part_run, &c, err);
 }
 
 int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err)
@@ -258,12 +258,12 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	cfg.journal = ss.journal;
 	if (def->n_merge > 0) {
 		char run[17];
-		part_dir_run_id(inputs, run);
+		bsim_part_dir_run_id(inputs, run);
 		long total = (long)e->n_groups * e->trials;
-		rc = part_dir_join(def->merge, def->n_merge, "sweep", run, inputs, size, total,
+		rc = bsim_part_dir_join(def->merge, def->n_merge, "sweep", run, inputs, size, total,
 		                   ss.journal, err);
 		if (rc == BSIM_OK)
-			rc = part_dir_journal_reopen(&ss, inputs, size, err);
+			rc = bsim_part_dir_journal_reopen(&ss, inputs, size, err);
 		cfg.journal = ss.journal;
 	} else if (spread == BSIM_SPREAD_SHARD || spread == BSIM_SPREAD_GATHER) {
 		rc = sweep_part(def, e, inputs, &cfg, size, &ss, err);
@@ -275,7 +275,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 			return rc;
 		}
 		if (rc == BSIM_OK)
-			rc = part_dir_journal_reopen(&ss, inputs, size, err);
+			rc = bsim_part_dir_journal_reopen(&ss, inputs, size, err);
 		cfg.journal = ss.journal;
 	}
 	free(inputs);

@@ -16,7 +16,7 @@ int bsim_table_open(const char *path, bsim_table_reader **out, bsim_error *err)
 	bsim_table_reader *t = malloc(sizeof *t);
 	if (!t)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
-	int rc = csv_stream_open(path, &t->s, err);
+	int rc = bsim_csv_stream_open(path, &t->s, err);
 	if (rc != BSIM_OK) {
 		free(t);
 		return rc;
@@ -37,7 +37,7 @@ const char *bsim_table_column(const bsim_table_reader *t, int c)
 
 int bsim_table_next(bsim_table_reader *t, const char *const **cells, bsim_error *err)
 {
-	int got = csv_stream_next(&t->s, err);
+	int got = bsim_csv_stream_next(&t->s, err);
 	*cells = got == 1 ? (const char *const *)t->s.cells : NULL;
 	return got;
 }
@@ -51,12 +51,12 @@ void bsim_table_close(bsim_table_reader *t)
 {
 	if (!t)
 		return;
-	csv_stream_close(&t->s);
+	bsim_csv_stream_close(&t->s);
 	free(t);
 }
 
 double bsim_table_count_rows(const char *path)
 {
-	double lines = csv_count_lines(path);
+	double lines = bsim_csv_count_lines(path);
 	return lines < 0 ? -1 : lines > 0 ? lines - 1 : 0;
 }

@@ -58,12 +58,12 @@ typedef struct trials_csv_writer {
 	int idx[BSIM_OUTPUT_AXES_MAX];
 } trials_csv_writer;
 
-int trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
+int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
                     bsim_error *err);
-void trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
+void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
                      const bsim_trial_result *results, const bsim_trial_log *logs);
-int trials_csv_commit(trials_csv_writer *w, bsim_error *err);
-void trials_csv_abort(trials_csv_writer *w);
+int bsim_trials_csv_commit(trials_csv_writer *w, bsim_error *err);
+void bsim_trials_csv_abort(trials_csv_writer *w);
 
 /* The shape a trials.csv read back must have: every (group, trial) of
  * n_groups x trials once (bsim_output_trials_read asks no more), and what
@@ -81,12 +81,12 @@ typedef struct trials_csv_shape {
 	                      * writes it */
 } trials_csv_shape;
 
-/* The text of the trials.csv at path (whole and checked: csv_text_read;
+/* The text of the trials.csv at path (whole and checked: bsim_csv_text_read;
  * split in place) into r, its groups aggregated. BSIM_EINPUT "PATH:LINE:
  * FIELD: expected ..., got ..." at the first field that does not fit the
  * shape, a (group, trial) read twice (naming the line of the first) or
  * missing (named, at the end of the file). */
-int trials_csv_parse(const char *path, char *text, const trials_csv_shape *shape,
+int bsim_trials_csv_parse(const char *path, char *text, const trials_csv_shape *shape,
                      bsim_sweep_result *r, bsim_error *err);
 
 #endif

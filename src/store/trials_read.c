@@ -282,7 +282,7 @@ static void column_list(int first, int end, char *buf, size_t size)
 static int read_header(reader *rd, char *line, bsim_error *err)
 {
 	char *f[MAX_FIELDS], names[400];
-	int n = csv_split(line, f, MAX_FIELDS);
+	int n = bsim_csv_split(line, f, MAX_FIELDS);
 	for (int k = 0; k < N_COLUMNS; k++)
 		rd->col[k] = -1;
 	if (n <= 0 || (n == 1 && !f[0][0]))
@@ -397,7 +397,7 @@ static int rows_complete(const reader *rd, long rows, bsim_error *err)
 	return BSIM_OK;
 }
 
-int trials_csv_parse(const char *path, char *text, const trials_csv_shape *shape,
+int bsim_trials_csv_parse(const char *path, char *text, const trials_csv_shape *shape,
                      bsim_sweep_result *r, bsim_error *err)
 {
 	memset(r, 0, sizeof *r);
@@ -417,7 +417,7 @@ int trials_csv_parse(const char *path, char *text, const trials_csv_shape *shape
 	long rows = 0;
 	while (rc == BSIM_OK && *next) {
 		char *line = next;
-		char *nl = strchr(line, '\n'); /* there is one: csv_text_check */
+		char *nl = strchr(line, '\n'); /* there is one: bsim_csv_text_check */
 		*nl = '\0';
 		next = nl + 1;
 		rd.line++;
@@ -428,7 +428,7 @@ int trials_csv_parse(const char *path, char *text, const trials_csv_shape *shape
 			r->has_turn = rd.col[COL_HEADING_END] >= 0;
 			continue;
 		}
-		rc = parse_row(&rd, field, csv_split(line, field, MAX_FIELDS), err);
+		rc = parse_row(&rd, field, bsim_csv_split(line, field, MAX_FIELDS), err);
 		rows++;
 	}
 	if (rc == BSIM_OK && rd.line == 0)
@@ -456,11 +456,11 @@ int bsim_output_trials_read(const char *path, int n_groups, int trials, bsim_swe
 	/* A regular file only (a link to /dev/zero or a FIFO is refused at
 	 * once), bounded, and whole: its last row ends in a line feed. */
 	file_text ft;
-	int rc = csv_text_read(path, &ft, err);
+	int rc = bsim_csv_text_read(path, &ft, err);
 	if (rc != BSIM_OK)
 		return rc;
 	trials_csv_shape shape = {.n_groups = n_groups, .trials = trials};
-	rc = trials_csv_parse(path, ft.text, &shape, r, err);
-	file_text_free(&ft);
+	rc = bsim_trials_csv_parse(path, ft.text, &shape, r, err);
+	bsim_file_text_free(&ft);
 	return rc;
 }

@@ -59,7 +59,7 @@ static int fill(csv_stream *s, bsim_error *err)
 /* The line feed that ends the row at p (avail bytes, the first scanned
  * of them already seen, with *quoted the quoting after them): one outside
  * double quotes, as a quoted field may hold a line break
- * (csv_field_write). NULL if the bytes hold none yet; *breaks counts the
+ * (bsim_csv_field_write). NULL if the bytes hold none yet; *breaks counts the
  * line feeds inside quotes. */
 static char *row_end(char *p, size_t avail, size_t *scanned, int *quoted, long *breaks)
 {
@@ -80,7 +80,7 @@ static char *row_end(char *p, size_t avail, size_t *scanned, int *quoted, long *
 
 /* The next row, its line feed (and a CR before it) cut off: 1 and *line,
  * 0 at the end of the file, -1 on a NUL byte or a last line cut short
- * (csv_text_check's messages) or a read error. */
+ * (bsim_csv_text_check's messages) or a read error. */
 static int next_line(csv_stream *s, char **line, bsim_error *err)
 {
 	size_t scanned = 0; /* bytes after start already seen */
@@ -123,7 +123,7 @@ static int next_line(csv_stream *s, char **line, bsim_error *err)
 	}
 }
 
-void csv_stream_close(csv_stream *s)
+void bsim_csv_stream_close(csv_stream *s)
 {
 	if (s->fd >= 0)
 		close(s->fd);
@@ -137,18 +137,18 @@ void csv_stream_close(csv_stream *s)
 	s->fd = -1;
 }
 
-int csv_stream_open(const char *path, csv_stream *s, bsim_error *err)
+int bsim_csv_stream_open(const char *path, csv_stream *s, bsim_error *err)
 {
 	memset(s, 0, sizeof *s);
 	s->path = path;
 	struct stat st;
-	s->fd = file_open_checked(path, &st);
+	s->fd = bsim_file_open_checked(path, &st);
 	if (s->fd < 0)
 		return cannot_read(path, errno, err);
 	int rc = BSIM_OK;
 	if (!S_ISREG(st.st_mode))
 		rc = bsim_error_set(err, BSIM_EINPUT, "%s: expected a CSV file, got %s", path,
-		                    file_kind(&st));
+		                    bsim_file_kind(&st));
 	else if ((double)st.st_size > CSV_TABLE_MAX_BYTES)
 		rc = too_big(path, err);
 	else if (!(s->buf = malloc(CSV_STREAM_CHUNK)))
@@ -161,7 +161,7 @@ int csv_stream_open(const char *path, csv_stream *s, bsim_error *err)
 	else if (!rc && got < 0)
 		rc = err ? err->code : BSIM_EINPUT;
 	if (!rc) {
-		s->n_cols = csv_count_fields(header);
+		s->n_cols = bsim_csv_count_fields(header);
 		s->names = calloc((size_t)s->n_cols, sizeof *s->names);
 		s->cells = calloc((size_t)s->n_cols, sizeof *s->cells);
 		char *copy = strdup(header);
@@ -169,21 +169,21 @@ int csv_stream_open(const char *path, csv_stream *s, bsim_error *err)
 			free(copy);
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 		} else {
-			csv_split(copy, s->names, s->n_cols);
+			bsim_csv_split(copy, s->names, s->n_cols);
 		}
 	}
 	if (rc)
-		csv_stream_close(s);
+		bsim_csv_stream_close(s);
 	return rc;
 }
 
-int csv_stream_next(csv_stream *s, bsim_error *err)
+int bsim_csv_stream_next(csv_stream *s, bsim_error *err)
 {
 	char *line;
 	int got;
 	while ((got = next_line(s, &line, err)) == 1) {
-		int n = csv_count_fields(line);
-		if (n == s->n_cols && s->bad_line == 0 && csv_split(line, s->cells, n) == n)
+		int n = bsim_csv_count_fields(line);
+		if (n == s->n_cols && s->bad_line == 0 && bsim_csv_split(line, s->cells, n) == n)
 			return 1;
 		if (s->bad_line == 0) {
 			s->bad_line = s->line;
@@ -205,10 +205,10 @@ int csv_stream_next(csv_stream *s, bsim_error *err)
 	return got;
 }
 
-double csv_count_lines(const char *path)
+double bsim_csv_count_lines(const char *path)
 {
 	struct stat st;
-	int fd = file_open_checked(path, &st);
+	int fd = bsim_file_open_checked(path, &st);
 	if (fd < 0)
 		return -1;
 	char *buf = S_ISREG(st.st_mode) ? malloc(CSV_STREAM_CHUNK) : NULL;

@@ -1,13 +1,13 @@
 /* Internal: a CSV table of beamsim's own making read row by row, for a
  * reader that must not hold the whole file (a .mat twin of a million-row
  * trajectory). The table is the CSV of util/csv_table.h, a quoted field
- * unquoted (csv_split; it may hold commas and line breaks), and is checked
+ * unquoted (bsim_csv_split; it may hold commas and line breaks), and is checked
  * the same way, with the same messages: a regular file (refused at once
  * otherwise, never waited on) of at most CSV_TABLE_MAX_BYTES, no NUL
  * byte, a last line ending in a line feed, every row as wide as the
  * header, a CR before a line feed dropped.
  *
- * csv_table_read checks the whole text before it splits a row, so a file
+ * bsim_csv_table_read checks the whole text before it splits a row, so a file
  * with several faults names the first NUL, then a cut-short last line,
  * then the first row of the wrong width. A stream keeps that order: a row
  * of the wrong width is remembered and reported at the end of the file,
@@ -37,22 +37,22 @@ typedef struct csv_stream {
 	int bad_got;
 } csv_stream;
 
-/* Opens path and reads its header. BSIM_EINPUT with csv_table_read's
+/* Opens path and reads its header. BSIM_EINPUT with bsim_csv_table_read's
  * message if the file cannot be read, is not a regular file, is too large
  * or has no header (or holds a NUL before the end of its header), BSIM_EFAIL
  * out of memory. Nothing to free on failure. */
-int csv_stream_open(const char *path, csv_stream *s, bsim_error *err);
+int bsim_csv_stream_open(const char *path, csv_stream *s, bsim_error *err);
 
 /* The next row into s->cells: 1, or 0 at the end of a sound file, or -1
- * with err set (csv_table_read's message for the first fault of the file,
+ * with err set (bsim_csv_table_read's message for the first fault of the file,
  * in its order). */
-int csv_stream_next(csv_stream *s, bsim_error *err);
+int bsim_csv_stream_next(csv_stream *s, bsim_error *err);
 
-void csv_stream_close(csv_stream *s);
+void bsim_csv_stream_close(csv_stream *s);
 
 /* The line feeds of the regular file path, counted without keeping a
  * line (a reader that decides before it keeps anything), or -1 if it is
- * not a regular file or cannot be read (csv_stream_open names why). */
-double csv_count_lines(const char *path);
+ * not a regular file or cannot be read (bsim_csv_stream_open names why). */
+double bsim_csv_count_lines(const char *path);
 
 #endif

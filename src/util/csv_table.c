@@ -36,7 +36,7 @@ static int count_fields(const char *line)
 	return n;
 }
 
-void csv_field_write(FILE *f, const char *s)
+void bsim_csv_field_write(FILE *f, const char *s)
 {
 	if (!strpbrk(s, ",\"\r\n")) {
 		fputs(s, f);
@@ -51,7 +51,7 @@ void csv_field_write(FILE *f, const char *s)
 	fputc('"', f);
 }
 
-int csv_split(char *line, char **field, int max)
+int bsim_csv_split(char *line, char **field, int max)
 {
 	int n = 0;
 	char *r = line, *w = line;
@@ -88,7 +88,7 @@ int csv_split(char *line, char **field, int max)
 	return n;
 }
 
-int csv_count_fields(const char *line)
+int bsim_csv_count_fields(const char *line)
 {
 	int n = 1, quoted = 0;
 	for (; *line; line++) {
@@ -100,7 +100,7 @@ int csv_count_fields(const char *line)
 	return n;
 }
 
-int csv_text_check(const char *path, const char *text, size_t len, bsim_error *err)
+int bsim_csv_text_check(const char *path, const char *text, size_t len, bsim_error *err)
 {
 	/* A NUL would end a line's text early, unseen: named where it is. */
 	long line = 1, col = 1;
@@ -125,7 +125,7 @@ int csv_text_check(const char *path, const char *text, size_t len, bsim_error *e
 	return BSIM_OK;
 }
 
-void csv_table_free(csv_table *t)
+void bsim_csv_table_free(csv_table *t)
 {
 	free(t->names);
 	free(t->cells);
@@ -133,22 +133,22 @@ void csv_table_free(csv_table *t)
 	memset(t, 0, sizeof *t);
 }
 
-int csv_text_read(const char *path, file_text *out, bsim_error *err)
+int bsim_csv_text_read(const char *path, file_text *out, bsim_error *err)
 {
 	/* Only a regular file, never waited on, and at most CSV_TABLE_MAX_BYTES
 	 * of it: a link to /dev/zero or a file that keeps growing must not
 	 * fill memory. */
-	int rc = file_read(path, "a CSV file", CSV_TABLE_MAX_BYTES, NULL, out, err);
-	if (rc == BSIM_OK && (rc = csv_text_check(path, out->text, out->len, err)) != BSIM_OK)
-		file_text_free(out);
+	int rc = bsim_file_read(path, "a CSV file", CSV_TABLE_MAX_BYTES, NULL, out, err);
+	if (rc == BSIM_OK && (rc = bsim_csv_text_check(path, out->text, out->len, err)) != BSIM_OK)
+		bsim_file_text_free(out);
 	return rc;
 }
 
-int csv_table_read(const char *path, csv_table *t, bsim_error *err)
+int bsim_csv_table_read(const char *path, csv_table *t, bsim_error *err)
 {
 	memset(t, 0, sizeof *t);
 	file_text f;
-	int rc = csv_text_read(path, &f, err);
+	int rc = bsim_csv_text_read(path, &f, err);
 	if (rc != BSIM_OK)
 		return rc;
 	t->text = f.text;
@@ -159,12 +159,12 @@ int csv_table_read(const char *path, csv_table *t, bsim_error *err)
 		n_lines += t->text[i] == '\n';
 	n_lines += len > 0 && t->text[len - 1] != '\n';
 	if (n_lines < 1) {
-		csv_table_free(t);
+		bsim_csv_table_free(t);
 		return bsim_error_set(err, BSIM_EINPUT, "%s:1: expected a header line", path);
 	}
 	char **lines = malloc((size_t)n_lines * sizeof *lines);
 	if (!lines) {
-		csv_table_free(t);
+		bsim_csv_table_free(t);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 	}
 	long k = 0;
@@ -187,7 +187,7 @@ int csv_table_read(const char *path, csv_table *t, bsim_error *err)
 	t->cells = malloc(((size_t)t->n_rows * t->n_cols + 1) * sizeof *t->cells);
 	if (!t->names || !t->cells) {
 		free(lines);
-		csv_table_free(t);
+		bsim_csv_table_free(t);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 	}
 	split(lines[0], t->names, t->n_cols);
@@ -196,7 +196,7 @@ int csv_table_read(const char *path, csv_table *t, bsim_error *err)
 		if (got != t->n_cols) {
 			int cols = t->n_cols;
 			free(lines);
-			csv_table_free(t);
+			bsim_csv_table_free(t);
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      "%s:%ld: expected %d fields, got %d", path, r + 2,
 			                      cols, got);
@@ -206,7 +206,7 @@ int csv_table_read(const char *path, csv_table *t, bsim_error *err)
 	return BSIM_OK;
 }
 
-int csv_table_col(const csv_table *t, const char *name)
+int bsim_csv_table_col(const csv_table *t, const char *name)
 {
 	for (int c = 0; c < t->n_cols; c++)
 		if (strcmp(t->names[c], name) == 0)
@@ -214,46 +214,46 @@ int csv_table_col(const csv_table *t, const char *name)
 	return -1;
 }
 
-const char *csv_table_cell(const csv_table *t, long row, int col)
+const char *bsim_csv_table_cell(const csv_table *t, long row, int col)
 {
 	return t->cells[(size_t)row * t->n_cols + col];
 }
 
-int csv_table_number(const csv_table *t, long row, int col, double *out)
+int bsim_csv_table_number(const csv_table *t, long row, int col, double *out)
 {
-	return csv_number(csv_table_cell(t, row, col), out);
+	return bsim_csv_number(bsim_csv_table_cell(t, row, col), out);
 }
 
-int csv_number(const char *s, double *out)
+int bsim_csv_number(const char *s, double *out)
 {
 	char *end;
-	if (!*s || decimal_other_base(s))
+	if (!*s || bsim_decimal_other_base(s))
 		return -1;
 	*out = strtod(s, &end); /* an underflow to 0 or subnormal is still that number */
 	return *end == '\0' ? 0 : -1;
 }
 
-int csv_table_numbers(const csv_table *t, const char *path, int col, int allow_empty,
+int bsim_csv_table_numbers(const csv_table *t, const char *path, int col, int allow_empty,
                       double empty_value, double *out, bsim_error *err)
 {
 	for (long r = 0; r < t->n_rows; r++) {
-		if (allow_empty && !*csv_table_cell(t, r, col)) {
+		if (allow_empty && !*bsim_csv_table_cell(t, r, col)) {
 			out[r] = empty_value;
 			continue;
 		}
-		if (csv_table_number(t, r, col, &out[r]) != 0)
+		if (bsim_csv_table_number(t, r, col, &out[r]) != 0)
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      "%s:%ld: %s: expected a number, got '%s'", path,
-			                      r + 2, t->names[col], csv_table_cell(t, r, col));
+			                      r + 2, t->names[col], bsim_csv_table_cell(t, r, col));
 	}
 	return BSIM_OK;
 }
 
-int csv_table_require(const csv_table *t, const char *path, const char *const *names, int n,
+int bsim_csv_table_require(const csv_table *t, const char *path, const char *const *names, int n,
                       int *cols, bsim_error *err)
 {
 	for (int i = 0; i < n; i++) {
-		cols[i] = csv_table_col(t, names[i]);
+		cols[i] = bsim_csv_table_col(t, names[i]);
 		if (cols[i] < 0)
 			return bsim_error_set(err, BSIM_EINPUT, "%s:1: expected a column '%s'",
 			                      path, names[i]);

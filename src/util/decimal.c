@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-int decimal_other_base(const char *t)
+int bsim_decimal_other_base(const char *t)
 {
 	while (isspace((unsigned char)*t))
 		t++;
@@ -64,11 +64,11 @@ static int scale10(int64_t *m, int k)
 	return 0;
 }
 
-int decimal_step(const char *a, const char *step, long i, char *buf, size_t size)
+int bsim_decimal_step(const char *a, const char *step, long i, char *buf, size_t size)
 {
 	int64_t ma, ms, v;
 	int ea, es;
-	if (decimal_other_base(a) || decimal_other_base(step) || decimal_parse(a, &ma, &ea) ||
+	if (bsim_decimal_other_base(a) || bsim_decimal_other_base(step) || decimal_parse(a, &ma, &ea) ||
 	    decimal_parse(step, &ms, &es))
 		return -1;
 	int e = ea < es ? ea : es;

@@ -11,7 +11,7 @@
 /* 1 if t, after spaces and a sign, starts as a number of another base
  * would: 0x, 0X, 0o, 0O, 0b, 0B, or a 0 followed by a digit. "0", "0.5",
  * "-0e3", ".5", "1e3" are decimal. */
-int decimal_other_base(const char *t);
+int bsim_decimal_other_base(const char *t);
 
 /* The number a + i * step, for a and step decimal numbers as written
  * ("0.1", "-2.5e-3", "100"), written as a user would write it: in the
@@ -20,6 +20,6 @@ int decimal_other_base(const char *t);
  * binary floating point, so the text reads back as the number a file
  * holding it gives. 0, or -1 if a or step is not such a number or the
  * result needs more than 18 digits (buf is then untouched). */
-int decimal_step(const char *a, const char *step, long i, char *buf, size_t size);
+int bsim_decimal_step(const char *a, const char *step, long i, char *buf, size_t size);
 
 #endif

@@ -13,7 +13,7 @@ int bsim_error_set(bsim_error *err, int code, const char *fmt, ...)
 		va_start(ap, fmt);
 		vsnprintf(err->msg, sizeof err->msg, fmt, ap);
 		va_end(ap);
-		text_escape(err->msg, sizeof err->msg);
+		bsim_text_escape(err->msg, sizeof err->msg);
 		err->code = code;
 	}
 	return code;

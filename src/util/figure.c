@@ -239,11 +239,11 @@ static int images_commit(const bsim_figure_def *d, const char *tmpbase, int stat
 	/* gnuplot ends a failure with `"NAME.gp" line N: what went wrong`,
 	 * after the command and a caret under the place; what one that
 	 * succeeded says are warnings, passed on. */
-	program_log_line(log, 1, last, sizeof last);
+	bsim_program_log_line(log, 1, last, sizeof last);
 	if (status == 0) {
 		char prefix[200];
 		snprintf(prefix, sizeof prefix, "gnuplot on %s.gp", d->name);
-		program_log_notes(log, prefix);
+		bsim_program_log_notes(log, prefix);
 	}
 	why[0] = '\0';
 	if (status != 0) {
@@ -314,7 +314,7 @@ int bsim_figure_render_all(const bsim_figure_def *defs, const char *const *bodie
 	for (int i = 0; i < n; i++) {
 		char tmpbase[256];
 		snprintf(tmpbase, sizeof tmpbase, "%s.tmp.%ld", defs[i].name, (long)getpid());
-		logs[i] = program_log_open();
+		logs[i] = bsim_program_log_open();
 		pids[i] = gnuplot_start(defs[i].dir, defs[i].name, tmpbase, logs[i]);
 	}
 	/* Every figure that failed is named with gnuplot's message, then the

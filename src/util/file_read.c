@@ -14,7 +14,7 @@
 
 #include "beamsim/limits.h"
 
-void file_text_free(file_text *t)
+void bsim_file_text_free(file_text *t)
 {
 	free(t->text);
 	t->text = NULL;
@@ -27,7 +27,7 @@ static int cannot_read(const char *path, int e, bsim_error *err)
 	                      e ? strerror(e) : "read error");
 }
 
-const char *file_kind(const struct stat *st)
+const char *bsim_file_kind(const struct stat *st)
 {
 	mode_t m = st->st_mode;
 	return S_ISDIR(m)    ? "a directory"
@@ -90,7 +90,7 @@ static char *read_fd(int fd, size_t cap, size_t limit, size_t *n)
 	return buf;
 }
 
-int file_open_checked(const char *path, struct stat *st)
+int bsim_file_open_checked(const char *path, struct stat *st)
 {
 	int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
 	if (fd >= 0 && fstat(fd, st) != 0) {
@@ -102,19 +102,19 @@ int file_open_checked(const char *path, struct stat *st)
 	return fd;
 }
 
-int file_read(const char *path, const char *what, double max_bytes, const char *limit_name,
+int bsim_file_read(const char *path, const char *what, double max_bytes, const char *limit_name,
               file_text *out, bsim_error *err)
 {
 	out->text = NULL;
 	out->len = 0;
 	struct stat st;
-	int fd = file_open_checked(path, &st);
+	int fd = bsim_file_open_checked(path, &st);
 	if (fd < 0)
 		return cannot_read(path, errno, err);
 	if (!S_ISREG(st.st_mode)) {
 		close(fd);
 		return bsim_error_set(err, BSIM_EINPUT, "%s: expected %s, got %s", path, what,
-		                      file_kind(&st));
+		                      bsim_file_kind(&st));
 	}
 	if ((double)st.st_size > max_bytes) {
 		close(fd);

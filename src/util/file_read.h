@@ -28,20 +28,20 @@ typedef struct file_text {
  *   BSIM_EINPUT "PATH: expected a file of at most N bytes, got more
  *               (limit NAME = N; raise it with --limit NAME=N)"
  *   BSIM_EFAIL  "PATH: out of memory" */
-int file_read(const char *path, const char *what, double max_bytes, const char *limit_name,
+int bsim_file_read(const char *path, const char *what, double max_bytes, const char *limit_name,
               file_text *out, bsim_error *err);
 
-void file_text_free(file_text *t);
+void bsim_file_text_free(file_text *t);
 
 /* Opens path for reading without blocking (O_NONBLOCK: a FIFO waits for no
  * writer; O_NOCTTY: a terminal never becomes the controlling one) and
  * fstat's it into *st, so that a caller checks what it is before the first
  * read: the descriptor, or -1 with errno set and nothing left open. */
-int file_open_checked(const char *path, struct stat *st);
+int bsim_file_open_checked(const char *path, struct stat *st);
 
 /* What a file that is not a regular one is, for messages: "a directory",
  * "a FIFO", "a character device", "a block device", "a socket" or "a
  * special file". */
-const char *file_kind(const struct stat *st);
+const char *bsim_file_kind(const struct stat *st);
 
 #endif

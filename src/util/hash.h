@@ -15,6 +15,6 @@
 /* The hash of n bytes at p continuing from seed (HASH_FNV1A64_SEED to
  * start, a previous result to hash more bytes after those):
  *   h = seed;  for each byte c:  h = (h XOR c) * 0x100000001b3  (mod 2^64) */
-uint64_t hash_fnv1a64(const void *p, size_t n, uint64_t seed);
+uint64_t bsim_hash_fnv1a64(const void *p, size_t n, uint64_t seed);
 
 #endif

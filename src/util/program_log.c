@@ -7,7 +7,7 @@
 
 #include "beamsim/error.h"
 
-FILE *program_log_open(void)
+FILE *bsim_program_log_open(void)
 {
 	FILE *f = tmpfile();
 	if (!f)
@@ -50,7 +50,7 @@ static int pick(void *user, const char *line)
 	return !p->last; /* the first: done */
 }
 
-void program_log_line(FILE *log, int last, char *buf, size_t n)
+void bsim_program_log_line(FILE *log, int last, char *buf, size_t n)
 {
 	if (n == 0)
 		return;
@@ -65,7 +65,7 @@ static int note(void *user, const char *line)
 	return 0;
 }
 
-void program_log_notes(FILE *log, const char *prefix)
+void bsim_program_log_notes(FILE *log, const char *prefix)
 {
 	each_line(log, note, (void *)prefix);
 }

@@ -13,14 +13,14 @@
  * started meanwhile do not hold it); dup2 its descriptor to the program's
  * standard error. NULL if none can be made (the messages are then lost,
  * not the run). */
-FILE *program_log_open(void);
+FILE *bsim_program_log_open(void);
 
 /* The first (last = 0) or last (last = 1) line of log that is not empty,
  * line ends removed, cut to fit buf (of size n); "" if there is none. */
-void program_log_line(FILE *log, int last, char *buf, size_t n);
+void bsim_program_log_line(FILE *log, int last, char *buf, size_t n);
 
 /* Every line of log that is not empty, passed on as a note (bsim_note):
  * "PREFIX: LINE". */
-void program_log_notes(FILE *log, const char *prefix);
+void bsim_program_log_notes(FILE *log, const char *prefix);
 
 #endif

@@ -6,27 +6,27 @@
 
 #include <gsl/gsl_cdf.h>
 
-void survival_km_start(survival_km *k, long n)
+void bsim_survival_km_start(survival_km *k, long n)
 {
 	k->at_risk = n;
 	k->s = 1.0;
 	k->greenwood = 0.0;
 }
 
-void survival_km_step(survival_km *k, long d, long c)
+void bsim_survival_km_step(survival_km *k, long d, long c)
 {
 	long n = k->at_risk;
 	if (d > 0 && n > 0) {
 		k->s *= 1.0 - (double)d / (double)n;
 		/* d = n takes S to 0, where the variance is 0 and the sum is
-		 * no longer used (survival_km_interval) */
+		 * no longer used (bsim_survival_km_interval) */
 		if (n > d)
 			k->greenwood += (double)d / ((double)n * (double)(n - d));
 	}
 	k->at_risk = n - d - c;
 }
 
-void survival_km_interval(const survival_km *k, double z, double *lo, double *hi)
+void bsim_survival_km_interval(const survival_km *k, double z, double *lo, double *hi)
 {
 	if (k->s >= 1.0 || k->s <= 0.0) {
 		*lo = *hi = k->s;
@@ -52,7 +52,7 @@ static double chisq_quantile(double p, double nu)
 	return nu * c * c * c;
 }
 
-void survival_rate(long events, double exposure, double *rate, double *lo, double *hi)
+void bsim_survival_rate(long events, double exposure, double *rate, double *lo, double *hi)
 {
 	if (!(exposure > 0.0)) {
 		*rate = NAN;

@@ -22,22 +22,22 @@ typedef struct survival_km {
 } survival_km;
 
 /* A curve of n trials, S = 1. */
-void survival_km_start(survival_km *k, long n);
+void bsim_survival_km_start(survival_km *k, long n);
 
 /* At one time: d events, then c censored. */
-void survival_km_step(survival_km *k, long d, long c);
+void bsim_survival_km_step(survival_km *k, long d, long c);
 
 /* The pointwise interval of S at confidence z (1.96: 95%) from Greenwood's
  * variance on the log(-log S) scale (Kalbfleisch and Prentice), which
  * stays inside [0, 1]: S^exp(+-z sigma), sigma = sqrt(greenwood) / |ln S|.
  * S = 1 (no event yet) gives [1, 1], S = 0 gives [0, 0]. */
-void survival_km_interval(const survival_km *k, double z, double *lo, double *hi);
+void bsim_survival_km_interval(const survival_km *k, double z, double *lo, double *hi);
 
 /* The maximum-likelihood rate of an exponential time to event with
  * censoring, events / exposure (1/s; exposure the summed time at risk, s),
  * and its exact (Garwood) 95% interval from the chi-square quantiles of the
  * Poisson count: [chi2(0.025; 2d) / 2T, chi2(0.975; 2d + 2) / 2T]. No
  * exposure gives rate NaN, [0, inf]. */
-void survival_rate(long events, double exposure, double *rate, double *lo, double *hi);
+void bsim_survival_rate(long events, double exposure, double *rate, double *lo, double *hi);
 
 #endif

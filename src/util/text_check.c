@@ -60,7 +60,7 @@ static int fault_at(text_fault *f, int line, int col, const char *fmt, ...)
 	return 0;
 }
 
-int text_check(const char *buf, size_t len, text_fault *fault)
+int bsim_text_check(const char *buf, size_t len, text_fault *fault)
 {
 	const unsigned char *s = (const unsigned char *)buf;
 	int line = 1, col = 1, quotes = 0;
@@ -104,7 +104,7 @@ int text_check(const char *buf, size_t len, text_fault *fault)
 	return 1;
 }
 
-size_t text_strip_cr(char *buf, size_t len)
+size_t bsim_text_strip_cr(char *buf, size_t len)
 {
 	size_t out = 0;
 	for (size_t i = 0; i < len; i++)
@@ -113,7 +113,7 @@ size_t text_strip_cr(char *buf, size_t len)
 	return out;
 }
 
-void text_escape(char *buf, size_t size)
+void bsim_text_escape(char *buf, size_t size)
 {
 	size_t len = strlen(buf), clean = 0;
 	uint32_t cp;
@@ -152,7 +152,7 @@ void text_escape(char *buf, size_t size)
 	free(copy);
 }
 
-void text_shell_word(FILE *f, const char *s)
+void bsim_text_shell_word(FILE *f, const char *s)
 {
 	if (*s && strspn(s, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789"
 	                    "_-+=.,/:@%") == strlen(s)) {

@@ -19,21 +19,21 @@ typedef struct text_fault {
 } text_fault;
 
 /* 1 if buf[0..len) is clean text, else 0 with *fault filled. */
-int text_check(const char *buf, size_t len, text_fault *fault);
+int bsim_text_check(const char *buf, size_t len, text_fault *fault);
 
-/* Drops the CR of every CRLF in place (after text_check, which allows CR
+/* Drops the CR of every CRLF in place (after bsim_text_check, which allows CR
  * only there); returns the new length. Line numbers do not change. */
-size_t text_strip_cr(char *buf, size_t len);
+size_t bsim_text_strip_cr(char *buf, size_t len);
 
 /* Rewrites the NUL-terminated buf (of capacity size) in place so that it
  * is one line of printable UTF-8: control characters and bytes that are not
  * UTF-8 become \xNN, cut to fit. Error messages quote what the user wrote,
  * and a terminal must not interpret it. */
-void text_escape(char *buf, size_t size);
+void bsim_text_escape(char *buf, size_t size);
 
 /* s written to f as one word for a POSIX shell: as it is if it is made of
  * safe characters, else in single quotes with each ' written as '\''
  * (replay and resume lines a user pastes back). */
-void text_shell_word(FILE *f, const char *s);
+void bsim_text_shell_word(FILE *f, const char *s);
 
 #endif

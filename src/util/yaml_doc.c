@@ -154,14 +154,14 @@ static parse_kind parse_checked(ydoc *d, char *text, size_t len, parse_fault *pf
 {
 	memset(pf, 0, sizeof *pf);
 	text_fault tf;
-	if (!text_check(text, len, &tf)) {
+	if (!bsim_text_check(text, len, &tf)) {
 		free(text);
 		pf->line = tf.line;
 		pf->col = tf.col;
 		snprintf(pf->what, sizeof pf->what, "%s", tf.what);
 		return pf->kind = PF_TEXT;
 	}
-	len = text_strip_cr(text, len);
+	len = bsim_text_strip_cr(text, len);
 	first_error fe;
 	int more = 0;
 	d->fyd = parse_quiet(text, len, &fe, &more);
@@ -172,7 +172,7 @@ static parse_kind parse_checked(ydoc *d, char *text, size_t len, parse_fault *pf
 		return pf->kind = PF_SYNTAX;
 	}
 	if (more) {
-		ydoc_free(d);
+		bsim_ydoc_free(d);
 		return pf->kind = PF_MORE;
 	}
 	struct fy_node *alias =
@@ -184,7 +184,7 @@ static parse_kind parse_checked(ydoc *d, char *text, size_t len, parse_fault *pf
 			pf->alias_line++;
 			pf->alias_col++;
 		}
-		ydoc_free(d);
+		bsim_ydoc_free(d);
 		return pf->kind = PF_ALIAS;
 	}
 	return PF_OK;
@@ -241,18 +241,18 @@ static int load(ydoc *d, const char *path, double max_bytes, const char *limit_n
 	memset(d, 0, sizeof *d);
 	d->path = path;
 	file_text f;
-	int rc = file_read(path, "a YAML file", max_bytes, limit_name, &f, err);
+	int rc = bsim_file_read(path, "a YAML file", max_bytes, limit_name, &f, err);
 	if (rc != BSIM_OK)
 		return rc;
 	return load_parsed(d, path, f.text, f.len, err);
 }
 
-int ydoc_load(ydoc *d, const char *path, bsim_error *err)
+int bsim_ydoc_load(ydoc *d, const char *path, bsim_error *err)
 {
 	return load(d, path, bsim_limits_get()->input_bytes, "input_bytes", err);
 }
 
-int ydoc_load_text(ydoc *d, const char *path, const char *text, size_t len, bsim_error *err)
+int bsim_ydoc_load_text(ydoc *d, const char *path, const char *text, size_t len, bsim_error *err)
 {
 	memset(d, 0, sizeof *d);
 	d->path = path;
@@ -264,7 +264,7 @@ int ydoc_load_text(ydoc *d, const char *path, const char *text, size_t len, bsim
 	return load_parsed(d, path, copy, len, err);
 }
 
-int ydoc_load_own(ydoc *d, const char *path, bsim_error *err)
+int bsim_ydoc_load_own(ydoc *d, const char *path, bsim_error *err)
 {
 	return load(d, path, INFINITY, NULL, err);
 }
@@ -283,18 +283,18 @@ static void alias_fault(struct fy_event *ev, parse_fault *pf)
 	pf->alias_col = m ? m->column + 1 : 0;
 }
 
-int ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text, bsim_error *err)
+int bsim_ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text, bsim_error *err)
 {
 	if (text)
 		*text = NULL;
 	file_text f;
-	int rc = file_read(path, "a YAML file", INFINITY, NULL, &f, err);
+	int rc = bsim_file_read(path, "a YAML file", INFINITY, NULL, &f, err);
 	if (rc != BSIM_OK)
 		return rc;
 	parse_fault pf;
 	memset(&pf, 0, sizeof pf);
 	text_fault tf;
-	if (!text_check(f.text, f.len, &tf)) {
+	if (!bsim_text_check(f.text, f.len, &tf)) {
 		free(f.text);
 		pf.kind = PF_TEXT;
 		pf.line = tf.line;
@@ -302,7 +302,7 @@ int ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text,
 		snprintf(pf.what, sizeof pf.what, "%s", tf.what);
 		return fault_error(path, &pf, err);
 	}
-	f.len = text_strip_cr(f.text, f.len);
+	f.len = bsim_text_strip_cr(f.text, f.len);
 	f.text[f.len] = '\0';
 	struct fy_diag *diag = quiet_diag();
 	struct fy_parse_cfg cfg;
@@ -352,7 +352,7 @@ int ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text,
 	return rc;
 }
 
-struct fy_document *ydoc_parse_text(const char *text, char *msg, size_t size)
+struct fy_document *bsim_ydoc_parse_text(const char *text, char *msg, size_t size)
 {
 	size_t len = strlen(text);
 	double limit = bsim_limits_get()->input_bytes;
@@ -395,14 +395,14 @@ struct fy_document *ydoc_parse_text(const char *text, char *msg, size_t size)
 		snprintf(msg, size, "no value");
 	return d.fyd;
 }
-void ydoc_free(ydoc *d)
+void bsim_ydoc_free(ydoc *d)
 {
 	if (d->fyd)
 		fy_document_destroy(d->fyd);
 	d->fyd = NULL;
 }
 
-const bsim_override *ydoc_origin(struct fy_node *n)
+const bsim_override *bsim_ydoc_origin(struct fy_node *n)
 {
 	/* Only nodes an override inserted carry meta (a pointer to its
 	 * bsim_override); their descendants find it through their parents. */
@@ -444,13 +444,13 @@ static void origin_text(const bsim_override *o, char *buf, size_t size)
 		snprintf(buf, size, "--set %s=%s", o->key ? o->key : "", o->value ? o->value : "");
 }
 
-void ydoc_where(const ydoc *d, struct fy_node *n, struct fy_node *alt, char *buf, size_t size)
+void bsim_ydoc_where(const ydoc *d, struct fy_node *n, struct fy_node *alt, char *buf, size_t size)
 {
 	/* Keys have no parent in libfyaml: a key an override brought in finds
 	 * its origin through alt (its mapping). */
-	const bsim_override *o = ydoc_origin(n);
+	const bsim_override *o = bsim_ydoc_origin(n);
 	if (!o)
-		o = ydoc_origin(alt);
+		o = bsim_ydoc_origin(alt);
 	if (o) {
 		origin_text(o, buf, size);
 		return;
@@ -461,13 +461,13 @@ void ydoc_where(const ydoc *d, struct fy_node *n, struct fy_node *alt, char *buf
 	snprintf(buf, size, "%s:%d:%d", d->path, line + 1, col + 1);
 }
 
-void ydoc_join(char *buf, size_t size, const char *a, const char *b)
+void bsim_ydoc_join(char *buf, size_t size, const char *a, const char *b)
 {
 	if (snprintf(buf, size, "%s%s", a, b) < 0)
 		buf[0] = '\0';
 }
 
-int ydoc_line(struct fy_node *n, struct fy_node *alt)
+int bsim_ydoc_line(struct fy_node *n, struct fy_node *alt)
 {
 	int line = 0, col = 0;
 	if (node_mark(n, &line, &col) || node_mark(alt, &line, &col))
@@ -475,11 +475,11 @@ int ydoc_line(struct fy_node *n, struct fy_node *alt)
 	return 0;
 }
 
-int ydoc_fail(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
+int bsim_ydoc_fail(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
               bsim_error *err, const char *fmt, ...)
 {
 	char where[512], what[512];
-	ydoc_where(d, n, alt, where, sizeof where);
+	bsim_ydoc_where(d, n, alt, where, sizeof where);
 	va_list ap;
 	va_start(ap, fmt);
 	vsnprintf(what, sizeof what, fmt, ap);
@@ -487,23 +487,23 @@ int ydoc_fail(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char 
 	return bsim_error_set(err, BSIM_EINPUT, "%s: %s: %s", where, field, what);
 }
 
-int ydoc_expected(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
+int bsim_ydoc_expected(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
                   const char *what, bsim_error *err)
 {
 	char got[128];
-	ydoc_describe(n, got, sizeof got);
-	return ydoc_fail(d, n, alt, field, err, "expected %s, got %s", what, got);
+	bsim_ydoc_describe(n, got, sizeof got);
+	return bsim_ydoc_fail(d, n, alt, field, err, "expected %s, got %s", what, got);
 }
 
-int ydoc_is_null(struct fy_node *n)
+int bsim_ydoc_is_null(struct fy_node *n)
 {
 	return !n || (fy_node_is_scalar(n) && fy_node_get_style(n) == FYNS_PLAIN &&
 	              fy_node_get_scalar_length(n) == 0);
 }
 
-void ydoc_describe(struct fy_node *n, char *buf, size_t size)
+void bsim_ydoc_describe(struct fy_node *n, char *buf, size_t size)
 {
-	if (ydoc_is_null(n)) {
+	if (bsim_ydoc_is_null(n)) {
 		snprintf(buf, size, "nothing");
 	} else if (fy_node_is_mapping(n)) {
 		int k = fy_node_mapping_item_count(n);
@@ -525,7 +525,7 @@ void ydoc_describe(struct fy_node *n, char *buf, size_t size)
 	}
 }
 
-const char *ydoc_plain(struct fy_node *n)
+const char *bsim_ydoc_plain(struct fy_node *n)
 {
 	if (!n || !fy_node_is_scalar(n) || fy_node_get_style(n) != FYNS_PLAIN)
 		return NULL;
@@ -544,12 +544,12 @@ static int yaml_nonfinite(const char *t)
 	return strlen(t) == 4 && (!strcmp(low, ".inf") || !strcmp(low, ".nan"));
 }
 
-int ydoc_number(struct fy_node *n, double *out)
+int bsim_ydoc_number(struct fy_node *n, double *out)
 {
-	return ydoc_number_text(ydoc_plain(n), out);
+	return bsim_ydoc_number_text(bsim_ydoc_plain(n), out);
 }
 
-int ydoc_number_text(const char *t, double *out)
+int bsim_ydoc_number_text(const char *t, double *out)
 {
 	if (!t || !*t)
 		return YDOC_NUM_NONE;
@@ -557,7 +557,7 @@ int ydoc_number_text(const char *t, double *out)
 		return YDOC_NUM_NONFINITE;
 	char *end = NULL;
 	double v = strtod(t, &end);
-	if (end == t || *end != '\0' || isspace((unsigned char)*t) || decimal_other_base(t))
+	if (end == t || *end != '\0' || isspace((unsigned char)*t) || bsim_decimal_other_base(t))
 		return YDOC_NUM_NONE;
 	if (!isfinite(v))
 		return YDOC_NUM_NONFINITE; /* "nan", "inf", or an overflow like 1e999 */
@@ -572,7 +572,7 @@ static int parse_decimal(const char *t, int *neg, uint64_t *mag)
 	*neg = 0;
 	if (*t == '+' || *t == '-')
 		*neg = *t++ == '-';
-	if (!isdigit((unsigned char)*t) || decimal_other_base(t))
+	if (!isdigit((unsigned char)*t) || bsim_decimal_other_base(t))
 		return 0;
 	uint64_t v = 0;
 	for (; isdigit((unsigned char)*t); t++) {
@@ -585,9 +585,9 @@ static int parse_decimal(const char *t, int *neg, uint64_t *mag)
 	return *t == '\0';
 }
 
-int ydoc_int64(struct fy_node *n, long long *out)
+int bsim_ydoc_int64(struct fy_node *n, long long *out)
 {
-	const char *t = ydoc_plain(n);
+	const char *t = bsim_ydoc_plain(n);
 	int neg;
 	uint64_t mag;
 	if (!t || !parse_decimal(t, &neg, &mag) || mag > (uint64_t)INT64_MAX)
@@ -596,9 +596,9 @@ int ydoc_int64(struct fy_node *n, long long *out)
 	return 1;
 }
 
-int ydoc_uint64(struct fy_node *n, uint64_t *out)
+int bsim_ydoc_uint64(struct fy_node *n, uint64_t *out)
 {
-	const char *t = ydoc_plain(n);
+	const char *t = bsim_ydoc_plain(n);
 	int neg;
 	uint64_t mag;
 	if (!t || !parse_decimal(t, &neg, &mag) || (neg && mag != 0))
@@ -607,7 +607,7 @@ int ydoc_uint64(struct fy_node *n, uint64_t *out)
 	return 1;
 }
 
-int ydoc_uint64_text(struct fy_node *n, uint64_t *out)
+int bsim_ydoc_uint64_text(struct fy_node *n, uint64_t *out)
 {
 	if (!n || !fy_node_is_scalar(n))
 		return 0;
@@ -620,7 +620,7 @@ int ydoc_uint64_text(struct fy_node *n, uint64_t *out)
 	return 1;
 }
 
-int ydoc_index(const char *comp, size_t len, int *out)
+int bsim_ydoc_index(const char *comp, size_t len, int *out)
 {
 	if (len == 0 || len > 9)
 		return 0;
@@ -636,7 +636,7 @@ int ydoc_index(const char *comp, size_t len, int *out)
 
 /* libfyaml's lookup_by_string parses the key as YAML (and may complain
  * about it); a key from a dotted path is plain text, so compare text. */
-struct fy_node_pair *ydoc_pair(struct fy_node *map, const char *comp, size_t len)
+struct fy_node_pair *bsim_ydoc_pair(struct fy_node *map, const char *comp, size_t len)
 {
 	void *it = NULL;
 	struct fy_node_pair *p;
@@ -650,24 +650,24 @@ struct fy_node_pair *ydoc_pair(struct fy_node *map, const char *comp, size_t len
 	return NULL;
 }
 
-struct fy_node *ydoc_child(struct fy_node *n, const char *comp, size_t len)
+struct fy_node *bsim_ydoc_child(struct fy_node *n, const char *comp, size_t len)
 {
 	if (n && fy_node_is_mapping(n)) {
-		struct fy_node_pair *p = ydoc_pair(n, comp, len);
+		struct fy_node_pair *p = bsim_ydoc_pair(n, comp, len);
 		return p ? fy_node_pair_value(p) : NULL;
 	}
 	int i;
-	if (n && fy_node_is_sequence(n) && ydoc_index(comp, len, &i))
+	if (n && fy_node_is_sequence(n) && bsim_ydoc_index(comp, len, &i))
 		return fy_node_sequence_get_by_index(n, i);
 	return NULL;
 }
 
-struct fy_node *ydoc_lookup(struct fy_node *root, const char *path)
+struct fy_node *bsim_ydoc_lookup(struct fy_node *root, const char *path)
 {
 	struct fy_node *n = root;
 	while (n && *path) {
 		size_t len = strcspn(path, ".");
-		n = ydoc_child(n, path, len);
+		n = bsim_ydoc_child(n, path, len);
 		path += len;
 		if (*path == '.')
 			path++;
@@ -675,9 +675,9 @@ struct fy_node *ydoc_lookup(struct fy_node *root, const char *path)
 	return n;
 }
 
-char *ydoc_flow_text(struct fy_node *n)
+char *bsim_ydoc_flow_text(struct fy_node *n)
 {
-	const char *t = ydoc_plain(n);
+	const char *t = bsim_ydoc_plain(n);
 	if (t) {
 		char *copy = malloc(strlen(t) + 1);
 		if (copy)

@@ -82,7 +82,7 @@ static int key_trim(const char *key, char *buf, size_t size)
 static int step_mapping(ydoc *d, slot *s, const char *comp, size_t len, struct fy_node *value,
                         const bsim_override *o)
 {
-	struct fy_node_pair *p = ydoc_pair(s->node, comp, len);
+	struct fy_node_pair *p = bsim_ydoc_pair(s->node, comp, len);
 	if (!p) {
 		struct fy_node *k = fy_node_create_scalar_copy(d->fyd, comp, len);
 		struct fy_node *v = value ? value : fy_node_create_mapping(d->fyd);
@@ -97,7 +97,7 @@ static int step_mapping(ydoc *d, slot *s, const char *comp, size_t len, struct f
 				fy_node_free(v);
 			return -1;
 		}
-		p = ydoc_pair(s->node, comp, len);
+		p = bsim_ydoc_pair(s->node, comp, len);
 		*s = (slot){v, p, NULL};
 		return 0;
 	}
@@ -112,7 +112,7 @@ static int step_list(ydoc *d, slot *s, const char *comp, size_t len, struct fy_n
 	int i = -1;
 	int count = fy_node_sequence_item_count(s->node);
 	char what[256];
-	if (!ydoc_index(comp, len, &i) || i >= count) {
+	if (!bsim_ydoc_index(comp, len, &i) || i >= count) {
 		if (count == 0)
 			snprintf(what, sizeof what,
 			         "expected an index into a list, got %.*s (the list is empty)",
@@ -136,7 +136,7 @@ static int place(ydoc *d, const bsim_override *o, const char *key, struct fy_nod
 		size_t len = strcspn(c, ".");
 		struct fy_node *v = c[len] ? NULL : value;
 		int rc;
-		if (ydoc_is_null(s.node)) {
+		if (bsim_ydoc_is_null(s.node)) {
 			/* "effects:" with nothing under it is an empty mapping. */
 			struct fy_node *map = fy_node_create_mapping(d->fyd);
 			if (!map || replace(d, &s, map))
@@ -151,7 +151,7 @@ static int place(ydoc *d, const bsim_override *o, const char *key, struct fy_nod
 				return rc;
 		} else {
 			char what[256], got[96];
-			ydoc_describe(s.node, got, sizeof got);
+			bsim_ydoc_describe(s.node, got, sizeof got);
 			snprintf(what, sizeof what, "expected a mapping or list at %.*s, got %s",
 			         (int)(c - key - 1), key, got);
 			return fail(o, key, (int)strlen(key), err, what);
@@ -175,7 +175,7 @@ static int apply_one(ydoc *d, const bsim_override *o, bsim_error *err)
 		return fail(o, k, (int)strlen(k), err, what);
 	}
 	char msg[400], what[600];
-	struct fy_document *vd = ydoc_parse_text(o->value, msg, sizeof msg);
+	struct fy_document *vd = bsim_ydoc_parse_text(o->value, msg, sizeof msg);
 	if (!vd || !fy_document_root(vd)) {
 		if (vd)
 			fy_document_destroy(vd);
@@ -196,7 +196,7 @@ static int apply_one(ydoc *d, const bsim_override *o, bsim_error *err)
 	return rc;
 }
 
-int yov_apply(ydoc *d, const bsim_override *ov, int n, bsim_error *err)
+int bsim_yov_apply(ydoc *d, const bsim_override *ov, int n, bsim_error *err)
 {
 	struct fy_node *root = fy_document_root(d->fyd);
 	if (!root || !fy_node_is_mapping(root))

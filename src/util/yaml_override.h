@@ -12,6 +12,6 @@
  * out of range or a path through a scalar is BSIM_EINPUT naming the
  * override. A document whose root is not a mapping is left alone (the
  * loader reports it). */
-int yov_apply(ydoc *d, const bsim_override *ov, int n, bsim_error *err);
+int bsim_yov_apply(ydoc *d, const bsim_override *ov, int n, bsim_error *err);
 
 #endif

@@ -66,7 +66,7 @@ static video_trail *trail_at(video_panel *pn, double s)
 	return t;
 }
 
-int video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scene,
+int bsim_video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scene,
                 const char *const *labels, int n_panels, bsim_error *err)
 {
 	int rc = bsim_video_def_check(def, err);
@@ -103,7 +103,7 @@ int video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scen
 		if (!v->entered)
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
 	}
-	video_field_bounds(scene, v->field);
+	bsim_video_field_bounds(scene, v->field);
 	v->k_min = scene->n_beams ? scene->beams[0].stiffness : 0.0;
 	v->k_max = v->k_min;
 	for (int i = 1; i < scene->n_beams; i++) {
@@ -115,7 +115,7 @@ int video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scen
 	double s_main[BSIM_VIDEO_PANELS_MAX], s_over[BSIM_VIDEO_PANELS_MAX];
 	int over[BSIM_VIDEO_PANELS_MAX];
 	for (int p = 0; p < n_panels; p++)
-		over[p] = video_panel_scales(v, p, &s_main[p], &s_over[p]);
+		over[p] = bsim_video_panel_scales(v, p, &s_main[p], &s_over[p]);
 	for (int q = 0; q < n_panels; q++) {
 		video_panel *pn = &v->panels[q];
 		for (int j = 0; j < n_panels; j++)
@@ -125,16 +125,16 @@ int video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scen
 	return BSIM_OK;
 }
 
-int video_panel_trail_add(bsim_video *v, int p, long step, const double x[2])
+int bsim_video_panel_trail_add(bsim_video *v, int p, long step, const double x[2])
 {
 	video_panel *pn = &v->panels[p];
 	for (int i = 0; i < pn->n_own; i++)
-		if (video_trail_add(&pn->own[i], step, x))
+		if (bsim_video_trail_add(&pn->own[i], step, x))
 			return -1;
 	return 0;
 }
 
-void video_teardown(bsim_video *v)
+void bsim_video_teardown(bsim_video *v)
 {
 	if (!v)
 		return;
@@ -144,12 +144,12 @@ void video_teardown(bsim_video *v)
 		cairo_surface_destroy(v->surface);
 	for (int p = 0; p < v->n_panels; p++)
 		for (int i = 0; i < v->panels[p].n_own; i++)
-			video_trail_free(&v->panels[p].own[i]);
+			bsim_video_trail_free(&v->panels[p].own[i]);
 	free(v->entered);
 	free(v);
 }
 
-int video_scene_check(const bsim_scene *scene, bsim_error *err)
+int bsim_video_scene_check(const bsim_scene *scene, bsim_error *err)
 {
 	if (scene->body.shape == BSIM_SHAPE_DISK)
 		return BSIM_OK;
@@ -165,7 +165,7 @@ int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
                      bsim_video **out, bsim_error *err)
 {
 	*out = NULL;
-	if (video_scene_check(scene, err) != BSIM_OK)
+	if (bsim_video_scene_check(scene, err) != BSIM_OK)
 		return BSIM_EINPUT;
 	bsim_video *v = calloc(1, sizeof *v);
 	if (!v)
@@ -177,14 +177,14 @@ int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
 		pn->track = t;
 		pn->result = bsim_video_track_result(t);
 		pn->frames = bsim_video_track_frames(t);
-		video_track_trail(t, &n);
+		bsim_video_track_trail(t, &n);
 		pn->last_step = n - 1;
-		pn->visits = video_track_visits(t, &pn->n_visits);
-		pn->random_axis = video_track_random_axis(t);
+		pn->visits = bsim_video_track_visits(t, &pn->n_visits);
+		pn->random_axis = bsim_video_track_random_axis(t);
 	}
-	int rc = video_setup(v, def, scene, labels, n_panels, err);
+	int rc = bsim_video_setup(v, def, scene, labels, n_panels, err);
 	if (rc != BSIM_OK) {
-		video_teardown(v);
+		bsim_video_teardown(v);
 		return rc;
 	}
 	/* Side by side, each panel parts from the first; the first from the
@@ -200,10 +200,10 @@ int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
 	/* The trails, thinned as a stream thins them. */
 	for (int p = 0; p < n_panels; p++) {
 		long n;
-		const double *xy = video_track_trail(tracks[p], &n);
+		const double *xy = bsim_video_track_trail(tracks[p], &n);
 		for (long i = 0; i < n; i++)
-			if (video_panel_trail_add(v, p, i, xy + 2 * i)) {
-				video_teardown(v);
+			if (bsim_video_panel_trail_add(v, p, i, xy + 2 * i)) {
+				bsim_video_teardown(v);
 				return bsim_error_set(err, BSIM_EFAIL, "out of memory for a video");
 			}
 	}
@@ -213,7 +213,7 @@ int bsim_video_alloc(const bsim_video_def *def, const bsim_scene *scene,
 
 void bsim_video_free(bsim_video *v)
 {
-	video_teardown(v);
+	bsim_video_teardown(v);
 }
 
 long bsim_video_frames(const bsim_video *v)
@@ -233,7 +233,7 @@ int bsim_video_render(bsim_video *v, long k, uint32_t *pixels, bsim_error *err)
 		return bsim_error_set(err, BSIM_EINPUT, "frame %ld: the video has frames 0 to %ld",
 		                      k, v->frames - 1);
 	/* The hold repeats the last simulated frame. */
-	int rc = video_render_frame(v, k < v->frames_sim ? k : v->frames_sim - 1, err);
+	int rc = bsim_video_render_frame(v, k < v->frames_sim ? k : v->frames_sim - 1, err);
 	if (rc != BSIM_OK)
 		return rc;
 	cairo_surface_t *sf = v->surface;

@@ -21,7 +21,7 @@
 
 #include "video/video_internal.h"
 
-void video_field_bounds(const bsim_scene *s, double field[4])
+void bsim_video_field_bounds(const bsim_scene *s, double field[4])
 {
 	const double r = s->body.radius;
 	double x0 = s->body.start[0] - r, x1 = s->body.start[0] + r;
@@ -61,7 +61,7 @@ static double axis_centre(double lo, double hi, double half, double body, double
 	return c;
 }
 
-void video_view_make(const double field[4], double view_span, double x0, double y0, double w,
+void bsim_video_view_make(const double field[4], double view_span, double x0, double y0, double w,
                      double h, const double body[2], double r, video_view *out)
 {
 	const double fw = field[2] - field[0], fh = field[3] - field[1];
@@ -76,7 +76,7 @@ void video_view_make(const double field[4], double view_span, double x0, double 
 	out->c[1] = axis_centre(field[1], field[3], 0.5 * h / out->scale, body[1], r);
 }
 
-int video_overview_make(const double field[4], const video_view *main, video_view *out)
+int bsim_video_overview_make(const double field[4], const video_view *main, video_view *out)
 {
 	const double fw = field[2] - field[0], fh = field[3] - field[1];
 	const double s_fit = fmin(main->w / fw, main->h / fh);

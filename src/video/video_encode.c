@@ -105,7 +105,7 @@ static void remove_stale(const char *path)
 static void describe_status(bsim_video_encoder *e, char *buf, size_t n)
 {
 	char last[320];
-	program_log_line(e->log, 0, last, sizeof last);
+	bsim_program_log_line(e->log, 0, last, sizeof last);
 	int k;
 	if (WIFEXITED(e->status))
 		k = snprintf(buf, n, "%s exited with status %d", e->program,
@@ -247,7 +247,7 @@ int bsim_video_encoder_open(const char *path, const char *program, int width, in
 		free(e);
 		return rc;
 	}
-	e->log = program_log_open();
+	e->log = bsim_program_log_open();
 	int fds[2] = {-1, -1};
 	if (!e->log || pipe(fds) != 0 || set_cloexec(fds[0]) || set_cloexec(fds[1])) {
 		rc = bsim_error_set(err, BSIM_EFAIL, "cannot make a pipe to %s: %s", e->program,
@@ -321,7 +321,7 @@ int bsim_video_encoder_write(bsim_video_encoder *e, const uint32_t *pixels, bsim
  * its exit status; a message at -loglevel error, which is an error
  * although the status is 0 (ffmpeg 5.1 exits with 0 after "Error writing
  * trailer": the index of the MP4 is missing); and, for a regular file, the
- * file itself (video_mp4_whole). */
+ * file itself (bsim_video_mp4_whole). */
 static void encoder_verdict(bsim_video_encoder *e, char *why, size_t n)
 {
 	char first[320];
@@ -330,7 +330,7 @@ static void encoder_verdict(bsim_video_encoder *e, char *why, size_t n)
 	/* At -loglevel error ffmpeg writes errors alone, the first the cause
 	 * ("Error writing trailer of ...: No space left on device"), those
 	 * after it what followed ("Error closing file ..."). */
-	program_log_line(e->log, 0, first, sizeof first);
+	bsim_program_log_line(e->log, 0, first, sizeof first);
 	if (e->status != 0) {
 		describe_status(e, why, n);
 		return;
@@ -342,7 +342,7 @@ static void encoder_verdict(bsim_video_encoder *e, char *why, size_t n)
 	const char *file = e->out.mode == BSIM_ATOMIC_RENAME ? e->out.tmp : e->path;
 	char cut[400];
 	if (e->out.mode != BSIM_ATOMIC_STDOUT && stat(file, &st) == 0 && S_ISREG(st.st_mode) &&
-	    video_mp4_whole(file, cut, sizeof cut) != 0)
+	    bsim_video_mp4_whole(file, cut, sizeof cut) != 0)
 		snprintf(why, n, "%s exited with status 0 but the MP4 is not whole: %s", e->program,
 		         cut);
 }

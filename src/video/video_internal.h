@@ -46,8 +46,8 @@ typedef struct video_trail {
 
 /* Adds the centre after step `step` (steps in order, from 0). 0, or -1 if
  * memory runs out. */
-int video_trail_add(video_trail *t, long step, const double x[2]);
-void video_trail_free(video_trail *t);
+int bsim_video_trail_add(video_trail *t, long step, const double x[2]);
+void bsim_video_trail_free(video_trail *t);
 
 /* The body centre after step n and its step, kept by a streamed panel for
  * a step a later frame draws up to (another panel's last step). */
@@ -101,22 +101,22 @@ struct bsim_video {
  * result, frames, last step, visits and random axis already set; makes the
  * rest: frame count, field, colour scale, the trails' lists at the views'
  * scales (empty). t_part and part_x are the caller's. */
-int video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scene,
+int bsim_video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scene,
                 const char *const *labels, int n_panels, bsim_error *err);
-/* Frees what video_setup made and v itself. */
-void video_teardown(bsim_video *v);
+/* Frees what bsim_video_setup made and v itself. */
+void bsim_video_teardown(bsim_video *v);
 
 /* Adds the centre after step `step` of panel p to each of its trails;
  * -1 if memory runs out. */
-int video_panel_trail_add(bsim_video *v, int p, long step, const double x[2]);
+int bsim_video_panel_trail_add(bsim_video *v, int p, long step, const double x[2]);
 
 /* The gate path of a track, in order (n = 0: none). */
-const video_gate_visit *video_track_visits(const bsim_video_track *t, int *n);
+const video_gate_visit *bsim_video_track_visits(const bsim_video_track *t, int *n);
 
 /* The body centre after every step of a track: 2 n doubles. */
-const double *video_track_trail(const bsim_video_track *t, long *n);
+const double *bsim_video_track_trail(const bsim_video_track *t, long *n);
 /* The body axis the random force acts along (0 = x). */
-int video_track_random_axis(const bsim_video_track *t);
+int bsim_video_track_random_axis(const bsim_video_track *t);
 
 /* The state a frame keeps besides the beams' angles and contacts. */
 typedef struct video_frame {
@@ -126,47 +126,47 @@ typedef struct video_frame {
 } video_frame;
 
 /* The step frame k shows, before the trial's end: floor(k / (fps h)). */
-long video_frame_step(double fps, double dt, long k);
+long bsim_video_frame_step(double fps, double dt, long k);
 /* The frames of a trial whose last step is n_last: ceil(n_last h fps) + 1. */
-long video_frame_count(double fps, double dt, long n_last);
+long bsim_video_frame_count(double fps, double dt, long n_last);
 /* The frame of the state s after step `step`: its energies (as
  * video_track.c says), its beams' angles (float) and contacts, and the
  * random force fx applies over the next step. */
-void video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const bsim_state *s,
+void bsim_video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const bsim_state *s,
                       video_frame *f, float *theta, unsigned char *contact);
 
 /* Pass 1 of a stream (video_stream.c): runs the trial as
  * bsim_video_track_record does but keeps only its result, its frame count
- * and its gate path; its effect pipeline (video_track_effects) is the
+ * and its gate path; its effect pipeline (bsim_video_track_effects) is the
  * one a second run of the trial takes its frames' forces from. */
-int video_track_summary(const bsim_scene *scene, const bsim_backend *backend,
+int bsim_video_track_summary(const bsim_scene *scene, const bsim_backend *backend,
                         const bsim_options *opts, uint64_t seed, double fps, bsim_video_track **out,
                         bsim_error *err);
-bsim_effects *video_track_effects(bsim_video_track *t);
+bsim_effects *bsim_video_track_effects(bsim_video_track *t);
 
 /* The field's bounding box: every beam's reach (pivot +- length), the
  * body at its start, the side boundaries and the success and
  * classification lines, with half a body radius around. */
-void video_field_bounds(const bsim_scene *s, double field[4]);
+void bsim_video_field_bounds(const bsim_scene *s, double field[4]);
 
 /* The view of panel rectangle (x0, y0, w, h) on the field: the whole
  * field if it fits with the shorter side spanning at most view_span
  * metres, else that scale with the camera on the body (radius r), kept
  * inside the field along each axis where the field is larger than the
  * view, and always keeping the whole body in view. */
-void video_view_make(const double field[4], double view_span, double x0, double y0, double w,
+void bsim_video_view_make(const double field[4], double view_span, double x0, double y0, double w,
                      double h, const double body[2], double r, video_view *out);
 
 /* The overview of a panel whose camera follows the body (the field is
  * larger than the view): the whole field at a small scale in the view's
  * bottom-right corner. 0 if the view shows the whole field (no overview). */
-int video_overview_make(const double field[4], const video_view *main, video_view *out);
+int bsim_video_overview_make(const double field[4], const video_view *main, video_view *out);
 
 /* The view of panel p at frame k: its camera on the body of that frame. */
-void video_panel_view(const bsim_video *v, int p, long k, video_view *out);
+void bsim_video_panel_view(const bsim_video *v, int p, long k, video_view *out);
 /* The scale of panel p's view and, if it has one (returns 1), of its
  * overview, px/m: the same in every frame (only the camera moves). */
-int video_panel_scales(const bsim_video *v, int p, double *s_main, double *s_over);
+int bsim_video_panel_scales(const bsim_video *v, int p, double *s_main, double *s_over);
 
 static inline void video_view_pixel(const video_view *v, const double p[2], double px[2])
 {
@@ -183,19 +183,19 @@ static inline bsim_video_sample video_panel_sample(const bsim_video *v, int p, l
 }
 
 /* Draws frame k into v's cairo surface (made on first use). */
-int video_render_frame(bsim_video *v, long k, bsim_error *err);
+int bsim_video_render_frame(bsim_video *v, long k, bsim_error *err);
 
 /* The stiffness colour scale, 0x00RRGGBB: u in [0, 1], 0 the softest. */
-uint32_t video_colormap(double u);
+uint32_t bsim_video_colormap(double u);
 
 /* 0 if the file at path is a whole MP4 (video_mp4.c): its boxes tile it
  * exactly and ftyp (first), moov and mdat are among them; else -1 with why
  * (of size n) saying what is wrong ("its box 'mdat' at byte 48 claims ...",
  * "... has no moov box"). */
-int video_mp4_whole(const char *path, char *why, size_t n);
+int bsim_video_mp4_whole(const char *path, char *why, size_t n);
 
 /* BSIM_OK for a scene the video can draw (a disk), else BSIM_EINPUT with
  * err naming body.shape (video.c). */
-int video_scene_check(const bsim_scene *scene, bsim_error *err);
+int bsim_video_scene_check(const bsim_scene *scene, bsim_error *err);
 
 #endif

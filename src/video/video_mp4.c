@@ -28,7 +28,7 @@ static uint64_t be(const unsigned char *p, int n)
 	return v;
 }
 
-int video_mp4_whole(const char *path, char *why, size_t n)
+int bsim_video_mp4_whole(const char *path, char *why, size_t n)
 {
 	FILE *f = fopen(path, "rb");
 	if (!f) {

@@ -58,7 +58,7 @@ static const unsigned char viridis[9][3] = {
 
 /* The softest beam is light (viridis 0.9, yellow-green, still visible on
  * white) and the stiffest dark (viridis 0). */
-uint32_t video_colormap(double u)
+uint32_t bsim_video_colormap(double u)
 {
 	if (!(u >= 0.0))
 		u = 0.0;
@@ -101,7 +101,7 @@ static uint32_t paled(uint32_t c, double f)
 uint32_t bsim_video_stiffness_color(const bsim_video *v, double k)
 {
 	double span = v->k_max - v->k_min;
-	return video_colormap(span > 0.0 ? (k - v->k_min) / span : 0.5);
+	return bsim_video_colormap(span > 0.0 ? (k - v->k_min) / span : 0.5);
 }
 
 static void set_color(cairo_t *cr, uint32_t c)
@@ -260,7 +260,7 @@ static void draw_gates(cairo_t *cr, const bsim_video *v, const video_view *vw,
 	cairo_set_dash(cr, NULL, 0, 0.0);
 }
 
-/* The overview ov of the whole field (video_overview_make): a lattice's
+/* The overview ov of the whole field (bsim_video_overview_make): a lattice's
  * gates by stiffness, the entered ones in the path colour, or the beams at
  * rest of any other scene; the bounds, the trail, the body as a dot and
  * the main view's rectangle. */
@@ -470,7 +470,7 @@ static void draw_legend(cairo_t *cr, const bsim_video *v, const video_view *vw, 
 	for (int j = 0; j < (int)bar_h; j++) {
 		double u = 1.0 - (j + 0.5) / bar_h;
 		cairo_rectangle(cr, bx, by + j, bar_w, 1.0);
-		set_color(cr, video_colormap(u));
+		set_color(cr, bsim_video_colormap(u));
 		cairo_fill(cr);
 	}
 	set_color(cr, COLOR_TEXT);
@@ -520,27 +520,27 @@ static double font_size(const bsim_video *v)
 	return fmax(11.0, floor(v->height / 40.0));
 }
 
-void video_panel_view(const bsim_video *v, int p, long k, video_view *out)
+void bsim_video_panel_view(const bsim_video *v, int p, long k, video_view *out)
 {
 	const double px0 = (double)(p * v->width / v->n_panels);
 	const double pw = (double)((p + 1) * v->width / v->n_panels) - px0;
 	const double title_h = ceil(2.0 * font_size(v));
 	const bsim_video_sample sm = video_panel_sample(v, p, k);
-	video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h, sm.x,
+	bsim_video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h, sm.x,
 	                v->scene->body.radius, out);
 }
 
-int video_panel_scales(const bsim_video *v, int p, double *s_main, double *s_over)
+int bsim_video_panel_scales(const bsim_video *v, int p, double *s_main, double *s_over)
 {
 	const double px0 = (double)(p * v->width / v->n_panels);
 	const double pw = (double)((p + 1) * v->width / v->n_panels) - px0;
 	const double title_h = ceil(2.0 * font_size(v));
 	video_view vw, ov;
-	video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h,
+	bsim_video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h,
 	                v->scene->body.start, v->scene->body.radius, &vw);
 	*s_main = vw.scale;
 	*s_over = 0.0;
-	if (!video_overview_make(v->field, &vw, &ov))
+	if (!bsim_video_overview_make(v->field, &vw, &ov))
 		return 0;
 	*s_over = ov.scale;
 	return 1;
@@ -554,8 +554,8 @@ int bsim_video_overview_pixel(const bsim_video *v, int panel, long k, const doub
 	if (k >= v->frames_sim)
 		k = v->frames_sim - 1;
 	video_view vw, ov;
-	video_panel_view(v, panel, k, &vw);
-	if (!video_overview_make(v->field, &vw, &ov))
+	bsim_video_panel_view(v, panel, k, &vw);
+	if (!bsim_video_overview_make(v->field, &vw, &ov))
 		return 0;
 	video_view_pixel(&ov, p, px);
 	return 1;
@@ -579,8 +579,8 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	cairo_paint(cr);
 
 	video_view vw, ov;
-	video_panel_view(v, p, k, &vw);
-	const int overview = video_overview_make(v->field, &vw, &ov);
+	bsim_video_panel_view(v, p, k, &vw);
+	const int overview = bsim_video_overview_make(v->field, &vw, &ov);
 	unsigned char *entered = NULL;
 	int cur[2] = {0, 0}, n_entered = 0;
 	if (s->has_lattice) {
@@ -685,7 +685,7 @@ static void draw_panel(cairo_t *cr, const bsim_video *v, int p, long k, double f
 	cairo_restore(cr);
 }
 
-int video_render_frame(bsim_video *v, long k, bsim_error *err)
+int bsim_video_render_frame(bsim_video *v, long k, bsim_error *err)
 {
 	if (!v->surface) {
 		cairo_surface_t *sf =

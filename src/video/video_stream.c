@@ -17,7 +17,7 @@
  * Pass 2 (bsim_video_stream_write) runs them again, one thread a panel, all
  * in step: a panel's trace callback (the runner's, called after every step)
  * collects the centres of the steps since the last frame and, at a frame's
- * step, the frame's state (video_frame_take), hands both to the drawing
+ * step, the frame's state (bsim_video_frame_take), hands both to the drawing
  * thread and goes on to the next frame while that one is drawn; it waits
  * only if the frame before is still not taken. The drawing thread waits for frame k from every
  * panel whose trial has not ended, compares the centres step by step where two panels part
@@ -122,7 +122,7 @@ static void buf_swap(stream_buf *a, stream_buf *b)
 /* The step frame k of a trial ending at n_last shows. */
 static long stream_frame_step(const stream *s, long k, long n_last)
 {
-	long n = video_frame_step(s->fps, s->scene->dt, k);
+	long n = bsim_video_frame_step(s->fps, s->scene->dt, k);
 	return n < n_last ? n : n_last;
 }
 
@@ -169,7 +169,7 @@ static void stream_trace(void *user, long step, const bsim_state *st)
 	/* Several frames fall on one step when fps h > 1. */
 	while (!sp->stopped && sp->k_next < sp->frames &&
 	       stream_frame_step(s, sp->k_next, sp->n_last) == step) {
-		video_frame_take(s->scene, video_track_effects(sp->summary), step, st, &sp->build.f,
+		bsim_video_frame_take(s->scene, bsim_video_track_effects(sp->summary), step, st, &sp->build.f,
 		                 sp->build.theta, sp->build.contact);
 		stream_deliver(sp, step);
 		sp->k_next++;
@@ -243,7 +243,7 @@ static int stream_use(stream *s, bsim_video *v, int p, long *steps_held)
 	for (long i = 0; i < b->n; i++) {
 		const long step = b->first + i;
 		const double *x = b->xy + 2 * i;
-		if (video_panel_trail_add(v, p, step, x))
+		if (bsim_video_panel_trail_add(v, p, step, x))
 			return -1;
 		/* The centre at a step another panel ends at: its last frames
 		 * draw this trail up to there. */
@@ -404,7 +404,7 @@ void bsim_video_stream_free(bsim_video_stream *vs)
 	}
 	for (int p = 0; p < vs->s.n; p++)
 		bsim_video_track_free(vs->s.panels[p].summary);
-	video_teardown(vs->v);
+	bsim_video_teardown(vs->v);
 	free(vs);
 }
 
@@ -416,7 +416,7 @@ int bsim_video_stream_alloc(const bsim_video_def *def, const bsim_scene *scene,
 	*out = NULL;
 	int rc = bsim_video_def_check(def, err);
 	if (rc == BSIM_OK)
-		rc = video_scene_check(scene, err);
+		rc = bsim_video_scene_check(scene, err);
 	if (rc != BSIM_OK)
 		return rc;
 	if (n_panels < 1 || n_panels > BSIM_VIDEO_PANELS_MAX)
@@ -440,7 +440,7 @@ int bsim_video_stream_alloc(const bsim_video_def *def, const bsim_scene *scene,
 		sp->s = s;
 		sp->backend = backends[p];
 		sp->opts = opts ? opts[p] : NULL;
-		rc = video_track_summary(scene, backends[p], sp->opts, seed, def->fps, &sp->summary,
+		rc = bsim_video_track_summary(scene, backends[p], sp->opts, seed, def->fps, &sp->summary,
 		                         err);
 		if (rc != BSIM_OK)
 			break;
@@ -452,11 +452,11 @@ int bsim_video_stream_alloc(const bsim_video_def *def, const bsim_scene *scene,
 		pn->result = r;
 		pn->frames = sp->frames;
 		pn->last_step = sp->n_last;
-		pn->visits = video_track_visits(sp->summary, &pn->n_visits);
-		pn->random_axis = video_track_random_axis(sp->summary);
+		pn->visits = bsim_video_track_visits(sp->summary, &pn->n_visits);
+		pn->random_axis = bsim_video_track_random_axis(sp->summary);
 	}
 	if (rc == BSIM_OK)
-		rc = video_setup(v, def, scene, labels, n_panels, err);
+		rc = bsim_video_setup(v, def, scene, labels, n_panels, err);
 	if (rc == BSIM_OK) {
 		if (pthread_mutex_init(&s->lock, NULL) == 0) {
 			if (pthread_cond_init(&s->cond, NULL) == 0)

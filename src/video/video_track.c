@@ -19,7 +19,7 @@
  * trial: 16 bytes a step for the trail and 56 + 5 n_beams bytes a frame.
  * It is for stills, tests and short trials; beamsim video streams instead
  * (video_stream.c), running the trial twice: first as a summary (result,
- * frame count and gate path only, video_track_summary), then drawing each
+ * frame count and gate path only, bsim_video_track_summary), then drawing each
  * frame as the trial reaches it. */
 #include "beamsim/video.h"
 
@@ -57,31 +57,31 @@ struct bsim_video_track {
 /* The step a frame shows. The 1e-9 keeps a frame time that is a whole
  * number of steps (k = 3 at 30 fps and 4 ms: 25 steps) on that step
  * whatever the rounding of k / (fps h). */
-long video_frame_step(double fps, double dt, long k)
+long bsim_video_frame_step(double fps, double dt, long k)
 {
 	return (long)floor((double)k / (fps * dt) + 1e-9);
 }
 
 static long frame_step(const bsim_video_track *t, long k)
 {
-	return video_frame_step(t->fps, t->scene->dt, k);
+	return bsim_video_frame_step(t->fps, t->scene->dt, k);
 }
 
 /* As bsim_video_track_record counts them: the frames whose step is at or
  * before n_last, and one more for the end state if no frame falls on
  * n_last, at most ceil(n_last h fps) + 1. */
-long video_frame_count(double fps, double dt, long n_last)
+long bsim_video_frame_count(double fps, double dt, long n_last)
 {
 	long k = (long)floor((double)n_last * fps * dt) - 2;
-	if (k < 0 || video_frame_step(fps, dt, k) > n_last)
+	if (k < 0 || bsim_video_frame_step(fps, dt, k) > n_last)
 		k = 0;
-	while (video_frame_step(fps, dt, k) <= n_last)
+	while (bsim_video_frame_step(fps, dt, k) <= n_last)
 		k++;
 	/* k frames at or before n_last; frame k - 1 is n_last's if any is */
 	const long frames = (long)ceil((double)n_last * fps * dt - 1e-9) + 1;
 	if (k >= frames)
 		return frames;
-	return video_frame_step(fps, dt, k - 1) == n_last ? k : k + 1;
+	return bsim_video_frame_step(fps, dt, k - 1) == n_last ? k : k + 1;
 }
 
 static int grow(void **p, long *cap, long need, size_t size)
@@ -119,7 +119,7 @@ static int frames_reserve(bsim_video_track *t, long need)
 	return 0;
 }
 
-void video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const bsim_state *s,
+void bsim_video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const bsim_state *s,
                       video_frame *f, float *th, unsigned char *ct)
 {
 	f->step = step;
@@ -146,7 +146,7 @@ void video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const b
 /* Writes the state of step `step` into frame slot k. */
 static void frame_take(bsim_video_track *t, long k, long step, const bsim_state *s)
 {
-	video_frame_take(t->scene, &t->fx, step, s, &t->frames[k],
+	bsim_video_frame_take(t->scene, &t->fx, step, s, &t->frames[k],
 	                 t->theta + (size_t)k * (size_t)t->n_beams,
 	                 t->contact + (size_t)k * (size_t)t->n_beams);
 }
@@ -239,7 +239,7 @@ static int track_run(const bsim_scene *scene, const bsim_backend *backend, const
 		return rc;
 	}
 	if (summary) {
-		t->n_frames = video_frame_count(fps, scene->dt, t->result.steps_run);
+		t->n_frames = bsim_video_frame_count(fps, scene->dt, t->result.steps_run);
 		*out = t;
 		return BSIM_OK;
 	}
@@ -263,14 +263,14 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 	return track_run(scene, backend, opts, seed, fps, 0, out, err);
 }
 
-int video_track_summary(const bsim_scene *scene, const bsim_backend *backend,
+int bsim_video_track_summary(const bsim_scene *scene, const bsim_backend *backend,
                         const bsim_options *opts, uint64_t seed, double fps, bsim_video_track **out,
                         bsim_error *err)
 {
 	return track_run(scene, backend, opts, seed, fps, 1, out, err);
 }
 
-bsim_effects *video_track_effects(bsim_video_track *t)
+bsim_effects *bsim_video_track_effects(bsim_video_track *t)
 {
 	return &t->fx;
 }
@@ -329,19 +329,19 @@ void bsim_video_track_position(const bsim_video_track *t, long n, double x[2])
 	x[1] = t->trail[2 * n + 1];
 }
 
-const double *video_track_trail(const bsim_video_track *t, long *n)
+const double *bsim_video_track_trail(const bsim_video_track *t, long *n)
 {
 	*n = t->n_trail;
 	return t->trail;
 }
 
-const video_gate_visit *video_track_visits(const bsim_video_track *t, int *n)
+const video_gate_visit *bsim_video_track_visits(const bsim_video_track *t, int *n)
 {
 	*n = t->n_visits;
 	return t->visits;
 }
 
-int video_track_random_axis(const bsim_video_track *t)
+int bsim_video_track_random_axis(const bsim_video_track *t)
 {
 	return t->fx.random ? t->fx.random->axis : 0;
 }

@@ -11,7 +11,7 @@
 
 #include "video/video_internal.h"
 
-int video_trail_add(video_trail *t, long step, const double x[2])
+int bsim_video_trail_add(video_trail *t, long step, const double x[2])
 {
 	if (t->broken >= 0)
 		return 0;
@@ -36,7 +36,7 @@ int video_trail_add(video_trail *t, long step, const double x[2])
 	return 0;
 }
 
-void video_trail_free(video_trail *t)
+void bsim_video_trail_free(video_trail *t)
 {
 	free(t->p);
 	t->p = NULL;

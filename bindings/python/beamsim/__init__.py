@@ -142,7 +142,7 @@ def _no_nul(what, text):
     if text is not None:
         text = os.fspath(text)
         if isinstance(text, str):
-            _beamsim.text_check(what, text)
+            _beamsim.bsim_text_check(what, text)
 
 
 _INT32_MAX = 2**31 - 1
