@@ -62,9 +62,19 @@ def test_grid_and_set(h1, tmp_path):
 
 def test_kept_trajectories(h1, tmp_path):
     cli("sweep", h1, "--trials", 2, "--trajectories", 1, "--out", tmp_path / "cli")
-    beamsim.sweep(h1, trials=2, trajectories=1, out=tmp_path / "py")
+    r = beamsim.sweep(h1, trials=2, trajectories=1, out=tmp_path / "py")
     assert filecmp.cmp(tmp_path / "cli" / "trajectories.csv",
                        tmp_path / "py" / "trajectories.csv", shallow=False)
+    # by trial, with or without out: each kept trial's rows of the file, in order
+    table = beamsim.read_csv(tmp_path / "cli" / "trajectories.csv")
+    for got in (r["trajectories"], beamsim.sweep(h1, trials=2, trajectories=1)["trajectories"]):
+        assert sorted(got) == [(g, 0) for g in range(30)]
+        for (g, t), cols in got.items():
+            rows = (table["group"] == g) & (table["trial"] == t)
+            assert set(cols) == set(table) - {"group", "trial"}
+            for c, v in cols.items():
+                assert v.shape == (rows.sum(),) and np.array_equal(v, table[c][rows]), (g, c)
+    assert beamsim.sweep(h1, trials=2)["trajectories"] == {}
 
 
 def test_stored_sweep_replays(h1, tmp_path):

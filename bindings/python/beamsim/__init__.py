@@ -334,7 +334,10 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
     Returns a dict: "groups" (summary.json's groups: params, trials,
     traversed, side_exit, stuck, left, right, p_traverse, ci95, ...),
     "trials" (trials.csv as a dict of NumPy arrays by column, read_csv),
-    "summary" (all of summary.json), "threads" and "out". A sweep whose
+    "summary" (all of summary.json), "trajectories" (the kept trials'
+    trajectories, {(group, trial): {column: array}}: t, x, y, theta1,
+    theta2, contact1, contact2, each (n_rows,); {} with trajectories=0),
+    "threads" and "out". A sweep whose
     arrays would not fit in the memory available is refused before it
     runs (ValueError). Unstable trials are warned of (RuntimeWarning);
     Ctrl-C stops the sweep (KeyboardInterrupt)."""
@@ -355,7 +358,23 @@ def sweep(experiment, trials=None, threads=None, backend=None, set=None, grid=No
         warnings.warn(text, RuntimeWarning, stacklevel=2)
     summary = files["summary"]
     return {"groups": summary["groups"], "trials": files["trials"], "summary": summary,
-            "threads": info["threads"], "out": out}
+            "trajectories": _by_trial(files.get("trajectories")), "threads": info["threads"],
+            "out": out}
+
+
+def _by_trial(table):
+    """trajectories.csv's rows split by trial: {(group, trial): {column: array}}, each
+    array a kept trial's (n_rows,), in the file's order; {} without the file."""
+    if not table:
+        return {}
+    g, t = table["group"], table["trial"]
+    # rows of one trial are consecutive: cut where (group, trial) changes
+    cuts = np.flatnonzero((np.diff(g) != 0) | (np.diff(t) != 0)) + 1
+    out = {}
+    for lo, hi in zip(np.r_[0, cuts], np.r_[cuts, len(g)]):
+        out[(int(g[lo]), int(t[lo]))] = {k: v[lo:hi] for k, v in table.items()
+                                          if k not in ("group", "trial")}
+    return out
 
 
 def compare(experiment, backends=None, trials=None, threads=None, set=None,
@@ -465,6 +484,8 @@ class World:
                                  _opts(backend_opt), _grid(grid))
 
     def step(self, force=None, n=1, torque=0.0):
+        """n steps: under the scene's own forces (force None), or under
+        force (F_x, F_y), N, and torque, N m, held over them."""
         if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
             raise ValueError(f"n {n!r}: expected an integer >= 1")
         if force is not None:
@@ -474,18 +495,22 @@ class World:
         self._w.step(force, int(n), float(torque))
 
     def reset(self):
+        """Back to step 0: the trial's start."""
         self._w.reset()
 
     @property
     def state(self):
+        """The state after the last step (a dict, the class's doc)."""
         return self._w.state
 
     @property
     def dt(self):
+        """The scene's time step, s."""
         return self._w.dt
 
     @property
     def backend(self):
+        """The backend's name (a stored comparison's side label)."""
         return self._w.backend
 
     def __repr__(self):
