@@ -1,6 +1,7 @@
 /* The progress line's ETA rule (cli_progress_eta): no ETA until the rate
  * rests on enough finished work, and then the time left at that rate. The
- * times are arguments, so nothing here waits or reads a clock. */
+ * times are arguments, so nothing here waits or reads a clock. And the
+ * lines off a terminal, at an interval of 0 s or one never reached. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -10,6 +11,10 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 
 /* The program's progress line, compiled in: it is not part of the
  * library the tests link. */
@@ -73,12 +78,67 @@ static void test_first_eta_near(void **state)
 	assert_true(shown > 0);
 }
 
+/* The lines a run of n items prints off a terminal (stderr a file) with
+ * BEAMSIM_PROGRESS_SECONDS at seconds ("" unset), enabled or not. */
+static int lines_off_terminal(const char *seconds, int enabled, long n, char *buf, size_t size)
+{
+	FILE *log = tmpfile();
+	assert_non_null(log);
+	fflush(stderr);
+	int saved = dup(STDERR_FILENO);
+	assert_true(saved >= 0 && dup2(fileno(log), STDERR_FILENO) >= 0);
+	if (seconds[0])
+		setenv("BEAMSIM_PROGRESS_SECONDS", seconds, 1);
+	else
+		unsetenv("BEAMSIM_PROGRESS_SECONDS");
+	cli_progress p;
+	cli_progress_init(&p, enabled, "trials");
+	for (long k = 1; k <= n; k++)
+		cli_progress_update(&p, k, n);
+	cli_progress_finish(&p);
+	fflush(stderr);
+	dup2(saved, STDERR_FILENO);
+	close(saved);
+	unsetenv("BEAMSIM_PROGRESS_SECONDS");
+	rewind(log);
+	size_t got = fread(buf, 1, size - 1, log);
+	buf[got] = '\0';
+	fclose(log);
+	int lines = 0;
+	for (const char *c = buf; *c; c++)
+		lines += *c == '\n';
+	return lines;
+}
+
+/* Off a terminal: a line of its own for each update once the interval has
+ * passed (0 s: every update but the last, which the command's own closing
+ * line reports), counting up, with no carriage return; none when disabled
+ * (--quiet), none within the interval. */
+static void test_off_terminal(void **state)
+{
+	(void)state;
+	char buf[4096];
+	assert_int_equal(lines_off_terminal("0", 1, 10, buf, sizeof buf), 9);
+	assert_null(strchr(buf, '\r'));
+	const char *at = buf;
+	for (long k = 1; k <= 9; k++) {
+		char want[64];
+		snprintf(want, sizeof want, "beamsim: progress: %ld/10 trials  %ld%%  ETA ", k,
+		         10 * k);
+		assert_true(strncmp(at, want, strlen(want)) == 0);
+		at = strchr(at, '\n') + 1;
+	}
+	assert_int_equal(lines_off_terminal("0", 0, 10, buf, sizeof buf), 0);
+	assert_int_equal(lines_off_terminal("1e9", 1, 10, buf, sizeof buf), 0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_no_rate_no_eta),
 	        cmocka_unit_test(test_thresholds),
 	        cmocka_unit_test(test_first_eta_near),
+	        cmocka_unit_test(test_off_terminal),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -5,7 +5,9 @@
 
 #include "util/clock.h"
 
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <unistd.h>
 
 /* Redraw interval, s: fast enough to look live, slow enough to cost nothing. */
@@ -23,9 +25,21 @@
 #define ETA_MIN_FRACTION 0.03
 #define ETA_MIN_SECONDS  2.0
 
+/* Off a terminal (a log, nohup, a batch job): a line every so many
+ * seconds, BEAMSIM_PROGRESS_SECONDS or LOG_INTERVAL; a run shorter than
+ * that prints none. */
+#define LOG_INTERVAL 10.0
+
 void cli_progress_init(cli_progress *p, int enabled, const char *unit)
 {
-	p->active = enabled && isatty(STDERR_FILENO);
+	p->tty = isatty(STDERR_FILENO);
+	p->active = enabled;
+	p->log_interval = LOG_INTERVAL;
+	const char *env = getenv("BEAMSIM_PROGRESS_SECONDS");
+	char *end;
+	double v = env ? strtod(env, &end) : NAN;
+	if (env && end != env && *end == '\0' && v >= 0.0)
+		p->log_interval = v;
 	p->unit = unit;
 	p->shown = 0;
 	p->t_start = bsim_clock_seconds();
@@ -67,8 +81,15 @@ void cli_progress_update(void *user, long done, long total)
 		p->done0 = done;
 		p->t0 = now;
 	}
-	if (done < total && p->t_last >= 0.0 && now - p->t_last < PROGRESS_INTERVAL)
+	if (!p->tty) {
+		/* a line of its own every log_interval s from the start, the last
+		 * item's left to the command's own closing line */
+		if (done >= total ||
+		    now - (p->t_last >= 0.0 ? p->t_last : p->t_start) < p->log_interval)
+			return;
+	} else if (done < total && p->t_last >= 0.0 && now - p->t_last < PROGRESS_INTERVAL) {
 		return;
+	}
 	p->t_last = now;
 
 	char eta[32] = "-:--";
@@ -77,9 +98,16 @@ void cli_progress_update(void *user, long done, long total)
 		format_duration(eta, sizeof eta, now - p->t_start);
 	else if (left >= 0.0)
 		format_duration(eta, sizeof eta, left);
+	const int pct = (int)(100.0 * (double)done / (double)total);
+	if (!p->tty) {
+		fprintf(stderr, "beamsim: progress: %ld/%ld %s  %d%%  ETA %s\n", done, total,
+		        p->unit, pct, eta);
+		fflush(stderr);
+		return;
+	}
 	/* Trailing spaces wipe what a longer previous line left behind. */
-	fprintf(stderr, "\r  %ld/%ld %s  %d%%  %s %s   ", done, total, p->unit,
-	        (int)(100.0 * (double)done / (double)total), done >= total ? "took" : "ETA", eta);
+	fprintf(stderr, "\r  %ld/%ld %s  %d%%  %s %s   ", done, total, p->unit, pct,
+	        done >= total ? "took" : "ETA", eta);
 	fflush(stderr);
 	p->shown = 1;
 }

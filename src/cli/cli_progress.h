@@ -1,16 +1,20 @@
-/* A progress line for long runs on a terminal (docs/files.md "Command line":
- * progress and an ETA on a terminal, quiet when not on one).
- *
- *   "\r  1234/3000 trials  41%  ETA 0:03" on stderr, redrawn in place. */
+/* A progress line for long runs (docs/files.md "Command line"): on a
+ * terminal
+ *   "\r  1234/3000 trials  41%  ETA 0:03" on stderr, redrawn in place;
+ * off one (a log, nohup, a batch job), a line of its own every 10 s
+ * (BEAMSIM_PROGRESS_SECONDS), none for a run shorter than that:
+ *   "beamsim: progress: 1234/3000 trials  41%  ETA 0:03". */
 #ifndef BSIM_CLI_CLI_PROGRESS_H
 #define BSIM_CLI_CLI_PROGRESS_H
 
 typedef struct cli_progress {
-	int active;       /* enabled and stderr is a terminal */
-	int shown;        /* a line is on the screen and needs a newline */
-	const char *unit; /* what is counted: "trials" */
-	double t_start;   /* s, monotonic */
-	double t_last;    /* s, when the line was last drawn */
+	int active;          /* enabled (not --quiet) */
+	int tty;             /* stderr is a terminal */
+	double log_interval; /* s between the lines off a terminal */
+	int shown;           /* a line is on the screen and needs a newline */
+	const char *unit;    /* what is counted: "trials" */
+	double t_start;      /* s, monotonic */
+	double t_last;       /* s, when the line was last drawn */
 	/* done and the time, s, at the first update, or done0 = -1 before it:
 	 * the rate counts from there, so neither the start-up nor a resumed
 	 * run's journaled trials (which took no time) enter it. */
@@ -18,8 +22,8 @@ typedef struct cli_progress {
 	double t0;
 } cli_progress;
 
-/* Starts the clock. Prints nothing ever if !enabled or stderr is not a
- * terminal. unit names what is counted. */
+/* Starts the clock. Prints nothing ever if !enabled. unit names what is
+ * counted. */
 void cli_progress_init(cli_progress *p, int enabled, const char *unit);
 
 /* A bsim_progress_fn (beamsim/progress.h): user is the cli_progress.
