@@ -488,8 +488,10 @@ static int load_group(const ydoc *scene, const bsim_experiment *e, int g,
 	return rc;
 }
 
-/* Guards the clone of an experiment's parsed scene, which threads making
- * their groups' scenes share. */
+/* Guards an experiment's parsed scene and every document cloned from it:
+ * libfyaml's copies share the parsed input, counted without atomics, so
+ * threads making their groups' scenes (the figures do) make them one at a
+ * time. */
 static pthread_mutex_t scene_doc_lock = PTHREAD_MUTEX_INITIALIZER;
 
 /* The scene file parsed: a copy of the document parsed at load, else the
@@ -499,9 +501,7 @@ static int scene_parse(const bsim_experiment *e, ydoc *scene, bsim_error *err)
 	if (e->scene_doc) {
 		memset(scene, 0, sizeof *scene);
 		scene->path = e->scene_path;
-		pthread_mutex_lock(&scene_doc_lock);
 		scene->fyd = fy_document_clone(e->scene_doc);
-		pthread_mutex_unlock(&scene_doc_lock);
 		return scene->fyd ? BSIM_OK
 		                  : bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
 	}
@@ -517,11 +517,13 @@ int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_over
 		return bsim_error_set(err, BSIM_EINPUT, "%s: group %d: expected 0 to %d", e->path,
 		                      g, e->n_groups - 1);
 	ydoc scene;
+	pthread_mutex_lock(&scene_doc_lock);
 	int rc = scene_parse(e, &scene, err);
-	if (rc)
-		return rc;
-	rc = load_group(&scene, e, g, extra, n_extra, out, err);
-	bsim_ydoc_free(&scene);
+	if (rc == BSIM_OK) {
+		rc = load_group(&scene, e, g, extra, n_extra, out, err);
+		bsim_ydoc_free(&scene);
+	}
+	pthread_mutex_unlock(&scene_doc_lock);
 	return rc;
 }
 
