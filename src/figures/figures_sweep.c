@@ -203,12 +203,18 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	}
 	int rows, cols;
 	layout(np, &rows, &cols);
+	/* A group without random force runs one trial (copied to the others):
+	 * its interval is a point, and the title says so rather than counting
+	 * trials it did not run. */
+	int one_trial = 0;
+	for (int k = 0; k < s->n_groups; k++)
+		one_trial |= s->g[k].selected && s->g[k].lo == s->g[k].hi;
 	char title[1000];
 	snprintf(title, sizeof title,
-	         "traversal probability p_traverse%s, %d trials per group, [95%% Wilson "
+	         "traversal probability p_traverse%s, %d trials per group%s, [95%% Wilson "
 	         "interval]\n%s",
 	         lattice ? " (reached the end of the lattice)" : "", s->trials_per_group,
-	         s->header);
+	         one_trial ? " (without random force: 1)" : "", s->header);
 	fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
 	bsim_gp_str(g.f, title);
 	fputs(" noenhanced\n"
@@ -250,7 +256,26 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 		pw = TEXT_PX(xlab) + 170;
 	if (ph < 300)
 		ph = 300;
-	for (int p = 0; p < np; p++) {
+	if (ax0 < 0 && ax1 < 0 && np == 1) {
+		/* one group: its p_traverse on a probability axis with its
+		 * interval, not a cell of a map without axes */
+		fputs("unset colorbox\nset xrange [-1:1]\nset yrange [0:1]\nset ytics 0.2 nomirror\n"
+		      "set ylabel 'p_{traverse}'\nset grid ytics\n",
+		      g.f);
+		panel_label(s, a, first[0], ax0, ax1, label, sizeof label);
+		fputs("set title ", g.f);
+		bsim_gp_str(g.f, label);
+		fputs(" noenhanced\n"
+		      "plot 'p_traverse.dat' index 0 using 1:3:4:5 with yerrorbars pt 7 ps 1.5 "
+		      "lc rgb '#08306B' notitle, \\\n"
+		      "     '' index 0 using ($1 + 0.1):3:($4 == $5 ? sprintf(\"%.2f (1 trial)\", "
+		      "$3) : sprintf(\"%.2f [%.2f, %.2f]\", $3, $4, $5)) with labels left "
+		      "font ',10' notitle\n",
+		      g.f);
+		pw = pw < 420 ? 420 : pw;
+		ph = 380;
+	}
+	for (int p = 0; p < np && !(ax0 < 0 && ax1 < 0 && np == 1); p++) {
 		panel_label(s, a, first[p], ax0, ax1, label, sizeof label);
 		if (pw < TEXT_PX(widest_line(label)) + 150)
 			pw = TEXT_PX(widest_line(label)) + 150;
@@ -260,9 +285,9 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 		        " noenhanced\n"
 		        "plot 'p_traverse.dat' index %d using 1:2:(0.5):(0.5):3 with boxxyerror "
 		        "fs solid 1.0 fc palette notitle, \\\n"
-		        "     '' index %d using 1:2:(sprintf(\"%%.2f\\n[%%.2f, %%.2f]\", $3, $4, "
-		        "$5)):($3 > 0.55 ? 0xFFFFFF : 0) with labels tc rgb variable font ',9' "
-		        "notitle\n",
+		        "     '' index %d using 1:2:($4 == $5 ? sprintf(\"%%.2f\\n(1 trial)\", $3) "
+		        ": sprintf(\"%%.2f\\n[%%.2f, %%.2f]\", $3, $4, $5)):($3 > 0.55 ? 0xFFFFFF : "
+		        "0) with labels tc rgb variable font ',9' notitle\n",
 		        p, p);
 	}
 	fputs("unset multiplot\n", g.f);
