@@ -135,6 +135,9 @@ int bsim_figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 	bsim_csv_table_free(&ht);
 	if (rc || n_shown == 0)
 		return rc;
+	/* the panels' height and, below them, the key's rows of 4 entries */
+	const int key_rows = (n_shown + 3) / 4, height = 560 + 18 * key_rows;
+	const double key_bottom = (70.0 + 18.0 * key_rows) / height;
 	gp_text g;
 	if ((rc = bsim_gp_text_open(&g, err)))
 		return rc;
@@ -146,12 +149,16 @@ int bsim_figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 	fprintf(g.f,
 	        " noenhanced\n"
 	        "set grid\nset style fill transparent solid 0.12 noborder\n"
-	        "set yrange [0:1]\nset xrange [0:%.6g]\nset key top right font ',9' "
-	        "noenhanced\n"
-	        "set arrow 1 from %.6g, graph 0 to %.6g, graph 1 nohead dt 3 lc rgb '%s'\n"
+	        "set yrange [0:1]\nset xrange [0:%.6g]\n"
+	        /* the key below both panels, not on the curves; both panels
+	         * end as high above it */
+	        "set bmargin at screen %.4f\nset tmargin at screen %.4f\n"
+	        "set key at screen 0.5, screen 0.01 center bottom horizontal maxcols 4 "
+	        "font ',9' noenhanced\n"
+	        "set arrow 1 from %.6g, graph 0 to %.6g, graph 1 nohead lw 2 dt 3 lc rgb '%s'\n"
 	        "set title 'still in the gate, S(t) (Kaplan-Meier, 95%% Greenwood band)'\n"
 	        "set xlabel 't (s)'\nset ylabel 'S(t)'\nplot ",
-	        horizon * 1.02, horizon, horizon, FIG_GREY);
+	        horizon * 1.02, key_bottom, 1.0 - 110.0 / height, horizon, horizon, FIG_GREY);
 	for (int i = 0; i < n_shown; i++) {
 		/* the key's one line: every axis, ", " where the label breaks */
 		char text[300], label[450];
@@ -174,9 +181,10 @@ int bsim_figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 		bsim_gp_str(g.f, label);
 	}
 	fprintf(g.f,
-	        "\nset title 'had the trials stopped at h: traversed (solid), stuck (dashed); "
-	        "dotted: the horizon'\n"
-	        "set xlabel 'horizon h (s)'\nset ylabel 'fraction of trials'\nunset key\nplot ");
+	        "\nset title \"had the trials stopped at h: traversed (solid), stuck (dashed)\\n"
+	        "dotted: where the trials end, %.6g s\"\n"
+	        "set xlabel 'horizon h (s)'\nset ylabel 'fraction of trials'\nunset key\nplot ",
+	        horizon);
 	for (int i = 0; i < n_shown; i++)
 		fprintf(g.f,
 		        "%s'survival.dat' index %d using 1:3:4 with filledcurves lc rgb '%s', \\\n"
@@ -187,7 +195,7 @@ int bsim_figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 		        n_shown + i, colour[i], n_shown + i, colour[i]);
 	fputs("\nunset multiplot\n", g.f);
 	char *body = bsim_gp_text_take(&g);
-	rc = body ? bsim_figs_render(f, "survival", 1300, 560, body, err)
+	rc = body ? bsim_figs_render(f, "survival", 1300, height, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;
