@@ -350,7 +350,10 @@ static int write_figure(const char *stage, const esc_job *j, int *drawn, bsim_er
 	         "ln k = ln k0 - dE / (c D), k0 = %.3g 1/s, c = %.3g +- %.2g m/(N s), n = %d, "
 	         "R^2 = %.2f'.\"\\n\".'%s' noenhanced\n"
 	         "set grid\nset xlabel 'dE / D (J / (N^2 s))'\nset ylabel 'ln k (k in 1/s)'\n"
-	         "set key bottom left font ',9'\n"
+	         /* the key below the left panel, off the points; both panels
+	          * as high */
+	         "set bmargin at screen 0.17\n"
+	         "set key at screen 0.27, screen 0.01 center bottom horizontal font ',9'\n"
 	         "set title 'traversal rate (95%% Poisson interval) and the fit'\n"
 	         "plot 'kramers.dat' index 0 using 1:2:3:4 with yerrorbars pt 7 lc rgb '#0072B2' "
 	         "title 'groups with a traversal', \\\n"
@@ -367,7 +370,7 @@ static int write_figure(const char *stage, const esc_job *j, int *drawn, bsim_er
 	d.dir = stage;
 	d.name = "kramers";
 	d.width = 1300;
-	d.height = 560;
+	d.height = 600;
 	return bsim_figure_render(&d, body, drawn, err);
 }
 
