@@ -201,6 +201,43 @@ static void test_compare_page(void **state)
 	if (!strstr(page, want))
 		fail_msg("index.html has no \"%s\"", want);
 	assert_non_null(strstr(page, "<a href=\"report.md\">report.md</a>"));
+	/* each group's verdict: report.md's table of groups row for row, its
+	 * cells (bold dropped) the page's */
+	const char *table = strstr(report, "\n| group |");
+	assert_non_null(table);
+	const char *html = strstr(page, "<table class=\"verdicts\">");
+	assert_non_null(html);
+	int rows = 0;
+	for (const char *l = table + 1; *l == '|'; l = strchr(l, '\n') + 1) {
+		if (strncmp(l, "|---", 4) == 0)
+			continue;
+		const char *tag = rows ? "<td>" : "<th>";
+		html = strstr(html, "<tr>");
+		assert_non_null(html);
+		for (const char *c = l + 1; strchr(c, '|') && strchr(c, '|') < strchr(l, '\n');
+		     c = strchr(c, '|') + 1) {
+			size_t n = strcspn(c, "|");
+			char cell[300], want_cell[320];
+			size_t k = 0;
+			for (size_t i = 0; i < n && k + 1 < sizeof cell; i++)
+				if (c[i] != '*')
+					cell[k++] = c[i];
+			cell[k] = '\0';
+			char *b = cell, *e = cell + strlen(cell);
+			while (*b == ' ')
+				b++;
+			while (e > b && e[-1] == ' ')
+				*--e = '\0';
+			snprintf(want_cell, sizeof want_cell, "%s%s", tag, b);
+			html = strstr(html, want_cell);
+			if (!html)
+				fail_msg("row %d of report.md's table of groups: no cell \"%s\" on "
+				         "the page",
+				         rows, b);
+		}
+		rows++;
+	}
+	assert_int_equal(rows, 1 + 2); /* the header and the experiment's 2 groups */
 	free(report);
 	free(page);
 }

@@ -40,8 +40,8 @@
 #include "util/figure.h"
 #include "util/survival.h"
 
-int bsim_escape_fit_line(const double *x, const double *y, const double *events, int n, escape_fit *out,
-                    bsim_error *err)
+int bsim_escape_fit_line(const double *x, const double *y, const double *events, int n,
+                         escape_fit *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
 	out->n = n;

@@ -102,9 +102,9 @@ int bsim_figs_survival(figs *f, const char *dir, const fsum *s, bsim_error *err)
 		}
 	if (n_sel > n_shown)
 		bsim_figs_note(f,
-		          "survival: %d of the %d selected groups drawn (those with the most "
-		          "exits); --select KEY=VALUE draws others",
-		          n_shown, n_sel);
+		               "survival: %d of the %d selected groups drawn (those with the most "
+		               "exits); --select KEY=VALUE draws others",
+		               n_shown, n_sel);
 	bsim_atomic_file o;
 	rc = bsim_figs_data_open(f, "survival.dat", &o, path, err);
 	if (!rc) {

@@ -92,7 +92,8 @@ static void panel_label(const fsum *s, const active *a, int g, int skip0, int sk
 		if (ax == skip0 || ax == skip1 || a->n[ax] < 2)
 			continue;
 		char kv[200];
-		bsim_figs_key_value(s->axes[ax].key, s->axes[ax].values[s->g[g].idx[ax]], kv, sizeof kv);
+		bsim_figs_key_value(s->axes[ax].key, s->axes[ax].values[s->g[g].idx[ax]], kv,
+		                    sizeof kv);
 		int n = snprintf(buf + k, size - k, "%s%s", k ? ", " : "", kv);
 		k += n > 0 ? (size_t)n : 0;
 	}
@@ -259,7 +260,8 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	if (ax0 < 0 && ax1 < 0 && np == 1) {
 		/* one group: its p_traverse on a probability axis with its
 		 * interval, not a cell of a map without axes */
-		fputs("unset colorbox\nset xrange [-1:1]\nset yrange [0:1]\nset ytics 0.2 nomirror\n"
+		fputs("unset colorbox\nset xrange [-1:1]\nset yrange [0:1]\nset ytics 0.2 "
+		      "nomirror\n"
 		      "set ylabel 'p_{traverse}'\nset grid ytics\n",
 		      g.f);
 		panel_label(s, a, first[0], ax0, ax1, label, sizeof label);
@@ -286,7 +288,8 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 		        "plot 'p_traverse.dat' index %d using 1:2:(0.5):(0.5):3 with boxxyerror "
 		        "fs solid 1.0 fc palette notitle, \\\n"
 		        "     '' index %d using 1:2:($4 == $5 ? sprintf(\"%%.2f\\n(1 trial)\", $3) "
-		        ": sprintf(\"%%.2f\\n[%%.2f, %%.2f]\", $3, $4, $5)):($3 > 0.55 ? 0xFFFFFF : "
+		        ": sprintf(\"%%.2f\\n[%%.2f, %%.2f]\", $3, $4, $5)):($3 > 0.55 ? 0xFFFFFF "
+		        ": "
 		        "0) with labels tc rgb variable font ',9' notitle\n",
 		        p, p);
 	}
@@ -458,8 +461,8 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 			if (oa != ax && a->n[oa] > 1) {
 				char kv[200];
 				bsim_figs_key_value(s->axes[oa].key,
-				               s->axes[oa].values[s->g[first[p]].idx[oa]], kv,
-				               sizeof kv);
+				                    s->axes[oa].values[s->g[first[p]].idx[oa]], kv,
+				                    sizeof kv);
 				int w = snprintf(label + k, sizeof label - k, "%s%s", k ? ", " : "",
 				                 kv);
 				k += w > 0 ? (size_t)w : 0;
@@ -578,8 +581,9 @@ static int classes_read(const char *dir, const fsum *s, fpaths *ps, bsim_error *
 	rc = bsim_csv_table_require(&t, path, need, 4, col, err);
 	for (long r = 0; !rc && r < t.n_rows; r++) {
 		double g, tr;
-		if (bsim_csv_table_number(&t, r, col[0], &g) || bsim_csv_table_number(&t, r, col[1], &tr) ||
-		    g < 0 || g >= s->n_groups || tr < 0 || tr >= per) {
+		if (bsim_csv_table_number(&t, r, col[0], &g) ||
+		    bsim_csv_table_number(&t, r, col[1], &tr) || g < 0 || g >= s->n_groups ||
+		    tr < 0 || tr >= per) {
 			rc = bsim_error_set(err, BSIM_EINPUT,
 			                    "%s:%ld: group, trial: expected integers within the "
 			                    "%d groups x %ld trials of summary.json",
@@ -589,7 +593,7 @@ static int classes_read(const char *dir, const fsum *s, fpaths *ps, bsim_error *
 		int i = which[(long)g * per + (long)tr];
 		if (i >= 0)
 			ps->p[i].cls = bsim_fpath_class(bsim_csv_table_cell(&t, r, col[2]),
-			                           bsim_csv_table_cell(&t, r, col[3]));
+			                                bsim_csv_table_cell(&t, r, col[3]));
 	}
 	free(which);
 	bsim_csv_table_free(&t);
@@ -651,9 +655,9 @@ static int group_figures(figs *f, traj_job *j, int g, bsim_error *err)
 			         "landscape\n%s",
 			         g, trav, n, label);
 		snprintf(name, sizeof name, "landscape_g%03d", g);
-		rc = bsim_figs_over_landscape(f, name, title, &scene, p, n,
-		                         1u << FPATH_LEFT | 1u << FPATH_RIGHT | 1u << FPATH_NONE,
-		                         err);
+		rc = bsim_figs_over_landscape(
+		        f, name, title, &scene, p, n,
+		        1u << FPATH_LEFT | 1u << FPATH_RIGHT | 1u << FPATH_NONE, err);
 	}
 	j->untraversed[g] = !rc && trav == 0;
 	bsim_scene_free(&scene);
@@ -677,10 +681,10 @@ static void untraversed_note(figs *f, const char *dir, const char *flag, int n)
 	}
 	if (count)
 		bsim_figs_note(f,
-		          "%s: no landscape figure for %d group%s without a traversed trial "
-		          "among the kept ones: %s%s",
-		          dir, count, count == 1 ? "" : "s", buf,
-		          k >= sizeof buf - 16 ? ", ..." : "");
+		               "%s: no landscape figure for %d group%s without a traversed trial "
+		               "among the kept ones: %s%s",
+		               dir, count, count == 1 ? "" : "s", buf,
+		               k >= sizeof buf - 16 ? ", ..." : "");
 }
 
 /* Everything the trajectory figures need, read and checked before any
@@ -697,7 +701,8 @@ static int traj_load(figs *f, const char *dir, const char *inputs, const fsum *s
 	if (stat(path, &st) != 0)
 		return BSIM_OK;
 	if (stat(exp_path, &st) != 0) {
-		bsim_figs_note(f, "%s: no %s, so no scene to draw the trajectories on", dir, exp_path);
+		bsim_figs_note(f, "%s: no %s, so no scene to draw the trajectories on", dir,
+		               exp_path);
 		return BSIM_OK;
 	}
 	int rc = bsim_experiment_load(exp_path, NULL, 0, &j->e_own, err);
@@ -782,9 +787,10 @@ static int trials_check(const char *dir, const fsum *s, bsim_error *err)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (long r = 0; !rc && r < t.n_rows; r++) {
 		double g, tr;
-		if (bsim_csv_table_number(&t, r, col[0], &g) || bsim_csv_table_number(&t, r, col[1], &tr) ||
-		    g < 0 || g >= s->n_groups || tr < 0 || tr >= per || g != (long)g ||
-		    tr != (long)tr || seen[(long)g * per + (long)tr]++)
+		if (bsim_csv_table_number(&t, r, col[0], &g) ||
+		    bsim_csv_table_number(&t, r, col[1], &tr) || g < 0 || g >= s->n_groups ||
+		    tr < 0 || tr >= per || g != (long)g || tr != (long)tr ||
+		    seen[(long)g * per + (long)tr]++)
 			rc = bsim_error_set(err, BSIM_EINPUT,
 			                    "%s:%ld: group, trial: expected each trial of the %d "
 			                    "groups x %ld trials of summary.json once",

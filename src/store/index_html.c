@@ -326,10 +326,71 @@ static const char *base_of(const char *rel)
 	return s ? s + 1 : rel;
 }
 
+/* A cell of a Markdown table row as text: its ** marks dropped. */
+static void cell_text(FILE *f, const char *p, size_t n)
+{
+	char cell[1024];
+	size_t k = 0;
+	for (size_t i = 0; i < n && k + 1 < sizeof cell; i++) {
+		if (p[i] == '*' && i + 1 < n && p[i + 1] == '*') {
+			i++;
+			continue;
+		}
+		cell[k++] = p[i];
+	}
+	cell[k] = '\0';
+	html_text(f, cell);
+}
+
+/* The next Markdown table of in whose first column is "group" (its lines
+ * "| a | b |", the second its "|---|" rule) as an HTML table: a report's
+ * per-group verdicts under its headline. Nothing if in has no such table. */
+static void page_table(FILE *f, FILE *in)
+{
+	char line[8192];
+	int row = 0, other = 0; /* other: within a table of something else */
+	while (fgets(line, sizeof line, in)) {
+		if (line[0] != '|') {
+			if (row)
+				break; /* the table's end */
+			other = 0;
+			continue;
+		}
+		if (other || (row == 0 && strncmp(line, "| group |", 9) != 0)) {
+			other = 1;
+			continue;
+		}
+		line[strcspn(line, "\n")] = '\0';
+		if (row == 1 && strncmp(line, "|---", 4) == 0) {
+			row++;
+			continue;
+		}
+		fputs(row ? "<tr>" : "<table class=\"verdicts\">\n<tr>", f);
+		for (char *p = line + 1; *p;) {
+			size_t n = strcspn(p, "|");
+			if (!p[n])
+				break; /* after the last | */
+			while (n && p[n - 1] == ' ')
+				n--;
+			while (n && *p == ' ')
+				p++, n--;
+			fputs(row ? "<td>" : "<th>", f);
+			cell_text(f, p, n);
+			fputs(row ? "</td>" : "</th>", f);
+			p = strchr(p, '|') + 1;
+		}
+		fputs("</tr>\n", f);
+		row++;
+	}
+	if (row)
+		fputs("</table>\n", f);
+}
+
 /* The first line of report.md or regress.md (found in stage, else in dir)
  * that opens in bold: the verdict's headline ("**0 of 30 groups
  * disagree.** 6 deterministic ..."), as a paragraph with its bold kept,
- * and a link to the whole report. Nothing if there is no such file. */
+ * the table that follows it (each group's verdict) and a link to the whole
+ * report. Nothing if there is no such file. */
 static void page_verdict(FILE *f, const flist *l, const char *stage, const char *dir)
 {
 	static const char *const reports[] = {"report.md", "regress.md"};
@@ -352,9 +413,10 @@ static void page_verdict(FILE *f, const flist *l, const char *stage, const char 
 		int found = 0;
 		while (!found && fgets(line, sizeof line, in))
 			found = strncmp(line, "**", 2) == 0;
-		fclose(in);
-		if (!found)
+		if (!found) {
+			fclose(in);
 			continue;
+		}
 		line[strcspn(line, "\n")] = '\0';
 		fputs("<h2>Verdict</h2>\n<p>", f);
 		/* **...** as bold, the rest as text */
@@ -372,7 +434,10 @@ static void page_verdict(FILE *f, const flist *l, const char *stage, const char 
 		}
 		if (bold)
 			fputs("</b>", f);
-		fputs("</p>\n<p>The whole report, each group's verdict and the statistics: ", f);
+		fputs("</p>\n", f);
+		page_table(f, in);
+		fclose(in);
+		fputs("<p>The whole report, each group's verdict and the statistics: ", f);
 		html_link(f, reports[r], reports[r]);
 		fputs(".</p>\n", f);
 		return;
@@ -389,7 +454,10 @@ static void page(FILE *f, const flist *l, const char *stage, const char *dir, in
 	      "body{font-family:sans-serif;margin:1.5em;max-width:1400px}\n"
 	      "figure{margin:0 0 2em 0}\nfigure img{max-width:100%;height:auto;"
 	      "border:1px solid #ddd}\nfigcaption{margin-top:.3em}\n"
-	      "code{font-size:90%}\nli{margin:.15em 0}\n</style>\n</head>\n"
+	      "code{font-size:90%}\nli{margin:.15em 0}\n"
+	      "table.verdicts{border-collapse:collapse;font-size:90%}\n"
+	      "table.verdicts td,table.verdicts th{border:1px solid #ccc;padding:.15em .5em}\n"
+	      "</style>\n</head>\n"
 	      "<body data-images=\"\">\n<h1>",
 	      f);
 	html_text(f, title);
