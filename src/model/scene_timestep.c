@@ -52,43 +52,49 @@ static void bound_paths(scene_dt_bound *b, const char *const *paths, int n, int 
 
 /* The random force and the oscillation: the forcing must be representable
  * at steps of dt. */
-static int forcing_bounds(const bsim_scene *s, scene_dt_bound *out)
+static int forcing_bounds(const bsim_scene *s, scene_dt_bound *out, int describe)
 {
 	const bsim_effects_def *e = &s->effects;
 	int n = 0;
 	if (e->has_random_force && e->random_model == BSIM_RANDOM_HELD) {
 		scene_dt_bound *b = &out[n++];
 		*b = (scene_dt_bound){.max = 1.0 / e->random_frequency};
-		snprintf(b->what, sizeof b->what, "the random force's hold 1/f, f = %g Hz",
-		         e->random_frequency);
-		static const char *const p[] = {"effects.random_force.frequency",
-		                                "effects.random_force.model"};
-		bound_paths(b, p, 2, 0);
+		if (describe) {
+			snprintf(b->what, sizeof b->what, "the random force's hold 1/f, f = %g Hz",
+			         e->random_frequency);
+			static const char *const p[] = {"effects.random_force.frequency",
+			                                "effects.random_force.model"};
+			bound_paths(b, p, 2, 0);
+		}
 	}
 	if (e->has_random_force && e->random_model == BSIM_RANDOM_OU) {
 		scene_dt_bound *b = &out[n++];
 		*b = (scene_dt_bound){.max = e->random_correlation_time};
-		snprintf(b->what, sizeof b->what,
-		         "the ou random force's correlation time tau = %g s",
-		         e->random_correlation_time);
-		static const char *const p[] = {"effects.random_force.correlation_time",
-		                                "effects.random_force.model"};
-		bound_paths(b, p, 2, 0);
+		if (describe) {
+			snprintf(b->what, sizeof b->what,
+			         "the ou random force's correlation time tau = %g s",
+			         e->random_correlation_time);
+			static const char *const p[] = {"effects.random_force.correlation_time",
+			                                "effects.random_force.model"};
+			bound_paths(b, p, 2, 0);
+		}
 	}
 	if (e->has_oscillation) {
 		scene_dt_bound *b = &out[n++];
 		*b = (scene_dt_bound){.max = 0.5 / e->osc_frequency, .strict = 1};
-		snprintf(b->what, sizeof b->what,
-		         "half the oscillation's period 1/(2f), f = %g Hz (Nyquist)",
-		         e->osc_frequency);
-		static const char *const p[] = {"effects.oscillation.frequency"};
-		bound_paths(b, p, 1, 0);
+		if (describe) {
+			snprintf(b->what, sizeof b->what,
+			         "half the oscillation's period 1/(2f), f = %g Hz (Nyquist)",
+			         e->osc_frequency);
+			static const char *const p[] = {"effects.oscillation.frequency"};
+			bound_paths(b, p, 1, 0);
+		}
 	}
 	return n;
 }
 
 /* The beams' spring and damper: the tightest beam of each. */
-static int beam_bounds(const bsim_scene *s, scene_dt_bound *out)
+static int beam_bounds(const bsim_scene *s, scene_dt_bound *out, int describe)
 {
 	int spring = -1, damper = -1;
 	double t_spring = INFINITY, t_damper = INFINITY;
@@ -116,30 +122,35 @@ static int beam_bounds(const bsim_scene *s, scene_dt_bound *out)
 		const bsim_beam_def *d = &s->beams[spring];
 		scene_dt_bound *b = &out[n++];
 		*b = (scene_dt_bound){.max = t_spring};
-		snprintf(b->what, sizeof b->what,
-		         "half the natural period pi sqrt(I/k) of beam %d (beams.%d), I = %g kg "
-		         "m^2, k = %g N m/rad",
-		         spring + 1, spring, d->inertia, d->stiffness);
-		if (s->has_lattice)
-			bound_paths(b, lattice_p, 5, 0);
-		else
-			bound_paths(b, beam_p, 4, spring);
+		if (describe) {
+			snprintf(b->what, sizeof b->what,
+			         "half the natural period pi sqrt(I/k) of beam %d (beams.%d), I = "
+			         "%g kg "
+			         "m^2, k = %g N m/rad",
+			         spring + 1, spring, d->inertia, d->stiffness);
+			if (s->has_lattice)
+				bound_paths(b, lattice_p, 5, 0);
+			else
+				bound_paths(b, beam_p, 4, spring);
+		}
 	}
 	if (damper >= 0) {
 		const bsim_beam_def *d = &s->beams[damper];
 		scene_dt_bound *b = &out[n++];
 		*b = (scene_dt_bound){.max = t_damper};
-		snprintf(
-		        b->what, sizeof b->what,
-		        "twice the damping time 2 I/d of beam %d (beams.%d), I = %g kg m^2, d = %g "
-		        "N m s/rad",
-		        damper + 1, damper, d->inertia, d->damping);
-		static const char *const beam_d[] = {"beams.%d.damping", "beams.%d.inertia",
-		                                     "beams.%d.mass", "beams.%d.length"};
-		static const char *const lattice_d[] = {"lattice.beam.damping",
-		                                        "lattice.beam.inertia", "lattice.beam.mass",
-		                                        "lattice.beam.length"};
-		bound_paths(b, s->has_lattice ? lattice_d : beam_d, 4, damper);
+		if (describe) {
+			snprintf(b->what, sizeof b->what,
+			         "twice the damping time 2 I/d of beam %d (beams.%d), I = %g kg "
+			         "m^2, d = %g "
+			         "N m s/rad",
+			         damper + 1, damper, d->inertia, d->damping);
+			static const char *const beam_d[] = {"beams.%d.damping", "beams.%d.inertia",
+			                                     "beams.%d.mass", "beams.%d.length"};
+			static const char *const lattice_d[] = {
+			        "lattice.beam.damping", "lattice.beam.inertia", "lattice.beam.mass",
+			        "lattice.beam.length"};
+			bound_paths(b, s->has_lattice ? lattice_d : beam_d, 4, damper);
+		}
 	}
 	return n;
 }
@@ -193,7 +204,7 @@ void bsim_scene_speed_scale(const bsim_scene *s, scene_speed *v)
 	v->total = v->start + v->forces + v->spin + v->tips;
 }
 
-static int crossing_bound(const bsim_scene *s, scene_dt_bound *b)
+static int crossing_bound(const bsim_scene *s, scene_dt_bound *b, int describe)
 {
 	scene_speed v;
 	bsim_scene_speed_scale(s, &v);
@@ -207,6 +218,8 @@ static int crossing_bound(const bsim_scene *s, scene_dt_bound *b)
 			shortest = i;
 		}
 	*b = (scene_dt_bound){.max = size / v.total};
+	if (!describe)
+		return 1;
 	char whose[64], extra[96] = "";
 	if (shortest >= 0)
 		snprintf(whose, sizeof whose, "beam %d's length", shortest + 1);
@@ -236,12 +249,19 @@ static int crossing_bound(const bsim_scene *s, scene_dt_bound *b)
 	return 1;
 }
 
+/* The bounds, each with its description and fields where describe (only
+ * a bound a step breaks needs them: a scene checked costs no text). */
+static int dt_bounds(const bsim_scene *s, scene_dt_bound out[SCENE_DT_BOUNDS], int describe)
+{
+	int n = forcing_bounds(s, out, describe);
+	n += beam_bounds(s, out + n, describe);
+	n += crossing_bound(s, out + n, describe);
+	return n;
+}
+
 int bsim_scene_dt_bounds(const bsim_scene *s, scene_dt_bound out[SCENE_DT_BOUNDS])
 {
-	int n = forcing_bounds(s, out);
-	n += beam_bounds(s, out + n);
-	n += crossing_bound(s, out + n);
-	return n;
+	return dt_bounds(s, out, 1);
 }
 
 static int dt_breaks(double dt, const scene_dt_bound *b)
@@ -253,13 +273,15 @@ static int dt_breaks(double dt, const scene_dt_bound *b)
 int bsim_scene_dt_find(const bsim_scene *s, scene_dt_bound *broken)
 {
 	scene_dt_bound all[SCENE_DT_BOUNDS];
-	int n = bsim_scene_dt_bounds(s, all), found = 0;
+	int n = dt_bounds(s, all, 0), found = -1;
 	for (int i = 0; i < n; i++)
-		if (dt_breaks(s->dt, &all[i]) && (!found || all[i].max < broken->max)) {
-			*broken = all[i];
-			found = 1;
-		}
-	return found;
+		if (dt_breaks(s->dt, &all[i]) && (found < 0 || all[i].max < all[found].max))
+			found = i;
+	if (found < 0)
+		return 0;
+	dt_bounds(s, all, 1); /* the same bounds, described */
+	*broken = all[found];
+	return 1;
 }
 
 /* x rounded down to 4 significant digits, so that the bound a message
