@@ -30,6 +30,7 @@
 #include "util/figure.h"
 #include "figures/figures_paths.h"
 #include "support.h"
+#include "store/index_html.h"
 
 /* ---- helpers --------------------------------------------------------------------- */
 
@@ -219,6 +220,53 @@ static const char *sweep_plotted(void)
 		plotted = 1;
 	}
 	return dir;
+}
+
+/* A figure holds at most 12 panels: traversal against F_prop over 13
+ * values of Rm is two pages, the second holding the 13th panel alone (the
+ * data file's block 12), each page a PNG of its own with its caption;
+ * traversal against Rm (2 panels) is one. */
+static void test_pages(void **state)
+{
+	(void)state;
+	const char *dir = bsim_test_dir("pages");
+	char yaml[2048], exp[1100];
+	snprintf(yaml, sizeof yaml,
+	         "scene: %s\ntrials: 1\nseed: 1\nset:\n  integration.duration: 0.2\ngrid:\n"
+	         "  effects.propulsion.force: [8, 9]\n"
+	         "  effects.random_force.magnitude: [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]\n",
+	         bsim_test_src("configs/thesis/gate.yaml"));
+	snprintf(exp, sizeof exp, "%s", bsim_test_write(dir, "pages.yaml", yaml));
+	char out_dir[1100];
+	snprintf(out_dir, sizeof out_dir, "%s", bsim_test_join(dir, "out"));
+	const char *sweep[] = {"sweep", exp, "--quiet", "--out", out_dir, NULL};
+	assert_int_equal(run_cli(sweep, NULL, NULL), 0);
+	const char *plot[] = {"plot", out_dir, NULL};
+	assert_int_equal(run_cli(plot, NULL, NULL), 0);
+	const char *f = "traversal_vs_effects_propulsion_force";
+	char path[1400];
+	snprintf(path, sizeof path, "%s/%s.png", out_dir, f);
+	assert_true(bsim_test_exists(path));
+	snprintf(path, sizeof path, "%s/%s_p2.png", out_dir, f);
+	assert_true(bsim_test_exists(path));
+	snprintf(path, sizeof path, "%s/%s_p3.png", out_dir, f);
+	assert_false(bsim_test_exists(path));
+	snprintf(path, sizeof path, "%s/%s_p2.gp", out_dir, f);
+	char *gp = bsim_test_read(path);
+	assert_non_null(gp);
+	assert_non_null(strstr(gp, "index 12 "));
+	assert_null(strstr(gp, "index 11 "));
+	assert_non_null(strstr(gp, "(page 2 of 2)"));
+	free(gp);
+	snprintf(path, sizeof path, "%s/traversal_vs_effects_random_force_magnitude_p2.png",
+	         out_dir);
+	assert_false(bsim_test_exists(path));
+	char caption[512];
+	bsim_index_caption("traversal_vs_effects_propulsion_force_p2.png", caption,
+	                   sizeof caption);
+	assert_non_null(strstr(caption, "propulsive force"));
+	assert_non_null(strstr(caption, "(page 2 of its panels)"));
+	assert_true(bsim_test_check_figures(out_dir) >= 4);
 }
 
 static void test_sweep_figures(void **state)
@@ -739,6 +787,7 @@ int main(void)
 	        cmocka_unit_test(test_sweep_figures),
 	        cmocka_unit_test(test_paths_over_landscape),
 	        cmocka_unit_test(test_select),
+	        cmocka_unit_test(test_pages),
 	        cmocka_unit_test(test_names_and_titles),
 	        cmocka_unit_test(test_not_an_output),
 	        cmocka_unit_test(test_bad_input),

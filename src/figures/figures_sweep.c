@@ -154,6 +154,9 @@ static void axes_along(const fsum *s, const active *a, int *ax0, int *ax1)
 
 /* ---- Fig. 3.1 -------------------------------------------------------------------- */
 
+/* The most panels one figure of traversal against an axis holds. */
+#define PAGE_PANELS 12
+
 /* Pixels of a text of n characters at the figures' 11 pt font. */
 #define TEXT_PX(n) (15 * (n) / 2 + 60)
 
@@ -386,90 +389,123 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 		free(first);
 		return rc;
 	}
-	gp_text g;
-	if ((rc = bsim_gp_text_open(&g, err))) {
-		free(first);
-		return rc;
-	}
-	/* The panels and, in the cell after them, the key; many panels get
-	 * smaller ones, so that the image stays well under 1 MB. A panel is
-	 * titled by the values of the other axes, named once in the title. A
-	 * single panel has its key beside it in a narrower cell. */
-	int rows, cols;
-	layout(np, &rows, &cols);
-	if (rows * cols == np && np > 1)
-		layout(np + 1, &rows, &cols);
-	const int pw = np > 12 ? 400 : 520, ph = np > 12 ? 300 : 380;
-	const int key_w = lattice ? 230 : 330;
-	int W = np == 1 ? 640 + key_w : pw * cols, H = np == 1 ? 560 : ph * rows + 90;
-	char title[2000], others[600] = "", axis_label[300];
-	size_t L = 0;
-	for (int oa = 0; oa < s->n_axes && L < sizeof others; oa++)
-		if (oa != ax && a->n[oa] > 1) {
-			char lab[300];
-			bsim_key_label(s->axes[oa].key, 0, lab, sizeof lab);
-			int w = snprintf(others + L, sizeof others - L, "%s%s", L ? ", " : "", lab);
-			L += w > 0 ? (size_t)w : 0;
-		}
-	bsim_key_label(A->key, 0, axis_label, sizeof axis_label);
-	snprintf(title, sizeof title,
-	         "%s against %s, %d trials per group, 95%% Wilson bands\n%s%s%s",
-	         lattice ? "where the trials ended" : "traversal", axis_label, s->trials_per_group,
-	         s->header, L ? "\npanels: " : "", others);
-	if (W < TEXT_PX(widest_line(title)))
-		W = TEXT_PX(widest_line(title));
-	/* a single panel placed by hand: below the title's lines */
-	int title_lines = 1;
-	for (const char *c = title; *c; c++)
-		title_lines += *c == '\n';
-	const double top = 1.0 - (18.0 * title_lines + 14.0) / H;
-	if (np == 1)
-		fputs("set multiplot title ", g.f);
-	else
-		fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
-	bsim_gp_str(g.f, title);
-	fputs(" noenhanced\nset yrange [0:1]\nset ylabel 'fraction of trials'\nset xlabel ", g.f);
-	bsim_gp_key_label(g.f, A->key);
-	fputs("\nset grid\nset style fill transparent solid 0.15 noborder\n"
-	      "unset key\n",
-	      g.f);
-	/* k_1 against a fixed k_2 (or the other way round): the essay's
-	 * stiffness ratio k_1/k_2 (H2, Fig. 3.4) on the top axis */
-	double other;
-	int ratio = 0;
-	if (A->numeric && strcmp(A->key, "beams.0.stiffness") == 0 &&
-	    bsim_fsum_fixed_number(s, "beams.1.stiffness", &other) && other > 0) {
-		fprintf(g.f, "set link x2 via x/%.17g inverse x*%.17g\n", other, other);
-		ratio = 1;
-	} else if (A->numeric && strcmp(A->key, "beams.1.stiffness") == 0 &&
-	           bsim_fsum_fixed_number(s, "beams.0.stiffness", &other) && other > 0) {
-		fprintf(g.f, "set link x2 via %.17g/x inverse %.17g/x\n", other, other);
-		ratio = 1;
-	}
-	if (ratio)
-		fputs("set x2tics nomirror\nset xtics nomirror\n"
-		      "set x2label 'stiffness ratio k_{1}/k_{2}' enhanced\n",
-		      g.f);
-	if (np == 1)
-		fprintf(g.f, "set origin 0,0\nset size %.4f,%.4f\n", 640.0 / W, top);
-	if (!A->numeric)
-		tics(g.f, "x", A, a->pos[ax]);
-	for (int p = 0; p < np; p++) {
-		char label[512] = "";
-		size_t k = 0;
-		for (int oa = 0; oa < s->n_axes && k < sizeof label; oa++)
+	/* At most PAGE_PANELS panels a figure, readable at its size: more are
+	 * pages of their own, traversal_vs_KEY_p2.png, ..., each with the key,
+	 * all drawing from the one data file. */
+	const int pages = (np + PAGE_PANELS - 1) / PAGE_PANELS;
+	for (int page = 0; rc == BSIM_OK && page < pages; page++) {
+		const int p0 = page * PAGE_PANELS;
+		const int npp = np - p0 < PAGE_PANELS ? np - p0 : PAGE_PANELS;
+		gp_text g;
+		if ((rc = bsim_gp_text_open(&g, err)))
+			break;
+		/* The panels and, in the cell after them, the key; many panels get
+		 * smaller ones, so that the image stays well under 1 MB. A panel is
+		 * titled by the values of the other axes, named once in the title. A
+		 * single panel has its key beside it in a narrower cell. */
+		int rows, cols;
+		layout(npp, &rows, &cols);
+		if (rows * cols == npp && npp > 1)
+			layout(npp + 1, &rows, &cols);
+		const int pw = npp > 12 ? 400 : 520, ph = npp > 12 ? 300 : 380;
+		const int key_w = lattice ? 230 : 330;
+		int W = npp == 1 ? 640 + key_w : pw * cols, H = npp == 1 ? 560 : ph * rows + 90;
+		char title[2000], others[600] = "", axis_label[300];
+		size_t L = 0;
+		for (int oa = 0; oa < s->n_axes && L < sizeof others; oa++)
 			if (oa != ax && a->n[oa] > 1) {
-				char kv[200];
-				bsim_figs_key_value(s->axes[oa].key,
-				                    s->axes[oa].values[s->g[first[p]].idx[oa]], kv,
-				                    sizeof kv);
-				int w = snprintf(label + k, sizeof label - k, "%s%s", k ? ", " : "",
-				                 kv);
-				k += w > 0 ? (size_t)w : 0;
+				char lab[300];
+				bsim_key_label(s->axes[oa].key, 0, lab, sizeof lab);
+				int w = snprintf(others + L, sizeof others - L, "%s%s",
+				                 L ? ", " : "", lab);
+				L += w > 0 ? (size_t)w : 0;
 			}
-		fputs("set title ", g.f);
-		bsim_gp_str(g.f, label);
-		if (lattice) {
+		bsim_key_label(A->key, 0, axis_label, sizeof axis_label);
+		char page_of[48] = "";
+		if (pages > 1)
+			snprintf(page_of, sizeof page_of, " (page %d of %d)", page + 1, pages);
+		snprintf(title, sizeof title,
+		         "%s against %s, %d trials per group, 95%% Wilson bands%s\n%s%s%s",
+		         lattice ? "where the trials ended" : "traversal", axis_label,
+		         s->trials_per_group, page_of, s->header, L ? "\npanels: " : "", others);
+		if (W < TEXT_PX(widest_line(title)))
+			W = TEXT_PX(widest_line(title));
+		/* a single panel placed by hand: below the title's lines */
+		int title_lines = 1;
+		for (const char *c = title; *c; c++)
+			title_lines += *c == '\n';
+		const double top = 1.0 - (18.0 * title_lines + 14.0) / H;
+		if (npp == 1)
+			fputs("set multiplot title ", g.f);
+		else
+			fprintf(g.f, "set multiplot layout %d,%d title ", rows, cols);
+		bsim_gp_str(g.f, title);
+		fputs(" noenhanced\nset yrange [0:1]\nset ylabel 'fraction of trials'\nset xlabel ",
+		      g.f);
+		bsim_gp_key_label(g.f, A->key);
+		fputs("\nset grid\nset style fill transparent solid 0.15 noborder\n"
+		      "unset key\n",
+		      g.f);
+		/* k_1 against a fixed k_2 (or the other way round): the essay's
+		 * stiffness ratio k_1/k_2 (H2, Fig. 3.4) on the top axis */
+		double other;
+		int ratio = 0;
+		if (A->numeric && strcmp(A->key, "beams.0.stiffness") == 0 &&
+		    bsim_fsum_fixed_number(s, "beams.1.stiffness", &other) && other > 0) {
+			fprintf(g.f, "set link x2 via x/%.17g inverse x*%.17g\n", other, other);
+			ratio = 1;
+		} else if (A->numeric && strcmp(A->key, "beams.1.stiffness") == 0 &&
+		           bsim_fsum_fixed_number(s, "beams.0.stiffness", &other) && other > 0) {
+			fprintf(g.f, "set link x2 via %.17g/x inverse %.17g/x\n", other, other);
+			ratio = 1;
+		}
+		if (ratio)
+			fputs("set x2tics nomirror\nset xtics nomirror\n"
+			      "set x2label 'stiffness ratio k_{1}/k_{2}' enhanced\n",
+			      g.f);
+		if (npp == 1)
+			fprintf(g.f, "set origin 0,0\nset size %.4f,%.4f\n", 640.0 / W, top);
+		if (!A->numeric)
+			tics(g.f, "x", A, a->pos[ax]);
+		for (int p = p0; p < p0 + npp; p++) {
+			char label[512] = "";
+			size_t k = 0;
+			for (int oa = 0; oa < s->n_axes && k < sizeof label; oa++)
+				if (oa != ax && a->n[oa] > 1) {
+					char kv[200];
+					bsim_figs_key_value(
+					        s->axes[oa].key,
+					        s->axes[oa].values[s->g[first[p]].idx[oa]], kv,
+					        sizeof kv);
+					int w = snprintf(label + k, sizeof label - k, "%s%s",
+					                 k ? ", " : "", kv);
+					k += w > 0 ? (size_t)w : 0;
+				}
+			fputs("set title ", g.f);
+			bsim_gp_str(g.f, label);
+			if (lattice) {
+				fprintf(g.f,
+				        " noenhanced\n"
+				        "plot '%s' index %d using 1:3:4 with filledcurves lc rgb "
+				        "'%s', \\\n"
+				        "     '' index %d using 1:6:7 with filledcurves lc rgb "
+				        "'%s', \\\n"
+				        "     '' index %d using 1:9:10 with filledcurves lc rgb "
+				        "'%s', \\\n"
+				        "     '' index %d using 1:2 with linespoints lw 2 pt 7 lc "
+				        "rgb "
+				        "'%s', \\\n"
+				        "     '' index %d using 1:5 with linespoints lw 1.5 pt 5 "
+				        "lc rgb "
+				        "'%s', "
+				        "\\\n"
+				        "     '' index %d using 1:8 with linespoints lw 1.5 pt 9 "
+				        "lc rgb "
+				        "'%s'\n",
+				        file, p, FIG_BLUE, p, FIG_GREY, p, FIG_DKGREY, p, FIG_BLUE,
+				        p, FIG_GREY, p, FIG_DKGREY);
+				continue;
+			}
 			fprintf(g.f,
 			        " noenhanced\n"
 			        "plot '%s' index %d using 1:3:4 with filledcurves lc rgb '%s', \\\n"
@@ -478,66 +514,67 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 			        "     '' index %d using 1:2 with linespoints lw 2 pt 7 lc rgb "
 			        "'%s', \\\n"
 			        "     '' index %d using 1:5 with linespoints lw 1.5 pt 5 lc rgb "
-			        "'%s', "
-			        "\\\n"
+			        "'%s', \\\n"
 			        "     '' index %d using 1:8 with linespoints lw 1.5 pt 9 lc rgb "
-			        "'%s'\n",
-			        file, p, FIG_BLUE, p, FIG_GREY, p, FIG_DKGREY, p, FIG_BLUE, p,
-			        FIG_GREY, p, FIG_DKGREY);
-			continue;
+			        "'%s', \\\n"
+			        "     '' index %d using 1:11 with lines dt 2 lc rgb '%s', \\\n"
+			        "     '' index %d using 1:12 with lines dt 2 lc rgb '%s'\n",
+			        file, p, FIG_BLACK, p, FIG_BLUE, p, FIG_RED, p, FIG_BLACK, p,
+			        FIG_BLUE, p, FIG_RED, p, FIG_BLUE, p, FIG_RED);
 		}
-		fprintf(g.f,
-		        " noenhanced\n"
-		        "plot '%s' index %d using 1:3:4 with filledcurves lc rgb '%s', \\\n"
-		        "     '' index %d using 1:6:7 with filledcurves lc rgb '%s', \\\n"
-		        "     '' index %d using 1:9:10 with filledcurves lc rgb '%s', \\\n"
-		        "     '' index %d using 1:2 with linespoints lw 2 pt 7 lc rgb '%s', \\\n"
-		        "     '' index %d using 1:5 with linespoints lw 1.5 pt 5 lc rgb '%s', \\\n"
-		        "     '' index %d using 1:8 with linespoints lw 1.5 pt 9 lc rgb '%s', \\\n"
-		        "     '' index %d using 1:11 with lines dt 2 lc rgb '%s', \\\n"
-		        "     '' index %d using 1:12 with lines dt 2 lc rgb '%s'\n",
-		        file, p, FIG_BLACK, p, FIG_BLUE, p, FIG_RED, p, FIG_BLACK, p, FIG_BLUE, p,
-		        FIG_RED, p, FIG_BLUE, p, FIG_RED);
+		if (npp == 1)
+			fprintf(g.f, "set origin %.4f,0\nset size %.4f,%.4f\n", 640.0 / W,
+			        1.0 - 640.0 / W, top);
+		fputs("unset link x2\nunset x2tics\nunset x2label\n", g.f);
+		if (lattice)
+			fprintf(g.f,
+			        "# the key, in a cell of its own\n"
+			        "unset title\nunset border\nunset tics\nunset xlabel\nunset "
+			        "ylabel\n"
+			        "unset grid\nset key center center vertical font ',10'\nset xrange "
+			        "[0:1]\n"
+			        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title 'reached "
+			        "the end "
+			        "(traversed)', \\\n"
+			        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'side "
+			        "exit', \\\n"
+			        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'stuck', "
+			        "\\\n"
+			        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
+			        FIG_BLUE, FIG_GREY, FIG_DKGREY, FIG_GREY);
+		else
+			fprintf(g.f,
+			        "# the key, in a cell of its own\n"
+			        "unset title\nunset border\nunset tics\nunset xlabel\nunset "
+			        "ylabel\nunset "
+			        "grid\n"
+			        "set key center center vertical font ',10'\nset xrange [0:1]\n"
+			        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title "
+			        "'traversed', \\\n"
+			        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'left "
+			        "type (v_x > "
+			        "0 at "
+			        "classify y)', \\\n"
+			        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'right "
+			        "type (v_x "
+			        "< 0)', "
+			        "\\\n"
+			        "     NaN with lines dt 2 lc rgb '%s' title 'over the left beam "
+			        "(landscape "
+			        "label)', \\\n"
+			        "     NaN with lines dt 2 lc rgb '%s' title 'over the right beam', "
+			        "\\\n"
+			        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
+			        FIG_BLACK, FIG_BLUE, FIG_RED, FIG_BLUE, FIG_RED, FIG_GREY);
+		fputs("unset multiplot\n", g.f);
+		char *body = bsim_gp_text_take(&g);
+		char page_name[160];
+		snprintf(page_name, sizeof page_name, page ? "%s_p%d" : "%s", name, page + 1);
+		rc = body ? bsim_figs_render(f, page_name, W, H, body, err)
+		          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		free(body);
 	}
-	if (np == 1)
-		fprintf(g.f, "set origin %.4f,0\nset size %.4f,%.4f\n", 640.0 / W, 1.0 - 640.0 / W,
-		        top);
-	fputs("unset link x2\nunset x2tics\nunset x2label\n", g.f);
-	if (lattice)
-		fprintf(g.f,
-		        "# the key, in a cell of its own\n"
-		        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\n"
-		        "unset grid\nset key center center vertical font ',10'\nset xrange [0:1]\n"
-		        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title 'reached the end "
-		        "(traversed)', \\\n"
-		        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'side exit', \\\n"
-		        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'stuck', \\\n"
-		        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
-		        FIG_BLUE, FIG_GREY, FIG_DKGREY, FIG_GREY);
-	else
-		fprintf(g.f,
-		        "# the key, in a cell of its own\n"
-		        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\nunset "
-		        "grid\n"
-		        "set key center center vertical font ',10'\nset xrange [0:1]\n"
-		        "plot NaN with linespoints lw 2 pt 7 lc rgb '%s' title 'traversed', \\\n"
-		        "     NaN with linespoints lw 1.5 pt 5 lc rgb '%s' title 'left type (v_x > "
-		        "0 at "
-		        "classify y)', \\\n"
-		        "     NaN with linespoints lw 1.5 pt 9 lc rgb '%s' title 'right type (v_x "
-		        "< 0)', "
-		        "\\\n"
-		        "     NaN with lines dt 2 lc rgb '%s' title 'over the left beam (landscape "
-		        "label)', \\\n"
-		        "     NaN with lines dt 2 lc rgb '%s' title 'over the right beam', \\\n"
-		        "     NaN with filledcurves lc rgb '%s' title '95%% interval'\n",
-		        FIG_BLACK, FIG_BLUE, FIG_RED, FIG_BLUE, FIG_RED, FIG_GREY);
-	fputs("unset multiplot\n", g.f);
 	free(first);
-	char *body = bsim_gp_text_take(&g);
-	rc = body ? bsim_figs_render(f, name, W, H, body, err)
-	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	free(body);
 	return rc;
 }
 

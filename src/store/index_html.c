@@ -175,9 +175,16 @@ void bsim_index_caption(const char *base, char *buf, size_t size)
 		const char *c = captions[i].caption, *p = strstr(c, "%s");
 		const char *k = strstr(c, "%k");
 		if (k) {
-			char label[256];
+			/* a page of a figure's panels, KEY_pN: the key's, and which page */
+			char label[256], page[40] = "";
+			char *under = strrchr(star, '_');
+			if (under && under[1] == 'p' && under[2] >= '2' && under[2] <= '9' &&
+			    strspn(under + 2, "0123456789") == strlen(under + 2)) {
+				snprintf(page, sizeof page, " (page %.6s of its panels)", under + 2);
+				*under = '\0';
+			}
 			key_of_ident(star, label, sizeof label);
-			snprintf(buf, size, "%.*s%s%s", (int)(k - c), c, label, k + 2);
+			snprintf(buf, size, "%.*s%s%s%s", (int)(k - c), c, label, k + 2, page);
 		} else if (!p) {
 			snprintf(buf, size, "%s", c);
 		} else {
