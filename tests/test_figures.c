@@ -262,8 +262,7 @@ static void test_pages(void **state)
 	         out_dir);
 	assert_false(bsim_test_exists(path));
 	char caption[512];
-	bsim_index_caption("traversal_vs_effects_propulsion_force_p2.png", caption,
-	                   sizeof caption);
+	bsim_index_caption("traversal_vs_effects_propulsion_force_p2.png", caption, sizeof caption);
 	assert_non_null(strstr(caption, "propulsive force"));
 	assert_non_null(strstr(caption, "(page 2 of its panels)"));
 	assert_true(bsim_test_check_figures(out_dir) >= 4);

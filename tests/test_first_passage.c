@@ -69,7 +69,8 @@ static void outcome_counts(const char *dir, long counts[2][3])
 		counts[(int)g][k]++;
 		/* t_exit: t_end, as written, for an exit; empty otherwise */
 		if (k < 2)
-			assert_string_equal(bsim_csv_table_cell(&t, r, cx), bsim_csv_table_cell(&t, r, ct));
+			assert_string_equal(bsim_csv_table_cell(&t, r, cx),
+			                    bsim_csv_table_cell(&t, r, ct));
 		else
 			assert_string_equal(bsim_csv_table_cell(&t, r, cx), "");
 	}

@@ -589,7 +589,8 @@ static void test_read_is_run(void **state)
 		for (int e = 0; e < 6; e++) {
 			/* a deterministic group's events have no p-value */
 			snprintf(p, sizeof p, "groups.%d.events.%s.p_mcnemar", g, ev[e]);
-			struct fy_node *n0 = bsim_ydoc_lookup(root[0], p), *n1 = bsim_ydoc_lookup(root[1], p);
+			struct fy_node *n0 = bsim_ydoc_lookup(root[0], p),
+			               *n1 = bsim_ydoc_lookup(root[1], p);
 			assert_true((n0 == NULL) == (n1 == NULL));
 			if (n0)
 				assert_string_equal(

@@ -108,8 +108,9 @@ static void test_km_file(void **state)
 	for (int row = 0; row < 5; row++)
 		for (int c = 0; c < 4; c++) {
 			double v;
-			assert_int_equal(bsim_csv_table_number(&t, row, bsim_csv_table_col(&t, cols[c]), &v),
-			                 0);
+			assert_int_equal(
+			        bsim_csv_table_number(&t, row, bsim_csv_table_col(&t, cols[c]), &v),
+			        0);
 			assert_true(fabs(v - want[row][c]) < 1e-9);
 		}
 	bsim_csv_table_free(&t);
@@ -231,11 +232,12 @@ static void test_kramers_fit(void **state)
 		w[i] = 1e4;
 	}
 	assert_int_equal(bsim_escape_fit_line(x, y, w, N, &f, &err), BSIM_OK);
-	print_message("scatter: R^2 %.3f, p %.3g: %s\n", f.r2, f.p_poisson, bsim_escape_fit_verdict(&f));
+	print_message("scatter: R^2 %.3f, p %.3g: %s\n", f.r2, f.p_poisson,
+	              bsim_escape_fit_verdict(&f));
 	assert_true(f.p_poisson < ESCAPE_P_REJECT);
 	assert_non_null(strstr(bsim_escape_fit_verdict(&f), f.r2 < ESCAPE_R2_LITTLE
-	                                                       ? "do not describe these groups"
-	                                                       : "are not their law"));
+	                                                            ? "do not describe these groups"
+	                                                            : "are not their law"));
 	/* under three points: no fit */
 	assert_int_equal(bsim_escape_fit_line(x, y, w, 2, &f, &err), BSIM_EINPUT);
 	gsl_rng_free(rng);

@@ -174,7 +174,8 @@ static void test_run_json(void **state)
 		for (int k = 0; k < 4; k++) {
 			char a[64];
 			snprintf(a, sizeof a, "%.10g", bsim_test_json_number(out, names[k]));
-			assert_string_equal(a, bsim_csv_table_cell(&t, r, bsim_csv_table_col(&t, names[k])));
+			assert_string_equal(
+			        a, bsim_csv_table_cell(&t, r, bsim_csv_table_col(&t, names[k])));
 		}
 		free(out);
 	}

@@ -1547,7 +1547,8 @@ int box2d_set_state(bsim_world *w, const bsim_state *st, bsim_error *err)
  * distance is the largest |signed distance| of the ellipse's points from
  * it (n_samples points at equal steps of the eccentric anomaly) and of its
  * vertices' offset points from the ellipse. */
-extern "C" int bsim_box2d_ellipse_error(double a, double b, double s, double *area_rel, double *max_dist)
+extern "C" int bsim_box2d_ellipse_error(double a, double b, double s, double *area_rel,
+                                        double *max_dist)
 {
 	if (!(a > 0 && b > 0 && s > 0) || std::fmin(a, b) * s <= 2.0 * b2_polygonRadius)
 		return BSIM_EINPUT;

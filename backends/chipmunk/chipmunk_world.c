@@ -182,7 +182,8 @@ static cpShape *body_shape_new(const bsim_body_def *body, cpBody *b)
 		return cpSegmentShapeNew(b, cpv(-0.5 * body->length, 0.0),
 		                         cpv(0.5 * body->length, 0.0), body->radius);
 	cpVect ring[ELLIPSE_VERTICES];
-	bsim_chipmunk_ellipse_polygon(body->semi_axes[0], body->semi_axes[1], ELLIPSE_VERTICES, ring);
+	bsim_chipmunk_ellipse_polygon(body->semi_axes[0], body->semi_axes[1], ELLIPSE_VERTICES,
+	                              ring);
 	return cpPolyShapeNew(b, ELLIPSE_VERTICES, ring, cpTransformIdentity, 0.0);
 }
 

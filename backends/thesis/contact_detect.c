@@ -13,7 +13,8 @@ int bsim_thesis_contact_detect_disk(struct bsim_world *w, int i, double margin, 
 	return contact_detect(w, i, margin, out, 0);
 }
 
-int bsim_thesis_contact_redetect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out)
+int bsim_thesis_contact_redetect_disk(struct bsim_world *w, int i, double margin,
+                                      thesis_contact *out)
 {
 	return disk_detect(w, i, margin, out, 1, 0);
 }

@@ -125,8 +125,8 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 	}
 }
 
-void bsim_thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
-                                     double h)
+void bsim_thesis_persistent_contact_solve(struct bsim_world *w, const double force[2],
+                                          double torque, double h)
 {
 	if (w->extended)
 		persistent_solve_extended(w, force, torque, h);
@@ -134,7 +134,8 @@ void bsim_thesis_persistent_contact_solve(struct bsim_world *w, const double for
 		bsim_thesis_persistent_contact_solve_disk(w, force, h);
 }
 
-void bsim_thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2], double h)
+void bsim_thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2],
+                                               double h)
 {
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};

@@ -146,7 +146,7 @@ void bsim_thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, cons
 }
 
 int bsim_thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
-                        thesis_contact *out)
+                             thesis_contact *out)
 {
 	if (!(g->dist2 - w->radius <= margin))
 		return 0;

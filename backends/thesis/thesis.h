@@ -252,7 +252,8 @@ int bsim_thesis_broad_phase_clear(struct bsim_world *w, const double force[2], d
 
 /* thesis_flight.c: up to n steps of free flight under force, each state
  * into out[k]; returns how many (0: the next step is not one). */
-int bsim_thesis_flight(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out);
+int bsim_thesis_flight(struct bsim_world *w, const double force[2], double h, int n,
+                       bsim_state *out);
 #define THESIS_FLIGHT_WAIT_MAX 64
 
 /* thesis_steps.c: runs of steps of advance, for the worlds bsim_thesis_steps_takes
@@ -261,7 +262,8 @@ int bsim_thesis_flight(struct bsim_world *w, const double force[2], double h, in
  * out[k] (sized for the world's beams); returns n, 0 for another world. */
 #define THESIS_STEPS_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
 int bsim_thesis_steps_takes(const struct bsim_world *w);
-int bsim_thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out);
+int bsim_thesis_steps(struct bsim_world *w, const double force[2], double h, int n,
+                      bsim_state *out);
 
 /* beam_sleep.c */
 void bsim_thesis_beam_wake(struct bsim_world *w, int i);
@@ -275,16 +277,18 @@ int bsim_thesis_contact_detect(struct bsim_world *w, int i, double margin, thesi
 /* Each _disk function below: the same for the essay's disk (w->extended 0)
  * only, compiled without the extended path's tests and stores (a contact's
  * extended fields are not set); thesis_step picks once a step. */
-int bsim_thesis_contact_detect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out);
+int bsim_thesis_contact_detect_disk(struct bsim_world *w, int i, double margin,
+                                    thesis_contact *out);
 /* The same for a beam the step found in contact (the projection's
  * re-detection): disk_detect's near, the same result. */
-int bsim_thesis_contact_redetect_disk(struct bsim_world *w, int i, double margin, thesis_contact *out);
+int bsim_thesis_contact_redetect_disk(struct bsim_world *w, int i, double margin,
+                                      thesis_contact *out);
 /* shape_contact.c: a body of another shape than the disk against beam b of
  * direction u (thesis_beam_direction), into b->geo; and a capsule's second contact with the beam of
  * geometry g into out[1] (out[0] the first) if within margin: 1, else 0. */
 void bsim_thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const double u[2]);
 int bsim_thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
-                        thesis_contact *out);
+                             thesis_contact *out);
 /* 0 if beam i certainly lies farther than R + margin from the body (its
  * reach, or the bound from its last geometry), 1 if it may not. */
 int bsim_thesis_contact_near(const struct bsim_world *w, int i, double margin);
@@ -320,9 +324,10 @@ int bsim_thesis_impact_resolve(struct bsim_world *w, double h);
 int bsim_thesis_impact_resolve_disk(struct bsim_world *w, double h);
 
 /* persistent_contact.c */
-void bsim_thesis_persistent_contact_solve(struct bsim_world *w, const double force[2], double torque,
-                                     double h);
-void bsim_thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2], double h);
+void bsim_thesis_persistent_contact_solve(struct bsim_world *w, const double force[2],
+                                          double torque, double h);
+void bsim_thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2],
+                                               double h);
 
 /* position_project.c; projections per step at most. */
 #define THESIS_PROJECT_PASSES_MAX 3

@@ -33,8 +33,8 @@ typedef struct escape_fit {
 /* Fits y = a + b x over n points (events[i] the Poisson weight of point i
  * for chisq_poisson; may be NULL). BSIM_EINPUT under 3 points or without
  * spread in x. */
-int bsim_escape_fit_line(const double *x, const double *y, const double *events, int n, escape_fit *out,
-                    bsim_error *err);
+int bsim_escape_fit_line(const double *x, const double *y, const double *events, int n,
+                         escape_fit *out, bsim_error *err);
 
 /* What the fit f says of the data, in a sentence (a constant string): the
  * Arrhenius line is rejected when the residuals exceed their Poisson

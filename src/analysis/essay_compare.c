@@ -618,7 +618,7 @@ static void sens_row(bsim_essay_sens_row *w, const essay_job *j, const char *mod
 }
 
 int bsim_essay_compare_batch(const bsim_essay_config *cfg, sweep_batch *sb, bsim_essay_result *out,
-                        bsim_error *err)
+                             bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
 	if (cfg->trials < 1 || cfg->lattice_trials < 1 || cfg->sens_trials < 0 || cfg->n_modes < 1)

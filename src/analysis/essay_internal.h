@@ -11,6 +11,6 @@
  * fills out's rows; otherwise (a shard, another rank) out holds nothing.
  * The caller ends sb (bsim_sweep_batch_end). */
 int bsim_essay_compare_batch(const bsim_essay_config *cfg, sweep_batch *sb, bsim_essay_result *out,
-                        bsim_error *err);
+                             bsim_error *err);
 
 #endif

@@ -96,7 +96,7 @@ int bsim_markov_bin_of(const bsim_markov_bins *b, const bsim_lattice_def *l, int
  * inside by half a step's normal travel (the lattice sees an entry at the
  * end of the step that crossed). */
 void bsim_markov_bin_sample(const bsim_markov_bins *b, const bsim_lattice_def *l, double h, int bin,
-                       gsl_rng *rng, double x[2], double v[2])
+                            gsl_rng *rng, double x[2], double v[2])
 {
 	int k = bin - 1;
 	int id = k % b->n_dir;

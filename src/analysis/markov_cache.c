@@ -58,8 +58,8 @@ static uint64_t layout_hash(const bsim_scene *lattice)
 	return h;
 }
 
-const char *bsim_markov_entries_label(const bsim_markov_def *def, const bsim_scene *lattice, char *buf,
-                                 size_t size)
+const char *bsim_markov_entries_label(const bsim_markov_def *def, const bsim_scene *lattice,
+                                      char *buf, size_t size)
 {
 	if (def->entries)
 		return def->entries->id;
@@ -113,8 +113,8 @@ static void markov_key_extra(FILE *f, const bsim_scene *s)
 }
 
 /* Every input of a map, a line each, numbers to the last bit (%.17g). */
-char *bsim_markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                      const bsim_options *opts, const double k[2])
+char *bsim_markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def,
+                           const bsim_backend *be, const bsim_options *opts, const double k[2])
 {
 	markov_gate_scene g;
 	bsim_markov_gate_scene_init(&g, lattice, k);
@@ -440,7 +440,7 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 }
 
 int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_markov_bins *b,
-                     bsim_error *err)
+                          bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/map_%016llx.key", stage, (unsigned long long)m->key);
@@ -490,7 +490,7 @@ int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsi
 }
 
 int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
-                     const bsim_options *opts, bsim_error *err)
+                          const bsim_options *opts, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/markov.json", stage);
@@ -603,11 +603,12 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	if (rc == BSIM_OK)
 		rc = def_string(&d, "/beamsim_version", version, sizeof version, err);
 	if (rc == BSIM_OK && strcmp(version, BSIM_VERSION) != 0)
-		rc = bsim_ydoc_fail(&d, def_field(&d, "/beamsim_version", "a string", err), NULL,
-		               "beamsim_version", err,
-		               "expected maps of this beamsim, %s, got maps built by beamsim %s "
-		               "(build them again with beamsim markov build)",
-		               BSIM_VERSION, version);
+		rc = bsim_ydoc_fail(
+		        &d, def_field(&d, "/beamsim_version", "a string", err), NULL,
+		        "beamsim_version", err,
+		        "expected maps of this beamsim, %s, got maps built by beamsim %s "
+		        "(build them again with beamsim markov build)",
+		        BSIM_VERSION, version);
 	if (rc == BSIM_OK)
 		rc = def_int(&d, "/bins/position", 1, 64, &def->bins.n_pos, err);
 	if (rc == BSIM_OK)
@@ -617,8 +618,10 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	if (rc == BSIM_OK) {
 		struct fy_node *n = def_field(&d, "/bins/v_max", "a speed > 0, m/s", err);
 		rc = !n ? BSIM_EINPUT
-		     : bsim_ydoc_number(n, &def->bins.v_max) != YDOC_NUM_OK || !(def->bins.v_max > 0)
-		             ? bsim_ydoc_expected(&d, n, NULL, "bins/v_max", "a speed > 0, m/s", err)
+		     : bsim_ydoc_number(n, &def->bins.v_max) != YDOC_NUM_OK ||
+		                     !(def->bins.v_max > 0)
+		             ? bsim_ydoc_expected(&d, n, NULL, "bins/v_max", "a speed > 0, m/s",
+		                                  err)
 		             : BSIM_OK;
 	}
 	if (rc == BSIM_OK)
@@ -630,10 +633,10 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 		char *end = NULL;
 		errno = 0;
 		seed = t && *t >= '0' && *t <= '9' ? strtoull(t, &end, 10) : 0;
-		rc = !n ? BSIM_EINPUT
-		     : !end || *end || errno
-		             ? bsim_ydoc_expected(&d, n, NULL, "seed", "a seed, an integer >= 0", err)
-		             : BSIM_OK;
+		rc = !n                      ? BSIM_EINPUT
+		     : !end || *end || errno ? bsim_ydoc_expected(&d, n, NULL, "seed",
+		                                                  "a seed, an integer >= 0", err)
+		                             : BSIM_OK;
 	}
 	if (rc == BSIM_OK)
 		rc = def_string(&d, "/backend", backend, sizeof backend, err);
@@ -642,7 +645,8 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 		if (!n)
 			rc = BSIM_EINPUT;
 		else if (!fy_node_is_sequence(n))
-			rc = bsim_ydoc_expected(&d, n, NULL, "options", "a list of \"KEY=VALUE\"", err);
+			rc = bsim_ydoc_expected(&d, n, NULL, "options", "a list of \"KEY=VALUE\"",
+			                        err);
 		void *it = NULL;
 		struct fy_node *kv;
 		while (rc == BSIM_OK && (kv = fy_node_sequence_iterate(n, &it))) {

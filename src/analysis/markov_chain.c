@@ -187,7 +187,7 @@ static void chain_free(chain *c, int n_maps)
 }
 
 int bsim_markov_gate_maps(const bsim_scene *lattice, const bsim_markov_set *set, int *gate_map,
-                     bsim_error *err)
+                          bsim_error *err)
 {
 	const bsim_lattice_def *l = &lattice->lattice;
 	for (int iy = 0; iy < l->rows; iy++)

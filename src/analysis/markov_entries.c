@@ -120,7 +120,7 @@ int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entrie
 }
 
 int bsim_markov_entry_index_init(markov_entry_index *x, const bsim_markov_entries *e,
-                            const bsim_markov_bins *b, const bsim_lattice_def *l)
+                                 const bsim_markov_bins *b, const bsim_lattice_def *l)
 {
 	const int nb = bsim_markov_bins_count(b);
 	x->first = calloc((size_t)nb + 1, sizeof *x->first);

@@ -29,7 +29,7 @@
 #define LABEL_FROM 0.005
 
 void bsim_markov_title_params(char *buf, size_t size, const char *backend, const bsim_override *ov,
-                         int n)
+                              int n)
 {
 	size_t k = 0;
 	buf[0] = '\0';
@@ -78,8 +78,8 @@ void bsim_markov_field_totals(const bsim_location *loc, const double *p, int n, 
 }
 
 int bsim_markov_field_figure(const char *stage, const char *name, const char *title,
-                        const bsim_location *loc, int n, const markov_field_panel *panel,
-                        int n_panels, int per_row, int *drawn, bsim_error *err)
+                             const bsim_location *loc, int n, const markov_field_panel *panel,
+                             int n_panels, int per_row, int *drawn, bsim_error *err)
 {
 	int ix_min, ix_max, rows;
 	extent(loc, n, &ix_min, &ix_max, &rows);

@@ -155,7 +155,7 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 			memcpy(s->body.velocity, def->entries->v[i], sizeof s->body.velocity);
 		} else {
 			bsim_markov_bin_sample(&def->bins, l, s->dt, bin, r->rng, s->body.start,
-			                  s->body.velocity);
+			                       s->body.velocity);
 		}
 	}
 	bsim_world *w = r->w;
@@ -232,16 +232,17 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 }
 
 int bsim_markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
-                        const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
-                        long *done, long total, bsim_error *err)
+                             const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
+                             long *done, long total, bsim_error *err)
 {
-	return bsim_markov_map_simulate_runs(lattice, def, be, opts, m, NULL, NULL, done, total, err);
+	return bsim_markov_map_simulate_runs(lattice, def, be, opts, m, NULL, NULL, done, total,
+	                                     err);
 }
 
 int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
-                             const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
-                             const markov_pool *pool, markov_run *runs, long *done, long total,
-                             bsim_error *err)
+                                  const bsim_backend *be, const bsim_options *opts,
+                                  bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
+                                  long *done, long total, bsim_error *err)
 {
 	const int nb = m->n_bins, T = def->trials;
 	const long units = (long)nb * T;

@@ -28,7 +28,7 @@ const char *bsim_markov_bin_edge(const bsim_markov_bins *b, int bin);
 /* A state drawn uniformly in entry bin `bin` (> 0) of a gate with time
  * step h: body centre x (gate frame) and velocity v. */
 void bsim_markov_bin_sample(const bsim_markov_bins *b, const bsim_lattice_def *l, double h, int bin,
-                       gsl_rng *rng, double x[2], double v[2]);
+                            gsl_rng *rng, double x[2], double v[2]);
 
 /* ---- observed entries by bin (markov_entries.c) ---- */
 
@@ -39,7 +39,7 @@ typedef struct markov_entry_index {
 
 /* 0, or -1 out of memory (then bsim_markov_entry_index_free all the same). */
 int bsim_markov_entry_index_init(markov_entry_index *x, const bsim_markov_entries *e,
-                            const bsim_markov_bins *b, const bsim_lattice_def *l);
+                                 const bsim_markov_bins *b, const bsim_lattice_def *l);
 void bsim_markov_entry_index_free(markov_entry_index *x);
 
 /* ---- single gates (markov_gate.c) ---- */
@@ -51,7 +51,8 @@ typedef struct markov_gate_scene {
 	bsim_beam_def beams[2];
 } markov_gate_scene;
 
-void bsim_markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice, const double k[2]);
+void bsim_markov_gate_scene_init(markov_gate_scene *g, const bsim_scene *lattice,
+                                 const double k[2]);
 
 /* One single-gate trial of a map: the entry state it started from and the
  * state it left with, in the frame of the gate it enters (the body at the
@@ -79,17 +80,17 @@ typedef struct markov_pool {
  * failed trial (in trial order, whatever the threads); BSIM_ESTOPPED,
  * err untouched and the counts not counted, if def->stop was set. */
 int bsim_markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
-                        const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
-                        long *done, long total, bsim_error *err);
+                             const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
+                             long *done, long total, bsim_error *err);
 
 /* The same with the self-consistent entries: the states of bin b > 0
  * drawn from pool's exits into b (pool NULL: as bsim_markov_map_simulate), and
  * every trial's entry and exit kept in runs[bin * trials + trial] (may be
  * NULL). */
 int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
-                             const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
-                             const markov_pool *pool, markov_run *runs, long *done, long total,
-                             bsim_error *err);
+                                  const bsim_backend *be, const bsim_options *opts,
+                                  bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
+                                  long *done, long total, bsim_error *err);
 
 /* ---- self-consistent entries (markov_self.c) ---- */
 
@@ -97,14 +98,14 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
  * id, "self N" (self-consistent, N passes), "flow N" (weighted by the
  * field's flow; in a key followed by "field HASH", the hash of lattice's
  * layout of stiffness pairs, lattice NULL for markov.json) or "none". */
-const char *bsim_markov_entries_label(const bsim_markov_def *def, const bsim_scene *lattice, char *buf,
-                                 size_t size);
+const char *bsim_markov_entries_label(const bsim_markov_def *def, const bsim_scene *lattice,
+                                      char *buf, size_t size);
 
 /* The passes of map m still to simulate (m's key for def->self_passes;
  * the last pass whose map and exits are in dir is reused): how many. */
 int bsim_markov_self_passes_left(const bsim_scene *lattice, const bsim_markov_def *def,
-                            const bsim_backend *be, const bsim_options *opts,
-                            const bsim_markov_map *m, const char *dir);
+                                 const bsim_backend *be, const bsim_options *opts,
+                                 const bsim_markov_map *m, const char *dir);
 
 /* The maps of set (maps[i] with key and counts allocated, have[i] those
  * read from the cache) by def's flow-weighted passes (self_entries 2): pass
@@ -115,9 +116,9 @@ int bsim_markov_self_passes_left(const bsim_scene *lattice, const bsim_markov_de
  * self-consistent pass 0 (read from dir where there); the passes simulated
  * now and the last pass of maps not in the cache written into stage. */
 int bsim_markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
-                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *maps,
-                         int n, const char *have, const char *dir, const char *stage, long *done,
-                         long total, bsim_error *err);
+                              const bsim_backend *be, const bsim_options *opts,
+                              bsim_markov_map *maps, int n, const char *have, const char *dir,
+                              const char *stage, long *done, long total, bsim_error *err);
 
 /* Moves from's holding times into to (to's freed first). */
 void bsim_markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from);
@@ -125,9 +126,9 @@ void bsim_markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from);
 /* Map m by def's self-consistent passes, starting from the last pass in
  * dir; each pass simulated now written into stage (map and exits). */
 int bsim_markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
-                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
-                         const char *dir, const char *stage, long *done, long total,
-                         bsim_error *err);
+                              const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
+                              const char *dir, const char *stage, long *done, long total,
+                              bsim_error *err);
 
 /* Map m's passes 0 .. last (def's self or flow entries) copied into stage
  * by the writers that wrote them, each pass from the first of dirs[0..
@@ -135,17 +136,18 @@ int bsim_markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *
  * final one (m, the caller's) and every pass's exits, the same bytes.
  * BSIM_EINPUT naming dirs[0] if a pass is in none, or the file if one is
  * malformed. */
-int bsim_markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                     const bsim_options *opts, const bsim_markov_map *m, int last,
-                     const char *const *dirs, int n_dirs, const char *stage, bsim_error *err);
+int bsim_markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def,
+                          const bsim_backend *be, const bsim_options *opts,
+                          const bsim_markov_map *m, int last, const char *const *dirs, int n_dirs,
+                          const char *stage, bsim_error *err);
 
 /* The pass a job array's round of flow-weighted maps makes (def
  * one_pass): the first pass that dir (NULL: none) does not hold, map and
  * exits, for every one of maps[0..n) (keys set); -1 with err if a pass's
  * exits there are malformed. */
-int bsim_markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                      const bsim_options *opts, const bsim_markov_map *maps, int n, const char *dir,
-                      bsim_error *err);
+int bsim_markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def,
+                           const bsim_backend *be, const bsim_options *opts,
+                           const bsim_markov_map *maps, int n, const char *dir, bsim_error *err);
 
 /* ---- the chain's exits (markov_chain.c) ---- */
 
@@ -160,14 +162,14 @@ void bsim_markov_exit_target(int cols, int rows, int nb, int g, int x, int *stat
  * gate (ix, iy) of lattice, by its pair of beam stiffnesses. BSIM_EINPUT
  * naming the first gate no map has. */
 int bsim_markov_gate_maps(const bsim_scene *lattice, const bsim_markov_set *set, int *gate_map,
-                     bsim_error *err);
+                          bsim_error *err);
 
 /* ---- the map directory (markov_cache.c) ---- */
 
 /* Every input of the map of stiffness pair k, a line each (malloc'd; NULL
  * out of memory). */
-char *bsim_markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                      const bsim_options *opts, const double k[2]);
+char *bsim_markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def,
+                           const bsim_backend *be, const bsim_options *opts, const double k[2]);
 
 /* The key of a key text: the map's file name, map_KEY. */
 uint64_t bsim_markov_key(const char *key_text);
@@ -179,17 +181,18 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err);
 
 /* Writes map m's key, counts and cost into stage. */
 int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_markov_bins *b,
-                     bsim_error *err);
+                          bsim_error *err);
 
 /* Writes stage/markov.json, the def of the build. */
 int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
-                     const bsim_options *opts, bsim_error *err);
+                          const bsim_options *opts, bsim_error *err);
 
 /* Reads dir/markov.json into def (its options into opts), every fault
  * naming the file position and field; a field the file leaves out keeps
  * the value def holds (the caller's defaults). Each field is checked on its own;
  * the def as a whole is checked where maps are built or loaded. */
-int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err);
+int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts,
+                         bsim_error *err);
 
 /* ---- figures of final locations (markov_figure.c) ---- */
 
@@ -206,14 +209,14 @@ void bsim_markov_field_totals(const bsim_location *loc, const double *p, int n, 
 /* "backend NAME, F_prop = 6 N, k_1 = 100 N m/rad": the backend (may be
  * NULL) and overrides in the model's symbols (beamsim/key_names.h). */
 void bsim_markov_title_params(char *buf, size_t size, const char *backend, const bsim_override *ov,
-                         int n);
+                              int n);
 
 /* Writes stage/NAME.dat and draws NAME: the n_panels panels, per_row to a
  * row, each a map of the field's n locations loc (every final location of
  * the lattice: its ends, sides and gates) with the totals of end, side and
  * stuck in the panel's title. */
 int bsim_markov_field_figure(const char *stage, const char *name, const char *title,
-                        const bsim_location *loc, int n, const markov_field_panel *panel,
-                        int n_panels, int per_row, int *drawn, bsim_error *err);
+                             const bsim_location *loc, int n, const markov_field_panel *panel,
+                             int n_panels, int per_row, int *drawn, bsim_error *err);
 
 #endif

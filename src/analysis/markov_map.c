@@ -172,7 +172,7 @@ static int round_fill(const bsim_scene *lattice, const bsim_markov_def *def, con
 		dirs[def->n_from] = def->passes_from;
 		for (int i = 0; i < n && rc == BSIM_OK; i++) {
 			rc = bsim_markov_self_copy(lattice, def, be, opts, &out->maps[i], out->pass,
-			                      dirs, def->n_from + 1, stage, err);
+			                           dirs, def->n_from + 1, stage, err);
 			out->maps[i].copied = 1;
 			out->copied++;
 		}
@@ -191,7 +191,7 @@ static int round_fill(const bsim_scene *lattice, const bsim_markov_def *def, con
 		}
 	clock_t c0 = clock();
 	rc = bsim_markov_flow_simulate(lattice, def, be, opts, out->maps, n, have, def->passes_from,
-	                          stage, &done, total, err);
+	                               stage, &done, total, err);
 	out->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 	if (rc == BSIM_OK)
 		out->built = own;
@@ -237,8 +237,8 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	const int round = def->self_entries == 2 && def->one_pass && stage;
 	out->pass = def->self_passes;
 	if (round && rc == BSIM_OK &&
-	    (out->pass = bsim_markov_flow_round(lattice, def, be, opts, out->maps, n, def->passes_from,
-	                                   err)) < 0)
+	    (out->pass = bsim_markov_flow_round(lattice, def, be, opts, out->maps, n,
+	                                        def->passes_from, err)) < 0)
 		rc = BSIM_EINPUT;
 	const int made = round && rc == BSIM_OK && out->pass < def->self_passes;
 	if (made) {
@@ -291,8 +291,8 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			        dir, m->k[0], m->k[1], (unsigned long long)m->key);
 		else
 			total += (long)m->n_bins * def->trials *
-			         (def->self_entries == 1 ? bsim_markov_self_passes_left(lattice, def, be,
-			                                                           opts, m, dir) +
+			         (def->self_entries == 1 ? bsim_markov_self_passes_left(
+			                                           lattice, def, be, opts, m, dir) +
 			                                           1
 			          : def->self_entries == 2 ? def->self_passes + 1
 			                                   : 1);
@@ -307,7 +307,8 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	                 (to_build > 0 || (def->parts > 1 && def->pass_exchange));
 	if (flow)
 		rc = bsim_markov_flow_simulate(lattice, def, be, opts, out->maps, n, have,
-		                          round ? def->passes_from : dir, stage, &done, total, err);
+		                               round ? def->passes_from : dir, stage, &done, total,
+		                               err);
 	for (int i = 0; i < n && rc == BSIM_OK && stage && !made; i++) {
 		bsim_markov_map *m = &out->maps[i];
 		if (have[i] || m->elsewhere)
@@ -317,8 +318,8 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			 * passes' maps and exits when built in passes */
 			const char *dirs[2] = {def->from[src[i]], round ? def->passes_from : NULL};
 			if (def->self_entries)
-				rc = bsim_markov_self_copy(lattice, def, be, opts, m, def->self_passes,
-				                      dirs, 2, stage, err);
+				rc = bsim_markov_self_copy(lattice, def, be, opts, m,
+				                           def->self_passes, dirs, 2, stage, err);
 			if (rc == BSIM_OK)
 				rc = bsim_markov_map_write(stage, m, &def->bins, err);
 			if (rc == BSIM_OK)
@@ -328,10 +329,10 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		clock_t c0 = clock();
 		rc = flow                      ? BSIM_OK
 		     : def->stop && *def->stop ? BSIM_ESTOPPED
-		     : def->self_entries
-		             ? bsim_markov_self_simulate(lattice, def, be, opts, m, dir, stage, &done,
-		                                    total, err)
-		             : bsim_markov_map_simulate(lattice, def, be, opts, m, &done, total, err);
+		     : def->self_entries ? bsim_markov_self_simulate(lattice, def, be, opts, m, dir,
+		                                                     stage, &done, total, err)
+		                         : bsim_markov_map_simulate(lattice, def, be, opts, m,
+		                                                    &done, total, err);
 		if (!flow) /* else the CPU time of its passes */
 			m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 		/* with self or flow entries, m->cost holds what the passes
@@ -400,8 +401,8 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 	rc = set_fill(lattice, def, dir, &ss, out, err);
 	if (rc == BSIM_OK)
 		rc = bsim_markov_def_write(ss.stage, def,
-		                      def->backend ? def->backend : bsim_backend_default(),
-		                      def->opts, err);
+		                           def->backend ? def->backend : bsim_backend_default(),
+		                           def->opts, err);
 	rc = bsim_session_close(&ss, rc, "markov build", NULL, err);
 	if (rc != BSIM_OK)
 		bsim_markov_set_free(out);
@@ -477,6 +478,6 @@ void bsim_markov_run_id(const uint64_t *keys, int n, char out[17])
 int bsim_markov_part_write(const char *dir, int index, int count, const char *run, long total,
                            long records, int argc, char *const *argv, bsim_error *err)
 {
-	return bsim_part_dir_write(dir, "markov build", index, count, run, total, records, argc, argv,
-	                      err);
+	return bsim_part_dir_write(dir, "markov build", index, count, run, total, records, argc,
+	                           argv, err);
 }

@@ -249,17 +249,17 @@ void bsim_markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from)
 }
 
 int bsim_markov_self_passes_left(const bsim_scene *lattice, const bsim_markov_def *def,
-                            const bsim_backend *be, const bsim_options *opts,
-                            const bsim_markov_map *m, const char *dir)
+                                 const bsim_backend *be, const bsim_options *opts,
+                                 const bsim_markov_map *m, const char *dir)
 {
 	int q = last_cached(lattice, def, be, opts, m, dir, NULL, NULL, NULL);
 	return def->self_passes - (q < 0 ? -1 : q);
 }
 
 int bsim_markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
-                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
-                         const char *dir, const char *stage, long *done, long total,
-                         bsim_error *err)
+                              const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
+                              const char *dir, const char *stage, long *done, long total,
+                              bsim_error *err)
 {
 	const int nb = m->n_bins, T = m->trials;
 	const long units = (long)nb * T;
@@ -290,10 +290,11 @@ int bsim_markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *
 			break;
 		}
 		clock_t c0 = clock();
-		rc = def->stop && *def->stop ? BSIM_ESTOPPED
-		                             : bsim_markov_map_simulate_runs(lattice, def, be, opts, &mq,
-		                                                        have_pool ? &pool : NULL,
-		                                                        cur, done, total, err);
+		rc = def->stop && *def->stop
+		             ? BSIM_ESTOPPED
+		             : bsim_markov_map_simulate_runs(lattice, def, be, opts, &mq,
+		                                             have_pool ? &pool : NULL, cur, done,
+		                                             total, err);
 		mq.seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 		cum += mq.seconds;
 		cum_steps += mq.steps;
@@ -321,9 +322,10 @@ int bsim_markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *
 	return rc;
 }
 
-int bsim_markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                     const bsim_options *opts, const bsim_markov_map *m, int last,
-                     const char *const *dirs, int n_dirs, const char *stage, bsim_error *err)
+int bsim_markov_self_copy(const bsim_scene *lattice, const bsim_markov_def *def,
+                          const bsim_backend *be, const bsim_options *opts,
+                          const bsim_markov_map *m, int last, const char *const *dirs, int n_dirs,
+                          const char *stage, bsim_error *err)
 {
 	const int nb = m->n_bins, T = m->trials;
 	markov_run *runs = calloc((size_t)nb * T, sizeof *runs);
@@ -402,9 +404,9 @@ static int passes_cached(const bsim_scene *lattice, const bsim_markov_def *def,
 	return first;
 }
 
-int bsim_markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                      const bsim_options *opts, const bsim_markov_map *maps, int n, const char *dir,
-                      bsim_error *err)
+int bsim_markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def,
+                           const bsim_backend *be, const bsim_options *opts,
+                           const bsim_markov_map *maps, int n, const char *dir, bsim_error *err)
 {
 	/* as bsim_markov_flow_simulate finds the passes it starts after */
 	return passes_cached(lattice, def, be, opts, maps, n, dir, NULL, NULL, err);
@@ -501,9 +503,9 @@ static int runs_exchange(const bsim_markov_def *def, markov_run **runs, int n, l
 }
 
 int bsim_markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
-                         const bsim_backend *be, const bsim_options *opts, bsim_markov_map *maps,
-                         int n, const char *have, const char *dir, const char *stage, long *done,
-                         long total, bsim_error *err)
+                              const bsim_backend *be, const bsim_options *opts,
+                              bsim_markov_map *maps, int n, const char *have, const char *dir,
+                              const char *stage, long *done, long total, bsim_error *err)
 {
 	const bsim_lattice_def *l = &lattice->lattice;
 	const int nb = maps[0].n_bins, T = maps[0].trials, cols = l->columns, rows = l->rows;
@@ -606,8 +608,8 @@ int bsim_markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *
 			rc = def->stop && *def->stop
 			             ? BSIM_ESTOPPED
 			             : bsim_markov_map_simulate_runs(lattice, def, be, opts, &mq,
-			                                        q > 0 ? &pool : NULL, cur[b], done,
-			                                        total, err);
+			                                             q > 0 ? &pool : NULL, cur[b],
+			                                             done, total, err);
 			mq.seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 			maps[b].seconds += mq.seconds;
 			maps[b].steps += mq.steps;

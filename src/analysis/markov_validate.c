@@ -388,8 +388,8 @@ static int write_figure(const char *stage, int g, const group_data *d,
 	        {"(d) chain - essay protocol", p->p, d->p_sim[0]},
 	        {"(e) chain - whole world", p->p, d->p_sim[1]},
 	};
-	return bsim_markov_field_figure(stage, name, title, p->loc, p->n_locations, panel, 6, 3, drawn,
-	                           err);
+	return bsim_markov_field_figure(stage, name, title, p->loc, p->n_locations, panel, 6, 3,
+	                                drawn, err);
 }
 
 /* ---- the run ------------------------------------------------------------------ */
@@ -446,7 +446,8 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 				        e->axes[a].key, e->axes[a].values[idx[a]], NULL};
 			const bsim_backend *b =
 			        set.def.backend ? set.def.backend : bsim_backend_default();
-			bsim_markov_title_params(d->title, sizeof d->title, b ? b->name : NULL, ov, n);
+			bsim_markov_title_params(d->title, sizeof d->title, b ? b->name : NULL, ov,
+			                         n);
 		}
 		free(ov);
 		free(idx);

@@ -62,8 +62,8 @@ static int write_figure(const char *stage, const bsim_scene *lattice, const bsim
 	         lattice->name, p->n_states, p->exact ? "LU" : "series", params,
 	         set ? set->def.trials : 0);
 	const markov_field_panel panel = {"probability of each final location", p->p, NULL};
-	return bsim_markov_field_figure(stage, "prediction", title, p->loc, p->n_locations, &panel, 1, 1,
-	                           drawn, err);
+	return bsim_markov_field_figure(stage, "prediction", title, p->loc, p->n_locations, &panel,
+	                                1, 1, drawn, err);
 }
 
 /* time.csv: the walks' distribution of the time to the outcome, a row a

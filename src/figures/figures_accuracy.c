@@ -135,7 +135,8 @@ int bsim_figs_accuracy(figs *f, const char *dir, bsim_error *err)
 			best = pt[i].err;
 			int r = first_row[pt[i].series];
 			fprintf(o.f, "%.6g %.6g %.6g %s \"%s\"\n", pt[i].speed, pt[i].err, pt[i].h,
-			        bsim_csv_table_cell(&t, r, col[0]), bsim_csv_table_cell(&t, r, col[1]));
+			        bsim_csv_table_cell(&t, r, col[0]),
+			        bsim_csv_table_cell(&t, r, col[1]));
 			on_front++;
 		}
 	}
@@ -161,8 +162,8 @@ int bsim_figs_accuracy(figs *f, const char *dir, bsim_error *err)
 			        "'accuracy.dat' index %d using 1:2 with linespoints lw 1.5 dt %d "
 			        "pt %d "
 			        "ps 0.9 lc rgb '%s' title ",
-			        s, s / 8 % 2 ? 2 : 1, backend_mark(bsim_csv_table_cell(&t, r, col[0])),
-			        palette[s % 8]);
+			        s, s / 8 % 2 ? 2 : 1,
+			        backend_mark(bsim_csv_table_cell(&t, r, col[0])), palette[s % 8]);
 			char label[200];
 			snprintf(label, sizeof label, "%s %s", bsim_csv_table_cell(&t, r, col[0]),
 			         bsim_csv_table_cell(&t, r, col[1]));

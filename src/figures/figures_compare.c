@@ -254,7 +254,7 @@ static int compare_data(figs *f, const ydoc *d, const fsum *s, int n_sides, cmp_
 		if (block != prev_block && prev_block >= 0) {
 			char kv[200];
 			bsim_figs_key_value(s->axes[bx].key, s->axes[bx].values[prev_block], kv,
-			               sizeof kv);
+			                    sizeof kv);
 			fputs(block_start ? ", " : "", lay->blocks.f);
 			bsim_gp_str(lay->blocks.f, kv);
 			fprintf(lay->blocks.f, " %g", 0.5 * (block_start + x));
@@ -558,10 +558,10 @@ static int compare_figure(figs *f, const ydoc *d, fsum *s, const char *inputs, i
 	if (w < text_px(title))
 		w = text_px(title);
 	rc = body ? bsim_figs_render(f, "compare",
-	                        w < 1000   ? 1000
-	                        : w > 2600 ? 2600
-	                                   : w,
-	                        h, body, err)
+	                             w < 1000   ? 1000
+	                             : w > 2600 ? 2600
+	                                        : w,
+	                             h, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;

@@ -80,8 +80,10 @@ int bsim_figs_essay(figs *f, const char *dir, bsim_error *err)
 			    strcmp(bsim_csv_table_cell(&t, r, col[2]), modes[k]) != 0)
 				continue;
 			fprintf(o.f, "%.3f %s %s %s %s\n", x + 0.15 * (k - 0.5 * (n_modes - 1)),
-			        bsim_csv_table_cell(&t, r, col[5]), bsim_csv_table_cell(&t, r, col[6]),
-			        bsim_csv_table_cell(&t, r, col[7]), bsim_csv_table_cell(&t, r, col[4]));
+			        bsim_csv_table_cell(&t, r, col[5]),
+			        bsim_csv_table_cell(&t, r, col[6]),
+			        bsim_csv_table_cell(&t, r, col[7]),
+			        bsim_csv_table_cell(&t, r, col[4]));
 			x++;
 			any = 1;
 		}

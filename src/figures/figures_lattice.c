@@ -114,8 +114,8 @@ static int map_read(const char *dir, flats *l, bsim_error *err)
 	if (!rc && !(v = malloc(((size_t)t.n_rows + 1) * 10 * sizeof *v)))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 	for (int c = 0; !rc && c < 10; c++)
-		rc = bsim_csv_table_numbers(&t, path, col[c], 0, 0.0, v + (size_t)c * (size_t)t.n_rows,
-		                       err);
+		rc = bsim_csv_table_numbers(&t, path, col[c], 0, 0.0,
+		                            v + (size_t)c * (size_t)t.n_rows, err);
 	const size_t n = (size_t)t.n_rows;
 #define MAP(c, r) v[(size_t)(c)*n + (size_t)(r)]
 	/* the extent of each group's lattice */
@@ -230,9 +230,9 @@ static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *
 	}
 	for (long r = 0; !rc && r < t.n_rows; r++) {
 		double g, tr, x_end;
-		if (bsim_csv_table_number(&t, r, col[0], &g) || bsim_csv_table_number(&t, r, col[1], &tr) ||
-		    g != floor(g) || g < 0 || g >= l->n_groups || tr != floor(tr) || tr < 0 ||
-		    tr >= per) {
+		if (bsim_csv_table_number(&t, r, col[0], &g) ||
+		    bsim_csv_table_number(&t, r, col[1], &tr) || g != floor(g) || g < 0 ||
+		    g >= l->n_groups || tr != floor(tr) || tr < 0 || tr >= per) {
 			rc = bsim_error_set(err, BSIM_EINPUT,
 			                    "%s:%ld: group, trial: expected integers within the %d "
 			                    "groups x %d trials of summary.json",
@@ -250,7 +250,8 @@ static int locations_read(const char *dir, const fsum *s, flats *l, bsim_error *
 				a->where[(int)tr] = FLAT_END;
 			}
 		} else if (!strncmp(loc, "side:", 5) && !loc_int(loc + 5, '\0', &p, &iy)) {
-			ok = iy >= 0 && iy < a->rows && !bsim_csv_table_number(&t, r, col[3], &x_end);
+			ok = iy >= 0 && iy < a->rows &&
+			     !bsim_csv_table_number(&t, r, col[3], &x_end);
 			if (ok) {
 				a->side[(x_end < a->centre_x ? 0 : a->rows) + iy]++;
 				a->where[(int)tr] = FLAT_SIDE;
@@ -819,8 +820,8 @@ static int paths_read(const char *dir, lat_job *j, bsim_error *err)
 	if (!j->cols || !j->paths || !j->first || !j->count)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 	for (int c = 0; !rc && c < 4; c++)
-		rc = bsim_csv_table_numbers(&j->table, path, col[c], 0, 0.0, j->cols + (size_t)c * n,
-		                       err);
+		rc = bsim_csv_table_numbers(&j->table, path, col[c], 0, 0.0,
+		                            j->cols + (size_t)c * n, err);
 	const double *gg = j->cols, *tt = gg + n, *xx = tt + n, *yy = xx + n;
 	for (size_t r = 0; !rc && r < n;) {
 		size_t e = r + 1;
@@ -896,8 +897,8 @@ static int lat_group(figs *f, lat_job *j, int g, bsim_error *err)
 	return rc;
 }
 
-int bsim_figs_lattice_load(figs *f, const char *dir, const char *inputs, const fsum *s, lat_job **out,
-                      bsim_error *err)
+int bsim_figs_lattice_load(figs *f, const char *dir, const char *inputs, const fsum *s,
+                           lat_job **out, bsim_error *err)
 {
 	lat_job *j = calloc(1, sizeof *j);
 	*out = NULL;
@@ -916,8 +917,8 @@ int bsim_figs_lattice_load(figs *f, const char *dir, const char *inputs, const f
 			                    "%s: %d groups, but %s/summary.json has %d", exp_path,
 			                    j->e.n_groups, dir, s->n_groups);
 	} else if (!rc) {
-		bsim_figs_note(f, "%s: no %s, so no scene to draw the stiffness map's beams on", dir,
-		          exp_path);
+		bsim_figs_note(f, "%s: no %s, so no scene to draw the stiffness map's beams on",
+		               dir, exp_path);
 	}
 	if (!rc && j->have_e && file_exists(dir, "trajectories.csv"))
 		rc = paths_read(dir, j, err);
@@ -955,7 +956,7 @@ int bsim_figs_is_lattice(const char *dir)
 /* ---- a comparison of two lattice runs -------------------------------------------------- */
 
 int bsim_figs_lattice_compare(figs *f, int n, const char *const *dirs, const char *const *labels,
-                         const fsum *s, const char *const *tests, bsim_error *err)
+                              const fsum *s, const char *const *tests, bsim_error *err)
 {
 	flats l[BSIM_COMPARE_SIDES_MAX];
 	int rc = BSIM_OK, read = 0;

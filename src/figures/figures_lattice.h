@@ -16,8 +16,8 @@ int bsim_figs_is_lattice(const char *dir);
  * trials.csv, the stored experiment, trajectories.csv) before any figure
  * is drawn; s must outlive the job. */
 typedef struct lat_job lat_job;
-int bsim_figs_lattice_load(figs *f, const char *dir, const char *inputs, const fsum *s, lat_job **out,
-                      bsim_error *err);
+int bsim_figs_lattice_load(figs *f, const char *dir, const char *inputs, const fsum *s,
+                           lat_job **out, bsim_error *err);
 int bsim_figs_lattice_draw(figs *f, lat_job *j, bsim_error *err);
 void bsim_figs_lattice_free(lat_job *j);
 
@@ -26,6 +26,6 @@ void bsim_figs_lattice_free(lat_job *j);
  * the groups (with the selection), tests[g] a line (or lines) on the
  * group's tests. */
 int bsim_figs_lattice_compare(figs *f, int n, const char *const *dirs, const char *const *labels,
-                         const fsum *s, const char *const *tests, bsim_error *err);
+                              const fsum *s, const char *const *tests, bsim_error *err);
 
 #endif

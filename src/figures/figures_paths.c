@@ -68,7 +68,7 @@ int bsim_fpath_below(const bsim_scene *s, double x, double y, const double *thet
 }
 
 void bsim_fpath_params(char *buf, size_t size, const char *backend, const char *const *keys,
-                  const char *const *values, int n)
+                       const char *const *values, int n)
 {
 	size_t k = 0;
 	buf[0] = '\0';
@@ -125,7 +125,8 @@ int bsim_fpaths_read(const csv_table *t, const char *path, fpaths *out, bsim_err
 	double *tt = out->cols, *xx = tt + n, *yy = xx + n, *gg = yy + n, *rr = gg + n,
 	       *th = rr + n;
 	for (int k = 0; !rc && k < 3; k++)
-		rc = bsim_csv_table_numbers(t, path, col[k], 0, 0.0, out->cols + (size_t)k * n, err);
+		rc = bsim_csv_table_numbers(t, path, col[k], 0, 0.0, out->cols + (size_t)k * n,
+		                            err);
 	if (!rc && gc >= 0)
 		rc = bsim_csv_table_numbers(t, path, gc, 0, 0.0, gg, err);
 	if (!rc && tc >= 0)
@@ -139,7 +140,8 @@ int bsim_fpaths_read(const csv_table *t, const char *path, fpaths *out, bsim_err
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory reading %s", path);
 	for (int b = 0; !rc && b < nb; b++) {
 		snprintf(name, sizeof name, "theta%d", b + 1);
-		rc = bsim_csv_table_numbers(t, path, bsim_csv_table_col(t, name), 0, 0.0, col_buf, err);
+		rc = bsim_csv_table_numbers(t, path, bsim_csv_table_col(t, name), 0, 0.0, col_buf,
+		                            err);
 		for (size_t r = 0; !rc && r < n; r++)
 			th[r * (size_t)nb + (size_t)b] = col_buf[r];
 	}
@@ -249,7 +251,7 @@ static int thin_keep(thin *t, double x, double y, double e, int below, int last,
 /* ---- Fig. 3.2: the bundle ------------------------------------------------------------ */
 
 int bsim_figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *scene,
-                const fpath *p, int n, bsim_error *err)
+                     const fpath *p, int n, bsim_error *err)
 {
 	char file[200], path[BSIM_PATH_MAX];
 	snprintf(file, sizeof file, "%s.dat", name);
@@ -539,7 +541,7 @@ static const char *class_color_over(int c)
 }
 
 int bsim_figs_over_landscape(figs *f, const char *name, const char *title, const bsim_scene *scene,
-                        const fpath *p, int n, unsigned mask, bsim_error *err)
+                             const fpath *p, int n, unsigned mask, bsim_error *err)
 {
 	char surf[200], file[200];
 	snprintf(surf, sizeof surf, "%s.surface.dat", name);

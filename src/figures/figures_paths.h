@@ -39,21 +39,21 @@ int bsim_fpath_below(const bsim_scene *s, double x, double y, const double *thet
 /* Fig. 3.2: the bundle in the plane, coloured by class, with the beams at
  * rest and the boundaries. */
 int bsim_figs_bundle(figs *f, const char *name, const char *title, const bsim_scene *scene,
-                const fpath *p, int n, bsim_error *err);
+                     const fpath *p, int n, bsim_error *err);
 
 /* Figs. 3.3 and 2.7: the landscape E_total(x, y) of scene seen from above
  * and in 3-D, with the paths over it at their own E, the stretches below
  * the surface in black. Draws the paths whose class is in mask (bits
  * 1 << FPATH_*). */
 int bsim_figs_over_landscape(figs *f, const char *name, const char *title, const bsim_scene *scene,
-                        const fpath *p, int n, unsigned mask, bsim_error *err);
+                             const fpath *p, int n, unsigned mask, bsim_error *err);
 
 /* The backend and the parameters of a figure's scene that differ from
  * its scene file's, for a title: "backend NAME, F_prop = 8 N, R_m = 30 N,
  * k_1 = 300 N m/rad" (beamsim/key_names.h), a line break after every third
  * item; backend may be NULL or "". */
 void bsim_fpath_params(char *buf, size_t size, const char *backend, const char *const *keys,
-                  const char *const *values, int n);
+                       const char *const *values, int n);
 
 /* The paths of a trajectory table (trajectories.csv, or one trajectory
  * with group = trial = 0 when the table has no group column): the rows of

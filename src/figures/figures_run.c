@@ -70,7 +70,7 @@ static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *ty
 		}
 		if (!text[2 * i] || !text[2 * i + 1])
 			rc = bsim_ydoc_expected(&d, fy_node_pair_value(p), set, "set",
-			                   "a mapping of KEY: VALUE strings", err);
+			                        "a mapping of KEY: VALUE strings", err);
 		ov[i] = (bsim_override){text[2 * i], text[2 * i + 1], path};
 	}
 	if (!rc)
@@ -350,9 +350,10 @@ static int single_beam(figs *f, bsim_scene *scene, const fpath *p, const char *t
 			peak[b] = fmax(peak[b], fabs(th[b]));
 	}
 	if (below == 0) {
-		bsim_figs_note(f, "landscape_path_single (Fig. 2.7c) not drawn: it shows a run in which "
-		             "a beam left the body while the body was still within its reach, and "
-		             "this run has none");
+		bsim_figs_note(
+		        f, "landscape_path_single (Fig. 2.7c) not drawn: it shows a run in which "
+		           "a beam left the body while the body was still within its reach, and "
+		           "this run has none");
 		return BSIM_OK;
 	}
 	for (int b = 1; b < nb; b++)
@@ -388,10 +389,11 @@ int bsim_figs_run(figs *f, const char *dir, bsim_error *err)
 	int found;
 	int rc = run_scene(dir, &scene, outcome, type, params, sizeof params, &found, err);
 	if (!rc && !found) {
-		bsim_figs_note(f,
-		          "%s: no run.json and inputs/scene.yaml, so no scene: only the ledger "
-		          "is drawn",
-		          dir);
+		bsim_figs_note(
+		        f,
+		        "%s: no run.json and inputs/scene.yaml, so no scene: only the ledger "
+		        "is drawn",
+		        dir);
 		return ledger(f, dir, err);
 	}
 	if (rc)
@@ -418,8 +420,8 @@ int bsim_figs_run(figs *f, const char *dir, bsim_error *err)
 			         "%s: one trial, %s%s%s, over its landscape\n%s", scene.name,
 			         outcome, *type && strcmp(type, "none") ? ", type " : "",
 			         strcmp(type, "none") ? type : "", params);
-			rc = bsim_figs_over_landscape(f, "landscape_path", title, &scene, ps.p, 1, ~0u,
-			                         err);
+			rc = bsim_figs_over_landscape(f, "landscape_path", title, &scene, ps.p, 1,
+			                              ~0u, err);
 			if (!rc)
 				rc = single_beam(f, &scene, &ps.p[0], title, err);
 		}

@@ -94,7 +94,8 @@ static int read_group(const ydoc *d, struct fy_node *gn, int g, fsum *s, bsim_er
 	struct fy_node *params = bsim_ydoc_lookup(gn, "params");
 	if (!params || !fy_node_is_mapping(params) ||
 	    (g > 0 && fy_node_mapping_item_count(params) != s->n_axes))
-		return bsim_ydoc_expected(d, params, gn, where, "a mapping of the grid's keys", err);
+		return bsim_ydoc_expected(d, params, gn, where, "a mapping of the grid's keys",
+		                          err);
 	if (g == 0) {
 		s->n_axes = fy_node_mapping_item_count(params);
 		s->axes = calloc((size_t)(s->n_axes ? s->n_axes : 1), sizeof *s->axes);
@@ -120,7 +121,7 @@ static int read_group(const ydoc *d, struct fy_node *gn, int g, fsum *s, bsim_er
 		free(val);
 		if (bad)
 			return bsim_ydoc_expected(d, fy_node_pair_key(p), params, where,
-			                     "the grid's keys in the order of group 0", err);
+			                          "the grid's keys in the order of group 0", err);
 	}
 	int rc = BSIM_OK;
 	struct {
@@ -138,14 +139,15 @@ static int read_group(const ydoc *d, struct fy_node *gn, int g, fsum *s, bsim_er
 	};
 	for (size_t i = 0; !rc && i < sizeof counts / sizeof counts[0]; i++)
 		rc = group_count(d, gn, counts[i].field, g, counts[i].out, err);
-	struct fy_node *pn = bsim_ydoc_lookup(gn, "p_traverse"), *lo = bsim_ydoc_lookup(gn, "ci95.0"),
-	               *hi = bsim_ydoc_lookup(gn, "ci95.1");
+	struct fy_node *pn = bsim_ydoc_lookup(gn, "p_traverse"),
+	               *lo = bsim_ydoc_lookup(gn, "ci95.0"), *hi = bsim_ydoc_lookup(gn, "ci95.1");
 	snprintf(where, sizeof where, "groups.%d.p_traverse", g);
 	if (!rc && (!pn || bsim_ydoc_number(pn, &G->p)))
 		rc = bsim_ydoc_expected(d, pn, gn, where, "a number", err);
 	snprintf(where, sizeof where, "groups.%d.ci95", g);
 	if (!rc && (!lo || !hi || bsim_ydoc_number(lo, &G->lo) || bsim_ydoc_number(hi, &G->hi)))
-		rc = bsim_ydoc_expected(d, bsim_ydoc_lookup(gn, "ci95"), gn, where, "[lo, hi]", err);
+		rc = bsim_ydoc_expected(d, bsim_ydoc_lookup(gn, "ci95"), gn, where, "[lo, hi]",
+		                        err);
 	G->selected = 1;
 	struct fy_node *det = bsim_ydoc_lookup(gn, "deterministic");
 	const char *dt = det ? bsim_ydoc_plain(det) : NULL;
@@ -311,7 +313,8 @@ int bsim_fsum_select(const figs *f, fsum *s, bsim_error *err)
 		}
 		int any = 0;
 		for (int g = 0; a < s->n_axes && g < s->n_groups; g++) {
-			int match = bsim_fsum_same_value(s->axes[a].values[s->g[g].idx[a]], o->value);
+			int match =
+			        bsim_fsum_same_value(s->axes[a].values[s->g[g].idx[a]], o->value);
 			s->g[g].selected &= match;
 			any |= match;
 		}
@@ -411,7 +414,8 @@ void bsim_fsum_label(const fsum *s, int g, char *buf, size_t size)
 		if (s->axes[a].n_selected == 1)
 			continue;
 		char kv[200];
-		bsim_figs_key_value(s->axes[a].key, s->axes[a].values[s->g[g].idx[a]], kv, sizeof kv);
+		bsim_figs_key_value(s->axes[a].key, s->axes[a].values[s->g[g].idx[a]], kv,
+		                    sizeof kv);
 		/* a line of its own from the third on, to fit a figure's width */
 		int n = snprintf(buf + k, size - k, "%s%s",
 		                 shown == 0  ? ""

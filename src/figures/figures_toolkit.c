@@ -12,7 +12,7 @@
 #include "beamsim/limits.h"
 
 int bsim_figs_data_open(const figs *f, const char *file, bsim_atomic_file *o, char *path,
-                   bsim_error *err)
+                        bsim_error *err)
 {
 	if (snprintf(path, BSIM_PATH_MAX, "%s/%s", f->out, file) >= BSIM_PATH_MAX)
 		return bsim_error_set(err, BSIM_EFAIL, "%s/%s: path too long", f->out, file);
@@ -38,7 +38,8 @@ static void list_add(char ***list, int *n, char *s)
 	*list = l;
 }
 
-int bsim_figs_render(figs *f, const char *name, int width, int height, const char *body, bsim_error *err)
+int bsim_figs_render(figs *f, const char *name, int width, int height, const char *body,
+                     bsim_error *err)
 {
 	bsim_figure_def d = bsim_figure_def_default();
 	d.dir = f->out;

@@ -48,7 +48,7 @@ typedef struct figs {
 
 /* Opens OUT/file for writing; path (BSIM_PATH_MAX bytes) gets its name. */
 int bsim_figs_data_open(const figs *f, const char *file, bsim_atomic_file *o, char *path,
-                   bsim_error *err);
+                        bsim_error *err);
 int bsim_figs_data_commit(bsim_atomic_file *o, bsim_error *err);
 
 /* Writes OUT/NAME.gp around body and draws it (width x height pixels);
@@ -57,7 +57,7 @@ int bsim_figs_data_commit(bsim_atomic_file *o, bsim_error *err);
  * bsim_figures_draw reports it at the end. Safe to call from several
  * threads. */
 int bsim_figs_render(figs *f, const char *name, int width, int height, const char *body,
-                bsim_error *err);
+                     bsim_error *err);
 
 /* Draws group g's figures of job; BSIM_OK also for a group with nothing
  * to draw. */

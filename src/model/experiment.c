@@ -46,7 +46,8 @@ static const char *key_text(struct fy_node *k)
 static int walk_scene_path(const ydoc *d, struct fy_node *n, struct fy_node *key,
                            bsim_experiment *e, bsim_error *err)
 {
-	const char *t = bsim_ydoc_is_null(n) || !fy_node_is_scalar(n) ? NULL : fy_node_get_scalar0(n);
+	const char *t =
+	        bsim_ydoc_is_null(n) || !fy_node_is_scalar(n) ? NULL : fy_node_get_scalar0(n);
 	if (!t)
 		return bsim_ydoc_expected(d, n, key, "scene", "a scene file name", err);
 	const char *slash = strrchr(d->path, '/');
@@ -59,7 +60,7 @@ static int walk_scene_path(const ydoc *d, struct fy_node *n, struct fy_node *key
 	file_text f;
 	bsim_error fe;
 	int rc = bsim_file_read(e->scene_path, "a YAML file", bsim_limits_get()->input_bytes,
-	                   "input_bytes", &f, &fe);
+	                        "input_bytes", &f, &fe);
 	if (rc == BSIM_EFAIL) {
 		*err = fe;
 		return rc;
@@ -81,7 +82,8 @@ static int walk_set(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim_
 	if (bsim_ydoc_is_null(n))
 		return BSIM_OK;
 	if (!fy_node_is_mapping(n))
-		return bsim_ydoc_expected(d, n, key, "set", "a mapping of dotted keys to values", err);
+		return bsim_ydoc_expected(d, n, key, "set", "a mapping of dotted keys to values",
+		                          err);
 	int count = fy_node_mapping_item_count(n);
 	e->set = calloc((size_t)count, sizeof *e->set);
 	if (!e->set)
@@ -149,9 +151,9 @@ static int walk_grid(const ydoc *d, struct fy_node *n, struct fy_node *key, bsim
 {
 	int count = n && fy_node_is_mapping(n) ? fy_node_mapping_item_count(n) : 0;
 	if (count == 0)
-		return bsim_ydoc_expected(d, n, key, "grid",
-		                     "at least one axis (a dotted scene key with a list of values)",
-		                     err);
+		return bsim_ydoc_expected(
+		        d, n, key, "grid",
+		        "at least one axis (a dotted scene key with a list of values)", err);
 	e->axes = calloc((size_t)count, sizeof *e->axes);
 	if (!e->axes)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", d->path);
@@ -204,7 +206,7 @@ static int walk_key(const ydoc *d, const char *name, struct fy_node *k, struct f
 		        "experiment: run it with beamsim run, or name it in an experiment's "
 		        "scene: with a grid:");
 	return bsim_ydoc_fail(d, k, NULL, name, err, "unknown key (expected one of %s)",
-	                 experiment_keys);
+	                      experiment_keys);
 }
 
 /* has_seed: a seed given beside the file stands in for its seed:. */
@@ -216,9 +218,9 @@ static int walk_experiment(const ydoc *d, int has_seed, bsim_experiment *e, bsim
 	                                     "a mapping of dotted keys to lists"};
 	struct fy_node *root = fy_document_root(d->fyd);
 	if (!root || !fy_node_is_mapping(root))
-		return bsim_ydoc_expected(d, root, NULL, "experiment",
-		                     "a mapping of experiment keys (scene, trials, seed, grid)",
-		                     err);
+		return bsim_ydoc_expected(
+		        d, root, NULL, "experiment",
+		        "a mapping of experiment keys (scene, trials, seed, grid)", err);
 	void *it = NULL;
 	struct fy_node_pair *p;
 	while ((p = fy_node_mapping_iterate(root, &it))) {
@@ -231,8 +233,8 @@ static int walk_experiment(const ydoc *d, int has_seed, bsim_experiment *e, bsim
 	for (int i = 0; i < 4; i++)
 		if (!bsim_ydoc_pair(root, required[i], strlen(required[i])) &&
 		    !(has_seed && !strcmp(required[i], "seed")))
-			return bsim_ydoc_fail(d, root, NULL, required[i], err, "missing (expected %s)",
-			                 phrase[i]);
+			return bsim_ydoc_fail(d, root, NULL, required[i], err,
+			                      "missing (expected %s)", phrase[i]);
 	return BSIM_OK;
 }
 
@@ -392,8 +394,8 @@ static int check_counts(const ydoc *d, bsim_experiment *e, int n_grid, bsim_erro
 	bsim_error why;
 	if (bsim_experiment_check_trials(e, e->trials, &why) != BSIM_OK) {
 		struct fy_node_pair *tp = bsim_ydoc_pair(root, "trials", 6);
-		return bsim_ydoc_fail(d, fy_node_pair_value(tp), fy_node_pair_key(tp), "trials", err,
-		                 "%s", why.msg);
+		return bsim_ydoc_fail(d, fy_node_pair_value(tp), fy_node_pair_key(tp), "trials",
+		                      err, "%s", why.msg);
 	}
 	return BSIM_OK;
 }

@@ -438,7 +438,8 @@ int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 	for (int i = 0; i < s->n_beams; i++) {
 		char prefix[64];
 		snprintf(prefix, sizeof prefix, "beams.%d.", i);
-		rc = check_table(s, &bsim_scene_beam_table, (const char *)&s->beams[i], prefix, err);
+		rc = check_table(s, &bsim_scene_beam_table, (const char *)&s->beams[i], prefix,
+		                 err);
 		if (rc)
 			return rc;
 	}

@@ -87,9 +87,9 @@ static int resolve(scene_walk *w, const ydoc *file, const horizon_pair *p)
 		return bsim_ydoc_expected(w->d, nt, kt, tfield, "a finite number (s)", w->err);
 	if (rc != YDOC_NUM_OK || !bsim_scene_in_range(p->time_range, t))
 		return bsim_ydoc_expected(w->d, nt, kt, tfield,
-		                     p->time_range == SR_POSITIVE ? "a positive number (s)"
-		                                                  : "a number >= 0 (s)",
-		                     w->err);
+		                          p->time_range == SR_POSITIVE ? "a positive number (s)"
+		                                                       : "a number >= 0 (s)",
+		                          w->err);
 	if (ns) {
 		const bsim_override *os = bsim_ydoc_origin(ns), *ot = bsim_ydoc_origin(nt);
 		if (later(os, ot))
@@ -110,10 +110,11 @@ static int resolve(scene_walk *w, const ydoc *file, const horizon_pair *p)
 	double n = bsim_scene_steps_for(t, w->s->dt);
 	if (!(n <= INT_MAX)) {
 		bsim_ydoc_describe(nt, got, sizeof got);
-		return bsim_ydoc_fail(w->d, nt, kt, tfield, w->err,
-		                 "expected at most %d steps of integration.dt %.15g s, got %s s "
-		                 "(%.3g steps)",
-		                 INT_MAX, w->s->dt, got, n);
+		return bsim_ydoc_fail(
+		        w->d, nt, kt, tfield, w->err,
+		        "expected at most %d steps of integration.dt %.15g s, got %s s "
+		        "(%.3g steps)",
+		        INT_MAX, w->s->dt, got, n);
 	}
 	*p->steps = (int)n;
 	return BSIM_OK;

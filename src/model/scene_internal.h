@@ -80,8 +80,8 @@ typedef struct scene_walk {
 
 /* Walks one mapping (NULL: an empty one) against table t into base: unknown
  * keys are errors, known ones are stored, missing required ones reported. */
-int bsim_scene_walk_table(scene_walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
-                     char *base, const char *prefix);
+int bsim_scene_walk_table(scene_walk *w, const scene_table *t, struct fy_node *map,
+                          struct fy_node *alt, char *base, const char *prefix);
 
 /* The lattice: block (scene_lattice.c). The loader walks its keys
  * (bsim_scene_lattice_table) between the two calls: begin sets the gate's
@@ -164,6 +164,6 @@ void bsim_scene_dt_message(const bsim_scene *s, const scene_dt_bound *b, char *b
 /* bsim_scene_load on a document already read (the experiment loader reads
  * the scene file once and builds every group from a clone of it). */
 int bsim_scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,
-                      bsim_error *err);
+                           bsim_error *err);
 
 #endif

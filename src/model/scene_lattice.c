@@ -54,30 +54,31 @@ static int lattice_range(scene_walk *w, struct fy_node *map, struct fy_node *key
 	if ((ix_min != NULL) != (ix_max != NULL)) {
 		struct fy_node *given = ix_min ? ix_min : ix_max;
 		return bsim_ydoc_fail(w->d, given, ix_min ? kmin : kmax,
-		                 ix_min ? "lattice.ix_max" : "lattice.ix_min", w->err,
-		                 "missing (expected both ix_min and ix_max, or columns)");
+		                      ix_min ? "lattice.ix_max" : "lattice.ix_min", w->err,
+		                      "missing (expected both ix_min and ix_max, or columns)");
 	}
 	if (ix_min) {
 		if (l->ix_max < l->ix_min)
 			return bsim_ydoc_fail(w->d, ix_max, kmax, "lattice.ix_max", w->err,
-			                 "expected an integer >= lattice.ix_min (%d), got %d",
-			                 l->ix_min, l->ix_max);
+			                      "expected an integer >= lattice.ix_min (%d), got %d",
+			                      l->ix_min, l->ix_max);
 		int span = l->ix_max - l->ix_min + 1;
 		if (columns && l->columns != span)
 			return bsim_ydoc_fail(w->d, columns, kc, "lattice.columns", w->err,
-			                 "expected %d (ix_min %d .. ix_max %d), got %d", span,
-			                 l->ix_min, l->ix_max, l->columns);
+			                      "expected %d (ix_min %d .. ix_max %d), got %d", span,
+			                      l->ix_min, l->ix_max, l->columns);
 		l->columns = span;
 		return BSIM_OK;
 	}
 	if (!columns)
-		return bsim_ydoc_fail(w->d, map, key, "lattice.columns", w->err,
-		                 "missing (expected a positive odd integer, or ix_min and ix_max)");
+		return bsim_ydoc_fail(
+		        w->d, map, key, "lattice.columns", w->err,
+		        "missing (expected a positive odd integer, or ix_min and ix_max)");
 	if (l->columns % 2 == 0)
 		return bsim_ydoc_fail(w->d, columns, kc, "lattice.columns", w->err,
-		                 "expected an odd number (gates ix = -(columns-1)/2 .. "
-		                 "(columns-1)/2; give ix_min and ix_max otherwise), got %d",
-		                 l->columns);
+		                      "expected an odd number (gates ix = -(columns-1)/2 .. "
+		                      "(columns-1)/2; give ix_min and ix_max otherwise), got %d",
+		                      l->columns);
 	l->ix_max = (l->columns - 1) / 2;
 	l->ix_min = -l->ix_max;
 	return BSIM_OK;
@@ -207,28 +208,29 @@ static int map_csv(scene_walk *w, struct fy_node *n, struct fy_node *key, double
 	const char *rel =
 	        n && fy_node_is_scalar(n) && !bsim_ydoc_is_null(n) ? fy_node_get_scalar0(n) : NULL;
 	if (!rel || !name_beside(rel))
-		return bsim_ydoc_expected(w->d, n, key, "lattice.stiffness_file",
-		                     "a CSV file name relative to the scene's directory (no '..')",
-		                     w->err);
+		return bsim_ydoc_expected(
+		        w->d, n, key, "lattice.stiffness_file",
+		        "a CSV file name relative to the scene's directory (no '..')", w->err);
 	if (strlen(rel) >= sizeof w->s->lattice.stiffness_file)
-		return bsim_ydoc_expected(w->d, n, key, "lattice.stiffness_file", "a shorter file name",
-		                     w->err);
+		return bsim_ydoc_expected(w->d, n, key, "lattice.stiffness_file",
+		                          "a shorter file name", w->err);
 	char path[1300];
 	if (csv_path(w->d->path, rel, path, sizeof path))
 		return bsim_ydoc_expected(w->d, n, key, "lattice.stiffness_file", "a shorter path",
-		                     w->err);
+		                          w->err);
 	/* Without blocking, and checked before the first read: a FIFO would
 	 * wait for a writer for ever, a directory fails only at the read. */
 	struct stat st;
 	int fd = bsim_file_open_checked(path, &st);
 	if (fd < 0)
 		return bsim_ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
-		                 "expected a readable CSV file, got %s (%s)", path,
-		                 strerror(errno));
+		                      "expected a readable CSV file, got %s (%s)", path,
+		                      strerror(errno));
 	if (!S_ISREG(st.st_mode)) {
 		close(fd);
 		return bsim_ydoc_fail(w->d, n, key, "lattice.stiffness_file", w->err,
-		                 "expected a regular CSV file, got %s (%s)", path, bsim_file_kind(&st));
+		                      "expected a regular CSV file, got %s (%s)", path,
+		                      bsim_file_kind(&st));
 	}
 	FILE *f = fdopen(fd, "r");
 	if (!f) {
@@ -331,9 +333,9 @@ static int lattice_protocol(scene_walk *w, struct fy_node *map)
 		w->s->lattice.protocol = BSIM_PROTOCOL_ESSAY;
 	else
 		return bsim_ydoc_expected(w->d, n, k, "lattice.protocol",
-		                     "world (one world, every beam kept) or essay (only the "
-		                     "active gate, reset on entry)",
-		                     w->err);
+		                          "world (one world, every beam kept) or essay (only the "
+		                          "active gate, reset on entry)",
+		                          w->err);
 	return BSIM_OK;
 }
 
@@ -348,7 +350,7 @@ static int lattice_maps_read(scene_walk *w, struct fy_node *map, lattice_maps *m
 	struct fy_node *gate_map = child(map, "stiffness", &kmap);
 	if (file && gate_map)
 		return bsim_ydoc_fail(w->d, file, kfile, "lattice.stiffness_file", w->err,
-		                 "expected either stiffness or stiffness_file, not both");
+		                      "expected either stiffness or stiffness_file, not both");
 	/* A per-gate map and a per-beam one give every beam twice: which one a
 	 * reader of the scene meant is not for beamsim to guess. */
 	for (int i = 1; i < 3 && (file || gate_map); i++) {
@@ -356,10 +358,10 @@ static int lattice_maps_read(scene_walk *w, struct fy_node *map, lattice_maps *m
 		struct fy_node *n = child(map, names[i], &k);
 		if (n)
 			return bsim_ydoc_fail(w->d, n, k,
-			                 i == 1 ? "lattice.stiffness_left"
-			                        : "lattice.stiffness_right",
-			                 w->err, "expected either %s or %s, not both",
-			                 file ? "stiffness_file" : "stiffness", names[i]);
+			                      i == 1 ? "lattice.stiffness_left"
+			                             : "lattice.stiffness_right",
+			                      w->err, "expected either %s or %s, not both",
+			                      file ? "stiffness_file" : "stiffness", names[i]);
 	}
 	for (int i = 0; i < 3; i++) {
 		struct fy_node *k;
@@ -403,8 +405,8 @@ int bsim_scene_lattice_finish(scene_walk *w, struct fy_node *n, struct fy_node *
 		struct fy_node *k;
 		struct fy_node *rows = child(n, "rows", &k);
 		return bsim_ydoc_fail(w->d, rows, k, "lattice.rows", w->err,
-		                 "expected at most %d gates (columns x rows), got %d x %d",
-		                 LATTICE_GATES_MAX, l->columns, l->rows);
+		                      "expected at most %d gates (columns x rows), got %d x %d",
+		                      LATTICE_GATES_MAX, l->columns, l->rows);
 	}
 	rc = lattice_protocol(w, n);
 	lattice_maps m = {0};

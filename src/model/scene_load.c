@@ -128,8 +128,8 @@ static int walk_lattice(walk *w, const scene_field *f, struct fy_node *n, struct
 {
 	if (!n || !fy_node_is_mapping(n))
 		return bsim_ydoc_expected(w->d, n, key, "lattice",
-		                     "a mapping (columns, rows, gate, beam, stiffness, ...)",
-		                     w->err);
+		                          "a mapping (columns, rows, gate, beam, stiffness, ...)",
+		                          w->err);
 	bsim_scene_lattice_begin(w->s);
 	int rc = walk_table(w, f->sub, n, key, (char *)w->s, "lattice.");
 	return rc ? rc : bsim_scene_lattice_finish(w, n, key);
@@ -173,7 +173,7 @@ static int find_field(const scene_table *t, const char *key)
  * errors, known ones are stored, missing required ones are reported at the
  * mapping (or at alt, the key naming it, when it is empty). */
 int bsim_scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
-                     char *base, const char *prefix)
+                          char *base, const char *prefix)
 {
 	unsigned seen = 0;
 	void *it = NULL;
@@ -185,7 +185,8 @@ int bsim_scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, st
 		bsim_ydoc_join(field, sizeof field, prefix, name ? name : "?");
 		int i = find_field(t, name);
 		/* An experiment given where a scene belongs (beamsim run EXP). */
-		if (i < 0 && !prefix[0] && bsim_ydoc_pair(map, "scene", 5) && bsim_ydoc_pair(map, "grid", 4))
+		if (i < 0 && !prefix[0] && bsim_ydoc_pair(map, "scene", 5) &&
+		    bsim_ydoc_pair(map, "grid", 4))
 			return bsim_ydoc_fail(
 			        w->d, k, map, field, w->err,
 			        "this is an experiment file (scene: and grid:), not a scene: "
@@ -193,7 +194,7 @@ int bsim_scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, st
 		if (i < 0) {
 			bsim_scene_keys(t, keys, sizeof keys);
 			return bsim_ydoc_fail(w->d, k, map, field, w->err,
-			                 "unknown key (expected one of %s)", keys);
+			                      "unknown key (expected one of %s)", keys);
 		}
 		seen |= 1u << i;
 		int rc = walk_field(w, &t->fields[i], fy_node_pair_value(p), k, base, field);
@@ -205,8 +206,8 @@ int bsim_scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, st
 		if (f->required && !(seen & (1u << i))) {
 			char field[300];
 			bsim_ydoc_join(field, sizeof field, prefix, f->key);
-			return bsim_ydoc_fail(w->d, map, alt, field, w->err, "missing (expected %s)",
-			                 bsim_scene_phrase(f));
+			return bsim_ydoc_fail(w->d, map, alt, field, w->err,
+			                      "missing (expected %s)", bsim_scene_phrase(f));
 		}
 	}
 	return BSIM_OK;
@@ -248,11 +249,11 @@ static int check_termination(walk *w)
 	bsim_ydoc_describe(n, got, sizeof got);
 	if (n == classify)
 		return bsim_ydoc_fail(w->d, n, NULL, paths[0], w->err,
-		                 "expected a number >= termination.success_y (%g), got %s",
-		                 s->success_y, got);
+		                      "expected a number >= termination.success_y (%g), got %s",
+		                      s->success_y, got);
 	return bsim_ydoc_fail(w->d, n, NULL, paths[1], w->err,
-	                 "expected a number <= termination.classify_y (%g), got %s", s->classify_y,
-	                 got);
+	                      "expected a number <= termination.classify_y (%g), got %s",
+	                      s->classify_y, got);
 }
 
 /* The default success line, 65 m, is the essay's gate's for its disk of
@@ -330,8 +331,8 @@ static int check_limits(walk *w)
 	bsim_limits_hint(hint, sizeof hint, x.limit, x.max);
 	bsim_scene_excess_detail(w->s, &x, detail, sizeof detail);
 	return bsim_ydoc_fail(w->d, node ? node : root, NULL, field, w->err,
-	                 "expected at most %.15g %s, got %.3g%s (%s)", x.max, x.what, x.got, detail,
-	                 hint);
+	                      "expected at most %.15g %s, got %.3g%s (%s)", x.max, x.what, x.got,
+	                      detail, hint);
 }
 
 /* A step the scene cannot be resolved at (scene_timestep.c): always said
@@ -403,10 +404,11 @@ static int random_model(walk *w, struct fy_node *root)
 			w->s->effects.random_model = (bsim_random_model)i;
 			return BSIM_OK;
 		}
-	return bsim_ydoc_expected(w->d, n, NULL, "effects.random_force.model",
-	                     "held (the essay's piecewise constant force), ou (Ornstein-Uhlenbeck, "
-	                     "correlation_time s) or white (a new value each step)",
-	                     w->err);
+	return bsim_ydoc_expected(
+	        w->d, n, NULL, "effects.random_force.model",
+	        "held (the essay's piecewise constant force), ou (Ornstein-Uhlenbeck, "
+	        "correlation_time s) or white (a new value each step)",
+	        w->err);
 }
 
 /* One of names[0 .. n) at path, or nothing; what names the value is
@@ -491,13 +493,13 @@ static int body_shape(walk *w, struct fy_node *root)
 		int needed = sizes[i].shape_mask >> shape & 1;
 		if (!needed && n)
 			return bsim_ydoc_fail(w->d, n, body, field, w->err,
-			                 "expected none for %s (it is %s)", names[shape],
-			                 i == 0   ? "sized by body.semi_axes"
-			                 : i == 1 ? "only a capsule that has a length"
-			                          : "only an ellipse that has semi-axes");
+			                      "expected none for %s (it is %s)", names[shape],
+			                      i == 0   ? "sized by body.semi_axes"
+			                      : i == 1 ? "only a capsule that has a length"
+			                               : "only an ellipse that has semi-axes");
 		if (needed && !n)
-			return bsim_ydoc_fail(w->d, body, root, field, w->err, "missing (expected %s)",
-			                 sizes[i].what);
+			return bsim_ydoc_fail(w->d, body, root, field, w->err,
+			                      "missing (expected %s)", sizes[i].what);
 		if (needed && !(value[i][0] > 0 && (i < 2 || value[i][1] > 0)))
 			return bsim_ydoc_expected(w->d, n, body, field, sizes[i].what, w->err);
 	}
@@ -511,11 +513,11 @@ static int check_beams_or_lattice(walk *w, struct fy_node *root)
 	struct fy_node_pair *lattice = bsim_ydoc_pair(root, "lattice", 7);
 	if (beams && lattice)
 		return bsim_ydoc_fail(w->d, fy_node_pair_key(lattice), root, "lattice", w->err,
-		                 "expected either beams: or lattice:, not both");
+		                      "expected either beams: or lattice:, not both");
 	if (!beams && !lattice)
 		return bsim_ydoc_fail(w->d, root, NULL, "beams", w->err,
-		                 "missing (expected a non-empty list of beams, or a lattice: "
-		                 "block)");
+		                      "missing (expected a non-empty list of beams, or a lattice: "
+		                      "block)");
 	return BSIM_OK;
 }
 
@@ -582,7 +584,7 @@ static int walk_scene(walk *w, const ydoc *file)
 }
 
 int bsim_scene_load_parsed(const ydoc *file, const bsim_override *ov, int n, bsim_scene *out,
-                      bsim_error *err)
+                           bsim_error *err)
 {
 	bsim_scene_defaults(out);
 	if (strlen(file->path) >= sizeof out->path)

@@ -249,7 +249,8 @@ static size_t record_bytes(int beams, int n)
 {
 	if (!beams)
 		return n > 1 ? bsim_sweep_record_size_sides(n) : sizeof(bsim_trial_result);
-	return (size_t)n * bsim_sweep_record_bytes(beams) + (size_t)bsim_sweep_pairs(n) * sizeof(double);
+	return (size_t)n * bsim_sweep_record_bytes(beams) +
+	       (size_t)bsim_sweep_pairs(n) * sizeof(double);
 }
 
 /* What the threads share. first_fail is the index of the lowest failed
@@ -340,11 +341,12 @@ static const void *record_of(sweep_shared *sh, long i, void *buf)
 	if (sh->n_sides == 1 && !sh->record_beams)
 		return &sh->results[0][k];
 	unsigned char *p = buf;
-	size_t side =
-	        sh->record_beams ? bsim_sweep_record_bytes(sh->record_beams) : sizeof(bsim_trial_result);
+	size_t side = sh->record_beams ? bsim_sweep_record_bytes(sh->record_beams)
+	                               : sizeof(bsim_trial_result);
 	for (int s = 0; s < sh->n_sides; s++, p += side)
 		if (sh->record_beams)
-			bsim_sweep_record_pack(p, sh->record_beams, &sh->results[s][k], &sh->logs[s][k]);
+			bsim_sweep_record_pack(p, sh->record_beams, &sh->results[s][k],
+			                       &sh->logs[s][k]);
 		else
 			memcpy(p, &sh->results[s][k], side);
 	for (int q = 0; q < bsim_sweep_pairs(sh->n_sides); q++, p += sizeof(double))
@@ -385,8 +387,8 @@ static int journal_take(void *user, uint64_t index, const void *payload)
 		return 0;
 	}
 	const unsigned char *p = payload;
-	size_t side =
-	        sh->record_beams ? bsim_sweep_record_bytes(sh->record_beams) : sizeof(bsim_trial_result);
+	size_t side = sh->record_beams ? bsim_sweep_record_bytes(sh->record_beams)
+	                               : sizeof(bsim_trial_result);
 	for (int s = 0; s < sh->n_sides; s++, p += side) {
 		if (!sh->record_beams) {
 			memcpy(&sh->results[s][index], p, side);
@@ -394,7 +396,7 @@ static int journal_take(void *user, uint64_t index, const void *payload)
 		}
 		/* a path too long for its record: the trial (every side) runs again */
 		int got = bsim_sweep_record_unpack(p, sh->record_beams, &sh->results[s][index],
-		                              &sh->logs[s][index]);
+		                                   &sh->logs[s][index]);
 		if (got <= 0)
 			return got;
 	}
@@ -473,7 +475,8 @@ static void sweep_thread(sweep_shared *sh)
 			}
 			sides->keep_stride = sh->keep_stride;
 			rc = bsim_trial_sides_run(sides, scenes, sh->backend, sh->opts, seed,
-			                     0.01 * body_size(scene), results, log, t_sep, &err);
+			                          0.01 * body_size(scene), results, log, t_sep,
+			                          &err);
 			for (int q = 0; rc == BSIM_OK && q < n_pairs; q++)
 				sh->t_separate[q][k] = t_sep[q];
 		} else {
@@ -852,7 +855,7 @@ static int stream_load(sweep_shared *sh, bsim_error *err)
 		}
 		/* a lattice's path too long for its record: the trial runs again */
 		int got = rec ? bsim_sweep_record_unpack(rec, sh->record_beams, &sh->results[0][k],
-		                                    &sh->logs[0][k])
+		                                         &sh->logs[0][k])
 		              : 1;
 		if (got < 0)
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");

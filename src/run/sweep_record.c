@@ -20,7 +20,7 @@ int bsim_sweep_record_beams(const bsim_scene *scenes, int n)
 }
 
 void bsim_sweep_record_pack(void *rec, int beams_max, const bsim_trial_result *r,
-                       const bsim_trial_log *log)
+                            const bsim_trial_log *log)
 {
 	unsigned char *p = rec;
 	memset(p, 0, bsim_sweep_record_bytes(beams_max));
@@ -41,7 +41,8 @@ void bsim_sweep_record_pack(void *rec, int beams_max, const bsim_trial_result *r
 		memcpy(p, log->peak, (size_t)n_beams * sizeof *log->peak);
 }
 
-int bsim_sweep_record_unpack(const void *rec, int beams_max, bsim_trial_result *r, bsim_trial_log *log)
+int bsim_sweep_record_unpack(const void *rec, int beams_max, bsim_trial_result *r,
+                             bsim_trial_log *log)
 {
 	const unsigned char *p = rec;
 	int32_t n_entries, n_beams;

@@ -33,10 +33,11 @@ int bsim_sweep_record_beams(const bsim_scene *scenes, int n);
 
 /* r and log packed into rec (bsim_sweep_record_bytes(beams_max) bytes). */
 void bsim_sweep_record_pack(void *rec, int beams_max, const bsim_trial_result *r,
-                       const bsim_trial_log *log);
+                            const bsim_trial_log *log);
 
 /* rec into r and log (grown as needed): 1; 0 if the record's path did not
  * fit (nothing filled: the trial runs again); -1 out of memory. */
-int bsim_sweep_record_unpack(const void *rec, int beams_max, bsim_trial_result *r, bsim_trial_log *log);
+int bsim_sweep_record_unpack(const void *rec, int beams_max, bsim_trial_result *r,
+                             bsim_trial_log *log);
 
 #endif

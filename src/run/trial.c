@@ -171,8 +171,8 @@ static int trial_world(trial_ctx *c, bsim_error *err)
 	runner_forget_world(r);
 	if (!essay)
 		return c->backend->create(scene, c->opts, &c->w, err);
-	int rc = bsim_trial_essay_start(&r->essay, scene, c->backend, c->opts, c->gate.ix, c->gate.iy,
-	                           &c->w, &c->out->reset_overlaps, err);
+	int rc = bsim_trial_essay_start(&r->essay, scene, c->backend, c->opts, c->gate.ix,
+	                                c->gate.iy, &c->w, &c->out->reset_overlaps, err);
 	c->ws = &r->essay.scene;
 	c->map = r->essay.map;
 	return rc;
@@ -259,8 +259,8 @@ static int trial_begin(trial_ctx *c, trial_loop *lp, bsim_state *s0, bsim_error 
 static void trial_record(trial_ctx *c, const bsim_state *s, long n)
 {
 	double f_rand = c->fx->random ? c->fx->random->last : 0.0;
-	bsim_trial_record_row(c->rec, c->scene, bsim_trial_record_state(&c->r->whole, c->map, s), n, f_rand,
-	                 &c->out->ledger);
+	bsim_trial_record_row(c->rec, c->scene, bsim_trial_record_state(&c->r->whole, c->map, s), n,
+	                      f_rand, &c->out->ledger);
 	c->recorded = n;
 }
 
@@ -279,7 +279,8 @@ static inline int trial_over(const trial_ctx *c, const trial_loop *lp, const bsi
 static int gate_enter(trial_ctx *c, trial_loop *lp, bsim_state *s, const double p0[2], int ix,
                       int iy, bsim_error *err)
 {
-	int rc = bsim_trial_gate_cross(&c->gate, c->log, c->scene, c->map, p0, s, ix, iy, lp->n, err);
+	int rc = bsim_trial_gate_cross(&c->gate, c->log, c->scene, c->map, p0, s, ix, iy, lp->n,
+	                               err);
 	if (rc || c->scene->lattice.protocol != BSIM_PROTOCOL_ESSAY)
 		return rc;
 	double e_before = lp->e0;
@@ -287,7 +288,7 @@ static int gate_enter(trial_ctx *c, trial_loop *lp, bsim_state *s, const double 
 	c->solver.iteration_limit += s->solver.iteration_limit;
 	c->solver.clamped += s->solver.clamped;
 	rc = bsim_trial_essay_enter(&c->r->essay, c->scene, c->backend, c->opts, ix, iy, s, &c->w,
-	                       &c->out->reset_overlaps, err);
+	                            &c->out->reset_overlaps, err);
 	if (rc)
 		return rc;
 	c->backend->get_state(c->w, s);
@@ -384,7 +385,8 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, bsim_state *s0, int r
 	trial_result(c, lp, s0);
 	if (rc == BSIM_OK)
 		rc = bsim_effects_status(c->fx, err);
-	if (rc == BSIM_OK && c->log && bsim_trial_log_peaks(c->log, c->r->peaks.peak, c->scene->n_beams))
+	if (rc == BSIM_OK && c->log &&
+	    bsim_trial_log_peaks(c->log, c->r->peaks.peak, c->scene->n_beams))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the peaks");
 	bsim_trial_runner *r = c->r;
 	bsim_effects_free_spare(c->fx, &r->spare);
@@ -406,9 +408,9 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, bsim_state *s0, int r
 __attribute__((noinline)) static void trial_measure(trial_ctx *c, const bsim_state *s1)
 {
 	if (c->overlap)
-		c->out->overlap_max =
-		        fmax(c->out->overlap_max, bsim_trial_overlap_depth(c->r->shape, c->ws->n_beams,
-		                                                      c->scene->body.radius, s1));
+		c->out->overlap_max = fmax(c->out->overlap_max,
+		                           bsim_trial_overlap_depth(c->r->shape, c->ws->n_beams,
+		                                                    c->scene->body.radius, s1));
 	trial_peaks_turn(&c->r->peaks, s1);
 }
 
@@ -586,7 +588,8 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	trial_loop lp;
 	rc = trial_begin(&c, &lp, s0, err);
 	const int plain = !c.recording && !c.trace && !c.measure && !c.map;
-	if (rc == BSIM_OK && bsim_trial_steps_start(&r->steps, plain, scene, &fx, c.n_max, c.gate_max))
+	if (rc == BSIM_OK &&
+	    bsim_trial_steps_start(&r->steps, plain, scene, &fx, c.n_max, c.gate_max))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
 		double f[BSIM_WRENCH];

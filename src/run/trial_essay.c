@@ -55,8 +55,8 @@ static int essay_create(trial_essay *te, const bsim_backend *b, const bsim_optio
 }
 
 int bsim_trial_essay_start(trial_essay *te, const bsim_scene *lattice, const bsim_backend *b,
-                      const bsim_options *opts, int ix, int iy, bsim_world **w, int *overlaps,
-                      bsim_error *err)
+                           const bsim_options *opts, int ix, int iy, bsim_world **w, int *overlaps,
+                           bsim_error *err)
 {
 	*w = NULL;
 	essay_scene(te, lattice, ix, iy, lattice->body.start, lattice->body.velocity);
@@ -64,8 +64,8 @@ int bsim_trial_essay_start(trial_essay *te, const bsim_scene *lattice, const bsi
 }
 
 int bsim_trial_essay_enter(trial_essay *te, const bsim_scene *lattice, const bsim_backend *b,
-                      const bsim_options *opts, int ix, int iy, const bsim_state *s, bsim_world **w,
-                      int *overlaps, bsim_error *err)
+                           const bsim_options *opts, int ix, int iy, const bsim_state *s,
+                           bsim_world **w, int *overlaps, bsim_error *err)
 {
 	bsim_trial_essay_release(te, b, w);
 	essay_scene(te, lattice, ix, iy, s->x, s->v);

@@ -55,7 +55,7 @@ static void entry_fill(bsim_gate_entry *e, const bsim_scene *scene, const int *m
 }
 
 int bsim_trial_gate_log_start(bsim_trial_log *log, const gate_track *g, const bsim_scene *scene,
-                         const int *map, const bsim_state *s0, bsim_error *err)
+                              const int *map, const bsim_state *s0, bsim_error *err)
 {
 	bsim_gate_entry e;
 	entry_fill(&e, scene, map, s0, g->ix, g->iy, BSIM_EDGE_START,
@@ -107,9 +107,9 @@ static int entries_of_step(const bsim_scene *scene, const int *map, const gate_t
 	return 2;
 }
 
-int bsim_trial_gate_cross(gate_track *g, bsim_trial_log *log, const bsim_scene *scene, const int *map,
-                     const double p0[2], const bsim_state *s, int ix, int iy, long n,
-                     bsim_error *err)
+int bsim_trial_gate_cross(gate_track *g, bsim_trial_log *log, const bsim_scene *scene,
+                          const int *map, const double p0[2], const bsim_state *s, int ix, int iy,
+                          long n, bsim_error *err)
 {
 	bsim_gate_entry e[2];
 	int k = entries_of_step(scene, map, g, p0, s, ix, iy, n, scene->dt, e);

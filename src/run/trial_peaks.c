@@ -44,7 +44,7 @@ void bsim_trial_peaks_free(trial_peaks *p)
 }
 
 void bsim_trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
-                       const bsim_state *s0)
+                            const bsim_state *s0)
 {
 	for (int k = 0; k < p->n_list; k++) {
 		p->peak[p->list[k]] = 0.0;

@@ -52,7 +52,7 @@ void bsim_trial_peaks_free(trial_peaks *p);
  * (its angle 0): its peak is 0, and the cost is that of the beams the last
  * trial moved, not of the scene. */
 void bsim_trial_peaks_start(trial_peaks *p, const bsim_scene *scene, const int *map,
-                       const bsim_state *s0);
+                            const bsim_state *s0);
 
 /* The landscape label of a traversal: the beam whose barrier the body
  * crossed (bsim_landscape_label at the last touching step), -1 if it

@@ -64,7 +64,7 @@ static void ledger_row(FILE *f, const bsim_record_row *row)
 }
 
 void bsim_trial_record_row(const bsim_recorder *rec, const bsim_scene *sc, const bsim_state *s,
-                      long step, double f_rand, const bsim_ledger *ledger)
+                           long step, double f_rand, const bsim_ledger *ledger)
 {
 	bsim_record_row row = {
 	        .step = step,

@@ -7,7 +7,7 @@
 
 /* One recorded row, the state s at step `step`, to every sink of rec. */
 void bsim_trial_record_row(const bsim_recorder *rec, const bsim_scene *sc, const bsim_state *s,
-                      long step, double f_rand, const bsim_ledger *ledger);
+                           long step, double f_rand, const bsim_ledger *ledger);
 
 /* The whole lattice's state for the recorder, in whole (a state of the
  * scene's beams), from the state s of the essay's world, whose beam i is

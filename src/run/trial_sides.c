@@ -98,9 +98,9 @@ static double separation(const trial_sides *p, int a, int b, double d, double dt
 }
 
 int bsim_trial_sides_run(trial_sides *p, const bsim_scene *const *scene,
-                    const bsim_backend *const *backend, const bsim_options *const *opts,
-                    uint64_t seed, double sep_distance, bsim_trial_result *const *result,
-                    bsim_trial_log *const *log, double *t_separate, bsim_error *err)
+                         const bsim_backend *const *backend, const bsim_options *const *opts,
+                         uint64_t seed, double sep_distance, bsim_trial_result *const *result,
+                         bsim_trial_log *const *log, double *t_separate, bsim_error *err)
 {
 	for (int s = 0; s < p->n; s++) {
 		int rc = run_traced(p, s, scene[s], backend[s], opts[s], seed, result[s],

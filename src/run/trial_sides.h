@@ -42,8 +42,8 @@ void bsim_trial_sides_keep_worlds(trial_sides *p, int on);
  * first time, s, at which the two body centres are more than sep_distance
  * apart (m), compared while both runs go on; -1 if they never are. */
 int bsim_trial_sides_run(trial_sides *p, const bsim_scene *const *scene,
-                    const bsim_backend *const *backend, const bsim_options *const *opts,
-                    uint64_t seed, double sep_distance, bsim_trial_result *const *result,
-                    bsim_trial_log *const *log, double *t_separate, bsim_error *err);
+                         const bsim_backend *const *backend, const bsim_options *const *opts,
+                         uint64_t seed, double sep_distance, bsim_trial_result *const *result,
+                         bsim_trial_log *const *log, double *t_separate, bsim_error *err);
 
 #endif

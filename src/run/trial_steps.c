@@ -51,7 +51,7 @@ static int steps_reserve(trial_steps *t, int n_beams)
 }
 
 int bsim_trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
-                      bsim_effect **random)
+                           bsim_effect **random)
 {
 	int holds = !scene->has_lattice && !scene->body.rotates && !scene->effects.has_drag &&
 	            !scene->effects.has_ground_friction && fx->n_work == fx->n;
@@ -71,7 +71,7 @@ int bsim_trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effec
 }
 
 int bsim_trial_steps_start(trial_steps *t, int plain, const bsim_scene *scene, bsim_effects *fx,
-                      long n_max, long gate_max)
+                           long n_max, long gate_max)
 {
 	t->on = plain && scene->n_beams <= TRIAL_STEPS_BEAMS &&
 	        bsim_trial_force_holds(scene, fx, &t->propulsion, &t->random);

@@ -53,14 +53,14 @@ void bsim_trial_steps_free(trial_steps *t);
  * the pipeline or simulated by the backend). The two effects into
  * *propulsion and *random (NULL: absent). */
 int bsim_trial_force_holds(const bsim_scene *scene, bsim_effects *fx, bsim_effect **propulsion,
-                      bsim_effect **random);
+                           bsim_effect **random);
 
 /* Sets t for a trial of scene in pipeline fx: runs when plain (nothing
  * recorded, traced or measured per step), the forces hold and the scene
  * has at most TRIAL_STEPS_BEAMS beams. BSIM_EFAIL out of memory for the
  * states (t->on 0 then). */
 int bsim_trial_steps_start(trial_steps *t, int plain, const bsim_scene *scene, bsim_effects *fx,
-                      long n_max, long gate_max);
+                           long n_max, long gate_max);
 
 /* The steps a run from step lp->n may make under the force just asked, the
  * gate's dwell steps so far: to the end of the trial (max_steps n_max, or

@@ -550,8 +550,8 @@ static int compare_spread(const bsim_compare_dir_def *def, compare_job *job, con
 	if (def->n_merge > 0) {
 		char run[17];
 		bsim_part_dir_run_id(inputs, run);
-		rc = bsim_part_dir_join(def->merge, def->n_merge, "compare", run, inputs, size, total,
-		                   ss->journal, err);
+		rc = bsim_part_dir_join(def->merge, def->n_merge, "compare", run, inputs, size,
+		                        total, ss->journal, err);
 		return rc == BSIM_OK ? bsim_part_dir_journal_reopen(ss, inputs, size, err) : rc;
 	}
 	job->journal = ss ? ss->journal : NULL;
@@ -569,7 +569,7 @@ static int reads_load(compare_job *job, bsim_error *err)
 	for (int i = 0; i < job->n; i++)
 		if (job->is_read[i] &&
 		    bsim_compare_read_load(&job->def->side[i], job->e, job->sets, job->n_sets,
-		                      &job->read[i], err) != BSIM_OK)
+		                           &job->read[i], err) != BSIM_OK)
 			return BSIM_EINPUT;
 	return BSIM_OK;
 }

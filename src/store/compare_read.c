@@ -157,7 +157,8 @@ static int groups_one_trial(const bsim_experiment *e, const bsim_override *extra
 }
 
 int bsim_compare_read_load(const bsim_compare_side *side, const bsim_experiment *e,
-                      const bsim_override *extra, int n_extra, compare_read *out, bsim_error *err)
+                           const bsim_override *extra, int n_extra, compare_read *out,
+                           bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
 	char spec[BSIM_PATH_MAX + 16];

@@ -46,7 +46,8 @@ typedef struct compare_read {
  * expected ..." on a file that does not fit, or if side->trials_hash is
  * given and the bytes' hash is another. */
 int bsim_compare_read_load(const bsim_compare_side *side, const bsim_experiment *e,
-                      const bsim_override *extra, int n_extra, compare_read *out, bsim_error *err);
+                           const bsim_override *extra, int n_extra, compare_read *out,
+                           bsim_error *err);
 void bsim_compare_read_free(compare_read *rd);
 
 #endif

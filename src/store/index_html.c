@@ -180,7 +180,8 @@ void bsim_index_caption(const char *base, char *buf, size_t size)
 			char *under = strrchr(star, '_');
 			if (under && under[1] == 'p' && under[2] >= '2' && under[2] <= '9' &&
 			    strspn(under + 2, "0123456789") == strlen(under + 2)) {
-				snprintf(page, sizeof page, " (page %.6s of its panels)", under + 2);
+				snprintf(page, sizeof page, " (page %.6s of its panels)",
+				         under + 2);
 				*under = '\0';
 			}
 			key_of_ident(star, label, sizeof label);

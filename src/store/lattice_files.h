@@ -17,7 +17,7 @@ void bsim_lattice_entries_rows(FILE *f, long first, long n, int trials, const bs
 /* beam_peaks.csv: each trial's beams that moved, with their peak angle. */
 void bsim_lattice_peaks_header(FILE *f);
 void bsim_lattice_peaks_rows(FILE *f, const bsim_lattice_def *def, long first, long n, int trials,
-                        const bsim_trial_log *logs);
+                             const bsim_trial_log *logs);
 
 /* Group g's summary: the streamed sweep's own (*ls points into r), or
  * summarised from its trials into **ls (the caller frees it then: *ls is

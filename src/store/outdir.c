@@ -534,23 +534,25 @@ static int manifest_read(const char *dir, olist *l, int *has, char *command, siz
 	 * read as if it were this. */
 	if (format && (!ft || strcmp(ft, "beamsim-manifest-1") != 0))
 		rc = bsim_ydoc_expected(&d, format, NULL, "format",
-		                   "\"beamsim-manifest-1\" (a manifest this beamsim reads)", err);
+		                        "\"beamsim-manifest-1\" (a manifest this beamsim reads)",
+		                        err);
 	if (!rc && (!files || !fy_node_is_sequence(files)))
 		rc = bsim_ydoc_expected(&d, files, NULL, "files", "a list of files", err);
 	int n = rc ? 0 : fy_node_sequence_item_count(files);
 	for (int i = 0; !rc && i < n; i++) {
 		struct fy_node *f = fy_node_sequence_get_by_index(files, i);
-		struct fy_node *pn = bsim_ydoc_lookup(f, "path"), *cn = bsim_ydoc_lookup(f, "crc32");
+		struct fy_node *pn = bsim_ydoc_lookup(f, "path"),
+		               *cn = bsim_ydoc_lookup(f, "crc32");
 		const char *rel = pn && fy_node_is_scalar(pn) ? fy_node_get_scalar0(pn) : NULL;
 		const char *crc = cn && fy_node_is_scalar(cn) ? fy_node_get_scalar0(cn) : NULL;
 		long long bytes = -1;
 		char *end = NULL;
 		unsigned long c = crc ? strtoul(crc, &end, 16) : 0;
 		if (!rel || !*rel || strstr(rel, "..") || rel[0] == '/' ||
-		    !bsim_ydoc_int64(bsim_ydoc_lookup(f, "bytes"), &bytes) || bytes < 0 || !crc || *end ||
-		    strlen(crc) != 8)
-			rc = bsim_ydoc_expected(&d, f, files, "files", "{path, bytes, crc32} of a file",
-			                   err);
+		    !bsim_ydoc_int64(bsim_ydoc_lookup(f, "bytes"), &bytes) || bytes < 0 || !crc ||
+		    *end || strlen(crc) != 8)
+			rc = bsim_ydoc_expected(&d, f, files, "files",
+			                        "{path, bytes, crc32} of a file", err);
 		else if (olist_add(l, rel, bytes, c) != 0)
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
@@ -726,9 +728,9 @@ static int verify_one(const char *dir, const char *path, const ofile *want, bsim
 		                      path, dir, BSIM_OUTDIR_MANIFEST, strerror(errno));
 	if (!S_ISREG(st.st_mode)) {
 		close(fd);
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s: expected the file %s/%s lists (%lld bytes), got %s",
-		                      path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, bsim_file_kind(&st));
+		return bsim_error_set(
+		        err, BSIM_EINPUT, "%s: expected the file %s/%s lists (%lld bytes), got %s",
+		        path, dir, BSIM_OUTDIR_MANIFEST, want->bytes, bsim_file_kind(&st));
 	}
 	unsigned char buf[65536];
 	uLong c = crc32(0L, Z_NULL, 0);

@@ -351,7 +351,7 @@ const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
 };
 
 int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
-                    bsim_error *err)
+                         bsim_error *err)
 {
 	memset(w, 0, sizeof *w);
 	if (bsim_atomic_file_open(&w->o, path, err) != BSIM_OK)
@@ -370,7 +370,7 @@ int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_expe
 }
 
 void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
-                     const bsim_trial_result *results, const bsim_trial_log *logs)
+                          const bsim_trial_result *results, const bsim_trial_log *logs)
 {
 	FILE *f = w->o.f;
 	for (long k = 0; k < n; k++) {
@@ -437,8 +437,8 @@ int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsi
 		return BSIM_EFAIL;
 	for (int g = 0; g < r->n_groups; g++)
 		bsim_trials_csv_rows(&w, (long)g * r->trials, r->trials, r->trials,
-		                &r->trials_out[(size_t)g * r->trials],
-		                r->logs ? &r->logs[(size_t)g * r->trials] : NULL);
+		                     &r->trials_out[(size_t)g * r->trials],
+		                     r->logs ? &r->logs[(size_t)g * r->trials] : NULL);
 	return bsim_trials_csv_commit(&w, err);
 }
 

@@ -149,7 +149,7 @@ void bsim_lattice_peaks_header(FILE *f)
 }
 
 void bsim_lattice_peaks_rows(FILE *f, const bsim_lattice_def *def, long first, long n, int trials,
-                        const bsim_trial_log *logs)
+                             const bsim_trial_log *logs)
 {
 	for (long i = 0; i < n; i++) {
 		int g = (int)((first + i) / trials), t = (int)((first + i) % trials);
@@ -186,7 +186,7 @@ static int write_peaks(FILE *f, const bsim_experiment *e, const bsim_override *e
 	(void)err;
 	bsim_lattice_peaks_header(f);
 	bsim_lattice_peaks_rows(f, &r->lattice_def, 0, (long)r->n_groups * r->trials, r->trials,
-	                   r->logs);
+	                        r->logs);
 	return BSIM_OK;
 }
 

@@ -19,11 +19,13 @@
 
 void bsim_part_dir_run_id(const char *inputs, char out[17])
 {
-	snprintf(out, 17, "%016" PRIx64, bsim_hash_fnv1a64(inputs, strlen(inputs), HASH_FNV1A64_SEED));
+	snprintf(out, 17, "%016" PRIx64,
+	         bsim_hash_fnv1a64(inputs, strlen(inputs), HASH_FNV1A64_SEED));
 }
 
-int bsim_part_dir_write(const char *stage, const char *command, int index, int count, const char *run,
-                   long total, long records, int argc, char *const *argv, bsim_error *err)
+int bsim_part_dir_write(const char *stage, const char *command, int index, int count,
+                        const char *run, long total, long records, int argc, char *const *argv,
+                        bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	if (bsim_session_path(path, sizeof path, stage, "part.json", err))
@@ -76,7 +78,7 @@ static int part_long(const ydoc *d, struct fy_node *root, const char *field, lon
 	double x;
 	if (!n || bsim_ydoc_number(n, &x) != YDOC_NUM_OK || x < lo || x > 1e15 || x != (long)x)
 		return bsim_ydoc_expected(d, n, NULL, field, lo ? "a whole number >= 1" : "a count",
-		                     err);
+		                          err);
 	*out = (long)x;
 	return BSIM_OK;
 }
@@ -104,7 +106,7 @@ int bsim_sweep_dir_part_read(const char *dir, bsim_sweep_dir_part *p, bsim_error
 		rc = part_long(&d, root, "parts", 1, &count, err);
 	if (!rc && (index > count || count > 1000000))
 		rc = bsim_ydoc_expected(&d, bsim_ydoc_lookup(root, "part"), NULL, "part",
-		                   "a part from 1 to parts", err);
+		                        "a part from 1 to parts", err);
 	if (!rc)
 		rc = part_text(&d, root, "run", p->run, sizeof p->run, err);
 	if (!rc)
@@ -112,7 +114,7 @@ int bsim_sweep_dir_part_read(const char *dir, bsim_sweep_dir_part *p, bsim_error
 	struct fy_node *av = bsim_ydoc_lookup(root, "argv");
 	if (!rc && (!av || !fy_node_is_sequence(av) || fy_node_sequence_item_count(av) < 1))
 		rc = bsim_ydoc_expected(&d, av, NULL, "argv", "the command line, a list of strings",
-		                   err);
+		                        err);
 	if (!rc) {
 		int n = fy_node_sequence_item_count(av);
 		p->argv = calloc((size_t)n + 1, sizeof *p->argv);
@@ -124,7 +126,8 @@ int bsim_sweep_dir_part_read(const char *dir, bsim_sweep_dir_part *p, bsim_error
 			const char *t =
 			        a && fy_node_is_scalar(a) ? fy_node_get_scalar(a, &len) : NULL;
 			if (!t) {
-				rc = bsim_ydoc_expected(&d, a, NULL, "argv", "a list of strings", err);
+				rc = bsim_ydoc_expected(&d, a, NULL, "argv", "a list of strings",
+				                        err);
 				break;
 			}
 			p->argv[i] = strndup(t, len);
@@ -173,7 +176,7 @@ static int join_take(void *user, uint64_t index, const void *payload)
 }
 
 int bsim_part_dir_check(const char *const *dirs, int n, const char *command, const char *run,
-                   bsim_sweep_dir_part *parts, bsim_error *err)
+                        bsim_sweep_dir_part *parts, bsim_error *err)
 {
 	int rc = BSIM_OK;
 	/* The run the caller gives is the one the first part's command line
@@ -234,8 +237,8 @@ int bsim_part_dir_check(const char *const *dirs, int n, const char *command, con
 }
 
 int bsim_part_dir_join(const char *const *dirs, int n, const char *command, const char *run,
-                  const char *inputs, size_t record_size, long total, bsim_journal *j,
-                  bsim_error *err)
+                       const char *inputs, size_t record_size, long total, bsim_journal *j,
+                       bsim_error *err)
 {
 	bsim_sweep_dir_part *parts = calloc((size_t)n, sizeof *parts);
 	if (!parts)
@@ -280,7 +283,7 @@ static int mark_done(void *user, uint64_t index, const void *payload)
 }
 
 int bsim_part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim_session *ss,
-                        part_dir_run_fn run, void *user, bsim_error *err)
+                             part_dir_run_fn run, void *user, bsim_error *err)
 {
 	long total = sp->total;
 	size_t bytes = (size_t)total / 8 + 1;
@@ -326,8 +329,8 @@ int bsim_part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim
 		if (rc == BSIM_OK) {
 			ss->journal_path[0] = '\0';
 			rc = bsim_part_dir_write(ss->stage, sp->command, sp->part->index + 1,
-			                    sp->part->count, id, total, records, sp->argc, sp->argv,
-			                    err);
+			                         sp->part->count, id, total, records, sp->argc,
+			                         sp->argv, err);
 		}
 	}
 	free(done);
@@ -335,7 +338,7 @@ int bsim_part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim
 }
 
 int bsim_part_dir_journal_reopen(bsim_session *ss, const char *inputs, size_t record_size,
-                            bsim_error *err)
+                                 bsim_error *err)
 {
 	int rc = bsim_journal_close(ss->journal, err);
 	ss->journal = NULL;

@@ -105,7 +105,7 @@ static int scene_text(FILE *f, const bsim_experiment *e, bsim_error *err)
 	}
 	file_text t;
 	int rc = bsim_file_read(e->scene_path, "a scene file", bsim_limits_get()->input_bytes,
-	                   "input_bytes", &t, err);
+	                        "input_bytes", &t, err);
 	if (rc != BSIM_OK)
 		return rc;
 	fwrite(t.text, 1, t.len, f);
@@ -327,7 +327,8 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 	     strlen(rec->read_hash[i]) != 16 ||
 	     strspn(rec->read_hash[i], "0123456789abcdef") != 16))
 		return bsim_ydoc_expected(d, bsim_ydoc_lookup(root, field), NULL, field,
-		                     "16 hex digits (the FNV-1a 64 hash of the file read)", err);
+		                          "16 hex digits (the FNV-1a 64 hash of the file read)",
+		                          err);
 	snprintf(field, sizeof field, "backends.%d.options", i);
 	struct fy_node *opts = bsim_ydoc_lookup(root, field);
 	if (!opts || !fy_node_is_mapping(opts) ||
@@ -342,7 +343,7 @@ static int read_backend(const ydoc *d, struct fy_node *root, int i, bsim_run_rec
 		bsim_options *o = &rec->opts[i];
 		if (!k || !v || kl >= sizeof o->key[0] || vl >= sizeof o->value[0])
 			return bsim_ydoc_expected(d, fy_node_pair_value(p), NULL, field,
-			                     "knob: value strings", err);
+			                          "knob: value strings", err);
 		snprintf(o->key[o->n], sizeof o->key[0], "%.*s", (int)kl, k);
 		snprintf(o->value[o->n], sizeof o->value[0], "%.*s", (int)vl, v);
 		o->n++;
@@ -402,12 +403,14 @@ int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 	for (int i = 0; !rc && i < rec->n_backends; i++)
 		rc = read_backend(&d, root, i, rec, err);
 	if (!rc && strcmp(rec->command, "compare") == 0 && rec->n_backends < 2)
-		rc = bsim_ydoc_expected(&d, b, NULL, "backends", "a comparison's 2 or more sides", err);
+		rc = bsim_ydoc_expected(&d, b, NULL, "backends", "a comparison's 2 or more sides",
+		                        err);
 	struct fy_node *pn = bsim_ydoc_lookup(root, "protocols");
 	if (!rc && pn &&
 	    (!fy_node_is_sequence(pn) || fy_node_sequence_item_count(pn) != 2 ||
 	     rec->n_backends != 2))
-		rc = bsim_ydoc_expected(&d, pn, NULL, "protocols", "a list of 2 lattice protocols", err);
+		rc = bsim_ydoc_expected(&d, pn, NULL, "protocols", "a list of 2 lattice protocols",
+		                        err);
 	for (int i = 0; !rc && pn && i < 2; i++) {
 		char field[32];
 		snprintf(field, sizeof field, "protocols.%d", i);
@@ -431,8 +434,8 @@ int bsim_run_record_read(const char *dir, bsim_run_record *rec, bsim_error *err)
 		rec->rule.alpha = alpha;
 		rec->rule.margin = margin;
 		if (strcmp(rec->command, "sweep") != 0 && strcmp(rec->command, "compare") != 0)
-			rc = bsim_ydoc_expected(&d, bsim_ydoc_lookup(root, "command"), NULL, "command",
-			                   "\"sweep\" or \"compare\"", err);
+			rc = bsim_ydoc_expected(&d, bsim_ydoc_lookup(root, "command"), NULL,
+			                        "command", "\"sweep\" or \"compare\"", err);
 	}
 	bsim_ydoc_free(&d);
 	return rc;

@@ -31,7 +31,8 @@ static int survival_files(const char *dir, const bsim_experiment *e, const bsim_
 	survival_acc a;
 	int rc = bsim_survival_acc_init(&a, e, extra, n_extra, err);
 	if (rc == BSIM_OK)
-		bsim_survival_acc_add(&a, 0, (long)r->n_groups * r->trials, r->trials, r->trials_out);
+		bsim_survival_acc_add(&a, 0, (long)r->n_groups * r->trials, r->trials,
+		                      r->trials_out);
 	if (rc == BSIM_OK)
 		rc = bsim_survival_acc_write(&a, dir, err);
 	bsim_survival_acc_free(&a);

@@ -31,7 +31,7 @@ double bsim_survival_exit_time(const bsim_trial_result *r)
 }
 
 int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_override *sets,
-                      int n_sets, bsim_error *err)
+                           int n_sets, bsim_error *err)
 {
 	memset(a, 0, sizeof *a);
 	a->e = e;
@@ -84,7 +84,7 @@ static int kind_of(bsim_outcome o)
 }
 
 void bsim_survival_acc_add(survival_acc *a, long first, long n, int trials,
-                      const bsim_trial_result *results)
+                           const bsim_trial_result *results)
 {
 	for (long k = 0; k < n; k++) {
 		long gi = (first + k) / trials;

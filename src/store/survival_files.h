@@ -48,12 +48,12 @@ typedef struct survival_acc {
  * its dt and max_steps). BSIM_EFAIL out of memory; free with
  * bsim_survival_acc_free either way. */
 int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_override *sets,
-                      int n_sets, bsim_error *err);
+                           int n_sets, bsim_error *err);
 void bsim_survival_acc_free(survival_acc *a);
 
 /* Counts trials first .. first + n - 1 of a sweep of `trials` per group. */
 void bsim_survival_acc_add(survival_acc *a, long first, long n, int trials,
-                      const bsim_trial_result *results);
+                           const bsim_trial_result *results);
 
 /* Writes dir/survival.csv and dir/horizon.csv (their twins come with the
  * sweep's, bsim_matlab_sweep). */

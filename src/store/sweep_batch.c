@@ -217,15 +217,16 @@ static int batch_parts(void *user, const bsim_sweep_part *part, bsim_error *err)
 	return rc;
 }
 
-int bsim_sweep_batch_run(sweep_batch *b, const bsim_experiment *const *e, const bsim_sweep_config *cfg,
-                    int n, bsim_sweep_result *res, bsim_error *err)
+int bsim_sweep_batch_run(sweep_batch *b, const bsim_experiment *const *e,
+                         const bsim_sweep_config *cfg, int n, bsim_sweep_result *res,
+                         bsim_error *err)
 {
 	return bsim_sweep_batch_run_cpu(b, e, cfg, n, res, NULL, err);
 }
 
 int bsim_sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
-                        const bsim_sweep_config *cfg, int n, bsim_sweep_result *res, double *cpu,
-                        bsim_error *err)
+                             const bsim_sweep_config *cfg, int n, bsim_sweep_result *res,
+                             double *cpu, bsim_error *err)
 {
 	b->open = b->writes = 0;
 	b->journal[0] = '\0';
@@ -269,8 +270,8 @@ int bsim_sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 	if (rc == BSIM_OK && merge) {
 		char run[17];
 		bsim_part_dir_run_id(inputs, run);
-		rc = bsim_part_dir_join(sp->merge, sp->n_merge, b->command, run, inputs, size, c.total,
-		                   b->ss.journal, err);
+		rc = bsim_part_dir_join(sp->merge, sp->n_merge, b->command, run, inputs, size,
+		                        c.total, b->ss.journal, err);
 		if (rc == BSIM_OK)
 			rc = bsim_part_dir_journal_reopen(&b->ss, inputs, size, err);
 	} else if (rc == BSIM_OK && spread != BSIM_SPREAD_NONE) {

@@ -52,14 +52,15 @@ typedef struct sweep_batch {
  * trials_out without logs), with out opened first (b->ss). With b->writes
  * 0 (a shard, another rank) res holds nothing. On error res holds nothing;
  * call bsim_sweep_batch_end in every case where b->open. */
-int bsim_sweep_batch_run(sweep_batch *b, const bsim_experiment *const *e, const bsim_sweep_config *cfg,
-                    int n, bsim_sweep_result *res, bsim_error *err);
+int bsim_sweep_batch_run(sweep_batch *b, const bsim_experiment *const *e,
+                         const bsim_sweep_config *cfg, int n, bsim_sweep_result *res,
+                         bsim_error *err);
 
 /* With cpu not NULL, cpu[0..n) gets the CPU time, s, this process spent
  * on each sweep (clock(): its part and the final run from the journal). */
 int bsim_sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
-                        const bsim_sweep_config *cfg, int n, bsim_sweep_result *res, double *cpu,
-                        bsim_error *err);
+                             const bsim_sweep_config *cfg, int n, bsim_sweep_result *res,
+                             double *cpu, bsim_error *err);
 
 /* Ends out's session with status rc (bsim_session_close): the files the
  * caller wrote into b->ss.stage (a shard's part.json and part.journal)

@@ -76,9 +76,9 @@ static int trials_sink_take(void *user, const bsim_sweep_block *b, bsim_error *e
 	bsim_survival_acc_add(&s->surv, b->first, b->n, s->trials, b->results);
 	if (s->n_files > 1) {
 		bsim_lattice_entries_rows(s->lattice[SINK_ENTRIES].f, b->first, b->n, s->trials,
-		                     b->logs);
-		bsim_lattice_peaks_rows(s->lattice[SINK_PEAKS].f, &s->def, b->first, b->n, s->trials,
-		                   b->logs);
+		                          b->logs);
+		bsim_lattice_peaks_rows(s->lattice[SINK_PEAKS].f, &s->def, b->first, b->n,
+		                        s->trials, b->logs);
 	}
 	for (int k = 0; k < s->n_files; k++) {
 		FILE *f = sink_file(s, k);
@@ -261,7 +261,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 		bsim_part_dir_run_id(inputs, run);
 		long total = (long)e->n_groups * e->trials;
 		rc = bsim_part_dir_join(def->merge, def->n_merge, "sweep", run, inputs, size, total,
-		                   ss.journal, err);
+		                        ss.journal, err);
 		if (rc == BSIM_OK)
 			rc = bsim_part_dir_journal_reopen(&ss, inputs, size, err);
 		cfg.journal = ss.journal;

@@ -59,9 +59,9 @@ typedef struct trials_csv_writer {
 } trials_csv_writer;
 
 int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
-                    bsim_error *err);
+                         bsim_error *err);
 void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
-                     const bsim_trial_result *results, const bsim_trial_log *logs);
+                          const bsim_trial_result *results, const bsim_trial_log *logs);
 int bsim_trials_csv_commit(trials_csv_writer *w, bsim_error *err);
 void bsim_trials_csv_abort(trials_csv_writer *w);
 
@@ -87,6 +87,6 @@ typedef struct trials_csv_shape {
  * shape, a (group, trial) read twice (naming the line of the first) or
  * missing (named, at the end of the file). */
 int bsim_trials_csv_parse(const char *path, char *text, const trials_csv_shape *shape,
-                     bsim_sweep_result *r, bsim_error *err);
+                          bsim_sweep_result *r, bsim_error *err);
 
 #endif

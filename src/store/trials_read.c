@@ -398,7 +398,7 @@ static int rows_complete(const reader *rd, long rows, bsim_error *err)
 }
 
 int bsim_trials_csv_parse(const char *path, char *text, const trials_csv_shape *shape,
-                     bsim_sweep_result *r, bsim_error *err)
+                          bsim_sweep_result *r, bsim_error *err)
 {
 	memset(r, 0, sizeof *r);
 	int n_groups = shape->n_groups, trials = shape->trials;

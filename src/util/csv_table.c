@@ -234,7 +234,7 @@ int bsim_csv_number(const char *s, double *out)
 }
 
 int bsim_csv_table_numbers(const csv_table *t, const char *path, int col, int allow_empty,
-                      double empty_value, double *out, bsim_error *err)
+                           double empty_value, double *out, bsim_error *err)
 {
 	for (long r = 0; r < t->n_rows; r++) {
 		if (allow_empty && !*bsim_csv_table_cell(t, r, col)) {
@@ -250,7 +250,7 @@ int bsim_csv_table_numbers(const csv_table *t, const char *path, int col, int al
 }
 
 int bsim_csv_table_require(const csv_table *t, const char *path, const char *const *names, int n,
-                      int *cols, bsim_error *err)
+                           int *cols, bsim_error *err)
 {
 	for (int i = 0; i < n; i++) {
 		cols[i] = bsim_csv_table_col(t, names[i]);

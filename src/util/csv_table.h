@@ -78,11 +78,11 @@ int bsim_csv_number(const char *s, double *out);
  * not one; an empty cell becomes empty_value if allow_empty. path names
  * the file in the message. */
 int bsim_csv_table_numbers(const csv_table *t, const char *path, int col, int allow_empty,
-                      double empty_value, double *out, bsim_error *err);
+                           double empty_value, double *out, bsim_error *err);
 
 /* Required columns: the index of each name in cols, or BSIM_EINPUT naming
  * the file and the first missing column. */
 int bsim_csv_table_require(const csv_table *t, const char *path, const char *const *names, int n,
-                      int *cols, bsim_error *err);
+                           int *cols, bsim_error *err);
 
 #endif

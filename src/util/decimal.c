@@ -68,8 +68,8 @@ int bsim_decimal_step(const char *a, const char *step, long i, char *buf, size_t
 {
 	int64_t ma, ms, v;
 	int ea, es;
-	if (bsim_decimal_other_base(a) || bsim_decimal_other_base(step) || decimal_parse(a, &ma, &ea) ||
-	    decimal_parse(step, &ms, &es))
+	if (bsim_decimal_other_base(a) || bsim_decimal_other_base(step) ||
+	    decimal_parse(a, &ma, &ea) || decimal_parse(step, &ms, &es))
 		return -1;
 	int e = ea < es ? ea : es;
 	if (scale10(&ma, ea - e) || scale10(&ms, es - e) || __builtin_mul_overflow(ms, i, &v) ||

@@ -103,7 +103,7 @@ int bsim_file_open_checked(const char *path, struct stat *st)
 }
 
 int bsim_file_read(const char *path, const char *what, double max_bytes, const char *limit_name,
-              file_text *out, bsim_error *err)
+                   file_text *out, bsim_error *err)
 {
 	out->text = NULL;
 	out->len = 0;

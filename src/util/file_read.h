@@ -29,7 +29,7 @@ typedef struct file_text {
  *               (limit NAME = N; raise it with --limit NAME=N)"
  *   BSIM_EFAIL  "PATH: out of memory" */
 int bsim_file_read(const char *path, const char *what, double max_bytes, const char *limit_name,
-              file_text *out, bsim_error *err);
+                   file_text *out, bsim_error *err);
 
 void bsim_file_text_free(file_text *t);
 

@@ -283,7 +283,8 @@ static void alias_fault(struct fy_event *ev, parse_fault *pf)
 	pf->alias_col = m ? m->column + 1 : 0;
 }
 
-int bsim_ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text, bsim_error *err)
+int bsim_ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text,
+                         bsim_error *err)
 {
 	if (text)
 		*text = NULL;
@@ -476,7 +477,7 @@ int bsim_ydoc_line(struct fy_node *n, struct fy_node *alt)
 }
 
 int bsim_ydoc_fail(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
-              bsim_error *err, const char *fmt, ...)
+                   bsim_error *err, const char *fmt, ...)
 {
 	char where[512], what[512];
 	bsim_ydoc_where(d, n, alt, where, sizeof where);
@@ -488,7 +489,7 @@ int bsim_ydoc_fail(const ydoc *d, struct fy_node *n, struct fy_node *alt, const 
 }
 
 int bsim_ydoc_expected(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
-                  const char *what, bsim_error *err)
+                       const char *what, bsim_error *err)
 {
 	char got[128];
 	bsim_ydoc_describe(n, got, sizeof got);

@@ -47,7 +47,8 @@ int bsim_ydoc_load_own(ydoc *d, const char *path, bsim_error *err);
  * that text (malloc'd, NUL-terminated; NULL on failure) for the caller to
  * free. */
 typedef int (*ydoc_event_fn)(void *user, struct fy_event *ev, const char *text, bsim_error *err);
-int bsim_ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text, bsim_error *err);
+int bsim_ydoc_events_own(const char *path, ydoc_event_fn fn, void *user, char **text,
+                         bsim_error *err);
 
 /* Parses YAML flow text (an override value) into a new document, checked
  * like a file. On failure returns NULL and puts in msg "expected ..., got
@@ -75,11 +76,11 @@ int bsim_ydoc_line(struct fy_node *n, struct fy_node *alt);
 
 /* Sets err to "WHERE: FIELD: MESSAGE" and returns BSIM_EINPUT. */
 int bsim_ydoc_fail(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
-              bsim_error *err, const char *fmt, ...) __attribute__((format(printf, 6, 7)));
+                   bsim_error *err, const char *fmt, ...) __attribute__((format(printf, 6, 7)));
 
 /* Sets err to "WHERE: FIELD: expected WHAT, got <n described>". */
 int bsim_ydoc_expected(const ydoc *d, struct fy_node *n, struct fy_node *alt, const char *field,
-                  const char *what, bsim_error *err);
+                       const char *what, bsim_error *err);
 
 /* An absent or empty value ("key:" with nothing after it). */
 int bsim_ydoc_is_null(struct fy_node *n);

@@ -67,7 +67,7 @@ static video_trail *trail_at(video_panel *pn, double s)
 }
 
 int bsim_video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scene,
-                const char *const *labels, int n_panels, bsim_error *err)
+                     const char *const *labels, int n_panels, bsim_error *err)
 {
 	int rc = bsim_video_def_check(def, err);
 	if (rc != BSIM_OK)

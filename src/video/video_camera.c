@@ -62,7 +62,7 @@ static double axis_centre(double lo, double hi, double half, double body, double
 }
 
 void bsim_video_view_make(const double field[4], double view_span, double x0, double y0, double w,
-                     double h, const double body[2], double r, video_view *out)
+                          double h, const double body[2], double r, video_view *out)
 {
 	const double fw = field[2] - field[0], fh = field[3] - field[1];
 	const double s_fit = fmin(w / fw, h / fh);

@@ -102,7 +102,7 @@ struct bsim_video {
  * rest: frame count, field, colour scale, the trails' lists at the views'
  * scales (empty). t_part and part_x are the caller's. */
 int bsim_video_setup(bsim_video *v, const bsim_video_def *def, const bsim_scene *scene,
-                const char *const *labels, int n_panels, bsim_error *err);
+                     const char *const *labels, int n_panels, bsim_error *err);
 /* Frees what bsim_video_setup made and v itself. */
 void bsim_video_teardown(bsim_video *v);
 
@@ -133,15 +133,15 @@ long bsim_video_frame_count(double fps, double dt, long n_last);
  * video_track.c says), its beams' angles (float) and contacts, and the
  * random force fx applies over the next step. */
 void bsim_video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const bsim_state *s,
-                      video_frame *f, float *theta, unsigned char *contact);
+                           video_frame *f, float *theta, unsigned char *contact);
 
 /* Pass 1 of a stream (video_stream.c): runs the trial as
  * bsim_video_track_record does but keeps only its result, its frame count
  * and its gate path; its effect pipeline (bsim_video_track_effects) is the
  * one a second run of the trial takes its frames' forces from. */
 int bsim_video_track_summary(const bsim_scene *scene, const bsim_backend *backend,
-                        const bsim_options *opts, uint64_t seed, double fps, bsim_video_track **out,
-                        bsim_error *err);
+                             const bsim_options *opts, uint64_t seed, double fps,
+                             bsim_video_track **out, bsim_error *err);
 bsim_effects *bsim_video_track_effects(bsim_video_track *t);
 
 /* The field's bounding box: every beam's reach (pivot +- length), the
@@ -155,7 +155,7 @@ void bsim_video_field_bounds(const bsim_scene *s, double field[4]);
  * inside the field along each axis where the field is larger than the
  * view, and always keeping the whole body in view. */
 void bsim_video_view_make(const double field[4], double view_span, double x0, double y0, double w,
-                     double h, const double body[2], double r, video_view *out);
+                          double h, const double body[2], double r, video_view *out);
 
 /* The overview of a panel whose camera follows the body (the field is
  * larger than the view): the whole field at a small scale in the view's

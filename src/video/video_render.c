@@ -526,8 +526,8 @@ void bsim_video_panel_view(const bsim_video *v, int p, long k, video_view *out)
 	const double pw = (double)((p + 1) * v->width / v->n_panels) - px0;
 	const double title_h = ceil(2.0 * font_size(v));
 	const bsim_video_sample sm = video_panel_sample(v, p, k);
-	bsim_video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h, sm.x,
-	                v->scene->body.radius, out);
+	bsim_video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h,
+	                     sm.x, v->scene->body.radius, out);
 }
 
 int bsim_video_panel_scales(const bsim_video *v, int p, double *s_main, double *s_over)
@@ -537,7 +537,7 @@ int bsim_video_panel_scales(const bsim_video *v, int p, double *s_main, double *
 	const double title_h = ceil(2.0 * font_size(v));
 	video_view vw, ov;
 	bsim_video_view_make(v->field, v->def.view_span, px0, title_h, pw, v->height - title_h,
-	                v->scene->body.start, v->scene->body.radius, &vw);
+	                     v->scene->body.start, v->scene->body.radius, &vw);
 	*s_main = vw.scale;
 	*s_over = 0.0;
 	if (!bsim_video_overview_make(v->field, &vw, &ov))

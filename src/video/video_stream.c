@@ -169,8 +169,8 @@ static void stream_trace(void *user, long step, const bsim_state *st)
 	/* Several frames fall on one step when fps h > 1. */
 	while (!sp->stopped && sp->k_next < sp->frames &&
 	       stream_frame_step(s, sp->k_next, sp->n_last) == step) {
-		bsim_video_frame_take(s->scene, bsim_video_track_effects(sp->summary), step, st, &sp->build.f,
-		                 sp->build.theta, sp->build.contact);
+		bsim_video_frame_take(s->scene, bsim_video_track_effects(sp->summary), step, st,
+		                      &sp->build.f, sp->build.theta, sp->build.contact);
 		stream_deliver(sp, step);
 		sp->k_next++;
 	}
@@ -440,8 +440,8 @@ int bsim_video_stream_alloc(const bsim_video_def *def, const bsim_scene *scene,
 		sp->s = s;
 		sp->backend = backends[p];
 		sp->opts = opts ? opts[p] : NULL;
-		rc = bsim_video_track_summary(scene, backends[p], sp->opts, seed, def->fps, &sp->summary,
-		                         err);
+		rc = bsim_video_track_summary(scene, backends[p], sp->opts, seed, def->fps,
+		                              &sp->summary, err);
 		if (rc != BSIM_OK)
 			break;
 		s->n = p + 1;

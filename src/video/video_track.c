@@ -120,7 +120,7 @@ static int frames_reserve(bsim_video_track *t, long need)
 }
 
 void bsim_video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, const bsim_state *s,
-                      video_frame *f, float *th, unsigned char *ct)
+                           video_frame *f, float *th, unsigned char *ct)
 {
 	f->step = step;
 	f->x[0] = s->x[0];
@@ -147,8 +147,8 @@ void bsim_video_frame_take(const bsim_scene *sc, bsim_effects *fx, long step, co
 static void frame_take(bsim_video_track *t, long k, long step, const bsim_state *s)
 {
 	bsim_video_frame_take(t->scene, &t->fx, step, s, &t->frames[k],
-	                 t->theta + (size_t)k * (size_t)t->n_beams,
-	                 t->contact + (size_t)k * (size_t)t->n_beams);
+	                      t->theta + (size_t)k * (size_t)t->n_beams,
+	                      t->contact + (size_t)k * (size_t)t->n_beams);
 }
 
 static void track_trace(void *user, long step, const bsim_state *s)
@@ -264,8 +264,8 @@ int bsim_video_track_record(const bsim_scene *scene, const bsim_backend *backend
 }
 
 int bsim_video_track_summary(const bsim_scene *scene, const bsim_backend *backend,
-                        const bsim_options *opts, uint64_t seed, double fps, bsim_video_track **out,
-                        bsim_error *err)
+                             const bsim_options *opts, uint64_t seed, double fps,
+                             bsim_video_track **out, bsim_error *err)
 {
 	return track_run(scene, backend, opts, seed, fps, 1, out, err);
 }
