@@ -192,15 +192,8 @@ const bsim_backend *pyb_backend(const char *spec, PyObject *seq, bsim_options *o
 	const bsim_backend *b = bsim_backend_find(name, &err);
 	if (!b)
 		return pyb_raise(err.code ? err.code : BSIM_EINPUT, &err), NULL;
-	for (const char *p = spec + n; *p == ':';) {
-		size_t len = strcspn(p + 1, ":");
-		char kv[128];
-		snprintf(kv, sizeof kv, "%.*s", (int)(len < sizeof kv ? len : sizeof kv - 1),
-		         p + 1);
-		if (bsim_options_add(opts, kv, &err) != BSIM_OK)
-			return pyb_raise(err.code, &err), NULL;
-		p += len + 1;
-	}
+	if (bsim_backend_spec_options(spec, opts, &err) != BSIM_OK)
+		return pyb_raise(err.code, &err), NULL;
 	if (bsim_options_check(opts, b->knobs, b->n_knobs, b->name, &err) != BSIM_OK) {
 		if (spec[n]) {
 			bsim_error e2;

@@ -42,6 +42,11 @@ BSIM_API const bsim_backend *bsim_backend_find(const char *name, bsim_error *err
  * to the ':' after PATH (a path has no ':'). */
 BSIM_API size_t bsim_backend_spec_name(const char *spec);
 
+/* The options a backend spec gives after its name ("...:KEY=VALUE:..."),
+ * added to opts in order (after those it holds, so they win):
+ * BSIM_OK, or bsim_options_add's BSIM_EINPUT and message. */
+BSIM_API int bsim_backend_spec_options(const char *spec, bsim_options *opts, bsim_error *err);
+
 /* The backends a comparison runs when none are named (compare's sides,
  * the accuracy study, bench --vs): the default first, then every other
  * registered backend in the registry's order; the first max of them into

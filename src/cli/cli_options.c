@@ -378,14 +378,9 @@ const bsim_backend *cli_backend_with_opts(const cli_common *c, const char *cmd, 
 	const char *own = b->name;
 	if (cli_backend_opts(c, cmd, 1, &own, &opts) != CLI_OK)
 		return NULL;
-	for (const char *p = spec + n; *p == ':';) {
-		size_t len = strcspn(p + 1, ":");
-		char kv[128];
-		snprintf(kv, sizeof kv, "%.*s", (int)(len < sizeof kv ? len : sizeof kv - 1),
-		         p + 1);
-		if (cli_options_add(opts, cmd, kv) != CLI_OK)
-			return NULL;
-		p += len + 1;
+	if (bsim_backend_spec_options(spec, opts, &err) != BSIM_OK) {
+		cli_usage(cmd, "%s", err.msg);
+		return NULL;
 	}
 	if (bsim_options_check(opts, b->knobs, b->n_knobs, b->name, &err) != BSIM_OK) {
 		if (spec[n]) /* the spec's own options */

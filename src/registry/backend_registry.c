@@ -192,6 +192,20 @@ size_t bsim_backend_spec_name(const char *spec)
 	return strcspn(spec, ":");
 }
 
+int bsim_backend_spec_options(const char *spec, bsim_options *opts, bsim_error *err)
+{
+	for (const char *p = spec + bsim_backend_spec_name(spec); *p == ':';) {
+		size_t len = strcspn(p + 1, ":");
+		char kv[128];
+		snprintf(kv, sizeof kv, "%.*s", (int)(len < sizeof kv ? len : sizeof kv - 1),
+		         p + 1);
+		if (bsim_options_add(opts, kv, err) != BSIM_OK)
+			return BSIM_EINPUT;
+		p += len + 1;
+	}
+	return BSIM_OK;
+}
+
 const bsim_backend *bsim_backend_find(const char *name, bsim_error *err)
 {
 	bsim_error e;

@@ -72,15 +72,8 @@ int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_erro
 		                      "--backends: side %s: its options are longer than %zu "
 		                      "characters",
 		                      spec, sizeof side->label - 1);
-	for (const char *p = spec + n; *p == ':';) {
-		const char *q = p + 1;
-		size_t len = strcspn(q, ":");
-		char kv[128];
-		snprintf(kv, sizeof kv, "%.*s", (int)len, q);
-		if (bsim_options_add(&side->opts, kv, err) != BSIM_OK)
-			return BSIM_EINPUT;
-		p = q + len;
-	}
+	if (bsim_backend_spec_options(spec, &side->opts, err) != BSIM_OK)
+		return BSIM_EINPUT;
 	snprintf(side->label, sizeof side->label, "%s%s", side->backend->name, spec + n);
 	return BSIM_OK;
 }
