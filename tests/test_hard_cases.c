@@ -148,7 +148,7 @@ static void zeno_one(const bsim_backend *b, double e)
 	assert_true(persistent_from > 0 && persistent_from <= last_impact + 1);
 	assert_true(last_impact < steps / 4);
 	/* the coupled body-beam mode about the rest point is lightly damped
-	 * (tests/test_persistent_contact.c: zeta ~ 0.08) and still rings */
+	 * (tests/test_persistent_contact.h: zeta ~ 0.08) and still rings */
 	assert_true(speed < 0.2);
 	assert_true(fabs(st.x[0]) < 1e-6);
 	bsim_state_free(&st);

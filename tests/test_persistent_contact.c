@@ -101,7 +101,7 @@ static void test_impact_chain_settles(void **state)
 	bsim_scene_free(&s);
 }
 
-/* The projection's pass limit (position_project.c: 3 passes a step) is
+/* The projection's pass limit (position_project.h: 3 passes a step) is
  * counted exactly when it leaves penetration: a body put at rest inside
  * the one beam of scene_one_beam (pivot (0, 0), pointing +x, R = 10 m) at
  * depth 10 - d, stepped once, counts the limit if and only if the body

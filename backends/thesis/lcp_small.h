@@ -65,6 +65,16 @@ THESIS_SPECIALISED void thesis_lcp_small(double inv_mass, double inv_j, thesis_c
 	}
 }
 
+/* bsim_thesis_lcp_solve (the essay's disk's solve), one or two contacts
+ * inline. */
+static inline int thesis_lcp_disk(double inv_mass, thesis_contact *cs, int n)
+{
+	if (n > 2)
+		return bsim_thesis_lcp_solve(inv_mass, cs, n);
+	thesis_lcp_small(inv_mass, 0.0, cs, n, 0);
+	return 0;
+}
+
 /* The total impulse sum P_i n_i on the body, N s. */
 static inline void thesis_impulse_sum(const thesis_contact *cs, int n, double j[2])
 {

@@ -5,7 +5,7 @@
  *   w_i = q_i + sum_j K_ij P_j >= 0,   P_i w_i = 0,
  *   q_i = vrel_i - bound_i,   K_ij = (n_i . n_j) / M + [same beam] c_i c_j inv_i,
  * (contacts on one beam: i = j, or a capsule's two, thesis_contact.two)
- * with 1/M from the caller (impacts pass 1/impact_mass, impact_resolve.c).
+ * with 1/M from the caller (impacts pass 1/impact_mass, impact_resolve.h).
  * K = J M^-1 J^T is symmetric positive definite (1/M > 0 and the normals of
  * two contacts are not parallel), so the solution is unique.
  *

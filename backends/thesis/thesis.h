@@ -146,10 +146,10 @@ struct bsim_world {
 	double body_inertia, inv_body_inertia;
 	double friction;
 	/* Friction impacts whose Newton impulse would have gained energy and
-	 * was scaled toward the plastic one (impact_resolve.c), since creation. */
+	 * was scaled toward the plastic one (impact_resolve.h), since creation. */
 	long impacts_scaled;
 	/* 1/impact_mass, 1/kg: the body's inverse mass in the impact solve
-	 * only (impact_resolve.c); 1/M unless the knob is given. */
+	 * only (impact_resolve.h); 1/M unless the knob is given. */
 	double impact_inv_mass;
 	int n_beams;
 	thesis_beam *beams;
@@ -194,7 +194,7 @@ struct bsim_world {
 	int any_held;
 	/* The beams pushed in the last step (a nonzero impact or
 	 * persistent-contact impulse: the state's touched), which decide with
-	 * the gap the beams listed (contact_list.c). */
+	 * the gap the beams listed (contact_list.h). */
 	unsigned char *pushed; /* per beam */
 	int *pushed_list;      /* beams whose pushed is set */
 	double *impulse;       /* per beam, where pushed: its pushes' normal impulses, N s */
@@ -294,11 +294,6 @@ int bsim_thesis_shape_second(const struct bsim_world *w, const thesis_geometry *
 int bsim_thesis_contact_near(const struct bsim_world *w, int i, double margin);
 int bsim_thesis_contact_near_disk(const struct bsim_world *w, int i, double margin);
 
-/* contact_list.c: the beams listed for the contact flag after a step (or
- * at creation). */
-void bsim_thesis_contact_list(struct bsim_world *w);
-void bsim_thesis_contact_list_disk(struct bsim_world *w);
-
 /* lcp_solve.c: 1 if the solve stopped at its iteration limit (the caller
  * counts it in w->solver), else 0. inv_mass is the body's 1/M, 1/kg (for
  * impacts, 1/impact_mass). */
@@ -319,23 +314,11 @@ void bsim_thesis_impulse_sum_extended(const thesis_contact *cs, int n, double j[
  * worlds, since the program started. */
 long bsim_thesis_lcp_fallbacks(void);
 
-/* impact_resolve.c */
-int bsim_thesis_impact_resolve(struct bsim_world *w, double h);
-int bsim_thesis_impact_resolve_disk(struct bsim_world *w, double h);
-
-/* persistent_contact.c */
-void bsim_thesis_persistent_contact_solve(struct bsim_world *w, const double force[2],
-                                          double torque, double h);
-void bsim_thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2],
-                                               double h);
-
-/* position_project.c; projections per step at most. */
+/* position_project.h: projections per step at most. */
 #define THESIS_PROJECT_PASSES_MAX 3
-void bsim_thesis_position_project(struct bsim_world *w, const double force[2], double torque);
-void bsim_thesis_position_project_disk(struct bsim_world *w, const double force[2]);
 
 /* The kinetic energy of body and beams, J; inline, so that the world
- * (thesis_world.c) and the impacts (impact_resolve.c) share it without
+ * (thesis_world.c) and the impacts (impact_resolve.h) share it without
  * calling into each other. Beams at rest have omega = 0 and add nothing:
  * the awake ones, in ascending order, give the sum over all beams to the
  * bit. extended: a constant, 0 for the essay's disk (w->extended 0),
@@ -386,7 +369,7 @@ static inline double thesis_step_margin(const struct bsim_world *w, const thesis
  * rounding, so a beam out of reach of the bound is out of reach of the
  * margin, and the test changes no result. The contact flag's tolerance is
  * added, so that a clear step also ends more than BSIM_CONTACT_TOL from
- * every beam (contact_list.c). m. */
+ * every beam (contact_list.h). m. */
 static inline double thesis_clear_margin(const struct bsim_world *w, const double force[2],
                                          double h)
 {
@@ -409,7 +392,7 @@ static inline int thesis_flight_clear(struct bsim_world *w, const double force[2
 
 /* Beam i exchanged a nonzero normal impulse (N s) with the body in this
  * step (the state reports it as touched, and the impulses' sum in the
- * order they came; contact_list.c lists the beam). */
+ * order they came; contact_list.h lists the beam). */
 static inline void thesis_beam_pushed(struct bsim_world *w, int i, double impulse)
 {
 	if (w->pushed[i]) {
@@ -432,7 +415,7 @@ static inline void thesis_contact_spent(struct bsim_world *w)
 
 /* The body's velocity at the step's end from its free velocity vf = v +
  * h F / M (v0 = v at the start) and the contacts' impulse sum j, and its
- * move by the mean velocity (persistent_contact.c); vm receives that
+ * move by the mean velocity (persistent_contact.h); vm receives that
  * velocity. Inline: the contact solve, a step in free flight (j = 0) and
  * the runs of steps (thesis_steps.c) share it, so all move the body by the
  * same operations. integrator: w->integrator, a constant where the caller
@@ -480,7 +463,7 @@ static inline void thesis_contact_velocity(const struct bsim_world *w, thesis_co
 	}
 }
 
-/* The first pass of the impacts (impact_resolve.c) over the step's nc
+/* The first pass of the impacts (impact_resolve.h) over the step's nc
  * contacts: each one's v_rel, and the touching ones (gap + h min(v_rel, 0)
  * <= slop) moved to the front in place, their 1/I set; *approaching set if
  * one of them approaches (v_rel < 0). Returns how many touch. Inline: the
@@ -511,14 +494,14 @@ THESIS_SPECIALISED int thesis_impacts_touching(struct bsim_world *w, int nc, dou
 	return n;
 }
 
-/* An impact's bound on contact c's solved normal velocity (impact_resolve.c):
+/* An impact's bound on contact c's solved normal velocity (impact_resolve.h):
  * -e v_rel, or 0 (plastic) below rest_threshold. */
 static inline void thesis_impact_bound(const struct bsim_world *w, thesis_contact *c)
 {
 	c->bound = c->vrel < -w->rest_threshold ? -c->e * c->vrel : 0.0;
 }
 
-/* Whether pass `pass` of the projection (position_project.c) projects the
+/* Whether pass `pass` of the projection (position_project.h) projects the
  * n contacts cs: 1 if one is deeper than slop and the passes are not used
  * up; at the limit, still too deep, the solver's iteration limit is
  * counted and 0 returned. */
@@ -537,7 +520,7 @@ static inline int thesis_project_more(struct bsim_world *w, const thesis_contact
 	return 1;
 }
 
-/* A projection's move (position_project.c) by the position impulses of
+/* A projection's move (position_project.h) by the position impulses of
  * cs[0 .. n): each beam's angle and the body's centre, the springs' energy
  * change and the force's work over the shift booked into *correction. */
 static inline void thesis_project_move(struct bsim_world *w, const thesis_contact *cs, int n,
@@ -559,7 +542,7 @@ static inline void thesis_project_move(struct bsim_world *w, const thesis_contac
 	*correction += (force[0] * dx + force[1] * dy) - de;
 }
 
-/* The smooth solve (persistent_contact.c) for the essay's disk: contact
+/* The smooth solve (persistent_contact.h) for the essay's disk: contact
  * c's row against beam b, from the body's velocity v0 at the step's start
  * and its free velocity vf = v0 + h F / M: the beam's free omega, the
  * response 1/(I D), v_rel at the free velocities and the bound that keeps

@@ -1,5 +1,6 @@
-/* The thesis backend: world creation, state access, knobs, and the order of
- * one step (docs/model.md sections 3-5):
+/* The thesis backend: world creation, state access, knobs, and the step's
+ * calls; the order of one step (docs/model.md sections 3-5; thesis_step.h
+ * makes it):
  *   1. detect the contacts the step can reach (speculative margin);
  *   2. impacts of approaching contacts (restitution, or plastic below
  *      rest_threshold);
@@ -9,7 +10,7 @@
  *   5. sleeping: beams the body has left and whose energy has decayed are
  *      put exactly to rest (beam_sleep.c);
  *   6. the beams listed for the contact flag the runner computes from the
- *      state (contact_list.c), which moves nothing.
+ *      state (contact_list.h), which moves nothing.
  * Only the beams near the body (broad_phase.c) and the awake ones are
  * touched, so a step costs the same in a field of one gate or a thousand.
  *
@@ -29,6 +30,7 @@
 #include "beamsim/version.h"
 #include "beamsim/body_shape.h"
 #include "thesis/thesis.h"
+#include "thesis/thesis_step.h"
 
 static const bsim_knob thesis_knobs[] = {
         {"integrator", BSIM_KNOB_CHOICE, "midpoint", "midpoint|euler",
@@ -316,7 +318,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
-	bsim_thesis_contact_list(w); /* a body that starts touching a beam */
+	contact_list_beams(w, NULL, 1); /* a body that starts touching a beam */
 	*out = w;
 	return BSIM_OK;
 }
@@ -373,130 +375,7 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	bsim_thesis_near_forget(w);
 	for (int k = 0; k < w->n_start_awake; k++)
 		bsim_thesis_beam_wake(w, w->start_awake[k]);
-	bsim_thesis_contact_list(w); /* a body that starts touching a beam */
-	return BSIM_OK;
-}
-
-/* contact_mode=essay: the beams held after this step's solve (touching at
- * its start and pressed by it); 1 if any is. */
-static int essay_hold(bsim_world *w)
-{
-	int any = 0;
-	for (int i = 0; i < w->n_beams; i++)
-		w->held[i] = 0;
-	for (int k = 0; k < w->n_contacts; k++) {
-		const thesis_contact *c = &w->contacts[k];
-		if (c->impulse > 0.0 && c->gap <= w->contact_tol)
-			any = w->held[c->beam] = 1;
-	}
-	return any;
-}
-
-/* The contacts the step can reach into w->contacts; returns how many, and
- * the speed bound of the margins in *speed. */
-THESIS_SPECIALISED int step_detect(bsim_world *w, const double force[2], double torque, double h,
-                                   double *speed, const int extended)
-{
-	/* A bound for the margin only: speeds and forces are far from overflow,
-	 * so sqrt serves where hypot's scaling would cost a tenth of a step. */
-	double v = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
-	           h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
-	/* A shape that turns: its outline moves up to reach |w| faster than its
-	 * centre (the disk's does not move when it turns). */
-	if (extended && w->shaped && w->rotates)
-		v += w->radius *
-		     (fabs(w->angular_velocity) + h * fabs(torque) * w->inv_body_inertia);
-	int holding = w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
-	int m = bsim_thesis_broad_phase(w, v, h);
-	int n = 0;
-	for (int k = 0; k < m; k++) {
-		int i = w->candidates[k];
-		if (holding && !w->held[i])
-			continue; /* essay: the constraint loop tests only held beams */
-		double margin = thesis_step_margin(w, &w->beams[i], v, h);
-		int got = extended ? bsim_thesis_contact_detect(w, i, margin, &w->contacts[n])
-		                   : bsim_thesis_contact_detect_disk(w, i, margin, &w->contacts[n]);
-		if (got)
-			bsim_thesis_beam_wake(w, i);
-		n += got;
-	}
-	*speed = v;
-	return n;
-}
-
-/* A step in free flight among beams at rest (none awake or typed, none in
- * reach: bsim_thesis_broad_phase_clear, which the caller asked) for the step
- * size the beams are prepared for: what thesis_step does then, without its
- * general path. No contact: no impact, no projection, nothing held; the
- * contact solve's body update with a zero impulse sum (thesis_body_advance,
- * as persistent_contact.c's with none); no beam to move, sleep or prune;
- * nothing to list. */
-THESIS_SPECIALISED void flight_step(bsim_world *w, const double force[2], double torque, double h,
-                                    const int extended)
-{
-	w->n_contacts = 0;
-	double v0[2] = {w->v[0], w->v[1]};
-	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
-	const double j[2] = {0.0, 0.0};
-	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
-	if (extended)
-		thesis_body_turn(w, w->angular_velocity, torque, 0.0, h);
-}
-
-/* A step of any body (extended 1) or of the essay's disk (extended 0,
- * w->extended 0): a constant, so that the disk's copy, and the _disk
- * functions it calls, are compiled without the extended path's tests
- * (docs/backends.md, "Cost to the essay's disk"). */
-THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double torque, double h,
-                                int in_flight, const int extended)
-{
-	/* The essay's disk's free flight was thesis_step's (w->flight_disk). */
-	if (extended && in_flight && w->n_typed == 0 && h == w->h_prepared &&
-	    w->contact_mode != THESIS_CONTACT_ESSAY) {
-		flight_step(w, force, torque, h, extended);
-		return BSIM_OK;
-	}
-	for (int k = 0; k < w->n_typed; k++)
-		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
-	w->n_typed = 0;
-	thesis_beams_prepare(w, h);
-	double speed = 0.0;
-	int n = in_flight ? 0 : step_detect(w, force, torque, h, &speed, extended);
-	w->n_contacts = n;
-	if (n) {
-		if (extended)
-			bsim_thesis_impact_resolve(w, h);
-		else
-			bsim_thesis_impact_resolve_disk(w, h);
-	}
-	if (extended)
-		bsim_thesis_persistent_contact_solve(w, force, torque, h);
-	else
-		bsim_thesis_persistent_contact_solve_disk(w, force, h);
-	if (w->contact_mode == THESIS_CONTACT_ESSAY)
-		w->any_held = essay_hold(w);
-	if (n) {
-		if (extended)
-			bsim_thesis_position_project(w, force, torque);
-		else
-			bsim_thesis_position_project_disk(w, force);
-	}
-	/* A beam's two contacts (a capsule along it) are adjacent: listed once. */
-	for (int k = 0; k < w->n_contacts; k++)
-		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE &&
-		    (!extended || k == 0 || w->contacts[k - 1].beam != w->contacts[k].beam))
-			w->typed[w->n_typed++] = w->contacts[k].beam;
-	if (!in_flight) {
-		if (w->sleep)
-			bsim_thesis_beams_sleep(w, speed, h);
-		bsim_thesis_awake_prune(w);
-	}
-	/* in flight nothing is in reach: nothing to list */
-	if (!in_flight && extended)
-		bsim_thesis_contact_list(w);
-	else if (!in_flight)
-		bsim_thesis_contact_list_disk(w);
+	contact_list_beams(w, NULL, 1); /* a body that starts touching a beam */
 	return BSIM_OK;
 }
 
@@ -505,12 +384,14 @@ THESIS_SPECIALISED int step_run(bsim_world *w, const double force[2], double tor
 THESIS_APART int step_extended(bsim_world *w, const double force[2], double torque, double h,
                                int in_flight)
 {
-	return step_run(w, force, torque, h, in_flight, 1);
+	return step_run(w, NULL, force, torque, h, in_flight, &w->energy, &w->impacts, 1,
+	                w->integrator);
 }
 
 THESIS_APART int step_disk(bsim_world *w, const double force[2], double h, int in_flight)
 {
-	return step_run(w, force, 0.0, h, in_flight, 0);
+	return step_run(w, NULL, force, 0.0, h, in_flight, &w->energy, &w->impacts, 0,
+	                w->integrator);
 }
 
 /* Nothing in a step allocates: the world's memory is sized at creation. */
@@ -536,21 +417,7 @@ static inline int thesis_step(bsim_world *w, const double force[2], double torqu
 
 THESIS_APART void thesis_get_state(const bsim_world *w, bsim_state *s)
 {
-	thesis_state_body(w, s);
-	/* Both lists empty (free flight): the same, nothing to set. */
-	if (w->n_awake || s->n_active)
-		bsim_state_set_active(s, w->awake, w->n_awake);
-	/* The beams' directions are kept for the next step's detection
-	 * (b->u): a cache, not the world's state, which stays as it is. */
-	bsim_world *cache = (bsim_world *)w;
-	for (int k = 0; k < s->n_active; k++) {
-		int i = s->active[k];
-		thesis_state_beam(cache, i, w->pushed[i], w->impulse[i],
-		                  bsim_thesis_contact_near(w, i, BSIM_CONTACT_TOL), s);
-	}
-	s->energy = w->energy;
-	s->impacts = w->impacts;
-	s->solver = w->solver;
+	step_state(w, NULL, s);
 }
 
 /* advance's steps one after another, thesis_step and get_state each;

@@ -30,17 +30,23 @@
  * velocity at the means), so energy.contact is the contact impulses' work
  *   -sum P_n (n . v_m + cb w_m - c omega_m) + P_t (t . v_m + cbt w_m - ct omega_m),
  * friction's loss included; the runner credits T h w_m, the torque's work
- * over the heading's change. */
+ * over the heading's change.
+ *
+ * Inline, included by the step (thesis_step.h), which compiles it for
+ * each body and each form of the step's sets (step_sets.h). */
+#ifndef BSIM_THESIS_PERSISTENT_CONTACT_H
+#define BSIM_THESIS_PERSISTENT_CONTACT_H
+
 #include <math.h>
 #include <stddef.h>
 
 #include "util/fminmax.h"
-#include "thesis/thesis.h"
+#include "thesis/step_sets.h"
 
-/* The extended path (this file's head); the essay's path below keeps its
- * own loop, which this one's terms would slow. */
-static void persistent_solve_extended(struct bsim_world *w, const double force[2], double torque,
-                                      double h)
+/* The extended path (this file's head), on the world's lists; the essay's
+ * path below keeps its own loop, which this one's terms would slow. */
+static inline void persistent_solve_extended(struct bsim_world *w, const double force[2],
+                                             double torque, double h)
 {
 	double v0[2] = {w->v[0], w->v[1]};
 	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
@@ -125,49 +131,52 @@ static void persistent_solve_extended(struct bsim_world *w, const double force[2
 	}
 }
 
-void bsim_thesis_persistent_contact_solve(struct bsim_world *w, const double force[2],
-                                          double torque, double h)
-{
-	if (w->extended)
-		persistent_solve_extended(w, force, torque, h);
-	else
-		bsim_thesis_persistent_contact_solve_disk(w, force, h);
-}
-
-void bsim_thesis_persistent_contact_solve_disk(struct bsim_world *w, const double force[2],
-                                               double h)
+/* The essay's disk's path: the body's free velocity v + dv (dv = h F /
+ * M, as the caller computes it); the dampers' loss added to *damper and
+ * minus the contacts' work to *contact, J. integrator: w->integrator, a
+ * constant where the caller gives one. */
+THESIS_SPECIALISED void persistent_solve_disk(struct bsim_world *w, thesis_run *run,
+                                              const double dv[2], double h, double *damper,
+                                              double *contact, const int integrator)
 {
 	double v0[2] = {w->v[0], w->v[1]};
-	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
+	double vf[2] = {v0[0] + dv[0], v0[1] + dv[1]};
 	thesis_contact *cs = w->contacts;
 	int n = w->n_contacts;
 
-	for (int k = 0; k < n; k++)
-		thesis_smooth_row(&cs[k], &w->beams[cs[k].beam], v0, vf, h, w->integrator);
+	for (int k = 0; k < n; k++) {
+		thesis_smooth_row(&cs[k], &w->beams[cs[k].beam], v0, vf, h, integrator);
+		w->contact_of[cs[k].beam] = k;
+	}
 	/* No contact (free flight): no solve, and the impulse sum of none is
 	 * 0 (thesis_impulse_sum's start), added as it would be. */
 	double j[2] = {0.0, 0.0};
 	if (n) {
-		w->solver.iteration_limit += bsim_thesis_lcp_solve(w->inv_mass, cs, n);
+		w->solver.iteration_limit += thesis_lcp_disk(w->inv_mass, cs, n);
 		thesis_impulse_sum(cs, n, j);
+		for (int k = 0; k < n; k++)
+			if (cs[k].impulse > 0.0)
+				step_push(w, run, cs[k].beam, cs[k].impulse);
 	}
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
+	thesis_body_advance(w, v0, vf, j, h, vm, integrator);
 
 	/* Beams in contact take their impulse; all others move freely. A beam
 	 * at rest and untouched stays at rest and costs nothing: only the awake
 	 * ones (every contact's beam among them) are visited, in ascending
 	 * order, so the ledger's sums are those over all beams. */
-	for (int k = 0; k < n; k++) {
-		w->contact_of[cs[k].beam] = k;
-		if (cs[k].impulse > 0.0)
-			thesis_beam_pushed(w, cs[k].beam, cs[k].impulse);
-	}
-	for (int a = 0; a < w->n_awake; a++) {
-		int i = w->awake[a];
+	double e_damper = *damper, e_contact = *contact;
+	for (int a = 0, na = step_awake_n(w, run); a < na; a++) {
+		int i = step_awake_at(w, run, a);
+		if (i < 0)
+			continue;
 		int k = w->contact_of[i];
 		w->contact_of[i] = -1;
-		thesis_smooth_beam(&w->beams[i], k < 0 ? NULL : &cs[k], vm, h, w->integrator,
-		                   &w->energy.damper, &w->energy.contact);
+		thesis_smooth_beam(&w->beams[i], k < 0 ? NULL : &cs[k], vm, h, integrator,
+		                   &e_damper, &e_contact);
 	}
+	*damper = e_damper;
+	*contact = e_contact;
 }
+
+#endif

@@ -42,12 +42,19 @@
  * in [0, 1] for which E' <= E is taken, a root of a quadratic in s. Both
  * ends lie in the cone and separate (u_n' >= 0), so P does too. The
  * impacts so scaled are counted in w->impacts_scaled. The loss, friction's
- * included, is energy.impact. */
+ * included, is energy.impact.
+ *
+ * Inline, included by the step (thesis_step.h), which compiles it for
+ * each body and each form of the step's sets (step_sets.h: run NULL, the
+ * world's lists). */
+#ifndef BSIM_THESIS_IMPACT_RESOLVE_H
+#define BSIM_THESIS_IMPACT_RESOLVE_H
+
 #include <math.h>
 #include <stddef.h>
 
 #include "util/fminmax.h"
-#include "thesis/thesis.h"
+#include "thesis/step_sets.h"
 
 /* Contacts whose friction impact's energy is checked (a body meets 4 at
  * most in a lattice). */
@@ -55,8 +62,8 @@
 
 /* extended: constant (contact_geometry.h's contact_detect): 0 compiles the
  * essay's disk's copy of this file's functions without the extended path. */
-THESIS_SPECIALISED void impact_apply(struct bsim_world *w, const thesis_contact *cs, int n,
-                                     const int extended)
+THESIS_SPECIALISED void impact_apply(struct bsim_world *w, thesis_run *run,
+                                     const thesis_contact *cs, int n, const int extended)
 {
 	double j[2], jw = 0.0;
 	if (extended && w->extended)
@@ -75,15 +82,15 @@ THESIS_SPECIALISED void impact_apply(struct bsim_world *w, const thesis_contact 
 		else
 			b->omega -= cs[i].impulse * cs[i].c / b->inertia;
 		if (cs[i].impulse > 0.0)
-			thesis_beam_pushed(w, cs[i].beam, cs[i].impulse);
+			step_push(w, run, cs[i].beam, cs[i].impulse);
 	}
 }
 
 /* The kinetic energy's change for impulses p (2 per contact: normal,
  * tangent) from contact velocities u (q without the bounds), J:
  * P . u + P . K P / 2, K from the rows as friction_solve.c builds it. */
-static double impact_energy_change(const struct bsim_world *w, const thesis_contact *cs, int n,
-                                   const double *pn, const double *pt)
+static inline double impact_energy_change(const struct bsim_world *w, const thesis_contact *cs,
+                                          int n, const double *pn, const double *pt)
 {
 	double jv[2] = {0.0, 0.0}, jw = 0.0, e = 0.0;
 	for (int i = 0; i < n; i++) {
@@ -106,7 +113,7 @@ static double impact_energy_change(const struct bsim_world *w, const thesis_cont
 /* The extended path's solve with friction: Newton's restitution, scaled
  * toward the plastic impulse where it would gain energy (this file's head).
  * 1 if a solve was not exact. */
-static int impact_solve_friction(struct bsim_world *w, thesis_contact *cs, int n)
+static inline int impact_solve_friction(struct bsim_world *w, thesis_contact *cs, int n)
 {
 	double inv_j = w->inv_body_inertia;
 	int inexact = bsim_thesis_contact_solve(w->impact_inv_mass, inv_j, cs, n);
@@ -167,7 +174,7 @@ THESIS_SPECIALISED int impact_solve(struct bsim_world *w, thesis_contact *cs, in
                                     const int extended)
 {
 	if (!(extended && w->extended))
-		return bsim_thesis_lcp_solve(w->impact_inv_mass, cs, n);
+		return thesis_lcp_disk(w->impact_inv_mass, cs, n);
 	if (w->friction > 0.0)
 		return impact_solve_friction(w, cs, n);
 	return bsim_thesis_contact_solve(w->impact_inv_mass, w->inv_body_inertia, cs, n);
@@ -179,7 +186,8 @@ THESIS_SPECIALISED int impact_solve(struct bsim_world *w, thesis_contact *cs, in
 #define IMPACT_APPROACH_TOL 1e-9
 
 /* The essay's order: one contact at a time, nearest first. */
-THESIS_SPECIALISED void impact_nearest_first(struct bsim_world *w, thesis_contact *cs, int n,
+THESIS_SPECIALISED void impact_nearest_first(struct bsim_world *w, thesis_run *run,
+                                             thesis_contact *cs, int n, int *impacts,
                                              const int extended)
 {
 	for (int pass = 0; pass <= IMPACT_PASSES_MAX; pass++) {
@@ -201,13 +209,16 @@ THESIS_SPECIALISED void impact_nearest_first(struct bsim_world *w, thesis_contac
 		}
 		thesis_impact_bound(w, next);
 		impact_solve(w, next, 1, extended);
-		impact_apply(w, next, 1, extended);
+		impact_apply(w, run, next, 1, extended);
 		if (next->impulse > 0.0 && next->vrel < -w->rest_threshold)
-			w->impacts++;
+			(*impacts)++;
 	}
 }
 
-THESIS_SPECIALISED int impact_resolve(struct bsim_world *w, double h, const int extended)
+/* The impacts of the step's w->n_contacts contacts; 1 if one approached.
+ * The loss into *e_impact, J, and the impacts into *impacts. */
+THESIS_SPECIALISED int impact_resolve(struct bsim_world *w, thesis_run *run, double h,
+                                      double *e_impact, int *impacts, const int extended)
 {
 	/* The touching contacts go to the front of the list. */
 	thesis_contact *cs = w->contacts;
@@ -216,27 +227,19 @@ THESIS_SPECIALISED int impact_resolve(struct bsim_world *w, double h, const int 
 	if (!approaching)
 		return 0;
 
-	double ke = thesis_kinetic_energy(w, extended);
-	if (w->impact_order == THESIS_NEAREST_FIRST) {
-		impact_nearest_first(w, cs, n, extended);
+	double ke = step_kinetic(w, run, extended);
+	if (!run && w->impact_order == THESIS_NEAREST_FIRST) { /* a run's are simultaneous */
+		impact_nearest_first(w, run, cs, n, impacts, extended);
 	} else {
 		for (int i = 0; i < n; i++)
 			thesis_impact_bound(w, &cs[i]);
 		w->solver.iteration_limit += impact_solve(w, cs, n, extended);
-		impact_apply(w, cs, n, extended);
+		impact_apply(w, run, cs, n, extended);
 		for (int i = 0; i < n; i++)
-			w->impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->rest_threshold;
+			*impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->rest_threshold;
 	}
-	w->energy.impact += ke - thesis_kinetic_energy(w, extended);
+	*e_impact += ke - step_kinetic(w, run, extended);
 	return 1;
 }
 
-int bsim_thesis_impact_resolve(struct bsim_world *w, double h)
-{
-	return impact_resolve(w, h, 1);
-}
-
-int bsim_thesis_impact_resolve_disk(struct bsim_world *w, double h)
-{
-	return impact_resolve(w, h, 0);
-}
+#endif

@@ -13,13 +13,20 @@
  *
  * Extended path (thesis.h's head): the body turns too, dpsi = sum mu_i cb_i
  * / J, and K has cb_i cb_j / J (frictionless: a projection moves along the
- * normals only); the torque's work over dpsi joins the correction. */
-#include "thesis/thesis.h"
+ * normals only); the torque's work over dpsi joins the correction.
+ *
+ * Inline, included by the step (thesis_step.h), which compiles it for
+ * each body and each form of the step's sets (step_sets.h). */
+#ifndef BSIM_THESIS_POSITION_PROJECT_H
+#define BSIM_THESIS_POSITION_PROJECT_H
+
+#include "thesis/step_sets.h"
 
 /* extended: constant (contact_geometry.h's contact_detect): 0 compiles the
  * essay's disk's copy of this file's functions without the extended path. */
 THESIS_SPECIALISED void project_once(struct bsim_world *w, thesis_contact *cs, int n,
-                                     const double force[2], double torque, const int extended)
+                                     const double force[2], double torque, double *correction,
+                                     const int extended)
 {
 	for (int k = 0; k < n; k++) {
 		cs[k].vrel = cs[k].gap;
@@ -30,29 +37,31 @@ THESIS_SPECIALISED void project_once(struct bsim_world *w, thesis_contact *cs, i
 		w->solver.iteration_limit +=
 		        bsim_thesis_lcp_solve_j(w->inv_mass, w->inv_body_inertia, cs, n);
 	else
-		w->solver.iteration_limit += bsim_thesis_lcp_solve(w->inv_mass, cs, n);
+		w->solver.iteration_limit += thesis_lcp_disk(w->inv_mass, cs, n);
 	if (extended && w->rotates) {
 		double dpsi = 0.0;
 		for (int k = 0; k < n; k++)
 			dpsi += cs[k].impulse * cs[k].cb;
 		dpsi *= w->inv_body_inertia;
 		w->heading += dpsi;
-		w->energy.correction += torque * dpsi;
+		*correction += torque * dpsi;
 	}
-	thesis_project_move(w, cs, n, force, &w->energy.correction);
+	thesis_project_move(w, cs, n, force, correction);
 }
 
 /* The contacts of the beams of cs[0..n) detected again into cs, each beam
  * once (a capsule may have two contacts with one beam, and may have one
  * where it had two, or two where it had one): the beams are listed first
- * (in w->candidates, free after the step's detection). */
-THESIS_SPECIALISED int redetect(struct bsim_world *w, thesis_contact *cs, int n, double margin,
-                                const int extended)
+ * (in w->candidates, free after the step's detection). A run touched
+ * every beam at its start (run not NULL). */
+THESIS_SPECIALISED int redetect(struct bsim_world *w, const thesis_run *run, thesis_contact *cs,
+                                int n, double margin, const int extended)
 {
 	if (!extended) { /* the essay's disk */
 		int m = 0;
 		for (int k = 0; k < n; k++)
-			m += bsim_thesis_contact_redetect_disk(w, cs[k].beam, margin, &cs[m]);
+			m += run ? disk_detect(w, cs[k].beam, margin, &cs[m], 1, 1)
+			         : disk_detect(w, cs[k].beam, margin, &cs[m], 1, 0);
 		return m;
 	}
 	if (!w->shaped) { /* one contact a beam: in place, in order */
@@ -76,29 +85,23 @@ THESIS_SPECIALISED int redetect(struct bsim_world *w, thesis_contact *cs, int n,
 }
 
 /* Re-detects the step's contacts at the new positions (they are the only
- * beams the step could have reached) and projects out penetration. */
-THESIS_SPECIALISED void position_project(struct bsim_world *w, const double force[2], double torque,
+ * beams the step could have reached) and projects out penetration; the
+ * correction's energy added to *correction, J. */
+THESIS_SPECIALISED void position_project(struct bsim_world *w, thesis_run *run,
+                                         const double force[2], double torque, double *correction,
                                          const int extended)
 {
 	double margin = w->contact_tol;
 	thesis_contact *cs = w->contacts;
-	int n = redetect(w, cs, w->n_contacts, margin, extended);
+	int n = redetect(w, run, cs, w->n_contacts, margin, extended);
 	for (int pass = 0; w->projection && thesis_project_more(w, cs, n, pass); pass++) {
-		project_once(w, cs, n, force, torque, extended);
-		n = redetect(w, cs, n, margin, extended);
+		project_once(w, cs, n, force, torque, correction, extended);
+		n = redetect(w, run, cs, n, margin, extended);
 	}
 	w->n_contacts = n;
 	for (int k = 0; k < n; k++)
 		if (cs[k].gap <= w->contact_tol)
-			w->contact_type[cs[k].beam] = cs[k].type;
+			step_type(w, run, cs[k].beam, cs[k].type);
 }
 
-void bsim_thesis_position_project(struct bsim_world *w, const double force[2], double torque)
-{
-	position_project(w, force, torque, 1);
-}
-
-void bsim_thesis_position_project_disk(struct bsim_world *w, const double force[2])
-{
-	position_project(w, force, 0.0, 0);
-}
+#endif
