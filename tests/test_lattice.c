@@ -33,6 +33,7 @@
 #include "beamsim/stats.h"
 #include "beamsim/trial.h"
 #include "beamsim/lattice_outcome.h"
+#include "run/sweep_record.h"
 #include "support.h"
 #include "thesis/thesis.h"
 
@@ -161,8 +162,13 @@ static int same_trial(const run_out *a, const run_out *b)
 	for (int k = 0; k < a->log->n_entries; k++)
 		if (memcmp(&a->log->entries[k], &b->log->entries[k], sizeof a->log->entries[k]))
 			return 0;
-	int n = a->log->n_beams < b->log->n_beams ? a->log->n_beams : b->log->n_beams;
-	return memcmp(a->log->peak, b->log->peak, (size_t)n * sizeof *a->log->peak) == 0;
+	if (a->log->n_peaks != b->log->n_peaks)
+		return 0;
+	for (int k = 0; k < a->log->n_peaks; k++)
+		if (a->log->peaks[k].beam != b->log->peaks[k].beam ||
+		    memcmp(&a->log->peaks[k].peak, &b->log->peaks[k].peak, sizeof(double)))
+			return 0;
+	return 1;
 }
 
 /* The broad phase is exact: every beam tested every step gives the same
@@ -183,6 +189,93 @@ static void broad_phase_is_exact(void **state)
 		run_free(&b);
 	}
 	assert_true(contacts >= 10); /* the trials pushed beams */
+	bsim_scene_free(&s);
+}
+
+/* Every beam's largest angle over a trial's states (its trace), rad. */
+typedef struct dense_peaks {
+	double *peak; /* every beam's */
+} dense_peaks;
+
+static void trace_peaks(void *user, long step, const bsim_state *s)
+{
+	(void)step;
+	dense_peaks *d = user;
+	for (int k = 0; k < s->n_active; k++) {
+		int i = s->active[k];
+		if (s->theta[i] > d->peak[i])
+			d->peak[i] = s->theta[i];
+	}
+}
+
+/* A trial's log keeps the peaks of the beams it moved only: against every
+ * beam's largest angle taken from the trace of its states (every beam of
+ * the field, the beams at rest at 0), the same beams in ascending order,
+ * each to the bit. Its journal record (run/sweep_record.h) gives back the
+ * same log, whatever the field's size; a log of more moved beams than a
+ * record holds is marked to run again. */
+static void peaks_of_moved_beams(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	load("configs/lattice/c_track.yaml", NULL, 0, &s);
+	int moved = 0;
+	for (uint64_t t = 0; t < 3; t++) {
+		dense_peaks d = {calloc((size_t)s.n_beams, sizeof(double))};
+		assert_non_null(d.peak);
+		bsim_trial_runner *runner = bsim_trial_runner_alloc();
+		bsim_trial_log *log = bsim_trial_log_alloc();
+		bsim_recorder rec = {
+		        .stride = 1, .log = log, .trace = trace_peaks, .trace_user = &d};
+		bsim_trial_result r;
+		bsim_error err;
+		bsim_options opts = {0};
+		if (bsim_trial_run(runner, &s, bsim_test_backend("thesis"), &opts,
+		                   bsim_schedule_seed_mix(1, 0, t), &rec, &r, &err))
+			fail_msg("%s", err.msg);
+		assert_int_equal(log->n_beams, s.n_beams);
+		int k = 0;
+		for (int i = 0; i < s.n_beams; i++) {
+			if (d.peak[i] == 0.0)
+				continue;
+			assert_true(k < log->n_peaks);
+			assert_int_equal(log->peaks[k].beam, i);
+			assert_memory_equal(&log->peaks[k].peak, &d.peak[i], sizeof(double));
+			k++;
+		}
+		assert_int_equal(k, log->n_peaks);
+		moved += k;
+
+		unsigned char *buf = malloc(bsim_sweep_record_bytes());
+		assert_non_null(buf);
+		bsim_sweep_record_pack(buf, &r, log);
+		bsim_trial_log *back = bsim_trial_log_alloc();
+		bsim_trial_result rb;
+		assert_int_equal(bsim_sweep_record_unpack(buf, &rb, back), 1);
+		assert_memory_equal(&rb, &r, sizeof r);
+		assert_int_equal(back->n_beams, log->n_beams);
+		assert_int_equal(back->n_entries, log->n_entries);
+		assert_int_equal(back->n_peaks, log->n_peaks);
+		assert_memory_equal(back->peaks, log->peaks,
+		                    (size_t)log->n_peaks * sizeof *log->peaks);
+
+		/* one moved beam more than a record holds */
+		bsim_beam_peak many[SWEEP_RECORD_PEAKS + 1];
+		for (int q = 0; q <= SWEEP_RECORD_PEAKS; q++)
+			many[q] = (bsim_beam_peak){q, 0.1};
+		bsim_trial_log over = *log;
+		over.peaks = many;
+		over.n_peaks = SWEEP_RECORD_PEAKS + 1;
+		bsim_sweep_record_pack(buf, &r, &over);
+		assert_int_equal(bsim_sweep_record_unpack(buf, &rb, back), 0);
+
+		free(buf);
+		free(d.peak);
+		bsim_trial_log_free(back);
+		bsim_trial_log_free(log);
+		bsim_trial_runner_free(runner);
+	}
+	assert_true(moved >= 6); /* the trials pushed beams */
 	bsim_scene_free(&s);
 }
 
@@ -669,6 +762,7 @@ int main(void)
 	        cmocka_unit_test(three_beams_static_equilibrium),
 	        cmocka_unit_test(permutation_is_mcnemar_for_two_locations),
 	        cmocka_unit_test(summary_counts),
+	        cmocka_unit_test(peaks_of_moved_beams),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

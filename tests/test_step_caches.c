@@ -560,7 +560,11 @@ static void kept_against_built(const bsim_scene *s, int trials)
 		assert_int_equal(a.outcome, b.outcome);
 		assert_int_equal(a.gates_entered, b.gates_entered);
 		assert_int_equal(la->n_beams, lb->n_beams);
-		assert_memory_equal(la->peak, lb->peak, (size_t)la->n_beams * sizeof *la->peak);
+		assert_int_equal(la->n_peaks, lb->n_peaks);
+		for (int k = 0; k < la->n_peaks; k++) {
+			assert_int_equal(la->peaks[k].beam, lb->peaks[k].beam);
+			assert_memory_equal(&la->peaks[k].peak, &lb->peaks[k].peak, sizeof(double));
+		}
 		gates += a.gates_entered;
 	}
 	if (s->has_lattice)

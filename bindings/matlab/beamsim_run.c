@@ -165,7 +165,12 @@ static void path_fields(mxArray *out, const bsim_trial_log *log)
 		mxSetCell(edges, (mwIndex)k,
 		          bmx_string(bsim_trial_edge_name(log->entries[k].edge)));
 	bmx_set(out, 0, "path_edge", edges);
-	bmx_set(out, 0, "peak_theta", bmx_row(log->peak, log->n_beams));
+	/* every beam's peak: the moved beams', 0 for the others */
+	mxArray *peak = mxCreateDoubleMatrix(1, (mwSize)log->n_beams, mxREAL);
+	double *pd = mxGetPr(peak);
+	for (int k = 0; k < log->n_peaks; k++)
+		pd[log->peaks[k].beam] = log->peaks[k].peak;
+	bmx_set(out, 0, "peak_theta", peak);
 }
 
 static mxArray *result_struct(const bsim_replay *rp, const bsim_backend *b,

@@ -160,14 +160,23 @@ typedef struct bsim_gate_entry {
 	double omega[2]; /* rad/s */
 } bsim_gate_entry;
 
+/* A beam that moved in a trial and its peak angle. */
+typedef struct bsim_beam_peak {
+	int beam;    /* the scene's, 0-based */
+	double peak; /* rad, the largest theta over the trial, not 0 */
+} bsim_beam_peak;
+
 /* What a trial can leave beyond its result (bsim_recorder.log): the gate
- * path with each entry's state, and every beam's peak angle. Reused from
- * trial to trial; alloc/free pair. */
+ * path with each entry's state, and the peak angle of every beam that
+ * moved; every other beam of the scene's n_beams kept a peak of 0. Its
+ * memory follows the beams the trial touched, not the field's. Reused
+ * from trial to trial; alloc/free pair. */
 typedef struct bsim_trial_log {
 	int n_entries, cap_entries;
 	bsim_gate_entry *entries;
-	int n_beams, cap_beams;
-	double *peak; /* n_beams: peak theta of every beam, rad */
+	int n_beams; /* the scene's */
+	int n_peaks, cap_peaks;
+	bsim_beam_peak *peaks; /* n_peaks, in ascending order of beam */
 } bsim_trial_log;
 
 BSIM_API bsim_trial_log *bsim_trial_log_alloc(void);

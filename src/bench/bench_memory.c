@@ -27,7 +27,14 @@
  *   python      beamsim.sweep of the one-group sweep above from Python
  *               (the python3 the module is built for, the module beside
  *               this program), 200,000 and 20,000 trials: its trials as
- *               NumPy columns; left out without the module.
+ *               NumPy columns; left out without the module;
+ *   lattice     the uniform lattice (configs/markov/uniform.yaml) at 5 x 5
+ *               and 33 x 33 gates, N / 100 trials of 1000 steps each
+ *               (20,000 by default), all threads, with every file: a
+ *               lattice trial should cost the beams it touched, not the
+ *               field's, so the two peaks and the wall times per step
+ *               (setup and output included; the steps from the sweep's
+ *               summary.json) are compared as ratios.
  * The growth per trial (per step, per value) is the difference of the two
  * peaks over the difference of the sizes: what memory costs per unit of
  * work, apart from what the program holds whatever the size. */
@@ -48,11 +55,13 @@
 
 #include "util/atomic_file.h"
 #include "util/json.h"
+#include "util/yaml_doc.h"
 #include "cli/cli_common.h"
 
 extern char **environ;
 
-#define BENCH_GATE "configs/thesis/gate.yaml"
+#define BENCH_GATE    "configs/thesis/gate.yaml"
+#define BENCH_LATTICE "configs/markov/uniform.yaml"
 
 /* The large grid axis's values and Python sweep's trials (the small: a
  * tenth). */
@@ -60,10 +69,11 @@ extern char **environ;
 #define PYTHON_TRIALS 200000
 
 typedef struct mem_run {
-	const char *what; /* sweep, twin, trajectory, grid axis, replay, python */
-	long size;        /* trials, steps or values */
+	const char *what; /* sweep, twin, trajectory, grid axis, replay, python, lattice */
+	long size;        /* trials, steps or values; a lattice's gates a side */
 	double rss;       /* bytes */
 	double wall;
+	double steps; /* a lattice's: every trial's steps */
 } mem_run;
 
 /* The directory of the runs' files; their standard error goes to a file
@@ -248,6 +258,43 @@ static int trajectory_peak(const char *tmp, const char *gate, long steps, mem_ru
 	return child_peak(argv, &out->rss, &out->wall);
 }
 
+/* The uniform lattice of n x n gates, trials trials of 1000 steps, into
+ * tmp/lattice_N; its steps from the sweep's summary.json. */
+static int lattice_peak(const char *tmp, const char *config, int n, long trials, mem_run *out)
+{
+	char dir[BSIM_PATH_MAX], cols[64], rows[64], t[32], summary[BSIM_PATH_MAX + 16];
+	snprintf(dir, sizeof dir, "%s/lattice_%d", tmp, n);
+	snprintf(cols, sizeof cols, "lattice.columns=%d", n);
+	snprintf(rows, sizeof rows, "lattice.rows=%d", n);
+	snprintf(t, sizeof t, "%ld", trials);
+	const char *argv[] = {"beamsim",  "sweep",   config,
+	                      "--set",    cols,      "--set",
+	                      rows,       "--set",   "integration.duration=4",
+	                      "--trials", t,         "--out",
+	                      dir,        "--quiet", NULL};
+	*out = (mem_run){.what = "lattice", .size = n};
+	int rc = child_peak(argv, &out->rss, &out->wall);
+	if (rc != CLI_OK)
+		return rc;
+	snprintf(summary, sizeof summary, "%s/summary.json", dir);
+	ydoc d;
+	bsim_error err;
+	long long steps = 0;
+	if (bsim_ydoc_load(&d, summary, &err) != BSIM_OK) {
+		cli_error("bench: %s", err.msg);
+		return CLI_FAIL;
+	}
+	struct fy_node *node =
+	        fy_node_by_path(fy_document_root(d.fyd), "/totals/steps", -1, FYNWF_DONT_FOLLOW);
+	if (!node || !bsim_ydoc_int64(node, &steps) || steps <= 0) {
+		cli_error("bench: %s: no totals.steps", summary);
+		rc = CLI_FAIL;
+	}
+	bsim_ydoc_free(&d);
+	out->steps = (double)steps;
+	return rc;
+}
+
 static void print_run(FILE *r, const mem_run *m, const char *unit)
 {
 	fprintf(r, "%-12s %10ld %-7s %10.1f MB %9.2f s\n", m->what, m->size, unit, m->rss / 1e6,
@@ -267,6 +314,10 @@ static void json_run(FILE *f, const mem_run *m)
 	bsim_json_number(f, m->rss);
 	fputs(", \"wall_seconds\": ", f);
 	bsim_json_number(f, m->wall);
+	if (m->steps > 0) {
+		fputs(", \"steps\": ", f);
+		bsim_json_number(f, m->steps);
+	}
 	fputc('}', f);
 }
 
@@ -282,8 +333,26 @@ enum {
 	REPLAY,
 	PY_SMALL,
 	PY_LARGE,
+	LATTICE_SMALL,
+	LATTICE_LARGE,
 	N_RUNS
 };
+
+/* The lattice's sizes, gates a side. */
+#define LATTICE_SMALL_N 5
+#define LATTICE_LARGE_N 33
+
+/* The large lattice's peak memory and wall time per step over the small's. */
+static double lattice_memory_ratio(const mem_run run[N_RUNS])
+{
+	return run[LATTICE_LARGE].rss / run[LATTICE_SMALL].rss;
+}
+
+static double lattice_wall_ratio(const mem_run run[N_RUNS])
+{
+	return (run[LATTICE_LARGE].wall / run[LATTICE_LARGE].steps) /
+	       (run[LATTICE_SMALL].wall / run[LATTICE_SMALL].steps);
+}
 
 /* "name": {"small": ..., "large": ..., "per": growth} */
 static void json_pair(FILE *f, const char *name, const mem_run *small, const mem_run *big,
@@ -324,7 +393,15 @@ static int write_json(const char *path, const mem_run run[N_RUNS], int python)
 	json_run(o.f, &run[REPLAY]);
 	if (python)
 		json_pair(o.f, "python_sweep", &run[PY_SMALL], &run[PY_LARGE], "bytes_per_trial");
-	fputs("}}\n", o.f);
+	fputs(", \"lattice\": {\"small\": ", o.f);
+	json_run(o.f, &run[LATTICE_SMALL]);
+	fputs(", \"large\": ", o.f);
+	json_run(o.f, &run[LATTICE_LARGE]);
+	fputs(", \"memory_ratio\": ", o.f);
+	bsim_json_number(o.f, lattice_memory_ratio(run));
+	fputs(", \"wall_per_step_ratio\": ", o.f);
+	bsim_json_number(o.f, lattice_wall_ratio(run));
+	fputs("}}}\n", o.f);
 	if (bsim_atomic_file_commit(&o, &err) != BSIM_OK) {
 		cli_error("bench: %s", err.msg);
 		return CLI_FAIL;
@@ -343,9 +420,10 @@ static void tmp_remove(const char *tmp)
 
 int bench_memory(const bench_memory_args *a)
 {
-	char gate[BSIM_PATH_MAX];
-	if (!realpath(BENCH_GATE, gate)) {
-		cli_error("%s not found: run beamsim bench from the source tree", BENCH_GATE);
+	char gate[BSIM_PATH_MAX], lattice[BSIM_PATH_MAX];
+	if (!realpath(BENCH_GATE, gate) || !realpath(BENCH_LATTICE, lattice)) {
+		cli_error("%s or %s not found: run beamsim bench from the source tree", BENCH_GATE,
+		          BENCH_LATTICE);
 		return CLI_USAGE;
 	}
 	char tmp[] = "/tmp/beamsim-bench-XXXXXX";
@@ -404,6 +482,17 @@ int bench_memory(const bench_memory_args *a)
 		if (rc == CLI_OK)
 			print_run(r, &run[PY_LARGE], "trials");
 	}
+	long lattice_trials = trials / 100 > 0 ? trials / 100 : 1;
+	if (rc == CLI_OK)
+		rc = lattice_peak(tmp, lattice, LATTICE_SMALL_N, lattice_trials,
+		                  &run[LATTICE_SMALL]);
+	if (rc == CLI_OK) {
+		print_run(r, &run[LATTICE_SMALL], "gates");
+		rc = lattice_peak(tmp, lattice, LATTICE_LARGE_N, lattice_trials,
+		                  &run[LATTICE_LARGE]);
+	}
+	if (rc == CLI_OK)
+		print_run(r, &run[LATTICE_LARGE], "gates");
 	if (rc == CLI_OK) {
 		fprintf(r,
 		        "\ngrowth: %.1f bytes per trial (the sweep), %.1f bytes per step (the "
@@ -418,6 +507,11 @@ int bench_memory(const bench_memory_args *a)
 			        growth(&run[PY_SMALL], &run[PY_LARGE]));
 		else
 			fputs(";\nno sweep from Python: no Python module beside this program", r);
+		fprintf(r,
+		        ";\n%ld lattice trials at %d x %d against %d x %d: %.2f times the peak "
+		        "memory, %.2f times the wall time a step",
+		        lattice_trials, LATTICE_LARGE_N, LATTICE_LARGE_N, LATTICE_SMALL_N,
+		        LATTICE_SMALL_N, lattice_memory_ratio(run), lattice_wall_ratio(run));
 		fputc('\n', r);
 	}
 	tmp_remove(tmp);

@@ -133,12 +133,10 @@ static void print_lattice(FILE *out, const bsim_scene *s, const bsim_trial_resul
 	        r->final_iy, r->gates_entered);
 	for (int k = 0; k < log->n_entries; k++)
 		fprintf(out, " %d:%d", log->entries[k].ix, log->entries[k].iy);
-	int moved = 0;
+	int moved = log->n_peaks;
 	double peak = 0.0;
-	for (int i = 0; i < log->n_beams; i++) {
-		moved += log->peak[i] != 0.0;
-		peak = fmax(peak, log->peak[i]);
-	}
+	for (int k = 0; k < log->n_peaks; k++)
+		peak = fmax(peak, log->peaks[k].peak);
 	fprintf(out,
 	        "\npeak theta  %d beams moved, the largest %.6g rad (run --json: every beam)\n",
 	        moved, peak);

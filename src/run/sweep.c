@@ -227,30 +227,23 @@ size_t bsim_sweep_record_size_sides(int n_sides)
 	       (size_t)bsim_sweep_pairs(n_sides) * sizeof(double);
 }
 
-/* The beams of a lattice sweep's records (run/sweep_record.h), 0 for
- * records of the result alone; a sweep of sides' are the most of the
- * sides' scenes (scenes_b NULL: the sides share scenes). */
-static int record_beams(const bsim_scene *scenes, const bsim_scene *scenes_b, int n_groups,
-                        const bsim_sweep_config *cfg)
+/* 1 if a sweep's records are lattice records (run/sweep_record.h: the
+ * result, the gate path and the moved beams' peaks), 0 for records of the
+ * result alone. */
+static int record_lattice(const bsim_scene *scenes, const bsim_sweep_config *cfg)
 {
-	if (cfg->results_only || !scenes[0].has_lattice)
-		return 0;
-	int beams = bsim_sweep_record_beams(scenes, n_groups);
-	int beams_b = scenes_b ? bsim_sweep_record_beams(scenes_b, n_groups) : 0;
-	beams = beams_b > beams ? beams_b : beams;
-	return beams > 0 ? beams : 1;
+	return !cfg->results_only && scenes[0].has_lattice;
 }
 
-/* The size of a record of beams beams (0: the result alone) of n sides (1:
- * a plain sweep). A lattice sweep of sides' record is each side's lattice
- * record in order, packed by run/sweep_record.c, then each pair's
- * separation time (a double). */
-static size_t record_bytes(int beams, int n)
+/* The size of a record (lattice: a lattice record, else the result
+ * alone) of n sides (1: a plain sweep). A lattice sweep of sides' record
+ * is each side's lattice record in order, packed by run/sweep_record.c,
+ * then each pair's separation time (a double). */
+static size_t record_bytes(int lattice, int n)
 {
-	if (!beams)
+	if (!lattice)
 		return n > 1 ? bsim_sweep_record_size_sides(n) : sizeof(bsim_trial_result);
-	return (size_t)n * bsim_sweep_record_bytes(beams) +
-	       (size_t)bsim_sweep_pairs(n) * sizeof(double);
+	return (size_t)n * bsim_sweep_record_bytes() + (size_t)bsim_sweep_pairs(n) * sizeof(double);
 }
 
 /* What the threads share. first_fail is the index of the lowest failed
@@ -283,10 +276,10 @@ typedef struct sweep_shared {
 	int stopped;                 /* a trial was not started because of cfg->stop */
 	const bsim_sweep_part *part; /* NULL: every trial is this process's */
 	long progress_total;         /* what progress counts up to */
-	/* > 0: a lattice sweep's records hold the gate path and the peaks of
-	 * this many beams (run/sweep_record.h; a sweep of sides', each side's:
+	/* 1: a lattice sweep's records hold the gate path and the moved beams'
+	 * peaks (run/sweep_record.h; a sweep of sides', each side's:
 	 * record_bytes); record_size bytes, every record's */
-	int record_beams;
+	int record_lattice;
 	size_t record_size;
 } sweep_shared;
 
@@ -338,15 +331,13 @@ static void shared_fail(sweep_shared *sh, long i, int code, const char *msg)
 static const void *record_of(sweep_shared *sh, long i, void *buf)
 {
 	long k = i - sh->first;
-	if (sh->n_sides == 1 && !sh->record_beams)
+	if (sh->n_sides == 1 && !sh->record_lattice)
 		return &sh->results[0][k];
 	unsigned char *p = buf;
-	size_t side = sh->record_beams ? bsim_sweep_record_bytes(sh->record_beams)
-	                               : sizeof(bsim_trial_result);
+	size_t side = sh->record_lattice ? bsim_sweep_record_bytes() : sizeof(bsim_trial_result);
 	for (int s = 0; s < sh->n_sides; s++, p += side)
-		if (sh->record_beams)
-			bsim_sweep_record_pack(p, sh->record_beams, &sh->results[s][k],
-			                       &sh->logs[s][k]);
+		if (sh->record_lattice)
+			bsim_sweep_record_pack(p, &sh->results[s][k], &sh->logs[s][k]);
 		else
 			memcpy(p, &sh->results[s][k], side);
 	for (int q = 0; q < bsim_sweep_pairs(sh->n_sides); q++, p += sizeof(double))
@@ -375,7 +366,7 @@ static int journal_take(void *user, uint64_t index, const void *payload)
 	 * does every trial of a lattice, whose gate path is not journaled,
 	 * unless only the results are wanted. */
 	if ((long)(index % (uint64_t)sh->e->trials) < sh->keep ||
-	    (sh->lattice && !cfg->results_only && !sh->record_beams))
+	    (sh->lattice && !cfg->results_only && !sh->record_lattice))
 		return 0;
 	if (sh->journaled) {
 		/* Streamed: the record waits in the spill file for its block. */
@@ -387,16 +378,14 @@ static int journal_take(void *user, uint64_t index, const void *payload)
 		return 0;
 	}
 	const unsigned char *p = payload;
-	size_t side = sh->record_beams ? bsim_sweep_record_bytes(sh->record_beams)
-	                               : sizeof(bsim_trial_result);
+	size_t side = sh->record_lattice ? bsim_sweep_record_bytes() : sizeof(bsim_trial_result);
 	for (int s = 0; s < sh->n_sides; s++, p += side) {
-		if (!sh->record_beams) {
+		if (!sh->record_lattice) {
 			memcpy(&sh->results[s][index], p, side);
 			continue;
 		}
 		/* a path too long for its record: the trial (every side) runs again */
-		int got = bsim_sweep_record_unpack(p, sh->record_beams, &sh->results[s][index],
-		                                   &sh->logs[s][index]);
+		int got = bsim_sweep_record_unpack(p, &sh->results[s][index], &sh->logs[s][index]);
 		if (got <= 0)
 			return got;
 	}
@@ -428,11 +417,11 @@ static void sweep_thread(sweep_shared *sh)
 	int logs_ok = 1;
 	for (int s = 0; s < n_sides; s++)
 		logs_ok &= (log[s] = bsim_trial_log_alloc()) != NULL;
-	void *record_buf = n_sides > 1 || sh->record_beams ? malloc(sh->record_size) : NULL;
+	void *record_buf = n_sides > 1 || sh->record_lattice ? malloc(sh->record_size) : NULL;
 	bsim_error err;
 
 	if (!runner || (n_sides > 1 && !sides) || !logs_ok ||
-	    ((n_sides > 1 || sh->record_beams) && !record_buf)) {
+	    ((n_sides > 1 || sh->record_lattice) && !record_buf)) {
 		bsim_trial_runner_free(runner);
 		runner = NULL;
 		shared_fail(sh, -1, BSIM_EFAIL, "out of memory for a trial runner");
@@ -714,8 +703,8 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 	for (int q = 0; q < n_pairs; q++)
 		sh.t_separate[q] = *t_separate + (size_t)q * (size_t)total;
 	if (rc == BSIM_OK) {
-		sh.record_beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
-		sh.record_size = record_bytes(sh.record_beams, n_sides);
+		sh.record_lattice = record_lattice(scenes, cfg);
+		sh.record_size = record_bytes(sh.record_lattice, n_sides);
 	}
 	if (rc == BSIM_OK && cfg->journal) {
 		sh.lattice = scenes[0].has_lattice;
@@ -837,9 +826,9 @@ static int stream_replay(sweep_shared *sh, bsim_error *err)
 /* Block [sh->first, sh->end)'s journaled trials into their slots. */
 static int stream_load(sweep_shared *sh, bsim_error *err)
 {
-	size_t size = sh->record_beams ? sh->record_size : sizeof(bsim_trial_result);
-	void *rec = sh->record_beams ? malloc(size) : NULL;
-	if (sh->record_beams && !rec)
+	size_t size = sh->record_lattice ? sh->record_size : sizeof(bsim_trial_result);
+	void *rec = sh->record_lattice ? malloc(size) : NULL;
+	if (sh->record_lattice && !rec)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	int rc = BSIM_OK;
 	for (long i = sh->first; rc == BSIM_OK && sh->journaled && i < sh->end; i++) {
@@ -854,8 +843,7 @@ static int stream_load(sweep_shared *sh, bsim_error *err)
 			break;
 		}
 		/* a lattice's path too long for its record: the trial runs again */
-		int got = rec ? bsim_sweep_record_unpack(rec, sh->record_beams, &sh->results[0][k],
-		                                         &sh->logs[0][k])
+		int got = rec ? bsim_sweep_record_unpack(rec, &sh->results[0][k], &sh->logs[0][k])
 		              : 1;
 		if (got < 0)
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
@@ -964,8 +952,8 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 	        .lattice = out->lattice,
 	};
 	if (rc == BSIM_OK) {
-		sh.record_beams = record_beams(scenes, NULL, e->n_groups, cfg);
-		sh.record_size = record_bytes(sh.record_beams, 1);
+		sh.record_lattice = record_lattice(scenes, cfg);
+		sh.record_size = record_bytes(sh.record_lattice, 1);
 	}
 	if (rc == BSIM_OK && cfg->journal)
 		rc = stream_replay(&sh, err);
@@ -1065,8 +1053,7 @@ int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config
 	int rc = scenes_build(e, cfg, 0, &scenes, err);
 	if (rc != BSIM_OK)
 		return rc;
-	int beams = record_beams(scenes, NULL, e->n_groups, cfg);
-	*size = record_bytes(beams, 1);
+	*size = record_bytes(record_lattice(scenes, cfg), 1);
 	scenes_free(scenes, e->n_groups);
 	return BSIM_OK;
 }
@@ -1077,19 +1064,12 @@ int bsim_sweep_record_size_sides_for(const bsim_experiment *e, const bsim_sweep_
 	int rc = sides_check(n_sides, err);
 	if (rc != BSIM_OK)
 		return rc;
-	bsim_scene *scenes = NULL, *scenes_b = NULL;
+	bsim_scene *scenes = NULL;
 	rc = scenes_build(e, cfg, 0, &scenes, err);
 	if (rc != BSIM_OK)
 		return rc;
-	if (cfg->n_extra_b > 0 && (rc = scenes_build(e, cfg, 1, &scenes_b, err)) != BSIM_OK) {
-		scenes_free(scenes, e->n_groups);
-		return rc;
-	}
-	int beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
-	*size = record_bytes(beams, n_sides);
+	*size = record_bytes(record_lattice(scenes, cfg), n_sides);
 	scenes_free(scenes, e->n_groups);
-	if (scenes_b)
-		scenes_free(scenes_b, e->n_groups);
 	return BSIM_OK;
 }
 
@@ -1151,8 +1131,8 @@ static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg, int 
 	for (int q = 0; rc == BSIM_OK && q < n_pairs; q++)
 		sh.t_separate[q] = t_separate + (size_t)q * BSIM_SWEEP_BLOCK;
 	if (rc == BSIM_OK) {
-		sh.record_beams = record_beams(scenes, scenes_b, e->n_groups, cfg);
-		sh.record_size = record_bytes(sh.record_beams, n_sides);
+		sh.record_lattice = record_lattice(scenes, cfg);
+		sh.record_size = record_bytes(sh.record_lattice, n_sides);
 	}
 	/* Progress: this part's trials, or with collect every part's. */
 	for (long i = 0; i < total; i++) {

@@ -5,69 +5,54 @@
 #include <stdlib.h>
 #include <string.h>
 
-size_t bsim_sweep_record_bytes(int beams_max)
+size_t bsim_sweep_record_bytes(void)
 {
-	return sizeof(bsim_trial_result) + 2 * sizeof(int32_t) +
-	       SWEEP_RECORD_ENTRIES * sizeof(bsim_gate_entry) + (size_t)beams_max * sizeof(double);
+	return sizeof(bsim_trial_result) + 3 * sizeof(int32_t) +
+	       SWEEP_RECORD_ENTRIES * sizeof(bsim_gate_entry) +
+	       SWEEP_RECORD_PEAKS * sizeof(bsim_beam_peak);
 }
 
-int bsim_sweep_record_beams(const bsim_scene *scenes, int n)
-{
-	int most = 0;
-	for (int g = 0; g < n; g++)
-		most = scenes[g].n_beams > most ? scenes[g].n_beams : most;
-	return most;
-}
-
-void bsim_sweep_record_pack(void *rec, int beams_max, const bsim_trial_result *r,
-                            const bsim_trial_log *log)
+void bsim_sweep_record_pack(void *rec, const bsim_trial_result *r, const bsim_trial_log *log)
 {
 	unsigned char *p = rec;
-	memset(p, 0, bsim_sweep_record_bytes(beams_max));
+	memset(p, 0, bsim_sweep_record_bytes());
 	memcpy(p, r, sizeof *r);
 	p += sizeof *r;
-	int32_t n_entries = log->n_entries, n_beams = log->n_beams;
-	if (n_entries > SWEEP_RECORD_ENTRIES || n_beams > beams_max)
-		n_entries = -1; /* does not fit: the trial runs again */
-	memcpy(p, &n_entries, sizeof n_entries);
-	memcpy(p + sizeof n_entries, &n_beams, sizeof n_beams);
-	p += 2 * sizeof(int32_t);
-	if (n_entries < 0)
+	int32_t n[3] = {log->n_entries, log->n_beams, log->n_peaks};
+	if (n[0] > SWEEP_RECORD_ENTRIES || n[2] > SWEEP_RECORD_PEAKS)
+		n[0] = -1; /* does not fit: the trial runs again */
+	memcpy(p, n, sizeof n);
+	p += sizeof n;
+	if (n[0] < 0)
 		return;
-	if (n_entries > 0)
-		memcpy(p, log->entries, (size_t)n_entries * sizeof *log->entries);
+	if (n[0] > 0)
+		memcpy(p, log->entries, (size_t)n[0] * sizeof *log->entries);
 	p += SWEEP_RECORD_ENTRIES * sizeof(bsim_gate_entry);
-	if (n_beams > 0)
-		memcpy(p, log->peak, (size_t)n_beams * sizeof *log->peak);
+	if (n[2] > 0)
+		memcpy(p, log->peaks, (size_t)n[2] * sizeof *log->peaks);
 }
 
-int bsim_sweep_record_unpack(const void *rec, int beams_max, bsim_trial_result *r,
-                             bsim_trial_log *log)
+int bsim_sweep_record_unpack(const void *rec, bsim_trial_result *r, bsim_trial_log *log)
 {
 	const unsigned char *p = rec;
-	int32_t n_entries, n_beams;
-	memcpy(&n_entries, p + sizeof *r, sizeof n_entries);
-	memcpy(&n_beams, p + sizeof *r + sizeof n_entries, sizeof n_beams);
-	if (n_entries < 0 || n_entries > SWEEP_RECORD_ENTRIES || n_beams < 0 || n_beams > beams_max)
+	int32_t n[3];
+	memcpy(n, p + sizeof *r, sizeof n);
+	if (n[0] < 0 || n[0] > SWEEP_RECORD_ENTRIES || n[1] < 0 || n[2] < 0 ||
+	    n[2] > SWEEP_RECORD_PEAKS)
 		return 0;
 	/* the log's own memory, grown as bsim_trial_log_copy grows it */
-	bsim_trial_log view = {0};
 	bsim_gate_entry entries[SWEEP_RECORD_ENTRIES];
-	const unsigned char *q = p + sizeof *r + 2 * sizeof(int32_t);
-	memcpy(entries, q, (size_t)n_entries * sizeof *entries);
-	view.n_entries = n_entries;
-	view.entries = entries;
-	double *peak = n_beams > 0 ? (double *)malloc((size_t)n_beams * sizeof *peak) : NULL;
-	if (n_beams > 0 && !peak)
-		return -1;
-	if (n_beams > 0)
-		memcpy(peak, q + SWEEP_RECORD_ENTRIES * sizeof(bsim_gate_entry),
-		       (size_t)n_beams * sizeof *peak);
-	view.n_beams = n_beams;
-	view.peak = peak;
-	int rc = bsim_trial_log_copy(log, &view);
-	free(peak);
-	if (rc != BSIM_OK)
+	bsim_beam_peak peaks[SWEEP_RECORD_PEAKS];
+	const unsigned char *q = p + sizeof *r + sizeof n;
+	memcpy(entries, q, (size_t)n[0] * sizeof *entries);
+	memcpy(peaks, q + SWEEP_RECORD_ENTRIES * sizeof(bsim_gate_entry),
+	       (size_t)n[2] * sizeof *peaks);
+	bsim_trial_log view = {.n_entries = n[0],
+	                       .entries = entries,
+	                       .n_beams = n[1],
+	                       .n_peaks = n[2],
+	                       .peaks = peaks};
+	if (bsim_trial_log_copy(log, &view) != BSIM_OK)
 		return -1;
 	memcpy(r, p, sizeof *r);
 	return 1;

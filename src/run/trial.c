@@ -386,7 +386,8 @@ static int trial_close(trial_ctx *c, const trial_loop *lp, bsim_state *s0, int r
 	if (rc == BSIM_OK)
 		rc = bsim_effects_status(c->fx, err);
 	if (rc == BSIM_OK && c->log &&
-	    bsim_trial_log_peaks(c->log, c->r->peaks.peak, c->scene->n_beams))
+	    bsim_trial_log_peaks(c->log, c->r->peaks.peak, c->r->peaks.list, c->r->peaks.n_list,
+	                         c->scene->n_beams))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the peaks");
 	bsim_trial_runner *r = c->r;
 	bsim_effects_free_spare(c->fx, &r->spare);

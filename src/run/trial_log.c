@@ -1,6 +1,6 @@
 /* The trial log (trial.h bsim_trial_log): what a trial can leave beyond
- * its result, the gate path and every beam's peak angle, in memory that
- * grows as needed and is reused from trial to trial. */
+ * its result, the gate path and the moved beams' peak angles, in memory
+ * that grows as needed and is reused from trial to trial. */
 #include "run/trial_log.h"
 
 #include <stdlib.h>
@@ -16,7 +16,7 @@ void bsim_trial_log_clear(bsim_trial_log *l)
 	if (!l)
 		return;
 	free(l->entries);
-	free(l->peak);
+	free(l->peaks);
 	memset(l, 0, sizeof *l);
 }
 
@@ -37,19 +37,20 @@ int bsim_trial_log_copy(bsim_trial_log *dst, const bsim_trial_log *src)
 		dst->entries = p;
 		dst->cap_entries = src->n_entries;
 	}
-	if (dst->cap_beams < src->n_beams) {
-		double *p = realloc(dst->peak, (size_t)src->n_beams * sizeof *p);
+	if (dst->cap_peaks < src->n_peaks) {
+		bsim_beam_peak *p = realloc(dst->peaks, (size_t)src->n_peaks * sizeof *p);
 		if (!p)
 			return BSIM_EFAIL;
-		dst->peak = p;
-		dst->cap_beams = src->n_beams;
+		dst->peaks = p;
+		dst->cap_peaks = src->n_peaks;
 	}
 	if (src->n_entries > 0)
 		memcpy(dst->entries, src->entries, (size_t)src->n_entries * sizeof *src->entries);
-	if (src->n_beams > 0)
-		memcpy(dst->peak, src->peak, (size_t)src->n_beams * sizeof *src->peak);
+	if (src->n_peaks > 0)
+		memcpy(dst->peaks, src->peaks, (size_t)src->n_peaks * sizeof *src->peaks);
 	dst->n_entries = src->n_entries;
 	dst->n_beams = src->n_beams;
+	dst->n_peaks = src->n_peaks;
 	return BSIM_OK;
 }
 
@@ -67,16 +68,28 @@ int bsim_trial_log_push(bsim_trial_log *l, const bsim_gate_entry *e)
 	return BSIM_OK;
 }
 
-int bsim_trial_log_peaks(bsim_trial_log *l, const double *peak, int n)
+static int peak_order(const void *a, const void *b)
 {
-	if (l->cap_beams < n) {
-		double *p = realloc(l->peak, (size_t)n * sizeof *p);
+	int i = ((const bsim_beam_peak *)a)->beam, j = ((const bsim_beam_peak *)b)->beam;
+	return (i > j) - (i < j);
+}
+
+int bsim_trial_log_peaks(bsim_trial_log *l, const double *peak, const int *list, int n_list,
+                         int n_beams)
+{
+	if (l->cap_peaks < n_list) {
+		bsim_beam_peak *p = realloc(l->peaks, (size_t)n_list * sizeof *p);
 		if (!p)
 			return BSIM_EFAIL;
-		l->peak = p;
-		l->cap_beams = n;
+		l->peaks = p;
+		l->cap_peaks = n_list;
 	}
-	memcpy(l->peak, peak, (size_t)n * sizeof *peak);
-	l->n_beams = n;
+	int n = 0;
+	for (int k = 0; k < n_list; k++)
+		if (peak[list[k]] != 0.0)
+			l->peaks[n++] = (bsim_beam_peak){list[k], peak[list[k]]};
+	qsort(l->peaks, (size_t)n, sizeof *l->peaks, peak_order);
+	l->n_peaks = n;
+	l->n_beams = n_beams;
 	return BSIM_OK;
 }

@@ -7,7 +7,10 @@
 /* Appends gate entry e to the path. */
 int bsim_trial_log_push(bsim_trial_log *l, const bsim_gate_entry *e);
 
-/* The n beams' peak angles, rad. */
-int bsim_trial_log_peaks(bsim_trial_log *l, const double *peak, int n);
+/* The peaks of a scene of n_beams beams: peak[g] (rad) for the n_list
+ * beams of list, the only ones whose peak may not be 0 (any order); those
+ * not 0 are kept, in ascending order of beam. */
+int bsim_trial_log_peaks(bsim_trial_log *l, const double *peak, const int *list, int n_list,
+                         int n_beams);
 
 #endif

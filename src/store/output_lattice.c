@@ -154,13 +154,11 @@ void bsim_lattice_peaks_rows(FILE *f, const bsim_lattice_def *def, long first, l
 	for (long i = 0; i < n; i++) {
 		int g = (int)((first + i) / trials), t = (int)((first + i) % trials);
 		const bsim_trial_log *l = &logs[i];
-		for (int b = 0; b < l->n_beams; b++) {
-			if (l->peak[b] == 0.0)
-				continue;
-			int ix, iy, side;
+		for (int k = 0; k < l->n_peaks; k++) {
+			int b = l->peaks[k].beam, ix, iy, side;
 			bsim_lattice_beam_gate(def, b, &ix, &iy, &side);
 			fprintf(f, "%d,%d,%d,%d,%d,%s,%.10g\n", g, t, b, ix, iy,
-			        side ? "right" : "left", l->peak[b]);
+			        side ? "right" : "left", l->peaks[k].peak);
 		}
 	}
 }

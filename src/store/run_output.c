@@ -81,9 +81,11 @@ static void path_json(FILE *f, const bsim_trial_result *r, const bsim_trial_log 
 		fputs("]}", f);
 	}
 	fputs("], \"peak_theta\": [", f);
-	for (int i = 0; i < log->n_beams; i++) {
+	for (int i = 0, k = 0; i < log->n_beams; i++) {
+		/* the moved beams in ascending order; every other beam's is 0 */
+		int moved = k < log->n_peaks && log->peaks[k].beam == i;
 		fputs(i ? ", " : "", f);
-		bsim_json_number(f, log->peak[i]);
+		bsim_json_number(f, moved ? log->peaks[k++].peak : 0.0);
 	}
 	fputc(']', f);
 }
