@@ -211,6 +211,9 @@ struct bsim_world {
 	int *touched_list;
 	int n_touched;
 	int touched_all;
+	/* Debug builds: where the next validation's scan of the field starts
+	 * (thesis_validate.c). */
+	int validate_from;
 	int *start_awake;
 	int n_start_awake;
 	/* The broad phase's candidate cache (broad_phase.c): every beam whose
@@ -264,6 +267,17 @@ int bsim_thesis_flight(struct bsim_world *w, const double force[2], double h, in
 int bsim_thesis_steps_takes(const struct bsim_world *w);
 int bsim_thesis_steps(struct bsim_world *w, const double force[2], double h, int n,
                       bsim_state *out);
+
+/* thesis_validate.c: asserts the world's invariants (debug builds; under
+ * NDEBUG nothing, not even a call). */
+#ifdef NDEBUG
+static inline void bsim_thesis_validate(struct bsim_world *w)
+{
+	(void)w;
+}
+#else
+void bsim_thesis_validate(struct bsim_world *w);
+#endif
 
 /* beam_sleep.c */
 void bsim_thesis_beam_wake(struct bsim_world *w, int i);

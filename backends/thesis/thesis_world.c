@@ -319,6 +319,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
 	contact_list_beams(w, NULL, 1); /* a body that starts touching a beam */
+	bsim_thesis_validate(w);
 	*out = w;
 	return BSIM_OK;
 }
@@ -376,6 +377,7 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	for (int k = 0; k < w->n_start_awake; k++)
 		bsim_thesis_beam_wake(w, w->start_awake[k]);
 	contact_list_beams(w, NULL, 1); /* a body that starts touching a beam */
+	bsim_thesis_validate(w);
 	return BSIM_OK;
 }
 
@@ -445,8 +447,8 @@ THESIS_APART int advance_each(bsim_world *w, const double force[2], double torqu
  * thesis_step's, to the bit (test_steps, test_flight). A try at flight
  * that makes no step costs its room test; after one, the next waits
  * (flight_skip), doubling the wait after each such try. */
-static int thesis_advance(bsim_world *w, const double force[2], double torque, double h, int n,
-                          bsim_state *out, int *made, bsim_error *err)
+static inline int advance_calls(bsim_world *w, const double force[2], double torque, double h,
+                                int n, bsim_state *out, int *made, bsim_error *err)
 {
 	if (n == 1 && (w->flight_skip || w->n_awake || !out)) {
 		/* one step, not of free flight: the step loop's usual call */
@@ -479,6 +481,14 @@ static int thesis_advance(bsim_world *w, const double force[2], double torque, d
 	return rc;
 }
 
+static int thesis_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+                          bsim_state *out, int *made, bsim_error *err)
+{
+	int rc = advance_calls(w, force, torque, h, n, out, made, err);
+	bsim_thesis_validate(w);
+	return rc;
+}
+
 static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 {
 	if (s->n_beams != w->n_beams)
@@ -508,6 +518,7 @@ static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 	w->flight_skip = w->flight_wait = 0;
 	w->touched_all = 1; /* every beam's angle set */
 	bsim_thesis_near_forget(w);
+	bsim_thesis_validate(w);
 	return BSIM_OK;
 }
 
