@@ -97,6 +97,12 @@ typedef struct bsim_sweep_config {
 	int n_extra;
 	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
+	bsim_plan_fn planned; /* may be NULL: said by bsim_sweep_plan_for */
+	void *planned_user;
+	/* NULL, or every group's scene with extra applied (bsim_sweep_plan_for's):
+	 * lent to the sweep, which reads them and neither builds them again nor
+	 * frees them. */
+	bsim_scene *scenes;
 	int measure_overlap; /* 1: each trial's overlap_max (plain sweeps only) */
 	int keep;            /* keep the trajectories of the first keep trials of each group */
 	int keep_stride;     /* of those, a row every keep_stride steps (<= 0: 5) */
@@ -172,12 +178,22 @@ BSIM_API size_t bsim_sweep_record_size_sides(int n_sides);
 /* The size of the journal records of the plain sweep of e with cfg (its
  * --set in cfg->extra): bsim_sweep_record_size(0), or for a lattice (unless
  * cfg->results_only) the result, then its gate path (a fixed number of
- * entries; a longer path is marked, and the trial runs again where the
- * records are read) and the peak of each of its scenes' beams, so that the
- * lattice's files can be written from the journal. BSIM_EINPUT if a
- * group's scene cannot be built. */
+ * entries) and the peaks of the beams it moved (a fixed number: a longer
+ * path or more moved beams are marked, and the trial runs again where the
+ * records are read), so that the lattice's files can be written from the
+ * journal. BSIM_EINPUT if a group's scene cannot be built. */
 BSIM_API int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                         size_t *size, bsim_error *err);
+
+/* A sweep planned once: every group's scene built (cfg's extra applied)
+ * into *scenes, for cfg->scenes and the caller's files, the record's size
+ * as bsim_sweep_record_size_for gives it, and the plan said to
+ * cfg->planned (bsim_plan_fn: the beam-steps the trials take at most)
+ * where it is given, before any trial runs or any file is opened. The
+ * scenes are the caller's: bsim_sweep_scenes_free. */
+BSIM_API int bsim_sweep_plan_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
+                                 size_t *size, bsim_scene **scenes, bsim_error *err);
+BSIM_API void bsim_sweep_scenes_free(bsim_scene *scenes, int n_groups);
 
 /* The same for the sweep of e on n_sides sides with cfg (the second side's
  * overrides in cfg->extra_b): bsim_sweep_record_size_sides(n_sides), or

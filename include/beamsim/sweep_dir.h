@@ -63,6 +63,8 @@ typedef struct bsim_sweep_dir_def {
 	const char *overwrite_option;
 	bsim_progress_fn progress; /* may be NULL */
 	void *progress_user;
+	bsim_plan_fn planned; /* may be NULL: the sweep's plan, before its first trial */
+	void *planned_user;
 	/* NULL, or a flag (set by a signal handler, say): once nonzero no trial
 	 * starts, those running finish and are journaled, and the run returns
 	 * BSIM_ESTOPPED with the journal kept for resume. */

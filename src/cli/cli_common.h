@@ -151,6 +151,8 @@ double cli_experiment_beam_steps(const char *path, const cli_sets *sets, const u
  * beam-step it assumes for backend b (its table's, with that cost's
  * basis); none for a backend that states no cost. */
 void cli_estimate_line(const bsim_backend *b, double beam_steps);
+/* cli_estimate_line as a run's plan (bsim_plan_fn), backend the bsim_backend. */
+void cli_estimate_planned(void *backend, double beam_steps);
 
 /* The names of the first max backends of the registry's default
  * comparison (bsim_backend_compared), joined by ',' into buf ("" if

@@ -163,10 +163,10 @@ static int sweep_main(int argc, char **argv, const cli_merge *m)
 		def.argv = stored;
 	}
 	cli_mpi_spread(&def.spread, &def.part, &def.agree, bsim_sweep_record_size(0), def.stop);
-	if (rank == 0 && !m)
-		cli_estimate_line(def.backend,
-		                  cli_experiment_beam_steps(experiment, &c.sets,
-		                                            c.has_seed ? &c.seed : NULL, c.trials));
+	if (rank == 0 && !m) {
+		def.planned = cli_estimate_planned;
+		def.planned_user = (void *)def.backend;
+	}
 	bsim_sweep_dir_result res;
 	bsim_error err;
 	cli_signals_install();

@@ -124,6 +124,14 @@ static void scenes_free(bsim_scene *scenes, int n)
 	free(scenes);
 }
 
+/* The side-0 scenes a sweep built (scenes_for), freed; those lent to it
+ * (cfg->scenes) left to their owner. */
+static void scenes_release(const bsim_sweep_config *cfg, bsim_scene *scenes, int n)
+{
+	if (scenes != cfg->scenes)
+		scenes_free(scenes, n);
+}
+
 /* The overrides a side's scenes are built with after the experiment's:
  * extra, then the second side's own of a paired sweep. malloc'd. */
 static bsim_override *side_overrides(const bsim_sweep_config *cfg, int side_b, int *n_ov)
@@ -163,6 +171,19 @@ static int scenes_build(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 	return BSIM_OK;
 }
 
+/* The beam-steps the trials of the groups' scenes take at most
+ * (bsim_plan_fn). */
+static double plan_beam_steps(const bsim_experiment *e, const bsim_scene *scenes)
+{
+	double total = 0.0;
+	for (int g = 0; g < e->n_groups; g++) {
+		const bsim_scene *s = &scenes[g];
+		double n = s->effects.has_random_force ? (double)e->trials : 1.0;
+		total += n * (double)s->max_steps * s->n_beams;
+	}
+	return total;
+}
+
 /* The scenes of every group for each of n sides, each checked against the
  * backend that runs it (bsim_experiment_group_check), so that a scene a
  * backend refuses (a body within Box2D's skin) is said where the scene
@@ -176,7 +197,11 @@ static int scenes_for(const bsim_experiment *e, const bsim_sweep_config *cfg, in
 	const int own_b = n > 1 && cfg->n_extra_b > 0;
 	if (scenes_b)
 		*scenes_b = NULL;
-	int rc = scenes_build(e, cfg, 0, scenes, err);
+	int rc = BSIM_OK;
+	if (cfg->scenes)
+		*scenes = cfg->scenes; /* lent by the caller (bsim_sweep_plan_for) */
+	else
+		rc = scenes_build(e, cfg, 0, scenes, err);
 	if (rc == BSIM_OK && own_b)
 		rc = scenes_build(e, cfg, 1, scenes_b, err);
 	for (int side = 0; rc == BSIM_OK && side < n; side++) {
@@ -193,7 +218,7 @@ static int scenes_for(const bsim_experiment *e, const bsim_sweep_config *cfg, in
 	}
 	if (rc != BSIM_OK) {
 		if (*scenes)
-			scenes_free(*scenes, e->n_groups);
+			scenes_release(cfg, *scenes, e->n_groups);
 		if (scenes_b && *scenes_b)
 			scenes_free(*scenes_b, e->n_groups);
 		*scenes = NULL;
@@ -674,7 +699,7 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 	int rc = scenes_for(e, cfg, n_sides, backend, opts, &scenes, &scenes_b, err);
 	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
 	if (rc == BSIM_OK && !deterministic) {
-		scenes_free(scenes, e->n_groups);
+		scenes_release(cfg, scenes, e->n_groups);
 		if (scenes_b)
 			scenes_free(scenes_b, e->n_groups);
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
@@ -714,7 +739,7 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 		                      : bsim_journal_replay(cfg->journal, journal_take, &sh, &kept,
 		                                            &cut, err);
 		if (rc != BSIM_OK) {
-			scenes_free(scenes, e->n_groups);
+			scenes_release(cfg, scenes, e->n_groups);
 			if (scenes_b)
 				scenes_free(scenes_b, e->n_groups);
 		}
@@ -732,7 +757,7 @@ static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg, 
 			out[s].lattice_def = sh.scenes[s][0].lattice;
 			groups_rotate(&out[s], sh.scenes[s]);
 		}
-		scenes_free(scenes, e->n_groups);
+		scenes_release(cfg, scenes, e->n_groups);
 		if (scenes_b)
 			scenes_free(scenes_b, e->n_groups);
 		if (sh.first_fail < sh.total)
@@ -997,7 +1022,7 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 		              bsim_clock_seconds() - t0);
 	}
 	if (scenes)
-		scenes_free(scenes, e->n_groups);
+		scenes_release(cfg, scenes, e->n_groups);
 	stream_free(&st, e->n_groups);
 	free(deterministic);
 	if (rc != BSIM_OK)
@@ -1046,31 +1071,63 @@ int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg
 	return rc;
 }
 
+/* Whether the sweep's records are lattice records (record_lattice): from
+ * group 0's scene, built alone (record_lattice reads no other). */
+static int records_lattice(const bsim_experiment *e, const bsim_sweep_config *cfg, int *lattice,
+                           bsim_error *err)
+{
+	int n_ov;
+	bsim_override *ov = side_overrides(cfg, 0, &n_ov);
+	if (!ov)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	bsim_scene s;
+	int rc = bsim_experiment_group_scene(e, 0, ov, n_ov, &s, err);
+	free(ov);
+	if (rc != BSIM_OK)
+		return rc;
+	*lattice = record_lattice(&s, cfg);
+	bsim_scene_free(&s);
+	return BSIM_OK;
+}
+
 int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config *cfg, size_t *size,
                                bsim_error *err)
 {
-	bsim_scene *scenes = NULL;
-	int rc = scenes_build(e, cfg, 0, &scenes, err);
+	int lattice;
+	int rc = records_lattice(e, cfg, &lattice, err);
+	if (rc == BSIM_OK)
+		*size = record_bytes(lattice, 1);
+	return rc;
+}
+
+int bsim_sweep_plan_for(const bsim_experiment *e, const bsim_sweep_config *cfg, size_t *size,
+                        bsim_scene **scenes, bsim_error *err)
+{
+	int rc = scenes_build(e, cfg, 0, scenes, err);
 	if (rc != BSIM_OK)
 		return rc;
-	*size = record_bytes(record_lattice(scenes, cfg), 1);
-	scenes_free(scenes, e->n_groups);
+	*size = record_bytes(record_lattice(*scenes, cfg), 1);
+	if (cfg->planned)
+		cfg->planned(cfg->planned_user, plan_beam_steps(e, *scenes));
 	return BSIM_OK;
+}
+
+void bsim_sweep_scenes_free(bsim_scene *scenes, int n_groups)
+{
+	if (scenes)
+		scenes_free(scenes, n_groups);
 }
 
 int bsim_sweep_record_size_sides_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                      int n_sides, size_t *size, bsim_error *err)
 {
+	int lattice;
 	int rc = sides_check(n_sides, err);
-	if (rc != BSIM_OK)
-		return rc;
-	bsim_scene *scenes = NULL;
-	rc = scenes_build(e, cfg, 0, &scenes, err);
-	if (rc != BSIM_OK)
-		return rc;
-	*size = record_bytes(record_lattice(scenes, cfg), n_sides);
-	scenes_free(scenes, e->n_groups);
-	return BSIM_OK;
+	if (rc == BSIM_OK)
+		rc = records_lattice(e, cfg, &lattice, err);
+	if (rc == BSIM_OK)
+		*size = record_bytes(lattice, n_sides);
+	return rc;
 }
 
 int bsim_sweep_record_size_paired_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
@@ -1164,7 +1221,7 @@ static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg, int 
 	if (rc == BSIM_OK && cfg->progress)
 		cfg->progress(cfg->progress_user, sh.progress_total, sh.progress_total);
 	if (scenes)
-		scenes_free(scenes, e->n_groups);
+		scenes_release(cfg, scenes, e->n_groups);
 	if (scenes_b)
 		scenes_free(scenes_b, e->n_groups);
 	for (size_t k = 0; logs && k < (size_t)n_sides * BSIM_SWEEP_BLOCK; k++)

@@ -29,7 +29,7 @@ static int survival_files(const char *dir, const bsim_experiment *e, const bsim_
                           int n_extra, const bsim_sweep_result *r, bsim_error *err)
 {
 	survival_acc a;
-	int rc = bsim_survival_acc_init(&a, e, extra, n_extra, err);
+	int rc = bsim_survival_acc_init(&a, e, NULL, extra, n_extra, err);
 	if (rc == BSIM_OK)
 		bsim_survival_acc_add(&a, 0, (long)r->n_groups * r->trials, r->trials,
 		                      r->trials_out);

@@ -30,8 +30,8 @@ double bsim_survival_exit_time(const bsim_trial_result *r)
 	return r->outcome == BSIM_TRAVERSED || r->outcome == BSIM_SIDE_EXIT ? r->t_end : NAN;
 }
 
-int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_override *sets,
-                           int n_sets, bsim_error *err)
+int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_scene *scenes,
+                           const bsim_override *sets, int n_sets, bsim_error *err)
 {
 	memset(a, 0, sizeof *a);
 	a->e = e;
@@ -45,13 +45,17 @@ int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim
 	                                      : (int)share;
 	for (int k = 0; k < e->n_groups; k++) {
 		bsim_scene s;
-		int rc = bsim_experiment_group_scene(e, k, sets, n_sets, &s, err);
-		if (rc != BSIM_OK)
-			return rc;
+		if (!scenes) {
+			int rc = bsim_experiment_group_scene(e, k, sets, n_sets, &s, err);
+			if (rc != BSIM_OK)
+				return rc;
+		}
+		const bsim_scene *sk = scenes ? &scenes[k] : &s;
 		survival_group *g = &a->g[k];
-		g->dt = s.dt;
-		g->max_steps = s.max_steps > 0 ? s.max_steps : 1;
-		bsim_scene_free(&s);
+		g->dt = sk->dt;
+		g->max_steps = sk->max_steps > 0 ? sk->max_steps : 1;
+		if (!scenes)
+			bsim_scene_free(&s);
 		g->width = (g->max_steps + cap - 1) / cap;
 		g->n_bins = (g->max_steps + g->width - 1) / g->width + 1;
 		g->count = calloc((size_t)g->n_bins * SURV_KINDS, sizeof *g->count);

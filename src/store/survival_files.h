@@ -44,11 +44,12 @@ typedef struct survival_acc {
 	survival_group *g;
 } survival_acc;
 
-/* Sets up the bins of every group of e (each group's scene with sets for
- * its dt and max_steps). BSIM_EFAIL out of memory; free with
+/* Sets up the bins of every group of e from its scene's dt and max_steps:
+ * scenes[k] (every group's, built with sets), or, scenes NULL, each group's
+ * scene built here with sets. BSIM_EFAIL out of memory; free with
  * bsim_survival_acc_free either way. */
-int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_override *sets,
-                           int n_sets, bsim_error *err);
+int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_scene *scenes,
+                           const bsim_override *sets, int n_sets, bsim_error *err);
 void bsim_survival_acc_free(survival_acc *a);
 
 /* Counts trials first .. first + n - 1 of a sweep of `trials` per group. */

@@ -91,19 +91,15 @@ static int trials_sink_take(void *user, const bsim_sweep_block *b, bsim_error *e
 	return BSIM_OK;
 }
 
-/* Opens the files in stage, headers written. */
+/* Opens the files in stage, headers written; scenes: every group's. */
 static int sink_open(trials_sink *s, const char *stage, const bsim_experiment *e,
-                     const bsim_override *sets, int n_sets, bsim_error *err)
+                     const bsim_scene *scenes, bsim_error *err)
 {
-	bsim_scene scene;
-	int rc = bsim_experiment_group_scene(e, 0, sets, n_sets, &scene, err);
-	if (rc != BSIM_OK)
-		return rc;
-	s->n_files = scene.has_lattice ? SINK_FILES : 1;
-	s->def = scene.lattice;
+	int rc;
+	s->n_files = scenes[0].has_lattice ? SINK_FILES : 1;
+	s->def = scenes[0].lattice;
 	s->trials = e->trials;
-	bsim_scene_free(&scene);
-	if ((rc = bsim_survival_acc_init(&s->surv, e, sets, n_sets, err)) != BSIM_OK)
+	if ((rc = bsim_survival_acc_init(&s->surv, e, scenes, NULL, 0, err)) != BSIM_OK)
 		return rc;
 	if (bsim_output_mkdir(stage, err) != BSIM_OK)
 		return BSIM_EFAIL;
@@ -180,62 +176,17 @@ static int sweep_part(const bsim_sweep_dir_def *def, const bsim_experiment *e, c
 	return bsim_part_dir_spread_run(&sp, inputs, ss, sweep_part_run, &c, err);
 }
 
-int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err)
+/* bsim_sweep_dir_run once planned (rc its status so far): the run of the
+ * sweep over cfg's lent scenes (cfg->scenes) into def->out, its files and
+ * run record. */
+static int sweep_dir_planned(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res,
+                             bsim_experiment *e, char *inputs, bsim_sweep_config *p_cfg,
+                             size_t size, int spread, double t0, const bsim_run_record *p_rec,
+                             int rc, bsim_error *err)
 {
-	double t0 = bsim_clock_seconds();
-	memset(res, 0, sizeof *res);
-	res->first_unstable = -1;
-	const bsim_backend *b = def->backend ? def->backend : bsim_backend_default();
-	if (bsim_options_check(&def->opts, b->knobs, b->n_knobs, b->name, err) != BSIM_OK)
-		return BSIM_EINPUT;
-	bsim_experiment *e = &res->e;
-	int rc = bsim_store_experiment(def->experiment, def->sets, def->n_sets, def->grid,
-	                               def->n_grid, def->trials, def->has_seed ? &def->seed : NULL,
-	                               e, err);
-	if (rc != BSIM_OK)
-		return rc;
-	if (def->hold_cell_bytes > 0 &&
-	    bsim_output_trials_fit(e, 0, def->hold_cell_bytes, err) != BSIM_OK) {
-		bsim_experiment_free(e);
-		return BSIM_EINPUT;
-	}
-	bsim_run_record rec;
-	const bsim_options *opts = &def->opts;
-	bsim_run_record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL);
-	char *inputs = bsim_run_record_inputs(&rec, e, def->sets, def->n_sets, err);
-	/* The overlap adds a column to every trial: a run measured so continues so. */
-	if (inputs && def->overlap) {
-		char *more = realloc(inputs, strlen(inputs) + sizeof "measure_overlap 1\n");
-		if (more)
-			strcat(more, "measure_overlap 1\n");
-		else
-			free(inputs);
-		inputs = more;
-		if (!inputs)
-			bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	}
-	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread;
-	rc = inputs ? BSIM_OK : err->code;
-	if (rc == BSIM_OK && def->n_merge > 0 && def->resume)
-		rc = bsim_error_set(err, BSIM_EINPUT, "merge: --resume does not apply");
-	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
-	bsim_sweep_config cfg = {
-	        .backend = b,
-	        .opts = &def->opts,
-	        .threads = res->threads,
-	        .extra = def->sets,
-	        .n_extra = def->n_sets,
-	        .progress = def->progress,
-	        .progress_user = def->progress_user,
-	        .measure_overlap = def->overlap,
-	        .keep = def->keep,
-	        .keep_stride = def->keep_stride,
-	        .stop = def->stop,
-	};
-	/* A lattice's records hold its trials' gate paths too. */
-	size_t size = bsim_sweep_record_size(0);
-	if (rc == BSIM_OK)
-		rc = bsim_sweep_record_size_for(e, &cfg, &size, err);
+	bsim_sweep_config cfg = *p_cfg;
+	const bsim_run_record rec = *p_rec;
+	const bsim_backend *b = cfg.backend;
 	if (rc == BSIM_OK && spread == BSIM_SPREAD_SEND) {
 		/* Another rank's: its records go to the gatherer; no directory. */
 		rc = sweep_part(def, e, inputs, &cfg, size, NULL, err);
@@ -283,7 +234,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	trials_sink sink = {0};
 	int opened = rc == BSIM_OK;
 	if (opened)
-		rc = sink_open(&sink, ss.stage, e, def->sets, def->n_sets, err);
+		rc = sink_open(&sink, ss.stage, e, cfg.scenes, err);
 	cfg.sink = trials_sink_take;
 	cfg.sink_user = &sink;
 	if (rc == BSIM_OK)
@@ -313,6 +264,73 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	return BSIM_OK;
 }
 
+int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res, bsim_error *err)
+{
+	double t0 = bsim_clock_seconds();
+	memset(res, 0, sizeof *res);
+	res->first_unstable = -1;
+	const bsim_backend *b = def->backend ? def->backend : bsim_backend_default();
+	if (bsim_options_check(&def->opts, b->knobs, b->n_knobs, b->name, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	bsim_experiment *e = &res->e;
+	int rc = bsim_store_experiment(def->experiment, def->sets, def->n_sets, def->grid,
+	                               def->n_grid, def->trials, def->has_seed ? &def->seed : NULL,
+	                               e, err);
+	if (rc != BSIM_OK)
+		return rc;
+	if (def->hold_cell_bytes > 0 &&
+	    bsim_output_trials_fit(e, 0, def->hold_cell_bytes, err) != BSIM_OK) {
+		bsim_experiment_free(e);
+		return BSIM_EINPUT;
+	}
+	bsim_run_record rec;
+	const bsim_options *opts = &def->opts;
+	bsim_run_record_fill(&rec, "sweep", e, 1, &b, &opts, NULL, NULL);
+	char *inputs = bsim_run_record_inputs(&rec, e, def->sets, def->n_sets, err);
+	/* The overlap adds a column to every trial: a run measured so continues so. */
+	if (inputs && def->overlap) {
+		char *more = realloc(inputs, strlen(inputs) + sizeof "measure_overlap 1\n");
+		if (more)
+			strcat(more, "measure_overlap 1\n");
+		else
+			free(inputs);
+		inputs = more;
+		if (!inputs)
+			bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	int spread = def->n_merge > 0 ? BSIM_SPREAD_NONE : def->spread;
+	rc = inputs ? BSIM_OK : err->code;
+	if (rc == BSIM_OK && def->n_merge > 0 && def->resume)
+		rc = bsim_error_set(err, BSIM_EINPUT, "merge: --resume does not apply");
+	res->threads = def->threads > 0 ? def->threads : omp_get_max_threads();
+	bsim_sweep_config cfg = {
+	        .backend = b,
+	        .opts = &def->opts,
+	        .threads = res->threads,
+	        .extra = def->sets,
+	        .n_extra = def->n_sets,
+	        .progress = def->progress,
+	        .progress_user = def->progress_user,
+	        .planned = def->planned,
+	        .planned_user = def->planned_user,
+	        .measure_overlap = def->overlap,
+	        .keep = def->keep,
+	        .keep_stride = def->keep_stride,
+	        .stop = def->stop,
+	};
+	/* A lattice's records hold its trials' gate paths too; the plan is
+	 * said before anything is opened. */
+	size_t size = bsim_sweep_record_size(0);
+	bsim_scene *scenes = NULL;
+	const int n_groups = e->n_groups;
+	if (rc == BSIM_OK)
+		rc = bsim_sweep_plan_for(e, &cfg, &size, &scenes, err);
+	cfg.scenes = scenes;
+	rc = sweep_dir_planned(def, res, e, inputs, &cfg, size, spread, t0, &rec, rc, err);
+	bsim_sweep_scenes_free(scenes, n_groups);
+	return rc;
+}
+
 int bsim_store_sweep_rerun(const bsim_sweep_dir_def *def, const bsim_experiment *e,
                            const char *stage, bsim_sweep_result *r, bsim_error *err)
 {
@@ -323,6 +341,8 @@ int bsim_store_sweep_rerun(const bsim_sweep_dir_def *def, const bsim_experiment 
 	        .threads = def->threads > 0 ? def->threads : omp_get_max_threads(),
 	        .progress = def->progress,
 	        .progress_user = def->progress_user,
+	        .planned = def->planned,
+	        .planned_user = def->planned_user,
 	};
 	int rc = bsim_sweep_run(e, &cfg, r, err);
 	if (rc != BSIM_OK)
