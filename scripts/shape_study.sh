@@ -55,8 +55,10 @@ colours = {"disk": "#1b6ca8", "capsule": "#c0392b", "ellipse": "#27ae60"}
 offset = {"disk": -0.12, "capsule": 0.0, "ellipse": 0.12}
 for model in ("held", "ou", "white"):
     for mu in (0, 0.3):
-        gp.append(f"set title 'random force {names[model]}, R_m 20 N; contact friction "
-                  f"{{/Symbol m}}_c = {mu}'")
+        # two lines: on one, the Ornstein-Uhlenbeck panel's title is wider
+        # than its half of the canvas and was cut at the edge
+        gp.append(f"set title \"random force {names[model]}, R_m 20 N\\n"
+                  f"contact friction {{/Symbol m}}_c = {mu}\"")
         plots = []
         for shape in ("disk", "capsule", "ellipse"):
             i = keys.index((model, mu, shape))

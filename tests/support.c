@@ -18,6 +18,7 @@
 #include "store/outdir.h"
 #include "util/yaml_doc.h"
 
+#include <cairo.h>
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -547,6 +548,54 @@ int bsim_test_await_glob(int pid, const char *pattern, long n, int *status)
 /* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
  * each over 1 kB and at most 1 MB; the number of figures, or -1 (said on
  * stderr) if one is missing or out of that range. */
+const char *bsim_test_png_edge(const char *path)
+{
+	static char why[128];
+	cairo_surface_t *img = cairo_image_surface_create_from_png(path);
+	if (cairo_surface_status(img) != CAIRO_STATUS_SUCCESS) {
+		snprintf(why, sizeof why, "unreadable (%s)",
+		         cairo_status_to_string(cairo_surface_status(img)));
+		cairo_surface_destroy(img);
+		return why;
+	}
+	cairo_surface_flush(img);
+	const int w = cairo_image_surface_get_width(img), h = cairo_image_surface_get_height(img);
+	const int stride = cairo_image_surface_get_stride(img);
+	const cairo_format_t fmt = cairo_image_surface_get_format(img);
+	const unsigned char *px = cairo_image_surface_get_data(img);
+	const int e = BSIM_TEST_EDGE_PX;
+	int side[4] = {0, 0, 0, 0}; /* left, right, top, bottom */
+	for (int y = 0; px && y < h; y++)
+		for (int x = 0; x < w; x++) {
+			if (x >= e && x < w - e && y >= e && y < h - e) {
+				x = w - e - 1; /* the row's inside: on to its right edge */
+				continue;
+			}
+			uint32_t p;
+			memcpy(&p, px + (size_t)y * (size_t)stride + 4 * (size_t)x, sizeof p);
+			/* ARGB32 (or RGB24, opaque): ink is a pixel not nearly
+			 * transparent and darker than the white background in any
+			 * channel (anti-aliased text edges included) */
+			const unsigned a = fmt == CAIRO_FORMAT_ARGB32 ? p >> 24 : 255;
+			const unsigned r = p >> 16 & 255, g = p >> 8 & 255, b = p & 255;
+			if (a <= 8 || (r >= 235 && g >= 235 && b >= 235))
+				continue;
+			side[0] |= x < e;
+			side[1] |= x >= w - e;
+			side[2] |= y < e;
+			side[3] |= y >= h - e;
+		}
+	cairo_surface_destroy(img);
+	static const char *const name[4] = {"left", "right", "top", "bottom"};
+	size_t k = 0;
+	why[0] = '\0';
+	for (int i = 0; i < 4; i++)
+		if (side[i])
+			k += (size_t)snprintf(why + k, sizeof why - k, "%s%s", k ? ", " : "",
+			                      name[i]);
+	return k ? why : NULL;
+}
+
 int bsim_test_check_figures(const char *dir)
 {
 	DIR *d = opendir(dir);
@@ -573,6 +622,15 @@ int bsim_test_check_figures(const char *dir)
 			} else if (st.st_size <= 1000 || st.st_size > 1000000) {
 				fprintf(stderr, "%s: %ld bytes\n", path, (long)st.st_size);
 				bad = 1;
+			} else if (i == 0) {
+				const char *edge = bsim_test_png_edge(path);
+				if (edge) {
+					fprintf(stderr,
+					        "%s: drawn within %d pixels of its edge (%s): a "
+					        "title, label or key cut off by the canvas\n",
+					        path, BSIM_TEST_EDGE_PX, edge);
+					bad = 1;
+				}
 			}
 		}
 	}

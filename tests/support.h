@@ -138,9 +138,21 @@ int bsim_test_count_lines(const char *text);
 const char *bsim_test_src(const char *rel);
 
 /* Every NAME.gp in dir has NAME.png and NAME.svg (when gnuplot is there),
- * each over 1 kB and at most 1 MB; the number of figures, or -1 (said on
- * stderr) if one is missing or out of that range. */
+ * each over 1 kB and at most 1 MB, and the PNG nothing drawn in its
+ * outermost BSIM_TEST_EDGE_PX pixels (bsim_test_png_edge); the number of
+ * figures, or -1 (said on stderr, naming the file) if one is missing, out
+ * of that range or drawn to its edge. */
 int bsim_test_check_figures(const char *dir);
+
+/* The outermost pixel columns and rows a figure leaves blank: text cut off
+ * by the canvas (a title or label wider than the image) or a key placed
+ * beyond it reaches the edge. */
+#define BSIM_TEST_EDGE_PX 3
+
+/* NULL if the PNG at path has only background (white or transparent)
+ * within BSIM_TEST_EDGE_PX pixels of its edges; else the sides that have
+ * more ("left, right"), or why it could not be read (a static buffer). */
+const char *bsim_test_png_edge(const char *path);
 
 /* The number after "key": in JSON text (the first such key from text on);
  * aborts the test if there is none. */

@@ -115,34 +115,76 @@ static void check_landscape_script(const char *gp, const char *const needles[])
 			fail_msg("'%s' not in the title %s", needles[i], t);
 }
 
-/* Rows of a landscape's NAME.surface.dat: x y E_total E_drawn E_3d. E_total
+/* Rows of a landscape's NAME.surface.dat: x y E_total E_drawn. E_total
  * must be f(x, y) (the model, written here again); E_drawn is E_total cut
- * at one level, and the 3-D surface is NaN wherever the map is cut and
- * E_total where it is drawn. The count of rows. */
-static int check_surface(const char *path, double (*f)(double x, double y))
+ * at one level, *cap. The count of rows. */
+static int check_surface(const char *path, double (*f)(double x, double y), double *cap)
 {
 	FILE *in = fopen(path, "r");
 	assert_non_null(in);
 	char line[256];
 	int n = 0, cut = 0;
+	*cap = -INFINITY;
 	while (fgets(line, sizeof line, in)) {
 		if (line[0] == '#' || line[0] == '\n')
 			continue;
 		double x, y, e, d;
-		char e3[64];
-		assert_int_equal(sscanf(line, "%lf %lf %lf %lf %63s", &x, &y, &e, &d, e3), 5);
+		assert_int_equal(sscanf(line, "%lf %lf %lf %lf", &x, &y, &e, &d), 4);
 		const double want = f(x, y);
 		assert_true(fabs(e - want) <= 1e-4 * fmax(1.0, fabs(want)));
-		if (d < e) {
-			assert_string_equal(e3, "NaN");
-			cut++;
-		} else if (strcmp(e3, "NaN") != 0)
-			assert_true(fabs(strtod(e3, NULL) - e) <= 1e-4 * fmax(1.0, fabs(e)));
+		assert_true(d <= e);
+		cut += d < e;
+		*cap = fmax(*cap, d);
 		n++;
 	}
 	fclose(in);
 	assert_true(cut > 0); /* near the pivots */
 	return n;
+}
+
+/* The 3-D surface NAME.mesh.dat: pm3d quadrangles (two scans of two
+ * points, then a scan of NaN), every vertex a point of the landscape f at
+ * or below the cap and outside the pivots' disks (rho >= R = 10 m about
+ * (+-25, 30), less the sagitta of a polygon's chord of a disk, under 1 cm). A vertex within 1 mm of
+ * a rim of reach (rho = L + R = 35 m) may carry the other side's value of the step, and one within
+ * 1 mm of a pivot's disk lies where th's slope is infinite, as its coordinates are printed to 7
+ * digits: those are left out. Vertices near the rims and the cap there are (the surface ends along
+ * them, not a grid cell away). */
+static void check_mesh(const char *path, double (*f)(double x, double y), double cap)
+{
+	FILE *in = fopen(path, "r");
+	assert_non_null(in);
+	char line[256];
+	int n = 0, nan_rows = 0, near_rim = 0, near_cap = 0;
+	while (fgets(line, sizeof line, in)) {
+		if (line[0] == '#' || line[0] == '\n')
+			continue;
+		double x, y, e;
+		assert_int_equal(sscanf(line, "%lf %lf %lf", &x, &y, &e), 3);
+		if (isnan(e)) {
+			nan_rows++;
+			continue;
+		}
+		n++;
+		const double r1 = hypot(x + 25, y - 30), r2 = hypot(x - 25, y - 30);
+		/* a vertex on a chord of a disk, within it by the chord's sagitta */
+		assert_true(r1 >= 10 - 1e-2 && r2 >= 10 - 1e-2);
+		assert_true(e <= cap * (1 + 1e-5) + 1e-5);
+		near_cap += fabs(e - cap) < 1e-3 * fmax(1.0, fabs(cap));
+		if (fabs(r1 - 35) < 1e-3 || fabs(r2 - 35) < 1e-3) {
+			near_rim++;
+			continue;
+		}
+		if (fabs(r1 - 10) < 1e-3 || fabs(r2 - 10) < 1e-3)
+			continue; /* th's slope is infinite at the pivot's disk */
+		const double want = f(x, y);
+		if (fabs(e - want) > 1e-4 * fmax(1.0, fabs(want)))
+			fail_msg("%s: (%g, %g): E %g, the landscape %g", path, x, y, e, want);
+	}
+	fclose(in);
+	print_message("%s: %d vertices, %d on a rim, %d at the cap\n", path, n, near_rim, near_cap);
+	assert_int_equal(nan_rows, n / 2); /* a scan of NaN after each quadrangle's two */
+	assert_true(n > 1000 && near_rim > 10 && near_cap > 10);
 }
 
 /* E_total of the gate at F_prop = 9 N (k = 400 N m/rad each), of beam 2
@@ -363,7 +405,10 @@ static void test_paths_over_landscape(void **state)
 	assert_true(nb >= below);
 	/* the surface is the model's; the script's colours and title */
 	snprintf(path, sizeof path, "%s/landscape_g003.surface.dat", dir);
-	assert_true(check_surface(path, e_gate_f9) > 1000);
+	double cap;
+	assert_true(check_surface(path, e_gate_f9, &cap) > 1000);
+	snprintf(path, sizeof path, "%s/landscape_g003.mesh.dat", dir);
+	check_mesh(path, e_gate_f9, cap);
 	snprintf(path, sizeof path, "%s/landscape_g003.gp", dir);
 	char *gp = bsim_test_read(path);
 	assert_non_null(gp);
@@ -376,7 +421,7 @@ static void test_paths_over_landscape(void **state)
  * the backend and the --set values, and landscape_path_single, the path
  * over beam 2's landscape alone (Fig. 2.7c), its surface F_prop (60 - y) +
  * 1/2 k th_2^2 and fewer of its states below it than below the whole
- * landscape; all five files of both figures in the manifest. */
+ * landscape; all six files of both figures in the manifest. */
 static void test_fig27(void **state)
 {
 	(void)state;
@@ -406,7 +451,10 @@ static void test_fig27(void **state)
 		free(gp);
 	}
 	snprintf(path, sizeof path, "%s/landscape_path_single.surface.dat", dir);
-	check_surface(path, e_beam2_f6);
+	double cap;
+	check_surface(path, e_beam2_f6, &cap);
+	snprintf(path, sizeof path, "%s/landscape_path_single.mesh.dat", dir);
+	check_mesh(path, e_beam2_f6, cap);
 	static double rows[20000][16];
 	snprintf(path, sizeof path, "%s/landscape_path.dat", dir);
 	const int below = bsim_test_data_rows(path, 1, rows, 20000);
@@ -417,9 +465,9 @@ static void test_fig27(void **state)
 	snprintf(path, sizeof path, "%s/manifest.json", dir);
 	char *manifest = bsim_test_read(path);
 	assert_non_null(manifest);
-	const char *ext[] = {"gp", "png", "svg", "dat", "surface.dat"};
+	const char *ext[] = {"gp", "png", "svg", "dat", "surface.dat", "mesh.dat"};
 	for (int i = 0; i < 2; i++)
-		for (int k = 0; k < 5; k++) {
+		for (int k = 0; k < 6; k++) {
 			char want[100];
 			snprintf(want, sizeof want, "\"%s.%s\"", names[i], ext[k]);
 			if (!strstr(manifest, want))
@@ -737,6 +785,45 @@ static void test_without_gnuplot(void **state)
 	assert_null(bsim_test_read(path));
 }
 
+/* ---- the edge check ------------------------------------------------------------------- */
+
+/* bsim_test_check_figures' edge check against figures made to fail it: a
+ * title three times wider than its 400-pixel canvas runs off both sides,
+ * the same title wrapped in lines fits, and so does a short one. */
+static void test_edge_check(void **state)
+{
+	(void)state;
+	if (!bsim_figure_available())
+		skip();
+	const char *dir = bsim_test_dir("edge");
+	static const char *const body[] = {
+	        "set title 'a title of a hundred and fifty characters, three times as wide as the "
+	        "canvas of four hundred pixels that gnuplot centres on it and cuts at both ends'\n"
+	        "plot x\n",
+	        "set title \"a title of a hundred and fifty characters,\\nthree times as wide "
+	        "as the canvas\\nof four hundred pixels that gnuplot\\ncentres on it and cuts "
+	        "at both ends\"\nplot x\n",
+	        "set title 'short'\nplot x\n"};
+	for (int i = 0; i < 3; i++) {
+		char name[16], png[1200];
+		snprintf(name, sizeof name, "edge%d", i);
+		bsim_figure_def d = bsim_figure_def_default();
+		d.dir = dir;
+		d.name = name;
+		d.width = 400;
+		d.height = 300;
+		assert_int_equal(bsim_figure_render(&d, body[i], NULL, NULL), BSIM_OK);
+		snprintf(png, sizeof png, "%s/%s.png", dir, name);
+		const char *edge = bsim_test_png_edge(png);
+		print_message("%s: %s\n", name, edge ? edge : "clear of the edges");
+		if (i == 0)
+			assert_string_equal(edge, "left, right");
+		else
+			assert_null(edge);
+	}
+	assert_int_equal(bsim_test_check_figures(dir), -1); /* edge0 */
+}
+
 /* ---- gnuplot failing ------------------------------------------------------------------- */
 
 /* A gnuplot that fails on one figure of a run's directory (and draws the
@@ -796,6 +883,7 @@ int main(void)
 	        cmocka_unit_test(test_without_gnuplot),
 	        cmocka_unit_test(test_fig27),
 	        cmocka_unit_test(test_gnuplot_fails),
+	        cmocka_unit_test(test_edge_check),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

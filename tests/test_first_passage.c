@@ -143,6 +143,7 @@ static void test_plot_and_escape(void **state)
 	const char *plot[] = {"plot", d12, NULL};
 	assert_int_equal(bsim_test_cli(plot, NULL, NULL), 0);
 	assert_true(bsim_test_exists(bsim_test_join(d12, "survival.gp")));
+	assert_true(bsim_test_check_figures(d12) >= 1);
 	char *out = strdup(bsim_test_join(bsim_test_dir("first_passage_escape"), "esc"));
 	char *o = NULL;
 	const char *esc[] = {"escape", d24, "--out", out, NULL};
@@ -156,6 +157,7 @@ static void test_plot_and_escape(void **state)
 	assert_non_null(strstr(csv, "group,barrier,above_start,kind,noise"));
 	free(csv);
 	assert_true(bsim_test_exists(bsim_test_join(out, "kramers.json")));
+	assert_true(bsim_test_check_figures(out) >= 0); /* kramers, when drawn */
 	char *js = bsim_test_read(bsim_test_join(out, "kramers.json"));
 	assert_non_null(strstr(js, "\"verdict\": null"));
 	free(js);

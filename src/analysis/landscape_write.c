@@ -4,14 +4,15 @@
  * without and with the propulsive term (Fig. 2.6a, b; d is the same for
  * an asymmetric gate).
  *
- * The figures read gnuplot "nonuniform matrix" files (first row: the
- * count and the x of each column; then per row its y and the values):
- * the top view at the grid's full resolution, the surfaces subsampled to
- * at most SURFACE_QUADS quadrangles, so that an SVG of pm3d quadrangles
- * stays under 1 MB. Points where the body cannot be (overlapping a pivot)
- * are drawn as walls at the clip level. Colours and heights are clipped a
- * little above the highest pass, so that the barriers, not the walls
- * beside the pivots, set the scale; the titles say where. */
+ * The top view reads a gnuplot "nonuniform matrix" file (first row: the
+ * count and the x of each column; then per row its y and the values) at
+ * the grid's full resolution; points where the body cannot be (overlapping
+ * a pivot) are drawn as walls at the clip level. The surfaces are polygons
+ * that end along the landscape's steps (figures/figures_surface.h), at
+ * most SURFACE_POLYGONS, so that an SVG of them stays under 1 MB. Colours
+ * and heights are clipped a little above the highest pass, so that the
+ * barriers, not the walls beside the pivots, set the scale; the titles say
+ * where. */
 #define _POSIX_C_SOURCE 200809L
 #include "beamsim/landscape.h"
 #include "beamsim/landscape_barriers.h"
@@ -24,14 +25,15 @@
 #include "util/atomic_file.h"
 #include "util/json.h"
 #include "util/figure.h"
+#include "figures/figures_surface.h"
 #include "beamsim/key_names.h"
 #include "store/mat.h"
 #include "beamsim/limits.h"
 
-/* Most quadrangles of a 3-D surface: an SVG spends about 120 bytes on
- * each (a lit fill, no mesh lines, which would triple it), so 4000 keep
- * it under 0.5 MB. */
-enum { SURFACE_QUADS = 2000 };
+/* Most polygons of a 3-D surface: an SVG spends about 100 bytes on each (a
+ * lit fill, no mesh lines, which would triple it), so 5000 keep it under
+ * 0.6 MB. */
+enum { SURFACE_POLYGONS = 5000 };
 
 /* dir/name into buf. */
 static int file_path(char *buf, size_t size, const char *dir, const char *name, bsim_error *err)
@@ -607,109 +609,46 @@ static int figure_top(const char *dir, const bsim_scene *s, const bsim_landscape
 	return BSIM_OK;
 }
 
-/* The surface as drawn: every stride-th point of v (the last row and
- * column always in), NaN where it is not drawn. gnuplot's pm3d leaves out
- * each quadrangle with a NaN corner, so a NaN point cuts the surface there:
- * - where the body cannot be (overlapping a pivot) and above the clip level
- *   (near a pivot th(x, y) nears pi and E thousands of joules);
- * - at a cliff, the step of the landscape at the rim of a beam's reach
- *   (rho = L + R, docs/model.md section 7): between neighbours that differ by
- *   more than CLIFF_SHARE of the drawn range and by more than CLIFF_RATIO
- *   times the steps on either side, the higher one. Drawn, a step is one
- *   quadrangle standing upright, which no lighting makes legible. */
-#define CLIFF_SHARE 0.12
-#define CLIFF_RATIO 3.0
-
-static int next_index(int i, int stride, int n)
-{
-	return i + stride < n || i == n - 1 ? i + stride : n - 1;
-}
-
+/* The surface as drawn (figures/figures_surface.h): polygons of E up to the
+ * clip level that end along the landscape's steps (the rim of each beam's
+ * reach, rho = L + R, docs/model.md section 7), the pivots and the clip
+ * level, finer where the surface bends. A step drawn as part of the
+ * surface would stand upright and hide what lies behind it. */
 static int write_surface(const char *dir, const char *file, const bsim_scene *s,
-                         const bsim_landscape_grid *g, const double *v, int stride, double e_min,
-                         double clip, bsim_error *err)
+                         const bsim_landscape_grid *g, int beam_only, double e_min, double clip,
+                         long *polygons, bsim_error *err)
 {
-	int ni = 0, nj = 0;
-	for (int i = 0; i < g->nx; i = next_index(i, stride, g->nx))
-		ni++;
-	for (int j = 0; j < g->ny; j = next_index(j, stride, g->ny))
-		nj++;
-	double *xs = malloc((size_t)ni * sizeof *xs), *ys = malloc((size_t)nj * sizeof *ys);
-	double *w = malloc((size_t)ni * (size_t)nj * sizeof *w);
-	unsigned char *cut = calloc((size_t)ni * (size_t)nj, 1);
-	if (!xs || !ys || !w || !cut) {
-		free(xs);
-		free(ys);
-		free(w);
-		free(cut);
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	}
-	int a = 0;
-	for (int i = 0; i < g->nx; i = next_index(i, stride, g->nx))
-		xs[a++] = g->x0 + i * g->spacing;
-	a = 0;
-	for (int j = 0; j < g->ny; j = next_index(j, stride, g->ny)) {
-		ys[a] = g->y0 + j * g->spacing;
-		int b = 0;
-		for (int i = 0; i < g->nx; i = next_index(i, stride, g->nx)) {
-			const double e = v[(size_t)j * (size_t)g->nx + (size_t)i];
-			w[(size_t)a * (size_t)ni + (size_t)b] =
-			        on_pivot(s, xs[b], ys[a]) || e > clip ? NAN : e;
-			b++;
-		}
-		a++;
-	}
-	/* cliffs along x (di = 1) and along y (di = ni) */
-	const double big = CLIFF_SHARE * (clip - e_min);
-	for (int dir_y = 0; dir_y < 2; dir_y++) {
-		const int outer = dir_y ? ni : nj, inner = dir_y ? nj : ni;
-		for (int o = 0; o < outer; o++)
-			for (int k = 0; k + 1 < inner; k++) {
-				size_t p0 = dir_y ? (size_t)k * (size_t)ni + (size_t)o
-				                  : (size_t)o * (size_t)ni + (size_t)k;
-				const size_t step = dir_y ? (size_t)ni : 1;
-				const double d = w[p0 + step] - w[p0];
-				if (!(fabs(d) > big))
-					continue;
-				const double before = k > 0 ? fabs(w[p0] - w[p0 - step]) : 0.0;
-				const double after =
-				        k + 2 < inner ? fabs(w[p0 + 2 * step] - w[p0 + step]) : 0.0;
-				if (fabs(d) > CLIFF_RATIO * fmax(isnan(before) ? 0 : before,
-				                                 isnan(after) ? 0 : after))
-					cut[d > 0 ? p0 + step : p0] = 1;
-			}
-	}
 	char path[BSIM_PATH_MAX];
 	int rc = file_path(path, sizeof path, dir, file, err);
 	bsim_atomic_file o;
 	if (!rc)
 		rc = bsim_atomic_file_open(&o, path, err);
-	if (!rc) {
-		/* gnuplot's grid format (a row of x per block), which takes NaN
-		 * without the warning a matrix gives */
-		fputs("# x y (m), E (J) as drawn: NaN where the surface is cut\n", o.f);
-		for (int j = 0; j < nj; j++) {
-			for (int i = 0; i < ni; i++) {
-				const size_t k = (size_t)j * (size_t)ni + (size_t)i;
-				if (cut[k] || isnan(w[k]))
-					fprintf(o.f, "%.8g %.8g NaN\n", xs[i], ys[j]);
-				else
-					fprintf(o.f, "%.8g %.8g %.6g\n", xs[i], ys[j], w[k]);
-			}
-			fputc('\n', o.f);
-		}
-		rc = bsim_atomic_file_commit(&o, err);
+	if (rc)
+		return rc;
+	fputs("# x y (m), E (J): the surface up to the clip level as polygons, each two "
+	      "scans of two\n# points (gnuplot pm3d), cut along the steps, the pivots and the "
+	      "clip level\n",
+	      o.f);
+	const fsurface d = {.region = {g->region[0], g->region[1], g->region[2], g->region[3]},
+	                    .cap = clip,
+	                    .e_min = e_min,
+	                    .beam_only = beam_only,
+	                    .max_polygons = SURFACE_POLYGONS};
+	rc = bsim_fsurface_write(o.f, s, &d, polygons, err);
+	if (!rc && *polygons == 0) /* gnuplot needs a point in a file it plots */
+		fputs("NaN NaN NaN\n", o.f);
+	if (rc) {
+		bsim_atomic_file_abort(&o);
+		return rc;
 	}
-	free(xs);
-	free(ys);
-	free(w);
-	free(cut);
-	return rc;
+	return bsim_atomic_file_commit(&o, err);
 }
 
 /* A 3-D surface of v (E_beam or E_total) with the passes marked (essay
  * Fig. 2.6a, b, d), in the landscapes' colours with a colour bar, seen
- * from the start's side. */
+ * from the start's side a little to the left, so that both passes show
+ * between the barriers. Lit without a specular highlight, which turned the
+ * small polygons along the steps facing the light into white slivers. */
 static int figure_surface(const char *dir, const char *name, const bsim_scene *s,
                           const bsim_landscape_grid *g, const bsim_landscape_barriers *br,
                           const double *v, int beam_only, bsim_figure_def *def, char **out,
@@ -717,13 +656,10 @@ static int figure_surface(const char *dir, const char *name, const bsim_scene *s
 {
 	char data[64];
 	snprintf(data, sizeof data, "%s.dat", name);
-	int stride = 1;
-	while ((double)((g->nx + stride - 1) / stride) * ((g->ny + stride - 1) / stride) >
-	       SURFACE_QUADS)
-		stride++;
 	const double e_min = grid_min(s, g, v);
 	const double clip = clip_level(g, br, v, e_min, beam_only);
-	int rc = write_surface(dir, data, s, g, v, stride, e_min, clip, err);
+	long polygons;
+	int rc = write_surface(dir, data, s, g, beam_only, e_min, clip, &polygons, err);
 	if (rc)
 		return rc;
 	char what[320];
@@ -746,8 +682,8 @@ static int figure_surface(const char *dir, const char *name, const bsim_scene *s
 	        "set cbrange [%.6g:%.6g]\nset zrange [%.6g:%.6g]\n"
 	        "set colorbox vertical user origin 0.88,0.2 size 0.025,0.55\n"
 	        "set cblabel '%s'\n"
-	        "set view 58,300,1,1.05\nset xyplane 0\nset hidden3d\n"
-	        "set pm3d depthorder interpolate 2,2 lighting primary 0.5 specular 0.15\n"
+	        "set view 50,330,1,1.05\nset xyplane relative 0.1\n"
+	        "set pm3d depthorder lighting primary 0.5 specular 0\n"
 	        "set grid\nset style textbox opaque fc rgb 'white' noborder\n"
 	        "set rmargin at screen 0.84\n",
 	        beam_only ? "E_{beam}" : "E_{total}", e_min, clip, e_min, clip,

@@ -3,7 +3,7 @@
  * ends as a row above the last row and the sides as a column beside the
  * field, the value of every cell of at least 0.5% written in it. Panels
  * side by side: probabilities (predicted, simulated) on one scale, their
- * differences on a diverging one. */
+ * differences on a diverging one, the colour bars in % as the cells. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <math.h>
@@ -167,22 +167,21 @@ int bsim_markov_field_figure(const char *stage, const char *name, const char *ti
 				tot[j] -= t2[j];
 			fprintf(f,
 			        "set palette defined (-1 '#B2182B', 0 '#F7F7F7', 1 '#2166AC')\n"
-			        "set cbrange [%g:%g]\nset cblabel 'difference (in the cells: %% "
-			        "points)'\n"
+			        "set cbrange [%g:%g]\nset cblabel 'difference (%% points)'\n"
 			        "set title \"%s\\nend %+.1f%%, side %+.1f%%, stuck %+.1f%%\" "
 			        "noenhanced\n",
-			        -fmax(dmax, 1e-3), fmax(dmax, 1e-3), panel[k].title, 100 * tot[0],
-			        100 * tot[1], 100 * tot[2]);
+			        -100 * fmax(dmax, 1e-3), 100 * fmax(dmax, 1e-3), panel[k].title,
+			        100 * tot[0], 100 * tot[1], 100 * tot[2]);
 		} else
 			fprintf(f,
 			        "set palette defined (0 '#FFFFFF', 0.5 '#9ECAE1', 1 '#3182BD')\n"
-			        "set cbrange [0:%g]\nset cblabel 'probability (in the cells: %%)'\n"
+			        "set cbrange [0:%g]\nset cblabel 'probability (%%)'\n"
 			        "set title \"%s\\nend %.1f%%, side %.1f%%, stuck %.1f%%\" "
 			        "noenhanced\n",
-			        fmax(vmax, 1e-3), panel[k].title, 100 * tot[0], 100 * tot[1],
+			        100 * fmax(vmax, 1e-3), panel[k].title, 100 * tot[0], 100 * tot[1],
 			        100 * tot[2]);
 		fprintf(f,
-		        "plot '%s.dat' index %d using 1:2:(%g):(%g):3 with boxxyerror "
+		        "plot '%s.dat' index %d using 1:2:(%g):(%g):(100 * $3) with boxxyerror "
 		        "fc palette, \\\n"
 		        "     '' index %d using 1:2:5 with labels font ',8' tc rgb 'black'\n",
 		        name, k, CELL_HALF, CELL_HALF, k);

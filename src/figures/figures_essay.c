@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "figures/figures_kinds.h"
+#include "util/figure.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
 #include "beamsim/limits.h"
@@ -107,22 +108,36 @@ int bsim_figs_essay(figs *f, const char *dir, bsim_error *err)
 	        "20) "
 	        "and beamsim''s%s%s%s, 95%% intervals' noenhanced\n",
 	        *backend ? " (" : "", backend, *backend ? " backend)" : "");
-	fputs(""
-	      "set ylabel 'probability'\nset yrange [-0.02:1.05]\nset grid ytics\n"
-	      "set key outside top center horizontal maxcols 2 noenhanced\nset bmargin 12\n"
-	      "set xtics rotate by 60 right font ',8' noenhanced (",
-	      g.f);
-	int x = 0;
-	for (int r = 0; r < t.n_rows && n_modes > 0; r++) {
-		if (strcmp(bsim_csv_table_cell(&t, r, col[3]), "level") != 0 ||
-		    strcmp(bsim_csv_table_cell(&t, r, col[2]), modes[0]) != 0)
-			continue;
-		char label[160];
-		snprintf(label, sizeof label, "%s %s", bsim_csv_table_cell(&t, r, col[0]),
-		         bsim_csv_table_cell(&t, r, col[1]));
-		fputs(x ? ", " : "", g.f);
-		bsim_gp_str(g.f, label);
-		fprintf(g.f, " %d", x++);
+	/* the levels' names, turned by 60 degrees at 8 pt under the axis: the
+	 * bottom margin (in lines of the 11 pt font, about 17 pixels) holds the
+	 * longest, and the axis label line under it */
+	int longest = 0;
+	for (int pass = 0; pass < 2; pass++) {
+		if (pass == 1)
+			fprintf(g.f,
+			        "set ylabel 'probability'\nset yrange [-0.02:1.05]\n"
+			        "set grid ytics\n"
+			        "set key outside top center horizontal maxcols 2 noenhanced\n"
+			        "set bmargin %d\n"
+			        "set xtics rotate by 60 right font ',8' noenhanced (",
+			        (int)(longest * 0.87 / 17.0) + 3);
+		int x = 0;
+		for (int r = 0; r < t.n_rows && n_modes > 0; r++) {
+			if (strcmp(bsim_csv_table_cell(&t, r, col[3]), "level") != 0 ||
+			    strcmp(bsim_csv_table_cell(&t, r, col[2]), modes[0]) != 0)
+				continue;
+			char label[160];
+			snprintf(label, sizeof label, "%s %s", bsim_csv_table_cell(&t, r, col[0]),
+			         bsim_csv_table_cell(&t, r, col[1]));
+			const int px = bsim_figure_text_px(label, 8);
+			longest = px > longest ? px : longest;
+			if (pass == 1) {
+				fputs(x ? ", " : "", g.f);
+				bsim_gp_str(g.f, label);
+				fprintf(g.f, " %d", x);
+			}
+			x++;
+		}
 	}
 	fprintf(g.f, ")\nset xrange [-0.7:%g]\nplot ", n_levels - 0.3);
 	for (int k = 0; k < n_modes; k++) {

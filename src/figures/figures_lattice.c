@@ -44,6 +44,7 @@
 #include "figures/figures_summary.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
+#include "util/figure.h"
 #include "beamsim/limits.h"
 
 /* ---- the data of a lattice run -------------------------------------------------------- */
@@ -513,14 +514,18 @@ static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
 		k_max += 1.0;
 	}
 	const int ends = sum_ints(a->end, a->cols);
-	char title[1800];
+	/* the map alone, without kept trajectories, is one panel, narrower: its
+	 * title is broken into lines that fit it */
+	const int width = n > 0 ? 1400 : 760;
+	char title[1800], wrapped[1900];
 	snprintf(title, sizeof title,
 	         "group %d: %d of %d trials reached the end (%.0f%%)\n%s\n"
 	         "each gate's left and right half coloured by the stiffness of the beam that "
 	         "sweeps it; gate columns i_x on top, rows i_y on the right",
 	         gi, ends, a->trials, a->trials ? 100.0 * ends / a->trials : 0.0, label);
+	bsim_figure_wrap(title, 11, width - 40, wrapped, sizeof wrapped);
 	fprintf(s, "set multiplot layout 1,%d title ", n > 0 ? 2 : 1);
-	bsim_gp_str(s, title);
+	bsim_gp_str(s, wrapped);
 	fprintf(s,
 	        " noenhanced\nset size ratio -1\nset xrange [%g:%g]\nset yrange [%g:%g]\n"
 	        "set cbrange [%.10g:%.10g]\nset cblabel 'k (N m/rad)'\nset style fill solid 1.0 "
@@ -529,18 +534,19 @@ static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
 	gate_marks(s, a, sc, box);
 	stiffness_palette(s, 0.0);
 	fprintf(s,
-	        "set title '(a) the stiffness map'\n"
+	        "set title '%sthe stiffness map'\n"
 	        "plot '%s' index 0 using (($1+$2)/2):(($3+$4)/2):(($2-$1)/2):(($4-$3)/2):5 with "
 	        "boxxyerror fc palette, \\\n"
 	        "     '' index 1 using 1:2:3:4 with vectors nohead lw 2 lc rgb '%s', \\\n"
 	        "     '+' using (%g):(%g):(%g) every ::0::0 with circles fs empty lc rgb '%s' lw "
 	        "1.5\n",
-	        file, FIG_GREY, sc->body.start[0], sc->body.start[1], sc->body.radius, FIG_BLACK);
+	        n > 0 ? "(a) " : "", file, FIG_GREY, sc->body.start[0], sc->body.start[1],
+	        sc->body.radius, FIG_BLACK);
 	if (n > 0) {
 		fprintf(s,
-		        "set title '(b) the first %d trajectories'\nunset colorbox\n"
-		        "set key below horizontal\n",
-		        n);
+		        "set title '(b) the paths of the first %d of the %d trials'\n"
+		        "unset colorbox\nset key below horizontal\n",
+		        n, a->trials);
 		stiffness_palette(s, 0.7);
 		fprintf(s,
 		        "plot '%s' index 0 using (($1+$2)/2):(($3+$4)/2):(($2-$1)/2):(($4-$3)/2):5 "
@@ -555,7 +561,7 @@ static int lattice_map_figure(figs *f, int gi, const char *label, const flat *a,
 	}
 	fputs("unset multiplot\n", s);
 	char *body = bsim_gp_text_take(&g);
-	rc = body ? bsim_figs_render(f, name, n > 0 ? 1400 : 760, 860, body, err)
+	rc = body ? bsim_figs_render(f, name, width, 860, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	free(body);
 	return rc;

@@ -19,6 +19,7 @@
 
 #include "beamsim/landscape.h"
 #include "figures/figures_paths.h"
+#include "figures/figures_surface.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
 #include "beamsim/limits.h"
@@ -322,65 +323,26 @@ int bsim_figs_bundle(figs *f, const char *name, const char *title, const bsim_sc
 
 /* ---- Figs. 2.7 and 3.3: over the landscape ------------------------------------------- */
 
-/* Cuts a step of the landscape out of the 3-D surface: between two
- * neighbours that differ by more than CLIFF_SHARE of the drawn range and by
- * more than CLIFF_RATIO times the steps on either side (the rim of a
- * beam's reach, rho = L + R), the higher one becomes NaN, and pm3d leaves
- * out the quadrangles around it. Drawn, a step is an upright quadrangle
- * that hides what is behind it. */
-#define CLIFF_SHARE 0.12
-#define CLIFF_RATIO 3.0
+/* Polygons of the 3-D surface: about 110 bytes of SVG each, so that with
+ * the map and a hundred paths the SVG stays under 1 MB. */
+#define SURFACE_POLYGONS 3500
 
-static void cut_steps(double *w, int nx, int ny, double range)
-{
-	unsigned char *cut = calloc((size_t)nx * (size_t)ny, 1);
-	if (!cut)
-		return; /* drawn uncut */
-	for (int along_y = 0; along_y < 2; along_y++) {
-		const int outer = along_y ? nx : ny, inner = along_y ? ny : nx;
-		const size_t step = along_y ? (size_t)nx : 1;
-		for (int o = 0; o < outer; o++)
-			for (int k = 0; k + 1 < inner; k++) {
-				const size_t p0 = along_y ? (size_t)k * (size_t)nx + (size_t)o
-				                          : (size_t)o * (size_t)nx + (size_t)k;
-				const double d = w[p0 + step] - w[p0];
-				if (!(fabs(d) > CLIFF_SHARE * range))
-					continue;
-				double before = k > 0 ? fabs(w[p0] - w[p0 - step]) : 0.0;
-				double after =
-				        k + 2 < inner ? fabs(w[p0 + 2 * step] - w[p0 + step]) : 0.0;
-				before = isnan(before) ? 0.0 : before;
-				after = isnan(after) ? 0.0 : after;
-				if (fabs(d) > CLIFF_RATIO * fmax(before, after))
-					cut[d > 0 ? p0 + step : p0] = 1;
-			}
-	}
-	for (size_t k = 0; k < (size_t)nx * (size_t)ny; k++)
-		if (cut[k])
-			w[k] = NAN;
-	free(cut);
-}
-
-/* The surface E_total(x, y) on a grid of about 1 m over the shown plane,
+/* The surface E_total(x, y) on a grid of about 0.5 m over the shown plane,
  * one y row per block (gnuplot's grid format): x y E_total, E_drawn (cut
  * at cap, for the map: near a pivot th(x, y) nears pi and E_total climbs
- * to thousands of joules where no path goes), E_3d (the 3-D surface, every
- * second point in x and y: NaN above cap, at the steps and at the points
- * between). e_min gets the lowest value. */
-static int surface_write(figs *f, const char *file, const bsim_scene *s, const double box[4],
-                         double cap, double *e_min, bsim_error *err)
+ * to thousands of joules where no path goes); and in mesh, the 3-D surface
+ * up to cap as polygons that end along the landscape's steps, the pivots
+ * and the cap (figures/figures_surface.h). e_min gets the lowest value. */
+static int surface_write(figs *f, const char *file, const char *mesh, const bsim_scene *s,
+                         const double box[4], double cap, double *e_min, bsim_error *err)
 {
-	const int nx = 51;
+	const int nx = 101;
 	const double dx = (box[1] - box[0] - 6.0) / (nx - 1);
 	const int ny = (int)ceil((box[3] - box[2]) / dx) + 1;
 	const double dy = (box[3] - box[2]) / (ny - 1);
 	double *e = malloc((size_t)nx * (size_t)ny * sizeof *e);
-	double *w = malloc((size_t)nx * (size_t)ny * sizeof *w);
-	if (!e || !w) {
-		free(e);
-		free(w);
+	if (!e)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	}
 	*e_min = INFINITY;
 	for (int j = 0; j < ny; j++)
 		for (int i = 0; i < nx; i++) {
@@ -388,56 +350,48 @@ static int surface_write(figs *f, const char *file, const bsim_scene *s, const d
 			const size_t k = (size_t)j * (size_t)nx + (size_t)i;
 			e[k] = bsim_landscape_energy(s, c, NULL, NULL, NULL);
 			*e_min = fmin(*e_min, e[k]);
-			w[k] = e[k] > cap ? NAN : e[k];
 		}
-	/* the 3-D surface is every second point in x and y (`every 2:2`: a
-	 * quarter of the quadrangles, to keep the SVG small); its steps are
-	 * found at that spacing, and every other point is NaN */
-	const int n3x = (nx + 1) / 2, n3y = (ny + 1) / 2;
-	double *w3 = malloc((size_t)n3x * (size_t)n3y * sizeof *w3);
-	if (!w3) {
-		free(e);
-		free(w);
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	}
-	for (int j = 0; j < n3y; j++)
-		for (int i = 0; i < n3x; i++)
-			w3[(size_t)j * (size_t)n3x + (size_t)i] =
-			        w[(size_t)(2 * j) * (size_t)nx + (size_t)(2 * i)];
-	cut_steps(w3, n3x, n3y, cap - *e_min);
-	for (int j = 0; j < ny; j++)
-		for (int i = 0; i < nx; i++)
-			w[(size_t)j * (size_t)nx + (size_t)i] =
-			        i % 2 || j % 2
-			                ? NAN
-			                : w3[(size_t)(j / 2) * (size_t)n3x + (size_t)(i / 2)];
-	free(w3);
 	char path[BSIM_PATH_MAX];
 	bsim_atomic_file o;
 	int rc = bsim_figs_data_open(f, file, &o, path, err);
 	if (!rc) {
 		fprintf(o.f,
 		        "# x y (m), E_total (J): the landscape F_prop (y0 - y) + sum 1/2 k "
-		        "th(x, y)^2,\n# then E_total as drawn on the map, cut at %.6g J, and in "
-		        "3-D: NaN above it and at the steps\n",
+		        "th(x, y)^2,\n# then E_total as drawn on the map, cut at %.6g J\n",
 		        cap);
 		for (int j = 0; j < ny; j++) {
 			for (int i = 0; i < nx; i++) {
 				const size_t k = (size_t)j * (size_t)nx + (size_t)i;
-				fprintf(o.f, "%.5g %.5g %.6g %.6g ", box[0] + 3.0 + i * dx,
+				fprintf(o.f, "%.5g %.5g %.6g %.6g\n", box[0] + 3.0 + i * dx,
 				        box[2] + j * dy, e[k], fmin(e[k], cap));
-				if (isnan(w[k]))
-					fputs("NaN\n", o.f);
-				else
-					fprintf(o.f, "%.6g\n", w[k]);
 			}
 			fputc('\n', o.f);
 		}
 		rc = bsim_figs_data_commit(&o, err);
 	}
 	free(e);
-	free(w);
-	return rc;
+	if (!rc)
+		rc = bsim_figs_data_open(f, mesh, &o, path, err);
+	if (rc)
+		return rc;
+	fprintf(o.f,
+	        "# x y (m), E_total (J): the surface up to %.6g J as polygons, each two scans of "
+	        "two\n# points (gnuplot pm3d), cut along the steps, the pivots and that level\n",
+	        cap);
+	const fsurface d = {.region = {box[0] + 3.0, box[1] - 3.0, box[2], box[3]},
+	                    .cap = cap,
+	                    .e_min = *e_min,
+	                    .beam_only = 0,
+	                    .max_polygons = SURFACE_POLYGONS};
+	long polygons = 0;
+	rc = bsim_fsurface_write(o.f, s, &d, &polygons, err);
+	if (!rc && polygons == 0) /* gnuplot needs a point in a file it plots */
+		fputs("NaN NaN NaN\n", o.f);
+	if (rc) {
+		bsim_atomic_file_abort(&o);
+		return rc;
+	}
+	return bsim_figs_data_commit(&o, err);
 }
 
 /* Where the surface is cut: a quarter above the highest energy the paths
@@ -543,13 +497,14 @@ static const char *class_color_over(int c)
 int bsim_figs_over_landscape(figs *f, const char *name, const char *title, const bsim_scene *scene,
                              const fpath *p, int n, unsigned mask, bsim_error *err)
 {
-	char surf[200], file[200];
+	char surf[200], mesh[200], file[200];
 	snprintf(surf, sizeof surf, "%s.surface.dat", name);
+	snprintf(mesh, sizeof mesh, "%s.mesh.dat", name);
 	snprintf(file, sizeof file, "%s.dat", name);
 	double box[4], e_min = 0.0, e_max = surface_cap(scene, p, n, mask);
 	long below, total;
 	scene_box(scene, box);
-	int rc = surface_write(f, surf, scene, box, e_max, &e_min, err);
+	int rc = surface_write(f, surf, mesh, scene, box, e_max, &e_min, err);
 	if (!rc)
 		rc = paths_write(f, file, scene, p, n, mask, &below, &total, err);
 	if (rc)
@@ -605,20 +560,20 @@ int bsim_figs_over_landscape(figs *f, const char *name, const char *title, const
 	 * every line of its plot, so that in one plot the paths would be
 	 * under a translucent surface. */
 	fprintf(s,
-	        "# (b) in 3-D, seen as landscape_total of beamsim landscape: the surface cut\n"
-	        "# above the top of the colours and at its steps; then, over it, each path at\n"
-	        "# its own energy, a stretch below the surface in black\n"
-	        "set origin 0.36,0\nset size 0.64,0.9\nunset colorbox\n"
+	        "# (b) in 3-D: the surface up to the top of the colours, ending along its\n"
+	        "# steps; then, over it, each path at its own energy, a stretch below the\n"
+	        "# surface in black\n"
+	        "set origin 0.36,0.06\nset size 0.64,0.84\nunset colorbox\n"
 	        "set title '(b) E along the paths over the surface E_{total}(x, y)'\n"
-	        "set view 55,300,1,1.05\nset size noratio\nset xyplane 0\n"
+	        "set view 55,300,1,1.05\nset size noratio\nset xyplane relative 0.1\n"
 	        "set zlabel 'E (J)' rotate parallel\nset zrange [%g:%g]\n"
-	        "set pm3d depthorder lighting primary 0.5 specular 0.1\n"
-	        "splot '%s' every 2:2 using 1:2:5 with pm3d notitle\n"
+	        "set pm3d depthorder lighting primary 0.5 specular 0\n"
+	        "splot '%s' using 1:2:3 with pm3d notitle\n"
 	        "unset title\nunset border\nunset tics\nunset xlabel\nunset ylabel\n"
 	        "unset zlabel\nunset grid\n"
-	        "set key at screen 0.99, screen 0.84 right top opaque box\n"
+	        "set key at screen 0.99, screen 0.05 right bottom horizontal maxrows 1\n"
 	        "splot ",
-	        e_min, e_max, surf);
+	        e_min, e_max, mesh);
 	int k = 0;
 	for (int c = 0; c < FPATH_N; c++)
 		if (count[c])

@@ -26,6 +26,7 @@
 #include "figures/figures_survival.h"
 #include "figures/figures_toolkit.h"
 #include "util/csv_table.h"
+#include "util/figure.h"
 #include "beamsim/limits.h"
 
 /* Positions of the selected values of each axis (-1: not selected) and
@@ -126,18 +127,6 @@ static int tics(FILE *f, const char *which, const fsum_axis *ax, const int *pos)
 	return longest;
 }
 
-/* The widest line of text, in characters. */
-static int widest_line(const char *t)
-{
-	int w = 0;
-	while (*t) {
-		int n = (int)strcspn(t, "\n");
-		w = n > w ? n : w;
-		t += n + (t[n] == '\n');
-	}
-	return w;
-}
-
 /* The axes drawn along: the first two with more than one selected value,
  * -1 for none. */
 static void axes_along(const fsum *s, const active *a, int *ax0, int *ax1)
@@ -157,8 +146,11 @@ static void axes_along(const fsum *s, const active *a, int *ax0, int *ax1)
 /* The most panels one figure of traversal against an axis holds. */
 #define PAGE_PANELS 12
 
-/* Pixels of a text of n characters at the figures' 11 pt font. */
-#define TEXT_PX(n) (15 * (n) / 2 + 60)
+/* Pixels of a text at the figures' 11 pt font, with a margin of 60. */
+static int text_px(const char *text)
+{
+	return bsim_figure_text_px(text, 11) + 60;
+}
 
 static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_error *err)
 {
@@ -228,14 +220,14 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	fprintf(g.f, "set xrange [-0.5:%g]\nset yrange [-0.5:%g]\n", n0 - 0.5, n1 - 0.5);
 	/* a cell fits its two lines of numbers and its tick label; the panel
 	 * its y labels, the colour box and its title */
-	int xtic = 4, ytic = 4, xlab = 0, ylab = 0;
-	char label[400];
+	int xtic = 4, ytic = 4, ylab = 0;
+	char label[400], xlab[400] = "";
 	if (ax0 >= 0) {
 		xtic = tics(g.f, "x", &s->axes[ax0], a->pos[ax0]);
 		fputs("set xlabel ", g.f);
 		bsim_gp_key_label(g.f, s->axes[ax0].key);
 		fputs("\n", g.f);
-		xlab = bsim_key_label(s->axes[ax0].key, 0, label, sizeof label);
+		bsim_key_label(s->axes[ax0].key, 0, xlab, sizeof xlab);
 	} else {
 		fputs("unset xtics\n", g.f);
 	}
@@ -256,8 +248,8 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	const int cell_w = xtic * 7 + 16 > 95 ? xtic * 7 + 16 : 95, cell_h = 62;
 	int pw = 40 + (ylab ? 30 : 0) + 7 * ytic + cell_w * n0 + 130;
 	int ph = 120 + cell_h * n1;
-	if (pw < TEXT_PX(xlab) + 170)
-		pw = TEXT_PX(xlab) + 170;
+	if (pw < text_px(xlab) + 170)
+		pw = text_px(xlab) + 170;
 	if (ph < 300)
 		ph = 300;
 	if (ax0 < 0 && ax1 < 0 && np == 1) {
@@ -282,8 +274,8 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	}
 	for (int p = 0; p < np && !(ax0 < 0 && ax1 < 0 && np == 1); p++) {
 		panel_label(s, a, first[p], ax0, ax1, label, sizeof label);
-		if (pw < TEXT_PX(widest_line(label)) + 150)
-			pw = TEXT_PX(widest_line(label)) + 150;
+		if (pw < text_px(label) + 150)
+			pw = text_px(label) + 150;
 		fputs("set title ", g.f);
 		bsim_gp_str(g.f, label);
 		fprintf(g.f,
@@ -299,8 +291,8 @@ static int heat_map(figs *f, const fsum *s, const active *a, int lattice, bsim_e
 	fputs("unset multiplot\n", g.f);
 	free(first);
 	int W = pw * cols, H = ph * rows + 60;
-	if (W < TEXT_PX(widest_line(title)))
-		W = TEXT_PX(widest_line(title));
+	if (W < text_px(title))
+		W = text_px(title);
 	char *body = bsim_gp_text_take(&g);
 	rc = body ? bsim_figs_render(f, "p_traverse", W, H, body, err)
 	          : bsim_error_set(err, BSIM_EFAIL, "out of memory");
@@ -408,7 +400,13 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 		if (rows * cols == npp && npp > 1)
 			layout(npp + 1, &rows, &cols);
 		const int pw = npp > 12 ? 400 : 520, ph = npp > 12 ? 300 : 380;
-		const int key_w = lattice ? 230 : 330;
+		/* a single panel's key cell: its widest entry at the key's 10 pt,
+		 * the line sample beside it and a margin either side */
+		const int key_w =
+		        bsim_figure_text_px(lattice ? "reached the end (traversed)"
+		                                    : "over the left beam (landscape label)",
+		                            10) +
+		        100;
 		int W = npp == 1 ? 640 + key_w : pw * cols, H = npp == 1 ? 560 : ph * rows + 90;
 		char title[2000], others[600] = "", axis_label[300];
 		size_t L = 0;
@@ -428,8 +426,8 @@ static int versus(figs *f, const fsum *s, const active *a, int ax, int lattice, 
 		         "%s against %s, %d trials per group, 95%% Wilson bands%s\n%s%s%s",
 		         lattice ? "where the trials ended" : "traversal", axis_label,
 		         s->trials_per_group, page_of, s->header, L ? "\npanels: " : "", others);
-		if (W < TEXT_PX(widest_line(title)))
-			W = TEXT_PX(widest_line(title));
+		if (W < text_px(title))
+			W = text_px(title);
 		/* a single panel placed by hand: below the title's lines */
 		int title_lines = 1;
 		for (const char *c = title; *c; c++)

@@ -68,6 +68,78 @@ int bsim_figure_available(void)
 	return 0;
 }
 
+/* Characters of the n bytes at s (UTF-8 continuation bytes not counted). */
+static int text_chars(const char *s, size_t n)
+{
+	int c = 0;
+	for (size_t i = 0; i < n; i++)
+		c += ((unsigned char)s[i] & 0xC0) != 0x80;
+	return c;
+}
+
+/* Pixels a character takes at pt points (see bsim_figure_text_px). */
+static double char_px(double pt)
+{
+	return pt * 15.0 / 22.0;
+}
+
+int bsim_figure_text_px(const char *text, double pt)
+{
+	int widest = 0;
+	while (*text) {
+		const size_t n = strcspn(text, "\n");
+		const int c = text_chars(text, n);
+		widest = c > widest ? c : widest;
+		text += n + (text[n] == '\n');
+	}
+	return (int)(widest * char_px(pt) + 0.999);
+}
+
+void bsim_figure_wrap(const char *text, double pt, int width, char *out, size_t size)
+{
+	if (!size)
+		return;
+	const int most = (int)(width / char_px(pt)) > 8 ? (int)(width / char_px(pt)) : 8;
+	size_t k = 0;
+	while (*text && k + 1 < size) {
+		size_t n = strcspn(text, "\n");
+		/* this line's head up to its break, then the rest as a line */
+		size_t cut = n;
+		if (text_chars(text, n) > most) {
+			size_t room = 0; /* the bytes of the first `most` characters */
+			for (int c = 0; room < n && c < most; c++)
+				do
+					room++;
+				while (room < n && ((unsigned char)text[room] & 0xC0) == 0x80);
+			static const char *const seps[] = {"; ", ", ", " "};
+			for (int s = 0; s < 3 && cut == n; s++) {
+				const size_t len = strlen(seps[s]);
+				for (size_t i = room; i-- > 1;)
+					if (i + len <= n && !strncmp(text + i, seps[s], len) &&
+					    (s == 2 || text_chars(text, i) >= most / 3)) {
+						cut = i + len - 1; /* the space becomes the break */
+						break;
+					}
+			}
+		}
+		for (size_t i = 0; i < cut && k + 1 < size; i++)
+			out[k++] = text[i];
+		if (cut < n) {
+			if (k + 1 < size)
+				out[k++] = '\n';
+			text += cut + 1;
+			continue;
+		}
+		text += n;
+		if (*text == '\n') {
+			if (k + 1 < size)
+				out[k++] = '\n';
+			text++;
+		}
+	}
+	out[k] = '\0';
+}
+
 /* Names are made by beamsim, never by a user; they go into a gnuplot
  * string and a file name, so only a safe alphabet is allowed. */
 static int name_ok(const char *s)

@@ -71,6 +71,19 @@ int bsim_figure_render(const bsim_figure_def *def, const char *body, int *drawn,
 int bsim_figure_render_all(const bsim_figure_def *defs, const char *const *bodies, int n,
                            int *drawn, bsim_error *err);
 
+/* Text in a figure, for sizing the canvas to it. The pixels the widest
+ * line of text (lines split at '\n', a UTF-8 character counted once) takes
+ * in gnuplot's pngcairo at a font of pt points: 0.68 pt a character, the
+ * width of the widest lines of the figures' sans measured on their titles
+ * (7.5 pixels at 11 pt), so that a title sized by it is not cut off. */
+int bsim_figure_text_px(const char *text, double pt);
+
+/* text into out (size bytes) with its lines broken where one would be
+ * wider than width pixels at pt points: after the last "; " that leaves a
+ * line at least a third as wide, else after the last ", ", else at the
+ * last space; a line without a space stays whole. */
+void bsim_figure_wrap(const char *text, double pt, int width, char *out, size_t size);
+
 /* 1 if gnuplot can be run (looked up once per process). */
 int bsim_figure_available(void);
 
