@@ -409,6 +409,73 @@ int bsim_test_run(const char *const argv[], char **out)
 	return run_captured(argv[0], (char *const *)argv, 1, NULL, out, NULL);
 }
 
+const char *bsim_test_gate_experiment(const char *dir)
+{
+	char yaml[2048];
+	snprintf(yaml, sizeof yaml,
+	         "scene: %s\ntrials: 4\nseed: 1\ngrid:\n"
+	         "  effects.propulsion.force: [9]\n"
+	         "  effects.random_force.magnitude: [0, 30]\n",
+	         bsim_test_src("configs/thesis/gate.yaml"));
+	return bsim_test_write(dir, "small.yaml", yaml);
+}
+
+char *bsim_test_browser_dom(const char *url, char **console)
+{
+	const char *probe[] = {"chromium", "--version", NULL};
+	if (bsim_test_run(probe, NULL) != 0)
+		fail_msg("chromium is not installed: run scripts/deps.sh (it installs the Debian "
+		         "package chromium), then run this test again");
+	char profile[1200];
+	snprintf(profile, sizeof profile, "--user-data-dir=%s", bsim_test_dir("chromium_profile"));
+	/* --no-sandbox: the sandbox refuses to run as root (CI, containers);
+	 * --virtual-time-budget: the DOM is dumped once the page has loaded;
+	 * --enable-logging=stderr: the page's console lines on stderr */
+	const char *argv[] = {"chromium",
+	                      "--headless",
+	                      "--no-sandbox",
+	                      "--disable-gpu",
+	                      "--no-first-run",
+	                      profile,
+	                      "--enable-logging=stderr",
+	                      "--v=0",
+	                      "--virtual-time-budget=5000",
+	                      "--dump-dom",
+	                      url,
+	                      NULL};
+	char *out = NULL, *err = NULL;
+	int rc = run_captured(argv[0], (char *const *)argv, 1, NULL, &out, &err);
+	if (rc != 0 || !out)
+		fail_msg("chromium %s: exit status %d: %s", url, rc, err ? err : "");
+	if (console) {
+		/* "[pid:tid:date:INFO:CONSOLE:line] "message", source: URL (line)" */
+		size_t n = 0;
+		char *lines = calloc(1, 1);
+		const char *l = err ? err : "";
+		while (lines && *l) {
+			const char *nl = strchr(l, '\n');
+			size_t len = nl ? (size_t)(nl - l) : strlen(l);
+			const char *hit = strstr(l, ":CONSOLE");
+			if (hit && hit < l + len) {
+				char *grown = realloc(lines, n + len + 2);
+				if (!grown)
+					abort();
+				lines = grown;
+				memcpy(lines + n, l, len);
+				n += len;
+				lines[n++] = '\n';
+				lines[n] = '\0';
+			}
+			l += len + (nl != NULL);
+		}
+		if (!lines)
+			abort();
+		*console = lines;
+	}
+	free(err);
+	return out;
+}
+
 int bsim_test_spawn_with(const char *const argv[], const bsim_test_opts *o)
 {
 	char **args = argv_build(BSIM_EXE, argv);

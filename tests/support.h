@@ -44,6 +44,19 @@ void bsim_test_check_input_error(int rc, const char *err, const char *const need
  * (may be NULL) and stderr discarded; returns its status as above. */
 int bsim_test_run(const char *const argv[], char **out);
 
+/* dir/small.yaml, a small experiment on configs/thesis/gate.yaml: 4 trials
+ * a group, seed 1, F_prop 9 N, groups R_m = 0 and 30 N. Its path (a
+ * static buffer). */
+const char *bsim_test_gate_experiment(const char *dir);
+
+/* chromium's DOM of the page at url (file://...) as it stands once the page
+ * has loaded and gone idle (headless, --virtual-time-budget: chromium
+ * dumps it on that event), malloc'd; *console (may be NULL) gets the lines
+ * the page wrote to its console (chromium's "CONSOLE" log lines), ""
+ * if none. Fails the test, saying what to do, if chromium is not
+ * installed (scripts/deps.sh installs it). */
+char *bsim_test_browser_dom(const char *url, char **console);
+
 /* Starts BSIM_EXE with argv in the background, stdout and stderr to
  * /dev/null (or o->out, o->err; o may be NULL); returns its pid. */
 int bsim_test_spawn(const char *const argv[]);

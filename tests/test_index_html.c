@@ -5,7 +5,8 @@
  * loads the page and every image on it (the page's script counts the
  * images with a natural width in <body data-images="LOADED/ALL">); every
  * figure has a caption of its own, not the catch-all; manifest.json lists
- * the page; a directory without figures gets no page. */
+ * the page; a directory without figures has only the trajectory player's
+ * page (test_viewer: and without trajectories, none). */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -50,33 +51,12 @@ static int pngs(const char *root, const char *rel, char names[][256], int n, int
 	return n;
 }
 
-/* chromium's dumped DOM of dir/index.html (malloc'd). Fails the test,
- * saying what to do, if chromium is not installed. */
+/* chromium's dumped DOM of dir/index.html (malloc'd). */
 static char *dump_dom(const char *dir)
 {
-	const char *probe[] = {"chromium", "--version", NULL};
-	if (bsim_test_run(probe, NULL) != 0)
-		fail_msg("chromium is not installed: run scripts/deps.sh (it installs the Debian "
-		         "package chromium), then run this test again");
-	char url[1200], profile[1200];
+	char url[1200];
 	snprintf(url, sizeof url, "file://%s/index.html", dir);
-	snprintf(profile, sizeof profile, "--user-data-dir=%s", bsim_test_dir("chromium_profile"));
-	/* --no-sandbox: the sandbox refuses to run as root (CI, containers);
-	 * --virtual-time-budget: the DOM is dumped once the page has loaded */
-	const char *argv[] = {"chromium",
-	                      "--headless",
-	                      "--no-sandbox",
-	                      "--disable-gpu",
-	                      "--no-first-run",
-	                      profile,
-	                      "--virtual-time-budget=5000",
-	                      "--dump-dom",
-	                      url,
-	                      NULL};
-	char *out = NULL;
-	assert_int_equal(bsim_test_run(argv, &out), 0);
-	assert_non_null(out);
-	return out;
+	return bsim_test_browser_dom(url, NULL);
 }
 
 /* Every png under dir is on the page with a caption of its own, the page
@@ -140,27 +120,21 @@ static void test_captions(void **state)
 	assert_string_equal(buf, "");
 }
 
-static const char *experiment(const char *dir)
-{
-	char yaml[2048];
-	snprintf(yaml, sizeof yaml,
-	         "scene: %s\ntrials: 4\nseed: 1\ngrid:\n"
-	         "  effects.propulsion.force: [9]\n"
-	         "  effects.random_force.magnitude: [0, 30]\n",
-	         bsim_test_src("configs/thesis/gate.yaml"));
-	return bsim_test_write(dir, "small.yaml", yaml);
-}
-
 static void test_sweep_page(void **state)
 {
 	(void)state;
 	char dir[1024], exp[1100];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("index_sweep"));
-	snprintf(exp, sizeof exp, "%s", experiment(bsim_test_dir("index_inputs")));
+	snprintf(exp, sizeof exp, "%s", bsim_test_gate_experiment(bsim_test_dir("index_inputs")));
 	const char *sweep[] = {"sweep", exp, "--trajectories", "2", "--quiet", "--out", dir, NULL};
 	assert_int_equal(bsim_test_cli(sweep, NULL, NULL), 0);
-	/* no figures yet: no page */
-	assert_false(bsim_test_exists(bsim_test_join(dir, "index.html")));
+	/* no figures yet: the page is the trajectory player's alone
+	 * (test_viewer checks the player) */
+	char *first = bsim_test_read(bsim_test_join(dir, "index.html"));
+	assert_non_null(first);
+	assert_non_null(strstr(first, "<h2>Trajectories</h2>"));
+	assert_null(strstr(first, "<h2>Figures</h2>"));
+	free(first);
 	const char *plot[] = {"plot", dir, "--quiet", NULL};
 	assert_int_equal(bsim_test_cli(plot, NULL, NULL), 0);
 	check_page(dir);
@@ -177,7 +151,7 @@ static void test_compare_page(void **state)
 	(void)state;
 	char dir[1024], exp[1100];
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir("index_compare"));
-	snprintf(exp, sizeof exp, "%s", experiment(bsim_test_dir("index_inputs2")));
+	snprintf(exp, sizeof exp, "%s", bsim_test_gate_experiment(bsim_test_dir("index_inputs2")));
 	const char *cmp[] = {"compare", exp, "--trials", "4", "--quiet", "--out", dir, NULL};
 	int rc = bsim_test_cli(cmp, NULL, NULL);
 	assert_true(rc == 0 || rc == 3);

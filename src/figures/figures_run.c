@@ -11,12 +11,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "beamsim/key_names.h"
 #include "figures/figures_kinds.h"
 #include "figures/figures_paths.h"
 #include "figures/figures_toolkit.h"
+#include "store/stored_run.h"
 #include "util/csv_table.h"
 #include "util/yaml_doc.h"
 #include "beamsim/limits.h"
@@ -24,75 +24,27 @@
 /* Most beams of a scene Fig. 2.7(c) is drawn for (a gate has two). */
 #define BSIM_MAX_BEAMS_FIG 16
 
-/* The scene of the run: inputs/scene.yaml with run.json's "set"
- * overrides; outcome and type of the trial into the buffers (32 bytes
- * each), the backend and the overrides for a title into params
- * (bsim_fpath_params). *found is 0 if there is no record to load it from. */
+/* The scene of the run (store/stored_run.h): inputs/scene.yaml with
+ * run.json's "set" overrides; outcome and type of the trial into the
+ * buffers (32 bytes each), the backend and the overrides for a title into
+ * params (bsim_fpath_params). *found is 0 if there is no record to load it
+ * from. */
 static int run_scene(const char *dir, bsim_scene *scene, char *outcome, char *type, char *params,
                      size_t params_size, int *found, bsim_error *err)
 {
-	char path[BSIM_PATH_MAX], scene_path[BSIM_PATH_MAX];
-	snprintf(path, sizeof path, "%s/run.json", dir);
-	snprintf(scene_path, sizeof scene_path, "%s/inputs/scene.yaml", dir);
-	struct stat st;
-	*found = stat(path, &st) == 0 && stat(scene_path, &st) == 0;
-	if (!*found)
-		return BSIM_OK;
-	ydoc d;
-	int rc = bsim_ydoc_load_own(&d, path, err);
-	if (rc)
+	bsim_run_scene rs;
+	int rc = bsim_run_scene_load(dir, &rs, found, err);
+	if (rc || !*found)
 		return rc;
-	struct fy_node *root = fy_document_root(d.fyd);
-	struct fy_node *set = bsim_ydoc_lookup(root, "set");
-	char backend[32] = "";
-	const char *names[3] = {"outcome", "type", "backend"};
-	char *bufs[3] = {outcome, type, backend};
-	for (int i = 0; i < 3; i++) {
-		struct fy_node *n = bsim_ydoc_lookup(root, names[i]);
-		size_t len = 0;
-		const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : "";
-		snprintf(bufs[i], 32, "%.*s", (int)(len < 31 ? len : 31), t ? t : "");
-	}
-	int n = set && fy_node_is_mapping(set) ? fy_node_mapping_item_count(set) : 0;
-	bsim_override *ov = calloc((size_t)n + 1, sizeof *ov);
-	char **text = calloc(2 * (size_t)n + 1, sizeof *text);
-	if (!ov || !text)
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	void *it = NULL;
-	struct fy_node_pair *p;
-	for (int i = 0; !rc && i < n && (p = fy_node_mapping_iterate(set, &it)); i++) {
-		for (int k = 0; k < 2; k++) {
-			struct fy_node *sn = k ? fy_node_pair_value(p) : fy_node_pair_key(p);
-			size_t len = 0;
-			const char *t =
-			        sn && fy_node_is_scalar(sn) ? fy_node_get_scalar(sn, &len) : NULL;
-			text[2 * i + k] = t ? strndup(t, len) : NULL;
-		}
-		if (!text[2 * i] || !text[2 * i + 1])
-			rc = bsim_ydoc_expected(&d, fy_node_pair_value(p), set, "set",
-			                        "a mapping of KEY: VALUE strings", err);
-		ov[i] = (bsim_override){text[2 * i], text[2 * i + 1], path};
-	}
-	if (!rc)
-		rc = bsim_scene_load(scene_path, ov, n, scene, err);
-	if (!rc) {
-		const char **kv = malloc(2 * (size_t)n * sizeof *kv + 1);
-		if (!kv)
-			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-		for (int i = 0; kv && i < n; i++) {
-			kv[i] = text[2 * i];
-			kv[n + i] = text[2 * i + 1];
-		}
-		if (kv)
-			bsim_fpath_params(params, params_size, backend, kv, kv + n, n);
-		free(kv);
-	}
-	for (int i = 0; text && i < 2 * n; i++)
-		free(text[i]);
-	free(text);
-	free(ov);
-	bsim_ydoc_free(&d);
-	return rc;
+	snprintf(outcome, 32, "%s", rs.outcome);
+	snprintf(type, 32, "%s", rs.type);
+	bsim_fpath_params(params, params_size, rs.backend, (const char *const *)rs.keys,
+	                  (const char *const *)rs.values, rs.n_sets);
+	/* the scene is the caller's now */
+	*scene = rs.scene;
+	rs.scene = (bsim_scene){0};
+	bsim_run_scene_free(&rs);
+	return BSIM_OK;
 }
 
 /* "thesis backend; R_m = 20 N": the run's backend and its --set values from

@@ -41,15 +41,6 @@ bsim_compare_dir_def bsim_compare_dir_def_default(void)
 	return d;
 }
 
-void bsim_compare_dir_label(const char *label, char *buf, size_t size)
-{
-	size_t k = 0;
-	for (; *label && k + 1 < size; label++)
-		buf[k++] = *label == ':' || *label == '/' ? '-' : *label;
-	if (size > 0)
-		buf[k] = '\0';
-}
-
 int bsim_compare_side_parse(const char *spec, bsim_compare_side *side, bsim_error *err)
 {
 	if (strncmp(spec, BSIM_TRIALS_PREFIX, strlen(BSIM_TRIALS_PREFIX)) == 0)

@@ -1,8 +1,11 @@
-/* DIR/index.html (index_html.h). The page lists the figures (every .png
- * under the directory, top level first) each with its caption and links to
- * NAME.svg, NAME.gp and NAME.*.dat beside it, then every other file. A
- * script sets <body data-images="LOADED/ALL"> once the page has loaded, so
- * a headless browser's dumped DOM says whether every image could be shown. */
+/* DIR/index.html (index_html.h). The page opens with the trajectory
+ * player where the set holds trajectories (store/viewer_data.h), then
+ * lists the figures (every .png under the directory, top level first) each
+ * with its caption and links to NAME.svg, NAME.gp and NAME.*.dat beside it,
+ * then every other file. A script sets <body data-images="LOADED/ALL"> once
+ * the page has loaded, so a headless browser's dumped DOM says whether
+ * every image could be shown; another, first in the page, collects every
+ * error of the page (window.beamsimErrors), which the player counts. */
 #define _POSIX_C_SOURCE 200809L
 #include "store/index_html.h"
 
@@ -13,6 +16,7 @@
 #include <sys/stat.h>
 
 #include "beamsim/key_names.h"
+#include "store/viewer_data.h"
 #include "util/atomic_file.h"
 #include "beamsim/limits.h"
 #include "beamsim/version.h"
@@ -117,7 +121,9 @@ static const struct {
         {"map_*.csv", "a single-gate map: entry bin, exit bin, count"},
         {"map_*.key", "everything that map depends on"},
         {"map_*.cost", "the CPU time and steps that map took"},
-        {"index.html", "every figure with a caption, for a browser"},
+        {"index.html", "every figure with a caption and the trajectory player, for a browser"},
+        {"viewer_data.js", "the trajectories and scenes index.html plays"},
+        {"viewer.js", "the trajectory player of index.html"},
         {"*.mp4", "the video"},
         {"*.gp", "gnuplot script (rerun with `gnuplot %s.gp` here)"},
         {"*.dat", "data of a figure"},
@@ -452,8 +458,42 @@ static void page_verdict(FILE *f, const flist *l, const char *stage, const char 
 	}
 }
 
+/* The player's section (store/viewer_data.h): what it plays and its caps,
+ * the element it draws into, and its scripts. */
+static void page_viewer(FILE *f, const bsim_viewer_summary *v)
+{
+	fputs("<h2>Trajectories</h2>\n<p>", f);
+	if (v->kept > v->shown)
+		fprintf(f, "The first %ld of the %ld trajectories kept", v->shown, v->kept);
+	else if (v->shown > 1)
+		fprintf(f, "The %ld trajectories kept", v->shown);
+	else
+		fputs("The trajectory", f);
+	if (v->sides > 1)
+		fprintf(f, ", a panel for each of the %d sides, all at the same time", v->sides);
+	fputs(v->landscapes ? ", over the landscape E_total" : "", f);
+	fprintf(f,
+	        ": <b>Play</b>, <b>Pause</b>, the slider for the time%s. At most %d "
+	        "trajectories a side are played, each at most %d frames and %d,%03d numbers (a "
+	        "scene of many beams gets fewer frames); a longer trajectory is played every "
+	        "k-th row of its file and its last",
+	        v->shown > 1 ? ", the list for the trial" : "", BSIM_VIEWER_TRAJECTORIES,
+	        BSIM_VIEWER_FRAMES, BSIM_VIEWER_VALUES / 1000, BSIM_VIEWER_VALUES % 1000);
+	if (v->most_every > 1)
+		fprintf(f, " (here k is at most %d, the longest of %ld rows)", v->most_every,
+		        v->most_rows);
+	else
+		fputs(" (here every row is played)", f);
+	fputs(". The data is <a href=\"viewer_data.js\">viewer_data.js</a>, the player "
+	      "<a href=\"viewer.js\">viewer.js</a>.</p>\n"
+	      "<div id=\"beamsim-viewer\" data-state=\"loading\"></div>\n"
+	      "<pre id=\"beamsim-viewer-result\" hidden></pre>\n"
+	      "<script src=\"viewer_data.js\"></script>\n<script src=\"viewer.js\"></script>\n",
+	      f);
+}
+
 static void page(FILE *f, const flist *l, const char *stage, const char *dir, int add,
-                 const char *command, char *used)
+                 const char *command, char *used, int figures, const bsim_viewer_summary *v)
 {
 	const char *title = base_of(dir);
 	fputs("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>", f);
@@ -465,19 +505,34 @@ static void page(FILE *f, const flist *l, const char *stage, const char *dir, in
 	      "code{font-size:90%}\nli{margin:.15em 0}\n"
 	      "table.verdicts{border-collapse:collapse;font-size:90%}\n"
 	      "table.verdicts td,table.verdicts th{border:1px solid #ccc;padding:.15em .5em}\n"
-	      "</style>\n</head>\n"
+	      "</style>\n"
+	      /* every error of the page, also a script that fails to load,
+	       * counted for the trajectory player's data-errors */
+	      "<script>\nwindow.beamsimErrors = [];\n"
+	      "window.addEventListener('error', function (e) {\n"
+	      "  var t = e.target, src = t && t !== window && (t.src || t.href);\n"
+	      "  window.beamsimErrors.push(src ? 'could not load ' + src : String(e.message));\n"
+	      "}, true);\n"
+	      "(function (c) {\n  var error = c.error;\n  c.error = function () {\n"
+	      "    window.beamsimErrors.push([].join.call(arguments, ' '));\n"
+	      "    return error.apply(c, arguments);\n  };\n})(console);\n</script>\n"
+	      "</head>\n"
 	      "<body data-images=\"\">\n<h1>",
 	      f);
 	html_text(f, title);
 	fputs("</h1>\n<p>Written by <code>beamsim ", f);
 	html_text(f, command ? command : "");
-	fputs("</code> (beamsim " BSIM_VERSION "). Each figure is its PNG; beside it its SVG, "
-	      "its gnuplot script (rerun with <code>gnuplot NAME.gp</code> in the figure's "
-	      "folder) and the data it draws. <code>manifest.json</code> lists every file with "
-	      "its size and CRC-32.</p>\n",
-	      f);
+	fputs("</code> (beamsim " BSIM_VERSION ").", f);
+	if (figures)
+		fputs(" Each figure is its PNG; beside it its SVG, its gnuplot script (rerun with "
+		      "<code>gnuplot NAME.gp</code> in the figure's folder) and the data it draws.",
+		      f);
+	fputs(" <code>manifest.json</code> lists every file with its size and CRC-32.</p>\n", f);
 	page_verdict(f, l, stage, add ? dir : NULL);
-	fputs("<h2>Figures</h2>\n", f);
+	if (v->shown > 0)
+		page_viewer(f, v);
+	if (figures)
+		fputs("<h2>Figures</h2>\n", f);
 	char caption[512];
 	for (int i = 0; i < l->n; i++) {
 		const char *r = l->rel[i];
@@ -541,6 +596,11 @@ static void page(FILE *f, const flist *l, const char *stage, const char *dir, in
 int bsim_index_html_write(const char *stage, const char *dir, int add, const char *command,
                           bsim_error *err)
 {
+	/* the player's files first, so that the page lists them */
+	bsim_viewer_summary v;
+	int rc = bsim_viewer_write(stage, dir, add, &v, err);
+	if (rc != BSIM_OK)
+		return rc;
 	flist l = {0};
 	int bad = collect(stage, "", 0, &l);
 	if (!bad && add)
@@ -552,14 +612,13 @@ int bsim_index_html_write(const char *stage, const char *dir, int add, const cha
 	int figures = 0;
 	for (int i = 0; i < l.n; i++)
 		figures += ends_with(l.rel[i], ".png");
-	if (!figures) {
+	if (!figures && v.shown == 0) {
 		flist_free(&l);
 		return BSIM_OK;
 	}
 	qsort(l.rel, (size_t)l.n, sizeof *l.rel, by_place);
 	char *used = calloc((size_t)l.n, 1);
 	char path[BSIM_PATH_MAX];
-	int rc = BSIM_OK;
 	if (!used)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	else if (snprintf(path, sizeof path, "%s/index.html", stage) >= (int)sizeof path)
@@ -568,7 +627,7 @@ int bsim_index_html_write(const char *stage, const char *dir, int add, const cha
 	if (!rc)
 		rc = bsim_atomic_file_open(&o, path, err);
 	if (!rc) {
-		page(o.f, &l, stage, dir, add, command, used);
+		page(o.f, &l, stage, dir, add, command, used, figures, &v);
 		rc = bsim_atomic_file_commit(&o, err);
 	}
 	free(used);

@@ -1,8 +1,9 @@
-/* DIR/index.html: a page showing every figure of an output directory with a
- * one-line caption and links to its SVG, its gnuplot script and its data,
- * then the directory's other files (index_html.c). Written into the
- * staging area with the run's other files, so it appears with them and
- * manifest.json lists it. */
+/* DIR/index.html: a page playing the trajectories of an output directory
+ * (store/viewer_data.h) and showing every figure of it with a one-line
+ * caption and links to its SVG, its gnuplot script and its data, then the
+ * directory's other files (index_html.c). Written into the staging area
+ * with the run's other files, so it appears with them and manifest.json
+ * lists it. */
 #ifndef BSIM_STORE_INDEX_HTML_H
 #define BSIM_STORE_INDEX_HTML_H
 
@@ -17,9 +18,10 @@
 void bsim_index_caption(const char *base, char *buf, size_t size);
 
 /* Writes stage/index.html if stage (or, with add, also dir: the set the
- * run's files join) holds a .png, under any subdirectory; dir is the
+ * run's files join) holds a .png, under any subdirectory, or a trajectory
+ * to play (then also stage/viewer_data.js and stage/viewer.js); dir is the
  * directory as the user named it (the page's title), command names the
- * run ("sweep", "plot"). Nothing is written if there is no figure. */
+ * run ("sweep", "plot"). Nothing is written if there is neither. */
 int bsim_index_html_write(const char *stage, const char *dir, int add, const char *command,
                           bsim_error *err);
 

@@ -752,15 +752,6 @@ static void md_sides(FILE *f, const bsim_report *r)
 
 /* ---- report.json ---------------------------------------------------------- */
 
-static void json_pair_of_numbers(FILE *f, const double v[2])
-{
-	fputc('[', f);
-	bsim_json_number(f, v[0]);
-	fputs(", ", f);
-	bsim_json_number(f, v[1]);
-	fputc(']', f);
-}
-
 static void json_quantiles(FILE *f, const double q[3])
 {
 	if (q[0] < 0.0) {
@@ -781,13 +772,13 @@ static void json_event(FILE *f, const bsim_event_test *t, int deterministic)
 	bsim_json_number(f, t->p_a);
 	if (!deterministic) {
 		fputs(", \"ci95_a\": ", f);
-		json_pair_of_numbers(f, t->ci_a);
+		bsim_json_pair(f, t->ci_a);
 	}
 	fputs(", \"p_b\": ", f);
 	bsim_json_number(f, t->p_b);
 	if (!deterministic) {
 		fputs(", \"ci95_b\": ", f);
-		json_pair_of_numbers(f, t->ci_b);
+		bsim_json_pair(f, t->ci_b);
 	}
 	fputs(", \"difference\": ", f);
 	bsim_json_number(f, t->diff);
@@ -798,7 +789,7 @@ static void json_event(FILE *f, const bsim_event_test *t, int deterministic)
 		return;
 	}
 	fputs(", \"difference_ci95\": ", f);
-	json_pair_of_numbers(f, t->diff_ci);
+	bsim_json_pair(f, t->diff_ci);
 	fputs(", \"p_mcnemar\": ", f);
 	bsim_json_number(f, t->p_value);
 	fputs(", \"p_holm\": ", f);
@@ -882,7 +873,7 @@ static void json_location_list(FILE *f, const bsim_lattice_summary *ls)
 		        c->count);
 		bsim_json_number(f, c->p);
 		fputs(", \"ci95\": ", f);
-		json_pair_of_numbers(f, c->ci95);
+		bsim_json_pair(f, c->ci95);
 		fputc('}', f);
 	}
 	fputc(']', f);
@@ -933,7 +924,7 @@ static void json_pooled(FILE *f, const bsim_comparison *c)
 		        t.b, t.c);
 		bsim_json_number(f, n > 0 ? (double)(t.b - t.c) / n : 0.0);
 		fputs(", \"difference_ci95\": ", f);
-		json_pair_of_numbers(f, ci);
+		bsim_json_pair(f, ci);
 		fputs(", \"p_mcnemar\": ", f);
 		bsim_json_number(f, p);
 		fputc('}', f);
@@ -1082,7 +1073,7 @@ static void json_sides_group(FILE *f, const bsim_report *r, int g)
 		fputs(", \"p_traverse\": ", f);
 		bsim_json_number(f, gr->p_traverse);
 		fputs(", \"ci95\": ", f);
-		json_pair_of_numbers(f, gr->ci95);
+		bsim_json_pair(f, gr->ci95);
 		fputc('}', f);
 	}
 	fputs("],\n     \"pairwise\": [", f);

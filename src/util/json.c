@@ -64,3 +64,12 @@ void bsim_json_u64(FILE *f, uint64_t x)
 	else
 		fprintf(f, "\"%" PRIu64 "\"", x);
 }
+
+void bsim_json_pair(FILE *f, const double v[2])
+{
+	fputc('[', f);
+	bsim_json_number(f, v[0]);
+	fputs(", ", f);
+	bsim_json_number(f, v[1]);
+	fputc(']', f);
+}

@@ -21,6 +21,9 @@ void bsim_json_string(FILE *f, const char *s);
  * double; null if x is not finite (JSON has no NaN or infinity). */
 void bsim_json_number(FILE *f, double x);
 
+/* [a, b] of two numbers, each as bsim_json_number writes it. */
+void bsim_json_pair(FILE *f, const double v[2]);
+
 /* An unsigned 64-bit integer (a seed): a number up to 2^53, which every
  * reader holds exactly in a double; above, a string of its decimal digits,
  * which a double-based reader (MATLAB's jsondecode, JavaScript) would

@@ -1,0 +1,12 @@
+# bsim_write_if_changed(PATH TEXT): writes TEXT to PATH unless PATH holds it
+# already, so that a generated header rewritten at every build with the same
+# text recompiles nothing.
+function(bsim_write_if_changed path text)
+  set(old "")
+  if(EXISTS ${path})
+    file(READ ${path} old)
+  endif()
+  if(NOT old STREQUAL text)
+    file(WRITE ${path} "${text}")
+  endif()
+endfunction()
