@@ -95,6 +95,7 @@ PUBLIC = {
     "trial": "run",
     "compare_dir": "store",
     "output": "store",
+    "trial_fields": "store",
     "regress": "store",
     "replay": "store",
     "report": "store",

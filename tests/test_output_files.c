@@ -26,6 +26,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "beamsim/trial_fields.h"
 #include "store/outdir.h"
 #include "support.h"
 
@@ -505,6 +506,54 @@ static void test_figures_join_the_set(void **state)
 	free(manifest);
 }
 
+/* The table of trials.csv's columns in docs/files.md against the library's
+ * description of them (beamsim/trial_fields.h): every column named there,
+ * in order, in the first cell of its row (a row may name several), each
+ * with its unit in the row where it has one, and no other column. */
+static void test_docs_trials_columns(void **state)
+{
+	(void)state;
+	char *doc = bsim_test_read(bsim_test_src("docs/files.md"));
+	assert_non_null(doc);
+	char *at = strstr(doc, "`trials.csv`, one row per trial");
+	assert_non_null(at);
+	at = strstr(at, "| column | meaning |");
+	assert_non_null(at);
+	at = strchr(at, '\n') + 1; /* the rule under the header */
+	at = strchr(at, '\n') + 1;
+	int n;
+	const bsim_trial_field *f = bsim_trial_fields(&n);
+	int k = 0;
+	while (at[0] == '|') {
+		char *eol = strchr(at, '\n');
+		assert_non_null(eol);
+		*eol = '\0';
+		char *cell_end = strstr(at + 1, " | ");
+		assert_non_null(cell_end);
+		*cell_end = '\0';
+		/* the first cell's names: `name`, `name` */
+		for (char *q = strchr(at, '`'); q; q = strchr(q, '`')) {
+			char *close = strchr(q + 1, '`');
+			assert_non_null(close);
+			*close = '\0';
+			if (k >= n)
+				fail_msg("docs/files.md: column %s is not one of trials.csv's",
+				         q + 1);
+			if (strcmp(q + 1, f[k].name) != 0)
+				fail_msg("docs/files.md: column %d is %s, the library's %s", k + 1,
+				         q + 1, f[k].name);
+			if (f[k].unit[0] && !strstr(cell_end + 3, f[k].unit))
+				fail_msg("docs/files.md: %s's row does not give its unit, %s",
+				         f[k].name, f[k].unit);
+			k++;
+			q = close + 1;
+		}
+		at = eol + 1;
+	}
+	assert_int_equal(k, n);
+	free(doc);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -520,6 +569,7 @@ int main(void)
 	        cmocka_unit_test(test_replacing_a_set),
 	        cmocka_unit_test(test_manifest_check),
 	        cmocka_unit_test(test_figures_join_the_set),
+	        cmocka_unit_test(test_docs_trials_columns),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -23,6 +23,8 @@
  * sweep's block of trials; a
  * sweep whose columns would not fit in the memory available is refused
  * before it runs (bsim_output_trials_fit). */
+#define _GNU_SOURCE /* open_memstream */
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,139 +36,6 @@ enum { A_TRIALS, A_SEED, A_THREADS, A_BACKEND, A_BACKEND_OPT, A_SET, A_GRID, A_O
 static const char *const arg_names[N_ARGS] = {"trials",      "seed", "threads", "backend",
                                               "backend_opt", "set",  "grid",    "overlap"};
 
-/* A number column of the trials. */
-typedef double (*trial_number)(const bsim_trial_result *x);
-
-static double c_steps(const bsim_trial_result *x)
-{
-	return x->steps;
-}
-static double c_t_end(const bsim_trial_result *x)
-{
-	return x->t_end;
-}
-static double c_x_end(const bsim_trial_result *x)
-{
-	return x->x_end;
-}
-static double c_y_end(const bsim_trial_result *x)
-{
-	return x->y_end;
-}
-static double c_vx_end(const bsim_trial_result *x)
-{
-	return x->vx_end;
-}
-static double c_max_theta1(const bsim_trial_result *x)
-{
-	return x->max_theta[0];
-}
-static double c_max_theta2(const bsim_trial_result *x)
-{
-	return x->max_theta[1];
-}
-static double c_e_start(const bsim_trial_result *x)
-{
-	return x->ledger.e_start;
-}
-static double c_e_end(const bsim_trial_result *x)
-{
-	return x->ledger.e_end;
-}
-static double c_work_in(const bsim_trial_result *x)
-{
-	return x->ledger.w_prop + x->ledger.w_rand;
-}
-/* as trials.csv: sleeping's and the essay protocol's resets too, so that
- * e_end - e_start = work_in - losses + residual */
-static double c_losses(const bsim_trial_result *x)
-{
-	const bsim_ledger *l = &x->ledger;
-	return l->damper + l->impact + l->contact + l->correction + l->sleep + l->reset;
-}
-static double c_residual(const bsim_trial_result *x)
-{
-	return x->ledger.residual;
-}
-static double c_overlap_max(const bsim_trial_result *x)
-{
-	return x->overlap_max;
-}
-static double c_final_ix(const bsim_trial_result *x)
-{
-	return x->final_ix;
-}
-static double c_final_iy(const bsim_trial_result *x)
-{
-	return x->final_iy;
-}
-static double c_iteration_limits(const bsim_trial_result *x)
-{
-	return (double)x->solver.iteration_limit;
-}
-static double c_clamps(const bsim_trial_result *x)
-{
-	return (double)x->solver.clamped;
-}
-/* when it left the gate (or the field); NaN (trials.csv: empty) if censored */
-static double c_t_exit(const bsim_trial_result *x)
-{
-	return x->outcome == BSIM_TRAVERSED || x->outcome == BSIM_SIDE_EXIT ? x->t_end : NAN;
-}
-static double c_heading_end(const bsim_trial_result *x)
-{
-	return x->heading_end;
-}
-static double c_angular_velocity_end(const bsim_trial_result *x)
-{
-	return x->angular_velocity_end;
-}
-static double c_turn_end(const bsim_trial_result *x)
-{
-	return x->turn_end;
-}
-static double c_turn_max(const bsim_trial_result *x)
-{
-	return x->turn_max;
-}
-
-typedef struct number_column {
-	const char *name;
-	trial_number fn;
-} number_column;
-
-/* trials.csv's columns in its order (docs/files.md); group, trial, outcome,
- * type, location and path are made apart. */
-static const number_column after_type[] = {
-        {"steps", c_steps},
-        {"t_end", c_t_end},
-        {"x_end", c_x_end},
-        {"y_end", c_y_end},
-        {"vx_end", c_vx_end},
-        {"max_theta1", c_max_theta1},
-        {"max_theta2", c_max_theta2},
-        {"e_start", c_e_start},
-        {"e_end", c_e_end},
-        {"work_in", c_work_in},
-        {"losses", c_losses},
-        {"residual", c_residual},
-        {"overlap_max", c_overlap_max},
-        {"final_ix", c_final_ix},
-        {"final_iy", c_final_iy},
-};
-static const number_column after_path[] = {
-        {"iteration_limits", c_iteration_limits},
-        {"clamps", c_clamps},
-        {"t_exit", c_t_exit},
-        {"heading_end", c_heading_end},
-        {"angular_velocity_end", c_angular_velocity_end},
-        {"turn_end", c_turn_end},
-        {"turn_max", c_turn_max},
-};
-
-enum { N_AFTER_TYPE = sizeof after_type / sizeof after_type[0] };
-enum { N_AFTER_PATH = sizeof after_path / sizeof after_path[0] };
-
 /* A grid value as a number, NaN if it is text. */
 static double value_number(const char *text)
 {
@@ -176,70 +45,65 @@ static double value_number(const char *text)
 }
 
 /* The trials as columns, made at their size before the sweep and filled
- * block by block as it streams them (the sink, on the calling thread). A
- * text column is codes from 1 into its labels: fixed lists for outcome and
- * type, the distinct texts in order of first appearance for location and
- * path (uint32 while the sweep runs, narrowed once their count is known). */
+ * block by block as it streams them (the sink, on the calling thread), one
+ * per field of trials.csv (beamsim/trial_fields.h) in its order. A number
+ * is a double (an index from 1); a word of a fixed list (outcome, type) is
+ * its code from 1 (uint8); a text made from the trial (location, path) is
+ * a code from 1 into the distinct texts in order of first appearance
+ * (uint32 while the sweep runs, narrowed once their count is known). */
 typedef struct trial_columns {
 	const bsim_experiment *e;
 	size_t n;
 	int trials;
-	mxArray *group, *trial, *outcome, *type;
-	mxArray *number[N_AFTER_TYPE + N_AFTER_PATH];
-	mxArray **axis; /* n_axes: doubles, or codes into the axis's values */
-	uint32_t *location, *path;
-	bmx_labels location_labels, path_labels;
+	const bsim_trial_field *field;
+	int n_fields;
+	mxArray **col;      /* n_fields: numbers and words; NULL for a text */
+	uint32_t **codes;   /* n_fields: a text's codes, else NULL */
+	bmx_labels *labels; /* n_fields: a text's labels */
+	mxArray **axis;     /* n_axes: doubles, or codes into the axis's values */
 	int *idx, *axis_text;
+	char *text; /* a text field's, from open_memstream */
+	size_t text_size;
 	int oom;
 } trial_columns;
 
-/* "ix:iy ix:iy ...", the gates entered in order, as trials.csv writes it,
- * into buf (grown as needed); NULL if out of memory. */
-static const char *path_text(const bsim_trial_result *x, const bsim_trial_log *tl, char **buf,
-                             size_t *size)
+/* Field f of row as a text (c->text, reused); NULL if out of memory. */
+static const char *field_text(trial_columns *c, const bsim_trial_field *f,
+                              const bsim_trial_row *row)
 {
-	size_t n = tl ? (size_t)tl->n_entries : 0, need = 24 * (n + 1);
-	if (need > *size) {
-		char *b = realloc(*buf, need);
-		if (!b)
-			return NULL;
-		*buf = b;
-		*size = need;
-	}
-	size_t len = 0;
-	for (size_t j = 0; j < n; j++)
-		len += (size_t)sprintf(*buf + len, "%s%d:%d", j ? " " : "", tl->entries[j].ix,
-		                       tl->entries[j].iy);
-	if (n == 0)
-		sprintf(*buf, "%d:%d", x->final_ix, x->final_iy);
-	return *buf;
+	free(c->text);
+	c->text = NULL;
+	FILE *m = open_memstream(&c->text, &c->text_size);
+	if (!m)
+		return NULL;
+	f->text(m, row);
+	if (fclose(m) != 0)
+		return NULL;
+	return c->text;
 }
 
 static int columns_block(void *user, const bsim_sweep_block *b, bsim_error *err)
 {
 	trial_columns *c = user;
-	char *buf = NULL;
-	size_t size = 0;
 	for (long k = 0; k < b->n && !c->oom; k++) {
 		size_t at = (size_t)(b->first + k);
-		const bsim_trial_result *x = &b->results[k];
-		mxGetPr(c->group)[at] = (double)(at / (size_t)c->trials) + 1;
-		mxGetPr(c->trial)[at] = (double)(at % (size_t)c->trials) + 1;
-		((uint8_t *)mxGetData(c->outcome))[at] = (uint8_t)(x->outcome + 1);
-		((uint8_t *)mxGetData(c->type))[at] = (uint8_t)(x->type + 1);
-		for (int i = 0; i < N_AFTER_TYPE; i++)
-			mxGetPr(c->number[i])[at] = after_type[i].fn(x);
-		for (int i = 0; i < N_AFTER_PATH; i++)
-			mxGetPr(c->number[N_AFTER_TYPE + i])[at] = after_path[i].fn(x);
-		char label[48];
-		bsim_lattice_location_label(bsim_lattice_location_of(x), label, sizeof label);
-		const char *path = path_text(x, b->logs ? &b->logs[k] : NULL, &buf, &size);
-		long lc = bmx_labels_code(&c->location_labels, label);
-		long pc = path ? bmx_labels_code(&c->path_labels, path) : -1;
-		c->oom = lc < 0 || pc < 0;
-		if (!c->oom) {
-			c->location[at] = (uint32_t)lc;
-			c->path[at] = (uint32_t)pc;
+		const bsim_trial_row row = {(int)(at / (size_t)c->trials),
+		                            (int)(at % (size_t)c->trials), &b->results[k],
+		                            b->logs ? &b->logs[k] : NULL};
+		for (int i = 0; i < c->n_fields && !c->oom; i++) {
+			const bsim_trial_field *f = &c->field[i];
+			if (f->kind == BSIM_FIELD_TEXT) {
+				const char *text = field_text(c, f, &row);
+				long code = text ? bmx_labels_code(&c->labels[i], text) : -1;
+				c->oom = code < 0;
+				if (!c->oom)
+					c->codes[i][at] = (uint32_t)code;
+			} else if (f->kind == BSIM_FIELD_WORD) {
+				((uint8_t *)mxGetData(c->col[i]))[at] =
+				        (uint8_t)(f->value(&row) + 1);
+			} else {
+				mxGetPr(c->col[i])[at] = f->value(&row) + (f->index ? 1 : 0);
+			}
 		}
 		/* One column per grid axis: its value, or its code from 1. */
 		if (at % (size_t)c->trials == 0 || k == 0)
@@ -252,7 +116,6 @@ static int columns_block(void *user, const bsim_sweep_block *b, bsim_error *err)
 				mxGetPr(c->axis[a])[at] = value_number(text);
 		}
 	}
-	free(buf);
 	if (c->oom)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for the trials' columns");
 	return BSIM_OK;
@@ -265,21 +128,30 @@ static int columns_alloc(trial_columns *c, const bsim_experiment *e, bsim_error 
 	c->e = e;
 	c->trials = e->trials;
 	c->n = (size_t)e->n_groups * (size_t)e->trials;
-	double *unused;
-	c->group = bmx_column(c->n, &unused);
-	c->trial = bmx_column(c->n, &unused);
-	c->outcome = mxCreateNumericMatrix((mwSize)c->n, 1, mxUINT8_CLASS, mxREAL);
-	c->type = mxCreateNumericMatrix((mwSize)c->n, 1, mxUINT8_CLASS, mxREAL);
-	for (int i = 0; i < N_AFTER_TYPE + N_AFTER_PATH; i++)
-		c->number[i] = bmx_column(c->n, &unused);
+	c->field = bsim_trial_fields(&c->n_fields);
+	c->col = calloc((size_t)c->n_fields, sizeof *c->col);
+	c->codes = calloc((size_t)c->n_fields, sizeof *c->codes);
+	c->labels = calloc((size_t)c->n_fields, sizeof *c->labels);
 	size_t axes = (size_t)(e->n_axes > 0 ? e->n_axes : 1);
 	c->axis = calloc(axes, sizeof *c->axis);
 	c->idx = calloc(axes, sizeof *c->idx);
 	c->axis_text = calloc(axes, sizeof *c->axis_text);
-	c->location = malloc((c->n ? c->n : 1) * sizeof *c->location);
-	c->path = malloc((c->n ? c->n : 1) * sizeof *c->path);
-	if (!c->axis || !c->idx || !c->axis_text || !c->location || !c->path)
+	if (!c->col || !c->codes || !c->labels || !c->axis || !c->idx || !c->axis_text)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for the trials' columns");
+	double *unused;
+	for (int i = 0; i < c->n_fields; i++) {
+		const bsim_trial_field *f = &c->field[i];
+		if (f->kind == BSIM_FIELD_TEXT) {
+			c->codes[i] = malloc((c->n ? c->n : 1) * sizeof *c->codes[i]);
+			if (!c->codes[i])
+				return bsim_error_set(err, BSIM_EFAIL,
+				                      "out of memory for the trials' columns");
+		} else if (f->kind == BSIM_FIELD_WORD) {
+			c->col[i] = mxCreateNumericMatrix((mwSize)c->n, 1, mxUINT8_CLASS, mxREAL);
+		} else {
+			c->col[i] = bmx_column(c->n, &unused);
+		}
+	}
 	/* an axis is numbers if every value is one, else text (codes) */
 	for (int a = 0; a < e->n_axes; a++) {
 		const bsim_grid_axis *ax = &e->axes[a];
@@ -294,13 +166,19 @@ static int columns_alloc(trial_columns *c, const bsim_experiment *e, bsim_error 
 
 static void columns_free(trial_columns *c)
 {
+	for (int i = 0; i < c->n_fields; i++) {
+		if (c->codes)
+			free(c->codes[i]);
+		if (c->labels)
+			bmx_labels_free(&c->labels[i]);
+	}
+	free(c->col);
+	free(c->codes);
+	free(c->labels);
 	free(c->axis);
 	free(c->idx);
 	free(c->axis_text);
-	free(c->location);
-	free(c->path);
-	bmx_labels_free(&c->location_labels);
-	bmx_labels_free(&c->path_labels);
+	free(c->text);
 	memset(c, 0, sizeof *c);
 }
 
@@ -309,24 +187,19 @@ static void columns_free(trial_columns *c)
 static void trials_fields(mxArray *s, trial_columns *c)
 {
 	mxArray *t = mxCreateStructMatrix(1, 1, 0, NULL), *l = mxCreateStructMatrix(1, 1, 0, NULL);
-	static const char *const outcomes[] = {"traversed", "side_exit", "stuck", "unstable"};
-	static const char *const types[] = {"none", "left", "right"};
-	bmx_set(t, 0, "group", c->group);
-	bmx_set(t, 0, "trial", c->trial);
-	bmx_text_field(t, l, "outcome", c->outcome, bmx_cellstr(outcomes, 4));
-	bmx_text_field(t, l, "type", c->type, bmx_cellstr(types, 3));
-	for (int i = 0; i < N_AFTER_TYPE; i++)
-		bmx_set(t, 0, after_type[i].name, c->number[i]);
-	bmx_text_field(t, l, "location", bmx_codes(c->location, c->n, c->location_labels.n),
-	               bmx_labels_cell(&c->location_labels));
-	free(c->location);
-	c->location = NULL;
-	bmx_text_field(t, l, "path", bmx_codes(c->path, c->n, c->path_labels.n),
-	               bmx_labels_cell(&c->path_labels));
-	free(c->path);
-	c->path = NULL;
-	for (int i = 0; i < N_AFTER_PATH; i++)
-		bmx_set(t, 0, after_path[i].name, c->number[N_AFTER_TYPE + i]);
+	for (int i = 0; i < c->n_fields; i++) {
+		const bsim_trial_field *f = &c->field[i];
+		if (f->kind == BSIM_FIELD_TEXT) {
+			bmx_text_field(t, l, f->name, bmx_codes(c->codes[i], c->n, c->labels[i].n),
+			               bmx_labels_cell(&c->labels[i]));
+			free(c->codes[i]);
+			c->codes[i] = NULL;
+		} else if (f->kind == BSIM_FIELD_WORD) {
+			bmx_text_field(t, l, f->name, c->col[i], bmx_cellstr(f->words, f->n_words));
+		} else {
+			bmx_set(t, 0, f->name, c->col[i]);
+		}
+	}
 	for (int a = 0; a < c->e->n_axes; a++) {
 		const bsim_grid_axis *ax = &c->e->axes[a];
 		char field[64];

@@ -45,6 +45,7 @@
 #include "beamsim/table.h"
 #include "beamsim/trajectory.h"
 #include "beamsim/trial.h"
+#include "beamsim/trial_fields.h"
 #include "beamsim/version.h"
 #include "beamsim/video.h"
 

@@ -326,29 +326,12 @@ int bsim_output_summary_json(const char *path, const bsim_experiment *e, const c
 
 /* ---- trials.csv -------------------------------------------------------- */
 
-/* A number, or an empty field if it was not measured (NaN). */
-static void number_field(FILE *f, double x)
+const char *bsim_trials_csv_column(int k)
 {
-	if (!isnan(x))
-		fprintf(f, "%.10g", x);
+	int n;
+	const bsim_trial_field *f = bsim_trial_fields(&n);
+	return k >= 0 && k < n ? f[k].name : "?";
 }
-
-const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS] = {
-        "group",       "trial",
-        "outcome",     "type",
-        "steps",       "t_end",
-        "x_end",       "y_end",
-        "vx_end",      "max_theta1",
-        "max_theta2",  "e_start",
-        "e_end",       "work_in",
-        "losses",      "residual",
-        "overlap_max", "final_ix",
-        "final_iy",    "location",
-        "path",        "iteration_limits",
-        "clamps",      "t_exit",
-        "heading_end", "angular_velocity_end",
-        "turn_end",    "turn_max",
-};
 
 int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
                          bsim_error *err)
@@ -360,7 +343,7 @@ int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_expe
 	w->axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
 	w->group = -1;
 	for (int c = 0; c < TRIALS_N_COLUMNS; c++)
-		fprintf(w->o.f, "%s%s", c ? "," : "", bsim_trials_csv_columns[c]);
+		fprintf(w->o.f, "%s%s", c ? "," : "", bsim_trials_csv_column(c));
 	for (int a = 0; a < w->axes; a++) {
 		fputc(',', w->o.f);
 		bsim_csv_field_write(w->o.f, e->axes[a].key);
@@ -373,44 +356,19 @@ void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
                           const bsim_trial_result *results, const bsim_trial_log *logs)
 {
 	FILE *f = w->o.f;
+	int n_fields;
+	const bsim_trial_field *fields = bsim_trial_fields(&n_fields);
 	for (long k = 0; k < n; k++) {
 		int g = (int)((first + k) / trials), t = (int)((first + k) % trials);
 		if (w->axes && g != w->group)
 			bsim_experiment_group_index(w->e, g, w->idx);
 		w->group = g;
-		const bsim_trial_result *x = &results[k];
-		const bsim_ledger *l = &x->ledger;
-		fprintf(f, "%d,%d,%s,%s,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", g, t,
-		        bsim_trial_outcome_name(x->outcome), bsim_trial_type_name(x->type),
-		        x->steps, x->t_end, x->x_end, x->y_end, x->vx_end, x->max_theta[0],
-		        x->max_theta[1]);
-		/* losses: sleeping's and the essay protocol's resets too, so that
-		 * e_end - e_start = work_in - losses + residual */
-		fprintf(f, ",%.10g,%.10g,%.10g,%.10g,%.10g,", l->e_start, l->e_end,
-		        l->w_prop + l->w_rand,
-		        l->damper + l->impact + l->contact + l->correction + l->sleep + l->reset,
-		        l->residual);
-		number_field(f, x->overlap_max);
-		/* the final gate and location, and the gates entered in order:
-		 * "ix:iy ix:iy ..." */
-		char label[48];
-		bsim_lattice_location_label(bsim_lattice_location_of(x), label, sizeof label);
-		fprintf(f, ",%d,%d,%s,", x->final_ix, x->final_iy, label);
-		const bsim_trial_log *tl = logs ? &logs[k] : NULL;
-		for (int j = 0; tl && j < tl->n_entries; j++)
-			fprintf(f, "%s%d:%d", j ? " " : "", tl->entries[j].ix, tl->entries[j].iy);
-		/* A trial without its path (taken from a resumed run's
-		 * journal, which lattices never are) stayed in one gate. */
-		if (!tl || tl->n_entries == 0)
-			fprintf(f, "%d:%d", x->final_ix, x->final_iy);
-		/* what the backend's solvers gave up on in this trial */
-		fprintf(f, ",%ld,%ld,", x->solver.iteration_limit, x->solver.clamped);
-		/* when it left the gate (the field), empty if censored */
-		number_field(f, bsim_survival_exit_time(x));
-		/* the body's turn: every body's, 0 for one that does not
-		 * rotate, so that every file has the same columns */
-		fprintf(f, ",%.10g,%.10g,%.10g,%.10g", x->heading_end, x->angular_velocity_end,
-		        x->turn_end, x->turn_max);
+		const bsim_trial_row row = {g, t, &results[k], logs ? &logs[k] : NULL};
+		for (int c = 0; c < n_fields; c++) {
+			if (c)
+				fputc(',', f);
+			bsim_trial_field_write(f, &fields[c], &row);
+		}
 		for (int a = 0; a < w->axes; a++) {
 			fputc(',', f);
 			bsim_csv_field_write(f, w->e->axes[a].values[w->idx[a]]);

@@ -1,14 +1,14 @@
-/* The columns of trials.csv, in the order they are written (docs/files.md
- * "Outputs of `sweep --out DIR`": the first eleven, group to max_theta2,
- * then those appended since): the one list the writer (output.c) and the
- * reader (trials_read.c) share. After them come the grid axes of the
- * experiment, one column each. */
+/* The columns of trials.csv by index, in the order they are written
+ * (beamsim/trial_fields.h, which describes each; docs/files.md "Outputs of
+ * `sweep --out DIR`"): the indices the reader (trials_read.c) finds them
+ * by. After them come the grid axes of the experiment, one column each. */
 #ifndef BSIM_STORE_TRIALS_CSV_H
 #define BSIM_STORE_TRIALS_CSV_H
 
 #include "beamsim/experiment.h"
 #include "beamsim/output.h"
 #include "beamsim/trial.h"
+#include "beamsim/trial_fields.h"
 #include "util/atomic_file.h"
 
 enum {
@@ -43,8 +43,9 @@ enum {
 	TRIALS_N_COLUMNS
 };
 
-/* Their names, as in the header line. */
-extern const char *const bsim_trials_csv_columns[TRIALS_N_COLUMNS];
+/* Column k's name, as in the header line: beamsim/trial_fields.h's k-th
+ * field, whose order these indices follow (test_output_files checks it). */
+const char *bsim_trials_csv_column(int k);
 
 /* trials.csv written as the trials come (a streamed sweep hands them over
  * block by block): open writes the header, rows appends trials first ..

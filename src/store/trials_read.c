@@ -94,7 +94,7 @@ typedef struct reader {
 
 static const char *column_name(int k)
 {
-	return bsim_trials_csv_columns[column_of[k]];
+	return bsim_trials_csv_column(column_of[k]);
 }
 
 /* The column k of this reader whose name s is, or -1. */

@@ -1,0 +1,149 @@
+/* trials.csv's columns, described once (beamsim/trial_fields.h). */
+#include "beamsim/trial_fields.h"
+
+#include <math.h>
+#include <stdio.h>
+
+#include "beamsim/lattice_outcome.h"
+#include "store/survival_files.h"
+
+static const char *const outcome_words[] = {"traversed", "side_exit", "stuck", "unstable"};
+static const char *const type_words[] = {"none", "left", "right"};
+
+/* One getter a column: the row's value. */
+#define GETTER(fn, expr)                                                                           \
+	static double fn(const bsim_trial_row *row)                                                \
+	{                                                                                          \
+		const bsim_trial_result *x = row->r;                                               \
+		const bsim_ledger *l = &x->ledger;                                                 \
+		(void)x;                                                                           \
+		(void)l;                                                                           \
+		return (expr);                                                                     \
+	}
+
+GETTER(f_group, row->group)
+GETTER(f_trial, row->trial)
+GETTER(f_outcome, x->outcome)
+GETTER(f_type, x->type)
+GETTER(f_steps, x->steps)
+GETTER(f_t_end, x->t_end)
+GETTER(f_x_end, x->x_end)
+GETTER(f_y_end, x->y_end)
+GETTER(f_vx_end, x->vx_end)
+GETTER(f_max_theta1, x->max_theta[0])
+GETTER(f_max_theta2, x->max_theta[1])
+GETTER(f_e_start, l->e_start)
+GETTER(f_e_end, l->e_end)
+GETTER(f_work_in, l->w_prop + l->w_rand)
+/* sleeping's and the essay protocol's resets too, so that e_end - e_start
+ * = work_in - losses + residual */
+GETTER(f_losses, l->damper + l->impact + l->contact + l->correction + l->sleep + l->reset)
+GETTER(f_residual, l->residual)
+GETTER(f_overlap_max, x->overlap_max)
+GETTER(f_final_ix, x->final_ix)
+GETTER(f_final_iy, x->final_iy)
+GETTER(f_iteration_limits, (double)x->solver.iteration_limit)
+GETTER(f_clamps, (double)x->solver.clamped)
+GETTER(f_t_exit, bsim_survival_exit_time(x))
+GETTER(f_heading_end, x->heading_end)
+GETTER(f_angular_velocity_end, x->angular_velocity_end)
+GETTER(f_turn_end, x->turn_end)
+GETTER(f_turn_max, x->turn_max)
+
+static void t_location(FILE *out, const bsim_trial_row *row)
+{
+	char label[48];
+	bsim_lattice_location_label(bsim_lattice_location_of(row->r), label, sizeof label);
+	fputs(label, out);
+}
+
+/* The gates entered in order, "ix:iy ix:iy ..."; a trial without its path
+ * (taken from a resumed run's journal, which lattices never are) stayed
+ * in one gate. */
+static void t_path(FILE *out, const bsim_trial_row *row)
+{
+	const bsim_trial_log *tl = row->log;
+	for (int j = 0; tl && j < tl->n_entries; j++)
+		fprintf(out, "%s%d:%d", j ? " " : "", tl->entries[j].ix, tl->entries[j].iy);
+	if (!tl || tl->n_entries == 0)
+		fprintf(out, "%d:%d", row->r->final_ix, row->r->final_iy);
+}
+
+#define NUMBER(name, kind, unit, help, fn)                                                         \
+	{                                                                                          \
+		name, kind, unit, help, 0, fn, NULL, 0, NULL                                       \
+	}
+
+static const bsim_trial_field fields[] = {
+        {"group", BSIM_FIELD_INT, "", "the group, 0-based", 1, f_group, NULL, 0, NULL},
+        {"trial", BSIM_FIELD_INT, "", "the trial within its group, 0-based", 1, f_trial, NULL, 0,
+         NULL},
+        {"outcome", BSIM_FIELD_WORD, "", "traversed, side_exit, stuck or unstable", 0, f_outcome,
+         outcome_words, 4, NULL},
+        {"type", BSIM_FIELD_WORD, "", "the beam a traversal went over: left, right or none", 0,
+         f_type, type_words, 3, NULL},
+        NUMBER("steps", BSIM_FIELD_INT, "", "steps to the outcome", f_steps),
+        NUMBER("t_end", BSIM_FIELD_REAL, "s", "time to the outcome", f_t_end),
+        NUMBER("x_end", BSIM_FIELD_REAL, "m", "the end position's x", f_x_end),
+        NUMBER("y_end", BSIM_FIELD_REAL, "m", "the end position's y", f_y_end),
+        NUMBER("vx_end", BSIM_FIELD_REAL, "m/s", "the end velocity's x", f_vx_end),
+        NUMBER("max_theta1", BSIM_FIELD_REAL, "rad", "beam 1's peak angle", f_max_theta1),
+        NUMBER("max_theta2", BSIM_FIELD_REAL, "rad", "beam 2's peak angle", f_max_theta2),
+        NUMBER("e_start", BSIM_FIELD_REAL, "J", "the energy at the start", f_e_start),
+        NUMBER("e_end", BSIM_FIELD_REAL, "J", "the energy at the end", f_e_end),
+        NUMBER("work_in", BSIM_FIELD_REAL, "J", "the forces' work", f_work_in),
+        NUMBER("losses", BSIM_FIELD_REAL, "J", "what dissipation took", f_losses),
+        NUMBER("residual", BSIM_FIELD_REAL, "J", "the ledger's residual", f_residual),
+        NUMBER("overlap_max", BSIM_FIELD_MEASURED, "m", "the deepest overlap of body and beams",
+               f_overlap_max),
+        NUMBER("final_ix", BSIM_FIELD_INT, "", "the final gate's column", f_final_ix),
+        NUMBER("final_iy", BSIM_FIELD_INT, "", "the final gate's row", f_final_iy),
+        {"location", BSIM_FIELD_TEXT, "", "where it ended: end:ix, side:iy or stuck:ix:iy", 0, NULL,
+         NULL, 0, t_location},
+        {"path", BSIM_FIELD_TEXT, "", "the gates entered, ix:iy separated by spaces", 0, NULL, NULL,
+         0, t_path},
+        NUMBER("iteration_limits", BSIM_FIELD_INT, "", "solves that stopped at their limit",
+               f_iteration_limits),
+        NUMBER("clamps", BSIM_FIELD_INT, "", "(sub)steps whose motion the solver clamped",
+               f_clamps),
+        NUMBER("t_exit", BSIM_FIELD_MEASURED, "s", "when the trial left the gate or the field",
+               f_t_exit),
+        NUMBER("heading_end", BSIM_FIELD_REAL, "rad", "the body's heading at the end",
+               f_heading_end),
+        NUMBER("angular_velocity_end", BSIM_FIELD_REAL, "rad/s",
+               "the body's angular velocity at the end", f_angular_velocity_end),
+        NUMBER("turn_end", BSIM_FIELD_REAL, "rad", "how far the body turned", f_turn_end),
+        NUMBER("turn_max", BSIM_FIELD_REAL, "rad", "the largest turn on the way", f_turn_max),
+};
+
+const bsim_trial_field *bsim_trial_fields(int *n)
+{
+	*n = (int)(sizeof fields / sizeof fields[0]);
+	return fields;
+}
+
+void bsim_trial_field_write(FILE *out, const bsim_trial_field *f, const bsim_trial_row *row)
+{
+	switch (f->kind) {
+	case BSIM_FIELD_INT:
+		fprintf(out, "%lld", (long long)f->value(row));
+		return;
+	case BSIM_FIELD_REAL:
+		fprintf(out, "%.10g", f->value(row));
+		return;
+	case BSIM_FIELD_MEASURED: {
+		double x = f->value(row);
+		if (!isnan(x))
+			fprintf(out, "%.10g", x);
+		return;
+	}
+	case BSIM_FIELD_WORD: {
+		int k = (int)f->value(row);
+		fputs(k >= 0 && k < f->n_words ? f->words[k] : "?", out);
+		return;
+	}
+	case BSIM_FIELD_TEXT:
+		f->text(out, row);
+		return;
+	}
+}
