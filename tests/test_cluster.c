@@ -112,7 +112,7 @@ static void drop_wall(char *text)
  * differ). */
 static void drop_cpu(char *text)
 {
-	static const char *const keys[] = {"sim_cpu_seconds", "predict_seconds", "speedup",
+	static const char *const keys[] = {"sim_cpu_seconds", "predict_cpu_seconds", "speedup",
 	                                   "break_even_lattices"};
 	for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
 		drop_key(text, keys[i]);

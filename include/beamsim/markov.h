@@ -423,7 +423,7 @@ typedef struct bsim_markov_check {
 	double tv_map;                 /* mean TV of the chain from resampled maps */
 	double gates_sim, gates_chain; /* mean gates visited */
 	double sim_cpu;                /* s, the direct simulation */
-	double predict;                /* s, one prediction */
+	double predict; /* s of CPU, one prediction as markov predict makes it by default */
 	int n_states, exact;
 	/* Time to the outcome, when the maps have holding times (has_time; else
 	 * the times NAN): the trials out (the end or a side) by the trial's

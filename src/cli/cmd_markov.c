@@ -909,7 +909,7 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 		       "(%lld single-gate steps)\n\n",
 		       a.map, v.bins, v.trials_per_bin, v.map_cost, v.map_steps);
 		printf("group protocol trials    TV  sampling (95%%)   map   gates sim/chain  "
-		       "sim CPU s  predict s   speedup  pays off after\n");
+		       "sim CPU s  predict CPU s   speedup  pays off after\n");
 		for (int i = 0; i < v.n; i++) {
 			const bsim_markov_check *k = &v.checks[i];
 			/* the fields (predictions) after which the maps cost less
@@ -920,7 +920,7 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 				snprintf(pays, sizeof pays, "%.0f fields",
 				         ceil(v.map_cost / saved));
 			printf("%5d %-8s %6d %5.3f  %5.3f (%5.3f)  %5.3f   %5.2f / %5.2f  %9.3f  "
-			       "%9.2e  "
+			       "%13.2e  "
 			       "%8.3g  %s\n",
 			       k->group, k->protocol == BSIM_PROTOCOL_ESSAY ? "essay" : "world",
 			       k->trials, k->tv, k->tv_sampling, k->tv_sampling95, k->tv_map,
