@@ -5,6 +5,8 @@
 # Wilson 95% intervals, one panel per forcing and friction, into
 # OUT/shape_study.png (+ .svg, the table shape_study.csv).
 #   scripts/shape_study.sh OUT [--backend B] [--trials N] [other sweep options]
+# Box2D and Chipmunk hold the ellipse as a polygon and refuse it unless told:
+# add --backend-opt ellipse=polygon with --backend box2d or chipmunk.
 set -euo pipefail
 out=${1:?usage: scripts/shape_study.sh OUT [sweep options]}
 shift

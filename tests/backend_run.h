@@ -60,7 +60,11 @@ static inline bsim_world *test_beam_released(const bsim_backend *b, bsim_scene *
 /* Over 3 s from 0.1 rad: the largest |theta - exact|, and from the peaks of
  * |theta| (its local maxima, every half period) the decay rate
  * ln(A_first / A_last) / (t_last - t_first) and the period, each relative to
- * the oscillator's (zeta omega_n, 2 pi / omega_d) less 1. */
+ * the oscillator's (zeta omega_n, 2 pi / omega_d) less 1. Each peak's time
+ * and height are the vertex of the parabola through the sample at the
+ * local maximum and its two neighbours: read off the samples alone, the
+ * peaks' times are whole steps, which puts up to h / (t_last - t_first)
+ * (0.2% at 4 ms) into the period and the rate. */
 typedef struct vibration {
 	double worst, rate_rel, period_rel;
 } vibration;
@@ -95,12 +99,16 @@ static inline vibration beam_vibration(const bsim_backend *b, const char *kv, do
 		double t = (double)n * h;
 		worst = fmax(worst, fabs(st.theta[0] - damped_oscillator(k, d, inertia, 0.1, t)));
 		if (n >= 2 && fabs(prev) > fabs(prev2) && fabs(prev) >= fabs(st.theta[0])) {
+			/* the parabola through (-h, y0), (0, y1), (h, y2) */
+			const double y0 = fabs(prev2), y1 = fabs(prev), y2 = fabs(st.theta[0]);
+			const double u = 0.5 * (y0 - y2) / (y0 - 2.0 * y1 + y2); /* in steps */
+			const double t_peak = t - h + u * h, a_peak = y1 - 0.25 * (y0 - y2) * u;
 			if (t_first < 0.0) {
-				t_first = t - h;
-				a_first = fabs(prev);
+				t_first = t_peak;
+				a_first = a_peak;
 			}
-			t_last = t - h;
-			a_last = fabs(prev);
+			t_last = t_peak;
+			a_last = a_peak;
 			peaks++;
 		}
 		prev2 = prev;

@@ -916,6 +916,22 @@ void bsim_test_skip_refused(const bsim_backend *b, bsim_scene *s)
 	}
 }
 
+bsim_options bsim_test_body_options(const bsim_backend *b, const bsim_body_def *body)
+{
+	bsim_options o;
+	memset(&o, 0, sizeof o);
+	if (body->shape != BSIM_SHAPE_ELLIPSE)
+		return o;
+	for (int k = 0; k < b->n_knobs; k++) {
+		if (strcmp(b->knobs[k].name, "ellipse") == 0) {
+			bsim_error err;
+			if (bsim_options_add(&o, "ellipse=polygon", &err) != BSIM_OK)
+				fail_msg("%s", err.msg);
+		}
+	}
+	return o;
+}
+
 bsim_world *bsim_test_world(const bsim_backend *b, const bsim_scene *s, const bsim_options *opts)
 {
 	bsim_world *w = NULL;

@@ -204,6 +204,13 @@ void bsim_test_skip(const bsim_backend *b, const char *fmt, ...)
  * frees s first then. */
 void bsim_test_skip_refused(const bsim_backend *b, bsim_scene *s);
 
+/* The options under which the checks of other things (a body's turn, drag,
+ * friction, mirror images) take body on b: none, or "ellipse=polygon" where
+ * b holds an ellipse only as a polygon and refuses it unless told (a knob
+ * "ellipse": off its axes the polygon's restitution is not the scene's,
+ * test_impact's "impact.shape.restitution"). */
+bsim_options bsim_test_body_options(const bsim_backend *b, const bsim_body_def *body);
+
 /* b's world for s with opts (may be NULL); fails the test with b's message
  * if b refuses. */
 bsim_world *bsim_test_world(const bsim_backend *b, const bsim_scene *s, const bsim_options *opts);

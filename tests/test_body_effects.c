@@ -548,6 +548,7 @@ static void test_box2d_damping_exact(void **state)
 			assert_int_equal(
 			        bsim_options_add(&o, sub ? "substeps=4" : "substeps=1", &err),
 			        BSIM_OK);
+			assert_int_equal(bsim_options_add(&o, "ellipse=polygon", &err), BSIM_OK);
 			decay_track t = {.h = s.dt, .rate = rate, .spin = spin};
 			bsim_recorder rec = {.trace = track_decay, .trace_user = &t};
 			bsim_trial_runner *r = bsim_trial_runner_alloc();

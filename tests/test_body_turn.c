@@ -56,7 +56,8 @@ static void run_seed(const bsim_backend *be, bsim_scene *s, uint64_t seed, const
 {
 	bsim_error err;
 	bsim_trial_runner *r = bsim_trial_runner_alloc();
-	int rc = bsim_trial_run(r, s, be, NULL, seed, rec, out, &err);
+	const bsim_options o = bsim_test_body_options(be, &s->body);
+	int rc = bsim_trial_run(r, s, be, &o, seed, rec, out, &err);
 	bsim_trial_runner_free(r);
 	if (rc == BSIM_EINPUT && strncmp(err.msg, be->name, strlen(be->name)) == 0) {
 		bsim_scene_free(s);
@@ -477,7 +478,8 @@ static void test_outline_flag(void **state)
 				bsim_error err;
 				assert_int_equal(bsim_scene_validate(&s, &err), BSIM_OK);
 				bsim_world *w = NULL;
-				if (be->create(&s, NULL, &w, &err) != BSIM_OK) {
+				const bsim_options o = bsim_test_body_options(be, &s.body);
+				if (be->create(&s, &o, &w, &err) != BSIM_OK) {
 					/* a backend without turning shapes refuses them
 					 * (test_disk_only_refused) */
 					bsim_scene_free(&s);

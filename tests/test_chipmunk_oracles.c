@@ -4,9 +4,9 @@
  * test_energy_ledger, test_mirror, ...: its bounds there are in its table,
  * backends/chipmunk/chipmunk_world.c), and what only it has: its explicit
  * spring's limit, which create refuses, the version it states, reset and
- * set_state, its options' checks, the ellipse's polygon, and a motion
- * beyond what Chipmunk steps. Each measured value is printed so a change
- * shows.
+ * set_state, its options' checks, the ellipse's polygon and its refusal
+ * unless ellipse=polygon (impact_ellipse_refusal), and a motion beyond what
+ * Chipmunk steps. Each measured value is printed so a change shows.
  *   1 free vibration:  substeps=4 against the analytic damped oscillator
  *                      (error, decay rate, period)
  *   2 stiff springs:   bounded below the explicit spring's limit, refused
@@ -55,9 +55,9 @@ static void test_version(void **state)
 
 /* The essay's beam released from 0.1 rad at h = 4 ms, at the defaults and
  * with substeps=4 (Chipmunk's steps of h/4): the decay rate and period
- * within 0.5% of the oscillator's (measured -0.08% and +0.34% at the
- * defaults, the period read off peaks a step apart), the error cut by more
- * than 3 (first order: measured 8.9e-4 and 2.2e-4 rad). */
+ * within 0.5% of the oscillator's (measured -0.00% and +0.26% at the
+ * defaults: its damper's decay is exact), the error cut by more than 3
+ * (first order: measured 8.9e-4 and 2.2e-4 rad). */
 static void test_substeps_vibration(void **state)
 {
 	(void)state;
@@ -349,9 +349,9 @@ static void test_bad_options(void **state)
 	(void)state;
 	bsim_scene s;
 	scene_gate_quiet(&s);
-	const char *bad[] = {"substeps=0",         "iterations=0",         "iterations=1001",
-	                     "collision_slop=-1",  "collision_bias=1.5",   "collision_bias=-0.1",
-	                     "collision_slop=inf", "velocity_iterations=8"};
+	const char *bad[] = {"substeps=0",         "iterations=0",          "iterations=1001",
+	                     "collision_slop=-1",  "collision_bias=1.5",    "collision_bias=-0.1",
+	                     "collision_slop=inf", "velocity_iterations=8", "ellipse=circle"};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
 		bsim_options o = test_options(bad[i], NULL);
 		bsim_world *w = NULL;
@@ -361,6 +361,13 @@ static void test_bad_options(void **state)
 		assert_true(strlen(err.msg) > 0);
 	}
 	bsim_scene_free(&s);
+}
+
+/* An ellipse refused by default, and why (impact_ellipse_refusal). */
+static void test_ellipse_refused(void **state)
+{
+	(void)state;
+	impact_ellipse_refusal(cm);
 }
 
 /* The ellipse's polygon (a = 12.5 m, b = 8 m, 128 vertices) against the
@@ -419,6 +426,7 @@ int main(void)
 	        cmocka_unit_test(test_motion_out_of_range),
 	        cmocka_unit_test(test_bad_options),
 	        cmocka_unit_test(test_ellipse_polygon),
+	        cmocka_unit_test(test_ellipse_refused),
 	        cmocka_unit_test(test_flat_impact_iterations),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);

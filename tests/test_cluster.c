@@ -271,7 +271,10 @@ static void test_shards_merged(void **state)
 	assert_same_dir(one, out);
 }
 
-/* A comparison of the sides backends in 3 parts, merged. */
+/* A comparison of the sides backends in 3 parts, merged: the one-process
+ * comparison's files and exit status (3 if a group disagrees: Box2D's
+ * float32 may tip the symmetric gate's deterministic traversal to a side,
+ * docs/compare.md), each part's 0. */
 static void compare_shards_merged(const char *name, const char *backends)
 {
 	char dir[1024], one[1100], out[1100], part[3][1100];
@@ -279,7 +282,8 @@ static void compare_shards_merged(const char *name, const char *backends)
 	snprintf(one, sizeof one, "%s/one", dir);
 	const char *argv1[] = {"compare", experiment, "--trials", "4",          "--threads", "2",
 	                       "--out",   one,        "--quiet",  "--backends", backends,    NULL};
-	assert_int_equal(bsim_test_cli(argv1, NULL, NULL), 0);
+	const int status = bsim_test_cli(argv1, NULL, NULL);
+	assert_true(status == 0 || status == 3);
 	for (int i = 0; i < 3; i++) {
 		char shard_arg[16];
 		snprintf(part[i], sizeof part[i], "%s/p%d", dir, i + 1);
@@ -291,7 +295,7 @@ static void compare_shards_merged(const char *name, const char *backends)
 	}
 	snprintf(out, sizeof out, "%s/merged", dir);
 	const char *argv[] = {"merge", part[1], part[2], part[0], "--out", out, "--quiet", NULL};
-	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), status);
 	assert_same_dir(one, out);
 }
 
@@ -1058,11 +1062,12 @@ static void test_mpi_compare(void **state)
 	snprintf(err_path, sizeof err_path, "%s.err", out);
 	const char *argv1[] = {"compare", experiment, "--trials", "6",       "--threads",
 	                       "2",       "--out",    one,        "--quiet", NULL};
-	assert_int_equal(bsim_test_cli(argv1, NULL, NULL), 0);
+	const int status = bsim_test_cli(argv1, NULL, NULL); /* 3: a group disagrees */
+	assert_true(status == 0 || status == 3);
 	int rc = wait_status(mpirun_command("compare", "2", out, "6", 0, err_path));
-	if (rc != 0)
+	if (rc != status)
 		print_stderr(err_path);
-	assert_int_equal(rc, 0);
+	assert_int_equal(rc, status);
 	assert_same_dir(one, out);
 }
 

@@ -1,7 +1,9 @@
 /* Regression test: a comparison of two sides writes the bytes it wrote
  * before comparisons took any number of sides. The fixtures in
  * tests/data/compare_two_sides/ are report.json, report.md and pairs.csv of
- * four comparisons written by beamsim before that change (H1 at 4 trials a
+ * four comparisons written by beamsim before that change (rewritten since
+ * where Box2D's defaults changed what it computes, and its knobs, which the
+ * reports list; H1 at 4 trials a
  * group; the stiff beam against Box2D's explicit springs, which disagree
  * and so list example trials with their replay lines; a lattice under two
  * protocols and a lattice on both backends, with the final-location
@@ -89,7 +91,9 @@ static void test_h1(void **state)
 {
 	(void)state;
 	const char *extra[] = {"--trials", "4", NULL};
-	run_compare("h1", "configs/thesis/h1_symmetric.yaml", extra, 0);
+	/* 3: the deterministic group F = 9 N differs in type (Box2D's float32
+	 * tips the symmetric gate's traversal to a side, docs/compare.md) */
+	run_compare("h1", "configs/thesis/h1_symmetric.yaml", extra, 3);
 }
 
 static void test_stiff_disagrees(void **state)

@@ -307,7 +307,8 @@ static void test_slide_and_spin_stop(void **state)
 		bsim_trial_runner *r = bsim_trial_runner_alloc();
 		bsim_trial_result out;
 		bsim_error err;
-		int rc = bsim_trial_run(r, &s, be, NULL, 1, &rec, &out, &err);
+		const bsim_options o = bsim_test_body_options(be, b);
+		int rc = bsim_trial_run(r, &s, be, &o, 1, &rec, &out, &err);
 		if (rc == BSIM_EINPUT) { /* a backend that does not take the shape */
 			print_message("%s %s: skipped (%s)\n", be->name, case_name[c], err.msg);
 			bsim_trial_runner_free(r);

@@ -150,7 +150,9 @@ static void zeno_one(const bsim_backend *b, double e)
 	/* the coupled body-beam mode about the rest point is lightly damped
 	 * (tests/test_persistent_contact.h: zeta ~ 0.08) and still rings */
 	assert_true(speed < 0.2);
-	assert_true(fabs(st.x[0]) < 1e-6);
+	/* on the midline, to the round-off of positions (Box2D's float32
+	 * breaks the tie a little, by which beam it solves first) */
+	assert_true(fabs(st.x[0]) <= apex_bound);
 	bsim_state_free(&st);
 	b->destroy(w);
 	bsim_scene_free(&s);

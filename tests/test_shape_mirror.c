@@ -185,7 +185,8 @@ static void run(const bsim_backend *be, const bsim_scene *s, uint64_t seed, path
 	bsim_trial_runner *r = bsim_trial_runner_alloc();
 	assert_non_null(r);
 	bsim_error err;
-	int rc = bsim_trial_run(r, s, be, NULL, seed, &rec, res, &err);
+	const bsim_options o = bsim_test_body_options(be, &s->body);
+	int rc = bsim_trial_run(r, s, be, &o, seed, &rec, res, &err);
 	if (rc)
 		print_message("%s: %s\n", be->name, err.msg);
 	assert_int_equal(rc, BSIM_OK);

@@ -38,7 +38,10 @@
  *              2 / (1 + cos(pi / K)) so that the chords' midpoints lie as
  *              far inside as the vertices lie outside; cut into fans of 6
  *              edges about the centre (b2_maxPolygonVertices = 8). Its
- *              shape error is bsim_box2d_ellipse_error's.
+ *              shape error is bsim_box2d_ellipse_error's. With knob
+ *              ellipse=polygon only: off its axes the polygon's
+ *              restitution is not the scene's, and check refuses it
+ *              unless told.
  *   beam i: dynamic body whose origin is the pivot P, angle a_i = sgn theta_i
  *          (sgn = +1 if the rest direction u0 has x >= 0, else -1: theta > 0
  *          swings the tip forward, +y), one two-sided edge from (0, 0) to
@@ -61,11 +64,21 @@
  *           gives  omega' = omega + h (tau + tau_c) / I,  theta' = theta + h omega'.
  *           The damper's work over the step is -d omega h omega'.
  *   weld:   b2WeldJoint at P (its rigid point rows are the pin) with angular
- *           stiffness k and damping d. Its soft row, solved to convergence,
- *           is backward Euler:  I (omega' - omega) = -h (k (theta + h omega') +
- *           d omega') + h tau_c;  the damper's share of its impulse,
- *           -h d omega', dissipates h d omega'^2. A beam with k = 0 keeps the
- *           revolute pin and torque damper (a weld with stiffness 0 is rigid).
+ *           stiffness k and damping d_w (Box2D 2.4.1's b2_weld_joint.cpp:
+ *           gamma = 1 / (h (d_w + h k)), bias = C h k gamma, the row
+ *           Cdot + bias + gamma P = 0). The beam's angular row does not
+ *           couple to the pin's (its centre is the anchor), so one
+ *           iteration solves it, and it is backward Euler:
+ *           I (omega' - omega) = -h (k (theta + h omega') + d_w omega') + h tau_c;
+ *           the damper's share of its impulse, -h d_w omega', dissipates
+ *           h d_w omega'^2. With d_w = d (knob weld_damping=scene) a free
+ *           beam's omega is divided by 1 + h (d + h k) / I a step, the
+ *           decay 2.7% too fast on the essay's beam at 4 ms; weld_damping=
+ *           matched (the default) sets d_w = I (exp(h d / I) - 1) / h - h k,
+ *           so that the factor is exp(-h d / I), the damper's own, and the
+ *           decay is the oscillator's (weld_coefficients_set). A beam with
+ *           k = 0 keeps the revolute pin and torque damper (a weld with
+ *           stiffness 0 is rigid).
  *
  * Friction: contact.friction mu on the body's and the beams' fixtures;
  * b2MixFriction's sqrt(mu mu) is mu to the bit (a correctly rounded
@@ -129,7 +142,7 @@
  * Energy of a step, for the runner's ledger (dE = W - damper - impact -
  * contact - correction):
  *   damper: torque mode d omega h omega' (omega as applied, omega' as solved);
- *           weld mode h d omega'^2.
+ *           weld mode h d_w omega'^2.
  *   impact, contact: the velocity solve changes the kinetic energy by exactly
  *           sum_j P_j (v_j- + v_j+)/2 over its rows j (impulse P_j, relative
  *           normal velocity v_j = J_j v before and after; the pin rows do no
@@ -154,8 +167,10 @@
  *           the kinetic energy it adds; at an impact the force and the spring
  *           torque act before the velocity jump and are credited over the
  *           motion after it (h F . dv, k theta h d omega); the weld's backward
- *           Euler removes k (h omega')^2 / 2 a step. All are O(h): the knob
- *           substeps shrinks them.
+ *           Euler removes I (omega' - omega)^2 / 2 + k (h omega')^2 / 2 a step
+ *           beside its damper's share (which, matched, this replaces: the
+ *           decay is the damper's). All are O(h): the knob substeps shrinks
+ *           them.
  */
 #include <box2d/box2d.h>
 
@@ -184,26 +199,36 @@ namespace
 constexpr double BSIM_PI = 3.14159265358979323846;
 
 /* The knobs. The spring default is chosen from these measurements
- * (tests/test_box2d_oracles.c prints them; h = 4 ms, substeps = 1):
- *   free vibration, Table 2.1 beam from 0.1 rad, max |theta - exact| over
- *   3 s: torque 8.1e-4 rad, weld 1.19e-3 rad; both first order (halved at
- *   h = 2 ms).
+ * (tests/test_box2d_oracles.c and test_free_vibration print them; h = 4 ms,
+ * substeps = 1; weld: weld_damping=matched, the default, and =scene):
+ *   free vibration, Table 2.1 beam from 0.1 rad over 3 s, decay rate and
+ *   period against the oscillator's: torque +0.48% and -0.22%, weld
+ *   matched 0.000% and +0.26% (scene +2.69%, +0.49%); max |theta - exact|
+ *   torque 8.1e-4 rad, weld 4.0e-4 (scene 1.19e-3); all first order
+ *   (halved at h = 2 ms).
  *   stiff springs, undamped, omega_n h = 0.5 / 1.5 / 4: torque keeps
  *   E/E0 within 1.33 / 4.0 (symplectic) and is unstable at 4 (E/E0 = 51,
  *   bounded only by Box2D's b2_maxRotation clamp); weld never gains
- *   energy and is stable at any step, but damps numerically (backward
- *   Euler, extra damping ratio ~ omega_n h / 2: 0.009 at the essay's beam,
- *   beside its physical 0.274).
+ *   energy and is stable at any step (backward Euler with d_w >= 0).
+ *   Matching both the decay and the period (the weld's stiffness changed
+ *   too, so that its eigenvalues are exp(lambda h)) needs d_w < 0 for
+ *   lightly damped beams and is not dissipative: a stiff spring's energy
+ *   rose 6.8 times (test_free_vibration's stiff springs) and the stiff
+ *   gate (configs/hard/stiff_beam.yaml) blew up; it also moves a held
+ *   beam's equilibrium by the stiffness's change (+0.48% at the essay's
+ *   beam). Only the damping is matched.
  *   conservative gate (e = 1, d = 0, no force): E drifts +1.5% (torque:
  *   the explicit spring torque acts before each impact's velocity jump
- *   and the beam turns after it) and -7.0% (weld) over 12 s.
+ *   and the beam turns after it) and -7.0% (weld: d_w = 0, backward
+ *   Euler's own damping) over 12 s.
  *   driven damped noisy gate (F = 7 N, Rm = 20 N), worst of 10 trials,
  *   |ledger residual| / energy throughput: torque 6.9e-2, weld 3.5e-2
  *   (torque with substeps = 4: 2.7e-2).
  * weld is the default: always stable (configs/hard/ has stiff beams), its
- * errors only ever remove energy, and its ledger closes 2 times better;
- * it costs a 1.5 times larger free-vibration error at the essay's step.
- * torque is the more accurate choice for soft beams and smooth motion. */
+ * errors only ever remove energy, its ledger closes 2 times better, and,
+ * matched, its free vibration is the closer of the two. torque's explicit
+ * spring would need create to refuse stiff beams (omega_n h >= 2), as
+ * Chipmunk's does. */
 const bsim_knob box2d_knobs[] = {
         {"velocity_iterations", BSIM_KNOB_INT, "8", NULL,
          "Box2D velocity iterations per step (sequential impulses), >= 1"},
@@ -214,6 +239,10 @@ const bsim_knob box2d_knobs[] = {
         {"spring", BSIM_KNOB_CHOICE, "weld", "torque|weld",
          "beam spring + damper: explicit torque on a revolute pin (symplectic, stable for "
          "omega_n h < 2), or a soft b2WeldJoint (implicit, always stable, dissipative)"},
+        {"weld_damping", BSIM_KNOB_CHOICE, "matched", "matched|scene",
+         "the weld's damping: matched, so that a free beam decays at the scene's rate a step "
+         "(I (exp(h d / I) - 1) / h - h k, at least 0); scene: the scene's d, to which "
+         "backward Euler adds its own"},
         {"unit_scale", BSIM_KNOB_DOUBLE, "1", NULL,
          "Box2D units per metre, > 0 (contacts start at a gap of 0.005 m / unit_scale)"},
         {"sleep", BSIM_KNOB_CHOICE, "auto", "auto|on|off",
@@ -223,6 +252,9 @@ const bsim_knob box2d_knobs[] = {
          "continuous collision for the body (a Box2D bullet, time of impact against the "
          "beams); off: discrete steps, enough while the body moves less than its radius a "
          "step"},
+        {"ellipse", BSIM_KNOB_CHOICE, "refuse", "refuse|polygon",
+         "an ellipse body: refused (off its axes the polygon's restitution is not the "
+         "scene's), or taken as Box2D's polygon of 72 vertices in 12 convex fans"},
 };
 /* The accuracy study's settings (beamsim accuracy): spring slowest-varying,
  * then substeps, then velocity iterations; the first, the reference, is
@@ -246,15 +278,19 @@ enum {
 	KNOB_POS_IT,
 	KNOB_SUBSTEPS,
 	KNOB_SPRING,
+	KNOB_WELD_DAMPING,
 	KNOB_UNIT_SCALE,
 	KNOB_SLEEP,
-	KNOB_CONTINUOUS
+	KNOB_CONTINUOUS,
+	KNOB_ELLIPSE
 };
 enum { CONTINUOUS_ON = 0, CONTINUOUS_OFF = 1 };
 enum { SLEEP_AUTO = 0, SLEEP_ON = 1, SLEEP_OFF = 2 };
+enum { ELLIPSE_REFUSE = 0, ELLIPSE_POLYGON = 1 };
 constexpr int N_KNOBS = (int)(sizeof box2d_knobs / sizeof box2d_knobs[0]);
 
 enum { SPRING_TORQUE = 0, SPRING_WELD = 1 };
+enum { WELD_MATCHED = 0, WELD_SCENE = 1 };
 
 /* The beam's translational mass in Box2D, as a multiple of the body's. The
  * pin holds the beam's centre (its pivot) still, so the exact dynamics never
@@ -292,14 +328,16 @@ constexpr uint16 CATEGORY_BODY = 0x0001, CATEGORY_BEAM = 0x0002;
 /* One beam: its Box2D body and what a step measures about it. */
 struct beam_rec {
 	b2Body *body = nullptr;
-	int index = 0;            /* in the scene's beams */
-	double pivot[2] = {0, 0}; /* m */
-	double u0[2] = {1, 0};    /* rest direction */
-	double sgn = 1.0;         /* Box2D angle = sgn theta */
-	double inertia = 0.0;     /* kg m^2 about the pivot */
-	double stiffness = 0.0;   /* N m/rad */
-	double damping = 0.0;     /* N m s/rad */
-	bool weld = false;        /* spring and damper in a b2WeldJoint */
+	int index = 0;                /* in the scene's beams */
+	double pivot[2] = {0, 0};     /* m */
+	double u0[2] = {1, 0};        /* rest direction */
+	double sgn = 1.0;             /* Box2D angle = sgn theta */
+	double inertia = 0.0;         /* kg m^2 about the pivot */
+	double stiffness = 0.0;       /* N m/rad */
+	double damping = 0.0;         /* N m s/rad */
+	bool weld = false;            /* spring and damper in a b2WeldJoint */
+	b2WeldJoint *joint = nullptr; /* the weld, or NULL */
+	double weld_d = 0.0;          /* the weld's damping d_w, N m s/rad */
 	/* the (sub)step in progress */
 	b2Vec2 start_position;      /* Box2D transform before the step, to tell */
 	float start_angle = 0;      /* the regular solve's PreSolve from a TOI's */
@@ -335,6 +373,8 @@ struct bsim_world {
 	/* knobs */
 	int velocity_iterations = 8, position_iterations = 3, substeps = 1;
 	int spring = SPRING_WELD;
+	int weld_damping = WELD_MATCHED;
+	double weld_h = 0.0;    /* the (sub)step h the welds' damping is set for, s */
 	double s = 1.0;         /* Box2D units per metre */
 	bool sleep = false;     /* Box2D's sleeping for the beams */
 	bool continuous = true; /* the body a bullet, continuous physics on */
@@ -750,6 +790,7 @@ void world_build(bsim_world *w, const double x[2], const double v[2], double psi
 		w->ground_friction = static_cast<b2FrictionJoint *>(w->world->CreateJoint(&jd));
 	}
 	w->damping_h = 0.0; /* the body's damping is set by the first step */
+	w->weld_h = 0.0;    /* and the welds' */
 
 	for (size_t i = 0; i < w->beams.size(); i++) {
 		beam_rec &b = w->beams[i];
@@ -784,13 +825,14 @@ void world_build(bsim_world *w, const double x[2], const double v[2], double psi
 		b.body->SetMassData(&bm);
 
 		const b2Vec2 anchor = b.body->GetPosition();
+		b.joint = nullptr;
 		if (b.weld) {
 			b2WeldJointDef jd;
 			jd.Initialize(ground, b.body, anchor);
 			jd.referenceAngle = 0.0f; /* the rest angle, whatever theta is now */
 			jd.stiffness = (float)(b.stiffness * s * s);
-			jd.damping = (float)(b.damping * s * s);
-			w->world->CreateJoint(&jd);
+			jd.damping = (float)(b.damping * s * s); /* until the first step's */
+			b.joint = static_cast<b2WeldJoint *>(w->world->CreateJoint(&jd));
 		} else {
 			b2RevoluteJointDef jd;
 			jd.Initialize(ground, b.body, anchor);
@@ -1154,6 +1196,21 @@ static int box2d_check(const bsim_scene *scene, const bsim_options *opts, char *
 	if (!(s > 0.0) || !std::isfinite(s))
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "box2d: unit_scale=%g: expected a positive number", s);
+	/* A polygon meets a beam at its vertex nearest the beam, not at the
+	 * ellipse's contact point, and the impulse's moment about the centre
+	 * is the vertex's: off its axes Newton's law does not hold at the
+	 * ellipse's point (test_impact, "impact.shape.restitution"), and a
+	 * finer outline does not bring it within 2% (docs/backends.md,
+	 * "Shapes"). */
+	if (scene->body.shape == BSIM_SHAPE_ELLIPSE &&
+	    bsim_options_choice(opts, &box2d_knobs[KNOB_ELLIPSE]) == ELLIPSE_REFUSE)
+		return refuse(
+		        bl, "body.shape", err,
+		        "an ellipse is Box2D's polygon of %d vertices, which meets a beam at a "
+		        "vertex: off its axes its restitution at the ellipse's contact point "
+		        "is 0.732 to 0.938 for e = 0.8 (17%% off; 4.4%% at 1152 "
+		        "vertices); --backend-opt ellipse=polygon takes it as that polygon",
+		        ELLIPSE_VERTICES);
 	if ((rc = scene_in_float_range(bl, scene, s, err)) != BSIM_OK)
 		return rc;
 	if ((rc = body_motion_in_range(bl, scene, s, scene->dt / (double)substeps, err)) != BSIM_OK)
@@ -1228,6 +1285,7 @@ int box2d_create_impl(const bsim_scene *scene, const bsim_options *opts, bsim_wo
 	w->position_iterations = (int)k.pos_it;
 	w->substeps = (int)k.substeps;
 	w->spring = bsim_options_choice(opts, &box2d_knobs[KNOB_SPRING]);
+	w->weld_damping = bsim_options_choice(opts, &box2d_knobs[KNOB_WELD_DAMPING]);
 	w->s = s;
 	int sleep = bsim_options_choice(opts, &box2d_knobs[KNOB_SLEEP]);
 	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
@@ -1316,6 +1374,34 @@ void body_damping_set(bsim_world *w, double h)
 	w->damping_h = h;
 }
 
+/* The welds' damping d_w for a (sub)step of h (knob weld_damping; the
+ * header's "Spring and damper"). Box2D's soft row
+ * divides the beam's free velocity by 1 + h (d_w + h k) / I; matched,
+ * d_w + h k = I (exp(h d / I) - 1) / h (damping_exact's, float32), so that
+ * factor is exp(-h d / I), the damper's exact decay over the step. d_w
+ * cannot go below 0 without the weld gaining energy (backward Euler is
+ * non-expansive for d_w >= 0 only), so a beam whose damping ratio is below
+ * about omega_n h / 2 keeps d_w = 0 and decays faster than its damper
+ * alone would make it. */
+void weld_coefficients_set(bsim_world *w, double h)
+{
+	const double hf = (double)(float)h, s2 = w->s * w->s;
+	for (beam_rec &b : w->beams) {
+		if (!b.joint)
+			continue;
+		double d = b.damping;
+		if (w->weld_damping == WELD_MATCHED) {
+			const double k = (double)(float)(b.stiffness * s2) / s2; /* Box2D's */
+			d = std::fmax(0.0,
+			              b.inertia * (double)damping_exact(b.damping / b.inertia, h) -
+			                      hf * k);
+		}
+		b.joint->SetDamping((float)(d * s2));
+		b.weld_d = d;
+	}
+	w->weld_h = h;
+}
+
 /* Before a (sub)step of h with drag or ground friction: the velocities
  * after the force, before Box2D damps them (v_force, w_force), and the
  * solve's start (v_pre, w_pre) after the damping. */
@@ -1389,6 +1475,8 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 	}
 	if (w->taken)
 		taken_start(w, h);
+	if (h != w->weld_h)
+		weld_coefficients_set(w, h);
 
 	const size_t n_live = w->track_live ? w->live.size() : w->beams.size();
 	for (size_t k = 0; k < n_live; k++) {
@@ -1437,7 +1525,7 @@ void box2d_substep(bsim_world *w, const double f[2], double torque, double h)
 		if (b.damping == 0.0)
 			continue;
 		double omega_new = b.sgn * (double)b.body->GetAngularVelocity();
-		w->energy.damper += b.weld ? h * b.damping * omega_new * omega_new
+		w->energy.damper += b.weld ? h * b.weld_d * omega_new * omega_new
 		                           : h * b.damping * b.omega_applied * omega_new;
 	}
 }
@@ -1619,13 +1707,16 @@ static const bsim_backend_bound box2d_bounds[] = {
         /* No "impact.shape.restitution": off its axes the ellipse's
          * polygon meets the beam at a vertex up to half a vertex's spacing
          * from the true contact point, and the impulse's moment with it:
-         * the restitution there 0.732 to 0.938 for e = 0.8 (test_impact
-         * prints it when it skips). */
-        {"vibration", 1.5e-3, "the weld's backward Euler, first order in h"},
+         * the restitution there 0.732 to 0.938 for e = 0.8; check refuses
+         * the ellipse unless ellipse=polygon (test_box2d_oracles). */
+        {"vibration", 5e-4,
+         "the weld, its damping matched: its decay exact, its period +0.26%, the amplitude "
+         "first order in h: 4.0e-4 rad"},
         {"vibration.order", 1, "backward Euler is first order"},
         {"vibration.mirror", 1e-6, "float32"},
         {"stiff", 1e-5, "backward Euler is non-expansive, float32 aside"},
-        {"ledger.drift", 0.08, "the weld's backward Euler damps: -7% over 12 s"},
+        {"ledger.drift", 0.08,
+         "the weld's backward Euler damps an undamped beam (d_w = 0): -7% over 12 s"},
         {"ledger.elastic", 1e-3, "elastic contacts in float32"},
         {"ledger.residual", 0.16,
          "semi-implicit Euler credits a force over the motion after the step's velocity "
@@ -1636,8 +1727,9 @@ static const bsim_backend_bound box2d_bounds[] = {
          "the beams' rows solved in creation order, which the mirror swaps, in float32"},
         {"mirror.free.capsule", 1e-6, "float32: the headings 80 and 100 deg, 3e-8 rad"},
         {"mirror.free.ellipse", 1e-6, "float32: the headings 80 and 100 deg, 3e-8 rad"},
-        {"mirror.contact.capsule", 0.02,
-         "contacts solved one after the other, in float32 (the angular velocity's departure)"},
+        {"mirror.contact.capsule", 0.08,
+         "contacts solved one after the other, in float32, the departure grown in the stuck "
+         "capsule's first second of contact: its angular velocity's, 0.060 rad/s"},
         {"mirror.contact.ellipse", 0.1,
          "the 12 edges of its polygon met in the other order in the image"},
         {"hard.apex", 1e-5, "float32 positions: ulp 2e-6 m at 20 m"},
