@@ -379,7 +379,8 @@ static void test_lattice_beam_steps(void **state)
 /* H1 on Box2D with max_steps 10^6: 6 groups without random force run one
  * trial, 24 with it 100 each: 2406 x 10^6 x 2 beams = 4.81e9 beam-steps,
  * 1.4 hours at the stated 1050 ns. The line comes before the output
- * directory is opened (which /proc refuses, so nothing runs). */
+ * directory is opened (which /proc refuses, so nothing runs), from the
+ * run's own plan (bsim_sweep_plan_for). */
 static void test_estimate_line(void **state)
 {
 	(void)state;
@@ -394,6 +395,20 @@ static void test_estimate_line(void **state)
 	assert_int_equal(rc, 2);
 	assert_non_null(strstr(err, "note: this run may take up to about 1.4 hours of one core: "
 	                            "at most 4.81e+09 beam-steps"));
+	assert_non_null(strstr(err, "1050 ns a beam-step on box2d"));
+	free(err);
+	/* A comparison of thesis and box2d: both sides run every trial, at the
+	 * costlier box2d's constant, 2 x 4.81e9 beam-steps, said before the
+	 * output directory is opened. */
+	const char *cmp[] = {"compare", bsim_test_src("configs/thesis/h1_symmetric.yaml"),
+	                     "--set",   "integration.max_steps=1000000",
+	                     "--limit", "beam_steps=1e13",
+	                     "--out",   "/proc/beamsim-none",
+	                     NULL};
+	rc = bsim_test_cli(cmp, NULL, &err);
+	assert_int_equal(rc, 2);
+	assert_non_null(strstr(err, "note: this run may take up to about 2.81 hours of one core: "
+	                            "at most 9.62e+09 beam-steps"));
 	assert_non_null(strstr(err, "1050 ns a beam-step on box2d"));
 	free(err);
 	/* The same on the thesis backend at its default steps: no line. */

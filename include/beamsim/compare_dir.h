@@ -97,6 +97,11 @@ typedef struct bsim_compare_dir_def {
 	const char *overwrite_option; /* as bsim_sweep_dir_def's */
 	bsim_progress_fn progress;
 	void *progress_user;
+	/* may be NULL: the beam-steps one side's trials take at most (every
+	 * side that runs runs them all), said once before anything runs or
+	 * opens (bsim_plan_fn) */
+	bsim_plan_fn planned;
+	void *planned_user;
 	const volatile sig_atomic_t *stop;
 	/* Spreading the comparison over processes, as a sweep is spread
 	 * (beamsim/sweep_dir.h, docs/cluster.md): spread, part, agree, argc and

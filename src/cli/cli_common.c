@@ -525,36 +525,6 @@ void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const 
 		                  : "");
 }
 
-double cli_experiment_beam_steps(const char *path, const cli_sets *sets, const uint64_t *seed,
-                                 long trials)
-{
-	bsim_experiment e;
-	bsim_error err;
-	const bsim_override *ov = sets ? sets->ov : NULL;
-	int n_ov = sets ? sets->n : 0;
-	if (bsim_experiment_load_seeded(path, ov, n_ov, sets ? sets->grid : NULL,
-	                                sets ? sets->n_grid : 0, seed, &e, &err) != BSIM_OK)
-		return 0.0;
-	if (trials > 0 && bsim_experiment_check_trials(&e, trials, &err) != BSIM_OK) {
-		bsim_experiment_free(&e);
-		return 0.0;
-	}
-	double total = 0.0;
-	for (int g = 0; g < e.n_groups; g++) {
-		bsim_scene s;
-		if (bsim_experiment_group_scene(&e, g, ov, n_ov, &s, &err) != BSIM_OK) {
-			total = 0.0;
-			break;
-		}
-		double n =
-		        s.effects.has_random_force ? (trials > 0 ? (double)trials : e.trials) : 1;
-		total += n * s.max_steps * s.n_beams;
-		bsim_scene_free(&s);
-	}
-	bsim_experiment_free(&e);
-	return total;
-}
-
 void cli_estimate_line(const bsim_backend *b, double beam_steps)
 {
 	double ns = b->cost_ns_per_beam_step;
@@ -570,6 +540,12 @@ void cli_estimate_line(const bsim_backend *b, double beam_steps)
 void cli_estimate_planned(void *backend, double beam_steps)
 {
 	cli_estimate_line(backend, beam_steps);
+}
+
+void cli_estimate_sides(void *user, double beam_steps)
+{
+	const cli_estimate *e = user;
+	cli_estimate_line(e->costlier, e->n_run * beam_steps);
 }
 
 void cli_backend_names(char *buf, size_t size, int max)

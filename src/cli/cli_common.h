@@ -137,15 +137,6 @@ int cli_run_end(int rc, const char *journal, int argc, char **argv);
  * written (where: "summary.json", ...). */
 void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const char *where);
 
-/* The beam-steps a run may take at most: trials x max_steps x beams
- * (every beam of a lattice), summed over the groups of the experiment at
- * path with the --set overrides and --grid axes (a group without random force runs one
- * trial); seed, if not NULL, stands in for a missing seed:; trials > 0
- * replaces the file's. 0 if the experiment does not load or asks for more
- * trials than the limit (the run itself then says why). */
-double cli_experiment_beam_steps(const char *path, const cli_sets *sets, const uint64_t *seed,
-                                 long trials);
-
 /* One line on stderr before a run that may take more than an hour of one
  * core: the estimate, the beam-steps it is made of and the cost of a
  * beam-step it assumes for backend b (its table's, with that cost's
@@ -153,6 +144,13 @@ double cli_experiment_beam_steps(const char *path, const cli_sets *sets, const u
 void cli_estimate_line(const bsim_backend *b, double beam_steps);
 /* cli_estimate_line as a run's plan (bsim_plan_fn), backend the bsim_backend. */
 void cli_estimate_planned(void *backend, double beam_steps);
+/* A comparison's: n_run sides each run every trial, the costlier
+ * backend's constant bounds the estimate. */
+typedef struct cli_estimate {
+	const bsim_backend *costlier;
+	int n_run;
+} cli_estimate;
+void cli_estimate_sides(void *user, double beam_steps);
 
 /* The names of the first max backends of the registry's default
  * comparison (bsim_backend_compared), joined by ',' into buf ("" if

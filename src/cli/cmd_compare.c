@@ -354,10 +354,11 @@ static int compare_main(int argc, char **argv, const cli_merge *m)
 			costlier = b;
 		n_run++;
 	}
-	if (rank == 0 && !m && costlier)
-		cli_estimate_line(costlier, n_run * cli_experiment_beam_steps(
-		                                            experiment, &c.sets,
-		                                            c.has_seed ? &c.seed : NULL, c.trials));
+	cli_estimate estimate = {costlier, n_run};
+	if (rank == 0 && !m && costlier) {
+		def.planned = cli_estimate_sides;
+		def.planned_user = &estimate;
+	}
 	bsim_compare_dir_result res;
 	bsim_error err;
 	cli_signals_install();

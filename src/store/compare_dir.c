@@ -566,12 +566,22 @@ static void reads_free(compare_job *job)
 }
 
 /* The size of the journal's records: those of the sweep of the sides
- * that run (none, one, or several), with cfg's overrides. */
+ * that run (none, one, or several), with cfg's overrides; and, where
+ * cfg->planned is given and a side runs, the plan said from the groups'
+ * scenes, built for it (bsim_sweep_plan_for). */
 static int journal_record_size(const compare_job *job, const bsim_sweep_config *cfg, size_t *size,
                                bsim_error *err)
 {
 	int idx[BSIM_COMPARE_SIDES_MAX], n_run = run_sides(job, idx);
 	*size = bsim_sweep_record_size(0);
+	if (n_run >= 1 && cfg->planned) {
+		bsim_scene *scenes = NULL;
+		size_t one;
+		int rc = bsim_sweep_plan_for(job->e, cfg, &one, &scenes, err);
+		bsim_sweep_scenes_free(scenes, job->e->n_groups);
+		if (rc != BSIM_OK)
+			return rc;
+	}
 	if (n_run == 1)
 		return bsim_sweep_record_size_for(job->e, cfg, size, err);
 	if (n_run >= 2)
@@ -637,6 +647,8 @@ int bsim_compare_dir_run(const bsim_compare_dir_def *def, bsim_compare_dir_resul
 		        .n_extra = job.n_sets,
 		        .extra_b = def->protocol[0] ? &job.protocol_b : NULL,
 		        .n_extra_b = def->protocol[0] != NULL,
+		        .planned = def->planned,
+		        .planned_user = def->planned_user,
 		};
 		rc = journal_record_size(&job, &cfg, &size, err);
 	}
