@@ -129,6 +129,27 @@ enum { THESIS_MIDPOINT = 0, THESIS_EULER = 1 };
 enum { THESIS_SIMULTANEOUS = 0, THESIS_NEAREST_FIRST = 1 };
 enum { THESIS_CONTACT_PHYSICAL = 0, THESIS_CONTACT_ESSAY = 1 };
 
+/* The world's per-beam arrays, listed once: name, element type, elements a
+ * beam (thesis_world.c carves them all from one allocation, each aligned
+ * for its type, zeroed). Their meanings are at their fields below. */
+#define THESIS_BEAM_ARRAYS(X)                                                                      \
+	X(beams, thesis_beam, 1)                                                                   \
+	X(contacts, thesis_contact, 2)                                                             \
+	X(contact_of, int, 1)                                                                      \
+	X(contact_type, int, 1)                                                                    \
+	X(awake, int, 1)                                                                           \
+	X(is_awake, unsigned char, 1)                                                              \
+	X(candidates, int, 1)                                                                      \
+	X(typed, int, 1)                                                                           \
+	X(held, int, 1)                                                                            \
+	X(pushed, unsigned char, 1)                                                                \
+	X(impulse, double, 1)                                                                      \
+	X(pushed_list, int, 1)                                                                     \
+	X(touched, unsigned char, 1)                                                               \
+	X(touched_list, int, 1)                                                                    \
+	X(start_awake, int, 1)                                                                     \
+	X(near, int, 1)
+
 struct bsim_world {
 	double x[2], v[2];       /* body centre and velocity */
 	double heading;          /* rad, psi */
@@ -152,6 +173,7 @@ struct bsim_world {
 	 * only (impact_resolve.h); 1/M unless the knob is given. */
 	double impact_inv_mass;
 	int n_beams;
+	void *beam_block; /* the one allocation of THESIS_BEAM_ARRAYS */
 	thesis_beam *beams;
 	double e_tangent, e_tip; /* restitution */
 	double rest_threshold;   /* m/s */

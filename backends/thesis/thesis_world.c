@@ -24,6 +24,7 @@
  * released by the first step whose solve leaves it unpressed. The default,
  * physical, tests every beam the step can reach. */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -162,24 +163,32 @@ static void thesis_destroy(bsim_world *w)
 {
 	if (!w)
 		return;
-	free(w->beams);
-	free(w->contacts);
-	free(w->contact_of);
-	free(w->contact_type);
-	free(w->awake);
-	free(w->is_awake);
-	free(w->candidates);
-	free(w->typed);
-	free(w->pushed);
-	free(w->impulse);
-	free(w->pushed_list);
-	free(w->touched);
-	free(w->touched_list);
-	free(w->start_awake);
-	free(w->near);
+	free(w->beam_block);
 	bsim_thesis_grid_free(&w->grid);
-	free(w->held);
 	free(w);
+}
+
+/* The arrays of THESIS_BEAM_ARRAYS for nb beams carved from one zeroed
+ * allocation, each at an offset aligned for any type; BSIM_EFAIL out of
+ * memory. */
+static int beam_arrays_alloc(bsim_world *w, size_t nb)
+{
+	const size_t align = _Alignof(max_align_t);
+	size_t size = 0;
+#define ARRAY_SIZE(name, type, per) size += (nb * (per) * sizeof(type) + align - 1) / align * align;
+	THESIS_BEAM_ARRAYS(ARRAY_SIZE)
+#undef ARRAY_SIZE
+	unsigned char *block = calloc(1, size);
+	if (!block)
+		return BSIM_EFAIL;
+	w->beam_block = block;
+	size_t at = 0;
+#define ARRAY_SET(name, type, per)                                                                 \
+	w->name = (type *)(void *)(block + at);                                                    \
+	at += (nb * (per) * sizeof(type) + align - 1) / align * align;
+	THESIS_BEAM_ARRAYS(ARRAY_SET)
+#undef ARRAY_SET
+	return BSIM_OK;
 }
 
 /* A shape whose outline bsim_body_shape_segment cannot give (a far segment has
@@ -226,27 +235,7 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		return rc;
 	bsim_world *w = calloc(1, sizeof *w);
 	size_t nb = scene->n_beams > 0 ? (size_t)scene->n_beams : 1;
-	if (w) {
-		w->beams = calloc(nb, sizeof *w->beams);
-		w->contacts = calloc(2 * nb, sizeof *w->contacts);
-		w->contact_of = malloc(nb * sizeof *w->contact_of);
-		w->contact_type = calloc(nb, sizeof *w->contact_type);
-		w->awake = malloc(nb * sizeof *w->awake);
-		w->is_awake = calloc(nb, sizeof *w->is_awake);
-		w->candidates = malloc(nb * sizeof *w->candidates);
-		w->typed = malloc(nb * sizeof *w->typed);
-		w->held = calloc(nb, sizeof *w->held);
-		w->pushed = calloc(nb, sizeof *w->pushed);
-		w->impulse = calloc(nb, sizeof *w->impulse);
-		w->pushed_list = malloc(nb * sizeof *w->pushed_list);
-		w->touched = calloc(nb, sizeof *w->touched);
-		w->touched_list = malloc(nb * sizeof *w->touched_list);
-		w->start_awake = malloc(nb * sizeof *w->start_awake);
-		w->near = malloc(nb * sizeof *w->near);
-	}
-	if (!w || !w->beams || !w->contacts || !w->contact_of || !w->contact_type || !w->awake ||
-	    !w->is_awake || !w->candidates || !w->typed || !w->held || !w->pushed || !w->impulse ||
-	    !w->pushed_list || !w->touched || !w->touched_list || !w->start_awake || !w->near) {
+	if (!w || beam_arrays_alloc(w, nb) != BSIM_OK) {
 		thesis_destroy(w);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
