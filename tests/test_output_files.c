@@ -28,6 +28,7 @@
 
 #include "beamsim/trial_fields.h"
 #include "store/outdir.h"
+#include "store/trials_csv.h"
 #include "support.h"
 
 static char gate[1200], h1[1200], h2[1200];
@@ -554,6 +555,51 @@ static void test_docs_trials_columns(void **state)
 	free(doc);
 }
 
+/* The reader's column indices (store/trials_csv.h) against the library's
+ * table (beamsim/trial_fields.h), which gives each index its name: an
+ * index out of step with the table would read one column as another. */
+static void test_trials_csv_indices(void **state)
+{
+	(void)state;
+	static const struct {
+		int k;
+		const char *name;
+	} idx[] = {{TRIALS_GROUP, "group"},
+	           {TRIALS_TRIAL, "trial"},
+	           {TRIALS_OUTCOME, "outcome"},
+	           {TRIALS_TYPE, "type"},
+	           {TRIALS_STEPS, "steps"},
+	           {TRIALS_T_END, "t_end"},
+	           {TRIALS_X_END, "x_end"},
+	           {TRIALS_Y_END, "y_end"},
+	           {TRIALS_VX_END, "vx_end"},
+	           {TRIALS_MAX_THETA1, "max_theta1"},
+	           {TRIALS_MAX_THETA2, "max_theta2"},
+	           {TRIALS_E_START, "e_start"},
+	           {TRIALS_E_END, "e_end"},
+	           {TRIALS_WORK_IN, "work_in"},
+	           {TRIALS_LOSSES, "losses"},
+	           {TRIALS_RESIDUAL, "residual"},
+	           {TRIALS_OVERLAP_MAX, "overlap_max"},
+	           {TRIALS_FINAL_IX, "final_ix"},
+	           {TRIALS_FINAL_IY, "final_iy"},
+	           {TRIALS_LOCATION, "location"},
+	           {TRIALS_PATH, "path"},
+	           {TRIALS_ITERATION_LIMITS, "iteration_limits"},
+	           {TRIALS_CLAMPS, "clamps"},
+	           {TRIALS_T_EXIT, "t_exit"},
+	           {TRIALS_HEADING_END, "heading_end"},
+	           {TRIALS_ANGULAR_VELOCITY_END, "angular_velocity_end"},
+	           {TRIALS_TURN_END, "turn_end"},
+	           {TRIALS_TURN_MAX, "turn_max"}};
+	int n;
+	bsim_trial_fields(&n);
+	assert_int_equal(n, TRIALS_N_COLUMNS);
+	assert_int_equal(sizeof idx / sizeof idx[0], TRIALS_N_COLUMNS);
+	for (size_t i = 0; i < sizeof idx / sizeof idx[0]; i++)
+		assert_string_equal(bsim_trials_csv_column(idx[i].k), idx[i].name);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -570,6 +616,7 @@ int main(void)
 	        cmocka_unit_test(test_manifest_check),
 	        cmocka_unit_test(test_figures_join_the_set),
 	        cmocka_unit_test(test_docs_trials_columns),
+	        cmocka_unit_test(test_trials_csv_indices),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -62,22 +62,21 @@ typedef struct trial_columns {
 	bmx_labels *labels; /* n_fields: a text's labels */
 	mxArray **axis;     /* n_axes: doubles, or codes into the axis's values */
 	int *idx, *axis_text;
-	char *text; /* a text field's, from open_memstream */
+	char *text; /* a block's stream's buffer (field_text) */
 	size_t text_size;
 	int oom;
 } trial_columns;
 
-/* Field f of row as a text (c->text, reused); NULL if out of memory. */
-static const char *field_text(trial_columns *c, const bsim_trial_field *f,
+/* Field f of row as a text: written from the start of the block's stream
+ * m, ended by a NUL, and read from its buffer (c->text, which m keeps and
+ * grows); NULL if out of memory. */
+static const char *field_text(trial_columns *c, FILE *m, const bsim_trial_field *f,
                               const bsim_trial_row *row)
 {
-	free(c->text);
-	c->text = NULL;
-	FILE *m = open_memstream(&c->text, &c->text_size);
-	if (!m)
+	if (fseek(m, 0, SEEK_SET) != 0)
 		return NULL;
 	f->text(m, row);
-	if (fclose(m) != 0)
+	if (fputc('\0', m) == EOF || fflush(m) != 0)
 		return NULL;
 	return c->text;
 }
@@ -85,6 +84,9 @@ static const char *field_text(trial_columns *c, const bsim_trial_field *f,
 static int columns_block(void *user, const bsim_sweep_block *b, bsim_error *err)
 {
 	trial_columns *c = user;
+	/* one stream for the block's texts (location, path) */
+	FILE *m = open_memstream(&c->text, &c->text_size);
+	c->oom = !m;
 	for (long k = 0; k < b->n && !c->oom; k++) {
 		size_t at = (size_t)(b->first + k);
 		const bsim_trial_row row = {(int)(at / (size_t)c->trials),
@@ -93,7 +95,7 @@ static int columns_block(void *user, const bsim_sweep_block *b, bsim_error *err)
 		for (int i = 0; i < c->n_fields && !c->oom; i++) {
 			const bsim_trial_field *f = &c->field[i];
 			if (f->kind == BSIM_FIELD_TEXT) {
-				const char *text = field_text(c, f, &row);
+				const char *text = field_text(c, m, f, &row);
 				long code = text ? bmx_labels_code(&c->labels[i], text) : -1;
 				c->oom = code < 0;
 				if (!c->oom)
@@ -116,6 +118,10 @@ static int columns_block(void *user, const bsim_sweep_block *b, bsim_error *err)
 				mxGetPr(c->axis[a])[at] = value_number(text);
 		}
 	}
+	if (m && fclose(m) != 0)
+		c->oom = 1;
+	free(c->text);
+	c->text = NULL;
 	if (c->oom)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory for the trials' columns");
 	return BSIM_OK;

@@ -185,14 +185,15 @@ BSIM_API size_t bsim_sweep_record_size_sides(int n_sides);
 BSIM_API int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
                                         size_t *size, bsim_error *err);
 
-/* A sweep planned once: every group's scene built (cfg's extra applied)
- * into *scenes, for cfg->scenes and the caller's files, the record's size
- * as bsim_sweep_record_size_for gives it, and the plan said to
- * cfg->planned (bsim_plan_fn: the beam-steps the trials take at most)
- * where it is given, before any trial runs or any file is opened. The
- * scenes are the caller's: bsim_sweep_scenes_free. */
+/* A sweep of n_sides sides (1: a plain sweep) planned once: every group's
+ * scene built (cfg's extra applied) into *scenes, for cfg->scenes and the
+ * caller's files, the record's size as bsim_sweep_record_size_for (or
+ * _sides_for) gives it, and the plan said to cfg->planned (bsim_plan_fn:
+ * the beam-steps one side's trials take at most) where it is given,
+ * before any trial runs or any file is opened. The scenes are the
+ * caller's: bsim_sweep_scenes_free. */
 BSIM_API int bsim_sweep_plan_for(const bsim_experiment *e, const bsim_sweep_config *cfg,
-                                 size_t *size, bsim_scene **scenes, bsim_error *err);
+                                 int n_sides, size_t *size, bsim_scene **scenes, bsim_error *err);
 BSIM_API void bsim_sweep_scenes_free(bsim_scene *scenes, int n_groups);
 
 /* The same for the sweep of e on n_sides sides with cfg (the second side's

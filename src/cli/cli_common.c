@@ -537,11 +537,6 @@ void cli_estimate_line(const bsim_backend *b, double beam_steps)
 		        hours, beam_steps, ns, b->name, b->cost_basis ? b->cost_basis : "");
 }
 
-void cli_estimate_planned(void *backend, double beam_steps)
-{
-	cli_estimate_line(backend, beam_steps);
-}
-
 void cli_estimate_sides(void *user, double beam_steps)
 {
 	const cli_estimate *e = user;

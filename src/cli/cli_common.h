@@ -142,10 +142,9 @@ void cli_solver_warning(const char *backend, const bsim_solver_counts *c, const 
  * beam-step it assumes for backend b (its table's, with that cost's
  * basis); none for a backend that states no cost. */
 void cli_estimate_line(const bsim_backend *b, double beam_steps);
-/* cli_estimate_line as a run's plan (bsim_plan_fn), backend the bsim_backend. */
-void cli_estimate_planned(void *backend, double beam_steps);
-/* A comparison's: n_run sides each run every trial, the costlier
- * backend's constant bounds the estimate. */
+/* cli_estimate_line as a run's plan (bsim_plan_fn, user a cli_estimate):
+ * n_run sides each run every trial (a sweep: 1), the costlier backend's
+ * constant bounds the estimate. */
 typedef struct cli_estimate {
 	const bsim_backend *costlier;
 	int n_run;

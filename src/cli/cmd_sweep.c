@@ -163,9 +163,10 @@ static int sweep_main(int argc, char **argv, const cli_merge *m)
 		def.argv = stored;
 	}
 	cli_mpi_spread(&def.spread, &def.part, &def.agree, bsim_sweep_record_size(0), def.stop);
+	cli_estimate estimate = {def.backend, 1};
 	if (rank == 0 && !m) {
-		def.planned = cli_estimate_planned;
-		def.planned_user = (void *)def.backend;
+		def.planned = cli_estimate_sides;
+		def.planned_user = &estimate;
 	}
 	bsim_sweep_dir_result res;
 	bsim_error err;

@@ -1100,13 +1100,15 @@ int bsim_sweep_record_size_for(const bsim_experiment *e, const bsim_sweep_config
 	return rc;
 }
 
-int bsim_sweep_plan_for(const bsim_experiment *e, const bsim_sweep_config *cfg, size_t *size,
-                        bsim_scene **scenes, bsim_error *err)
+int bsim_sweep_plan_for(const bsim_experiment *e, const bsim_sweep_config *cfg, int n_sides,
+                        size_t *size, bsim_scene **scenes, bsim_error *err)
 {
-	int rc = scenes_build(e, cfg, 0, scenes, err);
+	int rc = n_sides == 1 ? BSIM_OK : sides_check(n_sides, err);
+	if (rc == BSIM_OK)
+		rc = scenes_build(e, cfg, 0, scenes, err);
 	if (rc != BSIM_OK)
 		return rc;
-	*size = record_bytes(record_lattice(*scenes, cfg), 1);
+	*size = record_bytes(record_lattice(*scenes, cfg), n_sides);
 	if (cfg->planned)
 		cfg->planned(cfg->planned_user, plan_beam_steps(e, *scenes));
 	return BSIM_OK;

@@ -568,7 +568,7 @@ static void reads_free(compare_job *job)
 /* The size of the journal's records: those of the sweep of the sides
  * that run (none, one, or several), with cfg's overrides; and, where
  * cfg->planned is given and a side runs, the plan said from the groups'
- * scenes, built for it (bsim_sweep_plan_for). */
+ * scenes, built for it (bsim_sweep_plan_for, which sizes the records too). */
 static int journal_record_size(const compare_job *job, const bsim_sweep_config *cfg, size_t *size,
                                bsim_error *err)
 {
@@ -576,11 +576,9 @@ static int journal_record_size(const compare_job *job, const bsim_sweep_config *
 	*size = bsim_sweep_record_size(0);
 	if (n_run >= 1 && cfg->planned) {
 		bsim_scene *scenes = NULL;
-		size_t one;
-		int rc = bsim_sweep_plan_for(job->e, cfg, &one, &scenes, err);
+		int rc = bsim_sweep_plan_for(job->e, cfg, n_run, size, &scenes, err);
 		bsim_sweep_scenes_free(scenes, job->e->n_groups);
-		if (rc != BSIM_OK)
-			return rc;
+		return rc;
 	}
 	if (n_run == 1)
 		return bsim_sweep_record_size_for(job->e, cfg, size, err);

@@ -324,7 +324,7 @@ int bsim_sweep_dir_run(const bsim_sweep_dir_def *def, bsim_sweep_dir_result *res
 	bsim_scene *scenes = NULL;
 	const int n_groups = e->n_groups;
 	if (rc == BSIM_OK)
-		rc = bsim_sweep_plan_for(e, &cfg, &size, &scenes, err);
+		rc = bsim_sweep_plan_for(e, &cfg, 1, &size, &scenes, err);
 	cfg.scenes = scenes;
 	rc = sweep_dir_planned(def, res, e, inputs, &cfg, size, spread, t0, &rec, rc, err);
 	bsim_sweep_scenes_free(scenes, n_groups);

@@ -44,7 +44,8 @@ enum {
 };
 
 /* Column k's name, as in the header line: beamsim/trial_fields.h's k-th
- * field, whose order these indices follow (test_output_files checks it). */
+ * field, whose order these indices follow (test_output_files,
+ * test_trials_csv_indices, checks each index's name). */
 const char *bsim_trials_csv_column(int k);
 
 /* trials.csv written as the trials come (a streamed sweep hands them over
