@@ -356,10 +356,10 @@ static int set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 	return BSIM_OK;
 }
 
-static int advance(bsim_world *w, const double force[2], double torque, double h, int n,
-                   bsim_state *out, int *made, bsim_error *err)
+static int advance(bsim_world *w, const bsim_wrench *schedule, double h, int n, bsim_state *out,
+                   int *made, bsim_error *err)
 {
-	return bsim_backend_advance_each(w, step, get_state, force, torque, h, n, out, made, err);
+	return bsim_backend_advance_each(w, step, get_state, schedule, h, n, out, made, err);
 }
 
 static const bsim_knob_setting gate_euler_accuracy[] = {

@@ -882,16 +882,16 @@ const bsim_backend *bsim_test_backend(const char *name)
 
 long bsim_test_run_steps, bsim_test_run_free;
 
-int bsim_test_counted_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+int bsim_test_counted_advance(bsim_world *w, const bsim_wrench *schedule, double h, int n,
                               bsim_state *out, int *made, bsim_error *err)
 {
 	const bsim_backend *be = bsim_test_backend("thesis");
 	if (n == 1 && out) {
-		int rc = be->advance(w, force, torque, h, 1, NULL, made, err);
+		int rc = be->advance(w, schedule, h, 1, NULL, made, err);
 		be->get_state(w, out);
 		return rc;
 	}
-	int rc = be->advance(w, force, torque, h, n, out, made, err);
+	int rc = be->advance(w, schedule, h, n, out, made, err);
 	bsim_test_run_steps += *made;
 	for (int k = 0; out && k < *made; k++)
 		bsim_test_run_free += out[k].n_active == 0;

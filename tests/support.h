@@ -226,7 +226,7 @@ const bsim_backend *bsim_test_backend(const char *name);
  * of those whose state lists no beam (free flight's) to bsim_test_run_free.
  * A bsim_backend.advance, for a copy of the thesis backend's table. */
 extern long bsim_test_run_steps, bsim_test_run_free;
-int bsim_test_counted_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+int bsim_test_counted_advance(bsim_world *w, const bsim_wrench *schedule, double h, int n,
                               bsim_state *out, int *made, bsim_error *err);
 
 /* A test's own random numbers, reproducible: xorshift64* from the state

@@ -4,9 +4,9 @@
  * backend takes for it. The truth here is the backend's own single step:
  * two worlds of one scene take the same forces, one a step at a time
  * (advance of one step, no state written, then get_state), the other in
- * calls for 1 to 64 steps under a force held over each (as the runner asks
- * for the steps up to the random force's next draw), the rest asked again
- * where a call makes fewer; every state of the calls must be the stepped
+ * calls for 1 to 64 steps under a schedule whose lateral force changes
+ * every 1 to 8 steps (as the runner's schedules change at the random
+ * force's draws), the rest asked again where a call makes fewer; every state of the calls must be the stepped
  * one to the bit (body, listed beams, angles, velocities, touched beams,
  * the direction of each beam the runner's flag reads, energy flows,
  * impacts, solver counts). The scene: the essay's gate at three of H1's
@@ -101,16 +101,28 @@ static long compare(const bsim_backend *be, const bsim_scene *s, double f_prop, 
 		int len = 1 + (int)(rng_uniform() * CALL_MAX);
 		if (len > steps - n)
 			len = (int)(steps - n);
-		const double force[2] = {rm * (2.0 * rng_uniform() - 1.0) - 0.5 * f_prop * sa.x[0],
-		                         f_prop};
+		/* the call's schedule: the lateral force held over 1 to 8 steps
+		 * at a time, so that it changes within a call */
+		bsim_wrench schedule[CALL_MAX];
+		for (int k = 0, hold = 0; k < len; k++, hold--) {
+			if (hold == 0) {
+				hold = 1 + (int)(rng_uniform() * 8);
+				schedule[k] = (bsim_wrench){
+				        {rm * (2.0 * rng_uniform() - 1.0) - 0.5 * f_prop * sa.x[0],
+				         f_prop},
+				        0.0};
+			} else
+				schedule[k] = schedule[k - 1];
+		}
 		for (int made = 0, m; made < len; made += m) {
-			assert_int_equal(be->advance(wb, force, 0.0, s->dt, len - made, &run[made],
-			                             &m, &err),
+			assert_int_equal(be->advance(wb, &schedule[made], s->dt, len - made,
+			                             &run[made], &m, &err),
 			                 BSIM_OK);
 			assert_true(m >= 1 && m <= len - made);
 		}
 		for (int k = 0; k < len; k++, n++) {
-			assert_int_equal(bsim_backend_step(be, wa, force, 0.0, s->dt, &err),
+			assert_int_equal(bsim_backend_step(be, wa, schedule[k].force, 0.0, s->dt,
+			                                   &err),
 			                 BSIM_OK);
 			be->get_state(wa, &sa);
 			bsim_contact_flags(s, &sa);

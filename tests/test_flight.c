@@ -162,7 +162,9 @@ static void test_traversal_in_flight(void **state)
 	assert_same(&r, &r_step);
 	assert_int_equal(r.outcome, BSIM_TRAVERSED);
 	assert_true(r.steps < r.steps_run);
-	assert_int_equal(made, r.steps_run);
+	/* every step in flight; the last run goes on past the trial's end by
+	 * less than a run (64 steps) */
+	assert_true(made >= r.steps_run && made < r.steps_run + 64);
 	bsim_scene_free(&s);
 }
 
@@ -177,7 +179,7 @@ static void test_side_exit_in_flight(void **state)
 	long made = run_both(&s, 2, &r, &r_step);
 	assert_same(&r, &r_step);
 	assert_int_equal(r.outcome, BSIM_SIDE_EXIT);
-	assert_int_equal(made, r.steps_run);
+	assert_true(made >= r.steps_run && made < r.steps_run + 64);
 	bsim_scene_free(&s);
 }
 
@@ -216,8 +218,9 @@ static void test_one_force(void **state)
 	}
 }
 
-/* The backend alone: runs of 1 to 7 steps leave the body where as many
- * steps leave it, and a state as after them. */
+/* The backend alone: runs of 1 to 7 steps, their force changing within
+ * them, leave the body where as many steps leave it, and a state as after
+ * them. */
 static void test_thesis_runs(void **state)
 {
 	(void)state;
@@ -233,7 +236,11 @@ static void test_thesis_runs(void **state)
 	bsim_state sa, sb;
 	assert_int_equal(bsim_state_init(&sa, s.n_beams), BSIM_OK);
 	assert_int_equal(bsim_state_init(&sb, s.n_beams), BSIM_OK);
-	const double f[2] = {1.5, 7.0}, h = 0.004;
+	const double h = 0.004;
+	/* the lateral force turned over every second step, within a run */
+	bsim_wrench f[7];
+	for (int k = 0; k < 7; k++)
+		f[k] = (bsim_wrench){{(k / 2) % 2 ? -1.5 : 1.5, 7.0}, 0.0};
 	bsim_state run[7];
 	for (int k = 0; k < 7; k++)
 		assert_int_equal(bsim_state_init(&run[k], s.n_beams), BSIM_OK);
@@ -241,10 +248,10 @@ static void test_thesis_runs(void **state)
 	long steps = 0;
 	for (int n = 1; n <= 7; n++) {
 		int m;
-		assert_int_equal(t->advance(b, f, 0.0, h, n, run, &m, &err), BSIM_OK);
+		assert_int_equal(t->advance(b, f, h, n, run, &m, &err), BSIM_OK);
 		assert_int_equal(m, n);
 		for (int k = 0; k < n; k++) {
-			assert_int_equal(bsim_backend_step(t, a, f, 0.0, h, &err), BSIM_OK);
+			assert_int_equal(bsim_backend_step(t, a, f[k].force, 0.0, h, &err), BSIM_OK);
 			t->get_state(a, &sa);
 			assert_memory_equal(sa.x, run[k].x, sizeof sa.x);
 			assert_memory_equal(sa.v, run[k].v, sizeof sa.v);

@@ -3,14 +3,16 @@
  * after another) against the step they stand in for, which is the truth
  * here: two worlds of one scene and one set of knobs take the same forces,
  * one a step at a time (advance of one step, no state written, then
- * get_state), the other in runs of 1 to 64 steps under one force, and
+ * get_state), the other in runs of 1 to 64 steps under a schedule of
+ * forces, and
  * every state of the runs must equal the
  * stepped one to the bit (body, active beams, angles, velocities, contact
  * flags, energy flows, impacts, solver counts). Between runs the second
  * world also takes single steps, so the lists a run leaves must be the
  * ones the step leaves. The forces are drawn here (the runner's pipeline
- * is not involved): propulsion along +y and a lateral force held for a
- * run, as the essay's force is held between its draws, with a pull toward
+ * is not involved): propulsion along +y and a lateral force held for 1
+ * to 8 steps, as the essay's force is held between its draws (so that it
+ * changes within a run), with a pull toward
  * the centre line so that the body stays among the beams.
  *
  * The scenes: the essay's gate at the forces of H1, H2's asymmetric
@@ -145,18 +147,28 @@ static void compare_worlds(const bsim_scene *s, const char *const *kv, double f_
 		 * so that the body meets the beams rather than leaving by a side */
 		be->get_state(wa, &sa);
 		bsim_contact_flags(s, &sa);
-		const double force[2] = {rm * rng_normal() - 0.5 * f_prop * sa.x[0], f_prop};
+		bsim_wrench schedule[RUN_MAX];
+		for (int k = 0, hold = 0; k < len; k++, hold--) {
+			if (hold == 0) { /* a new lateral force every 1 to 8 steps */
+				hold = 1 + (int)(rng_uniform() * 8);
+				schedule[k] = (bsim_wrench){
+				        {rm * rng_normal() - 0.5 * f_prop * sa.x[0], f_prop}, 0.0};
+			} else
+				schedule[k] = schedule[k - 1];
+		}
+		const double *force = schedule[0].force;
 		/* one in four: a single step of the second world's own (thesis_step) */
 		int single = rng_uniform() < 0.25;
 		/* the rest asked again where a path ends short (free flight) */
 		for (int made = 0, m; !single && made < len; made += m) {
-			assert_int_equal(
-			        be->advance(wb, force, 0.0, h, len - made, &run[made], &m, &err),
-			        BSIM_OK);
+			assert_int_equal(be->advance(wb, &schedule[made], h, len - made, &run[made],
+			                             &m, &err),
+			                 BSIM_OK);
 			assert_true(m >= 1 && m <= len - made);
 		}
 		for (int k = 0; k < len; k++, n++) {
-			assert_int_equal(bsim_backend_step(be, wa, force, 0.0, h, &err), BSIM_OK);
+			assert_int_equal(bsim_backend_step(be, wa, schedule[k].force, 0.0, h, &err),
+			                 BSIM_OK);
 			be->get_state(wa, &sa);
 			bsim_contact_flags(s, &sa);
 			const bsim_state *b;

@@ -88,11 +88,11 @@ static void fake_get_state(const bsim_world *w, bsim_state *s)
 }
 
 /* advance: the steps one by one, each state read after its step */
-static int fake_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+static int fake_advance(bsim_world *w, const bsim_wrench *schedule, double h, int n,
                         bsim_state *out, int *made, bsim_error *err)
 {
-	return bsim_backend_advance_each(w, fake_step, fake_get_state, force, torque, h, n, out,
-	                                 made, err);
+	return bsim_backend_advance_each(w, fake_step, fake_get_state, schedule, h, n, out, made,
+	                                 err);
 }
 
 static const bsim_knob fake_knobs[] = {{"kind", BSIM_KNOB_INT, "0", NULL, "how it fails"}};

@@ -1589,11 +1589,11 @@ void box2d_get_state(const bsim_world *w, bsim_state *st)
 
 /* bsim_backend.advance: Box2D's steps one by one, each state read after
  * its step. */
-static int box2d_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+static int box2d_advance(bsim_world *w, const bsim_wrench *schedule, double h, int n,
                          bsim_state *out, int *made, bsim_error *err)
 {
-	return bsim_backend_advance_each(w, box2d_step, box2d_get_state, force, torque, h, n, out,
-	                                 made, err);
+	return bsim_backend_advance_each(w, box2d_step, box2d_get_state, schedule, h, n, out, made,
+	                                 err);
 }
 
 /* Rebuilds the world at the state: no contact or joint impulses carried

@@ -659,11 +659,11 @@ static void chipmunk_get_state(const bsim_world *w, bsim_state *st)
 
 /* bsim_backend.advance: the steps one by one, each state read after its
  * step. */
-static int chipmunk_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+static int chipmunk_advance(bsim_world *w, const bsim_wrench *schedule, double h, int n,
                             bsim_state *out, int *made, bsim_error *err)
 {
-	return bsim_backend_advance_each(w, chipmunk_step, chipmunk_get_state, force, torque, h, n,
-	                                 out, made, err);
+	return bsim_backend_advance_each(w, chipmunk_step, chipmunk_get_state, schedule, h, n, out,
+	                                 made, err);
 }
 
 #define STATE_EXPECTED                                                                             \

@@ -8,9 +8,10 @@
  *
  * A run's masks (thesis_run): for a world of at most THESIS_STEPS_BEAMS
  * beams, every one a candidate of every step (broad_phase.c tests them all
- * there), the same sets as bits of one word, and what a run of steps under
- * one held force computes once (thesis_steps.c): the force's parts of the
- * margins' speed bound and of the free velocity, and each beam's distance
+ * there), the same sets as bits of one word, and what a run of steps
+ * computes once for each force of its schedule (thesis_steps.c): the
+ * force's parts of the margins' speed bound and of the free velocity, and
+ * each beam's distance
  * from the body, measured where the last step ended, where the next one
  * starts. The lists are written back when the run ends, as steps one after
  * another leave them. Both forms hold the same beams after every step:

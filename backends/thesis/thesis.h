@@ -275,19 +275,21 @@ int bsim_thesis_broad_phase_near(struct bsim_world *w, double margin);
  * broad phase tests whole only; never with broad_phase=0); 0 if one may. */
 int bsim_thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h);
 
-/* thesis_flight.c: up to n steps of free flight under force, each state
- * into out[k]; returns how many (0: the next step is not one). */
-int bsim_thesis_flight(struct bsim_world *w, const double force[2], double h, int n,
+/* thesis_flight.c: up to n steps of free flight, step k under
+ * schedule[k], each state into out[k]; returns how many (0: the next step
+ * is not one). */
+int bsim_thesis_flight(struct bsim_world *w, const bsim_wrench *schedule, double h, int n,
                        bsim_state *out);
 #define THESIS_FLIGHT_WAIT_MAX 64
 
 /* thesis_steps.c: runs of steps of advance, for the worlds bsim_thesis_steps_takes
  * (1: the essay's disk, physical contacts, simultaneous impacts, no
- * sleeping, at most THESIS_STEPS_BEAMS beams): n steps, each state into
- * out[k] (sized for the world's beams); returns n, 0 for another world. */
+ * sleeping, at most THESIS_STEPS_BEAMS beams): n steps, step k under
+ * schedule[k], each state into out[k] (sized for the world's beams);
+ * returns n, 0 for another world. */
 #define THESIS_STEPS_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
 int bsim_thesis_steps_takes(const struct bsim_world *w);
-int bsim_thesis_steps(struct bsim_world *w, const double force[2], double h, int n,
+int bsim_thesis_steps(struct bsim_world *w, const bsim_wrench *schedule, double h, int n,
                       bsim_state *out);
 
 /* thesis_validate.c: asserts the world's invariants (debug builds; under

@@ -12,8 +12,8 @@
  * none of these but the body's position and velocity, so all but the room
  * test hold for the whole run and are asked once; the room test is asked
  * before every step, as thesis_step asks it: its inline part here on the
- * body held in locals (the same operations, the force's part of the
- * margin computed once), and where that fails bsim_thesis_broad_phase_clear,
+ * body held in locals (the same operations, with the step's own force),
+ * and where that fails bsim_thesis_broad_phase_clear,
  * which asks it again and then tests the beams, as thesis_flight_clear
  * does. (A world that the room test cannot serve, broad_phase=0 or more
  * than THESIS_BROAD_PHASE_MIN_BEAMS beams, is never clear: no run.)
@@ -29,7 +29,8 @@
 
 #include "thesis/thesis.h"
 
-int bsim_thesis_flight(bsim_world *w, const double force[2], double h, int n, bsim_state *out)
+int bsim_thesis_flight(bsim_world *w, const bsim_wrench *schedule, double h, int n,
+                       bsim_state *out)
 {
 	if (w->n_awake || w->n_typed || w->contact_mode == THESIS_CONTACT_ESSAY || w->rotates ||
 	    !w->broad_phase || w->n_beams > THESIS_BROAD_PHASE_MIN_BEAMS)
@@ -37,10 +38,18 @@ int bsim_thesis_flight(bsim_world *w, const double force[2], double h, int n, bs
 	/* The beams' constants for h, as the step would prepare them before
 	 * its flight (a step in flight reads none of them). */
 	thesis_beams_prepare(w, h);
-	const double inv_mass = w->inv_mass, f0 = force[0], f1 = force[1];
-	/* thesis_clear_margin's force term and the step's h F / M, 0 / M */
-	const double push = h * (fabs(f0) + fabs(f1)) * inv_mass;
-	const double dv0 = h * f0 * inv_mass, dv1 = h * f1 * inv_mass, zero = 0.0 * inv_mass;
+	const double inv_mass = w->inv_mass, zero = 0.0 * inv_mass;
+	/* The largest |F|_1 of the run's steps (a force not finite makes it
+	 * NaN: then no step is sure), for a bound on each step's thesis_clear_margin force term h
+	 * |F|_1 / M and on its |h F / M|_1, which differs from that by the
+	 * round-off of its products alone. */
+	double f_max = 0.0, nan = 0.0;
+	for (int k = 0; k < n; k++) {
+		const double f = fabs(schedule[k].force[0]) + fabs(schedule[k].force[1]);
+		f_max = f > f_max ? f : f_max;
+		nan += f - f; /* 0, or NaN for a force not finite */
+	}
+	const double push_max = h * (f_max + nan) * inv_mass * (1.0 + 1e-12), d_max = push_max;
 	const double slop = w->slop;
 	const int euler = w->integrator == THESIS_EULER;
 	double cx0 = w->clear_x[0], cx1 = w->clear_x[1], room = w->clear_room;
@@ -49,22 +58,26 @@ int bsim_thesis_flight(bsim_world *w, const double force[2], double h, int n, bs
 	const double heading = w->heading, angular_velocity = w->angular_velocity;
 	const bsim_solver_counts solver = w->solver;
 	/* The room test of every step of the run at once. Step k starts at
-	 * speed |v_k|_1 <= s + k d (s = |v|_1 now, d = |h F / M|_1 a step)
-	 * and |x_k - C_c|_1 <= |x - C_c|_1 + h k (s + k d) (each step moves
-	 * by h times a speed of at most that), so the test's left side is at
-	 * most its value for those bounds at k = n - 1; a cushion of 1e-9 of
-	 * the lengths involved covers the round-off of the steps and of the
-	 * test (1e-16 of the same lengths a step). If that passes, every
-	 * step's test would: the same steps. */
-	const double s = fabs(v0) + fabs(v1), d = fabs(dv0) + fabs(dv1), kn = (double)(n - 1);
+	 * speed |v_k|_1 <= s + k d (s = |v|_1 now, d the largest |h F / M|_1
+	 * of a step) and |x_k - C_c|_1 <= |x - C_c|_1 + h k (s + k d) (each
+	 * step moves by h times a speed of at most that), so the test's left
+	 * side is at most its value for those bounds at k = n - 1 with the
+	 * largest force term; a cushion of 1e-9 of the lengths involved covers
+	 * the round-off of the steps and of the test (1e-16 of the same
+	 * lengths a step). If that passes, every step's test would: the same
+	 * steps. */
+	const double s = fabs(v0) + fabs(v1), d = d_max, kn = (double)(n - 1);
 	const double reach = fabs(x0 - cx0) + fabs(x1 - cx1) + h * kn * (s + kn * d) +
-	                     2.0 * (h * ((s + kn * d + push) * (1.0 + 1e-12))) + slop +
+	                     2.0 * (h * ((s + kn * d + push_max) * (1.0 + 1e-12))) + slop +
 	                     BSIM_CONTACT_TOL;
 	const int sure =
 	        reach + 1e-9 * (reach + fabs(x0) + fabs(x1) + fabs(cx0) + fabs(cx1)) < room;
 	int k = 0;
 	for (; k < n; k++) {
+		const double *force = schedule[k].force;
+		const double dv0 = h * force[0] * inv_mass, dv1 = h * force[1] * inv_mass;
 		if (!sure) {
+			const double push = h * (fabs(force[0]) + fabs(force[1])) * inv_mass;
 			double speed = (fabs(v0) + fabs(v1)) + push;
 			double margin =
 			        2.0 * (h * (speed * (1.0 + 1e-12))) + slop + BSIM_CONTACT_TOL;

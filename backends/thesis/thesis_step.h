@@ -13,8 +13,9 @@
  * one out of reach, is the general step here, which detects nothing,
  * solves nothing and moves the body by the same operations, whose list
  * finds no beam within BSIM_CONTACT_TOL: the same state), the broad phase
- * (every beam a candidate, in order), the step size's constants and the
- * held force's terms (once a run), the typed list (a mask) and the essay's
+ * (every beam a candidate, in order), the step size's constants (once a
+ * run) and the force's terms (once for each force of the schedule), the
+ * typed list (a mask) and the essay's
  * contact mode, nearest-first impacts and sleeping (worlds a run does not
  * take: bsim_thesis_steps_takes). */
 #ifndef BSIM_THESIS_THESIS_STEP_H

@@ -27,10 +27,26 @@ int bsim_thesis_steps_takes(const struct bsim_world *w)
 	       w->n_beams <= THESIS_STEPS_BEAMS;
 }
 
+/* The force's parts of step_detect's margin, h |F| / M, and of the smooth
+ * solve's free velocity, h F / M, as they compute them. */
+static inline void steps_force(const struct bsim_world *w, thesis_run *run, const double force[2],
+                               double h)
+{
+	run->hv = h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
+	run->dv[0] = h * force[0] * w->inv_mass;
+	run->dv[1] = h * force[1] * w->inv_mass;
+}
+
+/* The same bits: a force whose terms need not be computed again. */
+static inline int steps_same_force(const double a[2], const double b[2])
+{
+	return memcmp(a, b, 2 * sizeof *a) == 0;
+}
+
 /* The run of n steps, nb beams and the integrator constants where the
  * caller can give them. */
-THESIS_SPECIALISED void steps_run(struct bsim_world *w, const double force[2], double h, int n,
-                                  bsim_state *out, const int integrator, const int nb)
+THESIS_SPECIALISED void steps_run(struct bsim_world *w, const bsim_wrench *schedule, double h,
+                                  int n, bsim_state *out, const int integrator, const int nb)
 {
 	double d2[THESIS_STEPS_BEAMS];
 	thesis_run run = {.nb = nb, .d2 = d2};
@@ -42,14 +58,13 @@ THESIS_SPECIALISED void steps_run(struct bsim_world *w, const double force[2], d
 	for (int k = 0; k < w->n_typed; k++)
 		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
 	const unsigned awake0 = run.awake;
-	/* step_detect's h |F| / M and the smooth solve's h F / M, as they
-	 * compute them */
-	run.hv = h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
-	run.dv[0] = h * force[0] * w->inv_mass;
-	run.dv[1] = h * force[1] * w->inv_mass;
+	steps_force(w, &run, schedule[0].force, h);
 	for (int i = 0; i < nb; i++)
 		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
 	for (int k = 0; k < n; k++) {
+		const double *force = schedule[k].force;
+		if (k && !steps_same_force(force, schedule[k - 1].force))
+			steps_force(w, &run, force, h);
 		bsim_state *s = &out[k];
 		memset(&s->energy, 0, sizeof s->energy);
 		s->impacts = 0;
@@ -84,7 +99,8 @@ THESIS_SPECIALISED void steps_run(struct bsim_world *w, const double force[2], d
 			thesis_beam_pushed(w, i, w->impulse[i]);
 }
 
-int bsim_thesis_steps(struct bsim_world *w, const double force[2], double h, int n, bsim_state *out)
+int bsim_thesis_steps(struct bsim_world *w, const bsim_wrench *schedule, double h, int n,
+                      bsim_state *out)
 {
 	if (n < 1 || !w->steps_disk || out[0].n_beams != w->n_beams)
 		return 0;
@@ -94,8 +110,8 @@ int bsim_thesis_steps(struct bsim_world *w, const double force[2], double h, int
 			thesis_beam_touch(w, i);
 	thesis_beams_prepare(w, h);
 	if (w->n_beams == 2 && w->integrator == THESIS_MIDPOINT) /* the essay's gate */
-		steps_run(w, force, h, n, out, THESIS_MIDPOINT, 2);
+		steps_run(w, schedule, h, n, out, THESIS_MIDPOINT, 2);
 	else
-		steps_run(w, force, h, n, out, w->integrator, w->n_beams);
+		steps_run(w, schedule, h, n, out, w->integrator, w->n_beams);
 	return n;
 }

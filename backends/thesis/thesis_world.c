@@ -413,11 +413,11 @@ THESIS_APART void thesis_get_state(const bsim_world *w, bsim_state *s)
 
 /* advance's steps one after another, thesis_step and get_state each;
  * into *made those made. Apart: the runs' dispatch stays short. */
-THESIS_APART int advance_each(bsim_world *w, const double force[2], double torque, double h, int n,
+THESIS_APART int advance_each(bsim_world *w, const bsim_wrench *schedule, double h, int n,
                               bsim_state *out, int *made, bsim_error *err)
 {
 	for (int m = 0; m < n; m++) {
-		int rc = thesis_step(w, force, torque, h, err);
+		int rc = thesis_step(w, schedule[m].force, schedule[m].torque, h, err);
 		if (rc) {
 			*made = m;
 			return rc;
@@ -436,21 +436,21 @@ THESIS_APART int advance_each(bsim_world *w, const double force[2], double torqu
  * thesis_step's, to the bit (test_steps, test_flight). A try at flight
  * that makes no step costs its room test; after one, the next waits
  * (flight_skip), doubling the wait after each such try. */
-static inline int advance_calls(bsim_world *w, const double force[2], double torque, double h,
-                                int n, bsim_state *out, int *made, bsim_error *err)
+static inline int advance_calls(bsim_world *w, const bsim_wrench *schedule, double h, int n,
+                                bsim_state *out, int *made, bsim_error *err)
 {
 	if (n == 1 && (w->flight_skip || w->n_awake || !out)) {
 		/* one step, not of free flight: the step loop's usual call */
 		if (w->flight_skip)
 			w->flight_skip--;
 		*made = 1;
-		int rc = thesis_step(w, force, torque, h, err);
+		int rc = thesis_step(w, schedule[0].force, schedule[0].torque, h, err);
 		if (out)
 			thesis_get_state(w, out);
 		return rc;
 	}
 	if (out && w->flight_skip == 0 && w->n_awake == 0) {
-		int m = bsim_thesis_flight(w, force, h, n, out);
+		int m = bsim_thesis_flight(w, schedule, h, n, out);
 		if (m > 0) {
 			w->flight_wait = 0;
 			*made = m;
@@ -463,17 +463,17 @@ static inline int advance_calls(bsim_world *w, const double force[2], double tor
 	}
 	int rc = BSIM_OK;
 	if (out && n > 1 && w->steps_disk && out[0].n_beams == w->n_beams)
-		*made = bsim_thesis_steps(w, force, h, n, out);
+		*made = bsim_thesis_steps(w, schedule, h, n, out);
 	else
-		rc = advance_each(w, force, torque, h, n, out, made, err);
+		rc = advance_each(w, schedule, h, n, out, made, err);
 	w->flight_skip = w->flight_skip > *made ? w->flight_skip - *made : 0;
 	return rc;
 }
 
-static int thesis_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+static int thesis_advance(bsim_world *w, const bsim_wrench *schedule, double h, int n,
                           bsim_state *out, int *made, bsim_error *err)
 {
-	int rc = advance_calls(w, force, torque, h, n, out, made, err);
+	int rc = advance_calls(w, schedule, h, n, out, made, err);
 	bsim_thesis_validate(w);
 	return rc;
 }

@@ -282,15 +282,16 @@ static void py_get_state(const bsim_world *w, bsim_state *out)
 	bsim_state_copy(out, &w->last);
 }
 
-static int py_advance(bsim_world *w, const double force[2], double torque, double h, int n,
+static int py_advance(bsim_world *w, const bsim_wrench *schedule, double h, int n,
                       bsim_state *out, int *made, bsim_error *err)
 {
 	int rc = BSIM_OK;
 	*made = 0;
 	PyGILState_STATE g = PyGILState_Ensure();
 	for (int k = 0; k < n; k++) {
-		PyObject *r = PyObject_CallMethod(w->obj, "advance", "(dd)dd", force[0], force[1],
-		                                  torque, h);
+		const bsim_wrench *f = &schedule[k];
+		PyObject *r = PyObject_CallMethod(w->obj, "advance", "(dd)dd", f->force[0],
+		                                  f->force[1], f->torque, h);
 		if (!r) {
 			rc = py_failure("advance", err);
 			break;

@@ -23,6 +23,14 @@ extern "C" {
 
 typedef struct bsim_world bsim_world; /* opaque, one per backend */
 
+/* What the runner applies to the body over one step: a force (N) on its
+ * centre and a torque (N m, counter-clockwise) about it. A schedule is
+ * one a step. */
+typedef struct bsim_wrench {
+	double force[2];
+	double torque;
+} bsim_wrench;
+
 /* A bound a backend holds itself to in a check that the tests run on every
  * registered backend (docs/tests.md, "Every backend"): the check's name,
  * the largest departure from the check's truth it allows (0: none, to the
@@ -43,21 +51,19 @@ typedef struct bsim_backend {
 	int (*create)(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
 	              bsim_error *err);
 	void (*destroy)(bsim_world *w);
-	/* The one call that moves a world: n >= 1 steps of h seconds each
-	 * under one wrench, force (N) on the body centre and torque (N m,
-	 * counter-clockwise) about it, held over them (a body that does not
-	 * rotate, body.rotates 0, ignores the torque); the state after each
-	 * into out[k] as get_state writes it (each sized for the world's beams
-	 * by bsim_state_init), or, out NULL, no state written. The steps made
-	 * into *made: n, or fewer (at least 1) where the backend's own paths
-	 * part (free flight ending near a beam, say); the caller asks again for
-	 * the rest. Whatever path makes them, each step is the step that a
-	 * call for one step would make, to the bit. BSIM_OK, or BSIM_EFAIL with
-	 * err saying why (out of memory): the world cannot go on. What a
-	 * solver gave up on without failing is counted in the state's solver
-	 * counts. */
-	int (*advance)(bsim_world *w, const double force[2], double torque, double h, int n,
-	               bsim_state *out, int *made, bsim_error *err);
+	/* The one call that moves a world: n >= 1 steps of h seconds each,
+	 * step k under the wrench schedule[k] (a body that does not rotate,
+	 * body.rotates 0, ignores the torque); the state after each into out[k]
+	 * as get_state writes it (each sized for the world's beams by
+	 * bsim_state_init), or, out NULL, no state written. The steps made into
+	 * *made: n, or fewer (at least 1) where the backend's own paths part
+	 * (free flight ending near a beam, say); the caller asks again for the
+	 * rest. Whatever path makes them, each step is the step that a call for
+	 * that one step would make, to the bit. BSIM_OK, or BSIM_EFAIL with err
+	 * saying why (out of memory): the world cannot go on. What a solver
+	 * gave up on without failing is counted in the state's solver counts. */
+	int (*advance)(bsim_world *w, const bsim_wrench *schedule, double h, int n, bsim_state *out,
+	               int *made, bsim_error *err);
 	void (*get_state)(const bsim_world *w, bsim_state *out);
 	int (*set_state)(bsim_world *w, const bsim_state *s, bsim_error *err);
 	/* The knob settings the accuracy study compares (beamsim/accuracy.h),
@@ -137,12 +143,12 @@ typedef int (*bsim_step_fn)(bsim_world *w, const double force[2], double torque,
 typedef void (*bsim_get_state_fn)(const bsim_world *w, bsim_state *out);
 
 /* bsim_backend.advance for a backend that makes its steps one by one: n
- * steps of step, each followed, where out is given, by get_state into
- * out[k]; into *made the steps made. The first failing step's status, else
- * BSIM_OK. */
+ * steps of step, step k under schedule[k], each followed, where out is
+ * given, by get_state into out[k]; into *made the steps made. The first
+ * failing step's status, else BSIM_OK. */
 BSIM_API int bsim_backend_advance_each(bsim_world *w, bsim_step_fn step,
-                                       bsim_get_state_fn get_state, const double force[2],
-                                       double torque, double h, int n, bsim_state *out, int *made,
+                                       bsim_get_state_fn get_state, const bsim_wrench *schedule,
+                                       double h, int n, bsim_state *out, int *made,
                                        bsim_error *err);
 
 /* One step of world w of b (b->advance for one step, no state written):

@@ -30,7 +30,7 @@ extern "C" {
 /* The version of the backend interface: of bsim_backend, bsim_state and
  * what they hold. It changes whenever their layout or meaning does, and a
  * plug-in built against another is refused. */
-#define BSIM_BACKEND_ABI 1
+#define BSIM_BACKEND_ABI 2 /* 2: advance takes a schedule of wrenches */
 
 /* The environment variable of the plug-ins every command loads. */
 #define BSIM_PLUGINS_ENV "BEAMSIM_PLUGINS"

@@ -38,6 +38,10 @@ BSIM_API long bsim_schedule_index(const bsim_schedule *s, long n, double h);
  * 0, and bsim_schedule_status then fails: never a NaN. */
 BSIM_API double bsim_schedule_value(bsim_schedule *s, long j);
 
+/* The force values j .. j + n - 1 (N) into out[0..n): bsim_schedule_value
+ * of each, in order, the same bits. */
+BSIM_API void bsim_schedule_values(bsim_schedule *s, long j, int n, double *out);
+
 /* The force value at step n of size h (N): bsim_schedule_value of
  * bsim_schedule_index, the same bits, with the value held over its steps
  * kept so that the steps between two refreshes read it at no cost. */
@@ -48,6 +52,17 @@ BSIM_API double bsim_schedule_at_step(bsim_schedule *s, long n, double h);
  * held[1] = 0 when no such steps are known), so that a caller can read the
  * value over them without calling again: the same bits. */
 BSIM_API double bsim_schedule_at_step_held(bsim_schedule *s, long n, double h, long held[2]);
+
+/* The steps of size h that one value holds: 1 / (f h) when that is a
+ * whole number of steps (5 for 50 Hz at 4 ms; value j then holds over
+ * steps [j k, (j + 1) k)), else 0. */
+BSIM_API long bsim_schedule_hold_steps(const bsim_schedule *s, double h);
+
+/* The values before index n are all a trial used: those drawn ahead of it
+ * (for a schedule of forces handed to a backend before the steps that
+ * would use them) no longer count among bsim_schedule_draws. The values
+ * themselves stay as drawn. */
+BSIM_API void bsim_schedule_used(bsim_schedule *s, long n);
 
 /* BSIM_OK, or BSIM_EFAIL saying which value could not be had and why,
  * since the last reset. */

@@ -191,7 +191,8 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 		double f[BSIM_WRENCH];
 		bsim_effects_force_at(&fx, n, s->dt, at, f);
 		int made;
-		if (be->advance(w, f, f[2], s->dt, 1, &r->s1, &made, err) != BSIM_OK) {
+		const bsim_wrench one = {{f[0], f[1]}, f[2]};
+		if (be->advance(w, &one, s->dt, 1, &r->s1, &made, err) != BSIM_OK) {
 			out = -1;
 			break;
 		}

@@ -3,12 +3,12 @@
 #include "beamsim/backend.h"
 
 int bsim_backend_advance_each(bsim_world *w, bsim_step_fn step, bsim_get_state_fn get_state,
-                              const double force[2], double torque, double h, int n,
-                              bsim_state *out, int *made, bsim_error *err)
+                              const bsim_wrench *schedule, double h, int n, bsim_state *out,
+                              int *made, bsim_error *err)
 {
 	*made = 0;
 	for (int k = 0; k < n; k++) {
-		int rc = step(w, force, torque, h, err);
+		int rc = step(w, schedule[k].force, schedule[k].torque, h, err);
 		if (rc)
 			return rc;
 		if (out)
@@ -21,6 +21,7 @@ int bsim_backend_advance_each(bsim_world *w, bsim_step_fn step, bsim_get_state_f
 int bsim_backend_step(const bsim_backend *b, bsim_world *w, const double force[2], double torque,
                       double h, bsim_error *err)
 {
+	const bsim_wrench one = {{force[0], force[1]}, torque};
 	int made = 0;
-	return b->advance(w, force, torque, h, 1, NULL, &made, err);
+	return b->advance(w, &one, h, 1, NULL, &made, err);
 }

@@ -109,9 +109,7 @@ void bsim_schedule_reset(bsim_schedule *s, double magnitude, uint64_t seed)
 	s->oom = 0;
 }
 
-/* Steps per value when 1/(f h) is a whole number of steps (5 for 50 Hz at
- * 4 ms), else 0. */
-static long schedule_steps_per_value(const bsim_schedule *s, double h)
+long bsim_schedule_hold_steps(const bsim_schedule *s, double h)
 {
 	double per = 1.0 / (s->frequency * h);
 	double whole = nearbyint(per);
@@ -125,7 +123,7 @@ long bsim_schedule_index(const bsim_schedule *s, long n, double h)
 	/* Value j applies on [j/f, (j+1)/f). When 1/(f h) is a whole number of
 	 * steps use integer division, so that rounding of n*h*f never moves a
 	 * refresh by a step. */
-	long whole = schedule_steps_per_value(s, h);
+	long whole = bsim_schedule_hold_steps(s, h);
 	if (whole)
 		return n / whole;
 	/* Validation keeps the index small (bsim_limits schedule); a scene
@@ -160,7 +158,7 @@ double bsim_schedule_at_step(bsim_schedule *s, long n, double h)
 		whole = s->held_hi - s->held_lo;
 		j = s->held_j + 1;
 	} else {
-		whole = schedule_steps_per_value(s, h);
+		whole = bsim_schedule_hold_steps(s, h);
 		j = whole ? n / whole : bsim_schedule_index(s, n, h);
 	}
 	double value = schedule_value_at(s, j);
@@ -233,6 +231,12 @@ double bsim_schedule_value(bsim_schedule *s, long j)
 	return s->magnitude * s->z[j];
 }
 
+void bsim_schedule_values(bsim_schedule *s, long j, int n, double *out)
+{
+	for (int k = 0; k < n; k++)
+		out[k] = schedule_value_at(s, j + k);
+}
+
 int bsim_schedule_status(const bsim_schedule *s, bsim_error *err)
 {
 	if (!s->failed)
@@ -243,6 +247,14 @@ int bsim_schedule_status(const bsim_schedule *s, bsim_error *err)
 	return bsim_error_set(
 	        err, BSIM_EFAIL,
 	        "random force: value %ld is beyond any schedule (at most 2^40 values)", s->failed);
+}
+
+void bsim_schedule_used(bsim_schedule *s, long n)
+{
+	/* One draw a value, in order: the draws of the values from n on are
+	 * those made ahead. Those already added to total_draws stay counted. */
+	if (n >= 0 && (unsigned long)n < s->draws)
+		s->draws = (unsigned long)n > s->counted ? (unsigned long)n : s->counted;
 }
 
 unsigned long bsim_schedule_draws(const bsim_schedule *s)

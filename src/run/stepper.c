@@ -116,7 +116,8 @@ int bsim_stepper_reset(bsim_stepper *s, bsim_error *err)
 static int step_one(bsim_stepper *s, const double f[BSIM_WRENCH], bsim_error *err)
 {
 	int made = 0;
-	int rc = s->backend->advance(s->w, f, f[2], s->scene.dt, 1, &s->state, &made, err);
+	const bsim_wrench one = {{f[0], f[1]}, f[2]};
+	int rc = s->backend->advance(s->w, &one, s->scene.dt, 1, &s->state, &made, err);
 	if (rc != BSIM_OK)
 		return rc;
 	s->n++;

@@ -9,9 +9,10 @@
  * One call moves the world (bsim_backend.advance): one step at a time in
  * the step loop, which books each state with all the runner defines; or,
  * in a plain trial (nothing recorded, traced or measured per step, no
- * lattice) whose forces hold between the random force's draws, the steps
- * up to the force's next change in one call, booked by run_book, which
- * gives the same bits as the step loop (test_steps, test_flight).
+ * lattice) whose forces hold between the random force's draws, up to
+ * TRIAL_STEPS_MAX steps of the schedule of forces in one call, booked by
+ * run_book, which gives the same bits as the step loop (test_steps,
+ * test_flight).
  *
  * Cost. A step's bookkeeping visits only the beams the backend lists as
  * active (bsim_state.active: the others are exactly at rest), so in a
@@ -367,6 +368,7 @@ static void trial_result(trial_ctx *c, const trial_loop *lp, bsim_state *s0)
 		out->landscape_beam = -1;
 		out->in_contact_end = 0;
 	}
+	bsim_trial_steps_used(&c->r->steps);
 	out->draws = c->fx->random ? bsim_schedule_draws(c->fx->random->schedule) : 0;
 	out->solver = c->solver;
 	out->solver.iteration_limit += s0->solver.iteration_limit;
@@ -467,12 +469,6 @@ static inline int trial_book(trial_ctx *c, trial_loop *lp, const bsim_state *s0,
 #define TRIAL_BOOK static inline
 #endif
 
-/* The pipeline of a run (bsim_trial_force_holds): the propulsion's force (N)
- * and the held random force's, each over the whole run. */
-typedef struct run_forces {
-	double cp, cr;
-} run_forces;
-
 /* The ledger's lines a step adds to (LEDGER_LINES_ADD), held in locals
  * while a run is booked. */
 typedef struct run_lines {
@@ -485,10 +481,10 @@ typedef struct run_lines {
  * or measured, no lattice: trial_book without the flags, the trace, the
  * measures and the gate), the operations in their order, with what the run
  * does not change held in locals: the ledger's lines, the loop's counters
- * and the pipeline's forces, propulsion rf->cp along
- * axis ap (has_p) and the held random force rf->cr along ar (has_r),
- * constants where the caller gives them; each force's work is summed from
- * 0.0, as ledger_step's loop sums it. Before each state, the step loop's
+ * and the pipeline's forces, propulsion cp along axis ap (has_p) and the
+ * held random force cr[k] in step k along ar (has_r), constants where the
+ * caller gives them; each force's work is summed from 0.0, as
+ * ledger_step's loop sums it. Before each state, the step loop's
  * test whether the trial is over (trial_over), once the outcome is known;
  * after it, the step loop's outcome (outcome_at). The peaks
  * take no contacts here (the caller gives them the run's last touching
@@ -497,14 +493,13 @@ typedef struct run_lines {
  * last booking gave (BOOK_ON: every state booked, or the trial over); *s0p
  * the last state kept, *listed 0 if no state booked lists a beam. */
 TRIAL_BOOK int run_book(trial_ctx *c, trial_loop *lp, bsim_state **s0p, bsim_state *states, int m,
-                        int *listed, const run_forces *rf, const int has_p, const int ap,
-                        const int has_r, const int ar)
+                        int *listed, const double cp, const double *cr, const int has_p,
+                        const int ap, const int has_r, const int ar)
 {
 	const bsim_scene *sc = c->scene;
 	bsim_trial_result *out = c->out;
 	bsim_ledger *l = &out->ledger;
 	trial_peaks *peaks = &c->r->peaks;
-	const double cp = rf->cp, cr = rf->cr;
 	bsim_state *s0 = *s0p;
 	trial_loop L = *lp; /* the loop's counters, in locals */
 	long dwell = c->gate.dwell;
@@ -535,7 +530,7 @@ TRIAL_BOOK int run_book(trial_ctx *c, trial_loop *lp, bsim_state **s0p, bsim_sta
 		if (has_p)
 			w_prop += cp * d[ap];
 		if (has_r)
-			w_rand += cr * d[ar];
+			w_rand += cr[k] * d[ar];
 		const bsim_step_energy *se = &s1->energy;
 		const double r = ledger_residual(L.e0, e1, w_prop, w_rand, se);
 		LEDGER_LINES_ADD(lines, w_prop, w_rand, se, r);
@@ -582,6 +577,7 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	               .rec = rec,
 	               .out = out,
 	               .fx = &fx};
+	r->steps.on = 0; /* until this trial's are set */
 	int rc = trial_open(&c, seed, err);
 	if (rc)
 		return rc;
@@ -592,38 +588,37 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 	if (rc == BSIM_OK &&
 	    bsim_trial_steps_start(&r->steps, plain, scene, &fx, c.n_max, c.gate_max))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	trial_steps *ts = &r->steps;
 	while (rc == BSIM_OK && !trial_over(&c, &lp, s0)) {
-		double f[BSIM_WRENCH];
-		bsim_effects_force_at(&fx, lp.n, lp.h, s0, f);
-		bsim_state *states;
 		int m = 0;
-		const long room =
-		        r->steps.on ? trial_steps_room(&r->steps, &lp, c.gate.dwell, s0, &states)
-		                    : 0;
-		if (room > 0) {
+		if (ts->on) {
+			bsim_state *states;
+			int room = (int)trial_steps_room(ts, &lp, c.gate.dwell, s0, &states);
+			bsim_trial_steps_schedule(ts, lp.n, room);
 			/* a world that fails part-way: the steps made before are
 			 * booked, then the trial ends */
-			rc = backend->advance(c.w, f, f[2], lp.h, (int)room, states, &m, err);
+			rc = backend->advance(c.w, ts->schedule, lp.h, room, states, &m, err);
 			/* The run's states, booked until the trial ends. The run's
 			 * room keeps max_steps and gate_steps: before the outcome
 			 * is known, only a booking ends it. */
 			const long n0 = lp.n;
 			const int open_at_start = !lp.done;
 			bsim_state *kept = s0;
-			run_forces rf = {r->steps.propulsion ? r->steps.propulsion->last : 0.0,
-			                 r->steps.random ? r->steps.random->last : 0.0};
+			const double cp = ts->propulsion ? ts->propulsion->param : 0.0;
 			int b, listed;
-			if (r->steps.propulsion && r->steps.random &&
-			    r->steps.propulsion->axis == 1 &&
-			    r->steps.random->axis == 0) /* the essay's */
-				b = run_book(&c, &lp, &kept, states, m, &listed, &rf, 1, 1, 1, 0);
+			if (ts->propulsion && ts->random && ts->propulsion->axis == 1 &&
+			    ts->random->axis == 0) /* the essay's */
+				b = run_book(&c, &lp, &kept, states, m, &listed, cp, ts->random_at, 1,
+				             1, 1, 0);
 			else
-				b = run_book(&c, &lp, &kept, states, m, &listed, &rf,
-				             r->steps.propulsion != NULL,
-				             r->steps.propulsion ? r->steps.propulsion->axis : 0,
-				             r->steps.random != NULL,
-				             r->steps.random ? r->steps.random->axis : 0);
+				b = run_book(&c, &lp, &kept, states, m, &listed, cp, ts->random_at,
+				             ts->propulsion != NULL,
+				             ts->propulsion ? ts->propulsion->axis : 0,
+				             ts->random != NULL, ts->random ? ts->random->axis : 0);
 			s0 = kept;
+			/* the steps made or tried: a state not finite, or a step
+			 * that failed after every state before it was booked */
+			ts->tried = lp.n + (b == BOOK_NONFINITE || (b == BOOK_ON && rc != BSIM_OK));
 			/* The states kept before the outcome was known: to the
 			 * traversal's step, or all kept. */
 			const long open = !open_at_start ? 0 : (lp.done ? out->steps : lp.n) - n0;
@@ -640,9 +635,12 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 				break;
 			continue;
 		}
+		double f[BSIM_WRENCH];
+		bsim_effects_force_at(&fx, lp.n, lp.h, s0, f);
 		if (c.recording && lp.n % c.stride == 0)
 			trial_record(&c, s0, lp.n);
-		if ((rc = backend->advance(c.w, f, f[2], lp.h, 1, s1, &m, err)) != BSIM_OK)
+		const bsim_wrench step = {{f[0], f[1]}, f[2]};
+		if ((rc = backend->advance(c.w, &step, lp.h, 1, s1, &m, err)) != BSIM_OK)
 			break;
 		int b = trial_book(&c, &lp, s0, s1, &rc, err);
 		if (b == BOOK_NONFINITE)

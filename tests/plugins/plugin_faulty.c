@@ -31,12 +31,11 @@ static int set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 }
 
 #if FAULT != 2
-static int advance(bsim_world *w, const double force[2], double torque, double h, int n,
-                   bsim_state *out, int *made, bsim_error *err)
+static int advance(bsim_world *w, const bsim_wrench *schedule, double h, int n, bsim_state *out,
+                   int *made, bsim_error *err)
 {
 	(void)w;
-	(void)force;
-	(void)torque;
+	(void)schedule;
 	(void)h;
 	(void)n;
 	(void)out;
