@@ -1,5 +1,6 @@
 % What the Octave tests of the MEX functions share (test_mex.m,
-% test_markov.m source it): checks, the program run, its messages.
+% test_markov.m source it): their set-up, checks, the program run, its
+% messages.
 1;
 
 function check(ok, varargin)
@@ -43,4 +44,23 @@ function check_message(what, msg, program_err, fn)
   want = [fn ': ' line(10:end)];
   check(strcmp(msg, want) || strcmp(msg, line(10:end)), ...
         '%s: MEX error\n  %s\nprogram\n  %s', what, msg, line);
+end
+
+% The test's arguments, BUILD SOURCE BEAMSIM TMP: TMP emptied and the MEX
+% functions of BUILD on the path. The program runs as it is, whatever
+% library Octave was started with (a check of the MEX code under a
+% preloaded sanitizer, docs/tests.md).
+function [build, source, exe, tmp] = test_setup()
+  unsetenv('LD_PRELOAD');
+  args = argv();
+  build = args{1};
+  source = args{2};
+  exe = args{3};
+  tmp = args{4};
+  if exist(tmp, 'dir')
+    confirm_recursive_rmdir(false, 'local');
+    rmdir(tmp, 's');
+  end
+  mkdir(tmp);
+  addpath(fullfile(build, 'matlab'));
 end

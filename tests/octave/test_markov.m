@@ -32,20 +32,8 @@ function s = untimed(s)
   end
 end
 
-unsetenv('LD_PRELOAD');
-args = argv();
-build = args{1};
-source = args{2};
-exe = args{3};
-tmp = args{4};
-% (source is the source tree here, not Octave's function)
-builtin('source', fullfile(source, 'tests', 'octave', 'mex_helpers.m'));
-if exist(tmp, 'dir')
-  confirm_recursive_rmdir(false, 'local');
-  rmdir(tmp, 's');
-end
-mkdir(tmp);
-addpath(fullfile(build, 'matlab'));
+source(fullfile(fileparts(mfilename('fullpath')), 'mex_helpers.m'));
+[build, source, exe, tmp] = test_setup();
 experiment = fullfile(source, 'configs', 'markov', 'c_track.yaml');
 scene = fullfile(source, 'configs', 'lattice', 'c_track.yaml');
 small = '--trials 3 --bins 2,2,1 --threads 2 --seed 5';

@@ -35,22 +35,8 @@ function check_column(what, name, v, fields, fmt)
         text{min(bad, end)}, fields{min(bad, end)});
 end
 
-% The program runs as it is, whatever library Octave was started with
-% (a check of the MEX code under a preloaded sanitizer, docs/tests.md).
-unsetenv('LD_PRELOAD');
-args = argv();
-build = args{1};
-source = args{2};
-exe = args{3};
-tmp = args{4};
-% (source is the source tree here, not Octave's function)
-builtin('source', fullfile(source, 'tests', 'octave', 'mex_helpers.m'));
-if exist(tmp, 'dir')
-  confirm_recursive_rmdir(false, 'local');
-  rmdir(tmp, 's');
-end
-mkdir(tmp);
-addpath(fullfile(build, 'matlab'));
+source(fullfile(fileparts(mfilename('fullpath')), 'mex_helpers.m'));
+[build, source, exe, tmp] = test_setup();
 gate = fullfile(source, 'configs', 'thesis', 'gate.yaml');
 h1 = fullfile(source, 'configs', 'thesis', 'h1_symmetric.yaml');
 h2 = fullfile(source, 'configs', 'thesis', 'h2_asymmetric.yaml');
