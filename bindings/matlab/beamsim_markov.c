@@ -334,6 +334,8 @@ static int validate(markov_call *c, const char *path, mxArray **out, bsim_error 
 	def.has_seed = v[A_SEED] != NULL;
 	def.threads = (int)threads;
 	def.bootstrap = (int)bootstrap;
+	def.resume_option = "'resume', true";
+	def.overwrite_option = "'overwrite', true";
 	def.sets = c->sets;
 	def.n_sets = c->n_sets;
 	def.grid = c->grid;

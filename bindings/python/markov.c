@@ -260,6 +260,8 @@ PyObject *pyb_markov_validate(PyObject *self, PyObject *args, PyObject *kw)
 		def.bootstrap = bootstrap;
 	def.resume = resume;
 	def.overwrite = overwrite;
+	def.resume_option = "resume=True";
+	def.overwrite_option = "overwrite=True";
 	def.progress = pyb_progress_update;
 	def.progress_user = &progress;
 	def.stop = &progress.stop;

@@ -561,6 +561,8 @@ typedef struct bsim_markov_validate_def {
 	int resume;
 	/* 1: replace the finished result or stopped run in out; 0: refuse it */
 	int overwrite;
+	const char *resume_option;    /* as bsim_sweep_dir_def's (NULL: "--resume") */
+	const char *overwrite_option; /* as bsim_sweep_dir_def's (NULL: "--overwrite") */
 	/* NULL, or a flag (a signal handler's): once nonzero no trial starts,
 	 * and the run returns BSIM_ESTOPPED with the journal kept. */
 	const volatile sig_atomic_t *stop;

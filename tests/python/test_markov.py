@@ -115,6 +115,10 @@ def test_validate_is_the_programs(maps):
         assert (tmp / "val_py" / "validate.csv").read_bytes() == f.read()
     assert list(got["files"]["validate"]["p_sim"]) == list(
         beamsim.read_csv(tmp / "val_prog" / "validate.csv")["p_sim"])
+    # a finished validation is refused without overwrite, in the module's words
+    with pytest.raises(ValueError, match="overwrite=True") as e:
+        beamsim.markov_validate(EXPERIMENT, py, trials=12, bootstrap=30, out=tmp / "val_py")
+    assert "--overwrite" not in str(e.value)
 
 
 def test_bad_arguments(maps, tmp_path):
