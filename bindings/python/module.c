@@ -424,6 +424,17 @@ static PyMethodDef methods[] = {
          "resume)"},
         {"landscape", (PyCFunction)(void (*)(void))pyb_landscape, METH_VARARGS | METH_KEYWORDS,
          "landscape(scene, sets, spacing, region)"},
+        {"markov_build", (PyCFunction)(void (*)(void))pyb_markov_build,
+         METH_VARARGS | METH_KEYWORDS,
+         "markov_build(experiment, out, trials, bins, vmax, entries, seed, threads, backend, "
+         "sets, grid, backend_opts, progress)"},
+        {"markov_predict", (PyCFunction)(void (*)(void))pyb_markov_predict,
+         METH_VARARGS | METH_KEYWORDS,
+         "markov_predict(scene, map, sets, tol, gates, walks, out, overwrite)"},
+        {"markov_validate", (PyCFunction)(void (*)(void))pyb_markov_validate,
+         METH_VARARGS | METH_KEYWORDS,
+         "markov_validate(experiment, map, out, trials, seed, threads, sets, grid, bootstrap, "
+         "progress, resume, overwrite)"},
         {"read_table", pyb_read_table, METH_VARARGS,
          "read_table(path): a CSV table as a dict of NumPy arrays by column"},
         {"version", py_version, METH_NOARGS, "the library's version"},

@@ -99,6 +99,10 @@ PyObject *pyb_register_backend(PyObject *self, PyObject *args);
 PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_landscape(PyObject *self, PyObject *args, PyObject *kw);
+/* markov_build, markov_predict and markov_validate (markov.c). */
+PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *pyb_markov_predict(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *pyb_markov_validate(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_read_table(PyObject *self, PyObject *args);
 
 /* Adds the type World (world.c) to the module: 0, or -1 with an

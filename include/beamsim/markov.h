@@ -46,6 +46,7 @@
 #include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "beamsim/base.h"
 #include "beamsim/backend.h"
@@ -254,6 +255,115 @@ BSIM_API int bsim_markov_part_write(const char *dir, int index, int count, const
                                     long total, long records, int argc, char *const *argv,
                                     bsim_error *err);
 
+/* ---- the maps of an experiment ----------------------------------------
+ *
+ * beamsim markov build EXPERIMENT --out DIR: the maps every group's lattice
+ * needs built into one map directory (bsim_markov_build per group, the
+ * maps of all groups in one cache), as one process, one part of a spread
+ * build (a shard), or the merge of the parts' directories.
+ *
+ *   bsim_markov_build_def def = bsim_markov_build_def_default();
+ *   def.experiment = "configs/markov/c_track.yaml";
+ *   def.out = "out/markov-maps";
+ *   def.map.trials = 800;
+ *   bsim_markov_build_result res;
+ *   if (bsim_markov_build_run(&def, &res, &err) == BSIM_OK) {
+ *           ... res.maps[0 .. res.n_maps) ...
+ *           bsim_markov_build_result_free(&res);
+ *   }
+ *
+ * DIR is a cache: maps already there with the same key are reused, the
+ * others join the directory's set as each is finished (a stopped or
+ * failed build keeps those), so that a finished build may be run again. */
+
+/* One map of a build, as it was had. */
+typedef struct bsim_markov_built {
+	int group;    /* the experiment's group whose lattice uses it (its first) */
+	double k[2];  /* N m/rad, the gate's left and right beam */
+	uint64_t key; /* the map's file name, map_%016llx */
+	int pass;     /* the set's pass (below def.map.self_passes: one round's) */
+	int cached, copied, elsewhere; /* as bsim_markov_map's; none: built now */
+} bsim_markov_built;
+
+typedef struct bsim_markov_build_def {
+	const char *experiment;    /* a lattice experiment file */
+	const char *out;           /* the map directory */
+	const bsim_override *sets; /* applied to every group */
+	int n_sets;
+	const bsim_grid_axis *grid; /* axes that replace or join the file's */
+	int n_grid;
+	int has_seed; /* 1: seed is the maps' (map.seed) and the experiment's */
+	uint64_t seed;
+	/* How each map is built: bins, trials, seed, backend and options,
+	 * threads, self or flow entries and their passes, progress, stop and
+	 * pass_exchange; entries, part, parts, part_first, from, n_from,
+	 * one_pass and passes_from are this call's (below). */
+	bsim_markov_def map;
+	/* gate_entries.csv files (or directories holding one), read with
+	 * bsim_markov_entries_load: a bin's states drawn from them. */
+	const char *const *entries;
+	int n_entries;
+	/* A spread build (docs/cluster.md): part (1-based) of parts > 0 builds
+	 * its maps only, the map j of the build (every group's pairs in turn)
+	 * being part j mod parts + 1's, and writes out/part.json with the
+	 * command line argc, argv. */
+	int part, parts;
+	/* Flow entries (map.self_entries 2) in a job array, one pass of the
+	 * maps a round: round 1 makes a part (parts > 0) one pass, its states
+	 * from the exits of passes, the merged directory of the round before
+	 * (NULL: the first round), and a merge (below) join one round's parts.
+	 * 0 for the parts of an MPI job, whose ranks meet after each pass
+	 * (map.pass_exchange). */
+	int round;
+	const char *passes;
+	int argc;
+	char *const *argv;
+	/* n_merge > 0: no single gate runs; the part directories merge[0 ..
+	 * n_merge) are joined into out (map.from), the first checked to be a
+	 * part of this build. */
+	const char *const *merge;
+	int n_merge;
+	/* May be NULL: called after each group's maps are had, with its maps
+	 * (the command's lines as they come). */
+	void (*group_done)(void *user, int group, const bsim_markov_built *maps, int n);
+	void *group_done_user;
+} bsim_markov_build_def;
+
+/* An entries value as the command line's --entries takes it: "self",
+ * "self:N", "flow" or "flow:N" (N passes, 0 to BSIM_MARKOV_SELF_PASSES_MAX,
+ * default 1) set def->self_entries (1 self, 2 flow) and def->self_passes
+ * and *is_kind 1; any other value is a gate_entries path (*is_kind 0, def
+ * untouched). BSIM_EINPUT naming the value for a bad N. */
+BSIM_API int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, int *is_kind,
+                                      bsim_error *err);
+
+/* bsim_markov_def_default() as map, one process, no entries. */
+BSIM_API bsim_markov_build_def bsim_markov_build_def_default(void);
+
+typedef struct bsim_markov_build_result {
+	int n_groups;
+	int n_maps;              /* every group's, in order (a map may serve two groups) */
+	bsim_markov_built *maps; /* n_maps */
+	int built, reused;       /* maps simulated now, maps read from the cache */
+	int copied;              /* maps read from the parts' directories (a merge) */
+	double seconds;          /* CPU time of the simulation of those built, s */
+	int pass;                /* a round's (or its merge's): the pass made; else
+	                          * map.self_passes */
+	int round;               /* 1: one pass of flow entries (a part's or a merge's) */
+	int n_bins;              /* entry bins of a map, the start's included */
+	char run[17];            /* the build's name (bsim_markov_run_id) */
+} bsim_markov_build_result;
+
+/* Builds the maps of every group of def->experiment into def->out.
+ * BSIM_EINPUT for a bad experiment, entries file, directory or
+ * combination (passes without a round, a merge of another build's parts);
+ * BSIM_EFAIL for an unstable single gate or a failed file; BSIM_ESTOPPED
+ * when def->map.stop stopped it (the maps finished are kept: the same call
+ * builds the rest). On any error res holds nothing to free. */
+BSIM_API int bsim_markov_build_run(const bsim_markov_build_def *def, bsim_markov_build_result *res,
+                                   bsim_error *err);
+BSIM_API void bsim_markov_build_result_free(bsim_markov_build_result *res);
+
 /* The chains small enough for the exact LU solve. */
 #define BSIM_MARKOV_LU_MAX 1000
 
@@ -357,6 +467,56 @@ BSIM_API int bsim_markov_prediction_store(const char *dir, int overwrite, const 
                                           const bsim_markov_set *set,
                                           const bsim_markov_prediction *p, bsim_error *err);
 
+/* ---- a prediction from a map directory ---------------------------------
+ *
+ * beamsim markov predict LATTICE_SCENE --map DIR [--out OUT]: the scene
+ * loaded, the maps read from DIR (bsim_markov_load), the chain solved
+ * (bsim_markov_predict_with), the time to the outcome by walks
+ * (bsim_markov_predict_time, when the maps have holding times) and, with
+ * out, the prediction's files (bsim_markov_prediction_store). */
+typedef struct bsim_markov_predict_def {
+	const char *scene; /* a lattice scene file */
+	const bsim_override *sets;
+	int n_sets;
+	const char *map_dir; /* the map directory of a build */
+	const char *out;     /* NULL: no files */
+	int overwrite;       /* 1: replace the result out holds; 0: refuse it */
+	/* How the caller spells overwrite in the refusal (NULL: "--overwrite"). */
+	const char *overwrite_option;
+	double tol; /* in (0, 1); <= 0: bsim_markov_tol_sampling of the maps */
+	int gates;  /* 1: the distribution of gates visited (the series); 0: not;
+	             * -1: with out only */
+	long walks; /* walks of the semi-Markov chain, 0 to 1e8; 0: none */
+} bsim_markov_predict_def;
+
+/* The maps' sampling tolerance, gates with out only, BSIM_MARKOV_WALKS. */
+BSIM_API bsim_markov_predict_def bsim_markov_predict_def_default(void);
+
+typedef struct bsim_markov_predict_result {
+	bsim_scene scene; /* as loaded, the sets applied */
+	int n_maps;
+	bsim_markov_prediction p; /* p.tol: the tolerance used */
+	double total[3];          /* p summed by kind: end, side, stuck */
+	double seconds;           /* wall time of the chain composed and solved (maps read) */
+	double cpu_seconds;       /* the thread's CPU time of the same */
+} bsim_markov_predict_result;
+
+/* Predicts def->scene from the maps in def->map_dir. BSIM_EINPUT for a bad
+ * scene, map directory, tol or walks, or an out that is refused (before
+ * the chain is solved); BSIM_EFAIL for a file that fails. On any error res
+ * holds nothing to free. */
+BSIM_API int bsim_markov_predict_run(const bsim_markov_predict_def *def,
+                                     bsim_markov_predict_result *res, bsim_error *err);
+BSIM_API void bsim_markov_predict_result_free(bsim_markov_predict_result *res);
+
+/* res as one JSON object on f, with a newline (markov predict --json):
+ * scene (the path scene_path as given), name, columns, rows, maps,
+ * states, solve, totals, mean_gates, left_in_field, tol, sweeps,
+ * mean_time, with walks: walks, duration and at_duration; predict_seconds,
+ * predict_cpu_seconds, locations (location, kind, p) and p_gates. */
+BSIM_API void bsim_markov_predict_json(FILE *f, const char *scene_path,
+                                       const bsim_markov_predict_result *res);
+
 /* The entry bin of a state in a gate's frame entered through edge
  * (BSIM_EDGE_BOTTOM .. BSIM_EDGE_TOP) at pos along it with velocity v; the
  * start is bin 0. For tools that bin a simulation's gate entries. */
@@ -401,6 +561,8 @@ typedef struct bsim_markov_validate_def {
 	int resume;
 	/* 1: replace the finished result or stopped run in out; 0: refuse it */
 	int overwrite;
+	const char *resume_option;    /* as bsim_sweep_dir_def's (NULL: "--resume") */
+	const char *overwrite_option; /* as bsim_sweep_dir_def's (NULL: "--overwrite") */
 	/* NULL, or a flag (a signal handler's): once nonzero no trial starts,
 	 * and the run returns BSIM_ESTOPPED with the journal kept. */
 	const volatile sig_atomic_t *stop;

@@ -548,10 +548,12 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		                              .extra = ov[pr],
 		                              .n_extra = def->n_sets + 1};
 	const bsim_sweep_spread *sp = &def->spread;
+	const bsim_outdir_spelling spelling = {def->resume_option, def->overwrite_option};
 	sweep_batch b = {.command = "markov validate",
 	                 .out = def->out,
 	                 .resume = def->resume,
 	                 .overwrite = def->overwrite,
+	                 .spelling = &spelling,
 	                 .spread = sp->spread != BSIM_SPREAD_NONE || sp->n_merge > 0 ? sp : NULL,
 	                 .progress = def->progress,
 	                 .progress_user = def->progress_user,

@@ -12,7 +12,6 @@
 #include <ftw.h>
 #include <sys/stat.h>
 
-#include "beamsim/experiment.h"
 #include "beamsim/markov.h"
 #include "beamsim/lattice_outcome.h"
 #include "cli/cli_wrote.h"
@@ -22,8 +21,6 @@
 #include "cli/cli_mpi.h"
 #include "store/outdir.h"
 #include "beamsim/sweep_dir.h"
-#include "util/clock.h"
-#include "util/json.h"
 
 enum {
 	OWN_BINS,
@@ -101,21 +98,22 @@ static int markov_option(void *args, int i, const char *value)
 	case OWN_ENTRIES:
 		/* self or self:N: the exits of the map's own single gates, N passes
 		 * (default 1); a file named self is ./self */
-		if (strcmp(value, "self") == 0 || strncmp(value, "self:", 5) == 0 ||
-		    strcmp(value, "flow") == 0 || strncmp(value, "flow:", 5) == 0) {
-			long n = 1;
-			if ((value[4] &&
-			     cli_parse_long(value + 5, 0, BSIM_MARKOV_SELF_PASSES_MAX, &n) != 0) ||
-			    a->def.self_entries)
+		{
+			bsim_markov_def kind = a->def;
+			int is_kind;
+			bsim_error err;
+			int rc = bsim_markov_entries_kind(value, &kind, &is_kind, &err);
+			if (is_kind && (rc != BSIM_OK || a->def.self_entries))
 				return cli_usage(
 				        "markov",
 				        "--entries %s: expected self, self:N, flow or flow:N, N "
 				        "passes 0 to "
 				        "%d, once",
 				        value, BSIM_MARKOV_SELF_PASSES_MAX);
-			a->def.self_entries = value[0] == 's' ? 1 : 2;
-			a->def.self_passes = (int)n;
-			return CLI_OK;
+			if (is_kind) {
+				a->def = kind;
+				return CLI_OK;
+			}
 		}
 		if (a->n_entries == MAX_ENTRIES)
 			return cli_usage("markov", "--entries %s: at most %d", value, MAX_ENTRIES);
@@ -332,18 +330,6 @@ static const cli_spec validate_spec = {
         .option = validate_option,
 };
 
-/* Appends the keys of set's maps to *keys (the run's name, below). */
-static int keys_add(uint64_t **keys, int *n, const bsim_markov_set *set)
-{
-	uint64_t *k = realloc(*keys, (size_t)(*n + set->n + 1) * sizeof *k);
-	if (!k)
-		return -1;
-	for (int i = 0; i < set->n; i++)
-		k[(*n)++] = set->maps[i].key;
-	*keys = k;
-	return 0;
-}
-
 /* A part of an MPI job's build: its rank's maps into a directory of
  * its own (markov_build_ranks). */
 typedef struct markov_part {
@@ -439,6 +425,47 @@ static int markov_build_ranks(int argc, char **argv, const cli_common *c)
 	return rc;
 }
 
+/* A group's maps as they come: one line each. */
+static void build_group_print(void *user, int group, const bsim_markov_built *maps, int n)
+{
+	const bsim_markov_build_def *def = user;
+	for (int i = 0; i < n; i++) {
+		char of_pass[32] = ""; /* a round before the last: one pass of the maps */
+		if (maps[i].pass < def->map.self_passes)
+			snprintf(of_pass, sizeof of_pass, "pass %d ", maps[i].pass);
+		printf("group %d  k = %g, %g N m/rad  map_%016llx  %s%s\n", group, maps[i].k[0],
+		       maps[i].k[1], (unsigned long long)maps[i].key, of_pass,
+		       maps[i].elsewhere ? "another part's"
+		       : maps[i].copied  ? "from a part"
+		       : maps[i].cached  ? "reused"
+		                         : "built");
+	}
+}
+
+static void build_print(const bsim_markov_build_def *def, const bsim_markov_build_result *res,
+                        const char *out)
+{
+	const int pass = res->pass, last = def->map.self_passes;
+	if (def->parts > 0)
+		printf("part %d of %d of the maps in %s; beamsim merge joins the %d parts' "
+		       "directories\n",
+		       def->part, def->parts, cli_path(out), def->parts);
+	if (res->round && pass < last && def->n_merge <= 0)
+		printf("pass %d of passes 0 to %d (flow entries): once merged into DIR, the next "
+		       "round is the same command with --passes DIR\n",
+		       pass, last);
+	else if (res->round && pass < last)
+		printf("passes 0 to %d of the %d (flow entries) in %s: the next round is the "
+		       "parts' command with --passes %s\n",
+		       pass, last + 1, cli_path(out), cli_path(out));
+	printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials each, in "
+	       "%s\n",
+	       res->built, res->seconds, res->reused,
+	       res->copied ? ", the others from the parts" : "", res->n_bins, def->map.trials,
+	       cli_path(out));
+	cli_wrote(stdout, out);
+}
+
 static int markov_build_main(int argc, char **argv, const cli_merge *m, const markov_part *p)
 {
 	cli_common c = cli_common_default();
@@ -450,7 +477,8 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		               "--shard builds one part in one process: not under mpirun (%d "
 		               "ranks)",
 		               cli_mpi_size());
-	/* flow entries in a job array: a round, one pass of the maps */
+	/* flow entries in a job array: a round, one pass of the maps (a merge's
+	 * command line is its parts') */
 	const int round = a.def.self_entries == 2 && a.shards > 0;
 	if (rc < 0 && a.passes && !round)
 		rc = cli_usage("markov build",
@@ -466,8 +494,6 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		cli_common_free(&c);
 		return rc;
 	}
-	bsim_sweep_dir_part first;
-	memset(&first, 0, sizeof first);
 	/* an MPI job's progress: rank 0's part's */
 	const int show_progress = !c.quiet && (!p || cli_mpi_rank() == 0);
 	if (p) {
@@ -476,20 +502,15 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		a.shard = p->shard;
 		a.shards = p->shards;
 	}
+	bsim_markov_build_def def = bsim_markov_build_def_default();
 	if (m) {
 		cli_merge_apply(m, &c);
 		a.shard = a.shards = 0;
-		a.def.from = m->parts;
-		a.def.n_from = m->n_parts;
-	}
-	if (a.shards > 0) {
-		a.def.part = a.shard - 1;
-		a.def.parts = a.shards;
+		def.merge = m->parts;
+		def.n_merge = m->n_parts;
 	}
 	if (p && cli_mpi_size() > 1) /* flow entries: the ranks meet after each pass */
 		a.def.pass_exchange = cli_mpi_pass_exchange;
-	a.def.one_pass = round;
-	a.def.passes_from = a.passes;
 	bsim_options opts = {0};
 	const bsim_backend *be = cli_backend_with_opts(
 	        &c, "markov build", c.backend ? c.backend : bsim_backend_default()->name, &opts);
@@ -497,82 +518,48 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		cli_common_free(&c);
 		return CLI_USAGE;
 	}
-	a.def.backend = be;
-	a.def.opts = &opts;
-	a.def.threads = (int)c.threads;
+	def.map = a.def;
+	def.map.backend = be;
+	def.map.opts = &opts;
+	def.map.threads = (int)c.threads;
 	if (c.trials > 0)
-		a.def.trials = (int)c.trials;
-	if (c.has_seed)
-		a.def.seed = c.seed;
-	bsim_experiment e;
-	bsim_error err;
-	bsim_markov_entries entries = {0};
-	if (a.n_entries > 0) {
-		if ((rc = bsim_markov_entries_load(a.entries, a.n_entries, &entries, &err)) !=
-		    BSIM_OK) {
-			cli_common_free(&c);
-			return cli_report(rc, &err);
-		}
-		a.def.entries = &entries;
-	}
-	/* c.trials is the single gates' per bin, not the experiment's */
-	if ((rc = cli_experiment_load(path, &c.sets, c.has_seed ? &c.seed : NULL, 0, &e)) !=
-	    CLI_OK) {
-		bsim_markov_entries_free(&entries);
-		cli_common_free(&c);
-		return rc;
+		def.map.trials = (int)c.trials;
+	def.experiment = path;
+	def.out = c.out;
+	def.sets = c.sets.ov;
+	def.n_sets = c.sets.n;
+	def.grid = c.sets.grid;
+	def.n_grid = c.sets.n_grid;
+	def.has_seed = c.has_seed;
+	def.seed = c.seed;
+	def.entries = a.entries;
+	def.n_entries = a.n_entries;
+	def.part = a.shard;
+	def.parts = a.shards;
+	def.round = round;
+	def.passes = a.passes;
+	/* part.json's command line, its paths as they resolve from anywhere */
+	const char *paths[2] = {path, a.passes};
+	char **stored = a.shards > 0 ? cli_stored_argv_paths(argc, argv, paths, 2) : NULL;
+	def.argc = stored ? argc : 0;
+	def.argv = stored;
+	if (!c.quiet) {
+		def.group_done = build_group_print;
+		def.group_done_user = &def;
 	}
 	cli_progress progress;
 	cli_progress_init(&progress, show_progress, "single gates");
-	a.def.progress = cli_progress_update;
-	a.def.progress_user = &progress;
-	a.def.stop = &cli_stop;
+	def.map.progress = cli_progress_update;
+	def.map.progress_user = &progress;
+	def.map.stop = &cli_stop;
+	bsim_markov_build_result res;
+	bsim_error err;
 	cli_signals_install();
-	int built = 0, reused = 0, copied = 0, own = 0;
-	int pass = a.def.self_passes; /* a round's: the pass made (the first group's) */
-	uint64_t *keys = NULL;
-	int n_keys = 0;
-	double cpu = 0.0;
-	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++) {
-		bsim_scene scene;
-		rc = bsim_experiment_group_scene(&e, g, c.sets.ov, c.sets.n, &scene, &err);
-		if (rc != BSIM_OK)
-			break;
-		bsim_markov_set set;
-		a.def.part_first = n_keys; /* the parts take turns along every group's maps */
-		rc = bsim_markov_build(&scene, &a.def, c.out, &set, &err);
-		bsim_scene_free(&scene);
-		if (rc != BSIM_OK)
-			break;
-		built += set.built;
-		reused += set.reused;
-		copied += set.copied;
-		own += set.built + set.reused;
-		cpu += set.seconds;
-		if (g == 0)
-			pass = set.pass;
-		else if (round && set.pass != pass)
-			rc = bsim_error_set(&err, BSIM_EINPUT,
-			                    "%s: group 0's maps are at pass %d but group %d's at "
-			                    "pass %d: not the merge of one round",
-			                    a.passes ? a.passes : "--passes", pass, g, set.pass);
-		if (keys_add(&keys, &n_keys, &set) != 0)
-			rc = bsim_error_set(&err, BSIM_EFAIL, "out of memory");
-		char of_pass[32] = ""; /* a round before the last: one pass of the maps */
-		if (set.pass < a.def.self_passes)
-			snprintf(of_pass, sizeof of_pass, "pass %d ", set.pass);
-		for (int i = 0; i < set.n && !c.quiet; i++)
-			printf("group %d  k = %g, %g N m/rad  map_%016llx  %s%s\n", g,
-			       set.maps[i].k[0], set.maps[i].k[1],
-			       (unsigned long long)set.maps[i].key, of_pass,
-			       set.maps[i].elsewhere ? "another part's"
-			       : set.maps[i].copied  ? "from a part"
-			       : set.maps[i].cached  ? "reused"
-			                             : "built");
-		bsim_markov_set_free(&set);
-	}
+	rc = a.shards > 0 && !stored ? bsim_error_set(&err, BSIM_EFAIL, "out of memory")
+	                             : bsim_markov_build_run(&def, &res, &err);
 	cli_progress_finish(&progress);
 	cli_signals_restore();
+	cli_stored_argv_free(stored, argc, argv);
 	if (rc == BSIM_ESTOPPED) {
 		/* Each finished map is in the directory already: the same command
 		 * reuses them and builds the rest. */
@@ -581,50 +568,10 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		          sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
 		rc = 128 + sig;
 	}
-	/* A spread build's parts carry the name of the run, from the keys of
-	 * all its maps: merge checks they are one build's, and this one's. */
-	char run[17];
-	if (round && keys) /* a round's parts: one pass's (keys has room for it) */
-		keys[n_keys] = (uint64_t)pass;
-	bsim_markov_run_id(keys, n_keys + (round && keys), run);
-	if (rc == BSIM_OK && m &&
-	    (rc = bsim_sweep_dir_part_read(m->parts[0], &first, &err)) == BSIM_OK &&
-	    strcmp(first.run, run) != 0)
-		rc = bsim_error_set(&err, BSIM_EINPUT,
-		                    "%s: part %d of %d of run %s, but the experiment read now "
-		                    "makes run %s: its file changed since the parts ran",
-		                    m->parts[0], first.index, first.count, first.run, run);
-	if (rc == BSIM_OK && a.shards > 0) {
-		const char *paths[2] = {path, a.passes};
-		char **stored = cli_stored_argv_paths(argc, argv, paths, 2);
-		rc = stored ? bsim_markov_part_write(c.out, a.shard, a.shards, run, n_keys, own,
-		                                     argc, stored, &err)
-		            : bsim_error_set(&err, BSIM_EFAIL, "out of memory");
-		cli_stored_argv_free(stored, argc, argv);
-	}
-	if (rc == BSIM_OK && !c.quiet && a.shards > 0)
-		printf("part %d of %d of the maps in %s; beamsim merge joins the %d parts' "
-		       "directories\n",
-		       a.shard, a.shards, cli_path(c.out), a.shards);
-	if (rc == BSIM_OK && !c.quiet && round && pass < a.def.self_passes && !m)
-		printf("pass %d of passes 0 to %d (flow entries): once merged into DIR, the next "
-		       "round is the same command with --passes DIR\n",
-		       pass, a.def.self_passes);
-	else if (rc == BSIM_OK && !c.quiet && round && pass < a.def.self_passes)
-		printf("passes 0 to %d of the %d (flow entries) in %s: the next round is the "
-		       "parts' command with --passes %s\n",
-		       pass, a.def.self_passes + 1, cli_path(c.out), cli_path(c.out));
 	if (rc == BSIM_OK && !c.quiet)
-		printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials "
-		       "each, in %s\n",
-		       built, cpu, reused, copied ? ", the others from the parts" : "",
-		       bsim_markov_bins_count(&a.def.bins), a.def.trials, cli_path(c.out));
-	if (rc == BSIM_OK && !c.quiet)
-		cli_wrote(stdout, c.out);
-	bsim_experiment_free(&e);
-	bsim_markov_entries_free(&entries);
-	bsim_sweep_dir_part_free(&first);
-	free(keys);
+		build_print(&def, &res, c.out);
+	if (rc == BSIM_OK)
+		bsim_markov_build_result_free(&res);
 	cli_common_free(&c);
 	return rc > BSIM_ESTOPPED ? rc : cli_report(rc, &err);
 }
@@ -639,22 +586,15 @@ int cmd_markov_merge(int argc, char **argv, const cli_merge *m)
 	return markov_build_main(argc, argv, m, NULL);
 }
 
-/* The probabilities of the end, a side and stuck: p summed by kind. */
-static void predict_totals(const bsim_markov_prediction *p, double total[3])
-{
-	total[0] = total[1] = total[2] = 0.0;
-	for (int i = 0; i < p->n_locations; i++)
-		total[p->loc[i].kind] += p->p[i];
-}
-
-static void predict_print(const char *path, const bsim_scene *scene, const bsim_markov_set *set,
-                          const bsim_markov_prediction *p, const char *out, int locations)
+static void predict_print(const char *path, const bsim_markov_predict_result *r, const char *out,
+                          int locations)
 {
 	static const char *const kinds[] = {"end", "side", "stuck"};
-	double total[3];
-	predict_totals(p, total);
+	const bsim_markov_prediction *p = &r->p;
+	const double *total = r->total;
 	printf("lattice     %s (%s): %d x %d gates, %d maps, %d states (%s)\n", cli_path(path),
-	       scene->name, scene->lattice.columns, scene->lattice.rows, set->n, p->n_states,
+	       r->scene.name, r->scene.lattice.columns, r->scene.lattice.rows, r->n_maps,
+	       p->n_states,
 	       p->exact    ? "LU"
 	       : p->sweeps ? "sweeps"
 	                   : "series");
@@ -702,75 +642,6 @@ static void predict_print(const char *path, const bsim_scene *scene, const bsim_
 		cli_wrote(stdout, out);
 }
 
-/* --json: one object with the totals and every final location. */
-static void predict_json(const char *path, const bsim_scene *scene, const bsim_markov_set *set,
-                         const bsim_markov_prediction *p, double seconds, double cpu)
-{
-	static const char *const kinds[] = {"end", "side", "stuck"};
-	double total[3];
-	predict_totals(p, total);
-	FILE *f = stdout;
-	fputs("{\"scene\": ", f);
-	bsim_json_string(f, path);
-	fputs(", \"name\": ", f);
-	bsim_json_string(f, scene->name);
-	fprintf(f,
-	        ", \"columns\": %d, \"rows\": %d, \"maps\": %d, \"states\": %d, \"solve\": "
-	        "\"%s\", \"totals\": {",
-	        scene->lattice.columns, scene->lattice.rows, set->n, p->n_states,
-	        p->exact    ? "LU"
-	        : p->sweeps ? "sweeps"
-	                    : "series");
-	for (int k = 0; k < 3; k++) {
-		fprintf(f, "%s\"%s\": ", k ? ", " : "", kinds[k]);
-		bsim_json_number(f, total[k]);
-	}
-	fputs("}, \"mean_gates\": ", f);
-	bsim_json_number(f, p->mean_gates);
-	fputs(", \"left_in_field\": ", f);
-	bsim_json_number(f, p->left_in_field);
-	fputs(", \"tol\": ", f);
-	bsim_json_number(f, p->tol);
-	fprintf(f, ", \"sweeps\": %d", p->sweeps);
-	fputs(", \"mean_time\": ", f);
-	bsim_json_number(f, p->mean_time);
-	if (p->walks > 0) {
-		fprintf(f, ", \"walks\": %ld, \"duration\": ", p->walks);
-		bsim_json_number(f, p->duration);
-		fputs(", \"at_duration\": {", f);
-		for (int k = 0; k < 3; k++) {
-			fprintf(f, "%s\"%s\": {\"p\": ", k ? ", " : "", kinds[k]);
-			bsim_json_number(f, p->p_by[k]);
-			fputs(", \"mean_time\": ", f);
-			bsim_json_number(f, p->t_mean[k]);
-			fputs(", \"sd_time\": ", f);
-			bsim_json_number(f, p->t_sd[k]);
-			fputc('}', f);
-		}
-		fputc('}', f);
-	}
-	fputs(", \"predict_seconds\": ", f);
-	bsim_json_number(f, seconds);
-	/* the CPU time of the same: what it costs on a machine others share */
-	fputs(", \"predict_cpu_seconds\": ", f);
-	bsim_json_number(f, cpu);
-	fputs(", \"locations\": [", f);
-	for (int i = 0; i < p->n_locations; i++) {
-		char label[48];
-		bsim_lattice_location_label(p->loc[i], label, sizeof label);
-		fprintf(f, "%s{\"location\": \"%s\", \"kind\": \"%s\", \"p\": ", i ? ", " : "",
-		        label, kinds[p->loc[i].kind]);
-		bsim_json_number(f, p->p[i]);
-		fputc('}', f);
-	}
-	fputs("], \"p_gates\": [", f);
-	for (int k = 0; k <= p->n_gates; k++) {
-		fputs(k ? ", " : "", f);
-		bsim_json_number(f, p->p_gates[k]);
-	}
-	fputs("]}\n", f);
-}
-
 static int markov_predict(int argc, char **argv)
 {
 	cli_common c = cli_common_default();
@@ -786,47 +657,26 @@ static int markov_predict(int argc, char **argv)
 		cli_common_free(&c);
 		return rc;
 	}
-	bsim_scene scene;
+	bsim_markov_predict_def def = bsim_markov_predict_def_default();
+	def.scene = path;
+	def.sets = c.sets.ov;
+	def.n_sets = c.sets.n;
+	def.map_dir = a.map;
+	def.out = c.out;
+	def.overwrite = c.overwrite;
+	def.tol = a.tol;
+	def.gates = a.no_gates ? 0 : a.gates ? 1 : -1;
+	def.walks = a.walks;
+	bsim_markov_predict_result r;
 	bsim_error err;
-	if ((rc = bsim_scene_load(path, c.sets.ov, c.sets.n, &scene, &err)) != BSIM_OK) {
-		cli_common_free(&c);
-		return cli_report(rc, &err);
-	}
-	bsim_options opts;
-	bsim_markov_set set;
-	bsim_markov_prediction p = {0};
-	/* --out refused before the chain is solved, not after */
-	rc = c.out ? bsim_outdir_probe(c.out, c.overwrite ? BSIM_OUTDIR_OVERWRITE : BSIM_OUTDIR_NEW,
-	                               NULL, &err)
-	           : BSIM_OK;
-	if (rc != BSIM_OK) {
-		bsim_scene_free(&scene);
-		cli_common_free(&c);
-		return cli_report(rc, &err);
-	}
-	rc = bsim_markov_load(&scene, a.map, &opts, &set, &err);
-	/* The wall time of the prediction alone (the chain composed and
-	 * solved; the maps already read). */
-	if (rc == BSIM_OK && a.tol < 0)
-		a.tol = bsim_markov_tol_sampling(&set);
-	double t0 = bsim_clock_seconds(), c0 = bsim_clock_thread_cpu_seconds();
-	if (rc == BSIM_OK)
-		rc = bsim_markov_predict_with(
-		        &scene, &set, a.tol,
-		        !a.no_gates && (a.gates || c.out) ? BSIM_MARKOV_GATES : 0, &p, &err);
-	double seconds = bsim_clock_seconds() - t0, cpu = bsim_clock_thread_cpu_seconds() - c0;
-	if (rc == BSIM_OK && p.has_time && a.walks > 0)
-		rc = bsim_markov_predict_time(&scene, &set, a.walks, set.def.seed, &p, &err);
-	if (rc == BSIM_OK && c.out)
-		rc = bsim_markov_prediction_store(c.out, c.overwrite, &scene, &set, &p, &err);
+	rc = bsim_markov_predict_run(&def, &r, &err);
 	/* --quiet wins over --json: nothing on stdout. */
 	if (rc == BSIM_OK && !c.quiet && a.json)
-		predict_json(path, &scene, &set, &p, seconds, cpu);
+		bsim_markov_predict_json(stdout, path, &r);
 	else if (rc == BSIM_OK && !c.quiet)
-		predict_print(path, &scene, &set, &p, c.out, a.locations);
-	bsim_markov_prediction_free(&p);
-	bsim_markov_set_free(&set);
-	bsim_scene_free(&scene);
+		predict_print(path, &r, c.out, a.locations);
+	if (rc == BSIM_OK)
+		bsim_markov_predict_result_free(&r);
 	cli_common_free(&c);
 	return cli_report(rc, &err);
 }

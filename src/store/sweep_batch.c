@@ -263,7 +263,7 @@ int bsim_sweep_batch_run_cpu(sweep_batch *b, const bsim_experiment *const *e,
 	}
 	if (rc == BSIM_OK && b->out) {
 		rc = bsim_session_open(&b->ss, b->out, bsim_session_mode(b->resume, b->overwrite),
-		                       b->command, NULL, inputs, size, err);
+		                       b->command, b->spelling, inputs, size, err);
 		b->open = rc == BSIM_OK;
 		c.journal = b->open ? b->ss.journal : NULL;
 	}

@@ -30,9 +30,10 @@ typedef struct sweep_batch {
 	const char *command; /* "markov validate", "essay": the journal's and part.json's */
 	const char *out;     /* the output directory; NULL: no directory, no journal */
 	int resume;
-	int overwrite;                   /* 1: replace what out holds (outdir.h) */
-	const bsim_sweep_spread *spread; /* NULL: one process */
-	bsim_progress_fn progress;       /* trials done of every sweep's; may be NULL */
+	int overwrite;                        /* 1: replace what out holds (outdir.h) */
+	const bsim_outdir_spelling *spelling; /* how refusals name resume, overwrite; may be NULL */
+	const bsim_sweep_spread *spread;      /* NULL: one process */
+	bsim_progress_fn progress;            /* trials done of every sweep's; may be NULL */
 	void *progress_user;
 	const volatile sig_atomic_t *stop;
 	/* Set by bsim_sweep_batch_run: */

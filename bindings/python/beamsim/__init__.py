@@ -444,6 +444,137 @@ def landscape(scene, set=None, resolution=None, region=None):
                               float(resolution) if resolution is not None else 0.0, region)
 
 
+def _entries(entries):
+    """--entries: None, one str or path, or a sequence of them ("self",
+    "self:N", "flow", "flow:N", or gate_entries.csv paths)."""
+    if entries is None:
+        return None
+    if isinstance(entries, (str, os.PathLike)):
+        entries = [entries]
+    out = []
+    for e in entries:
+        _no_nul("entries", e)
+        out.append(os.fspath(e))
+    return out
+
+
+def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=None, seed=None,
+                 threads=None, backend=None, backend_opt=None, set=None, grid=None,
+                 progress=None):
+    """The single-gate maps the lattices of an experiment need, one per pair
+    of beam stiffnesses, built into the map directory out as `beamsim
+    markov build EXPERIMENT --out DIR` builds them (docs/markov.md): the
+    same maps, byte for byte, for the same arguments.
+
+    out is a cache: maps already there with the same key are reused, the
+    others built there. trials: single gates per entry bin (None: 200);
+    bins: (positions, speeds, directions), 1 to 64 each (None: (4, 4, 3));
+    vmax: m/s, the top of the speed bins (None: 40); entries: gate_entries.csv
+    paths (a bin's states drawn from them), or "self", "self:N", "flow",
+    "flow:N" as --entries; seed: of the states and schedules (None: 1);
+    backend, backend_opt, set, grid, threads as in sweep. progress:
+    callable(done, total) over the single gates; Ctrl-C stops the build
+    (the maps finished are kept: the same call builds the rest).
+
+    Returns a dict: "maps" (one per group's map, in order: {"group", "k"
+    (left, right, N m/rad), "key" (its files' name, map_HASH), "how"
+    ("built" or "reused"), "pass"}), "built", "reused", "groups",
+    "cpu_seconds" (of the maps built now), "bins" (entry bins a map, the
+    start's included), "trials", "run" and "out"."""
+    if vmax is not None and not (vmax > 0 and math.isfinite(vmax)):
+        raise ValueError(f"--vmax {vmax}: expected a speed > 0 in m/s")
+    if bins is not None:
+        bins = tuple(bins)
+        if len(bins) != 3 or any(isinstance(b, bool) or not isinstance(b, numbers.Integral)
+                                 or not 1 <= b <= 64 for b in bins):
+            raise ValueError(f"--bins {bins}: expected P,S,D: 1 to 64 bins of position, "
+                             "speed and direction, e.g. (4, 4, 3)")
+        bins = tuple(int(b) for b in bins)
+    _no_nul("experiment", experiment)
+    _no_nul("out", out)
+    backend = _backend(backend)
+    info = _beamsim.markov_build(os.fspath(experiment), os.fspath(out),
+                                 _count("trials", trials, 1), bins,
+                                 float(vmax) if vmax is not None else 0.0, _entries(entries),
+                                 _seed(seed), _count("threads", threads, 1, 4096), backend,
+                                 _sets(set), _grid(grid), _opts(backend_opt), progress)
+    info["out"] = out
+    return info
+
+
+def markov_predict(scene, map, set=None, tol=None, gates=None, walks=None, out=None,
+                   overwrite=False):
+    """A gate lattice predicted from the maps in the map directory map, as
+    `beamsim markov predict SCENE --map DIR --json` predicts it: the same
+    numbers for the same maps.
+
+    scene: a lattice scene file; set: {dotted key: value} overrides; tol:
+    the probability left in the field at which the solution stops, in (0,
+    1) (None: the maps' sampling tolerance, 1 / (32 sqrt(trials per bin)));
+    gates: True for the distribution of gates visited (the series), False
+    for none (None: with out only); walks: walks of the semi-Markov chain
+    for the time to the outcome (None: 100000; 0: none). out: also write
+    prediction.csv, prediction_gates.csv, time.csv, their .mat twins and
+    the figures there; overwrite: replace the result out holds (without it
+    such an out is refused, ValueError).
+
+    Returns --json's object as a dict ("totals" {end, side, stuck},
+    "locations" [{location, kind, p}], "p_gates", "mean_gates",
+    "mean_time", "at_duration", "solve", "states", "tol", ...) with "p_time"
+    (a (bins, 3) array: the probability that the outcome, end, side or
+    stuck, happens in each time bin), "time_bin" (s) and "p_loc_time" (each
+    location's p at the trial's duration), both empty without walks."""
+    if tol is not None and not (0.0 < tol < 1.0):
+        raise ValueError(f"--tol {tol}: expected the probability left in the field at which "
+                         "the solution stops, in (0, 1), e.g. 1e-12")
+    _no_nul("scene", scene)
+    _no_nul("map", map)
+    _no_nul("out", out)
+    r = _beamsim.markov_predict(os.fspath(scene), os.fspath(map), _sets(set),
+                                float(tol) if tol is not None else 0.0,
+                                -1 if gates is None else int(bool(gates)),
+                                100000 if walks is None else _count("walks", walks, 0,
+                                                                     100000000),
+                                os.fspath(out) if out is not None else None, bool(overwrite))
+    d = json.loads(r["json"])
+    d["p_time"], d["time_bin"], d["p_loc_time"] = r["p_time"], r["time_bin"], r["p_loc_time"]
+    return d
+
+
+def markov_validate(experiment, map, out=None, trials=None, seed=None, threads=None, set=None,
+                    grid=None, bootstrap=None, progress=None, resume=False, overwrite=False):
+    """Every group of a lattice experiment simulated directly, under the
+    essay's protocol and as a whole world, against the chain of the maps in
+    map, as `beamsim markov validate EXPERIMENT --map DIR --out OUT` does
+    it. trials, seed: instead of the experiment's; bootstrap: resamples of
+    the simulation (None: 2000); out: keep the output directory there (None:
+    a temporary one); progress, resume, overwrite as in sweep.
+
+    Returns validate.json as a dict ("checks": one per group and protocol,
+    essay then world: group, protocol, trials, tv, tv_sampling,
+    tv_sampling95, tv_map, gates_sim, gates_chain, sim_cpu_seconds,
+    predict_cpu_seconds, speedup, break_even_lattices, states, exact and,
+    with the maps' holding times, "time"; "map_cpu_seconds", "entry_bins",
+    "trials_per_bin", ...) with "files" (the directory's files as load
+    reads them: "validate" (validate.csv), "gates", "time_validate", ...)
+    and "out"."""
+    _no_nul("experiment", experiment)
+    _no_nul("map", map)
+    _no_nul("out", out)
+    with _Dir(out, "validate") as d:
+        _beamsim.markov_validate(os.fspath(experiment), os.fspath(map), d,
+                                 _count("trials", trials, 1), _seed(seed),
+                                 _count("threads", threads, 1, 4096), _sets(set), _grid(grid),
+                                 -1 if bootstrap is None else
+                                 _count("bootstrap", bootstrap, 0, 1000000),
+                                 progress, bool(resume), bool(overwrite))
+        files = load(d)
+    info = files.pop("validate.json")
+    info["files"] = files
+    info["out"] = out
+    return info
+
+
 class World:
     """A world stepped by hand, on any backend: the scene's bodies and beams
     in a backend's world, advanced by the caller a step at a time

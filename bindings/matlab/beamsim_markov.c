@@ -1,0 +1,396 @@
+/* beamsim_markov: the Markov chain's maps built, a lattice predicted from
+ * them and the prediction validated against direct simulation, as `beamsim
+ * markov build`, `predict` and `validate` do them (beamsim/markov.h).
+ *
+ *   b = beamsim_markov('build', EXPERIMENT, 'out', DIR, NAME, VALUE, ...)
+ *   p = beamsim_markov('predict', SCENE, 'map', DIR, NAME, VALUE, ...)
+ *   v = beamsim_markov('validate', EXPERIMENT, 'map', DIR, 'out', DIR, ...)
+ *
+ * build's names: 'out' (the map directory, required), 'trials' (single
+ * gates per entry bin), 'bins' [P S D], 'vmax' (m/s), 'entries' (a text or
+ * a cell of texts: gate_entries.csv paths, or 'self', 'self:N', 'flow',
+ * 'flow:N'), 'seed', 'threads', 'backend', 'backend_opt', 'set', 'grid'.
+ * b.maps is a struct array, a map each (group from 1, k [left right] N
+ * m/rad, key its files' name, how 'built' or 'reused').
+ *
+ * predict's: 'map' (required), 'set', 'tol', 'gates' (true: the
+ * distribution of gates visited; default: with 'out' only), 'walks',
+ * 'out', 'overwrite'. p is what `markov predict --json` prints, decoded by
+ * jsondecode, with p.p_time (time bins x 3: end, side, stuck), p.time_bin
+ * (s) and p.p_loc_time.
+ *
+ * validate's: 'map' and 'out' (required), 'trials', 'seed', 'threads',
+ * 'set', 'grid', 'bootstrap', 'resume', 'overwrite'. v is validate.json,
+ * decoded, its checks' group from 1. */
+#define _GNU_SOURCE /* open_memstream */
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bsim_mex.h"
+
+enum {
+	A_OUT,
+	A_MAP,
+	A_TRIALS,
+	A_BINS,
+	A_VMAX,
+	A_ENTRIES,
+	A_SEED,
+	A_THREADS,
+	A_BACKEND,
+	A_BACKEND_OPT,
+	A_SET,
+	A_GRID,
+	A_TOL,
+	A_GATES,
+	A_WALKS,
+	A_OVERWRITE,
+	A_BOOTSTRAP,
+	A_RESUME,
+	N_ARGS
+};
+static const char *const arg_names[N_ARGS] = {
+        "out",  "map",     "trials",  "bins",        "vmax",      "entries",
+        "seed", "threads", "backend", "backend_opt", "set",       "grid",
+        "tol",  "gates",   "walks",   "overwrite",   "bootstrap", "resume"};
+
+/* The names each subcommand takes, the others refused. */
+static const int build_names[] = {A_OUT,     A_TRIALS,  A_BINS,        A_VMAX, A_ENTRIES, A_SEED,
+                                  A_THREADS, A_BACKEND, A_BACKEND_OPT, A_SET,  A_GRID};
+static const int predict_names[] = {A_MAP, A_SET, A_TOL, A_GATES, A_WALKS, A_OUT, A_OVERWRITE};
+static const int validate_names[] = {A_MAP, A_OUT,  A_TRIALS,    A_SEED,   A_THREADS,
+                                     A_SET, A_GRID, A_BOOTSTRAP, A_RESUME, A_OVERWRITE};
+
+typedef struct markov_call {
+	bmx_pool pool;
+	const mxArray *v[N_ARGS];
+	bsim_override *sets, *opts_kv;
+	int n_sets, n_opts_kv;
+	bsim_grid_axis *grid;
+	int n_grid;
+	const char **entries;
+	int n_entries;
+	bsim_options opts;
+	bsim_markov_build_result build;
+	bsim_markov_predict_result predict;
+	int built, predicted;
+} markov_call;
+
+/* The pairs after the path, each a name the subcommand takes. */
+static int pairs(markov_call *c, const char *sub, const int *names, int n, int nrhs,
+                 const mxArray *prhs[], bsim_error *err)
+{
+	if (bmx_pairs(nrhs, prhs, 2, arg_names, N_ARGS, c->v, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	for (int i = 0; i < N_ARGS; i++) {
+		int takes = 0;
+		for (int k = 0; k < n; k++)
+			takes |= names[k] == i;
+		if (c->v[i] && !takes)
+			return bsim_error_set(err, BSIM_EINPUT, "'%s': not an argument of '%s'",
+			                      arg_names[i], sub);
+	}
+	return BSIM_OK;
+}
+
+/* 'set' and 'grid'. */
+static int sets_grid(markov_call *c, bsim_error *err)
+{
+	if (bmx_overrides("set", c->v[A_SET], &c->pool, &c->sets, &c->n_sets, err) ||
+	    (c->v[A_GRID] && bmx_grid("grid", c->v[A_GRID], &c->pool, &c->grid, &c->n_grid, err)))
+		return err->code;
+	return BSIM_OK;
+}
+
+/* 'entries': one text or a cell of them, each a kind (self, flow) or a
+ * path. */
+static int entries(markov_call *c, bsim_markov_def *def, bsim_error *err)
+{
+	const mxArray *a = c->v[A_ENTRIES];
+	if (!a)
+		return BSIM_OK;
+	const size_t n = mxIsCell(a) ? mxGetNumberOfElements(a) : 1;
+	c->entries = calloc(n ? n : 1, sizeof *c->entries);
+	if (!c->entries)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (size_t i = 0; i < n; i++) {
+		const mxArray *e = mxIsCell(a) ? mxGetCell(a, (mwIndex)i) : a;
+		const char *text;
+		int is_kind;
+		if (!e || bmx_text("entries", e, &c->pool, &text, err) ||
+		    bsim_markov_entries_kind(text, def, &is_kind, err))
+			return e ? err->code
+			         : bsim_error_set(err, BSIM_EINPUT, "'entries': expected texts");
+		if (!is_kind)
+			c->entries[c->n_entries++] = text;
+	}
+	return BSIM_OK;
+}
+
+/* 'bins' [P S D]: the library checks the counts. */
+static int bins(const mxArray *a, bsim_markov_bins *b, bsim_error *err)
+{
+	if (!mxIsDouble(a) || mxIsComplex(a) || mxGetNumberOfElements(a) != 3)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "'bins': expected [P S D]: 1 to 64 bins of position, speed "
+		                      "and direction, e.g. [4 4 3]");
+	int *n[3] = {&b->n_pos, &b->n_speed, &b->n_dir};
+	for (int i = 0; i < 3; i++) {
+		const double x = mxGetPr(a)[i];
+		if (!(x >= 1 && x <= 64) || x != (int)x)
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "'bins': expected [P S D]: 1 to 64 bins of position, "
+			                      "speed and direction, e.g. [4 4 3]");
+		*n[i] = (int)x;
+	}
+	return BSIM_OK;
+}
+
+static mxArray *build_struct(const bsim_markov_build_result *r, int trials)
+{
+	mxArray *s = mxCreateStructMatrix(1, 1, 0, NULL);
+	static const char *const fields[] = {"group", "k", "key", "how"};
+	mxArray *maps = mxCreateStructMatrix((mwSize)r->n_maps, 1, 4, (const char **)fields);
+	for (int i = 0; i < r->n_maps; i++) {
+		const bsim_markov_built *m = &r->maps[i];
+		char key[24];
+		snprintf(key, sizeof key, "map_%016llx", (unsigned long long)m->key);
+		bmx_set(maps, (mwIndex)i, "group", bmx_scalar(m->group + 1));
+		bmx_set(maps, (mwIndex)i, "k", bmx_row(m->k, 2));
+		bmx_set(maps, (mwIndex)i, "key", bmx_string(key));
+		bmx_set(maps, (mwIndex)i, "how",
+		        bmx_string(m->elsewhere ? "elsewhere"
+		                   : m->copied  ? "copied"
+		                   : m->cached  ? "reused"
+		                                : "built"));
+	}
+	bmx_set(s, 0, "maps", maps);
+	bmx_set(s, 0, "built", bmx_scalar(r->built));
+	bmx_set(s, 0, "reused", bmx_scalar(r->reused));
+	bmx_set(s, 0, "cpu_seconds", bmx_scalar(r->seconds));
+	bmx_set(s, 0, "bins", bmx_scalar(r->n_bins));
+	bmx_set(s, 0, "trials", bmx_scalar(trials));
+	bmx_set(s, 0, "run", bmx_string(r->run));
+	return s;
+}
+
+static int build(markov_call *c, const char *path, mxArray **out, bsim_error *err)
+{
+	bsim_markov_build_def def = bsim_markov_build_def_default();
+	const char *backend = NULL;
+	long trials = 0, threads = 0;
+	const mxArray *const *v = c->v;
+	if (!v[A_OUT])
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "'build': 'out' (the map directory) is required");
+	if (bmx_text("out", v[A_OUT], &c->pool, &def.out, err) ||
+	    (v[A_TRIALS] && bmx_long("trials", v[A_TRIALS], 1, 2147483647L, &trials, err)) ||
+	    (v[A_BINS] && bins(v[A_BINS], &def.map.bins, err)) ||
+	    (v[A_VMAX] && bmx_double("vmax", v[A_VMAX], &def.map.bins.v_max, err)) ||
+	    (v[A_SEED] && bmx_seed("seed", v[A_SEED], &def.seed, err)) ||
+	    (v[A_THREADS] && bmx_long("threads", v[A_THREADS], 1, 4096, &threads, err)) ||
+	    (v[A_BACKEND] && bmx_text("backend", v[A_BACKEND], &c->pool, &backend, err)) ||
+	    bmx_overrides("backend_opt", v[A_BACKEND_OPT], &c->pool, &c->opts_kv, &c->n_opts_kv,
+	                  err) ||
+	    bmx_backend(backend, c->opts_kv, c->n_opts_kv, &def.map.backend, &c->opts, err) ||
+	    sets_grid(c, err) || entries(c, &def.map, err))
+		return err->code;
+	def.experiment = path;
+	def.has_seed = v[A_SEED] != NULL;
+	if (trials > 0)
+		def.map.trials = (int)trials;
+	def.map.threads = (int)threads;
+	def.map.opts = &c->opts;
+	def.entries = c->entries;
+	def.n_entries = c->n_entries;
+	def.sets = c->sets;
+	def.n_sets = c->n_sets;
+	def.grid = c->grid;
+	def.n_grid = c->n_grid;
+	if (bsim_markov_build_run(&def, &c->build, err) != BSIM_OK)
+		return err->code;
+	c->built = 1;
+	*out = build_struct(&c->build, def.map.trials);
+	return BSIM_OK;
+}
+
+/* jsondecode(text): MATLAB's and Octave's own reading of the JSON. */
+static int json_decode(mxArray *text, mxArray **out, bsim_error *err)
+{
+	if (mexCallMATLAB(1, out, 1, &text, "jsondecode") != 0)
+		return bsim_error_set(err, BSIM_EFAIL, "jsondecode failed");
+	mxDestroyArray(text);
+	return BSIM_OK;
+}
+
+/* The prediction as markov predict --json prints it, decoded, with its
+ * arrays beside. */
+static int predict_struct(const char *path, const bsim_markov_predict_result *r, mxArray **out,
+                          bsim_error *err)
+{
+	char *text = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&text, &len);
+	if (!f)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	bsim_markov_predict_json(f, path, r);
+	if (fclose(f) != 0) {
+		free(text);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	mxArray *s = NULL;
+	int rc = json_decode(bmx_string(text), &s, err);
+	free(text);
+	if (rc != BSIM_OK)
+		return rc;
+	const bsim_markov_prediction *p = &r->p;
+	const size_t bins = p->walks > 0 ? (size_t)p->n_time_bins : 0;
+	mxArray *pt = mxCreateDoubleMatrix((mwSize)bins, 3, mxREAL);
+	for (size_t b = 0; b < bins; b++)
+		for (size_t k = 0; k < 3; k++)
+			mxGetPr(pt)[k * bins + b] = p->p_time[b * 3 + k];
+	bmx_set(s, 0, "p_time", pt);
+	bmx_set(s, 0, "time_bin", bmx_scalar(p->walks > 0 ? p->time_bin : 0.0));
+	double *loc;
+	mxArray *pl = bmx_column(p->walks > 0 ? (size_t)p->n_locations : 0, &loc);
+	for (int i = 0; p->walks > 0 && i < p->n_locations; i++)
+		loc[i] = p->p_loc_time[i];
+	bmx_set(s, 0, "p_loc_time", pl);
+	*out = s;
+	return BSIM_OK;
+}
+
+static int predict(markov_call *c, const char *path, mxArray **out, bsim_error *err)
+{
+	bsim_markov_predict_def def = bsim_markov_predict_def_default();
+	const mxArray *const *v = c->v;
+	if (!v[A_MAP])
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "'predict': 'map' (the map directory) is required");
+	if (bmx_text("map", v[A_MAP], &c->pool, &def.map_dir, err) || sets_grid(c, err) ||
+	    (v[A_TOL] && bmx_double("tol", v[A_TOL], &def.tol, err)) ||
+	    (v[A_GATES] && bmx_flag("gates", v[A_GATES], &def.gates, err)) ||
+	    (v[A_WALKS] && bmx_long("walks", v[A_WALKS], 0, 100000000L, &def.walks, err)) ||
+	    (v[A_OUT] && bmx_text("out", v[A_OUT], &c->pool, &def.out, err)) ||
+	    (v[A_OVERWRITE] && bmx_flag("overwrite", v[A_OVERWRITE], &def.overwrite, err)))
+		return err->code;
+	if (v[A_TOL] && !(def.tol > 0 && def.tol < 1))
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "'tol' %g: expected the probability left in the field at which "
+		        "the solution stops, in (0, 1), e.g. 1e-12",
+		        def.tol);
+	def.scene = path;
+	def.sets = c->sets;
+	def.n_sets = c->n_sets;
+	def.overwrite_option = "'overwrite', true";
+	if (bsim_markov_predict_run(&def, &c->predict, err) != BSIM_OK)
+		return err->code;
+	c->predicted = 1;
+	return predict_struct(path, &c->predict, out, err);
+}
+
+/* validate.json of dir, decoded, each check's group from 1. */
+static int validation_struct(const char *dir, mxArray **out, bsim_error *err)
+{
+	char file[BSIM_PATH_MAX];
+	snprintf(file, sizeof file, "%s/validate.json", dir);
+	mxArray *name = bmx_string(file), *text = NULL;
+	if (mexCallMATLAB(1, &text, 1, &name, "fileread") != 0)
+		return bsim_error_set(err, BSIM_EFAIL, "%s: cannot be read", file);
+	mxDestroyArray(name);
+	int rc = json_decode(text, out, err);
+	mxArray *checks = rc == BSIM_OK ? mxGetField(*out, 0, "checks") : NULL;
+	for (size_t i = 0; checks && mxIsStruct(checks) && i < mxGetNumberOfElements(checks); i++) {
+		mxArray *g = mxGetField(checks, (mwIndex)i, "group");
+		if (g && mxIsDouble(g) && mxGetNumberOfElements(g) == 1)
+			mxGetPr(g)[0] += 1;
+	}
+	return rc;
+}
+
+static int validate(markov_call *c, const char *path, mxArray **out, bsim_error *err)
+{
+	bsim_markov_validate_def def = bsim_markov_validate_def_default();
+	const mxArray *const *v = c->v;
+	long threads = 0, bootstrap = def.bootstrap;
+	if (!v[A_MAP] || !v[A_OUT])
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "'validate': 'map' (the map directory) and 'out' (the output "
+		                      "directory) are required");
+	if (bmx_text("map", v[A_MAP], &c->pool, &def.map_dir, err) ||
+	    bmx_text("out", v[A_OUT], &c->pool, &def.out, err) || sets_grid(c, err) ||
+	    (v[A_TRIALS] && bmx_long("trials", v[A_TRIALS], 1, 2147483647L, &def.trials, err)) ||
+	    (v[A_SEED] && bmx_seed("seed", v[A_SEED], &def.seed, err)) ||
+	    (v[A_THREADS] && bmx_long("threads", v[A_THREADS], 1, 4096, &threads, err)) ||
+	    (v[A_BOOTSTRAP] &&
+	     bmx_long("bootstrap", v[A_BOOTSTRAP], 0, 1000000, &bootstrap, err)) ||
+	    (v[A_RESUME] && bmx_flag("resume", v[A_RESUME], &def.resume, err)) ||
+	    (v[A_OVERWRITE] && bmx_flag("overwrite", v[A_OVERWRITE], &def.overwrite, err)))
+		return err->code;
+	def.experiment = path;
+	def.has_seed = v[A_SEED] != NULL;
+	def.threads = (int)threads;
+	def.bootstrap = (int)bootstrap;
+	def.resume_option = "'resume', true";
+	def.overwrite_option = "'overwrite', true";
+	def.sets = c->sets;
+	def.n_sets = c->n_sets;
+	def.grid = c->grid;
+	def.n_grid = c->n_grid;
+	bsim_markov_validation val;
+	int rc = bsim_markov_validate(&def, &val, err);
+	bsim_markov_validation_free(&val);
+	return rc == BSIM_OK ? validation_struct(def.out, out, err) : rc;
+}
+
+static int markov(markov_call *c, int nrhs, const mxArray *prhs[], mxArray **out, bsim_error *err)
+{
+	const char *sub = NULL, *path = NULL;
+	if (nrhs < 2 || bmx_text("the first argument", prhs[0], &c->pool, &sub, err))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "expected 'build', 'predict' or 'validate', then a file and "
+		                      "name-value pairs");
+	if (strcmp(sub, "build") == 0 || strcmp(sub, "validate") == 0) {
+		const int is_build = sub[0] == 'b';
+		if (pairs(c, sub, is_build ? build_names : validate_names,
+		          is_build ? (int)(sizeof build_names / sizeof *build_names)
+		                   : (int)(sizeof validate_names / sizeof *validate_names),
+		          nrhs, prhs, err) ||
+		    bmx_text("experiment", prhs[1], &c->pool, &path, err))
+			return err->code;
+		return is_build ? build(c, path, out, err) : validate(c, path, out, err);
+	}
+	if (strcmp(sub, "predict") == 0) {
+		if (pairs(c, sub, predict_names,
+		          (int)(sizeof predict_names / sizeof *predict_names), nrhs, prhs, err) ||
+		    bmx_text("scene", prhs[1], &c->pool, &path, err))
+			return err->code;
+		return predict(c, path, out, err);
+	}
+	return bsim_error_set(err, BSIM_EINPUT, "'%s': expected 'build', 'predict' or 'validate'",
+	                      sub);
+}
+
+void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
+{
+	(void)nlhs;
+	markov_call c;
+	memset(&c, 0, sizeof c);
+	bsim_error err;
+	bsim_error_clear(&err);
+	mxArray *out = NULL;
+	int rc = markov(&c, nrhs, prhs, &out, &err);
+	if (c.built)
+		bsim_markov_build_result_free(&c.build);
+	if (c.predicted)
+		bsim_markov_predict_result_free(&c.predict);
+	free(c.entries);
+	bmx_grid_free(c.grid, c.n_grid);
+	bmx_pool_free(&c.pool);
+	if (rc != BSIM_OK)
+		bmx_fail(&err);
+	plhs[0] = out;
+}

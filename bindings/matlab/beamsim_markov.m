@@ -1,0 +1,54 @@
+%BEAMSIM_MARKOV The Markov chain of a gate lattice (a MEX function).
+%   B = BEAMSIM_MARKOV('build', EXPERIMENT, 'out', DIR, NAME, VALUE, ...)
+%   builds the single-gate maps the lattices of EXPERIMENT need into the
+%   map directory DIR, as `beamsim markov build` does (the same maps, byte
+%   for byte): maps already in DIR with the same key are reused.
+%
+%   P = BEAMSIM_MARKOV('predict', SCENE, 'map', DIR, NAME, VALUE, ...)
+%   predicts the lattice of the scene file from the maps in DIR, as
+%   `beamsim markov predict --json` does.
+%
+%   V = BEAMSIM_MARKOV('validate', EXPERIMENT, 'map', DIR, 'out', OUT, ...)
+%   simulates every group of EXPERIMENT directly and against the chain, as
+%   `beamsim markov validate` does, writing OUT's files.
+%
+%   build's names:
+%     'out'          the map directory (required)
+%     'trials'       single gates per entry bin (default 200)
+%     'bins'         [P S D], bins of position, speed and direction
+%                    (default [4 4 3])
+%     'vmax'         m/s, the top of the speed bins (default 40)
+%     'entries'      gate_entries.csv paths (a text or a cell of texts), or
+%                    'self', 'self:N', 'flow', 'flow:N' (docs/markov.md)
+%     'seed', 'threads', 'backend', 'backend_opt', 'set', 'grid'
+%                    as for BEAMSIM_SWEEP
+%   B.maps is a struct array, one map each: group (from 1), k ([left
+%   right], N m/rad), key (its files' name), how ('built' or 'reused');
+%   B.built, B.reused, B.cpu_seconds, B.bins, B.trials, B.run.
+%
+%   predict's names:
+%     'map'          the map directory (required)
+%     'set'          {KEY, VALUE, ...}, scene keys set as by --set
+%     'tol'          the probability left in the field at which the
+%                    solution stops, in (0, 1) (default: the maps' sampling
+%                    tolerance)
+%     'gates'        true: the distribution of gates visited (default: with
+%                    'out' only)
+%     'walks'        walks of the semi-Markov chain (default 100000; 0: none)
+%     'out'          a directory: also write the program's files there
+%     'overwrite'    true: replace the result 'out' holds
+%   P holds what `markov predict --json` prints (P.totals, P.locations,
+%   P.p_gates, P.mean_gates, P.at_duration, ...), and P.p_time (time bins
+%   x 3: end, side, stuck), P.time_bin (s) and P.p_loc_time.
+%
+%   validate's names: 'map', 'out' (both required), 'trials', 'seed',
+%   'threads', 'set', 'grid', 'bootstrap', 'resume', 'overwrite'. V is
+%   validate.json (V.checks: group from 1, protocol, tv, tv_sampling, ...).
+%
+%   Example:
+%     beamsim_markov('build', 'configs/markov/c_track.yaml', 'out', 'maps', ...
+%                    'trials', 20, 'bins', [2 2 1]);
+%     p = beamsim_markov('predict', 'configs/lattice/c_track.yaml', 'map', 'maps');
+%     p.totals
+%
+%   See also BEAMSIM_SWEEP, BEAMSIM_LOAD.

@@ -1,0 +1,284 @@
+/* _beamsim.markov_build, markov_predict and markov_validate: the Markov
+ * chain's maps built, a lattice predicted from them and the prediction
+ * validated against direct simulation, as `beamsim markov build`, `predict`
+ * and `validate` make them (beamsim/markov.h), with the GIL released, a
+ * progress callable and Ctrl-C for the long ones. The package
+ * (beamsim/__init__.py) checks and converts the arguments and reads the
+ * files back (validate.json: every check of a validation). */
+#define _GNU_SOURCE /* open_memstream */
+
+#include "pyb.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A map of a build as a dict: group, k (left, right), key ("map_HASH", its
+ * files' name) and how it was had. */
+static PyObject *built_dict(const bsim_markov_built *m)
+{
+	char key[24];
+	snprintf(key, sizeof key, "map_%016llx", (unsigned long long)m->key);
+	const char *how = m->elsewhere ? "elsewhere"
+	                  : m->copied  ? "copied"
+	                  : m->cached  ? "reused"
+	                               : "built";
+	return Py_BuildValue("{sis(dd)sssssi}", "group", m->group, "k", m->k[0], m->k[1], "key",
+	                     key, "how", how, "pass", m->pass);
+}
+
+/* entries: a sequence of str, each "self", "self:N", "flow", "flow:N" or a
+ * path (bsim_markov_entries_kind); the paths into *paths (the strings the
+ * sequence's own), malloc'd. -1 with an exception set. */
+static int entries_from(PyObject *seq, bsim_markov_def *def, const char ***paths, int *n)
+{
+	*paths = NULL;
+	*n = 0;
+	if (seq == Py_None)
+		return 0;
+	if (!PyList_Check(seq)) {
+		PyErr_SetString(PyExc_TypeError, "entries: expected a list of str");
+		return -1;
+	}
+	Py_ssize_t len = PyList_Size(seq);
+	*paths = calloc((size_t)(len ? len : 1), sizeof **paths);
+	if (!*paths) {
+		PyErr_NoMemory();
+		return -1;
+	}
+	for (Py_ssize_t i = 0; i < len; i++) {
+		const char *v = pyb_text(PyList_GetItem(seq, i), "entries");
+		int is_kind = 0;
+		bsim_error err;
+		if (v && bsim_markov_entries_kind(v, def, &is_kind, &err) != BSIM_OK) {
+			pyb_raise(err.code, &err);
+			v = NULL;
+		}
+		if (!v) {
+			free(*paths);
+			*paths = NULL;
+			return -1;
+		}
+		if (!is_kind)
+			(*paths)[(*n)++] = v;
+	}
+	return 0;
+}
+
+PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
+{
+	(void)self;
+	static char *kwlist[] = {"experiment", "out",          "trials",   "bins",    "vmax",
+	                         "entries",    "seed",         "threads",  "backend", "sets",
+	                         "grid",       "backend_opts", "progress", NULL};
+	const char *experiment, *out, *backend_spec = NULL;
+	int trials = 0, threads = 0;
+	double vmax = 0.0;
+	PyObject *bins_o = Py_None, *entries_o = Py_None, *seed_o = Py_None, *sets_o = Py_None,
+	         *grid_o = Py_None, *opts_o = Py_None, *progress_o = Py_None;
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|iOdOOizOOOO", kwlist, &experiment, &out,
+	                                 &trials, &bins_o, &vmax, &entries_o, &seed_o, &threads,
+	                                 &backend_spec, &sets_o, &grid_o, &opts_o, &progress_o))
+		return NULL;
+	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
+		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
+		return NULL;
+	}
+	bsim_markov_build_def def = bsim_markov_build_def_default();
+	if (bins_o != Py_None && !PyArg_ParseTuple(bins_o, "iii", &def.map.bins.n_pos,
+	                                           &def.map.bins.n_speed, &def.map.bins.n_dir))
+		return NULL;
+	if (vmax != 0.0) /* 0: the default; the library refuses one <= 0 */
+		def.map.bins.v_max = vmax;
+	if (trials > 0)
+		def.map.trials = trials;
+	bsim_options opts;
+	if (!(def.map.backend = pyb_backend(backend_spec, opts_o, &opts)))
+		return NULL;
+	def.map.opts = &opts;
+	def.map.threads = threads;
+	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
+		return NULL;
+	const char **paths;
+	if (entries_from(entries_o, &def.map, &paths, &def.n_entries))
+		return NULL;
+	def.entries = paths;
+	pyb_sets sets;
+	pyb_grid grid;
+	if (pyb_sets_grid_from(sets_o, grid_o, &sets, &grid)) {
+		free(paths);
+		return NULL;
+	}
+	pyb_progress progress;
+	pyb_progress_init(&progress, progress_o);
+	def.experiment = experiment;
+	def.out = out;
+	def.sets = sets.ov;
+	def.n_sets = sets.n;
+	def.grid = grid.axes;
+	def.n_grid = grid.n;
+	def.map.progress = pyb_progress_update;
+	def.map.progress_user = &progress;
+	def.map.stop = &progress.stop;
+	bsim_markov_build_result res;
+	bsim_error err;
+	int rc;
+	Py_BEGIN_ALLOW_THREADS;
+	rc = bsim_markov_build_run(&def, &res, &err);
+	Py_END_ALLOW_THREADS;
+	pyb_sets_free(&sets);
+	pyb_grid_free(&grid);
+	free(paths);
+	if (!pyb_progress_end(&progress, rc, &err)) {
+		if (rc == BSIM_OK)
+			bsim_markov_build_result_free(&res);
+		return NULL;
+	}
+	PyObject *maps = PyList_New(res.n_maps), *d = NULL;
+	for (int i = 0; maps && i < res.n_maps; i++) {
+		PyObject *m = built_dict(&res.maps[i]);
+		if (!m)
+			Py_CLEAR(maps);
+		else
+			PyList_SET_ITEM(maps, i, m);
+	}
+	if (maps)
+		d = Py_BuildValue("{sNsisisisdsisisssi}", "maps", maps, "built", res.built,
+		                  "reused", res.reused, "groups", res.n_groups, "cpu_seconds",
+		                  res.seconds, "bins", res.n_bins, "trials", def.map.trials, "run",
+		                  res.run, "pass", res.pass);
+	bsim_markov_build_result_free(&res);
+	return d;
+}
+
+/* The prediction as markov predict --json prints it (the text, which the
+ * package parses), with its arrays: p_time ((bins, 3): end, side, stuck),
+ * p_loc_time (a location's p at the trial's duration) and time_bin. */
+static PyObject *prediction_dict(const char *scene, const bsim_markov_predict_result *r)
+{
+	char *text = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&text, &len);
+	if (!f)
+		return PyErr_NoMemory();
+	bsim_markov_predict_json(f, scene, r);
+	if (fclose(f) != 0) {
+		free(text);
+		return PyErr_NoMemory();
+	}
+	const bsim_markov_prediction *p = &r->p;
+	PyObject *d = PyDict_New();
+	long dims[2] = {p->walks > 0 ? p->n_time_bins : 0, 3};
+	long n_loc = p->walks > 0 ? p->n_locations : 0;
+	if (!d || pyb_set(d, "json", PyUnicode_FromStringAndSize(text, (Py_ssize_t)len)) ||
+	    pyb_set(d, "time_bin", PyFloat_FromDouble(p->walks > 0 ? p->time_bin : 0.0)) ||
+	    pyb_set(d, "p_time", pyb_array(2, dims, p->p_time)) ||
+	    pyb_set(d, "p_loc_time", pyb_array(1, &n_loc, p->p_loc_time)))
+		Py_CLEAR(d);
+	free(text);
+	return d;
+}
+
+PyObject *pyb_markov_predict(PyObject *self, PyObject *args, PyObject *kw)
+{
+	(void)self;
+	static char *kwlist[] = {"scene", "map", "sets",      "tol", "gates",
+	                         "walks", "out", "overwrite", NULL};
+	const char *scene, *map, *out = NULL;
+	PyObject *sets_o = Py_None;
+	double tol = 0.0;
+	int gates = -1, overwrite = 0;
+	long walks = BSIM_MARKOV_WALKS;
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|Odilzp", kwlist, &scene, &map, &sets_o, &tol,
+	                                 &gates, &walks, &out, &overwrite))
+		return NULL;
+	pyb_sets sets;
+	if (pyb_sets_from(sets_o, &sets))
+		return NULL;
+	bsim_markov_predict_def def = bsim_markov_predict_def_default();
+	def.scene = scene;
+	def.map_dir = map;
+	def.sets = sets.ov;
+	def.n_sets = sets.n;
+	def.tol = tol;
+	def.gates = gates;
+	def.walks = walks;
+	def.out = out;
+	def.overwrite = overwrite;
+	def.overwrite_option = "overwrite=True";
+	bsim_markov_predict_result r;
+	bsim_error err;
+	int rc;
+	Py_BEGIN_ALLOW_THREADS;
+	rc = bsim_markov_predict_run(&def, &r, &err);
+	Py_END_ALLOW_THREADS;
+	pyb_sets_free(&sets);
+	if (rc != BSIM_OK)
+		return pyb_raise(rc, &err);
+	PyObject *d = prediction_dict(scene, &r);
+	bsim_markov_predict_result_free(&r);
+	return d;
+}
+
+PyObject *pyb_markov_validate(PyObject *self, PyObject *args, PyObject *kw)
+{
+	(void)self;
+	static char *kwlist[] = {"experiment", "map",       "out",  "trials",    "seed",
+	                         "threads",    "sets",      "grid", "bootstrap", "progress",
+	                         "resume",     "overwrite", NULL};
+	const char *experiment, *map, *out;
+	long trials = 0;
+	int threads = 0, bootstrap = -1, resume = 0, overwrite = 0;
+	PyObject *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None, *progress_o = Py_None;
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "sss|lOiOOiOpp", kwlist, &experiment, &map, &out,
+	                                 &trials, &seed_o, &threads, &sets_o, &grid_o, &bootstrap,
+	                                 &progress_o, &resume, &overwrite))
+		return NULL;
+	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
+		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
+		return NULL;
+	}
+	bsim_markov_validate_def def = bsim_markov_validate_def_default();
+	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
+		return NULL;
+	pyb_sets sets;
+	pyb_grid grid;
+	if (pyb_sets_grid_from(sets_o, grid_o, &sets, &grid))
+		return NULL;
+	pyb_progress progress;
+	pyb_progress_init(&progress, progress_o);
+	def.experiment = experiment;
+	def.map_dir = map;
+	def.out = out;
+	def.sets = sets.ov;
+	def.n_sets = sets.n;
+	def.grid = grid.axes;
+	def.n_grid = grid.n;
+	def.trials = trials;
+	def.threads = threads;
+	if (bootstrap >= 0)
+		def.bootstrap = bootstrap;
+	def.resume = resume;
+	def.overwrite = overwrite;
+	def.resume_option = "resume=True";
+	def.overwrite_option = "overwrite=True";
+	def.progress = pyb_progress_update;
+	def.progress_user = &progress;
+	def.stop = &progress.stop;
+	bsim_markov_validation v;
+	bsim_error err;
+	int rc;
+	Py_BEGIN_ALLOW_THREADS;
+	rc = bsim_markov_validate(&def, &v, &err);
+	Py_END_ALLOW_THREADS;
+	pyb_sets_free(&sets);
+	pyb_grid_free(&grid);
+	if (!pyb_progress_end(&progress, rc, &err)) {
+		if (rc == BSIM_OK)
+			bsim_markov_validation_free(&v);
+		return NULL;
+	}
+	/* the package reads validate.json, every check, back from out */
+	bsim_markov_validation_free(&v);
+	Py_RETURN_NONE;
+}
