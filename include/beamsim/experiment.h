@@ -47,6 +47,13 @@ typedef struct bsim_experiment {
 	char *scene_text;
 	size_t scene_len;
 	void *scene_doc; /* that text parsed once (internal: a libfyaml document) */
+	/* Every group's scene as the load built and validated it, with the
+	 * load's extra overrides (copied here), so that a group's scene is
+	 * built once: bsim_experiment_group_scene gives a copy of it for the
+	 * same overrides (internal; NULL: none kept). */
+	bsim_scene *group_scenes;
+	bsim_override *group_extra;
+	int n_group_extra;
 } bsim_experiment;
 
 /* Loads an experiment file. Errors (unknown keys, an empty grid, ...) are

@@ -490,6 +490,48 @@ static int load_group(const ydoc *scene, const bsim_experiment *e, int g,
 	return rc;
 }
 
+static void overrides_free(bsim_override *ov, int n)
+{
+	for (int i = 0; ov && i < n; i++) {
+		free((char *)ov[i].key);
+		free((char *)ov[i].value);
+		free((char *)ov[i].origin);
+	}
+	free(ov);
+}
+
+/* The overrides extra[0..n) copied into *copy (strings owned by it). */
+static int overrides_copy(const bsim_override *extra, int n, bsim_override **copy)
+{
+	*copy = calloc((size_t)(n ? n : 1), sizeof **copy);
+	if (!*copy)
+		return BSIM_EFAIL;
+	for (int i = 0; i < n; i++) {
+		(*copy)[i].key = dup_text(extra[i].key);
+		(*copy)[i].value = dup_text(extra[i].value);
+		(*copy)[i].origin = extra[i].origin ? dup_text(extra[i].origin) : NULL;
+		if (!(*copy)[i].key || !(*copy)[i].value ||
+		    (extra[i].origin && !(*copy)[i].origin)) {
+			overrides_free(*copy, i + 1);
+			*copy = NULL;
+			return BSIM_EFAIL;
+		}
+	}
+	return BSIM_OK;
+}
+
+/* The same keys and values, in the same order: the same scenes (where an
+ * override came from names it in messages, and changes no value). */
+static int overrides_same(const bsim_override *a, int n_a, const bsim_override *b, int n_b)
+{
+	if (n_a != n_b)
+		return 0;
+	for (int i = 0; i < n_a; i++)
+		if (strcmp(a[i].key, b[i].key) || strcmp(a[i].value, b[i].value))
+			return 0;
+	return 1;
+}
+
 /* Guards an experiment's parsed scene and every document cloned from it:
  * libfyaml's copies share the parsed input, counted without atomics, so
  * threads making their groups' scenes (the figures do) make them one at a
@@ -518,6 +560,11 @@ int bsim_experiment_group_scene(const bsim_experiment *e, int g, const bsim_over
 	if (g < 0 || g >= e->n_groups)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: group %d: expected 0 to %d", e->path,
 		                      g, e->n_groups - 1);
+	/* the scene the load built, for the same overrides */
+	if (e->group_scenes && overrides_same(extra, n_extra, e->group_extra, e->n_group_extra))
+		return bsim_scene_copy(out, &e->group_scenes[g]) == BSIM_OK
+		               ? BSIM_OK
+		               : bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
 	ydoc scene;
 	pthread_mutex_lock(&scene_doc_lock);
 	int rc = scene_parse(e, &scene, err);
@@ -582,6 +629,25 @@ static int check_conflicts(const bsim_experiment *e, const bsim_override *extra,
 	return BSIM_OK;
 }
 
+/* The scene of the group with value index idx[a] on each axis built and
+ * validated; kept as that group's (bsim_experiment.group_scenes) where the
+ * experiment keeps them. */
+static int value_check(const ydoc *scene, bsim_experiment *e, const int *idx,
+                       const bsim_override *extra, int n_extra, bsim_error *err)
+{
+	bsim_scene s;
+	int rc = load_at(scene, e, idx, extra, n_extra, &s, err);
+	if (rc || !e->group_scenes) {
+		bsim_scene_free(&s);
+		return rc;
+	}
+	int g = 0;
+	for (int a = 0; a < e->n_axes; a++)
+		g = g * e->axes[a].n_values + idx[a];
+	e->group_scenes[g] = s;
+	return BSIM_OK;
+}
+
 /* Each grid value in one group before the product is counted or expanded:
  * the first group, then every other value of each axis with the other axes
  * at their first. A value bad in itself is bad in every group that holds
@@ -591,7 +657,7 @@ static int check_conflicts(const bsim_experiment *e, const bsim_override *extra,
  * first, with the same message. At most 1 + sum(n_values - 1) scenes, which
  * is at most the number of groups: beyond the limit groups, check_counts
  * refuses without them. */
-static int check_values(const ydoc *scene, const bsim_experiment *e, const bsim_override *extra,
+static int check_values(const ydoc *scene, bsim_experiment *e, const bsim_override *extra,
                         int n_extra, bsim_error *err)
 {
 	double scenes = 1;
@@ -602,14 +668,11 @@ static int check_values(const ydoc *scene, const bsim_experiment *e, const bsim_
 	int *idx = calloc((size_t)(e->n_axes ? e->n_axes : 1), sizeof *idx);
 	if (!idx)
 		return bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", e->path);
-	bsim_scene s;
-	int rc = load_at(scene, e, idx, extra, n_extra, &s, err);
-	bsim_scene_free(&s);
+	int rc = value_check(scene, e, idx, extra, n_extra, err);
 	for (int a = e->n_axes - 1; !rc && a >= 0; a--) {
 		for (int i = 1; !rc && i < e->axes[a].n_values; i++) {
 			idx[a] = i;
-			rc = load_at(scene, e, idx, extra, n_extra, &s, err);
-			bsim_scene_free(&s);
+			rc = value_check(scene, e, idx, extra, n_extra, err);
 		}
 		idx[a] = 0;
 	}
@@ -617,15 +680,51 @@ static int check_values(const ydoc *scene, const bsim_experiment *e, const bsim_
 	return rc;
 }
 
-/* Builds every group's scene from the scene file read once. */
-static int check_groups(const ydoc *scene, const bsim_experiment *e, const bsim_override *extra,
+static void group_scenes_free(bsim_experiment *e)
+{
+	for (int g = 0; e->group_scenes && g < e->n_groups; g++)
+		bsim_scene_free(&e->group_scenes[g]);
+	free(e->group_scenes);
+	e->group_scenes = NULL;
+	overrides_free(e->group_extra, e->n_group_extra);
+	e->group_extra = NULL;
+	e->n_group_extra = 0;
+}
+
+/* Room for every group's scene (bsim_experiment.group_scenes), with the
+ * overrides they are built with, where the groups are within the limit
+ * and memory allows; else none kept. */
+static void group_scenes_keep(bsim_experiment *e, const bsim_override *extra, int n_extra)
+{
+	double groups = 1; /* the product check_counts will count */
+	for (int a = 0; a < e->n_axes; a++)
+		groups *= e->axes[a].n_values;
+	if (groups > bsim_limits_get()->groups || groups > INT_MAX)
+		return;
+	e->n_groups = (int)groups; /* for group_scenes_free, before check_counts sets it */
+	e->group_scenes = calloc((size_t)groups, sizeof *e->group_scenes);
+	if (e->group_scenes && overrides_copy(extra, n_extra, &e->group_extra) == BSIM_OK)
+		e->n_group_extra = n_extra;
+	else
+		group_scenes_free(e);
+}
+
+/* Builds and validates every group's scene from the scene file read once
+ * (but those check_values built and kept: a scene has beams once built),
+ * and keeps them where the experiment does. */
+static int check_groups(const ydoc *scene, bsim_experiment *e, const bsim_override *extra,
                         int n_extra, bsim_error *err)
 {
 	int rc = BSIM_OK;
 	for (int g = 0; !rc && g < e->n_groups; g++) {
+		if (e->group_scenes && e->group_scenes[g].beams)
+			continue;
 		bsim_scene s;
 		rc = load_group(scene, e, g, extra, n_extra, &s, err);
-		bsim_scene_free(&s);
+		if (!rc && e->group_scenes)
+			e->group_scenes[g] = s;
+		else
+			bsim_scene_free(&s);
 	}
 	return rc;
 }
@@ -670,6 +769,8 @@ int bsim_experiment_load_seeded(const char *path, const bsim_override *extra, in
 			rc = bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", out->path);
 	}
 	if (!rc)
+		group_scenes_keep(out, extra, n_extra);
+	if (!rc)
 		rc = check_values(&scene, out, extra, n_extra, err);
 	if (!rc)
 		rc = check_counts(&d, out, n_grid, err);
@@ -689,12 +790,8 @@ void bsim_experiment_free(bsim_experiment *e)
 {
 	if (!e)
 		return;
-	for (int i = 0; i < e->n_set; i++) {
-		free((char *)e->set[i].key);
-		free((char *)e->set[i].value);
-		free((char *)e->set[i].origin);
-	}
-	free(e->set);
+	group_scenes_free(e);
+	overrides_free(e->set, e->n_set);
 	for (int a = 0; a < e->n_axes; a++)
 		bsim_experiment_axis_free(&e->axes[a]);
 	free(e->axes);

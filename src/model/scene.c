@@ -292,57 +292,61 @@ static const char *scene_who(const bsim_scene *s)
 }
 
 static int check_value(const bsim_scene *s, const scene_field *f, const char *base,
-                       const char *field, bsim_error *err)
+                       const scene_path *at, bsim_error *err)
 {
 	const char *who = scene_who(s);
 	const char *p = base + f->offset;
 	double v[2] = {0, 0};
 	int n = 1;
+	char field[256];
 	if (f->kind == SK_INT) {
 		int k = *(const int *)p;
-		if (k < (f->range == SR_NONNEG ? 0 : 1))
-			return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s, got %d", who,
-			                      field, bsim_scene_phrase(f), k);
-		return BSIM_OK;
+		if (k >= (f->range == SR_NONNEG ? 0 : 1))
+			return BSIM_OK;
+		bsim_scene_path_format(at, field, sizeof field);
+		return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s, got %d", who, field,
+		                      bsim_scene_phrase(f), k);
 	}
-	if (f->kind == SK_NAME)
-		return memchr(p, '\0', sizeof s->name)
-		               ? BSIM_OK
-		               : bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s", who, field,
-		                                "a string of at most 127 characters");
+	if (f->kind == SK_NAME) {
+		if (memchr(p, '\0', sizeof s->name))
+			return BSIM_OK;
+		bsim_scene_path_format(at, field, sizeof field);
+		return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s", who, field,
+		                      "a string of at most 127 characters");
+	}
 	memcpy(v, p, (f->kind == SK_VEC2 ? 2 : 1) * sizeof(double));
 	n = f->kind == SK_VEC2 ? 2 : 1;
 	for (int i = 0; i < n; i++) {
+		if (isfinite(v[i]) && bsim_scene_in_range(f->range, v[i]))
+			continue;
+		bsim_scene_path_format(at, field, sizeof field);
 		if (!isfinite(v[i]))
 			return bsim_error_set(err, BSIM_EINPUT,
 			                      "%s: %s: expected a finite number, got %g", who,
 			                      field, v[i]);
-		if (!bsim_scene_in_range(f->range, v[i]))
-			return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s, got %g", who,
-			                      field, bsim_scene_phrase(f), v[i]);
+		return bsim_error_set(err, BSIM_EINPUT, "%s: %s: expected %s, got %g", who, field,
+		                      bsim_scene_phrase(f), v[i]);
 	}
 	return BSIM_OK;
 }
 
-/* Checks every field of table t over the struct at base. Blocks with a
- * presence flag that is 0 are not simulated, so not checked. */
+/* Checks every field of table t over the struct at base, at path at (NULL:
+ * the top). Blocks with a presence flag that is 0 are not simulated, so not
+ * checked. A path is spelled out only for a message. */
 static int check_table(const bsim_scene *s, const scene_table *t, const char *base,
-                       const char *prefix, bsim_error *err)
+                       const scene_path *at, bsim_error *err)
 {
 	for (int i = 0; i < t->n_fields; i++) {
 		const scene_field *f = &t->fields[i];
-		char field[256];
-		bsim_ydoc_join(field, sizeof field, prefix, f->key);
+		const scene_path field = {at, f->key, 0};
 		int rc = BSIM_OK;
 		if (f->kind == SK_BLOCK) {
 			if (f->offset != SCENE_NO_FLAG && !*(const int *)(base + f->offset))
 				continue;
-			char sub[260];
-			bsim_ydoc_join(sub, sizeof sub, field, ".");
-			rc = check_table(s, f->sub, base, sub, err);
+			rc = check_table(s, f->sub, base, &field, err);
 		} else if (f->kind == SK_NUMBER || f->kind == SK_INT || f->kind == SK_VEC2 ||
 		           f->kind == SK_NAME) {
-			rc = check_value(s, f, base, field, err);
+			rc = check_value(s, f, base, &field, err);
 		}
 		if (rc)
 			return rc;
@@ -429,17 +433,16 @@ void bsim_scene_excess_detail(const bsim_scene *s, const scene_excess *x, char *
 int bsim_scene_validate(const bsim_scene *s, bsim_error *err)
 {
 	const char *who = scene_who(s);
-	int rc = check_table(s, &bsim_scene_top_table, (const char *)s, "", err);
+	int rc = check_table(s, &bsim_scene_top_table, (const char *)s, NULL, err);
 	if (rc)
 		return rc;
 	if (s->n_beams < 1 || !s->beams)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: beams: expected %s, got %d beams", who,
 		                      "a non-empty list of beams", s->n_beams);
+	const scene_path beams = {NULL, "beams", 0};
 	for (int i = 0; i < s->n_beams; i++) {
-		char prefix[64];
-		snprintf(prefix, sizeof prefix, "beams.%d.", i);
-		rc = check_table(s, &bsim_scene_beam_table, (const char *)&s->beams[i], prefix,
-		                 err);
+		const scene_path beam = {&beams, NULL, i};
+		rc = check_table(s, &bsim_scene_beam_table, (const char *)&s->beams[i], &beam, err);
 		if (rc)
 			return rc;
 	}

@@ -71,6 +71,18 @@ void bsim_scene_defaults(bsim_scene *s);
  * crosses the body's centre line). */
 int bsim_scene_overlap(const bsim_scene *s, double *dist);
 
+/* A field's dotted path ("beams.3.stiffness", "body.start.0"), kept as its
+ * parts while a scene is walked or checked and spelled out only for a
+ * message: a field of a lattice's thousands of beams costs no formatting. */
+typedef struct scene_path {
+	const struct scene_path *up; /* the enclosing block's or list's, NULL at the top */
+	const char *key;             /* the field's key; NULL: item `index` of a list */
+	int index;
+} scene_path;
+
+/* The path p spelled out into buf ("" for none). */
+void bsim_scene_path_format(const scene_path *p, char *buf, size_t size);
+
 /* A walk of a scene document into a scene (scene_load.c). */
 typedef struct scene_walk {
 	const ydoc *d;
@@ -78,10 +90,11 @@ typedef struct scene_walk {
 	bsim_error *err;
 } scene_walk;
 
-/* Walks one mapping (NULL: an empty one) against table t into base: unknown
- * keys are errors, known ones are stored, missing required ones reported. */
+/* Walks one mapping (NULL: an empty one) at path `at` (NULL: the top)
+ * against table t into base: unknown keys are errors, known ones are
+ * stored, missing required ones reported. */
 int bsim_scene_walk_table(scene_walk *w, const scene_table *t, struct fy_node *map,
-                          struct fy_node *alt, char *base, const char *prefix);
+                          struct fy_node *alt, char *base, const scene_path *at);
 
 /* The lattice: block (scene_lattice.c). The loader walks its keys
  * (bsim_scene_lattice_table) between the two calls: begin sets the gate's

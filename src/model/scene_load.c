@@ -6,6 +6,7 @@
 
 #include <limits.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -18,15 +19,32 @@ typedef scene_walk walk;
 
 #define walk_table bsim_scene_walk_table
 
-/* "expected WHAT, got <the node>" at node n (or its key). */
-static int expected(walk *w, struct fy_node *n, struct fy_node *key, const char *field,
+/* "expected WHAT, got <the node>" at node n (or its key), field at. */
+static int expected(walk *w, struct fy_node *n, struct fy_node *key, const scene_path *at,
                     const char *what)
 {
+	char field[300];
+	bsim_scene_path_format(at, field, sizeof field);
 	return bsim_ydoc_expected(w->d, n, key, field, what, w->err);
 }
 
+/* bsim_ydoc_fail with the field at path at. */
+static int walk_fail(walk *w, struct fy_node *n, struct fy_node *alt, const scene_path *at,
+                     const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+static int walk_fail(walk *w, struct fy_node *n, struct fy_node *alt, const scene_path *at,
+                     const char *fmt, ...)
+{
+	char field[300], what[600];
+	bsim_scene_path_format(at, field, sizeof field);
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(what, sizeof what, fmt, ap);
+	va_end(ap);
+	return bsim_ydoc_fail(w->d, n, alt, field, w->err, "%s", what);
+}
+
 static int walk_number(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
-                       const char *field, double *out)
+                       const scene_path *field, double *out)
 {
 	int rc = bsim_ydoc_number(n, out);
 	if (rc == YDOC_NUM_NONFINITE)
@@ -37,7 +55,7 @@ static int walk_number(walk *w, const scene_field *f, struct fy_node *n, struct 
 }
 
 static int walk_int(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
-                    const char *field, int *out)
+                    const scene_path *field, int *out)
 {
 	long long v = 0;
 	long long lo = f->kind == SK_INDEX ? -1000000 : f->range == SR_NONNEG ? 0 : 1;
@@ -49,16 +67,14 @@ static int walk_int(walk *w, const scene_field *f, struct fy_node *n, struct fy_
 }
 
 static int walk_vec2(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
-                     const char *field, double *out)
+                     const scene_path *field, double *out)
 {
 	if (!n || !fy_node_is_sequence(n) || fy_node_sequence_item_count(n) != 2)
 		return expected(w, n, key, field, bsim_scene_phrase(f));
 	static const scene_field coord = {"", SK_NUMBER, SR_ANY, 0, 0, NULL};
 	for (int i = 0; i < 2; i++) {
-		char item[300], idx[16];
-		snprintf(idx, sizeof idx, ".%d", i);
-		bsim_ydoc_join(item, sizeof item, field, idx);
-		int rc = walk_number(w, &coord, fy_node_sequence_get_by_index(n, i), n, item,
+		const scene_path item = {field, NULL, i};
+		int rc = walk_number(w, &coord, fy_node_sequence_get_by_index(n, i), n, &item,
 		                     &out[i]);
 		if (rc)
 			return rc;
@@ -67,7 +83,7 @@ static int walk_vec2(walk *w, const scene_field *f, struct fy_node *n, struct fy
 }
 
 static int walk_name(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
-                     const char *field, char *out)
+                     const scene_path *field, char *out)
 {
 	size_t len = 0;
 	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar(n, &len) : NULL;
@@ -83,24 +99,23 @@ static int walk_name(walk *w, const scene_field *f, struct fy_node *n, struct fy
 /* Each list item is one beam: defaults first, then its keys. The inertia
  * default (a uniform rod about its end, m L^2 / 3) needs mass and length, so
  * it is filled in after the walk. */
-static int walk_beams(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key)
+static int walk_beams(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
+                      const scene_path *field)
 {
 	int count = n && fy_node_is_sequence(n) ? fy_node_sequence_item_count(n) : 0;
 	if (count == 0)
-		return expected(w, n, key, f->key, bsim_scene_phrase(f));
+		return expected(w, n, key, field, bsim_scene_phrase(f));
 	if (bsim_scene_set_beams(w->s, count) != BSIM_OK)
 		return bsim_error_set(w->err, BSIM_EFAIL, "%s: out of memory", w->d->path);
 	for (int i = 0; i < count; i++) {
 		struct fy_node *item = fy_node_sequence_get_by_index(n, i);
 		bsim_beam_def *b = &w->s->beams[i];
-		char field[32], prefix[32];
-		snprintf(field, sizeof field, "beams.%d", i);
-		snprintf(prefix, sizeof prefix, "beams.%d.", i);
+		const scene_path at = {field, NULL, i};
 		if (!item || !fy_node_is_mapping(item))
-			return expected(w, item, key, field, "a mapping (one beam)");
+			return expected(w, item, key, &at, "a mapping (one beam)");
 		memset(b, 0, sizeof *b);
 		b->inertia = NAN; /* not given yet */
-		int rc = walk_table(w, f->sub, item, key, (char *)b, prefix);
+		int rc = walk_table(w, f->sub, item, key, (char *)b, &at);
 		if (rc)
 			return rc;
 		if (isnan(b->inertia))
@@ -110,33 +125,32 @@ static int walk_beams(walk *w, const scene_field *f, struct fy_node *n, struct f
 }
 
 static int walk_block(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
-                      char *base, const char *field)
+                      char *base, const scene_path *field)
 {
 	/* "effects:" with nothing under it is an empty block. */
 	if (!bsim_ydoc_is_null(n) && !fy_node_is_mapping(n))
 		return expected(w, n, key, field, bsim_scene_phrase(f));
 	if (f->offset != SCENE_NO_FLAG)
 		*(int *)(base + f->offset) = 1;
-	char prefix[300];
-	bsim_ydoc_join(prefix, sizeof prefix, field, ".");
-	return walk_table(w, f->sub, bsim_ydoc_is_null(n) ? NULL : n, key, base, prefix);
+	return walk_table(w, f->sub, bsim_ydoc_is_null(n) ? NULL : n, key, base, field);
 }
 
 /* The lattice: block: its keys as a table, between the lattice module's
  * defaults and its checks and beams (scene_lattice.c). */
-static int walk_lattice(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key)
+static int walk_lattice(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
+                        const scene_path *field)
 {
 	if (!n || !fy_node_is_mapping(n))
 		return bsim_ydoc_expected(w->d, n, key, "lattice",
 		                          "a mapping (columns, rows, gate, beam, stiffness, ...)",
 		                          w->err);
 	bsim_scene_lattice_begin(w->s);
-	int rc = walk_table(w, f->sub, n, key, (char *)w->s, "lattice.");
+	int rc = walk_table(w, f->sub, n, key, (char *)w->s, field);
 	return rc ? rc : bsim_scene_lattice_finish(w, n, key);
 }
 
 static int walk_field(walk *w, const scene_field *f, struct fy_node *n, struct fy_node *key,
-                      char *base, const char *field)
+                      char *base, const scene_path *field)
 {
 	switch (f->kind) {
 	case SK_NUMBER:
@@ -150,11 +164,11 @@ static int walk_field(walk *w, const scene_field *f, struct fy_node *n, struct f
 	case SK_BLOCK:
 		return walk_block(w, f, n, key, base, field);
 	case SK_BEAMS:
-		return walk_beams(w, f, n, key);
+		return walk_beams(w, f, n, key, field);
 	case SK_INDEX:
 		return walk_int(w, f, n, key, field, (int *)(base + f->offset));
 	case SK_LATTICE:
-		return walk_lattice(w, f, n, key);
+		return walk_lattice(w, f, n, key, field);
 	case SK_LATER:
 		return BSIM_OK;
 	}
@@ -173,7 +187,7 @@ static int find_field(const scene_table *t, const char *key)
  * errors, known ones are stored, missing required ones are reported at the
  * mapping (or at alt, the key naming it, when it is empty). */
 int bsim_scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, struct fy_node *alt,
-                          char *base, const char *prefix)
+                          char *base, const scene_path *at)
 {
 	unsigned seen = 0;
 	void *it = NULL;
@@ -181,33 +195,32 @@ int bsim_scene_walk_table(walk *w, const scene_table *t, struct fy_node *map, st
 	while (map && (p = fy_node_mapping_iterate(map, &it))) {
 		struct fy_node *k = fy_node_pair_key(p);
 		const char *name = k && fy_node_is_scalar(k) ? fy_node_get_scalar0(k) : NULL;
-		char field[300], keys[512];
-		bsim_ydoc_join(field, sizeof field, prefix, name ? name : "?");
+		const scene_path field = {at, name ? name : "?", 0};
 		int i = find_field(t, name);
 		/* An experiment given where a scene belongs (beamsim run EXP). */
-		if (i < 0 && !prefix[0] && bsim_ydoc_pair(map, "scene", 5) &&
+		if (i < 0 && !at && bsim_ydoc_pair(map, "scene", 5) &&
 		    bsim_ydoc_pair(map, "grid", 4))
-			return bsim_ydoc_fail(
-			        w->d, k, map, field, w->err,
+			return walk_fail(
+			        w, k, map, &field,
 			        "this is an experiment file (scene: and grid:), not a scene: "
 			        "run it with beamsim sweep or compare, or run its scene");
 		if (i < 0) {
+			char keys[512];
 			bsim_scene_keys(t, keys, sizeof keys);
-			return bsim_ydoc_fail(w->d, k, map, field, w->err,
-			                      "unknown key (expected one of %s)", keys);
+			return walk_fail(w, k, map, &field, "unknown key (expected one of %s)",
+			                 keys);
 		}
 		seen |= 1u << i;
-		int rc = walk_field(w, &t->fields[i], fy_node_pair_value(p), k, base, field);
+		int rc = walk_field(w, &t->fields[i], fy_node_pair_value(p), k, base, &field);
 		if (rc)
 			return rc;
 	}
 	for (int i = 0; i < t->n_fields; i++) {
 		const scene_field *f = &t->fields[i];
 		if (f->required && !(seen & (1u << i))) {
-			char field[300];
-			bsim_ydoc_join(field, sizeof field, prefix, f->key);
-			return bsim_ydoc_fail(w->d, map, alt, field, w->err,
-			                      "missing (expected %s)", bsim_scene_phrase(f));
+			const scene_path field = {at, f->key, 0};
+			return walk_fail(w, map, alt, &field, "missing (expected %s)",
+			                 bsim_scene_phrase(f));
 		}
 	}
 	return BSIM_OK;
@@ -554,9 +567,9 @@ static int walk_scene(walk *w, const ydoc *file)
 {
 	struct fy_node *root = fy_document_root(w->d->fyd);
 	if (!root || !fy_node_is_mapping(root))
-		return expected(w, root, NULL, "scene",
-		                "a mapping of scene keys (body, beams, ...)");
-	int rc = walk_table(w, &bsim_scene_top_table, root, NULL, (char *)w->s, "");
+		return bsim_ydoc_expected(w->d, root, NULL, "scene",
+		                          "a mapping of scene keys (body, beams, ...)", w->err);
+	int rc = walk_table(w, &bsim_scene_top_table, root, NULL, (char *)w->s, NULL);
 	if (!rc)
 		rc = random_model(w, root);
 	if (!rc)

@@ -213,6 +213,22 @@ int bsim_scene_in_range(scene_range r, double v)
 	}
 }
 
+void bsim_scene_path_format(const scene_path *p, char *buf, size_t size)
+{
+	if (size == 0)
+		return;
+	buf[0] = '\0';
+	if (!p)
+		return;
+	bsim_scene_path_format(p->up, buf, size);
+	size_t len = strlen(buf);
+	const char *dot = len ? "." : "";
+	if (p->key)
+		snprintf(buf + len, size - len, "%s%s", dot, p->key);
+	else
+		snprintf(buf + len, size - len, "%s%d", dot, p->index);
+}
+
 void bsim_scene_keys(const scene_table *t, char *buf, size_t size)
 {
 	size_t used = 0;
