@@ -666,167 +666,118 @@ static int sweep_check(const bsim_experiment *e, const bsim_sweep_config *cfg, i
 	return BSIM_OK;
 }
 
-/* A plain sweep (n_sides = 1, cfg->backend into out[0]) or a sweep of
- * sides (backend[s] into out[s], the pairs' separation times into
- * *t_separate). */
-static int sweep_common(const bsim_experiment *e, const bsim_sweep_config *cfg, int n_sides,
-                        const bsim_backend *const *backend, const bsim_options *const *opts,
-                        bsim_sweep_result *out, double **t_separate, bsim_error *err)
+/* ---- the one driver -----------------------------------------------------
+ *
+ * Every kind of sweep is one sweep_drive: planned once (the checks, each
+ * side's scene of every group, the deterministic groups, the record's
+ * size), its trials run in blocks of consecutive indices by every thread,
+ * each block loaded from the journal before it runs and finished after,
+ * then the sweep finished, and everything it holds freed by one clean-up
+ * (drive_free).
+ *
+ * A sweep held in memory (SWEEP_WHOLE, plain or of sides) is one block of
+ * every trial, its results in place; the journal's records go straight to
+ * their trials' places before it runs; the deterministic groups' copies
+ * and the groups' counts are made at the end.
+ *
+ * A streamed sweep (SWEEP_STREAMED, a sink) runs blocks of
+ * BSIM_SWEEP_BLOCK: a block's slots are filled (from the journal, or by
+ * running its trials), its deterministic copies filled in, its trials
+ * added to their groups' counts, and the block handed to the sink; then
+ * the next block reuses the slots. What stays is per group (counts, a
+ * deterministic group's one trial) and one bit per trial (journaled or
+ * not). A resumed run's journal is read once, before the first block:
+ * each record goes to a spill file at its trial's place (unlinked at once,
+ * so nothing is left behind), from which its block reads it back.
+ *
+ * A part (SWEEP_PART, beamsim/sweep.h) runs blocks as a streamed sweep
+ * does, each thread passing over the other parts' trials; nothing is kept
+ * but the records handed on, so memory does not grow with the sweep. */
+
+typedef enum { SWEEP_WHOLE, SWEEP_STREAMED, SWEEP_PART } sweep_kind;
+
+typedef struct drive_state {
+	sweep_kind kind;
+	/* SWEEP_WHOLE: each side's result, and each pair's separation times
+	 * by trial (of sides); SWEEP_STREAMED: the one result */
+	bsim_sweep_result *out;
+	double **t_separate;
+	/* what the drive holds, freed by drive_free */
+	bsim_scene *scenes, *scenes_b;
+	int *deterministic;           /* per group */
+	bsim_trial_result *slots;     /* each side's BSIM_SWEEP_BLOCK (not whole) */
+	bsim_trial_log *slot_logs;    /* the same */
+	double *slot_t_separate;      /* each pair's BSIM_SWEEP_BLOCK (a part) */
+	unsigned char *from_journal;  /* per slot (whole: per trial) */
+	bsim_trial_result *det_first; /* streamed, per group: a deterministic */
+	bsim_trial_log *det_log;      /* group's trial 0 and its log */
+	sweep_shared sh;
+} drive_state;
+
+/* The results (whole, streamed) and the slots the trials go into, each
+ * side's and pair's place in sh. */
+static int drive_alloc(drive_state *d, int keep, bsim_error *err)
 {
-	double t0 = bsim_clock_seconds();
-	int keep = 0, rc0 = sweep_check(e, cfg, &keep, err);
-	if (rc0 != BSIM_OK)
-		return rc0;
-	const int n_pairs = bsim_sweep_pairs(n_sides);
-	long total = (long)e->n_groups * e->trials;
-	for (int s = 0; s < n_sides; s++)
-		if (result_alloc(&out[s], e->n_groups, e->trials, keep, 1, err) != BSIM_OK) {
-			while (s-- > 0)
-				bsim_sweep_result_free(&out[s]);
-			return BSIM_EFAIL;
-		}
-	if (n_pairs > 0) {
-		*t_separate =
-		        calloc(total ? (size_t)n_pairs * (size_t)total : 1, sizeof **t_separate);
-		if (!*t_separate) {
-			for (int s = 0; s < n_sides; s++)
-				bsim_sweep_result_free(&out[s]);
+	sweep_shared *sh = &d->sh;
+	const bsim_experiment *e = sh->e;
+	const int n_sides = sh->n_sides, n_pairs = bsim_sweep_pairs(n_sides);
+	const long total = sh->total;
+	if (d->kind == SWEEP_WHOLE) {
+		for (int s = 0; s < n_sides; s++) /* each freeable, whatever fails */
+			memset(&d->out[s], 0, sizeof d->out[s]);
+		for (int s = 0; s < n_sides; s++)
+			if (result_alloc(&d->out[s], e->n_groups, e->trials, keep, 1, err) !=
+			    BSIM_OK) {
+				while (s-- > 0)
+					bsim_sweep_result_free(&d->out[s]);
+				return BSIM_EFAIL;
+			}
+		if (n_pairs > 0 &&
+		    !(*d->t_separate = calloc(total ? (size_t)n_pairs * (size_t)total : 1,
+		                              sizeof **d->t_separate)))
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory for %ld pairs",
 			                      total);
+		for (int s = 0; s < n_sides; s++) {
+			sh->results[s] = d->out[s].trials_out;
+			sh->logs[s] = d->out[s].logs;
+			sh->kept[s] = d->out[s].kept;
 		}
+		for (int q = 0; q < n_pairs; q++)
+			sh->t_separate[q] = *d->t_separate + (size_t)q * (size_t)total;
+		if (sh->cfg->journal && !(d->from_journal = calloc(total ? (size_t)total : 1, 1)))
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		sh->from_journal = d->from_journal;
+		return BSIM_OK;
 	}
-	bsim_scene *scenes, *scenes_b = NULL;
-	int rc = scenes_for(e, cfg, n_sides, backend, opts, &scenes, &scenes_b, err);
-	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
-	if (rc == BSIM_OK && !deterministic) {
-		scenes_release(cfg, scenes, e->n_groups);
-		if (scenes_b)
-			scenes_free(scenes_b, e->n_groups);
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
+	if (d->kind == SWEEP_STREAMED) {
+		if (result_alloc(d->out, e->n_groups, e->trials, keep, 0, err) != BSIM_OK)
+			return BSIM_EFAIL;
+		sh->kept[0] = d->out->kept;
+		d->det_first = calloc((size_t)e->n_groups, sizeof *d->det_first);
+		d->det_log = calloc((size_t)e->n_groups, sizeof *d->det_log);
+		if (!d->det_first || !d->det_log)
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups",
+			                      e->n_groups);
 	}
-	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
-		deterministic[g] = !bsim_effects_random(&scenes[g]);
-	sweep_shared sh = {
-	        .e = e,
-	        .cfg = cfg,
-	        .n_sides = n_sides,
-	        .deterministic = deterministic,
-	        .keep = keep,
-	        .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
-	        .total = total,
-	        .end = total,
-	        .spill_fd = -1,
-	};
+	const size_t slots = (size_t)n_sides * BSIM_SWEEP_BLOCK;
+	d->slots = calloc(slots, sizeof *d->slots);
+	d->slot_logs = calloc(slots, sizeof *d->slot_logs);
+	if (n_pairs > 0)
+		d->slot_t_separate =
+		        calloc((size_t)n_pairs * BSIM_SWEEP_BLOCK, sizeof *d->slot_t_separate);
+	if (d->kind == SWEEP_STREAMED)
+		d->from_journal = calloc(BSIM_SWEEP_BLOCK, 1);
+	if (!d->slots || !d->slot_logs || (n_pairs > 0 && !d->slot_t_separate) ||
+	    (d->kind == SWEEP_STREAMED && !d->from_journal))
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
 	for (int s = 0; s < n_sides; s++) {
-		sh.scenes[s] = s == 1 && scenes_b ? scenes_b : scenes;
-		sh.backend[s] = backend[s];
-		sh.opts[s] = opts[s];
-		sh.results[s] = out[s].trials_out;
-		sh.logs[s] = out[s].logs;
-		sh.kept[s] = out[s].kept;
+		sh->results[s] = d->slots + (size_t)s * BSIM_SWEEP_BLOCK;
+		sh->logs[s] = d->slot_logs + (size_t)s * BSIM_SWEEP_BLOCK;
 	}
 	for (int q = 0; q < n_pairs; q++)
-		sh.t_separate[q] = *t_separate + (size_t)q * (size_t)total;
-	if (rc == BSIM_OK) {
-		sh.record_lattice = record_lattice(scenes, cfg);
-		sh.record_size = record_bytes(sh.record_lattice, n_sides);
-	}
-	if (rc == BSIM_OK && cfg->journal) {
-		sh.lattice = scenes[0].has_lattice;
-		sh.from_journal = calloc(total ? (size_t)total : 1, 1);
-		long kept = 0, cut = 0;
-		rc = !sh.from_journal ? bsim_error_set(err, BSIM_EFAIL, "out of memory")
-		                      : bsim_journal_replay(cfg->journal, journal_take, &sh, &kept,
-		                                            &cut, err);
-		if (rc != BSIM_OK) {
-			scenes_release(cfg, scenes, e->n_groups);
-			if (scenes_b)
-				scenes_free(scenes_b, e->n_groups);
-		}
-	}
-	if (rc == BSIM_OK) {
-		sh.first_fail = sh.total;
-		bsim_error_clear(&sh.fail);
-		int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
-		if (threads > sh.total)
-			threads = sh.total > 0 ? (int)sh.total : 1;
-#pragma omp parallel num_threads(threads)
-		sweep_thread(&sh);
-		for (int s = 0; s < n_sides; s++) {
-			out[s].lattice = sh.scenes[s][0].has_lattice;
-			out[s].lattice_def = sh.scenes[s][0].lattice;
-			groups_rotate(&out[s], sh.scenes[s]);
-		}
-		scenes_release(cfg, scenes, e->n_groups);
-		if (scenes_b)
-			scenes_free(scenes_b, e->n_groups);
-		if (sh.first_fail < sh.total)
-			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
-		else if (sh.stopped)
-			rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped after %ld of %ld trials",
-			                    sh.done, sh.total);
-	}
-	free(sh.from_journal);
-	/* The copies of deterministic groups, then the totals. */
-	for (int s = 0; rc == BSIM_OK && s < n_sides; s++)
-		if (deterministic_fill(out[s].trials_out, out[s].logs, deterministic, e->n_groups,
-		                       e->trials))
-			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for the gate paths");
-	for (int q = 0; rc == BSIM_OK && q < n_pairs; q++)
-		separation_fill(sh.t_separate[q], deterministic, e->n_groups, e->trials);
-	for (int s = 0; rc == BSIM_OK && s < n_sides; s++)
-		rc = kept_fill(&out[s], deterministic, err);
-	if (rc != BSIM_OK) {
-		free(deterministic);
-		for (int s = 0; s < n_sides; s++)
-			bsim_sweep_result_free(&out[s]);
-		if (n_pairs > 0) {
-			free(*t_separate);
-			*t_separate = NULL;
-		}
-		return rc;
-	}
-	/* The final count may have been reached on another thread. */
-	if (cfg->progress)
-		cfg->progress(cfg->progress_user, sh.total, sh.total);
-	double wall = bsim_clock_seconds() - t0;
-	for (int s = 0; s < n_sides; s++)
-		result_finish(&out[s], deterministic, e->n_groups, e->trials, wall);
-	free(deterministic);
+		sh->t_separate[q] = d->slot_t_separate + (size_t)q * BSIM_SWEEP_BLOCK;
+	sh->from_journal = d->from_journal;
 	return BSIM_OK;
-}
-
-/* ---- a streamed sweep ---------------------------------------------------
- *
- * The trials run in blocks of BSIM_SWEEP_BLOCK consecutive indices: a
- * block's slots are filled (from the journal, or by running the trials on
- * every thread), its deterministic copies filled in, its trials added to
- * their groups' counts, and the block handed to the sink; then the next
- * block reuses the slots. What stays is per group (counts, a deterministic
- * group's one trial) and one bit per trial (journaled or not). A resumed
- * run's journal is read once, before the first block: each record goes to
- * a spill file at its trial's place (unlinked at once, so nothing is left
- * behind), from which its block reads it back. */
-
-typedef struct stream_state {
-	bsim_trial_result *results; /* BSIM_SWEEP_BLOCK slots */
-	bsim_trial_log *logs;
-	unsigned char *from_journal;
-	bsim_trial_result *det_first; /* per group: a deterministic group's trial 0 */
-	bsim_trial_log *det_log;
-} stream_state;
-
-static void stream_free(stream_state *st, int n_groups)
-{
-	for (long k = 0; st->logs && k < BSIM_SWEEP_BLOCK; k++)
-		bsim_trial_log_clear(&st->logs[k]);
-	for (int g = 0; st->det_log && g < n_groups; g++)
-		bsim_trial_log_clear(&st->det_log[g]);
-	free(st->results);
-	free(st->logs);
-	free(st->from_journal);
-	free(st->det_first);
-	free(st->det_log);
 }
 
 /* The journal's records into the spill file, a bit per trial. */
@@ -846,6 +797,35 @@ static int stream_replay(sweep_shared *sh, bsim_error *err)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	long kept = 0, cut = 0;
 	return bsim_journal_replay(sh->cfg->journal, journal_take, sh, &kept, &cut, err);
+}
+
+/* What is known before the first block: the journal read (whole: into the
+ * trials' places; streamed: into the spill file), a part's progress. */
+static int drive_before(drive_state *d, bsim_error *err)
+{
+	sweep_shared *sh = &d->sh;
+	const bsim_sweep_config *cfg = sh->cfg;
+	if (d->kind == SWEEP_WHOLE && cfg->journal) {
+		long kept = 0, cut = 0;
+		return bsim_journal_replay(cfg->journal, journal_take, sh, &kept, &cut, err);
+	}
+	if (d->kind == SWEEP_STREAMED && cfg->journal)
+		return stream_replay(sh, err);
+	if (d->kind == SWEEP_PART) {
+		/* Progress: this part's trials, or with collect every part's. */
+		const bsim_sweep_part *part = sh->part;
+		for (long i = 0; i < sh->total; i++) {
+			long j = cfg->journal_first + i;
+			int done = part->done && (part->done[j / 8] & (1u << (j % 8)));
+			if (part->collect)
+				sh->done += done;
+			else
+				sh->progress_total += !part_skips(part, cfg->journal_first, i);
+		}
+		if (part->collect)
+			sh->progress_total = sh->total;
+	}
+	return BSIM_OK;
 }
 
 /* Block [sh->first, sh->end)'s journaled trials into their slots. */
@@ -878,26 +858,44 @@ static int stream_load(sweep_shared *sh, bsim_error *err)
 	return rc;
 }
 
-/* A finished block: copies filled in, counted, handed to the sink. */
-static int stream_block(sweep_shared *sh, stream_state *st, bsim_sweep_result *out, bsim_error *err)
+/* A streamed block before it runs: its slots emptied, then those the
+ * journal holds filled. */
+static int drive_block_load(drive_state *d, bsim_error *err)
 {
+	if (d->kind != SWEEP_STREAMED)
+		return BSIM_OK;
+	memset(d->slots, 0, BSIM_SWEEP_BLOCK * sizeof *d->slots);
+	memset(d->from_journal, 0, BSIM_SWEEP_BLOCK);
+	return stream_load(&d->sh, err);
+}
+
+/* A finished streamed block: copies filled in, counted, handed to the
+ * sink. */
+static int drive_block_done(drive_state *d, bsim_error *err)
+{
+	if (d->kind != SWEEP_STREAMED)
+		return BSIM_OK;
+	const sweep_shared *sh = &d->sh;
+	bsim_sweep_result *out = d->out;
+	bsim_trial_result *results = d->slots;
+	bsim_trial_log *logs = d->slot_logs;
 	int trials = sh->e->trials;
 	for (long i = sh->first; i < sh->end; i++) {
 		long k = i - sh->first;
 		int g = (int)(i / trials), t = (int)(i % trials);
 		if (sh->deterministic[g] && t == 0) {
-			st->det_first[g] = st->results[k];
-			if (bsim_trial_log_copy(&st->det_log[g], &st->logs[k]) != BSIM_OK)
+			d->det_first[g] = results[k];
+			if (bsim_trial_log_copy(&d->det_log[g], &logs[k]) != BSIM_OK)
 				return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		} else if (sh->deterministic[g]) {
-			st->results[k] = st->det_first[g];
-			if (bsim_trial_log_copy(&st->logs[k], &st->det_log[g]) != BSIM_OK)
+			results[k] = d->det_first[g];
+			if (bsim_trial_log_copy(&logs[k], &d->det_log[g]) != BSIM_OK)
 				return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
-		group_add(&out->groups[g], &st->results[k]);
-		if (st->results[k].outcome == BSIM_UNSTABLE && out->first_unstable < 0) {
+		group_add(&out->groups[g], &results[k]);
+		if (results[k].outcome == BSIM_UNSTABLE && out->first_unstable < 0) {
 			out->first_unstable = i;
-			out->first_unstable_result = st->results[k];
+			out->first_unstable_result = results[k];
 		}
 	}
 	/* A lattice group's summary grows by the block's run of its trials. */
@@ -905,33 +903,154 @@ static int stream_block(sweep_shared *sh, stream_state *st, bsim_sweep_result *o
 		int g = (int)(i / trials);
 		long end = (long)(g + 1) * trials < sh->end ? (long)(g + 1) * trials : sh->end;
 		long k = i - sh->first;
-		if (bsim_lattice_summary_add(&out->lattice_summaries[g], &st->results[k],
-		                             &st->logs[k], (int)(end - i)) != BSIM_OK)
+		if (bsim_lattice_summary_add(&out->lattice_summaries[g], &results[k], &logs[k],
+		                             (int)(end - i)) != BSIM_OK)
 			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		i = end;
 	}
-	bsim_sweep_block b = {sh->first, sh->end - sh->first, st->results, st->logs};
+	bsim_sweep_block b = {sh->first, sh->end - sh->first, results, logs};
 	return sh->cfg->sink(sh->cfg->sink_user, &b, err);
 }
 
-static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg,
-                          bsim_sweep_result *out, bsim_error *err)
+/* After the last block: a whole sweep's deterministic copies, counts and
+ * totals; a streamed sweep's groups closed and totals; a part's records
+ * from the others collected. */
+static int drive_after(drive_state *d, double t0, bsim_error *err)
 {
-	double t0 = bsim_clock_seconds();
-	int keep = 0, rc0 = sweep_check(e, cfg, &keep, err);
-	if (rc0 != BSIM_OK)
-		return rc0;
-	long total = (long)e->n_groups * e->trials;
-	if (result_alloc(out, e->n_groups, e->trials, keep, 0, err) != BSIM_OK)
-		return BSIM_EFAIL;
+	sweep_shared *sh = &d->sh;
+	const bsim_experiment *e = sh->e;
+	const bsim_sweep_config *cfg = sh->cfg;
+	int rc = BSIM_OK;
+	if (d->kind == SWEEP_WHOLE) {
+		for (int s = 0; rc == BSIM_OK && s < sh->n_sides; s++)
+			if (deterministic_fill(d->out[s].trials_out, d->out[s].logs,
+			                       d->deterministic, e->n_groups, e->trials))
+				rc = bsim_error_set(err, BSIM_EFAIL,
+				                    "out of memory for the gate paths");
+		for (int q = 0; rc == BSIM_OK && q < bsim_sweep_pairs(sh->n_sides); q++)
+			separation_fill(sh->t_separate[q], d->deterministic, e->n_groups,
+			                e->trials);
+		for (int s = 0; rc == BSIM_OK && s < sh->n_sides; s++)
+			rc = kept_fill(&d->out[s], d->deterministic, err);
+	} else if (d->kind == SWEEP_STREAMED) {
+		rc = kept_fill(d->out, d->deterministic, err);
+	} else if (sh->part->collect) {
+		rc = sh->part->collect(sh->part->user, 1, part_accept, sh, err);
+	}
+	if (rc != BSIM_OK)
+		return rc;
+	/* The final count may have been reached on another thread. */
+	long all = sh->progress_total ? sh->progress_total : sh->total;
+	if (cfg->progress)
+		cfg->progress(cfg->progress_user, all, all);
+	double wall = bsim_clock_seconds() - t0;
+	if (d->kind == SWEEP_WHOLE)
+		for (int s = 0; s < sh->n_sides; s++)
+			result_finish(&d->out[s], d->deterministic, e->n_groups, e->trials, wall);
+	if (d->kind == SWEEP_STREAMED) {
+		for (int g = 0; g < e->n_groups; g++) {
+			group_finish(&d->out->groups[g]);
+			if (d->out->lattice_summaries)
+				bsim_lattice_summary_end(&d->out->lattice_summaries[g]);
+		}
+		result_totals(d->out, d->deterministic, e->trials, d->det_first, 1, wall);
+	}
+	return BSIM_OK;
+}
 
-	bsim_scene *scenes = NULL;
-	stream_state st = {0};
-	int *deterministic = NULL;
-	int rc = scenes_for(e, cfg, 1, &cfg->backend, &cfg->opts, &scenes, NULL, err);
-	if (rc == BSIM_OK && scenes[0].has_lattice) {
-		out->lattice = 1;
-		out->lattice_def = scenes[0].lattice;
+/* The one clean-up: what the drive holds; on failure (rc) the results
+ * too. */
+static void drive_free(drive_state *d, int rc)
+{
+	sweep_shared *sh = &d->sh;
+	const bsim_experiment *e = sh->e;
+	if (d->scenes)
+		scenes_release(sh->cfg, d->scenes, e->n_groups);
+	if (d->scenes_b)
+		scenes_free(d->scenes_b, e->n_groups);
+	for (size_t k = 0; d->slot_logs && k < (size_t)sh->n_sides * BSIM_SWEEP_BLOCK; k++)
+		bsim_trial_log_clear(&d->slot_logs[k]);
+	for (int g = 0; d->det_log && g < e->n_groups; g++)
+		bsim_trial_log_clear(&d->det_log[g]);
+	free(d->slots);
+	free(d->slot_logs);
+	free(d->slot_t_separate);
+	free(d->from_journal);
+	free(d->det_first);
+	free(d->det_log);
+	free(d->deterministic);
+	if (sh->spill_fd >= 0)
+		close(sh->spill_fd);
+	free(sh->journaled);
+	if (rc == BSIM_OK)
+		return;
+	for (int s = 0; d->out && s < (d->kind == SWEEP_WHOLE ? sh->n_sides : 1); s++)
+		bsim_sweep_result_free(&d->out[s]);
+	if (d->t_separate) {
+		free(*d->t_separate);
+		*d->t_separate = NULL;
+	}
+}
+
+/* A sweep of kind: n_sides sides (1: a plain sweep, backend[0]), into out
+ * and *t_separate (whole), out (streamed) or part's records (a part). */
+static int sweep_drive(const bsim_experiment *e, const bsim_sweep_config *cfg, sweep_kind kind,
+                       int n_sides, const bsim_backend *const *backend,
+                       const bsim_options *const *opts, const bsim_sweep_part *part,
+                       bsim_sweep_result *out, double **t_separate, bsim_error *err)
+{
+	const double t0 = bsim_clock_seconds();
+	int keep = 0, rc = sweep_check(e, cfg, &keep, err);
+	if (rc != BSIM_OK)
+		return rc;
+	if (part && (part->count < 1 || part->index < 0 || part->index >= part->count))
+		return bsim_error_set(err, BSIM_EINPUT, "part %d of %d: expected 0 <= part < %d",
+		                      part->index, part->count, part->count);
+	const long total = (long)e->n_groups * e->trials;
+	if (t_separate)
+		*t_separate = NULL;
+	drive_state d = {
+	        .kind = kind,
+	        .out = out,
+	        .t_separate = bsim_sweep_pairs(n_sides) > 0 ? t_separate : NULL,
+	        .sh = {.e = e,
+	               .cfg = cfg,
+	               .n_sides = n_sides,
+	               .keep = kind == SWEEP_PART ? 0 : keep,
+	               .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
+	               .total = total,
+	               .spill_fd = -1,
+	               .first_fail = total,
+	               .part = part},
+	};
+	sweep_shared *sh = &d.sh;
+	rc = drive_alloc(&d, sh->keep, err);
+	if (rc == BSIM_OK)
+		rc = scenes_for(e, cfg, n_sides, backend, opts, &d.scenes,
+		                n_sides > 1 ? &d.scenes_b : NULL, err);
+	if (rc == BSIM_OK &&
+	    !(d.deterministic = calloc((size_t)e->n_groups, sizeof *d.deterministic)))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
+	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
+		d.deterministic[g] = !bsim_effects_random(&d.scenes[g]);
+	if (rc == BSIM_OK) {
+		sh->deterministic = d.deterministic;
+		for (int s = 0; s < n_sides; s++) {
+			sh->scenes[s] = s == 1 && d.scenes_b ? d.scenes_b : d.scenes;
+			sh->backend[s] = backend[s];
+			sh->opts[s] = opts[s];
+		}
+		sh->lattice = d.scenes[0].has_lattice;
+		sh->record_lattice = record_lattice(d.scenes, cfg);
+		sh->record_size = record_bytes(sh->record_lattice, n_sides);
+	}
+	for (int s = 0; rc == BSIM_OK && kind != SWEEP_PART && s < n_sides; s++) {
+		out[s].lattice = sh->scenes[s][0].has_lattice;
+		out[s].lattice_def = sh->scenes[s][0].lattice;
+		groups_rotate(&out[s], sh->scenes[s]);
+	}
+	/* a streamed lattice sweep's summaries grow block by block */
+	if (rc == BSIM_OK && kind == SWEEP_STREAMED && out->lattice) {
 		out->lattice_summaries =
 		        calloc((size_t)e->n_groups, sizeof *out->lattice_summaries);
 		for (int g = 0; out->lattice_summaries && g < e->n_groups && rc == BSIM_OK; g++)
@@ -941,101 +1060,39 @@ static int sweep_streamed(const bsim_experiment *e, const bsim_sweep_config *cfg
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups",
 			                    e->n_groups);
 	}
-	if (rc == BSIM_OK) {
-		deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
-		st.results = calloc(BSIM_SWEEP_BLOCK, sizeof *st.results);
-		st.logs = calloc(BSIM_SWEEP_BLOCK, sizeof *st.logs);
-		st.from_journal = calloc(BSIM_SWEEP_BLOCK, 1);
-		st.det_first = calloc((size_t)e->n_groups, sizeof *st.det_first);
-		st.det_log = calloc((size_t)e->n_groups, sizeof *st.det_log);
-		if (!deterministic || !st.results || !st.logs || !st.from_journal ||
-		    !st.det_first || !st.det_log)
-			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups",
-			                    e->n_groups);
-	}
-	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
-		deterministic[g] = !bsim_effects_random(&scenes[g]);
 	if (rc == BSIM_OK)
-		groups_rotate(out, scenes);
-	sweep_shared sh = {
-	        .e = e,
-	        .cfg = cfg,
-	        .n_sides = 1,
-	        .scenes = {scenes},
-	        .backend = {cfg->backend},
-	        .opts = {cfg->opts},
-	        .deterministic = deterministic,
-	        .results = {st.results},
-	        .logs = {st.logs},
-	        .kept = {out->kept},
-	        .keep = keep,
-	        .keep_stride = cfg->keep_stride > 0 ? cfg->keep_stride : 5,
-	        .total = total,
-	        .from_journal = st.from_journal,
-	        .spill_fd = -1,
-	        .first_fail = total,
-	        .lattice = out->lattice,
-	};
-	if (rc == BSIM_OK) {
-		sh.record_lattice = record_lattice(scenes, cfg);
-		sh.record_size = record_bytes(sh.record_lattice, 1);
-	}
-	if (rc == BSIM_OK && cfg->journal)
-		rc = stream_replay(&sh, err);
-	int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
-	if (threads > BSIM_SWEEP_BLOCK)
-		threads = BSIM_SWEEP_BLOCK;
-	for (long first = 0; rc == BSIM_OK && first < total; first += BSIM_SWEEP_BLOCK) {
-		sh.first = first;
-		sh.end = total - first < BSIM_SWEEP_BLOCK ? total : first + BSIM_SWEEP_BLOCK;
-		memset(st.results, 0, BSIM_SWEEP_BLOCK * sizeof *st.results);
-		memset(st.from_journal, 0, BSIM_SWEEP_BLOCK);
-		rc = stream_load(&sh, err);
-		if (rc != BSIM_OK)
+		rc = drive_before(&d, err);
+	const long block = kind == SWEEP_WHOLE ? total : BSIM_SWEEP_BLOCK;
+	const int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
+	for (long first = 0; rc == BSIM_OK && first < total; first += block) {
+		sh->first = first;
+		sh->end = total - first < block ? total : first + block;
+		if ((rc = drive_block_load(&d, err)) != BSIM_OK)
 			break;
-		long n = sh.end - sh.first;
-		bsim_error_clear(&sh.fail);
+		const long n = sh->end - sh->first;
+		bsim_error_clear(&sh->fail);
 #pragma omp parallel num_threads(threads < n ? threads : (int)n)
-		sweep_thread(&sh);
-		if (sh.first_fail < total)
-			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
-		else if (sh.stopped)
+		sweep_thread(sh);
+		if (sh->first_fail < total)
+			rc = bsim_error_set(err, sh->fail.code, "%s", sh->fail.msg);
+		else if (sh->stopped)
 			rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped after %ld of %ld trials",
-			                    sh.done, total);
+			                    sh->done,
+			                    sh->progress_total ? sh->progress_total : total);
 		else
-			rc = stream_block(&sh, &st, out, err);
+			rc = drive_block_done(&d, err);
 	}
-	if (sh.spill_fd >= 0)
-		close(sh.spill_fd);
-	free(sh.journaled);
-	if (rc == BSIM_OK && cfg->progress)
-		cfg->progress(cfg->progress_user, total, total);
 	if (rc == BSIM_OK)
-		rc = kept_fill(out, deterministic, err);
-	if (rc == BSIM_OK) {
-		for (int g = 0; g < e->n_groups; g++) {
-			group_finish(&out->groups[g]);
-			if (out->lattice_summaries)
-				bsim_lattice_summary_end(&out->lattice_summaries[g]);
-		}
-		result_totals(out, deterministic, e->trials, st.det_first, 1,
-		              bsim_clock_seconds() - t0);
-	}
-	if (scenes)
-		scenes_release(cfg, scenes, e->n_groups);
-	stream_free(&st, e->n_groups);
-	free(deterministic);
-	if (rc != BSIM_OK)
-		bsim_sweep_result_free(out);
+		rc = drive_after(&d, t0, err);
+	drive_free(&d, rc);
 	return rc;
 }
 
 int bsim_sweep_run(const bsim_experiment *e, const bsim_sweep_config *cfg, bsim_sweep_result *out,
                    bsim_error *err)
 {
-	if (cfg->sink)
-		return sweep_streamed(e, cfg, out, err);
-	return sweep_common(e, cfg, 1, &cfg->backend, &cfg->opts, out, NULL, err);
+	return sweep_drive(e, cfg, cfg->sink ? SWEEP_STREAMED : SWEEP_WHOLE, 1, &cfg->backend,
+	                   &cfg->opts, NULL, out, NULL, err);
 }
 
 static int sides_check(int n_sides, bsim_error *err)
@@ -1052,7 +1109,8 @@ int bsim_sweep_run_sides(const bsim_experiment *e, const bsim_sweep_config *cfg,
 {
 	int rc = sides_check(n_sides, err);
 	return rc != BSIM_OK ? rc
-	                     : sweep_common(e, cfg, n_sides, backend, opts, out, t_separate, err);
+	                     : sweep_drive(e, cfg, SWEEP_WHOLE, n_sides, backend, opts, NULL, out,
+	                                   t_separate, err);
 }
 
 int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
@@ -1063,7 +1121,7 @@ int bsim_sweep_run_paired(const bsim_experiment *e, const bsim_sweep_config *cfg
 	const bsim_backend *backend[2] = {cfg->backend, backend_b};
 	const bsim_options *opts[2] = {cfg->opts, opts_b};
 	bsim_sweep_result out[2];
-	int rc = sweep_common(e, cfg, 2, backend, opts, out, t_separate, err);
+	int rc = sweep_drive(e, cfg, SWEEP_WHOLE, 2, backend, opts, NULL, out, t_separate, err);
 	if (rc == BSIM_OK) {
 		*out_a = out[0];
 		*out_b = out[1];
@@ -1138,107 +1196,10 @@ int bsim_sweep_record_size_paired_for(const bsim_experiment *e, const bsim_sweep
 	return bsim_sweep_record_size_sides_for(e, cfg, 2, size, err);
 }
 
-/* ---- a part of a sweep (beamsim/sweep.h) ---------------------------------
- *
- * The trials run in blocks of BSIM_SWEEP_BLOCK indices as a streamed
- * sweep's do, each thread passing over the other parts' trials; nothing is
- * kept but the records handed on, so memory does not grow with the sweep. */
-
-static int run_part(const bsim_experiment *e, const bsim_sweep_config *cfg, int n_sides,
-                    const bsim_backend *const *backend, const bsim_options *const *opts,
-                    const bsim_sweep_part *part, bsim_error *err)
-{
-	int keep = 0, rc = sweep_check(e, cfg, &keep, err);
-	if (rc != BSIM_OK)
-		return rc;
-	if (part->count < 1 || part->index < 0 || part->index >= part->count)
-		return bsim_error_set(err, BSIM_EINPUT, "part %d of %d: expected 0 <= part < %d",
-		                      part->index, part->count, part->count);
-	const int n_pairs = bsim_sweep_pairs(n_sides);
-	long total = (long)e->n_groups * e->trials;
-	bsim_scene *scenes = NULL, *scenes_b = NULL;
-	int *deterministic = calloc((size_t)e->n_groups, sizeof *deterministic);
-	/* each side's slots, and each pair's separation times */
-	bsim_trial_result *results = calloc((size_t)n_sides * BSIM_SWEEP_BLOCK, sizeof *results);
-	bsim_trial_log *logs = calloc((size_t)n_sides * BSIM_SWEEP_BLOCK, sizeof *logs);
-	double *t_separate =
-	        n_pairs > 0 ? calloc((size_t)n_pairs * BSIM_SWEEP_BLOCK, sizeof *t_separate) : NULL;
-	if (!deterministic || !results || !logs || (n_pairs > 0 && !t_separate))
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory for %d groups", e->n_groups);
-	if (rc == BSIM_OK)
-		rc = scenes_for(e, cfg, n_sides, backend, opts, &scenes, &scenes_b, err);
-	for (int g = 0; rc == BSIM_OK && g < e->n_groups; g++)
-		deterministic[g] = !bsim_effects_random(&scenes[g]);
-	sweep_shared sh = {
-	        .e = e,
-	        .cfg = cfg,
-	        .n_sides = n_sides,
-	        .deterministic = deterministic,
-	        .keep_stride = 5,
-	        .total = total,
-	        .spill_fd = -1,
-	        .first_fail = total,
-	        .part = part,
-	};
-	for (int s = 0; rc == BSIM_OK && s < n_sides; s++) {
-		sh.scenes[s] = s == 1 && scenes_b ? scenes_b : scenes;
-		sh.backend[s] = backend[s];
-		sh.opts[s] = opts[s];
-		sh.results[s] = results + (size_t)s * BSIM_SWEEP_BLOCK;
-		sh.logs[s] = logs + (size_t)s * BSIM_SWEEP_BLOCK;
-	}
-	for (int q = 0; rc == BSIM_OK && q < n_pairs; q++)
-		sh.t_separate[q] = t_separate + (size_t)q * BSIM_SWEEP_BLOCK;
-	if (rc == BSIM_OK) {
-		sh.record_lattice = record_lattice(scenes, cfg);
-		sh.record_size = record_bytes(sh.record_lattice, n_sides);
-	}
-	/* Progress: this part's trials, or with collect every part's. */
-	for (long i = 0; i < total; i++) {
-		long j = cfg->journal_first + i;
-		int done = part->done && (part->done[j / 8] & (1u << (j % 8)));
-		if (part->collect)
-			sh.done += done;
-		else
-			sh.progress_total += !part_skips(part, cfg->journal_first, i);
-	}
-	if (part->collect)
-		sh.progress_total = total;
-	int threads = cfg->threads > 0 ? cfg->threads : omp_get_max_threads();
-	for (long first = 0; rc == BSIM_OK && first < total; first += BSIM_SWEEP_BLOCK) {
-		sh.first = first;
-		sh.end = total - first < BSIM_SWEEP_BLOCK ? total : first + BSIM_SWEEP_BLOCK;
-		long n = sh.end - sh.first;
-		bsim_error_clear(&sh.fail);
-#pragma omp parallel num_threads(threads < n ? threads : (int)n)
-		sweep_thread(&sh);
-		if (sh.first_fail < total)
-			rc = bsim_error_set(err, sh.fail.code, "%s", sh.fail.msg);
-		else if (sh.stopped)
-			rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped after %ld of %ld trials",
-			                    sh.done, sh.progress_total);
-	}
-	if (rc == BSIM_OK && part->collect)
-		rc = part->collect(part->user, 1, part_accept, &sh, err);
-	if (rc == BSIM_OK && cfg->progress)
-		cfg->progress(cfg->progress_user, sh.progress_total, sh.progress_total);
-	if (scenes)
-		scenes_release(cfg, scenes, e->n_groups);
-	if (scenes_b)
-		scenes_free(scenes_b, e->n_groups);
-	for (size_t k = 0; logs && k < (size_t)n_sides * BSIM_SWEEP_BLOCK; k++)
-		bsim_trial_log_clear(&logs[k]);
-	free(logs);
-	free(results);
-	free(t_separate);
-	free(deterministic);
-	return rc;
-}
-
 int bsim_sweep_run_part(const bsim_experiment *e, const bsim_sweep_config *cfg,
                         const bsim_sweep_part *part, bsim_error *err)
 {
-	return run_part(e, cfg, 1, &cfg->backend, &cfg->opts, part, err);
+	return sweep_drive(e, cfg, SWEEP_PART, 1, &cfg->backend, &cfg->opts, part, NULL, NULL, err);
 }
 
 int bsim_sweep_run_part_sides(const bsim_experiment *e, const bsim_sweep_config *cfg, int n_sides,
@@ -1246,7 +1207,9 @@ int bsim_sweep_run_part_sides(const bsim_experiment *e, const bsim_sweep_config 
                               const bsim_sweep_part *part, bsim_error *err)
 {
 	int rc = sides_check(n_sides, err);
-	return rc != BSIM_OK ? rc : run_part(e, cfg, n_sides, backend, opts, part, err);
+	return rc != BSIM_OK ? rc
+	                     : sweep_drive(e, cfg, SWEEP_PART, n_sides, backend, opts, part, NULL,
+	                                   NULL, err);
 }
 
 int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_sweep_config *cfg,
@@ -1255,5 +1218,5 @@ int bsim_sweep_run_part_paired(const bsim_experiment *e, const bsim_sweep_config
 {
 	const bsim_backend *backend[2] = {cfg->backend, backend_b};
 	const bsim_options *opts[2] = {cfg->opts, opts_b};
-	return run_part(e, cfg, 2, backend, opts, part, err);
+	return sweep_drive(e, cfg, SWEEP_PART, 2, backend, opts, part, NULL, NULL, err);
 }
