@@ -48,6 +48,29 @@ typedef struct bsim_trial_field {
 	void (*text)(FILE *out, const bsim_trial_row *row);
 } bsim_trial_field;
 
+/* A member of a trial's result, bsim_trial_result, as it lies in memory
+ * (a nested struct's members by their path, "ledger.e_start"); also the
+ * gate entries and beam peaks a lattice's journal record holds. A journal
+ * stores results byte for byte: its header names every member with its
+ * kind, offset and size (bsim_trial_record_fields), so that a journal of
+ * another layout is refused, naming the member that differs. */
+typedef struct bsim_trial_member {
+	const char *name; /* "t_end", "ledger.e_start", "gate_entry.x" */
+	const char *kind; /* "i32", "u32" (an enum), "i64", "u64", "f64" */
+	size_t offset;    /* bytes from the start of its struct */
+	size_t size;      /* bytes; an array's whole (max_theta: 16) */
+} bsim_trial_member;
+
+/* The members of bsim_trial_result, then bsim_gate_entry's and
+ * bsim_beam_peak's, each struct's in the order of its declaration (of its
+ * offsets); *n gets how many. */
+BSIM_API const bsim_trial_member *bsim_trial_members(int *n);
+
+/* The text a journal's header holds for its records: a line a struct
+ * ("bsim_trial_result 296") followed by a line a member ("t_end f64 16
+ * 8": name, kind, offset, size), made from bsim_trial_members. */
+BSIM_API const char *bsim_trial_record_fields(void);
+
 /* The columns, in trials.csv's order; *n gets how many. */
 BSIM_API const bsim_trial_field *bsim_trial_fields(int *n);
 

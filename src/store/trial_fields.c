@@ -2,7 +2,10 @@
 #include "beamsim/trial_fields.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stddef.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "beamsim/lattice_outcome.h"
 #include "store/survival_files.h"
@@ -146,4 +149,118 @@ void bsim_trial_field_write(FILE *out, const bsim_trial_field *f, const bsim_tri
 		f->text(out, row);
 		return;
 	}
+}
+
+/* ---- the result as it lies in memory (a journal's record) --------------- */
+
+/* Every member of each struct, in the order of its declaration; a nested
+ * struct's members by their path. A member added to the struct and not
+ * here leaves a gap that test_journal finds. */
+#define RESULT_MEMBERS(X)                                                                          \
+	X(outcome)                                                                                 \
+	X(type)                                                                                    \
+	X(landscape_beam)                                                                          \
+	X(steps)                                                                                   \
+	X(t_end)                                                                                   \
+	X(x_end)                                                                                   \
+	X(y_end)                                                                                   \
+	X(vx_end)                                                                                  \
+	X(max_theta)                                                                               \
+	X(in_contact_end)                                                                          \
+	X(steps_run)                                                                               \
+	X(draws)                                                                                   \
+	X(ledger.e_start)                                                                          \
+	X(ledger.e_end)                                                                            \
+	X(ledger.w_prop)                                                                           \
+	X(ledger.w_rand)                                                                           \
+	X(ledger.damper)                                                                           \
+	X(ledger.impact)                                                                           \
+	X(ledger.contact)                                                                          \
+	X(ledger.correction)                                                                       \
+	X(ledger.sleep)                                                                            \
+	X(ledger.reset)                                                                            \
+	X(ledger.residual)                                                                         \
+	X(ledger.residual_max)                                                                     \
+	X(ledger.residual_abs)                                                                     \
+	X(ledger.inflow)                                                                           \
+	X(ledger.drag)                                                                             \
+	X(ledger.w_osc)                                                                            \
+	X(ledger.friction)                                                                         \
+	X(instability)                                                                             \
+	X(unstable_step)                                                                           \
+	X(overlap_max)                                                                             \
+	X(final_ix)                                                                                \
+	X(final_iy)                                                                                \
+	X(gates_entered)                                                                           \
+	X(reset_overlaps)                                                                          \
+	X(solver.iteration_limit)                                                                  \
+	X(solver.clamped)                                                                          \
+	X(heading_end)                                                                             \
+	X(angular_velocity_end)                                                                    \
+	X(turn_end)                                                                                \
+	X(turn_max)
+#define ENTRY_MEMBERS(X) X(ix) X(iy) X(edge) X(step) X(t) X(pos) X(x) X(v) X(theta) X(omega)
+#define PEAK_MEMBERS(X)  X(beam) X(peak)
+
+/* A member's kind from its type, so that the table cannot misname it (an
+ * enum is an unsigned int here; an array is its element's kind). A type
+ * not listed does not compile. */
+#define KIND_OF(e)                                                                                 \
+	_Generic((e), int: "int", unsigned int: "uint", long: "long", unsigned long: "ulong",      \
+	         double: "double", double *: "double")
+
+#define MEMBER(T, prefix, m) {prefix #m, KIND_OF(((T *)0)->m), offsetof(T, m), sizeof(((T *)0)->m)},
+#define RESULT_MEMBER(m)     MEMBER(bsim_trial_result, "", m)
+#define ENTRY_MEMBER(m)      MEMBER(bsim_gate_entry, "gate_entry.", m)
+#define PEAK_MEMBER(m)       MEMBER(bsim_beam_peak, "beam_peak.", m)
+
+static const bsim_trial_member members[] = {
+        RESULT_MEMBERS(RESULT_MEMBER) ENTRY_MEMBERS(ENTRY_MEMBER) PEAK_MEMBERS(PEAK_MEMBER)};
+
+#define COUNT(LIST) (0 LIST(ONE))
+#define ONE(m)      +1
+enum {
+	N_RESULT = COUNT(RESULT_MEMBERS),
+	N_ENTRY = COUNT(ENTRY_MEMBERS),
+	N_PEAK = COUNT(PEAK_MEMBERS),
+};
+
+const bsim_trial_member *bsim_trial_members(int *n)
+{
+	*n = (int)(sizeof members / sizeof members[0]);
+	return members;
+}
+
+static char record_fields[4096];
+static pthread_once_t record_fields_once = PTHREAD_ONCE_INIT;
+
+static void record_fields_make(void)
+{
+	static const struct {
+		const char *name;
+		size_t size;
+		int n;
+	} structs[] = {{"bsim_trial_result", sizeof(bsim_trial_result), N_RESULT},
+	               {"bsim_gate_entry", sizeof(bsim_gate_entry), N_ENTRY},
+	               {"bsim_beam_peak", sizeof(bsim_beam_peak), N_PEAK}};
+	size_t used = 0;
+	const bsim_trial_member *m = members;
+	for (int s = 0; s < 3; s++) {
+		used += (size_t)snprintf(record_fields + used, sizeof record_fields - used,
+		                         "%s %zu\n", structs[s].name, structs[s].size);
+		for (int k = 0; k < structs[s].n; k++, m++) {
+			const char *dot = strchr(m->name, '.');
+			/* a gate entry's or peak's member by its own name */
+			const char *name = s > 0 && dot ? dot + 1 : m->name;
+			used += (size_t)snprintf(record_fields + used, sizeof record_fields - used,
+			                         "%s %s %zu %zu\n", name, m->kind, m->offset,
+			                         m->size);
+		}
+	}
+}
+
+const char *bsim_trial_record_fields(void)
+{
+	pthread_once(&record_fields_once, record_fields_make);
+	return record_fields;
 }
