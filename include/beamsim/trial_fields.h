@@ -74,6 +74,11 @@ BSIM_API const char *bsim_trial_record_fields(void);
 /* The columns, in trials.csv's order; *n gets how many. */
 BSIM_API const bsim_trial_field *bsim_trial_fields(int *n);
 
+/* Field f of row as a number as trials.csv holds it (an INT, REAL or
+ * MEASURED field; a REAL to the ten digits it is written with, what
+ * reading the file gives), NaN for a MEASURED field not measured. */
+BSIM_API double bsim_trial_field_number(const bsim_trial_field *f, const bsim_trial_row *row);
+
 /* Field f of row written as trials.csv writes it (no separator). */
 BSIM_API void bsim_trial_field_write(FILE *out, const bsim_trial_field *f,
                                      const bsim_trial_row *row);

@@ -17,6 +17,7 @@
 #include "beamsim/backend_registry.h"
 #include "util/atomic_file.h"
 #include "store/survival_files.h"
+#include "store/matlab.h"
 #include "store/trials_csv.h"
 #include "store/lattice_files.h"
 #include "util/csv_table.h"
@@ -333,7 +334,7 @@ const char *bsim_trials_csv_column(int k)
 	return k >= 0 && k < n ? f[k].name : "?";
 }
 
-int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
+int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e, int twin,
                          bsim_error *err)
 {
 	memset(w, 0, sizeof *w);
@@ -341,6 +342,10 @@ int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_expe
 		return BSIM_EFAIL;
 	w->e = e;
 	w->axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
+	if (twin && e && !(w->twin = bsim_matlab_trials_open(e, w->axes))) {
+		bsim_atomic_file_abort(&w->o);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %s's twin", path);
+	}
 	w->group = -1;
 	for (int c = 0; c < TRIALS_N_COLUMNS; c++)
 		fprintf(w->o.f, "%s%s", c ? "," : "", bsim_trials_csv_column(c));
@@ -358,6 +363,8 @@ void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 	FILE *f = w->o.f;
 	int n_fields;
 	const bsim_trial_field *fields = bsim_trial_fields(&n_fields);
+	if (w->twin)
+		bsim_matlab_trials_rows(w->twin, first, n, trials, results, logs);
 	for (long k = 0; k < n; k++) {
 		int g = (int)((first + k) / trials), t = (int)((first + k) % trials);
 		if (w->axes && g != w->group)
@@ -379,25 +386,45 @@ void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 
 int bsim_trials_csv_commit(trials_csv_writer *w, bsim_error *err)
 {
-	return bsim_atomic_file_commit(&w->o, err);
+	const char *path = w->o.path;
+	int rc = bsim_atomic_file_commit(&w->o, err);
+	if (rc == BSIM_OK && w->twin)
+		rc = bsim_matlab_trials_write(w->twin, path, err);
+	bsim_matlab_trials_free(w->twin);
+	w->twin = NULL;
+	return rc;
 }
 
 void bsim_trials_csv_abort(trials_csv_writer *w)
 {
 	bsim_atomic_file_abort(&w->o);
+	bsim_matlab_trials_free(w->twin);
+	w->twin = NULL;
 }
 
-int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
-                           bsim_error *err)
+static int trials_csv_write(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                            int twin, bsim_error *err)
 {
 	trials_csv_writer w;
-	if (bsim_trials_csv_open(&w, path, e, err) != BSIM_OK)
+	if (bsim_trials_csv_open(&w, path, e, twin, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	for (int g = 0; g < r->n_groups; g++)
 		bsim_trials_csv_rows(&w, (long)g * r->trials, r->trials, r->trials,
 		                     &r->trials_out[(size_t)g * r->trials],
 		                     r->logs ? &r->logs[(size_t)g * r->trials] : NULL);
 	return bsim_trials_csv_commit(&w, err);
+}
+
+int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                           bsim_error *err)
+{
+	return trials_csv_write(path, e, r, 0, err);
+}
+
+int bsim_trials_csv_write(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                          bsim_error *err)
+{
+	return trials_csv_write(path, e, r, 1, err);
 }
 
 int bsim_output_trials_fit(const bsim_experiment *e, long trials, double cell_bytes,

@@ -5,6 +5,7 @@
 #include <pthread.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "beamsim/lattice_outcome.h"
@@ -23,6 +24,11 @@ static const char *const type_words[] = {"none", "left", "right"};
 		(void)l;                                                                           \
 		return (expr);                                                                     \
 	}
+
+double bsim_survival_exit_time(const bsim_trial_result *r)
+{
+	return r->outcome == BSIM_TRAVERSED || r->outcome == BSIM_SIDE_EXIT ? r->t_end : NAN;
+}
 
 GETTER(f_group, row->group)
 GETTER(f_trial, row->trial)
@@ -123,6 +129,18 @@ const bsim_trial_field *bsim_trial_fields(int *n)
 {
 	*n = (int)(sizeof fields / sizeof fields[0]);
 	return fields;
+}
+
+double bsim_trial_field_number(const bsim_trial_field *f, const bsim_trial_row *row)
+{
+	double x = f->value(row);
+	if (f->kind == BSIM_FIELD_INT)
+		return (double)(long long)x;
+	if (f->kind == BSIM_FIELD_MEASURED && isnan(x))
+		return NAN;
+	char text[32];
+	snprintf(text, sizeof text, "%.10g", x);
+	return strtod(text, NULL);
 }
 
 void bsim_trial_field_write(FILE *out, const bsim_trial_field *f, const bsim_trial_row *row)
