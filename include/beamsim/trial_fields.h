@@ -61,9 +61,9 @@ typedef struct bsim_trial_member {
 	size_t size;      /* bytes; an array's whole (max_theta: 16) */
 } bsim_trial_member;
 
-/* The members of bsim_trial_result, then bsim_gate_entry's and
- * bsim_beam_peak's, each struct's in the order of its declaration (of its
- * offsets); *n gets how many. */
+/* The members of bsim_trial_result (in the order of beamsim/trial.h's
+ * lists, BSIM_TRIAL_RESULT_PLAIN ...), then bsim_gate_entry's and
+ * bsim_beam_peak's; *n gets how many. */
 BSIM_API const bsim_trial_member *bsim_trial_members(int *n);
 
 /* The text a journal's header holds for its records: a line a struct

@@ -171,52 +171,10 @@ void bsim_trial_field_write(FILE *out, const bsim_trial_field *f, const bsim_tri
 
 /* ---- the result as it lies in memory (a journal's record) --------------- */
 
-/* Every member of each struct, in the order of its declaration; a nested
- * struct's members by their path. A member added to the struct and not
- * here leaves a gap that test_journal finds. */
-#define RESULT_MEMBERS(X)                                                                          \
-	X(outcome)                                                                                 \
-	X(type)                                                                                    \
-	X(landscape_beam)                                                                          \
-	X(steps)                                                                                   \
-	X(t_end)                                                                                   \
-	X(x_end)                                                                                   \
-	X(y_end)                                                                                   \
-	X(vx_end)                                                                                  \
-	X(max_theta)                                                                               \
-	X(in_contact_end)                                                                          \
-	X(steps_run)                                                                               \
-	X(draws)                                                                                   \
-	X(ledger.e_start)                                                                          \
-	X(ledger.e_end)                                                                            \
-	X(ledger.w_prop)                                                                           \
-	X(ledger.w_rand)                                                                           \
-	X(ledger.damper)                                                                           \
-	X(ledger.impact)                                                                           \
-	X(ledger.contact)                                                                          \
-	X(ledger.correction)                                                                       \
-	X(ledger.sleep)                                                                            \
-	X(ledger.reset)                                                                            \
-	X(ledger.residual)                                                                         \
-	X(ledger.residual_max)                                                                     \
-	X(ledger.residual_abs)                                                                     \
-	X(ledger.inflow)                                                                           \
-	X(ledger.drag)                                                                             \
-	X(ledger.w_osc)                                                                            \
-	X(ledger.friction)                                                                         \
-	X(instability)                                                                             \
-	X(unstable_step)                                                                           \
-	X(overlap_max)                                                                             \
-	X(final_ix)                                                                                \
-	X(final_iy)                                                                                \
-	X(gates_entered)                                                                           \
-	X(reset_overlaps)                                                                          \
-	X(solver.iteration_limit)                                                                  \
-	X(solver.clamped)                                                                          \
-	X(heading_end)                                                                             \
-	X(angular_velocity_end)                                                                    \
-	X(turn_end)                                                                                \
-	X(turn_max)
+/* Every member of each struct: the result's as beamsim/trial.h lists
+ * them (a nested struct's by their path), a gate entry's and a beam
+ * peak's here. A member of a struct left out leaves a gap that
+ * test_journal finds. */
 #define ENTRY_MEMBERS(X) X(ix) X(iy) X(edge) X(step) X(t) X(pos) X(x) X(v) X(theta) X(omega)
 #define PEAK_MEMBERS(X)  X(beam) X(peak)
 
@@ -227,18 +185,30 @@ void bsim_trial_field_write(FILE *out, const bsim_trial_field *f, const bsim_tri
 	_Generic((e), int: "int", unsigned int: "uint", long: "long", unsigned long: "ulong",      \
 	         double: "double", double *: "double")
 
-#define MEMBER(T, prefix, m) {prefix #m, KIND_OF(((T *)0)->m), offsetof(T, m), sizeof(((T *)0)->m)},
-#define RESULT_MEMBER(m)     MEMBER(bsim_trial_result, "", m)
-#define ENTRY_MEMBER(m)      MEMBER(bsim_gate_entry, "gate_entry.", m)
-#define PEAK_MEMBER(m)       MEMBER(bsim_beam_peak, "beam_peak.", m)
+#define MEMBER(T, name, m) {name, KIND_OF(((T *)0)->m), offsetof(T, m), sizeof(((T *)0)->m)},
+#define RESULT_MEMBER(m)   MEMBER(bsim_trial_result, #m, m)
+#define LEDGER_MEMBER(m)   MEMBER(bsim_trial_result, "ledger." #m, ledger.m)
+#define SOLVER_MEMBER(m)   MEMBER(bsim_trial_result, "solver." #m, solver.m)
+#define ENTRY_MEMBER(m)    MEMBER(bsim_gate_entry, "gate_entry." #m, m)
+#define PEAK_MEMBER(m)     MEMBER(bsim_beam_peak, "beam_peak." #m, m)
 
+/* clang-format off */
 static const bsim_trial_member members[] = {
-        RESULT_MEMBERS(RESULT_MEMBER) ENTRY_MEMBERS(ENTRY_MEMBER) PEAK_MEMBERS(PEAK_MEMBER)};
+	BSIM_TRIAL_RESULT_PLAIN(RESULT_MEMBER)
+	BSIM_TRIAL_RESULT_OTHER(RESULT_MEMBER)
+	BSIM_LEDGER_SHOWN(LEDGER_MEMBER)
+	BSIM_LEDGER_OTHER(LEDGER_MEMBER)
+	BSIM_SOLVER_COUNTS(SOLVER_MEMBER)
+	ENTRY_MEMBERS(ENTRY_MEMBER)
+	PEAK_MEMBERS(PEAK_MEMBER)
+};
+/* clang-format on */
 
 #define COUNT(LIST) (0 LIST(ONE))
 #define ONE(m)      +1
 enum {
-	N_RESULT = COUNT(RESULT_MEMBERS),
+	N_RESULT = COUNT(BSIM_TRIAL_RESULT_PLAIN) + COUNT(BSIM_TRIAL_RESULT_OTHER) +
+	           COUNT(BSIM_LEDGER_SHOWN) + COUNT(BSIM_LEDGER_OTHER) + COUNT(BSIM_SOLVER_COUNTS),
 	N_ENTRY = COUNT(ENTRY_MEMBERS),
 	N_PEAK = COUNT(PEAK_MEMBERS),
 };
