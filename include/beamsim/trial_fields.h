@@ -46,6 +46,13 @@ typedef struct bsim_trial_field {
 	int n_words;
 	/* TEXT: its text written to out */
 	void (*text)(FILE *out, const bsim_trial_row *row);
+	/* INT and REAL read back (trials.csv read by regress and compare's
+	 * file sides): the member of bsim_trial_result the number goes to, at
+	 * back bytes from its start, of back_size bytes (an int, a long or a
+	 * double; a sum, work_in or losses, into its first term, which then
+	 * holds the whole). back_size 0: not read back (an index, a word, a
+	 * text, overlap_max, t_exit). */
+	size_t back, back_size;
 } bsim_trial_field;
 
 /* A member of a trial's result, bsim_trial_result, as it lies in memory

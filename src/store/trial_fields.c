@@ -80,49 +80,60 @@ static void t_path(FILE *out, const bsim_trial_row *row)
 
 #define NUMBER(name, kind, unit, help, fn)                                                         \
 	{                                                                                          \
-		name, kind, unit, help, 0, fn, NULL, 0, NULL                                       \
+		name, kind, unit, help, 0, fn, NULL, 0, NULL, 0, 0                                 \
+	}
+/* a number read back into member m of the result */
+#define READ(name, kind, unit, help, fn, m)                                                        \
+	{                                                                                          \
+		name, kind, unit, help, 0, fn, NULL, 0, NULL, offsetof(bsim_trial_result, m),      \
+		        sizeof(((bsim_trial_result *)0)->m)                                        \
 	}
 
 static const bsim_trial_field fields[] = {
-        {"group", BSIM_FIELD_INT, "", "the group, 0-based", 1, f_group, NULL, 0, NULL},
+        {"group", BSIM_FIELD_INT, "", "the group, 0-based", 1, f_group, NULL, 0, NULL, 0, 0},
         {"trial", BSIM_FIELD_INT, "", "the trial within its group, 0-based", 1, f_trial, NULL, 0,
-         NULL},
+         NULL, 0, 0},
         {"outcome", BSIM_FIELD_WORD, "", "traversed, side_exit, stuck or unstable", 0, f_outcome,
-         outcome_words, 4, NULL},
+         outcome_words, 4, NULL, 0, 0},
         {"type", BSIM_FIELD_WORD, "", "the beam a traversal went over: left, right or none", 0,
-         f_type, type_words, 3, NULL},
-        NUMBER("steps", BSIM_FIELD_INT, "", "steps to the outcome", f_steps),
-        NUMBER("t_end", BSIM_FIELD_REAL, "s", "time to the outcome", f_t_end),
-        NUMBER("x_end", BSIM_FIELD_REAL, "m", "the end position's x", f_x_end),
-        NUMBER("y_end", BSIM_FIELD_REAL, "m", "the end position's y", f_y_end),
-        NUMBER("vx_end", BSIM_FIELD_REAL, "m/s", "the end velocity's x", f_vx_end),
-        NUMBER("max_theta1", BSIM_FIELD_REAL, "rad", "beam 1's peak angle", f_max_theta1),
-        NUMBER("max_theta2", BSIM_FIELD_REAL, "rad", "beam 2's peak angle", f_max_theta2),
-        NUMBER("e_start", BSIM_FIELD_REAL, "J", "the energy at the start", f_e_start),
-        NUMBER("e_end", BSIM_FIELD_REAL, "J", "the energy at the end", f_e_end),
-        NUMBER("work_in", BSIM_FIELD_REAL, "J", "the forces' work", f_work_in),
-        NUMBER("losses", BSIM_FIELD_REAL, "J", "what dissipation took", f_losses),
-        NUMBER("residual", BSIM_FIELD_REAL, "J", "the ledger's residual", f_residual),
+         f_type, type_words, 3, NULL, 0, 0},
+        READ("steps", BSIM_FIELD_INT, "", "steps to the outcome", f_steps, steps),
+        READ("t_end", BSIM_FIELD_REAL, "s", "time to the outcome", f_t_end, t_end),
+        READ("x_end", BSIM_FIELD_REAL, "m", "the end position's x", f_x_end, x_end),
+        READ("y_end", BSIM_FIELD_REAL, "m", "the end position's y", f_y_end, y_end),
+        READ("vx_end", BSIM_FIELD_REAL, "m/s", "the end velocity's x", f_vx_end, vx_end),
+        READ("max_theta1", BSIM_FIELD_REAL, "rad", "beam 1's peak angle", f_max_theta1,
+             max_theta[0]),
+        READ("max_theta2", BSIM_FIELD_REAL, "rad", "beam 2's peak angle", f_max_theta2,
+             max_theta[1]),
+        READ("e_start", BSIM_FIELD_REAL, "J", "the energy at the start", f_e_start, ledger.e_start),
+        READ("e_end", BSIM_FIELD_REAL, "J", "the energy at the end", f_e_end, ledger.e_end),
+        READ("work_in", BSIM_FIELD_REAL, "J", "the forces' work", f_work_in, ledger.w_prop),
+        READ("losses", BSIM_FIELD_REAL, "J", "what dissipation took", f_losses, ledger.damper),
+        READ("residual", BSIM_FIELD_REAL, "J", "the ledger's residual", f_residual,
+             ledger.residual),
         NUMBER("overlap_max", BSIM_FIELD_MEASURED, "m", "the deepest overlap of body and beams",
                f_overlap_max),
-        NUMBER("final_ix", BSIM_FIELD_INT, "", "the final gate's column", f_final_ix),
-        NUMBER("final_iy", BSIM_FIELD_INT, "", "the final gate's row", f_final_iy),
+        READ("final_ix", BSIM_FIELD_INT, "", "the final gate's column", f_final_ix, final_ix),
+        READ("final_iy", BSIM_FIELD_INT, "", "the final gate's row", f_final_iy, final_iy),
         {"location", BSIM_FIELD_TEXT, "", "where it ended: end:ix, side:iy or stuck:ix:iy", 0, NULL,
-         NULL, 0, t_location},
+         NULL, 0, t_location, 0, 0},
         {"path", BSIM_FIELD_TEXT, "", "the gates entered, ix:iy separated by spaces", 0, NULL, NULL,
-         0, t_path},
-        NUMBER("iteration_limits", BSIM_FIELD_INT, "", "solves that stopped at their limit",
-               f_iteration_limits),
-        NUMBER("clamps", BSIM_FIELD_INT, "", "(sub)steps whose motion the solver clamped",
-               f_clamps),
+         0, t_path, 0, 0},
+        READ("iteration_limits", BSIM_FIELD_INT, "", "solves that stopped at their limit",
+             f_iteration_limits, solver.iteration_limit),
+        READ("clamps", BSIM_FIELD_INT, "", "(sub)steps whose motion the solver clamped", f_clamps,
+             solver.clamped),
         NUMBER("t_exit", BSIM_FIELD_MEASURED, "s", "when the trial left the gate or the field",
                f_t_exit),
-        NUMBER("heading_end", BSIM_FIELD_REAL, "rad", "the body's heading at the end",
-               f_heading_end),
-        NUMBER("angular_velocity_end", BSIM_FIELD_REAL, "rad/s",
-               "the body's angular velocity at the end", f_angular_velocity_end),
-        NUMBER("turn_end", BSIM_FIELD_REAL, "rad", "how far the body turned", f_turn_end),
-        NUMBER("turn_max", BSIM_FIELD_REAL, "rad", "the largest turn on the way", f_turn_max),
+        READ("heading_end", BSIM_FIELD_REAL, "rad", "the body's heading at the end", f_heading_end,
+             heading_end),
+        READ("angular_velocity_end", BSIM_FIELD_REAL, "rad/s",
+             "the body's angular velocity at the end", f_angular_velocity_end,
+             angular_velocity_end),
+        READ("turn_end", BSIM_FIELD_REAL, "rad", "how far the body turned", f_turn_end, turn_end),
+        READ("turn_max", BSIM_FIELD_REAL, "rad", "the largest turn on the way", f_turn_max,
+             turn_max),
 };
 
 const bsim_trial_field *bsim_trial_fields(int *n)
