@@ -90,8 +90,11 @@ static int columns_block(void *user, const bsim_sweep_block *b, bsim_error *err)
 	for (long k = 0; k < b->n && !c->oom; k++) {
 		size_t at = (size_t)(b->first + k);
 		const bsim_trial_row row = {(int)(at / (size_t)c->trials),
-		                            (int)(at % (size_t)c->trials), &b->results[k],
-		                            b->logs ? &b->logs[k] : NULL};
+		                            (int)(at % (size_t)c->trials),
+		                            &b->results[k],
+		                            b->logs ? &b->logs[k] : NULL,
+		                            0,
+		                            NULL};
 		for (int i = 0; i < c->n_fields && !c->oom; i++) {
 			const bsim_trial_field *f = &c->field[i];
 			if (f->kind == BSIM_FIELD_TEXT) {

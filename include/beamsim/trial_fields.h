@@ -11,6 +11,7 @@
 #include <stdio.h>
 
 #include "beamsim/base.h"
+#include "beamsim/lattice.h"
 #include "beamsim/trial.h"
 
 #ifdef __cplusplus
@@ -23,14 +24,19 @@ typedef enum {
 	BSIM_FIELD_MEASURED, /* a number, or nothing (NaN): not measured */
 	BSIM_FIELD_WORD,     /* a word of a fixed list (words, n_words) */
 	BSIM_FIELD_TEXT,     /* a text made from the trial */
+	BSIM_FIELD_FIXED,    /* a number, written "%.6f" */
 } bsim_field_kind;
 
 /* A row of trials.csv: trial `trial` (0-based) of group `group`, its result,
- * and its log (NULL: none; a lattice's path is then its final gate). */
+ * and its log (NULL: none; a lattice's path is then its final gate). A row
+ * of a lattice's gate_entries.csv or beam_peaks.csv is one of the log's
+ * entries or peaks, number seq, on the lattice def (its beams' gates). */
 typedef struct bsim_trial_row {
 	int group, trial;
 	const bsim_trial_result *r;
 	const bsim_trial_log *log;
+	int seq;
+	const bsim_lattice_def *def;
 } bsim_trial_row;
 
 typedef struct bsim_trial_field {
@@ -80,6 +86,18 @@ BSIM_API const char *bsim_trial_record_fields(void);
 
 /* The columns, in trials.csv's order; *n gets how many. */
 BSIM_API const bsim_trial_field *bsim_trial_fields(int *n);
+
+/* The columns of a lattice's gate_entries.csv (a row a gate entry, its
+ * state in the gate's frame) and of its beam_peaks.csv (a row a beam that
+ * moved), in their files' order, as bsim_trial_fields; *n gets how many. */
+BSIM_API const bsim_trial_field *bsim_gate_entry_fields(int *n);
+BSIM_API const bsim_trial_field *bsim_beam_peak_fields(int *n);
+
+/* The n fields' names as a CSV header line, or row's values as a CSV line,
+ * to out (each ended by a line feed). */
+BSIM_API void bsim_trial_fields_header(FILE *out, const bsim_trial_field *f, int n);
+BSIM_API void bsim_trial_fields_line(FILE *out, const bsim_trial_field *f, int n,
+                                     const bsim_trial_row *row);
 
 /* Field f of row as a number as trials.csv holds it (an INT, REAL or
  * MEASURED field; a REAL to the ten digits it is written with, what

@@ -578,8 +578,9 @@ void bsim_matlab_trials_rows(bsim_matlab_trials *w, long first, long n, int tria
 			}
 		}
 		int g = (int)((first + k) / trials);
-		const bsim_trial_row row = {g, (int)((first + k) % trials), &results[k],
-		                            logs ? &logs[k] : NULL};
+		const bsim_trial_row row = {g,           (int)((first + k) % trials),
+		                            &results[k], logs ? &logs[k] : NULL,
+		                            0,           NULL};
 		if (w->e->n_axes)
 			bsim_experiment_group_index(w->e, g, w->idx);
 		for (int c = 0; c < t->n_cols && !w->oom; c++)

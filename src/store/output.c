@@ -370,7 +370,7 @@ void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 		if (w->axes && g != w->group)
 			bsim_experiment_group_index(w->e, g, w->idx);
 		w->group = g;
-		const bsim_trial_row row = {g, t, &results[k], logs ? &logs[k] : NULL};
+		const bsim_trial_row row = {g, t, &results[k], logs ? &logs[k] : NULL, 0, NULL};
 		for (int c = 0; c < n_fields; c++) {
 			if (c)
 				fputc(',', f);

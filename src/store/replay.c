@@ -356,7 +356,7 @@ void bsim_replay_row(char *buf, size_t size, long group, long trial, const bsim_
 {
 	int n;
 	const bsim_trial_field *f = bsim_trial_fields(&n);
-	const bsim_trial_row row = {(int)group, (int)trial, x, NULL};
+	const bsim_trial_row row = {(int)group, (int)trial, x, NULL, 0, NULL};
 	char *text = NULL;
 	size_t len = 0;
 	FILE *m = open_memstream(&text, &len);

@@ -30,8 +30,17 @@ double bsim_survival_exit_time(const bsim_trial_result *r)
 	return r->outcome == BSIM_TRAVERSED || r->outcome == BSIM_SIDE_EXIT ? r->t_end : NAN;
 }
 
-GETTER(f_group, row->group)
-GETTER(f_trial, row->trial)
+/* the row's indices, for a row of any of the tables below (no result) */
+static double f_group(const bsim_trial_row *row)
+{
+	return row->group;
+}
+
+static double f_trial(const bsim_trial_row *row)
+{
+	return row->trial;
+}
+
 GETTER(f_outcome, x->outcome)
 GETTER(f_type, x->type)
 GETTER(f_steps, x->steps)
@@ -142,6 +151,124 @@ const bsim_trial_field *bsim_trial_fields(int *n)
 	return fields;
 }
 
+/* ---- a lattice's gate_entries.csv and beam_peaks.csv -------------------- */
+
+/* One getter a column of gate entry row->seq of the row's log. */
+#define ENTRY_GETTER(fn, expr)                                                                     \
+	static double fn(const bsim_trial_row *row)                                                \
+	{                                                                                          \
+		const bsim_gate_entry *e = &row->log->entries[row->seq];                           \
+		return (expr);                                                                     \
+	}
+
+static double e_seq(const bsim_trial_row *row)
+{
+	return row->seq;
+}
+
+ENTRY_GETTER(e_ix, e->ix)
+ENTRY_GETTER(e_iy, e->iy)
+ENTRY_GETTER(e_step, e->step)
+ENTRY_GETTER(e_t, e->t)
+ENTRY_GETTER(e_pos, e->pos)
+ENTRY_GETTER(e_x, e->x[0])
+ENTRY_GETTER(e_y, e->x[1])
+ENTRY_GETTER(e_vx, e->v[0])
+ENTRY_GETTER(e_vy, e->v[1])
+ENTRY_GETTER(e_theta_left, e->theta[0])
+ENTRY_GETTER(e_omega_left, e->omega[0])
+ENTRY_GETTER(e_theta_right, e->theta[1])
+ENTRY_GETTER(e_omega_right, e->omega[1])
+
+static void t_edge(FILE *out, const bsim_trial_row *row)
+{
+	fputs(bsim_trial_edge_name(row->log->entries[row->seq].edge), out);
+}
+
+static const bsim_trial_field entry_fields[] = {
+        {"group", BSIM_FIELD_INT, "", "the group, 0-based", 1, f_group, NULL, 0, NULL, 0, 0},
+        {"trial", BSIM_FIELD_INT, "", "the trial within its group, 0-based", 1, f_trial, NULL, 0,
+         NULL, 0, 0},
+        {"seq", BSIM_FIELD_INT, "", "the entry's place in the trial's path, 0-based", 1, e_seq,
+         NULL, 0, NULL, 0, 0},
+        NUMBER("ix", BSIM_FIELD_INT, "", "the entered gate's column", e_ix),
+        NUMBER("iy", BSIM_FIELD_INT, "", "the entered gate's row", e_iy),
+        {"edge", BSIM_FIELD_TEXT, "", "the edge crossed: start, bottom, left, right or top", 0,
+         NULL, NULL, 0, t_edge, 0, 0},
+        NUMBER("step", BSIM_FIELD_INT, "", "the step at whose end the body was inside", e_step),
+        NUMBER("t", BSIM_FIELD_FIXED, "s", "the time of that step's end", e_t),
+        NUMBER("pos", BSIM_FIELD_REAL, "m", "where the path crossed the edge, gate frame", e_pos),
+        NUMBER("x", BSIM_FIELD_REAL, "m", "the body's x, gate frame", e_x),
+        NUMBER("y", BSIM_FIELD_REAL, "m", "the body's y, gate frame", e_y),
+        NUMBER("vx", BSIM_FIELD_REAL, "m/s", "the body's velocity, x", e_vx),
+        NUMBER("vy", BSIM_FIELD_REAL, "m/s", "the body's velocity, y", e_vy),
+        NUMBER("theta_left", BSIM_FIELD_REAL, "rad", "the gate's left beam's angle", e_theta_left),
+        NUMBER("omega_left", BSIM_FIELD_REAL, "rad/s", "its angular velocity", e_omega_left),
+        NUMBER("theta_right", BSIM_FIELD_REAL, "rad", "the gate's right beam's angle",
+               e_theta_right),
+        NUMBER("omega_right", BSIM_FIELD_REAL, "rad/s", "its angular velocity", e_omega_right),
+};
+
+/* The gate of peak row->seq's beam: ix, iy or side (0 left, 1 right). */
+static double peak_gate(const bsim_trial_row *row, int which)
+{
+	int g[3];
+	bsim_lattice_beam_gate(row->def, row->log->peaks[row->seq].beam, &g[0], &g[1], &g[2]);
+	return g[which];
+}
+
+static double p_beam(const bsim_trial_row *row)
+{
+	return row->log->peaks[row->seq].beam;
+}
+
+static double p_ix(const bsim_trial_row *row)
+{
+	return peak_gate(row, 0);
+}
+
+static double p_iy(const bsim_trial_row *row)
+{
+	return peak_gate(row, 1);
+}
+
+static double p_side(const bsim_trial_row *row)
+{
+	return peak_gate(row, 2) != 0;
+}
+
+static double p_peak(const bsim_trial_row *row)
+{
+	return row->log->peaks[row->seq].peak;
+}
+
+static const char *const side_words[] = {"left", "right"};
+
+static const bsim_trial_field peak_fields[] = {
+        {"group", BSIM_FIELD_INT, "", "the group, 0-based", 1, f_group, NULL, 0, NULL, 0, 0},
+        {"trial", BSIM_FIELD_INT, "", "the trial within its group, 0-based", 1, f_trial, NULL, 0,
+         NULL, 0, 0},
+        {"beam", BSIM_FIELD_INT, "", "the beam, the scene's, 0-based", 1, p_beam, NULL, 0, NULL, 0,
+         0},
+        NUMBER("ix", BSIM_FIELD_INT, "", "its gate's column", p_ix),
+        NUMBER("iy", BSIM_FIELD_INT, "", "its gate's row", p_iy),
+        {"side", BSIM_FIELD_WORD, "", "its side of the gate: left or right", 0, p_side, side_words,
+         2, NULL, 0, 0},
+        NUMBER("max_theta", BSIM_FIELD_REAL, "rad", "its peak angle over the trial", p_peak),
+};
+
+const bsim_trial_field *bsim_gate_entry_fields(int *n)
+{
+	*n = (int)(sizeof entry_fields / sizeof entry_fields[0]);
+	return entry_fields;
+}
+
+const bsim_trial_field *bsim_beam_peak_fields(int *n)
+{
+	*n = (int)(sizeof peak_fields / sizeof peak_fields[0]);
+	return peak_fields;
+}
+
 double bsim_trial_field_number(const bsim_trial_field *f, const bsim_trial_row *row)
 {
 	double x = f->value(row);
@@ -149,8 +276,8 @@ double bsim_trial_field_number(const bsim_trial_field *f, const bsim_trial_row *
 		return (double)(long long)x;
 	if (f->kind == BSIM_FIELD_MEASURED && isnan(x))
 		return NAN;
-	char text[32];
-	snprintf(text, sizeof text, "%.10g", x);
+	char text[400]; /* "%.6f" of the largest double: 316 characters */
+	snprintf(text, sizeof text, f->kind == BSIM_FIELD_FIXED ? "%.6f" : "%.10g", x);
 	return strtod(text, NULL);
 }
 
@@ -177,7 +304,27 @@ void bsim_trial_field_write(FILE *out, const bsim_trial_field *f, const bsim_tri
 	case BSIM_FIELD_TEXT:
 		f->text(out, row);
 		return;
+	case BSIM_FIELD_FIXED:
+		fprintf(out, "%.6f", f->value(row));
+		return;
 	}
+}
+
+void bsim_trial_fields_header(FILE *out, const bsim_trial_field *f, int n)
+{
+	for (int c = 0; c < n; c++)
+		fprintf(out, "%s%s", c ? "," : "", f[c].name);
+	fputc('\n', out);
+}
+
+void bsim_trial_fields_line(FILE *out, const bsim_trial_field *f, int n, const bsim_trial_row *row)
+{
+	for (int c = 0; c < n; c++) {
+		if (c)
+			fputc(',', out);
+		bsim_trial_field_write(out, &f[c], row);
+	}
+	fputc('\n', out);
 }
 
 /* ---- the result as it lies in memory (a journal's record) --------------- */
