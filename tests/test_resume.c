@@ -236,6 +236,15 @@ static void test_compare3_killed(void **state)
 	kill_and_resume("compare3", compare3_files);
 }
 
+/* The uninterrupted sweep, into the test directory name (ref its path). */
+static void reference_sweep(char *ref, size_t size, const char *name)
+{
+	const char *argv[16];
+	snprintf(ref, size, "%s", bsim_test_dir(name));
+	command(argv, "sweep", ref, 0);
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+}
+
 /* SIGINT and SIGTERM: a clean stop, the journal kept, the resume line. The
  * signal comes once a trial is journaled: its handler is in place. */
 static void test_signals(void **state)
@@ -244,9 +253,7 @@ static void test_signals(void **state)
 	static const int sigs[] = {SIGINT, SIGTERM};
 	char ref[1200], dir[1200], errfile[1400];
 	const char *argv[16];
-	snprintf(ref, sizeof ref, "%s", bsim_test_dir("signal_ref"));
-	command(argv, "sweep", ref, 0);
-	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	reference_sweep(ref, sizeof ref, "signal_ref");
 	for (int i = 0; i < 2; i++) {
 		char name[32];
 		snprintf(name, sizeof name, "signal_%d", sigs[i]);
@@ -412,9 +419,7 @@ static void test_other_build(void **state)
 	(void)state;
 	char ref[1200], dir[1200], journal[1400];
 	const char *argv[16];
-	snprintf(ref, sizeof ref, "%s", bsim_test_dir("other_build_ref"));
-	command(argv, "sweep", ref, 0);
-	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	reference_sweep(ref, sizeof ref, "other_build_ref");
 	for (int v = 0; v < 2; v++) {
 		snprintf(dir, sizeof dir, "%s",
 		         bsim_test_dir(v ? "other_build_1" : "other_build_2"));
