@@ -131,45 +131,9 @@ static void rows_structs(mxArray *out, const rows *r)
 	bmx_set(out, 0, "ledger_rows", l);
 }
 
-/* A member at v of size bytes as it is, a number (a member of several
- * doubles a row of them); its kind from its type, as run --json gives it. */
-static mxArray *int_mx(const void *v, size_t size)
-{
-	(void)size;
-	return bmx_scalar(*(const int *)v);
-}
-
-static mxArray *ulong_mx(const void *v, size_t size)
-{
-	(void)size;
-	return bmx_scalar((double)*(const unsigned long *)v);
-}
-
-static mxArray *long_mx(const void *v, size_t size)
-{
-	(void)size;
-	return bmx_scalar((double)*(const long *)v);
-}
-
-static mxArray *doubles_mx(const void *v, size_t size)
-{
-	size_t n = size / sizeof(double);
-	return n > 1 ? bmx_row(v, (int)n) : bmx_scalar(*(const double *)v);
-}
-
-/* Member m of the struct at p as the field m of s (beamsim/trial.h's
- * lists); a type not listed does not compile. */
-#define MX_MEMBER(s, p, m)                                                                         \
-	bmx_set(s, 0, #m,                                                                          \
-	        _Generic(&(p)->m,                                                                  \
-	                const int *: int_mx,                                                       \
-	                const unsigned long *: ulong_mx,                                           \
-	                const long *: long_mx,                                                     \
-	                const double *: doubles_mx,                                                \
-	                const double(*)[2]: doubles_mx)(&(p)->m, sizeof(p)->m));
-#define MX_RESULT(m) MX_MEMBER(s, r, m)
-#define MX_LEDGER(m) MX_MEMBER(ledger, &r->ledger, m)
-#define MX_SOLVER(m) MX_MEMBER(solver, &r->solver, m)
+#define MX_RESULT(m) BMX_MEMBER(s, 0, r, m);
+#define MX_LEDGER(m) BMX_MEMBER(ledger, 0, &r->ledger, m);
+#define MX_SOLVER(m) BMX_MEMBER(solver, 0, &r->solver, m);
 
 /* The gates a lattice trial entered, one row each: ix, iy, t, pos, vx, vy
  * (run --json's path), and each beam's peak angle. */

@@ -206,34 +206,17 @@ static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 }
 
 /* What the backend's solvers gave up on (beamsim/state.h). */
+#define JSON_COUNT(m) BSIM_JSON_MEMBER(f, sep, c, m);
+
 static void json_solver(FILE *f, const bsim_solver_counts *c)
 {
-	fprintf(f, ", \"solver\": {\"iteration_limit\": %ld, \"clamped\": %ld}", c->iteration_limit,
-	        c->clamped);
+	const char *sep = "";
+	fputs(", \"solver\": {", f);
+	BSIM_SOLVER_COUNTS(JSON_COUNT)
+	fputc('}', f);
 }
 
-/* How many of a group's trials hit an iteration limit, and a clamp: the
- * trials whose motion is partly the solver's, not the model's. */
-static void json_solver_trials(FILE *f, const bsim_group_result *g)
-{
-	fprintf(f, ", \"trials_iteration_limit\": %d, \"trials_clamped\": %d",
-	        g->trials_iteration_limit, g->trials_clamped);
-}
-
-/* How far a group's bodies turned (a body that rotates): the mean final
- * turn (a bias to one side), the mean and largest of its size, and the
- * largest turn during a trial, rad. */
-static void json_turn(FILE *f, const bsim_group_result *g)
-{
-	const char *names[] = {"turn_end_mean", "turn_end_mean_abs", "turn_end_max_abs",
-	                       "turn_max"};
-	const double values[] = {g->turn_end_mean, g->turn_end_mean_abs, g->turn_end_max_abs,
-	                         g->turn_max};
-	for (int i = 0; i < 4; i++) {
-		fprintf(f, ", \"%s\": ", names[i]);
-		bsim_json_number(f, values[i]);
-	}
-}
+#define JSON_GROUP(m) BSIM_JSON_MEMBER(f, sep, g, m);
 
 static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int group,
                        int *idx)
@@ -241,24 +224,17 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 	const bsim_group_result *g = &r->groups[group];
 	fputs("{\"params\": ", f);
 	json_params(f, e, idx);
-	fprintf(f,
-	        ", \"trials\": %d, \"traversed\": %d, \"side_exit\": %d, \"stuck\": %d, "
-	        "\"left\": %d, \"right\": %d, \"p_traverse\": ",
-	        g->trials, g->traversed, g->side_exit, g->stuck, g->left, g->right);
-	bsim_json_number(f, g->p_traverse);
-	fputs(", \"ci95\": [", f);
-	bsim_json_number(f, g->ci95[0]);
-	fputs(", ", f);
-	bsim_json_number(f, g->ci95[1]);
-	fprintf(f,
-	        "], \"stuck_in_contact\": %d, \"landscape_left\": %d, \"landscape_right\": %d, "
-	        "\"steps\": %ld, \"unstable\": %d, \"deterministic\": %s",
-	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps, g->unstable,
-	        g->deterministic ? "true" : "false");
+	const char *sep = ", ";
+	BSIM_GROUP_RESULT_COUNTS(JSON_GROUP)
+	fprintf(f, ", \"deterministic\": %s", g->deterministic ? "true" : "false");
 	json_solver(f, &g->solver);
-	json_solver_trials(f, g);
-	if (g->rotates)
-		json_turn(f, g);
+	BSIM_GROUP_RESULT_SOLVER_TRIALS(JSON_GROUP)
+	/* how far a group's bodies turned (a body that rotates): the mean
+	 * final turn (a bias to one side), the mean and largest of its size,
+	 * and the largest turn during a trial, rad */
+	if (g->rotates) {
+		BSIM_GROUP_RESULT_TURN(JSON_GROUP)
+	}
 	if (r->lattice)
 		json_lattice(f, r, group);
 	fputc('}', f);

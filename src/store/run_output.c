@@ -27,52 +27,9 @@ bsim_run_info bsim_run_info_default(void)
 	return i;
 }
 
-/* sep, then "name": the value of a member at v of size bytes, as it is:
- * an integer, or a number (a member of several doubles a list of them). */
-static void json_int(FILE *f, const char *sep, const char *name, const void *v, size_t size)
-{
-	(void)size;
-	fprintf(f, "%s\"%s\": %d", sep, name, *(const int *)v);
-}
-
-static void json_ulong(FILE *f, const char *sep, const char *name, const void *v, size_t size)
-{
-	(void)size;
-	fprintf(f, "%s\"%s\": %lu", sep, name, *(const unsigned long *)v);
-}
-
-static void json_long(FILE *f, const char *sep, const char *name, const void *v, size_t size)
-{
-	(void)size;
-	fprintf(f, "%s\"%s\": %ld", sep, name, *(const long *)v);
-}
-
-static void json_doubles(FILE *f, const char *sep, const char *name, const void *v, size_t size)
-{
-	const double *d = v;
-	size_t n = size / sizeof *d;
-	fprintf(f, "%s\"%s\": %s", sep, name, n > 1 ? "[" : "");
-	for (size_t i = 0; i < n; i++) {
-		fputs(i ? ", " : "", f);
-		bsim_json_number(f, d[i]);
-	}
-	fputs(n > 1 ? "]" : "", f);
-}
-
-/* Member m of the struct at s, as it is, after sep, which becomes ", "
- * (beamsim/trial.h's lists); its kind from its type: a type not listed
- * does not compile. */
-#define JSON_MEMBER(s, m)                                                                            \
-	_Generic(&(s)->m,                                                                          \
-	        const int *: json_int,                                                             \
-	        const unsigned long *: json_ulong,                                                 \
-	        const long *: json_long,                                                           \
-	        const double *: json_doubles,                                                      \
-	        const double(*)[2]: json_doubles)(f, sep, #m, &(s)->m, sizeof(s)->m); \
-	sep = ", ";
-#define JSON_RESULT(m) JSON_MEMBER(r, m)
-#define JSON_LEDGER(m) JSON_MEMBER(&r->ledger, m)
-#define JSON_SOLVER(m) JSON_MEMBER(&r->solver, m)
+#define JSON_RESULT(m) BSIM_JSON_MEMBER(f, sep, r, m);
+#define JSON_LEDGER(m) BSIM_JSON_MEMBER(f, sep, &r->ledger, m);
+#define JSON_SOLVER(m) BSIM_JSON_MEMBER(f, sep, &r->solver, m);
 
 /* The final gate and location, the gate path and every beam's peak (the
  * lattice's per-trial data; the path and peaks only with a log). */
