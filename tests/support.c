@@ -501,16 +501,21 @@ long bsim_test_journal_records(const char *path)
 	int fd = open(path, O_RDONLY);
 	if (fd < 0)
 		return -1;
-	/* "BSIMJNL1", u32 record size, u32 inputs length, inputs, u32 CRC;
-	 * then records of u32 magic, u64 index, payload, u32 CRC. */
+	/* "BSIMJNL2", u32 record size, u32 fields length, fields, u32 inputs
+	 * length, inputs, u32 CRC; then records of u32 magic, u64 index,
+	 * payload, u32 CRC. */
 	unsigned char h[16];
 	struct stat st;
 	long n = 0;
-	if (read(fd, h, sizeof h) == (ssize_t)sizeof h && fstat(fd, &st) == 0) {
-		uint32_t size, len;
+	uint32_t size = 0, flen = 0, ilen = 0;
+	int ok = read(fd, h, sizeof h) == (ssize_t)sizeof h && fstat(fd, &st) == 0;
+	if (ok) {
 		memcpy(&size, h + 8, 4);
-		memcpy(&len, h + 12, 4);
-		long header = 16 + (long)len + 4, record = 16 + (long)size;
+		memcpy(&flen, h + 12, 4);
+		ok = pread(fd, &ilen, 4, 16 + (off_t)flen) == 4;
+	}
+	if (ok) {
+		long header = 16 + (long)flen + 4 + (long)ilen + 4, record = 16 + (long)size;
 		if ((long)st.st_size > header)
 			n = ((long)st.st_size - header) / record;
 	}

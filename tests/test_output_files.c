@@ -555,6 +555,60 @@ static void test_docs_trials_columns(void **state)
 	free(doc);
 }
 
+/* docs/lattice.md's row of file in its table of files: the columns it
+ * lists (the second cell, `a,b,...`) against the library's table of them,
+ * every name in order and no other; and the file as a sweep writes it
+ * (header) has that line first. */
+static void docs_lattice_columns(const char *doc, const char *file, const bsim_trial_field *f,
+                                 int n, const char *header)
+{
+	char row[64];
+	snprintf(row, sizeof row, "| `%s` | `", file);
+	const char *at = strstr(doc, row);
+	if (!at)
+		fail_msg("docs/lattice.md: no row for %s", file);
+	at += strlen(row);
+	size_t len = strcspn(at, "`");
+	char want[512] = "";
+	for (int k = 0; k < n; k++) {
+		strncat(want, k ? "," : "", sizeof want - strlen(want) - 1);
+		strncat(want, f[k].name, sizeof want - strlen(want) - 1);
+	}
+	if (len != strlen(want) || strncmp(at, want, len) != 0)
+		fail_msg("docs/lattice.md: %s's columns are %.*s, the library's %s", file, (int)len,
+		         at, want);
+	if (strncmp(header, want, strlen(want)) != 0 || header[strlen(want)] != '\n')
+		fail_msg("%s's header is not the library's columns %s", file, want);
+}
+
+/* The lattice's per-trial files, gate_entries.csv (the gate paths) and
+ * beam_peaks.csv, are described once (beamsim/trial_fields.h): the
+ * columns docs/lattice.md lists and a lattice sweep's files against those
+ * descriptions. */
+static void test_docs_lattice_columns(void **state)
+{
+	(void)state;
+	char *doc = bsim_test_read(bsim_test_src("docs/lattice.md"));
+	assert_non_null(doc);
+	const char *dir = bsim_test_dir("lattice_columns");
+	const char *argv[] = {"sweep",    bsim_test_src("configs/markov/c_track.yaml"),
+	                      "--trials", "1",
+	                      "--quiet",  "--out",
+	                      dir,        NULL};
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	static const char *const files[] = {"gate_entries.csv", "beam_peaks.csv"};
+	for (int i = 0; i < 2; i++) {
+		int n;
+		const bsim_trial_field *f =
+		        i ? bsim_beam_peak_fields(&n) : bsim_gate_entry_fields(&n);
+		char *text = bsim_test_read(bsim_test_join(dir, files[i]));
+		assert_non_null(text);
+		docs_lattice_columns(doc, files[i], f, n, text);
+		free(text);
+	}
+	free(doc);
+}
+
 /* The reader's column indices (store/trials_csv.h) against the library's
  * table (beamsim/trial_fields.h), which gives each index its name: an
  * index out of step with the table would read one column as another. */
@@ -616,6 +670,7 @@ int main(void)
 	        cmocka_unit_test(test_manifest_check),
 	        cmocka_unit_test(test_figures_join_the_set),
 	        cmocka_unit_test(test_docs_trials_columns),
+	        cmocka_unit_test(test_docs_lattice_columns),
 	        cmocka_unit_test(test_trials_csv_indices),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);

@@ -10,7 +10,9 @@
  * other inputs, or without a run to resume, is refused. Every kill and
  * signal waits on what the program does (its journal, its staging area),
  * never on time: the program installs its SIGINT and SIGTERM handlers
- * before it creates the journal. */
+ * before it creates the journal. A stopped run's journal written by another
+ * build (records of other fields, or the format before the journal named
+ * them) is refused by name and left as it was. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <setjmp.h>
@@ -24,6 +26,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <zlib.h>
 
 #include "store/outdir.h"
 #include "support.h"
@@ -232,6 +236,15 @@ static void test_compare3_killed(void **state)
 	kill_and_resume("compare3", compare3_files);
 }
 
+/* The uninterrupted sweep, into the test directory name (ref its path). */
+static void reference_sweep(char *ref, size_t size, const char *name)
+{
+	const char *argv[16];
+	snprintf(ref, size, "%s", bsim_test_dir(name));
+	command(argv, "sweep", ref, 0);
+	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+}
+
 /* SIGINT and SIGTERM: a clean stop, the journal kept, the resume line. The
  * signal comes once a trial is journaled: its handler is in place. */
 static void test_signals(void **state)
@@ -240,9 +253,7 @@ static void test_signals(void **state)
 	static const int sigs[] = {SIGINT, SIGTERM};
 	char ref[1200], dir[1200], errfile[1400];
 	const char *argv[16];
-	snprintf(ref, sizeof ref, "%s", bsim_test_dir("signal_ref"));
-	command(argv, "sweep", ref, 0);
-	assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
+	reference_sweep(ref, sizeof ref, "signal_ref");
 	for (int i = 0; i < 2; i++) {
 		char name[32];
 		snprintf(name, sizeof name, "signal_%d", sigs[i]);
@@ -322,6 +333,144 @@ static void test_refusals(void **state)
 	free(err);
 }
 
+/* The whole file at path, *n its bytes (a journal is binary). */
+static unsigned char *read_bytes(const char *path, long *n)
+{
+	FILE *f = fopen(path, "rb");
+	assert_non_null(f);
+	fseek(f, 0, SEEK_END);
+	*n = ftell(f);
+	rewind(f);
+	unsigned char *b = malloc((size_t)*n + 1);
+	assert_non_null(b);
+	assert_int_equal(fread(b, 1, (size_t)*n, f), (size_t)*n);
+	fclose(f);
+	return b;
+}
+
+/* The journal j (format 2, util/journal.h) written again at path with
+ * fields (NULL: in format 1, without them) and its own inputs and
+ * records. */
+static void journal_rewrite(const unsigned char *j, long n, const char *path, const char *fields)
+{
+	uint32_t fl, il;
+	memcpy(&fl, j + 12, 4);
+	memcpy(&il, j + 16 + fl, 4);
+	const unsigned char *inputs = j + 20 + fl;
+	long records = 20 + (long)fl + (long)il + 4;
+	uint32_t nf = fields ? (uint32_t)strlen(fields) : 0;
+	unsigned char *h = malloc(24 + nf + il);
+	assert_non_null(h);
+	memcpy(h, fields ? "BSIMJNL2" : "BSIMJNL1", 8);
+	memcpy(h + 8, j + 8, 4); /* the record size */
+	size_t at = 12;
+	if (fields) {
+		memcpy(h + at, &nf, 4);
+		memcpy(h + at + 4, fields, nf);
+		at += 4 + nf;
+	}
+	memcpy(h + at, &il, 4);
+	memcpy(h + at + 4, inputs, il);
+	at += 4 + il;
+	uint32_t crc = (uint32_t)crc32(0L, h, (uInt)at);
+	memcpy(h + at, &crc, 4);
+	FILE *f = fopen(path, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(h, 1, at + 4, f), at + 4);
+	assert_int_equal(fwrite(j + records, 1, (size_t)(n - records), f), (size_t)(n - records));
+	assert_int_equal(fclose(f), 0);
+	free(h);
+}
+
+/* --resume of a journal another build wrote: exit 2, one line naming the
+ * journal and what differs, the journal as it was; then --overwrite runs
+ * the sweep anew, as if never stopped. */
+static void refused_then_overwritten(const char *dir, const char *journal, const char *ref,
+                                     const char *const *want)
+{
+	const char *argv[16];
+	long n0, n1;
+	unsigned char *before = read_bytes(journal, &n0);
+	command(argv, "sweep", dir, 1);
+	char *err = NULL;
+	int rc = bsim_test_cli(argv, NULL, &err);
+	assert_int_equal(rc, 2);
+	for (int i = 0; want[i]; i++)
+		if (!strstr(err, want[i]))
+			fail_msg("expected \"%s\" in: %s", want[i], err);
+	assert_non_null(strstr(err, journal));
+	assert_int_equal(strcspn(err, "\n"), strlen(err) - 1); /* one line */
+	free(err);
+	unsigned char *after = read_bytes(journal, &n1);
+	assert_int_equal(n1, n0);
+	assert_memory_equal(after, before, (size_t)n0);
+	free(before);
+	free(after);
+	const char *over[] = {"sweep", experiment, "--quiet", "--out", dir, "--overwrite", NULL};
+	assert_int_equal(bsim_test_cli(over, NULL, NULL), 0);
+	same_files(ref, dir, (const char *const[]){"trials.csv", NULL});
+}
+
+/* A stopped sweep's journal as another build would have left it: one of
+ * its records' fields other (x_end's kind), or in format 1, the format
+ * before the journal named its fields. Each is refused by name. */
+static void test_other_build(void **state)
+{
+	(void)state;
+	char ref[1200], dir[1200], journal[1400];
+	const char *argv[16];
+	reference_sweep(ref, sizeof ref, "other_build_ref");
+	for (int v = 0; v < 2; v++) {
+		snprintf(dir, sizeof dir, "%s",
+		         bsim_test_dir(v ? "other_build_1" : "other_build_2"));
+		snprintf(journal, sizeof journal, "%s", bsim_test_join(dir, ".beamsim/journal"));
+		command(argv, "sweep", dir, 0);
+		int pid = bsim_test_spawn(argv), rc = 0;
+		if (bsim_test_await_records(pid, journal, 1, &rc)) {
+			kill(pid, SIGINT);
+			rc = bsim_test_wait(pid);
+		}
+		if (rc == 0) {
+			print_message("the sweep finished before the signal\n");
+			continue;
+		}
+		assert_int_equal(rc, 128 + SIGINT);
+		long n;
+		unsigned char *j = read_bytes(journal, &n);
+		assert_memory_equal(j, "BSIMJNL2", 8);
+		uint32_t fl;
+		memcpy(&fl, j + 12, 4);
+		char *fields = strndup((const char *)j + 16, fl);
+		char *x = strstr(fields, "\nx_end double ");
+		assert_non_null(x);
+		char line[64];
+		snprintf(line, sizeof line, "%.*s", (int)strcspn(x + 1, "\n"), x + 1);
+		if (v == 0) {
+			/* x_end a long, where this build has a double */
+			char *other = malloc(strlen(fields) + 8);
+			snprintf(other, strlen(fields) + 8, "%.*sx_end long %s",
+			         (int)(x + 1 - fields), fields, x + 1 + strlen("x_end double "));
+			journal_rewrite(j, n, journal, other);
+			char then[80], now[80];
+			snprintf(then, sizeof then, "\"x_end long %s\" then",
+			         line + strlen("x_end double "));
+			snprintf(now, sizeof now, "\"%s\" now", line);
+			refused_then_overwritten(
+			        dir, journal, ref,
+			        (const char *const[]){"records of other fields", then, now, NULL});
+			free(other);
+		} else {
+			journal_rewrite(j, n, journal, NULL);
+			refused_then_overwritten(
+			        dir, journal, ref,
+			        (const char *const[]){"--resume", "a journal of format 1",
+			                              "this build reads format 2", NULL});
+		}
+		free(fields);
+		free(j);
+	}
+}
+
 /* Regression: an experiment without seed: run with --seed N said "seed:
  * missing". The seed given stands in for it: the sweep is the one of the
  * same experiment with seed: N in the file, trials.csv byte for byte,
@@ -369,6 +518,7 @@ int main(void)
 	        cmocka_unit_test(test_sweep_killed),    cmocka_unit_test(test_compare_killed),
 	        cmocka_unit_test(test_compare3_killed), cmocka_unit_test(test_signals),
 	        cmocka_unit_test(test_refusals),        cmocka_unit_test(test_seed_beside_file),
+	        cmocka_unit_test(test_other_build),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }

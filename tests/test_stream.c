@@ -156,7 +156,9 @@ static void resumed_from_the_journal(void **state)
 	size_t size = bsim_sweep_record_size(0);
 	bsim_journal *j;
 	bsim_error err;
-	assert_int_equal(bsim_journal_create(&j, path, "stream test\n", size, &err), BSIM_OK);
+	assert_int_equal(bsim_journal_create(&j, path, bsim_trial_record_fields(), "stream test\n",
+	                                     size, &err),
+	                 BSIM_OK);
 	long cut = 0, kept = 0;
 	assert_int_equal(bsim_journal_replay(j, NULL, NULL, &kept, &cut, &err), BSIM_OK);
 
@@ -180,7 +182,9 @@ static void resumed_from_the_journal(void **state)
 	assert_int_equal(bsim_journal_close(j, &err), BSIM_OK);
 
 	/* Resumed: every trial streamed once, the same as in memory. */
-	assert_int_equal(bsim_journal_resume(&j, path, "stream test\n", size, &err), BSIM_OK);
+	assert_int_equal(bsim_journal_resume(&j, path, bsim_trial_record_fields(), "stream test\n",
+	                                     size, &err),
+	                 BSIM_OK);
 	seen s2 = {0};
 	cfg = bsim_sweep_config_default();
 	cfg.sink = take;

@@ -131,20 +131,9 @@ static void rows_structs(mxArray *out, const rows *r)
 	bmx_set(out, 0, "ledger_rows", l);
 }
 
-static mxArray *ledger_struct(const bsim_ledger *l)
-{
-	mxArray *s = mxCreateStructMatrix(1, 1, 0, NULL);
-	const char *names[] = {"e_start",  "e_end",        "w_prop",       "w_rand", "damper",
-	                       "impact",   "contact",      "correction",   "sleep",  "reset",
-	                       "residual", "residual_max", "residual_abs", "inflow"};
-	const double values[] = {l->e_start,      l->e_end,  l->w_prop,   l->w_rand,
-	                         l->damper,       l->impact, l->contact,  l->correction,
-	                         l->sleep,        l->reset,  l->residual, l->residual_max,
-	                         l->residual_abs, l->inflow};
-	for (size_t i = 0; i < sizeof values / sizeof values[0]; i++)
-		bmx_set(s, 0, names[i], bmx_scalar(values[i]));
-	return s;
-}
+#define MX_RESULT(m) BMX_MEMBER(s, 0, r, m);
+#define MX_LEDGER(m) BMX_MEMBER(ledger, 0, &r->ledger, m);
+#define MX_SOLVER(m) BMX_MEMBER(solver, 0, &r->solver, m);
 
 /* The gates a lattice trial entered, one row each: ix, iy, t, pos, vx, vy
  * (run --json's path), and each beam's peak angle. */
@@ -205,20 +194,7 @@ static mxArray *result_struct(const bsim_replay *rp, const bsim_backend *b,
 	bmx_set(s, 0, "outcome", bmx_string(bsim_trial_outcome_name(r->outcome)));
 	bmx_set(s, 0, "type", bmx_string(bsim_trial_type_name(r->type)));
 	bmx_set(s, 0, "landscape_beam", bmx_scalar(r->landscape_beam + 1));
-	bmx_set(s, 0, "in_contact_end", bmx_scalar(r->in_contact_end));
-	bmx_set(s, 0, "steps", bmx_scalar(r->steps));
-	bmx_set(s, 0, "steps_run", bmx_scalar(r->steps_run));
-	bmx_set(s, 0, "draws", bmx_scalar((double)r->draws));
-	bmx_set(s, 0, "t_end", bmx_scalar(r->t_end));
-	bmx_set(s, 0, "x_end", bmx_scalar(r->x_end));
-	bmx_set(s, 0, "y_end", bmx_scalar(r->y_end));
-	bmx_set(s, 0, "vx_end", bmx_scalar(r->vx_end));
-	bmx_set(s, 0, "heading_end", bmx_scalar(r->heading_end));
-	bmx_set(s, 0, "angular_velocity_end", bmx_scalar(r->angular_velocity_end));
-	bmx_set(s, 0, "turn_end", bmx_scalar(r->turn_end));
-	bmx_set(s, 0, "turn_max", bmx_scalar(r->turn_max));
-	bmx_set(s, 0, "max_theta", bmx_row(r->max_theta, 2));
-	bmx_set(s, 0, "overlap_max", bmx_scalar(r->overlap_max));
+	BSIM_TRIAL_RESULT_PLAIN(MX_RESULT)
 	const double gate[2] = {r->final_ix, r->final_iy};
 	bmx_set(s, 0, "final_gate", bmx_row(gate, 2));
 	char label[48];
@@ -226,10 +202,11 @@ static mxArray *result_struct(const bsim_replay *rp, const bsim_backend *b,
 	bmx_set(s, 0, "location", bmx_string(label));
 	bmx_set(s, 0, "reset_overlaps", bmx_scalar(r->reset_overlaps));
 	path_fields(s, log);
-	bmx_set(s, 0, "ledger", ledger_struct(&r->ledger));
+	mxArray *ledger = mxCreateStructMatrix(1, 1, 0, NULL);
+	BSIM_LEDGER_SHOWN(MX_LEDGER)
+	bmx_set(s, 0, "ledger", ledger);
 	mxArray *solver = mxCreateStructMatrix(1, 1, 0, NULL);
-	bmx_set(solver, 0, "iteration_limit", bmx_scalar((double)r->solver.iteration_limit));
-	bmx_set(solver, 0, "clamped", bmx_scalar((double)r->solver.clamped));
+	BSIM_SOLVER_COUNTS(MX_SOLVER)
 	bmx_set(s, 0, "solver", solver);
 	char why[256] = "";
 	if (r->instability)

@@ -90,8 +90,11 @@ static int columns_block(void *user, const bsim_sweep_block *b, bsim_error *err)
 	for (long k = 0; k < b->n && !c->oom; k++) {
 		size_t at = (size_t)(b->first + k);
 		const bsim_trial_row row = {(int)(at / (size_t)c->trials),
-		                            (int)(at % (size_t)c->trials), &b->results[k],
-		                            b->logs ? &b->logs[k] : NULL};
+		                            (int)(at % (size_t)c->trials),
+		                            &b->results[k],
+		                            b->logs ? &b->logs[k] : NULL,
+		                            0,
+		                            NULL};
 		for (int i = 0; i < c->n_fields && !c->oom; i++) {
 			const bsim_trial_field *f = &c->field[i];
 			if (f->kind == BSIM_FIELD_TEXT) {
@@ -223,6 +226,11 @@ static void trials_fields(mxArray *s, trial_columns *c)
 	bmx_set(s, 0, "labels", l);
 }
 
+/* A member of group g (beamsim/sweep.h's lists) as field of element i of
+ * s, or of its solver's counts. */
+#define MX_GROUP(m)  BMX_MEMBER(s, i, g, m);
+#define MX_SOLVER(m) BMX_MEMBER(solver, 0, &g->solver, m);
+
 static mxArray *groups_struct(const bsim_experiment *e, const bsim_sweep_result *r)
 {
 	mxArray *s = mxCreateStructMatrix((mwSize)r->n_groups, 1, 0, NULL);
@@ -242,50 +250,14 @@ static mxArray *groups_struct(const bsim_experiment *e, const bsim_sweep_result 
 			bmx_set(params, 0, field, isnan(x) ? bmx_string(text) : bmx_scalar(x));
 		}
 		bmx_set(s, i, "params", params);
-		const char *names[] = {"trials",
-		                       "traversed",
-		                       "side_exit",
-		                       "stuck",
-		                       "left",
-		                       "right",
-		                       "p_traverse",
-		                       "stuck_in_contact",
-		                       "landscape_left",
-		                       "landscape_right",
-		                       "steps",
-		                       "unstable",
-		                       "trials_iteration_limit",
-		                       "trials_clamped"};
-		const double values[] = {g->trials,
-		                         g->traversed,
-		                         g->side_exit,
-		                         g->stuck,
-		                         g->left,
-		                         g->right,
-		                         g->p_traverse,
-		                         g->stuck_in_contact,
-		                         g->landscape_left,
-		                         g->landscape_right,
-		                         (double)g->steps,
-		                         g->unstable,
-		                         g->trials_iteration_limit,
-		                         g->trials_clamped};
-		for (size_t f = 0; f < sizeof values / sizeof values[0]; f++) {
-			bmx_set(s, i, names[f], bmx_scalar(values[f]));
-			if (strcmp(names[f], "p_traverse") == 0)
-				bmx_set(s, i, "ci95", bmx_row(g->ci95, 2));
-		}
+		BSIM_GROUP_RESULT_COUNTS(MX_GROUP)
+		BSIM_GROUP_RESULT_SOLVER_TRIALS(MX_GROUP)
 		bmx_set(s, i, "deterministic", mxCreateLogicalScalar(g->deterministic != 0));
 		if (g->rotates) { /* summary.json's turn, where the body rotates */
-			bmx_set(s, i, "turn_end_mean", bmx_scalar(g->turn_end_mean));
-			bmx_set(s, i, "turn_end_mean_abs", bmx_scalar(g->turn_end_mean_abs));
-			bmx_set(s, i, "turn_end_max_abs", bmx_scalar(g->turn_end_max_abs));
-			bmx_set(s, i, "turn_max", bmx_scalar(g->turn_max));
+			BSIM_GROUP_RESULT_TURN(MX_GROUP)
 		}
 		mxArray *solver = mxCreateStructMatrix(1, 1, 0, NULL);
-		bmx_set(solver, 0, "iteration_limit",
-		        bmx_scalar((double)g->solver.iteration_limit));
-		bmx_set(solver, 0, "clamped", bmx_scalar((double)g->solver.clamped));
+		BSIM_SOLVER_COUNTS(MX_SOLVER)
 		bmx_set(s, i, "solver", solver);
 	}
 	free(idx);

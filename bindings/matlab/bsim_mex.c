@@ -725,3 +725,27 @@ void bmx_fail(const bsim_error *err)
 	                                               : "beamsim:failed";
 	mexErrMsgIdAndTxt(id, "%s", err->msg[0] ? err->msg : "failed");
 }
+
+mxArray *bmx_member_int(const void *v, size_t size)
+{
+	(void)size;
+	return bmx_scalar(*(const int *)v);
+}
+
+mxArray *bmx_member_long(const void *v, size_t size)
+{
+	(void)size;
+	return bmx_scalar((double)*(const long *)v);
+}
+
+mxArray *bmx_member_ulong(const void *v, size_t size)
+{
+	(void)size;
+	return bmx_scalar((double)*(const unsigned long *)v);
+}
+
+mxArray *bmx_member_doubles(const void *v, size_t size)
+{
+	size_t n = size / sizeof(double);
+	return n > 1 ? bmx_row(v, (int)n) : bmx_scalar(*(const double *)v);
+}

@@ -84,6 +84,24 @@ mxArray *bmx_row(const double *x, int n);
 /* An n x 1 double column; *data its values. */
 mxArray *bmx_column(size_t n, double **data);
 
+/* A member of a struct as it is, at v of size bytes: a number (several
+ * doubles a row of them), as run --json and summary.json give it. */
+mxArray *bmx_member_int(const void *v, size_t size);
+mxArray *bmx_member_long(const void *v, size_t size);
+mxArray *bmx_member_ulong(const void *v, size_t size);
+mxArray *bmx_member_doubles(const void *v, size_t size);
+/* Member m of the struct at p as the field m of element i of s (an
+ * X-macro's list names it, beamsim/trial.h, sweep.h); its kind from its
+ * type: a type not listed does not compile. */
+#define BMX_MEMBER(s, i, p, m)                                                                     \
+	bmx_set(s, i, #m,                                                                          \
+	        _Generic(&(p)->m,                                                                  \
+	                const int *: bmx_member_int,                                               \
+	                const long *: bmx_member_long,                                             \
+	                const unsigned long *: bmx_member_ulong,                                   \
+	                const double *: bmx_member_doubles,                                        \
+	                const double(*)[2]: bmx_member_doubles)(&(p)->m, sizeof(p)->m))
+
 /* Distinct texts, each kept once, in order of first appearance: the
  * labels of a text column whose rows are codes from 1 into them, so that a
  * column of a million trials holds a code a row, not a char array. */

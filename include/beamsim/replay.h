@@ -136,9 +136,11 @@ BSIM_API int bsim_replay_run(const bsim_replay *r, const bsim_backend *backend,
 /* The stored trials.csv row of a stored run's trial; NULL for any other. */
 BSIM_API const bsim_trial_result *bsim_replay_stored_row(const bsim_replay *r);
 
-/* The fields of a trials.csv row that say what happened to a trial
- * (group,trial,outcome,type,steps,t_end,x_end,y_end), written as the sweep
- * writes them: two results are the same trial's if these are equal. */
+/* The fields of a trials.csv row that say what happened to a trial, its
+ * first BSIM_REPLAY_ROW_FIELDS (beamsim/trial_fields.h: group, trial,
+ * outcome, type, steps, t_end, x_end, y_end), written as the sweep writes
+ * them: two results are the same trial's if these are equal. */
+#define BSIM_REPLAY_ROW_FIELDS 8
 BSIM_API void bsim_replay_row(char *buf, size_t size, long group, long trial,
                               const bsim_trial_result *x);
 

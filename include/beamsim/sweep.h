@@ -47,6 +47,29 @@ typedef struct bsim_group_result {
 	double turn_end_mean, turn_end_mean_abs, turn_end_max_abs, turn_max;
 } bsim_group_result;
 
+/* The members summary.json and MATLAB's beamsim_sweep give of each group
+ * as they are, by their names, named once here as X-macros (X(member)): the
+ * counts, in this order (ci95 a pair); the trials the solver gave up on;
+ * the turn, where the body rotates. deterministic, solver, rotates they
+ * give in a form of their own. */
+#define BSIM_GROUP_RESULT_COUNTS(X)                                                                \
+	X(trials)                                                                                  \
+	X(traversed)                                                                               \
+	X(side_exit)                                                                               \
+	X(stuck)                                                                                   \
+	X(left)                                                                                    \
+	X(right)                                                                                   \
+	X(p_traverse)                                                                              \
+	X(ci95)                                                                                    \
+	X(stuck_in_contact)                                                                        \
+	X(landscape_left)                                                                          \
+	X(landscape_right)                                                                         \
+	X(steps)                                                                                   \
+	X(unstable)
+#define BSIM_GROUP_RESULT_SOLVER_TRIALS(X) X(trials_iteration_limit) X(trials_clamped)
+#define BSIM_GROUP_RESULT_TURN(X)                                                                  \
+	X(turn_end_mean) X(turn_end_mean_abs) X(turn_end_max_abs) X(turn_max)
+
 /* Consecutive trials of a sweep, handed to a sink (bsim_sweep_config.sink)
  * in index order: trial first + k is results[k], with its gate path and
  * peaks in logs[k]. Valid only during the call. */

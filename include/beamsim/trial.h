@@ -131,6 +131,62 @@ typedef struct bsim_trial_result {
 	double heading_end, angular_velocity_end, turn_end, turn_max;
 } bsim_trial_result;
 
+/* Every member of bsim_trial_result named once, as X-macros (X(member)),
+ * so that what lists them is made from here: a journal's header (beamsim/
+ * trial_fields.h: bsim_trial_members), `run --json` and MATLAB's
+ * beamsim_run. A member added to the struct goes into one of them
+ * (test_journal fails on a member in none).
+ *
+ * The members run --json and beamsim_run give as they are, by name, in
+ * this order (a number each; max_theta a pair): */
+#define BSIM_TRIAL_RESULT_PLAIN(X)                                                                 \
+	X(in_contact_end)                                                                          \
+	X(steps)                                                                                   \
+	X(steps_run)                                                                               \
+	X(draws)                                                                                   \
+	X(t_end)                                                                                   \
+	X(x_end)                                                                                   \
+	X(y_end)                                                                                   \
+	X(vx_end)                                                                                  \
+	X(heading_end)                                                                             \
+	X(angular_velocity_end)                                                                    \
+	X(turn_end)                                                                                \
+	X(turn_max)                                                                                \
+	X(max_theta)                                                                               \
+	X(overlap_max)
+/* the others, which they give in a form of their own (outcome and type as
+ * words, the beam from 1, the final gate with its label, the instability
+ * as a text) or not at all: */
+#define BSIM_TRIAL_RESULT_OTHER(X)                                                                 \
+	X(outcome)                                                                                 \
+	X(type)                                                                                    \
+	X(landscape_beam)                                                                          \
+	X(instability)                                                                             \
+	X(unstable_step)                                                                           \
+	X(final_ix)                                                                                \
+	X(final_iy)                                                                                \
+	X(gates_entered)                                                                           \
+	X(reset_overlaps)
+/* the ledger's terms they give, in this order, then those they leave out: */
+#define BSIM_LEDGER_SHOWN(X)                                                                       \
+	X(e_start)                                                                                 \
+	X(e_end)                                                                                   \
+	X(w_prop)                                                                                  \
+	X(w_rand)                                                                                  \
+	X(damper)                                                                                  \
+	X(impact)                                                                                  \
+	X(contact)                                                                                 \
+	X(correction)                                                                              \
+	X(sleep)                                                                                   \
+	X(reset)                                                                                   \
+	X(residual)                                                                                \
+	X(residual_max)                                                                            \
+	X(residual_abs)                                                                            \
+	X(inflow)
+#define BSIM_LEDGER_OTHER(X) X(drag) X(w_osc) X(friction)
+/* the solver's counts (bsim_solver_counts, beamsim/state.h), all given: */
+#define BSIM_SOLVER_COUNTS(X) X(iteration_limit) X(clamped)
+
 /* Which edge of a gate the body crossed to enter it. */
 typedef enum {
 	BSIM_EDGE_START = 0,  /* the gate the trial starts in */

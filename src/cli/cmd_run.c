@@ -14,6 +14,7 @@
 #include "beamsim/run_output.h"
 #include "beamsim/schedule.h"
 #include "beamsim/trial.h"
+#include "beamsim/trial_fields.h"
 #include "beamsim/lattice_outcome.h"
 #include "beamsim/limits.h"
 #include "cli/cli_wrote.h"
@@ -219,10 +220,12 @@ static void print_text(FILE *out, const run_args *a, const bsim_replay *rp, uint
 	if (rp->kind != BSIM_REPLAY_SCENE) {
 		char row[256];
 		bsim_replay_row(row, sizeof row, a->group, a->trial, r);
-		fprintf(out,
-		        "row         %s (trials.csv: group,trial,outcome,type,steps,t_end,"
-		        "x_end,y_end)\n",
-		        row);
+		int n;
+		const bsim_trial_field *f = bsim_trial_fields(&n);
+		fprintf(out, "row         %s (trials.csv: ", row);
+		for (int c = 0; c < BSIM_REPLAY_ROW_FIELDS && c < n; c++)
+			fprintf(out, "%s%s", c ? "," : "", f[c].name);
+		fputs(")\n", out);
 	}
 }
 

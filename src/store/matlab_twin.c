@@ -19,6 +19,7 @@
 #include "store/mat.h"
 #include "util/yaml_doc.h"
 #include "beamsim/limits.h"
+#include "beamsim/trial_fields.h"
 
 /* ---- an arena of allocations freed together -------------------------- */
 
@@ -463,6 +464,195 @@ int bsim_matlab_from_csv(const char *csv_path, const char *mat_path, const char 
 	}
 	twin_free(&t);
 	return rc;
+}
+
+/* ---- trials.csv's twin from the trials ---------------------------------- */
+
+/* A column of trials.csv's twin: a field of the table, or a grid axis (a
+ * CSV column, or one the CSV lacks, added as group_params adds it). */
+typedef struct trials_col {
+	const bsim_trial_field *field; /* NULL: an axis */
+	int axis;
+	int param; /* an axis the CSV lacks: numbers by strtod, as group_params */
+} trials_col;
+
+struct bsim_matlab_trials {
+	twin_table t;
+	trials_col *col;
+	const bsim_experiment *e;
+	int *idx; /* the group's axis indices */
+	size_t cap;
+	FILE *m; /* a text field's stream, its text in buf */
+	char *buf;
+	size_t size;
+	int oom;
+};
+
+/* 1 if name is one of the first n names of t. */
+static int has_name(const twin_table *t, int n, const char *name)
+{
+	for (int c = 0; c < n; c++)
+		if (strcmp(t->names[c], name) == 0)
+			return 1;
+	return 0;
+}
+
+bsim_matlab_trials *bsim_matlab_trials_open(const bsim_experiment *e, int axes)
+{
+	bsim_matlab_trials *w = calloc(1, sizeof *w);
+	int n_fields;
+	const bsim_trial_field *f = bsim_trial_fields(&n_fields);
+	int n = n_fields + e->n_axes;
+	if (!w)
+		return NULL;
+	twin_table *t = &w->t;
+	w->e = e;
+	t->names = arena_alloc(&t->a, (size_t)n * sizeof *t->names);
+	t->cols = calloc((size_t)n, sizeof *t->cols);
+	w->col = calloc((size_t)n, sizeof *w->col);
+	w->idx = calloc((size_t)(e->n_axes ? e->n_axes : 1), sizeof *w->idx);
+	w->m = open_memstream(&w->buf, &w->size);
+	if (!t->names || !t->cols || !w->col || !w->idx || !w->m) {
+		bsim_matlab_trials_free(w);
+		return NULL;
+	}
+	for (int c = 0; c < n_fields; c++) {
+		t->names[t->n_cols] = f[c].name;
+		t->cols[t->n_cols].text =
+		        f[c].kind == BSIM_FIELD_WORD || f[c].kind == BSIM_FIELD_TEXT;
+		w->col[t->n_cols++].field = &f[c];
+	}
+	/* the CSV's axes, then those it lacks and names no column for */
+	for (int a = 0; a < e->n_axes; a++) {
+		int param = a >= axes;
+		if (param && has_name(t, n_fields + axes, e->axes[a].key))
+			continue;
+		t->names[t->n_cols] = e->axes[a].key;
+		t->cols[t->n_cols].text = 1;
+		w->col[t->n_cols++] = (trials_col){NULL, a, param};
+	}
+	return w;
+}
+
+/* Column c's cell of row: a number, or its text (interned or static). */
+static void trials_cell(bsim_matlab_trials *w, int c, long r, const bsim_trial_row *row)
+{
+	twin_col *col = &w->t.cols[c];
+	const trials_col *tc = &w->col[c];
+	const bsim_trial_field *f = tc->field;
+	if (!f) {
+		col->s[r] = w->e->axes[tc->axis].values[w->idx[tc->axis]];
+	} else if (!col->text) {
+		col->v[r] = bsim_trial_field_number(f, row);
+	} else if (f->kind == BSIM_FIELD_WORD) {
+		int k = (int)f->value(row);
+		col->s[r] = k >= 0 && k < f->n_words ? f->words[k] : "?";
+	} else {
+		rewind(w->m);
+		bsim_trial_field_write(w->m, f, row);
+		w->oom |= fputc('\0', w->m) == EOF || fflush(w->m) != 0;
+		if (!w->oom && !(col->s[r] = intern_str(&w->t.a, &w->t.in, w->buf)))
+			w->oom = 1;
+	}
+}
+
+void bsim_matlab_trials_rows(bsim_matlab_trials *w, long first, long n, int trials,
+                             const bsim_trial_result *results, const bsim_trial_log *logs)
+{
+	twin_table *t = &w->t;
+	const double limit = bsim_limits_get()->mat_rows;
+	for (long k = 0; k < n && !w->oom; k++) {
+		long r = t->n_rows++;
+		/* A table over the limit keeps nothing: its rows are only counted. */
+		if (!t->over && (double)t->n_rows > limit) {
+			t->over = 1;
+			twin_drop(t);
+		}
+		if (t->over)
+			continue;
+		if ((size_t)r == w->cap) {
+			w->cap = w->cap ? 2 * w->cap : 16;
+			if (twin_grow(t, w->cap) != 0) {
+				w->oom = 1;
+				break;
+			}
+		}
+		int g = (int)((first + k) / trials);
+		const bsim_trial_row row = {g,           (int)((first + k) % trials),
+		                            &results[k], logs ? &logs[k] : NULL,
+		                            0,           NULL};
+		if (w->e->n_axes)
+			bsim_experiment_group_index(w->e, g, w->idx);
+		for (int c = 0; c < t->n_cols && !w->oom; c++)
+			trials_cell(w, c, r, &row);
+	}
+}
+
+/* A text column as a reading of the CSV gives it: numbers if every cell
+ * is one or empty (NaN), as twin_cell decides; an axis the CSV lacks:
+ * numbers if every value of the axis is one, as group_params decides. */
+static int trials_numbers(bsim_matlab_trials *w, int c)
+{
+	twin_col *col = &w->t.cols[c];
+	const trials_col *tc = &w->col[c];
+	long n = w->t.n_rows;
+	double x;
+	int numeric = 1;
+	if (tc->param) {
+		const bsim_grid_axis *ax = &w->e->axes[tc->axis];
+		for (int i = 0; i < ax->n_values && numeric; i++) {
+			char *end;
+			strtod(ax->values[i], &end);
+			numeric = end != ax->values[i] && *end == '\0';
+		}
+	}
+	for (long r = 0; r < n && numeric && !tc->param; r++)
+		numeric = !*col->s[r] || bsim_csv_number(col->s[r], &x) == 0;
+	if (!numeric)
+		return 0;
+	double *v = malloc((size_t)(n ? n : 1) * sizeof *v);
+	if (!v)
+		return -1;
+	for (long r = 0; r < n; r++)
+		v[r] = tc->param                             ? strtod(col->s[r], NULL)
+		       : bsim_csv_number(col->s[r], &x) == 0 ? x
+		                                             : NAN;
+	free(col->s);
+	col->s = NULL;
+	col->v = v;
+	col->text = 0;
+	return 0;
+}
+
+int bsim_matlab_trials_write(bsim_matlab_trials *w, const char *csv_path, bsim_error *err)
+{
+	char mat[BSIM_PATH_MAX];
+	twin_table *t = &w->t;
+	if (bsim_matlab_path(csv_path, mat, sizeof mat, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	bsim_error_clear(err);
+	if (!w->oom && t->over)
+		return twin_skip(csv_path, mat, t, err);
+	for (int c = 0; c < t->n_cols && !w->oom; c++)
+		if (t->cols[c].text && trials_numbers(w, c) != 0)
+			w->oom = 1;
+	bsim_mat_field *f = w->oom ? NULL : twin_fields(t, 0);
+	if (!f)
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %s", mat);
+	return write_var(mat, "trials", f, t->n_cols, err);
+}
+
+void bsim_matlab_trials_free(bsim_matlab_trials *w)
+{
+	if (!w)
+		return;
+	if (w->m)
+		fclose(w->m);
+	free(w->buf);
+	free(w->col);
+	free(w->idx);
+	twin_free(&w->t);
+	free(w);
 }
 
 /* ---- JSON -------------------------------------------------------------- */
@@ -971,7 +1161,7 @@ static int sweep_table(const char *dir, const char *name, const bsim_experiment 
 	return rc;
 }
 
-int bsim_matlab_sweep(const char *dir, const bsim_experiment *e, bsim_error *err)
+int bsim_matlab_sweep(const char *dir, const bsim_experiment *e, int with_trials, bsim_error *err)
 {
 	char json[BSIM_PATH_MAX], mat[BSIM_PATH_MAX], traj[BSIM_PATH_MAX];
 	if (strlen(dir) + sizeof "/trajectories.csv" > sizeof json)
@@ -979,7 +1169,7 @@ int bsim_matlab_sweep(const char *dir, const bsim_experiment *e, bsim_error *err
 	snprintf(json, sizeof json, "%s/summary.json", dir);
 	snprintf(mat, sizeof mat, "%s/summary.mat", dir);
 	int rc = bsim_matlab_from_json(json, mat, "summary", err);
-	if (!rc)
+	if (!rc && with_trials)
 		rc = sweep_table(dir, "trials", e, err);
 	snprintf(traj, sizeof traj, "%s/trajectories.csv", dir);
 	FILE *f = rc ? NULL : fopen(traj, "r");

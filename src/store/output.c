@@ -17,6 +17,7 @@
 #include "beamsim/backend_registry.h"
 #include "util/atomic_file.h"
 #include "store/survival_files.h"
+#include "store/matlab.h"
 #include "store/trials_csv.h"
 #include "store/lattice_files.h"
 #include "util/csv_table.h"
@@ -205,34 +206,17 @@ static void json_lattice(FILE *f, const bsim_sweep_result *r, int group)
 }
 
 /* What the backend's solvers gave up on (beamsim/state.h). */
+#define JSON_COUNT(m) BSIM_JSON_MEMBER(f, sep, c, m);
+
 static void json_solver(FILE *f, const bsim_solver_counts *c)
 {
-	fprintf(f, ", \"solver\": {\"iteration_limit\": %ld, \"clamped\": %ld}", c->iteration_limit,
-	        c->clamped);
+	const char *sep = "";
+	fputs(", \"solver\": {", f);
+	BSIM_SOLVER_COUNTS(JSON_COUNT)
+	fputc('}', f);
 }
 
-/* How many of a group's trials hit an iteration limit, and a clamp: the
- * trials whose motion is partly the solver's, not the model's. */
-static void json_solver_trials(FILE *f, const bsim_group_result *g)
-{
-	fprintf(f, ", \"trials_iteration_limit\": %d, \"trials_clamped\": %d",
-	        g->trials_iteration_limit, g->trials_clamped);
-}
-
-/* How far a group's bodies turned (a body that rotates): the mean final
- * turn (a bias to one side), the mean and largest of its size, and the
- * largest turn during a trial, rad. */
-static void json_turn(FILE *f, const bsim_group_result *g)
-{
-	const char *names[] = {"turn_end_mean", "turn_end_mean_abs", "turn_end_max_abs",
-	                       "turn_max"};
-	const double values[] = {g->turn_end_mean, g->turn_end_mean_abs, g->turn_end_max_abs,
-	                         g->turn_max};
-	for (int i = 0; i < 4; i++) {
-		fprintf(f, ", \"%s\": ", names[i]);
-		bsim_json_number(f, values[i]);
-	}
-}
+#define JSON_GROUP(m) BSIM_JSON_MEMBER(f, sep, g, m);
 
 static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_result *r, int group,
                        int *idx)
@@ -240,24 +224,17 @@ static void json_group(FILE *f, const bsim_experiment *e, const bsim_sweep_resul
 	const bsim_group_result *g = &r->groups[group];
 	fputs("{\"params\": ", f);
 	json_params(f, e, idx);
-	fprintf(f,
-	        ", \"trials\": %d, \"traversed\": %d, \"side_exit\": %d, \"stuck\": %d, "
-	        "\"left\": %d, \"right\": %d, \"p_traverse\": ",
-	        g->trials, g->traversed, g->side_exit, g->stuck, g->left, g->right);
-	bsim_json_number(f, g->p_traverse);
-	fputs(", \"ci95\": [", f);
-	bsim_json_number(f, g->ci95[0]);
-	fputs(", ", f);
-	bsim_json_number(f, g->ci95[1]);
-	fprintf(f,
-	        "], \"stuck_in_contact\": %d, \"landscape_left\": %d, \"landscape_right\": %d, "
-	        "\"steps\": %ld, \"unstable\": %d, \"deterministic\": %s",
-	        g->stuck_in_contact, g->landscape_left, g->landscape_right, g->steps, g->unstable,
-	        g->deterministic ? "true" : "false");
+	const char *sep = ", ";
+	BSIM_GROUP_RESULT_COUNTS(JSON_GROUP)
+	fprintf(f, ", \"deterministic\": %s", g->deterministic ? "true" : "false");
 	json_solver(f, &g->solver);
-	json_solver_trials(f, g);
-	if (g->rotates)
-		json_turn(f, g);
+	BSIM_GROUP_RESULT_SOLVER_TRIALS(JSON_GROUP)
+	/* how far a group's bodies turned (a body that rotates): the mean
+	 * final turn (a bias to one side), the mean and largest of its size,
+	 * and the largest turn during a trial, rad */
+	if (g->rotates) {
+		BSIM_GROUP_RESULT_TURN(JSON_GROUP)
+	}
 	if (r->lattice)
 		json_lattice(f, r, group);
 	fputc('}', f);
@@ -333,7 +310,7 @@ const char *bsim_trials_csv_column(int k)
 	return k >= 0 && k < n ? f[k].name : "?";
 }
 
-int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
+int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e, int twin,
                          bsim_error *err)
 {
 	memset(w, 0, sizeof *w);
@@ -341,6 +318,10 @@ int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_expe
 		return BSIM_EFAIL;
 	w->e = e;
 	w->axes = e && e->n_axes <= BSIM_OUTPUT_AXES_MAX ? e->n_axes : 0;
+	if (twin && e && !(w->twin = bsim_matlab_trials_open(e, w->axes))) {
+		bsim_atomic_file_abort(&w->o);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory for %s's twin", path);
+	}
 	w->group = -1;
 	for (int c = 0; c < TRIALS_N_COLUMNS; c++)
 		fprintf(w->o.f, "%s%s", c ? "," : "", bsim_trials_csv_column(c));
@@ -358,12 +339,14 @@ void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 	FILE *f = w->o.f;
 	int n_fields;
 	const bsim_trial_field *fields = bsim_trial_fields(&n_fields);
+	if (w->twin)
+		bsim_matlab_trials_rows(w->twin, first, n, trials, results, logs);
 	for (long k = 0; k < n; k++) {
 		int g = (int)((first + k) / trials), t = (int)((first + k) % trials);
 		if (w->axes && g != w->group)
 			bsim_experiment_group_index(w->e, g, w->idx);
 		w->group = g;
-		const bsim_trial_row row = {g, t, &results[k], logs ? &logs[k] : NULL};
+		const bsim_trial_row row = {g, t, &results[k], logs ? &logs[k] : NULL, 0, NULL};
 		for (int c = 0; c < n_fields; c++) {
 			if (c)
 				fputc(',', f);
@@ -379,25 +362,45 @@ void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
 
 int bsim_trials_csv_commit(trials_csv_writer *w, bsim_error *err)
 {
-	return bsim_atomic_file_commit(&w->o, err);
+	const char *path = w->o.path;
+	int rc = bsim_atomic_file_commit(&w->o, err);
+	if (rc == BSIM_OK && w->twin)
+		rc = bsim_matlab_trials_write(w->twin, path, err);
+	bsim_matlab_trials_free(w->twin);
+	w->twin = NULL;
+	return rc;
 }
 
 void bsim_trials_csv_abort(trials_csv_writer *w)
 {
 	bsim_atomic_file_abort(&w->o);
+	bsim_matlab_trials_free(w->twin);
+	w->twin = NULL;
 }
 
-int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
-                           bsim_error *err)
+static int trials_csv_write(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                            int twin, bsim_error *err)
 {
 	trials_csv_writer w;
-	if (bsim_trials_csv_open(&w, path, e, err) != BSIM_OK)
+	if (bsim_trials_csv_open(&w, path, e, twin, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	for (int g = 0; g < r->n_groups; g++)
 		bsim_trials_csv_rows(&w, (long)g * r->trials, r->trials, r->trials,
 		                     &r->trials_out[(size_t)g * r->trials],
 		                     r->logs ? &r->logs[(size_t)g * r->trials] : NULL);
 	return bsim_trials_csv_commit(&w, err);
+}
+
+int bsim_output_trials_csv(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                           bsim_error *err)
+{
+	return trials_csv_write(path, e, r, 0, err);
+}
+
+int bsim_trials_csv_write(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                          bsim_error *err)
+{
+	return trials_csv_write(path, e, r, 1, err);
 }
 
 int bsim_output_trials_fit(const bsim_experiment *e, long trials, double cell_bytes,

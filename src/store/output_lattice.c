@@ -26,6 +26,7 @@
 #include "beamsim/lattice_outcome.h"
 #include "beamsim/limits.h"
 #include "store/lattice_files.h"
+#include "beamsim/trial_fields.h"
 
 typedef int (*lattice_writer)(FILE *f, const bsim_experiment *e, const bsim_override *extra,
                               int n_extra, const bsim_sweep_result *r, bsim_error *err);
@@ -118,49 +119,50 @@ int bsim_lattice_group_summary(const bsim_sweep_result *r, int g, bsim_lattice_s
 	                              r->lattice_def.rows, *ls);
 }
 
+/* The rows of the logs' gate entries, or (def given) their beams' peaks:
+ * a row each, the columns of the file's field table. */
+static void log_rows(FILE *f, const bsim_lattice_def *def, long first, long n, int trials,
+                     const bsim_trial_log *logs)
+{
+	int n_fields;
+	const bsim_trial_field *c =
+	        def ? bsim_beam_peak_fields(&n_fields) : bsim_gate_entry_fields(&n_fields);
+	for (long i = 0; i < n; i++) {
+		bsim_trial_row row = {(int)((first + i) / trials),
+		                      (int)((first + i) % trials),
+		                      NULL,
+		                      &logs[i],
+		                      0,
+		                      def};
+		int count = def ? logs[i].n_peaks : logs[i].n_entries;
+		for (row.seq = 0; row.seq < count; row.seq++)
+			bsim_trial_fields_line(f, c, n_fields, &row);
+	}
+}
+
 void bsim_lattice_entries_header(FILE *f)
 {
-	fputs("group,trial,seq,ix,iy,edge,step,t,pos,x,y,vx,vy,theta_left,omega_left,theta_right,"
-	      "omega_right\n",
-	      f);
+	int n;
+	const bsim_trial_field *c = bsim_gate_entry_fields(&n);
+	bsim_trial_fields_header(f, c, n);
 }
 
 void bsim_lattice_entries_rows(FILE *f, long first, long n, int trials, const bsim_trial_log *logs)
 {
-	for (long i = 0; i < n; i++) {
-		int g = (int)((first + i) / trials), t = (int)((first + i) % trials);
-		const bsim_trial_log *l = &logs[i];
-		for (int k = 0; k < l->n_entries; k++) {
-			const bsim_gate_entry *x = &l->entries[k];
-			fprintf(f,
-			        "%d,%d,%d,%d,%d,%s,%d,%.6f,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%."
-			        "10g,"
-			        "%.10g,%.10g\n",
-			        g, t, k, x->ix, x->iy, bsim_trial_edge_name(x->edge), x->step, x->t,
-			        x->pos, x->x[0], x->x[1], x->v[0], x->v[1], x->theta[0],
-			        x->omega[0], x->theta[1], x->omega[1]);
-		}
-	}
+	log_rows(f, NULL, first, n, trials, logs);
 }
 
 void bsim_lattice_peaks_header(FILE *f)
 {
-	fputs("group,trial,beam,ix,iy,side,max_theta\n", f);
+	int n;
+	const bsim_trial_field *c = bsim_beam_peak_fields(&n);
+	bsim_trial_fields_header(f, c, n);
 }
 
 void bsim_lattice_peaks_rows(FILE *f, const bsim_lattice_def *def, long first, long n, int trials,
                              const bsim_trial_log *logs)
 {
-	for (long i = 0; i < n; i++) {
-		int g = (int)((first + i) / trials), t = (int)((first + i) % trials);
-		const bsim_trial_log *l = &logs[i];
-		for (int k = 0; k < l->n_peaks; k++) {
-			int b = l->peaks[k].beam, ix, iy, side;
-			bsim_lattice_beam_gate(def, b, &ix, &iy, &side);
-			fprintf(f, "%d,%d,%d,%d,%d,%s,%.10g\n", g, t, b, ix, iy,
-			        side ? "right" : "left", l->peaks[k].peak);
-		}
-	}
+	log_rows(f, def, first, n, trials, logs);
 }
 
 static int write_entries(FILE *f, const bsim_experiment *e, const bsim_override *extra, int n_extra,

@@ -12,6 +12,7 @@
 #include "beamsim/limits.h"
 #include "beamsim/output.h"
 #include "beamsim/sweep_dir.h"
+#include "beamsim/trial_fields.h"
 #include "store/session.h"
 #include "util/hash.h"
 #include "util/json.h"
@@ -255,8 +256,8 @@ int bsim_part_dir_join(const char *const *dirs, int n, const char *command, cons
 		if (bsim_session_path(path, sizeof path, dirs[k], "part.journal", err))
 			rc = BSIM_EINPUT;
 		if (rc == BSIM_OK)
-			rc = bsim_journal_read(path, inputs, record_size, join_take, &c, &records,
-			                       &cut, err);
+			rc = bsim_journal_read(path, bsim_trial_record_fields(), inputs,
+			                       record_size, join_take, &c, &records, &cut, err);
 		if (rc == BSIM_OK && c.failed)
 			rc = c.failed;
 		else if (rc == BSIM_OK && (cut > 0 || c.distinct != parts[k].records))
@@ -317,8 +318,8 @@ int bsim_part_dir_spread_run(const part_dir_spread *sp, const char *inputs, bsim
 		unsigned char *bits = done;
 		memset(done, 0, bytes);
 		if (rc == BSIM_OK)
-			rc = bsim_journal_read(ss->journal_path, inputs, sp->record_size, mark_done,
-			                       &bits, &kept, &cut, err);
+			rc = bsim_journal_read(ss->journal_path, bsim_trial_record_fields(), inputs,
+			                       sp->record_size, mark_done, &bits, &kept, &cut, err);
 		for (long i = 0; rc == BSIM_OK && i < total; i++)
 			records += (done[i / 8] >> (i % 8)) & 1;
 		if (rc == BSIM_OK && bsim_output_mkdir(ss->stage, err) != BSIM_OK)
@@ -343,6 +344,7 @@ int bsim_part_dir_journal_reopen(bsim_session *ss, const char *inputs, size_t re
 	int rc = bsim_journal_close(ss->journal, err);
 	ss->journal = NULL;
 	if (rc == BSIM_OK)
-		rc = bsim_journal_resume(&ss->journal, ss->journal_path, inputs, record_size, err);
+		rc = bsim_journal_resume(&ss->journal, ss->journal_path, bsim_trial_record_fields(),
+		                         inputs, record_size, err);
 	return rc;
 }

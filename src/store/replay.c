@@ -14,6 +14,7 @@
 #include "beamsim/compare_dir.h"
 #include "beamsim/limits.h"
 #include "beamsim/run_output.h"
+#include "beamsim/trial_fields.h"
 #include "beamsim/run_record.h"
 #include "beamsim/schedule.h"
 #include "util/text_check.h"
@@ -353,7 +354,18 @@ const bsim_trial_result *bsim_replay_stored_row(const bsim_replay *r)
 
 void bsim_replay_row(char *buf, size_t size, long group, long trial, const bsim_trial_result *x)
 {
-	snprintf(buf, size, "%ld,%ld,%s,%s,%d,%.10g,%.10g,%.10g", group, trial,
-	         bsim_trial_outcome_name(x->outcome), bsim_trial_type_name(x->type), x->steps,
-	         x->t_end, x->x_end, x->y_end);
+	int n;
+	const bsim_trial_field *f = bsim_trial_fields(&n);
+	const bsim_trial_row row = {(int)group, (int)trial, x, NULL, 0, NULL};
+	char *text = NULL;
+	size_t len = 0;
+	FILE *m = open_memstream(&text, &len);
+	for (int c = 0; m && c < BSIM_REPLAY_ROW_FIELDS && c < n; c++) {
+		fputs(c ? "," : "", m);
+		bsim_trial_field_write(m, &f[c], &row);
+	}
+	if (m)
+		fclose(m);
+	snprintf(buf, size, "%s", text ? text : "");
+	free(text);
 }

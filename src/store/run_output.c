@@ -27,34 +27,9 @@ bsim_run_info bsim_run_info_default(void)
 	return i;
 }
 
-static void ledger_json(FILE *f, const bsim_ledger *l)
-{
-	const struct {
-		const char *name;
-		double value;
-	} terms[] = {
-	        {"e_start", l->e_start},
-	        {"e_end", l->e_end},
-	        {"w_prop", l->w_prop},
-	        {"w_rand", l->w_rand},
-	        {"damper", l->damper},
-	        {"impact", l->impact},
-	        {"contact", l->contact},
-	        {"correction", l->correction},
-	        {"sleep", l->sleep},
-	        {"reset", l->reset},
-	        {"residual", l->residual},
-	        {"residual_max", l->residual_max},
-	        {"residual_abs", l->residual_abs},
-	        {"inflow", l->inflow},
-	};
-	fputc('{', f);
-	for (size_t i = 0; i < sizeof terms / sizeof terms[0]; i++) {
-		fprintf(f, "%s\"%s\": ", i ? ", " : "", terms[i].name);
-		bsim_json_number(f, terms[i].value);
-	}
-	fputc('}', f);
-}
+#define JSON_RESULT(m) BSIM_JSON_MEMBER(f, sep, r, m);
+#define JSON_LEDGER(m) BSIM_JSON_MEMBER(f, sep, &r->ledger, m);
+#define JSON_SOLVER(m) BSIM_JSON_MEMBER(f, sep, &r->solver, m);
 
 /* The final gate and location, the gate path and every beam's peak (the
  * lattice's per-trial data; the path and peaks only with a log). */
@@ -129,30 +104,16 @@ void bsim_run_output_json(FILE *f, const bsim_run_info *info, const bsim_trial_r
 		fprintf(f, "%d", r->landscape_beam + 1);
 	else
 		fputs("null", f);
-	fprintf(f, ", \"in_contact_end\": %d", r->in_contact_end);
-	fprintf(f, ", \"steps\": %d, \"steps_run\": %d, \"draws\": %lu", r->steps, r->steps_run,
-	        r->draws);
-	const char *names[] = {"t_end",    "x_end",       "y_end",
-	                       "vx_end",   "heading_end", "angular_velocity_end",
-	                       "turn_end", "turn_max"};
-	const double values[] = {r->t_end,    r->x_end,       r->y_end,
-	                         r->vx_end,   r->heading_end, r->angular_velocity_end,
-	                         r->turn_end, r->turn_max};
-	for (int i = 0; i < 8; i++) {
-		fprintf(f, ", \"%s\": ", names[i]);
-		bsim_json_number(f, values[i]);
-	}
-	fputs(", \"max_theta\": [", f);
-	bsim_json_number(f, r->max_theta[0]);
-	fputs(", ", f);
-	bsim_json_number(f, r->max_theta[1]);
-	fputs("], \"overlap_max\": ", f);
-	bsim_json_number(f, r->overlap_max);
+	const char *sep = ", ";
+	BSIM_TRIAL_RESULT_PLAIN(JSON_RESULT)
 	path_json(f, r, info->log);
-	fputs(", \"ledger\": ", f);
-	ledger_json(f, &r->ledger);
-	fprintf(f, ", \"solver\": {\"iteration_limit\": %ld, \"clamped\": %ld}",
-	        r->solver.iteration_limit, r->solver.clamped);
+	fputs(", \"ledger\": {", f);
+	sep = "";
+	BSIM_LEDGER_SHOWN(JSON_LEDGER)
+	fputs("}, \"solver\": {", f);
+	sep = "";
+	BSIM_SOLVER_COUNTS(JSON_SOLVER)
+	fputc('}', f);
 	fputs(", \"instability\": ", f);
 	if (r->instability) {
 		char why[256];

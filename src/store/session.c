@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "store/session.h"
+#include "beamsim/trial_fields.h"
 #include "store/index_html.h"
 #include "util/file_read.h"
 
@@ -60,7 +61,8 @@ int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, c
 		                       "%s: %s holds no stopped run to resume (run without %s)",
 		                       opt, dir, opt);
 	} else if (resume) {
-		rc = bsim_journal_resume(&s->journal, s->journal_path, inputs, record_size, err);
+		rc = bsim_journal_resume(&s->journal, s->journal_path, bsim_trial_record_fields(),
+		                         inputs, record_size, err);
 		if (rc != BSIM_OK) {
 			char msg[sizeof err->msg];
 			snprintf(msg, sizeof msg, "%s", err->msg);
@@ -69,7 +71,8 @@ int bsim_session_open(bsim_session *s, const char *dir, bsim_outdir_mode mode, c
 	} else {
 		/* a stopped run's journal is there only if the user asked to
 		 * replace it (bsim_outdir_open refuses it otherwise) */
-		rc = bsim_journal_create(&s->journal, s->journal_path, inputs, record_size, err);
+		rc = bsim_journal_create(&s->journal, s->journal_path, bsim_trial_record_fields(),
+		                         inputs, record_size, err);
 	}
 	if (rc != BSIM_OK) {
 		/* The refused journal is another run's: it stays. */

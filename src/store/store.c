@@ -11,6 +11,7 @@
 #include "store/matlab.h"
 #include "store/session.h"
 #include "store/survival_files.h"
+#include "store/trials_csv.h"
 #include "beamsim/limits.h"
 
 /* path holding the len bytes at text, atomically. */
@@ -58,12 +59,12 @@ static int sweep_files(const char *dir, const bsim_experiment *e, const bsim_bac
 	}
 	if (bsim_output_mkdir(dir, err) != BSIM_OK ||
 	    bsim_output_summary_json(summary, e, b->name, opts, r, err) != BSIM_OK ||
-	    (r->trials_out && !text && bsim_output_trials_csv(trials, e, r, err) != BSIM_OK) ||
+	    (r->trials_out && !text && bsim_trials_csv_write(trials, e, r, err) != BSIM_OK) ||
 	    (text && bytes_write(trials, text, len, err) != BSIM_OK) ||
 	    (r->trials_out && survival_files(dir, e, extra, n_extra, r, err) != BSIM_OK) ||
 	    bsim_output_lattice(dir, e, extra, n_extra, r, err) != BSIM_OK ||
 	    bsim_output_trajectories_csv(traj, r, err) != BSIM_OK ||
-	    bsim_matlab_sweep(dir, e, err) != BSIM_OK)
+	    bsim_matlab_sweep(dir, e, text != NULL, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	return BSIM_OK;
 }

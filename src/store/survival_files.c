@@ -25,11 +25,6 @@
 /* Points of the horizon grid of each group: h = H j / HORIZON_POINTS. */
 #define HORIZON_POINTS 48
 
-double bsim_survival_exit_time(const bsim_trial_result *r)
-{
-	return r->outcome == BSIM_TRAVERSED || r->outcome == BSIM_SIDE_EXIT ? r->t_end : NAN;
-}
-
 int bsim_survival_acc_init(survival_acc *a, const bsim_experiment *e, const bsim_scene *scenes,
                            const bsim_override *sets, int n_sets, bsim_error *err)
 {

@@ -61,7 +61,9 @@ void bsim_survival_acc_add(survival_acc *a, long first, long n, int trials,
 int bsim_survival_acc_write(const survival_acc *a, const char *dir, bsim_error *err);
 
 /* The trial's exit time t_exit, s, or NaN when it is censored (stuck,
- * unstable): what trials.csv's t_exit column holds. */
+ * unstable): what trials.csv's t_exit column holds (defined with that
+ * column, in trial_fields.c, which the journal's writers call: so the
+ * field table calls nothing that calls them). */
 double bsim_survival_exit_time(const bsim_trial_result *r);
 
 #endif

@@ -13,6 +13,7 @@
 
 #include "beamsim/backend_registry.h"
 #include "beamsim/run_record.h"
+#include "beamsim/trial_fields.h"
 #include "store/part_dir.h"
 #include "util/journal.h"
 
@@ -93,7 +94,8 @@ static int spill_fill(batch_spill *sp, const char *journal, const char *inputs, 
 	if (!sp->have)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	long n = 0, cut = 0;
-	int rc = bsim_journal_read(journal, inputs, sp->size, spill_take, sp, &n, &cut, err);
+	int rc = bsim_journal_read(journal, bsim_trial_record_fields(), inputs, sp->size,
+	                           spill_take, sp, &n, &cut, err);
 	if (rc == BSIM_OK && sp->failed)
 		rc = bsim_error_set(err, BSIM_EFAIL, "%s: cannot write (%s)", path,
 		                    strerror(sp->failed));
@@ -107,7 +109,8 @@ static int spill_journal(const batch_spill *sp, const char *path, const char *in
 	bsim_journal *j = NULL;
 	*out = NULL;
 	unsigned char *buf = malloc(sp->size);
-	int rc = buf ? bsim_journal_create(&j, path, inputs, sp->size, err)
+	int rc = buf ? bsim_journal_create(&j, path, bsim_trial_record_fields(), inputs, sp->size,
+	                                   err)
 	             : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (long i = first; rc == BSIM_OK && i < end; i++) {
 		if (!(sp->have[i / 8] & (1u << (i % 8))))
@@ -126,7 +129,8 @@ static int spill_journal(const batch_spill *sp, const char *path, const char *in
 	if (rc == BSIM_OK)
 		rc = closed;
 	if (rc == BSIM_OK)
-		rc = bsim_journal_resume(out, path, inputs, sp->size, err);
+		rc = bsim_journal_resume(out, path, bsim_trial_record_fields(), inputs, sp->size,
+		                         err);
 	return rc;
 }
 

@@ -106,7 +106,7 @@ static int sink_open(trials_sink *s, const char *stage, const bsim_experiment *e
 	for (int k = 0; k < s->n_files; k++)
 		if (bsim_session_path(s->path[k], sizeof s->path[k], stage, sink_names[k], err))
 			return BSIM_EFAIL;
-	if (bsim_trials_csv_open(&s->w, s->path[SINK_TRIALS], e, err) != BSIM_OK)
+	if (bsim_trials_csv_open(&s->w, s->path[SINK_TRIALS], e, 1, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	for (int k = 1; k < s->n_files; k++)
 		if (bsim_atomic_file_open(&s->lattice[k], s->path[k], err) != BSIM_OK)
@@ -119,7 +119,7 @@ static int sink_open(trials_sink *s, const char *stage, const bsim_experiment *e
 }
 
 /* Commits the files (rc BSIM_OK) or leaves none; then the lattice files'
- * twins (trials.csv's comes with the sweep's other twins). */
+ * twins (trials.csv's its writer made from the trials, on commit). */
 static int sink_close(trials_sink *s, int rc, const char *stage, bsim_error *err)
 {
 	if (rc == BSIM_OK)

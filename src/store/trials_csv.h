@@ -51,21 +51,28 @@ const char *bsim_trials_csv_column(int k);
 /* trials.csv written as the trials come (a streamed sweep hands them over
  * block by block): open writes the header, rows appends trials first ..
  * first + n - 1 of a sweep of `trials` per group (logs may be NULL), commit
- * puts the whole file in place (util/atomic_file.h), abort leaves nothing. */
+ * puts the whole file in place (util/atomic_file.h), abort leaves nothing.
+ * With twin set the writer makes trials.mat beside it too, from the same
+ * trials (store/matlab.h, bsim_matlab_trials), written on commit. */
 typedef struct trials_csv_writer {
 	bsim_atomic_file o;
 	const bsim_experiment *e;
 	int axes;
 	int group; /* the group whose axis values idx holds */
 	int idx[BSIM_OUTPUT_AXES_MAX];
+	struct bsim_matlab_trials *twin; /* NULL: none */
 } trials_csv_writer;
 
-int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e,
+int bsim_trials_csv_open(trials_csv_writer *w, const char *path, const bsim_experiment *e, int twin,
                          bsim_error *err);
 void bsim_trials_csv_rows(trials_csv_writer *w, long first, long n, int trials,
                           const bsim_trial_result *results, const bsim_trial_log *logs);
 int bsim_trials_csv_commit(trials_csv_writer *w, bsim_error *err);
 void bsim_trials_csv_abort(trials_csv_writer *w);
+
+/* A sweep's trials.csv and its twin trials.mat, from r held in memory. */
+int bsim_trials_csv_write(const char *path, const bsim_experiment *e, const bsim_sweep_result *r,
+                          bsim_error *err);
 
 /* The shape a trials.csv read back must have: every (group, trial) of
  * n_groups x trials once (bsim_output_trials_read asks no more), and what

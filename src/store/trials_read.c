@@ -159,6 +159,38 @@ static int word_field(const reader *rd, char **f, int k, int n, const char *(*na
 	return field_error(rd, k, expected, s, err);
 }
 
+/* Columns first .. end - 1 (each of them the file has, every one if all)
+ * into their members of x (beamsim/trial_fields.h: back, back_size): a
+ * REAL as a number, an INT as an integer from lo to the member's largest
+ * (expected says so). */
+static int member_fields(const reader *rd, char **f, int first, int end, bsim_trial_result *x,
+                         long lo, const char *expected, bsim_error *err)
+{
+	int n;
+	const bsim_trial_field *table = bsim_trial_fields(&n);
+	for (int k = first; k < end; k++) {
+		const bsim_trial_field *fd = &table[column_of[k]];
+		char *at = (char *)x + fd->back;
+		long v;
+		if (rd->col[k] < 0 || fd->back_size == 0)
+			continue;
+		if (fd->kind == BSIM_FIELD_REAL) {
+			if (number_field(rd, f, k, (double *)at, err))
+				return BSIM_EINPUT;
+			continue;
+		}
+		int small = fd->back_size == sizeof(int);
+		if (int_field(rd, f, k, lo, small ? 0x7fffffffL : 0x7fffffffffffffffL, expected, &v,
+		              err))
+			return BSIM_EINPUT;
+		if (small)
+			*(int *)at = (int)v;
+		else
+			*(long *)at = v;
+	}
+	return BSIM_OK;
+}
+
 static const char *outcome_word(int i)
 {
 	return bsim_trial_outcome_name((bsim_outcome)i);
@@ -184,7 +216,7 @@ static int parse_row(const reader *rd, char **f, int n, bsim_error *err)
 		                      rd->path, rd->line, rd->n_fields, n);
 	const bsim_sweep_result *r = rd->r;
 	char expected[96];
-	long g, t, v;
+	long g, t;
 	snprintf(expected, sizeof expected, "an integer 0 to %d (the experiment's %d groups)",
 	         r->n_groups - 1, r->n_groups);
 	if (int_field(rd, f, COL_GROUP, 0, r->n_groups - 1, expected, &g, err))
@@ -212,42 +244,16 @@ static int parse_row(const reader *rd, char **f, int n, bsim_error *err)
 	}
 	x->outcome = (bsim_outcome)o;
 	x->type = (bsim_type)ty;
-	if (int_field(rd, f, COL_STEPS, 0, 0x7fffffffL, "an integer >= 0", &v, err))
+	/* The ledger's split columns come back as the ledger's first entry
+	 * of each sum: enough to compare two files field by field. */
+	if (member_fields(rd, f, COL_STEPS, COL_T_END, x, 0, "an integer >= 0", err) ||
+	    member_fields(rd, f, COL_T_END, LEDGER_END, x, 0, "a number", err) ||
+	    member_fields(rd, f, COL_FINAL_IX, COL_ITERATION_LIMITS, x, -0x7fffffffL, "an integer",
+	                  err) ||
+	    member_fields(rd, f, COL_ITERATION_LIMITS, COL_HEADING_END, x, 0, "an integer >= 0",
+	                  err) ||
+	    member_fields(rd, f, COL_HEADING_END, N_COLUMNS, x, 0, "a number", err))
 		return BSIM_EINPUT;
-	x->steps = (int)v;
-	double *num[6] = {&x->t_end,  &x->x_end,        &x->y_end,
-	                  &x->vx_end, &x->max_theta[0], &x->max_theta[1]};
-	for (int i = 0; i < 6; i++)
-		if (number_field(rd, f, COL_T_END + i, num[i], err))
-			return BSIM_EINPUT;
-	if (rd->col[COL_E_START] >= 0) {
-		/* The split columns come back as the ledger's first entry of
-		 * each sum: enough to compare two files field by field. */
-		bsim_ledger *l = &x->ledger;
-		double *lv[5] = {&l->e_start, &l->e_end, &l->w_prop, &l->damper, &l->residual};
-		for (int i = 0; i < 5; i++)
-			if (number_field(rd, f, COL_E_START + i, lv[i], err))
-				return BSIM_EINPUT;
-	}
-	int *gate[2] = {&x->final_ix, &x->final_iy};
-	for (int i = 0; i < 2; i++) {
-		if (rd->col[COL_FINAL_IX + i] < 0)
-			continue;
-		if (int_field(rd, f, COL_FINAL_IX + i, -0x7fffffffL, 0x7fffffffL, "an integer", &v,
-		              err))
-			return BSIM_EINPUT;
-		*gate[i] = (int)v;
-	}
-	long *solver[2] = {&x->solver.iteration_limit, &x->solver.clamped};
-	for (int i = 0; i < 2; i++)
-		if (rd->col[COL_ITERATION_LIMITS + i] >= 0 &&
-		    int_field(rd, f, COL_ITERATION_LIMITS + i, 0, 0x7fffffffffffffffL,
-		              "an integer >= 0", solver[i], err))
-			return BSIM_EINPUT;
-	double *turn[4] = {&x->heading_end, &x->angular_velocity_end, &x->turn_end, &x->turn_max};
-	for (int i = 0; i < 4 && rd->col[COL_HEADING_END] >= 0; i++)
-		if (number_field(rd, f, COL_HEADING_END + i, turn[i], err))
-			return BSIM_EINPUT;
 	x->steps_run = rd->line; /* marks the row as read; not in the file */
 	return BSIM_OK;
 }

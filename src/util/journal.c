@@ -16,7 +16,8 @@
 
 #include <zlib.h>
 
-static const char magic[8] = {'B', 'S', 'I', 'M', 'J', 'N', 'L', '1'};
+/* "BSIMJNL" and the format's version */
+static const char magic[8] = {'B', 'S', 'I', 'M', 'J', 'N', 'L', '0' + BSIM_JOURNAL_VERSION};
 #define RECORD_MAGIC  0x5243524Au
 #define SYNC_INTERVAL 1.0 /* s between syncs to disk */
 
@@ -97,30 +98,39 @@ static void journal_free(bsim_journal *j)
 	free(j);
 }
 
-/* The header for these inputs, malloc'd, its size in *n. */
-static unsigned char *header_encode(const char *inputs, size_t record_size, size_t *n)
+/* u32 n then n bytes of text at p; p past them. */
+static unsigned char *put_text(unsigned char *p, const char *text, uint32_t n)
 {
-	uint32_t rs = (uint32_t)record_size, il = (uint32_t)strlen(inputs);
-	*n = sizeof magic + 8 + il + 4;
+	memcpy(p, &n, 4);
+	memcpy(p + 4, text, n);
+	return p + 4 + n;
+}
+
+/* The header for these fields and inputs, malloc'd, its size in *n. */
+static unsigned char *header_encode(const char *fields, const char *inputs, size_t record_size,
+                                    size_t *n)
+{
+	uint32_t rs = (uint32_t)record_size, fl = (uint32_t)strlen(fields),
+	         il = (uint32_t)strlen(inputs);
+	*n = sizeof magic + 4 + 4 + fl + 4 + il + 4;
 	unsigned char *h = malloc(*n);
 	if (!h)
 		return NULL;
 	memcpy(h, magic, sizeof magic);
 	memcpy(h + 8, &rs, 4);
-	memcpy(h + 12, &il, 4);
-	memcpy(h + 16, inputs, il);
-	uint32_t crc = (uint32_t)crc32(0L, h, (uInt)(16 + il));
-	memcpy(h + 16 + il, &crc, 4);
+	unsigned char *p = put_text(put_text(h + 12, fields, fl), inputs, il);
+	uint32_t crc = (uint32_t)crc32(0L, h, (uInt)(p - h));
+	memcpy(p, &crc, 4);
 	return h;
 }
 
-int bsim_journal_create(bsim_journal **out, const char *path, const char *inputs,
-                        size_t record_size, bsim_error *err)
+int bsim_journal_create(bsim_journal **out, const char *path, const char *fields,
+                        const char *inputs, size_t record_size, bsim_error *err)
 {
 	*out = NULL;
 	bsim_journal *j = journal_alloc(path, record_size);
 	size_t n = 0;
-	unsigned char *h = j ? header_encode(inputs, record_size, &n) : NULL;
+	unsigned char *h = j ? header_encode(fields, inputs, record_size, &n) : NULL;
 	char tmp[BSIM_PATH_MAX];
 	if (!h || snprintf(tmp, sizeof tmp, "%s.new", path) >= (int)sizeof tmp) {
 		if (j)
@@ -148,8 +158,9 @@ int bsim_journal_create(bsim_journal **out, const char *path, const char *inputs
 	return BSIM_OK;
 }
 
-/* The first line where a and b differ, for the refusal message. */
-static void first_difference(const char *a, const char *b, char *msg, size_t size)
+/* The first line where a and b (the text named what) differ, for the
+ * refusal message. */
+static void first_difference(const char *a, const char *b, const char *what, char *msg, size_t size)
 {
 	int line = 1;
 	const char *la = a, *lb = b;
@@ -163,58 +174,100 @@ static void first_difference(const char *a, const char *b, char *msg, size_t siz
 		b++;
 	}
 	int na = (int)strcspn(la, "\n"), nb = (int)strcspn(lb, "\n");
-	snprintf(msg, size, "\"%.*s\" then, \"%.*s\" now (line %d of the inputs)",
-	         na > 120 ? 120 : na, la, nb > 120 ? 120 : nb, lb, line);
+	snprintf(msg, size, "\"%.*s\" then, \"%.*s\" now (line %d of the %s)", na > 120 ? 120 : na,
+	         la, nb > 120 ? 120 : nb, lb, line, what);
 }
 
-/* Checks the header at the start of fd against inputs. */
-static int header_check(int fd, const char *path, const char *inputs, size_t record_size,
-                        bsim_error *err)
+/* The next u32 length and text of the header being read into *h (grown),
+ * its bytes counted in *used; the text's offset in *at. 0, or -1 if the
+ * file ends or the length is past any header's. */
+static int read_text(int fd, unsigned char **h, size_t *used, size_t *at, uint32_t *len)
 {
-	unsigned char head[16];
-	uint32_t rs = 0, il = 0;
+	unsigned char *g = realloc(*h, *used + 4);
+	if (!g || read_all(fd, g + *used, 4) != 4) {
+		*h = g ? g : *h;
+		return -1;
+	}
+	*h = g;
+	memcpy(len, g + *used, 4);
+	*used += 4;
+	if (*len > 64u << 20)
+		return -1;
+	if (!(g = realloc(*h, *used + *len + 1)))
+		return -1;
+	*h = g;
+	*at = *used;
+	if (read_all(fd, g + *used, *len) != (ssize_t)*len)
+		return -1;
+	*used += *len;
+	return 0;
+}
+
+/* Checks the header at the start of fd against fields, inputs and
+ * record_size. */
+static int header_check(int fd, const char *path, const char *fields, const char *inputs,
+                        size_t record_size, bsim_error *err)
+{
+	unsigned char head[12];
+	uint32_t rs = 0, fl = 0, il = 0;
 	if (read_all(fd, head, sizeof head) != (ssize_t)sizeof head ||
-	    memcmp(head, magic, sizeof magic) != 0)
+	    memcmp(head, magic, sizeof magic - 1) != 0)
 		return bsim_error_set(err, BSIM_EINPUT, "%s: expected a beamsim journal", path);
-	memcpy(&rs, head + 8, 4);
-	memcpy(&il, head + 12, 4);
-	if (il > 64u << 20)
+	if (head[7] < '0' || head[7] > '9')
+		return bsim_error_set(err, BSIM_EINPUT, "%s: expected a beamsim journal", path);
+	if (head[7] != magic[7])
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "%s: expected a beamsim journal, got a damaged header", path);
-	unsigned char *h = malloc(16 + (size_t)il + 4);
+		                      "%s: a journal of format %c, this build reads format %c "
+		                      "(another beamsim build wrote it)",
+		                      path, head[7], magic[7]);
+	memcpy(&rs, head + 8, 4);
+	size_t used = sizeof head, f_at = 0, i_at = 0;
+	unsigned char *h = malloc(used);
 	if (!h)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	memcpy(h, head, sizeof head);
+	memcpy(h, head, used);
 	uint32_t crc = 0;
-	int ok = read_all(fd, h + 16, (size_t)il + 4) == (ssize_t)il + 4;
-	if (ok)
-		memcpy(&crc, h + 16 + il, 4);
-	if (!ok || crc != (uint32_t)crc32(0L, h, (uInt)(16 + il))) {
+	int ok = read_text(fd, &h, &used, &f_at, &fl) == 0 &&
+	         read_text(fd, &h, &used, &i_at, &il) == 0 && read_all(fd, &crc, 4) == 4 &&
+	         crc == (uint32_t)crc32(0L, h, (uInt)used);
+	if (!ok) {
 		free(h);
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "%s: expected a beamsim journal, got a damaged header", path);
 	}
-	char *then = (char *)h + 16;
+	char *then_fields = (char *)h + f_at, *then = (char *)h + i_at;
 	int rc = BSIM_OK;
-	if (strlen(inputs) != il || memcmp(then, inputs, il) != 0) {
-		char diff[400];
-		then[il] = '\0'; /* over the CRC, no longer needed */
-		first_difference(then, inputs, diff, sizeof diff);
-		rc = bsim_error_set(err, BSIM_EINPUT, "the run was started with other inputs: %s",
-		                    diff);
+	char diff[400];
+	if (strlen(fields) != fl || memcmp(then_fields, fields, fl) != 0) {
+		char *z = strndup(then_fields, fl);
+		if (!z) {
+			free(h);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		}
+		first_difference(z, fields, "fields", diff, sizeof diff);
+		free(z);
+		rc = bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "%s: records of other fields: %s (another beamsim build wrote it)", path,
+		        diff);
 	} else if (rs != record_size) {
 		rc = bsim_error_set(
 		        err, BSIM_EINPUT,
 		        "%s: records of %u bytes, this build writes %zu (another beamsim "
 		        "build)",
 		        path, rs, record_size);
+	} else if (strlen(inputs) != il || memcmp(then, inputs, il) != 0) {
+		then[il] = '\0'; /* the last text: room was made for it */
+		first_difference(then, inputs, "inputs", diff, sizeof diff);
+		rc = bsim_error_set(err, BSIM_EINPUT, "the run was started with other inputs: %s",
+		                    diff);
 	}
 	free(h);
 	return rc;
 }
 
-int bsim_journal_resume(bsim_journal **out, const char *path, const char *inputs,
-                        size_t record_size, bsim_error *err)
+int bsim_journal_resume(bsim_journal **out, const char *path, const char *fields,
+                        const char *inputs, size_t record_size, bsim_error *err)
 {
 	*out = NULL;
 	bsim_journal *j = journal_alloc(path, record_size);
@@ -227,7 +280,7 @@ int bsim_journal_resume(bsim_journal **out, const char *path, const char *inputs
 		return bsim_error_set(err, e == ENOENT ? BSIM_EINPUT : BSIM_EFAIL,
 		                      "%s: cannot read the journal: %s", path, strerror(e));
 	}
-	int rc = header_check(j->fd, path, inputs, record_size, err);
+	int rc = header_check(j->fd, path, fields, inputs, record_size, err);
 	if (rc) {
 		journal_free(j);
 		return rc;
@@ -279,8 +332,8 @@ int bsim_journal_replay(bsim_journal *j, bsim_journal_fn fn, void *user, long *n
 	return BSIM_OK;
 }
 
-int bsim_journal_read(const char *path, const char *inputs, size_t record_size, bsim_journal_fn fn,
-                      void *user, long *n_records, long *n_cut, bsim_error *err)
+int bsim_journal_read(const char *path, const char *fields, const char *inputs, size_t record_size,
+                      bsim_journal_fn fn, void *user, long *n_records, long *n_cut, bsim_error *err)
 {
 	*n_records = 0;
 	*n_cut = 0;
@@ -290,7 +343,7 @@ int bsim_journal_read(const char *path, const char *inputs, size_t record_size, 
 		return bsim_error_set(err, e == ENOENT ? BSIM_EINPUT : BSIM_EFAIL,
 		                      "%s: cannot read the journal: %s", path, strerror(e));
 	}
-	int rc = header_check(fd, path, inputs, record_size, err);
+	int rc = header_check(fd, path, fields, inputs, record_size, err);
 	size_t n = 4 + 8 + record_size + 4;
 	unsigned char *buf = rc ? NULL : malloc(n);
 	if (!rc && !buf)

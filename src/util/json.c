@@ -73,3 +73,34 @@ void bsim_json_pair(FILE *f, const double v[2])
 	bsim_json_number(f, v[1]);
 	fputc(']', f);
 }
+
+void bsim_json_member_int(FILE *f, const char *sep, const char *name, const void *v, size_t size)
+{
+	(void)size;
+	fprintf(f, "%s\"%s\": %d", sep, name, *(const int *)v);
+}
+
+void bsim_json_member_long(FILE *f, const char *sep, const char *name, const void *v, size_t size)
+{
+	(void)size;
+	fprintf(f, "%s\"%s\": %ld", sep, name, *(const long *)v);
+}
+
+void bsim_json_member_ulong(FILE *f, const char *sep, const char *name, const void *v, size_t size)
+{
+	(void)size;
+	fprintf(f, "%s\"%s\": %lu", sep, name, *(const unsigned long *)v);
+}
+
+void bsim_json_member_doubles(FILE *f, const char *sep, const char *name, const void *v,
+                              size_t size)
+{
+	const double *d = v;
+	size_t n = size / sizeof *d;
+	fprintf(f, "%s\"%s\": %s", sep, name, n > 1 ? "[" : "");
+	for (size_t i = 0; i < n; i++) {
+		fputs(i ? ", " : "", f);
+		bsim_json_number(f, d[i]);
+	}
+	fputs(n > 1 ? "]" : "", f);
+}

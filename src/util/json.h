@@ -5,6 +5,7 @@
 #ifndef BSIM_UTIL_JSON_H
 #define BSIM_UTIL_JSON_H
 
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 
@@ -29,6 +30,30 @@ void bsim_json_pair(FILE *f, const double v[2]);
  * which a double-based reader (MATLAB's jsondecode, JavaScript) would
  * otherwise round. */
 void bsim_json_u64(FILE *f, uint64_t x);
+
+/* A member of a struct as it is, after sep: sep, "name": and its value at
+ * v of size bytes, an integer, or a number (several doubles a list of
+ * them, as bsim_json_number writes each). */
+void bsim_json_member_int(FILE *f, const char *sep, const char *name, const void *v, size_t size);
+void bsim_json_member_long(FILE *f, const char *sep, const char *name, const void *v, size_t size);
+void bsim_json_member_ulong(FILE *f, const char *sep, const char *name, const void *v, size_t size);
+void bsim_json_member_doubles(FILE *f, const char *sep, const char *name, const void *v,
+                              size_t size);
+
+/* Member m of the struct at s (an X-macro's list names it) to f after sep,
+ * which then becomes ", "; its kind from its type: a type not listed does
+ * not compile. */
+#define BSIM_JSON_MEMBER(f, sep, s, m)                                                               \
+	do {                                                                                         \
+		_Generic(&(s)->m,                                                                  \
+		        const int *: bsim_json_member_int,                                         \
+		        const long *: bsim_json_member_long,                                       \
+		        const unsigned long *: bsim_json_member_ulong,                             \
+		        const double *: bsim_json_member_doubles,                                  \
+		        const double(*)[2]: bsim_json_member_doubles)(f, sep, #m, &(s)->m,         \
+		                                                      sizeof(s)->m); \
+		sep = ", ";                                                                          \
+	} while (0)
 
 #ifdef __cplusplus
 }

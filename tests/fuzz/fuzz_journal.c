@@ -24,6 +24,7 @@
 #define INDICES     64
 #define MAX_RECORDS 64
 
+static const char fields[] = "payload 24\nbytes uchar 0 24\n";
 static const char inputs[] = "beamsim fuzz\nbackend thesis\nseed 1\n";
 static uint8_t header[256];
 static size_t header_size;
@@ -35,7 +36,7 @@ static void make_header(void)
 	snprintf(path, sizeof path, "%s/header.jnl", fuzz_dir());
 	bsim_journal *j;
 	bsim_error err;
-	if (bsim_journal_create(&j, path, inputs, RECORD, &err) != BSIM_OK ||
+	if (bsim_journal_create(&j, path, fields, inputs, RECORD, &err) != BSIM_OK ||
 	    bsim_journal_close(j, &err) != BSIM_OK) {
 		fprintf(stderr, "fuzz: %s\n", err.msg);
 		abort();
@@ -100,7 +101,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	bsim_journal *j;
 	bsim_error err;
 	bsim_error_clear(&err);
-	int rc = bsim_journal_resume(&j, path, inputs, RECORD, &err);
+	int rc = bsim_journal_resume(&j, path, fields, inputs, RECORD, &err);
 	if (rc != BSIM_OK) {
 		fuzz_check_error(rc, &err);
 		return 0;
@@ -120,7 +121,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 		fail("close", &err);
 	/* Read back: what was kept, the appended record, nothing cut. */
 	long seen2 = 0, kept2 = 0, cut2 = 0;
-	if (bsim_journal_resume(&j, path, inputs, RECORD, &err) != BSIM_OK)
+	if (bsim_journal_resume(&j, path, fields, inputs, RECORD, &err) != BSIM_OK)
 		fail("resume after append", &err);
 	if (bsim_journal_replay(j, take, &seen2, &kept2, &cut2, &err) != BSIM_OK)
 		fail("replay after append", &err);

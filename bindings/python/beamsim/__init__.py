@@ -254,9 +254,9 @@ def run(scene, seed=None, group=0, trial=0, backend=None, set=None, backend_opt=
     set: {dotted key: value} scene overrides; backend_opt: {knob: value};
     grid: an experiment's axes {key: [values]}, as sweep's.
 
-    Returns run --json's object as a dict (outcome, type, steps, t_end,
-    x_end, y_end, vx_end, max_theta, ledger, ...), with "row" (the trial's
-    trials.csv fields), "grid" (an experiment's group values) and, for a
+    Returns run --json's object as a dict (the result's fields by their
+    names, as the library lists them: docs/files.md, "run"), with "row"
+    (the trial's trials.csv fields), "grid" (an experiment's group values) and, for a
     stored run, "stored_row" (its row in trials.csv). trajectory=True adds
     "trajectory": a dict of NumPy arrays by trajectory.csv column (t, x, y,
     vx, vy, theta1, omega1, ..., f_rand, contact1, ..., e_kin, e_beam,
