@@ -609,6 +609,51 @@ static void test_docs_lattice_columns(void **state)
 	free(doc);
 }
 
+/* A comparison's pairs.csv of `backends` (trials of H1, one a group): its
+ * header line, which docs/files.md gives as `line`, and each side's
+ * column a trials.csv column of the library's table (beamsim/trial_fields.h)
+ * with its side's letter, beside the pairs' separation times. */
+static void pairs_columns(const char *doc, const char *backends, const char *name)
+{
+	const char *dir = bsim_test_dir(name);
+	const char *argv[] = {"compare",    bsim_test_src("configs/thesis/h1_symmetric.yaml"),
+	                      "--backends", backends,
+	                      "--trials",   "1",
+	                      "--quiet",    "--out",
+	                      dir,          NULL};
+	int code = bsim_test_cli(argv, NULL, NULL);
+	assert_true(code == 0 || code == 3); /* 3: the sides disagree, a finding */
+	char *text = bsim_test_read(bsim_test_join(dir, "pairs.csv"));
+	assert_non_null(text);
+	*strchr(text, '\n') = '\0';
+	char quoted[600];
+	snprintf(quoted, sizeof quoted, "`%s`", text);
+	if (!strstr(doc, quoted))
+		fail_msg("docs/files.md does not give pairs.csv's header %s", text);
+	for (char *c = strtok(text, ","); c; c = strtok(NULL, ",")) {
+		if (!strcmp(c, "group") || !strcmp(c, "trial") || !strncmp(c, "t_separate", 10))
+			continue;
+		char *side = strrchr(c, '_');
+		assert_non_null(side);
+		*side = '\0';
+		if (!bsim_trial_field_find(c))
+			fail_msg("pairs.csv's column %s_%s is not one of trials.csv's", c, side + 1);
+	}
+	free(text);
+}
+
+/* pairs.csv's columns (two sides and three) against docs/files.md and the
+ * table of trials.csv's columns, whose descriptions its sides' take. */
+static void test_docs_pairs_columns(void **state)
+{
+	(void)state;
+	char *doc = bsim_test_read(bsim_test_src("docs/files.md"));
+	assert_non_null(doc);
+	pairs_columns(doc, "thesis,chipmunk", "pairs_two");
+	pairs_columns(doc, "thesis,chipmunk,box2d", "pairs_three");
+	free(doc);
+}
+
 /* The reader's column indices (store/trials_csv.h) against the library's
  * table (beamsim/trial_fields.h), which gives each index its name: an
  * index out of step with the table would read one column as another. */
@@ -671,6 +716,7 @@ int main(void)
 	        cmocka_unit_test(test_figures_join_the_set),
 	        cmocka_unit_test(test_docs_trials_columns),
 	        cmocka_unit_test(test_docs_lattice_columns),
+	        cmocka_unit_test(test_docs_pairs_columns),
 	        cmocka_unit_test(test_trials_csv_indices),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);

@@ -87,6 +87,11 @@ BSIM_API const char *bsim_trial_record_fields(void);
 /* The columns, in trials.csv's order; *n gets how many. */
 BSIM_API const bsim_trial_field *bsim_trial_fields(int *n);
 
+/* trials.csv's column of that name, or NULL: other records that show a
+ * trial's outcome, type or location (a comparison's pairs.csv, a side's
+ * columns) take the column's description from here. */
+BSIM_API const bsim_trial_field *bsim_trial_field_find(const char *name);
+
 /* The columns of a lattice's gate_entries.csv (a row a gate entry, its
  * state in the gate's frame) and of its beam_peaks.csv (a row a beam that
  * moved), in their files' order, as bsim_trial_fields; *n gets how many. */

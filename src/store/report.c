@@ -18,6 +18,7 @@
 #include "beamsim/lattice.h"
 #include "beamsim/output.h"
 #include "beamsim/lattice_outcome.h"
+#include "beamsim/trial_fields.h"
 #include "util/text_check.h"
 
 static void set_word(FILE *f, const char *key, const char *value)
@@ -1136,33 +1137,53 @@ void bsim_report_json(FILE *f, const bsim_report *r)
 	fputs("\n  ]\n}\n", f);
 }
 
+/* pairs.csv's columns of each side, lettered by side: trials.csv's, before
+ * and after the pairs' separation times. */
+static const char *const pairs_side_first[] = {"outcome", "type"};
+static const char *const pairs_side_last[] = {"location"};
+
+static void pairs_side_header(FILE *f, const char *const *names, int n_names, int n_sides)
+{
+	for (int s = 0; s < n_sides; s++)
+		for (int k = 0; k < n_names; k++)
+			fprintf(f, ",%s_%c", names[k], 'a' + s);
+}
+
+static void pairs_side_values(FILE *f, const char *const *names, int n_names,
+                              const bsim_report_side *sides, int n_sides, int g, int t, size_t i)
+{
+	for (int s = 0; s < n_sides; s++) {
+		const bsim_trial_row row = {g, t, &sides[s].run->trials_out[i], NULL, 0, NULL};
+		for (int k = 0; k < n_names; k++) {
+			fputc(',', f);
+			bsim_trial_field_write(f, bsim_trial_field_find(names[k]), &row);
+		}
+	}
+}
+
 void bsim_report_pairs_csv(FILE *f, const bsim_report *r)
 {
 	const bsim_comparison *c = r->cmp;
 	const int n = r->n_sides > 2 ? r->n_sides : 2, n_pairs = bsim_sweep_pairs(n);
 	const bsim_report_side *sides = r->n_sides > 2 ? r->sides : r->side;
 	const size_t total = (size_t)c->n_groups * (size_t)c->trials;
+	const int n_first = (int)(sizeof pairs_side_first / sizeof *pairs_side_first);
+	const int n_last = (int)(sizeof pairs_side_last / sizeof *pairs_side_last);
 	fputs("group,trial", f);
-	for (int s = 0; s < n; s++)
-		fprintf(f, ",outcome_%c,type_%c", 'a' + s, 'a' + s);
+	pairs_side_header(f, pairs_side_first, n_first, n);
 	fputs(",t_separate", f);
 	for (int k = 1; k < n_pairs; k++) {
 		int p[2];
 		bsim_sweep_pair(n, k, p);
 		fprintf(f, ",t_separate_%c_%c", 'a' + p[0], 'a' + p[1]);
 	}
-	for (int s = 0; s < n; s++)
-		fprintf(f, ",location_%c", 'a' + s);
+	pairs_side_header(f, pairs_side_last, n_last, n);
 	fputc('\n', f);
 	for (int g = 0; g < c->n_groups; g++)
 		for (int t = 0; t < c->trials; t++) {
 			size_t i = (size_t)g * c->trials + t;
 			fprintf(f, "%d,%d", g, t);
-			for (int s = 0; s < n; s++) {
-				const bsim_trial_result *x = &sides[s].run->trials_out[i];
-				fprintf(f, ",%s,%s", bsim_trial_outcome_name(x->outcome),
-				        bsim_trial_type_name(x->type));
-			}
+			pairs_side_values(f, pairs_side_first, n_first, sides, n, g, t, i);
 			for (int k = 0; k < n_pairs; k++) {
 				double ts =
 				        r->t_separate ? r->t_separate[(size_t)k * total + i] : -1.0;
@@ -1170,13 +1191,7 @@ void bsim_report_pairs_csv(FILE *f, const bsim_report *r)
 				if (ts >= 0.0)
 					fprintf(f, "%.10g", ts);
 			}
-			for (int s = 0; s < n; s++) {
-				char label[48];
-				bsim_lattice_location_label(
-				        bsim_lattice_location_of(&sides[s].run->trials_out[i]),
-				        label, sizeof label);
-				fprintf(f, ",%s", label);
-			}
+			pairs_side_values(f, pairs_side_last, n_last, sides, n, g, t, i);
 			fputc('\n', f);
 		}
 }

@@ -151,6 +151,14 @@ const bsim_trial_field *bsim_trial_fields(int *n)
 	return fields;
 }
 
+const bsim_trial_field *bsim_trial_field_find(const char *name)
+{
+	for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++)
+		if (!strcmp(fields[i].name, name))
+			return &fields[i];
+	return NULL;
+}
+
 /* ---- a lattice's gate_entries.csv and beam_peaks.csv -------------------- */
 
 /* One getter a column of gate entry row->seq of the row's log. */
