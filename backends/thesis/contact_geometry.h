@@ -108,13 +108,15 @@ THESIS_APART void geometry_compute(const thesis_beam_model *bm, thesis_beam *b, 
 {
 	thesis_geometry *g = &b->geo;
 	double dx = x[0] - bm->p[0], dy = x[1] - bm->p[1];
+	/* where it is computed, before the direction's sine and cosine: x
+	 * need not be kept across their call */
+	g->x[0] = x[0];
+	g->x[1] = x[1];
+	g->theta = b->theta;
 	double u[2];
 	thesis_beam_direction(bm, b, u);
 	double s = dx * u[0] + dy * u[1];
 	double a[2];
-	g->x[0] = x[0];
-	g->x[1] = x[1];
-	g->theta = b->theta;
 	if (s > 0.0 && s < bm->length) {
 		double cross = u[0] * dy - u[1] * dx; /* u x (C - P) */
 		double side = cross >= 0.0 ? 1.0 : -1.0;
