@@ -511,9 +511,7 @@ static double urand(unsigned *seed)
 static void lcp_many_contacts(void **state)
 {
 	(void)state;
-	struct bsim_world w;
-	memset(&w, 0, sizeof w);
-	w.inv_mass = 1.0;
+	const double inv_mass = 1.0; /* 1/kg */
 	unsigned seed = 11;
 	thesis_contact cs[8], gs[8];
 	int solved_with_impulse = 0;
@@ -536,13 +534,13 @@ static void lcp_many_contacts(void **state)
 			cs[0].c = cs[1].c = 0.0;
 		}
 		memcpy(gs, cs, sizeof cs);
-		assert_int_equal(bsim_thesis_lcp_solve(w.inv_mass, cs, n), 0); /* converged */
+		assert_int_equal(bsim_thesis_lcp_solve(inv_mass, cs, n), 0); /* converged */
 		double scale = 0.0;
 		for (int i = 0; i < n; i++) {
 			double wi = cs[i].vrel - cs[i].bound;
 			for (int j = 0; j < n; j++) {
 				double k = (cs[i].n[0] * cs[j].n[0] + cs[i].n[1] * cs[j].n[1]) *
-				           w.inv_mass;
+				           inv_mass;
 				if (i == j)
 					k += cs[i].c * cs[i].c * cs[i].inv_i;
 				wi += k * cs[j].impulse;
@@ -566,7 +564,7 @@ static void lcp_many_contacts(void **state)
 				for (int k2 = 0; k2 < n; k2++) {
 					double k = (gs[i].n[0] * gs[k2].n[0] +
 					            gs[i].n[1] * gs[k2].n[1]) *
-					           w.inv_mass;
+					           inv_mass;
 					if (i == k2) {
 						k += gs[i].c * gs[i].c * gs[i].inv_i;
 						kii = k;
@@ -635,11 +633,12 @@ static void three_beams_static_equilibrium(void **state)
 		if (!bsim_thesis_contact_detect(w, i, 1e-3, &c))
 			continue;
 		touching++;
+		const thesis_beam_model *bm = &w->model->beams[i];
 		thesis_beam *b = &w->beams[i];
 		double u[2];
-		thesis_beam_direction(b, u);
-		double lever = (w->x[0] - b->p[0]) * u[0] + (w->x[1] - b->p[1]) * u[1];
-		double force = b->stiffness * b->theta / lever; /* N, P_i = k theta / s */
+		thesis_beam_direction(bm, b, u);
+		double lever = (w->x[0] - bm->p[0]) * u[0] + (w->x[1] - bm->p[1]) * u[1];
+		double force = bm->stiffness * b->theta / lever; /* N, P_i = k theta / s */
 		assert_true(c.type == BSIM_CONTACT_TANGENT);
 		assert_true(c.gap > -2e-6);
 		sum[0] += force * c.n[0];

@@ -256,7 +256,7 @@ static void test_free_flight_as_detection(void **state)
 /* The distance from x to beam b's segment at rest (P to P + L u0), m:
  * the nearest point by the clamped projection, written here apart from the
  * library's. */
-static double rest_segment_distance(const thesis_beam *b, const double x[2])
+static double rest_segment_distance(const thesis_beam_model *b, const double x[2])
 {
 	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
 	double s = dx * b->u0[0] + dy * b->u0[1];
@@ -272,11 +272,12 @@ static double rest_segment_distance(const thesis_beam *b, const double x[2])
  * BSIM_CONTACT_TOL from it: no contact flag). */
 static void assert_clear_truly(const bsim_world *w, double speed, double h)
 {
-	for (int i = 0; i < w->n_beams; i++) {
-		const thesis_beam *c = &w->beams[i];
+	for (int i = 0; i < w->model->n_beams; i++) {
+		const thesis_beam_model *c = &w->model->beams[i];
 		double d = rest_segment_distance(c, w->x);
-		assert_true(d > w->radius + thesis_step_margin(w, c, speed, h));
-		assert_true(d > w->radius + BSIM_CONTACT_TOL + 2.0 * h * speed);
+		assert_true(d >
+		            w->model->radius + thesis_step_margin(w, c, &w->beams[i], speed, h));
+		assert_true(d > w->model->radius + BSIM_CONTACT_TOL + 2.0 * h * speed);
 	}
 }
 
@@ -328,9 +329,9 @@ static void test_free_flight_bound(void **state)
 		w->v[0] = gsl_ran_gaussian(rng, 50.0);
 		w->v[1] = gsl_ran_gaussian(rng, 50.0);
 		double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
-		               h * sqrt(f[0] * f[0] + f[1] * f[1]) * w->inv_mass;
-		const thesis_beam *b = &w->beams[(t / 4) % 2];
-		double reach = w->radius + thesis_clear_margin(w, f, h);
+		               h * sqrt(f[0] * f[0] + f[1] * f[1]) * w->model->inv_mass;
+		const thesis_beam_model *b = &w->model->beams[(t / 4) % 2];
+		double reach = w->model->radius + thesis_clear_margin(w, f, h);
 		double r = reach * (1.0 + gsl_ran_flat(rng, -1e-2, 1e-2));
 		place_off_segment(rng, t, b->p, b->u0, b->length, r, w->x);
 		if (!bsim_thesis_broad_phase_clear(w, f, h))
@@ -365,6 +366,7 @@ static void test_redetect_as_detect(void **state)
 	int far = 0, found = 0;
 	for (int t = 0; t < 100000; t++) {
 		int i = (t / 4) % 2;
+		const thesis_beam_model *bm = &w->model->beams[i];
 		thesis_beam *b = &w->beams[i];
 		const double margin = gsl_ran_flat(rng, 1e-4, 5e-3);
 		/* the configuration of the cached geometry: the body's centre
@@ -372,9 +374,9 @@ static void test_redetect_as_detect(void **state)
 		 * R + margin */
 		b->theta = gsl_ran_flat(rng, -0.3, 0.3);
 		double u[2];
-		thesis_beam_direction(b, u);
-		double r = w->radius + margin * gsl_ran_flat(rng, 0.0, 4.0);
-		place_off_segment(rng, t, b->p, u, b->length, r, w->x);
+		thesis_beam_direction(bm, b, u);
+		double r = w->model->radius + margin * gsl_ran_flat(rng, 0.0, 4.0);
+		place_off_segment(rng, t, bm->p, u, bm->length, r, w->x);
 		thesis_contact c0, c1;
 		bsim_thesis_contact_detect_disk(w, i, margin, &c0); /* the geometry cached */
 		/* the configuration detected: a step away */
@@ -382,7 +384,7 @@ static void test_redetect_as_detect(void **state)
 		w->x[0] += gsl_ran_flat(rng, -step, step);
 		w->x[1] += gsl_ran_flat(rng, -step, step);
 		b->theta += gsl_ran_flat(rng, -1e-3, 1e-3);
-		far += geometry_far(w, b, w->x, w->radius, margin, 0);
+		far += geometry_far(w, bm, b, w->x, w->model->radius, margin, 0);
 		const thesis_beam kept = *b;
 		memset(&c0, 0, sizeof c0);
 		memset(&c1, 0, sizeof c1);
@@ -419,8 +421,8 @@ static void test_free_flight_room(void **state)
 	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
 	const double h = s.dt;
 	/* R + 5 cm under the middle of beam 0 (it points along +x) */
-	const thesis_beam *b0 = &w->beams[0];
-	const double home[2] = {b0->p[0] + 0.5 * b0->length, b0->p[1] - w->radius - 0.05};
+	const thesis_beam_model *b0 = &w->model->beams[0];
+	const double home[2] = {b0->p[0] + 0.5 * b0->length, b0->p[1] - w->model->radius - 0.05};
 	w->x[0] = home[0];
 	w->x[1] = home[1];
 	int clear = 0, by_room = 0;
@@ -443,7 +445,7 @@ static void test_free_flight_room(void **state)
 		by_room +=
 		        w->clear_room == room_before && w->clear_x[0] == cx && w->clear_x[1] == cy;
 		double speed = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
-		               h * sqrt(f[0] * f[0] + f[1] * f[1]) * w->inv_mass;
+		               h * sqrt(f[0] * f[0] + f[1] * f[1]) * w->model->inv_mass;
 		assert_clear_truly(w, speed, h);
 	}
 	assert_true(clear > 20000);

@@ -20,47 +20,49 @@
 /* Inline: a step calls these for every awake beam, and the calls cost as
  * much as the arithmetic. Included by thesis.h. */
 
-static inline double thesis_beam_midpoint_d(const thesis_beam *b, double h)
+static inline double thesis_beam_midpoint_d(const thesis_beam_model *bm, double h)
 {
-	return 1.0 + h * b->damping / (2.0 * b->inertia) +
-	       h * h * b->stiffness / (4.0 * b->inertia);
+	return 1.0 + h * bm->damping / (2.0 * bm->inertia) +
+	       h * h * bm->stiffness / (4.0 * bm->inertia);
 }
 
 /* D and 1/(I D) for steps of h, computed once: a step reads them for every
  * beam in contact, the same bits as computing them there. */
-static inline void thesis_beam_prepare(thesis_beam *b, double h)
+static inline void thesis_beam_prepare(const thesis_beam_model *bm, thesis_beam *b, double h)
 {
-	b->h_d = h;
-	b->d = thesis_beam_midpoint_d(b, h);
-	b->response = 1.0 / (b->inertia * b->d);
+	b->d = thesis_beam_midpoint_d(bm, h);
+	b->response = 1.0 / (bm->inertia * b->d);
 }
 
 /* The two below are asked within a step only, after every beam was
  * prepared for its h (thesis_beams_prepare, at the start of thesis_step
  * and of a run of steps): D and 1/(I D) are read as prepared. */
-static inline double thesis_beam_response(const thesis_beam *b, int integrator)
+static inline double thesis_beam_response(const thesis_beam_model *bm, const thesis_beam *b,
+                                          int integrator)
 {
 	if (integrator == THESIS_EULER)
-		return 1.0 / b->inertia;
+		return 1.0 / bm->inertia;
 	return b->response;
 }
 
-static inline double thesis_beam_free_omega(const thesis_beam *b, double h, int integrator)
+static inline double thesis_beam_free_omega(const thesis_beam_model *bm, const thesis_beam *b,
+                                            double h, int integrator)
 {
 	if (integrator == THESIS_EULER)
 		return b->omega -
-		       h * (b->stiffness * b->theta + b->damping * b->omega) / b->inertia;
+		       h * (bm->stiffness * b->theta + bm->damping * b->omega) / bm->inertia;
 	const double d = b->d;
-	return (b->omega * (2.0 - d) - h * b->stiffness * b->theta / b->inertia) / d;
+	return (b->omega * (2.0 - d) - h * bm->stiffness * b->theta / bm->inertia) / d;
 }
 
 /* Moves theta to the end of the step; returns the damper's loss, J. */
-static inline double thesis_beam_advance(thesis_beam *b, double omega_new, double h, int integrator)
+static inline double thesis_beam_advance(const thesis_beam_model *bm, thesis_beam *b,
+                                         double omega_new, double h, int integrator)
 {
 	double omega_m = integrator == THESIS_EULER ? omega_new : 0.5 * (b->omega + omega_new);
 	b->theta += h * omega_m;
 	b->omega = omega_new;
-	return h * b->damping * omega_m * omega_m;
+	return h * bm->damping * omega_m * omega_m;
 }
 
 #endif

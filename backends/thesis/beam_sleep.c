@@ -51,7 +51,7 @@ void bsim_thesis_awake_prune(struct bsim_world *w)
 	for (int k = 0; k < w->n_awake; k++) {
 		int i = w->awake[k];
 		const thesis_beam *b = &w->beams[i];
-		if (b->theta == 0.0 && b->omega == 0.0 && w->contact_type[i] == BSIM_CONTACT_NONE) {
+		if (b->theta == 0.0 && b->omega == 0.0 && w->contact_of[i] < 0) {
 			w->is_awake[i] = 0;
 			continue;
 		}
@@ -64,16 +64,17 @@ void bsim_thesis_beams_sleep(struct bsim_world *w, double speed, double h)
 {
 	for (int k = 0; k < w->n_awake; k++) {
 		int i = w->awake[k];
+		const thesis_beam_model *bm = &w->model->beams[i];
 		thesis_beam *b = &w->beams[i];
-		if (b->stiffness <= 0.0 || w->contact_type[i] != BSIM_CONTACT_NONE ||
+		if (bm->stiffness <= 0.0 || w->contact_of[i] >= 0 ||
 		    (b->theta == 0.0 && b->omega == 0.0))
 			continue;
-		double e = 0.5 * b->inertia * b->omega * b->omega +
-		           0.5 * b->stiffness * b->theta * b->theta;
-		if (!(e < w->sleep_energy))
+		double e = 0.5 * bm->inertia * b->omega * b->omega +
+		           0.5 * bm->stiffness * b->theta * b->theta;
+		if (!(e < w->model->sleep_energy))
 			continue;
-		double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-		double clear = b->length + 2.0 * w->radius + 2.0 * h * speed;
+		double dx = w->x[0] - bm->p[0], dy = w->x[1] - bm->p[1];
+		double clear = bm->length + 2.0 * w->model->radius + 2.0 * h * speed;
 		if (dx * dx + dy * dy <= clear * clear)
 			continue;
 		b->theta = 0.0;

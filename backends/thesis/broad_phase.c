@@ -27,14 +27,6 @@
 
 #define BROAD_PHASE_MIN_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
 
-void bsim_thesis_grid_free(thesis_grid *g)
-{
-	free(g->start);
-	free(g->items);
-	g->start = g->items = NULL;
-	g->nx = g->ny = 0;
-}
-
 /* The cell of p, clamped to [-1, n] in floating point first, so that a
  * point however far away (a body flung at 1e300 m/s) converts to int
  * without overflow. NaN goes to -1. */
@@ -52,24 +44,26 @@ static void grid_cell_of(const thesis_grid *g, const double p[2], int *cx, int *
 	*cy = grid_index((p[1] - g->origin[1]) / g->cell, g->ny);
 }
 
-int bsim_thesis_grid_build(thesis_grid *g, const struct bsim_world *w)
+void bsim_thesis_grid_build(thesis_model *m)
 {
-	bsim_thesis_grid_free(g);
+	thesis_grid *g = &m->grid;
 	double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, reach = 0.0;
-	for (int i = 0; i < w->n_beams; i++) {
-		const thesis_beam *b = &w->beams[i];
+	for (int i = 0; i < m->n_beams; i++) {
+		const thesis_beam_model *b = &m->beams[i];
 		for (int a = 0; a < 2; a++) {
 			lo[a] = fmin(lo[a], b->p[a]);
 			hi[a] = fmax(hi[a], b->p[a]);
 		}
-		reach = fmax(reach, b->length + w->radius);
+		reach = fmax(reach, b->length + m->radius);
 	}
-	if (w->n_beams == 0)
+	if (m->n_beams == 0)
 		lo[0] = lo[1] = hi[0] = hi[1] = 0.0;
 	/* A cell at least the reach wide; wider where the pivots are spread so
-	 * far apart that the grid would hold many more cells than beams. */
+	 * far apart that the grid would hold many more cells than beams: at
+	 * most 4 n + 16 (nx <= span / cell + 1 exactly, and ny alike), the room
+	 * THESIS_BEAM_ARRAYS gives g->start. */
 	g->cell = reach > 0.0 ? reach : 1.0;
-	double cells_max = 4.0 * w->n_beams + 16.0;
+	double cells_max = 4.0 * m->n_beams + 16.0;
 	while (((hi[0] - lo[0]) / g->cell + 1.0) * ((hi[1] - lo[1]) / g->cell + 1.0) > cells_max)
 		g->cell *= 2.0;
 	g->origin[0] = lo[0];
@@ -77,34 +71,22 @@ int bsim_thesis_grid_build(thesis_grid *g, const struct bsim_world *w)
 	g->nx = (int)floor((hi[0] - lo[0]) / g->cell) + 1;
 	g->ny = (int)floor((hi[1] - lo[1]) / g->cell) + 1;
 	size_t cells = (size_t)g->nx * (size_t)g->ny;
-	g->start = calloc(cells + 1, sizeof *g->start);
-	g->items = malloc((w->n_beams > 0 ? (size_t)w->n_beams : 1) * sizeof *g->items);
-	if (!g->start || !g->items) {
-		bsim_thesis_grid_free(g);
-		return -1;
-	}
-	/* Counting sort by cell keeps the beams of a cell in ascending order. */
-	for (int i = 0; i < w->n_beams; i++) {
+	/* Counting sort by cell keeps the beams of a cell in ascending order:
+	 * start[c] counts cell c's beams and then sums them into the cell's
+	 * end (start[cells] = n), which filling from the last beam moves back
+	 * to the cell's start. */
+	for (int i = 0; i < m->n_beams; i++) {
 		int cx, cy;
-		grid_cell_of(g, w->beams[i].p, &cx, &cy);
-		g->start[(size_t)cy * g->nx + cx + 1]++;
+		grid_cell_of(g, m->beams[i].p, &cx, &cy);
+		g->start[(size_t)cy * g->nx + cx]++;
 	}
-	for (size_t c = 0; c < cells; c++)
-		g->start[c + 1] += g->start[c];
-	int *fill = malloc((cells ? cells : 1) * sizeof *fill);
-	if (!fill) {
-		bsim_thesis_grid_free(g);
-		return -1;
-	}
-	for (size_t c = 0; c < cells; c++)
-		fill[c] = g->start[c];
-	for (int i = 0; i < w->n_beams; i++) {
+	for (size_t c = 1; c <= cells; c++)
+		g->start[c] += g->start[c - 1];
+	for (int i = m->n_beams - 1; i >= 0; i--) {
 		int cx, cy;
-		grid_cell_of(g, w->beams[i].p, &cx, &cy);
-		g->items[fill[(size_t)cy * g->nx + cx]++] = i;
+		grid_cell_of(g, m->beams[i].p, &cx, &cy);
+		g->items[--g->start[(size_t)cy * g->nx + cx]] = i;
 	}
-	free(fill);
-	return 0;
 }
 
 static int cmp_int(const void *a, const void *b)
@@ -148,7 +130,7 @@ static void sort_small(int *v, int n)
  * at rest never move, so the room holds while they stay at rest (the
  * callers ask only then: no beam awake); it is refilled wherever the
  * beams are found clear after it failed. */
-static double rest_distance2(const struct bsim_world *w, const thesis_beam *b)
+static double rest_distance2(const struct bsim_world *w, const thesis_beam_model *b)
 {
 	int type;
 	return bsim_beam_distance2(b->p, b->u0, b->length, w->x, &type);
@@ -157,10 +139,10 @@ static double rest_distance2(const struct bsim_world *w, const thesis_beam *b)
 static void clear_fill(struct bsim_world *w)
 {
 	double room = INFINITY, reach_max = 0.0;
-	for (int i = 0; i < w->n_beams; i++) {
-		const thesis_beam *b = &w->beams[i];
-		room = fmin(room, sqrt(rest_distance2(w, b)) * (1.0 - 1e-9) - w->radius);
-		reach_max = fmax(reach_max, b->length + w->radius);
+	for (int i = 0; i < w->model->n_beams; i++) {
+		const thesis_beam_model *b = &w->model->beams[i];
+		room = fmin(room, sqrt(rest_distance2(w, b)) * (1.0 - 1e-9) - w->model->radius);
+		reach_max = fmax(reach_max, b->length + w->model->radius);
 	}
 	w->clear_x[0] = w->x[0];
 	w->clear_x[1] = w->x[1];
@@ -172,14 +154,14 @@ static void clear_fill(struct bsim_world *w)
  * (thesis_clear_margin bounds it). NaN or overflow: not clear. */
 int bsim_thesis_broad_phase_clear(struct bsim_world *w, const double force[2], double h)
 {
-	if (!w->broad_phase || w->n_beams > BROAD_PHASE_MIN_BEAMS)
+	if (!w->model->broad_phase || w->model->n_beams > BROAD_PHASE_MIN_BEAMS)
 		return 0; /* broad_phase=0: every beam tested, for checking */
 	double margin = thesis_clear_margin(w, force, h);
 	if (fabs(w->x[0] - w->clear_x[0]) + fabs(w->x[1] - w->clear_x[1]) + margin < w->clear_room)
 		return 1; /* clear_fill below */
-	for (int i = 0; i < w->n_beams; i++) {
-		const double reach = (w->radius + margin) * (1.0 + 1e-9);
-		if (!(rest_distance2(w, &w->beams[i]) > reach * reach))
+	for (int i = 0; i < w->model->n_beams; i++) {
+		const double reach = (w->model->radius + margin) * (1.0 + 1e-9);
+		if (!(rest_distance2(w, &w->model->beams[i]) > reach * reach))
 			return 0;
 	}
 	clear_fill(w);
@@ -208,7 +190,7 @@ void bsim_thesis_near_forget(struct bsim_world *w)
 
 static void near_fill(struct bsim_world *w, double margin)
 {
-	const thesis_grid *g = &w->grid;
+	const thesis_grid *g = &w->model->grid;
 	double d = 0.25 * g->cell + margin;
 	double r = g->cell + d;
 	double lo[2] = {w->x[0] - r, w->x[1] - r}, hi[2] = {w->x[0] + r, w->x[1] + r};
@@ -231,9 +213,9 @@ static void near_fill(struct bsim_world *w, double margin)
 			size_t c = (size_t)cy * g->nx + cx;
 			for (int k = g->start[c]; k < g->start[c + 1]; k++) {
 				int i = g->items[k];
-				const thesis_beam *b = &w->beams[i];
+				const thesis_beam_model *b = &w->model->beams[i];
 				double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
-				double reach = (b->length + w->radius + d) * (1.0 + 1e-9);
+				double reach = (b->length + w->model->radius + d) * (1.0 + 1e-9);
 				if (dx * dx + dy * dy > reach * reach)
 					continue;
 				w->near[w->n_near++] = i;
@@ -255,7 +237,7 @@ static int near_query(struct bsim_world *w, double margin, int *out, int n, int 
 		int i = w->near[k];
 		if (w->is_awake[i])
 			continue;
-		if (beam_beyond_reach(w, &w->beams[i], margin))
+		if (beam_beyond_reach(w, &w->model->beams[i], margin))
 			continue;
 		out[n++] = i;
 		*found = 1;
@@ -272,8 +254,8 @@ static int candidates_within(struct bsim_world *w, double margin, int *sleeping_
 	int *out = w->candidates;
 	int n = 0;
 	*sleeping_found = 0;
-	if (!w->broad_phase || w->n_beams <= BROAD_PHASE_MIN_BEAMS) {
-		for (int i = 0; i < w->n_beams; i++)
+	if (!w->model->broad_phase || w->model->n_beams <= BROAD_PHASE_MIN_BEAMS) {
+		for (int i = 0; i < w->model->n_beams; i++)
 			out[n++] = i;
 		return n;
 	}
@@ -287,7 +269,7 @@ static int candidates_within(struct bsim_world *w, double margin, int *sleeping_
 int bsim_thesis_broad_phase(struct bsim_world *w, double speed, double h)
 {
 	int sleeping_found;
-	int n = candidates_within(w, 2.0 * h * speed + w->slop, &sleeping_found);
+	int n = candidates_within(w, 2.0 * h * speed + w->model->slop, &sleeping_found);
 	if (sleeping_found)
 		sort_small(w->candidates, n);
 	return n;

@@ -18,7 +18,7 @@
  *   a = Q - P,  c = sgn (a x n),  ct = sgn (a . n),
  *   r_b = K - C,  cb = r_b x n,  cbt = r_b . n,
  * tip when Q is an end of the segment, tangent otherwise. The geometry
- * keeps dist = gap + reach (w->radius is the shape's reach), so that every
+ * keeps dist = gap + reach (w->model->radius is the shape's reach), so that every
  * bound below, written for a disk of radius `reach`, holds: the outline
  * lies within the reach of the centre. A turn of the body by dpsi moves no
  * point of its outline farther than reach |dpsi|, which the bound on the
@@ -34,22 +34,22 @@
  * call these for every beam in reach, and share one copy. */
 
 /* The direction u of beam b at its angle. */
-static inline void thesis_beam_direction(thesis_beam *b, double u[2])
+static inline void thesis_beam_direction(const thesis_beam_model *bm, thesis_beam *b, double u[2])
 {
 	/* At rest the rotation is the identity: u0 exactly, as the formula
 	 * below gives it (u0 - u0_perp * (+-0) = u0), without the sine and
 	 * cosine; a lattice has many beams at rest near the body. */
 	if (b->theta == 0.0) {
-		u[0] = b->u0[0];
-		u[1] = b->u0[1];
+		u[0] = bm->u0[0];
+		u[1] = bm->u0[1];
 		return;
 	}
 	/* The same angle gives the same bits: the sine and cosine once per
 	 * angle, however often a step asks (NaN never equals itself). */
 	if (b->theta != b->u_theta) {
-		double cs = cos(b->theta), sn = b->sgn * sin(b->theta);
-		b->u[0] = b->u0[0] * cs - b->u0[1] * sn;
-		b->u[1] = b->u0[1] * cs + b->u0[0] * sn;
+		double cs = cos(b->theta), sn = bm->sgn * sin(b->theta);
+		b->u[0] = bm->u0[0] * cs - bm->u0[1] * sn;
+		b->u[1] = bm->u0[1] * cs + bm->u0[0] * sn;
 		b->u_theta = b->theta;
 	}
 	u[0] = b->u[0];
@@ -58,18 +58,19 @@ static inline void thesis_beam_direction(thesis_beam *b, double u[2])
 
 /* thesis_beam_direction without keeping what it computes, for a world it
  * may not change (get_state): the kept direction where it is the angle's. */
-static inline void thesis_beam_direction_of(const thesis_beam *b, double u[2])
+static inline void thesis_beam_direction_of(const thesis_beam_model *bm, const thesis_beam *b,
+                                            double u[2])
 {
 	if (b->theta == 0.0) {
-		u[0] = b->u0[0];
-		u[1] = b->u0[1];
+		u[0] = bm->u0[0];
+		u[1] = bm->u0[1];
 	} else if (b->theta == b->u_theta) {
 		u[0] = b->u[0];
 		u[1] = b->u[1];
 	} else {
-		double cs = cos(b->theta), sn = b->sgn * sin(b->theta);
-		u[0] = b->u0[0] * cs - b->u0[1] * sn;
-		u[1] = b->u0[1] * cs + b->u0[0] * sn;
+		double cs = cos(b->theta), sn = bm->sgn * sin(b->theta);
+		u[0] = bm->u0[0] * cs - bm->u0[1] * sn;
+		u[1] = bm->u0[1] * cs + bm->u0[0] * sn;
 	}
 }
 
@@ -89,7 +90,7 @@ static inline void thesis_state_beam(struct bsim_world *w, int i, int pushed, do
 	s->touched[i] = pushed;
 	s->impulse[i] = pushed ? impulse : 0.0;
 	if (pushed || near) {
-		thesis_beam_direction(b, &s->direction[2 * i]);
+		thesis_beam_direction(&w->model->beams[i], b, &s->direction[2 * i]);
 	} else {
 		s->direction[2 * i] = NAN;
 		s->direction[2 * i + 1] = NAN;
@@ -102,18 +103,21 @@ static inline void thesis_state_beam(struct bsim_world *w, int i, int pushed, do
  * the sine and cosine): inline, the detection and the runs of steps around
  * it compiled to 30 instructions a step more on H1 (bench --callgrind),
  * most of their calls reusing a geometry or bounding it far instead. */
-THESIS_APART void geometry_compute(thesis_beam *b, const double x[2], const int extended)
+THESIS_APART void geometry_compute(const thesis_beam_model *bm, thesis_beam *b, const double x[2],
+                                   const int extended)
 {
 	thesis_geometry *g = &b->geo;
-	double dx = x[0] - b->p[0], dy = x[1] - b->p[1];
-	double u[2];
-	thesis_beam_direction(b, u);
-	double s = dx * u[0] + dy * u[1];
-	double a[2];
+	double dx = x[0] - bm->p[0], dy = x[1] - bm->p[1];
+	/* where it is computed, before the direction's sine and cosine: x
+	 * need not be kept across their call */
 	g->x[0] = x[0];
 	g->x[1] = x[1];
 	g->theta = b->theta;
-	if (s > 0.0 && s < b->length) {
+	double u[2];
+	thesis_beam_direction(bm, b, u);
+	double s = dx * u[0] + dy * u[1];
+	double a[2];
+	if (s > 0.0 && s < bm->length) {
 		double cross = u[0] * dy - u[1] * dx; /* u x (C - P) */
 		double side = cross >= 0.0 ? 1.0 : -1.0;
 		g->dist = fabs(cross);
@@ -123,7 +127,7 @@ THESIS_APART void geometry_compute(thesis_beam *b, const double x[2], const int 
 		a[1] = s * u[1];
 		g->type = BSIM_CONTACT_TANGENT;
 	} else {
-		double l = s > 0.0 ? b->length : 0.0;
+		double l = s > 0.0 ? bm->length : 0.0;
 		a[0] = l * u[0];
 		a[1] = l * u[1];
 		double qx = dx - a[0], qy = dy - a[1];
@@ -136,7 +140,7 @@ THESIS_APART void geometry_compute(thesis_beam *b, const double x[2], const int 
 		g->n[1] = qy / g->dist;
 		g->type = BSIM_CONTACT_TIP;
 	}
-	g->c = b->sgn * (a[0] * g->n[1] - a[1] * g->n[0]);
+	g->c = bm->sgn * (a[0] * g->n[1] - a[1] * g->n[0]);
 	if (extended) {
 		g->a[0] = a[0];
 		g->a[1] = a[1];
@@ -150,15 +154,15 @@ THESIS_APART void geometry_compute(thesis_beam *b, const double x[2], const int 
  *   dist >= dist_g - |x - x_g| - L |theta - theta_g|.
  * A cushion of 1e-9 of the lengths involved covers the round-off of both
  * distances, so the bound never rejects what the exact test would keep. */
-THESIS_SPECIALISED int geometry_far(const struct bsim_world *w, const thesis_beam *b,
-                                    const double x[2], double radius, double margin,
-                                    const int extended)
+THESIS_SPECIALISED int geometry_far(const struct bsim_world *w, const thesis_beam_model *bm,
+                                    const thesis_beam *b, const double x[2], double radius,
+                                    double margin, const int extended)
 {
 	const thesis_geometry *g = &b->geo;
 	double ex = x[0] - g->x[0], ey = x[1] - g->x[1];
-	double cushion = 1e-9 * (g->dist + b->length + radius + margin);
-	double slack = g->dist - b->length * fabs(b->theta - g->theta) - radius - margin - cushion;
-	if (extended && w->shaped)
+	double cushion = 1e-9 * (g->dist + bm->length + radius + margin);
+	double slack = g->dist - bm->length * fabs(b->theta - g->theta) - radius - margin - cushion;
+	if (extended && w->model->shaped)
 		slack -= radius * fabs(w->heading - g->psi);
 	return slack > 0.0 && ex * ex + ey * ey < slack * slack; /* false for NaN */
 }
@@ -187,9 +191,9 @@ THESIS_SPECIALISED int contact_from_geometry(const thesis_geometry *g, int i, do
 }
 
 /* |C - P|^2, m^2: the body's centre from beam b's pivot. */
-static inline double beam_pivot_distance2(const struct bsim_world *w, const thesis_beam *b)
+static inline double beam_pivot_distance2(const struct bsim_world *w, const thesis_beam_model *bm)
 {
-	double dx = w->x[0] - b->p[0], dy = w->x[1] - b->p[1];
+	double dx = w->x[0] - bm->p[0], dy = w->x[1] - bm->p[1];
 	return dx * dx + dy * dy;
 }
 
@@ -197,16 +201,17 @@ static inline double beam_pivot_distance2(const struct bsim_world *w, const thes
  * (beam_pivot_distance2), lies outside the beam's disc of radius L + R +
  * margin about the pivot, where no point of the beam, at any angle, comes
  * within R + margin: no trigonometry needed. */
-static inline int beam_beyond(const thesis_beam *b, double d2, double margin)
+static inline int beam_beyond(const thesis_beam_model *bm, double d2, double margin)
 {
-	double reach = b->reach + margin; /* L + R + margin */
+	double reach = bm->reach + margin; /* L + R + margin */
 	return d2 > reach * reach;
 }
 
 /* beam_beyond for the body where it is. */
-static inline int beam_beyond_reach(const struct bsim_world *w, const thesis_beam *b, double margin)
+static inline int beam_beyond_reach(const struct bsim_world *w, const thesis_beam_model *bm,
+                                    double margin)
 {
-	return beam_beyond(b, beam_pivot_distance2(w, b), margin);
+	return beam_beyond(bm, beam_pivot_distance2(w, bm), margin);
 }
 
 /* 1 if beam b's geometry is the body's at its angle now (and, for a shaped
@@ -218,10 +223,10 @@ static inline int geometry_fresh(const struct bsim_world *w, const thesis_beam *
 {
 	const thesis_geometry *g = &b->geo;
 	return g->x[0] == w->x[0] && g->x[1] == w->x[1] && g->theta == b->theta &&
-	       (!extended || !w->shaped || g->psi == w->heading);
+	       (!extended || !w->model->shaped || g->psi == w->heading);
 }
 
-/* The essay's disk (w->extended 0) against beam i: its contact within
+/* The essay's disk (w->model->extended 0) against beam i: its contact within
  * margin into out, 1, or 0; the geometry kept in the beam. contact_detect's
  * path for the disk, apart from the extended path's, whose tests it has
  * none of. near (a constant): beam i is one the step found in contact
@@ -234,69 +239,73 @@ static inline int geometry_fresh(const struct bsim_world *w, const thesis_beam *
 THESIS_SPECIALISED int disk_detect_at(struct bsim_world *w, int i, double d2, double margin,
                                       thesis_contact *out, const int near, const int touched)
 {
+	const thesis_beam_model *bm = &w->model->beams[i];
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
-	if (beam_beyond(b, d2, margin))
+	if (beam_beyond(bm, d2, margin))
 		return 0;
 	const thesis_geometry *g = &b->geo;
 	if (!geometry_fresh(w, b, 0)) {
-		if (!near && geometry_far(w, b, w->x, w->radius, margin, 0))
+		if (!near && geometry_far(w, bm, b, w->x, w->model->radius, margin, 0))
 			return 0;
 		if (!touched)
 			thesis_beam_touch(w, i);
-		geometry_compute(b, w->x, 0);
+		geometry_compute(bm, b, w->x, 0);
 	}
-	return contact_from_geometry(g, i, w->radius, margin, w->e_tip, w->e_tangent, out);
+	return contact_from_geometry(g, i, w->model->radius, margin, w->model->e_tip,
+	                             w->model->e_tangent, out);
 }
 
 /* disk_detect_at for the body where it is. */
 THESIS_SPECIALISED int disk_detect(struct bsim_world *w, int i, double margin, thesis_contact *out,
                                    const int near, const int touched)
 {
-	return disk_detect_at(w, i, beam_pivot_distance2(w, &w->beams[i]), margin, out, near,
+	return disk_detect_at(w, i, beam_pivot_distance2(w, &w->model->beams[i]), margin, out, near,
 	                      touched);
 }
 
 /* Detection for any body (extended 1: the world's flags decide) or for the
- * essay's disk (extended 0, w->extended 0): a constant, so that the disk's
+ * essay's disk (extended 0, w->model->extended 0): a constant, so that the disk's
  * copy is compiled without the extended path's tests and stores. */
 THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin,
                                       thesis_contact *out, const int extended)
 {
 	if (!extended)
 		return disk_detect(w, i, margin, out, 0, 0);
+	const thesis_beam_model *bm = &w->model->beams[i];
 	thesis_beam *b = &w->beams[i]; /* its geometry kept */
-	if (beam_beyond_reach(w, b, margin))
+	if (beam_beyond_reach(w, bm, margin))
 		return 0;
 	const thesis_geometry *g = &b->geo;
 	if (!geometry_fresh(w, b, 1)) {
-		if (geometry_far(w, b, w->x, w->radius, margin, 1))
+		if (geometry_far(w, bm, b, w->x, w->model->radius, margin, 1))
 			return 0;
 		thesis_beam_touch(w, i);
-		if (w->shaped) {
+		if (w->model->shaped) {
 			double u[2];
-			thesis_beam_direction(b, u);
-			bsim_thesis_shape_geometry(w, b, u);
+			thesis_beam_direction(bm, b, u);
+			bsim_thesis_shape_geometry(w, bm, b, u);
 		} else {
-			geometry_compute(b, w->x, 1);
+			geometry_compute(bm, b, w->x, 1);
 		}
 	}
-	if (!contact_from_geometry(g, i, w->radius, margin, w->e_tip, w->e_tangent, out))
+	if (!contact_from_geometry(g, i, w->model->radius, margin, w->model->e_tip,
+	                           w->model->e_tangent, out))
 		return 0;
 	out->two = 0; /* read by the extended path's solves only */
-	if (w->extended) {
-		out->mu = w->friction;
+	if (w->model->extended) {
+		out->mu = w->model->friction;
 		out->impulse_t = 0.0;
-		if (w->shaped) {
+		if (w->model->shaped) {
 			out->cb = g->cb;
 			out->cbt = g->cbt;
 			out->ct = g->ct;
 		} else {
 			out->cb = 0.0;
-			out->cbt = -w->radius;
-			out->ct = b->sgn * (g->a[0] * g->n[0] + g->a[1] * g->n[1]);
+			out->cbt = -w->model->radius;
+			out->ct = bm->sgn * (g->a[0] * g->n[0] + g->a[1] * g->n[1]);
 		}
 	}
-	if (w->shaped && g->has2)
+	if (w->model->shaped && g->has2)
 		return 1 + bsim_thesis_shape_second(w, g, margin, out);
 	return 1;
 }
@@ -308,17 +317,18 @@ THESIS_SPECIALISED int contact_detect(struct bsim_world *w, int i, double margin
 THESIS_SPECIALISED int contact_near_at(const struct bsim_world *w, int i, double d2, double margin,
                                        const int extended)
 {
-	const thesis_beam *b = &w->beams[i];
-	if (beam_beyond(b, d2, margin))
+	const thesis_beam_model *bm = &w->model->beams[i];
+	if (beam_beyond(bm, d2, margin))
 		return 0;
-	return !geometry_far(w, b, w->x, w->radius, margin, extended);
+	return !geometry_far(w, bm, &w->beams[i], w->x, w->model->radius, margin, extended);
 }
 
 /* contact_near_at for the body where it is. */
 THESIS_SPECIALISED int contact_near(const struct bsim_world *w, int i, double margin,
                                     const int extended)
 {
-	return contact_near_at(w, i, beam_pivot_distance2(w, &w->beams[i]), margin, extended);
+	return contact_near_at(w, i, beam_pivot_distance2(w, &w->model->beams[i]), margin,
+	                       extended);
 }
 
 #endif

@@ -3,7 +3,7 @@
  * beamsim/state.h): every beam the flag may mark must be listed. The flag
  * marks a beam within BSIM_CONTACT_TOL (6 mm) of the body at the step's
  * end, or one that took a nonzero impact or persistent-contact impulse in
- * the step (w->pushed, impact_resolve.h and persistent_contact.h, which
+ * the step (w->impulse > 0, impact_resolve.h and persistent_contact.h, which
  * the state reports as touched). So after each step the world wakes, and
  * its state lists, the pushed beams and those the broad phase finds within
  * L + R + 6 mm of the body, minus those whose last geometry bounds them
@@ -36,7 +36,7 @@ THESIS_SPECIALISED void contact_list_beams(struct bsim_world *w, thesis_run *run
 	if (run) {
 		run->near = 0;
 		for (int i = 0; i < run->nb; i++) {
-			run->d2[i] = beam_pivot_distance2(w, &w->beams[i]);
+			run->d2[i] = beam_pivot_distance2(w, &w->model->beams[i]);
 			if (thesis_run_has(run->pushed, i) ||
 			    contact_near_at(w, i, run->d2[i], BSIM_CONTACT_TOL, 0))
 				run->near |= 1u << i;

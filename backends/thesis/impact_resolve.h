@@ -66,21 +66,22 @@ THESIS_SPECIALISED void impact_apply(struct bsim_world *w, thesis_run *run,
                                      const thesis_contact *cs, int n, const int extended)
 {
 	double j[2], jw = 0.0;
-	if (extended && w->extended)
+	if (extended && w->model->extended)
 		bsim_thesis_impulse_sum_extended(cs, n, j, &jw);
 	else
 		thesis_impulse_sum(cs, n, j);
-	w->v[0] += j[0] * w->impact_inv_mass;
-	w->v[1] += j[1] * w->impact_inv_mass;
-	if (extended && w->rotates)
-		w->angular_velocity += jw * w->inv_body_inertia;
+	w->v[0] += j[0] * w->model->impact_inv_mass;
+	w->v[1] += j[1] * w->model->impact_inv_mass;
+	if (extended && w->model->rotates)
+		w->angular_velocity += jw * w->model->inv_body_inertia;
 	for (int i = 0; i < n; i++) {
 		thesis_beam *b = &w->beams[cs[i].beam];
-		if (extended && w->extended && cs[i].impulse_t != 0.0)
+		const double inertia = w->model->beams[cs[i].beam].inertia;
+		if (extended && w->model->extended && cs[i].impulse_t != 0.0)
 			b->omega -=
-			        (cs[i].impulse * cs[i].c + cs[i].impulse_t * cs[i].ct) / b->inertia;
+			        (cs[i].impulse * cs[i].c + cs[i].impulse_t * cs[i].ct) / inertia;
 		else
-			b->omega -= cs[i].impulse * cs[i].c / b->inertia;
+			b->omega -= cs[i].impulse * cs[i].c / inertia;
 		if (cs[i].impulse > 0.0)
 			step_push(w, run, cs[i].beam, cs[i].impulse);
 	}
@@ -105,8 +106,8 @@ static inline double impact_energy_change(const struct bsim_world *w, const thes
 			if (cs[i].two && cs[k].two && cs[i].beam == cs[k].beam)
 				e += jb * (pn[k] * cs[k].c + pt[k] * cs[k].ct) * cs[i].inv_i;
 	}
-	e += 0.5 * (jv[0] * jv[0] + jv[1] * jv[1]) * w->impact_inv_mass +
-	     0.5 * jw * jw * w->inv_body_inertia;
+	e += 0.5 * (jv[0] * jv[0] + jv[1] * jv[1]) * w->model->impact_inv_mass +
+	     0.5 * jw * jw * w->model->inv_body_inertia;
 	return e;
 }
 
@@ -115,8 +116,8 @@ static inline double impact_energy_change(const struct bsim_world *w, const thes
  * 1 if a solve was not exact. */
 static inline int impact_solve_friction(struct bsim_world *w, thesis_contact *cs, int n)
 {
-	double inv_j = w->inv_body_inertia;
-	int inexact = bsim_thesis_contact_solve(w->impact_inv_mass, inv_j, cs, n);
+	double inv_j = w->model->inv_body_inertia;
+	int inexact = bsim_thesis_contact_solve(w->model->impact_inv_mass, inv_j, cs, n);
 	double pn[IMPACT_CONTACTS_MAX], pt[IMPACT_CONTACTS_MAX];
 	if (n > IMPACT_CONTACTS_MAX)
 		return inexact;
@@ -131,7 +132,7 @@ static inline int impact_solve_friction(struct bsim_world *w, thesis_contact *cs
 		bound[i] = cs[i].bound;
 		cs[i].bound = 0.0;
 	}
-	inexact |= bsim_thesis_contact_solve(w->impact_inv_mass, inv_j, cs, n);
+	inexact |= bsim_thesis_contact_solve(w->model->impact_inv_mass, inv_j, cs, n);
 	double p0n[IMPACT_CONTACTS_MAX], p0t[IMPACT_CONTACTS_MAX], dn[IMPACT_CONTACTS_MAX],
 	        dt[IMPACT_CONTACTS_MAX];
 	for (int i = 0; i < n; i++) {
@@ -173,11 +174,12 @@ static inline int impact_solve_friction(struct bsim_world *w, thesis_contact *cs
 THESIS_SPECIALISED int impact_solve(struct bsim_world *w, thesis_contact *cs, int n,
                                     const int extended)
 {
-	if (!(extended && w->extended))
-		return thesis_lcp_disk(w->impact_inv_mass, cs, n);
-	if (w->friction > 0.0)
+	if (!(extended && w->model->extended))
+		return thesis_lcp_disk(w->model->impact_inv_mass, cs, n);
+	if (w->model->friction > 0.0)
 		return impact_solve_friction(w, cs, n);
-	return bsim_thesis_contact_solve(w->impact_inv_mass, w->inv_body_inertia, cs, n);
+	return bsim_thesis_contact_solve(w->model->impact_inv_mass, w->model->inv_body_inertia, cs,
+	                                 n);
 }
 
 /* Passes of the nearest-first order at most, and the approach speed, m/s,
@@ -210,7 +212,7 @@ THESIS_SPECIALISED void impact_nearest_first(struct bsim_world *w, thesis_run *r
 		thesis_impact_bound(w, next);
 		impact_solve(w, next, 1, extended);
 		impact_apply(w, run, next, 1, extended);
-		if (next->impulse > 0.0 && next->vrel < -w->rest_threshold)
+		if (next->impulse > 0.0 && next->vrel < -w->model->rest_threshold)
 			(*impacts)++;
 	}
 }
@@ -228,7 +230,7 @@ THESIS_SPECIALISED int impact_resolve(struct bsim_world *w, thesis_run *run, dou
 		return 0;
 
 	double ke = step_kinetic(w, run, extended);
-	if (!run && w->impact_order == THESIS_NEAREST_FIRST) { /* a run's are simultaneous */
+	if (!run && w->model->impact_order == THESIS_NEAREST_FIRST) { /* a run's are simultaneous */
 		impact_nearest_first(w, run, cs, n, impacts, extended);
 	} else {
 		for (int i = 0; i < n; i++)
@@ -236,7 +238,7 @@ THESIS_SPECIALISED int impact_resolve(struct bsim_world *w, thesis_run *run, dou
 		w->solver.iteration_limit += impact_solve(w, cs, n, extended);
 		impact_apply(w, run, cs, n, extended);
 		for (int i = 0; i < n; i++)
-			*impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->rest_threshold;
+			*impacts += cs[i].impulse > 0.0 && cs[i].vrel < -w->model->rest_threshold;
 	}
 	*e_impact += ke - step_kinetic(w, run, extended);
 	return 1;

@@ -49,40 +49,42 @@ static inline void persistent_solve_extended(struct bsim_world *w, const double 
                                              double torque, double h)
 {
 	double v0[2] = {w->v[0], w->v[1]};
-	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
+	double vf[2] = {v0[0] + h * force[0] * w->model->inv_mass,
+	                v0[1] + h * force[1] * w->model->inv_mass};
 	thesis_contact *cs = w->contacts;
 	int n = w->n_contacts;
 	double w0 = w->angular_velocity, wf = w0;
-	if (w->rotates)
-		wf = w0 + h * torque * w->inv_body_inertia;
+	if (w->model->rotates)
+		wf = w0 + h * torque * w->model->inv_body_inertia;
 
 	for (int k = 0; k < n; k++) {
 		thesis_contact *c = &cs[k];
+		const thesis_beam_model *bm = &w->model->beams[c->beam];
 		const thesis_beam *b = &w->beams[c->beam];
 		double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
-		c->omega_free = thesis_beam_free_omega(b, h, w->integrator);
+		c->omega_free = thesis_beam_free_omega(bm, b, h, w->model->integrator);
 		double gap = bsim_fmax(c->gap, 0.0);
-		c->inv_i = thesis_beam_response(b, w->integrator);
+		c->inv_i = thesis_beam_response(bm, b, w->model->integrator);
 		c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
 		vrel0 += w0 * c->cb;
 		c->vrel += wf * c->cb;
 		c->vrel_t =
 		        (vf[1] * c->n[0] - vf[0] * c->n[1]) + wf * c->cbt - c->omega_free * c->ct;
-		c->bound = w->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
+		c->bound = w->model->integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 	}
 	/* No contact (free flight): no solve, and the impulse sum of none is
 	 * 0 (thesis_impulse_sum's start), added as it would be. */
 	double j[2] = {0.0, 0.0}, jw = 0.0;
 	if (n) {
-		w->solver.iteration_limit +=
-		        bsim_thesis_contact_solve(w->inv_mass, w->inv_body_inertia, cs, n);
+		w->solver.iteration_limit += bsim_thesis_contact_solve(
+		        w->model->inv_mass, w->model->inv_body_inertia, cs, n);
 		bsim_thesis_impulse_sum_extended(cs, n, j, &jw);
 	}
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
+	thesis_body_advance(w, v0, vf, j, h, vm, w->model->integrator);
 	thesis_body_turn(w, w0, torque, jw, h);
-	double wm = w->integrator == THESIS_EULER ? w->angular_velocity
-	                                          : 0.5 * (w0 + w->angular_velocity);
+	double wm = w->model->integrator == THESIS_EULER ? w->angular_velocity
+	                                                 : 0.5 * (w0 + w->angular_velocity);
 
 	/* Beams in contact take their impulse; all others move freely. A beam
 	 * at rest and untouched stays at rest and costs nothing: only the awake
@@ -95,6 +97,7 @@ static inline void persistent_solve_extended(struct bsim_world *w, const double 
 	}
 	for (int a = 0; a < w->n_awake; a++) {
 		int i = w->awake[a];
+		const thesis_beam_model *bm = &w->model->beams[i];
 		thesis_beam *b = &w->beams[i];
 		int k = w->contact_of[i];
 		w->contact_of[i] = -1;
@@ -102,7 +105,7 @@ static inline void persistent_solve_extended(struct bsim_world *w, const double 
 			continue;
 		double omega_new;
 		if (k < 0) {
-			omega_new = thesis_beam_free_omega(b, h, w->integrator);
+			omega_new = thesis_beam_free_omega(bm, b, h, w->model->integrator);
 		} else {
 			/* The beam's contacts: one, or a capsule's two. */
 			double moment = 0.0;
@@ -111,7 +114,7 @@ static inline void persistent_solve_extended(struct bsim_world *w, const double 
 					moment += cs[q].impulse * cs[q].c +
 					          cs[q].impulse_t * cs[q].ct;
 			omega_new = cs[k].omega_free - moment * cs[k].inv_i;
-			double omega_m = w->integrator == THESIS_EULER
+			double omega_m = w->model->integrator == THESIS_EULER
 			                         ? omega_new
 			                         : 0.5 * (b->omega + omega_new);
 			for (int q = 0; q < n; q++) {
@@ -127,13 +130,13 @@ static inline void persistent_solve_extended(struct bsim_world *w, const double 
 				                        c->cbt * wm - c->ct * omega_m);
 			}
 		}
-		w->energy.damper += thesis_beam_advance(b, omega_new, h, w->integrator);
+		w->energy.damper += thesis_beam_advance(bm, b, omega_new, h, w->model->integrator);
 	}
 }
 
 /* The essay's disk's path: the body's free velocity v + dv (dv = h F /
  * M, as the caller computes it); the dampers' loss added to *damper and
- * minus the contacts' work to *contact, J. integrator: w->integrator, a
+ * minus the contacts' work to *contact, J. integrator: w->model->integrator, a
  * constant where the caller gives one. */
 THESIS_SPECIALISED void persistent_solve_disk(struct bsim_world *w, thesis_run *run,
                                               const double dv[2], double h, double *damper,
@@ -145,14 +148,15 @@ THESIS_SPECIALISED void persistent_solve_disk(struct bsim_world *w, thesis_run *
 	int n = w->n_contacts;
 
 	for (int k = 0; k < n; k++) {
-		thesis_smooth_row(&cs[k], &w->beams[cs[k].beam], v0, vf, h, integrator);
+		thesis_smooth_row(&cs[k], &w->model->beams[cs[k].beam], &w->beams[cs[k].beam], v0,
+		                  vf, h, integrator);
 		w->contact_of[cs[k].beam] = k;
 	}
 	/* No contact (free flight): no solve, and the impulse sum of none is
 	 * 0 (thesis_impulse_sum's start), added as it would be. */
 	double j[2] = {0.0, 0.0};
 	if (n) {
-		w->solver.iteration_limit += thesis_lcp_disk(w->inv_mass, cs, n);
+		w->solver.iteration_limit += thesis_lcp_disk(w->model->inv_mass, cs, n);
 		thesis_impulse_sum(cs, n, j);
 		for (int k = 0; k < n; k++)
 			if (cs[k].impulse > 0.0)
@@ -172,8 +176,8 @@ THESIS_SPECIALISED void persistent_solve_disk(struct bsim_world *w, thesis_run *
 			continue;
 		int k = w->contact_of[i];
 		w->contact_of[i] = -1;
-		thesis_smooth_beam(&w->beams[i], k < 0 ? NULL : &cs[k], vm, h, integrator,
-		                   &e_damper, &e_contact);
+		thesis_smooth_beam(&w->model->beams[i], &w->beams[i], k < 0 ? NULL : &cs[k], vm, h,
+		                   integrator, &e_damper, &e_contact);
 	}
 	*damper = e_damper;
 	*contact = e_contact;

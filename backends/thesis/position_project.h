@@ -31,18 +31,18 @@ THESIS_SPECIALISED void project_once(struct bsim_world *w, thesis_contact *cs, i
 	for (int k = 0; k < n; k++) {
 		cs[k].vrel = cs[k].gap;
 		cs[k].bound = 0.0;
-		cs[k].inv_i = w->beams[cs[k].beam].inv_inertia;
+		cs[k].inv_i = w->model->beams[cs[k].beam].inv_inertia;
 	}
-	if (extended && w->extended)
-		w->solver.iteration_limit +=
-		        bsim_thesis_lcp_solve_j(w->inv_mass, w->inv_body_inertia, cs, n);
+	if (extended && w->model->extended)
+		w->solver.iteration_limit += bsim_thesis_lcp_solve_j(
+		        w->model->inv_mass, w->model->inv_body_inertia, cs, n);
 	else
-		w->solver.iteration_limit += thesis_lcp_disk(w->inv_mass, cs, n);
-	if (extended && w->rotates) {
+		w->solver.iteration_limit += thesis_lcp_disk(w->model->inv_mass, cs, n);
+	if (extended && w->model->rotates) {
 		double dpsi = 0.0;
 		for (int k = 0; k < n; k++)
 			dpsi += cs[k].impulse * cs[k].cb;
-		dpsi *= w->inv_body_inertia;
+		dpsi *= w->model->inv_body_inertia;
 		w->heading += dpsi;
 		*correction += torque * dpsi;
 	}
@@ -64,7 +64,7 @@ THESIS_SPECIALISED int redetect(struct bsim_world *w, const thesis_run *run, the
 			         : disk_detect(w, cs[k].beam, margin, &cs[m], 1, 0);
 		return m;
 	}
-	if (!w->shaped) { /* one contact a beam: in place, in order */
+	if (!w->model->shaped) { /* one contact a beam: in place, in order */
 		int m = 0;
 		for (int k = 0; k < n; k++)
 			m += bsim_thesis_contact_detect(w, cs[k].beam, margin, &cs[m]);
@@ -91,17 +91,17 @@ THESIS_SPECIALISED void position_project(struct bsim_world *w, thesis_run *run,
                                          const double force[2], double torque, double *correction,
                                          const int extended)
 {
-	double margin = w->contact_tol;
+	double margin = w->model->contact_tol;
 	thesis_contact *cs = w->contacts;
 	int n = redetect(w, run, cs, w->n_contacts, margin, extended);
-	for (int pass = 0; w->projection && thesis_project_more(w, cs, n, pass); pass++) {
+	for (int pass = 0; w->model->projection && thesis_project_more(w, cs, n, pass); pass++) {
 		project_once(w, cs, n, force, torque, correction, extended);
 		n = redetect(w, run, cs, n, margin, extended);
 	}
 	w->n_contacts = n;
 	for (int k = 0; k < n; k++)
-		if (cs[k].gap <= w->contact_tol)
-			step_type(w, run, cs[k].beam, cs[k].type);
+		if (cs[k].gap <= w->model->contact_tol)
+			step_type(w, run, cs[k].beam, k);
 }
 
 #endif

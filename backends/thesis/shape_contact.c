@@ -17,7 +17,7 @@ typedef struct cap_pair {
 	int type;
 } cap_pair;
 
-static int pair_contact(const struct bsim_world *w, const thesis_beam *b, const double k[2],
+static int pair_contact(const struct bsim_world *w, const thesis_beam_model *b, const double k[2],
                         const double q[2], double s, cap_pair *out)
 {
 	double len = hypot(k[0] - q[0], k[1] - q[1]);
@@ -26,12 +26,12 @@ static int pair_contact(const struct bsim_world *w, const thesis_beam *b, const 
 	double *n = out->n;
 	n[0] = (k[0] - q[0]) / len;
 	n[1] = (k[1] - q[1]) / len;
-	out->dist = len - w->body.radius;
+	out->dist = len - w->model->body.radius;
 	out->s = s;
 	out->type = s > 0.0 && s < 1.0 ? BSIM_CONTACT_TANGENT : BSIM_CONTACT_TIP;
 	double a[2] = {q[0] - b->p[0], q[1] - b->p[1]};
-	double r[2] = {k[0] - w->body.radius * n[0] - w->x[0],
-	               k[1] - w->body.radius * n[1] - w->x[1]};
+	double r[2] = {k[0] - w->model->body.radius * n[0] - w->x[0],
+	               k[1] - w->model->body.radius * n[1] - w->x[1]};
 	out->lev[0] = b->sgn * (a[0] * n[1] - a[1] * n[0]);
 	out->lev[1] = b->sgn * (a[0] * n[0] + a[1] * n[1]);
 	out->lev[2] = r[0] * n[1] - r[1] * n[0];
@@ -58,10 +58,10 @@ static double along(const double p0[2], const double p1[2], const double q[2])
  * on one, and where it crosses the beam the second lies far and is
  * outside the step's margin. Otherwise (the nearest pair is end to end)
  * the one contact stays. */
-static void capsule_pairs(const struct bsim_world *w, const thesis_beam *b, const double tip[2],
-                          thesis_geometry *g)
+static void capsule_pairs(const struct bsim_world *w, const thesis_beam_model *b,
+                          const double tip[2], thesis_geometry *g)
 {
-	double half = 0.5 * w->body.length;
+	double half = 0.5 * w->model->body.length;
 	double hu[2] = {half * cos(w->heading), half * sin(w->heading)};
 	double core[2][2] = {{w->x[0] - hu[0], w->x[1] - hu[1]},
 	                     {w->x[0] + hu[0], w->x[1] + hu[1]}};
@@ -87,7 +87,7 @@ static void capsule_pairs(const struct bsim_world *w, const thesis_beam *b, cons
 	for (int k = 1; k < m; k++)
 		if (cand[k].dist < cand[first].dist)
 			first = k;
-	double gap = g->dist - w->radius; /* the outline's nearest */
+	double gap = g->dist - w->model->radius; /* the outline's nearest */
 	if (!(cand[first].dist <= gap + 1e-9 * (1.0 + fabs(gap))))
 		return;
 	int second = -1;
@@ -100,11 +100,11 @@ static void capsule_pairs(const struct bsim_world *w, const thesis_beam *b, cons
 	if (second < 0)
 		return;
 	const cap_pair *f = &cand[first], *o = &cand[second];
-	g->dist = f->dist + w->radius;
+	g->dist = f->dist + w->model->radius;
 	g->type = f->type;
 	g->n[0] = f->n[0], g->n[1] = f->n[1];
 	g->c = f->lev[0], g->ct = f->lev[1], g->cb = f->lev[2], g->cbt = f->lev[3];
-	g->dist2 = o->dist + w->radius;
+	g->dist2 = o->dist + w->model->radius;
 	g->type2 = o->type;
 	g->n2[0] = o->n[0], g->n2[1] = o->n[1];
 	g->c2 = o->lev[0], g->ct2 = o->lev[1], g->cb2 = o->lev[2], g->cbt2 = o->lev[3];
@@ -113,47 +113,49 @@ static void capsule_pairs(const struct bsim_world *w, const thesis_beam *b, cons
 
 /* A body of another shape against the beam: b->geo (thesis.h, the head of
  * this file). */
-void bsim_thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const double u[2])
+void bsim_thesis_shape_geometry(const struct bsim_world *w, const thesis_beam_model *bm,
+                                thesis_beam *b, const double u[2])
 {
 	thesis_geometry *g = &b->geo;
-	double tip[2] = {b->p[0] + b->length * u[0], b->p[1] + b->length * u[1]};
+	double tip[2] = {bm->p[0] + bm->length * u[0], bm->p[1] + bm->length * u[1]};
 	g->x[0] = w->x[0];
 	g->x[1] = w->x[1];
 	g->theta = b->theta;
 	g->psi = w->heading;
 	bsim_body_segment_contact sc;
 	g->has2 = 0;
-	if (bsim_body_shape_segment(&w->body, w->x, w->heading, b->p, tip, &sc) != BSIM_OK) {
+	if (bsim_body_shape_segment(&w->model->body, w->x, w->heading, bm->p, tip, &sc) !=
+	    BSIM_OK) {
 		/* The beam crosses the body's centre line: no normal. */
 		g->type = BSIM_CONTACT_NONE;
 		g->dist = 0.0;
 		return;
 	}
 	g->type = sc.at_end ? BSIM_CONTACT_TIP : BSIM_CONTACT_TANGENT;
-	g->dist = sc.dist + w->radius;
+	g->dist = sc.dist + w->model->radius;
 	g->n[0] = sc.n[0];
 	g->n[1] = sc.n[1];
-	double a[2] = {sc.on_segment[0] - b->p[0], sc.on_segment[1] - b->p[1]};
+	double a[2] = {sc.on_segment[0] - bm->p[0], sc.on_segment[1] - bm->p[1]};
 	double r[2] = {sc.on_body[0] - w->x[0], sc.on_body[1] - w->x[1]};
 	g->a[0] = a[0];
 	g->a[1] = a[1];
-	g->c = b->sgn * (a[0] * sc.n[1] - a[1] * sc.n[0]);
-	g->ct = b->sgn * (a[0] * sc.n[0] + a[1] * sc.n[1]);
+	g->c = bm->sgn * (a[0] * sc.n[1] - a[1] * sc.n[0]);
+	g->ct = bm->sgn * (a[0] * sc.n[0] + a[1] * sc.n[1]);
 	g->cb = r[0] * sc.n[1] - r[1] * sc.n[0];
 	g->cbt = r[0] * sc.n[0] + r[1] * sc.n[1];
-	if (w->body.shape == BSIM_SHAPE_CAPSULE)
-		capsule_pairs(w, b, tip, g);
+	if (w->model->body.shape == BSIM_SHAPE_CAPSULE)
+		capsule_pairs(w, bm, tip, g);
 }
 
 int bsim_thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
                              thesis_contact *out)
 {
-	if (!(g->dist2 - w->radius <= margin))
+	if (!(g->dist2 - w->model->radius <= margin))
 		return 0;
 	thesis_contact *o = out + 1;
 	out->two = 1;
 	*o = *out;
-	o->gap = g->dist2 - w->radius;
+	o->gap = g->dist2 - w->model->radius;
 	o->type = g->type2;
 	o->n[0] = g->n2[0];
 	o->n[1] = g->n2[1];
@@ -161,6 +163,6 @@ int bsim_thesis_shape_second(const struct bsim_world *w, const thesis_geometry *
 	o->cb = g->cb2;
 	o->cbt = g->cbt2;
 	o->ct = g->ct2;
-	o->e = g->type2 == BSIM_CONTACT_TIP ? w->e_tip : w->e_tangent;
+	o->e = g->type2 == BSIM_CONTACT_TIP ? w->model->e_tip : w->model->e_tangent;
 	return 1;
 }

@@ -2,8 +2,8 @@
  * (thesis_step.h) is written once and compiled for each.
  *
  * The world's lists (run NULL, a constant where the caller gives it): the
- * ascending awake list with its flags, the pushed flags and list, each
- * beam's contact_type; what any world keeps, a lattice's thousands of
+ * ascending awake list with its flags, the pushed list with each beam's
+ * impulse, each beam's contact_of (thesis.h); what any world keeps, a lattice's thousands of
  * beams included.
  *
  * A run's masks (thesis_run): for a world of at most THESIS_STEPS_BEAMS
@@ -25,7 +25,7 @@
 typedef struct thesis_run {
 	int nb;          /* beams: every one, in ascending order */
 	unsigned awake;  /* the awake list */
-	unsigned typed;  /* contact_type not NONE, this step's */
+	unsigned typed;  /* in contact where the step ended (contact_of), this step's */
 	unsigned pushed; /* pushed in this step */
 	unsigned near;   /* pushed, or not certainly beyond BSIM_CONTACT_TOL */
 	double hv;       /* h |F| / M, the force's part of the margins' speed bound */
@@ -59,13 +59,13 @@ THESIS_SPECIALISED void step_push(struct bsim_world *w, thesis_run *run, int i, 
 	run->pushed |= 1u << i;
 }
 
-/* Beam i in contact of type `type` (within contact_tol) at the step's end. */
-THESIS_SPECIALISED void step_type(struct bsim_world *w, thesis_run *run, int i, int type)
+/* Beam i in contact k (within contact_tol) at the step's end. */
+THESIS_SPECIALISED void step_type(struct bsim_world *w, thesis_run *run, int i, int k)
 {
 	if (run)
 		run->typed |= 1u << i;
 	else
-		w->contact_type[i] = type;
+		w->contact_of[i] = k;
 }
 
 /* How many places the awake set's walk visits (step_awake_at names the
@@ -84,7 +84,7 @@ THESIS_SPECIALISED int step_awake_at(const struct bsim_world *w, const thesis_ru
 	return w->awake[a];
 }
 
-/* The awake beams exactly at rest and untouched (contact_type NONE) put
+/* The awake beams exactly at rest and untouched (contact_of -1) put
  * to rest: out of the set (bsim_thesis_awake_prune). */
 THESIS_SPECIALISED void step_prune(struct bsim_world *w, thesis_run *run)
 {
@@ -108,10 +108,10 @@ THESIS_SPECIALISED double step_kinetic(const struct bsim_world *w, const thesis_
 {
 	if (!run)
 		return thesis_kinetic_energy(w, extended);
-	double e = 0.5 * w->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);
+	double e = 0.5 * w->model->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);
 	for (int i = 0; i < run->nb; i++) {
 		const thesis_beam *b = &w->beams[i];
-		e += 0.5 * b->inertia * b->omega * b->omega;
+		e += 0.5 * w->model->beams[i].inertia * b->omega * b->omega;
 	}
 	return e;
 }

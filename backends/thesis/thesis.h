@@ -10,7 +10,7 @@
  * the beam's omega loses P c / I, and v_rel = v . n - omega c.
  *
  * A body that turns (body.rotates) or is not a disk, or a scene with
- * contact friction, takes the extended path (w->extended). The body has
+ * contact friction, takes the extended path (w->model->extended). The body has
  * heading psi and angular velocity w (rad, rad/s, counter-clockwise) and
  * inertia J; the contact point on its outline is r_b from its centre; the
  * tangent is t = perp(n) = (-n_y, n_x). Each contact then has two rows, the
@@ -23,7 +23,7 @@
  *   v += (P_n n + P_t t) / M,  w += (P_n cb + P_t cbt) / J,
  *   omega -= (P_n c + P_t ct) / I.
  * A disk has r_b = -R n: cb = 0 and cbt = -R. A body that does not turn
- * has 1/J = 0 in every solve (w->inv_body_inertia). */
+ * has 1/J = 0 in every solve (w->model->inv_body_inertia). */
 #ifndef BSIM_THESIS_THESIS_H
 #define BSIM_THESIS_THESIS_H
 
@@ -34,7 +34,7 @@
 #include "util/fminmax.h"
 
 /* A function written once for any body with a constant `extended` and
- * called with 1 (any body) and 0 (the essay's disk, w->extended 0): always
+ * called with 1 (any body) and 0 (the essay's disk, w->model->extended 0): always
  * inlined, so that each copy is compiled for its constant and the disk's
  * has none of the extended path's tests. */
 #if defined(__GNUC__)
@@ -69,21 +69,15 @@ typedef struct thesis_geometry {
 	double dist2, n2[2], c2, cb2, cbt2, ct2;
 } thesis_geometry;
 
+/* A beam's part of the world's changing data: its angle and angular
+ * velocity, and what a step keeps of them to compute less. */
 typedef struct thesis_beam {
-	double p[2];        /* pivot, m */
-	double u0[2];       /* rest direction, exact for multiples of 90 degrees */
-	double sgn;         /* +1: forward swing is counter-clockwise */
-	double length;      /* m */
-	double reach;       /* L + R, m: the reach tests' L + R + margin, summed once */
-	double inertia;     /* kg m^2 about the pivot */
-	double stiffness;   /* N m/rad */
-	double damping;     /* N m s/rad */
-	double inv_inertia; /* 1/I, 1/(kg m^2) */
-	/* For the step size h_d: the midpoint rule's D and the response
-	 * 1/(I D) (beam_integrate.h), computed once rather than per use. */
-	double h_d, d, response;
 	double theta; /* rad */
 	double omega; /* rad/s */
+	/* For the step size the world's h_prepared names: the midpoint rule's D
+	 * and the response 1/(I D) (beam_integrate.h), computed once rather
+	 * than per use. */
+	double d, response;
 	/* The direction at angle u_theta (contact_geometry.h): detection and the
 	 * projection's re-detection of one step meet the same angle. */
 	double u_theta; /* rad */
@@ -92,6 +86,30 @@ typedef struct thesis_beam {
 	 * moved, and a bound on the distance when something did. */
 	thesis_geometry geo;
 } thesis_beam;
+
+/* A beam's part of the model (thesis_model): what its definition fixes.
+ * As long as a thesis_beam (the rest unused): a beam's offset into the
+ * model's array and into the data's is one product, which the step's
+ * loops compute once for both (9 instructions a step less on H1 than
+ * with its own size, docs/performance.md). */
+typedef struct thesis_beam_model {
+	union {
+		struct {
+			double p[2];    /* pivot, m */
+			double u0[2];   /* rest direction, exact for multiples of 90 degrees */
+			double sgn;     /* +1: forward swing is counter-clockwise */
+			double length;  /* m */
+			double reach;   /* L + R, m: the reach tests' L + R + margin, summed once */
+			double inertia; /* kg m^2 about the pivot */
+			double stiffness;   /* N m/rad */
+			double damping;     /* N m s/rad */
+			double inv_inertia; /* 1/I, 1/(kg m^2) */
+		};
+		thesis_beam size_;
+	};
+} thesis_beam_model;
+_Static_assert(sizeof(thesis_beam_model) == sizeof(thesis_beam),
+               "a beam's model and data index alike");
 
 typedef struct thesis_contact {
 	int beam;
@@ -129,52 +147,51 @@ enum { THESIS_MIDPOINT = 0, THESIS_EULER = 1 };
 enum { THESIS_SIMULTANEOUS = 0, THESIS_NEAREST_FIRST = 1 };
 enum { THESIS_CONTACT_PHYSICAL = 0, THESIS_CONTACT_ESSAY = 1 };
 
-/* The world's per-beam arrays, listed once: name, element type, elements a
- * beam (thesis_world.c carves them all from one allocation, each aligned
- * for its type, zeroed). Their meanings are at their fields below. */
-#define THESIS_BEAM_ARRAYS(X)                                                                      \
-	X(beams, thesis_beam, 1)                                                                   \
-	X(contacts, thesis_contact, 2)                                                             \
-	X(contact_of, int, 1)                                                                      \
-	X(contact_type, int, 1)                                                                    \
-	X(awake, int, 1)                                                                           \
-	X(is_awake, unsigned char, 1)                                                              \
-	X(candidates, int, 1)                                                                      \
-	X(typed, int, 1)                                                                           \
-	X(held, int, 1)                                                                            \
-	X(pushed, unsigned char, 1)                                                                \
-	X(impulse, double, 1)                                                                      \
-	X(pushed_list, int, 1)                                                                     \
-	X(touched, unsigned char, 1)                                                               \
-	X(touched_list, int, 1)                                                                    \
-	X(start_awake, int, 1)                                                                     \
-	X(near, int, 1)
+/* The per-beam arrays of the model and of the data, listed once: part
+ * (MODEL or DATA), name, element type, elements a beam and elements more
+ * (thesis_world.c carves each part's from that part's one allocation, each
+ * aligned for its type, zeroed). Their meanings are at their fields below.
+ * The first of each part, the beams, is its struct's last member (its
+ * address is the struct's plus a constant: no pointer to load); the
+ * others follow. The
+ * grid has at most 4 n + 16 cells (bsim_thesis_grid_build), and one offset
+ * more. */
+#define THESIS_BEAM_ARRAYS(MODEL, DATA)                                                            \
+	MODEL(start_awake, int, 1, 0)                                                              \
+	MODEL(grid.start, int, 4, 17)                                                              \
+	MODEL(grid.items, int, 1, 0)                                                               \
+	DATA(contacts, thesis_contact, 2, 0)                                                       \
+	DATA(contact_of, int, 1, 0)                                                                \
+	DATA(awake, int, 1, 0)                                                                     \
+	DATA(is_awake, unsigned char, 1, 0)                                                        \
+	DATA(candidates, int, 1, 0)                                                                \
+	DATA(held, int, 1, 0)                                                                      \
+	DATA(impulse, double, 1, 0)                                                                \
+	DATA(pushed_list, int, 1, 0)                                                               \
+	DATA(touched, unsigned char, 1, 0)                                                         \
+	DATA(touched_list, int, 1, 0)                                                              \
+	DATA(near, int, 1, 0)
 
-struct bsim_world {
-	double x[2], v[2];       /* body centre and velocity */
-	double heading;          /* rad, psi */
-	double angular_velocity; /* rad/s, w (next to the heading: get_state copies them) */
-	double mass, inv_mass;
+/* The model: what the scene and the options fix when the world is made,
+ * in one allocation, never changed after (the step reads it through a
+ * const pointer; debug builds check its bytes, thesis_validate.c). */
+typedef struct thesis_model {
+	int n_beams;
+	double mass, inv_mass; /* kg, 1/kg */
 	/* m: the disk's radius; for another shape its reach (bsim_body_shape_reach),
 	 * what every distance bound (broad phase, margins, sleep) needs. */
 	double radius;
 	/* The extended path (thesis.h's head): 1 if the body turns, is not a
 	 * disk, or contacts have friction; the body's shape, whether it turns,
-	 * its angular velocity w (rad/s), its inertia J and 1/J (0 if it does
-	 * not turn: no solve turns it), kg m^2, and the contacts' Coulomb mu. */
+	 * its inertia J and 1/J (0 if it does not turn: no solve turns it),
+	 * kg m^2, and the contacts' Coulomb mu. */
 	int extended, shaped, rotates;
 	bsim_body_def body;
 	double body_inertia, inv_body_inertia;
 	double friction;
-	/* Friction impacts whose Newton impulse would have gained energy and
-	 * was scaled toward the plastic one (impact_resolve.h), since creation. */
-	long impacts_scaled;
 	/* 1/impact_mass, 1/kg: the body's inverse mass in the impact solve
 	 * only (impact_resolve.h); 1/M unless the knob is given. */
 	double impact_inv_mass;
-	int n_beams;
-	void *beam_block; /* the one allocation of THESIS_BEAM_ARRAYS */
-	thesis_beam *beams;
 	double e_tangent, e_tip; /* restitution */
 	double rest_threshold;   /* m/s */
 	/* knobs */
@@ -182,20 +199,39 @@ struct bsim_world {
 	/* 1: the essay's disk (extended 0) with contact_mode physical, whose
 	 * free flight thesis_step takes at once. */
 	int flight_disk;
-	/* 1: a world the runs of steps take (bsim_thesis_steps_takes), once made. */
+	/* 1: a world the runs of steps take (bsim_thesis_steps_takes). */
 	int steps_disk;
+	double slop;         /* penetration tolerated before projection, m */
+	double contact_tol;  /* gap the solver counts as touching (held, awake), m */
+	int broad_phase;     /* 1: grid query for beams at rest; 0: test every beam */
+	int sleep;           /* 1: beams below sleep_energy, body far, are put to rest */
+	double sleep_energy; /* J */
+	thesis_grid grid;    /* built when broad_phase is 1 */
+	/* The beams the scene starts awake (theta or omega not 0), ascending:
+	 * what a reset wakes. */
+	int *start_awake;
+	int n_start_awake;
+	thesis_beam_model beams[]; /* n_beams */
+} thesis_model;
+
+/* The world: its model, and the data a step changes, in one allocation
+ * (the struct and its per-beam arrays). */
+struct bsim_world {
+	/* First, 16-byte aligned as the allocation is: the body's moves and
+	 * get_state's copy are two doubles at a time. */
+	double x[2], v[2];         /* body centre and velocity */
+	double heading;            /* rad, psi */
+	double angular_velocity;   /* rad/s, w (next to the heading: get_state copies them) */
+	const thesis_model *model; /* its own allocation, freed with the world */
+	/* Friction impacts whose Newton impulse would have gained energy and
+	 * was scaled toward the plastic one (impact_resolve.h), since creation. */
+	long impacts_scaled;
 	/* After a try at free flight that made no step (the body near a beam,
 	 * say), the steps left before the next try, and the wait after the last
 	 * failure: doubled by each, to THESIS_FLIGHT_WAIT_MAX, 0 after a run
 	 * (thesis_advance). Which steps are tried changes no result, only what
 	 * a stretch near the beams costs. */
 	int flight_skip, flight_wait;
-	double slop;         /* penetration tolerated before projection, m */
-	double contact_tol;  /* gap the solver counts as touching (held, awake), m */
-	int broad_phase;     /* 1: grid query for beams at rest; 0: test every beam */
-	int sleep;           /* 1: beams below sleep_energy, body far, are put to rest */
-	double sleep_energy; /* J */
-	thesis_grid grid;
 	/* Awake beams: every beam with theta or omega not exactly 0 or a
 	 * contact this step is listed (ascending); the others are at rest and
 	 * cost nothing (beam_sleep.c). */
@@ -203,23 +239,37 @@ struct bsim_world {
 	int n_awake;
 	unsigned char *is_awake; /* per beam */
 	int *candidates;         /* per step: beams to test, ascending */
-	int *typed;              /* beams whose contact_type is not NONE */
-	int n_typed;
-	/* per step */
+	/* The step's contacts: after a step, those within contact_tol where it
+	 * ended (position_project.h). */
 	thesis_contact *contacts; /* 2 n_beams capacity: a capsule has up to two
 	                           * contacts with one beam (contact_geometry.h) */
 	int n_contacts;
-	int *contact_of;   /* per beam: its index in contacts, or -1 */
-	int *contact_type; /* per beam, at the end of the step, within contact_tol:
-	                    * what keeps a beam awake and from sleeping */
-	int *held;         /* per beam: in persistent contact (contact_mode=essay) */
+	/* The beams' contact markers, each kept because the physics reads it
+	 * and nothing else holds it (thesis_validate.c checks them):
+	 *   contact_of: per beam, its index in contacts, or -1. Between steps,
+	 *     set for the beams of the last step's contacts (in contact where
+	 *     it ended: kept awake, kept from sleeping, beam_sleep.c), cleared
+	 *     from that list when the next step starts; within the smooth
+	 *     solve, its contacts' (persistent_contact.h). It stands for the
+	 *     contact type a beam had and for a list of the beams in contact:
+	 *     the type is the contact's, the list is contacts.
+	 *   is_awake: per beam, 1 if listed in awake (the list's membership,
+	 *     so that waking a beam costs no search).
+	 *   held: per beam, contact_mode=essay only: held in persistent
+	 *     contact by the last solve (while any is, the next step tests only
+	 *     held beams: essay_hold); the projection after that solve
+	 *     overwrites the contacts' impulses, so it is kept apart.
+	 *   impulse: per beam, the sum of its normal pushes (impact and
+	 *     persistent contact, N s, each > 0) in the last step, 0 if none:
+	 *     > 0 is what the state reports as touched, and decides with the
+	 *     gap the beams listed (contact_list.h); pushed_list lists the
+	 *     beams where it is > 0, so that the next step clears them.
+	 *   touched: per beam, below (what a reset restores). */
+	int *contact_of;
+	int *held;
 	int any_held;
-	/* The beams pushed in the last step (a nonzero impact or
-	 * persistent-contact impulse: the state's touched), which decide with
-	 * the gap the beams listed (contact_list.h). */
-	unsigned char *pushed; /* per beam */
-	int *pushed_list;      /* beams whose pushed is set */
-	double *impulse;       /* per beam, where pushed: its pushes' normal impulses, N s */
+	int *pushed_list;
+	double *impulse;
 	int n_pushed;
 	bsim_step_energy energy;
 	int impacts;
@@ -228,16 +278,16 @@ struct bsim_world {
 	/* What a reset (thesis_world.c) puts back: the beams whose angle,
 	 * contact or geometry a step or a state may have changed since the
 	 * world was made or last reset (woken or measured), every beam after
-	 * set_state; and the beams the scene starts awake. */
+	 * set_state. */
 	unsigned char *touched; /* per beam */
 	int *touched_list;
 	int n_touched;
 	int touched_all;
-	/* Debug builds: where the next validation's scan of the field starts
-	 * (thesis_validate.c). */
+	/* Debug builds: where the next validation's scan of the field starts,
+	 * and its check of the model's bytes (thesis_validate.c). */
 	int validate_from;
-	int *start_awake;
-	int n_start_awake;
+	size_t model_size, model_from;
+	unsigned long long model_sum, model_sum_run;
 	/* The broad phase's candidate cache (broad_phase.c): every beam whose
 	 * pivot lies within L + R + near_reach of near_x, from one grid query. */
 	int *near;
@@ -246,8 +296,9 @@ struct bsim_world {
 	double near_reach; /* m; 0: no cache */
 	/* The room of bsim_thesis_broad_phase_clear: every beam at rest lies
 	 * farther than R + clear_room from clear_x (0: none known). */
-	double clear_x[2]; /* m */
-	double clear_room; /* m */
+	double clear_x[2];   /* m */
+	double clear_room;   /* m */
+	thesis_beam beams[]; /* model->n_beams */
 };
 
 /* Beam i may differ from how the world was made: a reset restores it. */
@@ -265,8 +316,9 @@ static inline void thesis_beam_touch(struct bsim_world *w, int i)
  * two beams), and the result is the same bit for bit. */
 #define THESIS_BROAD_PHASE_MIN_BEAMS 8
 void bsim_thesis_near_forget(struct bsim_world *w);
-int bsim_thesis_grid_build(thesis_grid *g, const struct bsim_world *w);
-void bsim_thesis_grid_free(thesis_grid *g);
+/* The grid over model m's pivots, into its arrays (thesis_world.c sizes
+ * them): at model creation. */
+void bsim_thesis_grid_build(thesis_model *m);
 int bsim_thesis_broad_phase(struct bsim_world *w, double speed, double h);
 /* Fills w->candidates with every beam whose pivot may be within L + R +
  * margin of the body's centre now (awake or not); returns how many. */
@@ -288,19 +340,25 @@ int bsim_thesis_flight(struct bsim_world *w, const bsim_wrench *schedule, double
  * schedule[k], each state into out[k] (sized for the world's beams);
  * returns n, 0 for another world. */
 #define THESIS_STEPS_BEAMS THESIS_BROAD_PHASE_MIN_BEAMS
-int bsim_thesis_steps_takes(const struct bsim_world *w);
+int bsim_thesis_steps_takes(const thesis_model *m);
 int bsim_thesis_steps(struct bsim_world *w, const bsim_wrench *schedule, double h, int n,
                       bsim_state *out);
 
-/* thesis_validate.c: asserts the world's invariants (debug builds; under
- * NDEBUG nothing, not even a call). */
+/* thesis_validate.c: asserts the world's invariants, and seals its model
+ * once made (its bytes' checksum, which every validation checks in part);
+ * debug builds; under NDEBUG nothing, not even a call. */
 #ifdef NDEBUG
 static inline void bsim_thesis_validate(struct bsim_world *w)
 {
 	(void)w;
 }
+static inline void bsim_thesis_model_seal(struct bsim_world *w)
+{
+	(void)w;
+}
 #else
 void bsim_thesis_validate(struct bsim_world *w);
+void bsim_thesis_model_seal(struct bsim_world *w);
 #endif
 
 /* beam_sleep.c */
@@ -312,7 +370,7 @@ void bsim_thesis_awake_prune(struct bsim_world *w);
 /* The contacts of beam i within margin into out (room for 2); returns how
  * many (0, 1, or 2 for a capsule along the beam). */
 int bsim_thesis_contact_detect(struct bsim_world *w, int i, double margin, thesis_contact *out);
-/* Each _disk function below: the same for the essay's disk (w->extended 0)
+/* Each _disk function below: the same for the essay's disk (w->model->extended 0)
  * only, compiled without the extended path's tests and stores (a contact's
  * extended fields are not set); thesis_step picks once a step. */
 int bsim_thesis_contact_detect_disk(struct bsim_world *w, int i, double margin,
@@ -324,7 +382,8 @@ int bsim_thesis_contact_redetect_disk(struct bsim_world *w, int i, double margin
 /* shape_contact.c: a body of another shape than the disk against beam b of
  * direction u (thesis_beam_direction), into b->geo; and a capsule's second contact with the beam of
  * geometry g into out[1] (out[0] the first) if within margin: 1, else 0. */
-void bsim_thesis_shape_geometry(const struct bsim_world *w, thesis_beam *b, const double u[2]);
+void bsim_thesis_shape_geometry(const struct bsim_world *w, const thesis_beam_model *bm,
+                                thesis_beam *b, const double u[2]);
 int bsim_thesis_shape_second(const struct bsim_world *w, const thesis_geometry *g, double margin,
                              thesis_contact *out);
 /* 0 if beam i certainly lies farther than R + margin from the body (its
@@ -359,17 +418,17 @@ long bsim_thesis_lcp_fallbacks(void);
  * (thesis_world.c) and the impacts (impact_resolve.h) share it without
  * calling into each other. Beams at rest have omega = 0 and add nothing:
  * the awake ones, in ascending order, give the sum over all beams to the
- * bit. extended: a constant, 0 for the essay's disk (w->extended 0),
+ * bit. extended: a constant, 0 for the essay's disk (w->model->extended 0),
  * whose copy has no test of the body's rotation. */
 static inline double thesis_kinetic_energy(const struct bsim_world *w, const int extended)
 {
-	double e = 0.5 * w->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);
+	double e = 0.5 * w->model->mass * (w->v[0] * w->v[0] + w->v[1] * w->v[1]);
 	for (int k = 0; k < w->n_awake; k++) {
-		const thesis_beam *b = &w->beams[w->awake[k]];
-		e += 0.5 * b->inertia * b->omega * b->omega;
+		const int i = w->awake[k];
+		e += 0.5 * w->model->beams[i].inertia * w->beams[i].omega * w->beams[i].omega;
 	}
-	if (extended && w->rotates)
-		e += 0.5 * w->body_inertia * w->angular_velocity * w->angular_velocity;
+	if (extended && w->model->rotates)
+		e += 0.5 * w->model->body_inertia * w->angular_velocity * w->angular_velocity;
 	return e;
 }
 
@@ -382,23 +441,27 @@ static inline void thesis_beams_prepare(struct bsim_world *w, double h)
 {
 	if (h == w->h_prepared)
 		return;
-	for (int i = 0; i < w->n_beams; i++)
-		thesis_beam_prepare(&w->beams[i], h);
+	for (int i = 0; i < w->model->n_beams; i++)
+		thesis_beam_prepare(&w->model->beams[i], &w->beams[i], h);
 	w->h_prepared = h;
 }
 
 /* How far beam i and the body can close within a step (broad_phase.c
  * derives it), m; inline: every step asks it of every beam in reach. */
-static inline double thesis_step_margin(const struct bsim_world *w, const thesis_beam *b,
-                                        double speed, double h)
+static inline double thesis_step_margin(const struct bsim_world *w, const thesis_beam_model *bm,
+                                        const thesis_beam *b, double speed, double h)
 {
 	/* At rest the formula below is 2 h |v| + slop exactly (every other
-	 * term is +0), without its division. */
-	if (b->theta == 0.0 && b->omega == 0.0)
-		return 2.0 * (h * speed) + w->slop;
-	double accel = b->length * (b->stiffness * fabs(b->theta) + b->damping * fabs(b->omega)) /
-	               b->inertia;
-	return 2.0 * (h * (speed + b->length * fabs(b->omega)) + h * h * accel) + w->slop;
+	 * term is +0), without its division. The test is theta == 0 and omega
+	 * == 0 (false for NaN too), written as one comparison: as two, the
+	 * runs of steps kept the first's result as a value, 4 instructions a
+	 * step more on H1 (docs/performance.md). */
+	if (fabs(b->theta) + fabs(b->omega) == 0.0)
+		return 2.0 * (h * speed) + w->model->slop;
+	double accel = bm->length *
+	               (bm->stiffness * fabs(b->theta) + bm->damping * fabs(b->omega)) /
+	               bm->inertia;
+	return 2.0 * (h * (speed + bm->length * fabs(b->omega)) + h * h * accel) + w->model->slop;
 }
 
 /* With every beam at rest the step's margin is 2 h |v| + slop, |v| = |v| +
@@ -412,15 +475,15 @@ static inline double thesis_clear_margin(const struct bsim_world *w, const doubl
                                          double h)
 {
 	double speed = (fabs(w->v[0]) + fabs(w->v[1])) +
-	               h * (fabs(force[0]) + fabs(force[1])) * w->inv_mass;
-	return 2.0 * (h * (speed * (1.0 + 1e-12))) + w->slop + BSIM_CONTACT_TOL;
+	               h * (fabs(force[0]) + fabs(force[1])) * w->model->inv_mass;
+	return 2.0 * (h * (speed * (1.0 + 1e-12))) + w->model->slop + BSIM_CONTACT_TOL;
 }
 
 /* bsim_thesis_broad_phase_clear with its room's test inline, so that a step in
  * free flight is decided without a call: the same answer. */
 static inline int thesis_flight_clear(struct bsim_world *w, const double force[2], double h)
 {
-	if (w->broad_phase && w->n_beams <= THESIS_BROAD_PHASE_MIN_BEAMS &&
+	if (w->model->broad_phase && w->model->n_beams <= THESIS_BROAD_PHASE_MIN_BEAMS &&
 	    fabs(w->x[0] - w->clear_x[0]) + fabs(w->x[1] - w->clear_x[1]) +
 	                    thesis_clear_margin(w, force, h) <
 	            w->clear_room)
@@ -433,11 +496,10 @@ static inline int thesis_flight_clear(struct bsim_world *w, const double force[2
  * order they came; contact_list.h lists the beam). */
 static inline void thesis_beam_pushed(struct bsim_world *w, int i, double impulse)
 {
-	if (w->pushed[i]) {
+	if (w->impulse[i] > 0.0) {
 		w->impulse[i] += impulse;
 		return;
 	}
-	w->pushed[i] = 1;
 	w->impulse[i] = impulse;
 	w->pushed_list[w->n_pushed++] = i;
 }
@@ -447,7 +509,7 @@ static inline void thesis_beam_pushed(struct bsim_world *w, int i, double impuls
 static inline void thesis_contact_spent(struct bsim_world *w)
 {
 	for (int k = 0; k < w->n_pushed; k++)
-		w->pushed[w->pushed_list[k]] = 0;
+		w->impulse[w->pushed_list[k]] = 0.0;
 	w->n_pushed = 0;
 }
 
@@ -456,13 +518,13 @@ static inline void thesis_contact_spent(struct bsim_world *w)
  * move by the mean velocity (persistent_contact.h); vm receives that
  * velocity. Inline: the contact solve, a step in free flight (j = 0) and
  * the runs of steps (thesis_steps.c) share it, so all move the body by the
- * same operations. integrator: w->integrator, a constant where the caller
+ * same operations. integrator: w->model->integrator, a constant where the caller
  * gives one. */
 static inline void thesis_body_advance(struct bsim_world *w, const double v0[2], const double vf[2],
                                        const double j[2], double h, double vm[2], int integrator)
 {
-	w->v[0] = vf[0] + j[0] * w->inv_mass;
-	w->v[1] = vf[1] + j[1] * w->inv_mass;
+	w->v[0] = vf[0] + j[0] * w->model->inv_mass;
+	w->v[1] = vf[1] + j[1] * w->model->inv_mass;
 	vm[0] = 0.5 * (v0[0] + w->v[0]);
 	vm[1] = 0.5 * (v0[1] + w->v[1]);
 	if (integrator == THESIS_EULER) {
@@ -480,11 +542,11 @@ static inline void thesis_body_advance(struct bsim_world *w, const double v0[2],
 static inline void thesis_body_turn(struct bsim_world *w, double w0, double torque, double jw,
                                     double h)
 {
-	if (!w->rotates)
+	if (!w->model->rotates)
 		return;
-	w->angular_velocity = w0 + (h * torque + jw) * w->inv_body_inertia;
-	double wm = w->integrator == THESIS_EULER ? w->angular_velocity
-	                                          : 0.5 * (w0 + w->angular_velocity);
+	w->angular_velocity = w0 + (h * torque + jw) * w->model->inv_body_inertia;
+	double wm = w->model->integrator == THESIS_EULER ? w->angular_velocity
+	                                                 : 0.5 * (w0 + w->angular_velocity);
 	w->heading += h * wm;
 }
 
@@ -494,7 +556,7 @@ static inline void thesis_contact_velocity(const struct bsim_world *w, thesis_co
                                            const int extended)
 {
 	c->vrel = (w->v[0] * c->n[0] + w->v[1] * c->n[1]) - w->beams[c->beam].omega * c->c;
-	if (extended && w->extended) {
+	if (extended && w->model->extended) {
 		c->vrel += w->angular_velocity * c->cb;
 		c->vrel_t = (w->v[1] * c->n[0] - w->v[0] * c->n[1]) + w->angular_velocity * c->cbt -
 		            w->beams[c->beam].omega * c->ct;
@@ -518,9 +580,9 @@ THESIS_SPECIALISED int thesis_impacts_touching(struct bsim_world *w, int nc, dou
 		 * again by the contact solve. Swapped only when out of place. */
 		thesis_contact *c = &cs[i];
 		thesis_contact_velocity(w, c, extended);
-		if (c->gap + h * bsim_fmin(c->vrel, 0.0) > w->slop)
+		if (c->gap + h * bsim_fmin(c->vrel, 0.0) > w->model->slop)
 			continue;
-		c->inv_i = w->beams[c->beam].inv_inertia;
+		c->inv_i = w->model->beams[c->beam].inv_inertia;
 		*approaching |= c->vrel < 0.0;
 		if (i != n) {
 			thesis_contact t = cs[n];
@@ -536,7 +598,7 @@ THESIS_SPECIALISED int thesis_impacts_touching(struct bsim_world *w, int nc, dou
  * -e v_rel, or 0 (plastic) below rest_threshold. */
 static inline void thesis_impact_bound(const struct bsim_world *w, thesis_contact *c)
 {
-	c->bound = c->vrel < -w->rest_threshold ? -c->e * c->vrel : 0.0;
+	c->bound = c->vrel < -w->model->rest_threshold ? -c->e * c->vrel : 0.0;
 }
 
 /* Whether pass `pass` of the projection (position_project.h) projects the
@@ -548,7 +610,7 @@ static inline int thesis_project_more(struct bsim_world *w, const thesis_contact
 {
 	int deep = 0;
 	for (int k = 0; k < n; k++)
-		deep |= cs[k].gap < -w->slop;
+		deep |= cs[k].gap < -w->model->slop;
 	if (!deep)
 		return 0;
 	if (pass == THESIS_PROJECT_PASSES_MAX) { /* still deeper than slop */
@@ -568,13 +630,14 @@ static inline void thesis_project_move(struct bsim_world *w, const thesis_contac
 	for (int k = 0; k < n; k++) {
 		thesis_beam *b = &w->beams[cs[k].beam];
 		double theta = b->theta - cs[k].impulse * cs[k].c * cs[k].inv_i;
-		de += 0.5 * b->stiffness * (theta * theta - b->theta * b->theta);
+		de += 0.5 * w->model->beams[cs[k].beam].stiffness *
+		      (theta * theta - b->theta * b->theta);
 		b->theta = theta;
 		dx += cs[k].impulse * cs[k].n[0];
 		dy += cs[k].impulse * cs[k].n[1];
 	}
-	dx *= w->inv_mass;
-	dy *= w->inv_mass;
+	dx *= w->model->inv_mass;
+	dy *= w->model->inv_mass;
 	w->x[0] += dx;
 	w->x[1] += dy;
 	*correction += (force[0] * dx + force[1] * dy) - de;
@@ -585,13 +648,14 @@ static inline void thesis_project_move(struct bsim_world *w, const thesis_contac
  * and its free velocity vf = v0 + h F / M: the beam's free omega, the
  * response 1/(I D), v_rel at the free velocities and the bound that keeps
  * the gap from closing. */
-static inline void thesis_smooth_row(thesis_contact *c, const thesis_beam *b, const double v0[2],
-                                     const double vf[2], double h, int integrator)
+static inline void thesis_smooth_row(thesis_contact *c, const thesis_beam_model *bm,
+                                     const thesis_beam *b, const double v0[2], const double vf[2],
+                                     double h, int integrator)
 {
 	double vrel0 = (v0[0] * c->n[0] + v0[1] * c->n[1]) - b->omega * c->c;
-	c->omega_free = thesis_beam_free_omega(b, h, integrator);
+	c->omega_free = thesis_beam_free_omega(bm, b, h, integrator);
 	double gap = bsim_fmax(c->gap, 0.0);
-	c->inv_i = thesis_beam_response(b, integrator);
+	c->inv_i = thesis_beam_response(bm, b, integrator);
 	c->vrel = (vf[0] * c->n[0] + vf[1] * c->n[1]) - c->omega_free * c->c;
 	c->bound = integrator == THESIS_EULER ? -gap / h : -vrel0 - 2.0 * gap / h;
 }
@@ -600,21 +664,22 @@ static inline void thesis_smooth_row(thesis_contact *c, const thesis_beam *b, co
  * solved contact c (NULL: none) and the body's mean velocity vm: a beam at
  * rest without contact stays at rest; the dampers' loss added to *damper,
  * minus the contact impulse's work to *contact, J. */
-static inline void thesis_smooth_beam(thesis_beam *b, const thesis_contact *c, const double vm[2],
-                                      double h, int integrator, double *damper, double *contact)
+static inline void thesis_smooth_beam(const thesis_beam_model *bm, thesis_beam *b,
+                                      const thesis_contact *c, const double vm[2], double h,
+                                      int integrator, double *damper, double *contact)
 {
 	if (!c && b->theta == 0.0 && b->omega == 0.0)
 		return;
 	double omega_new;
 	if (!c) {
-		omega_new = thesis_beam_free_omega(b, h, integrator);
+		omega_new = thesis_beam_free_omega(bm, b, h, integrator);
 	} else {
 		omega_new = c->omega_free - c->impulse * c->c * c->inv_i;
 		double omega_m =
 		        integrator == THESIS_EULER ? omega_new : 0.5 * (b->omega + omega_new);
 		*contact -= c->impulse * ((c->n[0] * vm[0] + c->n[1] * vm[1]) - c->c * omega_m);
 	}
-	*damper += thesis_beam_advance(b, omega_new, h, integrator);
+	*damper += thesis_beam_advance(bm, b, omega_new, h, integrator);
 }
 
 /* get_state's body: its centre, velocity, heading and angular velocity;

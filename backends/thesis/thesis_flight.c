@@ -4,7 +4,7 @@
  * long as that path would be taken, each state written as get_state
  * writes it after such a step.
  *
- * thesis_step takes the flight path when no beam is awake or typed, the
+ * thesis_step takes the flight path when no beam is awake (nor in contact), the
  * room test finds every beam out of reach (thesis_flight_clear), the beams
  * are prepared for h and contact_mode is physical (a run prepares them for
  * h first, as the step would before a flight step otherwise: the flight
@@ -32,13 +32,13 @@
 int bsim_thesis_flight(bsim_world *w, const bsim_wrench *schedule, double h, int n,
                        bsim_state *out)
 {
-	if (w->n_awake || w->n_typed || w->contact_mode == THESIS_CONTACT_ESSAY || w->rotates ||
-	    !w->broad_phase || w->n_beams > THESIS_BROAD_PHASE_MIN_BEAMS)
+	if (w->n_awake || w->model->contact_mode == THESIS_CONTACT_ESSAY || w->model->rotates ||
+	    !w->model->broad_phase || w->model->n_beams > THESIS_BROAD_PHASE_MIN_BEAMS)
 		return 0;
 	/* The beams' constants for h, as the step would prepare them before
 	 * its flight (a step in flight reads none of them). */
 	thesis_beams_prepare(w, h);
-	const double inv_mass = w->inv_mass, zero = 0.0 * inv_mass;
+	const double inv_mass = w->model->inv_mass, zero = 0.0 * inv_mass;
 	/* The largest |F|_1 of the run's steps (a force not finite makes it
 	 * NaN: then no step is sure), for a bound on each step's thesis_clear_margin force term h
 	 * |F|_1 / M and on its |h F / M|_1, which differs from that by the
@@ -50,8 +50,8 @@ int bsim_thesis_flight(bsim_world *w, const bsim_wrench *schedule, double h, int
 		nan += f - f; /* 0, or NaN for a force not finite */
 	}
 	const double push_max = h * (f_max + nan) * inv_mass * (1.0 + 1e-12), d_max = push_max;
-	const double slop = w->slop;
-	const int euler = w->integrator == THESIS_EULER;
+	const double slop = w->model->slop;
+	const int euler = w->model->integrator == THESIS_EULER;
 	double cx0 = w->clear_x[0], cx1 = w->clear_x[1], room = w->clear_room;
 	double x0 = w->x[0], x1 = w->x[1], v0 = w->v[0], v1 = w->v[1];
 	/* what a flight step leaves as it is, for the states */

@@ -1,7 +1,7 @@
 /* One step of the thesis world and the state it leaves, written once and
  * compiled for each world it serves (thesis_world.c's head gives the
  * step's order):
- *   - any body (extended 1) or the essay's disk (extended 0, w->extended
+ *   - any body (extended 1) or the essay's disk (extended 0, w->model->extended
  *     0): a constant, so that the disk's copy is compiled without the
  *     extended path's tests (docs/backends.md, "Cost to the essay's disk");
  *   - the world's lists (run NULL) or a run's masks (step_sets.h): the
@@ -15,7 +15,7 @@
  * finds no beam within BSIM_CONTACT_TOL: the same state), the broad phase
  * (every beam a candidate, in order), the step size's constants (once a
  * run) and the force's terms (once for each force of the schedule), the
- * typed list (a mask) and the essay's
+ * beams in contact (a mask for contact_of) and the essay's
  * contact mode, nearest-first impacts and sleeping (worlds a run does not
  * take: bsim_thesis_steps_takes). */
 #ifndef BSIM_THESIS_THESIS_STEP_H
@@ -35,14 +35,22 @@
 static inline int essay_hold(struct bsim_world *w)
 {
 	int any = 0;
-	for (int i = 0; i < w->n_beams; i++)
+	for (int i = 0; i < w->model->n_beams; i++)
 		w->held[i] = 0;
 	for (int k = 0; k < w->n_contacts; k++) {
 		const thesis_contact *c = &w->contacts[k];
-		if (c->impulse > 0.0 && c->gap <= w->contact_tol)
+		if (c->impulse > 0.0 && c->gap <= w->model->contact_tol)
 			any = w->held[c->beam] = 1;
 	}
 	return any;
+}
+
+/* The last step's contacts are spent: their beams' contact_of cleared
+ * (thesis.h), as a step starts. */
+static inline void step_contacts_clear(struct bsim_world *w)
+{
+	for (int k = 0; k < w->n_contacts; k++)
+		w->contact_of[w->contacts[k].beam] = -1;
 }
 
 /* The contacts the step can reach into w->contacts; returns how many, and
@@ -52,22 +60,22 @@ THESIS_SPECIALISED int step_detect(struct bsim_world *w, thesis_run *run, const 
 {
 	/* A bound for the margin only: speeds and forces are far from overflow,
 	 * so sqrt serves where hypot's scaling would cost a tenth of a step. */
-	double v =
-	        sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
-	        (run ? run->hv : h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass);
+	double v = sqrt(w->v[0] * w->v[0] + w->v[1] * w->v[1]) +
+	           (run ? run->hv
+	                : h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->model->inv_mass);
 	/* A shape that turns: its outline moves up to reach |w| faster than its
 	 * centre (the disk's does not move when it turns). */
-	if (extended && w->shaped && w->rotates)
-		v += w->radius *
-		     (fabs(w->angular_velocity) + h * fabs(torque) * w->inv_body_inertia);
-	int holding = !run && w->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
+	if (extended && w->model->shaped && w->model->rotates)
+		v += w->model->radius *
+		     (fabs(w->angular_velocity) + h * fabs(torque) * w->model->inv_body_inertia);
+	int holding = !run && w->model->contact_mode == THESIS_CONTACT_ESSAY && w->any_held;
 	int m = run ? run->nb : bsim_thesis_broad_phase(w, v, h);
 	int n = 0;
 	for (int k = 0; k < m; k++) {
 		int i = run ? k : w->candidates[k];
 		if (holding && !w->held[i])
 			continue; /* essay: the constraint loop tests only held beams */
-		double margin = thesis_step_margin(w, &w->beams[i], v, h);
+		double margin = thesis_step_margin(w, &w->model->beams[i], &w->beams[i], v, h);
 		int got;
 		if (extended)
 			got = bsim_thesis_contact_detect(w, i, margin, &w->contacts[n]);
@@ -83,7 +91,7 @@ THESIS_SPECIALISED int step_detect(struct bsim_world *w, thesis_run *run, const 
 	return n;
 }
 
-/* A step in free flight among beams at rest (none awake or typed, none in
+/* A step in free flight among beams at rest (none awake or in contact, none in
  * reach: bsim_thesis_broad_phase_clear, which the caller asked) for the step
  * size the beams are prepared for: what the step does then, without its
  * general path. No contact: no impact, no projection, nothing held; the
@@ -95,10 +103,11 @@ THESIS_SPECIALISED void flight_step(struct bsim_world *w, const double force[2],
 {
 	w->n_contacts = 0;
 	double v0[2] = {w->v[0], w->v[1]};
-	double vf[2] = {v0[0] + h * force[0] * w->inv_mass, v0[1] + h * force[1] * w->inv_mass};
+	double vf[2] = {v0[0] + h * force[0] * w->model->inv_mass,
+	                v0[1] + h * force[1] * w->model->inv_mass};
 	const double j[2] = {0.0, 0.0};
 	double vm[2];
-	thesis_body_advance(w, v0, vf, j, h, vm, w->integrator);
+	thesis_body_advance(w, v0, vf, j, h, vm, w->model->integrator);
 	if (extended)
 		thesis_body_turn(w, w->angular_velocity, torque, 0.0, h);
 }
@@ -106,25 +115,24 @@ THESIS_SPECIALISED void flight_step(struct bsim_world *w, const double force[2],
 /* One step: its energy flows added to *e and its impacts to *impacts
  * (the world's, or in a run the state's, zeroed by the caller). in_flight:
  * the caller found the step one of free flight (never in a run).
- * integrator: w->integrator, a constant where the caller gives one. */
+ * integrator: w->model->integrator, a constant where the caller gives one. */
 THESIS_SPECIALISED int step_run(struct bsim_world *w, thesis_run *run, const double force[2],
                                 double torque, double h, int in_flight, bsim_step_energy *e,
                                 int *impacts, const int extended, const int integrator)
 {
-	/* The essay's disk's free flight was thesis_step's (w->flight_disk). */
-	if (extended && in_flight && w->n_typed == 0 && h == w->h_prepared &&
-	    w->contact_mode != THESIS_CONTACT_ESSAY) {
+	/* The essay's disk's free flight was thesis_step's (w->model->flight_disk). */
+	if (extended && in_flight && h == w->h_prepared &&
+	    w->model->contact_mode != THESIS_CONTACT_ESSAY) {
 		flight_step(w, force, torque, h, extended);
 		return BSIM_OK;
 	}
 	if (run) {
-		/* contact_type is the run's typed mask, written when it ends */
+		/* contact_of is the run's typed mask between steps, written when
+		 * the run ends */
 		run->typed = 0;
 		run->pushed = 0;
 	} else {
-		for (int k = 0; k < w->n_typed; k++)
-			w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
-		w->n_typed = 0;
+		step_contacts_clear(w);
 		thesis_beams_prepare(w, h);
 	}
 	double speed = 0.0;
@@ -137,21 +145,17 @@ THESIS_SPECIALISED int step_run(struct bsim_world *w, thesis_run *run, const dou
 	} else if (run) {
 		persistent_solve_disk(w, run, run->dv, h, &e->damper, &e->contact, integrator);
 	} else {
-		const double dv[2] = {h * force[0] * w->inv_mass, h * force[1] * w->inv_mass};
+		const double dv[2] = {h * force[0] * w->model->inv_mass,
+		                      h * force[1] * w->model->inv_mass};
 		persistent_solve_disk(w, run, dv, h, &e->damper, &e->contact, integrator);
 	}
-	if (!run && w->contact_mode == THESIS_CONTACT_ESSAY)
+	if (!run && w->model->contact_mode == THESIS_CONTACT_ESSAY)
 		w->any_held = essay_hold(w);
 	if (n)
 		position_project(w, run, force, torque, &e->correction, extended);
-	/* A beam's two contacts (a capsule along it) are adjacent: listed once. */
-	for (int k = 0; !run && k < w->n_contacts; k++)
-		if (w->contact_type[w->contacts[k].beam] != BSIM_CONTACT_NONE &&
-		    (!extended || k == 0 || w->contacts[k - 1].beam != w->contacts[k].beam))
-			w->typed[w->n_typed++] = w->contacts[k].beam;
 	/* in flight nothing is in reach: nothing to sleep, prune or list */
 	if (!in_flight) {
-		if (!run && w->sleep)
+		if (!run && w->model->sleep)
 			bsim_thesis_beams_sleep(w, speed, h);
 		step_prune(w, run);
 		contact_list_beams(w, run, extended);
@@ -191,7 +195,7 @@ THESIS_SPECIALISED void step_state(const struct bsim_world *w, const thesis_run 
 			bsim_state_set_active(s, w->awake, w->n_awake);
 		for (int k = 0; k < s->n_active; k++) {
 			int i = s->active[k];
-			thesis_state_beam(cache, i, w->pushed[i], w->impulse[i],
+			thesis_state_beam(cache, i, w->impulse[i] > 0.0, w->impulse[i],
 			                  bsim_thesis_contact_near(w, i, BSIM_CONTACT_TOL), s);
 		}
 	}

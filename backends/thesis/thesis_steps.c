@@ -3,7 +3,7 @@
  * the run's masks (step_sets.h), one step after another in one call, each
  * state written as get_state writes it.
  *
- * Which worlds. The essay's disk (w->extended 0) under contact_mode
+ * Which worlds. The essay's disk (w->model->extended 0) under contact_mode
  * physical, simultaneous impacts and no sleeping, among at most
  * THESIS_STEPS_BEAMS beams: the single gate of the essay and its variants
  * (H1, H2). There every beam is a candidate of every step, in ascending
@@ -20,11 +20,11 @@
 
 #include "thesis/thesis_step.h"
 
-int bsim_thesis_steps_takes(const struct bsim_world *w)
+int bsim_thesis_steps_takes(const thesis_model *m)
 {
-	return !w->extended && w->contact_mode == THESIS_CONTACT_PHYSICAL &&
-	       w->impact_order == THESIS_SIMULTANEOUS && !w->sleep &&
-	       w->n_beams <= THESIS_STEPS_BEAMS;
+	return !m->extended && m->contact_mode == THESIS_CONTACT_PHYSICAL &&
+	       m->impact_order == THESIS_SIMULTANEOUS && !m->sleep &&
+	       m->n_beams <= THESIS_STEPS_BEAMS;
 }
 
 /* The force's parts of step_detect's margin, h |F| / M, and of the smooth
@@ -32,9 +32,9 @@ int bsim_thesis_steps_takes(const struct bsim_world *w)
 static inline void steps_force(const struct bsim_world *w, thesis_run *run, const double force[2],
                                double h)
 {
-	run->hv = h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->inv_mass;
-	run->dv[0] = h * force[0] * w->inv_mass;
-	run->dv[1] = h * force[1] * w->inv_mass;
+	run->hv = h * sqrt(force[0] * force[0] + force[1] * force[1]) * w->model->inv_mass;
+	run->dv[0] = h * force[0] * w->model->inv_mass;
+	run->dv[1] = h * force[1] * w->model->inv_mass;
 }
 
 /* The same bits: a force whose terms need not be computed again. */
@@ -52,15 +52,14 @@ THESIS_SPECIALISED void steps_run(struct bsim_world *w, const bsim_wrench *sched
 	thesis_run run = {.nb = nb, .d2 = d2};
 	for (int i = 0; i < nb; i++)
 		run.awake |= (unsigned)w->is_awake[i] << i;
-	/* No step of the run reads contact_type (the typed mask, each step's,
-	 * stands for it): it is cleared here and set from the last step's
-	 * contacts at the end. */
-	for (int k = 0; k < w->n_typed; k++)
-		w->contact_type[w->typed[k]] = BSIM_CONTACT_NONE;
+	/* No step of the run reads contact_of between steps (the typed mask,
+	 * each step's, stands for it): it is cleared here and set from the
+	 * last step's contacts at the end. */
+	step_contacts_clear(w);
 	const unsigned awake0 = run.awake;
 	steps_force(w, &run, schedule[0].force, h);
 	for (int i = 0; i < nb; i++)
-		d2[i] = beam_pivot_distance2(w, &w->beams[i]);
+		d2[i] = beam_pivot_distance2(w, &w->model->beams[i]);
 	for (int k = 0; k < n; k++) {
 		const double *force = schedule[k].force;
 		if (k && !steps_same_force(force, schedule[k - 1].force))
@@ -72,12 +71,12 @@ THESIS_SPECIALISED void steps_run(struct bsim_world *w, const bsim_wrench *sched
 		step_state(w, &run, s);
 	}
 	/* The lists as steps one after another leave them: ascending awake
-	 * beams (those of the run's start where the mask is theirs), the typed
-	 * ones (any order: only cleared), the last step's pushes. */
+	 * beams (those of the run's start where the mask is theirs), the beams
+	 * in contact marked (contact_of), the last step's pushes. */
 	for (int k = 0; k < w->n_contacts; k++) {
 		const thesis_contact *c = &w->contacts[k];
-		if (c->gap <= w->contact_tol)
-			w->contact_type[c->beam] = c->type;
+		if (c->gap <= w->model->contact_tol)
+			w->contact_of[c->beam] = k;
 	}
 	if (run.awake != awake0) {
 		w->n_awake = 0;
@@ -87,31 +86,32 @@ THESIS_SPECIALISED void steps_run(struct bsim_world *w, const bsim_wrench *sched
 				w->awake[w->n_awake++] = i;
 		}
 	}
-	w->n_typed = 0;
-	for (int i = 0; i < nb; i++)
-		if (thesis_run_has(run.typed, i))
-			w->typed[w->n_typed++] = i;
 	w->energy = out[n - 1].energy;
 	w->impacts = out[n - 1].impacts;
-	/* the last step's pushes, which get_state reports as touched */
-	for (int i = 0; i < nb; i++)
+	/* the last step's pushes, which get_state reports as touched; a beam
+	 * pushed in an earlier step only keeps none */
+	for (int i = 0; i < nb; i++) {
+		const double p = w->impulse[i];
+		w->impulse[i] = 0.0;
 		if (thesis_run_has(run.pushed, i))
-			thesis_beam_pushed(w, i, w->impulse[i]);
+			thesis_beam_pushed(w, i, p);
+	}
 }
 
 int bsim_thesis_steps(struct bsim_world *w, const bsim_wrench *schedule, double h, int n,
                       bsim_state *out)
 {
-	if (n < 1 || !w->steps_disk || out[0].n_beams != w->n_beams)
+	if (n < 1 || !w->model->steps_disk || out[0].n_beams != w->model->n_beams)
 		return 0;
 	thesis_contact_spent(w);
-	if (w->n_touched < w->n_beams) /* else every beam is */
-		for (int i = 0; i < w->n_beams; i++)
+	if (w->n_touched < w->model->n_beams) /* else every beam is */
+		for (int i = 0; i < w->model->n_beams; i++)
 			thesis_beam_touch(w, i);
 	thesis_beams_prepare(w, h);
-	if (w->n_beams == 2 && w->integrator == THESIS_MIDPOINT) /* the essay's gate */
+	if (w->model->n_beams == 2 &&
+	    w->model->integrator == THESIS_MIDPOINT) /* the essay's gate */
 		steps_run(w, schedule, h, n, out, THESIS_MIDPOINT, 2);
 	else
-		steps_run(w, schedule, h, n, out, w->integrator, w->n_beams);
+		steps_run(w, schedule, h, n, out, w->model->integrator, w->model->n_beams);
 	return n;
 }

@@ -163,33 +163,59 @@ static void thesis_destroy(bsim_world *w)
 {
 	if (!w)
 		return;
-	free(w->beam_block);
-	bsim_thesis_grid_free(&w->grid);
+	free((void *)w->model);
 	free(w);
 }
 
-/* The arrays of THESIS_BEAM_ARRAYS for nb beams carved from one zeroed
- * allocation, each at an offset aligned for any type; BSIM_EFAIL out of
- * memory. */
-static int beam_arrays_alloc(bsim_world *w, size_t nb)
+/* Bytes, rounded up to an alignment for any type: each part of an
+ * allocation starts at such an offset. */
+static size_t part_round(size_t bytes)
 {
 	const size_t align = _Alignof(max_align_t);
-	size_t size = 0;
-#define ARRAY_SIZE(name, type, per) size += (nb * (per) * sizeof(type) + align - 1) / align * align;
-	THESIS_BEAM_ARRAYS(ARRAY_SIZE)
-#undef ARRAY_SIZE
+	return (bytes + align - 1) / align * align;
+}
+
+/* THESIS_BEAM_ARRAYS' bytes and places, for nb beams, in the allocation of
+ * the struct o (the model or the world), after it. */
+#define ARRAY_SIZE(name, type, per, more) size += part_round((nb * (per) + (more)) * sizeof(type));
+#define ARRAY_SET(name, type, per, more)                                                           \
+	o->name = (type *)(void *)(block + at);                                                    \
+	at += part_round((nb * (per) + (more)) * sizeof(type));
+#define ARRAY_NONE(name, type, per, more)
+
+/* The model for nb beams, its arrays carved from its one zeroed
+ * allocation; NULL out of memory. *size: the allocation's bytes. */
+static thesis_model *model_alloc(size_t nb, size_t *size_out)
+{
+	size_t size = part_round(sizeof(thesis_model) + nb * sizeof(thesis_beam_model));
+	THESIS_BEAM_ARRAYS(ARRAY_SIZE, ARRAY_NONE)
 	unsigned char *block = calloc(1, size);
 	if (!block)
-		return BSIM_EFAIL;
-	w->beam_block = block;
-	size_t at = 0;
-#define ARRAY_SET(name, type, per)                                                                 \
-	w->name = (type *)(void *)(block + at);                                                    \
-	at += (nb * (per) * sizeof(type) + align - 1) / align * align;
-	THESIS_BEAM_ARRAYS(ARRAY_SET)
-#undef ARRAY_SET
-	return BSIM_OK;
+		return NULL;
+	thesis_model *o = (thesis_model *)(void *)block;
+	size_t at = part_round(sizeof *o + nb * sizeof *o->beams);
+	THESIS_BEAM_ARRAYS(ARRAY_SET, ARRAY_NONE)
+	*size_out = size;
+	return o;
 }
+
+/* The world (its data) for nb beams, in one zeroed allocation; NULL out of
+ * memory. */
+static bsim_world *data_alloc(size_t nb)
+{
+	size_t size = part_round(sizeof(bsim_world) + nb * sizeof(thesis_beam));
+	THESIS_BEAM_ARRAYS(ARRAY_NONE, ARRAY_SIZE)
+	unsigned char *block = calloc(1, size);
+	if (!block)
+		return NULL;
+	bsim_world *o = (bsim_world *)(void *)block;
+	size_t at = part_round(sizeof *o + nb * sizeof *o->beams);
+	THESIS_BEAM_ARRAYS(ARRAY_NONE, ARRAY_SET)
+	return o;
+}
+#undef ARRAY_SIZE
+#undef ARRAY_SET
+#undef ARRAY_NONE
 
 /* A shape whose outline bsim_body_shape_segment cannot give (a far segment has
  * a normal for every shape it supports) is refused. */
@@ -210,18 +236,71 @@ static int shape_check(const bsim_scene *scene, bsim_error *err)
 }
 
 /* The body's extended-path fields (thesis.h) from its definition. */
-static void body_setup(bsim_world *w, const bsim_scene *scene)
+static void body_setup(thesis_model *m, const bsim_scene *scene)
 {
 	const bsim_body_def *b = &scene->body;
-	w->body = *b;
-	w->shaped = b->shape != BSIM_SHAPE_DISK;
-	w->rotates = b->rotates != 0;
-	w->friction = scene->contact.friction;
-	w->extended = w->shaped || w->rotates || w->friction > 0.0;
-	w->radius = w->shaped ? bsim_body_shape_reach(b) : b->radius;
-	w->body_inertia = bsim_body_inertia(b);
-	w->inv_body_inertia = w->rotates ? 1.0 / w->body_inertia : 0.0;
-	w->angular_velocity = w->rotates ? b->angular_velocity : 0.0;
+	m->body = *b;
+	m->shaped = b->shape != BSIM_SHAPE_DISK;
+	m->rotates = b->rotates != 0;
+	m->friction = scene->contact.friction;
+	m->extended = m->shaped || m->rotates || m->friction > 0.0;
+	m->radius = m->shaped ? bsim_body_shape_reach(b) : b->radius;
+	m->body_inertia = bsim_body_inertia(b);
+	m->inv_body_inertia = m->rotates ? 1.0 / m->body_inertia : 0.0;
+}
+
+/* The model of scene under opts into m (allocated for its beams). */
+static int model_setup(thesis_model *m, const bsim_scene *scene, const bsim_options *opts,
+                       bsim_error *err)
+{
+	m->mass = scene->body.mass;
+	m->inv_mass = 1.0 / scene->body.mass;
+	m->impact_inv_mass = m->inv_mass;
+	body_setup(m, scene);
+	m->n_beams = scene->n_beams;
+	for (int i = 0; i < scene->n_beams; i++) {
+		const bsim_beam_def *d = &scene->beams[i];
+		thesis_beam_model *b = &m->beams[i];
+		memcpy(b->p, d->pivot, sizeof b->p);
+		bsim_scene_beam_rest_direction(d, b->u0);
+		b->sgn = bsim_scene_beam_forward_sign(d); /* forward = toward +y */
+		b->length = d->length;
+		b->reach = b->length + m->radius; /* m->radius: body_setup's, above */
+		b->inertia = d->inertia;
+		b->inv_inertia = 1.0 / d->inertia;
+		b->stiffness = d->stiffness;
+		b->damping = d->damping;
+		if (d->initial_theta != 0.0 || d->initial_omega != 0.0)
+			m->start_awake[m->n_start_awake++] = i;
+	}
+	m->e_tangent = scene->contact.restitution;
+	m->e_tip = scene->contact.tip_restitution;
+	m->rest_threshold = scene->contact.rest_threshold;
+	m->integrator = bsim_options_choice(opts, &thesis_knobs[KNOB_INTEGRATOR]);
+	m->impact_order = bsim_options_choice(opts, &thesis_knobs[KNOB_IMPACT_ORDER]);
+	m->projection = bsim_options_int(opts, &thesis_knobs[KNOB_PROJECTION]) != 0;
+	m->slop = bsim_options_double(opts, &thesis_knobs[KNOB_SLOP]);
+	m->contact_tol = fmax(bsim_options_double(opts, &thesis_knobs[KNOB_CONTACT_TOL]), m->slop);
+	m->contact_mode = bsim_options_choice(opts, &thesis_knobs[KNOB_CONTACT_MODE]);
+	m->flight_disk = !m->extended && m->contact_mode != THESIS_CONTACT_ESSAY;
+	m->broad_phase = bsim_options_int(opts, &thesis_knobs[KNOB_BROAD_PHASE]) != 0;
+	int sleep = bsim_options_choice(opts, &thesis_knobs[KNOB_SLEEP]);
+	m->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
+	m->sleep_energy = bsim_options_double(opts, &thesis_knobs[KNOB_SLEEP_ENERGY]);
+	m->steps_disk = bsim_thesis_steps_takes(m);
+	if (!(m->sleep_energy >= 0.0) || !isfinite(m->sleep_energy))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "thesis: sleep_energy: expected a number >= 0 (J)");
+	if (bsim_options_get(opts, thesis_knobs[KNOB_IMPACT_MASS].name)) {
+		double mass = bsim_options_double(opts, &thesis_knobs[KNOB_IMPACT_MASS]);
+		if (!(mass > 0.0))
+			return bsim_error_set(err, BSIM_EINPUT,
+			                      "thesis: impact_mass: expected a number > 0 (kg)");
+		m->impact_inv_mass = 1.0 / mass;
+	}
+	if (m->broad_phase)
+		bsim_thesis_grid_build(m);
+	return BSIM_OK;
 }
 
 static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim_world **out,
@@ -233,81 +312,41 @@ static int thesis_create(const bsim_scene *scene, const bsim_options *opts, bsim
 		return rc;
 	if ((rc = shape_check(scene, err)) != BSIM_OK)
 		return rc;
-	bsim_world *w = calloc(1, sizeof *w);
-	size_t nb = scene->n_beams > 0 ? (size_t)scene->n_beams : 1;
-	if (!w || beam_arrays_alloc(w, nb) != BSIM_OK) {
-		thesis_destroy(w);
+	size_t nb = scene->n_beams > 0 ? (size_t)scene->n_beams : 1, model_size = 0;
+	thesis_model *m = model_alloc(nb, &model_size);
+	if (!m)
+		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
+	if ((rc = model_setup(m, scene, opts, err)) != BSIM_OK) {
+		free(m);
+		return rc;
+	}
+	bsim_world *w = data_alloc(nb);
+	if (!w) {
+		free(m);
 		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
 	}
+	w->model = m; /* const from here on */
+	w->model_size = model_size;
 	memcpy(w->x, scene->body.start, sizeof w->x);
 	memcpy(w->v, scene->body.velocity, sizeof w->v);
 	w->heading = bsim_body_heading(&scene->body);
-	w->h_prepared = NAN;
-	w->mass = scene->body.mass;
-	w->inv_mass = 1.0 / scene->body.mass;
-	w->impact_inv_mass = w->inv_mass;
-	body_setup(w, scene);
-	w->n_beams = scene->n_beams;
+	w->angular_velocity = m->rotates ? scene->body.angular_velocity : 0.0;
+	w->h_prepared = NAN; /* thesis_beams_prepare at the first step */
 	for (int i = 0; i < scene->n_beams; i++) {
 		const bsim_beam_def *d = &scene->beams[i];
 		thesis_beam *b = &w->beams[i];
-		memcpy(b->p, d->pivot, sizeof b->p);
-		bsim_scene_beam_rest_direction(d, b->u0);
-		b->sgn = bsim_scene_beam_forward_sign(d); /* forward = toward +y */
-		b->length = d->length;
-		b->reach = b->length + w->radius; /* w->radius: body_setup's, above */
-		b->inertia = d->inertia;
-		b->inv_inertia = 1.0 / d->inertia;
-		b->h_d = NAN; /* thesis_beam_prepare at the first step */
 		b->geo.theta = NAN;
-		b->stiffness = d->stiffness;
-		b->damping = d->damping;
 		b->theta = d->initial_theta;
 		b->omega = d->initial_omega;
 		b->u_theta = 0.0; /* the rest direction, u0: never read from here */
-		b->u[0] = b->u0[0];
-		b->u[1] = b->u0[1];
+		b->u[0] = m->beams[i].u0[0];
+		b->u[1] = m->beams[i].u0[1];
 		w->contact_of[i] = -1;
 	}
-	w->e_tangent = scene->contact.restitution;
-	w->e_tip = scene->contact.tip_restitution;
-	w->rest_threshold = scene->contact.rest_threshold;
-	w->integrator = bsim_options_choice(opts, &thesis_knobs[KNOB_INTEGRATOR]);
-	w->impact_order = bsim_options_choice(opts, &thesis_knobs[KNOB_IMPACT_ORDER]);
-	w->projection = bsim_options_int(opts, &thesis_knobs[KNOB_PROJECTION]) != 0;
-	w->slop = bsim_options_double(opts, &thesis_knobs[KNOB_SLOP]);
-	w->contact_tol = fmax(bsim_options_double(opts, &thesis_knobs[KNOB_CONTACT_TOL]), w->slop);
-	w->contact_mode = bsim_options_choice(opts, &thesis_knobs[KNOB_CONTACT_MODE]);
-	w->flight_disk = !w->extended && w->contact_mode != THESIS_CONTACT_ESSAY;
-	w->broad_phase = bsim_options_int(opts, &thesis_knobs[KNOB_BROAD_PHASE]) != 0;
-	int sleep = bsim_options_choice(opts, &thesis_knobs[KNOB_SLEEP]);
-	w->sleep = sleep == SLEEP_ON || (sleep == SLEEP_AUTO && scene->has_lattice);
-	w->sleep_energy = bsim_options_double(opts, &thesis_knobs[KNOB_SLEEP_ENERGY]);
-	w->steps_disk = bsim_thesis_steps_takes(w);
-	if (!(w->sleep_energy >= 0.0) || !isfinite(w->sleep_energy)) {
-		thesis_destroy(w);
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "thesis: sleep_energy: expected a number >= 0 (J)");
-	}
-	if (bsim_options_get(opts, thesis_knobs[KNOB_IMPACT_MASS].name)) {
-		double m = bsim_options_double(opts, &thesis_knobs[KNOB_IMPACT_MASS]);
-		if (!(m > 0.0)) {
-			thesis_destroy(w);
-			return bsim_error_set(err, BSIM_EINPUT,
-			                      "thesis: impact_mass: expected a number > 0 (kg)");
-		}
-		w->impact_inv_mass = 1.0 / m;
-	}
-	for (int i = 0; i < w->n_beams; i++)
-		if (w->beams[i].theta != 0.0 || w->beams[i].omega != 0.0) {
-			w->start_awake[w->n_start_awake++] = i;
-			bsim_thesis_beam_wake(w, i);
-		}
-	if (w->broad_phase && bsim_thesis_grid_build(&w->grid, w)) {
-		thesis_destroy(w);
-		return bsim_error_set(err, BSIM_EFAIL, "thesis: out of memory");
-	}
+	for (int k = 0; k < m->n_start_awake; k++)
+		bsim_thesis_beam_wake(w, m->start_awake[k]);
 	contact_list_beams(w, NULL, 1); /* a body that starts touching a beam */
+	bsim_thesis_model_seal(w);
 	bsim_thesis_validate(w);
 	*out = w;
 	return BSIM_OK;
@@ -320,31 +359,30 @@ static void beam_restore(bsim_world *w, int i, const bsim_beam_def *d)
 	b->theta = d->initial_theta;
 	b->omega = d->initial_omega;
 	b->u_theta = 0.0;
-	b->u[0] = b->u0[0];
-	b->u[1] = b->u0[1];
+	b->u[0] = w->model->beams[i].u0[0];
+	b->u[1] = w->model->beams[i].u0[1];
 	memset(&b->geo, 0, sizeof b->geo);
 	b->geo.theta = NAN;
 	w->is_awake[i] = 0;
-	w->contact_type[i] = BSIM_CONTACT_NONE;
-	w->pushed[i] = 0;
+	w->impulse[i] = 0.0;
 	w->held[i] = 0;
 	w->contact_of[i] = -1;
 	w->touched[i] = 0;
 }
 
 /* The world as thesis_create(scene) made it, at the cost of the beams the
- * trials since touched: the grid, the rest directions and forward signs,
- * and the constants for the last step size are kept (what the world holds
- * of them depends on the beams' definitions only, which the runner
- * guarantees unchanged: the same scene). The body and the beams' initial
- * angles are read again. */
+ * trials since touched: the model (the grid, the rest directions and
+ * forward signs ...) and the beams' constants for the last step size are
+ * kept (they depend on the scene's beams and the options only, which the
+ * runner guarantees unchanged: the same scene). The body and the beams'
+ * initial angles are read again. */
 static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 {
-	if (scene->n_beams != w->n_beams)
+	if (scene->n_beams != w->model->n_beams)
 		return bsim_error_set(err, BSIM_EINPUT, "thesis: reset to %d beams, world has %d",
-		                      scene->n_beams, w->n_beams);
+		                      scene->n_beams, w->model->n_beams);
 	if (w->touched_all)
-		for (int i = 0; i < w->n_beams; i++)
+		for (int i = 0; i < w->model->n_beams; i++)
 			beam_restore(w, i, &scene->beams[i]);
 	else
 		for (int k = 0; k < w->n_touched; k++)
@@ -354,17 +392,17 @@ static int thesis_reset(bsim_world *w, const bsim_scene *scene, bsim_error *err)
 	memcpy(w->x, scene->body.start, sizeof w->x);
 	memcpy(w->v, scene->body.velocity, sizeof w->v);
 	w->heading = bsim_body_heading(&scene->body);
-	w->angular_velocity = w->rotates ? scene->body.angular_velocity : 0.0;
+	w->angular_velocity = w->model->rotates ? scene->body.angular_velocity : 0.0;
 	w->impacts_scaled = 0;
-	w->n_awake = w->n_typed = w->n_pushed = w->n_contacts = 0;
+	w->n_awake = w->n_pushed = w->n_contacts = 0;
 	w->any_held = 0;
 	w->flight_skip = w->flight_wait = 0;
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
 	memset(&w->solver, 0, sizeof w->solver);
 	bsim_thesis_near_forget(w);
-	for (int k = 0; k < w->n_start_awake; k++)
-		bsim_thesis_beam_wake(w, w->start_awake[k]);
+	for (int k = 0; k < w->model->n_start_awake; k++)
+		bsim_thesis_beam_wake(w, w->model->start_awake[k]);
 	contact_list_beams(w, NULL, 1); /* a body that starts touching a beam */
 	bsim_thesis_validate(w);
 	return BSIM_OK;
@@ -376,13 +414,13 @@ THESIS_APART int step_extended(bsim_world *w, const double force[2], double torq
                                int in_flight)
 {
 	return step_run(w, NULL, force, torque, h, in_flight, &w->energy, &w->impacts, 1,
-	                w->integrator);
+	                w->model->integrator);
 }
 
 THESIS_APART int step_disk(bsim_world *w, const double force[2], double h, int in_flight)
 {
 	return step_run(w, NULL, force, 0.0, h, in_flight, &w->energy, &w->impacts, 0,
-	                w->integrator);
+	                w->model->integrator);
 }
 
 /* Nothing in a step allocates: the world's memory is sized at creation. */
@@ -397,11 +435,11 @@ static inline int thesis_step(bsim_world *w, const double force[2], double torqu
 	int in_flight = w->n_awake == 0 && thesis_flight_clear(w, force, h);
 	memset(&w->energy, 0, sizeof w->energy);
 	w->impacts = 0;
-	if (in_flight && w->n_typed == 0 && h == w->h_prepared && w->flight_disk) {
+	if (in_flight && h == w->h_prepared && w->model->flight_disk) {
 		flight_step(w, force, torque, h, 0);
 		return BSIM_OK;
 	}
-	if (w->extended)
+	if (w->model->extended)
 		return step_extended(w, force, torque, h, in_flight);
 	return step_disk(w, force, h, in_flight);
 }
@@ -462,7 +500,7 @@ static inline int advance_calls(bsim_world *w, const bsim_wrench *schedule, doub
 		w->flight_skip = w->flight_wait;
 	}
 	int rc = BSIM_OK;
-	if (out && n > 1 && w->steps_disk && out[0].n_beams == w->n_beams)
+	if (out && n > 1 && w->model->steps_disk && out[0].n_beams == w->model->n_beams)
 		*made = bsim_thesis_steps(w, schedule, h, n, out);
 	else
 		rc = advance_each(w, schedule, h, n, out, made, err);
@@ -480,25 +518,21 @@ static int thesis_advance(bsim_world *w, const bsim_wrench *schedule, double h, 
 
 static int thesis_set_state(bsim_world *w, const bsim_state *s, bsim_error *err)
 {
-	if (s->n_beams != w->n_beams)
+	if (s->n_beams != w->model->n_beams)
 		return bsim_error_set(err, BSIM_EINPUT, "thesis: state has %d beams, world has %d",
-		                      s->n_beams, w->n_beams);
+		                      s->n_beams, w->model->n_beams);
 	memcpy(w->x, s->x, sizeof w->x);
 	memcpy(w->v, s->v, sizeof w->v);
 	w->heading = s->heading;
-	w->angular_velocity = w->rotates ? s->angular_velocity : 0.0;
+	w->angular_velocity = w->model->rotates ? s->angular_velocity : 0.0;
 	w->n_awake = 0;
-	w->n_typed = 0;
-	for (int k = 0; k < w->n_pushed; k++)
-		w->pushed[w->pushed_list[k]] = 0;
-	w->n_pushed = 0;
-	memset(w->is_awake, 0, (size_t)w->n_beams * sizeof *w->is_awake);
-	for (int i = 0; i < w->n_beams; i++) {
+	step_contacts_clear(w); /* a state has no contacts: its flags wake beams */
+	w->n_contacts = 0;
+	thesis_contact_spent(w);
+	memset(w->is_awake, 0, (size_t)w->model->n_beams * sizeof *w->is_awake);
+	for (int i = 0; i < w->model->n_beams; i++) {
 		w->beams[i].theta = s->theta[i];
 		w->beams[i].omega = s->omega[i];
-		w->contact_type[i] = s->contact[i];
-		if (s->contact[i] != BSIM_CONTACT_NONE)
-			w->typed[w->n_typed++] = i;
 		if (s->theta[i] != 0.0 || s->omega[i] != 0.0 || s->contact[i] != BSIM_CONTACT_NONE)
 			bsim_thesis_beam_wake(w, i);
 		w->held[i] = 0; /* a state has no loop: contact_mode=essay starts afresh */
