@@ -38,7 +38,8 @@ enum {
 	OWN_WALKS,
 	OWN_GATES, /* predict's options follow each other from OWN_LOCATIONS */
 	OWN_SHARD,
-	OWN_PASSES
+	OWN_PASSES,
+	OWN_START_TRIALS
 };
 
 #define MAX_ENTRIES 16
@@ -56,6 +57,7 @@ typedef struct markov_args {
 	const char *passes;  /* build: --passes */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
+	int start_trials; /* build: --start-trials given */
 } markov_args;
 
 static int markov_option(void *args, int i, const char *value)
@@ -115,12 +117,24 @@ static int markov_option(void *args, int i, const char *value)
 				        value, BSIM_MARKOV_SELF_PASSES_MAX);
 			a->def.self_entries = value[0] == 's' ? 1 : 2;
 			a->def.self_passes = (int)n;
+			if (!a->start_trials) /* passes pool every bin's trials alike */
+				a->def.start_trials = 0;
 			return CLI_OK;
 		}
 		if (a->n_entries == MAX_ENTRIES)
 			return cli_usage("markov", "--entries %s: at most %d", value, MAX_ENTRIES);
 		a->entries[a->n_entries++] = value;
 		return CLI_OK;
+	case OWN_START_TRIALS: {
+		long n;
+		if (cli_parse_long(value, 1, 1000000, &n) != 0)
+			return cli_usage("markov build",
+			                 "--start-trials %s: expected an integer 1 to 1000000",
+			                 value);
+		a->def.start_trials = (int)n;
+		a->start_trials = 1;
+		return CLI_OK;
+	}
 	case OWN_MAP:
 		a->map = value;
 		return CLI_OK;
@@ -171,7 +185,7 @@ static int markov_option(void *args, int i, const char *value)
 static const cli_own build_own[] = {
         [OWN_BINS] = {"bins", 1, "P,S,D",
                       "entry bins of position along the edge, speed and\n"
-                      "direction (default 4,4,3)"},
+                      "direction (default 8,8,9)"},
         [OWN_VMAX] = {"vmax", 1, "V", "m/s, the top of the speed bins (default 40)"},
         [OWN_ENTRIES] = {"entries", 1, "PATH",
                          "gate_entries.csv of a lattice sweep (or its directory),\n"
@@ -192,17 +206,25 @@ static const cli_own build_own[] = {
          "with --entries flow[:N] and --shard: the map directory\n"
          "beamsim merge wrote of the round before, whose passes the\n"
          "next round's states come from (none: the first round)"},
+        {"start-trials", 1, "N",
+         "single-gate trials of the start bin (default 4000, or\n"
+         "--trials with self or flow entries, which take no other)"},
 };
 
 static int build_option(void *args, int i, const char *value)
 {
-	return markov_option(args, i == 3 ? OWN_SHARD : i == 4 ? OWN_PASSES : i, value);
+	return markov_option(args,
+	                     i == 3   ? OWN_SHARD
+	                     : i == 4 ? OWN_PASSES
+	                     : i == 5 ? OWN_START_TRIALS
+	                              : i,
+	                     value);
 }
 
 static const char *const build_help[CLI_N_OPTS] = {
         [CLI_OPT_OUT] = "the map directory: maps already there with the same key are\n"
                         "reused, the others are built there (required)",
-        [CLI_OPT_TRIALS] = "single-gate trials per entry bin (default 200)",
+        [CLI_OPT_TRIALS] = "single-gate trials per entry bin (default 50)",
         [CLI_OPT_SEED] = "seed of the entry states and schedules (default 1)",
 };
 
@@ -224,7 +246,7 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 5,
+        .n_own = 6,
         .option = build_option,
 };
 
@@ -616,9 +638,10 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		       pass, a.def.self_passes + 1, cli_path(c.out), cli_path(c.out));
 	if (rc == BSIM_OK && !c.quiet)
 		printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials "
-		       "each, in %s\n",
+		       "each, the start's %d, in %s\n",
 		       built, cpu, reused, copied ? ", the others from the parts" : "",
-		       bsim_markov_bins_count(&a.def.bins), a.def.trials, cli_path(c.out));
+		       bsim_markov_bins_count(&a.def.bins), a.def.trials,
+		       a.def.start_trials > 0 ? a.def.start_trials : a.def.trials, cli_path(c.out));
 	if (rc == BSIM_OK && !c.quiet)
 		cli_wrote(stdout, c.out);
 	bsim_experiment_free(&e);
