@@ -746,10 +746,14 @@ static void test_threads_and_cache(void **state)
 	snprintf(d1, sizeof d1, "%s", bsim_test_dir("threads1"));
 	snprintf(d2, sizeof d2, "%s", bsim_test_dir("threads2"));
 	const char *exp = bsim_test_src("configs/lattice/c_track_essay.yaml");
-	const char *b1[] = {"markov", "build",   exp,     "--trials", "3", "--threads",
-	                    "1",      "--quiet", "--out", d1,         NULL};
-	const char *b2[] = {"markov", "build",   exp,     "--trials", "3", "--threads",
-	                    "2",      "--quiet", "--out", d2,         NULL};
+	/* 4,4,3 bins and the start's trials as the others': cheap maps (the
+	 * default's 2,305 bins and 4,000 start trials are other keys alike) */
+	const char *b1[] = {"markov", "build",    exp, "--bins",    "4,4,3", "--start-trials",
+	                    "3",      "--trials", "3", "--threads", "1",     "--quiet",
+	                    "--out",  d1,         NULL};
+	const char *b2[] = {"markov", "build",    exp, "--bins",    "4,4,3", "--start-trials",
+	                    "3",      "--trials", "3", "--threads", "2",     "--quiet",
+	                    "--out",  d2,         NULL};
 	assert_int_equal(bsim_test_cli(b1, NULL, NULL), 0);
 	assert_int_equal(bsim_test_cli(b2, NULL, NULL), 0);
 	char *t1 = map_text(d1), *t2 = map_text(d2);
@@ -760,7 +764,8 @@ static void test_threads_and_cache(void **state)
 
 	/* The same again: both maps reused. */
 	char *out = NULL;
-	const char *again[] = {"markov", "build", exp, "--trials", "3", "--out", d1, NULL};
+	const char *again[] = {"markov", "build",    exp, "--bins", "4,4,3", "--start-trials",
+	                       "3",      "--trials", "3", "--out",  d1,      NULL};
 	assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
 	assert_non_null(strstr(out, "0 maps built"));
 	assert_non_null(strstr(out, "2 reused"));
@@ -773,9 +778,20 @@ static void test_threads_and_cache(void **state)
 	                            {"--trials", "4", "--threads", "2"},
 	                            {"--trials", "3", "--backend-opt", "integrator=euler"}};
 	for (int i = 0; i < 6; i++) {
-		const char *argv[] = {
-		        "markov",      "build", exp, changes[i][0], changes[i][1], changes[i][2],
-		        changes[i][3], "--out", d1,  NULL};
+		const char *argv[] = {"markov",
+		                      "build",
+		                      exp,
+		                      "--bins",
+		                      "4,4,3",
+		                      "--start-trials",
+		                      "3",
+		                      changes[i][0],
+		                      changes[i][1],
+		                      changes[i][2],
+		                      changes[i][3],
+		                      "--out",
+		                      d1,
+		                      NULL};
 		out = NULL;
 		assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
 		if (!strstr(out, "2 maps built") || !strstr(out, "0 reused"))
@@ -901,8 +917,9 @@ static void test_field_figures(void **state)
 	snprintf(vdir, sizeof vdir, "%s/validation", maps);
 	char exp[1200]; /* bsim_test_src's buffer is reused by the next call */
 	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
-	const char *build[] = {"markov",  "build", exp,  "--trials", "10",
-	                       "--quiet", "--out", maps, NULL};
+	const char *build[] = {"markov", "build",          exp,  "--bins",  "4,4,3", "--trials",
+	                       "10",     "--start-trials", "10", "--quiet", "--out", maps,
+	                       NULL};
 	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
 	const char *pred[] = {"markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
 	                      "--map",  maps,      "--out",
