@@ -37,7 +37,8 @@ for s in "${settings[@]}"; do
     read -r bins trials <<<"$s"
     maps=$out/maps-${bins//,/x}-$trials
     for l in "${lattices[@]}"; do
-        $exe markov build configs/markov/$l.yaml --bins "$bins" --trials "$trials" "${opts[@]}" \
+        $exe markov build configs/markov/$l.yaml --bins "$bins" --trials "$trials" \
+            --start-trials "$trials" "${opts[@]}" \
             --quiet --out "$maps"
     done
     for l in "${lattices[@]}"; do

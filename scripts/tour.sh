@@ -42,7 +42,7 @@ step $b regress $o/h1-compare --out $o/h1-rerun
 step $b landscape configs/thesis/gate.yaml --out $o/landscape
 step $b escape $o/h2 --out $o/escape
 step $b sweep configs/lattice/c_track_1000.yaml --out $o/c-track
-step $b markov build configs/markov/c_track.yaml --trials 800 --entries flow:1 --out $o/markov-maps
+step $b markov build configs/markov/c_track.yaml --bins 4,4,3 --trials 800 --entries flow:1 --out $o/markov-maps
 step $b markov predict configs/lattice/c_track.yaml --map $o/markov-maps --out $o/c-track-predicted
 step $b markov validate configs/markov/c_track.yaml --map $o/markov-maps --out $o/markov-check
 step $b video configs/thesis/gate.yaml --backends thesis,box2d --seed 3 --trial 2 --out $o/trial.mp4

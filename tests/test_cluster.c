@@ -389,11 +389,14 @@ static const char *markov_lattice(void)
 
 static void markov_build(const char *out, const char *threads, const char *a, const char *b)
 {
-	const char *argv[] = {"markov",    "build",     markov_lattice(),
-	                      "--trials",  "3",         "--grid",
-	                      MARKOV_GRID, "--threads", threads,
-	                      "--out",     out,         "--quiet",
-	                      a,           b,           NULL};
+	/* 4,4,3 bins and the start's trials as the others': cheap maps */
+	const char *argv[] = {"markov",  "build",     markov_lattice(),
+	                      "--bins",  "4,4,3",     "--start-trials",
+	                      "3",       "--trials",  "3",
+	                      "--grid",  MARKOV_GRID, "--threads",
+	                      threads,   "--out",     out,
+	                      "--quiet", a,           b,
+	                      NULL};
 	run_ok(argv);
 }
 
@@ -426,9 +429,13 @@ static void test_markov_shards_merged(void **state)
 	}
 	/* a part of another build: another seed */
 	snprintf(part[3], sizeof part[3], "%s/seed2", dir);
-	const char *argv_seed[] = {"markov", "build",     markov_lattice(), "--trials", "3",
-	                           "--grid", MARKOV_GRID, "--seed",         "2",        "--shard",
-	                           "2/3",    "--out",     part[3],          "--quiet",  NULL};
+	const char *argv_seed[] = {"markov", "build",     markov_lattice(),
+	                           "--bins", "4,4,3",     "--start-trials",
+	                           "3",      "--trials",  "3",
+	                           "--grid", MARKOV_GRID, "--seed",
+	                           "2",      "--shard",   "2/3",
+	                           "--out",  part[3],     "--quiet",
+	                           NULL};
 	assert_int_equal(bsim_test_cli(argv_seed, NULL, NULL), 0);
 	snprintf(out, sizeof out, "%s/merged", dir);
 	const char *argv[] = {"merge", part[2], part[0], part[1], "--out", out, "--quiet", NULL};
@@ -791,8 +798,9 @@ static const char *validate_maps(void)
 		snprintf(maps, sizeof maps, "%s", bsim_test_dir(name));
 		char exp[1200];
 		snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
-		const char *argv[] = {"markov", "build",   exp,     "--trials", "5", "--bins",
-		                      "2,2,2",  "--quiet", "--out", maps,       NULL};
+		const char *argv[] = {
+		        "markov",         "build", exp,       "--trials", "5",  "--bins", "2,2,2",
+		        "--start-trials", "5",     "--quiet", "--out",    maps, NULL};
 		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	}
 	return maps;
@@ -1095,6 +1103,10 @@ static void test_mpi_markov_build(void **state)
 	                      "markov",
 	                      "build",
 	                      markov_lattice(),
+	                      "--bins",
+	                      "4,4,3",
+	                      "--start-trials",
+	                      "3",
 	                      "--trials",
 	                      "3",
 	                      "--grid",
@@ -1174,6 +1186,10 @@ static void test_mpi_markov_killed_reused(void **state)
 	const char *one_argv[] = {"markov",
 	                          "build",
 	                          markov_lattice(),
+	                          "--bins",
+	                          "4,4,3",
+	                          "--start-trials",
+	                          "20",
 	                          "--trials",
 	                          "20",
 	                          "--grid",
@@ -1193,6 +1209,10 @@ static void test_mpi_markov_killed_reused(void **state)
 	                      "markov",
 	                      "build",
 	                      markov_lattice(),
+	                      "--bins",
+	                      "4,4,3",
+	                      "--start-trials",
+	                      "20",
 	                      "--trials",
 	                      "20",
 	                      "--grid",

@@ -74,7 +74,7 @@ static bsim_markov_set hand_set(double k, const int rows[][NB], int n_rows, cons
 static void hand_hold(bsim_markov_set *s, const int steps[][NB], int n_rows, const int *which)
 {
 	bsim_markov_map *m = &s->maps[0];
-	m->trials = 100;
+	m->trials = m->start_trials = 100;
 	m->hold_exit = calloc(NB * 100, sizeof(int));
 	m->hold_steps = malloc(NB * 100 * sizeof(int));
 	for (int u = 0; u < NB * 100; u++)
@@ -447,6 +447,7 @@ static void test_map_cost(void **state)
 	bsim_markov_def def = bsim_markov_def_default();
 	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
 	def.trials = 8;
+	def.start_trials = 0; /* the self-consistent maps' pass 0 is this map */
 	def.threads = 1;
 	char uni[1024], self[1024];
 	snprintf(uni, sizeof uni, "%s", exe_dir("cost_uniform"));
@@ -482,9 +483,60 @@ static void test_map_cost(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The start bin's trials are part of a map's key, only where they differ
+ * from the other bins' (a map built before keeps its key): a map of other
+ * start trials is built, never reused. A map directory without the map a
+ * scene needs is refused naming the lines of the nearest map's key that
+ * differ. */
+static void test_start_trials_key(void **state)
+{
+	(void)state;
+	bsim_scene s, s5;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 1, 6, 30), BSIM_OK);
+	assert_int_equal(bsim_lattice_scene_init(&s5, 1, 1, 5, 30), BSIM_OK);
+	const char *dir = exe_dir("start_trials");
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
+	def.trials = 20;
+	const int starts[] = {20, 60, 20};
+	uint64_t key[3];
+	for (int i = 0; i < 3; i++) {
+		def.start_trials = starts[i];
+		bsim_markov_set set;
+		bsim_error err;
+		assert_int_equal(bsim_markov_build(&s, &def, dir, &set, &err), BSIM_OK);
+		const bsim_markov_map *m = &set.maps[0];
+		key[i] = m->key;
+		assert_int_equal(m->start_trials, starts[i]);
+		assert_int_equal(set.built, i < 2);
+		assert_int_equal(set.reused, i == 2);
+		assert_int_equal(strstr(m->key_text, "start_trials 60\n") != NULL, starts[i] == 60);
+		assert_null(strstr(m->key_text, "start_trials 20"));
+		long row0 = 0;
+		for (int x = 0; x < NB; x++)
+			row0 += m->counts[START * NB + x];
+		assert_int_equal(row0, starts[i]);
+		bsim_markov_set_free(&set);
+	}
+	assert_true(key[0] != key[1]);
+	assert_true(key[0] == key[2]);
+	/* a scene of another force: no map of its key; the refusal names the
+	 * line of the key that differs, both ways */
+	bsim_options opts = {0};
+	bsim_markov_set set;
+	bsim_error err;
+	assert_int_equal(bsim_markov_load(&s5, dir, &opts, &set, &err), BSIM_EINPUT);
+	print_message("%s\n", err.msg);
+	assert_non_null(strstr(err.msg, "has 'effects propulsion 1 6 "));
+	assert_non_null(strstr(err.msg, "needs 'effects propulsion 1 5 "));
+	bsim_scene_free(&s);
+	bsim_scene_free(&s5);
+}
+
 /* One gate, where the essay's protocol is the whole world: the chain from a
- * map of 400 start trials against 400 independent trials of the lattice
- * run directly, each outcome within 4.5 standard errors of the difference
+ * map of 1600 start trials (the other bins' 400: the start row counted and
+ * weighed as its own) against 400 independent trials of the lattice run
+ * directly, each outcome within 4.5 standard errors of the difference
  * (the maps' and the simulation's sampling errors together). */
 static void test_one_gate_against_simulation(void **state)
 {
@@ -494,6 +546,7 @@ static void test_one_gate_against_simulation(void **state)
 	bsim_markov_def def = bsim_markov_def_default();
 	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
 	def.trials = 400;
+	def.start_trials = 1600;
 	def.seed = 11;
 	bsim_markov_set set;
 	bsim_error err;
@@ -541,11 +594,18 @@ static void test_one_gate_against_simulation(void **state)
 	 * probability back: E = h0 + P(0 -> TOP) h1 / (1 - back). */
 	const bsim_markov_map *m = &set.maps[0];
 	assert_non_null(m->hold_steps);
+	assert_int_equal(m->start_trials, 1600);
+	int row0 = 0;
+	for (int x = 0; x < NB; x++)
+		row0 += m->counts[START * NB + x];
+	assert_int_equal(row0, 1600);
+	/* the start's single gates first, then bin BOTTOM's */
 	double h[2] = {0, 0};
-	for (int a = 0; a < 2; a++)
-		for (int t = 0; t < m->trials; t++)
-			h[a] += m->hold_steps[a * m->trials + t] * s.dt / m->trials;
-	const double down = (double)m->counts[START * NB + TOP] / m->trials,
+	for (int t = 0; t < m->start_trials; t++)
+		h[0] += m->hold_steps[t] * s.dt / m->start_trials;
+	for (int t = 0; t < m->trials; t++)
+		h[1] += m->hold_steps[m->start_trials + t] * s.dt / m->trials;
+	const double down = (double)m->counts[START * NB + TOP] / m->start_trials,
 	             back = (double)m->counts[BOTTOM * NB + TOP] / m->trials;
 	const double e = h[0] + (down > 0 ? down * h[1] / (1 - back) : 0.0);
 	assert_true(p.has_time);
@@ -686,10 +746,14 @@ static void test_threads_and_cache(void **state)
 	snprintf(d1, sizeof d1, "%s", bsim_test_dir("threads1"));
 	snprintf(d2, sizeof d2, "%s", bsim_test_dir("threads2"));
 	const char *exp = bsim_test_src("configs/lattice/c_track_essay.yaml");
-	const char *b1[] = {"markov", "build",   exp,     "--trials", "3", "--threads",
-	                    "1",      "--quiet", "--out", d1,         NULL};
-	const char *b2[] = {"markov", "build",   exp,     "--trials", "3", "--threads",
-	                    "2",      "--quiet", "--out", d2,         NULL};
+	/* 4,4,3 bins and the start's trials as the others': cheap maps (the
+	 * default's 2,305 bins and 4,000 start trials are other keys alike) */
+	const char *b1[] = {"markov", "build",    exp, "--bins",    "4,4,3", "--start-trials",
+	                    "3",      "--trials", "3", "--threads", "1",     "--quiet",
+	                    "--out",  d1,         NULL};
+	const char *b2[] = {"markov", "build",    exp, "--bins",    "4,4,3", "--start-trials",
+	                    "3",      "--trials", "3", "--threads", "2",     "--quiet",
+	                    "--out",  d2,         NULL};
 	assert_int_equal(bsim_test_cli(b1, NULL, NULL), 0);
 	assert_int_equal(bsim_test_cli(b2, NULL, NULL), 0);
 	char *t1 = map_text(d1), *t2 = map_text(d2);
@@ -700,7 +764,8 @@ static void test_threads_and_cache(void **state)
 
 	/* The same again: both maps reused. */
 	char *out = NULL;
-	const char *again[] = {"markov", "build", exp, "--trials", "3", "--out", d1, NULL};
+	const char *again[] = {"markov", "build",    exp, "--bins", "4,4,3", "--start-trials",
+	                       "3",      "--trials", "3", "--out",  d1,      NULL};
 	assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
 	assert_non_null(strstr(out, "0 maps built"));
 	assert_non_null(strstr(out, "2 reused"));
@@ -713,9 +778,20 @@ static void test_threads_and_cache(void **state)
 	                            {"--trials", "4", "--threads", "2"},
 	                            {"--trials", "3", "--backend-opt", "integrator=euler"}};
 	for (int i = 0; i < 6; i++) {
-		const char *argv[] = {
-		        "markov",      "build", exp, changes[i][0], changes[i][1], changes[i][2],
-		        changes[i][3], "--out", d1,  NULL};
+		const char *argv[] = {"markov",
+		                      "build",
+		                      exp,
+		                      "--bins",
+		                      "4,4,3",
+		                      "--start-trials",
+		                      "3",
+		                      changes[i][0],
+		                      changes[i][1],
+		                      changes[i][2],
+		                      changes[i][3],
+		                      "--out",
+		                      d1,
+		                      NULL};
 		out = NULL;
 		assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
 		if (!strstr(out, "2 maps built") || !strstr(out, "0 reused"))
@@ -841,8 +917,9 @@ static void test_field_figures(void **state)
 	snprintf(vdir, sizeof vdir, "%s/validation", maps);
 	char exp[1200]; /* bsim_test_src's buffer is reused by the next call */
 	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
-	const char *build[] = {"markov",  "build", exp,  "--trials", "10",
-	                       "--quiet", "--out", maps, NULL};
+	const char *build[] = {"markov", "build",          exp,  "--bins",  "4,4,3", "--trials",
+	                       "10",     "--start-trials", "10", "--quiet", "--out", maps,
+	                       NULL};
 	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
 	const char *pred[] = {"markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
 	                      "--map",  maps,      "--out",
@@ -973,6 +1050,12 @@ static void test_bad_inputs(void **state)
 	        {{"markov", "validate", essay, "--map", dir, "--out", target, NULL},
 	         "markov.json: cannot read"},
 	        {{"markov", "buld", NULL}, "did you mean 'build'"},
+	        {{"markov", "build", essay, "--start-trials", "0", "--out", target, NULL},
+	         "--start-trials 0: expected an integer 1 to 1000000"},
+	        {{"markov", "build", essay, "--entries", "self:1", "--start-trials", "300", "--out",
+	          target, NULL},
+	         "start trials: self-consistent and flow entries take the start bin's trials "
+	         "equal to every bin's (50), got 300"},
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
 		char *err = NULL;
@@ -1028,8 +1111,10 @@ static void test_bad_map_files(void **state)
 	/* bsim_test_src's buffer is static: a copy per path */
 	char *essay = strdup(bsim_test_src("configs/lattice/c_track_essay.yaml"));
 	char *track = strdup(bsim_test_src("configs/lattice/c_track.yaml"));
-	const char *build[] = {"markov", "build",   essay,   "--bins", "1,1,1", "--trials",
-	                       "2",      "--quiet", "--out", dir,      NULL};
+	/* the start's trials as the others': the damaged files fit a buffer */
+	const char *build[] = {"markov", "build",          essay, "--bins",  "1,1,1", "--trials",
+	                       "2",      "--start-trials", "2",   "--quiet", "--out", dir,
+	                       NULL};
 	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
 	const char *pred[] = {"markov", "predict", track, "--map", dir, NULL};
 	/* Without the manifest, which would refuse any edit by its CRC-32
@@ -1257,6 +1342,7 @@ static void test_self_entries(void **state)
 	bsim_markov_def def = bsim_markov_def_default();
 	def.bins = (bsim_markov_bins){2, 2, 2, 40.0};
 	def.trials = 30;
+	def.start_trials = 0; /* the passes take every bin's trials alike */
 	def.threads = 2;
 	bsim_error err;
 	bsim_markov_set uni, p0, p1a, p1b, again;
@@ -1401,6 +1487,7 @@ static void test_flow_entries(void **state)
 	def.bins = (bsim_markov_bins){2, 2, 2, 40.0};
 	def.trials = 20;
 	def.self_entries = 2;
+	def.start_trials = 0; /* the passes take every bin's trials alike */
 	def.self_passes = 1;
 	def.threads = 1;
 	bsim_error err;
@@ -1538,6 +1625,7 @@ int main(void)
 	        cmocka_unit_test(test_sweeps_against_series),
 	        cmocka_unit_test(test_map_cost),
 	        cmocka_unit_test(test_one_gate_against_simulation),
+	        cmocka_unit_test(test_start_trials_key),
 	        cmocka_unit_test(test_threads_and_cache),
 	        cmocka_unit_test(test_interrupted_build),
 	        cmocka_unit_test(test_entries),

@@ -70,7 +70,11 @@ typedef struct bsim_markov_bins {
 	double v_max; /* m/s: speeds above it fall in the last speed bin */
 } bsim_markov_bins;
 
-/* 4 positions, 4 speeds up to 40 m/s, 3 directions. */
+/* 8 positions, 8 speeds up to 40 m/s, 9 directions: where in a bin a
+ * lattice's entries fall matters to where the body goes next, above all
+ * their direction, so the bins are fine enough that states uniform in
+ * each predict fields of any layout (docs/markov.md, "Maps of a
+ * physics"). */
 BSIM_API bsim_markov_bins bsim_markov_bins_default(void);
 
 /* The number of entry bins, the start's included: 1 + 4 n_pos n_speed n_dir. */
@@ -108,7 +112,12 @@ BSIM_API void bsim_markov_entries_free(bsim_markov_entries *e);
 /* How a map is built. */
 typedef struct bsim_markov_def {
 	bsim_markov_bins bins;
-	int trials;                         /* single-gate trials per entry bin */
+	int trials; /* single-gate trials per entry bin */
+	/* Single-gate trials of the start bin (bin 0), <= 0: trials. Every
+	 * body passes through the start bin once, so its row weighs on every
+	 * prediction and is cheap to sample finely (one bin of many).
+	 * Self-consistent and flow entries take only start_trials == trials. */
+	int start_trials;
 	uint64_t seed;                      /* of the entry states and the schedules */
 	const bsim_backend *backend;        /* NULL: the default backend */
 	const bsim_options *opts;           /* NULL: no options */
@@ -181,28 +190,33 @@ typedef struct bsim_markov_def {
 #define BSIM_MARKOV_SELF_GATES      16
 #define BSIM_MARKOV_SELF_PASSES_MAX 8
 
-/* bsim_markov_bins_default(), 200 trials per bin, seed 1, the default
- * backend, all cores. */
+/* The start bin's single-gate trials by default. */
+#define BSIM_MARKOV_START_TRIALS 4000
+
+/* bsim_markov_bins_default(), 50 trials per bin and BSIM_MARKOV_START_TRIALS
+ * of the start bin, seed 1, the default backend, all cores. */
 BSIM_API bsim_markov_def bsim_markov_def_default(void);
 
 /* One single-gate map. */
 typedef struct bsim_markov_map {
-	double k[2];     /* N m/rad, the gate's left and right beam */
-	uint64_t key;    /* FNV-1a hash of key_text: the map's file name */
-	char *key_text;  /* everything the map depends on, a line each */
-	int n_bins;      /* bsim_markov_bins_count */
-	int trials;      /* per entry bin */
-	int *counts;     /* n_bins x n_bins, [entry * n_bins + exit], exit 0 = stuck */
-	double seconds;  /* CPU time of its simulation now, s (0 if read from the cache) */
-	double cost;     /* CPU time its simulation took when it was built, s: with self or
-	                  * flow entries every pass's, those reused from the cache too */
-	long long steps; /* single-gate time steps that simulation took (as cost); 0 if
-	                  * the map's .cost file predates the count */
-	int cached;      /* 1: read from the cache, 0: simulated now */
+	double k[2];      /* N m/rad, the gate's left and right beam */
+	uint64_t key;     /* FNV-1a hash of key_text: the map's file name */
+	char *key_text;   /* everything the map depends on, a line each */
+	int n_bins;       /* bsim_markov_bins_count */
+	int trials;       /* per entry bin, but the start's */
+	int start_trials; /* of the start bin, bin 0 (bsim_markov_bin_trials) */
+	int *counts;      /* n_bins x n_bins, [entry * n_bins + exit], exit 0 = stuck */
+	double seconds;   /* CPU time of its simulation now, s (0 if read from the cache) */
+	double cost;      /* CPU time its simulation took when it was built, s: with self or
+	                   * flow entries every pass's, those reused from the cache too */
+	long long steps;  /* single-gate time steps that simulation took (as cost); 0 if
+	                   * the map's .cost file predates the count */
+	int cached;       /* 1: read from the cache, 0: simulated now */
 	/* Holding times: each single gate's exit bin (0 stuck) and the time
 	 * steps it spent in the gate (to the step that left it, or gate_steps
-	 * if stuck), [entry * trials + trial] (map_HASH.hold.csv). NULL for a
-	 * map read without that file (built before holding times were kept):
+	 * if stuck), [start_trials + (entry - 1) * trials + trial] for entry > 0,
+	 * [trial] for the start (map_HASH.hold.csv). NULL for a map read
+	 * without that file (built before holding times were kept):
 	 * the chain then has no times, and a build simulates it again. */
 	int *hold_exit, *hold_steps;
 	int elsewhere; /* 1: left to another part (def parts): no counts here */
@@ -331,8 +345,9 @@ typedef struct bsim_markov_build_def {
 
 /* An entries value as the command line's --entries takes it: "self",
  * "self:N", "flow" or "flow:N" (N passes, 0 to BSIM_MARKOV_SELF_PASSES_MAX,
- * default 1) set def->self_entries (1 self, 2 flow) and def->self_passes
- * and *is_kind 1; any other value is a gate_entries path (*is_kind 0, def
+ * default 1) set def->self_entries (1 self, 2 flow) and def->self_passes,
+ * def->start_trials 0 (the start bin's trials are then def->trials, as
+ * those entries need), and *is_kind 1; any other value is a gate_entries path (*is_kind 0, def
  * untouched). BSIM_EINPUT naming the value for a bad N. */
 BSIM_API int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, int *is_kind,
                                       bsim_error *err);

@@ -37,6 +37,7 @@ int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, int *is_ki
 		                      value, BSIM_MARKOV_SELF_PASSES_MAX);
 	def->self_entries = value[0] == 's' ? 1 : 2;
 	def->self_passes = (int)n;
+	def->start_trials = 0; /* passes pool every bin's trials alike: the start's are trials */
 	return BSIM_OK;
 }
 

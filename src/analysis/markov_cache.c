@@ -21,6 +21,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -152,6 +153,9 @@ char *bsim_markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def
 	fprintf(f, "bins %d %d %d %.17g\ntrials %d\nseed %llu\n", def->bins.n_pos,
 	        def->bins.n_speed, def->bins.n_dir, def->bins.v_max, def->trials,
 	        (unsigned long long)def->seed);
+	/* only where it differs: a map of equal trials keeps the key it had */
+	if (bsim_markov_def_start_trials(def) != def->trials)
+		fprintf(f, "start_trials %d\n", bsim_markov_def_start_trials(def));
 	if (fclose(f) != 0) {
 		free(text);
 		return NULL;
@@ -177,6 +181,73 @@ static int key_same(const char *path, const char *key_text)
 	int same = t.len == len && memcmp(t.text, key_text, len) == 0;
 	bsim_file_text_free(&t);
 	return same;
+}
+
+/* Whether line [a, a + n) of one key text is a line of the other text t. */
+static int key_has_line(const char *t, const char *a, size_t n)
+{
+	for (const char *c = t; *c;) {
+		const char *e = strchr(c, '\n');
+		size_t len = e ? (size_t)(e - c) : strlen(c);
+		if (len == n && memcmp(c, a, n) == 0)
+			return 1;
+		c += len + (e != NULL);
+	}
+	return 0;
+}
+
+/* The lines of a not in b, "; "-separated, each quoted, into buf (at most
+ * size); their number. */
+static int key_lines_not_in(const char *a, const char *b, char *buf, size_t size)
+{
+	int n = 0;
+	size_t used = 0;
+	buf[0] = '\0';
+	for (const char *c = a; *c;) {
+		const char *e = strchr(c, '\n');
+		size_t len = e ? (size_t)(e - c) : strlen(c);
+		if (len && !key_has_line(b, c, len)) {
+			int w = snprintf(buf + used, size - used, "%s'%.*s'", n ? "; " : "",
+			                 (int)len, c);
+			used = w > 0 && used + (size_t)w < size ? used + (size_t)w : used;
+			n++;
+		}
+		c += len + (e != NULL);
+	}
+	return n;
+}
+
+void bsim_markov_key_nearest(const char *dir, const char *want, char *buf, size_t size)
+{
+	buf[0] = '\0';
+	DIR *d = opendir(dir);
+	if (!d)
+		return;
+	int best = INT_MAX;
+	const struct dirent *e;
+	while ((e = readdir(d))) {
+		size_t len = strlen(e->d_name);
+		if (len != 24 || strncmp(e->d_name, "map_", 4) != 0 ||
+		    strcmp(e->d_name + 20, ".key") != 0)
+			continue;
+		char path[BSIM_PATH_MAX];
+		snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+		file_text t;
+		bsim_error ignored;
+		if (bsim_file_read(path, "a map key", 65536.0, NULL, &t, &ignored) != BSIM_OK)
+			continue;
+		char has[320], wants[320];
+		int n = key_lines_not_in(t.text, want, has, sizeof has) +
+		        key_lines_not_in(want, t.text, wants, sizeof wants);
+		if (n < best) {
+			best = n;
+			snprintf(buf, size,
+			         "the nearest map there, %s, has %s where this one needs %s",
+			         e->d_name, has, wants);
+		}
+		bsim_file_text_free(&t);
+	}
+	closedir(d);
 }
 
 /* A map's file beside its key, or 0 with *absent if there is none. */
@@ -223,7 +294,8 @@ static const char *map_row(char *line, const bsim_markov_map *m, long v[3], doub
 		char *end;
 		errno = 0;
 		v[i] = strtol(f[i], &end, 10);
-		long lo = i < 2 ? 0 : 1, hi = i < 2 ? m->n_bins - 1 : m->trials;
+		long lo = i < 2 ? 0 : 1,
+		     hi = i < 2 ? m->n_bins - 1 : bsim_markov_bin_trials(m, (int)v[0]);
 		if (end == f[i] || *end || errno || v[i] < lo || v[i] > hi)
 			return field[i];
 	}
@@ -237,7 +309,7 @@ static const char *map_row(char *line, const bsim_markov_map *m, long v[3], doub
 	*p = strtod(f[5], &end);
 	/* written as count / trials to 9 digits */
 	if (end == f[5] || *end || !isfinite(*p) || *p < 0.0 || *p > 1.0 ||
-	    fabs(*p - (double)v[2] / m->trials) > 1e-8)
+	    fabs(*p - (double)v[2] / bsim_markov_bin_trials(m, (int)v[0])) > 1e-8)
 		return "p";
 	return NULL;
 }
@@ -250,7 +322,7 @@ static const char HOLD_HEADER[] = "entry,trial,exit,steps";
 static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 {
 	const int nb = m->n_bins, T = m->trials;
-	const long units = (long)nb * T;
+	const long units = bsim_markov_map_units(m);
 	file_text t;
 	int absent = 0;
 	/* a row is at most four integers of 11 characters */
@@ -280,12 +352,13 @@ static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 			bad = end == c || errno || *end != (k < 3 ? ',' : '\0');
 			c = end + 1;
 		}
-		bad = bad || v[0] != u / T || v[1] != u % T || v[2] < 0 || v[2] >= nb || v[3] < 1 ||
-		      v[3] > INT_MAX;
+		const int a = bsim_markov_unit_bin(m, u);
+		bad = bad || v[0] != a || v[1] != u - bsim_markov_bin_first(m, a) || v[2] < 0 ||
+		      v[2] >= nb || v[3] < 1 || v[3] > INT_MAX;
 		if (!bad) {
 			ex[u] = (int)v[2];
 			st[u] = (int)v[3];
-			count[(u / T) * nb + ex[u]]++;
+			count[a * nb + ex[u]]++;
 			u++;
 		}
 	}
@@ -313,8 +386,9 @@ static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 			bsim_error_set(
 			        err, BSIM_EINPUT,
 			        "%s:%ld: expected a row entry,trial,exit,steps (exit 0 to %d, "
-			        "steps >= 1) for each of the %d bins x %d trials in order",
-			        path, lineno, nb - 1, nb, T);
+			        "steps >= 1) for the start's %d trials and each of the other %d "
+			        "bins x %d trials in order",
+			        path, lineno, nb - 1, m->start_trials, nb - 1, T);
 		return -1;
 	}
 	m->hold_exit = ex;
@@ -386,13 +460,13 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	}
 	/* Every entry bin ran the map's trials, each ending somewhere. */
 	for (int a = 0; !bad && a < nb; a++)
-		if (sum[a] != m->trials) {
+		if (sum[a] != bsim_markov_bin_trials(m, a)) {
 			bad = "count";
 			lineno = last[a] ? last[a] : lineno;
 			snprintf(
 			        what, sizeof what,
 			        "the counts of entry bin %d to sum to the map's %d trials, got %ld",
-			        a, m->trials, sum[a]);
+			        a, bsim_markov_bin_trials(m, a), sum[a]);
 		}
 	free(sum);
 	free(last);
@@ -483,9 +557,11 @@ int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsi
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	fprintf(o.f, "%s\n", HOLD_HEADER);
-	for (long u = 0; u < (long)m->n_bins * m->trials; u++)
-		fprintf(o.f, "%ld,%ld,%d,%d\n", u / m->trials, u % m->trials, m->hold_exit[u],
+	for (long u = 0; u < bsim_markov_map_units(m); u++) {
+		const int a = bsim_markov_unit_bin(m, u);
+		fprintf(o.f, "%d,%ld,%d,%d\n", a, u - bsim_markov_bin_first(m, a), m->hold_exit[u],
 		        m->hold_steps[u]);
+	}
 	return bsim_atomic_file_commit(&o, err);
 }
 
@@ -502,7 +578,8 @@ int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const b
 	        "\"speed\": %d, \"direction\": %d, \"v_max\": ",
 	        MAP_FORMAT, BSIM_VERSION, def->bins.n_pos, def->bins.n_speed, def->bins.n_dir);
 	bsim_json_number(o.f, def->bins.v_max);
-	fprintf(o.f, "}, \"trials\": %d, \"seed\": ", def->trials);
+	fprintf(o.f, "}, \"trials\": %d, \"start_trials\": %d, \"seed\": ", def->trials,
+	        bsim_markov_def_start_trials(def));
 	bsim_json_u64(o.f, def->seed);
 	fputs(", \"backend\": ", o.f);
 	bsim_json_string(o.f, be->name);
@@ -626,6 +703,11 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	}
 	if (rc == BSIM_OK)
 		rc = def_int(&d, "/trials", 1, 1000000, &def->trials, err);
+	/* absent in maps built before the start bin had trials of its own */
+	def->start_trials = 0;
+	if (rc == BSIM_OK &&
+	    fy_node_by_path(fy_document_root(d.fyd), "/start_trials", -1, FYNWF_DONT_FOLLOW))
+		rc = def_int(&d, "/start_trials", 1, 1000000, &def->start_trials, err);
 	if (rc == BSIM_OK) {
 		/* above 2^53 written as a string (bsim_json_u64) */
 		struct fy_node *n = def_field(&d, "/seed", "a seed, an integer >= 0", err);

@@ -48,16 +48,18 @@ typedef struct sparse_map {
 /* Row a's mean holding time, s: its single gates' steps times dt. */
 static int sparse_hold(sparse_map *s, const bsim_markov_map *m, double dt)
 {
-	const int nb = m->n_bins, T = m->trials;
+	const int nb = m->n_bins;
 	if (!m->hold_steps)
 		return 0;
 	s->hold = malloc((size_t)nb * sizeof *s->hold);
 	if (!s->hold)
 		return -1;
 	for (int a = 0; a < nb; a++) {
+		const int T = bsim_markov_bin_trials(m, a);
+		const long u0 = bsim_markov_bin_first(m, a);
 		long long sum = 0;
 		for (int t = 0; t < T; t++)
-			sum += m->hold_steps[(size_t)a * T + t];
+			sum += m->hold_steps[u0 + t];
 		s->hold[a] = (double)sum / T * dt;
 	}
 	return 0;

@@ -245,8 +245,8 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
                                   bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
                                   long *done, long total, bsim_error *err)
 {
-	const int nb = m->n_bins, T = def->trials;
-	const long units = (long)nb * T;
+	const int nb = m->n_bins;
+	const long units = bsim_markov_map_units(m);
 	int *exit = malloc((size_t)units * sizeof *exit);
 	int *held = malloc((size_t)units * sizeof *held);
 	if (!exit || !held) {
@@ -301,8 +301,9 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
 			r.g.s.body.velocity[0] = lattice->body.velocity[0];
 			r.g.s.body.velocity[1] = lattice->body.velocity[1];
 			r.run = runs ? &runs[u] : NULL;
-			exit[u] = gate_trial(&r, lattice, def, be, opts, (int)(u / T), (int)(u % T),
-			                     &e);
+			const int bin = bsim_markov_unit_bin(m, u);
+			exit[u] = gate_trial(&r, lattice, def, be, opts, bin,
+			                     (int)(u - bsim_markov_bin_first(m, bin)), &e);
 			held[u] = (int)r.steps;
 #pragma omp atomic
 			steps += r.steps;
@@ -335,7 +336,7 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
 			*err = first;
 	}
 	for (long u = 0; !failed && u < units; u++)
-		m->counts[(u / T) * nb + exit[u]]++;
+		m->counts[bsim_markov_unit_bin(m, u) * nb + exit[u]]++;
 	m->steps += steps;
 	if (!failed) { /* the holding times: the map keeps both arrays */
 		free(m->hold_exit);

@@ -42,6 +42,33 @@ int bsim_markov_entry_index_init(markov_entry_index *x, const bsim_markov_entrie
                                  const bsim_markov_bins *b, const bsim_lattice_def *l);
 void bsim_markov_entry_index_free(markov_entry_index *x);
 
+/* The start bin's single-gate trials of def: start_trials, or trials. */
+static inline int bsim_markov_def_start_trials(const bsim_markov_def *def)
+{
+	return def->start_trials > 0 ? def->start_trials : def->trials;
+}
+
+/* The single gates of entry bin a of map m, and the index of its first
+ * in the map's single gates (the start bin's first, then every other
+ * bin's trials in turn); their total. */
+static inline int bsim_markov_bin_trials(const bsim_markov_map *m, int a)
+{
+	return a == 0 ? m->start_trials : m->trials;
+}
+static inline long bsim_markov_bin_first(const bsim_markov_map *m, int a)
+{
+	return a == 0 ? 0 : m->start_trials + (long)(a - 1) * m->trials;
+}
+static inline long bsim_markov_map_units(const bsim_markov_map *m)
+{
+	return m->start_trials + (long)(m->n_bins - 1) * m->trials;
+}
+/* The entry bin of single gate u of map m. */
+static inline int bsim_markov_unit_bin(const bsim_markov_map *m, long u)
+{
+	return u < m->start_trials ? 0 : 1 + (int)((u - m->start_trials) / m->trials);
+}
+
 /* ---- single gates (markov_gate.c) ---- */
 
 /* The gate of the lattice's start, moved to its own frame, as the essay's
@@ -173,6 +200,12 @@ char *bsim_markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def
 
 /* The key of a key text: the map's file name, map_KEY. */
 uint64_t bsim_markov_key(const char *key_text);
+
+/* What tells the map directory dir's nearest map (the key with the fewest
+ * lines unlike want's) from the map of key text want: "the nearest map
+ * there, map_HASH.key, has 'LINE'; ... where this one needs 'LINE'; ...",
+ * into buf; "" if dir holds no map. */
+void bsim_markov_key_nearest(const char *dir, const char *want, char *buf, size_t size);
 
 /* Reads map m (key, key_text, n_bins and counts set) from dir: 1 if there
  * with the same key text, 0 if not there or another key, -1 with err if

@@ -21,7 +21,10 @@
 
 bsim_markov_def bsim_markov_def_default(void)
 {
-	return (bsim_markov_def){.bins = bsim_markov_bins_default(), .trials = 200, .seed = 1};
+	return (bsim_markov_def){.bins = bsim_markov_bins_default(),
+	                         .trials = 50,
+	                         .start_trials = BSIM_MARKOV_START_TRIALS,
+	                         .seed = 1};
 }
 
 /* The chain's lattice: its side boundary at the field's edge and its end
@@ -84,6 +87,7 @@ static int map_init(bsim_markov_map *m, const bsim_scene *lattice, const bsim_ma
 	m->k[1] = k[1];
 	m->n_bins = bsim_markov_bins_count(&def->bins);
 	m->trials = def->trials;
+	m->start_trials = bsim_markov_def_start_trials(def);
 	m->key_text = bsim_markov_key_text(lattice, def, be, opts, k);
 	m->counts = calloc((size_t)m->n_bins * m->n_bins, sizeof *m->counts);
 	if (!m->key_text || !m->counts)
@@ -123,6 +127,16 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 	if (def->trials < 1 || def->trials > 1000000)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "trials: expected 1 to 1000000 per bin, got %d", def->trials);
+	if (def->start_trials > 1000000)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "start trials: expected 1 to 1000000, got %d",
+		                      def->start_trials);
+	/* The passes' exits are kept and pooled per trial of every bin alike. */
+	if (def->self_entries && bsim_markov_def_start_trials(def) != def->trials)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "start trials: self-consistent and flow entries take the "
+		                      "start bin's trials equal to every bin's (%d), got %d",
+		                      def->trials, def->start_trials);
 	return BSIM_OK;
 }
 
@@ -186,7 +200,7 @@ static int round_fill(const bsim_scene *lattice, const bsim_markov_def *def, con
 	int own = 0;
 	for (int i = 0; i < n; i++)
 		if (!out->maps[i].elsewhere) {
-			total += (long)out->maps[i].n_bins * def->trials;
+			total += bsim_markov_map_units(&out->maps[i]);
 			own++;
 		}
 	clock_t c0 = clock();
@@ -282,15 +296,20 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			have[i] = m->cached = 1, out->reused++;
 		else if (got)
 			out->copied++;
-		else if (!stage)
+		else if (!stage) {
+			/* a map is used only where its whole key matches: say what
+			 * differs from the nearest one there */
+			char near[700];
+			bsim_markov_key_nearest(dir, m->key_text, near, sizeof near);
 			rc = bsim_error_set(
 			        err, BSIM_EINPUT,
 			        "%s: no map for k = %g, %g N m/rad with this scene's physics "
-			        "and the map's settings (key %016llx): beamsim markov build "
+			        "and the map's settings (key %016llx)%s%s: beamsim markov build "
 			        "writes it",
-			        dir, m->k[0], m->k[1], (unsigned long long)m->key);
-		else
-			total += (long)m->n_bins * def->trials *
+			        dir, m->k[0], m->k[1], (unsigned long long)m->key,
+			        near[0] ? "; " : "", near);
+		} else
+			total += bsim_markov_map_units(m) *
 			         (def->self_entries == 1 ? bsim_markov_self_passes_left(
 			                                           lattice, def, be, opts, m, dir) +
 			                                           1

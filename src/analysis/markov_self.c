@@ -192,6 +192,7 @@ static int pass_map(bsim_markov_map *q_map, const bsim_scene *lattice, const bsi
 	q_map->k[1] = m->k[1];
 	q_map->n_bins = m->n_bins;
 	q_map->trials = m->trials;
+	q_map->start_trials = m->start_trials;
 	q_map->key_text = bsim_markov_key_text(lattice, &dq, be, opts, m->k);
 	q_map->counts = calloc((size_t)m->n_bins * m->n_bins, sizeof *q_map->counts);
 	if (!q_map->key_text || !q_map->counts)

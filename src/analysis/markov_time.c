@@ -96,8 +96,7 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 	}
 	int sx, sy;
 	bsim_lattice_gate_at(lattice, lattice->body.start, &sx, &sy);
-	const int start = sy * cols + sx - l->ix_min, nb = set->maps[0].n_bins,
-	          T = set->maps[0].trials;
+	const int start = sy * cols + sx - l->ix_min, nb = set->maps[0].n_bins;
 	double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
 	long n_kind[3] = {0, 0, 0};
 	uint64_t rng = seed;
@@ -115,7 +114,8 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 				break;
 			}
 			const bsim_markov_map *m = &set->maps[gate_map[g]];
-			const size_t u = (size_t)a * T + (size_t)draw(&rng, T);
+			const size_t u = (size_t)bsim_markov_bin_first(m, a) +
+			                 (size_t)draw(&rng, bsim_markov_bin_trials(m, a));
 			const int x = m->hold_exit[u];
 			t += m->hold_steps[u];
 			if (max_steps > 0 && t >= max_steps && (x == 0 || t > max_steps)) {

@@ -35,7 +35,8 @@ enum {
 	OWN_WALKS,
 	OWN_GATES, /* predict's options follow each other from OWN_LOCATIONS */
 	OWN_SHARD,
-	OWN_PASSES
+	OWN_PASSES,
+	OWN_START_TRIALS
 };
 
 #define MAX_ENTRIES 16
@@ -53,6 +54,7 @@ typedef struct markov_args {
 	const char *passes;  /* build: --passes */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
+	int start_trials; /* build: --start-trials given */
 } markov_args;
 
 static int markov_option(void *args, int i, const char *value)
@@ -111,6 +113,8 @@ static int markov_option(void *args, int i, const char *value)
 				        "%d, once",
 				        value, BSIM_MARKOV_SELF_PASSES_MAX);
 			if (is_kind) {
+				if (a->start_trials) /* given: kept, and checked by the build */
+					kind.start_trials = a->def.start_trials;
 				a->def = kind;
 				return CLI_OK;
 			}
@@ -119,6 +123,16 @@ static int markov_option(void *args, int i, const char *value)
 			return cli_usage("markov", "--entries %s: at most %d", value, MAX_ENTRIES);
 		a->entries[a->n_entries++] = value;
 		return CLI_OK;
+	case OWN_START_TRIALS: {
+		long n;
+		if (cli_parse_long(value, 1, 1000000, &n) != 0)
+			return cli_usage("markov build",
+			                 "--start-trials %s: expected an integer 1 to 1000000",
+			                 value);
+		a->def.start_trials = (int)n;
+		a->start_trials = 1;
+		return CLI_OK;
+	}
 	case OWN_MAP:
 		a->map = value;
 		return CLI_OK;
@@ -169,7 +183,7 @@ static int markov_option(void *args, int i, const char *value)
 static const cli_own build_own[] = {
         [OWN_BINS] = {"bins", 1, "P,S,D",
                       "entry bins of position along the edge, speed and\n"
-                      "direction (default 4,4,3)"},
+                      "direction (default 8,8,9)"},
         [OWN_VMAX] = {"vmax", 1, "V", "m/s, the top of the speed bins (default 40)"},
         [OWN_ENTRIES] = {"entries", 1, "PATH",
                          "gate_entries.csv of a lattice sweep (or its directory),\n"
@@ -190,17 +204,25 @@ static const cli_own build_own[] = {
          "with --entries flow[:N] and --shard: the map directory\n"
          "beamsim merge wrote of the round before, whose passes the\n"
          "next round's states come from (none: the first round)"},
+        {"start-trials", 1, "N",
+         "single-gate trials of the start bin (default 4000, or\n"
+         "--trials with self or flow entries, which take no other)"},
 };
 
 static int build_option(void *args, int i, const char *value)
 {
-	return markov_option(args, i == 3 ? OWN_SHARD : i == 4 ? OWN_PASSES : i, value);
+	return markov_option(args,
+	                     i == 3   ? OWN_SHARD
+	                     : i == 4 ? OWN_PASSES
+	                     : i == 5 ? OWN_START_TRIALS
+	                              : i,
+	                     value);
 }
 
 static const char *const build_help[CLI_N_OPTS] = {
         [CLI_OPT_OUT] = "the map directory: maps already there with the same key are\n"
                         "reused, the others are built there (required)",
-        [CLI_OPT_TRIALS] = "single-gate trials per entry bin (default 200)",
+        [CLI_OPT_TRIALS] = "single-gate trials per entry bin (default 50)",
         [CLI_OPT_SEED] = "seed of the entry states and schedules (default 1)",
 };
 
@@ -222,7 +244,7 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 5,
+        .n_own = 6,
         .option = build_option,
 };
 
@@ -458,10 +480,11 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 		printf("passes 0 to %d of the %d (flow entries) in %s: the next round is the "
 		       "parts' command with --passes %s\n",
 		       pass, last + 1, cli_path(out), cli_path(out));
-	printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials each, in "
-	       "%s\n",
+	printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials each, the "
+	       "start's %d, in %s\n",
 	       res->built, res->seconds, res->reused,
 	       res->copied ? ", the others from the parts" : "", res->n_bins, def->map.trials,
+	       def->map.start_trials > 0 ? def->map.start_trials : def->map.trials,
 	       cli_path(out));
 	cli_wrote(stdout, out);
 }

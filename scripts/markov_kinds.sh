@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Maps of a physics against layouts they were not built on (docs/markov.md,
+# "Maps of a physics"): the fields of configs/markov/kinds/ (gate kinds
+# A = (150, 600), B = (600, 300), C = (300, 150) N m/rad at F_prop = 7 N,
+# Rm = 25 N), each simulated directly (10,000 trials, seed 1, both
+# protocols) by `markov validate` with the default maps, and predicted by
+# the maps of every method (`markov predict --out`), whose total variation
+# from the same simulation is computed here from prediction.csv and
+# validate.csv. The default maps are built once, on the first field, and
+# reused on every other; flow:1 maps are built per field (they hold for
+# that layout only). ring5 and check11 are the fields the settings were
+# chosen on; test_* were made after. Prints one row per method and field;
+# the runs stay in OUT (default out/markov-kinds), the table in
+# OUT/table.txt. FIELDS="..." chooses the fields.
+#   scripts/markov_kinds.sh [OUT] [THREADS]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-out/markov-kinds}
+threads=${2:-2}
+exe=build/beamsim
+fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b})
+# method name and its build options (the default: none)
+methods=("default:"
+         "fine-bins-alone:--start-trials 50"
+         "start-trials-alone:--bins 4,4,3 --trials 200"
+         "previous-default:--bins 4,4,3 --trials 200 --start-trials 200"
+         "flow1:--bins 4,4,3 --trials 200 --entries flow:1")
+mkdir -p "$out"
+# TV of prediction.csv ($1) against validate.csv's p_sim ($2) for protocol $3
+tv() {
+    awk -F, -v proto="$3" 'NR == FNR { if (FNR > 1) p[$1] = $5; next }
+        FNR > 1 && $2 == proto { d = p[$3] - $4; s += d < 0 ? -d : d; seen[$3] = 1 }
+        END { for (k in p) if (!(k in seen)) s += p[k] < 0 ? -p[k] : p[k]; printf "%.3f", s / 2 }' "$1" "$2"
+}
+printf '%-20s %-11s %6s %6s %9s %9s %9s\n' method field essay world sampling map_cpu_s maps_built
+for f in "${fields[@]}"; do
+    exp=configs/markov/kinds/exp_$f.yaml
+    v=$out/validate-$f
+    for m in "${methods[@]}"; do
+        name=${m%%:*}
+        read -r -a opts <<<"${m#*:}"
+        maps=$out/maps-$name
+        [ "$name" = flow1 ] && maps=$out/maps-flow1-$f
+        log=$($exe markov build "$exp" "${opts[@]}" --threads "$threads" --out "$maps" 2>&1 | grep -E '^[0-9]+ maps? built' || true)
+        if [ "$name" = default ]; then
+            [ -f "$v/validate.json" ] ||
+                $exe markov validate "$exp" --map "$maps" --threads "$threads" --quiet --out "$v"
+        fi
+        p=$out/predict-$name-$f
+        $exe markov predict configs/markov/kinds/field_$f.yaml --map "$maps" --walks 0 --quiet \
+            --overwrite --out "$p"
+        cpu=$(sed -n 's/.*"map_cpu_seconds": \([0-9.]*\).*/\1/p' "$v/validate.json")
+        samp=$(grep '"protocol": "essay"' "$v/validate.json" | sed -E 's/.*"tv_sampling": ([0-9.]*).*/\1/')
+        printf '%-20s %-11s %6s %6s %9.3f %9s %s\n' "$name" "$f" "$(tv "$p/prediction.csv" "$v/validate.csv" essay)" \
+            "$(tv "$p/prediction.csv" "$v/validate.csv" world)" "$samp" "${cpu:-}" "${log:-}"
+    done
+done | tee "$out/table.txt"
