@@ -7,11 +7,10 @@
  *   v = beamsim_markov('validate', EXPERIMENT, 'map', DIR, 'out', DIR, ...)
  *
  * build's names: 'out' (the map directory, required), 'trials' (single
- * gates per entry bin), 'bins' [P S D], 'vmax' (m/s), 'entries' (a text or
- * a cell of texts: gate_entries.csv paths, or 'self', 'self:N', 'flow',
- * 'flow:N'), 'seed', 'threads', 'backend', 'backend_opt', 'set', 'grid'.
- * b.maps is a struct array, a map each (group from 1, k [left right] N
- * m/rad, key its files' name, how 'built' or 'reused').
+ * gates per entry bin), 'start_trials' (of the start bin), 'bins' [P S D], 'vmax' (m/s), 'entries'
+ * (a text or a cell of texts: gate_entries.csv paths, or 'self', 'self:N', 'flow', 'flow:N'),
+ * 'seed', 'threads', 'backend', 'backend_opt', 'set', 'grid'. b.maps is a struct array, a map each
+ * (group from 1, k [left right] N m/rad, key its files' name, how 'built' or 'reused').
  *
  * predict's: 'map' (required), 'set', 'tol', 'gates' (true: the
  * distribution of gates visited; default: with 'out' only), 'walks',
@@ -49,16 +48,18 @@ enum {
 	A_OVERWRITE,
 	A_BOOTSTRAP,
 	A_RESUME,
+	A_START_TRIALS,
 	N_ARGS
 };
 static const char *const arg_names[N_ARGS] = {
-        "out",  "map",     "trials",  "bins",        "vmax",      "entries",
-        "seed", "threads", "backend", "backend_opt", "set",       "grid",
-        "tol",  "gates",   "walks",   "overwrite",   "bootstrap", "resume"};
+        "out",     "map",       "trials",      "bins",   "vmax",        "entries", "seed",
+        "threads", "backend",   "backend_opt", "set",    "grid",        "tol",     "gates",
+        "walks",   "overwrite", "bootstrap",   "resume", "start_trials"};
 
 /* The names each subcommand takes, the others refused. */
-static const int build_names[] = {A_OUT,     A_TRIALS,  A_BINS,        A_VMAX, A_ENTRIES, A_SEED,
-                                  A_THREADS, A_BACKEND, A_BACKEND_OPT, A_SET,  A_GRID};
+static const int build_names[] = {A_OUT,     A_TRIALS,      A_BINS,    A_VMAX,
+                                  A_ENTRIES, A_SEED,        A_THREADS, A_BACKEND,
+                                  A_SET,     A_BACKEND_OPT, A_GRID,    A_START_TRIALS};
 static const int predict_names[] = {A_MAP, A_SET, A_TOL, A_GATES, A_WALKS, A_OUT, A_OVERWRITE};
 static const int validate_names[] = {A_MAP, A_OUT,  A_TRIALS,    A_SEED,   A_THREADS,
                                      A_SET, A_GRID, A_BOOTSTRAP, A_RESUME, A_OVERWRITE};
@@ -180,7 +181,7 @@ static int build(markov_call *c, const char *path, mxArray **out, bsim_error *er
 {
 	bsim_markov_build_def def = bsim_markov_build_def_default();
 	const char *backend = NULL;
-	long trials = 0, threads = 0;
+	long trials = 0, threads = 0, start_trials = 0;
 	const mxArray *const *v = c->v;
 	if (!v[A_OUT])
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -195,8 +196,12 @@ static int build(markov_call *c, const char *path, mxArray **out, bsim_error *er
 	    bmx_overrides("backend_opt", v[A_BACKEND_OPT], &c->pool, &c->opts_kv, &c->n_opts_kv,
 	                  err) ||
 	    bmx_backend(backend, c->opts_kv, c->n_opts_kv, &def.map.backend, &c->opts, err) ||
-	    sets_grid(c, err) || entries(c, &def.map, err))
+	    sets_grid(c, err) || entries(c, &def.map, err) ||
+	    (v[A_START_TRIALS] &&
+	     bmx_long("start_trials", v[A_START_TRIALS], 1, 1000000, &start_trials, err)))
 		return err->code;
+	if (start_trials > 0) /* none: the default (self and flow entries: trials) */
+		def.map.start_trials = (int)start_trials;
 	def.experiment = path;
 	def.has_seed = v[A_SEED] != NULL;
 	if (trials > 0)

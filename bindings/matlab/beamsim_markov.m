@@ -14,9 +14,11 @@
 %
 %   build's names:
 %     'out'          the map directory (required)
-%     'trials'       single gates per entry bin (default 200)
+%     'trials'       single gates per entry bin (default 50)
+%     'start_trials' single gates of the start bin (default 4000, or
+%                    'trials' with self or flow entries)
 %     'bins'         [P S D], bins of position, speed and direction
-%                    (default [4 4 3])
+%                    (default [8 8 9])
 %     'vmax'         m/s, the top of the speed bins (default 40)
 %     'entries'      gate_entries.csv paths (a text or a cell of texts), or
 %                    'self', 'self:N', 'flow', 'flow:N' (docs/markov.md)

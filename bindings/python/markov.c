@@ -68,17 +68,18 @@ static int entries_from(PyObject *seq, bsim_markov_def *def, const char ***paths
 PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"experiment", "out",          "trials",   "bins",    "vmax",
-	                         "entries",    "seed",         "threads",  "backend", "sets",
-	                         "grid",       "backend_opts", "progress", NULL};
+	static char *kwlist[] = {"experiment", "out",          "trials",   "bins",         "vmax",
+	                         "entries",    "seed",         "threads",  "backend",      "sets",
+	                         "grid",       "backend_opts", "progress", "start_trials", NULL};
 	const char *experiment, *out, *backend_spec = NULL;
-	int trials = 0, threads = 0;
+	int trials = 0, threads = 0, start_trials = 0;
 	double vmax = 0.0;
 	PyObject *bins_o = Py_None, *entries_o = Py_None, *seed_o = Py_None, *sets_o = Py_None,
 	         *grid_o = Py_None, *opts_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|iOdOOizOOOO", kwlist, &experiment, &out,
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|iOdOOizOOOOi", kwlist, &experiment, &out,
 	                                 &trials, &bins_o, &vmax, &entries_o, &seed_o, &threads,
-	                                 &backend_spec, &sets_o, &grid_o, &opts_o, &progress_o))
+	                                 &backend_spec, &sets_o, &grid_o, &opts_o, &progress_o,
+	                                 &start_trials))
 		return NULL;
 	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
 		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
@@ -102,6 +103,8 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 	const char **paths;
 	if (entries_from(entries_o, &def.map, &paths, &def.n_entries))
 		return NULL;
+	if (start_trials != 0) /* 0: the default (self and flow entries: trials) */
+		def.map.start_trials = start_trials;
 	def.entries = paths;
 	pyb_sets sets;
 	pyb_grid grid;

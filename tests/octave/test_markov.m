@@ -36,12 +36,12 @@ source(fullfile(fileparts(mfilename('fullpath')), 'mex_helpers.m'));
 [build, source, exe, tmp] = test_setup();
 experiment = fullfile(source, 'configs', 'markov', 'c_track.yaml');
 scene = fullfile(source, 'configs', 'lattice', 'c_track.yaml');
-small = '--trials 3 --bins 2,2,1 --threads 2 --seed 5';
+small = '--trials 3 --start-trials 7 --bins 2,2,1 --threads 2 --seed 5';
 
 % ---- build: the program's maps -------------------------------------------
 mine = fullfile(tmp, 'maps_mex');
 theirs = fullfile(tmp, 'maps_program');
-b = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'bins', [2 2 1], ...
+b = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'bins', [2 2 1], ...
                    'threads', 2, 'seed', 5);
 [out, err, status] = program(exe, tmp, sprintf('markov build %s %s --out %s', experiment, ...
                                                small, theirs));
@@ -56,7 +56,7 @@ check(all([b.maps.group] == 1) && b.built == numel(keys) && b.reused == 0 && b.b
 [n2, t2] = map_files(theirs);
 check(isequal(n1, n2) && isequal(t1, t2), 'the maps differ from the program''s: %s / %s', ...
       strjoin(n1, ' '), strjoin(n2, ' '));
-again = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'bins', [2 2 1], 'seed', 5);
+again = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'bins', [2 2 1], 'seed', 5);
 check(again.reused == numel(keys) && again.built == 0, 'a build again: %d reused', again.reused);
 printf('build: %d maps, the program''s bytes\n', numel(keys));
 

@@ -15,8 +15,8 @@ from conftest import cli, cli_message, config
 
 EXPERIMENT = config("markov", "c_track.yaml")
 SCENE = config("lattice", "c_track.yaml")
-SMALL = dict(trials=3, bins=(2, 2, 1), threads=2)
-SMALL_ARGS = ["--trials", "3", "--bins", "2,2,1", "--threads", "2"]
+SMALL = dict(trials=3, bins=(2, 2, 1), threads=2, start_trials=7)
+SMALL_ARGS = ["--trials", "3", "--bins", "2,2,1", "--threads", "2", "--start-trials", "7"]
 # what two runs of one prediction or validation measure differently
 TIMES = ("predict_seconds", "predict_cpu_seconds", "sim_cpu_seconds", "speedup",
          "break_even_lattices", "map_cpu_seconds")
