@@ -282,6 +282,7 @@ static void test_conservation(void **state)
 	bsim_markov_def def = bsim_markov_def_default();
 	def.bins = (bsim_markov_bins){2, 2, 2, 40.0};
 	def.trials = 4;
+	def.start_trials = 0; /* the start's as the others': conservation holds for any */
 	bsim_markov_set set;
 	const char *dir = exe_dir("conservation");
 	assert_int_equal(bsim_markov_build(&s, &def, dir, &set, &err), BSIM_OK);
@@ -305,8 +306,9 @@ static void test_conservation(void **state)
 	bsim_scene_free(&s);
 }
 
-/* The C-track and its maps of 4 trials per bin (the default bins), built
- * into the test's folder name. */
+/* The C-track and its maps of 4 trials per bin (4,4,3 bins, the start's
+ * trials as the others': what the tests of the solution check holds for
+ * any maps), built into the test's folder name. */
 static void c_track_maps(const char *name, bsim_scene *s, bsim_markov_set *set)
 {
 	bsim_error err;
@@ -314,12 +316,14 @@ static void c_track_maps(const char *name, bsim_scene *s, bsim_markov_set *set)
 	        bsim_scene_load(bsim_test_src("configs/lattice/c_track.yaml"), NULL, 0, s, &err),
 	        BSIM_OK);
 	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){4, 4, 3, def.bins.v_max};
 	def.trials = 4;
+	def.start_trials = 0;
 	assert_int_equal(bsim_markov_build(s, &def, exe_dir(name), set, &err), BSIM_OK);
 }
 
-/* The series' tolerance: on the C-track (maps of 4 trials per bin, the
- * default bins), the prediction stopped at the default tolerance differs
+/* The series' tolerance: on the C-track (maps of 4 trials per bin), the
+ * prediction stopped at the default tolerance differs
  * from the one summed to 1e-12 by no more than the probability it left in
  * the field, location by location and in all (each partial sum only
  * grows), and what it left plus what it placed is the whole. */
@@ -360,7 +364,7 @@ static void test_tolerance(void **state)
 }
 
 /* The sweeps against the other path through the chain, the series to
- * 1e-12, on the C-track (maps of 4 trials per bin, the default bins): at
+ * 1e-12, on the C-track (maps of 4 trials per bin): at
  * every location within the sweeps' bound (left_in_field, plus the
  * series' own 1e-12), both short of the exact p, the probabilities plus
  * the bound at least one and at most one; the sweeps' expected visits
@@ -1260,6 +1264,7 @@ static void test_entries(void **state)
 	bsim_markov_def def = bsim_markov_def_default();
 	def.bins = b;
 	def.trials = 60;
+	def.start_trials = 0; /* the start's as the others': only bin `bin` differs */
 	bsim_markov_set uni, obs;
 	char d1[1100], d2[1100];
 	snprintf(d1, sizeof d1, "%s/uniform", dir);
@@ -1570,8 +1575,11 @@ static void test_interrupted_build(void **state)
 	const char *exp = bsim_test_src("configs/lattice/c_track_essay.yaml");
 	char whole[1024];
 	snprintf(whole, sizeof whole, "%s", bsim_test_dir("build_whole"));
-	const char *b[] = {"markov", "build",   exp,     "--trials", "400", "--bins",
-	                   "2,2,2",  "--quiet", "--out", whole,      NULL};
+	/* the start's trials as the others' (the test is of the stop, not the
+	 * maps) */
+	const char *b[] = {"markov",         "build", exp,      "--trials", "200",
+	                   "--start-trials", "200",   "--bins", "2,2,2",    "--quiet",
+	                   "--out",          whole,   NULL};
 	assert_int_equal(bsim_test_cli(b, NULL, NULL), 0);
 	char *want = maps_of(whole);
 	static const int sigs[] = {SIGINT, SIGTERM, SIGKILL};
@@ -1579,8 +1587,9 @@ static void test_interrupted_build(void **state)
 		char dir[1024], errfile[1100];
 		snprintf(dir, sizeof dir, "%s", bsim_test_dir("build_stopped"));
 		snprintf(errfile, sizeof errfile, "%s.err", dir);
-		const char *argv[] = {"markov", "build",   exp,     "--trials", "400", "--bins",
-		                      "2,2,2",  "--quiet", "--out", dir,        NULL};
+		const char *argv[] = {
+		        "markov", "build", "--start-trials", "200",   exp, "--trials", "200",
+		        "--bins", "2,2,2", "--quiet",        "--out", dir, NULL};
 		const bsim_test_opts o = {.err = errfile};
 		int pid = bsim_test_spawn_with(argv, &o);
 		int status = -1;
@@ -1598,8 +1607,9 @@ static void test_interrupted_build(void **state)
 		}
 		free(err);
 		unlink(errfile);
-		const char *again[] = {"markov", "build", exp,     "--trials", "400",
-		                       "--bins", "2,2,2", "--out", dir,        NULL};
+		const char *again[] = {"markov", "build",          exp,   "--trials",
+		                       "200",    "--start-trials", "200", "--bins",
+		                       "2,2,2",  "--out",          dir,   NULL};
 		char *out = NULL;
 		assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
 		assert_non_null(strstr(out, "1 maps built"));
