@@ -6,14 +6,14 @@
  * (advance of one step, no state written, then get_state), the other in
  * calls for 1 to 64 steps under a schedule whose lateral force changes
  * every 1 to 8 steps (as the runner's schedules change at the random
- * force's draws), the rest asked again where a call makes fewer; every state of the calls must be the stepped
- * one to the bit (body, listed beams, angles, velocities, touched beams,
- * the direction of each beam the runner's flag reads, energy flows,
- * impacts, solver counts). The scene: the essay's gate at three of H1's
- * propulsions, the body from its start below the beams through them (free
- * flight, impacts, resting contact). The test counts the states it compared
- * and those with a contact flag, so that a run that never reached the
- * beams fails rather than passes. */
+ * force's draws), the rest asked again where a call makes fewer; every
+ * state of the calls must be the stepped one to the bit (body, listed
+ * beams, angles, velocities, touched beams, the direction of each beam the
+ * runner's flag reads, energy flows, impacts, solver counts). The scene:
+ * the essay's gate at three of H1's propulsions, the body from its start
+ * below the beams through them (free flight, impacts, resting contact).
+ * The test counts the states it compared and those with a contact flag,
+ * so that a run that never reached the beams fails rather than passes. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -121,9 +121,9 @@ static long compare(const bsim_backend *be, const bsim_scene *s, double f_prop, 
 			assert_true(m >= 1 && m <= len - made);
 		}
 		for (int k = 0; k < len; k++, n++) {
-			assert_int_equal(bsim_backend_step(be, wa, schedule[k].force, 0.0, s->dt,
-			                                   &err),
-			                 BSIM_OK);
+			assert_int_equal(
+			        bsim_backend_step(be, wa, schedule[k].force, 0.0, s->dt, &err),
+			        BSIM_OK);
 			be->get_state(wa, &sa);
 			bsim_contact_flags(s, &sa);
 			bsim_contact_flags(s, &run[k]);

@@ -251,7 +251,8 @@ static void test_thesis_runs(void **state)
 		assert_int_equal(t->advance(b, f, h, n, run, &m, &err), BSIM_OK);
 		assert_int_equal(m, n);
 		for (int k = 0; k < n; k++) {
-			assert_int_equal(bsim_backend_step(t, a, f[k].force, 0.0, h, &err), BSIM_OK);
+			assert_int_equal(bsim_backend_step(t, a, f[k].force, 0.0, h, &err),
+			                 BSIM_OK);
 			t->get_state(a, &sa);
 			assert_memory_equal(sa.x, run[k].x, sizeof sa.x);
 			assert_memory_equal(sa.v, run[k].v, sizeof sa.v);

@@ -637,7 +637,8 @@ static void pairs_columns(const char *doc, const char *backends, const char *nam
 		assert_non_null(side);
 		*side = '\0';
 		if (!bsim_trial_field_find(c))
-			fail_msg("pairs.csv's column %s_%s is not one of trials.csv's", c, side + 1);
+			fail_msg("pairs.csv's column %s_%s is not one of trials.csv's", c,
+			         side + 1);
 	}
 	free(text);
 }

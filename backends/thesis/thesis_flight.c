@@ -29,8 +29,7 @@
 
 #include "thesis/thesis.h"
 
-int bsim_thesis_flight(bsim_world *w, const bsim_wrench *schedule, double h, int n,
-                       bsim_state *out)
+int bsim_thesis_flight(bsim_world *w, const bsim_wrench *schedule, double h, int n, bsim_state *out)
 {
 	if (w->n_awake || w->model->contact_mode == THESIS_CONTACT_ESSAY || w->model->rotates ||
 	    !w->model->broad_phase || w->model->n_beams > THESIS_BROAD_PHASE_MIN_BEAMS)

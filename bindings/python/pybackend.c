@@ -282,8 +282,8 @@ static void py_get_state(const bsim_world *w, bsim_state *out)
 	bsim_state_copy(out, &w->last);
 }
 
-static int py_advance(bsim_world *w, const bsim_wrench *schedule, double h, int n,
-                      bsim_state *out, int *made, bsim_error *err)
+static int py_advance(bsim_world *w, const bsim_wrench *schedule, double h, int n, bsim_state *out,
+                      int *made, bsim_error *err)
 {
 	int rc = BSIM_OK;
 	*made = 0;

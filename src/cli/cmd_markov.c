@@ -484,8 +484,7 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 	       "start's %d, in %s\n",
 	       res->built, res->seconds, res->reused,
 	       res->copied ? ", the others from the parts" : "", res->n_bins, def->map.trials,
-	       def->map.start_trials > 0 ? def->map.start_trials : def->map.trials,
-	       cli_path(out));
+	       def->map.start_trials > 0 ? def->map.start_trials : def->map.trials, cli_path(out));
 	cli_wrote(stdout, out);
 }
 

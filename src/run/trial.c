@@ -608,8 +608,8 @@ int bsim_trial_run(bsim_trial_runner *r, const bsim_scene *scene, const bsim_bac
 			int b, listed;
 			if (ts->propulsion && ts->random && ts->propulsion->axis == 1 &&
 			    ts->random->axis == 0) /* the essay's */
-				b = run_book(&c, &lp, &kept, states, m, &listed, cp, ts->random_at, 1,
-				             1, 1, 0);
+				b = run_book(&c, &lp, &kept, states, m, &listed, cp, ts->random_at,
+				             1, 1, 1, 0);
 			else
 				b = run_book(&c, &lp, &kept, states, m, &listed, cp, ts->random_at,
 				             ts->propulsion != NULL,

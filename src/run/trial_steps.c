@@ -56,7 +56,8 @@ void bsim_trial_steps_schedule(trial_steps *t, long n, int m)
 void bsim_trial_steps_used(const trial_steps *t)
 {
 	if (t->on && t->random)
-		bsim_schedule_used(t->random->schedule, t->tried > 0 ? (t->tried - 1) / t->hold + 1 : 0);
+		bsim_schedule_used(t->random->schedule,
+		                   t->tried > 0 ? (t->tried - 1) / t->hold + 1 : 0);
 }
 
 void bsim_trial_steps_free(trial_steps *t)
