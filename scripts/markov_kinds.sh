@@ -11,7 +11,8 @@
 # that layout only). ring5 and check11 are the fields the settings were
 # chosen on; test_* were made after. Prints one row per method and field;
 # the runs stay in OUT (default out/markov-kinds), the table in
-# OUT/table.txt. FIELDS="..." chooses the fields.
+# OUT/table.txt. FIELDS="..." chooses the fields, TRIALS=N the direct
+# trials of each (default the experiments', 10,000).
 #   scripts/markov_kinds.sh [OUT] [THREADS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,11 +20,15 @@ out=${1:-out/markov-kinds}
 threads=${2:-2}
 exe=build/beamsim
 fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b})
-# method name and its build options (the default: none)
+# method name and its build options (the default: none); each of the
+# default's three parts (fine bins, many start trials, the gate after the
+# start) alone and without the others
 methods=("default:"
-         "fine-bins-alone:--start-trials 50"
-         "start-trials-alone:--bins 4,4,3 --trials 200"
-         "previous-default:--bins 4,4,3 --trials 200 --start-trials 200"
+         "without-after-start:--after-start 0"
+         "fine-bins-alone:--start-trials 50 --after-start 0"
+         "start-trials-alone:--bins 4,4,3 --trials 200 --after-start 0"
+         "after-start-alone:--bins 4,4,3 --trials 200 --start-trials 200"
+         "previous-default:--bins 4,4,3 --trials 200 --start-trials 200 --after-start 0"
          "flow1:--bins 4,4,3 --trials 200 --entries flow:1")
 mkdir -p "$out"
 # TV of prediction.csv ($1) against validate.csv's p_sim ($2) for protocol $3
@@ -42,14 +47,18 @@ for f in "${fields[@]}"; do
         maps=$out/maps-$name
         [ "$name" = flow1 ] && maps=$out/maps-flow1-$f
         log=$($exe markov build "$exp" "${opts[@]}" --threads "$threads" --out "$maps" 2>&1 | grep -E '^[0-9]+ maps? built' || true)
+        # the maps' CPU: what the builds into that directory took (a build
+        # that reuses every map adds nothing)
+        echo "$log" | sed -n 's/.*built (\([0-9.]*\) s of CPU).*/\1/p' >>"$maps.cpu"
         if [ "$name" = default ]; then
             [ -f "$v/validate.json" ] ||
-                $exe markov validate "$exp" --map "$maps" --threads "$threads" --quiet --out "$v"
+                $exe markov validate "$exp" --map "$maps" ${TRIALS:+--trials "$TRIALS"} \
+                    --threads "$threads" --quiet --out "$v"
         fi
         p=$out/predict-$name-$f
         $exe markov predict configs/markov/kinds/field_$f.yaml --map "$maps" --walks 0 --quiet \
             --overwrite --out "$p"
-        cpu=$(sed -n 's/.*"map_cpu_seconds": \([0-9.]*\).*/\1/p' "$v/validate.json")
+        cpu=$(awk '{ s += $1 } END { printf "%.1f", s }' "$maps.cpu")
         samp=$(grep '"protocol": "essay"' "$v/validate.json" | sed -E 's/.*"tv_sampling": ([0-9.]*).*/\1/')
         printf '%-20s %-11s %6s %6s %9.3f %9s %s\n' "$name" "$f" "$(tv "$p/prediction.csv" "$v/validate.csv" essay)" \
             "$(tv "$p/prediction.csv" "$v/validate.csv" world)" "$samp" "${cpu:-}" "${log:-}"

@@ -7,7 +7,8 @@
  *     each sum to one on the C-track;
  *   - on a field of one gate, where the essay's protocol is exact, the
  *     chain's probability of each outcome agrees with direct simulation of
- *     independent trials within their sampling error;
+ *     independent trials within their sampling error; on a column of two,
+ *     with the gate after the start, where the entry bins alone do not;
  *   - the map is the same with 1 and 2 threads; its cache reuses a map only
  *     when nothing it depends on changed;
  *   - self-consistent and flow-weighted entry states are exits of the
@@ -636,6 +637,138 @@ static void test_one_gate_against_simulation(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The probability of each of p's locations among N direct trials of s
+ * (seeds from 99), into sim. */
+static void simulate_locations(const bsim_scene *s, const bsim_markov_prediction *p, int N,
+                               double *sim)
+{
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
+	const bsim_options none = {0};
+	bsim_error err;
+	for (int t = 0; t < N; t++) {
+		bsim_trial_result res;
+		assert_int_equal(bsim_trial_run(r, s, bsim_backend_default(), &none,
+		                                bsim_schedule_seed_mix(99, 0, (uint64_t)t), NULL,
+		                                &res, &err),
+		                 BSIM_OK);
+		const bsim_location loc = bsim_lattice_location_of(&res);
+		for (int i = 0; i < p->n_locations; i++)
+			if (p->loc[i].kind == loc.kind && p->loc[i].ix == loc.ix &&
+			    p->loc[i].iy == loc.iy)
+				sim[i] += 1.0 / N;
+	}
+	bsim_trial_runner_free(r);
+}
+
+/* How many of p's locations lie beyond 4.5 standard errors of the
+ * difference from sim, N direct trials (the maps' T start trials' and the
+ * simulation's sampling errors together). */
+static int outcomes_off(const bsim_markov_prediction *p, const double *sim, int T, int N)
+{
+	int off = 0;
+	for (int i = 0; i < p->n_locations; i++) {
+		const double q = 0.5 * (sim[i] + p->p[i]);
+		const double se = sqrt(q * (1.0 - q) * (1.0 / N + 1.0 / T)) + 1e-9;
+		print_message("location %d (%d, %d, %d): chain %.3f, simulation %.3f (se %.3f)\n",
+		              i, p->loc[i].kind, p->loc[i].ix, p->loc[i].iy, p->p[i], sim[i], se);
+		off += !(fabs(sim[i] - p->p[i]) <= 4.5 * se);
+	}
+	return off;
+}
+
+/* The gate after the start against direct simulation: a column of two
+ * gates of two stiffness pairs under the essay's protocol, where a body's
+ * gates are single gates (each entered with its beams at rest). One bin
+ * an edge: a bin's states, uniform over the edge, every speed to 40 m/s
+ * and every direction, are nothing like a body leaving the start, so the
+ * chain without the gate after the start is off on at least one outcome;
+ * with it, the upper gate is run from each start trial's own exit and
+ * every outcome agrees with 1000 direct trials within 4.5 standard
+ * errors. The pairs of maps are those the build names, read back alike. */
+static void test_after_start_against_simulation(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 2, 6, 30), BSIM_OK);
+	const double kl[2] = {100, 400}, kr[2] = {100, 300};
+	assert_int_equal(bsim_lattice_build(&s, kl, kr), BSIM_OK);
+	s.lattice.protocol = BSIM_PROTOCOL_ESSAY;
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
+	def.trials = 100;
+	def.start_trials = 1000;
+	def.seed = 5;
+	const char *dir = exe_dir("after_start");
+	const int N = 1000;
+	double *sim = NULL;
+	int off[2];
+	for (int after = 0; after < 2; after++) {
+		def.after_start = after;
+		bsim_markov_set set;
+		bsim_error err;
+		assert_int_equal(bsim_markov_build(&s, &def, dir, &set, &err), BSIM_OK);
+		assert_int_equal(set.n, 2);
+		assert_int_equal(set.next != NULL, after);
+		assert_int_equal(set.next_built, after ? 4 : 0);
+		bsim_markov_prediction p;
+		assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
+		if (!sim) { /* one simulation for both: the same locations */
+			sim = calloc((size_t)p.n_locations, sizeof *sim);
+			simulate_locations(&s, &p, N, sim);
+		}
+		off[after] = outcomes_off(&p, sim, def.start_trials, N);
+		if (after) {
+			/* each start trial's continuation where it left into a gate */
+			for (int i = 0; i < 4; i++) {
+				const bsim_markov_next *x = &set.next[i];
+				const bsim_markov_map *m = &set.maps[x->start];
+				for (int t = 0; t < m->start_trials; t++)
+					assert_int_equal(x->exit[t] >= 0, m->hold_exit[t] > 0);
+			}
+			/* read back: the same prediction */
+			bsim_markov_set again;
+			bsim_options opts = {0};
+			assert_int_equal(bsim_markov_load(&s, dir, &opts, &again, &err), BSIM_OK);
+			assert_int_equal(again.next_reused, 4);
+			bsim_markov_prediction q;
+			assert_int_equal(bsim_markov_predict(&s, &again, &q, &err), BSIM_OK);
+			for (int i = 0; i < p.n_locations; i++)
+				assert_double_equal(q.p[i], p.p[i], 0.0);
+			bsim_markov_prediction_free(&q);
+			bsim_markov_set_free(&again);
+		}
+		bsim_markov_prediction_free(&p);
+		bsim_markov_set_free(&set);
+	}
+	print_message("outcomes off: %d without the gate after the start, %d with\n", off[0],
+	              off[1]);
+	assert_true(off[0] >= 1);
+	assert_int_equal(off[1], 0);
+	free(sim);
+
+	/* A pair the directory lacks: a column of another kind alone, then
+	 * the column with that kind above the start. Both maps are there, the
+	 * start's continuation in the new kind is not: refused, naming the
+	 * file. */
+	bsim_scene one;
+	assert_int_equal(bsim_lattice_scene_init(&one, 1, 2, 6, 30), BSIM_OK);
+	const double k1[2] = {250, 250};
+	assert_int_equal(bsim_lattice_build(&one, k1, k1), BSIM_OK);
+	bsim_markov_set set;
+	bsim_error err;
+	assert_int_equal(bsim_markov_build(&one, &def, dir, &set, &err), BSIM_OK);
+	bsim_markov_set_free(&set);
+	const double kl2[2] = {100, 250}, kr2[2] = {100, 250};
+	assert_int_equal(bsim_lattice_build(&s, kl2, kr2), BSIM_OK);
+	bsim_options opts = {0};
+	assert_int_equal(bsim_markov_load(&s, dir, &opts, &set, &err), BSIM_EINPUT);
+	print_message("%s\n", err.msg);
+	assert_non_null(strstr(err.msg, ".after_"));
+	assert_non_null(strstr(err.msg, "absent: the gate after the start"));
+	bsim_scene_free(&one);
+	bsim_scene_free(&s);
+}
+
 static char *map_text(const char *dir)
 {
 	char *text = bsim_test_read_glob(bsim_test_join(dir, "map_*.csv"));
@@ -1159,8 +1292,10 @@ static void test_bad_map_files(void **state)
 	free(json);
 
 	/* a map's CSV: an exit bin past the last of 1 + 4 bins */
-	const char *first = bsim_test_glob_first(bsim_test_join(dir, "map_*.csv"));
-	assert_non_null(first);
+	const char *key = bsim_test_glob_first(bsim_test_join(dir, "map_*.key"));
+	assert_non_null(key);
+	char first[1024];
+	snprintf(first, sizeof first, "%.*s.csv", (int)(strlen(key) - 4), key);
 	snprintf(path, sizeof path, "%s", first);
 	char *csv = bsim_test_read(path);
 	assert_non_null(csv);
@@ -1206,6 +1341,28 @@ static void test_bad_map_files(void **state)
 	assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
 	assert_non_null(strstr(err, "do not count up to the map's counts"));
 	free(err);
+	bsim_test_write(dir, hname, hold);
+	assert_int_equal(bsim_test_cli(pred, NULL, NULL), 0);
+
+	/* the gate after the start: a row whose start exit is not the start
+	 * map's */
+	snprintf(path, sizeof path, "%s",
+	         bsim_test_glob_first(bsim_test_join(dir, "map_*.after_*.csv")));
+	char *after = bsim_test_read(path);
+	assert_non_null(after);
+	char *a2 = strchr(after, '\n') + 1; /* "TRIAL,START_EXIT,EXIT,STEPS" */
+	char *a3 = strchr(strchr(a2, ',') + 1, ',');
+	snprintf(text, sizeof text, "%.*s,0%s", (int)(strchr(a2, ',') - after), after, a3);
+	const char *aname = strrchr(path, '/') + 1;
+	bsim_test_write(dir, aname, text);
+	err = NULL;
+	assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
+	if (!strstr(err, ".csv:2: expected a row trial,start_exit,exit,steps"))
+		print_error("%s\n", err);
+	assert_non_null(strstr(err, aname));
+	assert_non_null(strstr(err, ".csv:2: expected a row trial,start_exit,exit,steps"));
+	free(err);
+	free(after);
 	free(hold);
 	free(csv);
 	free(essay);
@@ -1635,6 +1792,7 @@ int main(void)
 	        cmocka_unit_test(test_sweeps_against_series),
 	        cmocka_unit_test(test_map_cost),
 	        cmocka_unit_test(test_one_gate_against_simulation),
+	        cmocka_unit_test(test_after_start_against_simulation),
 	        cmocka_unit_test(test_start_trials_key),
 	        cmocka_unit_test(test_threads_and_cache),
 	        cmocka_unit_test(test_interrupted_build),

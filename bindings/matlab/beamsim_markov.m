@@ -17,6 +17,10 @@
 %     'trials'       single gates per entry bin (default 50)
 %     'start_trials' single gates of the start bin (default 4000, or
 %                    'trials' with self or flow entries)
+%     'after_start'  1 (default): each start trial that leaves into a gate
+%                    goes on there from its exact state, and the chain
+%                    takes the first two gates from those; 0: entry bins
+%                    from the start on (0 with self or flow entries)
 %     'bins'         [P S D], bins of position, speed and direction
 %                    (default [8 8 9])
 %     'vmax'         m/s, the top of the speed bins (default 40)

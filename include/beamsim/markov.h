@@ -124,6 +124,16 @@ typedef struct bsim_markov_def {
 	int threads;                        /* <= 0: all cores; the map is the same for any */
 	const bsim_markov_entries *entries; /* NULL: states uniform in each bin */
 	char entries_id[64];                /* the entries' id when read back from markov.json */
+	/* The gate after the start (1, the default): each of the start bin's
+	 * single gates that leaves into a gate is continued there, one single
+	 * gate from its exact exit state, for every stiffness pair of the
+	 * lattice (bsim_markov_next), and the chain takes the body's first two
+	 * gates from those runs rather than from the entry bins. The start's
+	 * exits are those a body's first gate delivers to every lattice, so
+	 * these runs are of the physics, not of a layout. 0: the entry bins
+	 * from the start on. Only with states uniform in each bin or observed
+	 * entries (self and flow entries: 0). */
+	int after_start;
 	bsim_progress_fn progress;          /* may be NULL; counts single-gate trials */
 	void *progress_user;
 	/* May be NULL. When *stop becomes nonzero (a signal handler sets it),
@@ -223,6 +233,22 @@ typedef struct bsim_markov_map {
 	int copied;    /* 1: read from a part's directory (def from) and written */
 } bsim_markov_map;
 
+/* The gate after the start: map `start`'s start-bin single gates each
+ * continued from its exact exit state in a gate of map `gate` (both
+ * indices into the set's maps), the beams at rest: exit[t] the exit bin of
+ * that gate (0 stuck) and steps[t] the time steps it took, for start trial
+ * t, or exit[t] = -1 where the start's single gate did not leave into a
+ * gate (it was stuck). Stored as map_START.after_GATE.csv and .cost in the
+ * map directory, named by both maps' keys. */
+typedef struct bsim_markov_next {
+	int start, gate;
+	int trials; /* the start map's start trials */
+	int *exit, *steps;
+	double seconds, cost; /* as bsim_markov_map's */
+	long long steps_total;
+	int cached, copied, elsewhere; /* as bsim_markov_map's */
+} bsim_markov_next;
+
 /* The maps of one lattice: one per stiffness pair it uses. */
 typedef struct bsim_markov_set {
 	bsim_markov_def def; /* as built (backend and opts: the caller's) */
@@ -233,6 +259,10 @@ typedef struct bsim_markov_set {
 	int copied;        /* maps read from the parts' directories (def from) */
 	int pass; /* def one_pass: the pass made (or merged); below def self_passes, the set's
 	           * maps hold no counts */
+	/* def after_start: n x n, next[s * n + k] the start of map s continued
+	 * in a gate of map k; else NULL. */
+	bsim_markov_next *next;
+	int next_built, next_reused; /* of them simulated now, read from the cache */
 } bsim_markov_set;
 
 /* The maps lattice needs, from the cache directory dir: a map whose key is
@@ -241,16 +271,19 @@ typedef struct bsim_markov_set {
  * holds every input of the map (the gate, its beams and stiffness pair,
  * the body, contact, effects, time step, gate_steps, the backend and its
  * options, bins, trials, seed and the map format's version), so a changed
- * parameter never reuses a map. BSIM_EINPUT if lattice is not a lattice or
- * its side boundary is not the field's edge; an unstable single gate is
- * BSIM_EFAIL, never a count. */
+ * parameter never reuses a map. With def->after_start (and neither self
+ * nor flow entries), the gates after the start of every ordered pair of
+ * those maps too (out->next), read or built alike. BSIM_EINPUT if lattice
+ * is not a lattice or its side boundary is not the field's edge; an
+ * unstable single gate is BSIM_EFAIL, never a count. */
 BSIM_API int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def,
                                const char *dir, bsim_markov_set *out, bsim_error *err);
 
 /* The maps lattice needs, read from dir only, with the def stored in
- * dir/markov.json (opts: filled into *opts, which must outlive the set).
- * BSIM_EINPUT naming the stiffness pair whose map is missing, with the
- * command that builds it. */
+ * dir/markov.json (opts: filled into *opts, which must outlive the set),
+ * and their gates after the start where it says after_start 1.
+ * BSIM_EINPUT naming the stiffness pair whose map is missing, or the file
+ * of a missing gate after the start, with the command that builds it. */
 BSIM_API int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *opts,
                               bsim_markov_set *out, bsim_error *err);
 
@@ -347,8 +380,9 @@ typedef struct bsim_markov_build_def {
  * "self:N", "flow" or "flow:N" (N passes, 0 to BSIM_MARKOV_SELF_PASSES_MAX,
  * default 1) set def->self_entries (1 self, 2 flow) and def->self_passes,
  * def->start_trials 0 (the start bin's trials are then def->trials, as
- * those entries need), and *is_kind 1; any other value is a gate_entries path (*is_kind 0, def
- * untouched). BSIM_EINPUT naming the value for a bad N. */
+ * those entries need), def->after_start 0, and *is_kind 1; any other
+ * value is a gate_entries path (*is_kind 0, def untouched). BSIM_EINPUT
+ * naming the value for a bad N. */
 BSIM_API int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, int *is_kind,
                                       bsim_error *err);
 
@@ -360,6 +394,7 @@ typedef struct bsim_markov_build_result {
 	int n_maps;              /* every group's, in order (a map may serve two groups) */
 	bsim_markov_built *maps; /* n_maps */
 	int built, reused;       /* maps simulated now, maps read from the cache */
+	int next_built, next_reused; /* the gates after the start (map.after_start), likewise */
 	int copied;              /* maps read from the parts' directories (a merge) */
 	double seconds;          /* CPU time of the simulation of those built, s */
 	int pass;                /* a round's (or its merge's): the pass made; else

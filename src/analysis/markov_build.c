@@ -38,6 +38,7 @@ int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, int *is_ki
 	def->self_entries = value[0] == 's' ? 1 : 2;
 	def->self_passes = (int)n;
 	def->start_trials = 0; /* passes pool every bin's trials alike: the start's are trials */
+	def->after_start = 0;  /* the start's exits are those of its own pass */
 	return BSIM_OK;
 }
 
@@ -115,6 +116,8 @@ static int build_groups(const bsim_markov_build_def *def, const bsim_experiment 
 			break;
 		res->built += set.built;
 		res->reused += set.reused;
+		res->next_built += set.next_built;
+		res->next_reused += set.next_reused;
 		res->copied += set.copied;
 		*own += set.built + set.reused;
 		res->seconds += set.seconds;

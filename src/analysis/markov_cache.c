@@ -7,6 +7,10 @@
  *   DIR/map_HASH.hold.csv  entry,trial,exit,steps: each single gate's exit
  *                      and the time steps it spent in the gate (a map
  *                      without it has no holding times)
+ *   DIR/map_START.after_GATE.csv  trial,start_exit,exit,steps: the gate
+ *                      after the start (bsim_markov_next): map START's
+ *                      start trials that left into a gate, each continued
+ *                      in a gate of map GATE; and its .cost beside it
  *   DIR/markov.json    the def of the last build, for bsim_markov_load
  * A map is reused only if its .key file holds the whole key text, so a
  * hash collision never reuses a map either. */
@@ -314,6 +318,26 @@ static const char *map_row(char *line, const bsim_markov_map *m, long v[3], doub
 	return NULL;
 }
 
+/* The line after *nl (a text checked by bsim_csv_text_check: every line
+ * ends in one), four integers "a,b,c,d", into v; *nl moves to its end and
+ * *lineno counts it. 0, or 1 if it is not four integers. */
+static int row_of_four(char **nl, long *lineno, long v[4])
+{
+	char *line = *nl + 1, *end = line;
+	(*lineno)++;
+	if (!(*nl = strchr(line, '\n')))
+		return 1;
+	**nl = '\0';
+	for (int k = 0; k < 4; k++) {
+		errno = 0;
+		v[k] = strtol(line, &end, 10);
+		if (end == line || errno || *end != (k < 3 ? ',' : '\0'))
+			return 1;
+		line = end + 1;
+	}
+	return 0;
+}
+
 static const char HOLD_HEADER[] = "entry,trial,exit,steps";
 
 /* map_HASH.hold.csv into m->hold_exit and m->hold_steps (m->counts read):
@@ -336,25 +360,11 @@ static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	long u = 0, lineno = 1;
 	int bad = !ex || !st || !count || !nl || (*nl = '\0', strcmp(line, HOLD_HEADER) != 0);
 	while (!bad && u < units) {
-		line = nl + 1;
-		lineno++;
-		nl = strchr(line, '\n'); /* every line has one: bsim_csv_text_check */
-		if (!nl) {
-			bad = 1;
-			break;
-		}
-		*nl = '\0';
 		long v[4];
-		char *c = line, *end = line;
-		for (int k = 0; k < 4 && !bad; k++) {
-			errno = 0;
-			v[k] = strtol(c, &end, 10);
-			bad = end == c || errno || *end != (k < 3 ? ',' : '\0');
-			c = end + 1;
-		}
 		const int a = bsim_markov_unit_bin(m, u);
-		bad = bad || v[0] != a || v[1] != u - bsim_markov_bin_first(m, a) || v[2] < 0 ||
-		      v[2] >= nb || v[3] < 1 || v[3] > INT_MAX;
+		bad = row_of_four(&nl, &lineno, v) || v[0] != a ||
+		      v[1] != u - bsim_markov_bin_first(m, a) || v[2] < 0 || v[2] >= nb ||
+		      v[3] < 1 || v[3] > INT_MAX;
 		if (!bad) {
 			ex[u] = (int)v[2];
 			st[u] = (int)v[3];
@@ -394,6 +404,41 @@ static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	m->hold_exit = ex;
 	m->hold_steps = st;
 	return 1;
+}
+
+/* map_HASH.EXT (m's key), "cpu_seconds S" and "steps N", a line each
+ * (steps absent in maps built before it): what a build cost, 0 if the
+ * file is absent; BSIM_EINPUT naming the file if malformed. */
+static int cost_read(const char *dir, const bsim_markov_map *m, const char *ext, double *cost,
+                     long long *steps, bsim_error *err)
+{
+	file_text t;
+	int absent = 0;
+	*cost = 0.0;
+	*steps = 0;
+	if (map_file(dir, m, ext, 256.0, &t, &absent, err) != BSIM_OK)
+		return BSIM_EINPUT;
+	if (absent)
+		return BSIM_OK;
+	char *end = NULL;
+	if (strncmp(t.text, "cpu_seconds ", 12) == 0)
+		*cost = strtod(t.text + 12, &end);
+	int ok = end && end != t.text + 12 && (*end == '\n' || *end == '\0') && isfinite(*cost) &&
+	         *cost >= 0.0;
+	if (ok && *end == '\n' && end[1]) {
+		char *s = end + 1, *e2 = NULL;
+		errno = 0;
+		if (strncmp(s, "steps ", 6) == 0 && s[6] >= '0' && s[6] <= '9')
+			*steps = strtoll(s + 6, &e2, 10);
+		ok = e2 && !errno && (*e2 == '\0' || (*e2 == '\n' && !e2[1]));
+	}
+	bsim_file_text_free(&t);
+	if (ok)
+		return BSIM_OK;
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "%s/map_%016llx.%s: expected \"cpu_seconds S\" (S >= 0 the CPU "
+	                      "time of the build) and \"steps N\", a line each",
+	                      dir, (unsigned long long)m->key, ext);
 }
 
 int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
@@ -478,35 +523,8 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	}
 	/* What the map cost when it was built; a map without the file cost
 	 * nothing known. */
-	m->cost = 0.0;
-	if (map_file(dir, m, "cost", 256.0, &t, &absent, err) != BSIM_OK)
+	if (cost_read(dir, m, "cost", &m->cost, &m->steps, err) != BSIM_OK)
 		return -1;
-	if (!absent) {
-		char *end = NULL;
-		if (strncmp(t.text, "cpu_seconds ", 12) == 0)
-			m->cost = strtod(t.text + 12, &end);
-		int ok = end && end != t.text + 12 && (*end == '\n' || *end == '\0') &&
-		         isfinite(m->cost) && m->cost >= 0.0;
-		/* "steps N" on the second line; absent in maps built before it */
-		m->steps = 0;
-		if (ok && *end == '\n' && end[1]) {
-			char *s = end + 1, *e2 = NULL;
-			errno = 0;
-			if (strncmp(s, "steps ", 6) == 0 && s[6] >= '0' && s[6] <= '9')
-				m->steps = strtoll(s + 6, &e2, 10);
-			ok = e2 && !errno && (*e2 == '\0' || (*e2 == '\n' && !e2[1]));
-		}
-		bsim_file_text_free(&t);
-		if (!ok) {
-			snprintf(path, sizeof path, "%s/map_%016llx.cost", dir,
-			         (unsigned long long)m->key);
-			bsim_error_set(err, BSIM_EINPUT,
-			               "%s: expected \"cpu_seconds S\" (S >= 0 the CPU time of "
-			               "the map's build) and \"steps N\", a line each",
-			               path);
-			return -1;
-		}
-	}
 	free(m->hold_exit);
 	free(m->hold_steps);
 	m->hold_exit = m->hold_steps = NULL;
@@ -565,6 +583,103 @@ int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsi
 	return bsim_atomic_file_commit(&o, err);
 }
 
+static const char NEXT_HEADER[] = "trial,start_exit,exit,steps";
+
+/* "after_GATE.csv" or "after_GATE.cost": the extension of a gate after the
+ * start's files beside the start map's (map_START.after_GATE.csv). */
+static void next_ext(char *buf, size_t size, const bsim_markov_map *gate, const char *what)
+{
+	snprintf(buf, size, "after_%016llx.%s", (unsigned long long)gate->key, what);
+}
+
+int bsim_markov_next_write(const char *stage, const bsim_markov_next *x,
+                           const bsim_markov_map *start, const bsim_markov_map *gate,
+                           bsim_error *err)
+{
+	char path[BSIM_PATH_MAX], ext[64];
+	next_ext(ext, sizeof ext, gate, "csv");
+	snprintf(path, sizeof path, "%s/map_%016llx.%s", stage, (unsigned long long)start->key,
+	         ext);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fprintf(o.f, "%s\n", NEXT_HEADER);
+	for (int t = 0; t < x->trials; t++)
+		if (x->exit[t] >= 0)
+			fprintf(o.f, "%d,%d,%d,%d\n", t, start->hold_exit[t], x->exit[t],
+			        x->steps[t]);
+	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	next_ext(ext, sizeof ext, gate, "cost");
+	snprintf(path, sizeof path, "%s/map_%016llx.%s", stage, (unsigned long long)start->key,
+	         ext);
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fprintf(o.f, "cpu_seconds %.6g\nsteps %lld\n", x->cost, x->steps_total);
+	return bsim_atomic_file_commit(&o, err);
+}
+
+int bsim_markov_next_read(const char *dir, bsim_markov_next *x, const bsim_markov_map *start,
+                          const bsim_markov_map *gate, bsim_error *err)
+{
+	const int T = start->start_trials, nb = gate->n_bins;
+	char ext[64];
+	next_ext(ext, sizeof ext, gate, "csv");
+	file_text t;
+	int absent = 0;
+	/* a row is at most four integers of 11 characters */
+	if (map_file(dir, start, ext, ((double)T + 1.0) * 48.0, &t, &absent, err) != BSIM_OK)
+		return -1;
+	if (absent)
+		return 0;
+	char path[BSIM_PATH_MAX];
+	snprintf(path, sizeof path, "%s/map_%016llx.%s", dir, (unsigned long long)start->key, ext);
+	if (bsim_csv_text_check(path, t.text, t.len, err) != BSIM_OK) {
+		bsim_file_text_free(&t);
+		return -1;
+	}
+	free(x->exit);
+	free(x->steps);
+	x->trials = T;
+	x->exit = malloc((size_t)T * sizeof *x->exit);
+	x->steps = malloc((size_t)T * sizeof *x->steps);
+	char *line = t.text, *nl = strchr(line, '\n');
+	long lineno = 1;
+	int bad = !x->exit || !x->steps || !start->hold_exit || !nl ||
+	          (*nl = '\0', strcmp(line, NEXT_HEADER) != 0);
+	/* a row for each start trial that left into a gate, in order, its
+	 * start exit the start map's */
+	for (int u = 0; !bad && u < T; u++) {
+		x->exit[u] = -1;
+		x->steps[u] = 0;
+		if (start->hold_exit[u] == 0)
+			continue;
+		long v[4];
+		bad = row_of_four(&nl, &lineno, v) || v[0] != u || v[1] != start->hold_exit[u] ||
+		      v[2] < 0 || v[2] >= nb || v[3] < 1 || v[3] > INT_MAX;
+		if (!bad) {
+			x->exit[u] = (int)v[2];
+			x->steps[u] = (int)v[3];
+		}
+	}
+	if (!bad && *(nl + 1))
+		bad = 1, lineno++;
+	bsim_file_text_free(&t);
+	if (bad) {
+		bsim_error_set(err, BSIM_EINPUT,
+		               "%s:%ld: expected a row trial,start_exit,exit,steps for each of "
+		               "the start's %d single gates of map_%016llx.hold.csv that left "
+		               "into a gate, in order (start_exit as there, exit 0 to %d, steps "
+		               ">= 1)",
+		               path, lineno, T, (unsigned long long)start->key, nb - 1);
+		return -1;
+	}
+	next_ext(ext, sizeof ext, gate, "cost");
+	if (cost_read(dir, start, ext, &x->cost, &x->steps_total, err) != BSIM_OK)
+		return -1;
+	return 1;
+}
+
 int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
                           const bsim_options *opts, bsim_error *err)
 {
@@ -593,7 +708,7 @@ int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const b
 	fputs("], \"entries\": ", o.f);
 	char label[64];
 	bsim_json_string(o.f, bsim_markov_entries_label(def, NULL, label, sizeof label));
-	fputs("}\n", o.f);
+	fprintf(o.f, ", \"after_start\": %d}\n", bsim_markov_def_after_start(def));
 	return bsim_atomic_file_commit(&o, err);
 }
 
@@ -739,6 +854,11 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	}
 	if (rc == BSIM_OK)
 		rc = def_string(&d, "/entries", id, sizeof id, err);
+	/* absent in maps built before the gate after the start: without it */
+	def->after_start = 0;
+	if (rc == BSIM_OK &&
+	    fy_node_by_path(fy_document_root(d.fyd), "/after_start", -1, FYNWF_DONT_FOLLOW))
+		rc = def_int(&d, "/after_start", 0, 1, &def->after_start, err);
 	bsim_ydoc_free(&d);
 	if (rc != BSIM_OK)
 		return rc;

@@ -13,6 +13,12 @@
  * gate in the lattice; the chain lets it enter that gate again through its
  * bottom edge, with the same position, speed and direction bins.
  *
+ * The start. s is the start state (the start gate's bin 0), or, with the
+ * gate after the start (set->next), the probability entering each state
+ * once a body's first two gates are behind, taken from the start's single
+ * gates and their continuations (chain_start_init); what those two gates
+ * absorbed is added to p.
+ *
  * Solution. p = s (I - Q)^-1 R. Exactly: y (I - Q) = s, i.e. (I - Q)^T y^T
  * = s^T, by LU (GSL) for at most BSIM_MARKOV_LU_MAX states; y is the
  * expected number of visits of each state and p = y R. Always, one of
@@ -30,6 +36,7 @@
 #include "analysis/markov_internal.h"
 #include "beamsim/lattice_outcome.h"
 
+#include <assert.h>
 #include <gsl/gsl_linalg.h>
 #include <math.h>
 #include <stdlib.h>
@@ -280,6 +287,104 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
 	return BSIM_OK;
 }
 
+/* Where the chain starts: the probability entering each transient state
+ * once the first `gates` gates are behind (init, n_states; the gates
+ * [glo, ghi) hold it, in_field in all), what those gates absorbed (p_loc,
+ * and p_gates[k] in the k-th), the gates they entered (visits, the start
+ * counted) and their expected holding time, s. Without the gate after the
+ * start: the start state, no gate behind. */
+typedef struct chain_start {
+	double *init, *p_loc;
+	double p_gates[3];
+	int gates, glo, ghi;
+	double in_field, visits, time;
+} chain_start;
+
+/* Mass w leaving gate g (the second gate) by exit x into st. */
+static void start_place(chain_start *st, const chain *c, int g, int x, double w)
+{
+	int state, loc = c->cols + c->rows + g; /* x = 0: stuck in g */
+	if (x > 0)
+		bsim_markov_exit_target(c->cols, c->rows, c->nb, g, x, &state, &loc);
+	if (x > 0 && state >= 0) {
+		st->init[state] += w;
+	} else {
+		st->p_loc[loc] += w;
+		st->p_gates[2] += w;
+	}
+}
+
+/* The first two gates from the gate after the start (set->next): start
+ * trial t of the start gate's map (weight 1 / T) ends there, stuck or out
+ * of the field, or enters gate g, where its own continuation in g's map
+ * (the exact state it entered with, not its bin) leaves by exit x2. A
+ * body leaving the start gate downwards enters it again through its
+ * bottom, as everywhere in the chain: that bin's row. Exact for the
+ * mixture: no bin stands between the first gate and the second. */
+static int chain_start_init(chain_start *st, const chain *c, const bsim_markov_set *set, int g0,
+                            double dt)
+{
+	memset(st, 0, sizeof *st);
+	const int nb = c->nb, n = c->n_states, S = c->gate_map[g0];
+	st->init = calloc((size_t)n, sizeof *st->init);
+	st->p_loc = calloc((size_t)c->n_loc, sizeof *st->p_loc);
+	if (!st->init || !st->p_loc)
+		return -1;
+	const bsim_markov_map *m = &set->maps[S];
+	if (!set->next || !m->hold_exit) {
+		st->init[(size_t)g0 * nb] = 1.0;
+	} else {
+		const int T = m->start_trials;
+		const double w = 1.0 / T;
+		st->gates = 2;
+		for (int t = 0; t < T; t++) {
+			const int x1 = m->hold_exit[t]; /* the start bin's units come first */
+			st->visits += w;
+			st->time += w * m->hold_steps[t] * dt;
+			int state = -1, loc = c->cols + c->rows + g0;
+			if (x1 > 0)
+				bsim_markov_exit_target(c->cols, c->rows, nb, g0, x1, &state, &loc);
+			if (state < 0) {
+				st->p_loc[loc] += w;
+				st->p_gates[1] += w;
+				continue;
+			}
+			const int g = state / nb;
+			st->visits += w;
+			if (g == g0) {
+				const sparse_map *sm = &c->sm[S];
+				const int a = state % nb;
+				if (sm->hold)
+					st->time += w * sm->hold[a];
+				for (int j = sm->first[a]; j < sm->first[a + 1]; j++)
+					start_place(st, c, g, sm->exit[j], w * sm->p[j]);
+				continue;
+			}
+			const bsim_markov_next *x = &set->next[(size_t)S * set->n + c->gate_map[g]];
+			assert(x->exit && x->exit[t] >= 0);
+			st->time += w * x->steps[t] * dt;
+			start_place(st, c, g, x->exit[t], w);
+		}
+	}
+	st->glo = c->cols * c->rows;
+	for (int g = 0; g < c->cols * c->rows; g++)
+		for (int a = 0; a < nb; a++)
+			if (st->init[(size_t)g * nb + a] != 0.0) {
+				st->glo = g < st->glo ? g : st->glo;
+				st->ghi = g + 1;
+				st->in_field += st->init[(size_t)g * nb + a];
+			}
+	if (st->ghi == 0)
+		st->glo = 0;
+	return 0;
+}
+
+static void chain_start_free(chain_start *st)
+{
+	free(st->init);
+	free(st->p_loc);
+}
+
 /* The series from the start state, until less than tol is left in the
  * field: p_loc (n_loc), p_gates (grown as needed), the probability left.
  * Every buffer is allocated before the loop. A term walks the gates that
@@ -288,11 +393,11 @@ static int chain_init(chain *c, const bsim_scene *lattice, const bsim_markov_set
  * the last n_loc entries of next, emptied into p_loc after each term. */
 /* Out of line (as sweeps()): both inlined into their one caller, the
  * series took 2.2 times as long (perf stat, C-track, 800-trial maps). */
-__attribute__((noinline)) static int series(const chain *c, int start, double tol, double *p_loc,
-                                            double **p_gates, int *n_gates, double *left,
-                                            double *time)
+__attribute__((noinline)) static int series(const chain *c, const chain_start *st, double tol,
+                                            double *p_loc, double **p_gates, int *n_gates,
+                                            double *left, double *time)
 {
-	double tm = 0.0; /* s, the sum of each state's mass times its mean holding time */
+	double tm = st->time; /* s, the sum of each state's mass times its mean holding time */
 	const int n = c->n_states, nb = c->nb, G = c->cols * c->rows;
 	double *cur = calloc((size_t)n + c->n_loc, sizeof *cur);
 	double *next = calloc((size_t)n + c->n_loc, sizeof *next);
@@ -304,11 +409,13 @@ __attribute__((noinline)) static int series(const chain *c, int start, double to
 		free(pg);
 		return -1;
 	}
-	cur[start] = 1.0;
+	memcpy(cur, st->init, (size_t)n * sizeof *cur);
+	for (int g = 0; g <= st->gates && g <= cap; g++)
+		pg[g] = st->p_gates[g];
 	/* the gates that may hold probability: [glo, ghi) */
-	int glo = start / nb, ghi = glo + 1;
-	double in_field = 1.0;
-	int k = 0;
+	int glo = st->glo, ghi = st->ghi;
+	double in_field = st->in_field;
+	int k = st->gates;
 	while (in_field > tol && k < SERIES_MAX) {
 		k++;
 		if (k > cap) {
@@ -438,11 +545,11 @@ static int exit_offset(int x, int nb, int W)
 	}
 }
 
-__attribute__((noinline)) static int sweeps(const chain *c, int n_maps, int start, double tol,
-                                            double *p_loc, double *visits, double *left,
+__attribute__((noinline)) static int sweeps(const chain *c, int n_maps, const chain_start *st,
+                                            double tol, double *p_loc, double *visits, double *left,
                                             int *n_sweeps, double *time)
 {
-	double tm = 0.0; /* s, as vis with each push weighted by its mean holding time */
+	double tm = st->time; /* s, as vis with each push weighted by its mean holding time */
 	const int nb = c->nb, cols = c->cols, rows = c->rows, G = cols * rows;
 	const int W = cols + 2, S = nb + 1, per_edge = (nb - 1) / 4;
 	double *r = calloc((size_t)W * (rows + 2) * S, sizeof *r);
@@ -467,8 +574,10 @@ __attribute__((noinline)) static int sweeps(const chain *c, int n_maps, int star
 	}
 	for (int g = 0; g < G; g++)
 		base[g] = ((g / cols + 1) * W + g % cols + 1) * S;
-	r[base[start / nb] + start % nb] = 1.0;
-	double in_field = 1.0, vis = 0.0;
+	for (int g = st->glo; g < st->ghi; g++)
+		for (int a = 0; a < nb; a++)
+			r[base[g] + a] = st->init[(size_t)g * nb + a];
+	double in_field = st->in_field, vis = st->visits;
 	int k = 0;
 	while (in_field > tol && k < SERIES_MAX) {
 		k++;
@@ -536,11 +645,14 @@ __attribute__((noinline)) static int sweeps(const chain *c, int n_maps, int star
 	return 0;
 }
 
-/* p_loc by LU of (I - Q)^T y = e_start; *time the sum of the visits y
- * times each state's mean holding time (with holding times). */
-static int lu_solve(const chain *c, int start, double *p_loc, double *time)
+/* p_loc by LU of (I - Q)^T y = init (st's), added to what the first
+ * gates absorbed; *time the sum of the visits y times each state's mean
+ * holding time (with holding times), st's first gates' included. */
+static int lu_solve(const chain *c, const chain_start *st, double *p_loc, double *time)
 {
-	*time = 0.0;
+	*time = st->time;
+	for (int l = 0; l < c->n_loc; l++)
+		p_loc[l] = st->p_loc[l];
 	const int n = c->n_states;
 	gsl_matrix *A = gsl_matrix_calloc((size_t)n, (size_t)n);
 	gsl_vector *e = gsl_vector_calloc((size_t)n);
@@ -558,7 +670,8 @@ static int lu_solve(const chain *c, int start, double *p_loc, double *time)
 				               gsl_matrix_get(A, (size_t)to, (size_t)s) - c->p[j]);
 		}
 	}
-	gsl_vector_set(e, (size_t)start, 1.0);
+	for (int s = 0; s < n; s++)
+		gsl_vector_set(e, (size_t)s, st->init[s]);
 	if (gsl_linalg_LU_decomp(A, perm, &sign) || gsl_linalg_LU_solve(A, perm, e, y))
 		goto done;
 	for (int s = 0; s < n; s++) {
@@ -613,6 +726,7 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 		                      "at which the series stops, in (0, 1)",
 		                      tol);
 	chain c;
+	chain_start st = {0};
 	int rc = chain_init(&c, lattice, set, flags & BSIM_MARKOV_GATES, err);
 	const bsim_lattice_def *l = &lattice->lattice;
 	if (rc == BSIM_OK) {
@@ -634,17 +748,22 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 			        BSIM_LOCATION_STUCK, l->ix_min + g % c.cols, g / c.cols};
 		int ix, iy;
 		bsim_lattice_gate_at(lattice, lattice->body.start, &ix, &iy);
-		int start = ((iy * c.cols) + ix - l->ix_min) * c.nb;
+		if (chain_start_init(&st, &c, set, iy * c.cols + ix - l->ix_min, lattice->dt))
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		else
+			memcpy(out->p, st.p_loc, (size_t)c.n_loc * sizeof *out->p);
+	}
+	if (rc == BSIM_OK) {
 		if (flags & BSIM_MARKOV_GATES) {
 			/* The series: p and the distribution of gates visited. */
-			if (series(&c, start, tol, out->p, &out->p_gates, &out->n_gates,
+			if (series(&c, &st, tol, out->p, &out->p_gates, &out->n_gates,
 			           &out->left_in_field, &out->mean_time))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 			for (int k = 1; rc == BSIM_OK && k <= out->n_gates; k++)
 				out->mean_gates += k * out->p_gates[k];
 		} else {
 			/* The sweeps: p and the expected visits alone. */
-			if (sweeps(&c, set->n, start, tol, out->p, &out->mean_gates,
+			if (sweeps(&c, set->n, &st, tol, out->p, &out->mean_gates,
 			           &out->left_in_field, &out->sweeps, &out->mean_time) ||
 			    !(out->p_gates = calloc(1, sizeof *out->p_gates)))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
@@ -658,7 +777,7 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 			else {
 				memcpy(by_series, out->p, (size_t)c.n_loc * sizeof *out->p);
 				memset(out->p, 0, (size_t)c.n_loc * sizeof *out->p);
-				if (lu_solve(&c, start, out->p, &out->mean_time))
+				if (lu_solve(&c, &st, out->p, &out->mean_time))
 					rc = bsim_error_set(
 					        err, BSIM_EFAIL,
 					        "the chain's LU solve failed (out of memory or a "
@@ -681,6 +800,7 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 			out->mean_time = NAN;
 	}
 	chain_free(&c, set->n);
+	chain_start_free(&st);
 	if (rc != BSIM_OK)
 		bsim_markov_prediction_free(out);
 	return rc;

@@ -11,8 +11,10 @@
 #include <gsl/gsl_rng.h>
 #include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "beamsim/effects.h"
 #include "beamsim/schedule.h"
@@ -81,6 +83,8 @@ static int exit_bin(const bsim_markov_bins *b, const bsim_lattice_def *l, const 
 
 /* Salt of the self-consistent passes' entry-state seeds. */
 #define SELF_SALT 0x73656c6670617373ULL
+/* Salt of the schedules of the single gates after the start. */
+#define NEXT_SALT 0x6e65787467617465ULL
 
 /* A state of bin (> 0) from the pool's exits into it, each with its
  * weight; uniformly in the bin where none arrived. */
@@ -128,8 +132,9 @@ typedef struct gate_runner {
 	bsim_world *w;
 } gate_runner;
 
-/* One single-gate trial from entry bin `bin` (0: the start) with trial index
- * t: the exit bin, 0 if stuck; -1 with err on failure. */
+/* One single-gate trial from entry bin `bin` (0: the start; < 0: the gate
+ * after the start, from the state the caller set) with trial index t: the
+ * exit bin, 0 if stuck; -1 with err on failure. */
 static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_markov_def *def,
                       const bsim_backend *be, const bsim_options *opts, int bin, int t,
                       bsim_error *err)
@@ -167,9 +172,11 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 		return -1;
 	}
 	bsim_effects fx;
-	if (bsim_effects_init_taking(&fx, s,
-	                             bsim_schedule_seed_mix(def->seed, (uint64_t)bin, (uint64_t)t),
-	                             be->takes)) {
+	/* bin < 0: the gate after the start, its own schedules */
+	const uint64_t seed =
+	        bin >= 0 ? bsim_schedule_seed_mix(def->seed, (uint64_t)bin, (uint64_t)t)
+	                 : bsim_schedule_seed_mix(def->seed ^ NEXT_SALT, 0, (uint64_t)t);
+	if (bsim_effects_init_taking(&fx, s, seed, be->takes)) {
 		be->destroy(w);
 		bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		return -1;
@@ -198,10 +205,14 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 		}
 		if (!isfinite(r->s1.x[0]) || !isfinite(r->s1.x[1]) || !isfinite(r->s1.v[0]) ||
 		    !isfinite(r->s1.v[1])) {
+			char where[32] = "after the start";
+			if (bin >= 0)
+				snprintf(where, sizeof where, "entry bin %d", bin);
 			bsim_error_set(err, BSIM_EFAIL,
-			               "a single gate (k = %g, %g N m/rad, entry bin %d, trial %d) "
+			               "a single gate (k = %g, %g N m/rad, %s, trial %d) "
 			               "became unstable at step %ld",
-			               s->beams[0].stiffness, s->beams[1].stiffness, bin, t, n + 1);
+			               s->beams[0].stiffness, s->beams[1].stiffness, where, t,
+			               n + 1);
 			out = -1;
 			break;
 		}
@@ -240,30 +251,26 @@ int bsim_markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *d
 	                                     err);
 }
 
-int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
-                                  const bsim_backend *be, const bsim_options *opts,
-                                  bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
-                                  long *done, long total, bsim_error *err)
+/* Single gates 0 .. units-1 of a gate with stiffness k on def->threads
+ * threads: unit u's exit bin (0 stuck) into exit[u] and its time steps
+ * into held[u], its entry and exit into runs[u] (runs may be NULL). Unit u
+ * is trial u - first of bin of map m (m's bins, states drawn in the bin or
+ * from pool), or, with from, the gate after the start: the body starts in
+ * from[u]'s exit state, its schedule that of start trial trial[u]. The
+ * first failure in unit order is the error, whatever the threads. */
+static int units_run(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                     const bsim_options *opts, const double k[2], long units,
+                     const bsim_markov_map *m, const markov_pool *pool, const markov_run *from,
+                     const int *trial, markov_run *runs, int *exit, int *held, long long *steps,
+                     long *done, long total, bsim_error *err)
 {
-	const int nb = m->n_bins;
-	const long units = bsim_markov_map_units(m);
-	int *exit = malloc((size_t)units * sizeof *exit);
-	int *held = malloc((size_t)units * sizeof *held);
-	if (!exit || !held) {
-		free(exit);
-		free(held);
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	}
 	markov_entry_index ex = {0};
-	if (def->entries &&
+	if (def->entries && !from &&
 	    bsim_markov_entry_index_init(&ex, def->entries, &def->bins, &lattice->lattice)) {
-		free(exit);
-		free(held);
 		bsim_markov_entry_index_free(&ex);
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
-	int failed = 0, stopped = 0;
-	long long steps = 0;
+	int stopped = 0;
 	bsim_error first = {0};
 	long first_unit = units;
 	int threads = def->threads > 0 ? def->threads : 0;
@@ -274,10 +281,10 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
 		int ok = bsim_state_init(&r.s0, 2) == BSIM_OK &&
 		         bsim_state_init(&r.s1, 2) == BSIM_OK;
 		r.rng = gsl_rng_alloc(gsl_rng_mt19937);
-		r.ex = def->entries ? &ex : NULL;
 		r.pool = pool;
-		bsim_markov_gate_scene_init(&r.g, lattice, m->k);
+		bsim_markov_gate_scene_init(&r.g, lattice, k);
 		const double start[2] = {r.g.s.body.start[0], r.g.s.body.start[1]};
+		r.ex = def->entries && !from ? &ex : NULL;
 #pragma omp for schedule(dynamic, 16)
 		for (long u = 0; u < units; u++) {
 			if (!ok || !r.rng) {
@@ -296,17 +303,25 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
 				continue;
 			}
 			bsim_error e;
-			r.g.s.body.start[0] = start[0];
-			r.g.s.body.start[1] = start[1];
-			r.g.s.body.velocity[0] = lattice->body.velocity[0];
-			r.g.s.body.velocity[1] = lattice->body.velocity[1];
+			int bin, t;
+			if (from) { /* the exit state of start trial trial[u] */
+				memcpy(r.g.s.body.start, from[u].exit_x, sizeof from[u].exit_x);
+				memcpy(r.g.s.body.velocity, from[u].exit_v, sizeof from[u].exit_v);
+				bin = -1;
+				t = trial[u];
+			} else {
+				r.g.s.body.start[0] = start[0];
+				r.g.s.body.start[1] = start[1];
+				r.g.s.body.velocity[0] = lattice->body.velocity[0];
+				r.g.s.body.velocity[1] = lattice->body.velocity[1];
+				bin = bsim_markov_unit_bin(m, u);
+				t = (int)(u - bsim_markov_bin_first(m, bin));
+			}
 			r.run = runs ? &runs[u] : NULL;
-			const int bin = bsim_markov_unit_bin(m, u);
-			exit[u] = gate_trial(&r, lattice, def, be, opts, bin,
-			                     (int)(u - bsim_markov_bin_first(m, bin)), &e);
+			exit[u] = gate_trial(&r, lattice, def, be, opts, bin, t, &e);
 			held[u] = (int)r.steps;
 #pragma omp atomic
-			steps += r.steps;
+			*steps += r.steps;
 			if (exit[u] < 0) {
 #pragma omp critical(bsim_markov_fail)
 				if (u < first_unit) {
@@ -328,25 +343,129 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
 		bsim_state_free(&r.s0);
 		bsim_state_free(&r.s1);
 	}
-	if (stopped) {
-		failed = 1;
-	} else if (first_unit < units) {
-		failed = 1;
+	bsim_markov_entry_index_free(&ex);
+	if (stopped)
+		return BSIM_ESTOPPED;
+	if (first_unit < units) {
 		if (err)
 			*err = first;
+		return BSIM_EFAIL;
 	}
-	for (long u = 0; !failed && u < units; u++)
-		m->counts[bsim_markov_unit_bin(m, u) * nb + exit[u]]++;
-	m->steps += steps;
-	if (!failed) { /* the holding times: the map keeps both arrays */
+	return BSIM_OK;
+}
+
+int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
+                                  const bsim_backend *be, const bsim_options *opts,
+                                  bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
+                                  long *done, long total, bsim_error *err)
+{
+	const int nb = m->n_bins;
+	const long units = bsim_markov_map_units(m);
+	int *exit = malloc((size_t)units * sizeof *exit);
+	int *held = malloc((size_t)units * sizeof *held);
+	if (!exit || !held) {
+		free(exit);
+		free(held);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	long long steps = 0;
+	int rc = units_run(lattice, def, be, opts, m->k, units, m, pool, NULL, NULL, runs, exit,
+	                   held, &steps, done, total, err);
+	if (rc == BSIM_OK) { /* the holding times: the map keeps both arrays */
+		for (long u = 0; u < units; u++)
+			m->counts[bsim_markov_unit_bin(m, u) * nb + exit[u]]++;
 		free(m->hold_exit);
 		free(m->hold_steps);
 		m->hold_exit = exit;
 		m->hold_steps = held;
 		exit = held = NULL;
 	}
+	m->steps += steps;
 	free(exit);
 	free(held);
-	bsim_markov_entry_index_free(&ex);
-	return stopped ? BSIM_ESTOPPED : failed ? BSIM_EFAIL : BSIM_OK;
+	return rc;
+}
+
+long bsim_markov_next_units(const bsim_markov_map *start, int n)
+{
+	return (long)start->start_trials * (1 + n);
+}
+
+int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
+                              const bsim_backend *be, const bsim_options *opts,
+                              const bsim_markov_map *start, const bsim_markov_map *const *gate,
+                              bsim_markov_next *const *nx, int n, long *done, long total,
+                              bsim_error *err)
+{
+	const long T = start->start_trials;
+	/* the start bin's single gates alone: a map of its units only */
+	bsim_markov_map sm = *start;
+	sm.trials = 1;
+	sm.n_bins = 1;
+	markov_run *runs = malloc((size_t)T * sizeof *runs);
+	markov_run *from = malloc((size_t)T * sizeof *from);
+	int *trial = malloc((size_t)T * sizeof *trial);
+	int *exit = malloc((size_t)T * sizeof *exit), *held = malloc((size_t)T * sizeof *held);
+	if (!runs || !from || !trial || !exit || !held) {
+		free(runs);
+		free(from);
+		free(trial);
+		free(exit);
+		free(held);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	long long steps = 0;
+	clock_t c0 = clock();
+	int rc = units_run(lattice, def, be, opts, start->k, T, &sm, NULL, NULL, NULL, runs, exit,
+	                   held, &steps, done, total, err);
+	/* The same seeds as the map's start bin: the same single gates. */
+	for (long t = 0; rc == BSIM_OK && start->hold_exit && t < T; t++)
+		if (exit[t] != start->hold_exit[t] || held[t] != start->hold_steps[t])
+			rc = bsim_error_set(err, BSIM_EFAIL,
+			                    "the start's single gate %ld of map_%016llx ran again "
+			                    "to exit %d after %d steps, the map's to %d after %d",
+			                    t, (unsigned long long)start->key, exit[t], held[t],
+			                    start->hold_exit[t], start->hold_steps[t]);
+	long left = 0;
+	for (long t = 0; rc == BSIM_OK && t < T; t++)
+		if (exit[t] > 0) {
+			from[left] = runs[t];
+			trial[left++] = (int)t;
+		}
+	const double start_seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
+	for (int i = 0; i < n && rc == BSIM_OK; i++) {
+		bsim_markov_next *x = nx[i];
+		c0 = clock();
+		long long gs = 0;
+		x->trials = (int)T;
+		x->exit = malloc((size_t)T * sizeof *x->exit);
+		x->steps = malloc((size_t)T * sizeof *x->steps);
+		if (!x->exit || !x->steps) {
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+			break;
+		}
+		rc = units_run(lattice, def, be, opts, gate[i]->k, left, NULL, NULL, from, trial,
+		               NULL, exit, held, &gs, done, total, err);
+		/* the start's units again count once, shared by the n gates */
+		if (rc != BSIM_OK)
+			break;
+		for (long t = 0; t < T; t++)
+			x->exit[t] = -1, x->steps[t] = 0;
+		for (long u = 0; u < left; u++) {
+			x->exit[trial[u]] = exit[u];
+			x->steps[trial[u]] = held[u];
+		}
+		x->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC + start_seconds / n;
+		x->cost = x->seconds;
+		x->steps_total = gs + steps / n;
+	}
+	/* counted: the units of the gates after the start that did not run */
+	if (rc == BSIM_OK)
+		*done += (T - left) * n;
+	free(runs);
+	free(from);
+	free(trial);
+	free(exit);
+	free(held);
+	return rc;
 }

@@ -48,6 +48,13 @@ static inline int bsim_markov_def_start_trials(const bsim_markov_def *def)
 	return def->start_trials > 0 ? def->start_trials : def->trials;
 }
 
+/* Whether def's maps have the gate after the start: after_start, but never
+ * with self or flow entries (their start's exits are of their own pass). */
+static inline int bsim_markov_def_after_start(const bsim_markov_def *def)
+{
+	return def->after_start && !def->self_entries;
+}
+
 /* The single gates of entry bin a of map m, and the index of its first
  * in the map's single gates (the start bin's first, then every other
  * bin's trials in turn); their total. */
@@ -118,6 +125,19 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
                                   const bsim_backend *be, const bsim_options *opts,
                                   bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
                                   long *done, long total, bsim_error *err);
+
+/* The gate after the start (bsim_markov_next): the start bin's single
+ * gates of map start again (the same seeds as the map's: the same exits,
+ * BSIM_EFAIL if they differ from its holding times), and from the exit
+ * state of each that left into a gate one single gate of each of the n
+ * maps gate[i], into nx[i] (exit and steps allocated). *done counts
+ * bsim_markov_next_units(start, n) units of total. */
+int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
+                              const bsim_backend *be, const bsim_options *opts,
+                              const bsim_markov_map *start, const bsim_markov_map *const *gate,
+                              bsim_markov_next *const *nx, int n, long *done, long total,
+                              bsim_error *err);
+long bsim_markov_next_units(const bsim_markov_map *start, int n);
 
 /* ---- self-consistent entries (markov_self.c) ---- */
 
@@ -215,6 +235,16 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err);
 /* Writes map m's key, counts and cost into stage. */
 int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsim_markov_bins *b,
                           bsim_error *err);
+
+/* The gate after the start x of maps start and gate (map_START.after_GATE
+ * .csv and .cost) written into stage, or read from dir: 1 if there, 0 if
+ * absent, -1 with err naming the line if malformed or not of start's
+ * holding times. */
+int bsim_markov_next_write(const char *stage, const bsim_markov_next *x,
+                           const bsim_markov_map *start, const bsim_markov_map *gate,
+                           bsim_error *err);
+int bsim_markov_next_read(const char *dir, bsim_markov_next *x, const bsim_markov_map *start,
+                          const bsim_markov_map *gate, bsim_error *err);
 
 /* Writes stage/markov.json, the def of the build. */
 int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,

@@ -24,6 +24,7 @@ bsim_markov_def bsim_markov_def_default(void)
 	return (bsim_markov_def){.bins = bsim_markov_bins_default(),
 	                         .trials = 50,
 	                         .start_trials = BSIM_MARKOV_START_TRIALS,
+	                         .after_start = 1,
 	                         .seed = 1};
 }
 
@@ -150,6 +151,11 @@ void bsim_markov_set_free(bsim_markov_set *s)
 		free(s->maps[i].hold_exit);
 		free(s->maps[i].hold_steps);
 	}
+	for (int i = 0; s->next && i < s->n * s->n; i++) {
+		free(s->next[i].exit);
+		free(s->next[i].steps);
+	}
+	free(s->next);
 	free(s->maps);
 	memset(s, 0, sizeof *s);
 }
@@ -210,6 +216,114 @@ static int round_fill(const bsim_scene *lattice, const bsim_markov_def *def, con
 	if (rc == BSIM_OK)
 		out->built = own;
 	free(have);
+	return rc;
+}
+
+/* The path of the gate after the start of maps a and k in dir. */
+static void next_path(char *buf, size_t size, const char *dir, const bsim_markov_map *a,
+                      const bsim_markov_map *k)
+{
+	snprintf(buf, size, "%s/map_%016llx.after_%016llx.csv", dir, (unsigned long long)a->key,
+	         (unsigned long long)k->key);
+}
+
+/* The single gates of the gates after the start that dir does not hold,
+ * of the start maps this process builds. */
+static long next_units_missing(const bsim_markov_set *set, const char *dir)
+{
+	long units = 0;
+	for (int a = 0; a < set->n; a++) {
+		int missing = 0;
+		for (int k = 0; k < set->n && !set->maps[a].elsewhere; k++) {
+			char path[BSIM_PATH_MAX];
+			struct stat st;
+			next_path(path, sizeof path, dir, &set->maps[a], &set->maps[k]);
+			missing += lstat(path, &st) != 0;
+		}
+		units += missing ? bsim_markov_next_units(&set->maps[a], missing) : 0;
+	}
+	return units;
+}
+
+/* The gates after the start of out's maps (def->after_start), every start
+ * map continued in a gate of every map: read from dir where there; in a
+ * merge, from the part that holds it (written into the stage); with a
+ * session, the others simulated into its stage, a start map's at once,
+ * and committed; without, the first missing is an error. A part makes
+ * those of its own start maps. */
+static int next_fill(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
+                     const bsim_options *opts, const char *dir, bsim_session *ss,
+                     bsim_markov_set *out, long *done, long total, bsim_error *err)
+{
+	const int n = out->n;
+	const char *stage = ss ? ss->stage : NULL;
+	out->next = calloc((size_t)n * n, sizeof *out->next);
+	bsim_markov_next **todo = malloc((size_t)n * sizeof *todo);
+	const bsim_markov_map **gate = malloc((size_t)n * sizeof *gate);
+	int rc = out->next && todo && gate ? BSIM_OK
+	                                   : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int a = 0; a < n && rc == BSIM_OK; a++) {
+		const bsim_markov_map *sm = &out->maps[a];
+		int nt = 0;
+		for (int k = 0; k < n && rc == BSIM_OK; k++) {
+			bsim_markov_next *x = &out->next[(size_t)a * n + k];
+			x->start = a;
+			x->gate = k;
+			if ((x->elsewhere = sm->elsewhere))
+				continue;
+			int got = bsim_markov_next_read(dir, x, sm, &out->maps[k], err);
+			for (int j = 0; got == 0 && j < def->n_from; j++)
+				if ((got = bsim_markov_next_read(def->from[j], x, sm, &out->maps[k],
+				                                 err)) > 0)
+					x->copied = 1;
+			char path[BSIM_PATH_MAX];
+			next_path(path, sizeof path, dir, sm, &out->maps[k]);
+			if (got < 0)
+				rc = BSIM_EINPUT;
+			else if (got > 0 && x->copied) {
+				rc = bsim_markov_next_write(stage, x, sm, &out->maps[k], err);
+				if (rc == BSIM_OK)
+					rc = map_commit(ss, err);
+			} else if (got > 0) {
+				x->cached = 1;
+				out->next_reused++;
+			} else if (def->n_from > 0)
+				rc = bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "no part holds %s, the gate after the start: the "
+				        "parts are of another build, or one is missing",
+				        path);
+			else if (!stage)
+				rc = bsim_error_set(
+				        err, BSIM_EINPUT,
+				        "%s: absent: the gate after the start (k = %g, %g N m/rad, "
+				        "then k = %g, %g N m/rad) of maps built with after_start "
+				        "1: "
+				        "beamsim markov build writes it",
+				        path, sm->k[0], sm->k[1], out->maps[k].k[0],
+				        out->maps[k].k[1]);
+			else {
+				todo[nt] = x;
+				gate[nt++] = &out->maps[k];
+			}
+		}
+		if (rc != BSIM_OK || nt == 0)
+			continue;
+		rc = def->stop && *def->stop
+		             ? BSIM_ESTOPPED
+		             : bsim_markov_next_simulate(lattice, def, be, opts, sm, gate, todo, nt,
+		                                         done, total, err);
+		for (int i = 0; i < nt && rc == BSIM_OK; i++) {
+			out->seconds += todo[i]->seconds;
+			rc = bsim_markov_next_write(stage, todo[i], sm, gate[i], err);
+		}
+		if (rc == BSIM_OK)
+			rc = map_commit(ss, err);
+		if (rc == BSIM_OK)
+			out->next_built += nt;
+	}
+	free(todo);
+	free(gate);
 	return rc;
 }
 
@@ -316,6 +430,9 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			          : def->self_entries == 2 ? def->self_passes + 1
 			                                   : 1);
 	}
+	/* the gates after the start to simulate, counted in the progress */
+	if (rc == BSIM_OK && bsim_markov_def_after_start(def) && stage && !made && def->n_from == 0)
+		total += next_units_missing(out, dir);
 	int to_build = made ? 0 : n - out->reused - out->copied;
 	for (int i = 0; i < n && !made; i++)
 		to_build -= out->maps[i].elsewhere;
@@ -365,6 +482,8 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		if (rc == BSIM_OK)
 			out->built++;
 	}
+	if (rc == BSIM_OK && bsim_markov_def_after_start(def) && !made)
+		rc = next_fill(lattice, def, be, opts, dir, ss, out, &done, total, err);
 	if (rc == BSIM_ESTOPPED && made)
 		bsim_error_set(err, BSIM_ESTOPPED, "stopped in pass %d; nothing of it is kept",
 		               out->pass);
@@ -428,9 +547,23 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
 	return rc;
 }
 
+/* BSIM_EINPUT unless name, a file in dir, is one of the manifest's files. */
+static int file_listed(char *const *files, size_t n, const char *dir, const char *name,
+                       bsim_error *err)
+{
+	for (size_t j = 0; j < n; j++)
+		if (strcmp(files[j], name) == 0)
+			return BSIM_OK;
+	return bsim_error_set(err, BSIM_EINPUT,
+	                      "%s/%s: not listed in %s/manifest.json, so not checked against it: "
+	                      "rebuild the maps with beamsim markov build EXPERIMENT --out %s",
+	                      dir, name, dir, dir);
+}
+
 /* With a manifest, every map file read must be one it lists (and so was
  * checked against its size and CRC-32 by bsim_markov_def_read): a map copied
- * in from elsewhere after the build is not used unchecked. */
+ * in from elsewhere after the build is not used unchecked. The gates after
+ * the start likewise. */
 static int maps_listed(const char *dir, const bsim_markov_set *set, bsim_error *err)
 {
 	char **files = NULL;
@@ -445,17 +578,17 @@ static int maps_listed(const char *dir, const bsim_markov_set *set, bsim_error *
 			struct stat st;
 			char path[BSIM_PATH_MAX];
 			snprintf(path, sizeof path, "%s/%s", dir, name);
-			if (lstat(path, &st) != 0)
-				continue; /* a map without a .cost file: its cost unknown */
-			size_t j = 0;
-			while (j < n && strcmp(files[j], name) != 0)
-				j++;
-			if (j == n)
-				rc = bsim_error_set(err, BSIM_EINPUT,
-				                    "%s: not listed in %s/manifest.json, so not "
-				                    "checked against it: rebuild the maps with "
-				                    "beamsim markov build EXPERIMENT --out %s",
-				                    path, dir, dir);
+			if (lstat(path, &st) ==
+			    0) /* a map without a .cost file: its cost unknown */
+				rc = file_listed(files, n, dir, name, err);
+		}
+	for (int a = 0; rc == BSIM_OK && n > 0 && set->next && a < set->n; a++)
+		for (int k = 0; rc == BSIM_OK && k < set->n * 2; k++) {
+			char name[80];
+			snprintf(name, sizeof name, "map_%016llx.after_%016llx.%s",
+			         (unsigned long long)set->maps[a].key,
+			         (unsigned long long)set->maps[k / 2].key, k % 2 ? "cost" : "csv");
+			rc = file_listed(files, n, dir, name, err);
 		}
 	bsim_outdir_files_free(files, n);
 	return rc;

@@ -18,6 +18,11 @@
  * first-step analysis (bsim_markov_predict_with's mean_time) is exact and
  * checks it.
  *
+ * With the gate after the start (set->next), a walk's first single gate
+ * is a start trial, and where it enters another gate its second is that
+ * trial's own continuation there (bsim_markov_predict_with's first two
+ * gates).
+ *
  * The outcome is decided as a lattice trial's (docs/lattice.md): stuck when
  * a gate holds the body gate_steps steps (the map's exit 0: its single gate
  * ran out of steps) or when max_steps steps have passed in all (the trial's
@@ -104,6 +109,10 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 	for (long w = 0; w < walks && rc == BSIM_OK; w++) {
 		int g = start, a = 0, loc = -1;
 		long t = 0; /* steps so far */
+		/* the gate after the start (set->next): the start trial drawn
+		 * first goes on in the next gate as its own continuation */
+		const bsim_markov_next *after = NULL;
+		int trial = -1;
 		for (long n = 0; loc < 0; n++) {
 			if (n == WALK_GATES_MAX) {
 				rc = bsim_error_set(
@@ -114,10 +123,19 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 				break;
 			}
 			const bsim_markov_map *m = &set->maps[gate_map[g]];
-			const size_t u = (size_t)bsim_markov_bin_first(m, a) +
-			                 (size_t)draw(&rng, bsim_markov_bin_trials(m, a));
-			const int x = m->hold_exit[u];
-			t += m->hold_steps[u];
+			int x;
+			if (after) {
+				x = after->exit[trial];
+				t += after->steps[trial];
+				after = NULL;
+				trial = -1;
+			} else {
+				const size_t u = (size_t)bsim_markov_bin_first(m, a) +
+				                 (size_t)draw(&rng, bsim_markov_bin_trials(m, a));
+				x = m->hold_exit[u];
+				t += m->hold_steps[u];
+				trial = n == 0 ? (int)u : -1; /* the start bin's units come first */
+			}
 			if (max_steps > 0 && t >= max_steps && (x == 0 || t > max_steps)) {
 				t = max_steps; /* the trial's duration is over first */
 				loc = cols + rows + g;
@@ -126,6 +144,9 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 			} else {
 				int state;
 				bsim_markov_exit_target(cols, rows, nb, g, x, &state, &loc);
+				if (state >= 0 && trial >= 0 && set->next && state / nb != g)
+					after = &set->next[(size_t)gate_map[g] * set->n +
+					                   gate_map[state / nb]];
 				if (state >= 0) {
 					g = state / nb;
 					a = state % nb;

@@ -460,6 +460,10 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 			v->map_cost += set.maps[i].cost;
 			v->map_steps += set.maps[i].steps;
 		}
+		for (int i = 0; set.next && i < set.n * set.n; i++) {
+			v->map_cost += set.next[i].cost; /* the gates after the start */
+			v->map_steps += set.next[i].steps_total;
+		}
 	}
 	const bsim_lattice_def *l = &scene.lattice;
 	const int nl = d->pred.n_locations;

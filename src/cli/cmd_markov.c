@@ -36,7 +36,8 @@ enum {
 	OWN_GATES, /* predict's options follow each other from OWN_LOCATIONS */
 	OWN_SHARD,
 	OWN_PASSES,
-	OWN_START_TRIALS
+	OWN_START_TRIALS,
+	OWN_AFTER_START
 };
 
 #define MAX_ENTRIES 16
@@ -123,6 +124,14 @@ static int markov_option(void *args, int i, const char *value)
 			return cli_usage("markov", "--entries %s: at most %d", value, MAX_ENTRIES);
 		a->entries[a->n_entries++] = value;
 		return CLI_OK;
+	case OWN_AFTER_START: {
+		long n;
+		if (cli_parse_long(value, 0, 1, &n) != 0)
+			return cli_usage("markov build", "--after-start %s: expected 0 or 1",
+			                 value);
+		a->def.after_start = (int)n;
+		return CLI_OK;
+	}
 	case OWN_START_TRIALS: {
 		long n;
 		if (cli_parse_long(value, 1, 1000000, &n) != 0)
@@ -207,6 +216,11 @@ static const cli_own build_own[] = {
         {"start-trials", 1, "N",
          "single-gate trials of the start bin (default 4000, or\n"
          "--trials with self or flow entries, which take no other)"},
+        {"after-start", 1, "0|1",
+         "1 (default): each start trial that leaves into a gate goes\n"
+         "on there from its exact state, for every pair of stiffnesses,\n"
+         "and the chain takes the first two gates from those (0 with\n"
+         "self or flow entries); 0: entry bins from the start on"},
 };
 
 static int build_option(void *args, int i, const char *value)
@@ -215,6 +229,7 @@ static int build_option(void *args, int i, const char *value)
 	                     i == 3   ? OWN_SHARD
 	                     : i == 4 ? OWN_PASSES
 	                     : i == 5 ? OWN_START_TRIALS
+	                     : i == 6 ? OWN_AFTER_START
 	                              : i,
 	                     value);
 }
@@ -234,8 +249,11 @@ static const cli_spec build_spec = {
                  "direction; and the start) single gates with their beams at rest, as the\n"
                  "essay's protocol resets them, run from states drawn in the bin with fresh\n"
                  "random-force schedules until the body leaves the gate or is stuck; the\n"
-                 "counts of where it left are the map. DIR caches them: map_HASH.csv (entry,\n"
-                 "exit, count), map_HASH.key (everything the map depends on), markov.json.\n",
+                 "counts of where it left are the map. Each start trial that leaves into a\n"
+                 "gate goes on there, in a gate of every pair, from its exact state (the gate\n"
+                 "after the start). DIR caches them: map_HASH.csv (entry, exit, count),\n"
+                 "map_HASH.key (everything the map depends on), map_START.after_GATE.csv,\n"
+                 "markov.json.\n",
         .positional = "EXPERIMENT",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
                   CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_BACKEND) |
@@ -244,7 +262,7 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 6,
+        .n_own = 7,
         .option = build_option,
 };
 
@@ -485,6 +503,9 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 	       res->built, res->seconds, res->reused,
 	       res->copied ? ", the others from the parts" : "", res->n_bins, def->map.trials,
 	       def->map.start_trials > 0 ? def->map.start_trials : def->map.trials, cli_path(out));
+	if (def->map.after_start && !def->map.self_entries)
+		printf("the gate after the start: %d pairs of maps built, %d reused (CPU above)\n",
+		       res->next_built, res->next_reused);
 	cli_wrote(stdout, out);
 }
 

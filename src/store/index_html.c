@@ -10,6 +10,7 @@
 #include "store/index_html.h"
 
 #include <dirent.h>
+#include <fnmatch.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -118,6 +119,8 @@ static const struct {
         {"markov.json", "the settings the maps were built with"},
         {"map_*.exits.csv", "every single gate's entry and exit state (--entries self, flow)"},
         {"map_*.hold.csv", "each single gate's exit bin and time steps in the gate"},
+        {"map_*.after_*.csv", "the start's single gates continued in the gate after the start"},
+        {"map_*.after_*.cost", "the CPU time and steps the gate after the start took"},
         {"map_*.csv", "a single-gate map: entry bin, exit bin, count"},
         {"map_*.key", "everything that map depends on"},
         {"map_*.cost", "the CPU time and steps that map took"},
@@ -132,14 +135,15 @@ static const struct {
         {"*.yaml", "input as the run read it"},
 };
 
-/* 1 if name matches pattern (at most one '*'); star gets what '*' matched. */
+/* 1 if name matches pattern; with one '*', star gets what it matched
+ * (with more, fnmatch's glob and star ""). */
 static int match(const char *pattern, const char *name, char *star, size_t size)
 {
 	const char *s = strchr(pattern, '*');
-	if (!s) {
+	if (!s || strchr(s + 1, '*')) {
 		if (size)
 			star[0] = '\0';
-		return strcmp(pattern, name) == 0;
+		return s ? fnmatch(pattern, name, 0) == 0 : strcmp(pattern, name) == 0;
 	}
 	size_t pre = (size_t)(s - pattern), post = strlen(s + 1), n = strlen(name);
 	if (n < pre + post || strncmp(pattern, name, pre) != 0 ||

@@ -56,6 +56,20 @@ check(all([b.maps.group] == 1) && b.built == numel(keys) && b.reused == 0 && b.b
 [n2, t2] = map_files(theirs);
 check(isequal(n1, n2) && isequal(t1, t2), 'the maps differ from the program''s: %s / %s', ...
       strjoin(n1, ' '), strjoin(n2, ' '));
+check(any(~cellfun(@isempty, strfind(n1, '.after_'))), 'no gate after the start in %s', ...
+      strjoin(n1, ' '));
+% 'after_start', 0 as --after-start 0: no gate after the start
+mine0 = fullfile(tmp, 'maps_mex_after0');
+theirs0 = fullfile(tmp, 'maps_program_after0');
+beamsim_markov('build', experiment, 'out', mine0, 'trials', 3, 'start_trials', 7, 'bins', [2 2 1], ...
+               'threads', 2, 'seed', 5, 'after_start', 0);
+[out, err, status] = program(exe, tmp, sprintf('markov build %s %s --after-start 0 --out %s', ...
+                                               experiment, small, theirs0));
+check(status == 0, 'beamsim markov build --after-start 0: exit %d: %s', status, err);
+[n3, t3] = map_files(mine0);
+[n4, t4] = map_files(theirs0);
+check(isequal(n3, n4) && isequal(t3, t4) && all(cellfun(@isempty, strfind(n3, '.after_'))), ...
+      'after_start 0: %s / %s', strjoin(n3, ' '), strjoin(n4, ' '));
 again = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'bins', [2 2 1], 'seed', 5);
 check(again.reused == numel(keys) && again.built == 0, 'a build again: %d reused', again.reused);
 printf('build: %d maps, the program''s bytes\n', numel(keys));

@@ -62,11 +62,24 @@ def test_build_is_the_programs(maps):
     assert [m["key"] for m in built["maps"]] == listed
     assert built["built"] == len(built["maps"]) and built["reused"] == 0
     assert built["bins"] == 1 + 4 * 2 * 2 * 1 and built["trials"] == 3
-    # the same maps, byte for byte (not the CPU time each took)
+    # the same maps, byte for byte (not the CPU time each took), the gates
+    # after the start among them
     assert map_files(py) == map_files(prog)
+    assert any(".after_" in name for name in map_files(py))
     # a build again reuses every map
     again = beamsim.markov_build(EXPERIMENT, py, seed=5, **SMALL)
     assert again["reused"] == len(built["maps"]) and again["built"] == 0
+
+
+def test_after_start_is_the_programs(tmp_path):
+    """after_start=False builds what --after-start 0 builds: no gate after
+    the start."""
+    py, prog = tmp_path / "py", tmp_path / "prog"
+    beamsim.markov_build(EXPERIMENT, py, seed=5, after_start=False, **SMALL)
+    cli("markov", "build", EXPERIMENT, *SMALL_ARGS, "--seed", "5", "--after-start", "0",
+        "--out", prog)
+    assert map_files(py) == map_files(prog)
+    assert not any(".after_" in name for name in map_files(py))
 
 
 def test_predict_is_the_programs(maps):

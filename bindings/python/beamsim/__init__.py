@@ -460,7 +460,7 @@ def _entries(entries):
 
 def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=None, seed=None,
                  threads=None, backend=None, backend_opt=None, set=None, grid=None,
-                 progress=None, start_trials=None):
+                 progress=None, start_trials=None, after_start=None):
     """The single-gate maps the lattices of an experiment need, one per pair
     of beam stiffnesses, built into the map directory out as `beamsim
     markov build EXPERIMENT --out DIR` builds them (docs/markov.md): the
@@ -469,7 +469,10 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
     out is a cache: maps already there with the same key are reused, the
     others built there. trials: single gates per entry bin (None: 50);
     start_trials: of the start bin (None: 4,000, or trials with self or flow
-    entries); bins: (positions, speeds, directions), 1 to 64 each (None:
+    entries); after_start: True (None: the default, False with self or flow
+    entries) continues each start trial that leaves into a gate there from
+    its exact state, for every pair of stiffnesses, and the chain takes the
+    first two gates from those; False: entry bins from the start on; bins: (positions, speeds, directions), 1 to 64 each (None:
     (8, 8, 9));
     vmax: m/s, the top of the speed bins (None: 40); entries: gate_entries.csv
     paths (a bin's states drawn from them), or "self", "self:N", "flow",
@@ -500,7 +503,8 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
                                  float(vmax) if vmax is not None else 0.0, _entries(entries),
                                  _seed(seed), _count("threads", threads, 1, 4096), backend,
                                  _sets(set), _grid(grid), _opts(backend_opt), progress,
-                                 _count("start_trials", start_trials, 1, 1000000))
+                                 _count("start_trials", start_trials, 1, 1000000),
+                                 -1 if after_start is None else int(bool(after_start)))
     info["out"] = out
     return info
 
