@@ -9,7 +9,8 @@
 # validate.csv. The default maps are built once, on the first field, and
 # reused on every other; flow:1 maps are built per field (they hold for
 # that layout only). ring5 and check11 are the fields the settings were
-# chosen on; test_* were made after. Prints one row per method and field;
+# chosen on; test_* were made after the bins and trials were fixed, fresh_*
+# after the gate after the start was. Prints one row per method and field;
 # the runs stay in OUT (default out/markov-kinds), the table in
 # OUT/table.txt. FIELDS="..." chooses the fields, TRIALS=N the direct
 # trials of each (default the experiments', 10,000).
@@ -19,7 +20,7 @@ cd "$(dirname "$0")/.."
 out=${1:-out/markov-kinds}
 threads=${2:-2}
 exe=build/beamsim
-fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b})
+fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13 fresh_cols9 fresh_r21})
 # method name and its build options (the default: none); each of the
 # default's three parts (fine bins, many start trials, the gate after the
 # start) alone and without the others

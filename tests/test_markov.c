@@ -725,6 +725,26 @@ static void test_after_start_against_simulation(void **state)
 				for (int t = 0; t < m->start_trials; t++)
 					assert_int_equal(x->exit[t] >= 0, m->hold_exit[t] > 0);
 			}
+			/* the walks take the same first two gates: their outcomes are
+			 * the chain's p, their mean time its first-step mean, within
+			 * 4.5 of the walks' standard errors */
+			const long W = 20000;
+			assert_int_equal(bsim_markov_predict_time(&s, &set, W, 3, &p, &err), BSIM_OK);
+			double mean = 0.0, m2 = 0.0;
+			for (int k = 0; k < 3; k++) {
+				mean += p.p_by[k] * p.t_mean[k];
+				m2 += p.p_by[k] *
+				      (p.t_sd[k] * p.t_sd[k] + p.t_mean[k] * p.t_mean[k]);
+				double tot = 0.0;
+				for (int i = 0; i < p.n_locations; i++)
+					tot += (int)p.loc[i].kind == k ? p.p[i] : 0.0;
+				assert_double_equal(p.p_by[k], tot,
+				                    4.5 * sqrt(tot * (1 - tot) / W) + 1e-12);
+			}
+			const double se = sqrt((m2 - mean * mean) / W);
+			print_message("mean time: first step %.3f s, walks %.3f s (se %.3f)\n",
+			              p.mean_time, mean, se);
+			assert_double_equal(mean, p.mean_time, 4.5 * se);
 			/* read back: the same prediction */
 			bsim_markov_set again;
 			bsim_options opts = {0};
