@@ -729,7 +729,8 @@ static void test_after_start_against_simulation(void **state)
 			 * the chain's p, their mean time its first-step mean, within
 			 * 4.5 of the walks' standard errors */
 			const long W = 20000;
-			assert_int_equal(bsim_markov_predict_time(&s, &set, W, 3, &p, &err), BSIM_OK);
+			assert_int_equal(bsim_markov_predict_time(&s, &set, W, 3, &p, &err),
+			                 BSIM_OK);
 			double mean = 0.0, m2 = 0.0;
 			for (int k = 0; k < 3; k++) {
 				mean += p.p_by[k] * p.t_mean[k];
