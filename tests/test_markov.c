@@ -169,6 +169,30 @@ static void test_two_gates_geometric(void **state)
 	bsim_scene_free(&s);
 }
 
+/* W walks of the time to the outcome (seed 3) against the chain's
+ * solution p of s: their totals of end, side and stuck are p's, and their
+ * mean time the first-step mean, within 4.5 of the walks' standard errors. */
+static void walks_agree(const bsim_scene *s, const bsim_markov_set *set, bsim_markov_prediction *p,
+                        long W)
+{
+	bsim_error err;
+	assert_int_equal(bsim_markov_predict_time(s, set, W, 3, p, &err), BSIM_OK);
+	double mean = 0.0, m2 = 0.0;
+	for (int k = 0; k < 3; k++) {
+		mean += p->p_by[k] * p->t_mean[k];
+		m2 += p->p_by[k] * (p->t_sd[k] * p->t_sd[k] + p->t_mean[k] * p->t_mean[k]);
+		double tot = 0.0;
+		for (int i = 0; i < p->n_locations; i++)
+			tot += (int)p->loc[i].kind == k ? p->p[i] : 0.0;
+		assert_double_equal(p->p_by[k], tot, 4.5 * sqrt(tot * (1 - tot) / W) + 1e-12);
+	}
+	const double se = sqrt((m2 - mean * mean) / W);
+	print_message("mean time: first step %.4f s, walks %.4f s (se %.4f)\n", p->mean_time, mean,
+	              se);
+	assert_true(se > 0);
+	assert_double_equal(mean, p->mean_time, 4.5 * se);
+}
+
 /* Time to the outcome on hand-made maps with fixed holding times (steps):
  * - two gates passed straight through (the start up after 500 steps, the
  *   gate above to the end after 700): the time is the sum, 1200 steps,
@@ -239,23 +263,7 @@ static void test_time_by_hand(void **state)
 		assert_int_equal(bsim_markov_predict_with(&s, &set, 1e-12, 0, &q, &err), BSIM_OK);
 		assert_double_equal(q.mean_time, e0 * dt, 1e-9 * e0 * dt);
 		bsim_markov_prediction_free(&q);
-		const long W = 40000;
-		assert_int_equal(bsim_markov_predict_time(&s, &set, W, 3, &p, &err), BSIM_OK);
-		double mean = 0.0, m2 = 0.0;
-		for (int k = 0; k < 3; k++) {
-			mean += p.p_by[k] * p.t_mean[k];
-			m2 += p.p_by[k] * (p.t_sd[k] * p.t_sd[k] + p.t_mean[k] * p.t_mean[k]);
-			double tot = 0.0;
-			for (int i = 0; i < p.n_locations; i++)
-				tot += (int)p.loc[i].kind == k ? p.p[i] : 0.0;
-			assert_double_equal(p.p_by[k], tot,
-			                    4.5 * sqrt(tot * (1 - tot) / W) + 1e-12);
-		}
-		const double se = sqrt((m2 - mean * mean) / W);
-		print_message("mean time: first step %.4f s, walks %.4f s (se %.4f)\n", p.mean_time,
-		              mean, se);
-		assert_true(se > 0);
-		assert_double_equal(mean, p.mean_time, 4.5 * se);
+		walks_agree(&s, &set, &p, 40000);
 		bsim_markov_prediction_free(&p);
 		bsim_markov_set_free(&set);
 	}
@@ -725,27 +733,8 @@ static void test_after_start_against_simulation(void **state)
 				for (int t = 0; t < m->start_trials; t++)
 					assert_int_equal(x->exit[t] >= 0, m->hold_exit[t] > 0);
 			}
-			/* the walks take the same first two gates: their outcomes are
-			 * the chain's p, their mean time its first-step mean, within
-			 * 4.5 of the walks' standard errors */
-			const long W = 20000;
-			assert_int_equal(bsim_markov_predict_time(&s, &set, W, 3, &p, &err),
-			                 BSIM_OK);
-			double mean = 0.0, m2 = 0.0;
-			for (int k = 0; k < 3; k++) {
-				mean += p.p_by[k] * p.t_mean[k];
-				m2 += p.p_by[k] *
-				      (p.t_sd[k] * p.t_sd[k] + p.t_mean[k] * p.t_mean[k]);
-				double tot = 0.0;
-				for (int i = 0; i < p.n_locations; i++)
-					tot += (int)p.loc[i].kind == k ? p.p[i] : 0.0;
-				assert_double_equal(p.p_by[k], tot,
-				                    4.5 * sqrt(tot * (1 - tot) / W) + 1e-12);
-			}
-			const double se = sqrt((m2 - mean * mean) / W);
-			print_message("mean time: first step %.3f s, walks %.3f s (se %.3f)\n",
-			              p.mean_time, mean, se);
-			assert_double_equal(mean, p.mean_time, 4.5 * se);
+			/* the walks take the same first two gates */
+			walks_agree(&s, &set, &p, 20000);
 			/* read back: the same prediction */
 			bsim_markov_set again;
 			bsim_options opts = {0};
