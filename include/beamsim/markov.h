@@ -244,8 +244,8 @@ typedef struct bsim_markov_next {
 	int start, gate;
 	int trials; /* the start map's start trials */
 	int *exit, *steps;
-	double seconds, cost; /* as bsim_markov_map's */
-	long long steps_total;
+	double seconds, cost;          /* as bsim_markov_map's */
+	long long steps_total;         /* single-gate time steps, as bsim_markov_map's steps */
 	int cached, copied, elsewhere; /* as bsim_markov_map's */
 } bsim_markov_next;
 
