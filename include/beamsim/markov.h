@@ -134,7 +134,7 @@ typedef struct bsim_markov_def {
 	 * from the start on. Only with states uniform in each bin or observed
 	 * entries (self and flow entries: 0). */
 	int after_start;
-	bsim_progress_fn progress;          /* may be NULL; counts single-gate trials */
+	bsim_progress_fn progress; /* may be NULL; counts single-gate trials */
 	void *progress_user;
 	/* May be NULL. When *stop becomes nonzero (a signal handler sets it),
 	 * no further single gate starts, the map under way is dropped, the
@@ -391,17 +391,17 @@ BSIM_API bsim_markov_build_def bsim_markov_build_def_default(void);
 
 typedef struct bsim_markov_build_result {
 	int n_groups;
-	int n_maps;              /* every group's, in order (a map may serve two groups) */
-	bsim_markov_built *maps; /* n_maps */
-	int built, reused;       /* maps simulated now, maps read from the cache */
+	int n_maps;                  /* every group's, in order (a map may serve two groups) */
+	bsim_markov_built *maps;     /* n_maps */
+	int built, reused;           /* maps simulated now, maps read from the cache */
 	int next_built, next_reused; /* the gates after the start (map.after_start), likewise */
-	int copied;              /* maps read from the parts' directories (a merge) */
-	double seconds;          /* CPU time of the simulation of those built, s */
-	int pass;                /* a round's (or its merge's): the pass made; else
-	                          * map.self_passes */
-	int round;               /* 1: one pass of flow entries (a part's or a merge's) */
-	int n_bins;              /* entry bins of a map, the start's included */
-	char run[17];            /* the build's name (bsim_markov_run_id) */
+	int copied;                  /* maps read from the parts' directories (a merge) */
+	double seconds;              /* CPU time of the simulation of those built, s */
+	int pass;                    /* a round's (or its merge's): the pass made; else
+	                              * map.self_passes */
+	int round;                   /* 1: one pass of flow entries (a part's or a merge's) */
+	int n_bins;                  /* entry bins of a map, the start's included */
+	char run[17];                /* the build's name (bsim_markov_run_id) */
 } bsim_markov_build_result;
 
 /* Builds the maps of every group of def->experiment into def->out.
