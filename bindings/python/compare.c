@@ -38,10 +38,6 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 	                                 &sides_o, &trials, &threads, &seed_o, &sets_o, &grid_o,
 	                                 &progress_o, &resume, &overwrite))
 		return NULL;
-	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
-		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
-		return NULL;
-	}
 	bsim_compare_dir_def def = bsim_compare_dir_def_default();
 	bsim_error err;
 	/* sides None: the registry's default ones (bsim_compare_dir_def_default) */
@@ -77,37 +73,23 @@ PyObject *pyb_compare(PyObject *self, PyObject *args, PyObject *kw)
 		}
 	}
 	Py_XDECREF(sides);
-	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
+	pyb_run_inputs in;
+	if (pyb_run_inputs_from(seed_o, sets_o, grid_o, progress_o, &in))
 		return NULL;
-	pyb_sets sets;
-	pyb_grid grid;
-	if (pyb_sets_grid_from(sets_o, grid_o, &sets, &grid))
-		return NULL;
-	pyb_progress progress;
-	pyb_progress_init(&progress, progress_o);
+	PYB_RUN_INPUTS_SET(def, in);
 	def.experiment = experiment;
 	def.out = out;
-	def.sets = sets.ov;
-	def.n_sets = sets.n;
-	def.grid = grid.axes;
-	def.n_grid = grid.n;
 	def.trials = trials;
 	def.threads = threads;
 	def.resume = resume;
 	def.overwrite = overwrite;
-	def.resume_option = "resume=True";
-	def.overwrite_option = "overwrite=True";
-	def.progress = pyb_progress_update;
-	def.progress_user = &progress;
-	def.stop = &progress.stop;
 	bsim_compare_dir_result res;
 	int rc;
 	Py_BEGIN_ALLOW_THREADS;
 	rc = bsim_compare_dir_run(&def, &res, &err);
 	Py_END_ALLOW_THREADS;
-	pyb_sets_free(&sets);
-	pyb_grid_free(&grid);
-	if (!pyb_progress_end(&progress, rc, &err)) {
+	pyb_run_inputs_free(&in);
+	if (!pyb_progress_end(&in.progress, rc, &err)) {
 		if (rc == BSIM_OK)
 			bsim_compare_dir_result_free(&res);
 		return NULL;

@@ -82,10 +82,6 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 	                                 &backend_spec, &sets_o, &grid_o, &opts_o, &progress_o,
 	                                 &start_trials, &after_start))
 		return NULL;
-	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
-		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
-		return NULL;
-	}
 	bsim_markov_build_def def = bsim_markov_build_def_default();
 	if (bins_o != Py_None && !PyArg_ParseTuple(bins_o, "iii", &def.map.bins.n_pos,
 	                                           &def.map.bins.n_speed, &def.map.bins.n_dir))
@@ -99,8 +95,6 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 		return NULL;
 	def.map.opts = &opts;
 	def.map.threads = threads;
-	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
-		return NULL;
 	const char **paths;
 	if (entries_from(entries_o, &def.map, &paths, &def.n_entries))
 		return NULL;
@@ -109,33 +103,26 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 	if (after_start >= 0) /* -1: the default (self and flow entries: 0) */
 		def.map.after_start = after_start;
 	def.entries = paths;
-	pyb_sets sets;
-	pyb_grid grid;
-	if (pyb_sets_grid_from(sets_o, grid_o, &sets, &grid)) {
+	pyb_run_inputs in;
+	if (pyb_run_inputs_from(seed_o, sets_o, grid_o, progress_o, &in)) {
 		free(paths);
 		return NULL;
 	}
-	pyb_progress progress;
-	pyb_progress_init(&progress, progress_o);
+	PYB_RUN_INPUTS_SET_SCENES(def, in);
 	def.experiment = experiment;
 	def.out = out;
-	def.sets = sets.ov;
-	def.n_sets = sets.n;
-	def.grid = grid.axes;
-	def.n_grid = grid.n;
 	def.map.progress = pyb_progress_update;
-	def.map.progress_user = &progress;
-	def.map.stop = &progress.stop;
+	def.map.progress_user = &in.progress;
+	def.map.stop = &in.progress.stop;
 	bsim_markov_build_result res;
 	bsim_error err;
 	int rc;
 	Py_BEGIN_ALLOW_THREADS;
 	rc = bsim_markov_build_run(&def, &res, &err);
 	Py_END_ALLOW_THREADS;
-	pyb_sets_free(&sets);
-	pyb_grid_free(&grid);
+	pyb_run_inputs_free(&in);
 	free(paths);
-	if (!pyb_progress_end(&progress, rc, &err)) {
+	if (!pyb_progress_end(&in.progress, rc, &err)) {
 		if (rc == BSIM_OK)
 			bsim_markov_build_result_free(&res);
 		return NULL;
@@ -240,46 +227,28 @@ PyObject *pyb_markov_validate(PyObject *self, PyObject *args, PyObject *kw)
 	                                 &trials, &seed_o, &threads, &sets_o, &grid_o, &bootstrap,
 	                                 &progress_o, &resume, &overwrite))
 		return NULL;
-	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
-		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
-		return NULL;
-	}
 	bsim_markov_validate_def def = bsim_markov_validate_def_default();
-	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
+	pyb_run_inputs in;
+	if (pyb_run_inputs_from(seed_o, sets_o, grid_o, progress_o, &in))
 		return NULL;
-	pyb_sets sets;
-	pyb_grid grid;
-	if (pyb_sets_grid_from(sets_o, grid_o, &sets, &grid))
-		return NULL;
-	pyb_progress progress;
-	pyb_progress_init(&progress, progress_o);
+	PYB_RUN_INPUTS_SET(def, in);
 	def.experiment = experiment;
 	def.map_dir = map;
 	def.out = out;
-	def.sets = sets.ov;
-	def.n_sets = sets.n;
-	def.grid = grid.axes;
-	def.n_grid = grid.n;
 	def.trials = trials;
 	def.threads = threads;
 	if (bootstrap >= 0)
 		def.bootstrap = bootstrap;
 	def.resume = resume;
 	def.overwrite = overwrite;
-	def.resume_option = "resume=True";
-	def.overwrite_option = "overwrite=True";
-	def.progress = pyb_progress_update;
-	def.progress_user = &progress;
-	def.stop = &progress.stop;
 	bsim_markov_validation v;
 	bsim_error err;
 	int rc;
 	Py_BEGIN_ALLOW_THREADS;
 	rc = bsim_markov_validate(&def, &v, &err);
 	Py_END_ALLOW_THREADS;
-	pyb_sets_free(&sets);
-	pyb_grid_free(&grid);
-	if (!pyb_progress_end(&progress, rc, &err)) {
+	pyb_run_inputs_free(&in);
+	if (!pyb_progress_end(&in.progress, rc, &err)) {
 		if (rc == BSIM_OK)
 			bsim_markov_validation_free(&v);
 		return NULL;

@@ -334,6 +334,27 @@ void pyb_progress_init(pyb_progress *p, PyObject *fn)
 	p->last = now();
 }
 
+int pyb_run_inputs_from(PyObject *seed_o, PyObject *sets_o, PyObject *grid_o, PyObject *progress_o,
+                        pyb_run_inputs *in)
+{
+	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
+		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
+		return -1;
+	}
+	in->has_seed = 0;
+	if (pyb_seed_from(seed_o, &in->has_seed, &in->seed) ||
+	    pyb_sets_grid_from(sets_o, grid_o, &in->sets, &in->grid))
+		return -1;
+	pyb_progress_init(&in->progress, progress_o);
+	return 0;
+}
+
+void pyb_run_inputs_free(pyb_run_inputs *in)
+{
+	pyb_sets_free(&in->sets);
+	pyb_grid_free(&in->grid);
+}
+
 void pyb_progress_update(void *user, long done, long total)
 {
 	pyb_progress *p = user;

@@ -127,4 +127,46 @@ void pyb_progress_update(void *user, long done, long total);
  * Py_None (borrowed, a non-NULL marker). */
 PyObject *pyb_progress_end(pyb_progress *p, int rc, const bsim_error *err);
 
+/* What the runs of an experiment (sweep, compare, markov_build and
+ * markov_validate) take alike: the seed, set=, grid= and the progress
+ * callable. */
+typedef struct pyb_run_inputs {
+	int has_seed;
+	uint64_t seed;
+	pyb_sets sets;
+	pyb_grid grid;
+	pyb_progress progress;
+} pyb_run_inputs;
+/* progress_o checked to be None or a callable, then the seed, sets and
+ * grid read: 0, or -1 with a Python exception and nothing held. */
+int pyb_run_inputs_from(PyObject *seed_o, PyObject *sets_o, PyObject *grid_o, PyObject *progress_o,
+                        pyb_run_inputs *in);
+/* Frees the sets and grid (after the run). */
+void pyb_run_inputs_free(pyb_run_inputs *in);
+/* Sets a run's def's seed (where one was given), sets and grid from in:
+ * fields the defs of sweep, compare, markov build and validate name
+ * alike (in outlives the run). */
+#define PYB_RUN_INPUTS_SET_SCENES(def, in)                                                         \
+	do {                                                                                       \
+		if ((in).has_seed) {                                                               \
+			(def).has_seed = 1;                                                        \
+			(def).seed = (in).seed;                                                    \
+		}                                                                                  \
+		(def).sets = (in).sets.ov;                                                         \
+		(def).n_sets = (in).sets.n;                                                        \
+		(def).grid = (in).grid.axes;                                                       \
+		(def).n_grid = (in).grid.n;                                                        \
+	} while (0)
+/* The same and the progress and the names of resume and overwrite, as
+ * sweep's, compare's and markov validate's defs have them. */
+#define PYB_RUN_INPUTS_SET(def, in)                                                                \
+	do {                                                                                       \
+		PYB_RUN_INPUTS_SET_SCENES(def, in);                                                \
+		(def).resume_option = "resume=True";                                               \
+		(def).overwrite_option = "overwrite=True";                                         \
+		(def).progress = pyb_progress_update;                                              \
+		(def).progress_user = &(in).progress;                                              \
+		(def).stop = &(in).progress.stop;                                                  \
+	} while (0)
+
 #endif

@@ -26,48 +26,30 @@ PyObject *pyb_sweep(PyObject *self, PyObject *args, PyObject *kw)
 	                                 &grid_o, &opts_o, &progress_o, &keep, &resume, &overwrite,
 	                                 &hold))
 		return NULL;
-	if (progress_o != Py_None && !PyCallable_Check(progress_o)) {
-		PyErr_SetString(PyExc_TypeError, "progress: expected a callable(done, total)");
-		return NULL;
-	}
 	bsim_sweep_dir_def def = bsim_sweep_dir_def_default();
 	if (!(def.backend = pyb_backend(backend_spec, opts_o, &def.opts)))
 		return NULL;
-	if (pyb_seed_from(seed_o, &def.has_seed, &def.seed))
+	pyb_run_inputs in;
+	if (pyb_run_inputs_from(seed_o, sets_o, grid_o, progress_o, &in))
 		return NULL;
-	pyb_sets sets;
-	pyb_grid grid;
-	if (pyb_sets_grid_from(sets_o, grid_o, &sets, &grid))
-		return NULL;
-	pyb_progress progress;
-	pyb_progress_init(&progress, progress_o);
+	PYB_RUN_INPUTS_SET(def, in);
 	def.experiment = experiment;
 	def.out = out;
-	def.sets = sets.ov;
-	def.n_sets = sets.n;
-	def.grid = grid.axes;
-	def.n_grid = grid.n;
 	def.trials = trials;
 	def.threads = threads;
 	def.keep = (int)keep;
 	def.resume = resume;
 	def.overwrite = overwrite;
-	def.resume_option = "resume=True";
-	def.overwrite_option = "overwrite=True";
 	def.hold_cell_bytes = hold;
-	def.progress = pyb_progress_update;
-	def.progress_user = &progress;
-	def.stop = &progress.stop;
 	bsim_sweep_dir_result res;
 	bsim_error err;
 	int rc;
 	Py_BEGIN_ALLOW_THREADS;
 	rc = bsim_sweep_dir_run(&def, &res, &err);
 	Py_END_ALLOW_THREADS;
-	pyb_sets_free(&sets);
-	pyb_grid_free(&grid);
+	pyb_run_inputs_free(&in);
 	PyObject *d = NULL;
-	if (!pyb_progress_end(&progress, rc, &err)) {
+	if (!pyb_progress_end(&in.progress, rc, &err)) {
 		if (rc == BSIM_OK)
 			bsim_sweep_dir_result_free(&res);
 		return NULL;
