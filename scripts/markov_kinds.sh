@@ -12,8 +12,9 @@
 # chosen on; test_* were made after the bins and trials were fixed, fresh_*
 # after the gate after the start was. Prints one row per method and field;
 # the runs stay in OUT (default out/markov-kinds), the table in
-# OUT/table.txt. FIELDS="..." chooses the fields, TRIALS=N the direct
-# trials of each (default the experiments', 10,000).
+# OUT/table.txt. FIELDS="..." chooses the fields, METHODS="..." the methods
+# (by name), TRIALS=N the direct trials of each (default the experiments',
+# 10,000).
 #   scripts/markov_kinds.sh [OUT] [THREADS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,14 +24,24 @@ exe=build/beamsim
 fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13 fresh_cols9 fresh_r21})
 # method name and its build options (the default: none); each of the
 # default's three parts (fine bins, many start trials, the gate after the
-# start) alone and without the others
+# start) alone and without the others; flow:1; self:1 at the default bins;
+# the default at finer bins
 methods=("default:"
          "without-after-start:--after-start 0"
          "fine-bins-alone:--start-trials 50 --after-start 0"
          "start-trials-alone:--bins 4,4,3 --trials 200 --after-start 0"
          "after-start-alone:--bins 4,4,3 --trials 200 --start-trials 200"
          "previous-default:--bins 4,4,3 --trials 200 --start-trials 200 --after-start 0"
-         "flow1:--bins 4,4,3 --trials 200 --entries flow:1")
+         "flow1:--bins 4,4,3 --trials 200 --entries flow:1"
+         "self1:--entries self:1"
+         "bins14613:--bins 14,6,13")
+if [ -n "${METHODS:-}" ]; then
+    chosen=()
+    for m in "${methods[@]}"; do
+        for want in $METHODS; do [ "${m%%:*}" = "$want" ] && chosen+=("$m"); done
+    done
+    methods=("${chosen[@]}")
+fi
 mkdir -p "$out"
 # TV of prediction.csv ($1) against validate.csv's p_sim ($2) for protocol $3
 tv() {

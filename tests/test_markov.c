@@ -910,14 +910,18 @@ static void test_threads_and_cache(void **state)
 	free(t1);
 	free(t2);
 
-	/* The same again: both maps reused. */
-	char *out = NULL;
+	/* The same again: both maps reused, and a note that these bins and
+	 * start trials are coarser than the default method's. */
+	char *out = NULL, *note = NULL;
 	const char *again[] = {"markov", "build",    exp, "--bins", "4,4,3", "--start-trials",
 	                       "3",      "--trials", "3", "--out",  d1,      NULL};
-	assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
+	assert_int_equal(bsim_test_cli(again, &out, &note), 0);
 	assert_non_null(strstr(out, "0 maps built"));
 	assert_non_null(strstr(out, "2 reused"));
+	assert_non_null(strstr(note, "note: maps with 4,4,3 bins (the default 8,8,9), 3 start "
+	                             "trials (the default 4000): measured less accurate"));
 	free(out);
+	free(note);
 	/* Anything the maps depend on: new maps, none reused. */
 	const char *changes[][4] = {{"--trials", "3", "--set", "contact.restitution=0.7"},
 	                            {"--trials", "3", "--set", "lattice.beam.damping=40"},
@@ -1733,6 +1737,49 @@ static void test_flow_entries(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The note on a method's scope names what keeps it from the maps of a
+ * physics, and nothing for the default method or finer settings. */
+static void test_scope(void **state)
+{
+	(void)state;
+	char buf[320];
+	const bsim_markov_def d0 = bsim_markov_def_default();
+	assert_string_equal(bsim_markov_def_scope(&d0, buf, sizeof buf), "");
+	bsim_markov_def d = d0;
+	d.bins.n_pos = 14;
+	d.bins.n_speed = 6;
+	d.bins.n_dir = 13; /* more bins, not fewer */
+	d.start_trials = 8000;
+	d.trials = 20; /* the maps' sampling error, which validate reports */
+	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf), "");
+	d = d0;
+	d.after_start = 0;
+	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf),
+	                    "maps with no gate after the start: measured less accurate than the "
+	                    "default's on layouts they were not built on (docs/markov.md, "
+	                    "\"What each part does\")");
+	d.start_trials = 50;
+	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
+	                       "maps with 50 start trials (the default 4000), no gate after the "
+	                       "start: "));
+	d = d0;
+	int is_kind;
+	bsim_error err;
+	assert_int_equal(bsim_markov_entries_kind("flow:2", &d, &is_kind, &err), BSIM_OK);
+	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf), "layout only"));
+	d = d0;
+	assert_int_equal(bsim_markov_entries_kind("self", &d, &is_kind, &err), BSIM_OK);
+	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
+	                       "self-consistent entries: measured above TV 0.05"));
+	d = d0;
+	snprintf(d.entries_id, sizeof d.entries_id, "0123abcd 20");
+	assert_non_null(
+	        strstr(bsim_markov_def_scope(&d, buf, sizeof buf), "entries observed in sweeps"));
+	/* cut short, never past the buffer */
+	char small[8];
+	assert_string_equal(bsim_markov_def_scope(&d, small, sizeof small), "entries");
+}
+
 /* A build stopped by SIGINT or SIGTERM once its first map is committed
  * (the manifest appears with it) exits 128 + the signal, keeping that map;
  * one killed (SIGKILL) keeps it too; the same command then builds only the
@@ -1798,6 +1845,7 @@ int main(void)
 	        cmocka_unit_test(test_two_gates_geometric),
 	        cmocka_unit_test(test_time_by_hand),
 	        cmocka_unit_test(test_bins),
+	        cmocka_unit_test(test_scope),
 	        cmocka_unit_test(test_conservation),
 	        cmocka_unit_test(test_tolerance),
 	        cmocka_unit_test(test_sweeps_against_series),

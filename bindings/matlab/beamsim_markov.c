@@ -177,6 +177,7 @@ static mxArray *build_struct(const bsim_markov_build_result *r, int trials)
 	bmx_set(s, 0, "bins", bmx_scalar(r->n_bins));
 	bmx_set(s, 0, "trials", bmx_scalar(trials));
 	bmx_set(s, 0, "run", bmx_string(r->run));
+	bmx_set(s, 0, "scope", bmx_string(r->scope));
 	return s;
 }
 

@@ -30,7 +30,9 @@
 %                    as for BEAMSIM_SWEEP
 %   B.maps is a struct array, one map each: group (from 1), k ([left
 %   right], N m/rad), key (its files' name), how ('built' or 'reused');
-%   B.built, B.reused, B.cpu_seconds, B.bins, B.trials, B.run.
+%   B.built, B.reused, B.cpu_seconds, B.bins, B.trials, B.run, B.scope
+%   (where maps of this method were measured to fall short on layouts
+%   they were not built on; '' for the default method).
 %
 %   predict's names:
 %     'map'          the map directory (required)

@@ -136,10 +136,10 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 			PyList_SET_ITEM(maps, i, m);
 	}
 	if (maps)
-		d = Py_BuildValue("{sNsisisisdsisisssi}", "maps", maps, "built", res.built,
+		d = Py_BuildValue("{sNsisisisdsisisssiss}", "maps", maps, "built", res.built,
 		                  "reused", res.reused, "groups", res.n_groups, "cpu_seconds",
 		                  res.seconds, "bins", res.n_bins, "trials", def.map.trials, "run",
-		                  res.run, "pass", res.pass);
+		                  res.run, "pass", res.pass, "scope", res.scope);
 	bsim_markov_build_result_free(&res);
 	return d;
 }

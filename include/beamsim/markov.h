@@ -386,6 +386,17 @@ typedef struct bsim_markov_build_def {
 BSIM_API int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, int *is_kind,
                                       bsim_error *err);
 
+/* Where maps of def were measured to fall short on layouts they were not
+ * built on, one sentence into buf, or "" for maps of the method measured
+ * to hold for any layout: states uniform in bins at least as many as the
+ * default's, the default's start trials or more and the gate after the
+ * start (docs/markov.md, "Maps of a physics"). Flow entries: maps of one
+ * layout; self-consistent entries, entries observed in sweeps, and the
+ * default method with coarser bins, fewer start trials or no gate after
+ * the start: each measured less accurate there. buf of 320 bytes holds
+ * any. markov build prints it as a note. */
+BSIM_API const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t size);
+
 /* bsim_markov_def_default() as map, one process, no entries. */
 BSIM_API bsim_markov_build_def bsim_markov_build_def_default(void);
 
@@ -402,6 +413,7 @@ typedef struct bsim_markov_build_result {
 	int round;                   /* 1: one pass of flow entries (a part's or a merge's) */
 	int n_bins;                  /* entry bins of a map, the start's included */
 	char run[17];                /* the build's name (bsim_markov_run_id) */
+	char scope[320];             /* bsim_markov_def_scope of the maps' method */
 } bsim_markov_build_result;
 
 /* Builds the maps of every group of def->experiment into def->out.

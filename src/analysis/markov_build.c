@@ -194,6 +194,7 @@ int bsim_markov_build_run(const bsim_markov_build_def *def, bsim_markov_build_re
 			return rc;
 		md.entries = &entries;
 	}
+	bsim_markov_def_scope(&md, res->scope, sizeof res->scope);
 	/* the experiment's trials are not the maps' (map.trials per bin) */
 	bsim_experiment e;
 	rc = bsim_experiment_load_seeded(def->experiment, def->sets, def->n_sets, def->grid,

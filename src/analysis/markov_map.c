@@ -141,6 +141,52 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 	return BSIM_OK;
 }
 
+const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t size)
+{
+	static const char *const each_part = "docs/markov.md, \"What each part does\"";
+	const bsim_markov_def d0 = bsim_markov_def_default();
+	if (def->self_entries == 2) {
+		snprintf(buf, size,
+		         "flow-weighted entries: these maps hold for this lattice's layout only "
+		         "(its hash is in their keys)");
+		return buf;
+	}
+	if (def->self_entries == 1) {
+		snprintf(buf, size,
+		         "self-consistent entries: measured above TV 0.05 on layouts the maps were "
+		         "not built on (%s)",
+		         each_part);
+		return buf;
+	}
+	if (def->entries || def->entries_id[0]) {
+		snprintf(buf, size,
+		         "entries observed in sweeps: a bin's states are those of the sweeps' "
+		         "layouts (TV 0.054 on a field they did not come from; docs/markov.md, "
+		         "\"Accuracy\")");
+		return buf;
+	}
+	/* The default method's three parts, each measured without the others. */
+	char bins[64] = "", start[64] = "";
+	if (bsim_markov_bins_count(&def->bins) < bsim_markov_bins_count(&d0.bins))
+		snprintf(bins, sizeof bins, "%d,%d,%d bins (the default %d,%d,%d)", def->bins.n_pos,
+		         def->bins.n_speed, def->bins.n_dir, d0.bins.n_pos, d0.bins.n_speed,
+		         d0.bins.n_dir);
+	if (bsim_markov_def_start_trials(def) < d0.start_trials)
+		snprintf(start, sizeof start, "%d start trials (the default %d)",
+		         bsim_markov_def_start_trials(def), d0.start_trials);
+	const char *next = def->after_start ? "" : "no gate after the start";
+	if (!bins[0] && !start[0] && !next[0]) {
+		snprintf(buf, size, "%s", "");
+		return buf;
+	}
+	snprintf(buf, size,
+	         "maps with %s%s%s%s%s: measured less accurate than the default's on layouts "
+	         "they were not built on (%s)",
+	         bins, bins[0] && (start[0] || next[0]) ? ", " : "", start,
+	         start[0] && next[0] ? ", " : "", next, each_part);
+	return buf;
+}
+
 void bsim_markov_set_free(bsim_markov_set *s)
 {
 	if (!s)

@@ -613,6 +613,8 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 	}
 	if (rc == BSIM_OK && !c.quiet)
 		build_print(&def, &res, c.out);
+	if (rc == BSIM_OK && res.scope[0]) /* quiet too: it is about the maps, not progress */
+		cli_error("note: %s", res.scope);
 	if (rc == BSIM_OK)
 		bsim_markov_build_result_free(&res);
 	cli_common_free(&c);

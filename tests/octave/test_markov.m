@@ -58,6 +58,8 @@ check(isequal(n1, n2) && isequal(t1, t2), 'the maps differ from the program''s: 
       strjoin(n1, ' '), strjoin(n2, ' '));
 check(any(~cellfun(@isempty, strfind(n1, '.after_'))), 'no gate after the start in %s', ...
       strjoin(n1, ' '));
+check(strncmp(b.scope, 'maps with 2,2,1 bins', 20) && ~isempty(strfind(err, ['note: ' b.scope])), ...
+      'the scope ''%s'' is not the program''s note: %s', b.scope, err);
 % 'after_start', 0 as --after-start 0: no gate after the start
 mine0 = fullfile(tmp, 'maps_mex_after0');
 theirs0 = fullfile(tmp, 'maps_program_after0');

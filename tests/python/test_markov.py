@@ -56,8 +56,11 @@ def maps(tmp_path_factory):
 def test_build_is_the_programs(maps):
     built, py, prog, _ = maps
     # the maps the program lists, each with its key, in order
-    lines = cli("markov", "build", EXPERIMENT, *SMALL_ARGS, "--seed", "5", "--out",
-                prog).stdout.splitlines()
+    run = cli("markov", "build", EXPERIMENT, *SMALL_ARGS, "--seed", "5", "--out", prog)
+    lines = run.stdout.splitlines()
+    # the program's note on these coarse bins and few start trials
+    assert built["scope"].startswith("maps with 2,2,1 bins (the default 8,8,9), 7 start")
+    assert f"note: {built['scope']}" in run.stderr
     listed = [line.split()[-2] for line in lines if line.startswith("group ")]
     assert [m["key"] for m in built["maps"]] == listed
     assert built["built"] == len(built["maps"]) and built["reused"] == 0

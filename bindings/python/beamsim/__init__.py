@@ -485,7 +485,9 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
     (left, right, N m/rad), "key" (its files' name, map_HASH), "how"
     ("built" or "reused"), "pass"}), "built", "reused", "groups",
     "cpu_seconds" (of the maps built now), "bins" (entry bins a map, the
-    start's included), "trials", "run" and "out"."""
+    start's included), "trials", "run", "out" and "scope" (where maps of
+    this method were measured to fall short on layouts they were not
+    built on; "" for the default method)."""
     if vmax is not None and not (vmax > 0 and math.isfinite(vmax)):
         raise ValueError(f"--vmax {vmax}: expected a speed > 0 in m/s")
     if bins is not None:
