@@ -1085,7 +1085,14 @@ static void test_field_figures(void **state)
 	int rc = bsim_test_cli(val, NULL, &err);
 	if (rc != 0)
 		fail_msg("validate: exit %d: %s", rc, err ? err : "");
+	/* the maps' method named, as the build named it, and in validate.json */
+	assert_non_null(strstr(err, "note: maps with 4,4,3 bins (the default 8,8,9), 10 start"));
 	free(err);
+	snprintf(path, sizeof path, "%s/validate.json", vdir);
+	char *vjson = bsim_test_read(path);
+	assert_non_null(vjson);
+	assert_non_null(strstr(vjson, "\"maps_scope\": \"maps with 4,4,3 bins"));
+	free(vjson);
 	assert_int_equal(bsim_test_check_figures(pdir), 2); /* prediction and time */
 	assert_int_equal(bsim_test_check_figures(vdir), 1);
 
@@ -1771,7 +1778,12 @@ static void test_scope(void **state)
 	assert_int_equal(bsim_markov_entries_kind("self", &d, &is_kind, &err), BSIM_OK);
 	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
 	                       "self-consistent entries: measured above TV 0.05"));
+	/* as markov.json gives them back */
 	d = d0;
+	snprintf(d.entries_id, sizeof d.entries_id, "flow 1");
+	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf), "layout only"));
+	snprintf(d.entries_id, sizeof d.entries_id, "self 2");
+	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf), "self-consistent"));
 	snprintf(d.entries_id, sizeof d.entries_id, "0123abcd 20");
 	assert_non_null(
 	        strstr(bsim_markov_def_scope(&d, buf, sizeof buf), "entries observed in sweeps"));

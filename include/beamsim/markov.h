@@ -672,6 +672,7 @@ typedef struct bsim_markov_validation {
 	double map_cost;           /* s of CPU the maps took to build (every pass) */
 	long long map_steps;       /* single-gate steps those builds took */
 	int bins, trials_per_bin;
+	char scope[320]; /* bsim_markov_def_scope of the maps' method ("" the default) */
 	/* When the run stopped or failed after finishing trials: the journal
 	 * that resume continues from ("" otherwise). */
 	char journal[BSIM_PATH_MAX];

@@ -145,20 +145,22 @@ const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t 
 {
 	static const char *const each_part = "docs/markov.md, \"What each part does\"";
 	const bsim_markov_def d0 = bsim_markov_def_default();
-	if (def->self_entries == 2) {
+	/* a def read back from markov.json names its entries in entries_id */
+	const char *id = def->entries_id;
+	if (def->self_entries == 2 || strncmp(id, "flow ", 5) == 0) {
 		snprintf(buf, size,
 		         "flow-weighted entries: these maps hold for this lattice's layout only "
 		         "(its hash is in their keys)");
 		return buf;
 	}
-	if (def->self_entries == 1) {
+	if (def->self_entries == 1 || strncmp(id, "self ", 5) == 0) {
 		snprintf(buf, size,
 		         "self-consistent entries: measured above TV 0.05 on layouts the maps were "
 		         "not built on (%s)",
 		         each_part);
 		return buf;
 	}
-	if (def->entries || def->entries_id[0]) {
+	if (def->entries || id[0]) {
 		snprintf(buf, size,
 		         "entries observed in sweeps: a bin's states are those of the sweeps' "
 		         "layouts (TV 0.054 on a field they did not come from; docs/markov.md, "

@@ -314,7 +314,8 @@ static int write_json(const char *stage, const bsim_markov_validate_def *def,
 	fprintf(f, ", \"entry_bins\": %d, \"trials_per_bin\": %d, \"map_cpu_seconds\": ", v->bins,
 	        v->trials_per_bin);
 	bsim_json_number(f, v->map_cost);
-	fprintf(f, ", \"map_steps\": %lld", v->map_steps);
+	fprintf(f, ", \"map_steps\": %lld, \"maps_scope\": ", v->map_steps);
+	bsim_json_string(f, v->scope);
 	fputs(", \"checks\": [", f);
 	for (int i = 0; i < v->n; i++) {
 		const bsim_markov_check *c = &v->checks[i];
@@ -456,6 +457,7 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 		free(idx);
 		v->bins = set.n ? set.maps[0].n_bins : 0;
 		v->trials_per_bin = set.def.trials;
+		bsim_markov_def_scope(&set.def, v->scope, sizeof v->scope);
 		for (int i = 0; i < set.n; i++) {
 			v->map_cost += set.maps[i].cost;
 			v->map_steps += set.maps[i].steps;

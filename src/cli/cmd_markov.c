@@ -799,6 +799,8 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 		cli_common_free(&c);
 		return rc;
 	}
+	if (rc == BSIM_OK && v.scope[0])
+		cli_error("note: %s", v.scope);
 	if (rc == BSIM_OK && !c.quiet) {
 		printf("maps        %s: %d entry bins x %d trials, %.1f s of CPU to build "
 		       "(%lld single-gate steps)\n\n",

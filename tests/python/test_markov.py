@@ -127,6 +127,7 @@ def test_validate_is_the_programs(maps):
     del want["map_dir"], got["map_dir"]
     assert untimed({k: got[k] for k in want}) == untimed(want)
     assert [c["protocol"] for c in got["checks"]] == ["essay", "world"]
+    assert got["maps_scope"].startswith("maps with 2,2,1 bins (the default 8,8,9)")
     with open(tmp / "val_prog" / "validate.csv", "rb") as f:
         assert (tmp / "val_py" / "validate.csv").read_bytes() == f.read()
     assert list(got["files"]["validate"]["p_sim"]) == list(

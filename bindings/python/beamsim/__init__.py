@@ -564,7 +564,7 @@ def markov_validate(experiment, map, out=None, trials=None, seed=None, threads=N
     tv_sampling95, tv_map, gates_sim, gates_chain, sim_cpu_seconds,
     predict_cpu_seconds, speedup, break_even_lattices, states, exact and,
     with the maps' holding times, "time"; "map_cpu_seconds", "entry_bins",
-    "trials_per_bin", ...) with "files" (the directory's files as load
+    "trials_per_bin", "maps_scope", ...) with "files" (the directory's files as load
     reads them: "validate" (validate.csv), "gates", "time_validate", ...)
     and "out"."""
     _no_nul("experiment", experiment)
