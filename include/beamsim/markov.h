@@ -17,8 +17,9 @@
  * with a fresh random-force schedule, and run until the body leaves the
  * gate's rectangle or gate_steps steps pass. The exit state is binned as
  * the entry state of the gate it enters, so a map is a matrix of counts
- * counts[entry][exit], exit 0 being "stuck". One map per pair of beam
- * stiffnesses (left, right) the lattice uses.
+ * from entry to exit bin, exit 0 being "stuck", kept by row (each row's
+ * nonzero exits, at most its trials: bsim_markov_map). One map per pair
+ * of beam stiffnesses (left, right) the lattice uses.
  *
  * The chain. The transient states are (gate, entry bin); the absorbing ones
  * the final locations of docs/model.md section 8: the end through column ix
@@ -80,14 +81,15 @@ BSIM_API bsim_markov_bins bsim_markov_bins_default(void);
 /* The number of entry bins, the start's included: 1 + 4 n_pos n_speed n_dir. */
 BSIM_API int bsim_markov_bins_count(const bsim_markov_bins *b);
 
-/* The most cells (entry bin x exit bin counts) a map may hold. */
-#define BSIM_MARKOV_MAX_CELLS 20000000L
+/* The most single gates a map may hold: every entry bin's trials, the
+ * start's included (its counts and holding times are indexed by them). */
+#define BSIM_MARKOV_MAX_UNITS 2147483647L
 
-/* BSIM_OK if the bins make a map that may be built: 1 to 64 positions,
- * speeds and directions, and at most BSIM_MARKOV_MAX_CELLS cells
- * (bsim_markov_bins_count squared); else BSIM_EINPUT saying what is wrong
- * and what is accepted (n_pos n_speed n_dir at most 1117). v_max is not
- * checked. */
+/* BSIM_OK if the bins are 1 to 64 positions, speeds and directions; else
+ * BSIM_EINPUT saying what is wrong and what is accepted. A map keeps its
+ * counts by row (bsim_markov_map), so its size grows as its bins times
+ * its trials, which BSIM_MARKOV_MAX_UNITS bounds where the map is built.
+ * v_max is not checked. */
 BSIM_API int bsim_markov_bins_check(const bsim_markov_bins *b, bsim_error *err);
 
 /* Gate entries observed in simulation (gate_entries.csv of lattice sweeps,
@@ -215,13 +217,20 @@ typedef struct bsim_markov_map {
 	int n_bins;       /* bsim_markov_bins_count */
 	int trials;       /* per entry bin, but the start's */
 	int start_trials; /* of the start bin, bin 0 (bsim_markov_bin_trials) */
-	int *counts;      /* n_bins x n_bins, [entry * n_bins + exit], exit 0 = stuck */
-	double seconds;   /* CPU time of its simulation now, s (0 if read from the cache) */
-	double cost;      /* CPU time its simulation took when it was built, s: with self or
-	                   * flow entries every pass's, those reused from the cache too */
-	long long steps;  /* single-gate time steps that simulation took (as cost); 0 if
-	                   * the map's .cost file predates the count */
-	int cached;       /* 1: read from the cache, 0: simulated now */
+	/* The counts, a row an entry bin: row a's exits (0 = stuck) are
+	 * count_exit[count_first[a] .. count_first[a + 1]), ascending, each
+	 * count_n[] times; the row's other exits 0 times. A row sums to
+	 * bsim_markov_bin_trials (a map of its own single gates) and holds at
+	 * most that many exits, so a map's size grows as its bins, not their
+	 * square (bsim_markov_map_count reads one; NULL: not counted yet). */
+	int *count_first; /* n_bins + 1 */
+	int *count_exit, *count_n;
+	double seconds;  /* CPU time of its simulation now, s (0 if read from the cache) */
+	double cost;     /* CPU time its simulation took when it was built, s: with self or
+	                  * flow entries every pass's, those reused from the cache too */
+	long long steps; /* single-gate time steps that simulation took (as cost); 0 if
+	                  * the map's .cost file predates the count */
+	int cached;      /* 1: read from the cache, 0: simulated now */
 	/* Holding times: each single gate's exit bin (0 stuck) and the time
 	 * steps it spent in the gate (to the step that left it, or gate_steps
 	 * if stuck), [start_trials + (entry - 1) * trials + trial] for entry > 0,
@@ -232,6 +241,15 @@ typedef struct bsim_markov_map {
 	int elsewhere; /* 1: left to another part (def parts): no counts here */
 	int copied;    /* 1: read from a part's directory (def from) and written */
 } bsim_markov_map;
+
+/* The count of exit `exit` from entry bin `entry` of map m: the single
+ * gates of that bin that left there. */
+BSIM_API int bsim_markov_map_count(const bsim_markov_map *m, int entry, int exit);
+
+/* Sets map m's counts (m->n_bins set) from a dense n_bins x n_bins matrix
+ * [entry * n_bins + exit], for maps made by hand; BSIM_EFAIL out of
+ * memory. */
+BSIM_API int bsim_markov_map_set_counts(bsim_markov_map *m, const int *dense, bsim_error *err);
 
 /* The gate after the start: map `start`'s start-bin single gates each
  * continued from its exact exit state in a gate of map `gate` (both

@@ -26,17 +26,7 @@ int bsim_markov_bins_check(const bsim_markov_bins *b, bsim_error *err)
 		        "expected 1 to 64 bins of position, speed and direction each, "
 		        "got %d,%d,%d",
 		        b->n_pos, b->n_speed, b->n_dir);
-	const double n = bsim_markov_bins_count(b);
-	if (n * n <= (double)BSIM_MARKOV_MAX_CELLS)
-		return BSIM_OK;
-	/* The most entry bins whose square fits, and P S D for them. */
-	const long most = (long)floor(sqrt((double)BSIM_MARKOV_MAX_CELLS));
-	const long psd = (most - 1) / 4;
-	return bsim_error_set(err, BSIM_EINPUT,
-	                      "1 + 4 x %d x %d x %d = %.0f entry bins make a map of %.3g cells, "
-	                      "more than %.3g; expected P x S x D at most %ld (%ld entry bins)",
-	                      b->n_pos, b->n_speed, b->n_dir, n, n * n,
-	                      (double)BSIM_MARKOV_MAX_CELLS, psd, 1 + 4 * psd);
+	return BSIM_OK;
 }
 
 /* Bin 0 is the start; bin 1 + ((e n_pos + ip) n_speed + is) n_dir + id is

@@ -355,10 +355,9 @@ static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	if (absent)
 		return 0;
 	int *ex = malloc((size_t)units * sizeof *ex), *st = malloc((size_t)units * sizeof *st);
-	int *count = calloc((size_t)nb * nb, sizeof *count);
 	char *line = t.text, *nl = strchr(line, '\n');
 	long u = 0, lineno = 1;
-	int bad = !ex || !st || !count || !nl || (*nl = '\0', strcmp(line, HOLD_HEADER) != 0);
+	int bad = !ex || !st || !nl || (*nl = '\0', strcmp(line, HOLD_HEADER) != 0);
 	while (!bad && u < units) {
 		long v[4];
 		const int a = bsim_markov_unit_bin(m, u);
@@ -368,25 +367,30 @@ static int hold_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 		if (!bad) {
 			ex[u] = (int)v[2];
 			st[u] = (int)v[3];
-			count[a * nb + ex[u]]++;
 			u++;
 		}
 	}
 	if (!bad && *(nl + 1))
 		bad = 1, lineno++;
 	/* the same single gates as the counts */
-	for (long i = 0; !bad && i < (long)nb * nb; i++)
-		if (count[i] != m->counts[i])
-			bad = 2;
+	if (!bad) {
+		bsim_markov_map held = *m;
+		held.count_first = held.count_exit = held.count_n = NULL;
+		bad = bsim_markov_counts_of_exits(&held, ex) != 0 ? 3
+		      : !bsim_markov_counts_equal(&held, m)       ? 2
+		                                                  : 0;
+		bsim_markov_counts_free(&held);
+	}
 	bsim_file_text_free(&t);
-	free(count);
 	if (bad) {
 		free(ex);
 		free(st);
 		char path[BSIM_PATH_MAX];
 		snprintf(path, sizeof path, "%s/map_%016llx.hold.csv", dir,
 		         (unsigned long long)m->key);
-		if (bad == 2)
+		if (bad == 3)
+			bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
+		else if (bad == 2)
 			bsim_error_set(
 			        err, BSIM_EINPUT,
 			        "%s: its exits do not count up to the map's counts (map_%016llx."
@@ -448,8 +452,8 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	if (!key_same(path, m->key_text))
 		return 0;
 	snprintf(path, sizeof path, "%s/map_%016llx.csv", dir, (unsigned long long)m->key);
-	/* At most a row per cell, each well under 256 bytes. */
-	double max_bytes = ((double)m->n_bins * m->n_bins + 1.0) * 256.0;
+	/* At most a row per single gate, each well under 256 bytes. */
+	double max_bytes = ((double)bsim_markov_map_units(m) + 1.0) * 256.0;
 	file_text t;
 	int absent = 0;
 	if (map_file(dir, m, "csv", max_bytes, &t, &absent, err) != BSIM_OK)
@@ -457,15 +461,19 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	if (absent)
 		return 0;
 	const int nb = m->n_bins;
-	long *sum = calloc((size_t)nb, sizeof *sum);
+	/* the cells as they come, a line each: cell[3 i ..] entry, exit, count */
+	long *sum = calloc((size_t)nb, sizeof *sum), n = 0, room = 1024;
+	int oom = 0;
 	int *last = calloc((size_t)nb, sizeof *last);
+	int *cell = malloc((size_t)room * 3 * sizeof *cell);
 	char what[128];
 	const char *bad = NULL;
 	int lineno = 1;
 	char *line = t.text, *nl = strchr(line, '\n');
-	if (!sum || !last) {
+	if (!sum || !last || !cell) {
 		free(sum);
 		free(last);
+		free(cell);
 		bsim_file_text_free(&t);
 		bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
 		return -1;
@@ -493,15 +501,38 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 			snprintf(what, sizeof what, "the name of a bin, got %.20s", got);
 		else if (bad)
 			snprintf(what, sizeof what, "a bin 0 to %d, got %.20s", nb - 1, got);
-		else if (m->counts[(size_t)v[0] * nb + v[1]]) {
-			bad = "exit";
-			snprintf(what, sizeof what, "each entry,exit pair once, got %ld,%ld again",
-			         v[0], v[1]);
-		} else {
-			m->counts[(size_t)v[0] * nb + v[1]] = (int)v[2];
+		else {
+			if (n == room) {
+				int *more = realloc(cell, (size_t)room * 2 * 3 * sizeof *cell);
+				if (!more) {
+					oom = 1;
+					break;
+				}
+				cell = more;
+				room *= 2;
+			}
+			for (int i = 0; i < 3; i++)
+				cell[3 * n + i] = (int)v[i];
+			n++;
 			sum[v[0]] += v[2];
 			last[v[0]] = lineno;
 		}
+	}
+	long again = -1;
+	const int cells = bad || oom ? -oom : bsim_markov_counts_of_cells(m, n, cell, &again);
+	if (cells == 1) { /* at the later line of the two, after the header */
+		bad = "exit";
+		snprintf(what, sizeof what, "each entry,exit pair once, got %d,%d again",
+		         cell[3 * again], cell[3 * again + 1]);
+		lineno = (int)again + 2;
+	}
+	free(cell);
+	if (cells < 0) {
+		free(sum);
+		free(last);
+		bsim_file_text_free(&t);
+		bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
+		return -1;
 	}
 	/* Every entry bin ran the map's trials, each ending somewhere. */
 	for (int a = 0; !bad && a < nb; a++)
@@ -517,7 +548,7 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	free(last);
 	bsim_file_text_free(&t);
 	if (bad) {
-		memset(m->counts, 0, (size_t)nb * nb * sizeof *m->counts);
+		bsim_markov_counts_free(m);
 		bsim_error_set(err, BSIM_EINPUT, "%s:%d: %s: expected %s", path, lineno, bad, what);
 		return -1;
 	}
@@ -547,13 +578,12 @@ int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsi
 		return BSIM_EFAIL;
 	fputs("entry,exit,count,entry_edge,exit_edge,p\n", o.f);
 	for (int a = 0; a < m->n_bins; a++) {
+		const int first = m->count_first[a], end = m->count_first[a + 1];
 		long total = 0;
-		for (int x = 0; x < m->n_bins; x++)
-			total += m->counts[(size_t)a * m->n_bins + x];
-		for (int x = 0; x < m->n_bins; x++) {
-			int c = m->counts[(size_t)a * m->n_bins + x];
-			if (c == 0)
-				continue;
+		for (int i = first; i < end; i++)
+			total += m->count_n[i];
+		for (int i = first; i < end; i++) {
+			const int x = m->count_exit[i], c = m->count_n[i];
 			fprintf(o.f, "%d,%d,%d,%s,%s,%.9g\n", a, x, c, bsim_markov_bin_edge(b, a),
 			        x == 0 ? "stuck" : bsim_markov_bin_edge(b, x), (double)c / total);
 		}

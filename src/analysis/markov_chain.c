@@ -74,30 +74,21 @@ static int sparse_hold(sparse_map *s, const bsim_markov_map *m, double dt)
 
 static int sparse_init(sparse_map *s, const bsim_markov_map *m)
 {
-	const int nb = m->n_bins;
-	long nnz = 0;
-	for (long i = 0; i < (long)nb * nb; i++)
-		nnz += m->counts[i] != 0;
+	const int nb = m->n_bins, nnz = m->count_first[nb];
 	s->first = malloc((size_t)(nb + 1) * sizeof *s->first);
 	s->exit = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *s->exit);
 	s->p = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *s->p);
 	if (!s->first || !s->exit || !s->p)
 		return -1;
-	int k = 0;
+	memcpy(s->first, m->count_first, (size_t)(nb + 1) * sizeof *s->first);
+	memcpy(s->exit, m->count_exit, (size_t)(nnz > 0 ? nnz : 0) * sizeof *s->exit);
 	for (int a = 0; a < nb; a++) {
-		s->first[a] = k;
 		long total = 0;
-		for (int x = 0; x < nb; x++)
-			total += m->counts[(size_t)a * nb + x];
-		for (int x = 0; x < nb; x++) {
-			int c = m->counts[(size_t)a * nb + x];
-			if (c) {
-				s->exit[k] = x;
-				s->p[k++] = (double)c / (double)total;
-			}
-		}
+		for (int i = m->count_first[a]; i < m->count_first[a + 1]; i++)
+			total += m->count_n[i];
+		for (int i = m->count_first[a]; i < m->count_first[a + 1]; i++)
+			s->p[i] = (double)m->count_n[i] / (double)total;
 	}
-	s->first[nb] = k;
 	return 0;
 }
 

@@ -359,7 +359,6 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
                                   bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
                                   long *done, long total, bsim_error *err)
 {
-	const int nb = m->n_bins;
 	const long units = bsim_markov_map_units(m);
 	int *exit = malloc((size_t)units * sizeof *exit);
 	int *held = malloc((size_t)units * sizeof *held);
@@ -371,9 +370,9 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
 	long long steps = 0;
 	int rc = units_run(lattice, def, be, opts, m->k, units, m, pool, NULL, NULL, runs, exit,
 	                   held, &steps, done, total, err);
+	if (rc == BSIM_OK && bsim_markov_counts_of_exits(m, exit) != 0)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (rc == BSIM_OK) { /* the holding times: the map keeps both arrays */
-		for (long u = 0; u < units; u++)
-			m->counts[bsim_markov_unit_bin(m, u) * nb + exit[u]]++;
 		free(m->hold_exit);
 		free(m->hold_steps);
 		m->hold_exit = exit;

@@ -76,6 +76,27 @@ static inline int bsim_markov_unit_bin(const bsim_markov_map *m, long u)
 	return u < m->start_trials ? 0 : 1 + (int)((u - m->start_trials) / m->trials);
 }
 
+/* ---- counts by row (markov_counts.c) ---- */
+
+/* Map m's counts (its bins and trials set) from its single gates' exit
+ * bins, exit[u] of unit u (bsim_markov_unit_bin's order); the old counts
+ * freed. 0, or -1 out of memory (then no counts). */
+int bsim_markov_counts_of_exits(bsim_markov_map *m, const int *exit);
+
+/* Map m's counts from the n cells of a map file, in any order, cell i
+ * entry cells[3 i] to exit cells[3 i + 1] counted cells[3 i + 2] times
+ * (bins within m's): 0; 1 if a pair is given twice, *again the index of
+ * its later cell (no counts); -1 out of memory. */
+int bsim_markov_counts_of_cells(bsim_markov_map *m, long n, const int *cells, long *again);
+
+/* to's counts a copy of from's (to->n_bins set): 0, or -1 out of memory. */
+int bsim_markov_counts_copy(bsim_markov_map *to, const bsim_markov_map *from);
+
+/* 1 if both maps have the same counts. */
+int bsim_markov_counts_equal(const bsim_markov_map *a, const bsim_markov_map *b);
+
+void bsim_markov_counts_free(bsim_markov_map *m);
+
 /* ---- single gates (markov_gate.c) ---- */
 
 /* The gate of the lattice's start, moved to its own frame, as the essay's
@@ -167,8 +188,8 @@ int bsim_markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *
                               bsim_markov_map *maps, int n, const char *have, const char *dir,
                               const char *stage, long *done, long total, bsim_error *err);
 
-/* Moves from's holding times into to (to's freed first). */
-void bsim_markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from);
+/* Moves from's counts and holding times into to (to's freed first). */
+void bsim_markov_map_take_counts(bsim_markov_map *to, bsim_markov_map *from);
 
 /* Map m by def's self-consistent passes, starting from the last pass in
  * dir; each pass simulated now written into stage (map and exits). */

@@ -90,8 +90,7 @@ static int map_init(bsim_markov_map *m, const bsim_scene *lattice, const bsim_ma
 	m->trials = def->trials;
 	m->start_trials = bsim_markov_def_start_trials(def);
 	m->key_text = bsim_markov_key_text(lattice, def, be, opts, k);
-	m->counts = calloc((size_t)m->n_bins * m->n_bins, sizeof *m->counts);
-	if (!m->key_text || !m->counts)
+	if (!m->key_text)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	m->key = bsim_markov_key(m->key_text);
 	return BSIM_OK;
@@ -132,6 +131,16 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "start trials: expected 1 to 1000000, got %d",
 		                      def->start_trials);
+	const double units = (double)(bsim_markov_bins_count(b) - 1) * def->trials +
+	                     bsim_markov_def_start_trials(def);
+	if (units > (double)BSIM_MARKOV_MAX_UNITS)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "bins and trials: %d entry bins x %d trials (the start's %d) "
+		                      "make %.0f single gates a map, more than %.0f; expected "
+		                      "fewer bins or trials",
+		                      bsim_markov_bins_count(b) - 1, def->trials,
+		                      bsim_markov_def_start_trials(def), units,
+		                      (double)BSIM_MARKOV_MAX_UNITS);
 	/* The passes' exits are kept and pooled per trial of every bin alike. */
 	if (def->self_entries && bsim_markov_def_start_trials(def) != def->trials)
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -195,7 +204,7 @@ void bsim_markov_set_free(bsim_markov_set *s)
 		return;
 	for (int i = 0; i < s->n; i++) {
 		free(s->maps[i].key_text);
-		free(s->maps[i].counts);
+		bsim_markov_counts_free(&s->maps[i]);
 		free(s->maps[i].hold_exit);
 		free(s->maps[i].hold_steps);
 	}
@@ -447,7 +456,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		if (got > 0 && stage && !m->hold_exit) {
 			/* built before holding times were kept: simulated again
 			 * (the same seeds: the same counts) with them */
-			memset(m->counts, 0, (size_t)m->n_bins * m->n_bins * sizeof *m->counts);
+			bsim_markov_counts_free(m);
 			m->cost = 0.0;
 			m->steps = 0;
 			got = 0;

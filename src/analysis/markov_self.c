@@ -194,8 +194,7 @@ static int pass_map(bsim_markov_map *q_map, const bsim_scene *lattice, const bsi
 	q_map->trials = m->trials;
 	q_map->start_trials = m->start_trials;
 	q_map->key_text = bsim_markov_key_text(lattice, &dq, be, opts, m->k);
-	q_map->counts = calloc((size_t)m->n_bins * m->n_bins, sizeof *q_map->counts);
-	if (!q_map->key_text || !q_map->counts)
+	if (!q_map->key_text)
 		return -1;
 	q_map->key = bsim_markov_key(q_map->key_text);
 	return 0;
@@ -204,7 +203,7 @@ static int pass_map(bsim_markov_map *q_map, const bsim_scene *lattice, const bsi
 static void pass_map_free(bsim_markov_map *q)
 {
 	free(q->key_text);
-	free(q->counts);
+	bsim_markov_counts_free(q);
 	free(q->hold_exit);
 	free(q->hold_steps);
 }
@@ -240,8 +239,13 @@ static int last_cached(const bsim_scene *lattice, const bsim_markov_def *def,
 	return -1;
 }
 
-void bsim_markov_map_take_hold(bsim_markov_map *to, bsim_markov_map *from)
+void bsim_markov_map_take_counts(bsim_markov_map *to, bsim_markov_map *from)
 {
+	bsim_markov_counts_free(to);
+	to->count_first = from->count_first;
+	to->count_exit = from->count_exit;
+	to->count_n = from->count_n;
+	from->count_first = from->count_exit = from->count_n = NULL;
 	free(to->hold_exit);
 	free(to->hold_steps);
 	to->hold_exit = from->hold_exit;
@@ -308,8 +312,7 @@ int bsim_markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *
 		if (rc == BSIM_OK)
 			rc = runs_write(stage, mq.key, cur, nb, T, err);
 		if (rc == BSIM_OK && q == def->self_passes) {
-			memcpy(m->counts, mq.counts, (size_t)nb * nb * sizeof *m->counts);
-			bsim_markov_map_take_hold(m, &mq);
+			bsim_markov_map_take_counts(m, &mq);
 		}
 		pass_map_free(&mq);
 		markov_run *tmp = prev;
@@ -625,9 +628,7 @@ int bsim_markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *
 			if (rc == BSIM_OK && (!last || !have[b]))
 				rc = runs_write(stage, mq.key, cur[b], nb, T, err);
 			if (rc == BSIM_OK && last) {
-				memcpy(maps[b].counts, mq.counts,
-				       (size_t)nb * nb * sizeof *mq.counts);
-				bsim_markov_map_take_hold(&maps[b], &mq);
+				bsim_markov_map_take_counts(&maps[b], &mq);
 			}
 			pass_map_free(&mq);
 		}

@@ -100,30 +100,42 @@ static int bootstrap_maps(gsl_rng *rng, const bsim_scene *scene, const bsim_mark
 		return BSIM_OK;
 	bsim_markov_set rs = *set;
 	rs.maps = calloc((size_t)set->n, sizeof *rs.maps);
-	const int nb = set->maps[0].n_bins;
-	double *p = malloc((size_t)nb * sizeof *p);
-	unsigned int *k = malloc((size_t)nb * sizeof *k);
+	/* a row's exits are at most its trials: the start's the most */
+	int most = 1;
+	for (int i = 0; i < set->n; i++) {
+		const bsim_markov_map *m = &set->maps[i];
+		for (int a = 0; a < m->n_bins; a++)
+			if (m->count_first[a + 1] - m->count_first[a] > most)
+				most = m->count_first[a + 1] - m->count_first[a];
+	}
+	double *p = malloc((size_t)most * sizeof *p);
+	unsigned int *k = malloc((size_t)most * sizeof *k);
 	int rc = rs.maps && p && k ? BSIM_OK : bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (int i = 0; rc == BSIM_OK && i < set->n; i++) {
 		rs.maps[i] = set->maps[i];
-		rs.maps[i].counts = malloc((size_t)nb * nb * sizeof *rs.maps[i].counts);
-		if (!rs.maps[i].counts)
+		rs.maps[i].count_first = rs.maps[i].count_exit = rs.maps[i].count_n = NULL;
+		if (bsim_markov_counts_copy(&rs.maps[i], &set->maps[i]) != 0)
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	double s = 0.0;
 	for (int b = 0; rc == BSIM_OK && b < B; b++) {
-		for (int i = 0; i < set->n; i++)
-			for (int a = 0; a < nb; a++) {
-				const int *row = set->maps[i].counts + (size_t)a * nb;
+		/* each row resampled over its own exits: an exit it never had
+		 * has probability 0 */
+		for (int i = 0; i < set->n; i++) {
+			const bsim_markov_map *m = &set->maps[i];
+			for (int a = 0; a < m->n_bins; a++) {
+				const int first = m->count_first[a],
+				          n = m->count_first[a + 1] - first;
 				long total = 0;
-				for (int x = 0; x < nb; x++)
-					total += row[x];
-				for (int x = 0; x < nb; x++)
-					p[x] = (double)row[x];
-				gsl_ran_multinomial(rng, (size_t)nb, (unsigned)total, p, k);
-				for (int x = 0; x < nb; x++)
-					rs.maps[i].counts[(size_t)a * nb + x] = (int)k[x];
+				for (int x = 0; x < n; x++) {
+					total += m->count_n[first + x];
+					p[x] = (double)m->count_n[first + x];
+				}
+				gsl_ran_multinomial(rng, (size_t)n, (unsigned)total, p, k);
+				for (int x = 0; x < n; x++)
+					rs.maps[i].count_n[first + x] = (int)k[x];
 			}
+		}
 		bsim_markov_prediction q;
 		rc = bsim_markov_predict(scene, &rs, &q, err);
 		if (rc == BSIM_OK)
@@ -133,7 +145,7 @@ static int bootstrap_maps(gsl_rng *rng, const bsim_scene *scene, const bsim_mark
 	if (rc == BSIM_OK)
 		*mean = s / B;
 	for (int i = 0; rs.maps && i < set->n; i++)
-		free(rs.maps[i].counts);
+		bsim_markov_counts_free(&rs.maps[i]);
 	free(rs.maps);
 	free(p);
 	free(k);
