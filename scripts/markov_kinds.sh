@@ -25,7 +25,8 @@ fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13
 # method name and its build options (the default: none); each of the
 # default's three parts (fine bins, many start trials, the gate after the
 # start) alone and without the others; flow:1; self:1 at the default bins;
-# the default at finer bins
+# the default at finer bins; the default with the states of a training
+# field's entries (train: the sweep of exp_train_r21.yaml, run first)
 methods=("default:"
          "without-after-start:--after-start 0"
          "fine-bins-alone:--start-trials 50 --after-start 0"
@@ -34,7 +35,8 @@ methods=("default:"
          "previous-default:--bins 4,4,3 --trials 200 --start-trials 200 --after-start 0"
          "flow1:--bins 4,4,3 --trials 200 --entries flow:1"
          "self1:--entries self:1"
-         "bins14613:--bins 14,6,13")
+         "bins14613:--bins 14,6,13"
+         "train:--entries $out/train-sweep")
 if [ -n "${METHODS:-}" ]; then
     chosen=()
     for m in "${methods[@]}"; do
@@ -43,6 +45,12 @@ if [ -n "${METHODS:-}" ]; then
     methods=("${chosen[@]}")
 fi
 mkdir -p "$out"
+for m in "${methods[@]}"; do
+    if [ "${m%%:*}" = train ] && [ ! -f "$out/train-sweep/gate_entries.csv" ]; then
+        $exe sweep configs/markov/kinds/exp_train_r21.yaml --threads "$threads" --quiet \
+            --out "$out/train-sweep" >/dev/null
+    fi
+done
 # TV of prediction.csv ($1) against validate.csv's p_sim ($2) for protocol $3
 tv() {
     awk -F, -v proto="$3" 'NR == FNR { if (FNR > 1) p[$1] = $5; next }

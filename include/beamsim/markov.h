@@ -405,14 +405,15 @@ BSIM_API int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, i
                                       bsim_error *err);
 
 /* Where maps of def were measured to fall short on layouts they were not
- * built on, one sentence into buf, or "" for maps of the method measured
- * to hold for any layout: states uniform in bins at least as many as the
- * default's, the default's start trials or more and the gate after the
- * start (docs/markov.md, "Maps of a physics"). Flow entries: maps of one
- * layout; self-consistent entries, entries observed in sweeps, and the
- * default method with coarser bins, fewer start trials or no gate after
- * the start: each measured less accurate there. buf of 320 bytes holds
- * any. markov build prints it as a note. */
+ * built on, one sentence into buf, or "" for maps of the default method:
+ * states uniform in bins at least as many as the default's, the default's
+ * start trials or more and the gate after the start (docs/markov.md,
+ * "Maps of a physics"). Flow entries: maps of one layout; self-consistent
+ * entries, and the default method with coarser bins, fewer start trials
+ * or no gate after the start: each measured less accurate there; entries
+ * observed in sweeps: maps for layouts like the sweeps' (from a random
+ * field of the kinds, as close as the default's or closer). buf of 320
+ * bytes holds any. markov build and validate print it as a note. */
 BSIM_API const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t size);
 
 /* bsim_markov_def_default() as map, one process, no entries. */

@@ -171,9 +171,10 @@ const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t 
 	}
 	if (def->entries || id[0]) {
 		snprintf(buf, size,
-		         "entries observed in sweeps: a bin's states are those of the sweeps' "
-		         "layouts (TV 0.054 on a field they did not come from; docs/markov.md, "
-		         "\"Accuracy\")");
+		         "entries observed in sweeps: the maps hold for layouts like the sweeps' "
+		         "(those of a random field of the gate kinds were measured about as close "
+		         "as the default's or closer on other layouts; docs/markov.md, \"A "
+		         "training field\")");
 		return buf;
 	}
 	/* The default method's three parts, each measured without the others. */
