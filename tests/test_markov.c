@@ -1347,6 +1347,22 @@ static void test_bad_map_files(void **state)
 	assert_non_null(strstr(err, name));
 	assert_non_null(strstr(err, ":2: exit: expected a bin 0 to 4"));
 	free(err);
+	/* a row given twice, last: named at its second line, whatever the
+	 * order the rows come in */
+	int lines = 0;
+	for (const char *c = csv; *c; c++)
+		lines += *c == '\n';
+	const char *row2_end = strchr(row2 + 1, '\n');
+	snprintf(text, sizeof text, "%s%.*s", csv, (int)(row2_end - row2), row2 + 1);
+	bsim_test_write(dir, name, text);
+	err = NULL;
+	assert_int_equal(bsim_test_cli(pred, NULL, &err), 2);
+	char says[64];
+	snprintf(says, sizeof says, ":%d: exit: expected each entry,exit pair once", lines + 1);
+	if (!strstr(err, says))
+		print_error("%s\n", err);
+	assert_non_null(strstr(err, says));
+	free(err);
 	bsim_test_write(dir, name, csv);
 	assert_int_equal(bsim_test_cli(pred, NULL, NULL), 0);
 
