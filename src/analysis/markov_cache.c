@@ -501,7 +501,11 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 			snprintf(what, sizeof what, "the name of a bin, got %.20s", got);
 		else if (bad)
 			snprintf(what, sizeof what, "a bin 0 to %d, got %.20s", nb - 1, got);
-		else {
+		else if (n == bsim_markov_map_units(m)) { /* each row counts one at least */
+			bad = "count";
+			snprintf(what, sizeof what, "at most a row per single gate, %ld",
+			         bsim_markov_map_units(m));
+		} else {
 			if (n == room) {
 				int *more = realloc(cell, (size_t)room * 2 * 3 * sizeof *cell);
 				if (!more) {

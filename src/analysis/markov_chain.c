@@ -81,7 +81,7 @@ static int sparse_init(sparse_map *s, const bsim_markov_map *m)
 	if (!s->first || !s->exit || !s->p)
 		return -1;
 	memcpy(s->first, m->count_first, (size_t)(nb + 1) * sizeof *s->first);
-	memcpy(s->exit, m->count_exit, (size_t)(nnz > 0 ? nnz : 0) * sizeof *s->exit);
+	memcpy(s->exit, m->count_exit, (size_t)nnz * sizeof *s->exit);
 	for (int a = 0; a < nb; a++) {
 		long total = 0;
 		for (int i = m->count_first[a]; i < m->count_first[a + 1]; i++)
