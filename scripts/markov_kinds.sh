@@ -26,7 +26,8 @@ fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13
 # default's three parts (fine bins, many start trials, the gate after the
 # start) alone and without the others; flow:1; self:1 at the default bins;
 # the default at finer bins; the default with the states of a training
-# field's entries (train: the sweep of exp_train_r21.yaml, run first)
+# field's entries (train: the sweep of exp_train_r21.yaml, run first), and
+# with 10,000 trials of it and 14,6,13 bins
 methods=("default:"
          "without-after-start:--after-start 0"
          "fine-bins-alone:--start-trials 50 --after-start 0"
@@ -36,7 +37,8 @@ methods=("default:"
          "flow1:--bins 4,4,3 --trials 200 --entries flow:1"
          "self1:--entries self:1"
          "bins14613:--bins 14,6,13"
-         "train:--entries $out/train-sweep")
+         "train:--entries $out/train-sweep"
+         "train10k-bins14613:--entries $out/train-sweep-10k --bins 14,6,13")
 if [ -n "${METHODS:-}" ]; then
     chosen=()
     for m in "${methods[@]}"; do
@@ -45,11 +47,16 @@ if [ -n "${METHODS:-}" ]; then
     methods=("${chosen[@]}")
 fi
 mkdir -p "$out"
+# the training sweeps the methods name: 2,000 trials (the experiment's) and 10,000
 for m in "${methods[@]}"; do
-    if [ "${m%%:*}" = train ] && [ ! -f "$out/train-sweep/gate_entries.csv" ]; then
-        $exe sweep configs/markov/kinds/exp_train_r21.yaml --threads "$threads" --quiet \
-            --out "$out/train-sweep" >/dev/null
-    fi
+    case "${m%%:*}" in
+    train) sweep=train-sweep trials=2000 ;;
+    train10k-*) sweep=train-sweep-10k trials=10000 ;;
+    *) continue ;;
+    esac
+    [ -f "$out/$sweep/gate_entries.csv" ] ||
+        $exe sweep configs/markov/kinds/exp_train_r21.yaml --trials "$trials" --threads "$threads" \
+            --quiet --out "$out/$sweep" >/dev/null
 done
 # TV of prediction.csv ($1) against validate.csv's p_sim ($2) for protocol $3
 tv() {
