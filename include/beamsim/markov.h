@@ -243,7 +243,8 @@ typedef struct bsim_markov_map {
 } bsim_markov_map;
 
 /* The count of exit `exit` from entry bin `entry` of map m: the single
- * gates of that bin that left there. */
+ * gates of that bin that left there (0 for a map not counted or a bin
+ * not of it). */
 BSIM_API int bsim_markov_map_count(const bsim_markov_map *m, int entry, int exit);
 
 /* Sets map m's counts (m->n_bins set) from a dense n_bins x n_bins matrix

@@ -138,6 +138,8 @@ int bsim_markov_counts_equal(const bsim_markov_map *a, const bsim_markov_map *b)
 
 int bsim_markov_map_count(const bsim_markov_map *m, int entry, int exit)
 {
+	if (!m->count_first || entry < 0 || entry >= m->n_bins)
+		return 0; /* not counted, or no such row */
 	int lo = m->count_first[entry], hi = m->count_first[entry + 1];
 	while (lo < hi) { /* the first exit >= exit */
 		const int mid = lo + (hi - lo) / 2;
