@@ -22,6 +22,7 @@
  *   - a bad input exits 2 naming what is wrong and writes nothing. */
 #define _POSIX_C_SOURCE 200809L
 
+#include <dirent.h>
 #include <math.h>
 #include <setjmp.h>
 #include <signal.h>
@@ -1773,6 +1774,60 @@ static void test_flow_entries(void **state)
 	bsim_scene_free(&s);
 }
 
+/* The fields of the maps of a physics (configs/markov/kinds, docs/markov.md
+ * "Maps of a physics"): every experiment there loads, simulates its field
+ * under the physics the docs give (F_prop = 7 N, Rm = 25 N), and every
+ * gate of its field is of kind A = (150, 600), B = (600, 300) or C = (300,
+ * 150) N m/rad; the training field alone under the essay's protocol. */
+static void test_kinds_configs(void **state)
+{
+	(void)state;
+	char dir[1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_src("configs/markov/kinds"));
+	DIR *d = opendir(dir);
+	assert_non_null(d);
+	const double kind[3][2] = {{150, 600}, {600, 300}, {300, 150}};
+	int n_exp = 0;
+	struct dirent *de;
+	while ((de = readdir(d))) {
+		if (strncmp(de->d_name, "exp_", 4) != 0)
+			continue;
+		char path[1400];
+		snprintf(path, sizeof path, "%s/%s", dir, de->d_name);
+		bsim_experiment e;
+		bsim_error err;
+		if (bsim_experiment_load(path, NULL, 0, &e, &err) != BSIM_OK)
+			fail_msg("%s: %s", de->d_name, err.msg);
+		assert_int_equal(e.n_groups, 1);
+		bsim_scene s;
+		assert_int_equal(bsim_experiment_group_scene(&e, 0, NULL, 0, &s, &err), BSIM_OK);
+		assert_true(s.has_lattice);
+		assert_true(s.effects.has_propulsion && s.effects.propulsion_force == 7.0);
+		assert_true(s.effects.has_random_force && s.effects.random_magnitude == 25.0);
+		const int train = strcmp(de->d_name, "exp_train_r21.yaml") == 0;
+		assert_int_equal(s.lattice.protocol,
+		                 train ? BSIM_PROTOCOL_ESSAY : BSIM_PROTOCOL_WORLD);
+		for (int iy = 0; iy < s.lattice.rows; iy++)
+			for (int ix = s.lattice.ix_min; ix <= s.lattice.ix_max; ix++) {
+				const double kl =
+				        s.beams[bsim_lattice_beam(&s.lattice, ix, iy, 0)].stiffness;
+				const double kr =
+				        s.beams[bsim_lattice_beam(&s.lattice, ix, iy, 1)].stiffness;
+				int of = 0;
+				for (int k = 0; k < 3; k++)
+					of += kl == kind[k][0] && kr == kind[k][1];
+				if (of != 1)
+					fail_msg("%s: gate (%d, %d) is %g, %g N m/rad", de->d_name, ix,
+					         iy, kl, kr);
+			}
+		bsim_scene_free(&s);
+		bsim_experiment_free(&e);
+		n_exp++;
+	}
+	closedir(d);
+	assert_true(n_exp >= 18);
+}
+
 /* The note on a method's scope names what keeps it from the maps of a
  * physics, and nothing for the default method or finer settings. */
 static void test_scope(void **state)
@@ -1887,6 +1942,7 @@ int main(void)
 	        cmocka_unit_test(test_time_by_hand),
 	        cmocka_unit_test(test_bins),
 	        cmocka_unit_test(test_scope),
+	        cmocka_unit_test(test_kinds_configs),
 	        cmocka_unit_test(test_conservation),
 	        cmocka_unit_test(test_tolerance),
 	        cmocka_unit_test(test_sweeps_against_series),
