@@ -10,7 +10,9 @@
 # reused on every other; flow:1 maps are built per field (they hold for
 # that layout only). ring5 and check11 are the fields the settings were
 # chosen on; test_* were made after the bins and trials were fixed, fresh_*
-# after the gate after the start was. Prints one row per method and field;
+# after the gate after the start was, late_* after the training field
+# (method train), final_* after the training field with finer bins (method
+# train10k-bins14613; name them in FIELDS). Prints one row per method and field;
 # the runs stay in OUT (default out/markov-kinds), the table in
 # OUT/table.txt. FIELDS="..." chooses the fields, METHODS="..." the methods
 # (by name), TRIALS=N the direct trials of each (default the experiments',
