@@ -1,9 +1,10 @@
 /* Internal: what the files of the single-gate maps (beamsim/markov.h)
  * share. markov_bins.c lays out the entry bins and draws states in them,
  * markov_entries.c reads observed entries and indexes them by bin,
- * markov_gate.c runs the single gates that fill a map, markov_cache.c
- * keys maps and reads and writes a map directory, and markov_map.c builds
- * or loads the maps of a lattice from those. */
+ * markov_gate.c runs the single gates that fill a map, markov_counts.c
+ * keeps a map's counts by row, markov_cache.c keys maps and reads and
+ * writes a map directory, and markov_map.c builds or loads the maps of a
+ * lattice from those. */
 #ifndef BSIM_ANALYSIS_MARKOV_INTERNAL_H
 #define BSIM_ANALYSIS_MARKOV_INTERNAL_H
 
