@@ -1817,8 +1817,8 @@ static void test_kinds_configs(void **state)
 				for (int k = 0; k < 3; k++)
 					of += kl == kind[k][0] && kr == kind[k][1];
 				if (of != 1)
-					fail_msg("%s: gate (%d, %d) is %g, %g N m/rad", de->d_name, ix,
-					         iy, kl, kr);
+					fail_msg("%s: gate (%d, %d) is %g, %g N m/rad", de->d_name,
+					         ix, iy, kl, kr);
 			}
 		bsim_scene_free(&s);
 		bsim_experiment_free(&e);
