@@ -45,9 +45,11 @@
 #define SERIES_MAX 1000000
 
 /* A map's rows in compressed sparse rows: row a's nonzero transitions are
- * exit[first[a] .. first[a + 1]) with probabilities p[], contiguous. */
+ * exit[first[a] .. first[a + 1]) with probabilities p[], contiguous;
+ * first and exit are the map's own count_first and count_exit (the set
+ * outlives the chain). */
 typedef struct sparse_map {
-	int *first, *exit;
+	const int *first, *exit;
 	double *p;
 	double *hold; /* s, each row's mean holding time; NULL without holding times */
 } sparse_map;
@@ -75,13 +77,11 @@ static int sparse_hold(sparse_map *s, const bsim_markov_map *m, double dt)
 static int sparse_init(sparse_map *s, const bsim_markov_map *m)
 {
 	const int nb = m->n_bins, nnz = m->count_first[nb];
-	s->first = malloc((size_t)(nb + 1) * sizeof *s->first);
-	s->exit = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *s->exit);
+	s->first = m->count_first;
+	s->exit = m->count_exit;
 	s->p = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *s->p);
-	if (!s->first || !s->exit || !s->p)
+	if (!s->p)
 		return -1;
-	memcpy(s->first, m->count_first, (size_t)(nb + 1) * sizeof *s->first);
-	memcpy(s->exit, m->count_exit, (size_t)nnz * sizeof *s->exit);
 	for (int a = 0; a < nb; a++) {
 		long total = 0;
 		for (int i = m->count_first[a]; i < m->count_first[a + 1]; i++)
@@ -173,8 +173,6 @@ void bsim_markov_prediction_free(bsim_markov_prediction *p)
 static void chain_free(chain *c, int n_maps)
 {
 	for (int i = 0; c->sm && i < n_maps; i++) {
-		free(c->sm[i].first);
-		free(c->sm[i].exit);
 		free(c->sm[i].p);
 		free(c->sm[i].hold);
 	}
