@@ -31,15 +31,16 @@ fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13
 # field's entries (train: the sweep of exp_train_r21.yaml, run first), and
 # with 10,000 trials of it and 14,6,13 bins
 methods=("default:"
-         "without-after-start:--after-start 0"
-         "fine-bins-alone:--start-trials 50 --after-start 0"
-         "start-trials-alone:--bins 4,4,3 --trials 200 --after-start 0"
-         "after-start-alone:--bins 4,4,3 --trials 200 --start-trials 200"
-         "previous-default:--bins 4,4,3 --trials 200 --start-trials 200 --after-start 0"
+         "uniform:--train 0 --bins 8,8,9"
+         "without-after-start:--train 0 --bins 8,8,9 --after-start 0"
+         "fine-bins-alone:--train 0 --bins 8,8,9 --start-trials 50 --after-start 0"
+         "start-trials-alone:--train 0 --bins 4,4,3 --trials 200 --after-start 0"
+         "after-start-alone:--train 0 --bins 4,4,3 --trials 200 --start-trials 200"
+         "previous-default:--train 0 --bins 4,4,3 --trials 200 --start-trials 200 --after-start 0"
          "flow1:--bins 4,4,3 --trials 200 --entries flow:1"
-         "self1:--entries self:1"
-         "bins14613:--bins 14,6,13"
-         "train:--entries $out/train-sweep"
+         "self1:--bins 8,8,9 --entries self:1"
+         "bins14613:--train 0 --bins 14,6,13"
+         "train:--entries $out/train-sweep --bins 8,8,9"
          "train10k-bins14613:--entries $out/train-sweep-10k --bins 14,6,13")
 if [ -n "${METHODS:-}" ]; then
     chosen=()

@@ -38,7 +38,7 @@ for s in "${settings[@]}"; do
     maps=$out/maps-${bins//,/x}-$trials
     for l in "${lattices[@]}"; do
         $exe markov build configs/markov/$l.yaml --bins "$bins" --trials "$trials" \
-            --start-trials "$trials" "${opts[@]}" \
+            --start-trials "$trials" --train 0 "${opts[@]}" \
             --quiet --out "$maps"
     done
     for l in "${lattices[@]}"; do

@@ -389,14 +389,15 @@ static const char *markov_lattice(void)
 
 static void markov_build(const char *out, const char *threads, const char *a, const char *b)
 {
-	/* 4,4,3 bins and the start's trials as the others': cheap maps */
-	const char *argv[] = {"markov",  "build",     markov_lattice(),
-	                      "--bins",  "4,4,3",     "--start-trials",
-	                      "3",       "--trials",  "3",
-	                      "--grid",  MARKOV_GRID, "--threads",
-	                      threads,   "--out",     out,
-	                      "--quiet", a,           b,
-	                      NULL};
+	/* 4,4,3 bins, 3 start trials and 20 of the training field: cheap
+	 * maps; each part runs the training field of its maps, the same */
+	const char *argv[] = {"markov",    "build",     markov_lattice(),
+	                      "--bins",    "4,4,3",     "--start-trials",
+	                      "3",         "--trials",  "3",
+	                      "--train",   "20",        "--grid",
+	                      MARKOV_GRID, "--threads", threads,
+	                      "--out",     out,         "--quiet",
+	                      a,           b,           NULL};
 	run_ok(argv);
 }
 
@@ -429,13 +430,13 @@ static void test_markov_shards_merged(void **state)
 	}
 	/* a part of another build: another seed */
 	snprintf(part[3], sizeof part[3], "%s/seed2", dir);
-	const char *argv_seed[] = {"markov", "build",     markov_lattice(),
-	                           "--bins", "4,4,3",     "--start-trials",
-	                           "3",      "--trials",  "3",
-	                           "--grid", MARKOV_GRID, "--seed",
-	                           "2",      "--shard",   "2/3",
-	                           "--out",  part[3],     "--quiet",
-	                           NULL};
+	const char *argv_seed[] = {"markov",    "build",    markov_lattice(),
+	                           "--bins",    "4,4,3",    "--start-trials",
+	                           "3",         "--trials", "3",
+	                           "--train",   "20",       "--grid",
+	                           MARKOV_GRID, "--seed",   "2",
+	                           "--shard",   "2/3",      "--out",
+	                           part[3],     "--quiet",  NULL};
 	assert_int_equal(bsim_test_cli(argv_seed, NULL, NULL), 0);
 	snprintf(out, sizeof out, "%s/merged", dir);
 	const char *argv[] = {"merge", part[2], part[0], part[1], "--out", out, "--quiet", NULL};
@@ -798,9 +799,10 @@ static const char *validate_maps(void)
 		snprintf(maps, sizeof maps, "%s", bsim_test_dir(name));
 		char exp[1200];
 		snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
-		const char *argv[] = {
-		        "markov",         "build", exp,       "--trials", "5",  "--bins", "2,2,2",
-		        "--start-trials", "5",     "--quiet", "--out",    maps, NULL};
+		const char *argv[] = {"markov", "build",   exp,     "--trials",
+		                      "5",      "--bins",  "2,2,2", "--start-trials",
+		                      "5",      "--train", "20",    "--quiet",
+		                      "--out",  maps,      NULL};
 		assert_int_equal(bsim_test_cli(argv, NULL, NULL), 0);
 	}
 	return maps;
@@ -1109,6 +1111,8 @@ static void test_mpi_markov_build(void **state)
 	                      "3",
 	                      "--trials",
 	                      "3",
+	                      "--train",
+	                      "20",
 	                      "--grid",
 	                      MARKOV_GRID,
 	                      "--threads",
@@ -1192,6 +1196,8 @@ static void test_mpi_markov_killed_reused(void **state)
 	                          "20",
 	                          "--trials",
 	                          "20",
+	                          "--train",
+	                          "20",
 	                          "--grid",
 	                          "effects.propulsion.force=6,7,8",
 	                          "--threads",
@@ -1214,6 +1220,8 @@ static void test_mpi_markov_killed_reused(void **state)
 	                      "--start-trials",
 	                      "20",
 	                      "--trials",
+	                      "20",
+	                      "--train",
 	                      "20",
 	                      "--grid",
 	                      "effects.propulsion.force=6,7,8",

@@ -303,6 +303,7 @@ static void test_conservation(void **state)
 	        bsim_scene_load(bsim_test_src("configs/lattice/c_track.yaml"), NULL, 0, &s, &err),
 	        BSIM_OK);
 	bsim_markov_def def = bsim_markov_def_default();
+	def.train_trials = 20; /* a small training field: conservation holds for any */
 	def.bins = (bsim_markov_bins){2, 2, 2, 40.0};
 	def.trials = 4;
 	def.start_trials = 0; /* the start's as the others': conservation holds for any */
@@ -339,6 +340,7 @@ static void c_track_maps(const char *name, bsim_scene *s, bsim_markov_set *set)
 	        bsim_scene_load(bsim_test_src("configs/lattice/c_track.yaml"), NULL, 0, s, &err),
 	        BSIM_OK);
 	bsim_markov_def def = bsim_markov_def_default();
+	def.train_trials = 0; /* states uniform in each bin */
 	def.bins = (bsim_markov_bins){4, 4, 3, def.bins.v_max};
 	def.trials = 4;
 	def.start_trials = 0;
@@ -472,6 +474,7 @@ static void test_map_cost(void **state)
 	        BSIM_OK);
 	const long gate_steps = s.gate_steps > 0 ? s.gate_steps : s.max_steps;
 	bsim_markov_def def = bsim_markov_def_default();
+	def.train_trials = 0; /* states uniform in each bin */
 	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
 	def.trials = 8;
 	def.start_trials = 0; /* the self-consistent maps' pass 0 is this map */
@@ -523,6 +526,7 @@ static void test_start_trials_key(void **state)
 	assert_int_equal(bsim_lattice_scene_init(&s5, 1, 1, 5, 30), BSIM_OK);
 	const char *dir = exe_dir("start_trials");
 	bsim_markov_def def = bsim_markov_def_default();
+	def.train_trials = 0; /* states uniform in each bin */
 	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
 	def.trials = 20;
 	const int starts[] = {20, 60, 20};
@@ -571,6 +575,7 @@ static void test_one_gate_against_simulation(void **state)
 	bsim_scene s;
 	assert_int_equal(bsim_lattice_scene_init(&s, 1, 1, 6, 30), BSIM_OK);
 	bsim_markov_def def = bsim_markov_def_default();
+	def.train_trials = 0; /* states uniform in each bin */
 	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
 	def.trials = 400;
 	def.start_trials = 1600;
@@ -717,6 +722,7 @@ static void test_after_start_against_simulation(void **state)
 	assert_int_equal(bsim_lattice_build(&s, kl, kr), BSIM_OK);
 	s.lattice.protocol = BSIM_PROTOCOL_ESSAY;
 	bsim_markov_def def = bsim_markov_def_default();
+	def.train_trials = 0; /* states uniform in each bin */
 	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
 	def.trials = 50;
 	def.start_trials = 600;
@@ -792,6 +798,123 @@ static void test_after_start_against_simulation(void **state)
 	assert_non_null(strstr(err.msg, "absent: the gate after the start"));
 	bsim_scene_free(&one);
 	bsim_scene_free(&s);
+}
+
+/* The training field against direct simulation: a column of three gates
+ * of two stiffness pairs under the essay's protocol, one bin an edge and
+ * no gate after the start, so that the gates above the start are
+ * entered with a bin's states. States uniform over the edge, every speed
+ * to 40 m/s and every direction, are nothing like a body's, and the chain
+ * is off on at least one outcome; states drawn from the entries of a
+ * training field of the same two kinds (a 21 x 21 field, not the column)
+ * put every outcome within 4.5 standard errors of 600 direct trials. */
+static void test_training_against_simulation(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 3, 6, 30), BSIM_OK);
+	const double kl[3] = {100, 400, 100}, kr[3] = {100, 300, 100};
+	assert_int_equal(bsim_lattice_build(&s, kl, kr), BSIM_OK);
+	s.lattice.protocol = BSIM_PROTOCOL_ESSAY;
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
+	def.trials = 300;
+	def.start_trials = 600;
+	def.after_start = 0;
+	def.seed = 3;
+	const char *dir = exe_dir("training");
+	const int N = 600, train[2] = {0, 400};
+	double *sim = NULL;
+	int off[2];
+	for (int i = 0; i < 2; i++) {
+		def.train_trials = train[i];
+		bsim_markov_set set;
+		bsim_error err;
+		assert_int_equal(bsim_markov_build(&s, &def, dir, &set, &err), BSIM_OK);
+		assert_int_equal(set.built, 2);
+		bsim_markov_prediction p;
+		assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
+		if (!sim) { /* one simulation for both: the same locations */
+			sim = calloc((size_t)p.n_locations, sizeof *sim);
+			simulate_locations(&s, &p, N, sim);
+		}
+		off[i] = outcomes_off(&p, sim, def.trials, N);
+		bsim_markov_prediction_free(&p);
+		bsim_markov_set_free(&set);
+	}
+	print_message("outcomes off: %d with uniform states, %d from the training field\n", off[0],
+	              off[1]);
+	assert_true(off[0] >= 1);
+	assert_int_equal(off[1], 0);
+	free(sim);
+	bsim_scene_free(&s);
+}
+
+/* The training field depends on the set of a lattice's gate kinds only:
+ * another layout of the same kinds, met in another order, has the same
+ * maps (reused: no training field run, no CPU), and a lattice of other
+ * kinds its own; the maps read back from the directory serve every
+ * layout whose kinds they were trained on. */
+static void test_training_kinds(void **state)
+{
+	(void)state;
+	bsim_scene a, b, c;
+	const double A[2] = {100, 400}, B[2] = {400, 300}, C[2] = {200, 200};
+	const double *lay[3][3] = {{A, B, A}, {B, A, A}, {A, C, C}};
+	bsim_scene *sc[3] = {&a, &b, &c};
+	for (int f = 0; f < 3; f++) {
+		assert_int_equal(bsim_lattice_scene_init(sc[f], 3, 1, 6, 30), BSIM_OK);
+		double kl[3], kr[3];
+		for (int g = 0; g < 3; g++)
+			kl[g] = lay[f][g][0], kr[g] = lay[f][g][1];
+		assert_int_equal(bsim_lattice_build(sc[f], kl, kr), BSIM_OK);
+	}
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){2, 2, 2, 40.0};
+	def.trials = 3;
+	def.start_trials = 6;
+	def.train_trials = 20;
+	const char *dir = exe_dir("training_kinds");
+	bsim_markov_set sa, sb, sc2;
+	bsim_error err;
+	assert_int_equal(bsim_markov_build(&a, &def, dir, &sa, &err), BSIM_OK);
+	assert_int_equal(sa.built, 2);
+	assert_true(sa.seconds > 0.0);
+	assert_int_equal(bsim_markov_build(&b, &def, dir, &sb, &err), BSIM_OK);
+	assert_int_equal(sb.built, 0);
+	assert_int_equal(sb.reused, 2);
+	assert_true(sb.seconds == 0.0);
+	for (int i = 0; i < 2; i++) /* b meets B first */
+		assert_true(sb.maps[i].key == sa.maps[1 - i].key);
+	assert_int_equal(bsim_markov_build(&c, &def, dir, &sc2, &err), BSIM_OK);
+	assert_int_equal(sc2.built, 2); /* A's map too: another training field */
+	assert_true(sc2.maps[0].key != sa.maps[0].key);
+	/* markov.json names the training field's trials; the kinds are each
+	 * lattice's own */
+	for (int f = 0; f < 3; f++) {
+		bsim_markov_set back;
+		bsim_options opts = {0};
+		assert_int_equal(bsim_markov_load(sc[f], dir, &opts, &back, &err), BSIM_OK);
+		assert_int_equal(back.def.train_trials, 20);
+		bsim_markov_set_free(&back);
+	}
+	/* a lattice of kinds no build trained on together: refused, naming
+	 * the training field's kinds that differ */
+	bsim_scene d;
+	assert_int_equal(bsim_lattice_scene_init(&d, 3, 1, 6, 30), BSIM_OK);
+	const double kl[3] = {400, 200, 200}, kr[3] = {300, 200, 200};
+	assert_int_equal(bsim_lattice_build(&d, kl, kr), BSIM_OK);
+	bsim_markov_set none;
+	bsim_options opts = {0};
+	assert_int_equal(bsim_markov_load(&d, dir, &opts, &none, &err), BSIM_EINPUT);
+	print_message("%s\n", err.msg);
+	assert_non_null(strstr(err.msg, "'entries train 20 kinds 2 "));
+	bsim_markov_set_free(&sa);
+	bsim_markov_set_free(&sb);
+	bsim_markov_set_free(&sc2);
+	for (int f = 0; f < 3; f++)
+		bsim_scene_free(sc[f]);
+	bsim_scene_free(&d);
 }
 
 static char *map_text(const char *dir)
@@ -908,14 +1031,16 @@ static void test_threads_and_cache(void **state)
 	snprintf(d1, sizeof d1, "%s", bsim_test_dir("threads1"));
 	snprintf(d2, sizeof d2, "%s", bsim_test_dir("threads2"));
 	const char *exp = bsim_test_src("configs/lattice/c_track_essay.yaml");
-	/* 4,4,3 bins and the start's trials as the others': cheap maps (the
-	 * default's 2,305 bins and 4,000 start trials are other keys alike) */
-	const char *b1[] = {"markov", "build",    exp, "--bins",    "4,4,3", "--start-trials",
-	                    "3",      "--trials", "3", "--threads", "1",     "--quiet",
-	                    "--out",  d1,         NULL};
-	const char *b2[] = {"markov", "build",    exp, "--bins",    "4,4,3", "--start-trials",
-	                    "3",      "--trials", "3", "--threads", "2",     "--quiet",
-	                    "--out",  d2,         NULL};
+	/* 4,4,3 bins, 3 start trials and a training field of 30 trials: cheap
+	 * maps (the default's 4,369 bins, 4,000 start trials and 10,000 training
+	 * trials are other keys alike); the training field's trials run on the
+	 * threads too */
+	const char *b1[] = {"markov", "build",    exp,     "--bins",  "4,4,3", "--start-trials",
+	                    "3",      "--trials", "3",     "--train", "30",    "--threads",
+	                    "1",      "--quiet",  "--out", d1,        NULL};
+	const char *b2[] = {"markov", "build",    exp,     "--bins",  "4,4,3", "--start-trials",
+	                    "3",      "--trials", "3",     "--train", "30",    "--threads",
+	                    "2",      "--quiet",  "--out", d2,        NULL};
 	assert_int_equal(bsim_test_cli(b1, NULL, NULL), 0);
 	assert_int_equal(bsim_test_cli(b2, NULL, NULL), 0);
 	char *t1 = map_text(d1), *t2 = map_text(d2);
@@ -924,16 +1049,20 @@ static void test_threads_and_cache(void **state)
 	free(t1);
 	free(t2);
 
-	/* The same again: both maps reused, and a note that these bins and
-	 * start trials are coarser than the default method's. */
+	/* The same again: both maps reused, no training field run, and a note
+	 * that these training trials, bins and start trials are fewer than the
+	 * default method's. */
 	char *out = NULL, *note = NULL;
-	const char *again[] = {"markov", "build",    exp, "--bins", "4,4,3", "--start-trials",
-	                       "3",      "--trials", "3", "--out",  d1,      NULL};
+	const char *again[] = {"markov", "build",    exp, "--bins",  "4,4,3", "--start-trials",
+	                       "3",      "--trials", "3", "--train", "30",    "--out",
+	                       d1,       NULL};
 	assert_int_equal(bsim_test_cli(again, &out, &note), 0);
-	assert_non_null(strstr(out, "0 maps built"));
+	assert_non_null(strstr(out, "0 maps built (0.0 s of CPU)"));
 	assert_non_null(strstr(out, "2 reused"));
-	assert_non_null(strstr(note, "note: maps with 4,4,3 bins (the default 8,8,9), 3 start "
-	                             "trials (the default 4000): measured less accurate"));
+	assert_null(strstr(out, "training field"));
+	assert_non_null(strstr(note, "note: maps with 30 training trials (the default 10000), "
+	                             "4,4,3 bins (the default 14,6,13), 3 start trials (the "
+	                             "default 4000): measured less accurate"));
 	free(out);
 	free(note);
 	/* Anything the maps depend on: new maps, none reused. */
@@ -942,8 +1071,10 @@ static void test_threads_and_cache(void **state)
 	                            {"--trials", "3", "--set", "integration.dt=0.002"},
 	                            {"--trials", "3", "--seed", "2"},
 	                            {"--trials", "4", "--threads", "2"},
-	                            {"--trials", "3", "--backend-opt", "integrator=euler"}};
-	for (int i = 0; i < 6; i++) {
+	                            {"--trials", "3", "--backend-opt", "integrator=euler"},
+	                            {"--trials", "3", "--train", "31"},
+	                            {"--trials", "3", "--train", "0"}};
+	for (int i = 0; i < 8; i++) {
 		const char *argv[] = {"markov",
 		                      "build",
 		                      exp,
@@ -955,6 +1086,8 @@ static void test_threads_and_cache(void **state)
 		                      changes[i][1],
 		                      changes[i][2],
 		                      changes[i][3],
+		                      strcmp(changes[i][2], "--train") ? "--train" : "--threads",
+		                      strcmp(changes[i][2], "--train") ? "30" : "1",
 		                      "--out",
 		                      d1,
 		                      NULL};
@@ -1083,9 +1216,9 @@ static void test_field_figures(void **state)
 	snprintf(vdir, sizeof vdir, "%s/validation", maps);
 	char exp[1200]; /* bsim_test_src's buffer is reused by the next call */
 	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
-	const char *build[] = {"markov", "build",          exp,  "--bins",  "4,4,3", "--trials",
-	                       "10",     "--start-trials", "10", "--quiet", "--out", maps,
-	                       NULL};
+	const char *build[] = {
+	        "markov", "build",   exp, "--bins",  "4,4,3", "--trials", "10", "--start-trials",
+	        "10",     "--train", "0", "--quiet", "--out", maps,       NULL};
 	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
 	const char *pred[] = {"markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
 	                      "--map",  maps,      "--out",
@@ -1100,12 +1233,13 @@ static void test_field_figures(void **state)
 	if (rc != 0)
 		fail_msg("validate: exit %d: %s", rc, err ? err : "");
 	/* the maps' method named, as the build named it, and in validate.json */
-	assert_non_null(strstr(err, "note: maps with 4,4,3 bins (the default 8,8,9), 10 start"));
+	assert_non_null(strstr(err, "note: maps with states uniform in each bin (no training "
+	                            "field), 4,4,3 bins (the default 14,6,13), 10 start"));
 	free(err);
 	snprintf(path, sizeof path, "%s/validate.json", vdir);
 	char *vjson = bsim_test_read(path);
 	assert_non_null(vjson);
-	assert_non_null(strstr(vjson, "\"maps_scope\": \"maps with 4,4,3 bins"));
+	assert_non_null(strstr(vjson, "\"maps_scope\": \"maps with states uniform in each bin"));
 	free(vjson);
 	assert_int_equal(bsim_test_check_figures(pdir), 2); /* prediction and time */
 	assert_int_equal(bsim_test_check_figures(vdir), 1);
@@ -1283,9 +1417,9 @@ static void test_bad_map_files(void **state)
 	char *essay = strdup(bsim_test_src("configs/lattice/c_track_essay.yaml"));
 	char *track = strdup(bsim_test_src("configs/lattice/c_track.yaml"));
 	/* the start's trials as the others': the damaged files fit a buffer */
-	const char *build[] = {"markov", "build",          essay, "--bins",  "1,1,1", "--trials",
-	                       "2",      "--start-trials", "2",   "--quiet", "--out", dir,
-	                       NULL};
+	const char *build[] = {
+	        "markov", "build",   essay, "--bins",  "1,1,1", "--trials", "2", "--start-trials",
+	        "2",      "--train", "0",   "--quiet", "--out", dir,        NULL};
 	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
 	const char *pred[] = {"markov", "predict", track, "--map", dir, NULL};
 	/* Without the manifest, which would refuse any edit by its CRC-32
@@ -1469,6 +1603,7 @@ static void test_entries(void **state)
 	const bsim_markov_bins b = {2, 1, 1, 40.0};
 	const int bin = bsim_markov_bin_of(&b, &s.lattice, BSIM_EDGE_BOTTOM, 20.0, e.v[0]);
 	bsim_markov_def def = bsim_markov_def_default();
+	def.train_trials = 0; /* states uniform in each bin */
 	def.bins = b;
 	def.trials = 60;
 	def.start_trials = 0; /* the start's as the others': only bin `bin` differs */
@@ -1551,6 +1686,7 @@ static void test_self_entries(void **state)
 	snprintf(d0, sizeof d0, "%s/pass0", dir);
 	snprintf(d1, sizeof d1, "%s/pass1", dir);
 	bsim_markov_def def = bsim_markov_def_default();
+	def.train_trials = 0; /* states uniform in each bin: pass 0's */
 	def.bins = (bsim_markov_bins){2, 2, 2, 40.0};
 	def.trials = 30;
 	def.start_trials = 0; /* the passes take every bin's trials alike */
@@ -1837,12 +1973,27 @@ static void test_scope(void **state)
 	const bsim_markov_def d0 = bsim_markov_def_default();
 	assert_string_equal(bsim_markov_def_scope(&d0, buf, sizeof buf), "");
 	bsim_markov_def d = d0;
-	d.bins.n_pos = 14;
+	d.bins.n_pos = 20;
 	d.bins.n_speed = 6;
-	d.bins.n_dir = 13; /* more bins, not fewer */
+	d.bins.n_dir = 18; /* more bins, not fewer */
 	d.start_trials = 8000;
+	d.train_trials = 20000;
 	d.trials = 20; /* the maps' sampling error, which validate reports */
 	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf), "");
+	d = d0;
+	d.train_trials = 0;
+	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf),
+	                    "maps with states uniform in each bin (no training field): measured "
+	                    "less accurate than the default's on layouts they were not built on "
+	                    "(docs/markov.md, \"What each part does\")");
+	d.bins = (bsim_markov_bins){8, 8, 9, 40.0}; /* the default before the training field */
+	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
+	                       "maps with states uniform in each bin (no training field), 8,8,9 "
+	                       "bins (the default 14,6,13): "));
+	d = d0;
+	d.train_trials = 2000;
+	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
+	                       "maps with 2000 training trials (the default 10000): "));
 	d = d0;
 	d.after_start = 0;
 	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf),
@@ -1888,9 +2039,9 @@ static void test_interrupted_build(void **state)
 	snprintf(whole, sizeof whole, "%s", bsim_test_dir("build_whole"));
 	/* the start's trials as the others' (the test is of the stop, not the
 	 * maps) */
-	const char *b[] = {"markov",         "build", exp,      "--trials", "200",
-	                   "--start-trials", "200",   "--bins", "2,2,2",    "--quiet",
-	                   "--out",          whole,   NULL};
+	const char *b[] = {"markov", "build",  exp,     "--trials", "200", "--start-trials",
+	                   "200",    "--bins", "2,2,2", "--train",  "50",  "--quiet",
+	                   "--out",  whole,    NULL};
 	assert_int_equal(bsim_test_cli(b, NULL, NULL), 0);
 	char *want = maps_of(whole);
 	static const int sigs[] = {SIGINT, SIGTERM, SIGKILL};
@@ -1898,9 +2049,9 @@ static void test_interrupted_build(void **state)
 		char dir[1024], errfile[1100];
 		snprintf(dir, sizeof dir, "%s", bsim_test_dir("build_stopped"));
 		snprintf(errfile, sizeof errfile, "%s.err", dir);
-		const char *argv[] = {
-		        "markov", "build", "--start-trials", "200",   exp, "--trials", "200",
-		        "--bins", "2,2,2", "--quiet",        "--out", dir, NULL};
+		const char *argv[] = {"markov",   "build",   "--start-trials", "200",   exp,
+		                      "--trials", "200",     "--bins",         "2,2,2", "--train",
+		                      "50",       "--quiet", "--out",          dir,     NULL};
 		const bsim_test_opts o = {.err = errfile};
 		int pid = bsim_test_spawn_with(argv, &o);
 		int status = -1;
@@ -1918,9 +2069,10 @@ static void test_interrupted_build(void **state)
 		}
 		free(err);
 		unlink(errfile);
-		const char *again[] = {"markov", "build",          exp,   "--trials",
-		                       "200",    "--start-trials", "200", "--bins",
-		                       "2,2,2",  "--out",          dir,   NULL};
+		const char *again[] = {
+		        "markov", "build",  exp,     "--trials", "200", "--start-trials",
+		        "200",    "--bins", "2,2,2", "--train",  "50",  "--out",
+		        dir,      NULL};
 		char *out = NULL;
 		assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
 		assert_non_null(strstr(out, "1 maps built"));
@@ -1949,6 +2101,8 @@ int main(void)
 	        cmocka_unit_test(test_map_cost),
 	        cmocka_unit_test(test_one_gate_against_simulation),
 	        cmocka_unit_test(test_after_start_against_simulation),
+	        cmocka_unit_test(test_training_against_simulation),
+	        cmocka_unit_test(test_training_kinds),
 	        cmocka_unit_test(test_start_trials_key),
 	        cmocka_unit_test(test_threads_and_cache),
 	        cmocka_unit_test(test_interrupted_build),

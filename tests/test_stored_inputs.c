@@ -50,9 +50,9 @@ static void map_build(const char *dir, int with_manifest)
 	char exp[1200];
 	snprintf(exp, sizeof exp, "%s", essay);
 	/* the start's trials as the others': every bin's counts sum to 2 */
-	const char *build[] = {"markov", "build",          exp, "--bins",  "1,1,1", "--trials",
-	                       "2",      "--start-trials", "2", "--quiet", "--out", dir,
-	                       NULL};
+	const char *build[] = {
+	        "markov", "build",   exp, "--bins",  "1,1,1", "--trials", "2", "--start-trials",
+	        "2",      "--train", "0", "--quiet", "--out", dir,        NULL};
 	assert_int_equal(bsim_test_remove(dir), 0);
 	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
 	if (!with_manifest)

@@ -21,8 +21,12 @@
 %                    goes on there from its exact state, and the chain
 %                    takes the first two gates from those; 0: entry bins
 %                    from the start on (0 with self or flow entries)
+%     'train'        trials of the training field, a 21 x 21 field of the
+%                    lattice's gate kinds at random whose gate entries the
+%                    bins' states are drawn from (default 10000; run only
+%                    when a map is built); 0: states uniform in each bin
 %     'bins'         [P S D], bins of position, speed and direction
-%                    (default [8 8 9])
+%                    (default [14 6 13])
 %     'vmax'         m/s, the top of the speed bins (default 40)
 %     'entries'      gate_entries.csv paths (a text or a cell of texts), or
 %                    'self', 'self:N', 'flow', 'flow:N' (docs/markov.md)

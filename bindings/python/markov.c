@@ -68,19 +68,19 @@ static int entries_from(PyObject *seq, bsim_markov_def *def, const char ***paths
 PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"experiment", "out",          "trials",      "bins",
-	                         "vmax",       "entries",      "seed",        "threads",
-	                         "backend",    "sets",         "grid",        "backend_opts",
-	                         "progress",   "start_trials", "after_start", NULL};
+	static char *kwlist[] = {
+	        "experiment", "out",          "trials",      "bins",  "vmax", "entries",
+	        "seed",       "threads",      "backend",     "sets",  "grid", "backend_opts",
+	        "progress",   "start_trials", "after_start", "train", NULL};
 	const char *experiment, *out, *backend_spec = NULL;
-	int trials = 0, threads = 0, start_trials = 0, after_start = -1;
+	int trials = 0, threads = 0, start_trials = 0, after_start = -1, train = -1;
 	double vmax = 0.0;
 	PyObject *bins_o = Py_None, *entries_o = Py_None, *seed_o = Py_None, *sets_o = Py_None,
 	         *grid_o = Py_None, *opts_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|iOdOOizOOOOii", kwlist, &experiment, &out,
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|iOdOOizOOOOiii", kwlist, &experiment, &out,
 	                                 &trials, &bins_o, &vmax, &entries_o, &seed_o, &threads,
 	                                 &backend_spec, &sets_o, &grid_o, &opts_o, &progress_o,
-	                                 &start_trials, &after_start))
+	                                 &start_trials, &after_start, &train))
 		return NULL;
 	bsim_markov_build_def def = bsim_markov_build_def_default();
 	if (bins_o != Py_None && !PyArg_ParseTuple(bins_o, "iii", &def.map.bins.n_pos,
@@ -102,6 +102,8 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 		def.map.start_trials = start_trials;
 	if (after_start >= 0) /* -1: the default (self and flow entries: 0) */
 		def.map.after_start = after_start;
+	if (train >= 0) /* -1: the default training field */
+		def.map.train_trials = train;
 	def.entries = paths;
 	pyb_run_inputs in;
 	if (pyb_run_inputs_from(seed_o, sets_o, grid_o, progress_o, &in)) {

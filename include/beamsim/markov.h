@@ -71,11 +71,11 @@ typedef struct bsim_markov_bins {
 	double v_max; /* m/s: speeds above it fall in the last speed bin */
 } bsim_markov_bins;
 
-/* 8 positions, 8 speeds up to 40 m/s, 9 directions: where in a bin a
+/* 14 positions, 6 speeds up to 40 m/s, 13 directions: where in a bin a
  * lattice's entries fall matters to where the body goes next, above all
- * their direction, so the bins are fine enough that states uniform in
- * each predict fields of any layout (docs/markov.md, "Maps of a
- * physics"). */
+ * their position and direction, so the bins are fine, and their states
+ * drawn from a training field's entries, so that maps of a physics
+ * predict fields of any layout (docs/markov.md, "Maps of a physics"). */
 BSIM_API bsim_markov_bins bsim_markov_bins_default(void);
 
 /* The number of entry bins, the start's included: 1 + 4 n_pos n_speed n_dir. */
@@ -124,8 +124,17 @@ typedef struct bsim_markov_def {
 	const bsim_backend *backend;        /* NULL: the default backend */
 	const bsim_options *opts;           /* NULL: no options */
 	int threads;                        /* <= 0: all cores; the map is the same for any */
-	const bsim_markov_entries *entries; /* NULL: states uniform in each bin */
+	const bsim_markov_entries *entries; /* NULL: a training field's, or uniform in each bin */
 	char entries_id[64];                /* the entries' id when read back from markov.json */
+	/* With neither entries nor self or flow entries: > 0 (the default,
+	 * BSIM_MARKOV_TRAIN_TRIALS) draws each bin's states from the gate
+	 * entries of a training field, train_trials trials of a
+	 * BSIM_MARKOV_TRAIN_SIZE-square field of the lattice's gate kinds laid
+	 * out at random (seed) under the essay's protocol, run only when a map
+	 * is to be built; its label ("train N kinds n HASH") is in the maps'
+	 * keys, so the maps hold for every layout of the same kinds and
+	 * physics. 0: states uniform in each bin. */
+	int train_trials;
 	/* The gate after the start (1, the default): each of the start bin's
 	 * single gates that leaves into a gate is continued there, one single
 	 * gate from its exact exit state, for every stiffness pair of the
@@ -204,9 +213,13 @@ typedef struct bsim_markov_def {
 
 /* The start bin's single-gate trials by default. */
 #define BSIM_MARKOV_START_TRIALS 4000
+/* The training field's trials by default, and its gates across and along. */
+#define BSIM_MARKOV_TRAIN_TRIALS 10000
+#define BSIM_MARKOV_TRAIN_SIZE   21
 
 /* bsim_markov_bins_default(), 50 trials per bin and BSIM_MARKOV_START_TRIALS
- * of the start bin, seed 1, the default backend, all cores. */
+ * of the start bin, a training field of BSIM_MARKOV_TRAIN_TRIALS, seed 1,
+ * the default backend, all cores. */
 BSIM_API bsim_markov_def bsim_markov_def_default(void);
 
 /* One single-gate map. */

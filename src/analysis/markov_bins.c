@@ -9,7 +9,7 @@ static const double PI = 3.14159265358979323846;
 
 bsim_markov_bins bsim_markov_bins_default(void)
 {
-	return (bsim_markov_bins){.n_pos = 8, .n_speed = 8, .n_dir = 9, .v_max = 40.0};
+	return (bsim_markov_bins){.n_pos = 14, .n_speed = 6, .n_dir = 13, .v_max = 40.0};
 }
 
 int bsim_markov_bins_count(const bsim_markov_bins *b)

@@ -79,6 +79,8 @@ const char *bsim_markov_entries_label(const bsim_markov_def *def, const bsim_sce
 		         (unsigned long long)layout_hash(lattice));
 	else if (flow || def->self_entries)
 		snprintf(buf, size, "%s %d", flow ? "flow" : "self", passes);
+	else if (bsim_markov_def_trains(def))
+		return bsim_markov_train_label(lattice, def->train_trials, buf, size);
 	else
 		return def->entries_id[0] ? def->entries_id : "none";
 	return buf;
@@ -896,7 +898,13 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	bsim_ydoc_free(&d);
 	if (rc != BSIM_OK)
 		return rc;
-	if (strcmp(id, "none") != 0)
+	/* "train N": a training field of N trials, of each lattice's kinds */
+	int train = 0, used = 0;
+	def->train_trials = 0;
+	if (sscanf(id, "train %d%n", &train, &used) == 1 && train > 0 &&
+	    (id[used] == '\0' || id[used] == ' '))
+		def->train_trials = train;
+	else if (strcmp(id, "none") != 0)
 		snprintf(def->entries_id, sizeof def->entries_id, "%s", id);
 	def->seed = seed;
 	def->backend = bsim_backend_find(backend, err);

@@ -57,6 +57,20 @@ static int entries_push(bsim_markov_entries *e, int *cap, int edge, double pos, 
 	return 0;
 }
 
+int bsim_markov_entries_alloc(bsim_markov_entries *e, int n)
+{
+	memset(e, 0, sizeof *e);
+	const size_t m = n > 0 ? (size_t)n : 1;
+	e->edge = malloc(m * sizeof *e->edge);
+	e->pos = malloc(m * sizeof *e->pos);
+	e->x = malloc(m * sizeof *e->x);
+	e->v = malloc(m * sizeof *e->v);
+	if (e->edge && e->pos && e->x && e->v)
+		return 0;
+	bsim_markov_entries_free(e);
+	return -1;
+}
+
 int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entries *out,
                              bsim_error *err)
 {

@@ -1,6 +1,7 @@
 /* Internal: what the files of the single-gate maps (beamsim/markov.h)
  * share. markov_bins.c lays out the entry bins and draws states in them,
  * markov_entries.c reads observed entries and indexes them by bin,
+ * markov_train.c runs a training field for them,
  * markov_gate.c runs the single gates that fill a map, markov_counts.c
  * keeps a map's counts by row, markov_cache.c keys maps and reads and
  * writes a map directory, and markov_map.c builds or loads the maps of a
@@ -38,6 +39,10 @@ typedef struct markov_entry_index {
 	int *first, *idx;
 } markov_entry_index;
 
+/* e with room for n entries, none yet (e->n 0): 0, or -1 out of memory
+ * (e then empty). */
+int bsim_markov_entries_alloc(bsim_markov_entries *e, int n);
+
 /* 0, or -1 out of memory (then bsim_markov_entry_index_free all the same). */
 int bsim_markov_entry_index_init(markov_entry_index *x, const bsim_markov_entries *e,
                                  const bsim_markov_bins *b, const bsim_lattice_def *l);
@@ -47,6 +52,13 @@ void bsim_markov_entry_index_free(markov_entry_index *x);
 static inline int bsim_markov_def_start_trials(const bsim_markov_def *def)
 {
 	return def->start_trials > 0 ? def->start_trials : def->trials;
+}
+
+/* Whether def's states come from a training field (markov_train.c): the
+ * default, with neither observed, self nor flow entries. */
+static inline int bsim_markov_def_trains(const bsim_markov_def *def)
+{
+	return def->train_trials > 0 && !def->entries && !def->entries_id[0] && !def->self_entries;
 }
 
 /* Whether def's maps have the gate after the start: after_start, but never
@@ -76,6 +88,25 @@ static inline int bsim_markov_unit_bin(const bsim_markov_map *m, long u)
 {
 	return u < m->start_trials ? 0 : 1 + (int)((u - m->start_trials) / m->trials);
 }
+
+/* ---- the training field (markov_train.c) ---- */
+
+/* The lattice's stiffness pairs (its gate kinds) in the order first met,
+ * row 0 first, into *pairs (malloc'd): their number, or -1 out of memory. */
+int bsim_markov_lattice_pairs(const bsim_scene *lattice, double (**pairs)[2]);
+
+/* The id of the entries of a training field of def->train_trials trials of
+ * lattice's gate kinds: "train N kinds n HASH" (HASH of the kinds sorted),
+ * or "train N" without a lattice (as markov.json names it). */
+const char *bsim_markov_train_label(const bsim_scene *lattice, int trials, char *buf, size_t size);
+
+/* The gate entries of lattice's training field (def->train_trials trials,
+ * on def->threads threads, the same for any number), the start's left
+ * out, in trial order; out->id its label. BSIM_EFAIL naming the first
+ * unstable trial, BSIM_ESTOPPED when def->stop was set. */
+int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
+                          const bsim_backend *be, const bsim_options *opts,
+                          bsim_markov_entries *out, bsim_error *err);
 
 /* ---- counts by row (markov_counts.c) ---- */
 

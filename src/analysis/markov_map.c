@@ -24,6 +24,7 @@ bsim_markov_def bsim_markov_def_default(void)
 	return (bsim_markov_def){.bins = bsim_markov_bins_default(),
 	                         .trials = 50,
 	                         .start_trials = BSIM_MARKOV_START_TRIALS,
+	                         .train_trials = BSIM_MARKOV_TRAIN_TRIALS,
 	                         .after_start = 1,
 	                         .seed = 1};
 }
@@ -55,7 +56,7 @@ static int check_lattice(const bsim_scene *s, bsim_error *err)
 
 /* The distinct (left, right) stiffness pairs of the lattice's gates, in
  * the order first met (row 0 first); returns how many, -1 out of memory. */
-static int lattice_pairs(const bsim_scene *s, double (**pairs)[2])
+int bsim_markov_lattice_pairs(const bsim_scene *s, double (**pairs)[2])
 {
 	const bsim_lattice_def *l = &s->lattice;
 	int n = 0, cap = l->columns * l->rows;
@@ -127,6 +128,10 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 	if (def->trials < 1 || def->trials > 1000000)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "trials: expected 1 to 1000000 per bin, got %d", def->trials);
+	if (def->train_trials < 0 || def->train_trials > 1000000)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "training trials: expected 0 to 1000000, got %d",
+		                      def->train_trials);
 	if (def->start_trials > 1000000)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "start trials: expected 1 to 1000000, got %d",
@@ -172,30 +177,39 @@ const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t 
 	if (def->entries || id[0]) {
 		snprintf(buf, size,
 		         "entries observed in sweeps: the maps hold for layouts like the sweeps' "
-		         "(those of a random field of the gate kinds were measured about as close "
-		         "as the default's or closer on other layouts; docs/markov.md, \"A "
-		         "training field\")");
+		         "(those of a random field of the gate kinds, as the default's training "
+		         "field, were measured as close; docs/markov.md, \"A training field\")");
 		return buf;
 	}
-	/* The default method's three parts, each measured without the others. */
-	char bins[64] = "", start[64] = "";
+	/* The default method's parts, each measured without the others. */
+	char part[4][64] = {"", "", "", ""};
+	if (!bsim_markov_def_trains(def))
+		snprintf(part[0], sizeof part[0], "states uniform in each bin (no training field)");
+	else if (def->train_trials < d0.train_trials)
+		snprintf(part[0], sizeof part[0], "%d training trials (the default %d)",
+		         def->train_trials, d0.train_trials);
 	if (bsim_markov_bins_count(&def->bins) < bsim_markov_bins_count(&d0.bins))
-		snprintf(bins, sizeof bins, "%d,%d,%d bins (the default %d,%d,%d)", def->bins.n_pos,
-		         def->bins.n_speed, def->bins.n_dir, d0.bins.n_pos, d0.bins.n_speed,
-		         d0.bins.n_dir);
+		snprintf(part[1], sizeof part[1], "%d,%d,%d bins (the default %d,%d,%d)",
+		         def->bins.n_pos, def->bins.n_speed, def->bins.n_dir, d0.bins.n_pos,
+		         d0.bins.n_speed, d0.bins.n_dir);
 	if (bsim_markov_def_start_trials(def) < d0.start_trials)
-		snprintf(start, sizeof start, "%d start trials (the default %d)",
+		snprintf(part[2], sizeof part[2], "%d start trials (the default %d)",
 		         bsim_markov_def_start_trials(def), d0.start_trials);
-	const char *next = def->after_start ? "" : "no gate after the start";
-	if (!bins[0] && !start[0] && !next[0]) {
+	if (!def->after_start)
+		snprintf(part[3], sizeof part[3], "no gate after the start");
+	char list[4 * 64 + 8] = "";
+	size_t len = 0;
+	for (int k = 0; k < 4; k++)
+		if (part[k][0])
+			len += (size_t)snprintf(list + len, sizeof list - len, "%s%s",
+			                        len ? ", " : "", part[k]);
+	if (!len)
 		snprintf(buf, size, "%s", "");
-		return buf;
-	}
-	snprintf(buf, size,
-	         "maps with %s%s%s%s%s: measured less accurate than the default's on layouts "
-	         "they were not built on (%s)",
-	         bins, bins[0] && (start[0] || next[0]) ? ", " : "", start,
-	         start[0] && next[0] ? ", " : "", next, each_part);
+	else
+		snprintf(buf, size,
+		         "maps with %s: measured less accurate than the default's on layouts "
+		         "they were not built on (%s)",
+		         list, each_part);
 	return buf;
 }
 
@@ -397,7 +411,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	const bsim_options none = {0};
 	const bsim_options *opts = def->opts ? def->opts : &none;
 	double(*pairs)[2] = NULL;
-	int n = lattice_pairs(lattice, &pairs);
+	int n = bsim_markov_lattice_pairs(lattice, &pairs);
 	if (n < 0)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	out->def = *def;
@@ -497,6 +511,19 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	/* Flow-weighted entries: every map's passes at once, the lattice's
 	 * chain weighting each pass's states. Parts that meet after each pass
 	 * all take part, those with no map of this lattice too. */
+	/* The training field, run only when a map is to be simulated here:
+	 * its entries the states of every map this set builds. */
+	bsim_markov_entries train = {0};
+	bsim_markov_def with_train;
+	double train_share = 0.0; /* a built map's part of the field's CPU, s */
+	if (rc == BSIM_OK && stage && !made && to_build > 0 && bsim_markov_def_trains(def)) {
+		clock_t c0 = clock();
+		rc = bsim_markov_train_run(lattice, def, be, opts, &train, err);
+		train_share = (double)(clock() - c0) / CLOCKS_PER_SEC / to_build;
+		with_train = *def;
+		with_train.entries = &train;
+		def = &with_train;
+	}
 	const int flow = def->self_entries == 2 && stage && rc == BSIM_OK &&
 	                 (to_build > 0 || (def->parts > 1 && def->pass_exchange));
 	if (flow)
@@ -528,7 +555,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		                         : bsim_markov_map_simulate(lattice, def, be, opts, m,
 		                                                    &done, total, err);
 		if (!flow) /* else the CPU time of its passes */
-			m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
+			m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC + train_share;
 		/* with self or flow entries, m->cost holds what the passes
 		 * reused from the cache cost */
 		m->cost = m->seconds + (def->self_entries ? m->cost : 0.0);
@@ -549,6 +576,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		bsim_error_set(err, BSIM_ESTOPPED,
 		               "stopped after %d of the %d maps to build; those are kept in %s",
 		               out->built, to_build, dir);
+	bsim_markov_entries_free(&train);
 	free(have);
 	free(src);
 	free(pairs);

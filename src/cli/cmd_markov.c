@@ -37,7 +37,8 @@ enum {
 	OWN_SHARD,
 	OWN_PASSES,
 	OWN_START_TRIALS,
-	OWN_AFTER_START
+	OWN_AFTER_START,
+	OWN_TRAIN
 };
 
 #define MAX_ENTRIES 16
@@ -142,6 +143,14 @@ static int markov_option(void *args, int i, const char *value)
 		a->start_trials = 1;
 		return CLI_OK;
 	}
+	case OWN_TRAIN: {
+		long n;
+		if (cli_parse_long(value, 0, 1000000, &n) != 0)
+			return cli_usage("markov build",
+			                 "--train %s: expected an integer 0 to 1000000", value);
+		a->def.train_trials = (int)n;
+		return CLI_OK;
+	}
 	case OWN_MAP:
 		a->map = value;
 		return CLI_OK;
@@ -192,12 +201,12 @@ static int markov_option(void *args, int i, const char *value)
 static const cli_own build_own[] = {
         [OWN_BINS] = {"bins", 1, "P,S,D",
                       "entry bins of position along the edge, speed and\n"
-                      "direction (default 8,8,9)"},
+                      "direction (default 14,6,13)"},
         [OWN_VMAX] = {"vmax", 1, "V", "m/s, the top of the speed bins (default 40)"},
         [OWN_ENTRIES] = {"entries", 1, "PATH",
                          "gate_entries.csv of a lattice sweep (or its directory),\n"
                          "repeatable: a bin's states are drawn from the entries\n"
-                         "that fall in it (default: uniformly in the bin); self or\n"
+                         "that fall in it (default: a training field's, --train); self or\n"
                          "self:N: from the exits of the map's own single gates, N\n"
                          "passes (default 1); flow or flow:N: from every map's exits\n"
                          "weighted by the chain's flow on each lattice (maps for\n"
@@ -221,6 +230,11 @@ static const cli_own build_own[] = {
          "on there from its exact state, for every pair of stiffnesses,\n"
          "and the chain takes the first two gates from those (0 with\n"
          "self or flow entries); 0: entry bins from the start on"},
+        {"train", 1, "N",
+         "trials of the training field, a 21 x 21 field of the\n"
+         "lattice's gate kinds at random, whose gate entries the\n"
+         "bins' states are drawn from (default 10000; run only when\n"
+         "a map is built); 0: states uniform in each bin"},
 };
 
 static int build_option(void *args, int i, const char *value)
@@ -230,6 +244,7 @@ static int build_option(void *args, int i, const char *value)
 	                     : i == 4 ? OWN_PASSES
 	                     : i == 5 ? OWN_START_TRIALS
 	                     : i == 6 ? OWN_AFTER_START
+	                     : i == 7 ? OWN_TRAIN
 	                              : i,
 	                     value);
 }
@@ -262,7 +277,7 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 7,
+        .n_own = 8,
         .option = build_option,
 };
 
@@ -503,6 +518,11 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 	       res->built, res->seconds, res->reused,
 	       res->copied ? ", the others from the parts" : "", res->n_bins, def->map.trials,
 	       def->map.start_trials > 0 ? def->map.start_trials : def->map.trials, cli_path(out));
+	if (res->built > 0 && def->n_entries <= 0 && def->map.train_trials > 0 &&
+	    !def->map.self_entries)
+		printf("the bins' states from the gate entries of a training field, %d trials of "
+		       "%d x %d gates of the lattice's kinds at random (CPU above)\n",
+		       def->map.train_trials, BSIM_MARKOV_TRAIN_SIZE, BSIM_MARKOV_TRAIN_SIZE);
 	if (def->map.after_start && !def->map.self_entries)
 		printf("the gate after the start: %d pairs of maps built, %d reused (CPU above)\n",
 		       res->next_built, res->next_reused);

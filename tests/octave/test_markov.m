@@ -36,12 +36,12 @@ source(fullfile(fileparts(mfilename('fullpath')), 'mex_helpers.m'));
 [build, source, exe, tmp] = test_setup();
 experiment = fullfile(source, 'configs', 'markov', 'c_track.yaml');
 scene = fullfile(source, 'configs', 'lattice', 'c_track.yaml');
-small = '--trials 3 --start-trials 7 --bins 2,2,1 --threads 2 --seed 5';
+small = '--trials 3 --start-trials 7 --train 40 --bins 2,2,1 --threads 2 --seed 5';
 
 % ---- build: the program's maps -------------------------------------------
 mine = fullfile(tmp, 'maps_mex');
 theirs = fullfile(tmp, 'maps_program');
-b = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'bins', [2 2 1], ...
+b = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'train', 40, 'bins', [2 2 1], ...
                    'threads', 2, 'seed', 5);
 [out, err, status] = program(exe, tmp, sprintf('markov build %s %s --out %s', experiment, ...
                                                small, theirs));
@@ -58,12 +58,12 @@ check(isequal(n1, n2) && isequal(t1, t2), 'the maps differ from the program''s: 
       strjoin(n1, ' '), strjoin(n2, ' '));
 check(any(~cellfun(@isempty, strfind(n1, '.after_'))), 'no gate after the start in %s', ...
       strjoin(n1, ' '));
-check(strncmp(b.scope, 'maps with 2,2,1 bins', 20) && ~isempty(strfind(err, ['note: ' b.scope])), ...
+check(strncmp(b.scope, 'maps with 40 training trials', 28) && ~isempty(strfind(err, ['note: ' b.scope])), ...
       'the scope ''%s'' is not the program''s note: %s', b.scope, err);
 % 'after_start', 0 as --after-start 0: no gate after the start
 mine0 = fullfile(tmp, 'maps_mex_after0');
 theirs0 = fullfile(tmp, 'maps_program_after0');
-beamsim_markov('build', experiment, 'out', mine0, 'trials', 3, 'start_trials', 7, 'bins', [2 2 1], ...
+beamsim_markov('build', experiment, 'out', mine0, 'trials', 3, 'start_trials', 7, 'train', 40, 'bins', [2 2 1], ...
                'threads', 2, 'seed', 5, 'after_start', 0);
 [out, err, status] = program(exe, tmp, sprintf('markov build %s %s --after-start 0 --out %s', ...
                                                experiment, small, theirs0));
@@ -72,7 +72,7 @@ check(status == 0, 'beamsim markov build --after-start 0: exit %d: %s', status, 
 [n4, t4] = map_files(theirs0);
 check(isequal(n3, n4) && isequal(t3, t4) && all(cellfun(@isempty, strfind(n3, '.after_'))), ...
       'after_start 0: %s / %s', strjoin(n3, ' '), strjoin(n4, ' '));
-again = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'bins', [2 2 1], 'seed', 5);
+again = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'train', 40, 'bins', [2 2 1], 'seed', 5);
 check(again.reused == numel(keys) && again.built == 0, 'a build again: %d reused', again.reused);
 printf('build: %d maps, the program''s bytes\n', numel(keys));
 

@@ -15,8 +15,9 @@ from conftest import cli, cli_message, config
 
 EXPERIMENT = config("markov", "c_track.yaml")
 SCENE = config("lattice", "c_track.yaml")
-SMALL = dict(trials=3, bins=(2, 2, 1), threads=2, start_trials=7)
-SMALL_ARGS = ["--trials", "3", "--bins", "2,2,1", "--threads", "2", "--start-trials", "7"]
+SMALL = dict(trials=3, bins=(2, 2, 1), threads=2, start_trials=7, train=40)
+SMALL_ARGS = ["--trials", "3", "--bins", "2,2,1", "--threads", "2", "--start-trials", "7",
+              "--train", "40"]
 # what two runs of one prediction or validation measure differently
 TIMES = ("predict_seconds", "predict_cpu_seconds", "sim_cpu_seconds", "speedup",
          "break_even_lattices", "map_cpu_seconds")
@@ -59,7 +60,8 @@ def test_build_is_the_programs(maps):
     run = cli("markov", "build", EXPERIMENT, *SMALL_ARGS, "--seed", "5", "--out", prog)
     lines = run.stdout.splitlines()
     # the program's note on these coarse bins and few start trials
-    assert built["scope"].startswith("maps with 2,2,1 bins (the default 8,8,9), 7 start")
+    assert built["scope"].startswith("maps with 40 training trials (the default 10000), 2,2,1 "
+                                     "bins (the default 14,6,13), 7 start")
     assert f"note: {built['scope']}" in run.stderr
     listed = [line.split()[-2] for line in lines if line.startswith("group ")]
     assert [m["key"] for m in built["maps"]] == listed
@@ -127,7 +129,8 @@ def test_validate_is_the_programs(maps):
     del want["map_dir"], got["map_dir"]
     assert untimed({k: got[k] for k in want}) == untimed(want)
     assert [c["protocol"] for c in got["checks"]] == ["essay", "world"]
-    assert got["maps_scope"].startswith("maps with 2,2,1 bins (the default 8,8,9)")
+    assert got["maps_scope"].startswith("maps with 40 training trials (the default 10000), "
+                                        "2,2,1 bins (the default 14,6,13)")
     with open(tmp / "val_prog" / "validate.csv", "rb") as f:
         assert (tmp / "val_py" / "validate.csv").read_bytes() == f.read()
     assert list(got["files"]["validate"]["p_sim"]) == list(
@@ -159,6 +162,8 @@ def test_bad_arguments(maps, tmp_path):
         beamsim.markov_build(EXPERIMENT, target, bins=(2, 0, 1))
     with pytest.raises(ValueError, match="entries self:9: expected self, self:N"):
         beamsim.markov_build(EXPERIMENT, target, entries="self:9")
+    with pytest.raises(ValueError, match=r"--train -1: expected an integer >= 0"):
+        beamsim.markov_build(EXPERIMENT, target, train=-1)
     with pytest.raises(ValueError, match=r"--tol 2: expected the probability"):
         beamsim.markov_predict(SCENE, py, tol=2)
     with pytest.raises(ValueError, match=r"--walks -1: expected an integer"):

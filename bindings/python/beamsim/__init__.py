@@ -460,7 +460,7 @@ def _entries(entries):
 
 def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=None, seed=None,
                  threads=None, backend=None, backend_opt=None, set=None, grid=None,
-                 progress=None, start_trials=None, after_start=None):
+                 progress=None, start_trials=None, after_start=None, train=None):
     """The single-gate maps the lattices of an experiment need, one per pair
     of beam stiffnesses, built into the map directory out as `beamsim
     markov build EXPERIMENT --out DIR` builds them (docs/markov.md): the
@@ -472,8 +472,12 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
     entries); after_start: True (None: the default, False with self or flow
     entries) continues each start trial that leaves into a gate there from
     its exact state, for every pair of stiffnesses, and the chain takes the
-    first two gates from those; False: entry bins from the start on; bins: (positions, speeds, directions), 1 to 64 each (None:
-    (8, 8, 9));
+    first two gates from those; False: entry bins from the start on;
+    train: trials of the training field, a 21 x 21 field of the lattice's
+    gate kinds at random whose gate entries the bins' states are drawn from
+    (None: 10,000; run only when a map is built), 0: states uniform in each
+    bin; bins: (positions, speeds, directions), 1 to 64 each (None:
+    (14, 6, 13));
     vmax: m/s, the top of the speed bins (None: 40); entries: gate_entries.csv
     paths (a bin's states drawn from them), or "self", "self:N", "flow",
     "flow:N" as --entries; seed: of the states and schedules (None: 1);
@@ -506,7 +510,8 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
                                  _seed(seed), _count("threads", threads, 1, 4096), backend,
                                  _sets(set), _grid(grid), _opts(backend_opt), progress,
                                  _count("start_trials", start_trials, 1, 1000000),
-                                 -1 if after_start is None else int(bool(after_start)))
+                                 -1 if after_start is None else int(bool(after_start)),
+                                 -1 if train is None else _count("train", train, 0, 1000000))
     info["out"] = out
     return info
 

@@ -1,0 +1,207 @@
+/* The training field of a map build (beamsim/markov.h, train_trials): a
+ * BSIM_MARKOV_TRAIN_SIZE x BSIM_MARKOV_TRAIN_SIZE field of the lattice's
+ * gate kinds laid out at random, run under the essay's protocol, whose gate
+ * entries are the states the maps' single gates start from. The field
+ * depends on the lattice only through its set of gate kinds (sorted, so
+ * not on the order they are met in) and its physics, so the maps stay of
+ * the physics: every layout of the same kinds shares them. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "analysis/markov_internal.h"
+
+#include <gsl/gsl_rng.h>
+#include <limits.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beamsim/lattice.h"
+#include "beamsim/limits.h"
+#include "beamsim/schedule.h"
+#include "model/scene_internal.h"
+#include "util/hash.h"
+
+/* Salt of the training field's layout and schedules. */
+#define TRAIN_SALT 0x747261696e696e67ULL
+
+static int pair_less(const void *a, const void *b)
+{
+	const double *p = a, *q = b;
+	return p[0] != q[0] ? (p[0] > q[0]) - (p[0] < q[0]) : (p[1] > q[1]) - (p[1] < q[1]);
+}
+
+/* The lattice's gate kinds in ascending order (left, then right): their
+ * number, or -1 out of memory. */
+static int kinds_sorted(const bsim_scene *lattice, double (**kinds)[2])
+{
+	const int n = bsim_markov_lattice_pairs(lattice, kinds);
+	if (n > 0)
+		qsort(*kinds, (size_t)n, sizeof **kinds, pair_less);
+	return n;
+}
+
+const char *bsim_markov_train_label(const bsim_scene *lattice, int trials, char *buf, size_t size)
+{
+	double(*kinds)[2] = NULL;
+	const int n = lattice ? kinds_sorted(lattice, &kinds) : 0;
+	uint64_t h = HASH_FNV1A64_SEED;
+	for (int i = 0; i < n; i++)
+		h = bsim_hash_fnv1a64(kinds[i], sizeof kinds[i], h);
+	free(kinds);
+	if (n > 0)
+		snprintf(buf, size, "train %d kinds %d %016llx", trials, n, (unsigned long long)h);
+	else
+		snprintf(buf, size, "train %d", trials);
+	return buf;
+}
+
+/* The training field of lattice into s: its physics, gate and body start
+ * (in the start gate's frame, moved to gate (0, 0)), every gate a kind of
+ * lattice drawn at random, the essay's protocol and a lattice's ends. */
+static int train_scene(const bsim_scene *lattice, uint64_t seed, bsim_scene *s, bsim_error *err)
+{
+	double(*kinds)[2] = NULL;
+	const int n = kinds_sorted(lattice, &kinds);
+	const int size = BSIM_MARKOV_TRAIN_SIZE, gates = size * size;
+	double *k = malloc(2 * (size_t)gates * sizeof *k);
+	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+	int rc = n > 0 && k && rng && bsim_scene_copy(s, lattice) == BSIM_OK ? BSIM_OK : BSIM_EFAIL;
+	if (rc == BSIM_OK) {
+		gsl_rng_set(rng, bsim_schedule_seed_mix(seed ^ TRAIN_SALT, 0, 0));
+		for (int g = 0; g < gates; g++) {
+			const int j = (int)gsl_rng_uniform_int(rng, (unsigned long)n);
+			k[g] = kinds[j][0];
+			k[gates + g] = kinds[j][1];
+		}
+		int ix, iy;
+		bsim_lattice_gate_at(lattice, lattice->body.start, &ix, &iy);
+		s->body.start[0] -= lattice->lattice.width * ix;
+		s->body.start[1] -= lattice->lattice.depth * iy;
+		bsim_lattice_def *l = &s->lattice;
+		l->rows = size;
+		l->ix_min = -(size / 2);
+		l->ix_max = size / 2;
+		l->protocol = BSIM_PROTOCOL_ESSAY;
+		l->stiffness_file[0] = '\0';
+		rc = bsim_lattice_build(s, k, k + gates);
+	}
+	if (rc == BSIM_OK) {
+		const int gate_steps = lattice->gate_steps;
+		bsim_scene_lattice_defaults(s);
+		if (gate_steps > 0) /* the lattice's own stuck limit, a gate's */
+			s->gate_steps = gate_steps;
+		/* a body stuck in no row crosses them all: a gate's limit a row,
+		 * within the beam-steps a trial may take (a trial that reaches it
+		 * ends, its entries kept) */
+		const double most = bsim_limits_get()->beam_steps / s->n_beams;
+		s->max_steps = (int)fmin((double)s->gate_steps * s->lattice.rows, most);
+		s->path[0] = '\0'; /* built here, from the lattice's file */
+		rc = bsim_scene_validate(s, err);
+	} else {
+		bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	gsl_rng_free(rng);
+	free(k);
+	free(kinds);
+	return rc;
+}
+
+int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
+                          const bsim_backend *be, const bsim_options *opts,
+                          bsim_markov_entries *out, bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	bsim_scene s;
+	memset(&s, 0, sizeof s);
+	int rc = train_scene(lattice, def->seed, &s, err);
+	const long T = def->train_trials;
+	bsim_trial_log *logs = rc == BSIM_OK ? calloc((size_t)T, sizeof *logs) : NULL;
+	if (rc == BSIM_OK && !logs)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	/* the first failure in trial order, whatever the threads */
+	long first = T;
+	bsim_error fail = {0};
+	int stopped = 0;
+	const int threads = def->threads > 0 ? def->threads : omp_get_max_threads();
+#pragma omp parallel num_threads(threads) if (rc == BSIM_OK)
+	{
+		bsim_trial_runner *r = bsim_trial_runner_alloc();
+		bsim_trial_log *log = bsim_trial_log_alloc();
+#pragma omp for schedule(dynamic, 4)
+		for (long t = 0; t < T; t++) {
+			if (rc != BSIM_OK)
+				continue;
+			bsim_error e = {0};
+			int trc = BSIM_OK;
+			if (def->stop && *def->stop) {
+#pragma omp atomic write
+				stopped = 1;
+				continue;
+			}
+			bsim_trial_result res;
+			bsim_recorder rec = {.stride = 1, .log = log};
+			if (!r || !log)
+				trc = bsim_error_set(&e, BSIM_EFAIL, "out of memory");
+			else
+				trc = bsim_trial_run(r, &s, be, opts,
+				                     bsim_schedule_seed_mix(def->seed ^ TRAIN_SALT,
+				                                            1, (uint64_t)t),
+				                     &rec, &res, &e);
+			if (trc == BSIM_OK && res.outcome == BSIM_UNSTABLE) {
+				char why[160];
+				bsim_trial_instability_text(&res, s.dt, why, sizeof why);
+				trc = bsim_error_set(&e, BSIM_EFAIL,
+				                     "trial %ld of the maps' training field became "
+				                     "unstable: %s",
+				                     t, why);
+			}
+			if (trc == BSIM_OK && bsim_trial_log_copy(&logs[t], log) != BSIM_OK)
+				trc = bsim_error_set(&e, BSIM_EFAIL, "out of memory");
+			if (trc != BSIM_OK) {
+#pragma omp critical(bsim_markov_train_fail)
+				if (t < first) {
+					first = t;
+					fail = e;
+				}
+			}
+		}
+		bsim_trial_log_free(log);
+		bsim_trial_runner_free(r);
+	}
+	if (rc == BSIM_OK && stopped)
+		rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped in the maps' training field");
+	else if (rc == BSIM_OK && first < T) {
+		rc = BSIM_EFAIL;
+		if (err)
+			*err = fail;
+	}
+	/* every entry but the start's, in trial order */
+	long n = 0;
+	for (long t = 0; rc == BSIM_OK && t < T; t++)
+		for (int j = 0; j < logs[t].n_entries; j++)
+			n += logs[t].entries[j].edge != BSIM_EDGE_START;
+	if (rc == BSIM_OK && (n > INT_MAX || bsim_markov_entries_alloc(out, (int)n)))
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (long t = 0; rc == BSIM_OK && t < T; t++)
+		for (int j = 0; j < logs[t].n_entries; j++) {
+			const bsim_gate_entry *g = &logs[t].entries[j];
+			if (g->edge == BSIM_EDGE_START)
+				continue;
+			const int i = out->n++;
+			out->edge[i] = (int)g->edge;
+			out->pos[i] = g->pos;
+			memcpy(out->x[i], g->x, sizeof out->x[i]);
+			memcpy(out->v[i], g->v, sizeof out->v[i]);
+		}
+	for (long t = 0; logs && t < T; t++)
+		bsim_trial_log_clear(&logs[t]);
+	free(logs);
+	bsim_scene_free(&s);
+	if (rc != BSIM_OK)
+		bsim_markov_entries_free(out);
+	else
+		bsim_markov_train_label(lattice, def->train_trials, out->id, sizeof out->id);
+	return rc;
+}
