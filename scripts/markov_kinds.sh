@@ -3,16 +3,19 @@
 # "Maps of a physics"): the fields of configs/markov/kinds/ (gate kinds
 # A = (150, 600), B = (600, 300), C = (300, 150) N m/rad at F_prop = 7 N,
 # Rm = 25 N), each simulated directly (10,000 trials, seed 1, both
-# protocols) by `markov validate` with the default maps, and predicted by
-# the maps of every method (`markov predict --out`), whose total variation
-# from the same simulation is computed here from prediction.csv and
-# validate.csv. The default maps are built once, on the first field, and
-# reused on every other; flow:1 maps are built per field (they hold for
-# that layout only). ring5 and check11 are the fields the settings were
-# chosen on; test_* were made after the bins and trials were fixed, fresh_*
-# after the gate after the start was, late_* after the training field
-# (method train), final_* after the training field with finer bins (method
-# train10k-bins14613; name them in FIELDS). Prints one row per method and field;
+# protocols) by `markov validate` with the first method's maps, and
+# predicted by the maps of every method (`markov predict --out`), whose
+# total variation from the same simulation is computed here from
+# prediction.csv and validate.csv. A method's maps are built once, on the
+# first field of a set of gate kinds, and reused on every other; flow:1
+# maps are built per field (they hold for that layout only). default is
+# the default now (a training field of the kinds, 14,6,13 bins), uniform
+# the default before it (states uniform in 8,8,9 bins). ring5 and check11
+# are the fields the settings were chosen on; test_* were made after the
+# bins and trials were fixed, fresh_* after the gate after the start was,
+# late_* after the training field (method train), final_* after the
+# training field with finer bins (method train10k-bins14613), held_* after
+# the default now (name them in FIELDS). Prints one row per method and field;
 # the runs stay in OUT (default out/markov-kinds), the table in
 # OUT/table.txt. FIELDS="..." chooses the fields, METHODS="..." the methods
 # (by name), TRIALS=N the direct trials of each (default the experiments',
@@ -24,12 +27,12 @@ out=${1:-out/markov-kinds}
 threads=${2:-2}
 exe=build/beamsim
 fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13 fresh_cols9 fresh_r21})
-# method name and its build options (the default: none); each of the
-# default's three parts (fine bins, many start trials, the gate after the
-# start) alone and without the others; flow:1; self:1 at the default bins;
-# the default at finer bins; the default with the states of a training
-# field's entries (train: the sweep of exp_train_r21.yaml, run first), and
-# with 10,000 trials of it and 14,6,13 bins
+# method name and its build options (the default: none); uniform, the
+# default before, and each of its three parts (fine bins, many start
+# trials, the gate after the start) alone and without the others; flow:1;
+# self:1 at 8,8,9 bins; uniform at finer bins; uniform with the states of
+# a training field's entries (train: the sweep of exp_train_r21.yaml, run
+# first), and with 10,000 trials of it and 14,6,13 bins
 methods=("default:"
          "uniform:--train 0 --bins 8,8,9"
          "without-after-start:--train 0 --bins 8,8,9 --after-start 0"
@@ -80,11 +83,9 @@ for f in "${fields[@]}"; do
         # the maps' CPU: what the builds into that directory took (a build
         # that reuses every map adds nothing)
         echo "$log" | sed -n 's/.*built (\([0-9.]*\) s of CPU).*/\1/p' >>"$maps.cpu"
-        if [ "$name" = default ]; then
-            [ -f "$v/validate.json" ] ||
-                $exe markov validate "$exp" --map "$maps" ${TRIALS:+--trials "$TRIALS"} \
-                    --threads "$threads" --quiet --out "$v"
-        fi
+        [ -f "$v/validate.json" ] ||
+            $exe markov validate "$exp" --map "$maps" ${TRIALS:+--trials "$TRIALS"} \
+                --threads "$threads" --quiet --out "$v"
         p=$out/predict-$name-$f
         $exe markov predict configs/markov/kinds/field_$f.yaml --map "$maps" --walks 0 --quiet \
             --overwrite --out "$p"

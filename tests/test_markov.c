@@ -807,7 +807,7 @@ static void test_after_start_against_simulation(void **state)
  * to 40 m/s and every direction, are nothing like a body's, and the chain
  * is off on at least one outcome; states drawn from the entries of a
  * training field of the same two kinds (a 21 x 21 field, not the column)
- * put every outcome within 4.5 standard errors of 600 direct trials. */
+ * put every outcome within 4.5 standard errors of 400 direct trials. */
 static void test_training_against_simulation(void **state)
 {
 	(void)state;
@@ -818,12 +818,12 @@ static void test_training_against_simulation(void **state)
 	s.lattice.protocol = BSIM_PROTOCOL_ESSAY;
 	bsim_markov_def def = bsim_markov_def_default();
 	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
-	def.trials = 300;
+	def.trials = 100;
 	def.start_trials = 600;
 	def.after_start = 0;
 	def.seed = 3;
 	const char *dir = exe_dir("training");
-	const int N = 600, train[2] = {0, 400};
+	const int N = 400, train[2] = {0, 200};
 	double *sim = NULL;
 	int off[2];
 	for (int i = 0; i < 2; i++) {
@@ -2040,7 +2040,7 @@ static void test_interrupted_build(void **state)
 	/* the start's trials as the others' (the test is of the stop, not the
 	 * maps) */
 	const char *b[] = {"markov", "build",  exp,     "--trials", "200", "--start-trials",
-	                   "200",    "--bins", "2,2,2", "--train",  "50",  "--quiet",
+	                   "200",    "--bins", "2,2,2", "--train",  "10",  "--quiet",
 	                   "--out",  whole,    NULL};
 	assert_int_equal(bsim_test_cli(b, NULL, NULL), 0);
 	char *want = maps_of(whole);
@@ -2051,7 +2051,7 @@ static void test_interrupted_build(void **state)
 		snprintf(errfile, sizeof errfile, "%s.err", dir);
 		const char *argv[] = {"markov",   "build",   "--start-trials", "200",   exp,
 		                      "--trials", "200",     "--bins",         "2,2,2", "--train",
-		                      "50",       "--quiet", "--out",          dir,     NULL};
+		                      "10",       "--quiet", "--out",          dir,     NULL};
 		const bsim_test_opts o = {.err = errfile};
 		int pid = bsim_test_spawn_with(argv, &o);
 		int status = -1;
@@ -2071,7 +2071,7 @@ static void test_interrupted_build(void **state)
 		unlink(errfile);
 		const char *again[] = {
 		        "markov", "build",  exp,     "--trials", "200", "--start-trials",
-		        "200",    "--bins", "2,2,2", "--train",  "50",  "--out",
+		        "200",    "--bins", "2,2,2", "--train",  "10",  "--out",
 		        dir,      NULL};
 		char *out = NULL;
 		assert_int_equal(bsim_test_cli(again, &out, NULL), 0);
@@ -2086,8 +2086,10 @@ static void test_interrupted_build(void **state)
 	free(want);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+	if (argc > 1) /* one test by name, e.g. test_training_kinds */
+		cmocka_set_test_filter(argv[1]);
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_one_gate_is_the_map),
 	        cmocka_unit_test(test_two_gates_geometric),
