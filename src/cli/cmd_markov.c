@@ -264,9 +264,12 @@ static const cli_spec build_spec = {
                  "direction; and the start) single gates with their beams at rest, as the\n"
                  "essay's protocol resets them, run from states drawn in the bin with fresh\n"
                  "random-force schedules until the body leaves the gate or is stuck; the\n"
-                 "counts of where it left are the map. Each start trial that leaves into a\n"
-                 "gate goes on there, in a gate of every pair, from its exact state (the gate\n"
-                 "after the start). DIR caches them: map_HASH.csv (entry, exit, count),\n"
+                 "counts of where it left are the map. A bin's states are the gate entries\n"
+                 "in it of a training field (--train trials of a 21 x 21 field of the\n"
+                 "lattice's gate kinds at random), so the maps serve every layout of those\n"
+                 "kinds. Each start trial that leaves into a gate goes on there, in a gate\n"
+                 "of every pair, from its exact state (the gate after the start). DIR\n"
+                 "caches them: map_HASH.csv (entry, exit, count),\n"
                  "map_HASH.key (everything the map depends on), map_START.after_GATE.csv,\n"
                  "markov.json.\n",
         .positional = "EXPERIMENT",
