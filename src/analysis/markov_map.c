@@ -508,9 +508,6 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	int to_build = made ? 0 : n - out->reused - out->copied;
 	for (int i = 0; i < n && !made; i++)
 		to_build -= out->maps[i].elsewhere;
-	/* Flow-weighted entries: every map's passes at once, the lattice's
-	 * chain weighting each pass's states. Parts that meet after each pass
-	 * all take part, those with no map of this lattice too. */
 	/* The training field, run only when a map is to be simulated here:
 	 * its entries the states of every map this set builds. */
 	bsim_markov_entries train = {0};
@@ -524,6 +521,9 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		with_train.entries = &train;
 		def = &with_train;
 	}
+	/* Flow-weighted entries: every map's passes at once, the lattice's
+	 * chain weighting each pass's states. Parts that meet after each pass
+	 * all take part, those with no map of this lattice too. */
 	const int flow = def->self_entries == 2 && stage && rc == BSIM_OK &&
 	                 (to_build > 0 || (def->parts > 1 && def->pass_exchange));
 	if (flow)

@@ -98,6 +98,7 @@ static int train_scene(const bsim_scene *lattice, uint64_t seed, bsim_scene *s, 
 		const double most = bsim_limits_get()->beam_steps / s->n_beams;
 		s->max_steps = (int)fmin((double)s->gate_steps * s->lattice.rows, most);
 		s->path[0] = '\0'; /* built here, from the lattice's file */
+		snprintf(s->name, sizeof s->name, "the training field of %.90s", lattice->name);
 		rc = bsim_scene_validate(s, err);
 	} else {
 		bsim_error_set(err, BSIM_EFAIL, "out of memory");
