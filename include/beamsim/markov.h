@@ -13,7 +13,8 @@
  *   direction  the angle of v from the edge's inward normal, in
  *              [-90, 90] degrees, n_dir equal bins (beyond: the end bins).
  * For each bin, `trials` single gates (the two beams at rest, as the essay
- * resets them on entry) start from states drawn uniformly in the bin, each
+ * resets them on entry) start from states drawn from a training field's
+ * gate entries in the bin (train_trials; or uniformly in the bin), each
  * with a fresh random-force schedule, and run until the body leaves the
  * gate's rectangle or gate_steps steps pass. The exit state is binned as
  * the entry state of the gate it enters, so a map is a matrix of counts
@@ -142,7 +143,7 @@ typedef struct bsim_markov_def {
 	 * gates from those runs rather than from the entry bins. The start's
 	 * exits are those a body's first gate delivers to every lattice, so
 	 * these runs are of the physics, not of a layout. 0: the entry bins
-	 * from the start on. Only with states uniform in each bin or observed
+	 * from the start on. Only with a training field's, uniform or observed
 	 * entries (self and flow entries: 0). */
 	int after_start;
 	bsim_progress_fn progress; /* may be NULL; counts single-gate trials */

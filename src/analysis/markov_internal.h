@@ -1,7 +1,7 @@
 /* Internal: what the files of the single-gate maps (beamsim/markov.h)
  * share. markov_bins.c lays out the entry bins and draws states in them,
  * markov_entries.c reads observed entries and indexes them by bin,
- * markov_train.c runs a training field for them,
+ * markov_train.c lists a lattice's gate kinds and runs their training field,
  * markov_gate.c runs the single gates that fill a map, markov_counts.c
  * keeps a map's counts by row, markov_cache.c keys maps and reads and
  * writes a map directory, and markov_map.c builds or loads the maps of a
@@ -89,7 +89,7 @@ static inline int bsim_markov_unit_bin(const bsim_markov_map *m, long u)
 	return u < m->start_trials ? 0 : 1 + (int)((u - m->start_trials) / m->trials);
 }
 
-/* ---- the training field (markov_train.c) ---- */
+/* ---- the lattice's gate kinds and its training field (markov_train.c) ---- */
 
 /* The lattice's stiffness pairs (its gate kinds) in the order first met,
  * row 0 first, into *pairs (malloc'd): their number, or -1 out of memory. */

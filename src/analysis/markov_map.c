@@ -54,32 +54,6 @@ static int check_lattice(const bsim_scene *s, bsim_error *err)
 	return BSIM_OK;
 }
 
-/* The distinct (left, right) stiffness pairs of the lattice's gates, in
- * the order first met (row 0 first); returns how many, -1 out of memory. */
-int bsim_markov_lattice_pairs(const bsim_scene *s, double (**pairs)[2])
-{
-	const bsim_lattice_def *l = &s->lattice;
-	int n = 0, cap = l->columns * l->rows;
-	double(*p)[2] = malloc((size_t)cap * sizeof *p);
-	if (!p)
-		return -1;
-	for (int iy = 0; iy < l->rows; iy++)
-		for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
-			double k[2] = {s->beams[bsim_lattice_beam(l, ix, iy, 0)].stiffness,
-			               s->beams[bsim_lattice_beam(l, ix, iy, 1)].stiffness};
-			int j = 0;
-			while (j < n && !(p[j][0] == k[0] && p[j][1] == k[1]))
-				j++;
-			if (j == n) {
-				p[n][0] = k[0];
-				p[n][1] = k[1];
-				n++;
-			}
-		}
-	*pairs = p;
-	return n;
-}
-
 static int map_init(bsim_markov_map *m, const bsim_scene *lattice, const bsim_markov_def *def,
                     const bsim_backend *be, const bsim_options *opts, const double k[2],
                     bsim_error *err)

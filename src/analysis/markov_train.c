@@ -1,4 +1,5 @@
-/* The training field of a map build (beamsim/markov.h, train_trials): a
+/* A lattice's gate kinds (its stiffness pairs), and the training field of
+ * a map build (beamsim/markov.h, train_trials): a
  * BSIM_MARKOV_TRAIN_SIZE x BSIM_MARKOV_TRAIN_SIZE field of the lattice's
  * gate kinds laid out at random, run under the essay's protocol, whose gate
  * entries are the states the maps' single gates start from. The field
@@ -25,6 +26,32 @@
 
 /* Salt of the training field's layout and schedules. */
 #define TRAIN_SALT 0x747261696e696e67ULL
+
+/* The distinct (left, right) stiffness pairs of the lattice's gates, in
+ * the order first met (row 0 first); returns how many, -1 out of memory. */
+int bsim_markov_lattice_pairs(const bsim_scene *s, double (**pairs)[2])
+{
+	const bsim_lattice_def *l = &s->lattice;
+	int n = 0, cap = l->columns * l->rows;
+	double(*p)[2] = malloc((size_t)cap * sizeof *p);
+	if (!p)
+		return -1;
+	for (int iy = 0; iy < l->rows; iy++)
+		for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
+			double k[2] = {s->beams[bsim_lattice_beam(l, ix, iy, 0)].stiffness,
+			               s->beams[bsim_lattice_beam(l, ix, iy, 1)].stiffness};
+			int j = 0;
+			while (j < n && !(p[j][0] == k[0] && p[j][1] == k[1]))
+				j++;
+			if (j == n) {
+				p[n][0] = k[0];
+				p[n][1] = k[1];
+				n++;
+			}
+		}
+	*pairs = p;
+	return n;
+}
 
 static int pair_less(const void *a, const void *b)
 {
