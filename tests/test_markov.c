@@ -2086,10 +2086,11 @@ static void test_interrupted_build(void **state)
 	free(want);
 }
 
+/* ctest runs the long tests (against direct simulation, and a build
+ * stopped by signals) as test_markov_long, `test_markov long`, each with
+ * its own time limit; any other argument runs the tests of that name. */
 int main(int argc, char **argv)
 {
-	if (argc > 1) /* one test by name, e.g. test_training_kinds */
-		cmocka_set_test_filter(argv[1]);
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_one_gate_is_the_map),
 	        cmocka_unit_test(test_two_gates_geometric),
@@ -2101,13 +2102,9 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_tolerance),
 	        cmocka_unit_test(test_sweeps_against_series),
 	        cmocka_unit_test(test_map_cost),
-	        cmocka_unit_test(test_one_gate_against_simulation),
-	        cmocka_unit_test(test_after_start_against_simulation),
-	        cmocka_unit_test(test_training_against_simulation),
 	        cmocka_unit_test(test_training_kinds),
 	        cmocka_unit_test(test_start_trials_key),
 	        cmocka_unit_test(test_threads_and_cache),
-	        cmocka_unit_test(test_interrupted_build),
 	        cmocka_unit_test(test_entries),
 	        cmocka_unit_test(test_self_entries),
 	        cmocka_unit_test(test_flow_entries),
@@ -2115,5 +2112,18 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_bad_map_files),
 	        cmocka_unit_test(test_field_figures),
 	};
+	const struct CMUnitTest long_tests[] = {
+	        cmocka_unit_test(test_one_gate_against_simulation),
+	        cmocka_unit_test(test_after_start_against_simulation),
+	        cmocka_unit_test(test_training_against_simulation),
+	        cmocka_unit_test(test_interrupted_build),
+	};
+	if (argc > 1 && strcmp(argv[1], "long") == 0)
+		return cmocka_run_group_tests_name("markov_long", long_tests, NULL, NULL);
+	if (argc > 1) { /* one test by name, e.g. test_training_kinds */
+		cmocka_set_test_filter(argv[1]);
+		return cmocka_run_group_tests(tests, NULL, NULL) |
+		       cmocka_run_group_tests_name("markov_long", long_tests, NULL, NULL);
+	}
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
