@@ -1092,11 +1092,29 @@ static void test_threads_and_cache(void **state)
 		                      d1,
 		                      NULL};
 		out = NULL;
-		assert_int_equal(bsim_test_cli(argv, &out, NULL), 0);
+		char *progress = NULL;
+		/* off a terminal, every progress line */
+		setenv("BEAMSIM_PROGRESS_SECONDS", "0", 1);
+		assert_int_equal(bsim_test_cli(argv, &out, &progress), 0);
+		unsetenv("BEAMSIM_PROGRESS_SECONDS");
 		if (!strstr(out, "2 maps built") || !strstr(out, "0 reused"))
 			print_error("%s %s: %s\n", changes[i][2], changes[i][3], out);
 		assert_non_null(strstr(out, "2 maps built"));
 		assert_non_null(strstr(out, "0 reused"));
+		/* the training field's trials counted first, then the single
+		 * gates; none without a training field */
+		const char *trained = strstr(progress, "beamsim: progress: 1/3"),
+		           *gates = strstr(progress, " single gates ");
+		assert_non_null(gates);
+		if (strcmp(changes[i][3], "0") == 0) {
+			assert_null(strstr(progress, "training trials"));
+		} else {
+			assert_non_null(trained);
+			assert_true(strncmp(trained + 22, "0 training trials", 17) == 0 ||
+			            strncmp(trained + 22, "1 training trials", 17) == 0);
+			assert_true(trained < gates);
+		}
+		free(progress);
 		free(out);
 	}
 	/* predict reads only what the last build's settings and this scene's

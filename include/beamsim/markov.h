@@ -148,6 +148,10 @@ typedef struct bsim_markov_def {
 	int after_start;
 	bsim_progress_fn progress; /* may be NULL; counts single-gate trials */
 	void *progress_user;
+	/* May be NULL; counts the training field's trials, before any single
+	 * gate, a hundred times over the field at most. */
+	bsim_progress_fn train_progress;
+	void *train_progress_user;
 	/* May be NULL. When *stop becomes nonzero (a signal handler sets it),
 	 * no further single gate starts, the map under way is dropped, the
 	 * maps finished are kept in the map directory, and the build returns

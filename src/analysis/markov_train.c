@@ -149,7 +149,8 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 	if (rc == BSIM_OK && !logs)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	/* the first failure in trial order, whatever the threads */
-	long first = T;
+	long first = T, done = 0;
+	const long every = T >= 100 ? T / 100 : 1; /* trials between progress calls */
 	bsim_error fail = {0};
 	int stopped = 0;
 	const int threads = def->threads > 0 ? def->threads : omp_get_max_threads();
@@ -193,6 +194,13 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 					first = t;
 					fail = e;
 				}
+			}
+			long now;
+#pragma omp atomic capture
+			now = ++done;
+			if (def->train_progress && (now % every == 0 || now == T)) {
+#pragma omp critical(bsim_markov_progress)
+				def->train_progress(def->train_progress_user, now, T);
 			}
 		}
 		bsim_trial_log_free(log);

@@ -395,6 +395,15 @@ typedef struct markov_part {
 	int shard, shards; /* 1-based */
 } markov_part;
 
+/* The training field's line, ended when its last trial is done: the
+ * single gates' line follows on its own. */
+static void train_progress_update(void *user, long done, long total)
+{
+	cli_progress_update(user, done, total);
+	if (done == total)
+		cli_progress_finish(user);
+}
+
 static int markov_build_main(int argc, char **argv, const cli_merge *m, const markov_part *p);
 
 static int remove_one(const char *path, const struct stat *st, int type, struct FTW *ftw)
@@ -613,10 +622,13 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		def.group_done = build_group_print;
 		def.group_done_user = &def;
 	}
-	cli_progress progress;
+	cli_progress progress, training;
 	cli_progress_init(&progress, show_progress, "single gates");
+	cli_progress_init(&training, show_progress, "training trials");
 	def.map.progress = cli_progress_update;
 	def.map.progress_user = &progress;
+	def.map.train_progress = train_progress_update;
+	def.map.train_progress_user = &training;
 	def.map.stop = &cli_stop;
 	bsim_markov_build_result res;
 	bsim_error err;
