@@ -28,8 +28,8 @@ void bsim_markov_entries_free(bsim_markov_entries *e)
 	memset(e, 0, sizeof *e);
 }
 
-static int entries_push(bsim_markov_entries *e, int *cap, int edge, double pos, const double x[2],
-                        const double v[2])
+int bsim_markov_entries_push(bsim_markov_entries *e, int *cap, int edge, double pos,
+                             const double x[2], const double v[2])
 {
 	if (e->n == *cap) {
 		int nc = *cap ? 2 * *cap : 1024;
@@ -55,20 +55,6 @@ static int entries_push(bsim_markov_entries *e, int *cap, int edge, double pos, 
 	memcpy(e->v[e->n], v, sizeof e->v[0]);
 	e->n++;
 	return 0;
-}
-
-int bsim_markov_entries_alloc(bsim_markov_entries *e, int n)
-{
-	memset(e, 0, sizeof *e);
-	const size_t m = n > 0 ? (size_t)n : 1;
-	e->edge = malloc(m * sizeof *e->edge);
-	e->pos = malloc(m * sizeof *e->pos);
-	e->x = malloc(m * sizeof *e->x);
-	e->v = malloc(m * sizeof *e->v);
-	if (e->edge && e->pos && e->x && e->v)
-		return 0;
-	bsim_markov_entries_free(e);
-	return -1;
 }
 
 int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entries *out,
@@ -120,7 +106,7 @@ int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entrie
 			h = bsim_hash_fnv1a64(&e, sizeof e, h);
 			h = bsim_hash_fnv1a64(val + 1, 5 * sizeof val[0], h);
 			const double x[2] = {val[2], val[3]}, v[2] = {val[4], val[5]};
-			if (entries_push(out, &cap, e, val[1], x, v))
+			if (bsim_markov_entries_push(out, &cap, e, val[1], x, v))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
 		bsim_csv_table_free(&t);

@@ -39,9 +39,10 @@ typedef struct markov_entry_index {
 	int *first, *idx;
 } markov_entry_index;
 
-/* e with room for n entries, none yet (e->n 0): 0, or -1 out of memory
- * (e then empty). */
-int bsim_markov_entries_alloc(bsim_markov_entries *e, int n);
+/* Appends an entry to e, whose arrays hold *cap (grown as needed; 0 for
+ * an empty e): 0, or -1 out of memory (e keeps what it had). */
+int bsim_markov_entries_push(bsim_markov_entries *e, int *cap, int edge, double pos,
+                             const double x[2], const double v[2]);
 
 /* 0, or -1 out of memory (then bsim_markov_entry_index_free all the same). */
 int bsim_markov_entry_index_init(markov_entry_index *x, const bsim_markov_entries *e,

@@ -214,22 +214,14 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 			*err = fail;
 	}
 	/* every entry but the start's, in trial order */
-	long n = 0;
+	int cap = 0;
 	for (long t = 0; rc == BSIM_OK && t < T; t++)
-		for (int j = 0; j < logs[t].n_entries; j++)
-			n += logs[t].entries[j].edge != BSIM_EDGE_START;
-	if (rc == BSIM_OK && (n > INT_MAX || bsim_markov_entries_alloc(out, (int)n)))
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (long t = 0; rc == BSIM_OK && t < T; t++)
-		for (int j = 0; j < logs[t].n_entries; j++) {
+		for (int j = 0; rc == BSIM_OK && j < logs[t].n_entries; j++) {
 			const bsim_gate_entry *g = &logs[t].entries[j];
-			if (g->edge == BSIM_EDGE_START)
-				continue;
-			const int i = out->n++;
-			out->edge[i] = (int)g->edge;
-			out->pos[i] = g->pos;
-			memcpy(out->x[i], g->x, sizeof out->x[i]);
-			memcpy(out->v[i], g->v, sizeof out->v[i]);
+			if (g->edge != BSIM_EDGE_START &&
+			    (out->n == INT_MAX ||
+			     bsim_markov_entries_push(out, &cap, (int)g->edge, g->pos, g->x, g->v)))
+				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
 	for (long t = 0; logs && t < T; t++)
 		bsim_trial_log_clear(&logs[t]);
