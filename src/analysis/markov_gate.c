@@ -251,6 +251,26 @@ int bsim_markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *d
 	                                     err);
 }
 
+void bsim_markov_trial_end(long i, const bsim_error *e, long *first, bsim_error *first_err,
+                           long *done, long total, long every, bsim_progress_fn progress,
+                           void *user)
+{
+	if (e) {
+#pragma omp critical(bsim_markov_fail)
+		if (i < *first) {
+			*first = i;
+			*first_err = *e;
+		}
+	}
+	long now;
+#pragma omp atomic capture
+	now = ++*done;
+	if (progress && (now % every == 0 || now == total)) {
+#pragma omp critical(bsim_markov_progress)
+		progress(user, now, total);
+	}
+}
+
 /* Single gates 0 .. units-1 of a gate with stiffness k on def->threads
  * threads: unit u's exit bin (0 stuck) into exit[u] and its time steps
  * into held[u], its entry and exit into runs[u] (runs may be NULL). Unit u
@@ -322,20 +342,8 @@ static int units_run(const bsim_scene *lattice, const bsim_markov_def *def, cons
 			held[u] = (int)r.steps;
 #pragma omp atomic
 			*steps += r.steps;
-			if (exit[u] < 0) {
-#pragma omp critical(bsim_markov_fail)
-				if (u < first_unit) {
-					first_unit = u;
-					first = e;
-				}
-			}
-			long now;
-#pragma omp atomic capture
-			now = ++*done;
-			if (def->progress && (now % 256 == 0 || now == total)) {
-#pragma omp critical(bsim_markov_progress)
-				def->progress(def->progress_user, now, total);
-			}
+			bsim_markov_trial_end(u, exit[u] < 0 ? &e : NULL, &first_unit, &first, done,
+			                      total, 256, def->progress, def->progress_user);
 		}
 		if (r.w)
 			be->destroy(r.w);

@@ -132,6 +132,15 @@ void bsim_markov_counts_free(bsim_markov_map *m);
 
 /* ---- single gates (markov_gate.c) ---- */
 
+/* The end of trial i of a loop on the threads: e (NULL: it did not fail)
+ * kept in *first_err if i is the first failure in trial order so far
+ * (*first), so that the error is the same for any number of threads; *done
+ * counted, and progress(user, done, total) called every `every` trials and
+ * at the last (progress may be NULL). */
+void bsim_markov_trial_end(long i, const bsim_error *e, long *first, bsim_error *first_err,
+                           long *done, long total, long every, bsim_progress_fn progress,
+                           void *user);
+
 /* The gate of the lattice's start, moved to its own frame, as the essay's
  * protocol builds it on entry: its two beams at rest, with stiffness k. */
 typedef struct markov_gate_scene {

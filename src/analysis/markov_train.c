@@ -188,20 +188,9 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 			}
 			if (trc == BSIM_OK && bsim_trial_log_copy(&logs[t], log) != BSIM_OK)
 				trc = bsim_error_set(&e, BSIM_EFAIL, "out of memory");
-			if (trc != BSIM_OK) {
-#pragma omp critical(bsim_markov_train_fail)
-				if (t < first) {
-					first = t;
-					fail = e;
-				}
-			}
-			long now;
-#pragma omp atomic capture
-			now = ++done;
-			if (def->train_progress && (now % every == 0 || now == T)) {
-#pragma omp critical(bsim_markov_progress)
-				def->train_progress(def->train_progress_user, now, T);
-			}
+			bsim_markov_trial_end(t, trc != BSIM_OK ? &e : NULL, &first, &fail, &done,
+			                      T, every, def->train_progress,
+			                      def->train_progress_user);
 		}
 		bsim_trial_log_free(log);
 		bsim_trial_runner_free(r);
