@@ -805,9 +805,10 @@ static void test_after_start_against_simulation(void **state)
  * no gate after the start, so that the gates above the start are
  * entered with a bin's states. States uniform over the edge, every speed
  * to 40 m/s and every direction, are nothing like a body's, and the chain
- * is off on at least one outcome; states drawn from the entries of a
- * training field of the same two kinds (a 21 x 21 field, not the column)
- * put every outcome within 4.5 standard errors of 400 direct trials. */
+ * is off on at least one outcome; a training field of the same two kinds
+ * (a 21 x 21 field, not the column), its entries the single gates'
+ * states or its crossings counted, puts every outcome within 4.5
+ * standard errors of 400 direct trials. */
 static void test_training_against_simulation(void **state)
 {
 	(void)state;
@@ -823,11 +824,12 @@ static void test_training_against_simulation(void **state)
 	def.after_start = 0;
 	def.seed = 3;
 	const char *dir = exe_dir("training");
-	const int N = 400, train[2] = {0, 200};
+	const int N = 400, train[3] = {0, 200, 200};
 	double *sim = NULL;
-	int off[2];
-	for (int i = 0; i < 2; i++) {
+	int off[3];
+	for (int i = 0; i < 3; i++) {
 		def.train_trials = train[i];
+		def.train_crossings = i == 2;
 		bsim_markov_set set;
 		bsim_error err;
 		assert_int_equal(bsim_markov_build(&s, &def, dir, &set, &err), BSIM_OK);
@@ -842,11 +844,119 @@ static void test_training_against_simulation(void **state)
 		bsim_markov_prediction_free(&p);
 		bsim_markov_set_free(&set);
 	}
-	print_message("outcomes off: %d with uniform states, %d from the training field\n", off[0],
-	              off[1]);
+	print_message("outcomes off: %d with uniform states, %d from the training field's "
+	              "entries, %d from its crossings\n",
+	              off[0], off[1], off[2]);
 	assert_true(off[0] >= 1);
 	assert_int_equal(off[1], 0);
+	assert_int_equal(off[2], 0);
 	free(sim);
+	bsim_scene_free(&s);
+}
+
+/* A training field's crossings are single gates: under the essay's
+ * protocol a gate entered is a gate at rest started from the entry's
+ * state, so the crossings of a bin leave as single gates started from
+ * states drawn among the same entries. A field of one gate kind (all its
+ * entries of that kind), one bin an edge: the map counted from the
+ * crossings (topped up to 1 single gate a bin) against the map of 400
+ * single gates a bin from the field's entries, every exit of the bottom
+ * bin (most entries) within 4.5 standard errors, and the mean time in the
+ * gate too. The layout of a map of crossings reads back from its files. */
+static void test_crossings_are_single_gates(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 3, 2, 6, 30), BSIM_OK);
+	const double k[6] = {200, 200, 200, 200, 200, 200};
+	assert_int_equal(bsim_lattice_build(&s, k, k), BSIM_OK);
+	bsim_markov_def def = bsim_markov_def_default();
+	def.bins = (bsim_markov_bins){1, 1, 1, 40.0};
+	def.start_trials = 20;
+	def.after_start = 0;
+	def.train_trials = 300;
+	def.seed = 7;
+	const char *dir = exe_dir("crossings");
+	bsim_markov_set set[2];
+	bsim_error err;
+	for (int i = 0; i < 2; i++) {
+		def.train_crossings = 1 - i;
+		def.trials = i ? 400 : 1;
+		assert_int_equal(bsim_markov_build(&s, &def, dir, &set[i], &err), BSIM_OK);
+		assert_int_equal(set[i].n, 1);
+	}
+	const bsim_markov_map *cx = &set[0].maps[0], *sg = &set[1].maps[0];
+	assert_non_null(cx->bin_first);
+	assert_null(sg->bin_first);
+	const int nb = cx->n_bins;
+	int a = 1; /* the bin most crossings entered */
+	for (int b = 2; b < nb; b++)
+		if (cx->bin_first[b + 1] - cx->bin_first[b] >
+		    cx->bin_first[a + 1] - cx->bin_first[a])
+			a = b;
+	const long n = cx->bin_first[a + 1] - cx->bin_first[a], T = sg->trials;
+	print_message("bin %d: %ld crossings\n", a, n);
+	assert_true(n >= 200);
+	int off = 0;
+	for (int x = 0; x < nb; x++) {
+		const double p = (double)bsim_markov_map_count(cx, a, x) / n,
+		             q = (double)bsim_markov_map_count(sg, a, x) / T, m = 0.5 * (p + q);
+		const double se = sqrt(m * (1.0 - m) * (1.0 / n + 1.0 / T)) + 1e-9;
+		print_message("exit %d: crossings %.3f, single gates %.3f (se %.3f)\n", x, p, q,
+		              se);
+		off += !(fabs(p - q) <= 4.5 * se);
+	}
+	assert_int_equal(off, 0);
+	/* the mean time in the gate, crossings against single gates */
+	double mean[2] = {0, 0}, sq[2] = {0, 0};
+	const bsim_markov_map *both[2] = {cx, sg};
+	const long cnt[2] = {n, T};
+	for (int i = 0; i < 2; i++) {
+		const long u0 = both[i]->bin_first ? both[i]->bin_first[a]
+		                                   : both[i]->start_trials + (long)(a - 1) * T;
+		for (long u = u0; u < u0 + cnt[i]; u++) {
+			mean[i] += both[i]->hold_steps[u];
+			sq[i] += (double)both[i]->hold_steps[u] * both[i]->hold_steps[u];
+		}
+		mean[i] /= cnt[i];
+		sq[i] = sq[i] / cnt[i] - mean[i] * mean[i];
+	}
+	const double se = sqrt(sq[0] / n + sq[1] / T);
+	print_message("steps in the gate: crossings %.1f, single gates %.1f (se %.1f)\n", mean[0],
+	              mean[1], se);
+	assert_true(fabs(mean[0] - mean[1]) <= 4.5 * se);
+	/* read back from the directory: the same layout and counts */
+	def.train_crossings = 1;
+	def.trials = 1;
+	bsim_markov_set again;
+	assert_int_equal(bsim_markov_build(&s, &def, dir, &again, &err), BSIM_OK);
+	assert_int_equal(again.reused, 1);
+	for (int b = 0; b <= nb; b++)
+		assert_int_equal(again.maps[0].bin_first[b], cx->bin_first[b]);
+	assert_true(counts_same(&again.maps[0], cx, -1));
+	bsim_markov_set_free(&again);
+	/* its start row one count over the start's trials: refused, naming
+	 * the file, the line and the field */
+	char name[64];
+	snprintf(name, sizeof name, "map_%016llx.csv", (unsigned long long)cx->key);
+	char *csv = bsim_test_read(bsim_test_join(dir, name));
+	assert_non_null(csv);
+	char *row = strchr(csv, '\n') + 1; /* "0,EXIT,COUNT,..." */
+	char *count = strchr(strchr(row, ',') + 1, ',') + 1;
+	assert_int_equal(row[0], '0');
+	char text[16384];
+	snprintf(text, sizeof text, "%.*s%d%s", (int)(count - csv), csv, atoi(count) + 1,
+	         strchr(count, ','));
+	bsim_test_write(dir, name, text);
+	assert_int_equal(bsim_markov_build(&s, &def, dir, &again, &err), BSIM_EINPUT);
+	print_message("%s\n", err.msg);
+	assert_non_null(strstr(err.msg, name));
+	assert_non_null(strstr(err.msg, ".csv:2: p: expected a probability in [0, 1], count / 21 "
+	                                "trials"));
+	bsim_test_write(dir, name, csv);
+	free(csv);
+	for (int i = 0; i < 2; i++)
+		bsim_markov_set_free(&set[i]);
 	bsim_scene_free(&s);
 }
 
@@ -896,6 +1006,7 @@ static void test_training_kinds(void **state)
 		bsim_options opts = {0};
 		assert_int_equal(bsim_markov_load(sc[f], dir, &opts, &back, &err), BSIM_OK);
 		assert_int_equal(back.def.train_trials, 20);
+		assert_int_equal(back.def.train_crossings, 0);
 		bsim_markov_set_free(&back);
 	}
 	/* a lattice of kinds no build trained on together: refused, naming
@@ -1048,6 +1159,27 @@ static void test_threads_and_cache(void **state)
 	assert_string_equal(t1, t2);
 	free(t1);
 	free(t2);
+	/* maps counted from the training field's crossings alike: the
+	 * crossings in trial order, whatever the threads */
+	char c1[1024], c2[1024];
+	snprintf(c1, sizeof c1, "%s", bsim_test_dir("threads_crossings1"));
+	snprintf(c2, sizeof c2, "%s", bsim_test_dir("threads_crossings2"));
+	const char *x1[] = {"markov", "build",     exp, "--bins",  "4,4,3", "--start-trials",
+	                    "3",      "--trials",  "3", "--train", "30",    "--crossings",
+	                    "1",      "--threads", "1", "--quiet", "--out", c1,
+	                    NULL};
+	const char *x2[] = {"markov", "build",     exp, "--bins",  "4,4,3", "--start-trials",
+	                    "3",      "--trials",  "3", "--train", "30",    "--crossings",
+	                    "1",      "--threads", "2", "--quiet", "--out", c2,
+	                    NULL};
+	assert_int_equal(bsim_test_cli(x1, NULL, NULL), 0);
+	assert_int_equal(bsim_test_cli(x2, NULL, NULL), 0);
+	t1 = map_text(c1);
+	t2 = map_text(c2);
+	assert_true(strlen(t1) > 1000);
+	assert_string_equal(t1, t2);
+	free(t1);
+	free(t2);
 
 	/* The same again: both maps reused, no training field run, and a note
 	 * that these training trials, bins and start trials are fewer than the
@@ -1073,8 +1205,9 @@ static void test_threads_and_cache(void **state)
 	                            {"--trials", "4", "--threads", "2"},
 	                            {"--trials", "3", "--backend-opt", "integrator=euler"},
 	                            {"--trials", "3", "--train", "31"},
-	                            {"--trials", "3", "--train", "0"}};
-	for (int i = 0; i < 8; i++) {
+	                            {"--trials", "3", "--train", "0"},
+	                            {"--trials", "3", "--crossings", "1"}};
+	for (int i = 0; i < 9; i++) {
 		const char *argv[] = {"markov",
 		                      "build",
 		                      exp,
@@ -2121,6 +2254,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_sweeps_against_series),
 	        cmocka_unit_test(test_map_cost),
 	        cmocka_unit_test(test_training_kinds),
+	        cmocka_unit_test(test_crossings_are_single_gates),
 	        cmocka_unit_test(test_start_trials_key),
 	        cmocka_unit_test(test_threads_and_cache),
 	        cmocka_unit_test(test_entries),

@@ -136,6 +136,19 @@ typedef struct bsim_markov_def {
 	 * keys, so the maps hold for every layout of the same kinds and
 	 * physics. 0: states uniform in each bin. */
 	int train_trials;
+	/* With a training field: 1 counts every bin of a map from the
+	 * field's own crossings of the gates of the map's kind that were
+	 * entered in that bin (where each left and after how many time steps:
+	 * under the essay's protocol a gate entered is a single gate started
+	 * from the entry's state), and tops each bin up to `trials` with
+	 * single gates whose states are drawn from the field's entries in the
+	 * bin; a bin then holds its crossings or `trials`, whichever is more
+	 * (bsim_markov_map.bin_first). The start bin keeps its start_trials
+	 * single gates. Cheap maps, few single gates a bin and a smaller
+	 * field, need it (docs/markov.md, "Cheap maps: the training field's
+	 * crossings"). 0 (the default): `trials` single gates a bin, their
+	 * states drawn from the field's entries. */
+	int train_crossings;
 	/* The gate after the start (1, the default): each of the start bin's
 	 * single gates that leaves into a gate is continued there, one single
 	 * gate from its exact exit state, for every stiffness pair of the
@@ -233,8 +246,16 @@ typedef struct bsim_markov_map {
 	uint64_t key;     /* FNV-1a hash of key_text: the map's file name */
 	char *key_text;   /* everything the map depends on, a line each */
 	int n_bins;       /* bsim_markov_bins_count */
-	int trials;       /* per entry bin, but the start's */
+	int trials;       /* per entry bin, but the start's (the least, with bin_first) */
 	int start_trials; /* of the start bin, bin 0 (bsim_markov_bin_trials) */
+	/* A map counted from a training field's crossings (def train_crossings)
+	 * holds a number of single gates of its own in each bin: bin a's are
+	 * [bin_first[a], bin_first[a + 1]) (n_bins + 1 entries, bin_first[0]
+	 * = 0, bin_first[1] = start_trials, every other bin trials or more).
+	 * NULL: the start bin start_trials, every other trials. */
+	long *bin_first;
+	int of_crossings; /* 1: counted from crossings (its key says so), bin_first set
+	                   * once counted or read */
 	/* The counts, a row an entry bin: row a's exits (0 = stuck) are
 	 * count_exit[count_first[a] .. count_first[a + 1]), ascending, each
 	 * count_n[] times; the row's other exits 0 times. A row sums to

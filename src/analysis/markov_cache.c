@@ -80,7 +80,7 @@ const char *bsim_markov_entries_label(const bsim_markov_def *def, const bsim_sce
 	else if (flow || def->self_entries)
 		snprintf(buf, size, "%s %d", flow ? "flow" : "self", passes);
 	else if (bsim_markov_def_trains(def))
-		return bsim_markov_train_label(lattice, def->train_trials, buf, size);
+		return bsim_markov_train_label(lattice, def, buf, size);
 	else
 		return def->entries_id[0] ? def->entries_id : "none";
 	return buf;
@@ -447,6 +447,32 @@ static int cost_read(const char *dir, const bsim_markov_map *m, const char *ext,
 	                      dir, (unsigned long long)m->key, ext);
 }
 
+/* The bins of a map of crossings laid out from its CSV text (m's
+ * bin_first set): each bin holds what its rows count, summed as far as
+ * they read as numbers (the rows are checked after, against this). 0, or
+ * -1 out of memory. */
+static int crossings_layout_read(const char *text, bsim_markov_map *m)
+{
+	const int nb = m->n_bins;
+	long *first = calloc((size_t)nb + 1, sizeof *first);
+	if (!first)
+		return -1;
+	for (const char *c = strchr(text, '\n'); c && c[1]; c = strchr(c + 1, '\n')) {
+		char *end;
+		const long a = strtol(c + 1, &end, 10);
+		const char *f = end && *end == ',' ? strchr(end + 1, ',') : NULL;
+		const long n = f ? strtol(f + 1, &end, 10) : 0;
+		if (a >= 0 && a < nb && n > 0 && n <= INT_MAX && *end == ',' &&
+		    first[a + 1] <= INT_MAX - n)
+			first[a + 1] += n;
+	}
+	for (int a = 0; a < nb; a++)
+		first[a + 1] += first[a];
+	free(m->bin_first);
+	m->bin_first = first;
+	return 0;
+}
+
 int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
@@ -454,14 +480,23 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 	if (!key_same(path, m->key_text))
 		return 0;
 	snprintf(path, sizeof path, "%s/map_%016llx.csv", dir, (unsigned long long)m->key);
-	/* At most a row per single gate, each well under 256 bytes. */
-	double max_bytes = ((double)bsim_markov_map_units(m) + 1.0) * 256.0;
+	/* At most a row per single gate (of crossings: per pair of bins), each
+	 * well under 256 bytes. */
+	double max_bytes = ((m->of_crossings ? (double)m->n_bins * m->n_bins
+	                                     : (double)bsim_markov_map_units(m)) +
+	                    1.0) *
+	                   256.0;
 	file_text t;
 	int absent = 0;
 	if (map_file(dir, m, "csv", max_bytes, &t, &absent, err) != BSIM_OK)
 		return -1;
 	if (absent)
 		return 0;
+	if (m->of_crossings && crossings_layout_read(t.text, m) != 0) {
+		bsim_file_text_free(&t);
+		bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
+		return -1;
+	}
 	const int nb = m->n_bins;
 	/* the cells as they come, a line each: cell[3 i ..] entry, exit, count */
 	long *sum = calloc((size_t)nb, sizeof *sum), n = 0, room = 1024;
@@ -494,11 +529,11 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 		bad = map_row(line, m, v, &p, &got);
 		if (bad && strcmp(bad, "count") == 0)
 			snprintf(what, sizeof what, "a count of trials 1 to %d, got %.20s",
-			         m->trials, got);
+			         bsim_markov_bin_trials(m, (int)v[0]), got);
 		else if (bad && strcmp(bad, "p") == 0)
 			snprintf(what, sizeof what,
-			         "a probability in [0, 1], count / %d trials, got %.20s", m->trials,
-			         got);
+			         "a probability in [0, 1], count / %d trials, got %.20s",
+			         bsim_markov_bin_trials(m, (int)v[0]), got);
 		else if (bad && strstr(bad, "_edge"))
 			snprintf(what, sizeof what, "the name of a bin, got %.20s", got);
 		else if (bad)
@@ -540,7 +575,17 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 		bsim_error_set(err, BSIM_EFAIL, "%s: out of memory", path);
 		return -1;
 	}
-	/* Every entry bin ran the map's trials, each ending somewhere. */
+	/* Every entry bin ran the map's trials, each ending somewhere; a map
+	 * of crossings holds trials or more a bin, the start start_trials. */
+	for (int a = 0; !bad && m->of_crossings && a < nb; a++)
+		if (a == 0 ? sum[a] != m->start_trials : sum[a] < m->trials) {
+			bad = "count";
+			lineno = last[a] ? last[a] : lineno;
+			snprintf(what, sizeof what,
+			         "the counts of entry bin %d to sum to %s%d trials, got %ld", a,
+			         a == 0 ? "the start's " : "the map's crossings topped up to ",
+			         a == 0 ? m->start_trials : m->trials, sum[a]);
+		}
 	for (int a = 0; !bad && a < nb; a++)
 		if (sum[a] != bsim_markov_bin_trials(m, a)) {
 			bad = "count";
@@ -901,10 +946,12 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	/* "train N": a training field of N trials, of each lattice's kinds */
 	int train = 0, used = 0;
 	def->train_trials = 0;
+	def->train_crossings = 0;
 	if (sscanf(id, "train %d%n", &train, &used) == 1 && train > 0 &&
-	    (id[used] == '\0' || id[used] == ' '))
+	    (id[used] == '\0' || id[used] == ' ')) {
 		def->train_trials = train;
-	else if (strcmp(id, "none") != 0)
+		def->train_crossings = strncmp(id + used, " crossings", 10) == 0;
+	} else if (strcmp(id, "none") != 0)
 		snprintf(def->entries_id, sizeof def->entries_id, "%s", id);
 	def->seed = seed;
 	def->backend = bsim_backend_find(backend, err);

@@ -243,14 +243,6 @@ static int gate_trial(gate_runner *r, const bsim_scene *lattice, const bsim_mark
 	return out;
 }
 
-int bsim_markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
-                             const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
-                             long *done, long total, bsim_error *err)
-{
-	return bsim_markov_map_simulate_runs(lattice, def, be, opts, m, NULL, NULL, done, total,
-	                                     err);
-}
-
 void bsim_markov_trial_end(long i, const bsim_error *e, long *first, bsim_error *first_err,
                            long *done, long total, long every, bsim_progress_fn progress,
                            void *user)
@@ -272,14 +264,15 @@ void bsim_markov_trial_end(long i, const bsim_error *e, long *first, bsim_error 
 }
 
 /* Single gates 0 .. units-1 of a gate with stiffness k on def->threads
- * threads: unit u's exit bin (0 stuck) into exit[u] and its time steps
- * into held[u], its entry and exit into runs[u] (runs may be NULL). Unit u
- * is trial u - first of bin of map m (m's bins, states drawn in the bin or
- * from pool), or, with from, the gate after the start: the body starts in
- * from[u]'s exit state, its schedule that of start trial trial[u]. The
- * first failure in unit order is the error, whatever the threads. */
+ * threads, or with todo those units todo[0 .. units-1]: unit u's exit bin
+ * (0 stuck) into exit[u] and its time steps into held[u], its entry and
+ * exit into runs[u] (runs may be NULL). Unit u is trial u - first of bin
+ * of map m (m's bins, states drawn in the bin or from pool), or, with
+ * from, the gate after the start: the body starts in from[u]'s exit
+ * state, its schedule that of start trial trial[u]. The first failure in
+ * unit order is the error, whatever the threads. */
 static int units_run(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
-                     const bsim_options *opts, const double k[2], long units,
+                     const bsim_options *opts, const double k[2], long units, const long *todo,
                      const bsim_markov_map *m, const markov_pool *pool, const markov_run *from,
                      const int *trial, markov_run *runs, int *exit, int *held, long long *steps,
                      long *done, long total, bsim_error *err)
@@ -306,7 +299,8 @@ static int units_run(const bsim_scene *lattice, const bsim_markov_def *def, cons
 		const double start[2] = {r.g.s.body.start[0], r.g.s.body.start[1]};
 		r.ex = def->entries && !from ? &ex : NULL;
 #pragma omp for schedule(dynamic, 16)
-		for (long u = 0; u < units; u++) {
+		for (long i = 0; i < units; i++) {
+			const long u = todo ? todo[i] : i;
 			if (!ok || !r.rng) {
 				exit[u] = -1;
 #pragma omp critical(bsim_markov_fail)
@@ -376,8 +370,8 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	long long steps = 0;
-	int rc = units_run(lattice, def, be, opts, m->k, units, m, pool, NULL, NULL, runs, exit,
-	                   held, &steps, done, total, err);
+	int rc = units_run(lattice, def, be, opts, m->k, units, NULL, m, pool, NULL, NULL, runs,
+	                   exit, held, &steps, done, total, err);
 	if (rc == BSIM_OK && bsim_markov_counts_of_exits(m, exit) != 0)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (rc == BSIM_OK) { /* the holding times: the map keeps both arrays */
@@ -393,6 +387,82 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
 	return rc;
 }
 
+/* Whether crossing i of cx is of map m's gate kind. */
+static int crossing_of(const markov_crossings *cx, long i, const bsim_markov_map *m)
+{
+	return cx->k[i][0] == m->k[0] && cx->k[i][1] == m->k[1];
+}
+
+long bsim_markov_crossings_layout(bsim_markov_map *m, const markov_crossings *cx)
+{
+	const int nb = m->n_bins;
+	long *first = calloc((size_t)nb + 1, sizeof *first);
+	if (!first)
+		return -1;
+	/* first[a + 1] counts bin a's crossings, then becomes its end */
+	long placed = 0;
+	for (long i = 0; i < cx->n; i++)
+		if (crossing_of(cx, i, m))
+			first[cx->entry[i] + 1]++, placed++;
+	first[1] = m->start_trials;
+	for (int a = 1; a < nb; a++)
+		first[a + 1] = first[a] + (first[a + 1] > m->trials ? first[a + 1] : m->trials);
+	free(m->bin_first);
+	m->bin_first = first;
+	return placed;
+}
+
+int bsim_markov_map_simulate_crossings(const bsim_scene *lattice, const bsim_markov_def *def,
+                                       const bsim_backend *be, const bsim_options *opts,
+                                       bsim_markov_map *m, const markov_crossings *cx,
+                                       markov_run *runs, long *done, long total, bsim_error *err)
+{
+	const int nb = m->n_bins;
+	const long units = bsim_markov_map_units(m);
+	int *exit = malloc((size_t)units * sizeof *exit);
+	int *held = malloc((size_t)units * sizeof *held);
+	long *todo = malloc((size_t)units * sizeof *todo);
+	long *fill = calloc((size_t)nb, sizeof *fill); /* bin a's crossings placed */
+	if (!exit || !held || !todo || !fill) {
+		free(exit);
+		free(held);
+		free(todo);
+		free(fill);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	/* each bin's crossings first, in trial order, then its single gates */
+	for (long i = 0; i < cx->n; i++)
+		if (crossing_of(cx, i, m)) {
+			const int a = cx->entry[i];
+			const long u = bsim_markov_bin_first(m, a) + fill[a]++;
+			exit[u] = cx->exit[i];
+			held[u] = cx->steps[i];
+		}
+	long n_todo = 0;
+	for (int a = 0; a < nb; a++)
+		for (long u = bsim_markov_bin_first(m, a) + fill[a];
+		     u < bsim_markov_bin_first(m, a + 1); u++)
+			todo[n_todo++] = u;
+	long long steps = 0;
+	int rc = units_run(lattice, def, be, opts, m->k, n_todo, todo, m, NULL, NULL, NULL, runs,
+	                   exit, held, &steps, done, total, err);
+	if (rc == BSIM_OK && bsim_markov_counts_of_exits(m, exit) != 0)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	if (rc == BSIM_OK) { /* the holding times: the map keeps both arrays */
+		free(m->hold_exit);
+		free(m->hold_steps);
+		m->hold_exit = exit;
+		m->hold_steps = held;
+		exit = held = NULL;
+	}
+	m->steps += steps;
+	free(exit);
+	free(held);
+	free(todo);
+	free(fill);
+	return rc;
+}
+
 long bsim_markov_next_units(const bsim_markov_map *start, int n)
 {
 	return (long)start->start_trials * (1 + n);
@@ -400,15 +470,16 @@ long bsim_markov_next_units(const bsim_markov_map *start, int n)
 
 int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                               const bsim_backend *be, const bsim_options *opts,
-                              const bsim_markov_map *start, const bsim_markov_map *const *gate,
-                              bsim_markov_next *const *nx, int n, long *done, long total,
-                              bsim_error *err)
+                              const bsim_markov_map *start, const markov_run *start_runs,
+                              const bsim_markov_map *const *gate, bsim_markov_next *const *nx,
+                              int n, long *done, long total, bsim_error *err)
 {
 	const long T = start->start_trials;
 	/* the start bin's single gates alone: a map of its units only */
 	bsim_markov_map sm = *start;
 	sm.trials = 1;
 	sm.n_bins = 1;
+	sm.bin_first = NULL;
 	markov_run *runs = malloc((size_t)T * sizeof *runs);
 	markov_run *from = malloc((size_t)T * sizeof *from);
 	int *trial = malloc((size_t)T * sizeof *trial);
@@ -423,8 +494,15 @@ int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *
 	}
 	long long steps = 0;
 	clock_t c0 = clock();
-	int rc = units_run(lattice, def, be, opts, start->k, T, &sm, NULL, NULL, NULL, runs, exit,
-	                   held, &steps, done, total, err);
+	int rc = BSIM_OK;
+	if (start_runs) { /* the start's single gates as the map's build left them */
+		memcpy(runs, start_runs, (size_t)T * sizeof *runs);
+		memcpy(exit, start->hold_exit, (size_t)T * sizeof *exit);
+		memcpy(held, start->hold_steps, (size_t)T * sizeof *held);
+		*done += T;
+	} else
+		rc = units_run(lattice, def, be, opts, start->k, T, NULL, &sm, NULL, NULL, NULL,
+		               runs, exit, held, &steps, done, total, err);
 	/* The same seeds as the map's start bin: the same single gates. */
 	for (long t = 0; rc == BSIM_OK && start->hold_exit && t < T; t++)
 		if (exit[t] != start->hold_exit[t] || held[t] != start->hold_steps[t])
@@ -451,8 +529,8 @@ int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 			break;
 		}
-		rc = units_run(lattice, def, be, opts, gate[i]->k, left, NULL, NULL, from, trial,
-		               NULL, exit, held, &gs, done, total, err);
+		rc = units_run(lattice, def, be, opts, gate[i]->k, left, NULL, NULL, NULL, from,
+		               trial, NULL, exit, held, &gs, done, total, err);
 		/* the start's units again count once, shared by the n gates */
 		if (rc != BSIM_OK)
 			break;

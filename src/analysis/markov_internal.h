@@ -71,23 +71,46 @@ static inline int bsim_markov_def_after_start(const bsim_markov_def *def)
 
 /* The single gates of entry bin a of map m, and the index of its first
  * in the map's single gates (the start bin's first, then every other
- * bin's trials in turn); their total. */
+ * bin's in turn); their total. */
 static inline int bsim_markov_bin_trials(const bsim_markov_map *m, int a)
 {
+	if (m->bin_first)
+		return (int)(m->bin_first[a + 1] - m->bin_first[a]);
 	return a == 0 ? m->start_trials : m->trials;
 }
 static inline long bsim_markov_bin_first(const bsim_markov_map *m, int a)
 {
+	if (m->bin_first)
+		return m->bin_first[a];
 	return a == 0 ? 0 : m->start_trials + (long)(a - 1) * m->trials;
 }
 static inline long bsim_markov_map_units(const bsim_markov_map *m)
 {
+	if (m->bin_first)
+		return m->bin_first[m->n_bins];
 	return m->start_trials + (long)(m->n_bins - 1) * m->trials;
 }
 /* The entry bin of single gate u of map m. */
 static inline int bsim_markov_unit_bin(const bsim_markov_map *m, long u)
 {
+	if (m->bin_first) { /* the last bin whose first is at most u */
+		int lo = 0, hi = m->n_bins - 1;
+		while (lo < hi) {
+			const int mid = hi - (hi - lo) / 2;
+			if (m->bin_first[mid] <= u)
+				lo = mid;
+			else
+				hi = mid - 1;
+		}
+		return lo;
+	}
 	return u < m->start_trials ? 0 : 1 + (int)((u - m->start_trials) / m->trials);
+}
+
+/* Whether def's maps are counted from the training field's crossings. */
+static inline int bsim_markov_def_crossings(const bsim_markov_def *def)
+{
+	return def->train_crossings && bsim_markov_def_trains(def);
 }
 
 /* ---- the lattice's gate kinds and its training field (markov_train.c) ---- */
@@ -98,16 +121,33 @@ int bsim_markov_lattice_pairs(const bsim_scene *lattice, double (**pairs)[2]);
 
 /* The id of the entries of a training field of def->train_trials trials of
  * lattice's gate kinds: "train N kinds n HASH" (HASH of the kinds sorted),
- * or "train N" without a lattice (as markov.json names it). */
-const char *bsim_markov_train_label(const bsim_scene *lattice, int trials, char *buf, size_t size);
+ * or "train N" without a lattice (as markov.json names it); "train N
+ * crossings ..." where the maps are counted from its crossings. */
+const char *bsim_markov_train_label(const bsim_scene *lattice, const bsim_markov_def *def,
+                                    char *buf, size_t size);
+
+/* A training field's crossings of its gates, in trial order, the start
+ * gate's left out: crossing i entered a gate of stiffness pair k[i] in
+ * entry bin entry[i] (> 0) and left it into bin exit[i] (0 stuck) after
+ * steps[i] time steps (gate_steps if stuck). A gate the trial left out of
+ * the field, or ended in before being stuck there, is not a crossing: its
+ * exit is not known. */
+typedef struct markov_crossings {
+	long n;
+	double (*k)[2];
+	int *entry, *exit, *steps;
+} markov_crossings;
+
+void bsim_markov_crossings_free(markov_crossings *c);
 
 /* The gate entries of lattice's training field (def->train_trials trials,
  * on def->threads threads, the same for any number), the start's left
- * out, in trial order; out->id its label. BSIM_EFAIL naming the first
- * unstable trial, BSIM_ESTOPPED when def->stop was set. */
+ * out, in trial order; out->id its label; and its crossings into cx (may
+ * be NULL). BSIM_EFAIL naming the first unstable trial, BSIM_ESTOPPED
+ * when def->stop was set. */
 int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
                           const bsim_backend *be, const bsim_options *opts,
-                          bsim_markov_entries *out, bsim_error *err);
+                          bsim_markov_entries *out, markov_crossings *cx, bsim_error *err);
 
 /* ---- counts by row (markov_counts.c) ---- */
 
@@ -172,34 +212,48 @@ typedef struct markov_pool {
 } markov_pool;
 
 /* Map m's counts (n_bins, k and counts allocated) from def->trials single
- * gates per entry bin, on def->threads threads; *done counts the trials
- * run of total, for def->progress. BSIM_EFAIL with the error of the first
- * failed trial (in trial order, whatever the threads); BSIM_ESTOPPED,
- * err untouched and the counts not counted, if def->stop was set. */
-int bsim_markov_map_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
-                             const bsim_backend *be, const bsim_options *opts, bsim_markov_map *m,
-                             long *done, long total, bsim_error *err);
-
-/* The same with the self-consistent entries: the states of bin b > 0
- * drawn from pool's exits into b (pool NULL: as bsim_markov_map_simulate), and
- * every trial's entry and exit kept in runs[bin * trials + trial] (may be
- * NULL). */
+ * gates per entry bin, on def->threads threads, the states of bin b > 0
+ * drawn from pool's exits into b (pool NULL: in the bin, or among
+ * def->entries), and every trial's entry and exit kept in runs[u] of its
+ * unit u (bsim_markov_unit_bin's order; runs may be NULL); *done counts
+ * the trials run of total, for def->progress. BSIM_EFAIL with the error
+ * of the first failed trial (in trial order, whatever the threads);
+ * BSIM_ESTOPPED, err untouched and the counts not counted, if def->stop
+ * was set. */
 int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
                                   const bsim_backend *be, const bsim_options *opts,
                                   bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
                                   long *done, long total, bsim_error *err);
 
+/* Map m's bins laid out for the crossings of its gate kind in cx (m's
+ * bin_first set): each bin holds its crossings or m->trials, whichever is
+ * more, the start bin m->start_trials. The crossings placed, or -1 out of
+ * memory; the single gates left to simulate are the rest of
+ * bsim_markov_map_units(m). */
+long bsim_markov_crossings_layout(bsim_markov_map *m, const markov_crossings *cx);
+
+/* Map m's counts (bins laid out by bsim_markov_crossings_layout from cx)
+ * from the crossings of cx of its kind, each bin's in trial order, and
+ * the single gates that top each bin up (their runs into runs, as
+ * bsim_markov_map_simulate_runs keeps them; may be NULL). */
+int bsim_markov_map_simulate_crossings(const bsim_scene *lattice, const bsim_markov_def *def,
+                                       const bsim_backend *be, const bsim_options *opts,
+                                       bsim_markov_map *m, const markov_crossings *cx,
+                                       markov_run *runs, long *done, long total, bsim_error *err);
+
 /* The gate after the start (bsim_markov_next): the start bin's single
  * gates of map start again (the same seeds as the map's: the same exits,
- * BSIM_EFAIL if they differ from its holding times), and from the exit
- * state of each that left into a gate one single gate of each of the n
- * maps gate[i], into nx[i] (exit and steps allocated). *done counts
- * bsim_markov_next_units(start, n) units of total. */
+ * BSIM_EFAIL if they differ from its holding times), or, with start_runs,
+ * their runs as the map's build kept them (start_runs[t] for start trial
+ * t), and from the exit state of each that left into a gate one single
+ * gate of each of the n maps gate[i], into nx[i] (exit and steps
+ * allocated). *done counts bsim_markov_next_units(start, n) units of
+ * total. */
 int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                               const bsim_backend *be, const bsim_options *opts,
-                              const bsim_markov_map *start, const bsim_markov_map *const *gate,
-                              bsim_markov_next *const *nx, int n, long *done, long total,
-                              bsim_error *err);
+                              const bsim_markov_map *start, const markov_run *start_runs,
+                              const bsim_markov_map *const *gate, bsim_markov_next *const *nx,
+                              int n, long *done, long total, bsim_error *err);
 long bsim_markov_next_units(const bsim_markov_map *start, int n);
 
 /* ---- self-consistent entries (markov_self.c) ---- */

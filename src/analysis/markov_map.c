@@ -64,6 +64,7 @@ static int map_init(bsim_markov_map *m, const bsim_scene *lattice, const bsim_ma
 	m->n_bins = bsim_markov_bins_count(&def->bins);
 	m->trials = def->trials;
 	m->start_trials = bsim_markov_def_start_trials(def);
+	m->of_crossings = bsim_markov_def_crossings(def);
 	m->key_text = bsim_markov_key_text(lattice, def, be, opts, k);
 	if (!m->key_text)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
@@ -194,6 +195,7 @@ void bsim_markov_set_free(bsim_markov_set *s)
 	for (int i = 0; i < s->n; i++) {
 		free(s->maps[i].key_text);
 		bsim_markov_counts_free(&s->maps[i]);
+		free(s->maps[i].bin_first);
 		free(s->maps[i].hold_exit);
 		free(s->maps[i].hold_steps);
 	}
@@ -299,7 +301,8 @@ static long next_units_missing(const bsim_markov_set *set, const char *dir)
  * those of its own start maps. */
 static int next_fill(const bsim_scene *lattice, const bsim_markov_def *def, const bsim_backend *be,
                      const bsim_options *opts, const char *dir, bsim_session *ss,
-                     bsim_markov_set *out, long *done, long total, bsim_error *err)
+                     bsim_markov_set *out, markov_run *const *start_runs, long *done, long total,
+                     bsim_error *err)
 {
 	const int n = out->n;
 	const char *stage = ss ? ss->stage : NULL;
@@ -357,8 +360,8 @@ static int next_fill(const bsim_scene *lattice, const bsim_markov_def *def, cons
 			continue;
 		rc = def->stop && *def->stop
 		             ? BSIM_ESTOPPED
-		             : bsim_markov_next_simulate(lattice, def, be, opts, sm, gate, todo, nt,
-		                                         done, total, err);
+		             : bsim_markov_next_simulate(lattice, def, be, opts, sm, start_runs[a],
+		                                         gate, todo, nt, done, total, err);
 		for (int i = 0; i < nt && rc == BSIM_OK; i++) {
 			out->seconds += todo[i]->seconds;
 			rc = bsim_markov_next_write(stage, todo[i], sm, gate[i], err);
@@ -399,7 +402,10 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	long total = 0, done = 0;
 	char *have = calloc((size_t)n, 1);
 	int *src = calloc((size_t)n, sizeof *src); /* a copied map's part: from[src[i]] */
-	if (!have || !src)
+	/* the start bin's single gates of each map simulated now, for the
+	 * gate after the start (NULL: run again from the map's seeds) */
+	markov_run **start_runs = calloc((size_t)n, sizeof *start_runs);
+	if (!have || !src || !start_runs)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	for (int i = 0; i < n && rc == BSIM_OK; i++) {
 		rc = map_init(&out->maps[i], lattice, def, be, opts, pairs[i], err);
@@ -485,15 +491,29 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	/* The training field, run only when a map is to be simulated here:
 	 * its entries the states of every map this set builds. */
 	bsim_markov_entries train = {0};
+	markov_crossings cx = {0};
+	const int crossings = bsim_markov_def_crossings(def);
 	bsim_markov_def with_train;
 	double train_share = 0.0; /* a built map's part of the field's CPU, s */
 	if (rc == BSIM_OK && stage && !made && to_build > 0 && bsim_markov_def_trains(def)) {
 		clock_t c0 = clock();
-		rc = bsim_markov_train_run(lattice, def, be, opts, &train, err);
+		rc = bsim_markov_train_run(lattice, def, be, opts, &train, crossings ? &cx : NULL,
+		                           err);
 		train_share = (double)(clock() - c0) / CLOCKS_PER_SEC / to_build;
 		with_train = *def;
 		with_train.entries = &train;
 		def = &with_train;
+		/* the bins hold the crossings: only the rest is simulated */
+		for (int i = 0; i < n && rc == BSIM_OK && crossings; i++) {
+			bsim_markov_map *m = &out->maps[i];
+			if (have[i] || m->elsewhere || m->copied)
+				continue;
+			total -= bsim_markov_map_units(m);
+			const long placed = bsim_markov_crossings_layout(m, &cx);
+			if (placed < 0)
+				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+			total += bsim_markov_map_units(m) - placed;
+		}
 	}
 	/* Flow-weighted entries: every map's passes at once, the lattice's
 	 * chain weighting each pass's states. Parts that meet after each pass
@@ -522,12 +542,27 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			continue;
 		}
 		clock_t c0 = clock();
-		rc = flow                      ? BSIM_OK
-		     : def->stop && *def->stop ? BSIM_ESTOPPED
-		     : def->self_entries ? bsim_markov_self_simulate(lattice, def, be, opts, m, dir,
-		                                                     stage, &done, total, err)
-		                         : bsim_markov_map_simulate(lattice, def, be, opts, m,
-		                                                    &done, total, err);
+		markov_run *runs = NULL;
+		if (!flow && !def->self_entries && bsim_markov_def_after_start(def) &&
+		    !(runs = malloc((size_t)bsim_markov_map_units(m) * sizeof *runs)))
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		else
+			rc = flow                      ? BSIM_OK
+			     : def->stop && *def->stop ? BSIM_ESTOPPED
+			     : def->self_entries
+			             ? bsim_markov_self_simulate(lattice, def, be, opts, m, dir,
+			                                         stage, &done, total, err)
+			     : crossings
+			             ? bsim_markov_map_simulate_crossings(lattice, def, be, opts, m,
+			                                                  &cx, runs, &done, total,
+			                                                  err)
+			             : bsim_markov_map_simulate_runs(lattice, def, be, opts, m,
+			                                             NULL, runs, &done, total, err);
+		if (runs && rc == BSIM_OK) { /* the start bin's come first */
+			markov_run *kept = realloc(runs, (size_t)m->start_trials * sizeof *runs);
+			start_runs[i] = kept ? kept : runs;
+		} else
+			free(runs);
 		if (!flow) /* else the CPU time of its passes */
 			m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC + train_share;
 		/* with self or flow entries, m->cost holds what the passes
@@ -542,7 +577,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			out->built++;
 	}
 	if (rc == BSIM_OK && bsim_markov_def_after_start(def) && !made)
-		rc = next_fill(lattice, def, be, opts, dir, ss, out, &done, total, err);
+		rc = next_fill(lattice, def, be, opts, dir, ss, out, start_runs, &done, total, err);
 	if (rc == BSIM_ESTOPPED && made)
 		bsim_error_set(err, BSIM_ESTOPPED, "stopped in pass %d; nothing of it is kept",
 		               out->pass);
@@ -551,6 +586,10 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 		               "stopped after %d of the %d maps to build; those are kept in %s",
 		               out->built, to_build, dir);
 	bsim_markov_entries_free(&train);
+	bsim_markov_crossings_free(&cx);
+	for (int i = 0; start_runs && i < n; i++)
+		free(start_runs[i]);
+	free(start_runs);
 	free(have);
 	free(src);
 	free(pairs);

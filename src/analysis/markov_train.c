@@ -69,8 +69,11 @@ static int kinds_sorted(const bsim_scene *lattice, double (**kinds)[2])
 	return n;
 }
 
-const char *bsim_markov_train_label(const bsim_scene *lattice, int trials, char *buf, size_t size)
+const char *bsim_markov_train_label(const bsim_scene *lattice, const bsim_markov_def *def,
+                                    char *buf, size_t size)
 {
+	const int trials = def->train_trials;
+	const char *how = bsim_markov_def_crossings(def) ? " crossings" : "";
 	double(*kinds)[2] = NULL;
 	const int n = lattice ? kinds_sorted(lattice, &kinds) : 0;
 	uint64_t h = HASH_FNV1A64_SEED;
@@ -78,9 +81,10 @@ const char *bsim_markov_train_label(const bsim_scene *lattice, int trials, char 
 		h = bsim_hash_fnv1a64(kinds[i], sizeof kinds[i], h);
 	free(kinds);
 	if (n > 0)
-		snprintf(buf, size, "train %d kinds %d %016llx", trials, n, (unsigned long long)h);
+		snprintf(buf, size, "train %d%s kinds %d %016llx", trials, how, n,
+		         (unsigned long long)h);
 	else
-		snprintf(buf, size, "train %d", trials);
+		snprintf(buf, size, "train %d%s", trials, how);
 	return buf;
 }
 
@@ -136,17 +140,77 @@ static int train_scene(const bsim_scene *lattice, uint64_t seed, bsim_scene *s, 
 	return rc;
 }
 
+void bsim_markov_crossings_free(markov_crossings *c)
+{
+	free(c->k);
+	free(c->entry);
+	free(c->exit);
+	free(c->steps);
+	memset(c, 0, sizeof *c);
+}
+
+/* Trial log g's crossings (but the start gate's) appended to c, whose
+ * arrays hold *cap: the gate entered by each entry but the last left into
+ * the next entry's bin; the last, in a trial stuck there for gate_steps
+ * (res), was stuck; else its exit is not known. 0, or -1 out of memory. */
+static int crossings_push(markov_crossings *c, long *cap, const bsim_scene *s,
+                          const bsim_markov_def *def, const bsim_trial_log *g,
+                          const bsim_trial_result *res)
+{
+	const bsim_lattice_def *l = &s->lattice;
+	for (int j = 1; j < g->n_entries; j++) {
+		const bsim_gate_entry *e = &g->entries[j],
+		                      *next = j + 1 < g->n_entries ? e + 1 : NULL;
+		int exit = 0, steps = s->gate_steps;
+		if (next) {
+			exit = bsim_markov_bin_of(&def->bins, l, (int)next->edge, next->pos,
+			                          next->v);
+			/* a gate crossed at a corner, within one step, held it one */
+			steps = next->step > e->step ? next->step - e->step : 1;
+		} else if (res->outcome != BSIM_STUCK || res->steps_run - e->step < s->gate_steps)
+			break; /* left the field, or the trial ended: no exit known */
+		if (c->n == *cap) {
+			const long more = *cap ? 2 * *cap : 1024;
+			double(*k)[2] = realloc(c->k, (size_t)more * sizeof *k);
+			int ok = k != NULL;
+			if (k)
+				c->k = k;
+			int **a[3] = {&c->entry, &c->exit, &c->steps};
+			for (int i = 0; i < 3; i++) {
+				int *p = realloc(*a[i], (size_t)more * sizeof *p);
+				if (p)
+					*a[i] = p;
+				ok = ok && p;
+			}
+			if (!ok)
+				return -1;
+			*cap = more;
+		}
+		for (int side = 0; side < 2; side++)
+			c->k[c->n][side] =
+			        s->beams[bsim_lattice_beam(l, e->ix, e->iy, side)].stiffness;
+		c->entry[c->n] = bsim_markov_bin_of(&def->bins, l, (int)e->edge, e->pos, e->v);
+		c->exit[c->n] = exit;
+		c->steps[c->n] = steps;
+		c->n++;
+	}
+	return 0;
+}
+
 int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
                           const bsim_backend *be, const bsim_options *opts,
-                          bsim_markov_entries *out, bsim_error *err)
+                          bsim_markov_entries *out, markov_crossings *cx, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
+	if (cx)
+		memset(cx, 0, sizeof *cx);
 	bsim_scene s;
 	memset(&s, 0, sizeof s);
 	int rc = train_scene(lattice, def->seed, &s, err);
 	const long T = def->train_trials;
 	bsim_trial_log *logs = rc == BSIM_OK ? calloc((size_t)T, sizeof *logs) : NULL;
-	if (rc == BSIM_OK && !logs)
+	bsim_trial_result *results = rc == BSIM_OK ? calloc((size_t)T, sizeof *results) : NULL;
+	if (rc == BSIM_OK && (!logs || !results))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	/* the first failure in trial order, whatever the threads */
 	long first = T, done = 0;
@@ -188,6 +252,8 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 			}
 			if (trc == BSIM_OK && bsim_trial_log_copy(&logs[t], log) != BSIM_OK)
 				trc = bsim_error_set(&e, BSIM_EFAIL, "out of memory");
+			if (trc == BSIM_OK)
+				results[t] = res;
 			bsim_markov_trial_end(t, trc != BSIM_OK ? &e : NULL, &first, &fail, &done,
 			                      T, every, def->train_progress,
 			                      def->train_progress_user);
@@ -202,9 +268,10 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 		if (err)
 			*err = fail;
 	}
-	/* every entry but the start's, in trial order */
+	/* every entry but the start's, and every crossing, in trial order */
 	int cap = 0;
-	for (long t = 0; rc == BSIM_OK && t < T; t++)
+	long cx_cap = 0;
+	for (long t = 0; rc == BSIM_OK && t < T; t++) {
 		for (int j = 0; rc == BSIM_OK && j < logs[t].n_entries; j++) {
 			const bsim_gate_entry *g = &logs[t].entries[j];
 			if (g->edge != BSIM_EDGE_START &&
@@ -212,13 +279,20 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 			     bsim_markov_entries_push(out, &cap, (int)g->edge, g->pos, g->x, g->v)))
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 		}
+		if (rc == BSIM_OK && cx &&
+		    crossings_push(cx, &cx_cap, &s, def, &logs[t], &results[t]))
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
 	for (long t = 0; logs && t < T; t++)
 		bsim_trial_log_clear(&logs[t]);
 	free(logs);
+	free(results);
 	bsim_scene_free(&s);
-	if (rc != BSIM_OK)
+	if (rc != BSIM_OK) {
 		bsim_markov_entries_free(out);
-	else
-		bsim_markov_train_label(lattice, def->train_trials, out->id, sizeof out->id);
+		if (cx)
+			bsim_markov_crossings_free(cx);
+	} else
+		bsim_markov_train_label(lattice, def, out->id, sizeof out->id);
 	return rc;
 }

@@ -38,7 +38,8 @@ enum {
 	OWN_PASSES,
 	OWN_START_TRIALS,
 	OWN_AFTER_START,
-	OWN_TRAIN
+	OWN_TRAIN,
+	OWN_CROSSINGS
 };
 
 #define MAX_ENTRIES 16
@@ -151,6 +152,13 @@ static int markov_option(void *args, int i, const char *value)
 		a->def.train_trials = (int)n;
 		return CLI_OK;
 	}
+	case OWN_CROSSINGS: {
+		long n;
+		if (cli_parse_long(value, 0, 1, &n) != 0)
+			return cli_usage("markov build", "--crossings %s: expected 0 or 1", value);
+		a->def.train_crossings = (int)n;
+		return CLI_OK;
+	}
 	case OWN_MAP:
 		a->map = value;
 		return CLI_OK;
@@ -235,6 +243,11 @@ static const cli_own build_own[] = {
          "lattice's gate kinds at random, whose gate entries the\n"
          "bins' states are drawn from (default 10000; run only when\n"
          "a map is built); 0: states uniform in each bin"},
+        {"crossings", 1, "0|1",
+         "1: each bin counts the training field's own crossings of\n"
+         "the map's gate kind entered in it, topped up to --trials\n"
+         "with single gates (cheap maps: docs/markov.md); 0 (default):\n"
+         "--trials single gates a bin, from the field's entries"},
 };
 
 static int build_option(void *args, int i, const char *value)
@@ -245,6 +258,7 @@ static int build_option(void *args, int i, const char *value)
 	                     : i == 5 ? OWN_START_TRIALS
 	                     : i == 6 ? OWN_AFTER_START
 	                     : i == 7 ? OWN_TRAIN
+	                     : i == 8 ? OWN_CROSSINGS
 	                              : i,
 	                     value);
 }
@@ -280,7 +294,7 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 8,
+        .n_own = 9,
         .option = build_option,
 };
 
@@ -525,15 +539,20 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 		printf("passes 0 to %d of the %d (flow entries) in %s: the next round is the "
 		       "parts' command with --passes %s\n",
 		       pass, last + 1, cli_path(out), cli_path(out));
-	printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %d trials each, the "
+	const int trained = def->n_entries <= 0 && def->map.train_trials > 0 &&
+	                    !def->map.self_entries,
+	          crossings = trained && def->map.train_crossings;
+	printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %s%d trials each, the "
 	       "start's %d, in %s\n",
 	       res->built, res->seconds, res->reused,
-	       res->copied ? ", the others from the parts" : "", res->n_bins, def->map.trials,
+	       res->copied ? ", the others from the parts" : "", res->n_bins,
+	       crossings ? "their crossings or " : "", def->map.trials,
 	       def->map.start_trials > 0 ? def->map.start_trials : def->map.trials, cli_path(out));
-	if (res->built > 0 && def->n_entries <= 0 && def->map.train_trials > 0 &&
-	    !def->map.self_entries)
-		printf("the bins' states from the gate entries of a training field, %d trials of "
-		       "%d x %d gates of the lattice's kinds at random (CPU above)\n",
+	if (res->built > 0 && trained)
+		printf("the bins' %s a training field, %d trials of %d x %d gates of the lattice's "
+		       "kinds at random (CPU above)\n",
+		       crossings ? "counts from the crossings (topped up from the entries) of"
+		                 : "states from the gate entries of",
 		       def->map.train_trials, BSIM_MARKOV_TRAIN_SIZE, BSIM_MARKOV_TRAIN_SIZE);
 	if (def->map.after_start && !def->map.self_entries)
 		printf("the gate after the start: %d pairs of maps built, %d reused (CPU above)\n",

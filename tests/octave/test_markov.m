@@ -74,6 +74,18 @@ check(isequal(n3, n4) && isequal(t3, t4) && all(cellfun(@isempty, strfind(n3, '.
       'after_start 0: %s / %s', strjoin(n3, ' '), strjoin(n4, ' '));
 again = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'train', 40, 'bins', [2 2 1], 'seed', 5);
 check(again.reused == numel(keys) && again.built == 0, 'a build again: %d reused', again.reused);
+% 'crossings', 1 as --crossings 1: bins counted from the training field's crossings
+mine1 = fullfile(tmp, 'maps_mex_crossings');
+theirs1 = fullfile(tmp, 'maps_program_crossings');
+beamsim_markov('build', experiment, 'out', mine1, 'trials', 3, 'start_trials', 7, 'train', 40, 'bins', [2 2 1], ...
+               'threads', 2, 'seed', 5, 'crossings', 1);
+[out, err, status] = program(exe, tmp, sprintf('markov build %s %s --crossings 1 --out %s', ...
+                                               experiment, small, theirs1));
+check(status == 0, 'beamsim markov build --crossings 1: exit %d: %s', status, err);
+[n5, t5] = map_files(mine1);
+[n6, t6] = map_files(theirs1);
+check(isequal(n5, n6) && isequal(t5, t6), 'crossings 1: %s / %s', ...
+      strjoin(n5, ' '), strjoin(n6, ' '));
 printf('build: %d maps, the program''s bytes\n', numel(keys));
 
 % ---- predict: the program's --json ---------------------------------------

@@ -87,6 +87,20 @@ def test_after_start_is_the_programs(tmp_path):
     assert not any(".after_" in name for name in map_files(py))
 
 
+def test_crossings_is_the_programs(tmp_path):
+    """crossings=True builds what --crossings 1 builds: bins counted from
+    the training field's crossings, each holding its own number of single
+    gates."""
+    py, prog = tmp_path / "py", tmp_path / "prog"
+    beamsim.markov_build(EXPERIMENT, py, seed=5, crossings=True, **SMALL)
+    cli("markov", "build", EXPERIMENT, *SMALL_ARGS, "--seed", "5", "--crossings", "1",
+        "--out", prog)
+    files = map_files(py)
+    assert files == map_files(prog)
+    keys = [text for name, text in files.items() if name.endswith(".key")]
+    assert keys and all(b"entries train 40 crossings kinds " in text for text in keys)
+
+
 def test_predict_is_the_programs(maps):
     _, py, prog, tmp = maps
     for walks in (None, 0, 500):
