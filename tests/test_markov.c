@@ -1194,7 +1194,7 @@ static void test_threads_and_cache(void **state)
 	assert_null(strstr(out, "training field"));
 	assert_non_null(strstr(note, "note: maps with 30 training trials (the default 10000), "
 	                             "4,4,3 bins (the default 14,6,13), 3 start trials (the "
-	                             "default 4000): measured less accurate"));
+	                             "default 16000): measured less accurate"));
 	free(out);
 	free(note);
 	/* Anything the maps depend on: new maps, none reused. */
@@ -1536,8 +1536,8 @@ static void test_bad_inputs(void **state)
 	int rc = bsim_test_cli(big, NULL, &err);
 	bsim_test_check_input_error(
 	        rc, err,
-	        (const char *const[]){"1048576 entry bins x 2048 trials (the start's 4000) make "
-	                              "2147487648 single gates a map, more than 2147483647",
+	        (const char *const[]){"1048576 entry bins x 2048 trials (the start's 16000) make "
+	                              "2147499648 single gates a map, more than 2147483647",
 	                              NULL},
 	        0);
 	free(err);
@@ -2127,7 +2127,7 @@ static void test_scope(void **state)
 	d.bins.n_pos = 20;
 	d.bins.n_speed = 6;
 	d.bins.n_dir = 18; /* more bins, not fewer */
-	d.start_trials = 8000;
+	d.start_trials = 32000;
 	d.train_trials = 20000;
 	d.trials = 20; /* the maps' sampling error, which validate reports */
 	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf), "");
@@ -2153,7 +2153,7 @@ static void test_scope(void **state)
 	                    "\"What each part does\")");
 	d.start_trials = 50;
 	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
-	                       "maps with 50 start trials (the default 4000), no gate after the "
+	                       "maps with 50 start trials (the default 16000), no gate after the "
 	                       "start: "));
 	d = d0;
 	int is_kind;

@@ -15,7 +15,7 @@
 %   build's names:
 %     'out'          the map directory (required)
 %     'trials'       single gates per entry bin (default 50)
-%     'start_trials' single gates of the start bin (default 4000, or
+%     'start_trials' single gates of the start bin (default 16000, or
 %                    'trials' with self or flow entries)
 %     'after_start'  1 (default): each start trial that leaves into a gate
 %                    goes on there from its exact state, and the chain

@@ -230,7 +230,7 @@ typedef struct bsim_markov_def {
 #define BSIM_MARKOV_SELF_PASSES_MAX 8
 
 /* The start bin's single-gate trials by default. */
-#define BSIM_MARKOV_START_TRIALS 4000
+#define BSIM_MARKOV_START_TRIALS 16000
 /* The training field's trials by default, and its gates across and along. */
 #define BSIM_MARKOV_TRAIN_TRIALS 10000
 #define BSIM_MARKOV_TRAIN_SIZE   21
@@ -267,8 +267,9 @@ typedef struct bsim_markov_map {
 	double seconds;  /* CPU time of its simulation now, s (0 if read from the cache) */
 	double cost;     /* CPU time its simulation took when it was built, s: with self or
 	                  * flow entries every pass's, those reused from the cache too */
-	long long steps; /* single-gate time steps that simulation took (as cost); 0 if
-	                  * the map's .cost file predates the count */
+	long long steps; /* single-gate time steps that simulation took, with its share
+	                  * of the training field's (as cost); 0 if the map's .cost
+	                  * file predates the count */
 	int cached;      /* 1: read from the cache, 0: simulated now */
 	/* Holding times: each single gate's exit bin (0 stuck) and the time
 	 * steps it spent in the gate (to the step that left it, or gate_steps

@@ -356,37 +356,6 @@ static int units_run(const bsim_scene *lattice, const bsim_markov_def *def, cons
 	return BSIM_OK;
 }
 
-int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
-                                  const bsim_backend *be, const bsim_options *opts,
-                                  bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
-                                  long *done, long total, bsim_error *err)
-{
-	const long units = bsim_markov_map_units(m);
-	int *exit = malloc((size_t)units * sizeof *exit);
-	int *held = malloc((size_t)units * sizeof *held);
-	if (!exit || !held) {
-		free(exit);
-		free(held);
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	}
-	long long steps = 0;
-	int rc = units_run(lattice, def, be, opts, m->k, units, NULL, m, pool, NULL, NULL, runs,
-	                   exit, held, &steps, done, total, err);
-	if (rc == BSIM_OK && bsim_markov_counts_of_exits(m, exit) != 0)
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	if (rc == BSIM_OK) { /* the holding times: the map keeps both arrays */
-		free(m->hold_exit);
-		free(m->hold_steps);
-		m->hold_exit = exit;
-		m->hold_steps = held;
-		exit = held = NULL;
-	}
-	m->steps += steps;
-	free(exit);
-	free(held);
-	return rc;
-}
-
 /* Whether crossing i of cx is of map m's gate kind. */
 static int crossing_of(const markov_crossings *cx, long i, const bsim_markov_map *m)
 {
@@ -412,25 +381,16 @@ long bsim_markov_crossings_layout(bsim_markov_map *m, const markov_crossings *cx
 	return placed;
 }
 
-int bsim_markov_map_simulate_crossings(const bsim_scene *lattice, const bsim_markov_def *def,
-                                       const bsim_backend *be, const bsim_options *opts,
-                                       bsim_markov_map *m, const markov_crossings *cx,
-                                       markov_run *runs, long *done, long total, bsim_error *err)
+/* With cx, each bin's crossings of m's kind placed first in its single
+ * gates, in trial order (exit and held set), and the others listed in
+ * todo: how many; -1 out of memory. */
+static long crossings_place(const bsim_markov_map *m, const markov_crossings *cx, int *exit,
+                            int *held, long *todo)
 {
 	const int nb = m->n_bins;
-	const long units = bsim_markov_map_units(m);
-	int *exit = malloc((size_t)units * sizeof *exit);
-	int *held = malloc((size_t)units * sizeof *held);
-	long *todo = malloc((size_t)units * sizeof *todo);
 	long *fill = calloc((size_t)nb, sizeof *fill); /* bin a's crossings placed */
-	if (!exit || !held || !todo || !fill) {
-		free(exit);
-		free(held);
-		free(todo);
-		free(fill);
-		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	}
-	/* each bin's crossings first, in trial order, then its single gates */
+	if (!fill)
+		return -1;
 	for (long i = 0; i < cx->n; i++)
 		if (crossing_of(cx, i, m)) {
 			const int a = cx->entry[i];
@@ -438,14 +398,37 @@ int bsim_markov_map_simulate_crossings(const bsim_scene *lattice, const bsim_mar
 			exit[u] = cx->exit[i];
 			held[u] = cx->steps[i];
 		}
-	long n_todo = 0;
+	long n = 0;
 	for (int a = 0; a < nb; a++)
 		for (long u = bsim_markov_bin_first(m, a) + fill[a];
 		     u < bsim_markov_bin_first(m, a + 1); u++)
-			todo[n_todo++] = u;
+			todo[n++] = u;
+	free(fill);
+	return n;
+}
+
+int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
+                                  const bsim_backend *be, const bsim_options *opts,
+                                  bsim_markov_map *m, const markov_pool *pool,
+                                  const markov_crossings *cx, markov_run *runs, long *done,
+                                  long total, bsim_error *err)
+{
+	const long units = bsim_markov_map_units(m);
+	int *exit = malloc((size_t)units * sizeof *exit);
+	int *held = malloc((size_t)units * sizeof *held);
+	long *todo = cx ? malloc((size_t)units * sizeof *todo) : NULL;
+	const long n = !exit || !held || (cx && !todo) ? -1
+	               : cx                            ? crossings_place(m, cx, exit, held, todo)
+	                                               : units;
+	if (n < 0) {
+		free(exit);
+		free(held);
+		free(todo);
+		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
 	long long steps = 0;
-	int rc = units_run(lattice, def, be, opts, m->k, n_todo, todo, m, NULL, NULL, NULL, runs,
-	                   exit, held, &steps, done, total, err);
+	int rc = units_run(lattice, def, be, opts, m->k, n, todo, m, pool, NULL, NULL, runs, exit,
+	                   held, &steps, done, total, err);
 	if (rc == BSIM_OK && bsim_markov_counts_of_exits(m, exit) != 0)
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	if (rc == BSIM_OK) { /* the holding times: the map keeps both arrays */
@@ -459,7 +442,6 @@ int bsim_markov_map_simulate_crossings(const bsim_scene *lattice, const bsim_mar
 	free(exit);
 	free(held);
 	free(todo);
-	free(fill);
 	return rc;
 }
 

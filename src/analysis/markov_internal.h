@@ -142,12 +142,13 @@ void bsim_markov_crossings_free(markov_crossings *c);
 
 /* The gate entries of lattice's training field (def->train_trials trials,
  * on def->threads threads, the same for any number), the start's left
- * out, in trial order; out->id its label; and its crossings into cx (may
- * be NULL). BSIM_EFAIL naming the first unstable trial, BSIM_ESTOPPED
- * when def->stop was set. */
+ * out, in trial order; out->id its label; its crossings into cx (may be
+ * NULL) and the time steps its trials took into *steps. BSIM_EFAIL naming
+ * the first unstable trial, BSIM_ESTOPPED when def->stop was set. */
 int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
                           const bsim_backend *be, const bsim_options *opts,
-                          bsim_markov_entries *out, markov_crossings *cx, bsim_error *err);
+                          bsim_markov_entries *out, markov_crossings *cx, long long *steps,
+                          bsim_error *err);
 
 /* ---- counts by row (markov_counts.c) ---- */
 
@@ -211,20 +212,6 @@ typedef struct markov_pool {
 	double *cw;
 } markov_pool;
 
-/* Map m's counts (n_bins, k and counts allocated) from def->trials single
- * gates per entry bin, on def->threads threads, the states of bin b > 0
- * drawn from pool's exits into b (pool NULL: in the bin, or among
- * def->entries), and every trial's entry and exit kept in runs[u] of its
- * unit u (bsim_markov_unit_bin's order; runs may be NULL); *done counts
- * the trials run of total, for def->progress. BSIM_EFAIL with the error
- * of the first failed trial (in trial order, whatever the threads);
- * BSIM_ESTOPPED, err untouched and the counts not counted, if def->stop
- * was set. */
-int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
-                                  const bsim_backend *be, const bsim_options *opts,
-                                  bsim_markov_map *m, const markov_pool *pool, markov_run *runs,
-                                  long *done, long total, bsim_error *err);
-
 /* Map m's bins laid out for the crossings of its gate kind in cx (m's
  * bin_first set): each bin holds its crossings or m->trials, whichever is
  * more, the start bin m->start_trials. The crossings placed, or -1 out of
@@ -232,14 +219,22 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
  * bsim_markov_map_units(m). */
 long bsim_markov_crossings_layout(bsim_markov_map *m, const markov_crossings *cx);
 
-/* Map m's counts (bins laid out by bsim_markov_crossings_layout from cx)
- * from the crossings of cx of its kind, each bin's in trial order, and
- * the single gates that top each bin up (their runs into runs, as
- * bsim_markov_map_simulate_runs keeps them; may be NULL). */
-int bsim_markov_map_simulate_crossings(const bsim_scene *lattice, const bsim_markov_def *def,
-                                       const bsim_backend *be, const bsim_options *opts,
-                                       bsim_markov_map *m, const markov_crossings *cx,
-                                       markov_run *runs, long *done, long total, bsim_error *err);
+/* Map m's counts (n_bins, k and counts allocated) from its single gates,
+ * def->trials per entry bin, on def->threads threads, the states of bin
+ * b > 0 drawn from pool's exits into b (pool NULL: in the bin, or among
+ * def->entries); with cx (bins laid out by bsim_markov_crossings_layout),
+ * each bin's crossings of cx first, in trial order, then the single gates
+ * that top it up. Every trial's entry and exit kept in runs[u] of its unit
+ * u (bsim_markov_unit_bin's order; runs may be NULL; a crossing's left
+ * as it was); *done counts the trials run of total, for def->progress.
+ * BSIM_EFAIL with the error of the first failed trial (in trial order,
+ * whatever the threads); BSIM_ESTOPPED, err untouched and the counts not
+ * counted, if def->stop was set. */
+int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_def *def,
+                                  const bsim_backend *be, const bsim_options *opts,
+                                  bsim_markov_map *m, const markov_pool *pool,
+                                  const markov_crossings *cx, markov_run *runs, long *done,
+                                  long total, bsim_error *err);
 
 /* The gate after the start (bsim_markov_next): the start bin's single
  * gates of map start again (the same seeds as the map's: the same exits,

@@ -494,12 +494,14 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	markov_crossings cx = {0};
 	const int crossings = bsim_markov_def_crossings(def);
 	bsim_markov_def with_train;
-	double train_share = 0.0; /* a built map's part of the field's CPU, s */
+	double train_share = 0.0;  /* a built map's part of the field's CPU, s */
+	long long train_steps = 0; /* and of its time steps */
 	if (rc == BSIM_OK && stage && !made && to_build > 0 && bsim_markov_def_trains(def)) {
 		clock_t c0 = clock();
 		rc = bsim_markov_train_run(lattice, def, be, opts, &train, crossings ? &cx : NULL,
-		                           err);
+		                           &train_steps, err);
 		train_share = (double)(clock() - c0) / CLOCKS_PER_SEC / to_build;
+		train_steps /= to_build;
 		with_train = *def;
 		with_train.entries = &train;
 		def = &with_train;
@@ -552,12 +554,9 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			     : def->self_entries
 			             ? bsim_markov_self_simulate(lattice, def, be, opts, m, dir,
 			                                         stage, &done, total, err)
-			     : crossings
-			             ? bsim_markov_map_simulate_crossings(lattice, def, be, opts, m,
-			                                                  &cx, runs, &done, total,
-			                                                  err)
 			             : bsim_markov_map_simulate_runs(lattice, def, be, opts, m,
-			                                             NULL, runs, &done, total, err);
+			                                             NULL, crossings ? &cx : NULL,
+			                                             runs, &done, total, err);
 		if (runs && rc == BSIM_OK) { /* the start bin's come first */
 			markov_run *kept = realloc(runs, (size_t)m->start_trials * sizeof *runs);
 			start_runs[i] = kept ? kept : runs;
@@ -565,6 +564,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 			free(runs);
 		if (!flow) /* else the CPU time of its passes */
 			m->seconds = (double)(clock() - c0) / CLOCKS_PER_SEC + train_share;
+		m->steps += train_steps;
 		/* with self or flow entries, m->cost holds what the passes
 		 * reused from the cache cost */
 		m->cost = m->seconds + (def->self_entries ? m->cost : 0.0);

@@ -298,8 +298,8 @@ int bsim_markov_self_simulate(const bsim_scene *lattice, const bsim_markov_def *
 		rc = def->stop && *def->stop
 		             ? BSIM_ESTOPPED
 		             : bsim_markov_map_simulate_runs(lattice, def, be, opts, &mq,
-		                                             have_pool ? &pool : NULL, cur, done,
-		                                             total, err);
+		                                             have_pool ? &pool : NULL, NULL, cur,
+		                                             done, total, err);
 		mq.seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 		cum += mq.seconds;
 		cum_steps += mq.steps;
@@ -612,8 +612,8 @@ int bsim_markov_flow_simulate(const bsim_scene *lattice, const bsim_markov_def *
 			rc = def->stop && *def->stop
 			             ? BSIM_ESTOPPED
 			             : bsim_markov_map_simulate_runs(lattice, def, be, opts, &mq,
-			                                             q > 0 ? &pool : NULL, cur[b],
-			                                             done, total, err);
+			                                             q > 0 ? &pool : NULL, NULL,
+			                                             cur[b], done, total, err);
 			mq.seconds = (double)(clock() - c0) / CLOCKS_PER_SEC;
 			maps[b].seconds += mq.seconds;
 			maps[b].steps += mq.steps;

@@ -199,7 +199,8 @@ static int crossings_push(markov_crossings *c, long *cap, const bsim_scene *s,
 
 int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
                           const bsim_backend *be, const bsim_options *opts,
-                          bsim_markov_entries *out, markov_crossings *cx, bsim_error *err)
+                          bsim_markov_entries *out, markov_crossings *cx, long long *steps,
+                          bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
 	if (cx)
@@ -271,7 +272,9 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 	/* every entry but the start's, and every crossing, in trial order */
 	int cap = 0;
 	long cx_cap = 0;
+	*steps = 0;
 	for (long t = 0; rc == BSIM_OK && t < T; t++) {
+		*steps += results[t].steps_run;
 		for (int j = 0; rc == BSIM_OK && j < logs[t].n_entries; j++) {
 			const bsim_gate_entry *g = &logs[t].entries[j];
 			if (g->edge != BSIM_EDGE_START &&

@@ -231,7 +231,7 @@ static const cli_own build_own[] = {
          "beamsim merge wrote of the round before, whose passes the\n"
          "next round's states come from (none: the first round)"},
         {"start-trials", 1, "N",
-         "single-gate trials of the start bin (default 4000, or\n"
+         "single-gate trials of the start bin (default 16000, or\n"
          "--trials with self or flow entries, which take no other)"},
         {"after-start", 1, "0|1",
          "1 (default): each start trial that leaves into a gate goes\n"

@@ -469,7 +469,7 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
 
     out is a cache: maps already there with the same key are reused, the
     others built there. trials: single gates per entry bin (None: 50);
-    start_trials: of the start bin (None: 4,000, or trials with self or flow
+    start_trials: of the start bin (None: 16,000, or trials with self or flow
     entries); after_start: True (None: the default, False with self or flow
     entries) continues each start trial that leaves into a gate there from
     its exact state, for every pair of stiffnesses, and the chain takes the
