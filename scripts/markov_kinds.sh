@@ -9,17 +9,24 @@
 # prediction.csv and validate.csv. A method's maps are built once, on the
 # first field of a set of gate kinds, and reused on every other; flow:1
 # maps are built per field (they hold for that layout only). default is
-# the default now (a training field of the kinds, 14,6,13 bins), uniform
-# the default before it (states uniform in 8,8,9 bins). ring5 and check11
-# are the fields the settings were chosen on; test_* were made after the
-# bins and trials were fixed, fresh_* after the gate after the start was,
-# late_* after the training field (method train), final_* after the
-# training field with finer bins (method train10k-bins14613), held_* after
-# the default now (name them in FIELDS). Prints one row per method and field;
+# the default now (a training field of the kinds, 14,6,13 bins, 16,000
+# start trials), start4000 the default before it (4,000 start trials),
+# uniform the default before that (states uniform in 8,8,9 bins). ring5
+# and check11 are the fields the settings were chosen on; test_* were made
+# after the bins and trials were fixed, fresh_* after the gate after the
+# start was, late_* after the training field (method train), final_* after
+# the training field with finer bins (method train10k-bins14613), held_*
+# after start4000, cheap_* after the cheap maps (method cheap: a training
+# field of 4,000 trials counted by its crossings, 5 single gates a bin at
+# least, 2,000 from the start; crossings: start4000 counted by its
+# crossings), start_* after the default's 16,000 start trials (name them
+# in FIELDS). Prints one row per method and field;
 # the runs stay in OUT (default out/markov-kinds), the table in
 # OUT/table.txt. FIELDS="..." chooses the fields, METHODS="..." the methods
 # (by name), TRIALS=N the direct trials of each (default the experiments',
-# 10,000).
+# 10,000); DIRECT=N adds a row per field, direct-N: a direct simulation of
+# its own (N trials, seed 2) against the same validation, what the maps
+# are weighed against at that cost.
 #   scripts/markov_kinds.sh [OUT] [THREADS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -34,17 +41,20 @@ fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13
 # a training field's entries (train: the sweep of exp_train_r21.yaml, run
 # first), and with 10,000 trials of it and 14,6,13 bins
 methods=("default:"
-         "uniform:--train 0 --bins 8,8,9"
-         "without-after-start:--train 0 --bins 8,8,9 --after-start 0"
+         "start4000:--start-trials 4000"
+         "uniform:--train 0 --bins 8,8,9 --start-trials 4000"
+         "without-after-start:--train 0 --bins 8,8,9 --after-start 0 --start-trials 4000"
          "fine-bins-alone:--train 0 --bins 8,8,9 --start-trials 50 --after-start 0"
          "start-trials-alone:--train 0 --bins 4,4,3 --trials 200 --after-start 0"
          "after-start-alone:--train 0 --bins 4,4,3 --trials 200 --start-trials 200"
          "previous-default:--train 0 --bins 4,4,3 --trials 200 --start-trials 200 --after-start 0"
          "flow1:--bins 4,4,3 --trials 200 --entries flow:1"
          "self1:--bins 8,8,9 --entries self:1"
-         "bins14613:--train 0 --bins 14,6,13"
-         "train:--entries $out/train-sweep --bins 8,8,9"
-         "train10k-bins14613:--entries $out/train-sweep-10k --bins 14,6,13")
+         "bins14613:--train 0 --bins 14,6,13 --start-trials 4000"
+         "train:--entries $out/train-sweep --bins 8,8,9 --start-trials 4000"
+         "train10k-bins14613:--entries $out/train-sweep-10k --bins 14,6,13 --start-trials 4000"
+         "crossings:--crossings 1 --start-trials 4000"
+         "cheap:--crossings 1 --train 4000 --trials 5 --start-trials 2000")
 if [ -n "${METHODS:-}" ]; then
     chosen=()
     for m in "${methods[@]}"; do
@@ -64,6 +74,12 @@ for m in "${methods[@]}"; do
         $exe sweep configs/markov/kinds/exp_train_r21.yaml --trials "$trials" --threads "$threads" \
             --quiet --out "$out/$sweep" >/dev/null
 done
+# TV of validate.csv's p_sim ($1) against another's ($2) for protocol $3
+tv_sim() {
+    awk -F, -v proto="$3" 'NR == FNR { if (FNR > 1 && $2 == proto) p[$3] = $4; next }
+        FNR > 1 && $2 == proto { d = p[$3] - $4; s += d < 0 ? -d : d; seen[$3] = 1 }
+        END { for (k in p) if (!(k in seen)) s += p[k]; printf "%.3f", s / 2 }' "$1" "$2"
+}
 # TV of prediction.csv ($1) against validate.csv's p_sim ($2) for protocol $3
 tv() {
     awk -F, -v proto="$3" 'NR == FNR { if (FNR > 1) p[$1] = $5; next }
@@ -94,4 +110,14 @@ for f in "${fields[@]}"; do
         printf '%-20s %-11s %6s %6s %9.3f %9s %s\n' "$name" "$f" "$(tv "$p/prediction.csv" "$v/validate.csv" essay)" \
             "$(tv "$p/prediction.csv" "$v/validate.csv" world)" "$samp" "${cpu:-}" "${log:-}"
     done
+    if [ -n "${DIRECT:-}" ]; then
+        d=$out/direct$DIRECT-$f
+        [ -f "$d/validate.json" ] ||
+            $exe markov validate "$exp" --map "$maps" --trials "$DIRECT" --seed 2 \
+                --threads "$threads" --quiet --out "$d"
+        samp=$(grep '"protocol": "essay"' "$v/validate.json" | sed -E 's/.*"tv_sampling": ([0-9.]*).*/\1/')
+        printf '%-20s %-11s %6s %6s %9.3f\n' "direct-$DIRECT" "$f" \
+            "$(tv_sim "$d/validate.csv" "$v/validate.csv" essay)" \
+            "$(tv_sim "$d/validate.csv" "$v/validate.csv" world)" "$samp"
+    fi
 done | tee "$out/table.txt"
