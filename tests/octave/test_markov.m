@@ -60,32 +60,26 @@ check(any(~cellfun(@isempty, strfind(n1, '.after_'))), 'no gate after the start 
       strjoin(n1, ' '));
 check(strncmp(b.scope, 'maps with 40 training trials', 28) && ~isempty(strfind(err, ['note: ' b.scope])), ...
       'the scope ''%s'' is not the program''s note: %s', b.scope, err);
-% 'after_start', 0 as --after-start 0: no gate after the start
-mine0 = fullfile(tmp, 'maps_mex_after0');
-theirs0 = fullfile(tmp, 'maps_program_after0');
-beamsim_markov('build', experiment, 'out', mine0, 'trials', 3, 'start_trials', 7, 'train', 40, 'bins', [2 2 1], ...
-               'threads', 2, 'seed', 5, 'after_start', 0);
-[out, err, status] = program(exe, tmp, sprintf('markov build %s %s --after-start 0 --out %s', ...
-                                               experiment, small, theirs0));
-check(status == 0, 'beamsim markov build --after-start 0: exit %d: %s', status, err);
-[n3, t3] = map_files(mine0);
-[n4, t4] = map_files(theirs0);
-check(isequal(n3, n4) && isequal(t3, t4) && all(cellfun(@isempty, strfind(n3, '.after_'))), ...
-      'after_start 0: %s / %s', strjoin(n3, ' '), strjoin(n4, ' '));
+% 'after_start', 0 as --after-start 0 (no gate after the start), and 'crossings', 1 as
+% --crossings 1 (bins counted from the training field's crossings)
+variants = {'after_start', 0, '--after-start 0'; 'crossings', 1, '--crossings 1'};
+for i = 1:rows(variants)
+  [name, value, option] = variants{i, :};
+  mine0 = fullfile(tmp, ['maps_mex_' name]);
+  theirs0 = fullfile(tmp, ['maps_program_' name]);
+  beamsim_markov('build', experiment, 'out', mine0, 'trials', 3, 'start_trials', 7, 'train', 40, ...
+                 'bins', [2 2 1], 'threads', 2, 'seed', 5, name, value);
+  [out, err, status] = program(exe, tmp, sprintf('markov build %s %s %s --out %s', ...
+                                                 experiment, small, option, theirs0));
+  check(status == 0, 'beamsim markov build %s: exit %d: %s', option, status, err);
+  [n3, t3] = map_files(mine0);
+  [n4, t4] = map_files(theirs0);
+  none_after = all(cellfun(@isempty, strfind(n3, '.after_')));
+  check(isequal(n3, n4) && isequal(t3, t4) && none_after == strcmp(name, 'after_start'), ...
+        '%s: %s / %s', option, strjoin(n3, ' '), strjoin(n4, ' '));
+end
 again = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'train', 40, 'bins', [2 2 1], 'seed', 5);
 check(again.reused == numel(keys) && again.built == 0, 'a build again: %d reused', again.reused);
-% 'crossings', 1 as --crossings 1: bins counted from the training field's crossings
-mine1 = fullfile(tmp, 'maps_mex_crossings');
-theirs1 = fullfile(tmp, 'maps_program_crossings');
-beamsim_markov('build', experiment, 'out', mine1, 'trials', 3, 'start_trials', 7, 'train', 40, 'bins', [2 2 1], ...
-               'threads', 2, 'seed', 5, 'crossings', 1);
-[out, err, status] = program(exe, tmp, sprintf('markov build %s %s --crossings 1 --out %s', ...
-                                               experiment, small, theirs1));
-check(status == 0, 'beamsim markov build --crossings 1: exit %d: %s', status, err);
-[n5, t5] = map_files(mine1);
-[n6, t6] = map_files(theirs1);
-check(isequal(n5, n6) && isequal(t5, t6), 'crossings 1: %s / %s', ...
-      strjoin(n5, ' '), strjoin(n6, ' '));
 printf('build: %d maps, the program''s bytes\n', numel(keys));
 
 % ---- predict: the program's --json ---------------------------------------
