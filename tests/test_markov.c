@@ -1514,6 +1514,14 @@ static void test_bad_inputs(void **state)
 	          target, NULL},
 	         "start trials: self-consistent and flow entries take the start bin's trials "
 	         "equal to every bin's (50), got 300"},
+	        {{"markov", "build", essay, "--train", "0", "--crossings", "1", "--out", target,
+	          NULL},
+	         "crossings: a map counts a training field's crossings only with a training "
+	         "field (training trials > 0, got 0)"},
+	        {{"markov", "build", essay, "--entries", "self", "--crossings", "1", "--out",
+	          target, NULL},
+	         "crossings: a map counts a training field's crossings only with a training "
+	         "field"},
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
 		char *err = NULL;

@@ -121,6 +121,12 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		                      bsim_markov_bins_count(b) - 1, def->trials,
 		                      bsim_markov_def_start_trials(def), units,
 		                      (double)BSIM_MARKOV_MAX_UNITS);
+	if (def->train_crossings && !bsim_markov_def_trains(def))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "crossings: a map counts a training field's crossings only "
+		                      "with a training field (training trials > 0, got %d) and "
+		                      "neither observed, self nor flow entries",
+		                      def->train_trials);
 	/* The passes' exits are kept and pooled per trial of every bin alike. */
 	if (def->self_entries && bsim_markov_def_start_trials(def) != def->trials)
 		return bsim_error_set(err, BSIM_EINPUT,
