@@ -485,8 +485,9 @@ int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *
 	} else
 		rc = units_run(lattice, def, be, opts, start->k, T, NULL, &sm, NULL, NULL, NULL,
 		               runs, exit, held, &steps, done, total, err);
-	/* The same seeds as the map's start bin: the same single gates. */
-	for (long t = 0; rc == BSIM_OK && start->hold_exit && t < T; t++)
+	/* Run again, the same seeds as the map's start bin: the same single
+	 * gates (the kept runs are the map's own). */
+	for (long t = 0; rc == BSIM_OK && !start_runs && start->hold_exit && t < T; t++)
 		if (exit[t] != start->hold_exit[t] || held[t] != start->hold_steps[t])
 			rc = bsim_error_set(err, BSIM_EFAIL,
 			                    "the start's single gate %ld of map_%016llx ran again "
