@@ -862,7 +862,8 @@ static void test_training_against_simulation(void **state)
  * crossings (topped up to 1 single gate a bin) against the map of 400
  * single gates a bin from the field's entries, every exit of the bottom
  * bin (most entries) within 4.5 standard errors, and the mean time in the
- * gate too. The layout of a map of crossings reads back from its files. */
+ * gate too. The layout of a map of crossings reads back from its files,
+ * and a bin topped up per crossing holds what the rule says. */
 static void test_crossings_are_single_gates(void **state)
 {
 	(void)state;
@@ -955,6 +956,36 @@ static void test_crossings_are_single_gates(void **state)
 	                                "trials"));
 	bsim_test_write(dir, name, csv);
 	free(csv);
+	/* topped up per crossing: a bin of c crossings (c of the map above,
+	 * whose bins hold their crossings or 1) holds c or 2 single gates a
+	 * crossing (2 where none entered), at most 200, whichever is more; it
+	 * reads back the same */
+	def.trials = 200;
+	def.trials_per_crossing = 2;
+	bsim_markov_set per;
+	assert_int_equal(bsim_markov_build(&s, &def, dir, &per, &err), BSIM_OK);
+	assert_int_equal(per.built, 1);
+	const bsim_markov_map *pm = &per.maps[0];
+	assert_non_null(pm->bin_first);
+	assert_int_equal(pm->bin_first[1], def.start_trials);
+	int cut = 0, full = 0;
+	for (int b = 1; b < nb; b++) {
+		const long c = cx->bin_first[b + 1] - cx->bin_first[b];
+		const long topped = 2 * c < 200 ? 2 * c : 200, want = c > topped ? c : topped;
+		print_message("bin %d: %ld crossings, %ld single gates\n", b, c,
+		              pm->bin_first[b + 1] - pm->bin_first[b]);
+		assert_int_equal(pm->bin_first[b + 1] - pm->bin_first[b], want);
+		cut += want > c && want < 200; /* topped up, short of trials */
+		full += want == c;             /* its crossings alone */
+	}
+	assert_true(cut >= 1 && full >= 1);
+	assert_int_equal(bsim_markov_build(&s, &def, dir, &again, &err), BSIM_OK);
+	assert_int_equal(again.reused, 1);
+	for (int b = 0; b <= nb; b++)
+		assert_int_equal(again.maps[0].bin_first[b], pm->bin_first[b]);
+	assert_true(counts_same(&again.maps[0], pm, -1));
+	bsim_markov_set_free(&again);
+	bsim_markov_set_free(&per);
 	for (int i = 0; i < 2; i++)
 		bsim_markov_set_free(&set[i]);
 	bsim_scene_free(&s);
@@ -1006,7 +1037,9 @@ static void test_training_kinds(void **state)
 		bsim_options opts = {0};
 		assert_int_equal(bsim_markov_load(sc[f], dir, &opts, &back, &err), BSIM_OK);
 		assert_int_equal(back.def.train_trials, 20);
-		assert_int_equal(back.def.train_crossings, 0);
+		/* the default counts the crossings, 5 single gates a crossing */
+		assert_int_equal(back.def.train_crossings, 1);
+		assert_int_equal(back.def.trials_per_crossing, BSIM_MARKOV_TRIALS_PER_CROSSING);
 		bsim_markov_set_free(&back);
 	}
 	/* a lattice of kinds no build trained on together: refused, naming
@@ -1019,7 +1052,7 @@ static void test_training_kinds(void **state)
 	bsim_options opts = {0};
 	assert_int_equal(bsim_markov_load(&d, dir, &opts, &none, &err), BSIM_EINPUT);
 	print_message("%s\n", err.msg);
-	assert_non_null(strstr(err.msg, "'entries train 20 kinds 2 "));
+	assert_non_null(strstr(err.msg, "'entries train 20 crossings per 5 kinds 2 "));
 	bsim_markov_set_free(&sa);
 	bsim_markov_set_free(&sb);
 	bsim_markov_set_free(&sc2);
@@ -1159,27 +1192,32 @@ static void test_threads_and_cache(void **state)
 	assert_string_equal(t1, t2);
 	free(t1);
 	free(t2);
-	/* maps counted from the training field's crossings alike: the
-	 * crossings in trial order, whatever the threads */
-	char c1[1024], c2[1024];
-	snprintf(c1, sizeof c1, "%s", bsim_test_dir("threads_crossings1"));
-	snprintf(c2, sizeof c2, "%s", bsim_test_dir("threads_crossings2"));
-	const char *x1[] = {"markov", "build",     exp, "--bins",  "4,4,3", "--start-trials",
-	                    "3",      "--trials",  "3", "--train", "30",    "--crossings",
-	                    "1",      "--threads", "1", "--quiet", "--out", c1,
-	                    NULL};
-	const char *x2[] = {"markov", "build",     exp, "--bins",  "4,4,3", "--start-trials",
-	                    "3",      "--trials",  "3", "--train", "30",    "--crossings",
-	                    "1",      "--threads", "2", "--quiet", "--out", c2,
-	                    NULL};
-	assert_int_equal(bsim_test_cli(x1, NULL, NULL), 0);
-	assert_int_equal(bsim_test_cli(x2, NULL, NULL), 0);
-	t1 = map_text(c1);
-	t2 = map_text(c2);
-	assert_true(strlen(t1) > 1000);
-	assert_string_equal(t1, t2);
-	free(t1);
-	free(t2);
+	/* maps topped up to 1 single gate a crossing, and maps of single gates
+	 * alone (no crossings counted), alike: the crossings in trial order,
+	 * whatever the threads */
+	const char *how[2][2] = {{"--per-crossing", "1"}, {"--crossings", "0"}};
+	for (int h = 0; h < 2; h++) {
+		char c[2][1024];
+		char *t[2];
+		for (int n = 0; n < 2; n++) {
+			char name[32];
+			snprintf(name, sizeof name, "threads_crossings%d%d", h, n);
+			snprintf(c[n], sizeof c[n], "%s", bsim_test_dir(name));
+			const char *x[] = {"markov",  "build",     exp,
+			                   "--bins",  "4,4,3",     "--start-trials",
+			                   "3",       "--trials",  "3",
+			                   "--train", "30",        how[h][0],
+			                   how[h][1], "--threads", n ? "2" : "1",
+			                   "--quiet", "--out",     c[n],
+			                   NULL};
+			assert_int_equal(bsim_test_cli(x, NULL, NULL), 0);
+			t[n] = map_text(c[n]);
+		}
+		assert_true(strlen(t[0]) > 1000);
+		assert_string_equal(t[0], t[1]);
+		free(t[0]);
+		free(t[1]);
+	}
 
 	/* The same again: both maps reused, no training field run, and a note
 	 * that these training trials, bins and start trials are fewer than the
@@ -1206,8 +1244,9 @@ static void test_threads_and_cache(void **state)
 	                            {"--trials", "3", "--backend-opt", "integrator=euler"},
 	                            {"--trials", "3", "--train", "31"},
 	                            {"--trials", "3", "--train", "0"},
-	                            {"--trials", "3", "--crossings", "1"}};
-	for (int i = 0; i < 9; i++) {
+	                            {"--trials", "3", "--crossings", "0"},
+	                            {"--trials", "3", "--per-crossing", "3"}};
+	for (int i = 0; i < 10; i++) {
 		const char *argv[] = {"markov",
 		                      "build",
 		                      exp,
@@ -1239,7 +1278,7 @@ static void test_threads_and_cache(void **state)
 		const char *trained = strstr(progress, "beamsim: progress: 1/3"),
 		           *gates = strstr(progress, " single gates ");
 		assert_non_null(gates);
-		if (strcmp(changes[i][3], "0") == 0) {
+		if (strcmp(changes[i][2], "--train") == 0 && strcmp(changes[i][3], "0") == 0) {
 			assert_null(strstr(progress, "training trials"));
 		} else {
 			assert_non_null(trained);
@@ -1522,6 +1561,8 @@ static void test_bad_inputs(void **state)
 	          target, NULL},
 	         "crossings: a map counts a training field's crossings only with a training "
 	         "field"},
+	        {{"markov", "build", essay, "--per-crossing", "-1", "--out", target, NULL},
+	         "--per-crossing -1: expected an integer 0 to 1000000"},
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
 		char *err = NULL;

@@ -25,10 +25,14 @@
 %                    lattice's gate kinds at random whose gate entries the
 %                    bins' states are drawn from (default 10000; run only
 %                    when a map is built); 0: states uniform in each bin
-%     'crossings'    1: each bin counts the training field's own crossings
-%                    of the map's gate kind entered in it, topped up to
-%                    'trials' with single gates (cheap maps); 0 (default):
-%                    'trials' single gates a bin, from the field's entries
+%     'crossings'    1 (default, with a training field): each bin counts
+%                    the training field's own crossings of the map's gate
+%                    kind entered in it, topped up with single gates as
+%                    'per_crossing' says; 0: 'trials' single gates a bin,
+%                    from the field's entries
+%     'per_crossing' single gates a bin is topped up to for each crossing
+%                    that entered it (as for one where none did), at most
+%                    'trials' (default 5); 0: every bin topped up to 'trials'
 %     'bins'         [P S D], bins of position, speed and direction
 %                    (default [14 6 13])
 %     'vmax'         m/s, the top of the speed bins (default 40)

@@ -68,19 +68,21 @@ static int entries_from(PyObject *seq, bsim_markov_def *def, const char ***paths
 PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {
-	        "experiment", "out",          "trials",      "bins",  "vmax",      "entries",
-	        "seed",       "threads",      "backend",     "sets",  "grid",      "backend_opts",
-	        "progress",   "start_trials", "after_start", "train", "crossings", NULL};
+	static char *kwlist[] = {"experiment", "out",          "trials",      "bins",
+	                         "vmax",       "entries",      "seed",        "threads",
+	                         "backend",    "sets",         "grid",        "backend_opts",
+	                         "progress",   "start_trials", "after_start", "train",
+	                         "crossings",  "per_crossing", NULL};
 	const char *experiment, *out, *backend_spec = NULL;
-	int trials = 0, threads = 0, start_trials = 0, after_start = -1, train = -1, crossings = -1;
+	int trials = 0, threads = 0, start_trials = 0, after_start = -1, train = -1, crossings = -1,
+	    per_crossing = -1;
 	double vmax = 0.0;
 	PyObject *bins_o = Py_None, *entries_o = Py_None, *seed_o = Py_None, *sets_o = Py_None,
 	         *grid_o = Py_None, *opts_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|iOdOOizOOOOiiii", kwlist, &experiment, &out,
-	                                 &trials, &bins_o, &vmax, &entries_o, &seed_o, &threads,
-	                                 &backend_spec, &sets_o, &grid_o, &opts_o, &progress_o,
-	                                 &start_trials, &after_start, &train, &crossings))
+	if (!PyArg_ParseTupleAndKeywords(
+	            args, kw, "ss|iOdOOizOOOOiiiii", kwlist, &experiment, &out, &trials, &bins_o,
+	            &vmax, &entries_o, &seed_o, &threads, &backend_spec, &sets_o, &grid_o, &opts_o,
+	            &progress_o, &start_trials, &after_start, &train, &crossings, &per_crossing))
 		return NULL;
 	bsim_markov_build_def def = bsim_markov_build_def_default();
 	if (bins_o != Py_None && !PyArg_ParseTuple(bins_o, "iii", &def.map.bins.n_pos,
@@ -104,8 +106,10 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 		def.map.after_start = after_start;
 	if (train >= 0) /* -1: the default training field */
 		def.map.train_trials = train;
-	if (crossings >= 0) /* -1: the default, single gates a bin */
+	if (crossings >= 0) /* -1: the default, counted where a training field */
 		def.map.train_crossings = crossings;
+	if (per_crossing >= 0) /* -1: the default */
+		def.map.trials_per_crossing = per_crossing;
 	def.entries = paths;
 	pyb_run_inputs in;
 	if (pyb_run_inputs_from(seed_o, sets_o, grid_o, progress_o, &in)) {

@@ -140,15 +140,23 @@ typedef struct bsim_markov_def {
 	 * field's own crossings of the gates of the map's kind that were
 	 * entered in that bin (where each left and after how many time steps:
 	 * under the essay's protocol a gate entered is a single gate started
-	 * from the entry's state), and tops each bin up to `trials` with
-	 * single gates whose states are drawn from the field's entries in the
-	 * bin; a bin then holds its crossings or `trials`, whichever is more
-	 * (bsim_markov_map.bin_first). The start bin keeps its start_trials
-	 * single gates. Cheap maps, few single gates a bin and a smaller
-	 * field, need it (docs/markov.md, "Cheap maps: the training field's
-	 * crossings"). 0 (the default): `trials` single gates a bin, their
-	 * states drawn from the field's entries. */
+	 * from the entry's state), and tops each bin up with single gates
+	 * whose states are drawn from the field's entries in the bin, as far
+	 * as trials_per_crossing says (bsim_markov_map.bin_first). The start
+	 * bin keeps its start_trials single gates. -1 (the default): 1 where
+	 * the maps have a training field, else 0. 0: `trials` single gates a
+	 * bin, their states drawn from the field's entries. 1 without a
+	 * training field is refused. */
 	int train_crossings;
+	/* With crossings counted: a bin is topped up to trials_per_crossing
+	 * single gates for each crossing that entered it (as for one where
+	 * none did), at most `trials`; a bin then holds its crossings or that,
+	 * whichever is more. The bins bodies take hold `trials` or more, and
+	 * the thousands a training field hardly enters few, where they cost
+	 * most of the single gates (docs/markov.md, "Single gates where the
+	 * crossings are"). Default BSIM_MARKOV_TRIALS_PER_CROSSING; 0: every
+	 * bin topped up to `trials`. */
+	int trials_per_crossing;
 	/* The gate after the start (1, the default): each of the start bin's
 	 * single gates that leaves into a gate is continued there, one single
 	 * gate from its exact exit state, for every stiffness pair of the
@@ -234,9 +242,13 @@ typedef struct bsim_markov_def {
 /* The training field's trials by default, and its gates across and along. */
 #define BSIM_MARKOV_TRAIN_TRIALS 10000
 #define BSIM_MARKOV_TRAIN_SIZE   21
+/* The single gates a bin by default for each crossing of the training
+ * field that entered it (at most the bin's trials). */
+#define BSIM_MARKOV_TRIALS_PER_CROSSING 5
 
 /* bsim_markov_bins_default(), 50 trials per bin and BSIM_MARKOV_START_TRIALS
- * of the start bin, a training field of BSIM_MARKOV_TRAIN_TRIALS, seed 1,
+ * of the start bin, a training field of BSIM_MARKOV_TRAIN_TRIALS whose
+ * crossings are counted (BSIM_MARKOV_TRIALS_PER_CROSSING), seed 1,
  * the default backend, all cores. */
 BSIM_API bsim_markov_def bsim_markov_def_default(void);
 
@@ -256,6 +268,8 @@ typedef struct bsim_markov_map {
 	long *bin_first;
 	int of_crossings; /* 1: counted from crossings (its key says so), bin_first set
 	                   * once counted or read */
+	int per_crossing; /* its def trials_per_crossing: a bin holds min(trials,
+	                   * per_crossing) at least (0: trials) */
 	/* The counts, a row an entry bin: row a's exits (0 = stuck) are
 	 * count_exit[count_first[a] .. count_first[a + 1]), ascending, each
 	 * count_n[] times; the row's other exits 0 times. A row sums to

@@ -447,6 +447,16 @@ static int cost_read(const char *dir, const bsim_markov_map *m, const char *ext,
 	                      dir, (unsigned long long)m->key, ext);
 }
 
+/* Whether a bin of map m of crossings may hold n single gates: n
+ * crossings at least what they are topped up to, or the top-up of fewer. */
+static int crossings_bin_holds(const bsim_markov_map *m, long n)
+{
+	if (bsim_markov_crossings_topped(m, n) <= n)
+		return 1;
+	const int per = m->per_crossing;
+	return per > 0 && n % per == 0 && bsim_markov_crossings_topped(m, n / per) == n;
+}
+
 /* The bins of a map of crossings laid out from its CSV text (m's
  * bin_first set): each bin holds what its rows count, summed as far as
  * they read as numbers (the rows are checked after, against this). 0, or
@@ -576,15 +586,23 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 		return -1;
 	}
 	/* Every entry bin ran the map's trials, each ending somewhere; a map
-	 * of crossings holds trials or more a bin, the start start_trials. */
+	 * of crossings holds its crossings or what they are topped up to a
+	 * bin, the start start_trials. */
 	for (int a = 0; !bad && m->of_crossings && a < nb; a++)
-		if (a == 0 ? sum[a] != m->start_trials : sum[a] < m->trials) {
+		if (a == 0 ? sum[a] != m->start_trials : !crossings_bin_holds(m, sum[a])) {
 			bad = "count";
 			lineno = last[a] ? last[a] : lineno;
-			snprintf(what, sizeof what,
-			         "the counts of entry bin %d to sum to %s%d trials, got %ld", a,
-			         a == 0 ? "the start's " : "the map's crossings topped up to ",
-			         a == 0 ? m->start_trials : m->trials, sum[a]);
+			if (a == 0)
+				snprintf(what, sizeof what,
+				         "the counts of entry bin 0 to sum to the start's %d "
+				         "trials, "
+				         "got %ld",
+				         m->start_trials, sum[a]);
+			else
+				snprintf(what, sizeof what,
+				         "the counts of entry bin %d to sum to the map's crossings "
+				         "topped up to %d trials (%d a crossing), got %ld",
+				         a, m->trials, m->per_crossing, sum[a]);
 		}
 	for (int a = 0; !bad && a < nb; a++)
 		if (sum[a] != bsim_markov_bin_trials(m, a)) {
@@ -947,10 +965,15 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	int train = 0, used = 0;
 	def->train_trials = 0;
 	def->train_crossings = 0;
+	def->trials_per_crossing = 0;
 	if (sscanf(id, "train %d%n", &train, &used) == 1 && train > 0 &&
 	    (id[used] == '\0' || id[used] == ' ')) {
 		def->train_trials = train;
 		def->train_crossings = strncmp(id + used, " crossings", 10) == 0;
+		/* "per N": topped up to N a crossing (before it: every bin) */
+		if (def->train_crossings &&
+		    sscanf(id + used + 10, " per %d", &def->trials_per_crossing) != 1)
+			def->trials_per_crossing = 0;
 	} else if (strcmp(id, "none") != 0)
 		snprintf(def->entries_id, sizeof def->entries_id, "%s", id);
 	def->seed = seed;

@@ -374,8 +374,10 @@ long bsim_markov_crossings_layout(bsim_markov_map *m, const markov_crossings *cx
 		if (crossing_of(cx, i, m))
 			first[cx->entry[i] + 1]++, placed++;
 	first[1] = m->start_trials;
-	for (int a = 1; a < nb; a++)
-		first[a + 1] = first[a] + (first[a + 1] > m->trials ? first[a + 1] : m->trials);
+	for (int a = 1; a < nb; a++) {
+		const long c = first[a + 1], topped = bsim_markov_crossings_topped(m, c);
+		first[a + 1] = first[a] + (c > topped ? c : topped);
+	}
 	free(m->bin_first);
 	m->bin_first = first;
 	return placed;

@@ -107,10 +107,22 @@ static inline int bsim_markov_unit_bin(const bsim_markov_map *m, long u)
 	return u < m->start_trials ? 0 : 1 + (int)((u - m->start_trials) / m->trials);
 }
 
+/* The single gates a bin of map m of crossings is topped up to where c
+ * crossings entered it: per_crossing for each (as for one where none did),
+ * at most trials; every bin trials with per_crossing 0. The bin holds c
+ * or this, whichever is more. */
+static inline long bsim_markov_crossings_topped(const bsim_markov_map *m, long c)
+{
+	if (m->per_crossing <= 0)
+		return m->trials;
+	const long want = (long)m->per_crossing * (c > 1 ? c : 1);
+	return want < m->trials ? want : m->trials;
+}
+
 /* Whether def's maps are counted from the training field's crossings. */
 static inline int bsim_markov_def_crossings(const bsim_markov_def *def)
 {
-	return def->train_crossings && bsim_markov_def_trains(def);
+	return def->train_crossings != 0 && bsim_markov_def_trains(def);
 }
 
 /* ---- the lattice's gate kinds and its training field (markov_train.c) ---- */

@@ -25,6 +25,8 @@ bsim_markov_def bsim_markov_def_default(void)
 	                         .trials = 50,
 	                         .start_trials = BSIM_MARKOV_START_TRIALS,
 	                         .train_trials = BSIM_MARKOV_TRAIN_TRIALS,
+	                         .train_crossings = -1,
+	                         .trials_per_crossing = BSIM_MARKOV_TRIALS_PER_CROSSING,
 	                         .after_start = 1,
 	                         .seed = 1};
 }
@@ -65,6 +67,7 @@ static int map_init(bsim_markov_map *m, const bsim_scene *lattice, const bsim_ma
 	m->trials = def->trials;
 	m->start_trials = bsim_markov_def_start_trials(def);
 	m->of_crossings = bsim_markov_def_crossings(def);
+	m->per_crossing = m->of_crossings ? def->trials_per_crossing : 0;
 	m->key_text = bsim_markov_key_text(lattice, def, be, opts, k);
 	if (!m->key_text)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
@@ -121,7 +124,16 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		                      bsim_markov_bins_count(b) - 1, def->trials,
 		                      bsim_markov_def_start_trials(def), units,
 		                      (double)BSIM_MARKOV_MAX_UNITS);
-	if (def->train_crossings && !bsim_markov_def_trains(def))
+	if (def->train_crossings < -1 || def->train_crossings > 1)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "crossings: expected -1 (where a training field), 0 or 1, "
+		                      "got %d",
+		                      def->train_crossings);
+	if (def->trials_per_crossing < 0 || def->trials_per_crossing > 1000000)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "trials per crossing: expected 0 to 1000000, got %d",
+		                      def->trials_per_crossing);
+	if (def->train_crossings == 1 && !bsim_markov_def_trains(def))
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "crossings: a map counts a training field's crossings only "
 		                      "with a training field (training trials > 0, got %d) and "

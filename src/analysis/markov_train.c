@@ -73,7 +73,13 @@ const char *bsim_markov_train_label(const bsim_scene *lattice, const bsim_markov
                                     char *buf, size_t size)
 {
 	const int trials = def->train_trials;
-	const char *how = bsim_markov_def_crossings(def) ? " crossings" : "";
+	/* crossings topped up to every bin's trials name no "per" (the key
+	 * such maps had) */
+	char how[48] = "";
+	if (bsim_markov_def_crossings(def) && def->trials_per_crossing > 0)
+		snprintf(how, sizeof how, " crossings per %d", def->trials_per_crossing);
+	else if (bsim_markov_def_crossings(def))
+		snprintf(how, sizeof how, " crossings");
 	double(*kinds)[2] = NULL;
 	const int n = lattice ? kinds_sorted(lattice, &kinds) : 0;
 	uint64_t h = HASH_FNV1A64_SEED;

@@ -39,7 +39,8 @@ enum {
 	OWN_START_TRIALS,
 	OWN_AFTER_START,
 	OWN_TRAIN,
-	OWN_CROSSINGS
+	OWN_CROSSINGS,
+	OWN_PER_CROSSING
 };
 
 #define MAX_ENTRIES 16
@@ -159,6 +160,15 @@ static int markov_option(void *args, int i, const char *value)
 		a->def.train_crossings = (int)n;
 		return CLI_OK;
 	}
+	case OWN_PER_CROSSING: {
+		long n;
+		if (cli_parse_long(value, 0, 1000000, &n) != 0)
+			return cli_usage("markov build",
+			                 "--per-crossing %s: expected an integer 0 to 1000000",
+			                 value);
+		a->def.trials_per_crossing = (int)n;
+		return CLI_OK;
+	}
 	case OWN_MAP:
 		a->map = value;
 		return CLI_OK;
@@ -244,10 +254,15 @@ static const cli_own build_own[] = {
          "bins' states are drawn from (default 10000; run only when\n"
          "a map is built); 0: states uniform in each bin"},
         {"crossings", 1, "0|1",
-         "1: each bin counts the training field's own crossings of\n"
-         "the map's gate kind entered in it, topped up to --trials\n"
-         "with single gates (cheap maps: docs/markov.md); 0 (default):\n"
-         "--trials single gates a bin, from the field's entries"},
+         "1 (default, with a training field): each bin counts the\n"
+         "training field's own crossings of the map's gate kind\n"
+         "entered in it, topped up with single gates as\n"
+         "--per-crossing says; 0: --trials single gates a bin, from\n"
+         "the field's entries"},
+        {"per-crossing", 1, "N",
+         "single gates a bin is topped up to for each crossing that\n"
+         "entered it (as for one where none did), at most --trials\n"
+         "(default 5); 0: every bin topped up to --trials"},
 };
 
 static int build_option(void *args, int i, const char *value)
@@ -259,6 +274,7 @@ static int build_option(void *args, int i, const char *value)
 	                     : i == 6 ? OWN_AFTER_START
 	                     : i == 7 ? OWN_TRAIN
 	                     : i == 8 ? OWN_CROSSINGS
+	                     : i == 9 ? OWN_PER_CROSSING
 	                              : i,
 	                     value);
 }
@@ -294,7 +310,7 @@ static const cli_spec build_spec = {
         .help = build_help,
         .out_required = 1,
         .own = build_own,
-        .n_own = 9,
+        .n_own = sizeof build_own / sizeof build_own[0],
         .option = build_option,
 };
 
@@ -541,12 +557,20 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 		       pass, last + 1, cli_path(out), cli_path(out));
 	const int trained = def->n_entries <= 0 && def->map.train_trials > 0 &&
 	                    !def->map.self_entries,
-	          crossings = trained && def->map.train_crossings;
-	printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %s%d trials each, the "
-	       "start's %d, in %s\n",
+	          crossings = trained && def->map.train_crossings != 0;
+	/* what a bin holds */
+	char holds[96];
+	if (crossings && def->map.trials_per_crossing > 0)
+		snprintf(holds, sizeof holds,
+		         "their crossings or %d single gates a crossing (at most %d trials)",
+		         def->map.trials_per_crossing, def->map.trials);
+	else
+		snprintf(holds, sizeof holds, "%s%d trials", crossings ? "their crossings or " : "",
+		         def->map.trials);
+	printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %s each, the start's "
+	       "%d, in %s\n",
 	       res->built, res->seconds, res->reused,
-	       res->copied ? ", the others from the parts" : "", res->n_bins,
-	       crossings ? "their crossings or " : "", def->map.trials,
+	       res->copied ? ", the others from the parts" : "", res->n_bins, holds,
 	       def->map.start_trials > 0 ? def->map.start_trials : def->map.trials, cli_path(out));
 	if (res->built > 0 && trained)
 		printf("the bins' %s a training field, %d trials of %d x %d gates of the lattice's "

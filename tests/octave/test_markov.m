@@ -60,9 +60,10 @@ check(any(~cellfun(@isempty, strfind(n1, '.after_'))), 'no gate after the start 
       strjoin(n1, ' '));
 check(strncmp(b.scope, 'maps with 40 training trials', 28) && ~isempty(strfind(err, ['note: ' b.scope])), ...
       'the scope ''%s'' is not the program''s note: %s', b.scope, err);
-% 'after_start', 0 as --after-start 0 (no gate after the start), and 'crossings', 1 as
-% --crossings 1 (bins counted from the training field's crossings)
-variants = {'after_start', 0, '--after-start 0'; 'crossings', 1, '--crossings 1'};
+% 'after_start', 0 as --after-start 0 (no gate after the start), 'crossings', 0 as
+% --crossings 0 (bins of single gates alone) and 'per_crossing', 1 as --per-crossing 1
+variants = {'after_start', 0, '--after-start 0'; 'crossings', 0, '--crossings 0'; ...
+            'per_crossing', 1, '--per-crossing 1'};
 for i = 1:rows(variants)
   [name, value, option] = variants{i, :};
   mine0 = fullfile(tmp, ['maps_mex_' name]);

@@ -87,18 +87,22 @@ def test_after_start_is_the_programs(tmp_path):
     assert not any(".after_" in name for name in map_files(py))
 
 
-def test_crossings_is_the_programs(tmp_path):
-    """crossings=True builds what --crossings 1 builds: bins counted from
-    the training field's crossings, each holding its own number of single
-    gates."""
+@pytest.mark.parametrize("arg, option, entries", [
+    (dict(crossings=False), ["--crossings", "0"], b"entries train 40 kinds "),
+    (dict(per_crossing=1), ["--per-crossing", "1"], b"entries train 40 crossings per 1 kinds "),
+])
+def test_crossings_is_the_programs(tmp_path, arg, option, entries):
+    """crossings=False builds what --crossings 0 builds (bins of single
+    gates alone), per_crossing=1 what --per-crossing 1 builds (bins counted
+    from the training field's crossings, topped up to 1 single gate a
+    crossing)."""
     py, prog = tmp_path / "py", tmp_path / "prog"
-    beamsim.markov_build(EXPERIMENT, py, seed=5, crossings=True, **SMALL)
-    cli("markov", "build", EXPERIMENT, *SMALL_ARGS, "--seed", "5", "--crossings", "1",
-        "--out", prog)
+    beamsim.markov_build(EXPERIMENT, py, seed=5, **arg, **SMALL)
+    cli("markov", "build", EXPERIMENT, *SMALL_ARGS, "--seed", "5", *option, "--out", prog)
     files = map_files(py)
     assert files == map_files(prog)
     keys = [text for name, text in files.items() if name.endswith(".key")]
-    assert keys and all(b"entries train 40 crossings kinds " in text for text in keys)
+    assert keys and all(entries in text for text in keys)
 
 
 def test_predict_is_the_programs(maps):

@@ -461,7 +461,7 @@ def _entries(entries):
 def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=None, seed=None,
                  threads=None, backend=None, backend_opt=None, set=None, grid=None,
                  progress=None, start_trials=None, after_start=None, train=None,
-                 crossings=None):
+                 crossings=None, per_crossing=None):
     """The single-gate maps the lattices of an experiment need, one per pair
     of beam stiffnesses, built into the map directory out as `beamsim
     markov build EXPERIMENT --out DIR` builds them (docs/markov.md): the
@@ -477,10 +477,12 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
     train: trials of the training field, a 21 x 21 field of the lattice's
     gate kinds at random whose gate entries the bins' states are drawn from
     (None: 10,000; run only when a map is built), 0: states uniform in each
-    bin; crossings: True counts each bin from the training field's own
-    crossings of the map's gate kind entered in it, topped up to trials
-    with single gates (cheap maps); False (None): trials single gates a
-    bin; bins: (positions, speeds, directions), 1 to 64 each (None:
+    bin; crossings: True (None, with a training field) counts each bin
+    from the training field's own crossings of the map's gate kind entered
+    in it, topped up with single gates as per_crossing says; False: trials
+    single gates a bin; per_crossing: single gates a bin is topped up to
+    for each crossing that entered it (as for one where none did), at most
+    trials (None: 5), 0: every bin topped up to trials; bins: (positions, speeds, directions), 1 to 64 each (None:
     (14, 6, 13));
     vmax: m/s, the top of the speed bins (None: 40); entries: gate_entries.csv
     paths (a bin's states drawn from them), or "self", "self:N", "flow",
@@ -516,7 +518,9 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
                                  _count("start_trials", start_trials, 1, 1000000),
                                  -1 if after_start is None else int(bool(after_start)),
                                  -1 if train is None else _count("train", train, 0, 1000000),
-                                 -1 if crossings is None else int(bool(crossings)))
+                                 -1 if crossings is None else int(bool(crossings)),
+                                 -1 if per_crossing is None
+                                 else _count("per_crossing", per_crossing, 0, 1000000))
     info["out"] = out
     return info
 
