@@ -1430,6 +1430,8 @@ static void test_field_figures(void **state)
 	char *vjson = bsim_test_read(path);
 	assert_non_null(vjson);
 	assert_non_null(strstr(vjson, "\"maps_scope\": \"maps with states uniform in each bin"));
+	/* no training field: no crossings counted */
+	assert_non_null(strstr(vjson, "\"of_crossings\": 0, \"per_crossing\": 0"));
 	free(vjson);
 	assert_int_equal(bsim_test_check_figures(pdir), 2); /* prediction and time */
 	assert_int_equal(bsim_test_check_figures(vdir), 1);

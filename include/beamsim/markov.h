@@ -258,12 +258,14 @@ typedef struct bsim_markov_map {
 	uint64_t key;     /* FNV-1a hash of key_text: the map's file name */
 	char *key_text;   /* everything the map depends on, a line each */
 	int n_bins;       /* bsim_markov_bins_count */
-	int trials;       /* per entry bin, but the start's (the least, with bin_first) */
+	int trials;       /* per entry bin, but the start's (with bin_first: the most a bin is
+	                   * topped up to) */
 	int start_trials; /* of the start bin, bin 0 (bsim_markov_bin_trials) */
 	/* A map counted from a training field's crossings (def train_crossings)
 	 * holds a number of single gates of its own in each bin: bin a's are
 	 * [bin_first[a], bin_first[a + 1]) (n_bins + 1 entries, bin_first[0]
-	 * = 0, bin_first[1] = start_trials, every other bin trials or more).
+	 * = 0, bin_first[1] = start_trials, every other bin its crossings or
+	 * what they are topped up to, per_crossing).
 	 * NULL: the start bin start_trials, every other trials. */
 	long *bin_first;
 	int of_crossings; /* 1: counted from crossings (its key says so), bin_first set
@@ -746,6 +748,10 @@ typedef struct bsim_markov_validation {
 	double map_cost;           /* s of CPU the maps took to build (every pass) */
 	long long map_steps;       /* single-gate steps those builds took */
 	int bins, trials_per_bin;
+	/* 1: the bins count a training field's crossings, topped up to
+	 * per_crossing single gates a crossing (0: to trials_per_bin), as the
+	 * maps' bsim_markov_map of_crossings and per_crossing */
+	int of_crossings, per_crossing;
 	char scope[320]; /* bsim_markov_def_scope of the maps' method ("" the default) */
 	/* When the run stopped or failed after finishing trials: the journal
 	 * that resume continues from ("" otherwise). */

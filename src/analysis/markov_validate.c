@@ -323,8 +323,10 @@ static int write_json(const char *stage, const bsim_markov_validate_def *def,
 	bsim_json_string(f, e->path);
 	fputs(", \"map_dir\": ", f);
 	bsim_json_string(f, def->map_dir);
-	fprintf(f, ", \"entry_bins\": %d, \"trials_per_bin\": %d, \"map_cpu_seconds\": ", v->bins,
-	        v->trials_per_bin);
+	fprintf(f,
+	        ", \"entry_bins\": %d, \"trials_per_bin\": %d, \"of_crossings\": %d, "
+	        "\"per_crossing\": %d, \"map_cpu_seconds\": ",
+	        v->bins, v->trials_per_bin, v->of_crossings, v->per_crossing);
 	bsim_json_number(f, v->map_cost);
 	fprintf(f, ", \"map_steps\": %lld, \"maps_scope\": ", v->map_steps);
 	bsim_json_string(f, v->scope);
@@ -469,6 +471,8 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 		free(idx);
 		v->bins = set.n ? set.maps[0].n_bins : 0;
 		v->trials_per_bin = set.def.trials;
+		v->of_crossings = set.n ? set.maps[0].of_crossings : 0;
+		v->per_crossing = set.n ? set.maps[0].per_crossing : 0;
 		bsim_markov_def_scope(&set.def, v->scope, sizeof v->scope);
 		for (int i = 0; i < set.n; i++) {
 			v->map_cost += set.maps[i].cost;

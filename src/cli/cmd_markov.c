@@ -265,6 +265,17 @@ static const cli_own build_own[] = {
          "(default 5); 0: every bin topped up to --trials"},
 };
 
+/* What a map's entry bin holds, for the summaries: trials single gates,
+ * or crossings topped up (per single gates a crossing; 0: to trials). */
+static void bins_hold(int crossings, int per, int trials, char *buf, size_t size)
+{
+	if (crossings && per > 0)
+		snprintf(buf, size, "their crossings or %d single gates a crossing (at most %d trials)",
+		         per, trials);
+	else
+		snprintf(buf, size, "%s%d trials", crossings ? "their crossings or " : "", trials);
+}
+
 static int build_option(void *args, int i, const char *value)
 {
 	return markov_option(args,
@@ -558,15 +569,8 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 	const int trained = def->n_entries <= 0 && def->map.train_trials > 0 &&
 	                    !def->map.self_entries,
 	          crossings = trained && def->map.train_crossings != 0;
-	/* what a bin holds */
 	char holds[96];
-	if (crossings && def->map.trials_per_crossing > 0)
-		snprintf(holds, sizeof holds,
-		         "their crossings or %d single gates a crossing (at most %d trials)",
-		         def->map.trials_per_crossing, def->map.trials);
-	else
-		snprintf(holds, sizeof holds, "%s%d trials", crossings ? "their crossings or " : "",
-		         def->map.trials);
+	bins_hold(crossings, def->map.trials_per_crossing, def->map.trials, holds, sizeof holds);
 	printf("%d maps built (%.1f s of CPU), %d reused%s; %d entry bins x %s each, the start's "
 	       "%d, in %s\n",
 	       res->built, res->seconds, res->reused,
@@ -880,9 +884,11 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	if (rc == BSIM_OK && v.scope[0])
 		cli_error("note: %s", v.scope);
 	if (rc == BSIM_OK && !c.quiet) {
-		printf("maps        %s: %d entry bins x %d trials, %.1f s of CPU to build "
+		char holds[96];
+		bins_hold(v.of_crossings, v.per_crossing, v.trials_per_bin, holds, sizeof holds);
+		printf("maps        %s: %d entry bins x %s, %.1f s of CPU to build "
 		       "(%lld single-gate steps)\n\n",
-		       a.map, v.bins, v.trials_per_bin, v.map_cost, v.map_steps);
+		       a.map, v.bins, holds, v.map_cost, v.map_steps);
 		printf("group protocol trials    TV  sampling (95%%)   map   gates sim/chain  "
 		       "sim CPU s  predict CPU s   speedup  pays off after\n");
 		for (int i = 0; i < v.n; i++) {

@@ -149,6 +149,8 @@ def test_validate_is_the_programs(maps):
     assert [c["protocol"] for c in got["checks"]] == ["essay", "world"]
     assert got["maps_scope"].startswith("maps with 40 training trials (the default 10000), "
                                         "2,2,1 bins (the default 14,6,13)")
+    # maps of the default method: bins counted from the crossings, 5 a crossing
+    assert (got["of_crossings"], got["per_crossing"]) == (1, 5)
     with open(tmp / "val_prog" / "validate.csv", "rb") as f:
         assert (tmp / "val_py" / "validate.csv").read_bytes() == f.read()
     assert list(got["files"]["validate"]["p_sim"]) == list(
