@@ -9,9 +9,11 @@
 # prediction.csv and validate.csv. A method's maps are built once, on the
 # first field of a set of gate kinds, and reused on every other; flow:1
 # maps are built per field (they hold for that layout only). default is
-# the default now (a training field of the kinds, 14,6,13 bins, 16,000
-# start trials), start4000 the default before it (4,000 start trials),
-# uniform the default before that (states uniform in 8,8,9 bins). ring5
+# the default now (a training field of the kinds whose crossings the bins
+# count, topped up to 5 single gates a crossing and at most 50, 14,6,13
+# bins, 16,000 start trials), crossings0 the default before it (50 single
+# gates every bin), start4000 the one before that (4,000 start trials),
+# uniform the one before that (states uniform in 8,8,9 bins). ring5
 # and check11 are the fields the settings were chosen on; test_* were made
 # after the bins and trials were fixed, fresh_* after the gate after the
 # start was, late_* after the training field (method train), final_* after
@@ -19,7 +21,8 @@
 # after start4000, cheap_* after the cheap maps (method cheap: a training
 # field of 4,000 trials counted by its crossings, 5 single gates a bin at
 # least, 2,000 from the start; crossings: start4000 counted by its
-# crossings), start_* after the default's 16,000 start trials (name them
+# crossings, every bin topped up to 50), start_* after crossings0's 16,000
+# start trials, per_* after the default's 5 single gates a crossing (name them
 # in FIELDS). Prints one row per method and field;
 # the runs stay in OUT (default out/markov-kinds), the table in
 # OUT/table.txt. FIELDS="..." chooses the fields, METHODS="..." the methods
@@ -41,7 +44,8 @@ fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13
 # a training field's entries (train: the sweep of exp_train_r21.yaml, run
 # first), and with 10,000 trials of it and 14,6,13 bins
 methods=("default:"
-         "start4000:--start-trials 4000"
+         "crossings0:--crossings 0"
+         "start4000:--crossings 0 --start-trials 4000"
          "uniform:--train 0 --bins 8,8,9 --start-trials 4000"
          "without-after-start:--train 0 --bins 8,8,9 --after-start 0 --start-trials 4000"
          "fine-bins-alone:--train 0 --bins 8,8,9 --start-trials 50 --after-start 0"
@@ -53,7 +57,7 @@ methods=("default:"
          "bins14613:--train 0 --bins 14,6,13 --start-trials 4000"
          "train:--entries $out/train-sweep --bins 8,8,9 --start-trials 4000"
          "train10k-bins14613:--entries $out/train-sweep-10k --bins 14,6,13 --start-trials 4000"
-         "crossings:--crossings 1 --start-trials 4000"
+         "crossings:--crossings 1 --per-crossing 0 --start-trials 4000"
          "cheap:--crossings 1 --train 4000 --trials 5 --start-trials 2000")
 if [ -n "${METHODS:-}" ]; then
     chosen=()

@@ -270,8 +270,9 @@ static const cli_own build_own[] = {
 static void bins_hold(int crossings, int per, int trials, char *buf, size_t size)
 {
 	if (crossings && per > 0)
-		snprintf(buf, size, "their crossings or %d single gates a crossing (at most %d trials)",
-		         per, trials);
+		snprintf(buf, size,
+		         "their crossings or %d single gates a crossing (at most %d trials)", per,
+		         trials);
 	else
 		snprintf(buf, size, "%s%d trials", crossings ? "their crossings or " : "", trials);
 }
