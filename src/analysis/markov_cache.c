@@ -595,8 +595,7 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 			if (a == 0)
 				snprintf(what, sizeof what,
 				         "the counts of entry bin 0 to sum to the start's %d "
-				         "trials, "
-				         "got %ld",
+				         "trials, got %ld",
 				         m->start_trials, sum[a]);
 			else
 				snprintf(what, sizeof what,
