@@ -985,6 +985,57 @@ static void test_crossings_are_single_gates(void **state)
 		assert_int_equal(again.maps[0].bin_first[b], pm->bin_first[b]);
 	assert_true(counts_same(&again.maps[0], pm, -1));
 	bsim_markov_set_free(&again);
+	/* a bin topped up short of trials, one count over (its p's made
+	 * count / its new sum): a sum the rule cannot give, refused naming the
+	 * file, the line and the rule */
+	int top = 1;
+	while (top < nb && !(pm->bin_first[top + 1] - pm->bin_first[top] < 200 &&
+	                     pm->bin_first[top + 1] - pm->bin_first[top] >
+	                             cx->bin_first[top + 1] - cx->bin_first[top]))
+		top++;
+	assert_true(top < nb);
+	const long held = pm->bin_first[top + 1] - pm->bin_first[top];
+	snprintf(name, sizeof name, "map_%016llx.csv", (unsigned long long)pm->key);
+	char *pcsv = bsim_test_read(bsim_test_join(dir, name));
+	assert_non_null(pcsv);
+	char *damaged = malloc(strlen(pcsv) + 4096), *o = damaged;
+	int first_row = 1;
+	for (char *line = pcsv; *line;) {
+		char *end = strchr(line, '\n');
+		const size_t len = end ? (size_t)(end - line) : strlen(line);
+		int entry, exit_bin, row_count;
+		char edges[64];
+		if (sscanf(line, "%d,%d,%d,%63[^,\n],", &entry, &exit_bin, &row_count, edges) ==
+		            4 &&
+		    entry == top) {
+			row_count += first_row;
+			first_row = 0;
+			const char *e2 =
+			        strchr(strchr(strchr(strchr(line, ',') + 1, ',') + 1, ',') + 1,
+			               ','); /* ",EXIT_EDGE,p" */
+			const char *pp = strchr(e2 + 1, ',');
+			o += sprintf(o, "%d,%d,%d,%s%.*s,%.12g\n", entry, exit_bin, row_count,
+			             edges, (int)(pp - e2), e2,
+			             (double)row_count / (double)(held + 1));
+		} else {
+			o += sprintf(o, "%.*s\n", (int)len, line);
+		}
+		line += len + (end != NULL);
+	}
+	*o = '\0';
+	bsim_test_write(dir, name, damaged);
+	assert_int_equal(bsim_markov_build(&s, &def, dir, &again, &err), BSIM_EINPUT);
+	print_message("%s\n", err.msg);
+	assert_non_null(strstr(err.msg, name));
+	char says[160];
+	snprintf(says, sizeof says,
+	         "the counts of entry bin %d to sum to the map's crossings topped up to 200 trials "
+	         "(2 a crossing), got %ld",
+	         top, held + 1);
+	assert_non_null(strstr(err.msg, says));
+	bsim_test_write(dir, name, pcsv);
+	free(damaged);
+	free(pcsv);
 	bsim_markov_set_free(&per);
 	for (int i = 0; i < 2; i++)
 		bsim_markov_set_free(&set[i]);
