@@ -597,11 +597,16 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 				         "the counts of entry bin 0 to sum to the start's %d "
 				         "trials, got %ld",
 				         m->start_trials, sum[a]);
-			else
+			else if (m->per_crossing > 0)
 				snprintf(what, sizeof what,
 				         "the counts of entry bin %d to sum to the map's crossings "
 				         "topped up to %d trials (%d a crossing), got %ld",
 				         a, m->trials, m->per_crossing, sum[a]);
+			else
+				snprintf(what, sizeof what,
+				         "the counts of entry bin %d to sum to the map's crossings "
+				         "topped up to %d trials, got %ld",
+				         a, m->trials, sum[a]);
 		}
 	for (int a = 0; !bad && a < nb; a++)
 		if (sum[a] != bsim_markov_bin_trials(m, a)) {

@@ -225,8 +225,9 @@ typedef struct markov_pool {
 } markov_pool;
 
 /* Map m's bins laid out for the crossings of its gate kind in cx (m's
- * bin_first set): each bin holds its crossings or m->trials, whichever is
- * more, the start bin m->start_trials. The crossings placed, or -1 out of
+ * bin_first set): each bin holds its crossings or what they are topped up
+ * to (bsim_markov_crossings_topped), whichever is more, the start bin
+ * m->start_trials. The crossings placed, or -1 out of
  * memory; the single gates left to simulate are the rest of
  * bsim_markov_map_units(m). */
 long bsim_markov_crossings_layout(bsim_markov_map *m, const markov_crossings *cx);
