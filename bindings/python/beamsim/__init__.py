@@ -482,8 +482,8 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
     in it, topped up with single gates as per_crossing says; False: trials
     single gates a bin; per_crossing: single gates a bin is topped up to
     for each crossing that entered it (as for one where none did), at most
-    trials (None: 5), 0: every bin topped up to trials; bins: (positions, speeds, directions), 1 to 64 each (None:
-    (14, 6, 13));
+    trials (None: 5), 0: every bin topped up to trials; bins: (positions,
+    speeds, directions), 1 to 64 each (None: (14, 6, 13));
     vmax: m/s, the top of the speed bins (None: 40); entries: gate_entries.csv
     paths (a bin's states drawn from them), or "self", "self:N", "flow",
     "flow:N" as --entries; seed: of the states and schedules (None: 1);
