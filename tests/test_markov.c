@@ -183,6 +183,66 @@ static void test_two_gates_geometric(void **state)
 	bsim_scene_free(&s);
 }
 
+/* A set of states never left. Reached: a column of two gates whose start
+ * goes up and whose bins pass the body up and down between them with
+ * probability 1 (as a bin of few single gates can): the series and the
+ * sweeps stop within a few thousand steps, not at their limit of 1e6,
+ * and say that all of it is left in the field; the LU of the singular
+ * I - Q is not taken for an answer. Not reached: two gates side by side
+ * whose side bins pass the body to each other, the start going straight
+ * to the end: the iterative answer stands (the end 1), I - Q singular. */
+static void test_closed_loop_said(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	assert_int_equal(bsim_lattice_scene_init(&s, 1, 2, 6, 30), BSIM_OK);
+	const int rows[][NB] = {
+	        {0, 100, 0, 0, 0}, /* start: up */
+	        {0, 0, 0, 0, 100}, /* bottom bin: down, into the top bin below */
+	        {0, 100, 0, 0, 0}, /* top bin: up, into the bottom bin above */
+	};
+	const int which[] = {START, BOTTOM, TOP};
+	bsim_markov_set set = hand_set(400, rows, 3, which);
+	bsim_error err;
+	for (int gates = 0; gates < 2; gates++) {
+		bsim_markov_prediction p;
+		assert_int_equal(bsim_markov_predict_with(&s, &set, 1e-9,
+		                                          gates ? BSIM_MARKOV_GATES : 0, &p, &err),
+		                 BSIM_OK);
+		const int steps = gates ? p.n_gates : p.sweeps;
+		print_message("closed loop, %s: %d steps, %g left in the field\n",
+		              gates ? "series" : "sweeps", steps, p.left_in_field);
+		assert_true(steps < 10000);
+		assert_double_equal(p.left_in_field, 1.0, 1e-12);
+		assert_false(p.exact);
+		for (int i = 0; i < p.n_locations; i++)
+			assert_double_equal(p.p[i], 0.0, 1e-12);
+		bsim_markov_prediction_free(&p);
+	}
+	bsim_markov_set_free(&set);
+	bsim_scene_free(&s);
+
+	assert_int_equal(bsim_lattice_scene_init(&s, 2, 1, 6, 30), BSIM_OK);
+	const int side[][NB] = {
+	        {0, 100, 0, 0, 0}, /* start: up, the end */
+	        {0, 0, 0, 100, 0}, /* left bin: back to the left, into its right bin */
+	        {0, 0, 100, 0, 0}, /* right bin: back to the right, into its left bin */
+	};
+	const int at[] = {START, LEFT, RIGHT};
+	set = hand_set(400, side, 3, at);
+	bsim_markov_prediction p;
+	assert_int_equal(bsim_markov_predict_tol(&s, &set, 1e-12, &p, &err), BSIM_OK);
+	assert_false(p.exact);
+	assert_double_equal(p.left_in_field, 0.0, 1e-12);
+	double end = 0.0;
+	for (int i = 0; i < p.n_locations; i++)
+		end += p.loc[i].kind == BSIM_LOCATION_END ? p.p[i] : 0.0;
+	assert_double_equal(end, 1.0, 1e-12);
+	bsim_markov_prediction_free(&p);
+	bsim_markov_set_free(&set);
+	bsim_scene_free(&s);
+}
+
 /* W walks of the time to the outcome (seed 3) against the chain's
  * solution p of s: their totals of end, side and stuck are p's, and their
  * mean time the first-step mean, within 4.5 of the walks' standard errors. */
@@ -712,7 +772,9 @@ static int outcomes_off(const bsim_markov_prediction *p, const double *sim, int 
  * chain without the gate after the start is off on at least one outcome;
  * with it, the upper gate is run from each start trial's own exit and
  * every outcome agrees with 600 direct trials within 4.5 standard
- * errors. The pairs of maps are those the build names, read back alike. */
+ * errors; so it does with only the first 150 start trials continued, the
+ * others taking their continuations pooled. The pairs of maps are those
+ * the build names, read back alike; a pair short of a row is refused. */
 static void test_after_start_against_simulation(void **state)
 {
 	(void)state;
@@ -730,9 +792,13 @@ static void test_after_start_against_simulation(void **state)
 	const char *dir = exe_dir("after_start");
 	const int N = 600;
 	double *sim = NULL;
-	int off[2];
-	for (int after = 0; after < 2; after++) {
+	int off[3];
+	/* none, every start trial continued, the first 150 (A) */
+	const int A = 150;
+	for (int v = 0; v < 3; v++) {
+		const int after = v > 0;
 		def.after_start = after;
+		def.after_trials = v == 2 ? A : 0;
 		bsim_markov_set set;
 		bsim_error err;
 		assert_int_equal(bsim_markov_build(&s, &def, dir, &set, &err), BSIM_OK);
@@ -745,13 +811,15 @@ static void test_after_start_against_simulation(void **state)
 			sim = calloc((size_t)p.n_locations, sizeof *sim);
 			simulate_locations(&s, &p, N, sim);
 		}
-		off[after] = outcomes_off(&p, sim, def.start_trials, N);
+		off[v] = outcomes_off(&p, sim, def.start_trials, N);
 		if (after) {
-			/* each start trial's continuation where it left into a gate */
+			/* each continued start trial's continuation where it left
+			 * into a gate */
 			for (int i = 0; i < 4; i++) {
 				const bsim_markov_next *x = &set.next[i];
 				const bsim_markov_map *m = &set.maps[x->start];
-				for (int t = 0; t < m->start_trials; t++)
+				assert_int_equal(x->trials, v == 2 ? A : m->start_trials);
+				for (int t = 0; t < x->trials; t++)
 					assert_int_equal(x->exit[t] >= 0, m->hold_exit[t] > 0);
 			}
 			/* the walks take the same first two gates */
@@ -771,11 +839,43 @@ static void test_after_start_against_simulation(void **state)
 		bsim_markov_prediction_free(&p);
 		bsim_markov_set_free(&set);
 	}
-	print_message("outcomes off: %d without the gate after the start, %d with\n", off[0],
-	              off[1]);
+	print_message("outcomes off: %d without the gate after the start, %d with, %d with the "
+	              "first %d continued\n",
+	              off[0], off[1], off[2], A);
 	assert_true(off[0] >= 1);
 	assert_int_equal(off[1], 0);
+	assert_int_equal(off[2], 0);
 	free(sim);
+
+	/* The pairs of the first A are files of their own, beside those of
+	 * every start trial; one short of its last row is refused, naming the
+	 * file and the count. */
+	const char *pair = bsim_test_glob_first(bsim_test_join(dir, "map_*.after_*.first150.csv"));
+	assert_non_null(pair);
+	char *text = bsim_test_read(pair);
+	assert_non_null(text);
+	const size_t len = strlen(text);
+	assert_true(len > 2 && text[len - 1] == '\n');
+	size_t cut = len - 1;
+	while (cut > 0 && text[cut - 1] != '\n')
+		cut--;
+	char *shorter = strndup(text, cut), *name = strdup(strrchr(pair, '/') + 1);
+	bsim_test_write(dir, name, shorter);
+	{
+		def.after_trials = A;
+		bsim_markov_set again;
+		bsim_error err;
+		assert_int_equal(bsim_markov_build(&s, &def, dir, &again, &err), BSIM_EINPUT);
+		print_message("%s\n", err.msg);
+		assert_non_null(strstr(err.msg, name));
+		assert_non_null(strstr(err.msg, "the first 150 of the start's single gates"));
+		bsim_markov_set_free(&again);
+	}
+	bsim_test_write(dir, name, text);
+	free(shorter);
+	free(name);
+	free(text);
+	def.after_trials = 0;
 
 	/* A pair the directory lacks: a column of another kind alone, then
 	 * the column with that kind above the start. Both maps are there, the
@@ -1227,7 +1327,7 @@ static void test_threads_and_cache(void **state)
 	snprintf(d2, sizeof d2, "%s", bsim_test_dir("threads2"));
 	const char *exp = bsim_test_src("configs/lattice/c_track_essay.yaml");
 	/* 4,4,3 bins, 3 start trials and a training field of 30 trials: cheap
-	 * maps (the default's 4,369 bins, 4,000 start trials and 10,000 training
+	 * maps (the default's 4,369 bins, 16,000 start trials and 4,000 training
 	 * trials are other keys alike); the training field's trials run on the
 	 * threads too */
 	const char *b1[] = {"markov", "build",    exp,     "--bins",  "4,4,3", "--start-trials",
@@ -1243,11 +1343,12 @@ static void test_threads_and_cache(void **state)
 	assert_string_equal(t1, t2);
 	free(t1);
 	free(t2);
-	/* maps topped up to 1 single gate a crossing, and maps of single gates
-	 * alone (no crossings counted), alike: the crossings in trial order,
-	 * whatever the threads */
-	const char *how[2][2] = {{"--per-crossing", "1"}, {"--crossings", "0"}};
-	for (int h = 0; h < 2; h++) {
+	/* maps topped up to 1 single gate a crossing, maps of single gates
+	 * alone (no crossings counted), and the first 2 of the start trials
+	 * continued, alike: the crossings in trial order, whatever the threads */
+	const char *how[3][2] = {
+	        {"--per-crossing", "1"}, {"--crossings", "0"}, {"--after-trials", "2"}};
+	for (int h = 0; h < 3; h++) {
 		char c[2][1024];
 		char *t[2];
 		for (int n = 0; n < 2; n++) {
@@ -1266,6 +1367,9 @@ static void test_threads_and_cache(void **state)
 		}
 		assert_true(strlen(t[0]) > 1000);
 		assert_string_equal(t[0], t[1]);
+		assert_int_equal(bsim_test_glob_first(bsim_test_join(c[0], "map_*.first2.csv")) !=
+		                         NULL,
+		                 h == 2);
 		free(t[0]);
 		free(t[1]);
 	}
@@ -1281,9 +1385,25 @@ static void test_threads_and_cache(void **state)
 	assert_non_null(strstr(out, "0 maps built (0.0 s of CPU)"));
 	assert_non_null(strstr(out, "2 reused"));
 	assert_null(strstr(out, "training field"));
-	assert_non_null(strstr(note, "note: maps with 30 training trials (the default 10000), "
+	assert_non_null(strstr(note, "note: maps with 30 training trials (the default 4000), "
 	                             "4,4,3 bins (the default 14,6,13), 3 start trials (the "
 	                             "default 16000): measured less accurate"));
+	free(out);
+	free(note);
+	/* Fewer start trials continued: the maps reused, the gates after the
+	 * start built anew beside the others, and a note. */
+	const char *fewer[] = {"markov", "build",    exp, "--bins",  "4,4,3", "--start-trials",
+	                       "3",      "--trials", "3", "--train", "30",    "--after-trials",
+	                       "2",      "--out",    d1,  NULL};
+	assert_int_equal(bsim_test_cli(fewer, &out, &note), 0);
+	/* (the CPU said is the new pairs') */
+	assert_non_null(strstr(out, "0 maps built ("));
+	assert_non_null(strstr(out, "2 reused"));
+	assert_non_null(strstr(out, "the gate after the start (2 of the start trials continued): "
+	                            "4 pairs of maps built, 0 reused"));
+	assert_non_null(strstr(note, "2 start trials continued (the default 8000)"));
+	assert_non_null(bsim_test_glob_first(bsim_test_join(d1, "map_*.after_*.first2.csv")));
+	assert_non_null(bsim_test_glob_first(bsim_test_join(d1, "map_*.after_*[0-9a-f].csv")));
 	free(out);
 	free(note);
 	/* Anything the maps depend on: new maps, none reused. */
@@ -1616,6 +1736,8 @@ static void test_bad_inputs(void **state)
 	         "field"},
 	        {{"markov", "build", essay, "--per-crossing", "-1", "--out", target, NULL},
 	         "--per-crossing -1: expected an integer 0 to 1000000"},
+	        {{"markov", "build", essay, "--after-trials", "-1", "--out", target, NULL},
+	         "--after-trials -1: expected an integer 0 to 1000000"},
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
 		char *err = NULL;
@@ -2246,7 +2368,7 @@ static void test_scope(void **state)
 	d = d0;
 	d.train_trials = 2000;
 	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
-	                       "maps with 2000 training trials (the default 10000): "));
+	                       "maps with 2000 training trials (the default 4000): "));
 	d = d0;
 	d.after_start = 0;
 	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf),
@@ -2257,6 +2379,17 @@ static void test_scope(void **state)
 	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
 	                       "maps with 50 start trials (the default 16000), no gate after the "
 	                       "start: "));
+	/* fewer start trials continued than the default's: said; every one,
+	 * or all of fewer start trials (which that part of the note says): not */
+	d = d0;
+	d.after_trials = 4000;
+	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
+	                       "maps with 4000 start trials continued (the default 8000): "));
+	d.after_trials = 0;
+	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf), "");
+	d = d0;
+	d.start_trials = 3000;
+	assert_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf), "continued"));
 	d = d0;
 	int is_kind;
 	bsim_error err;
@@ -2368,6 +2501,7 @@ int main(int argc, char **argv)
 	};
 	const struct CMUnitTest long_tests[] = {
 	        cmocka_unit_test(test_one_gate_against_simulation),
+	        cmocka_unit_test(test_closed_loop_said),
 	        cmocka_unit_test(test_after_start_against_simulation),
 	        cmocka_unit_test(test_training_against_simulation),
 	        cmocka_unit_test(test_interrupted_build),

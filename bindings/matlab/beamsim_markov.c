@@ -8,7 +8,8 @@
  *
  * build's names: 'out' (the map directory, required), 'trials' (single
  * gates per entry bin), 'start_trials' (of the start bin), 'after_start' (1, the default: the
- * gate after the start from each start trial's exit; 0: entry bins from the start on), 'train'
+ * gate after the start from each start trial's exit; 0: entry bins from the start on),
+ * 'after_trials' (the first start trials continued there, default 8000; 0: every one), 'train'
  * (the training field's trials, 0: states uniform in each bin), 'crossings' (1, the default with a
  * training field: each bin counts the training field's crossings, topped up as 'per_crossing'
  * says; 0: 'trials' single gates a bin), 'per_crossing' (single gates a bin for each crossing
@@ -60,19 +61,20 @@ enum {
 	A_TRAIN,
 	A_CROSSINGS,
 	A_PER_CROSSING,
+	A_AFTER_TRIALS,
 	N_ARGS
 };
 static const char *const arg_names[N_ARGS] = {
-        "out",          "map",         "trials",  "bins",        "vmax",        "entries",
-        "seed",         "threads",     "backend", "backend_opt", "set",         "grid",
-        "tol",          "gates",       "walks",   "overwrite",   "bootstrap",   "resume",
-        "start_trials", "after_start", "train",   "crossings",   "per_crossing"};
+        "out",          "map",         "trials",  "bins",        "vmax",         "entries",
+        "seed",         "threads",     "backend", "backend_opt", "set",          "grid",
+        "tol",          "gates",       "walks",   "overwrite",   "bootstrap",    "resume",
+        "start_trials", "after_start", "train",   "crossings",   "per_crossing", "after_trials"};
 
 /* The names each subcommand takes, the others refused. */
-static const int build_names[] = {A_OUT,         A_TRIALS,      A_BINS,      A_VMAX,
-                                  A_ENTRIES,     A_SEED,        A_THREADS,   A_BACKEND,
-                                  A_SET,         A_BACKEND_OPT, A_GRID,      A_START_TRIALS,
-                                  A_AFTER_START, A_TRAIN,       A_CROSSINGS, A_PER_CROSSING};
+static const int build_names[] = {
+        A_OUT,         A_TRIALS,  A_BINS,      A_VMAX,         A_ENTRIES,     A_SEED,
+        A_THREADS,     A_BACKEND, A_SET,       A_BACKEND_OPT,  A_GRID,        A_START_TRIALS,
+        A_AFTER_START, A_TRAIN,   A_CROSSINGS, A_PER_CROSSING, A_AFTER_TRIALS};
 static const int predict_names[] = {A_MAP, A_SET, A_TOL, A_GATES, A_WALKS, A_OUT, A_OVERWRITE};
 static const int validate_names[] = {A_MAP, A_OUT,  A_TRIALS,    A_SEED,   A_THREADS,
                                      A_SET, A_GRID, A_BOOTSTRAP, A_RESUME, A_OVERWRITE};
@@ -196,7 +198,7 @@ static int build(markov_call *c, const char *path, mxArray **out, bsim_error *er
 	bsim_markov_build_def def = bsim_markov_build_def_default();
 	const char *backend = NULL;
 	long trials = 0, threads = 0, start_trials = 0, after_start = -1, train = -1,
-	     crossings = -1, per_crossing = -1;
+	     crossings = -1, per_crossing = -1, after_trials = -1;
 	const mxArray *const *v = c->v;
 	if (!v[A_OUT])
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -219,7 +221,9 @@ static int build(markov_call *c, const char *path, mxArray **out, bsim_error *er
 	    (v[A_TRAIN] && bmx_long("train", v[A_TRAIN], 0, 1000000, &train, err)) ||
 	    (v[A_CROSSINGS] && bmx_long("crossings", v[A_CROSSINGS], 0, 1, &crossings, err)) ||
 	    (v[A_PER_CROSSING] &&
-	     bmx_long("per_crossing", v[A_PER_CROSSING], 0, 1000000, &per_crossing, err)))
+	     bmx_long("per_crossing", v[A_PER_CROSSING], 0, 1000000, &per_crossing, err)) ||
+	    (v[A_AFTER_TRIALS] &&
+	     bmx_long("after_trials", v[A_AFTER_TRIALS], 0, 1000000, &after_trials, err)))
 		return err->code;
 	if (start_trials > 0) /* none: the default (self and flow entries: trials) */
 		def.map.start_trials = (int)start_trials;
@@ -231,6 +235,8 @@ static int build(markov_call *c, const char *path, mxArray **out, bsim_error *er
 		def.map.train_crossings = (int)crossings;
 	if (per_crossing >= 0) /* none: the default */
 		def.map.trials_per_crossing = (int)per_crossing;
+	if (after_trials >= 0) /* none: the default; 0: every start trial */
+		def.map.after_trials = (int)after_trials;
 	def.experiment = path;
 	def.has_seed = v[A_SEED] != NULL;
 	if (trials > 0)

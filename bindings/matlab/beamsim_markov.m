@@ -21,9 +21,12 @@
 %                    goes on there from its exact state, and the chain
 %                    takes the first two gates from those; 0: entry bins
 %                    from the start on (0 with self or flow entries)
+%     'after_trials' the first start trials continued there (default
+%                    8000; the others take the continuations of those
+%                    that entered the same gate); 0: every start trial
 %     'train'        trials of the training field, a 21 x 21 field of the
 %                    lattice's gate kinds at random whose gate entries the
-%                    bins' states are drawn from (default 10000; run only
+%                    bins' states are drawn from (default 4000; run only
 %                    when a map is built); 0: states uniform in each bin
 %     'crossings'    1 (default, with a training field): each bin counts
 %                    the training field's own crossings of the map's gate

@@ -68,21 +68,22 @@ static int entries_from(PyObject *seq, bsim_markov_def *def, const char ***paths
 PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"experiment", "out",          "trials",      "bins",
-	                         "vmax",       "entries",      "seed",        "threads",
-	                         "backend",    "sets",         "grid",        "backend_opts",
-	                         "progress",   "start_trials", "after_start", "train",
-	                         "crossings",  "per_crossing", NULL};
+	static char *kwlist[] = {"experiment", "out",          "trials",       "bins",
+	                         "vmax",       "entries",      "seed",         "threads",
+	                         "backend",    "sets",         "grid",         "backend_opts",
+	                         "progress",   "start_trials", "after_start",  "train",
+	                         "crossings",  "per_crossing", "after_trials", NULL};
 	const char *experiment, *out, *backend_spec = NULL;
 	int trials = 0, threads = 0, start_trials = 0, after_start = -1, train = -1, crossings = -1,
-	    per_crossing = -1;
+	    per_crossing = -1, after_trials = -1;
 	double vmax = 0.0;
 	PyObject *bins_o = Py_None, *entries_o = Py_None, *seed_o = Py_None, *sets_o = Py_None,
 	         *grid_o = Py_None, *opts_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(
-	            args, kw, "ss|iOdOOizOOOOiiiii", kwlist, &experiment, &out, &trials, &bins_o,
-	            &vmax, &entries_o, &seed_o, &threads, &backend_spec, &sets_o, &grid_o, &opts_o,
-	            &progress_o, &start_trials, &after_start, &train, &crossings, &per_crossing))
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|iOdOOizOOOOiiiiii", kwlist, &experiment,
+	                                 &out, &trials, &bins_o, &vmax, &entries_o, &seed_o,
+	                                 &threads, &backend_spec, &sets_o, &grid_o, &opts_o,
+	                                 &progress_o, &start_trials, &after_start, &train,
+	                                 &crossings, &per_crossing, &after_trials))
 		return NULL;
 	bsim_markov_build_def def = bsim_markov_build_def_default();
 	if (bins_o != Py_None && !PyArg_ParseTuple(bins_o, "iii", &def.map.bins.n_pos,
@@ -110,6 +111,8 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 		def.map.train_crossings = crossings;
 	if (per_crossing >= 0) /* -1: the default */
 		def.map.trials_per_crossing = per_crossing;
+	if (after_trials >= 0) /* -1: the default; 0: every start trial */
+		def.map.after_trials = after_trials;
 	def.entries = paths;
 	pyb_run_inputs in;
 	if (pyb_run_inputs_from(seed_o, sets_o, grid_o, progress_o, &in)) {

@@ -167,6 +167,15 @@ typedef struct bsim_markov_def {
 	 * from the start on. Only with a training field's, uniform or observed
 	 * entries (self and flow entries: 0). */
 	int after_start;
+	/* With the gate after the start: the first after_trials of the start
+	 * bin's single gates are continued (default BSIM_MARKOV_AFTER_TRIALS;
+	 * <= 0 or start_trials and more: every one). The chain takes a body's
+	 * second gate from those continuations that entered the same gate,
+	 * pooled, for every start trial that entered it: the start's own exits
+	 * keep all start_trials, and the gate after them an unbiased sample of
+	 * the exact states at a quarter of the cost (docs/markov.md, "Fewer
+	 * start trials continued"). */
+	int after_trials;
 	bsim_progress_fn progress; /* may be NULL; counts single-gate trials */
 	void *progress_user;
 	/* May be NULL; counts the training field's trials, before any single
@@ -240,11 +249,14 @@ typedef struct bsim_markov_def {
 /* The start bin's single-gate trials by default. */
 #define BSIM_MARKOV_START_TRIALS 16000
 /* The training field's trials by default, and its gates across and along. */
-#define BSIM_MARKOV_TRAIN_TRIALS 10000
+#define BSIM_MARKOV_TRAIN_TRIALS 4000
 #define BSIM_MARKOV_TRAIN_SIZE   21
 /* The single gates a bin by default for each crossing of the training
  * field that entered it (at most the bin's trials). */
 #define BSIM_MARKOV_TRIALS_PER_CROSSING 5
+/* The start bin's single gates continued in the gate after the start by
+ * default, the first ones. */
+#define BSIM_MARKOV_AFTER_TRIALS 8000
 
 /* bsim_markov_bins_default(), 50 trials per bin and BSIM_MARKOV_START_TRIALS
  * of the start bin, a training field of BSIM_MARKOV_TRAIN_TRIALS whose
@@ -308,16 +320,18 @@ BSIM_API int bsim_markov_map_count(const bsim_markov_map *m, int entry, int exit
  * memory. */
 BSIM_API int bsim_markov_map_set_counts(bsim_markov_map *m, const int *dense, bsim_error *err);
 
-/* The gate after the start: map `start`'s start-bin single gates each
- * continued from its exact exit state in a gate of map `gate` (both
- * indices into the set's maps), the beams at rest: exit[t] the exit bin of
- * that gate (0 stuck) and steps[t] the time steps it took, for start trial
- * t, or exit[t] = -1 where the start's single gate did not leave into a
- * gate (it was stuck). Stored as map_START.after_GATE.csv and .cost in the
- * map directory, named by both maps' keys. */
+/* The gate after the start: map `start`'s first `trials` start-bin single
+ * gates each continued from its exact exit state in a gate of map `gate`
+ * (both indices into the set's maps), the beams at rest: exit[t] the exit
+ * bin of that gate (0 stuck) and steps[t] the time steps it took, for
+ * start trial t < trials, or exit[t] = -1 where the start's single gate did
+ * not leave into a gate (it was stuck). Stored as map_START.after_GATE.csv
+ * and .cost in the map directory, named by both maps' keys (with
+ * .firstN before the extension where N, the trials, is fewer than the
+ * start map's start trials). */
 typedef struct bsim_markov_next {
 	int start, gate;
-	int trials; /* the start map's start trials */
+	int trials; /* the start trials continued: def after_trials, at most the start map's */
 	int *exit, *steps;
 	double seconds, cost;          /* as bsim_markov_map's */
 	long long steps_total;         /* single-gate time steps, as bsim_markov_map's steps */

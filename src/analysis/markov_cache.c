@@ -18,6 +18,7 @@
 
 #include "analysis/markov_internal.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
@@ -688,19 +689,24 @@ int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsi
 
 static const char NEXT_HEADER[] = "trial,start_exit,exit,steps";
 
-/* "after_GATE.csv" or "after_GATE.cost": the extension of a gate after the
- * start's files beside the start map's (map_START.after_GATE.csv). */
-static void next_ext(char *buf, size_t size, const bsim_markov_map *gate, const char *what)
+/* Beside the start map's files: map_START.after_GATE.csv, or
+ * map_START.after_GATE.firstN.csv for the first N of its start trials. */
+void bsim_markov_next_ext(char *buf, size_t size, const bsim_markov_map *start,
+                          const bsim_markov_map *gate, int after, const char *what)
 {
-	snprintf(buf, size, "after_%016llx.%s", (unsigned long long)gate->key, what);
+	if (after < start->start_trials)
+		snprintf(buf, size, "after_%016llx.first%d.%s", (unsigned long long)gate->key,
+		         after, what);
+	else
+		snprintf(buf, size, "after_%016llx.%s", (unsigned long long)gate->key, what);
 }
 
 int bsim_markov_next_write(const char *stage, const bsim_markov_next *x,
                            const bsim_markov_map *start, const bsim_markov_map *gate,
                            bsim_error *err)
 {
-	char path[BSIM_PATH_MAX], ext[64];
-	next_ext(ext, sizeof ext, gate, "csv");
+	char path[BSIM_PATH_MAX], ext[80];
+	bsim_markov_next_ext(ext, sizeof ext, start, gate, x->trials, "csv");
 	snprintf(path, sizeof path, "%s/map_%016llx.%s", stage, (unsigned long long)start->key,
 	         ext);
 	bsim_atomic_file o;
@@ -713,7 +719,7 @@ int bsim_markov_next_write(const char *stage, const bsim_markov_next *x,
 			        x->steps[t]);
 	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
 		return BSIM_EFAIL;
-	next_ext(ext, sizeof ext, gate, "cost");
+	bsim_markov_next_ext(ext, sizeof ext, start, gate, x->trials, "cost");
 	snprintf(path, sizeof path, "%s/map_%016llx.%s", stage, (unsigned long long)start->key,
 	         ext);
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
@@ -725,9 +731,11 @@ int bsim_markov_next_write(const char *stage, const bsim_markov_next *x,
 int bsim_markov_next_read(const char *dir, bsim_markov_next *x, const bsim_markov_map *start,
                           const bsim_markov_map *gate, bsim_error *err)
 {
-	const int T = start->start_trials, nb = gate->n_bins;
-	char ext[64];
-	next_ext(ext, sizeof ext, gate, "csv");
+	/* the first T of the start's trials, as x->trials says */
+	const int T = x->trials, nb = gate->n_bins;
+	assert(T >= 1 && T <= start->start_trials);
+	char ext[80];
+	bsim_markov_next_ext(ext, sizeof ext, start, gate, x->trials, "csv");
 	file_text t;
 	int absent = 0;
 	/* a row is at most four integers of 11 characters */
@@ -743,7 +751,6 @@ int bsim_markov_next_read(const char *dir, bsim_markov_next *x, const bsim_marko
 	}
 	free(x->exit);
 	free(x->steps);
-	x->trials = T;
 	x->exit = malloc((size_t)T * sizeof *x->exit);
 	x->steps = malloc((size_t)T * sizeof *x->steps);
 	char *line = t.text, *nl = strchr(line, '\n');
@@ -771,13 +778,13 @@ int bsim_markov_next_read(const char *dir, bsim_markov_next *x, const bsim_marko
 	if (bad) {
 		bsim_error_set(err, BSIM_EINPUT,
 		               "%s:%ld: expected a row trial,start_exit,exit,steps for each of "
-		               "the start's %d single gates of map_%016llx.hold.csv that left "
-		               "into a gate, in order (start_exit as there, exit 0 to %d, steps "
-		               ">= 1)",
+		               "the first %d of the start's single gates of map_%016llx.hold.csv "
+		               "that left into a gate, in order (start_exit as there, exit 0 to "
+		               "%d, steps >= 1)",
 		               path, lineno, T, (unsigned long long)start->key, nb - 1);
 		return -1;
 	}
-	next_ext(ext, sizeof ext, gate, "cost");
+	bsim_markov_next_ext(ext, sizeof ext, start, gate, x->trials, "cost");
 	if (cost_read(dir, start, ext, &x->cost, &x->steps_total, err) != BSIM_OK)
 		return -1;
 	return 1;
@@ -811,7 +818,10 @@ int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const b
 	fputs("], \"entries\": ", o.f);
 	char label[64];
 	bsim_json_string(o.f, bsim_markov_entries_label(def, NULL, label, sizeof label));
-	fprintf(o.f, ", \"after_start\": %d}\n", bsim_markov_def_after_start(def));
+	fprintf(o.f, ", \"after_start\": %d", bsim_markov_def_after_start(def));
+	if (bsim_markov_def_after_start(def))
+		fprintf(o.f, ", \"after_trials\": %d", bsim_markov_def_after_trials(def));
+	fputs("}\n", o.f);
 	return bsim_atomic_file_commit(&o, err);
 }
 
@@ -962,6 +972,11 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	if (rc == BSIM_OK &&
 	    fy_node_by_path(fy_document_root(d.fyd), "/after_start", -1, FYNWF_DONT_FOLLOW))
 		rc = def_int(&d, "/after_start", 0, 1, &def->after_start, err);
+	/* absent in maps built before fewer were continued: every start trial */
+	def->after_trials = 0;
+	if (rc == BSIM_OK &&
+	    fy_node_by_path(fy_document_root(d.fyd), "/after_trials", -1, FYNWF_DONT_FOLLOW))
+		rc = def_int(&d, "/after_trials", 1, 1000000, &def->after_trials, err);
 	bsim_ydoc_free(&d);
 	if (rc != BSIM_OK)
 		return rc;

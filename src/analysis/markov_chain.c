@@ -23,7 +23,8 @@
  * = s^T, by LU (GSL) for at most BSIM_MARKOV_LU_MAX states; y is the
  * expected number of visits of each state and p = y R. Always, one of
  * two iterations, which stop when less than tol is left in the field (or
- * after 1e6 steps), said in left_in_field: each location's probability is
+ * after 1e6 steps, or when STALL_STEPS steps leave it where it was), said
+ * in left_in_field: each location's probability is
  * short by at most left_in_field. With BSIM_MARKOV_GATES (the default),
  * the series s Q^(k-1) R, k = 1, 2, ..., whose k-th term is the
  * probability of ending after the k-th gate entered: p and the
@@ -43,6 +44,13 @@
 #include <string.h>
 
 #define SERIES_MAX 1000000
+/* The series and the sweeps look every STALL_STEPS steps at the probability
+ * left in the field: if it has not fallen by a relative 1e-9 since, it is
+ * held by a set of states that are never left (rows of the maps that lead
+ * only into each other, as a few single gates a bin can give), the
+ * remaining steps up to SERIES_MAX would not move it, and they stop, said
+ * in left_in_field. */
+#define STALL_STEPS 1024
 
 /* A map's rows in compressed sparse rows: row a's nonzero transitions are
  * exit[first[a] .. first[a + 1]) with probabilities p[], contiguous;
@@ -303,18 +311,46 @@ static void start_place(chain_start *st, const chain *c, int g, int x, double w)
 	}
 }
 
+/* Mass w entering state (gate g, bin a) after the start, on through the
+ * bin's row of g's map. */
+static void start_by_bin(chain_start *st, const chain *c, int state, double w)
+{
+	const int g = state / c->nb, a = state % c->nb;
+	const sparse_map *sm = &c->sm[c->gate_map[g]];
+	if (sm->hold)
+		st->time += w * sm->hold[a];
+	for (int j = sm->first[a]; j < sm->first[a + 1]; j++)
+		start_place(st, c, g, sm->exit[j], w * sm->p[j]);
+}
+
+/* The state start trial t of map m enters on leaving gate g0, or -1 (loc
+ * then where it ended: stuck in g0 or out of the field). */
+static int start_entered(const chain *c, const bsim_markov_map *m, int g0, int t, int *loc)
+{
+	const int x1 = m->hold_exit[t]; /* the start bin's units come first */
+	int state = -1;
+	*loc = c->cols + c->rows + g0;
+	if (x1 > 0)
+		bsim_markov_exit_target(c->cols, c->rows, c->nb, g0, x1, &state, loc);
+	return state;
+}
+
 /* The first two gates from the gate after the start (set->next): start
  * trial t of the start gate's map (weight 1 / T) ends there, stuck or out
  * of the field, or enters gate g, where its own continuation in g's map
- * (the exact state it entered with, not its bin) leaves by exit x2. A
- * body leaving the start gate downwards enters it again through its
- * bottom, as everywhere in the chain: that bin's row. Exact for the
- * mixture: no bin stands between the first gate and the second. */
+ * (the exact state it entered with, not its bin) leaves by exit x2. Only
+ * the first A trials are continued (bsim_markov_next.trials): a trial t >=
+ * A that entered g takes the continuations of the trials t' < A that
+ * entered g, each an equal share, an unbiased sample of the exact states
+ * entering g (where none of them entered g, g's bin row). A body leaving
+ * the start gate downwards enters it again through its bottom, as
+ * everywhere in the chain: that bin's row. Exact for the mixture at A = T:
+ * no bin stands between the first gate and the second. */
 static int chain_start_init(chain_start *st, const chain *c, const bsim_markov_set *set, int g0,
                             double dt)
 {
 	memset(st, 0, sizeof *st);
-	const int nb = c->nb, n = c->n_states, S = c->gate_map[g0];
+	const int nb = c->nb, n = c->n_states, S = c->gate_map[g0], G = c->cols * c->rows;
 	st->init = calloc((size_t)n, sizeof *st->init);
 	st->p_loc = calloc((size_t)c->n_loc, sizeof *st->p_loc);
 	if (!st->init || !st->p_loc)
@@ -323,16 +359,28 @@ static int chain_start_init(chain_start *st, const chain *c, const bsim_markov_s
 	if (!set->next || !m->hold_exit) {
 		st->init[(size_t)g0 * nb] = 1.0;
 	} else {
-		const int T = m->start_trials;
+		const int T = m->start_trials, A = set->next[(size_t)S * set->n].trials;
 		const double w = 1.0 / T;
+		/* the continued trials that entered each gate, and the weight of
+		 * the others that take their share */
+		int *count = calloc((size_t)G, sizeof *count);
+		double *pooled = calloc((size_t)G, sizeof *pooled);
+		if (!count || !pooled) {
+			free(count);
+			free(pooled);
+			return -1;
+		}
+		int loc;
+		for (int t = 0; t < A; t++) {
+			const int state = start_entered(c, m, g0, t, &loc);
+			if (state >= 0 && state / nb != g0)
+				count[state / nb]++;
+		}
 		st->gates = 2;
 		for (int t = 0; t < T; t++) {
-			const int x1 = m->hold_exit[t]; /* the start bin's units come first */
 			st->visits += w;
 			st->time += w * m->hold_steps[t] * dt;
-			int state = -1, loc = c->cols + c->rows + g0;
-			if (x1 > 0)
-				bsim_markov_exit_target(c->cols, c->rows, nb, g0, x1, &state, &loc);
+			const int state = start_entered(c, m, g0, t, &loc);
 			if (state < 0) {
 				st->p_loc[loc] += w;
 				st->p_gates[1] += w;
@@ -340,23 +388,33 @@ static int chain_start_init(chain_start *st, const chain *c, const bsim_markov_s
 			}
 			const int g = state / nb;
 			st->visits += w;
-			if (g == g0) {
-				const sparse_map *sm = &c->sm[S];
-				const int a = state % nb;
-				if (sm->hold)
-					st->time += w * sm->hold[a];
-				for (int j = sm->first[a]; j < sm->first[a + 1]; j++)
-					start_place(st, c, g, sm->exit[j], w * sm->p[j]);
+			if (g == g0 || (t >= A && count[g] == 0)) {
+				start_by_bin(st, c, state, w);
+				continue;
+			}
+			if (t >= A) {
+				pooled[g] += w;
 				continue;
 			}
 			const bsim_markov_next *x = &set->next[(size_t)S * set->n + c->gate_map[g]];
-			assert(x->exit && x->exit[t] >= 0);
+			assert(x->trials == A && x->exit && x->exit[t] >= 0);
 			st->time += w * x->steps[t] * dt;
 			start_place(st, c, g, x->exit[t], w);
 		}
+		for (int t = 0; t < A; t++) { /* the pooled shares */
+			const int state = start_entered(c, m, g0, t, &loc), g = state / nb;
+			if (state < 0 || g == g0 || pooled[g] == 0.0)
+				continue;
+			const bsim_markov_next *x = &set->next[(size_t)S * set->n + c->gate_map[g]];
+			const double share = pooled[g] / count[g];
+			st->time += share * x->steps[t] * dt;
+			start_place(st, c, g, x->exit[t], share);
+		}
+		free(count);
+		free(pooled);
 	}
-	st->glo = c->cols * c->rows;
-	for (int g = 0; g < c->cols * c->rows; g++)
+	st->glo = G;
+	for (int g = 0; g < G; g++)
 		for (int a = 0; a < nb; a++)
 			if (st->init[(size_t)g * nb + a] != 0.0) {
 				st->glo = g < st->glo ? g : st->glo;
@@ -403,9 +461,14 @@ __attribute__((noinline)) static int series(const chain *c, const chain_start *s
 		pg[g] = st->p_gates[g];
 	/* the gates that may hold probability: [glo, ghi) */
 	int glo = st->glo, ghi = st->ghi;
-	double in_field = st->in_field;
+	double in_field = st->in_field, was = in_field;
 	int k = st->gates;
 	while (in_field > tol && k < SERIES_MAX) {
+		if ((k + 1) % STALL_STEPS == 0) {
+			if (in_field >= was * (1.0 - 1e-9))
+				break;
+			was = in_field;
+		}
 		k++;
 		if (k > cap) {
 			double *np = realloc(pg, ((size_t)2 * cap + 1) * sizeof *pg);
@@ -566,9 +629,14 @@ __attribute__((noinline)) static int sweeps(const chain *c, int n_maps, const ch
 	for (int g = st->glo; g < st->ghi; g++)
 		for (int a = 0; a < nb; a++)
 			r[base[g] + a] = st->init[(size_t)g * nb + a];
-	double in_field = st->in_field, vis = st->visits;
+	double in_field = st->in_field, vis = st->visits, was = in_field;
 	int k = 0;
 	while (in_field > tol && k < SERIES_MAX) {
+		if ((k + 1) % STALL_STEPS == 0) {
+			if (in_field >= was * (1.0 - 1e-9))
+				break;
+			was = in_field;
+		}
 		k++;
 		const int back = !(k & 1);
 		for (int gi = 0; gi < G; gi++) {
@@ -636,7 +704,8 @@ __attribute__((noinline)) static int sweeps(const chain *c, int n_maps, const ch
 
 /* p_loc by LU of (I - Q)^T y = init (st's), added to what the first
  * gates absorbed; *time the sum of the visits y times each state's mean
- * holding time (with holding times), st's first gates' included. */
+ * holding time (with holding times), st's first gates' included. 0; 1,
+ * p_loc and *time unfinished, if I - Q is singular; -1 on failure. */
 static int lu_solve(const chain *c, const chain_start *st, double *p_loc, double *time)
 {
 	*time = st->time;
@@ -661,7 +730,17 @@ static int lu_solve(const chain *c, const chain_start *st, double *p_loc, double
 	}
 	for (int s = 0; s < n; s++)
 		gsl_vector_set(e, (size_t)s, st->init[s]);
-	if (gsl_linalg_LU_decomp(A, perm, &sign) || gsl_linalg_LU_solve(A, perm, e, y))
+	if (gsl_linalg_LU_decomp(A, perm, &sign))
+		goto done;
+	/* a zero pivot: I - Q singular, a set of states never left (whether
+	 * or not the start reaches it); GSL's solve would call its error
+	 * handler, which aborts */
+	for (int s = 0; s < n; s++)
+		if (gsl_matrix_get(A, (size_t)s, (size_t)s) == 0.0) {
+			rc = 1;
+			goto done;
+		}
+	if (gsl_linalg_LU_solve(A, perm, e, y))
 		goto done;
 	for (int s = 0; s < n; s++) {
 		double visits = gsl_vector_get(y, (size_t)s);
@@ -761,17 +840,26 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 			/* Two solutions of one chain: they must agree to within what
 			 * the series or the sweeps left in the field. */
 			double *by_series = malloc((size_t)c.n_loc * sizeof *by_series);
+			const double iter_time = out->mean_time;
+			int lu = -1;
 			if (!by_series)
 				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 			else {
 				memcpy(by_series, out->p, (size_t)c.n_loc * sizeof *out->p);
 				memset(out->p, 0, (size_t)c.n_loc * sizeof *out->p);
-				if (lu_solve(&c, &st, out->p, &out->mean_time))
+				lu = lu_solve(&c, &st, out->p, &out->mean_time);
+				if (lu < 0)
 					rc = bsim_error_set(
 					        err, BSIM_EFAIL,
-					        "the chain's LU solve failed (out of memory or a "
-					        "singular I - Q: a set of states never left)");
-				for (int i = 0; rc == BSIM_OK && i < c.n_loc; i++)
+					        "the chain's LU solve failed: out of memory");
+				if (lu > 0) {
+					/* a set of states never left: the iterative
+					 * solution stands, and what it left in the field
+					 * (all that reaches that set) is said */
+					memcpy(out->p, by_series, (size_t)c.n_loc * sizeof *out->p);
+					out->mean_time = iter_time;
+				}
+				for (int i = 0; rc == BSIM_OK && lu == 0 && i < c.n_loc; i++)
 					if (!(fabs(out->p[i] - by_series[i]) <=
 					      1e-9 + out->left_in_field))
 						rc = bsim_error_set(
@@ -782,7 +870,7 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 						        i, out->p[i], by_series[i]);
 				free(by_series);
 			}
-			out->exact = 1;
+			out->exact = lu == 0;
 		}
 		out->has_time = c.has_time;
 		if (!c.has_time)

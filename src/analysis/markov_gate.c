@@ -8,6 +8,8 @@
 
 #include "analysis/markov_internal.h"
 
+#include <assert.h>
+
 #include <gsl/gsl_rng.h>
 #include <math.h>
 #include <omp.h>
@@ -447,9 +449,9 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
 	return rc;
 }
 
-long bsim_markov_next_units(const bsim_markov_map *start, int n)
+long bsim_markov_next_units(int after_trials, int n)
 {
-	return (long)start->start_trials * (1 + n);
+	return (long)after_trials * (1 + n);
 }
 
 int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
@@ -458,16 +460,18 @@ int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *
                               const bsim_markov_map *const *gate, bsim_markov_next *const *nx,
                               int n, long *done, long total, bsim_error *err)
 {
-	const long T = start->start_trials;
+	/* the first A start trials go on: the chain pools them for the rest */
+	const long A = bsim_markov_def_after_trials(def);
+	assert(A >= 1 && A <= start->start_trials);
 	/* the start bin's single gates alone: a map of its units only */
 	bsim_markov_map sm = *start;
 	sm.trials = 1;
 	sm.n_bins = 1;
 	sm.bin_first = NULL;
-	markov_run *runs = malloc((size_t)T * sizeof *runs);
-	markov_run *from = malloc((size_t)T * sizeof *from);
-	int *trial = malloc((size_t)T * sizeof *trial);
-	int *exit = malloc((size_t)T * sizeof *exit), *held = malloc((size_t)T * sizeof *held);
+	markov_run *runs = malloc((size_t)A * sizeof *runs);
+	markov_run *from = malloc((size_t)A * sizeof *from);
+	int *trial = malloc((size_t)A * sizeof *trial);
+	int *exit = malloc((size_t)A * sizeof *exit), *held = malloc((size_t)A * sizeof *held);
 	if (!runs || !from || !trial || !exit || !held) {
 		free(runs);
 		free(from);
@@ -480,16 +484,16 @@ int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *
 	clock_t c0 = clock();
 	int rc = BSIM_OK;
 	if (start_runs) { /* the start's single gates as the map's build left them */
-		memcpy(runs, start_runs, (size_t)T * sizeof *runs);
-		memcpy(exit, start->hold_exit, (size_t)T * sizeof *exit);
-		memcpy(held, start->hold_steps, (size_t)T * sizeof *held);
-		*done += T;
+		memcpy(runs, start_runs, (size_t)A * sizeof *runs);
+		memcpy(exit, start->hold_exit, (size_t)A * sizeof *exit);
+		memcpy(held, start->hold_steps, (size_t)A * sizeof *held);
+		*done += A;
 	} else
-		rc = units_run(lattice, def, be, opts, start->k, T, NULL, &sm, NULL, NULL, NULL,
+		rc = units_run(lattice, def, be, opts, start->k, A, NULL, &sm, NULL, NULL, NULL,
 		               runs, exit, held, &steps, done, total, err);
 	/* Run again, the same seeds as the map's start bin: the same single
 	 * gates (the kept runs are the map's own). */
-	for (long t = 0; rc == BSIM_OK && !start_runs && start->hold_exit && t < T; t++)
+	for (long t = 0; rc == BSIM_OK && !start_runs && start->hold_exit && t < A; t++)
 		if (exit[t] != start->hold_exit[t] || held[t] != start->hold_steps[t])
 			rc = bsim_error_set(err, BSIM_EFAIL,
 			                    "the start's single gate %ld of map_%016llx ran again "
@@ -497,7 +501,7 @@ int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *
 			                    t, (unsigned long long)start->key, exit[t], held[t],
 			                    start->hold_exit[t], start->hold_steps[t]);
 	long left = 0;
-	for (long t = 0; rc == BSIM_OK && t < T; t++)
+	for (long t = 0; rc == BSIM_OK && t < A; t++)
 		if (exit[t] > 0) {
 			from[left] = runs[t];
 			trial[left++] = (int)t;
@@ -507,9 +511,9 @@ int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *
 		bsim_markov_next *x = nx[i];
 		c0 = clock();
 		long long gs = 0;
-		x->trials = (int)T;
-		x->exit = malloc((size_t)T * sizeof *x->exit);
-		x->steps = malloc((size_t)T * sizeof *x->steps);
+		x->trials = (int)A;
+		x->exit = malloc((size_t)A * sizeof *x->exit);
+		x->steps = malloc((size_t)A * sizeof *x->steps);
 		if (!x->exit || !x->steps) {
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 			break;
@@ -519,7 +523,7 @@ int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *
 		/* the start's units again count once, shared by the n gates */
 		if (rc != BSIM_OK)
 			break;
-		for (long t = 0; t < T; t++)
+		for (long t = 0; t < A; t++)
 			x->exit[t] = -1, x->steps[t] = 0;
 		for (long u = 0; u < left; u++) {
 			x->exit[trial[u]] = exit[u];
@@ -531,7 +535,7 @@ int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *
 	}
 	/* counted: the units of the gates after the start that did not run */
 	if (rc == BSIM_OK)
-		*done += (T - left) * n;
+		*done += (A - left) * n;
 	free(runs);
 	free(from);
 	free(trial);

@@ -69,6 +69,14 @@ static inline int bsim_markov_def_after_start(const bsim_markov_def *def)
 	return def->after_start && !def->self_entries;
 }
 
+/* The start trials def's maps continue in the gate after the start, the
+ * first ones: after_trials, or every start trial. */
+static inline int bsim_markov_def_after_trials(const bsim_markov_def *def)
+{
+	const int T = bsim_markov_def_start_trials(def);
+	return def->after_trials > 0 && def->after_trials < T ? def->after_trials : T;
+}
+
 /* The single gates of entry bin a of map m, and the index of its first
  * in the map's single gates (the start bin's first, then every other
  * bin's in turn); their total. */
@@ -253,16 +261,17 @@ int bsim_markov_map_simulate_runs(const bsim_scene *lattice, const bsim_markov_d
  * gates of map start again (the same seeds as the map's: the same exits,
  * BSIM_EFAIL if they differ from its holding times), or, with start_runs,
  * their runs as the map's build kept them (start_runs[t] for start trial
- * t), and from the exit state of each that left into a gate one single
- * gate of each of the n maps gate[i], into nx[i] (exit and steps
- * allocated). *done counts bsim_markov_next_units(start, n) units of
+ * t), and from the exit state of each of the first
+ * bsim_markov_def_after_trials(def) that left into a gate one single gate
+ * of each of the n maps gate[i], into nx[i] (trials set, exit and steps
+ * allocated). *done counts bsim_markov_next_units(that, n) units of
  * total. */
 int bsim_markov_next_simulate(const bsim_scene *lattice, const bsim_markov_def *def,
                               const bsim_backend *be, const bsim_options *opts,
                               const bsim_markov_map *start, const markov_run *start_runs,
                               const bsim_markov_map *const *gate, bsim_markov_next *const *nx,
                               int n, long *done, long total, bsim_error *err);
-long bsim_markov_next_units(const bsim_markov_map *start, int n);
+long bsim_markov_next_units(int after_trials, int n);
 
 /* ---- self-consistent entries (markov_self.c) ---- */
 
@@ -365,6 +374,12 @@ int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsi
  * .csv and .cost) written into stage, or read from dir: 1 if there, 0 if
  * absent, -1 with err naming the line if malformed or not of start's
  * holding times. */
+/* The name of the gate after the start of maps start and gate after the
+ * start map's key and its dot: "after_GATE.what", or where `after`, the
+ * start trials continued, is fewer than the start map's,
+ * "after_GATE.firstAFTER.what". */
+void bsim_markov_next_ext(char *buf, size_t size, const bsim_markov_map *start,
+                          const bsim_markov_map *gate, int after, const char *what);
 int bsim_markov_next_write(const char *stage, const bsim_markov_next *x,
                            const bsim_markov_map *start, const bsim_markov_map *gate,
                            bsim_error *err);

@@ -28,6 +28,7 @@ bsim_markov_def bsim_markov_def_default(void)
 	                         .train_crossings = -1,
 	                         .trials_per_crossing = BSIM_MARKOV_TRIALS_PER_CROSSING,
 	                         .after_start = 1,
+	                         .after_trials = BSIM_MARKOV_AFTER_TRIALS,
 	                         .seed = 1};
 }
 
@@ -129,6 +130,11 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		                      "crossings: expected -1 (where a training field), 0 or 1, "
 		                      "got %d",
 		                      def->train_crossings);
+	if (def->after_trials < 0 || def->after_trials > 1000000)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "start trials continued after the start: expected 0 (every "
+		                      "one) to 1000000, got %d",
+		                      def->after_trials);
 	if (def->trials_per_crossing < 0 || def->trials_per_crossing > 1000000)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "trials per crossing: expected 0 to 1000000, got %d",
@@ -190,6 +196,12 @@ const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t 
 		         bsim_markov_def_start_trials(def), d0.start_trials);
 	if (!def->after_start)
 		snprintf(part[3], sizeof part[3], "no gate after the start");
+	else if (bsim_markov_def_after_trials(def) <
+	         (d0.after_trials < bsim_markov_def_start_trials(def)
+	                  ? d0.after_trials
+	                  : bsim_markov_def_start_trials(def)))
+		snprintf(part[3], sizeof part[3], "%d start trials continued (the default %d)",
+		         bsim_markov_def_after_trials(def), d0.after_trials);
 	char list[4 * 64 + 8] = "";
 	size_t len = 0;
 	for (int k = 0; k < 4; k++)
@@ -285,28 +297,33 @@ static int round_fill(const bsim_scene *lattice, const bsim_markov_def *def, con
 	return rc;
 }
 
-/* The path of the gate after the start of maps a and k in dir. */
+/* The path in dir of the gate after the start of maps a and k, of a's
+ * first `after` start trials: its file `what` ("csv" or "cost"). */
 static void next_path(char *buf, size_t size, const char *dir, const bsim_markov_map *a,
-                      const bsim_markov_map *k)
+                      const bsim_markov_map *k, int after, const char *what)
 {
-	snprintf(buf, size, "%s/map_%016llx.after_%016llx.csv", dir, (unsigned long long)a->key,
-	         (unsigned long long)k->key);
+	char ext[80];
+	bsim_markov_next_ext(ext, sizeof ext, a, k, after, what);
+	snprintf(buf, size, "%s/map_%016llx.%s", dir, (unsigned long long)a->key, ext);
 }
 
 /* The single gates of the gates after the start that dir does not hold,
  * of the start maps this process builds. */
-static long next_units_missing(const bsim_markov_set *set, const char *dir)
+static long next_units_missing(const bsim_markov_set *set, const bsim_markov_def *def,
+                               const char *dir)
 {
+	const int after = bsim_markov_def_after_trials(def);
 	long units = 0;
 	for (int a = 0; a < set->n; a++) {
 		int missing = 0;
 		for (int k = 0; k < set->n && !set->maps[a].elsewhere; k++) {
 			char path[BSIM_PATH_MAX];
 			struct stat st;
-			next_path(path, sizeof path, dir, &set->maps[a], &set->maps[k]);
+			next_path(path, sizeof path, dir, &set->maps[a], &set->maps[k], after,
+			          "csv");
 			missing += lstat(path, &st) != 0;
 		}
-		units += missing ? bsim_markov_next_units(&set->maps[a], missing) : 0;
+		units += missing ? bsim_markov_next_units(after, missing) : 0;
 	}
 	return units;
 }
@@ -336,6 +353,7 @@ static int next_fill(const bsim_scene *lattice, const bsim_markov_def *def, cons
 			bsim_markov_next *x = &out->next[(size_t)a * n + k];
 			x->start = a;
 			x->gate = k;
+			x->trials = bsim_markov_def_after_trials(def);
 			if ((x->elsewhere = sm->elsewhere))
 				continue;
 			int got = bsim_markov_next_read(dir, x, sm, &out->maps[k], err);
@@ -344,7 +362,7 @@ static int next_fill(const bsim_scene *lattice, const bsim_markov_def *def, cons
 				                                 err)) > 0)
 					x->copied = 1;
 			char path[BSIM_PATH_MAX];
-			next_path(path, sizeof path, dir, sm, &out->maps[k]);
+			next_path(path, sizeof path, dir, sm, &out->maps[k], x->trials, "csv");
 			if (got < 0)
 				rc = BSIM_EINPUT;
 			else if (got > 0 && x->copied) {
@@ -502,7 +520,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const
 	}
 	/* the gates after the start to simulate, counted in the progress */
 	if (rc == BSIM_OK && bsim_markov_def_after_start(def) && stage && !made && def->n_from == 0)
-		total += next_units_missing(out, dir);
+		total += next_units_missing(out, def, dir);
 	int to_build = made ? 0 : n - out->reused - out->copied;
 	for (int i = 0; i < n && !made; i++)
 		to_build -= out->maps[i].elsewhere;
@@ -701,11 +719,11 @@ static int maps_listed(const char *dir, const bsim_markov_set *set, bsim_error *
 		}
 	for (int a = 0; rc == BSIM_OK && n > 0 && set->next && a < set->n; a++)
 		for (int k = 0; rc == BSIM_OK && k < set->n * 2; k++) {
-			char name[80];
-			snprintf(name, sizeof name, "map_%016llx.after_%016llx.%s",
-			         (unsigned long long)set->maps[a].key,
-			         (unsigned long long)set->maps[k / 2].key, k % 2 ? "cost" : "csv");
-			rc = file_listed(files, n, dir, name, err);
+			char name[BSIM_PATH_MAX];
+			next_path(name, sizeof name, "", &set->maps[a], &set->maps[k / 2],
+			          set->next[(size_t)a * set->n + k / 2].trials,
+			          k % 2 ? "cost" : "csv");
+			rc = file_listed(files, n, dir, name + 1, err);
 		}
 	bsim_outdir_files_free(files, n);
 	return rc;

@@ -20,8 +20,9 @@
  *
  * With the gate after the start (set->next), a walk's first single gate
  * is a start trial, and where it enters another gate its second is that
- * trial's own continuation there (bsim_markov_predict_with's first two
- * gates).
+ * trial's own continuation there, or, for a trial past the continued ones,
+ * the continuation of a continued trial that entered the same gate, drawn
+ * uniformly (bsim_markov_predict_with's first two gates).
  *
  * The outcome is decided as a lattice trial's (docs/lattice.md): stuck when
  * a gate holds the body gate_steps steps (the map's exit 0: its single gate
@@ -105,6 +106,42 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 	double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
 	long n_kind[3] = {0, 0, 0};
 	uint64_t rng = seed;
+	/* The continued start trials by the gate they entered: pool[pool_first[g]
+	 * .. pool_first[g + 1]) for gate g (a counting sort). */
+	int *pool = NULL, *pool_first = NULL;
+	if (set->next && set->maps[gate_map[start]].hold_exit) {
+		const bsim_markov_map *sm = &set->maps[gate_map[start]];
+		const int A = set->next[(size_t)gate_map[start] * set->n].trials;
+		pool = malloc((size_t)A * sizeof *pool);
+		pool_first = calloc((size_t)G + 1, sizeof *pool_first);
+		int *entered = malloc((size_t)A * sizeof *entered),
+		    *at = malloc((size_t)G * sizeof *at);
+		if (!pool || !pool_first || !entered || !at) {
+			free(pool);
+			free(pool_first);
+			free(entered);
+			free(at);
+			free(gate_map);
+			return bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		}
+		for (int t = 0; t < A; t++) {
+			int state = -1, loc;
+			if (sm->hold_exit[t] > 0)
+				bsim_markov_exit_target(cols, rows, nb, start, sm->hold_exit[t],
+				                        &state, &loc);
+			entered[t] = state >= 0 && state / nb != start ? state / nb : -1;
+			if (entered[t] >= 0)
+				pool_first[entered[t] + 1]++;
+		}
+		for (int g = 0; g < G; g++)
+			pool_first[g + 1] += pool_first[g];
+		memcpy(at, pool_first, (size_t)G * sizeof *at);
+		for (int t = 0; t < A; t++)
+			if (entered[t] >= 0)
+				pool[at[entered[t]]++] = t;
+		free(entered);
+		free(at);
+	}
 	int rc = BSIM_OK;
 	for (long w = 0; w < walks && rc == BSIM_OK; w++) {
 		int g = start, a = 0, loc = -1;
@@ -144,9 +181,16 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 			} else {
 				int state;
 				bsim_markov_exit_target(cols, rows, nb, g, x, &state, &loc);
-				if (state >= 0 && trial >= 0 && set->next && state / nb != g)
+				if (state >= 0 && trial >= 0 && set->next && state / nb != g) {
+					const int h = state / nb,
+					          np = pool_first[h + 1] - pool_first[h];
 					after = &set->next[(size_t)gate_map[g] * set->n +
-					                   gate_map[state / nb]];
+					                   gate_map[h]];
+					if (trial >= after->trials && np == 0)
+						after = NULL; /* none continued there: bins */
+					else if (trial >= after->trials)
+						trial = pool[pool_first[h] + draw(&rng, np)];
+				}
 				if (state >= 0) {
 					g = state / nb;
 					a = state % nb;
@@ -166,6 +210,8 @@ int bsim_markov_predict_time(const bsim_scene *lattice, const bsim_markov_set *s
 		n_kind[kind]++;
 	}
 	free(gate_map);
+	free(pool);
+	free(pool_first);
 	if (rc != BSIM_OK)
 		return rc;
 	for (int i = 0; i < n_bins * 3; i++)

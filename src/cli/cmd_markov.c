@@ -40,7 +40,8 @@ enum {
 	OWN_AFTER_START,
 	OWN_TRAIN,
 	OWN_CROSSINGS,
-	OWN_PER_CROSSING
+	OWN_PER_CROSSING,
+	OWN_AFTER_TRIALS
 };
 
 #define MAX_ENTRIES 16
@@ -133,6 +134,15 @@ static int markov_option(void *args, int i, const char *value)
 			return cli_usage("markov build", "--after-start %s: expected 0 or 1",
 			                 value);
 		a->def.after_start = (int)n;
+		return CLI_OK;
+	}
+	case OWN_AFTER_TRIALS: {
+		long n;
+		if (cli_parse_long(value, 0, 1000000, &n) != 0)
+			return cli_usage("markov build",
+			                 "--after-trials %s: expected an integer 0 to 1000000",
+			                 value);
+		a->def.after_trials = (int)n;
 		return CLI_OK;
 	}
 	case OWN_START_TRIALS: {
@@ -251,7 +261,7 @@ static const cli_own build_own[] = {
         {"train", 1, "N",
          "trials of the training field, a 21 x 21 field of the\n"
          "lattice's gate kinds at random, whose gate entries the\n"
-         "bins' states are drawn from (default 10000; run only when\n"
+         "bins' states are drawn from (default 4000; run only when\n"
          "a map is built); 0: states uniform in each bin"},
         {"crossings", 1, "0|1",
          "1 (default, with a training field): each bin counts the\n"
@@ -263,6 +273,10 @@ static const cli_own build_own[] = {
          "single gates a bin is topped up to for each crossing that\n"
          "entered it (as for one where none did), at most --trials\n"
          "(default 5); 0: every bin topped up to --trials"},
+        {"after-trials", 1, "N",
+         "the first N start trials go on into the gate after the\n"
+         "start (default 8000); the others take the continuations of\n"
+         "those that entered the same gate; 0: every start trial"},
 };
 
 /* What a map's entry bin holds, for the summaries: trials single gates,
@@ -280,14 +294,15 @@ static void bins_hold(int crossings, int per, int trials, char *buf, size_t size
 static int build_option(void *args, int i, const char *value)
 {
 	return markov_option(args,
-	                     i == 3   ? OWN_SHARD
-	                     : i == 4 ? OWN_PASSES
-	                     : i == 5 ? OWN_START_TRIALS
-	                     : i == 6 ? OWN_AFTER_START
-	                     : i == 7 ? OWN_TRAIN
-	                     : i == 8 ? OWN_CROSSINGS
-	                     : i == 9 ? OWN_PER_CROSSING
-	                              : i,
+	                     i == 3    ? OWN_SHARD
+	                     : i == 4  ? OWN_PASSES
+	                     : i == 5  ? OWN_START_TRIALS
+	                     : i == 6  ? OWN_AFTER_START
+	                     : i == 7  ? OWN_TRAIN
+	                     : i == 8  ? OWN_CROSSINGS
+	                     : i == 9  ? OWN_PER_CROSSING
+	                     : i == 10 ? OWN_AFTER_TRIALS
+	                               : i,
 	                     value);
 }
 
@@ -583,9 +598,16 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 		       crossings ? "counts from the crossings (topped up from the entries) of"
 		                 : "states from the gate entries of",
 		       def->map.train_trials, BSIM_MARKOV_TRAIN_SIZE, BSIM_MARKOV_TRAIN_SIZE);
-	if (def->map.after_start && !def->map.self_entries)
-		printf("the gate after the start: %d pairs of maps built, %d reused (CPU above)\n",
-		       res->next_built, res->next_reused);
+	if (def->map.after_start && !def->map.self_entries) {
+		const int start = def->map.start_trials > 0 ? def->map.start_trials
+		                                            : def->map.trials,
+		          after = def->map.after_trials > 0 && def->map.after_trials < start
+		                          ? def->map.after_trials
+		                          : start;
+		printf("the gate after the start (%d of the start trials continued): %d pairs of "
+		       "maps built, %d reused (CPU above)\n",
+		       after, res->next_built, res->next_reused);
+	}
 	cli_wrote(stdout, out);
 }
 

@@ -61,9 +61,10 @@ check(any(~cellfun(@isempty, strfind(n1, '.after_'))), 'no gate after the start 
 check(strncmp(b.scope, 'maps with 40 training trials', 28) && ~isempty(strfind(err, ['note: ' b.scope])), ...
       'the scope ''%s'' is not the program''s note: %s', b.scope, err);
 % 'after_start', 0 as --after-start 0 (no gate after the start), 'crossings', 0 as
-% --crossings 0 (bins of single gates alone) and 'per_crossing', 1 as --per-crossing 1
+% --crossings 0 (bins of single gates alone), 'per_crossing', 1 as --per-crossing 1 and
+% 'after_trials', 3 as --after-trials 3 (the first 3 start trials continued)
 variants = {'after_start', 0, '--after-start 0'; 'crossings', 0, '--crossings 0'; ...
-            'per_crossing', 1, '--per-crossing 1'};
+            'per_crossing', 1, '--per-crossing 1'; 'after_trials', 3, '--after-trials 3'};
 for i = 1:rows(variants)
   [name, value, option] = variants{i, :};
   mine0 = fullfile(tmp, ['maps_mex_' name]);
@@ -76,7 +77,9 @@ for i = 1:rows(variants)
   [n3, t3] = map_files(mine0);
   [n4, t4] = map_files(theirs0);
   none_after = all(cellfun(@isempty, strfind(n3, '.after_')));
-  check(isequal(n3, n4) && isequal(t3, t4) && none_after == strcmp(name, 'after_start'), ...
+  first3 = any(~cellfun(@isempty, strfind(n3, '.first3.csv')));
+  check(isequal(n3, n4) && isequal(t3, t4) && none_after == strcmp(name, 'after_start') && ...
+        first3 == strcmp(name, 'after_trials'), ...
         '%s: %s / %s', option, strjoin(n3, ' '), strjoin(n4, ' '));
 end
 again = beamsim_markov('build', experiment, 'out', mine, 'trials', 3, 'start_trials', 7, 'train', 40, 'bins', [2 2 1], 'seed', 5);

@@ -60,7 +60,7 @@ def test_build_is_the_programs(maps):
     run = cli("markov", "build", EXPERIMENT, *SMALL_ARGS, "--seed", "5", "--out", prog)
     lines = run.stdout.splitlines()
     # the program's note on these coarse bins and few start trials
-    assert built["scope"].startswith("maps with 40 training trials (the default 10000), 2,2,1 "
+    assert built["scope"].startswith("maps with 40 training trials (the default 4000), 2,2,1 "
                                      "bins (the default 14,6,13), 7 start")
     assert f"note: {built['scope']}" in run.stderr
     listed = [line.split()[-2] for line in lines if line.startswith("group ")]
@@ -85,6 +85,17 @@ def test_after_start_is_the_programs(tmp_path):
         "--out", prog)
     assert map_files(py) == map_files(prog)
     assert not any(".after_" in name for name in map_files(py))
+
+
+def test_after_trials_is_the_programs(tmp_path):
+    """after_trials=3 builds what --after-trials 3 builds: the first 3 of
+    the 7 start trials continued, in files of their own."""
+    py, prog = tmp_path / "py", tmp_path / "prog"
+    beamsim.markov_build(EXPERIMENT, py, seed=5, after_trials=3, **SMALL)
+    cli("markov", "build", EXPERIMENT, *SMALL_ARGS, "--seed", "5", "--after-trials", "3",
+        "--out", prog)
+    assert map_files(py) == map_files(prog)
+    assert any(name.endswith(".first3.csv") for name in map_files(py))
 
 
 @pytest.mark.parametrize("arg, option, entries", [
@@ -147,7 +158,7 @@ def test_validate_is_the_programs(maps):
     del want["map_dir"], got["map_dir"]
     assert untimed({k: got[k] for k in want}) == untimed(want)
     assert [c["protocol"] for c in got["checks"]] == ["essay", "world"]
-    assert got["maps_scope"].startswith("maps with 40 training trials (the default 10000), "
+    assert got["maps_scope"].startswith("maps with 40 training trials (the default 4000), "
                                         "2,2,1 bins (the default 14,6,13)")
     # maps of the default method: bins counted from the crossings, 5 a crossing
     assert (got["of_crossings"], got["per_crossing"]) == (1, 5)

@@ -461,7 +461,7 @@ def _entries(entries):
 def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=None, seed=None,
                  threads=None, backend=None, backend_opt=None, set=None, grid=None,
                  progress=None, start_trials=None, after_start=None, train=None,
-                 crossings=None, per_crossing=None):
+                 crossings=None, per_crossing=None, after_trials=None):
     """The single-gate maps the lattices of an experiment need, one per pair
     of beam stiffnesses, built into the map directory out as `beamsim
     markov build EXPERIMENT --out DIR` builds them (docs/markov.md): the
@@ -474,9 +474,11 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
     entries) continues each start trial that leaves into a gate there from
     its exact state, for every pair of stiffnesses, and the chain takes the
     first two gates from those; False: entry bins from the start on;
-    train: trials of the training field, a 21 x 21 field of the lattice's
+    after_trials: the first start trials continued there (None: 8,000; the
+    others take the continuations of those that entered the same gate), 0:
+    every start trial; train: trials of the training field, a 21 x 21 field of the lattice's
     gate kinds at random whose gate entries the bins' states are drawn from
-    (None: 10,000; run only when a map is built), 0: states uniform in each
+    (None: 4,000; run only when a map is built), 0: states uniform in each
     bin; crossings: True (None, with a training field) counts each bin
     from the training field's own crossings of the map's gate kind entered
     in it, topped up with single gates as per_crossing says; False: trials
@@ -520,7 +522,9 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
                                  -1 if train is None else _count("train", train, 0, 1000000),
                                  -1 if crossings is None else int(bool(crossings)),
                                  -1 if per_crossing is None
-                                 else _count("per_crossing", per_crossing, 0, 1000000))
+                                 else _count("per_crossing", per_crossing, 0, 1000000),
+                                 -1 if after_trials is None
+                                 else _count("after_trials", after_trials, 0, 1000000))
     info["out"] = out
     return info
 
