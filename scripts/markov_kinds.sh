@@ -9,11 +9,15 @@
 # prediction.csv and validate.csv. A method's maps are built once, on the
 # first field of a set of gate kinds, and reused on every other; flow:1
 # maps are built per field (they hold for that layout only). default is
-# the default now (a training field of the kinds whose crossings the bins
-# count, topped up to 5 single gates a crossing and at most 50, 14,6,13
-# bins, 16,000 start trials), crossings0 the default before it (50 single
-# gates every bin), start4000 the one before that (4,000 start trials),
-# uniform the one before that (states uniform in 8,8,9 bins). ring5
+# the default now (a training field of 4,000 trials of the kinds whose
+# crossings the bins count, topped up to 5 single gates a crossing and at
+# most 50, 14,6,13 bins, 16,000 start trials, the first 8,000 continued in
+# the gate after the start), train10k the default before it (10,000
+# training trials, every start trial continued), crossings0 the one before
+# that (50 single gates every bin), start4000 the one before that (4,000
+# start trials), uniform the one before that (states uniform in 8,8,9
+# bins); the methods after cheap are the settings tried for the default
+# now (docs/markov.md, "A smaller training field"). ring5
 # and check11 are the fields the settings were chosen on; test_* were made
 # after the bins and trials were fixed, fresh_* after the gate after the
 # start was, late_* after the training field (method train), final_* after
@@ -22,8 +26,10 @@
 # field of 4,000 trials counted by its crossings, 5 single gates a bin at
 # least, 2,000 from the start; crossings: start4000 counted by its
 # crossings, every bin topped up to 50), start_* after crossings0's 16,000
-# start trials, per_* after the default's 5 single gates a crossing (name them
-# in FIELDS). Prints one row per method and field;
+# start trials, per_* after the default's 5 single gates a crossing, pool_*
+# after the default's training field of 4,000 trials and its first 8,000
+# start trials continued (train10k: the default before; name them in
+# FIELDS). Prints one row per method and field;
 # the runs stay in OUT (default out/markov-kinds), the table in
 # OUT/table.txt. FIELDS="..." chooses the fields, METHODS="..." the methods
 # (by name), TRIALS=N the direct trials of each (default the experiments',
@@ -44,8 +50,9 @@ fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13
 # a training field's entries (train: the sweep of exp_train_r21.yaml, run
 # first), and with 10,000 trials of it and 14,6,13 bins
 methods=("default:"
-         "crossings0:--crossings 0"
-         "start4000:--crossings 0 --start-trials 4000"
+         "train10k:--train 10000 --after-trials 0"
+         "crossings0:--train 10000 --after-trials 0 --crossings 0"
+         "start4000:--train 10000 --crossings 0 --start-trials 4000"
          "uniform:--train 0 --bins 8,8,9 --start-trials 4000"
          "without-after-start:--train 0 --bins 8,8,9 --after-start 0 --start-trials 4000"
          "fine-bins-alone:--train 0 --bins 8,8,9 --start-trials 50 --after-start 0"
@@ -57,8 +64,17 @@ methods=("default:"
          "bins14613:--train 0 --bins 14,6,13 --start-trials 4000"
          "train:--entries $out/train-sweep --bins 8,8,9 --start-trials 4000"
          "train10k-bins14613:--entries $out/train-sweep-10k --bins 14,6,13 --start-trials 4000"
-         "crossings:--crossings 1 --per-crossing 0 --start-trials 4000"
-         "cheap:--crossings 1 --train 4000 --trials 5 --start-trials 2000")
+         "crossings:--train 10000 --crossings 1 --per-crossing 0 --start-trials 4000"
+         "cheap:--crossings 1 --train 4000 --trials 5 --start-trials 2000"
+         "train10k-after8000:--train 10000 --after-trials 8000"
+         "train10k-after4000:--train 10000 --after-trials 4000"
+         "train10k-no-after:--train 10000 --after-start 0"
+         "after-all:--after-trials 0"
+         "after4000:--after-trials 4000"
+         "no-after:--after-start 0"
+         "start4000-no-after:--start-trials 4000 --after-start 0"
+         "train3000-no-after:--train 3000 --start-trials 6000 --after-start 0 --trials 20"
+         "train2000:--train 2000")
 if [ -n "${METHODS:-}" ]; then
     chosen=()
     for m in "${methods[@]}"; do
