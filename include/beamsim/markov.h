@@ -173,8 +173,8 @@ typedef struct bsim_markov_def {
 	 * second gate from those continuations that entered the same gate,
 	 * pooled, for every start trial that entered it: the start's own exits
 	 * keep all start_trials, and the gate after them an unbiased sample of
-	 * the exact states at a quarter of the cost (docs/markov.md, "Fewer
-	 * start trials continued"). */
+	 * the exact states, at a cost in proportion (docs/markov.md, "A smaller
+	 * training field and fewer start trials continued"). */
 	int after_trials;
 	bsim_progress_fn progress; /* may be NULL; counts single-gate trials */
 	void *progress_user;
@@ -259,8 +259,9 @@ typedef struct bsim_markov_def {
 #define BSIM_MARKOV_AFTER_TRIALS 8000
 
 /* bsim_markov_bins_default(), 50 trials per bin and BSIM_MARKOV_START_TRIALS
- * of the start bin, a training field of BSIM_MARKOV_TRAIN_TRIALS whose
- * crossings are counted (BSIM_MARKOV_TRIALS_PER_CROSSING), seed 1,
+ * of the start bin, the first BSIM_MARKOV_AFTER_TRIALS of them continued in
+ * the gate after the start, a training field of BSIM_MARKOV_TRAIN_TRIALS
+ * whose crossings are counted (BSIM_MARKOV_TRIALS_PER_CROSSING), seed 1,
  * the default backend, all cores. */
 BSIM_API bsim_markov_def bsim_markov_def_default(void);
 
