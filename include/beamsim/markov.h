@@ -497,6 +497,7 @@ typedef struct bsim_markov_build_result {
 	bsim_markov_built *maps;     /* n_maps */
 	int built, reused;           /* maps simulated now, maps read from the cache */
 	int next_built, next_reused; /* the gates after the start (map.after_start), likewise */
+	int after_trials;            /* the start trials they continue; 0 without them */
 	int copied;                  /* maps read from the parts' directories (a merge) */
 	double seconds;              /* CPU time of the simulation of those built, s */
 	int pass;                    /* a round's (or its merge's): the pass made; else

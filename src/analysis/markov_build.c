@@ -2,6 +2,8 @@
  * group's lattice's maps built into one map directory by bsim_markov_build,
  * the parts of a spread build taking turns along all of them, a part's
  * part.json and a merge's check that its parts are this build's. */
+#include "analysis/markov_internal.h"
+
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -187,6 +189,8 @@ int bsim_markov_build_run(const bsim_markov_build_def *def, bsim_markov_build_re
 	md.passes_from = def->passes;
 	res->pass = md.self_passes;
 	res->n_bins = bsim_markov_bins_count(&md.bins);
+	res->after_trials =
+	        bsim_markov_def_after_start(&md) ? bsim_markov_def_after_trials(&md) : 0;
 	bsim_markov_entries entries = {0};
 	if (def->n_entries > 0) {
 		if ((rc = bsim_markov_entries_load(def->entries, def->n_entries, &entries, err)) !=

@@ -689,10 +689,10 @@ int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsi
 
 static const char NEXT_HEADER[] = "trial,start_exit,exit,steps";
 
-/* Beside the start map's files: map_START.after_GATE.csv, or
- * map_START.after_GATE.firstN.csv for the first N of its start trials. */
-void bsim_markov_next_ext(char *buf, size_t size, const bsim_markov_map *start,
-                          const bsim_markov_map *gate, int after, const char *what)
+/* What follows "map_START." in the name of a gate after the start's file
+ * (bsim_markov_next_name), as map_file and cost_read take it. */
+static void next_ext(char *buf, size_t size, const bsim_markov_map *start,
+                     const bsim_markov_map *gate, int after, const char *what)
 {
 	if (after < start->start_trials)
 		snprintf(buf, size, "after_%016llx.first%d.%s", (unsigned long long)gate->key,
@@ -701,14 +701,21 @@ void bsim_markov_next_ext(char *buf, size_t size, const bsim_markov_map *start,
 		snprintf(buf, size, "after_%016llx.%s", (unsigned long long)gate->key, what);
 }
 
+void bsim_markov_next_name(char *buf, size_t size, const bsim_markov_map *start,
+                           const bsim_markov_map *gate, int after, const char *what)
+{
+	char ext[64];
+	next_ext(ext, sizeof ext, start, gate, after, what);
+	snprintf(buf, size, "map_%016llx.%s", (unsigned long long)start->key, ext);
+}
+
 int bsim_markov_next_write(const char *stage, const bsim_markov_next *x,
                            const bsim_markov_map *start, const bsim_markov_map *gate,
                            bsim_error *err)
 {
-	char path[BSIM_PATH_MAX], ext[80];
-	bsim_markov_next_ext(ext, sizeof ext, start, gate, x->trials, "csv");
-	snprintf(path, sizeof path, "%s/map_%016llx.%s", stage, (unsigned long long)start->key,
-	         ext);
+	char path[BSIM_PATH_MAX], name[96];
+	bsim_markov_next_name(name, sizeof name, start, gate, x->trials, "csv");
+	snprintf(path, sizeof path, "%s/%s", stage, name);
 	bsim_atomic_file o;
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
@@ -719,9 +726,8 @@ int bsim_markov_next_write(const char *stage, const bsim_markov_next *x,
 			        x->steps[t]);
 	if (bsim_atomic_file_commit(&o, err) != BSIM_OK)
 		return BSIM_EFAIL;
-	bsim_markov_next_ext(ext, sizeof ext, start, gate, x->trials, "cost");
-	snprintf(path, sizeof path, "%s/map_%016llx.%s", stage, (unsigned long long)start->key,
-	         ext);
+	bsim_markov_next_name(name, sizeof name, start, gate, x->trials, "cost");
+	snprintf(path, sizeof path, "%s/%s", stage, name);
 	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
 		return BSIM_EFAIL;
 	fprintf(o.f, "cpu_seconds %.6g\nsteps %lld\n", x->cost, x->steps_total);
@@ -735,7 +741,7 @@ int bsim_markov_next_read(const char *dir, bsim_markov_next *x, const bsim_marko
 	const int T = x->trials, nb = gate->n_bins;
 	assert(T >= 1 && T <= start->start_trials);
 	char ext[80];
-	bsim_markov_next_ext(ext, sizeof ext, start, gate, x->trials, "csv");
+	next_ext(ext, sizeof ext, start, gate, T, "csv");
 	file_text t;
 	int absent = 0;
 	/* a row is at most four integers of 11 characters */
@@ -784,7 +790,7 @@ int bsim_markov_next_read(const char *dir, bsim_markov_next *x, const bsim_marko
 		               path, lineno, T, (unsigned long long)start->key, nb - 1);
 		return -1;
 	}
-	bsim_markov_next_ext(ext, sizeof ext, start, gate, x->trials, "cost");
+	next_ext(ext, sizeof ext, start, gate, T, "cost");
 	if (cost_read(dir, start, ext, &x->cost, &x->steps_total, err) != BSIM_OK)
 		return -1;
 	return 1;

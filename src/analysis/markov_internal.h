@@ -374,12 +374,12 @@ int bsim_markov_map_write(const char *stage, const bsim_markov_map *m, const bsi
  * .csv and .cost) written into stage, or read from dir: 1 if there, 0 if
  * absent, -1 with err naming the line if malformed or not of start's
  * holding times. */
-/* The name of the gate after the start of maps start and gate after the
- * start map's key and its dot: "after_GATE.what", or where `after`, the
- * start trials continued, is fewer than the start map's,
- * "after_GATE.firstAFTER.what". */
-void bsim_markov_next_ext(char *buf, size_t size, const bsim_markov_map *start,
-                          const bsim_markov_map *gate, int after, const char *what);
+/* The file name of the gate after the start of maps start and gate:
+ * "map_START.after_GATE.what", or where `after`, the start trials
+ * continued, is fewer than the start map's,
+ * "map_START.after_GATE.firstAFTER.what" (what: "csv" or "cost"). */
+void bsim_markov_next_name(char *buf, size_t size, const bsim_markov_map *start,
+                           const bsim_markov_map *gate, int after, const char *what);
 int bsim_markov_next_write(const char *stage, const bsim_markov_next *x,
                            const bsim_markov_map *start, const bsim_markov_map *gate,
                            bsim_error *err);

@@ -302,9 +302,9 @@ static int round_fill(const bsim_scene *lattice, const bsim_markov_def *def, con
 static void next_path(char *buf, size_t size, const char *dir, const bsim_markov_map *a,
                       const bsim_markov_map *k, int after, const char *what)
 {
-	char ext[80];
-	bsim_markov_next_ext(ext, sizeof ext, a, k, after, what);
-	snprintf(buf, size, "%s/map_%016llx.%s", dir, (unsigned long long)a->key, ext);
+	char name[96];
+	bsim_markov_next_name(name, sizeof name, a, k, after, what);
+	snprintf(buf, size, "%s/%s", dir, name);
 }
 
 /* The single gates of the gates after the start that dir does not hold,
@@ -719,11 +719,11 @@ static int maps_listed(const char *dir, const bsim_markov_set *set, bsim_error *
 		}
 	for (int a = 0; rc == BSIM_OK && n > 0 && set->next && a < set->n; a++)
 		for (int k = 0; rc == BSIM_OK && k < set->n * 2; k++) {
-			char name[BSIM_PATH_MAX];
-			next_path(name, sizeof name, "", &set->maps[a], &set->maps[k / 2],
-			          set->next[(size_t)a * set->n + k / 2].trials,
-			          k % 2 ? "cost" : "csv");
-			rc = file_listed(files, n, dir, name + 1, err);
+			char name[96];
+			bsim_markov_next_name(name, sizeof name, &set->maps[a], &set->maps[k / 2],
+			                      set->next[(size_t)a * set->n + k / 2].trials,
+			                      k % 2 ? "cost" : "csv");
+			rc = file_listed(files, n, dir, name, err);
 		}
 	bsim_outdir_files_free(files, n);
 	return rc;

@@ -62,6 +62,18 @@ typedef struct markov_args {
 	int start_trials; /* build: --start-trials given */
 } markov_args;
 
+/* An integer option of markov build, lo to hi, into *out; else the usage
+ * error naming it. */
+static int build_count(const char *opt, const char *value, long lo, long hi, int *out)
+{
+	long n;
+	if (cli_parse_long(value, lo, hi, &n) != 0)
+		return cli_usage("markov build", "--%s %s: expected an integer %ld to %ld", opt,
+		                 value, lo, hi);
+	*out = (int)n;
+	return CLI_OK;
+}
+
 static int markov_option(void *args, int i, const char *value)
 {
 	markov_args *a = args;
@@ -136,33 +148,16 @@ static int markov_option(void *args, int i, const char *value)
 		a->def.after_start = (int)n;
 		return CLI_OK;
 	}
-	case OWN_AFTER_TRIALS: {
-		long n;
-		if (cli_parse_long(value, 0, 1000000, &n) != 0)
-			return cli_usage("markov build",
-			                 "--after-trials %s: expected an integer 0 to 1000000",
-			                 value);
-		a->def.after_trials = (int)n;
-		return CLI_OK;
-	}
+	case OWN_AFTER_TRIALS:
+		return build_count("after-trials", value, 0, 1000000, &a->def.after_trials);
 	case OWN_START_TRIALS: {
-		long n;
-		if (cli_parse_long(value, 1, 1000000, &n) != 0)
-			return cli_usage("markov build",
-			                 "--start-trials %s: expected an integer 1 to 1000000",
-			                 value);
-		a->def.start_trials = (int)n;
-		a->start_trials = 1;
-		return CLI_OK;
+		const int rc = build_count("start-trials", value, 1, 1000000, &a->def.start_trials);
+		if (rc == CLI_OK)
+			a->start_trials = 1;
+		return rc;
 	}
-	case OWN_TRAIN: {
-		long n;
-		if (cli_parse_long(value, 0, 1000000, &n) != 0)
-			return cli_usage("markov build",
-			                 "--train %s: expected an integer 0 to 1000000", value);
-		a->def.train_trials = (int)n;
-		return CLI_OK;
-	}
+	case OWN_TRAIN:
+		return build_count("train", value, 0, 1000000, &a->def.train_trials);
 	case OWN_CROSSINGS: {
 		long n;
 		if (cli_parse_long(value, 0, 1, &n) != 0)
@@ -170,15 +165,8 @@ static int markov_option(void *args, int i, const char *value)
 		a->def.train_crossings = (int)n;
 		return CLI_OK;
 	}
-	case OWN_PER_CROSSING: {
-		long n;
-		if (cli_parse_long(value, 0, 1000000, &n) != 0)
-			return cli_usage("markov build",
-			                 "--per-crossing %s: expected an integer 0 to 1000000",
-			                 value);
-		a->def.trials_per_crossing = (int)n;
-		return CLI_OK;
-	}
+	case OWN_PER_CROSSING:
+		return build_count("per-crossing", value, 0, 1000000, &a->def.trials_per_crossing);
 	case OWN_MAP:
 		a->map = value;
 		return CLI_OK;
@@ -598,16 +586,10 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 		       crossings ? "counts from the crossings (topped up from the entries) of"
 		                 : "states from the gate entries of",
 		       def->map.train_trials, BSIM_MARKOV_TRAIN_SIZE, BSIM_MARKOV_TRAIN_SIZE);
-	if (def->map.after_start && !def->map.self_entries) {
-		const int start = def->map.start_trials > 0 ? def->map.start_trials
-		                                            : def->map.trials,
-		          after = def->map.after_trials > 0 && def->map.after_trials < start
-		                          ? def->map.after_trials
-		                          : start;
+	if (res->after_trials > 0)
 		printf("the gate after the start (%d of the start trials continued): %d pairs of "
 		       "maps built, %d reused (CPU above)\n",
-		       after, res->next_built, res->next_reused);
-	}
+		       res->after_trials, res->next_built, res->next_reused);
 	cli_wrote(stdout, out);
 }
 
