@@ -798,7 +798,7 @@ static void test_after_start_against_simulation(void **state)
 	for (int v = 0; v < 3; v++) {
 		const int after = v > 0;
 		def.after_start = after;
-		def.after_trials = v == 2 ? A : 0;
+		def.after_trials = v == 2 ? A : after ? 0 : -1; /* -1: none to continue */
 		bsim_markov_set set;
 		bsim_error err;
 		assert_int_equal(bsim_markov_build(&s, &def, dir, &set, &err), BSIM_OK);
@@ -1738,6 +1738,13 @@ static void test_bad_inputs(void **state)
 	         "--per-crossing -1: expected an integer 0 to 1000000"},
 	        {{"markov", "build", essay, "--after-trials", "-1", "--out", target, NULL},
 	         "--after-trials -1: expected an integer 0 to 1000000"},
+	        {{"markov", "build", essay, "--after-start", "0", "--after-trials", "4000", "--out",
+	          target, NULL},
+	         "start trials continued after the start (4000): maps without the gate after the "
+	         "start (after_start 0) have none to continue"},
+	        {{"markov", "build", essay, "--entries", "self", "--after-trials", "0", "--out",
+	          target, NULL},
+	         "(self or flow entries) have none to continue"},
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
 		char *err = NULL;
@@ -2192,6 +2199,71 @@ static char *maps_of(const char *dir)
 	return both;
 }
 
+/* The speed bins' range by default is the propulsion's (40 m/s at 7 N on
+ * 1 kg and below, in proportion above): a lattice at 14 N gets 80 m/s, its
+ * maps those of --vmax 80 file for file, and the directory says 0 (from
+ * the propulsion), so a lattice of another force reads it with its own;
+ * at 7 N the maps of --vmax 40, the range before. */
+static void test_speed_range(void **state)
+{
+	(void)state;
+	const bsim_markov_bins dflt = bsim_markov_bins_default(), given = {2, 2, 2, 55.0};
+	const double force[4] = {3.5, 7.0, 14.0, 21.0}, want[4] = {40.0, 40.0, 80.0, 120.0};
+	for (int i = 0; i < 4; i++) {
+		bsim_scene s;
+		assert_int_equal(bsim_lattice_scene_init(&s, 1, 2, force[i], 25), BSIM_OK);
+		assert_double_equal(bsim_markov_bins_v_max(&dflt, &s), want[i], 1e-12);
+		assert_double_equal(bsim_markov_bins_v_max(&given, &s), 55.0, 0.0);
+		s.body.mass = 2.0; /* the acceleration, not the force */
+		assert_double_equal(bsim_markov_bins_v_max(&dflt, &s), fmax(40.0, want[i] / 2),
+		                    1e-12);
+		bsim_scene_free(&s);
+	}
+	const char *dir = exe_dir("speed_range");
+	const double vmax[3] = {0.0, 80.0, 40.0};
+	for (int f = 0; f < 2; f++) {
+		char own[1100], at80[1100], at40[1100];
+		snprintf(own, sizeof own, "%s/own%d", dir, f);
+		snprintf(at80, sizeof at80, "%s/vmax80_%d", dir, f);
+		snprintf(at40, sizeof at40, "%s/vmax40_%d", dir, f);
+		const char *dirs[3] = {own, at80, at40};
+		bsim_scene s;
+		assert_int_equal(bsim_lattice_scene_init(&s, 1, 2, f ? 14.0 : 7.0, 25), BSIM_OK);
+		s.lattice.protocol = BSIM_PROTOCOL_ESSAY;
+		char *maps[3];
+		for (int v = 0; v < 3; v++) {
+			bsim_markov_def def = bsim_markov_def_default();
+			def.bins = (bsim_markov_bins){2, 2, 2, vmax[v]};
+			def.trials = 3;
+			def.start_trials = 20;
+			def.train_trials = 30;
+			def.seed = 4;
+			bsim_markov_set set;
+			bsim_error err;
+			assert_int_equal(bsim_markov_build(&s, &def, dirs[v], &set, &err), BSIM_OK);
+			assert_double_equal(set.def.bins.v_max, v ? vmax[v] : f ? 80.0 : 40.0, 0.0);
+			bsim_markov_set_free(&set);
+			maps[v] = maps_of(dirs[v]);
+			if (v == 0) { /* read back with this lattice's range */
+				bsim_options opts;
+				assert_int_equal(bsim_markov_load(&s, own, &opts, &set, &err),
+				                 BSIM_OK);
+				assert_double_equal(set.def.bins.v_max, f ? 80.0 : 40.0, 0.0);
+				bsim_markov_set_free(&set);
+				char *json = bsim_test_read(bsim_test_join(own, "markov.json"));
+				assert_non_null(strstr(json, "\"v_max\": 0}"));
+				free(json);
+			}
+		}
+		/* 14 N: --vmax 80's maps, not 40's; 7 N: 40's, not 80's */
+		assert_string_equal(maps[0], maps[f ? 1 : 2]);
+		assert_string_not_equal(maps[0], maps[f ? 2 : 1]);
+		for (int v = 0; v < 3; v++)
+			free(maps[v]);
+		bsim_scene_free(&s);
+	}
+}
+
 /* Flow-weighted entries (--entries flow:N) on a column of two gates of
  * different stiffness pairs: the maps are the same with 1 and 2 threads;
  * each pass-1 state of a bin is the exit state of a pass-0 single gate of
@@ -2472,6 +2544,64 @@ static void test_interrupted_build(void **state)
 	free(want);
 }
 
+/* The validation's last trial sets the stop flag, as a signal would:
+ * the maps' resamples that follow stop at the first (each a chain solve,
+ * a minute's work on a field of many gates), BSIM_ESTOPPED with the trials
+ * journaled and nothing else written; resumed, the run ends as one never
+ * stopped. */
+static void stop_at_last_trial(void *user, long done, long total)
+{
+	if (done == total)
+		*(volatile sig_atomic_t *)user = 1;
+}
+
+static void test_validation_stopped_in_resamples(void **state)
+{
+	(void)state;
+	char maps[1024], dir[1100], whole[1100], exp[1200];
+	snprintf(maps, sizeof maps, "%s", bsim_test_dir("stopped_maps"));
+	snprintf(dir, sizeof dir, "%s/stopped", maps);
+	snprintf(whole, sizeof whole, "%s/whole", maps);
+	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
+	const char *build[] = {
+	        "markov", "build",   exp, "--bins",  "4,4,3", "--trials", "10", "--start-trials",
+	        "10",     "--train", "0", "--quiet", "--out", maps,       NULL};
+	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
+	static volatile sig_atomic_t flag;
+	flag = 0;
+	bsim_markov_validate_def def = bsim_markov_validate_def_default();
+	def.experiment = exp;
+	def.map_dir = maps;
+	def.trials = 30;
+	def.bootstrap = 50;
+	def.threads = 2;
+	def.out = dir;
+	def.progress = stop_at_last_trial;
+	def.progress_user = (void *)&flag;
+	def.stop = &flag;
+	bsim_markov_validation v, w;
+	bsim_error err;
+	assert_int_equal(bsim_markov_validate(&def, &v, &err), BSIM_ESTOPPED);
+	assert_non_null(strstr(err.msg, "stopped in the maps' resample 1 of 40"));
+	assert_true(v.journal[0] && bsim_test_exists(v.journal));
+	assert_false(bsim_test_exists(bsim_test_join(dir, "validate.json")));
+	def.progress = NULL;
+	flag = 0;
+	def.resume = 1;
+	assert_int_equal(bsim_markov_validate(&def, &v, &err), BSIM_OK);
+	def.resume = 0;
+	def.out = whole;
+	assert_int_equal(bsim_markov_validate(&def, &w, &err), BSIM_OK);
+	assert_int_equal(v.n, w.n);
+	for (int i = 0; i < v.n; i++) {
+		assert_double_equal(v.checks[i].tv, w.checks[i].tv, 0.0);
+		assert_double_equal(v.checks[i].tv_sampling, w.checks[i].tv_sampling, 0.0);
+		assert_double_equal(v.checks[i].tv_map, w.checks[i].tv_map, 0.0);
+	}
+	bsim_markov_validation_free(&v);
+	bsim_markov_validation_free(&w);
+}
+
 /* ctest runs the long tests (against direct simulation, and a build
  * stopped by signals) as test_markov_long, `test_markov long`, each with
  * its own time limit; any other argument runs the tests of that name. */
@@ -2491,6 +2621,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_training_kinds),
 	        cmocka_unit_test(test_crossings_are_single_gates),
 	        cmocka_unit_test(test_start_trials_key),
+	        cmocka_unit_test(test_speed_range),
 	        cmocka_unit_test(test_threads_and_cache),
 	        cmocka_unit_test(test_entries),
 	        cmocka_unit_test(test_self_entries),
@@ -2505,6 +2636,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_after_start_against_simulation),
 	        cmocka_unit_test(test_training_against_simulation),
 	        cmocka_unit_test(test_interrupted_build),
+	        cmocka_unit_test(test_validation_stopped_in_resamples),
 	};
 	if (argc > 1 && strcmp(argv[1], "long") == 0)
 		return cmocka_run_group_tests_name("markov_long", long_tests, NULL, NULL);

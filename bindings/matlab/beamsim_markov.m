@@ -38,7 +38,8 @@
 %                    'trials' (default 5); 0: every bin topped up to 'trials'
 %     'bins'         [P S D], bins of position, speed and direction
 %                    (default [14 6 13])
-%     'vmax'         m/s, the top of the speed bins (default 40)
+%     'vmax'         m/s, the top of the speed bins (default: 40, or F_prop/M x 40/7 s
+%                    where that is more)
 %     'entries'      gate_entries.csv paths (a text or a cell of texts), or
 %                    'self', 'self:N', 'flow', 'flow:N' (docs/markov.md)
 %     'seed', 'threads', 'backend', 'backend_opt', 'set', 'grid'

@@ -89,7 +89,7 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 	if (bins_o != Py_None && !PyArg_ParseTuple(bins_o, "iii", &def.map.bins.n_pos,
 	                                           &def.map.bins.n_speed, &def.map.bins.n_dir))
 		return NULL;
-	if (vmax != 0.0) /* 0: the default; the library refuses one <= 0 */
+	if (vmax != 0.0) /* 0: the default, from the propulsion; the library refuses one < 0 */
 		def.map.bins.v_max = vmax;
 	if (trials > 0)
 		def.map.trials = trials;

@@ -69,15 +69,30 @@ extern "C" {
 /* The entry-state bins. */
 typedef struct bsim_markov_bins {
 	int n_pos, n_speed, n_dir;
-	double v_max; /* m/s: speeds above it fall in the last speed bin */
+	/* m/s: speeds above it fall in the last speed bin; 0 (the default):
+	 * from the lattice's propulsion, bsim_markov_bins_v_max */
+	double v_max;
 } bsim_markov_bins;
 
-/* 14 positions, 6 speeds up to 40 m/s, 13 directions: where in a bin a
+/* 14 positions, 6 speeds up to v_max, 13 directions: where in a bin a
  * lattice's entries fall matters to where the body goes next, above all
  * their position and direction, so the bins are fine, and their states
  * drawn from a training field's entries, so that maps of a physics
  * predict fields of any layout (docs/markov.md, "Maps of a physics"). */
 BSIM_API bsim_markov_bins bsim_markov_bins_default(void);
+
+/* The speed range by default: BSIM_MARKOV_V_MAX, or the propulsion's
+ * acceleration F_prop / M times BSIM_MARKOV_V_MAX_TIME where that is more.
+ * The speeds bodies enter gates at grow in proportion to the propulsion
+ * (the training field's 90th percentile 31 m/s at 7 N, 62 m/s at 14 N),
+ * and those above v_max share one bin, whatever their speed
+ * (docs/markov.md, "A speed range from the propulsion"). */
+#define BSIM_MARKOV_V_MAX      40.0         /* m/s */
+#define BSIM_MARKOV_V_MAX_TIME (40.0 / 7.0) /* s: 40 m/s at 7 N on 1 kg */
+
+/* The speed range of bins b for a lattice: b->v_max, or where that is 0,
+ * the default above from the lattice's propulsion and body mass. */
+BSIM_API double bsim_markov_bins_v_max(const bsim_markov_bins *b, const bsim_scene *lattice);
 
 /* The number of entry bins, the start's included: 1 + 4 n_pos n_speed n_dir. */
 BSIM_API int bsim_markov_bins_count(const bsim_markov_bins *b);
@@ -168,8 +183,9 @@ typedef struct bsim_markov_def {
 	 * entries (self and flow entries: 0). */
 	int after_start;
 	/* With the gate after the start: the first after_trials of the start
-	 * bin's single gates are continued (default BSIM_MARKOV_AFTER_TRIALS;
-	 * <= 0 or start_trials and more: every one). The chain takes a body's
+	 * bin's single gates are continued (-1, the default:
+	 * BSIM_MARKOV_AFTER_TRIALS; 0 or start_trials and more: every one; set
+	 * without the gate after the start: refused). The chain takes a body's
 	 * second gate from those continuations that entered the same gate,
 	 * pooled, for every start trial that entered it: the start's own exits
 	 * keep all start_trials, and the gate after them an unbiased sample of
@@ -718,7 +734,8 @@ typedef struct bsim_markov_validate_def {
 	const char *resume_option;    /* as bsim_sweep_dir_def's (NULL: "--resume") */
 	const char *overwrite_option; /* as bsim_sweep_dir_def's (NULL: "--overwrite") */
 	/* NULL, or a flag (a signal handler's): once nonzero no trial starts,
-	 * and the run returns BSIM_ESTOPPED with the journal kept. */
+	 * nor another of the maps' resamples, and the run returns
+	 * BSIM_ESTOPPED with the journal kept. */
 	const volatile sig_atomic_t *stop;
 	/* Spread over processes (beamsim/sweep_dir.h, docs/cluster.md): a
 	 * shard writes a part directory into out, an MPI rank other than 0

@@ -9,7 +9,16 @@ static const double PI = 3.14159265358979323846;
 
 bsim_markov_bins bsim_markov_bins_default(void)
 {
-	return (bsim_markov_bins){.n_pos = 14, .n_speed = 6, .n_dir = 13, .v_max = 40.0};
+	return (bsim_markov_bins){.n_pos = 14, .n_speed = 6, .n_dir = 13, .v_max = 0.0};
+}
+
+double bsim_markov_bins_v_max(const bsim_markov_bins *b, const bsim_scene *lattice)
+{
+	if (b->v_max > 0)
+		return b->v_max;
+	const bsim_effects_def *e = &lattice->effects;
+	const double a = e->has_propulsion ? fabs(e->propulsion_force) / lattice->body.mass : 0.0;
+	return fmax(BSIM_MARKOV_V_MAX, a * BSIM_MARKOV_V_MAX_TIME);
 }
 
 int bsim_markov_bins_count(const bsim_markov_bins *b)

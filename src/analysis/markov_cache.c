@@ -927,12 +927,13 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	if (rc == BSIM_OK)
 		rc = def_int(&d, "/bins/direction", 1, 64, &def->bins.n_dir, err);
 	if (rc == BSIM_OK) {
-		struct fy_node *n = def_field(&d, "/bins/v_max", "a speed > 0, m/s", err);
+		/* 0: each lattice's from its propulsion (bsim_markov_bins_v_max) */
+		static const char speed[] = "a speed > 0, m/s, or 0 (from the propulsion)";
+		struct fy_node *n = def_field(&d, "/bins/v_max", speed, err);
 		rc = !n ? BSIM_EINPUT
 		     : bsim_ydoc_number(n, &def->bins.v_max) != YDOC_NUM_OK ||
-		                     !(def->bins.v_max > 0)
-		             ? bsim_ydoc_expected(&d, n, NULL, "bins/v_max", "a speed > 0, m/s",
-		                                  err)
+		                     !(def->bins.v_max >= 0) || !isfinite(def->bins.v_max)
+		             ? bsim_ydoc_expected(&d, n, NULL, "bins/v_max", speed, err)
 		             : BSIM_OK;
 	}
 	if (rc == BSIM_OK)
@@ -978,8 +979,9 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	if (rc == BSIM_OK &&
 	    fy_node_by_path(fy_document_root(d.fyd), "/after_start", -1, FYNWF_DONT_FOLLOW))
 		rc = def_int(&d, "/after_start", 0, 1, &def->after_start, err);
-	/* absent in maps built before fewer were continued: every start trial */
-	def->after_trials = 0;
+	/* absent in maps built before fewer were continued: every start trial
+	 * (without the gate after the start: none to continue, the default) */
+	def->after_trials = def->after_start ? 0 : -1;
 	if (rc == BSIM_OK &&
 	    fy_node_by_path(fy_document_root(d.fyd), "/after_trials", -1, FYNWF_DONT_FOLLOW))
 		rc = def_int(&d, "/after_trials", 1, 1000000, &def->after_trials, err);

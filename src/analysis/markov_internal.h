@@ -70,11 +70,13 @@ static inline int bsim_markov_def_after_start(const bsim_markov_def *def)
 }
 
 /* The start trials def's maps continue in the gate after the start, the
- * first ones: after_trials, or every start trial. */
+ * first ones: after_trials (-1: BSIM_MARKOV_AFTER_TRIALS), or every start
+ * trial. */
 static inline int bsim_markov_def_after_trials(const bsim_markov_def *def)
 {
 	const int T = bsim_markov_def_start_trials(def);
-	return def->after_trials > 0 && def->after_trials < T ? def->after_trials : T;
+	const int A = def->after_trials < 0 ? BSIM_MARKOV_AFTER_TRIALS : def->after_trials;
+	return A > 0 && A < T ? A : T;
 }
 
 /* The single gates of entry bin a of map m, and the index of its first

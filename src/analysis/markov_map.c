@@ -28,7 +28,7 @@ bsim_markov_def bsim_markov_def_default(void)
 	                         .train_crossings = -1,
 	                         .trials_per_crossing = BSIM_MARKOV_TRIALS_PER_CROSSING,
 	                         .after_start = 1,
-	                         .after_trials = BSIM_MARKOV_AFTER_TRIALS,
+	                         .after_trials = -1,
 	                         .seed = 1};
 }
 
@@ -82,9 +82,11 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 	bsim_error why;
 	if (bsim_markov_bins_check(b, &why) != BSIM_OK)
 		return bsim_error_set(err, BSIM_EINPUT, "bins: %s", why.msg);
-	if (!(b->v_max > 0) || !isfinite(b->v_max))
+	if (!(b->v_max >= 0) || !isfinite(b->v_max))
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "bins: v_max %g: expected a speed > 0 in m/s", b->v_max);
+		                      "bins: v_max %g: expected a speed > 0 in m/s (0: from the "
+		                      "propulsion)",
+		                      b->v_max);
 	if (def->self_entries && (def->entries || def->self_entries > 2 || def->self_passes < 0 ||
 	                          def->self_passes > BSIM_MARKOV_SELF_PASSES_MAX))
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -130,11 +132,18 @@ static int def_check(const bsim_markov_def *def, bsim_error *err)
 		                      "crossings: expected -1 (where a training field), 0 or 1, "
 		                      "got %d",
 		                      def->train_crossings);
-	if (def->after_trials < 0 || def->after_trials > 1000000)
+	if (def->after_trials < -1 || def->after_trials > 1000000)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "start trials continued after the start: expected 0 (every "
 		                      "one) to 1000000, got %d",
 		                      def->after_trials);
+	/* set where nothing continues them, it would be ignored without a word */
+	if (def->after_trials >= 0 && !bsim_markov_def_after_start(def))
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "start trials continued after the start (%d): maps without "
+		                      "the gate after the start (%s) have none to continue",
+		                      def->after_trials,
+		                      def->self_entries ? "self or flow entries" : "after_start 0");
 	if (def->trials_per_crossing < 0 || def->trials_per_crossing > 1000000)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "trials per crossing: expected 0 to 1000000, got %d",
@@ -197,11 +206,11 @@ const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t 
 	if (!def->after_start)
 		snprintf(part[3], sizeof part[3], "no gate after the start");
 	else if (bsim_markov_def_after_trials(def) <
-	         (d0.after_trials < bsim_markov_def_start_trials(def)
-	                  ? d0.after_trials
+	         (BSIM_MARKOV_AFTER_TRIALS < bsim_markov_def_start_trials(def)
+	                  ? BSIM_MARKOV_AFTER_TRIALS
 	                  : bsim_markov_def_start_trials(def)))
 		snprintf(part[3], sizeof part[3], "%d start trials continued (the default %d)",
-		         bsim_markov_def_after_trials(def), d0.after_trials);
+		         bsim_markov_def_after_trials(def), BSIM_MARKOV_AFTER_TRIALS);
 	char list[4 * 64 + 8] = "";
 	size_t len = 0;
 	for (int k = 0; k < 4; k++)
@@ -416,9 +425,13 @@ static int next_fill(const bsim_scene *lattice, const bsim_markov_def *def, cons
  * the others simulated into its stage and committed one by one (def->stop
  * is looked at between single gates); without, the first missing is an
  * error. */
-static int set_fill(const bsim_scene *lattice, const bsim_markov_def *def, const char *dir,
+static int set_fill(const bsim_scene *lattice, const bsim_markov_def *given, const char *dir,
                     bsim_session *ss, bsim_markov_set *out, bsim_error *err)
 {
+	/* the speed range of this lattice's physics: in every key and bin */
+	bsim_markov_def resolved = *given;
+	resolved.bins.v_max = bsim_markov_bins_v_max(&given->bins, lattice);
+	const bsim_markov_def *def = &resolved;
 	const char *stage = ss ? ss->stage : NULL;
 	const bsim_backend *be = def->backend ? def->backend : bsim_backend_default();
 	const bsim_options none = {0};

@@ -91,9 +91,11 @@ static void bootstrap_sim(gsl_rng *rng, const double *p, int n_loc, int trials, 
 }
 
 /* Mean TV between the chain of set and chains of its maps with each row
- * resampled multinomially (the same number of trials per bin). */
+ * resampled multinomially (the same number of trials per bin). A chain a
+ * resample, so stop (may be NULL) is looked at before each. */
 static int bootstrap_maps(gsl_rng *rng, const bsim_scene *scene, const bsim_markov_set *set,
-                          const bsim_markov_prediction *pred, int B, double *mean, bsim_error *err)
+                          const bsim_markov_prediction *pred, int B,
+                          const volatile sig_atomic_t *stop, double *mean, bsim_error *err)
 {
 	*mean = NAN;
 	if (B <= 0 || set->n == 0)
@@ -119,6 +121,14 @@ static int bootstrap_maps(gsl_rng *rng, const bsim_scene *scene, const bsim_mark
 	}
 	double s = 0.0;
 	for (int b = 0; rc == BSIM_OK && b < B; b++) {
+		if (stop && *stop) {
+			rc = bsim_error_set(
+			        err, BSIM_ESTOPPED,
+			        "stopped in the maps' resample %d of %d (their sampling "
+			        "error), the trials done",
+			        b + 1, B);
+			break;
+		}
 		/* each row resampled over its own exits: an exit it never had
 		 * has probability 0 */
 		for (int i = 0; i < set->n; i++) {
@@ -446,7 +456,8 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 	if (rc == BSIM_OK)
 		rc = time_predict(&scene, &set, &predict, err);
 	if (rc == BSIM_OK)
-		rc = bootstrap_maps(rng, &scene, &set, &d->pred, def->map_resamples, &tv_map, err);
+		rc = bootstrap_maps(rng, &scene, &set, &d->pred, def->map_resamples, def->stop,
+		                    &tv_map, err);
 	if (rc == BSIM_OK) {
 		/* the figure's title: the backend, the experiment's set:, the
 		 * command line's --set and the group's grid values */

@@ -218,7 +218,9 @@ static const cli_own build_own[] = {
         [OWN_BINS] = {"bins", 1, "P,S,D",
                       "entry bins of position along the edge, speed and\n"
                       "direction (default 14,6,13)"},
-        [OWN_VMAX] = {"vmax", 1, "V", "m/s, the top of the speed bins (default 40)"},
+        [OWN_VMAX] = {"vmax", 1, "V",
+                      "m/s, the top of the speed bins (default 40, or\n"
+                      "F_prop/M x 40/7 s where that is more)"},
         [OWN_ENTRIES] = {"entries", 1, "PATH",
                          "gate_entries.csv of a lattice sweep (or its directory),\n"
                          "repeatable: a bin's states are drawn from the entries\n"
