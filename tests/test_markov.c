@@ -1561,6 +1561,17 @@ static int kind_of(const char *loc)
 	return strncmp(loc, "end:", 4) == 0 ? 0 : strncmp(loc, "side:", 5) == 0 ? 1 : 2;
 }
 
+/* Maps of experiment exp into maps: 4,4,3 bins of 10 single gates, 10
+ * from the start, states uniform in each bin (with 3, most bins empty, the
+ * chain's map resamples take a minute). */
+static void build_small_maps(const char *exp, const char *maps)
+{
+	const char *build[] = {
+	        "markov", "build",   exp, "--bins",  "4,4,3", "--trials", "10", "--start-trials",
+	        "10",     "--train", "0", "--quiet", "--out", maps,       NULL};
+	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
+}
+
 /* markov predict --out and markov validate draw the final locations as
  * the field: the figure files are there and in the manifest, every cell's
  * value is the location's probability in the CSV the command writes (the
@@ -1577,16 +1588,11 @@ static void test_field_figures(void **state)
 	snprintf(vdir, sizeof vdir, "%s/validation", maps);
 	char exp[1200]; /* bsim_test_src's buffer is reused by the next call */
 	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
-	const char *build[] = {
-	        "markov", "build",   exp, "--bins",  "4,4,3", "--trials", "10", "--start-trials",
-	        "10",     "--train", "0", "--quiet", "--out", maps,       NULL};
-	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
+	build_small_maps(exp, maps);
 	const char *pred[] = {"markov", "predict", bsim_test_src("configs/lattice/c_track.yaml"),
 	                      "--map",  maps,      "--out",
 	                      pdir,     NULL};
 	assert_int_equal(bsim_test_cli(pred, NULL, NULL), 0);
-	/* maps of 10 trials a bin: with 3, most bins empty, the chain's map
-	 * resamples take a minute */
 	const char *val[] = {"markov",      "validate", exp,       "--map", maps, "--trials", "30",
 	                     "--bootstrap", "50",       "--quiet", "--out", vdir, NULL};
 	char *err = NULL;
@@ -2563,10 +2569,7 @@ static void test_validation_stopped_in_resamples(void **state)
 	snprintf(dir, sizeof dir, "%s/stopped", maps);
 	snprintf(whole, sizeof whole, "%s/whole", maps);
 	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/c_track.yaml"));
-	const char *build[] = {
-	        "markov", "build",   exp, "--bins",  "4,4,3", "--trials", "10", "--start-trials",
-	        "10",     "--train", "0", "--quiet", "--out", maps,       NULL};
-	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
+	build_small_maps(exp, maps);
 	static volatile sig_atomic_t flag;
 	flag = 0;
 	bsim_markov_validate_def def = bsim_markov_validate_def_default();
