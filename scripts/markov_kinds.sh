@@ -35,7 +35,12 @@
 # (by name), TRIALS=N the direct trials of each (default the experiments',
 # 10,000); DIRECT=N adds a row per field, direct-N: a direct simulation of
 # its own (N trials, seed 2) against the same validation, what the maps
-# are weighed against at that cost.
+# are weighed against at that cost. FORCE=F runs every field, build and
+# prediction at F_prop = F N (--grid / --set effects.propulsion.force=F;
+# an OUT of its own: the validations are named by field only); vmax40 is
+# the speed bins' range before it came from the propulsion (docs/markov.md,
+# "A speed range from the propulsion": FORCE=14 TRIALS=40000
+# METHODS="default vmax40").
 #   scripts/markov_kinds.sh [OUT] [THREADS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -43,6 +48,11 @@ out=${1:-out/markov-kinds}
 threads=${2:-2}
 exe=build/beamsim
 fields=(${FIELDS:-ring5 check11 test_r7 test_rows9 test_r21a test_r21b fresh_r13 fresh_cols9 fresh_r21})
+grid=() set=()
+if [ -n "${FORCE:-}" ]; then
+    grid=(--grid "effects.propulsion.force=$FORCE")
+    set=(--set "effects.propulsion.force=$FORCE")
+fi
 # method name and its build options (the default: none); uniform, the
 # default before, and each of its three parts (fine bins, many start
 # trials, the gate after the start) alone and without the others; flow:1;
@@ -74,7 +84,8 @@ methods=("default:"
          "no-after:--after-start 0"
          "start4000-no-after:--start-trials 4000 --after-start 0"
          "train3000-no-after:--train 3000 --start-trials 6000 --after-start 0 --trials 20"
-         "train2000:--train 2000")
+         "train2000:--train 2000"
+         "vmax40:--vmax 40")
 if [ -n "${METHODS:-}" ]; then
     chosen=()
     for m in "${methods[@]}"; do
@@ -115,16 +126,16 @@ for f in "${fields[@]}"; do
         read -r -a opts <<<"${m#*:}"
         maps=$out/maps-$name
         [ "$name" = flow1 ] && maps=$out/maps-flow1-$f
-        log=$($exe markov build "$exp" "${opts[@]}" --threads "$threads" --out "$maps" 2>&1 | grep -E '^[0-9]+ maps? built' || true)
+        log=$($exe markov build "$exp" "${opts[@]}" "${grid[@]}" --threads "$threads" --out "$maps" 2>&1 | grep -E '^[0-9]+ maps? built' || true)
         # the maps' CPU: what the builds into that directory took (a build
         # that reuses every map adds nothing)
         echo "$log" | sed -n 's/.*built (\([0-9.]*\) s of CPU).*/\1/p' >>"$maps.cpu"
         [ -f "$v/validate.json" ] ||
-            $exe markov validate "$exp" --map "$maps" ${TRIALS:+--trials "$TRIALS"} \
+            $exe markov validate "$exp" --map "$maps" ${TRIALS:+--trials "$TRIALS"} "${grid[@]}" \
                 --threads "$threads" --quiet --out "$v"
         p=$out/predict-$name-$f
-        $exe markov predict configs/markov/kinds/field_$f.yaml --map "$maps" --walks 0 --quiet \
-            --overwrite --out "$p"
+        $exe markov predict configs/markov/kinds/field_$f.yaml --map "$maps" "${set[@]}" --walks 0 \
+            --quiet --overwrite --out "$p"
         cpu=$(awk '{ s += $1 } END { printf "%.1f", s }' "$maps.cpu")
         samp=$(grep '"protocol": "essay"' "$v/validate.json" | sed -E 's/.*"tv_sampling": ([0-9.]*).*/\1/')
         printf '%-20s %-11s %6s %6s %9.3f %9s %s\n' "$name" "$f" "$(tv "$p/prediction.csv" "$v/validate.csv" essay)" \
@@ -133,7 +144,7 @@ for f in "${fields[@]}"; do
     if [ -n "${DIRECT:-}" ]; then
         d=$out/direct$DIRECT-$f
         [ -f "$d/validate.json" ] ||
-            $exe markov validate "$exp" --map "$maps" --trials "$DIRECT" --seed 2 \
+            $exe markov validate "$exp" --map "$maps" --trials "$DIRECT" --seed 2 "${grid[@]}" \
                 --threads "$threads" --quiet --out "$d"
         samp=$(grep '"protocol": "essay"' "$v/validate.json" | sed -E 's/.*"tv_sampling": ([0-9.]*).*/\1/')
         printf '%-20s %-11s %6s %6s %9.3f\n' "direct-$DIRECT" "$f" \
