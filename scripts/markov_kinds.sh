@@ -29,8 +29,9 @@
 # start trials, per_* after the default's 5 single gates a crossing, pool_*
 # after the default's training field of 4,000 trials and its first 8,000
 # start trials continued (train10k: the default before), spd_* after the
-# speed bins' range from the propulsion (name them in FIELDS). Prints one row per method and field;
-# the runs stay in OUT (default out/markov-kinds), the table in
+# speed bins' range from the propulsion (name them in FIELDS). Prints one
+# row per method and field; the runs stay in OUT (default
+# out/markov-kinds), the table in
 # OUT/table.txt. FIELDS="..." chooses the fields, METHODS="..." the methods
 # (by name), TRIALS=N the direct trials of each (default the experiments',
 # 10,000); DIRECT=N adds a row per field, direct-N: a direct simulation of
