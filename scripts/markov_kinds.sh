@@ -29,7 +29,8 @@
 # start trials, per_* after the default's 5 single gates a crossing, pool_*
 # after the default's training field of 4,000 trials and its first 8,000
 # start trials continued (train10k: the default before), spd_* after the
-# speed bins' range from the propulsion (name them in FIELDS). Prints one
+# speed bins' range from the propulsion, hi_* after its measurement at
+# 14 N (name them in FIELDS). Prints one
 # row per method and field; the runs stay in OUT (default
 # out/markov-kinds), the table in
 # OUT/table.txt. FIELDS="..." chooses the fields, METHODS="..." the methods
