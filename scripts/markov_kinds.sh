@@ -42,7 +42,10 @@
 # an OUT of its own: the validations are named by field only); vmax40 is
 # the speed bins' range before it came from the propulsion (docs/markov.md,
 # "A speed range from the propulsion": FORCE=14 TRIALS=40000
-# METHODS="default vmax40").
+# METHODS="default vmax40"); per-crossing1-3 top a bin up to fewer single
+# gates a crossing ("Fewer single gates a crossing at 7 N"). The other_*
+# fields are of a physics of their own (gate kinds D, E and G, F_prop = 8
+# N, Rm = 20 N; "A held-out physics"): run them without FORCE.
 #   scripts/markov_kinds.sh [OUT] [THREADS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -87,7 +90,10 @@ methods=("default:"
          "start4000-no-after:--start-trials 4000 --after-start 0"
          "train3000-no-after:--train 3000 --start-trials 6000 --after-start 0 --trials 20"
          "train2000:--train 2000"
-         "vmax40:--vmax 40")
+         "vmax40:--vmax 40"
+         "per-crossing1:--per-crossing 1"
+         "per-crossing2:--per-crossing 2"
+         "per-crossing3:--per-crossing 3")
 if [ -n "${METHODS:-}" ]; then
     chosen=()
     for m in "${methods[@]}"; do
