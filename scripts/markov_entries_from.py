@@ -12,65 +12,29 @@ through one edge must have neighbours of one kind there; the entries kept
 the start's. Maps built on them (`markov build LAYOUT --entries OUT`) draw
 each bin's states from entries out of the neighbours the layout has, as
 maps split by the neighbour a body came from would for it. The kinds are
-stiffness pairs (left, right) given as flow lists in the scene file
-(`stiffness_left:` and `stiffness_right:`, a row `- [...]` a line, row 0
-first); the columns centred on the start's (ix from -(columns // 2)).
-Exit status 2 on a field it cannot read or a layout without one
-neighbour kind per gate kind and edge.
+stiffness pairs (left, right), read as lattice_field.py says. Exit status
+2 on a field it cannot read or a layout without one neighbour kind per gate
+kind and edge.
 """
 import csv
 import os
 import sys
 
-EDGES = {"bottom": (0, -1), "top": (0, 1), "left": (-1, 0), "right": (1, 0)}
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from lattice_field import EDGES, Field  # noqa: E402
+
+SCRIPT = "markov_entries_from.py"
 
 
 def fail(msg):
-    print(f"markov_entries_from.py: {msg}", file=sys.stderr)
+    print(f"{SCRIPT}: {msg}", file=sys.stderr)
     sys.exit(2)
-
-
-def grid(path, key):
-    rows, inside = [], False
-    with open(path) as f:
-        for n, line in enumerate(f, 1):
-            s = line.strip()
-            if s == key + ":":
-                inside = True
-            elif inside and s.startswith("- ["):
-                try:
-                    rows.append([float(v) for v in s[3:s.index("]")].split(",")])
-                except ValueError:
-                    fail(f"{path}:{n}: {key}: expected a row of numbers, got {s!r}")
-            elif inside:
-                break
-    if not rows or len({len(r) for r in rows}) != 1:
-        fail(f"{path}: {key}: expected rows of stiffnesses as flow lists, one a line")
-    return rows
-
-
-class Field:
-    def __init__(self, path):
-        self.left, self.right = grid(path, "stiffness_left"), grid(path, "stiffness_right")
-        if len(self.left) != len(self.right) or len(self.left[0]) != len(self.right[0]):
-            fail(f"{path}: stiffness_left and stiffness_right differ in size")
-        self.rows, self.half = len(self.left), len(self.left[0]) // 2
-
-    def kind(self, ix, iy):
-        c = ix + self.half
-        if 0 <= iy < self.rows and 0 <= c < len(self.left[0]):
-            return (self.left[iy][c], self.right[iy][c])
-        return None
-
-    def came_from(self, ix, iy, edge):
-        dx, dy = EDGES[edge]
-        return self.kind(ix + dx, iy + dy)
 
 
 def main():
     if len(sys.argv) != 5:
         fail("usage: markov_entries_from.py TRAIN_FIELD LAYOUT_FIELD ENTRIES OUT")
-    train, layout = Field(sys.argv[1]), Field(sys.argv[2])
+    train, layout = Field(sys.argv[1], SCRIPT), Field(sys.argv[2], SCRIPT)
     want = {}
     for iy in range(layout.rows):
         for ix in range(-layout.half, layout.half + 1):
@@ -92,7 +56,8 @@ def main():
                 w.writeheader()
             total += 1
             edge, ix, iy = row["edge"], int(row["ix"]), int(row["iy"])
-            if edge in EDGES and want.get((train.kind(ix, iy), edge)) != train.came_from(ix, iy, edge):
+            came = train.came_from(ix, iy, edge) if edge in EDGES else None
+            if edge in EDGES and want.get((train.kind(ix, iy), edge)) != came:
                 continue
             w.writerow(row)
             kept += 1
