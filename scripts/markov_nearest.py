@@ -34,11 +34,12 @@ bottom, as in the chain. The walks are seeded (--seed): the same numbers on
 every run.
 
 DIR/prediction.csv: location, p, walks; DIR/tv.json: the training sweeps'
-CPU time and the walks', and with --validate VDIR (`markov validate` of
-FIELD) the total variation from its simulation under each protocol (also
-printed) and the walks' own sampling error. Needs NumPy and SciPy
-(scripts/deps.sh). Exit status 2 on bad input, 1 if a walk is still in the
-field after 10,000 gates.
+CPU time and the walks', the visits, those stuck, the gates entered on the
+training fields' edges by their exits (visits() says why), and with
+--validate VDIR (`markov validate` of FIELD) the total variation from its
+simulation under each protocol (also printed) and the walks' own sampling
+error. Needs NumPy and SciPy (scripts/deps.sh). Exit status 2 on bad input,
+1 if a walk is still in the field after 10,000 gates.
 """
 import argparse
 import csv
@@ -174,9 +175,13 @@ def sweep_training(args, field, phys):
     return dirs
 
 
-def visits(dirs, phys):
+def visits(dirs, phys, on_edge):
     """(kind, edge) -> (features, exits) and kind -> start exits; an exit is
-    "stuck" or (edge, pos, vx, vy)."""
+    "stuck" or (edge, pos, vx, vy). on_edge counts the gates entered on the
+    training fields' edges (the last row, the outer columns) by what is
+    known of their exits: a gate there whose exit left the field is no
+    visit, while one stuck there is, so the visits kept there are stuck
+    more often than all of them were."""
     pool, starts = defaultdict(lambda: ([], [])), defaultdict(list)
     for d in dirs:
         field = Field(os.path.join(d, "field.yaml"), SCRIPT)
@@ -192,6 +197,7 @@ def visits(dirs, phys):
             location, steps = end[key]
             for j, e in enumerate(es):
                 ix, iy = int(e["ix"]), int(e["iy"])
+                edge_gate = iy == field.rows - 1 or abs(ix) == field.half
                 if j + 1 < len(es):
                     n = es[j + 1]
                     out = (n["edge"], float(n["pos"]), float(n["vx"]), float(n["vy"]))
@@ -199,7 +205,9 @@ def visits(dirs, phys):
                       steps - int(e["step"]) >= phys.gate_steps):
                     out = "stuck"
                 else:
+                    on_edge["exit unknown"] += edge_gate
                     continue
+                on_edge["stuck" if out == "stuck" else "left"] += edge_gate
                 k = field.kind(ix, iy)
                 if e["edge"] == "start":
                     starts[k].append(out)
@@ -295,11 +303,14 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     dirs = sweep_training(args, field, phys)
     c0 = time.process_time()
-    pool, starts = visits(dirs, phys)
+    on_edge = defaultdict(int)
+    pool, starts = visits(dirs, phys, on_edge)
     count = walk(field, phys, pool, starts, args.k, args.walks, args.seed)
     p = {x: n / args.walks for x, n in count.items()}
     result = {"walks": args.walks, "k": args.k, "training_trials": args.trials * len(dirs),
               "visits": sum(len(v[1]) for v in pool.values()),
+              "visits_stuck": sum(o == "stuck" for v in pool.values() for o in v[1]),
+              "on_training_edge": dict(on_edge),
               "training_cpu_seconds": sum(float(open(os.path.join(d, "cpu_seconds")).read())
                                           for d in dirs),
               "walk_cpu_seconds": time.process_time() - c0,
