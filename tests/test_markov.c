@@ -2367,7 +2367,10 @@ static void test_flow_entries(void **state)
  * "Maps of a physics"): every experiment there loads, simulates its field
  * under the physics the docs give (F_prop = 7 N, Rm = 25 N), and every
  * gate of its field is of kind A = (150, 600), B = (600, 300) or C = (300,
- * 150) N m/rad; the training field alone under the essay's protocol. */
+ * 150) N m/rad; those of the held-out physics (other_*, "A held-out
+ * physics") at F_prop = 8 N, Rm = 20 N, of kind D = (200, 500), E = (700,
+ * 250) or G = (400, 120); the training fields alone under the essay's
+ * protocol. */
 static void test_kinds_configs(void **state)
 {
 	(void)state;
@@ -2375,8 +2378,10 @@ static void test_kinds_configs(void **state)
 	snprintf(dir, sizeof dir, "%s", bsim_test_src("configs/markov/kinds"));
 	DIR *d = opendir(dir);
 	assert_non_null(d);
-	const double kind[3][2] = {{150, 600}, {600, 300}, {300, 150}};
-	int n_exp = 0;
+	const double kinds[2][3][2] = {{{150, 600}, {600, 300}, {300, 150}},
+	                               {{200, 500}, {700, 250}, {400, 120}}};
+	const double force[2] = {7.0, 8.0}, magnitude[2] = {25.0, 20.0};
+	int n_exp = 0, n_other = 0;
 	struct dirent *de;
 	while ((de = readdir(d))) {
 		if (strncmp(de->d_name, "exp_", 4) != 0)
@@ -2391,9 +2396,14 @@ static void test_kinds_configs(void **state)
 		bsim_scene s;
 		assert_int_equal(bsim_experiment_group_scene(&e, 0, NULL, 0, &s, &err), BSIM_OK);
 		assert_true(s.has_lattice);
-		assert_true(s.effects.has_propulsion && s.effects.propulsion_force == 7.0);
-		assert_true(s.effects.has_random_force && s.effects.random_magnitude == 25.0);
-		const int train = strcmp(de->d_name, "exp_train_r21.yaml") == 0;
+		const int other = strncmp(de->d_name, "exp_other_", 10) == 0;
+		const double(*kind)[2] = kinds[other];
+		n_other += other;
+		assert_true(s.effects.has_propulsion && s.effects.propulsion_force == force[other]);
+		assert_true(s.effects.has_random_force &&
+		            s.effects.random_magnitude == magnitude[other]);
+		const int train = strcmp(de->d_name, "exp_train_r21.yaml") == 0 ||
+		                  strcmp(de->d_name, "exp_other_train.yaml") == 0;
 		assert_int_equal(s.lattice.protocol,
 		                 train ? BSIM_PROTOCOL_ESSAY : BSIM_PROTOCOL_WORLD);
 		for (int iy = 0; iy < s.lattice.rows; iy++)
@@ -2415,6 +2425,7 @@ static void test_kinds_configs(void **state)
 	}
 	closedir(d);
 	assert_true(n_exp >= 18);
+	assert_true(n_other >= 5);
 }
 
 /* The note on a method's scope names what keeps it from the maps of a
