@@ -25,13 +25,13 @@ def read(path, key, value):
 
 
 def test_walks_against_direct_simulation(tmp_path):
-    n_sim, n_walks = 4000, 20000
+    n_sim, n_walks = 2000, 20000
     cli("sweep", config("markov", "kinds", "exp_ring5.yaml"), "--trials", n_sim,
         "--set", "lattice.protocol=essay", "--threads", 2, "--quiet", "--out", tmp_path / "sim")
     sim = {}
     for loc in read(tmp_path / "sim" / "trials.csv", "trial", "location").values():
         sim[loc] = sim.get(loc, 0) + 1 / n_sim
-    p = nearest(RING, "--out", tmp_path / "nn", "--trials", 2000, "--walks", n_walks,
+    p = nearest(RING, "--out", tmp_path / "nn", "--trials", 1000, "--walks", n_walks,
                 "--threads", 2)
     assert p.returncode == 0, p.stderr
     nn = {k: float(v) for k, v in read(tmp_path / "nn" / "prediction.csv", "location",
@@ -47,7 +47,7 @@ def test_walks_against_direct_simulation(tmp_path):
 
 
 def test_same_seed_same_walks_and_training_reused(tmp_path):
-    args = (RING, "--train", tmp_path / "train", "--trials", 300, "--walks", 3000,
+    args = (RING, "--train", tmp_path / "train", "--trials", 200, "--walks", 3000,
             "--threads", 2)
     p1 = nearest(*args, "--out", tmp_path / "a")
     assert p1.returncode == 0, p1.stderr
