@@ -30,7 +30,10 @@ def grid(path, key, script):
     return rows
 
 
+# A gate's edges: where the neighbour across each lies, and (INWARD) the way
+# a body crossing it moves, the edge's inward normal.
 EDGES = {"bottom": (0, -1), "top": (0, 1), "left": (-1, 0), "right": (1, 0)}
+INWARD = {edge: (-dx, -dy) for edge, (dx, dy) in EDGES.items()}
 
 
 class Field:

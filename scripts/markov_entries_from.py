@@ -21,14 +21,13 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from lattice_field import EDGES, Field  # noqa: E402
+from lattice_field import EDGES, Field, fail as field_fail  # noqa: E402
 
 SCRIPT = "markov_entries_from.py"
 
 
 def fail(msg):
-    print(f"{SCRIPT}: {msg}", file=sys.stderr)
-    sys.exit(2)
+    field_fail(SCRIPT, msg)
 
 
 def main():
@@ -56,8 +55,8 @@ def main():
                 w.writeheader()
             total += 1
             edge, ix, iy = row["edge"], int(row["ix"]), int(row["iy"])
-            came = train.came_from(ix, iy, edge) if edge in EDGES else None
-            if edge in EDGES and want.get((train.kind(ix, iy), edge)) != came:
+            if edge in EDGES and (want.get((train.kind(ix, iy), edge)) !=
+                                  train.came_from(ix, iy, edge)):
                 continue
             w.writerow(row)
             kept += 1

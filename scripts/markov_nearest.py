@@ -57,14 +57,13 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from lattice_field import Field, fail as field_fail  # noqa: E402
+from lattice_field import INWARD, Field, fail as field_fail  # noqa: E402
 
 SCRIPT = "markov_nearest.py"
 TRAIN_SIZE = 21
 BINS = (14, 6, 13)  # the default bins: the distance's units
 V_MAX, V_MAX_TIME = 40.0, 40.0 / 7.0  # bsim_markov_bins_v_max
 MOST_GATES = 10000
-NORMAL = {"bottom": (0, 1), "left": (1, 0), "right": (-1, 0), "top": (0, -1)}
 
 
 def fail(msg):
@@ -102,7 +101,7 @@ class Physics:
         self.text = text
 
     def feature(self, edge, pos, vx, vy):
-        n = NORMAL[edge]
+        n = INWARD[edge]
         t = (abs(n[1]), abs(n[0]))
         lo, length = ((-0.5 * self.width, self.width) if edge in ("bottom", "top")
                       else (0.0, self.depth))
@@ -223,8 +222,8 @@ def walk(field, phys, pool, starts, k, n_walks, seed):
     rng = np.random.default_rng(seed)
 
     def leads(ix, iy, out):
-        edge, pos, vx, vy = out
-        dx, dy = {"bottom": (0, 1), "top": (0, -1), "left": (1, 0), "right": (-1, 0)}[edge]
+        edge, pos, vx, vy = out  # entering the next gate through `edge`
+        dx, dy = INWARD[edge]
         jx, jy = ix + dx, iy + dy
         if jy >= field.rows:
             return f"end:{ix}"
