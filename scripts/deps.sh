@@ -10,17 +10,17 @@ set -euo pipefail
 # python3-pytest: the Python module (bindings/python) and its tests; python3-venv,
 # python3-pip and python3-setuptools: `pip install .` of the module into a
 # virtual environment, and its test; python3-matplotlib: beamsim.plot and its
-# test; python3-scipy: the nearest-neighbour search of
-# scripts/markov_nearest.py and its test.
+# test.
 # libopenmpi-dev and openmpi-bin: the program's MPI build and its test under
 # mpirun (docs/cluster.md). octave and liboctave-dev (mkoctfile): the MEX
 # functions of bindings/matlab and their test. libchipmunk-dev: the chipmunk backend
-# (backends/chipmunk, Chipmunk2D 7).
+# (backends/chipmunk, Chipmunk2D 7). libnanoflann-dev: the exact k-d tree of
+# the Markov chain's nearest-neighbour walks (src/analysis/markov_kdtree.cpp).
 pkgs=(build-essential cmake pkg-config libgsl-dev libcmocka-dev libfyaml-dev libbox2d-dev
       libmatio-dev libchipmunk-dev gnuplot-nox fonts-dejavu-core libcairo2-dev ffmpeg zlib1g-dev
       clang libclang-rt-14-dev libomp-dev python3 chromium python3-dev python3-numpy
       python3-pytest python3-venv python3-pip python3-setuptools python3-matplotlib
-      python3-scipy libopenmpi-dev openmpi-bin
+      libnanoflann-dev libopenmpi-dev openmpi-bin
       octave liboctave-dev)
 missing=()
 for p in "${pkgs[@]}"; do

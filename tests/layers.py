@@ -108,6 +108,7 @@ PUBLIC = {
     "accuracy": "analysis",
     "essay_compare": "analysis",
     "landscape_barriers": "analysis",
+    "markov_nearest": "analysis",
     "markov": "analysis",
 }
 

@@ -1721,7 +1721,7 @@ static void test_bad_inputs(void **state)
 	        {{"markov", "build", essay, "--set", "termination.side_x=300", "--out", target,
 	          NULL},
 	         "termination.side_x: the chain needs the side boundary"},
-	        {{"markov", "predict", track, NULL}, "--map DIR is required"},
+	        {{"markov", "predict", track, NULL}, "expected one of --map DIR and --visits DIR"},
 	        {{"markov", "predict", track, "--map", dir, NULL}, "markov.json: cannot read"},
 	        {{"markov", "validate", essay, "--map", dir, "--out", target, NULL},
 	         "markov.json: cannot read"},

@@ -1,6 +1,7 @@
 /* The Box2D 2.4.1 backend ("box2d"): the model of docs/model.md sections
  * 2-5 built from Box2D's rigid bodies, joints and contacts, behind the C
- * interface of include/beamsim/backend.h. The only C++ in the project.
+ * interface of include/beamsim/backend.h. C++ as Box2D is (the k-d tree of
+ * src/analysis/markov_kdtree.cpp is the other C++ file).
  *
  * Units. Box2D works in float32 and prefers moving bodies of 0.1-10 units;
  * our body is 10 m and the beams 25 m. Every quantity is scaled by s (knob

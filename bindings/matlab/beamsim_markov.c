@@ -20,15 +20,18 @@
  * 'seed', 'threads', 'backend', 'backend_opt', 'set', 'grid'. b.maps is a struct array, a map each
  * (group from 1, k [left right] N m/rad, key its files' name, how 'built' or 'reused').
  *
- * predict's: 'map' (required), 'set', 'tol', 'gates' (true: the
- * distribution of gates visited; default: with 'out' only), 'walks',
- * 'out', 'overwrite'. p is what `markov predict --json` prints, decoded by
- * jsondecode, with p.p_time (time bins x 3: end, side, stuck), p.time_bin
- * (s) and p.p_loc_time.
+ * predict's: 'map' (the map directory) or 'visits' (nearest-neighbour
+ * walks over the visits kept there, as `markov predict --visits DIR`),
+ * 'set', 'out', 'overwrite', 'walks'; with 'map': 'tol', 'gates' (true:
+ * the distribution of gates visited; default: with 'out' only); with
+ * 'visits': 'k', 'train', 'seed', 'threads'. p is what `markov predict
+ * --json` prints, decoded by jsondecode, with p.p_time (time bins x 3:
+ * end, side, stuck), p.time_bin (s) and p.p_loc_time.
  *
- * validate's: 'map' and 'out' (required), 'trials', 'seed', 'threads',
- * 'set', 'grid', 'bootstrap', 'resume', 'overwrite'. v is validate.json,
- * decoded, its checks' group from 1. */
+ * validate's: 'out' (required), 'map' or 'visits' (then 'k', 'train',
+ * 'walks'), 'trials', 'seed', 'threads', 'set', 'grid', 'bootstrap',
+ * 'resume', 'overwrite'. v is validate.json, decoded, its checks' group
+ * from 1. */
 #define _GNU_SOURCE /* open_memstream */
 
 #include <stdio.h>
@@ -62,22 +65,28 @@ enum {
 	A_CROSSINGS,
 	A_PER_CROSSING,
 	A_AFTER_TRIALS,
+	A_VISITS,
+	A_K,
 	N_ARGS
 };
 static const char *const arg_names[N_ARGS] = {
-        "out",          "map",         "trials",  "bins",        "vmax",         "entries",
-        "seed",         "threads",     "backend", "backend_opt", "set",          "grid",
-        "tol",          "gates",       "walks",   "overwrite",   "bootstrap",    "resume",
-        "start_trials", "after_start", "train",   "crossings",   "per_crossing", "after_trials"};
+        "out",       "map",       "trials",       "bins",         "vmax",
+        "entries",   "seed",      "threads",      "backend",      "backend_opt",
+        "set",       "grid",      "tol",          "gates",        "walks",
+        "overwrite", "bootstrap", "resume",       "start_trials", "after_start",
+        "train",     "crossings", "per_crossing", "after_trials", "visits",
+        "k"};
 
 /* The names each subcommand takes, the others refused. */
 static const int build_names[] = {
         A_OUT,         A_TRIALS,  A_BINS,      A_VMAX,         A_ENTRIES,     A_SEED,
         A_THREADS,     A_BACKEND, A_SET,       A_BACKEND_OPT,  A_GRID,        A_START_TRIALS,
         A_AFTER_START, A_TRAIN,   A_CROSSINGS, A_PER_CROSSING, A_AFTER_TRIALS};
-static const int predict_names[] = {A_MAP, A_SET, A_TOL, A_GATES, A_WALKS, A_OUT, A_OVERWRITE};
-static const int validate_names[] = {A_MAP, A_OUT,  A_TRIALS,    A_SEED,   A_THREADS,
-                                     A_SET, A_GRID, A_BOOTSTRAP, A_RESUME, A_OVERWRITE};
+static const int predict_names[] = {A_MAP,       A_SET,    A_TOL, A_GATES, A_WALKS, A_OUT,
+                                    A_OVERWRITE, A_VISITS, A_K,   A_TRAIN, A_SEED,  A_THREADS};
+static const int validate_names[] = {A_MAP,    A_OUT,  A_TRIALS,    A_SEED,   A_THREADS,
+                                     A_SET,    A_GRID, A_BOOTSTRAP, A_RESUME, A_OVERWRITE,
+                                     A_VISITS, A_K,    A_TRAIN,     A_WALKS};
 
 typedef struct markov_call {
 	bmx_pool pool;
@@ -302,17 +311,59 @@ static int predict_struct(const char *path, const bsim_markov_predict_result *r,
 	return BSIM_OK;
 }
 
+/* 'visits', 'k', 'train' and 'walks' into def (threads: c's 'threads'):
+ * nearest-neighbour walks; the maps' own names refused beside 'visits',
+ * and its own beside 'map'. */
+static int nearest_args(markov_call *c, const char *sub, const char **visits,
+                        bsim_markov_nearest_def *def, bsim_error *err)
+{
+	const mxArray *const *v = c->v;
+	if (!v[A_MAP] == !v[A_VISITS])
+		return bsim_error_set(
+		        err, BSIM_EINPUT,
+		        "'%s': expected one of 'map' (the map directory) and 'visits' "
+		        "(nearest-neighbour walks)",
+		        sub);
+	const int own[] = {A_K, A_TRAIN};
+	for (int i = 0; i < 2 && v[A_MAP]; i++)
+		if (v[own[i]])
+			return bsim_error_set(err, BSIM_EINPUT, "'%s': for 'visits' only",
+			                      arg_names[own[i]]);
+	if (!v[A_VISITS])
+		return BSIM_OK;
+	long k = def->k, train = def->trials, threads = 0;
+	if (bmx_text("visits", v[A_VISITS], &c->pool, visits, err) ||
+	    (v[A_K] && bmx_long("k", v[A_K], 1, 64, &k, err)) ||
+	    (v[A_TRAIN] && bmx_long("train", v[A_TRAIN], 1, 2147483647L, &train, err)) ||
+	    (v[A_WALKS] && bmx_long("walks", v[A_WALKS], 1, 100000000L, &def->walks, err)) ||
+	    (v[A_THREADS] && bmx_long("threads", v[A_THREADS], 1, 4096, &threads, err)))
+		return err->code;
+	def->k = (int)k;
+	def->trials = (int)train;
+	def->threads = (int)threads;
+	return BSIM_OK;
+}
+
 static int predict(markov_call *c, const char *path, mxArray **out, bsim_error *err)
 {
 	bsim_markov_predict_def def = bsim_markov_predict_def_default();
 	const mxArray *const *v = c->v;
-	if (!v[A_MAP])
-		return bsim_error_set(err, BSIM_EINPUT,
-		                      "'predict': 'map' (the map directory) is required");
-	if (bmx_text("map", v[A_MAP], &c->pool, &def.map_dir, err) || sets_grid(c, err) ||
-	    (v[A_TOL] && bmx_double("tol", v[A_TOL], &def.tol, err)) ||
+	if (nearest_args(c, "predict", &def.visits_dir, &def.nearest, err))
+		return err->code;
+	if (v[A_VISITS]) {
+		if (v[A_TOL] || v[A_GATES])
+			return bsim_error_set(err, BSIM_EINPUT, "'%s': for 'map' only",
+			                      v[A_TOL] ? "tol" : "gates");
+		if (v[A_SEED] && bmx_seed("seed", v[A_SEED], &def.nearest.seed, err))
+			return err->code;
+	} else if (v[A_SEED] || v[A_THREADS])
+		return bsim_error_set(err, BSIM_EINPUT, "'%s': for 'visits' only",
+		                      v[A_SEED] ? "seed" : "threads");
+	if ((v[A_MAP] && bmx_text("map", v[A_MAP], &c->pool, &def.map_dir, err)) ||
+	    sets_grid(c, err) || (v[A_TOL] && bmx_double("tol", v[A_TOL], &def.tol, err)) ||
 	    (v[A_GATES] && bmx_flag("gates", v[A_GATES], &def.gates, err)) ||
-	    (v[A_WALKS] && bmx_long("walks", v[A_WALKS], 0, 100000000L, &def.walks, err)) ||
+	    (!v[A_VISITS] && v[A_WALKS] &&
+	     bmx_long("walks", v[A_WALKS], 0, 100000000L, &def.walks, err)) ||
 	    (v[A_OUT] && bmx_text("out", v[A_OUT], &c->pool, &def.out, err)) ||
 	    (v[A_OVERWRITE] && bmx_flag("overwrite", v[A_OVERWRITE], &def.overwrite, err)))
 		return err->code;
@@ -356,11 +407,14 @@ static int validate(markov_call *c, const char *path, mxArray **out, bsim_error 
 	bsim_markov_validate_def def = bsim_markov_validate_def_default();
 	const mxArray *const *v = c->v;
 	long threads = 0, bootstrap = def.bootstrap;
-	if (!v[A_MAP] || !v[A_OUT])
+	if (!v[A_OUT])
 		return bsim_error_set(err, BSIM_EINPUT,
-		                      "'validate': 'map' (the map directory) and 'out' (the output "
-		                      "directory) are required");
-	if (bmx_text("map", v[A_MAP], &c->pool, &def.map_dir, err) ||
+		                      "'validate': 'out' (the output directory) is required");
+	if (nearest_args(c, "validate", &def.visits_dir, &def.nearest, err))
+		return err->code;
+	if (v[A_MAP] && v[A_WALKS])
+		return bsim_error_set(err, BSIM_EINPUT, "'walks': for 'visits' only");
+	if ((v[A_MAP] && bmx_text("map", v[A_MAP], &c->pool, &def.map_dir, err)) ||
 	    bmx_text("out", v[A_OUT], &c->pool, &def.out, err) || sets_grid(c, err) ||
 	    (v[A_TRIALS] && bmx_long("trials", v[A_TRIALS], 1, 2147483647L, &def.trials, err)) ||
 	    (v[A_SEED] && bmx_seed("seed", v[A_SEED], &def.seed, err)) ||

@@ -50,24 +50,37 @@
 %   (where maps of this method were measured to fall short on layouts
 %   they were not built on; '' for the default method).
 %
+%   P = BEAMSIM_MARKOV('predict', SCENE, 'visits', DIR, NAME, VALUE, ...)
+%   and V = BEAMSIM_MARKOV('validate', EXPERIMENT, 'visits', DIR, 'out',
+%   OUT, ...) predict by nearest-neighbour walks over the visits of
+%   training fields kept in DIR (those missing run there first), as
+%   `beamsim markov predict --visits DIR` and `validate --visits DIR` do.
+%
 %   predict's names:
-%     'map'          the map directory (required)
+%     'map'          the map directory (or 'visits')
+%     'visits'       the visits directory (or 'map')
 %     'set'          {KEY, VALUE, ...}, scene keys set as by --set
 %     'tol'          the probability left in the field at which the
 %                    solution stops, in (0, 1) (default: the maps' sampling
 %                    tolerance)
 %     'gates'        true: the distribution of gates visited (default: with
 %                    'out' only)
-%     'walks'        walks of the semi-Markov chain (default 100000; 0: none)
+%     'walks'        walks of the semi-Markov chain (default 100000; 0: none);
+%                    with 'visits' the nearest-neighbour walks (default 200000)
 %     'out'          a directory: also write the program's files there
 %     'overwrite'    true: replace the result 'out' holds
+%     'k', 'train', 'seed', 'threads'
+%                    with 'visits': each step from the k nearest visits
+%                    (default 20), trials of each training field (default
+%                    10000), the fields' and the walks' seed, threads
 %   P holds what `markov predict --json` prints (P.totals, P.locations,
 %   P.p_gates, P.mean_gates, P.at_duration, ...), and P.p_time (time bins
 %   x 3: end, side, stuck), P.time_bin (s) and P.p_loc_time.
 %
-%   validate's names: 'map', 'out' (both required), 'trials', 'seed',
-%   'threads', 'set', 'grid', 'bootstrap', 'resume', 'overwrite'. V is
-%   validate.json (V.checks: group from 1, protocol, tv, tv_sampling, ...).
+%   validate's names: 'out' (required), 'map' or 'visits' (then 'k',
+%   'train', 'walks' as predict's), 'trials', 'seed', 'threads', 'set',
+%   'grid', 'bootstrap', 'resume', 'overwrite'. V is validate.json
+%   (V.checks: group from 1, protocol, tv, tv_sampling, ...).
 %
 %   Example:
 %     beamsim_markov('build', 'configs/markov/c_track.yaml', 'out', 'maps', ...

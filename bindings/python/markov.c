@@ -186,15 +186,16 @@ static PyObject *prediction_dict(const char *scene, const bsim_markov_predict_re
 PyObject *pyb_markov_predict(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"scene", "map", "sets",      "tol", "gates",
-	                         "walks", "out", "overwrite", NULL};
-	const char *scene, *map, *out = NULL;
-	PyObject *sets_o = Py_None;
+	static char *kwlist[] = {"scene",     "map",    "sets", "tol",   "gates", "walks",   "out",
+	                         "overwrite", "visits", "k",    "train", "seed",  "threads", NULL};
+	const char *scene, *map, *out = NULL, *visits = NULL;
+	PyObject *sets_o = Py_None, *seed_o = Py_None;
 	double tol = 0.0;
-	int gates = -1, overwrite = 0;
+	int gates = -1, overwrite = 0, k = 0, train = 0, threads = 0;
 	long walks = BSIM_MARKOV_WALKS;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|Odilzp", kwlist, &scene, &map, &sets_o, &tol,
-	                                 &gates, &walks, &out, &overwrite))
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "sz|OdilzpziiOi", kwlist, &scene, &map, &sets_o,
+	                                 &tol, &gates, &walks, &out, &overwrite, &visits, &k,
+	                                 &train, &seed_o, &threads))
 		return NULL;
 	pyb_sets sets;
 	if (pyb_sets_from(sets_o, &sets))
@@ -202,6 +203,22 @@ PyObject *pyb_markov_predict(PyObject *self, PyObject *args, PyObject *kw)
 	bsim_markov_predict_def def = bsim_markov_predict_def_default();
 	def.scene = scene;
 	def.map_dir = map;
+	if (visits) { /* nearest-neighbour walks; the package checked the numbers */
+		def.visits_dir = visits;
+		def.nearest.walks = walks;
+		def.nearest.threads = threads;
+		if (k > 0)
+			def.nearest.k = k;
+		if (train > 0)
+			def.nearest.trials = train;
+		if (seed_o != Py_None) {
+			def.nearest.seed = PyLong_AsUnsignedLongLongMask(seed_o);
+			if (PyErr_Occurred()) {
+				pyb_sets_free(&sets);
+				return NULL;
+			}
+		}
+	}
 	def.sets = sets.ov;
 	def.n_sets = sets.n;
 	def.tol = tol;
@@ -227,16 +244,18 @@ PyObject *pyb_markov_predict(PyObject *self, PyObject *args, PyObject *kw)
 PyObject *pyb_markov_validate(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"experiment", "map",       "out",  "trials",    "seed",
-	                         "threads",    "sets",      "grid", "bootstrap", "progress",
-	                         "resume",     "overwrite", NULL};
-	const char *experiment, *map, *out;
-	long trials = 0;
-	int threads = 0, bootstrap = -1, resume = 0, overwrite = 0;
+	static char *kwlist[] = {"experiment", "map",       "out",    "trials",    "seed",
+	                         "threads",    "sets",      "grid",   "bootstrap", "progress",
+	                         "resume",     "overwrite", "visits", "k",         "train",
+	                         "walks",      NULL};
+	const char *experiment, *map, *out, *visits = NULL;
+	long trials = 0, walks = 0;
+	int threads = 0, bootstrap = -1, resume = 0, overwrite = 0, k = 0, train = 0;
 	PyObject *seed_o = Py_None, *sets_o = Py_None, *grid_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "sss|lOiOOiOpp", kwlist, &experiment, &map, &out,
-	                                 &trials, &seed_o, &threads, &sets_o, &grid_o, &bootstrap,
-	                                 &progress_o, &resume, &overwrite))
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "szs|lOiOOiOppziil", kwlist, &experiment, &map,
+	                                 &out, &trials, &seed_o, &threads, &sets_o, &grid_o,
+	                                 &bootstrap, &progress_o, &resume, &overwrite, &visits, &k,
+	                                 &train, &walks))
 		return NULL;
 	bsim_markov_validate_def def = bsim_markov_validate_def_default();
 	pyb_run_inputs in;
@@ -245,6 +264,16 @@ PyObject *pyb_markov_validate(PyObject *self, PyObject *args, PyObject *kw)
 	PYB_RUN_INPUTS_SET(def, in);
 	def.experiment = experiment;
 	def.map_dir = map;
+	if (visits) { /* nearest-neighbour walks; the package checked the numbers */
+		def.visits_dir = visits;
+		def.nearest.threads = threads;
+		if (k > 0)
+			def.nearest.k = k;
+		if (train > 0)
+			def.nearest.trials = train;
+		if (walks > 0)
+			def.nearest.walks = walks;
+	}
 	def.out = out;
 	def.trials = trials;
 	def.threads = threads;

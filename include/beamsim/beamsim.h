@@ -26,6 +26,7 @@
 #include "beamsim/lattice_outcome.h"
 #include "beamsim/limits.h"
 #include "beamsim/markov.h"
+#include "beamsim/markov_nearest.h"
 #include "beamsim/options.h"
 #include "beamsim/output.h"
 #include "beamsim/override.h"

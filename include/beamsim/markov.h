@@ -55,6 +55,7 @@
 #include "beamsim/error.h"
 #include "beamsim/experiment.h"
 #include "beamsim/lattice.h"
+#include "beamsim/markov_nearest.h"
 #include "beamsim/options.h"
 #include "beamsim/progress.h"
 #include "beamsim/scene.h"
@@ -572,6 +573,11 @@ typedef struct bsim_markov_prediction {
 	double t_mean[3];   /* s, mean time of each kind's outcome (NAN if none) */
 	double t_sd[3];     /* s, its standard deviation over the walks */
 	double *p_loc_time; /* n_locations: the final locations at the duration */
+	/* > 0: p by that many nearest-neighbour walks (beamsim/markov_nearest.h)
+	 * over n_states visits, each step drawn from the nearest_k nearest;
+	 * 0: by the chain. */
+	long nearest_walks;
+	int nearest_k;
 } bsim_markov_prediction;
 
 /* The series stops when less than this is left in the field: far below
@@ -657,6 +663,13 @@ typedef struct bsim_markov_predict_def {
 	int gates;  /* 1: the distribution of gates visited (the series); 0: not;
 	             * -1: with out only */
 	long walks; /* walks of the semi-Markov chain, 0 to 1e8; 0: none */
+	/* NULL: the chain of the maps in map_dir. Else the prediction is by
+	 * nearest-neighbour walks (beamsim/markov_nearest.h, as nearest says)
+	 * over the visits in this directory, their training fields run there
+	 * where missing (bsim_markov_visits_build); map_dir, tol, gates and
+	 * walks are not used. */
+	const char *visits_dir;
+	bsim_markov_nearest_def nearest;
 } bsim_markov_predict_def;
 
 /* The maps' sampling tolerance, gates with out only, BSIM_MARKOV_WALKS. */
@@ -668,7 +681,13 @@ typedef struct bsim_markov_predict_result {
 	bsim_markov_prediction p; /* p.tol: the tolerance used */
 	double total[3];          /* p summed by kind: end, side, stuck */
 	double seconds;           /* wall time of the chain composed and solved (maps read) */
-	double cpu_seconds;       /* the thread's CPU time of the same */
+	double cpu_seconds;       /* the thread's CPU time of the same (of the walks: the
+	                           * process's, on every thread) */
+	/* With visits_dir: the training fields (n_maps of them), those run now
+	 * and what all took when they were run (s of CPU). */
+	int fields_built;
+	double fields_cost;
+	double tv_walks; /* the walks' own sampling error (bsim_markov_nearest_tv_walks) */
 } bsim_markov_predict_result;
 
 /* Predicts def->scene from the maps in def->map_dir. BSIM_EINPUT for a bad
@@ -741,6 +760,15 @@ typedef struct bsim_markov_validate_def {
 	 * shard writes a part directory into out, an MPI rank other than 0
 	 * writes nothing; merge joins the parts. All zero: one process. */
 	bsim_sweep_spread spread;
+	/* NULL: the chain of the maps in map_dir. Else the prediction is by
+	 * nearest-neighbour walks over the visits in this directory, as
+	 * markov predict's (bsim_markov_predict_def), their training fields
+	 * run there first where missing, before any trial; the simulation on
+	 * nearest's backend. A check's tv_map is then the walks' own sampling
+	 * error (bsim_markov_nearest_tv_walks), predict the walks' CPU time,
+	 * and the validation's map_cost the training fields'. */
+	const char *visits_dir;
+	bsim_markov_nearest_def nearest;
 } bsim_markov_validate_def;
 
 BSIM_API bsim_markov_validate_def bsim_markov_validate_def_default(void);

@@ -75,20 +75,40 @@ static int clamp_bin(double u, int n)
 	return i < 0 ? 0 : i >= n ? n - 1 : i;
 }
 
+/* The entry state's position, speed and direction, each as a share of
+ * its range: u[0] along the edge, u[1] of v_max, u[2] of [-pi/2, pi/2]. */
+static void entry_shares(const bsim_markov_bins *b, const bsim_lattice_def *l, int edge, double pos,
+                         const double v[2], double u[3])
+{
+	double lo, hi, n[2], t[2];
+	edge_range(edge, l, &lo, &hi);
+	edge_frame(edge, n, t);
+	u[0] = (pos - lo) / (hi - lo);
+	u[1] = hypot(v[0], v[1]) / b->v_max;
+	double a = atan2(v[0] * t[0] + v[1] * t[1], v[0] * n[0] + v[1] * n[1]);
+	u[2] = (a + 0.5 * PI) / PI;
+}
+
 int bsim_markov_bin_of(const bsim_markov_bins *b, const bsim_lattice_def *l, int edge, double pos,
                        const double v[2])
 {
 	if (edge < BSIM_EDGE_BOTTOM || edge > BSIM_EDGE_TOP)
 		return 0;
-	double lo, hi, n[2], t[2];
-	edge_range(edge, l, &lo, &hi);
-	edge_frame(edge, n, t);
-	int ip = clamp_bin((pos - lo) / (hi - lo), b->n_pos);
-	double speed = hypot(v[0], v[1]);
-	int is = clamp_bin(speed / b->v_max, b->n_speed);
-	double a = atan2(v[0] * t[0] + v[1] * t[1], v[0] * n[0] + v[1] * n[1]);
-	int id = clamp_bin((a + 0.5 * PI) / PI, b->n_dir);
+	double u[3];
+	entry_shares(b, l, edge, pos, v, u);
+	int ip = clamp_bin(u[0], b->n_pos);
+	int is = clamp_bin(u[1], b->n_speed);
+	int id = clamp_bin(u[2], b->n_dir);
 	return 1 + (((edge - BSIM_EDGE_BOTTOM) * b->n_pos + ip) * b->n_speed + is) * b->n_dir + id;
+}
+
+void bsim_markov_entry_feature(const bsim_markov_bins *b, const bsim_lattice_def *l, int edge,
+                               double pos, const double v[2], double f[3])
+{
+	entry_shares(b, l, edge, pos, v, f);
+	f[0] *= b->n_pos;
+	f[1] *= b->n_speed;
+	f[2] *= b->n_dir;
 }
 
 /* A state drawn uniformly in entry bin (> 0): position on the edge, moved

@@ -161,6 +161,18 @@ void bsim_markov_exit_target(int cols, int rows, int nb, int g, int x, int *stat
 	*state = (jy * cols + jx) * nb + x;
 }
 
+void bsim_markov_locations_fill(const bsim_lattice_def *l, bsim_location *loc)
+{
+	const int cols = l->columns, rows = l->rows;
+	for (int i = 0; i < cols; i++)
+		loc[i] = (bsim_location){BSIM_LOCATION_END, l->ix_min + i, 0};
+	for (int i = 0; i < rows; i++)
+		loc[cols + i] = (bsim_location){BSIM_LOCATION_SIDE, 0, i};
+	for (int g = 0; g < cols * rows; g++)
+		loc[cols + rows + g] =
+		        (bsim_location){BSIM_LOCATION_STUCK, l->ix_min + g % cols, g / cols};
+}
+
 static void target(const chain *c, int g, int x, int *state, int *loc)
 {
 	bsim_markov_exit_target(c->cols, c->rows, c->nb, g, x, state, loc);
@@ -807,13 +819,7 @@ int bsim_markov_predict_with(const bsim_scene *lattice, const bsim_markov_set *s
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
 	if (rc == BSIM_OK) {
-		for (int i = 0; i < c.cols; i++)
-			out->loc[i] = (bsim_location){BSIM_LOCATION_END, l->ix_min + i, 0};
-		for (int i = 0; i < c.rows; i++)
-			out->loc[c.cols + i] = (bsim_location){BSIM_LOCATION_SIDE, 0, i};
-		for (int g = 0; g < c.cols * c.rows; g++)
-			out->loc[c.cols + c.rows + g] = (bsim_location){
-			        BSIM_LOCATION_STUCK, l->ix_min + g % c.cols, g / c.cols};
+		bsim_markov_locations_fill(l, out->loc);
 		int ix, iy;
 		bsim_lattice_gate_at(lattice, lattice->body.start, &ix, &iy);
 		if (chain_start_init(&st, &c, set, iy * c.cols + ix - l->ix_min, lattice->dt))

@@ -5,7 +5,8 @@
  * markov_gate.c runs the single gates that fill a map, markov_counts.c
  * keeps a map's counts by row, markov_cache.c keys maps and reads and
  * writes a map directory, and markov_map.c builds or loads the maps of a
- * lattice from those. */
+ * lattice from those; markov_nearest.c keeps the training fields' visits
+ * and walks over them (beamsim/markov_nearest.h). */
 #ifndef BSIM_ANALYSIS_MARKOV_INTERNAL_H
 #define BSIM_ANALYSIS_MARKOV_INTERNAL_H
 
@@ -15,6 +16,7 @@
 
 #include "beamsim/lattice_outcome.h"
 #include "beamsim/markov.h"
+#include "beamsim/markov_nearest.h"
 #include "beamsim/override.h"
 #include "beamsim/trial.h" /* BSIM_EDGE_* */
 
@@ -31,6 +33,12 @@ const char *bsim_markov_bin_edge(const bsim_markov_bins *b, int bin);
  * step h: body centre x (gate frame) and velocity v. */
 void bsim_markov_bin_sample(const bsim_markov_bins *b, const bsim_lattice_def *l, double h, int bin,
                             gsl_rng *rng, double x[2], double v[2]);
+
+/* An entry state through edge (BSIM_EDGE_BOTTOM .. TOP) in units of b's
+ * bin widths (b->v_max set): f[0] position, f[1] speed, f[2] direction,
+ * whose floors (clamped) are bsim_markov_bin_of's bin. */
+void bsim_markov_entry_feature(const bsim_markov_bins *b, const bsim_lattice_def *l, int edge,
+                               double pos, const double v[2], double f[3]);
 
 /* ---- observed entries by bin (markov_entries.c) ---- */
 
@@ -141,6 +149,9 @@ static inline int bsim_markov_def_crossings(const bsim_markov_def *def)
  * row 0 first, into *pairs (malloc'd): their number, or -1 out of memory. */
 int bsim_markov_lattice_pairs(const bsim_scene *lattice, double (**pairs)[2]);
 
+/* The same, in ascending order (left, then right). */
+int bsim_markov_lattice_kinds(const bsim_scene *lattice, double (**kinds)[2]);
+
 /* The id of the entries of a training field of def->train_trials trials of
  * lattice's gate kinds: "train N kinds n HASH" (HASH of the kinds sorted),
  * or "train N" without a lattice (as markov.json names it); "train N
@@ -171,6 +182,17 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
                           const bsim_backend *be, const bsim_options *opts,
                           bsim_markov_entries *out, markov_crossings *cx, long long *steps,
                           bsim_error *err);
+
+/* The visits (beamsim/markov_nearest.h) of lattice's training field whose
+ * start gate is of kind start (def->train_trials trials, each trial's
+ * layout of lattice's kinds at random and its schedule from seed and the
+ * trial), appended to out (its arrays hold *cap), the gates
+ * on the field's last row and outer columns counted in out->left_out; the
+ * time steps its trials took into *steps. Errors as bsim_markov_train_run. */
+int bsim_markov_train_visits(const bsim_scene *lattice, const bsim_markov_def *def,
+                             const double start[2], uint64_t seed, const bsim_backend *be,
+                             const bsim_options *opts, bsim_markov_visits *out, long *cap,
+                             long long *steps, bsim_error *err);
 
 /* ---- counts by row (markov_counts.c) ---- */
 
@@ -333,6 +355,11 @@ int bsim_markov_flow_round(const bsim_scene *lattice, const bsim_markov_def *def
                            const bsim_markov_map *maps, int n, const char *dir, bsim_error *err);
 
 /* ---- the chain's exits (markov_chain.c) ---- */
+
+/* The final locations of lattice l in bsim_markov_prediction's order into
+ * loc (columns + rows + columns rows): the ends by ix, the sides by iy, the
+ * stuck gates by g = iy columns + ix - ix_min. */
+void bsim_markov_locations_fill(const bsim_lattice_def *l, bsim_location *loc);
 
 /* Where exit x (0 stuck, else an entry bin of the gate entered) of gate g =
  * iy cols + ix - ix_min of a cols x rows field leads: *state = g' nb + bin

@@ -13,7 +13,9 @@
 
 bsim_markov_predict_def bsim_markov_predict_def_default(void)
 {
-	return (bsim_markov_predict_def){.gates = -1, .walks = BSIM_MARKOV_WALKS};
+	return (bsim_markov_predict_def){.gates = -1,
+	                                 .walks = BSIM_MARKOV_WALKS,
+	                                 .nearest = bsim_markov_nearest_def_default()};
 }
 
 void bsim_markov_predict_result_free(bsim_markov_predict_result *res)
@@ -47,10 +49,52 @@ static int predict_chain(const bsim_markov_predict_def *def, const bsim_markov_s
 	return rc;
 }
 
+/* The walks over the visits in def->visits_dir for res->scene, the
+ * training fields run there first where missing. */
+static int predict_nearest(const bsim_markov_predict_def *def, bsim_markov_predict_result *res,
+                           bsim_error *err)
+{
+	bsim_markov_visits v;
+	int rc = bsim_markov_visits_build(&res->scene, &def->nearest, def->visits_dir, &v, err);
+	if (rc != BSIM_OK)
+		return rc;
+	res->n_maps = v.fields;
+	res->fields_built = v.built;
+	res->fields_cost = v.cost;
+	/* the walks run on every thread: the process's CPU time */
+	const double t0 = bsim_clock_seconds(), c0 = bsim_clock_process_cpu_seconds();
+	rc = bsim_markov_nearest_predict(&res->scene, &v, &def->nearest, &res->p, err);
+	res->seconds = bsim_clock_seconds() - t0;
+	res->cpu_seconds = bsim_clock_process_cpu_seconds() - c0;
+	bsim_markov_visits_free(&v);
+	for (int i = 0; rc == BSIM_OK && i < res->p.n_locations; i++)
+		res->total[res->p.loc[i].kind] += res->p.p[i];
+	if (rc == BSIM_OK)
+		res->tv_walks = bsim_markov_nearest_tv_walks(res->p.p, res->p.n_locations,
+		                                             res->p.nearest_walks);
+	return rc;
+}
+
 int bsim_markov_predict_run(const bsim_markov_predict_def *def, bsim_markov_predict_result *res,
                             bsim_error *err)
 {
 	memset(res, 0, sizeof *res);
+	if (def->scene && def->visits_dir) {
+		int rc = bsim_scene_load(def->scene, def->sets, def->n_sets, &res->scene, err);
+		const bsim_outdir_spelling spelling = {NULL, def->overwrite_option};
+		if (rc == BSIM_OK && def->out)
+			rc = bsim_outdir_probe(
+			        def->out, def->overwrite ? BSIM_OUTDIR_OVERWRITE : BSIM_OUTDIR_NEW,
+			        &spelling, err);
+		if (rc == BSIM_OK)
+			rc = predict_nearest(def, res, err);
+		if (rc == BSIM_OK && def->out)
+			rc = bsim_markov_prediction_store(def->out, def->overwrite, &res->scene,
+			                                  NULL, &res->p, err);
+		if (rc != BSIM_OK)
+			bsim_markov_predict_result_free(res);
+		return rc;
+	}
 	if (!def->scene || !def->map_dir)
 		return bsim_error_set(
 		        err, BSIM_EINPUT,
@@ -96,11 +140,23 @@ void bsim_markov_predict_json(FILE *f, const char *scene_path,
 	bsim_json_string(f, res->scene.name);
 	fprintf(f,
 	        ", \"columns\": %d, \"rows\": %d, \"maps\": %d, \"states\": %d, \"solve\": "
-	        "\"%s\", \"totals\": {",
+	        "\"%s\", ",
 	        res->scene.lattice.columns, res->scene.lattice.rows, res->n_maps, p->n_states,
-	        p->exact    ? "LU"
-	        : p->sweeps ? "sweeps"
-	                    : "series");
+	        p->nearest_walks > 0 ? "nearest"
+	        : p->exact           ? "LU"
+	        : p->sweeps          ? "sweeps"
+	                             : "series");
+	if (p->nearest_walks > 0) {
+		/* maps: the training fields; states: their visits */
+		fprintf(f, "\"nearest_walks\": %ld, \"nearest_k\": %d, \"fields_built\": %d, ",
+		        p->nearest_walks, p->nearest_k, res->fields_built);
+		fputs("\"fields_cpu_seconds\": ", f);
+		bsim_json_number(f, res->fields_cost);
+		fputs(", \"tv_walks\": ", f);
+		bsim_json_number(f, res->tv_walks);
+		fputs(", ", f);
+	}
+	fputs("\"totals\": {", f);
 	for (int k = 0; k < 3; k++) {
 		fprintf(f, "%s\"%s\": ", k ? ", " : "", kinds[k]);
 		bsim_json_number(f, res->total[k]);

@@ -59,9 +59,7 @@ static int pair_less(const void *a, const void *b)
 	return p[0] != q[0] ? (p[0] > q[0]) - (p[0] < q[0]) : (p[1] > q[1]) - (p[1] < q[1]);
 }
 
-/* The lattice's gate kinds in ascending order (left, then right): their
- * number, or -1 out of memory. */
-static int kinds_sorted(const bsim_scene *lattice, double (**kinds)[2])
+int bsim_markov_lattice_kinds(const bsim_scene *lattice, double (**kinds)[2])
 {
 	const int n = bsim_markov_lattice_pairs(lattice, kinds);
 	if (n > 0)
@@ -81,7 +79,7 @@ const char *bsim_markov_train_label(const bsim_scene *lattice, const bsim_markov
 	else if (bsim_markov_def_crossings(def))
 		snprintf(how, sizeof how, " crossings");
 	double(*kinds)[2] = NULL;
-	const int n = lattice ? kinds_sorted(lattice, &kinds) : 0;
+	const int n = lattice ? bsim_markov_lattice_kinds(lattice, &kinds) : 0;
 	uint64_t h = HASH_FNV1A64_SEED;
 	for (int i = 0; i < n; i++)
 		h = bsim_hash_fnv1a64(kinds[i], sizeof kinds[i], h);
@@ -96,21 +94,27 @@ const char *bsim_markov_train_label(const bsim_scene *lattice, const bsim_markov
 
 /* The training field of lattice into s: its physics, gate and body start
  * (in the start gate's frame, moved to gate (0, 0)), every gate a kind of
- * lattice drawn at random, the essay's protocol and a lattice's ends. */
-static int train_scene(const bsim_scene *lattice, uint64_t seed, bsim_scene *s, bsim_error *err)
+ * lattice drawn at random (from seed) but the start gate's, kind start
+ * where that is not NULL, the essay's protocol and a lattice's ends. */
+static int train_scene(const bsim_scene *lattice, uint64_t seed, const double *start, bsim_scene *s,
+                       bsim_error *err)
 {
 	double(*kinds)[2] = NULL;
-	const int n = kinds_sorted(lattice, &kinds);
+	const int n = bsim_markov_lattice_kinds(lattice, &kinds);
 	const int size = BSIM_MARKOV_TRAIN_SIZE, gates = size * size;
 	double *k = malloc(2 * (size_t)gates * sizeof *k);
 	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
 	int rc = n > 0 && k && rng && bsim_scene_copy(s, lattice) == BSIM_OK ? BSIM_OK : BSIM_EFAIL;
 	if (rc == BSIM_OK) {
-		gsl_rng_set(rng, bsim_schedule_seed_mix(seed ^ TRAIN_SALT, 0, 0));
+		gsl_rng_set(rng, bsim_schedule_seed_mix(seed, 0, 0));
 		for (int g = 0; g < gates; g++) {
 			const int j = (int)gsl_rng_uniform_int(rng, (unsigned long)n);
 			k[g] = kinds[j][0];
 			k[gates + g] = kinds[j][1];
+		}
+		if (start) { /* gate (0, 0): row 0's middle */
+			k[size / 2] = start[0];
+			k[gates + size / 2] = start[1];
 		}
 		int ix, iy;
 		bsim_lattice_gate_at(lattice, lattice->body.start, &ix, &iy);
@@ -203,36 +207,64 @@ static int crossings_push(markov_crossings *c, long *cap, const bsim_scene *s,
 	return 0;
 }
 
-int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
-                          const bsim_backend *be, const bsim_options *opts,
-                          bsim_markov_entries *out, markov_crossings *cx, long long *steps,
-                          bsim_error *err)
+/* A layout of its own for each trial of a training field: every gate one
+ * of n kinds at random, from (seed, t), but the start gate (0, 0), of kind
+ * start. */
+typedef struct train_layout {
+	double (*kinds)[2];
+	int n;
+	uint64_t seed;
+	const double *start;
+} train_layout;
+
+/* Trial t's layout of L into s's beams (s the training field); 0, or -1
+ * out of memory. */
+static int layout_draw(const train_layout *L, long t, bsim_scene *s)
 {
-	memset(out, 0, sizeof *out);
-	if (cx)
-		memset(cx, 0, sizeof *cx);
-	bsim_scene s;
-	memset(&s, 0, sizeof s);
-	int rc = train_scene(lattice, def->seed, &s, err);
-	const long T = def->train_trials;
-	bsim_trial_log *logs = rc == BSIM_OK ? calloc((size_t)T, sizeof *logs) : NULL;
-	bsim_trial_result *results = rc == BSIM_OK ? calloc((size_t)T, sizeof *results) : NULL;
-	if (rc == BSIM_OK && (!logs || !results))
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+	if (!rng)
+		return -1;
+	gsl_rng_set(rng, bsim_schedule_seed_mix(L->seed, 2, (uint64_t)t));
+	const bsim_lattice_def *l = &s->lattice;
+	for (int iy = 0; iy < l->rows; iy++)
+		for (int ix = l->ix_min; ix <= l->ix_max; ix++) {
+			const int j = (int)gsl_rng_uniform_int(rng, (unsigned long)L->n);
+			const double *k = ix == 0 && iy == 0 ? L->start : L->kinds[j];
+			for (int side = 0; side < 2; side++)
+				s->beams[bsim_lattice_beam(l, ix, iy, side)].stiffness = k[side];
+		}
+	gsl_rng_free(rng);
+	return 0;
+}
+
+/* T trials of the training field s (trial t seeded by seed and t; laid
+ * out by L where that is not NULL) into logs and results, on def->threads
+ * threads (the same for any number), stopped by def->stop, counted by
+ * def->train_progress. BSIM_EFAIL naming the first unstable trial in trial
+ * order, BSIM_ESTOPPED when stopped. */
+static int train_trials(const bsim_scene *s, const train_layout *L, uint64_t seed, long T,
+                        const bsim_markov_def *def, const bsim_backend *be,
+                        const bsim_options *opts, bsim_trial_log *logs, bsim_trial_result *results,
+                        bsim_error *err)
+{
+	int rc = BSIM_OK;
 	/* the first failure in trial order, whatever the threads */
 	long first = T, done = 0;
 	const long every = T >= 100 ? T / 100 : 1; /* trials between progress calls */
 	bsim_error fail = {0};
 	int stopped = 0;
 	const int threads = def->threads > 0 ? def->threads : omp_get_max_threads();
-#pragma omp parallel num_threads(threads) if (rc == BSIM_OK)
+#pragma omp parallel num_threads(threads)
 	{
 		bsim_trial_runner *r = bsim_trial_runner_alloc();
 		bsim_trial_log *log = bsim_trial_log_alloc();
+		/* the thread's own field, its layout redrawn for each trial */
+		bsim_scene mine;
+		memset(&mine, 0, sizeof mine);
+		const int copied = L && bsim_scene_copy(&mine, s) == BSIM_OK;
+		const bsim_scene *field = L ? &mine : s;
 #pragma omp for schedule(dynamic, 4)
 		for (long t = 0; t < T; t++) {
-			if (rc != BSIM_OK)
-				continue;
 			bsim_error e = {0};
 			int trc = BSIM_OK;
 			if (def->stop && *def->stop) {
@@ -242,16 +274,15 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 			}
 			bsim_trial_result res;
 			bsim_recorder rec = {.stride = 1, .log = log};
-			if (!r || !log)
+			if (!r || !log || (L && (!copied || layout_draw(L, t, &mine))))
 				trc = bsim_error_set(&e, BSIM_EFAIL, "out of memory");
 			else
-				trc = bsim_trial_run(r, &s, be, opts,
-				                     bsim_schedule_seed_mix(def->seed ^ TRAIN_SALT,
-				                                            1, (uint64_t)t),
+				trc = bsim_trial_run(r, field, be, opts,
+				                     bsim_schedule_seed_mix(seed, 1, (uint64_t)t),
 				                     &rec, &res, &e);
 			if (trc == BSIM_OK && res.outcome == BSIM_UNSTABLE) {
 				char why[160];
-				bsim_trial_instability_text(&res, s.dt, why, sizeof why);
+				bsim_trial_instability_text(&res, s->dt, why, sizeof why);
 				trc = bsim_error_set(&e, BSIM_EFAIL,
 				                     "trial %ld of the maps' training field became "
 				                     "unstable: %s",
@@ -267,14 +298,63 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 		}
 		bsim_trial_log_free(log);
 		bsim_trial_runner_free(r);
+		bsim_scene_free(&mine);
 	}
-	if (rc == BSIM_OK && stopped)
+	if (stopped)
 		rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped in the maps' training field");
-	else if (rc == BSIM_OK && first < T) {
+	else if (first < T) {
 		rc = BSIM_EFAIL;
 		if (err)
 			*err = fail;
 	}
+	return rc;
+}
+
+/* The training field s and its trials' logs and results (*logs, *results
+ * malloc'd, T each; freed by train_free), as train_trials runs them. */
+static int train_field(const bsim_scene *lattice, uint64_t seed, const double *start,
+                       const train_layout *L, long T, const bsim_markov_def *def,
+                       const bsim_backend *be, const bsim_options *opts, bsim_scene *s,
+                       bsim_trial_log **logs, bsim_trial_result **results, bsim_error *err)
+{
+	memset(s, 0, sizeof *s);
+	*logs = NULL;
+	*results = NULL;
+	int rc = train_scene(lattice, seed, start, s, err);
+	if (rc == BSIM_OK) {
+		*logs = calloc((size_t)T, sizeof **logs);
+		*results = calloc((size_t)T, sizeof **results);
+		if (!*logs || !*results)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	if (rc == BSIM_OK)
+		rc = train_trials(s, L, seed, T, def, be, opts, *logs, *results, err);
+	return rc;
+}
+
+static void train_free(bsim_scene *s, bsim_trial_log *logs, bsim_trial_result *results, long T)
+{
+	for (long t = 0; logs && t < T; t++)
+		bsim_trial_log_clear(&logs[t]);
+	free(logs);
+	free(results);
+	bsim_scene_free(s);
+}
+
+int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
+                          const bsim_backend *be, const bsim_options *opts,
+                          bsim_markov_entries *out, markov_crossings *cx, long long *steps,
+                          bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	if (cx)
+		memset(cx, 0, sizeof *cx);
+	bsim_scene s;
+	bsim_trial_log *logs;
+	bsim_trial_result *results;
+	const long T = def->train_trials;
+	int rc = train_field(lattice, def->seed ^ TRAIN_SALT, NULL, NULL, T, def, be, opts, &s,
+	                     &logs, &results, err);
 	/* every entry but the start's, and every crossing, in trial order */
 	int cap = 0;
 	long cx_cap = 0;
@@ -292,16 +372,83 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 		    crossings_push(cx, &cx_cap, &s, def, &logs[t], &results[t]))
 			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	}
-	for (long t = 0; logs && t < T; t++)
-		bsim_trial_log_clear(&logs[t]);
-	free(logs);
-	free(results);
-	bsim_scene_free(&s);
+	train_free(&s, logs, results, T);
 	if (rc != BSIM_OK) {
 		bsim_markov_entries_free(out);
 		if (cx)
 			bsim_markov_crossings_free(cx);
 	} else
 		bsim_markov_train_label(lattice, def, out->id, sizeof out->id);
+	return rc;
+}
+
+/* Trial log g's visits appended to out (see bsim_markov_train_visits). */
+static int visits_push(bsim_markov_visits *out, long *cap, const bsim_scene *s,
+                       const bsim_trial_log *g, const bsim_trial_result *res)
+{
+	const bsim_lattice_def *l = &s->lattice;
+	for (int j = 0; j < g->n_entries; j++) {
+		const bsim_gate_entry *e = &g->entries[j],
+		                      *next = j + 1 < g->n_entries ? e + 1 : NULL;
+		if (!next &&
+		    (res->outcome != BSIM_STUCK || res->steps_run - e->step < s->gate_steps))
+			break; /* left the field, or the trial ended: no exit known */
+		if (e->iy == l->rows - 1 || e->ix == l->ix_min || e->ix == l->ix_max) {
+			out->left_out++;
+			continue;
+		}
+		if (out->n == *cap) {
+			const long more = *cap ? 2 * *cap : 4096;
+			bsim_markov_visit *v = realloc(out->v, (size_t)more * sizeof *v);
+			if (!v)
+				return -1;
+			out->v = v;
+			*cap = more;
+		}
+		bsim_markov_visit *v = &out->v[out->n++];
+		memset(v, 0, sizeof *v);
+		for (int side = 0; side < 2; side++)
+			v->k[side] = s->beams[bsim_lattice_beam(l, e->ix, e->iy, side)].stiffness;
+		v->edge = (int)e->edge;
+		v->pos = e->pos;
+		v->v[0] = e->v[0];
+		v->v[1] = e->v[1];
+		v->steps = s->gate_steps;
+		if (next) {
+			v->exit_edge = (int)next->edge;
+			v->exit_pos = next->pos;
+			v->exit_v[0] = next->v[0];
+			v->exit_v[1] = next->v[1];
+			/* a gate crossed at a corner, within one step, held it one */
+			v->steps = next->step > e->step ? next->step - e->step : 1;
+		}
+	}
+	return 0;
+}
+
+int bsim_markov_train_visits(const bsim_scene *lattice, const bsim_markov_def *def,
+                             const double start[2], uint64_t seed, const bsim_backend *be,
+                             const bsim_options *opts, bsim_markov_visits *out, long *cap,
+                             long long *steps, bsim_error *err)
+{
+	bsim_scene s;
+	memset(&s, 0, sizeof s);
+	bsim_trial_log *logs = NULL;
+	bsim_trial_result *results = NULL;
+	const long T = def->train_trials;
+	double(*kinds)[2] = NULL;
+	const int n = bsim_markov_lattice_kinds(lattice, &kinds);
+	const train_layout L = {kinds, n, seed, start};
+	int rc = n > 0 ? train_field(lattice, seed, start, &L, T, def, be, opts, &s, &logs,
+	                             &results, err)
+	               : bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	*steps = 0;
+	for (long t = 0; rc == BSIM_OK && t < T; t++) {
+		*steps += results[t].steps_run;
+		if (layout_draw(&L, t, &s) || visits_push(out, cap, &s, &logs[t], &results[t]))
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	}
+	train_free(&s, logs, results, T);
+	free(kinds);
 	return rc;
 }

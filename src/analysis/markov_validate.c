@@ -32,7 +32,9 @@
 
 bsim_markov_validate_def bsim_markov_validate_def_default(void)
 {
-	return (bsim_markov_validate_def){.bootstrap = 2000, .map_resamples = 40};
+	return (bsim_markov_validate_def){.bootstrap = 2000,
+	                                  .map_resamples = 40,
+	                                  .nearest = bsim_markov_nearest_def_default()};
 }
 
 void bsim_markov_validation_free(bsim_markov_validation *v)
@@ -331,8 +333,11 @@ static int write_json(const char *stage, const bsim_markov_validate_def *def,
 	FILE *f = o.f;
 	fputs("{\"experiment\": ", f);
 	bsim_json_string(f, e->path);
-	fputs(", \"map_dir\": ", f);
-	bsim_json_string(f, def->map_dir);
+	fputs(def->visits_dir ? ", \"visits_dir\": " : ", \"map_dir\": ", f);
+	bsim_json_string(f, def->visits_dir ? def->visits_dir : def->map_dir);
+	if (def->visits_dir) /* the maps' fields below are the training fields' */
+		fprintf(f, ", \"nearest_walks\": %ld, \"nearest_k\": %d, \"train_trials\": %d",
+		        def->nearest.walks, def->nearest.k, def->nearest.trials);
 	fprintf(f,
 	        ", \"entry_bins\": %d, \"trials_per_bin\": %d, \"of_crossings\": %d, "
 	        "\"per_crossing\": %d, \"map_cpu_seconds\": ",
@@ -436,6 +441,66 @@ static bsim_override *protocol_sets(const bsim_markov_validate_def *def, int pr)
 	return ov;
 }
 
+/* The chain of the maps in set for scene into pred (with the time to the
+ * outcome where they have holding times), the CPU of one prediction as
+ * markov predict makes it, the maps' own sampling error (tv_map) and what
+ * the maps are (v's bins, trials, scope and cost). */
+static int predict_maps(const bsim_markov_validate_def *def, const bsim_scene *scene,
+                        const bsim_markov_set *set, gsl_rng *rng, bsim_markov_prediction *pred,
+                        double *predict, double *tv_map, bsim_markov_validation *v, bsim_error *err)
+{
+	int rc = bsim_markov_predict(scene, set, pred, err);
+	if (rc == BSIM_OK && pred->has_time)
+		rc = bsim_markov_predict_time(scene, set, BSIM_MARKOV_WALKS, set->def.seed, pred,
+		                              err);
+	if (rc == BSIM_OK)
+		rc = time_predict(scene, set, predict, err);
+	if (rc == BSIM_OK)
+		rc = bootstrap_maps(rng, scene, set, pred, def->map_resamples, def->stop, tv_map,
+		                    err);
+	if (rc != BSIM_OK)
+		return rc;
+	v->bins = set->n ? set->maps[0].n_bins : 0;
+	v->trials_per_bin = set->def.trials;
+	v->of_crossings = set->n ? set->maps[0].of_crossings : 0;
+	v->per_crossing = set->n ? set->maps[0].per_crossing : 0;
+	bsim_markov_def_scope(&set->def, v->scope, sizeof v->scope);
+	for (int i = 0; i < set->n; i++) {
+		v->map_cost += set->maps[i].cost;
+		v->map_steps += set->maps[i].steps;
+	}
+	for (int i = 0; set->next && i < set->n * set->n; i++) {
+		v->map_cost += set->next[i].cost; /* the gates after the start */
+		v->map_steps += set->next[i].steps_total;
+	}
+	return BSIM_OK;
+}
+
+/* The nearest-neighbour walks over the visits in def->visits_dir (read:
+ * they were run before the simulation) for scene into pred, their CPU
+ * time, their own sampling error (tv_map) and what they are (v's scope
+ * and the training fields' cost). */
+static int predict_nearest(const bsim_markov_validate_def *def, const bsim_scene *scene,
+                           bsim_markov_prediction *pred, double *predict, double *tv_map,
+                           bsim_markov_validation *v, bsim_error *err)
+{
+	bsim_markov_visits vs;
+	int rc = bsim_markov_visits_build(scene, &def->nearest, def->visits_dir, &vs, err);
+	if (rc != BSIM_OK)
+		return rc;
+	const double c0 = bsim_clock_process_cpu_seconds();
+	rc = bsim_markov_nearest_predict(scene, &vs, &def->nearest, pred, err);
+	*predict = bsim_clock_process_cpu_seconds() - c0;
+	if (rc == BSIM_OK) {
+		*tv_map = bsim_markov_nearest_tv_walks(pred->p, pred->n_locations,
+		                                       pred->nearest_walks);
+		v->map_cost += vs.cost;
+		v->map_steps += vs.steps;
+	}
+	bsim_markov_visits_free(&vs);
+	return rc;
+}
+
 static int group_validate(const bsim_markov_validate_def *def, const bsim_experiment *e, int g,
                           const bsim_sweep_result res[2], const double cpu[2], gsl_rng *rng,
                           group_data *d, bsim_markov_validation *v, bsim_error *err)
@@ -445,19 +510,18 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 	if (rc != BSIM_OK)
 		return rc;
 	bsim_options opts;
-	bsim_markov_set set;
-	rc = bsim_markov_load(&scene, def->map_dir, &opts, &set, err);
-	if (rc == BSIM_OK)
-		rc = bsim_markov_predict(&scene, &set, &d->pred, err);
-	if (rc == BSIM_OK && d->pred.has_time)
-		rc = bsim_markov_predict_time(&scene, &set, BSIM_MARKOV_WALKS, set.def.seed,
-		                              &d->pred, err);
+	bsim_markov_set set = {0};
 	double predict = 0.0, tv_map = NAN;
-	if (rc == BSIM_OK)
-		rc = time_predict(&scene, &set, &predict, err);
-	if (rc == BSIM_OK)
-		rc = bootstrap_maps(rng, &scene, &set, &d->pred, def->map_resamples, def->stop,
-		                    &tv_map, err);
+	const bsim_backend *be = def->nearest.backend;
+	if (def->visits_dir)
+		rc = predict_nearest(def, &scene, &d->pred, &predict, &tv_map, v, err);
+	else {
+		rc = bsim_markov_load(&scene, def->map_dir, &opts, &set, err);
+		if (rc == BSIM_OK)
+			rc = predict_maps(def, &scene, &set, rng, &d->pred, &predict, &tv_map, v,
+			                  err);
+		be = set.def.backend;
+	}
 	if (rc == BSIM_OK) {
 		/* the figure's title: the backend, the experiment's set:, the
 		 * command line's --set and the group's grid values */
@@ -473,26 +537,12 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 			for (int a = 0; a < na; a++)
 				ov[e->n_set + def->n_sets + a] = (bsim_override){
 				        e->axes[a].key, e->axes[a].values[idx[a]], NULL};
-			const bsim_backend *b =
-			        set.def.backend ? set.def.backend : bsim_backend_default();
+			const bsim_backend *b = be ? be : bsim_backend_default();
 			bsim_markov_title_params(d->title, sizeof d->title, b ? b->name : NULL, ov,
 			                         n);
 		}
 		free(ov);
 		free(idx);
-		v->bins = set.n ? set.maps[0].n_bins : 0;
-		v->trials_per_bin = set.def.trials;
-		v->of_crossings = set.n ? set.maps[0].of_crossings : 0;
-		v->per_crossing = set.n ? set.maps[0].per_crossing : 0;
-		bsim_markov_def_scope(&set.def, v->scope, sizeof v->scope);
-		for (int i = 0; i < set.n; i++) {
-			v->map_cost += set.maps[i].cost;
-			v->map_steps += set.maps[i].steps;
-		}
-		for (int i = 0; set.next && i < set.n * set.n; i++) {
-			v->map_cost += set.next[i].cost; /* the gates after the start */
-			v->map_steps += set.next[i].steps_total;
-		}
 	}
 	const bsim_lattice_def *l = &scene.lattice;
 	const int nl = d->pred.n_locations;
@@ -567,8 +617,20 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 		if (rc != BSIM_OK)
 			break;
 		bsim_markov_set_free(&set0);
-		rc = bsim_markov_load(&scene, def->map_dir, &opts0, &set0, err);
+		if (def->visits_dir) { /* the training fields run now, if missing */
+			bsim_markov_visits vs;
+			rc = bsim_markov_visits_build(&scene, &def->nearest, def->visits_dir, &vs,
+			                              err);
+			bsim_markov_visits_free(&vs);
+		} else
+			rc = bsim_markov_load(&scene, def->map_dir, &opts0, &set0, err);
 		bsim_scene_free(&scene);
+	}
+	const bsim_options no_opts = {0};
+	if (def->visits_dir) { /* the simulation on the training fields' backend */
+		set0.def.backend =
+		        def->nearest.backend ? def->nearest.backend : bsim_backend_default();
+		set0.def.opts = def->nearest.opts ? def->nearest.opts : &no_opts;
 	}
 	/* Both protocols' sweeps, journaled in out as one job. */
 	bsim_override *ov[2] = {protocol_sets(def, 0), protocol_sets(def, 1)};

@@ -56,11 +56,17 @@ static int write_figure(const char *stage, const bsim_scene *lattice, const bsim
 	                             {"effects.random_force.magnitude", rm, NULL}};
 	const bsim_backend *b = set && set->def.backend ? set->def.backend : bsim_backend_default();
 	bsim_markov_title_params(params, sizeof params, b ? b->name : NULL, ov, 2);
-	snprintf(title, sizeof title,
-	         "%s: final locations predicted by the Markov chain (%d states, %s)\n%s, "
-	         "%d trials per entry bin",
-	         lattice->name, p->n_states, p->exact ? "LU" : "series", params,
-	         set ? set->def.trials : 0);
+	if (p->nearest_walks > 0)
+		snprintf(title, sizeof title,
+		         "%s: final locations predicted by %ld nearest-neighbour walks\n%s, "
+		         "each step from the %d nearest of %d visits",
+		         lattice->name, p->nearest_walks, params, p->nearest_k, p->n_states);
+	else
+		snprintf(title, sizeof title,
+		         "%s: final locations predicted by the Markov chain (%d states, %s)\n%s, "
+		         "%d trials per entry bin",
+		         lattice->name, p->n_states, p->exact ? "LU" : "series", params,
+		         set ? set->def.trials : 0);
 	const markov_field_panel panel = {"probability of each final location", p->p, NULL};
 	return bsim_markov_field_figure(stage, "prediction", title, p->loc, p->n_locations, &panel,
 	                                1, 1, drawn, err);

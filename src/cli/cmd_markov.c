@@ -4,6 +4,7 @@
 #define _GNU_SOURCE /* asprintf, mkdtemp */
 
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -55,6 +56,9 @@ typedef struct markov_args {
 	int gates;           /* predict: --gates */
 	double tol;          /* predict: --tol */
 	long walks;          /* predict: --walks */
+	const char *visits;  /* predict, validate: --visits */
+	int k;               /* predict, validate: --k */
+	int train;           /* predict, validate: --train with --visits */
 	int shard, shards;   /* build: --shard, 1-based; 0: every map */
 	const char *passes;  /* build: --passes */
 	int n_entries;
@@ -349,12 +353,58 @@ static const cli_own predict_own[] = {
         {"gates", 0, NULL,
          "also the distribution of gates visited (the series,\nslower; --out implies "
          "it): p_gates,\nprediction_gates.csv"},
+        {"visits", 1, "DIR",
+         "instead of --map: nearest-neighbour walks over the visits\nof training fields "
+         "of the lattice's gate kinds in DIR,\nthose missing run there first "
+         "(docs/markov.md);\n--walks N of them (default 200000)"},
+        {"k", 1, "K",
+         "with --visits: each step drawn from the K nearest visits\n(1 to 64, default "
+         "20)"},
+        {"train", 1, "N", "with --visits: trials of each training field (default\n10000)"},
 };
+
+/* The options of the nearest-neighbour walks: --visits, --k, --train and
+ * (validate's) --walks. */
+static int nearest_option(markov_args *a, const char *cmd, int i, const char *value)
+{
+	static const char *const name[] = {"visits", "k", "train", "walks"};
+	static const long most[] = {0, 64, INT_MAX, 100000000L};
+	long n = 0;
+	if (i > 0 && cli_parse_long(value, 1, most[i], &n) != 0)
+		return cli_usage(cmd, "--%s %s: expected an integer 1 to %ld", name[i], value,
+		                 most[i]);
+	if (i == 0)
+		a->visits = value;
+	else if (i == 1)
+		a->k = (int)n;
+	else if (i == 2)
+		a->train = (int)n;
+	else
+		a->walks = n;
+	return CLI_OK;
+}
+
+/* The walks' def of --visits' options (0: not given, the default kept). */
+static void nearest_apply(const markov_args *a, const cli_common *c, const bsim_backend *be,
+                          const bsim_options *opts, bsim_markov_nearest_def *def)
+{
+	def->backend = be;
+	def->opts = opts;
+	def->threads = (int)c->threads;
+	if (a->train > 0)
+		def->trials = a->train;
+	if (a->k > 0)
+		def->k = a->k;
+	if (a->walks > 0)
+		def->walks = a->walks;
+}
 
 /* predict's own options: --map, then --locations, --json and the others
  * (validate's: validate_option). */
 static int predict_option(void *args, int i, const char *value)
 {
+	if (i >= 7) /* --visits, --k, --train */
+		return nearest_option(args, "markov predict", i - 7, value);
 	return markov_option(args, i == 0 ? OWN_MAP : OWN_LOCATIONS + i - 1, value);
 }
 
@@ -362,11 +412,14 @@ static const char *const predict_help[CLI_N_OPTS] = {
         [CLI_OPT_OUT] = "also write prediction.csv, prediction_gates.csv, time.csv,\n"
                         "their .mat twins and the figures prediction.png (the field)\n"
                         "and time.png into DIR",
+        [CLI_OPT_SEED] = "with --visits: seed of the training fields and the walks\n(default 1)",
+        [CLI_OPT_THREADS] = "with --visits: threads (default all cores; the same answer)",
+        [CLI_OPT_BACKEND] = "with --visits: the training fields' backend",
 };
 
 static const cli_spec predict_spec = {
         .name = "markov predict",
-        .usage = "LATTICE_SCENE --map DIR [OPTIONS]",
+        .usage = "LATTICE_SCENE (--map DIR | --visits DIR) [OPTIONS]",
         .about = "Composes the maps in DIR over the lattice of LATTICE_SCENE into an absorbing\n"
                  "Markov chain and prints the probabilities of ending through the end, out\n"
                  "a side and stuck in a gate, and the mean number of gates visited. The\n"
@@ -375,13 +428,18 @@ static const cli_spec predict_spec = {
                  "printed with --locations or --json. With the maps' holding times it\n"
                  "prints the expected time to the outcome (first-step analysis) and, by\n"
                  "walks of the semi-Markov chain, the outcome at the trial's duration and\n"
-                 "the time of each kind (--out DIR's time.csv and time.png).\n",
+                 "the time of each kind (--out DIR's time.csv and time.png).\n"
+                 "With --visits DIR instead: the final locations by nearest-neighbour\n"
+                 "walks over the exact gate visits of a training field per gate kind\n"
+                 "(--train trials each, default 10000), kept in DIR for every layout of the\n"
+                 "same kinds and physics.\n",
         .positional = "LATTICE_SCENE",
         .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) |
-                  CLI_USES(CLI_OPT_QUIET),
+                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS) |
+                  CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_BACKEND_OPT),
         .help = predict_help,
         .own = predict_own,
-        .n_own = 7,
+        .n_own = 10,
         .option = predict_option,
 };
 
@@ -394,6 +452,12 @@ static const cli_own validate_own[] = {
          "protocol's g*trials+t, then the world's) is part j mod N + 1's;\n"
          "DIR gets part.json and part.journal, beamsim merge joins the\n"
          "N parts' directories into the validation's (docs/cluster.md)"},
+        {"visits", 1, "DIR",
+         "instead of --map: predict by nearest-neighbour walks over\nthe visits in DIR, "
+         "as markov predict --visits (the training\nfields missing there run first)"},
+        {"k", 1, "K", "with --visits: as markov predict's (default 20)"},
+        {"train", 1, "N", "with --visits: as markov predict's (default 10000)"},
+        {"walks", 1, "N", "with --visits: the walks (default 200000)"},
 };
 
 static int validate_option(void *args, int i, const char *value)
@@ -401,11 +465,15 @@ static int validate_option(void *args, int i, const char *value)
 	markov_args *a = args;
 	if (i == 2)
 		return cli_shard_parse("markov validate", value, &a->shard, &a->shards);
+	if (i >= 3)
+		return nearest_option(a, "markov validate", i - 3, value);
 	return markov_option(args, OWN_MAP + i, value); /* --map, --bootstrap */
 }
 
 static const char *const validate_help[CLI_N_OPTS] = {
         [CLI_OPT_OUT] = "output directory (required)",
+        [CLI_OPT_BACKEND] = "with --visits: the backend of the training fields and the\n"
+                            "simulation (with --map: the maps')",
 };
 
 static const cli_spec validate_spec = {
@@ -427,11 +495,12 @@ static const cli_spec validate_spec = {
         .positional = "LATTICE_EXPERIMENT",
         .common = CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_TRIALS) | CLI_USES(CLI_OPT_SEED) |
                   CLI_USES(CLI_OPT_THREADS) | CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_GRID) |
-                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_OVERWRITE),
+                  CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_RESUME) | CLI_USES(CLI_OPT_OVERWRITE) |
+                  CLI_USES(CLI_OPT_BACKEND) | CLI_USES(CLI_OPT_BACKEND_OPT),
         .help = validate_help,
         .out_required = 1,
         .own = validate_own,
-        .n_own = 3,
+        .n_own = 7,
         .option = validate_option,
 };
 
@@ -720,22 +789,9 @@ int cmd_markov_merge(int argc, char **argv, const cli_merge *m)
 	return markov_build_main(argc, argv, m, NULL);
 }
 
-static void predict_print(const char *path, const bsim_markov_predict_result *r, const char *out,
-                          int locations)
+/* What the chain's solution says beyond the locations. */
+static void chain_print(const bsim_markov_prediction *p)
 {
-	static const char *const kinds[] = {"end", "side", "stuck"};
-	const bsim_markov_prediction *p = &r->p;
-	const double *total = r->total;
-	printf("lattice     %s (%s): %d x %d gates, %d maps, %d states (%s)\n", cli_path(path),
-	       r->scene.name, r->scene.lattice.columns, r->scene.lattice.rows, r->n_maps,
-	       p->n_states,
-	       p->exact    ? "LU"
-	       : p->sweeps ? "sweeps"
-	                   : "series");
-	printf("\nfinal location      p\n");
-	for (int k = 0; k < 3; k++)
-		printf("%-12s %7.4f\n", kinds[k], total[k]);
-	printf("%-12s %7.4f\n", "(sum)", total[0] + total[1] + total[2]);
 	if (p->n_gates > 0)
 		printf("\ngates visited: mean %.2f (%d terms of the series)", p->mean_gates,
 		       p->n_gates);
@@ -751,6 +807,37 @@ static void predict_print(const char *path, const bsim_markov_predict_result *r,
 	else
 		printf("\nexpected time: none (maps built before holding times were kept: "
 		       "beamsim markov build simulates them again)\n");
+}
+
+static void predict_print(const char *path, const bsim_markov_predict_result *r, const char *out,
+                          int locations)
+{
+	static const char *const kinds[] = {"end", "side", "stuck"};
+	const bsim_markov_prediction *p = &r->p;
+	const double *total = r->total;
+	if (p->nearest_walks > 0)
+		printf("lattice     %s (%s): %d x %d gates, %d training fields (%d run now, "
+		       "%.1f s of CPU when run), %d visits\n"
+		       "walks       %ld, each step from the %d nearest visits (%.2f s of CPU)\n",
+		       cli_path(path), r->scene.name, r->scene.lattice.columns,
+		       r->scene.lattice.rows, r->n_maps, r->fields_built, r->fields_cost,
+		       p->n_states, p->nearest_walks, p->nearest_k, r->cpu_seconds);
+	else
+		printf("lattice     %s (%s): %d x %d gates, %d maps, %d states (%s)\n",
+		       cli_path(path), r->scene.name, r->scene.lattice.columns,
+		       r->scene.lattice.rows, r->n_maps, p->n_states,
+		       p->exact    ? "LU"
+		       : p->sweeps ? "sweeps"
+		                   : "series");
+	printf("\nfinal location      p\n");
+	for (int k = 0; k < 3; k++)
+		printf("%-12s %7.4f\n", kinds[k], total[k]);
+	printf("%-12s %7.4f\n", "(sum)", total[0] + total[1] + total[2]);
+	if (p->nearest_walks > 0)
+		printf("\ngates visited: mean %.2f; the walks' own sampling error: TV %.4f\n",
+		       p->mean_gates, r->tv_walks);
+	else
+		chain_print(p);
 	if (p->walks > 0) {
 		printf("\nat the trial's duration, %g s (%ld walks of the semi-Markov chain; "
 		       "their error on a p: at most %.4f):\n"
@@ -782,16 +869,49 @@ static int markov_predict(int argc, char **argv)
 	/* The default tolerance is the maps' sampling one (-1: from the maps,
 	 * once read): the lean sweeps to it take under 5 ms of CPU on a 9 x 9
 	 * field at 4,4,3 bins, where the series to 1e-6 took 24 ms. */
-	markov_args a = {.def = bsim_markov_def_default(), .tol = -1.0, .walks = BSIM_MARKOV_WALKS};
+	markov_args a = {.def = bsim_markov_def_default(), .tol = -1.0, .walks = -1};
 	const char *path = NULL;
 	int rc = cli_parse(&predict_spec, argc, argv, &c, &a, &path);
-	if (rc < 0 && !a.map)
-		rc = cli_usage("markov predict", "--map DIR is required");
+	if (rc < 0 && !a.map == !a.visits)
+		rc = cli_usage("markov predict", "expected one of --map DIR and --visits DIR");
+	if (rc < 0 && a.map) {
+		const char *alone = c.has_seed  ? "--seed"
+		                    : c.threads ? "--threads"
+		                    : c.backend ? "--backend"
+		                    : a.k       ? "--k"
+		                    : a.train   ? "--train"
+		                                : NULL;
+		if (alone)
+			rc = cli_usage("markov predict",
+			               "%s is for --visits (the maps of --map hold their own)",
+			               alone);
+	}
+	if (rc < 0 && a.visits && (a.tol > 0 || a.no_gates || a.gates))
+		rc = cli_usage("markov predict", "--tol, --gates and --no-gates are for --map");
+	if (rc < 0 && a.visits && a.walks == 0)
+		rc = cli_usage("markov predict",
+		               "--walks 0: expected 1 or more walks with --visits");
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
 	}
 	bsim_markov_predict_def def = bsim_markov_predict_def_default();
+	bsim_options opts = {0};
+	if (a.visits) {
+		const bsim_backend *be = cli_backend_with_opts(
+		        &c, "markov predict", c.backend ? c.backend : bsim_backend_default()->name,
+		        &opts);
+		if (!be) {
+			cli_common_free(&c);
+			return CLI_USAGE;
+		}
+		def.visits_dir = a.visits;
+		nearest_apply(&a, &c, be, &opts, &def.nearest);
+		if (c.has_seed)
+			def.nearest.seed = c.seed;
+	}
+	if (a.walks < 0)
+		a.walks = BSIM_MARKOV_WALKS;
 	def.scene = path;
 	def.sets = c.sets.ov;
 	def.n_sets = c.sets.n;
@@ -822,8 +942,15 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	const char *path = NULL;
 	char **stored = NULL;
 	int rc = cli_parse(&validate_spec, argc, argv, &c, &a, &path);
-	if (rc < 0 && !a.map)
-		rc = cli_usage("markov validate", "--map DIR is required");
+	if (rc < 0 && !a.map == !a.visits)
+		rc = cli_usage("markov validate", "expected one of --map DIR and --visits DIR");
+	if (rc < 0 && a.map && (a.k || a.train || a.walks || c.backend))
+		rc = cli_usage("markov validate",
+		               "--%s is for --visits (the maps of --map hold their own)",
+		               a.k       ? "k"
+		               : a.train ? "train"
+		               : a.walks ? "walks"
+		                         : "backend");
 	if (rc < 0 && a.shards > 0 && cli_mpi_size() > 1)
 		rc = cli_usage("markov validate",
 		               "--shard runs one part in one process: not under mpirun, "
@@ -841,7 +968,7 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 		def.spread.n_merge = m->n_parts;
 	}
 	if (a.shards > 0) {
-		const char *paths[2] = {path, a.map};
+		const char *paths[2] = {path, a.map ? a.map : a.visits};
 		def.spread.spread = BSIM_SPREAD_SHARD;
 		def.spread.part.index = a.shard - 1;
 		def.spread.part.count = a.shards;
@@ -857,6 +984,19 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	               bsim_sweep_record_size(0), def.stop);
 	def.experiment = path;
 	def.map_dir = a.map;
+	bsim_options nearest_opts = {0};
+	if (a.visits) {
+		const bsim_backend *be = cli_backend_with_opts(
+		        &c, "markov validate", c.backend ? c.backend : bsim_backend_default()->name,
+		        &nearest_opts);
+		if (!be) {
+			cli_stored_argv_free(stored, argc, argv);
+			cli_common_free(&c);
+			return CLI_USAGE;
+		}
+		def.visits_dir = a.visits;
+		nearest_apply(&a, &c, be, &nearest_opts, &def.nearest);
+	}
 	def.out = c.out;
 	def.sets = c.sets.ov;
 	def.n_sets = c.sets.n;
@@ -893,9 +1033,17 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	if (rc == BSIM_OK && !c.quiet) {
 		char holds[96];
 		bins_hold(v.of_crossings, v.per_crossing, v.trials_per_bin, holds, sizeof holds);
-		printf("maps        %s: %d entry bins x %s, %.1f s of CPU to build "
-		       "(%lld single-gate steps)\n\n",
-		       a.map, v.bins, holds, v.map_cost, v.map_steps);
+		if (a.visits)
+			printf("visits      %s: nearest-neighbour walks, %ld of them, each step "
+			       "from "
+			       "the %d nearest visits;\n            training fields of %d trials, "
+			       "%.1f s of CPU to run (%lld time steps)\n\n",
+			       a.visits, def.nearest.walks, def.nearest.k, def.nearest.trials,
+			       v.map_cost, v.map_steps);
+		else
+			printf("maps        %s: %d entry bins x %s, %.1f s of CPU to build "
+			       "(%lld single-gate steps)\n\n",
+			       a.map, v.bins, holds, v.map_cost, v.map_steps);
 		printf("group protocol trials    TV  sampling (95%%)   map   gates sim/chain  "
 		       "sim CPU s  predict CPU s   speedup  pays off after\n");
 		for (int i = 0; i < v.n; i++) {

@@ -137,6 +137,17 @@ check(strcmp(id, 'beamsim:input') && ~isempty(strfind(msg, '''overwrite'', true'
 printf('validate: TV %.3f (essay), %.3f (world), the program''s\n', v.checks(1).tv, ...
        v.checks(2).tv);
 
+% ---- nearest-neighbour walks: the program's --visits ------------------------
+visits = fullfile(tmp, 'visits');
+p = beamsim_markov('predict', scene, 'visits', visits, 'train', 200, 'walks', 2000, 'threads', 2);
+[out, err, status] = program(exe, tmp, sprintf(['markov predict %s --visits %s --train 200 ' ...
+                                                '--walks 2000 --threads 1 --json'], scene, visits));
+check(status == 0, 'beamsim markov predict --visits: exit %d: %s', status, err);
+want = jsondecode(out);
+check(strcmp(p.solve, 'nearest') && p.fields_built > 0 && want.fields_built == 0 && ...
+      isequal([p.locations.p], [want.locations.p]), 'predict --visits: not the program''s');
+printf('predict --visits: end %.4f, the program''s\n', p.totals.xEnd);
+
 % ---- refusals ---------------------------------------------------------------
 h1 = fullfile(source, 'configs', 'thesis', 'h1_symmetric.yaml');
 target = fullfile(tmp, 'refused');
@@ -153,7 +164,8 @@ bad = {{'build', experiment, 'out', target, 'bins', [2 0 1]}, '''bins'': expecte
        {'build', experiment, 'out', target, 'entries', 'self:9'}, 'entries self:9: expected';
        {'predict', scene, 'map', mine, 'tol', 2}, '''tol'' 2: expected the probability';
        {'predict', scene, 'map', mine, 'trials', 3}, '''trials'': not an argument of ''predict''';
-       {'predict', scene}, '''map'' (the map directory) is required';
+       {'predict', scene}, 'expected one of ''map'' (the map directory) and ''visits''';
+       {'predict', scene, 'map', mine, 'k', 3}, '''k'': for ''visits'' only';
        {'bild', scene}, '''bild'': expected ''build'', ''predict'' or ''validate'''};
 for k = 1:size(bad, 1)
   [id, msg] = raised(@beamsim_markov, bad{k, 1}{:});

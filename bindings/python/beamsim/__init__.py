@@ -529,11 +529,31 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
     return info
 
 
-def markov_predict(scene, map, set=None, tol=None, gates=None, walks=None, out=None,
-                   overwrite=False):
+def _method(map, visits, k, train):
+    """The one of map and visits given; k and train with visits only."""
+    if (map is None) == (visits is None):
+        raise ValueError("expected one of map (the chain of a map directory) and visits "
+                         "(nearest-neighbour walks)")
+    if map is not None and (k is not None or train is not None):
+        raise ValueError(f"{'k' if k is not None else 'train'}: for visits only (the maps "
+                         "of map hold their own)")
+    _no_nul("map", map)
+    _no_nul("visits", visits)
+    return (os.fspath(map) if map is not None else None,
+            os.fspath(visits) if visits is not None else None)
+
+
+def markov_predict(scene, map=None, set=None, tol=None, gates=None, walks=None, out=None,
+                   overwrite=False, visits=None, k=None, train=None, seed=None, threads=None):
     """A gate lattice predicted from the maps in the map directory map, as
     `beamsim markov predict SCENE --map DIR --json` predicts it: the same
-    numbers for the same maps.
+    numbers for the same maps. Or, with visits instead of map, by
+    nearest-neighbour walks over the visits of training fields kept in the
+    directory visits (those missing run there first), as `beamsim markov
+    predict SCENE --visits DIR --json`: walks (None: 200000) of them, each
+    step from the k nearest visits (None: 20), training fields of train
+    trials a gate kind (None: 10000), seed (None: 1), threads (None: all
+    cores; the same numbers on any); tol and gates are for map.
 
     scene: a lattice scene file; set: {dotted key: value} overrides; tol:
     the probability left in the field at which the solution stops, in (0,
@@ -555,21 +575,30 @@ def markov_predict(scene, map, set=None, tol=None, gates=None, walks=None, out=N
         raise ValueError(f"--tol {tol}: expected the probability left in the field at which "
                          "the solution stops, in (0, 1), e.g. 1e-12")
     _no_nul("scene", scene)
-    _no_nul("map", map)
     _no_nul("out", out)
-    r = _beamsim.markov_predict(os.fspath(scene), os.fspath(map), _sets(set),
+    map, visits = _method(map, visits, k, train)
+    if visits is not None and (tol is not None or gates is not None):
+        raise ValueError("tol, gates: for map only")
+    if visits is None and (seed is not None or threads is not None):
+        raise ValueError("seed, threads: for visits only (the maps of map hold their own)")
+    if visits is not None:
+        walks = 200000 if walks is None else _count("walks", walks, 1, 100000000)
+    else:
+        walks = 100000 if walks is None else _count("walks", walks, 0, 100000000)
+    r = _beamsim.markov_predict(os.fspath(scene), map, _sets(set),
                                 float(tol) if tol is not None else 0.0,
-                                -1 if gates is None else int(bool(gates)),
-                                100000 if walks is None else _count("walks", walks, 0,
-                                                                     100000000),
-                                os.fspath(out) if out is not None else None, bool(overwrite))
+                                -1 if gates is None else int(bool(gates)), walks,
+                                os.fspath(out) if out is not None else None, bool(overwrite),
+                                visits, _count("k", k, 1, 64), _count("train", train, 1),
+                                _seed(seed), _count("threads", threads, 1, 4096))
     d = json.loads(r["json"])
     d["p_time"], d["time_bin"], d["p_loc_time"] = r["p_time"], r["time_bin"], r["p_loc_time"]
     return d
 
 
-def markov_validate(experiment, map, out=None, trials=None, seed=None, threads=None, set=None,
-                    grid=None, bootstrap=None, progress=None, resume=False, overwrite=False):
+def markov_validate(experiment, map=None, out=None, trials=None, seed=None, threads=None,
+                    set=None, grid=None, bootstrap=None, progress=None, resume=False,
+                    overwrite=False, visits=None, k=None, train=None, walks=None):
     """Every group of a lattice experiment simulated directly, under the
     essay's protocol and as a whole world, against the chain of the maps in
     map, as `beamsim markov validate EXPERIMENT --map DIR --out OUT` does
@@ -584,17 +613,23 @@ def markov_validate(experiment, map, out=None, trials=None, seed=None, threads=N
     with the maps' holding times, "time"; "map_cpu_seconds", "entry_bins",
     "trials_per_bin", "maps_scope", ...) with "files" (the directory's files as load
     reads them: "validate" (validate.csv), "gates", "time_validate", ...)
-    and "out"."""
+    and "out". With visits instead of map: the prediction by
+    nearest-neighbour walks, as markov_predict's (k, train, walks), as
+    `beamsim markov validate EXPERIMENT --visits DIR` makes it."""
     _no_nul("experiment", experiment)
-    _no_nul("map", map)
     _no_nul("out", out)
+    map, visits = _method(map, visits, k, train)
+    if visits is None and walks is not None:
+        raise ValueError("walks: for visits only")
     with _Dir(out, "validate") as d:
-        _beamsim.markov_validate(os.fspath(experiment), os.fspath(map), d,
+        _beamsim.markov_validate(os.fspath(experiment), map, d,
                                  _count("trials", trials, 1), _seed(seed),
                                  _count("threads", threads, 1, 4096), _sets(set), _grid(grid),
                                  -1 if bootstrap is None else
                                  _count("bootstrap", bootstrap, 0, 1000000),
-                                 progress, bool(resume), bool(overwrite))
+                                 progress, bool(resume), bool(overwrite), visits,
+                                 _count("k", k, 1, 64), _count("train", train, 1),
+                                 _count("walks", walks, 1, 100000000))
         files = load(d)
     info = files.pop("validate.json")
     info["files"] = files
