@@ -2378,10 +2378,13 @@ static void test_kinds_configs(void **state)
 	snprintf(dir, sizeof dir, "%s", bsim_test_src("configs/markov/kinds"));
 	DIR *d = opendir(dir);
 	assert_non_null(d);
-	const double kinds[2][3][2] = {{{150, 600}, {600, 300}, {300, 150}},
-	                               {{200, 500}, {700, 250}, {400, 120}}};
-	const double force[2] = {7.0, 8.0}, magnitude[2] = {25.0, 20.0};
-	int n_exp = 0, n_other = 0;
+	/* A, B, C; the held-out physics' D, E, G (exp_other_*); and the third
+	 * physics' H, I, J (exp_third_*) */
+	const double kinds[3][3][2] = {{{150, 600}, {600, 300}, {300, 150}},
+	                               {{200, 500}, {700, 250}, {400, 120}},
+	                               {{250, 450}, {550, 180}, {350, 350}}};
+	const double force[3] = {7.0, 8.0, 10.0}, magnitude[3] = {25.0, 20.0, 25.0};
+	int n_exp = 0, n_other = 0, n_third = 0;
 	struct dirent *de;
 	while ((de = readdir(d))) {
 		if (strncmp(de->d_name, "exp_", 4) != 0)
@@ -2396,9 +2399,12 @@ static void test_kinds_configs(void **state)
 		bsim_scene s;
 		assert_int_equal(bsim_experiment_group_scene(&e, 0, NULL, 0, &s, &err), BSIM_OK);
 		assert_true(s.has_lattice);
-		const int other = strncmp(de->d_name, "exp_other_", 10) == 0;
+		const int other = strncmp(de->d_name, "exp_other_", 10) == 0   ? 1
+		                  : strncmp(de->d_name, "exp_third_", 10) == 0 ? 2
+		                                                               : 0;
 		const double(*kind)[2] = kinds[other];
-		n_other += other;
+		n_other += other == 1;
+		n_third += other == 2;
 		assert_true(s.effects.has_propulsion && s.effects.propulsion_force == force[other]);
 		assert_true(s.effects.has_random_force &&
 		            s.effects.random_magnitude == magnitude[other]);
@@ -2425,7 +2431,8 @@ static void test_kinds_configs(void **state)
 	}
 	closedir(d);
 	assert_true(n_exp >= 18);
-	assert_true(n_other >= 5);
+	assert_true(n_other >= 6);
+	assert_true(n_third >= 3);
 }
 
 /* The note on a method's scope names what keeps it from the maps of a

@@ -39,7 +39,7 @@ struct markov_kdtree {
 	cloud c;
 	tree t;
 	markov_kdtree(const double (*pts)[3], size_t n)
-	    : c{pts, n}, t(3, c, nanoflann::KDTreeSingleIndexAdaptorParams(10))
+	    : c{pts, n}, t(3, c, nanoflann::KDTreeSingleIndexAdaptorParams(32))
 	{
 	}
 };

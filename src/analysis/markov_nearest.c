@@ -385,6 +385,33 @@ static pool *pools_make(const bsim_markov_visits *v, double (*kinds)[2], int n,
 	return p;
 }
 
+/* The visits of pool q nearest visit x's exit state (x's exit edge, and
+ * in the default bins' units b): every walk that leaves by x into a gate
+ * of q's kind asks the same question, so it is answered once and kept in
+ * *slot (its count, then the visits' indices), installed atomically: the
+ * answer is the same whichever thread gives it. NULL out of memory. */
+static const int *nearest_of(int **slot, const pool *q, const bsim_markov_visit *x, int k,
+                             const bsim_markov_bins *b, const bsim_lattice_def *l)
+{
+	int *got = __atomic_load_n(slot, __ATOMIC_ACQUIRE);
+	if (got)
+		return got;
+	int *mine = malloc((size_t)(k + 1) * sizeof *mine);
+	if (!mine)
+		return NULL;
+	double f[3];
+	long near[BSIM_MARKOV_KDTREE_K_MAX];
+	bsim_markov_entry_feature(b, l, x->exit_edge, x->exit_pos, x->exit_v, f);
+	mine[0] = bsim_markov_kdtree_nearest(q->tree, f, k, near);
+	for (int i = 0; i < mine[0]; i++)
+		mine[1 + i] = (int)q->visit[near[i]];
+	int *none = NULL;
+	if (__atomic_compare_exchange_n(slot, &none, mine, 0, __ATOMIC_ACQ_REL, __ATOMIC_ACQUIRE))
+		return mine;
+	free(mine); /* another thread's, the same */
+	return none;
+}
+
 /* Where one walk is: gate (ix, iy) entered through edge at pos with v. */
 typedef struct walker {
 	int ix, iy, edge;
@@ -478,7 +505,10 @@ int bsim_markov_nearest_predict(const bsim_scene *lattice, const bsim_markov_vis
 		                    "the visits are of other kinds or another physics",
 		                    kinds[start_kind][0], kinds[start_kind][1]);
 	long *count = rc == BSIM_OK ? calloc((size_t)n_loc + most + 2, sizeof *count) : NULL;
-	if (rc == BSIM_OK && !count)
+	/* memo[x n + j]: the visits of kind j nearest visit x's exit
+	 * (nearest_of) */
+	int **memo = rc == BSIM_OK ? calloc((size_t)v->n * n + 1, sizeof *memo) : NULL;
+	if (rc == BSIM_OK && (!count || !memo))
 		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
 	/* the first (kind, edge) without visits that a walk entered, in the
 	 * pools' order, whatever the threads */
@@ -515,14 +545,27 @@ int bsim_markov_nearest_predict(const bsim_scene *lattice, const bsim_markov_vis
 					missing = kp < missing ? kp : missing;
 					break;
 				}
-				double f[3];
-				long near[BSIM_MARKOV_KDTREE_K_MAX];
-				bsim_markov_entry_feature(&b, l, at.edge, at.pos, at.v, f);
-				const int got =
-				        bsim_markov_kdtree_nearest(q->tree, f, def->k, near);
 				const uint64_t r =
 				        bsim_schedule_seed_mix(seed, (uint64_t)w, (uint64_t)gates);
-				x = &v->v[q->visit[near[r % (uint64_t)got]]];
+				if (at.edge != x->exit_edge) {
+					/* row 0 entered again from below: a state of its own */
+					double f[3];
+					long near[BSIM_MARKOV_KDTREE_K_MAX];
+					bsim_markov_entry_feature(&b, l, at.edge, at.pos, at.v, f);
+					const int got = bsim_markov_kdtree_nearest(q->tree, f,
+					                                           def->k, near);
+					x = &v->v[q->visit[near[r % (uint64_t)got]]];
+					continue;
+				}
+				const int *near =
+				        nearest_of(&memo[(size_t)(x - v->v) * n + kp / EDGES], q, x,
+				                   def->k, &b, l);
+				if (!near) {
+#pragma omp atomic write
+					oom = 1;
+					break;
+				}
+				x = &v->v[near[1 + r % (uint64_t)near[0]]];
 			}
 			if (loc >= 0) {
 				mine[loc]++;
@@ -576,6 +619,9 @@ int bsim_markov_nearest_predict(const bsim_scene *lattice, const bsim_markov_vis
 		}
 	}
 	free(count);
+	for (long i = 0; memo && i < v->n * n; i++)
+		free(memo[i]);
+	free(memo);
 	pools_free(pools, n * EDGES);
 	free(gate_kind);
 	free(kinds);
