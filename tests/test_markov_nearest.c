@@ -455,7 +455,7 @@ static void test_cli(void **state)
 	}
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
 	const struct CMUnitTest tests[] = {
 	        cmocka_unit_test(test_walks_by_hand),
@@ -466,5 +466,7 @@ int main(void)
 	        cmocka_unit_test(test_bad_inputs),
 	        cmocka_unit_test(test_cli),
 	};
+	if (argc > 1) /* one test by name, e.g. test_cli */
+		cmocka_set_test_filter(argv[1]);
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -494,10 +494,11 @@ BSIM_API int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, i
                                       bsim_error *err);
 
 /* Where maps of def were measured to fall short on layouts they were not
- * built on, one sentence into buf, or "" for maps of the default method:
- * states uniform in bins at least as many as the default's, the default's
- * start trials or more and the gate after the start (docs/markov.md,
- * "Maps of a physics"). Flow entries: maps of one layout; self-consistent
+ * built on, one sentence into buf. Maps of the default method (states from
+ * a training field, bins at least as many as the default's, the default's
+ * start trials or more and the gate after the start): where they missed
+ * TV 0.05 and the nearest-neighbour walks did not (docs/markov.md, "A
+ * kernel over exact states"). Flow entries: maps of one layout; self-consistent
  * entries, and the default method with coarser bins, fewer start trials
  * or no gate after the start: each measured less accurate there; entries
  * observed in sweeps: maps for layouts like the sweeps' (from a random

@@ -4,6 +4,7 @@
 #include "analysis/markov_internal.h"
 
 #include <math.h>
+#include <string.h>
 
 static const double PI = 3.14159265358979323846;
 
@@ -159,6 +160,14 @@ static const char *const edge_names[] = {"start", "bottom", "left", "right", "to
 const char *bsim_markov_edge_name(int edge)
 {
 	return edge_names[edge];
+}
+
+int bsim_markov_edge_of(const char *name)
+{
+	for (int e = BSIM_EDGE_START; e <= BSIM_EDGE_TOP; e++)
+		if (strcmp(name, bsim_markov_edge_name(e)) == 0)
+			return e;
+	return -1;
 }
 
 const char *bsim_markov_bin_edge(const bsim_markov_bins *b, int bin)

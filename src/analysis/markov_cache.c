@@ -175,10 +175,7 @@ uint64_t bsim_markov_key(const char *key_text)
 	return bsim_hash_fnv1a64(key_text, strlen(key_text), HASH_FNV1A64_SEED);
 }
 
-/* Whether path, a map's .key file, holds exactly key_text: a file that
- * is longer (it is not read past that length), shorter or unreadable does
- * not. */
-static int key_same(const char *path, const char *key_text)
+int bsim_markov_key_same(const char *path, const char *key_text)
 {
 	size_t len = strlen(key_text);
 	file_text t;
@@ -488,7 +485,7 @@ int bsim_markov_map_read(const char *dir, bsim_markov_map *m, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/map_%016llx.key", dir, (unsigned long long)m->key);
-	if (!key_same(path, m->key_text))
+	if (!bsim_markov_key_same(path, m->key_text))
 		return 0;
 	snprintf(path, sizeof path, "%s/map_%016llx.csv", dir, (unsigned long long)m->key);
 	/* At most a row per single gate (of crossings: per pair of bins), each

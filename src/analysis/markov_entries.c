@@ -84,10 +84,7 @@ int bsim_markov_entries_load(const char *const *paths, int n, bsim_markov_entrie
 		rc = bsim_csv_table_require(&t, path, want, 6, col, err);
 		for (long r = 0; rc == BSIM_OK && r < t.n_rows; r++) {
 			const char *edge = bsim_csv_table_cell(&t, r, col[0]);
-			int e = -1;
-			for (int k = 0; k < 5; k++)
-				if (strcmp(edge, bsim_markov_edge_name(k)) == 0)
-					e = k;
+			const int e = bsim_markov_edge_of(edge);
 			double val[6];
 			int bad = e < 0;
 			for (int k = 1; k < 6 && !bad; k++)

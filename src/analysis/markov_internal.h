@@ -25,6 +25,8 @@
 /* The name of an edge, BSIM_EDGE_START .. BSIM_EDGE_TOP: "start",
  * "bottom", "left", "right", "top" (gate_entries.csv and map files). */
 const char *bsim_markov_edge_name(int edge);
+/* The edge of such a name, or -1. */
+int bsim_markov_edge_of(const char *name);
 
 /* The name of the edge of entry bin `bin`, "start" for bin 0. */
 const char *bsim_markov_bin_edge(const bsim_markov_bins *b, int bin);
@@ -380,6 +382,11 @@ int bsim_markov_gate_maps(const bsim_scene *lattice, const bsim_markov_set *set,
  * out of memory). */
 char *bsim_markov_key_text(const bsim_scene *lattice, const bsim_markov_def *def,
                            const bsim_backend *be, const bsim_options *opts, const double k[2]);
+
+/* Whether path, a .key file, holds exactly key_text: a file that is
+ * longer (it is not read past that length), shorter or unreadable does
+ * not. */
+int bsim_markov_key_same(const char *path, const char *key_text);
 
 /* The key of a key text: the map's file name, map_KEY. */
 uint64_t bsim_markov_key(const char *key_text);

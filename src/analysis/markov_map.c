@@ -217,8 +217,13 @@ const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t 
 		if (part[k][0])
 			len += (size_t)snprintf(list + len, sizeof list - len, "%s%s",
 			                        len ? ", " : "", part[k]);
-	if (!len)
-		snprintf(buf, size, "%s", "");
+	if (!len) /* the default method, or finer */
+		snprintf(buf, size,
+		         "maps of entry bins: measured beyond TV 0.05 on 7 of 40 fields, columns "
+		         "and "
+		         "a random field of a physics they were not chosen on among them, where "
+		         "nearest-neighbour walks (markov predict --visits DIR) were within 0.05 "
+		         "on all 40 (docs/markov.md, \"A kernel over exact states\")");
 	else
 		snprintf(buf, size,
 		         "maps with %s: measured less accurate than the default's on layouts "

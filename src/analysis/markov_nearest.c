@@ -105,14 +105,6 @@ static char *visits_key(const bsim_scene *lattice, const bsim_markov_def *m, con
 	return text;
 }
 
-static int edge_of(const char *name, int stuck_ok)
-{
-	for (int e = BSIM_EDGE_START; e <= BSIM_EDGE_TOP; e++)
-		if (strcmp(name, bsim_markov_edge_name(e)) == 0)
-			return e == BSIM_EDGE_START && stuck_ok ? -1 : e;
-	return stuck_ok && strcmp(name, "stuck") == 0 ? 0 : -1;
-}
-
 /* dir/visits_HASH.csv and .cost appended to out (cap its arrays'). */
 static int visits_read(const char *dir, uint64_t hash, bsim_markov_visits *out, long *cap,
                        bsim_error *err)
@@ -162,8 +154,11 @@ static int visits_read(const char *dir, uint64_t hash, bsim_markov_visits *out, 
 		for (int i = 0; i < 9 && bad < 0; i++)
 			if (bsim_csv_table_number(&t, r, col[num[i]], &x[i]) != 0)
 				bad = num[i];
-		v->edge = edge_of(bsim_csv_table_cell(&t, r, col[2]), 0);
-		v->exit_edge = edge_of(bsim_csv_table_cell(&t, r, col[6]), 1);
+		const char *into = bsim_csv_table_cell(&t, r, col[6]);
+		const int into_edge = bsim_markov_edge_of(into);
+		v->edge = bsim_markov_edge_of(bsim_csv_table_cell(&t, r, col[2]));
+		/* an exit is into a gate's edge (not a start), or stuck (0) */
+		v->exit_edge = strcmp(into, "stuck") == 0 ? 0 : into_edge > 0 ? into_edge : -1;
 		if (bad < 0 && v->edge < 0)
 			bad = 2;
 		if (bad < 0 && v->exit_edge < 0)
@@ -239,14 +234,7 @@ static int key_there(const char *dir, uint64_t hash, const char *key)
 {
 	char path[BSIM_PATH_MAX];
 	snprintf(path, sizeof path, "%s/visits_%016llx.key", dir, (unsigned long long)hash);
-	const size_t len = strlen(key);
-	file_text t;
-	bsim_error ignored;
-	if (bsim_file_read(path, "a visits key", (double)len, NULL, &t, &ignored) != BSIM_OK)
-		return 0;
-	const int same = t.len == len && memcmp(t.text, key, len) == 0;
-	bsim_file_text_free(&t);
-	return same;
+	return bsim_markov_key_same(path, key);
 }
 
 int bsim_markov_visits_build(const bsim_scene *lattice, const bsim_markov_nearest_def *def,
