@@ -13,7 +13,7 @@
  *   - the visits are the same with 1 and 2 threads, read back from their
  *     directory as they were run, and run again when the physics changes;
  *     the walks are the same on any number of threads and change with the
- *     seed;
+ *     seed; a build stopped keeps the training fields it finished;
  *   - a malformed visits file, visits of other kinds and bad options are
  *     input errors naming what is wrong (exit 2 from the program). */
 #define _POSIX_C_SOURCE 200809L
@@ -21,6 +21,7 @@
 #include <glob.h>
 #include <math.h>
 #include <setjmp.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -342,6 +343,58 @@ static void test_threads_cache_and_seed(void **state)
 	bsim_scene_free(&s);
 }
 
+/* A progress callback that stops the build as the second training field
+ * starts: its first count after the first field's last (one thread: the
+ * counts in order). */
+typedef struct stopper {
+	volatile sig_atomic_t stop;
+	int first_done;
+} stopper;
+
+static void stop_at_second_field(void *user, long done, long total)
+{
+	stopper *st = user;
+	if (st->first_done)
+		st->stop = 1;
+	if (done == total)
+		st->first_done = 1;
+}
+
+/* A build stopped in its second training field keeps the first, whole,
+ * and writes nothing of the second; run again it runs the second alone,
+ * and the visits are those of a build never stopped. */
+static void test_stopped_keeps_fields(void **state)
+{
+	(void)state;
+	bsim_scene s;
+	ring(&s);
+	char dir[1100], whole[1100];
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir_held("stopped"));
+	snprintf(whole, sizeof whole, "%s", bsim_test_dir_held("unstopped"));
+	bsim_markov_nearest_def def = bsim_markov_nearest_def_default();
+	def.trials = 300;
+	def.threads = 1;
+	stopper st = {0};
+	def.progress = stop_at_second_field;
+	def.progress_user = &st;
+	def.stop = &st.stop;
+	bsim_markov_visits a, b;
+	bsim_error err;
+	assert_int_equal(bsim_markov_visits_build(&s, &def, dir, &a, &err), BSIM_ESTOPPED);
+	assert_int_equal(files_matching(dir, "visits_*.key"), 1);
+	assert_int_equal(files_matching(dir, "visits_*.csv"), 1);
+	def.progress = NULL;
+	def.stop = NULL;
+	assert_int_equal(bsim_markov_visits_build(&s, &def, dir, &a, &err), BSIM_OK);
+	assert_int_equal(a.built, 1);
+	assert_int_equal(a.reused, 1);
+	assert_int_equal(bsim_markov_visits_build(&s, &def, whole, &b, &err), BSIM_OK);
+	assert_true(visits_same(&a, &b));
+	bsim_markov_visits_free(&a);
+	bsim_markov_visits_free(&b);
+	bsim_scene_free(&s);
+}
+
 /* Replaces the first `from` in path's text after its header with `to`. */
 static void spoil(const char *path, const char *from, const char *to)
 {
@@ -463,6 +516,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_walks_that_never_end_said),
 	        cmocka_unit_test(test_walks_against_simulation),
 	        cmocka_unit_test(test_threads_cache_and_seed),
+	        cmocka_unit_test(test_stopped_keeps_fields),
 	        cmocka_unit_test(test_bad_inputs),
 	        cmocka_unit_test(test_cli),
 	};

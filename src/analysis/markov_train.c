@@ -284,7 +284,7 @@ static int train_trials(const bsim_scene *s, const train_layout *L, uint64_t see
 				char why[160];
 				bsim_trial_instability_text(&res, s->dt, why, sizeof why);
 				trc = bsim_error_set(&e, BSIM_EFAIL,
-				                     "trial %ld of the maps' training field became "
+				                     "trial %ld of a training field became "
 				                     "unstable: %s",
 				                     t, why);
 			}
@@ -301,7 +301,7 @@ static int train_trials(const bsim_scene *s, const train_layout *L, uint64_t see
 		bsim_scene_free(&mine);
 	}
 	if (stopped)
-		rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped in the maps' training field");
+		rc = bsim_error_set(err, BSIM_ESTOPPED, "stopped in a training field");
 	else if (first < T) {
 		rc = BSIM_EFAIL;
 		if (err)

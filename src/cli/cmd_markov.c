@@ -897,6 +897,8 @@ static int markov_predict(int argc, char **argv)
 	}
 	bsim_markov_predict_def def = bsim_markov_predict_def_default();
 	bsim_options opts = {0};
+	cli_progress training;
+	cli_progress_init(&training, !c.quiet && a.visits, "training trials");
 	if (a.visits) {
 		const bsim_backend *be = cli_backend_with_opts(
 		        &c, "markov predict", c.backend ? c.backend : bsim_backend_default()->name,
@@ -909,6 +911,9 @@ static int markov_predict(int argc, char **argv)
 		nearest_apply(&a, &c, be, &opts, &def.nearest);
 		if (c.has_seed)
 			def.nearest.seed = c.seed;
+		def.nearest.progress = train_progress_update;
+		def.nearest.progress_user = &training;
+		def.nearest.stop = &cli_stop;
 	}
 	if (a.walks < 0)
 		a.walks = BSIM_MARKOV_WALKS;
@@ -923,7 +928,18 @@ static int markov_predict(int argc, char **argv)
 	def.walks = a.walks;
 	bsim_markov_predict_result r;
 	bsim_error err;
+	cli_signals_install();
 	rc = bsim_markov_predict_run(&def, &r, &err);
+	cli_signals_restore();
+	cli_progress_finish(&training);
+	if (rc == BSIM_ESTOPPED) {
+		/* Each finished training field is in the directory already. */
+		const int sig = cli_stop ? (int)cli_stop : SIGINT;
+		cli_error("%s: %s; the same command runs the rest",
+		          sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
+		cli_common_free(&c);
+		return 128 + sig;
+	}
 	/* --quiet wins over --json: nothing on stdout. */
 	if (rc == BSIM_OK && !c.quiet && a.json)
 		bsim_markov_predict_json(stdout, path, &r);
@@ -996,6 +1012,7 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 		}
 		def.visits_dir = a.visits;
 		nearest_apply(&a, &c, be, &nearest_opts, &def.nearest);
+		def.nearest.stop = &cli_stop;
 	}
 	def.out = c.out;
 	def.sets = c.sets.ov;
@@ -1012,11 +1029,16 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	cli_progress_init(&progress, !c.quiet && rank == 0, "trials");
 	def.progress = rank == 0 ? cli_progress_update : NULL;
 	def.progress_user = &progress;
+	cli_progress training; /* the walks' training fields, before the trials */
+	cli_progress_init(&training, !c.quiet && rank == 0 && a.visits, "training trials");
+	def.nearest.progress = rank == 0 ? train_progress_update : NULL;
+	def.nearest.progress_user = &training;
 	bsim_markov_validation v;
 	bsim_error err;
 	cli_signals_install();
 	rc = bsim_markov_validate(&def, &v, &err);
 	cli_signals_restore();
+	cli_progress_finish(&training);
 	cli_progress_finish(&progress);
 	cli_stored_argv_free(stored, argc, argv);
 	if (rc != BSIM_OK || def.spread.spread == BSIM_SPREAD_SEND || a.shards > 0) {
