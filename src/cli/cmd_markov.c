@@ -1066,8 +1066,10 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 			printf("maps        %s: %d entry bins x %s, %.1f s of CPU to build "
 			       "(%lld single-gate steps)\n\n",
 			       a.map, v.bins, holds, v.map_cost, v.map_steps);
-		printf("group protocol trials    TV  sampling (95%%)   map   gates sim/chain  "
-		       "sim CPU s  predict CPU s   speedup  pays off after\n");
+		/* the maps' sampling error, or with --visits the walks' own */
+		printf("group protocol trials    TV  sampling (95%%) %5s   gates sim/chain  "
+		       "sim CPU s  predict CPU s   speedup  pays off after\n",
+		       a.visits ? "walks" : "map");
 		for (int i = 0; i < v.n; i++) {
 			const bsim_markov_check *k = &v.checks[i];
 			/* the fields (predictions) after which the maps cost less
