@@ -336,7 +336,7 @@ static const cli_spec build_spec = {
 };
 
 static const cli_own predict_own[] = {
-        {"map", 1, "DIR", "the map directory of beamsim markov build (required)"},
+        {"map", 1, "DIR", "the map directory of beamsim markov build (or --visits)"},
         {"locations", 0, NULL, "also print every final location with its probability"},
         {"json", 0, NULL,
          "print one JSON object (totals, every location, predict_seconds)\ninstead of text"},
@@ -444,7 +444,7 @@ static const cli_spec predict_spec = {
 };
 
 static const cli_own validate_own[] = {
-        {"map", 1, "DIR", "the map directory of beamsim markov build (required)"},
+        {"map", 1, "DIR", "the map directory of beamsim markov build (or --visits)"},
         {"bootstrap", 1, "B", "resamples of the simulation (default 2000)"},
         {"shard", 1, "I/N",
          "simulate part I of N (I from 1 to N, as SLURM_ARRAY_TASK_ID\n"
