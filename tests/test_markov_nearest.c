@@ -221,8 +221,8 @@ static void ring(bsim_scene *s)
 }
 
 /* A ring of one kind around 3 x 3 of another (5 x 5) under the essay's
- * protocol: the walks over the visits of two training fields of 1,000
- * trials each against 2,000 direct trials, every location within 4.5
+ * protocol: the walks over the visits of two training fields of 600
+ * trials each against 1,500 direct trials, every location within 4.5
  * standard errors of both samples. */
 static void test_walks_against_simulation(void **state)
 {
@@ -230,7 +230,7 @@ static void test_walks_against_simulation(void **state)
 	bsim_scene s;
 	ring(&s);
 	bsim_markov_nearest_def def = bsim_markov_nearest_def_default();
-	def.trials = 1000;
+	def.trials = 600;
 	def.walks = 20000;
 	bsim_markov_visits vs;
 	bsim_error err;
@@ -241,7 +241,7 @@ static void test_walks_against_simulation(void **state)
 	assert_true(vs.cost > 0 && vs.steps > 0 && vs.left_out > 0);
 	bsim_markov_prediction p;
 	assert_int_equal(bsim_markov_nearest_predict(&s, &vs, &def, &p, &err), BSIM_OK);
-	const int N = 2000;
+	const int N = 1500;
 	double *sim = calloc((size_t)p.n_locations, sizeof *sim);
 	simulate(&s, &p, N, sim);
 	int seen = 0;
@@ -299,7 +299,7 @@ static void test_threads_cache_and_seed(void **state)
 	snprintf(one, sizeof one, "%s", bsim_test_dir_held("threads1"));
 	snprintf(two, sizeof two, "%s", bsim_test_dir_held("threads2"));
 	bsim_markov_nearest_def def = bsim_markov_nearest_def_default();
-	def.trials = 150;
+	def.trials = 80;
 	def.walks = 3000;
 	bsim_markov_visits a, b, c;
 	bsim_error err;
@@ -372,7 +372,7 @@ static void test_stopped_keeps_fields(void **state)
 	snprintf(dir, sizeof dir, "%s", bsim_test_dir_held("stopped"));
 	snprintf(whole, sizeof whole, "%s", bsim_test_dir_held("unstopped"));
 	bsim_markov_nearest_def def = bsim_markov_nearest_def_default();
-	def.trials = 300;
+	def.trials = 100;
 	def.threads = 1;
 	stopper st = {0};
 	def.progress = stop_at_second_field;
