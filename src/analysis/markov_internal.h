@@ -185,6 +185,10 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
                           bsim_markov_entries *out, markov_crossings *cx, long long *steps,
                           bsim_error *err);
 
+/* Room for one more visit in v, whose array holds *cap (grown as needed,
+ * 0 for an empty v): 0, or -1 out of memory (v keeps what it had). */
+int bsim_markov_visits_reserve(bsim_markov_visits *v, long *cap);
+
 /* The visits (beamsim/markov_nearest.h) of lattice's training field whose
  * start gate is of kind start (def->train_trials trials, each trial's
  * layout of lattice's kinds at random and its schedule from seed and the

@@ -136,15 +136,9 @@ static int visits_read(const char *dir, uint64_t hash, bsim_markov_visits *out, 
 	int col[11];
 	rc = bsim_csv_table_require(&t, path, names, 11, col, err);
 	for (long r = 0; rc == BSIM_OK && r < t.n_rows; r++) {
-		if (out->n == *cap) {
-			const long more = *cap ? 2 * *cap : 4096;
-			bsim_markov_visit *v = realloc(out->v, (size_t)more * sizeof *v);
-			if (!v) {
-				rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-				break;
-			}
-			out->v = v;
-			*cap = more;
+		if (bsim_markov_visits_reserve(out, cap)) {
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+			break;
 		}
 		bsim_markov_visit *v = &out->v[out->n];
 		memset(v, 0, sizeof *v);

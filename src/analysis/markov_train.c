@@ -159,6 +159,32 @@ void bsim_markov_crossings_free(markov_crossings *c)
 	memset(c, 0, sizeof *c);
 }
 
+/* Whether the exit of trial log g's entry j is known: the gate was left
+ * into the next entry, or the trial's last gate held it gate_steps steps
+ * (res: stuck); *steps the time steps it spent there (gate_steps if
+ * stuck). A gate the trial left the field from, or ended in otherwise, has
+ * no known exit. */
+static int exit_known(const bsim_scene *s, const bsim_trial_log *g, const bsim_trial_result *res,
+                      int j, int *steps)
+{
+	const bsim_gate_entry *e = &g->entries[j];
+	*steps = s->gate_steps;
+	if (j + 1 < g->n_entries) {
+		const int next = g->entries[j + 1].step;
+		/* a gate crossed at a corner, within one step, held it one */
+		*steps = next > e->step ? next - e->step : 1;
+		return 1;
+	}
+	return res->outcome == BSIM_STUCK && res->steps_run - e->step >= s->gate_steps;
+}
+
+/* The stiffness pair of the lattice s's gate (ix, iy) into k. */
+static void gate_kind(const bsim_scene *s, int ix, int iy, double k[2])
+{
+	for (int side = 0; side < 2; side++)
+		k[side] = s->beams[bsim_lattice_beam(&s->lattice, ix, iy, side)].stiffness;
+}
+
 /* Trial log g's crossings (but the start gate's) appended to c, whose
  * arrays hold *cap: the gate entered by each entry but the last left into
  * the next entry's bin; the last, in a trial stuck there for gate_steps
@@ -171,14 +197,12 @@ static int crossings_push(markov_crossings *c, long *cap, const bsim_scene *s,
 	for (int j = 1; j < g->n_entries; j++) {
 		const bsim_gate_entry *e = &g->entries[j],
 		                      *next = j + 1 < g->n_entries ? e + 1 : NULL;
-		int exit = 0, steps = s->gate_steps;
-		if (next) {
-			exit = bsim_markov_bin_of(&def->bins, l, (int)next->edge, next->pos,
-			                          next->v);
-			/* a gate crossed at a corner, within one step, held it one */
-			steps = next->step > e->step ? next->step - e->step : 1;
-		} else if (res->outcome != BSIM_STUCK || res->steps_run - e->step < s->gate_steps)
-			break; /* left the field, or the trial ended: no exit known */
+		int steps;
+		if (!exit_known(s, g, res, j, &steps))
+			break;
+		const int exit = next ? bsim_markov_bin_of(&def->bins, l, (int)next->edge,
+		                                           next->pos, next->v)
+		                      : 0;
 		if (c->n == *cap) {
 			const long more = *cap ? 2 * *cap : 1024;
 			double(*k)[2] = realloc(c->k, (size_t)more * sizeof *k);
@@ -196,9 +220,7 @@ static int crossings_push(markov_crossings *c, long *cap, const bsim_scene *s,
 				return -1;
 			*cap = more;
 		}
-		for (int side = 0; side < 2; side++)
-			c->k[c->n][side] =
-			        s->beams[bsim_lattice_beam(l, e->ix, e->iy, side)].stiffness;
+		gate_kind(s, e->ix, e->iy, c->k[c->n]);
 		c->entry[c->n] = bsim_markov_bin_of(&def->bins, l, (int)e->edge, e->pos, e->v);
 		c->exit[c->n] = exit;
 		c->steps[c->n] = steps;
@@ -382,6 +404,19 @@ int bsim_markov_train_run(const bsim_scene *lattice, const bsim_markov_def *def,
 	return rc;
 }
 
+int bsim_markov_visits_reserve(bsim_markov_visits *v, long *cap)
+{
+	if (v->n < *cap)
+		return 0;
+	const long more = *cap ? 2 * *cap : 4096;
+	bsim_markov_visit *grown = realloc(v->v, (size_t)more * sizeof *grown);
+	if (!grown)
+		return -1;
+	v->v = grown;
+	*cap = more;
+	return 0;
+}
+
 /* Trial log g's visits appended to out (see bsim_markov_train_visits). */
 static int visits_push(bsim_markov_visits *out, long *cap, const bsim_scene *s,
                        const bsim_trial_log *g, const bsim_trial_result *res)
@@ -390,37 +425,28 @@ static int visits_push(bsim_markov_visits *out, long *cap, const bsim_scene *s,
 	for (int j = 0; j < g->n_entries; j++) {
 		const bsim_gate_entry *e = &g->entries[j],
 		                      *next = j + 1 < g->n_entries ? e + 1 : NULL;
-		if (!next &&
-		    (res->outcome != BSIM_STUCK || res->steps_run - e->step < s->gate_steps))
-			break; /* left the field, or the trial ended: no exit known */
+		int steps;
+		if (!exit_known(s, g, res, j, &steps))
+			break;
 		if (e->iy == l->rows - 1 || e->ix == l->ix_min || e->ix == l->ix_max) {
 			out->left_out++;
 			continue;
 		}
-		if (out->n == *cap) {
-			const long more = *cap ? 2 * *cap : 4096;
-			bsim_markov_visit *v = realloc(out->v, (size_t)more * sizeof *v);
-			if (!v)
-				return -1;
-			out->v = v;
-			*cap = more;
-		}
+		if (bsim_markov_visits_reserve(out, cap))
+			return -1;
 		bsim_markov_visit *v = &out->v[out->n++];
 		memset(v, 0, sizeof *v);
-		for (int side = 0; side < 2; side++)
-			v->k[side] = s->beams[bsim_lattice_beam(l, e->ix, e->iy, side)].stiffness;
+		gate_kind(s, e->ix, e->iy, v->k);
 		v->edge = (int)e->edge;
 		v->pos = e->pos;
 		v->v[0] = e->v[0];
 		v->v[1] = e->v[1];
-		v->steps = s->gate_steps;
+		v->steps = steps;
 		if (next) {
 			v->exit_edge = (int)next->edge;
 			v->exit_pos = next->pos;
 			v->exit_v[0] = next->v[0];
 			v->exit_v[1] = next->v[1];
-			/* a gate crossed at a corner, within one step, held it one */
-			v->steps = next->step > e->step ? next->step - e->step : 1;
 		}
 	}
 	return 0;
