@@ -13,6 +13,8 @@
 
 #include "beamsim/backend_plugin.h"
 #include "beamsim/backend_registry.h"
+#include "beamsim/schedule.h"
+#include "beamsim/trial.h"
 
 #include "util/figure.h"
 #include "store/outdir.h"
@@ -944,4 +946,25 @@ bsim_world *bsim_test_world(const bsim_backend *b, const bsim_scene *s, const bs
 	if (b->create(s, opts, &w, &err) != BSIM_OK)
 		fail_msg("%s: %s", b->name, err.msg);
 	return w;
+}
+
+void bsim_test_simulate_locations(const bsim_scene *s, const bsim_location *loc, int n, int N,
+                                  uint64_t seed, double *share)
+{
+	bsim_trial_runner *r = bsim_trial_runner_alloc();
+	const bsim_options none = {0};
+	bsim_error err;
+	assert_non_null(r);
+	for (int t = 0; t < N; t++) {
+		bsim_trial_result res;
+		assert_int_equal(bsim_trial_run(r, s, bsim_backend_default(), &none,
+		                                bsim_schedule_seed_mix(seed, 0, (uint64_t)t), NULL,
+		                                &res, &err),
+		                 BSIM_OK);
+		const bsim_location at = bsim_lattice_location_of(&res);
+		for (int i = 0; i < n; i++)
+			if (bsim_lattice_location_equal(loc[i], at))
+				share[i] += 1.0 / N;
+	}
+	bsim_trial_runner_free(r);
 }

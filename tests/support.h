@@ -7,6 +7,8 @@
 #include <stdint.h>
 
 #include "beamsim/backend_registry.h"
+#include "beamsim/lattice_outcome.h"
+#include "beamsim/scene.h"
 
 struct CMUnitTest;
 
@@ -124,6 +126,12 @@ void bsim_test_path_restore(char *old);
  * left (dir/.beamsim). */
 void bsim_test_check_committed(const char *dir, const char *const files[],
                                const char *const absent[]);
+
+/* N independent direct trials of the lattice s on the default backend,
+ * trial t seeded bsim_schedule_seed_mix(seed, 0, t): share[i] += the share
+ * that ended in loc[i] (n locations). Fails the test if a trial fails. */
+void bsim_test_simulate_locations(const bsim_scene *s, const bsim_location *loc, int n, int N,
+                                  uint64_t seed, double *share);
 
 /* Reads a whole file into a malloc'd, NUL-terminated string (NULL on error). */
 char *bsim_test_read(const char *path);

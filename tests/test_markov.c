@@ -725,29 +725,6 @@ static void test_one_gate_against_simulation(void **state)
 	bsim_scene_free(&s);
 }
 
-/* The probability of each of p's locations among N direct trials of s
- * (seeds from 99), into sim. */
-static void simulate_locations(const bsim_scene *s, const bsim_markov_prediction *p, int N,
-                               double *sim)
-{
-	bsim_trial_runner *r = bsim_trial_runner_alloc();
-	const bsim_options none = {0};
-	bsim_error err;
-	for (int t = 0; t < N; t++) {
-		bsim_trial_result res;
-		assert_int_equal(bsim_trial_run(r, s, bsim_backend_default(), &none,
-		                                bsim_schedule_seed_mix(99, 0, (uint64_t)t), NULL,
-		                                &res, &err),
-		                 BSIM_OK);
-		const bsim_location loc = bsim_lattice_location_of(&res);
-		for (int i = 0; i < p->n_locations; i++)
-			if (p->loc[i].kind == loc.kind && p->loc[i].ix == loc.ix &&
-			    p->loc[i].iy == loc.iy)
-				sim[i] += 1.0 / N;
-	}
-	bsim_trial_runner_free(r);
-}
-
 /* How many of p's locations lie beyond 4.5 standard errors of the
  * difference from sim, N direct trials (the maps' T start trials' and the
  * simulation's sampling errors together). */
@@ -809,7 +786,7 @@ static void test_after_start_against_simulation(void **state)
 		assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
 		if (!sim) { /* one simulation for both: the same locations */
 			sim = calloc((size_t)p.n_locations, sizeof *sim);
-			simulate_locations(&s, &p, N, sim);
+			bsim_test_simulate_locations(&s, p.loc, p.n_locations, N, 99, sim);
 		}
 		off[v] = outcomes_off(&p, sim, def.start_trials, N);
 		if (after) {
@@ -938,7 +915,7 @@ static void test_training_against_simulation(void **state)
 		assert_int_equal(bsim_markov_predict(&s, &set, &p, &err), BSIM_OK);
 		if (!sim) { /* one simulation for both: the same locations */
 			sim = calloc((size_t)p.n_locations, sizeof *sim);
-			simulate_locations(&s, &p, N, sim);
+			bsim_test_simulate_locations(&s, p.loc, p.n_locations, N, 99, sim);
 		}
 		off[i] = outcomes_off(&p, sim, def.trials, N);
 		bsim_markov_prediction_free(&p);

@@ -191,26 +191,6 @@ static void test_walks_that_never_end_said(void **state)
 	bsim_scene_free(&s);
 }
 
-/* N direct trials of s into sim, by p's locations (the default backend). */
-static void simulate(const bsim_scene *s, const bsim_markov_prediction *p, int N, double *sim)
-{
-	bsim_trial_runner *r = bsim_trial_runner_alloc();
-	const bsim_options none = {0};
-	bsim_error err;
-	for (int t = 0; t < N; t++) {
-		bsim_trial_result res;
-		assert_int_equal(bsim_trial_run(r, s, bsim_backend_default(), &none,
-		                                bsim_schedule_seed_mix(77, 0, (uint64_t)t), NULL,
-		                                &res, &err),
-		                 BSIM_OK);
-		const bsim_location loc = bsim_lattice_location_of(&res);
-		for (int i = 0; i < p->n_locations; i++)
-			if (bsim_lattice_location_equal(p->loc[i], loc))
-				sim[i] += 1.0 / N;
-	}
-	bsim_trial_runner_free(r);
-}
-
 static void ring(bsim_scene *s)
 {
 	bsim_error err;
@@ -243,7 +223,7 @@ static void test_walks_against_simulation(void **state)
 	assert_int_equal(bsim_markov_nearest_predict(&s, &vs, &def, &p, &err), BSIM_OK);
 	const int N = 1500;
 	double *sim = calloc((size_t)p.n_locations, sizeof *sim);
-	simulate(&s, &p, N, sim);
+	bsim_test_simulate_locations(&s, p.loc, p.n_locations, N, 77, sim);
 	int seen = 0;
 	double worst = 0.0;
 	for (int i = 0; i < p.n_locations; i++) {
