@@ -8,8 +8,10 @@
 # total variation from the same simulation is computed here from
 # prediction.csv and validate.csv. A method's maps are built once, on the
 # first field of a set of gate kinds, and reused on every other; flow:1
-# maps are built per field (they hold for that layout only). default is
-# the default now (a training field of 4,000 trials of the kinds whose
+# maps are built per field (they hold for that layout only). Every method
+# is markov build --method maps (the walks, markov build's default, are
+# measured by markov validate --map on their own build). default is the
+# maps' defaults (a training field of 4,000 trials of the kinds whose
 # crossings the bins count, topped up to 5 single gates a crossing and at
 # most 50, 14,6,13 bins, 16,000 start trials, the first 8,000 continued in
 # the gate after the start), train10k the default before it (10,000
@@ -134,7 +136,7 @@ for f in "${fields[@]}"; do
         read -r -a opts <<<"${m#*:}"
         maps=$out/maps-$name
         [ "$name" = flow1 ] && maps=$out/maps-flow1-$f
-        log=$($exe markov build "$exp" "${opts[@]}" "${grid[@]}" --threads "$threads" --out "$maps" 2>&1 | grep -E '^[0-9]+ maps? built' || true)
+        log=$($exe markov build "$exp" --method maps "${opts[@]}" "${grid[@]}" --threads "$threads" --out "$maps" 2>&1 | grep -E '^[0-9]+ maps? built' || true)
         # the maps' CPU: what the builds into that directory took (a build
         # that reuses every map adds nothing)
         echo "$log" | sed -n 's/.*built (\([0-9.]*\) s of CPU).*/\1/p' >>"$maps.cpu"

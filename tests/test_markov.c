@@ -2417,8 +2417,8 @@ static void test_kinds_configs(void **state)
  * missed and the nearest-neighbour walks did not. */
 static const char DEFAULT_SCOPE[] =
         "maps of entry bins: measured beyond TV 0.05 on 7 of 40 fields, columns and a random "
-        "field of a physics they were not chosen on among them, where nearest-neighbour walks "
-        "(markov predict --visits DIR) were within 0.05 on all 40 (docs/markov.md, \"A kernel "
+        "field of a physics they were not chosen on among them, where the nearest-neighbour "
+        "walks (markov build's default) were within 0.05 on all 40 (docs/markov.md, \"A kernel "
         "over exact states\")";
 
 static void test_scope(void **state)
@@ -2439,7 +2439,8 @@ static void test_scope(void **state)
 	d.train_trials = 0;
 	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf),
 	                    "maps with states uniform in each bin (no training field): measured "
-	                    "less accurate than the default's on layouts they were not built on "
+	                    "less accurate than with the maps' defaults on layouts they were not "
+	                    "built on "
 	                    "(docs/markov.md, \"What each part does\")");
 	d.bins = (bsim_markov_bins){8, 8, 9, 40.0}; /* the default before the training field */
 	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),
@@ -2452,8 +2453,8 @@ static void test_scope(void **state)
 	d = d0;
 	d.after_start = 0;
 	assert_string_equal(bsim_markov_def_scope(&d, buf, sizeof buf),
-	                    "maps with no gate after the start: measured less accurate than the "
-	                    "default's on layouts they were not built on (docs/markov.md, "
+	                    "maps with no gate after the start: measured less accurate than with "
+	                    "the maps' defaults on layouts they were not built on (docs/markov.md, "
 	                    "\"What each part does\")");
 	d.start_trials = 50;
 	assert_non_null(strstr(bsim_markov_def_scope(&d, buf, sizeof buf),

@@ -473,7 +473,7 @@ static void test_cli(void **state)
 	        {{"markov", "predict", ring5, "--visits", dir, "--k", "65", NULL},
 	         "--k 65: expected an integer 1 to 64"},
 	        {{"markov", "predict", ring5, "--visits", dir, "--tol", "0.01", NULL},
-	         "--tol, --gates and --no-gates are for --map"},
+	         "--tol, --gates and --no-gates are for maps"},
 	        {{"markov", "validate", exp, "--map", dir, "--k", "3", "--out", val, NULL},
 	         "--k is for --visits"},
 	        {{"markov", "validate", exp, "--out", val, NULL},
@@ -481,6 +481,113 @@ static void test_cli(void **state)
 	};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
 		/* a usage error: its line, then the pointer to --help */
+		char *err = NULL;
+		const int rc = bsim_test_cli(bad[i].argv, NULL, &err);
+		bsim_test_check_input_error(rc, err, (const char *const[]){bad[i].says, NULL}, 0);
+		free(err);
+	}
+}
+
+/* markov build's default is the walks: its directory is a build (a
+ * manifest, markov.json) that markov predict and validate --map walk
+ * over, to the same numbers as the walks over a cache of the same
+ * settings; another layout of the same kinds needs no new field, another
+ * physics is refused naming what differs; the maps are --method maps, or
+ * implied by an option only they have. */
+static void test_default_build(void **state)
+{
+	(void)state;
+	char ring5[1100], cols9[1100], exp[1100], dir[1100], built[1200], cache[1200];
+	snprintf(ring5, sizeof ring5, "%s", bsim_test_src("configs/markov/kinds/field_ring5.yaml"));
+	snprintf(cols9, sizeof cols9, "%s",
+	         bsim_test_src("configs/markov/kinds/field_late_cols9.yaml"));
+	snprintf(exp, sizeof exp, "%s", bsim_test_src("configs/markov/kinds/exp_ring5.yaml"));
+	snprintf(dir, sizeof dir, "%s", bsim_test_dir("default_build"));
+	snprintf(built, sizeof built, "%s/built", dir);
+	snprintf(cache, sizeof cache, "%s/cache", dir);
+	const char *build[] = {"markov", "build", exp,       "--train", "60",
+	                       "--out",  built,   "--quiet", NULL};
+	assert_int_equal(bsim_test_cli(build, NULL, NULL), 0);
+	char *json = bsim_test_read(bsim_test_join(built, "markov.json"));
+	assert_non_null(json);
+	assert_non_null(strstr(json, "\"method\": \"nearest\""));
+	assert_non_null(strstr(json, "\"train\": 60"));
+	free(json);
+	char *manifest = bsim_test_read(bsim_test_join(built, "manifest.json"));
+	assert_non_null(manifest);
+	assert_non_null(strstr(manifest, "visits_"));
+	free(manifest);
+	/* the same walks over the build and over a cache of its settings */
+	for (int f = 0; f < 2; f++) {
+		const char *scene = f ? cols9 : ring5;
+		char *a = NULL, *b = NULL;
+		const char *over_build[] = {"markov",  "predict", scene,    "--map", built,
+		                            "--walks", "2000",    "--json", NULL};
+		const char *over_cache[] = {"markov", "predict", scene, "--visits",
+		                            cache,    "--train", "60",  "--walks",
+		                            "2000",   "--json",  NULL};
+		assert_int_equal(bsim_test_cli(over_build, &a, NULL), 0);
+		assert_int_equal(bsim_test_cli(over_cache, &b, NULL), 0);
+		/* no field run for the build's prediction, another layout too */
+		assert_non_null(strstr(a, "\"fields_built\": 0"));
+		const char *la = strstr(a, "\"locations\""), *lb = strstr(b, "\"locations\"");
+		assert_non_null(la);
+		assert_non_null(lb);
+		assert_string_equal(la, lb);
+		free(a);
+		free(b);
+	}
+	char val[1300];
+	snprintf(val, sizeof val, "%s/val", dir);
+	const char *validate[] = {"markov",  "validate", exp,        "--map", built,
+	                          "--walks", "500",      "--trials", "40",    "--out",
+	                          val,       "--quiet",  NULL};
+	assert_int_equal(bsim_test_cli(validate, NULL, NULL), 0);
+	json = bsim_test_read(bsim_test_join(val, "validate.json"));
+	assert_non_null(json);
+	assert_non_null(strstr(json, "\"map_dir\""));
+	assert_non_null(strstr(json, "\"method\": \"nearest\""));
+	assert_non_null(strstr(json, "\"train_trials\": 60"));
+	free(json);
+	/* the maps: --method maps, or implied by --bins */
+	char maps[1300];
+	snprintf(maps, sizeof maps, "%s/maps", dir);
+	const char *build_maps[] = {
+	        "markov", "build",   exp, "--bins", "1,1,1", "--trials", "2", "--start-trials",
+	        "20",     "--train", "0", "--out",  maps,    "--quiet",  NULL};
+	assert_int_equal(bsim_test_cli(build_maps, NULL, NULL), 0);
+	json = bsim_test_read(bsim_test_join(maps, "markov.json"));
+	assert_non_null(json);
+	assert_null(strstr(json, "nearest"));
+	assert_non_null(strstr(json, "\"bins\""));
+	free(json);
+	char *o = NULL;
+	const char *predict_maps[] = {"markov", "predict", ring5, "--map", maps, "--json", NULL};
+	assert_int_equal(bsim_test_cli(predict_maps, &o, NULL), 0);
+	assert_null(strstr(o, "\"solve\": \"nearest\""));
+	free(o);
+	struct {
+		const char *argv[12];
+		const char *says;
+	} bad[] = {
+	        {{"markov", "predict", ring5, "--map", built, "--set", "effects.propulsion.force=8",
+	          NULL},
+	         "where this one needs 'effects propulsion 1 8"},
+	        {{"markov", "build", exp, "--method", "nearest", "--bins", "2,2,2", "--out", dir,
+	          NULL},
+	         "--bins is for method maps"},
+	        {{"markov", "build", exp, "--method", "maps", "--k", "3", "--out", dir, NULL},
+	         "--k is for the nearest-neighbour walks"},
+	        {{"markov", "build", exp, "--method", "bins", "--out", dir, NULL},
+	         "method bins: expected nearest or maps"},
+	        {{"markov", "predict", ring5, "--map", built, "--tol", "0.01", NULL},
+	         "--tol, --gates and --no-gates are for maps"},
+	        {{"markov", "predict", ring5, "--map", maps, "--threads", "2", NULL},
+	         "--threads is for the walks"},
+	        {{"markov", "validate", exp, "--map", maps, "--walks", "9", "--out", val, NULL},
+	         "--walks is for the walks"},
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
 		char *err = NULL;
 		const int rc = bsim_test_cli(bad[i].argv, NULL, &err);
 		bsim_test_check_input_error(rc, err, (const char *const[]){bad[i].says, NULL}, 0);
@@ -499,6 +606,7 @@ int main(int argc, char **argv)
 	        cmocka_unit_test(test_stopped_keeps_fields),
 	        cmocka_unit_test(test_bad_inputs),
 	        cmocka_unit_test(test_cli),
+	        cmocka_unit_test(test_default_build),
 	};
 	if (argc > 1) /* one test by name, e.g. test_cli */
 		cmocka_set_test_filter(argv[1]);

@@ -1,12 +1,15 @@
-/* beamsim_markov: the Markov chain's maps built, a lattice predicted from
- * them and the prediction validated against direct simulation, as `beamsim
- * markov build`, `predict` and `validate` do them (beamsim/markov.h).
+/* beamsim_markov: the Markov chain's walks' training fields or maps built,
+ * a lattice predicted from them and the prediction validated against
+ * direct simulation, as `beamsim markov build`, `predict` and `validate` do
+ * them (beamsim/markov.h).
  *
  *   b = beamsim_markov('build', EXPERIMENT, 'out', DIR, NAME, VALUE, ...)
  *   p = beamsim_markov('predict', SCENE, 'map', DIR, NAME, VALUE, ...)
  *   v = beamsim_markov('validate', EXPERIMENT, 'map', DIR, 'out', DIR, ...)
  *
- * build's names: 'out' (the map directory, required), 'trials' (single
+ * build's names: 'out' (the directory, required), 'method' ('nearest', the
+ * default: the walks' training fields, 'train' their trials and 'k'; 'maps',
+ * implied by any of the maps' names), 'trials' (single
  * gates per entry bin), 'start_trials' (of the start bin), 'after_start' (1, the default: the
  * gate after the start from each start trial's exit; 0: entry bins from the start on),
  * 'after_trials' (the first start trials continued there, default 8000; 0: every one), 'train'
@@ -20,7 +23,8 @@
  * 'seed', 'threads', 'backend', 'backend_opt', 'set', 'grid'. b.maps is a struct array, a map each
  * (group from 1, k [left right] N m/rad, key its files' name, how 'built' or 'reused').
  *
- * predict's: 'map' (the map directory) or 'visits' (nearest-neighbour
+ * predict's: 'map' (a build: of the walks, then 'walks' and 'threads', or of
+ * maps) or 'visits' (nearest-neighbour
  * walks over the visits kept there, as `markov predict --visits DIR`),
  * 'set', 'out', 'overwrite', 'walks'; with 'map': 'tol', 'gates' (true:
  * the distribution of gates visited; default: with 'out' only); with
@@ -67,21 +71,22 @@ enum {
 	A_AFTER_TRIALS,
 	A_VISITS,
 	A_K,
+	A_METHOD,
 	N_ARGS
 };
 static const char *const arg_names[N_ARGS] = {
-        "out",       "map",       "trials",       "bins",         "vmax",
-        "entries",   "seed",      "threads",      "backend",      "backend_opt",
-        "set",       "grid",      "tol",          "gates",        "walks",
-        "overwrite", "bootstrap", "resume",       "start_trials", "after_start",
-        "train",     "crossings", "per_crossing", "after_trials", "visits",
-        "k"};
+        "out",          "map",         "trials",  "bins",        "vmax",         "entries",
+        "seed",         "threads",     "backend", "backend_opt", "set",          "grid",
+        "tol",          "gates",       "walks",   "overwrite",   "bootstrap",    "resume",
+        "start_trials", "after_start", "train",   "crossings",   "per_crossing", "after_trials",
+        "visits",       "k",           "method"};
 
 /* The names each subcommand takes, the others refused. */
-static const int build_names[] = {
-        A_OUT,         A_TRIALS,  A_BINS,      A_VMAX,         A_ENTRIES,     A_SEED,
-        A_THREADS,     A_BACKEND, A_SET,       A_BACKEND_OPT,  A_GRID,        A_START_TRIALS,
-        A_AFTER_START, A_TRAIN,   A_CROSSINGS, A_PER_CROSSING, A_AFTER_TRIALS};
+static const int build_names[] = {A_OUT,          A_TRIALS,      A_BINS,      A_VMAX,
+                                  A_ENTRIES,      A_SEED,        A_THREADS,   A_BACKEND,
+                                  A_SET,          A_BACKEND_OPT, A_GRID,      A_START_TRIALS,
+                                  A_AFTER_START,  A_TRAIN,       A_CROSSINGS, A_PER_CROSSING,
+                                  A_AFTER_TRIALS, A_METHOD,      A_K};
 static const int predict_names[] = {A_MAP,       A_SET,    A_TOL, A_GATES, A_WALKS, A_OUT,
                                     A_OVERWRITE, A_VISITS, A_K,   A_TRAIN, A_SEED,  A_THREADS};
 static const int validate_names[] = {A_MAP,    A_OUT,  A_TRIALS,    A_SEED,   A_THREADS,
@@ -175,13 +180,15 @@ static int bins(const mxArray *a, bsim_markov_bins *b, bsim_error *err)
 
 static mxArray *build_struct(const bsim_markov_build_result *r, int trials)
 {
+	const int nearest = r->method == BSIM_MARKOV_METHOD_NEAREST;
 	mxArray *s = mxCreateStructMatrix(1, 1, 0, NULL);
 	static const char *const fields[] = {"group", "k", "key", "how"};
 	mxArray *maps = mxCreateStructMatrix((mwSize)r->n_maps, 1, 4, (const char **)fields);
 	for (int i = 0; i < r->n_maps; i++) {
 		const bsim_markov_built *m = &r->maps[i];
-		char key[24];
-		snprintf(key, sizeof key, "map_%016llx", (unsigned long long)m->key);
+		char key[32];
+		snprintf(key, sizeof key, "%s_%016llx", nearest ? "visits" : "map",
+		         (unsigned long long)m->key);
 		bmx_set(maps, (mwIndex)i, "group", bmx_scalar(m->group + 1));
 		bmx_set(maps, (mwIndex)i, "k", bmx_row(m->k, 2));
 		bmx_set(maps, (mwIndex)i, "key", bmx_string(key));
@@ -199,19 +206,33 @@ static mxArray *build_struct(const bsim_markov_build_result *r, int trials)
 	bmx_set(s, 0, "trials", bmx_scalar(trials));
 	bmx_set(s, 0, "run", bmx_string(r->run));
 	bmx_set(s, 0, "scope", bmx_string(r->scope));
+	bmx_set(s, 0, "method", bmx_string(nearest ? "nearest" : "maps"));
+	bmx_set(s, 0, "visits", bmx_scalar((double)r->visits));
 	return s;
 }
 
 static int build(markov_call *c, const char *path, mxArray **out, bsim_error *err)
 {
 	bsim_markov_build_def def = bsim_markov_build_def_default();
-	const char *backend = NULL;
+	const char *backend = NULL, *method = NULL;
 	long trials = 0, threads = 0, start_trials = 0, after_start = -1, train = -1,
-	     crossings = -1, per_crossing = -1, after_trials = -1;
+	     crossings = -1, per_crossing = -1, after_trials = -1, k = 0;
 	const mxArray *const *v = c->v;
 	if (!v[A_OUT])
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "'build': 'out' (the map directory) is required");
+	/* the method: as given, else maps if a name of theirs alone is */
+	static const int maps_own[] = {A_TRIALS,    A_BINS,         A_VMAX,
+	                               A_ENTRIES,   A_START_TRIALS, A_AFTER_START,
+	                               A_CROSSINGS, A_PER_CROSSING, A_AFTER_TRIALS};
+	const char *maps_only = NULL;
+	for (size_t i = 0; !maps_only && i < sizeof maps_own / sizeof *maps_own; i++)
+		if (v[maps_own[i]])
+			maps_only = arg_names[maps_own[i]];
+	if ((v[A_METHOD] && bmx_text("method", v[A_METHOD], &c->pool, &method, err)) ||
+	    bsim_markov_build_method(method, maps_only, v[A_K] ? "k" : NULL, &def.method, err) ||
+	    (v[A_K] && bmx_long("k", v[A_K], 1, 64, &k, err)))
+		return err->code;
 	if (bmx_text("out", v[A_OUT], &c->pool, &def.out, err) ||
 	    (v[A_TRIALS] && bmx_long("trials", v[A_TRIALS], 1, 2147483647L, &trials, err)) ||
 	    (v[A_BINS] && bins(v[A_BINS], &def.map.bins, err)) ||
@@ -258,10 +279,19 @@ static int build(markov_call *c, const char *path, mxArray **out, bsim_error *er
 	def.n_sets = c->n_sets;
 	def.grid = c->grid;
 	def.n_grid = c->n_grid;
+	/* the walks' training fields: train trials each, k, the same backend */
+	def.nearest.backend = def.map.backend;
+	def.nearest.opts = &c->opts;
+	def.nearest.threads = (int)threads;
+	if (train >= 0)
+		def.nearest.trials = (int)train;
+	if (k > 0)
+		def.nearest.k = (int)k;
 	if (bsim_markov_build_run(&def, &c->build, err) != BSIM_OK)
 		return err->code;
 	c->built = 1;
-	*out = build_struct(&c->build, def.map.trials);
+	*out = build_struct(&c->build, def.method == BSIM_MARKOV_METHOD_NEAREST ? def.nearest.trials
+	                                                                        : def.map.trials);
 	return BSIM_OK;
 }
 
@@ -312,10 +342,11 @@ static int predict_struct(const char *path, const bsim_markov_predict_result *r,
 }
 
 /* 'visits', 'k', 'train' and 'walks' into def (threads: c's 'threads'):
- * nearest-neighbour walks; the maps' own names refused beside 'visits',
- * and its own beside 'map'. */
+ * nearest-neighbour walks, over 'visits' or a build of the walks in 'map'
+ * (*walking 1; 'walks' and 'threads' only); the maps' own names refused
+ * beside them, and the walks' beside maps. */
 static int nearest_args(markov_call *c, const char *sub, const char **visits,
-                        bsim_markov_nearest_def *def, bsim_error *err)
+                        bsim_markov_nearest_def *def, int *walking, bsim_error *err)
 {
 	const mxArray *const *v = c->v;
 	if (!v[A_MAP] == !v[A_VISITS])
@@ -329,10 +360,16 @@ static int nearest_args(markov_call *c, const char *sub, const char **visits,
 		if (v[own[i]])
 			return bsim_error_set(err, BSIM_EINPUT, "'%s': for 'visits' only",
 			                      arg_names[own[i]]);
-	if (!v[A_VISITS])
+	const char *map = NULL;
+	bsim_markov_method method = BSIM_MARKOV_METHOD_NEAREST;
+	if (v[A_MAP] && (bmx_text("map", v[A_MAP], &c->pool, &map, err) ||
+	                 bsim_markov_dir_method(map, &method, err)))
+		return err->code;
+	*walking = method == BSIM_MARKOV_METHOD_NEAREST;
+	if (!*walking)
 		return BSIM_OK;
 	long k = def->k, train = def->trials, threads = 0;
-	if (bmx_text("visits", v[A_VISITS], &c->pool, visits, err) ||
+	if ((v[A_VISITS] && bmx_text("visits", v[A_VISITS], &c->pool, visits, err)) ||
 	    (v[A_K] && bmx_long("k", v[A_K], 1, 64, &k, err)) ||
 	    (v[A_TRAIN] && bmx_long("train", v[A_TRAIN], 1, 2147483647L, &train, err)) ||
 	    (v[A_WALKS] && bmx_long("walks", v[A_WALKS], 1, 100000000L, &def->walks, err)) ||
@@ -348,21 +385,21 @@ static int predict(markov_call *c, const char *path, mxArray **out, bsim_error *
 {
 	bsim_markov_predict_def def = bsim_markov_predict_def_default();
 	const mxArray *const *v = c->v;
-	if (nearest_args(c, "predict", &def.visits_dir, &def.nearest, err))
+	int walking = 0;
+	if (nearest_args(c, "predict", &def.visits_dir, &def.nearest, &walking, err))
 		return err->code;
-	if (v[A_VISITS]) {
-		if (v[A_TOL] || v[A_GATES])
-			return bsim_error_set(err, BSIM_EINPUT, "'%s': for 'map' only",
-			                      v[A_TOL] ? "tol" : "gates");
-		if (v[A_SEED] && bmx_seed("seed", v[A_SEED], &def.nearest.seed, err))
-			return err->code;
-	} else if (v[A_SEED] || v[A_THREADS])
+	if (walking && (v[A_TOL] || v[A_GATES]))
+		return bsim_error_set(err, BSIM_EINPUT, "'%s': for maps only",
+		                      v[A_TOL] ? "tol" : "gates");
+	if (v[A_VISITS] && v[A_SEED] && bmx_seed("seed", v[A_SEED], &def.nearest.seed, err))
+		return err->code;
+	if (v[A_MAP] && (v[A_SEED] || (!walking && v[A_THREADS])))
 		return bsim_error_set(err, BSIM_EINPUT, "'%s': for 'visits' only",
 		                      v[A_SEED] ? "seed" : "threads");
 	if ((v[A_MAP] && bmx_text("map", v[A_MAP], &c->pool, &def.map_dir, err)) ||
 	    sets_grid(c, err) || (v[A_TOL] && bmx_double("tol", v[A_TOL], &def.tol, err)) ||
 	    (v[A_GATES] && bmx_flag("gates", v[A_GATES], &def.gates, err)) ||
-	    (!v[A_VISITS] && v[A_WALKS] &&
+	    (!walking && v[A_WALKS] &&
 	     bmx_long("walks", v[A_WALKS], 0, 100000000L, &def.walks, err)) ||
 	    (v[A_OUT] && bmx_text("out", v[A_OUT], &c->pool, &def.out, err)) ||
 	    (v[A_OVERWRITE] && bmx_flag("overwrite", v[A_OVERWRITE], &def.overwrite, err)))
@@ -410,10 +447,11 @@ static int validate(markov_call *c, const char *path, mxArray **out, bsim_error 
 	if (!v[A_OUT])
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "'validate': 'out' (the output directory) is required");
-	if (nearest_args(c, "validate", &def.visits_dir, &def.nearest, err))
+	int walking = 0;
+	if (nearest_args(c, "validate", &def.visits_dir, &def.nearest, &walking, err))
 		return err->code;
-	if (v[A_MAP] && v[A_WALKS])
-		return bsim_error_set(err, BSIM_EINPUT, "'walks': for 'visits' only");
+	if (!walking && v[A_WALKS])
+		return bsim_error_set(err, BSIM_EINPUT, "'walks': for the walks only");
 	if ((v[A_MAP] && bmx_text("map", v[A_MAP], &c->pool, &def.map_dir, err)) ||
 	    bmx_text("out", v[A_OUT], &c->pool, &def.out, err) || sets_grid(c, err) ||
 	    (v[A_TRIALS] && bmx_long("trials", v[A_TRIALS], 1, 2147483647L, &def.trials, err)) ||

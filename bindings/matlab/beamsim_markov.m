@@ -1,19 +1,29 @@
 %BEAMSIM_MARKOV The Markov chain of a gate lattice (a MEX function).
 %   B = BEAMSIM_MARKOV('build', EXPERIMENT, 'out', DIR, NAME, VALUE, ...)
-%   builds the single-gate maps the lattices of EXPERIMENT need into the
-%   map directory DIR, as `beamsim markov build` does (the same maps, byte
-%   for byte): maps already in DIR with the same key are reused.
+%   builds what the lattices of EXPERIMENT are predicted from into DIR, as
+%   `beamsim markov build` does (the same files, byte for byte): by default
+%   the nearest-neighbour walks' training fields, one per gate kind of a
+%   lattice's physics; with 'method', 'maps' (or any of the maps' names
+%   below) the single-gate maps. Those already in DIR with the same key are
+%   reused.
 %
 %   P = BEAMSIM_MARKOV('predict', SCENE, 'map', DIR, NAME, VALUE, ...)
-%   predicts the lattice of the scene file from the maps in DIR, as
-%   `beamsim markov predict --json` does.
+%   predicts the lattice of the scene file from the build in DIR (walks
+%   over its training fields, or the chain of its maps), as `beamsim
+%   markov predict --json` does.
 %
 %   V = BEAMSIM_MARKOV('validate', EXPERIMENT, 'map', DIR, 'out', OUT, ...)
 %   simulates every group of EXPERIMENT directly and against the chain, as
 %   `beamsim markov validate` does, writing OUT's files.
 %
 %   build's names:
-%     'out'          the map directory (required)
+%     'out'          the directory (required)
+%     'method'       'nearest' (the default): the walks' training fields;
+%                    'maps': the maps (implied by 'trials', 'start_trials',
+%                    'after_start', 'after_trials', 'crossings',
+%                    'per_crossing', 'bins', 'vmax', 'entries')
+%     'k'            the walks: each step from the k nearest visits
+%                    (default 20)
 %     'trials'       single gates per entry bin (default 50)
 %     'start_trials' single gates of the start bin (default 16000, or
 %                    'trials' with self or flow entries)
@@ -24,10 +34,11 @@
 %     'after_trials' the first start trials continued there (default
 %                    8000; the others take the continuations of those
 %                    that entered the same gate); 0: every start trial
-%     'train'        trials of the training field, a 21 x 21 field of the
-%                    lattice's gate kinds at random whose gate entries the
-%                    bins' states are drawn from (default 4000; run only
-%                    when a map is built); 0: states uniform in each bin
+%     'train'        trials of each training field, a 21 x 21 field of the
+%                    lattice's gate kinds at random (the walks' default
+%                    10000); maps: the field whose gate entries the bins'
+%                    states are drawn from (default 4000; run only when a
+%                    map is built); 0: states uniform in each bin
 %     'crossings'    1 (default, with a training field): each bin counts
 %                    the training field's own crossings of the map's gate
 %                    kind entered in it, topped up with single gates as
@@ -44,11 +55,12 @@
 %                    'self', 'self:N', 'flow', 'flow:N' (docs/markov.md)
 %     'seed', 'threads', 'backend', 'backend_opt', 'set', 'grid'
 %                    as for BEAMSIM_SWEEP
-%   B.maps is a struct array, one map each: group (from 1), k ([left
-%   right], N m/rad), key (its files' name), how ('built' or 'reused');
-%   B.built, B.reused, B.cpu_seconds, B.bins, B.trials, B.run, B.scope
-%   (where maps of this method were measured to fall short on layouts
-%   they were not built on; '' for the default method).
+%   B.maps is a struct array, one map (or training field) each: group
+%   (from 1), k ([left right], N m/rad), key (its files' name, map_HASH or
+%   visits_HASH), how ('built' or 'reused'); B.method ('nearest' or
+%   'maps'), B.built, B.reused, B.cpu_seconds, B.bins, B.trials, B.visits,
+%   B.run, B.scope (where maps of this method were measured to fall short
+%   on layouts they were not built on; '' for the walks).
 %
 %   P = BEAMSIM_MARKOV('predict', SCENE, 'visits', DIR, NAME, VALUE, ...)
 %   and V = BEAMSIM_MARKOV('validate', EXPERIMENT, 'visits', DIR, 'out',
@@ -57,7 +69,7 @@
 %   `beamsim markov predict --visits DIR` and `validate --visits DIR` do.
 %
 %   predict's names:
-%     'map'          the map directory (or 'visits')
+%     'map'          the directory of a build (or 'visits')
 %     'visits'       the visits directory (or 'map')
 %     'set'          {KEY, VALUE, ...}, scene keys set as by --set
 %     'tol'          the probability left in the field at which the
@@ -65,20 +77,22 @@
 %                    tolerance)
 %     'gates'        true: the distribution of gates visited (default: with
 %                    'out' only)
-%     'walks'        walks of the semi-Markov chain (default 100000; 0: none);
-%                    with 'visits' the nearest-neighbour walks (default 200000)
+%     'walks'        the nearest-neighbour walks (default 200000); with the
+%                    maps, walks of the semi-Markov chain (default 100000;
+%                    0: none)
 %     'out'          a directory: also write the program's files there
 %     'overwrite'    true: replace the result 'out' holds
 %     'k', 'train', 'seed', 'threads'
 %                    with 'visits': each step from the k nearest visits
 %                    (default 20), trials of each training field (default
-%                    10000), the fields' and the walks' seed, threads
+%                    10000), the fields' and the walks' seed, threads;
+%                    with a 'map' of the walks: 'threads'
 %   P holds what `markov predict --json` prints (P.totals, P.locations,
 %   P.p_gates, P.mean_gates, P.at_duration, ...), and P.p_time (time bins
 %   x 3: end, side, stuck), P.time_bin (s) and P.p_loc_time.
 %
-%   validate's names: 'out' (required), 'map' or 'visits' (then 'k',
-%   'train', 'walks' as predict's), 'trials', 'seed', 'threads', 'set',
+%   validate's names: 'out' (required), 'map' (of the walks: then 'walks')
+%   or 'visits' (then 'k', 'train', 'walks' as predict's), 'trials', 'seed', 'threads', 'set',
 %   'grid', 'bootstrap', 'resume', 'overwrite'. V is validate.json
 %   (V.checks: group from 1, protocol, tv, tv_sampling, ...).
 %

@@ -14,11 +14,13 @@
 #include <string.h>
 
 /* A map of a build as a dict: group, k (left, right), key ("map_HASH", its
- * files' name) and how it was had. */
-static PyObject *built_dict(const bsim_markov_built *m)
+ * files' name; a training field's "visits_HASH") and how it was had. */
+static PyObject *built_dict(const bsim_markov_built *m, bsim_markov_method method)
 {
-	char key[24];
-	snprintf(key, sizeof key, "map_%016llx", (unsigned long long)m->key);
+	char key[32];
+	snprintf(key, sizeof key, "%s_%016llx",
+	         method == BSIM_MARKOV_METHOD_NEAREST ? "visits" : "map",
+	         (unsigned long long)m->key);
 	const char *how = m->elsewhere ? "elsewhere"
 	                  : m->copied  ? "copied"
 	                  : m->cached  ? "reused"
@@ -68,24 +70,41 @@ static int entries_from(PyObject *seq, bsim_markov_def *def, const char ***paths
 PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
-	static char *kwlist[] = {"experiment", "out",          "trials",       "bins",
-	                         "vmax",       "entries",      "seed",         "threads",
-	                         "backend",    "sets",         "grid",         "backend_opts",
-	                         "progress",   "start_trials", "after_start",  "train",
-	                         "crossings",  "per_crossing", "after_trials", NULL};
-	const char *experiment, *out, *backend_spec = NULL;
+	static char *kwlist[] = {
+	        "experiment",   "out",          "trials",      "bins",  "vmax",      "entries",
+	        "seed",         "threads",      "backend",     "sets",  "grid",      "backend_opts",
+	        "progress",     "start_trials", "after_start", "train", "crossings", "per_crossing",
+	        "after_trials", "method",       "k",           NULL};
+	const char *experiment, *out, *backend_spec = NULL, *method = NULL;
 	int trials = 0, threads = 0, start_trials = 0, after_start = -1, train = -1, crossings = -1,
-	    per_crossing = -1, after_trials = -1;
+	    per_crossing = -1, after_trials = -1, k = 0;
 	double vmax = 0.0;
 	PyObject *bins_o = Py_None, *entries_o = Py_None, *seed_o = Py_None, *sets_o = Py_None,
 	         *grid_o = Py_None, *opts_o = Py_None, *progress_o = Py_None;
-	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|iOdOOizOOOOiiiiii", kwlist, &experiment,
+	if (!PyArg_ParseTupleAndKeywords(args, kw, "ss|iOdOOizOOOOiiiiiizi", kwlist, &experiment,
 	                                 &out, &trials, &bins_o, &vmax, &entries_o, &seed_o,
 	                                 &threads, &backend_spec, &sets_o, &grid_o, &opts_o,
 	                                 &progress_o, &start_trials, &after_start, &train,
-	                                 &crossings, &per_crossing, &after_trials))
+	                                 &crossings, &per_crossing, &after_trials, &method, &k))
 		return NULL;
 	bsim_markov_build_def def = bsim_markov_build_def_default();
+	/* the method: as given, else maps if an argument of theirs alone is */
+	const char *maps_only = trials > 0             ? "trials"
+	                        : bins_o != Py_None    ? "bins"
+	                        : vmax != 0.0          ? "vmax"
+	                        : entries_o != Py_None ? "entries"
+	                        : start_trials != 0    ? "start_trials"
+	                        : after_start >= 0     ? "after_start"
+	                        : crossings >= 0       ? "crossings"
+	                        : per_crossing >= 0    ? "per_crossing"
+	                        : after_trials >= 0    ? "after_trials"
+	                                               : NULL;
+	bsim_error err;
+	if (bsim_markov_build_method(method, maps_only, k > 0 ? "k" : NULL, &def.method, &err) !=
+	    BSIM_OK) {
+		PyErr_SetString(PyExc_ValueError, err.msg);
+		return NULL;
+	}
 	if (bins_o != Py_None && !PyArg_ParseTuple(bins_o, "iii", &def.map.bins.n_pos,
 	                                           &def.map.bins.n_speed, &def.map.bins.n_dir))
 		return NULL;
@@ -125,8 +144,19 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 	def.map.progress = pyb_progress_update;
 	def.map.progress_user = &in.progress;
 	def.map.stop = &in.progress.stop;
+	/* the walks' training fields: their trials (train), k, the same
+	 * backend, threads, progress and stop */
+	def.nearest.backend = def.map.backend;
+	def.nearest.opts = &opts;
+	def.nearest.threads = threads;
+	if (train >= 0)
+		def.nearest.trials = train;
+	if (k > 0)
+		def.nearest.k = k;
+	def.nearest.progress = pyb_progress_update;
+	def.nearest.progress_user = &in.progress;
+	def.nearest.stop = &in.progress.stop;
 	bsim_markov_build_result res;
-	bsim_error err;
 	int rc;
 	Py_BEGIN_ALLOW_THREADS;
 	rc = bsim_markov_build_run(&def, &res, &err);
@@ -140,17 +170,20 @@ PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw)
 	}
 	PyObject *maps = PyList_New(res.n_maps), *d = NULL;
 	for (int i = 0; maps && i < res.n_maps; i++) {
-		PyObject *m = built_dict(&res.maps[i]);
+		PyObject *m = built_dict(&res.maps[i], res.method);
 		if (!m)
 			Py_CLEAR(maps);
 		else
 			PyList_SET_ITEM(maps, i, m);
 	}
+	const int nearest = res.method == BSIM_MARKOV_METHOD_NEAREST;
 	if (maps)
-		d = Py_BuildValue("{sNsisisisdsisisssiss}", "maps", maps, "built", res.built,
+		d = Py_BuildValue("{sNsisisisdsisisssisssssl}", "maps", maps, "built", res.built,
 		                  "reused", res.reused, "groups", res.n_groups, "cpu_seconds",
-		                  res.seconds, "bins", res.n_bins, "trials", def.map.trials, "run",
-		                  res.run, "pass", res.pass, "scope", res.scope);
+		                  res.seconds, "bins", res.n_bins, "trials",
+		                  nearest ? def.nearest.trials : def.map.trials, "run", res.run,
+		                  "pass", res.pass, "scope", res.scope, "method",
+		                  nearest ? "nearest" : "maps", "visits", res.visits);
 	bsim_markov_build_result_free(&res);
 	return d;
 }
@@ -183,6 +216,20 @@ static PyObject *prediction_dict(const char *scene, const bsim_markov_predict_re
 	return d;
 }
 
+PyObject *pyb_markov_method(PyObject *self, PyObject *args)
+{
+	(void)self;
+	const char *dir;
+	if (!PyArg_ParseTuple(args, "s", &dir))
+		return NULL;
+	bsim_markov_method method;
+	bsim_error err;
+	const int rc = bsim_markov_dir_method(dir, &method, &err);
+	if (rc != BSIM_OK)
+		return pyb_raise(rc, &err);
+	return PyUnicode_FromString(method == BSIM_MARKOV_METHOD_NEAREST ? "nearest" : "maps");
+}
+
 PyObject *pyb_markov_predict(PyObject *self, PyObject *args, PyObject *kw)
 {
 	(void)self;
@@ -203,10 +250,11 @@ PyObject *pyb_markov_predict(PyObject *self, PyObject *args, PyObject *kw)
 	bsim_markov_predict_def def = bsim_markov_predict_def_default();
 	def.scene = scene;
 	def.map_dir = map;
+	/* the walks over a build in map (the package said which): these */
+	def.nearest.walks = walks > 0 ? walks : def.nearest.walks;
+	def.nearest.threads = threads;
 	if (visits) { /* nearest-neighbour walks; the package checked the numbers */
 		def.visits_dir = visits;
-		def.nearest.walks = walks;
-		def.nearest.threads = threads;
 		if (k > 0)
 			def.nearest.k = k;
 		if (train > 0)
@@ -264,15 +312,16 @@ PyObject *pyb_markov_validate(PyObject *self, PyObject *args, PyObject *kw)
 	PYB_RUN_INPUTS_SET(def, in);
 	def.experiment = experiment;
 	def.map_dir = map;
+	/* the walks, over visits or a build in map: these */
+	def.nearest.threads = threads;
+	if (walks > 0)
+		def.nearest.walks = walks;
 	if (visits) { /* nearest-neighbour walks; the package checked the numbers */
 		def.visits_dir = visits;
-		def.nearest.threads = threads;
 		if (k > 0)
 			def.nearest.k = k;
 		if (train > 0)
 			def.nearest.trials = train;
-		if (walks > 0)
-			def.nearest.walks = walks;
 	}
 	def.out = out;
 	def.trials = trials;

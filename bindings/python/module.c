@@ -448,10 +448,12 @@ static PyMethodDef methods[] = {
         {"markov_build", (PyCFunction)(void (*)(void))pyb_markov_build,
          METH_VARARGS | METH_KEYWORDS,
          "markov_build(experiment, out, trials, bins, vmax, entries, seed, threads, backend, "
-         "sets, grid, backend_opts, progress)"},
+         "sets, grid, backend_opts, progress, ..., method, k)"},
         {"markov_predict", (PyCFunction)(void (*)(void))pyb_markov_predict,
          METH_VARARGS | METH_KEYWORDS,
          "markov_predict(scene, map, sets, tol, gates, walks, out, overwrite)"},
+        {"markov_method", pyb_markov_method, METH_VARARGS,
+         "markov_method(dir): 'nearest' or 'maps', what the build in dir holds"},
         {"markov_validate", (PyCFunction)(void (*)(void))pyb_markov_validate,
          METH_VARARGS | METH_KEYWORDS,
          "markov_validate(experiment, map, out, trials, seed, threads, sets, grid, bootstrap, "

@@ -102,6 +102,7 @@ PyObject *pyb_landscape(PyObject *self, PyObject *args, PyObject *kw);
 /* markov_build, markov_predict and markov_validate (markov.c). */
 PyObject *pyb_markov_build(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_markov_predict(PyObject *self, PyObject *args, PyObject *kw);
+PyObject *pyb_markov_method(PyObject *self, PyObject *args);
 PyObject *pyb_markov_validate(PyObject *self, PyObject *args, PyObject *kw);
 PyObject *pyb_read_table(PyObject *self, PyObject *args);
 

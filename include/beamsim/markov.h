@@ -411,14 +411,18 @@ BSIM_API int bsim_markov_part_write(const char *dir, int index, int count, const
 
 /* ---- the maps of an experiment ----------------------------------------
  *
- * beamsim markov build EXPERIMENT --out DIR: the maps every group's lattice
- * needs built into one map directory (bsim_markov_build per group, the
- * maps of all groups in one cache), as one process, one part of a spread
- * build (a shard), or the merge of the parts' directories.
+ * beamsim markov build EXPERIMENT --out DIR: by default the training
+ * fields of the nearest-neighbour walks every group's lattice needs (a
+ * field per gate kind of its physics) in one directory; with method
+ * BSIM_MARKOV_METHOD_MAPS the maps every group's lattice needs built into
+ * one map directory (bsim_markov_build per group, the maps of all groups
+ * in one cache), as one process, one part of a spread build (a shard), or
+ * the merge of the parts' directories.
  *
  *   bsim_markov_build_def def = bsim_markov_build_def_default();
  *   def.experiment = "configs/markov/c_track.yaml";
  *   def.out = "out/markov-maps";
+ *   def.method = BSIM_MARKOV_METHOD_MAPS;
  *   def.map.trials = 800;
  *   bsim_markov_build_result res;
  *   if (bsim_markov_build_run(&def, &res, &err) == BSIM_OK) {
@@ -430,14 +434,25 @@ BSIM_API int bsim_markov_part_write(const char *dir, int index, int count, const
  * others join the directory's set as each is finished (a stopped or
  * failed build keeps those), so that a finished build may be run again. */
 
-/* One map of a build, as it was had. */
+/* One map of a build, as it was had (of the walks: one training field). */
 typedef struct bsim_markov_built {
 	int group;    /* the experiment's group whose lattice uses it (its first) */
-	double k[2];  /* N m/rad, the gate's left and right beam */
-	uint64_t key; /* the map's file name, map_%016llx */
+	double k[2];  /* N m/rad, the gate's left and right beam (a field's start gate) */
+	uint64_t key; /* the map's file name, map_%016llx (a field's: visits_%016llx) */
 	int pass;     /* the set's pass (below def.map.self_passes: one round's) */
 	int cached, copied, elsewhere; /* as bsim_markov_map's; none: built now */
 } bsim_markov_built;
+
+/* What markov build builds. */
+typedef enum bsim_markov_method {
+	/* The default: the visits of the nearest-neighbour walks' training
+	 * fields (beamsim/markov_nearest.h), a field per gate kind, and
+	 * markov.json naming the walks' settings; markov predict and
+	 * validate --map walk over them. */
+	BSIM_MARKOV_METHOD_NEAREST = 0,
+	/* The single-gate maps of entry bins. */
+	BSIM_MARKOV_METHOD_MAPS = 1,
+} bsim_markov_method;
 
 typedef struct bsim_markov_build_def {
 	const char *experiment;    /* a lattice experiment file */
@@ -448,6 +463,14 @@ typedef struct bsim_markov_build_def {
 	int n_grid;
 	int has_seed; /* 1: seed is the maps' (map.seed) and the experiment's */
 	uint64_t seed;
+	/* BSIM_MARKOV_METHOD_NEAREST: the training fields as nearest says
+	 * (trials, k, seed, backend, opts, threads, progress, stop; its walks
+	 * are the predictions'), the fields of every group's kinds and physics
+	 * written into out as each finishes; map, entries, part, parts,
+	 * round, passes and merge are the maps' (BSIM_EINPUT if set).
+	 * BSIM_MARKOV_METHOD_MAPS: the maps, as the fields below say. */
+	bsim_markov_method method;
+	bsim_markov_nearest_def nearest;
 	/* How each map is built: bins, trials, seed, backend and options,
 	 * threads, self or flow entries and their passes, progress, stop and
 	 * pass_exchange; entries, part, parts, part_first, from, n_from,
@@ -506,7 +529,23 @@ BSIM_API int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, i
  * bytes holds any. markov build and validate print it as a note. */
 BSIM_API const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t size);
 
-/* bsim_markov_def_default() as map, one process, no entries. */
+/* The method a build's options choose (markov build, the bindings):
+ * method as given, "nearest" or "maps" (NULL: not given: maps if an
+ * option of the maps' own was given, else the walks); maps_option the
+ * first option given that only maps have (NULL: none), k_option the
+ * walks' k if given (NULL: not), each as the caller spells it. BSIM_EINPUT
+ * naming the option and the method it is for. */
+BSIM_API int bsim_markov_build_method(const char *method, const char *maps_option,
+                                      const char *k_option, bsim_markov_method *out,
+                                      bsim_error *err);
+
+/* What the build in dir holds (its markov.json): *method. BSIM_EINPUT,
+ * naming file, line and field, if dir is no build of markov build, or a
+ * damaged one, or another beamsim's. */
+BSIM_API int bsim_markov_dir_method(const char *dir, bsim_markov_method *method, bsim_error *err);
+
+/* The walks (bsim_markov_nearest_def_default() as nearest);
+ * bsim_markov_def_default() as map, one process, no entries. */
 BSIM_API bsim_markov_build_def bsim_markov_build_def_default(void);
 
 typedef struct bsim_markov_build_result {
@@ -524,6 +563,8 @@ typedef struct bsim_markov_build_result {
 	int n_bins;                  /* entry bins of a map, the start's included */
 	char run[17];                /* the build's name (bsim_markov_run_id) */
 	char scope[320];             /* bsim_markov_def_scope of the maps' method */
+	bsim_markov_method method;   /* def's */
+	long visits;                 /* the walks': every training field's visits */
 } bsim_markov_build_result;
 
 /* Builds the maps of every group of def->experiment into def->out.
@@ -815,6 +856,10 @@ typedef struct bsim_markov_validation {
 	 * maps' bsim_markov_map of_crossings and per_crossing */
 	int of_crossings, per_crossing;
 	char scope[320]; /* bsim_markov_def_scope of the maps' method ("" the default) */
+	/* The walks' (0 for maps): their number, k and the training fields'
+	 * trials, as given or as the build in map_dir set them. */
+	long nearest_walks;
+	int nearest_k, nearest_trials;
 	/* When the run stopped or failed after finishing trials: the journal
 	 * that resume continues from ("" otherwise). */
 	char journal[BSIM_PATH_MAX];

@@ -84,6 +84,10 @@ typedef struct bsim_markov_nearest_def {
 	/* May be NULL: once nonzero no training trial starts, the fields
 	 * finished are kept, and BSIM_ESTOPPED is returned. */
 	const volatile sig_atomic_t *stop;
+	/* 1: the directory is a build's (beamsim markov build), read only: a
+	 * training field missing there is refused, naming what tells it from
+	 * the nearest there. 0: a cache, the fields missing run into it. */
+	int read_only;
 } bsim_markov_nearest_def;
 
 #define BSIM_MARKOV_NEAREST_TRIALS 10000
@@ -98,7 +102,7 @@ BSIM_API bsim_markov_nearest_def bsim_markov_nearest_def_default(void);
 
 /* The visits of lattice's kinds, read from dir where a training field's key
  * is there, else run and written there (a field at a time, as it
- * finishes). A key holds every input of the field: the physics (as a
+ * finishes; with def->read_only refused). A key holds every input of the field: the physics (as a
  * map's key), the kinds, the start's, trials, seed and the file format.
  * BSIM_EINPUT if lattice is not a lattice or def is out of range, or a
  * file there is malformed (naming file and line); BSIM_EFAIL for an

@@ -9,13 +9,18 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beamsim/backend_registry.h"
 #include "beamsim/experiment.h"
 #include "beamsim/markov.h"
+#include "beamsim/output.h"
 #include "beamsim/sweep_dir.h"
+#include "store/outdir.h"
 
 bsim_markov_build_def bsim_markov_build_def_default(void)
 {
-	return (bsim_markov_build_def){.map = bsim_markov_def_default()};
+	return (bsim_markov_build_def){.method = BSIM_MARKOV_METHOD_NEAREST,
+	                               .nearest = bsim_markov_nearest_def_default(),
+	                               .map = bsim_markov_def_default()};
 }
 
 int bsim_markov_entries_kind(const char *value, bsim_markov_def *def, int *is_kind, bsim_error *err)
@@ -169,10 +174,155 @@ static int build_name(const bsim_markov_build_def *def, bsim_markov_build_result
 	return rc;
 }
 
+int bsim_markov_build_method(const char *method, const char *maps_option, const char *k_option,
+                             bsim_markov_method *out, bsim_error *err)
+{
+	if (method && strcmp(method, "nearest") != 0 && strcmp(method, "maps") != 0)
+		return bsim_error_set(err, BSIM_EINPUT, "method %s: expected nearest or maps",
+		                      method);
+	*out = method ? (method[0] == 'n' ? BSIM_MARKOV_METHOD_NEAREST : BSIM_MARKOV_METHOD_MAPS)
+	       : maps_option ? BSIM_MARKOV_METHOD_MAPS
+	                     : BSIM_MARKOV_METHOD_NEAREST;
+	if (*out == BSIM_MARKOV_METHOD_NEAREST && maps_option)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s is for method maps: the nearest-neighbour walks' "
+		                      "training fields have no entry bins",
+		                      maps_option);
+	if (*out == BSIM_MARKOV_METHOD_MAPS && k_option)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "%s is for the nearest-neighbour walks (method nearest), "
+		                      "not maps",
+		                      k_option);
+	return BSIM_OK;
+}
+
+/* A walks' build as it goes: its directory, the group whose fields are
+ * being had, and the result they join. */
+typedef struct nearest_build {
+	bsim_outdir *od;
+	int group;
+	bsim_markov_build_result *res;
+	int oom;
+} nearest_build;
+
+/* A training field just written into the stage joins the directory's set
+ * at once, so a build stopped or killed later keeps it. */
+static int field_commit(void *user, bsim_error *err)
+{
+	nearest_build *nb = user;
+	if (bsim_outdir_add(nb->od, "markov build", err) != BSIM_OK)
+		return BSIM_EFAIL;
+	return bsim_output_mkdir(bsim_outdir_stage(nb->od), err);
+}
+
+static void field_had(void *user, const double k[2], uint64_t hash, int reused, double cost)
+{
+	nearest_build *nb = user;
+	bsim_markov_build_result *res = nb->res;
+	if (!reused)
+		res->seconds += cost;
+	bsim_markov_built *m = realloc(res->maps, (size_t)(res->n_maps + 1) * sizeof *m);
+	if (!m) {
+		nb->oom = 1;
+		return;
+	}
+	res->maps = m;
+	m[res->n_maps++] = (bsim_markov_built){
+	        .group = nb->group, .k = {k[0], k[1]}, .key = hash, .cached = reused};
+}
+
+/* The walks' training fields of every group into def->out, and markov.json
+ * naming their settings. */
+static int build_nearest(const bsim_markov_build_def *def, bsim_markov_build_result *res,
+                         bsim_error *err)
+{
+	const char *maps_only = def->n_entries > 0 ? "entries"
+	                        : def->parts > 0   ? "a part"
+	                        : def->n_merge > 0 ? "a merge of parts"
+	                        : def->round       ? "a round"
+	                        : def->passes      ? "passes"
+	                                           : NULL;
+	if (maps_only)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "markov build: %s: for maps (method maps), not the "
+		                      "nearest-neighbour walks' training fields",
+		                      maps_only);
+	bsim_markov_nearest_def nd = def->nearest;
+	if (def->has_seed)
+		nd.seed = def->seed;
+	nd.read_only = 0;
+	const bsim_backend *be = nd.backend ? nd.backend : bsim_backend_default();
+	bsim_experiment e;
+	int rc = bsim_experiment_load_seeded(def->experiment, def->sets, def->n_sets, def->grid,
+	                                     def->n_grid, def->has_seed ? &def->seed : NULL, &e,
+	                                     err);
+	if (rc != BSIM_OK)
+		return rc ? rc : BSIM_EINPUT;
+	res->n_groups = e.n_groups;
+	nearest_build nb = {.res = res};
+	rc = bsim_outdir_open(&nb.od, def->out, BSIM_OUTDIR_ADD, "markov build", NULL, err);
+	const markov_visits_io io = {.stage = rc == BSIM_OK ? bsim_outdir_stage(nb.od) : NULL,
+	                             .commit = field_commit,
+	                             .field = field_had,
+	                             .user = &nb};
+	for (int g = 0; g < e.n_groups && rc == BSIM_OK; g++) {
+		bsim_scene scene;
+		rc = bsim_experiment_group_scene(&e, g, def->sets, def->n_sets, &scene, err);
+		if (rc != BSIM_OK)
+			break;
+		const int first = res->n_maps;
+		nb.group = g;
+		bsim_markov_visits v;
+		rc = bsim_markov_visits_gather(&scene, &nd, def->out, &io, &v, err);
+		bsim_scene_free(&scene);
+		if (rc == BSIM_OK && nb.oom)
+			rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+		if (rc != BSIM_OK)
+			break;
+		res->built += v.built;
+		res->reused += v.reused;
+		res->visits += v.n;
+		bsim_markov_visits_free(&v);
+		if (def->group_done)
+			def->group_done(def->group_done_user, g, res->maps + first,
+			                res->n_maps - first);
+	}
+	uint64_t *keys = rc == BSIM_OK ? malloc((size_t)(res->n_maps + 1) * sizeof *keys) : NULL;
+	if (rc == BSIM_OK && !keys)
+		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
+	for (int i = 0; keys && i < res->n_maps; i++)
+		keys[i] = res->maps[i].key;
+	if (keys)
+		bsim_markov_run_id(keys, res->n_maps, res->run);
+	free(keys);
+	if (rc == BSIM_OK)
+		rc = bsim_markov_nearest_def_write(bsim_outdir_stage(nb.od), &nd, be, nd.opts, err);
+	if (rc == BSIM_OK)
+		rc = bsim_outdir_add(nb.od, "markov build", err);
+	bsim_outdir_close(nb.od);
+	bsim_experiment_free(&e);
+	return rc;
+}
+
 int bsim_markov_build_run(const bsim_markov_build_def *def, bsim_markov_build_result *res,
                           bsim_error *err)
 {
 	memset(res, 0, sizeof *res);
+	res->method = def->method;
+	if (def->method == BSIM_MARKOV_METHOD_NEAREST) {
+		int rc = !def->experiment || !def->out
+		                 ? bsim_error_set(err, BSIM_EINPUT,
+		                                  "markov build: expected an experiment and a "
+		                                  "directory")
+		                 : build_nearest(def, res, err);
+		if (rc != BSIM_OK)
+			bsim_markov_build_result_free(res);
+		return rc;
+	}
+	if (def->method != BSIM_MARKOV_METHOD_MAPS)
+		return bsim_error_set(err, BSIM_EINPUT,
+		                      "markov build: method %d: expected nearest (0) or maps (1)",
+		                      (int)def->method);
 	int rc = build_check(def, err);
 	if (rc != BSIM_OK)
 		return rc;

@@ -17,6 +17,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "analysis/markov_internal.h"
+#include "analysis/markov_kdtree.h"
 
 #include <assert.h>
 #include <errno.h>
@@ -221,9 +222,11 @@ static int key_lines_not_in(const char *a, const char *b, char *buf, size_t size
 	return n;
 }
 
-void bsim_markov_key_nearest(const char *dir, const char *want, char *buf, size_t size)
+void bsim_markov_key_nearest(const char *dir, const char *prefix, const char *want, char *buf,
+                             size_t size)
 {
 	buf[0] = '\0';
+	const size_t plen = strlen(prefix);
 	DIR *d = opendir(dir);
 	if (!d)
 		return;
@@ -231,14 +234,14 @@ void bsim_markov_key_nearest(const char *dir, const char *want, char *buf, size_
 	const struct dirent *e;
 	while ((e = readdir(d))) {
 		size_t len = strlen(e->d_name);
-		if (len != 24 || strncmp(e->d_name, "map_", 4) != 0 ||
-		    strcmp(e->d_name + 20, ".key") != 0)
+		if (len != plen + 20 || strncmp(e->d_name, prefix, plen) != 0 ||
+		    strcmp(e->d_name + plen + 16, ".key") != 0)
 			continue;
 		char path[BSIM_PATH_MAX];
 		snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
 		file_text t;
 		bsim_error ignored;
-		if (bsim_file_read(path, "a map key", 65536.0, NULL, &t, &ignored) != BSIM_OK)
+		if (bsim_file_read(path, "a key", 65536.0, NULL, &t, &ignored) != BSIM_OK)
 			continue;
 		char has[320], wants[320];
 		int n = key_lines_not_in(t.text, want, has, sizeof has) +
@@ -246,8 +249,9 @@ void bsim_markov_key_nearest(const char *dir, const char *want, char *buf, size_
 		if (n < best) {
 			best = n;
 			snprintf(buf, size,
-			         "the nearest map there, %s, has %s where this one needs %s",
-			         e->d_name, has, wants);
+			         "the nearest %s there, %s, has %s where this one needs %s",
+			         strcmp(prefix, "map_") == 0 ? "map" : "training field", e->d_name,
+			         has, wants);
 		}
 		bsim_file_text_free(&t);
 	}
@@ -793,6 +797,22 @@ int bsim_markov_next_read(const char *dir, bsim_markov_next *x, const bsim_marko
 	return 1;
 }
 
+/* markov.json's backend and its options: ", \"backend\": NAME, \"options\":
+ * [\"KEY=VALUE\", ...]". */
+static void def_engine_write(FILE *f, const bsim_backend *be, const bsim_options *opts)
+{
+	fputs(", \"backend\": ", f);
+	bsim_json_string(f, be->name);
+	fputs(", \"options\": [", f);
+	for (int i = 0; opts && i < opts->n; i++) {
+		char kv[128];
+		snprintf(kv, sizeof kv, "%s=%s", opts->key[i], opts->value[i]);
+		fputs(i ? ", " : "", f);
+		bsim_json_string(f, kv);
+	}
+	fputc(']', f);
+}
+
 int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
                           const bsim_options *opts, bsim_error *err)
 {
@@ -809,16 +829,8 @@ int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const b
 	fprintf(o.f, "}, \"trials\": %d, \"start_trials\": %d, \"seed\": ", def->trials,
 	        bsim_markov_def_start_trials(def));
 	bsim_json_u64(o.f, def->seed);
-	fputs(", \"backend\": ", o.f);
-	bsim_json_string(o.f, be->name);
-	fputs(", \"options\": [", o.f);
-	for (int i = 0; opts && i < opts->n; i++) {
-		char kv[128];
-		snprintf(kv, sizeof kv, "%s=%s", opts->key[i], opts->value[i]);
-		fputs(i ? ", " : "", o.f);
-		bsim_json_string(o.f, kv);
-	}
-	fputs("], \"entries\": ", o.f);
+	def_engine_write(o.f, be, opts);
+	fputs(", \"entries\": ", o.f);
 	char label[64];
 	bsim_json_string(o.f, bsim_markov_entries_label(def, NULL, label, sizeof label));
 	fprintf(o.f, ", \"after_start\": %d", bsim_markov_def_after_start(def));
@@ -868,10 +880,46 @@ static int def_string(const ydoc *d, const char *path, char *buf, size_t size, b
 	return BSIM_OK;
 }
 
-/* markov.json's def, read as JSON (a YAML flow document) with libfyaml:
- * every field bsim_markov_def_write writes, each fault naming its file position
- * and field. */
-int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err)
+/* markov.json's seed, backend and its options, the fields every build
+ * writes. */
+static int def_engine_read(const ydoc *d, uint64_t *seed, char *backend, size_t size,
+                           bsim_options *opts, bsim_error *err)
+{
+	/* above 2^53 written as a string (bsim_json_u64) */
+	struct fy_node *n = def_field(d, "/seed", "a seed, an integer >= 0", err);
+	const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
+	char *end = NULL;
+	errno = 0;
+	*seed = t && *t >= '0' && *t <= '9' ? strtoull(t, &end, 10) : 0;
+	int rc = !n ? BSIM_EINPUT
+	         : !end || *end || errno
+	                 ? bsim_ydoc_expected(d, n, NULL, "seed", "a seed, an integer >= 0", err)
+	                 : BSIM_OK;
+	if (rc == BSIM_OK)
+		rc = def_string(d, "/backend", backend, size, err);
+	if (rc == BSIM_OK) {
+		n = def_field(d, "/options", "a list of \"KEY=VALUE\"", err);
+		if (!n)
+			rc = BSIM_EINPUT;
+		else if (!fy_node_is_sequence(n))
+			rc = bsim_ydoc_expected(d, n, NULL, "options", "a list of \"KEY=VALUE\"",
+			                        err);
+		void *it = NULL;
+		struct fy_node *kv;
+		while (rc == BSIM_OK && (kv = fy_node_sequence_iterate(n, &it))) {
+			t = fy_node_is_scalar(kv) ? fy_node_get_scalar0(kv) : NULL;
+			rc = t ? bsim_options_add(opts, t, err)
+			       : bsim_ydoc_expected(d, kv, n, "options", "\"KEY=VALUE\"", err);
+		}
+	}
+	return rc;
+}
+
+/* dir/markov.json loaded into d, as its last build committed it, of
+ * this beamsim and format; *is_nearest: 1 for a build of the walks'
+ * ("method": "nearest"), 0 for maps (the method, or none: maps built
+ * before there was another). */
+static int def_open(const char *dir, ydoc *d, int *is_nearest, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
 	/* The directory as its last build committed it: with a manifest,
@@ -897,26 +945,54 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 		                      "build",
 		                      path, strerror(errno));
 	close(probe);
-	memset(opts, 0, sizeof *opts);
-	ydoc d;
-	int rc = bsim_ydoc_load(&d, path, err);
+	int rc = bsim_ydoc_load(d, path, err);
 	if (rc != BSIM_OK)
 		return rc;
 	int format = 0;
-	uint64_t seed = 0;
-	char backend[64] = "", id[64] = "", version[64] = "";
-	rc = def_int(&d, "/format", MAP_FORMAT, MAP_FORMAT, &format, err);
+	char version[64] = "", method[16] = "maps";
+	rc = def_int(d, "/format", MAP_FORMAT, MAP_FORMAT, &format, err);
 	/* Maps of another version are another simulator's: the keys name the
 	 * version too, so none would be found; saying so here names why. */
 	if (rc == BSIM_OK)
-		rc = def_string(&d, "/beamsim_version", version, sizeof version, err);
+		rc = def_string(d, "/beamsim_version", version, sizeof version, err);
 	if (rc == BSIM_OK && strcmp(version, BSIM_VERSION) != 0)
 		rc = bsim_ydoc_fail(
-		        &d, def_field(&d, "/beamsim_version", "a string", err), NULL,
+		        d, def_field(d, "/beamsim_version", "a string", err), NULL,
 		        "beamsim_version", err,
 		        "expected maps of this beamsim, %s, got maps built by beamsim %s "
 		        "(build them again with beamsim markov build)",
 		        BSIM_VERSION, version);
+	if (rc == BSIM_OK &&
+	    fy_node_by_path(fy_document_root(d->fyd), "/method", -1, FYNWF_DONT_FOLLOW) &&
+	    (rc = def_string(d, "/method", method, sizeof method, err)) == BSIM_OK &&
+	    strcmp(method, "maps") != 0 && strcmp(method, "nearest") != 0)
+		rc = bsim_ydoc_fail(d, def_field(d, "/method", "a string", err), NULL, "method",
+		                    err, "expected maps or nearest, got %s", method);
+	*is_nearest = strcmp(method, "nearest") == 0;
+	if (rc != BSIM_OK)
+		bsim_ydoc_free(d);
+	return rc;
+}
+
+/* markov.json's def, read as JSON (a YAML flow document) with libfyaml:
+ * every field bsim_markov_def_write writes, each fault naming its file position
+ * and field. */
+int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err)
+{
+	memset(opts, 0, sizeof *opts);
+	ydoc d;
+	int nearest = 0;
+	int rc = def_open(dir, &d, &nearest, err);
+	if (rc != BSIM_OK)
+		return rc;
+	uint64_t seed = 0;
+	char backend[64] = "", id[64] = "";
+	if (nearest)
+		rc = bsim_error_set(err, BSIM_EINPUT,
+		                    "%s: a build of nearest-neighbour walks (markov build's "
+		                    "default), not of maps: beamsim markov predict and validate "
+		                    "--map %s walk over it",
+		                    dir, dir);
 	if (rc == BSIM_OK)
 		rc = def_int(&d, "/bins/position", 1, 64, &def->bins.n_pos, err);
 	if (rc == BSIM_OK)
@@ -940,35 +1016,8 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	if (rc == BSIM_OK &&
 	    fy_node_by_path(fy_document_root(d.fyd), "/start_trials", -1, FYNWF_DONT_FOLLOW))
 		rc = def_int(&d, "/start_trials", 1, 1000000, &def->start_trials, err);
-	if (rc == BSIM_OK) {
-		/* above 2^53 written as a string (bsim_json_u64) */
-		struct fy_node *n = def_field(&d, "/seed", "a seed, an integer >= 0", err);
-		const char *t = n && fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
-		char *end = NULL;
-		errno = 0;
-		seed = t && *t >= '0' && *t <= '9' ? strtoull(t, &end, 10) : 0;
-		rc = !n                      ? BSIM_EINPUT
-		     : !end || *end || errno ? bsim_ydoc_expected(&d, n, NULL, "seed",
-		                                                  "a seed, an integer >= 0", err)
-		                             : BSIM_OK;
-	}
 	if (rc == BSIM_OK)
-		rc = def_string(&d, "/backend", backend, sizeof backend, err);
-	if (rc == BSIM_OK) {
-		struct fy_node *n = def_field(&d, "/options", "a list of \"KEY=VALUE\"", err);
-		if (!n)
-			rc = BSIM_EINPUT;
-		else if (!fy_node_is_sequence(n))
-			rc = bsim_ydoc_expected(&d, n, NULL, "options", "a list of \"KEY=VALUE\"",
-			                        err);
-		void *it = NULL;
-		struct fy_node *kv;
-		while (rc == BSIM_OK && (kv = fy_node_sequence_iterate(n, &it))) {
-			const char *t = fy_node_is_scalar(kv) ? fy_node_get_scalar0(kv) : NULL;
-			rc = t ? bsim_options_add(opts, t, err)
-			       : bsim_ydoc_expected(&d, kv, n, "options", "\"KEY=VALUE\"", err);
-		}
-	}
+		rc = def_engine_read(&d, &seed, backend, sizeof backend, opts, err);
 	if (rc == BSIM_OK)
 		rc = def_string(&d, "/entries", id, sizeof id, err);
 	/* absent in maps built before the gate after the start: without it */
@@ -1004,4 +1053,60 @@ int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *op
 	def->backend = bsim_backend_find(backend, err);
 	def->opts = opts;
 	return def->backend ? BSIM_OK : BSIM_EINPUT;
+}
+
+int bsim_markov_nearest_def_write(const char *stage, const bsim_markov_nearest_def *def,
+                                  const bsim_backend *be, const bsim_options *opts, bsim_error *err)
+{
+	char path[BSIM_PATH_MAX];
+	snprintf(path, sizeof path, "%s/markov.json", stage);
+	bsim_atomic_file o;
+	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fprintf(o.f,
+	        "{\"format\": %d, \"beamsim_version\": \"%s\", \"method\": \"nearest\", "
+	        "\"train\": %d, \"k\": %d, \"seed\": ",
+	        MAP_FORMAT, BSIM_VERSION, def->trials, def->k);
+	bsim_json_u64(o.f, def->seed);
+	def_engine_write(o.f, be, opts);
+	fputs("}\n", o.f);
+	return bsim_atomic_file_commit(&o, err);
+}
+
+int bsim_markov_nearest_def_read(const char *dir, bsim_markov_nearest_def *def, bsim_options *opts,
+                                 int *is_nearest, bsim_error *err)
+{
+	ydoc d;
+	int rc = def_open(dir, &d, is_nearest, err);
+	if (rc != BSIM_OK || !*is_nearest) {
+		if (rc == BSIM_OK)
+			bsim_ydoc_free(&d);
+		return rc;
+	}
+	memset(opts, 0, sizeof *opts);
+	char backend[64] = "";
+	rc = def_int(&d, "/train", 1, 100000000, &def->trials, err);
+	if (rc == BSIM_OK)
+		rc = def_int(&d, "/k", 1, BSIM_MARKOV_KDTREE_K_MAX, &def->k, err);
+	if (rc == BSIM_OK)
+		rc = def_engine_read(&d, &def->seed, backend, sizeof backend, opts, err);
+	bsim_ydoc_free(&d);
+	if (rc != BSIM_OK)
+		return rc;
+	def->backend = bsim_backend_find(backend, err);
+	def->opts = opts;
+	def->read_only = 1;
+	return def->backend ? BSIM_OK : BSIM_EINPUT;
+}
+
+int bsim_markov_dir_method(const char *dir, bsim_markov_method *method, bsim_error *err)
+{
+	ydoc d;
+	int is_nearest = 0;
+	const int rc = def_open(dir, &d, &is_nearest, err);
+	if (rc != BSIM_OK)
+		return rc;
+	bsim_ydoc_free(&d);
+	*method = is_nearest ? BSIM_MARKOV_METHOD_NEAREST : BSIM_MARKOV_METHOD_MAPS;
+	return BSIM_OK;
 }

@@ -200,6 +200,51 @@ int bsim_markov_train_visits(const bsim_scene *lattice, const bsim_markov_def *d
                              const bsim_options *opts, bsim_markov_visits *out, long *cap,
                              long long *steps, bsim_error *err);
 
+/* The chain's lattice (markov_map.c): BSIM_EINPUT naming the field unless
+ * s is a lattice with its side boundary at the field's edge and its end
+ * at the last row's top edge, where the chain's (and the walks')
+ * absorbing states are. */
+int bsim_markov_check_lattice(const bsim_scene *s, bsim_error *err);
+
+/* How bsim_markov_visits_gather writes and tells: a training field run is
+ * written into stage (NULL: the directory it reads), commit(user) then
+ * called (may be NULL: none; a build's, that adds the field's files to
+ * its directory's set), and field(user) told of each field, run or read,
+ * with the s of CPU it took when it was run (may be NULL). */
+typedef struct markov_visits_io {
+	const char *stage;
+	int (*commit)(void *user, bsim_error *err);
+	void (*field)(void *user, const double k[2], uint64_t hash, int reused, double cost);
+	void *user;
+} markov_visits_io;
+
+/* bsim_markov_visits_build (markov_nearest.c) as io says. */
+int bsim_markov_visits_gather(const bsim_scene *lattice, const bsim_markov_nearest_def *def,
+                              const char *dir, const markov_visits_io *io, bsim_markov_visits *out,
+                              bsim_error *err);
+
+/* The walks' def of a build's directory (markov_cache.c): *is_nearest 1
+ * and def's trials, k, seed, backend and opts (kept in *opts) from
+ * dir/markov.json if it is a build of the walks' (markov build's default),
+ * else *is_nearest 0 and def untouched (maps, or no markov.json: the
+ * maps' reader says). BSIM_EINPUT naming file, line and field. */
+int bsim_markov_nearest_def_read(const char *dir, bsim_markov_nearest_def *def, bsim_options *opts,
+                                 int *is_nearest, bsim_error *err);
+
+/* The walks a prediction makes: with visits_dir, given's over it (*vdir);
+ * else, if map_dir is a walks' build, given's walks, threads, progress
+ * and stop with the build's settings (bsim_markov_nearest_def_read, read
+ * only) over map_dir; else *vdir NULL: the maps' chain. *nd is given's
+ * then. */
+int bsim_markov_nearest_of_dir(const char *map_dir, const char *visits_dir,
+                               const bsim_markov_nearest_def *given, bsim_markov_nearest_def *nd,
+                               bsim_options *opts, const char **vdir, bsim_error *err);
+
+/* dir/markov.json of a walks' build (stage: where it is written). */
+int bsim_markov_nearest_def_write(const char *stage, const bsim_markov_nearest_def *def,
+                                  const bsim_backend *be, const bsim_options *opts,
+                                  bsim_error *err);
+
 /* ---- counts by row (markov_counts.c) ---- */
 
 /* Map m's counts (its bins and trials set) from its single gates' exit
@@ -395,11 +440,13 @@ int bsim_markov_key_same(const char *path, const char *key_text);
 /* The key of a key text: the map's file name, map_KEY. */
 uint64_t bsim_markov_key(const char *key_text);
 
-/* What tells the map directory dir's nearest map (the key with the fewest
- * lines unlike want's) from the map of key text want: "the nearest map
- * there, map_HASH.key, has 'LINE'; ... where this one needs 'LINE'; ...",
- * into buf; "" if dir holds no map. */
-void bsim_markov_key_nearest(const char *dir, const char *want, char *buf, size_t size);
+/* What tells the directory dir's nearest key of files prefix ("map_", or
+ * "visits_": a training field's) (the key with the fewest lines unlike
+ * want's) from key text want: "the nearest map there, map_HASH.key, has
+ * 'LINE'; ... where this one needs 'LINE'; ...", into buf; "" if dir holds
+ * no such key. */
+void bsim_markov_key_nearest(const char *dir, const char *prefix, const char *want, char *buf,
+                             size_t size);
 
 /* Reads map m (key, key_text, n_bins and counts set) from dir: 1 if there
  * with the same key text, 0 if not there or another key, -1 with err if

@@ -34,7 +34,7 @@ bsim_markov_def bsim_markov_def_default(void)
 
 /* The chain's lattice: its side boundary at the field's edge and its end
  * at the last row's top edge, where the chain's absorbing states are. */
-static int check_lattice(const bsim_scene *s, bsim_error *err)
+int bsim_markov_check_lattice(const bsim_scene *s, bsim_error *err)
 {
 	if (!s->has_lattice)
 		return bsim_error_set(err, BSIM_EINPUT,
@@ -222,12 +222,12 @@ const char *bsim_markov_def_scope(const bsim_markov_def *def, char *buf, size_t 
 		         "maps of entry bins: measured beyond TV 0.05 on 7 of 40 fields, columns "
 		         "and "
 		         "a random field of a physics they were not chosen on among them, where "
-		         "nearest-neighbour walks (markov predict --visits DIR) were within 0.05 "
+		         "the nearest-neighbour walks (markov build's default) were within 0.05 "
 		         "on all 40 (docs/markov.md, \"A kernel over exact states\")");
 	else
 		snprintf(buf, size,
-		         "maps with %s: measured less accurate than the default's on layouts "
-		         "they were not built on (%s)",
+		         "maps with %s: measured less accurate than with the maps' defaults on "
+		         "layouts they were not built on (%s)",
 		         list, each_part);
 	return buf;
 }
@@ -520,7 +520,7 @@ static int set_fill(const bsim_scene *lattice, const bsim_markov_def *given, con
 			/* a map is used only where its whole key matches: say what
 			 * differs from the nearest one there */
 			char near[700];
-			bsim_markov_key_nearest(dir, m->key_text, near, sizeof near);
+			bsim_markov_key_nearest(dir, "map_", m->key_text, near, sizeof near);
 			rc = bsim_error_set(
 			        err, BSIM_EINPUT,
 			        "%s: no map for k = %g, %g N m/rad with this scene's physics "
@@ -656,7 +656,7 @@ int bsim_markov_build(const bsim_scene *lattice, const bsim_markov_def *def, con
                       bsim_markov_set *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
-	int rc = check_lattice(lattice, err);
+	int rc = bsim_markov_check_lattice(lattice, err);
 	if (rc == BSIM_OK)
 		rc = def_check(def, err);
 	if (rc != BSIM_OK)
@@ -751,7 +751,7 @@ int bsim_markov_load(const bsim_scene *lattice, const char *dir, bsim_options *o
                      bsim_markov_set *out, bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
-	int rc = check_lattice(lattice, err);
+	int rc = bsim_markov_check_lattice(lattice, err);
 	if (rc != BSIM_OK)
 		return rc;
 	bsim_markov_def def = bsim_markov_def_default();

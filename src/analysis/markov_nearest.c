@@ -231,12 +231,13 @@ static int key_there(const char *dir, uint64_t hash, const char *key)
 	return bsim_markov_key_same(path, key);
 }
 
-int bsim_markov_visits_build(const bsim_scene *lattice, const bsim_markov_nearest_def *def,
-                             const char *dir, bsim_markov_visits *out, bsim_error *err)
+int bsim_markov_visits_gather(const bsim_scene *lattice, const bsim_markov_nearest_def *def,
+                              const char *dir, const markov_visits_io *io, bsim_markov_visits *out,
+                              bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
-	if (!lattice->has_lattice)
-		return bsim_error_set(err, BSIM_EINPUT, "%s: not a gate lattice", lattice->name);
+	if (bsim_markov_check_lattice(lattice, err) != BSIM_OK)
+		return BSIM_EINPUT;
 	if (def->trials < 1)
 		return bsim_error_set(err, BSIM_EINPUT,
 		                      "training trials %d: expected 1 or more a gate kind",
@@ -245,13 +246,14 @@ int bsim_markov_visits_build(const bsim_scene *lattice, const bsim_markov_neares
 	const bsim_options none = {0};
 	const bsim_options *opts = def->opts ? def->opts : &none;
 	const bsim_markov_def m = train_def(def);
+	const char *stage = io->stage ? io->stage : dir;
 	/* the kinds in ascending order: the fields and their seeds do not
 	 * depend on the order a lattice meets them in */
 	double(*kinds)[2] = NULL;
 	const int n = bsim_markov_lattice_kinds(lattice, &kinds);
 	if (n < 0)
 		return bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	int rc = bsim_output_mkdir(dir, err);
+	int rc = def->read_only ? BSIM_OK : bsim_output_mkdir(stage, err);
 	long cap = 0;
 	for (int i = 0; rc == BSIM_OK && i < n; i++) {
 		char *key = visits_key(lattice, &m, be, opts, kinds[i]);
@@ -260,9 +262,24 @@ int bsim_markov_visits_build(const bsim_scene *lattice, const bsim_markov_neares
 			break;
 		}
 		const uint64_t hash = bsim_markov_key(key);
-		if (key_there(dir, hash, key)) {
+		const int there = key_there(dir, hash, key);
+		const double cost0 = out->cost;
+		if (there) {
 			rc = visits_read(dir, hash, out, &cap, err);
 			out->reused += rc == BSIM_OK;
+		} else if (def->read_only) {
+			/* a build's fields are used only where the whole key
+			 * matches: say what differs from the nearest there */
+			char near[700];
+			bsim_markov_key_nearest(dir, "visits_", key, near, sizeof near);
+			rc = bsim_error_set(
+			        err, BSIM_EINPUT,
+			        "%s: no training field for k = %g, %g N m/rad with this "
+			        "scene's physics and gate kinds and the build's "
+			        "settings (key %016llx)%s%s: beamsim markov build "
+			        "writes it",
+			        dir, kinds[i][0], kinds[i][1], (unsigned long long)hash,
+			        near[0] ? "; " : "", near);
 		} else {
 			const long first = out->n, left0 = out->left_out;
 			long long steps = 0;
@@ -273,20 +290,46 @@ int bsim_markov_visits_build(const bsim_scene *lattice, const bsim_markov_neares
 			        opts, out, &cap, &steps, err);
 			const double cost = bsim_clock_process_cpu_seconds() - c0;
 			if (rc == BSIM_OK)
-				rc = visits_write(dir, hash, key, out, first, cost, steps,
+				rc = visits_write(stage, hash, key, out, first, cost, steps,
 				                  out->left_out - left0, err);
+			if (rc == BSIM_OK && io->commit)
+				rc = io->commit(io->user, err);
 			if (rc == BSIM_OK) {
 				out->built++;
 				out->cost += cost;
 				out->steps += steps;
 			}
 		}
+		if (rc == BSIM_OK && io->field)
+			io->field(io->user, kinds[i], hash, there, out->cost - cost0);
 		out->fields += rc == BSIM_OK;
 		free(key);
 	}
 	free(kinds);
 	if (rc != BSIM_OK)
 		bsim_markov_visits_free(out);
+	return rc;
+}
+
+int bsim_markov_visits_build(const bsim_scene *lattice, const bsim_markov_nearest_def *def,
+                             const char *dir, bsim_markov_visits *out, bsim_error *err)
+{
+	const markov_visits_io io = {0};
+	return bsim_markov_visits_gather(lattice, def, dir, &io, out, err);
+}
+
+int bsim_markov_nearest_of_dir(const char *map_dir, const char *visits_dir,
+                               const bsim_markov_nearest_def *given, bsim_markov_nearest_def *nd,
+                               bsim_options *opts, const char **vdir, bsim_error *err)
+{
+	*nd = *given;
+	*vdir = visits_dir;
+	if (visits_dir || !map_dir)
+		return BSIM_OK;
+	int is_nearest = 0;
+	const int rc = bsim_markov_nearest_def_read(map_dir, nd, opts, &is_nearest, err);
+	if (rc == BSIM_OK && is_nearest)
+		*vdir = map_dir;
 	return rc;
 }
 
@@ -454,8 +497,8 @@ int bsim_markov_nearest_predict(const bsim_scene *lattice, const bsim_markov_vis
                                 bsim_error *err)
 {
 	memset(out, 0, sizeof *out);
-	if (!lattice->has_lattice)
-		return bsim_error_set(err, BSIM_EINPUT, "%s: not a gate lattice", lattice->name);
+	if (bsim_markov_check_lattice(lattice, err) != BSIM_OK)
+		return BSIM_EINPUT;
 	if (def->k < 1 || def->k > BSIM_MARKOV_KDTREE_K_MAX)
 		return bsim_error_set(err, BSIM_EINPUT, "k %d: expected 1 to %d nearest visits",
 		                      def->k, BSIM_MARKOV_KDTREE_K_MAX);

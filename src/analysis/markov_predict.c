@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "analysis/markov_internal.h"
 #include "beamsim/lattice_outcome.h"
 #include "beamsim/markov.h"
 #include "store/outdir.h"
@@ -49,13 +50,13 @@ static int predict_chain(const bsim_markov_predict_def *def, const bsim_markov_s
 	return rc;
 }
 
-/* The walks over the visits in def->visits_dir for res->scene, the
- * training fields run there first where missing. */
-static int predict_nearest(const bsim_markov_predict_def *def, bsim_markov_predict_result *res,
-                           bsim_error *err)
+/* The walks nd over the visits in dir for res->scene, the training fields
+ * run there first where missing (not in a build's: nd->read_only). */
+static int predict_nearest(const bsim_markov_nearest_def *nd, const char *dir,
+                           bsim_markov_predict_result *res, bsim_error *err)
 {
 	bsim_markov_visits v;
-	int rc = bsim_markov_visits_build(&res->scene, &def->nearest, def->visits_dir, &v, err);
+	int rc = bsim_markov_visits_build(&res->scene, nd, dir, &v, err);
 	if (rc != BSIM_OK)
 		return rc;
 	res->n_maps = v.fields;
@@ -63,7 +64,7 @@ static int predict_nearest(const bsim_markov_predict_def *def, bsim_markov_predi
 	res->fields_cost = v.cost;
 	/* the walks run on every thread: the process's CPU time */
 	const double t0 = bsim_clock_seconds(), c0 = bsim_clock_process_cpu_seconds();
-	rc = bsim_markov_nearest_predict(&res->scene, &v, &def->nearest, &res->p, err);
+	rc = bsim_markov_nearest_predict(&res->scene, &v, nd, &res->p, err);
 	res->seconds = bsim_clock_seconds() - t0;
 	res->cpu_seconds = bsim_clock_process_cpu_seconds() - c0;
 	bsim_markov_visits_free(&v);
@@ -79,7 +80,17 @@ int bsim_markov_predict_run(const bsim_markov_predict_def *def, bsim_markov_pred
                             bsim_error *err)
 {
 	memset(res, 0, sizeof *res);
-	if (def->scene && def->visits_dir) {
+	/* walks: over visits_dir, or map_dir if a walks' build */
+	bsim_markov_nearest_def nd;
+	bsim_options nd_opts = {0};
+	const char *vdir = NULL;
+	if (def->scene) {
+		const int rc = bsim_markov_nearest_of_dir(def->map_dir, def->visits_dir,
+		                                          &def->nearest, &nd, &nd_opts, &vdir, err);
+		if (rc != BSIM_OK)
+			return rc;
+	}
+	if (vdir) {
 		int rc = bsim_scene_load(def->scene, def->sets, def->n_sets, &res->scene, err);
 		const bsim_outdir_spelling spelling = {NULL, def->overwrite_option};
 		if (rc == BSIM_OK && def->out)
@@ -87,7 +98,7 @@ int bsim_markov_predict_run(const bsim_markov_predict_def *def, bsim_markov_pred
 			        def->out, def->overwrite ? BSIM_OUTDIR_OVERWRITE : BSIM_OUTDIR_NEW,
 			        &spelling, err);
 		if (rc == BSIM_OK)
-			rc = predict_nearest(def, res, err);
+			rc = predict_nearest(&nd, vdir, res, err);
 		if (rc == BSIM_OK && def->out)
 			rc = bsim_markov_prediction_store(def->out, def->overwrite, &res->scene,
 			                                  NULL, &res->p, err);

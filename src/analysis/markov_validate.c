@@ -333,8 +333,11 @@ static int write_json(const char *stage, const bsim_markov_validate_def *def,
 	FILE *f = o.f;
 	fputs("{\"experiment\": ", f);
 	bsim_json_string(f, e->path);
-	fputs(def->visits_dir ? ", \"visits_dir\": " : ", \"map_dir\": ", f);
-	bsim_json_string(f, def->visits_dir ? def->visits_dir : def->map_dir);
+	/* the walks over a cache (--visits) or a build's directory (--map) */
+	const int walks = def->visits_dir != NULL, cache = walks && !def->nearest.read_only;
+	fputs(cache ? ", \"visits_dir\": " : ", \"map_dir\": ", f);
+	bsim_json_string(f, walks ? def->visits_dir : def->map_dir);
+	fprintf(f, ", \"method\": \"%s\"", walks ? "nearest" : "maps");
 	if (def->visits_dir) /* the maps' fields below are the training fields' */
 		fprintf(f, ", \"nearest_walks\": %ld, \"nearest_k\": %d, \"train_trials\": %d",
 		        def->nearest.walks, def->nearest.k, def->nearest.trials);
@@ -588,10 +591,9 @@ static int group_validate(const bsim_markov_validate_def *def, const bsim_experi
 	return rc;
 }
 
-int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_validation *out,
-                         bsim_error *err)
+static int validate_run(const bsim_markov_validate_def *def, bsim_markov_validation *out,
+                        bsim_error *err)
 {
-	memset(out, 0, sizeof *out);
 	bsim_experiment e;
 	int rc = bsim_experiment_load_seeded(def->experiment, def->sets, def->n_sets, def->grid,
 	                                     def->n_grid, def->has_seed ? &def->seed : NULL, &e,
@@ -734,5 +736,24 @@ int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_valida
 	if (rc != BSIM_OK)
 		bsim_markov_validation_free(out);
 	snprintf(out->journal, sizeof out->journal, "%s", b.journal);
+	return rc;
+}
+
+int bsim_markov_validate(const bsim_markov_validate_def *def, bsim_markov_validation *out,
+                         bsim_error *err)
+{
+	memset(out, 0, sizeof *out);
+	/* walks: over visits_dir, or map_dir if a walks' build */
+	bsim_markov_validate_def d = *def;
+	bsim_options opts = {0};
+	int rc = bsim_markov_nearest_of_dir(def->map_dir, def->visits_dir, &def->nearest,
+	                                    &d.nearest, &opts, &d.visits_dir, err);
+	if (rc == BSIM_OK)
+		rc = validate_run(&d, out, err);
+	if (d.visits_dir) {
+		out->nearest_walks = d.nearest.walks;
+		out->nearest_k = d.nearest.k;
+		out->nearest_trials = d.nearest.trials;
+	}
 	return rc;
 }

@@ -64,6 +64,9 @@ typedef struct markov_args {
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
 	int start_trials; /* build: --start-trials given */
+	const char *method;    /* build: --method, NULL not given */
+	int train_given;       /* build: --train given (def.train_trials) */
+	const char *maps_only; /* build: the first option of the maps' only given */
 } markov_args;
 
 /* An integer option of markov build, lo to hi, into *out; else the usage
@@ -253,10 +256,11 @@ static const cli_own build_own[] = {
          "and the chain takes the first two gates from those (0 with\n"
          "self or flow entries); 0: entry bins from the start on"},
         {"train", 1, "N",
-         "trials of the training field, a 21 x 21 field of the\n"
-         "lattice's gate kinds at random, whose gate entries the\n"
-         "bins' states are drawn from (default 4000; run only when\n"
-         "a map is built); 0: states uniform in each bin"},
+         "trials of each training field, a 21 x 21 field of the\n"
+         "lattice's gate kinds at random (the walks' default 10000);\n"
+         "maps: the field whose gate entries the bins' states are\n"
+         "drawn from (default 4000; run only when a map is built),\n"
+         "0: states uniform in each bin"},
         {"crossings", 1, "0|1",
          "1 (default, with a training field): each bin counts the\n"
          "training field's own crossings of the map's gate kind\n"
@@ -271,6 +275,12 @@ static const cli_own build_own[] = {
          "the first N start trials go on into the gate after the\n"
          "start (default 8000); the others take the continuations of\n"
          "those that entered the same gate; 0: every start trial"},
+        {"method", 1, "nearest|maps",
+         "nearest (the default): the training fields of the\n"
+         "nearest-neighbour walks; maps: single-gate maps of entry\n"
+         "bins (implied by any option above but --train)"},
+        {"k", 1, "K",
+         "the walks: each step drawn from the K nearest visits\n(1 to 64, default 20)"},
 };
 
 /* What a map's entry bin holds, for the summaries: trials single gates,
@@ -285,8 +295,21 @@ static void bins_hold(int crossings, int per, int trials, char *buf, size_t size
 		snprintf(buf, size, "%s%d trials", crossings ? "their crossings or " : "", trials);
 }
 
+static int nearest_option(markov_args *a, const char *cmd, int i, const char *value);
+
 static int build_option(void *args, int i, const char *value)
 {
+	markov_args *a = args;
+	if (i == 11) {
+		a->method = value;
+		return CLI_OK;
+	}
+	if (i == 12)
+		return nearest_option(a, "markov build", 1, value);
+	if (i == 7) /* --train: the walks' training fields or the maps' */
+		a->train_given = 1;
+	else if (!a->maps_only)
+		a->maps_only = build_own[i].name;
 	return markov_option(args,
 	                     i == 3    ? OWN_SHARD
 	                     : i == 4  ? OWN_PASSES
@@ -301,16 +324,26 @@ static int build_option(void *args, int i, const char *value)
 }
 
 static const char *const build_help[CLI_N_OPTS] = {
-        [CLI_OPT_OUT] = "the map directory: maps already there with the same key are\n"
-                        "reused, the others are built there (required)",
-        [CLI_OPT_TRIALS] = "single-gate trials per entry bin (default 50)",
-        [CLI_OPT_SEED] = "seed of the entry states and schedules (default 1)",
+        [CLI_OPT_OUT] = "the directory: training fields or maps already there with the\n"
+                        "same key are reused, the others are built there (required)",
+        [CLI_OPT_TRIALS] = "maps: single-gate trials per entry bin (default 50)",
+        [CLI_OPT_SEED] = "seed of the training fields, entry states and schedules\n(default 1)",
 };
 
 static const cli_spec build_spec = {
         .name = "markov build",
         .usage = "EXPERIMENT --out DIR [OPTIONS]",
-        .about = "Builds the single-gate maps the lattices of EXPERIMENT need, one per pair of\n"
+        .about = "Builds what the Markov chain predicts the lattices of EXPERIMENT from. By\n"
+                 "default (--method nearest) the nearest-neighbour walks' training fields:\n"
+                 "for each gate kind of a lattice's physics, --train trials (default 10000)\n"
+                 "of a 21 x 21 field of the lattice's kinds at random, each trial its own\n"
+                 "layout, every gate visit kept with its exact entry and exit states\n"
+                 "(visits_HASH.csv, .key, .cost) and markov.json; markov predict and\n"
+                 "validate --map DIR walk over them, each step from the --k nearest visits,\n"
+                 "for every layout of the same kinds and physics (docs/markov.md).\n"
+                 "With --method maps (or any option of theirs: --bins, --vmax, --trials,\n"
+                 "--entries, --start-trials, --after-start, --after-trials, --crossings,\n"
+                 "--per-crossing, --shard, --passes), the single-gate maps, one per pair of\n"
                  "beam stiffnesses: for every entry bin (edge, position along it, speed,\n"
                  "direction; and the start) single gates with their beams at rest, as the\n"
                  "essay's protocol resets them, run from states drawn in the bin with fresh\n"
@@ -336,7 +369,9 @@ static const cli_spec build_spec = {
 };
 
 static const cli_own predict_own[] = {
-        {"map", 1, "DIR", "the map directory of beamsim markov build (or --visits)"},
+        {"map", 1, "DIR",
+         "the directory of beamsim markov build: its walks'\ntraining fields, or maps (or "
+         "--visits)"},
         {"locations", 0, NULL, "also print every final location with its probability"},
         {"json", 0, NULL,
          "print one JSON object (totals, every location, predict_seconds)\ninstead of text"},
@@ -348,8 +383,8 @@ static const cli_own predict_own[] = {
          "no distribution of gates visited, even with --out\n(the sweeps; the mean "
          "from the expected visits)"},
         {"walks", 1, "N",
-         "walks of the semi-Markov chain for the distribution of\nthe time to the "
-         "outcome (default 100000; 0: none)"},
+         "the nearest-neighbour walks (default 200000); maps: walks\nof the semi-Markov "
+         "chain for the distribution of the time\nto the outcome (default 100000; 0: none)"},
         {"gates", 0, NULL,
          "also the distribution of gates visited (the series,\nslower; --out implies "
          "it): p_gates,\nprediction_gates.csv"},
@@ -413,14 +448,16 @@ static const char *const predict_help[CLI_N_OPTS] = {
                         "their .mat twins and the figures prediction.png (the field)\n"
                         "and time.png into DIR",
         [CLI_OPT_SEED] = "with --visits: seed of the training fields and the walks\n(default 1)",
-        [CLI_OPT_THREADS] = "with --visits: threads (default all cores; the same answer)",
+        [CLI_OPT_THREADS] = "the walks' threads (default all cores; the same answer)",
         [CLI_OPT_BACKEND] = "with --visits: the training fields' backend",
 };
 
 static const cli_spec predict_spec = {
         .name = "markov predict",
         .usage = "LATTICE_SCENE (--map DIR | --visits DIR) [OPTIONS]",
-        .about = "Composes the maps in DIR over the lattice of LATTICE_SCENE into an absorbing\n"
+        .about = "Predicts the lattice of LATTICE_SCENE from the build in DIR: by\n"
+                 "nearest-neighbour walks over its training fields' visits (markov build's\n"
+                 "default), or, for maps, composes them into an absorbing\n"
                  "Markov chain and prints the probabilities of ending through the end, out\n"
                  "a side and stuck in a gate, and the mean number of gates visited. The\n"
                  "distribution over every final location (the end through column ix, a side\n"
@@ -444,7 +481,9 @@ static const cli_spec predict_spec = {
 };
 
 static const cli_own validate_own[] = {
-        {"map", 1, "DIR", "the map directory of beamsim markov build (or --visits)"},
+        {"map", 1, "DIR",
+         "the directory of beamsim markov build: its walks'\ntraining fields, or maps (or "
+         "--visits)"},
         {"bootstrap", 1, "B", "resamples of the simulation (default 2000)"},
         {"shard", 1, "I/N",
          "simulate part I of N (I from 1 to N, as SLURM_ARRAY_TASK_ID\n"
@@ -457,7 +496,7 @@ static const cli_own validate_own[] = {
          "as markov predict --visits (the training\nfields missing there run first)"},
         {"k", 1, "K", "with --visits: as markov predict's (default 20)"},
         {"train", 1, "N", "with --visits: as markov predict's (default 10000)"},
-        {"walks", 1, "N", "with --visits: the walks (default 200000)"},
+        {"walks", 1, "N", "the nearest-neighbour walks (default 200000)"},
 };
 
 static int validate_option(void *args, int i, const char *value)
@@ -480,10 +519,11 @@ static const cli_spec validate_spec = {
         .name = "markov validate",
         .usage = "LATTICE_EXPERIMENT --map DIR --out DIR [OPTIONS]",
         .about = "Simulates every group of LATTICE_EXPERIMENT directly, under the essay's\n"
-                 "protocol and as a whole world, predicts it with the chain of the maps in\n"
-                 "--map, and writes into --out: validate.json (total variation distance of\n"
-                 "the final-location distributions with the simulation's and the maps'\n"
-                 "sampling errors, mean gates visited, CPU time of simulation and\n"
+                 "protocol and as a whole world, predicts it from the build in --map (the\n"
+                 "walks, or the chain of its maps), and writes into --out: validate.json\n"
+                 "(total variation distance of the final-location distributions with the\n"
+                 "simulation's and the walks' or maps' sampling errors, mean gates visited, CPU "
+                 "time of simulation and\n"
                  "prediction, the lattices after which building the maps pays off; with\n"
                  "the maps' holding times the exit times against the chain's walks),\n"
                  "validate.csv, gates.csv, time_validate.csv, their .mat twins and\n"
@@ -521,6 +561,16 @@ static void train_progress_update(void *user, long done, long total)
 }
 
 static int markov_build_main(int argc, char **argv, const cli_merge *m, const markov_part *p);
+
+/* A run stopped by SIGINT or SIGTERM, its finished work kept (err says
+ * what): said, with what the same command does next; 128 + the signal. */
+static int stopped(const bsim_error *err, const char *next)
+{
+	const int sig = cli_stop ? (int)cli_stop : SIGINT;
+	cli_error("%s: %s; the same command %s", sig == SIGTERM ? "SIGTERM" : "SIGINT", err->msg,
+	          next);
+	return 128 + sig;
+}
 
 static int remove_one(const char *path, const struct stat *st, int type, struct FTW *ftw)
 {
@@ -612,12 +662,14 @@ static int markov_build_ranks(int argc, char **argv, const cli_common *c)
 static void build_group_print(void *user, int group, const bsim_markov_built *maps, int n)
 {
 	const bsim_markov_build_def *def = user;
+	const int nearest = def->method == BSIM_MARKOV_METHOD_NEAREST;
 	for (int i = 0; i < n; i++) {
 		char of_pass[32] = ""; /* a round before the last: one pass of the maps */
-		if (maps[i].pass < def->map.self_passes)
+		if (!nearest && maps[i].pass < def->map.self_passes)
 			snprintf(of_pass, sizeof of_pass, "pass %d ", maps[i].pass);
-		printf("group %d  k = %g, %g N m/rad  map_%016llx  %s%s\n", group, maps[i].k[0],
-		       maps[i].k[1], (unsigned long long)maps[i].key, of_pass,
+		printf("group %d  k = %g, %g N m/rad  %s_%016llx  %s%s\n", group, maps[i].k[0],
+		       maps[i].k[1], nearest ? "visits" : "map", (unsigned long long)maps[i].key,
+		       of_pass,
 		       maps[i].elsewhere ? "another part's"
 		       : maps[i].copied  ? "from a part"
 		       : maps[i].cached  ? "reused"
@@ -664,12 +716,93 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 	cli_wrote(stdout, out);
 }
 
+/* markov build's default: the walks' training fields, their progress and
+ * lines. */
+static int markov_build_nearest(cli_common *c, const markov_args *a, const char *path)
+{
+	bsim_options opts = {0};
+	const bsim_backend *be = cli_backend_with_opts(
+	        c, "markov build", c->backend ? c->backend : bsim_backend_default()->name, &opts);
+	if (!be)
+		return CLI_USAGE;
+	bsim_markov_build_def def = bsim_markov_build_def_default();
+	markov_args given = *a;
+	if (a->train_given)
+		given.train = a->def.train_trials;
+	nearest_apply(&given, c, be, &opts, &def.nearest);
+	def.experiment = path;
+	def.out = c->out;
+	def.sets = c->sets.ov;
+	def.n_sets = c->sets.n;
+	def.grid = c->sets.grid;
+	def.n_grid = c->sets.n_grid;
+	def.has_seed = c->has_seed;
+	def.seed = c->seed;
+	cli_progress training;
+	cli_progress_init(&training, !c->quiet, "training trials");
+	def.nearest.progress = train_progress_update;
+	def.nearest.progress_user = &training;
+	def.nearest.stop = &cli_stop;
+	if (!c->quiet) {
+		def.group_done = build_group_print;
+		def.group_done_user = &def;
+	}
+	bsim_markov_build_result res;
+	bsim_error err;
+	cli_signals_install();
+	int rc = bsim_markov_build_run(&def, &res, &err);
+	cli_signals_restore();
+	cli_progress_finish(&training);
+	/* Each finished training field is in the directory already. */
+	if (rc == BSIM_ESTOPPED)
+		return stopped(&err, "runs the rest");
+	if (rc == BSIM_OK && !c->quiet) {
+		printf("%d training fields run (%.1f s of CPU), %d reused: %ld visits, each "
+		       "field %d trials of %d x %d gates of the lattice's kinds at random, in "
+		       "%s\n"
+		       "markov predict and validate --map %s walk over them, each step from "
+		       "the %d nearest visits\n",
+		       res.built, res.seconds, res.reused, res.visits, def.nearest.trials,
+		       BSIM_MARKOV_TRAIN_SIZE, BSIM_MARKOV_TRAIN_SIZE, cli_path(c->out),
+		       cli_path(c->out), def.nearest.k);
+		cli_wrote(stdout, c->out);
+	}
+	if (rc == BSIM_OK)
+		bsim_markov_build_result_free(&res);
+	return cli_report(rc, &err);
+}
+
 static int markov_build_main(int argc, char **argv, const cli_merge *m, const markov_part *p)
 {
 	cli_common c = cli_common_default();
 	markov_args a = {.def = bsim_markov_def_default()};
 	const char *path = NULL;
 	int rc = cli_parse(&build_spec, argc, argv, &c, &a, &path);
+	/* the method: --method's, else maps if an option of theirs alone is
+	 * given, else the walks */
+	char maps_only[32] = "", k_given[16] = "";
+	if (a.maps_only || c.trials > 0)
+		snprintf(maps_only, sizeof maps_only, "--%s", a.maps_only ? a.maps_only : "trials");
+	if (a.k)
+		snprintf(k_given, sizeof k_given, "--k");
+	bsim_markov_method method = BSIM_MARKOV_METHOD_NEAREST;
+	bsim_error err;
+	if (rc < 0 &&
+	    bsim_markov_build_method(a.method, maps_only[0] ? maps_only : NULL,
+	                             k_given[0] ? k_given : NULL, &method, &err) != BSIM_OK)
+		rc = cli_usage("markov build", "%s", err.msg);
+	const int nearest = method == BSIM_MARKOV_METHOD_NEAREST && !m && !p;
+	if (rc < 0 && nearest && cli_mpi_size() > 1)
+		rc = cli_usage("markov build",
+		               "the walks' training fields run in one process, on its threads: "
+		               "not under mpirun (%d ranks); --method maps spreads its maps over "
+		               "the ranks",
+		               cli_mpi_size());
+	if (rc < 0 && nearest) {
+		rc = markov_build_nearest(&c, &a, path);
+		cli_common_free(&c);
+		return rc;
+	}
 	if (rc < 0 && a.shards > 0 && cli_mpi_size() > 1)
 		rc = cli_usage("markov build",
 		               "--shard builds one part in one process: not under mpirun (%d "
@@ -701,6 +834,7 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 		a.shards = p->shards;
 	}
 	bsim_markov_build_def def = bsim_markov_build_def_default();
+	def.method = BSIM_MARKOV_METHOD_MAPS;
 	if (m) {
 		cli_merge_apply(m, &c);
 		a.shard = a.shards = 0;
@@ -754,21 +888,16 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 	def.map.train_progress_user = &training;
 	def.map.stop = &cli_stop;
 	bsim_markov_build_result res;
-	bsim_error err;
 	cli_signals_install();
 	rc = a.shards > 0 && !stored ? bsim_error_set(&err, BSIM_EFAIL, "out of memory")
 	                             : bsim_markov_build_run(&def, &res, &err);
 	cli_progress_finish(&progress);
 	cli_signals_restore();
 	cli_stored_argv_free(stored, argc, argv);
-	if (rc == BSIM_ESTOPPED) {
-		/* Each finished map is in the directory already: the same command
-		 * reuses them and builds the rest. */
-		int sig = cli_stop ? (int)cli_stop : SIGINT;
-		cli_error("%s: %s; the same command builds the rest",
-		          sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
-		rc = 128 + sig;
-	}
+	/* Each finished map is in the directory already: the same command
+	 * reuses them and builds the rest. */
+	if (rc == BSIM_ESTOPPED)
+		rc = stopped(&err, "builds the rest");
 	if (rc == BSIM_OK && !c.quiet)
 		build_print(&def, &res, c.out);
 	if (rc == BSIM_OK && res.scope[0]) /* quiet too: it is about the maps, not progress */
@@ -875,22 +1004,31 @@ static int markov_predict(int argc, char **argv)
 	if (rc < 0 && !a.map == !a.visits)
 		rc = cli_usage("markov predict", "expected one of --map DIR and --visits DIR");
 	if (rc < 0 && a.map) {
-		const char *alone = c.has_seed  ? "--seed"
-		                    : c.threads ? "--threads"
-		                    : c.backend ? "--backend"
-		                    : a.k       ? "--k"
-		                    : a.train   ? "--train"
-		                                : NULL;
+		const char *alone = c.has_seed                      ? "--seed"
+		                    : c.backend || c.n_backend_opts ? "--backend"
+		                    : a.k                           ? "--k"
+		                    : a.train                       ? "--train"
+		                                                    : NULL;
 		if (alone)
 			rc = cli_usage("markov predict",
-			               "%s is for --visits (the maps of --map hold their own)",
+			               "%s is for --visits (the build in --map holds its own)",
 			               alone);
 	}
-	if (rc < 0 && a.visits && (a.tol > 0 || a.no_gates || a.gates))
-		rc = cli_usage("markov predict", "--tol, --gates and --no-gates are for --map");
-	if (rc < 0 && a.visits && a.walks == 0)
+	/* --map's build: walks (markov build's default) or maps */
+	bsim_error err;
+	bsim_markov_method method = BSIM_MARKOV_METHOD_NEAREST;
+	if (rc < 0 && a.map && bsim_markov_dir_method(a.map, &method, &err) != BSIM_OK)
+		rc = cli_report(err.code, &err);
+	const int walks = a.visits || method == BSIM_MARKOV_METHOD_NEAREST;
+	if (rc < 0 && !walks && c.threads)
 		rc = cli_usage("markov predict",
-		               "--walks 0: expected 1 or more walks with --visits");
+		               "--threads is for the walks (the maps' solve is one "
+		               "thread's)");
+	if (rc < 0 && walks && (a.tol > 0 || a.no_gates || a.gates))
+		rc = cli_usage("markov predict", "--tol, --gates and --no-gates are for maps");
+	if (rc < 0 && walks && a.walks == 0)
+		rc = cli_usage("markov predict",
+		               "--walks 0: expected 1 or more nearest-neighbour walks");
 	if (rc >= 0) {
 		cli_common_free(&c);
 		return rc;
@@ -914,6 +1052,10 @@ static int markov_predict(int argc, char **argv)
 		def.nearest.progress = train_progress_update;
 		def.nearest.progress_user = &training;
 		def.nearest.stop = &cli_stop;
+	} else if (walks) { /* a walks' build: its settings, these walks */
+		def.nearest.threads = (int)c.threads;
+		if (a.walks > 0)
+			def.nearest.walks = a.walks;
 	}
 	if (a.walks < 0)
 		a.walks = BSIM_MARKOV_WALKS;
@@ -927,18 +1069,14 @@ static int markov_predict(int argc, char **argv)
 	def.gates = a.no_gates ? 0 : a.gates ? 1 : -1;
 	def.walks = a.walks;
 	bsim_markov_predict_result r;
-	bsim_error err;
 	cli_signals_install();
 	rc = bsim_markov_predict_run(&def, &r, &err);
 	cli_signals_restore();
 	cli_progress_finish(&training);
 	if (rc == BSIM_ESTOPPED) {
 		/* Each finished training field is in the directory already. */
-		const int sig = cli_stop ? (int)cli_stop : SIGINT;
-		cli_error("%s: %s; the same command runs the rest",
-		          sig == SIGTERM ? "SIGTERM" : "SIGINT", err.msg);
 		cli_common_free(&c);
-		return 128 + sig;
+		return stopped(&err, "runs the rest");
 	}
 	/* --quiet wins over --json: nothing on stdout. */
 	if (rc == BSIM_OK && !c.quiet && a.json)
@@ -960,13 +1098,21 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	int rc = cli_parse(&validate_spec, argc, argv, &c, &a, &path);
 	if (rc < 0 && !a.map == !a.visits)
 		rc = cli_usage("markov validate", "expected one of --map DIR and --visits DIR");
-	if (rc < 0 && a.map && (a.k || a.train || a.walks || c.backend))
+	if (rc < 0 && a.map && (a.k || a.train || c.backend))
 		rc = cli_usage("markov validate",
-		               "--%s is for --visits (the maps of --map hold their own)",
+		               "--%s is for --visits (the build in --map holds its own)",
 		               a.k       ? "k"
 		               : a.train ? "train"
-		               : a.walks ? "walks"
 		                         : "backend");
+	/* --map's build: walks (markov build's default) or maps */
+	bsim_error err;
+	bsim_markov_method method = BSIM_MARKOV_METHOD_NEAREST;
+	if (rc < 0 && a.map && bsim_markov_dir_method(a.map, &method, &err) != BSIM_OK)
+		rc = cli_report(err.code, &err);
+	const int walks = a.visits || method == BSIM_MARKOV_METHOD_NEAREST;
+	if (rc < 0 && a.walks && !walks)
+		rc = cli_usage("markov validate",
+		               "--walks is for the walks (the maps in --map hold their own)");
 	if (rc < 0 && a.shards > 0 && cli_mpi_size() > 1)
 		rc = cli_usage("markov validate",
 		               "--shard runs one part in one process: not under mpirun, "
@@ -1013,6 +1159,10 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 		def.visits_dir = a.visits;
 		nearest_apply(&a, &c, be, &nearest_opts, &def.nearest);
 		def.nearest.stop = &cli_stop;
+	} else if (walks) { /* a walks' build: its settings, these walks */
+		def.nearest.threads = (int)c.threads;
+		if (a.walks > 0)
+			def.nearest.walks = a.walks;
 	}
 	def.out = c.out;
 	def.sets = c.sets.ov;
@@ -1034,7 +1184,6 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	def.nearest.progress = rank == 0 ? train_progress_update : NULL;
 	def.nearest.progress_user = &training;
 	bsim_markov_validation v;
-	bsim_error err;
 	cli_signals_install();
 	rc = bsim_markov_validate(&def, &v, &err);
 	cli_signals_restore();
@@ -1055,13 +1204,13 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	if (rc == BSIM_OK && !c.quiet) {
 		char holds[96];
 		bins_hold(v.of_crossings, v.per_crossing, v.trials_per_bin, holds, sizeof holds);
-		if (a.visits)
+		if (walks)
 			printf("visits      %s: nearest-neighbour walks, %ld of them, each step "
 			       "from "
 			       "the %d nearest visits;\n            training fields of %d trials, "
 			       "%.1f s of CPU to run (%lld time steps)\n\n",
-			       a.visits, def.nearest.walks, def.nearest.k, def.nearest.trials,
-			       v.map_cost, v.map_steps);
+			       a.visits ? a.visits : a.map, v.nearest_walks, v.nearest_k,
+			       v.nearest_trials, v.map_cost, v.map_steps);
 		else
 			printf("maps        %s: %d entry bins x %s, %.1f s of CPU to build "
 			       "(%lld single-gate steps)\n\n",
@@ -1069,7 +1218,7 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 		/* the maps' sampling error, or with --visits the walks' own */
 		printf("group protocol trials    TV  sampling (95%%) %5s   gates sim/chain  "
 		       "sim CPU s  predict CPU s   speedup  pays off after\n",
-		       a.visits ? "walks" : "map");
+		       walks ? "walks" : "map");
 		for (int i = 0; i < v.n; i++) {
 			const bsim_markov_check *k = &v.checks[i];
 			/* the fields (predictions) after which the maps cost less

@@ -148,6 +148,28 @@ check(strcmp(p.solve, 'nearest') && p.fields_built > 0 && want.fields_built == 0
       isequal([p.locations.p], [want.locations.p]), 'predict --visits: not the program''s');
 printf('predict --visits: end %.4f, the program''s\n', p.totals.xEnd);
 
+% ---- the default build: the walks' training fields, as the program's -------
+walks = fullfile(tmp, 'walks_mex');
+walks_program = fullfile(tmp, 'walks_program');
+b = beamsim_markov('build', experiment, 'out', walks, 'train', 60, 'threads', 2);
+[out, err, status] = program(exe, tmp, sprintf('markov build %s --train 60 --out %s', ...
+                                               experiment, walks_program));
+check(status == 0, 'beamsim markov build (the walks): exit %d: %s', status, err);
+check(strcmp(b.method, 'nearest') && b.visits > 0 && all(strncmp({b.maps.key}, 'visits_', 7)), ...
+      'build: method %s, %d visits', b.method, b.visits);
+[n1, t1] = map_files(walks);
+[n2, t2] = map_files(walks_program);
+check(isequal(n1, n2) && isequal(t1, t2), 'the training fields differ from the program''s: %s / %s', ...
+      strjoin(n1, ' '), strjoin(n2, ' '));
+p = beamsim_markov('predict', scene, 'map', walks, 'walks', 2000);
+[out, err, status] = program(exe, tmp, sprintf('markov predict %s --map %s --walks 2000 --json', ...
+                                               scene, walks_program));
+check(status == 0, 'beamsim markov predict --map (the walks): exit %d: %s', status, err);
+want = jsondecode(out);
+check(strcmp(p.solve, 'nearest') && p.fields_built == 0 && ...
+      isequal([p.locations.p], [want.locations.p]), 'predict over the build: not the program''s');
+printf('build (the walks) and predict --map: end %.4f, the program''s\n', p.totals.xEnd);
+
 % ---- refusals ---------------------------------------------------------------
 h1 = fullfile(source, 'configs', 'thesis', 'h1_symmetric.yaml');
 target = fullfile(tmp, 'refused');
@@ -166,6 +188,9 @@ bad = {{'build', experiment, 'out', target, 'bins', [2 0 1]}, '''bins'': expecte
        {'predict', scene, 'map', mine, 'trials', 3}, '''trials'': not an argument of ''predict''';
        {'predict', scene}, 'expected one of ''map'' (the map directory) and ''visits''';
        {'predict', scene, 'map', mine, 'k', 3}, '''k'': for ''visits'' only';
+       {'build', experiment, 'out', target, 'method', 'maps', 'k', 3}, 'k is for the nearest';
+       {'build', experiment, 'out', target, 'method', 'nearest', 'bins', [2 2 1]}, ...
+       'bins is for method maps';
        {'bild', scene}, '''bild'': expected ''build'', ''predict'' or ''validate'''};
 for k = 1:size(bad, 1)
   [id, msg] = raised(@beamsim_markov, bad{k, 1}{:});

@@ -1,7 +1,8 @@
-"""The nearest-neighbour walks from Python: markov_predict(visits=...) and
-markov_validate(visits=...) give the program's numbers (`beamsim markov
-predict --visits DIR --json`, `markov validate --visits DIR`) for the same
-visits, and refuse what the program refuses."""
+"""The nearest-neighbour walks from Python: markov_build's default (the
+walks' training fields), markov_predict(visits=... or map=...) and
+markov_validate(visits=...) give the program's files and numbers (`beamsim
+markov build`, `markov predict --visits DIR --json`, `markov validate
+--visits DIR`) for the same inputs, and refuse what the program refuses."""
 
 import json
 
@@ -47,7 +48,37 @@ def test_refused(tmp_path):
         beamsim.markov_predict(RING, map=tmp_path, k=3)
     with pytest.raises(ValueError, match="--k 65"):
         beamsim.markov_predict(RING, visits=tmp_path, k=65)
-    with pytest.raises(ValueError, match="tol, gates: for map only"):
+    with pytest.raises(ValueError, match="tol, gates: for maps only"):
         beamsim.markov_predict(RING, visits=tmp_path, tol=0.01)
-    with pytest.raises(ValueError, match="walks: for visits only"):
+    with pytest.raises(ValueError, match="markov.json: cannot read"):
         beamsim.markov_validate(RING_EXP, map=tmp_path, walks=10)
+
+
+def _files(d):
+    """A build's files but for the CPU times (.cost) and the manifest."""
+    return {f.name: f.read_bytes() for f in sorted(d.iterdir())
+            if f.suffix != ".cost" and f.name != "manifest.json"}
+
+
+def test_build_default_as_the_program(tmp_path):
+    b = beamsim.markov_build(RING_EXP, tmp_path / "a", train=60, threads=2)
+    cli("markov", "build", RING_EXP, "--train", 60, "--quiet", "--out", tmp_path / "b")
+    assert b["method"] == "nearest" and b["built"] == 2 and b["visits"] > 0
+    assert all(m["key"].startswith("visits_") for m in b["maps"])
+    assert _files(tmp_path / "a") == _files(tmp_path / "b")
+    d = beamsim.markov_predict(RING, map=tmp_path / "a", walks=2000, threads=2)
+    p = json.loads(cli("markov", "predict", RING, "--map", tmp_path / "b", "--walks", 2000,
+                       "--json").stdout)
+    assert d["solve"] == "nearest" and d["fields_built"] == 0
+    assert [x["p"] for x in d["locations"]] == [x["p"] for x in p["locations"]]
+    m = beamsim.markov_build(RING_EXP, tmp_path / "m", bins=(1, 1, 1), trials=2,
+                             start_trials=20, train=0)
+    assert m["method"] == "maps" and m["maps"][0]["key"].startswith("map_")
+    with pytest.raises(ValueError, match="walks: for the walks only"):
+        beamsim.markov_validate(RING_EXP, map=tmp_path / "m", walks=10)
+    with pytest.raises(ValueError, match="threads: for the walks only"):
+        beamsim.markov_predict(RING, map=tmp_path / "m", threads=2)
+    with pytest.raises(ValueError, match="bins is for method maps"):
+        beamsim.markov_build(RING_EXP, tmp_path / "c", method="nearest", bins=(2, 2, 2))
+    with pytest.raises(ValueError, match="k is for the nearest-neighbour walks"):
+        beamsim.markov_build(RING_EXP, tmp_path / "c", method="maps", k=3)

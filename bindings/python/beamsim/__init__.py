@@ -461,11 +461,20 @@ def _entries(entries):
 def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=None, seed=None,
                  threads=None, backend=None, backend_opt=None, set=None, grid=None,
                  progress=None, start_trials=None, after_start=None, train=None,
-                 crossings=None, per_crossing=None, after_trials=None):
-    """The single-gate maps the lattices of an experiment need, one per pair
-    of beam stiffnesses, built into the map directory out as `beamsim
-    markov build EXPERIMENT --out DIR` builds them (docs/markov.md): the
-    same maps, byte for byte, for the same arguments.
+                 crossings=None, per_crossing=None, after_trials=None, method=None, k=None):
+    """What the chain predicts the lattices of an experiment from, built into
+    the directory out as `beamsim markov build EXPERIMENT --out DIR` builds
+    it (docs/markov.md): the same files, byte for byte, for the same
+    arguments.
+
+    method: "nearest" (None, unless an argument only maps have is given):
+    the training fields of the nearest-neighbour walks, one per gate kind
+    of the lattices' physics (train trials each, None: 10,000; k: each
+    step drawn from the k nearest visits, None: 20), which markov_predict
+    and markov_validate with map=out walk over; "maps" (None with any of
+    trials, bins, vmax, entries, start_trials, after_start, crossings,
+    per_crossing, after_trials): the single-gate maps, one per pair of beam
+    stiffnesses, as below.
 
     out is a cache: maps already there with the same key are reused, the
     others built there. trials: single gates per entry bin (None: 50);
@@ -476,8 +485,8 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
     first two gates from those; False: entry bins from the start on;
     after_trials: the first start trials continued there (None: 8,000; the
     others take the continuations of those that entered the same gate), 0:
-    every start trial; train: trials of the training field, a 21 x 21 field of the lattice's
-    gate kinds at random whose gate entries the bins' states are drawn from
+    every start trial; train: trials of the maps' training field, a 21 x 21 field of the
+    lattice's gate kinds at random whose gate entries the bins' states are drawn from
     (None: 4,000; run only when a map is built), 0: states uniform in each
     bin; crossings: True (None, with a training field) counts each bin
     from the training field's own crossings of the map's gate kind entered
@@ -490,16 +499,21 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
     paths (a bin's states drawn from them), or "self", "self:N", "flow",
     "flow:N" as --entries; seed: of the states and schedules (None: 1);
     backend, backend_opt, set, grid, threads as in sweep. progress:
-    callable(done, total) over the single gates; Ctrl-C stops the build
-    (the maps finished are kept: the same call builds the rest).
+    callable(done, total) over the single gates (the walks': the training
+    trials); Ctrl-C stops the build (the maps or fields finished are kept:
+    the same call builds the rest).
 
-    Returns a dict: "maps" (one per group's map, in order: {"group", "k"
-    (left, right, N m/rad), "key" (its files' name, map_HASH), "how"
-    ("built" or "reused"), "pass"}), "built", "reused", "groups",
-    "cpu_seconds" (of the maps built now), "bins" (entry bins a map, the
-    start's included), "trials", "run", "out" and "scope" (where maps of
-    this method were measured to fall short on layouts they were not
-    built on; "" for the default method)."""
+    Returns a dict: "method" ("nearest" or "maps"), "maps" (one per group's
+    map, or the walks' training field, in order: {"group", "k" (left,
+    right, N m/rad), "key" (its files' name, map_HASH or visits_HASH),
+    "how" ("built" or "reused"), "pass"}), "built", "reused", "groups",
+    "cpu_seconds" (of those built now), "bins" (entry bins a map, the
+    start's included; 0 for the walks), "trials" (a bin's, or the walks'
+    training trials), "visits" (the walks' training fields' visits), "run",
+    "out" and "scope" (where maps of this method were measured to fall
+    short on layouts they were not built on; "" for the walks)."""
+    if method is not None and method not in ("nearest", "maps"):
+        raise ValueError(f"method {method!r}: expected 'nearest' or 'maps'")
     if vmax is not None and not (vmax > 0 and math.isfinite(vmax)):
         raise ValueError(f"--vmax {vmax}: expected a speed > 0 in m/s")
     if bins is not None:
@@ -524,30 +538,37 @@ def markov_build(experiment, out, trials=None, bins=None, vmax=None, entries=Non
                                  -1 if per_crossing is None
                                  else _count("per_crossing", per_crossing, 0, 1000000),
                                  -1 if after_trials is None
-                                 else _count("after_trials", after_trials, 0, 1000000))
+                                 else _count("after_trials", after_trials, 0, 1000000),
+                                 method, _count("k", k, 1, 64))
     info["out"] = out
     return info
 
 
 def _method(map, visits, k, train):
-    """The one of map and visits given; k and train with visits only."""
+    """The one of map and visits given, and whether the prediction walks
+    (visits, or a build of the walks in map); k and train with visits
+    only."""
     if (map is None) == (visits is None):
-        raise ValueError("expected one of map (the chain of a map directory) and visits "
-                         "(nearest-neighbour walks)")
-    if map is not None and (k is not None or train is not None):
-        raise ValueError(f"{'k' if k is not None else 'train'}: for visits only (the maps "
-                         "of map hold their own)")
+        raise ValueError("expected one of map (a directory of beamsim markov build) and "
+                         "visits (nearest-neighbour walks)")
     _no_nul("map", map)
     _no_nul("visits", visits)
-    return (os.fspath(map) if map is not None else None,
-            os.fspath(visits) if visits is not None else None)
+    if map is not None and (k is not None or train is not None):
+        raise ValueError(f"{'k' if k is not None else 'train'}: for visits only (the build "
+                         "in map holds its own)")
+    map = os.fspath(map) if map is not None else None
+    walks = visits is not None or _beamsim.markov_method(map) == "nearest"
+    return map, os.fspath(visits) if visits is not None else None, walks
 
 
 def markov_predict(scene, map=None, set=None, tol=None, gates=None, walks=None, out=None,
                    overwrite=False, visits=None, k=None, train=None, seed=None, threads=None):
-    """A gate lattice predicted from the maps in the map directory map, as
+    """A gate lattice predicted from the build in the directory map, as
     `beamsim markov predict SCENE --map DIR --json` predicts it: the same
-    numbers for the same maps. Or, with visits instead of map, by
+    numbers for the same build. A build of the walks (markov_build's
+    default) is walked over: walks (None: 200000), threads (None: all
+    cores; the same numbers on any); the build's k, training trials and
+    seed its own. A build of maps is solved as below. Or, with visits instead of map, by
     nearest-neighbour walks over the visits of training fields kept in the
     directory visits (those missing run there first), as `beamsim markov
     predict SCENE --visits DIR --json`: walks (None: 200000) of them, each
@@ -576,12 +597,14 @@ def markov_predict(scene, map=None, set=None, tol=None, gates=None, walks=None, 
                          "the solution stops, in (0, 1), e.g. 1e-12")
     _no_nul("scene", scene)
     _no_nul("out", out)
-    map, visits = _method(map, visits, k, train)
-    if visits is not None and (tol is not None or gates is not None):
-        raise ValueError("tol, gates: for map only")
-    if visits is None and (seed is not None or threads is not None):
-        raise ValueError("seed, threads: for visits only (the maps of map hold their own)")
-    if visits is not None:
+    map, visits, walking = _method(map, visits, k, train)
+    if walking and (tol is not None or gates is not None):
+        raise ValueError("tol, gates: for maps only")
+    if map is not None and seed is not None:
+        raise ValueError("seed: for visits only (map holds its own)")
+    if not walking and threads is not None:
+        raise ValueError("threads: for the walks only (the maps of map hold their own)")
+    if walking:
         walks = 200000 if walks is None else _count("walks", walks, 1, 100000000)
     else:
         walks = 100000 if walks is None else _count("walks", walks, 0, 100000000)
@@ -613,14 +636,16 @@ def markov_validate(experiment, map=None, out=None, trials=None, seed=None, thre
     with the maps' holding times, "time"; "map_cpu_seconds", "entry_bins",
     "trials_per_bin", "maps_scope", ...) with "files" (the directory's files as load
     reads them: "validate" (validate.csv), "gates", "time_validate", ...)
-    and "out". With visits instead of map: the prediction by
+    and "out". With map a build of the walks (markov_build's default), the
+    prediction by its nearest-neighbour walks (walks: None, 200000). With
+    visits instead of map: the prediction by
     nearest-neighbour walks, as markov_predict's (k, train, walks), as
     `beamsim markov validate EXPERIMENT --visits DIR` makes it."""
     _no_nul("experiment", experiment)
     _no_nul("out", out)
-    map, visits = _method(map, visits, k, train)
-    if visits is None and walks is not None:
-        raise ValueError("walks: for visits only")
+    map, visits, walking = _method(map, visits, k, train)
+    if not walking and walks is not None:
+        raise ValueError("walks: for the walks only (the maps of map hold their own)")
     with _Dir(out, "validate") as d:
         _beamsim.markov_validate(os.fspath(experiment), map, d,
                                  _count("trials", trials, 1), _seed(seed),
