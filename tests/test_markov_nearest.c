@@ -432,6 +432,16 @@ static void test_bad_inputs(void **state)
 /* The program: --visits predicts and validates, writing the usual files;
  * options that belong to the other method, or none of --map and
  * --visits, are refused with exit 2. */
+/* The program refuses argv: exit 2, and says says (a usage error: its
+ * line, then the pointer to --help). */
+static void refused(const char *const *argv, const char *says)
+{
+	char *err = NULL;
+	const int rc = bsim_test_cli(argv, NULL, &err);
+	bsim_test_check_input_error(rc, err, (const char *const[]){says, NULL}, 0);
+	free(err);
+}
+
 static void test_cli(void **state)
 {
 	(void)state;
@@ -479,13 +489,8 @@ static void test_cli(void **state)
 	        {{"markov", "validate", exp, "--out", val, NULL},
 	         "expected one of --map DIR and --visits DIR"},
 	};
-	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-		/* a usage error: its line, then the pointer to --help */
-		char *err = NULL;
-		const int rc = bsim_test_cli(bad[i].argv, NULL, &err);
-		bsim_test_check_input_error(rc, err, (const char *const[]){bad[i].says, NULL}, 0);
-		free(err);
-	}
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+		refused(bad[i].argv, bad[i].says);
 }
 
 /* markov build's default is the walks: its directory is a build (a
@@ -587,12 +592,8 @@ static void test_default_build(void **state)
 	        {{"markov", "validate", exp, "--map", maps, "--walks", "9", "--out", val, NULL},
 	         "--walks is for the walks"},
 	};
-	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-		char *err = NULL;
-		const int rc = bsim_test_cli(bad[i].argv, NULL, &err);
-		bsim_test_check_input_error(rc, err, (const char *const[]){bad[i].says, NULL}, 0);
-		free(err);
-	}
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+		refused(bad[i].argv, bad[i].says);
 }
 
 int main(int argc, char **argv)

@@ -287,14 +287,8 @@ static int build_nearest(const bsim_markov_build_def *def, bsim_markov_build_res
 			def->group_done(def->group_done_user, g, res->maps + first,
 			                res->n_maps - first);
 	}
-	uint64_t *keys = rc == BSIM_OK ? malloc((size_t)(res->n_maps + 1) * sizeof *keys) : NULL;
-	if (rc == BSIM_OK && !keys)
-		rc = bsim_error_set(err, BSIM_EFAIL, "out of memory");
-	for (int i = 0; keys && i < res->n_maps; i++)
-		keys[i] = res->maps[i].key;
-	if (keys)
-		bsim_markov_run_id(keys, res->n_maps, res->run);
-	free(keys);
+	if (rc == BSIM_OK) /* the fields' keys name the build, as the maps' do */
+		rc = build_name(def, res, err);
 	if (rc == BSIM_OK)
 		rc = bsim_markov_nearest_def_write(bsim_outdir_stage(nb.od), &nd, be, nd.opts, err);
 	if (rc == BSIM_OK)

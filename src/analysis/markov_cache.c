@@ -813,18 +813,28 @@ static void def_engine_write(FILE *f, const bsim_backend *be, const bsim_options
 	fputc(']', f);
 }
 
+/* stage/markov.json opened as o, its name in path (which o keeps: it must
+ * outlive o), its first fields written: the format and this beamsim's
+ * version, which every build's holds. */
+static int def_open_write(const char *stage, char path[BSIM_PATH_MAX], bsim_atomic_file *o,
+                          bsim_error *err)
+{
+	snprintf(path, BSIM_PATH_MAX, "%s/markov.json", stage);
+	if (bsim_atomic_file_open(o, path, err) != BSIM_OK)
+		return BSIM_EFAIL;
+	fprintf(o->f, "{\"format\": %d, \"beamsim_version\": \"%s\", ", MAP_FORMAT, BSIM_VERSION);
+	return BSIM_OK;
+}
+
 int bsim_markov_def_write(const char *stage, const bsim_markov_def *def, const bsim_backend *be,
                           const bsim_options *opts, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
-	snprintf(path, sizeof path, "%s/markov.json", stage);
 	bsim_atomic_file o;
-	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+	if (def_open_write(stage, path, &o, err) != BSIM_OK)
 		return BSIM_EFAIL;
-	fprintf(o.f,
-	        "{\"format\": %d, \"beamsim_version\": \"%s\", \"bins\": {\"position\": %d, "
-	        "\"speed\": %d, \"direction\": %d, \"v_max\": ",
-	        MAP_FORMAT, BSIM_VERSION, def->bins.n_pos, def->bins.n_speed, def->bins.n_dir);
+	fprintf(o.f, "\"bins\": {\"position\": %d, \"speed\": %d, \"direction\": %d, \"v_max\": ",
+	        def->bins.n_pos, def->bins.n_speed, def->bins.n_dir);
 	bsim_json_number(o.f, def->bins.v_max);
 	fprintf(o.f, "}, \"trials\": %d, \"start_trials\": %d, \"seed\": ", def->trials,
 	        bsim_markov_def_start_trials(def));
@@ -918,10 +928,11 @@ static int def_engine_read(const ydoc *d, uint64_t *seed, char *backend, size_t 
 /* dir/markov.json loaded into d, as its last build committed it, of
  * this beamsim and format; *is_nearest: 1 for a build of the walks'
  * ("method": "nearest"), 0 for maps (the method, or none: maps built
- * before there was another). */
-static int def_open(const char *dir, ydoc *d, int *is_nearest, bsim_error *err)
+ * before there was another). Its name in path, which d borrows: path
+ * must outlive d. */
+static int def_open(const char *dir, char path[BSIM_PATH_MAX], ydoc *d, int *is_nearest,
+                    bsim_error *err)
 {
-	char path[BSIM_PATH_MAX];
 	/* The directory as its last build committed it: with a manifest,
 	 * every map file has the size and CRC-32 listed there (a map's CSV
 	 * put in another's place is refused here). */
@@ -936,7 +947,7 @@ static int def_open(const char *dir, ydoc *d, int *is_nearest, bsim_error *err)
 		}
 		return BSIM_EINPUT;
 	}
-	snprintf(path, sizeof path, "%s/markov.json", dir);
+	snprintf(path, BSIM_PATH_MAX, "%s/markov.json", dir);
 	/* Without blocking: a FIFO there is refused by bsim_ydoc_load. */
 	int probe = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
 	if (probe < 0)
@@ -980,9 +991,10 @@ static int def_open(const char *dir, ydoc *d, int *is_nearest, bsim_error *err)
 int bsim_markov_def_read(const char *dir, bsim_markov_def *def, bsim_options *opts, bsim_error *err)
 {
 	memset(opts, 0, sizeof *opts);
+	char path[BSIM_PATH_MAX];
 	ydoc d;
 	int nearest = 0;
-	int rc = def_open(dir, &d, &nearest, err);
+	int rc = def_open(dir, path, &d, &nearest, err);
 	if (rc != BSIM_OK)
 		return rc;
 	uint64_t seed = 0;
@@ -1059,14 +1071,11 @@ int bsim_markov_nearest_def_write(const char *stage, const bsim_markov_nearest_d
                                   const bsim_backend *be, const bsim_options *opts, bsim_error *err)
 {
 	char path[BSIM_PATH_MAX];
-	snprintf(path, sizeof path, "%s/markov.json", stage);
 	bsim_atomic_file o;
-	if (bsim_atomic_file_open(&o, path, err) != BSIM_OK)
+	if (def_open_write(stage, path, &o, err) != BSIM_OK)
 		return BSIM_EFAIL;
-	fprintf(o.f,
-	        "{\"format\": %d, \"beamsim_version\": \"%s\", \"method\": \"nearest\", "
-	        "\"train\": %d, \"k\": %d, \"seed\": ",
-	        MAP_FORMAT, BSIM_VERSION, def->trials, def->k);
+	fprintf(o.f, "\"method\": \"nearest\", \"train\": %d, \"k\": %d, \"seed\": ", def->trials,
+	        def->k);
 	bsim_json_u64(o.f, def->seed);
 	def_engine_write(o.f, be, opts);
 	fputs("}\n", o.f);
@@ -1076,8 +1085,9 @@ int bsim_markov_nearest_def_write(const char *stage, const bsim_markov_nearest_d
 int bsim_markov_nearest_def_read(const char *dir, bsim_markov_nearest_def *def, bsim_options *opts,
                                  int *is_nearest, bsim_error *err)
 {
+	char path[BSIM_PATH_MAX];
 	ydoc d;
-	int rc = def_open(dir, &d, is_nearest, err);
+	int rc = def_open(dir, path, &d, is_nearest, err);
 	if (rc != BSIM_OK || !*is_nearest) {
 		if (rc == BSIM_OK)
 			bsim_ydoc_free(&d);
@@ -1101,9 +1111,10 @@ int bsim_markov_nearest_def_read(const char *dir, bsim_markov_nearest_def *def, 
 
 int bsim_markov_dir_method(const char *dir, bsim_markov_method *method, bsim_error *err)
 {
+	char path[BSIM_PATH_MAX];
 	ydoc d;
 	int is_nearest = 0;
-	const int rc = def_open(dir, &d, &is_nearest, err);
+	const int rc = def_open(dir, path, &d, &is_nearest, err);
 	if (rc != BSIM_OK)
 		return rc;
 	bsim_ydoc_free(&d);

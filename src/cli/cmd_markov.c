@@ -455,21 +455,20 @@ static const char *const predict_help[CLI_N_OPTS] = {
 static const cli_spec predict_spec = {
         .name = "markov predict",
         .usage = "LATTICE_SCENE (--map DIR | --visits DIR) [OPTIONS]",
-        .about = "Predicts the lattice of LATTICE_SCENE from the build in DIR: by\n"
-                 "nearest-neighbour walks over its training fields' visits (markov build's\n"
-                 "default), or, for maps, composes them into an absorbing\n"
-                 "Markov chain and prints the probabilities of ending through the end, out\n"
-                 "a side and stuck in a gate, and the mean number of gates visited. The\n"
+        .about = "Predicts the lattice of LATTICE_SCENE from the build in DIR and prints the\n"
+                 "probabilities of ending through the end, out a side and stuck in a gate,\n"
+                 "and the mean number of gates visited: by nearest-neighbour walks over its\n"
+                 "training fields' visits (markov build's default), or, of maps, by the\n"
+                 "absorbing Markov chain they compose over the lattice. The\n"
                  "distribution over every final location (the end through column ix, a side\n"
                  "at row iy, stuck in gate (ix, iy)) is --out DIR's prediction.csv, or\n"
                  "printed with --locations or --json. With the maps' holding times it\n"
                  "prints the expected time to the outcome (first-step analysis) and, by\n"
                  "walks of the semi-Markov chain, the outcome at the trial's duration and\n"
                  "the time of each kind (--out DIR's time.csv and time.png).\n"
-                 "With --visits DIR instead: the final locations by nearest-neighbour\n"
-                 "walks over the exact gate visits of a training field per gate kind\n"
-                 "(--train trials each, default 10000), kept in DIR for every layout of the\n"
-                 "same kinds and physics.\n",
+                 "With --visits DIR instead: the walks over a cache of training fields,\n"
+                 "those missing run there first (--train trials each, default 10000), kept\n"
+                 "for every layout of the same kinds and physics.\n",
         .positional = "LATTICE_SCENE",
         .common = CLI_USES(CLI_OPT_SET) | CLI_USES(CLI_OPT_OUT) | CLI_USES(CLI_OPT_OVERWRITE) |
                   CLI_USES(CLI_OPT_QUIET) | CLI_USES(CLI_OPT_SEED) | CLI_USES(CLI_OPT_THREADS) |
