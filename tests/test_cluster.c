@@ -1132,6 +1132,21 @@ static void test_mpi_markov_build(void **state)
 	assert_int_equal(rmdir(tmp), 0); /* nor any directory */
 	/* the ranks' parts, merged, are gone */
 	assert_false(bsim_test_exists(bsim_test_join(out, ".beamsim")));
+	/* the walks' training fields (markov build's default) run in one
+	 * process: under mpirun refused, naming the maps, nothing written */
+	char walks[1100];
+	snprintf(walks, sizeof walks, "%s/walks", dir);
+	const char *argv_walks[] = {
+	        BSIM_TEST_MPIEXEC, "--oversubscribe", "-np", "2",     BSIM_EXE, "markov", "build",
+	        markov_lattice(),  "--train",         "20",  "--out", walks,    NULL};
+	rc = wait_status(spawn_mpirun(argv_walks, err_path));
+	long n = 0;
+	char *said = file_bytes(err_path, &n);
+	assert_int_not_equal(rc, 0);
+	assert_non_null(said);
+	assert_non_null(strstr(said, "not under mpirun (2 ranks); --method maps spreads"));
+	free(said);
+	assert_false(bsim_test_exists(walks));
 }
 
 /* A wait for a file's text: the text at path once it holds needle. */
