@@ -63,7 +63,7 @@ typedef struct markov_args {
 	const char *passes;  /* build: --passes */
 	int n_entries;
 	const char *entries[MAX_ENTRIES];
-	int start_trials; /* build: --start-trials given */
+	int start_trials;      /* build: --start-trials given */
 	const char *method;    /* build: --method, NULL not given */
 	int train_given;       /* build: --train given (def.train_trials) */
 	const char *maps_only; /* build: the first option of the maps' only given */
@@ -434,6 +434,29 @@ static void nearest_apply(const markov_args *a, const cli_common *c, const bsim_
 		def->walks = a->walks;
 }
 
+/* Whether the prediction walks, into *walks: --visits, or --map a build
+ * of the walks (markov build's default; else of maps). rc as parsing left
+ * it, or the refusal of a --map that is no build. */
+static int map_walks(const markov_args *a, int rc, int *walks)
+{
+	bsim_markov_method method = BSIM_MARKOV_METHOD_NEAREST;
+	bsim_error err;
+	if (rc < 0 && a->map && bsim_markov_dir_method(a->map, &method, &err) != BSIM_OK)
+		rc = cli_report(err.code, &err);
+	*walks = a->visits || method == BSIM_MARKOV_METHOD_NEAREST;
+	return rc;
+}
+
+/* The walks over a build in --map: its own settings (read by the
+ * library), these walks and threads. */
+static void build_walks_apply(const markov_args *a, const cli_common *c,
+                              bsim_markov_nearest_def *def)
+{
+	def->threads = (int)c->threads;
+	if (a->walks > 0)
+		def->walks = a->walks;
+}
+
 /* predict's own options: --map, then --locations, --json and the others
  * (validate's: validate_option). */
 static int predict_option(void *args, int i, const char *value)
@@ -715,6 +738,20 @@ static void build_print(const bsim_markov_build_def *def, const bsim_markov_buil
 	cli_wrote(stdout, out);
 }
 
+/* A build's inputs from the command line, whatever its method: the
+ * experiment, the directory, --set, --grid and --seed. */
+static void build_inputs(bsim_markov_build_def *def, const cli_common *c, const char *path)
+{
+	def->experiment = path;
+	def->out = c->out;
+	def->sets = c->sets.ov;
+	def->n_sets = c->sets.n;
+	def->grid = c->sets.grid;
+	def->n_grid = c->sets.n_grid;
+	def->has_seed = c->has_seed;
+	def->seed = c->seed;
+}
+
 /* markov build's default: the walks' training fields, their progress and
  * lines. */
 static int markov_build_nearest(cli_common *c, const markov_args *a, const char *path)
@@ -729,14 +766,7 @@ static int markov_build_nearest(cli_common *c, const markov_args *a, const char 
 	if (a->train_given)
 		given.train = a->def.train_trials;
 	nearest_apply(&given, c, be, &opts, &def.nearest);
-	def.experiment = path;
-	def.out = c->out;
-	def.sets = c->sets.ov;
-	def.n_sets = c->sets.n;
-	def.grid = c->sets.grid;
-	def.n_grid = c->sets.n_grid;
-	def.has_seed = c->has_seed;
-	def.seed = c->seed;
+	build_inputs(&def, c, path);
 	cli_progress training;
 	cli_progress_init(&training, !c->quiet, "training trials");
 	def.nearest.progress = train_progress_update;
@@ -855,14 +885,7 @@ static int markov_build_main(int argc, char **argv, const cli_merge *m, const ma
 	def.map.threads = (int)c.threads;
 	if (c.trials > 0)
 		def.map.trials = (int)c.trials;
-	def.experiment = path;
-	def.out = c.out;
-	def.sets = c.sets.ov;
-	def.n_sets = c.sets.n;
-	def.grid = c.sets.grid;
-	def.n_grid = c.sets.n_grid;
-	def.has_seed = c.has_seed;
-	def.seed = c.seed;
+	build_inputs(&def, &c, path);
 	def.entries = a.entries;
 	def.n_entries = a.n_entries;
 	def.part = a.shard;
@@ -1013,12 +1036,8 @@ static int markov_predict(int argc, char **argv)
 			               "%s is for --visits (the build in --map holds its own)",
 			               alone);
 	}
-	/* --map's build: walks (markov build's default) or maps */
-	bsim_error err;
-	bsim_markov_method method = BSIM_MARKOV_METHOD_NEAREST;
-	if (rc < 0 && a.map && bsim_markov_dir_method(a.map, &method, &err) != BSIM_OK)
-		rc = cli_report(err.code, &err);
-	const int walks = a.visits || method == BSIM_MARKOV_METHOD_NEAREST;
+	int walks = 0;
+	rc = map_walks(&a, rc, &walks);
 	if (rc < 0 && !walks && c.threads)
 		rc = cli_usage("markov predict",
 		               "--threads is for the walks (the maps' solve is one "
@@ -1051,11 +1070,8 @@ static int markov_predict(int argc, char **argv)
 		def.nearest.progress = train_progress_update;
 		def.nearest.progress_user = &training;
 		def.nearest.stop = &cli_stop;
-	} else if (walks) { /* a walks' build: its settings, these walks */
-		def.nearest.threads = (int)c.threads;
-		if (a.walks > 0)
-			def.nearest.walks = a.walks;
-	}
+	} else if (walks)
+		build_walks_apply(&a, &c, &def.nearest);
 	if (a.walks < 0)
 		a.walks = BSIM_MARKOV_WALKS;
 	def.scene = path;
@@ -1068,6 +1084,7 @@ static int markov_predict(int argc, char **argv)
 	def.gates = a.no_gates ? 0 : a.gates ? 1 : -1;
 	def.walks = a.walks;
 	bsim_markov_predict_result r;
+	bsim_error err;
 	cli_signals_install();
 	rc = bsim_markov_predict_run(&def, &r, &err);
 	cli_signals_restore();
@@ -1103,12 +1120,8 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 		               a.k       ? "k"
 		               : a.train ? "train"
 		                         : "backend");
-	/* --map's build: walks (markov build's default) or maps */
-	bsim_error err;
-	bsim_markov_method method = BSIM_MARKOV_METHOD_NEAREST;
-	if (rc < 0 && a.map && bsim_markov_dir_method(a.map, &method, &err) != BSIM_OK)
-		rc = cli_report(err.code, &err);
-	const int walks = a.visits || method == BSIM_MARKOV_METHOD_NEAREST;
+	int walks = 0;
+	rc = map_walks(&a, rc, &walks);
 	if (rc < 0 && a.walks && !walks)
 		rc = cli_usage("markov validate",
 		               "--walks is for the walks (the maps in --map hold their own)");
@@ -1158,11 +1171,8 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 		def.visits_dir = a.visits;
 		nearest_apply(&a, &c, be, &nearest_opts, &def.nearest);
 		def.nearest.stop = &cli_stop;
-	} else if (walks) { /* a walks' build: its settings, these walks */
-		def.nearest.threads = (int)c.threads;
-		if (a.walks > 0)
-			def.nearest.walks = a.walks;
-	}
+	} else if (walks)
+		build_walks_apply(&a, &c, &def.nearest);
 	def.out = c.out;
 	def.sets = c.sets.ov;
 	def.n_sets = c.sets.n;
@@ -1183,6 +1193,7 @@ static int markov_validate_main(int argc, char **argv, const cli_merge *m)
 	def.nearest.progress = rank == 0 ? train_progress_update : NULL;
 	def.nearest.progress_user = &training;
 	bsim_markov_validation v;
+	bsim_error err;
 	cli_signals_install();
 	rc = bsim_markov_validate(&def, &v, &err);
 	cli_signals_restore();
